@@ -1,0 +1,54 @@
+"""Command-line interface ``pidcore``: a thin layer over the library.
+
+Each sub-command lives in its own module with ``register(subparsers)``; all logic is in the
+library. Errors derived from :class:`pidcore.errors.PidcoreError` become one line on stderr and
+exit code 2; Ctrl-C exits 130 after finished work has been saved.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+from .. import __version__
+from ..errors import PidcoreError
+
+#: Sub-command modules, each exposing ``register(subparsers) -> None``.
+_COMMAND_MODULES = ("analyze", "dem", "bench", "report", "model", "app", "samples")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="pidcore",
+        description="Particle impact damping: measure, predict (DEM) and compare SDC.",
+    )
+    parser.add_argument("--version", action="version", version=f"pidcore {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+    for name in _COMMAND_MODULES:
+        try:
+            module = importlib.import_module(f"{__name__}.{name}")
+        except ModuleNotFoundError as exc:
+            if exc.name == f"{__name__}.{name}":
+                continue  # command not built yet
+            raise
+        module.register(sub)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return int(args.func(args) or 0)
+    except PidcoreError as exc:
+        print(f"pidcore {args.command}: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print(f"pidcore {args.command}: interrupted; finished results are saved",
+              file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,51 @@
+"""Closed vocabularies and physical constants shared by all subpackages.
+
+Closed vocabularies are ``Literal`` aliases so that type checkers and ``get_args`` can validate
+user input in one place.
+"""
+
+from typing import Literal, get_args
+
+#: Physical quantity a channel carries (after unit normalisation).
+Quantity = Literal["force", "velocity", "acceleration", "displacement", "pressure", "voltage",
+                   "time", "unknown"]
+#: Role a channel plays in a power analysis.
+ChannelRole = Literal["force", "velocity", "acceleration"]
+#: File formats the readers understand.
+FileFormat = Literal["uff", "csv", "mat", "hdf5"]
+#: Drive direction of the coupon in the cell frame (z normal to the face sheets).
+DriveDirection = Literal["z", "x", "y"]
+#: Particle materials in the materials table.
+ParticleMaterial = Literal["acrylic", "aluminium"]
+#: Normal damping behaviour at the end of a contact (Eq. 2 taken literally or cut at zero).
+NormalDampingMode = Literal["literal", "no_attraction"]
+#: Which mass enters E = m_c a^2 / (2 w^2) (Eq. 10).
+VibratedMassConvention = Literal["coupon_plus_particles", "coupon", "particles"]
+#: How particles move when the drive starts.
+StartProtocol = Literal["rest", "with_cell"]
+#: Report output formats.
+ReportFormat = Literal["csv", "md", "html", "tex", "pdf"]
+
+QUANTITIES: tuple[str, ...] = get_args(Quantity)
+CHANNEL_ROLES: tuple[str, ...] = get_args(ChannelRole)
+DRIVE_DIRECTIONS: tuple[str, ...] = get_args(DriveDirection)
+PARTICLE_MATERIALS: tuple[str, ...] = get_args(ParticleMaterial)
+NORMAL_DAMPING_MODES: tuple[str, ...] = get_args(NormalDampingMode)
+VIBRATED_MASS_CONVENTIONS: tuple[str, ...] = get_args(VibratedMassConvention)
+START_PROTOCOLS: tuple[str, ...] = get_args(StartProtocol)
+REPORT_FORMATS: tuple[str, ...] = get_args(ReportFormat)
+
+#: Standard gravity, m/s^2 (ISO 80000-3); used for g <-> m/s^2 and for gravity on particles.
+STANDARD_GRAVITY = 9.80665
+
+#: SI unit of each quantity, as written in every output.
+SI_UNITS: dict[str, str] = {
+    "force": "N",
+    "velocity": "m/s",
+    "acceleration": "m/s^2",
+    "displacement": "m",
+    "pressure": "Pa",
+    "voltage": "V",
+    "time": "s",
+    "unknown": "1",
+}

@@ -1,0 +1,33 @@
+"""Exception hierarchy.
+
+Every error a user can cause derives from :class:`PidcoreError`; the CLI prints its message as
+one line and exits non-zero. Messages name the file, channel or parameter and what was expected.
+"""
+
+
+class PidcoreError(Exception):
+    """Base class of all errors caused by user input or user data."""
+
+
+class InputFileError(PidcoreError):
+    """A file cannot be read, or holds nothing usable (wrong dataset type, corrupt bytes)."""
+
+
+class ChannelError(PidcoreError):
+    """A channel is missing, ambiguous, non-finite, clipped or inconsistent with the others."""
+
+
+class SignalError(PidcoreError):
+    """A record cannot be analysed: too few periods, no dominant drive frequency, ..."""
+
+
+class ParameterError(PidcoreError, ValueError):
+    """A parameter is out of range or of the wrong kind."""
+
+
+class StoreError(PidcoreError):
+    """The HDF5 store is missing, corrupt, locked or lacks the requested entry."""
+
+
+class SimulationError(PidcoreError):
+    """A DEM run became unphysical (excess overlap, particle escaped) or was refused."""

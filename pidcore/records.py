@@ -1,0 +1,92 @@
+"""Domain records that flow from the readers to analysis, store and reports.
+
+Readers produce :class:`Measurement` objects whose channels are already in SI units. Nothing
+downstream of a reader knows about file formats.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .constants import SI_UNITS
+from .errors import ChannelError
+
+
+@dataclass(frozen=True)
+class Channel:
+    """One evenly sampled time record in SI units.
+
+    Attributes
+    ----------
+    name : str
+        Channel name from the file (id line, column header, variable name).
+    quantity : str
+        Physical quantity (see :data:`pidcore.constants.Quantity`).
+    data : numpy.ndarray
+        Samples in SI units (float64, 1-D).
+    sample_rate_hz : float
+        Samples per second, Hz.
+    source_unit : str
+        Unit as written in the file, before conversion.
+    start_time_s : float
+        Time of the first sample, s.
+    """
+
+    name: str
+    quantity: str
+    data: np.ndarray
+    sample_rate_hz: float
+    source_unit: str = ""
+    start_time_s: float = 0.0
+
+    @property
+    def unit(self) -> str:
+        """SI unit of :attr:`data`."""
+        return SI_UNITS.get(self.quantity, "1")
+
+    @property
+    def n_samples(self) -> int:
+        return int(self.data.shape[0])
+
+    @property
+    def duration_s(self) -> float:
+        return self.n_samples / self.sample_rate_hz
+
+
+@dataclass(frozen=True)
+class Measurement:
+    """All channels read from one source file.
+
+    Attributes
+    ----------
+    source : str
+        File name (or path) the channels came from.
+    channels : tuple of Channel
+    sha256 : str
+        SHA-256 of the file's bytes; identifies the file in the store.
+    file_format : str
+        One of :data:`pidcore.constants.FileFormat`.
+    metadata : mapping
+        Free-form scalar metadata (dates, ids, nominal frequency hints, load-case labels).
+    """
+
+    source: str
+    channels: tuple[Channel, ...]
+    sha256: str = ""
+    file_format: str = ""
+    metadata: Mapping[str, str | float | int] = field(default_factory=dict)
+
+    def channel(self, name: str) -> Channel:
+        """The channel called ``name``; :class:`ChannelError` lists the names there are."""
+        for ch in self.channels:
+            if ch.name == name:
+                return ch
+        names = ", ".join(repr(c.name) for c in self.channels) or "none"
+        raise ChannelError(f"{self.source}: no channel named {name!r}; channels are {names}")
+
+    @property
+    def channel_names(self) -> list[str]:
+        return [c.name for c in self.channels]

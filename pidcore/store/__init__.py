@@ -1,0 +1,1 @@
+"""pidcore.store"""

@@ -1,0 +1,127 @@
+"""Unit normalisation to SI at the edges.
+
+A small table instead of a units library (pint): exporters write a handful of spellings
+("m/s2", "m/s²", "mm/s", "g", "kN", "lbf", ...) and the table makes the accepted set explicit,
+testable and free of a heavy dependency. Every conversion is a pure scale factor.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+from .constants import SI_UNITS, STANDARD_GRAVITY
+from .errors import ParameterError
+
+
+@dataclass(frozen=True)
+class UnitInfo:
+    """What a unit string means: its quantity and the factor that takes it to SI."""
+
+    quantity: str
+    factor: float  # value_SI = factor * value_in_unit
+
+    @property
+    def si_unit(self) -> str:
+        return SI_UNITS[self.quantity]
+
+
+_LBF = 4.4482216152605
+_INCH = 0.0254
+
+_TABLE: dict[str, UnitInfo] = {
+    # force
+    "n": UnitInfo("force", 1.0),
+    "newton": UnitInfo("force", 1.0),
+    "kn": UnitInfo("force", 1e3),
+    "mn": UnitInfo("force", 1e-3),
+    "lbf": UnitInfo("force", _LBF),
+    # velocity
+    "m/s": UnitInfo("velocity", 1.0),
+    "mm/s": UnitInfo("velocity", 1e-3),
+    "cm/s": UnitInfo("velocity", 1e-2),
+    "um/s": UnitInfo("velocity", 1e-6),
+    "in/s": UnitInfo("velocity", _INCH),
+    "ips": UnitInfo("velocity", _INCH),
+    # acceleration
+    "m/s^2": UnitInfo("acceleration", 1.0),
+    "mm/s^2": UnitInfo("acceleration", 1e-3),
+    "g": UnitInfo("acceleration", STANDARD_GRAVITY),
+    "g0": UnitInfo("acceleration", STANDARD_GRAVITY),
+    "gn": UnitInfo("acceleration", STANDARD_GRAVITY),
+    "in/s^2": UnitInfo("acceleration", _INCH),
+    # displacement
+    "m": UnitInfo("displacement", 1.0),
+    "mm": UnitInfo("displacement", 1e-3),
+    "um": UnitInfo("displacement", 1e-6),
+    "in": UnitInfo("displacement", _INCH),
+    # others seen in exports
+    "pa": UnitInfo("pressure", 1.0),
+    "kpa": UnitInfo("pressure", 1e3),
+    "v": UnitInfo("voltage", 1.0),
+    "mv": UnitInfo("voltage", 1e-3),
+    "s": UnitInfo("time", 1.0),
+    "sec": UnitInfo("time", 1.0),
+    "ms": UnitInfo("time", 1e-3),
+}
+
+
+def canonical_unit_text(text: str) -> str:
+    """Normalise the spelling of a unit: case, blanks, brackets, superscripts, ``**``.
+
+    >>> canonical_unit_text(" (m/s²) ")
+    'm/s^2'
+    """
+    t = text.strip().strip("()[]{} ").lower()
+    t = t.replace("µ", "u").replace("μ", "u")  # micro sign and Greek mu
+    t = t.replace("²", "^2").replace("\ufffd", "^2")  # Latin-1 0xB2 decoded with errors='replace'
+    t = t.replace("**", "^").replace(" ", "")
+    t = re.sub(r"/s2$", "/s^2", t)
+    t = t.replace("sec^2", "s^2")
+    if t in {"g's", "gs"}:
+        t = "g"
+    return t
+
+
+def lookup_unit(text: str) -> UnitInfo | None:
+    """Return the :class:`UnitInfo` of a unit string, or ``None`` if it is not known."""
+    return _TABLE.get(canonical_unit_text(text))
+
+
+def to_si_factor(unit: str, quantity: str | None = None, *, what: str = "unit") -> float:
+    """Factor that converts values in ``unit`` to SI.
+
+    Parameters
+    ----------
+    unit : str
+        Unit as written in a file or on the command line (``"mm/s"``, ``"g"``, ``"kN"``).
+    quantity : str, optional
+        Expected quantity; a unit of another quantity raises :class:`ParameterError`.
+    what : str
+        Name used in the error message (file and channel).
+
+    Examples
+    --------
+    >>> to_si_factor("mm/s")
+    0.001
+    >>> round(to_si_factor("g", "acceleration"), 5)
+    9.80665
+    """
+    info = lookup_unit(unit)
+    if info is None:
+        raise ParameterError(f"{what}: unknown unit {unit!r}; expected one of "
+                             f"{', '.join(sorted(_TABLE))}")
+    if quantity is not None and info.quantity != quantity:
+        raise ParameterError(f"{what}: unit {unit!r} is a {info.quantity} unit, "
+                             f"expected a {quantity} unit ({SI_UNITS[quantity]})")
+    return info.factor
+
+
+def g_to_si(value_g: float) -> float:
+    """Acceleration in g to m/s^2 (standard gravity)."""
+    return value_g * STANDARD_GRAVITY
+
+
+def si_to_g(value_m_s2: float) -> float:
+    """Acceleration in m/s^2 to g (standard gravity)."""
+    return value_m_s2 / STANDARD_GRAVITY
