@@ -7,6 +7,8 @@ from pathlib import Path
 
 #: Store file used when none is given.
 STORE_PATH = Path("pid_store.h5")
+#: Seconds a writer waits for the store's write lock before giving up with a StoreError.
+STORE_LOCK_TIMEOUT_S = 60.0
 
 # --- Measurement (Eq. 11) -------------------------------------------------------------------
 #: Number of drive harmonics fitted (1 = fundamental only). Harmonics above Nyquist are dropped.
@@ -19,6 +21,15 @@ N_UNCERTAINTY_BLOCKS = 8
 CLIPPING_RELATIVE_TOLERANCE = 1e-9
 #: Run of identical extreme samples that flags a channel as clipped.
 CLIPPING_MIN_RUN = 4
+#: A frequency hint is searched within +- this fraction of itself (and at least +- 3 FFT bins).
+FREQUENCY_SEARCH_RELATIVE_WIDTH = 0.05
+#: The drive peak's power must exceed the median spectral power by this factor (20 dB); the
+#: largest of ~1e6 white-noise bins exceeds the median by ~20 (13 dB), a drive tone by >> 1e3.
+DOMINANT_PEAK_MIN_POWER_RATIO = 100.0
+#: Harmonics above this fraction of the Nyquist frequency are dropped from the fit.
+HARMONIC_MAX_FRACTION_OF_NYQUIST = 0.9
+#: Longest FFT used for the coarse drive-frequency estimate (memory bound on long records).
+FREQUENCY_FFT_MAX_SAMPLES = 2**20
 
 # --- DEM ------------------------------------------------------------------------------------
 DEM_TIME_STEP_S = 2e-6
@@ -27,6 +38,33 @@ DEM_CELLS = 8
 DEM_MIN_STEADY_CYCLES = 80
 DEM_MAX_OVERLAP_FRACTION = 0.05
 DEM_SEED = 12345
+#: Time step used when ``time_step="auto"``: min(DEM_TIME_STEP_S, t_contact / steps per contact).
+DEM_TIME_STEP_MODE = "auto"
+#: Normal damping at the end of a contact: "no_attraction" (no adhesion: a wall or a dry grain
+#: cannot pull) or "literal" (Eq. 2 as written, slightly attractive at the end of a contact).
+DEM_NORMAL_DAMPING_MODE = "no_attraction"
+#: Mass in E = m_c a^2 / (2 w^2) (Eq. 10): coupon (face sheets + core) plus all particles.
+DEM_VIBRATED_MASS_CONVENTION = "coupon_plus_particles"
+#: Particles move with the cell when the drive starts (no start jolt, as on a real shaker).
+DEM_START_PROTOCOL = "with_cell"
+#: 100 % fill is the cell's capacity (dense drop packing), or "paper" (36 particles).
+DEM_FILL_REFERENCE = "capacity"
+#: Tangential speed below which Coulomb friction is scaled down linearly (no chatter at v_t->0).
+DEM_FRICTION_REGULARISATION_SPEED_M_S = 1e-6
+#: At low frequency a steady window of this duration suffices instead of DEM_MIN_STEADY_CYCLES.
+DEM_MIN_STEADY_TIME_S = 1.0
+#: Cycles per block for steady-state detection (block means compared).
+DEM_STEADY_BLOCK_CYCLES = 10
+#: Successive block means within this relative difference (plus 2 standard errors) = steady.
+DEM_STEADY_RELATIVE_TOLERANCE = 0.1
+#: Longest transient skipped before measuring regardless (then flagged not converged).
+DEM_MAX_TRANSIENT_CYCLES = 100
+#: Force samples per drive cycle kept for the virtual shaker test (interval means).
+DEM_SAMPLES_PER_CYCLE = 64
+#: Settling ends when every cell's kinetic energy is below this fraction of N m g r.
+DEM_SETTLE_KINETIC_FRACTION = 1e-6
+#: Longest settling time before the run is refused, s.
+DEM_MAX_SETTLE_TIME_S = 0.5
 
 # --- Coupon (paper Sect. 2, Table 2) ---------------------------------------------------------
 COUPON_SIDE_M = 0.100
@@ -42,3 +80,34 @@ PAPER_PARTICLES_PER_FULL_CELL = 36
 # --- Reports / app --------------------------------------------------------------------------
 APP_PORT = 8501
 APP_MAX_UPLOAD_MB = 200
+
+# --- Compare (measured vs DEM vs paper) -----------------------------------------------------
+#: A measured case sits on a DEM grid point when its frequency is within this relative
+#: tolerance: the shaker controller sets the drive frequency exactly and the analysis estimates
+#: it to far better than 0.1 %, so 1 % only absorbs rounding of the nominal grid values.
+COMPARE_FREQUENCY_RTOL = 0.01
+#: ... and its acceleration amplitude within this relative tolerance: sine control holds the
+#: amplitude to a few percent of the set level (control tolerance, sensor calibration), so 5 %.
+COMPARE_ACCELERATION_RTOL = 0.05
+#: ... and its fill within this many percentage points (one particle of 36 is 2.8 points, so
+#: 0.5 points only absorbs rounding of a stated fill such as 33.3 vs 33.33).
+COMPARE_FILL_ATOL_PERCENT = 0.5
+#: Particle material and drive direction assumed when a measurement states none (the paper's).
+COMPARE_DEFAULT_MATERIAL = "acrylic"
+COMPARE_DEFAULT_DIRECTION = "z"
+#: Report formats written by ``pidcore report`` unless --format says otherwise.
+REPORT_FORMATS = ("csv", "md", "html", "tex", "pdf")
+#: Resolution of the PNG figures of a report, dots per inch.
+REPORT_FIGURE_DPI = 150
+
+# --- SDC model, equivalent damper, model figures (pidcore.model, pidcore model) ---------------
+#: Interpolate SDC in log10(frequency) instead of frequency.
+MODEL_LOG_FREQUENCY = False
+#: Which mass enters E = m_c a^2 / (2 w^2) in ``pidcore model damper`` (VibratedMassConvention).
+MODEL_VIBRATED_MASS_CONVENTION = "coupon_plus_particles"
+#: Particle material assumed for the particle mass of the paper's table.
+MODEL_PARTICLE_MATERIAL = "acrylic"
+#: Curves of the SDC-vs-acceleration figures (DEM and interpolated frequencies), Hz.
+MODEL_FIGURE_FREQUENCIES_HZ = (50.0, 100.0, 250.0, 500.0, 750.0, 1000.0)
+#: Curves of the SDC-vs-frequency figures (DEM and interpolated fills), %.
+MODEL_FIGURE_FILLS_PERCENT = (25.0, 40.0, 50.0, 60.0, 75.0, 90.0)

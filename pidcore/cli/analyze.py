@@ -1,0 +1,84 @@
+"""``pidcore analyze``: complex power, loss factor and SDC of shaker-test exports."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+from .. import defaults
+from ..measure import AnalysisOptions, analyze_file
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    p = subparsers.add_parser(
+        "analyze",
+        help="loss factor and SDC from force/velocity exports (Eq. 11)",
+        description="Analyse shaker-test exports (UFF58/58b, CSV/TXT, MAT, HDF5): complex power "
+                    "(Eq. 11), loss factor, specific damping capacity, one record per load case. "
+                    "Results are saved to the store unless --no-store.",
+    )
+    p.add_argument("paths", nargs="+", metavar="PATH", type=Path, help="export files")
+    p.add_argument("--force", metavar="NAME", help="force channel name (default: detected)")
+    p.add_argument("--velocity", metavar="NAME", help="velocity channel name")
+    p.add_argument("--acceleration", metavar="NAME", help="acceleration channel name")
+    p.add_argument("--velocity-delay", metavar="SECONDS", type=float, default=0.0,
+                   help="vibrometer output delay to remove, s (default 0)")
+    p.add_argument("--mass-below-gauge", metavar="KG", type=float, default=0.0,
+                   help="mass between force gauge and structure to cancel, kg (default 0)")
+    p.add_argument("--baseline-loss-factor", metavar="ETA", type=float, default=0.0,
+                   help="loss factor of the empty coupon to subtract (default 0)")
+    p.add_argument("--frequency", metavar="HZ", type=float, default=None,
+                   help="drive frequency hint, Hz (estimated from the data anyway)")
+    p.add_argument("--harmonics", metavar="N", type=int, default=defaults.N_HARMONICS,
+                   help=f"drive harmonics fitted (default {defaults.N_HARMONICS})")
+    p.add_argument("--sample-rate", metavar="HZ", type=float, default=None,
+                   help="sample rate for CSV/TXT files without a time column, Hz")
+    p.add_argument("--allow-clipped", action="store_true",
+                   help="analyse clipped channels anyway (reported in the output)")
+    p.add_argument("--store", metavar="FILE", type=Path, default=defaults.STORE_PATH,
+                   help=f"HDF5 store (default ./{defaults.STORE_PATH})")
+    p.add_argument("--no-store", action="store_true", help="do not save to the store")
+    p.add_argument("--json", action="store_true", help="one JSON document on stdout")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    options = AnalysisOptions(
+        force=args.force, velocity=args.velocity, acceleration=args.acceleration,
+        velocity_delay_s=args.velocity_delay, mass_below_gauge_kg=args.mass_below_gauge,
+        baseline_loss_factor=args.baseline_loss_factor, frequency_hz=args.frequency,
+        n_harmonics=args.harmonics, sample_rate_hz=args.sample_rate,
+        allow_clipped=args.allow_clipped,
+    )
+    # Analyse everything before writing anything: one bad file leaves the store untouched.
+    results = [analyze_file(path, options) for path in args.paths]
+    if not args.no_store:
+        from ..measure import save_analyses
+
+        save_analyses(args.store, results, options)
+    if args.json:
+        json.dump({"records": [r.analysis.to_dict() for r in results]}, sys.stdout)
+        sys.stdout.write("\n")
+    else:
+        print(format_table(results))
+        if not args.no_store:
+            print(f"saved {len(results)} record(s) to {args.store}")
+    return 0
+
+
+def format_table(results: list) -> str:
+    header = (f"{'source':<40} {'frequency [Hz]':>14} {'accel. [g]':>10} {'loss factor [-]':>15} "
+              f"{'SDC [-]':>9} {'± SE [-]':>9} {'zeta [-]':>9} {'dE/cycle [J]':>12}")
+    lines = [header, "-" * len(header)]
+    for r in results:
+        a = r.analysis
+        zeta = "n/a" if a.damping_ratio is None else f"{a.damping_ratio:9.5f}"
+        name = Path(a.source).name
+        lines.append(f"{name[-40:]:<40} {a.frequency_hz:14.4f} {a.acceleration_g:10.4f} "
+                     f"{a.loss_factor:15.6f} {a.sdc:9.5f} {a.sdc_stderr:9.5f} {zeta:>9} "
+                     f"{a.energy_per_cycle_j:12.4e}")
+        for note in r.notes:
+            lines.append(f"    note: {note}")
+    return "\n".join(lines)

@@ -1,0 +1,787 @@
+"""The HDF5 store: measurements, analyses and DEM runs with units and provenance.
+
+Layout (every group explains itself through its attributes)::
+
+    /                          attrs: pidcore_store_version (1), created_utc, pidcore_version
+    /measurements/<key>        pidcore.io.hdf5_layout measurement group
+                               + attrs imported_utc, pidcore_version, key_basis
+    /analyses/<key>            attrs: pidcore_layout="analysis", measurement_key, created_utc,
+                                      pidcore_version, parameters_json, null_fields_json
+    /analyses/<key>/record     one attribute per scalar field
+    /analyses/<key>/units      one attribute per field or array: its unit
+    /analyses/<key>/arrays/<name>   dataset (complex allowed), attr unit
+    /dem_runs/<case_key>       as an analysis, with case_key instead of measurement_key
+
+Writes are transactions: under an exclusive lock on ``<store>.lock`` the store is copied to a
+temporary file beside it, changed there, flushed, fsync'ed and moved over the original with
+:func:`os.replace`; any exception (KeyboardInterrupt included) discards the copy. The file at
+the store's path therefore only ever holds a complete, committed state.
+
+Readers take no lock. Because the path is only ever swapped atomically and an open HDF5 handle
+keeps reading the file it opened, a reader sees the last committed state even while a writer
+works, instead of waiting for it.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import secrets
+import shutil
+import threading
+from collections.abc import Iterable, Iterator, Mapping
+from contextlib import contextmanager, suppress
+from dataclasses import dataclass, field
+from datetime import UTC, datetime
+from pathlib import Path
+from typing import Any
+
+import h5py
+import numpy as np
+import pandas as pd
+
+from .. import __version__, defaults
+from ..errors import InputFileError, ParameterError, StoreError
+from ..io.hdf5_layout import read_measurement_group, write_measurement_group
+from ..records import Measurement
+from .lock import exclusive_lock, lock_path_for
+from .values import (
+    RESERVED_FIELDS,
+    Scalar,
+    analysis_key,
+    check_name,
+    from_attribute,
+    parameters_to_json,
+    to_array,
+    to_attribute,
+)
+
+#: Layout version written to the root attribute ``pidcore_store_version``.
+STORE_VERSION = 1
+
+_MEASUREMENTS, _ANALYSES, _DEM_RUNS = "measurements", "analyses", "dem_runs"
+_LAYOUT_ANALYSIS, _LAYOUT_DEM_RUN = "analysis", "dem_run"
+_ROOT_ATTRS = ("pidcore_store_version", "created_utc", "pidcore_version")
+_MEASUREMENT_ATTRS = ("pidcore_layout", "source", "sha256", "file_format", "metadata_json",
+                      "imported_utc", "pidcore_version")
+_ENTRY_ATTRS = ("pidcore_layout", "created_utc", "pidcore_version", "parameters_json",
+                "null_fields_json")
+_DEM_ITEM_FIELDS = frozenset({"case_key", "record", "arrays", "parameters", "units"})
+
+
+@dataclass(frozen=True)
+class StoredEntry:
+    """One analysis or DEM run read back from the store.
+
+    Attributes
+    ----------
+    key : str
+        Analysis key or DEM case key.
+    record : dict
+        Scalar fields as stored (``None`` where ``None`` was given).
+    arrays : dict of numpy.ndarray
+        Array fields (complex arrays stay complex).
+    parameters : dict
+        Parameters the result was computed with (decoded ``parameters_json``).
+    attrs : dict
+        Provenance attributes of the entry group (pidcore_version, created_utc, ...).
+    units : dict of str
+        Unit of each field or array that was given one.
+    """
+
+    key: str
+    record: dict[str, Scalar]
+    arrays: dict[str, np.ndarray]
+    parameters: dict[str, Any]
+    attrs: dict[str, Any]
+    units: dict[str, str] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class _PreparedEntry:
+    """A validated analysis or DEM run, ready to be written."""
+
+    values: dict[str, Any]
+    null_fields: tuple[str, ...]
+    arrays: dict[str, np.ndarray]
+    units: dict[str, str]
+    parameters_json: str
+
+
+def _utc_now() -> str:
+    return datetime.now(UTC).isoformat(timespec="microseconds")
+
+
+def _text(value: Any) -> str:
+    return value.decode("utf-8", "replace") if isinstance(value, bytes) else str(value)
+
+
+def _fsync_path(path: Path, *, directory: bool = False) -> None:
+    fd = os.open(path, os.O_RDONLY | (os.O_DIRECTORY if directory else 0))
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)
+
+
+def _new_file_mode() -> int:
+    # A new store gets the permissions any new file would get (0o666 less the umask); os.umask
+    # can only be read by setting it, so set it back at once.
+    umask = os.umask(0)
+    os.umask(umask)
+    return 0o666 & ~umask
+
+
+def _prepare_entry(record: Mapping[str, Any], arrays: Mapping[str, Any] | None,
+                   parameters: Mapping[str, Any] | None, units: Mapping[str, str] | None,
+                   *, where: str) -> _PreparedEntry:
+    if not isinstance(record, Mapping):
+        raise StoreError(f"{where}: record must be a mapping of field name to scalar, "
+                         f"got {type(record).__name__}")
+    arrays = {} if arrays is None else arrays
+    units = {} if units is None else units
+    if not isinstance(arrays, Mapping) or not isinstance(units, Mapping):
+        raise StoreError(f"{where}: arrays and units must be mappings")
+    values: dict[str, Any] = {}
+    nulls = []
+    for name, value in record.items():
+        check_name(name, what="record field", where=where)
+        if name in RESERVED_FIELDS:
+            raise StoreError(f"{where}: record field {name!r} is reserved for the listing "
+                             f"columns ({', '.join(sorted(RESERVED_FIELDS))})")
+        values[name], was_none = to_attribute(value, field=name, where=where)
+        if was_none:
+            nulls.append(name)
+    prepared_arrays = {}
+    for name, value in arrays.items():
+        check_name(name, what="array", where=where)
+        if name in values:
+            raise StoreError(f"{where}: {name!r} is both a record field and an array")
+        prepared_arrays[name] = to_array(value, name=name, where=where)
+    for name, unit in units.items():
+        if name not in values and name not in prepared_arrays:
+            raise StoreError(f"{where}: units given for {name!r}, which is neither a record field "
+                             "nor an array")
+        if not isinstance(unit, str):
+            raise StoreError(f"{where}: unit of {name!r} must be a string, "
+                             f"got {type(unit).__name__}")
+    return _PreparedEntry(values, tuple(nulls), prepared_arrays, dict(units),
+                          parameters_to_json({} if parameters is None else parameters,
+                                             where=where))
+
+
+def _write_entry(parent: h5py.Group, key: str, entry: _PreparedEntry, *, layout: str,
+                 link_attrs: Mapping[str, str]) -> None:
+    group = parent.create_group(key)
+    group.attrs["pidcore_layout"] = layout
+    for name, value in link_attrs.items():
+        group.attrs[name] = value
+    group.attrs["created_utc"] = _utc_now()
+    group.attrs["pidcore_version"] = __version__
+    group.attrs["parameters_json"] = entry.parameters_json
+    group.attrs["null_fields_json"] = json.dumps(list(entry.null_fields))
+    # track_order keeps the caller's field order, which becomes the listing's column order.
+    record = group.create_group("record", track_order=True)
+    for name, value in entry.values.items():
+        record.attrs[name] = value
+    units = group.create_group("units", track_order=True)
+    for name, unit in entry.units.items():
+        units.attrs[name] = unit
+    arrays = group.create_group("arrays", track_order=True)
+    for name, array in entry.arrays.items():
+        # fletcher32 makes verify() detect flipped bits in stored arrays; gzip only for arrays
+        # large enough for it to pay (small chunked datasets cost more than they save).
+        big = array.size >= 1024
+        dataset = arrays.create_dataset(name, data=array, fletcher32=array.ndim > 0,
+                                        compression="gzip" if big else None)
+        dataset.attrs["unit"] = entry.units.get(name, "")
+
+
+def _read_entry(group: h5py.Group, key: str) -> StoredEntry:
+    attrs = {name: from_attribute(value) for name, value in group.attrs.items()}
+    nulls = set(json.loads(_text(group.attrs.get("null_fields_json", "[]"))))
+    record = {name: (None if name in nulls else from_attribute(value))
+              for name, value in group["record"].attrs.items()}
+    units = {name: _text(value) for name, value in group["units"].attrs.items()}
+    arrays = {name: dataset[()] for name, dataset in group["arrays"].items()}
+    parameters = json.loads(_text(group.attrs.get("parameters_json", "{}")))
+    return StoredEntry(key=key, record=record, arrays=arrays, parameters=parameters, attrs=attrs,
+                       units=units)
+
+
+def _measurement_key(measurement: Measurement) -> tuple[str, str]:
+    """``(key, basis)``: the file's SHA-256 when known, else a hash of the channel contents."""
+    sha = measurement.sha256.strip().lower()
+    if sha:
+        if len(sha) < 16 or any(c not in "0123456789abcdef" for c in sha):
+            raise StoreError(f"{measurement.source}: sha256 {measurement.sha256!r} is not a hex "
+                             "digest of at least 16 digits")
+        return sha[:16], "file_sha256"
+    # Measurements built in memory (simulations, tests) have no file; hash what defines them so
+    # that storing the same one twice still deduplicates.
+    digest = hashlib.sha256()
+    digest.update(measurement.source.encode("utf-8"))
+    for ch in measurement.channels:
+        header = f"\0{ch.name}\0{ch.quantity}\0{ch.sample_rate_hz!r}\0{ch.start_time_s!r}\0"
+        digest.update(header.encode("utf-8"))
+        digest.update(np.ascontiguousarray(ch.data, dtype=np.float64).tobytes())
+    return digest.hexdigest()[:16], "content_sha256"
+
+
+def _check_measurement(measurement: Measurement) -> None:
+    if not isinstance(measurement, Measurement):
+        raise StoreError("expected a pidcore.records.Measurement, "
+                         f"got {type(measurement).__name__}")
+    if not measurement.channels:
+        raise StoreError(f"{measurement.source}: measurement has no channels; nothing to store")
+    for ch in measurement.channels:
+        where = f"{measurement.source}: channel {ch.name!r}"
+        try:
+            data = np.asarray(ch.data, dtype=np.float64)
+        except (TypeError, ValueError) as exc:
+            raise StoreError(f"{where}: samples cannot be stored as float64 ({exc})") from None
+        if data.ndim != 1:
+            raise StoreError(f"{where}: expected 1-D samples, got shape {data.shape}")
+        rate = float(ch.sample_rate_hz)
+        if not np.isfinite(rate) or rate <= 0:
+            raise StoreError(f"{where}: sample_rate_hz must be finite and > 0, got {rate}")
+
+
+class Store:
+    """pidcore's HDF5 store of measurements, analyses and DEM runs.
+
+    Parameters
+    ----------
+    path : str or os.PathLike, optional
+        Store file; created on the first write. Default :data:`pidcore.defaults.STORE_PATH`.
+    lock_timeout_s : float, optional
+        Seconds a write waits for another writer's lock, s.
+        Default :data:`pidcore.defaults.STORE_LOCK_TIMEOUT_S`.
+
+    Raises
+    ------
+    StoreError
+        A file exists at ``path`` but is not a readable pidcore store (it is never modified).
+
+    Examples
+    --------
+    >>> store = Store("pid_store.h5")                        # doctest: +SKIP
+    >>> key, added = store.add_measurement(measurement)       # doctest: +SKIP
+    >>> with store.transaction():                             # doctest: +SKIP
+    ...     for case_key, record in results.items():
+    ...         store.add_dem_run(case_key, record, units={"sdc": "1"})
+    """
+
+    def __init__(self, path: str | os.PathLike[str] = defaults.STORE_PATH, *,
+                 lock_timeout_s: float = defaults.STORE_LOCK_TIMEOUT_S) -> None:
+        self.path = Path(os.fspath(path))
+        timeout = float(lock_timeout_s)
+        if not np.isfinite(timeout) or timeout < 0:
+            raise ParameterError(f"lock_timeout_s must be finite and >= 0 s, got {lock_timeout_s}")
+        self.lock_timeout_s = timeout
+        self._active: h5py.File | None = None
+        self._active_thread: int | None = None
+        if self.path.exists():
+            with self._reading():
+                pass  # refuse a corrupt or foreign file now rather than at first use
+
+    def __repr__(self) -> str:
+        return f"Store({str(self.path)!r})"
+
+    @property
+    def lock_path(self) -> Path:
+        """Sidecar file whose ``flock`` serialises writers."""
+        return lock_path_for(self.path)
+
+    # --- transactions and file access ----------------------------------------------------------
+
+    def _in_transaction(self) -> bool:
+        return self._active is not None and self._active_thread == threading.get_ident()
+
+    def _unreadable(self, reason: object) -> StoreError:
+        return StoreError(f"{self.path}: not a readable pidcore store ({reason})")
+
+    def _check_root(self, h5: h5py.File) -> None:
+        version = h5.attrs.get("pidcore_store_version")
+        if version is None:
+            raise self._unreadable("HDF5 file without the root attribute pidcore_store_version")
+        try:
+            version = int(from_attribute(version))
+        except (TypeError, ValueError):
+            raise self._unreadable(f"pidcore_store_version {version!r} is not an integer") from None
+        if version > STORE_VERSION:
+            raise StoreError(f"{self.path}: store version {version} is newer than this pidcore "
+                             f"({__version__}) understands (version {STORE_VERSION}); "
+                             "upgrade pidcore")
+
+    @contextmanager
+    def _reading(self) -> Iterator[h5py.File | None]:
+        """Open the committed store read-only (``None`` when it does not exist yet)."""
+        if self._in_transaction():
+            yield self._active
+            return
+        if not self.path.exists():
+            yield None
+            return
+        try:
+            h5 = h5py.File(self.path, "r")
+        except OSError as exc:
+            raise self._unreadable(exc) from None
+        try:
+            self._check_root(h5)
+            yield h5
+        except (OSError, RuntimeError) as exc:
+            # h5py reports damaged objects inside an openable file as OSError/RuntimeError.
+            raise self._unreadable(exc) from None
+        finally:
+            h5.close()
+
+    def _remove_stale_temporaries(self) -> None:
+        # Called under the write lock: no other writer is running, so any temporary copy left
+        # beside the store was abandoned by a writer that was killed before it could clean up.
+        prefix = f".{self.path.name}."
+        for stale in self.path.parent.iterdir():
+            if stale.name.startswith(prefix) and stale.name.endswith(".tmp"):
+                stale.unlink(missing_ok=True)
+
+    @contextmanager
+    def transaction(self) -> Iterator[h5py.File]:
+        """Batch writes into one atomic commit; yields the working copy opened ``r+``.
+
+        Every ``add_*`` call made inside the block (same thread) joins it, so a batch copies the
+        store once. Leaving the block normally commits; any exception, KeyboardInterrupt
+        included, discards every change of the batch and leaves the store file untouched.
+        Nested ``transaction()`` blocks join the outermost one.
+
+        Raises
+        ------
+        StoreError
+            The write lock cannot be taken in time, the directory does not exist, or the file
+            at the path is not a readable pidcore store (it is never overwritten).
+        """
+        if self._in_transaction():
+            yield self._active
+            return
+        directory = self.path.parent
+        if not directory.is_dir():
+            raise StoreError(f"{self.path}: directory {directory} does not exist")
+        with exclusive_lock(self.path, timeout_s=self.lock_timeout_s):
+            self._remove_stale_temporaries()
+            exists = self.path.exists()
+            if exists:
+                with self._reading():
+                    pass  # validates: a foreign or corrupt file must never be replaced
+            tmp = directory / f".{self.path.name}.{secrets.token_hex(8)}.tmp"
+            try:
+                h5 = self._working_copy(tmp, exists=exists)
+                try:
+                    self._active, self._active_thread = h5, threading.get_ident()
+                    yield h5
+                except BaseException:
+                    with suppress(Exception):  # the copy is discarded anyway
+                        h5.close()
+                    raise
+                finally:
+                    self._active, self._active_thread = None, None
+                try:
+                    h5.close()
+                    _fsync_path(tmp)
+                    os.replace(tmp, self.path)
+                except OSError as exc:
+                    raise StoreError(f"{self.path}: cannot commit the changes ({exc}); "
+                                     "the store is unchanged") from None
+                # Makes the rename itself durable; the commit has happened either way, and some
+                # file systems cannot fsync a directory, so a failure here is not an error.
+                with suppress(OSError):
+                    _fsync_path(directory, directory=True)
+            except BaseException:
+                tmp.unlink(missing_ok=True)
+                raise
+
+    def _working_copy(self, tmp: Path, *, exists: bool) -> h5py.File:
+        """Copy of the committed store (or a new store) at ``tmp``, opened for writing."""
+        try:
+            os.close(os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600))
+            if exists:
+                shutil.copyfile(self.path, tmp)
+                shutil.copymode(self.path, tmp)
+            else:
+                os.chmod(tmp, _new_file_mode())
+            h5 = h5py.File(tmp, "r+" if exists else "w")
+        except OSError as exc:
+            raise StoreError(f"{self.path}: cannot make the working copy {tmp.name} ({exc}); "
+                             "the store is unchanged") from None
+        try:
+            if not exists:
+                h5.attrs["pidcore_store_version"] = np.int64(STORE_VERSION)
+                h5.attrs["created_utc"] = _utc_now()
+                h5.attrs["pidcore_version"] = __version__
+            for name in (_MEASUREMENTS, _ANALYSES, _DEM_RUNS):
+                h5.require_group(name)
+        except BaseException:
+            h5.close()
+            raise
+        return h5
+
+    # --- measurements --------------------------------------------------------------------------
+
+    def add_measurement(self, measurement: Measurement) -> tuple[str, bool]:
+        """Store a measurement unless the same file is stored already.
+
+        Parameters
+        ----------
+        measurement : pidcore.records.Measurement
+
+        Returns
+        -------
+        key : str
+            First 16 hex digits of the file's SHA-256 (of the channel contents when the
+            measurement has no ``sha256``).
+        added : bool
+            False when the measurement was stored before (nothing was written).
+        """
+        _check_measurement(measurement)
+        key, basis = _measurement_key(measurement)
+        with self._reading() as h5:
+            if h5 is not None and key in h5.get(_MEASUREMENTS, {}):
+                self._check_same_measurement(h5[_MEASUREMENTS][key], measurement, key)
+                return key, False
+        with self.transaction() as h5:
+            parent = h5[_MEASUREMENTS]
+            if key in parent:  # stored by another process since the check above
+                self._check_same_measurement(parent[key], measurement, key)
+                return key, False
+            group = parent.create_group(key)
+            try:
+                write_measurement_group(group, measurement)
+            except (TypeError, ValueError) as exc:
+                raise StoreError(f"{measurement.source}: cannot be stored ({exc})") from None
+            group.attrs["imported_utc"] = _utc_now()
+            group.attrs["pidcore_version"] = __version__
+            group.attrs["key_basis"] = basis
+        return key, True
+
+    def _check_same_measurement(self, group: h5py.Group, measurement: Measurement,
+                                key: str) -> None:
+        stored = _text(group.attrs.get("sha256", ""))
+        if measurement.sha256 and stored and stored.lower() != measurement.sha256.lower():
+            raise StoreError(f"{self.path}: measurement key {key} already holds {stored}, not "
+                             f"{measurement.sha256} ({measurement.source}); keys collide")
+
+    def get_measurement(self, key: str) -> Measurement:
+        """The measurement stored under ``key``."""
+        check_name(key, what="measurement key", where=str(self.path))
+        with self._reading() as h5:
+            group = self._entry_group(h5, _MEASUREMENTS, key, "measurement")
+            try:
+                return read_measurement_group(group, where=f"{self.path}:{group.name}")
+            except InputFileError as exc:
+                raise StoreError(str(exc)) from None
+
+    def has_measurement(self, key: str) -> bool:
+        """Whether a measurement is stored under ``key``."""
+        check_name(key, what="measurement key", where=str(self.path))
+        with self._reading() as h5:
+            return h5 is not None and key in h5.get(_MEASUREMENTS, {})
+
+    def list_measurements(self) -> pd.DataFrame:
+        """One row per measurement: key, source, file_format, n_channels, channel_names,
+        sha256, imported_utc, pidcore_version (sorted by import time)."""
+        columns = ["key", "source", "file_format", "n_channels", "channel_names", "sha256",
+                   "imported_utc", "pidcore_version"]
+        rows = []
+        with self._reading() as h5:
+            for key, group in ({} if h5 is None else h5.get(_MEASUREMENTS, {})).items():
+                channels = group.get("channels", {})
+                names = tuple(_text(channels[c].attrs.get("name", c)) for c in sorted(channels))
+                rows.append({
+                    "key": key,
+                    "source": _text(group.attrs.get("source", "")),
+                    "file_format": _text(group.attrs.get("file_format", "")),
+                    "n_channels": len(names),
+                    "channel_names": names,
+                    "sha256": _text(group.attrs.get("sha256", "")),
+                    "imported_utc": _text(group.attrs.get("imported_utc", "")),
+                    "pidcore_version": _text(group.attrs.get("pidcore_version", "")),
+                })
+        frame = pd.DataFrame(rows, columns=columns)
+        return frame.sort_values(["imported_utc", "key"], ignore_index=True)
+
+    # --- analyses ------------------------------------------------------------------------------
+
+    def add_analysis(self, measurement_key: str, record: Mapping[str, Scalar], *,
+                     arrays: Mapping[str, np.ndarray] | None = None,
+                     parameters: Mapping[str, Any] | None = None,
+                     units: Mapping[str, str] | None = None) -> str:
+        """Store one analysis result of a stored measurement.
+
+        Parameters
+        ----------
+        measurement_key : str
+            Key of the analysed measurement (must be stored).
+        record : mapping of str to scalar
+            Result fields, e.g. ``frequency_hz``, ``loss_factor``, ``sdc``, ``sdc_stderr``.
+        arrays : mapping of str to numpy.ndarray, optional
+            Array results, e.g. complex harmonic phasors.
+        parameters : mapping, optional
+            JSON-safe parameters the analysis ran with; with ``measurement_key`` they define
+            the key, so re-analysing with the same parameters replaces the entry.
+        units : mapping of str to str, optional
+            Unit of each field or array, e.g. ``{"frequency_hz": "Hz", "sdc": "1"}``.
+
+        Returns
+        -------
+        str
+            The analysis key.
+        """
+        where = f"{self.path}: analysis of measurement {measurement_key!r}"
+        check_name(measurement_key, what="measurement key", where=str(self.path))
+        entry = _prepare_entry(record, arrays, parameters, units, where=where)
+        key = analysis_key(measurement_key, entry.parameters_json)
+        with self.transaction() as h5:
+            if measurement_key not in h5[_MEASUREMENTS]:
+                raise StoreError(f"{where}: no measurement with that key is stored; "
+                                 "add the measurement first")
+            parent = h5[_ANALYSES]
+            if key in parent:
+                del parent[key]
+            _write_entry(parent, key, entry, layout=_LAYOUT_ANALYSIS,
+                         link_attrs={"measurement_key": measurement_key})
+        return key
+
+    def get_analysis(self, key: str) -> StoredEntry:
+        """The analysis stored under ``key``."""
+        check_name(key, what="analysis key", where=str(self.path))
+        with self._reading() as h5:
+            return _read_entry(self._entry_group(h5, _ANALYSES, key, "analysis"), key)
+
+    def list_analyses(self) -> pd.DataFrame:
+        """One row per analysis: key, measurement_key, source, created_utc, every scalar field,
+        parameters_json, pidcore_version (sorted by creation time)."""
+        with self._reading() as h5:
+            sources = {}
+            if h5 is not None:
+                sources = {k: _text(g.attrs.get("source", ""))
+                           for k, g in h5.get(_MEASUREMENTS, {}).items()}
+
+            def link(group: h5py.Group) -> dict[str, Any]:
+                measurement_key = _text(group.attrs.get("measurement_key", ""))
+                return {"measurement_key": measurement_key,
+                        "source": sources.get(measurement_key, "")}
+
+            return self._listing(h5, _ANALYSES, ["key", "measurement_key", "source"], link)
+
+    # --- DEM runs ------------------------------------------------------------------------------
+
+    def add_dem_run(self, case_key: str, record: Mapping[str, Scalar], *,
+                    arrays: Mapping[str, np.ndarray] | None = None,
+                    parameters: Mapping[str, Any] | None = None,
+                    units: Mapping[str, str] | None = None, replace: bool = False) -> str:
+        """Store one DEM run under a key chosen by the caller.
+
+        Parameters
+        ----------
+        case_key : str
+            E.g. ``"f50_a5_fill50_acrylic_z_seed12345_cells8"``.
+        record, arrays, parameters, units
+            As for :meth:`add_analysis`.
+        replace : bool, optional
+            Overwrite an existing run with this key; without it an existing key is a StoreError.
+
+        Returns
+        -------
+        str
+            ``case_key``.
+        """
+        return self.add_dem_runs([{"case_key": case_key, "record": record, "arrays": arrays,
+                                   "parameters": parameters, "units": units}],
+                                 replace=replace)[0]
+
+    def add_dem_runs(self, items: Iterable[Mapping[str, Any]], *,
+                     replace: bool = False) -> list[str]:
+        """Store several DEM runs in one transaction (all or none).
+
+        Parameters
+        ----------
+        items : iterable of mapping
+            Each with key ``case_key`` and ``record``, optionally ``arrays``, ``parameters``,
+            ``units`` (the arguments of :meth:`add_dem_run`).
+        replace : bool, optional
+            Overwrite runs whose case key is stored already.
+
+        Returns
+        -------
+        list of str
+            The case keys, in order.
+        """
+        prepared: dict[str, _PreparedEntry] = {}
+        for index, item in enumerate(items):
+            if not isinstance(item, Mapping):
+                raise StoreError(f"{self.path}: DEM run #{index} must be a mapping, "
+                                 f"got {type(item).__name__}")
+            unknown = set(item) - _DEM_ITEM_FIELDS
+            if unknown or "case_key" not in item or "record" not in item:
+                raise StoreError(f"{self.path}: DEM run #{index} needs keys case_key and record "
+                                 f"(optional: arrays, parameters, units); "
+                                 f"unknown: {sorted(map(str, unknown))}")
+            case_key = check_name(item["case_key"], what="DEM case key", where=str(self.path))
+            if case_key in prepared:
+                raise StoreError(f"{self.path}: DEM case key {case_key!r} appears twice "
+                                 "in one batch")
+            prepared[case_key] = _prepare_entry(
+                item["record"], item.get("arrays"), item.get("parameters"), item.get("units"),
+                where=f"{self.path}: DEM run {case_key!r}")
+        with self.transaction() as h5:
+            parent = h5[_DEM_RUNS]
+            for case_key, entry in prepared.items():
+                if case_key in parent:
+                    if not replace:
+                        raise StoreError(f"{self.path}: DEM run {case_key!r} is stored already; "
+                                         "pass replace=True to overwrite it")
+                    del parent[case_key]
+                _write_entry(parent, case_key, entry, layout=_LAYOUT_DEM_RUN,
+                             link_attrs={"case_key": case_key})
+        return list(prepared)
+
+    def has_dem_run(self, case_key: str) -> bool:
+        """Whether a DEM run is stored under ``case_key``."""
+        check_name(case_key, what="DEM case key", where=str(self.path))
+        with self._reading() as h5:
+            return h5 is not None and case_key in h5.get(_DEM_RUNS, {})
+
+    def get_dem_run(self, case_key: str) -> StoredEntry:
+        """The DEM run stored under ``case_key``."""
+        check_name(case_key, what="DEM case key", where=str(self.path))
+        with self._reading() as h5:
+            return _read_entry(self._entry_group(h5, _DEM_RUNS, case_key, "DEM run"), case_key)
+
+    def list_dem_runs(self) -> pd.DataFrame:
+        """One row per DEM run: case_key, created_utc, every scalar field, parameters_json,
+        pidcore_version (sorted by case key)."""
+        with self._reading() as h5:
+            frame = self._listing(h5, _DEM_RUNS, [], lambda group: {})
+        return frame.rename(columns={"key": "case_key"}).sort_values("case_key",
+                                                                     ignore_index=True)
+
+    # --- shared reading helpers ----------------------------------------------------------------
+
+    def _entry_group(self, h5: h5py.File | None, section: str, key: str, what: str) -> h5py.Group:
+        if h5 is None:
+            raise StoreError(f"{self.path}: no {what} {key!r}; the store does not exist yet")
+        parent = h5.get(section, {})
+        if key not in parent:
+            raise StoreError(f"{self.path}: no {what} {key!r} ({len(parent)} stored)")
+        return parent[key]
+
+    def _listing(self, h5: h5py.File | None, section: str, leading: list[str],
+                 link: Any) -> pd.DataFrame:
+        rows = []
+        fields: dict[str, None] = {}  # ordered set of field names over all entries
+        for key, group in ({} if h5 is None else h5.get(section, {})).items():
+            row: dict[str, Any] = {"key": key, **link(group),
+                                   "created_utc": _text(group.attrs.get("created_utc", ""))}
+            record = group.get("record")
+            for name, value in ({} if record is None else record.attrs).items():
+                row[name] = from_attribute(value)
+                fields[name] = None
+            row["parameters_json"] = _text(group.attrs.get("parameters_json", "{}"))
+            row["pidcore_version"] = _text(group.attrs.get("pidcore_version", ""))
+            rows.append(row)
+        leading = ["key", *[c for c in leading if c != "key"], "created_utc"]
+        columns = [*leading, *fields, "parameters_json", "pidcore_version"]
+        frame = pd.DataFrame(rows, columns=columns)
+        return frame.sort_values(["created_utc", "key"], ignore_index=True)
+
+    # --- integrity -----------------------------------------------------------------------------
+
+    def verify(self) -> list[str]:
+        """Integrity check: one line per problem found (empty list: the store is sound).
+
+        Checks the root attributes, that every measurement, analysis and DEM run has its
+        provenance attributes and readable datasets (checksummed arrays are read in full), that
+        keys match their contents and that every analysis refers to a stored measurement.
+        """
+        if not self.path.exists():
+            return [f"{self.path}: store does not exist"]
+        try:
+            h5 = h5py.File(self.path, "r")
+        except OSError as exc:
+            return [str(self._unreadable(exc))]
+        problems: list[str] = []
+        try:
+            try:
+                self._check_root(h5)
+            except StoreError as exc:
+                return [str(exc)]
+            problems += [f"{self.path}: root attribute {name} missing"
+                         for name in _ROOT_ATTRS if name not in h5.attrs]
+            for section in (_MEASUREMENTS, _ANALYSES, _DEM_RUNS):
+                if section not in h5:
+                    problems.append(f"{self.path}: group /{section} missing")
+                    continue
+                for key in h5[section]:
+                    where = f"{self.path}:/{section}/{key}"
+                    try:
+                        problems += self._verify_entry(h5, section, key, where)
+                    except Exception as exc:  # report any damage; verify must never crash
+                        problems.append(f"{where}: unreadable ({type(exc).__name__}: {exc})")
+        finally:
+            h5.close()
+        return problems
+
+    def _verify_entry(self, h5: h5py.File, section: str, key: str, where: str) -> list[str]:
+        group = h5[section][key]
+        if section == _MEASUREMENTS:
+            problems = [f"{where}: attribute {name} missing"
+                        for name in _MEASUREMENT_ATTRS if name not in group.attrs]
+            try:
+                measurement = read_measurement_group(group, where=where)
+            except InputFileError as exc:
+                return [*problems, str(exc)]
+            basis = _text(group.attrs.get("key_basis", "file_sha256"))
+            if basis == "file_sha256":
+                expected = measurement.sha256.lower()[:16]
+            else:
+                expected = _measurement_key(
+                    Measurement(measurement.source, measurement.channels))[0]
+            if expected != key:
+                problems.append(f"{where}: key does not match its contents (expected {expected})")
+            return problems
+        problems = [f"{where}: attribute {name} missing"
+                    for name in _ENTRY_ATTRS if name not in group.attrs]
+        problems += [f"{where}: group {name}/ missing"
+                     for name in ("record", "units", "arrays") if name not in group]
+        if problems:
+            return problems
+        entry = _read_entry(group, key)  # reads every array, so checksums are checked
+        if section == _ANALYSES:
+            measurement_key = _text(group.attrs.get("measurement_key", ""))
+            if measurement_key not in h5.get(_MEASUREMENTS, {}):
+                problems.append(f"{where}: refers to measurement {measurement_key!r}, "
+                                "which is not stored")
+            canonical = parameters_to_json(entry.parameters, where=where)
+            if analysis_key(measurement_key, canonical) != key:
+                problems.append(f"{where}: key does not match measurement_key and parameters")
+        elif _text(group.attrs.get("case_key", "")) != key:
+            problems.append(f"{where}: attribute case_key does not match the group name")
+        return problems
+
+    def summary(self) -> dict[str, Any]:
+        """Counts and identity of the store: path, exists, store_version, created_utc,
+        n_measurements, n_analyses, n_dem_runs, size_bytes."""
+        with self._reading() as h5:
+            if h5 is None:
+                return {"path": str(self.path), "exists": False, "store_version": None,
+                        "created_utc": None, "n_measurements": 0, "n_analyses": 0,
+                        "n_dem_runs": 0, "size_bytes": 0}
+            return {
+                "path": str(self.path),
+                "exists": True,
+                "store_version": int(from_attribute(h5.attrs["pidcore_store_version"])),
+                "created_utc": _text(h5.attrs.get("created_utc", "")),
+                "n_measurements": len(h5.get(_MEASUREMENTS, {})),
+                "n_analyses": len(h5.get(_ANALYSES, {})),
+                "n_dem_runs": len(h5.get(_DEM_RUNS, {})),
+                "size_bytes": self.path.stat().st_size,
+            }

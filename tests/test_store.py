@@ -1,0 +1,291 @@
+"""Store contents: round trips, deduplication, keys, listings, verification, bad input."""
+
+from __future__ import annotations
+
+import hashlib
+import math
+
+import h5py
+import numpy as np
+import pytest
+
+from pidcore.errors import StoreError
+from pidcore.records import Channel, Measurement
+from pidcore.store import STORE_VERSION, Store
+
+
+def make_measurement(seed: int = 0, *, source: str = "coupon.uff", sha256: str | None = None,
+                     n_samples: int = 256) -> Measurement:
+    rng = np.random.default_rng(seed)
+    force = rng.normal(size=n_samples)
+    accel = rng.normal(size=n_samples) * 9.80665
+    if sha256 is None:
+        sha256 = hashlib.sha256(f"{source}-{seed}".encode()).hexdigest()
+    return Measurement(
+        source=source,
+        channels=(
+            Channel("Force/Drive pt 1", "force", force, 2048.0, "lbf", 0.5),
+            Channel("Accel 1:+Z", "acceleration", accel, 2048.0, "g"),
+        ),
+        sha256=sha256,
+        file_format="uff",
+        metadata={"date": "2024-05-01", "fill_percent": 50.0, "run": 7},
+    )
+
+
+@pytest.fixture
+def store(tmp_path):
+    return Store(tmp_path / "pid_store.h5")
+
+
+def test_new_store_has_root_attributes(store):
+    store.add_dem_run("c", {"sdc": 0.1})
+    with h5py.File(store.path, "r") as h5:
+        assert int(h5.attrs["pidcore_store_version"]) == STORE_VERSION == 1
+        assert h5.attrs["created_utc"].endswith("+00:00")
+        assert isinstance(h5.attrs["pidcore_version"], str)
+        assert {"measurements", "analyses", "dem_runs"} <= set(h5)
+
+
+def test_measurement_round_trip(store):
+    m = make_measurement(1)
+    key, added = store.add_measurement(m)
+    assert added and key == m.sha256[:16]
+    back = store.get_measurement(key)
+    assert back.source == m.source and back.sha256 == m.sha256
+    assert back.file_format == m.file_format and dict(back.metadata) == dict(m.metadata)
+    assert back.channel_names == m.channel_names  # order and '/'-containing names preserved
+    for a, b in zip(m.channels, back.channels, strict=True):
+        # float64 written and read losslessly (gzip is lossless): exact equality.
+        np.testing.assert_array_equal(a.data, b.data)
+        assert (a.quantity, a.unit, a.source_unit) == (b.quantity, b.unit, b.source_unit)
+        assert (a.sample_rate_hz, a.start_time_s) == (b.sample_rate_hz, b.start_time_s)
+    with h5py.File(store.path, "r") as h5:
+        assert h5[f"measurements/{key}"].attrs["imported_utc"].endswith("+00:00")
+        assert h5[f"measurements/{key}"].attrs["pidcore_version"]
+
+
+def test_reimport_does_not_duplicate_nor_rewrite(store):
+    m = make_measurement(2)
+    key, _ = store.add_measurement(m)
+    size_and_bytes = store.path.read_bytes()
+    assert store.add_measurement(m) == (key, False)
+    assert store.path.read_bytes() == size_and_bytes  # dedupe writes nothing
+    other_key, added = store.add_measurement(make_measurement(3))
+    assert added and other_key != key
+    listing = store.list_measurements()
+    assert sorted(listing["key"]) == sorted([key, other_key])
+    row = listing.set_index("key").loc[key]
+    assert row["n_channels"] == 2 and row["source"] == "coupon.uff"
+    assert tuple(row["channel_names"]) == tuple(m.channel_names)
+    assert row["file_format"] == "uff" and row["sha256"] == m.sha256
+
+
+def test_measurement_without_sha_deduplicates_on_content(store):
+    m = make_measurement(4, sha256="")
+    key, added = store.add_measurement(m)
+    assert added
+    assert store.add_measurement(make_measurement(4, sha256="")) == (key, False)
+    changed = make_measurement(5, sha256="")
+    assert store.add_measurement(changed)[0] != key
+    assert store.verify() == []
+
+
+def test_analysis_same_parameters_replace_different_parameters_add(store):
+    mkey, _ = store.add_measurement(make_measurement(6))
+    phasors = np.array([1 + 2j, -0.5 + 0.25j, 3e-3j])
+    record = {"frequency_hz": 50.0, "acceleration_g": 5.0, "sdc": 0.31, "sdc_stderr": 0.01,
+              "n_periods": 40, "clipped": False, "label": "fill 50 %", "comment": None}
+    units = {"frequency_hz": "Hz", "acceleration_g": "g", "sdc": "1", "sdc_stderr": "1",
+             "harmonic_force_n": "N"}
+    params = {"n_harmonics": 5, "force_channel": "Force/Drive pt 1"}
+    k1 = store.add_analysis(mkey, record, arrays={"harmonic_force_n": phasors},
+                            parameters=params, units=units)
+    # Same measurement + same parameters (other key order, numpy scalar) -> same key, replaced.
+    k2 = store.add_analysis(mkey, {**record, "sdc": 0.32},
+                            parameters={"force_channel": "Force/Drive pt 1",
+                                        "n_harmonics": np.int64(5)})
+    assert k2 == k1
+    assert len(store.list_analyses()) == 1
+    assert store.get_analysis(k1).record["sdc"] == 0.32
+    assert store.get_analysis(k1).arrays == {}  # the replacement carries no arrays
+    k3 = store.add_analysis(mkey, record, arrays={"harmonic_force_n": phasors},
+                            parameters={**params, "n_harmonics": 3}, units=units)
+    assert k3 != k1
+    listing = store.list_analyses()
+    assert sorted(listing["key"]) == sorted([k1, k3])
+    assert set(listing["measurement_key"]) == {mkey}
+    assert set(listing["source"]) == {"coupon.uff"}
+    entry = store.get_analysis(k3)
+    assert entry.parameters == {**params, "n_harmonics": 3}
+    assert entry.record == {**record, "clipped": 0}  # bools stored as int, None read back
+    assert isinstance(entry.record["n_periods"], int)
+    assert entry.arrays["harmonic_force_n"].dtype == np.complex128
+    np.testing.assert_array_equal(entry.arrays["harmonic_force_n"], phasors)
+    assert entry.units == units
+    assert entry.attrs["measurement_key"] == mkey
+    assert entry.attrs["pidcore_layout"] == "analysis"
+    row = listing.set_index("key").loc[k3]
+    assert math.isnan(row["comment"])  # None is NaN in the table
+    assert row["frequency_hz"] == 50.0 and row["label"] == "fill 50 %"
+    assert store.verify() == []
+
+
+def test_analysis_needs_stored_measurement(store):
+    store.add_measurement(make_measurement(7))
+    with pytest.raises(StoreError, match="no measurement"):
+        store.add_analysis("0123456789abcdef", {"sdc": 0.1})
+
+
+@pytest.mark.parametrize(("record", "kwargs", "message"), [
+    ({"sdc": [0.1, 0.2]}, {}, "expected a scalar"),
+    ({"key": 1.0}, {}, "reserved"),
+    ({"a/b": 1.0}, {}, "not valid"),
+    ({"sdc": 0.1}, {"units": {"sdcc": "1"}}, "neither a record field"),
+    ({"sdc": 0.1}, {"arrays": {"names": np.array(["a", "b"])}}, "numeric"),
+    ({"sdc": 0.1}, {"parameters": {"f": object()}}, "JSON"),
+    ({"sdc": 2**70}, {}, "int64"),
+])
+def test_bad_entries_are_refused_and_store_unchanged(store, record, kwargs, message):
+    store.add_dem_run("existing", {"sdc": 0.1})
+    before = store.path.read_bytes()
+    with pytest.raises(StoreError, match=message):
+        store.add_dem_run("new", record, **kwargs)
+    assert store.path.read_bytes() == before
+
+
+def test_dem_run_add_has_get_list_replace(store):
+    case = "f50_a5_fill50_acrylic_z_seed12345_cells8"
+    assert not store.has_dem_run(case)
+    energy = np.linspace(0.0, 1.0, 2000)
+    store.add_dem_run(case, {"sdc": 0.25, "power_loss_w": 1.5e-3},
+                      arrays={"dissipated_energy_j": energy},
+                      parameters={"seed": 12345, "cells": 8}, units={"sdc": "1",
+                                                                    "dissipated_energy_j": "J"})
+    assert store.has_dem_run(case)
+    run = store.get_dem_run(case)
+    assert run.key == case and run.record == {"sdc": 0.25, "power_loss_w": 1.5e-3}
+    np.testing.assert_array_equal(run.arrays["dissipated_energy_j"], energy)
+    assert run.parameters == {"seed": 12345, "cells": 8}
+    assert run.units["dissipated_energy_j"] == "J"
+    with pytest.raises(StoreError, match="replace=True"):
+        store.add_dem_run(case, {"sdc": 0.5})
+    assert store.get_dem_run(case).record["sdc"] == 0.25
+    store.add_dem_run(case, {"sdc": 0.5}, replace=True)
+    assert store.get_dem_run(case).record == {"sdc": 0.5}
+    keys = store.add_dem_runs([{"case_key": f"b{i}", "record": {"sdc": i / 10, "extra": i}}
+                               for i in range(3)])
+    assert keys == ["b0", "b1", "b2"]
+    listing = store.list_dem_runs()
+    assert list(listing["case_key"]) == ["b0", "b1", "b2", case]
+    assert list(listing["sdc"]) == [0.0, 0.1, 0.2, 0.5]
+    assert math.isnan(listing.set_index("case_key").loc[case, "extra"])
+    assert store.summary()["n_dem_runs"] == 4
+    with pytest.raises(StoreError, match="no DEM run"):
+        store.get_dem_run("missing")
+    with pytest.raises(StoreError, match="not valid"):
+        store.has_dem_run("a/b")
+
+
+def test_batch_with_one_bad_item_stores_none(store):
+    store.add_dem_run("x", {"sdc": 0.1})
+    before = store.path.read_bytes()
+    with pytest.raises(StoreError, match="replace=True"):
+        store.add_dem_runs([{"case_key": "y", "record": {"sdc": 0.2}},
+                            {"case_key": "x", "record": {"sdc": 0.3}}])
+    assert store.path.read_bytes() == before and not store.has_dem_run("y")
+    with pytest.raises(StoreError, match="twice"):
+        store.add_dem_runs([{"case_key": "z", "record": {}}, {"case_key": "z", "record": {}}])
+    with pytest.raises(StoreError, match="unknown"):
+        store.add_dem_runs([{"case_key": "z", "record": {}, "replce": True}])
+
+
+def test_summary_counts(store):
+    assert store.summary()["exists"] is False and store.summary()["n_measurements"] == 0
+    mkey, _ = store.add_measurement(make_measurement(8))
+    store.add_measurement(make_measurement(9))
+    store.add_analysis(mkey, {"sdc": 0.2})
+    store.add_dem_run("c", {"sdc": 0.1})
+    summary = store.summary()
+    assert (summary["n_measurements"], summary["n_analyses"], summary["n_dem_runs"]) == (2, 1, 1)
+    assert summary["store_version"] == 1 and summary["size_bytes"] == store.path.stat().st_size
+
+
+def test_verify_finds_tampering(store):
+    mkey, _ = store.add_measurement(make_measurement(10))
+    akey = store.add_analysis(mkey, {"sdc": 0.2}, arrays={"x": np.arange(100.0)})
+    store.add_dem_run("c", {"sdc": 0.1})
+    assert store.verify() == []
+    with h5py.File(store.path, "r+") as h5:
+        del h5[f"analyses/{akey}"].attrs["created_utc"]
+        h5["dem_runs/c"].attrs["case_key"] = "other"
+        del h5[f"measurements/{mkey}/channels/000"].attrs["sample_rate_hz"]
+    problems = store.verify()
+    assert len(problems) == 3
+    assert any(akey in p and "created_utc" in p for p in problems)
+    assert any("/dem_runs/c" in p and "case_key" in p for p in problems)
+    assert any(mkey in p and "sample_rate_hz" in p for p in problems)
+
+
+def test_verify_detects_flipped_bits_in_array(store):
+    mkey, _ = store.add_measurement(make_measurement(11))
+    akey = store.add_analysis(mkey, {"sdc": 0.2}, arrays={"x": np.arange(1000.0)})
+    with h5py.File(store.path, "r") as h5:
+        # fletcher32 makes the dataset chunked: locate the first chunk's bytes in the file.
+        offset = h5[f"analyses/{akey}/arrays/x"].id.get_chunk_info(0).byte_offset
+    raw = bytearray(store.path.read_bytes())
+    raw[offset + 8] ^= 0xFF  # inside the (uncompressed, checksummed) samples
+    store.path.write_bytes(bytes(raw))
+    problems = store.verify()
+    assert len(problems) == 1 and akey in problems[0]
+
+
+def test_corrupt_file_is_refused_and_never_overwritten(tmp_path):
+    path = tmp_path / "pid_store.h5"
+    store = Store(path)  # no file yet: fine, created on first write
+    path.write_bytes(b"this is not HDF5 at all\n" * 100)  # e.g. a half-copied or foreign file
+    before = path.read_bytes()
+    with pytest.raises(StoreError, match=r"pid_store\.h5: not a readable pidcore store \("):
+        Store(path)
+    with pytest.raises(StoreError, match="not a readable pidcore store"):
+        store.list_measurements()
+    with pytest.raises(StoreError, match="not a readable pidcore store"):
+        store.get_dem_run("c")
+    with pytest.raises(StoreError, match=r"pid_store\.h5: not a readable pidcore store"):
+        store.add_dem_run("c", {"sdc": 0.1})
+    with pytest.raises(StoreError, match="not a readable pidcore store"):
+        store.add_measurement(make_measurement(12))
+    problems = store.verify()
+    assert len(problems) == 1 and "not a readable pidcore store" in problems[0]
+    assert path.read_bytes() == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["pid_store.h5", "pid_store.h5.lock"]
+
+
+def test_hdf5_without_version_attribute_is_refused(tmp_path):
+    path = tmp_path / "other.h5"
+    store = Store(path)
+    with h5py.File(path, "w") as h5:  # an HDF5 file that is not a store (e.g. a DAQ export)
+        h5["data"] = np.arange(3)
+    before = path.read_bytes()
+    with pytest.raises(StoreError, match="pidcore_store_version"):
+        Store(path)
+    with pytest.raises(StoreError, match="pidcore_store_version"):
+        store.summary()
+    with pytest.raises(StoreError, match="pidcore_store_version"):
+        store.add_dem_run("c", {"sdc": 0.1})
+    assert path.read_bytes() == before
+
+
+def test_directory_and_unwritable_paths_give_store_errors(tmp_path):
+    with pytest.raises(StoreError, match="not a readable pidcore store"):
+        Store(tmp_path)  # a directory
+    with pytest.raises(StoreError, match="does not exist"):
+        Store(tmp_path / "missing" / "s.h5").add_dem_run("c", {"sdc": 0.1})
+
+
+def test_newer_store_version_is_refused(store):
+    store.add_dem_run("c", {"sdc": 0.1})
+    with h5py.File(store.path, "r+") as h5:
+        h5.attrs["pidcore_store_version"] = np.int64(STORE_VERSION + 1)
+    with pytest.raises(StoreError, match="newer"):
+        store.list_dem_runs()
