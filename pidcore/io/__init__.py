@@ -1,1 +1,192 @@
-"""pidcore.io"""
+"""Readers and writers of measurement files, and channel role detection.
+
+Every reader returns a :class:`~pidcore.records.Measurement` whose channels are in SI units,
+whose ``source`` is the path as given, whose ``sha256`` is the hash of the file's bytes and whose
+``file_format`` is one of :data:`pidcore.constants.FileFormat`. Readers do not judge the samples
+(NaN and inf are passed on; the analysis rejects them naming the channel). A file that cannot be
+read raises :class:`~pidcore.errors.InputFileError` naming the file and what was expected.
+
+Formats (detected from the content first, the extension second):
+
+========  =====================================================  ==========================
+format    content                                                module
+========  =====================================================  ==========================
+uff       UFF dataset 58/58b time records (``.uff``, ``.unv``)   :mod:`pidcore.io.uff`
+csv       delimited text with a ``Name [unit]`` header           :mod:`pidcore.io.delimited`
+mat       MATLAB v5 / v7.3                                       :mod:`pidcore.io.matlab`
+hdf5      pidcore measurement group or store                     :mod:`pidcore.io.hdf5`
+========  =====================================================  ==========================
+
+Examples
+--------
+>>> from pidcore.io import read_measurement, assign_roles  # doctest: +SKIP
+>>> m = read_measurement("run_012.uff")                     # doctest: +SKIP
+>>> roles = assign_roles(m, force="Drive point force")      # doctest: +SKIP
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from pathlib import Path
+
+from ..constants import FileFormat
+from ..errors import InputFileError, ParameterError
+from ..records import Measurement
+from .delimited import read_csv, write_csv
+from .hdf5 import hdf5_keys, read_hdf5, write_hdf5
+from .matlab import read_mat, write_mat
+from .roles import RoleAssignment, assign_roles, name_suggests
+from .uff import read_uff, write_uff
+
+__all__ = [
+    "FILE_FORMAT_EXTENSIONS", "RoleAssignment", "assign_roles", "detect_file_format",
+    "hdf5_keys", "name_suggests", "read_csv", "read_hdf5", "read_mat", "read_measurement",
+    "read_measurements", "read_uff", "write_csv", "write_hdf5", "write_mat",
+    "write_measurement", "write_uff",
+]
+
+#: File name extensions of each format (lower case), used when the content does not decide.
+FILE_FORMAT_EXTENSIONS: dict[str, tuple[str, ...]] = {
+    "uff": (".uff", ".unv", ".bunv", ".frf"),
+    "csv": (".csv", ".txt", ".tsv", ".dat"),
+    "mat": (".mat",),
+    "hdf5": (".h5", ".hdf5", ".hdf"),
+}
+_FORMATS = tuple(FILE_FORMAT_EXTENSIONS)
+_HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
+_UFF_START = re.compile(rb"\A\s*-1[ \t]*\r?\n\s*\d+")
+
+
+def detect_file_format(path: str | os.PathLike[str]) -> str:
+    """Format of a file from its first bytes, else from its extension.
+
+    Raises
+    ------
+    InputFileError
+        Missing, unreadable or empty file, or neither content nor extension decides.
+    """
+    where = str(path)
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(1024)
+    except FileNotFoundError:
+        raise InputFileError(f"{where}: file not found") from None
+    except OSError as exc:
+        raise InputFileError(f"{where}: cannot open ({exc.strerror})") from None
+    if not head:
+        raise InputFileError(f"{where}: empty file; expected a UFF, CSV, MAT or HDF5 "
+                             "measurement file")
+    if head.startswith(b"MATLAB"):
+        return "mat"  # v5 header text; v7.3 is HDF5 behind the same 128-byte text header
+    if head.startswith(_HDF5_SIGNATURE) or head[512:520] == _HDF5_SIGNATURE:
+        return "hdf5"
+    if _UFF_START.match(head):
+        return "uff"
+    suffix = Path(where).suffix.lower()
+    for fmt, extensions in FILE_FORMAT_EXTENSIONS.items():
+        if suffix in extensions:
+            return fmt
+    if b"\x00" not in head:
+        return "csv"
+    raise InputFileError(f"{where}: unknown file format; expected UFF (.uff/.unv), CSV/TXT, "
+                         "MATLAB (.mat) or pidcore HDF5 (.h5)")
+
+
+def _check_format(file_format: str | None) -> None:
+    if file_format is not None and file_format not in _FORMATS:
+        raise ParameterError(f"file_format must be one of {', '.join(_FORMATS)}; "
+                             f"got {file_format!r}")
+
+
+def read_measurements(path: str | os.PathLike[str], *, sample_rate_hz: float | None = None,
+                      file_format: FileFormat | None = None) -> list[Measurement]:
+    """All measurements in a file: several for a pidcore store, otherwise one.
+
+    See :func:`read_measurement` for the parameters.
+    """
+    _check_format(file_format)
+    fmt = file_format or detect_file_format(path)
+    if fmt == "hdf5":
+        return read_hdf5(path)
+    return [read_measurement(path, sample_rate_hz=sample_rate_hz, file_format=fmt)]
+
+
+def read_measurement(path: str | os.PathLike[str], *, sample_rate_hz: float | None = None,
+                     file_format: FileFormat | None = None, key: str | None = None
+                     ) -> Measurement:
+    """Read one measurement file into SI channels.
+
+    Parameters
+    ----------
+    path : str or path-like
+        UFF (58/58b), CSV/TXT, MATLAB or pidcore HDF5 file.
+    sample_rate_hz : float, optional
+        Sample rate, Hz, for CSV or MATLAB files without a time vector. Where the file has a
+        time base, a different value raises :class:`ParameterError`; UFF and HDF5 files carry
+        their own rate and ignore it.
+    file_format : {"uff", "csv", "mat", "hdf5"}, optional
+        Skip detection.
+    key : str, optional
+        Which measurement of a pidcore store (``/measurements/<key>``) to read.
+
+    Returns
+    -------
+    Measurement
+
+    Raises
+    ------
+    InputFileError
+        The file is missing, empty, truncated, corrupt or holds no time record; a store holds
+        several measurements and no ``key`` was given (the message lists the keys).
+    """
+    _check_format(file_format)
+    fmt = file_format or detect_file_format(path)
+    if not Path(path).is_file():
+        raise InputFileError(f"{path}: file not found")
+    if sample_rate_hz is not None and not sample_rate_hz > 0:
+        raise ParameterError(f"sample_rate_hz must be positive, got {sample_rate_hz!r}")
+    if fmt == "uff":
+        return read_uff(path)
+    if fmt == "csv":
+        return read_csv(path, sample_rate_hz=sample_rate_hz)
+    if fmt == "mat":
+        return read_mat(path, sample_rate_hz=sample_rate_hz)
+    keys = hdf5_keys(path)
+    if key is None and len(keys) > 1:
+        raise InputFileError(f"{path}: holds {len(keys)} measurements ({', '.join(keys)}); "
+                             "choose one with key=")
+    return read_hdf5(path, key=key)[0]
+
+
+def write_measurement(measurement: Measurement, path: str | os.PathLike[str],
+                      file_format: FileFormat | None = None, *, binary: bool = False) -> None:
+    """Write ``measurement`` to ``path`` atomically (temporary file, then rename).
+
+    Parameters
+    ----------
+    measurement : Measurement
+    path : str or path-like
+    file_format : {"uff", "csv", "mat", "hdf5"}, optional
+        Defaults to the format of the extension of ``path``.
+    binary : bool
+        UFF only: write 58b (float64) instead of ASCII 58.
+    """
+    _check_format(file_format)
+    fmt = file_format
+    if fmt is None:
+        suffix = Path(path).suffix.lower()
+        fmt = next((f for f, exts in FILE_FORMAT_EXTENSIONS.items() if suffix in exts), None)
+        if fmt is None:
+            raise ParameterError(f"{path}: cannot tell the format from the extension "
+                                 f"{suffix!r}; give file_format ({', '.join(_FORMATS)})")
+    if binary and fmt != "uff":
+        raise ParameterError(f"binary=True applies to UFF only, not {fmt}")
+    if fmt == "uff":
+        write_uff(measurement, path, binary=binary)
+    elif fmt == "csv":
+        write_csv(measurement, path)
+    elif fmt == "mat":
+        write_mat(measurement, path)
+    else:
+        write_hdf5(measurement, path)

@@ -1,0 +1,211 @@
+"""Sweeps of DEM load cases: local process pool by default, dask.distributed on request.
+
+Every finished case is written to the store at once, in its own transaction, by the parent
+process (the store's lock serialises writers, but one writer is simpler and faster). An
+interrupted sweep therefore keeps every finished case, and a re-run skips them: the case key
+holds every input that changes the result (load case, cells, seed, numerical options).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import time
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ..constants import DriveDirection, ParticleMaterial
+from ..errors import ParameterError
+from .simulate import DemConfig, LoadCase, config_parameters, simulate_load_case
+
+#: Named grids. ``table3`` is the paper's Table 3: 4 frequencies x 3 accelerations x 4 fills.
+GRIDS: dict[str, dict[str, tuple[float, ...]]] = {
+    "table3": {
+        "frequency_hz": (50.0, 100.0, 500.0, 1000.0),
+        "acceleration_g": (1.0, 5.0, 10.0),
+        "fill_percent": (25.0, 50.0, 75.0, 90.0),
+    },
+}
+
+#: Units of the scalar fields stored per DEM run.
+DEM_RUN_UNITS = {
+    "frequency_hz": "Hz", "acceleration_g": "g", "fill_percent": "%", "sdc": "1",
+    "sdc_stderr": "1", "loss_factor": "1", "energy_per_cycle_j": "J",
+    "energy_dissipated_normal_j": "J", "energy_dissipated_friction_j": "J",
+    "max_kinetic_energy_j": "J", "m_c_kg": "kg", "coupon_mass_kg": "kg",
+    "energy_balance_error": "1", "work_walls_j": "J", "dissipated_total_j": "J",
+    "mechanical_energy_change_j": "J", "wall_s": "s", "particle_steps_per_s": "1/s",
+    "time_step_s": "s", "settle_time_s": "s", "sample_rate_hz": "Hz",
+}
+
+
+def grid_cases(grid: str = "table3", *, material: ParticleMaterial = "acrylic",
+               direction: DriveDirection = "z") -> list[LoadCase]:
+    """Load cases of a named grid, ordered like the paper's Table 3 (f, a, fill)."""
+    if grid not in GRIDS:
+        raise ParameterError(f"--grid: unknown grid {grid!r}; expected one of {sorted(GRIDS)}")
+    g = GRIDS[grid]
+    return [LoadCase(f, a, p, material, direction)
+            for f in g["frequency_hz"] for a in g["acceleration_g"] for p in g["fill_percent"]]
+
+
+def run_key(case: LoadCase, config: DemConfig) -> str:
+    """Store key of one DEM run: readable load case plus a hash of every other input."""
+    params = config_parameters(case, config)
+    digest = hashlib.sha256(json.dumps(params, sort_keys=True, default=str).encode()).hexdigest()
+    return f"{case.key()}_seed{config.seed}_cells{config.cells}_{digest[:10]}"
+
+
+@dataclass(frozen=True)
+class CaseOutcome:
+    """What a worker sends back: plain data, cheap to pickle, ready for the store."""
+
+    key: str
+    record: dict
+    arrays: dict
+    parameters: dict
+
+
+def run_case(case: LoadCase, config: DemConfig) -> CaseOutcome:
+    """Simulate one case (in a worker) and package it for the store."""
+    result = simulate_load_case(case, config)
+    record = result.to_dict()
+    record.pop("case_key", None)  # the store keeps the key itself
+    return CaseOutcome(run_key(case, config), record, result.arrays(),
+                       config_parameters(case, config))
+
+
+def _single_thread_worker() -> None:
+    # Parallelism is across load cases; threads inside each would oversubscribe the cores.
+    import numba
+
+    numba.set_num_threads(1)
+
+
+@dataclass
+class SweepSummary:
+    """What a sweep did: keys run now, keys skipped as already stored, wall time."""
+
+    completed: list[str] = field(default_factory=list)
+    skipped: list[str] = field(default_factory=list)
+    wall_s: float = 0.0
+    store_path: str = ""
+
+    def to_dict(self) -> dict:
+        return {"completed": len(self.completed), "skipped": len(self.skipped),
+                "wall_s": self.wall_s, "store": self.store_path}
+
+
+def run_sweep(cases: Sequence[LoadCase], config: DemConfig, *,
+              store_path: str | os.PathLike, workers: int | None = None,
+              scheduler: str | None = None, progress: bool = True,
+              on_case: Callable[[CaseOutcome], None] | None = None) -> SweepSummary:
+    """Run every case not yet in the store and save each one as soon as it finishes.
+
+    Parameters
+    ----------
+    cases : sequence of LoadCase
+    config : DemConfig
+        Numerical settings shared by all cases (cells, seed, time step, ...).
+    store_path : path
+        HDF5 store; finished cases found there are skipped (resume).
+    workers : int, optional
+        Local processes (default: all cores). Ignored with ``scheduler``.
+    scheduler : str, optional
+        Address of a dask.distributed scheduler (``tcp://host:8786``); needs the
+        ``distributed`` extra.
+    progress : bool
+        tqdm bar on stderr.
+    on_case : callable, optional
+        Called with each finished :class:`CaseOutcome` after it is stored (the app's progress).
+    """
+    from ..store import Store
+
+    start = time.perf_counter()
+    store = Store(store_path)
+    summary = SweepSummary(store_path=str(Path(store_path)))
+    todo: list[tuple[LoadCase, str]] = []
+    for case in cases:
+        key = run_key(case, config)
+        if store.has_dem_run(key):
+            summary.skipped.append(key)
+        else:
+            todo.append((case, key))
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        bar = tqdm(total=len(cases), initial=len(summary.skipped), unit="case", desc="DEM sweep")
+
+    def finish(outcome: CaseOutcome) -> None:
+        store.add_dem_run(outcome.key, outcome.record, arrays=outcome.arrays,
+                          parameters=outcome.parameters, units=DEM_RUN_UNITS, replace=True)
+        summary.completed.append(outcome.key)
+        if bar is not None:
+            bar.update(1)
+            bar.set_postfix_str(outcome.key.split("_seed")[0])
+        if on_case is not None:
+            on_case(outcome)
+
+    try:
+        if todo and scheduler:
+            _run_dask(todo, config, scheduler, finish)
+        elif todo:
+            _run_local(todo, config, workers, finish)
+    finally:
+        if bar is not None:
+            bar.close()
+        summary.wall_s = time.perf_counter() - start
+    return summary
+
+
+def _run_local(todo: Iterable[tuple[LoadCase, str]], config: DemConfig, workers: int | None,
+               finish: Callable[[CaseOutcome], None]) -> None:
+    todo = list(todo)
+    workers = workers or os.cpu_count() or 1
+    if workers < 1:
+        raise ParameterError(f"--workers: expected a positive number of processes, got {workers}")
+    if workers == 1 or len(todo) == 1:
+        for case, _ in todo:
+            finish(run_case(case, config))
+        return
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor, as_completed
+
+    # spawn, not fork: forking a process whose numba kernels already started OpenMP threads
+    # is unsafe (the child aborts). Spawned workers load the kernels from numba's disk cache.
+    pool = ProcessPoolExecutor(max_workers=min(workers, len(todo)),
+                               mp_context=multiprocessing.get_context("spawn"),
+                               initializer=_single_thread_worker)
+    try:
+        futures = [pool.submit(run_case, case, config) for case, _ in todo]
+        for future in as_completed(futures):
+            finish(future.result())
+    except BaseException:
+        # Ctrl-C or a failed case: drop queued work now; finished cases are already stored.
+        pool.shutdown(wait=False, cancel_futures=True)
+        raise
+    pool.shutdown()
+
+
+def _run_dask(todo: Iterable[tuple[LoadCase, str]], config: DemConfig, scheduler: str,
+              finish: Callable[[CaseOutcome], None]) -> None:
+    try:
+        from distributed import Client, as_completed
+    except ImportError:
+        raise ParameterError("--scheduler needs dask.distributed: "
+                             "pip install 'pidcore[distributed]'") from None
+    client = Client(scheduler)
+    try:
+        futures = [client.submit(run_case, case, config, key=f"pidcore-{key}", pure=False)
+                   for case, key in todo]
+        try:
+            for future in as_completed(futures):
+                finish(future.result())
+        except BaseException:
+            client.cancel(futures)
+            raise
+    finally:
+        client.close()

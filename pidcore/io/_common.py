@@ -1,0 +1,139 @@
+"""Helpers shared by the readers and writers: hashing, naming, time bases, units, atomic writes."""
+
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import os
+import tempfile
+from collections.abc import Iterator, Sequence
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import InputFileError
+from ..records import Channel
+from ..units import canonical_unit_text, lookup_unit
+
+#: Largest deviation of a sample time from the fitted even grid, as a fraction of the sample
+#: interval. Printed time columns carry rounding errors far below this; a dropped or repeated
+#: sample moves later samples by a whole interval and is caught.
+EVEN_SPACING_TOLERANCE = 0.05
+
+#: Relative distance within which a sample rate read from float64 data is snapped to whole Hz
+#: (removes only representation noise such as 1/0.0001).
+FLOAT64_RATE_RESOLUTION = 1e-9
+
+
+def file_sha256(path: str | os.PathLike[str]) -> str:
+    """SHA-256 (hex) of a file's bytes, read in blocks."""
+    digest = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()
+
+
+def unique_names(names: Sequence[str]) -> list[str]:
+    """Make names unique by suffixing repeats with ``" (2)"``, ``" (3)"``, ... in file order.
+
+    >>> unique_names(["1+Z", "2+Z", "1+Z"])
+    ['1+Z', '2+Z', '1+Z (2)']
+    """
+    seen: set[str] = set()
+    counts: dict[str, int] = {}
+    out = []
+    for name in names:
+        candidate = name
+        if candidate in seen:
+            k = counts.get(name, 1)
+            while candidate in seen:
+                k += 1
+                candidate = f"{name} ({k})"
+            counts[name] = k
+        seen.add(candidate)
+        out.append(candidate)
+    return out
+
+
+def snap_rate(rate_hz: float, relative_resolution: float) -> float:
+    """Round a sample rate to whole Hz when it lies within the file's number resolution.
+
+    UFF writes the sample interval with six significant digits, so 65 536 Hz reads back as
+    1/1.52588e-05 = 65 535.95 Hz; snapping restores the rate the instrument used.
+    """
+    nearest = round(rate_hz)
+    if nearest > 0 and abs(rate_hz - nearest) <= relative_resolution * rate_hz:
+        return float(nearest)
+    return float(rate_hz)
+
+
+def rate_from_times(times: np.ndarray, *, what: str) -> tuple[float, float]:
+    """Sample rate (Hz) and start time (s) of an evenly spaced time vector.
+
+    Raises :class:`InputFileError` naming ``what`` when the vector is too short, not
+    increasing or not evenly spaced (see :data:`EVEN_SPACING_TOLERANCE`).
+    """
+    t = np.asarray(times, dtype=np.float64)
+    if t.ndim != 1 or t.size < 2:
+        raise InputFileError(f"{what}: a time base needs at least 2 samples, found {t.size}")
+    if not np.all(np.isfinite(t)):
+        raise InputFileError(f"{what}: the time column holds non-finite values")
+    dt = (t[-1] - t[0]) / (t.size - 1)
+    if not dt > 0:
+        raise InputFileError(f"{what}: time does not increase (first {t[0]!r}, last {t[-1]!r})")
+    residual = np.max(np.abs(t - (t[0] + dt * np.arange(t.size))))
+    if residual > EVEN_SPACING_TOLERANCE * dt:
+        worst = int(np.argmax(np.abs(np.diff(t) - dt)))
+        raise InputFileError(
+            f"{what}: time is not evenly spaced (mean interval {dt:.6g} s, interval after sample "
+            f"{worst} is {t[worst + 1] - t[worst]:.6g} s); expected a constant sample interval")
+    return snap_rate(1.0 / dt, FLOAT64_RATE_RESOLUTION), float(t[0])
+
+
+def interpret_unit(unit_text: str) -> tuple[str, float]:
+    """Quantity and SI factor of a unit label; unknown or empty labels give ``("unknown", 1)``.
+
+    Readers keep channels of unknown units (a voltage squared, a sound level) rather than fail:
+    the analysis decides whether it needs them.
+    """
+    text = unit_text.strip()
+    if not text or canonical_unit_text(text) in {"none", "-", "1", ""}:
+        return "unknown", 1.0
+    info = lookup_unit(text)
+    if info is None:
+        return "unknown", 1.0
+    return info.quantity, info.factor
+
+
+def make_channel(name: str, values: np.ndarray, *, sample_rate_hz: float, unit: str,
+                 start_time_s: float = 0.0, quantity: str | None = None,
+                 factor: float | None = None) -> Channel:
+    """Build a SI :class:`Channel` from raw values in ``unit``."""
+    if quantity is None or factor is None:
+        quantity, factor = interpret_unit(unit)
+    data = np.asarray(values, dtype=np.float64).reshape(-1)
+    if factor != 1.0:
+        data = data * factor
+    return Channel(name=name, quantity=quantity, data=data, sample_rate_hz=float(sample_rate_hz),
+                   source_unit=unit.strip(), start_time_s=float(start_time_s))
+
+
+@contextlib.contextmanager
+def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
+    """Yield a temporary path beside ``path``; on success move it over ``path`` in one step.
+
+    A crash or exception leaves any existing file at ``path`` untouched and removes the
+    temporary file.
+    """
+    target = Path(path)
+    directory = target.parent if str(target.parent) else Path(".")
+    fd, tmp_name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=directory)
+    os.close(fd)
+    tmp = Path(tmp_name)
+    try:
+        yield tmp
+        os.replace(tmp, target)
+    finally:
+        if tmp.exists():
+            tmp.unlink()

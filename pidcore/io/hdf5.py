@@ -1,0 +1,86 @@
+"""pidcore HDF5 files: one measurement group (:mod:`pidcore.io.hdf5_layout`) at the root, or a
+store whose ``/measurements/<key>`` groups are measurement groups.
+
+The file read is what the user named, so ``source`` and ``sha256`` describe this file; the
+provenance stored in the group (the original file's name, hash and format) is kept in
+``metadata`` as ``original_source``, ``original_sha256`` and ``original_file_format``.
+"""
+
+from __future__ import annotations
+
+import os
+
+import h5py
+
+from ..errors import InputFileError, ParameterError
+from ..records import Measurement
+from ._common import atomic_path, file_sha256
+from .hdf5_layout import LAYOUT_TAG, read_measurement_group, write_measurement_group
+
+MEASUREMENTS_GROUP = "measurements"
+
+
+def _is_measurement(group: h5py.Group) -> bool:
+    tag = group.attrs.get("pidcore_layout", "")
+    return (tag.decode() if isinstance(tag, bytes) else str(tag)) == LAYOUT_TAG
+
+
+def _as_read(measurement: Measurement, where: str, sha256: str) -> Measurement:
+    metadata = dict(measurement.metadata)
+    metadata.update(original_source=measurement.source, original_sha256=measurement.sha256,
+                    original_file_format=measurement.file_format)
+    return Measurement(source=where, channels=measurement.channels, sha256=sha256,
+                       file_format="hdf5", metadata=metadata)
+
+
+def hdf5_keys(path: str | os.PathLike[str]) -> list[str]:
+    """Keys of the measurements in a pidcore HDF5 file (``[""]`` for a root measurement)."""
+    where = str(path)
+    try:
+        with h5py.File(where, "r") as h5:
+            if _is_measurement(h5):
+                return [""]
+            group = h5.get(MEASUREMENTS_GROUP)
+            if isinstance(group, h5py.Group):
+                return sorted(k for k in group if _is_measurement(group[k]))
+    except OSError as exc:
+        raise InputFileError(f"{where}: not a readable HDF5 file ({exc})") from None
+    raise InputFileError(f"{where}: HDF5 file without a pidcore measurement (expected a root "
+                         f"group with pidcore_layout='measurement' or '/{MEASUREMENTS_GROUP}/')")
+
+
+def read_hdf5(path: str | os.PathLike[str], *, key: str | None = None) -> list[Measurement]:
+    """Read the measurement(s) of a pidcore HDF5 file.
+
+    Parameters
+    ----------
+    path : str or path-like
+    key : str, optional
+        Read only ``/measurements/<key>``; an unknown key raises :class:`InputFileError`
+        listing the keys there are.
+    """
+    where = str(path)
+    keys = hdf5_keys(where)
+    if key is not None and keys != [""]:
+        if key not in keys:
+            raise InputFileError(f"{where}: no measurement {key!r}; keys are "
+                                 f"{', '.join(keys) or 'none'}")
+        keys = [key]
+    sha = file_sha256(where)
+    try:
+        with h5py.File(where, "r") as h5:
+            if keys == [""]:
+                return [_as_read(read_measurement_group(h5, where=where), where, sha)]
+            return [_as_read(read_measurement_group(h5[MEASUREMENTS_GROUP][k],
+                                                    where=f"{where}:/{MEASUREMENTS_GROUP}/{k}"),
+                             where, sha) for k in keys]
+    except OSError as exc:  # h5py raises OSError for damaged chunks
+        raise InputFileError(f"{where}: corrupt HDF5 data ({exc})") from None
+
+
+def write_hdf5(measurement: Measurement, path: str | os.PathLike[str]) -> None:
+    """Write one measurement group at the root of a new HDF5 file, atomically."""
+    if not measurement.channels:
+        raise ParameterError(f"{measurement.source}: nothing to write (no channels)")
+    with atomic_path(path) as tmp, h5py.File(tmp, "w") as h5:
+        write_measurement_group(h5, measurement)

@@ -1,0 +1,274 @@
+"""MATLAB ``.mat`` files (v5 via :func:`scipy.io.loadmat`, v7.3 via :mod:`h5py`).
+
+Three layouts are understood, tried in this order:
+
+1. **pidcore layout** (what :func:`write_mat` writes): ``pidcore_layout = 'measurement'`` and
+   ``pidcore_channels``, a cell array of structs with fields ``name``, ``quantity``, ``unit``
+   (SI), ``source_unit``, ``data`` (SI samples), ``sample_rate_hz``, ``start_time_s``.
+2. **LMS Test.Lab export**: a struct (or struct array) ``Signal`` with
+   ``x_values.start_value``, ``x_values.increment`` (s), ``x_values.number_of_values``,
+   ``y_values.values`` (one column per channel) and, where present,
+   ``function_record.name`` (channel name; a cell of names for several columns) and the unit in
+   ``y_values.quantity`` (fields ``unit``/``units``/``unit_label``; a bare ``label`` such as
+   ``'Acceleration'`` is taken as that quantity in SI, the unit Test.Lab exports in).
+3. **simple layout**: a time vector ``time`` or ``t`` (s) plus one numeric vector per channel
+   (the variable name is the channel name), optionally ``units`` as a struct
+   (``units.Force = 'kN'``) or a cell of unit strings in the order of the channel variables.
+   Without a time vector, a scalar ``sample_rate_hz`` / ``fs`` or the reader's
+   ``sample_rate_hz`` argument gives the time base.
+
+Nothing in a ``.mat`` file is executed or unpickled: loadmat reads plain arrays and structs;
+MATLAB objects (``MCOS``) are ignored.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping
+
+import h5py
+import numpy as np
+import scipy.io
+
+from ..constants import SI_UNITS
+from ..errors import InputFileError, ParameterError
+from ..records import Channel, Measurement
+from ._common import (
+    atomic_path,
+    file_sha256,
+    make_channel,
+    rate_from_times,
+    unique_names,
+)
+
+_TIME_VARIABLES = ("time", "t", "Time", "T")
+_RATE_VARIABLES = ("sample_rate_hz", "fs", "Fs", "sample_rate")
+
+
+def _as_list(value: object) -> list:
+    if value is None:
+        return []
+    if isinstance(value, list | tuple):
+        return list(value)
+    if isinstance(value, np.ndarray) and value.dtype == object:
+        return list(value.ravel())
+    return [value]
+
+
+def _scalar(value: object, what: str) -> float:
+    arr = np.asarray(value, dtype=np.float64).ravel()
+    if arr.size != 1:
+        raise InputFileError(f"{what}: expected a scalar, found {arr.size} values")
+    return float(arr[0])
+
+
+def _text(value: object) -> str:
+    if isinstance(value, bytes):
+        return value.decode("utf-8", "replace")
+    if isinstance(value, str):
+        return value
+    if isinstance(value, np.ndarray) and value.dtype.kind in "US":
+        return "".join(str(v) for v in value.ravel())
+    return ""
+
+
+def _numeric_vector(value: object) -> np.ndarray | None:
+    if isinstance(value, np.ndarray) and value.dtype.kind in "fiub" and value.size >= 2:
+        squeezed = np.squeeze(value)
+        if squeezed.ndim == 1:
+            return squeezed.astype(np.float64)
+    return None
+
+
+# --- v7.3 (HDF5) -> the same nested dict/list/array shape loadmat(simplify_cells=True) gives
+
+
+def _h5_value(obj: h5py.Group | h5py.Dataset, file: h5py.File) -> object:
+    if isinstance(obj, h5py.Group):
+        return {k: _h5_value(obj[k], file) for k in obj if not k.startswith("#")}
+    matlab_class = obj.attrs.get("MATLAB_class", b"")
+    matlab_class = matlab_class.decode() if isinstance(matlab_class, bytes) else matlab_class
+    data = obj[()]
+    if matlab_class == "char":
+        return "".join(chr(c) for c in np.asarray(data).T.ravel())
+    if obj.dtype == h5py.ref_dtype:
+        return [_h5_value(file[ref], file) for ref in np.asarray(data).T.ravel()]
+    if obj.attrs.get("MATLAB_empty", 0):
+        return np.zeros(0)
+    arr = np.asarray(data)
+    return np.squeeze(arr.T) if arr.ndim > 1 else arr  # MATLAB is column-major
+
+
+def _load_v73(path: str) -> dict:
+    with h5py.File(path, "r") as h5:
+        return {k: _h5_value(h5[k], h5) for k in h5 if not k.startswith("#")}
+
+
+def _load(path: str) -> dict:
+    with open(path, "rb") as fh:
+        head = fh.read(520)
+    if not head:
+        raise InputFileError(f"{path}: empty file; expected a MATLAB .mat file")
+    if head.startswith(b"MATLAB 7.3") or head[512:520] == b"\x89HDF\r\n\x1a\n":
+        try:
+            return _load_v73(path)
+        except OSError as exc:
+            raise InputFileError(f"{path}: corrupt MATLAB v7.3 (HDF5) file ({exc})") from None
+    try:
+        return scipy.io.loadmat(path, simplify_cells=True)
+    except NotImplementedError:
+        return _load_v73(path)
+    except Exception as exc:  # scipy raises ValueError, TypeError, MatReadError, ...
+        raise InputFileError(f"{path}: not a readable MATLAB .mat file ({exc})") from None
+
+
+# --- layouts -------------------------------------------------------------------------------
+
+
+def _pidcore_layout(variables: Mapping, where: str) -> list[Channel]:
+    channels = []
+    for i, item in enumerate(_as_list(variables.get("pidcore_channels"))):
+        if not isinstance(item, Mapping):
+            raise InputFileError(f"{where}: pidcore_channels{{{i + 1}}} is not a struct")
+        try:
+            channels.append(Channel(
+                name=_text(item["name"]), quantity=_text(item["quantity"]),
+                data=np.atleast_1d(np.asarray(item["data"], dtype=np.float64)).ravel(),
+                sample_rate_hz=_scalar(item["sample_rate_hz"], where),
+                source_unit=_text(item.get("source_unit", "")),
+                start_time_s=_scalar(item.get("start_time_s", 0.0), where)))
+        except KeyError as exc:
+            raise InputFileError(f"{where}: pidcore_channels{{{i + 1}}} lacks field "
+                                 f"{exc}") from None
+    return channels
+
+
+def _lms_unit(quantity_struct: object) -> str:
+    if not isinstance(quantity_struct, Mapping):
+        return _text(quantity_struct)
+    for key in ("unit", "units", "unit_label", "unit_name"):
+        text = _text(quantity_struct.get(key))
+        if text:
+            return text
+    label = _text(quantity_struct.get("label")).strip().lower()
+    if label in SI_UNITS and label not in ("unknown", "time"):
+        return SI_UNITS[label]  # Test.Lab exports values in SI; the label names the quantity
+    return label
+
+
+def _lms_layout(signal: object, where: str) -> list[Channel]:
+    channels: list[Channel] = []
+    for k, sig in enumerate(_as_list(signal)):
+        what = f"{where}: Signal({k + 1})"
+        if not isinstance(sig, Mapping) or "x_values" not in sig or "y_values" not in sig:
+            raise InputFileError(f"{what}: expected fields x_values and y_values "
+                                 "(LMS Test.Lab export)")
+        x, y = sig["x_values"], sig["y_values"]
+        try:
+            start = _scalar(x.get("start_value", 0.0), what)
+            increment = _scalar(x["increment"], what)
+            values = np.asarray(y["values"], dtype=np.float64)
+        except (KeyError, AttributeError, TypeError, ValueError) as exc:
+            raise InputFileError(f"{what}: incomplete x_values/y_values ({exc})") from None
+        if not increment > 0:
+            raise InputFileError(f"{what}: x_values.increment is {increment!r}; expected a "
+                                 "positive sample interval in s")
+        values = values.reshape(values.shape[0], -1) if values.ndim > 1 else values[:, None]
+        if "number_of_values" in x:
+            n = int(_scalar(x["number_of_values"], what))
+            if values.shape[0] != n and values.shape[1] == n:
+                values = values.T  # channels stored as rows
+            if values.shape[0] < n:
+                raise InputFileError(f"{what}: y_values holds {values.shape[0]} of "
+                                     f"{n} samples; the file is truncated")
+            values = values[:n]
+        record = sig.get("function_record", {})
+        names = [_text(v) for v in _as_list(record.get("name") if isinstance(record, Mapping)
+                                            else None)]
+        unit = _lms_unit(y.get("quantity") if isinstance(y, Mapping) else None)
+        for j in range(values.shape[1]):
+            name = names[j] if j < len(names) and names[j] else f"Signal {k + 1}.{j + 1}"
+            channels.append(make_channel(name, values[:, j], sample_rate_hz=1.0 / increment,
+                                         unit=unit, start_time_s=start))
+    return channels
+
+
+def _simple_layout(variables: Mapping, where: str,
+                   sample_rate_hz: float | None) -> list[Channel]:
+    public = {k: v for k, v in variables.items() if not k.startswith("__")}
+    time_key = next((k for k in _TIME_VARIABLES if _numeric_vector(public.get(k)) is not None),
+                    None)
+    rate_key = next((k for k in _RATE_VARIABLES if k in public), None)
+    if time_key is not None:
+        rate, start = rate_from_times(_numeric_vector(public[time_key]),
+                                      what=f"{where}: variable {time_key!r}")
+        n = _numeric_vector(public[time_key]).size
+    elif rate_key is not None or sample_rate_hz is not None:
+        rate = (_scalar(public[rate_key], f"{where}: {rate_key}") if rate_key is not None
+                else float(sample_rate_hz))
+        start, n = 0.0, None
+    else:
+        raise InputFileError(f"{where}: no time vector ('time' or 't') and no sample rate "
+                             "('fs' or 'sample_rate_hz'); give the sample rate (--sample-rate)")
+    if sample_rate_hz is not None and abs(rate - sample_rate_hz) > 1e-6 * rate:
+        raise ParameterError(f"{where}: the file gives {rate:.9g} Hz but "
+                             f"sample_rate_hz={sample_rate_hz:.9g} was given")
+    skip = {time_key, rate_key, "units"}
+    vectors = {k: _numeric_vector(v) for k, v in public.items() if k not in skip}
+    vectors = {k: v for k, v in vectors.items() if v is not None and (n is None or v.size == n)}
+    units_var = public.get("units")
+    if isinstance(units_var, Mapping):
+        units = {k: _text(units_var.get(k)) for k in vectors}
+    else:
+        unit_list = [_text(u) for u in _as_list(units_var)]
+        units = {k: (unit_list[i] if i < len(unit_list) else "")
+                 for i, k in enumerate(vectors)}
+    return [make_channel(k, v, sample_rate_hz=rate, unit=units[k], start_time_s=start)
+            for k, v in vectors.items()]
+
+
+def read_mat(path: str | os.PathLike[str], *, sample_rate_hz: float | None = None) -> Measurement:
+    """Read a MATLAB file in one of the layouts of this module into a SI measurement.
+
+    Raises
+    ------
+    InputFileError
+        Unreadable file, or none of the layouts found (the message lists the variables).
+    """
+    where = str(path)
+    variables = _load(where)
+    if _text(variables.get("pidcore_layout")) == "measurement":
+        channels = _pidcore_layout(variables, where)
+        layout = "pidcore"
+    elif "Signal" in variables:
+        channels = _lms_layout(variables["Signal"], where)
+        layout = "lms_testlab"
+    else:
+        channels = _simple_layout(variables, where, sample_rate_hz)
+        layout = "simple"
+    if not channels:
+        names = ", ".join(k for k in variables if not k.startswith("__")) or "none"
+        raise InputFileError(f"{where}: no channel found (variables: {names}); expected numeric "
+                             "vectors beside 'time', an LMS 'Signal' struct or a pidcore layout")
+    names = unique_names([c.name for c in channels])
+    channels = [c if c.name == nm else Channel(nm, c.quantity, c.data, c.sample_rate_hz,
+                                               c.source_unit, c.start_time_s)
+                for c, nm in zip(channels, names, strict=True)]
+    return Measurement(source=where, channels=tuple(channels), sha256=file_sha256(path),
+                       file_format="mat", metadata={"mat_layout": layout})
+
+
+def write_mat(measurement: Measurement, path: str | os.PathLike[str]) -> None:
+    """Write the pidcore layout (MATLAB v5, float64, SI), atomically."""
+    if not measurement.channels:
+        raise ParameterError(f"{measurement.source}: nothing to write (no channels)")
+    cell = np.empty(len(measurement.channels), dtype=object)
+    for i, ch in enumerate(measurement.channels):
+        cell[i] = {"name": ch.name, "quantity": ch.quantity, "unit": ch.unit,
+                   "source_unit": ch.source_unit,
+                   "data": np.asarray(ch.data, dtype=np.float64).reshape(-1, 1),
+                   "sample_rate_hz": float(ch.sample_rate_hz),
+                   "start_time_s": float(ch.start_time_s)}
+    with atomic_path(path) as tmp, open(tmp, "wb") as fh:
+        scipy.io.savemat(fh, {"pidcore_layout": "measurement", "pidcore_channels": cell,
+                              "source": measurement.source}, do_compression=True)

@@ -1,0 +1,163 @@
+"""Which channel is the drive force, the velocity and the acceleration of a measurement.
+
+Rules, in order, for each role not named by the user:
+
+1. Channels whose quantity (from their unit) is the role's quantity. One -> taken. Several ->
+   those whose name also says the role (``"Force"``, ``"Kraft"``, ``"LDV"``, ``"acc"``, ...);
+   if that does not leave exactly one, :class:`ChannelError` names the candidates and the option
+   to choose (``--force NAME``).
+2. No channel of that quantity: channels of quantity ``"unknown"`` (no or unrecognised unit)
+   whose name says the role; their values are taken as SI. Several -> ambiguous, as above.
+
+Explicit names (``force=``, ``velocity=``, ``acceleration=``) override detection. A named
+channel must exist (else the error lists the channels) and must be of the role's quantity or
+of quantity ``"unknown"`` (taken as SI, e.g. a voltage-less export without units); a channel
+of another known quantity (``--force`` naming an acceleration channel) is refused.
+
+A force channel and at least one of velocity or acceleration are required.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+from ..errors import ChannelError
+from ..records import Channel, Measurement
+
+_NAME_TOKENS = {
+    "force": {"force", "f", "fz", "kraft", "load", "forcecell", "loadcell"},
+    "velocity": {"vel", "velocity", "v", "vz", "ldv", "vibrometer", "laser", "speed",
+                 "geschwindigkeit", "schnelle"},
+    "acceleration": {"acc", "accel", "acceleration", "accelerometer", "a", "az",
+                     "beschleunigung"},
+}
+_NAME_PREFIXES = {
+    "force": ("force", "kraft"),
+    "velocity": ("veloc", "vibrom", "ldv"),
+    "acceleration": ("accel", "acc", "beschl"),
+}
+_OPTIONS = {"force": "--force", "velocity": "--velocity", "acceleration": "--acceleration"}
+
+
+@dataclass(frozen=True)
+class RoleAssignment:
+    """Channels playing the roles of a power analysis.
+
+    Attributes
+    ----------
+    force : Channel
+        Drive force, N.
+    velocity : Channel or None
+        Drive-point velocity, m/s.
+    acceleration : Channel or None
+        Drive-point acceleration, m/s^2.
+    """
+
+    force: Channel
+    velocity: Channel | None
+    acceleration: Channel | None
+
+
+def name_suggests(name: str, role: str) -> bool:
+    """Whether a channel name says ``role`` (``"Drive point force"`` -> force).
+
+    >>> name_suggests("Acc 1", "acceleration"), name_suggests("1+Z", "force")
+    (True, False)
+    """
+    tokens = re.findall(r"[a-zäöüß]+", name.lower())
+    if any(t in _NAME_TOKENS[role] for t in tokens):
+        return True
+    return any(t.startswith(_NAME_PREFIXES[role]) for t in tokens if len(t) > 2)
+
+
+def _names(channels: list[Channel]) -> str:
+    return ", ".join(repr(c.name) for c in channels) or "none"
+
+
+def _detect(measurement: Measurement, role: str, taken: set[str]) -> Channel | None:
+    free = [c for c in measurement.channels if c.name not in taken]
+    by_quantity = [c for c in free if c.quantity == role]
+    if len(by_quantity) == 1:
+        return by_quantity[0]
+    if len(by_quantity) > 1:
+        named = [c for c in by_quantity if name_suggests(c.name, role)]
+        if len(named) == 1:
+            return named[0]
+        raise ChannelError(f"{measurement.source}: {len(by_quantity)} {role} channels "
+                           f"({_names(by_quantity)}); choose one with {_OPTIONS[role]} NAME")
+    by_name = [c for c in free if c.quantity == "unknown" and name_suggests(c.name, role)]
+    if len(by_name) == 1:
+        return by_name[0]
+    if len(by_name) > 1:
+        raise ChannelError(f"{measurement.source}: {len(by_name)} channels look like {role} "
+                           f"({_names(by_name)}); choose one with {_OPTIONS[role]} NAME")
+    return None
+
+
+def _named(measurement: Measurement, role: str, name: str) -> Channel:
+    channel = measurement.channel(name)  # ChannelError listing the channels there are
+    if channel.quantity not in (role, "unknown"):
+        raise ChannelError(f"{measurement.source}: {_OPTIONS[role]} {name!r} is a "
+                           f"{channel.quantity} channel ({channel.source_unit or channel.unit});"
+                           f" expected a {role} channel or one without a unit")
+    return channel
+
+
+def assign_roles(measurement: Measurement, *, force: str | None = None,
+                 velocity: str | None = None, acceleration: str | None = None
+                 ) -> RoleAssignment:
+    """Find the force, velocity and acceleration channels of ``measurement``.
+
+    Parameters
+    ----------
+    measurement : Measurement
+    force, velocity, acceleration : str, optional
+        Channel names that override detection.
+
+    Returns
+    -------
+    RoleAssignment
+
+    Raises
+    ------
+    ChannelError
+        Unknown or unsuitable named channel, ambiguous detection, no force channel, or neither
+        velocity nor acceleration.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from pidcore.records import Channel, Measurement
+    >>> chans = (Channel("F", "force", np.zeros(4), 100.0),
+    ...          Channel("LDV", "velocity", np.zeros(4), 100.0))
+    >>> assign_roles(Measurement("demo.csv", chans)).velocity.name
+    'LDV'
+    """
+    explicit = {"force": force, "velocity": velocity, "acceleration": acceleration}
+    chosen: dict[str, Channel | None] = {}
+    for role, name in explicit.items():
+        if name is not None:
+            chosen[role] = _named(measurement, role, name)
+    taken = {c.name for c in chosen.values() if c is not None}
+    repeated = [r for r, c in chosen.items()
+                if c is not None and sum(o is c for o in chosen.values()) > 1]
+    if repeated:
+        raise ChannelError(f"{measurement.source}: one channel named for several roles "
+                           f"({', '.join(repeated)})")
+    for role in ("force", "velocity", "acceleration"):
+        if role not in chosen:
+            chosen[role] = _detect(measurement, role, taken)
+            if chosen[role] is not None:
+                taken.add(chosen[role].name)
+        if role == "force" and chosen["force"] is None:
+            # Checked before the other roles: a missing force is the more basic problem.
+            raise ChannelError(f"{measurement.source}: no force channel among "
+                               f"{_names(list(measurement.channels))}; name one with "
+                               "--force NAME")
+    if chosen["velocity"] is None and chosen["acceleration"] is None:
+        raise ChannelError(f"{measurement.source}: no velocity or acceleration channel among "
+                           f"{_names(list(measurement.channels))}; name one with --velocity NAME "
+                           "or --acceleration NAME")
+    return RoleAssignment(force=chosen["force"], velocity=chosen["velocity"],
+                          acceleration=chosen["acceleration"])

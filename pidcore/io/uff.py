@@ -1,0 +1,322 @@
+"""Universal File Format (UFF/UNV) dataset 58 time records, ASCII and binary (58b).
+
+Reading and writing go through :mod:`pyuff`. What this module adds on top:
+
+* Only time records become channels: function type 1 ("time response"), or type 0
+  ("general") with a time abscissa (specific data type 17). FRFs, spectra and geometry are
+  refused with a message listing what the file holds.
+* One file is one :class:`~pidcore.records.Measurement`; its time records are the channels, in
+  file order. Records of different sample rates are kept; the analysis refuses them.
+* Channel name: the response entity name (``"1+Z"``, ``"Mic 01"``), else ID line 1, else
+  node and direction (``"12+Z"``), else ``"record <k>"``. Repeated names get ``" (2)"``, ...
+* Units: the ordinate units label when :mod:`pidcore.units` recognises it (``"m/s2"``, ``"g"``,
+  ``"N"``, ``"Pa"``); otherwise the specific data type code (8, 9, 11, 12, 13, 15) with the
+  dataset 164 unit factors of the file (SI when the file has no dataset 164); otherwise the
+  channel keeps its values with quantity ``"unknown"`` (e.g. ``"V^2"``).
+* Quirks handled: the zero padding of the last data line (values beyond ``num_pts`` are
+  dropped), an extra CR LF after 58b binary data (pyuff ignores the stray bytes), E13.5 fields
+  without separating blanks and 3-digit exponents (pyuff reads fixed columns), Latin-1 header
+  bytes (decoded with replacement; they only occur in labels).
+* The sample interval is written with six significant digits (E13.5), so a sample rate within
+  that resolution of a whole number of Hz is snapped to it (65 535.95 Hz -> 65 536 Hz).
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import os
+import re
+from pathlib import Path
+
+import numpy as np
+import pyuff
+
+from ..constants import SI_UNITS
+from ..errors import InputFileError, ParameterError
+from ..records import Channel, Measurement
+from ._common import (
+    atomic_path,
+    file_sha256,
+    interpret_unit,
+    rate_from_times,
+    snap_rate,
+    unique_names,
+)
+from ._uff_ascii import parse_uff_ascii
+
+#: Relative resolution of an E13.5 field (six significant digits): half a unit in the sixth.
+UFF_INTERVAL_RESOLUTION = 5e-6
+
+_DATASET_NAMES = {
+    15: "nodes", 18: "coordinate systems", 55: "data at nodes", 58: "functions",
+    82: "trace lines", 151: "header", 164: "units", 1858: "function qualifiers",
+    2400: "model header", 2411: "nodes", 2412: "elements", 2414: "analysis data",
+    2420: "coordinate systems", 2429: "coordinate groups", 2467: "groups",
+}
+_FUNCTION_TYPES = {
+    0: "general", 1: "time response", 2: "auto spectrum", 3: "cross spectrum",
+    4: "frequency response function", 5: "transmissibility", 6: "coherence",
+    7: "auto correlation", 8: "cross correlation", 9: "power spectral density",
+    10: "energy spectral density", 11: "probability density function", 12: "spectrum",
+}
+#: SDRC specific data type -> (quantity, length exponent, force exponent) for translational DOFs.
+_DATA_TYPE_CODES = {
+    8: ("displacement", 1, 0), 9: ("force", 0, 1), 11: ("velocity", 1, 0),
+    12: ("acceleration", 1, 0), 13: ("force", 0, 1), 15: ("pressure", -2, 1),
+    17: ("time", 0, 0),
+}
+_QUANTITY_CODES = {"displacement": 8, "force": 13, "velocity": 11, "acceleration": 12,
+                   "pressure": 15, "time": 17}
+#: Quantity -> (length exponent, force exponent) written with each code.
+_EXPONENTS = {q: _DATA_TYPE_CODES[c][1:] for q, c in _QUANTITY_CODES.items()}
+_DIRECTIONS = {1: "+X", 2: "+Y", 3: "+Z", 4: "+RX", 5: "+RY", 6: "+RZ",
+               -1: "-X", -2: "-Y", -3: "-Z", -4: "-RX", -5: "-RY", -6: "-RZ"}
+
+
+def _label(value: object) -> str:
+    text = str(value or "").strip()
+    return "" if text.upper() == "NONE" else text
+
+
+def _channel_name(dset: dict, index: int) -> str:
+    for key in ("rsp_ent_name", "id1"):
+        text = _label(dset.get(key))
+        if text:
+            return text
+    node = int(dset.get("rsp_node", 0) or 0)
+    if node:
+        return f"{node}{_DIRECTIONS.get(int(dset.get('rsp_dir', 0) or 0), '')}"
+    return f"record {index + 1}"
+
+
+def _ordinate_unit(dset: dict, unit_factors: tuple[float, float]) -> tuple[str, float, str]:
+    """Quantity, SI factor and source-unit text of a record's ordinate."""
+    label = _label(dset.get("ordinate_axis_units_lab"))
+    quantity, factor = interpret_unit(label)
+    if quantity != "unknown":
+        return quantity, factor, label
+    code = int(dset.get("ordinate_spec_data_type", 0) or 0)
+    if code in _DATA_TYPE_CODES:
+        quantity, len_exp, force_exp = _DATA_TYPE_CODES[code]
+        length_factor, force_factor = unit_factors
+        # Dataset 164: "to convert from universal file units to SI divide by the factor".
+        factor = 1.0 / (length_factor**len_exp * force_factor**force_exp)
+        return quantity, factor, label or f"UFF data type {code}"
+    return "unknown", 1.0, label
+
+
+def _time_factor(dset: dict) -> float:
+    quantity, factor = interpret_unit(_label(dset.get("abscissa_axis_units_lab")))
+    return factor if quantity == "time" else 1.0
+
+
+def _is_time_record(dset: dict) -> bool:
+    func_type = int(dset.get("func_type", -1))
+    time_abscissa = int(dset.get("abscissa_spec_data_type", 0) or 0) == 17
+    return func_type == 1 or (func_type == 0 and time_abscissa)
+
+
+def _describe(set_types: list[int], func_types: list[int]) -> str:
+    seen: list[int] = []
+    for t in set_types:
+        if t not in seen:
+            seen.append(t)
+    words = []
+    for t in seen:
+        if t == 58 and func_types:
+            kinds = sorted({_FUNCTION_TYPES.get(f, f"function type {f}") for f in func_types})
+            words.append(", ".join(kinds))
+        else:
+            words.append(_DATASET_NAMES.get(t, "unsupported"))
+    return f"datasets {', '.join(str(t) for t in seen)} ({', '.join(words)})"
+
+
+def _record_channel(dset: dict, index: int, where: str,
+                    unit_factors: tuple[float, float]) -> Channel:
+    num_pts = int(dset["num_pts"])
+    values = np.asarray(dset["data"])
+    if np.iscomplexobj(values):
+        raise InputFileError(f"{where}: record {index + 1} is a time record with complex "
+                             "ordinates; expected real samples")
+    if values.size < num_pts:
+        raise InputFileError(f"{where}: record {index + 1} holds {values.size} of its "
+                             f"{num_pts} samples; the file is truncated or corrupt")
+    # Writers pad the last E13.5 line with zeros; the header's num_pts is authoritative.
+    values = values[:num_pts].astype(np.float64)
+    time_factor = _time_factor(dset)
+    if int(dset.get("abscissa_spacing", 1)) == 1:
+        dt = float(dset["abscissa_inc"]) * time_factor
+        start = float(dset.get("abscissa_min", 0.0)) * time_factor
+    else:
+        x = np.asarray(dset["x"], dtype=np.float64)[:num_pts] * time_factor
+        rate, start = rate_from_times(x, what=f"{where}: record {index + 1}")
+        dt = 1.0 / rate
+    if not (np.isfinite(dt) and dt > 0):
+        raise InputFileError(f"{where}: record {index + 1} has abscissa increment {dt!r}; "
+                             "expected a positive sample interval in seconds")
+    quantity, factor, source_unit = _ordinate_unit(dset, unit_factors)
+    if factor != 1.0:
+        values = values * factor
+    return Channel(name=_channel_name(dset, index), quantity=quantity, data=values,
+                   sample_rate_hz=snap_rate(1.0 / dt, UFF_INTERVAL_RESOLUTION),
+                   source_unit=source_unit, start_time_s=start)
+
+
+_BINARY_58 = re.compile(rb"^ *58b", re.MULTILINE)
+
+
+def _fallback_records(where: str, raw: bytes, expected: int) -> list[dict]:
+    """Dataset 58 records parsed by :mod:`._uff_ascii` (Fortran number rules)."""
+    try:
+        # UTF-8 with replacement, as pyuff decodes: a Latin-1 '²' becomes U+FFFD, which
+        # pidcore.units reads as '^2' in a unit label.
+        records = [d for t, d in parse_uff_ascii(raw.decode("utf-8", "replace")) if t == 58]
+    except ValueError as exc:
+        raise InputFileError(f"{where}: dataset 58 is corrupt ({exc}); expected E13.5 or "
+                             "E20.12 numbers in fixed columns") from None
+    if len(records) != expected:
+        raise InputFileError(f"{where}: found {len(records)} datasets 58 where the block "
+                             f"structure shows {expected}; the file is corrupt")
+    return records
+
+
+def read_uff(path: str | os.PathLike[str]) -> Measurement:
+    """Read the dataset 58 time records of a UFF file (ASCII or binary) as one measurement.
+
+    Parameters
+    ----------
+    path : str or path-like
+        ``.uff`` / ``.unv`` file.
+
+    Returns
+    -------
+    Measurement
+        One channel per time record, in SI units; ``file_format="uff"``.
+
+    Raises
+    ------
+    InputFileError
+        The file is missing, truncated or corrupt, or holds no time record (the message lists
+        the datasets it does hold).
+    """
+    where = str(path)
+    raw = Path(path).read_bytes()
+    if not raw.strip():
+        raise InputFileError(f"{where}: empty file; expected UFF datasets")
+    if not raw.rstrip().endswith(b"-1"):
+        raise InputFileError(f"{where}: the file ends inside a UFF dataset (no closing '    -1' "
+                             "line); it is truncated or not a UFF file")
+    try:
+        uff = pyuff.UFF(where)
+        set_types = [int(t) for t in uff.get_set_types()]
+    except Exception as exc:  # pyuff raises bare Exception for every failure
+        raise InputFileError(f"{where}: cannot parse as UFF ({exc})") from None
+    if not set_types:
+        raise InputFileError(f"{where}: no UFF dataset found (expected blocks that start and "
+                             "end with a '    -1' line)")
+    unit_factors = (1.0, 1.0)
+    records: list[dict] = []
+    fallback: list[dict] | None = None
+    n58 = 0
+    for i, set_type in enumerate(set_types):
+        if set_type not in (58, 164):
+            continue
+        try:
+            dset = uff.read_sets(i)
+        except Exception as exc:
+            if set_type != 58 or _BINARY_58.search(raw):
+                raise InputFileError(f"{where}: dataset {set_type} (block {i + 1}) is corrupt "
+                                     f"({exc})") from None
+            if fallback is None:
+                fallback = _fallback_records(where, raw, set_types.count(58))
+            dset = fallback[n58]
+        if set_type == 58:
+            n58 += 1
+        if set_type == 164:
+            unit_factors = (float(dset.get("length", 1.0)), float(dset.get("force", 1.0)))
+        else:
+            records.append(dset)
+    time_records = [d for d in records if _is_time_record(d)]
+    if not time_records:
+        what = _describe(set_types, [int(d.get("func_type", -1)) for d in records])
+        raise InputFileError(f"{where}: holds {what} but no UFF58 time record "
+                             "(function type 1); expected time histories")
+    channels = [_record_channel(d, k, where, unit_factors) for k, d in enumerate(time_records)]
+    names = unique_names([c.name for c in channels])
+    channels = [c if c.name == n else Channel(n, c.quantity, c.data, c.sample_rate_hz,
+                                              c.source_unit, c.start_time_s)
+                for c, n in zip(channels, names, strict=True)]
+    metadata: dict[str, str | float | int] = {"uff_time_records": len(channels)}
+    date = _label(time_records[0].get("id3"))
+    if date:
+        metadata["uff_id3"] = date
+    return Measurement(source=where, channels=tuple(channels), sha256=file_sha256(path),
+                       file_format="uff", metadata=metadata)
+
+
+def _dataset_58(ch: Channel, index: int) -> dict:
+    if ch.n_samples < 2:
+        raise ParameterError(f"channel {ch.name!r}: UFF needs at least 2 samples, "
+                             f"has {ch.n_samples}")
+    quantity = ch.quantity
+    if quantity in _QUANTITY_CODES:
+        code, unit_label = _QUANTITY_CODES[quantity], SI_UNITS[quantity]
+        len_exp, force_exp = _EXPONENTS[quantity]
+    else:
+        # Unknown quantities keep their values as read; keep their label so that they read
+        # back as the same (unknown) unit.
+        code, len_exp, force_exp = 0, 0, 0
+        unit_label = SI_UNITS["voltage"] if quantity == "voltage" else (ch.source_unit or "NONE")
+    if not np.all(np.isfinite(ch.data)):
+        # pyuff silently replaces NaN/inf by numbers (np.nan_to_num); refuse instead.
+        raise ParameterError(f"channel {ch.name!r}: non-finite samples cannot be written to UFF")
+    x = ch.start_time_s + np.arange(ch.n_samples) / ch.sample_rate_hz
+    # Fixed-width header fields: an entity name has 10 columns, labels 20; longer text would
+    # shift the following fields, so the full name goes to ID line 1 (80 columns).
+    entity = ch.name if len(ch.name) <= 10 and ch.name.strip() else "NONE"
+    return {
+        "type": 58, "binary": 0, "func_type": 1, "func_id": index + 1, "ver_num": 0,
+        "load_case_id": 0, "id1": ch.name[:80] or "NONE", "id2": "pidcore",
+        "id3": _dt.datetime.now().strftime("%d-%b-%y %H:%M:%S"), "id4": "NONE", "id5": "NONE",
+        "rsp_ent_name": entity, "rsp_node": index + 1, "rsp_dir": 0,
+        "ref_ent_name": "NONE", "ref_node": 0, "ref_dir": 0,
+        "abscissa_spacing": 1, "abscissa_spec_data_type": 17, "abscissa_axis_lab": "Time",
+        "abscissa_axis_units_lab": "s", "abscissa_len_unit_exp": 0,
+        "abscissa_force_unit_exp": 0, "abscissa_temp_unit_exp": 0,
+        "ordinate_spec_data_type": code, "ordinate_len_unit_exp": len_exp,
+        "ordinate_force_unit_exp": force_exp, "ordinate_temp_unit_exp": 0,
+        "ordinate_axis_lab": quantity[:20], "ordinate_axis_units_lab": unit_label[:20],
+        "orddenom_spec_data_type": 0, "z_axis_spec_data_type": 0, "z_axis_value": 0.0,
+        "x": x, "data": np.asarray(ch.data, dtype=np.float64),
+    }
+
+
+def write_uff(measurement: Measurement, path: str | os.PathLike[str], *,
+              binary: bool = False) -> None:
+    """Write every channel as a dataset 58 time record (double precision), atomically.
+
+    Parameters
+    ----------
+    measurement : Measurement
+    path : str or path-like
+    binary : bool
+        ``True`` writes 58b (IEEE 754 float64, native byte order) via pyuff; ``False`` writes
+        ASCII (E20.11, twelve significant digits).
+
+    Notes
+    -----
+    The sample interval is stored with six significant digits (the E13.5 field of the
+    format); readers snap rates within that resolution to whole Hz.
+    """
+    if not measurement.channels:
+        raise ParameterError(f"{measurement.source}: nothing to write (no channels)")
+    sets = [_dataset_58(ch, i) for i, ch in enumerate(measurement.channels)]
+    for dset in sets:
+        dset["binary"] = 1 if binary else 0
+    with atomic_path(path) as tmp:
+        # mode="add" on the empty temporary file: in "overwrite" mode pyuff 2.5 reopens the
+        # file with "wb" before the binary samples of the first set, erasing its header.
+        try:
+            pyuff.UFF(str(tmp)).write_sets(sets, mode="add", force_double=True)
+        except Exception as exc:  # pyuff raises bare Exception
+            raise ParameterError(f"{path}: cannot write UFF ({exc})") from None

@@ -1,0 +1,149 @@
+"""Bundled sample data: the paper's Table 3, a DEM store of the Table 3 grid and
+virtual shaker-test exports, all regenerable with ``pidcore samples make``.
+
+The exports are **synthetic**: the DEM coupon driven at a few load cases, recorded as an
+LMS/Testlab user would export them. Force = m_coupon * a + force of the particles on the cells
+(scaled to 441 cells); velocity as a laser vibrometer sees it (with an output delay);
+acceleration as the impedance head sees it; sensor noise; 25.6 kHz sampling. Each is written in
+one of the formats users export (UFF58 ASCII, UFF58b binary, CSV, MAT, HDF5).
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+from dataclasses import dataclass
+from fractions import Fraction
+from pathlib import Path
+
+import numpy as np
+from scipy.signal import resample_poly
+
+from .errors import StoreError
+from .records import Channel, Measurement
+
+#: Sampling rate of the exports, Hz (a common Testlab setting).
+EXPORT_SAMPLE_RATE_HZ = 25_600.0
+#: Vibrometer output delay put into the exports, s (pass it with --velocity-delay).
+EXPORT_VELOCITY_DELAY_S = 5e-5
+#: Sensor signal-to-noise ratio of the exports, dB.
+EXPORT_SNR_DB = 45.0
+
+
+@dataclass(frozen=True)
+class SampleCase:
+    """One virtual shaker test: load case and the format it is exported in."""
+
+    frequency_hz: float
+    acceleration_g: float
+    fill_percent: float
+    file_format: str  # "uff", "uff58b", "csv", "mat", "hdf5"
+
+    @property
+    def file_name(self) -> str:
+        ext = {"uff": "uff", "uff58b": "uff", "csv": "csv", "mat": "mat", "hdf5": "h5"}
+        tag = "_58b" if self.file_format == "uff58b" else ""
+        return (f"synthetic_f{self.frequency_hz:g}Hz_a{self.acceleration_g:g}g_"
+                f"fill{self.fill_percent:g}_acrylic{tag}.{ext[self.file_format]}")
+
+
+#: The bundled exports: the paper's experimental cases (50 % fill), one per format.
+SAMPLE_CASES: tuple[SampleCase, ...] = (
+    SampleCase(50, 5, 50, "uff"),
+    SampleCase(100, 10, 50, "uff58b"),
+    SampleCase(500, 1, 50, "csv"),
+    SampleCase(500, 5, 50, "mat"),
+    SampleCase(1000, 5, 50, "hdf5"),
+)
+
+
+def virtual_shaker_measurement(
+    *, time_s: np.ndarray, shaker_force_n: np.ndarray, frequency_hz: float,
+    acceleration_m_s2: float, source: str,
+    sample_rate_hz: float = EXPORT_SAMPLE_RATE_HZ,
+    velocity_delay_s: float = EXPORT_VELOCITY_DELAY_S,
+    snr_db: float = EXPORT_SNR_DB, seed: int = 0,
+) -> Measurement:
+    """Turn a DEM shaker-force record into a sensor-like export at ``sample_rate_hz``.
+
+    The coupon motion is known exactly (acceleration ``a sin wt``), so velocity and acceleration
+    are written analytically at the export rate; only the force is resampled (polyphase, with
+    anti-aliasing) from the DEM sampling rate. Edge cycles touched by the resampling filter are
+    dropped.
+    """
+    fs_in = 1.0 / float(np.median(np.diff(time_s)))
+    ratio = Fraction(sample_rate_hz / fs_in).limit_denominator(1000)
+    force = resample_poly(shaker_force_n, ratio.numerator, ratio.denominator)
+    t = time_s[0] + np.arange(force.size) / sample_rate_hz
+    trim = int(round(2 * sample_rate_hz / frequency_hz))  # two periods each end
+    force, t = force[trim:-trim], t[trim:-trim]
+    w = 2 * np.pi * frequency_hz
+    accel = acceleration_m_s2 * np.sin(w * t)
+    velocity = -acceleration_m_s2 / w * np.cos(w * (t - velocity_delay_s))
+    rng = np.random.default_rng(seed)
+
+    def noisy(x: np.ndarray) -> np.ndarray:
+        rms = float(np.sqrt(np.mean((x - x.mean()) ** 2)))
+        return x + rng.normal(0.0, rms * 10 ** (-snr_db / 20), x.size)
+
+    channels = (
+        Channel("Force", "force", noisy(force), sample_rate_hz, "N"),
+        Channel("Velocity", "velocity", noisy(velocity), sample_rate_hz, "m/s"),
+        Channel("Acceleration", "acceleration", noisy(accel), sample_rate_hz, "m/s^2"),
+    )
+    metadata = {"synthetic": "virtual shaker test from pidcore DEM",
+                "nominal_frequency_hz": frequency_hz,
+                "nominal_acceleration_m_s2": acceleration_m_s2,
+                "velocity_delay_s": velocity_delay_s, "snr_db": snr_db}
+    return Measurement(source, channels, "", "", metadata)
+
+
+def make_samples(out_dir: str | os.PathLike = "data_samples", *, run_sweep: bool = True,
+                 workers: int | None = None, progress: bool = True) -> dict[str, Path]:
+    """Regenerate ``data_samples/``: Table 3 CSV, DEM grid store, virtual shaker exports."""
+    from importlib import resources
+
+    from .dem.simulate import DemConfig
+    from .dem.sweep import grid_cases, run_key
+    from .dem.sweep import run_sweep as sweep
+    from .io import write_measurement
+    from .store import Store
+
+    out = Path(out_dir)
+    (out / "exports").mkdir(parents=True, exist_ok=True)
+    written: dict[str, Path] = {}
+    table = out / "paper_table3.csv"
+    with resources.as_file(resources.files("pidcore.data") / "paper_table3.csv") as src:
+        shutil.copyfile(src, table)
+    written["paper_table3"] = table
+
+    store_path = out / "dem_table3.h5"
+    config = DemConfig()
+    cases = grid_cases("table3")
+    if run_sweep:
+        sweep(cases, config, store_path=store_path, workers=workers, progress=progress)
+    written["dem_store"] = store_path
+    store = Store(store_path)
+    for i, sample in enumerate(SAMPLE_CASES):
+        case = next(c for c in cases if (c.frequency_hz, c.acceleration_g, c.fill_percent)
+                    == (sample.frequency_hz, sample.acceleration_g, sample.fill_percent))
+        key = run_key(case, config)
+        if not store.has_dem_run(key):
+            raise StoreError(f"{store_path}: no DEM run {key}; run without --skip-sweep first")
+        entry = store.get_dem_run(key)
+        start = int(entry.record["steady_start_cycle"]) * int(
+            round(entry.record["sample_rate_hz"] / case.frequency_hz))
+        m = virtual_shaker_measurement(
+            time_s=entry.arrays["sample_time_s"][start:],
+            shaker_force_n=entry.arrays["shaker_force_n"][start:],
+            frequency_hz=case.frequency_hz, acceleration_m_s2=case.acceleration_m_s2,
+            source=sample.file_name, seed=1000 + i)
+        path = out / "exports" / sample.file_name
+        fmt = "uff" if sample.file_format.startswith("uff") else sample.file_format
+        write_measurement(m, path, fmt, binary=sample.file_format == "uff58b")
+        written[sample.file_name] = path
+    sidecar = out / "exports" / "loadcases.csv"
+    sidecar.write_text("file,fill_percent,material,direction\n" + "".join(
+        f"{s.file_name},{s.fill_percent:g},acrylic,z\n" for s in SAMPLE_CASES))
+    written["loadcases"] = sidecar
+    return written

@@ -1,0 +1,106 @@
+"""Unreadable input gives one InputFileError naming the file and what was expected."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from pidcore.errors import InputFileError, ParameterError
+from pidcore.io import detect_file_format, read_measurement, write_measurement
+from pidcore.records import Channel, Measurement
+
+
+def _measurement() -> Measurement:
+    t = np.arange(600) / 1200.0
+    return Measurement("m", (Channel("F", "force", np.sin(2 * np.pi * 60 * t), 1200.0, "N"),
+                             Channel("V", "velocity", np.cos(2 * np.pi * 60 * t), 1200.0, "m/s")))
+
+
+@pytest.mark.parametrize("suffix", [".uff", ".csv", ".mat", ".h5"])
+def test_empty_file(tmp_path, suffix):
+    path = tmp_path / f"empty{suffix}"
+    path.write_bytes(b"")
+    with pytest.raises(InputFileError, match=rf"empty{suffix}.*empty file"):
+        read_measurement(path)
+
+
+def test_missing_file(tmp_path):
+    with pytest.raises(InputFileError, match=r"nothere\.uff: file not found"):
+        read_measurement(tmp_path / "nothere.uff")
+
+
+@pytest.mark.parametrize(("suffix", "file_format", "binary"), [
+    (".uff", "uff", False), (".uff", "uff", True), (".mat", "mat", False),
+    (".h5", "hdf5", False),
+])
+def test_truncated_file(tmp_path, suffix, file_format, binary):
+    good = tmp_path / f"good{suffix}"
+    write_measurement(_measurement(), good, file_format, binary=binary)
+    raw = good.read_bytes()
+    cut = tmp_path / f"cut{suffix}"
+    cut.write_bytes(raw[: len(raw) * 2 // 3])
+    with pytest.raises(InputFileError, match=rf"cut\{suffix}"):
+        read_measurement(cut)
+
+
+def test_garbage_with_known_extensions(tmp_path):
+    rng = np.random.default_rng(1)
+    noise = rng.integers(0, 256, 4000, dtype=np.uint8).tobytes()
+    for suffix in (".mat", ".h5", ".uff"):
+        path = tmp_path / f"noise{suffix}"
+        path.write_bytes(b"\x00" + noise)
+        with pytest.raises(InputFileError, match=rf"noise\{suffix}"):
+            read_measurement(path)
+
+
+def test_binary_content_with_unknown_extension(tmp_path):
+    path = tmp_path / "blob.bin"
+    path.write_bytes(b"\x00\x01\x02" * 100)
+    with pytest.raises(InputFileError, match=r"blob\.bin: unknown file format"):
+        detect_file_format(path)
+
+
+def test_csv_header_only_and_text_cells(tmp_path):
+    header_only = tmp_path / "header_only.csv"
+    header_only.write_text("Time [s],F [N]\n")
+    with pytest.raises(InputFileError, match=r"header_only\.csv: header but no data rows"):
+        read_measurement(header_only)
+    words = tmp_path / "words.csv"
+    words.write_text("Time [s],F [N]\n0,1\n0.1,abc\n")
+    with pytest.raises(InputFileError, match=r"words\.csv.*abc"):
+        read_measurement(words)
+
+
+def test_mat_without_channels_lists_variables(tmp_path):
+    import scipy.io
+
+    path = tmp_path / "odd.mat"
+    scipy.io.savemat(path, {"comment": "no data here", "fs": 100.0})
+    with pytest.raises(InputFileError, match=r"odd\.mat: no channel found.*comment"):
+        read_measurement(path)
+
+
+def test_hdf5_without_pidcore_layout(tmp_path):
+    import h5py
+
+    path = tmp_path / "other.h5"
+    with h5py.File(path, "w") as h5:
+        h5["x"] = np.arange(3)
+    with pytest.raises(InputFileError, match=r"other\.h5.*pidcore_layout"):
+        read_measurement(path)
+
+
+def test_uff_time_record_with_fewer_samples_than_declared(tmp_path):
+    good = tmp_path / "good.uff"
+    write_measurement(_measurement(), good)
+    lines = good.read_text().splitlines(keepends=True)
+    # Drop one data line of the first record (4 values of E20.11 per line) but keep the "-1".
+    short = tmp_path / "short.uff"
+    short.write_text("".join(lines[:20] + lines[21:]))
+    with pytest.raises(InputFileError, match=r"short\.uff: record 1 holds 596 of its 600"):
+        read_measurement(short)
+
+
+def test_bad_parameters():
+    with pytest.raises(ParameterError, match="file_format"):
+        read_measurement("x.csv", file_format="xls")

@@ -1,0 +1,311 @@
+"""Writers and readers: round trips, unit conversion, CSV time bases, MATLAB layouts, HDF5."""
+
+from __future__ import annotations
+
+import hashlib
+import re
+
+import h5py
+import numpy as np
+import pytest
+import pyuff
+import scipy.io
+
+from pidcore.constants import STANDARD_GRAVITY
+from pidcore.errors import InputFileError, ParameterError
+from pidcore.io import read_measurement, read_measurements, write_measurement
+from pidcore.io.hdf5_layout import write_measurement_group
+from pidcore.records import Channel, Measurement
+
+FS = 2560.0  # Hz; a whole number, so UFF's 6-digit interval snaps back exactly
+
+
+def _measurement(rate: float = FS, n: int = 1280) -> Measurement:
+    rng = np.random.default_rng(7)
+    t = np.arange(n) / rate
+    channels = (
+        Channel("Drive point force", "force", 12.5 * np.sin(2 * np.pi * 40 * t)
+                + rng.normal(0, 0.1, n), rate, "N"),
+        Channel("LDV", "velocity", 3e-3 * np.cos(2 * np.pi * 40 * t), rate, "mm/s"),
+        Channel("Acc 1", "acceleration", 9.81 * np.sin(2 * np.pi * 40 * t + 0.3), rate, "g"),
+        Channel("Bridge", "unknown", rng.normal(0, 1, n), rate, "V^2"),
+    )
+    return Measurement("made-up.csv", channels, file_format="csv")
+
+
+def _assert_same(read: Measurement, written: Measurement, *, rtol: float) -> None:
+    assert read.channel_names == written.channel_names
+    for r, w in zip(read.channels, written.channels, strict=True):
+        assert r.quantity == w.quantity
+        assert r.n_samples == w.n_samples
+        assert r.sample_rate_hz == w.sample_rate_hz
+        assert r.start_time_s == pytest.approx(w.start_time_s, abs=1e-12)
+        np.testing.assert_allclose(r.data, w.data, rtol=rtol, atol=rtol * np.max(np.abs(w.data)))
+
+
+# rtol per format: float64 stores (binary UFF, CSV with %.17g, MAT, HDF5) are exact; ASCII UFF
+# writes E20.11, i.e. 12 significant digits (relative rounding <= 5e-12).
+@pytest.mark.parametrize(("suffix", "file_format", "binary", "rtol"), [
+    (".uff", "uff", False, 1e-11),
+    (".uff", "uff", True, 0.0),
+    (".csv", "csv", False, 0.0),
+    (".mat", "mat", False, 0.0),
+    (".h5", "hdf5", False, 0.0),
+])
+def test_round_trip(tmp_path, suffix, file_format, binary, rtol):
+    written = _measurement()
+    path = tmp_path / f"record{suffix}"
+    write_measurement(written, path, file_format, binary=binary)
+    read = read_measurement(path)
+    assert read.file_format == file_format
+    assert read.source == str(path)
+    assert read.sha256 == hashlib.sha256(path.read_bytes()).hexdigest()
+    _assert_same(read, written, rtol=rtol)
+    # The unknown channel keeps its unit text, so it reads back as the same unknown unit.
+    assert read.channel("Bridge").source_unit == "V^2"
+    assert [p.name for p in tmp_path.iterdir()] == [path.name]  # no temporary file left
+
+
+def test_uff_binary_flag_writes_58b(tmp_path):
+    path = tmp_path / "b.uff"
+    write_measurement(_measurement(), path, "uff", binary=True)
+    raw = path.read_bytes()
+    # Record 1 of a binary set reads "    58b" (pyuff's get_set_formats() misreports bytes).
+    assert raw.count(b"\n    58b") + raw.startswith(b"    58b") == 4
+    assert read_measurement(path).channels[0].n_samples == 1280
+
+
+def test_uff_non_integer_rate_within_format_resolution(tmp_path):
+    written = _measurement(rate=2000.232)  # not snapped: 0.232 Hz is far above 5e-6 relative
+    path = tmp_path / "r.unv"
+    write_measurement(written, path)
+    rate = read_measurement(path).channels[0].sample_rate_hz
+    assert rate == pytest.approx(2000.232, rel=5e-6)  # E13.5 interval: 6 significant digits
+
+
+def test_uff_refuses_to_write_nan(tmp_path):
+    m = _measurement()
+    bad = Measurement("x", (Channel("F", "force", np.array([0.0, np.nan, 1.0]), 10.0),))
+    with pytest.raises(ParameterError, match="non-finite"):
+        write_measurement(bad, tmp_path / "x.uff")
+    assert m.channels  # the good one still writes
+    write_measurement(m, tmp_path / "ok.uff")
+
+
+def test_uff_units_from_data_type_code_and_dataset_164(tmp_path):
+    """Without a units label, code 12 (acceleration) in a mm-based unit system is scaled."""
+    path = tmp_path / "mm.uff"
+    n = 64
+    data = np.linspace(-500.0, 500.0, n)  # mm/s^2
+    uff = pyuff.UFF(str(path))
+    uff.write_sets(pyuff.prepare_164(units_code=5, units_description="mm (milli newton)",
+                                     temp_mode=1, length=1000.0, force=1000.0, temp=1.0,
+                                     temp_offset=273.15), mode="add")
+    uff.write_sets(pyuff.prepare_58(binary=0, func_type=1, rsp_node=3, rsp_dir=3,
+                                    ref_node=0, ref_dir=0, ordinate_spec_data_type=12,
+                                    abscissa_spec_data_type=17, orddenom_spec_data_type=0,
+                                    z_axis_spec_data_type=0, data=data,
+                                    x=np.arange(n) / 100.0), mode="add")
+    (ch,) = read_measurement(path).channels
+    assert ch.name == "3+Z"  # no entity name or ID line: node and direction
+    assert ch.quantity == "acceleration"
+    # Dataset 164: SI = file value / length_factor**1. E20.11 keeps 12 significant digits.
+    np.testing.assert_allclose(ch.data, data / 1000.0, rtol=1e-11)
+
+
+def test_csv_unit_conversion_and_delimiters(tmp_path):
+    rows = [(0.0, 1.5, 2.0, 1.0), (0.001, 1.6, 3.0, -0.5), (0.002, 1.7, 4.0, 0.25)]
+    variants = {
+        "comma.csv": ("Time [s],Force (kN),Velocity [mm/s],Acceleration [g]", ",", "."),
+        "semicolon.csv": ("Time [s];Force (kN);Velocity [mm/s];Acceleration [g]", ";", ","),
+        "tab.txt": ("Time [s]\tForce (kN)\tVelocity [mm/s]\tAcceleration [g]", "\t", "."),
+        "blank.txt": ("Time[s]  Force(kN)  Velocity[mm/s]  Acceleration[g]", "  ", "."),
+    }
+    for name, (header, sep, decimal) in variants.items():
+        lines = [header] + [sep.join(repr(v).replace(".", decimal) for v in row)
+                            for row in rows]
+        path = tmp_path / name
+        path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+        m = read_measurement(path)
+        assert m.file_format == "csv", name
+        assert m.channel_names == ["Force", "Velocity", "Acceleration"], name
+        force, velocity, acceleration = m.channels
+        assert force.quantity == "force" and force.source_unit == "kN"
+        np.testing.assert_allclose(force.data, [1500.0, 1600.0, 1700.0], rtol=1e-15)
+        np.testing.assert_allclose(velocity.data, [2e-3, 3e-3, 4e-3], rtol=1e-15)
+        np.testing.assert_allclose(acceleration.data,
+                                   np.array([1.0, -0.5, 0.25]) * STANDARD_GRAVITY, rtol=1e-15)
+        assert force.sample_rate_hz == 1000.0, name
+
+
+def test_csv_sample_rate_given_equals_time_column(tmp_path):
+    t = np.arange(200) / 500.0
+    force, vel = np.sin(t), np.cos(t)
+    with_time = tmp_path / "with_time.csv"
+    with_time.write_text("Time [s],F [N],V [m/s]\n" + "".join(
+        f"{a:.17g},{b:.17g},{c:.17g}\n" for a, b, c in zip(t, force, vel, strict=True)))
+    without = tmp_path / "without.csv"
+    without.write_text("F [N],V [m/s]\n" + "".join(
+        f"{b:.17g},{c:.17g}\n" for b, c in zip(force, vel, strict=True)))
+    a = read_measurement(with_time)
+    b = read_measurement(without, sample_rate_hz=500.0)
+    _assert_same(b, a, rtol=0.0)
+    with pytest.raises(ParameterError, match="500"):
+        read_measurement(with_time, sample_rate_hz=400.0)
+    with pytest.raises(InputFileError, match=r"without\.csv.*--sample-rate"):
+        read_measurement(without)
+
+
+def test_csv_uneven_time_column_rejected(tmp_path):
+    t = np.arange(100) / 1000.0
+    t[50:] += 1e-3  # one dropped sample
+    path = tmp_path / "gap.csv"
+    path.write_text("Time [s],F [N]\n" + "".join(f"{x:.17g},1.0\n" for x in t))
+    with pytest.raises(InputFileError, match=r"gap\.csv.*not evenly spaced"):
+        read_measurement(path)
+
+
+def test_csv_time_rounded_to_printed_digits_is_accepted(tmp_path):
+    t = np.arange(5000) / 3000.0  # 1/3000 s does not print exactly
+    path = tmp_path / "rounded.csv"
+    path.write_text("Time [s],F [N]\n" + "".join(f"{x:.7g},1.0\n" for x in t))
+    assert read_measurement(path).channels[0].sample_rate_hz == pytest.approx(3000.0, rel=1e-6)
+
+
+def test_csv_nan_passes_through_reader(tmp_path):
+    path = tmp_path / "nan.csv"
+    path.write_text("Time [s],F [N],V [m/s]\n0,1,nan\n0.1,,2\n0.2,3,inf\n")
+    m = read_measurement(path)
+    assert np.isnan(m.channel("F").data[1]) and np.isnan(m.channel("V").data[0])
+    assert np.isinf(m.channel("V").data[2])
+
+
+def test_mat_simple_layout_with_units_struct_and_cell(tmp_path):
+    t = np.arange(300) / 1000.0
+    path = tmp_path / "simple.mat"
+    scipy.io.savemat(path, {"time": t, "Force": np.sin(t), "Vel": np.cos(t),
+                            "units": {"Force": "kN", "Vel": "mm/s"}})
+    m = read_measurement(path)
+    assert m.channel_names == ["Force", "Vel"] and m.metadata["mat_layout"] == "simple"
+    np.testing.assert_allclose(m.channel("Force").data, 1e3 * np.sin(t), rtol=1e-15)
+    np.testing.assert_allclose(m.channel("Vel").data, 1e-3 * np.cos(t), rtol=1e-15)
+    assert m.channel("Force").sample_rate_hz == 1000.0
+    cell = tmp_path / "cell.mat"
+    scipy.io.savemat(cell, {"fs": 250.0, "a": np.ones(10), "b": np.zeros(10),
+                            "units": np.array(["g", "N"], dtype=object)})
+    m = read_measurement(cell)
+    assert [c.quantity for c in m.channels] == ["acceleration", "force"]
+    assert m.channels[0].sample_rate_hz == 250.0
+    np.testing.assert_allclose(m.channels[0].data, STANDARD_GRAVITY)
+
+
+def test_mat_lms_testlab_signal_struct(tmp_path):
+    n, rate = 400, 1024.0
+    values = np.column_stack([np.arange(n, dtype=float), -np.arange(n, dtype=float)])
+    signal = {"x_values": {"start_value": 0.5, "increment": 1 / rate, "number_of_values": n},
+              "y_values": {"values": values, "quantity": {"label": "Acceleration"}},
+              "function_record": {"name": np.array(["P1:+Z", "P2:+Z"], dtype=object)}}
+    path = tmp_path / "lms.mat"
+    scipy.io.savemat(path, {"Signal": signal})
+    m = read_measurement(path)
+    assert m.metadata["mat_layout"] == "lms_testlab"
+    assert m.channel_names == ["P1:+Z", "P2:+Z"]
+    for ch, col in zip(m.channels, values.T, strict=True):
+        assert ch.quantity == "acceleration" and ch.sample_rate_hz == rate
+        assert ch.start_time_s == 0.5
+        np.testing.assert_array_equal(ch.data, col)
+
+
+def test_mat_v73_hdf5_simple_layout(tmp_path):
+    """A v7.3 file is HDF5 behind a 512-byte MATLAB text header; arrays are column-major."""
+    path = tmp_path / "v73.mat"
+    t = np.arange(100) / 200.0
+    with h5py.File(path, "w", userblock_size=512) as h5:
+        for name, vec in {"t": t, "Force": np.cos(t)}.items():
+            h5.create_dataset(name, data=vec[None, :]).attrs["MATLAB_class"] = np.bytes_("double")
+        units = h5.create_group("units")
+        units.attrs["MATLAB_class"] = np.bytes_("struct")
+        units.create_dataset("Force", data=np.array([[ord("k")], [ord("N")]], dtype=np.uint16)
+                             ).attrs["MATLAB_class"] = np.bytes_("char")
+    with open(path, "r+b") as fh:
+        fh.write(b"MATLAB 7.3 MAT-file, Platform: GLNXA64, HDF5 schema 1.00 .".ljust(128))
+    m = read_measurement(path)
+    assert m.file_format == "mat"
+    (ch,) = m.channels
+    assert ch.name == "Force" and ch.sample_rate_hz == 200.0
+    np.testing.assert_allclose(ch.data, 1e3 * np.cos(t), rtol=1e-15)
+
+
+def test_hdf5_store_with_several_measurements(tmp_path):
+    path = tmp_path / "store.h5"
+    a, b = _measurement(), _measurement(rate=1000.0, n=50)
+    with h5py.File(path, "w") as h5:
+        write_measurement_group(h5.create_group("measurements/run_a"), a)
+        write_measurement_group(h5.create_group("measurements/run_b"), b)
+    with pytest.raises(InputFileError, match=r"store\.h5.*run_a, run_b"):
+        read_measurement(path)
+    got = read_measurement(path, key="run_b")
+    _assert_same(got, b, rtol=0.0)
+    assert got.metadata["original_source"] == "made-up.csv"
+    assert got.source == str(path) and got.file_format == "hdf5"
+    assert len(read_measurements(path)) == 2
+    with pytest.raises(InputFileError, match="run_c"):
+        read_measurement(path, key="run_c")
+
+
+def test_failed_write_leaves_existing_file_untouched(tmp_path):
+    path = tmp_path / "keep.csv"
+    path.write_text("original")
+    mixed = Measurement("m", (Channel("a", "force", np.zeros(4), 10.0),
+                              Channel("b", "force", np.zeros(4), 20.0)))
+    with pytest.raises(ParameterError, match="one sample rate"):
+        write_measurement(mixed, path)
+    assert path.read_text() == "original"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["keep.csv"]
+
+
+def test_write_format_from_extension_and_unknown_extension(tmp_path):
+    m = _measurement()
+    write_measurement(m, tmp_path / "x.hdf5")
+    assert read_measurement(tmp_path / "x.hdf5").file_format == "hdf5"
+    with pytest.raises(ParameterError, match=r"\.xyz"):
+        write_measurement(m, tmp_path / "x.xyz")
+
+
+def test_content_decides_over_extension(tmp_path):
+    """DAQ exports often carry .txt or .dat extensions whatever their content."""
+    path = tmp_path / "export.txt"
+    write_measurement(_measurement(), path, "uff")
+    assert read_measurement(path).file_format == "uff"
+
+
+def test_uff_fortran_d_and_missing_e_exponents_use_fallback(tmp_path):
+    """pyuff's float() rejects 1.0D+00 and 1.0-100; the fallback parser reads them."""
+    written = _measurement(n=40)
+    path = tmp_path / "fortran.uff"
+    write_measurement(written, path)
+    lines = path.read_text().splitlines(keepends=True)
+    number_line = re.compile(r"^(\s*-?\d\.\d+e[+-]\d+)+\s*$")  # data lines only
+    fortran = [ln.replace("e", "D") if number_line.match(ln) else ln for ln in lines]
+    fortran_text = "".join(fortran)
+    assert fortran_text.count("D+") + fortran_text.count("D-") >= written.channels[0].n_samples
+    path.write_text(fortran_text)
+    read = read_measurement(path)
+    _assert_same(read, written, rtol=1e-11)  # E20.11: 12 significant digits
+
+
+def test_fortran_float():
+    from pidcore.io._uff_ascii import fortran_float
+
+    assert fortran_float(" 1.25D+02") == 125.0
+    assert fortran_float("-3.5-100") == -3.5e-100
+    assert fortran_float("2.0+005") == 2.0e5
+    assert fortran_float("  -0.00115633") == -0.00115633
+
+
+def test_csv_writer_header_names_si_units(tmp_path):
+    path = tmp_path / "h.csv"
+    write_measurement(_measurement(n=3), path)
+    header = path.read_text().splitlines()[0]
+    assert header == "Time [s],Drive point force [N],LDV [m/s],Acc 1 [m/s^2],Bridge [V^2]"
+    assert len(read_measurements(path)) == 1

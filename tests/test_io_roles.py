@@ -1,0 +1,94 @@
+"""Channel roles: detection by quantity, then by name; overrides; ambiguity errors."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from pidcore.errors import ChannelError
+from pidcore.io import RoleAssignment, assign_roles, name_suggests
+from pidcore.records import Channel, Measurement
+
+
+def _ch(name: str, quantity: str, unit: str = "") -> Channel:
+    return Channel(name, quantity, np.zeros(8), 100.0, unit)
+
+
+def _m(*channels: Channel) -> Measurement:
+    return Measurement("run.uff", tuple(channels))
+
+
+def test_detect_by_quantity_whatever_the_names():
+    m = _m(_ch("ch1", "acceleration", "g"), _ch("ch2", "force", "N"),
+           _ch("ch3", "velocity", "mm/s"), _ch("mic", "pressure", "Pa"))
+    roles = assign_roles(m)
+    assert isinstance(roles, RoleAssignment)
+    assert (roles.force.name, roles.velocity.name, roles.acceleration.name) == \
+        ("ch2", "ch3", "ch1")
+
+
+def test_two_force_channels_resolved_by_name():
+    m = _m(_ch("Reaction", "force", "N"), _ch("Drive point force", "force", "N"),
+           _ch("LDV", "velocity", "m/s"))
+    roles = assign_roles(m)
+    assert roles.force.name == "Drive point force"
+    assert roles.acceleration is None
+
+
+def test_two_force_channels_unnamed_is_ambiguous():
+    m = _m(_ch("F1", "force", "N"), _ch("F2", "force", "N"), _ch("a", "acceleration", "g"))
+    with pytest.raises(ChannelError) as info:
+        assign_roles(m)
+    message = str(info.value)
+    assert "'F1'" in message and "'F2'" in message and "--force NAME" in message
+    assert assign_roles(m, force="F2").force.name == "F2"
+
+
+def test_unknown_quantity_channels_detected_by_name():
+    m = _m(_ch("Kraft", "unknown"), _ch("Vibrometer 1", "unknown", "V"), _ch("x", "unknown"))
+    roles = assign_roles(m)
+    assert roles.force.name == "Kraft" and roles.velocity.name == "Vibrometer 1"
+    assert roles.acceleration is None
+
+
+def test_override_unknown_name_lists_channels():
+    m = _m(_ch("F", "force", "N"), _ch("a", "acceleration", "g"))
+    with pytest.raises(ChannelError, match=r"no channel named 'Force'.*'F', 'a'"):
+        assign_roles(m, force="Force")
+
+
+def test_override_of_other_quantity_refused_unknown_accepted():
+    m = _m(_ch("F", "force", "N"), _ch("acc", "acceleration", "g"), _ch("raw", "unknown", "V^2"))
+    with pytest.raises(ChannelError, match=r"--force 'acc' is a acceleration channel"):
+        assign_roles(m, force="acc")
+    roles = assign_roles(m, force="raw")  # unit-less channel taken as SI newtons
+    assert roles.force.name == "raw" and roles.acceleration.name == "acc"
+
+
+def test_same_channel_for_two_roles_refused():
+    m = _m(_ch("raw", "unknown"), _ch("F", "force", "N"))
+    with pytest.raises(ChannelError, match="several roles"):
+        assign_roles(m, force="raw", velocity="raw")
+
+
+def test_missing_force_and_missing_motion():
+    with pytest.raises(ChannelError, match=r"no force channel.*--force NAME"):
+        assign_roles(_m(_ch("v", "velocity", "m/s")))
+    with pytest.raises(ChannelError, match=r"no velocity or acceleration channel"):
+        assign_roles(_m(_ch("F", "force", "N"), _ch("mic", "pressure", "Pa")))
+
+
+@pytest.mark.parametrize(("name", "role", "expected"), [
+    ("Drive point force", "force", True), ("F", "force", True), ("Kraft_1", "force", True),
+    ("LDV", "velocity", True), ("vel_z", "velocity", True), ("Acc 3", "acceleration", True),
+    ("Accelerometer", "acceleration", True), ("a", "acceleration", True),
+    ("1+Z", "force", False), ("Mic 01", "velocity", False), ("Field Voltage", "velocity", False),
+])
+def test_name_suggests(name, role, expected):
+    assert name_suggests(name, role) is expected
+
+
+def test_missing_force_reported_before_motion_ambiguity():
+    m = _m(_ch("1+Z", "acceleration", "m/s2"), _ch("2+Z", "acceleration", "m/s2"))
+    with pytest.raises(ChannelError, match="no force channel"):
+        assign_roles(m)
