@@ -1,0 +1,284 @@
+"""Equivalent viscous damper from the specific damping capacity (paper abstract, Sect. 1 and 3).
+
+For a coupon driven at constant acceleration amplitude ``a`` [m/s^2] and angular frequency
+``w = 2 pi f``:
+
+* maximum kinetic energy (Eq. 10): ``E = m_c a^2 / (2 w^2)``;
+* energy dissipated per cycle (Eq. 8): ``dE = SDC * E``;
+* displacement amplitude: ``X = a / w^2``;
+* a viscous damper ``c`` moving as ``X sin(w t)`` dissipates ``pi c w X^2`` per cycle, so the
+  damper dissipating the same energy is ``c_eq = dE / (pi w X^2) = SDC m_c w / (2 pi)``;
+* loss factor ``SDC / (2 pi)`` and damping ratio ``-ln(1 - SDC) / (4 pi)`` (Sect. 3; the latter
+  from the logarithmic decrement of a free decay losing the fraction SDC of its energy per cycle,
+  small-damping form; undefined for SDC >= 1, reported as NaN).
+
+``c_eq`` per unit area divides by the coupon area: the particles in a cell respond to the motion
+of the cell, so the dissipation (not the mass) is what carries over to another structure with
+the same fill, acceleration and frequency.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable, Sequence
+from datetime import UTC, datetime
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from .. import __version__
+from .. import defaults as D
+from ..constants import STANDARD_GRAVITY
+from ..errors import ParameterError
+from .sdc_model import SdcModel
+
+#: Output columns of :func:`equivalent_damper_table` and their units.
+DAMPER_COLUMNS: dict[str, str] = {
+    "frequency [Hz]": "Hz",
+    "acceleration [g]": "g",
+    "fill [%]": "%",
+    "sdc [-]": "-",
+    "sdc_filled [-]": "-",
+    "loss_factor [-]": "-",
+    "damping_ratio [-]": "-",
+    "vibrated_mass [kg]": "kg",
+    "energy_per_cycle [J]": "J",
+    "displacement_amplitude [m]": "m",
+    "c_eq [N s/m]": "N s/m",
+    "c_eq_per_area [N s/m^3]": "N s/m^3",
+}
+
+
+def _positive(name: str, value: np.ndarray) -> np.ndarray:
+    arr = np.asarray(value, dtype=float)
+    if not np.all(np.isfinite(arr)) or np.any(arr <= 0):
+        raise ParameterError(f"{name} must be finite and > 0, got {value!r}")
+    return arr
+
+
+def loss_factor(sdc: float | np.ndarray) -> np.ndarray:
+    """Loss factor [-] from SDC [-]: ``SDC / (2 pi)``."""
+    return np.asarray(sdc, dtype=float) / (2.0 * np.pi)
+
+
+def damping_ratio(sdc: float | np.ndarray) -> np.ndarray:
+    """Damping ratio [-] from SDC [-]: ``-ln(1 - SDC) / (4 pi)``; NaN where SDC >= 1."""
+    s = np.asarray(sdc, dtype=float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(s < 1.0, -np.log1p(-np.minimum(s, 1.0)) / (4.0 * np.pi), np.nan)
+
+
+def energy_per_cycle(sdc: float | np.ndarray, *, vibrated_mass_kg: float | np.ndarray,
+                     acceleration_m_s2: float | np.ndarray,
+                     frequency_hz: float | np.ndarray) -> np.ndarray:
+    """Energy dissipated per cycle [J]: ``SDC * m_c a^2 / (2 w^2)`` (Eq. 8-10)."""
+    m = _positive("vibrated_mass_kg", vibrated_mass_kg)
+    a = _positive("acceleration_m_s2", acceleration_m_s2)
+    w = 2.0 * np.pi * _positive("frequency_hz", frequency_hz)
+    return np.asarray(sdc, dtype=float) * m * a**2 / (2.0 * w**2)
+
+
+def displacement_amplitude(acceleration_m_s2: float | np.ndarray,
+                           frequency_hz: float | np.ndarray) -> np.ndarray:
+    """Displacement amplitude [m] of harmonic motion: ``a / w^2``."""
+    w = 2.0 * np.pi * _positive("frequency_hz", frequency_hz)
+    return _positive("acceleration_m_s2", acceleration_m_s2) / w**2
+
+
+def equivalent_damping_coefficient(sdc: float | np.ndarray, *,
+                                   vibrated_mass_kg: float | np.ndarray,
+                                   frequency_hz: float | np.ndarray) -> np.ndarray:
+    """Viscous damper [N s/m] dissipating the same energy per cycle: ``SDC m_c w / (2 pi)``.
+
+    Independent of the acceleration amplitude for a given SDC (the amplitude dependence is in
+    SDC itself). Equals ``dE / (pi w X^2)`` with :func:`energy_per_cycle` and
+    :func:`displacement_amplitude`.
+
+    Examples
+    --------
+    >>> float(equivalent_damping_coefficient(2 * np.pi * 0.01, vibrated_mass_kg=1.0,
+    ...                                      frequency_hz=1 / (2 * np.pi)))
+    0.01
+    """
+    m = _positive("vibrated_mass_kg", vibrated_mass_kg)
+    w = 2.0 * np.pi * _positive("frequency_hz", frequency_hz)
+    return np.asarray(sdc, dtype=float) * m * w / (2.0 * np.pi)
+
+
+def sdc_from_damping_coefficient(c_eq: float | np.ndarray, *,
+                                 vibrated_mass_kg: float | np.ndarray,
+                                 frequency_hz: float | np.ndarray) -> np.ndarray:
+    """Inverse of :func:`equivalent_damping_coefficient`: ``2 pi c_eq / (m_c w)``."""
+    m = _positive("vibrated_mass_kg", vibrated_mass_kg)
+    w = 2.0 * np.pi * _positive("frequency_hz", frequency_hz)
+    return 2.0 * np.pi * np.asarray(c_eq, dtype=float) / (m * w)
+
+
+def coupon_area_m2(side_m: float = D.COUPON_SIDE_M) -> float:
+    """Face area of the square coupon [m^2] (paper: 0.1 m x 0.1 m)."""
+    return float(_positive("side_m", side_m)) ** 2
+
+
+def coupon_vibrated_mass_kg(*, particles_mass_kg: float = 0.0,
+                            side_m: float = D.COUPON_SIDE_M,
+                            face_sheet_thickness_m: float = D.FACE_SHEET_THICKNESS_M,
+                            face_sheet_density_kg_m3: float = D.FACE_SHEET_DENSITY_KG_M3,
+                            core_height_m: float = D.CELL_HEIGHT_M,
+                            core_density_kg_m3: float = D.CORE_DENSITY_KG_M3) -> float:
+    """Mass m_c [kg] entering Eq. 10: two face sheets + core (paper Table 2) + particles.
+
+    The particle mass is an explicit argument because the number of particles that fit in a cell
+    is the DEM module's business; :func:`paper_particles_mass_kg` gives the paper's count.
+
+    Examples
+    --------
+    >>> round(coupon_vibrated_mass_kg(), 5)  # 2 x 0.1^2 x 0.25e-3 x 2800 + 0.1^2 x 0.0254 x 32.1
+    0.02215
+    """
+    if particles_mass_kg < 0 or not np.isfinite(particles_mass_kg):
+        raise ParameterError(f"particles_mass_kg must be >= 0, got {particles_mass_kg!r}")
+    area = coupon_area_m2(side_m)
+    faces = 2.0 * area * _positive("face_sheet_thickness_m", face_sheet_thickness_m) \
+        * _positive("face_sheet_density_kg_m3", face_sheet_density_kg_m3)
+    core = area * _positive("core_height_m", core_height_m) \
+        * _positive("core_density_kg_m3", core_density_kg_m3)
+    return float(faces + core + particles_mass_kg)
+
+
+def _particle_mass_kg(material: str) -> float:
+    path = resources.files("pidcore.data").joinpath("materials.csv")
+    with resources.as_file(path) as p:
+        table = pd.read_csv(p, comment="#")
+    row = table[(table["name"] == material) & (table["role"] == "particle")]
+    if row.empty:
+        names = table.loc[table["role"] == "particle", "name"].tolist()
+        raise ParameterError(f"material {material!r} is not a particle material; expected one "
+                             f"of {names}")
+    r = float(row["default_radius_m"].iloc[0])
+    return float(row["density_kg_m3"].iloc[0]) * 4.0 / 3.0 * np.pi * r**3
+
+
+def paper_particles_mass_kg(fill_percent: float, material: str = "acrylic", *,
+                            cells: int = D.COUPON_CELLS,
+                            particles_per_full_cell: int = D.PAPER_PARTICLES_PER_FULL_CELL
+                            ) -> float:
+    """Particle mass [kg] in the coupon by the paper's count (Sect. 5.1).
+
+    ``round(particles_per_full_cell * fill / 100)`` particles of the material's default radius
+    and density (``pidcore/data/materials.csv``) in each of ``cells`` cells.
+    """
+    if not 0.0 <= fill_percent <= 100.0:
+        raise ParameterError(f"fill_percent must be in [0, 100], got {fill_percent!r}")
+    per_cell = round(particles_per_full_cell * fill_percent / 100.0)
+    return cells * per_cell * _particle_mass_kg(material)
+
+
+def equivalent_damper_table(model: SdcModel, *, fills: Sequence[float],
+                            accelerations: Sequence[float], frequencies: Sequence[float],
+                            vibrated_mass_kg: float | Callable[[float], float],
+                            area_m2: float | None = None,
+                            clip_to_range: bool = False) -> pd.DataFrame:
+    """Equivalent damper over a grid of fill [%], acceleration [g] and frequency [Hz].
+
+    Parameters
+    ----------
+    model : SdcModel
+        SDC model.
+    fills, accelerations, frequencies : sequence of float
+        Values in %, g and Hz; the table is their Cartesian product.
+    vibrated_mass_kg : float or callable
+        m_c [kg] of Eq. 10, or a function of fill [%] returning it (the particle mass grows
+        with fill).
+    area_m2 : float, optional
+        Coupon area for the per-area damper; default :func:`coupon_area_m2`.
+    clip_to_range : bool
+        Passed to :meth:`SdcModel.evaluate` (default: refuse points outside the model).
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns :data:`DAMPER_COLUMNS` (names carry units); ``sdc_filled [-]`` (bool) is True where
+        the point coincides with a filled hole of the model grid.
+    """
+    grid = pd.MultiIndex.from_product(
+        [np.asarray(frequencies, float), np.asarray(accelerations, float),
+         np.asarray(fills, float)], names=["f", "a", "p"]).to_frame(index=False)
+    if grid.empty:
+        raise ParameterError("equivalent_damper_table: fills, accelerations and frequencies "
+                             "must each hold at least one value")
+    f, a_g, p = (grid[c].to_numpy() for c in ("f", "a", "p"))
+    if callable(vibrated_mass_kg):
+        mass = np.array([float(vibrated_mass_kg(x)) for x in p])
+    else:
+        mass = np.full(p.shape, float(vibrated_mass_kg))
+    mass = _positive("vibrated_mass_kg", mass)
+    area = coupon_area_m2() if area_m2 is None else float(_positive("area_m2", area_m2))
+    sdc = model.evaluate(p, a_g, f, clip_to_range=clip_to_range)
+    a = _positive("acceleration [g]", a_g) * STANDARD_GRAVITY
+    c_eq = equivalent_damping_coefficient(sdc, vibrated_mass_kg=mass, frequency_hz=f)
+    filled_pts = model.filled_points()
+    filled = np.zeros(p.shape, dtype=bool)
+    for _, row in filled_pts.iterrows():
+        filled[(p == row["fill_percent"]) & (a_g == row["acceleration_g"])
+               & (f == row["frequency_hz"])] = True
+    out = pd.DataFrame({
+        "frequency [Hz]": f,
+        "acceleration [g]": a_g,
+        "fill [%]": p,
+        "sdc [-]": sdc,
+        "sdc_filled [-]": filled,
+        "loss_factor [-]": loss_factor(sdc),
+        "damping_ratio [-]": damping_ratio(sdc),
+        "vibrated_mass [kg]": mass,
+        "energy_per_cycle [J]": energy_per_cycle(sdc, vibrated_mass_kg=mass,
+                                                 acceleration_m_s2=a, frequency_hz=f),
+        "displacement_amplitude [m]": displacement_amplitude(a, f),
+        "c_eq [N s/m]": c_eq,
+        "c_eq_per_area [N s/m^3]": c_eq / area,
+    })
+    return out
+
+
+def _json_value(value):
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    if isinstance(value, (int, np.integer)):
+        return int(value)
+    if isinstance(value, (float, np.floating)):
+        return float(value) if np.isfinite(value) else None
+    return value
+
+
+def write_damper_table(table: pd.DataFrame, out_dir: str | Path, *,
+                       formats: Sequence[str] = ("csv", "json"), stem: str = "equivalent_damper",
+                       provenance: dict | None = None) -> list[Path]:
+    """Write an :func:`equivalent_damper_table` as CSV and/or JSON; return the paths.
+
+    JSON holds ``{"records": [...], "units": {column: unit}, "provenance": {...}}``; NaN is
+    written as ``null``.
+    """
+    unknown = sorted(set(formats) - {"csv", "json"})
+    if unknown or not formats:
+        raise ParameterError(f"formats: unknown {unknown or list(formats)}; expected csv, json")
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    paths: list[Path] = []
+    if "csv" in formats:
+        p = out / f"{stem}.csv"
+        table.to_csv(p, index=False)
+        paths.append(p)
+    if "json" in formats:
+        p = out / f"{stem}.json"
+        prov = {"pidcore_version": __version__,
+                "created_utc": datetime.now(UTC).isoformat(timespec="seconds")}
+        prov.update(provenance or {})
+        # to_dict keeps full float precision (to_json rounds to 10 significant digits)
+        records = [{k: _json_value(v) for k, v in row.items()}
+                   for row in table.to_dict(orient="records")]
+        units = {c: DAMPER_COLUMNS.get(c, "") for c in table.columns}
+        p.write_text(json.dumps({"records": records, "units": units, "provenance": prov},
+                                indent=1))
+        paths.append(p)
+    return paths

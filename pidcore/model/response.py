@@ -1,0 +1,333 @@
+"""Harmonic response of a structure treated with particle dampers (paper Sect. 1 and 8).
+
+A mode of the treated structure is a single-degree-of-freedom oscillator (modal mass ``m``,
+natural frequency ``f_n``, structural damping ratio ``zeta_s``) driven by a force
+``F0 cos(w t)`` applied to the modal mass (force excitation: a shaker or an acoustic load
+projected on the mode; base excitation would add the base motion to the damper's relative
+velocity and is not modelled). The particles add the amplitude-dependent equivalent damper of
+:mod:`pidcore.model.damper`:
+
+    c_pd(X, w) = SDC(fill, a = w^2 X, f) * (m_c / A_c) * w / (2 pi) * A_t
+
+with ``m_c`` and ``A_c`` the vibrated mass and area of the coupon tests behind the SDC model and
+``A_t`` the treated area: the damper dissipates, per unit treated area, what the coupon
+dissipated per unit area at the same acceleration amplitude and frequency.
+
+First-order harmonic balance gives the amplitude as the root of
+
+    X |k - m w^2 + j w (c_s + c_pd(X, w))| = F0,    k = m (2 pi f_n)^2,  c_s = 2 zeta_s m 2 pi f_n.
+
+Since ``c_pd >= 0`` every root lies between the response with the largest particle damping and
+the response without particles; the bracket is scanned on a log grid for sign changes and each
+one is refined with :func:`scipy.optimize.brentq`. The SDC dips at high acceleration, so
+several roots (jumps) can exist; the largest amplitude is returned (conservative) and flagged.
+
+Outside the model range (acceleration amplitude or frequency beyond the SDC grid) the solver
+refuses with :class:`~pidcore.errors.ParameterError` unless ``clip_to_range=True``, which holds
+the SDC at the nearest edge of the grid and flags the point.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.integrate import solve_ivp
+from scipy.optimize import brentq
+
+from ..constants import STANDARD_GRAVITY
+from ..errors import ParameterError
+from .damper import coupon_area_m2, equivalent_damping_coefficient
+from .sdc_model import SdcModel
+
+#: Points of the log-spaced scan for sign changes of the harmonic-balance residual.
+_SCAN_POINTS = 400
+#: Relative residual treated as zero (round-off of |D| X / F0).
+_ZERO_RESIDUAL = 1e-12
+#: Relative slack when deciding whether a solution's acceleration is inside the model range.
+_RANGE_RTOL = 1e-9
+
+
+@dataclass(frozen=True)
+class TreatedMode:
+    """One mode of a structure treated with particle dampers (SI units).
+
+    Attributes
+    ----------
+    natural_frequency_hz : float
+        Undamped natural frequency f_n [Hz].
+    modal_mass_kg : float
+        Modal mass m [kg].
+    structural_damping_ratio : float
+        Viscous damping ratio of the untreated mode zeta_s [-] (loss factor / 2 at resonance).
+    treated_area_m2 : float
+        Area A_t filled with particles [m^2] moving with the modal coordinate.
+    fill_percent : float
+        Fill of the treated cells [%].
+    coupon_vibrated_mass_kg : float
+        m_c [kg] of the coupon tests the SDC model comes from (Eq. 10).
+    coupon_area_m2 : float
+        A_c [m^2] of those coupons.
+    """
+
+    natural_frequency_hz: float
+    modal_mass_kg: float
+    structural_damping_ratio: float
+    treated_area_m2: float
+    fill_percent: float
+    coupon_vibrated_mass_kg: float
+    coupon_area_m2: float = coupon_area_m2()
+
+    def __post_init__(self) -> None:
+        for name in ("natural_frequency_hz", "modal_mass_kg", "treated_area_m2",
+                     "coupon_vibrated_mass_kg", "coupon_area_m2"):
+            v = getattr(self, name)
+            if not np.isfinite(v) or v <= 0:
+                raise ParameterError(f"TreatedMode: {name} must be finite and > 0, got {v!r}")
+        if not np.isfinite(self.structural_damping_ratio) or self.structural_damping_ratio < 0:
+            raise ParameterError(f"TreatedMode: structural_damping_ratio must be >= 0, got "
+                                 f"{self.structural_damping_ratio!r}")
+
+    @property
+    def stiffness_n_m(self) -> float:
+        """Modal stiffness k = m w_n^2 [N/m]."""
+        return self.modal_mass_kg * (2.0 * np.pi * self.natural_frequency_hz) ** 2
+
+    @property
+    def structural_damping_n_s_m(self) -> float:
+        """Structural damper c_s = 2 zeta_s m w_n [N s/m]."""
+        return (2.0 * self.structural_damping_ratio * self.modal_mass_kg
+                * 2.0 * np.pi * self.natural_frequency_hz)
+
+
+@dataclass(frozen=True)
+class HarmonicResponse:
+    """Steady harmonic response over a frequency sweep (all arrays share the sweep's shape).
+
+    Attributes
+    ----------
+    frequency_hz : ndarray
+        Drive frequency [Hz].
+    amplitude_m : ndarray
+        Displacement amplitude X [m].
+    phase_rad : ndarray
+        Phase of the displacement relative to the force [rad] (negative: lagging).
+    acceleration_g : ndarray
+        Acceleration amplitude w^2 X [g] at which the SDC was taken.
+    sdc : ndarray
+        SDC [-] used at the solution.
+    particle_damping_n_s_m : ndarray
+        c_pd [N s/m] at the solution.
+    amplitude_untreated_m : ndarray
+        Amplitude without particles [m], for comparison.
+    clipped : ndarray of bool
+        SDC taken at the edge of the model range (only with ``clip_to_range=True``).
+    multiple_solutions : ndarray of bool
+        More than one amplitude balances the force; the largest is reported.
+    """
+
+    frequency_hz: np.ndarray
+    amplitude_m: np.ndarray
+    phase_rad: np.ndarray
+    acceleration_g: np.ndarray
+    sdc: np.ndarray
+    particle_damping_n_s_m: np.ndarray
+    amplitude_untreated_m: np.ndarray
+    clipped: np.ndarray
+    multiple_solutions: np.ndarray
+    force_amplitude_n: float
+
+    def plot(self, ax=None):
+        """Plot amplitude (and the untreated amplitude) against frequency; return the Axes."""
+        import matplotlib.pyplot as plt
+
+        if ax is None:
+            _, ax = plt.subplots()
+        ax.plot(self.frequency_hz, self.amplitude_untreated_m, "--", label="untreated")
+        ax.plot(self.frequency_hz, self.amplitude_m, "-", label="with particle damper")
+        if np.any(self.clipped):
+            ax.plot(self.frequency_hz[self.clipped], self.amplitude_m[self.clipped], "x",
+                    label="SDC held at model edge")
+        ax.set_yscale("log")
+        ax.set_xlabel("frequency [Hz]")
+        ax.set_ylabel("displacement amplitude [m]")
+        ax.legend()
+        return ax
+
+
+def _sdc_section(model: SdcModel, mode: TreatedMode, frequency_hz: float,
+                 clip_to_range: bool):
+    """SDC as a function of acceleration [g] (clamped to the grid) at this fill and frequency."""
+    f_lo, f_hi = model.bounds["frequency_hz"]
+    inside_f = f_lo * (1 - _RANGE_RTOL) <= frequency_hz <= f_hi * (1 + _RANGE_RTOL)
+    if not inside_f and not clip_to_range:
+        raise ParameterError(f"harmonic_response: frequency {frequency_hz:g} Hz outside the "
+                             f"SDC model range [{f_lo:g}, {f_hi:g}] Hz; pass "
+                             f"clip_to_range=True to hold the edge SDC")
+    section = model.acceleration_section(mode.fill_percent,
+                                         float(np.clip(frequency_hz, f_lo, f_hi)))
+    a_lo, a_hi = model.bounds["acceleration_g"]
+
+    def sdc(a_g: np.ndarray) -> np.ndarray:
+        return section(np.clip(a_g, a_lo, a_hi))
+
+    return sdc, (not inside_f)
+
+
+def particle_damping_n_s_m(sdc: np.ndarray | float, mode: TreatedMode,
+                           frequency_hz: float) -> np.ndarray:
+    """c_pd [N s/m] of the treated area for a given SDC (module docstring)."""
+    per_area = equivalent_damping_coefficient(
+        sdc, vibrated_mass_kg=mode.coupon_vibrated_mass_kg,
+        frequency_hz=frequency_hz) / mode.coupon_area_m2
+    return per_area * mode.treated_area_m2
+
+
+def harmonic_response(model: SdcModel, mode: TreatedMode, *, frequencies_hz: np.ndarray,
+                      force_amplitude_n: float, clip_to_range: bool = False
+                      ) -> HarmonicResponse:
+    """Steady response amplitude and phase by first-order harmonic balance.
+
+    Parameters
+    ----------
+    model : SdcModel
+        SDC model (fill [%], acceleration [g], frequency [Hz]).
+    mode : TreatedMode
+        The treated mode.
+    frequencies_hz : array_like
+        Drive frequencies [Hz].
+    force_amplitude_n : float
+        F0 [N] of the force ``F0 cos(w t)`` on the modal mass.
+    clip_to_range : bool
+        Hold SDC at the model's edge where the solution leaves its range instead of raising.
+
+    Returns
+    -------
+    HarmonicResponse
+    """
+    if not np.isfinite(force_amplitude_n) or force_amplitude_n <= 0:
+        raise ParameterError(f"force_amplitude_n must be finite and > 0, got "
+                             f"{force_amplitude_n!r}")
+    freqs = np.atleast_1d(np.asarray(frequencies_hz, dtype=float))
+    if not np.all(np.isfinite(freqs)) or np.any(freqs <= 0):
+        raise ParameterError("frequencies_hz must be finite and > 0")
+    k, m, c_s = mode.stiffness_n_m, mode.modal_mass_kg, mode.structural_damping_n_s_m
+    a_lo, a_hi = model.bounds["acceleration_g"]
+    sdc_max = float(np.max(model.values))
+    out = {name: np.empty(freqs.shape) for name in
+           ("x", "phase", "acc", "sdc", "c_pd", "x0")}
+    clipped = np.zeros(freqs.shape, dtype=bool)
+    multiple = np.zeros(freqs.shape, dtype=bool)
+    for i, f in enumerate(freqs):
+        w = 2.0 * np.pi * f
+        sdc_of, freq_clipped = _sdc_section(model, mode, f, clip_to_range)
+
+        def c_pd(x: np.ndarray, sdc_of=sdc_of, w=w, f=f) -> np.ndarray:
+            return particle_damping_n_s_m(sdc_of(w**2 * x / STANDARD_GRAVITY), mode, f)
+
+        def residual(log_x: np.ndarray, c_pd=c_pd, w=w) -> np.ndarray:
+            x = np.exp(log_x)
+            return x * np.abs(k - m * w**2 + 1j * w * (c_s + c_pd(x))) / force_amplitude_n - 1.0
+
+        x_hi = force_amplitude_n / abs(k - m * w**2 + 1j * w * c_s)
+        c_max = float(particle_damping_n_s_m(max(sdc_max, 0.0), mode, f))
+        x_lo = force_amplitude_n / abs(k - m * w**2 + 1j * w * (c_s + c_max))
+        if x_hi <= x_lo * (1 + 1e-14):
+            roots = [np.log(x_hi)]
+        else:
+            grid = np.linspace(np.log(x_lo), np.log(x_hi), _SCAN_POINTS)
+            r = residual(grid)
+            # the residual is relative to F0: |r| below round-off is a root on the scan grid
+            # (e.g. at x_hi when the SDC is 0 there)
+            zero = np.abs(r) <= _ZERO_RESIDUAL
+            roots = list(grid[zero])
+            for j in np.flatnonzero((np.sign(r[:-1]) * np.sign(r[1:]) < 0)
+                                    & ~zero[:-1] & ~zero[1:]):
+                roots.append(brentq(residual, grid[j], grid[j + 1], xtol=1e-14, rtol=1e-13))
+            if not roots:  # residual >= 0 at x_lo within round-off: the bracket edge is the root
+                roots = [grid[int(np.argmin(np.abs(r)))]]
+        x = float(np.exp(max(roots)))
+        # roots closer than 1e-9 in log(X) are one root found twice
+        multiple[i] = np.unique(np.round(np.asarray(roots), 9)).size > 1
+        acc = w**2 * x / STANDARD_GRAVITY
+        acc_outside = not (a_lo * (1 - _RANGE_RTOL) <= acc <= a_hi * (1 + _RANGE_RTOL))
+        if acc_outside and not clip_to_range:
+            raise ParameterError(
+                f"harmonic_response: at {f:g} Hz the response acceleration {acc:.3g} g is "
+                f"outside the SDC model range [{a_lo:g}, {a_hi:g}] g; change the force or pass "
+                f"clip_to_range=True to hold the edge SDC")
+        clipped[i] = acc_outside or freq_clipped
+        cp = float(c_pd(np.array(x)))
+        out["x"][i] = x
+        out["phase"][i] = -np.angle(k - m * w**2 + 1j * w * (c_s + cp))
+        out["acc"][i] = acc
+        out["sdc"][i] = float(sdc_of(np.array(acc)))
+        out["c_pd"][i] = cp
+        out["x0"][i] = x_hi
+    return HarmonicResponse(frequency_hz=freqs, amplitude_m=out["x"], phase_rad=out["phase"],
+                            acceleration_g=out["acc"], sdc=out["sdc"],
+                            particle_damping_n_s_m=out["c_pd"],
+                            amplitude_untreated_m=out["x0"], clipped=clipped,
+                            multiple_solutions=multiple,
+                            force_amplitude_n=float(force_amplitude_n))
+
+
+@dataclass(frozen=True)
+class TimeDomainSteadyState:
+    """Steady state of the time integration: fundamental amplitude [m] and phase [rad]."""
+
+    frequency_hz: float
+    amplitude_m: float
+    phase_rad: float
+    peak_amplitude_m: float
+    settle_time_s: float
+
+
+def time_domain_response(model: SdcModel, mode: TreatedMode, *, frequency_hz: float,
+                         force_amplitude_n: float, settle_cycles: int | None = None,
+                         measure_cycles: int = 10, rtol: float = 1e-9
+                         ) -> TimeDomainSteadyState:
+    """Integrate the same nonlinear oscillator in time from rest; measure its steady state.
+
+    The damper force is ``c_pd(A(t), w) * v`` with the instantaneous amplitude
+    ``A = sqrt(x^2 + (v / w)^2)``, which equals X in steady harmonic motion. The harmonic-balance
+    solution is therefore an exact periodic solution of this ODE; the comparison checks the
+    root finding, the assembly of c_pd from the model and the units, and that the solution
+    is the one the system settles on from rest. It does not check the equivalent-damper idea
+    against DEM. SDC is held at the model edge while A(t) is outside the range (transients).
+
+    ``settle_cycles`` defaults to 8 decay time constants of the lightest possible damping
+    (structural only), in drive cycles.
+    """
+    w = 2.0 * np.pi * frequency_hz
+    k, m, c_s = mode.stiffness_n_m, mode.modal_mass_kg, mode.structural_damping_n_s_m
+    sdc_of, _ = _sdc_section(model, mode, frequency_hz, True)
+    wn = 2.0 * np.pi * mode.natural_frequency_hz
+    if settle_cycles is None:
+        zeta = max(mode.structural_damping_ratio, 1e-3)
+        settle_cycles = int(np.ceil(8.0 / (zeta * wn) * frequency_hz))
+    period = 1.0 / frequency_hz
+    t_settle = settle_cycles * period
+    t_end = t_settle + measure_cycles * period
+
+    def rhs(t: float, y: np.ndarray) -> list[float]:
+        x, v = y
+        amp = np.sqrt(x * x + (v / w) ** 2)
+        c = c_s + float(particle_damping_n_s_m(sdc_of(np.array(w**2 * amp / STANDARD_GRAVITY)),
+                                               mode, frequency_hz))
+        return [v, (force_amplitude_n * np.cos(w * t) - c * v - k * x) / m]
+
+    x_scale = force_amplitude_n / k
+    sol = solve_ivp(rhs, (0.0, t_end), [0.0, 0.0], method="DOP853", rtol=rtol,
+                    atol=[1e-12 * x_scale, 1e-12 * x_scale * w], dense_output=True,
+                    max_step=period / 8)
+    if not sol.success:
+        raise ParameterError(f"time_domain_response: integration failed: {sol.message}")
+    t = np.linspace(t_settle, t_end, measure_cycles * 256, endpoint=False)
+    x = sol.sol(t)[0]
+    # fundamental by projection over whole cycles: x ~ X cos(w t + phase)
+    coef = 2.0 * np.mean(x * np.exp(-1j * w * t))
+    return TimeDomainSteadyState(frequency_hz=float(frequency_hz), amplitude_m=float(abs(coef)),
+                                 phase_rad=float(np.angle(coef)),
+                                 peak_amplitude_m=float(0.5 * (x.max() - x.min())),
+                                 settle_time_s=float(t_settle))

@@ -1,0 +1,349 @@
+"""Multivariate pchip model of the specific damping capacity (paper Sect. 4 and 8).
+
+The paper interpolates its Table 3 with a "pchip" interpolant in fill fraction, acceleration
+amplitude and drive frequency. :class:`SdcModel` is that interpolant: a tensor-product of
+one-dimensional piecewise cubic Hermite interpolants with Fritsch-Carlson (pchip) slopes,
+evaluated axis after axis.
+
+Why not ``scipy.interpolate.RegularGridInterpolator(method="pchip")``: it demands at least four
+points per axis and Table 3 has three accelerations (1, 5, 10 g). The slopes and Hermite
+coefficients still come from :class:`scipy.interpolate.PchipInterpolator`; only the per-point
+selection of the interval is done here.
+
+Properties that follow from the construction (and are tested):
+
+* every grid point is reproduced (up to round-off);
+* pchip is monotone on every interval, so each one-dimensional pass stays between its two
+  neighbouring values and the result stays within the min/max of the 2^3 surrounding grid
+  values: no overshoot, SDC stays in [0, 1] when the data do;
+* along a grid line (two coordinates on grid values) the model is monotone wherever the data are.
+
+The passes run in the fixed order frequency, fill, acceleration. pchip is nonlinear in the data,
+so the order matters between grid lines (not on them); acceleration goes last so that, at a fixed
+fill and frequency, the model is exactly one 1-D pchip in acceleration
+(:meth:`SdcModel.acceleration_section`), which the harmonic-response solver uses.
+
+Holes (a grid combination with no value, such as the paper's DEM value at 1000 Hz, 1 g, 90 %) are
+filled before the grid is built, along the fill axis at the same frequency and acceleration:
+
+* between two known fills: 1-D pchip through the known fills of that line;
+* beyond the last (or before the first) known fill: the nearest known value is held constant.
+
+Holding is chosen over pchip or linear extrapolation because extrapolating a cubic is unbounded
+and the paper's hole sits where SDC is already 0.81 at 75 %: linear extrapolation from 50-75 %
+gives 0.92, the ratio from the 500 Hz line gives 1.06 (beyond the physical limit 1). At every
+other (frequency, acceleration) of Table 3 SDC rises from 75 % to 90 %, so holding the 75 %
+value is a lower bound: it under-predicts damping there, the conservative side for a response
+prediction. Filled points are flagged (:attr:`SdcModel.filled`, :meth:`SdcModel.filled_points`)
+so reports can say so.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+from scipy.interpolate import PchipInterpolator
+
+from ..errors import ParameterError
+
+#: Names of the model's axes, in the order of :attr:`SdcModel.axes` and of ``__call__``.
+AXIS_NAMES: tuple[str, str, str] = ("fill_percent", "acceleration_g", "frequency_hz")
+_AXIS_UNITS = {"fill_percent": "%", "acceleration_g": "g", "frequency_hz": "Hz"}
+#: Relative slack on the grid bounds in :meth:`SdcModel.contains` (float noise from unit
+#: conversions such as g -> m/s^2 -> g must not push a grid-edge point outside).
+_BOUND_RTOL = 1e-9
+
+
+def _pchip_select(x: np.ndarray, y: np.ndarray, xq: np.ndarray, *,
+                  shared: bool = False) -> np.ndarray:
+    """pchip along axis 0 of ``y``, each query point on its own column.
+
+    Not shared: ``y`` has shape ``(len(x), ..., N)`` and column ``n`` (last axis) is evaluated at
+    ``xq[n]`` only. Shared: ``y`` has shape ``(len(x), ...)`` and every query uses all of it.
+    Returns shape ``(..., N)``. This is the per-point 1-D pass of the tensor-product interpolant
+    without the N x N cost of evaluating every column at every query.
+    """
+    # c[k, i, ...] multiplies (xq - x[i])**(3 - k) on interval i
+    c = PchipInterpolator(x, y, axis=0, extrapolate=False).c
+    interval = np.clip(np.searchsorted(x, xq, side="right") - 1, 0, len(x) - 2)
+    dx = xq - x[interval]
+    if shared:
+        coeffs = c[:, interval]  # (4, N, ...)
+        coeffs = np.moveaxis(coeffs, 1, -1)  # (4, ..., N)
+    else:
+        coeffs = c[:, interval, ..., np.arange(xq.size)]  # advanced indices first: (N, 4, ...)
+        coeffs = np.moveaxis(coeffs, 0, -1)  # (4, ..., N)
+    out = coeffs[0]
+    for k in range(1, coeffs.shape[0]):
+        out = out * dx + coeffs[k]
+    return out
+
+
+def _fill_holes_along_fill(values: np.ndarray, fills: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Fill NaNs along the fill axis (axis 0); see the module docstring for the rule."""
+    values = values.copy()
+    filled = np.isnan(values)
+    for ia in range(values.shape[1]):
+        for iz in range(values.shape[2]):
+            line = values[:, ia, iz]
+            known = ~np.isnan(line)
+            if known.all():
+                continue
+            if not known.any():
+                raise ParameterError(
+                    f"SDC table: no value at any fill for acceleration index {ia}, frequency "
+                    f"index {iz}; cannot fill the grid (every frequency/acceleration pair needs "
+                    f"at least one fill value)")
+            xk, yk = fills[known], line[known]
+            inner = (~known) & (fills > xk[0]) & (fills < xk[-1])
+            if inner.any():
+                line[inner] = PchipInterpolator(xk, yk)(fills[inner]) if xk.size > 1 else yk[0]
+            line[(~known) & (fills < xk[0])] = yk[0]
+            line[(~known) & (fills > xk[-1])] = yk[-1]
+    return values, filled
+
+
+@dataclass(frozen=True, eq=False)
+class SdcModel:
+    """Tensor-product pchip interpolant of SDC over fill, acceleration and frequency.
+
+    Build it with :meth:`from_table`. Inputs are in the units of the paper's table (fill in %,
+    acceleration amplitude in g, frequency in Hz); the output is SDC [-].
+
+    Attributes
+    ----------
+    axes : tuple of ndarray
+        Grid of fill [%], acceleration [g], frequency [Hz], each strictly increasing.
+    values : ndarray
+        Grid values, shape ``(n_fill, n_acceleration, n_frequency)``, holes filled.
+    filled : ndarray of bool
+        Same shape; True where the value was filled rather than given.
+    value_name : str
+        Column the values came from (``"sdc_dem"``, ``"sdc"``...).
+    log_frequency : bool
+        Interpolate in log10(frequency) instead of frequency.
+    source : str
+        Where the data came from (for provenance in reports).
+    """
+
+    axes: tuple[np.ndarray, np.ndarray, np.ndarray]
+    values: np.ndarray
+    filled: np.ndarray
+    value_name: str = "sdc"
+    log_frequency: bool = False
+    source: str = ""
+    _freq_nodes: np.ndarray = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        for name, ax in zip(AXIS_NAMES, self.axes, strict=True):
+            if ax.ndim != 1 or ax.size < 2 or not np.all(np.diff(ax) > 0):
+                raise ParameterError(f"SdcModel: axis {name} needs at least 2 strictly "
+                                     f"increasing values, got {ax.tolist()}")
+        shape = tuple(ax.size for ax in self.axes)
+        if self.values.shape != shape or self.filled.shape != shape:
+            raise ParameterError(f"SdcModel: values shape {self.values.shape} does not match "
+                                 f"the axes {shape}")
+        if not np.all(np.isfinite(self.values)):
+            raise ParameterError("SdcModel: values must be finite after hole filling")
+        if self.log_frequency and self.axes[2][0] <= 0:
+            raise ParameterError("SdcModel: log_frequency needs positive frequencies")
+        nodes = np.log10(self.axes[2]) if self.log_frequency else self.axes[2]
+        object.__setattr__(self, "_freq_nodes", nodes)
+        for arr in (*self.axes, self.values, self.filled, nodes):
+            arr.setflags(write=False)
+
+    # ------------------------------------------------------------------ construction
+    @classmethod
+    def from_table(cls, table: pd.DataFrame, *, value: str = "sdc_dem",
+                   log_frequency: bool = False, source: str = "") -> SdcModel:
+        """Build the model from a long table of SDC values.
+
+        Parameters
+        ----------
+        table : pandas.DataFrame
+            Columns ``fill_percent`` [%], ``acceleration_g`` [g], ``frequency_hz`` [Hz] and the
+            value column. Rows with a NaN value are ignored; duplicate grid points (repeated DEM
+            runs) are averaged. Missing grid combinations are holes, filled along the fill axis
+            (module docstring) and flagged.
+        value : str
+            Name of the value column (``"sdc_dem"`` for Table 3, ``"sdc"`` for store runs).
+        log_frequency : bool
+            Interpolate in log10(frequency) (grid points unchanged, interior values differ).
+        source : str
+            Free text kept for provenance.
+
+        Examples
+        --------
+        >>> from pidcore.model import load_paper_table3
+        >>> m = SdcModel.from_table(load_paper_table3())
+        >>> float(m(50, 5, 100))
+        0.1891
+        """
+        needed = [*AXIS_NAMES, value]
+        missing = [c for c in needed if c not in table.columns]
+        if missing:
+            raise ParameterError(f"SDC table: missing columns {missing}; expected {needed}")
+        data = table.loc[:, needed].astype(float)
+        data = data[np.isfinite(data[value])]
+        if data.empty:
+            raise ParameterError(f"SDC table: no finite values in column {value!r}")
+        if not np.all(np.isfinite(data[list(AXIS_NAMES)].to_numpy())):
+            raise ParameterError(f"SDC table: non-finite coordinates in {list(AXIS_NAMES)}")
+        mean = data.groupby(list(AXIS_NAMES))[value].mean()
+        # Axes come from every row of the table, including rows whose value is NaN, so that a
+        # documented hole (Table 3) stays a grid point.
+        coords = table.loc[:, list(AXIS_NAMES)].astype(float)
+        coords = coords[np.all(np.isfinite(coords.to_numpy()), axis=1)]
+        axes = tuple(np.unique(coords[name].to_numpy()) for name in AXIS_NAMES)
+        for name, ax in zip(AXIS_NAMES, axes, strict=True):
+            if ax.size < 2:
+                raise ParameterError(f"SDC table: column {name} has {ax.size} distinct value(s); "
+                                     f"the model needs at least 2 per axis")
+        full = pd.MultiIndex.from_product(axes, names=list(AXIS_NAMES))
+        grid = mean.reindex(full).to_numpy().reshape(tuple(a.size for a in axes))
+        values, filled = _fill_holes_along_fill(grid, axes[0])
+        return cls(axes=axes, values=values, filled=filled, value_name=value,
+                   log_frequency=log_frequency, source=source)
+
+    # ------------------------------------------------------------------ queries
+    @property
+    def bounds(self) -> dict[str, tuple[float, float]]:
+        """Range of each axis, ``{"fill_percent": (25.0, 90.0), ...}``."""
+        return {n: (float(a[0]), float(a[-1])) for n, a in zip(AXIS_NAMES, self.axes, strict=True)}
+
+    def contains(self, point: Sequence[float]) -> bool:
+        """True if ``point = (fill_percent, acceleration_g, frequency_hz)`` lies in the grid box."""
+        if len(point) != 3:
+            raise ParameterError(f"SdcModel.contains: point must be (fill_percent, "
+                                 f"acceleration_g, frequency_hz), got {point!r}")
+        return bool(np.all(self._inside(*(np.asarray(p, dtype=float) for p in point))))
+
+    def _inside(self, *coords: np.ndarray) -> np.ndarray:
+        inside = np.ones(np.broadcast_shapes(*(c.shape for c in coords)), dtype=bool)
+        for c, ax in zip(coords, self.axes, strict=True):
+            slack = _BOUND_RTOL * max(abs(ax[0]), abs(ax[-1]))
+            inside &= (c >= ax[0] - slack) & (c <= ax[-1] + slack)
+        return inside
+
+    def __call__(self, fill_percent: float | np.ndarray, acceleration_g: float | np.ndarray,
+                 frequency_hz: float | np.ndarray) -> np.ndarray:
+        """SDC [-] at the given points (broadcast); raises outside the grid (:meth:`evaluate`)."""
+        return self.evaluate(fill_percent, acceleration_g, frequency_hz)
+
+    def evaluate(self, fill_percent: float | np.ndarray, acceleration_g: float | np.ndarray,
+                 frequency_hz: float | np.ndarray, *, clip_to_range: bool = False) -> np.ndarray:
+        """SDC [-] at the given points.
+
+        Parameters
+        ----------
+        fill_percent, acceleration_g, frequency_hz : array_like
+            Coordinates in %, g and Hz; broadcast against each other.
+        clip_to_range : bool
+            False (default): any point outside the grid box raises :class:`ParameterError`
+            (extrapolating a cubic is unsafe). True: each coordinate is clamped to its axis range,
+            i.e. SDC is held at the nearest edge of the data.
+
+        Returns
+        -------
+        numpy.ndarray
+            SDC with the broadcast shape of the inputs.
+        """
+        coords = [np.asarray(c, dtype=float) for c in (fill_percent, acceleration_g, frequency_hz)]
+        shape = np.broadcast_shapes(*(c.shape for c in coords))
+        coords = [np.broadcast_to(c, shape).ravel() for c in coords]
+        if not all(np.all(np.isfinite(c)) for c in coords):
+            raise ParameterError("SdcModel: fill_percent, acceleration_g and frequency_hz must "
+                                 "be finite")
+        if clip_to_range:
+            coords = [np.clip(c, ax[0], ax[-1]) for c, ax in zip(coords, self.axes, strict=True)]
+        else:
+            inside = self._inside(*coords)
+            if not np.all(inside):
+                i = int(np.argmin(inside))
+                bad = ", ".join(f"{n}={c[i]:g} {_AXIS_UNITS[n]}"
+                                for n, c in zip(AXIS_NAMES, coords, strict=True))
+                rng = ", ".join(f"{n} in [{lo:g}, {hi:g}]" for n, (lo, hi) in self.bounds.items())
+                raise ParameterError(f"SdcModel: point ({bad}) is outside the model range "
+                                     f"({rng}); pass clip_to_range=True to hold edge values")
+            coords = [np.clip(c, ax[0], ax[-1]) for c, ax in zip(coords, self.axes, strict=True)]
+        fill, acc, freq = coords
+        if fill.size == 0:
+            return np.zeros(shape)
+        fq = np.log10(freq) if self.log_frequency else freq
+        # pass 1: frequency -> (n_fill, n_acc, N)
+        v = _pchip_select(self._freq_nodes, np.moveaxis(self.values, 2, 0), fq, shared=True)
+        # pass 2: fill -> (n_acc, N)
+        v = _pchip_select(self.axes[0], v, fill)
+        # pass 3: acceleration -> (N,)
+        v = _pchip_select(self.axes[1], v, acc)
+        return v.reshape(shape)
+
+    def acceleration_section(self, fill_percent: float, frequency_hz: float) -> PchipInterpolator:
+        """The model along acceleration at a fixed fill and frequency, as a 1-D pchip in g.
+
+        Exactly equal to the model on that line (acceleration is the last pass). Raises
+        :class:`ParameterError` if fill or frequency lies outside the grid.
+        """
+        if not self.contains((fill_percent, self.axes[1][0], frequency_hz)):
+            raise ParameterError(f"SdcModel: fill_percent={fill_percent:g} %, frequency_hz="
+                                 f"{frequency_hz:g} Hz outside the model range {self.bounds}")
+        f = np.clip(float(fill_percent), self.axes[0][0], self.axes[0][-1])
+        z = np.clip(float(frequency_hz), self.axes[2][0], self.axes[2][-1])
+        zq = np.log10(z) if self.log_frequency else z
+        v = _pchip_select(self._freq_nodes, np.moveaxis(self.values, 2, 0), np.array([zq]),
+                          shared=True)
+        v = _pchip_select(self.axes[0], v, np.array([f]))[:, 0]
+        return PchipInterpolator(self.axes[1], v, extrapolate=False)
+
+    # ------------------------------------------------------------------ views
+    def grid_table(self) -> pd.DataFrame:
+        """The grid as a long table with a boolean ``filled`` column."""
+        idx = pd.MultiIndex.from_product(self.axes, names=list(AXIS_NAMES))
+        return pd.DataFrame({self.value_name: self.values.ravel(),
+                             "filled": self.filled.ravel()}, index=idx).reset_index()
+
+    def data_points(self) -> pd.DataFrame:
+        """Grid points that carry data (not filled), as a long table."""
+        t = self.grid_table()
+        return t[~t["filled"]].drop(columns="filled").reset_index(drop=True)
+
+    def filled_points(self) -> pd.DataFrame:
+        """Grid points whose value was filled, as a long table (empty if none)."""
+        t = self.grid_table()
+        return t[t["filled"]].drop(columns="filled").reset_index(drop=True)
+
+
+#: Columns of stored DEM runs that define the simulated conditions besides the three axes.
+#: Runs differing in any of them are not averaged into one model.
+DEM_CONDITION_COLUMNS: tuple[str, ...] = (
+    "material", "direction", "normal_damping_mode", "vibrated_mass_convention",
+    "start_protocol", "fill_reference",
+)
+
+
+def select_runs(runs: pd.DataFrame, *, where: Mapping[str, str] | None = None) -> pd.DataFrame:
+    """Runs matching ``where`` (column -> value, compared as text), checked to be homogeneous.
+
+    Raises :class:`ParameterError` if a column of ``where`` is missing, nothing matches, or the
+    remaining runs differ in a :data:`DEM_CONDITION_COLUMNS` column (averaging acrylic with
+    aluminium runs, say, would make a meaningless model).
+    """
+    selected = runs
+    for column, wanted in (where or {}).items():
+        if column not in runs.columns:
+            raise ParameterError(f"DEM runs: no column {column!r} to select on; columns are "
+                                 f"{sorted(runs.columns)}")
+        selected = selected[selected[column].astype(str) == str(wanted)]
+    if selected.empty:
+        raise ParameterError(f"DEM runs: none match {dict(where or {})}")
+    for column in DEM_CONDITION_COLUMNS:
+        if column in selected.columns:
+            distinct = sorted(selected[column].dropna().astype(str).unique())
+            if len(distinct) > 1:
+                raise ParameterError(
+                    f"DEM runs differ in {column} ({', '.join(distinct)}); select one, e.g. "
+                    f"where={{{column!r}: {distinct[0]!r}}} (CLI: --where {column}={distinct[0]})")
+    return selected

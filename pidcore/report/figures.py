@@ -1,0 +1,175 @@
+"""Figures of the SDC model (paper Figs. 8-14); plotting only, the physics is in pidcore.model.
+
+* :func:`plot_sdc_vs_acceleration` - SDC against acceleration amplitude, one panel per fill,
+  one curve per frequency, data points marked (paper Figs. 8-11).
+* :func:`plot_sdc_vs_frequency` - SDC against frequency, one panel per acceleration, one curve
+  per fill, data points marked (paper Figs. 12-14).
+* :func:`save_figure` - PNG and SVG.
+
+Each curve is one ``Line2D``; the data points of a curve (grid points of the model or rows of a
+given table at that curve's fill and frequency/acceleration) are one more ``Line2D`` with
+markers only, drawn right after it, labelled ``"... data"``. Filled holes of the model grid are
+drawn as open markers labelled ``"... filled"``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ..errors import ParameterError
+from ..model.sdc_model import SdcModel
+
+#: Points per curve.
+_CURVE_POINTS = 200
+
+
+def _figure_and_axes(n_panels: int, ax):
+    if ax is not None:
+        if n_panels != 1:
+            raise ParameterError(f"ax given but {n_panels} panels requested; pass a single "
+                                 f"value for the panel variable or ax=None")
+        return ax.figure, [ax]
+    # A bare Figure (no pyplot) needs no GUI backend and is not kept alive by pyplot's registry;
+    # savefig renders it with Agg/SVG.
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(6.4, 4.0 * n_panels), layout="constrained")
+    axes = fig.subplots(n_panels, 1, squeeze=False)[:, 0]
+    return fig, list(axes)
+
+
+def _points(model: SdcModel, table: pd.DataFrame | None, value: str | None) -> pd.DataFrame:
+    """Data points (columns fill_percent, acceleration_g, frequency_hz, value, filled)."""
+    if table is None:
+        t = model.grid_table().rename(columns={model.value_name: "value"})
+        return t
+    value = value or model.value_name
+    needed = ["fill_percent", "acceleration_g", "frequency_hz", value]
+    missing = [c for c in needed if c not in table.columns]
+    if missing:
+        raise ParameterError(f"table: missing columns {missing}; expected {needed}")
+    t = table.loc[:, needed].rename(columns={value: "value"})
+    t = t[np.isfinite(t["value"].astype(float))].copy()
+    t["filled"] = False
+    return t
+
+
+def _mark(ax, pts: pd.DataFrame, xcol: str, color, label: str) -> None:
+    pts = pts.sort_values(xcol)
+    data = pts[~pts["filled"].astype(bool)]
+    filled = pts[pts["filled"].astype(bool)]
+    if len(data):
+        ax.plot(data[xcol].to_numpy(float), data["value"].to_numpy(float), linestyle="none",
+                marker="o", color=color, label=f"{label} data")
+    if len(filled):
+        ax.plot(filled[xcol].to_numpy(float), filled["value"].to_numpy(float), linestyle="none",
+                marker="o", markerfacecolor="none", color=color, label=f"{label} filled")
+
+
+def _default(values: Sequence[float] | None, axis: np.ndarray) -> list[float]:
+    return [float(v) for v in (axis if values is None else values)]
+
+
+def plot_sdc_vs_acceleration(model: SdcModel, *, fills: Sequence[float] | None = None,
+                             frequencies: Sequence[float] | None = None, ax=None,
+                             table: pd.DataFrame | None = None, value: str | None = None):
+    """SDC against acceleration amplitude: a panel per fill, a curve per frequency (Figs. 8-11).
+
+    Parameters
+    ----------
+    model : SdcModel
+        The interpolant drawn as curves.
+    fills : sequence of float, optional
+        Fill [%] of each panel (default: the model's fill grid).
+    frequencies : sequence of float, optional
+        Frequency [Hz] of each curve (default: the model's frequency grid).
+    ax : matplotlib Axes, optional
+        Draw into this Axes (only with a single fill).
+    table : pandas.DataFrame, optional
+        Points to mark (e.g. the store's DEM runs); default: the model's grid points.
+    value : str, optional
+        Value column of ``table`` (default: the model's ``value_name``).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    fills = _default(fills, model.axes[0])
+    frequencies = _default(frequencies, model.axes[2])
+    fig, axes = _figure_and_axes(len(fills), ax)
+    pts = _points(model, table, value)
+    lo, hi = model.bounds["acceleration_g"]
+    acc = np.linspace(lo, hi, _CURVE_POINTS)
+    for panel, fill in zip(axes, fills, strict=True):
+        for freq in frequencies:
+            (line,) = panel.plot(acc, model(fill, acc, freq), label=f"{freq:g} Hz")
+            sel = pts[np.isclose(pts["fill_percent"], fill)
+                      & np.isclose(pts["frequency_hz"], freq)]
+            _mark(panel, sel, "acceleration_g", line.get_color(), f"{freq:g} Hz")
+        panel.set_title(f"SDC at {fill:g} % fill")
+        panel.set_xlabel("acceleration amplitude [g]")
+        panel.set_ylabel("SDC [-]")
+        panel.legend(fontsize="small", ncols=2)
+    return fig
+
+
+def plot_sdc_vs_frequency(model: SdcModel, *, accelerations: Sequence[float] | None = None,
+                          fills: Sequence[float] | None = None, ax=None,
+                          table: pd.DataFrame | None = None, value: str | None = None,
+                          log_x: bool = True):
+    """SDC against frequency: a panel per acceleration, a curve per fill (Figs. 12-14).
+
+    Parameters
+    ----------
+    model : SdcModel
+        The interpolant drawn as curves.
+    accelerations : sequence of float, optional
+        Acceleration amplitude [g] of each panel (default: the model's acceleration grid).
+    fills : sequence of float, optional
+        Fill [%] of each curve (default: the model's fill grid).
+    ax : matplotlib Axes, optional
+        Draw into this Axes (only with a single acceleration).
+    table, value : optional
+        Points to mark, as in :func:`plot_sdc_vs_acceleration`.
+    log_x : bool
+        Logarithmic frequency axis.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    accelerations = _default(accelerations, model.axes[1])
+    fills = _default(fills, model.axes[0])
+    fig, axes = _figure_and_axes(len(accelerations), ax)
+    pts = _points(model, table, value)
+    lo, hi = model.bounds["frequency_hz"]
+    freq = np.geomspace(lo, hi, _CURVE_POINTS) if log_x else np.linspace(lo, hi, _CURVE_POINTS)
+    for panel, acc in zip(axes, accelerations, strict=True):
+        for fill in fills:
+            (line,) = panel.plot(freq, model(fill, acc, freq), label=f"{fill:g} %")
+            sel = pts[np.isclose(pts["fill_percent"], fill)
+                      & np.isclose(pts["acceleration_g"], acc)]
+            _mark(panel, sel, "frequency_hz", line.get_color(), f"{fill:g} %")
+        if log_x:
+            panel.set_xscale("log")
+        panel.set_title(f"SDC at {acc:g} g")
+        panel.set_xlabel("frequency [Hz]")
+        panel.set_ylabel("SDC [-]")
+        panel.legend(fontsize="small", ncols=2)
+    return fig
+
+
+def save_figure(fig, out_dir: str | Path, stem: str) -> list[Path]:
+    """Write ``fig`` as ``<out_dir>/<stem>.png`` and ``.svg``; return both paths."""
+    if not stem or any(c in stem for c in "/\\") or stem.startswith("."):
+        raise ParameterError(f"save_figure: stem {stem!r} must be a plain file name")
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    paths = [out / f"{stem}.png", out / f"{stem}.svg"]
+    fig.savefig(paths[0], dpi=150)
+    fig.savefig(paths[1])
+    return paths

@@ -1,0 +1,156 @@
+"""Equivalent viscous damper from SDC: definitions, energy balance, round trip, table, files."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pandas as pd
+import pytest
+from scipy.integrate import quad
+
+from pidcore.constants import STANDARD_GRAVITY
+from pidcore.errors import ParameterError
+from pidcore.model import (
+    DAMPER_COLUMNS,
+    SdcModel,
+    coupon_vibrated_mass_kg,
+    damping_ratio,
+    energy_per_cycle,
+    equivalent_damper_table,
+    equivalent_damping_coefficient,
+    load_paper_table3,
+    loss_factor,
+    paper_particles_mass_kg,
+    sdc_from_damping_coefficient,
+    write_damper_table,
+)
+
+
+@pytest.fixture(scope="module")
+def model() -> SdcModel:
+    return SdcModel.from_table(load_paper_table3())
+
+
+def test_round_trip_sdc_to_c_eq_to_sdc():
+    sdc = np.array([1.5e-4, 0.01, 0.3, 0.8843, 0.99])
+    m = np.array([0.02, 0.1, 1.0, 3.0, 10.0])
+    f = np.array([50.0, 100.0, 333.0, 500.0, 1000.0])
+    c = equivalent_damping_coefficient(sdc, vibrated_mass_kg=m, frequency_hz=f)
+    # two multiplications and two divisions: a few ulps
+    np.testing.assert_allclose(sdc_from_damping_coefficient(c, vibrated_mass_kg=m,
+                                                            frequency_hz=f), sdc, rtol=1e-14)
+
+
+def test_c_eq_of_a_linear_viscous_damper():
+    # A viscous damper c on mass m vibrating at w has loss factor c w / (m w^2) = c / (m w)
+    # (at resonance this is 2 zeta). SDC = 2 pi * loss factor, so SDC = 2 pi 0.01 must give back
+    # c = 0.01 m w = 2 zeta m w with zeta = 0.005.
+    m, f = 1.7, 120.0
+    w = 2 * np.pi * f
+    c = equivalent_damping_coefficient(2 * np.pi * 0.01, vibrated_mass_kg=m, frequency_hz=f)
+    assert c == pytest.approx(2 * 0.005 * m * w, rel=1e-14)
+    assert loss_factor(2 * np.pi * 0.01) == pytest.approx(0.01, rel=1e-15)
+
+
+@pytest.mark.parametrize("sdc,a_g,f", [(0.1891, 5.0, 100.0), (0.8843, 5.0, 1000.0),
+                                       (1.5702e-4, 1.0, 50.0)])
+def test_c_eq_dissipates_sdc_times_peak_kinetic_energy(sdc, a_g, f):
+    # Integrate the viscous power c v^2 over one cycle of the coupon's motion (acceleration
+    # amplitude a) numerically; it must equal SDC * m a^2 / (2 w^2) (Eq. 8-10).
+    m = 0.0988
+    w = 2 * np.pi * f
+    a = a_g * STANDARD_GRAVITY
+    c = float(equivalent_damping_coefficient(sdc, vibrated_mass_kg=m, frequency_hz=f))
+    v_amp = a / w
+    dissipated, _ = quad(lambda t: c * (v_amp * np.cos(w * t)) ** 2, 0, 2 * np.pi / w,
+                         epsabs=0, epsrel=1e-12)
+    kinetic_peak = 0.5 * m * v_amp**2
+    assert dissipated == pytest.approx(sdc * kinetic_peak, rel=1e-10)
+    assert energy_per_cycle(sdc, vibrated_mass_kg=m, acceleration_m_s2=a,
+                            frequency_hz=f) == pytest.approx(sdc * kinetic_peak, rel=1e-14)
+
+
+def test_damping_ratio_limits():
+    s = np.array([1e-6, 1e-3, 0.5, 1.0, 1.2])
+    z = damping_ratio(s)
+    # small damping: -ln(1-s)/(4 pi) -> s/(4 pi) = loss factor / 2, relative error ~ s/2
+    assert z[0] == pytest.approx(loss_factor(s[0]) / 2, rel=1e-6)
+    assert z[1] == pytest.approx(loss_factor(s[1]) / 2, rel=1e-3)
+    # free decay losing half its energy per cycle: exp(-4 pi zeta) = 1/2
+    assert np.exp(-4 * np.pi * z[2]) == pytest.approx(0.5, rel=1e-14)
+    assert np.isnan(z[3]) and np.isnan(z[4])
+
+
+def test_coupon_mass_from_table_2():
+    faces = 2 * 0.1 * 0.1 * 0.25e-3 * 2800
+    core = 0.1 * 0.1 * 25.4e-3 * 32.1
+    assert coupon_vibrated_mass_kg() == pytest.approx(faces + core, rel=1e-14)
+    assert coupon_vibrated_mass_kg(particles_mass_kg=0.05) == pytest.approx(faces + core + 0.05)
+    with pytest.raises(ParameterError):
+        coupon_vibrated_mass_kg(particles_mass_kg=-1.0)
+
+
+def test_paper_particle_mass():
+    one = 1180 * 4 / 3 * np.pi * 1.25e-3**3  # acrylic, Table 1
+    assert paper_particles_mass_kg(50) == pytest.approx(441 * 18 * one, rel=1e-14)
+    assert paper_particles_mass_kg(100, "aluminium") == pytest.approx(
+        441 * 36 * 2850 * 4 / 3 * np.pi * 1e-3**3, rel=1e-14)
+    with pytest.raises(ParameterError, match="not a particle material"):
+        paper_particles_mass_kg(50, "aluminium_wall")
+
+
+def test_damper_table_content(model):
+    def mass(fill):
+        return 0.02 + fill / 1000
+
+    t = equivalent_damper_table(model, fills=[25, 90], accelerations=[1, 5],
+                                frequencies=[100, 1000], vibrated_mass_kg=mass)
+    assert list(t.columns) == list(DAMPER_COLUMNS)
+    assert len(t) == 8
+    sdc = model(t["fill [%]"].to_numpy(), t["acceleration [g]"].to_numpy(),
+                t["frequency [Hz]"].to_numpy())
+    np.testing.assert_array_equal(t["sdc [-]"], sdc)
+    np.testing.assert_allclose(t["vibrated_mass [kg]"], 0.02 + t["fill [%]"] / 1000)
+    np.testing.assert_allclose(t["c_eq_per_area [N s/m^3]"], t["c_eq [N s/m]"] / 0.01,
+                               rtol=1e-14)
+    w = 2 * np.pi * t["frequency [Hz]"]
+    x = t["displacement_amplitude [m]"]
+    np.testing.assert_allclose(x * w**2, t["acceleration [g]"] * STANDARD_GRAVITY, rtol=1e-14)
+    # c_eq = dE / (pi w X^2) by definition of the equivalent damper
+    np.testing.assert_allclose(t["c_eq [N s/m]"], t["energy_per_cycle [J]"] / (np.pi * w * x**2),
+                               rtol=1e-13)
+    flagged = t[t["sdc_filled [-]"]]
+    assert flagged[["fill [%]", "acceleration [g]", "frequency [Hz]"]].values.tolist() == [
+        [90.0, 1.0, 1000.0]]
+
+
+def test_damper_table_refuses_out_of_range(model):
+    with pytest.raises(ParameterError, match="outside the model range"):
+        equivalent_damper_table(model, fills=[50], accelerations=[20], frequencies=[100],
+                                vibrated_mass_kg=0.1)
+    with pytest.raises(ParameterError, match="vibrated_mass_kg"):
+        equivalent_damper_table(model, fills=[50], accelerations=[5], frequencies=[100],
+                                vibrated_mass_kg=0.0)
+
+
+def test_written_files_round_trip(tmp_path):
+    grid = pd.MultiIndex.from_product([[25.0, 90.0], [1.0, 10.0], [50.0, 1000.0]],
+                                      names=["fill_percent", "acceleration_g", "frequency_hz"])
+    t = grid.to_frame(index=False)
+    t["sdc"] = np.linspace(1e-7, 1.0, len(t))  # includes SDC = 1: damping ratio undefined
+    m = SdcModel.from_table(t, value="sdc", source="synthetic")
+    table = equivalent_damper_table(m, fills=[25, 90], accelerations=[1, 10],
+                                    frequencies=[50, 1000], vibrated_mass_kg=0.1)
+    paths = write_damper_table(table, tmp_path, provenance={"sdc_source": m.source})
+    assert [p.name for p in paths] == ["equivalent_damper.csv", "equivalent_damper.json"]
+    back = pd.read_csv(paths[0])
+    pd.testing.assert_frame_equal(back, table, check_exact=False, rtol=1e-15)
+    doc = json.loads(paths[1].read_text())
+    assert doc["units"]["c_eq_per_area [N s/m^3]"] == "N s/m^3"
+    assert doc["provenance"]["sdc_source"] == "synthetic"
+    energies = [r["energy_per_cycle [J]"] for r in doc["records"]]
+    assert energies == table["energy_per_cycle [J]"].tolist()  # full precision in JSON
+    assert doc["records"][-1]["damping_ratio [-]"] is None
+    with pytest.raises(ParameterError, match="formats"):
+        write_damper_table(table, tmp_path, formats=("xlsx",))

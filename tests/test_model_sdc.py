@@ -1,0 +1,264 @@
+"""SDC interpolation model: Table 3 loader, pchip grid model, holes, range handling."""
+
+from __future__ import annotations
+
+import itertools
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+from scipy.interpolate import PchipInterpolator, RegularGridInterpolator
+
+from pidcore.errors import ParameterError
+from pidcore.model import SdcModel, load_paper_table3
+
+SHARED_TABLE = Path("/work/shared/reference/table3.csv")
+# Round-off of a cubic evaluated at an interval end: a few ulps of values <= 1.
+RTOL_GRID = 1e-12
+ATOL_ROUNDOFF = 1e-12
+
+
+@pytest.fixture(scope="module")
+def table() -> pd.DataFrame:
+    return load_paper_table3()
+
+
+@pytest.fixture(scope="module")
+def model(table) -> SdcModel:
+    return SdcModel.from_table(table)
+
+
+def _synthetic_table(rng: np.random.Generator, *, shape=(4, 4, 5)) -> pd.DataFrame:
+    fills = np.sort(rng.uniform(10, 95, shape[0]))
+    accs = np.sort(rng.uniform(0.5, 12, shape[1]))
+    freqs = np.sort(rng.uniform(20, 1200, shape[2]))
+    rows = [(p, a, f, rng.uniform(0, 1))
+            for p, a, f in itertools.product(fills, accs, freqs)]
+    return pd.DataFrame(rows, columns=["fill_percent", "acceleration_g", "frequency_hz", "sdc"])
+
+
+# --------------------------------------------------------------------------- Table 3
+def test_table3_matches_transcription_notes(table):
+    assert list(table.columns) == ["frequency_hz", "acceleration_g", "fill_percent", "sdc_dem",
+                                   "sdc_experimental"]
+    assert len(table) == 4 * 3 * 4
+    missing = table[table["sdc_dem"].isna()]
+    assert missing[["frequency_hz", "acceleration_g", "fill_percent"]].values.tolist() == [
+        [1000.0, 1.0, 90.0]]
+    reattributed = table[(table.frequency_hz == 500) & (table.acceleration_g == 10)
+                         & (table.fill_percent == 90)]
+    assert reattributed["sdc_dem"].item() == 0.4756
+    exp = table[table["sdc_experimental"].notna()]
+    assert len(exp) == 12 and set(exp["fill_percent"]) == {50.0}
+
+
+@pytest.mark.skipif(not SHARED_TABLE.exists(), reason="shared reference not available")
+def test_packaged_table_equals_shared_reference(table):
+    shared = pd.read_csv(SHARED_TABLE)
+    pd.testing.assert_frame_equal(table, shared.astype(float))
+
+
+# --------------------------------------------------------------------------- grid model
+@pytest.mark.parametrize("log_frequency", [False, True])
+def test_reproduces_every_grid_point(table, log_frequency):
+    m = SdcModel.from_table(table, log_frequency=log_frequency)
+    data = table[table["sdc_dem"].notna()]
+    got = m(data.fill_percent.to_numpy(), data.acceleration_g.to_numpy(),
+            data.frequency_hz.to_numpy())
+    np.testing.assert_allclose(got, data.sdc_dem.to_numpy(), rtol=RTOL_GRID, atol=0)
+
+
+def test_equals_scipy_regular_grid_pchip_on_4_point_axes():
+    # RegularGridInterpolator(pchip) needs >= 4 points per axis (Table 3 has 3 accelerations),
+    # so compare on a synthetic 4x4x5 grid. RGI folds the last axis first, then the others in
+    # descending order; our pass order frequency, fill, acceleration is RGI on axes
+    # (acceleration, fill, frequency).
+    rng = np.random.default_rng(1)
+    t = _synthetic_table(rng)
+    m = SdcModel.from_table(t, value="sdc")
+    fills, accs, freqs = m.axes
+    rgi = RegularGridInterpolator((accs, fills, freqs), np.transpose(m.values, (1, 0, 2)),
+                                  method="pchip")
+    q = np.column_stack([rng.uniform(accs[0], accs[-1], 300), rng.uniform(fills[0], fills[-1], 300),
+                         rng.uniform(freqs[0], freqs[-1], 300)])
+    np.testing.assert_allclose(m(q[:, 1], q[:, 0], q[:, 2]), rgi(q), rtol=1e-12, atol=1e-14)
+
+
+def test_grid_lines_equal_one_dimensional_pchip(model, table):
+    # On a line through grid nodes the tensor model is the 1-D pchip of that line's data.
+    t = model.grid_table()
+    x = np.linspace(1, 10, 57)
+    line = t[(t.fill_percent == 75) & (t.frequency_hz == 500)].sort_values("acceleration_g")
+    ref = PchipInterpolator(line.acceleration_g, line.sdc_dem)(x)
+    np.testing.assert_allclose(model(75, x, 500), ref, rtol=1e-12)
+    f = np.linspace(50, 1000, 77)
+    line = t[(t.fill_percent == 25) & (t.acceleration_g == 5)].sort_values("frequency_hz")
+    ref = PchipInterpolator(line.frequency_hz, line.sdc_dem)(f)
+    np.testing.assert_allclose(model(25, 5, f), ref, rtol=1e-12)
+
+
+def test_bounded_by_neighbouring_corners(model):
+    # pchip is monotone on every interval, so each 1-D pass stays between its two neighbours
+    # and the result within min/max of the 8 corners of the grid cell.
+    rng = np.random.default_rng(7)
+    n = 20000
+    q = [rng.uniform(ax[0], ax[-1], n) for ax in model.axes]
+    v = model(*q)
+    idx = [np.clip(np.searchsorted(ax, c, side="right") - 1, 0, ax.size - 2)
+           for ax, c in zip(model.axes, q, strict=True)]
+    corners = np.stack([model.values[idx[0] + i, idx[1] + j, idx[2] + k]
+                        for i, j, k in itertools.product((0, 1), repeat=3)])
+    assert np.all(v >= corners.min(axis=0) - ATOL_ROUNDOFF)
+    assert np.all(v <= corners.max(axis=0) + ATOL_ROUNDOFF)
+    assert np.all((v >= 0) & (v <= 1))
+
+
+@pytest.mark.parametrize("axis", [0, 1, 2])
+def test_monotone_between_monotone_data(model, axis):
+    others = [i for i in range(3) if i != axis]
+    ax = model.axes[axis]
+    for i0, i1 in itertools.product(range(model.axes[others[0]].size),
+                                    range(model.axes[others[1]].size)):
+        for k in range(ax.size - 1):
+            x = np.linspace(ax[k], ax[k + 1], 101)
+            coords = [None, None, None]
+            coords[axis] = x
+            coords[others[0]] = model.axes[others[0]][i0]
+            coords[others[1]] = model.axes[others[1]][i1]
+            y = model(*coords)
+            node = [slice(None)] * 3
+            node[others[0]], node[others[1]] = i0, i1
+            data = model.values[tuple(node)]
+            step = np.sign(data[k + 1] - data[k])
+            assert np.all(step * np.diff(y) >= -ATOL_ROUNDOFF)
+
+
+def test_broadcasting_shape(model):
+    out = model(np.array([30.0, 60.0]), np.array([[2.0], [3.0], [4.0]]), 300.0)
+    assert out.shape == (3, 2)
+    assert out[1, 0] == model(30.0, 3.0, 300.0)
+
+
+def test_acceleration_section_is_the_model(model):
+    a = np.linspace(1, 10, 41)
+    for fill, freq in [(60.0, 300.0), (25.0, 50.0), (90.0, 1000.0)]:
+        np.testing.assert_allclose(model.acceleration_section(fill, freq)(a),
+                                   model(fill, a, freq), rtol=1e-13)
+
+
+# --------------------------------------------------------------------------- hole filling
+def test_paper_hole_is_filled_and_flagged(model):
+    value = model(90.0, 1.0, 1000.0)
+    # rule: beyond the last known fill the nearest known value (75 %) is held
+    assert value == pytest.approx(0.8078, rel=1e-12)
+    filled = model.filled_points()
+    assert filled[["fill_percent", "acceleration_g", "frequency_hz"]].values.tolist() == [
+        [90.0, 1.0, 1000.0]]
+    assert model.filled.sum() == 1
+    assert not model.data_points()[["fill_percent", "acceleration_g", "frequency_hz"]].apply(
+        tuple, axis=1).isin([(90.0, 1.0, 1000.0)]).any()
+
+
+def test_interior_hole_uses_pchip_along_fill():
+    rng = np.random.default_rng(3)
+    t = _synthetic_table(rng)
+    fills = np.sort(t.fill_percent.unique())
+    a0, f0 = t.acceleration_g.min(), t.frequency_hz.max()
+    line = t[(t.acceleration_g == a0) & (t.frequency_hz == f0)].sort_values("fill_percent")
+    hole = (t.fill_percent == fills[1]) & (t.acceleration_g == a0) & (t.frequency_hz == f0)
+    t2 = t.copy()
+    t2.loc[hole, "sdc"] = np.nan
+    m = SdcModel.from_table(t2, value="sdc")
+    known = line[line.fill_percent != fills[1]]
+    expected = PchipInterpolator(known.fill_percent, known.sdc)(fills[1])
+    assert m(fills[1], a0, f0) == pytest.approx(expected, rel=1e-12)
+    assert m.filled.sum() == 1
+
+
+def test_missing_rows_are_holes_too():
+    rng = np.random.default_rng(4)
+    t = _synthetic_table(rng)
+    top = t.fill_percent.max()
+    drop = (t.fill_percent == top) & (t.acceleration_g == t.acceleration_g.min())
+    m = SdcModel.from_table(t[~drop], value="sdc")
+    assert m.filled.sum() == drop.sum() and m.filled[-1, 0, :].all()
+
+
+def test_line_without_any_value_is_refused():
+    rng = np.random.default_rng(5)
+    t = _synthetic_table(rng)
+    t.loc[(t.acceleration_g == t.acceleration_g.min()) & (t.frequency_hz == t.frequency_hz.min()),
+          "sdc"] = np.nan
+    with pytest.raises(ParameterError, match="no value at any fill"):
+        SdcModel.from_table(t, value="sdc")
+
+
+# --------------------------------------------------------------------------- range handling
+@pytest.mark.parametrize("point", [(24.9, 5, 100), (95, 5, 100), (50, 0.5, 100), (50, 11, 100),
+                                   (50, 5, 40), (50, 5, 1001)])
+def test_refuses_extrapolation(model, point):
+    assert not model.contains(point)
+    with pytest.raises(ParameterError, match="outside the model range"):
+        model(*point)
+
+
+def test_clip_to_range_holds_edge_value(model):
+    assert model.evaluate(50, 12, 2000, clip_to_range=True) == model(50, 10, 1000)
+    assert model.evaluate(10, 0.2, 10, clip_to_range=True) == model(25, 1, 50)
+
+
+def test_contains_edges(model):
+    assert model.contains((25, 1, 50)) and model.contains((90, 10, 1000))
+    assert model.contains((50, 10 * (1 + 1e-12), 1000))  # float noise from unit conversions
+    with pytest.raises(ParameterError):
+        model.contains((50, 5))
+
+
+def test_log_frequency_changes_interior_not_grid(table):
+    lin = SdcModel.from_table(table)
+    log = SdcModel.from_table(table, log_frequency=True)
+    np.testing.assert_allclose(lin.values, log.values, rtol=0)
+    assert abs(lin(50, 5, 300) - log(50, 5, 300)) > 1e-3
+    assert log(50, 5, 500) == pytest.approx(lin(50, 5, 500), rel=1e-12)
+
+
+# --------------------------------------------------------------------------- other tables
+def test_store_like_table_averages_duplicates():
+    rng = np.random.default_rng(6)
+    t = _synthetic_table(rng, shape=(2, 3, 2))
+    up, down = t.copy(), t.copy()
+    up["sdc"] += 0.05
+    down["sdc"] -= 0.05
+    runs = pd.concat([up, down], ignore_index=True)
+    runs["sdc_stderr"] = 0.01
+    m = SdcModel.from_table(runs, value="sdc")
+    got = m(t.fill_percent.to_numpy(), t.acceleration_g.to_numpy(), t.frequency_hz.to_numpy())
+    np.testing.assert_allclose(got, t.sdc.to_numpy(), rtol=1e-12)
+
+
+def test_bad_tables_are_refused(table):
+    with pytest.raises(ParameterError, match="missing columns"):
+        SdcModel.from_table(table, value="sdc")
+    one_freq = table[table.frequency_hz == 50]
+    with pytest.raises(ParameterError, match="frequency_hz has 1 distinct"):
+        SdcModel.from_table(one_freq)
+
+
+def test_select_runs_refuses_mixed_conditions():
+    from pidcore.model import select_runs
+
+    rng = np.random.default_rng(8)
+    t = _synthetic_table(rng, shape=(2, 2, 2))
+    runs = pd.concat([t.assign(material="acrylic"), t.assign(material="aluminium", sdc=0.5)],
+                     ignore_index=True)
+    with pytest.raises(ParameterError, match="differ in material"):
+        select_runs(runs)
+    acrylic = select_runs(runs, where={"material": "acrylic"})
+    m = SdcModel.from_table(acrylic, value="sdc")
+    np.testing.assert_allclose(m(t.fill_percent, t.acceleration_g, t.frequency_hz), t.sdc,
+                               rtol=1e-12)
+    with pytest.raises(ParameterError, match="none match"):
+        select_runs(runs, where={"material": "steel"})
+    with pytest.raises(ParameterError, match="no column 'seed'"):
+        select_runs(runs, where={"seed": "1"})
