@@ -1,1 +1,22 @@
-"""pidcore.signal"""
+"""pidcore.signal: complex power, loss factor and SDC of shaker records (paper Sect. 5.1).
+
+Public API
+----------
+analyze_power
+    Array-level analysis of force and velocity (or acceleration) samples.
+analyze_channels
+    The same on :class:`~pidcore.records.Channel` records, after validation.
+PowerAnalysis
+    Frozen result (phasors, complex power, loss factor, SDC, damping ratio, uncertainty).
+estimate_drive_frequency
+    Drive frequency of the motion channel (FFT peak + Gauss-Newton phase refinement).
+synthesize_shaker_record
+    Synthetic records with an analytic answer.
+"""
+
+from .frequency import estimate_drive_frequency
+from .power import PowerAnalysis, analyze_channels, analyze_power
+from .synthetic import SyntheticRecord, synthesize_shaker_record
+
+__all__ = ["PowerAnalysis", "SyntheticRecord", "analyze_channels", "analyze_power",
+           "estimate_drive_frequency", "synthesize_shaker_record"]

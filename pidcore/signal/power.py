@@ -1,0 +1,497 @@
+"""Complex input power, loss factor and specific damping capacity of a shaker record (Eq. 8-11).
+
+Conventions
+-----------
+A periodic signal is written with one-sided phasors, ``x(t) = x_0 + sum_n Re(X_n exp(j n w t))``.
+The complex power is
+
+    P_c = 1/2 sum_n F_n conj(V_n)
+
+summed over the harmonics fitted in both channels. The printed Eq. 11 of the paper omits the
+conjugate; without it the time average of the product would not be the power. With it,
+``Re(P_c)`` is the time average of ``f(t) v(t)``, the mean power flowing *into* the structure
+(> 0 for a damper), and ``Im(P_c)`` the reactive power: a rigid mass, ``F_n = j n w m V_n``,
+gives ``Im(P_c) = 1/2 w m |V_1|^2 > 0`` (inertance); a spring gives ``Im(P_c) < 0``.
+
+From ``P_c`` (``T = 1/f``, ``w = 2 pi f``):
+
+* energy dissipated per cycle ``dE = Re(P_c) T``;
+* maximum kinetic energy ``E = Im(P_c) / w`` -- for a rigid mass driven by a sine,
+  ``Im(P_c)/w = 1/2 m |V_1|^2 = m a^2/(2 w^2)``, which is Eq. 10; for a measurement it is the
+  kinetic energy of the mass that the gauge actually drives, without having to know it;
+* loss factor ``eta_l = Re(P_c)/Im(P_c) = dE / (2 pi E)``;
+* SDC (Eq. 8) ``psi = dE/E = 2 pi eta_l``;
+* equivalent viscous damping ratio ``zeta = -ln(1 - psi) / (4 pi)`` (paper Sect. 3), defined
+  only for ``0 <= psi < 1``.
+
+Corrections (applied to the phasors in this order):
+
+1. ``velocity_delay_s``: a laser vibrometer outputs ``v(t - tau)``; its phasors are multiplied by
+   ``exp(+j n w tau)``.
+2. Velocity from acceleration when there is no velocity channel: ``V_n = A_n / (j n w)``.
+3. Mass cancellation: the gauge also feels the inertia of the mass between it and the coupon
+   (impedance-head seismic mass, fixture): ``F_n -= m_below A_n`` with ``A_n`` from the
+   acceleration channel when there is one, else ``j n w V_n``.
+4. Baseline subtraction: the loss factor of the empty coupon (measured the same way) is
+   subtracted, ``eta_l - eta_baseline``, and so are its SDC and energy per cycle. Loss factors
+   add only when normalised by the same kinetic energy, so this assumes the baseline run had the
+   same vibrated mass and amplitude (or that the particles' mass is small against the coupon's).
+   ``complex_power_w`` stays the measured (corrections 1-3) value.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from .. import defaults
+from ..constants import STANDARD_GRAVITY
+from ..errors import ParameterError, SignalError
+from ..records import Channel
+from . import validate
+from .frequency import estimate_drive_frequency
+from .harmonics import fit_harmonics
+
+
+@dataclass(frozen=True)
+class PowerAnalysis:
+    """Result of :func:`analyze_power`: phasors, complex power and damping measures (SI units).
+
+    Attributes
+    ----------
+    source : str
+        Record the result belongs to.
+    frequency_hz : float
+        Estimated drive frequency, Hz.
+    omega_rad_s : float
+        Drive angular frequency, rad/s.
+    n_periods : float
+        Drive periods in the record.
+    sample_rate_hz : float
+        Sample rate, Hz.
+    harmonics : numpy.ndarray of int
+        Harmonic orders fitted (1..H, those below 0.9 x Nyquist).
+    force_phasors_n : numpy.ndarray of complex
+        F_n after mass cancellation, N.
+    velocity_phasors_m_s : numpy.ndarray of complex
+        V_n after delay correction (or from acceleration), m/s.
+    complex_power_w : complex
+        ``1/2 sum F_n conj(V_n)``, W (before baseline subtraction).
+    loss_factor, loss_factor_stderr : float
+        Loss factor (baseline subtracted) and its standard error (NaN when not available).
+    loss_factor_raw : float
+        Loss factor before baseline subtraction.
+    sdc, sdc_stderr : float
+        Specific damping capacity ``2 pi loss_factor`` and its standard error.
+    damping_ratio : float or None
+        ``-ln(1 - sdc)/(4 pi)``; None when undefined, see ``damping_ratio_note``.
+    damping_ratio_note : str
+        Why ``damping_ratio`` is None (empty otherwise).
+    energy_per_cycle_j : float
+        Dissipated energy per cycle, J (baseline subtracted).
+    max_kinetic_energy_j : float
+        ``Im(P_c)/omega``, J.
+    force_amplitude_n, velocity_amplitude_m_s : float
+        Fundamental amplitudes |F_1|, |V_1|.
+    acceleration_amplitude_m_s2 : float
+        ``omega |V_1|``, m/s^2.
+    displacement_amplitude_m : float
+        ``|V_1| / omega``, m.
+    n_blocks : int
+        Blocks used for the standard errors (0 when none).
+    uncertainty_note : str
+        Why the standard errors are NaN (empty otherwise).
+    corrections : dict
+        Corrections applied and their values.
+    """
+
+    source: str
+    frequency_hz: float
+    omega_rad_s: float
+    n_periods: float
+    sample_rate_hz: float
+    harmonics: np.ndarray
+    force_phasors_n: np.ndarray
+    velocity_phasors_m_s: np.ndarray
+    complex_power_w: complex
+    loss_factor: float
+    loss_factor_stderr: float
+    loss_factor_raw: float
+    sdc: float
+    sdc_stderr: float
+    damping_ratio: float | None
+    damping_ratio_note: str
+    energy_per_cycle_j: float
+    max_kinetic_energy_j: float
+    force_amplitude_n: float
+    velocity_amplitude_m_s: float
+    acceleration_amplitude_m_s2: float
+    displacement_amplitude_m: float
+    n_blocks: int
+    uncertainty_note: str
+    corrections: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def acceleration_g(self) -> float:
+        """Fundamental acceleration amplitude in g (standard gravity)."""
+        return self.acceleration_amplitude_m_s2 / STANDARD_GRAVITY
+
+    @property
+    def period_s(self) -> float:
+        """Drive period, s."""
+        return 1.0 / self.frequency_hz
+
+    def force_displacement_loop(self, n_points: int = 256) -> tuple[np.ndarray, np.ndarray]:
+        """One period of the reconstructed force-displacement loop (harmonic synthesis).
+
+        Returns ``(displacement_m, force_n)`` at ``n_points`` equally spaced phases (the curve
+        is closed: the point after the last is the first). DC is left out. The loop's area,
+        ``oint f dx``, equals ``complex_power_w.real * period_s`` (the energy per cycle before
+        baseline subtraction).
+        """
+        phase = 2 * np.pi * np.arange(n_points) / n_points
+        rot = np.exp(1j * np.outer(self.harmonics, phase))
+        disp = self.velocity_phasors_m_s / (1j * self.harmonics * self.omega_rad_s)
+        return (np.real(disp @ rot), np.real(self.force_phasors_n @ rot))
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-safe scalars (NaN -> None); includes the CLI keys."""
+
+        def num(v: float | None) -> float | None:
+            return None if v is None or not math.isfinite(v) else float(v)
+
+        p = self.complex_power_w
+        return {
+            "source": self.source,
+            "frequency_hz": num(self.frequency_hz),
+            "acceleration_g": num(self.acceleration_g),
+            "complex_power": {"real": num(p.real), "imag": num(p.imag)},
+            "loss_factor": num(self.loss_factor),
+            "sdc": num(self.sdc),
+            "sdc_stderr": num(self.sdc_stderr),
+            "damping_ratio": num(self.damping_ratio),
+            "energy_per_cycle_j": num(self.energy_per_cycle_j),
+            "omega_rad_s": num(self.omega_rad_s),
+            "n_periods": num(self.n_periods),
+            "sample_rate_hz": num(self.sample_rate_hz),
+            "complex_power_real_w": num(p.real),
+            "complex_power_imag_w": num(p.imag),
+            "loss_factor_stderr": num(self.loss_factor_stderr),
+            "loss_factor_raw": num(self.loss_factor_raw),
+            "damping_ratio_note": self.damping_ratio_note,
+            "max_kinetic_energy_j": num(self.max_kinetic_energy_j),
+            "force_amplitude_n": num(self.force_amplitude_n),
+            "velocity_amplitude_m_s": num(self.velocity_amplitude_m_s),
+            "acceleration_amplitude_m_s2": num(self.acceleration_amplitude_m_s2),
+            "displacement_amplitude_m": num(self.displacement_amplitude_m),
+            "harmonics": [int(n) for n in self.harmonics],
+            "n_blocks": int(self.n_blocks),
+            "uncertainty_note": self.uncertainty_note,
+            "corrections": {k: (num(v) if isinstance(v, float) else v)
+                            for k, v in self.corrections.items()},
+        }
+
+    def plot(self, ax: Any = None) -> Any:
+        """Harmonic spectrum: |F_n| (N, left axis) and |V_n| (m/s, right axis). Returns ``ax``."""
+        import matplotlib.pyplot as plt  # lazy: plotting is optional
+
+        if ax is None:
+            _, ax = plt.subplots()
+        n = self.harmonics
+        ax.bar(n - 0.2, np.abs(self.force_phasors_n), width=0.4, color="C0", label="|F_n| [N]")
+        ax.set_xlabel("harmonic order n [-]")
+        ax.set_ylabel("force amplitude [N]")
+        ax.set_yscale("log")
+        ax2 = ax.twinx()
+        ax2.bar(n + 0.2, np.abs(self.velocity_phasors_m_s), width=0.4, color="C1",
+                label="|V_n| [m/s]")
+        ax2.set_ylabel("velocity amplitude [m/s]")
+        ax2.set_yscale("log")
+        ax.set_xticks(n)
+        ax.set_title(f"{self.source} {self.frequency_hz:.4g} Hz, sdc = {self.sdc:.4g}")
+        return ax
+
+
+def _damping_ratio(sdc: float, loss_factor: float) -> tuple[float | None, str]:
+    if not math.isfinite(loss_factor):
+        return None, "loss factor undefined (reactive power Im(P_c) <= 0: not mass-like)"
+    if loss_factor < 0:
+        return None, f"loss factor {loss_factor:.4g} < 0: no equivalent positive damping"
+    if sdc >= 1:
+        return None, f"sdc {sdc:.4g} >= 1: -ln(1 - sdc)/(4 pi) is undefined"
+    return -math.log1p(-sdc) / (4 * math.pi), ""
+
+
+def _complex_power(f_ph: np.ndarray, m_ph: np.ndarray, a_ph: np.ndarray | None,
+                   n: np.ndarray, omega: float, *, motion_is_velocity: bool, delay_s: float,
+                   mass_kg: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Corrected (F, V) phasors and P_c; arrays over (..., harmonic)."""
+    jnw = 1j * n * omega
+    if motion_is_velocity:
+        v = m_ph * np.exp(1j * n * omega * delay_s)
+    else:
+        v = m_ph / jnw
+    if mass_kg:
+        acc = a_ph if a_ph is not None else jnw * v
+        f = f_ph - mass_kg * acc
+    else:
+        f = f_ph
+    return f, v, 0.5 * np.sum(f * np.conj(v), axis=-1)
+
+
+def _check_parameters(sample_rate_hz: float, n_harmonics: int, n_blocks: int, min_periods: int,
+                      mass_below_gauge_kg: float, frequency_hz: float | None,
+                      velocity_delay_s: float, baseline_loss_factor: float) -> None:
+    if not (math.isfinite(sample_rate_hz) and sample_rate_hz > 0):
+        raise ParameterError(f"sample_rate_hz: {sample_rate_hz!r}, expected a positive number")
+    if int(n_harmonics) != n_harmonics or n_harmonics < 1:
+        raise ParameterError(f"n_harmonics: {n_harmonics!r}, expected an integer >= 1")
+    if int(n_blocks) != n_blocks or n_blocks < 0:
+        raise ParameterError(f"n_blocks: {n_blocks!r}, expected an integer >= 0 (0: no stderr)")
+    if int(min_periods) != min_periods or min_periods < 1:
+        raise ParameterError(f"min_periods: {min_periods!r}, expected an integer >= 1")
+    if not (math.isfinite(mass_below_gauge_kg) and mass_below_gauge_kg >= 0):
+        raise ParameterError(f"mass_below_gauge_kg: {mass_below_gauge_kg!r}, expected >= 0 kg")
+    if frequency_hz is not None and not (math.isfinite(frequency_hz) and frequency_hz > 0):
+        raise ParameterError(f"frequency_hz: {frequency_hz!r}, expected a positive hint in Hz")
+    if frequency_hz is not None and frequency_hz >= sample_rate_hz / 2:
+        raise ParameterError(f"frequency_hz: {frequency_hz:g} Hz is not below the Nyquist "
+                             f"frequency {sample_rate_hz / 2:g} Hz")
+    if not math.isfinite(velocity_delay_s):
+        raise ParameterError(f"velocity_delay_s: {velocity_delay_s!r}, expected a finite time")
+    if not math.isfinite(baseline_loss_factor):
+        raise ParameterError(f"baseline_loss_factor: {baseline_loss_factor!r}, expected finite")
+
+
+def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz: float, *,
+                  acceleration: np.ndarray | None = None,
+                  frequency_hz: float | None = None,
+                  n_harmonics: int = defaults.N_HARMONICS,
+                  velocity_delay_s: float = 0.0,
+                  mass_below_gauge_kg: float = 0.0,
+                  baseline_loss_factor: float = 0.0,
+                  n_blocks: int = defaults.N_UNCERTAINTY_BLOCKS,
+                  min_periods: int = defaults.MIN_PERIODS,
+                  source: str = "",
+                  force_name: str = "force",
+                  velocity_name: str = "velocity") -> PowerAnalysis:
+    """Complex power, loss factor and SDC of a sine-driven force/velocity record (Eq. 8-11).
+
+    Parameters
+    ----------
+    force : numpy.ndarray
+        Force at the gauge, N.
+    velocity : numpy.ndarray or None
+        Velocity of the driving point, m/s. None: derived from ``acceleration``.
+    sample_rate_hz : float
+        Sample rate of all channels, Hz.
+    acceleration : numpy.ndarray, optional
+        Acceleration of the driving point, m/s^2 (velocity source when ``velocity`` is None,
+        and the acceleration used by mass cancellation when given).
+    frequency_hz : float, optional
+        Nominal drive frequency, Hz: only a hint; the frequency is estimated from the motion
+        channel within +-5 % of it (see :mod:`pidcore.signal.frequency`).
+    n_harmonics : int
+        Harmonics fitted; those above 0.9 x Nyquist are dropped.
+    velocity_delay_s : float
+        Output delay of the velocity signal (vibrometer), s; requires a velocity channel.
+    mass_below_gauge_kg : float
+        Mass between force gauge and structure whose inertia force is cancelled, kg.
+    baseline_loss_factor : float
+        Loss factor of the empty structure, subtracted from the result.
+    n_blocks : int
+        Blocks of whole periods for the standard errors (0 or 1: none).
+    min_periods : int
+        Fewest drive periods accepted.
+    source, force_name, velocity_name : str
+        Names used in messages and in the result.
+
+    Returns
+    -------
+    PowerAnalysis
+
+    Raises
+    ------
+    SignalError
+        No dominant drive frequency, or fewer than ``min_periods`` periods.
+    ChannelError
+        Non-finite samples, mismatched lengths.
+    ParameterError
+        Out-of-range options.
+
+    Examples
+    --------
+    >>> fs, f, m, c = 10000.0, 100.0, 0.5, 2.0
+    >>> t = np.arange(20000) / fs
+    >>> v = 0.01 * np.sin(2 * np.pi * f * t)
+    >>> force = m * 0.01 * 2 * np.pi * f * np.cos(2 * np.pi * f * t) + c * v  # m dv/dt + c v
+    >>> res = analyze_power(force, v, fs)
+    >>> round(res.loss_factor, 4), round(c / (m * 2 * np.pi * f), 4)
+    (0.0064, 0.0064)
+    """
+    _check_parameters(sample_rate_hz, n_harmonics, n_blocks, min_periods, mass_below_gauge_kg,
+                      frequency_hz, velocity_delay_s, baseline_loss_factor)
+    if velocity is None and acceleration is None:
+        raise ParameterError(f"{source or 'record'}: neither a velocity nor an acceleration "
+                             "channel given; expected at least one")
+    if velocity is None and velocity_delay_s:
+        raise ParameterError("velocity_delay_s: a vibrometer delay needs a velocity channel; "
+                             "the velocity here comes from the acceleration")
+    acc_name = "acceleration" if velocity is not None else velocity_name
+    channels: list[tuple[str, np.ndarray]] = [(force_name, np.asarray(force, dtype=np.float64))]
+    if velocity is not None:
+        channels.append((velocity_name, np.asarray(velocity, dtype=np.float64)))
+    if acceleration is not None:
+        channels.append((acc_name, np.asarray(acceleration, dtype=np.float64)))
+    for name, data in channels:
+        validate.check_length(data, source=source, channel=name, min_samples=8)
+        validate.check_finite(data, source=source, channel=name)
+    validate.check_same_sampling([c[0] for c in channels], [sample_rate_hz] * len(channels),
+                                 [c[1].shape[0] for c in channels], source=source)
+    f_data = channels[0][1]
+    motion_name, motion = channels[1]
+    acc_data = channels[-1][1] if acceleration is not None else None
+    n_samples = f_data.shape[0]
+    what = f"{source}: channel {motion_name!r}" if source else f"channel {motion_name!r}"
+
+    freq = estimate_drive_frequency(motion, sample_rate_hz, frequency_hint_hz=frequency_hz,
+                                    what=what)
+    n_periods = n_samples * freq / sample_rate_hz
+    if n_periods < min_periods:
+        raise SignalError(f"{what}: {n_periods:.2f} drive periods of {freq:.6g} Hz in "
+                          f"{n_samples} samples, expected at least {min_periods}")
+    max_harm = int(defaults.HARMONIC_MAX_FRACTION_OF_NYQUIST * 0.5 * sample_rate_hz / freq)
+    n_harm = min(int(n_harmonics), max_harm)
+    if n_harm < 1:
+        raise SignalError(f"{what}: drive frequency {freq:.6g} Hz is too close to the Nyquist "
+                          f"frequency {sample_rate_hz / 2:g} Hz")
+    harmonics = np.arange(1, n_harm + 1)
+    omega = 2 * np.pi * freq
+    theta = omega / sample_rate_hz
+
+    # Blocks of whole periods for the standard error; the remainder (< K periods) is only in
+    # the global fit, which uses every sample.
+    whole = int(math.floor(n_periods))
+    k_blocks = int(n_blocks)
+    if k_blocks >= 2 and whole >= k_blocks:
+        per_block = whole // k_blocks
+        edges = np.round(np.arange(k_blocks + 1) * per_block * sample_rate_hz / freq)
+        edges = np.append(edges.astype(np.int64), n_samples) if edges[-1] < n_samples else \
+            edges.astype(np.int64)
+        uncertainty_note = ""
+    else:
+        edges = np.array([0, n_samples], dtype=np.int64)
+        uncertainty_note = (f"no standard error: {whole} whole periods cannot make "
+                            f"{k_blocks} blocks (need n_blocks >= 2 and >= 1 period each)")
+        k_blocks = 0
+
+    fit = fit_harmonics(f_data, motion, theta, n_harm, edges)
+    a_fit = None
+    if acc_data is not None and velocity is not None:
+        a_fit = fit_harmonics(acc_data, None, theta, n_harm, edges)
+    kw = dict(motion_is_velocity=velocity is not None, delay_s=float(velocity_delay_s),
+              mass_kg=float(mass_below_gauge_kg))
+    f_ph, v_ph, p_c = _complex_power(fit.total[0], fit.total[1],
+                                     None if a_fit is None else a_fit.total[0],
+                                     harmonics, omega, **kw)
+    p_c = complex(p_c)
+
+    loss_raw = p_c.real / p_c.imag if p_c.imag > 0 else float("nan")
+    loss = loss_raw - baseline_loss_factor
+    sdc = 2 * np.pi * loss
+    lf_stderr = float("nan")
+    if k_blocks:
+        _, _, p_blocks = _complex_power(fit.phasors[0, :k_blocks], fit.phasors[1, :k_blocks],
+                                        None if a_fit is None else a_fit.phasors[0, :k_blocks],
+                                        harmonics, omega, **kw)
+        lf_blocks = p_blocks.real / p_blocks.imag
+        lf_stderr = float(np.std(lf_blocks, ddof=1) / np.sqrt(k_blocks))
+        if not math.isfinite(lf_stderr):
+            uncertainty_note = "no standard error: a block's reactive power is <= 0"
+    zeta, zeta_note = _damping_ratio(sdc, loss)
+    period = 1.0 / freq
+    v1 = abs(v_ph[0])
+    corrections: dict[str, Any] = {
+        "velocity_delay_s": float(velocity_delay_s),
+        "mass_below_gauge_kg": float(mass_below_gauge_kg),
+        "baseline_loss_factor": float(baseline_loss_factor),
+        "velocity_from_acceleration": velocity is None,
+        "mass_acceleration_from": ("none" if not mass_below_gauge_kg else
+                                   "acceleration channel" if acc_data is not None
+                                   else "velocity (j n w V_n)"),
+    }
+    return PowerAnalysis(
+        source=source,
+        frequency_hz=float(freq),
+        omega_rad_s=float(omega),
+        n_periods=float(n_periods),
+        sample_rate_hz=float(sample_rate_hz),
+        harmonics=harmonics,
+        force_phasors_n=f_ph,
+        velocity_phasors_m_s=v_ph,
+        complex_power_w=p_c,
+        loss_factor=float(loss),
+        loss_factor_stderr=lf_stderr,
+        loss_factor_raw=float(loss_raw),
+        sdc=float(sdc),
+        sdc_stderr=float(2 * np.pi * lf_stderr),
+        damping_ratio=zeta,
+        damping_ratio_note=zeta_note,
+        energy_per_cycle_j=float((p_c.real - baseline_loss_factor * p_c.imag) * period),
+        max_kinetic_energy_j=float(p_c.imag / omega),
+        force_amplitude_n=float(abs(f_ph[0])),
+        velocity_amplitude_m_s=float(v1),
+        acceleration_amplitude_m_s2=float(omega * v1),
+        displacement_amplitude_m=float(v1 / omega),
+        n_blocks=k_blocks,
+        uncertainty_note=uncertainty_note,
+        corrections=corrections,
+    )
+
+
+def analyze_channels(force: Channel, velocity: Channel | None, *,
+                     acceleration: Channel | None = None,
+                     source: str,
+                     frequency_hz: float | None = None,
+                     n_harmonics: int = defaults.N_HARMONICS,
+                     velocity_delay_s: float = 0.0,
+                     mass_below_gauge_kg: float = 0.0,
+                     baseline_loss_factor: float = 0.0,
+                     n_blocks: int = defaults.N_UNCERTAINTY_BLOCKS,
+                     min_periods: int = defaults.MIN_PERIODS,
+                     allow_clipped: bool = False) -> PowerAnalysis:
+    """:func:`analyze_power` on :class:`~pidcore.records.Channel` records, after validation.
+
+    Checks, each a one-line :class:`~pidcore.errors.ChannelError` naming ``source`` and the
+    channel: quantity of each channel, NaN/inf samples, all-equal (zero) channels, clipping
+    (unless ``allow_clipped``), equal sample rates and lengths; then fewer than ``min_periods``
+    periods or no dominant frequency raise :class:`~pidcore.errors.SignalError`.
+    """
+    if velocity is None and acceleration is None:
+        raise ParameterError(f"{source}: neither a velocity nor an acceleration channel given; "
+                             "expected at least one")
+    roles = [("force", force), ("velocity", velocity), ("acceleration", acceleration)]
+    present = [(role, ch) for role, ch in roles if ch is not None]
+    for role, ch in present:
+        validate.check_quantity(ch.quantity, role, source=source, channel=ch.name)
+        data = np.asarray(ch.data, dtype=np.float64)
+        validate.check_length(data, source=source, channel=ch.name, min_samples=8)
+        validate.check_finite(data, source=source, channel=ch.name)
+        validate.check_not_constant(data, source=source, channel=ch.name, unit=ch.unit)
+        if not allow_clipped:
+            validate.check_clipping(data, source=source, channel=ch.name, unit=ch.unit)
+    validate.check_same_sampling([ch.name for _, ch in present],
+                                 [ch.sample_rate_hz for _, ch in present],
+                                 [ch.n_samples for _, ch in present], source=source)
+    motion = velocity if velocity is not None else acceleration
+    assert motion is not None
+    return analyze_power(
+        force.data, None if velocity is None else velocity.data, force.sample_rate_hz,
+        acceleration=None if acceleration is None else acceleration.data,
+        frequency_hz=frequency_hz, n_harmonics=n_harmonics, velocity_delay_s=velocity_delay_s,
+        mass_below_gauge_kg=mass_below_gauge_kg, baseline_loss_factor=baseline_loss_factor,
+        n_blocks=n_blocks, min_periods=min_periods, source=source, force_name=force.name,
+        velocity_name=motion.name)
