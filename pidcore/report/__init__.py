@@ -1,1 +1,21 @@
-"""pidcore.report"""
+"""pidcore.report: the comparison table, figures, provenance and the report files.
+
+* :func:`build_report_table` (:mod:`.table`) - Table 3-style comparison of our DEM, our
+  measurements and the paper.
+* :func:`write_report` (:mod:`.render`) - CSV, Markdown, self-contained HTML, LaTeX (booktabs)
+  and PDF, figures as PNG and SVG, written atomically.
+* :func:`collect_provenance` (:mod:`.provenance`) - versions, parameters, seeds, hashes.
+* :func:`make_report` (:mod:`.pipeline`) - everything ``pidcore report`` does.
+* Figures: :mod:`.figures` (model families, paper Figs. 8-14) and :mod:`.comparison_figures`.
+"""
+
+from .pipeline import MeasuredResult, ReportResult, analyse_files, make_report, open_verified_store
+from .provenance import Provenance, collect_provenance, sha256_file
+from .render import RENDERERS, REPORT_MARKER, parse_formats, write_report
+from .table import ALIGNMENT_COLUMN, REPORT_COLUMNS, build_report_table
+
+__all__ = [
+    "ALIGNMENT_COLUMN", "RENDERERS", "REPORT_COLUMNS", "REPORT_MARKER", "MeasuredResult",
+    "Provenance", "ReportResult", "analyse_files", "build_report_table", "collect_provenance",
+    "make_report", "open_verified_store", "parse_formats", "sha256_file", "write_report",
+]

@@ -1,0 +1,87 @@
+"""``pidcore report``: measured SDC vs our DEM vs the paper, as CSV/Markdown/HTML/LaTeX/PDF.
+
+All logic is in :func:`pidcore.report.pipeline.make_report`.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from ..constants import DRIVE_DIRECTIONS, PARTICLE_MATERIALS
+from ..report.render import format_cell
+
+#: Columns of the short table printed on stdout.
+_STDOUT_COLUMNS = (
+    "frequency [Hz]", "acceleration [g]", "packing ratio [%]", "SDC DEM (ours) [-]",
+    "SDC measured [-]", "SDC DEM (paper) [-]", "SDC measured (paper) [-]",
+    "alignment [grid/interpolated/out_of_range]",
+)
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    p = subparsers.add_parser(
+        "report", help="compare measured SDC, our DEM and the paper (Table 3 style report)",
+        description="Analyse measurement FILES (optional), add them to --store, align every "
+                    "measured load case with the DEM runs of --dem-store (default: --store) "
+                    "and with the paper's Table 3, and write a report (CSV, Markdown, "
+                    "self-contained HTML, LaTeX, PDF, figures as PNG and SVG) into --out. "
+                    "Fill is stated in the file name (..._fill50_... or ..._50pct_...), in "
+                    "a sidecar loadcases.csv, or with --fill.")
+    p.add_argument("files", nargs="*", metavar="FILE", type=Path,
+                   help="measurement exports to analyse (UFF58, CSV/TXT, MAT, HDF5)")
+    p.add_argument("--out", metavar="DIR", type=Path, required=True,
+                   help="report folder (new, empty or an earlier report, replaced atomically)")
+    p.add_argument("--store", metavar="FILE", type=Path, default=None,
+                   help="HDF5 store: analyses of FILES are added to it; without FILES its "
+                        "analyses are reported")
+    p.add_argument("--dem-store", metavar="FILE", type=Path, default=None,
+                   help="HDF5 store holding the DEM runs (default: --store); only read")
+    p.add_argument("--format", metavar="FMT", default="all",
+                   help="all or a comma-separated list of csv, md, html, tex, pdf (default all)")
+    p.add_argument("--fill", metavar="PERCENT", type=float, default=None,
+                   help="packing ratio of every FILE, %% (overrides file name and sidecar)")
+    p.add_argument("--material", choices=PARTICLE_MATERIALS, default=None,
+                   help="particle material of every FILE (default: stated or acrylic)")
+    p.add_argument("--direction", choices=DRIVE_DIRECTIONS, default=None,
+                   help="drive direction of every FILE (default: stated or z)")
+    p.add_argument("--sidecar", metavar="CSV", type=Path, default=None,
+                   help="load case table (columns file, fill_percent, material, direction); "
+                        "default: loadcases.csv beside each file")
+    p.add_argument("--velocity-delay", metavar="SECONDS", type=float, default=0.0,
+                   help="vibrometer output delay to remove, s (default 0)")
+    p.add_argument("--mass-below-gauge", metavar="KG", type=float, default=0.0,
+                   help="mass between force gauge and coupon to cancel, kg (default 0)")
+    p.add_argument("--sample-rate", metavar="HZ", type=float, default=None,
+                   help="sample rate for CSV/TXT files without a time column, Hz")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..report.pipeline import make_report
+
+    result = make_report(
+        args.files, out_dir=args.out, store=args.store, dem_store=args.dem_store,
+        formats=args.format, fill_percent=args.fill, material=args.material,
+        direction=args.direction, sidecar=args.sidecar, velocity_delay_s=args.velocity_delay,
+        mass_below_gauge_kg=args.mass_below_gauge, sample_rate_hz=args.sample_rate)
+    print(short_table(result.table))
+    for note in result.notes:
+        print(f"note: {note}")
+    for name, path in result.paths.items():
+        print(f"wrote {name}: {path}")
+    return 0
+
+
+def short_table(table) -> str:
+    """A fixed-width text table of the main columns."""
+    cols = [c for c in _STDOUT_COLUMNS if c in table.columns]
+    heads = [c.replace("alignment [grid/interpolated/out_of_range]", "alignment") for c in cols]
+    rows = [[format_cell(v) for v in row] for row in table.loc[:, cols].itertuples(index=False)]
+    widths = [max([len(h), *(len(r[i]) for r in rows)]) for i, h in enumerate(heads)]
+    lines = ["  ".join(h.rjust(w) for h, w in zip(heads, widths, strict=True))]
+    lines.append("  ".join("-" * w for w in widths))
+    lines += ["  ".join(v.rjust(w) for v, w in zip(r, widths, strict=True)) for r in rows]
+    if not rows:
+        lines.append("(no load cases)")
+    return "\n".join(lines)

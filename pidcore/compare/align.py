@@ -1,0 +1,427 @@
+"""Align measured load cases with our DEM results and with the paper's Table 3.
+
+A measured case (frequency and acceleration measured, fill/material/direction stated) is
+compared with our DEM in one of three ways, named by :data:`AlignmentStatus`:
+
+``"grid"``
+    A DEM case of ours lies within the tolerances of :mod:`pidcore.defaults`
+    (``COMPARE_FREQUENCY_RTOL`` 1 % in frequency, ``COMPARE_ACCELERATION_RTOL`` 5 % in
+    acceleration, ``COMPARE_FILL_ATOL_PERCENT`` 0.5 points in fill) with the same material and
+    direction; its runs' mean SDC is used.
+``"interpolated"``
+    No such DEM case; the pchip model (:class:`pidcore.model.SdcModel`) over our DEM cases is
+    evaluated at the measured point, which lies inside the model's grid box.
+``"out_of_range"``
+    Outside the model's box, or no model can be built: no value, a message says why. The model is
+    never extrapolated.
+
+The paper's DEM and experimental values are attached where the case is a Table 3 grid point
+within the same tolerances (the paper used acrylic particles driven along z); otherwise NaN.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+from typing import Literal, get_args
+
+import numpy as np
+import pandas as pd
+
+from .. import defaults
+from ..errors import ParameterError
+from .loadcase import LoadCase
+
+#: How a measured case was matched with our DEM.
+AlignmentStatus = Literal["grid", "interpolated", "out_of_range"]
+ALIGNMENT_STATUSES: tuple[str, ...] = get_args(AlignmentStatus)
+
+#: Columns a table of measured cases must have (one row per analysed measurement).
+MEASURED_COLUMNS: tuple[str, ...] = ("frequency_hz", "acceleration_g", "fill_percent", "material",
+                                     "direction", "sdc", "sdc_stderr", "source")
+#: Columns a table of DEM runs must have (as :meth:`pidcore.store.Store.list_dem_runs` gives).
+DEM_COLUMNS: tuple[str, ...] = ("frequency_hz", "acceleration_g", "fill_percent", "material",
+                                "direction", "sdc", "sdc_stderr")
+#: The paper's particles and drive direction (Sect. 4): Table 3 applies to these only.
+PAPER_MATERIAL = "acrylic"
+PAPER_DIRECTION = "z"
+
+
+@dataclass(frozen=True)
+class Tolerances:
+    """When two load cases are the same grid point.
+
+    Attributes
+    ----------
+    frequency_rtol : float
+        Relative frequency tolerance, ``|f - f_grid| <= rtol * f_grid``.
+    acceleration_rtol : float
+        Relative acceleration tolerance.
+    fill_atol_percent : float
+        Absolute fill tolerance, percentage points.
+    """
+
+    frequency_rtol: float = defaults.COMPARE_FREQUENCY_RTOL
+    acceleration_rtol: float = defaults.COMPARE_ACCELERATION_RTOL
+    fill_atol_percent: float = defaults.COMPARE_FILL_ATOL_PERCENT
+
+    def __post_init__(self) -> None:
+        for name in ("frequency_rtol", "acceleration_rtol", "fill_atol_percent"):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value >= 0):
+                raise ParameterError(f"Tolerances: {name} must be a finite number >= 0, "
+                                     f"got {value!r}")
+
+    def matches(self, case: LoadCase, grid: LoadCase) -> bool:
+        """True if ``case`` is the grid point ``grid``."""
+        return (abs(case.frequency_hz - grid.frequency_hz)
+                <= self.frequency_rtol * grid.frequency_hz
+                and abs(case.acceleration_g - grid.acceleration_g)
+                <= self.acceleration_rtol * grid.acceleration_g
+                and abs(case.fill_percent - grid.fill_percent) <= self.fill_atol_percent
+                and case.material == grid.material and case.direction == grid.direction)
+
+    def distance(self, case: LoadCase, grid: LoadCase) -> float:
+        """Distance in units of the tolerances (picks the nearest of several matches)."""
+        parts = (
+            (case.frequency_hz - grid.frequency_hz) / max(self.frequency_rtol * grid.frequency_hz,
+                                                           1e-300),
+            (case.acceleration_g - grid.acceleration_g)
+            / max(self.acceleration_rtol * grid.acceleration_g, 1e-300),
+            (case.fill_percent - grid.fill_percent) / max(self.fill_atol_percent, 1e-300),
+        )
+        return float(np.hypot.reduce(parts))
+
+
+@dataclass(frozen=True)
+class DemCase:
+    """Our DEM result at one load case, pooled over its runs (seeds).
+
+    Attributes
+    ----------
+    load_case : LoadCase
+    sdc : float
+        Mean SDC of the runs, [-].
+    sdc_stderr : float
+        Standard error of that mean, [-]: the run's own standard error for one run; for several
+        runs the larger of the propagated within-run error ``sqrt(sum se_i^2) / n`` and the
+        between-run scatter ``std(sdc, ddof=1) / sqrt(n)``, because independent seeds show the
+        chaos of granular flow that a single run's block error cannot.
+    n_runs : int
+    particles_per_cell : float
+        Particles per cell of the runs (NaN if unknown or differing).
+    run_keys : tuple of str
+        Store keys of the runs.
+    """
+
+    load_case: LoadCase
+    sdc: float
+    sdc_stderr: float
+    n_runs: int
+    particles_per_cell: float = math.nan
+    run_keys: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
+class AlignedCase:
+    """One measured case next to our DEM and the paper.
+
+    Attributes
+    ----------
+    load_case : LoadCase
+        The measured case (measured frequency and acceleration, stated fill/material/direction).
+    status : str
+        One of :data:`AlignmentStatus`.
+    sdc_dem : float
+        Our DEM SDC at the case [-] (mean of the grid case's runs, or the model's value); NaN
+        when out of range.
+    sdc_dem_stderr : float
+        Standard error of ``sdc_dem`` [-]; NaN for interpolated values (the model carries none).
+    grid_case : DemCase or None
+        The matched DEM case for status ``"grid"``.
+    sdc_paper_dem, sdc_paper_experimental : float
+        The paper's Table 3 values at the case [-], NaN where Table 3 has none.
+    paper_case : LoadCase or None
+        The Table 3 grid point matched.
+    message : str
+        Why the status is what it is (model used, range it covers...).
+    """
+
+    load_case: LoadCase
+    status: str
+    sdc_dem: float = math.nan
+    sdc_dem_stderr: float = math.nan
+    grid_case: DemCase | None = None
+    sdc_paper_dem: float = math.nan
+    sdc_paper_experimental: float = math.nan
+    paper_case: LoadCase | None = None
+    message: str = ""
+
+    def to_dict(self) -> dict[str, float | str]:
+        """One row with unit-suffixed column names."""
+        lc = self.load_case
+        return {
+            "frequency [Hz]": lc.frequency_hz,
+            "acceleration [g]": lc.acceleration_g,
+            "packing ratio [%]": lc.fill_percent,
+            "material": lc.material,
+            "direction": lc.direction,
+            "load case": lc.key,
+            "alignment": self.status,
+            "SDC DEM (ours) [-]": self.sdc_dem,
+            "SDC DEM stderr [-]": self.sdc_dem_stderr,
+            "DEM grid case": self.grid_case.load_case.key if self.grid_case else "",
+            "SDC DEM (paper) [-]": self.sdc_paper_dem,
+            "SDC measured (paper) [-]": self.sdc_paper_experimental,
+            "message": self.message,
+        }
+
+
+def _check_columns(table: pd.DataFrame, columns: Iterable[str], what: str) -> None:
+    missing = [c for c in columns if c not in table.columns]
+    if missing:
+        raise ParameterError(f"{what}: missing columns {missing}; expected {list(columns)}")
+
+
+def _row_case(row: pd.Series) -> LoadCase:
+    material = row.get("material", defaults.COMPARE_DEFAULT_MATERIAL)
+    direction = row.get("direction", defaults.COMPARE_DEFAULT_DIRECTION)
+    return LoadCase(float(row["frequency_hz"]), float(row["acceleration_g"]),
+                    float(row["fill_percent"]),
+                    material if isinstance(material, str) and material
+                    else defaults.COMPARE_DEFAULT_MATERIAL,
+                    direction if isinstance(direction, str) and direction
+                    else defaults.COMPARE_DEFAULT_DIRECTION)
+
+
+def pooled_mean(values: np.ndarray, stderrs: np.ndarray) -> tuple[float, float]:
+    """Mean and its standard error, pooled as described in :class:`DemCase`.
+
+    For one value both numbers are returned unchanged (bit for bit).
+    """
+    values = np.asarray(values, dtype=float)
+    stderrs = np.asarray(stderrs, dtype=float)
+    if values.size == 1:
+        return float(values[0]), float(stderrs[0])
+    n = values.size
+    mean = float(np.mean(values))
+    within = float(np.sqrt(np.sum(stderrs ** 2)) / n) if np.all(np.isfinite(stderrs)) else math.nan
+    between = float(np.std(values, ddof=1) / math.sqrt(n))
+    return mean, float(np.nanmax([within, between]))
+
+
+def dem_cases(dem_runs: pd.DataFrame, *, tolerances: Tolerances | None = None) -> list[DemCase]:
+    """Group DEM runs into load cases (runs within the tolerances pool into one case).
+
+    Parameters
+    ----------
+    dem_runs : pandas.DataFrame
+        Columns :data:`DEM_COLUMNS` (plus optional ``case_key`` or ``key``,
+        ``particles_per_cell``); one row per
+        run, as :meth:`pidcore.store.Store.list_dem_runs` returns. Runs with a non-finite SDC are
+        skipped (an interrupted run has no result).
+
+    Returns
+    -------
+    list of DemCase
+        Sorted by frequency, acceleration, fill, material, direction.
+    """
+    tolerances = tolerances or Tolerances()
+    if dem_runs is None or dem_runs.empty:
+        return []
+    _check_columns(dem_runs, DEM_COLUMNS, "DEM runs")
+    runs = dem_runs[np.isfinite(dem_runs["sdc"].astype(float))]
+    groups: list[tuple[LoadCase, list[int]]] = []
+    for pos, (_, row) in enumerate(runs.iterrows()):
+        case = _row_case(row)
+        for grid, members in groups:
+            if tolerances.matches(case, grid):
+                members.append(pos)
+                break
+        else:
+            groups.append((case, [pos]))
+    out = []
+    for case, members in groups:
+        sub = runs.iloc[members]
+        sdc, stderr = pooled_mean(sub["sdc"].to_numpy(float), sub["sdc_stderr"].to_numpy(float))
+        ppc = math.nan
+        if "particles_per_cell" in sub:
+            unique = pd.unique(sub["particles_per_cell"].astype(float))
+            if unique.size == 1:
+                ppc = float(unique[0])
+        key_column = "case_key" if "case_key" in sub else "key"
+        keys = tuple(str(k) for k in sub[key_column]) if key_column in sub else ()
+        out.append(DemCase(case, sdc, stderr, len(members), ppc, keys))
+    return sorted(out, key=lambda c: _sort_key(c.load_case))
+
+
+def _sort_key(case: LoadCase) -> tuple:
+    return (case.frequency_hz, case.acceleration_g, case.fill_percent, case.material,
+            case.direction)
+
+
+def match_paper(case: LoadCase, paper: pd.DataFrame | None, *,
+                tolerances: Tolerances | None = None) -> tuple[float, float, LoadCase | None]:
+    """The paper's (DEM, experimental) SDC at ``case`` if it is a Table 3 grid point.
+
+    Table 3 holds acrylic particles driven along z only; other materials or directions get NaN.
+    """
+    tolerances = tolerances or Tolerances()
+    if paper is None or paper.empty or case.material != PAPER_MATERIAL \
+            or case.direction != PAPER_DIRECTION:
+        return math.nan, math.nan, None
+    best: tuple[float, pd.Series, LoadCase] | None = None
+    for _, row in paper.iterrows():
+        grid = LoadCase(float(row["frequency_hz"]), float(row["acceleration_g"]),
+                        float(row["fill_percent"]), PAPER_MATERIAL, PAPER_DIRECTION)
+        if tolerances.matches(case, grid):
+            d = tolerances.distance(case, grid)
+            if best is None or d < best[0]:
+                best = (d, row, grid)
+    if best is None:
+        return math.nan, math.nan, None
+    row = best[1]
+    return float(row["sdc_dem"]), float(row["sdc_experimental"]), best[2]
+
+
+def build_dem_models(cases: list[DemCase]) -> dict[tuple[str, str], object]:
+    """pchip models over our DEM cases, one per (material, direction); failures map to a message.
+
+    Returns
+    -------
+    dict
+        ``{(material, direction): SdcModel or str}``; the string says why no model could be built
+        (for example fewer than two distinct values on an axis).
+    """
+    from ..model import SdcModel
+
+    models: dict[tuple[str, str], object] = {}
+    by_kind: dict[tuple[str, str], list[DemCase]] = {}
+    for c in cases:
+        by_kind.setdefault((c.load_case.material, c.load_case.direction), []).append(c)
+    for kind, members in by_kind.items():
+        table = pd.DataFrame({
+            "fill_percent": [c.load_case.fill_percent for c in members],
+            "acceleration_g": [c.load_case.acceleration_g for c in members],
+            "frequency_hz": [c.load_case.frequency_hz for c in members],
+            "sdc": [c.sdc for c in members],
+        })
+        try:
+            models[kind] = SdcModel.from_table(table, value="sdc",
+                                               source=f"our DEM runs ({kind[0]}, {kind[1]})")
+        except ParameterError as exc:
+            models[kind] = f"no pchip model over our DEM runs ({kind[0]}, {kind[1]}): {exc}"
+    return models
+
+
+@dataclass(frozen=True)
+class Aligner:
+    """Aligns measured cases with our DEM cases and the paper (see the module docstring).
+
+    Build with :meth:`from_tables`; call :meth:`align` per case.
+
+    Attributes
+    ----------
+    cases : list of DemCase
+        Our DEM cases.
+    paper : DataFrame or None
+        Table 3 (:func:`pidcore.model.load_paper_table3`).
+    model : SdcModel or None
+        Model used for every off-grid case; None builds one per material/direction from ``cases``.
+    tolerances : Tolerances
+    """
+
+    cases: list[DemCase]
+    paper: pd.DataFrame | None = None
+    model: object | None = None
+    tolerances: Tolerances = field(default_factory=Tolerances)
+    _models: dict = field(default_factory=dict, init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        if self.model is None:
+            self._models.update(build_dem_models(self.cases))
+
+    @property
+    def models(self) -> dict[tuple[str, str], object]:
+        """Models built over our DEM cases: ``{(material, direction): SdcModel or reason}``."""
+        return dict(self._models)
+
+    @classmethod
+    def from_tables(cls, dem_runs: pd.DataFrame | None, paper: pd.DataFrame | None = None, *,
+                    model: object | None = None,
+                    tolerances: Tolerances | None = None) -> Aligner:
+        """Aligner over a table of DEM runs (see :func:`dem_cases`)."""
+        tolerances = tolerances or Tolerances()
+        cases = dem_cases(dem_runs if dem_runs is not None else pd.DataFrame(),
+                          tolerances=tolerances)
+        return cls(cases, paper, model, tolerances)
+
+    def grid_case(self, case: LoadCase) -> DemCase | None:
+        """Our DEM case nearest to ``case`` within the tolerances, or None."""
+        hits = [c for c in self.cases if self.tolerances.matches(case, c.load_case)]
+        if not hits:
+            return None
+        return min(hits, key=lambda c: self.tolerances.distance(case, c.load_case))
+
+    def align(self, case: LoadCase) -> AlignedCase:
+        """Align one measured case; never extrapolates the model."""
+        paper_dem, paper_exp, paper_case = match_paper(case, self.paper,
+                                                       tolerances=self.tolerances)
+        common = {"sdc_paper_dem": paper_dem, "sdc_paper_experimental": paper_exp,
+                  "paper_case": paper_case}
+        grid = self.grid_case(case)
+        if grid is not None:
+            return AlignedCase(case, "grid", grid.sdc, grid.sdc_stderr, grid, **common,
+                               message=f"DEM grid case {grid.load_case.key} "
+                                       f"({grid.n_runs} run(s))")
+        model = self.model if self.model is not None \
+            else self._models.get((case.material, case.direction),
+                                  f"no DEM runs of ours for {case.material}, direction "
+                                  f"{case.direction}")
+        if isinstance(model, str):
+            return AlignedCase(case, "out_of_range", **common, message=model)
+        point = (case.fill_percent, case.acceleration_g, case.frequency_hz)
+        source = getattr(model, "source", "") or "pchip model"
+        if not model.contains(point):
+            bounds = getattr(model, "bounds", {})
+            rng = ", ".join(f"{k} in [{lo:g}, {hi:g}]" for k, (lo, hi) in bounds.items())
+            return AlignedCase(case, "out_of_range", **common,
+                               message=f"{case.label()} lies outside the range of {source} "
+                                       f"({rng}); not extrapolated")
+        value = float(np.asarray(model(*point)))
+        return AlignedCase(case, "interpolated", value, math.nan, None, **common,
+                           message=f"pchip interpolation over {source}")
+
+
+def align_measured(measured: pd.DataFrame, dem_runs: pd.DataFrame | None,
+                   paper: pd.DataFrame | None = None, *, model: object | None = None,
+                   tolerances: Tolerances | None = None) -> pd.DataFrame:
+    """Align each measured case; one row per measured case with unit-suffixed columns.
+
+    Parameters
+    ----------
+    measured : pandas.DataFrame
+        Columns :data:`MEASURED_COLUMNS`.
+    dem_runs : pandas.DataFrame or None
+        Our DEM runs (:data:`DEM_COLUMNS`).
+    paper : pandas.DataFrame, optional
+        Table 3 (:func:`pidcore.model.load_paper_table3`).
+    model : SdcModel, optional
+        Model for off-grid cases (default: pchip over our DEM cases).
+
+    Returns
+    -------
+    pandas.DataFrame
+        :meth:`AlignedCase.to_dict` columns plus ``SDC measured [-]``,
+        ``SDC measured stderr [-]`` and ``source file(s)``.
+    """
+    _check_columns(measured, MEASURED_COLUMNS, "measured cases")
+    aligner = Aligner.from_tables(dem_runs, paper, model=model, tolerances=tolerances)
+    rows = []
+    for _, row in measured.iterrows():
+        aligned = aligner.align(_row_case(row))
+        rows.append({**aligned.to_dict(), "SDC measured [-]": float(row["sdc"]),
+                     "SDC measured stderr [-]": float(row["sdc_stderr"]),
+                     "source file(s)": str(row["source"])})
+    return pd.DataFrame(rows)

@@ -1,0 +1,350 @@
+"""Load cases: the (frequency, acceleration, fill, material, direction) a result belongs to.
+
+A DEM run knows its load case from its parameters. A measurement knows only its frequency and
+acceleration (both measured, from the power analysis); fill, particle material and drive direction
+are what the user *states*, in one of three ways (later ones override earlier ones):
+
+1. **File name.** Tokens are separated by ``_``, ``-``, ``.`` or blanks (case-insensitive):
+
+   - fill: ``fill50``, ``fill-50``, ``fill_62.5``, ``50pct``, ``50percent`` (see
+     :data:`FILL_PATTERN`),
+   - material: ``acrylic`` / ``pmma``, ``aluminium`` / ``aluminum`` (see :data:`MATERIAL_PATTERN`),
+   - direction: ``dirz``, ``dir-x``, ``zdir`` (see :data:`DIRECTION_PATTERN`).
+
+   Example: ``coupon3_fill50_acrylic_dirz_500Hz_5g.uff``.
+2. **Sidecar table** ``loadcases.csv`` beside the file (or given explicitly) with columns
+   ``file, fill_percent, material, direction``; rows are looked up by file name (no folder).
+   Empty cells state nothing.
+3. **Options** ``--fill``, ``--material``, ``--direction`` (keyword arguments here).
+
+Material and direction default to the paper's acrylic particles driven along z
+(:data:`pidcore.defaults.COMPARE_DEFAULT_MATERIAL`, ``COMPARE_DEFAULT_DIRECTION``); the fill has no
+default: a measurement without a stated fill raises :class:`LoadCaseError`.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+import pandas as pd
+
+from .. import defaults
+from ..constants import DRIVE_DIRECTIONS, PARTICLE_MATERIALS
+from ..errors import ParameterError
+
+#: Name of the sidecar table looked for beside each measurement file.
+SIDECAR_NAME = "loadcases.csv"
+#: Columns of the sidecar table (``file`` and ``fill_percent`` required).
+SIDECAR_COLUMNS: tuple[str, ...] = ("file", "fill_percent", "material", "direction")
+
+_SEP = r"(?:^|(?<=[_\-. ]))"  # token start: beginning of the stem or after a separator
+_END = r"(?=$|[_\-. ])"  # token end
+#: Fill token in a file name: ``fill50``, ``fill-50``, ``fill_62.5``, ``50pct``, ``50percent``.
+FILL_PATTERN = re.compile(
+    _SEP + r"(?:fill[_\-]?(?P<fill>\d+(?:\.\d+)?)(?:pct|percent)?"
+    r"|(?P<pct>\d+(?:\.\d+)?)(?:pct|percent))" + _END,
+    re.IGNORECASE,
+)
+#: Particle material token in a file name.
+MATERIAL_PATTERN = re.compile(_SEP + r"(?P<material>acrylic|pmma|aluminium|aluminum)" + _END,
+                              re.IGNORECASE)
+#: Drive direction token in a file name: ``dirz``, ``dir-x``, ``dir_y``, ``zdir``.
+DIRECTION_PATTERN = re.compile(
+    _SEP + r"(?:dir[_\-]?(?P<d1>[xyz])|(?P<d2>[xyz])[_\-]?dir)" + _END, re.IGNORECASE)
+
+_MATERIAL_ALIASES = {"pmma": "acrylic", "aluminum": "aluminium"}
+
+
+class LoadCaseError(ParameterError):
+    """A measurement's load case is not stated, stated twice differently, or out of range."""
+
+
+@dataclass(frozen=True)
+class LoadCase:
+    """One load case of the paper's grid (or between its points).
+
+    Attributes
+    ----------
+    frequency_hz : float
+        Drive frequency, Hz.
+    acceleration_g : float
+        Acceleration amplitude of the drive, g (standard gravity).
+    fill_percent : float
+        Packing ratio: particles per cell over the full-cell count, %.
+    material : str
+        Particle material (:data:`pidcore.constants.ParticleMaterial`).
+    direction : str
+        Drive direction in the cell frame (:data:`pidcore.constants.DriveDirection`).
+
+    Examples
+    --------
+    >>> LoadCase(500.0, 5.0, 50.0).key
+    'f500Hz_a5g_fill50pct_acrylic_z'
+    """
+
+    frequency_hz: float
+    acceleration_g: float
+    fill_percent: float
+    material: str = defaults.COMPARE_DEFAULT_MATERIAL
+    direction: str = defaults.COMPARE_DEFAULT_DIRECTION
+
+    def __post_init__(self) -> None:
+        for name in ("frequency_hz", "acceleration_g"):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value > 0):
+                raise LoadCaseError(f"load case: {name} must be a positive finite number, "
+                                    f"got {value!r}")
+        _check_fill(self.fill_percent, "load case")
+        object.__setattr__(self, "material", normalize_material(self.material, "load case"))
+        object.__setattr__(self, "direction", normalize_direction(self.direction, "load case"))
+
+    @property
+    def key(self) -> str:
+        """Stable text key; numbers to 6 significant digits so float noise does not split keys."""
+        return (f"f{self.frequency_hz:.6g}Hz_a{self.acceleration_g:.6g}g_"
+                f"fill{self.fill_percent:.6g}pct_{self.material}_{self.direction}")
+
+    def label(self) -> str:
+        """Short human label, e.g. ``'500 Hz, 5 g, 50 %'``."""
+        return f"{self.frequency_hz:.4g} Hz, {self.acceleration_g:.3g} g, {self.fill_percent:.3g} %"
+
+
+@dataclass(frozen=True)
+class StatedLoadCase:
+    """What the user states about a measurement: fill, material, direction and where from.
+
+    Attributes
+    ----------
+    fill_percent : float
+        Packing ratio, %.
+    material, direction : str
+        Particle material and drive direction.
+    origin : str
+        Where each value came from, e.g. ``"fill: file name; material: default; ..."``.
+    """
+
+    fill_percent: float
+    material: str
+    direction: str
+    origin: str
+
+    def load_case(self, frequency_hz: float, acceleration_g: float) -> LoadCase:
+        """The full load case with the measured frequency (Hz) and acceleration (g)."""
+        return LoadCase(float(frequency_hz), float(acceleration_g), self.fill_percent,
+                        self.material, self.direction)
+
+
+def normalize_material(value: str, what: str) -> str:
+    """Canonical material name (``aluminum`` -> ``aluminium``, ``pmma`` -> ``acrylic``)."""
+    text = str(value).strip().lower()
+    text = _MATERIAL_ALIASES.get(text, text)
+    if text not in PARTICLE_MATERIALS:
+        raise LoadCaseError(f"{what}: unknown particle material {value!r}; expected one of "
+                            f"{', '.join(PARTICLE_MATERIALS)}")
+    return text
+
+
+def normalize_direction(value: str, what: str) -> str:
+    """Canonical drive direction (``'Z'`` -> ``'z'``)."""
+    text = str(value).strip().lower()
+    if text not in DRIVE_DIRECTIONS:
+        raise LoadCaseError(f"{what}: unknown drive direction {value!r}; expected one of "
+                            f"{', '.join(DRIVE_DIRECTIONS)}")
+    return text
+
+
+def _check_fill(value: float, what: str) -> float:
+    try:
+        fill = float(value)
+    except (TypeError, ValueError):
+        raise LoadCaseError(f"{what}: fill {value!r} is not a number (packing ratio in %)") \
+            from None
+    if not (math.isfinite(fill) and 0.0 < fill <= 100.0):
+        raise LoadCaseError(f"{what}: fill must be in (0, 100] % (packing ratio), got {value!r}")
+    return fill
+
+
+def parse_file_name(name: str | Path) -> dict[str, float | str]:
+    """Fill, material and direction stated in a file name (only those found).
+
+    Parameters
+    ----------
+    name : str or Path
+        File name or path; only the name without its last suffix is searched.
+
+    Returns
+    -------
+    dict
+        Subset of ``{"fill_percent": float, "material": str, "direction": str}``.
+
+    Examples
+    --------
+    >>> parse_file_name("run7_fill75_aluminum_dirx.uff")
+    {'fill_percent': 75.0, 'material': 'aluminium', 'direction': 'x'}
+    >>> parse_file_name("coupon_50pct_500Hz.csv")
+    {'fill_percent': 50.0}
+    """
+    path = Path(name)
+    stem = path.stem
+    found: dict[str, float | str] = {}
+    fills = {float(m.group("fill") or m.group("pct")) for m in FILL_PATTERN.finditer(stem)}
+    if len(fills) > 1:
+        raise LoadCaseError(f"{path.name}: file name states several fills "
+                            f"{sorted(fills)}; state one (or use --fill)")
+    if fills:
+        found["fill_percent"] = _check_fill(fills.pop(), path.name)
+    materials = {normalize_material(m.group("material"), path.name)
+                 for m in MATERIAL_PATTERN.finditer(stem)}
+    if len(materials) > 1:
+        raise LoadCaseError(f"{path.name}: file name states several materials {sorted(materials)}")
+    if materials:
+        found["material"] = materials.pop()
+    directions = {(m.group("d1") or m.group("d2")).lower()
+                  for m in DIRECTION_PATTERN.finditer(stem)}
+    if len(directions) > 1:
+        raise LoadCaseError(f"{path.name}: file name states several directions "
+                            f"{sorted(directions)}")
+    if directions:
+        found["direction"] = directions.pop()
+    return found
+
+
+def read_sidecar(path: str | Path) -> pd.DataFrame:
+    """Read a ``loadcases.csv`` sidecar table.
+
+    Parameters
+    ----------
+    path : str or Path
+        CSV with a header row; columns ``file`` and ``fill_percent`` required, ``material`` and
+        ``direction`` optional. ``#`` starts a comment line.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per file, columns :data:`SIDECAR_COLUMNS` (missing optional ones empty).
+    """
+    path = Path(path)
+    try:
+        table = pd.read_csv(path, comment="#", dtype=str, skipinitialspace=True,
+                            keep_default_na=False)
+    except FileNotFoundError:
+        raise LoadCaseError(f"{path}: sidecar table not found") from None
+    except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
+        raise LoadCaseError(f"{path}: not a readable CSV table ({exc})") from None
+    table.columns = [str(c).strip().lower() for c in table.columns]
+    for required in ("file", "fill_percent"):
+        if required not in table.columns:
+            raise LoadCaseError(f"{path}: sidecar table lacks column {required!r}; expected "
+                                f"columns {', '.join(SIDECAR_COLUMNS)}")
+    for optional in ("material", "direction"):
+        if optional not in table.columns:
+            table[optional] = ""
+    table = table.loc[:, list(SIDECAR_COLUMNS)].apply(lambda col: col.str.strip())
+    duplicated = table["file"][table["file"].duplicated()].tolist()
+    if duplicated:
+        raise LoadCaseError(f"{path}: sidecar table lists {duplicated[0]!r} more than once")
+    return table.reset_index(drop=True)
+
+
+def _sidecar_entry(table: pd.DataFrame, file_name: str, where: Path) -> dict[str, float | str]:
+    rows = table[table["file"] == file_name]
+    if rows.empty:  # exporters and file systems disagree on case; accept a unique case-fold match
+        rows = table[table["file"].str.casefold() == file_name.casefold()]
+    if rows.empty:
+        return {}
+    row = rows.iloc[0]
+    what = f"{where} (row {file_name!r})"
+    found: dict[str, float | str] = {}
+    if row["fill_percent"]:
+        found["fill_percent"] = _check_fill(row["fill_percent"], what)
+    if row["material"]:
+        found["material"] = normalize_material(row["material"], what)
+    if row["direction"]:
+        found["direction"] = normalize_direction(row["direction"], what)
+    return found
+
+
+def missing_fill_message(path: str | Path) -> str:
+    """The error text for a measurement without a stated fill (names the three ways)."""
+    return (f"{Path(path).name}: no fill (packing ratio, %) stated; state it (1) in the file name, "
+            f"e.g. '..._fill50_...' or '..._50pct_...', (2) in a sidecar table {SIDECAR_NAME} "
+            f"beside the file or given with --sidecar (columns {', '.join(SIDECAR_COLUMNS)}), "
+            "or (3) with --fill")
+
+
+def resolve_load_case(
+    path: str | Path,
+    *,
+    fill_percent: float | None = None,
+    material: str | None = None,
+    direction: str | None = None,
+    sidecar: str | Path | pd.DataFrame | None = None,
+) -> StatedLoadCase:
+    """What the user states about a measurement file: file name < sidecar < options.
+
+    Parameters
+    ----------
+    path : str or Path
+        The measurement file (its name is parsed; its folder is searched for ``loadcases.csv``).
+    fill_percent : float, optional
+        Fill from the command line, %; overrides file name and sidecar.
+    material, direction : str, optional
+        Particle material and drive direction from the command line; override the others.
+    sidecar : path or DataFrame, optional
+        Sidecar table to use instead of ``loadcases.csv`` beside the file.
+
+    Returns
+    -------
+    StatedLoadCase
+
+    Raises
+    ------
+    LoadCaseError
+        No fill stated anywhere (the message names the file and the three ways), or a value that
+        is not a valid fill, material or direction.
+
+    Examples
+    --------
+    >>> s = resolve_load_case("x_fill50_acrylic.uff", sidecar=None)
+    >>> s.fill_percent, s.material, s.direction
+    (50.0, 'acrylic', 'z')
+    >>> s.load_case(500.2, 4.98).key
+    'f500.2Hz_a4.98g_fill50pct_acrylic_z'
+    """
+    path = Path(path)
+    values: dict[str, float | str] = {}
+    origin: dict[str, str] = {}
+
+    def take(found: dict[str, float | str], where: str) -> None:
+        for name, value in found.items():
+            values[name] = value
+            origin[name] = where
+
+    take(parse_file_name(path), "file name")
+    if isinstance(sidecar, pd.DataFrame):
+        take(_sidecar_entry(sidecar, path.name, Path("sidecar")), "sidecar table")
+    else:
+        sidecar_path = Path(sidecar) if sidecar is not None else path.parent / SIDECAR_NAME
+        if sidecar is not None or sidecar_path.is_file():
+            take(_sidecar_entry(read_sidecar(sidecar_path), path.name, sidecar_path),
+                 f"{sidecar_path.name}")
+    options: dict[str, float | str] = {}
+    if fill_percent is not None:
+        options["fill_percent"] = _check_fill(fill_percent, "--fill")
+    if material is not None:
+        options["material"] = normalize_material(material, "--material")
+    if direction is not None:
+        options["direction"] = normalize_direction(direction, "--direction")
+    take(options, "option")
+
+    if "fill_percent" not in values:
+        raise LoadCaseError(missing_fill_message(path))
+    values.setdefault("material", defaults.COMPARE_DEFAULT_MATERIAL)
+    values.setdefault("direction", defaults.COMPARE_DEFAULT_DIRECTION)
+    text = "; ".join(f"{name.split('_')[0]}: {origin.get(name, 'default')}"
+                     for name in ("fill_percent", "material", "direction"))
+    return StatedLoadCase(float(values["fill_percent"]), str(values["material"]),
+                          str(values["direction"]), text)

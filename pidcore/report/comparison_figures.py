@@ -1,0 +1,221 @@
+"""Report figures that compare measurement, our DEM and the paper (plotting only).
+
+* :func:`plot_sdc_comparison` - per load case: measured SDC ± standard error, our DEM mean ±
+  standard error, the paper's DEM and experimental values.
+* :func:`plot_loop_overlay` - force-displacement loop of a measurement over the DEM's loop at
+  the same load case.
+* :func:`dem_loop_from_arrays` - the DEM loop from a stored run's decimated time series.
+
+The model families (paper Figs. 8-14) are in :mod:`pidcore.report.figures`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+import pandas as pd
+
+from .table import ALIGNMENT_COLUMN
+
+#: Force arrays looked for in a DEM run, in order: the force a shaker's gauge would measure
+#: (coupon inertia + particles, :class:`pidcore.dem.result.DemResult`), comparable with a
+#: measured force; then the particles' force on the walls alone.
+DEM_FORCE_ARRAYS: tuple[str, ...] = ("shaker_force_n", "wall_force_n")
+#: Coupon velocity arrays looked for in a DEM run.
+DEM_VELOCITY_ARRAYS: tuple[str, ...] = ("velocity_m_s", "coupon_velocity_m_s")
+#: Time arrays (sample instants) looked for in a DEM run.
+DEM_TIME_ARRAYS: tuple[str, ...] = ("sample_time_s", "time_s")
+
+
+def _new_figure(width: float, height: float):
+    # A bare Figure needs no GUI backend and is not kept alive by pyplot's registry.
+    from matplotlib.figure import Figure
+
+    return Figure(figsize=(width, height), layout="constrained")
+
+
+def plot_sdc_comparison(table: pd.DataFrame, *, ax=None):
+    """SDC per load case: measured, our DEM and the paper's values side by side.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        The report table (:func:`pidcore.report.build_report_table`). Rows with a measured
+        value are drawn; if there is none, every row is.
+    ax : matplotlib Axes, optional
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Error bars are one standard error; interpolated DEM values are drawn as open markers
+        without error bars (the model carries none).
+    """
+    rows = table[np.isfinite(table["SDC measured [-]"].astype(float))]
+    if rows.empty:
+        rows = table
+    n = len(rows)
+    if ax is None:
+        fig = _new_figure(max(6.4, 0.55 * n + 2.0), 4.2)
+        ax = fig.subplots()
+    else:
+        fig = ax.figure
+    x = np.arange(n, dtype=float)
+    width = 0.18
+    labels = [f"{r['frequency [Hz]']:.4g} Hz\n{r['acceleration [g]']:.3g} g\n"
+              f"{r['packing ratio [%]']:.3g} %" for _, r in rows.iterrows()]
+    ax.errorbar(x - 1.5 * width, rows["SDC measured [-]"], yerr=rows["SDC measured stderr [-]"],
+                fmt="o", color="C0", capsize=3, label="measured (ours) ± SE")
+    on_grid = (rows[ALIGNMENT_COLUMN] == "grid").to_numpy()
+    ax.errorbar(x[on_grid] - 0.5 * width, rows["SDC DEM (ours) [-]"][on_grid],
+                yerr=rows["SDC DEM stderr [-]"][on_grid], fmt="s", color="C1", capsize=3,
+                label="DEM (ours) ± SE")
+    if (~on_grid).any():
+        ax.plot(x[~on_grid] - 0.5 * width, rows["SDC DEM (ours) [-]"][~on_grid], "s",
+                markerfacecolor="none", color="C1", label="DEM (ours), pchip-interpolated")
+    ax.plot(x + 0.5 * width, rows["SDC DEM (paper) [-]"], "D", color="C2", label="DEM (paper)")
+    ax.plot(x + 1.5 * width, rows["SDC measured (paper) [-]"], "^", color="C3",
+            label="measured (paper)")
+    ax.set_xticks(x, labels, fontsize="small")
+    ax.set_ylabel("SDC [-]")
+    ax.set_title("SDC per load case")
+    ax.grid(axis="y", alpha=0.3)
+    ax.legend(fontsize="small")
+    return fig
+
+
+def _first(arrays: Mapping[str, np.ndarray], names: tuple[str, ...]) -> np.ndarray | None:
+    for name in names:
+        if name in arrays:
+            return np.asarray(arrays[name], dtype=float)
+    return None
+
+
+def dem_loop_from_arrays(arrays: Mapping[str, np.ndarray],
+                         record: Mapping[str, object] | None = None,
+                         ) -> tuple[np.ndarray, np.ndarray] | str:
+    """One period of a DEM run's force-displacement loop, or a note why there is none.
+
+    The stored virtual shaker record (force :data:`DEM_FORCE_ARRAYS`, coupon velocity
+    :data:`DEM_VELOCITY_ARRAYS`) from the steady state on (``steady_start_cycle`` of the record)
+    is analysed like a measurement (:func:`pidcore.signal.analyze_power`) and the loop
+    synthesised from its harmonics, so measured and DEM loops are drawn the same way.
+
+    Parameters
+    ----------
+    arrays : mapping
+        The run's arrays (:attr:`pidcore.store.StoredEntry.arrays`).
+    record : mapping, optional
+        The run's scalars: ``frequency_hz``, ``sample_rate_hz`` (else from the time array),
+        ``steady_start_cycle`` (default 0).
+
+    Returns
+    -------
+    (displacement m, force N) or str
+    """
+    from ..errors import PidcoreError
+    from ..signal import analyze_power
+
+    record = record or {}
+    force = _first(arrays, DEM_FORCE_ARRAYS)
+    velocity = _first(arrays, DEM_VELOCITY_ARRAYS)
+    if force is None or velocity is None:
+        return (f"DEM run keeps no force ({', '.join(DEM_FORCE_ARRAYS)}) or velocity "
+                f"({', '.join(DEM_VELOCITY_ARRAYS)}) time series")
+    if force.shape != velocity.shape or force.ndim != 1:
+        return "DEM run's force and velocity arrays differ in shape"
+    rate = record.get("sample_rate_hz")
+    time = _first(arrays, DEM_TIME_ARRAYS)
+    if not isinstance(rate, int | float) and time is not None and time.size > 1:
+        rate = 1.0 / float(np.mean(np.diff(time)))
+    freq = record.get("frequency_hz")
+    if not isinstance(rate, int | float) or not isinstance(freq, int | float):
+        return "DEM run lacks sample_rate_hz or frequency_hz"
+    start_cycle = record.get("steady_start_cycle") or 0
+    start = int(round(float(start_cycle) * float(rate) / float(freq)))
+    try:
+        analysis = analyze_power(force[start:], velocity[start:], float(rate),
+                                 frequency_hz=float(freq), source="DEM run")
+    except PidcoreError as exc:
+        return f"DEM time series cannot be analysed ({exc})"
+    return analysis.force_displacement_loop()
+
+
+def loop_from_phasors(arrays: Mapping[str, np.ndarray], frequency_hz: object, *,
+                      n_points: int = 256) -> tuple[np.ndarray, np.ndarray] | str:
+    """One period of a stored analysis' force-displacement loop, or a note why there is none.
+
+    Rebuilt from the stored harmonic phasors (``harmonics``, ``force_phasors_n``,
+    ``velocity_phasors_m_s``, as :func:`pidcore.measure.analysis_arrays` stores them) exactly as
+    :meth:`pidcore.signal.PowerAnalysis.force_displacement_loop` does: X_n = V_n / (j n w).
+    """
+    needed = ("harmonics", "force_phasors_n", "velocity_phasors_m_s")
+    if any(name not in arrays for name in needed):
+        return f"stored analysis keeps no harmonic phasors ({', '.join(needed)})"
+    if not isinstance(frequency_hz, int | float) or not frequency_hz > 0:
+        return "stored analysis has no drive frequency"
+    harmonics = np.asarray(arrays["harmonics"], dtype=float)
+    force = np.asarray(arrays["force_phasors_n"], dtype=complex)
+    velocity = np.asarray(arrays["velocity_phasors_m_s"], dtype=complex)
+    omega = 2 * np.pi * float(frequency_hz)
+    phase = 2 * np.pi * np.arange(n_points) / n_points
+    rot = np.exp(1j * np.outer(harmonics, phase))
+    displacement = velocity / (1j * harmonics * omega)
+    return np.real(displacement @ rot), np.real(force @ rot)
+
+
+def loop_arrays(loop: object) -> tuple[np.ndarray, np.ndarray]:
+    """(displacement m, force N) from a loop object or a 2-tuple.
+
+    Accepts a ``(displacement, force)`` tuple or an object with attributes ``displacement_m`` and
+    ``force_n`` (as :meth:`PowerAnalysis.force_displacement_loop` returns).
+    """
+    if isinstance(loop, tuple) and len(loop) == 2:
+        return np.asarray(loop[0], dtype=float), np.asarray(loop[1], dtype=float)
+    for xname, fname in (("displacement_m", "force_n"), ("displacement", "force")):
+        if hasattr(loop, xname) and hasattr(loop, fname):
+            return (np.asarray(getattr(loop, xname), dtype=float),
+                    np.asarray(getattr(loop, fname), dtype=float))
+    raise TypeError(f"cannot read a force-displacement loop from {type(loop).__name__}")
+
+
+def _closed(x: np.ndarray, f: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Append the first point so a one-period loop is drawn closed."""
+    return np.append(x, x[:1]), np.append(f, f[:1])
+
+
+def plot_loop_overlay(measured: object, dem: tuple[np.ndarray, np.ndarray] | None, *,
+                      title: str = "", ax=None):
+    """Force-displacement loop of a measurement, with the DEM's at the same load case.
+
+    Parameters
+    ----------
+    measured : loop or (displacement m, force N)
+        The measured loop (see :func:`loop_arrays`).
+    dem : (displacement m, force N) or None
+        The DEM loop (:func:`dem_loop_from_arrays`), or None to draw the measurement alone.
+    title : str
+    ax : matplotlib Axes, optional
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Displacement in µm, force in N; the enclosed area is the energy per cycle.
+    """
+    if ax is None:
+        fig = _new_figure(5.5, 4.2)
+        ax = fig.subplots()
+    else:
+        fig = ax.figure
+    x, f = _closed(*loop_arrays(measured))
+    ax.plot(x * 1e6, f, color="C0", label="measured")
+    if dem is not None:
+        xd, fd = _closed(*loop_arrays(dem))
+        ax.plot(xd * 1e6, fd, color="C1", alpha=0.8, label="DEM (ours)")
+    ax.set_xlabel("displacement [µm]")
+    ax.set_ylabel("force [N]")
+    ax.set_title(title or "force-displacement loop")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize="small")
+    return fig
+

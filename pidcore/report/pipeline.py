@@ -1,0 +1,382 @@
+"""``pidcore report`` as a library function: analyse, store, align, tabulate, plot, render.
+
+Order matters for the guarantees of the command:
+
+1. formats and the output folder are checked, the stores are opened and verified — a corrupt or
+   partial store stops everything with one :class:`~pidcore.errors.StoreError` before anything
+   is analysed, stored or written;
+2. every file is analysed before anything is stored (one bad file leaves the store untouched);
+3. the analyses go into the store in one transaction;
+4. the table is built from the store's numbers (read back), so the report shows exactly what is
+   stored; figures and provenance follow, and :func:`~pidcore.report.render.write_report` writes
+   everything atomically.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+import pandas as pd
+
+from .. import defaults
+from ..compare.align import Aligner, Tolerances, dem_cases
+from ..compare.loadcase import LoadCase, LoadCaseError, StatedLoadCase, resolve_load_case
+from ..errors import StoreError
+from .provenance import collect_provenance
+from .render import check_out_dir, parse_formats, write_report
+from .table import build_report_table
+
+if TYPE_CHECKING:  # pragma: no cover
+    from ..measure import AnalysisOptions, AnalyzedRecord
+
+# pidcore.measure (readers, signal analysis) is imported where used: `import pidcore.report`
+# stays light for the app, which only renders stored results.
+
+#: Most force-displacement loop figures in one report (one per measurement).
+MAX_LOOP_FIGURES = 12
+
+
+@dataclass(frozen=True)
+class MeasuredResult:
+    """One analysed measurement file with its load case.
+
+    Attributes
+    ----------
+    path : Path
+    analyzed : pidcore.measure.AnalyzedRecord
+        Measurement, analysis and the channels used (the same glue as ``pidcore analyze``).
+    stated : StatedLoadCase
+        Fill, material, direction as stated, and where from.
+    load_case : LoadCase
+        Measured frequency and acceleration with the stated fill/material/direction.
+    """
+
+    path: Path
+    analyzed: AnalyzedRecord
+    stated: StatedLoadCase
+    load_case: LoadCase
+
+    @property
+    def measurement(self):
+        return self.analyzed.measurement
+
+    @property
+    def analysis(self):
+        return self.analyzed.analysis
+
+    def record(self) -> dict[str, object]:
+        """The record ``pidcore analyze`` stores, plus the load case."""
+        from ..measure import analysis_record
+
+        return {**analysis_record(self.analyzed),
+                "fill_percent": self.load_case.fill_percent,
+                "material": self.load_case.material,
+                "direction": self.load_case.direction,
+                "load_case_key": self.load_case.key,
+                "load_case_origin": self.stated.origin}
+
+
+@dataclass(frozen=True)
+class ReportResult:
+    """What :func:`make_report` produced.
+
+    Attributes
+    ----------
+    paths : dict of str to Path
+        Files written (format -> path, ``figure:<name>`` -> path).
+    table : pandas.DataFrame
+        The report table.
+    measured : list of MeasuredResult
+        The files analysed in this call.
+    notes : list of str
+        Records left out, figures skipped, and why.
+    """
+
+    paths: dict[str, Path]
+    table: pd.DataFrame
+    measured: list[MeasuredResult] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+
+
+def open_verified_store(path: str | Path, *, must_exist: bool):
+    """Open a store and verify it; a corrupt or partial store raises one-line StoreError.
+
+    Parameters
+    ----------
+    path : path
+        Store file.
+    must_exist : bool
+        True for stores that are only read (a missing file is an error); False for a store that
+        analyses will be added to (created on first write).
+    """
+    from ..store import Store
+
+    path = Path(path)
+    if not path.exists():
+        if must_exist:
+            raise StoreError(f"{path}: store not found")
+        return Store(path)
+    store = Store(path)
+    problems = store.verify()
+    if problems:
+        more = f" (and {len(problems) - 1} more problem(s))" if len(problems) > 1 else ""
+        raise StoreError(f"{path}: corrupt or partial store, no report written: "
+                         f"{problems[0]}{more}")
+    return store
+
+
+def analyse_files(paths: Sequence[str | Path], *, fill_percent: float | None = None,
+                  material: str | None = None, direction: str | None = None,
+                  sidecar: str | Path | None = None,
+                  options: AnalysisOptions | None = None) -> list[MeasuredResult]:
+    """Read, assign roles, analyse (Eq. 11) and attach the load case of every file.
+
+    The load case is resolved first for every file, so a missing fill is reported before any
+    (slow) analysis runs. Files with identical contents are one measurement: kept once, and
+    refused if they state different load cases.
+    """
+    from ..measure import AnalysisOptions, analyze_file
+
+    options = options or AnalysisOptions()
+    stated = [resolve_load_case(p, fill_percent=fill_percent, material=material,
+                                direction=direction, sidecar=sidecar) for p in paths]
+    out: list[MeasuredResult] = []
+    seen: dict[str, MeasuredResult] = {}
+    for path, st in zip(paths, stated, strict=True):
+        analyzed = analyze_file(path, options)
+        a = analyzed.analysis
+        result = MeasuredResult(Path(path), analyzed, st,
+                                st.load_case(a.frequency_hz, a.acceleration_g))
+        sha = analyzed.measurement.sha256
+        twin = seen.get(sha) if sha else None
+        if twin is not None:
+            # Identical bytes are one measurement (the store keeps it once); it cannot belong to
+            # two load cases, and counting it twice would shrink the pooled standard error.
+            if twin.load_case.key != result.load_case.key:
+                raise LoadCaseError(f"{Path(path).name} and {twin.path.name} have identical "
+                                    f"contents but state different load cases "
+                                    f"({result.load_case.key} vs {twin.load_case.key})")
+            continue
+        if sha:
+            seen[sha] = result
+        out.append(result)
+    return out
+
+
+def measured_frame(results: Iterable[MeasuredResult]) -> pd.DataFrame:
+    """The analyses table (as the store lists it) for results that were not stored."""
+    rows = [{"source": str(r.path), **r.record()} for r in results]
+    return pd.DataFrame(rows)
+
+
+def latest_per_measurement(analyses: pd.DataFrame) -> pd.DataFrame:
+    """The newest analysis of each measurement that states a fill (store-only reports)."""
+    if analyses.empty or "fill_percent" not in analyses.columns:
+        return analyses.iloc[0:0]
+    with_fill = analyses[np.isfinite(pd.to_numeric(analyses["fill_percent"], errors="coerce"))]
+    return (with_fill.sort_values("created_utc", kind="stable")
+            .groupby("measurement_key", sort=False).tail(1).reset_index(drop=True))
+
+
+def _store_results(store, results: list[MeasuredResult], options: AnalysisOptions) -> list[str]:
+    # As pidcore.measure.save_analyses (same record, arrays, parameters, so the entry of
+    # `pidcore analyze` for the same file and options is replaced, not duplicated), plus the
+    # load case fields.
+    from ..measure import ANALYSIS_UNITS, analysis_arrays
+
+    keys = []
+    with store.transaction():
+        for r in results:
+            mkey, _ = store.add_measurement(r.measurement)
+            keys.append(store.add_analysis(
+                mkey, r.record(), arrays=analysis_arrays(r.analysis),
+                parameters={**options.parameters(), "channels": r.analyzed.channels_used},
+                units={**ANALYSIS_UNITS, "fill_percent": "%"}))
+    return keys
+
+
+def _measured_loops(results: list[MeasuredResult], analyses: pd.DataFrame, store,
+                    notes: list[str]) -> list[tuple[str, LoadCase, tuple]]:
+    """(name, load case, loop) per measurement: from the fresh analyses, else from the store's
+    harmonic phasors (store-only reports)."""
+    from .comparison_figures import loop_from_phasors
+
+    if results:
+        return [(r.path.name, r.load_case, r.analysis.force_displacement_loop())
+                for r in results]
+    loops = []
+    if store is None or analyses.empty or "key" not in analyses.columns:
+        return loops
+    for _, row in analyses.iterrows():
+        name = Path(str(row.get("source", "") or row["key"])).name
+        entry = store.get_analysis(str(row["key"]))
+        found = loop_from_phasors(entry.arrays, row.get("frequency_hz"))
+        if isinstance(found, str):
+            notes.append(f"{name}: {found}; loop not drawn")
+            continue
+        case = LoadCase(float(row["frequency_hz"]), float(row["acceleration_g"]),
+                        float(row["fill_percent"]), str(row.get("material") or "acrylic"),
+                        str(row.get("direction") or "z"))
+        loops.append((name, case, found))
+    return loops
+
+
+def _figures(table: pd.DataFrame, dem_runs: pd.DataFrame | None, aligner: Aligner,
+             loops: list[tuple[str, LoadCase, tuple]], dem_store,
+             notes: list[str]) -> dict[str, object]:
+    from .comparison_figures import dem_loop_from_arrays, plot_loop_overlay, plot_sdc_comparison
+
+    figures: dict[str, object] = {}
+    if not table.empty:
+        figures["sdc_per_load_case"] = plot_sdc_comparison(table)
+    models = {k: m for k, m in aligner.models.items() if not isinstance(m, str)}
+    if models:
+        from .figures import plot_sdc_vs_acceleration, plot_sdc_vs_frequency
+
+        for (material, direction), model in models.items():
+            sub = dem_runs[(dem_runs["material"] == material)
+                           & (dem_runs["direction"] == direction)]
+            suffix = f"{material}_{direction}"
+            figures[f"sdc_vs_acceleration_{suffix}"] = plot_sdc_vs_acceleration(
+                model, table=sub, value="sdc")
+            figures[f"sdc_vs_frequency_{suffix}"] = plot_sdc_vs_frequency(
+                model, table=sub, value="sdc")
+    for i, (name, case, loop) in enumerate(loops[:MAX_LOOP_FIGURES]):
+        dem_loop = None
+        grid = aligner.grid_case(case)
+        if grid is None or not grid.run_keys or dem_store is None:
+            notes.append(f"{name}: no DEM run at {case.label()}; loop drawn without DEM overlay")
+        else:
+            entry = dem_store.get_dem_run(grid.run_keys[0])
+            found = dem_loop_from_arrays(entry.arrays, entry.record)
+            if isinstance(found, str):
+                notes.append(f"{name}: {found}; loop drawn without DEM overlay")
+            else:
+                dem_loop = found
+        figures[f"loop_{i:02d}_{case.key}"] = plot_loop_overlay(
+            loop, dem_loop, title=f"{name}: {case.label()}")
+    if len(loops) > MAX_LOOP_FIGURES:
+        notes.append(f"loops drawn for the first {MAX_LOOP_FIGURES} of {len(loops)} measurements")
+    return figures
+
+
+def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
+                store: str | Path | None = None, dem_store: str | Path | None = None,
+                formats: str | Iterable[str] = defaults.REPORT_FORMATS,
+                fill_percent: float | None = None, material: str | None = None,
+                direction: str | None = None, sidecar: str | Path | None = None,
+                velocity_delay_s: float = 0.0, mass_below_gauge_kg: float = 0.0,
+                sample_rate_hz: float | None = None,
+                tolerances: Tolerances | None = None) -> ReportResult:
+    """Analyse files, store them, align with DEM and the paper, and write the report.
+
+    Parameters
+    ----------
+    files : sequence of path
+        Measurement files to analyse (may be empty: report what the store holds).
+    out_dir : path
+        Report folder (new, empty or an earlier report, which is replaced atomically).
+    store : path, optional
+        Store the analyses are added to; without files its analyses are reported (the newest
+        per measurement that states a fill).
+    dem_store : path, optional
+        Store whose DEM runs are compared (default: ``store``). Only read.
+    formats : str or iterable of str
+        ``csv, md, html, tex, pdf`` or ``"all"``.
+    fill_percent, material, direction, sidecar
+        Load case statements (:func:`pidcore.compare.resolve_load_case`).
+    velocity_delay_s : float
+        Vibrometer delay removed before Eq. 11, s.
+    mass_below_gauge_kg : float
+        Mass between force gauge and coupon cancelled, kg.
+    sample_rate_hz : float, optional
+        For CSV files without a time column, Hz.
+    tolerances : Tolerances, optional
+        Grid-match tolerances.
+
+    Returns
+    -------
+    ReportResult
+    """
+    from ..measure import AnalysisOptions
+    from ..model import load_paper_table3
+
+    formats = parse_formats(formats)
+    out_dir = Path(out_dir)
+    check_out_dir(out_dir)
+    tolerances = tolerances or Tolerances()
+    files = [Path(f) for f in files]
+    if not files and store is None and dem_store is None:
+        raise StoreError("nothing to report: give measurement files, --store or --dem-store")
+    main = open_verified_store(store, must_exist=not files) if store is not None else None
+    dem_path = Path(dem_store) if dem_store is not None else (Path(store) if store else None)
+    dem = None
+    if dem_path is not None:
+        dem = main if (main is not None and dem_path == Path(store)) else \
+            open_verified_store(dem_path, must_exist=True)
+
+    options = AnalysisOptions(velocity_delay_s=float(velocity_delay_s),
+                              mass_below_gauge_kg=float(mass_below_gauge_kg),
+                              sample_rate_hz=sample_rate_hz)
+    parameters = options.parameters()
+    results = analyse_files(files, fill_percent=fill_percent, material=material,
+                            direction=direction, sidecar=sidecar,
+                            options=options) if files else []
+    notes: list[str] = [f"{r.path.name}: load case {r.load_case.key} ({r.stated.origin})"
+                        for r in results]
+    if len(results) < len(files):
+        kept = {r.path for r in results}
+        notes += [f"{f.name}: identical contents to another file given; counted once"
+                  for f in files if f not in kept]
+    if main is not None and results:
+        keys = _store_results(main, results, options)
+        listed = main.list_analyses()
+        analyses = listed[listed["key"].isin(keys)]
+        analyses = analyses.set_index("key").loc[keys].reset_index()  # order of the files
+    elif main is not None:
+        listed = main.list_analyses()
+        analyses = latest_per_measurement(listed)
+        if not listed.empty:
+            left_out = listed["measurement_key"].nunique() - analyses["measurement_key"].nunique()
+            if left_out:
+                notes.append(f"{left_out} stored measurement(s) have no analysis stating a fill; "
+                             "not in the table (re-run with the files and --fill)")
+    else:
+        analyses = measured_frame(results)
+
+    dem_runs = dem.list_dem_runs() if dem is not None else None
+    if dem_runs is not None and dem_runs.empty:
+        notes.append(f"{dem_path}: holds no DEM runs")
+        dem_runs = None
+    paper = load_paper_table3()
+    table = build_report_table(dem_runs, analyses, paper, tolerances=tolerances)
+    notes.extend(table.attrs.get("notes", []))
+    aligner = Aligner(dem_cases(dem_runs, tolerances=tolerances) if dem_runs is not None else [],
+                      paper, None, tolerances)
+    loops = _measured_loops(results, analyses, main, notes)
+    figures = _figures(table, dem_runs, aligner, loops, dem, notes)
+    try:
+        seeds = []
+        if dem_runs is not None and "seed" in dem_runs.columns:
+            seeds = [int(s) for s in dem_runs["seed"] if s is not None and not (
+                isinstance(s, float) and math.isnan(s))]
+        stores = [p for p in (Path(store) if store else None, dem_path)
+                  if p is not None and p.exists()]
+        provenance = collect_provenance(
+            parameters={**parameters,
+                        "frequency_rtol": tolerances.frequency_rtol,
+                        "acceleration_rtol": tolerances.acceleration_rtol,
+                        "fill_atol_percent": tolerances.fill_atol_percent},
+            seeds=seeds, inputs=[r.path for r in results],
+            input_hashes={str(r.path): getattr(r.measurement, "sha256", "") for r in results},
+            stores=stores, notes=notes)
+        paths = write_report(table, figures, provenance, out_dir, formats)
+    finally:
+        for fig in figures.values():  # bare Figures: drop references to free Agg buffers
+            fig.clear()
+    return ReportResult(paths, table, results, notes)

@@ -1,0 +1,121 @@
+"""Provenance of a report: software versions, parameters, seeds, inputs and their hashes."""
+
+from __future__ import annotations
+
+import hashlib
+import platform
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, field
+from datetime import UTC, datetime
+from importlib.metadata import PackageNotFoundError, version
+from pathlib import Path
+
+#: Packages whose versions every report lists.
+PROVENANCE_PACKAGES: tuple[str, ...] = ("numpy", "scipy", "numba", "pandas", "matplotlib", "h5py")
+
+
+def sha256_file(path: str | Path, *, chunk_bytes: int = 1 << 20) -> str:
+    """SHA-256 hex digest of a file's bytes, read in chunks (stores can be large)."""
+    digest = hashlib.sha256()
+    with open(path, "rb") as fh:
+        while chunk := fh.read(chunk_bytes):
+            digest.update(chunk)
+    return digest.hexdigest()
+
+
+def _package_version(name: str) -> str:
+    try:
+        return version(name)
+    except PackageNotFoundError:
+        return "not installed"
+
+
+@dataclass(frozen=True)
+class Provenance:
+    """Everything needed to reproduce a report.
+
+    Attributes
+    ----------
+    versions : mapping
+        ``{"pidcore": ..., "python": ..., "numpy": ..., ...}``.
+    parameters : mapping
+        Analysis and comparison parameters (name -> value, units in the name).
+    seeds : tuple of int
+        Random seeds of the DEM runs in the report.
+    inputs : tuple of (str, str)
+        Input file names and their SHA-256.
+    stores : tuple of (str, str)
+        Store paths and their SHA-256 (at the time the report was made).
+    created_utc : str
+        ISO 8601 time stamp, UTC.
+    notes : tuple of str
+        Records left out and why, and other remarks.
+    """
+
+    versions: Mapping[str, str]
+    parameters: Mapping[str, object] = field(default_factory=dict)
+    seeds: tuple[int, ...] = ()
+    inputs: tuple[tuple[str, str], ...] = ()
+    stores: tuple[tuple[str, str], ...] = ()
+    created_utc: str = ""
+    notes: tuple[str, ...] = ()
+
+    def lines(self) -> list[str]:
+        """The provenance as plain text lines (the footer of every format)."""
+        out = [f"created (UTC): {self.created_utc}",
+               "software: " + ", ".join(f"{k} {v}" for k, v in self.versions.items())]
+        if self.parameters:
+            out.append("parameters: " + ", ".join(f"{k}={v}" for k, v in self.parameters.items()))
+        out.append("seeds: " + (", ".join(str(s) for s in self.seeds) or "none"))
+        for name, digest in self.stores:
+            out.append(f"store: {name} sha256 {digest}")
+        for name, digest in self.inputs:
+            out.append(f"input: {name} sha256 {digest}")
+        out.extend(f"note: {n}" for n in self.notes)
+        return out
+
+    def to_dict(self) -> dict[str, object]:
+        return {"versions": dict(self.versions), "parameters": dict(self.parameters),
+                "seeds": list(self.seeds), "inputs": [list(i) for i in self.inputs],
+                "stores": [list(s) for s in self.stores], "created_utc": self.created_utc,
+                "notes": list(self.notes)}
+
+
+def collect_provenance(*, parameters: Mapping[str, object] | None = None,
+                       seeds: Iterable[int] = (), inputs: Iterable[str | Path] = (),
+                       input_hashes: Mapping[str, str] | None = None,
+                       stores: Iterable[str | Path] = (), notes: Iterable[str] = (),
+                       created_utc: datetime | None = None) -> Provenance:
+    """Collect versions, hashes and a time stamp into a :class:`Provenance`.
+
+    Parameters
+    ----------
+    parameters : mapping, optional
+        Parameters to list.
+    seeds : iterable of int
+        DEM seeds (duplicates removed, sorted).
+    inputs : iterable of path
+        Input files; hashed here unless ``input_hashes`` already has their SHA-256.
+    input_hashes : mapping, optional
+        Known SHA-256 per input path (as text), e.g. from :attr:`Measurement.sha256`.
+    stores : iterable of path
+        Store files, hashed here.
+    notes : iterable of str
+    created_utc : datetime, optional
+        Time stamp (default: now).
+    """
+    from .. import __version__
+
+    versions = {"pidcore": __version__, "python": platform.python_version()}
+    versions.update({name: _package_version(name) for name in PROVENANCE_PACKAGES})
+    input_hashes = dict(input_hashes or {})
+    hashed_inputs = []
+    for path in inputs:
+        digest = input_hashes.get(str(path)) or sha256_file(path)
+        hashed_inputs.append((Path(path).name, digest))
+    hashed_stores = tuple((str(p), sha256_file(p)) for p in dict.fromkeys(map(str, stores)))
+    stamp = (created_utc or datetime.now(UTC)).astimezone(UTC)
+    return Provenance(versions=versions, parameters=dict(parameters or {}),
+                      seeds=tuple(sorted({int(s) for s in seeds})), inputs=tuple(hashed_inputs),
+                      stores=hashed_stores, created_utc=stamp.isoformat(timespec="seconds"),
+                      notes=tuple(notes))

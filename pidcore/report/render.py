@@ -1,0 +1,321 @@
+"""Write a report (table, figures, provenance) as CSV, Markdown, HTML, LaTeX and PDF.
+
+All formats are written into a temporary folder beside the output folder and moved into place
+only when every one succeeded, so a failure leaves no partial report and an earlier report in
+the output folder untouched.
+
+Markdown and LaTeX are written here rather than through ``DataFrame.to_markdown`` (needs
+``tabulate``) or ``Styler.to_latex`` (needs ``jinja2``): both are ~20 lines of escaping and
+joining, not worth a dependency. The PDF is drawn by matplotlib (``PdfPages``), so no LaTeX
+toolchain is needed.
+"""
+
+from __future__ import annotations
+
+import base64
+import csv
+import html
+import math
+import os
+import shutil
+import tempfile
+import textwrap
+from collections.abc import Callable, Iterable, Mapping, Sequence
+from pathlib import Path
+
+import pandas as pd
+
+from .. import defaults
+from ..constants import REPORT_FORMATS
+from ..errors import ParameterError
+from .provenance import Provenance
+
+#: File written into every report folder; only folders holding it are ever replaced.
+REPORT_MARKER = ".pidcore-report"
+#: Base name of the table files (``report.csv``, ``report.md``...).
+REPORT_STEM = "report"
+#: Columns shown in the PDF table (the full table is in every other format).
+PDF_COLUMNS: tuple[str, ...] = (
+    "frequency [Hz]", "acceleration [g]", "packing ratio [%]", "SDC DEM (ours) [-]",
+    "SDC DEM stderr [-]", "SDC measured [-]", "SDC measured stderr [-]", "SDC DEM (paper) [-]",
+    "SDC measured (paper) [-]", "alignment [grid/interpolated/out_of_range]",
+)
+_TITLE = "Specific damping capacity: our DEM, our measurements and the paper (Table 3)"
+
+
+def format_cell(value: object) -> str:
+    """Display text of one cell: 4 significant digits, empty for NaN."""
+    if isinstance(value, float):
+        return "" if math.isnan(value) else f"{value:.4g}"
+    if value is None:
+        return ""
+    return str(value)
+
+
+def _display_rows(table: pd.DataFrame, columns: Sequence[str] | None = None) -> list[list[str]]:
+    cols = list(columns) if columns is not None else list(table.columns)
+    return [[format_cell(v) for v in row] for row in table.loc[:, cols].itertuples(index=False)]
+
+
+def parse_formats(formats: str | Iterable[str]) -> tuple[str, ...]:
+    """Validate report formats; ``"all"`` means every one of :data:`REPORT_FORMATS`."""
+    items = [formats] if isinstance(formats, str) else list(formats)
+    out: list[str] = []
+    for item in items:
+        for name in str(item).split(","):
+            name = name.strip().lower()
+            if name == "all":
+                out.extend(REPORT_FORMATS)
+            elif name in REPORT_FORMATS:
+                out.append(name)
+            else:
+                raise ParameterError(f"report format {name!r} unknown; expected all or one of "
+                                     f"{', '.join(REPORT_FORMATS)}")
+    if not out:
+        raise ParameterError("no report format given")
+    return tuple(dict.fromkeys(out))
+
+
+# ---------------------------------------------------------------------------- formats
+def _write_csv(table: pd.DataFrame, figures: Mapping[str, Path], prov: Provenance,
+               folder: Path) -> Path:
+    path = folder / f"{REPORT_STEM}.csv"
+    # Floats are written as repr (read back bit for bit); text is quoted so that a '#' in a file
+    # name is not taken for the start of the footer comment: read_csv(path, comment="#").
+    table.to_csv(path, index=False, quoting=csv.QUOTE_NONNUMERIC)
+    with open(path, "a", encoding="utf-8") as fh:
+        fh.writelines(f"# {line}\n" for line in prov.lines())
+    return path
+
+
+def _md_escape(text: str) -> str:
+    return text.replace("\\", "\\\\").replace("|", "\\|").replace("\n", " ")
+
+
+def _write_md(table: pd.DataFrame, figures: Mapping[str, Path], prov: Provenance,
+              folder: Path) -> Path:
+    path = folder / f"{REPORT_STEM}.md"
+    lines = [f"# {_TITLE}", ""]
+    lines.append("| " + " | ".join(_md_escape(c) for c in table.columns) + " |")
+    numeric = [pd.api.types.is_numeric_dtype(table[c]) for c in table.columns]
+    lines.append("|" + "|".join("---:" if n else "---" for n in numeric) + "|")
+    for row in _display_rows(table):
+        lines.append("| " + " | ".join(_md_escape(c) for c in row) + " |")
+    lines.append("")
+    for stem, png in figures.items():
+        lines += [f"![{stem}](figures/{png.name})", ""]
+    lines += ["## Provenance", ""]
+    lines += [f"- {_md_escape(line)}" for line in prov.lines()]
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    return path
+
+
+_CSS = """
+body { font-family: system-ui, sans-serif; margin: 2em; color: #222; }
+table { border-collapse: collapse; font-size: 0.85em; }
+th, td { border-bottom: 1px solid #ccc; padding: 0.25em 0.6em; }
+th { border-bottom: 2px solid #444; text-align: left; }
+td.num { text-align: right; font-variant-numeric: tabular-nums; }
+figure { margin: 1.5em 0; }
+figure img { max-width: 100%; }
+footer { margin-top: 2em; font-size: 0.8em; color: #555; }
+"""
+
+
+def _write_html(table: pd.DataFrame, figures: Mapping[str, Path], prov: Provenance,
+                folder: Path) -> Path:
+    path = folder / f"{REPORT_STEM}.html"
+    numeric = [pd.api.types.is_numeric_dtype(table[c]) for c in table.columns]
+    head = "".join(f"<th>{html.escape(c)}</th>" for c in table.columns)
+    body = []
+    for row in _display_rows(table):
+        cells = "".join(f'<td class="num">{html.escape(v)}</td>' if n
+                        else f"<td>{html.escape(v)}</td>" for v, n in zip(row, numeric,
+                                                                            strict=True))
+        body.append(f"<tr>{cells}</tr>")
+    figs = []
+    for stem, png in figures.items():  # embedded: the file must open offline, alone
+        data = base64.b64encode(png.read_bytes()).decode("ascii")
+        figs.append(f'<figure><img alt="{html.escape(stem)}" src="data:image/png;base64,{data}">'
+                    f"<figcaption>{html.escape(stem)}</figcaption></figure>")
+    foot = "".join(f"<li>{html.escape(line)}</li>" for line in prov.lines())
+    text = (f'<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8">'
+            f"<title>{html.escape(_TITLE)}</title><style>{_CSS}</style></head><body>"
+            f"<h1>{html.escape(_TITLE)}</h1><table><thead><tr>{head}</tr></thead>"
+            f"<tbody>{''.join(body)}</tbody></table>{''.join(figs)}"
+            f"<footer><h2>Provenance</h2><ul>{foot}</ul></footer></body></html>\n")
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+_TEX_SPECIAL = {"\\": r"\textbackslash{}", "&": r"\&", "%": r"\%", "$": r"\$", "#": r"\#",
+                "_": r"\_", "{": r"\{", "}": r"\}", "~": r"\textasciitilde{}",
+                "^": r"\textasciicircum{}"}
+
+
+def tex_escape(text: str) -> str:
+    """Escape LaTeX special characters."""
+    return "".join(_TEX_SPECIAL.get(ch, ch) for ch in text)
+
+
+def _write_tex(table: pd.DataFrame, figures: Mapping[str, Path], prov: Provenance,
+               folder: Path) -> Path:
+    path = folder / f"{REPORT_STEM}.tex"
+    numeric = [pd.api.types.is_numeric_dtype(table[c]) for c in table.columns]
+    spec = "".join("r" if n else "l" for n in numeric)
+    lines = [r"\documentclass[a4paper,landscape]{article}",
+             r"\usepackage[margin=1.5cm]{geometry}", r"\usepackage{booktabs}",
+             r"\usepackage{graphicx}", r"\usepackage[utf8]{inputenc}",
+             r"\usepackage[T1]{fontenc}", r"\begin{document}",
+             rf"\section*{{{tex_escape(_TITLE)}}}", r"\begin{table}[ht]\centering",
+             r"\resizebox{\textwidth}{!}{%", rf"\begin{{tabular}}{{{spec}}}", r"\toprule",
+             " & ".join(tex_escape(c) for c in table.columns) + r" \\", r"\midrule"]
+    lines += [" & ".join(tex_escape(v) for v in row) + r" \\" for row in _display_rows(table)]
+    lines += [r"\bottomrule", r"\end{tabular}}", r"\end{table}"]
+    for stem, png in figures.items():
+        lines += [r"\begin{figure}[ht]\centering",
+                  rf"\includegraphics[width=0.8\textwidth]{{figures/{png.name}}}",
+                  rf"\caption{{{tex_escape(stem)}}}", r"\end{figure}"]
+    lines += [r"\section*{Provenance}", r"{\footnotesize\begin{itemize}"]
+    lines += [rf"\item {tex_escape(line)}" for line in prov.lines()]
+    lines += [r"\end{itemize}}", r"\end{document}"]
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    return path
+
+
+def _write_pdf(table: pd.DataFrame, figures: Mapping[str, Path], prov: Provenance,
+               folder: Path, *, figure_objects: Mapping[str, object] | None = None) -> Path:
+    import matplotlib.pyplot as plt
+    from matplotlib.backends.backend_pdf import PdfPages
+
+    path = folder / f"{REPORT_STEM}.pdf"
+    cols = [c for c in PDF_COLUMNS if c in table.columns]
+    rows = _display_rows(table, cols)
+    per_page = 28
+    with PdfPages(path) as pdf:
+        for start in range(0, max(len(rows), 1), per_page):
+            fig, ax = plt.subplots(figsize=(11.69, 8.27))  # A4 landscape, inches
+            ax.axis("off")
+            ax.set_title(_TITLE if start == 0 else f"{_TITLE} (continued)", fontsize=10)
+            chunk = rows[start:start + per_page] or [[""] * len(cols)]
+            labels = ["\n".join(textwrap.wrap(c.split(" [grid/")[0], 14)) for c in cols]
+            tab = ax.table(cellText=chunk, colLabels=labels, loc="upper center",
+                           cellLoc="right")
+            tab.auto_set_font_size(False)
+            tab.set_fontsize(7)
+            tab.scale(1.0, 1.3)
+            for (row, _), cell in tab.get_celld().items():
+                if row == 0:  # room for three lines of header text
+                    cell.set_height(cell.get_height() * 2.6)
+            pdf.savefig(fig)
+            plt.close(fig)
+        for fig in (figure_objects or {}).values():
+            pdf.savefig(fig)
+        fig = plt.figure(figsize=(11.69, 8.27))
+        lines = [part for line in prov.lines()
+                 for part in textwrap.wrap(line, 150, subsequent_indent="    ") or [""]]
+        fig.text(0.03, 0.97, "Provenance\n\n" + "\n".join(lines), va="top",
+                 family="monospace", fontsize=6)
+        pdf.savefig(fig)
+        plt.close(fig)
+    return path
+
+
+#: One writer per format: ``(table, figure PNG paths, provenance, folder) -> path``.
+RENDERERS: dict[str, Callable[..., Path]] = {
+    "csv": _write_csv, "md": _write_md, "html": _write_html, "tex": _write_tex,
+    "pdf": _write_pdf,
+}
+
+
+def save_figure_files(fig: object, folder: Path, stem: str, *,
+                      dpi: int = defaults.REPORT_FIGURE_DPI) -> tuple[Path, Path]:
+    """Save a matplotlib figure as ``<stem>.png`` and ``<stem>.svg`` in ``folder``."""
+    folder.mkdir(parents=True, exist_ok=True)
+    png, svg = folder / f"{stem}.png", folder / f"{stem}.svg"
+    fig.savefig(png, dpi=dpi, bbox_inches="tight")
+    fig.savefig(svg, bbox_inches="tight")
+    return png, svg
+
+
+def check_out_dir(out_dir: Path) -> None:
+    """Refuse an output path that is a file or an unrelated non-empty folder (never replaced)."""
+    if out_dir.exists():
+        if not out_dir.is_dir():
+            raise ParameterError(f"{out_dir}: report output exists and is not a folder")
+        if any(out_dir.iterdir()) and not (out_dir / REPORT_MARKER).exists():
+            raise ParameterError(f"{out_dir}: folder exists, is not empty and holds no earlier "
+                                 "pidcore report; choose a new or empty folder for --out")
+
+
+def _move_into_place(tmp: Path, out_dir: Path) -> None:
+    if not out_dir.exists():
+        os.replace(tmp, out_dir)
+        return
+    old = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.", suffix=".old", dir=out_dir.parent))
+    old.rmdir()
+    os.replace(out_dir, old)
+    try:
+        os.replace(tmp, out_dir)
+    except BaseException:
+        os.replace(old, out_dir)
+        raise
+    shutil.rmtree(old, ignore_errors=True)
+
+
+def write_report(table: pd.DataFrame, figures: Mapping[str, object], provenance: Provenance,
+                 out_dir: str | Path, formats: str | Iterable[str] = defaults.REPORT_FORMATS,
+                 ) -> dict[str, Path]:
+    """Write the report into ``out_dir``, atomically.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        The report table (:func:`pidcore.report.build_report_table`).
+    figures : mapping of str to matplotlib Figure
+        Figures by file stem; each is saved as ``figures/<stem>.png`` and ``.svg`` and shown in
+        every format (HTML embeds the PNG as base64, so the page is self-contained).
+    provenance : Provenance
+        Footer of every format.
+    out_dir : path
+        Output folder. It must be new, empty or an earlier pidcore report (which is replaced).
+    formats : str or iterable of str
+        Any of ``csv, md, html, tex, pdf`` or ``"all"``.
+
+    Returns
+    -------
+    dict of str to Path
+        Format name -> file, and ``"figure:<stem>.png"`` / ``".svg"`` -> figure file.
+
+    Raises
+    ------
+    ParameterError
+        Unknown format, or ``out_dir`` is an unrelated non-empty folder.
+    """
+    formats = parse_formats(formats)
+    out_dir = Path(out_dir)
+    check_out_dir(out_dir)
+    out_dir.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.", suffix=".partial",
+                                dir=out_dir.parent))
+    written: dict[str, Path] = {}
+    try:
+        pngs: dict[str, Path] = {}
+        for stem, fig in figures.items():
+            png, svg = save_figure_files(fig, tmp / "figures", stem)
+            pngs[stem] = png
+            written[f"figure:{png.name}"] = png
+            written[f"figure:{svg.name}"] = svg
+        for name in formats:
+            if name == "pdf":
+                written[name] = RENDERERS[name](table, pngs, provenance, tmp,
+                                                figure_objects=figures)
+            else:
+                written[name] = RENDERERS[name](table, pngs, provenance, tmp)
+        (tmp / REPORT_MARKER).write_text("written by pidcore report\n", encoding="utf-8")
+        os.chmod(tmp, 0o755)  # mkdtemp makes 0700; a report folder is meant to be shared
+        _move_into_place(tmp, out_dir)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    return {k: out_dir / p.relative_to(tmp) for k, p in written.items()}

@@ -1,0 +1,223 @@
+"""The report's main table: our DEM, our measurements and the paper, per load case (Table 3 style).
+
+Rows are the union of our DEM grid cases and the measured cases. A measured case that matches a
+DEM grid case (:mod:`pidcore.compare.align`) shares its row; one that does not gets its own row
+with our DEM value interpolated by the pchip model (or none, out of range). Numbers are copied
+from the inputs unchanged; only several runs or measurements at one case are pooled
+(:func:`pidcore.compare.pooled_mean`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+
+from ..compare.align import Aligner, DemCase, Tolerances, match_paper, pooled_mean
+from ..compare.loadcase import LoadCase, LoadCaseError
+
+#: Column holding the alignment status.
+ALIGNMENT_COLUMN = "alignment [grid/interpolated/out_of_range]"
+#: Columns of :func:`build_report_table`, in order.
+REPORT_COLUMNS: tuple[str, ...] = (
+    "frequency [Hz]", "acceleration [g]", "packing ratio [%]", "material", "direction",
+    "particles per cell [-]", "DEM runs [-]", "SDC DEM (ours) [-]", "SDC DEM stderr [-]",
+    "measured frequency [Hz]", "measured acceleration [g]", "SDC measured [-]",
+    "SDC measured stderr [-]", "SDC DEM (paper) [-]", "SDC measured (paper) [-]",
+    "difference ours - paper DEM [-]", "difference measured - ours [-]", ALIGNMENT_COLUMN,
+    "source file(s)", "load case", "note",
+)
+#: Columns an analyses table needs (as :meth:`pidcore.store.Store.list_analyses` gives, with the
+#: load case fields the report pipeline stores in each record).
+ANALYSIS_COLUMNS: tuple[str, ...] = ("frequency_hz", "acceleration_g", "fill_percent", "sdc",
+                                     "sdc_stderr")
+
+
+@dataclass
+class _Row:
+    case: LoadCase
+    status: str
+    dem: DemCase | None = None
+    sdc_dem: float = math.nan
+    sdc_dem_stderr: float = math.nan
+    paper_dem: float = math.nan
+    paper_exp: float = math.nan
+    measured: list[tuple[float, float, float, float, str]] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+
+
+def _measured_rows(analyses: pd.DataFrame | None, notes: list[str]) -> list[tuple[LoadCase,
+                                                                                  pd.Series]]:
+    if analyses is None or analyses.empty:
+        return []
+    missing = [c for c in ANALYSIS_COLUMNS if c not in analyses.columns]
+    if "fill_percent" in missing:
+        notes.append(f"{len(analyses)} analysed record(s) have no fill stated; not in the table")
+        return []
+    if missing:
+        raise LoadCaseError(f"analyses table: missing columns {missing}; expected "
+                            f"{list(ANALYSIS_COLUMNS)}")
+    out = []
+    for _, row in analyses.iterrows():
+        source = str(row.get("source", "") or row.get("key", ""))
+        fill = float(row["fill_percent"]) if row["fill_percent"] is not None else math.nan
+        if not math.isfinite(fill):
+            notes.append(f"{source}: no fill stated; not in the table")
+            continue
+        material = row.get("material") or "acrylic"
+        direction = row.get("direction") or "z"
+        case = LoadCase(float(row["frequency_hz"]), float(row["acceleration_g"]), fill,
+                        str(material), str(direction))
+        out.append((case, row))
+    return out
+
+
+def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | None,
+                       paper: pd.DataFrame | None, *, model: object | None = None,
+                       tolerances: Tolerances | None = None) -> pd.DataFrame:
+    """Table 3-style comparison of our DEM, our measurements and the paper.
+
+    Parameters
+    ----------
+    dem_runs : pandas.DataFrame or None
+        Our DEM runs, one row each (:meth:`pidcore.store.Store.list_dem_runs`): columns
+        ``frequency_hz``, ``acceleration_g``, ``fill_percent``, ``material``, ``direction``,
+        ``sdc``, ``sdc_stderr``, optionally ``particles_per_cell`` and ``key``.
+    analyses : pandas.DataFrame or None
+        Our measurements, one row each (:meth:`pidcore.store.Store.list_analyses`): columns
+        ``frequency_hz``, ``acceleration_g``, ``fill_percent``, ``sdc``, ``sdc_stderr``,
+        optionally ``material``, ``direction``, ``source``.
+    paper : pandas.DataFrame or None
+        The paper's Table 3 (:func:`pidcore.model.load_paper_table3`).
+    model : SdcModel, optional
+        pchip model for measured cases off our DEM grid; default: built from ``dem_runs`` per
+        material and direction.
+    tolerances : Tolerances, optional
+        Grid-match tolerances (default from :mod:`pidcore.defaults`).
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns :data:`REPORT_COLUMNS`, sorted by frequency, acceleration, fill (as Table 3).
+        ``table.attrs["notes"]`` lists records left out and why.
+
+    Examples
+    --------
+    >>> import pandas as pd
+    >>> dem = pd.DataFrame({"frequency_hz": [500.0], "acceleration_g": [5.0],
+    ...                     "fill_percent": [50.0], "material": ["acrylic"], "direction": ["z"],
+    ...                     "sdc": [0.52], "sdc_stderr": [0.01]})
+    >>> from pidcore.model import load_paper_table3
+    >>> t = build_report_table(dem, None, load_paper_table3())
+    >>> round(float(t.loc[0, "difference ours - paper DEM [-]"]), 6)  # 0.52 - 0.5417
+    -0.0217
+    """
+    tolerances = tolerances or Tolerances()
+    notes: list[str] = []
+    aligner = Aligner.from_tables(dem_runs, paper, model=model, tolerances=tolerances)
+    rows: dict[str, _Row] = {}
+    for dem in aligner.cases:
+        paper_dem, paper_exp, _ = match_paper(dem.load_case, paper, tolerances=tolerances)
+        rows[dem.load_case.key] = _Row(dem.load_case, "grid", dem, dem.sdc, dem.sdc_stderr,
+                                       paper_dem, paper_exp)
+    for case, rec in _measured_rows(analyses, notes):
+        aligned = aligner.align(case)
+        entry = (float(rec["sdc"]), float(rec["sdc_stderr"]), case.frequency_hz,
+                 case.acceleration_g, str(rec.get("source", "")))
+        if aligned.status == "grid" and aligned.grid_case is not None:
+            rows[aligned.grid_case.load_case.key].measured.append(entry)
+            continue
+        row = rows.get(case.key)
+        if row is None:
+            row = rows[case.key] = _Row(case, aligned.status, None, aligned.sdc_dem,
+                                        aligned.sdc_dem_stderr, aligned.sdc_paper_dem,
+                                        aligned.sdc_paper_experimental,
+                                        notes=[aligned.message])
+        row.measured.append(entry)
+
+    records = []
+    for row in rows.values():
+        lc = row.case
+        sdc_m = sdc_m_se = f_m = a_m = math.nan
+        sources = ""
+        if row.measured:
+            values = np.array([m[0] for m in row.measured])
+            errors = np.array([m[1] for m in row.measured])
+            sdc_m, sdc_m_se = pooled_mean(values, errors)
+            f_m = float(np.mean([m[2] for m in row.measured]))
+            a_m = float(np.mean([m[3] for m in row.measured]))
+            sources = "; ".join(m[4] for m in row.measured if m[4])
+        note = list(row.notes)
+        if len(row.measured) > 1:
+            note.append(f"{len(row.measured)} measurements pooled")
+        if row.dem is not None and row.dem.n_runs > 1:
+            note.append(f"{row.dem.n_runs} DEM runs pooled")
+        records.append({
+            "frequency [Hz]": lc.frequency_hz,
+            "acceleration [g]": lc.acceleration_g,
+            "packing ratio [%]": lc.fill_percent,
+            "material": lc.material,
+            "direction": lc.direction,
+            "particles per cell [-]": row.dem.particles_per_cell if row.dem else math.nan,
+            "DEM runs [-]": row.dem.n_runs if row.dem else 0,
+            "SDC DEM (ours) [-]": row.sdc_dem,
+            "SDC DEM stderr [-]": row.sdc_dem_stderr,
+            "measured frequency [Hz]": f_m,
+            "measured acceleration [g]": a_m,
+            "SDC measured [-]": sdc_m,
+            "SDC measured stderr [-]": sdc_m_se,
+            "SDC DEM (paper) [-]": row.paper_dem,
+            "SDC measured (paper) [-]": row.paper_exp,
+            "difference ours - paper DEM [-]": row.sdc_dem - row.paper_dem,
+            "difference measured - ours [-]": sdc_m - row.sdc_dem,
+            ALIGNMENT_COLUMN: row.status,
+            "source file(s)": sources,
+            "load case": lc.key,
+            "note": "; ".join(note),
+        })
+    table = pd.DataFrame.from_records(records, columns=list(REPORT_COLUMNS))
+    table["DEM runs [-]"] = table["DEM runs [-]"].astype(int)
+    table = _sort_like_table3(table, aligner, paper, tolerances)
+    table.attrs["notes"] = notes
+    return table
+
+
+def _snap(values: pd.Series, grid: np.ndarray, *, rtol: float = 0.0,
+          atol: float = 0.0) -> np.ndarray:
+    """Each value replaced by the nearest grid value within the tolerance (else kept)."""
+    out = values.to_numpy(dtype=float).copy()
+    if grid.size == 0:
+        return out
+    for i, v in enumerate(out):
+        nearest = grid[np.argmin(np.abs(grid - v))]
+        if abs(v - nearest) <= rtol * abs(nearest) + atol:
+            out[i] = nearest
+    return out
+
+
+def _sort_like_table3(table: pd.DataFrame, aligner: Aligner, paper: pd.DataFrame | None,
+                      tolerances: Tolerances) -> pd.DataFrame:
+    """Sort by frequency, acceleration, fill as Table 3 does; a measured case sorts by the grid
+    value it is within tolerance of, so 499.97 Hz sorts with the 500 Hz block, not before it."""
+    axes = {"frequency_hz": [], "acceleration_g": [], "fill_percent": []}
+    for case in aligner.cases:
+        for name in axes:
+            axes[name].append(getattr(case.load_case, name))
+    if paper is not None and not paper.empty:
+        for name in axes:
+            axes[name].extend(paper[name].astype(float).tolist())
+    grid = {name: np.unique(np.asarray(v, dtype=float)) for name, v in axes.items()}
+    keys = pd.DataFrame({
+        "f": _snap(table["frequency [Hz]"], grid["frequency_hz"],
+                   rtol=tolerances.frequency_rtol),
+        "a": _snap(table["acceleration [g]"], grid["acceleration_g"],
+                   rtol=tolerances.acceleration_rtol),
+        "p": _snap(table["packing ratio [%]"], grid["fill_percent"],
+                   atol=tolerances.fill_atol_percent),
+        "fx": table["frequency [Hz]"], "ax": table["acceleration [g]"],
+        "px": table["packing ratio [%]"], "m": table["material"], "d": table["direction"],
+    })
+    order = keys.sort_values(list(keys.columns), kind="stable").index
+    return table.loc[order].reset_index(drop=True)

@@ -1,0 +1,155 @@
+"""Alignment of measured cases with our DEM grid, the pchip model and the paper's Table 3."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from pidcore.compare import Aligner, LoadCase, Tolerances, align_measured, dem_cases, pooled_mean
+from pidcore.model import load_paper_table3
+
+
+def linear_sdc(fill, acc, freq):
+    """A field linear in each coordinate: on a 2-point-per-axis grid the tensor-product pchip is
+    trilinear, so it reproduces this field exactly anywhere inside the box (analytic truth)."""
+    return 0.01 + 0.004 * fill + 0.02 * acc + 0.0005 * freq
+
+
+def dem_grid(material="acrylic", direction="z"):
+    rows = []
+    for fill in (25.0, 50.0):
+        for acc in (1.0, 5.0):
+            for freq in (50.0, 100.0):
+                rows.append({"case_key": f"run_{freq:g}_{acc:g}_{fill:g}_{material}",
+                             "frequency_hz": freq, "acceleration_g": acc, "fill_percent": fill,
+                             "material": material, "direction": direction,
+                             "sdc": linear_sdc(fill, acc, freq), "sdc_stderr": 0.001 * acc,
+                             "particles_per_cell": fill * 36 / 100, "seed": 1})
+    return pd.DataFrame(rows)
+
+
+@pytest.fixture(scope="module")
+def aligner():
+    return Aligner.from_tables(dem_grid(), load_paper_table3())
+
+
+def test_grid_match_within_tolerances_copies_the_run_exactly(aligner):
+    runs = dem_grid()
+    case = LoadCase(50.4, 5.2, 50.2)  # 0.8 % in f, 4 % in a, 0.2 points in fill
+    out = aligner.align(case)
+    assert out.status == "grid"
+    stored = runs[(runs.frequency_hz == 50) & (runs.acceleration_g == 5)
+                  & (runs.fill_percent == 50)].iloc[0]
+    assert out.sdc_dem == stored.sdc and out.sdc_dem_stderr == stored.sdc_stderr
+    assert out.grid_case.run_keys == (stored.case_key,)
+    assert out.load_case == case  # the measured values are kept, not snapped to the grid
+
+
+@pytest.mark.parametrize(("case", "status"), [
+    (LoadCase(50.0 * 1.0099, 5.0, 50.0), "grid"),          # inside 1 % in frequency
+    (LoadCase(50.0 * 1.0101, 5.0, 50.0), "interpolated"),  # just outside
+    (LoadCase(50.0, 5.0 * 1.0499, 50.0), "grid"),          # inside 5 % in acceleration
+    (LoadCase(50.0, 5.0 * 0.9490, 50.0), "interpolated"),  # just outside
+    (LoadCase(50.0, 5.0, 50.49), "grid"),                  # inside 0.5 points of fill
+    (LoadCase(50.0, 5.0, 49.4), "interpolated"),           # outside, inside the fill range
+    (LoadCase(50.0, 5.0, 50.6), "out_of_range"),           # outside, above the fill range
+])
+def test_tolerance_edges(aligner, case, status):
+    assert aligner.align(case).status == status
+
+
+def test_off_grid_case_is_interpolated_exactly_for_a_linear_field(aligner):
+    case = LoadCase(73.0, 2.7, 37.5)
+    out = aligner.align(case)
+    assert out.status == "interpolated"
+    # trilinear reproduction of a linear field: equal to round-off (a few ulp of 0.3)
+    assert out.sdc_dem == pytest.approx(linear_sdc(37.5, 2.7, 73.0), rel=1e-12)
+    assert math.isnan(out.sdc_dem_stderr)
+    assert "pchip" in out.message
+
+
+@pytest.mark.parametrize("case", [
+    LoadCase(200.0, 2.0, 30.0),   # frequency above the grid
+    LoadCase(75.0, 10.0, 30.0),   # acceleration above
+    LoadCase(75.0, 2.0, 10.0),    # fill below
+])
+def test_outside_the_model_range_is_refused_not_extrapolated(aligner, case):
+    out = aligner.align(case)
+    assert out.status == "out_of_range"
+    assert math.isnan(out.sdc_dem)
+    assert "not extrapolated" in out.message
+
+
+def test_other_material_or_direction_never_borrows_acrylic_results(aligner):
+    out = aligner.align(LoadCase(50.0, 5.0, 50.0, "aluminium"))
+    assert out.status == "out_of_range" and math.isnan(out.sdc_dem)
+    assert "aluminium" in out.message
+    assert math.isnan(out.sdc_paper_dem)  # Table 3 is for acrylic only
+    assert aligner.align(LoadCase(50.0, 5.0, 50.0, direction="x")).status == "out_of_range"
+
+
+def test_paper_values_attached_only_at_table3_points(aligner):
+    out = aligner.align(LoadCase(100.5, 4.9, 50.0))
+    assert (out.sdc_paper_dem, out.sdc_paper_experimental) == (0.1891, 0.21)  # Table 3
+    off = aligner.align(LoadCase(73.0, 2.7, 37.5))
+    assert math.isnan(off.sdc_paper_dem) and math.isnan(off.sdc_paper_experimental)
+    hole = Aligner([], load_paper_table3()).align(LoadCase(1000.0, 1.0, 90.0))
+    assert math.isnan(hole.sdc_paper_dem)  # the printed table has no value there
+
+
+def test_no_dem_runs_gives_out_of_range_with_a_reason():
+    out = Aligner.from_tables(None).align(LoadCase(50.0, 5.0, 50.0))
+    assert out.status == "out_of_range" and "no DEM runs" in out.message
+
+
+def test_grid_that_cannot_be_modelled_says_why():
+    one_fill = dem_grid()
+    one_fill = one_fill[one_fill.fill_percent == 50]
+    out = Aligner.from_tables(one_fill).align(LoadCase(75.0, 3.0, 50.0))
+    assert out.status == "out_of_range" and "fill_percent" in out.message
+
+
+def test_pooled_mean_of_repeated_runs():
+    # one run: returned unchanged, bit for bit
+    assert pooled_mean(np.array([0.1 + 0.2]), np.array([0.3])) == (0.1 + 0.2, 0.3)
+    # two seeds 0.2 and 0.3 with tiny within-run errors: between-seed scatter dominates,
+    # std(ddof=1) = 0.0707..., / sqrt(2) = 0.05
+    mean, se = pooled_mean(np.array([0.2, 0.3]), np.array([0.001, 0.001]))
+    assert mean == pytest.approx(0.25) and se == pytest.approx(0.05)
+    # equal values with real within-run errors: propagated sqrt(2 * 0.02^2) / 2
+    mean, se = pooled_mean(np.array([0.2, 0.2]), np.array([0.02, 0.02]))
+    assert se == pytest.approx(math.sqrt(2) * 0.02 / 2)
+
+
+def test_runs_of_one_case_pool_into_one_dem_case():
+    runs = dem_grid()
+    extra = runs.iloc[[0]].assign(case_key="seed2", sdc=runs.iloc[0].sdc + 0.02,
+                                  frequency_hz=50.2)
+    cases = dem_cases(pd.concat([runs, extra], ignore_index=True))
+    assert len(cases) == 8
+    pooled = [c for c in cases if c.n_runs == 2]
+    assert len(pooled) == 1 and set(pooled[0].run_keys) == {runs.iloc[0].case_key, "seed2"}
+    assert pooled[0].sdc == pytest.approx(runs.iloc[0].sdc + 0.01)
+
+
+def test_align_measured_returns_unit_suffixed_rows():
+    measured = pd.DataFrame({
+        "frequency_hz": [50.2, 73.0, 300.0], "acceleration_g": [5.1, 2.7, 3.0],
+        "fill_percent": [25.0, 37.5, 30.0], "material": ["acrylic"] * 3, "direction": ["z"] * 3,
+        "sdc": [0.3, 0.4, 0.5], "sdc_stderr": [0.01, 0.02, 0.03],
+        "source": ["a.uff", "b.uff", "c.uff"]})
+    out = align_measured(measured, dem_grid(), load_paper_table3())
+    assert list(out["alignment"]) == ["grid", "interpolated", "out_of_range"]
+    assert list(out["SDC measured [-]"]) == [0.3, 0.4, 0.5]
+    assert out.loc[0, "SDC DEM (paper) [-]"] == 0.2210  # Table 3: 50 Hz, 5 g, 25 %
+    for column in ("frequency [Hz]", "acceleration [g]", "packing ratio [%]",
+                   "SDC DEM (ours) [-]", "SDC measured stderr [-]"):
+        assert column in out.columns
+
+
+def test_tolerances_are_validated():
+    with pytest.raises(ValueError, match="frequency_rtol"):
+        Tolerances(frequency_rtol=-0.1)

@@ -1,0 +1,121 @@
+"""Load cases: from file names, sidecar tables and options; the missing-fill error."""
+
+from __future__ import annotations
+
+import pytest
+
+from pidcore.compare import (
+    LoadCase,
+    LoadCaseError,
+    parse_file_name,
+    read_sidecar,
+    resolve_load_case,
+)
+from pidcore.errors import PidcoreError
+
+
+@pytest.mark.parametrize(("name", "expected"), [
+    ("coupon3_fill50_acrylic_dirz_500Hz_5g.uff", {"fill_percent": 50.0, "material": "acrylic",
+                                                   "direction": "z"}),
+    ("run-fill-62.5-ALUMINUM-xdir.csv", {"fill_percent": 62.5, "material": "aluminium",
+                                          "direction": "x"}),
+    ("shaker_75pct_100Hz.mat", {"fill_percent": 75.0}),
+    ("shaker 90percent pmma.txt", {"fill_percent": 90.0, "material": "acrylic"}),
+    ("fill25.uff", {"fill_percent": 25.0}),
+    # tokens must stand alone: "refill50" and "50pcts" are not fill statements
+    ("refill50_50pcts.uff", {}),
+    ("acrylics_dirzz.uff", {}),
+])
+def test_file_name_patterns(name, expected):
+    assert parse_file_name(name) == expected
+
+
+def test_file_name_with_two_different_fills_is_refused():
+    with pytest.raises(LoadCaseError, match="several fills"):
+        parse_file_name("x_fill50_75pct.uff")
+
+
+def test_file_name_fill_out_of_range_is_refused():
+    with pytest.raises(LoadCaseError, match=r"\(0, 100\]"):
+        parse_file_name("x_fill150.uff")
+
+
+def test_key_is_stable_against_float_noise_and_distinguishes_cases():
+    a = LoadCase(500.0, 5.0, 50.0)
+    b = LoadCase(500.0 * (1 + 1e-12), 5.0, 50.0)
+    assert a.key == b.key == "f500Hz_a5g_fill50pct_acrylic_z"
+    assert LoadCase(500.0, 5.0, 50.0, "aluminium").key != a.key
+    assert LoadCase(500.0, 5.0, 50.0, direction="x").key != a.key
+    assert LoadCase(500.0, 5.0, 50.0, "Aluminum", "X").material == "aluminium"
+
+
+@pytest.mark.parametrize("kwargs", [
+    {"frequency_hz": 0.0}, {"acceleration_g": -1.0}, {"fill_percent": 0.0},
+    {"material": "steel"}, {"direction": "w"},
+])
+def test_invalid_load_case_is_refused(kwargs):
+    values = {"frequency_hz": 50.0, "acceleration_g": 1.0, "fill_percent": 50.0, **kwargs}
+    with pytest.raises(LoadCaseError):
+        LoadCase(**values)
+
+
+def _write_sidecar(folder, text):
+    path = folder / "loadcases.csv"
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def test_sidecar_beside_file_is_found_and_overrides_file_name(tmp_path):
+    _write_sidecar(tmp_path, "file,fill_percent,material,direction\n"
+                             "a_fill25.uff,75,aluminium,\n"
+                             "other.uff,90,,\n")
+    stated = resolve_load_case(tmp_path / "a_fill25.uff")
+    assert (stated.fill_percent, stated.material, stated.direction) == (75.0, "aluminium", "z")
+    assert "fill: loadcases.csv" in stated.origin and "direction: default" in stated.origin
+
+
+def test_sidecar_without_the_file_leaves_file_name(tmp_path):
+    _write_sidecar(tmp_path, "file,fill_percent\nother.uff,90\n")
+    assert resolve_load_case(tmp_path / "a_fill25.uff").fill_percent == 25.0
+
+
+def test_explicit_sidecar_and_options_override(tmp_path):
+    side = tmp_path / "cases" / "my.csv"
+    side.parent.mkdir()
+    side.write_text("file,fill_percent,direction\nrun1.uff,50,x\n", encoding="utf-8")
+    stated = resolve_load_case(tmp_path / "run1.uff", sidecar=side)
+    assert (stated.fill_percent, stated.direction) == (50.0, "x")
+    stated = resolve_load_case(tmp_path / "run1.uff", sidecar=side, fill_percent=90,
+                               material="aluminium", direction="y")
+    assert (stated.fill_percent, stated.material, stated.direction) == (90.0, "aluminium", "y")
+    assert stated.origin == "fill: option; material: option; direction: option"
+
+
+def test_sidecar_errors_name_the_file(tmp_path):
+    bad = _write_sidecar(tmp_path, "name,fill\nx.uff,50\n")
+    with pytest.raises(LoadCaseError, match=r"loadcases\.csv.*'file'"):
+        read_sidecar(bad)
+    dup = _write_sidecar(tmp_path, "file,fill_percent\nx.uff,50\nx.uff,75\n")
+    with pytest.raises(LoadCaseError, match="more than once"):
+        read_sidecar(dup)
+    _write_sidecar(tmp_path, "file,fill_percent\nx.uff,half\n")
+    with pytest.raises(LoadCaseError, match="not a number"):
+        resolve_load_case(tmp_path / "x.uff")
+    with pytest.raises(LoadCaseError, match="not found"):
+        resolve_load_case(tmp_path / "x.uff", sidecar=tmp_path / "missing.csv")
+
+
+def test_missing_fill_names_file_and_the_three_ways(tmp_path):
+    with pytest.raises(LoadCaseError) as info:
+        resolve_load_case(tmp_path / "run_500Hz_acrylic.uff")
+    message = str(info.value)
+    assert isinstance(info.value, PidcoreError) and "\n" not in message
+    assert message.startswith("run_500Hz_acrylic.uff:")
+    for way in ("_fill50_", "_50pct_", "loadcases.csv", "--fill"):
+        assert way in message
+
+
+def test_stated_load_case_takes_measured_frequency_and_acceleration():
+    stated = resolve_load_case("x_fill50.uff", sidecar=None)
+    case = stated.load_case(499.7, 5.1)
+    assert case == LoadCase(499.7, 5.1, 50.0, "acrylic", "z")

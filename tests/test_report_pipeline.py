@@ -1,0 +1,185 @@
+"""``pidcore report`` end to end: analyse, store, align, render; refusals leave nothing behind."""
+
+from __future__ import annotations
+
+import h5py
+import numpy as np
+import pandas as pd
+import pytest
+
+from pidcore.cli import main
+from pidcore.compare import LoadCaseError
+from pidcore.constants import STANDARD_GRAVITY
+from pidcore.errors import StoreError
+from pidcore.io import write_measurement
+from pidcore.records import Channel, Measurement
+from pidcore.report import make_report, sha256_file
+from pidcore.signal import synthesize_shaker_record
+from pidcore.store import Store
+
+FREQ_HZ = 500.0
+ACC_G = 5.0
+RATE_HZ = 20000.0
+
+
+def _record(seed: int, damping: float):
+    # rigid 0.2 kg mass with viscous damping: a clean record the analysis handles exactly
+    return synthesize_shaker_record(mass_kg=0.2, acceleration_amplitude_m_s2=ACC_G
+                                    * STANDARD_GRAVITY, frequency_hz=FREQ_HZ,
+                                    sample_rate_hz=RATE_HZ, n_periods=40,
+                                    viscous_damping_n_s_m=damping, seed=seed)
+
+
+def _write_measurement(path, seed=0, damping=3.0):
+    rec = _record(seed, damping)
+    m = Measurement(source=str(path), channels=(
+        Channel("Force", "force", rec.force_n, rec.sample_rate_hz, "N"),
+        Channel("Velocity", "velocity", rec.velocity_m_s, rec.sample_rate_hz, "m/s")))
+    write_measurement(m, path)
+    return path
+
+
+def _dem_store(path):
+    """A DEM store with grid runs around the measurement, one with a virtual shaker record."""
+    rec = _record(1, 2.0)
+    items = []
+    for fill in (25.0, 50.0):
+        for acc in (1.0, 5.0):
+            for freq in (100.0, 500.0):
+                arrays = None
+                record = {"frequency_hz": freq, "acceleration_g": acc, "fill_percent": fill,
+                          "material": "acrylic", "direction": "z",
+                          "sdc": 0.1 + fill / 500 + acc / 50 + freq / 5000,
+                          "sdc_stderr": 0.01, "particles_per_cell": int(fill * 36 / 100),
+                          "seed": 11, "cells_simulated": 8}
+                if (freq, acc, fill) == (FREQ_HZ, ACC_G, 50.0):
+                    arrays = {"shaker_force_n": rec.force_n, "velocity_m_s": rec.velocity_m_s,
+                              "sample_time_s": np.arange(rec.force_n.size) / RATE_HZ}
+                    record.update(sample_rate_hz=RATE_HZ, steady_start_cycle=2)
+                items.append({"case_key": f"f{freq:g}_a{acc:g}_fill{fill:g}_seed11",
+                              "record": record, "arrays": arrays})
+    Store(path).add_dem_runs(items)
+    return path
+
+
+@pytest.fixture(scope="module")
+def dem_store(tmp_path_factory):
+    return _dem_store(tmp_path_factory.mktemp("dem") / "dem.h5")
+
+
+@pytest.fixture(scope="module")
+def e2e(tmp_path_factory, dem_store):
+    folder = tmp_path_factory.mktemp("e2e")
+    file = _write_measurement(folder / "coupon1_fill50_acrylic.csv")
+    dem_sha = sha256_file(dem_store)
+    store = folder / "store.h5"
+    result = make_report([file], out_dir=folder / "report", store=store, dem_store=dem_store,
+                         formats="all")
+    return file, store, dem_sha, result
+
+
+def test_report_end_to_end(e2e, dem_store):
+    file, store, dem_sha, result = e2e
+    # the dem store is only read
+    assert sha256_file(dem_store) == dem_sha
+    # the analysis is in the store with its load case, and the table shows the stored numbers
+    analyses = Store(store).list_analyses()
+    assert len(analyses) == 1
+    stored = analyses.iloc[0]
+    assert (stored["fill_percent"], stored["material"], stored["direction"]) == \
+        (50.0, "acrylic", "z")
+    row = result.table[result.table["source file(s)"] != ""].iloc[0]
+    assert row["SDC measured [-]"] == stored["sdc"] == result.measured[0].analysis.sdc
+    assert row["SDC measured stderr [-]"] == stored["sdc_stderr"]
+    assert row["alignment [grid/interpolated/out_of_range]"] == "grid"
+    dem_rec = Store(dem_store).get_dem_run("f500_a5_fill50_seed11").record
+    assert row["SDC DEM (ours) [-]"] == dem_rec["sdc"]
+    assert row["SDC DEM (paper) [-]"] == 0.5417  # Table 3, 500 Hz, 5 g, 50 %
+    # every format, the comparison figure, the model families and the loop with DEM overlay
+    for name in ("csv", "md", "html", "tex", "pdf", "figure:sdc_per_load_case.png",
+                 "figure:sdc_vs_acceleration_acrylic_z.svg"):
+        assert result.paths[name].is_file(), name
+    loops = [k for k in result.paths if k.startswith("figure:loop_") and k.endswith(".png")]
+    assert len(loops) == 1
+    assert not any("without DEM overlay" in n for n in result.notes)
+    # provenance names the input's hash and the store's hash after the analysis was added
+    text = result.paths["md"].read_text(encoding="utf-8")
+    assert sha256_file(file) in text and sha256_file(store) in text and dem_sha in text
+
+
+def test_report_from_store_only_uses_stored_analyses(e2e, dem_store, tmp_path):
+    _, store, _, first = e2e
+    again = make_report([], out_dir=tmp_path / "r2", store=store, dem_store=dem_store,
+                        formats="csv")
+    pd.testing.assert_frame_equal(again.table, first.table)
+    # the measured loop is rebuilt from the stored phasors, with the DEM overlay
+    assert [k for k in again.paths if k.startswith("figure:loop_")] == \
+        [k for k in first.paths if k.startswith("figure:loop_")]
+    assert not any("without DEM overlay" in n for n in again.notes)
+
+
+def test_cli_with_dem_store_only_stores_nothing(tmp_path, dem_store, capsys):
+    file = _write_measurement(tmp_path / "coupon2_75pct.csv", seed=3)
+    code = main(["report", str(file), "--dem-store", str(dem_store), "--out",
+                 str(tmp_path / "out"), "--format", "md,html"])
+    out = capsys.readouterr().out
+    assert code == 0
+    assert "wrote md:" in out and "wrote html:" in out and "out_of_range" in out
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["coupon2_75pct.csv", "out"]
+    # 75 % is above our DEM fills (25, 50): never extrapolated
+    html = (tmp_path / "out" / "report.html").read_text(encoding="utf-8")
+    assert "not extrapolated" in html
+
+
+def _corrupt_garbage(path):
+    path.write_bytes(b"\x89HDF\r\n\x1a\n" + b"garbage" * 100)
+
+
+def _corrupt_partial(path):
+    with h5py.File(path, "w") as h5:  # root attributes but none of the groups
+        h5.attrs["pidcore_store_version"] = 1
+
+
+@pytest.mark.parametrize("corrupt", [_corrupt_garbage, _corrupt_partial])
+def test_corrupt_store_gives_one_line_error_and_no_report(tmp_path, corrupt, capsys):
+    store = tmp_path / "store.h5"
+    corrupt(store)
+    file = _write_measurement(tmp_path / "x_fill50.csv")
+    out = tmp_path / "out"
+    with pytest.raises(StoreError, match="store.h5"):
+        make_report([file], out_dir=out, store=store)
+    code = main(["report", str(file), "--store", str(store), "--out", str(out)])
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("\n") == 1 and "store.h5" in err
+    assert not out.exists()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["store.h5", "x_fill50.csv"]
+
+
+def test_missing_fill_stops_before_anything_is_stored(tmp_path, capsys):
+    file = _write_measurement(tmp_path / "no_fill_here.csv")
+    store = tmp_path / "store.h5"
+    with pytest.raises(LoadCaseError, match="no_fill_here.csv"):
+        make_report([file], out_dir=tmp_path / "out", store=store)
+    assert not store.exists() and not (tmp_path / "out").exists()
+    # the option states it
+    code = main(["report", str(file), "--store", str(store), "--out", str(tmp_path / "out"),
+                 "--fill", "50", "--format", "csv"])
+    out = capsys.readouterr().out
+    assert code == 0 and "wrote csv" in out and "SDC measured" in out
+    assert Store(store).list_analyses().iloc[0]["fill_percent"] == 50.0
+
+
+def test_identical_files_with_different_load_cases_are_refused(tmp_path):
+    a = _write_measurement(tmp_path / "a_fill50.csv")
+    b = tmp_path / "b_fill75.csv"
+    b.write_bytes(a.read_bytes())
+    with pytest.raises(LoadCaseError, match="identical contents"):
+        make_report([a, b], out_dir=tmp_path / "out", store=tmp_path / "s.h5")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a_fill50.csv", "b_fill75.csv"]
+
+
+def test_missing_dem_store_is_an_error(tmp_path):
+    file = _write_measurement(tmp_path / "x_fill50.csv")
+    with pytest.raises(StoreError, match="not found"):
+        make_report([file], out_dir=tmp_path / "out", dem_store=tmp_path / "nope.h5")
+    assert not (tmp_path / "out").exists()

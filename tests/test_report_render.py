@@ -1,0 +1,180 @@
+"""Report files: CSV round trip, Markdown, self-contained HTML, booktabs LaTeX, PDF, atomicity."""
+
+from __future__ import annotations
+
+import base64
+import re
+from datetime import UTC, datetime
+
+import numpy as np
+import pandas as pd
+import pytest
+from matplotlib.figure import Figure
+
+from pidcore.errors import ParameterError
+from pidcore.model import load_paper_table3
+from pidcore.report import (
+    RENDERERS,
+    REPORT_MARKER,
+    build_report_table,
+    collect_provenance,
+    parse_formats,
+    sha256_file,
+    write_report,
+)
+
+INPUT_SHA = "ab" * 32
+
+
+@pytest.fixture(scope="module")
+def table():
+    dem = pd.DataFrame({"frequency_hz": [50.0, 500.0, 500.0], "acceleration_g": [5.0, 5.0, 5.0],
+                        "fill_percent": [50.0, 50.0, 25.0], "material": ["acrylic"] * 3,
+                        "direction": ["z"] * 3, "sdc": [0.19, 0.55, 1.5702e-4],
+                        "sdc_stderr": [0.004, 0.01, 2e-6], "case_key": ["a", "b", "c"]})
+    analyses = pd.DataFrame({"frequency_hz": [500.2], "acceleration_g": [4.95],
+                             "fill_percent": [50.0], "sdc": [0.62], "sdc_stderr": [0.03],
+                             "source": ["run_50%_a&b_#1.uff"]})  # LaTeX/Markdown specials
+    return build_report_table(dem, analyses, load_paper_table3())
+
+
+@pytest.fixture(scope="module")
+def provenance(tmp_path_factory):
+    store = tmp_path_factory.mktemp("prov") / "store.h5"
+    store.write_bytes(b"not really a store, just bytes to hash")
+    return collect_provenance(parameters={"velocity_delay_s": 0.0}, seeds=[3, 1, 3],
+                              inputs=["in/run.uff"], input_hashes={"in/run.uff": INPUT_SHA},
+                              stores=[store], notes=["a note"],
+                              created_utc=datetime(2026, 1, 2, 3, 4, 5, tzinfo=UTC))
+
+
+def _figures():
+    fig = Figure(figsize=(3, 2))
+    ax = fig.subplots()
+    ax.plot(np.arange(5), np.arange(5) ** 2)
+    return {"parabola": fig}
+
+
+@pytest.fixture(scope="module")
+def report(tmp_path_factory, table, provenance):
+    out = tmp_path_factory.mktemp("rep") / "report"
+    return out, write_report(table, _figures(), provenance, out, "all")
+
+
+def test_every_format_and_figure_is_written(report):
+    out, paths = report
+    for name in ("csv", "md", "html", "tex", "pdf", "figure:parabola.png", "figure:parabola.svg"):
+        assert paths[name].is_file() and paths[name].parent.is_relative_to(out)
+    assert paths["figure:parabola.png"].read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert b"<svg" in paths["figure:parabola.svg"].read_bytes()[:1000]
+    assert (out / REPORT_MARKER).is_file()
+
+
+def test_csv_reads_back_equal_to_the_table(report, table):
+    back = pd.read_csv(report[1]["csv"], comment="#")
+    text_cols = [c for c in table.columns if not pd.api.types.is_numeric_dtype(table[c])]
+    for c in text_cols:  # an all-empty text column reads back as NaN floats
+        back[c] = back[c].astype(object).where(back[c].notna(), "")
+    # exact: floats are written as repr and parsed back bit for bit
+    pd.testing.assert_frame_equal(back, table, check_dtype=False, check_exact=True)
+
+
+def test_provenance_footer_in_every_text_format(report, provenance):
+    store_sha = provenance.stores[0][1]
+    for name in ("csv", "md", "html", "tex"):
+        text = report[1][name].read_text(encoding="utf-8")
+        assert INPUT_SHA in text and store_sha in text, name
+        assert "2026-01-02T03:04:05+00:00" in text and "seeds: 1, 3" in text
+        assert f"numpy {np.__version__}" in text
+
+
+def test_store_hash_is_the_files_sha256(provenance, tmp_path):
+    import hashlib
+
+    path = tmp_path / "x.bin"
+    path.write_bytes(b"abc" * 1000)
+    assert sha256_file(path, chunk_bytes=7) == hashlib.sha256(b"abc" * 1000).hexdigest()
+
+
+def test_markdown_table_shape(report, table):
+    lines = report[1]["md"].read_text(encoding="utf-8").splitlines()
+    rows = [ln for ln in lines if ln.startswith("|")]
+    assert len(rows) == len(table) + 2  # header, separator, rows
+    # an escaped pipe does not split a cell: every row has as many cells as the header
+    cells = [len(re.split(r"(?<!\\)\|", r)) for r in rows]
+    assert len(set(cells)) == 1 and cells[0] == len(table.columns) + 2
+    assert "![parabola](figures/parabola.png)" in lines
+
+
+def test_html_is_self_contained(report):
+    text = report[1]["html"].read_text(encoding="utf-8")
+    assert not re.search(r"""(src|href)\s*=\s*["']?\s*(https?:|//)""", text, re.I)
+    assert "<script" not in text.lower() and "<link" not in text.lower()
+    match = re.search(r'<img [^>]*src="data:image/png;base64,([A-Za-z0-9+/=]+)"', text)
+    assert match and base64.b64decode(match.group(1))[:4] == b"\x89PNG"
+    assert "run_50%_a&amp;b_#1.uff" in text  # escaped, not raw HTML
+
+
+def test_latex_uses_booktabs_and_escapes(report, table):
+    text = report[1]["tex"].read_text(encoding="utf-8")
+    assert r"\usepackage{booktabs}" in text
+    top, mid, bottom = text.index(r"\toprule"), text.index(r"\midrule"), \
+        text.index(r"\bottomrule")
+    assert top < mid < bottom
+    body = text[mid:bottom].splitlines()[1:]
+    assert len([ln for ln in body if ln.endswith(r"\\")]) == len(table)
+    assert r"run\_50\%\_a\&b\_\#1.uff" in text
+    assert text.count(r"\begin{") == text.count(r"\end{")
+
+
+def test_pdf_has_table_figure_and_provenance_pages(report):
+    data = report[1]["pdf"].read_bytes()
+    assert data.startswith(b"%PDF")
+    pages = len(re.findall(rb"/Type\s*/Page\b(?!s)", data))
+    assert pages >= 3  # table, the one figure, provenance
+
+
+def test_failure_in_one_renderer_leaves_the_earlier_report_unchanged(
+        tmp_path, table, provenance, monkeypatch):
+    out = tmp_path / "out"
+    write_report(table, _figures(), provenance, out, ("csv", "md"))
+    before = {p.relative_to(out): p.read_bytes() for p in out.rglob("*") if p.is_file()}
+
+    def broken(*args, **kwargs):
+        raise RuntimeError("renderer failed")
+
+    monkeypatch.setitem(RENDERERS, "html", broken)
+    with pytest.raises(RuntimeError, match="renderer failed"):
+        write_report(table.iloc[:1], _figures(), provenance, out, "all")
+    after = {p.relative_to(out): p.read_bytes() for p in out.rglob("*") if p.is_file()}
+    assert after == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]  # no temporary left
+
+
+def test_failure_on_a_new_folder_creates_nothing(tmp_path, table, provenance, monkeypatch):
+    monkeypatch.setitem(RENDERERS, "pdf", lambda *a, **k: 1 / 0)
+    with pytest.raises(ZeroDivisionError):
+        write_report(table, {}, provenance, tmp_path / "new", "all")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_success_replaces_an_earlier_report(tmp_path, table, provenance):
+    out = tmp_path / "out"
+    write_report(table, _figures(), provenance, out, "all")
+    paths = write_report(table, {}, provenance, out, "csv")
+    assert sorted(p.name for p in out.iterdir()) == sorted([REPORT_MARKER, "report.csv"])
+    assert paths == {"csv": out / "report.csv"}
+
+
+def test_unrelated_folder_is_never_replaced(tmp_path, table, provenance):
+    (tmp_path / "mine.txt").write_text("precious")
+    with pytest.raises(ParameterError, match="choose a new or empty folder"):
+        write_report(table, {}, provenance, tmp_path, "csv")
+    assert [p.name for p in tmp_path.iterdir()] == ["mine.txt"]
+
+
+def test_parse_formats():
+    assert parse_formats("all") == ("csv", "md", "html", "tex", "pdf")
+    assert parse_formats("pdf,csv,pdf") == ("pdf", "csv")
+    with pytest.raises(ParameterError, match="docx"):
+        parse_formats("docx")

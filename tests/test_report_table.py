@@ -1,0 +1,186 @@
+"""The Table 3-style report table: rows, order, and numbers equal to the store's."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from pidcore.model import load_paper_table3
+from pidcore.records import Channel, Measurement
+from pidcore.report import ALIGNMENT_COLUMN, REPORT_COLUMNS, build_report_table
+from pidcore.store import Store
+
+FILLS = (25.0, 50.0)
+ACCS = (1.0, 5.0)
+FREQS = (50.0, 100.0)
+
+
+def _sdc(fill, acc, freq):
+    # irrational-looking values so that any rounding on the way would show
+    return math.sqrt(fill) / 17.0 + acc / 31.0 + freq / 7001.0
+
+
+def _dem_items():
+    items = []
+    for freq in FREQS:
+        for acc in ACCS:
+            for fill in FILLS:
+                items.append({
+                    "case_key": f"f{freq:g}_a{acc:g}_fill{fill:g}_acrylic_z_seed7",
+                    "record": {"frequency_hz": freq, "acceleration_g": acc, "fill_percent": fill,
+                               "material": "acrylic", "direction": "z",
+                               "sdc": _sdc(fill, acc, freq),
+                               "sdc_stderr": _sdc(fill, acc, freq) / 97.0,
+                               "particles_per_cell": int(round(fill * 36 / 100)), "seed": 7,
+                               "cells_simulated": 8},
+                    "units": {"frequency_hz": "Hz", "acceleration_g": "g", "sdc": "1"},
+                })
+    return items
+
+
+def _measurement(name: str, seed: int) -> Measurement:
+    rng = np.random.default_rng(seed)
+    channels = (Channel("force", "force", rng.standard_normal(64), 1000.0, "N"),
+                Channel("velocity", "velocity", rng.standard_normal(64), 1000.0, "m/s"))
+    return Measurement(source=name, channels=channels, file_format="csv")
+
+
+MEASURED = [  # (file, frequency, acceleration, fill, sdc, stderr)
+    ("on_grid_fill50.csv", 100.3, 4.93, 50.0, 0.3141592653589793, 0.0123456789),
+    ("off_grid_fill40.csv", 70.0, 3.0, 40.0, 0.2718281828459045, 0.0234567891),
+    ("outside_fill50.csv", 300.0, 3.0, 50.0, 0.1414213562373095, 0.0345678912),
+]
+
+
+@pytest.fixture(scope="module")
+def store(tmp_path_factory):
+    path = tmp_path_factory.mktemp("store") / "pid_store.h5"
+    s = Store(path)
+    s.add_dem_runs(_dem_items())
+    for i, (name, freq, acc, fill, sdc, se) in enumerate(MEASURED):
+        key, _ = s.add_measurement(_measurement(name, i))
+        s.add_analysis(key, {"frequency_hz": freq, "acceleration_g": acc, "fill_percent": fill,
+                             "material": "acrylic", "direction": "z", "sdc": sdc,
+                             "sdc_stderr": se})
+    return s
+
+
+@pytest.fixture(scope="module")
+def table(store):
+    return build_report_table(store.list_dem_runs(), store.list_analyses(), load_paper_table3())
+
+
+def test_columns_and_rows(table):
+    assert tuple(table.columns) == REPORT_COLUMNS
+    # 8 DEM grid cases + the two measured cases off the grid; the on-grid one shares a row
+    assert len(table) == 10
+    assert set(table[ALIGNMENT_COLUMN]) == {"grid", "interpolated", "out_of_range"}
+
+
+def test_sorted_like_table3(table):
+    keys = list(zip(table["frequency [Hz]"], table["acceleration [g]"],
+                    table["packing ratio [%]"], strict=True))
+    assert keys == sorted(keys)
+
+
+def test_dem_numbers_equal_the_stores_exactly(store, table):
+    runs = store.list_dem_runs()
+    assert len(runs) == 8
+    for case_key in runs["case_key"]:
+        rec = store.get_dem_run(case_key).record
+        row = table[(table["frequency [Hz]"] == rec["frequency_hz"])
+                    & (table["acceleration [g]"] == rec["acceleration_g"])
+                    & (table["packing ratio [%]"] == rec["fill_percent"])]
+        assert len(row) == 1
+        row = row.iloc[0]
+        assert row["SDC DEM (ours) [-]"] == rec["sdc"]  # exact, not approx
+        assert row["SDC DEM stderr [-]"] == rec["sdc_stderr"]
+        assert row["particles per cell [-]"] == rec["particles_per_cell"]
+        assert row["DEM runs [-]"] == 1
+
+
+def test_measured_numbers_equal_the_stores_exactly(store, table):
+    analyses = store.list_analyses()
+    for name, freq, _acc, _fill, sdc, se in MEASURED:
+        stored = analyses[analyses["source"] == name].iloc[0]
+        row = table[table["source file(s)"] == name].iloc[0]
+        assert row["SDC measured [-]"] == stored["sdc"] == sdc
+        assert row["SDC measured stderr [-]"] == stored["sdc_stderr"] == se
+        assert row["measured frequency [Hz]"] == freq
+
+
+def test_on_grid_measurement_shares_the_dem_row_and_paper_values(table):
+    row = table[table["source file(s)"] == "on_grid_fill50.csv"].iloc[0]
+    assert (row["frequency [Hz]"], row["acceleration [g]"], row["packing ratio [%]"]) == \
+        (100.0, 5.0, 50.0)
+    assert row[ALIGNMENT_COLUMN] == "grid"
+    assert row["SDC DEM (paper) [-]"] == 0.1891 and row["SDC measured (paper) [-]"] == 0.21
+    assert row["difference ours - paper DEM [-]"] == row["SDC DEM (ours) [-]"] - 0.1891
+    assert row["difference measured - ours [-]"] == \
+        row["SDC measured [-]"] - row["SDC DEM (ours) [-]"]
+
+
+def test_off_grid_measurement_is_interpolated_within_its_neighbours(table):
+    row = table[table["source file(s)"] == "off_grid_fill40.csv"].iloc[0]
+    assert row[ALIGNMENT_COLUMN] == "interpolated"
+    assert (row["frequency [Hz]"], row["packing ratio [%]"]) == (70.0, 40.0)
+    # pchip does not overshoot: the value lies within the 8 surrounding grid values
+    corners = [_sdc(f, a, z) for f in FILLS for a in ACCS for z in FREQS]
+    assert min(corners) <= row["SDC DEM (ours) [-]"] <= max(corners)
+    assert math.isnan(row["SDC DEM (paper) [-]"])  # 70 Hz is no Table 3 point
+    assert math.isnan(row["particles per cell [-]"]) and row["DEM runs [-]"] == 0
+
+
+def test_out_of_range_measurement_has_no_dem_value(table):
+    row = table[table["source file(s)"] == "outside_fill50.csv"].iloc[0]
+    assert row[ALIGNMENT_COLUMN] == "out_of_range"
+    assert math.isnan(row["SDC DEM (ours) [-]"])
+    assert math.isnan(row["difference measured - ours [-]"])
+    assert "not extrapolated" in row["note"]
+
+
+def test_repeated_measurements_at_one_case_are_pooled():
+    dem = pd.DataFrame([{**i["record"], "case_key": i["case_key"]} for i in _dem_items()])
+    analyses = pd.DataFrame({"frequency_hz": [50.1, 49.9], "acceleration_g": [1.0, 1.02],
+                             "fill_percent": [25.0, 25.0], "sdc": [0.2, 0.3],
+                             "sdc_stderr": [0.001, 0.001], "source": ["a.csv", "b.csv"]})
+    t = build_report_table(dem, analyses, None)
+    row = t[t["source file(s)"] == "a.csv; b.csv"].iloc[0]
+    assert row["SDC measured [-]"] == pytest.approx(0.25)
+    assert row["SDC measured stderr [-]"] == pytest.approx(0.05)  # std(ddof=1)/sqrt(2)
+    assert row["measured frequency [Hz]"] == pytest.approx(50.0)
+
+
+def test_analyses_without_fill_are_left_out_with_a_note():
+    analyses = pd.DataFrame({"frequency_hz": [50.0], "acceleration_g": [1.0], "sdc": [0.2],
+                             "sdc_stderr": [0.01], "source": ["x.csv"]})
+    t = build_report_table(None, analyses, load_paper_table3())
+    assert t.empty and "no fill" in t.attrs["notes"][0]
+    analyses["fill_percent"] = [float("nan")]
+    t = build_report_table(None, analyses, load_paper_table3())
+    assert t.empty and "x.csv" in t.attrs["notes"][0]
+
+
+def test_measured_only_table_shows_paper_values():
+    analyses = pd.DataFrame({"frequency_hz": [500.0], "acceleration_g": [5.0],
+                             "fill_percent": [50.0], "sdc": [0.6], "sdc_stderr": [0.02],
+                             "source": ["m.csv"]})
+    t = build_report_table(None, analyses, load_paper_table3())
+    row = t.iloc[0]
+    assert row[ALIGNMENT_COLUMN] == "out_of_range"
+    assert (row["SDC DEM (paper) [-]"], row["SDC measured (paper) [-]"]) == (0.5417, 0.65)
+
+
+def test_measured_case_sorts_into_its_grid_block():
+    dem = pd.DataFrame([{**i["record"], "case_key": i["case_key"]} for i in _dem_items()])
+    analyses = pd.DataFrame({"frequency_hz": [99.7], "acceleration_g": [0.98],
+                             "fill_percent": [90.0], "sdc": [0.2], "sdc_stderr": [0.01],
+                             "source": ["m.csv"]})
+    t = build_report_table(dem, analyses, None)
+    # 99.7 Hz, 0.98 g sorts as 100 Hz, 1 g: after every 50 Hz row, before 100 Hz / 5 g
+    pos = int(np.flatnonzero(t["source file(s)"] == "m.csv")[0])
+    assert list(t["frequency [Hz]"][:pos]) == [50.0] * 4 + [100.0] * 2
+    assert list(t["acceleration [g]"][pos + 1:]) == [5.0, 5.0]
