@@ -142,7 +142,7 @@ def make_samples(out_dir: str | os.PathLike = "data_samples", *, run_sweep: bool
         fmt = "uff" if sample.file_format.startswith("uff") else sample.file_format
         write_measurement(m, path, fmt, binary=sample.file_format == "uff58b")
         written[sample.file_name] = path
-    sidecar = out / "exports" / "loadcases.csv"
+    sidecar = out / "loadcases.csv"
     sidecar.write_text("file,fill_percent,material,direction\n" + "".join(
         f"{s.file_name},{s.fill_percent:g},acrylic,z\n" for s in SAMPLE_CASES))
     written["loadcases"] = sidecar

@@ -1,0 +1,99 @@
+"""``pidcore app``: start the Streamlit app on localhost with the default store."""
+
+from __future__ import annotations
+
+import argparse
+import importlib.util
+import os
+import signal
+import subprocess
+import sys
+from pathlib import Path
+
+from .. import defaults
+from ..errors import ParameterError
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    p = subparsers.add_parser(
+        "app",
+        help="start the web app (Streamlit) on localhost",
+        description="Start the pidcore app (upload & analyse, compare with DEM and the paper, "
+                    "run DEM cases, download reports) on http://localhost:PORT. It reads and "
+                    "writes the store given by --store; no other server is involved. Needs "
+                    "the 'app' extra: pip install 'pidcore[app]'.",
+    )
+    p.add_argument("--port", type=int, default=defaults.APP_PORT,
+                   help=f"TCP port on localhost (default {defaults.APP_PORT})")
+    p.add_argument("--store", metavar="FILE", type=Path, default=defaults.STORE_PATH,
+                   help=f"HDF5 store the app uses (default ./{defaults.STORE_PATH})")
+    p.add_argument("--dem-store", metavar="FILE", type=Path, default=None,
+                   help="read-only store of reference DEM runs shown next to the store's own "
+                        "(default: data_samples/dem_table3.h5 if it exists here)")
+    p.add_argument("--print-command", action="store_true",
+                   help="print the streamlit command line instead of running it")
+    p.set_defaults(func=run)
+
+
+def streamlit_command(port: int, *, python: str | None = None) -> list[str]:
+    """The command line that serves the packaged app on ``localhost:port``, headless.
+
+    The entry script is located through the installed package
+    (:data:`pidcore._app.ENTRY_SCRIPT`), so it works for editable and regular installs alike.
+    """
+    from .._app import ENTRY_SCRIPT
+
+    if not 1 <= int(port) <= 65535:
+        raise ParameterError(f"--port {port}: expected a TCP port number 1..65535")
+    return [
+        python or sys.executable, "-m", "streamlit", "run", str(ENTRY_SCRIPT),
+        "--server.address", "localhost",
+        "--server.port", str(int(port)),
+        "--server.headless", "true",
+        "--server.maxUploadSize", str(defaults.APP_MAX_UPLOAD_MB),
+        "--browser.gatherUsageStats", "false",
+        "--client.toolbarMode", "minimal",
+        "--global.developmentMode", "false",
+    ]
+
+
+def app_environment(store: Path, dem_store: Path | None = None,
+                    environ: dict[str, str] | None = None) -> dict[str, str]:
+    """Environment of the app process: store paths (absolute) and usage statistics off."""
+    from ..app_support import DEM_STORE_ENV_VAR, STORE_ENV_VAR
+
+    env = dict(os.environ if environ is None else environ)
+    env[STORE_ENV_VAR] = str(Path(store).expanduser().resolve())
+    if dem_store is not None:
+        if not Path(dem_store).is_file():
+            raise ParameterError(f"--dem-store {dem_store}: no such file")
+        env[DEM_STORE_ENV_VAR] = str(Path(dem_store).expanduser().resolve())
+    env["STREAMLIT_BROWSER_GATHER_USAGE_STATS"] = "false"
+    return env
+
+
+def run(args: argparse.Namespace) -> int:
+    command = streamlit_command(args.port)
+    if args.print_command:
+        print(" ".join(command))
+        return 0
+    if importlib.util.find_spec("streamlit") is None:
+        raise ParameterError("the app needs Streamlit, which is not installed; "
+                             "install it with: pip install 'pidcore[app]'")
+    env = app_environment(args.store, args.dem_store)
+    print(f"pidcore app: http://localhost:{args.port}  (store {env['PIDCORE_STORE']}); "
+          "Ctrl-C stops it", file=sys.stderr)
+    server = subprocess.Popen(command, env=env)
+    # SIGTERM (a service manager, a test) must stop the server too: turn it into SystemExit
+    # so that the cleanup below runs instead of the interpreter dying on the spot.
+    previous = signal.signal(signal.SIGTERM, lambda signum, frame: sys.exit(128 + signum))
+    try:
+        return server.wait()
+    finally:
+        if server.poll() is None:  # interrupted: never leave the server running behind us
+            server.terminate()
+            try:
+                server.wait(timeout=10)
+            except subprocess.TimeoutExpired:
+                server.kill()
+        signal.signal(signal.SIGTERM, previous)

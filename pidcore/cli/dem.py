@@ -1,0 +1,148 @@
+"""``pidcore dem``: DEM prediction of the SDC of one load case (``run``).
+
+A ``sweep`` sub-command (grid of load cases) plugs in beside ``run``: add its parser in
+``register`` below.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+from .. import defaults
+from ..constants import (
+    DRIVE_DIRECTIONS,
+    NORMAL_DAMPING_MODES,
+    PARTICLE_MATERIALS,
+    START_PROTOCOLS,
+    VIBRATED_MASS_CONVENTIONS,
+)
+
+#: Keys of ``pidcore dem run --json`` (more may follow them).
+JSON_KEYS = ("sdc", "sdc_stderr", "energy_per_cycle_j", "energy_dissipated_normal_j",
+             "energy_dissipated_friction_j", "particles_per_cell", "cells_simulated", "m_c_kg",
+             "energy_balance_error", "steps", "wall_s", "particle_steps_per_s")
+
+
+def _time_step(text: str) -> float | str:
+    if text == "auto":
+        return text
+    try:
+        return float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected seconds or 'auto', got {text!r}") from None
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    dem = subparsers.add_parser(
+        "dem", help="DEM prediction of the SDC (paper Eq. 1-10)",
+        description="Discrete element simulation of particles in honeycomb cells.")
+    sub = dem.add_subparsers(dest="dem_command", metavar="DEM_COMMAND", required=True)
+    _register_run(sub)
+    # sweep: sub.add_parser("sweep", ...) goes here (grid of LoadCase over
+    # pidcore.dem.simulate_load_case).
+
+
+def _register_run(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "run", help="simulate one load case",
+        description="Simulate K independent cells of the 441 of a 100 x 100 mm coupon under "
+                    "harmonic drive and report the specific damping capacity (Eq. 8-10).")
+    p.add_argument("--frequency", metavar="HZ", type=float, required=True,
+                   help="drive frequency, Hz")
+    p.add_argument("--acceleration", metavar="G", type=float, required=True,
+                   help="acceleration amplitude, g")
+    p.add_argument("--fill", metavar="PERCENT", type=float, required=True,
+                   help="fill fraction, %% of the 100 %% count (see --fill-reference)")
+    p.add_argument("--cells", metavar="K", type=int, default=defaults.DEM_CELLS,
+                   help=f"independent cells simulated (default {defaults.DEM_CELLS})")
+    p.add_argument("--seed", metavar="S", type=int, default=defaults.DEM_SEED,
+                   help=f"random seed of the packings (default {defaults.DEM_SEED})")
+    p.add_argument("--material", choices=PARTICLE_MATERIALS, default="acrylic")
+    p.add_argument("--direction", choices=DRIVE_DIRECTIONS, default="z",
+                   help="drive direction in the cell frame (z normal to the face sheets)")
+    p.add_argument("--cycles", metavar="N", type=int, default=None,
+                   help=f"steady-state cycles measured (default: min("
+                        f"{defaults.DEM_MIN_STEADY_CYCLES}, {defaults.DEM_MIN_STEADY_TIME_S:g} s"
+                        " x f))")
+    p.add_argument("--time-step", metavar="S", type=_time_step,
+                   default=defaults.DEM_TIME_STEP_MODE,
+                   help=f"time step, s, or 'auto' (default: min(2e-6 s, contact time / "
+                        f"{defaults.DEM_MIN_STEPS_PER_CONTACT}))")
+    p.add_argument("--damping-mode", choices=NORMAL_DAMPING_MODES,
+                   default=defaults.DEM_NORMAL_DAMPING_MODE,
+                   help=f"normal damping at contact end (default "
+                        f"{defaults.DEM_NORMAL_DAMPING_MODE})")
+    p.add_argument("--damping-coefficient", choices=("eq3", "calibrated"),
+                   default=defaults.DEM_DAMPING_COEFFICIENT,
+                   help="alpha by Eq. 3, or calibrated to the table's restitution")
+    p.add_argument("--mass-convention", choices=VIBRATED_MASS_CONVENTIONS,
+                   default=defaults.DEM_VIBRATED_MASS_CONVENTION,
+                   help="mass m_c in E = m_c a^2 / (2 w^2)")
+    p.add_argument("--start", choices=START_PROTOCOLS, default=defaults.DEM_START_PROTOCOL,
+                   help="particles at rest or moving with the cell when the drive starts")
+    p.add_argument("--fill-reference", choices=("capacity", "paper"),
+                   default=defaults.DEM_FILL_REFERENCE,
+                   help="100 %% = cell capacity (dense packing) or the paper's 36 particles")
+    p.add_argument("--store", metavar="FILE", type=Path, default=None,
+                   help="also save the run to this HDF5 store")
+    p.add_argument("--json", action="store_true", help="one JSON document on stdout")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..dem import DemConfig, LoadCase, simulate_load_case
+
+    case = LoadCase(args.frequency, args.acceleration, args.fill, material=args.material,
+                    direction=args.direction)
+    config = DemConfig(cells=args.cells, seed=args.seed, time_step=args.time_step,
+                       normal_damping_mode=args.damping_mode,
+                       damping_coefficient=args.damping_coefficient,
+                       vibrated_mass=args.mass_convention, start_protocol=args.start,
+                       fill_reference=args.fill_reference, steady_cycles=args.cycles)
+    result = simulate_load_case(case, config,
+                                progress=not args.no_progress and sys.stderr.isatty())
+    key = None
+    if args.store is not None:
+        from ..dem.persist import save_dem_result
+
+        key = save_dem_result(args.store, result)
+    if args.json:
+        out = {k: result.to_dict()[k] for k in JSON_KEYS}
+        out.update(result.to_dict())
+        if key is not None:
+            out["store_key"] = key
+        print(json.dumps(out))
+        return 0
+    print(format_summary(result))
+    if key is not None:
+        print(f"saved to {args.store} as {key}")
+    return 0
+
+
+def format_summary(result) -> str:
+    """Readable multi-line summary with units."""
+    c = result.case
+    lines = [
+        f"DEM load case   {c.frequency_hz:g} Hz, {c.acceleration_g:g} g, fill "
+        f"{c.fill_percent:g} % ({result.particles_per_cell} of {result.particles_full_cell} "
+        f"{c.material} particles per cell, reference {result.config.fill_reference}), "
+        f"drive along {c.direction}",
+        f"SDC             {result.sdc:.4g} +- {result.sdc_stderr:.2g} [-] "
+        f"(loss factor {result.loss_factor:.4g} [-]) over {result.cells_simulated} cells",
+        f"dissipated      {result.energy_per_cycle_j:.4g} J/cycle (coupon, 441 cells): normal "
+        f"damping {result.energy_dissipated_normal_j:.4g} J, friction "
+        f"{result.energy_dissipated_friction_j:.4g} J",
+        f"E (Eq. 10)      {result.max_kinetic_energy_j:.4g} J with m_c = "
+        f"{result.m_c_kg:.4g} kg ({result.config.vibrated_mass})",
+        f"energy balance  closure error {result.energy_balance_error:.2%}",
+        f"steady state    from cycle {result.steady_start_cycle} "
+        f"({'detected' if result.steady_detected else 'NOT converged, transient cap'}), "
+        f"{result.steady_cycles} cycles measured",
+        f"numerics        dt {result.time_step_s:.4g} s, {result.steps} steps, "
+        f"{result.wall_s:.1f} s wall, {result.particle_steps_per_s:.3g} particle-steps/s",
+    ]
+    return "\n".join(lines)

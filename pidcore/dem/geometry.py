@@ -1,0 +1,150 @@
+"""Hexagonal honeycomb cell (paper Eq. 1, Table 2) and particle packing in it.
+
+Cell frame: origin at the cell centre, z normal to the face sheets. The six side walls are the
+planes y = +-(sqrt(3)/2) R and x +- y/sqrt(3) = +-R, whose distance from the axis (the apothem,
+(sqrt(3)/2) R) is half the inscribed-circle diameter 4.76 mm; the face sheets are z = +-h/2.
+Every wall is stored as an inward unit normal ``n`` and offset ``d`` so that a point ``p`` is
+inside when ``n . p + d >= 0`` (the signed distance from the wall).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import defaults
+from ..errors import ParameterError
+
+#: Wall names in kernel order.
+WALL_NAMES: tuple[str, ...] = ("side_30deg", "side_90deg", "side_150deg", "side_210deg",
+                               "side_270deg", "side_330deg", "floor", "ceiling")
+
+
+@dataclass(frozen=True)
+class CellGeometry:
+    """Hexagonal cell with inscribed diameter ``inscribed_diameter_m`` and height ``height_m``."""
+
+    inscribed_diameter_m: float = defaults.CELL_INSCRIBED_DIAMETER_M
+    height_m: float = defaults.CELL_HEIGHT_M
+
+    def __post_init__(self):
+        if not (self.inscribed_diameter_m > 0 and self.height_m > 0):
+            raise ParameterError("cell geometry: inscribed diameter and height must be > 0 m")
+
+    @property
+    def apothem_m(self) -> float:
+        """Distance from the cell axis to each side wall, (sqrt(3)/2) R, m."""
+        return 0.5 * self.inscribed_diameter_m
+
+    @property
+    def circumradius_m(self) -> float:
+        """R of Eq. 1 (centre to corner), m."""
+        return self.apothem_m * 2.0 / np.sqrt(3.0)
+
+    @property
+    def wall_normals(self) -> np.ndarray:
+        """(8, 3) inward unit normals, side walls first (see :data:`WALL_NAMES`)."""
+        angles = np.deg2rad([30.0, 90.0, 150.0, 210.0, 270.0, 330.0])
+        sides = -np.column_stack([np.cos(angles), np.sin(angles), np.zeros(6)])
+        faces = np.array([[0.0, 0.0, 1.0], [0.0, 0.0, -1.0]])
+        return np.ascontiguousarray(np.vstack([sides, faces]))
+
+    @property
+    def wall_offsets(self) -> np.ndarray:
+        """(8,) offsets d of ``n . p + d = 0``, m."""
+        return np.array([self.apothem_m] * 6 + [0.5 * self.height_m] * 2)
+
+    def signed_distances(self, points: np.ndarray) -> np.ndarray:
+        """Signed distance of (..., 3) points from each wall, (..., 8), m (> 0 inside)."""
+        return np.asarray(points) @ self.wall_normals.T + self.wall_offsets
+
+    def volume_m3(self) -> float:
+        return 2.0 * np.sqrt(3.0) * self.apothem_m**2 * self.height_m
+
+
+def _candidate_grid(geometry: CellGeometry, radius_m: float, spacing_m: float) -> np.ndarray:
+    """xy points where a sphere centre may sit (inside the hexagon shrunk by the radius)."""
+    inner = geometry.apothem_m - radius_m
+    if inner < 0:
+        raise ParameterError(
+            f"particle radius {radius_m * 1e3:.3g} mm does not fit a cell of inscribed "
+            f"diameter {geometry.inscribed_diameter_m * 1e3:.3g} mm")
+    rc = inner * 2.0 / np.sqrt(3.0)
+    g = np.arange(-rc, rc + spacing_m / 2, spacing_m)
+    xx, yy = np.meshgrid(g, g)
+    pts = np.column_stack([xx.ravel(), yy.ravel(), np.zeros(xx.size)])
+    sd = pts @ geometry.wall_normals[:6].T + geometry.wall_offsets[:6]
+    ok = np.all(sd >= radius_m * (1 + 1e-9), axis=1)
+    return pts[ok, :2]
+
+
+def drop_packing(geometry: CellGeometry, radius_m: float, n_particles: int | None, *,
+                 rng: np.random.Generator | None = None, gap_fraction: float = 1e-4,
+                 grid_fraction: float = 0.04,
+                 random_band_fraction: float = 0.5) -> np.ndarray:
+    """Place spheres one by one, each dropped vertically onto floor and spheres below.
+
+    Deterministic greedy ("lowest drop", ``rng=None``): each sphere goes to the candidate xy
+    (grid of spacing ``grid_fraction * r`` inside the cell) where it comes to rest lowest --
+    a dense sequential packing. Random (``rng`` given): each sphere is dropped at a random
+    candidate xy among those where it would rest within ``random_band_fraction * r`` of the
+    lowest rest height (random, slightly looser packings; different per seed). Spheres keep a gap of
+    ``gap_fraction * r`` so that the start state never overlaps. Stops when the next sphere
+    would stick out of the cell top; ``n_particles=None`` fills to that point.
+
+    Returns
+    -------
+    (n, 3) ndarray of centres, m.
+    """
+    r = float(radius_m)
+    cand = _candidate_grid(geometry, r, grid_fraction * r)
+    floor_z = -0.5 * geometry.height_m + r * (1 + gap_fraction)
+    top_z = 0.5 * geometry.height_m - r * (1 + gap_fraction)
+    contact = 2.0 * r * (1 + gap_fraction)
+    rest = np.full(len(cand), floor_z)
+    centres: list[np.ndarray] = []
+    limit = n_particles if n_particles is not None else 10**6
+    while len(centres) < limit:
+        if rng is None:
+            idx = int(np.argmin(rest))
+        else:
+            low = np.flatnonzero(rest <= rest.min() + random_band_fraction * r)
+            idx = int(low[rng.integers(len(low))])
+        z = rest[idx]
+        if z > top_z:
+            if n_particles is None:
+                break
+            raise ParameterError(f"{n_particles} particles of radius {r * 1e3:.3g} mm do "
+                                 f"not fit the cell (capacity {len(centres)})")
+        c = np.array([cand[idx, 0], cand[idx, 1], z])
+        centres.append(c)
+        d2 = np.sum((cand - c[:2]) ** 2, axis=1)
+        near = d2 < contact**2
+        rest[near] = np.maximum(rest[near], z + np.sqrt(contact**2 - d2[near]))
+    return np.array(centres).reshape(-1, 3)
+
+
+def cell_capacity(geometry: CellGeometry, radius_m: float) -> int:
+    """Number of spheres the cell holds (dense greedy drop packing, :func:`drop_packing`).
+
+    A sequential estimate, not a proven optimum; it is the reference of ``fill_reference=
+    "capacity"`` (100 % fill).
+    """
+    return len(drop_packing(geometry, radius_m, None))
+
+
+def random_packing(geometry: CellGeometry, radius_m: float, n_particles: int,
+                   rng: np.random.Generator) -> np.ndarray:
+    """Random non-overlapping start packing of ``n_particles`` (see :func:`drop_packing`).
+
+    Narrows the random band (0.5 r, 0.2 r, 0.05 r, 0.01 r) until the particles fit, then falls
+    back to the dense deterministic packing; always returns centres with no overlap.
+    """
+    for band in (0.5, 0.2, 0.05, 0.01):
+        try:
+            return drop_packing(geometry, radius_m, n_particles, rng=rng,
+                                random_band_fraction=band)
+        except ParameterError:
+            continue
+    return drop_packing(geometry, radius_m, n_particles, rng=None)

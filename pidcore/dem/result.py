@@ -1,0 +1,235 @@
+"""Result of a DEM load case: SDC, energy tallies, energy balance, virtual shaker record."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from .. import defaults
+
+if TYPE_CHECKING:  # pragma: no cover
+    from .contact import ContactLaw
+    from .simulate import DemConfig, LoadCase
+
+#: Unit of every scalar and array of :class:`DemResult`.
+UNITS: dict[str, str] = {
+    "sdc": "-", "sdc_stderr": "-", "loss_factor": "-",
+    "energy_per_cycle_j": "J", "energy_dissipated_normal_j": "J",
+    "energy_dissipated_friction_j": "J", "max_kinetic_energy_j": "J", "work_per_cycle_j": "J",
+    "stored_energy_change_per_cycle_j": "J",
+    "particles_per_cell": "1", "particles_full_cell": "1", "cells_simulated": "1",
+    "m_c_kg": "kg", "coupon_mass_kg": "kg", "energy_balance_error": "-", "steps": "1",
+    "wall_s": "s", "particle_steps_per_s": "1/s", "time_step_s": "s",
+    "steady_start_cycle": "1", "steady_cycles": "1", "cycles_simulated": "1",
+    "settle_time_s": "s", "frequency_hz": "Hz", "acceleration_g": "g", "fill_percent": "%",
+    "sdc_per_cell": "-", "dissipation_per_cycle_j": "J", "sample_time_s": "s",
+    "wall_force_n": "N", "shaker_force_n": "N", "velocity_m_s": "m/s",
+    "sample_rate_hz": "Hz", "work_walls_j": "J", "dissipated_total_j": "J",
+    "mechanical_energy_change_j": "J",
+}
+
+
+@dataclass(frozen=True)
+class DemResult:
+    """Outcome of :func:`~pidcore.dem.simulate.simulate_load_case` (SI units, see UNITS).
+
+    Coupon-level quantities scale the K-cell mean to the coupon's 441 cells.
+    ``energy_dissipated_normal_j`` / ``_friction_j`` split ``energy_per_cycle_j`` (steady
+    state, per cycle, coupon); ``work_per_cycle_j`` is the walls' work on the particles per
+    steady cycle; it equals the dissipation plus ``stored_energy_change_per_cycle_j`` (the
+    change of the particles' mechanical energy over the steady window divided by its cycles,
+    e.g. a bed compacting). ``energy_balance_error`` is (W_walls - dE_mech - D) / W_walls
+    over the whole driven run (all cells), with dE_mech = kinetic (incl. rotation) + gravity +
+    Hertz elastic energy change. ``particle_steps_per_s`` counts settling and driven steps
+    over the time spent in the kernel (all threads); ``wall_s`` is the whole call.
+
+    ``dissipation_per_cycle_j`` (cycles,) is the coupon dissipation of every driven cycle;
+    ``wall_force_n`` (samples,) the drive-axis force the walls exert on the particles of the
+    coupon (interval means, 441 x cell mean), ``shaker_force_n`` = coupon mass x acceleration +
+    ``wall_force_n`` (the force a shaker would measure), ``velocity_m_s`` the coupon velocity,
+    all sampled at ``sample_rate_hz`` from the drive start.
+    """
+
+    case: LoadCase
+    config: DemConfig
+    sdc: float
+    sdc_stderr: float
+    sdc_per_cell: np.ndarray
+    energy_per_cycle_j: float
+    energy_dissipated_normal_j: float
+    energy_dissipated_friction_j: float
+    work_per_cycle_j: float
+    stored_energy_change_per_cycle_j: float
+    max_kinetic_energy_j: float
+    particles_per_cell: int
+    particles_full_cell: int
+    cells_simulated: int
+    m_c_kg: float
+    coupon_mass_kg: float
+    energy_balance_error: float
+    work_walls_j: float
+    dissipated_total_j: float
+    mechanical_energy_change_j: float
+    steps: int
+    wall_s: float
+    particle_steps_per_s: float
+    time_step_s: float
+    steady_start_cycle: int
+    steady_detected: bool
+    steady_cycles: int
+    settle_time_s: float
+    dissipation_per_cycle_j: np.ndarray
+    dissipation_per_cell_cycle_j: np.ndarray
+    sample_rate_hz: float
+    sample_time_s: np.ndarray
+    wall_force_n: np.ndarray
+    shaker_force_n: np.ndarray
+    velocity_m_s: np.ndarray
+    samples_per_cycle: int
+
+    @classmethod
+    def from_run(cls, *, case: LoadCase, config: DemConfig, law: ContactLaw,
+                 tally: np.ndarray, wall_force: np.ndarray, steady_start_cycle: int,
+                 steady_detected: bool, particles_per_cell: int, full_count: int,
+                 m_c_kg: float, coupon_mass_kg: float, dt_s: float, steps_per_cycle: int,
+                 sample_every: int, energy_start: np.ndarray, energy_end: np.ndarray,
+                 stored_energy_change_steady: np.ndarray,
+                 settle_time_s: float, steps: int, wall_s: float, kernel_s: float,
+                 particle_steps: int) -> DemResult:
+        n_coupon = defaults.COUPON_CELLS
+        k = tally.shape[0]
+        steady = tally[:, steady_start_cycle:, :]
+        per_cell_cycle = tally[:, :, 1] + tally[:, :, 2]
+        e_max = m_c_kg * case.acceleration_m_s2**2 / (2 * case.omega_rad_s**2)
+        per_cell = n_coupon * steady[:, :, 1:].sum(axis=2).mean(axis=1)  # coupon J / cycle
+        sdc_cells = per_cell / e_max if e_max > 0 else np.full(k, np.nan)
+        stderr = float(np.std(sdc_cells, ddof=1) / math.sqrt(k)) if k > 1 else float("nan")
+        work = float(tally[:, :, 0].sum())
+        dissipated = float(tally[:, :, 1:].sum())
+        d_mech = float(np.sum(energy_end[:, 3] - energy_start[:, 3]))
+        scale = max(abs(work), dissipated, 1e-300)
+        # virtual shaker record, sample interval j covers force evaluations at t=(step+1) dt
+        spc = steps_per_cycle // sample_every
+        n_s = wall_force.shape[1]
+        h = sample_every * dt_s
+        t0 = (np.arange(n_s) * sample_every + 0.5) * dt_s
+        t1 = t0 + h
+        a, w = case.acceleration_m_s2, case.omega_rad_s
+        vel = -a / w**2 * (np.sin(w * t1) - np.sin(w * t0)) / h
+        acc = a / w * (np.cos(w * t0) - np.cos(w * t1)) / h
+        wall_n = n_coupon * wall_force.mean(axis=0)
+        return cls(
+            case=case, config=config, sdc=float(np.mean(sdc_cells)), sdc_stderr=stderr,
+            sdc_per_cell=sdc_cells,
+            energy_per_cycle_j=float(np.mean(per_cell)),
+            energy_dissipated_normal_j=float(n_coupon * steady[:, :, 1].mean()),
+            energy_dissipated_friction_j=float(n_coupon * steady[:, :, 2].mean()),
+            work_per_cycle_j=float(n_coupon * steady[:, :, 0].mean()),
+            stored_energy_change_per_cycle_j=float(
+                n_coupon * np.mean(stored_energy_change_steady) / max(steady.shape[1], 1)),
+            max_kinetic_energy_j=float(e_max),
+            particles_per_cell=int(particles_per_cell), particles_full_cell=int(full_count),
+            cells_simulated=int(k), m_c_kg=float(m_c_kg), coupon_mass_kg=float(coupon_mass_kg),
+            energy_balance_error=float((work - d_mech - dissipated) / scale),
+            work_walls_j=work, dissipated_total_j=dissipated, mechanical_energy_change_j=d_mech,
+            steps=int(steps), wall_s=float(wall_s),
+            particle_steps_per_s=float(particle_steps / kernel_s) if kernel_s > 0
+            else float("nan"),
+            time_step_s=float(dt_s), steady_start_cycle=int(steady_start_cycle),
+            steady_detected=bool(steady_detected),
+            steady_cycles=int(tally.shape[1] - steady_start_cycle),
+            settle_time_s=float(settle_time_s),
+            dissipation_per_cycle_j=n_coupon * per_cell_cycle.mean(axis=0),
+            dissipation_per_cell_cycle_j=per_cell_cycle,
+            sample_rate_hz=1.0 / h, sample_time_s=0.5 * (t0 + t1), wall_force_n=wall_n,
+            shaker_force_n=coupon_mass_kg * acc + wall_n, velocity_m_s=vel,
+            samples_per_cycle=int(spc),
+        )
+
+    @property
+    def loss_factor(self) -> float:
+        """eta / (2 pi) (paper Sect. 3) [-]."""
+        return self.sdc / (2 * math.pi)
+
+    def steady_slice(self) -> slice:
+        """Slice of the sample arrays covering the steady-state cycles."""
+        return slice(self.steady_start_cycle * self.samples_per_cycle, None)
+
+    def power_analysis(self, *, n_harmonics: int = defaults.N_HARMONICS):
+        """Virtual shaker test: :func:`pidcore.signal.analyze_power` of the steady record."""
+        from ..signal import analyze_power
+
+        sl = self.steady_slice()
+        return analyze_power(self.shaker_force_n[sl], self.velocity_m_s[sl],
+                             self.sample_rate_hz, frequency_hz=self.case.frequency_hz,
+                             n_harmonics=n_harmonics)
+
+    def to_dict(self, *, include_arrays: bool = False) -> dict[str, Any]:
+        """JSON-safe dict: scalars (and arrays as lists when ``include_arrays``)."""
+        out: dict[str, Any] = {
+            "case_key": self.case.key(),
+            "frequency_hz": self.case.frequency_hz,
+            "acceleration_g": self.case.acceleration_g,
+            "fill_percent": self.case.fill_percent,
+            "material": self.case.material,
+            "direction": self.case.direction,
+            "normal_damping_mode": self.config.normal_damping_mode,
+            "vibrated_mass_convention": self.config.vibrated_mass,
+            "start_protocol": self.config.start_protocol,
+            "fill_reference": self.config.fill_reference,
+            "seed": self.config.seed,
+        }
+        for name in ("sdc", "sdc_stderr", "loss_factor", "energy_per_cycle_j", "work_per_cycle_j",
+                     "stored_energy_change_per_cycle_j",
+                     "energy_dissipated_normal_j", "energy_dissipated_friction_j",
+                     "max_kinetic_energy_j", "particles_per_cell", "particles_full_cell",
+                     "cells_simulated", "m_c_kg", "coupon_mass_kg", "energy_balance_error",
+                     "work_walls_j", "dissipated_total_j", "mechanical_energy_change_j",
+                     "steps", "wall_s", "particle_steps_per_s", "time_step_s",
+                     "steady_start_cycle", "steady_detected", "steady_cycles",
+                     "settle_time_s", "sample_rate_hz"):
+            value = getattr(self, name)
+            if isinstance(value, float) and not math.isfinite(value):
+                value = None
+            out[name] = value
+        if include_arrays:
+            for name in self.array_names():
+                out[name] = np.asarray(getattr(self, name)).tolist()
+        return out
+
+    @staticmethod
+    def array_names() -> tuple[str, ...]:
+        return ("sdc_per_cell", "dissipation_per_cycle_j", "sample_time_s", "wall_force_n",
+                "shaker_force_n", "velocity_m_s")
+
+    def arrays(self) -> dict[str, np.ndarray]:
+        return {name: np.asarray(getattr(self, name)) for name in self.array_names()}
+
+    def plot(self, ax=None):
+        """Per-cycle dissipation (top) and wall force over the last cycles (bottom).
+
+        ``ax``: a pair of matplotlib axes, or None for a new figure. Returns the axes.
+        """
+        import matplotlib.pyplot as plt
+
+        if ax is None:
+            _, ax = plt.subplots(2, 1, figsize=(7, 6), constrained_layout=True)
+        a0, a1 = ax
+        cycles = np.arange(len(self.dissipation_per_cycle_j))
+        a0.plot(cycles, self.dissipation_per_cycle_j, ".-", label="coupon")
+        a0.axvline(self.steady_start_cycle, color="k", ls="--", label="steady from")
+        a0.set_xlabel("cycle [-]")
+        a0.set_ylabel("dissipated per cycle [J]")
+        a0.legend()
+        n = 5 * self.samples_per_cycle
+        a1.plot(self.sample_time_s[-n:], self.wall_force_n[-n:], label="walls on particles")
+        a1.plot(self.sample_time_s[-n:], self.shaker_force_n[-n:], label="shaker force")
+        a1.set_xlabel("time [s]")
+        a1.set_ylabel("force [N]")
+        a1.legend()
+        a0.set_title(f"{self.case.key()}: SDC {self.sdc:.4g} +- {self.sdc_stderr:.2g}, "
+                     f"{self.particles_per_cell} particles/cell")
+        return ax

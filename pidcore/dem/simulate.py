@@ -1,0 +1,438 @@
+"""One DEM load case: settle, drive, detect steady state, tally energy, compute the SDC.
+
+:func:`simulate_load_case` is a pure function of a :class:`LoadCase` and a :class:`DemConfig`
+(same inputs and seed -> same result), so a sweep can map it over a grid.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from .. import defaults
+from ..constants import (
+    DRIVE_DIRECTIONS,
+    PARTICLE_MATERIALS,
+    STANDARD_GRAVITY,
+    START_PROTOCOLS,
+    VIBRATED_MASS_CONVENTIONS,
+    DriveDirection,
+    NormalDampingMode,
+    ParticleMaterial,
+    StartProtocol,
+    VibratedMassConvention,
+)
+from ..errors import ParameterError, SimulationError
+from .contact import ContactLaw, check_damping_mode
+from .geometry import CellGeometry, cell_capacity, random_packing
+from .result import DemResult
+from .state import (
+    AXIS_INDEX,
+    CellsState,
+    KernelSettings,
+    advance,
+    assert_no_overlap,
+    energies,
+    wall_displacement,
+)
+
+FILL_REFERENCES = ("capacity", "paper")
+#: "eq3": alpha from the table's e_n by Eq. 3; "calibrated": alpha root-found so that a
+#: simulated head-on impact at DEM_CALIBRATION_SPEED_M_S gives the table's e_n exactly.
+DAMPING_COEFFICIENTS = ("eq3", "calibrated")
+
+
+@dataclass(frozen=True)
+class LoadCase:
+    """A harmonic load case: frequency (Hz), acceleration amplitude (g), fill (% of 100 %)."""
+
+    frequency_hz: float
+    acceleration_g: float
+    fill_percent: float
+    material: ParticleMaterial = "acrylic"
+    direction: DriveDirection = "z"
+
+    def __post_init__(self):
+        if not (math.isfinite(self.frequency_hz) and self.frequency_hz > 0):
+            raise ParameterError(f"frequency: expected > 0 Hz, got {self.frequency_hz}")
+        if not (math.isfinite(self.acceleration_g) and self.acceleration_g >= 0):
+            raise ParameterError(f"acceleration: expected >= 0 g, got {self.acceleration_g}")
+        if not (0 < self.fill_percent <= 100):
+            raise ParameterError(f"fill: expected 0 < fill <= 100 %, got {self.fill_percent}")
+        if self.material not in PARTICLE_MATERIALS:
+            raise ParameterError(f"material: expected one of {PARTICLE_MATERIALS}, "
+                                 f"got {self.material!r}")
+        if self.direction not in DRIVE_DIRECTIONS:
+            raise ParameterError(f"direction: expected one of {DRIVE_DIRECTIONS}, "
+                                 f"got {self.direction!r}")
+
+    @property
+    def omega_rad_s(self) -> float:
+        return 2.0 * math.pi * self.frequency_hz
+
+    @property
+    def acceleration_m_s2(self) -> float:
+        return self.acceleration_g * STANDARD_GRAVITY
+
+    def key(self) -> str:
+        """Stable text key, e.g. ``acrylic_z_f50_a5_fill50``."""
+        return (f"{self.material}_{self.direction}_f{self.frequency_hz:g}"
+                f"_a{self.acceleration_g:g}_fill{self.fill_percent:g}")
+
+
+@dataclass(frozen=True)
+class DemConfig:
+    """Numerical settings of a DEM run (defaults in :mod:`pidcore.defaults`).
+
+    ``steady_cycles=None``: measure min(DEM_MIN_STEADY_CYCLES, DEM_MIN_STEADY_TIME_S * f)
+    cycles (at least one block). ``time_step``: seconds, or ``"auto"`` = min(2e-6 s,
+    t_contact / DEM_MIN_STEPS_PER_CONTACT). The step actually used is shortened slightly so that
+    a drive period is a whole number of sample intervals.
+    """
+
+    cells: int = defaults.DEM_CELLS
+    seed: int = defaults.DEM_SEED
+    time_step: float | str = defaults.DEM_TIME_STEP_MODE
+    normal_damping_mode: NormalDampingMode = defaults.DEM_NORMAL_DAMPING_MODE
+    vibrated_mass: VibratedMassConvention = defaults.DEM_VIBRATED_MASS_CONVENTION
+    start_protocol: StartProtocol = defaults.DEM_START_PROTOCOL
+    fill_reference: str = defaults.DEM_FILL_REFERENCE
+    steady_cycles: int | None = None
+    block_cycles: int = defaults.DEM_STEADY_BLOCK_CYCLES
+    steady_relative_tolerance: float = defaults.DEM_STEADY_RELATIVE_TOLERANCE
+    max_transient_cycles: int = defaults.DEM_MAX_TRANSIENT_CYCLES
+    samples_per_cycle: int = defaults.DEM_SAMPLES_PER_CYCLE
+    friction_regularisation_m_s: float = defaults.DEM_FRICTION_REGULARISATION_SPEED_M_S
+    alpha_pp: float | None = None
+    alpha_pw: float | None = None
+    damping_coefficient: str = defaults.DEM_DAMPING_COEFFICIENT
+
+    def __post_init__(self):
+        if self.cells < 1:
+            raise ParameterError(f"cells: expected >= 1, got {self.cells}")
+        check_damping_mode(self.normal_damping_mode)
+        for name, value, allowed in (
+                ("vibrated_mass", self.vibrated_mass, VIBRATED_MASS_CONVENTIONS),
+                ("start_protocol", self.start_protocol, START_PROTOCOLS),
+                ("fill_reference", self.fill_reference, FILL_REFERENCES)):
+            if value not in allowed:
+                raise ParameterError(f"{name}: expected one of {allowed}, got {value!r}")
+        if self.damping_coefficient not in DAMPING_COEFFICIENTS:
+            raise ParameterError(f"damping_coefficient: expected one of "
+                                 f"{DAMPING_COEFFICIENTS}, got {self.damping_coefficient!r}")
+        if isinstance(self.time_step, str):
+            if self.time_step != "auto":
+                raise ParameterError(f"time_step: expected seconds or 'auto', "
+                                     f"got {self.time_step!r}")
+        elif not self.time_step > 0:
+            raise ParameterError(f"time_step: expected > 0 s, got {self.time_step}")
+        if self.steady_cycles is not None and self.steady_cycles < 1:
+            raise ParameterError(f"steady_cycles: expected >= 1, got {self.steady_cycles}")
+        if self.block_cycles < 1 or self.max_transient_cycles < 0:
+            raise ParameterError("block_cycles >= 1 and max_transient_cycles >= 0 expected")
+        if self.samples_per_cycle < 8:
+            raise ParameterError(f"samples_per_cycle: expected >= 8, "
+                                 f"got {self.samples_per_cycle}")
+
+
+def coupon_mass_kg() -> float:
+    """Mass of the empty coupon: two face sheets plus the honeycomb core (Table 2), kg."""
+    area = defaults.COUPON_SIDE_M**2
+    return (2 * area * defaults.FACE_SHEET_THICKNESS_M * defaults.FACE_SHEET_DENSITY_KG_M3
+            + area * defaults.CELL_HEIGHT_M * defaults.CORE_DENSITY_KG_M3)
+
+
+def vibrated_mass_kg(convention: VibratedMassConvention, *, particles_per_cell: int,
+                     particle_mass_kg: float, cells: int = defaults.COUPON_CELLS) -> float:
+    """m_c of Eq. 10 under a named convention, kg."""
+    particles = cells * particles_per_cell * particle_mass_kg
+    return {"coupon_plus_particles": coupon_mass_kg() + particles,
+            "coupon": coupon_mass_kg(), "particles": particles}[convention]
+
+
+def max_impact_speed(case: LoadCase, geometry: CellGeometry) -> float:
+    """Largest expected impact speed, m/s: 2 a/w (particle and wall moving oppositely at the
+    drive's velocity amplitude) plus free fall over the cell height, sqrt(2 g h)."""
+    return (2 * case.acceleration_m_s2 / case.omega_rad_s
+            + math.sqrt(2 * STANDARD_GRAVITY * geometry.height_m))
+
+
+def choose_time_step(case: LoadCase, law: ContactLaw, geometry: CellGeometry,
+                     requested: float | str) -> float:
+    """Check or pick the time step, s (>= DEM_MIN_STEPS_PER_CONTACT steps per contact)."""
+    v = max_impact_speed(case, geometry)
+    t_contact = law.contact_time(v)
+    safe = t_contact / defaults.DEM_MIN_STEPS_PER_CONTACT
+    if requested == "auto":
+        return min(defaults.DEM_TIME_STEP_S, safe)
+    if requested > safe:
+        raise ParameterError(
+            f"time_step {requested:.3g} s gives {t_contact / requested:.1f} steps per "
+            f"{case.material} contact at the largest expected impact speed {v:.2f} m/s "
+            f"(t_contact {t_contact:.3g} s); need >= {defaults.DEM_MIN_STEPS_PER_CONTACT}: "
+            f"use time_step <= {safe:.3g} s or 'auto'")
+    return float(requested)
+
+
+def particles_per_cell(fill_percent: float, material_name: str, *,
+                       geometry: CellGeometry | None = None,
+                       fill_reference: str = defaults.DEM_FILL_REFERENCE) -> tuple[int, int]:
+    """(particles per cell, count taken as 100 %) for a fill percentage.
+
+    ``fill_reference="capacity"``: 100 % is :func:`~pidcore.dem.geometry.cell_capacity`;
+    ``"paper"``: 36 particles, refused when 36 do not fit the cell.
+    """
+    geometry = geometry or CellGeometry()
+    law = ContactLaw.for_material(material_name)
+    capacity = cell_capacity(geometry, law.radius_m)
+    if fill_reference == "paper":
+        full = defaults.PAPER_PARTICLES_PER_FULL_CELL
+        if full > capacity:
+            raise ParameterError(
+                f"fill_reference='paper': {full} {material_name} particles (r = "
+                f"{law.radius_m * 1e3:g} mm) do not fit a {geometry.inscribed_diameter_m * 1e3:g}"
+                f" x {geometry.height_m * 1e3:g} mm cell (capacity {capacity}); use "
+                "fill_reference='capacity'")
+    elif fill_reference == "capacity":
+        full = capacity
+    else:
+        raise ParameterError(f"fill_reference: expected one of {FILL_REFERENCES}, "
+                             f"got {fill_reference!r}")
+    n = int(round(fill_percent / 100.0 * full))
+    if n < 1:
+        raise ParameterError(f"fill {fill_percent:g} % of {full} particles rounds to none")
+    return n, full
+
+
+def settle(state: CellsState, settings: KernelSettings, *,
+           max_time_s: float = defaults.DEM_MAX_SETTLE_TIME_S,
+           kinetic_fraction: float = defaults.DEM_SETTLE_KINETIC_FRACTION) -> float:
+    """Let the particles come to rest under gravity in the resting cell; returns the time, s.
+
+    Ends when every cell's kinetic energy is below ``kinetic_fraction * N m g r``. Spheres
+    without rolling resistance can roll about for a long time in a wide cell; after half of
+    ``max_time_s`` the velocities are therefore zeroed after every 2 ms chunk (quench) so the
+    bed comes to rest in its contacts. Raises SimulationError if not at rest by ``max_time_s``.
+    """
+    law = settings.law
+    threshold = kinetic_fraction * state.n_particles * law.mass_kg * settings.gravity_m_s2 \
+        * law.radius_m
+    chunk = max(int(round(2e-3 / settings.dt_s)), 1)
+    elapsed = 0.0
+    zero = np.zeros(3)
+    while True:
+        advance(state, settings, chunk)
+        elapsed += chunk * settings.dt_s
+        e = energies(state, law, settings.geometry, wall_offset_m=zero,
+                     gravity_m_s2=settings.gravity_m_s2)
+        if np.all(e[:, 0] < threshold):
+            state.step = 0
+            return elapsed
+        if elapsed > 0.5 * max_time_s:
+            state.vel[:] = 0.0
+            state.omg[:] = 0.0
+        if elapsed > max_time_s:
+            raise SimulationError(
+                f"settling: kinetic energy still {e[:, 0].max():.3g} J > {threshold:.3g} J "
+                f"after {elapsed:.3g} s")
+
+
+def _steady_start(dissipated: np.ndarray, work: np.ndarray, config: DemConfig) -> int | None:
+    """First cycle of the steady state from coupon-level per-cycle dissipation and wall work.
+
+    Successive blocks of ``block_cycles`` cycles are compared: steady from block b-1 on when
+    (1) the dissipation means of blocks b-1 and b differ by less than
+    ``steady_relative_tolerance`` of the larger mean plus two combined standard errors (the
+    cycle-to-cycle scatter of a granular bed is large; the error term keeps noise from
+    delaying detection forever), and (2) in both blocks the walls' work matches the
+    dissipation within DEM_STEADY_BALANCE_TOLERANCE (no stored energy drifting, e.g. a bed
+    still compacting, which releases potential energy for tens of cycles).
+    """
+    b = config.block_cycles
+    n_blocks = len(dissipated) // b
+    tol_balance = defaults.DEM_STEADY_BALANCE_TOLERANCE
+
+    def balanced(k: int) -> bool:
+        d = dissipated[k * b:(k + 1) * b].sum()
+        w = work[k * b:(k + 1) * b].sum()
+        return abs(w - d) <= tol_balance * max(abs(d), 1e-300) or d == w
+
+    for k in range(1, n_blocks):
+        x0 = dissipated[(k - 1) * b:k * b]
+        x1 = dissipated[k * b:(k + 1) * b]
+        m0, m1 = x0.mean(), x1.mean()
+        se = math.sqrt((x0.var(ddof=1) + x1.var(ddof=1)) / b) if b > 1 else 0.0
+        converged = abs(m1 - m0) <= (config.steady_relative_tolerance * max(abs(m0), abs(m1))
+                                     + 2 * se)
+        if converged and balanced(k - 1) and balanced(k):
+            return (k - 1) * b
+    return None
+
+
+def required_steady_cycles(case: LoadCase, config: DemConfig) -> int:
+    if config.steady_cycles is not None:
+        return config.steady_cycles
+    by_time = math.ceil(defaults.DEM_MIN_STEADY_TIME_S * case.frequency_hz)
+    return max(min(defaults.DEM_MIN_STEADY_CYCLES, by_time), config.block_cycles)
+
+
+def simulate_load_case(case: LoadCase, config: DemConfig | None = None, *,
+                       progress: bool = False,
+                       geometry: CellGeometry | None = None) -> DemResult:
+    """Simulate K independent cells under one load case and return the SDC (Eq. 8-10).
+
+    Parameters
+    ----------
+    case : LoadCase
+        Frequency, acceleration amplitude, fill, particle material, drive direction.
+    config : DemConfig, optional
+        Numerical settings; ``DemConfig()`` by default.
+    progress : bool
+        Show a tqdm progress bar on stderr.
+    geometry : CellGeometry, optional
+        Cell shape; paper Table 2 by default.
+
+    Returns
+    -------
+    DemResult
+
+    Raises
+    ------
+    ParameterError
+        Unsafe time step, impossible fill.
+    SimulationError
+        Excess overlap, particle escape, no settling.
+
+    Examples
+    --------
+    >>> r = simulate_load_case(LoadCase(500, 5, 50), DemConfig(cells=2, steady_cycles=10))
+    ... # doctest: +SKIP
+    """
+    config = config or DemConfig()
+    geometry = geometry or CellGeometry()
+    wall_clock = time.perf_counter()
+    law = ContactLaw.for_material(case.material, alpha_pp=config.alpha_pp,
+                                  alpha_pw=config.alpha_pw)
+    n, full = particles_per_cell(case.fill_percent, case.material, geometry=geometry,
+                                 fill_reference=config.fill_reference)
+    dt_req = choose_time_step(case, law, geometry, config.time_step)
+    spc_samples = config.samples_per_cycle
+    period = 1.0 / case.frequency_hz
+    sample_every = math.ceil(period / (spc_samples * dt_req))
+    steps_per_cycle = sample_every * spc_samples
+    dt = period / steps_per_cycle
+    if config.damping_coefficient == "calibrated":
+        from .impact import calibrate_damping_coefficient
+
+        v_cal = defaults.DEM_CALIBRATION_SPEED_M_S
+        law = ContactLaw.for_material(
+            case.material,
+            alpha_pw=config.alpha_pw if config.alpha_pw is not None else
+            calibrate_damping_coefficient(law.restitution_pw, "wall", v_cal, dt,
+                                          config.normal_damping_mode, material=case.material),
+            alpha_pp=config.alpha_pp if config.alpha_pp is not None else
+            calibrate_damping_coefficient(law.restitution_pp, "particle", v_cal, dt,
+                                          config.normal_damping_mode, material=case.material))
+
+    rng = np.random.default_rng(config.seed)
+    positions = np.stack([random_packing(geometry, law.radius_m, n, rng)
+                          for _ in range(config.cells)])
+    assert_no_overlap(positions, law.radius_m, geometry)
+    state = CellsState.from_positions(positions, mass_kg=law.mass_kg)
+    common = dict(law=law, geometry=geometry, dt_s=dt, direction=case.direction,
+                  clip_attraction=config.normal_damping_mode == "no_attraction",
+                  friction_regularisation_m_s=config.friction_regularisation_m_s,
+                  max_overlap_fraction=defaults.DEM_MAX_OVERLAP_FRACTION)
+    kernel_clock = time.perf_counter()
+    settle_time = settle(state, KernelSettings(**common))
+    settle_steps = int(round(settle_time / dt))
+    kernel_s = time.perf_counter() - kernel_clock
+
+    axis = AXIS_INDEX[case.direction]
+    unit = np.zeros(3)
+    unit[axis] = 1.0
+    drive = KernelSettings(omega_rad_s=case.omega_rad_s, accel_m_s2=case.acceleration_m_s2,
+                           **common)
+    if config.start_protocol == "with_cell":
+        state.vel[axis] += -case.acceleration_m_s2 / case.omega_rad_s
+    e_start = energies(state, law, geometry, wall_offset_m=np.zeros(3),
+                       gravity_m_s2=STANDARD_GRAVITY)
+
+    need = required_steady_cycles(case, config)
+    b = config.block_cycles
+    tallies: list[np.ndarray] = []
+    samples: list[np.ndarray] = []
+    block_energy = [e_start[:, 3]]  # mechanical energy per cell at each block boundary
+    steady_start: int | None = None
+    detected = False
+    bar = None
+    if progress:
+        from tqdm import tqdm
+        bar = tqdm(total=need + 2 * b, unit="cycle", desc=f"DEM {case.key()}", leave=False)
+    try:
+        while True:
+            kernel_clock = time.perf_counter()
+            t, s = advance(state, drive, b * steps_per_cycle, steps_per_cycle=steps_per_cycle,
+                           sample_every=sample_every)
+            kernel_s += time.perf_counter() - kernel_clock
+            tallies.append(t)
+            samples.append(s)
+            u_now = wall_displacement(state.step * dt, accel_m_s2=case.acceleration_m_s2,
+                                      omega_rad_s=case.omega_rad_s)
+            block_energy.append(energies(state, law, geometry, wall_offset_m=unit * u_now,
+                                         gravity_m_s2=STANDARD_GRAVITY)[:, 3])
+            done = len(tallies) * b
+            if bar is not None:
+                bar.update(b)
+            if steady_start is None:
+                all_t = np.concatenate(tallies, axis=1).mean(axis=0)  # (cycles, 3)
+                steady_start = _steady_start(all_t[:, 1] + all_t[:, 2], all_t[:, 0], config)
+                detected = steady_start is not None
+                if steady_start is None and done >= config.max_transient_cycles:
+                    steady_start = -(-config.max_transient_cycles // b) * b  # block boundary
+                if bar is not None and steady_start is not None:
+                    bar.total = steady_start + need
+                    bar.refresh()
+            if steady_start is not None and done - steady_start >= need:
+                break
+    finally:
+        if bar is not None:
+            bar.close()
+
+    tally = np.concatenate(tallies, axis=1)  # (K, cycles, 3)
+    force = np.concatenate(samples, axis=1)  # (K, cycles * samples_per_cycle)
+    t_end = state.step * dt
+    u_end = wall_displacement(t_end, accel_m_s2=case.acceleration_m_s2,
+                              omega_rad_s=case.omega_rad_s)
+    e_end = energies(state, law, geometry, wall_offset_m=unit * u_end,
+                     gravity_m_s2=STANDARD_GRAVITY)
+    stored_change = block_energy[-1] - block_energy[steady_start // b]  # (K,) J
+    n_cycles = tally.shape[1]
+    m_c = vibrated_mass_kg(config.vibrated_mass, particles_per_cell=n,
+                           particle_mass_kg=law.mass_kg)
+    wall = time.perf_counter() - wall_clock
+    total_steps = n_cycles * steps_per_cycle
+    return DemResult.from_run(
+        case=case, config=config, law=law, tally=tally, wall_force=force,
+        steady_start_cycle=int(steady_start), steady_detected=detected,
+        particles_per_cell=n, full_count=full, m_c_kg=m_c, coupon_mass_kg=coupon_mass_kg(),
+        dt_s=dt, steps_per_cycle=steps_per_cycle, sample_every=sample_every,
+        energy_start=e_start, energy_end=e_end, settle_time_s=settle_time,
+        stored_energy_change_steady=stored_change,
+        steps=total_steps, wall_s=wall, kernel_s=kernel_s,
+        particle_steps=(total_steps + settle_steps) * n * config.cells)
+
+
+def config_parameters(case: LoadCase, config: DemConfig) -> dict:
+    """Flat dict of every input (JSON-safe) for records and stores."""
+    out = {f"case_{k}": v for k, v in asdict(case).items()}
+    out.update({f"config_{k}": v for k, v in asdict(config).items()})
+    return {k: ("" if v is None else v) for k, v in out.items()}
+
+
+__all__ = ["LoadCase", "DemConfig", "simulate_load_case", "choose_time_step",
+           "particles_per_cell", "vibrated_mass_kg", "coupon_mass_kg", "max_impact_speed",
+           "settle", "config_parameters"]

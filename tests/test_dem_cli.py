@@ -1,0 +1,48 @@
+"""``pidcore dem run`` command line."""
+
+import json
+
+import pytest
+
+from pidcore.cli import main
+from pidcore.cli.dem import JSON_KEYS
+
+ARGS = ["dem", "run", "--frequency", "500", "--acceleration", "5", "--fill", "50",
+        "--cells", "2", "--cycles", "5", "--no-progress"]
+
+
+def test_json_is_one_document_with_the_agreed_keys(capsys):
+    assert main(ARGS + ["--json"]) == 0
+    out = capsys.readouterr().out
+    doc = json.loads(out)  # exactly one JSON document: json.loads rejects trailing data
+    assert set(JSON_KEYS) <= set(doc)
+    assert doc["particles_per_cell"] == 11 and doc["cells_simulated"] == 2
+    assert doc["sdc"] == pytest.approx(doc["energy_per_cycle_j"] / doc["max_kinetic_energy_j"])
+
+
+def test_readable_summary_names_units_and_particle_count(capsys):
+    assert main(ARGS + ["--start", "rest", "--damping-mode", "literal"]) == 0
+    out = capsys.readouterr().out
+    assert "11 of 22 acrylic particles per cell" in out and "J/cycle" in out and "[-]" in out
+
+
+def test_unsafe_time_step_is_one_line_error_exit_2(capsys):
+    code = main(["dem", "run", "--frequency", "50", "--acceleration", "10", "--fill", "50",
+                 "--time-step", "2e-6", "--no-progress"])
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("\n") == 1 and "time_step <=" in err
+
+
+def test_paper_fill_reference_refused(capsys):
+    code = main(ARGS + ["--fill-reference", "paper"])
+    assert code == 2 and "do not fit" in capsys.readouterr().err
+
+
+def test_store_round_trip(tmp_path, capsys):
+    store_mod = pytest.importorskip("pidcore.store")
+    path = tmp_path / "s.h5"
+    assert main(ARGS + ["--json", "--store", str(path)]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    store = store_mod.Store(path)
+    assert doc["store_key"] == "acrylic_z_f500_a5_fill50_seed12345_cells2"
+    assert hasattr(store, "add_dem_run")
