@@ -59,7 +59,7 @@ DEM_STEADY_BLOCK_CYCLES = 10
 DEM_STEADY_RELATIVE_TOLERANCE = 0.1
 #: ... and in both blocks the walls' work matches the dissipation within this fraction (a bed
 #: still compacting releases potential energy: work < dissipation for tens of cycles).
-DEM_STEADY_BALANCE_TOLERANCE = 0.05
+DEM_STEADY_BALANCE_TOLERANCE = 0.02
 #: Longest transient skipped before measuring regardless (then flagged not converged).
 DEM_MAX_TRANSIENT_CYCLES = 100
 #: Force samples per drive cycle kept for the virtual shaker test (interval means).

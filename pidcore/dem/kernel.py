@@ -18,7 +18,7 @@ Energy tallies per cell and cycle (index ``[cell, cycle, k]``):
   0 work of the walls on the particles, sum f_wall_on_particle . v_wall dt
   1 dissipated by normal damping, sum f_damping * delta_dot(t) * dt
   2 dissipated by friction, sum -f_t . v_t(t) dt
-with the full-step velocities v(t) after the second kick (see below). The force law makes
+with the full-step velocities v(t) after the second kick (see above). The force law makes
 both non-negative with the predicted velocity it uses; with v(t) an increment could only turn
 negative if other contacts reversed the motion within one step (tests check the totals).
 Samples: sum over the sample interval of the drive-axis component of the force the walls

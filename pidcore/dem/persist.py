@@ -9,9 +9,14 @@ from .simulate import config_parameters
 
 
 def run_key(result: DemResult) -> str:
-    """Store key of a run: case, seed and cell count, e.g.
-    ``acrylic_z_f50_a5_fill50_seed12345_cells8``."""
-    return f"{result.case.key()}_seed{result.config.seed}_cells{result.cells_simulated}"
+    """Store key of a run, the same as a sweep gives it (so a sweep skips it on resume):
+    case, seed, cell count and a hash of every other input, e.g.
+    ``acrylic_z_f50_a5_fill50_seed12345_cells8_<hash>``."""
+    try:
+        from .sweep import run_key as sweep_key
+    except ImportError:  # sweep module not installed in this tree
+        return f"{result.case.key()}_seed{result.config.seed}_cells{result.cells_simulated}"
+    return sweep_key(result.case, result.config)
 
 
 def save_dem_result(store_path: str | Path, result: DemResult, *,

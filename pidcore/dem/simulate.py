@@ -1,7 +1,35 @@
 """One DEM load case: settle, drive, detect steady state, tally energy, compute the SDC.
 
 :func:`simulate_load_case` is a pure function of a :class:`LoadCase` and a :class:`DemConfig`
-(same inputs and seed -> same result), so a sweep can map it over a grid.
+(same inputs and seed -> same result, whatever the thread count), so a sweep can map it over a
+grid.
+
+Method (choices and why):
+
+* **Cells.** K independent cells (default 8, different random packings from one seed) stand
+  for the coupon's 441 identical cells; coupon energies are 441 x the K-cell mean, and the
+  SDC's standard error is taken across the K cells.
+* **Fill.** 100 % is the cell's capacity: spheres dropped one by one, each to the lowest rest
+  position on a fine grid of centres (:func:`~pidcore.dem.geometry.cell_capacity`; 22 acrylic
+  r = 1.25 mm, 55 aluminium r = 1 mm in the 4.76 x 25.4 mm cell). The paper's 36 particles
+  = 100 % (``fill_reference="paper"``) is refused where 36 do not fit (acrylic: the particle
+  centres are confined to a hexagon of apothem 1.13 mm, two spheres per layer at most).
+* **Start.** Random non-overlapping drop packings (asserted), settled under gravity in the
+  resting cell until every cell's kinetic energy < DEM_SETTLE_KINETIC_FRACTION x N m g r;
+  then the drive starts with the particles moving with the cell (``start_protocol="with_cell"``,
+  no start jolt) or at rest.
+* **Time step.** ``"auto"`` = min(2e-6 s, t_contact / 10) with t_contact the Hertz contact time
+  at the largest expected impact speed 2 a/w + sqrt(2 g h) (particle and wall moving
+  oppositely at the drive's velocity amplitude, plus a free fall over the cell height); an
+  explicit step above that is refused. The step is then shortened slightly so that a drive
+  period holds a whole number of sample intervals (DEM_SAMPLES_PER_CYCLE per cycle).
+* **Steady state.** Blocks of DEM_STEADY_BLOCK_CYCLES cycles: steady once successive block
+  means of the dissipation agree and the walls' work balances the dissipation in both blocks
+  (:func:`_steady_start`), at most DEM_MAX_TRANSIENT_CYCLES skipped (then flagged). Measured
+  window: DEM_MIN_STEADY_CYCLES cycles, or at low frequency DEM_MIN_STEADY_TIME_S of
+  simulated time if that is fewer cycles (50 cycles at 50 Hz).
+* **SDC.** Eq. 8-10: steady dissipation per cycle over E = m_c a^2 / (2 w^2), m_c per
+  ``vibrated_mass`` (default: coupon face sheets + core + all particles of the 441 cells).
 """
 
 from __future__ import annotations
