@@ -184,3 +184,35 @@ def test_measured_case_sorts_into_its_grid_block():
     pos = int(np.flatnonzero(t["source file(s)"] == "m.csv")[0])
     assert list(t["frequency [Hz]"][:pos]) == [50.0] * 4 + [100.0] * 2
     assert list(t["acceleration [g]"][pos + 1:]) == [5.0, 5.0]
+
+
+def test_measured_sdc_with_eq10_energy_uses_the_dem_vibrated_mass():
+    """ΔE_measured / (m_c a^2 / (2 w^2)) with m_c of the aligned DEM case, computed by hand."""
+    import math
+
+    import pandas as pd
+
+    from pidcore.constants import STANDARD_GRAVITY
+    from pidcore.model import load_paper_table3
+    from pidcore.report import build_report_table
+    from pidcore.report.table import MEASURED_EQ10_COLUMN
+
+    m_c, energy = 0.069, 1.25e-5
+    dem = pd.DataFrame({"frequency_hz": [500.0], "acceleration_g": [5.0], "fill_percent": [50.0],
+                        "material": ["acrylic"], "direction": ["z"], "sdc": [1.5],
+                        "sdc_stderr": [0.03], "m_c_kg": [m_c]})
+    measured = pd.DataFrame({"frequency_hz": [500.2], "acceleration_g": [4.98],
+                             "fill_percent": [50.0], "sdc": [4.3], "sdc_stderr": [0.1],
+                             "energy_per_cycle_j": [energy], "source": ["x.csv"]})
+    table = build_report_table(dem, measured, load_paper_table3())
+    row = table[table["load case"].str.startswith("f500Hz_a5g_fill50")].iloc[0]
+    w = 2 * math.pi * 500.2
+    expected = energy / (m_c * (4.98 * STANDARD_GRAVITY) ** 2 / (2 * w**2))
+    assert row[MEASURED_EQ10_COLUMN] == pytest.approx(expected, rel=1e-12)
+    assert row["SDC measured [-]"] == 4.3  # Eq. 11 value kept as measured
+    assert row["difference measured - ours [-]"] == pytest.approx(expected - 1.5, rel=1e-12)
+    # without m_c the like-for-like column is empty and the difference falls back to Eq. 11
+    table = build_report_table(dem.drop(columns="m_c_kg"), measured, load_paper_table3())
+    row = table[table["load case"].str.startswith("f500Hz_a5g_fill50")].iloc[0]
+    assert math.isnan(row[MEASURED_EQ10_COLUMN])
+    assert row["difference measured - ours [-]"] == pytest.approx(4.3 - 1.5, rel=1e-12)

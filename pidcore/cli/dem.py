@@ -1,8 +1,4 @@
-"""``pidcore dem``: DEM prediction of the SDC of one load case (``run``).
-
-A ``sweep`` sub-command (grid of load cases) plugs in beside ``run``: add its parser in
-``register`` below.
-"""
+"""``pidcore dem``: DEM prediction of the SDC of one load case (``run``) or a grid (``sweep``)."""
 
 from __future__ import annotations
 
@@ -41,8 +37,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         description="Discrete element simulation of particles in honeycomb cells.")
     sub = dem.add_subparsers(dest="dem_command", metavar="DEM_COMMAND", required=True)
     _register_run(sub)
-    # sweep: sub.add_parser("sweep", ...) goes here (grid of LoadCase over
-    # pidcore.dem.simulate_load_case).
+    _register_sweep(sub)
 
 
 def _register_run(sub: argparse._SubParsersAction) -> None:
@@ -56,6 +51,16 @@ def _register_run(sub: argparse._SubParsersAction) -> None:
                    help="acceleration amplitude, g")
     p.add_argument("--fill", metavar="PERCENT", type=float, required=True,
                    help="fill fraction, %% of the 100 %% count (see --fill-reference)")
+    _add_config_options(p)
+    p.add_argument("--store", metavar="FILE", type=Path, default=None,
+                   help="also save the run to this HDF5 store")
+    p.add_argument("--json", action="store_true", help="one JSON document on stdout")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.set_defaults(func=run)
+
+
+def _add_config_options(p: argparse.ArgumentParser) -> None:
+    """Options of DemConfig and of the load case shared by ``run`` and ``sweep``."""
     p.add_argument("--cells", metavar="K", type=int, default=defaults.DEM_CELLS,
                    help=f"independent cells simulated (default {defaults.DEM_CELLS})")
     p.add_argument("--seed", metavar="S", type=int, default=defaults.DEM_SEED,
@@ -86,23 +91,57 @@ def _register_run(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--fill-reference", choices=("capacity", "paper"),
                    default=defaults.DEM_FILL_REFERENCE,
                    help="100 %% = cell capacity (dense packing) or the paper's 36 particles")
-    p.add_argument("--store", metavar="FILE", type=Path, default=None,
-                   help="also save the run to this HDF5 store")
+
+
+def _register_sweep(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "sweep", help="simulate a grid of load cases (resumable)",
+        description="Simulate every load case of a grid and save each to the store as it "
+                    "finishes; a re-run skips finished cases. Local processes by default, a "
+                    "dask.distributed cluster with --scheduler.")
+    p.add_argument("--grid", default="table3", help="named grid (default table3: 48 cases)")
+    _add_config_options(p)
+    p.add_argument("--workers", metavar="N", type=int, default=None,
+                   help="local processes (default: all cores)")
+    p.add_argument("--scheduler", metavar="ADDR", default=None,
+                   help="dask.distributed scheduler address (needs the 'distributed' extra)")
+    p.add_argument("--store", metavar="FILE", type=Path, default=defaults.STORE_PATH,
+                   help=f"HDF5 store (default ./{defaults.STORE_PATH})")
     p.add_argument("--json", action="store_true", help="one JSON document on stdout")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
-    p.set_defaults(func=run)
+    p.set_defaults(func=sweep)
+
+
+def _config(args: argparse.Namespace):
+    from ..dem import DemConfig
+
+    return DemConfig(cells=args.cells, seed=args.seed, time_step=args.time_step,
+                     normal_damping_mode=args.damping_mode,
+                     damping_coefficient=args.damping_coefficient,
+                     vibrated_mass=args.mass_convention, start_protocol=args.start,
+                     fill_reference=args.fill_reference, steady_cycles=args.cycles)
+
+
+def sweep(args: argparse.Namespace) -> int:
+    from ..dem.sweep import grid_cases, run_sweep
+
+    cases = grid_cases(args.grid, material=args.material, direction=args.direction)
+    summary = run_sweep(cases, _config(args), store_path=args.store, workers=args.workers,
+                        scheduler=args.scheduler, progress=not args.no_progress)
+    if args.json:
+        print(json.dumps(summary.to_dict()))
+    else:
+        print(f"{len(summary.completed)} case(s) simulated, {len(summary.skipped)} already in "
+              f"{args.store}; wall time {summary.wall_s:.1f} s")
+    return 0
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..dem import DemConfig, LoadCase, simulate_load_case
+    from ..dem import LoadCase, simulate_load_case
 
     case = LoadCase(args.frequency, args.acceleration, args.fill, material=args.material,
                     direction=args.direction)
-    config = DemConfig(cells=args.cells, seed=args.seed, time_step=args.time_step,
-                       normal_damping_mode=args.damping_mode,
-                       damping_coefficient=args.damping_coefficient,
-                       vibrated_mass=args.mass_convention, start_protocol=args.start,
-                       fill_reference=args.fill_reference, steady_cycles=args.cycles)
+    config = _config(args)
     result = simulate_load_case(case, config,
                                 progress=not args.no_progress and sys.stderr.isatty())
     key = None

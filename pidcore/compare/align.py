@@ -113,6 +113,8 @@ class DemCase:
         Particles per cell of the runs (NaN if unknown or differing).
     run_keys : tuple of str
         Store keys of the runs.
+    vibrated_mass_kg : float
+        Mean m_c of the runs (the mass in E = m_c a^2 / (2 w^2), Eq. 10), kg; NaN if unknown.
     """
 
     load_case: LoadCase
@@ -121,6 +123,7 @@ class DemCase:
     n_runs: int
     particles_per_cell: float = math.nan
     run_keys: tuple[str, ...] = ()
+    vibrated_mass_kg: float = math.nan
 
 
 @dataclass(frozen=True)
@@ -252,7 +255,8 @@ def dem_cases(dem_runs: pd.DataFrame, *, tolerances: Tolerances | None = None) -
                 ppc = float(unique[0])
         key_column = "case_key" if "case_key" in sub else "key"
         keys = tuple(str(k) for k in sub[key_column]) if key_column in sub else ()
-        out.append(DemCase(case, sdc, stderr, len(members), ppc, keys))
+        m_c = float(sub["m_c_kg"].astype(float).mean()) if "m_c_kg" in sub else math.nan
+        out.append(DemCase(case, sdc, stderr, len(members), ppc, keys, m_c))
     return sorted(out, key=lambda c: _sort_key(c.load_case))
 
 

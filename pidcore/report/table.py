@@ -17,7 +17,12 @@ import pandas as pd
 
 from ..compare.align import Aligner, DemCase, Tolerances, match_paper, pooled_mean
 from ..compare.loadcase import LoadCase, LoadCaseError
+from ..constants import STANDARD_GRAVITY
 
+#: Measured energy per cycle over the DEM case's E = m_c a^2 / (2 w^2) (Eq. 10): the like-for-like
+#: counterpart of our DEM SDC. The Eq. 11 SDC divides by Im(P_c)/w instead, the reactive energy,
+#: which is smaller than Eq. 10's E whenever particles fly free of the cell walls.
+MEASURED_EQ10_COLUMN = "SDC measured, E of Eq. 10 [-]"
 #: Column holding the alignment status.
 ALIGNMENT_COLUMN = "alignment [grid/interpolated/out_of_range]"
 #: Columns of :func:`build_report_table`, in order.
@@ -25,7 +30,8 @@ REPORT_COLUMNS: tuple[str, ...] = (
     "frequency [Hz]", "acceleration [g]", "packing ratio [%]", "material", "direction",
     "particles per cell [-]", "DEM runs [-]", "SDC DEM (ours) [-]", "SDC DEM stderr [-]",
     "measured frequency [Hz]", "measured acceleration [g]", "SDC measured [-]",
-    "SDC measured stderr [-]", "SDC DEM (paper) [-]", "SDC measured (paper) [-]",
+    "SDC measured stderr [-]", MEASURED_EQ10_COLUMN, "SDC DEM (paper) [-]",
+    "SDC measured (paper) [-]",
     "difference ours - paper DEM [-]", "difference measured - ours [-]", ALIGNMENT_COLUMN,
     "source file(s)", "load case", "note",
 )
@@ -125,7 +131,8 @@ def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | N
     for case, rec in _measured_rows(analyses, notes):
         aligned = aligner.align(case)
         entry = (float(rec["sdc"]), float(rec["sdc_stderr"]), case.frequency_hz,
-                 case.acceleration_g, str(rec.get("source", "")))
+                 case.acceleration_g, str(rec.get("source", "")),
+                 float(rec.get("energy_per_cycle_j", math.nan)))
         if aligned.status == "grid" and aligned.grid_case is not None:
             rows[aligned.grid_case.load_case.key].measured.append(entry)
             continue
@@ -149,6 +156,12 @@ def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | N
             f_m = float(np.mean([m[2] for m in row.measured]))
             a_m = float(np.mean([m[3] for m in row.measured]))
             sources = "; ".join(m[4] for m in row.measured if m[4])
+        sdc_m10 = sdc_m10_se = math.nan
+        m_c = row.dem.vibrated_mass_kg if row.dem is not None else math.nan
+        if row.measured and math.isfinite(m_c):
+            sdc10 = np.array([_sdc_eq10(m[5], m_c, m[3], m[2]) for m in row.measured])
+            scale = sdc10 / np.array([m[0] for m in row.measured])
+            sdc_m10, sdc_m10_se = pooled_mean(sdc10, errors * scale)
         note = list(row.notes)
         if len(row.measured) > 1:
             note.append(f"{len(row.measured)} measurements pooled")
@@ -168,10 +181,13 @@ def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | N
             "measured acceleration [g]": a_m,
             "SDC measured [-]": sdc_m,
             "SDC measured stderr [-]": sdc_m_se,
+            MEASURED_EQ10_COLUMN: sdc_m10,
             "SDC DEM (paper) [-]": row.paper_dem,
             "SDC measured (paper) [-]": row.paper_exp,
             "difference ours - paper DEM [-]": row.sdc_dem - row.paper_dem,
-            "difference measured - ours [-]": sdc_m - row.sdc_dem,
+            # like with like where the DEM's m_c is known, else the paper's way (Eq. 11)
+            "difference measured - ours [-]": (sdc_m10 if math.isfinite(sdc_m10) else sdc_m)
+            - row.sdc_dem,
             ALIGNMENT_COLUMN: row.status,
             "source file(s)": sources,
             "load case": lc.key,
@@ -182,6 +198,14 @@ def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | N
     table = _sort_like_table3(table, aligner, paper, tolerances)
     table.attrs["notes"] = notes
     return table
+
+
+def _sdc_eq10(energy_per_cycle_j: float, vibrated_mass_kg: float, acceleration_g: float,
+              frequency_hz: float) -> float:
+    """Energy per cycle over E = m_c a^2 / (2 w^2) (Eq. 8-10), [-]."""
+    omega = 2 * math.pi * frequency_hz
+    energy = vibrated_mass_kg * (acceleration_g * STANDARD_GRAVITY) ** 2 / (2 * omega**2)
+    return energy_per_cycle_j / energy if energy > 0 else math.nan
 
 
 def _snap(values: pd.Series, grid: np.ndarray, *, rtol: float = 0.0,
