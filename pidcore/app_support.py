@@ -309,6 +309,62 @@ def load_case_of(record: AnalyzedRecord, *, fill_percent: float, material: str,
                     material, direction)
 
 
+#: Name of an uploaded sidecar table stating fill/material/direction per file.
+SIDECAR_UPLOAD_NAME = "loadcases.csv"
+
+
+def is_sidecar_upload(name: str) -> bool:
+    """Whether an upload is a load case sidecar table rather than a measurement."""
+    return Path(name).name.lower() == SIDECAR_UPLOAD_NAME
+
+
+def read_sidecar_upload(data: bytes) -> pd.DataFrame:
+    """An uploaded ``loadcases.csv`` (:func:`pidcore.compare.read_sidecar`), via a temp file."""
+    from .compare import read_sidecar
+
+    with tempfile.TemporaryDirectory(prefix="pidcore_upload_") as folder:
+        path = Path(folder) / SIDECAR_UPLOAD_NAME
+        path.write_bytes(data)
+        try:
+            return read_sidecar(path)
+        except PidcoreError as exc:
+            raise type(exc)(str(exc).replace(str(path), SIDECAR_UPLOAD_NAME)) from None
+
+
+@dataclass(frozen=True)
+class StatedCase:
+    """Fill, material and direction proposed for an upload, and where they come from."""
+
+    fill_percent: float
+    material: str
+    direction: str
+    origin: str
+
+
+def stated_case(name: str, sidecar: pd.DataFrame | None = None) -> StatedCase:
+    """What the file name and an uploaded sidecar state about an upload (sidecar wins).
+
+    Without a stated fill, :data:`DEFAULT_FILL_PERCENT` is proposed and the origin says so;
+    the user confirms or corrects it in the app.
+    """
+    from .compare import SIDECAR_COLUMNS, resolve_load_case
+    from .compare.loadcase import parse_file_name
+
+    table = sidecar if sidecar is not None else pd.DataFrame(columns=list(SIDECAR_COLUMNS))
+    try:
+        s = resolve_load_case(Path(Path(name).name), sidecar=table)
+        return StatedCase(s.fill_percent, s.material, s.direction, s.origin)
+    except PidcoreError:
+        try:  # no fill stated (or a bad sidecar row): keep what the name states, propose a fill
+            found = parse_file_name(Path(name).name)
+        except PidcoreError:
+            found = {}
+        return StatedCase(DEFAULT_FILL_PERCENT,
+                          str(found.get("material", defaults.COMPARE_DEFAULT_MATERIAL)),
+                          str(found.get("direction", defaults.COMPARE_DEFAULT_DIRECTION)),
+                          f"fill: not stated, {DEFAULT_FILL_PERCENT:g} % proposed")
+
+
 def group_load_cases(cases: Sequence[LoadCase]) -> list[list[int]]:
     """Indices of ``cases`` grouped into one load case each (within the compare tolerances).
 

@@ -49,10 +49,10 @@ def _free_port() -> int:
 
 
 def _sample(tmp_path: Path) -> Path:
-    """A bundled data_samples/ export if there is one, else a synthetic mass-damper CSV."""
-    for pattern in ("**/*.csv", "**/*.uff"):
-        found = sorted(p for p in (REPO / "data_samples").glob(pattern)
-                       if p.is_file() and p.name != "loadcases.csv")
+    """A bundled sample export (CSV, else UFF) if there is one, else a synthetic CSV."""
+    samples = Path(os.environ.get("PIDCORE_SAMPLES_DIR", REPO / "data_samples"))
+    for pattern in ("exports/*.csv", "exports/*.uff", "**/*.uff"):
+        found = sorted(p for p in samples.glob(pattern) if p.is_file())
         if found:
             return found[0]
     path = tmp_path / "synthetic_fill50_acrylic.csv"

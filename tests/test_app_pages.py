@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 import time
 from pathlib import Path
 
@@ -300,3 +301,67 @@ def test_reference_dem_store_is_compared_but_never_written(store_file, tmp_path,
     at.run()
     assert len(Store(store_file).list_analyses()) == 1
     assert ref.read_bytes() == ref_bytes
+
+
+#: The bundled samples (``pidcore samples make``); PIDCORE_SAMPLES_DIR points elsewhere.
+SAMPLES = Path(os.environ.get("PIDCORE_SAMPLES_DIR", REPO / "data_samples"))
+
+
+def test_bundled_samples_switch_load_cases_from_the_cache(store_file, monkeypatch):
+    from pidcore.measure import AnalysisOptions, analyze_file
+
+    exports = sorted(p for p in (SAMPLES / "exports").glob("*") if p.is_file())
+    dem_store = SAMPLES / "dem_table3.h5"
+    if not exports or not dem_store.is_file():
+        pytest.skip(f"no bundled samples in {SAMPLES} (pidcore samples make)")
+    from pidcore.samples import EXPORT_VELOCITY_DELAY_S
+
+    monkeypatch.setenv(app_support.DEM_STORE_ENV_VAR, str(dem_store))
+    calls = []
+    real = app_support.analyze_parsed
+
+    def counting(parsed, options):
+        calls.append(parsed.name)
+        return real(parsed, options)
+
+    monkeypatch.setattr(app_support, "analyze_parsed", counting)
+    at = _app()
+    at.number_input(key="delay_us").set_value(EXPORT_VELOCITY_DELAY_S * 1e6)
+    at.run()
+    at = _upload(at, [(p.name, p.read_bytes()) for p in exports])
+    assert not at.error, [e.value for e in at.error]
+    options = AnalysisOptions(velocity_delay_s=EXPORT_VELOCITY_DELAY_S)
+    want = {p.name: analyze_file(p, options).analysis.sdc for p in exports}
+    table = _table(at, "velocity channel")
+    assert dict(zip(table["file"], table["SDC [-]"], strict=True)) == pytest.approx(want,
+                                                                                   rel=1e-12)
+    n_cases = len(at.selectbox(key="compare_case").options)
+    assert n_cases == len(exports)  # one load case per sample export
+    analysed = len(calls)
+    timings = []
+    for _ in range(2):
+        for choice in range(n_cases):
+            at.selectbox(key="compare_case").set_value(choice)
+            start = time.perf_counter()
+            at.run()
+            timings.append(time.perf_counter() - start)
+            assert not at.exception
+            # Every sample lies on the DEM grid of the bundled store.
+            assert "DEM alignment: grid" in " ".join(c.value for c in at.caption)
+    assert len(calls) == analysed  # switching never re-analyses
+    ARTIFACTS.mkdir(exist_ok=True)
+    (ARTIFACTS / "app_switch_timing_samples.json").write_text(json.dumps(
+        {"load_case_switch_s": timings, "cases": n_cases,
+         "note": "AppTest whole-page run after choosing another load case with the bundled "
+                 "samples uploaded; first pass builds each comparison, second pass is cached"},
+        indent=1))
+
+
+def test_uploaded_sidecar_states_the_load_case(store_file):
+    at = _upload(_app(), [("loadcases.csv", b"file,fill_percent,material\nrun7.csv,75,aluminium\n"),
+                          ("run7.csv", mass_damper_csv())])
+    assert any("loadcases.csv: load cases of 1 file(s) stated" in i.value for i in at.info)
+    table = _table(at, "velocity channel")
+    assert table["file"].tolist() == ["run7.csv"]  # the sidecar is not a measurement
+    assert table["material"].tolist() == ["aluminium"]
+    assert table["load case"].iloc[0].endswith("75 %")

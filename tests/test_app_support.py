@@ -462,3 +462,23 @@ def test_stores_come_from_the_environment_or_the_bundled_samples(tmp_path):
     before = stores.stamp()
     (tmp_path / "a.h5").write_bytes(b"x")
     assert stores.stamp() != before  # a rewritten store invalidates cached listings
+
+
+def test_load_case_is_proposed_from_name_and_uploaded_sidecar():
+    from pidcore.compare import LoadCaseError
+
+    by_name = app_support.stated_case("run_fill75_aluminum_dirx.csv")
+    assert (by_name.fill_percent, by_name.material, by_name.direction) == (75.0, "aluminium",
+                                                                           "x")
+    sidecar = app_support.read_sidecar_upload(
+        b"file,fill_percent,material,direction\nrun_fill75_aluminum_dirx.csv,90,acrylic,z\n")
+    # The sidecar overrides the file name (as in pidcore report).
+    both = app_support.stated_case("run_fill75_aluminum_dirx.csv", sidecar)
+    assert (both.fill_percent, both.material, both.direction) == (90.0, "acrylic", "z")
+    assert "sidecar" in both.origin
+    unstated = app_support.stated_case("plain.csv", sidecar)
+    assert unstated.fill_percent == app_support.DEFAULT_FILL_PERCENT
+    assert "not stated" in unstated.origin
+    assert app_support.is_sidecar_upload("LoadCases.CSV")
+    with pytest.raises(LoadCaseError, match=r"^loadcases\.csv: .*lacks column 'file'"):
+        app_support.read_sidecar_upload(b"a,b\n1,2\n")

@@ -110,9 +110,8 @@ def _corrections():
                            sample_rate_hz=rate if rate > 0 else None)
 
 
-def _file_panel(index: int, upload, base_options):
+def _file_panel(index: int, upload, base_options, sidecar):
     """Mapping, load case and results of one file; returns (record, load case) or None."""
-    from pidcore.compare import parse_file_name
     from pidcore.errors import PidcoreError
 
     name = upload.name
@@ -139,25 +138,20 @@ def _file_panel(index: int, upload, base_options):
             opts = ch.options(role)
             roles[role] = col.selectbox(f"{role} channel", opts, index=ch.default_index(role),
                                         key=f"{role}_{wkey}")
-        try:
-            stated = parse_file_name(name)
-        except PidcoreError:
-            stated = {}
+        stated = app_support.stated_case(name, sidecar)
         c4, c5, c6 = st.columns(3)
         fill = c4.number_input("fill (packing ratio) [%]", min_value=0.1, max_value=100.0,
-                               value=float(stated.get("fill_percent",
-                                                      app_support.DEFAULT_FILL_PERCENT)),
-                               step=5.0, key=f"fill_{wkey}")
+                               value=float(stated.fill_percent), step=5.0,
+                               key=f"fill_{wkey}")
         materials = list(PARTICLE_MATERIALS)
         material = c5.selectbox("particle material", materials,
-                                index=materials.index(stated.get(
-                                    "material", defaults.COMPARE_DEFAULT_MATERIAL)),
+                                index=materials.index(stated.material),
                                 key=f"material_{wkey}")
         directions = list(DRIVE_DIRECTIONS)
         direction = c6.selectbox("drive direction", directions,
-                                 index=directions.index(stated.get(
-                                     "direction", defaults.COMPARE_DEFAULT_DIRECTION)),
+                                 index=directions.index(stated.direction),
                                  key=f"direction_{wkey}")
+        st.caption(f"load case stated by {stated.origin}")
         options = app_support.role_options(base_options, **roles)
         outcome = _analysed(sha, name, options.sample_rate_hz,
                             app_support.options_to_json(options), upload)
@@ -190,9 +184,22 @@ def analyse_page(stores) -> list:
     uploads = st.file_uploader("shaker-test exports", accept_multiple_files=True,
                                key="uploads", max_upload_size=defaults.APP_MAX_UPLOAD_MB)
     base = _corrections()
+    sidecar = None
+    measurements = []
+    for upload in uploads or []:
+        if not app_support.is_sidecar_upload(upload.name):
+            measurements.append(upload)
+            continue
+        from pidcore.errors import PidcoreError
+
+        try:
+            sidecar = app_support.read_sidecar_upload(upload.getvalue())
+            st.info(f"{upload.name}: load cases of {len(sidecar)} file(s) stated")
+        except PidcoreError as exc:
+            st.error(str(exc))
     analysed = []
-    for i, upload in enumerate(uploads or []):
-        result = _file_panel(i, upload, base)
+    for i, upload in enumerate(measurements):
+        result = _file_panel(i, upload, base, sidecar)
         if result is not None:
             analysed.append(result)
     if analysed:

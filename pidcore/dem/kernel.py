@@ -45,6 +45,13 @@ STATUS_NONFINITE = 3
 N_TALLIES = 3
 
 
+#: Verlet skin of the neighbour lists, as a fraction of the radius. Purely numerical: a pair
+#: (or a particle and a wall) is a candidate while closer than contact + skin, and the lists
+#: are rebuilt before any particle has moved skin/2, so no contact is ever missed and the set
+#: and order of contacts (hence every result bit) are those of the brute-force search.
+NEIGHBOUR_SKIN_FRACTION = 0.3
+
+
 @njit(cache=True, parallel=True)
 def advance_cells(pos, vel, omg, frc, trq, wall_n, wall_d,
                   radius, mass, inertia,
@@ -54,268 +61,414 @@ def advance_cells(pos, vel, omg, frc, trq, wall_n, wall_d,
                   steps_per_cycle, sample_every, max_overlap_fraction,
                   tally, samples, status, fail_step):
     n_cells = pos.shape[1]
+    for c in prange(n_cells):
+        if status[c] != STATUS_OK:
+            continue
+        _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
+                      radius, mass, inertia,
+                      k_pp, c_pp, mu_pp, mt_pp, k_pw, c_pw, mu_pw, mt_pw,
+                      v_reg, clip_attraction, gravity,
+                      dt, step0, n_steps, omega, accel_amp, drive_axis,
+                      steps_per_cycle, sample_every, max_overlap_fraction,
+                      tally, samples, status, fail_step)
+    return 0
+
+
+@njit(cache=True)
+def _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
+                  radius, mass, inertia,
+                  k_pp, c_pp, mu_pp, mt_pp, k_pw, c_pw, mu_pw, mt_pw,
+                  v_reg, clip_attraction, gravity,
+                  dt, step0, n_steps, omega, accel_amp, drive_axis,
+                  steps_per_cycle, sample_every, max_overlap_fraction,
+                  tally, samples, status, fail_step):
+    """Advance cell ``c`` by ``n_steps`` (see the module docstring).
+
+    Speed (results are bit-identical to a brute-force search over all pairs and walls):
+    the cell's state is copied into contiguous 1-D arrays for the chunk; particle pairs
+    and particle-wall pairs come from Verlet lists (candidates within contact + skin, kept
+    in the brute-force order i < j, walls ascending, so forces are summed in the same order)
+    rebuilt whenever a particle has moved skin/2 since the last build (relative to the
+    cell for the walls, which move with it).
+    """
     n_part = pos.shape[2]
     n_walls = wall_n.shape[0]
     inv_m = 1.0 / mass
     inv_i = 1.0 / inertia
     two_r = 2.0 * radius
     max_overlap = max_overlap_fraction * radius
-    for c in prange(n_cells):
-        if status[c] != STATUS_OK:
-            continue
-        vp = np.empty((3, n_part))  # predicted full-step velocities (see module docstring)
-        wp = np.empty((3, n_part))
-        max_contacts = n_walls * n_part + n_part * (n_part - 1) // 2
-        c_idx = np.empty((2, max_contacts), dtype=np.int64)  # i, j (j < 0: wall)
-        c_val = np.empty((8, max_contacts))  # n (3), arm, f_damping, friction force (3)
-        for s in range(n_steps):
-            # --- first half kick and drift -------------------------------------------------
+    skin = NEIGHBOUR_SKIN_FRACTION * radius
+    half_skin2 = 0.25 * skin * skin
+    pair_reach2 = (two_r + skin) * (two_r + skin)
+    wall_reach = radius + skin
+    # contiguous per-cell copies (written back at the end of the chunk)
+    px = pos[0, c].copy()
+    py = pos[1, c].copy()
+    pz = pos[2, c].copy()
+    vx = vel[0, c].copy()
+    vy = vel[1, c].copy()
+    vz = vel[2, c].copy()
+    ox = omg[0, c].copy()
+    oy = omg[1, c].copy()
+    oz = omg[2, c].copy()
+    fx = frc[0, c].copy()
+    fy = frc[1, c].copy()
+    fz = frc[2, c].copy()
+    tx = trq[0, c].copy()
+    ty = trq[1, c].copy()
+    tz = trq[2, c].copy()
+    # predicted full-step velocities (see module docstring)
+    vpx = np.empty(n_part)
+    vpy = np.empty(n_part)
+    vpz = np.empty(n_part)
+    wpx = np.empty(n_part)
+    wpy = np.empty(n_part)
+    wpz = np.empty(n_part)
+    wnx = wall_n[:, 0].copy()
+    wny = wall_n[:, 1].copy()
+    wnz = wall_n[:, 2].copy()
+    wd = wall_d.copy()
+    max_pairs = n_part * (n_part - 1) // 2
+    max_contacts = n_walls * n_part + max_pairs
+    c_idx = np.empty((2, max_contacts), dtype=np.int64)  # i, j (j < 0: wall)
+    c_val = np.empty((8, max_contacts))  # n (3), arm, f_damping, friction force (3)
+    # Verlet lists: pair candidates (i < j, brute-force order), wall candidates per particle
+    nb_i = np.empty(max_pairs, dtype=np.int64)
+    nb_j = np.empty(max_pairs, dtype=np.int64)
+    n_nb = 0
+    wl_start = np.empty(n_part + 1, dtype=np.int64)
+    wl_w = np.empty(n_walls * n_part, dtype=np.int64)
+    ref_x = np.empty(n_part)  # positions at the last build (absolute)
+    ref_y = np.empty(n_part)
+    ref_z = np.empty(n_part)
+    ref_ux = 0.0  # cell displacement at the last build
+    ref_uy = 0.0
+    ref_uz = 0.0
+    rebuild = True
+    for s in range(n_steps):
+        # --- first half kick and drift -------------------------------------------------
+        for i in range(n_part):
+            vx[i] += 0.5 * dt * fx[i] * inv_m
+            vy[i] += 0.5 * dt * fy[i] * inv_m
+            vz[i] += 0.5 * dt * fz[i] * inv_m
+            ox[i] += 0.5 * dt * tx[i] * inv_i
+            oy[i] += 0.5 * dt * ty[i] * inv_i
+            oz[i] += 0.5 * dt * tz[i] * inv_i
+            px[i] += dt * vx[i]
+            py[i] += dt * vy[i]
+            pz[i] += dt * vz[i]
+            vpx[i] = vx[i] + 0.5 * dt * fx[i] * inv_m
+            vpy[i] = vy[i] + 0.5 * dt * fy[i] * inv_m
+            vpz[i] = vz[i] + 0.5 * dt * fz[i] * inv_m
+            wpx[i] = ox[i] + 0.5 * dt * tx[i] * inv_i
+            wpy[i] = oy[i] + 0.5 * dt * ty[i] * inv_i
+            wpz[i] = oz[i] + 0.5 * dt * tz[i] * inv_i
+            fx[i] = 0.0
+            fy[i] = 0.0
+            fz[i] = -mass * gravity
+            tx[i] = 0.0
+            ty[i] = 0.0
+            tz[i] = 0.0
+        # --- wall motion at the new time ------------------------------------------------
+        t = (step0 + s + 1) * dt
+        u = 0.0
+        uv = 0.0
+        if omega > 0.0:
+            u = -accel_amp / (omega * omega) * np.sin(omega * t)
+            uv = -accel_amp / omega * np.cos(omega * t)
+        ux = 0.0
+        uy = 0.0
+        uz = 0.0
+        wvx = 0.0
+        wvy = 0.0
+        wvz = 0.0
+        if drive_axis == 0:
+            ux = u
+            wvx = uv
+        elif drive_axis == 1:
+            uy = u
+            wvy = uv
+        else:
+            uz = u
+            wvz = uv
+        # --- Verlet lists: rebuild once a particle may have moved skin/2 ----------------
+        if not rebuild:
+            dux = ux - ref_ux
+            duy = uy - ref_uy
+            duz = uz - ref_uz
             for i in range(n_part):
-                for k in range(3):
-                    vel[k, c, i] += 0.5 * dt * frc[k, c, i] * inv_m
-                    omg[k, c, i] += 0.5 * dt * trq[k, c, i] * inv_i
-                    pos[k, c, i] += dt * vel[k, c, i]
-                    vp[k, i] = vel[k, c, i] + 0.5 * dt * frc[k, c, i] * inv_m
-                    wp[k, i] = omg[k, c, i] + 0.5 * dt * trq[k, c, i] * inv_i
-                    frc[k, c, i] = 0.0
-                    trq[k, c, i] = 0.0
-                frc[2, c, i] = -mass * gravity
-            # --- wall motion at the new time ------------------------------------------------
-            t = (step0 + s + 1) * dt
-            u = 0.0
-            uv = 0.0
-            if omega > 0.0:
-                u = -accel_amp / (omega * omega) * np.sin(omega * t)
-                uv = -accel_amp / omega * np.cos(omega * t)
-            ux = 0.0
-            uy = 0.0
-            uz = 0.0
-            wvx = 0.0
-            wvy = 0.0
-            wvz = 0.0
-            if drive_axis == 0:
-                ux = u
-                wvx = uv
-            elif drive_axis == 1:
-                uy = u
-                wvy = uv
-            else:
-                uz = u
-                wvz = uv
-            cyc = s // steps_per_cycle
-            smp = s // sample_every
-            w_wall = 0.0
-            d_norm = 0.0
-            d_fric = 0.0
-            f_drive = 0.0
-            n_c = 0
-            # --- particle-wall contacts -----------------------------------------------------
+                ax = px[i] - ref_x[i]
+                ay = py[i] - ref_y[i]
+                az = pz[i] - ref_z[i]
+                if ax * ax + ay * ay + az * az >= half_skin2:
+                    rebuild = True
+                    break
+                ax -= dux
+                ay -= duy
+                az -= duz
+                if ax * ax + ay * ay + az * az >= half_skin2:
+                    rebuild = True
+                    break
+        if rebuild:
+            rebuild = False
+            ref_ux = ux
+            ref_uy = uy
+            ref_uz = uz
+            n_nb = 0
+            n_wl = 0
             for i in range(n_part):
-                px = pos[0, c, i]
-                py = pos[1, c, i]
-                pz = pos[2, c, i]
-                if not (np.isfinite(px) and np.isfinite(py) and np.isfinite(pz)):
-                    status[c] = STATUS_NONFINITE
+                ref_x[i] = px[i]
+                ref_y[i] = py[i]
+                ref_z[i] = pz[i]
+                wl_start[i] = n_wl
                 for w in range(n_walls):
-                    nx = wall_n[w, 0]
-                    ny = wall_n[w, 1]
-                    nz = wall_n[w, 2]
-                    dist = nx * (px - ux) + ny * (py - uy) + nz * (pz - uz) + wall_d[w]
-                    delta = radius - dist
-                    if delta <= 0.0:
-                        continue
-                    if dist < 0.0:
-                        status[c] = STATUS_ESCAPED
-                    if delta > max_overlap:
-                        status[c] = STATUS_OVERLAP
-                    arm = radius - delta
-                    ox = wp[0, i]
-                    oy = wp[1, i]
-                    oz = wp[2, i]
-                    # contact point velocity relative to the wall; contact point at -arm*n
-                    rvx = vp[0, i] - arm * (oy * nz - oz * ny) - wvx
-                    rvy = vp[1, i] - arm * (oz * nx - ox * nz) - wvy
-                    rvz = vp[2, i] - arm * (ox * ny - oy * nx) - wvz
-                    vn = rvx * nx + rvy * ny + rvz * nz
-                    delta_dot = -vn
-                    f_el = k_pw * delta * np.sqrt(delta)
-                    f_n = f_el + c_pw * np.sqrt(np.sqrt(delta)) * delta_dot
-                    if clip_attraction and f_n < 0.0:
-                        f_n = 0.0
-                    fx = f_n * nx
-                    fy = f_n * ny
-                    fz = f_n * nz
-                    gx = 0.0
-                    gy = 0.0
-                    gz = 0.0
-                    tvx = rvx - vn * nx
-                    tvy = rvy - vn * ny
-                    tvz = rvz - vn * nz
-                    vt = np.sqrt(tvx * tvx + tvy * tvy + tvz * tvz)
-                    if vt > 0.0:
-                        ft = mu_pw * abs(f_n)
-                        if vt < v_reg:
-                            ft *= vt / v_reg
-                        cap = 0.5 * mt_pw * vt / dt
-                        if ft > cap:
-                            ft = cap
-                        scale = -ft / vt
-                        gx = scale * tvx
-                        gy = scale * tvy
-                        gz = scale * tvz
-                        fx += gx
-                        fy += gy
-                        fz += gz
-                        # torque = (-arm n) x g
-                        trq[0, c, i] -= arm * (ny * gz - nz * gy)
-                        trq[1, c, i] -= arm * (nz * gx - nx * gz)
-                        trq[2, c, i] -= arm * (nx * gy - ny * gx)
-                    frc[0, c, i] += fx
-                    frc[1, c, i] += fy
-                    frc[2, c, i] += fz
-                    c_idx[0, n_c] = i
-                    c_idx[1, n_c] = -1
-                    c_val[0, n_c] = nx
-                    c_val[1, n_c] = ny
-                    c_val[2, n_c] = nz
-                    c_val[3, n_c] = arm
-                    c_val[4, n_c] = f_n - f_el
-                    c_val[5, n_c] = gx
-                    c_val[6, n_c] = gy
-                    c_val[7, n_c] = gz
-                    n_c += 1
-                    w_wall += (fx * wvx + fy * wvy + fz * wvz) * dt
-                    if drive_axis == 0:
-                        f_drive += fx
-                    elif drive_axis == 1:
-                        f_drive += fy
-                    else:
-                        f_drive += fz
-            # --- particle-particle contacts (brute force, early reject on z) ---------------
-            for i in range(n_part - 1):
-                xi = pos[0, c, i]
-                yi = pos[1, c, i]
-                zi = pos[2, c, i]
+                    dist = (wnx[w] * (px[i] - ux) + wny[w] * (py[i] - uy)
+                            + wnz[w] * (pz[i] - uz) + wd[w])
+                    # not finite: keep the wall so the contact loop flags the cell
+                    if not dist >= wall_reach:
+                        wl_w[n_wl] = w
+                        n_wl += 1
                 for j in range(i + 1, n_part):
-                    dz = pos[2, c, j] - zi
-                    if dz >= two_r or dz <= -two_r:
-                        continue
-                    dx = pos[0, c, j] - xi
-                    dy = pos[1, c, j] - yi
-                    d2 = dx * dx + dy * dy + dz * dz
-                    if d2 >= two_r * two_r:
-                        continue
-                    d = np.sqrt(d2)
-                    inv_d = 1.0 / d
-                    nx = dx * inv_d
-                    ny = dy * inv_d
-                    nz = dz * inv_d
-                    delta = two_r - d
-                    if delta > max_overlap:
-                        status[c] = STATUS_OVERLAP
-                    arm = radius - 0.5 * delta
-                    # omega_i x (arm n) - omega_j x (-arm n) = arm (omega_i + omega_j) x n
-                    sx = wp[0, i] + wp[0, j]
-                    sy = wp[1, i] + wp[1, j]
-                    sz = wp[2, i] + wp[2, j]
-                    rvx = vp[0, i] - vp[0, j] + arm * (sy * nz - sz * ny)
-                    rvy = vp[1, i] - vp[1, j] + arm * (sz * nx - sx * nz)
-                    rvz = vp[2, i] - vp[2, j] + arm * (sx * ny - sy * nx)
-                    delta_dot = rvx * nx + rvy * ny + rvz * nz
-                    f_el = k_pp * delta * np.sqrt(delta)
-                    f_n = f_el + c_pp * np.sqrt(np.sqrt(delta)) * delta_dot
-                    if clip_attraction and f_n < 0.0:
-                        f_n = 0.0
-                    # force on i: -f_n n (+ friction g); on j: the opposite
-                    fx = -f_n * nx
-                    fy = -f_n * ny
-                    fz = -f_n * nz
-                    gx = 0.0
-                    gy = 0.0
-                    gz = 0.0
-                    tvx = rvx - delta_dot * nx
-                    tvy = rvy - delta_dot * ny
-                    tvz = rvz - delta_dot * nz
-                    vt = np.sqrt(tvx * tvx + tvy * tvy + tvz * tvz)
-                    if vt > 0.0:
-                        ft = mu_pp * abs(f_n)
-                        if vt < v_reg:
-                            ft *= vt / v_reg
-                        cap = 0.5 * mt_pp * vt / dt
-                        if ft > cap:
-                            ft = cap
-                        scale = -ft / vt
-                        gx = scale * tvx
-                        gy = scale * tvy
-                        gz = scale * tvz
-                        fx += gx
-                        fy += gy
-                        fz += gz
-                        # torque on i and on j: arm n x g (same for both)
-                        tx = arm * (ny * gz - nz * gy)
-                        ty = arm * (nz * gx - nx * gz)
-                        tz = arm * (nx * gy - ny * gx)
-                        trq[0, c, i] += tx
-                        trq[1, c, i] += ty
-                        trq[2, c, i] += tz
-                        trq[0, c, j] += tx
-                        trq[1, c, j] += ty
-                        trq[2, c, j] += tz
-                    frc[0, c, i] += fx
-                    frc[1, c, i] += fy
-                    frc[2, c, i] += fz
-                    frc[0, c, j] -= fx
-                    frc[1, c, j] -= fy
-                    frc[2, c, j] -= fz
-                    c_idx[0, n_c] = i
-                    c_idx[1, n_c] = j
-                    c_val[0, n_c] = nx
-                    c_val[1, n_c] = ny
-                    c_val[2, n_c] = nz
-                    c_val[3, n_c] = arm
-                    c_val[4, n_c] = f_n - f_el
-                    c_val[5, n_c] = gx
-                    c_val[6, n_c] = gy
-                    c_val[7, n_c] = gz
-                    n_c += 1
-            # --- second half kick ----------------------------------------------------------
-            for i in range(n_part):
-                for k in range(3):
-                    vel[k, c, i] += 0.5 * dt * frc[k, c, i] * inv_m
-                    omg[k, c, i] += 0.5 * dt * trq[k, c, i] * inv_i
-            # --- dissipation with the new full-step velocities ---------------------------
-            # v(t) is what the kicks of this step's force act on (sum_t F(t).v(t) dt is the
-            # kinetic energy change to second order), so the tally closes the energy balance.
-            for q in range(n_c):
-                i = c_idx[0, q]
-                j = c_idx[1, q]
-                nx = c_val[0, q]
-                ny = c_val[1, q]
-                nz = c_val[2, q]
-                arm = c_val[3, q]
-                ox = omg[0, c, i]
-                oy = omg[1, c, i]
-                oz = omg[2, c, i]
-                if j < 0:
-                    rvx = vel[0, c, i] - arm * (oy * nz - oz * ny) - wvx
-                    rvy = vel[1, c, i] - arm * (oz * nx - ox * nz) - wvy
-                    rvz = vel[2, c, i] - arm * (ox * ny - oy * nx) - wvz
-                    delta_dot = -(rvx * nx + rvy * ny + rvz * nz)
+                    dx = px[j] - px[i]
+                    dy = py[j] - py[i]
+                    dz = pz[j] - pz[i]
+                    if not dx * dx + dy * dy + dz * dz >= pair_reach2:
+                        nb_i[n_nb] = i
+                        nb_j[n_nb] = j
+                        n_nb += 1
+            wl_start[n_part] = n_wl
+        cyc = s // steps_per_cycle
+        smp = s // sample_every
+        w_wall = 0.0
+        d_norm = 0.0
+        d_fric = 0.0
+        f_drive = 0.0
+        n_c = 0
+        # --- particle-wall contacts -----------------------------------------------------
+        for i in range(n_part):
+            pxi = px[i]
+            pyi = py[i]
+            pzi = pz[i]
+            if not (np.isfinite(pxi) and np.isfinite(pyi) and np.isfinite(pzi)):
+                status[c] = STATUS_NONFINITE
+            for q in range(wl_start[i], wl_start[i + 1]):
+                w = wl_w[q]
+                nx = wnx[w]
+                ny = wny[w]
+                nz = wnz[w]
+                dist = nx * (pxi - ux) + ny * (pyi - uy) + nz * (pzi - uz) + wd[w]
+                delta = radius - dist
+                if delta <= 0.0:
+                    continue
+                if dist < 0.0:
+                    status[c] = STATUS_ESCAPED
+                if delta > max_overlap:
+                    status[c] = STATUS_OVERLAP
+                arm = radius - delta
+                wxi = wpx[i]
+                wyi = wpy[i]
+                wzi = wpz[i]
+                # contact point velocity relative to the wall; contact point at -arm*n
+                rvx = vpx[i] - arm * (wyi * nz - wzi * ny) - wvx
+                rvy = vpy[i] - arm * (wzi * nx - wxi * nz) - wvy
+                rvz = vpz[i] - arm * (wxi * ny - wyi * nx) - wvz
+                vn = rvx * nx + rvy * ny + rvz * nz
+                delta_dot = -vn
+                sq = np.sqrt(delta)
+                f_el = k_pw * delta * sq
+                f_n = f_el + c_pw * np.sqrt(sq) * delta_dot
+                if clip_attraction and f_n < 0.0:
+                    f_n = 0.0
+                cfx = f_n * nx
+                cfy = f_n * ny
+                cfz = f_n * nz
+                gx = 0.0
+                gy = 0.0
+                gz = 0.0
+                tvx = rvx - vn * nx
+                tvy = rvy - vn * ny
+                tvz = rvz - vn * nz
+                vt = np.sqrt(tvx * tvx + tvy * tvy + tvz * tvz)
+                if vt > 0.0:
+                    ft = mu_pw * abs(f_n)
+                    if vt < v_reg:
+                        ft *= vt / v_reg
+                    cap = 0.5 * mt_pw * vt / dt
+                    if ft > cap:
+                        ft = cap
+                    scale = -ft / vt
+                    gx = scale * tvx
+                    gy = scale * tvy
+                    gz = scale * tvz
+                    cfx += gx
+                    cfy += gy
+                    cfz += gz
+                    # torque = (-arm n) x g
+                    tx[i] -= arm * (ny * gz - nz * gy)
+                    ty[i] -= arm * (nz * gx - nx * gz)
+                    tz[i] -= arm * (nx * gy - ny * gx)
+                fx[i] += cfx
+                fy[i] += cfy
+                fz[i] += cfz
+                c_idx[0, n_c] = i
+                c_idx[1, n_c] = -1
+                c_val[0, n_c] = nx
+                c_val[1, n_c] = ny
+                c_val[2, n_c] = nz
+                c_val[3, n_c] = arm
+                c_val[4, n_c] = f_n - f_el
+                c_val[5, n_c] = gx
+                c_val[6, n_c] = gy
+                c_val[7, n_c] = gz
+                n_c += 1
+                w_wall += (cfx * wvx + cfy * wvy + cfz * wvz) * dt
+                if drive_axis == 0:
+                    f_drive += cfx
+                elif drive_axis == 1:
+                    f_drive += cfy
                 else:
-                    ox += omg[0, c, j]
-                    oy += omg[1, c, j]
-                    oz += omg[2, c, j]
-                    rvx = vel[0, c, i] - vel[0, c, j] + arm * (oy * nz - oz * ny)
-                    rvy = vel[1, c, i] - vel[1, c, j] + arm * (oz * nx - ox * nz)
-                    rvz = vel[2, c, i] - vel[2, c, j] + arm * (ox * ny - oy * nx)
-                    delta_dot = rvx * nx + rvy * ny + rvz * nz
-                d_norm += c_val[4, q] * delta_dot * dt
-                d_fric -= (c_val[5, q] * rvx + c_val[6, q] * rvy + c_val[7, q] * rvz) * dt
-            tally[c, cyc, 0] += w_wall
-            tally[c, cyc, 1] += d_norm
-            tally[c, cyc, 2] += d_fric
-            samples[c, smp] += f_drive
-            if status[c] != STATUS_OK:
-                fail_step[c] = step0 + s + 1
-                break
-    return 0
+                    f_drive += cfz
+        # --- particle-particle contacts (Verlet candidates) -----------------------------
+        for q in range(n_nb):
+            i = nb_i[q]
+            j = nb_j[q]
+            dz = pz[j] - pz[i]
+            if dz >= two_r or dz <= -two_r:
+                continue
+            dx = px[j] - px[i]
+            dy = py[j] - py[i]
+            d2 = dx * dx + dy * dy + dz * dz
+            if d2 >= two_r * two_r:
+                continue
+            d = np.sqrt(d2)
+            inv_d = 1.0 / d
+            nx = dx * inv_d
+            ny = dy * inv_d
+            nz = dz * inv_d
+            delta = two_r - d
+            if delta > max_overlap:
+                status[c] = STATUS_OVERLAP
+            arm = radius - 0.5 * delta
+            # omega_i x (arm n) - omega_j x (-arm n) = arm (omega_i + omega_j) x n
+            sx = wpx[i] + wpx[j]
+            sy = wpy[i] + wpy[j]
+            sz = wpz[i] + wpz[j]
+            rvx = vpx[i] - vpx[j] + arm * (sy * nz - sz * ny)
+            rvy = vpy[i] - vpy[j] + arm * (sz * nx - sx * nz)
+            rvz = vpz[i] - vpz[j] + arm * (sx * ny - sy * nx)
+            delta_dot = rvx * nx + rvy * ny + rvz * nz
+            sq = np.sqrt(delta)
+            f_el = k_pp * delta * sq
+            f_n = f_el + c_pp * np.sqrt(sq) * delta_dot
+            if clip_attraction and f_n < 0.0:
+                f_n = 0.0
+            # force on i: -f_n n (+ friction g); on j: the opposite
+            cfx = -f_n * nx
+            cfy = -f_n * ny
+            cfz = -f_n * nz
+            gx = 0.0
+            gy = 0.0
+            gz = 0.0
+            tvx = rvx - delta_dot * nx
+            tvy = rvy - delta_dot * ny
+            tvz = rvz - delta_dot * nz
+            vt = np.sqrt(tvx * tvx + tvy * tvy + tvz * tvz)
+            if vt > 0.0:
+                ft = mu_pp * abs(f_n)
+                if vt < v_reg:
+                    ft *= vt / v_reg
+                cap = 0.5 * mt_pp * vt / dt
+                if ft > cap:
+                    ft = cap
+                scale = -ft / vt
+                gx = scale * tvx
+                gy = scale * tvy
+                gz = scale * tvz
+                cfx += gx
+                cfy += gy
+                cfz += gz
+                # torque on i and on j: arm n x g (same for both)
+                ctx = arm * (ny * gz - nz * gy)
+                cty = arm * (nz * gx - nx * gz)
+                ctz = arm * (nx * gy - ny * gx)
+                tx[i] += ctx
+                ty[i] += cty
+                tz[i] += ctz
+                tx[j] += ctx
+                ty[j] += cty
+                tz[j] += ctz
+            fx[i] += cfx
+            fy[i] += cfy
+            fz[i] += cfz
+            fx[j] -= cfx
+            fy[j] -= cfy
+            fz[j] -= cfz
+            c_idx[0, n_c] = i
+            c_idx[1, n_c] = j
+            c_val[0, n_c] = nx
+            c_val[1, n_c] = ny
+            c_val[2, n_c] = nz
+            c_val[3, n_c] = arm
+            c_val[4, n_c] = f_n - f_el
+            c_val[5, n_c] = gx
+            c_val[6, n_c] = gy
+            c_val[7, n_c] = gz
+            n_c += 1
+        # --- second half kick ----------------------------------------------------------
+        for i in range(n_part):
+            vx[i] += 0.5 * dt * fx[i] * inv_m
+            vy[i] += 0.5 * dt * fy[i] * inv_m
+            vz[i] += 0.5 * dt * fz[i] * inv_m
+            ox[i] += 0.5 * dt * tx[i] * inv_i
+            oy[i] += 0.5 * dt * ty[i] * inv_i
+            oz[i] += 0.5 * dt * tz[i] * inv_i
+        # --- dissipation with the new full-step velocities ---------------------------
+        # v(t) is what the kicks of this step's force act on (sum_t F(t).v(t) dt is the
+        # kinetic energy change to second order), so the tally closes the energy balance.
+        for q in range(n_c):
+            i = c_idx[0, q]
+            j = c_idx[1, q]
+            nx = c_val[0, q]
+            ny = c_val[1, q]
+            nz = c_val[2, q]
+            arm = c_val[3, q]
+            sx = ox[i]
+            sy = oy[i]
+            sz = oz[i]
+            if j < 0:
+                rvx = vx[i] - arm * (sy * nz - sz * ny) - wvx
+                rvy = vy[i] - arm * (sz * nx - sx * nz) - wvy
+                rvz = vz[i] - arm * (sx * ny - sy * nx) - wvz
+                delta_dot = -(rvx * nx + rvy * ny + rvz * nz)
+            else:
+                sx += ox[j]
+                sy += oy[j]
+                sz += oz[j]
+                rvx = vx[i] - vx[j] + arm * (sy * nz - sz * ny)
+                rvy = vy[i] - vy[j] + arm * (sz * nx - sx * nz)
+                rvz = vz[i] - vz[j] + arm * (sx * ny - sy * nx)
+                delta_dot = rvx * nx + rvy * ny + rvz * nz
+            d_norm += c_val[4, q] * delta_dot * dt
+            d_fric -= (c_val[5, q] * rvx + c_val[6, q] * rvy + c_val[7, q] * rvz) * dt
+        tally[c, cyc, 0] += w_wall
+        tally[c, cyc, 1] += d_norm
+        tally[c, cyc, 2] += d_fric
+        samples[c, smp] += f_drive
+        if status[c] != STATUS_OK:
+            fail_step[c] = step0 + s + 1
+            break
+    pos[0, c] = px
+    pos[1, c] = py
+    pos[2, c] = pz
+    vel[0, c] = vx
+    vel[1, c] = vy
+    vel[2, c] = vz
+    omg[0, c] = ox
+    omg[1, c] = oy
+    omg[2, c] = oz
+    frc[0, c] = fx
+    frc[1, c] = fy
+    frc[2, c] = fz
+    trq[0, c] = tx
+    trq[1, c] = ty
+    trq[2, c] = tz
