@@ -600,6 +600,10 @@ class CaseComparison:
     model_fill_percent, model_sdc : numpy.ndarray
         The pchip model over Table 3 (DEM) along fill at this frequency and acceleration
         (empty where the case lies outside the model's range; it is never extrapolated).
+    measured_sdc_eq10, measured_stderr_eq10 : float
+        The records' energy per cycle over the DEM case's ``E = m_c a^2 / (2 w^2)`` (Eq. 10),
+        pooled: the like-for-like counterpart of our DEM SDC (the Eq. 11 SDC divides by the
+        reactive energy instead). NaN without a DEM grid case that knows ``m_c``.
     """
 
     load_case: LoadCase
@@ -611,6 +615,23 @@ class CaseComparison:
     paper_points: pd.DataFrame
     model_fill_percent: np.ndarray
     model_sdc: np.ndarray
+    measured_sdc_eq10: float = float("nan")
+    measured_stderr_eq10: float = float("nan")
+
+
+def sdc_with_eq10_energy(energy_per_cycle_j: float, *, vibrated_mass_kg: float,
+                         acceleration_g: float, frequency_hz: float) -> float:
+    """Energy per cycle over ``E = m_c a^2 / (2 w^2)`` (paper Eq. 8-10), [-].
+
+    >>> round(sdc_with_eq10_energy(1.0, vibrated_mass_kg=2.0, acceleration_g=1.0,
+    ...                            frequency_hz=1.0), 6)  # E = 2 * g^2 / (2 (2 pi)^2)
+    0.410505
+    """
+    from .constants import STANDARD_GRAVITY
+
+    omega = 2 * np.pi * frequency_hz
+    energy = vibrated_mass_kg * (acceleration_g * STANDARD_GRAVITY) ** 2 / (2 * omega ** 2)
+    return float(energy_per_cycle_j / energy) if energy > 0 else float("nan")
 
 
 def _paper_model(paper: pd.DataFrame):
@@ -683,15 +704,28 @@ def compare_case(records: Sequence[tuple[AnalyzedRecord, LoadCase]],
             model_x = np.linspace(lo, hi, model_points)
             model_y = np.asarray(model(model_x, case.acceleration_g, case.frequency_hz),
                                  dtype=float)
+    sdc10 = stderr10 = float("nan")
+    grid = getattr(aligned, "grid_case", None)
+    m_c = float(getattr(grid, "vibrated_mass_kg", float("nan"))) if grid else float("nan")
+    if np.isfinite(m_c):
+        values = np.array([sdc_with_eq10_energy(
+            r.analysis.energy_per_cycle_j, vibrated_mass_kg=m_c,
+            acceleration_g=r.analysis.acceleration_g, frequency_hz=r.analysis.frequency_hz)
+            for r, _ in records])
+        # Same relative error as the Eq. 11 SDC: only the reference energy differs.
+        scale = values / measured["SDC [-]"].to_numpy(float)
+        sdc10, stderr10 = pooled_mean(values, measured["SDC stderr [-]"].to_numpy(float) * scale)
+        measured["SDC, E of Eq. 10 [-]"] = values
     return CaseComparison(case, measured, sdc, stderr, aligned, dem_points, paper_points,
-                          model_x, model_y)
+                          model_x, model_y, sdc10, stderr10)
 
 
 # --- chart data (long tables the app's Vega-Lite charts draw; rendered in the browser) ------
 
 #: Series names of :func:`sdc_chart_data`.
 SDC_SERIES = ("pchip model (paper Table 3 DEM)", "paper DEM", "paper measured",
-              "our DEM (mean ± stderr)", "our DEM (pchip over our runs)", "measured (± stderr)")
+              "our DEM (mean ± stderr)", "our DEM (pchip over our runs)", "measured (± stderr)",
+              "measured, E of Eq. 10 (± stderr)")
 
 
 def sdc_chart_data(comparison: CaseComparison) -> pd.DataFrame:
@@ -720,6 +754,8 @@ def sdc_chart_data(comparison: CaseComparison) -> pd.DataFrame:
     if getattr(c.aligned, "status", "") == "interpolated":
         add(SDC_SERIES[4], [c.load_case.fill_percent], [c.aligned.sdc_dem])
     add(SDC_SERIES[5], [c.load_case.fill_percent], [c.measured_sdc], [c.measured_stderr])
+    add(SDC_SERIES[6], [c.load_case.fill_percent], [c.measured_sdc_eq10],
+        [c.measured_stderr_eq10])
     return pd.concat(parts, ignore_index=True)
 
 

@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import hashlib
+import json
 import math
+import re
 import threading
 import tomllib
 from pathlib import Path
@@ -199,6 +201,8 @@ def test_compare_case_on_the_paper_grid(good_csv, options):
     row = comp.paper_points.set_index("fill [%]").loc[50.0]
     assert row["SDC DEM (paper) [-]"] == 0.1891
     assert row["SDC measured (paper) [-]"] == 0.21
+    # Without the DEM's m_c the like-for-like SDC is unknown.
+    assert math.isnan(comp.measured_sdc_eq10)
     # pchip interpolates: the curve passes through the paper's DEM values at its grid fills.
     at_grid = np.interp(comp.paper_points["fill [%]"], comp.model_fill_percent, comp.model_sdc)
     np.testing.assert_allclose(at_grid, comp.paper_points["SDC DEM (paper) [-]"], rtol=2e-2)
@@ -482,3 +486,52 @@ def test_load_case_is_proposed_from_name_and_uploaded_sidecar():
     assert app_support.is_sidecar_upload("LoadCases.CSV")
     with pytest.raises(LoadCaseError, match=r"^loadcases\.csv: .*lacks column 'file'"):
         app_support.read_sidecar_upload(b"a,b\n1,2\n")
+
+
+def test_chart_specs_are_valid_vega_lite(good_csv, options):
+    # The app sends the specs unvalidated (speed); validate them here against the schema.
+    from pidcore._app import charts
+
+    rec = _record(good_csv, options)
+    case = app_support.load_case_of(rec, fill_percent=50, material="acrylic")
+    comp = app_support.compare_case([(rec, case)], None, app_support.paper_table())
+    loops = [app_support.measured_loop(rec)]
+    for chart in (charts.sdc_chart(app_support.sdc_chart_data(comp)),
+                  charts.loop_chart(app_support.loop_chart_data(loops)),
+                  charts.spectrum_chart(app_support.spectrum_table(rec))):
+        spec = chart.to_dict(validate=True)
+        assert spec["$schema"].startswith("https://vega.github.io/schema/vega-lite/")
+        # Vega-Lite reads "[" and "." in field names as nested access: none may be used.
+        fields = json.dumps(spec["layer"] if "layer" in spec else spec.get("hconcat", spec))
+        assert "[" not in "".join(re.findall(r'"field": "([^"]*)"', fields))
+
+
+def test_like_for_like_sdc_uses_the_dem_vibrated_mass_as_the_report_does(good_csv, options):
+    from pidcore.report import build_report_table
+    from pidcore.report.table import MEASURED_EQ10_COLUMN
+
+    rec = _record(good_csv, options, name="c.csv")
+    case = app_support.load_case_of(rec, fill_percent=50, material="acrylic")
+    dem_runs = pd.DataFrame({
+        "case_key": ["r1"], "frequency_hz": [100.0], "acceleration_g": [5.0],
+        "fill_percent": [50.0], "material": ["acrylic"], "direction": ["z"],
+        "sdc": [0.2], "sdc_stderr": [0.01], "m_c_kg": [0.9]})
+    paper = app_support.paper_table()
+    comp = app_support.compare_case([(rec, case)], dem_runs, paper)
+    a = rec.analysis
+    w = 2 * math.pi * a.frequency_hz
+    e_ref = 0.9 * (a.acceleration_g * 9.80665) ** 2 / (2 * w ** 2)  # Eq. 10 with m_c = 0.9 kg
+    assert comp.measured_sdc_eq10 == pytest.approx(a.energy_per_cycle_j / e_ref, rel=1e-12)
+    # Only the reference energy differs from the Eq. 11 SDC: same relative error.
+    assert comp.measured_stderr_eq10 / comp.measured_sdc_eq10 == pytest.approx(
+        a.sdc_stderr / a.sdc, rel=1e-12)
+    from pidcore.measure import analysis_record
+
+    analyses = pd.DataFrame([{**analysis_record(rec), "fill_percent": 50.0,
+                              "material": "acrylic", "direction": "z"}])
+    table = build_report_table(dem_runs, analyses, paper)
+    assert table[MEASURED_EQ10_COLUMN].iloc[0] == pytest.approx(comp.measured_sdc_eq10,
+                                                                 rel=1e-12)
+    series = app_support.sdc_chart_data(comp).groupby("series")
+    assert series.get_group("measured, E of Eq. 10 (± stderr)")["SDC [-]"].iloc[0] == \
+        comp.measured_sdc_eq10

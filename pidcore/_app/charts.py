@@ -14,7 +14,8 @@ from pidcore.app_support import SDC_SERIES
 
 _MODEL = "pchip model (paper Table 3 DEM)"
 #: One fixed colour per series of pidcore.app_support.SDC_SERIES, whatever series a case has.
-_SDC_COLOURS = ("#7f7f7f", "#1f77b4", "#2ca02c", "#ff7f0e", "#ffbb78", "#d62728")
+_SDC_COLOURS = ("#7f7f7f", "#1f77b4", "#2ca02c", "#ff7f0e", "#ffbb78", "#d62728",
+                "#9467bd")
 
 
 def sdc_chart(data: pd.DataFrame) -> alt.LayerChart:

@@ -74,7 +74,7 @@ def advance_cells(pos, vel, omg, frc, trq, wall_n, wall_d,
     return 0
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
                   radius, mass, inertia,
                   k_pp, c_pp, mu_pp, mt_pp, k_pw, c_pw, mu_pw, mt_pw,
