@@ -8,7 +8,8 @@ import sys
 from pathlib import Path
 
 from .. import defaults
-from ..measure import AnalysisOptions, analyze_file
+from ..measure import analyze_file
+from ._options import add_measurement_options, analysis_options
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -20,23 +21,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                     "Results are saved to the store unless --no-store.",
     )
     p.add_argument("paths", nargs="+", metavar="PATH", type=Path, help="export files")
-    p.add_argument("--force", metavar="NAME", help="force channel name (default: detected)")
-    p.add_argument("--velocity", metavar="NAME", help="velocity channel name")
-    p.add_argument("--acceleration", metavar="NAME", help="acceleration channel name")
-    p.add_argument("--velocity-delay", metavar="SECONDS", type=float, default=0.0,
-                   help="vibrometer output delay to remove, s (default 0)")
-    p.add_argument("--mass-below-gauge", metavar="KG", type=float, default=0.0,
-                   help="mass between force gauge and structure to cancel, kg (default 0)")
-    p.add_argument("--baseline-loss-factor", metavar="ETA", type=float, default=0.0,
-                   help="loss factor of the empty coupon to subtract (default 0)")
-    p.add_argument("--frequency", metavar="HZ", type=float, default=None,
-                   help="drive frequency hint, Hz (estimated from the data anyway)")
-    p.add_argument("--harmonics", metavar="N", type=int, default=defaults.N_HARMONICS,
-                   help=f"drive harmonics fitted (default {defaults.N_HARMONICS})")
-    p.add_argument("--sample-rate", metavar="HZ", type=float, default=None,
-                   help="sample rate for CSV/TXT files without a time column, Hz")
-    p.add_argument("--allow-clipped", action="store_true",
-                   help="analyse clipped channels anyway (reported in the output)")
+    add_measurement_options(p)
     p.add_argument("--store", metavar="FILE", type=Path, default=defaults.STORE_PATH,
                    help=f"HDF5 store (default ./{defaults.STORE_PATH})")
     p.add_argument("--no-store", action="store_true", help="do not save to the store")
@@ -45,13 +30,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    options = AnalysisOptions(
-        force=args.force, velocity=args.velocity, acceleration=args.acceleration,
-        velocity_delay_s=args.velocity_delay, mass_below_gauge_kg=args.mass_below_gauge,
-        baseline_loss_factor=args.baseline_loss_factor, frequency_hz=args.frequency,
-        n_harmonics=args.harmonics, sample_rate_hz=args.sample_rate,
-        allow_clipped=args.allow_clipped,
-    )
+    options = analysis_options(args)
     # Analyse everything before writing anything: one bad file leaves the store untouched.
     results = [analyze_file(path, options) for path in args.paths]
     if not args.no_store:

@@ -10,6 +10,7 @@ from pathlib import Path
 
 from ..constants import DRIVE_DIRECTIONS, PARTICLE_MATERIALS
 from ..report.render import format_cell
+from ._options import add_measurement_options, analysis_options
 
 #: Columns of the short table printed on stdout.
 _STDOUT_COLUMNS = (
@@ -48,12 +49,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--sidecar", metavar="CSV", type=Path, default=None,
                    help="load case table (columns file, fill_percent, material, direction); "
                         "default: loadcases.csv beside each file")
-    p.add_argument("--velocity-delay", metavar="SECONDS", type=float, default=0.0,
-                   help="vibrometer output delay to remove, s (default 0)")
-    p.add_argument("--mass-below-gauge", metavar="KG", type=float, default=0.0,
-                   help="mass between force gauge and coupon to cancel, kg (default 0)")
-    p.add_argument("--sample-rate", metavar="HZ", type=float, default=None,
-                   help="sample rate for CSV/TXT files without a time column, Hz")
+    add_measurement_options(p)
     p.set_defaults(func=run)
 
 
@@ -63,8 +59,7 @@ def run(args: argparse.Namespace) -> int:
     result = make_report(
         args.files, out_dir=args.out, store=args.store, dem_store=args.dem_store,
         formats=args.format, fill_percent=args.fill, material=args.material,
-        direction=args.direction, sidecar=args.sidecar, velocity_delay_s=args.velocity_delay,
-        mass_below_gauge_kg=args.mass_below_gauge, sample_rate_hz=args.sample_rate)
+        direction=args.direction, sidecar=args.sidecar, options=analysis_options(args))
     print(short_table(result.table))
     for note in result.notes:
         print(f"note: {note}")

@@ -270,8 +270,7 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
                 formats: str | Iterable[str] = defaults.REPORT_FORMATS,
                 fill_percent: float | None = None, material: str | None = None,
                 direction: str | None = None, sidecar: str | Path | None = None,
-                velocity_delay_s: float = 0.0, mass_below_gauge_kg: float = 0.0,
-                sample_rate_hz: float | None = None,
+                options: AnalysisOptions | None = None,
                 tolerances: Tolerances | None = None) -> ReportResult:
     """Analyse files, store them, align with DEM and the paper, and write the report.
 
@@ -290,12 +289,9 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         ``csv, md, html, tex, pdf`` or ``"all"``.
     fill_percent, material, direction, sidecar
         Load case statements (:func:`pidcore.compare.resolve_load_case`).
-    velocity_delay_s : float
-        Vibrometer delay removed before Eq. 11, s.
-    mass_below_gauge_kg : float
-        Mass between force gauge and coupon cancelled, kg.
-    sample_rate_hz : float, optional
-        For CSV files without a time column, Hz.
+    options : AnalysisOptions, optional
+        Channel mapping and corrections of the Eq. 11 analysis (vibrometer delay, mass
+        cancellation, baseline, sample rate for CSV without time column).
     tolerances : Tolerances, optional
         Grid-match tolerances.
 
@@ -320,9 +316,8 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         dem = main if (main is not None and dem_path == Path(store)) else \
             open_verified_store(dem_path, must_exist=True)
 
-    options = AnalysisOptions(velocity_delay_s=float(velocity_delay_s),
-                              mass_below_gauge_kg=float(mass_below_gauge_kg),
-                              sample_rate_hz=sample_rate_hz)
+
+    options = options or AnalysisOptions()
     parameters = options.parameters()
     results = analyse_files(files, fill_percent=fill_percent, material=material,
                             direction=direction, sidecar=sidecar,

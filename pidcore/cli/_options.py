@@ -1,0 +1,41 @@
+"""Option groups shared by several sub-commands (one definition, one set of defaults)."""
+
+from __future__ import annotations
+
+import argparse
+
+from .. import defaults
+from ..measure import AnalysisOptions
+
+
+def add_measurement_options(p: argparse.ArgumentParser) -> None:
+    """Channel mapping and corrections of the Eq. 11 analysis (``analyze``, ``report``)."""
+    g = p.add_argument_group("measurement analysis")
+    g.add_argument("--force", metavar="NAME", help="force channel name (default: detected)")
+    g.add_argument("--velocity", metavar="NAME", help="velocity channel name")
+    g.add_argument("--acceleration", metavar="NAME", help="acceleration channel name")
+    g.add_argument("--velocity-delay", metavar="SECONDS", type=float, default=0.0,
+                   help="vibrometer output delay to remove, s (default 0)")
+    g.add_argument("--mass-below-gauge", metavar="KG", type=float, default=0.0,
+                   help="mass between force gauge and structure to cancel, kg (default 0)")
+    g.add_argument("--baseline-loss-factor", metavar="ETA", type=float, default=0.0,
+                   help="loss factor of the empty coupon to subtract (default 0)")
+    g.add_argument("--frequency", metavar="HZ", type=float, default=None,
+                   help="drive frequency hint, Hz (estimated from the data anyway)")
+    g.add_argument("--harmonics", metavar="N", type=int, default=defaults.N_HARMONICS,
+                   help=f"drive harmonics fitted (default {defaults.N_HARMONICS})")
+    g.add_argument("--sample-rate", metavar="HZ", type=float, default=None,
+                   help="sample rate for CSV/TXT files without a time column, Hz")
+    g.add_argument("--allow-clipped", action="store_true",
+                   help="analyse clipped channels anyway (reported in the output)")
+
+
+def analysis_options(args: argparse.Namespace) -> AnalysisOptions:
+    """The :class:`AnalysisOptions` the options of :func:`add_measurement_options` state."""
+    return AnalysisOptions(
+        force=args.force, velocity=args.velocity, acceleration=args.acceleration,
+        velocity_delay_s=args.velocity_delay, mass_below_gauge_kg=args.mass_below_gauge,
+        baseline_loss_factor=args.baseline_loss_factor, frequency_hz=args.frequency,
+        n_harmonics=args.harmonics, sample_rate_hz=args.sample_rate,
+        allow_clipped=args.allow_clipped,
+    )
