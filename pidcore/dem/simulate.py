@@ -25,7 +25,8 @@ Method (choices and why):
   period holds a whole number of sample intervals (DEM_SAMPLES_PER_CYCLE per cycle).
 * **Steady state.** Blocks of DEM_STEADY_BLOCK_CYCLES cycles: steady once successive block
   means of the dissipation agree and the walls' work balances the dissipation in both blocks
-  (:func:`_steady_start`), at most DEM_MAX_TRANSIENT_CYCLES skipped (then flagged). Measured
+  (:func:`_steady_start`), at most DEM_MAX_TRANSIENT_CYCLES and DEM_MAX_TRANSIENT_TIME_S
+  skipped (then flagged). Measured
   window: DEM_MIN_STEADY_CYCLES cycles, or at low frequency DEM_MIN_STEADY_TIME_S of
   simulated time if that is fewer cycles (50 cycles at 50 Hz).
 * **SDC.** Eq. 8-10: steady dissipation per cycle over E = m_c a^2 / (2 w^2), m_c per
@@ -132,6 +133,7 @@ class DemConfig:
     block_cycles: int = defaults.DEM_STEADY_BLOCK_CYCLES
     steady_relative_tolerance: float = defaults.DEM_STEADY_RELATIVE_TOLERANCE
     max_transient_cycles: int = defaults.DEM_MAX_TRANSIENT_CYCLES
+    max_transient_s: float = defaults.DEM_MAX_TRANSIENT_TIME_S
     samples_per_cycle: int = defaults.DEM_SAMPLES_PER_CYCLE
     friction_regularisation_m_s: float = defaults.DEM_FRICTION_REGULARISATION_SPEED_M_S
     alpha_pp: float | None = None
@@ -161,6 +163,12 @@ class DemConfig:
             raise ParameterError(f"steady_cycles: expected >= 1, got {self.steady_cycles}")
         if self.block_cycles < 1 or self.max_transient_cycles < 0:
             raise ParameterError("block_cycles >= 1 and max_transient_cycles >= 0 expected")
+        if not self.max_transient_s >= 0:
+            raise ParameterError(f"max_transient_s: expected >= 0 s, got {self.max_transient_s}")
+
+    def transient_cap_cycles(self, frequency_hz: float) -> int:
+        """Most transient cycles skipped at ``frequency_hz``: the cycle and the time caps."""
+        return min(self.max_transient_cycles, math.ceil(self.max_transient_s * frequency_hz))
         if self.samples_per_cycle < 8:
             raise ParameterError(f"samples_per_cycle: expected >= 8, "
                                  f"got {self.samples_per_cycle}")
@@ -419,8 +427,9 @@ def simulate_load_case(case: LoadCase, config: DemConfig | None = None, *,
                 all_t = np.concatenate(tallies, axis=1).mean(axis=0)  # (cycles, 3)
                 steady_start = _steady_start(all_t[:, 1] + all_t[:, 2], all_t[:, 0], config)
                 detected = steady_start is not None
-                if steady_start is None and done >= config.max_transient_cycles:
-                    steady_start = -(-config.max_transient_cycles // b) * b  # block boundary
+                cap = config.transient_cap_cycles(case.frequency_hz)
+                if steady_start is None and done >= cap:
+                    steady_start = -(-cap // b) * b  # block boundary
                 if bar is not None and steady_start is not None:
                     bar.total = steady_start + need
                     bar.refresh()
