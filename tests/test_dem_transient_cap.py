@@ -8,7 +8,7 @@ from pidcore.errors import ParameterError
 
 def test_cap_is_the_smaller_of_cycles_and_time():
     config = DemConfig(max_transient_cycles=100, max_transient_s=0.5)
-    assert config.transient_cap_cycles(50.0) == 25     # 0.5 s at 50 Hz
+    assert config.transient_cap_cycles(50.0) == 25     # 0.5 s at 50 Hz (explicit cap)
     assert config.transient_cap_cycles(1000.0) == 100  # the cycle cap binds at high frequency
     with pytest.raises(ParameterError, match="max_transient_s"):
         DemConfig(max_transient_s=-1.0)
