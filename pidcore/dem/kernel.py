@@ -52,6 +52,38 @@ N_TALLIES = 3
 NEIGHBOUR_SKIN_FRACTION = 0.3
 
 
+@njit(cache=True, inline="always")
+def _normal_force(delta, delta_dot, k_n, c_n, clip_attraction):
+    """Eq. 2: Hertz elastic part k delta^1.5 and total with Tsuji damping c delta^0.25 ddelta/dt.
+
+    ``c_n`` is alpha sqrt(m* k_n) (Eq. 3-4); with ``clip_attraction`` the total may not pull.
+    Returns (elastic, total) normal force magnitudes, N.
+    """
+    sq = np.sqrt(delta)
+    f_el = k_n * delta * sq
+    f_n = f_el + c_n * np.sqrt(sq) * delta_dot
+    if clip_attraction and f_n < 0.0:
+        f_n = 0.0
+    return f_el, f_n
+
+
+@njit(cache=True, inline="always")
+def _friction_scale(f_n, vt, mu, v_reg, m_t, dt):
+    """Eq. 5 as a factor on the tangential slip velocity: f_t = scale * v_t.
+
+    Coulomb mu |f_n| against the slip, scaled down linearly below ``v_reg`` (no chatter at
+    v_t -> 0) and capped at m_t v_t / (2 dt) so that one step can never reverse the slip (friction
+    never injects energy). ``vt`` > 0.
+    """
+    ft = mu * abs(f_n)
+    if vt < v_reg:
+        ft *= vt / v_reg
+    cap = 0.5 * m_t * vt / dt
+    if ft > cap:
+        ft = cap
+    return -ft / vt
+
+
 @njit(cache=True, parallel=True)
 def advance_cells(pos, vel, omg, frc, trq, wall_n, wall_d,
                   radius, mass, inertia,
@@ -274,11 +306,7 @@ def _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
                 rvz = vpz[i] - arm * (wxi * ny - wyi * nx) - wvz
                 vn = rvx * nx + rvy * ny + rvz * nz
                 delta_dot = -vn
-                sq = np.sqrt(delta)
-                f_el = k_pw * delta * sq
-                f_n = f_el + c_pw * np.sqrt(sq) * delta_dot
-                if clip_attraction and f_n < 0.0:
-                    f_n = 0.0
+                f_el, f_n = _normal_force(delta, delta_dot, k_pw, c_pw, clip_attraction)
                 cfx = f_n * nx
                 cfy = f_n * ny
                 cfz = f_n * nz
@@ -290,13 +318,7 @@ def _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
                 tvz = rvz - vn * nz
                 vt = np.sqrt(tvx * tvx + tvy * tvy + tvz * tvz)
                 if vt > 0.0:
-                    ft = mu_pw * abs(f_n)
-                    if vt < v_reg:
-                        ft *= vt / v_reg
-                    cap = 0.5 * mt_pw * vt / dt
-                    if ft > cap:
-                        ft = cap
-                    scale = -ft / vt
+                    scale = _friction_scale(f_n, vt, mu_pw, v_reg, mt_pw, dt)
                     gx = scale * tvx
                     gy = scale * tvy
                     gz = scale * tvz
@@ -357,11 +379,7 @@ def _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
             rvy = vpy[i] - vpy[j] + arm * (sz * nx - sx * nz)
             rvz = vpz[i] - vpz[j] + arm * (sx * ny - sy * nx)
             delta_dot = rvx * nx + rvy * ny + rvz * nz
-            sq = np.sqrt(delta)
-            f_el = k_pp * delta * sq
-            f_n = f_el + c_pp * np.sqrt(sq) * delta_dot
-            if clip_attraction and f_n < 0.0:
-                f_n = 0.0
+            f_el, f_n = _normal_force(delta, delta_dot, k_pp, c_pp, clip_attraction)
             # force on i: -f_n n (+ friction g); on j: the opposite
             cfx = -f_n * nx
             cfy = -f_n * ny
@@ -374,13 +392,7 @@ def _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
             tvz = rvz - delta_dot * nz
             vt = np.sqrt(tvx * tvx + tvy * tvy + tvz * tvz)
             if vt > 0.0:
-                ft = mu_pp * abs(f_n)
-                if vt < v_reg:
-                    ft *= vt / v_reg
-                cap = 0.5 * mt_pp * vt / dt
-                if ft > cap:
-                    ft = cap
-                scale = -ft / vt
+                scale = _friction_scale(f_n, vt, mu_pp, v_reg, mt_pp, dt)
                 gx = scale * tvx
                 gy = scale * tvy
                 gz = scale * tvz
