@@ -12,18 +12,23 @@ PUBLIC_MODULES = ("pidcore.io", "pidcore.signal", "pidcore.store", "pidcore.dem"
                   "pidcore.model", "pidcore.compare", "pidcore.report")
 
 
-def _public_objects():
+def _public_names() -> list[str]:
+    names = []
     for name in PUBLIC_MODULES:
         module = importlib.import_module(name)
         for attr in getattr(module, "__all__", ()):
             obj = getattr(module, attr)
             if inspect.isfunction(obj) or inspect.isclass(obj):
-                yield f"{name}.{attr}", obj
+                names.append(f"{name}:{attr}")
+    return names
 
 
-@pytest.mark.parametrize("qualname,obj", list(_public_objects()), ids=lambda v: str(v)[:60])
-def test_public_functions_and_classes_have_docstrings(qualname, obj):
-    assert inspect.getdoc(obj), f"{qualname} has no docstring"
+# parametrised by name only: ids must be identical in every pytest-xdist worker
+@pytest.mark.parametrize("qualname", _public_names())
+def test_public_functions_and_classes_have_docstrings(qualname):
+    module, attr = qualname.split(":")
+    assert inspect.getdoc(getattr(importlib.import_module(module), attr)), \
+        f"{qualname} has no docstring"
 
 
 def test_every_public_module_declares_its_api():
