@@ -66,8 +66,7 @@ def analyze_measurement(measurement: Measurement, options: AnalysisOptions) -> A
         used["velocity"] = roles.velocity.name
     if roles.acceleration is not None:
         used["acceleration"] = roles.acceleration.name
-    notes = tuple(getattr(analysis, "notes", ()) or ())
-    return AnalyzedRecord(measurement, analysis, used, notes)
+    return AnalyzedRecord(measurement, analysis, used, analysis.notes)
 
 
 def analyze_file(path: str | os.PathLike, options: AnalysisOptions) -> AnalyzedRecord:

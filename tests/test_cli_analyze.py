@@ -132,3 +132,19 @@ def test_table_output_names_units(tmp_path, capsys):
     out = capsys.readouterr().out
     for unit in ("[Hz]", "[g]", "[-]", "[J]"):
         assert unit in out
+
+
+def test_allow_clipped_analyses_and_reports_the_clipping(tmp_path, capsys):
+    rec = synthesize_shaker_record(mass_kg=MASS, acceleration_amplitude_m_s2=ACCEL,
+                                   frequency_hz=FREQ, sample_rate_hz=FS, n_periods=20)
+    level = 0.9 * float(np.max(rec.force_n))
+    force = np.minimum(rec.force_n, level)
+    path = tmp_path / "clipped.csv"
+    write_measurement(Measurement(path.name, (Channel("Force", "force", force, FS, "N"),
+                                              Channel("Velocity", "velocity", rec.velocity_m_s,
+                                                      FS, "m/s"))), path, "csv")
+    assert main(["analyze", str(path), "--no-store"]) != 0  # refused by default
+    assert "clipped" in capsys.readouterr().err
+    assert main(["analyze", str(path), "--no-store", "--allow-clipped"]) == 0
+    out = capsys.readouterr().out
+    assert "note:" in out and "'Force' clipped" in out

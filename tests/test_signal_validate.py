@@ -68,6 +68,10 @@ def test_clipped_channel_reported_and_allowed_on_request():
     assert "allow_clipped=True" in msg
     res = analyze_channels(_with(force, clipped), vel, source="clip.uff", allow_clipped=True)
     assert np.isfinite(res.loss_factor)
+    # analysed on request, but still reported: the same count and level as the refusal
+    assert any(f"'Fz' clipped: {expected} samples at {level:+.6g} N" in n for n in res.notes)
+    clean = analyze_channels(force, vel, source="clip.uff", allow_clipped=True)
+    assert not any("clipped" in n for n in clean.notes)
 
 
 def test_clipped_samples_counts_only_runs():

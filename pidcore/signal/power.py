@@ -42,7 +42,7 @@ Corrections (applied to the phasors in this order):
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -106,6 +106,9 @@ class PowerAnalysis:
         Why the standard errors are NaN (empty otherwise).
     corrections : dict
         Corrections applied and their values.
+    notes : tuple of str
+        Lines to read beside the numbers: the damping-ratio and uncertainty notes, and channels
+        analysed although clipped (``allow_clipped``).
     """
 
     source: str
@@ -133,6 +136,7 @@ class PowerAnalysis:
     n_blocks: int
     uncertainty_note: str
     corrections: dict[str, Any] = field(default_factory=dict)
+    notes: tuple[str, ...] = ()
 
     @property
     def acceleration_g(self) -> float:
@@ -449,6 +453,7 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
         n_blocks=k_blocks,
         uncertainty_note=uncertainty_note,
         corrections=corrections,
+        notes=tuple(n for n in (zeta_note, uncertainty_note) if n),
     )
 
 
@@ -475,6 +480,7 @@ def analyze_channels(force: Channel, velocity: Channel | None, *,
                              "expected at least one")
     roles = [("force", force), ("velocity", velocity), ("acceleration", acceleration)]
     present = [(role, ch) for role, ch in roles if ch is not None]
+    clipping_notes: list[str] = []
     for role, ch in present:
         validate.check_quantity(ch.quantity, role, source=source, channel=ch.name)
         data = np.asarray(ch.data, dtype=np.float64)
@@ -483,15 +489,20 @@ def analyze_channels(force: Channel, velocity: Channel | None, *,
         validate.check_not_constant(data, source=source, channel=ch.name, unit=ch.unit)
         if not allow_clipped:
             validate.check_clipping(data, source=source, channel=ch.name, unit=ch.unit)
+        else:  # analysed on request, but reported, never silently used
+            clipping_notes.append(validate.clipping_description(
+                data, source=source, channel=ch.name, unit=ch.unit))
     validate.check_same_sampling([ch.name for _, ch in present],
                                  [ch.sample_rate_hz for _, ch in present],
                                  [ch.n_samples for _, ch in present], source=source)
     motion = velocity if velocity is not None else acceleration
     assert motion is not None
-    return analyze_power(
+    result = analyze_power(
         force.data, None if velocity is None else velocity.data, force.sample_rate_hz,
         acceleration=None if acceleration is None else acceleration.data,
         frequency_hz=frequency_hz, n_harmonics=n_harmonics, velocity_delay_s=velocity_delay_s,
         mass_below_gauge_kg=mass_below_gauge_kg, baseline_loss_factor=baseline_loss_factor,
         n_blocks=n_blocks, min_periods=min_periods, source=source, force_name=force.name,
         velocity_name=motion.name)
+    clipped = tuple(n for n in clipping_notes if n)
+    return replace(result, notes=result.notes + clipped) if clipped else result

@@ -88,15 +88,23 @@ def clipped_samples(data: np.ndarray, *, min_run: int = defaults.CLIPPING_MIN_RU
     return best
 
 
+def clipping_description(data: np.ndarray, *, source: str, channel: str, unit: str = "",
+                         min_run: int = defaults.CLIPPING_MIN_RUN) -> str:
+    """'<source>: channel 'F' clipped: 37 samples at +10 N (...)', or '' when not clipped."""
+    count, level = clipped_samples(data, min_run=min_run)
+    if not count:
+        return ""
+    return (f"{_label(source, channel)} clipped: {count} samples at {level:+.6g} {unit}".rstrip()
+            + f" (runs of >= {min_run} equal extreme samples)")
+
+
 def check_clipping(data: np.ndarray, *, source: str, channel: str, unit: str = "",
                    min_run: int = defaults.CLIPPING_MIN_RUN) -> None:
     """Reject a clipped channel ('clipped: 37 samples at +10 N')."""
-    count, level = clipped_samples(data, min_run=min_run)
-    if count:
-        raise ChannelError(f"{_label(source, channel)} clipped: {count} samples at "
-                           f"{level:+.6g} {unit}".rstrip()
-                           + f" (runs of >= {min_run} equal extreme samples); "
-                           "pass allow_clipped=True to analyse anyway")
+    message = clipping_description(data, source=source, channel=channel, unit=unit,
+                                   min_run=min_run)
+    if message:
+        raise ChannelError(f"{message}; pass allow_clipped=True to analyse anyway")
 
 
 def check_same_sampling(names: list[str], sample_rates_hz: list[float], lengths: list[int], *,
