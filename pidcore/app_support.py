@@ -619,21 +619,6 @@ class CaseComparison:
     measured_stderr_eq10: float = float("nan")
 
 
-def sdc_with_eq10_energy(energy_per_cycle_j: float, *, vibrated_mass_kg: float,
-                         acceleration_g: float, frequency_hz: float) -> float:
-    """Energy per cycle over ``E = m_c a^2 / (2 w^2)`` (paper Eq. 8-10), [-].
-
-    >>> round(sdc_with_eq10_energy(1.0, vibrated_mass_kg=2.0, acceleration_g=1.0,
-    ...                            frequency_hz=1.0), 6)  # E = 2 * g^2 / (2 (2 pi)^2)
-    0.410505
-    """
-    from .constants import STANDARD_GRAVITY
-
-    omega = 2 * np.pi * frequency_hz
-    energy = vibrated_mass_kg * (acceleration_g * STANDARD_GRAVITY) ** 2 / (2 * omega ** 2)
-    return float(energy_per_cycle_j / energy) if energy > 0 else float("nan")
-
-
 def _paper_model(paper: pd.DataFrame):
     from .model import SdcModel
 
@@ -708,10 +693,12 @@ def compare_case(records: Sequence[tuple[AnalyzedRecord, LoadCase]],
     grid = getattr(aligned, "grid_case", None)
     m_c = float(getattr(grid, "vibrated_mass_kg", float("nan"))) if grid else float("nan")
     if np.isfinite(m_c):
-        values = np.array([sdc_with_eq10_energy(
+        from .model import sdc_from_energy_per_cycle
+
+        values = np.array([sdc_from_energy_per_cycle(
             r.analysis.energy_per_cycle_j, vibrated_mass_kg=m_c,
-            acceleration_g=r.analysis.acceleration_g, frequency_hz=r.analysis.frequency_hz)
-            for r, _ in records])
+            acceleration_m_s2=r.analysis.acceleration_amplitude_m_s2,
+            frequency_hz=r.analysis.frequency_hz) for r, _ in records])
         # Same relative error as the Eq. 11 SDC: only the reference energy differs.
         scale = values / measured["SDC [-]"].to_numpy(float)
         sdc10, stderr10 = pooled_mean(values, measured["SDC stderr [-]"].to_numpy(float) * scale)

@@ -154,3 +154,19 @@ def test_written_files_round_trip(tmp_path):
     assert doc["records"][-1]["damping_ratio [-]"] is None
     with pytest.raises(ParameterError, match="formats"):
         write_damper_table(table, tmp_path, formats=("xlsx",))
+
+
+def test_sdc_from_energy_per_cycle_inverts_energy_per_cycle():
+    import math
+
+    from pidcore.model import energy_per_cycle, sdc_from_energy_per_cycle
+
+    for sdc, m, a, f in ((0.35, 0.069, 49.0, 500.0), (1.7, 0.02, 98.1, 50.0)):
+        energy = float(energy_per_cycle(sdc, vibrated_mass_kg=m, acceleration_m_s2=a,
+                                        frequency_hz=f))
+        back = sdc_from_energy_per_cycle(energy, vibrated_mass_kg=m, acceleration_m_s2=a,
+                                         frequency_hz=f)
+        assert back == pytest.approx(sdc, rel=1e-14)  # two float operations each way
+    # no reference energy (unknown m_c): NaN, not an exception or a number
+    assert math.isnan(sdc_from_energy_per_cycle(1e-3, vibrated_mass_kg=float("nan"),
+                                                acceleration_m_s2=9.8, frequency_hz=100.0))

@@ -17,6 +17,7 @@ from .damper import (
     loss_factor,
     paper_particles_mass_kg,
     sdc_from_damping_coefficient,
+    sdc_from_energy_per_cycle,
     write_damper_table,
 )
 from .response import (
@@ -36,5 +37,6 @@ __all__ = [
     "coupon_vibrated_mass_kg", "damping_ratio", "displacement_amplitude", "energy_per_cycle",
     "equivalent_damper_table", "equivalent_damping_coefficient", "harmonic_response",
     "load_paper_table3", "loss_factor", "paper_particles_mass_kg", "particle_damping_n_s_m",
-    "sdc_from_damping_coefficient", "select_runs", "time_domain_response", "write_damper_table",
+    "sdc_from_damping_coefficient", "sdc_from_energy_per_cycle", "select_runs",
+    "time_domain_response", "write_damper_table",
 ]

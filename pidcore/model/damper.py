@@ -80,6 +80,28 @@ def energy_per_cycle(sdc: float | np.ndarray, *, vibrated_mass_kg: float | np.nd
     return np.asarray(sdc, dtype=float) * m * a**2 / (2.0 * w**2)
 
 
+def sdc_from_energy_per_cycle(energy_per_cycle_j: float, *, vibrated_mass_kg: float,
+                              acceleration_m_s2: float, frequency_hz: float) -> float:
+    """SDC [-] of a measured energy per cycle: ``dE / (m_c a^2 / (2 w^2))`` (Eq. 8-10).
+
+    The inverse of :func:`energy_per_cycle`; NaN where ``m_c``, ``a`` or ``f`` is not finite
+    and > 0 (no reference energy, e.g. an unknown vibrated mass).
+
+    Examples
+    --------
+    >>> round(sdc_from_energy_per_cycle(1.0, vibrated_mass_kg=2.0, acceleration_m_s2=9.80665,
+    ...                                 frequency_hz=1.0), 6)  # E = 2 g^2 / (2 (2 pi)^2)
+    0.410505
+    """
+    try:
+        reference = float(energy_per_cycle(1.0, vibrated_mass_kg=vibrated_mass_kg,
+                                           acceleration_m_s2=acceleration_m_s2,
+                                           frequency_hz=frequency_hz))
+    except ParameterError:
+        return float("nan")
+    return float(energy_per_cycle_j) / reference
+
+
 def displacement_amplitude(acceleration_m_s2: float | np.ndarray,
                            frequency_hz: float | np.ndarray) -> np.ndarray:
     """Displacement amplitude [m] of harmonic motion: ``a / w^2``."""

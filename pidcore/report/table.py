@@ -17,7 +17,8 @@ import pandas as pd
 
 from ..compare.align import Aligner, DemCase, Tolerances, match_paper, pooled_mean
 from ..compare.loadcase import LoadCase, LoadCaseError
-from ..constants import STANDARD_GRAVITY
+from ..model.damper import sdc_from_energy_per_cycle
+from ..units import g_to_si
 
 #: Measured energy per cycle over the DEM case's E = m_c a^2 / (2 w^2) (Eq. 10): the like-for-like
 #: counterpart of our DEM SDC. The Eq. 11 SDC divides by Im(P_c)/w instead, the reactive energy,
@@ -159,7 +160,9 @@ def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | N
         sdc_m10 = sdc_m10_se = math.nan
         m_c = row.dem.vibrated_mass_kg if row.dem is not None else math.nan
         if row.measured and math.isfinite(m_c):
-            sdc10 = np.array([_sdc_eq10(m[5], m_c, m[3], m[2]) for m in row.measured])
+            sdc10 = np.array([sdc_from_energy_per_cycle(
+                m[5], vibrated_mass_kg=m_c, acceleration_m_s2=g_to_si(m[3]), frequency_hz=m[2])
+                for m in row.measured])
             scale = sdc10 / np.array([m[0] for m in row.measured])
             sdc_m10, sdc_m10_se = pooled_mean(sdc10, errors * scale)
         note = list(row.notes)
@@ -198,14 +201,6 @@ def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | N
     table = _sort_like_table3(table, aligner, paper, tolerances)
     table.attrs["notes"] = notes
     return table
-
-
-def _sdc_eq10(energy_per_cycle_j: float, vibrated_mass_kg: float, acceleration_g: float,
-              frequency_hz: float) -> float:
-    """Energy per cycle over E = m_c a^2 / (2 w^2) (Eq. 8-10), [-]."""
-    omega = 2 * math.pi * frequency_hz
-    energy = vibrated_mass_kg * (acceleration_g * STANDARD_GRAVITY) ** 2 / (2 * omega**2)
-    return energy_per_cycle_j / energy if energy > 0 else math.nan
 
 
 def _snap(values: pd.Series, grid: np.ndarray, *, rtol: float = 0.0,
