@@ -84,6 +84,22 @@ def _friction_scale(f_n, vt, mu, v_reg, m_t, dt):
     return -ft / vt
 
 
+@njit(cache=True, inline="always")
+def _friction_force(rvx, rvy, rvz, vn, nx, ny, nz, f_n, mu, v_reg, m_t, dt):
+    """Eq. 5 friction vector on the contact from the relative contact-point velocity rv.
+
+    The slip is rv minus its normal part ``vn`` along n; no slip, no force. Returns (gx, gy, gz), N.
+    """
+    tvx = rvx - vn * nx
+    tvy = rvy - vn * ny
+    tvz = rvz - vn * nz
+    vt = np.sqrt(tvx * tvx + tvy * tvy + tvz * tvz)
+    if vt > 0.0:
+        scale = _friction_scale(f_n, vt, mu, v_reg, m_t, dt)
+        return scale * tvx, scale * tvy, scale * tvz
+    return 0.0, 0.0, 0.0
+
+
 @njit(cache=True, parallel=True)
 def advance_cells(pos, vel, omg, frc, trq, wall_n, wall_d,
                   radius, mass, inertia,
@@ -307,28 +323,15 @@ def _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
                 vn = rvx * nx + rvy * ny + rvz * nz
                 delta_dot = -vn
                 f_el, f_n = _normal_force(delta, delta_dot, k_pw, c_pw, clip_attraction)
-                cfx = f_n * nx
-                cfy = f_n * ny
-                cfz = f_n * nz
-                gx = 0.0
-                gy = 0.0
-                gz = 0.0
-                tvx = rvx - vn * nx
-                tvy = rvy - vn * ny
-                tvz = rvz - vn * nz
-                vt = np.sqrt(tvx * tvx + tvy * tvy + tvz * tvz)
-                if vt > 0.0:
-                    scale = _friction_scale(f_n, vt, mu_pw, v_reg, mt_pw, dt)
-                    gx = scale * tvx
-                    gy = scale * tvy
-                    gz = scale * tvz
-                    cfx += gx
-                    cfy += gy
-                    cfz += gz
-                    # torque = (-arm n) x g
-                    tx[i] -= arm * (ny * gz - nz * gy)
-                    ty[i] -= arm * (nz * gx - nx * gz)
-                    tz[i] -= arm * (nx * gy - ny * gx)
+                gx, gy, gz = _friction_force(rvx, rvy, rvz, vn, nx, ny, nz, f_n, mu_pw, v_reg,
+                                             mt_pw, dt)
+                cfx = f_n * nx + gx
+                cfy = f_n * ny + gy
+                cfz = f_n * nz + gz
+                # torque = (-arm n) x g
+                tx[i] -= arm * (ny * gz - nz * gy)
+                ty[i] -= arm * (nz * gx - nx * gz)
+                tz[i] -= arm * (nx * gy - ny * gx)
                 fx[i] += cfx
                 fy[i] += cfy
                 fz[i] += cfz
@@ -381,34 +384,21 @@ def _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
             delta_dot = rvx * nx + rvy * ny + rvz * nz
             f_el, f_n = _normal_force(delta, delta_dot, k_pp, c_pp, clip_attraction)
             # force on i: -f_n n (+ friction g); on j: the opposite
-            cfx = -f_n * nx
-            cfy = -f_n * ny
-            cfz = -f_n * nz
-            gx = 0.0
-            gy = 0.0
-            gz = 0.0
-            tvx = rvx - delta_dot * nx
-            tvy = rvy - delta_dot * ny
-            tvz = rvz - delta_dot * nz
-            vt = np.sqrt(tvx * tvx + tvy * tvy + tvz * tvz)
-            if vt > 0.0:
-                scale = _friction_scale(f_n, vt, mu_pp, v_reg, mt_pp, dt)
-                gx = scale * tvx
-                gy = scale * tvy
-                gz = scale * tvz
-                cfx += gx
-                cfy += gy
-                cfz += gz
-                # torque on i and on j: arm n x g (same for both)
-                ctx = arm * (ny * gz - nz * gy)
-                cty = arm * (nz * gx - nx * gz)
-                ctz = arm * (nx * gy - ny * gx)
-                tx[i] += ctx
-                ty[i] += cty
-                tz[i] += ctz
-                tx[j] += ctx
-                ty[j] += cty
-                tz[j] += ctz
+            gx, gy, gz = _friction_force(rvx, rvy, rvz, delta_dot, nx, ny, nz, f_n, mu_pp, v_reg,
+                                         mt_pp, dt)
+            cfx = -f_n * nx + gx
+            cfy = -f_n * ny + gy
+            cfz = -f_n * nz + gz
+            # torque on i and on j: arm n x g (same for both)
+            ctx = arm * (ny * gz - nz * gy)
+            cty = arm * (nz * gx - nx * gz)
+            ctz = arm * (nx * gy - ny * gx)
+            tx[i] += ctx
+            ty[i] += cty
+            tz[i] += ctz
+            tx[j] += ctx
+            ty[j] += cty
+            tz[j] += ctz
             fx[i] += cfx
             fy[i] += cfy
             fz[i] += cfz
