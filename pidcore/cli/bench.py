@@ -51,7 +51,7 @@ DEM_BENCH_BEDS = (
 
 
 def _bench_dem(args: argparse.Namespace) -> int:
-    from ..dem.bench import run_dem_bench
+    from ..dem.bench import run_dem_bench, run_grid_bench
 
     result: dict = {}
     for label, material, n, accel in DEM_BENCH_BEDS:
@@ -60,8 +60,6 @@ def _bench_dem(args: argparse.Namespace) -> int:
     result["threads"] = 1
     result["target_particle_steps_per_s"] = 2e7
     if args.grid:
-        grid = run_dem_bench(grid=True, workers=args.workers, steps=1)
-        result.update(grid_cases=grid["grid_cases"], grid_wall_s=grid["grid_wall_s"],
-                      target_grid_wall_s=120.0)
+        result.update(run_grid_bench(workers=args.workers), target_grid_wall_s=120.0)
     _emit(result, args.json)
     return 0

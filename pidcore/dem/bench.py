@@ -54,20 +54,28 @@ def run_dem_bench(*, particles_per_cell: int = 20, cells: int = 8, steps: int = 
     finally:
         numba.set_num_threads(previous)
     rate = steps * cells * particles_per_cell / wall
-    extra: dict = {}
-    if grid:
-        import tempfile
-        from pathlib import Path
-
-        from .simulate import DemConfig
-        from .sweep import grid_cases, run_sweep
-
-        cases = grid_cases("table3", material=material)
-        with tempfile.TemporaryDirectory() as tmp:
-            summary = run_sweep(cases, DemConfig(seed=seed), store_path=Path(tmp) / "b.h5",
-                                workers=workers, progress=True)
-        extra = {"grid_cases": len(cases), "grid_wall_s": summary.wall_s}
+    extra = run_grid_bench(material=material, seed=seed, workers=workers) if grid else {}
     return extra | {"particle_steps_per_s": rate,
             "particle_steps_per_s_per_thread": rate / max(threads, 1),
             "wall_s": wall, "particles_per_cell": particles_per_cell, "cells": cells,
             "steps": steps, "threads": threads, "time_step_s": dt, "material": material}
+
+
+def run_grid_bench(*, material: str = "acrylic", seed: int = defaults.DEM_SEED,
+                   workers: int | None = None) -> dict:
+    """Wall time of the paper's Table 3 grid with default settings, into a temporary store.
+
+    Returns ``grid_cases`` and ``grid_wall_s`` [s] of :func:`pidcore.dem.sweep.run_sweep` with
+    ``workers`` processes.
+    """
+    import tempfile
+    from pathlib import Path
+
+    from .simulate import DemConfig
+    from .sweep import grid_cases, run_sweep
+
+    cases = grid_cases("table3", material=material)
+    with tempfile.TemporaryDirectory() as tmp:
+        summary = run_sweep(cases, DemConfig(seed=seed), store_path=Path(tmp) / "b.h5",
+                            workers=workers, progress=True)
+    return {"grid_cases": len(cases), "grid_wall_s": summary.wall_s}
