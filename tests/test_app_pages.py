@@ -135,9 +135,10 @@ def test_mapping_and_corrections_change_the_analysis_like_the_library(store_file
     assert table["SDC [-]"].iloc[0] == pytest.approx(want.sdc, rel=1e-12)
 
 
-def test_compare_shows_dem_model_and_paper_and_switching_uses_the_cache(store_file,
-                                                                       monkeypatch):
-    calls = []
+@pytest.fixture
+def analysis_calls(monkeypatch) -> list[str]:
+    """Names of the uploads the app analyses (a spy on app_support.analyze_parsed)."""
+    calls: list[str] = []
     real = app_support.analyze_parsed
 
     def counting(parsed, options):
@@ -145,6 +146,12 @@ def test_compare_shows_dem_model_and_paper_and_switching_uses_the_cache(store_fi
         return real(parsed, options)
 
     monkeypatch.setattr(app_support, "analyze_parsed", counting)
+    return calls
+
+
+def test_compare_shows_dem_model_and_paper_and_switching_uses_the_cache(store_file,
+                                                                       analysis_calls):
+    calls = analysis_calls
     # Our DEM at 100 Hz, 5 g, 50 %: two runs in the store.
     from pidcore.store import Store
 
@@ -306,7 +313,9 @@ def test_reference_dem_store_is_compared_but_never_written(store_file, tmp_path,
 SAMPLES = Path(os.environ.get("PIDCORE_SAMPLES_DIR", REPO / "data_samples"))
 
 
-def test_bundled_samples_switch_load_cases_from_the_cache(store_file, monkeypatch):
+def test_bundled_samples_switch_load_cases_from_the_cache(store_file, monkeypatch,
+                                                          analysis_calls):
+    calls = analysis_calls
     from pidcore.measure import AnalysisOptions, analyze_file
 
     exports = sorted(p for p in (SAMPLES / "exports").glob("*") if p.is_file())
@@ -316,14 +325,6 @@ def test_bundled_samples_switch_load_cases_from_the_cache(store_file, monkeypatc
     from pidcore.samples import EXPORT_VELOCITY_DELAY_S
 
     monkeypatch.setenv(app_support.DEM_STORE_ENV_VAR, str(dem_store))
-    calls = []
-    real = app_support.analyze_parsed
-
-    def counting(parsed, options):
-        calls.append(parsed.name)
-        return real(parsed, options)
-
-    monkeypatch.setattr(app_support, "analyze_parsed", counting)
     at = _app()
     at.number_input(key="delay_us").set_value(EXPORT_VELOCITY_DELAY_S * 1e6)
     at.run()
