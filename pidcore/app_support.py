@@ -880,10 +880,7 @@ def run_dem_case(path: str | os.PathLike, case, config) -> str:
     Each finished case is its own transaction, so cancelling a sweep keeps every case that
     finished before.
     """
-    from .dem.sweep import DEM_RUN_UNITS, run_case
+    from .dem.sweep import run_case
     from .store import Store
 
-    outcome = run_case(case, config)
-    Store(path).add_dem_run(outcome.key, outcome.record, arrays=outcome.arrays,
-                            parameters=outcome.parameters, units=DEM_RUN_UNITS, replace=True)
-    return outcome.key
+    return run_case(case, config).save_to(Store(path))

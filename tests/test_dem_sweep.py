@@ -102,3 +102,17 @@ def test_dask_scheduler_path(tmp_path):
                             scheduler=cluster.scheduler_address, progress=False)
     assert summary.completed == [run_key(CASES[0], CONFIG)]
     assert Store(tmp_path / "d.h5").has_dem_run(summary.completed[0])
+
+
+def test_a_run_saved_by_dem_run_is_skipped_by_a_sweep(tmp_path):
+    from pidcore.dem import simulate_load_case
+    from pidcore.dem.persist import save_dem_result
+    from pidcore.dem.result import UNITS
+
+    store_path = tmp_path / "s.h5"
+    key = save_dem_result(store_path, simulate_load_case(CASES[0], CONFIG))
+    assert key == run_key(CASES[0], CONFIG)
+    summary = run_sweep(CASES[:1], CONFIG, store_path=store_path, workers=1, progress=False)
+    assert summary.skipped == [key] and not summary.completed
+    entry = Store(store_path).get_dem_run(key)
+    assert entry.units["sdc"] == UNITS["sdc"] and entry.units["shaker_force_n"] == "N"

@@ -1,22 +1,34 @@
-"""Saving DEM results to the HDF5 store (:mod:`pidcore.store`)."""
+"""Saving DEM results to the HDF5 store (:mod:`pidcore.store`): one key, one entry layout."""
 
 from __future__ import annotations
 
+import hashlib
+import json
 from pathlib import Path
 
 from .result import UNITS, DemResult
-from .simulate import config_parameters
+from .simulate import DemConfig, LoadCase, config_parameters
 
 
-def run_key(result: DemResult) -> str:
-    """Store key of a run, the same as a sweep gives it (so a sweep skips it on resume):
-    case, seed, cell count and a hash of every other input, e.g.
-    ``acrylic_z_f50_a5_fill50_seed12345_cells8_<hash>``."""
-    try:
-        from .sweep import run_key as sweep_key
-    except ImportError:  # sweep module not installed in this tree
-        return f"{result.case.key()}_seed{result.config.seed}_cells{result.cells_simulated}"
-    return sweep_key(result.case, result.config)
+def run_key(case: LoadCase, config: DemConfig) -> str:
+    """Store key of one DEM run: readable load case plus a hash of every other input.
+
+    The same for ``pidcore dem run --store``, sweeps and the app, so a sweep skips a run saved
+    by any of them, e.g. ``acrylic_z_f50_a5_fill50_seed12345_cells8_<hash>``.
+    """
+    params = config_parameters(case, config)
+    digest = hashlib.sha256(json.dumps(params, sort_keys=True, default=str).encode()).hexdigest()
+    return f"{case.key()}_seed{config.seed}_cells{config.cells}_{digest[:10]}"
+
+
+def dem_run_entry(result: DemResult) -> dict:
+    """``record``, ``arrays``, ``parameters`` and ``units`` of a run, as the store takes them."""
+    record = result.to_dict()
+    record.pop("case_key", None)  # reserved listing column; the key is the entry name
+    arrays = result.arrays()
+    units = {k: v for k, v in UNITS.items() if k in record or k in arrays}
+    return {"record": record, "arrays": arrays,
+            "parameters": config_parameters(result.case, result.config), "units": units}
 
 
 def save_dem_result(store_path: str | Path, result: DemResult, *,
@@ -24,10 +36,6 @@ def save_dem_result(store_path: str | Path, result: DemResult, *,
     """Add ``result`` (scalars, arrays, every input, units) to the store; returns its key."""
     from ..store import Store
 
-    record = result.to_dict()
-    record.pop("case_key", None)  # reserved listing column; the key is the entry name
-    units = {k: v for k, v in UNITS.items() if k in record or k in result.array_names()}
-    return Store(store_path).add_dem_run(
-        run_key(result), record, arrays=result.arrays(),
-        parameters=config_parameters(result.case, result.config), units=units,
-        replace=replace)
+    key = run_key(result.case, result.config)
+    Store(store_path).add_dem_run(key, **dem_run_entry(result), replace=replace)
+    return key

@@ -8,8 +8,6 @@ holds every input that changes the result (load case, cells, seed, numerical opt
 
 from __future__ import annotations
 
-import hashlib
-import json
 import os
 import time
 from collections.abc import Callable, Iterable, Sequence
@@ -18,7 +16,8 @@ from pathlib import Path
 
 from ..constants import DriveDirection, ParticleMaterial
 from ..errors import ParameterError
-from .simulate import DemConfig, LoadCase, config_parameters, simulate_load_case
+from .persist import dem_run_entry, run_key
+from .simulate import DemConfig, LoadCase, simulate_load_case
 
 #: Named grids. ``table3`` is the paper's Table 3: 4 frequencies x 3 accelerations x 4 fills.
 GRIDS: dict[str, dict[str, tuple[float, ...]]] = {
@@ -28,18 +27,6 @@ GRIDS: dict[str, dict[str, tuple[float, ...]]] = {
         "fill_percent": (25.0, 50.0, 75.0, 90.0),
     },
 }
-
-#: Units of the scalar fields stored per DEM run.
-DEM_RUN_UNITS = {
-    "frequency_hz": "Hz", "acceleration_g": "g", "fill_percent": "%", "sdc": "1",
-    "sdc_stderr": "1", "loss_factor": "1", "energy_per_cycle_j": "J",
-    "energy_dissipated_normal_j": "J", "energy_dissipated_friction_j": "J",
-    "max_kinetic_energy_j": "J", "m_c_kg": "kg", "coupon_mass_kg": "kg",
-    "energy_balance_error": "1", "work_walls_j": "J", "dissipated_total_j": "J",
-    "mechanical_energy_change_j": "J", "wall_s": "s", "particle_steps_per_s": "1/s",
-    "time_step_s": "s", "settle_time_s": "s", "sample_rate_hz": "Hz",
-}
-
 
 def grid_cases(grid: str = "table3", *, material: ParticleMaterial = "acrylic",
                direction: DriveDirection = "z") -> list[LoadCase]:
@@ -51,13 +38,6 @@ def grid_cases(grid: str = "table3", *, material: ParticleMaterial = "acrylic",
             for f in g["frequency_hz"] for a in g["acceleration_g"] for p in g["fill_percent"]]
 
 
-def run_key(case: LoadCase, config: DemConfig) -> str:
-    """Store key of one DEM run: readable load case plus a hash of every other input."""
-    params = config_parameters(case, config)
-    digest = hashlib.sha256(json.dumps(params, sort_keys=True, default=str).encode()).hexdigest()
-    return f"{case.key()}_seed{config.seed}_cells{config.cells}_{digest[:10]}"
-
-
 @dataclass(frozen=True)
 class CaseOutcome:
     """What a worker sends back: plain data, cheap to pickle, ready for the store."""
@@ -66,15 +46,18 @@ class CaseOutcome:
     record: dict
     arrays: dict
     parameters: dict
+    units: dict
+
+    def save_to(self, store) -> str:
+        """Add (or replace) this run in ``store``; returns its key."""
+        return store.add_dem_run(self.key, self.record, arrays=self.arrays,
+                                 parameters=self.parameters, units=self.units, replace=True)
 
 
 def run_case(case: LoadCase, config: DemConfig) -> CaseOutcome:
     """Simulate one case (in a worker) and package it for the store."""
-    result = simulate_load_case(case, config)
-    record = result.to_dict()
-    record.pop("case_key", None)  # the store keeps the key itself
-    return CaseOutcome(run_key(case, config), record, result.arrays(),
-                       config_parameters(case, config))
+    return CaseOutcome(run_key(case, config),
+                       **dem_run_entry(simulate_load_case(case, config)))
 
 
 def _single_thread_worker() -> None:
@@ -140,8 +123,7 @@ def run_sweep(cases: Sequence[LoadCase], config: DemConfig, *,
         bar = tqdm(total=len(cases), initial=len(summary.skipped), unit="case", desc="DEM sweep")
 
     def finish(outcome: CaseOutcome) -> None:
-        store.add_dem_run(outcome.key, outcome.record, arrays=outcome.arrays,
-                          parameters=outcome.parameters, units=DEM_RUN_UNITS, replace=True)
+        outcome.save_to(store)
         summary.completed.append(outcome.key)
         if bar is not None:
             bar.update(1)
