@@ -426,27 +426,17 @@ def save_records(path: str | os.PathLike,
     corrections and each file's channel mapping are stored as the analysis parameters. Two
     sessions saving at once are serialised by the store's write lock.
     """
-    from .measure import ANALYSIS_UNITS, analysis_arrays, analysis_record
+    from .measure import store_analysis
     from .store import Store
 
     if not records:
         raise ParameterError("nothing to save: no file was analysed successfully")
+    # the channel mapping is per file: stored as each analysis's "channels", not as options
+    parameters = replace(options, force=None, velocity=None, acceleration=None).parameters()
     store = Store(path)
-    keys = []
     with store.transaction():
-        for r, case in records:
-            measurement_key, _ = store.add_measurement(r.measurement)
-            record = {**analysis_record(r), "fill_percent": case.fill_percent,
-                      "material": case.material, "direction": case.direction,
-                      "load_case_key": case.key, "load_case_origin": "stated in the app"}
-            parameters = {**replace(options, force=None, velocity=None,
-                                    acceleration=None).parameters(),
-                          "channels": r.channels_used}
-            keys.append(store.add_analysis(
-                measurement_key, record, arrays=analysis_arrays(r.analysis),
-                parameters=parameters,
-                units={**ANALYSIS_UNITS, "fill_percent": "%"}))
-    return keys
+        return [store_analysis(store, r, parameters, fields=case.as_record("stated in the app"))
+                for r, case in records]
 
 
 # --- chart data -------------------------------------------------------------------------------

@@ -7,7 +7,7 @@ stays thin.
 from __future__ import annotations
 
 import os
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
@@ -75,22 +75,30 @@ def analyze_file(path: str | os.PathLike, options: AnalysisOptions) -> AnalyzedR
     return analyze_measurement(measurement, options)
 
 
+def store_analysis(store, result: AnalyzedRecord, parameters: Mapping, *,
+                   fields: Mapping | None = None) -> str:
+    """Add one analysed record and its measurement to an open :class:`~pidcore.store.Store`.
+
+    The analysis is keyed by its measurement and ``parameters`` (plus the channels used), so
+    the same file analysed with the same options replaces its entry. ``fields`` adds record
+    fields (the load case, :meth:`pidcore.compare.LoadCase.as_record`). Returns the key.
+    """
+    measurement_key, _ = store.add_measurement(result.measurement)
+    record = {**analysis_record(result), **(fields or {})}
+    return store.add_analysis(
+        measurement_key, record, arrays=analysis_arrays(result.analysis),
+        parameters={**parameters, "channels": result.channels_used},
+        units={k: v for k, v in ANALYSIS_UNITS.items() if k in record})
+
+
 def save_analyses(store_path: str | os.PathLike, results: Sequence[AnalyzedRecord],
                   options: AnalysisOptions) -> list[str]:
     """Save measurements and their analyses to the store in one transaction."""
     from .store import Store
 
     store = Store(store_path)
-    keys = []
     with store.transaction():
-        for r in results:
-            key, _ = store.add_measurement(r.measurement)
-            record = analysis_record(r)
-            keys.append(store.add_analysis(
-                key, record, arrays=analysis_arrays(r.analysis),
-                parameters={**options.parameters(), "channels": r.channels_used},
-                units=ANALYSIS_UNITS))
-    return keys
+        return [store_analysis(store, r, options.parameters()) for r in results]
 
 
 #: Units of the scalar fields stored per analysis.
@@ -100,6 +108,7 @@ ANALYSIS_UNITS = {
     "loss_factor_stderr": "1", "sdc": "1", "sdc_stderr": "1", "damping_ratio": "1",
     "energy_per_cycle_j": "J", "max_kinetic_energy_j": "J", "force_amplitude_n": "N",
     "velocity_amplitude_m_s": "m/s", "displacement_amplitude_m": "m", "n_periods": "1",
+    "fill_percent": "%",
 }
 
 

@@ -107,6 +107,13 @@ class LoadCase:
         return (f"f{self.frequency_hz:.6g}Hz_a{self.acceleration_g:.6g}g_"
                 f"fill{self.fill_percent:.6g}pct_{self.material}_{self.direction}")
 
+    def as_record(self, origin: str) -> dict[str, object]:
+        """The fields a stored analysis carries about its load case; ``origin`` says who stated
+        fill, material and direction."""
+        return {"fill_percent": self.fill_percent, "material": self.material,
+                "direction": self.direction, "load_case_key": self.key,
+                "load_case_origin": origin}
+
     def label(self) -> str:
         """Short human label, e.g. ``'500 Hz, 5 g, 50 %'``."""
         return f"{self.frequency_hz:.4g} Hz, {self.acceleration_g:.3g} g, {self.fill_percent:.3g} %"

@@ -73,12 +73,7 @@ class MeasuredResult:
         """The record ``pidcore analyze`` stores, plus the load case."""
         from ..measure import analysis_record
 
-        return {**analysis_record(self.analyzed),
-                "fill_percent": self.load_case.fill_percent,
-                "material": self.load_case.material,
-                "direction": self.load_case.direction,
-                "load_case_key": self.load_case.key,
-                "load_case_origin": self.stated.origin}
+        return {**analysis_record(self.analyzed), **self.load_case.as_record(self.stated.origin)}
 
 
 @dataclass(frozen=True)
@@ -184,20 +179,13 @@ def latest_per_measurement(analyses: pd.DataFrame) -> pd.DataFrame:
 
 
 def _store_results(store, results: list[MeasuredResult], options: AnalysisOptions) -> list[str]:
-    # As pidcore.measure.save_analyses (same record, arrays, parameters, so the entry of
-    # `pidcore analyze` for the same file and options is replaced, not duplicated), plus the
-    # load case fields.
-    from ..measure import ANALYSIS_UNITS, analysis_arrays
+    # Same entry as `pidcore analyze` for the same file and options (replaced, not
+    # duplicated), plus the load case fields.
+    from ..measure import store_analysis
 
-    keys = []
     with store.transaction():
-        for r in results:
-            mkey, _ = store.add_measurement(r.measurement)
-            keys.append(store.add_analysis(
-                mkey, r.record(), arrays=analysis_arrays(r.analysis),
-                parameters={**options.parameters(), "channels": r.analyzed.channels_used},
-                units={**ANALYSIS_UNITS, "fill_percent": "%"}))
-    return keys
+        return [store_analysis(store, r.analyzed, options.parameters(),
+                               fields=r.load_case.as_record(r.stated.origin)) for r in results]
 
 
 def _measured_loops(results: list[MeasuredResult], analyses: pd.DataFrame, store,
