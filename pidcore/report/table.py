@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
 import pandas as pd
@@ -42,6 +43,17 @@ ANALYSIS_COLUMNS: tuple[str, ...] = ("frequency_hz", "acceleration_g", "fill_per
                                      "sdc_stderr")
 
 
+class _Measured(NamedTuple):
+    """One measured record in a row, in the units of the analyses table."""
+
+    sdc: float
+    sdc_stderr: float
+    frequency_hz: float
+    acceleration_g: float
+    source: str
+    energy_per_cycle_j: float
+
+
 @dataclass
 class _Row:
     case: LoadCase
@@ -51,7 +63,7 @@ class _Row:
     sdc_dem_stderr: float = math.nan
     paper_dem: float = math.nan
     paper_exp: float = math.nan
-    measured: list[tuple[float, float, float, float, str]] = field(default_factory=list)
+    measured: list[_Measured] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
 
 
@@ -131,9 +143,9 @@ def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | N
                                        paper_dem, paper_exp)
     for case, rec in _measured_rows(analyses, notes):
         aligned = aligner.align(case)
-        entry = (float(rec["sdc"]), float(rec["sdc_stderr"]), case.frequency_hz,
-                 case.acceleration_g, str(rec.get("source", "")),
-                 float(rec.get("energy_per_cycle_j", math.nan)))
+        entry = _Measured(float(rec["sdc"]), float(rec["sdc_stderr"]), case.frequency_hz,
+                          case.acceleration_g, str(rec.get("source", "")),
+                          float(rec.get("energy_per_cycle_j", math.nan)))
         if aligned.status == "grid" and aligned.grid_case is not None:
             rows[aligned.grid_case.load_case.key].measured.append(entry)
             continue
@@ -151,19 +163,20 @@ def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | N
         sdc_m = sdc_m_se = f_m = a_m = math.nan
         sources = ""
         if row.measured:
-            values = np.array([m[0] for m in row.measured])
-            errors = np.array([m[1] for m in row.measured])
+            values = np.array([m.sdc for m in row.measured])
+            errors = np.array([m.sdc_stderr for m in row.measured])
             sdc_m, sdc_m_se = pooled_mean(values, errors)
-            f_m = float(np.mean([m[2] for m in row.measured]))
-            a_m = float(np.mean([m[3] for m in row.measured]))
-            sources = "; ".join(m[4] for m in row.measured if m[4])
+            f_m = float(np.mean([m.frequency_hz for m in row.measured]))
+            a_m = float(np.mean([m.acceleration_g for m in row.measured]))
+            sources = "; ".join(m.source for m in row.measured if m.source)
         sdc_m10 = sdc_m10_se = math.nan
         m_c = row.dem.vibrated_mass_kg if row.dem is not None else math.nan
         if row.measured and math.isfinite(m_c):
             sdc10 = np.array([sdc_from_energy_per_cycle(
-                m[5], vibrated_mass_kg=m_c, acceleration_m_s2=g_to_si(m[3]), frequency_hz=m[2])
+                m.energy_per_cycle_j, vibrated_mass_kg=m_c,
+                acceleration_m_s2=g_to_si(m.acceleration_g), frequency_hz=m.frequency_hz)
                 for m in row.measured])
-            scale = sdc10 / np.array([m[0] for m in row.measured])
+            scale = sdc10 / values
             sdc_m10, sdc_m10_se = pooled_mean(sdc10, errors * scale)
         note = list(row.notes)
         if len(row.measured) > 1:
