@@ -23,6 +23,12 @@ NormalDampingMode = Literal["literal", "no_attraction"]
 VibratedMassConvention = Literal["coupon_plus_particles", "coupon", "particles"]
 #: How particles move when the drive starts.
 StartProtocol = Literal["rest", "with_cell"]
+#: Tangential contact force (Eq. 5): "stick_slip" = elastic tangential spring capped by
+#: mu |f_n| (Cundall-Strack); "coulomb" = Eq. 5 as written, regularised near v_t = 0.
+TangentialModel = Literal["stick_slip", "coulomb"]
+#: Packing the drive starts from: "dense" = settled without friction, then settled again
+#: with friction; "loose" = settled with friction from the random drop.
+StartPacking = Literal["dense", "loose"]
 #: Report output formats.
 ReportFormat = Literal["csv", "md", "html", "tex", "pdf"]
 
@@ -33,6 +39,8 @@ PARTICLE_MATERIALS: tuple[str, ...] = get_args(ParticleMaterial)
 NORMAL_DAMPING_MODES: tuple[str, ...] = get_args(NormalDampingMode)
 VIBRATED_MASS_CONVENTIONS: tuple[str, ...] = get_args(VibratedMassConvention)
 START_PROTOCOLS: tuple[str, ...] = get_args(StartProtocol)
+TANGENTIAL_MODELS: tuple[str, ...] = get_args(TangentialModel)
+START_PACKINGS: tuple[str, ...] = get_args(StartPacking)
 REPORT_FORMATS: tuple[str, ...] = get_args(ReportFormat)
 
 #: Standard gravity, m/s^2 (ISO 80000-3); used for g <-> m/s^2 and for gravity on particles.

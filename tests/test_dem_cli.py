@@ -24,6 +24,18 @@ def test_readable_summary_names_units_and_particle_count(capsys):
     assert main(ARGS + ["--start", "rest", "--damping-mode", "literal"]) == 0
     out = capsys.readouterr().out
     assert "11 of 22 acrylic particles per cell" in out and "J/cycle" in out and "[-]" in out
+    assert "friction stick_slip, normal damping literal, start dense packing rest" in out
+
+
+def test_model_options_reach_the_simulation(capsys):
+    # the named options land in the result (and so in the store): not silently defaults
+    assert main(ARGS + ["--json", "--tangential-model", "coulomb", "--packing", "loose"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["tangential_model"] == "coulomb" and doc["start_packing"] == "loose"
+    assert main(ARGS + ["--json"]) == 0
+    default = json.loads(capsys.readouterr().out)
+    assert default["tangential_model"] == "stick_slip" and default["start_packing"] == "dense"
+    assert default["sdc"] != doc["sdc"]  # a different model gives a different number
 
 
 def test_unsafe_time_step_is_one_line_error_exit_2(capsys):

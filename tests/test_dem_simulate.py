@@ -1,5 +1,6 @@
 """DEM load cases: energy balance, SDC, steady state, power closure, refusals."""
 
+import dataclasses
 import json
 import math
 
@@ -160,17 +161,36 @@ def test_power_closure_virtual_shaker_matches_energy_tally():
     # closes to < 1 %); the stored part is what separates the shaker's view from the tally
     assert pa.energy_per_cycle_j == pytest.approx(
         r.energy_per_cycle_j + r.stored_energy_change_per_cycle_j, rel=0.01)
-    # and it is small in steady state: the power-based energy per cycle is within 5 % of the
-    # tally's dissipation (measured 2.9 % for this seed: a bed still compacting slowly)
-    assert pa.energy_per_cycle_j == pytest.approx(r.energy_per_cycle_j, rel=0.05)
+    # point 10 of the issue: in steady state the stored part is small, and the power-based
+    # energy per cycle agrees with the tally's dissipation within 2 % (measured 0.03 % for
+    # this seed; 48/48 grid cases within 0.9 % from the dense start packing)
+    assert r.steady_detected
+    assert pa.energy_per_cycle_j == pytest.approx(r.energy_per_cycle_j, rel=0.02)
     # the power-based SDC uses E = Im(P)/w (effective mass incl. the particles' reactive
     # share); with the tally's E = m_c a^2/(2 w^2) the two SDCs compare like with like
     sdc_same_e = pa.energy_per_cycle_j / r.max_kinetic_energy_j
-    assert sdc_same_e == pytest.approx(r.sdc, rel=0.05)
+    assert sdc_same_e == pytest.approx(r.sdc, rel=0.02)
     # mean wall force over the steady window carries the particles' weight (441 cells);
     # 10 %: momentum change of the bouncing beds over 60 cycles
     weight = 441 * r.particles_per_cell * ContactLaw.for_material("acrylic").mass_kg * 9.80665
     assert np.mean(r.wall_force_n[r.steady_slice()]) == pytest.approx(weight, rel=0.10)
+
+
+def test_resting_bed_power_closure_needs_the_dense_start():
+    # 1 g, 100 Hz: a bed settled with friction only (loose) keeps compacting: potential
+    # energy released each cycle is dissipated too, so the shaker (walls' work) sees far less
+    # than the tally (measured -66 %) and the SDC is inflated ~7x. From the dense start the
+    # bed is at rest in its packing: shaker and tally agree within 2 % (measured 0.14 %).
+    config = DemConfig(cells=4, block_cycles=5, steady_cycles=20, max_transient_cycles=10)
+    dense = simulate_load_case(LoadCase(100, 1, 50), config)
+    loose = simulate_load_case(LoadCase(100, 1, 50),
+                               dataclasses.replace(config, start_packing="loose"))
+    shaker = dense.power_analysis().energy_per_cycle_j
+    assert shaker == pytest.approx(dense.energy_per_cycle_j, rel=0.02)
+    assert abs(dense.stored_energy_change_per_cycle_j) < 0.01 * dense.energy_per_cycle_j
+    assert loose.work_per_cycle_j < 0.8 * loose.energy_per_cycle_j  # compacting
+    assert loose.stored_energy_change_per_cycle_j < 0
+    assert loose.sdc > 2 * dense.sdc
 
 
 def test_x_drive_runs_and_balances():

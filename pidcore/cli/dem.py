@@ -12,7 +12,9 @@ from ..constants import (
     DRIVE_DIRECTIONS,
     NORMAL_DAMPING_MODES,
     PARTICLE_MATERIALS,
+    START_PACKINGS,
     START_PROTOCOLS,
+    TANGENTIAL_MODELS,
     VIBRATED_MASS_CONVENTIONS,
 )
 
@@ -69,9 +71,8 @@ def _add_config_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--direction", choices=DRIVE_DIRECTIONS, default="z",
                    help="drive direction in the cell frame (z normal to the face sheets)")
     p.add_argument("--cycles", metavar="N", type=int, default=None,
-                   help=f"steady-state cycles measured (default: min("
-                        f"{defaults.DEM_MIN_STEADY_CYCLES}, {defaults.DEM_MIN_STEADY_TIME_S:g} s"
-                        " x f))")
+                   help=f"steady-state cycles measured (default "
+                        f"{defaults.DEM_MIN_STEADY_CYCLES})")
     p.add_argument("--time-step", metavar="S", type=_time_step,
                    default=defaults.DEM_TIME_STEP_MODE,
                    help=f"time step, s, or 'auto' (default: min(2e-6 s, contact time / "
@@ -88,6 +89,14 @@ def _add_config_options(p: argparse.ArgumentParser) -> None:
                    help="mass m_c in E = m_c a^2 / (2 w^2)")
     p.add_argument("--start", choices=START_PROTOCOLS, default=defaults.DEM_START_PROTOCOL,
                    help="particles at rest or moving with the cell when the drive starts")
+    p.add_argument("--packing", choices=START_PACKINGS, default=defaults.DEM_START_PACKING,
+                   help="start packing: settled first without friction (dense) or with "
+                        f"friction only (loose) (default {defaults.DEM_START_PACKING})")
+    p.add_argument("--tangential-model", choices=TANGENTIAL_MODELS,
+                   default=defaults.DEM_TANGENTIAL_MODEL,
+                   help="friction: tangential spring capped by mu |f_n| (stick_slip) or Eq. 5 "
+                        f"regularised near zero slip (coulomb) (default "
+                        f"{defaults.DEM_TANGENTIAL_MODEL})")
     p.add_argument("--fill-reference", choices=("capacity", "paper"),
                    default=defaults.DEM_FILL_REFERENCE,
                    help="100 %% = cell capacity (dense packing) or the paper's 36 particles")
@@ -119,6 +128,7 @@ def _config(args: argparse.Namespace):
                      normal_damping_mode=args.damping_mode,
                      damping_coefficient=args.damping_coefficient,
                      vibrated_mass=args.mass_convention, start_protocol=args.start,
+                     start_packing=args.packing, tangential_model=args.tangential_model,
                      fill_reference=args.fill_reference, steady_cycles=args.cycles)
 
 
@@ -181,6 +191,9 @@ def format_summary(result) -> str:
         f"steady state    from cycle {result.steady_start_cycle} "
         f"({'detected' if result.steady_detected else 'NOT converged, transient cap'}), "
         f"{result.steady_cycles} cycles measured",
+        f"model           friction {result.config.tangential_model}, normal damping "
+        f"{result.config.normal_damping_mode}, start {result.config.start_packing} packing "
+        f"{result.config.start_protocol.replace('_', ' ')}",
         f"numerics        dt {result.time_step_s:.4g} s, {result.steps} steps, "
         f"{result.wall_s:.1f} s wall, {result.particle_steps_per_s:.3g} particle-steps/s",
     ]

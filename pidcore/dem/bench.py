@@ -10,7 +10,7 @@ import numpy as np
 from .. import defaults
 from .contact import ContactLaw
 from .geometry import CellGeometry, random_packing
-from .simulate import LoadCase, choose_time_step, settle
+from .simulate import LoadCase, choose_time_step, settle_bed
 from .state import CellsState, KernelSettings, advance
 
 
@@ -46,7 +46,7 @@ def run_dem_bench(*, particles_per_cell: int = 20, cells: int = 8, steps: int = 
     previous = numba.get_num_threads()
     numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
     try:
-        settle(state, dataclasses.replace(settings, omega_rad_s=0.0, accel_m_s2=0.0))
+        settle_bed(state, dataclasses.replace(settings, omega_rad_s=0.0, accel_m_s2=0.0))
         advance(state, settings, int(2 / (frequency_hz * dt)))  # bed in steady motion
         start = time.perf_counter()
         advance(state, settings, steps)

@@ -7,6 +7,18 @@ rate ``delta_dot`` (> 0 while the bodies approach)::
 
 ``alpha`` from the restitution coefficient by Eq. 3, ``m*`` by Eq. 4 (a wall has infinite
 mass: ``m* = m_i``), ``k_n = 4/3 E* sqrt(R*)`` (a wall has infinite radius: ``R* = r_i``).
+
+Tangential force, two named models (``constants.TangentialModel``):
+
+* ``"stick_slip"`` (default): an elastic tangential spring, f_t = -k_t xi with xi the
+  accumulated tangential displacement of the contact points, capped at mu |f_n| (when the cap
+  acts the contact slides and xi is shortened to the cap: the energy removed is the friction
+  dissipation). k_t is constant per pair of materials: Mindlin's initial stiffness
+  8 G* sqrt(R* delta) at the Hertz maximum overlap of a DEM_TANGENTIAL_REFERENCE_SPEED_M_S
+  impact (constant so that 1/2 k_t xi^2 is a true potential and the energy balance closes).
+* ``"coulomb"``: Eq. 5 as written, mu |f_n| against the slip velocity, scaled down linearly
+  below a regularisation speed. Below that speed it is a viscous damper, so a bed under
+  tangential load creeps and dissipates forever (it cannot stick).
 The kernel (:mod:`pidcore.dem.kernel`) evaluates the same expressions inline; the tests check
 the kernel against these functions.
 """
@@ -17,7 +29,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..constants import NORMAL_DAMPING_MODES, NormalDampingMode
+from .. import defaults
+from ..constants import NORMAL_DAMPING_MODES, TANGENTIAL_MODELS, NormalDampingMode
 from ..errors import ParameterError
 from .materials import WALL_MATERIAL, material, pair_properties
 
@@ -39,6 +52,18 @@ def effective_mass(m1_kg: float, m2_kg: float | None) -> float:
     if m2_kg is None:
         return m1_kg
     return m1_kg * m2_kg / (m1_kg + m2_kg)
+
+
+def effective_shear_modulus(e1_pa: float, nu1: float, e2_pa: float, nu2: float) -> float:
+    """Mindlin's effective shear modulus G* = 1 / ((2-nu1)/G1 + (2-nu2)/G2), G = E/(2(1+nu)), Pa."""
+    g1 = e1_pa / (2.0 * (1.0 + nu1))
+    g2 = e2_pa / (2.0 * (1.0 + nu2))
+    return 1.0 / ((2.0 - nu1) / g1 + (2.0 - nu2) / g2)
+
+
+def tangential_stiffness(g_star_pa: float, r_star_m: float, overlap_m: float) -> float:
+    """Mindlin's initial tangential stiffness k_t = 8 G* sqrt(R* delta), N/m."""
+    return 8.0 * g_star_pa * np.sqrt(r_star_m * overlap_m)
 
 
 def hertz_stiffness(e_star_pa: float, r_star_m: float) -> float:
@@ -105,6 +130,7 @@ class ContactLaw:
     ``alpha sqrt(m* k_n)`` (N s / m^(5/4)); ``tangential_mass_*`` is the effective mass of
     sliding at the contact point, 1/m_t = sum(1/m + arm^2/I) (arm = r), used to cap the
     friction (at m_t |v_t| / (2 dt)) so it never reverses the slip within one step.
+    ``tangential_stiffness_*`` (N/m) is k_t of the stick-slip model (module docstring).
     """
 
     particle_material: str
@@ -123,6 +149,8 @@ class ContactLaw:
     restitution_pw: float
     tangential_mass_pp: float
     tangential_mass_pw: float
+    tangential_stiffness_pp: float
+    tangential_stiffness_pw: float
 
     @classmethod
     def for_material(cls, name: str, *, radius_m: float | None = None,
@@ -146,6 +174,15 @@ class ContactLaw:
         k_pw = hertz_stiffness(effective_modulus(mat.youngs_modulus_pa, mat.poisson_ratio,
                                                  wall.youngs_modulus_pa, wall.poisson_ratio),
                                effective_radius(r, None))
+        g_pp = effective_shear_modulus(mat.youngs_modulus_pa, mat.poisson_ratio,
+                                       mat.youngs_modulus_pa, mat.poisson_ratio)
+        g_pw = effective_shear_modulus(mat.youngs_modulus_pa, mat.poisson_ratio,
+                                       wall.youngs_modulus_pa, wall.poisson_ratio)
+        v_ref = defaults.DEM_TANGENTIAL_REFERENCE_SPEED_M_S
+        kt_pp = tangential_stiffness(g_pp, effective_radius(r, r), maximum_overlap(
+            stiffness=k_pp, mass_kg=effective_mass(m, m), impact_speed_m_s=v_ref))
+        kt_pw = tangential_stiffness(g_pw, effective_radius(r, None), maximum_overlap(
+            stiffness=k_pw, mass_kg=effective_mass(m, None), impact_speed_m_s=v_ref))
         a_pp = damping_constant_from_restitution(pp.normal_restitution) \
             if alpha_pp is None else float(alpha_pp)
         a_pw = damping_constant_from_restitution(pw.normal_restitution) \
@@ -159,6 +196,7 @@ class ContactLaw:
             restitution_pp=pp.normal_restitution, restitution_pw=pw.normal_restitution,
             tangential_mass_pp=1.0 / (2.0 / m + 2.0 * r * r / inertia),
             tangential_mass_pw=1.0 / (1.0 / m + r * r / inertia),
+            tangential_stiffness_pp=kt_pp, tangential_stiffness_pw=kt_pw,
         )
 
     def contact_time(self, impact_speed_m_s: float) -> float:
@@ -169,7 +207,19 @@ class ContactLaw:
                                       impact_speed_m_s=impact_speed_m_s))
 
 
+    def tangential_period(self) -> float:
+        """Shortest period of a stuck tangential spring, 2 pi sqrt(m_t / k_t) (pair or wall), s."""
+        return 2.0 * np.pi * min(np.sqrt(self.tangential_mass_pp / self.tangential_stiffness_pp),
+                                 np.sqrt(self.tangential_mass_pw / self.tangential_stiffness_pw))
+
+
 def check_damping_mode(mode: str) -> None:
     if mode not in NORMAL_DAMPING_MODES:
         raise ParameterError(
             f"normal_damping_mode: expected one of {NORMAL_DAMPING_MODES}, got {mode!r}")
+
+
+def check_tangential_model(model: str) -> None:
+    if model not in TANGENTIAL_MODELS:
+        raise ParameterError(
+            f"tangential_model: expected one of {TANGENTIAL_MODELS}, got {model!r}")

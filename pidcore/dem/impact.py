@@ -15,7 +15,8 @@ from typing import Literal
 import numpy as np
 from scipy.optimize import brentq
 
-from ..constants import NormalDampingMode
+from .. import defaults
+from ..constants import NormalDampingMode, TangentialModel
 from ..errors import ParameterError
 from .contact import ContactLaw, check_damping_mode
 from .geometry import CellGeometry
@@ -26,7 +27,8 @@ ImpactPair = Literal["wall", "particle"]
 
 @dataclasses.dataclass(frozen=True)
 class ImpactOutcome:
-    """Velocities before/after one impact (SI units) and the dissipated energy [J]."""
+    """Velocities before/after one impact (SI units), kinetic energies (translation and
+    rotation of both bodies) and the dissipated energy [J]."""
 
     normal_speed_before_m_s: float
     normal_speed_after_m_s: float
@@ -36,13 +38,17 @@ class ImpactOutcome:
     dissipated_normal_j: float
     dissipated_friction_j: float
     steps: int
+    kinetic_energy_before_j: float
+    kinetic_energy_after_j: float
 
 
 def simulate_impact(*, pair: ImpactPair = "wall", impact_speed_m_s: float, dt_s: float,
                     mode: NormalDampingMode = "no_attraction", material: str = "acrylic",
                     tangential_speed_m_s: float = 0.0, spin_rad_s: float = 0.0,
                     wall: str = "floor", alpha: float | None = None,
-                    law: ContactLaw | None = None) -> ImpactOutcome:
+                    law: ContactLaw | None = None,
+                    tangential_model: TangentialModel = defaults.DEM_TANGENTIAL_MODEL,
+                    ) -> ImpactOutcome:
     """One impact without gravity through :func:`pidcore.dem.kernel.advance_cells`.
 
     ``pair="wall"``: a particle hits wall ``wall`` (a name of
@@ -50,7 +56,7 @@ def simulate_impact(*, pair: ImpactPair = "wall", impact_speed_m_s: float, dt_s:
     tangential velocity ``tangential_speed_m_s`` (along the wall) and spin ``spin_rad_s``
     about the axis normal to both. ``pair="particle"``: two particles approach along z at
     relative speed ``impact_speed_m_s`` (each at half of it). ``alpha`` overrides Eq. 3 for
-    this contact.
+    this contact; ``tangential_model`` picks the friction law (:mod:`pidcore.dem.contact`).
     """
     from .geometry import WALL_NAMES
 
@@ -91,8 +97,10 @@ def simulate_impact(*, pair: ImpactPair = "wall", impact_speed_m_s: float, dt_s:
         state.vel[0, 0, 0] = 0.5 * tangential_speed_m_s
         state.vel[0, 0, 1] = -0.5 * tangential_speed_m_s
     settings = KernelSettings(law=law, geometry=geometry, dt_s=dt_s, gravity_m_s2=0.0,
-                              clip_attraction=mode == "no_attraction")
+                              clip_attraction=mode == "no_attraction",
+                              tangential_model=tangential_model)
     steps = int(math.ceil(3.0 * m_t / dt_s)) + 2
+    ke_before = _kinetic_energy(state, law)
     tally, _ = advance(state, settings, steps)
     if pair == "wall":
         v_after = state.vel[:, 0, 0]
@@ -110,7 +118,13 @@ def simulate_impact(*, pair: ImpactPair = "wall", impact_speed_m_s: float, dt_s:
         vt_after = float(rel[0])
     return ImpactOutcome(impact_speed_m_s, vn_after, vt_before, vt_after,
                          vn_after / impact_speed_m_s, float(tally[..., 1].sum()),
-                         float(tally[..., 2].sum()), steps)
+                         float(tally[..., 2].sum()), steps, ke_before,
+                         _kinetic_energy(state, law))
+
+
+def _kinetic_energy(state: CellsState, law: ContactLaw) -> float:
+    return float(0.5 * law.mass_kg * np.sum(state.vel**2)
+                 + 0.5 * law.inertia_kg_m2 * np.sum(state.omg**2))
 
 
 def measure_restitution(*, pair: ImpactPair = "wall", impact_speed_m_s: float, dt_s: float,

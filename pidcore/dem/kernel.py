@@ -17,17 +17,27 @@ the cell: u(t) = -(a/w^2) sin(w t) along the drive axis, wall velocity -(a/w) co
 Energy tallies per cell and cycle (index ``[cell, cycle, k]``):
   0 work of the walls on the particles, sum f_wall_on_particle . v_wall dt
   1 dissipated by normal damping, sum f_damping * delta_dot(t) * dt
-  2 dissipated by friction, sum -f_t . v_t(t) dt
-with the full-step velocities v(t) after the second kick (see above). The force law makes
-both non-negative with the predicted velocity it uses; with v(t) an increment could only turn
-negative if other contacts reversed the motion within one step (tests check the totals).
+  2 dissipated by friction (tangential model, see below)
+with the full-step velocities v(t) after the second kick (see above). Normal damping only
+needs the translational velocities: rotation moves a contact point within the tangent plane.
 Samples: sum over the sample interval of the drive-axis component of the force the walls
 exert on the particles (divide by ``sample_every`` for the interval mean).
 
-Friction (Eq. 5): f_t = -mu |f_n| v_t/|v_t|, scaled linearly below ``v_reg`` and capped at
-m_t |v_t| / (2 dt) (m_t: effective tangential mass of the contact): the cap removes at most half
-the slip per step, so at the slide-to-stick transition the slip decays geometrically instead of
-chattering around zero, and friction never reverses the slip nor injects energy.
+Tangential force, ``stick_slip`` true (default; :mod:`pidcore.dem.contact`): a spring per
+contact, stretched by the contact points' tangential displacement over each step (drift
+velocities, i.e. the displacement the positions really made, and the walls' displacement),
+projected into the current tangent plane, capped at mu |f_n|. The friction tally is the work
+of the contact on the spring minus the spring energy gained (trapezoidal force times
+displacement, which is what velocity Verlet changes the kinetic energy by): exactly zero
+while stuck. A spring left stretched when its contact opens is counted as dissipated, and its
+energy, 1/2 k_t |xi|^2, is part of the stored (elastic) energy until then. Pair springs live
+in an N x N table [i, j], wall springs in N x walls, so they survive neighbour-list rebuilds.
+
+``stick_slip`` false, Eq. 5 as written: f_t = -mu |f_n| v_t/|v_t|, scaled linearly below
+``v_reg`` and capped at m_t |v_t| / (2 dt) (m_t: effective tangential mass of the contact):
+the cap removes at most half the slip per step, so at the slide-to-stick transition the slip
+decays geometrically instead of chattering around zero, and friction never reverses the slip
+nor injects energy. Tally: sum -f_t . v_t(t) dt.
 
 Status per cell: 0 ok; 1 overlap above ``max_overlap_fraction * r``; 2 a particle centre left
 the cell; 3 non-finite state. ``fail_step`` holds the step where it happened.
@@ -100,11 +110,53 @@ def _friction_force(rvx, rvy, rvz, vn, nx, ny, nz, f_n, mu, v_reg, m_t, dt):
     return 0.0, 0.0, 0.0
 
 
+@njit(cache=True, inline="always")
+def _spring_force(sx, sy, sz, dsx, dsy, dsz, nx, ny, nz, f_n, mu, k_t):
+    """Stick-slip tangential spring (Eq. 5 with a tangential spring, capped by mu |f_n|).
+
+    The stored stretch xi = (sx, sy, sz) is projected into the current tangent plane, the
+    step's tangential displacement ds of the contact points is added, and the force -k_t xi
+    is capped at mu |f_n| by shortening xi (sliding).
+    Returns (xi_x, xi_y, xi_z, dissipated). Dissipated = work of the contact on the spring
+    minus the spring energy gained, with the work taken as the mean of the old and new spring
+    forces times ds (velocity Verlet changes the kinetic energy by exactly that mean force
+    times the drift, so the balance closes): zero while stuck, mu |f_n| |ds| while sliding
+    steadily, J.
+    """
+    # into the tangent plane: the normal part of xi (second order in the normal's turn per
+    # step) is dropped and its energy counted as lost, so the balance still closes
+    sn = sx * nx + sy * ny + sz * nz
+    sx -= sn * nx
+    sy -= sn * ny
+    sz -= sn * nz
+    turned = 0.5 * k_t * sn * sn
+    old2 = sx * sx + sy * sy + sz * sz
+    dn = dsx * nx + dsy * ny + dsz * nz
+    dsx -= dn * nx
+    dsy -= dn * ny
+    dsz -= dn * nz
+    ax = sx + dsx
+    ay = sy + dsy
+    az = sz + dsz
+    trial2 = ax * ax + ay * ay + az * az
+    limit = mu * abs(f_n)
+    if k_t * k_t * trial2 <= limit * limit:
+        return ax, ay, az, turned
+    keep = limit / (k_t * np.sqrt(trial2))
+    ax *= keep
+    ay *= keep
+    az *= keep
+    work = 0.5 * k_t * ((sx + ax) * dsx + (sy + ay) * dsy + (sz + az) * dsz)
+    gained = 0.5 * k_t * (ax * ax + ay * ay + az * az - old2)
+    return ax, ay, az, turned + work - gained
+
+
 @njit(cache=True, parallel=True)
 def advance_cells(pos, vel, omg, frc, trq, wall_n, wall_d,
                   radius, mass, inertia,
                   k_pp, c_pp, mu_pp, mt_pp, k_pw, c_pw, mu_pw, mt_pw,
                   v_reg, clip_attraction, gravity,
+                  stick_slip, kt_pp, kt_pw, spr_pp, spr_pw,
                   dt, step0, n_steps, omega, accel_amp, drive_axis,
                   steps_per_cycle, sample_every, max_overlap_fraction,
                   tally, samples, status, fail_step):
@@ -116,6 +168,7 @@ def advance_cells(pos, vel, omg, frc, trq, wall_n, wall_d,
                       radius, mass, inertia,
                       k_pp, c_pp, mu_pp, mt_pp, k_pw, c_pw, mu_pw, mt_pw,
                       v_reg, clip_attraction, gravity,
+                      stick_slip, kt_pp, kt_pw, spr_pp, spr_pw,
                       dt, step0, n_steps, omega, accel_amp, drive_axis,
                       steps_per_cycle, sample_every, max_overlap_fraction,
                       tally, samples, status, fail_step)
@@ -127,6 +180,7 @@ def _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
                   radius, mass, inertia,
                   k_pp, c_pp, mu_pp, mt_pp, k_pw, c_pw, mu_pw, mt_pw,
                   v_reg, clip_attraction, gravity,
+                  stick_slip, kt_pp, kt_pw, spr_pp, spr_pw,
                   dt, step0, n_steps, omega, accel_amp, drive_axis,
                   steps_per_cycle, sample_every, max_overlap_fraction,
                   tally, samples, status, fail_step):
@@ -176,6 +230,17 @@ def _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
     wny = wall_n[:, 1].copy()
     wnz = wall_n[:, 2].copy()
     wd = wall_d.copy()
+    # tangential springs (stick-slip model): [i, j] for pairs i < j, [i, wall] for walls
+    qpx = spr_pp[0, c].copy()
+    qpy = spr_pp[1, c].copy()
+    qpz = spr_pp[2, c].copy()
+    qwx = spr_pw[0, c].copy()
+    qwy = spr_pw[1, c].copy()
+    qwz = spr_pw[2, c].copy()
+    u_prev = 0.0  # cell displacement along the drive axis at the previous step
+    if omega > 0.0:
+        t_prev = step0 * dt  # same rounding as t below, so chunking does not change bits
+        u_prev = -accel_amp / (omega * omega) * np.sin(omega * t_prev)
     max_pairs = n_part * (n_part - 1) // 2
     max_contacts = n_walls * n_part + max_pairs
     c_idx = np.empty((2, max_contacts), dtype=np.int64)  # i, j (j < 0: wall)
@@ -230,15 +295,23 @@ def _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
         wvx = 0.0
         wvy = 0.0
         wvz = 0.0
+        # wall displacement over this step (the tangential springs follow real displacements)
+        dwx = 0.0
+        dwy = 0.0
+        dwz = 0.0
         if drive_axis == 0:
             ux = u
             wvx = uv
+            dwx = u - u_prev
         elif drive_axis == 1:
             uy = u
             wvy = uv
+            dwy = u - u_prev
         else:
             uz = u
             wvz = uv
+            dwz = u - u_prev
+        u_prev = u
         # --- Verlet lists: rebuild once a particle may have moved skin/2 ----------------
         if not rebuild:
             dux = ux - ref_ux
@@ -307,24 +380,56 @@ def _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
                 dist = nx * (pxi - ux) + ny * (pyi - uy) + nz * (pzi - uz) + wd[w]
                 delta = radius - dist
                 if delta <= 0.0:
+                    if stick_slip and (qwx[i, w] != 0.0 or qwy[i, w] != 0.0
+                                       or qwz[i, w] != 0.0):
+                        # contact opened with energy left in its spring: count it as lost
+                        d_fric += 0.5 * kt_pw * (qwx[i, w] ** 2 + qwy[i, w] ** 2
+                                                 + qwz[i, w] ** 2)
+                        qwx[i, w] = 0.0
+                        qwy[i, w] = 0.0
+                        qwz[i, w] = 0.0
                     continue
                 if dist < 0.0:
                     status[c] = STATUS_ESCAPED
                 if delta > max_overlap:
                     status[c] = STATUS_OVERLAP
                 arm = radius - delta
-                wxi = wpx[i]
-                wyi = wpy[i]
-                wzi = wpz[i]
-                # contact point velocity relative to the wall; contact point at -arm*n
-                rvx = vpx[i] - arm * (wyi * nz - wzi * ny) - wvx
-                rvy = vpy[i] - arm * (wzi * nx - wxi * nz) - wvy
-                rvz = vpz[i] - arm * (wxi * ny - wyi * nx) - wvz
+                # contact point velocity relative to the wall (contact point at -arm*n); the
+                # rotation part lies in the tangent plane and is added only where needed
+                rvx = vpx[i] - wvx
+                rvy = vpy[i] - wvy
+                rvz = vpz[i] - wvz
                 vn = rvx * nx + rvy * ny + rvz * nz
                 delta_dot = -vn
                 f_el, f_n = _normal_force(delta, delta_dot, k_pw, c_pw, clip_attraction)
-                gx, gy, gz = _friction_force(rvx, rvy, rvz, vn, nx, ny, nz, f_n, mu_pw, v_reg,
-                                             mt_pw, dt)
+                if stick_slip:
+                    # contact-point displacement relative to the wall over the step, with the
+                    # drift (half-step) velocities the positions moved with
+                    oxi = ox[i]
+                    oyi = oy[i]
+                    ozi = oz[i]
+                    sxn, syn, szn, lost = _spring_force(
+                        qwx[i, w], qwy[i, w], qwz[i, w],
+                        dt * (vx[i] - arm * (oyi * nz - ozi * ny)) - dwx,
+                        dt * (vy[i] - arm * (ozi * nx - oxi * nz)) - dwy,
+                        dt * (vz[i] - arm * (oxi * ny - oyi * nx)) - dwz,
+                        nx, ny, nz, f_n, mu_pw, kt_pw)
+                    qwx[i, w] = sxn
+                    qwy[i, w] = syn
+                    qwz[i, w] = szn
+                    d_fric += lost
+                    gx = -kt_pw * sxn
+                    gy = -kt_pw * syn
+                    gz = -kt_pw * szn
+                else:
+                    wxi = wpx[i]
+                    wyi = wpy[i]
+                    wzi = wpz[i]
+                    rvx -= arm * (wyi * nz - wzi * ny)
+                    rvy -= arm * (wzi * nx - wxi * nz)
+                    rvz -= arm * (wxi * ny - wyi * nx)
+                    gx, gy, gz = _friction_force(rvx, rvy, rvz, vn, nx, ny, nz, f_n, mu_pw,
+                                                 v_reg, mt_pw, dt)
                 cfx = f_n * nx + gx
                 cfy = f_n * ny + gy
                 cfz = f_n * nz + gz
@@ -358,12 +463,15 @@ def _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
             i = nb_i[q]
             j = nb_j[q]
             dz = pz[j] - pz[i]
-            if dz >= two_r or dz <= -two_r:
-                continue
             dx = px[j] - px[i]
             dy = py[j] - py[i]
             d2 = dx * dx + dy * dy + dz * dz
-            if d2 >= two_r * two_r:
+            if dz >= two_r or dz <= -two_r or d2 >= two_r * two_r:
+                if stick_slip and (qpx[i, j] != 0.0 or qpy[i, j] != 0.0 or qpz[i, j] != 0.0):
+                    d_fric += 0.5 * kt_pp * (qpx[i, j] ** 2 + qpy[i, j] ** 2 + qpz[i, j] ** 2)
+                    qpx[i, j] = 0.0
+                    qpy[i, j] = 0.0
+                    qpz[i, j] = 0.0
                 continue
             d = np.sqrt(d2)
             inv_d = 1.0 / d
@@ -374,18 +482,39 @@ def _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
             if delta > max_overlap:
                 status[c] = STATUS_OVERLAP
             arm = radius - 0.5 * delta
-            # omega_i x (arm n) - omega_j x (-arm n) = arm (omega_i + omega_j) x n
-            sx = wpx[i] + wpx[j]
-            sy = wpy[i] + wpy[j]
-            sz = wpz[i] + wpz[j]
-            rvx = vpx[i] - vpx[j] + arm * (sy * nz - sz * ny)
-            rvy = vpy[i] - vpy[j] + arm * (sz * nx - sx * nz)
-            rvz = vpz[i] - vpz[j] + arm * (sx * ny - sy * nx)
+            rvx = vpx[i] - vpx[j]
+            rvy = vpy[i] - vpy[j]
+            rvz = vpz[i] - vpz[j]
             delta_dot = rvx * nx + rvy * ny + rvz * nz
             f_el, f_n = _normal_force(delta, delta_dot, k_pp, c_pp, clip_attraction)
             # force on i: -f_n n (+ friction g); on j: the opposite
-            gx, gy, gz = _friction_force(rvx, rvy, rvz, delta_dot, nx, ny, nz, f_n, mu_pp, v_reg,
-                                         mt_pp, dt)
+            if stick_slip:
+                hx = ox[i] + ox[j]
+                hy = oy[i] + oy[j]
+                hz = oz[i] + oz[j]
+                sxn, syn, szn, lost = _spring_force(
+                    qpx[i, j], qpy[i, j], qpz[i, j],
+                    dt * (vx[i] - vx[j] + arm * (hy * nz - hz * ny)),
+                    dt * (vy[i] - vy[j] + arm * (hz * nx - hx * nz)),
+                    dt * (vz[i] - vz[j] + arm * (hx * ny - hy * nx)),
+                    nx, ny, nz, f_n, mu_pp, kt_pp)
+                qpx[i, j] = sxn
+                qpy[i, j] = syn
+                qpz[i, j] = szn
+                d_fric += lost
+                gx = -kt_pp * sxn
+                gy = -kt_pp * syn
+                gz = -kt_pp * szn
+            else:
+                # omega_i x (arm n) - omega_j x (-arm n) = arm (omega_i + omega_j) x n
+                sx = wpx[i] + wpx[j]
+                sy = wpy[i] + wpy[j]
+                sz = wpz[i] + wpz[j]
+                rvx += arm * (sy * nz - sz * ny)
+                rvy += arm * (sz * nx - sx * nz)
+                rvz += arm * (sx * ny - sy * nx)
+                gx, gy, gz = _friction_force(rvx, rvy, rvz, delta_dot, nx, ny, nz, f_n, mu_pp,
+                                             v_reg, mt_pp, dt)
             cfx = -f_n * nx + gx
             cfy = -f_n * ny + gy
             cfz = -f_n * nz + gz
@@ -433,24 +562,35 @@ def _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
             nx = c_val[0, q]
             ny = c_val[1, q]
             nz = c_val[2, q]
+            # translation only: rotation moves the contact point along the tangent plane
+            if j < 0:
+                rvx = vx[i] - wvx
+                rvy = vy[i] - wvy
+                rvz = vz[i] - wvz
+                delta_dot = -(rvx * nx + rvy * ny + rvz * nz)
+            else:
+                rvx = vx[i] - vx[j]
+                rvy = vy[i] - vy[j]
+                rvz = vz[i] - vz[j]
+                delta_dot = rvx * nx + rvy * ny + rvz * nz
+            d_norm += c_val[4, q] * delta_dot * dt
+            if stick_slip:
+                continue  # friction loss was tallied where the spring slid
             arm = c_val[3, q]
             sx = ox[i]
             sy = oy[i]
             sz = oz[i]
             if j < 0:
-                rvx = vx[i] - arm * (sy * nz - sz * ny) - wvx
-                rvy = vy[i] - arm * (sz * nx - sx * nz) - wvy
-                rvz = vz[i] - arm * (sx * ny - sy * nx) - wvz
-                delta_dot = -(rvx * nx + rvy * ny + rvz * nz)
+                rvx -= arm * (sy * nz - sz * ny)
+                rvy -= arm * (sz * nx - sx * nz)
+                rvz -= arm * (sx * ny - sy * nx)
             else:
                 sx += ox[j]
                 sy += oy[j]
                 sz += oz[j]
-                rvx = vx[i] - vx[j] + arm * (sy * nz - sz * ny)
-                rvy = vy[i] - vy[j] + arm * (sz * nx - sx * nz)
-                rvz = vz[i] - vz[j] + arm * (sx * ny - sy * nx)
-                delta_dot = rvx * nx + rvy * ny + rvz * nz
-            d_norm += c_val[4, q] * delta_dot * dt
+                rvx += arm * (sy * nz - sz * ny)
+                rvy += arm * (sz * nx - sx * nz)
+                rvz += arm * (sx * ny - sy * nx)
             d_fric -= (c_val[5, q] * rvx + c_val[6, q] * rvy + c_val[7, q] * rvz) * dt
         tally[c, cyc, 0] += w_wall
         tally[c, cyc, 1] += d_norm
@@ -474,3 +614,9 @@ def _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
     trq[0, c] = tx
     trq[1, c] = ty
     trq[2, c] = tz
+    spr_pp[0, c] = qpx
+    spr_pp[1, c] = qpy
+    spr_pp[2, c] = qpz
+    spr_pw[0, c] = qwx
+    spr_pw[1, c] = qwy
+    spr_pw[2, c] = qwz

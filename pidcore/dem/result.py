@@ -179,6 +179,8 @@ class DemResult:
             "normal_damping_mode": self.config.normal_damping_mode,
             "vibrated_mass_convention": self.config.vibrated_mass,
             "start_protocol": self.config.start_protocol,
+            "start_packing": self.config.start_packing,
+            "tangential_model": self.config.tangential_model,
             "fill_reference": self.config.fill_reference,
             "seed": self.config.seed,
         }

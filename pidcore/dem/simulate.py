@@ -16,8 +16,11 @@ Method (choices and why):
   centres are confined to a hexagon of apothem 1.13 mm, two spheres per layer at most).
 * **Start.** Random non-overlapping drop packings (asserted), settled under gravity in the
   resting cell until every cell's kinetic energy < DEM_SETTLE_KINETIC_FRACTION x N m g r;
-  then the drive starts with the particles moving with the cell (``start_protocol="with_cell"``,
-  no start jolt) or at rest.
+  with ``start_packing="dense"`` (default) first without friction (the bed slides into the
+  densest state gravity gives), then again with friction; ``"loose"`` settles once, with
+  friction, and such a bed keeps compacting under a 1 g drive. Then the drive starts with
+  the particles moving with the cell (``start_protocol="with_cell"``, no start jolt) or at
+  rest.
 * **Time step.** ``"auto"`` = min(2e-6 s, t_contact / 10) with t_contact the Hertz contact time
   at the largest expected impact speed 2 a/w + sqrt(2 g h) (particle and wall moving
   oppositely at the drive's velocity amplitude, plus a free fall over the cell height); an
@@ -26,15 +29,15 @@ Method (choices and why):
 * **Steady state.** Blocks of DEM_STEADY_BLOCK_CYCLES cycles: steady once successive block
   means of the dissipation agree and the walls' work balances the dissipation in both blocks
   (:func:`_steady_start`), at most DEM_MAX_TRANSIENT_CYCLES and DEM_MAX_TRANSIENT_TIME_S
-  skipped (then flagged). Measured
-  window: DEM_MIN_STEADY_CYCLES cycles, or at low frequency DEM_MIN_STEADY_TIME_S of
-  simulated time if that is fewer cycles (50 cycles at 50 Hz).
+  skipped (then flagged). Measured window: DEM_MIN_STEADY_CYCLES cycles (80: 1.6 s at
+  50 Hz).
 * **SDC.** Eq. 8-10: steady dissipation per cycle over E = m_c a^2 / (2 w^2), m_c per
   ``vibrated_mass`` (default: coupon face sheets + core + all particles of the 441 cells).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from dataclasses import asdict, dataclass
@@ -46,16 +49,19 @@ from ..constants import (
     DRIVE_DIRECTIONS,
     PARTICLE_MATERIALS,
     STANDARD_GRAVITY,
+    START_PACKINGS,
     START_PROTOCOLS,
     VIBRATED_MASS_CONVENTIONS,
     DriveDirection,
     NormalDampingMode,
     ParticleMaterial,
+    StartPacking,
     StartProtocol,
+    TangentialModel,
     VibratedMassConvention,
 )
 from ..errors import ParameterError, SimulationError
-from .contact import ContactLaw, check_damping_mode
+from .contact import ContactLaw, check_damping_mode, check_tangential_model
 from .geometry import CellGeometry, cell_capacity, random_packing
 from .result import DemResult
 from .state import (
@@ -116,10 +122,11 @@ class LoadCase:
 class DemConfig:
     """Numerical settings of a DEM run (defaults in :mod:`pidcore.defaults`).
 
-    ``steady_cycles=None``: measure min(DEM_MIN_STEADY_CYCLES, DEM_MIN_STEADY_TIME_S * f)
-    cycles (at least one block). ``time_step``: seconds, or ``"auto"`` = min(2e-6 s,
-    t_contact / DEM_MIN_STEPS_PER_CONTACT). The step actually used is shortened slightly so that
-    a drive period is a whole number of sample intervals.
+    ``steady_cycles=None``: measure DEM_MIN_STEADY_CYCLES cycles (at least one block).
+    ``time_step``: seconds, or ``"auto"`` = min(2e-6 s, t_contact / DEM_MIN_STEPS_PER_CONTACT).
+    The step actually used is shortened slightly so that a drive period is a whole number of
+    sample intervals. ``tangential_model`` and ``start_packing``: see the module docstring
+    and :mod:`pidcore.dem.contact`.
     """
 
     cells: int = defaults.DEM_CELLS
@@ -128,6 +135,7 @@ class DemConfig:
     normal_damping_mode: NormalDampingMode = defaults.DEM_NORMAL_DAMPING_MODE
     vibrated_mass: VibratedMassConvention = defaults.DEM_VIBRATED_MASS_CONVENTION
     start_protocol: StartProtocol = defaults.DEM_START_PROTOCOL
+    start_packing: StartPacking = defaults.DEM_START_PACKING
     fill_reference: str = defaults.DEM_FILL_REFERENCE
     steady_cycles: int | None = None
     block_cycles: int = defaults.DEM_STEADY_BLOCK_CYCLES
@@ -136,6 +144,7 @@ class DemConfig:
     max_transient_s: float = defaults.DEM_MAX_TRANSIENT_TIME_S
     samples_per_cycle: int = defaults.DEM_SAMPLES_PER_CYCLE
     friction_regularisation_m_s: float = defaults.DEM_FRICTION_REGULARISATION_SPEED_M_S
+    tangential_model: TangentialModel = defaults.DEM_TANGENTIAL_MODEL
     alpha_pp: float | None = None
     alpha_pw: float | None = None
     damping_coefficient: str = defaults.DEM_DAMPING_COEFFICIENT
@@ -144,9 +153,11 @@ class DemConfig:
         if self.cells < 1:
             raise ParameterError(f"cells: expected >= 1, got {self.cells}")
         check_damping_mode(self.normal_damping_mode)
+        check_tangential_model(self.tangential_model)
         for name, value, allowed in (
                 ("vibrated_mass", self.vibrated_mass, VIBRATED_MASS_CONVENTIONS),
                 ("start_protocol", self.start_protocol, START_PROTOCOLS),
+                ("start_packing", self.start_packing, START_PACKINGS),
                 ("fill_reference", self.fill_reference, FILL_REFERENCES)):
             if value not in allowed:
                 raise ParameterError(f"{name}: expected one of {allowed}, got {value!r}")
@@ -165,13 +176,13 @@ class DemConfig:
             raise ParameterError("block_cycles >= 1 and max_transient_cycles >= 0 expected")
         if not self.max_transient_s >= 0:
             raise ParameterError(f"max_transient_s: expected >= 0 s, got {self.max_transient_s}")
+        if self.samples_per_cycle < 8:
+            raise ParameterError(f"samples_per_cycle: expected >= 8, "
+                                 f"got {self.samples_per_cycle}")
 
     def transient_cap_cycles(self, frequency_hz: float) -> int:
         """Most transient cycles skipped at ``frequency_hz``: the cycle and the time caps."""
         return min(self.max_transient_cycles, math.ceil(self.max_transient_s * frequency_hz))
-        if self.samples_per_cycle < 8:
-            raise ParameterError(f"samples_per_cycle: expected >= 8, "
-                                 f"got {self.samples_per_cycle}")
 
 
 def coupon_mass_kg() -> float:
@@ -197,18 +208,27 @@ def max_impact_speed(case: LoadCase, geometry: CellGeometry) -> float:
 
 
 def choose_time_step(case: LoadCase, law: ContactLaw, geometry: CellGeometry,
-                     requested: float | str) -> float:
-    """Check or pick the time step, s (>= DEM_MIN_STEPS_PER_CONTACT steps per contact)."""
+                     requested: float | str,
+                     tangential_model: TangentialModel = defaults.DEM_TANGENTIAL_MODEL) -> float:
+    """Check or pick the time step, s (>= DEM_MIN_STEPS_PER_CONTACT steps per contact).
+
+    With the stick-slip model the period of a stuck tangential spring (about the contact
+    time) must be resolved as well.
+    """
     v = max_impact_speed(case, geometry)
     t_contact = law.contact_time(v)
+    what = f"{case.material} contact at the largest expected impact speed {v:.2f} m/s " \
+        f"(t_contact {t_contact:.3g} s)"
+    if tangential_model == "stick_slip" and law.tangential_period() < t_contact:
+        t_contact = law.tangential_period()
+        what = f"period of a stuck {case.material} tangential spring ({t_contact:.3g} s)"
     safe = t_contact / defaults.DEM_MIN_STEPS_PER_CONTACT
     if requested == "auto":
         return min(defaults.DEM_TIME_STEP_S, safe)
     if requested > safe:
         raise ParameterError(
             f"time_step {requested:.3g} s gives {t_contact / requested:.1f} steps per "
-            f"{case.material} contact at the largest expected impact speed {v:.2f} m/s "
-            f"(t_contact {t_contact:.3g} s); need >= {defaults.DEM_MIN_STEPS_PER_CONTACT}: "
+            f"{what}; need >= {defaults.DEM_MIN_STEPS_PER_CONTACT}: "
             f"use time_step <= {safe:.3g} s or 'auto'")
     return float(requested)
 
@@ -276,6 +296,20 @@ def settle(state: CellsState, settings: KernelSettings, *,
                 f"after {elapsed:.3g} s")
 
 
+def settle_bed(state: CellsState, settings: KernelSettings,
+               packing: StartPacking = defaults.DEM_START_PACKING) -> float:
+    """Settle the start packing (``"dense"`` or ``"loose"``, see the module docstring), s."""
+    if packing not in START_PACKINGS:
+        raise ParameterError(f"start_packing: expected one of {START_PACKINGS}, got {packing!r}")
+    elapsed = 0.0
+    if packing == "dense":
+        frictionless = dataclasses.replace(settings.law, friction_pp=0.0, friction_pw=0.0)
+        elapsed += settle(state, dataclasses.replace(settings, law=frictionless))
+        state.spring_pp[:] = 0.0  # none stretched without friction; start the springs clean
+        state.spring_pw[:] = 0.0
+    return elapsed + settle(state, settings)
+
+
 def _steady_start(dissipated: np.ndarray, work: np.ndarray, config: DemConfig) -> int | None:
     """First cycle of the steady state from coupon-level per-cycle dissipation and wall work.
 
@@ -311,8 +345,7 @@ def _steady_start(dissipated: np.ndarray, work: np.ndarray, config: DemConfig) -
 def required_steady_cycles(case: LoadCase, config: DemConfig) -> int:
     if config.steady_cycles is not None:
         return config.steady_cycles
-    by_time = math.ceil(defaults.DEM_MIN_STEADY_TIME_S * case.frequency_hz)
-    return max(min(defaults.DEM_MIN_STEADY_CYCLES, by_time), config.block_cycles)
+    return max(defaults.DEM_MIN_STEADY_CYCLES, config.block_cycles)
 
 
 def simulate_load_case(case: LoadCase, config: DemConfig | None = None, *,
@@ -354,7 +387,7 @@ def simulate_load_case(case: LoadCase, config: DemConfig | None = None, *,
                                   alpha_pw=config.alpha_pw)
     n, full = particles_per_cell(case.fill_percent, case.material, geometry=geometry,
                                  fill_reference=config.fill_reference)
-    dt_req = choose_time_step(case, law, geometry, config.time_step)
+    dt_req = choose_time_step(case, law, geometry, config.time_step, config.tangential_model)
     spc_samples = config.samples_per_cycle
     period = 1.0 / case.frequency_hz
     sample_every = math.ceil(period / (spc_samples * dt_req))
@@ -381,9 +414,10 @@ def simulate_load_case(case: LoadCase, config: DemConfig | None = None, *,
     common = dict(law=law, geometry=geometry, dt_s=dt, direction=case.direction,
                   clip_attraction=config.normal_damping_mode == "no_attraction",
                   friction_regularisation_m_s=config.friction_regularisation_m_s,
+                  tangential_model=config.tangential_model,
                   max_overlap_fraction=defaults.DEM_MAX_OVERLAP_FRACTION)
     kernel_clock = time.perf_counter()
-    settle_time = settle(state, KernelSettings(**common))
+    settle_time = settle_bed(state, KernelSettings(**common), config.start_packing)
     settle_steps = int(round(settle_time / dt))
     kernel_s = time.perf_counter() - kernel_clock
 
@@ -472,4 +506,4 @@ def config_parameters(case: LoadCase, config: DemConfig) -> dict:
 
 __all__ = ["LoadCase", "DemConfig", "simulate_load_case", "choose_time_step",
            "particles_per_cell", "vibrated_mass_kg", "coupon_mass_kg", "max_impact_speed",
-           "settle", "config_parameters"]
+           "settle", "settle_bed", "config_parameters"]

@@ -6,10 +6,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .. import defaults
 from ..constants import DRIVE_DIRECTIONS, STANDARD_GRAVITY
 from ..errors import SimulationError
-from .contact import ContactLaw
-from .geometry import CellGeometry
+from .contact import ContactLaw, check_tangential_model
+from .geometry import WALL_NAMES, CellGeometry
 from .kernel import (
     N_TALLIES,
     STATUS_ESCAPED,
@@ -28,7 +29,9 @@ class CellsState:
     """Mutable structure-of-arrays state of K cells of N particles (SI units).
 
     ``pos``, ``vel``, ``omg``, ``frc``, ``trq`` have shape (3, K, N); ``step`` counts steps
-    since the drive clock's origin (t = step * dt).
+    since the drive clock's origin (t = step * dt). ``spring_pp`` (3, K, N, N; entry [i, j]
+    with i < j) and ``spring_pw`` (3, K, N, walls) hold the stretch of the tangential contact
+    springs of the stick-slip model, m (zero where there is no contact).
     """
 
     pos: np.ndarray
@@ -36,6 +39,8 @@ class CellsState:
     omg: np.ndarray
     frc: np.ndarray
     trq: np.ndarray
+    spring_pp: np.ndarray
+    spring_pw: np.ndarray
     step: int = 0
 
     @classmethod
@@ -50,7 +55,10 @@ class CellsState:
         zeros = np.zeros_like(pos)
         frc = zeros.copy()
         frc[2] = -mass_kg * gravity_m_s2
-        return cls(pos=pos, vel=zeros.copy(), omg=zeros.copy(), frc=frc, trq=zeros.copy())
+        k, n = pos.shape[1], pos.shape[2]
+        return cls(pos=pos, vel=zeros.copy(), omg=zeros.copy(), frc=frc, trq=zeros.copy(),
+                   spring_pp=np.zeros((3, k, n, n)),
+                   spring_pw=np.zeros((3, k, n, len(WALL_NAMES))))
 
     @property
     def n_cells(self) -> int:
@@ -62,7 +70,8 @@ class CellsState:
 
     def copy(self) -> CellsState:
         return CellsState(self.pos.copy(), self.vel.copy(), self.omg.copy(), self.frc.copy(),
-                          self.trq.copy(), self.step)
+                          self.trq.copy(), self.spring_pp.copy(), self.spring_pw.copy(),
+                          self.step)
 
 
 def wall_displacement(t_s, *, accel_m_s2: float, omega_rad_s: float):
@@ -84,7 +93,8 @@ def energies(state: CellsState, law: ContactLaw, geometry: CellGeometry, *,
     """Per-cell mechanical energy, (K, 4): kinetic (incl. rotation), potential, elastic, sum; J.
 
     ``wall_offset_m`` is the (3,) displacement of the cell at the state's time. The potential
-    energy is m g z of the particle centres (absolute z).
+    energy is m g z of the particle centres (absolute z); the elastic energy is the Hertz
+    energy of the overlaps plus 1/2 k_t |xi|^2 of the tangential springs.
     """
     m = law.mass_kg
     ke = 0.5 * m * np.sum(state.vel**2, axis=(0, 2)) \
@@ -98,7 +108,9 @@ def energies(state: CellsState, law: ContactLaw, geometry: CellGeometry, *,
     overlap = np.maximum(2 * law.radius_m - d, 0.0)
     overlap[:, np.arange(p.shape[1]), np.arange(p.shape[1])] = 0.0
     u_pair = 0.5 * np.sum(0.4 * law.stiffness_pp * overlap**2.5, axis=(1, 2))
-    elastic = np.sum(u_wall, axis=(1, 2)) + u_pair
+    u_spring = (0.5 * law.tangential_stiffness_pp * np.sum(state.spring_pp**2, axis=(0, 2, 3))
+                + 0.5 * law.tangential_stiffness_pw * np.sum(state.spring_pw**2, axis=(0, 2, 3)))
+    elastic = np.sum(u_wall, axis=(1, 2)) + u_pair + u_spring
     return np.column_stack([ke, pe, elastic, ke + pe + elastic])
 
 
@@ -126,12 +138,14 @@ class KernelSettings:
     direction: str = "z"
     gravity_m_s2: float = STANDARD_GRAVITY
     clip_attraction: bool = True
-    friction_regularisation_m_s: float = 1e-6
-    max_overlap_fraction: float = 0.05
+    tangential_model: str = defaults.DEM_TANGENTIAL_MODEL
+    friction_regularisation_m_s: float = defaults.DEM_FRICTION_REGULARISATION_SPEED_M_S
+    max_overlap_fraction: float = defaults.DEM_MAX_OVERLAP_FRACTION
 
     def __post_init__(self):
         if self.direction not in DRIVE_DIRECTIONS:
             raise SimulationError(f"direction: expected one of {DRIVE_DIRECTIONS}")
+        check_tangential_model(self.tangential_model)
 
 
 def advance(state: CellsState, settings: KernelSettings, n_steps: int, *,
@@ -159,7 +173,10 @@ def advance(state: CellsState, settings: KernelSettings, n_steps: int, *,
                   law.stiffness_pp, law.damping_pp, law.friction_pp, law.tangential_mass_pp,
                   law.stiffness_pw, law.damping_pw, law.friction_pw, law.tangential_mass_pw,
                   settings.friction_regularisation_m_s, settings.clip_attraction,
-                  settings.gravity_m_s2, settings.dt_s, np.int64(state.step), np.int64(n_steps),
+                  settings.gravity_m_s2,
+                  settings.tangential_model == "stick_slip", law.tangential_stiffness_pp,
+                  law.tangential_stiffness_pw, state.spring_pp, state.spring_pw,
+                  settings.dt_s, np.int64(state.step), np.int64(n_steps),
                   settings.omega_rad_s, settings.accel_m_s2,
                   AXIS_INDEX[settings.direction],
                   np.int64(spc), np.int64(se), settings.max_overlap_fraction,
