@@ -120,6 +120,13 @@ def make_samples(out_dir: str | os.PathLike = "data_samples", *, run_sweep: bool
     store_path = out / "dem_table3.h5"
     config = DemConfig()
     cases = grid_cases("table3")
+    if store_path.exists():
+        # the bundled store must hold one consistent grid; never delete a user's runs
+        wanted = {run_key(case, config) for case in cases}
+        stale = set(Store(store_path).list_dem_runs().get("case_key", [])) - wanted
+        if stale:
+            raise StoreError(f"{store_path}: holds {len(stale)} DEM run(s) from other settings "
+                             f"(e.g. {sorted(stale)[0]}); move or delete it to regenerate")
     if run_sweep:
         sweep(cases, config, store_path=store_path, workers=workers, progress=progress)
     written["dem_store"] = store_path

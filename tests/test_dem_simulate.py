@@ -155,7 +155,7 @@ def test_power_closure_virtual_shaker_matches_energy_tally():
                                      max_transient_cycles=100))
     pa = r.power_analysis()
     # Re(P) T from shaker force and velocity is the walls' work per cycle: only the
-    # box-car sampling (64 samples per cycle, < 0.1 %) separates them
+    # box-car sampling (128 samples per cycle, < 0.1 % here) separates them
     assert pa.energy_per_cycle_j == pytest.approx(r.work_per_cycle_j, rel=0.005)
     # work = dissipation + change of the beds' stored energy over the window (energy balance,
     # closes to < 1 %); the stored part is what separates the shaker's view from the tally

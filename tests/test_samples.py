@@ -76,3 +76,19 @@ def test_sample_cases_cover_every_export_format_and_state_their_load_case():
         assert case.file_name.startswith("synthetic_")  # labelled as synthetic
         stated = parse_file_name(case.file_name)
         assert stated == {"fill_percent": case.fill_percent, "material": "acrylic"}
+
+
+def test_make_samples_refuses_a_store_holding_other_settings(tmp_path):
+    # regenerating into a store of older runs would mix two models in the bundled grid
+    from pidcore.dem.persist import save_dem_result
+    from pidcore.errors import StoreError
+    from pidcore.samples import make_samples
+
+    path = tmp_path / "dem_table3.h5"
+    old = simulate_load_case(LoadCase(500, 5, 50), DemConfig(cells=1, steady_cycles=2,
+                                                             block_cycles=2))
+    save_dem_result(path, old)
+    before = path.read_bytes()
+    with pytest.raises(StoreError, match="other settings"):
+        make_samples(tmp_path, run_sweep=False, progress=False)
+    assert path.read_bytes() == before  # untouched
