@@ -297,6 +297,20 @@ def test_too_few_periods_and_noise_raise_signal_error():
         analyze_power(noise[0], noise[1], fs, source="noise.uff")
 
 
+def test_exactly_the_minimum_number_of_periods_is_accepted():
+    # 10 whole periods: the frequency estimated from the record may come out a few ppm low,
+    # which must not turn 10.000 periods into a refusal (a DEM window of 10 cycles did)
+    fs = 64000.0
+    for frequency in (499.9998262046107, 500.0, 500.0003):
+        rec = synthesize_shaker_record(mass_kg=0.5, acceleration_amplitude_m_s2=G,
+                                       frequency_hz=frequency, sample_rate_hz=fs,
+                                       n_periods=10, viscous_damping_n_s_m=2.0)
+        omega = 2 * np.pi * frequency
+        truth = np.pi * 2.0 * (G / omega) ** 2 / omega  # viscous: pi c V^2 / w per cycle
+        result = analyze_power(rec.force_n, rec.velocity_m_s, fs, min_periods=10, n_blocks=2)
+        assert result.energy_per_cycle_j == pytest.approx(truth, rel=1e-6)  # noise-free
+
+
 def test_zero_motion_array_has_no_dominant_frequency():
     """analyze_power (array level, no channel checks) must not invent a peak in zeros."""
     rec = synthesize_shaker_record(mass_kg=0.5, acceleration_amplitude_m_s2=G, frequency_hz=100.0,

@@ -364,7 +364,9 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
     freq = estimate_drive_frequency(motion, sample_rate_hz, frequency_hint_hz=frequency_hz,
                                     what=what)
     n_periods = n_samples * freq / sample_rate_hz
-    if n_periods < min_periods:
+    # a record of exactly min_periods periods must pass although the estimated frequency may
+    # be a few ppm low: allow half a percent of a period
+    if n_periods < min_periods - 0.005:
         raise SignalError(f"{what}: {n_periods:.2f} drive periods of {freq:.6g} Hz in "
                           f"{n_samples} samples, expected at least {min_periods}")
     max_harm = int(defaults.HARMONIC_MAX_FRACTION_OF_NYQUIST * 0.5 * sample_rate_hz / freq)
