@@ -237,6 +237,10 @@ def _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
     qwx = spr_pw[0, c].copy()
     qwy = spr_pw[1, c].copy()
     qwz = spr_pw[2, c].copy()
+    # which springs may hold a stretch (one byte read per idle candidate instead of three
+    # floats): set on contact, cleared when the contact opens
+    live_p = (qpx != 0.0) | (qpy != 0.0) | (qpz != 0.0)
+    live_w = (qwx != 0.0) | (qwy != 0.0) | (qwz != 0.0)
     u_prev = 0.0  # cell displacement along the drive axis at the previous step
     if omega > 0.0:
         t_prev = step0 * dt  # same rounding as t below, so chunking does not change bits
@@ -380,14 +384,14 @@ def _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
                 dist = nx * (pxi - ux) + ny * (pyi - uy) + nz * (pzi - uz) + wd[w]
                 delta = radius - dist
                 if delta <= 0.0:
-                    if stick_slip and (qwx[i, w] != 0.0 or qwy[i, w] != 0.0
-                                       or qwz[i, w] != 0.0):
+                    if live_w[i, w]:
                         # contact opened with energy left in its spring: count it as lost
                         d_fric += 0.5 * kt_pw * (qwx[i, w] ** 2 + qwy[i, w] ** 2
                                                  + qwz[i, w] ** 2)
                         qwx[i, w] = 0.0
                         qwy[i, w] = 0.0
                         qwz[i, w] = 0.0
+                        live_w[i, w] = False
                     continue
                 if dist < 0.0:
                     status[c] = STATUS_ESCAPED
@@ -417,6 +421,7 @@ def _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
                     qwx[i, w] = sxn
                     qwy[i, w] = syn
                     qwz[i, w] = szn
+                    live_w[i, w] = True
                     d_fric += lost
                     gx = -kt_pw * sxn
                     gy = -kt_pw * syn
@@ -463,15 +468,19 @@ def _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
             i = nb_i[q]
             j = nb_j[q]
             dz = pz[j] - pz[i]
-            dx = px[j] - px[i]
-            dy = py[j] - py[i]
-            d2 = dx * dx + dy * dy + dz * dz
-            if dz >= two_r or dz <= -two_r or d2 >= two_r * two_r:
-                if stick_slip and (qpx[i, j] != 0.0 or qpy[i, j] != 0.0 or qpz[i, j] != 0.0):
+            touching = dz < two_r and dz > -two_r
+            if touching:
+                dx = px[j] - px[i]
+                dy = py[j] - py[i]
+                d2 = dx * dx + dy * dy + dz * dz
+                touching = d2 < two_r * two_r
+            if not touching:
+                if live_p[i, j]:  # opened with energy left in its spring: lost
                     d_fric += 0.5 * kt_pp * (qpx[i, j] ** 2 + qpy[i, j] ** 2 + qpz[i, j] ** 2)
                     qpx[i, j] = 0.0
                     qpy[i, j] = 0.0
                     qpz[i, j] = 0.0
+                    live_p[i, j] = False
                 continue
             d = np.sqrt(d2)
             inv_d = 1.0 / d
@@ -501,6 +510,7 @@ def _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
                 qpx[i, j] = sxn
                 qpy[i, j] = syn
                 qpz[i, j] = szn
+                live_p[i, j] = True
                 d_fric += lost
                 gx = -kt_pp * sxn
                 gy = -kt_pp * syn
