@@ -19,7 +19,6 @@ from pidcore.model import (
     energy_per_cycle,
     equivalent_damper_table,
     equivalent_damping_coefficient,
-    load_paper_table3,
     loss_factor,
     paper_particles_mass_kg,
     sdc_from_damping_coefficient,
@@ -27,9 +26,9 @@ from pidcore.model import (
 )
 
 
-@pytest.fixture(scope="module")
-def model() -> SdcModel:
-    return SdcModel.from_table(load_paper_table3())
+@pytest.fixture
+def model(paper_model) -> SdcModel:
+    return paper_model
 
 
 def test_round_trip_sdc_to_c_eq_to_sdc():

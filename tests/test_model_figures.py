@@ -7,21 +7,21 @@ import pandas as pd
 import pytest
 
 from pidcore.errors import ParameterError
-from pidcore.model import SdcModel, load_paper_table3
+from pidcore.model import SdcModel
 from pidcore.report.figures import plot_sdc_vs_acceleration, plot_sdc_vs_frequency, save_figure
 
 FREQS = [50.0, 100.0, 250.0, 500.0, 750.0, 1000.0]  # 4 with data, 2 interpolated
 FILLS = [25.0, 40.0, 50.0, 60.0, 75.0, 90.0]
 
 
-@pytest.fixture(scope="module")
-def table() -> pd.DataFrame:
-    return load_paper_table3()
+@pytest.fixture
+def table(paper_table) -> pd.DataFrame:
+    return paper_table
 
 
-@pytest.fixture(scope="module")
-def model(table) -> SdcModel:
-    return SdcModel.from_table(table)
+@pytest.fixture
+def model(paper_model) -> SdcModel:
+    return paper_model
 
 
 def _lines(ax) -> tuple[list, list]:

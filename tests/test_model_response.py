@@ -16,7 +16,6 @@ from pidcore.model import (
     coupon_vibrated_mass_kg,
     equivalent_damping_coefficient,
     harmonic_response,
-    load_paper_table3,
     paper_particles_mass_kg,
     time_domain_response,
 )
@@ -24,9 +23,9 @@ from pidcore.model import (
 FORCE_N = 10.0
 
 
-@pytest.fixture(scope="module")
-def model() -> SdcModel:
-    return SdcModel.from_table(load_paper_table3())
+@pytest.fixture
+def model(paper_model) -> SdcModel:
+    return paper_model
 
 
 @pytest.fixture(scope="module")

@@ -11,7 +11,7 @@ import pytest
 from scipy.interpolate import PchipInterpolator, RegularGridInterpolator
 
 from pidcore.errors import ParameterError
-from pidcore.model import SdcModel, load_paper_table3
+from pidcore.model import SdcModel
 
 SHARED_TABLE = Path("/work/shared/reference/table3.csv")
 # Round-off of a cubic evaluated at an interval end: a few ulps of values <= 1.
@@ -19,14 +19,14 @@ RTOL_GRID = 1e-12
 ATOL_ROUNDOFF = 1e-12
 
 
-@pytest.fixture(scope="module")
-def table() -> pd.DataFrame:
-    return load_paper_table3()
+@pytest.fixture
+def table(paper_table) -> pd.DataFrame:
+    return paper_table
 
 
-@pytest.fixture(scope="module")
-def model(table) -> SdcModel:
-    return SdcModel.from_table(table)
+@pytest.fixture
+def model(paper_model) -> SdcModel:
+    return paper_model
 
 
 def _synthetic_table(rng: np.random.Generator, *, shape=(4, 4, 5)) -> pd.DataFrame:

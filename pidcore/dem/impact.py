@@ -20,7 +20,7 @@ from ..constants import NormalDampingMode, TangentialModel
 from ..errors import ParameterError
 from .contact import ContactLaw, check_damping_mode
 from .geometry import CellGeometry
-from .state import CellsState, KernelSettings, advance
+from .state import CellsState, KernelSettings, advance, energies
 
 ImpactPair = Literal["wall", "particle"]
 
@@ -100,7 +100,13 @@ def simulate_impact(*, pair: ImpactPair = "wall", impact_speed_m_s: float, dt_s:
                               clip_attraction=mode == "no_attraction",
                               tangential_model=tangential_model)
     steps = int(math.ceil(3.0 * m_t / dt_s)) + 2
-    ke_before = _kinetic_energy(state, law)
+    zero = np.zeros(3)
+
+    def kinetic() -> float:  # translation and rotation, all bodies
+        return float(energies(state, law, geometry, wall_offset_m=zero,
+                              gravity_m_s2=0.0)[:, 0].sum())
+
+    ke_before = kinetic()
     tally, _ = advance(state, settings, steps)
     if pair == "wall":
         v_after = state.vel[:, 0, 0]
@@ -119,12 +125,8 @@ def simulate_impact(*, pair: ImpactPair = "wall", impact_speed_m_s: float, dt_s:
     return ImpactOutcome(impact_speed_m_s, vn_after, vt_before, vt_after,
                          vn_after / impact_speed_m_s, float(tally[..., 1].sum()),
                          float(tally[..., 2].sum()), steps, ke_before,
-                         _kinetic_energy(state, law))
+                         kinetic())
 
-
-def _kinetic_energy(state: CellsState, law: ContactLaw) -> float:
-    return float(0.5 * law.mass_kg * np.sum(state.vel**2)
-                 + 0.5 * law.inertia_kg_m2 * np.sum(state.omg**2))
 
 
 def measure_restitution(*, pair: ImpactPair = "wall", impact_speed_m_s: float, dt_s: float,

@@ -111,18 +111,23 @@ def _friction_force(rvx, rvy, rvz, vn, nx, ny, nz, f_n, mu, v_reg, m_t, dt):
 
 
 @njit(cache=True, inline="always")
-def _spring_force(sx, sy, sz, dsx, dsy, dsz, nx, ny, nz, f_n, mu, k_t):
+def _spring_force(qx, qy, qz, live, a, b, dsx, dsy, dsz, nx, ny, nz, f_n, mu, k_t):
     """Stick-slip tangential spring (Eq. 5 with a tangential spring, capped by mu |f_n|).
 
-    The stored stretch xi = (sx, sy, sz) is projected into the current tangent plane, the
-    step's tangential displacement ds of the contact points is added, and the force -k_t xi
-    is capped at mu |f_n| by shortening xi (sliding).
-    Returns (xi_x, xi_y, xi_z, dissipated). Dissipated = work of the contact on the spring
-    minus the spring energy gained, with the work taken as the mean of the old and new spring
-    forces times ds (velocity Verlet changes the kinetic energy by exactly that mean force
-    times the drift, so the balance closes): zero while stuck, mu |f_n| |ds| while sliding
-    steadily, J.
+    The spring of contact [a, b] lives in the tables ``qx``, ``qy``, ``qz`` (its stretch xi,
+    updated in place) and ``live`` (set). The stretch is projected into the current tangent
+    plane, the step's tangential displacement ds of the contact points is added, and the
+    force -k_t xi is capped at mu |f_n| by shortening xi (sliding).
+
+    Returns (gx, gy, gz, dissipated): the force on the contact's first body, N, and the
+    energy lost, J. Dissipated = work of the contact on the spring minus the spring energy
+    gained, with the work taken as the mean of the old and new spring forces times ds
+    (velocity Verlet changes the kinetic energy by exactly that mean force times the drift,
+    so the balance closes): zero while stuck, mu |f_n| |ds| while sliding steadily.
     """
+    sx = qx[a, b]
+    sy = qy[a, b]
+    sz = qz[a, b]
     # into the tangent plane: the normal part of xi (second order in the normal's turn per
     # step) is dropped and its energy counted as lost, so the balance still closes
     sn = sx * nx + sy * ny + sz * nz
@@ -140,15 +145,36 @@ def _spring_force(sx, sy, sz, dsx, dsy, dsz, nx, ny, nz, f_n, mu, k_t):
     az = sz + dsz
     trial2 = ax * ax + ay * ay + az * az
     limit = mu * abs(f_n)
-    if k_t * k_t * trial2 <= limit * limit:
-        return ax, ay, az, turned
-    keep = limit / (k_t * np.sqrt(trial2))
-    ax *= keep
-    ay *= keep
-    az *= keep
-    work = 0.5 * k_t * ((sx + ax) * dsx + (sy + ay) * dsy + (sz + az) * dsz)
-    gained = 0.5 * k_t * (ax * ax + ay * ay + az * az - old2)
-    return ax, ay, az, turned + work - gained
+    lost = turned
+    if k_t * k_t * trial2 > limit * limit:
+        keep = limit / (k_t * np.sqrt(trial2))
+        ax *= keep
+        ay *= keep
+        az *= keep
+        work = 0.5 * k_t * ((sx + ax) * dsx + (sy + ay) * dsy + (sz + az) * dsz)
+        gained = 0.5 * k_t * (ax * ax + ay * ay + az * az - old2)
+        lost = turned + work - gained
+    qx[a, b] = ax
+    qy[a, b] = ay
+    qz[a, b] = az
+    live[a, b] = True
+    return -k_t * ax, -k_t * ay, -k_t * az, lost
+
+
+@njit(cache=True, inline="always")
+def _release_spring(qx, qy, qz, live, a, b, k_t):
+    """Contact [a, b] is open: clear its spring; returns the energy it still held, J.
+
+    That energy leaves with the contact, so it is counted as dissipated by friction.
+    """
+    if not live[a, b]:
+        return 0.0
+    held = 0.5 * k_t * (qx[a, b] ** 2 + qy[a, b] ** 2 + qz[a, b] ** 2)
+    qx[a, b] = 0.0
+    qy[a, b] = 0.0
+    qz[a, b] = 0.0
+    live[a, b] = False
+    return held
 
 
 @njit(cache=True, parallel=True)
@@ -384,14 +410,7 @@ def _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
                 dist = nx * (pxi - ux) + ny * (pyi - uy) + nz * (pzi - uz) + wd[w]
                 delta = radius - dist
                 if delta <= 0.0:
-                    if live_w[i, w]:
-                        # contact opened with energy left in its spring: count it as lost
-                        d_fric += 0.5 * kt_pw * (qwx[i, w] ** 2 + qwy[i, w] ** 2
-                                                 + qwz[i, w] ** 2)
-                        qwx[i, w] = 0.0
-                        qwy[i, w] = 0.0
-                        qwz[i, w] = 0.0
-                        live_w[i, w] = False
+                    d_fric += _release_spring(qwx, qwy, qwz, live_w, i, w, kt_pw)
                     continue
                 if dist < 0.0:
                     status[c] = STATUS_ESCAPED
@@ -412,20 +431,13 @@ def _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
                     oxi = ox[i]
                     oyi = oy[i]
                     ozi = oz[i]
-                    sxn, syn, szn, lost = _spring_force(
-                        qwx[i, w], qwy[i, w], qwz[i, w],
+                    gx, gy, gz, lost = _spring_force(
+                        qwx, qwy, qwz, live_w, i, w,
                         dt * (vx[i] - arm * (oyi * nz - ozi * ny)) - dwx,
                         dt * (vy[i] - arm * (ozi * nx - oxi * nz)) - dwy,
                         dt * (vz[i] - arm * (oxi * ny - oyi * nx)) - dwz,
                         nx, ny, nz, f_n, mu_pw, kt_pw)
-                    qwx[i, w] = sxn
-                    qwy[i, w] = syn
-                    qwz[i, w] = szn
-                    live_w[i, w] = True
                     d_fric += lost
-                    gx = -kt_pw * sxn
-                    gy = -kt_pw * syn
-                    gz = -kt_pw * szn
                 else:
                     wxi = wpx[i]
                     wyi = wpy[i]
@@ -475,12 +487,7 @@ def _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
                 d2 = dx * dx + dy * dy + dz * dz
                 touching = d2 < two_r * two_r
             if not touching:
-                if live_p[i, j]:  # opened with energy left in its spring: lost
-                    d_fric += 0.5 * kt_pp * (qpx[i, j] ** 2 + qpy[i, j] ** 2 + qpz[i, j] ** 2)
-                    qpx[i, j] = 0.0
-                    qpy[i, j] = 0.0
-                    qpz[i, j] = 0.0
-                    live_p[i, j] = False
+                d_fric += _release_spring(qpx, qpy, qpz, live_p, i, j, kt_pp)
                 continue
             d = np.sqrt(d2)
             inv_d = 1.0 / d
@@ -501,20 +508,13 @@ def _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
                 hx = ox[i] + ox[j]
                 hy = oy[i] + oy[j]
                 hz = oz[i] + oz[j]
-                sxn, syn, szn, lost = _spring_force(
-                    qpx[i, j], qpy[i, j], qpz[i, j],
+                gx, gy, gz, lost = _spring_force(
+                    qpx, qpy, qpz, live_p, i, j,
                     dt * (vx[i] - vx[j] + arm * (hy * nz - hz * ny)),
                     dt * (vy[i] - vy[j] + arm * (hz * nx - hx * nz)),
                     dt * (vz[i] - vz[j] + arm * (hx * ny - hy * nx)),
                     nx, ny, nz, f_n, mu_pp, kt_pp)
-                qpx[i, j] = sxn
-                qpy[i, j] = syn
-                qpz[i, j] = szn
-                live_p[i, j] = True
                 d_fric += lost
-                gx = -kt_pp * sxn
-                gy = -kt_pp * syn
-                gz = -kt_pp * szn
             else:
                 # omega_i x (arm n) - omega_j x (-arm n) = arm (omega_i + omega_j) x n
                 sx = wpx[i] + wpx[j]
