@@ -7,21 +7,10 @@ import pandas as pd
 import pytest
 
 from pidcore.errors import ParameterError
-from pidcore.model import SdcModel
 from pidcore.report.figures import plot_sdc_vs_acceleration, plot_sdc_vs_frequency, save_figure
 
 FREQS = [50.0, 100.0, 250.0, 500.0, 750.0, 1000.0]  # 4 with data, 2 interpolated
 FILLS = [25.0, 40.0, 50.0, 60.0, 75.0, 90.0]
-
-
-@pytest.fixture
-def table(paper_table) -> pd.DataFrame:
-    return paper_table
-
-
-@pytest.fixture
-def model(paper_model) -> SdcModel:
-    return paper_model
 
 
 def _lines(ax) -> tuple[list, list]:
@@ -30,19 +19,20 @@ def _lines(ax) -> tuple[list, list]:
     return curves, markers
 
 
-def test_sdc_vs_acceleration_content(model, table):
-    fig = plot_sdc_vs_acceleration(model, fills=[50.0, 90.0], frequencies=FREQS)
+def test_sdc_vs_acceleration_content(paper_model, paper_table):
+    fig = plot_sdc_vs_acceleration(paper_model, fills=[50.0, 90.0], frequencies=FREQS)
     assert len(fig.axes) == 2
     for ax, fill in zip(fig.axes, [50.0, 90.0], strict=True):
         curves, markers = _lines(ax)
         assert len(curves) == len(FREQS)
         for curve, freq in zip(curves, FREQS, strict=True):
             x, y = curve.get_xdata(), curve.get_ydata()
-            np.testing.assert_allclose(y, model(fill, x, freq), rtol=1e-14)
+            np.testing.assert_allclose(y, paper_model(fill, x, freq), rtol=1e-14)
         data = {ln.get_label(): ln for ln in markers}
         for freq in [50.0, 100.0, 500.0, 1000.0]:
-            rows = table[(table.fill_percent == fill) & (table.frequency_hz == freq)
-                         & table.sdc_dem.notna()].sort_values("acceleration_g")
+            t = paper_table
+            rows = t[(t.fill_percent == fill) & (t.frequency_hz == freq)
+                     & t.sdc_dem.notna()].sort_values("acceleration_g")
             line = data[f"{freq:g} Hz data"]
             np.testing.assert_array_equal(line.get_xdata(), rows.acceleration_g)
             np.testing.assert_array_equal(line.get_ydata(), rows.sdc_dem)
@@ -55,46 +45,46 @@ def test_sdc_vs_acceleration_content(model, table):
     assert len(_lines(fig.axes[0])[1]) == 4
 
 
-def test_sdc_vs_frequency_content(model, table):
-    fig = plot_sdc_vs_frequency(model, accelerations=[5.0], fills=FILLS)
+def test_sdc_vs_frequency_content(paper_model, paper_table):
+    fig = plot_sdc_vs_frequency(paper_model, accelerations=[5.0], fills=FILLS)
     (ax,) = fig.axes
     assert ax.get_xscale() == "log"
     curves, markers = _lines(ax)
     assert len(curves) == len(FILLS) and len(markers) == 4
     for curve, fill in zip(curves, FILLS, strict=True):
-        np.testing.assert_allclose(curve.get_ydata(), model(fill, 5.0, curve.get_xdata()),
+        np.testing.assert_allclose(curve.get_ydata(), paper_model(fill, 5.0, curve.get_xdata()),
                                    rtol=1e-14)
     for ln, fill in zip(markers, [25.0, 50.0, 75.0, 90.0], strict=True):
-        rows = table[(table.fill_percent == fill) & (table.acceleration_g == 5.0)]
+        rows = paper_table[(paper_table.fill_percent == fill) & (paper_table.acceleration_g == 5.0)]
         np.testing.assert_array_equal(ln.get_xdata(), rows.frequency_hz)
         np.testing.assert_array_equal(ln.get_ydata(), rows.sdc_dem)
 
 
-def test_marks_points_of_a_given_table(model):
+def test_marks_points_of_a_given_table(paper_model):
     runs = pd.DataFrame({"fill_percent": [50.0, 50.0, 75.0], "acceleration_g": [2.0, 7.0, 2.0],
                          "frequency_hz": [100.0, 100.0, 100.0], "sdc": [0.1, 0.2, 0.3]})
-    fig = plot_sdc_vs_acceleration(model, fills=[50.0], frequencies=[100.0, 500.0], table=runs,
-                                   value="sdc")
+    fig = plot_sdc_vs_acceleration(paper_model, fills=[50.0], frequencies=[100.0, 500.0],
+                                   table=runs, value="sdc")
     curves, markers = _lines(fig.axes[0])
     assert len(curves) == 2 and len(markers) == 1
     np.testing.assert_array_equal(markers[0].get_xdata(), [2.0, 7.0])
     np.testing.assert_array_equal(markers[0].get_ydata(), [0.1, 0.2])
 
 
-def test_into_given_axes_and_refusals(model):
+def test_into_given_axes_and_refusals(paper_model):
     from matplotlib.figure import Figure
 
     ax = Figure().subplots()
-    fig = plot_sdc_vs_frequency(model, accelerations=[10.0], fills=[50.0], ax=ax)
+    fig = plot_sdc_vs_frequency(paper_model, accelerations=[10.0], fills=[50.0], ax=ax)
     assert fig is ax.figure and len(ax.lines) == 2
     with pytest.raises(ParameterError, match="single"):
-        plot_sdc_vs_acceleration(model, fills=[25.0, 50.0], ax=ax)
+        plot_sdc_vs_acceleration(paper_model, fills=[25.0, 50.0], ax=ax)
     with pytest.raises(ParameterError, match="outside the model range"):
-        plot_sdc_vs_acceleration(model, fills=[95.0])
+        plot_sdc_vs_acceleration(paper_model, fills=[95.0])
 
 
-def test_save_figure_writes_png_and_svg(model, tmp_path):
-    fig = plot_sdc_vs_acceleration(model, fills=[25.0], frequencies=[50.0])
+def test_save_figure_writes_png_and_svg(paper_model, tmp_path):
+    fig = plot_sdc_vs_acceleration(paper_model, fills=[25.0], frequencies=[50.0])
     paths = save_figure(fig, tmp_path / "figs", "fig8")
     assert [p.name for p in paths] == ["fig8.png", "fig8.svg"]
     assert paths[0].read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
