@@ -10,13 +10,9 @@ import pytest
 
 from pidcore.measure import analysis_arrays
 from pidcore.report import ALIGNMENT_COLUMN, build_report_table
-from pidcore.report.comparison_figures import (
-    dem_loop_from_arrays,
-    loop_from_phasors,
-    plot_loop_overlay,
-    plot_sdc_comparison,
-)
+from pidcore.report.comparison_figures import plot_loop_overlay, plot_sdc_comparison
 from pidcore.signal import analyze_power, synthesize_shaker_record
+from pidcore.signal.loops import dem_loop_from_arrays, loop_from_phasors
 
 FREQ_HZ, RATE_HZ, ACC_M_S2, DAMPING = 200.0, 10000.0, 20.0, 4.0
 

@@ -63,7 +63,8 @@ def report(tmp_path_factory, table, provenance):
 
 def test_every_format_and_figure_is_written(report):
     out, paths = report
-    for name in ("csv", "md", "html", "tex", "pdf", "figure:parabola.png", "figure:parabola.svg"):
+    for name in ("csv", "csv_provenance", "md", "html", "tex", "pdf", "figure:parabola.png",
+                 "figure:parabola.svg"):
         assert paths[name].is_file() and paths[name].parent.is_relative_to(out)
     assert paths["figure:parabola.png"].read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert b"<svg" in paths["figure:parabola.svg"].read_bytes()[:1000]
@@ -71,7 +72,10 @@ def test_every_format_and_figure_is_written(report):
 
 
 def test_csv_reads_back_equal_to_the_table(report, table):
-    back = pd.read_csv(report[1]["csv"], comment="#")
+    # No comment= option: the CSV holds exactly the table (notes go to a sidecar file), so a
+    # spreadsheet or a plain read_csv reads no junk rows.
+    back = pd.read_csv(report[1]["csv"])
+    assert len(back) == len(table)
     text_cols = [c for c in table.columns if not pd.api.types.is_numeric_dtype(table[c])]
     for c in text_cols:  # an all-empty text column reads back as NaN floats
         back[c] = back[c].astype(object).where(back[c].notna(), "")
@@ -81,7 +85,7 @@ def test_csv_reads_back_equal_to_the_table(report, table):
 
 def test_provenance_footer_in_every_text_format(report, provenance):
     store_sha = provenance.stores[0][1]
-    for name in ("csv", "md", "html", "tex"):
+    for name in ("csv_provenance", "md", "html", "tex"):
         text = report[1][name].read_text(encoding="utf-8")
         assert INPUT_SHA in text and store_sha in text, name
         assert "2026-01-02T03:04:05+00:00" in text and "seeds: 1, 3" in text
@@ -162,8 +166,9 @@ def test_success_replaces_an_earlier_report(tmp_path, table, provenance):
     out = tmp_path / "out"
     write_report(table, _figures(), provenance, out, "all")
     paths = write_report(table, {}, provenance, out, "csv")
-    assert sorted(p.name for p in out.iterdir()) == sorted([REPORT_MARKER, "report.csv"])
-    assert paths == {"csv": out / "report.csv"}
+    assert sorted(p.name for p in out.iterdir()) == sorted([REPORT_MARKER, "report.csv",
+                                                            "report.provenance.txt"])
+    assert paths == {"csv": out / "report.csv", "csv_provenance": out / "report.provenance.txt"}
 
 
 def test_unrelated_folder_is_never_replaced(tmp_path, table, provenance):

@@ -11,6 +11,7 @@ import pytest
 from pidcore.model import load_paper_table3
 from pidcore.records import Channel, Measurement
 from pidcore.report import ALIGNMENT_COLUMN, REPORT_COLUMNS, build_report_table
+from pidcore.report.table import CONSISTENCY_COLUMN, DIFFERENCE_COLUMN
 from pidcore.store import Store
 
 FILLS = (25.0, 50.0)
@@ -119,8 +120,9 @@ def test_on_grid_measurement_shares_the_dem_row_and_paper_values(table):
     assert row[ALIGNMENT_COLUMN] == "grid"
     assert row["SDC DEM (paper) [-]"] == 0.1891 and row["SDC measured (paper) [-]"] == 0.21
     assert row["difference ours - paper DEM [-]"] == row["SDC DEM (ours) [-]"] - 0.1891
-    assert row["difference measured - ours [-]"] == \
-        row["SDC measured [-]"] - row["SDC DEM (ours) [-]"]
+    # the DEM runs of this fixture record no m_c: no like-for-like difference, and no Eq. 11
+    # value passed off as one
+    assert math.isnan(row[DIFFERENCE_COLUMN]) and "no DEM m_c" in row["note"]
 
 
 def test_off_grid_measurement_is_interpolated_within_its_neighbours(table):
@@ -138,7 +140,7 @@ def test_out_of_range_measurement_has_no_dem_value(table):
     row = table[table["source file(s)"] == "outside_fill50.csv"].iloc[0]
     assert row[ALIGNMENT_COLUMN] == "out_of_range"
     assert math.isnan(row["SDC DEM (ours) [-]"])
-    assert math.isnan(row["difference measured - ours [-]"])
+    assert math.isnan(row[DIFFERENCE_COLUMN])
     assert "not extrapolated" in row["note"]
 
 
@@ -210,9 +212,64 @@ def test_measured_sdc_with_eq10_energy_uses_the_dem_vibrated_mass():
     expected = energy / (m_c * (4.98 * STANDARD_GRAVITY) ** 2 / (2 * w**2))
     assert row[MEASURED_EQ10_COLUMN] == pytest.approx(expected, rel=1e-12)
     assert row["SDC measured [-]"] == 4.3  # Eq. 11 value kept as measured
-    assert row["difference measured - ours [-]"] == pytest.approx(expected - 1.5, rel=1e-12)
-    # without m_c the like-for-like column is empty and the difference falls back to Eq. 11
+    # the same SDC (Eq. 10 energy) on both sides of the difference, named in its header
+    assert "Eq. 10" in DIFFERENCE_COLUMN
+    assert row[DIFFERENCE_COLUMN] == pytest.approx(expected - 1.5, rel=1e-12)
+    # without m_c there is no like-for-like value: the difference is empty, never Eq. 11 - DEM
     table = build_report_table(dem.drop(columns="m_c_kg"), measured, load_paper_table3())
     row = table[table["load case"].str.startswith("f500Hz_a5g_fill50")].iloc[0]
-    assert math.isnan(row[MEASURED_EQ10_COLUMN])
-    assert row["difference measured - ours [-]"] == pytest.approx(4.3 - 1.5, rel=1e-12)
+    assert math.isnan(row[MEASURED_EQ10_COLUMN]) and math.isnan(row[DIFFERENCE_COLUMN])
+
+
+def _run(cells: int, sdc: float, seed: int = 1) -> dict:
+    import json
+
+    params = {"case_frequency_hz": 500.0, "config_cells": cells, "config_seed": seed,
+              "config_steady_cycles": 10 if cells < 8 else ""}
+    return {"frequency_hz": 500.0, "acceleration_g": 5.0, "fill_percent": 50.0,
+            "material": "acrylic", "direction": "z", "sdc": sdc, "sdc_stderr": 0.01,
+            "m_c_kg": 0.07, "cells_simulated": cells, "case_key": f"k{cells}_{seed}",
+            "parameters_json": json.dumps(params)}
+
+
+def test_dem_runs_of_different_settings_are_separate_rows_unless_pooled():
+    # a 2-cell smoke run and two seeds of a 32-cell run at one load case
+    dem = pd.DataFrame([_run(2, 0.9), _run(32, 0.5, 1), _run(32, 0.52, 2)])
+    t = build_report_table(dem, None, None)
+    assert len(t) == 2
+    by_cells = {s.split(",")[0]: r for s, (_, r) in zip(t["DEM settings"], t.iterrows(),
+                                                         strict=True)}
+    assert by_cells["cells 2"]["SDC DEM (ours) [-]"] == 0.9  # not averaged with the 32-cell runs
+    assert by_cells["cells 32"]["SDC DEM (ours) [-]"] == pytest.approx(0.51)
+    assert by_cells["cells 32"]["DEM runs [-]"] == 2
+    pooled = build_report_table(dem, None, None, pool=True)
+    assert len(pooled) == 1 and pooled.iloc[0]["DEM runs [-]"] == 3
+    assert "--pool" in pooled.iloc[0]["note"]
+
+
+def test_a_measurement_is_compared_with_the_largest_dem_run():
+    dem = pd.DataFrame([_run(2, 0.9), _run(32, 0.5)])
+    measured = pd.DataFrame({"frequency_hz": [500.0], "acceleration_g": [5.0],
+                             "fill_percent": [50.0], "sdc": [0.6], "sdc_stderr": [0.02],
+                             "energy_per_cycle_j": [1e-5], "source": ["m.csv"]})
+    t = build_report_table(dem, measured, None)
+    row = t[t["source file(s)"] == "m.csv"].iloc[0]
+    assert row["DEM settings"].startswith("cells 32")
+
+
+def test_specimens_are_separate_rows_and_pooled_files_get_a_consistency_check():
+    measured = pd.DataFrame({
+        "frequency_hz": [500.0] * 3, "acceleration_g": [5.0] * 3, "fill_percent": [50.0] * 3,
+        "sdc": [0.6, 0.62, 0.9], "sdc_stderr": [0.01, 0.01, 0.01],
+        "source": ["a1.csv", "a2.csv", "b.csv"], "specimen": ["A", "A", "B"]})
+    t = build_report_table(None, measured, None)
+    assert sorted(t["specimen"]) == ["A", "B"]
+    row_a = t[t["specimen"] == "A"].iloc[0]
+    assert row_a["SDC measured [-]"] == pytest.approx(0.61)
+    # two values 0.02 apart with errors 0.01: chi2 = 2 * (0.01 / 0.01)^2 = 2, dof 1
+    assert row_a[CONSISTENCY_COLUMN] == pytest.approx(2.0)
+    assert math.isnan(t[t["specimen"] == "B"].iloc[0][CONSISTENCY_COLUMN])
+    pooled = build_report_table(None, measured, None, pool=True)
+    assert len(pooled) == 1 and pooled.iloc[0]["source file(s)"] == "a1.csv; a2.csv; b.csv"
+    # 0.9 lies 29 sigma off the others: flagged in the note
+    assert pooled.iloc[0][CONSISTENCY_COLUMN] > 3 and "scatter" in pooled.iloc[0]["note"]

@@ -49,6 +49,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--sidecar", metavar="CSV", type=Path, default=None,
                    help="load case table (columns file, fill_percent, material, direction); "
                         "default: loadcases.csv beside each file")
+    p.add_argument("--pool", action="store_true",
+                   help="pool DEM runs of different numerical settings and measurements of "
+                        "different specimens at one load case into one row (default: a row "
+                        "each)")
     add_measurement_options(p)
     p.set_defaults(func=run)
 
@@ -59,7 +63,8 @@ def run(args: argparse.Namespace) -> int:
     result = make_report(
         args.files, out_dir=args.out, store=args.store, dem_store=args.dem_store,
         formats=args.format, fill_percent=args.fill, material=args.material,
-        direction=args.direction, sidecar=args.sidecar, options=analysis_options(args))
+        direction=args.direction, sidecar=args.sidecar, options=analysis_options(args),
+        pool=args.pool)
     print(short_table(result.table))
     for note in result.notes:
         print(f"note: {note}")

@@ -115,6 +115,13 @@ class DemCase:
         Store keys of the runs.
     vibrated_mass_kg : float
         Mean m_c of the runs (the mass in E = m_c a^2 / (2 w^2), Eq. 10), kg; NaN if unknown.
+    settings : str
+        The numerical settings the runs share, e.g. ``"cells 8, steady cycles auto [3fa2c1]"``
+        (every input but the load case and the seed); runs of different settings are separate
+        cases unless pooled explicitly. Empty where the runs do not record their settings.
+    cells_simulated : float
+        Cells simulated per run (NaN if unknown); the preferred case of several settings at one
+        load case is the one with the most cells.
     """
 
     load_case: LoadCase
@@ -124,6 +131,8 @@ class DemCase:
     particles_per_cell: float = math.nan
     run_keys: tuple[str, ...] = ()
     vibrated_mass_kg: float = math.nan
+    settings: str = ""
+    cells_simulated: float = math.nan
 
 
 @dataclass(frozen=True)
@@ -214,8 +223,78 @@ def pooled_mean(values: np.ndarray, stderrs: np.ndarray) -> tuple[float, float]:
     return mean, float(np.nanmax([within, between]))
 
 
-def dem_cases(dem_runs: pd.DataFrame, *, tolerances: Tolerances | None = None) -> list[DemCase]:
+def pooled_sdc_eq10(energy_per_cycle_j: np.ndarray, acceleration_m_s2: np.ndarray,
+                    frequency_hz: np.ndarray, sdc_eq11: np.ndarray, sdc_eq11_stderr: np.ndarray,
+                    *, vibrated_mass_kg: float) -> tuple[np.ndarray, float, float]:
+    """Measured SDC over the DEM case's ``E = m_c a^2 / (2 w^2)`` (Eq. 10), per record and pooled.
+
+    The like-for-like counterpart of our DEM SDC (the Eq. 11 SDC divides by the reactive
+    energy instead). Each record keeps the relative standard error of its Eq. 11 SDC: only the
+    reference energy differs. Returns ``(values, pooled mean, pooled stderr)``
+    (:func:`pooled_mean`); all NaN where ``vibrated_mass_kg`` is unknown.
+    """
+    from ..model.damper import sdc_from_energy_per_cycle
+
+    energy = np.asarray(energy_per_cycle_j, dtype=float)
+    if not math.isfinite(vibrated_mass_kg) or energy.size == 0:
+        return np.full(energy.shape, math.nan), math.nan, math.nan
+    values = np.array([sdc_from_energy_per_cycle(float(e), vibrated_mass_kg=vibrated_mass_kg,
+                                                 acceleration_m_s2=float(a),
+                                                 frequency_hz=float(f))
+                       for e, a, f in zip(energy, acceleration_m_s2, frequency_hz, strict=True)])
+    scale = values / np.asarray(sdc_eq11, dtype=float)
+    mean, stderr = pooled_mean(values, np.asarray(sdc_eq11_stderr, dtype=float) * scale)
+    return values, mean, stderr
+
+
+def consistency_chi2(values: np.ndarray, stderrs: np.ndarray) -> tuple[float, int]:
+    """Chi-square of ``values`` about their inverse-variance mean and its degrees of freedom.
+
+    A pooled set of measurements is consistent when chi2 / dof is about 1; much larger means
+    the records scatter more than their own errors allow (different set-ups, a wrong
+    correction). Returns ``(nan, 0)`` for fewer than two finite values with finite errors.
+    """
+    v = np.asarray(values, dtype=float)
+    e = np.asarray(stderrs, dtype=float)
+    ok = np.isfinite(v) & np.isfinite(e) & (e > 0)
+    if ok.sum() < 2:
+        return math.nan, 0
+    w = 1.0 / e[ok] ** 2
+    mean = float(np.sum(w * v[ok]) / np.sum(w))
+    return float(np.sum(w * (v[ok] - mean) ** 2)), int(ok.sum() - 1)
+
+
+def _settings_of(row: pd.Series) -> tuple[str, float]:
+    """(label, cells) of the numerical settings of one DEM run: every stored input except the
+    load case and the seed (a hash of them), with the cells and steady cycles spelled out."""
+    import hashlib
+    import json
+
+    cells = float(row.get("cells_simulated", math.nan) or math.nan) \
+        if "cells_simulated" in row else math.nan
+    text = row.get("parameters_json")
+    if not isinstance(text, str) or not text:
+        return (f"cells {cells:g}" if math.isfinite(cells) else ""), cells
+    try:
+        params = json.loads(text)
+    except ValueError:
+        return "", cells
+    settings = {k: v for k, v in params.items()
+                if not k.startswith("case_") and k != "config_seed"}
+    if not math.isfinite(cells) and isinstance(settings.get("config_cells"), int | float):
+        cells = float(settings["config_cells"])
+    steady = settings.get("config_steady_cycles", "")
+    digest = hashlib.sha256(json.dumps(settings, sort_keys=True, default=str).encode())
+    return (f"cells {cells:g}, steady cycles {steady if steady not in ('', None) else 'auto'} "
+            f"[{digest.hexdigest()[:6]}]"), cells
+
+
+def dem_cases(dem_runs: pd.DataFrame, *, tolerances: Tolerances | None = None,
+              pool_settings: bool = False) -> list[DemCase]:
     """Group DEM runs into load cases (runs within the tolerances pool into one case).
+
+    Runs of different numerical settings (a 2-cell smoke run beside a 32-cell run) are separate
+    cases unless ``pool_settings`` is true; only seeds are pooled.
 
     Parameters
     ----------
@@ -235,17 +314,20 @@ def dem_cases(dem_runs: pd.DataFrame, *, tolerances: Tolerances | None = None) -
         return []
     _check_columns(dem_runs, DEM_COLUMNS, "DEM runs")
     runs = dem_runs[np.isfinite(dem_runs["sdc"].astype(float))]
-    groups: list[tuple[LoadCase, list[int]]] = []
+    groups: list[tuple[LoadCase, str, list[int]]] = []
+    cells_of: dict[str, float] = {}
     for pos, (_, row) in enumerate(runs.iterrows()):
         case = _row_case(row)
-        for grid, members in groups:
-            if tolerances.matches(case, grid):
+        settings, cells = ("", math.nan) if pool_settings else _settings_of(row)
+        cells_of[settings] = cells
+        for grid, grid_settings, members in groups:
+            if grid_settings == settings and tolerances.matches(case, grid):
                 members.append(pos)
                 break
         else:
-            groups.append((case, [pos]))
+            groups.append((case, settings, [pos]))
     out = []
-    for case, members in groups:
+    for case, settings, members in groups:
         sub = runs.iloc[members]
         sdc, stderr = pooled_mean(sub["sdc"].to_numpy(float), sub["sdc_stderr"].to_numpy(float))
         ppc = math.nan
@@ -256,8 +338,9 @@ def dem_cases(dem_runs: pd.DataFrame, *, tolerances: Tolerances | None = None) -
         key_column = "case_key" if "case_key" in sub else "key"
         keys = tuple(str(k) for k in sub[key_column]) if key_column in sub else ()
         m_c = float(sub["m_c_kg"].astype(float).mean()) if "m_c_kg" in sub else math.nan
-        out.append(DemCase(case, sdc, stderr, len(members), ppc, keys, m_c))
-    return sorted(out, key=lambda c: _sort_key(c.load_case))
+        out.append(DemCase(case, sdc, stderr, len(members), ppc, keys, m_c, settings,
+                           cells_of.get(settings, math.nan)))
+    return sorted(out, key=lambda c: (*_sort_key(c.load_case), c.settings))
 
 
 def _sort_key(case: LoadCase) -> tuple:
@@ -354,19 +437,25 @@ class Aligner:
     @classmethod
     def from_tables(cls, dem_runs: pd.DataFrame | None, paper: pd.DataFrame | None = None, *,
                     model: object | None = None,
-                    tolerances: Tolerances | None = None) -> Aligner:
+                    tolerances: Tolerances | None = None,
+                    pool_settings: bool = False) -> Aligner:
         """Aligner over a table of DEM runs (see :func:`dem_cases`)."""
         tolerances = tolerances or Tolerances()
         cases = dem_cases(dem_runs if dem_runs is not None else pd.DataFrame(),
-                          tolerances=tolerances)
+                          tolerances=tolerances, pool_settings=pool_settings)
         return cls(cases, paper, model, tolerances)
 
     def grid_case(self, case: LoadCase) -> DemCase | None:
-        """Our DEM case nearest to ``case`` within the tolerances, or None."""
+        """Our DEM case nearest to ``case`` within the tolerances, or None.
+
+        Of several numerical settings at one load case the one with the most cells simulated
+        is preferred (then the most runs): the least noisy estimate.
+        """
         hits = [c for c in self.cases if self.tolerances.matches(case, c.load_case)]
         if not hits:
             return None
-        return min(hits, key=lambda c: self.tolerances.distance(case, c.load_case))
+        return min(hits, key=lambda c: (self.tolerances.distance(case, c.load_case),
+                                        -np.nan_to_num(c.cells_simulated, nan=0.0), -c.n_runs))
 
     def align(self, case: LoadCase) -> AlignedCase:
         """Align one measured case; never extrapolates the model."""
@@ -378,7 +467,8 @@ class Aligner:
         if grid is not None:
             return AlignedCase(case, "grid", grid.sdc, grid.sdc_stderr, grid, **common,
                                message=f"DEM grid case {grid.load_case.key} "
-                                       f"({grid.n_runs} run(s))")
+                                       f"({grid.n_runs} run(s)"
+                                       + (f", {grid.settings})" if grid.settings else ")"))
         model = self.model if self.model is not None \
             else self._models.get((case.material, case.direction),
                                   f"no DEM runs of ours for {case.material}, direction "

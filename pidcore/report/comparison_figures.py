@@ -4,28 +4,18 @@
   standard error, the paper's DEM and experimental values.
 * :func:`plot_loop_overlay` - force-displacement loop of a measurement over the DEM's loop at
   the same load case.
-* :func:`dem_loop_from_arrays` - the DEM loop from a stored run's decimated time series.
+
+Loops come as data from :mod:`pidcore.signal.loops` (the app's charts draw the same data).
 
 The model families (paper Figs. 8-14) are in :mod:`pidcore.report.figures`.
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-
 import numpy as np
 import pandas as pd
 
 from .table import ALIGNMENT_COLUMN
-
-#: Force arrays looked for in a DEM run, in order: the force a shaker's gauge would measure
-#: (coupon inertia + particles, :class:`pidcore.dem.result.DemResult`), comparable with a
-#: measured force; then the particles' force on the walls alone.
-DEM_FORCE_ARRAYS: tuple[str, ...] = ("shaker_force_n", "wall_force_n")
-#: Coupon velocity arrays looked for in a DEM run.
-DEM_VELOCITY_ARRAYS: tuple[str, ...] = ("velocity_m_s", "coupon_velocity_m_s")
-#: Time arrays (sample instants) looked for in a DEM run.
-DEM_TIME_ARRAYS: tuple[str, ...] = ("sample_time_s", "time_s")
 
 
 def _new_figure(width: float, height: float):
@@ -84,98 +74,15 @@ def plot_sdc_comparison(table: pd.DataFrame, *, ax=None):
     return fig
 
 
-def _first(arrays: Mapping[str, np.ndarray], names: tuple[str, ...]) -> np.ndarray | None:
-    for name in names:
-        if name in arrays:
-            return np.asarray(arrays[name], dtype=float)
-    return None
-
-
-def dem_loop_from_arrays(arrays: Mapping[str, np.ndarray],
-                         record: Mapping[str, object] | None = None,
-                         ) -> tuple[np.ndarray, np.ndarray] | str:
-    """One period of a DEM run's force-displacement loop, or a note why there is none.
-
-    The stored virtual shaker record (force :data:`DEM_FORCE_ARRAYS`, coupon velocity
-    :data:`DEM_VELOCITY_ARRAYS`) from the steady state on (``steady_start_cycle`` of the record)
-    is analysed like a measurement (:func:`pidcore.signal.analyze_power`) and the loop
-    synthesised from its harmonics, so measured and DEM loops are drawn the same way.
-
-    Parameters
-    ----------
-    arrays : mapping
-        The run's arrays (:attr:`pidcore.store.StoredEntry.arrays`).
-    record : mapping, optional
-        The run's scalars: ``frequency_hz``, ``sample_rate_hz`` (else from the time array),
-        ``steady_start_cycle`` (default 0).
-
-    Returns
-    -------
-    (displacement m, force N) or str
-    """
-    from ..errors import PidcoreError
-    from ..signal import analyze_power
-
-    record = record or {}
-    force = _first(arrays, DEM_FORCE_ARRAYS)
-    velocity = _first(arrays, DEM_VELOCITY_ARRAYS)
-    if force is None or velocity is None:
-        return (f"DEM run keeps no force ({', '.join(DEM_FORCE_ARRAYS)}) or velocity "
-                f"({', '.join(DEM_VELOCITY_ARRAYS)}) time series")
-    if force.shape != velocity.shape or force.ndim != 1:
-        return "DEM run's force and velocity arrays differ in shape"
-    rate = record.get("sample_rate_hz")
-    time = _first(arrays, DEM_TIME_ARRAYS)
-    if not isinstance(rate, int | float) and time is not None and time.size > 1:
-        rate = 1.0 / float(np.mean(np.diff(time)))
-    freq = record.get("frequency_hz")
-    if not isinstance(rate, int | float) or not isinstance(freq, int | float):
-        return "DEM run lacks sample_rate_hz or frequency_hz"
-    start_cycle = record.get("steady_start_cycle") or 0
-    start = int(round(float(start_cycle) * float(rate) / float(freq)))
-    try:
-        analysis = analyze_power(force[start:], velocity[start:], float(rate),
-                                 frequency_hz=float(freq), source="DEM run")
-    except PidcoreError as exc:
-        return f"DEM time series cannot be analysed ({exc})"
-    return analysis.force_displacement_loop()
-
-
-def loop_from_phasors(arrays: Mapping[str, np.ndarray], frequency_hz: object, *,
-                      n_points: int = 256) -> tuple[np.ndarray, np.ndarray] | str:
-    """One period of a stored analysis' force-displacement loop, or a note why there is none.
-
-    Rebuilt from the stored harmonic phasors (``harmonics``, ``force_phasors_n``,
-    ``velocity_phasors_m_s``, as :func:`pidcore.measure.analysis_arrays` stores them) exactly as
-    :meth:`pidcore.signal.PowerAnalysis.force_displacement_loop` does: X_n = V_n / (j n w).
-    """
-    needed = ("harmonics", "force_phasors_n", "velocity_phasors_m_s")
-    if any(name not in arrays for name in needed):
-        return f"stored analysis keeps no harmonic phasors ({', '.join(needed)})"
-    if not isinstance(frequency_hz, int | float) or not frequency_hz > 0:
-        return "stored analysis has no drive frequency"
-    harmonics = np.asarray(arrays["harmonics"], dtype=float)
-    force = np.asarray(arrays["force_phasors_n"], dtype=complex)
-    velocity = np.asarray(arrays["velocity_phasors_m_s"], dtype=complex)
-    omega = 2 * np.pi * float(frequency_hz)
-    phase = 2 * np.pi * np.arange(n_points) / n_points
-    rot = np.exp(1j * np.outer(harmonics, phase))
-    displacement = velocity / (1j * harmonics * omega)
-    return np.real(displacement @ rot), np.real(force @ rot)
-
-
 def loop_arrays(loop: object) -> tuple[np.ndarray, np.ndarray]:
-    """(displacement m, force N) from a loop object or a 2-tuple.
-
-    Accepts a ``(displacement, force)`` tuple or an object with attributes ``displacement_m`` and
-    ``force_n`` (as :meth:`PowerAnalysis.force_displacement_loop` returns).
+    """(displacement m, force N) from a ``(displacement, force)`` tuple (as
+    :meth:`PowerAnalysis.force_displacement_loop` returns) or a
+    :class:`pidcore.signal.loops.LoopCurve`.
     """
     if isinstance(loop, tuple) and len(loop) == 2:
         return np.asarray(loop[0], dtype=float), np.asarray(loop[1], dtype=float)
-    for xname, fname in (("displacement_m", "force_n"), ("displacement", "force")):
-        if hasattr(loop, xname) and hasattr(loop, fname):
-            return (np.asarray(getattr(loop, xname), dtype=float),
-                    np.asarray(getattr(loop, fname), dtype=float))
+    if hasattr(loop, "displacement_m") and hasattr(loop, "force_n"):
+        return (np.asarray(loop.displacement_m, dtype=float), np.asarray(loop.force_n, dtype=float))
     raise TypeError(f"cannot read a force-displacement loop from {type(loop).__name__}")
 
 
@@ -193,7 +100,8 @@ def plot_loop_overlay(measured: object, dem: tuple[np.ndarray, np.ndarray] | Non
     measured : loop or (displacement m, force N)
         The measured loop (see :func:`loop_arrays`).
     dem : (displacement m, force N) or None
-        The DEM loop (:func:`dem_loop_from_arrays`), or None to draw the measurement alone.
+        The DEM loop (:func:`pidcore.signal.loops.dem_loop_from_arrays`), or None to draw
+        the measurement alone.
     title : str
     ax : matplotlib Axes, optional
 

@@ -23,9 +23,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 import pandas as pd
 
-from .. import defaults
 from ..compare.align import Aligner, Tolerances, dem_cases
 from ..compare.loadcase import LoadCase, LoadCaseError, StatedLoadCase, resolve_load_case
+from ..constants import REPORT_FORMATS
 from ..errors import StoreError
 from .provenance import collect_provenance
 from .render import check_out_dir, parse_formats, write_report
@@ -192,7 +192,7 @@ def _measured_loops(results: list[MeasuredResult], analyses: pd.DataFrame, store
                     notes: list[str]) -> list[tuple[str, LoadCase, tuple]]:
     """(name, load case, loop) per measurement: from the fresh analyses, else from the store's
     harmonic phasors (store-only reports)."""
-    from .comparison_figures import loop_from_phasors
+    from ..signal.loops import loop_from_phasors
 
     if results:
         return [(r.path.name, r.load_case, r.analysis.force_displacement_loop())
@@ -217,7 +217,8 @@ def _measured_loops(results: list[MeasuredResult], analyses: pd.DataFrame, store
 def _figures(table: pd.DataFrame, dem_runs: pd.DataFrame | None, aligner: Aligner,
              loops: list[tuple[str, LoadCase, tuple]], dem_store,
              notes: list[str]) -> dict[str, object]:
-    from .comparison_figures import dem_loop_from_arrays, plot_loop_overlay, plot_sdc_comparison
+    from ..signal.loops import dem_loop_from_arrays
+    from .comparison_figures import plot_loop_overlay, plot_sdc_comparison
 
     figures: dict[str, object] = {}
     if not table.empty:
@@ -255,11 +256,11 @@ def _figures(table: pd.DataFrame, dem_runs: pd.DataFrame | None, aligner: Aligne
 
 def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
                 store: str | Path | None = None, dem_store: str | Path | None = None,
-                formats: str | Iterable[str] = defaults.REPORT_FORMATS,
+                formats: str | Iterable[str] = REPORT_FORMATS,
                 fill_percent: float | None = None, material: str | None = None,
                 direction: str | None = None, sidecar: str | Path | None = None,
                 options: AnalysisOptions | None = None,
-                tolerances: Tolerances | None = None) -> ReportResult:
+                tolerances: Tolerances | None = None, pool: bool = False) -> ReportResult:
     """Analyse files, store them, align with DEM and the paper, and write the report.
 
     Parameters
@@ -282,6 +283,9 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         cancellation, baseline, sample rate for CSV without time column).
     tolerances : Tolerances, optional
         Grid-match tolerances.
+    pool : bool
+        Pool DEM runs of different settings and measurements of different specimens at one
+        load case (default: separate rows; see :func:`pidcore.report.build_report_table`).
 
     Returns
     -------
@@ -337,9 +341,10 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         notes.append(f"{dem_path}: holds no DEM runs")
         dem_runs = None
     paper = load_paper_table3()
-    table = build_report_table(dem_runs, analyses, paper, tolerances=tolerances)
+    table = build_report_table(dem_runs, analyses, paper, tolerances=tolerances, pool=pool)
     notes.extend(table.attrs.get("notes", []))
-    aligner = Aligner(dem_cases(dem_runs, tolerances=tolerances) if dem_runs is not None else [],
+    aligner = Aligner(dem_cases(dem_runs, tolerances=tolerances, pool_settings=pool)
+                      if dem_runs is not None else [],
                       paper, None, tolerances)
     loops = _measured_loops(results, analyses, main, notes)
     figures = _figures(table, dem_runs, aligner, loops, dem, notes)

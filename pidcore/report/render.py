@@ -77,14 +77,18 @@ def parse_formats(formats: str | Iterable[str]) -> tuple[str, ...]:
 
 
 # ---------------------------------------------------------------------------- formats
+#: Sidecar of the CSV: provenance and notes, one per line (the CSV itself holds only the table,
+#: so ``pandas.read_csv`` and spreadsheets read exactly the table's rows).
+CSV_NOTES_SUFFIX = ".provenance.txt"
+
+
 def _write_csv(table: pd.DataFrame, figures: Mapping[str, Path], prov: Provenance,
                folder: Path) -> Path:
     path = folder / f"{REPORT_STEM}.csv"
-    # Floats are written as repr (read back bit for bit); text is quoted so that a '#' in a file
-    # name is not taken for the start of the footer comment: read_csv(path, comment="#").
+    # Floats are written as repr (read back bit for bit); text is quoted.
     table.to_csv(path, index=False, quoting=csv.QUOTE_NONNUMERIC)
-    with open(path, "a", encoding="utf-8") as fh:
-        fh.writelines(f"# {line}\n" for line in prov.lines())
+    notes = folder / f"{REPORT_STEM}{CSV_NOTES_SUFFIX}"
+    notes.write_text("".join(f"{line}\n" for line in prov.lines()), encoding="utf-8")
     return path
 
 
@@ -264,7 +268,7 @@ def _move_into_place(tmp: Path, out_dir: Path) -> None:
 
 
 def write_report(table: pd.DataFrame, figures: Mapping[str, object], provenance: Provenance,
-                 out_dir: str | Path, formats: str | Iterable[str] = defaults.REPORT_FORMATS,
+                 out_dir: str | Path, formats: str | Iterable[str] = REPORT_FORMATS,
                  ) -> dict[str, Path]:
     """Write the report into ``out_dir``, atomically.
 
@@ -285,7 +289,8 @@ def write_report(table: pd.DataFrame, figures: Mapping[str, object], provenance:
     Returns
     -------
     dict of str to Path
-        Format name -> file, and ``"figure:<stem>.png"`` / ``".svg"`` -> figure file.
+        Format name -> file, ``"csv_provenance"`` -> the CSV's provenance and notes sidecar
+        (with csv), and ``"figure:<stem>.png"`` / ``".svg"`` -> figure file.
 
     Raises
     ------
@@ -312,6 +317,8 @@ def write_report(table: pd.DataFrame, figures: Mapping[str, object], provenance:
                                                 figure_objects=figures)
             else:
                 written[name] = RENDERERS[name](table, pngs, provenance, tmp)
+            if name == "csv":
+                written["csv_provenance"] = tmp / f"{REPORT_STEM}{CSV_NOTES_SUFFIX}"
         (tmp / REPORT_MARKER).write_text("written by pidcore report\n", encoding="utf-8")
         os.chmod(tmp, 0o755)  # mkdtemp makes 0700; a report folder is meant to be shared
         _move_into_place(tmp, out_dir)

@@ -3,8 +3,13 @@
 Rows are the union of our DEM grid cases and the measured cases. A measured case that matches a
 DEM grid case (:mod:`pidcore.compare.align`) shares its row; one that does not gets its own row
 with our DEM value interpolated by the pchip model (or none, out of range). Numbers are copied
-from the inputs unchanged; only several runs or measurements at one case are pooled
-(:func:`pidcore.compare.pooled_mean`).
+from the inputs unchanged; only runs of one case and settings (seeds) and measurements of one
+case and specimen are pooled (:func:`pidcore.compare.pooled_mean`). DEM runs of different
+numerical settings and measurements of different specimens get rows of their own unless
+``pool=True`` (``pidcore report --pool``), which the row's note then says.
+
+The difference column compares like with like: the measured energy per cycle over the DEM
+case's E = m_c a^2 / (2 w^2) (Eq. 10), as our DEM SDC is defined, minus our DEM SDC.
 """
 
 from __future__ import annotations
@@ -16,15 +21,28 @@ from typing import NamedTuple
 import numpy as np
 import pandas as pd
 
-from ..compare.align import Aligner, DemCase, Tolerances, match_paper, pooled_mean
+from ..compare.align import (
+    Aligner,
+    DemCase,
+    Tolerances,
+    consistency_chi2,
+    match_paper,
+    pooled_mean,
+    pooled_sdc_eq10,
+)
 from ..compare.loadcase import LoadCase, LoadCaseError
-from ..model.damper import sdc_from_energy_per_cycle
 from ..units import g_to_si
 
 #: Measured energy per cycle over the DEM case's E = m_c a^2 / (2 w^2) (Eq. 10): the like-for-like
 #: counterpart of our DEM SDC. The Eq. 11 SDC divides by Im(P_c)/w instead, the reactive energy,
 #: which is smaller than Eq. 10's E whenever particles fly free of the cell walls.
 MEASURED_EQ10_COLUMN = "SDC measured, E of Eq. 10 [-]"
+#: Measured (Eq. 10 energy, as :data:`MEASURED_EQ10_COLUMN`) minus our DEM SDC: the same SDC on
+#: both sides. NaN where the DEM case's m_c is unknown (no like-for-like value).
+DIFFERENCE_COLUMN = "difference measured (E of Eq. 10) - ours [-]"
+#: Chi-square per degree of freedom of the pooled measurements about their mean (~1: they agree
+#: within their errors; NaN for a single measurement).
+CONSISTENCY_COLUMN = "measured chi2/dof [-]"
 #: Column holding the alignment status.
 ALIGNMENT_COLUMN = "alignment [grid/interpolated/out_of_range]"
 #: Columns of :func:`build_report_table`, in order.
@@ -34,8 +52,8 @@ REPORT_COLUMNS: tuple[str, ...] = (
     "measured frequency [Hz]", "measured acceleration [g]", "SDC measured [-]",
     "SDC measured stderr [-]", MEASURED_EQ10_COLUMN, "SDC DEM (paper) [-]",
     "SDC measured (paper) [-]",
-    "difference ours - paper DEM [-]", "difference measured - ours [-]", ALIGNMENT_COLUMN,
-    "source file(s)", "load case", "note",
+    "difference ours - paper DEM [-]", DIFFERENCE_COLUMN, CONSISTENCY_COLUMN, ALIGNMENT_COLUMN,
+    "DEM settings", "specimen", "source file(s)", "load case", "note",
 )
 #: Columns an analyses table needs (as :meth:`pidcore.store.Store.list_analyses` gives, with the
 #: load case fields the report pipeline stores in each record).
@@ -52,6 +70,7 @@ class _Measured(NamedTuple):
     acceleration_g: float
     source: str
     energy_per_cycle_j: float
+    specimen: str
 
 
 @dataclass
@@ -65,6 +84,7 @@ class _Row:
     paper_exp: float = math.nan
     measured: list[_Measured] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
+    specimen: str | None = None  # None: no measurement claimed the row yet
 
 
 def _measured_rows(analyses: pd.DataFrame | None, notes: list[str]) -> list[tuple[LoadCase,
@@ -95,7 +115,8 @@ def _measured_rows(analyses: pd.DataFrame | None, notes: list[str]) -> list[tupl
 
 def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | None,
                        paper: pd.DataFrame | None, *, model: object | None = None,
-                       tolerances: Tolerances | None = None) -> pd.DataFrame:
+                       tolerances: Tolerances | None = None,
+                       pool: bool = False) -> pd.DataFrame:
     """Table 3-style comparison of our DEM, our measurements and the paper.
 
     Parameters
@@ -115,6 +136,9 @@ def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | N
         material and direction.
     tolerances : Tolerances, optional
         Grid-match tolerances (default from :mod:`pidcore.defaults`).
+    pool : bool
+        Pool DEM runs of different numerical settings and measurements of different specimens
+        at one load case (default: separate rows).
 
     Returns
     -------
@@ -135,33 +159,44 @@ def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | N
     """
     tolerances = tolerances or Tolerances()
     notes: list[str] = []
-    aligner = Aligner.from_tables(dem_runs, paper, model=model, tolerances=tolerances)
-    rows: dict[str, _Row] = {}
+    aligner = Aligner.from_tables(dem_runs, paper, model=model, tolerances=tolerances,
+                                  pool_settings=pool)
+    rows: dict[str, list[_Row]] = {}
     for dem in aligner.cases:
         paper_dem, paper_exp, _ = match_paper(dem.load_case, paper, tolerances=tolerances)
-        rows[dem.load_case.key] = _Row(dem.load_case, "grid", dem, dem.sdc, dem.sdc_stderr,
-                                       paper_dem, paper_exp)
+        rows.setdefault(dem.load_case.key, []).append(
+            _Row(dem.load_case, "grid", dem, dem.sdc, dem.sdc_stderr, paper_dem, paper_exp))
     for case, rec in _measured_rows(analyses, notes):
         aligned = aligner.align(case)
+        specimen = "" if pool else str(rec.get("specimen", "") or "")
         entry = _Measured(float(rec["sdc"]), float(rec["sdc_stderr"]), case.frequency_hz,
                           case.acceleration_g, str(rec.get("source", "")),
-                          float(rec.get("energy_per_cycle_j", math.nan)))
+                          float(rec.get("energy_per_cycle_j", math.nan)), specimen)
         if aligned.status == "grid" and aligned.grid_case is not None:
-            rows[aligned.grid_case.load_case.key].measured.append(entry)
-            continue
-        row = rows.get(case.key)
+            dem = aligned.grid_case
+            group = rows[dem.load_case.key]
+            base = next(r for r in group if r.dem is dem)
+        else:
+            group = rows.setdefault(case.key, [])
+            base = _Row(case, aligned.status, None, aligned.sdc_dem, aligned.sdc_dem_stderr,
+                        aligned.sdc_paper_dem, aligned.sdc_paper_experimental,
+                        notes=[aligned.message])
+        row = next((r for r in group if r.dem is base.dem and r.specimen == specimen), None)
         if row is None:
-            row = rows[case.key] = _Row(case, aligned.status, None, aligned.sdc_dem,
-                                        aligned.sdc_dem_stderr, aligned.sdc_paper_dem,
-                                        aligned.sdc_paper_experimental,
-                                        notes=[aligned.message])
+            row = next((r for r in group if r.dem is base.dem and r.specimen is None), None)
+        if row is None:  # another specimen at this case: a row of its own beside the DEM's
+            row = _Row(base.case, base.status, base.dem, base.sdc_dem, base.sdc_dem_stderr,
+                       base.paper_dem, base.paper_exp, notes=list(base.notes))
+            group.append(row)
+        row.specimen = specimen
         row.measured.append(entry)
 
     records = []
-    for row in rows.values():
+    for row in (r for group in rows.values() for r in group):
         lc = row.case
-        sdc_m = sdc_m_se = f_m = a_m = math.nan
+        sdc_m = sdc_m_se = f_m = a_m = chi2_dof = math.nan
         sources = ""
+        values = errors = np.empty(0)
         if row.measured:
             values = np.array([m.sdc for m in row.measured])
             errors = np.array([m.sdc_stderr for m in row.measured])
@@ -169,20 +204,25 @@ def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | N
             f_m = float(np.mean([m.frequency_hz for m in row.measured]))
             a_m = float(np.mean([m.acceleration_g for m in row.measured]))
             sources = "; ".join(m.source for m in row.measured if m.source)
-        sdc_m10 = sdc_m10_se = math.nan
+            chi2, dof = consistency_chi2(values, errors)
+            chi2_dof = chi2 / dof if dof else math.nan
         m_c = row.dem.vibrated_mass_kg if row.dem is not None else math.nan
-        if row.measured and math.isfinite(m_c):
-            sdc10 = np.array([sdc_from_energy_per_cycle(
-                m.energy_per_cycle_j, vibrated_mass_kg=m_c,
-                acceleration_m_s2=g_to_si(m.acceleration_g), frequency_hz=m.frequency_hz)
-                for m in row.measured])
-            scale = sdc10 / values
-            sdc_m10, sdc_m10_se = pooled_mean(sdc10, errors * scale)
+        _, sdc_m10, _ = pooled_sdc_eq10(
+            np.array([m.energy_per_cycle_j for m in row.measured]),
+            np.array([g_to_si(m.acceleration_g) for m in row.measured]),
+            np.array([m.frequency_hz for m in row.measured]), values, errors,
+            vibrated_mass_kg=m_c)
         note = list(row.notes)
         if len(row.measured) > 1:
-            note.append(f"{len(row.measured)} measurements pooled")
+            note.append(f"{len(row.measured)} measurements pooled"
+                        + (f" (chi2/dof {chi2_dof:.2g}: they scatter more than their errors)"
+                           if chi2_dof > 3 else ""))
         if row.dem is not None and row.dem.n_runs > 1:
             note.append(f"{row.dem.n_runs} DEM runs pooled")
+        if pool:
+            note.append("pooled across specimens and DEM settings (--pool)")
+        if row.measured and math.isfinite(row.sdc_dem) and not math.isfinite(sdc_m10):
+            note.append("no DEM m_c: no like-for-like difference")
         records.append({
             "frequency [Hz]": lc.frequency_hz,
             "acceleration [g]": lc.acceleration_g,
@@ -201,10 +241,11 @@ def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | N
             "SDC DEM (paper) [-]": row.paper_dem,
             "SDC measured (paper) [-]": row.paper_exp,
             "difference ours - paper DEM [-]": row.sdc_dem - row.paper_dem,
-            # like with like where the DEM's m_c is known, else the paper's way (Eq. 11)
-            "difference measured - ours [-]": (sdc_m10 if math.isfinite(sdc_m10) else sdc_m)
-            - row.sdc_dem,
+            DIFFERENCE_COLUMN: sdc_m10 - row.sdc_dem,
+            CONSISTENCY_COLUMN: chi2_dof,
             ALIGNMENT_COLUMN: row.status,
+            "DEM settings": row.dem.settings if row.dem else "",
+            "specimen": row.specimen or "",
             "source file(s)": sources,
             "load case": lc.key,
             "note": "; ".join(note),
@@ -250,6 +291,7 @@ def _sort_like_table3(table: pd.DataFrame, aligner: Aligner, paper: pd.DataFrame
                    atol=tolerances.fill_atol_percent),
         "fx": table["frequency [Hz]"], "ax": table["acceleration [g]"],
         "px": table["packing ratio [%]"], "m": table["material"], "d": table["direction"],
+        "s": table["DEM settings"], "sp": table["specimen"],
     })
     order = keys.sort_values(list(keys.columns), kind="stable").index
     return table.loc[order].reset_index(drop=True)
