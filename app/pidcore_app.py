@@ -1,5 +1,5 @@
-"""``streamlit run app/pidcore_app.py``: shim for the app shipped in the package (pidcore._app)."""
+"""``streamlit run app/pidcore_app.py``: shim for the app shipped in the package (pidcore.app)."""
 
-from pidcore._app.ui import main
+from pidcore.app.main import main
 
 main()

@@ -39,9 +39,9 @@ def streamlit_command(port: int, *, python: str | None = None) -> list[str]:
     """The command line that serves the packaged app on ``localhost:port``, headless.
 
     The entry script is located through the installed package
-    (:data:`pidcore._app.ENTRY_SCRIPT`), so it works for editable and regular installs alike.
+    (:data:`pidcore.app.ENTRY_SCRIPT`), so it works for editable and regular installs alike.
     """
-    from .._app import ENTRY_SCRIPT
+    from ..app import ENTRY_SCRIPT
 
     if not 1 <= int(port) <= 65535:
         raise ParameterError(f"--port {port}: expected a TCP port number 1..65535")
@@ -60,7 +60,7 @@ def streamlit_command(port: int, *, python: str | None = None) -> list[str]:
 def app_environment(store: Path, dem_store: Path | None = None,
                     environ: dict[str, str] | None = None) -> dict[str, str]:
     """Environment of the app process: store paths (absolute) and usage statistics off."""
-    from ..app_support import DEM_STORE_ENV_VAR, STORE_ENV_VAR
+    from ..app.stores import DEM_STORE_ENV_VAR, STORE_ENV_VAR
 
     env = dict(os.environ if environ is None else environ)
     env[STORE_ENV_VAR] = str(Path(store).expanduser().resolve())

@@ -40,6 +40,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import time
+from collections.abc import Callable
 from dataclasses import asdict, dataclass
 
 import numpy as np
@@ -350,7 +351,8 @@ def required_steady_cycles(case: LoadCase, config: DemConfig) -> int:
 
 def simulate_load_case(case: LoadCase, config: DemConfig | None = None, *,
                        progress: bool = False,
-                       geometry: CellGeometry | None = None) -> DemResult:
+                       geometry: CellGeometry | None = None,
+                       on_block: Callable[[int, int], None] | None = None) -> DemResult:
     """Simulate K independent cells under one load case and return the SDC (Eq. 8-10).
 
     Parameters
@@ -363,6 +365,9 @@ def simulate_load_case(case: LoadCase, config: DemConfig | None = None, *,
         Show a tqdm progress bar on stderr.
     geometry : CellGeometry, optional
         Cell shape; paper Table 2 by default.
+    on_block : callable, optional
+        Called after every block as ``on_block(cycles_done, cycles_expected)`` (the
+        expectation grows until the steady state is found); a job runner's progress hook.
 
     Returns
     -------
@@ -467,6 +472,9 @@ def simulate_load_case(case: LoadCase, config: DemConfig | None = None, *,
                 if bar is not None and steady_start is not None:
                     bar.total = steady_start + need
                     bar.refresh()
+            if on_block is not None:
+                on_block(done, steady_start + need if steady_start is not None
+                         else done + need + b)
             if steady_start is not None and done - steady_start >= need:
                 break
     finally:

@@ -1,5 +1,5 @@
 """Streamlit entry script of the pidcore app: ``streamlit run <this file>``."""
 
-from pidcore._app.ui import main
+from pidcore.app.main import main
 
 main()

@@ -1,0 +1,310 @@
+"""DEM jobs of the app: run outside Streamlit's script runs, cancellable, each saved as it ends.
+
+Streamlit reruns the page script on every click, so a computation inside a script run is
+interrupted or repeated by the next click. Here cases run in a worker thread owned by a
+module-level registry (one :class:`DemJobRunner` per store, living as long as the server
+process); the page only submits, cancels and reads snapshots. Each case runs in its own
+``spawn``-ed process, so *Cancel* terminates it at once (a Numba kernel cannot be interrupted
+from inside); its result comes back through a pipe and the worker thread saves it to the store
+in its own transaction, so a killed case never leaves a half-written store.
+
+A case is never started twice: a submission is dropped when the same run (same store key: load
+case and every numerical setting) is queued, running, or already in the store.
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+import threading
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from .. import defaults
+from ..errors import ParameterError
+
+#: Job states, in the order a job passes through them.
+JOB_STATES = ("queued", "running", "saved", "in store", "cancelled", "failed")
+#: Seconds between checks of the running case (progress, cancel).
+_POLL_S = 0.05
+#: Seconds a terminated process gets before it is killed.
+_TERMINATE_GRACE_S = 1.0
+
+
+@dataclass
+class DemJob:
+    """One DEM case submitted to the runner (mutated by the worker thread only)."""
+
+    job_id: str
+    case: object
+    config: object
+    run_key: str
+    state: str = "queued"
+    submitted: float = field(default_factory=time.time)
+    started: float | None = None
+    finished: float | None = None
+    cycles_done: int = 0
+    cycles_expected: int = 0
+    message: str = ""
+
+    def elapsed_s(self, now: float | None = None) -> float:
+        """Seconds the case has run (0 while queued)."""
+        if self.started is None:
+            return 0.0
+        return (self.finished or now or time.time()) - self.started
+
+    def fraction(self) -> float:
+        """Fraction of the expected cycles done, 0..1 (1 once saved)."""
+        if self.state in ("saved", "in store"):
+            return 1.0
+        if self.cycles_expected <= 0:
+            return 0.0
+        return min(1.0, self.cycles_done / self.cycles_expected)
+
+    def eta_s(self, now: float | None = None) -> float | None:
+        """Seconds left, extrapolated from the cycles done so far (None before any block)."""
+        if self.state != "running" or self.cycles_done <= 0:
+            return None
+        f = self.fraction()
+        return self.elapsed_s(now) * (1.0 - f) / f if f > 0 else None
+
+    def row(self, now: float | None = None) -> dict:
+        """One row of the job table shown in the app (units in the column names)."""
+        eta = self.eta_s(now)
+        return {"job": self.job_id, "load case": self.case.key(), "state": self.state,
+                "progress [%]": round(100 * self.fraction(), 1),
+                "cycles [-]": f"{self.cycles_done}/{self.cycles_expected or '?'}",
+                "elapsed [s]": round(self.elapsed_s(now), 1),
+                "ETA [s]": None if eta is None else round(eta, 1),
+                "store key": self.run_key, "message": self.message}
+
+
+def _child(case, config, conn) -> None:
+    """Worker process: simulate one case, report progress, send the store entry back."""
+    try:
+        import numba
+
+        numba.set_num_threads(1)  # one case per process; threads would oversubscribe
+        from ..dem.persist import dem_run_entry
+        from ..dem.simulate import simulate_load_case
+
+        result = simulate_load_case(
+            case, config, on_block=lambda done, expected: conn.send(("progress", done, expected)))
+        conn.send(("done", dem_run_entry(result)))
+    except BaseException as exc:  # noqa: BLE001 - reported to the parent as the job's error
+        conn.send(("error", f"{type(exc).__name__}: {exc}"))
+    finally:
+        conn.close()
+
+
+class DemJobRunner:
+    """Queue of DEM cases for one store, run one at a time by a background thread.
+
+    Parameters
+    ----------
+    store_path : path
+        Store every finished case is saved to.
+    """
+
+    def __init__(self, store_path: str | Path) -> None:
+        self.store_path = Path(store_path)
+        self._lock = threading.Lock()
+        self._wake = threading.Condition(self._lock)
+        self._jobs: list[DemJob] = []
+        self._cancel: set[str] = set()
+        self._counter = 0
+        self._thread = threading.Thread(target=self._work, name="pidcore-dem-jobs", daemon=True)
+        self._thread.start()
+
+    # --- used by the page ---------------------------------------------------------------------
+
+    def submit(self, cases: Sequence, config) -> list[DemJob]:
+        """Queue ``cases`` with ``config``; returns the jobs created (duplicates are skipped:
+        a run queued, running or already in the store is not submitted again)."""
+        from ..dem.persist import run_key
+        from ..store import Store
+
+        stored = Store(self.store_path) if self.store_path.is_file() else None
+        created = []
+        with self._lock:
+            active = {j.run_key for j in self._jobs if j.state in ("queued", "running")}
+            for case in cases:
+                key = run_key(case, config)
+                if key in active:
+                    continue
+                self._counter += 1
+                job = DemJob(f"job{self._counter:04d}", case, config, key)
+                if stored is not None and stored.has_dem_run(key):
+                    job.state, job.message = "in store", "already in the store; not run again"
+                    job.finished = time.time()
+                self._jobs.append(job)
+                active.add(key)
+                created.append(job)
+            self._wake.notify_all()
+        return created
+
+    def cancel(self, job_ids: Sequence[str] | None = None) -> int:
+        """Cancel queued and running jobs (all of them, or ``job_ids``); returns how many.
+
+        A running case's process is terminated within :data:`_POLL_S` + the grace time.
+        """
+        n = 0
+        with self._lock:
+            for job in self._jobs:
+                if job.state in ("queued", "running") and (job_ids is None
+                                                           or job.job_id in job_ids):
+                    self._cancel.add(job.job_id)
+                    if job.state == "queued":
+                        job.state, job.finished = "cancelled", time.time()
+                        job.message = "cancelled before it started"
+                    n += 1
+            self._wake.notify_all()
+        return n
+
+    def jobs(self) -> list[DemJob]:
+        """Copies of every job, oldest first (safe to read while the worker runs)."""
+        with self._lock:
+            return [DemJob(**vars(j)) for j in self._jobs]
+
+    def busy(self) -> bool:
+        """Whether a job is queued or running."""
+        with self._lock:
+            return any(j.state in ("queued", "running") for j in self._jobs)
+
+    def clear_finished(self) -> None:
+        """Forget finished jobs (the store keeps their runs)."""
+        with self._lock:
+            self._jobs = [j for j in self._jobs if j.state in ("queued", "running")]
+
+    # --- worker thread ------------------------------------------------------------------------
+
+    def _next(self) -> DemJob | None:
+        with self._lock:
+            while True:
+                for job in self._jobs:
+                    if job.state == "queued":
+                        job.state, job.started = "running", time.time()
+                        return job
+                self._wake.wait()
+
+    def _work(self) -> None:
+        while True:
+            job = self._next()
+            try:
+                self._run(job)
+            except Exception as exc:  # noqa: BLE001 - a failed save must not stop the queue
+                self._finish(job, "failed", f"{type(exc).__name__}: {exc}")
+
+    def _finish(self, job: DemJob, state: str, message: str = "") -> None:
+        with self._lock:
+            job.state, job.message, job.finished = state, message, time.time()
+            self._cancel.discard(job.job_id)
+
+    def _run(self, job: DemJob) -> None:
+        from ..dem.sweep import CaseOutcome
+        from ..store import Store
+
+        ctx = multiprocessing.get_context("spawn")
+        parent, child = ctx.Pipe(duplex=False)
+        proc = ctx.Process(target=_child, args=(job.case, job.config, child), daemon=True,
+                           name=f"pidcore-dem-{job.job_id}")
+        proc.start()
+        child.close()
+        outcome = None
+        try:
+            while True:
+                with self._lock:
+                    cancelled = job.job_id in self._cancel
+                if cancelled:
+                    proc.terminate()
+                    proc.join(_TERMINATE_GRACE_S)
+                    if proc.is_alive():
+                        proc.kill()
+                        proc.join()
+                    self._finish(job, "cancelled", "cancelled while running; nothing saved")
+                    return
+                if parent.poll(_POLL_S):
+                    try:
+                        message = parent.recv()
+                    except EOFError:
+                        proc.join(_TERMINATE_GRACE_S)
+                        self._finish(job, "failed",
+                                     f"the DEM process ended (exit code {proc.exitcode})")
+                        return
+                    if message[0] == "progress":
+                        with self._lock:
+                            job.cycles_done = message[1]
+                            job.cycles_expected = max(message[1], message[2])
+                    elif message[0] == "error":
+                        self._finish(job, "failed", message[1])
+                        return
+                    else:
+                        outcome = message[1]
+                        break
+        finally:
+            parent.close()
+            if proc.is_alive():
+                proc.join(_TERMINATE_GRACE_S)
+                if proc.is_alive():
+                    proc.kill()
+        with self._lock:
+            if job.job_id in self._cancel:  # cancelled after the result came: not saved
+                job.state, job.finished = "cancelled", time.time()
+                job.message = "cancelled as it finished; nothing saved"
+                self._cancel.discard(job.job_id)
+                return
+        CaseOutcome(job.run_key, **outcome).save_to(Store(self.store_path))
+        self._finish(job, "saved", f"saved as {job.run_key}")
+
+
+_RUNNERS: dict[str, DemJobRunner] = {}
+_RUNNERS_LOCK = threading.Lock()
+
+
+def runner_for(store_path: str | Path) -> DemJobRunner:
+    """The process-wide job runner of a store (created on first use; outlives script runs and
+    browser sessions, so a reload shows the jobs still running)."""
+    key = str(Path(store_path).resolve())
+    with _RUNNERS_LOCK:
+        if key not in _RUNNERS:
+            _RUNNERS[key] = DemJobRunner(key)
+        return _RUNNERS[key]
+
+
+def plan_dem_cases(frequencies_hz: Sequence[float], accelerations_g: Sequence[float],
+                   fills_percent: Sequence[float], *, material: str, direction: str,
+                   max_cases: int = defaults.APP_MAX_DEM_CASES) -> list:
+    """Every combination of the chosen values as :class:`pidcore.dem.LoadCase` (Table 3 order).
+
+    Any positive frequency and acceleration is accepted, not only grid values. Raises
+    :class:`ParameterError` for an empty choice or more than ``max_cases`` cases.
+    """
+    from ..dem import LoadCase as DemLoadCase
+
+    cases = [DemLoadCase(float(f), float(a), float(p), material, direction)
+             for f in sorted(set(frequencies_hz)) for a in sorted(set(accelerations_g))
+             for p in sorted(set(fills_percent))]
+    if not cases:
+        raise ParameterError("choose at least one frequency, acceleration and fill")
+    if len(cases) > max_cases:
+        raise ParameterError(f"{len(cases)} load cases chosen; the app runs at most "
+                             f"{max_cases} at a time (use `pidcore dem` for larger sweeps)")
+    return cases
+
+
+def parse_values(text: str, *, name: str) -> list[float]:
+    """Numbers typed as ``"50, 100 500"``: positive floats, or a one-line error naming
+    ``name``."""
+    values = []
+    for token in text.replace(",", " ").replace(";", " ").split():
+        try:
+            value = float(token)
+        except ValueError:
+            raise ParameterError(f"{name}: {token!r} is not a number") from None
+        if not value > 0 or value != value or value == float("inf"):
+            raise ParameterError(f"{name}: {token!r}, expected a positive number")
+        values.append(value)
+    if not values:
+        raise ParameterError(f"{name}: give at least one value")
+    return values

@@ -1,0 +1,39 @@
+"""Layout of the pidcore Streamlit app: sidebar and five tabs, one page module each.
+
+Tabs rather than separate pages: every tab is drawn on each run, so uploads and their
+per-file settings live as long as the session without copying widget state around, and a tab
+switch happens in the browser (no server round trip).
+"""
+
+from __future__ import annotations
+
+import streamlit as st
+
+from pidcore import __version__, defaults
+from pidcore.app.pages import analyse, calibrate, compare, dem, report
+from pidcore.app.stores import AppStores
+
+
+def main() -> None:
+    """Draw the app (the entry script calls this on every run)."""
+    st.set_page_config(page_title="pidcore", layout="wide")
+    stores = AppStores.from_environment()
+    st.title("pidcore: particle impact damping")
+    with st.sidebar:
+        st.markdown(f"**store**: `{stores.path}`")
+        if stores.dem_reference is not None:
+            st.markdown(f"**reference DEM runs** (read-only): `{stores.dem_reference}`")
+        st.markdown(f"**upload limit**: {defaults.APP_MAX_UPLOAD_MB} MB per file")
+        st.caption(f"pidcore {__version__}")
+    t_analyse, t_compare, t_dem, t_cal, t_report = st.tabs(
+        ["Analyse", "Compare", "DEM", "Calibrate", "Report"])
+    with t_analyse:
+        analysed = analyse.render(stores)
+    with t_compare:
+        compare.render(stores, analysed)
+    with t_dem:
+        dem.render(stores)
+    with t_cal:
+        calibrate.render(stores)
+    with t_report:
+        report.render(stores)

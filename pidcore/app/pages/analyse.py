@@ -1,0 +1,192 @@
+"""Analyse page: upload exports, per-file settings (load case, specimen, corrections, channels),
+results with plausibility warnings, Save."""
+
+from __future__ import annotations
+
+import hashlib
+import math
+
+import pandas as pd
+import streamlit as st
+
+from pidcore import defaults
+from pidcore.app import state, uploads
+from pidcore.constants import DRIVE_DIRECTIONS, PARTICLE_MATERIALS
+
+
+def _size(n: int) -> str:
+    return (f"{n / 2**20:.1f} MB" if n >= 2**20 else f"{n / 1024:.0f} kB" if n >= 1024
+            else f"{n} bytes")
+
+
+def _settings_editor(measurements, tables: dict[str, pd.DataFrame], channel_names: list[str]):
+    """The editable per-file settings table; returns the edited frame."""
+    from pidcore.compare.case import stated_case
+
+    names = [u.name for u in measurements]
+    sig = (tuple((u.name, state.upload_sha256(u)) for u in measurements), tuple(sorted(tables)))
+    ss = st.session_state
+    if ss.get("settings_sig") != sig:
+        applied = ss.get("settings_tables_applied", set())
+        earlier = [t for sha, t in tables.items() if sha in applied]
+        new = [t for sha, t in tables.items() if sha not in applied]
+        ss["settings_base"] = uploads.merge_settings(
+            names, [stated_case(n) for n in names], ss.get("settings_current"), new,
+            earlier_tables=earlier)
+        ss["settings_tables_applied"] = set(tables)
+        ss["settings_sig"] = sig
+    channels = [uploads.AUTO_CHANNEL, uploads.NO_CHANNEL, *channel_names]
+    key = "settings_" + hashlib.sha256(repr(sig).encode()).hexdigest()[:12]
+    edited = st.data_editor(
+        ss["settings_base"], key=key, hide_index=True, num_rows="fixed",
+        width="stretch", disabled=["file"],
+        column_config={
+            "fill [%]": st.column_config.NumberColumn(min_value=0.1, max_value=100.0, step=1.0),
+            "material": st.column_config.SelectboxColumn(options=list(PARTICLE_MATERIALS),
+                                                         required=True),
+            "direction": st.column_config.SelectboxColumn(options=list(DRIVE_DIRECTIONS),
+                                                          required=True),
+            "vibrometer delay [µs]": st.column_config.NumberColumn(
+                step=1.0, help="output delay of the laser vibrometer, removed from velocity"),
+            "mass below gauge [g]": st.column_config.NumberColumn(
+                min_value=0.0, step=0.1, help="mass between force gauge and coupon"),
+            "baseline loss factor [-]": st.column_config.NumberColumn(
+                min_value=0.0, step=0.0001, format="%.5f",
+                help="loss factor of the empty coupon, subtracted"),
+            **{f"{role} channel": st.column_config.SelectboxColumn(options=channels)
+               for role in ("force", "velocity", "acceleration")},
+        })
+    ss["settings_current"] = edited
+    st.download_button("Download these settings as a CSV template", uploads.settings_template(
+        edited), file_name="pidcore_file_settings.csv", mime="text/csv",
+        key="settings_template")
+    return edited
+
+
+def _card(upload, row, sample_rate_hz):
+    """Results of one file; returns an AnalysedFile or None."""
+    from pidcore.compare.case import load_case_of
+    from pidcore.compare.plausibility import check_analysis
+    from pidcore.errors import PidcoreError
+
+    name = upload.name
+    with st.container(border=True):
+        st.markdown(f"**{name}** · {_size(upload.size)}")
+        sha = state.upload_sha256(upload)
+        found = state.parsed(sha, name, sample_rate_hz, upload)
+        if found.error is not None:
+            st.error(found.error)
+            return None
+        try:
+            options = uploads.options_of(row, sample_rate_hz=sample_rate_hz)
+        except PidcoreError as exc:
+            st.error(str(exc))
+            return None
+        outcome = state.analysed(sha, name, sample_rate_hz, uploads.options_to_json(options),
+                                 upload)
+        ch = found.channels
+        st.caption(f"channels: {', '.join(ch.names)} · used: force "
+                   f"{outcome.record.channels_used.get('force', '?') if outcome.ok else '?'}, "
+                   f"velocity "
+                   f"{outcome.record.channels_used.get('velocity', '?') if outcome.ok else '?'}"
+                   f" · vibrometer delay {options.velocity_delay_s * 1e6:g} µs")
+        if outcome.error is not None:
+            st.error(outcome.error)
+            return None
+        record = outcome.record
+        try:
+            fill = float(row["fill [%]"])
+            if not math.isfinite(fill):
+                raise ValueError
+            case = load_case_of(record, fill_percent=fill, material=str(row["material"]),
+                                direction=str(row["direction"]))
+        except (PidcoreError, ValueError, TypeError) as exc:
+            st.error(f"{name}: no valid load case ({exc or 'fill [%] missing'}); set it in "
+                     "the settings table")
+            return None
+        a = record.analysis
+        m1, m2, m3, m4 = st.columns(4)
+        m1.metric("frequency [Hz]", f"{a.frequency_hz:.3f}")
+        m2.metric("acceleration [g]", f"{a.acceleration_g:.3f}")
+        m3.metric("loss factor [-]", f"{a.loss_factor:.5f}")
+        m4.metric("SDC ± stderr [-]", uploads.format_sdc(a.sdc, a.sdc_stderr))
+        warnings = check_analysis(a)
+        for w in warnings:
+            st.warning(f"**Implausible:** {w.message}. *Likely cause:* {w.likely_cause}.",
+                       icon="⚠️")
+        for note in record.notes:
+            st.caption(f"note: {note}")
+        return uploads.AnalysedFile(record, case, options, str(row.get("specimen", "") or ""),
+                                    warnings)
+
+
+def render(stores) -> list:
+    """The page; returns this session's analysed files (for the Compare page)."""
+    from pidcore.errors import PidcoreError
+
+    st.subheader("Upload & analyse")
+    st.caption(f"UFF58 (ASCII or binary), CSV/TXT, MAT and HDF5 exports; several at once. "
+               f"Upload limit: {defaults.APP_MAX_UPLOAD_MB} MB per file. Files are parsed, "
+               "never executed; nothing is stored until you press Save. A CSV table with a "
+               "`file` column and settings columns (e.g. `fill_percent`, `velocity_delay_us`, "
+               "as in the template below) is read as per-file settings, under any name and at "
+               "any time.")
+    files = st.file_uploader("shaker-test exports and settings tables",
+                             accept_multiple_files=True, key="uploads",
+                             max_upload_size=defaults.APP_MAX_UPLOAD_MB)
+    with st.expander("Options for every file", expanded=False):
+        rate = st.number_input("sample rate if no time column [Hz]", value=0.0, min_value=0.0,
+                               step=1000.0, key="sample_rate",
+                               help="only for CSV/TXT files without a time column; 0 = none")
+    sample_rate_hz = rate if rate > 0 else None
+    measurements, tables = [], {}
+    for upload in files or []:
+        try:
+            uploads.check_upload_size(upload.name, upload.size)
+        except PidcoreError as exc:
+            st.error(str(exc))
+            continue
+        data = upload.getvalue()
+        if uploads.is_settings_table(data):
+            try:
+                table = uploads.read_settings_table(upload.name, data)
+            except PidcoreError as exc:
+                st.error(str(exc))
+                continue
+            tables[state.upload_sha256(upload)] = table
+            st.info(f"{upload.name}: settings of {len(table)} file(s) read "
+                    f"({', '.join(c for c in table.columns if c != 'file')})")
+        else:
+            measurements.append(upload)
+    if not measurements:
+        return []
+    channel_names = []
+    for upload in measurements:
+        found = state.parsed(state.upload_sha256(upload), upload.name, sample_rate_hz, upload)
+        if found.channels is not None:
+            channel_names += [n for n in found.channels.names if n not in channel_names]
+    st.markdown("**Per-file settings** (edit the cells; each file is analysed with its own row)")
+    settings = _settings_editor(measurements, tables, channel_names)
+    analysed = []
+    for upload, (_, row) in zip(measurements, settings.iterrows(), strict=True):
+        result = _card(upload, row, sample_rate_hz)
+        if result is not None:
+            analysed.append(result)
+    if analysed:
+        st.markdown("**Results**")
+        st.dataframe(uploads.results_table(analysed), hide_index=True, key="results_table",
+                     width="stretch")
+    flagged = [f for f in analysed if f.warnings]
+    confirm = False
+    if flagged:
+        confirm = st.checkbox(f"Save the {len(flagged)} implausible record(s) anyway (their "
+                              "warnings are saved with them)", key="confirm_implausible")
+    if st.button(f"Save {len(analysed)} record(s) to the store", disabled=not analysed,
+                 type="primary", key="save"):
+        try:
+            keys = uploads.save_records(stores.path, analysed, confirm_implausible=confirm)
+        except PidcoreError as exc:
+            st.error(f"not saved: {exc}")
+        else:
+            st.success(f"saved {len(keys)} analysis record(s) to {stores.path}")
+    return analysed

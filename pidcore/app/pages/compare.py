@@ -1,0 +1,125 @@
+"""Compare page: every saved record of the store (and this session's unsaved ones), filtered,
+per load case: the headline (like-for-like measured SDC vs our DEM), SDC against fill, loops,
+spectrum."""
+
+from __future__ import annotations
+
+import math
+
+import streamlit as st
+
+from pidcore.app import state, uploads, workbench
+
+
+def _entries(stores, session_files):
+    """Saved entries (filtered by the user) + this session's unsaved ones."""
+    from pidcore.compare.case import MeasuredEntry
+    from pidcore.store.listing import filter_analyses
+
+    stamp = stores.stamp()
+    saved = state.store_listing("analyses", stamp, stores)
+    if not saved.empty:
+        f1, f2, f3 = st.columns(3)
+        specimens = f1.multiselect("specimen", sorted(set(saved["specimen"])),
+                                   key="filter_specimen",
+                                   format_func=lambda s: s or "(none named)")
+        dates = f2.multiselect("date saved", sorted(set(saved["date"]), reverse=True),
+                               key="filter_date")
+        files = f3.multiselect("file", sorted(set(saved["file"])), key="filter_file")
+        saved = filter_analyses(saved, specimens=specimens, dates=dates, files=files)
+    entries = list(state.saved_entries(tuple(saved["key"]) if not saved.empty else (), stamp,
+                                       stores, saved)) if not saved.empty else []
+    include = st.checkbox("include this session's unsaved analyses", value=True,
+                          key="include_session")
+    if include:
+        known = {(e.file, e.sdc) for e in entries}
+        for f in session_files:
+            e = MeasuredEntry.from_record(f.record, f.load_case, specimen=f.specimen)
+            if (e.file, e.sdc) not in known:
+                entries.append(e)
+    return entries
+
+
+def _group_key(members) -> str:
+    return "|".join(f"{e.key}:{e.load_case.key}:{e.specimen}:{e.sdc!r}" for e in members)
+
+
+def render(stores, session_files: list) -> None:
+    """The page."""
+    from pidcore.errors import PidcoreError
+
+    st.subheader("Compare per load case")
+    try:
+        entries = _entries(stores, session_files)
+    except PidcoreError as exc:
+        st.error(f"cannot read the store: {exc}")
+        return
+    if not entries:
+        st.info(f"No analysed records: {stores.path} holds no saved analyses with a load case "
+                "(or the filters exclude them), and nothing is analysed in this session. "
+                "Upload and save measurements on the Analyse tab.")
+        return
+    groups = workbench.group_entries(entries)
+    labels = [workbench.group_label(entries, g) for g in groups]
+    choice = st.selectbox("load case", range(len(groups)), format_func=labels.__getitem__,
+                          key="compare_case")
+    choice = min(choice or 0, len(groups) - 1)
+    members = [entries[i] for i in groups[choice]]
+    stamp = stores.stamp()
+    try:
+        view = state.case_view(_group_key(members), stamp, members, stores)
+    except PidcoreError as exc:
+        st.error(f"cannot compare: {exc}")
+        return
+    comp, head = view["comparison"], view["headline"]
+    aligned = comp.aligned
+    dem_text = (uploads.format_sdc(head.dem, head.dem_stderr) if math.isfinite(head.dem)
+                else "none")
+    st.markdown(f"### measured {uploads.format_sdc(head.measured, head.measured_stderr)} "
+                f"vs our DEM {dem_text} — {head.verdict}")
+    st.caption(f"Measured SDC: {head.measured_kind}"
+               + (" (energy per cycle over the DEM case's m_c a²/(2ω²), as our DEM SDC is "
+                  "defined)" if head.measured_kind.startswith("Eq. 10") else "")
+               + f". DEM alignment: {aligned.status}. {aligned.message}")
+    if len(members) > 1:
+        if math.isfinite(comp.chi2_dof) and comp.chi2_dof > 3:
+            st.warning(f"The {len(members)} pooled files scatter more than their errors allow "
+                       f"(χ²/dof = {comp.chi2_dof:.2g}): different set-ups or corrections? "
+                       "Check the per-file settings.", icon="⚠️")
+        else:
+            st.caption(f"{len(members)} files pooled; consistent within their errors "
+                       f"(χ²/dof = {comp.chi2_dof:.2g})")
+    with st.expander("details: Eq. 11 SDC and the paper", expanded=False):
+        c1, c2, c3 = st.columns(3)
+        c1.metric("SDC measured, Eq. 11 ± stderr [-]",
+                  uploads.format_sdc(comp.measured_sdc, comp.measured_stderr),
+                  help="energy per cycle over the reactive energy Im(P)/w")
+        c2.metric("SDC paper DEM [-]", f"{aligned.sdc_paper_dem:.4f}"
+                  if math.isfinite(aligned.sdc_paper_dem) else "not a Table 3 case")
+        c3.metric("SDC paper measured [-]", f"{aligned.sdc_paper_experimental:.4f}"
+                  if math.isfinite(aligned.sdc_paper_experimental) else "not a Table 3 case")
+    for note in view["notes"]:
+        st.caption(f"note: {note}")
+    left, right = st.columns(2)
+    left.vega_lite_chart(spec=view["sdc_spec"], key="sdc_chart", width="stretch")
+    right.vega_lite_chart(spec=view["loop_spec"], key="loop_chart", width="stretch")
+    if view["energies"]:
+        st.markdown("energy per cycle (loop area): " + " · ".join(
+            f"{label}: **{energy:.4e} J**" for label, energy in view["energies"].items()))
+    left2, right2 = st.columns([3, 2])
+    left2.vega_lite_chart(spec=view["spectrum_spec"], key="spectrum_chart")
+    right2.dataframe(view["spectrum"], hide_index=True, width="stretch")
+    st.dataframe(comp.measured, hide_index=True, width="stretch", key="compare_measured")
+    # Warm the cache for the other load cases after this one is on screen, so that switching
+    # to any of them is a cache hit.
+    warmed = st.session_state.setdefault("_compare_warmed", set())
+    for other, indices in enumerate(groups):
+        rest = [entries[i] for i in indices]
+        key = (_group_key(rest), stamp)
+        if other == choice or key in warmed:
+            continue
+        try:
+            state.case_view(key[0], stamp, rest, stores)
+        except PidcoreError:
+            pass  # shown when that case is chosen
+        warmed.add(key)

@@ -1,0 +1,120 @@
+"""DEM page: submit load cases (any frequency, acceleration and fill) to the background job
+runner (:mod:`pidcore.app.jobs`), watch progress with elapsed time and ETA, cancel at any time.
+
+The page never computes: a click submits or cancels and returns at once, the job table
+refreshes itself every second (a fragment), and every finished case is saved by the runner.
+"""
+
+from __future__ import annotations
+
+import pandas as pd
+import streamlit as st
+
+from pidcore import defaults
+from pidcore.app import jobs, state
+from pidcore.constants import DRIVE_DIRECTIONS, PARTICLE_MATERIALS
+
+#: Seconds between refreshes of the job table while jobs run.
+REFRESH_S = 1.0
+
+
+def _config(cells: int, seed: int, steady_cycles: int):
+    from pidcore.dem import DemConfig
+
+    return DemConfig(cells=int(cells), seed=int(seed),
+                     steady_cycles=int(steady_cycles) if steady_cycles > 0 else None)
+
+
+def _cancel(stores) -> None:
+    # Button callback: runs before the script, so the cancel reaches the runner at once.
+    n = jobs.runner_for(stores.path).cancel()
+    st.session_state["dem_message"] = ("warning", f"cancel requested for {n} job(s); finished "
+                                                  "cases stay saved")
+
+
+@st.fragment(run_every=REFRESH_S)
+def _job_table(stores) -> None:
+    runner = jobs.runner_for(stores.path)
+    rows = [j.row() for j in runner.jobs()]
+    busy = runner.busy()
+    running = [r for r in rows if r["state"] == "running"]
+    if running:
+        r = running[0]
+        eta = "…" if r["ETA [s]"] is None else f"{r['ETA [s]']:.0f} s"
+        st.progress(r["progress [%]"] / 100,
+                    text=f"{r['job']} {r['load case']}: {r['cycles [-]']} cycles, "
+                         f"{r['elapsed [s]']:.0f} s elapsed, ETA {eta}")
+    if rows:
+        st.dataframe(pd.DataFrame(rows), hide_index=True, width="stretch", key="dem_jobs")
+        counts = pd.Series([r["state"] for r in rows]).value_counts()
+        st.caption("jobs: " + ", ".join(f"{n} {s}" for s, n in counts.items())
+                   + (" · refreshing every second" if busy else ""))
+    # A job that finished since the last look changes the store: let the other tabs re-read.
+    done = sum(r["state"] == "saved" for r in rows)
+    if st.session_state.get("_dem_saved_seen", 0) != done:
+        st.session_state["_dem_saved_seen"] = done
+        if done:
+            st.rerun(scope="app")
+
+
+def render(stores) -> None:
+    """The page."""
+    from pidcore.errors import PidcoreError
+
+    st.subheader("DEM: run load cases")
+    st.caption(f"Any frequencies, accelerations and fills (at most "
+               f"{defaults.APP_MAX_DEM_CASES} cases at a time). Cases run in the background, "
+               "one after the other, each saved to the store as it finishes; you can switch "
+               "tabs or reload meanwhile. Larger grids: `pidcore dem`.")
+    c1, c2, c3 = st.columns(3)
+    freqs = c1.text_input("frequencies [Hz]", "100", key="dem_freqs",
+                          help="one or more values, e.g. 50, 100, 333")
+    accs = c2.text_input("accelerations [g]", "5", key="dem_accs", help="e.g. 1, 5, 7.5")
+    fills = c3.text_input("fills [%]", "50", key="dem_fills", help="e.g. 25, 50")
+    c4, c5 = st.columns(2)
+    material = c4.selectbox("particle material", PARTICLE_MATERIALS, key="dem_material")
+    direction = c5.selectbox("drive direction", DRIVE_DIRECTIONS, key="dem_direction")
+    with st.expander("numerical settings", expanded=False):
+        d1, d2, d3 = st.columns(3)
+        cells = d1.number_input("cells simulated", min_value=1, max_value=64,
+                                value=defaults.DEM_CELLS, step=1, key="dem_cells")
+        seed = d2.number_input("seed", min_value=0, value=defaults.DEM_SEED, step=1,
+                               key="dem_seed")
+        steady = d3.number_input("steady cycles (0 = automatic)", min_value=0, value=0, step=1,
+                                 key="dem_steady")
+    b1, b2 = st.columns(2)
+    start = b1.button("Run", type="primary", key="dem_run")
+    b2.button("Cancel", key="dem_cancel", on_click=_cancel, args=(stores,),
+              help="stops the running case within a second and drops the queued ones")
+    if start:
+        try:
+            config = _config(cells, seed, steady)
+            cases = jobs.plan_dem_cases(
+                jobs.parse_values(freqs, name="frequencies [Hz]"),
+                jobs.parse_values(accs, name="accelerations [g]"),
+                jobs.parse_values(fills, name="fills [%]"), material=material,
+                direction=direction)
+        except PidcoreError as exc:
+            st.session_state["dem_message"] = ("error", str(exc))
+        else:
+            created = jobs.runner_for(stores.path).submit(cases, config)
+            skipped = len(cases) - len(created)
+            st.session_state["dem_message"] = (
+                "info", f"{len(created)} job(s) submitted"
+                + (f"; {skipped} already queued or running, not submitted again"
+                   if skipped else ""))
+    message = st.session_state.get("dem_message")
+    if message:
+        getattr(st, message[0])(message[1])
+    _job_table(stores)
+    try:
+        runs = state.store_listing("dem_runs", stores.stamp(), stores)
+    except PidcoreError as exc:
+        st.error(f"cannot read the DEM runs: {exc}")
+        return
+    if not runs.empty:
+        cols = [c for c in ("case_key", "frequency_hz", "acceleration_g", "fill_percent",
+                            "material", "direction", "sdc", "sdc_stderr", "cells_simulated",
+                            "seed", "wall_s", "store") if c in runs.columns]
+        st.markdown(f"**DEM runs in the stores** ({len(runs)})")
+        st.dataframe(runs[cols], hide_index=True, width="stretch", key="dem_runs_table")

@@ -1,0 +1,46 @@
+"""Report page: the Table 3-style table of the store and its downloads."""
+
+from __future__ import annotations
+
+import streamlit as st
+
+from pidcore.app import state
+
+
+def render(stores) -> None:
+    """The page."""
+    from pidcore.errors import PidcoreError
+    from pidcore.report.downloads import report_files
+
+    st.subheader("Report (Table 3 style)")
+    pool = st.checkbox("pool DEM settings and specimens at one load case", value=False,
+                       key="report_pool",
+                       help="default: a row per DEM setting and per specimen")
+    try:
+        table = state.store_listing("report_table_pooled" if pool else "report_table",
+                                    stores.stamp(), stores)
+    except PidcoreError as exc:
+        st.error(f"cannot read the store: {exc}")
+        return
+    if table.empty:
+        st.info(f"{stores.path} holds no saved analyses with a load case and no DEM runs yet: "
+                "save analysed files (tab Analyse) or run DEM cases (tab DEM).")
+        return
+    st.dataframe(table, hide_index=True, key="report_table", width="stretch")
+    for note in table.attrs.get("notes", []):
+        st.caption(f"note: {note}")
+    if st.button("Build report files (CSV, Markdown, HTML, LaTeX, PDF)", key="build_report"):
+        try:
+            with st.spinner("Writing the report ..."):
+                st.session_state["report_files"] = ((stores.stamp(), pool), report_files(
+                    stores.path, stores.dem_reference, pool=pool))
+        except PidcoreError as exc:
+            st.error(f"no report: {exc}")
+    stamp, files = st.session_state.get("report_files") or (None, None)
+    if files and stamp == (stores.stamp(), pool):  # files of an older state are not offered
+        cols = st.columns(len(files))
+        for col, (fmt, (name, data, mime)) in zip(cols, files.items(), strict=True):
+            label = "CSV notes" if fmt == "csv_provenance" else fmt.upper()
+            col.download_button(label, data, file_name=name, mime=mime, key=f"download_{fmt}")
+        st.caption("report.csv holds only the table (pandas.read_csv reads it as is); "
+                   "provenance and notes are in the CSV notes file and in the other formats.")

@@ -1,0 +1,85 @@
+"""Cached reads of the app (Streamlit caches), keyed by content hashes and store stamps."""
+
+from __future__ import annotations
+
+import streamlit as st
+
+from pidcore.app import charts, uploads, workbench
+
+_CACHE_ENTRIES = 64
+#: Parsed uploads kept in memory (each can be up to the upload limit).
+_PARSED_ENTRIES = 16
+
+
+# cache_resource, not cache_data: measurements can be large, and cache_data would unpickle a
+# copy on every hit. The records are frozen and never mutated, so sharing them is safe.
+@st.cache_resource(max_entries=_PARSED_ENTRIES, show_spinner="Reading file ...")
+def parsed(sha256: str, name: str, sample_rate_hz: float | None, _upload):
+    """The upload read and its channels detected (once per content and sample rate)."""
+    return uploads.parse_upload(name, _upload.getvalue(), sample_rate_hz=sample_rate_hz)
+
+
+@st.cache_resource(max_entries=4 * _PARSED_ENTRIES, show_spinner="Analysing ...")
+def analysed(sha256: str, name: str, sample_rate_hz: float | None, options_json: str,
+             _upload):
+    """The upload analysed with one set of options (once per content and options)."""
+    found = parsed(sha256, name, sample_rate_hz, _upload)
+    return uploads.analyze_parsed(found, uploads.options_from_json(options_json))
+
+
+def upload_sha256(upload) -> str:
+    """Content hash of an upload, computed once per uploaded file."""
+    known = st.session_state.setdefault("_upload_sha256", {})
+    file_id = getattr(upload, "file_id", None)
+    if file_id is None or file_id not in known:
+        digest = uploads.content_sha256(upload.getvalue())
+        if file_id is None:
+            return digest
+        known[file_id] = digest
+    return known[file_id]
+
+
+@st.cache_data(max_entries=16, show_spinner=False)
+def store_listing(what: str, stamp: tuple, _stores):
+    """Store listings, re-read only when a store file changed (``AppStores.stamp``)."""
+    from pidcore.report.downloads import store_report_table
+    from pidcore.store.listing import list_dem_runs, saved_analyses
+
+    if what == "dem_runs":
+        return list_dem_runs(_stores.path, _stores.dem_reference)
+    if what == "analyses":
+        return saved_analyses(_stores.path)
+    if what in ("report_table", "report_table_pooled"):
+        return store_report_table(_stores.path, _stores.dem_reference,
+                                  pool=what.endswith("pooled"))
+    raise ValueError(what)
+
+
+@st.cache_resource(max_entries=_CACHE_ENTRIES, show_spinner=False)
+def saved_entries(keys: tuple[str, ...], stamp: tuple, _stores, _rows):
+    """Measured entries of saved analyses (phasors read once per store state)."""
+    return workbench.saved_entries(_stores.path, _rows)
+
+
+@st.cache_data(show_spinner=False)
+def paper():
+    """The paper's Table 3."""
+    from pidcore.compare.case import paper_table
+
+    return paper_table()
+
+
+@st.cache_data(max_entries=_CACHE_ENTRIES, show_spinner=False)
+def case_view(group_key: str, stamp: tuple, _entries, _stores) -> dict:
+    """The Compare page's data and Vega-Lite specs of one load case.
+
+    Keyed by the records' identity and the stores' state; specs are built once per case so a
+    revisit only sends them (schema validation is left to the tests).
+    """
+    view = workbench.case_view(_entries, store_listing("dem_runs", stamp, _stores), paper(),
+                               (_stores.path, _stores.dem_reference))
+    view["sdc_spec"] = charts.sdc_chart(view["sdc_points"]).to_dict(validate=False)
+    view["loop_spec"] = charts.loop_chart(view["loops"], view["energies"]).to_dict(
+        validate=False)
+    view["spectrum_spec"] = charts.spectrum_chart(view["spectrum"]).to_dict(validate=False)
+    return view

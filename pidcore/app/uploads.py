@@ -1,0 +1,416 @@
+"""Uploads of the app, kept free of Streamlit: reading, per-file settings, analysis, saving.
+
+Uploaded bytes are only ever *parsed* by :mod:`pidcore.io` readers (text, UFF, HDF5 datasets,
+MAT arrays) or read as a CSV table; nothing uploaded is unpickled or evaluated.
+
+Every uploaded measurement has its own row of settings (:data:`FILE_TABLE_COLUMNS`): load case,
+specimen, corrections and channel mapping, because files from different set-ups need different
+corrections. A CSV whose header holds ``file`` and any other settings column is taken as a
+settings table (under any name, uploaded at any time) and fills the rows of the files it names.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import io
+import json
+import math
+import os
+import re
+import tempfile
+from collections.abc import Mapping, Sequence
+from dataclasses import asdict, dataclass, replace
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import pandas as pd
+
+from .. import defaults
+from ..errors import ParameterError, PidcoreError
+
+if TYPE_CHECKING:
+    from ..compare import LoadCase
+    from ..measure import AnalysisOptions, AnalyzedRecord
+    from ..records import Measurement
+
+#: Label of "no channel" (acceleration is optional).
+NO_CHANNEL = "(none)"
+#: Label of "the channel the readers detect".
+AUTO_CHANNEL = "(auto)"
+
+#: Per-file settings: column shown in the app -> column of the CSV template / uploaded table.
+FILE_TABLE_COLUMNS: dict[str, str] = {
+    "file": "file",
+    "fill [%]": "fill_percent",
+    "material": "material",
+    "direction": "direction",
+    "specimen": "specimen",
+    "vibrometer delay [µs]": "velocity_delay_us",
+    "mass below gauge [g]": "mass_below_gauge_g",
+    "baseline loss factor [-]": "baseline_loss_factor",
+    "force channel": "force",
+    "velocity channel": "velocity",
+    "acceleration channel": "acceleration",
+}
+_NUMERIC = ("fill [%]", "vibrometer delay [µs]", "mass below gauge [g]",
+            "baseline loss factor [-]")
+
+
+# --- reading ----------------------------------------------------------------------------------
+
+def content_sha256(data: bytes) -> str:
+    """SHA-256 hex digest of an upload (the cache and store key of its content)."""
+    return hashlib.sha256(data).hexdigest()
+
+
+def check_upload_size(name: str, n_bytes: int, *, limit_mb: float | None = None) -> None:
+    """Raise :class:`ParameterError` if an upload is empty or larger than ``limit_mb`` MB.
+
+    ``limit_mb`` defaults to :data:`pidcore.defaults.APP_MAX_UPLOAD_MB`; Streamlit enforces the
+    same limit in the browser, this is the server-side guard.
+    """
+    limit_mb = defaults.APP_MAX_UPLOAD_MB if limit_mb is None else limit_mb
+    if n_bytes > limit_mb * 1024 * 1024:
+        raise ParameterError(f"{name}: {n_bytes / 1024 / 1024:.1f} MB is larger than the upload "
+                             f"limit of {limit_mb:g} MB")
+    if n_bytes == 0:
+        raise ParameterError(f"{name}: the file is empty")
+
+
+def safe_file_name(name: str) -> str:
+    """A file name safe to create in a temporary folder (no folders, no odd characters).
+
+    >>> safe_file_name("../../etc/pass wd.csv")
+    'pass_wd.csv'
+    """
+    base = re.split(r"[\\/]", name)[-1]
+    base = re.sub(r"[^A-Za-z0-9._+-]", "_", base).lstrip(".")
+    return base[:200] or "upload"
+
+
+def read_upload(name: str, data: bytes, *, sample_rate_hz: float | None = None) -> Measurement:
+    """Parse uploaded bytes with :func:`pidcore.io.read_measurement` (via a private temporary
+    file); the measurement's ``source`` is the uploaded name."""
+    from ..io import read_measurement
+
+    check_upload_size(name, len(data))
+    with tempfile.TemporaryDirectory(prefix="pidcore_upload_") as folder:
+        path = Path(folder) / safe_file_name(name)
+        path.write_bytes(data)
+        measurement = read_measurement(path, sample_rate_hz=sample_rate_hz)
+    return replace(measurement, source=name, sha256=measurement.sha256 or content_sha256(data))
+
+
+@dataclass(frozen=True)
+class ChannelChoice:
+    """Channels of one upload and the roles detected for them (``None`` = not found)."""
+
+    names: tuple[str, ...]
+    quantities: tuple[str, ...]
+    force: str | None
+    velocity: str | None
+    acceleration: str | None
+
+
+def detect_channels(measurement: Measurement) -> ChannelChoice:
+    """Channel names and the roles :func:`pidcore.io.assign_roles` picks automatically
+    (``None`` everywhere when detection fails; the user then maps them)."""
+    from ..io import assign_roles
+
+    force = velocity = acceleration = None
+    try:
+        roles = assign_roles(measurement)
+        force = roles.force.name if roles.force is not None else None
+        velocity = roles.velocity.name if roles.velocity is not None else None
+        acceleration = roles.acceleration.name if roles.acceleration is not None else None
+    except PidcoreError:
+        pass
+    return ChannelChoice(tuple(c.name for c in measurement.channels),
+                         tuple(c.quantity for c in measurement.channels),
+                         force, velocity, acceleration)
+
+
+@dataclass(frozen=True)
+class ParsedUpload:
+    """One upload after reading: its measurement and detected channels, or the read error."""
+
+    name: str
+    sha256: str
+    measurement: Measurement | None = None
+    channels: ChannelChoice | None = None
+    error: str | None = None
+
+
+@dataclass(frozen=True)
+class UploadOutcome:
+    """Analysis of one uploaded file: a record, or the one-line error that stopped it."""
+
+    name: str
+    sha256: str
+    record: AnalyzedRecord | None = None
+    error: str | None = None
+
+    @property
+    def ok(self) -> bool:
+        """Whether the analysis succeeded."""
+        return self.record is not None
+
+
+def error_message(name: str, exc: BaseException) -> str:
+    """One-line message for a failed upload; library errors already name the file."""
+    text = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+    text = re.sub(r"\S*pidcore_upload_[^/\\\s]*[/\\][^:\s]*", name, text)
+    # The library's hints name CLI options; in the app the same choice is a table column.
+    text = re.sub(r"--(force|velocity|acceleration) NAME", r"the '\1 channel' column", text)
+    if isinstance(exc, PidcoreError):
+        return text if name in text else f"{name}: {text}"
+    return f"{name}: could not be read ({type(exc).__name__}: {text})"
+
+
+#: Exceptions that mean "this upload is bad": readers are the boundary to arbitrary bytes and
+#: the parsers they use (pyuff, h5py, scipy.io, pandas) raise these on malformed input.
+_BAD_INPUT_ERRORS = (PidcoreError, ValueError, OSError, KeyError, IndexError, TypeError,
+                     UnicodeError, EOFError, OverflowError, AttributeError)
+
+
+def parse_upload(name: str, data: bytes, *, sample_rate_hz: float | None = None) -> ParsedUpload:
+    """Read one upload and detect its channel roles; never raises for bad data."""
+    sha = content_sha256(data)
+    try:
+        measurement = read_upload(name, data, sample_rate_hz=sample_rate_hz)
+        return ParsedUpload(name, sha, measurement, detect_channels(measurement))
+    except _BAD_INPUT_ERRORS as exc:
+        return ParsedUpload(name, sha, error=error_message(name, exc))
+
+
+def analyze_parsed(parsed: ParsedUpload, options: AnalysisOptions) -> UploadOutcome:
+    """Analyse a parsed upload with ``options``; any failure becomes the outcome's error."""
+    from ..measure import analyze_measurement
+
+    if parsed.measurement is None:
+        return UploadOutcome(parsed.name, parsed.sha256, error=parsed.error)
+    try:
+        record = analyze_measurement(parsed.measurement, options)
+    except _BAD_INPUT_ERRORS as exc:
+        return UploadOutcome(parsed.name, parsed.sha256, error=error_message(parsed.name, exc))
+    return UploadOutcome(parsed.name, parsed.sha256, record=record)
+
+
+def analyze_upload(name: str, data: bytes, options: AnalysisOptions) -> UploadOutcome:
+    """Read and analyse one upload; never raises for bad user data."""
+    return analyze_parsed(parse_upload(name, data, sample_rate_hz=options.sample_rate_hz),
+                          options)
+
+
+def options_to_json(options: AnalysisOptions) -> str:
+    """Canonical JSON of analysis options (a stable, hashable cache key)."""
+    return json.dumps(asdict(options), sort_keys=True)
+
+
+def options_from_json(text: str) -> AnalysisOptions:
+    """Inverse of :func:`options_to_json`."""
+    from ..measure import AnalysisOptions
+
+    return AnalysisOptions(**json.loads(text))
+
+
+# --- per-file settings --------------------------------------------------------------------------
+
+def is_settings_table(data: bytes) -> bool:
+    """Whether uploaded bytes are a per-file settings table (a load-case table is one): a CSV
+    whose header names ``file`` and at least one other column of :data:`FILE_TABLE_COLUMNS`."""
+    head = data[:4096].decode("utf-8-sig", errors="replace").splitlines()
+    if not head:
+        return False
+    names = {c.strip().strip('"').lower() for c in head[0].split(",")}
+    known = set(FILE_TABLE_COLUMNS.values()) | {k.lower() for k in FILE_TABLE_COLUMNS}
+    return "file" in names and len(names & known) >= 2
+
+
+def read_settings_table(name: str, data: bytes) -> pd.DataFrame:
+    """An uploaded settings table as rows of :data:`FILE_TABLE_COLUMNS` (app column names).
+
+    Columns may be given by their template or app names; missing ones stay empty (NaN or "")
+    and leave a file's other settings alone. Raises :class:`ParameterError` naming the table,
+    row and column for a value that is not a number, material or direction.
+    """
+    from ..compare.loadcase import normalize_direction, normalize_material
+
+    try:
+        raw = pd.read_csv(io.BytesIO(data), dtype=str, keep_default_na=False,
+                          skipinitialspace=True)
+    except (ValueError, UnicodeError) as exc:
+        raise ParameterError(f"{name}: not a readable CSV table ({exc})") from None
+    by_name = {k.lower(): k for k in FILE_TABLE_COLUMNS} | {
+        v: k for k, v in FILE_TABLE_COLUMNS.items()}
+    raw.columns = [by_name.get(str(c).strip().lower(), str(c).strip()) for c in raw.columns]
+    unknown = [c for c in raw.columns if c not in FILE_TABLE_COLUMNS]
+    if unknown:
+        raise ParameterError(f"{name}: unknown column(s) {unknown}; expected some of "
+                             f"{list(FILE_TABLE_COLUMNS.values())}")
+    out = pd.DataFrame({c: raw[c].str.strip() if c in raw else "" for c in FILE_TABLE_COLUMNS})
+    for column in _NUMERIC:
+        values = []
+        for i, text in enumerate(out[column], start=2):
+            try:
+                values.append(float(text) if text != "" else math.nan)
+            except ValueError:
+                raise ParameterError(f"{name}, line {i}: {FILE_TABLE_COLUMNS[column]} "
+                                     f"{text!r} is not a number") from None
+        out[column] = values
+    for column, normalize in (("material", normalize_material),
+                              ("direction", normalize_direction)):
+        out[column] = [normalize(v, f"{name}: {column}") if v else "" for v in out[column]]
+    if (out["file"] == "").any():
+        raise ParameterError(f"{name}: every row needs a file name")
+    return out
+
+
+def default_settings_row(name: str, stated) -> dict:
+    """Settings of a newly uploaded file: its stated load case, no corrections, auto channels."""
+    return {"file": name, "fill [%]": float(stated.fill_percent), "material": stated.material,
+            "direction": stated.direction, "specimen": "", "vibrometer delay [µs]": 0.0,
+            "mass below gauge [g]": 0.0, "baseline loss factor [-]": 0.0,
+            "force channel": AUTO_CHANNEL, "velocity channel": AUTO_CHANNEL,
+            "acceleration channel": AUTO_CHANNEL}
+
+
+def merge_settings(names: Sequence[str], stated: Sequence, previous: pd.DataFrame | None,
+                   tables: Sequence[pd.DataFrame] = (), *,
+                   earlier_tables: Sequence[pd.DataFrame] = ()) -> pd.DataFrame:
+    """The settings table of the files ``names``.
+
+    In order, later wins: defaults from ``stated`` (what the names state), ``earlier_tables``
+    (tables uploaded before: they fill files added since), the user's values (``previous``),
+    then newly uploaded ``tables``. An empty table cell leaves the value alone.
+    """
+    rows = {n: default_settings_row(n, s) for n, s in zip(names, stated, strict=True)}
+    _apply_tables(rows, earlier_tables)
+    if previous is not None and not previous.empty:
+        for _, old in previous.iterrows():
+            if old["file"] in rows:
+                rows[old["file"]].update({k: old[k] for k in FILE_TABLE_COLUMNS if k in old})
+    _apply_tables(rows, tables)
+    return pd.DataFrame(list(rows.values()), columns=list(FILE_TABLE_COLUMNS))
+
+
+def _apply_tables(rows: dict[str, dict], tables: Sequence[pd.DataFrame]) -> None:
+    for table in tables:
+        for _, new in table.iterrows():
+            target = new["file"] if new["file"] in rows else next(
+                (n for n in rows if Path(n).name == Path(str(new["file"])).name), None)
+            if target is None:
+                continue
+            for k in FILE_TABLE_COLUMNS:
+                value = new.get(k, "")
+                if k != "file" and not (value == "" or (isinstance(value, float)
+                                                        and math.isnan(value))):
+                    rows[target][k] = value
+
+
+def settings_template(settings: pd.DataFrame) -> bytes:
+    """The settings table as a CSV template (template column names), to fill in and upload."""
+    return settings.rename(columns=FILE_TABLE_COLUMNS).to_csv(index=False).encode()
+
+
+def options_of(row: Mapping, *, sample_rate_hz: float | None = None) -> AnalysisOptions:
+    """Analysis options of one file's settings row (SI inside: µs and g converted here)."""
+    from ..measure import AnalysisOptions
+
+    def channel(value) -> str | None:
+        return None if value in (None, "", AUTO_CHANNEL, NO_CHANNEL) else str(value)
+
+    def number(value, name: str) -> float:
+        v = float(value) if value not in (None, "") else 0.0
+        if not math.isfinite(v):
+            raise ParameterError(f"{row['file']}: {name} {value!r}, expected a number")
+        return v
+
+    mass_g = number(row["mass below gauge [g]"], "mass below gauge [g]")
+    baseline = number(row["baseline loss factor [-]"], "baseline loss factor [-]")
+    if mass_g < 0 or baseline < 0:
+        raise ParameterError(f"{row['file']}: mass below gauge and baseline loss factor must "
+                             "be >= 0")
+    return AnalysisOptions(
+        force=channel(row["force channel"]), velocity=channel(row["velocity channel"]),
+        acceleration=channel(row["acceleration channel"]),
+        velocity_delay_s=number(row["vibrometer delay [µs]"], "vibrometer delay [µs]") * 1e-6,
+        mass_below_gauge_kg=mass_g * 1e-3, baseline_loss_factor=baseline,
+        sample_rate_hz=sample_rate_hz)
+
+
+# --- results and saving ------------------------------------------------------------------------
+
+#: Columns of the results table, units in the names.
+RESULT_COLUMNS = ("file", "load case", "specimen", "frequency [Hz]", "acceleration [g]",
+                  "loss factor [-]", "SDC [-]", "SDC stderr [-]", "vibrometer delay [µs]",
+                  "force channel", "velocity channel", "warnings")
+
+
+@dataclass(frozen=True)
+class AnalysedFile:
+    """One successfully analysed upload with everything needed to show and save it."""
+
+    record: AnalyzedRecord
+    load_case: LoadCase
+    options: AnalysisOptions
+    specimen: str
+    warnings: tuple = ()
+
+
+def results_table(files: Sequence[AnalysedFile]) -> pd.DataFrame:
+    """One row per analysed file: drive, loss factor, SDC, the corrections used, warnings."""
+    rows = []
+    for f in files:
+        a = f.record.analysis
+        rows.append({
+            "file": Path(f.record.measurement.source).name, "load case": f.load_case.label(),
+            "specimen": f.specimen, "frequency [Hz]": a.frequency_hz,
+            "acceleration [g]": a.acceleration_g, "loss factor [-]": a.loss_factor,
+            "SDC [-]": a.sdc, "SDC stderr [-]": a.sdc_stderr,
+            "vibrometer delay [µs]": f.options.velocity_delay_s * 1e6,
+            "force channel": f.record.channels_used.get("force", ""),
+            "velocity channel": f.record.channels_used.get("velocity", ""),
+            "warnings": "; ".join(w.check for w in f.warnings),
+        })
+    return pd.DataFrame(rows, columns=list(RESULT_COLUMNS))
+
+
+def format_sdc(sdc: float, stderr: float) -> str:
+    """SDC with its standard error as shown, e.g. ``'0.1856 ± 0.0042'``; ``'—'`` for none."""
+    if not math.isfinite(sdc):
+        return "—"
+    return f"{sdc:.4f} ± {stderr:.4f}" if math.isfinite(stderr) else f"{sdc:.4f}"
+
+
+def save_records(path: str | os.PathLike, files: Sequence[AnalysedFile], *,
+                 confirm_implausible: bool = False) -> list[str]:
+    """Save analysed files with their load cases to the store in one locked transaction.
+
+    Each file's own corrections are its analysis parameters (with its channel mapping); the
+    load case fields and the specimen go into its record. A file with plausibility warnings is
+    only saved with ``confirm_implausible`` (the user's explicit confirmation).
+    """
+    from ..measure import store_analysis
+    from ..store import Store
+
+    if not files:
+        raise ParameterError("nothing to save: no file was analysed successfully")
+    flagged = [Path(f.record.measurement.source).name for f in files if f.warnings]
+    if flagged and not confirm_implausible:
+        raise ParameterError(f"{', '.join(flagged)}: implausible result(s); confirm to save "
+                             "them anyway")
+    store = Store(path)
+    with store.transaction():
+        keys = []
+        for f in files:
+            parameters = replace(f.options, force=None, velocity=None,
+                                 acceleration=None).parameters()
+            fields = f.load_case.as_record("stated in the app")
+            if f.specimen:
+                fields = {**fields, "specimen": f.specimen}
+            if f.warnings:
+                fields = {**fields, "plausibility_warnings": "; ".join(str(w)
+                                                                       for w in f.warnings)}
+            keys.append(store_analysis(store, f.record, parameters, fields=fields))
+        return keys

@@ -1,0 +1,102 @@
+"""What the Compare page shows, assembled from records and stores (no Streamlit here).
+
+Records come from this session's uploads and from every saved analysis of the store
+(:func:`pidcore.store.listing.saved_analyses`), so a reload or another session sees them.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from pathlib import Path
+
+import pandas as pd
+
+from ..compare.case import (
+    CaseComparison,
+    MeasuredEntry,
+    compare_case,
+    group_load_cases,
+    headline,
+    sdc_points,
+)
+from ..signal.loops import LoopCurve, dem_loop_from_arrays, loop_frame
+
+
+def saved_entries(path: str | os.PathLike, rows: pd.DataFrame) -> list[MeasuredEntry]:
+    """Entries of the saved analyses ``rows`` (from :func:`pidcore.store.listing.saved_analyses`),
+    with their harmonic phasors read from the store."""
+    from ..store import Store
+
+    if rows.empty:
+        return []
+    store = Store(path)
+    return [MeasuredEntry.from_store(row, store.get_analysis(str(row["key"])).arrays)
+            for _, row in rows.iterrows()]
+
+
+def group_entries(entries: Sequence[MeasuredEntry]) -> list[list[int]]:
+    """Indices of ``entries`` grouped by load case (and specimen: specimens are never pooled)."""
+    out: list[list[int]] = []
+    by_specimen: dict[str, list[int]] = {}
+    for i, e in enumerate(entries):
+        by_specimen.setdefault(e.specimen, []).append(i)
+    for members in by_specimen.values():
+        for group in group_load_cases([entries[i].load_case for i in members]):
+            out.append([members[j] for j in group])
+    return out
+
+
+def group_label(entries: Sequence[MeasuredEntry], group: Sequence[int]) -> str:
+    """E.g. ``'500 Hz, 5 g, 50 %, acrylic, z, specimen A (2 file(s))'``."""
+    e = entries[group[0]]
+    specimen = f", specimen {e.specimen}" if e.specimen else ""
+    return (f"{e.load_case.label()}, {e.load_case.material}, {e.load_case.direction}{specimen} "
+            f"({len(group)} file(s))")
+
+
+def dem_loop(paths: Sequence[str | os.PathLike | None],
+             comparison: CaseComparison) -> LoopCurve | str | None:
+    """Our DEM's loop at the comparison's grid case (first store that holds the run), a note
+    why it cannot be drawn, or None where there is no DEM run at the case."""
+    from ..store import Store
+
+    grid = getattr(comparison.aligned, "grid_case", None)
+    if grid is None or not grid.run_keys:
+        return None
+    key = grid.run_keys[0]
+    for where in paths:
+        if where is not None and Path(where).is_file() and Store(where).has_dem_run(key):
+            entry = Store(where).get_dem_run(key)
+            found = dem_loop_from_arrays(entry.arrays, entry.record)
+            if isinstance(found, str):
+                return f"DEM run {key}: {found}"
+            return LoopCurve(f"our DEM: {key.split('_seed')[0]}", *found)
+    return None
+
+
+def case_view(entries: Sequence[MeasuredEntry], dem_runs: pd.DataFrame | None,
+              paper: pd.DataFrame, store_paths: Sequence[str | os.PathLike | None]) -> dict:
+    """Everything the Compare page draws for one load case, as plain data.
+
+    Keys: ``comparison``, ``headline``, ``sdc_points`` (frame), ``loops`` (frame, SI),
+    ``energies`` (series -> J per cycle), ``spectrum`` (frame of the first record), ``notes``.
+    """
+    comparison = compare_case(entries, dem_runs, paper)
+    notes = list(comparison.notes)
+    loops = []
+    for e in entries:
+        found = e.loop()
+        if isinstance(found, str):
+            notes.append(f"{e.file}: {found}")
+        else:
+            loops.append(found)
+    found = dem_loop(store_paths, comparison)
+    if isinstance(found, str):
+        notes.append(found)
+    elif found is not None:
+        loops.append(found)
+    return {"comparison": comparison, "headline": headline(comparison),
+            "sdc_points": sdc_points(comparison), "loops": loop_frame(loops),
+            "energies": {loop.label: loop.energy_per_cycle_j for loop in loops},
+            "spectrum": entries[0].spectrum(), "notes": notes}

@@ -1,0 +1,420 @@
+"""One load case of measurements beside our DEM, the pchip model and the paper.
+
+The Compare page of the app and its headline come from here; it reads analysed records (fresh
+uploads or records of the store) and the store's DEM runs, never widgets.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+import pandas as pd
+
+from .. import defaults
+from ..errors import ParameterError, PidcoreError
+from .align import Aligner, Tolerances, consistency_chi2, pooled_mean, pooled_sdc_eq10
+from .loadcase import LoadCase, StatedLoadCase
+
+if TYPE_CHECKING:
+    from ..measure import AnalyzedRecord
+
+#: Fill (packing ratio, %) proposed for a file whose name states none (the paper's experiments
+#: were all at 50 %); the user confirms or corrects it.
+PROPOSED_FILL_PERCENT = 50.0
+#: How many standard errors apart measured and DEM may lie and still "agree".
+AGREEMENT_SIGMAS = 2.0
+
+
+def load_case_of(record: AnalyzedRecord, *, fill_percent: float, material: str,
+                 direction: str = defaults.COMPARE_DEFAULT_DIRECTION) -> LoadCase:
+    """Load case of an analysed record: measured frequency and acceleration, stated fill etc."""
+    a = record.analysis
+    return LoadCase(float(a.frequency_hz), float(a.acceleration_g), float(fill_percent),
+                    material, direction)
+
+
+def stated_case(name: str, sidecar: pd.DataFrame | None = None) -> StatedLoadCase:
+    """What the file name and a load-case table state about a file (the table wins).
+
+    Without a stated fill, :data:`PROPOSED_FILL_PERCENT` is proposed and the origin says so.
+    """
+    from .loadcase import SIDECAR_COLUMNS, parse_file_name, resolve_load_case
+
+    table = sidecar if sidecar is not None else pd.DataFrame(columns=list(SIDECAR_COLUMNS))
+    try:
+        return resolve_load_case(Path(Path(name).name), sidecar=table)
+    except PidcoreError:
+        try:  # no fill stated (or a bad table row): keep what the name states, propose a fill
+            found = parse_file_name(Path(name).name)
+        except PidcoreError:
+            found = {}
+        return StatedLoadCase(PROPOSED_FILL_PERCENT,
+                              str(found.get("material", defaults.COMPARE_DEFAULT_MATERIAL)),
+                              str(found.get("direction", defaults.COMPARE_DEFAULT_DIRECTION)),
+                              f"fill: not stated, {PROPOSED_FILL_PERCENT:g} % proposed")
+
+
+def group_load_cases(cases: Sequence[LoadCase]) -> list[list[int]]:
+    """Indices of ``cases`` grouped into one load case each (within :class:`Tolerances`)."""
+    tol = Tolerances()
+    groups: list[list[int]] = []
+    for i, case in enumerate(cases):
+        for members in groups:
+            if tol.matches(case, cases[members[0]]):
+                members.append(i)
+                break
+        else:
+            groups.append([i])
+    return groups
+
+
+def paper_table() -> pd.DataFrame:
+    """The paper's Table 3 (:func:`pidcore.model.load_paper_table3`)."""
+    from ..model import load_paper_table3
+
+    return load_paper_table3()
+
+
+@dataclass(frozen=True)
+class CaseComparison:
+    """Everything shown for one load case.
+
+    Attributes
+    ----------
+    load_case : LoadCase
+        Mean measured frequency [Hz] and acceleration [g] of the records, stated fill,
+        material and direction.
+    measured : pandas.DataFrame
+        One row per record: ``file``, ``fill [%]``, ``SDC [-]``, ``SDC stderr [-]`` (Eq. 11) and,
+        with a DEM m_c, ``SDC, E of Eq. 10 [-]``.
+    measured_sdc, measured_stderr : float
+        Eq. 11 SDC of the records pooled (:func:`pidcore.compare.pooled_mean`), [-].
+    aligned : AlignedCase
+        Our DEM (grid value or pchip interpolation) and the paper's values at the case.
+    dem_points : pandas.DataFrame
+        Our DEM cases at this frequency, acceleration, material and direction, every fill:
+        ``fill [%]``, ``SDC [-]``, ``SDC stderr [-]``, ``runs [-]``.
+    paper_points : pandas.DataFrame
+        Table 3 rows at this frequency and acceleration.
+    model_fill_percent, model_sdc : numpy.ndarray
+        The pchip model over Table 3 (DEM) along fill at this case (empty outside its range).
+    measured_sdc_eq10, measured_stderr_eq10 : float
+        Energy per cycle over the DEM case's ``E = m_c a^2 / (2 w^2)`` (Eq. 10), pooled: the
+        like-for-like counterpart of our DEM SDC. NaN without a DEM case that knows ``m_c``.
+    chi2_dof : float
+        Consistency of the pooled records (:func:`pidcore.compare.align.consistency_chi2`), per
+        degree of freedom; NaN for one record.
+    notes : tuple of str
+        What was adjusted or left out (a model evaluated at the edge of its range, ...).
+    """
+
+    load_case: LoadCase
+    measured: pd.DataFrame
+    measured_sdc: float
+    measured_stderr: float
+    aligned: object
+    dem_points: pd.DataFrame
+    paper_points: pd.DataFrame
+    model_fill_percent: np.ndarray
+    model_sdc: np.ndarray
+    measured_sdc_eq10: float = math.nan
+    measured_stderr_eq10: float = math.nan
+    chi2_dof: float = math.nan
+    notes: tuple[str, ...] = ()
+
+
+def _model_point(model, tol: Tolerances, acceleration_g: float,
+                 frequency_hz: float) -> tuple[float, float, str] | None:
+    """(acceleration, frequency) to evaluate the model at: the case itself, or the nearest edge
+    of the model's range where the case lies outside it by no more than the grid-match
+    tolerance (49.999998 Hz is the 50 Hz case). None where it lies further out."""
+    a_lo, a_hi = model.bounds["acceleration_g"]
+    f_lo, f_hi = model.bounds["frequency_hz"]
+    a = min(max(acceleration_g, a_lo), a_hi)
+    f = min(max(frequency_hz, f_lo), f_hi)
+    if abs(a - acceleration_g) > tol.acceleration_rtol * a \
+            or abs(f - frequency_hz) > tol.frequency_rtol * f:
+        return None
+    note = ""
+    if (a, f) != (acceleration_g, frequency_hz):
+        note = (f"model drawn at {f:.6g} Hz, {a:.4g} g: the case ({frequency_hz:.8g} Hz, "
+                f"{acceleration_g:.6g} g) lies at the edge of its range, within the grid "
+                "tolerance")
+    return a, f, note
+
+
+@dataclass(frozen=True)
+class MeasuredEntry:
+    """One analysed measurement with its load case, from an upload or from the store.
+
+    Attributes
+    ----------
+    key : str
+        Store analysis key, or ``"upload:<sha256>"`` for an unsaved upload.
+    file : str
+        The measurement's file name.
+    origin : str
+        ``"store"`` or ``"this session (unsaved)"``.
+    load_case : LoadCase
+    frequency_hz, acceleration_m_s2 : float
+        Measured drive, Hz and m/s^2.
+    loss_factor, sdc, sdc_stderr : float
+        Eq. 11 results, [-].
+    energy_per_cycle_j : float
+        Energy dissipated per cycle, J.
+    harmonics, force_phasors_n, velocity_phasors_m_s : numpy.ndarray
+        Fitted harmonics (for the loop and the spectrum).
+    specimen, created_utc : str
+        Specimen named with the record (may be empty) and when it was saved.
+    """
+
+    key: str
+    file: str
+    origin: str
+    load_case: LoadCase
+    frequency_hz: float
+    acceleration_m_s2: float
+    loss_factor: float
+    sdc: float
+    sdc_stderr: float
+    energy_per_cycle_j: float
+    harmonics: np.ndarray
+    force_phasors_n: np.ndarray
+    velocity_phasors_m_s: np.ndarray
+    specimen: str = ""
+    created_utc: str = ""
+
+    @classmethod
+    def from_record(cls, record: AnalyzedRecord, load_case: LoadCase, *,
+                    specimen: str = "") -> MeasuredEntry:
+        """Entry of a fresh (unsaved) analysis."""
+        a = record.analysis
+        return cls(f"upload:{record.measurement.sha256}", Path(record.measurement.source).name,
+                   "this session (unsaved)", load_case, float(a.frequency_hz),
+                   float(a.acceleration_amplitude_m_s2), float(a.loss_factor), float(a.sdc),
+                   float(a.sdc_stderr), float(a.energy_per_cycle_j),
+                   np.asarray(a.harmonics), np.asarray(a.force_phasors_n),
+                   np.asarray(a.velocity_phasors_m_s), specimen)
+
+    @classmethod
+    def from_store(cls, row: pd.Series, arrays: dict) -> MeasuredEntry:
+        """Entry of a saved analysis: a row of :func:`pidcore.store.listing.saved_analyses`
+        and the entry's arrays (:meth:`pidcore.store.Store.get_analysis`)."""
+        from .align import _row_case
+
+        empty = np.empty(0)
+        return cls(str(row["key"]), Path(str(row.get("source", ""))).name, "store",
+                   _row_case(row), float(row["frequency_hz"]),
+                   float(row.get("acceleration_m_s2", math.nan)),
+                   float(row.get("loss_factor", math.nan)), float(row["sdc"]),
+                   float(row["sdc_stderr"]), float(row.get("energy_per_cycle_j", math.nan)),
+                   np.asarray(arrays.get("harmonics", empty)),
+                   np.asarray(arrays.get("force_phasors_n", empty)),
+                   np.asarray(arrays.get("velocity_phasors_m_s", empty)),
+                   str(row.get("specimen", "") or ""), str(row.get("created_utc", "")))
+
+    def loop(self):
+        """The measured loop (:class:`pidcore.signal.loops.LoopCurve`), or a note why none."""
+        from ..signal.loops import LoopCurve, loop_from_phasors
+
+        found = loop_from_phasors({"harmonics": self.harmonics,
+                                   "force_phasors_n": self.force_phasors_n,
+                                   "velocity_phasors_m_s": self.velocity_phasors_m_s},
+                                  self.frequency_hz)
+        if isinstance(found, str):
+            return found
+        return LoopCurve(f"measured: {self.file}", *found)
+
+    def spectrum(self) -> pd.DataFrame:
+        """Amplitudes of the fitted force and velocity harmonics (units in the columns)."""
+        h = np.asarray(self.harmonics, dtype=float)
+        return pd.DataFrame({
+            "harmonic [-]": h.astype(int),
+            "frequency [Hz]": h * self.frequency_hz,
+            "force amplitude [N]": np.abs(np.asarray(self.force_phasors_n)),
+            "velocity amplitude [m/s]": np.abs(np.asarray(self.velocity_phasors_m_s)),
+        })
+
+
+def compare_case(records: Sequence[MeasuredEntry],
+                 dem_runs: pd.DataFrame | None, paper: pd.DataFrame, *,
+                 model_points: int = 121) -> CaseComparison:
+    """Measured SDC of one load case next to our DEM, the pchip model and the paper.
+
+    Parameters
+    ----------
+    records : sequence of MeasuredEntry
+        The records of one load case (see :func:`group_load_cases`); at least one.
+    dem_runs : pandas.DataFrame or None
+        :meth:`pidcore.store.Store.list_dem_runs` (may be empty).
+    paper : pandas.DataFrame
+        Table 3 (:func:`pidcore.model.load_paper_table3`).
+    model_points : int
+        Points on the model curve.
+    """
+    from ..model import SdcModel
+    from .align import PAPER_DIRECTION, PAPER_MATERIAL
+
+    if not records:
+        raise ParameterError("compare_case: no records given")
+    first = records[0].load_case
+    case = LoadCase(float(np.mean([r.load_case.frequency_hz for r in records])),
+                    float(np.mean([r.load_case.acceleration_g for r in records])),
+                    first.fill_percent, first.material, first.direction)
+    measured = pd.DataFrame({
+        "file": [r.file for r in records],
+        "origin": [r.origin for r in records],
+        "specimen": [r.specimen for r in records],
+        "fill [%]": [r.load_case.fill_percent for r in records],
+        "SDC [-]": [r.sdc for r in records],
+        "SDC stderr [-]": [r.sdc_stderr for r in records],
+    })
+    values = measured["SDC [-]"].to_numpy(float)
+    errors = measured["SDC stderr [-]"].to_numpy(float)
+    sdc, stderr = pooled_mean(values, errors)
+    chi2, dof = consistency_chi2(values, errors)
+    tol = Tolerances()
+    runs = dem_runs if dem_runs is not None and not dem_runs.empty else None
+    aligner = Aligner.from_tables(runs, paper, tolerances=tol)
+    aligned = aligner.align(case)
+    notes: list[str] = []
+
+    dem_rows = []
+    for c in aligner.cases:
+        probe = replace(case, fill_percent=c.load_case.fill_percent)
+        if tol.matches(probe, c.load_case):
+            dem_rows.append({"fill [%]": c.load_case.fill_percent, "SDC [-]": c.sdc,
+                             "SDC stderr [-]": c.sdc_stderr, "runs [-]": c.n_runs,
+                             "settings": c.settings})
+    dem_points = pd.DataFrame(dem_rows, columns=["fill [%]", "SDC [-]", "SDC stderr [-]",
+                                                 "runs [-]", "settings"])
+
+    paper_cols = ["fill [%]", "SDC DEM (paper) [-]", "SDC measured (paper) [-]"]
+    paper_points = pd.DataFrame(columns=paper_cols)
+    model_x = model_y = np.empty(0)
+    if case.material == PAPER_MATERIAL and case.direction == PAPER_DIRECTION:
+        f = paper["frequency_hz"].to_numpy(float)
+        a = paper["acceleration_g"].to_numpy(float)
+        at_case = ((np.abs(f - case.frequency_hz) <= tol.frequency_rtol * f)
+                   & (np.abs(a - case.acceleration_g) <= tol.acceleration_rtol * a))
+        rows = paper[at_case].sort_values("fill_percent")
+        paper_points = pd.DataFrame({
+            "fill [%]": rows["fill_percent"].to_numpy(float),
+            "SDC DEM (paper) [-]": rows["sdc_dem"].to_numpy(float),
+            "SDC measured (paper) [-]": rows["sdc_experimental"].to_numpy(float)})
+        model = SdcModel.from_table(paper, value="sdc_dem", source="paper Table 3 (DEM)")
+        point = _model_point(model, tol, case.acceleration_g, case.frequency_hz)
+        if point is None:
+            notes.append(f"{case.label()} lies outside the range of the paper's pchip model; "
+                         "no model curve (never extrapolated)")
+        else:
+            lo, hi = model.bounds["fill_percent"]
+            model_x = np.linspace(lo, hi, model_points)
+            model_y = np.asarray(model(model_x, point[0], point[1]), dtype=float)
+            if point[2]:
+                notes.append(point[2])
+    grid = getattr(aligned, "grid_case", None)
+    m_c = float(grid.vibrated_mass_kg) if grid is not None else math.nan
+    eq10, sdc10, stderr10 = pooled_sdc_eq10(
+        np.array([r.energy_per_cycle_j for r in records]),
+        np.array([r.acceleration_m_s2 for r in records]),
+        np.array([r.frequency_hz for r in records]), values, errors,
+        vibrated_mass_kg=m_c)
+    if math.isfinite(m_c):
+        measured["SDC, E of Eq. 10 [-]"] = eq10
+    return CaseComparison(case, measured, sdc, stderr, aligned, dem_points, paper_points,
+                          model_x, model_y, sdc10, stderr10, chi2 / dof if dof else math.nan,
+                          tuple(notes))
+
+
+@dataclass(frozen=True)
+class Headline:
+    """The one line per load case: like-for-like measured SDC beside our DEM.
+
+    Attributes
+    ----------
+    measured, measured_stderr : float
+        Measured SDC with the Eq. 10 energy of the DEM case when known (like for like), else
+        the Eq. 11 SDC, [-].
+    measured_kind : str
+        ``"Eq. 10 (DEM m_c)"`` or ``"Eq. 11"``.
+    dem, dem_stderr : float
+        Our DEM SDC (grid or pchip) [-]; NaN when there is none.
+    sigmas : float
+        |measured - DEM| over the combined standard error; NaN when not comparable.
+    verdict : str
+        E.g. ``"agrees within 2 σ (0.8 σ)"``, ``"differs by 5.1 σ"``, ``"no DEM value"``.
+    """
+
+    measured: float
+    measured_stderr: float
+    measured_kind: str
+    dem: float
+    dem_stderr: float
+    sigmas: float
+    verdict: str
+
+
+def headline(comparison: CaseComparison, *, k: float = AGREEMENT_SIGMAS) -> Headline:
+    """Measured (like for like) vs our DEM for one load case, with "agrees within k σ"."""
+    c = comparison
+    if math.isfinite(c.measured_sdc_eq10):
+        m, m_se, kind = c.measured_sdc_eq10, c.measured_stderr_eq10, "Eq. 10 (DEM m_c)"
+    else:
+        m, m_se, kind = c.measured_sdc, c.measured_stderr, "Eq. 11"
+    dem = float(getattr(c.aligned, "sdc_dem", math.nan))
+    dem_se = float(getattr(c.aligned, "sdc_dem_stderr", math.nan))
+    if not math.isfinite(dem):
+        return Headline(m, m_se, kind, dem, dem_se, math.nan, "no DEM value at this case")
+    if kind == "Eq. 11":
+        return Headline(m, m_se, kind, dem, dem_se, math.nan,
+                        "not comparable: the DEM case has no m_c for the Eq. 10 energy")
+    se = math.hypot(m_se if math.isfinite(m_se) else 0.0, dem_se if math.isfinite(dem_se)
+                    else 0.0)
+    if not se > 0:
+        return Headline(m, m_se, kind, dem, dem_se, math.nan, "no standard error to judge by")
+    z = abs(m - dem) / se
+    verdict = (f"agrees within {k:g} σ ({z:.1f} σ)" if z <= k else f"differs by {z:.1f} σ")
+    return Headline(m, m_se, kind, dem, dem_se, z, verdict)
+
+
+#: Series of :func:`sdc_points`, in legend order.
+SDC_SERIES = ("pchip model (paper Table 3 DEM)", "paper DEM", "paper measured",
+              "our DEM (mean ± stderr)", "our DEM (pchip over our runs)", "measured (± stderr)",
+              "measured, E of Eq. 10 (± stderr)")
+
+
+def sdc_points(comparison: CaseComparison) -> pd.DataFrame:
+    """SDC against fill for one load case, one row per point (the chart's data).
+
+    Columns ``series`` (one of :data:`SDC_SERIES`), ``fill [%]``, ``SDC [-]``, ``low [-]`` and
+    ``high [-]`` (value ± standard error; equal to the value where there is no error).
+    """
+    c = comparison
+    parts = []
+
+    def add(series: str, fill, sdc, err=None) -> None:
+        fill = np.asarray(fill, dtype=float)
+        sdc = np.asarray(sdc, dtype=float)
+        err = np.zeros_like(sdc) if err is None else np.nan_to_num(np.asarray(err, float))
+        keep = np.isfinite(sdc)
+        parts.append(pd.DataFrame({"series": series, "fill [%]": fill[keep],
+                                   "SDC [-]": sdc[keep], "low [-]": (sdc - err)[keep],
+                                   "high [-]": (sdc + err)[keep]}))
+
+    add(SDC_SERIES[0], c.model_fill_percent, c.model_sdc)
+    add(SDC_SERIES[1], c.paper_points["fill [%]"], c.paper_points["SDC DEM (paper) [-]"])
+    add(SDC_SERIES[2], c.paper_points["fill [%]"], c.paper_points["SDC measured (paper) [-]"])
+    add(SDC_SERIES[3], c.dem_points["fill [%]"], c.dem_points["SDC [-]"],
+        c.dem_points["SDC stderr [-]"])
+    if getattr(c.aligned, "status", "") == "interpolated":
+        add(SDC_SERIES[4], [c.load_case.fill_percent], [c.aligned.sdc_dem])
+    add(SDC_SERIES[5], [c.load_case.fill_percent], [c.measured_sdc], [c.measured_stderr])
+    add(SDC_SERIES[6], [c.load_case.fill_percent], [c.measured_sdc_eq10],
+        [c.measured_stderr_eq10])
+    return pd.concat(parts, ignore_index=True)

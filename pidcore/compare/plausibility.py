@@ -1,0 +1,93 @@
+"""Plausibility of an Eq. 11 result: the numbers a wrong set-up produces, named with their cause.
+
+A wrong vibrometer delay, an inverted channel or a mass correction larger than the mass give
+numbers that look ordinary in a table (a loss factor of -0.24, an SDC of 19.5). These checks
+read only the analysis (:class:`pidcore.signal.PowerAnalysis`) and return warnings with the
+likely cause; the app shows them on the file's card and asks for confirmation before saving.
+
+The fundamental's complex power ``P = F V* / 2`` of a coupon shaken well below its first
+resonance is mostly reactive and inertial: ``Im P > 0`` (force leads velocity by about 90°)
+and a small positive ``Re P`` (the damping). So:
+
+* ``Re P < 0`` (negative loss factor) is energy *delivered* by the coupon: impossible for a
+  passive damper. A velocity delayed by ``tau`` turns the phase by ``-w tau``; the delay that
+  would make the loss factor zero is reported.
+* ``Im P < 0`` is a force lagging the velocity: a spring, or a channel of inverted sign.
+* An SDC above :data:`SDC_UPPER_BOUND` dissipates more per radian of motion than the coupon
+  stores; no particle damper in the paper comes near (Table 3's largest SDC is 0.88).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+#: SDC above which a result is implausible for a particle damper on a coupon: 2*pi, a loss
+#: factor of 1 (the energy dissipated per radian equals the peak stored energy). Table 3's
+#: largest SDC is 0.88 (DEM) and 0.71 (measured), so this bound only catches gross set-up errors.
+SDC_UPPER_BOUND = 2 * math.pi
+
+
+@dataclass(frozen=True)
+class PlausibilityWarning:
+    """One implausible number, what it probably means, and what to check.
+
+    Attributes
+    ----------
+    check : str
+        ``"negative_loss_factor"``, ``"sdc_above_bound"`` or ``"force_lags_velocity"``.
+    message : str
+        The finding, with the number.
+    likely_cause : str
+        What usually produces it and what to change.
+    """
+
+    check: str
+    message: str
+    likely_cause: str
+
+    def __str__(self) -> str:
+        return f"{self.message}. Likely cause: {self.likely_cause}"
+
+
+def check_analysis(analysis) -> tuple[PlausibilityWarning, ...]:
+    """Plausibility warnings of one Eq. 11 analysis (empty when it looks physical).
+
+    Parameters
+    ----------
+    analysis : PowerAnalysis
+        Needs ``complex_power_w``, ``loss_factor``, ``sdc`` and ``omega_rad_s``.
+    """
+    p = complex(analysis.complex_power_w)
+    eta = float(analysis.loss_factor)
+    sdc = float(analysis.sdc)
+    omega = float(analysis.omega_rad_s)
+    out = []
+    if p.imag < 0:
+        phase = math.degrees(math.atan2(p.imag, p.real))
+        out.append(PlausibilityWarning(
+            "force_lags_velocity",
+            f"force lags velocity (phase of P {phase:.0f}°, a coupon's inertia makes it about "
+            "+90°)",
+            "a force or velocity channel of inverted sign (check the channel mapping and the "
+            "sensor sign), or the wrong channel chosen as force"))
+    if math.isfinite(eta) and eta < 0:
+        cause = ("more energy out than in is impossible for a passive damper: an uncorrected "
+                 "vibrometer output delay, or a mass-below-gauge or baseline correction that "
+                 "is too large")
+        if p.imag > 0 and omega > 0:
+            # a velocity delayed by tau turns P by +w tau; this tau brings Re P to zero
+            tau = -math.atan2(p.real, p.imag) / omega
+            if tau > 0:
+                cause += (f"; a vibrometer delay of about {tau * 1e6:.0f} µs more would bring "
+                          "the loss factor to zero")
+        out.append(PlausibilityWarning("negative_loss_factor",
+                                       f"negative loss factor {eta:.4g} (SDC {sdc:.4g})", cause))
+    if math.isfinite(sdc) and sdc > SDC_UPPER_BOUND:
+        out.append(PlausibilityWarning(
+            "sdc_above_bound",
+            f"SDC {sdc:.4g} is above the physical bound {SDC_UPPER_BOUND:.3g} (loss factor "
+            f"{eta:.3g} > 1)",
+            "a wrong vibrometer delay (a delay too large turns the force-velocity phase and "
+            "inflates Re P), or a mass-below-gauge correction close to the whole moving mass"))
+    return tuple(out)

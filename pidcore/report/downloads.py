@@ -1,0 +1,95 @@
+"""The report of what stores hold, as in-memory files (the app's downloads).
+
+Written by :func:`pidcore.report.write_report` into a temporary folder and read back, so the
+downloads are exactly the files ``pidcore report`` writes.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+
+import pandas as pd
+
+from ..constants import REPORT_FORMATS
+from ..errors import ParameterError
+
+#: MIME type of each report format (:data:`pidcore.constants.REPORT_FORMATS`).
+REPORT_MIME_TYPES: dict[str, str] = {
+    "csv": "text/csv", "md": "text/markdown", "html": "text/html",
+    "tex": "application/x-tex", "pdf": "application/pdf",
+}
+#: Name of the report files offered for download: ``pidcore_report.<format>``.
+DOWNLOAD_STEM = "pidcore_report"
+
+
+def store_report_table(path: str | os.PathLike, dem_store: str | os.PathLike | None = None, *,
+                       analysis_keys: list[str] | None = None,
+                       pool: bool = False) -> pd.DataFrame:
+    """The Table 3-style report table of what the stores hold (empty if they hold nothing).
+
+    Measurements: the newest analysis per measurement and parameters of the store that states
+    a fill (:func:`pidcore.store.listing.saved_analyses`), or only ``analysis_keys``. DEM: the
+    runs of both stores.
+    """
+    from ..compare.case import paper_table
+    from ..store.listing import list_dem_runs, saved_analyses
+    from .table import build_report_table
+
+    analyses = saved_analyses(path)
+    if analysis_keys is not None and not analyses.empty:
+        analyses = analyses[analyses["key"].isin(analysis_keys)]
+    dem_runs = list_dem_runs(path, dem_store)
+    if analyses.empty and dem_runs.empty:
+        return pd.DataFrame()
+    return build_report_table(dem_runs if not dem_runs.empty else None,
+                              analyses if not analyses.empty else None, paper_table(),
+                              pool=pool)
+
+
+def report_files(path: str | os.PathLike, dem_store: str | os.PathLike | None = None, *,
+                 analysis_keys: list[str] | None = None, pool: bool = False,
+                 ) -> dict[str, tuple[str, bytes, str]]:
+    """The report of :func:`store_report_table` as downloads: format -> (file name, bytes,
+    MIME type), plus ``"csv_provenance"`` (the CSV's notes sidecar).
+
+    Stores are verified first: a corrupt store raises :class:`pidcore.errors.StoreError` and
+    nothing is written.
+    """
+    from ..compare import Tolerances
+    from ..store.listing import list_dem_runs
+    from .comparison_figures import plot_sdc_comparison
+    from .pipeline import open_verified_store
+    from .provenance import collect_provenance
+    from .render import write_report
+
+    stores = [Path(p) for p in (path, dem_store) if p is not None and Path(p).is_file()]
+    for p in stores:
+        open_verified_store(p, must_exist=True)
+    table = store_report_table(path, dem_store, analysis_keys=analysis_keys, pool=pool)
+    if table.empty:
+        raise ParameterError("nothing to report: the stores hold no saved analyses with a "
+                             "load case and no DEM runs")
+    tol = Tolerances()
+    runs = list_dem_runs(path, dem_store)
+    seeds = sorted({int(s) for s in runs.get("seed", pd.Series(dtype=float)).dropna()})
+    provenance = collect_provenance(
+        parameters={"frequency_rtol": tol.frequency_rtol,
+                    "acceleration_rtol": tol.acceleration_rtol,
+                    "fill_atol_percent": tol.fill_atol_percent, "pool": pool},
+        seeds=seeds, stores=stores, notes=table.attrs.get("notes", []))
+    figures = {"sdc_per_load_case": plot_sdc_comparison(table)}
+    try:
+        with tempfile.TemporaryDirectory(prefix="pidcore_report_") as folder:
+            paths = write_report(table, figures, provenance, Path(folder) / "report",
+                                 REPORT_FORMATS)
+            out = {fmt: (f"{DOWNLOAD_STEM}.{fmt}", paths[fmt].read_bytes(),
+                         REPORT_MIME_TYPES[fmt]) for fmt in REPORT_FORMATS}
+            sidecar = paths["csv_provenance"]
+            out["csv_provenance"] = (f"{DOWNLOAD_STEM}{sidecar.name[len('report'):]}",
+                                     sidecar.read_bytes(), "text/plain")
+            return out
+    finally:
+        for fig in figures.values():
+            fig.clear()

@@ -1,0 +1,71 @@
+"""Listings across stores for the app and reports: DEM runs of several stores, saved analyses
+with their load cases, filtered.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from .store import Store
+
+#: Columns a saved analysis needs to be placed in a load case.
+LOAD_CASE_FIELDS = ("frequency_hz", "acceleration_g", "fill_percent", "material", "direction")
+
+
+def list_dem_runs(*paths: str | os.PathLike | None) -> pd.DataFrame:
+    """DEM runs of every existing store in ``paths`` (empty where none holds any).
+
+    A run in several stores (same case key) is taken from the first. Column ``store`` says
+    where each run is kept.
+    """
+    frames = []
+    for where in paths:
+        if where is not None and Path(where).is_file():
+            runs = Store(where).list_dem_runs()
+            if not runs.empty:
+                frames.append(runs.assign(store=str(where)))
+    if not frames:
+        return pd.DataFrame()
+    runs = pd.concat(frames, ignore_index=True)
+    return runs.drop_duplicates("case_key", keep="first").reset_index(drop=True)
+
+
+def saved_analyses(path: str | os.PathLike, *, latest_only: bool = True) -> pd.DataFrame:
+    """Analyses of a store that state a load case (a fill), newest first.
+
+    ``latest_only`` keeps the newest analysis of each measurement and set of parameters
+    (re-analysing with other corrections is a separate record). Adds ``file`` (the source's
+    name) and ``date`` (``YYYY-MM-DD`` of ``created_utc``). Empty for a missing store.
+    """
+    if not Path(path).is_file():
+        return pd.DataFrame()
+    analyses = Store(path).list_analyses()
+    if analyses.empty or "fill_percent" not in analyses.columns:
+        return analyses.iloc[0:0]
+    fill = pd.to_numeric(analyses["fill_percent"], errors="coerce")
+    out = analyses[np.isfinite(fill.to_numpy(float))].copy()
+    if latest_only:
+        out = (out.sort_values("created_utc", kind="stable")
+               .groupby(["measurement_key", "parameters_json"], sort=False).tail(1))
+    out["file"] = [Path(str(s)).name for s in out["source"]]
+    out["date"] = out["created_utc"].astype(str).str[:10]
+    if "specimen" not in out.columns:
+        out["specimen"] = ""
+    out["specimen"] = out["specimen"].fillna("").astype(str)
+    return out.sort_values("created_utc", ascending=False, kind="stable").reset_index(drop=True)
+
+
+def filter_analyses(analyses: pd.DataFrame, *, specimens=(), dates=(), files=(),
+                    load_cases=()) -> pd.DataFrame:
+    """Rows of :func:`saved_analyses` whose specimen, date, file and ``load_case`` column are
+    among the values given (an empty choice keeps every row)."""
+    keep = np.ones(len(analyses), dtype=bool)
+    for column, values in (("specimen", specimens), ("date", dates), ("file", files),
+                           ("load_case", load_cases)):
+        if values and column in analyses.columns:
+            keep &= analyses[column].isin(list(values)).to_numpy()
+    return analyses[keep].reset_index(drop=True)
