@@ -1,4 +1,5 @@
-"""pidcore.app_support: the app's logic, tested without Streamlit."""
+"""The app's logic, tested without Streamlit: uploads and per-file settings, stores, the
+comparison of one load case, loops, chart specs, report downloads, DEM jobs."""
 
 from __future__ import annotations
 
@@ -15,8 +16,23 @@ import pandas as pd
 import pytest
 from _app_samples import analytic_sdc, mass_damper_csv
 
-from pidcore import app_support, defaults
+from pidcore import defaults
+from pidcore.app import jobs, stores, uploads
+from pidcore.app.uploads import AnalysedFile
+from pidcore.compare.case import (
+    PROPOSED_FILL_PERCENT,
+    MeasuredEntry,
+    compare_case,
+    group_load_cases,
+    load_case_of,
+    paper_table,
+    sdc_points,
+    stated_case,
+)
 from pidcore.errors import ParameterError
+from pidcore.report.downloads import report_files, store_report_table
+from pidcore.signal.loops import dem_loop_from_arrays, loop_area, loop_frame
+from pidcore.store.listing import list_dem_runs
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -43,38 +59,37 @@ def options():
     ("", "upload"),
 ])
 def test_safe_file_name_keeps_no_folder_and_the_extension(name, expected):
-    assert app_support.safe_file_name(name) == expected
+    assert uploads.safe_file_name(name) == expected
 
 
 def test_upload_size_limit_is_the_configured_one():
     limit = defaults.APP_MAX_UPLOAD_MB * 1024 * 1024
-    app_support.check_upload_size("a.csv", limit)  # exactly at the limit is allowed
+    uploads.check_upload_size("a.csv", limit)  # exactly at the limit is allowed
     with pytest.raises(ParameterError, match=r"a\.csv.*limit of 200 MB"):
-        app_support.check_upload_size("a.csv", limit + 1)
+        uploads.check_upload_size("a.csv", limit + 1)
     with pytest.raises(ParameterError, match="empty"):
-        app_support.check_upload_size("a.csv", 0)
+        uploads.check_upload_size("a.csv", 0)
 
 
 def test_store_path_comes_from_the_environment(tmp_path):
-    assert app_support.store_path({}) == defaults.STORE_PATH
+    assert stores.store_path({}) == defaults.STORE_PATH
     target = tmp_path / "s.h5"
-    assert app_support.store_path({app_support.STORE_ENV_VAR: str(target)}) == target
+    assert stores.store_path({stores.STORE_ENV_VAR: str(target)}) == target
 
 
 def test_parse_upload_names_the_users_file_and_detects_roles(good_csv):
-    parsed = app_support.parse_upload("coupon_fill50.csv", good_csv)
+    parsed = uploads.parse_upload("coupon_fill50.csv", good_csv)
     assert parsed.error is None
     assert parsed.measurement.source == "coupon_fill50.csv"  # not the temporary copy
     assert parsed.sha256 == hashlib.sha256(good_csv).hexdigest()
     assert parsed.channels.force == "Force"
     assert parsed.channels.velocity == "Velocity"
-    assert parsed.channels.options("acceleration")[-1] == app_support.NO_CHANNEL
 
 
 def test_upload_analysis_equals_analyze_file_and_the_analytic_truth(tmp_path, good_csv, options):
     from pidcore.measure import analyze_file
 
-    outcome = app_support.analyze_upload("coupon.csv", good_csv, options)
+    outcome = uploads.analyze_upload("coupon.csv", good_csv, options)
     path = tmp_path / "coupon.csv"
     path.write_bytes(good_csv)
     direct = analyze_file(path, options)
@@ -89,7 +104,7 @@ def test_upload_analysis_equals_analyze_file_and_the_analytic_truth(tmp_path, go
 @pytest.mark.parametrize("data", [b"not,a\nmeasurement\x00\x01", b"\x89HDF\r\n\x1a\ngarbage",
                                   b"    -1\n    58\ngarbage\n"])
 def test_bad_upload_becomes_a_message_naming_the_file(data, options):
-    outcome = app_support.analyze_upload("broken_export.uff", data, options)
+    outcome = uploads.analyze_upload("broken_export.uff", data, options)
     assert not outcome.ok
     assert "broken_export.uff" in outcome.error
     assert "pidcore_upload_" not in outcome.error  # the temporary copy is never shown
@@ -99,31 +114,88 @@ def test_bad_upload_becomes_a_message_naming_the_file(data, options):
 def test_missing_channel_message_points_to_the_selectboxes(options):
     data = b"Time [s],Pressure [Pa]\n" + b"".join(
         f"{i / 1000:.4f},{np.sin(i / 10):.6f}\n".encode() for i in range(2000))
-    outcome = app_support.analyze_upload("mic.csv", data, options)
+    outcome = uploads.analyze_upload("mic.csv", data, options)
     assert not outcome.ok and "mic.csv" in outcome.error
     assert "--force" not in outcome.error and "--velocity" not in outcome.error
+
+
+def _row(name: str, **changes) -> dict:
+    row = uploads.default_settings_row(name, stated_case(name))
+    row.update(changes)
+    return row
 
 
 def test_channel_mapping_is_applied(good_csv, options):
     from pidcore.measure import AnalysisOptions
 
     data = mass_damper_csv(extra_velocity_phase_rad=0.3)
-    default = app_support.analyze_upload("x.csv", data, app_support.role_options(
-        options, force="Force", velocity="Velocity", acceleration=app_support.NO_CHANNEL))
-    moved = app_support.analyze_upload("x.csv", data, app_support.role_options(
-        options, force="Force", velocity="Velocity 2", acceleration=app_support.NO_CHANNEL))
+    default = uploads.analyze_upload("x.csv", data, uploads.options_of(_row(
+        "x.csv", **{"force channel": "Force", "velocity channel": "Velocity",
+                    "acceleration channel": uploads.NO_CHANNEL})))
+    moved = uploads.analyze_upload("x.csv", data, uploads.options_of(_row(
+        "x.csv", **{"velocity channel": "Velocity 2"})))
     assert moved.record.channels_used["velocity"] == "Velocity 2"
     assert moved.record.analysis.sdc != pytest.approx(default.record.analysis.sdc, rel=1e-3)
-    assert app_support.options_from_json(app_support.options_to_json(
+    assert uploads.options_from_json(uploads.options_to_json(
         AnalysisOptions(velocity="Velocity 2"))) == AnalysisOptions(velocity="Velocity 2")
+
+
+def test_per_file_settings_convert_units_and_each_file_keeps_its_own():
+    row = _row("a.csv", **{"vibrometer delay [µs]": 50.0, "mass below gauge [g]": 2.5,
+                           "baseline loss factor [-]": 0.001})
+    o = uploads.options_of(row, sample_rate_hz=1000.0)
+    # µs and g at the edge, SI inside
+    assert (o.velocity_delay_s, o.mass_below_gauge_kg) == (pytest.approx(50e-6),
+                                                           pytest.approx(2.5e-3))
+    assert o.baseline_loss_factor == 0.001 and o.sample_rate_hz == 1000.0
+    assert o.force is None  # "(auto)": the readers' detection
+    with pytest.raises(ParameterError, match="a.csv"):
+        uploads.options_of({**row, "mass below gauge [g]": -1.0})
+
+
+def test_a_settings_table_is_detected_by_its_columns_under_any_name():
+    table_bytes = (b"file,fill_percent,velocity_delay_us,specimen\n"
+                   b"b_fill75.csv,,200,B\n")
+    assert uploads.is_settings_table(table_bytes)
+    assert uploads.is_settings_table(b"file,fill_percent,material,direction\nx.uff,50,,\n")
+    assert not uploads.is_settings_table(mass_damper_csv())
+    assert not uploads.is_settings_table(b"file,notes\nx,y\n")  # no settings column
+    table = uploads.read_settings_table("my setup.csv", table_bytes)
+    names = ["a_fill50.csv", "b_fill75.csv"]
+    settings = uploads.merge_settings(names, [stated_case(n) for n in names], None, [table])
+    a, b = settings.iloc[0], settings.iloc[1]
+    assert (a["fill [%]"], a["vibrometer delay [µs]"], a["specimen"]) == (50.0, 0.0, "")
+    # the table fills b's delay and specimen; its empty fill cell keeps the name's 75 %
+    assert (b["fill [%]"], b["vibrometer delay [µs]"], b["specimen"]) == (75.0, 200.0, "B")
+    # the user's edits survive a later upload; a table uploaded later wins over them
+    edited = settings.copy()
+    edited.loc[0, "vibrometer delay [µs]"] = 50.0
+    again = uploads.merge_settings(names, [stated_case(n) for n in names], edited, [],
+                                   earlier_tables=[table])
+    assert again["vibrometer delay [µs]"].tolist() == [50.0, 200.0]
+    # the template round-trips through the reader
+    back = uploads.read_settings_table("t.csv", uploads.settings_template(again))
+    assert back["vibrometer delay [µs]"].tolist() == [50.0, 200.0]
+    with pytest.raises(ParameterError, match=r"t\.csv, line 2: velocity_delay_us 'x'"):
+        uploads.read_settings_table("t.csv", b"file,velocity_delay_us\na.csv,x\n")
 
 
 # --- load cases, loops, spectrum -----------------------------------------------------------------
 
 def _record(data: bytes, options, name="x.csv"):
-    outcome = app_support.analyze_upload(name, data, options)
+    outcome = uploads.analyze_upload(name, data, options)
     assert outcome.ok, outcome.error
     return outcome.record
+
+
+def _entry(rec, fill=50.0, **kw):
+    return MeasuredEntry.from_record(rec, load_case_of(rec, fill_percent=fill,
+                                                       material="acrylic"), **kw)
+
+
+def _file(rec, options, fill=50.0, specimen=""):
+    return AnalysedFile(rec, load_case_of(rec, fill_percent=fill, material="acrylic"), options,
+                        specimen)
 
 
 def test_load_cases_group_within_the_compare_tolerances(options):
@@ -131,29 +203,29 @@ def test_load_cases_group_within_the_compare_tolerances(options):
     b = _record(mass_damper_csv(frequency_hz=100.0, acceleration_g=5.1, seed=2), options)
     c = _record(mass_damper_csv(frequency_hz=500.0, acceleration_g=5.0, sample_rate_hz=20000),
                 options)
-    cases = [app_support.load_case_of(a, fill_percent=50, material="acrylic"),
-             app_support.load_case_of(b, fill_percent=50, material="acrylic"),
-             app_support.load_case_of(a, fill_percent=75, material="acrylic"),
-             app_support.load_case_of(c, fill_percent=50, material="acrylic")]
+    cases = [load_case_of(a, fill_percent=50, material="acrylic"),
+             load_case_of(b, fill_percent=50, material="acrylic"),
+             load_case_of(a, fill_percent=75, material="acrylic"),
+             load_case_of(c, fill_percent=50, material="acrylic")]
     # 5.0 and 5.1 g are 2 % apart (< 5 % acceleration tolerance): one case.
-    assert app_support.group_load_cases(cases) == [[0, 1], [2], [3]]
+    assert group_load_cases(cases) == [[0, 1], [2], [3]]
 
 
 def test_loop_area_is_the_analytic_ellipse_area():
     theta = np.linspace(0, 2 * np.pi, 4000, endpoint=False)
     x, f = 2.0 * np.cos(theta), 3.0 * np.sin(theta)
     # The ellipse x = a cos, y = b sin has area pi a b (counter-clockwise: positive).
-    assert app_support.loop_area(x, f) == pytest.approx(math.pi * 6.0, rel=1e-6)
-    assert app_support.loop_area(x[::-1], f[::-1]) == pytest.approx(-math.pi * 6.0, rel=1e-6)
+    assert loop_area(x, f) == pytest.approx(math.pi * 6.0, rel=1e-6)
+    assert loop_area(x[::-1], f[::-1]) == pytest.approx(-math.pi * 6.0, rel=1e-6)
     with pytest.raises(ParameterError):
-        app_support.loop_area(x, f[:-1])
+        loop_area(x, f[:-1])
 
 
 def test_measured_loop_area_is_the_dissipated_energy(good_csv, options):
     from _app_samples import MASS_KG, damper_for
 
     rec = _record(good_csv, options)
-    loop = app_support.measured_loop(rec)
+    loop = _entry(rec).loop()
     w = 2 * math.pi * rec.analysis.frequency_hz
     x_amp = rec.analysis.velocity_amplitude_m_s / w
     c = damper_for(0.05, 100.0)
@@ -165,7 +237,7 @@ def test_measured_loop_area_is_the_dissipated_energy(good_csv, options):
 
 def test_spectrum_table_holds_the_fitted_phasor_amplitudes(good_csv, options):
     rec = _record(good_csv, options)
-    table = app_support.spectrum_table(rec)
+    table = _entry(rec).spectrum()
     a = rec.analysis
     np.testing.assert_array_equal(table["force amplitude [N]"], np.abs(a.force_phasors_n))
     np.testing.assert_array_equal(table["velocity amplitude [m/s]"],
@@ -182,13 +254,12 @@ def test_compare_case_on_the_paper_grid(good_csv, options):
 
     paper = load_paper_table3()
     rec = _record(good_csv, options)
-    case = app_support.load_case_of(rec, fill_percent=50, material="acrylic")
     dem_runs = pd.DataFrame({
         "case_key": ["r1", "r2", "r3"], "frequency_hz": [100.0, 100.0, 100.0],
         "acceleration_g": [5.0, 5.0, 5.0], "fill_percent": [50.0, 50.0, 75.0],
         "material": ["acrylic"] * 3, "direction": ["z"] * 3,
         "sdc": [0.20, 0.22, 0.30], "sdc_stderr": [0.01, 0.01, 0.02]})
-    comp = app_support.compare_case([(rec, case)], dem_runs, paper)
+    comp = compare_case([_entry(rec)], dem_runs, paper)
     # One record: pooled values are the record's own.
     assert comp.measured_sdc == rec.analysis.sdc
     assert comp.measured_stderr == rec.analysis.sdc_stderr
@@ -212,13 +283,12 @@ def test_chart_data_hold_every_series_with_their_errors(good_csv, options):
     from pidcore.model import load_paper_table3
 
     rec = _record(good_csv, options)
-    case = app_support.load_case_of(rec, fill_percent=50, material="acrylic")
     dem_runs = pd.DataFrame({
         "case_key": ["r1"], "frequency_hz": [100.0], "acceleration_g": [5.0],
         "fill_percent": [25.0], "material": ["acrylic"], "direction": ["z"],
         "sdc": [0.15], "sdc_stderr": [0.02]})
-    comp = app_support.compare_case([(rec, case)], dem_runs, load_paper_table3())
-    data = app_support.sdc_chart_data(comp)
+    comp = compare_case([_entry(rec)], dem_runs, load_paper_table3())
+    data = sdc_points(comp)
     by = {name: g for name, g in data.groupby("series")}
     measured = by["measured (± stderr)"].iloc[0]
     a = rec.analysis
@@ -231,12 +301,12 @@ def test_chart_data_hold_every_series_with_their_errors(good_csv, options):
     # Only 50 % fill has a measured value in Table 3: NaN rows are left out.
     assert by["paper measured"]["fill [%]"].tolist() == [50.0]
     assert by["paper DEM"]["fill [%]"].tolist() == [25.0, 50.0, 75.0, 90.0]
-    loops = app_support.loop_chart_data([app_support.measured_loop(rec)])
-    # Closed: last point repeats the first; displacement shown in mm.
+    loop = _entry(rec).loop()
+    loops = loop_frame([loop])
+    # Closed: last point repeats the first; SI units (the chart converts to µm).
     assert loops.iloc[0]["force [N]"] == loops.iloc[-1]["force [N]"]
-    loop = app_support.measured_loop(rec)
-    assert loops["displacement [mm]"].iloc[1] == pytest.approx(loop.displacement_m[1] * 1e3)
-    assert f"{loop.energy_per_cycle_j:.3e} J/cycle" in loops["series"].iloc[0]
+    assert loops["displacement [m]"].iloc[1] == loop.displacement_m[1]
+    assert loops["series"].iloc[0] == f"measured: {Path(rec.measurement.source).name}"
 
 
 # --- store -------------------------------------------------------------------------------------
@@ -245,15 +315,15 @@ def test_save_writes_the_load_case_and_the_report_reads_it(tmp_path, good_csv, o
     from pidcore.store import Store
 
     rec = _record(good_csv, options, name="coupon_fill50.csv")
-    case = app_support.load_case_of(rec, fill_percent=50, material="acrylic")
     store_file = tmp_path / "store.h5"
-    keys = app_support.save_records(store_file, [(rec, case)], options)
+    keys = uploads.save_records(store_file, [_file(rec, options, specimen="S1")])
     listed = Store(store_file).list_analyses()
     assert listed["key"].tolist() == keys
     row = listed.iloc[0]
     assert row["sdc"] == rec.analysis.sdc
     assert (row["fill_percent"], row["material"], row["direction"]) == (50.0, "acrylic", "z")
-    table = app_support.report_table(store_file)
+    assert row["specimen"] == "S1"
+    table = store_report_table(store_file)
     assert table["SDC measured [-]"].tolist() == [rec.analysis.sdc]
     assert table["SDC DEM (paper) [-]"].tolist() == [0.1891]
 
@@ -267,8 +337,7 @@ def test_two_sessions_saving_at_once_keep_the_store_whole(tmp_path, options):
         recs = []
         for j in range(3):
             rec = _record(mass_damper_csv(seed=10 * i + j), options, name=f"s{i}_{j}.csv")
-            recs.append((rec, app_support.load_case_of(rec, fill_percent=50,
-                                                       material="acrylic")))
+            recs.append(_file(rec, options))
         batches.append(recs)
     barrier = threading.Barrier(2)
     errors = []
@@ -276,7 +345,7 @@ def test_two_sessions_saving_at_once_keep_the_store_whole(tmp_path, options):
     def save(batch):
         try:
             barrier.wait()
-            app_support.save_records(store_file, batch, options)
+            uploads.save_records(store_file, batch)
         except Exception as exc:  # noqa: BLE001 - reported below
             errors.append(exc)
 
@@ -295,16 +364,17 @@ def test_two_sessions_saving_at_once_keep_the_store_whole(tmp_path, options):
 
 def test_report_downloads_hold_the_saved_numbers(tmp_path, good_csv, options):
     rec = _record(good_csv, options, name="coupon.csv")
-    case = app_support.load_case_of(rec, fill_percent=50, material="acrylic")
     store_file = tmp_path / "store.h5"
-    app_support.save_records(store_file, [(rec, case)], options)
-    files = app_support.report_files(store_file)
-    assert set(files) == {"csv", "html", "tex", "pdf"}
+    uploads.save_records(store_file, [_file(rec, options)])
+    files = report_files(store_file)
+    assert set(files) == {"csv", "md", "html", "tex", "pdf", "csv_provenance"}
     name, data, mime = files["pdf"]
     assert name.endswith(".pdf") and data.startswith(b"%PDF") and mime == "application/pdf"
     import io
 
-    table = pd.read_csv(io.BytesIO(files["csv"][1]), comment="#")
+    # a plain read_csv reads exactly the table: no footer lines
+    table = pd.read_csv(io.BytesIO(files["csv"][1]))
+    assert len(table) == 1 and b"sha256" in files["csv_provenance"][1]
     assert table["SDC measured [-]"].iloc[0] == pytest.approx(rec.analysis.sdc, rel=1e-9)
     assert b"<table" in files["html"][1]
     assert b"\\begin{" in files["tex"][1]
@@ -312,16 +382,18 @@ def test_report_downloads_hold_the_saved_numbers(tmp_path, good_csv, options):
 
 # --- launching ---------------------------------------------------------------------------------
 
-@pytest.mark.parametrize("folder", [REPO, REPO / "app"])
-def test_streamlit_config_matches_the_defaults(folder):
-    config = tomllib.loads((folder / ".streamlit" / "config.toml").read_text())
+def test_one_streamlit_config_matching_the_defaults():
+    found = sorted(p.relative_to(REPO) for p in REPO.rglob("config.toml")
+                   if p.parent.name == ".streamlit")
+    assert found == [Path(".streamlit/config.toml")]
+    config = tomllib.loads((REPO / ".streamlit" / "config.toml").read_text())
     assert config["server"]["maxUploadSize"] == defaults.APP_MAX_UPLOAD_MB
     assert config["browser"]["gatherUsageStats"] is False
 
 
 def test_app_command_serves_the_packaged_entry_on_localhost(tmp_path):
     import pidcore
-    from pidcore._app import ENTRY_SCRIPT
+    from pidcore.app import ENTRY_SCRIPT
     from pidcore.cli.app import app_environment, streamlit_command
 
     cmd = streamlit_command(8765, python="python")
@@ -339,50 +411,99 @@ def test_app_command_serves_the_packaged_entry_on_localhost(tmp_path):
     with pytest.raises(ParameterError, match="port"):
         streamlit_command(70000)
     env = app_environment(Path("rel.h5"), environ={})
-    assert Path(env[app_support.STORE_ENV_VAR]).is_absolute()
+    assert Path(env[stores.STORE_ENV_VAR]).is_absolute()
     assert env["STREAMLIT_BROWSER_GATHER_USAGE_STATS"] == "false"
-    assert app_support.DEM_STORE_ENV_VAR not in env
+    assert stores.DEM_STORE_ENV_VAR not in env
     with pytest.raises(ParameterError, match="dem-store"):
         app_environment(Path("rel.h5"), tmp_path / "missing.h5", environ={})
     # The repository shim runs the packaged app.
     shim = (REPO / "app" / "pidcore_app.py").read_text()
-    assert "from pidcore._app.ui import main" in shim
+    assert "from pidcore.app.main import main" in shim
 
 
 # --- DEM from the app ----------------------------------------------------------------------------
 
 def test_dem_sweep_plan_is_the_product_and_is_kept_small():
-    cases = app_support.plan_dem_cases([100.0, 50.0], [5.0], [75.0, 25.0], material="acrylic",
+    cases = jobs.plan_dem_cases([100.0, 50.0], [5.0], [75.0, 25.0], material="acrylic",
                                        direction="z")
     assert [(c.frequency_hz, c.fill_percent) for c in cases] == [
         (50.0, 25.0), (50.0, 75.0), (100.0, 25.0), (100.0, 75.0)]
     with pytest.raises(ParameterError, match="at least one"):
-        app_support.plan_dem_cases([], [5.0], [50.0], material="acrylic", direction="z")
+        jobs.plan_dem_cases([], [5.0], [50.0], material="acrylic", direction="z")
     with pytest.raises(ParameterError, match="at most"):
-        app_support.plan_dem_cases([50, 100, 500], [1, 5, 10], [25, 50], material="acrylic",
+        jobs.plan_dem_cases([50, 100, 500], [1, 5, 10], [25, 50], material="acrylic",
                                    direction="z")
 
 
-def test_dem_case_is_saved_and_its_loop_area_is_the_shaker_work(tmp_path):
+def _wait(runner, timeout_s: float = 300.0) -> None:
+    import time
+
+    deadline = time.monotonic() + timeout_s
+    while runner.busy():
+        assert time.monotonic() < deadline, [j.row() for j in runner.jobs()]
+        time.sleep(0.1)
+
+
+def test_dem_job_is_saved_once_and_its_loop_area_is_the_shaker_work(tmp_path):
     from pidcore.dem import DemConfig, simulate_load_case
     from pidcore.store import Store
 
     store_file = tmp_path / "dem.h5"
-    (case,) = app_support.plan_dem_cases([100.0], [5.0], [50.0], material="acrylic",
-                                         direction="z")
+    (case,) = jobs.plan_dem_cases([100.0], [5.0], [50.0], material="acrylic", direction="z")
     config = DemConfig(cells=2, steady_cycles=20)
-    assert not app_support.dem_run_stored(store_file, case, config)
-    key = app_support.run_dem_case(store_file, case, config)
-    assert app_support.dem_run_stored(store_file, case, config)
-    entry = Store(store_file).get_dem_run(key)
+    runner = jobs.DemJobRunner(store_file)
+    first = runner.submit([case], config)
+    again = runner.submit([case], config)  # a rerun's second click: not queued twice
+    assert len(first) == 1 and again == []
+    _wait(runner)
+    (job,) = runner.jobs()
+    assert job.state == "saved", job.message
+    assert job.cycles_done == job.cycles_expected > 0 and job.fraction() == 1.0
+    # already in the store: a later submission is recorded but not run
+    (later,) = runner.submit([case], config)
+    assert later.state == "in store"
+    entry = Store(store_file).get_dem_run(job.run_key)
+    assert len(Store(store_file).list_dem_runs()) == 1
     # Deterministic (seeded): the stored SDC is the simulation's.
     assert entry.record["sdc"] == simulate_load_case(case, config).sdc
-    loop = app_support.dem_loop(entry)
-    assert not isinstance(loop, str), loop
+    x, f = dem_loop_from_arrays(entry.arrays, entry.record)
     # With a sine drive only the fundamental carries power, so the loop's area is the shaker's
     # work per steady cycle: the dissipated energy per cycle up to the change of stored
     # mechanical energy over 20 cycles of 2 cells (a few percent), hence 5 %.
-    assert loop.energy_per_cycle_j == pytest.approx(entry.record["energy_per_cycle_j"], rel=5e-2)
+    assert abs(loop_area(x, f)) == pytest.approx(entry.record["energy_per_cycle_j"], rel=5e-2)
+
+
+def test_cancel_stops_a_running_dem_case_within_two_seconds_and_saves_nothing(tmp_path):
+    import time
+
+    from pidcore.dem import DemConfig
+    from pidcore.store import Store
+
+    store_file = tmp_path / "dem.h5"
+    runner = jobs.DemJobRunner(store_file)
+    cases = jobs.plan_dem_cases([50.0], [5.0], [50.0, 75.0], material="acrylic",
+                                direction="z")
+    # long enough to be running when cancelled (thousands of steady cycles)
+    runner.submit(cases, DemConfig(cells=4, steady_cycles=5000))
+    deadline = time.monotonic() + 120
+    while not any(j.state == "running" and j.cycles_done > 0 for j in runner.jobs()):
+        assert time.monotonic() < deadline
+        time.sleep(0.05)
+    t0 = time.monotonic()
+    assert runner.cancel() == 2
+    while runner.busy():
+        assert time.monotonic() - t0 < 2.0, "cancel took longer than 2 s"
+        time.sleep(0.02)
+    assert [j.state for j in runner.jobs()] == ["cancelled", "cancelled"]
+    assert not store_file.exists() or Store(store_file).list_dem_runs().empty
+
+
+def test_dem_values_are_any_positive_numbers():
+    assert jobs.parse_values("50, 123.5;7", name="f") == [50.0, 123.5, 7.0]
+    with pytest.raises(ParameterError, match="f: 'x' is not a number"):
+        jobs.parse_values("50 x", name="f")
+    with pytest.raises(ParameterError, match="positive"):
+        jobs.parse_values("-5", name="f")
 
 
 def test_pidcore_app_serves_on_localhost_until_stopped(tmp_path):
@@ -433,72 +554,58 @@ def test_reference_dem_store_joins_the_app_store_read_only(tmp_path, good_csv, o
     Store(ref_file).add_dem_run("ref_only", _dem_record(0.30, fill=75.0))
     Store(app_file).add_dem_run("shared", _dem_record(0.20))
     ref_bytes = ref_file.read_bytes()
-    runs = app_support.list_dem_runs(app_file, ref_file).set_index("case_key")
+    runs = list_dem_runs(app_file, ref_file).set_index("case_key")
     # A key in both comes from the app store; the reference adds its other runs.
     assert runs.loc["shared", "sdc"] == 0.20 and runs.loc["shared", "store"] == str(app_file)
     assert runs.loc["ref_only", "store"] == str(ref_file)
-    assert app_support.list_dem_runs(tmp_path / "none.h5").empty
+    assert list_dem_runs(tmp_path / "none.h5").empty
 
     rec = _record(good_csv, options, name="c.csv")
-    app_support.save_records(app_file, [(rec, app_support.load_case_of(
-        rec, fill_percent=50, material="acrylic"))], options)
-    table = app_support.report_table(app_file, ref_file)
+    uploads.save_records(app_file, [_file(rec, options)])
+    table = store_report_table(app_file, ref_file)
     assert table["packing ratio [%]"].tolist() == [50.0, 75.0]
     assert table["SDC DEM (ours) [-]"].tolist() == [0.20, 0.30]
     assert table["SDC measured [-]"].iloc[0] == rec.analysis.sdc
-    files = app_support.report_files(app_file, ref_file)
+    files = report_files(app_file, ref_file)
     html = files["html"][1].decode()
     assert str(ref_file.name) in html and str(app_file.name) in html  # provenance: both stores
     assert ref_file.read_bytes() == ref_bytes  # never written
 
 
 def test_stores_come_from_the_environment_or_the_bundled_samples(tmp_path):
-    env = {app_support.STORE_ENV_VAR: str(tmp_path / "a.h5")}
-    assert app_support.AppStores.from_environment(env, cwd=tmp_path) == app_support.AppStores(
+    env = {stores.STORE_ENV_VAR: str(tmp_path / "a.h5")}
+    assert stores.AppStores.from_environment(env, cwd=tmp_path) == stores.AppStores(
         tmp_path / "a.h5", None)
-    bundled = tmp_path / app_support.BUNDLED_DEM_STORE
+    bundled = tmp_path / stores.BUNDLED_DEM_STORE
     bundled.parent.mkdir(parents=True)
     bundled.write_bytes(b"")
-    assert app_support.dem_store_path({}, cwd=tmp_path) == bundled
-    named = {app_support.DEM_STORE_ENV_VAR: str(tmp_path / "ref.h5")}
-    assert app_support.dem_store_path(named, cwd=tmp_path) == tmp_path / "ref.h5"
-    stores = app_support.AppStores(tmp_path / "a.h5", bundled)
-    before = stores.stamp()
+    assert stores.dem_store_path({}, cwd=tmp_path) == bundled
+    named = {stores.DEM_STORE_ENV_VAR: str(tmp_path / "ref.h5")}
+    assert stores.dem_store_path(named, cwd=tmp_path) == tmp_path / "ref.h5"
+    app_stores = stores.AppStores(tmp_path / "a.h5", bundled)
+    before = app_stores.stamp()
     (tmp_path / "a.h5").write_bytes(b"x")
-    assert stores.stamp() != before  # a rewritten store invalidates cached listings
+    assert app_stores.stamp() != before  # a rewritten store invalidates cached listings
 
 
-def test_load_case_is_proposed_from_name_and_uploaded_sidecar():
-    from pidcore.compare import LoadCaseError
-
-    by_name = app_support.stated_case("run_fill75_aluminum_dirx.csv")
+def test_load_case_is_proposed_from_the_name_or_a_fill_proposed():
+    by_name = stated_case("run_fill75_aluminum_dirx.csv")
     assert (by_name.fill_percent, by_name.material, by_name.direction) == (75.0, "aluminium",
                                                                            "x")
-    sidecar = app_support.read_sidecar_upload(
-        b"file,fill_percent,material,direction\nrun_fill75_aluminum_dirx.csv,90,acrylic,z\n")
-    # The sidecar overrides the file name (as in pidcore report).
-    both = app_support.stated_case("run_fill75_aluminum_dirx.csv", sidecar)
-    assert (both.fill_percent, both.material, both.direction) == (90.0, "acrylic", "z")
-    assert "sidecar" in both.origin
-    unstated = app_support.stated_case("plain.csv", sidecar)
-    assert unstated.fill_percent == app_support.DEFAULT_FILL_PERCENT
+    unstated = stated_case("plain.csv")
+    assert unstated.fill_percent == PROPOSED_FILL_PERCENT
     assert "not stated" in unstated.origin
-    assert app_support.is_sidecar_upload("LoadCases.CSV")
-    with pytest.raises(LoadCaseError, match=r"^loadcases\.csv: .*lacks column 'file'"):
-        app_support.read_sidecar_upload(b"a,b\n1,2\n")
 
 
 def test_chart_specs_are_valid_vega_lite(good_csv, options):
     # The app sends the specs unvalidated (speed); validate them here against the schema.
-    from pidcore._app import charts
+    from pidcore.app import charts
 
     rec = _record(good_csv, options)
-    case = app_support.load_case_of(rec, fill_percent=50, material="acrylic")
-    comp = app_support.compare_case([(rec, case)], None, app_support.paper_table())
-    loops = [app_support.measured_loop(rec)]
-    for chart in (charts.sdc_chart(app_support.sdc_chart_data(comp)),
-                  charts.loop_chart(app_support.loop_chart_data(loops)),
-                  charts.spectrum_chart(app_support.spectrum_table(rec))):
+    comp = compare_case([_entry(rec)], None, paper_table())
+    for chart in (charts.sdc_chart(sdc_points(comp)),
+                  charts.loop_chart(loop_frame([_entry(rec).loop()])),
+                  charts.spectrum_chart(_entry(rec).spectrum())):
         spec = chart.to_dict(validate=True)
         assert spec["$schema"].startswith("https://vega.github.io/schema/vega-lite/")
         # Vega-Lite reads "[" and "." in field names as nested access: none may be used.
@@ -511,13 +618,12 @@ def test_like_for_like_sdc_uses_the_dem_vibrated_mass_as_the_report_does(good_cs
     from pidcore.report.table import MEASURED_EQ10_COLUMN
 
     rec = _record(good_csv, options, name="c.csv")
-    case = app_support.load_case_of(rec, fill_percent=50, material="acrylic")
     dem_runs = pd.DataFrame({
         "case_key": ["r1"], "frequency_hz": [100.0], "acceleration_g": [5.0],
         "fill_percent": [50.0], "material": ["acrylic"], "direction": ["z"],
         "sdc": [0.2], "sdc_stderr": [0.01], "m_c_kg": [0.9]})
-    paper = app_support.paper_table()
-    comp = app_support.compare_case([(rec, case)], dem_runs, paper)
+    paper = paper_table()
+    comp = compare_case([_entry(rec)], dem_runs, paper)
     a = rec.analysis
     w = 2 * math.pi * a.frequency_hz
     e_ref = 0.9 * (a.acceleration_g * 9.80665) ** 2 / (2 * w ** 2)  # Eq. 10 with m_c = 0.9 kg
@@ -532,6 +638,6 @@ def test_like_for_like_sdc_uses_the_dem_vibrated_mass_as_the_report_does(good_cs
     table = build_report_table(dem_runs, analyses, paper)
     assert table[MEASURED_EQ10_COLUMN].iloc[0] == pytest.approx(comp.measured_sdc_eq10,
                                                                  rel=1e-12)
-    series = app_support.sdc_chart_data(comp).groupby("series")
+    series = sdc_points(comp).groupby("series")
     assert series.get_group("measured, E of Eq. 10 (± stderr)")["SDC [-]"].iloc[0] == \
         comp.measured_sdc_eq10
