@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 from _app_samples import mass_damper_csv
 
-from pidcore import app_support
+from pidcore.app import jobs, stores, uploads
 
 pytest.importorskip("streamlit")
 from streamlit.testing.v1 import AppTest  # noqa: E402
@@ -29,10 +29,10 @@ def store_file(tmp_path, monkeypatch):
     st.cache_data.clear()
     st.cache_resource.clear()
     path = tmp_path / "app_store.h5"
-    monkeypatch.setenv(app_support.STORE_ENV_VAR, str(path))
+    monkeypatch.setenv(stores.STORE_ENV_VAR, str(path))
     # No reference DEM store unless a test names one (the bundled samples' store would be
     # picked up from the repository root otherwise).
-    monkeypatch.delenv(app_support.DEM_STORE_ENV_VAR, raising=False)
+    monkeypatch.delenv(stores.DEM_STORE_ENV_VAR, raising=False)
     monkeypatch.chdir(tmp_path)
     yield path
     st.cache_data.clear()
@@ -55,6 +55,14 @@ def _upload(at: AppTest, files: list[tuple[str, bytes]]) -> AppTest:
 
 def _metric(at: AppTest, label: str) -> list[str]:
     return [m.value for m in at.metric if m.label == label]
+
+
+def _wait_for_jobs(store_path, timeout_s: float = 300.0) -> None:
+    deadline = time.monotonic() + timeout_s
+    runner = jobs.runner_for(store_path)
+    while runner.busy():
+        assert time.monotonic() < deadline, [j.row() for j in runner.jobs()]
+        time.sleep(0.1)
 
 
 def _table(at: AppTest, column: str):
@@ -85,8 +93,8 @@ def test_upload_shows_the_library_sdc_and_bad_files_do_not_stop_the_others(store
         path.write_bytes(data)
         expected.append(analyze_file(path, _options()).analysis)
     shown = _metric(at, "SDC ± stderr [-]")
-    assert shown == [app_support.format_sdc(a.sdc, a.sdc_stderr) for a in expected]
-    table = _table(at, "velocity channel")
+    assert shown == [uploads.format_sdc(a.sdc, a.sdc_stderr) for a in expected]
+    table = _table(at, "warnings")
     assert table["file"].tolist() == ["good_fill50.csv", "other_fill50.csv"]
     assert table["SDC [-]"].tolist() == [a.sdc for a in expected]
     assert table["SDC stderr [-]"].tolist() == [a.sdc_stderr for a in expected]
@@ -100,8 +108,6 @@ def test_save_writes_to_the_store_only_when_pressed(store_file):
 
     data = mass_damper_csv()
     at = _upload(_app(), [("coupon_fill75_aluminium.csv", data)])
-    at.number_input(key="delay_us").set_value(0.0)
-    at.run()
     assert not store_file.exists()
     at.button(key="save").click()
     at.run()
@@ -112,61 +118,94 @@ def test_save_writes_to_the_store_only_when_pressed(store_file):
     row = listed.iloc[0]
     # The load case stated in the file name reached the store.
     assert (row["fill_percent"], row["material"]) == (75.0, "aluminium")
-    shown = _table(at, "velocity channel")
+    shown = _table(at, "warnings")
     assert row["sdc"] == shown["SDC [-]"].iloc[0]
 
 
-def test_mapping_and_corrections_change_the_analysis_like_the_library(store_file, tmp_path):
+def test_each_file_is_analysed_with_its_own_corrections_and_mapping(store_file, tmp_path):
+    """Two files of different set-ups (vibrometer delays 0 and 200 µs, another velocity
+    channel) in one session: each equals the library run with its own settings."""
     from pidcore.measure import analyze_file
 
-    data = mass_damper_csv(extra_velocity_phase_rad=0.3)
-    path = tmp_path / "two_velocities.csv"
-    path.write_bytes(data)
-    at = _upload(_app(), [("two_velocities.csv", data)])
-    velocity_box = next(s for s in at.selectbox if s.label == "velocity channel")
-    velocity_box.set_value("Velocity 2")
-    at.number_input(key="baseline_eta").set_value(0.002)
+    a = mass_damper_csv(frequency_hz=100.0)
+    b = mass_damper_csv(frequency_hz=200.0, extra_velocity_phase_rad=0.3, seed=5)
+    settings = (b"file,velocity_delay_us,velocity,baseline_loss_factor\n"
+                b"b_fill50.csv,200,Velocity 2,0.002\n")
+    # files first, the settings table (any name) afterwards: it still applies
+    at = _upload(_app(), [("a_fill50.csv", a), ("b_fill50.csv", b)])
+    at = _upload(at, [("a_fill50.csv", a), ("b_fill50.csv", b), ("setup B.csv", settings)])
+    assert any("setup B.csv: settings of 1 file(s)" in i.value for i in at.info)
+    want = {}
+    for name, data, options in (
+            ("a_fill50.csv", a, _options()),
+            ("b_fill50.csv", b, _options(velocity_delay_s=200e-6, velocity="Velocity 2",
+                                         baseline_loss_factor=0.002))):
+        path = tmp_path / name
+        path.write_bytes(data)
+        want[name] = analyze_file(path, options).analysis.sdc
+    table = _table(at, "warnings")
+    assert table["file"].tolist() == ["a_fill50.csv", "b_fill50.csv"]  # the table is no file
+    assert dict(zip(table["file"], table["SDC [-]"], strict=True)) == pytest.approx(want,
+                                                                                   rel=1e-12)
+    assert table["vibrometer delay [µs]"].tolist() == pytest.approx([0.0, 200.0])
+    assert table["velocity channel"].tolist() == ["Velocity", "Velocity 2"]
+    template = next(b for b in at.get("download_button")
+                    if b.proto.label.startswith("Download these settings"))
+    assert template is not None
+
+
+def test_negative_loss_factor_is_flagged_and_saving_needs_confirmation(store_file):
+    from pidcore.store import Store
+
+    at = _upload(_app(), [("odd_fill50.csv", mass_damper_csv(loss_factor=-0.04))])
+    warnings = [w.value for w in at.warning]
+    assert any("negative loss factor" in w and "Likely cause" in w for w in warnings)
+    at.button(key="save").click()
     at.run()
-    assert not at.exception
-    want = analyze_file(path, _options(velocity="Velocity 2", baseline_loss_factor=0.002,
-                                       force="Force")).analysis
-    table = _table(at, "velocity channel")
-    assert table["velocity channel"].iloc[0] == "Velocity 2"
-    assert table["SDC [-]"].iloc[0] == pytest.approx(want.sdc, rel=1e-12)
+    assert any("confirm" in e.value for e in at.error)
+    assert not store_file.exists()
+    at.checkbox(key="confirm_implausible").check()
+    at.run()
+    at.button(key="save").click()
+    at.run()
+    listed = Store(store_file).list_analyses()
+    assert len(listed) == 1 and "negative loss factor" in listed["plausibility_warnings"].iloc[0]
 
 
-@pytest.fixture
-def analysis_calls(monkeypatch) -> list[str]:
-    """Names of the uploads the app analyses (a spy on app_support.analyze_parsed)."""
+def _dem_store_with_runs(path, runs=(("dem_a", 0.20), ("dem_b", 0.22))):
+    from pidcore.store import Store
+
+    store = Store(path)
+    for key, sdc in runs:
+        store.add_dem_run(key, {"frequency_hz": 100.0, "acceleration_g": 5.0,
+                                "fill_percent": 50.0, "material": "acrylic", "direction": "z",
+                                "sdc": sdc, "sdc_stderr": 0.01, "m_c_kg": 0.3})
+
+
+def _headline(at: AppTest) -> str:
+    return next(m.value for m in at.markdown if m.value.startswith("### measured"))
+
+
+def test_compare_shows_dem_model_and_paper_and_switching_uses_the_cache(store_file,
+                                                                       monkeypatch):
     calls: list[str] = []
-    real = app_support.analyze_parsed
+    real = uploads.analyze_parsed
 
     def counting(parsed, options):
         calls.append(parsed.name)
         return real(parsed, options)
 
-    monkeypatch.setattr(app_support, "analyze_parsed", counting)
-    return calls
-
-
-def test_compare_shows_dem_model_and_paper_and_switching_uses_the_cache(store_file,
-                                                                       analysis_calls):
-    calls = analysis_calls
-    # Our DEM at 100 Hz, 5 g, 50 %: two runs in the store.
-    from pidcore.store import Store
-
-    store = Store(store_file)
-    for key, sdc in (("dem_a", 0.20), ("dem_b", 0.22)):
-        store.add_dem_run(key, {"frequency_hz": 100.0, "acceleration_g": 5.0,
-                                "fill_percent": 50.0, "material": "acrylic", "direction": "z",
-                                "sdc": sdc, "sdc_stderr": 0.01})
+    monkeypatch.setattr(uploads, "analyze_parsed", counting)
+    _dem_store_with_runs(store_file)
     files = [("a_fill50.csv", mass_damper_csv(frequency_hz=100.0, acceleration_g=5.0)),
              ("b_fill90.csv", mass_damper_csv(frequency_hz=100.0, acceleration_g=5.0,
                                               loss_factor=0.08, seed=4))]
     at = _upload(_app(), files)
     assert calls == ["a_fill50.csv", "b_fill90.csv"]
-    assert _metric(at, "SDC our DEM ± stderr [-]") == ["0.2100 ± 0.0100"]
-    assert _metric(at, "SDC paper DEM / measured [-]") == ["0.1891 / 0.2100"]
+    # like for like: measured with the DEM case's m_c (Eq. 10) beside our DEM 0.21 ± 0.01
+    assert "vs our DEM 0.2100 ± 0.0100" in _headline(at)
+    assert "σ" in _headline(at)
+    assert _metric(at, "SDC paper DEM [-]") == ["0.1891"]
     specs = [json.loads(c.proto.spec) for c in at.get("vega_lite_chart")]
     titles = sorted(json.dumps(s.get("title", "")) for s in specs)
     assert len(specs) == 3 and any("loop" in t for t in titles)  # SDC, loop, spectrum
@@ -177,13 +216,13 @@ def test_compare_shows_dem_model_and_paper_and_switching_uses_the_cache(store_fi
         at.run()
         timings.append(time.perf_counter() - start)
         assert not at.exception
-    # Table 3 at 100 Hz, 5 g, 90 %: DEM 0.3190, no measured value.
-    assert _metric(at, "SDC paper DEM / measured [-]") == ["0.1891 / 0.2100"]
     at.selectbox(key="compare_case").set_value(1)
     at.run()
-    assert _metric(at, "SDC paper DEM / measured [-]") == ["0.3190 / nan"]
-    # Switching load cases never re-analyses a file (content-hash cache).
-    assert calls == ["a_fill50.csv", "b_fill90.csv"]
+    # Table 3 at 100 Hz, 5 g, 90 %: DEM 0.3190, no measured value: said, never "nan"
+    assert _metric(at, "SDC paper DEM [-]") == ["0.3190"]
+    assert _metric(at, "SDC paper measured [-]") == ["not a Table 3 case"]
+    assert "vs our DEM none — no DEM value" in _headline(at)
+    assert calls == ["a_fill50.csv", "b_fill90.csv"]  # switching never re-analyses
     ARTIFACTS.mkdir(exist_ok=True)
     (ARTIFACTS / "app_switch_timing.json").write_text(json.dumps(
         {"load_case_switch_s": timings,
@@ -191,12 +230,39 @@ def test_compare_shows_dem_model_and_paper_and_switching_uses_the_cache(store_fi
                  "was warmed in the cache after the upload"}, indent=1))
 
 
-def test_report_tab_shows_the_table_and_offers_downloads(store_file):
+def test_saved_records_are_compared_after_a_reload_and_filtered(store_file):
+    _dem_store_with_runs(store_file)
+    files = [("s1_fill50.csv", mass_damper_csv(frequency_hz=100.0)),
+             ("s2_fill50.csv", mass_damper_csv(frequency_hz=100.0, seed=7))]
+    at = _upload(_app(), files)
+    at.button(key="save").click()
+    at.run()
+    # a new session (a browser reload): no uploads, the store's records are there
+    fresh = _app()
+    labels = fresh.selectbox(key="compare_case").options
+    assert labels == ["100 Hz, 5 g, 50 %, acrylic, z (2 file(s))"]
+    measured = next(d.value for d in fresh.dataframe if "origin" in d.value.columns)
+    assert sorted(measured["file"]) == ["s1_fill50.csv", "s2_fill50.csv"]
+    assert set(measured["origin"]) == {"store"}
+    # pooled files get a consistency check (chi2/dof shown, with a warning above 3)
+    said = " ".join([c.value for c in fresh.caption] + [w.value for w in fresh.warning])
+    assert "χ²/dof" in said and ("2 files pooled" in said or "2 pooled files" in said)
+    fresh.multiselect(key="filter_file").set_value(["s2_fill50.csv"])
+    fresh.run()
+    assert fresh.selectbox(key="compare_case").options == [
+        "100 Hz, 5 g, 50 %, acrylic, z (1 file(s))"]
+
+
+def test_report_tab_shows_the_table_and_offers_clean_downloads(store_file):
+    import io
+
+    import pandas as pd
+
     data = mass_damper_csv()
     at = _upload(_app(), [("coupon_fill50.csv", data)])
     at.button(key="save").click()
     at.run()
-    shown_sdc = _table(at, "velocity channel")["SDC [-]"].iloc[0]
+    shown_sdc = _table(at, "warnings")["SDC [-]"].iloc[0]
     at.run()  # the report tab reads the store written by the previous run
     table = _table(at, "SDC measured [-]")
     assert table["SDC measured [-]"].tolist() == [shown_sdc]
@@ -204,43 +270,82 @@ def test_report_tab_shows_the_table_and_offers_downloads(store_file):
     at.button(key="build_report").click()
     at.run(timeout=RUN_TIMEOUT_S)
     assert not at.exception
-    labels = sorted(b.label for b in at.get("download_button"))
-    assert labels == ["CSV", "HTML", "PDF", "TEX"]
+    labels = sorted(b.label for b in at.get("download_button")
+                    if not b.proto.label.startswith("Download these"))
+    assert labels == ["CSV", "CSV notes", "HTML", "MD", "PDF", "TEX"]
+    from pidcore.report.downloads import report_files
+
+    files = report_files(store_file)
+    back = pd.read_csv(io.BytesIO(files["csv"][1]))
+    assert len(back) == 1 and back["SDC measured [-]"].iloc[0] == shown_sdc
 
 
-def test_dem_tab_runs_saves_and_the_compare_tab_uses_the_run(store_file):
+def test_dem_tab_runs_in_the_background_and_the_compare_tab_uses_the_run(store_file):
     from pidcore.dem import DemConfig, LoadCase, simulate_load_case
     from pidcore.store import Store
 
     at = _upload(_app(), [("coupon_fill50.csv", mass_damper_csv(frequency_hz=100.0,
                                                                  acceleration_g=5.0))])
-    assert _metric(at, "SDC our DEM ± stderr [-]") == ["none"]
-    at.multiselect(key="dem_freqs").set_value([100.0])
-    at.multiselect(key="dem_accs").set_value([5.0])
-    at.multiselect(key="dem_fills").set_value([50.0])
+    assert "vs our DEM none" in _headline(at)
+    at.text_input(key="dem_freqs").set_value("100")
+    at.text_input(key="dem_accs").set_value("5")
+    at.text_input(key="dem_fills").set_value("50")
     at.number_input(key="dem_cells").set_value(2)
     at.number_input(key="dem_steady").set_value(20)
     at.run()
     assert not store_file.exists()
+    assert not at.button(key="dem_cancel").disabled  # Cancel is always enabled
     at.button(key="dem_run").click()
+    start = time.perf_counter()
     at.run(timeout=RUN_TIMEOUT_S)
-    assert not at.exception, at.exception
-    assert any("1 case(s) run and saved" in s.value for s in at.success)
+    # the click returns at once: the case runs outside the script run
+    assert time.perf_counter() - start < 5.0
+    assert any("1 job(s) submitted" in i.value for i in at.info)
+    at.run()  # another interaction while it runs: never a second start
+    _wait_for_jobs(store_file)
+    at.run()
     runs = Store(store_file).list_dem_runs()
     assert len(runs) == 1
+    assert [j.state for j in jobs.runner_for(store_file).jobs()] == ["saved"]
     want = simulate_load_case(LoadCase(100.0, 5.0, 50.0), DemConfig(cells=2, steady_cycles=20))
     assert runs["sdc"].iloc[0] == want.sdc
-    # The Compare tab now shows our DEM (mean ± stderr of the one run) for the measured case,
-    # and its loop (with its energy per cycle) next to the measurement's.
-    assert _metric(at, "SDC our DEM ± stderr [-]") == [
-        app_support.format_sdc(want.sdc, want.sdc_stderr)]
+    assert f"vs our DEM {uploads.format_sdc(want.sdc, want.sdc_stderr)}" in _headline(at)
     energies = [m.value for m in at.markdown if m.value.startswith("energy per cycle")]
     assert len(energies) == 1 and "our DEM" in energies[0] and "measured" in energies[0]
-    # A second run of the same case is recognised as stored and not simulated again.
+    # A second Run of the same case is recognised as stored and not simulated again.
     at.button(key="dem_run").click()
-    at.run(timeout=RUN_TIMEOUT_S)
-    assert any("0 case(s) run and saved, 1 already in the store" in s.value for s in at.success)
+    at.run()
+    _wait_for_jobs(store_file)
+    assert [j.state for j in jobs.runner_for(store_file).jobs()] == ["saved", "in store"]
     assert len(Store(store_file).list_dem_runs()) == 1
+
+
+def test_dem_cancel_stops_the_running_case(store_file):
+    from pidcore.store import Store
+
+    at = _app()
+    at.text_input(key="dem_freqs").set_value("50")
+    at.text_input(key="dem_accs").set_value("5")
+    at.text_input(key="dem_fills").set_value("25, 50")
+    at.number_input(key="dem_cells").set_value(4)
+    at.number_input(key="dem_steady").set_value(5000)
+    at.run()
+    at.button(key="dem_run").click()
+    at.run()
+    runner = jobs.runner_for(store_file)
+    deadline = time.monotonic() + 120
+    while not any(j.state == "running" and j.cycles_done > 0 for j in runner.jobs()):
+        assert time.monotonic() < deadline
+        time.sleep(0.05)
+    at.button(key="dem_cancel").click()
+    t0 = time.monotonic()
+    at.run()
+    while runner.busy():
+        assert time.monotonic() - t0 < 2.0, "cancel took longer than 2 s"
+        time.sleep(0.02)
+    assert [j.state for j in runner.jobs()] == ["cancelled", "cancelled"]
+    assert any("cancel requested for 2 job(s)" in w.value for w in at.warning)
+    assert not store_file.exists() or Store(store_file).list_dem_runs().empty
 
 
 def test_upload_limit_is_shown_and_enforced_per_file(store_file, monkeypatch):
@@ -254,41 +359,7 @@ def test_upload_limit_is_shown_and_enforced_per_file(store_file, monkeypatch):
     assert any("Upload limit: 1 MB per file" in c.value for c in at.caption)
     errors = [e.value for e in at.error]
     assert len(errors) == 1 and "large.csv" in errors[0] and "limit of 1 MB" in errors[0]
-    assert _table(at, "velocity channel")["file"].tolist() == ["small_fill50.csv"]
-
-
-def test_dem_cancel_keeps_finished_cases_and_drops_the_rest(store_file, monkeypatch):
-    import streamlit as st
-
-    from pidcore.store import Store
-
-    real = app_support.run_dem_case
-    finished = []
-
-    def run_then_press_cancel(path, case, config):
-        key = real(path, case, config)
-        finished.append(key)
-        # The user presses Cancel while this case runs: Streamlit runs the button's callback
-        # at the start of the rerun that follows; here it is set directly.
-        st.session_state["dem_cancel_requested"] = True
-        return key
-
-    monkeypatch.setattr(app_support, "run_dem_case", run_then_press_cancel)
-    at = _app()
-    at.multiselect(key="dem_freqs").set_value([500.0])
-    at.multiselect(key="dem_accs").set_value([5.0])
-    at.multiselect(key="dem_fills").set_value([25.0, 50.0, 75.0])
-    at.number_input(key="dem_cells").set_value(1)
-    at.number_input(key="dem_steady").set_value(4)
-    at.run()
-    at.button(key="dem_run").click()
-    at.run(timeout=RUN_TIMEOUT_S)
-    assert not at.exception, at.exception
-    assert len(finished) == 1
-    assert any("cancelled: 2 case(s) not run; 1 finished case(s) are saved" in w.value
-               for w in at.warning)
-    assert Store(store_file).list_dem_runs()["case_key"].tolist() == finished
-    assert at.button(key="dem_cancel").disabled  # nothing left to cancel
+    assert _table(at, "warnings")["file"].tolist() == ["small_fill50.csv"]
 
 
 def test_reference_dem_store_is_compared_but_never_written(store_file, tmp_path, monkeypatch):
@@ -299,23 +370,33 @@ def test_reference_dem_store_is_compared_but_never_written(store_file, tmp_path,
                                        "fill_percent": 50.0, "material": "acrylic",
                                        "direction": "z", "sdc": 0.25, "sdc_stderr": 0.02})
     ref_bytes = ref.read_bytes()
-    monkeypatch.setenv(app_support.DEM_STORE_ENV_VAR, str(ref))
+    monkeypatch.setenv(stores.DEM_STORE_ENV_VAR, str(ref))
     at = _upload(_app(), [("coupon_fill50.csv", mass_damper_csv())])
     assert any(str(ref) in m.value for m in at.sidebar.markdown)
-    assert _metric(at, "SDC our DEM ± stderr [-]") == ["0.2500 ± 0.0200"]
+    assert "vs our DEM 0.2500 ± 0.0200" in _headline(at)
     at.button(key="save").click()
     at.run()
     assert len(Store(store_file).list_analyses()) == 1
     assert ref.read_bytes() == ref_bytes
 
 
+def test_calibrate_page_says_when_the_library_is_missing(store_file):
+    import importlib.util
+
+    at = _app()
+    if importlib.util.find_spec("pidcore.calibrate") is None:
+        assert any("Calibration is not available" in i.value for i in at.info)
+    else:
+        assert any("pidcore.calibrate is installed" in i.value for i in at.info)
+
+
 #: The bundled samples (``pidcore samples make``); PIDCORE_SAMPLES_DIR points elsewhere.
 SAMPLES = Path(os.environ.get("PIDCORE_SAMPLES_DIR", REPO / "data_samples"))
+#: Longest whole-page run after a load-case switch, s (the issue's budget).
+SWITCH_BUDGET_S = 1.0
 
 
-def test_bundled_samples_switch_load_cases_from_the_cache(store_file, monkeypatch,
-                                                          analysis_calls):
-    calls = analysis_calls
+def test_bundled_samples_switch_load_cases_within_a_second(store_file, monkeypatch):
     from pidcore.measure import AnalysisOptions, analyze_file
 
     exports = sorted(p for p in (SAMPLES / "exports").glob("*") if p.is_file())
@@ -324,20 +405,19 @@ def test_bundled_samples_switch_load_cases_from_the_cache(store_file, monkeypatc
         pytest.skip(f"no bundled samples in {SAMPLES} (pidcore samples make)")
     from pidcore.samples import EXPORT_VELOCITY_DELAY_S
 
-    monkeypatch.setenv(app_support.DEM_STORE_ENV_VAR, str(dem_store))
-    at = _app()
-    at.number_input(key="delay_us").set_value(EXPORT_VELOCITY_DELAY_S * 1e6)
-    at.run()
-    at = _upload(at, [(p.name, p.read_bytes()) for p in exports])
+    monkeypatch.setenv(stores.DEM_STORE_ENV_VAR, str(dem_store))
+    delay_us = EXPORT_VELOCITY_DELAY_S * 1e6
+    table = "file,velocity_delay_us\n" + "".join(f"{p.name},{delay_us:g}\n" for p in exports)
+    at = _upload(_app(), [(p.name, p.read_bytes()) for p in exports]
+                 + [("bench settings.csv", table.encode())])
     assert not at.error, [e.value for e in at.error]
     options = AnalysisOptions(velocity_delay_s=EXPORT_VELOCITY_DELAY_S)
     want = {p.name: analyze_file(p, options).analysis.sdc for p in exports}
-    table = _table(at, "velocity channel")
-    assert dict(zip(table["file"], table["SDC [-]"], strict=True)) == pytest.approx(want,
+    shown = _table(at, "warnings")
+    assert dict(zip(shown["file"], shown["SDC [-]"], strict=True)) == pytest.approx(want,
                                                                                    rel=1e-12)
     n_cases = len(at.selectbox(key="compare_case").options)
     assert n_cases == len(exports)  # one load case per sample export
-    analysed = len(calls)
     timings = []
     for _ in range(2):
         for choice in range(n_cases):
@@ -348,22 +428,13 @@ def test_bundled_samples_switch_load_cases_from_the_cache(store_file, monkeypatc
             assert not at.exception
             # Every sample lies on the DEM grid of the bundled store, whose runs know m_c.
             assert "DEM alignment: grid" in " ".join(c.value for c in at.caption)
-            assert "±" in _metric(at, "SDC measured, E of Eq. 10 [-]")[0]
-    assert len(calls) == analysed  # switching never re-analyses
+            assert "Eq. 10" in " ".join(c.value for c in at.caption)
     ARTIFACTS.mkdir(exist_ok=True)
     (ARTIFACTS / "app_switch_timing_samples.json").write_text(json.dumps(
         {"load_case_switch_s": timings, "cases": n_cases,
          "note": "AppTest whole-page run after choosing another load case with the bundled "
-                 "samples uploaded (the Compare tab warms every case's comparison after the "
-                 "upload, so every switch is a cache hit)"},
+                 "samples uploaded (every case's comparison is warmed after the upload)"},
         indent=1))
-
-
-def test_uploaded_sidecar_states_the_load_case(store_file):
-    at = _upload(_app(), [("loadcases.csv", b"file,fill_percent,material\nrun7.csv,75,aluminium\n"),
-                          ("run7.csv", mass_damper_csv())])
-    assert any("loadcases.csv: load cases of 1 file(s) stated" in i.value for i in at.info)
-    table = _table(at, "velocity channel")
-    assert table["file"].tolist() == ["run7.csv"]  # the sidecar is not a measurement
-    assert table["material"].tolist() == ["aluminium"]
-    assert table["load case"].iloc[0].endswith("75 %")
+    # the median switch (whole page, all five tabs drawn) within the budget; the first visit
+    # of each case may pay for the browser-side spec once
+    assert sorted(timings)[len(timings) // 2] <= SWITCH_BUDGET_S, timings
