@@ -1,0 +1,99 @@
+"""Plausibility checks and the one-line headline of a load case, on analytic mass-damper
+records whose truth is known (tests/_app_samples.py)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from _app_samples import mass_damper_csv
+
+from pidcore.app import uploads
+from pidcore.compare.case import MeasuredEntry, compare_case, headline, load_case_of, paper_table
+from pidcore.compare.plausibility import SDC_UPPER_BOUND, check_analysis
+from pidcore.measure import AnalysisOptions
+
+
+def _analysis(data: bytes, **options):
+    outcome = uploads.analyze_upload("x_fill50.csv", data, AnalysisOptions(**options))
+    assert outcome.ok, outcome.error
+    return outcome.record
+
+
+def test_a_physical_record_raises_no_warning():
+    assert check_analysis(_analysis(mass_damper_csv(loss_factor=0.05)).analysis) == ()
+
+
+def test_uncorrected_delay_gives_a_negative_loss_factor_and_the_delay_that_explains_it():
+    # A velocity recorded 200 µs late turns P by +w tau = 7.2° at 100 Hz: a loss factor of
+    # 0.05 (2.9°) becomes about tan(2.9° - 7.2°) = -0.075.
+    rec = _analysis(mass_damper_csv(loss_factor=0.05), velocity_delay_s=-200e-6)
+    (w,) = check_analysis(rec.analysis)
+    assert w.check == "negative_loss_factor" and rec.analysis.loss_factor < 0
+    # the delay that brings the loss factor to zero: 200 µs minus the 0.05 damping's own
+    # 2.86° (79.5 µs at 100 Hz) = 120 µs
+    tau_us = float(w.likely_cause.split("about ")[1].split(" µs")[0])
+    expected = 200.0 - math.degrees(math.atan(0.05)) / 360 / 100.0 * 1e6
+    assert tau_us == pytest.approx(expected, abs=2.0)
+
+
+def test_an_inverted_channel_is_named():
+    data = mass_damper_csv(loss_factor=0.05).decode().splitlines()
+    flipped = [data[0]] + [",".join([t, str(-float(f)), v]) for t, f, v in
+                           (line.split(",") for line in data[1:])]
+    rec = _analysis("\n".join(flipped).encode())
+    checks = {w.check for w in check_analysis(rec.analysis)}
+    assert "force_lags_velocity" in checks
+
+
+def test_sdc_above_the_bound_is_flagged():
+    rec = _analysis(mass_damper_csv(loss_factor=1.5))
+    assert rec.analysis.sdc > SDC_UPPER_BOUND
+    assert [w.check for w in check_analysis(rec.analysis)] == ["sdc_above_bound"]
+
+
+def _entry(rec):
+    return MeasuredEntry.from_record(rec, load_case_of(rec, fill_percent=50.0,
+                                                       material="acrylic"))
+
+
+def _dem(sdc: float, stderr: float, m_c: float = 0.3):
+    import pandas as pd
+
+    return pd.DataFrame({"case_key": ["r"], "frequency_hz": [100.0], "acceleration_g": [5.0],
+                         "fill_percent": [50.0], "material": ["acrylic"], "direction": ["z"],
+                         "sdc": [sdc], "sdc_stderr": [stderr], "m_c_kg": [m_c]})
+
+
+def test_headline_compares_like_with_like_and_counts_sigmas():
+    rec = _analysis(mass_damper_csv(loss_factor=0.05))
+    paper = paper_table()
+    probe = compare_case([_entry(rec)], _dem(0.3, 0.01), paper)
+    m, se = probe.measured_sdc_eq10, probe.measured_stderr_eq10
+    assert np.isfinite(m)
+    agree = headline(compare_case([_entry(rec)], _dem(m + 0.01, 0.01), paper))
+    assert agree.measured_kind.startswith("Eq. 10") and agree.measured == m
+    assert agree.sigmas == pytest.approx(0.01 / math.hypot(se, 0.01))
+    assert agree.verdict.startswith("agrees within 2 σ")
+    far = headline(compare_case([_entry(rec)], _dem(m + 1.0, 0.01), paper))
+    assert far.verdict.startswith("differs by") and far.sigmas > 2
+    # without the DEM case's m_c the Eq. 11 SDC is not passed off as comparable
+    unknown = headline(compare_case([_entry(rec)], _dem(0.3, 0.01).drop(columns="m_c_kg"),
+                                    paper))
+    assert unknown.measured_kind == "Eq. 11" and math.isnan(unknown.sigmas)
+
+
+def test_model_curve_is_drawn_for_a_case_a_hair_below_the_grid_edge():
+    # 49.999998 Hz lies 4e-8 outside the model's 50-1000 Hz: within the grid tolerance, so the
+    # curve is drawn at 50 Hz with a note, never dropped silently
+    rec = _analysis(mass_damper_csv(frequency_hz=50.0))
+    entry = _entry(rec)
+    edge = MeasuredEntry(**{**entry.__dict__, "load_case": entry.load_case.__class__(
+        49.999998, 5.0, 50.0)})
+    comp = compare_case([edge], None, paper_table())
+    assert comp.model_sdc.size > 0
+    assert any("edge of its range" in n for n in comp.notes)
+    # pchip through the paper's DEM values at 50 Hz, 5 g
+    at = np.interp(comp.paper_points["fill [%]"], comp.model_fill_percent, comp.model_sdc)
+    np.testing.assert_allclose(at, comp.paper_points["SDC DEM (paper) [-]"], rtol=2e-2)
