@@ -7,6 +7,7 @@ browser is downloaded: Playwright drives the system chromium through ``executabl
 from __future__ import annotations
 
 import os
+import re
 import socket
 import subprocess
 import sys
@@ -17,7 +18,8 @@ from pathlib import Path
 import pytest
 from _app_samples import mass_damper_csv
 
-from pidcore import app_support
+from pidcore.app import uploads
+from pidcore.app.stores import STORE_ENV_VAR
 
 pytestmark = pytest.mark.browser
 
@@ -27,6 +29,9 @@ ARTIFACTS = REPO / "test-artifacts"
 CHROMIUM = Path("/usr/bin/chromium")
 CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
                  "--disable-component-update", "--disable-sync", "--no-first-run"]
+#: The issue's budget: Cancel stops a running case within this many seconds (the job table
+#: refreshes every second, so what the browser sees includes up to one refresh).
+CANCEL_BUDGET_S = 2.0
 #: Seconds to wait for the server to answer and for results to appear (cold imports included).
 START_TIMEOUT_S = 45
 RESULT_TIMEOUT_MS = 30_000
@@ -69,26 +74,35 @@ def sample(tmp_path):
 def store_with_dem_run(tmp_path, sample):
     """A store holding one short DEM run at the sample's load case (for the loop overlay)."""
     from pidcore.compare import parse_file_name
+    from pidcore.compare.case import PROPOSED_FILL_PERCENT
     from pidcore.dem import DemConfig
     from pidcore.dem import LoadCase as DemLoadCase
+    from pidcore.dem.sweep import run_case
     from pidcore.measure import AnalysisOptions, analyze_file
+    from pidcore.store import Store
 
     analysis = analyze_file(sample, AnalysisOptions()).analysis
     stated = parse_file_name(sample.name)
     case = DemLoadCase(analysis.frequency_hz, analysis.acceleration_g,
-                       stated.get("fill_percent", app_support.DEFAULT_FILL_PERCENT),
+                       stated.get("fill_percent", PROPOSED_FILL_PERCENT),
                        stated.get("material", "acrylic"), stated.get("direction", "z"))
     path = tmp_path / "e2e_store.h5"
-    app_support.run_dem_case(path, case, DemConfig(cells=2, steady_cycles=10,
-                                                   max_transient_cycles=4))
+    run_case(case, DemConfig(cells=2, steady_cycles=10, max_transient_cycles=4)).save_to(
+        Store(path))
     return path
 
 
 @pytest.fixture
-def app_url(tmp_path, store_with_dem_run):
+def empty_store(tmp_path):
+    return tmp_path / "e2e_empty_store.h5"
+
+
+def _serve(tmp_path: Path, store: Path):
     port = _free_port()
-    env = {**os.environ, app_support.STORE_ENV_VAR: str(store_with_dem_run),
-           "STREAMLIT_BROWSER_GATHER_USAGE_STATS": "false"}
+    env = {**os.environ, STORE_ENV_VAR: str(store),
+           "STREAMLIT_BROWSER_GATHER_USAGE_STATS": "false",
+           "PYTHONPATH": os.pathsep.join([str(REPO), os.environ.get("PYTHONPATH", "")])}
+    env.pop("PIDCORE_DEM_STORE", None)
     log = (tmp_path / "streamlit.log").open("wb")
     proc = subprocess.Popen(
         [sys.executable, "-m", "streamlit", "run", str(SHIM), "--server.headless", "true",
@@ -96,83 +110,286 @@ def app_url(tmp_path, store_with_dem_run):
          "--browser.gatherUsageStats", "false", "--server.fileWatcherType", "none"],
         cwd=tmp_path, env=env, stdout=log, stderr=subprocess.STDOUT)
     url = f"http://localhost:{port}"
+    deadline = time.monotonic() + START_TIMEOUT_S
+    while True:
+        try:
+            with urllib.request.urlopen(f"{url}/_stcore/health", timeout=2) as r:
+                if r.read().strip() == b"ok":
+                    break
+        except OSError:
+            pass
+        if proc.poll() is not None or time.monotonic() > deadline:
+            log.close()
+            proc.kill()
+            pytest.fail("streamlit did not start: "
+                        + (tmp_path / "streamlit.log").read_text()[-2000:])
+        time.sleep(0.2)
+    return proc, log, url
+
+
+def _stop(proc, log) -> None:
+    proc.terminate()
     try:
-        deadline = time.monotonic() + START_TIMEOUT_S
-        while True:
-            try:
-                with urllib.request.urlopen(f"{url}/_stcore/health", timeout=2) as r:
-                    if r.read().strip() == b"ok":
-                        break
-            except OSError:
-                pass
-            if proc.poll() is not None or time.monotonic() > deadline:
-                log.close()
-                pytest.fail("streamlit did not start: "
-                            + (tmp_path / "streamlit.log").read_text()[-2000:])
-            time.sleep(0.2)
+        proc.wait(timeout=10)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+    log.close()
+
+
+@pytest.fixture
+def app_url(tmp_path, store_with_dem_run):
+    proc, log, url = _serve(tmp_path, store_with_dem_run)
+    try:
         yield url
     finally:
-        proc.terminate()
-        try:
-            proc.wait(timeout=10)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-        log.close()
+        _stop(proc, log)
 
 
-def test_upload_shows_sdc_and_the_loop_overlay_renders(app_url, sample, tmp_path):
+@pytest.fixture
+def empty_app(tmp_path, empty_store):
+    proc, log, url = _serve(tmp_path, empty_store)
+    try:
+        yield url, empty_store
+    finally:
+        _stop(proc, log)
+
+
+@pytest.fixture
+def browser_page():
     if not CHROMIUM.exists():
         pytest.skip(f"{CHROMIUM} not installed (apt-get install chromium)")
     sync_api = pytest.importorskip("playwright.sync_api",
                                    reason="playwright for Python not installed")
-    from pidcore.measure import AnalysisOptions, analyze_file
-
-    expected = analyze_file(sample, AnalysisOptions()).analysis
-    expected_text = app_support.format_sdc(expected.sdc, expected.sdc_stderr)
     ARTIFACTS.mkdir(exist_ok=True)
     with sync_api.sync_playwright() as pw:
         browser = pw.chromium.launch(executable_path=str(CHROMIUM), args=CHROMIUM_ARGS)
         try:
-            page = browser.new_page(viewport={"width": 1500, "height": 1600})
-            page.goto(app_url)
-            page.locator("input[type=file]").first.wait_for(state="attached",
-                                                            timeout=RESULT_TIMEOUT_MS)
-            bad = tmp_path / "corrupt_export.uff"
-            bad.write_bytes(b"    -1\n    58\nnot a dataset\n")
-            page.locator("input[type=file]").first.set_input_files([str(sample), str(bad)])
-            metric = page.locator('[data-testid="stMetric"]').filter(has_text="SDC ± stderr")
-            metric.first.wait_for(timeout=RESULT_TIMEOUT_MS)
-            # The browser shows the library's SDC for the same file ...
-            assert expected_text in metric.first.inner_text()
-            # ... and the bad file's error, without stopping the session.
-            error = page.locator('[data-testid="stAlertContentError"]').filter(
-                has_text="corrupt_export.uff")
-            error.first.wait_for(timeout=RESULT_TIMEOUT_MS)
-            page.get_by_role("button", name="Save 1 record(s) to the store").wait_for(
-                timeout=RESULT_TIMEOUT_MS)
-            page.screenshot(path=str(ARTIFACTS / "app_e2e_analyse.png"), full_page=True)
-
-            page.get_by_role("tab", name="Compare").click()
-            charts = page.locator('[data-testid="stVegaLiteChart"]')
-            loop = charts.filter(has_text="force-displacement loop")
-            # Vega draws into a canvas (or svg); its presence means the chart rendered.
-            loop.first.locator("canvas, svg").first.wait_for(timeout=RESULT_TIMEOUT_MS)
-            assert charts.count() == 3
-            page.wait_for_timeout(500)  # let Vega finish drawing
-            # Data were drawn, not just axes: the loop line is coloured, axes and text are grey.
-            assert _coloured_pixels(loop.first.screenshot()) > 300
-            sdc = charts.filter(has_text="SDC against fill")
-            assert _coloured_pixels(sdc.first.screenshot()) > 300
-            # Both loops are drawn: the measurement's and our DEM run's at this load case.
-            energies = page.get_by_text("energy per cycle (loop area)")
-            assert "measured" in energies.inner_text() and "our DEM" in energies.inner_text()
-            dem_metric = page.locator('[data-testid="stMetric"]').filter(
-                has_text="SDC our DEM ± stderr")
-            assert "±" in dem_metric.first.inner_text()
-            measured = page.locator('[data-testid="stMetric"]').filter(
-                has_text="SDC measured ± stderr")
-            assert expected_text in measured.first.inner_text()
-            page.screenshot(path=str(ARTIFACTS / "app_e2e.png"), full_page=True)
+            page = browser.new_page(viewport={"width": 1500, "height": 1600},
+                                    accept_downloads=True)
+            yield page
             assert not page.locator('[data-testid="stException"]').count()
         finally:
             browser.close()
+
+
+def _open(page, url: str) -> None:
+    page.goto(url)
+    page.locator("input[type=file]").first.wait_for(state="attached", timeout=RESULT_TIMEOUT_MS)
+
+
+def _metric_texts(page, label: str) -> list[str]:
+    metric = page.locator('[data-testid="stMetric"]').filter(has_text=label)
+    metric.first.wait_for(timeout=RESULT_TIMEOUT_MS)
+    return [metric.nth(i).inner_text() for i in range(metric.count())]
+
+
+def _analysis_of(path: Path, **options):
+    from pidcore.measure import AnalysisOptions, analyze_file
+
+    return analyze_file(path, AnalysisOptions(**options)).analysis
+
+
+def test_upload_shows_sdc_and_the_loop_overlay_renders(app_url, sample, tmp_path,
+                                                       browser_page):
+    page = browser_page
+    expected = _analysis_of(sample)
+    expected_text = uploads.format_sdc(expected.sdc, expected.sdc_stderr)
+    _open(page, app_url)
+    bad = tmp_path / "corrupt_export.uff"
+    bad.write_bytes(b"    -1\n    58\nnot a dataset\n")
+    page.locator("input[type=file]").first.set_input_files([str(sample), str(bad)])
+    # The browser shows the library's SDC for the same file ...
+    assert expected_text in _metric_texts(page, "SDC ± stderr")[0]
+    # ... and the bad file's error, without stopping the session.
+    error = page.locator('[data-testid="stAlertContentError"]').filter(
+        has_text="corrupt_export.uff")
+    error.first.wait_for(timeout=RESULT_TIMEOUT_MS)
+    page.get_by_role("button", name="Save 1 record(s) to the store").wait_for(
+        timeout=RESULT_TIMEOUT_MS)
+    page.screenshot(path=str(ARTIFACTS / "app_e2e_analyse.png"), full_page=True)
+
+    page.get_by_role("tab", name="Compare").click()
+    charts = page.locator('[data-testid="stVegaLiteChart"]')
+    loop = charts.filter(has_text="force-displacement loop")
+    # Vega draws into a canvas (or svg); its presence means the chart rendered.
+    loop.first.locator("canvas, svg").first.wait_for(timeout=RESULT_TIMEOUT_MS)
+    assert charts.count() == 3
+    page.wait_for_timeout(500)  # let Vega finish drawing
+    # Data were drawn, not just axes: the loop line is coloured, axes and text are grey.
+    assert _coloured_pixels(loop.first.screenshot()) > 300
+    sdc = charts.filter(has_text="SDC against fill")
+    assert _coloured_pixels(sdc.first.screenshot()) > 300
+    # Both loops are drawn: the measurement's and our DEM run's at this load case.
+    energies = page.get_by_text("energy per cycle (loop area)")
+    assert "measured" in energies.inner_text() and "our DEM" in energies.inner_text()
+    headline = page.get_by_role("heading").filter(has_text="vs our DEM")
+    assert "±" in headline.first.inner_text() and "σ" in headline.first.inner_text()
+    page.screenshot(path=str(ARTIFACTS / "app_e2e.png"), full_page=True)
+
+
+def _job_states(page) -> str:
+    # the job table is drawn on a canvas; its caption counts the jobs per state in text
+    caption = page.locator('[data-testid="stCaptionContainer"]').filter(has_text="jobs: ")
+    return caption.first.inner_text() if caption.count() else ""
+
+
+def _saved_runs(store: Path) -> int:
+    from pidcore.store import Store
+
+    return 0 if not store.exists() else len(Store(store).list_dem_runs())
+
+
+def _fill_dem(page, *, freqs: str, accs: str, fills: str, cells: int, steady: int) -> None:
+    page.get_by_role("tab", name="DEM").click()
+    for label, value in (("frequencies [Hz]", freqs), ("accelerations [g]", accs),
+                         ("fills [%]", fills)):
+        box = page.get_by_role("textbox", name=label, exact=True)
+        box.fill(value)
+        box.press("Enter")
+    settings = page.get_by_text("numerical settings")
+    if not page.get_by_role("spinbutton", name="cells simulated").is_visible():
+        settings.click()
+    for label, value in (("cells simulated", cells), ("steady cycles (0 = automatic)", steady)):
+        box = page.get_by_role("spinbutton", name=label, exact=True)
+        box.fill(str(value))
+        box.press("Enter")
+    page.wait_for_timeout(500)
+
+
+def test_cancel_stops_a_running_case_within_two_seconds_and_nothing_runs_twice(
+        empty_app, browser_page):
+    url, store = empty_app
+    page = browser_page
+    _open(page, url)
+    # 1) a short case, Run clicked twice while it runs: one job, one saved run
+    _fill_dem(page, freqs="100", accs="5", fills="50", cells=1, steady=10)
+    run = page.get_by_role("button", name="Run", exact=True)
+    run.click()
+    page.get_by_text("1 job(s) submitted").wait_for(timeout=RESULT_TIMEOUT_MS)
+    run.click()
+    page.get_by_text("already queued or running, not submitted again").or_(
+        page.get_by_text("1 job(s) submitted")).first.wait_for(timeout=RESULT_TIMEOUT_MS)
+    deadline = time.monotonic() + 120
+    while _saved_runs(store) < 1:
+        assert time.monotonic() < deadline, _job_states(page)
+        time.sleep(0.2)
+    time.sleep(1.5)  # a second start would show up as another saved run or job
+    assert _saved_runs(store) == 1
+    # 2) a long sweep of two cases; Cancel while the first runs
+    _fill_dem(page, freqs="50", accs="5", fills="25, 50", cells=4, steady=5000)
+    run.click()
+    progress = page.locator('[data-testid="stProgress"]')
+    progress.first.wait_for(timeout=RESULT_TIMEOUT_MS)
+    # running: blocks of cycles done, with elapsed time and an ETA
+    page.get_by_text(re.compile(r"fill25: [1-9][0-9]*/[0-9]+ cycles, [0-9]+ s elapsed, "
+                                r"ETA [0-9]+ s")).first.wait_for(timeout=120_000)
+    cancel = page.get_by_role("button", name="Cancel")
+    assert cancel.is_enabled()  # always enabled, also during a run
+    page.screenshot(path=str(ARTIFACTS / "app_e2e_dem_running.png"), full_page=True)
+    t0 = time.monotonic()
+    cancel.click()
+    while "running" in _job_states(page) or "queued" in _job_states(page):
+        assert time.monotonic() - t0 < CANCEL_BUDGET_S, _job_states(page)
+        time.sleep(0.05)
+    stopped_s = time.monotonic() - t0
+    states = _job_states(page)
+    assert "2 cancelled" in states and "1 saved" in states, states
+    page.screenshot(path=str(ARTIFACTS / "app_e2e_dem_cancelled.png"), full_page=True)
+    time.sleep(1.5)
+    assert _saved_runs(store) == 1  # the cancelled cases saved nothing, nothing ran twice
+    (ARTIFACTS / "app_e2e_cancel_timing.txt").write_text(
+        f"Cancel click to the job table showing both jobs cancelled: {stopped_s:.2f} s "
+        "(includes up to one 1 s table refresh)\n")
+
+
+def _two_files(tmp_path: Path) -> tuple[Path, Path]:
+    a = tmp_path / "setupA_fill50.csv"
+    b = tmp_path / "setupB_fill50.csv"
+    a.write_bytes(mass_damper_csv(frequency_hz=100.0, loss_factor=0.05))
+    b.write_bytes(mass_damper_csv(frequency_hz=100.0, loss_factor=0.05, seed=9))
+    return a, b
+
+
+def test_reload_shows_the_saved_records_on_compare(empty_app, browser_page, tmp_path):
+    url, store = empty_app
+    page = browser_page
+    _open(page, url)
+    a, b = _two_files(tmp_path)
+    page.locator("input[type=file]").first.set_input_files([str(a), str(b)])
+    save = page.get_by_role("button", name="Save 2 record(s) to the store")
+    save.wait_for(timeout=RESULT_TIMEOUT_MS)
+    save.click()
+    page.get_by_text("saved 2 analysis record(s)").wait_for(timeout=RESULT_TIMEOUT_MS)
+    page.reload()
+    _open(page, url)
+    page.get_by_role("tab", name="Compare").click()
+    page.get_by_role("heading").filter(has_text="measured").first.wait_for(
+        timeout=RESULT_TIMEOUT_MS)
+    # no uploads in the reloaded session: the two records come from the store
+    choice = page.locator('[data-testid="stSelectbox"]').filter(has_text="load case").first
+    shown = choice.inner_text() + " ".join(
+        choice.locator("input").nth(i).input_value()
+        for i in range(choice.locator("input").count()))
+    assert "(2 file(s))" in shown, shown
+    page.screenshot(path=str(ARTIFACTS / "app_e2e_reload_compare.png"), full_page=True)
+
+
+def test_two_files_with_different_vibrometer_delays_in_one_session(empty_app, browser_page,
+                                                                    tmp_path):
+    url, _ = empty_app
+    page = browser_page
+    _open(page, url)
+    a, b = _two_files(tmp_path)
+    table = tmp_path / "my bench settings.csv"
+    table.write_text(f"file,velocity_delay_us\n{a.name},0\n{b.name},200\n")
+    page.locator("input[type=file]").first.set_input_files([str(a), str(b), str(table)])
+    page.get_by_text("settings of 2 file(s) read").wait_for(timeout=RESULT_TIMEOUT_MS)
+    want = [_analysis_of(a), _analysis_of(b, velocity_delay_s=200e-6)]
+    page.get_by_text("vibrometer delay 200 µs").wait_for(timeout=RESULT_TIMEOUT_MS)
+    deadline = time.monotonic() + RESULT_TIMEOUT_MS / 1000
+    while len(_metric_texts(page, "SDC ± stderr")) < 2:
+        assert time.monotonic() < deadline
+        time.sleep(0.2)
+    shown = _metric_texts(page, "SDC ± stderr")
+    for text, analysis in zip(shown, want, strict=True):
+        assert uploads.format_sdc(analysis.sdc, analysis.sdc_stderr) in text
+    assert want[0].sdc != pytest.approx(want[1].sdc, rel=1e-3)  # the delays matter
+    page.screenshot(path=str(ARTIFACTS / "app_e2e_two_delays.png"), full_page=True)
+
+
+def test_negative_loss_factor_shows_the_warning(empty_app, browser_page, tmp_path):
+    url, _ = empty_app
+    page = browser_page
+    _open(page, url)
+    odd = tmp_path / "odd_fill50.csv"
+    odd.write_bytes(mass_damper_csv(loss_factor=-0.04))
+    page.locator("input[type=file]").first.set_input_files([str(odd)])
+    warning = page.locator('[data-testid="stAlertContentWarning"]').filter(
+        has_text="negative loss factor")
+    warning.first.wait_for(timeout=RESULT_TIMEOUT_MS)
+    assert "Likely cause" in warning.first.inner_text()
+    page.get_by_text("Save the 1 implausible record(s) anyway").wait_for(
+        timeout=RESULT_TIMEOUT_MS)
+    page.screenshot(path=str(ARTIFACTS / "app_e2e_negative_loss_factor.png"), full_page=True)
+
+
+def test_report_csv_reads_with_pandas_and_no_extra_rows(app_url, browser_page, sample,
+                                                        store_with_dem_run):
+    import pandas as pd
+
+    from pidcore.report.downloads import store_report_table
+
+    page = browser_page
+    _open(page, app_url)
+    page.get_by_role("tab", name="Report").click()
+    page.get_by_role("button", name="Build report files").click()
+    button = page.get_by_role("button", name="CSV", exact=True)
+    button.wait_for(timeout=RESULT_TIMEOUT_MS)
+    with page.expect_download() as info:
+        button.click()
+    path = info.value.path()
+    table = pd.read_csv(path)
+    want = store_report_table(store_with_dem_run)
+    assert len(table) == len(want) and list(table.columns) == list(want.columns)
+    assert table["SDC DEM (ours) [-]"].tolist() == want["SDC DEM (ours) [-]"].tolist()
+    page.screenshot(path=str(ARTIFACTS / "app_e2e_report.png"), full_page=True)

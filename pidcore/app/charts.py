@@ -22,7 +22,13 @@ _SDC_COLOURS = dict(zip(SDC_SERIES, ("#7f7f7f", "#1f77b4", "#2ca02c", "#ff7f0e",
 #: Colours of measured loops, in turn; our DEM's loop is always orange as in the SDC chart.
 _LOOP_COLOURS = ("#d62728", "#9467bd", "#17becf", "#e377c2", "#8c564b", "#bcbd22")
 _DEM_COLOUR = "#ff7f0e"
+#: Marker of each series; the model curve's legend symbol is a line ("stroke").
+_SDC_SHAPES = dict(zip(SDC_SERIES, ("stroke", "square", "triangle-up", "diamond", "diamond",
+                                    "circle", "circle"), strict=True))
 _LEGEND = {"orient": "bottom", "columns": 1, "labelLimit": 0, "title": None}
+#: Fit the width to the column, keep the plot's height: the legend below adds to it (with
+#: "fit" on both axes a long legend squeezes the plot away).
+_AUTOSIZE = alt.AutoSizeParams(type="fit-x", contains="padding")
 
 
 def sdc_chart(data: pd.DataFrame) -> alt.LayerChart:
@@ -44,26 +50,29 @@ def sdc_chart(data: pd.DataFrame) -> alt.LayerChart:
     others = base.transform_filter(alt.datum.series != _MODEL)
     bars = others.mark_errorbar(ticks=True).encode(y=alt.Y("low:Q", title="SDC [-]"),
                                                    y2="high:Q")
+    # colour and shape share domain and legend, so the legend lists every series present,
+    # the model curve (drawn as a line symbol) included
+    shape = alt.Shape("series:N", scale=alt.Scale(domain=present,
+                                                  range=[_SDC_SHAPES[s] for s in present]),
+                      legend=alt.Legend(**_LEGEND))
     points = others.mark_point(size=90, filled=True).encode(
-        y="sdc:Q", shape=alt.Shape("series:N", legend=None),
+        y="sdc:Q", shape=shape,
         tooltip=[alt.Tooltip("series:N"), alt.Tooltip("fill:Q", title="fill [%]"),
                  alt.Tooltip("sdc:Q", title="SDC [-]", format=".4f"),
                  alt.Tooltip("low:Q", title="- stderr", format=".4f"),
                  alt.Tooltip("high:Q", title="+ stderr", format=".4f")])
-    return alt.layer(curve, bars, points).properties(height=360, width="container",
-                                                     title="SDC against fill")
+    return alt.layer(curve, bars, points).properties(height=300, title="SDC against fill",
+                                                     autosize=_AUTOSIZE)
 
 
-def loop_chart(frame: pd.DataFrame, energies: dict[str, float] | None = None) -> alt.Chart:
+def loop_chart(frame: pd.DataFrame) -> alt.Chart:
     """Force-displacement loops overlaid, displacement in µm (a coupon moves micrometres).
 
-    ``frame`` is :func:`pidcore.signal.loops.loop_frame` (SI); ``energies`` maps a series to its
-    energy per cycle, J, shown in the legend.
+    ``frame`` is :func:`pidcore.signal.loops.loop_frame` (SI). Legend labels are the loops'
+    names only (the page prints their energies per cycle below), so none is cut.
     """
-    energies = energies or {}
     series = list(dict.fromkeys(frame["series"]))
-    labels = {s: (f"{s} (ΔE = {energies[s]:.3e} J/cycle)" if s in energies else s)
-              for s in series}
+    labels = {s: s for s in series}
     colours, k = [], 0
     for s in series:
         if s.startswith("our DEM"):
@@ -76,14 +85,14 @@ def loop_chart(frame: pd.DataFrame, energies: dict[str, float] | None = None) ->
                           "force_n": frame["force [N]"].astype(float),
                           "order": frame["order"]})
     return alt.Chart(plain).mark_line().encode(
-        x=alt.X("displacement_um:Q", title="displacement [µm]", axis=alt.Axis(format="~g")),
-        y=alt.Y("force_n:Q", title="force [N]", axis=alt.Axis(format="~g")),
+        x=alt.X("displacement_um:Q", title="displacement [µm]", axis=alt.Axis(format=".4~r")),
+        y=alt.Y("force_n:Q", title="force [N]", axis=alt.Axis(format=".4~r")),
         order="order:Q",
         color=alt.Color("series:N", scale=alt.Scale(domain=[labels[s] for s in series],
                                                     range=colours),
                         legend=alt.Legend(**_LEGEND)),
-    ).properties(height=360, width="container",
-                 title="force-displacement loop (area = energy per cycle)")
+    ).properties(height=300, title="force-displacement loop (area = energy per cycle)",
+                 autosize=_AUTOSIZE)
 
 
 def spectrum_chart(table: pd.DataFrame) -> alt.HConcatChart:

@@ -79,7 +79,6 @@ def case_view(group_key: str, stamp: tuple, _entries, _stores) -> dict:
     view = workbench.case_view(_entries, store_listing("dem_runs", stamp, _stores), paper(),
                                (_stores.path, _stores.dem_reference))
     view["sdc_spec"] = charts.sdc_chart(view["sdc_points"]).to_dict(validate=False)
-    view["loop_spec"] = charts.loop_chart(view["loops"], view["energies"]).to_dict(
-        validate=False)
+    view["loop_spec"] = charts.loop_chart(view["loops"]).to_dict(validate=False)
     view["spectrum_spec"] = charts.spectrum_chart(view["spectrum"]).to_dict(validate=False)
     return view

@@ -106,7 +106,7 @@ def render(stores, session_files: list) -> None:
     if view["energies"]:
         st.markdown("energy per cycle (loop area): " + " · ".join(
             f"{label}: **{energy:.4e} J**" for label, energy in view["energies"].items()))
-    left2, right2 = st.columns([3, 2])
+    left2, right2 = st.columns(2)
     left2.vega_lite_chart(spec=view["spectrum_spec"], key="spectrum_chart")
     right2.dataframe(view["spectrum"], hide_index=True, width="stretch")
     st.dataframe(comp.measured, hide_index=True, width="stretch", key="compare_measured")
