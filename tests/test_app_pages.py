@@ -438,3 +438,69 @@ def test_bundled_samples_switch_load_cases_within_a_second(store_file, monkeypat
     # the median switch (whole page, all five tabs drawn) within the budget; the first visit
     # of each case may pay for the browser-side spec once
     assert sorted(timings)[len(timings) // 2] <= SWITCH_BUDGET_S, timings
+
+
+def _fake_calibrate_module(calls: list):
+    """A stand-in for pidcore.calibrate (written on another branch) with the functions the
+    page uses, so the page's wiring is tested against that API."""
+    import types
+    from dataclasses import dataclass
+
+    @dataclass(frozen=True)
+    class MeasuredPoint:
+        frequency_hz: float
+        acceleration_g: float
+        fill_percent: float
+        sdc: float
+        sdc_stderr: float = 0.0
+
+    module = types.ModuleType("pidcore.calibrate")
+    module.CATALOGUE = {"fixture_mass_kg": None, "baseline_loss_factor": None}
+    module.parse_fit = lambda text=None, specimen=None: (
+        ["fixture_mass_kg", "baseline_loss_factor"] if text is None
+        else [n.strip() for n in text if n.strip()])
+
+    def measured_from_store(path):
+        from pidcore.store import Store
+
+        rows = Store(path).list_analyses()
+        return [MeasuredPoint(r.frequency_hz, r.acceleration_g, r.fill_percent, r.sdc,
+                              r.sdc_stderr) for r in rows.itertuples()]
+
+    def calibrate(points, *, fit, store_path, cells, design_size, progress):
+        calls.append((len(points), tuple(fit), cells))
+        return {"fit": fit}
+
+    def write_outputs(result, out_dir):
+        out = Path(out_dir)
+        (out / "summary.md").write_text("# Calibration summary\n\nfixture_mass_kg: 0.01\n")
+        (out / "calibrated_specimen.toml").write_text("[coupon]\nmass_kg = 0.3\n")
+        return [out / "summary.md", out / "calibrated_specimen.toml"]
+
+    module.measured_from_store = measured_from_store
+    module.calibrate = calibrate
+    module.write_outputs = write_outputs
+    return module
+
+
+def test_calibrate_page_runs_the_library_on_the_stores_measurements(store_file, monkeypatch):
+    import sys
+
+    calls: list = []
+    monkeypatch.setitem(sys.modules, "pidcore.calibrate", _fake_calibrate_module(calls))
+    at = _upload(_app(), [("c_fill50.csv", mass_damper_csv())])
+    at.button(key="save").click()
+    at.run()
+    at.button(key="calibration_run").click()
+    at.run()
+    from pidcore.app.calibration import runner_for
+
+    deadline = time.monotonic() + 10
+    while runner_for(store_file).task.state == "running":
+        assert time.monotonic() < deadline
+        time.sleep(0.05)
+    at.run()
+    assert calls == [(1, ("fixture_mass_kg", "baseline_loss_factor"), 4)]
+    assert any("Calibration summary" in m.value for m in at.markdown)
+    labels = [b.label for b in at.get("download_button")]
+    assert "calibrated specimen (calibrated_specimen.toml)" in labels

@@ -1,20 +1,106 @@
-"""The calibration page's boundary to :mod:`pidcore.calibrate` (written on another branch).
+"""The calibration page's boundary to :mod:`pidcore.calibrate` and its background task.
 
-The page calls only :func:`calibration_api`; while the library is missing it shows why.
+The page calls only what is here. :func:`calibration_api` says whether the calibration library
+is installed (it is written on its own branch); :class:`CalibrationRunner` runs
+``pidcore.calibrate.calibrate`` on the store's measurements in a thread outside the script
+runs (it starts DEM runs, minutes) and keeps the outputs of ``write_outputs`` in memory for
+the page to show and offer for download. The DEM runs it needs are cached in the store, so a
+calibration started again reuses them.
 """
 
 from __future__ import annotations
 
 import importlib
-import importlib.util
+import tempfile
+import threading
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+#: Module the page wraps.
+CALIBRATE_MODULE = "pidcore.calibrate"
+#: Functions and tables the page needs from it.
+REQUIRED = ("calibrate", "measured_from_store", "write_outputs", "CATALOGUE", "parse_fit")
 
 
 def calibration_api() -> tuple[object | None, str]:
-    """``(module, "")`` when :mod:`pidcore.calibrate` is importable, else ``(None, reason)``."""
-    if importlib.util.find_spec("pidcore.calibrate") is None:
-        return None, ("pidcore.calibrate is not part of this installation yet (it is being "
-                      "written on the `calibrate` branch); use `pidcore calibrate` once merged")
+    """``(module, "")`` when :mod:`pidcore.calibrate` offers :data:`REQUIRED`, else
+    ``(None, reason)``."""
     try:
-        return importlib.import_module("pidcore.calibrate"), ""
+        module = importlib.import_module(CALIBRATE_MODULE)
+    except ModuleNotFoundError as exc:
+        if exc.name not in (CALIBRATE_MODULE, "pidcore"):
+            return None, f"{CALIBRATE_MODULE} cannot be imported: {exc}"
+        return None, (f"{CALIBRATE_MODULE} is not part of this installation yet (it is written "
+                      "on the `calibrate` branch); `pidcore calibrate` will be there once "
+                      "merged")
     except ImportError as exc:
-        return None, f"pidcore.calibrate cannot be imported: {exc}"
+        return None, f"{CALIBRATE_MODULE} cannot be imported: {exc}"
+    missing = [name for name in REQUIRED if not hasattr(module, name)]
+    if missing:
+        return None, f"{CALIBRATE_MODULE} lacks {', '.join(missing)}"
+    return module, ""
+
+
+@dataclass
+class CalibrationTask:
+    """One calibration: its state (``running``, ``done``, ``failed``) and outputs."""
+
+    fit: tuple[str, ...]
+    n_points: int
+    state: str = "running"
+    started: float = field(default_factory=time.time)
+    finished: float | None = None
+    message: str = ""
+    outputs: dict[str, bytes] = field(default_factory=dict)
+
+    def elapsed_s(self) -> float:
+        """Seconds since the start (to the end once finished)."""
+        return (self.finished or time.time()) - self.started
+
+
+class CalibrationRunner:
+    """One calibration at a time for one store, in a background thread."""
+
+    def __init__(self, store_path: str | Path) -> None:
+        self.store_path = Path(store_path)
+        self._lock = threading.Lock()
+        self.task: CalibrationTask | None = None
+
+    def start(self, api, points: Sequence, *, fit: Sequence[str], cells: int,
+              design_size: int | None) -> CalibrationTask | None:
+        """Start a calibration; None (nothing started) while one is running."""
+        with self._lock:
+            if self.task is not None and self.task.state == "running":
+                return None
+            task = self.task = CalibrationTask(tuple(fit), len(points))
+        threading.Thread(target=self._run, args=(api, task, list(points), list(fit), cells,
+                                                 design_size),
+                         name="pidcore-calibration", daemon=True).start()
+        return task
+
+    def _run(self, api, task: CalibrationTask, points, fit, cells, design_size) -> None:
+        try:
+            result = api.calibrate(points, fit=fit, store_path=self.store_path, cells=cells,
+                                   design_size=design_size, progress=False)
+            with tempfile.TemporaryDirectory(prefix="pidcore_calibration_") as folder:
+                paths = api.write_outputs(result, folder)
+                outputs = {Path(p).name: Path(p).read_bytes() for p in paths}
+            state, message = "done", f"{len(points)} load case(s), fitted {', '.join(fit)}"
+        except Exception as exc:  # noqa: BLE001 - shown on the page as the task's error
+            outputs, state, message = {}, "failed", f"{type(exc).__name__}: {exc}"
+        with self._lock:
+            task.outputs, task.state, task.message = outputs, state, message
+            task.finished = time.time()
+
+
+_RUNNERS: dict[str, CalibrationRunner] = {}
+_RUNNERS_LOCK = threading.Lock()
+
+
+def runner_for(store_path: str | Path) -> CalibrationRunner:
+    """The process-wide calibration runner of a store."""
+    key = str(Path(store_path).resolve())
+    with _RUNNERS_LOCK:
+        return _RUNNERS.setdefault(key, CalibrationRunner(key))

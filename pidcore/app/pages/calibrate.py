@@ -1,19 +1,87 @@
-"""Calibration page: fit the DEM to saved measurements (:mod:`pidcore.calibrate`)."""
+"""Calibration page: fit DEM parameters to the store's measurements (:mod:`pidcore.calibrate`),
+show the posterior and the measured-vs-predicted plot with bands, download the specimen."""
 
 from __future__ import annotations
 
+import dataclasses
+from pathlib import Path
+
+import pandas as pd
 import streamlit as st
 
-from pidcore.app.calibration import calibration_api
+from pidcore.app.calibration import calibration_api, runner_for
+
+
+@st.fragment(run_every=2.0)
+def _task(stores) -> None:
+    task = runner_for(stores.path).task
+    if task is None:
+        return
+    if task.state == "running":
+        st.info(f"calibrating ({', '.join(task.fit)}, {task.n_points} load case(s)): "
+                f"{task.elapsed_s():.0f} s elapsed; DEM runs are saved in the store as they "
+                "finish")
+        return
+    if task.state == "failed":
+        st.error(f"calibration failed: {task.message}")
+        return
+    st.success(f"calibrated in {task.elapsed_s():.0f} s: {task.message}")
+    out = task.outputs
+    if "summary.md" in out:
+        st.markdown(out["summary.md"].decode())
+    c1, c2 = st.columns(2)
+    if "predictions.png" in out:
+        c1.image(out["predictions.png"], caption="measured vs predicted SDC, 95 % bands")
+    if "posterior_pairs.png" in out:
+        c2.image(out["posterior_pairs.png"], caption="posterior")
+    mimes = {".toml": "application/toml", ".json": "application/json", ".html": "text/html"}
+    files = [n for n in sorted(out) if Path(n).suffix in mimes]
+    for col, name in zip(st.columns(max(len(files), 1)), files, strict=False):
+        label = f"calibrated specimen ({name})" if name.endswith(".toml") else name
+        col.download_button(label, out[name], file_name=name, mime=mimes[Path(name).suffix],
+                            key=f"calibration_{name}")
 
 
 def render(stores) -> None:
     """The page (a clear "not available" state while the calibration library is missing)."""
+    from pidcore.errors import PidcoreError
+
     st.subheader("Calibrate the DEM against measurements")
     api, reason = calibration_api()
     if api is None:
         st.info(f"Calibration is not available: {reason}.")
         return
-    st.info("pidcore.calibrate is installed; run `pidcore calibrate --store "
-            f"{stores.path}` for the posterior and the calibrated specimen (the page's own "
-            "controls are not built yet).")
+    try:
+        points = api.measured_from_store(stores.path) if stores.path.is_file() else []
+    except PidcoreError as exc:
+        st.info(f"Nothing to calibrate against: {exc}")
+        return
+    if not points:
+        st.info(f"{stores.path} holds no saved measurements with a load case yet.")
+        return
+    st.markdown(f"**Measured load cases** ({len(points)}, from the store)")
+    st.dataframe(pd.DataFrame([dataclasses.asdict(p) for p in points]), hide_index=True,
+                 width="stretch", key="calibration_points")
+    c1, c2, c3 = st.columns(3)
+    chosen = c1.multiselect("parameters to fit", sorted(api.CATALOGUE),
+                            default=[n for n in api.parse_fit(None) if n in api.CATALOGUE],
+                            key="calibration_fit")
+    extra = c1.text_input("more parameters (specimen fields, comma-separated)", "",
+                          key="calibration_fit_extra",
+                          help="e.g. friction, restitution (as `pidcore calibrate --fit`)")
+    cells = c2.number_input("cells per DEM run", min_value=1, max_value=64, value=4,
+                            key="calibration_cells")
+    design = c3.number_input("design points (0 = default)", min_value=0, value=0,
+                             key="calibration_design")
+    if st.button("Run calibration", type="primary", key="calibration_run",
+                 disabled=not (chosen or extra.strip())):
+        try:
+            fit = api.parse_fit([*chosen, *extra.split(",")])
+            started = runner_for(stores.path).start(api, points, fit=fit, cells=int(cells),
+                                                    design_size=int(design) or None)
+        except PidcoreError as exc:
+            st.error(str(exc))
+        else:
+            if started is None:
+                st.warning("a calibration is running already; wait for it to finish")
+    _task(stores)
