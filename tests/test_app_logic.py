@@ -641,3 +641,24 @@ def test_like_for_like_sdc_uses_the_dem_vibrated_mass_as_the_report_does(good_cs
     series = sdc_points(comp).groupby("series")
     assert series.get_group("measured, E of Eq. 10 (± stderr)")["SDC [-]"].iloc[0] == \
         comp.measured_sdc_eq10
+
+
+def test_load_case_pdf_has_the_plots_and_the_corrections_page(good_csv, options):
+    from dataclasses import replace
+
+    from pidcore.app.workbench import case_view
+    from pidcore.report.case_sheet import case_pdf
+
+    rec = _record(good_csv, options, name="c_fill50.csv")
+    corrected = replace(options, velocity_delay_s=50e-6, mass_below_gauge_kg=2e-3)
+    entry = MeasuredEntry.from_record(rec, load_case_of(rec, fill_percent=50,
+                                                        material="acrylic"),
+                                      options=corrected)
+    assert entry.corrections == ("vibrometer delay 50 µs, mass below gauge 2 g, "
+                                 "baseline loss factor 0")
+    view = case_view([entry], None, paper_table(), ())
+    assert view["comparison"].measured["corrections"].tolist() == [entry.corrections]
+    data = case_pdf(view, title="100 Hz, 5 g, 50 %")
+    assert data.startswith(b"%PDF")
+    # two pages (plots; files with their corrections): two page objects besides /Pages
+    assert data.count(b"/Type /Page /") == 2

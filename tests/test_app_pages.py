@@ -244,6 +244,14 @@ def test_saved_records_are_compared_after_a_reload_and_filtered(store_file):
     measured = next(d.value for d in fresh.dataframe if "origin" in d.value.columns)
     assert sorted(measured["file"]) == ["s1_fill50.csv", "s2_fill50.csv"]
     assert set(measured["origin"]) == {"store"}
+    # the corrections each record was saved with come back from the store
+    assert set(measured["corrections"]) == {
+        "vibrometer delay 0 µs, mass below gauge 0 g, baseline loss factor 0"}
+    fresh.button(key="case_pdf").click()
+    fresh.run()
+    pdf = next(b for b in fresh.get("download_button") if b.proto.label.startswith(
+        "Download the load case PDF"))
+    assert pdf is not None
     # pooled files get a consistency check (chi2/dof shown, with a warning above 3)
     said = " ".join([c.value for c in fresh.caption] + [w.value for w in fresh.warning])
     assert "χ²/dof" in said and ("2 files pooled" in said or "2 pooled files" in said)

@@ -171,6 +171,9 @@ class MeasuredEntry:
         Fitted harmonics (for the loop and the spectrum).
     specimen, created_utc : str
         Specimen named with the record (may be empty) and when it was saved.
+    corrections : str
+        The corrections the analysis ran with, e.g. ``"vibrometer delay 50 µs, mass below
+        gauge 0 g, baseline loss factor 0"`` (empty where unknown).
     """
 
     key: str
@@ -188,18 +191,21 @@ class MeasuredEntry:
     velocity_phasors_m_s: np.ndarray
     specimen: str = ""
     created_utc: str = ""
+    corrections: str = ""
 
     @classmethod
     def from_record(cls, record: AnalyzedRecord, load_case: LoadCase, *,
-                    specimen: str = "") -> MeasuredEntry:
-        """Entry of a fresh (unsaved) analysis."""
+                    specimen: str = "", options=None) -> MeasuredEntry:
+        """Entry of a fresh (unsaved) analysis; ``options`` (AnalysisOptions) names the
+        corrections."""
         a = record.analysis
         return cls(f"upload:{record.measurement.sha256}", Path(record.measurement.source).name,
                    "this session (unsaved)", load_case, float(a.frequency_hz),
                    float(a.acceleration_amplitude_m_s2), float(a.loss_factor), float(a.sdc),
                    float(a.sdc_stderr), float(a.energy_per_cycle_j),
                    np.asarray(a.harmonics), np.asarray(a.force_phasors_n),
-                   np.asarray(a.velocity_phasors_m_s), specimen)
+                   np.asarray(a.velocity_phasors_m_s), specimen,
+                   corrections=describe_corrections(vars(options)) if options else "")
 
     @classmethod
     def from_store(cls, row: pd.Series, arrays: dict) -> MeasuredEntry:
@@ -216,7 +222,8 @@ class MeasuredEntry:
                    np.asarray(arrays.get("harmonics", empty)),
                    np.asarray(arrays.get("force_phasors_n", empty)),
                    np.asarray(arrays.get("velocity_phasors_m_s", empty)),
-                   str(row.get("specimen", "") or ""), str(row.get("created_utc", "")))
+                   str(row.get("specimen", "") or ""), str(row.get("created_utc", "")),
+                   describe_corrections(_json_dict(row.get("parameters_json"))))
 
     def loop(self):
         """The measured loop (:class:`pidcore.signal.loops.LoopCurve`), or a note why none."""
@@ -239,6 +246,27 @@ class MeasuredEntry:
             "force amplitude [N]": np.abs(np.asarray(self.force_phasors_n)),
             "velocity amplitude [m/s]": np.abs(np.asarray(self.velocity_phasors_m_s)),
         })
+
+
+def _json_dict(text) -> dict:
+    import json
+
+    try:
+        found = json.loads(text) if isinstance(text, str) and text else {}
+    except ValueError:
+        return {}
+    return found if isinstance(found, dict) else {}
+
+
+def describe_corrections(parameters: dict) -> str:
+    """The corrections of an analysis in words, units at the edge (µs, g)."""
+    if not parameters:
+        return ""
+    delay = float(parameters.get("velocity_delay_s", 0.0) or 0.0) * 1e6
+    mass = float(parameters.get("mass_below_gauge_kg", 0.0) or 0.0) * 1e3
+    baseline = float(parameters.get("baseline_loss_factor", 0.0) or 0.0)
+    return (f"vibrometer delay {delay:g} µs, mass below gauge {mass:g} g, "
+            f"baseline loss factor {baseline:g}")
 
 
 def compare_case(records: Sequence[MeasuredEntry],
@@ -270,6 +298,7 @@ def compare_case(records: Sequence[MeasuredEntry],
         "file": [r.file for r in records],
         "origin": [r.origin for r in records],
         "specimen": [r.specimen for r in records],
+        "corrections": [r.corrections for r in records],
         "fill [%]": [r.load_case.fill_percent for r in records],
         "SDC [-]": [r.sdc for r in records],
         "SDC stderr [-]": [r.sdc_stderr for r in records],

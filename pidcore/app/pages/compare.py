@@ -34,7 +34,8 @@ def _entries(stores, session_files):
     if include:
         known = {(e.file, e.sdc) for e in entries}
         for f in session_files:
-            e = MeasuredEntry.from_record(f.record, f.load_case, specimen=f.specimen)
+            e = MeasuredEntry.from_record(f.record, f.load_case, specimen=f.specimen,
+                                          options=f.options)
             if (e.file, e.sdc) not in known:
                 entries.append(e)
     return entries
@@ -110,6 +111,16 @@ def render(stores, session_files: list) -> None:
     left2.vega_lite_chart(spec=view["spectrum_spec"], key="spectrum_chart")
     right2.dataframe(view["spectrum"], hide_index=True, width="stretch")
     st.dataframe(comp.measured, hide_index=True, width="stretch", key="compare_measured")
+    if st.button("PDF of this load case (plots and corrections)", key="case_pdf"):
+        from pidcore.report.case_sheet import case_pdf
+
+        st.session_state["case_pdf_bytes"] = (_group_key(members), case_pdf(
+            view, title=labels[choice]))
+    made = st.session_state.get("case_pdf_bytes")
+    if made and made[0] == _group_key(members):
+        st.download_button("Download the load case PDF", made[1], mime="application/pdf",
+                           file_name=f"pidcore_{comp.load_case.key}.pdf",
+                           key="case_pdf_download")
     # Warm the cache for the other load cases after this one is on screen, so that switching
     # to any of them is a cache hit.
     warmed = st.session_state.setdefault("_compare_warmed", set())
