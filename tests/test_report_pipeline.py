@@ -183,3 +183,36 @@ def test_missing_dem_store_is_an_error(tmp_path):
     with pytest.raises(StoreError, match="not found"):
         make_report([file], out_dir=tmp_path / "out", dem_store=tmp_path / "nope.h5")
     assert not (tmp_path / "out").exists()
+
+
+def test_cli_pool_merges_dem_settings_that_are_separate_rows_by_default(tmp_path, dem_store):
+    import shutil
+
+    # a 2-cell smoke run beside the store's 8-cell run at 500 Hz, 5 g, 50 %
+    store = tmp_path / "dem.h5"
+    shutil.copy(dem_store, store)
+    Store(store).add_dem_run("smoke", {
+        "frequency_hz": FREQ_HZ, "acceleration_g": ACC_G, "fill_percent": 50.0,
+        "material": "acrylic", "direction": "z", "sdc": 9.0, "sdc_stderr": 0.5,
+        "cells_simulated": 2, "seed": 11},
+        parameters={"config_cells": 2, "config_seed": 11, "config_steady_cycles": 4})
+    at_case = (f"{FREQ_HZ:g}", f"{ACC_G:g}", "50")
+
+    def rows(*extra):
+        out = tmp_path / ("pooled" if extra else "separate")
+        assert main(["report", "--dem-store", str(store), "--out", str(out), "--format",
+                     "csv", *extra]) == 0
+        table = pd.read_csv(out / "report.csv")  # the CSV is the table, nothing else
+        keep = [(f"{f:g}", f"{a:g}", f"{p:g}") == at_case for f, a, p in zip(
+            table["frequency [Hz]"], table["acceleration [g]"], table["packing ratio [%]"],
+            strict=True)]
+        assert (out / "report.provenance.txt").is_file()  # notes and provenance go here
+        return table[keep]
+
+    separate = rows()
+    assert len(separate) == 2 and sorted(separate["DEM runs [-]"]) == [1, 1]
+    # the smoke run's 9.0 is never averaged into the 8-cell run's value
+    assert 9.0 in separate["SDC DEM (ours) [-]"].tolist()
+    pooled = rows("--pool")
+    assert len(pooled) == 1 and pooled["DEM runs [-]"].iloc[0] == 2
+    assert "--pool" in pooled["note"].iloc[0]
