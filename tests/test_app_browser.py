@@ -6,6 +6,7 @@ browser is downloaded: Playwright drives the system chromium through ``executabl
 
 from __future__ import annotations
 
+import json
 import os
 import re
 import socket
@@ -32,6 +33,8 @@ CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-backg
 #: The issue's budget: Cancel stops a running case within this many seconds (the job table
 #: refreshes every second, so what the browser sees includes up to one refresh).
 CANCEL_BUDGET_S = 2.0
+#: The issue's budget for a page switch, s.
+PAGE_SWITCH_BUDGET_S = 1.0
 #: Seconds to wait for the server to answer and for results to appear (cold imports included).
 START_TIMEOUT_S = 45
 RESULT_TIMEOUT_MS = 30_000
@@ -225,6 +228,20 @@ def test_upload_shows_sdc_and_the_loop_overlay_renders(app_url, sample, tmp_path
     headline = page.get_by_role("heading").filter(has_text="vs our DEM")
     assert "±" in headline.first.inner_text() and "σ" in headline.first.inner_text()
     page.screenshot(path=str(ARTIFACTS / "app_e2e.png"), full_page=True)
+    # page switches: each tab's heading visible within the budget
+    timings = {}
+    for tab, heading in (("Report", "Report (Table 3 style)"), ("DEM", "DEM: run load cases"),
+                         ("Calibrate", "Calibrate the DEM"), ("Analyse", "Upload & analyse"),
+                         ("Compare", "Compare per load case")):
+        start = time.monotonic()
+        page.get_by_role("tab", name=tab).click()
+        page.get_by_role("heading", name=heading).wait_for(state="visible",
+                                                           timeout=RESULT_TIMEOUT_MS)
+        timings[tab] = time.monotonic() - start
+    (ARTIFACTS / "app_e2e_page_switch.json").write_text(json.dumps(
+        {"page_switch_s": timings, "note": "tab click to the tab's heading visible, chromium"},
+        indent=1))
+    assert max(timings.values()) <= PAGE_SWITCH_BUDGET_S, timings
 
 
 def _job_states(page) -> str:
