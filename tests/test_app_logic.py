@@ -161,6 +161,7 @@ def test_a_settings_table_is_detected_by_its_columns_under_any_name():
     assert not uploads.is_settings_table(mass_damper_csv())
     assert not uploads.is_settings_table(b"file,notes\nx,y\n")  # no settings column
     table = uploads.read_settings_table("my setup.csv", table_bytes)
+    assert table.attrs["given"] == ["fill [%]", "specimen", "vibrometer delay [µs]"]
     names = ["a_fill50.csv", "b_fill75.csv"]
     settings = uploads.merge_settings(names, [stated_case(n) for n in names], None, [table])
     a, b = settings.iloc[0], settings.iloc[1]

@@ -231,8 +231,9 @@ def read_settings_table(name: str, data: bytes) -> pd.DataFrame:
     """An uploaded settings table as rows of :data:`FILE_TABLE_COLUMNS` (app column names).
 
     Columns may be given by their template or app names; missing ones stay empty (NaN or "")
-    and leave a file's other settings alone. Raises :class:`ParameterError` naming the table,
-    row and column for a value that is not a number, material or direction.
+    and leave a file's other settings alone (``attrs["given"]`` lists the columns given).
+    Raises :class:`ParameterError` naming the table, row and column for a value that is not a
+    number, material or direction.
     """
     from ..compare.loadcase import normalize_direction, normalize_material
 
@@ -263,6 +264,7 @@ def read_settings_table(name: str, data: bytes) -> pd.DataFrame:
         out[column] = [normalize(v, f"{name}: {column}") if v else "" for v in out[column]]
     if (out["file"] == "").any():
         raise ParameterError(f"{name}: every row needs a file name")
+    out.attrs["given"] = [c for c in FILE_TABLE_COLUMNS if c in raw.columns and c != "file"]
     return out
 
 

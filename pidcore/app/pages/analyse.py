@@ -155,7 +155,7 @@ def render(stores) -> list:
                 continue
             tables[state.upload_sha256(upload)] = table
             st.info(f"{upload.name}: settings of {len(table)} file(s) read "
-                    f"({', '.join(c for c in table.columns if c != 'file')})")
+                    f"({', '.join(table.attrs.get('given', []))})")
         else:
             measurements.append(upload)
     if not measurements:
