@@ -663,3 +663,22 @@ def test_load_case_pdf_has_the_plots_and_the_corrections_page(good_csv, options)
     assert data.startswith(b"%PDF")
     # two pages (plots; files with their corrections): two page objects besides /Pages
     assert data.count(b"/Type /Page /") == 2
+
+
+def test_a_file_saved_again_with_other_corrections_counts_once(tmp_path, good_csv, options):
+    from dataclasses import replace
+
+    from pidcore.store.listing import saved_analyses
+
+    store_file = tmp_path / "s.h5"
+    rec = _record(good_csv, options, name="c_fill50.csv")
+    uploads.save_records(store_file, [_file(rec, options)])
+    delayed = replace(options, velocity_delay_s=20e-6)
+    rec2 = uploads.analyze_upload("c_fill50.csv", good_csv, delayed).record
+    uploads.save_records(store_file, [_file(rec2, delayed)])
+    saved = saved_analyses(store_file)
+    # both analyses are kept in the store, the newest one is the file's result
+    assert len(saved) == 1 and saved["sdc"].iloc[0] == rec2.analysis.sdc
+    assert saved["file"].tolist() == ["c_fill50.csv"]
+    table = store_report_table(store_file)
+    assert table["SDC measured [-]"].dropna().tolist() == [rec2.analysis.sdc]

@@ -512,3 +512,18 @@ def test_calibrate_page_runs_the_library_on_the_stores_measurements(store_file, 
     assert any("Calibration summary" in m.value for m in at.markdown)
     labels = [b.label for b in at.get("download_button")]
     assert "calibrated specimen (calibrated_specimen.toml)" in labels
+
+
+def test_report_chooses_among_the_saved_records(store_file):
+    files = [("a_fill50.csv", mass_damper_csv(frequency_hz=100.0)),
+             ("b_fill75.csv", mass_damper_csv(frequency_hz=100.0, seed=3))]
+    at = _upload(_app(), files)
+    at.button(key="save").click()
+    at.run()
+    at.run()
+    table = _table(at, "SDC measured [-]")
+    assert sorted(s for s in table["source file(s)"] if s) == ["a_fill50.csv", "b_fill75.csv"]
+    at.multiselect(key="report_filter_files").set_value(["b_fill75.csv"])
+    at.run()
+    table = _table(at, "SDC measured [-]")
+    assert [s for s in table["source file(s)"] if s] == ["b_fill75.csv"]

@@ -42,17 +42,22 @@ def upload_sha256(upload) -> str:
 @st.cache_data(max_entries=16, show_spinner=False)
 def store_listing(what: str, stamp: tuple, _stores):
     """Store listings, re-read only when a store file changed (``AppStores.stamp``)."""
-    from pidcore.report.downloads import store_report_table
     from pidcore.store.listing import list_dem_runs, saved_analyses
 
     if what == "dem_runs":
         return list_dem_runs(_stores.path, _stores.dem_reference)
     if what == "analyses":
         return saved_analyses(_stores.path)
-    if what in ("report_table", "report_table_pooled"):
-        return store_report_table(_stores.path, _stores.dem_reference,
-                                  pool=what.endswith("pooled"))
     raise ValueError(what)
+
+
+@st.cache_data(max_entries=16, show_spinner=False)
+def report_table(stamp: tuple, pool: bool, keys: tuple[str, ...] | None, _stores):
+    """The report table of the stores (only the analyses ``keys``, all when None)."""
+    from pidcore.report.downloads import store_report_table
+
+    return store_report_table(_stores.path, _stores.dem_reference, pool=pool,
+                              analysis_keys=None if keys is None else list(keys))
 
 
 @st.cache_resource(max_entries=_CACHE_ENTRIES, show_spinner=False)

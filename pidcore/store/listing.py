@@ -37,9 +37,10 @@ def list_dem_runs(*paths: str | os.PathLike | None) -> pd.DataFrame:
 def saved_analyses(path: str | os.PathLike, *, latest_only: bool = True) -> pd.DataFrame:
     """Analyses of a store that state a load case (a fill), newest first.
 
-    ``latest_only`` keeps the newest analysis of each measurement and set of parameters
-    (re-analysing with other corrections is a separate record). Adds ``file`` (the source's
-    name) and ``date`` (``YYYY-MM-DD`` of ``created_utc``). Empty for a missing store.
+    ``latest_only`` keeps the newest analysis of each measurement (a file re-analysed with
+    other corrections replaces its earlier result rather than being counted twice, as
+    ``pidcore report`` does). Adds ``file`` (the source's name) and ``date`` (``YYYY-MM-DD`` of
+    ``created_utc``). Empty for a missing store.
     """
     if not Path(path).is_file():
         return pd.DataFrame()
@@ -50,7 +51,7 @@ def saved_analyses(path: str | os.PathLike, *, latest_only: bool = True) -> pd.D
     out = analyses[np.isfinite(fill.to_numpy(float))].copy()
     if latest_only:
         out = (out.sort_values("created_utc", kind="stable")
-               .groupby(["measurement_key", "parameters_json"], sort=False).tail(1))
+               .groupby("measurement_key", sort=False).tail(1))
     out["file"] = [Path(str(s)).name for s in out["source"]]
     out["date"] = out["created_utc"].astype(str).str[:10]
     if "specimen" not in out.columns:

@@ -105,7 +105,7 @@ def _card(upload, row, sample_rate_hz):
                      "the settings table")
             return None
         a = record.analysis
-        m1, m2, m3, m4 = st.columns(4)
+        m1, m2, m3, m4 = st.columns([1, 1, 1, 1.6])  # the SDC ± stderr needs the room
         m1.metric("frequency [Hz]", f"{a.frequency_hz:.3f}")
         m2.metric("acceleration [g]", f"{a.acceleration_g:.3f}")
         m3.metric("loss factor [-]", f"{a.loss_factor:.5f}")

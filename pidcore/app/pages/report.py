@@ -13,12 +13,22 @@ def render(stores) -> None:
     from pidcore.report.downloads import report_files
 
     st.subheader("Report (Table 3 style)")
-    pool = st.checkbox("pool DEM settings and specimens at one load case", value=False,
-                       key="report_pool",
-                       help="default: a row per DEM setting and per specimen")
+    stamp = stores.stamp()
     try:
-        table = state.store_listing("report_table_pooled" if pool else "report_table",
-                                    stores.stamp(), stores)
+        saved = state.store_listing("analyses", stamp, stores)
+    except PidcoreError as exc:
+        st.error(f"cannot read the store: {exc}")
+        return
+    c1, c2 = st.columns([3, 1])
+    chosen = c1.multiselect("measurements in the report (all when none chosen)",
+                            sorted(set(saved["file"])) if not saved.empty else [],
+                            key="report_filter_files")
+    pool = c2.checkbox("pool DEM settings and specimens at one load case", value=False,
+                       key="report_pool", help="default: a row per DEM setting and per specimen")
+    keys = (tuple(saved[saved["file"].isin(chosen)]["key"]) if chosen and not saved.empty
+            else None)
+    try:
+        table = state.report_table(stamp, pool, keys, stores)
     except PidcoreError as exc:
         st.error(f"cannot read the store: {exc}")
         return
@@ -32,12 +42,13 @@ def render(stores) -> None:
     if st.button("Build report files (CSV, Markdown, HTML, LaTeX, PDF)", key="build_report"):
         try:
             with st.spinner("Writing the report ..."):
-                st.session_state["report_files"] = ((stores.stamp(), pool), report_files(
-                    stores.path, stores.dem_reference, pool=pool))
+                st.session_state["report_files"] = ((stamp, pool, keys), report_files(
+                    stores.path, stores.dem_reference, pool=pool,
+                    analysis_keys=None if keys is None else list(keys)))
         except PidcoreError as exc:
             st.error(f"no report: {exc}")
-    stamp, files = st.session_state.get("report_files") or (None, None)
-    if files and stamp == (stores.stamp(), pool):  # files of an older state are not offered
+    made, files = st.session_state.get("report_files") or (None, None)
+    if files and made == (stamp, pool, keys):  # files of an older state are not offered
         cols = st.columns(len(files))
         for col, (fmt, (name, data, mime)) in zip(cols, files.items(), strict=True):
             label = "CSV notes" if fmt == "csv_provenance" else fmt.upper()
