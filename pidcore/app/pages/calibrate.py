@@ -59,7 +59,11 @@ def render(stores) -> None:
     if not points:
         st.info(f"{stores.path} holds no saved measurements with a load case yet.")
         return
-    st.markdown(f"**Measured load cases** ({len(points)}, from the store)")
+    labels = [f"{p.frequency_hz:g} Hz, {p.acceleration_g:g} g, {p.fill_percent:g} %"
+              for p in points]
+    chosen_cases = st.multiselect("measured load cases to calibrate against (from the store)",
+                                  labels, default=labels, key="calibration_cases")
+    points = [p for p, label in zip(points, labels, strict=True) if label in chosen_cases]
     st.dataframe(pd.DataFrame([dataclasses.asdict(p) for p in points]), hide_index=True,
                  width="stretch", key="calibration_points")
     c1, c2, c3 = st.columns(3)
@@ -74,7 +78,7 @@ def render(stores) -> None:
     design = c3.number_input("design points (0 = default)", min_value=0, value=0,
                              key="calibration_design")
     if st.button("Run calibration", type="primary", key="calibration_run",
-                 disabled=not (chosen or extra.strip())):
+                 disabled=not points or not (chosen or extra.strip())):
         try:
             fit = api.parse_fit([*chosen, *extra.split(",")])
             started = runner_for(stores.path).start(api, points, fit=fit, cells=int(cells),
