@@ -31,6 +31,9 @@ HARMONIC_MAX_FRACTION_OF_NYQUIST = 0.9
 #: Longest FFT used for the coarse drive-frequency estimate (memory bound on long records).
 FREQUENCY_FFT_MAX_SAMPLES = 2**20
 
+#: Points on one synthesised force-displacement loop (:class:`pidcore.loop.ForceDisplacementLoop`).
+LOOP_POINTS = 256
+
 # --- DEM ------------------------------------------------------------------------------------
 DEM_TIME_STEP_S = 2e-6
 DEM_MIN_STEPS_PER_CONTACT = 10

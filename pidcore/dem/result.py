@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .. import defaults
+from ..loop import ForceDisplacementLoop
 
 if TYPE_CHECKING:  # pragma: no cover
     from .contact import ContactLaw
@@ -210,28 +211,65 @@ class DemResult:
     def arrays(self) -> dict[str, np.ndarray]:
         return {name: np.asarray(getattr(self, name)) for name in self.array_names()}
 
-    def plot(self, ax=None):
-        """Per-cycle dissipation (top) and wall force over the last cycles (bottom).
+    def loop(self, n_points: int = defaults.LOOP_POINTS, *,
+             n_harmonics: int = defaults.N_HARMONICS) -> ForceDisplacementLoop:
+        """One period of the steady virtual shaker record's force-displacement loop.
+
+        Built exactly as a measurement's (:func:`virtual_shaker_loop`), so the two loops'
+        areas are comparable energies per cycle.
+        """
+        return virtual_shaker_loop(
+            self.shaker_force_n, self.velocity_m_s, sample_rate_hz=self.sample_rate_hz,
+            frequency_hz=self.case.frequency_hz, steady_start_cycle=self.steady_start_cycle,
+            n_points=n_points, n_harmonics=n_harmonics, label=f"DEM {self.case.key()}")
+
+    def plot(self, ax: Any = None) -> Any:
+        """Per-cycle dissipation and forces (:func:`pidcore.report.figures_results.plot_dem_run`).
 
         ``ax``: a pair of matplotlib axes, or None for a new figure. Returns the axes.
         """
-        import matplotlib.pyplot as plt
+        from ..report.figures_results import plot_dem_run  # lazy: drawing is optional
 
-        if ax is None:
-            _, ax = plt.subplots(2, 1, figsize=(7, 6), constrained_layout=True)
-        a0, a1 = ax
-        cycles = np.arange(len(self.dissipation_per_cycle_j))
-        a0.plot(cycles, self.dissipation_per_cycle_j, ".-", label="coupon")
-        a0.axvline(self.steady_start_cycle, color="k", ls="--", label="steady from")
-        a0.set_xlabel("cycle [-]")
-        a0.set_ylabel("dissipated per cycle [J]")
-        a0.legend()
-        n = 5 * self.samples_per_cycle
-        a1.plot(self.sample_time_s[-n:], self.wall_force_n[-n:], label="walls on particles")
-        a1.plot(self.sample_time_s[-n:], self.shaker_force_n[-n:], label="shaker force")
-        a1.set_xlabel("time [s]")
-        a1.set_ylabel("force [N]")
-        a1.legend()
-        a0.set_title(f"{self.case.key()}: SDC {self.sdc:.4g} +- {self.sdc_stderr:.2g}, "
-                     f"{self.particles_per_cell} particles/cell")
-        return ax
+        return plot_dem_run(self, ax=ax)
+
+
+def virtual_shaker_loop(force_n: np.ndarray, velocity_m_s: np.ndarray, *,
+                        sample_rate_hz: float, frequency_hz: float,
+                        steady_start_cycle: float = 0,
+                        n_points: int = defaults.LOOP_POINTS,
+                        n_harmonics: int = defaults.N_HARMONICS,
+                        label: str = "DEM") -> ForceDisplacementLoop:
+    """Force-displacement loop of a DEM run's virtual shaker record (arrays in SI units).
+
+    The record from ``steady_start_cycle`` on goes through the same harmonic analysis as a
+    measurement (:func:`pidcore.signal.analyze_power`); a short record (fewer than
+    :data:`pidcore.defaults.MIN_PERIODS` steady cycles, at least 2) is accepted with fewer
+    uncertainty blocks, as the loop needs no standard error.
+
+    Raises
+    ------
+    ParameterError
+        Arrays of different shapes, or fewer than 2 steady cycles.
+    SignalError
+        The record cannot be analysed (no dominant drive frequency).
+    """
+    from ..errors import ParameterError
+    from ..signal import analyze_power
+
+    force = np.asarray(force_n, dtype=np.float64)
+    velocity = np.asarray(velocity_m_s, dtype=np.float64)
+    if force.ndim != 1 or force.shape != velocity.shape:
+        raise ParameterError(f"{label}: force and velocity records differ in shape "
+                             f"({force.shape} vs {velocity.shape})")
+    per_cycle = float(sample_rate_hz) / float(frequency_hz)
+    start = int(round(float(steady_start_cycle or 0) * per_cycle))
+    cycles = int((force.size - start) / per_cycle)
+    if cycles < 2:
+        raise ParameterError(f"{label}: {cycles} steady cycles in the virtual shaker record, "
+                             "expected at least 2")
+    analysis = analyze_power(force[start:], velocity[start:], float(sample_rate_hz),
+                             frequency_hz=float(frequency_hz), n_harmonics=n_harmonics,
+                             min_periods=min(defaults.MIN_PERIODS, cycles),
+                             n_blocks=max(2, min(defaults.N_UNCERTAINTY_BLOCKS, cycles)),
+                             source=label)
+    return analysis.loop(n_points)

@@ -16,6 +16,8 @@ from collections.abc import Mapping
 import numpy as np
 import pandas as pd
 
+from .. import defaults
+from ..loop import ForceDisplacementLoop
 from .table import ALIGNMENT_COLUMN
 
 #: Force arrays looked for in a DEM run, in order: the force a shaker's gauge would measure
@@ -142,40 +144,31 @@ def dem_loop_from_arrays(arrays: Mapping[str, np.ndarray],
 
 
 def loop_from_phasors(arrays: Mapping[str, np.ndarray], frequency_hz: object, *,
-                      n_points: int = 256) -> tuple[np.ndarray, np.ndarray] | str:
+                      n_points: int = defaults.LOOP_POINTS) -> ForceDisplacementLoop | str:
     """One period of a stored analysis' force-displacement loop, or a note why there is none.
 
-    Rebuilt from the stored harmonic phasors (``harmonics``, ``force_phasors_n``,
-    ``velocity_phasors_m_s``, as :func:`pidcore.measure.analysis_arrays` stores them) exactly as
-    :meth:`pidcore.signal.PowerAnalysis.force_displacement_loop` does: X_n = V_n / (j n w).
+    Reads the stored harmonic phasors (``harmonics``, ``force_phasors_n``,
+    ``velocity_phasors_m_s``, as :func:`pidcore.measure.analysis_arrays` stores them) into
+    :meth:`pidcore.loop.ForceDisplacementLoop.from_phasors`, the synthesis behind
+    :meth:`pidcore.signal.PowerAnalysis.loop`.
     """
     needed = ("harmonics", "force_phasors_n", "velocity_phasors_m_s")
     if any(name not in arrays for name in needed):
         return f"stored analysis keeps no harmonic phasors ({', '.join(needed)})"
     if not isinstance(frequency_hz, int | float) or not frequency_hz > 0:
         return "stored analysis has no drive frequency"
-    harmonics = np.asarray(arrays["harmonics"], dtype=float)
-    force = np.asarray(arrays["force_phasors_n"], dtype=complex)
-    velocity = np.asarray(arrays["velocity_phasors_m_s"], dtype=complex)
-    omega = 2 * np.pi * float(frequency_hz)
-    phase = 2 * np.pi * np.arange(n_points) / n_points
-    rot = np.exp(1j * np.outer(harmonics, phase))
-    displacement = velocity / (1j * harmonics * omega)
-    return np.real(displacement @ rot), np.real(force @ rot)
+    return ForceDisplacementLoop.from_phasors(
+        arrays["harmonics"], arrays["force_phasors_n"], arrays["velocity_phasors_m_s"],
+        float(frequency_hz), n_points=n_points)
 
 
-def loop_arrays(loop: object) -> tuple[np.ndarray, np.ndarray]:
-    """(displacement m, force N) from a loop object or a 2-tuple.
-
-    Accepts a ``(displacement, force)`` tuple or an object with attributes ``displacement_m`` and
-    ``force_n`` (as :meth:`PowerAnalysis.force_displacement_loop` returns).
-    """
+def loop_arrays(loop: ForceDisplacementLoop | tuple) -> tuple[np.ndarray, np.ndarray]:
+    """(displacement m, force N) from a :class:`~pidcore.loop.ForceDisplacementLoop` or a
+    ``(displacement, force)`` 2-tuple."""
+    if isinstance(loop, ForceDisplacementLoop):
+        return loop.displacement_m, loop.force_n
     if isinstance(loop, tuple) and len(loop) == 2:
         return np.asarray(loop[0], dtype=float), np.asarray(loop[1], dtype=float)
-    for xname, fname in (("displacement_m", "force_n"), ("displacement", "force")):
-        if hasattr(loop, xname) and hasattr(loop, fname):
-            return (np.asarray(getattr(loop, xname), dtype=float),
-                    np.asarray(getattr(loop, fname), dtype=float))
     raise TypeError(f"cannot read a force-displacement loop from {type(loop).__name__}")
 
 

@@ -32,6 +32,7 @@ from .render import check_out_dir, parse_formats, write_report
 from .table import build_report_table
 
 if TYPE_CHECKING:  # pragma: no cover
+    from ..loop import ForceDisplacementLoop
     from ..measure import AnalysisOptions, AnalyzedRecord
 
 # pidcore.measure (readers, signal analysis) is imported where used: `import pidcore.report`
@@ -189,13 +190,13 @@ def _store_results(store, results: list[MeasuredResult], options: AnalysisOption
 
 
 def _measured_loops(results: list[MeasuredResult], analyses: pd.DataFrame, store,
-                    notes: list[str]) -> list[tuple[str, LoadCase, tuple]]:
+                    notes: list[str]) -> list[tuple[str, LoadCase, ForceDisplacementLoop]]:
     """(name, load case, loop) per measurement: from the fresh analyses, else from the store's
     harmonic phasors (store-only reports)."""
     from .comparison_figures import loop_from_phasors
 
     if results:
-        return [(r.path.name, r.load_case, r.analysis.force_displacement_loop())
+        return [(r.path.name, r.load_case, r.analysis.loop())
                 for r in results]
     loops = []
     if store is None or analyses.empty or "key" not in analyses.columns:
@@ -215,7 +216,7 @@ def _measured_loops(results: list[MeasuredResult], analyses: pd.DataFrame, store
 
 
 def _figures(table: pd.DataFrame, dem_runs: pd.DataFrame | None, aligner: Aligner,
-             loops: list[tuple[str, LoadCase, tuple]], dem_store,
+             loops: list[tuple[str, LoadCase, ForceDisplacementLoop]], dem_store,
              notes: list[str]) -> dict[str, object]:
     from .comparison_figures import dem_loop_from_arrays, plot_loop_overlay, plot_sdc_comparison
 

@@ -46,10 +46,12 @@ from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
+import pandas as pd
 
 from .. import defaults
 from ..constants import STANDARD_GRAVITY
 from ..errors import ParameterError, SignalError
+from ..loop import ForceDisplacementLoop
 from ..records import Channel
 from . import validate
 from .frequency import estimate_drive_frequency
@@ -148,18 +150,44 @@ class PowerAnalysis:
         """Drive period, s."""
         return 1.0 / self.frequency_hz
 
-    def force_displacement_loop(self, n_points: int = 256) -> tuple[np.ndarray, np.ndarray]:
+    def loop(self, n_points: int = defaults.LOOP_POINTS, *,
+             label: str | None = None) -> ForceDisplacementLoop:
         """One period of the reconstructed force-displacement loop (harmonic synthesis).
 
-        Returns ``(displacement_m, force_n)`` at ``n_points`` equally spaced phases (the curve
-        is closed: the point after the last is the first). DC is left out. The loop's area,
-        ``oint f dx``, equals ``complex_power_w.real * period_s`` (the energy per cycle before
-        baseline subtraction).
+        ``n_points`` equally spaced phases; DC is left out. The loop's area
+        (``energy_per_cycle_j``) equals ``complex_power_w.real * period_s`` (the energy per
+        cycle before baseline subtraction). ``label`` defaults to :attr:`source`.
         """
-        phase = 2 * np.pi * np.arange(n_points) / n_points
-        rot = np.exp(1j * np.outer(self.harmonics, phase))
-        disp = self.velocity_phasors_m_s / (1j * self.harmonics * self.omega_rad_s)
-        return (np.real(disp @ rot), np.real(self.force_phasors_n @ rot))
+        return ForceDisplacementLoop.from_phasors(
+            self.harmonics, self.force_phasors_n, self.velocity_phasors_m_s, self.frequency_hz,
+            n_points=n_points, label=self.source if label is None else label)
+
+    def force_displacement_loop(self, n_points: int = defaults.LOOP_POINTS,
+                                ) -> tuple[np.ndarray, np.ndarray]:
+        """``(displacement_m, force_n)`` of :meth:`loop` (kept for callers of pidcore 0.1)."""
+        loop = self.loop(n_points)
+        return loop.displacement_m, loop.force_n
+
+    def spectrum_frame(self) -> pd.DataFrame:
+        """Fitted harmonics, one row each: order, frequency, amplitudes and phases (SI units).
+
+        Columns ``harmonic [-]``, ``frequency [Hz]``, ``force amplitude [N]``,
+        ``velocity amplitude [m/s]``, ``force phase [rad]``, ``velocity phase [rad]``
+        (``|F_n|`` and ``arg F_n`` of the one-sided phasors, after corrections).
+        """
+        n = np.asarray(self.harmonics, dtype=int)
+        f = np.asarray(self.force_phasors_n, dtype=complex)
+        v = np.asarray(self.velocity_phasors_m_s, dtype=complex)
+        frame = pd.DataFrame({
+            "harmonic [-]": n,
+            "frequency [Hz]": n.astype(float) * self.frequency_hz,
+            "force amplitude [N]": np.abs(f),
+            "velocity amplitude [m/s]": np.abs(v),
+            "force phase [rad]": np.angle(f),
+            "velocity phase [rad]": np.angle(v),
+        })
+        frame.attrs.update(source=self.source, frequency_hz=self.frequency_hz, sdc=self.sdc)
+        return frame
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-safe scalars (NaN -> None); includes the CLI keys."""
@@ -199,24 +227,11 @@ class PowerAnalysis:
         }
 
     def plot(self, ax: Any = None) -> Any:
-        """Harmonic spectrum: |F_n| (N, left axis) and |V_n| (m/s, right axis). Returns ``ax``."""
-        import matplotlib.pyplot as plt  # lazy: plotting is optional
+        """Harmonic spectrum (:func:`pidcore.report.figures_results.plot_spectrum`); returns ``ax``.
+        """
+        from ..report.figures_results import plot_spectrum  # lazy: drawing is optional
 
-        if ax is None:
-            _, ax = plt.subplots()
-        n = self.harmonics
-        ax.bar(n - 0.2, np.abs(self.force_phasors_n), width=0.4, color="C0", label="|F_n| [N]")
-        ax.set_xlabel("harmonic order n [-]")
-        ax.set_ylabel("force amplitude [N]")
-        ax.set_yscale("log")
-        ax2 = ax.twinx()
-        ax2.bar(n + 0.2, np.abs(self.velocity_phasors_m_s), width=0.4, color="C1",
-                label="|V_n| [m/s]")
-        ax2.set_ylabel("velocity amplitude [m/s]")
-        ax2.set_yscale("log")
-        ax.set_xticks(n)
-        ax.set_title(f"{self.source} {self.frequency_hz:.4g} Hz, sdc = {self.sdc:.4g}")
-        return ax
+        return plot_spectrum(self.spectrum_frame(), ax=ax)
 
 
 def _damping_ratio(sdc: float, loss_factor: float) -> tuple[float | None, str]:
