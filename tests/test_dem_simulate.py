@@ -112,7 +112,7 @@ def test_energy_balance_closes_and_dissipation_non_negative(run_500hz):
 
 def test_sdc_definition(run_500hz):
     r = run_500hz
-    e = r.m_c_kg * (5 * 9.80665) ** 2 / (2 * (2 * math.pi * 500) ** 2)
+    e = r.vibrated_mass_kg * (5 * 9.80665) ** 2 / (2 * (2 * math.pi * 500) ** 2)
     assert r.max_kinetic_energy_j == pytest.approx(e, rel=1e-12)
     assert r.sdc == pytest.approx(np.mean(r.sdc_per_cell), rel=1e-12)
     assert r.sdc * e == pytest.approx(r.energy_per_cycle_j, rel=1e-12)

@@ -20,8 +20,8 @@ from ..constants import (
 
 #: Keys of ``pidcore dem run --json`` (more may follow them).
 JSON_KEYS = ("sdc", "sdc_stderr", "energy_per_cycle_j", "energy_dissipated_normal_j",
-             "energy_dissipated_friction_j", "particles_per_cell", "cells_simulated", "m_c_kg",
-             "energy_balance_error", "steps", "wall_s", "particle_steps_per_s")
+             "energy_dissipated_friction_j", "particles_per_cell", "cells_simulated",
+             "vibrated_mass_kg", "energy_balance_error", "steps", "wall_s", "particle_steps_per_s")
 
 
 def _time_step(text: str) -> float | str:
@@ -186,7 +186,7 @@ def format_summary(result) -> str:
         f"damping {result.energy_dissipated_normal_j:.4g} J, friction "
         f"{result.energy_dissipated_friction_j:.4g} J",
         f"E (Eq. 10)      {result.max_kinetic_energy_j:.4g} J with m_c = "
-        f"{result.m_c_kg:.4g} kg ({result.config.vibrated_mass})",
+        f"{result.vibrated_mass_kg:.4g} kg ({result.config.vibrated_mass})",
         f"energy balance  closure error {result.energy_balance_error:.2%}",
         f"steady state    from cycle {result.steady_start_cycle} "
         f"({'detected' if result.steady_detected else 'NOT converged, transient cap'}), "

@@ -6,6 +6,7 @@ import hashlib
 import json
 from pathlib import Path
 
+from ..loadcase import key_0_1
 from .result import UNITS, DemResult
 from .simulate import DemConfig, LoadCase, config_parameters
 
@@ -14,11 +15,21 @@ def run_key(case: LoadCase, config: DemConfig) -> str:
     """Store key of one DEM run: readable load case plus a hash of every other input.
 
     The same for ``pidcore dem run --store``, sweeps and the app, so a sweep skips a run saved
-    by any of them, e.g. ``acrylic_z_f50_a5_fill50_seed12345_cells8_<hash>``.
+    by any of them, e.g. ``f50Hz_a5g_fill50pct_acrylic_z_seed12345_cells8_<hash>``.
     """
+    return f"{case.key}_{_run_suffix(case, config)}"
+
+
+def run_key_0_1(case: LoadCase, config: DemConfig) -> str:
+    """The key pidcore 0.1 stored the same run under (``acrylic_z_f50_a5_fill50_seed...``), so
+    a sweep over a 0.1 store skips the runs it holds."""
+    return f"{key_0_1(case)}_{_run_suffix(case, config)}"
+
+
+def _run_suffix(case: LoadCase, config: DemConfig) -> str:
     params = config_parameters(case, config)
     digest = hashlib.sha256(json.dumps(params, sort_keys=True, default=str).encode()).hexdigest()
-    return f"{case.key()}_seed{config.seed}_cells{config.cells}_{digest[:10]}"
+    return f"seed{config.seed}_cells{config.cells}_{digest[:10]}"
 
 
 def dem_run_entry(result: DemResult) -> dict:

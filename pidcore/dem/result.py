@@ -22,7 +22,7 @@ UNITS: dict[str, str] = {
     "energy_dissipated_friction_j": "J", "max_kinetic_energy_j": "J", "work_per_cycle_j": "J",
     "stored_energy_change_per_cycle_j": "J",
     "particles_per_cell": "1", "particles_full_cell": "1", "cells_simulated": "1",
-    "m_c_kg": "kg", "coupon_mass_kg": "kg", "energy_balance_error": "-", "steps": "1",
+    "vibrated_mass_kg": "kg", "coupon_mass_kg": "kg", "energy_balance_error": "-", "steps": "1",
     "wall_s": "s", "particle_steps_per_s": "1/s", "time_step_s": "s",
     "steady_start_cycle": "1", "steady_cycles": "1", "cycles_simulated": "1",
     "settle_time_s": "s", "frequency_hz": "Hz", "acceleration_g": "g", "fill_percent": "%",
@@ -68,7 +68,7 @@ class DemResult:
     particles_per_cell: int
     particles_full_cell: int
     cells_simulated: int
-    m_c_kg: float
+    vibrated_mass_kg: float
     coupon_mass_kg: float
     energy_balance_error: float
     work_walls_j: float
@@ -95,7 +95,7 @@ class DemResult:
     def from_run(cls, *, case: LoadCase, config: DemConfig, law: ContactLaw,
                  tally: np.ndarray, wall_force: np.ndarray, steady_start_cycle: int,
                  steady_detected: bool, particles_per_cell: int, full_count: int,
-                 m_c_kg: float, coupon_mass_kg: float, dt_s: float, steps_per_cycle: int,
+                 vibrated_mass_kg: float, coupon_mass_kg: float, dt_s: float, steps_per_cycle: int,
                  sample_every: int, energy_start: np.ndarray, energy_end: np.ndarray,
                  stored_energy_change_steady: np.ndarray,
                  settle_time_s: float, steps: int, wall_s: float, kernel_s: float,
@@ -104,7 +104,7 @@ class DemResult:
         k = tally.shape[0]
         steady = tally[:, steady_start_cycle:, :]
         per_cell_cycle = tally[:, :, 1] + tally[:, :, 2]
-        e_max = m_c_kg * case.acceleration_m_s2**2 / (2 * case.omega_rad_s**2)
+        e_max = vibrated_mass_kg * case.acceleration_m_s2**2 / (2 * case.omega_rad_s**2)
         per_cell = n_coupon * steady[:, :, 1:].sum(axis=2).mean(axis=1)  # coupon J / cycle
         sdc_cells = per_cell / e_max if e_max > 0 else np.full(k, np.nan)
         stderr = float(np.std(sdc_cells, ddof=1) / math.sqrt(k)) if k > 1 else float("nan")
@@ -133,7 +133,8 @@ class DemResult:
                 n_coupon * np.mean(stored_energy_change_steady) / max(steady.shape[1], 1)),
             max_kinetic_energy_j=float(e_max),
             particles_per_cell=int(particles_per_cell), particles_full_cell=int(full_count),
-            cells_simulated=int(k), m_c_kg=float(m_c_kg), coupon_mass_kg=float(coupon_mass_kg),
+            cells_simulated=int(k), vibrated_mass_kg=float(vibrated_mass_kg),
+            coupon_mass_kg=float(coupon_mass_kg),
             energy_balance_error=float((work - d_mech - dissipated) / scale),
             work_walls_j=work, dissipated_total_j=dissipated, mechanical_energy_change_j=d_mech,
             steps=int(steps), wall_s=float(wall_s),
@@ -171,7 +172,7 @@ class DemResult:
     def to_dict(self, *, include_arrays: bool = False) -> dict[str, Any]:
         """JSON-safe dict: scalars (and arrays as lists when ``include_arrays``)."""
         out: dict[str, Any] = {
-            "case_key": self.case.key(),
+            "case_key": self.case.key,
             "frequency_hz": self.case.frequency_hz,
             "acceleration_g": self.case.acceleration_g,
             "fill_percent": self.case.fill_percent,
@@ -189,7 +190,8 @@ class DemResult:
                      "stored_energy_change_per_cycle_j",
                      "energy_dissipated_normal_j", "energy_dissipated_friction_j",
                      "max_kinetic_energy_j", "particles_per_cell", "particles_full_cell",
-                     "cells_simulated", "m_c_kg", "coupon_mass_kg", "energy_balance_error",
+                     "cells_simulated", "vibrated_mass_kg", "coupon_mass_kg",
+                     "energy_balance_error",
                      "work_walls_j", "dissipated_total_j", "mechanical_energy_change_j",
                      "steps", "wall_s", "particle_steps_per_s", "time_step_s",
                      "steady_start_cycle", "steady_detected", "steady_cycles",
@@ -221,7 +223,7 @@ class DemResult:
         return virtual_shaker_loop(
             self.shaker_force_n, self.velocity_m_s, sample_rate_hz=self.sample_rate_hz,
             frequency_hz=self.case.frequency_hz, steady_start_cycle=self.steady_start_cycle,
-            n_points=n_points, n_harmonics=n_harmonics, label=f"DEM {self.case.key()}")
+            n_points=n_points, n_harmonics=n_harmonics, label=f"DEM {self.case.key}")
 
     def plot(self, ax: Any = None) -> Any:
         """Per-cycle dissipation and forces (:func:`pidcore.report.figures_results.plot_dem_run`).

@@ -46,21 +46,18 @@ import numpy as np
 
 from .. import defaults
 from ..constants import (
-    DRIVE_DIRECTIONS,
-    PARTICLE_MATERIALS,
     STANDARD_GRAVITY,
     START_PACKINGS,
     START_PROTOCOLS,
     VIBRATED_MASS_CONVENTIONS,
-    DriveDirection,
     NormalDampingMode,
-    ParticleMaterial,
     StartPacking,
     StartProtocol,
     TangentialModel,
     VibratedMassConvention,
 )
 from ..errors import ParameterError, SimulationError
+from ..loadcase import LoadCase
 from .contact import ContactLaw, check_damping_mode, check_tangential_model
 from .geometry import CellGeometry, cell_capacity, random_packing
 from .result import DemResult
@@ -78,44 +75,6 @@ FILL_REFERENCES = ("capacity", "paper")
 #: "eq3": alpha from the table's e_n by Eq. 3; "calibrated": alpha root-found so that a
 #: simulated head-on impact at DEM_CALIBRATION_SPEED_M_S gives the table's e_n exactly.
 DAMPING_COEFFICIENTS = ("eq3", "calibrated")
-
-
-@dataclass(frozen=True)
-class LoadCase:
-    """A harmonic load case: frequency (Hz), acceleration amplitude (g), fill (% of 100 %)."""
-
-    frequency_hz: float
-    acceleration_g: float
-    fill_percent: float
-    material: ParticleMaterial = "acrylic"
-    direction: DriveDirection = "z"
-
-    def __post_init__(self):
-        if not (math.isfinite(self.frequency_hz) and self.frequency_hz > 0):
-            raise ParameterError(f"frequency: expected > 0 Hz, got {self.frequency_hz}")
-        if not (math.isfinite(self.acceleration_g) and self.acceleration_g >= 0):
-            raise ParameterError(f"acceleration: expected >= 0 g, got {self.acceleration_g}")
-        if not (0 < self.fill_percent <= 100):
-            raise ParameterError(f"fill: expected 0 < fill <= 100 %, got {self.fill_percent}")
-        if self.material not in PARTICLE_MATERIALS:
-            raise ParameterError(f"material: expected one of {PARTICLE_MATERIALS}, "
-                                 f"got {self.material!r}")
-        if self.direction not in DRIVE_DIRECTIONS:
-            raise ParameterError(f"direction: expected one of {DRIVE_DIRECTIONS}, "
-                                 f"got {self.direction!r}")
-
-    @property
-    def omega_rad_s(self) -> float:
-        return 2.0 * math.pi * self.frequency_hz
-
-    @property
-    def acceleration_m_s2(self) -> float:
-        return self.acceleration_g * STANDARD_GRAVITY
-
-    def key(self) -> str:
-        """Stable text key, e.g. ``acrylic_z_f50_a5_fill50``."""
-        return (f"{self.material}_{self.direction}_f{self.frequency_hz:g}"
-                f"_a{self.acceleration_g:g}_fill{self.fill_percent:g}")
 
 
 @dataclass(frozen=True)
@@ -441,7 +400,7 @@ def simulate_load_case(case: LoadCase, config: DemConfig | None = None, *,
     bar = None
     if progress:
         from tqdm import tqdm
-        bar = tqdm(total=need + 2 * b, unit="cycle", desc=f"DEM {case.key()}", leave=False)
+        bar = tqdm(total=need + 2 * b, unit="cycle", desc=f"DEM {case.key}", leave=False)
     try:
         while True:
             kernel_clock = time.perf_counter()
@@ -489,7 +448,8 @@ def simulate_load_case(case: LoadCase, config: DemConfig | None = None, *,
     return DemResult.from_run(
         case=case, config=config, law=law, tally=tally, wall_force=force,
         steady_start_cycle=int(steady_start), steady_detected=detected,
-        particles_per_cell=n, full_count=full, m_c_kg=m_c, coupon_mass_kg=coupon_mass_kg(),
+        particles_per_cell=n, full_count=full, vibrated_mass_kg=m_c,
+        coupon_mass_kg=coupon_mass_kg(),
         dt_s=dt, steps_per_cycle=steps_per_cycle, sample_every=sample_every,
         energy_start=e_start, energy_end=e_end, settle_time_s=settle_time,
         stored_energy_change_steady=stored_change,

@@ -16,7 +16,7 @@ from pathlib import Path
 
 from ..constants import DriveDirection, ParticleMaterial
 from ..errors import ParameterError
-from .persist import dem_run_entry, run_key
+from .persist import dem_run_entry, run_key, run_key_0_1
 from .simulate import DemConfig, LoadCase, simulate_load_case
 
 #: Named grids. ``table3`` is the paper's Table 3: 4 frequencies x 3 accelerations x 4 fills.
@@ -112,8 +112,9 @@ def run_sweep(cases: Sequence[LoadCase], config: DemConfig, *,
     todo: list[tuple[LoadCase, str]] = []
     for case in cases:
         key = run_key(case, config)
-        if store.has_dem_run(key):
-            summary.skipped.append(key)
+        stored = [k for k in (key, run_key_0_1(case, config)) if store.has_dem_run(k)]
+        if stored:  # also under the key a 0.1 store holds it by
+            summary.skipped.append(stored[0])
         else:
             todo.append((case, key))
     bar = None

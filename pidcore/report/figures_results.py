@@ -94,6 +94,6 @@ def plot_dem_run(result: DemResult, *, ax: Any = None) -> Any:
     a1.set_xlabel("time [s]")
     a1.set_ylabel("force [N]")
     a1.legend()
-    a0.set_title(f"{result.case.key()}: SDC {result.sdc:.4g} +- {result.sdc_stderr:.2g}, "
+    a0.set_title(f"{result.case.key}: SDC {result.sdc:.4g} +- {result.sdc_stderr:.2g}, "
                  f"{result.particles_per_cell} particles/cell")
     return ax

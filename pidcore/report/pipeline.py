@@ -126,11 +126,11 @@ def open_verified_store(path: str | Path, *, must_exist: bool):
     return store
 
 
-def analyse_files(paths: Sequence[str | Path], *, fill_percent: float | None = None,
+def analyze_files(paths: Sequence[str | Path], *, fill_percent: float | None = None,
                   material: str | None = None, direction: str | None = None,
                   sidecar: str | Path | None = None,
                   options: AnalysisOptions | None = None) -> list[MeasuredResult]:
-    """Read, assign roles, analyse (Eq. 11) and attach the load case of every file.
+    """Read, assign roles, analyze (Eq. 11) and attach the load case of every file.
 
     The load case is resolved first for every file, so a missing fill is reported before any
     (slow) analysis runs. Files with identical contents are one measurement: kept once, and
@@ -308,7 +308,7 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
 
     options = options or AnalysisOptions()
     parameters = options.parameters()
-    results = analyse_files(files, fill_percent=fill_percent, material=material,
+    results = analyze_files(files, fill_percent=fill_percent, material=material,
                             direction=direction, sidecar=sidecar,
                             options=options) if files else []
     notes: list[str] = [f"{r.path.name}: load case {r.load_case.key} ({r.stated.origin})"
