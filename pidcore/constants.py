@@ -31,6 +31,11 @@ TangentialModel = Literal["stick_slip", "coulomb"]
 StartPacking = Literal["dense", "loose"]
 #: Report output formats.
 ReportFormat = Literal["csv", "md", "html", "tex", "pdf"]
+#: What 100 % fill is: the cell's capacity (dense drop packing) or the paper's 36 particles.
+FillReference = Literal["capacity", "paper"]
+#: Normal damping constant: "eq3" = alpha from the table's e_n by Eq. 3; "calibrated" = alpha
+#: root-found so that a simulated head-on impact gives the table's e_n exactly.
+DampingCoefficient = Literal["eq3", "calibrated"]
 
 QUANTITIES: tuple[str, ...] = get_args(Quantity)
 CHANNEL_ROLES: tuple[str, ...] = get_args(ChannelRole)
@@ -42,6 +47,8 @@ START_PROTOCOLS: tuple[str, ...] = get_args(StartProtocol)
 TANGENTIAL_MODELS: tuple[str, ...] = get_args(TangentialModel)
 START_PACKINGS: tuple[str, ...] = get_args(StartPacking)
 REPORT_FORMATS: tuple[str, ...] = get_args(ReportFormat)
+FILL_REFERENCES: tuple[str, ...] = get_args(FillReference)
+DAMPING_COEFFICIENTS: tuple[str, ...] = get_args(DampingCoefficient)
 
 #: Standard gravity, m/s^2 (ISO 80000-3); used for g <-> m/s^2 and for gravity on particles.
 STANDARD_GRAVITY = 9.80665

@@ -5,6 +5,8 @@ Change a default here and every CLI option, function and app widget follows.
 
 from pathlib import Path
 
+from . import constants
+
 #: Store file used when none is given.
 STORE_PATH = Path("pid_store.h5")
 #: Seconds a writer waits for the store's write lock before giving up with a StoreError.
@@ -113,6 +115,9 @@ APP_PORT = 8501
 APP_MAX_UPLOAD_MB = 200
 #: Most load cases one DEM sweep started from the app may hold (larger grids: ``pidcore dem``).
 APP_MAX_DEM_CASES = 12
+#: Fill (packing ratio, %) the app proposes for an upload whose name states none (the paper's
+#: experiments were all at 50 %).
+APP_DEFAULT_FILL_PERCENT = 50.0
 
 # --- Compare (measured vs DEM vs paper) -----------------------------------------------------
 #: A measured case sits on a DEM grid point when its frequency is within this relative
@@ -128,10 +133,12 @@ COMPARE_FILL_ATOL_PERCENT = 0.5
 #: Particle material and drive direction assumed when a measurement states none (the paper's).
 COMPARE_DEFAULT_MATERIAL = "acrylic"
 COMPARE_DEFAULT_DIRECTION = "z"
-#: Report formats written by ``pidcore report`` unless --format says otherwise.
-REPORT_FORMATS = ("csv", "md", "html", "tex", "pdf")
+#: Report formats written by ``pidcore report`` unless --format says otherwise: all of them.
+REPORT_FORMATS: tuple[str, ...] = constants.REPORT_FORMATS
 #: Resolution of the PNG figures of a report, dots per inch.
 REPORT_FIGURE_DPI = 150
+#: Last drive cycles of a DEM run's force records drawn by ``DemResult.plot``.
+FIGURE_DEM_FORCE_CYCLES = 5
 
 # --- SDC model, equivalent damper, model figures (pidcore.model, pidcore model) ---------------
 #: Interpolate SDC in log10(frequency) instead of frequency.

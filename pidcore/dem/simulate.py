@@ -46,6 +46,8 @@ import numpy as np
 
 from .. import defaults
 from ..constants import (
+    DAMPING_COEFFICIENTS,
+    FILL_REFERENCES,
     STANDARD_GRAVITY,
     START_PACKINGS,
     START_PROTOCOLS,
@@ -70,11 +72,6 @@ from .state import (
     energies,
     wall_displacement,
 )
-
-FILL_REFERENCES = ("capacity", "paper")
-#: "eq3": alpha from the table's e_n by Eq. 3; "calibrated": alpha root-found so that a
-#: simulated head-on impact at DEM_CALIBRATION_SPEED_M_S gives the table's e_n exactly.
-DAMPING_COEFFICIENTS = ("eq3", "calibrated")
 
 
 @dataclass(frozen=True)

@@ -25,9 +25,9 @@ from .table import ALIGNMENT_COLUMN
 #: measured force; then the particles' force on the walls alone.
 DEM_FORCE_ARRAYS: tuple[str, ...] = ("shaker_force_n", "wall_force_n")
 #: Coupon velocity arrays looked for in a DEM run.
-DEM_VELOCITY_ARRAYS: tuple[str, ...] = ("velocity_m_s", "coupon_velocity_m_s")
+DEM_VELOCITY_ARRAYS: tuple[str, ...] = ("velocity_m_s",)
 #: Time arrays (sample instants) looked for in a DEM run.
-DEM_TIME_ARRAYS: tuple[str, ...] = ("sample_time_s", "time_s")
+DEM_TIME_ARRAYS: tuple[str, ...] = ("sample_time_s",)
 
 
 def _new_figure(width: float, height: float):
@@ -95,7 +95,7 @@ def _first(arrays: Mapping[str, np.ndarray], names: tuple[str, ...]) -> np.ndarr
 
 def dem_loop_from_arrays(arrays: Mapping[str, np.ndarray],
                          record: Mapping[str, object] | None = None,
-                         ) -> tuple[np.ndarray, np.ndarray] | str:
+                         ) -> ForceDisplacementLoop | str:
     """One period of a DEM run's force-displacement loop, or a note why there is none.
 
     The stored virtual shaker record (force :data:`DEM_FORCE_ARRAYS`, coupon velocity
@@ -113,7 +113,7 @@ def dem_loop_from_arrays(arrays: Mapping[str, np.ndarray],
 
     Returns
     -------
-    (displacement m, force N) or str
+    ForceDisplacementLoop or str
     """
     from ..errors import PidcoreError
     from ..signal import analyze_power
@@ -140,7 +140,7 @@ def dem_loop_from_arrays(arrays: Mapping[str, np.ndarray],
                                  frequency_hz=float(freq), source="DEM run")
     except PidcoreError as exc:
         return f"DEM time series cannot be analysed ({exc})"
-    return analysis.force_displacement_loop()
+    return analysis.loop()
 
 
 def loop_from_phasors(arrays: Mapping[str, np.ndarray], frequency_hz: object, *,
@@ -177,15 +177,16 @@ def _closed(x: np.ndarray, f: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.append(x, x[:1]), np.append(f, f[:1])
 
 
-def plot_loop_overlay(measured: object, dem: tuple[np.ndarray, np.ndarray] | None, *,
+def plot_loop_overlay(measured: ForceDisplacementLoop | tuple,
+                      dem: ForceDisplacementLoop | tuple | None, *,
                       title: str = "", ax=None):
     """Force-displacement loop of a measurement, with the DEM's at the same load case.
 
     Parameters
     ----------
-    measured : loop or (displacement m, force N)
+    measured : ForceDisplacementLoop or (displacement m, force N)
         The measured loop (see :func:`loop_arrays`).
-    dem : (displacement m, force N) or None
+    dem : ForceDisplacementLoop or (displacement m, force N) or None
         The DEM loop (:func:`dem_loop_from_arrays`), or None to draw the measurement alone.
     title : str
     ax : matplotlib Axes, optional

@@ -18,12 +18,11 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import pandas as pd
 
+from .. import defaults
+
 if TYPE_CHECKING:  # pragma: no cover
     from ..dem.result import DemResult
     from ..loop import ForceDisplacementLoop
-
-#: Cycles of the force records drawn by :func:`plot_dem_run`.
-DEM_RUN_FORCE_CYCLES = 5
 
 
 def plot_spectrum(frame: pd.DataFrame, *, ax: Any = None) -> Any:
@@ -88,7 +87,7 @@ def plot_dem_run(result: DemResult, *, ax: Any = None) -> Any:
     a0.set_xlabel("cycle [-]")
     a0.set_ylabel("dissipated per cycle [J]")
     a0.legend()
-    n = DEM_RUN_FORCE_CYCLES * result.samples_per_cycle
+    n = defaults.FIGURE_DEM_FORCE_CYCLES * result.samples_per_cycle
     a1.plot(result.sample_time_s[-n:], result.wall_force_n[-n:], label="walls on particles")
     a1.plot(result.sample_time_s[-n:], result.shaker_force_n[-n:], label="shaker force")
     a1.set_xlabel("time [s]")
