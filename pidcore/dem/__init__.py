@@ -10,11 +10,11 @@ cell_capacity, particles_per_cell
     How many particles fit; fill percentage -> particle count.
 measure_restitution, calibrate_damping_coefficient, simulate_impact
     Single impacts through the production kernel.
-run_dem_bench
-    Kernel throughput (particle-steps per second).
+
+Benchmarks (kernel throughput, a grid sweep into a temporary store) are in
+:mod:`pidcore.dem.bench`.
 """
 
-from .bench import run_dem_bench
 from .contact import ContactLaw
 from .geometry import CellGeometry, cell_capacity
 from .impact import calibrate_damping_coefficient, measure_restitution, simulate_impact
@@ -23,4 +23,4 @@ from .simulate import DemConfig, LoadCase, particles_per_cell, simulate_load_cas
 
 __all__ = ["CellGeometry", "ContactLaw", "DemConfig", "DemResult", "LoadCase",
            "calibrate_damping_coefficient", "cell_capacity", "measure_restitution",
-           "particles_per_cell", "run_dem_bench", "simulate_impact", "simulate_load_case"]
+           "particles_per_cell", "simulate_impact", "simulate_load_case"]
