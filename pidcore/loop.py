@@ -113,3 +113,6 @@ class ForceDisplacementLoop:
         frame.attrs.update(label=self.label, frequency_hz=self.frequency_hz,
                            energy_per_cycle_j=self.energy_per_cycle_j)
         return frame
+
+
+__all__ = ["ForceDisplacementLoop"]

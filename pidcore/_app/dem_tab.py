@@ -107,7 +107,7 @@ def render(stores) -> None:
             case, config = state["dem_queue"][0]
             done = total - len(state["dem_queue"])
             progress.progress(done / total, text=f"case {done + 1} of {total}: "
-                                                 f"{case.key()} ...")
+                                                 f"{case.key} ...")
             try:
                 if app_support.dem_run_stored(stores.path, case, config):
                     state["dem_skipped"].append(app_support.dem_run_key(case, config))
@@ -115,7 +115,7 @@ def render(stores) -> None:
                     state["dem_done"].append(app_support.run_dem_case(stores.path, case, config))
             except PidcoreError as exc:
                 state["dem_queue"] = []
-                state["dem_message"] = ("error", f"{case.key()}: {exc} (finished cases are "
+                state["dem_message"] = ("error", f"{case.key}: {exc} (finished cases are "
                                                  "saved)")
                 st.rerun()
             state["dem_queue"] = state["dem_queue"][1:]
