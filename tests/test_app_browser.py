@@ -19,7 +19,7 @@ from _app_samples import mass_damper_csv
 
 from pidcore import app_support
 
-pytestmark = pytest.mark.browser
+pytestmark = [pytest.mark.browser, pytest.mark.slow]
 
 REPO = Path(__file__).resolve().parents[1]
 SHIM = REPO / "app" / "pidcore_app.py"

@@ -313,6 +313,7 @@ def test_reference_dem_store_is_compared_but_never_written(store_file, tmp_path,
 SAMPLES = Path(os.environ.get("PIDCORE_SAMPLES_DIR", REPO / "data_samples"))
 
 
+@pytest.mark.slow
 def test_bundled_samples_switch_load_cases_from_the_cache(store_file, monkeypatch,
                                                           analysis_calls):
     calls = analysis_calls

@@ -176,6 +176,7 @@ def test_power_closure_virtual_shaker_matches_energy_tally():
     assert np.mean(r.wall_force_n[r.steady_slice()]) == pytest.approx(weight, rel=0.10)
 
 
+@pytest.mark.slow
 def test_resting_bed_power_closure_needs_the_dense_start():
     # 1 g, 100 Hz: a bed settled with friction only (loose) keeps compacting: potential
     # energy released each cycle is dissipated too, so the shaker (walls' work) sees far less
