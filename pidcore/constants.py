@@ -29,6 +29,8 @@ TangentialModel = Literal["stick_slip", "coulomb"]
 #: Packing the drive starts from: "dense" = settled without friction, then settled again
 #: with friction; "loose" = settled with friction from the random drop.
 StartPacking = Literal["dense", "loose"]
+#: Cell shape of a specimen (``[cell] shape``); cylindrical and rectangular cells may follow.
+CellShape = Literal["hexagonal"]
 #: Report output formats.
 ReportFormat = Literal["csv", "md", "html", "tex", "pdf"]
 
@@ -42,6 +44,7 @@ START_PROTOCOLS: tuple[str, ...] = get_args(StartProtocol)
 TANGENTIAL_MODELS: tuple[str, ...] = get_args(TangentialModel)
 START_PACKINGS: tuple[str, ...] = get_args(StartPacking)
 REPORT_FORMATS: tuple[str, ...] = get_args(ReportFormat)
+CELL_SHAPES: tuple[str, ...] = get_args(CellShape)
 
 #: Standard gravity, m/s^2 (ISO 80000-3); used for g <-> m/s^2 and for gravity on particles.
 STANDARD_GRAVITY = 9.80665
