@@ -313,8 +313,9 @@ class Specimen:
         return hashlib.sha256(self.text.encode("utf-8")).hexdigest()
 
     def is_paper(self) -> bool:
-        """True if this is the paper's coupon (so the paper's Table 3 applies to its runs)."""
-        return self.hash == paper_specimen().hash
+        """True for the paper's coupon (acrylic, or another table particle material): the
+        specimen of the paper's Table 3, so only its runs are compared with that table."""
+        return self.hash in _paper_hashes()
 
     # --- what follows from it ------------------------------------------------------------
 
@@ -638,6 +639,69 @@ def contact_law(specimen: Specimen, *, alpha_pp: float | None = None,
         tangential_stiffness_pp=kt_pp, tangential_stiffness_pw=kt_pw)
 
 
+@functools.cache
+def _paper_hashes() -> frozenset[str]:
+    from .constants import PARTICLE_MATERIALS
+
+    return frozenset(paper_specimen(m).hash for m in PARTICLE_MATERIALS)
+
+
+# --- what follows from a specimen ------------------------------------------------------------
+
+#: Load case whose impacts are the hardest of the paper's Table 3 grid (largest 2 a/w): the
+#: time step :func:`describe` reports is the one ``time_step="auto"`` picks for it.
+DESCRIBE_FREQUENCY_HZ = 50.0
+DESCRIBE_ACCELERATION_G = 10.0
+
+
+def describe(specimen: Specimen) -> dict[str, Any]:
+    """What follows from a specimen (units in the keys): capacity, masses, contact numbers.
+
+    Particle counts and masses are for the specimen's stated fill (``count_per_cell`` or
+    ``fill_percent`` of the capacity) where it states one, else for a full cell. Contact time
+    and time step are for the hardest impact of the Table 3 grid (50 Hz, 10 g).
+    """
+    from . import defaults
+    from .constants import PARTICLE_MATERIALS
+    from .dem.simulate import LoadCase, choose_time_step, max_impact_speed
+
+    law = contact_law(specimen)
+    geometry = specimen.geometry()
+    capacity = specimen.capacity_per_cell()
+    p = specimen.particles
+    if p.count_per_cell is not None:
+        count, basis = p.count_per_cell, "count_per_cell"
+    elif p.fill_percent is not None:
+        count, basis = int(round(p.fill_percent / 100.0 * capacity)), "fill_percent"
+    else:
+        count, basis = capacity, "capacity"
+    material = p.material if p.material in PARTICLE_MATERIALS else "acrylic"
+    case = LoadCase(DESCRIBE_FREQUENCY_HZ, DESCRIBE_ACCELERATION_G, 100.0, material=material)
+    speed = max_impact_speed(case, geometry)
+    return {
+        "name": specimen.name, "sha256": specimen.hash, "is_paper": specimen.is_paper(),
+        "cell_shape": specimen.cell.shape, "cells_per_coupon": specimen.cell.count,
+        "capacity_per_cell": capacity, "particles_per_cell": count,
+        "particles_per_cell_basis": basis,
+        "particle_mass_kg": p.mass_kg,
+        "particles_mass_kg": specimen.cell.count * count * p.mass_kg,
+        "coupon_mass_kg": specimen.coupon.mass_kg,
+        "fixture_mass_kg": specimen.coupon.fixture_mass_kg,
+        "vibrated_mass_kg": specimen.vibrated_mass_kg(count),
+        "wall_to_wall_gap_m": specimen.cell.inscribed_diameter_m - 2 * p.radius_m,
+        "floor_to_ceiling_gap_m": specimen.cell.height_m - 2 * p.radius_m,
+        "normal_stiffness_pp_n_m1_5": law.stiffness_pp,
+        "normal_stiffness_pw_n_m1_5": law.stiffness_pw,
+        "tangential_stiffness_pp_n_m": law.tangential_stiffness_pp,
+        "tangential_stiffness_pw_n_m": law.tangential_stiffness_pw,
+        "reference_impact_speed_m_s": speed,
+        "contact_time_s": law.contact_time(speed),
+        "tangential_period_s": law.tangential_period(),
+        "time_step_s": choose_time_step(case, law, geometry, "auto",
+                                        defaults.DEM_TANGENTIAL_MODEL),
+    }
+
+
 # --- geometry -------------------------------------------------------------------------------
 
 def cell_geometry(cell: CellSpec):
@@ -662,5 +726,6 @@ def _capacity(shape: str, inscribed_diameter_m: float, height_m: float, radius_m
 
 
 __all__ = ["CellSpec", "CouponSpec", "PairSpec", "PairsSpec", "ParticleSpec", "Specimen",
-           "cell_geometry", "contact_law", "load_specimen", "numeric_fields", "paper_specimen"]
+           "cell_geometry", "contact_law", "describe", "load_specimen", "numeric_fields",
+           "paper_specimen"]
 
