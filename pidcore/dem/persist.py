@@ -15,6 +15,7 @@ import hashlib
 import json
 import math
 import os
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -190,6 +191,46 @@ def run_or_load(store: Store | str | os.PathLike[str], specimen: Specimen | None
     return result
 
 
+def rekey_dem_store(source: str | os.PathLike[str], target: str | os.PathLike[str]) -> int:
+    """Copy every DEM run of ``source`` into a new store ``target`` under today's key.
+
+    For stores written before specimens (runs without ``specimen_sha256``: the paper's coupon
+    with their particle material) or before a change of the key's inputs. Each run gets the
+    specimen's text and hash as provenance; its numbers are copied, not recomputed, so this
+    is only right while :data:`DEM_CODE_VERSION` is the one the runs were made with (checked
+    where a run states it; a run that does not is taken as version 1, the first versioned
+    code, which reproduces them bit for bit). ``source`` must hold DEM runs only (a store with
+    measurements or analyses is refused); ``target`` must not exist. Returns the run count.
+    """
+    from ..store import Store
+
+    source, target = Path(source), Path(target)
+    if target.exists():
+        raise StoreError(f"{target}: exists already; rekey_dem_store writes a new store")
+    old = Store(source)
+    if len(old.list_measurements()) or len(old.list_analyses()):
+        raise StoreError(f"{source}: holds measurements or analyses; only a store of DEM runs "
+                         "can be re-keyed")
+    items = []
+    for key in old.list_dem_runs()["case_key"]:
+        entry = old.get_dem_run(key)
+        version = entry.parameters.get("dem_code_version", 1)
+        if version != DEM_CODE_VERSION:
+            raise StoreError(f"{source}: DEM run {key!r} is from DEM code version {version}, "
+                             f"this is {DEM_CODE_VERSION}: simulate it again instead")
+        result = load_dem_result(entry)
+        new = dem_run_entry(result)
+        # keep what the stored run says about itself (timings, arrays it has)
+        new["record"] = {**new["record"], **{k: v for k, v in entry.record.items()
+                                            if k in new["record"]}}
+        new["arrays"] = {k: v for k, v in entry.arrays.items()}
+        new["units"] = {k: v for k, v in new["units"].items()
+                        if k in new["record"] or k in new["arrays"]}
+        items.append({"case_key": run_key(result.case, result.config, result.specimen), **new})
+    Store(target).add_dem_runs(items)
+    return len(items)
+
+
 __all__ = ["DEM_CODE_VERSION", "dem_run_entry", "load_dem_result", "run_key", "run_or_load",
-           "run_parameters", "save_dem_entry", "save_dem_result"]
+           "run_parameters", "rekey_dem_store", "save_dem_entry", "save_dem_result"]
 
