@@ -315,8 +315,7 @@ def settle_bed(state: CellsState, settings: KernelSettings,
         raise ParameterError(f"start_packing: expected one of {START_PACKINGS}, got {packing!r}")
     elapsed = 0.0
     if packing == "dense":
-        frictionless = dataclasses.replace(settings.law, friction_pp=0.0, friction_pw=0.0)
-        elapsed += settle(state, dataclasses.replace(settings, law=frictionless))
+        elapsed += settle(state, dataclasses.replace(settings, law=settings.law.frictionless()))
         state.spring_pp[:] = 0.0  # none stretched without friction; start the springs clean
         state.spring_pw[:] = 0.0
     return elapsed + settle(state, settings)
@@ -437,10 +436,10 @@ def simulate_load_case(case: LoadCase, config: DemConfig | None = None, *,
         law = contact_law(
             specimen,
             alpha_pw=config.alpha_pw if config.alpha_pw is not None else
-            calibrate_damping_coefficient(law.restitution_pw, "wall", v_cal, dt,
+            calibrate_damping_coefficient(law.pair_wall.restitution, "wall", v_cal, dt,
                                           config.normal_damping_mode, material=case.material),
             alpha_pp=config.alpha_pp if config.alpha_pp is not None else
-            calibrate_damping_coefficient(law.restitution_pp, "particle", v_cal, dt,
+            calibrate_damping_coefficient(law.pair_particle.restitution, "particle", v_cal, dt,
                                           config.normal_damping_mode, material=case.material))
 
     rng = np.random.default_rng(config.seed)
