@@ -15,6 +15,7 @@ coupon, ``pidcore/data/specimens/paper_coupon.toml``)::
     wall_material = "aluminium_wall"   # a materials.csv row, or inline:
     # wall_youngs_modulus_pa = 72e9
     # wall_poisson_ratio = 0.33
+    # wall_density_kg_m3 = 2800.0      # walls move rigidly with the coupon: not used yet
 
     [coupon]
     mass_kg = 0.0221534                # face sheets + core, without particles
@@ -33,7 +34,8 @@ coupon, ``pidcore/data/specimens/paper_coupon.toml``)::
     restitution = 0.70
     sliding_friction = 0.096
     static_friction = 0.096            # >= sliding_friction
-    rolling_friction = 0.0
+    rolling_friction = 0.0             # mu_r: largest rolling torque mu_r R* |f_n|
+    rolling_damping_ratio = 0.0        # rolling dashpot, fraction of critical
 
     [pairs.particle_wall]
     restitution = 0.70
@@ -102,6 +104,7 @@ class CellSpec:
     wall_material: str
     wall_youngs_modulus_pa: float
     wall_poisson_ratio: float
+    wall_density_kg_m3: float
 
     def __post_init__(self):
         if self.shape not in CELL_SHAPES:
@@ -112,6 +115,7 @@ class CellSpec:
             raise _fail("[cell] count", f"expected a whole number >= 1, got {self.count!r}")
         _positive("[cell] wall_youngs_modulus_pa", self.wall_youngs_modulus_pa, "Pa")
         _poisson("[cell] wall_poisson_ratio", self.wall_poisson_ratio)
+        _positive("[cell] wall_density_kg_m3", self.wall_density_kg_m3, "kg/m^3")
 
 
 @dataclass(frozen=True)
@@ -177,6 +181,7 @@ class PairSpec:
     sliding_friction: float
     static_friction: float
     rolling_friction: float = 0.0
+    rolling_damping_ratio: float = 0.0
 
     def check(self, where: str) -> None:
         """Raise a ParameterError naming ``where`` if a value is out of range."""
@@ -186,6 +191,7 @@ class PairSpec:
         _non_negative(f"{where} sliding_friction", self.sliding_friction, "[-]")
         _non_negative(f"{where} static_friction", self.static_friction, "[-]")
         _non_negative(f"{where} rolling_friction", self.rolling_friction, "[-]")
+        _non_negative(f"{where} rolling_damping_ratio", self.rolling_damping_ratio, "[-]")
         if self.static_friction < self.sliding_friction:
             raise _fail(f"{where} static_friction",
                         f"{self.static_friction!r} is below sliding_friction "
@@ -351,7 +357,7 @@ SCHEMA: dict[str, dict[str, tuple[bool, str]]] = {
     "cell": {"shape": (True, "str"), "inscribed_diameter_m": (True, "float"),
              "height_m": (True, "float"), "count": (True, "int"),
              "wall_material": (True, "str"), "wall_youngs_modulus_pa": (False, "float"),
-             "wall_poisson_ratio": (False, "float")},
+             "wall_poisson_ratio": (False, "float"), "wall_density_kg_m3": (False, "float")},
     "coupon": {"mass_kg": (True, "float"), "fixture_mass_kg": (False, "float"),
                "baseline_loss_factor": (False, "float")},
     "particles": {"material": (True, "str"), "radius_m": (False, "float"),
@@ -359,7 +365,8 @@ SCHEMA: dict[str, dict[str, tuple[bool, str]]] = {
                   "poisson_ratio": (False, "float"), "count_per_cell": (False, "int"),
                   "fill_percent": (False, "float")},
     "pair": {"restitution": (True, "float"), "sliding_friction": (True, "float"),
-             "static_friction": (False, "float"), "rolling_friction": (False, "float")},
+             "static_friction": (False, "float"), "rolling_friction": (False, "float"),
+             "rolling_damping_ratio": (False, "float")},
 }
 PAIR_NAMES = ("particle_particle", "particle_wall")
 
@@ -451,7 +458,8 @@ def _from_mapping(data: Mapping[str, Any], *, source: str) -> Specimen:
     cell = _take(data["cell"], "cell", "[cell]")
     wall = _table_material(cell["wall_material"], "[cell] wall_material", None)
     for key, column in (("wall_youngs_modulus_pa", "youngs_modulus_pa"),
-                        ("wall_poisson_ratio", "poisson_ratio")):
+                        ("wall_poisson_ratio", "poisson_ratio"),
+                        ("wall_density_kg_m3", "density_kg_m3")):
         if key not in cell:
             if wall is None:
                 raise ParameterError(
@@ -548,8 +556,8 @@ def paper_specimen(material: str = "acrylic") -> Specimen:
     """The paper's coupon (bundled file); ``material`` swaps in another table particle.
 
     With another particle material, radius and contact pairs come from the tables
-    (``materials.csv``, ``material_pairs.csv``; static friction = sliding, no rolling
-    friction), which reproduces ``--material aluminium`` runs of earlier versions.
+    (``materials.csv``, ``material_pairs.csv``), which reproduces ``--material aluminium``
+    runs of earlier versions.
     """
     base = Specimen.from_text(_paper_text(), source=f"pidcore:{PAPER_SPECIMEN_NAME}.toml")
     if material == base.particles.material:
@@ -565,10 +573,12 @@ def paper_specimen(material: str = "acrylic") -> Specimen:
                              density_kg_m3=row.density_kg_m3,
                              youngs_modulus_pa=row.youngs_modulus_pa,
                              poisson_ratio=row.poisson_ratio)
-    pairs = PairsSpec(
-        particle_particle=PairSpec(pp.normal_restitution, pp.sliding_friction,
-                                   pp.sliding_friction),
-        particle_wall=PairSpec(pw.normal_restitution, pw.sliding_friction, pw.sliding_friction))
+    pairs = PairsSpec(**{name: PairSpec(restitution=t.restitution,
+                                        sliding_friction=t.sliding_friction,
+                                        static_friction=t.static_friction,
+                                        rolling_friction=t.rolling_friction,
+                                        rolling_damping_ratio=t.rolling_damping_ratio)
+                         for name, t in (("particle_particle", pp), ("particle_wall", pw))})
     return dataclasses.replace(
         base, name=f"{PAPER_SPECIMEN_NAME}_{material}", particles=particles, pairs=pairs,
         description=f"the paper's coupon with {material} spheres from the tables")
@@ -576,67 +586,51 @@ def paper_specimen(material: str = "acrylic") -> Specimen:
 
 # --- contact law ----------------------------------------------------------------------------
 
+#: Whether the DEM kernel models static friction above the sliding one and rolling
+#: resistance. Until it does, a specimen asking for them is refused rather than simulated
+#: without them (set True when the kernel gains them; the contact law already carries them).
+KERNEL_HAS_STATIC_AND_ROLLING_FRICTION = False
+
+
 def contact_law(specimen: Specimen, *, alpha_pp: float | None = None,
                 alpha_pw: float | None = None):
     """The DEM contact law of a specimen's particles in its cell (paper Eq. 2-5).
 
-    The one adapter between a specimen and :class:`pidcore.dem.contact.ContactLaw`: the same
-    expressions as ``ContactLaw.for_material`` (so the paper's specimen gives that law bit
-    for bit), fed from the specimen's resolved numbers instead of the tables. Static friction
-    above the sliding one and rolling friction are refused until the kernel models them.
+    :meth:`pidcore.dem.contact.ContactLaw.from_properties` fed from the specimen's resolved
+    numbers (so the paper's specimen gives ``ContactLaw.for_material`` bit for bit).
+    ``alpha_*`` override Eq. 3's damping constants.
     """
-    import numpy as np
+    from .dem.contact import ContactLaw
+    from .dem.materials import MaterialProperties, PairParameters
 
-    from . import defaults
-    from .dem.contact import (
-        ContactLaw,
-        damping_constant_from_restitution,
-        effective_mass,
-        effective_modulus,
-        effective_radius,
-        effective_shear_modulus,
-        hertz_stiffness,
-        maximum_overlap,
-        tangential_stiffness,
-    )
-
-    for name in PAIR_NAMES:
-        pair = getattr(specimen.pairs, name)
-        if pair.static_friction != pair.sliding_friction or pair.rolling_friction != 0:
-            raise ParameterError(
-                f"{specimen.source}: [pairs.{name}] static_friction != sliding_friction or "
-                "rolling_friction != 0 needs the static-friction/rolling-resistance contact "
-                "law, which this build's kernel does not have yet")
+    if not KERNEL_HAS_STATIC_AND_ROLLING_FRICTION:
+        for name in PAIR_NAMES:
+            pair = getattr(specimen.pairs, name)
+            if pair.static_friction != pair.sliding_friction or pair.rolling_friction != 0:
+                raise ParameterError(
+                    f"{specimen.source}: [pairs.{name}] static_friction above sliding_friction"
+                    " or rolling_friction > 0 needs the static-friction/rolling-resistance "
+                    "kernel, which this build does not have yet")
     p, c = specimen.particles, specimen.cell
-    r = p.radius_m
-    m = p.density_kg_m3 * 4.0 / 3.0 * np.pi * r**3  # as Material.sphere_mass
-    inertia = 0.4 * m * r * r
-    e_p, nu_p = p.youngs_modulus_pa, p.poisson_ratio
-    e_w, nu_w = c.wall_youngs_modulus_pa, c.wall_poisson_ratio
-    k_pp = hertz_stiffness(effective_modulus(e_p, nu_p, e_p, nu_p), effective_radius(r, r))
-    k_pw = hertz_stiffness(effective_modulus(e_p, nu_p, e_w, nu_w), effective_radius(r, None))
-    g_pp = effective_shear_modulus(e_p, nu_p, e_p, nu_p)
-    g_pw = effective_shear_modulus(e_p, nu_p, e_w, nu_w)
-    v_ref = defaults.DEM_TANGENTIAL_REFERENCE_SPEED_M_S
-    kt_pp = tangential_stiffness(g_pp, effective_radius(r, r), maximum_overlap(
-        stiffness=k_pp, mass_kg=effective_mass(m, m), impact_speed_m_s=v_ref))
-    kt_pw = tangential_stiffness(g_pw, effective_radius(r, None), maximum_overlap(
-        stiffness=k_pw, mass_kg=effective_mass(m, None), impact_speed_m_s=v_ref))
-    pp, pw = specimen.pairs.particle_particle, specimen.pairs.particle_wall
-    a_pp = damping_constant_from_restitution(pp.restitution) if alpha_pp is None \
-        else float(alpha_pp)
-    a_pw = damping_constant_from_restitution(pw.restitution) if alpha_pw is None \
-        else float(alpha_pw)
-    return ContactLaw(
-        particle_material=p.material, radius_m=r, mass_kg=m, inertia_kg_m2=inertia,
-        stiffness_pp=k_pp, stiffness_pw=k_pw, alpha_pp=a_pp, alpha_pw=a_pw,
-        damping_pp=a_pp * np.sqrt(effective_mass(m, m) * k_pp),
-        damping_pw=a_pw * np.sqrt(effective_mass(m, None) * k_pw),
-        friction_pp=pp.sliding_friction, friction_pw=pw.sliding_friction,
-        restitution_pp=pp.restitution, restitution_pw=pw.restitution,
-        tangential_mass_pp=1.0 / (2.0 / m + 2.0 * r * r / inertia),
-        tangential_mass_pw=1.0 / (1.0 / m + r * r / inertia),
-        tangential_stiffness_pp=kt_pp, tangential_stiffness_pw=kt_pw)
+
+    def pair(spec: PairSpec) -> PairParameters:
+        return PairParameters(restitution=spec.restitution,
+                              sliding_friction=spec.sliding_friction,
+                              static_friction=spec.static_friction,
+                              rolling_friction=spec.rolling_friction,
+                              rolling_damping_ratio=spec.rolling_damping_ratio)
+
+    return ContactLaw.from_properties(
+        particle=MaterialProperties(density_kg_m3=p.density_kg_m3,
+                                    youngs_modulus_pa=p.youngs_modulus_pa,
+                                    poisson_ratio=p.poisson_ratio),
+        radius_m=p.radius_m,
+        wall=MaterialProperties(density_kg_m3=c.wall_density_kg_m3,  # rigid: mass unused
+                                youngs_modulus_pa=c.wall_youngs_modulus_pa,
+                                poisson_ratio=c.wall_poisson_ratio),
+        pair_particle=pair(specimen.pairs.particle_particle),
+        pair_wall=pair(specimen.pairs.particle_wall),
+        particle_material=p.material, alpha_pp=alpha_pp, alpha_pw=alpha_pw)
 
 
 @functools.cache
@@ -690,10 +684,10 @@ def describe(specimen: Specimen) -> dict[str, Any]:
         "vibrated_mass_kg": specimen.vibrated_mass_kg(count),
         "wall_to_wall_gap_m": specimen.cell.inscribed_diameter_m - 2 * p.radius_m,
         "floor_to_ceiling_gap_m": specimen.cell.height_m - 2 * p.radius_m,
-        "normal_stiffness_pp_n_m1_5": law.stiffness_pp,
-        "normal_stiffness_pw_n_m1_5": law.stiffness_pw,
-        "tangential_stiffness_pp_n_m": law.tangential_stiffness_pp,
-        "tangential_stiffness_pw_n_m": law.tangential_stiffness_pw,
+        "normal_stiffness_pp_n_m1_5": law.pair_particle.stiffness,
+        "normal_stiffness_pw_n_m1_5": law.pair_wall.stiffness,
+        "tangential_stiffness_pp_n_m": law.pair_particle.tangential_stiffness,
+        "tangential_stiffness_pw_n_m": law.pair_wall.tangential_stiffness,
         "reference_impact_speed_m_s": speed,
         "contact_time_s": law.contact_time(speed),
         "tangential_period_s": law.tangential_period(),
@@ -721,7 +715,7 @@ def _capacity(shape: str, inscribed_diameter_m: float, height_m: float, radius_m
 
     cell = CellSpec(shape=shape, inscribed_diameter_m=inscribed_diameter_m, height_m=height_m,
                     count=1, wall_material="-", wall_youngs_modulus_pa=1.0,
-                    wall_poisson_ratio=0.0)
+                    wall_poisson_ratio=0.0, wall_density_kg_m3=1.0)
     return cell_capacity(cell_geometry(cell), radius_m)
 
 

@@ -219,11 +219,8 @@ def rekey_dem_store(source: str | os.PathLike[str], target: str | os.PathLike[st
             raise StoreError(f"{source}: DEM run {key!r} is from DEM code version {version}, "
                              f"this is {DEM_CODE_VERSION}: simulate it again instead")
         result = load_dem_result(entry)
-        new = dem_run_entry(result)
-        # keep what the stored run says about itself (timings, arrays it has)
-        new["record"] = {**new["record"], **{k: v for k, v in entry.record.items()
-                                            if k in new["record"]}}
-        new["arrays"] = {k: v for k, v in entry.arrays.items()}
+        new = dem_run_entry(result)  # the stored numbers, with today's provenance fields
+        new["arrays"] = dict(entry.arrays)  # not the NaN stand-ins for arrays it lacks
         new["units"] = {k: v for k, v in new["units"].items()
                         if k in new["record"] or k in new["arrays"]}
         items.append({"case_key": run_key(result.case, result.config, result.specimen), **new})
