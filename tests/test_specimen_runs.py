@@ -156,3 +156,30 @@ def test_case_material_must_not_contradict_the_specimen():
     with pytest.raises(ParameterError, match="holds 'acrylic' particles"):
         simulate_load_case(LoadCase(1000, 5, 25, material="aluminium"), TINY,
                            specimen=paper_specimen())
+
+
+def test_report_compares_runs_of_one_specimen_and_the_paper_only_for_its_coupon(tmp_path,
+                                                                                 capsys):
+    import pandas as pd
+
+    store = tmp_path / "runs.h5"
+    own = paper_specimen().with_values({"coupon.fixture_mass_kg": 0.05, "cell.count": 400})
+    own_file = tmp_path / "own.toml"
+    own_file.write_text(own.to_toml())
+    paper_run = run_or_load(store, None, CASE, TINY)
+    own_run = run_or_load(store, own, CASE, TINY)
+    assert own_run.sdc != paper_run.sdc
+
+    def report(*extra):
+        out = tmp_path / f"report{len(extra)}"
+        assert main(["report", "--dem-store", str(store), "--out", str(out), "--format", "csv",
+                     *extra]) == 0
+        capsys.readouterr()
+        return pd.read_csv(out / "report.csv", comment="#")
+
+    default = report()  # the paper's coupon: its run, beside the paper's Table 3
+    assert default["SDC DEM (ours) [-]"].tolist() == pytest.approx([paper_run.sdc])
+    assert default["SDC DEM (paper) [-]"].notna().all()
+    mine = report("--specimen", str(own_file))  # only the own specimen's run, no paper
+    assert mine["SDC DEM (ours) [-]"].tolist() == pytest.approx([own_run.sdc])
+    assert mine["SDC DEM (paper) [-]"].isna().all()

@@ -191,6 +191,29 @@ def run_or_load(store: Store | str | os.PathLike[str], specimen: Specimen | None
     return result
 
 
+def runs_of_specimen(runs, specimen: Specimen | None = None):
+    """Rows of a DEM-run listing (:meth:`pidcore.store.Store.list_dem_runs`) of one specimen.
+
+    ``specimen=None`` is the paper's coupon: its runs with any table particle material, and
+    runs stored before specimens existed (no ``specimen_sha256``), which are all the paper's.
+    """
+    if runs is None or runs.empty:
+        return runs
+    specimen = specimen or paper_specimen()
+    if "specimen_sha256" in runs.columns:
+        stated = runs["specimen_sha256"].map(lambda h: h if isinstance(h, str) and h else None)
+    else:
+        stated = runs["case_key"].map(lambda _: None)
+    if specimen.is_paper():
+        from ..constants import PARTICLE_MATERIALS
+
+        paper = {paper_specimen(m).hash for m in PARTICLE_MATERIALS}
+        keep = stated.map(lambda h: h is None or h in paper)
+    else:
+        keep = stated == specimen.hash
+    return runs[keep.astype(bool)].reset_index(drop=True)
+
+
 def rekey_dem_store(source: str | os.PathLike[str], target: str | os.PathLike[str]) -> int:
     """Copy every DEM run of ``source`` into a new store ``target`` under today's key.
 
@@ -229,5 +252,6 @@ def rekey_dem_store(source: str | os.PathLike[str], target: str | os.PathLike[st
 
 
 __all__ = ["DEM_CODE_VERSION", "dem_run_entry", "load_dem_result", "run_key", "run_or_load",
-           "run_parameters", "rekey_dem_store", "save_dem_entry", "save_dem_result"]
+           "run_parameters", "runs_of_specimen", "rekey_dem_store", "save_dem_entry",
+           "save_dem_result"]
 
