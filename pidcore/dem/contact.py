@@ -515,8 +515,17 @@ class ContactLaw:
                    self.pair_particle.contact_time(impact_speed_m_s))
 
     def tangential_period(self) -> float:
-        """Shortest period of a stuck tangential or rolling spring (pair or wall), s."""
-        return min(self.pair_particle.spring_period(), self.pair_wall.spring_period())
+        """Shortest period of a stuck tangential or rolling spring (pair or wall), s.
+
+        With Mindlin's k_t, at the largest overlap the kernel accepts
+        (DEM_MAX_OVERLAP_FRACTION of the radius).
+        """
+        pairs = (self.pair_particle, self.pair_wall)
+        if self.tangential_stiffness_model == "mindlin":
+            delta = defaults.DEM_MAX_OVERLAP_FRACTION * self.radius_m
+            pairs = tuple(dataclasses.replace(
+                p, tangential_stiffness=p.mindlin_factor * np.sqrt(delta)) for p in pairs)
+        return min(p.spring_period() for p in pairs)
 
 
 def check_damping_mode(mode: str) -> None:
