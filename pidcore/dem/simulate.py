@@ -6,9 +6,13 @@ grid.
 
 Method (choices and why):
 
+* **Specimen.** Cell, coupon and fixture masses, particles and contact pairs come from a
+  :class:`~pidcore.specimen.Specimen` (default: the paper's coupon,
+  ``pidcore/data/specimens/paper_coupon.toml``, with ``case.material`` particles).
 * **Cells.** K independent cells (default 8, different random packings from one seed) stand
-  for the coupon's 441 identical cells; coupon energies are 441 x the K-cell mean, and the
-  SDC's standard error is taken across the K cells.
+  for the coupon's identical cells (the specimen's ``[cell] count``, 441 for the paper's);
+  coupon energies are that count x the K-cell mean, and the SDC's standard error is taken
+  across the K cells.
 * **Fill.** 100 % is the cell's capacity: spheres dropped one by one, each to the lowest rest
   position on a fine grid of centres (:func:`~pidcore.dem.geometry.cell_capacity`; 22 acrylic
   r = 1.25 mm, 55 aluminium r = 1 mm in the 4.76 x 25.4 mm cell). The paper's 36 particles
