@@ -100,6 +100,8 @@ DEM_DAMPING_COEFFICIENT = "eq3"
 DEM_CALIBRATION_SPEED_M_S = 0.3
 
 # --- Coupon (paper Sect. 2, Table 2) ---------------------------------------------------------
+# The DEM reads the coupon from its specimen file (pidcore/data/specimens/paper_coupon.toml,
+# written from these values); these remain for the paper-table model (pidcore.model).
 COUPON_SIDE_M = 0.100
 COUPON_CELLS = 441
 CELL_INSCRIBED_DIAMETER_M = 4.76e-3

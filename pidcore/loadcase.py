@@ -22,10 +22,10 @@ _NUMBER = r"\d+(?:\.\d+)?(?:e[+-]?\d+)?"
 #: :attr:`LoadCase.key`, e.g. ``f500Hz_a5g_fill50pct_acrylic_z`` (a run key may follow).
 KEY_PATTERN = re.compile(
     rf"^f(?P<f>{_NUMBER})Hz_a(?P<a>{_NUMBER})g_fill(?P<p>{_NUMBER})pct_"
-    r"(?P<material>[a-z]+)_(?P<direction>[xyz])(?=$|_)")
+    r"(?P<material>[a-z][a-z0-9_]*?)_(?P<direction>[xyz])(?=$|_)")
 #: The DEM run key of pidcore 0.1, e.g. ``acrylic_z_f50_a5_fill50`` (read, never written).
 KEY_PATTERN_0_1 = re.compile(
-    rf"^(?P<material>[a-z]+)_(?P<direction>[xyz])_f(?P<f>{_NUMBER})_a(?P<a>{_NUMBER})"
+    rf"^(?P<material>[a-z][a-z0-9_]*?)_(?P<direction>[xyz])_f(?P<f>{_NUMBER})_a(?P<a>{_NUMBER})"
     rf"_fill(?P<p>{_NUMBER})(?=$|_)")
 
 
@@ -33,13 +33,26 @@ class LoadCaseError(ParameterError):
     """A load case is not stated, stated twice differently, or out of range."""
 
 
-def normalize_material(value: str, what: str) -> str:
-    """Canonical material name (``aluminum`` -> ``aluminium``, ``pmma`` -> ``acrylic``)."""
+#: Form of a particle material name in a load case: the table's materials and a specimen's
+#: own (inline) materials such as ``steel`` or ``tungsten_carbide``.
+_MATERIAL_NAME = re.compile(r"^[a-z][a-z0-9_]*$")
+
+
+def normalize_material(value: str, what: str,
+                       known: tuple[str, ...] | None = PARTICLE_MATERIALS) -> str:
+    """Canonical material name (``aluminum`` -> ``aluminium``, ``pmma`` -> ``acrylic``).
+
+    ``known``: the names accepted (the materials table by default, plus a specimen's own
+    material where one is given); ``None`` accepts any lower-case identifier.
+    """
     text = str(value).strip().lower()
     text = _MATERIAL_ALIASES.get(text, text)
-    if text not in PARTICLE_MATERIALS:
+    if known is not None and text not in known:
         raise LoadCaseError(f"{what}: unknown particle material {value!r}; expected one of "
-                            f"{', '.join(PARTICLE_MATERIALS)}")
+                            f"{', '.join(known)}")
+    if not _MATERIAL_NAME.match(text):
+        raise LoadCaseError(f"{what}: particle material {value!r} is not a name (expected "
+                            "lower-case letters, digits and '_', e.g. 'acrylic')")
     return text
 
 
@@ -106,7 +119,9 @@ class LoadCase:
                                     f"got {value!r}")
             object.__setattr__(self, name, number)
         object.__setattr__(self, "fill_percent", check_fill(self.fill_percent, "load case"))
-        object.__setattr__(self, "material", normalize_material(self.material, "load case"))
+        # any material name: a specimen may define its own (the edges check the vocabulary)
+        object.__setattr__(self, "material",
+                           normalize_material(self.material, "load case", known=None))
         object.__setattr__(self, "direction", normalize_direction(self.direction, "load case"))
 
     @property
