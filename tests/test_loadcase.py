@@ -12,7 +12,7 @@ from pidcore.compare import LoadCase as CompareLoadCase
 from pidcore.constants import STANDARD_GRAVITY
 from pidcore.dem import LoadCase as DemLoadCase
 from pidcore.errors import ParameterError
-from pidcore.loadcase import LoadCase, LoadCaseError, key_0_1, parse_key
+from pidcore.loadcase import LoadCase, LoadCaseError, key_0_1, normalize_material, parse_key
 
 BUNDLED_STORE = Path(__file__).resolve().parents[1] / "data_samples" / "dem_table3.h5"
 
@@ -46,11 +46,26 @@ def test_key_format_is_the_one_of_store_cli_reports_and_app():
     assert record["load_case_key"] == "f50Hz_a5g_fill50pct_acrylic_z"
 
 
-@pytest.mark.parametrize("text", ["", "f50Hz_a5g", "steel_z_f50_a5_fill50",
-                                  "f50Hz_a5g_fill150pct_acrylic_z"])
+@pytest.mark.parametrize("text", ["", "f50Hz_a5g", "9steel_z_f50_a5_fill50",
+                                  "f50Hz_a5g_fill150pct_acrylic_z", "f50Hz_a5g_fill50pct_Steel_z"])
 def test_bad_keys_are_refused(text):
     with pytest.raises(LoadCaseError):
         parse_key(text)
+
+
+@pytest.mark.parametrize("material", ["steel", "tungsten_carbide"])
+def test_a_specimen_material_round_trips_through_both_key_formats(material):
+    # a specimen may bring its own particle material: the key names it and reads back
+    case = LoadCase(500.0, 5.0, 50.0, material, "x")
+    assert parse_key(case.key + "_seed1_cells2_0123456789") == case
+    assert parse_key(key_0_1(case) + "_seed1_cells2_0123456789") == case
+
+
+def test_edges_still_check_the_material_vocabulary():
+    # sidecars and --material name table materials; a typo is refused there, not carried on
+    with pytest.raises(LoadCaseError, match="acryllic"):
+        normalize_material("acryllic", "loadcases.csv row 2")
+    assert normalize_material("steel", "specimen", known=("acrylic", "steel")) == "steel"
 
 
 @pytest.mark.parametrize("kwargs", [{"frequency_hz": math.nan}, {"acceleration_g": 0.0},
@@ -60,8 +75,35 @@ def test_out_of_range_fields_are_refused(kwargs):
         LoadCase(**{"frequency_hz": 50.0, "acceleration_g": 1.0, "fill_percent": 50.0, **kwargs})
 
 
+def _store_as_written_by_0_1(source: Path, target: Path) -> None:
+    """The bundled grid as pidcore 0.1 stored it: 0.1 keys, the Eq. 10 mass as ``m_c_kg``, no
+    specimen provenance (the layout 0.1 wrote; the numbers are the bundled ones)."""
+    from pidcore.dem.persist import run_key_0_1
+    from pidcore.dem.simulate import DemConfig
+    from pidcore.store import Store
+
+    old = Store(source)
+    items = []
+    for key in old.list_dem_runs()["case_key"]:
+        entry = old.get_dem_run(key)
+        record = {k: v for k, v in entry.record.items()
+                  if not k.startswith("specimen_") and k not in (
+                      "fixture_mass_kg", "coupon_cells", "samples_per_cycle",
+                      "energy_dissipated_rolling_j")}
+        record["m_c_kg"] = record.pop("vibrated_mass_kg")
+        parameters = {k: v for k, v in entry.parameters.items()
+                      if k.startswith(("case_", "config_"))}
+        config = DemConfig(**{k[7:]: (None if v == "" else v) for k, v in parameters.items()
+                              if k.startswith("config_")})
+        items.append({"case_key": run_key_0_1(parse_key(key), config), "record": record,
+                      "arrays": dict(entry.arrays), "parameters": parameters,
+                      "units": {k: v for k, v in entry.units.items() if k in record
+                                or k in entry.arrays}})
+    Store(target).add_dem_runs(items)
+
+
 @pytest.mark.skipif(not BUNDLED_STORE.is_file(), reason="bundled DEM store not present")
-def test_store_written_by_0_1_opens_and_reports_the_same_numbers():
+def test_store_written_by_0_1_opens_and_reports_the_same_numbers(tmp_path):
     from pidcore.dem.persist import run_key_0_1
     from pidcore.dem.simulate import DemConfig
     from pidcore.dem.sweep import grid_cases
@@ -69,8 +111,10 @@ def test_store_written_by_0_1_opens_and_reports_the_same_numbers():
     from pidcore.report import build_report_table
     from pidcore.store import Store
 
-    store = Store(BUNDLED_STORE)
+    _store_as_written_by_0_1(BUNDLED_STORE, tmp_path / "v0_1.h5")
+    store = Store(tmp_path / "v0_1.h5")
     runs = store.list_dem_runs()
+    assert runs["case_key"].str.startswith("acrylic_z_f").all()
     assert len(runs) == 48
     # every 0.1 run name names the load case its record holds
     for _, row in runs.iterrows():

@@ -141,7 +141,9 @@ def load_dem_result(entry: StoredEntry) -> DemResult:
     text = params.get("specimen_text")
     specimen = Specimen.from_text(text, source=f"stored run {entry.key}") if text \
         else paper_specimen(case.material)
-    record = entry.record
+    record = dict(entry.record)
+    if "m_c_kg" in record:  # the column's name in stores written by pidcore 0.1
+        record.setdefault("vibrated_mass_kg", record.pop("m_c_kg"))
     values: dict[str, Any] = {"case": case, "config": config, "specimen": specimen}
     for f in dataclasses.fields(DemResult):
         if f.name in values:
@@ -152,6 +154,11 @@ def load_dem_result(entry: StoredEntry) -> DemResult:
             value = record[f.name]
             values[f.name] = float("nan") if value is None else value
     values.setdefault("coupon_cells", specimen.cell.count)
+    if "energy_dissipated_rolling_j" not in record and not any(
+            pair.rolling_friction for pair in (specimen.pairs.particle_particle,
+                                               specimen.pairs.particle_wall)):
+        # stored before rolling resistance was tallied: none acted (rolling friction 0)
+        values["energy_dissipated_rolling_j"] = 0.0
     values.setdefault("samples_per_cycle",
                       int(round(record["sample_rate_hz"] / case.frequency_hz)))
     values.setdefault("dissipation_per_cell_cycle_j", np.full(
