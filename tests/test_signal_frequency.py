@@ -76,8 +76,9 @@ def test_harmonic_fit_matches_dense_least_squares_on_noise():
     theta = 0.0731
     edges = np.array([0, 1000, 2200, x.shape[0]])
     fit = fit_harmonics(x, None, theta, 3, edges)
-    for lo, hi, got, dc in [(0, x.shape[0], fit.total[0], fit.dc_total[0])] + [
-            (a, b, fit.phasors[0, s], None) for s, (a, b) in enumerate(zip(edges[:-1], edges[1:]))]:
+    cases = [(0, x.shape[0], fit.total[0], fit.dc_total[0])]
+    cases += [(edges[s], edges[s + 1], fit.phasors[0, s], None) for s in range(3)]
+    for lo, hi, got, dc in cases:
         i = np.arange(lo, hi)
         cols = [np.ones(i.size), i - i.mean()] + [np.cos(n * theta * i) for n in range(1, 4)] + \
             [np.sin(n * theta * i) for n in range(1, 4)]

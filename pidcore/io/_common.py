@@ -25,6 +25,19 @@ EVEN_SPACING_TOLERANCE = 0.05
 FLOAT64_RATE_RESOLUTION = 1e-9
 
 
+def reraise_interrupt(exc: BaseException) -> None:
+    """Raise :class:`KeyboardInterrupt` when ``exc`` was caused by one.
+
+    pyuff and scipy turn every failure, Ctrl-C included, into a plain ``Exception``; a reader
+    that reported those as a corrupt file would turn an interruption into a wrong diagnosis.
+    """
+    seen = exc
+    while seen is not None:
+        if isinstance(seen, KeyboardInterrupt):
+            raise KeyboardInterrupt from None
+        seen = seen.__cause__ or seen.__context__
+
+
 def file_sha256(path: str | os.PathLike[str]) -> str:
     """SHA-256 (hex) of a file's bytes, read in blocks."""
     digest = hashlib.sha256()

@@ -38,6 +38,7 @@ from ._common import (
     file_sha256,
     make_channel,
     rate_from_times,
+    reraise_interrupt,
     unique_names,
 )
 
@@ -119,6 +120,7 @@ def _load(path: str) -> dict:
     except NotImplementedError:
         return _load_v73(path)
     except Exception as exc:  # scipy raises ValueError, TypeError, MatReadError, ...
+        reraise_interrupt(exc)
         raise InputFileError(f"{path}: not a readable MATLAB .mat file ({exc})") from None
 
 

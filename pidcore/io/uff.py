@@ -39,6 +39,7 @@ from ._common import (
     file_sha256,
     interpret_unit,
     rate_from_times,
+    reraise_interrupt,
     snap_rate,
     unique_names,
 )
@@ -210,6 +211,7 @@ def read_uff(path: str | os.PathLike[str]) -> Measurement:
         uff = pyuff.UFF(where)
         set_types = [int(t) for t in uff.get_set_types()]
     except Exception as exc:  # pyuff raises bare Exception for every failure
+        reraise_interrupt(exc)
         raise InputFileError(f"{where}: cannot parse as UFF ({exc})") from None
     if not set_types:
         raise InputFileError(f"{where}: no UFF dataset found (expected blocks that start and "
@@ -224,6 +226,7 @@ def read_uff(path: str | os.PathLike[str]) -> Measurement:
         try:
             dset = uff.read_sets(i)
         except Exception as exc:
+            reraise_interrupt(exc)
             if set_type != 58 or _BINARY_58.search(raw):
                 raise InputFileError(f"{where}: dataset {set_type} (block {i + 1}) is corrupt "
                                      f"({exc})") from None
@@ -319,4 +322,5 @@ def write_uff(measurement: Measurement, path: str | os.PathLike[str], *,
         try:
             pyuff.UFF(str(tmp)).write_sets(sets, mode="add", force_double=True)
         except Exception as exc:  # pyuff raises bare Exception
+            reraise_interrupt(exc)
             raise ParameterError(f"{path}: cannot write UFF ({exc})") from None

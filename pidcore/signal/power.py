@@ -545,13 +545,13 @@ def _cut_dropouts(channels: list[Channel], datas: list[np.ndarray], *, source: s
     described: list[str] = []
     for ch, data in zip(channels, datas, strict=True):
         runs = validate.dropout_runs(data)
-        for start, length, value in runs:
-            bad.append((start, start + length))
+        bad.extend((start, start + length) for start, length, _ in runs)
         if runs:
             start, length, value = max(runs, key=lambda r: r[1])
+            at = ch.start_time_s + start / ch.sample_rate_hz
             described.append(
                 f"channel {ch.name!r}: {len(runs)} dropout(s), longest {length} samples stuck at "
-                f"{value:+.6g} {ch.unit} from t = {ch.start_time_s + start / ch.sample_rate_hz:.6g} s")
+                f"{value:+.6g} {ch.unit} from t = {at:.6g} s")
     if not bad:
         return datas, [], None
     n = datas[0].shape[0]
