@@ -196,15 +196,23 @@ def _lms_layout(signal: object, where: str) -> list[Channel]:
 
 
 def _simple_layout(variables: Mapping, where: str,
-                   sample_rate_hz: float | None) -> list[Channel]:
+                   sample_rate_hz: float | None) -> tuple[list[Channel], list[str]]:
     public = {k: v for k, v in variables.items() if not k.startswith("__")}
     time_key = next((k for k in _TIME_VARIABLES if _numeric_vector(public.get(k)) is not None),
                     None)
     rate_key = next((k for k in _RATE_VARIABLES if k in public), None)
-    if time_key is not None:
-        rate, start = rate_from_times(_numeric_vector(public[time_key]),
-                                      what=f"{where}: variable {time_key!r}")
+    notes: list[str] = []
+    if time_key is not None and sample_rate_hz is not None:
+        rate, start = float(sample_rate_hz), float(_numeric_vector(public[time_key])[0])
         n = _numeric_vector(public[time_key]).size
+        notes.append(f"{where}: time vector {time_key!r} ignored: the sample rate "
+                     f"{rate:g} Hz was given (--sample-rate)")
+    elif time_key is not None:
+        rate, start, note = rate_from_times(_numeric_vector(public[time_key]),
+                                            what=f"{where}: variable {time_key!r}",
+                                            with_note=True)
+        n = _numeric_vector(public[time_key]).size
+        notes += [note] if note else []
     elif rate_key is not None or sample_rate_hz is not None:
         rate = (_scalar(public[rate_key], f"{where}: {rate_key}") if rate_key is not None
                 else float(sample_rate_hz))
@@ -213,8 +221,9 @@ def _simple_layout(variables: Mapping, where: str,
         raise InputFileError(f"{where}: no time vector ('time' or 't') and no sample rate "
                              "('fs' or 'sample_rate_hz'); give the sample rate (--sample-rate)")
     if sample_rate_hz is not None and abs(rate - sample_rate_hz) > 1e-6 * rate:
-        raise ParameterError(f"{where}: the file gives {rate:.9g} Hz but "
-                             f"sample_rate_hz={sample_rate_hz:.9g} was given")
+        notes.append(f"{where}: the file's sample rate {rate:.9g} Hz overridden by "
+                     f"{sample_rate_hz:.9g} Hz (--sample-rate)")
+        rate = float(sample_rate_hz)
     skip = {time_key, rate_key, "units"}
     vectors = {k: _numeric_vector(v) for k, v in public.items() if k not in skip}
     vectors = {k: v for k, v in vectors.items() if v is not None and (n is None or v.size == n)}
@@ -226,7 +235,7 @@ def _simple_layout(variables: Mapping, where: str,
         units = {k: (unit_list[i] if i < len(unit_list) else "")
                  for i, k in enumerate(vectors)}
     return [make_channel(k, v, sample_rate_hz=rate, unit=units[k], start_time_s=start)
-            for k, v in vectors.items()]
+            for k, v in vectors.items()], notes
 
 
 def read_mat(path: str | os.PathLike[str], *, sample_rate_hz: float | None = None) -> Measurement:
@@ -239,6 +248,7 @@ def read_mat(path: str | os.PathLike[str], *, sample_rate_hz: float | None = Non
     """
     where = str(path)
     variables = _load(where)
+    notes: list[str] = []
     if _text(variables.get("pidcore_layout")) == "measurement":
         channels = _pidcore_layout(variables, where)
         layout = "pidcore"
@@ -246,7 +256,7 @@ def read_mat(path: str | os.PathLike[str], *, sample_rate_hz: float | None = Non
         channels = _lms_layout(variables["Signal"], where)
         layout = "lms_testlab"
     else:
-        channels = _simple_layout(variables, where, sample_rate_hz)
+        channels, notes = _simple_layout(variables, where, sample_rate_hz)
         layout = "simple"
     if not channels:
         names = ", ".join(k for k in variables if not k.startswith("__")) or "none"
@@ -256,8 +266,11 @@ def read_mat(path: str | os.PathLike[str], *, sample_rate_hz: float | None = Non
     channels = [c if c.name == nm else Channel(nm, c.quantity, c.data, c.sample_rate_hz,
                                                c.source_unit, c.start_time_s)
                 for c, nm in zip(channels, names, strict=True)]
+    metadata: dict = {"mat_layout": layout}
+    if notes:
+        metadata["reader_notes"] = notes
     return Measurement(source=where, channels=tuple(channels), sha256=file_sha256(path),
-                       file_format="mat", metadata={"mat_layout": layout})
+                       file_format="mat", metadata=metadata)
 
 
 def write_mat(measurement: Measurement, path: str | os.PathLike[str]) -> None:
