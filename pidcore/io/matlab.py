@@ -9,8 +9,10 @@ Three layouts are understood, tried in this order:
    ``x_values.start_value``, ``x_values.increment`` (s), ``x_values.number_of_values``,
    ``y_values.values`` (one column per channel) and, where present,
    ``function_record.name`` (channel name; a cell of names for several columns) and the unit in
-   ``y_values.quantity`` (fields ``unit``/``units``/``unit_label``; a bare ``label`` such as
-   ``'Acceleration'`` is taken as that quantity in SI, the unit Test.Lab exports in).
+   ``y_values.quantity`` (fields ``unit``/``units``/``unit_label``, a unit struct
+   ``unit.label``, or ``quantity_terms(k).unit.label`` with exponents; only a bare ``label``
+   such as ``'Acceleration'`` is taken as that quantity in SI, the unit Test.Lab exports in).
+   v7.3 struct *arrays* (``Signal(1)``, ``Signal(2)``, ...) are read like v5 ones.
 3. **simple layout**: a time vector ``time`` or ``t`` (s) plus one numeric vector per channel
    (the variable name is the channel name), optionally ``units`` as a struct
    (``units.Force = 'kN'``) or a cell of unit strings in the order of the channel variables.
@@ -41,6 +43,7 @@ from ._common import (
     reraise_interrupt,
     unique_names,
 )
+from ._hdf5_safety import check_hdf5_input
 
 _TIME_VARIABLES = ("time", "t", "Time", "T")
 _RATE_VARIABLES = ("sample_rate_hz", "fs", "Fs", "sample_rate")
@@ -84,8 +87,39 @@ def _numeric_vector(value: object) -> np.ndarray | None:
 # --- v7.3 (HDF5) -> the same nested dict/list/array shape loadmat(simplify_cells=True) gives
 
 
+def _struct_array_fields(group: h5py.Group) -> list[str] | None:
+    """Field names when ``group`` is a MATLAB struct *array* (not 1x1), else None.
+
+    v7.3 stores a 1x1 struct as a group of its field values, but a struct array as a group
+    whose every field is an array of object references (one per element) without a
+    ``MATLAB_class`` of its own.
+    """
+    if _attr_text(group, "MATLAB_class") != "struct":
+        return None
+    fields = [k for k in group if not k.startswith("#")]
+    shapes = set()
+    for k in fields:
+        item = group[k]
+        if not isinstance(item, h5py.Dataset) or item.dtype != h5py.ref_dtype \
+                or _attr_text(item, "MATLAB_class"):
+            return None
+        shapes.add(item.shape)
+    return fields if fields and len(shapes) == 1 else None
+
+
+def _attr_text(obj: h5py.Group | h5py.Dataset, name: str) -> str:
+    value = obj.attrs.get(name, b"")
+    return value.decode() if isinstance(value, bytes) else str(value)
+
+
 def _h5_value(obj: h5py.Group | h5py.Dataset, file: h5py.File) -> object:
     if isinstance(obj, h5py.Group):
+        fields = _struct_array_fields(obj)
+        if fields is not None:  # struct array -> list of dicts, as loadmat gives
+            columns = {k: [_h5_value(file[ref], file) for ref in np.asarray(obj[k][()]).T.ravel()]
+                       for k in fields}
+            n = len(next(iter(columns.values())))
+            return [{k: columns[k][i] for k in fields} for i in range(n)]
         return {k: _h5_value(obj[k], file) for k in obj if not k.startswith("#")}
     matlab_class = obj.attrs.get("MATLAB_class", b"")
     matlab_class = matlab_class.decode() if isinstance(matlab_class, bytes) else matlab_class
@@ -101,6 +135,7 @@ def _h5_value(obj: h5py.Group | h5py.Dataset, file: h5py.File) -> object:
 
 
 def _load_v73(path: str) -> dict:
+    check_hdf5_input(path, what="MATLAB v7.3 (HDF5)")
     with h5py.File(path, "r") as h5:
         return {k: _h5_value(h5[k], h5) for k in h5 if not k.startswith("#")}
 
@@ -145,13 +180,46 @@ def _pidcore_layout(variables: Mapping, where: str) -> list[Channel]:
     return channels
 
 
+def _unit_text(value: object) -> str:
+    """A unit from text or from a unit struct (``unit.label``)."""
+    if isinstance(value, Mapping):
+        for key in ("label", "name", "unit", "symbol"):
+            text = _text(value.get(key))
+            if text:
+                return text
+        return ""
+    return _text(value)
+
+
+def _terms_unit(terms: object) -> str:
+    """Unit of Test.Lab ``quantity_terms``: one term (``unit.label``) or a product of terms
+    with ``unit_exponent`` / ``exponent`` (``m^1*s^-2``)."""
+    parts = []
+    for term in _as_list(terms):
+        if not isinstance(term, Mapping):
+            continue
+        text = _unit_text(term.get("unit", term))
+        if not text:
+            continue
+        exponent = term.get("unit_exponent", term.get("exponent"))
+        try:
+            power = 1.0 if exponent is None else _scalar(exponent, "exponent")
+        except InputFileError:
+            power = 1.0
+        parts.append(text if power == 1 else f"{text}^{power:g}")
+    return "*".join(parts)
+
+
 def _lms_unit(quantity_struct: object) -> str:
     if not isinstance(quantity_struct, Mapping):
         return _text(quantity_struct)
     for key in ("unit", "units", "unit_label", "unit_name"):
-        text = _text(quantity_struct.get(key))
+        text = _unit_text(quantity_struct.get(key))
         if text:
             return text
+    text = _terms_unit(quantity_struct.get("quantity_terms"))
+    if text:
+        return text
     label = _text(quantity_struct.get("label")).strip().lower()
     if label in SI_UNITS and label not in ("unknown", "time"):
         return SI_UNITS[label]  # Test.Lab exports values in SI; the label names the quantity
