@@ -91,8 +91,8 @@ def test_override_of_other_quantity_refused_unknown_accepted():
     m = _m(_ch("F", "force", "N"), _ch("acc", "acceleration", "g"), _ch("raw", "unknown", "V^2"))
     with pytest.raises(ChannelError, match=r"--force 'acc' is a acceleration channel"):
         assign_roles(m, force="acc")
-    roles = assign_roles(m, force="raw")  # unit-less channel taken as SI newtons
-    assert roles.force.name == "raw" and roles.acceleration.name == "acc"
+    roles = assign_roles(m, force="raw")  # accepted here; the analysis asks for its unit
+    assert roles.force.name == "raw" and roles.acceleration.name == "acc"  # no velocity
 
 
 def test_same_channel_for_two_roles_refused():

@@ -238,6 +238,7 @@ def read_uff(path: str | os.PathLike[str]) -> Measurement:
         raise InputFileError(f"{where}: no UFF dataset found (expected blocks that start and "
                              "end with a '    -1' line)")
     unit_factors = (1.0, 1.0)
+    has_units_dataset = 164 in set_types
     records: list[dict] = []
     fallback: list[dict] | None = None
     n58 = 0
@@ -267,6 +268,12 @@ def read_uff(path: str | os.PathLike[str]) -> Measurement:
                              "(function type 1); expected time histories")
     channels = [_record_channel(d, k, where, unit_factors) for k, d in enumerate(time_records)]
     notes: list[str] = []
+    for k, c in enumerate(channels):
+        if c.source_unit.startswith("UFF data type"):
+            basis = ("the file's dataset 164 unit factors" if has_units_dataset
+                     else "SI (no dataset 164 in the file)")
+            notes.append(f"{where}: record {k + 1} ({c.name!r}) has no unit label; unit from "
+                         f"its {c.source_unit} ({c.quantity}) in {basis}")
     described = _described_names(time_records)
     if described is not None:
         channels = [replace(c, name=n) for c, n in zip(channels, described, strict=True)]
