@@ -426,13 +426,18 @@ def test_csv_reading_memory_within_three_times_the_file(tmp_path):
     data = np.column_stack([t, np.sin(W * t) * 12.345678, np.cos(W * t) * 0.0123456789])
     np.savetxt(path, data, delimiter=",", fmt="%.10g",
                header="Time [s],Force [N],Velocity [m/s]", comments="")
+    # VmHWM (peak resident set) belongs to the new process image; ru_maxrss would carry the
+    # parent's peak over the exec
     script = (
-        "import resource, sys\n"
+        "import sys\n"
         "import numpy, pandas, pidcore.io\n"
-        "base = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss\n"
+        "def hwm():\n"
+        "    for line in open('/proc/self/status'):\n"
+        "        if line.startswith('VmHWM:'):\n"
+        "            return int(line.split()[1]) * 1024\n"
+        "base = hwm()\n"
         "m = pidcore.io.read_measurement(sys.argv[1])\n"
-        "peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss\n"
-        "print((peak - base) * 1024, m.channels[0].n_samples)\n")
+        "print(hwm() - base, m.channels[0].n_samples)\n")
     env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[1])}
     out = subprocess.run([sys.executable, "-c", script, str(path)], capture_output=True,
                          text=True, env=env, check=True).stdout.split()
