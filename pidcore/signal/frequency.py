@@ -108,17 +108,18 @@ def estimate_drive_frequency(x: np.ndarray, sample_rate_hz: float, *,
     if x.shape[0] > max_samples and k < 8:
         power, bin_hz = _decimated_spectrum(x, sample_rate_hz, max_samples)
         f0, ratio, k = _peak(power, bin_hz, frequency_hint_hz, rel)
-    if frequency_hint_hz is not None:
+    if frequency_hint_hz is not None and power.shape[0] > 4:
         # A wrong hint must not pull the estimate onto the skirt of the real line: look at the
         # whole spectrum, and refuse when the dominant line lies outside the search window.
-        f_all, ratio_all, _ = _peak(power, bin_hz, None, rel)
-        outside = abs(f_all - frequency_hint_hz) > rel * frequency_hint_hz + 3 * bin_hz
-        if outside and ratio_all >= defaults.DOMINANT_PEAK_MIN_POWER_RATIO \
-                and ratio < HINT_MIN_FRACTION_OF_LINE * ratio_all:
-            raise SignalError(
-                f"{what}: the drive line is at {f_all:.6g} Hz, outside +-{100 * rel:g} % of "
-                f"the frequency hint {frequency_hint_hz:g} Hz; correct the hint (--frequency) "
-                "or leave it out")
+        k_all = 2 + int(np.argmax(power[2:-2]))
+        if power[k] < HINT_MIN_FRACTION_OF_LINE * power[k_all]:
+            f_all, ratio_all, _ = _peak(power, bin_hz, None, rel)
+            outside = abs(f_all - frequency_hint_hz) > rel * frequency_hint_hz + 3 * bin_hz
+            if outside and ratio_all >= defaults.DOMINANT_PEAK_MIN_POWER_RATIO:
+                raise SignalError(
+                    f"{what}: the drive line is at {f_all:.6g} Hz, outside +-{100 * rel:g} % of "
+                    f"the frequency hint {frequency_hint_hz:g} Hz; correct the hint "
+                    "(--frequency) or leave it out")
     if not np.isfinite(f0) or ratio < defaults.DOMINANT_PEAK_MIN_POWER_RATIO:
         near = f" near the hint {frequency_hint_hz:g} Hz" if frequency_hint_hz else ""
         raise SignalError(
