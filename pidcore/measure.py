@@ -45,6 +45,12 @@ class AnalysisOptions:
     acceleration_unit: str | None = None
     invert: tuple[str, ...] = ()
 
+    def __post_init__(self) -> None:
+        if isinstance(self.invert, str):
+            raise ParameterError(f"invert: expected a sequence of channel names, got "
+                                 f"{self.invert!r}")
+        object.__setattr__(self, "invert", tuple(self.invert))  # JSON gives back a list
+
     def parameters(self) -> dict:
         """JSON-safe parameters stored as provenance."""
         return {k: (list(v) if isinstance(v, tuple) else v) for k, v in asdict(self).items()
