@@ -130,7 +130,8 @@ def test_sweep_of_a_specimen_stores_its_runs_with_provenance_and_resumes(tmp_pat
     assert first.completed == [key] and key != run_key(CASES[0], CONFIG)
     entry = Store(store_path).get_dem_run(key)
     assert entry.parameters["specimen_sha256"] == own.hash
-    assert entry.record["vibrated_mass_kg"] > 0.02 + own.coupon.mass_kg  # fixture in the vibrated mass
+    # the fixture is in the vibrated mass
+    assert entry.record["vibrated_mass_kg"] > 0.02 + own.coupon.mass_kg
     again = run_sweep(CASES[:1], CONFIG, store_path=store_path, workers=1, progress=False,
                       specimen=own)
     assert again.skipped == [key] and not again.completed

@@ -77,7 +77,8 @@ def test_fixture_mass_changes_only_the_vibrated_mass():
         {"coupon.fixture_mass_kg": 0.1}))
     assert heavy.energy_per_cycle_j == base.energy_per_cycle_j
     assert heavy.vibrated_mass_kg == pytest.approx(base.vibrated_mass_kg + 0.1, rel=1e-15)
-    assert heavy.sdc == pytest.approx(base.sdc * base.vibrated_mass_kg / heavy.vibrated_mass_kg, rel=1e-12)
+    assert heavy.sdc == pytest.approx(
+        base.sdc * base.vibrated_mass_kg / heavy.vibrated_mass_kg, rel=1e-12)
     # the virtual shaker carries the fixture too: F = (coupon + fixture) a + walls' force
     extra = (heavy.shaker_force_n - heavy.wall_force_n) - (base.shaker_force_n - base.wall_force_n)
     accel = (base.shaker_force_n - base.wall_force_n) / base.coupon_mass_kg
@@ -88,14 +89,15 @@ def test_a_specimen_unlike_the_papers_runs_end_to_end():
     steel = load_specimen(STEEL)
     facts = describe(steel)
     assert not facts["is_paper"] and facts["cells_per_coupon"] == 286
-    r = simulate_load_case(LoadCase(500.0, 5.0, 50.0, "steel"), DemConfig(cells=2, steady_cycles=40),
+    r = simulate_load_case(LoadCase(500.0, 5.0, 50.0, "steel"),
+                           DemConfig(cells=2, steady_cycles=40),
                            specimen=steel)
     # particle count and masses follow from the specimen, not from the paper's coupon
     assert r.particles_full_cell == facts["capacity_per_cell"]
     assert r.particles_per_cell == round(0.5 * facts["capacity_per_cell"])
     m_particle = 7850.0 * 4.0 / 3.0 * np.pi * 1e-3**3
-    assert r.vibrated_mass_kg == pytest.approx(0.0333 + 0.015 + 286 * r.particles_per_cell * m_particle,
-                                     rel=1e-12)
+    assert r.vibrated_mass_kg == pytest.approx(
+        0.0333 + 0.015 + 286 * r.particles_per_cell * m_particle, rel=1e-12)
     # coupon energies are 286 x the cell mean (not 441)
     steady = r.dissipation_per_cell_cycle_j[:, r.steady_start_cycle:]
     assert r.energy_per_cycle_j == pytest.approx(286 * steady.mean(), rel=1e-12)

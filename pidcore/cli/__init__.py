@@ -43,6 +43,11 @@ def main(argv: list[str] | None = None) -> int:
         print(f"pidcore {args.command}: interrupted; finished results are saved",
               file=sys.stderr)
         return 130
+    except BrokenPipeError:  # the reader of stdout (| head) stopped: end quietly
+        import os
+
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 141
 
 
 if __name__ == "__main__":  # pragma: no cover
