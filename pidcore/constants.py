@@ -26,11 +26,21 @@ StartProtocol = Literal["rest", "with_cell"]
 #: Tangential contact force (Eq. 5): "stick_slip" = elastic tangential spring capped by
 #: mu |f_n| (Cundall-Strack); "coulomb" = Eq. 5 as written, regularised near v_t = 0.
 TangentialModel = Literal["stick_slip", "coulomb"]
+#: Tangential spring stiffness of the stick-slip model: "constant" = Mindlin's k_t at a
+#: reference overlap; "mindlin" = 8 G* sqrt(R* delta) of the current overlap.
+TangentialStiffnessModel = Literal["constant", "mindlin"]
 #: Packing the drive starts from: "dense" = settled without friction, then settled again
 #: with friction; "loose" = settled with friction from the random drop.
 StartPacking = Literal["dense", "loose"]
+#: Cell shape of a specimen (``[cell] shape``); cylindrical and rectangular cells may follow.
+CellShape = Literal["hexagonal"]
 #: Report output formats.
 ReportFormat = Literal["csv", "md", "html", "tex", "pdf"]
+#: What 100 % fill is: the cell's capacity (dense drop packing) or the paper's 36 particles.
+FillReference = Literal["capacity", "paper"]
+#: Normal damping constant: "eq3" = alpha from the table's e_n by Eq. 3; "calibrated" = alpha
+#: root-found so that a simulated head-on impact gives the table's e_n exactly.
+DampingCoefficient = Literal["eq3", "calibrated"]
 
 QUANTITIES: tuple[str, ...] = get_args(Quantity)
 CHANNEL_ROLES: tuple[str, ...] = get_args(ChannelRole)
@@ -41,7 +51,11 @@ VIBRATED_MASS_CONVENTIONS: tuple[str, ...] = get_args(VibratedMassConvention)
 START_PROTOCOLS: tuple[str, ...] = get_args(StartProtocol)
 TANGENTIAL_MODELS: tuple[str, ...] = get_args(TangentialModel)
 START_PACKINGS: tuple[str, ...] = get_args(StartPacking)
+TANGENTIAL_STIFFNESS_MODELS: tuple[str, ...] = get_args(TangentialStiffnessModel)
 REPORT_FORMATS: tuple[str, ...] = get_args(ReportFormat)
+FILL_REFERENCES: tuple[str, ...] = get_args(FillReference)
+DAMPING_COEFFICIENTS: tuple[str, ...] = get_args(DampingCoefficient)
+CELL_SHAPES: tuple[str, ...] = get_args(CellShape)
 
 #: Standard gravity, m/s^2 (ISO 80000-3); used for g <-> m/s^2 and for gravity on particles.
 STANDARD_GRAVITY = 9.80665

@@ -5,6 +5,8 @@ Change a default here and every CLI option, function and app widget follows.
 
 from pathlib import Path
 
+from . import constants
+
 #: Store file used when none is given.
 STORE_PATH = Path("pid_store.h5")
 #: Seconds a writer waits for the store's write lock before giving up with a StoreError.
@@ -30,6 +32,9 @@ DOMINANT_PEAK_MIN_POWER_RATIO = 100.0
 HARMONIC_MAX_FRACTION_OF_NYQUIST = 0.9
 #: Longest FFT used for the coarse drive-frequency estimate (memory bound on long records).
 FREQUENCY_FFT_MAX_SAMPLES = 2**20
+
+#: Points on one synthesised force-displacement loop (:class:`pidcore.loop.ForceDisplacementLoop`).
+LOOP_POINTS = 256
 
 # --- DEM ------------------------------------------------------------------------------------
 DEM_TIME_STEP_S = 2e-6
@@ -95,6 +100,8 @@ DEM_DAMPING_COEFFICIENT = "eq3"
 DEM_CALIBRATION_SPEED_M_S = 0.3
 
 # --- Coupon (paper Sect. 2, Table 2) ---------------------------------------------------------
+# The DEM reads the coupon from its specimen file (pidcore/data/specimens/paper_coupon.toml,
+# written from these values); these remain for the paper-table model (pidcore.model).
 COUPON_SIDE_M = 0.100
 COUPON_CELLS = 441
 CELL_INSCRIBED_DIAMETER_M = 4.76e-3
@@ -110,6 +117,9 @@ APP_PORT = 8501
 APP_MAX_UPLOAD_MB = 200
 #: Most load cases one DEM sweep started from the app may hold (larger grids: ``pidcore dem``).
 APP_MAX_DEM_CASES = 12
+#: Fill (packing ratio, %) the app proposes for an upload whose name states none (the paper's
+#: experiments were all at 50 %).
+APP_DEFAULT_FILL_PERCENT = 50.0
 
 # --- Compare (measured vs DEM vs paper) -----------------------------------------------------
 #: A measured case sits on a DEM grid point when its frequency is within this relative
@@ -125,10 +135,12 @@ COMPARE_FILL_ATOL_PERCENT = 0.5
 #: Particle material and drive direction assumed when a measurement states none (the paper's).
 COMPARE_DEFAULT_MATERIAL = "acrylic"
 COMPARE_DEFAULT_DIRECTION = "z"
-#: Report formats written by ``pidcore report`` unless --format says otherwise.
-REPORT_FORMATS = ("csv", "md", "html", "tex", "pdf")
+#: Report formats written by ``pidcore report`` unless --format says otherwise: all of them.
+REPORT_FORMATS: tuple[str, ...] = constants.REPORT_FORMATS
 #: Resolution of the PNG figures of a report, dots per inch.
 REPORT_FIGURE_DPI = 150
+#: Last drive cycles of a DEM run's force records drawn by ``DemResult.plot``.
+FIGURE_DEM_FORCE_CYCLES = 5
 
 # --- SDC model, equivalent damper, model figures (pidcore.model, pidcore model) ---------------
 #: Interpolate SDC in log10(frequency) instead of frequency.

@@ -6,15 +6,24 @@ stays thin.
 
 from __future__ import annotations
 
+import math
 import os
 from collections.abc import Mapping, Sequence
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 
+import numpy as np
+
 from . import defaults
+from .errors import ChannelError, ParameterError
 from .io import assign_roles, read_measurement
-from .records import Measurement
+from .records import Channel, Measurement
 from .signal import PowerAnalysis, analyze_channels
+from .units import lookup_unit
+
+#: Largest fractional-sample offset between the start times of the force channel and an
+#: acceleration channel that is ignored (the velocity's is corrected as a delay instead).
+MAX_IGNORED_OFFSET_SAMPLES = 0.02
 
 
 @dataclass(frozen=True)
@@ -31,10 +40,21 @@ class AnalysisOptions:
     n_harmonics: int = defaults.N_HARMONICS
     sample_rate_hz: float | None = None
     allow_clipped: bool = False
+    force_unit: str | None = None
+    velocity_unit: str | None = None
+    acceleration_unit: str | None = None
+    invert: tuple[str, ...] = ()
+
+    def __post_init__(self) -> None:
+        if isinstance(self.invert, str):
+            raise ParameterError(f"invert: expected a sequence of channel names, got "
+                                 f"{self.invert!r}")
+        object.__setattr__(self, "invert", tuple(self.invert))  # JSON gives back a list
 
     def parameters(self) -> dict:
         """JSON-safe parameters stored as provenance."""
-        return {k: v for k, v in asdict(self).items() if v is not None}
+        return {k: (list(v) if isinstance(v, tuple) else v) for k, v in asdict(self).items()
+                if v is not None and v != ()}
 
 
 @dataclass(frozen=True)
@@ -45,28 +65,166 @@ class AnalyzedRecord:
     analysis: PowerAnalysis
     channels_used: dict[str, str]
     notes: tuple[str, ...] = field(default_factory=tuple)
+    channels: tuple[dict, ...] = field(default_factory=tuple)
+    corrections: dict = field(default_factory=dict)
+
+    def to_dict(self) -> dict:
+        """JSON-safe record: the analysis, the channels used (role, name, SI unit, unit in the
+        file), every note and every correction applied (reader, channel preparation, analysis).
+        """
+        out = self.analysis.to_dict()
+        out["channels"] = [dict(c) for c in self.channels]
+        out["notes"] = list(self.notes)
+        out["corrections"] = {**out.get("corrections", {}), **self.corrections}
+        return out
+
+
+_UNIT_OPTIONS = {"force": "--force-unit", "velocity": "--velocity-unit",
+                 "acceleration": "--acceleration-unit"}
+_UNIT_EXAMPLES = {"force": "N, kN, lbf", "velocity": "m/s, mm/s, in/s",
+                  "acceleration": "m/s^2, g"}
+
+
+def _with_unit(ch: Channel, role: str, unit: str | None, source: str,
+               notes: list[str], corrections: dict) -> Channel:
+    """The channel in SI: its file unit, or ``unit`` (an option) which overrides it."""
+    if unit is None:
+        if ch.quantity == "unknown":
+            said = f"the file gives {ch.source_unit!r}" if ch.source_unit else "the file gives none"
+            raise ChannelError(
+                f"{source}: channel {ch.name!r} ({role}) has no recognised unit ({said}); give "
+                f"it with {_UNIT_OPTIONS[role]} UNIT (e.g. {_UNIT_EXAMPLES[role]})")
+        return ch
+    info = lookup_unit(unit)
+    if info is None or info.quantity != role:
+        raise ParameterError(f"{_UNIT_OPTIONS[role]} {unit!r}: not a {role} unit")
+    if ch.quantity == role:
+        old = lookup_unit(ch.source_unit)
+        old_factor = old.factor if old is not None and old.quantity == role else 1.0
+        raw = np.asarray(ch.data) / old_factor
+        notes.append(f"channel {ch.name!r}: the file says {ch.source_unit!r}; taken as {unit!r} "
+                     f"({_UNIT_OPTIONS[role]})")
+    else:
+        raw = np.asarray(ch.data)
+        notes.append(f"channel {ch.name!r}: no unit in the file; taken as {unit!r} "
+                     f"({_UNIT_OPTIONS[role]})")
+    corrections[f"{role}_unit"] = unit
+    return Channel(ch.name, role, raw * info.factor, ch.sample_rate_hz, unit, ch.start_time_s)
+
+
+def _align(channels: dict[str, Channel], source: str, notes: list[str],
+           corrections: dict) -> tuple[dict[str, Channel], float]:
+    """Cut the channels to their common time span; returns them and the velocity delay (s)
+    that corrects a fractional-sample start offset of the velocity against the force."""
+    rates = {ch.sample_rate_hz for ch in channels.values()}
+    if len(rates) > 1:
+        return channels, 0.0  # refused by the analysis with both rates named
+    rate = rates.pop()
+    starts = {r: ch.start_time_s for r, ch in channels.items()}
+    lengths = {r: ch.n_samples for r, ch in channels.items()}
+    if len(set(starts.values())) == 1 and len(set(lengths.values())) == 1:
+        return channels, 0.0
+    force_start = starts["force"]
+    # offsets of each channel from the force in samples: integer part cut, fraction corrected
+    offsets = {r: (s - force_start) * rate for r, s in starts.items()}
+    shift = {r: math.floor(o + 0.5) for r, o in offsets.items()}
+    frac = {r: offsets[r] - shift[r] for r in offsets}
+    delay = 0.0
+    for role, f in frac.items():
+        if abs(f) <= 1e-6:
+            continue
+        if role == "velocity":
+            # sampled f samples after the force's instants: the channel holds v(t + f/rate),
+            # a delay of -f/rate in the convention of velocity_delay_s (v(t - tau))
+            delay = -f / rate
+        elif abs(f) > MAX_IGNORED_OFFSET_SAMPLES:
+            raise ChannelError(f"{source}: channel {channels[role].name!r} starts "
+                               f"{f:+.3f} samples off the force channel's sample grid; "
+                               "expected channels sampled at the same instants")
+    first = max(shift.values())
+    last = min(shift[r] + lengths[r] for r in channels)
+    if last - first < 8:
+        names = ", ".join(repr(c.name) for c in channels.values())
+        raise ChannelError(f"{source}: the channels {names} do not overlap in time (start times "
+                           f"{', '.join(f'{s:.6g} s' for s in starts.values())})")
+    out = {}
+    for role, ch in channels.items():
+        a = first - shift[role]
+        out[role] = replace(ch, data=ch.data[a:a + last - first],
+                            start_time_s=ch.start_time_s + a / rate)
+    span = f"{force_start + first / rate:.6g} s to {force_start + last / rate:.6g} s"
+    notes.append("channels aligned on their common time span " + span + " (starts "
+                 + ", ".join(f"{ch.name!r} {starts[r]:.6g} s" for r, ch in channels.items())
+                 + "; lengths " + ", ".join(str(n) for n in lengths.values()) + ")")
+    corrections["aligned_span_s"] = [force_start + first / rate, force_start + last / rate]
+    if delay:
+        notes.append(f"channel {channels['velocity'].name!r} starts {frac['velocity']:+.4f} "
+                     "samples off the force's grid: corrected as a velocity delay of "
+                     f"{delay:.6g} s")
+        corrections["start_offset_delay_s"] = delay
+    return out, delay
+
+
+def _invert(measurement: Measurement, names: Sequence[str], notes: list[str]) -> Measurement:
+    if not names:
+        return measurement
+    known = {c.name for c in measurement.channels}
+    for name in names:
+        if name not in known:
+            raise ChannelError(f"{measurement.source}: --invert {name!r}: no such channel; "
+                               f"channels are {', '.join(repr(n) for n in known)}")
+    channels = tuple(replace(c, data=-np.asarray(c.data)) if c.name in names else c
+                     for c in measurement.channels)
+    notes.extend(f"channel {n!r} inverted (--invert)" for n in names)
+    return replace(measurement, channels=channels)
 
 
 def analyze_measurement(measurement: Measurement, options: AnalysisOptions) -> AnalyzedRecord:
-    """Map channels to roles and run the Eq. 11 analysis on one measurement."""
+    """Map channels to roles, prepare them and run the Eq. 11 analysis on one measurement.
+
+    Preparation, each step announced in the notes: channels inverted on request
+    (``invert``), units given by option for channels without one (a channel of unknown unit is
+    never taken as SI), channels cut to their common time span when their start times or
+    lengths differ (a fractional-sample start offset of the velocity is corrected as a delay),
+    channels no role needs named as ignored.
+    """
+    notes: list[str] = list(measurement.metadata.get("reader_notes", ()) or ())
+    corrections: dict = {}
+    measurement = _invert(measurement, options.invert, notes)
+    if options.invert:
+        corrections["inverted_channels"] = list(options.invert)
     roles = assign_roles(measurement, force=options.force, velocity=options.velocity,
-                         acceleration=options.acceleration)
+                         acceleration=options.acceleration,
+                         mass_cancellation=options.mass_below_gauge_kg > 0)
+    units = {"force": options.force_unit, "velocity": options.velocity_unit,
+             "acceleration": options.acceleration_unit}
+    chosen = {role: _with_unit(ch, role, units[role], measurement.source, notes, corrections)
+              for role, ch in (("force", roles.force), ("velocity", roles.velocity),
+                               ("acceleration", roles.acceleration)) if ch is not None}
+    for role, unit in units.items():
+        if unit is not None and role not in chosen:
+            raise ParameterError(f"{_UNIT_OPTIONS[role]} {unit!r}: {measurement.source} has no "
+                                 f"{role} channel in use")
+    chosen, start_delay = _align(chosen, measurement.source, notes, corrections)
+    if roles.ignored:
+        notes.append("ignored channels (not needed): "
+                     + ", ".join(repr(n) for n in roles.ignored))
+        corrections["ignored_channels"] = list(roles.ignored)
     analysis = analyze_channels(
-        roles.force, roles.velocity, acceleration=roles.acceleration,
+        chosen["force"], chosen.get("velocity"), acceleration=chosen.get("acceleration"),
         source=measurement.source,
-        velocity_delay_s=options.velocity_delay_s,
+        velocity_delay_s=options.velocity_delay_s + start_delay,
         mass_below_gauge_kg=options.mass_below_gauge_kg,
         baseline_loss_factor=options.baseline_loss_factor,
         frequency_hz=options.frequency_hz,
         n_harmonics=options.n_harmonics,
         allow_clipped=options.allow_clipped,
     )
-    used = {"force": roles.force.name}
-    if roles.velocity is not None:
-        used["velocity"] = roles.velocity.name
-    if roles.acceleration is not None:
-        used["acceleration"] = roles.acceleration.name
-    return AnalyzedRecord(measurement, analysis, used, analysis.notes)
+    used = {role: ch.name for role, ch in chosen.items()}
+    detail = tuple({"role": role, "name": ch.name, "unit": ch.unit,
+                    "source_unit": ch.source_unit} for role, ch in chosen.items())
+    return AnalyzedRecord(measurement, analysis, used, tuple(notes) + analysis.notes,
+                          detail, corrections)
 
 
 def analyze_file(path: str | os.PathLike, options: AnalysisOptions) -> AnalyzedRecord:

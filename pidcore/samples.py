@@ -103,6 +103,7 @@ def make_samples(out_dir: str | os.PathLike = "data_samples", *, run_sweep: bool
     """Regenerate ``data_samples/``: Table 3 CSV, DEM grid store, virtual shaker exports."""
     from importlib import resources
 
+    from .dem.persist import run_key_0_1
     from .dem.simulate import DemConfig
     from .dem.sweep import grid_cases, run_key
     from .dem.sweep import run_sweep as sweep
@@ -122,7 +123,8 @@ def make_samples(out_dir: str | os.PathLike = "data_samples", *, run_sweep: bool
     cases = grid_cases("table3")
     if store_path.exists():
         # the bundled store must hold one consistent grid; never delete a user's runs
-        wanted = {run_key(case, config) for case in cases}
+        wanted = {run_key(case, config) for case in cases} | {
+            run_key_0_1(case, config) for case in cases}  # a store written by 0.1
         stale = set(Store(store_path).list_dem_runs().get("case_key", [])) - wanted
         if stale:
             raise StoreError(f"{store_path}: holds {len(stale)} DEM run(s) from other settings "
@@ -135,6 +137,8 @@ def make_samples(out_dir: str | os.PathLike = "data_samples", *, run_sweep: bool
         case = next(c for c in cases if (c.frequency_hz, c.acceleration_g, c.fill_percent)
                     == (sample.frequency_hz, sample.acceleration_g, sample.fill_percent))
         key = run_key(case, config)
+        if not store.has_dem_run(key) and store.has_dem_run(run_key_0_1(case, config)):
+            key = run_key_0_1(case, config)
         if not store.has_dem_run(key):
             raise StoreError(f"{store_path}: no DEM run {key}; run without --skip-sweep first")
         entry = store.get_dem_run(key)

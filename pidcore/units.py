@@ -1,8 +1,11 @@
 """Unit normalisation to SI at the edges.
 
-A small table instead of a units library (pint): exporters write a handful of spellings
-("m/s2", "m/s²", "mm/s", "g", "kN", "lbf", ...) and the table makes the accepted set explicit,
-testable and free of a heavy dependency. Every conversion is a pure scale factor.
+Two steps: a small table of the spellings exporters write ("m/s2", "m/s²", "mm/s", "g", "kN",
+"lbf", ...) that pins the meanings a general library gets wrong for vibration data (``g`` is
+standard gravity here, not the gram), then :mod:`pint` for everything else (``mm/sec``,
+``ft/s``, ``dN``, ``km/h``), accepted only when its dimension is one of the quantities pidcore
+knows. Every conversion is a pure scale factor. A unit neither step understands is *unknown*:
+never taken as SI (the analysis asks for ``--force-unit`` etc.).
 """
 
 from __future__ import annotations
@@ -83,9 +86,52 @@ def canonical_unit_text(text: str) -> str:
     return t
 
 
+#: Quantity of each dimension, as {base dimension: exponent}.
+_PINT_DIMENSIONS = {
+    (("[length]", 1), ("[mass]", 1), ("[time]", -2)): "force",
+    (("[length]", 1), ("[time]", -1)): "velocity",
+    (("[length]", 1), ("[time]", -2)): "acceleration",
+    (("[length]", 1),): "displacement",
+    (("[length]", -1), ("[mass]", 1), ("[time]", -2)): "pressure",
+    (("[current]", -1), ("[length]", 2), ("[mass]", 1), ("[time]", -3)): "voltage",
+    (("[time]", 1),): "time",
+}
+_PINT_REGISTRY = None
+
+
+def _pint_lookup(text: str) -> UnitInfo | None:
+    global _PINT_REGISTRY
+    import pint  # lazy: only for spellings outside the table
+
+    if _PINT_REGISTRY is None:
+        _PINT_REGISTRY = pint.UnitRegistry()
+    # pint is case sensitive (mN vs MN): keep the case, normalise the rest as the table does
+    t = text.strip().strip("()[]{} ").replace("µ", "u").replace("μ", "u")
+    t = t.replace("²", "^2").replace("\ufffd", "^2").replace("**", "^").replace(" ", "")
+    t = re.sub(r"/s2$", "/s^2", t)
+    if not re.fullmatch(r"[A-Za-z0-9/^.*()_-]+", t) or not re.search(r"[A-Za-z]", t):
+        return None
+    try:
+        quantity = _PINT_REGISTRY.Quantity(1.0, t.replace("^", "**")).to_base_units()
+    except Exception:  # pint raises many kinds (UndefinedUnitError, DefinitionSyntaxError, ...)
+        return None
+    name = _PINT_DIMENSIONS.get(tuple(sorted(dict(quantity.dimensionality).items())))
+    if name is None or not quantity.magnitude > 0:
+        return None
+    return UnitInfo(name, float(quantity.magnitude))
+
+
 def lookup_unit(text: str) -> UnitInfo | None:
-    """Return the :class:`UnitInfo` of a unit string, or ``None`` if it is not known."""
-    return _TABLE.get(canonical_unit_text(text))
+    """Return the :class:`UnitInfo` of a unit string, or ``None`` if it is not known.
+
+    >>> lookup_unit("mm/sec").factor, lookup_unit("g").quantity, lookup_unit("V^2")
+    (0.001, 'acceleration', None)
+    """
+    canonical = canonical_unit_text(text)
+    if canonical == "mn" and "M" in text:
+        return UnitInfo("force", 1e6)  # MN (meganewton), not the table's mN
+    info = _TABLE.get(canonical)
+    return info if info is not None else _pint_lookup(text)
 
 
 def to_si_factor(unit: str, quantity: str | None = None, *, what: str = "unit") -> float:

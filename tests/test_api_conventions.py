@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 
 PUBLIC_MODULES = ("pidcore.io", "pidcore.signal", "pidcore.store", "pidcore.dem",
-                  "pidcore.model", "pidcore.compare", "pidcore.report")
+                  "pidcore.model", "pidcore.compare", "pidcore.report", "pidcore.loadcase",
+                  "pidcore.loop")
 
 
 def _public_names() -> list[str]:

@@ -19,6 +19,7 @@ from _app_samples import analytic_sdc, mass_damper_csv
 from pidcore import defaults
 from pidcore.app import jobs, stores, uploads
 from pidcore.app.uploads import AnalysedFile
+from pidcore.app.workbench import loop_frame
 from pidcore.compare.case import (
     PROPOSED_FILL_PERCENT,
     MeasuredEntry,
@@ -30,8 +31,8 @@ from pidcore.compare.case import (
     stated_case,
 )
 from pidcore.errors import ParameterError
+from pidcore.report.comparison_figures import dem_loop_from_arrays
 from pidcore.report.downloads import report_files, store_report_table
-from pidcore.signal.loops import dem_loop_from_arrays, loop_area, loop_frame
 from pidcore.store.listing import list_dem_runs
 
 REPO = Path(__file__).resolve().parents[1]
@@ -210,16 +211,6 @@ def test_load_cases_group_within_the_compare_tolerances(options):
              load_case_of(c, fill_percent=50, material="acrylic")]
     # 5.0 and 5.1 g are 2 % apart (< 5 % acceleration tolerance): one case.
     assert group_load_cases(cases) == [[0, 1], [2], [3]]
-
-
-def test_loop_area_is_the_analytic_ellipse_area():
-    theta = np.linspace(0, 2 * np.pi, 4000, endpoint=False)
-    x, f = 2.0 * np.cos(theta), 3.0 * np.sin(theta)
-    # The ellipse x = a cos, y = b sin has area pi a b (counter-clockwise: positive).
-    assert loop_area(x, f) == pytest.approx(math.pi * 6.0, rel=1e-6)
-    assert loop_area(x[::-1], f[::-1]) == pytest.approx(-math.pi * 6.0, rel=1e-6)
-    with pytest.raises(ParameterError):
-        loop_area(x, f[:-1])
 
 
 def test_measured_loop_area_is_the_dissipated_energy(good_csv, options):
@@ -467,11 +458,12 @@ def test_dem_job_is_saved_once_and_its_loop_area_is_the_shaker_work(tmp_path):
     assert len(Store(store_file).list_dem_runs()) == 1
     # Deterministic (seeded): the stored SDC is the simulation's.
     assert entry.record["sdc"] == simulate_load_case(case, config).sdc
-    x, f = dem_loop_from_arrays(entry.arrays, entry.record)
+    loop = dem_loop_from_arrays(entry.arrays, entry.record)
+    assert not isinstance(loop, str), loop
     # With a sine drive only the fundamental carries power, so the loop's area is the shaker's
     # work per steady cycle: the dissipated energy per cycle up to the change of stored
     # mechanical energy over 20 cycles of 2 cells (a few percent), hence 5 %.
-    assert abs(loop_area(x, f)) == pytest.approx(entry.record["energy_per_cycle_j"], rel=5e-2)
+    assert loop.energy_per_cycle_j == pytest.approx(entry.record["energy_per_cycle_j"], rel=5e-2)
 
 
 def test_cancel_stops_a_running_dem_case_within_two_seconds_and_saves_nothing(tmp_path):

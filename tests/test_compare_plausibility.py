@@ -38,13 +38,37 @@ def test_uncorrected_delay_gives_a_negative_loss_factor_and_the_delay_that_expla
     assert tau_us == pytest.approx(expected, abs=2.0)
 
 
-def test_an_inverted_channel_is_named():
+def _flipped_force() -> bytes:
     data = mass_damper_csv(loss_factor=0.05).decode().splitlines()
-    flipped = [data[0]] + [",".join([t, str(-float(f)), v]) for t, f, v in
-                           (line.split(",") for line in data[1:])]
-    rec = _analysis("\n".join(flipped).encode())
-    checks = {w.check for w in check_analysis(rec.analysis)}
+    return "\n".join([data[0]] + [",".join([t, str(-float(f)), v]) for t, f, v in
+                                  (line.split(",") for line in data[1:])]).encode()
+
+
+def test_an_inverted_channel_is_refused_and_the_settings_column_corrects_it():
+    # the library refuses Im(P) <= 0; the app's message points to its own column
+    outcome = uploads.analyze_upload("x_fill50.csv", _flipped_force(), AnalysisOptions())
+    assert not outcome.ok and "inverted" in outcome.error
+    assert "--invert" not in outcome.error and "'inverted channels' column" in outcome.error
+    row = {**uploads.default_settings_row("x_fill50.csv", _Stated()),
+           "inverted channels": "Force"}
+    fixed = uploads.analyze_upload("x_fill50.csv", _flipped_force(), uploads.options_of(row))
+    truth = _analysis(mass_damper_csv(loss_factor=0.05)).analysis.sdc
+    assert fixed.ok and fixed.record.analysis.sdc == pytest.approx(truth, rel=1e-9)
+
+
+class _Stated:
+    fill_percent, material, direction = 50.0, "acrylic", "z"
+
+
+def test_force_lagging_velocity_is_named_as_an_inverted_channel():
+    from types import SimpleNamespace
+
+    # P = F V* / 2 with the force's sign flipped: Im P < 0
+    analysis = SimpleNamespace(complex_power_w=complex(0.1, -2.0), loss_factor=-0.05,
+                               sdc=-0.31, omega_rad_s=628.3)
+    checks = {w.check: w for w in check_analysis(analysis)}
     assert "force_lags_velocity" in checks
+    assert "inverted sign" in checks["force_lags_velocity"].likely_cause
 
 
 def test_sdc_above_the_bound_is_flagged():

@@ -56,5 +56,5 @@ def test_store_round_trip(tmp_path, capsys):
     assert main(ARGS + ["--json", "--store", str(path)]) == 0
     doc = json.loads(capsys.readouterr().out)
     store = store_mod.Store(path)
-    assert doc["store_key"].startswith("acrylic_z_f500_a5_fill50_seed12345_cells2")
+    assert doc["store_key"].startswith("f500Hz_a5g_fill50pct_acrylic_z_seed12345_cells2")
     assert store.has_dem_run(doc["store_key"])

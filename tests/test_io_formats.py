@@ -150,8 +150,10 @@ def test_csv_sample_rate_given_equals_time_column(tmp_path):
     a = read_measurement(with_time)
     b = read_measurement(without, sample_rate_hz=500.0)
     _assert_same(b, a, rtol=0.0)
-    with pytest.raises(ParameterError, match="500"):
-        read_measurement(with_time, sample_rate_hz=400.0)
+    # --sample-rate overrides a time column, and says so
+    c = read_measurement(with_time, sample_rate_hz=400.0)
+    assert c.channels[0].sample_rate_hz == 400.0
+    assert "time column 'Time' ignored" in c.metadata["reader_notes"][0]
     with pytest.raises(InputFileError, match=r"without\.csv.*--sample-rate"):
         read_measurement(without)
 

@@ -76,7 +76,10 @@ def test_binary_double_precision_sine_in_g_is_converted_to_si():
 
 def test_malformed_multichannel_58b_with_duplicate_entity_names():
     m = _read("pyuff_MPSTD_Set001_2024_10_08_10_27_07.uff")
-    assert m.channel_names == ["1+Z", "2+Z", "3+Z", "1+Z (2)"]
+    # The entity names repeat (node 1 twice); the ID lines 1 ("MPS set1 Dof1".."Dof4", the
+    # export's own description) tell the records apart, so they name the channels.
+    assert m.channel_names == ["MPS set1 Dof1", "MPS set1 Dof2", "MPS set1 Dof3",
+                               "MPS set1 Dof4"]
     for ch in m.channels:
         assert ch.quantity == "acceleration" and ch.source_unit == "m/s2"
         assert ch.n_samples == 222400
@@ -175,7 +178,7 @@ def test_roles_on_real_exports():
     from pidcore.io import assign_roles
 
     four_acc = _read("pyuff_MPSTD_Set001_2024_10_08_10_27_07.uff")
-    with pytest.raises(ChannelError, match=r"no force channel among '1\+Z'.*--force NAME"):
+    with pytest.raises(ChannelError, match=r"no force channel among 'MPS set1 Dof1'.*--force NAME"):
         assign_roles(four_acc)
     force_only = _read("UFFFilesjl_dataset58_time.unv")
     with pytest.raises(ChannelError, match="no velocity or acceleration channel"):

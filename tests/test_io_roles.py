@@ -21,10 +21,40 @@ def _m(*channels: Channel) -> Measurement:
 def test_detect_by_quantity_whatever_the_names():
     m = _m(_ch("ch1", "acceleration", "g"), _ch("ch2", "force", "N"),
            _ch("ch3", "velocity", "mm/s"), _ch("mic", "pressure", "Pa"))
-    roles = assign_roles(m)
+    roles = assign_roles(m, mass_cancellation=True)
     assert isinstance(roles, RoleAssignment)
     assert (roles.force.name, roles.velocity.name, roles.acceleration.name) == \
         ("ch2", "ch3", "ch1")
+    # without mass cancellation the acceleration is not needed beside a velocity: ignored
+    roles = assign_roles(m)
+    assert roles.acceleration is None and roles.ignored == ("ch1", "mic")
+
+
+def test_extra_channels_do_not_block_force_velocity_pair():
+    """Two reference accelerometers, a microphone: none is needed, none blocks, all named."""
+    m = _m(_ch("Force", "force", "N"), _ch("LDV", "velocity", "m/s"),
+           _ch("Ref acc", "acceleration", "g"), _ch("Acc 2", "acceleration", "g"),
+           _ch("Mic", "pressure", "Pa"))
+    roles = assign_roles(m)
+    assert roles.velocity.name == "LDV" and roles.acceleration is None
+    assert roles.ignored == ("Ref acc", "Acc 2", "Mic")
+
+
+def test_mass_cancellation_needs_the_drive_point_acceleration():
+    two = _m(_ch("Force", "force", "N"), _ch("LDV", "velocity", "m/s"),
+             _ch("Ref acc", "acceleration", "g"), _ch("Acc 2", "acceleration", "g"))
+    with pytest.raises(ChannelError, match=r"2 acceleration channels.*drive point.*"
+                                           r"--acceleration NAME"):
+        assign_roles(two, mass_cancellation=True)
+    assert assign_roles(two, mass_cancellation=True, acceleration="Acc 2").acceleration.name \
+        == "Acc 2"
+    ref_only = _m(_ch("Force", "force", "N"), _ch("LDV", "velocity", "m/s"),
+                  _ch("Shaker table", "acceleration", "g"))
+    with pytest.raises(ChannelError, match=r"'Shaker table' is named like a reference"):
+        assign_roles(ref_only, mass_cancellation=True)
+    # no acceleration channel at all: the velocity gives the acceleration (j n w V_n)
+    none = _m(_ch("Force", "force", "N"), _ch("LDV", "velocity", "m/s"))
+    assert assign_roles(none, mass_cancellation=True).acceleration is None
 
 
 def test_two_force_channels_resolved_by_name():
@@ -61,8 +91,8 @@ def test_override_of_other_quantity_refused_unknown_accepted():
     m = _m(_ch("F", "force", "N"), _ch("acc", "acceleration", "g"), _ch("raw", "unknown", "V^2"))
     with pytest.raises(ChannelError, match=r"--force 'acc' is a acceleration channel"):
         assign_roles(m, force="acc")
-    roles = assign_roles(m, force="raw")  # unit-less channel taken as SI newtons
-    assert roles.force.name == "raw" and roles.acceleration.name == "acc"
+    roles = assign_roles(m, force="raw")  # accepted here; the analysis asks for its unit
+    assert roles.force.name == "raw" and roles.acceleration.name == "acc"  # no velocity
 
 
 def test_same_channel_for_two_roles_refused():

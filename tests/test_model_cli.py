@@ -76,6 +76,7 @@ def test_damper_from_store_runs(tmp_path, monkeypatch):
                                table["acceleration [g]"], table["frequency [Hz]"]), rtol=1e-12)
 
 
+@pytest.mark.slow
 def test_figures_writes_every_family(tmp_path):
     assert _run(["model", "figures", "--out", str(tmp_path)]) == 0
     names = sorted(p.name for p in tmp_path.iterdir())

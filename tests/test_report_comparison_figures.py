@@ -10,9 +10,13 @@ import pytest
 
 from pidcore.measure import analysis_arrays
 from pidcore.report import ALIGNMENT_COLUMN, build_report_table
-from pidcore.report.comparison_figures import plot_loop_overlay, plot_sdc_comparison
+from pidcore.report.comparison_figures import (
+    dem_loop_from_arrays,
+    loop_from_phasors,
+    plot_loop_overlay,
+    plot_sdc_comparison,
+)
 from pidcore.signal import analyze_power, synthesize_shaker_record
-from pidcore.signal.loops import dem_loop_from_arrays, loop_from_phasors
 
 FREQ_HZ, RATE_HZ, ACC_M_S2, DAMPING = 200.0, 10000.0, 20.0, 4.0
 
@@ -31,7 +35,8 @@ def dem_arrays():
 
 
 def test_dem_loop_encloses_the_viscous_energy_per_cycle(dem_arrays):
-    x, f = dem_loop_from_arrays(dem_arrays, {"frequency_hz": FREQ_HZ, "steady_start_cycle": 3})
+    loop = dem_loop_from_arrays(dem_arrays, {"frequency_hz": FREQ_HZ, "steady_start_cycle": 3})
+    x, f = loop.displacement_m, loop.force_n
     w = 2 * math.pi * FREQ_HZ
     amplitude_m = ACC_M_S2 / w**2
     expected_j = math.pi * DAMPING * w * amplitude_m**2  # energy per cycle of a viscous damper
@@ -45,7 +50,7 @@ def test_dem_loop_uses_time_array_when_rate_is_missing(dem_arrays):
     with_rate = dem_loop_from_arrays(dem_arrays, {"frequency_hz": FREQ_HZ,
                                                   "sample_rate_hz": RATE_HZ})
     from_time = dem_loop_from_arrays(dem_arrays, {"frequency_hz": FREQ_HZ})
-    np.testing.assert_allclose(from_time[1], with_rate[1], rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(from_time.force_n, with_rate.force_n, rtol=1e-9, atol=1e-12)
 
 
 @pytest.mark.parametrize(("arrays", "record", "says"), [
@@ -61,12 +66,12 @@ def test_dem_loop_missing_series_gives_a_note(arrays, record, says):
 
 def test_loop_overlay_draws_both_closed_loops(dem_arrays):
     dem = dem_loop_from_arrays(dem_arrays, {"frequency_hz": FREQ_HZ})
-    measured = (dem[0] * 1.1, dem[1] * 0.9)
+    measured = (dem.displacement_m * 1.1, dem.force_n * 0.9)
     fig = plot_loop_overlay(measured, dem, title="t")
     lines = fig.axes[0].get_lines()
     assert [ln.get_label() for ln in lines] == ["measured", "DEM (ours)"]
     xd, yd = lines[1].get_data()
-    np.testing.assert_allclose(xd[:-1], dem[0] * 1e6)  # µm
+    np.testing.assert_allclose(xd[:-1], dem.displacement_m * 1e6)  # µm
     assert (xd[0], yd[0]) == (xd[-1], yd[-1])  # closed
     alone = plot_loop_overlay(measured, None)
     assert len(alone.axes[0].get_lines()) == 1
@@ -94,8 +99,9 @@ def test_sdc_comparison_plots_the_table_values():
 
 def test_loop_from_stored_phasors_equals_the_analysis_loop(dem_arrays):
     a = analyze_power(dem_arrays["shaker_force_n"], dem_arrays["velocity_m_s"], RATE_HZ)
-    x, f = loop_from_phasors(analysis_arrays(a), a.frequency_hz)
-    x0, f0 = a.force_displacement_loop()
+    stored = loop_from_phasors(analysis_arrays(a), a.frequency_hz)
+    x, f = stored.displacement_m, stored.force_n
+    x0, f0 = a.loop().displacement_m, a.loop().force_n
     # same formula; only omega = 2 pi f vs the stored omega differ, by round-off
     np.testing.assert_allclose(x, x0, rtol=1e-12, atol=1e-18)
     np.testing.assert_allclose(f, f0, rtol=1e-12, atol=1e-12)

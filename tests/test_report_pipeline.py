@@ -78,6 +78,7 @@ def e2e(tmp_path_factory, dem_store):
     return file, store, dem_sha, result
 
 
+@pytest.mark.slow
 def test_report_end_to_end(e2e, dem_store):
     file, store, dem_sha, result = e2e
     # the dem store is only read
@@ -107,6 +108,7 @@ def test_report_end_to_end(e2e, dem_store):
     assert sha256_file(file) in text and sha256_file(store) in text and dem_sha in text
 
 
+@pytest.mark.slow
 def test_report_from_store_only_uses_stored_analyses(e2e, dem_store, tmp_path):
     _, store, _, first = e2e
     again = make_report([], out_dir=tmp_path / "r2", store=store, dem_store=dem_store,
@@ -118,6 +120,7 @@ def test_report_from_store_only_uses_stored_analyses(e2e, dem_store, tmp_path):
     assert not any("without DEM overlay" in n for n in again.notes)
 
 
+@pytest.mark.slow
 def test_cli_with_dem_store_only_stores_nothing(tmp_path, dem_store, capsys):
     file = _write_measurement(tmp_path / "coupon2_75pct.csv", seed=3)
     code = main(["report", str(file), "--dem-store", str(dem_store), "--out",

@@ -69,14 +69,21 @@ def test_harmonic_fit_exact_on_non_whole_periods_and_blocks():
 
 
 def test_harmonic_fit_matches_dense_least_squares_on_noise():
-    """Against numpy's lstsq with the explicit design matrix (small N)."""
+    """Against numpy's lstsq with the explicit design matrix (small N), linear trend included,
+    for the union and for every segment (segments share one global index)."""
     rng = np.random.default_rng(0)
-    x = rng.standard_normal(3001)
+    x = rng.standard_normal(3001) + 1e-3 * np.arange(3001)
     theta = 0.0731
-    i = np.arange(x.shape[0])
-    cols = [np.ones_like(x)] + [np.cos(n * theta * i) for n in range(1, 4)] + \
-        [np.sin(n * theta * i) for n in range(1, 4)]
-    coef = np.linalg.lstsq(np.column_stack(cols), x, rcond=None)[0]
-    fit = fit_harmonics(x, None, theta, 3, np.array([0, x.shape[0]]))
-    np.testing.assert_allclose(fit.total[0], coef[1:4] - 1j * coef[4:7], atol=1e-12)
-    assert fit.dc_total[0] == pytest.approx(coef[0], abs=1e-12)
+    edges = np.array([0, 1000, 2200, x.shape[0]])
+    fit = fit_harmonics(x, None, theta, 3, edges)
+    cases = [(0, x.shape[0], fit.total[0], fit.dc_total[0])]
+    cases += [(edges[s], edges[s + 1], fit.phasors[0, s], None) for s in range(3)]
+    for lo, hi, got, dc in cases:
+        i = np.arange(lo, hi)
+        cols = [np.ones(i.size), i - i.mean()] + [np.cos(n * theta * i) for n in range(1, 4)] + \
+            [np.sin(n * theta * i) for n in range(1, 4)]
+        coef = np.linalg.lstsq(np.column_stack(cols), x[lo:hi], rcond=None)[0]
+        # 1e-10: round-off of the closed-form Gram against a dense QR solve
+        np.testing.assert_allclose(got, coef[2:5] - 1j * coef[5:8], atol=1e-10)
+        if dc is not None:
+            assert dc == pytest.approx(coef[0], abs=1e-10)

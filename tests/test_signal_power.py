@@ -102,17 +102,21 @@ def test_conjugate_convention_pure_mass_and_pure_damper():
     assert res.energy_per_cycle_j == pytest.approx(np.pi * c * v**2 / w, rel=1e-9)
 
 
-def test_spring_like_record_has_no_loss_factor():
-    """Force in phase with displacement: Im(P_c) < 0, the loss factor is undefined."""
+def test_spring_like_or_inverted_record_is_refused():
+    """Force in phase with displacement (Im(P_c) < 0), or a mass record with the velocity
+    inverted: never a NaN loss factor or a negative energy, an error naming both channels."""
     fs, f = 10240.0, 100.0
     t = np.arange(int(fs)) / fs
     v = 0.01 * np.sin(2 * np.pi * f * t)
     x = -0.01 / (2 * np.pi * f) * np.cos(2 * np.pi * f * t)
-    res = analyze_power(1e4 * x, v, fs)
-    assert res.complex_power_w.imag < 0
-    assert math.isnan(res.loss_factor)
-    assert res.damping_ratio is None and "Im(P_c)" in res.damping_ratio_note
-    assert json.loads(json.dumps(res.to_dict()))["loss_factor"] is None
+    with pytest.raises(SignalError, match=r"Im\(P_c\) = -.*'F' / 'V' is probably inverted"):
+        analyze_power(1e4 * x, v, fs, force_name="F", velocity_name="V")
+    rec = synthesize_shaker_record(mass_kg=0.5, acceleration_amplitude_m_s2=20.0,
+                                   frequency_hz=f, sample_rate_hz=fs, n_periods=40,
+                                   viscous_damping_n_s_m=1.0)
+    assert analyze_power(rec.force_n, rec.velocity_m_s, fs).loss_factor > 0
+    with pytest.raises(SignalError, match="--invert NAME"):
+        analyze_power(rec.force_n, -rec.velocity_m_s, fs)
 
 
 def test_acceleration_only_path():

@@ -5,7 +5,7 @@ compare, dem, calibrate, report), :mod:`.charts` the Vega-Lite charts and :mod:`
 cached reads. The logic the pages call is free of Streamlit and tested directly:
 :mod:`.uploads` (uploads, per-file settings, saving), :mod:`.stores` (which stores the app
 uses), :mod:`.jobs` (the DEM job runner); comparison, loops, store listings and report files
-live in :mod:`pidcore.compare.case`, :mod:`pidcore.signal.loops`, :mod:`pidcore.store.listing`
+live in :mod:`pidcore.compare.case`, :mod:`pidcore.loop`, :mod:`pidcore.store.listing`
 and :mod:`pidcore.report.downloads`.
 
 The entry script :data:`ENTRY_SCRIPT` lives in the package so that ``pidcore app`` finds it in

@@ -1,5 +1,5 @@
 """Vega-Lite (Altair) charts of the app: layout only; they draw the frames of the library
-(:func:`pidcore.compare.case.sdc_points`, :func:`pidcore.signal.loops.loop_frame`,
+(:func:`pidcore.compare.case.sdc_points`, :func:`pidcore.app.workbench.loop_frame`,
 :meth:`pidcore.compare.case.MeasuredEntry.spectrum`), the same data the report's matplotlib
 figures draw.
 
@@ -68,7 +68,7 @@ def sdc_chart(data: pd.DataFrame) -> alt.LayerChart:
 def loop_chart(frame: pd.DataFrame) -> alt.Chart:
     """Force-displacement loops overlaid, displacement in µm (a coupon moves micrometres).
 
-    ``frame`` is :func:`pidcore.signal.loops.loop_frame` (SI). Legend labels are the loops'
+    ``frame`` is :func:`pidcore.app.workbench.loop_frame` (SI). Legend labels are the loops'
     names only (the page prints their energies per cycle below), so none is cut.
     """
     series = list(dict.fromkeys(frame["series"]))

@@ -72,7 +72,7 @@ class DemJob:
     def row(self, now: float | None = None) -> dict:
         """One row of the job table shown in the app (units in the column names)."""
         eta = self.eta_s(now)
-        return {"job": self.job_id, "load case": self.case.key(), "state": self.state,
+        return {"job": self.job_id, "load case": self.case.key, "state": self.state,
                 "progress [%]": round(100 * self.fraction(), 1),
                 "cycles [-]": f"{self.cycles_done}/{self.cycles_expected or '?'}",
                 "elapsed [s]": round(self.elapsed_s(now), 1),

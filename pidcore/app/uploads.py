@@ -51,6 +51,7 @@ FILE_TABLE_COLUMNS: dict[str, str] = {
     "force channel": "force",
     "velocity channel": "velocity",
     "acceleration channel": "acceleration",
+    "inverted channels": "invert",
 }
 _NUMERIC = ("fill [%]", "vibrometer delay [µs]", "mass below gauge [g]",
             "baseline loss factor [-]")
@@ -162,6 +163,8 @@ def error_message(name: str, exc: BaseException) -> str:
     text = re.sub(r"\S*pidcore_upload_[^/\\\s]*[/\\][^:\s]*", name, text)
     # The library's hints name CLI options; in the app the same choice is a table column.
     text = re.sub(r"--(force|velocity|acceleration) NAME", r"the '\1 channel' column", text)
+    text = text.replace("pass --invert NAME for the inverted channel",
+                        "name the inverted channel in the 'inverted channels' column")
     if isinstance(exc, PidcoreError):
         return text if name in text else f"{name}: {text}"
     return f"{name}: could not be read ({type(exc).__name__}: {text})"
@@ -274,7 +277,7 @@ def default_settings_row(name: str, stated) -> dict:
             "direction": stated.direction, "specimen": "", "vibrometer delay [µs]": 0.0,
             "mass below gauge [g]": 0.0, "baseline loss factor [-]": 0.0,
             "force channel": AUTO_CHANNEL, "velocity channel": AUTO_CHANNEL,
-            "acceleration channel": AUTO_CHANNEL}
+            "acceleration channel": AUTO_CHANNEL, "inverted channels": ""}
 
 
 def merge_settings(names: Sequence[str], stated: Sequence, previous: pd.DataFrame | None,
@@ -333,9 +336,11 @@ def options_of(row: Mapping, *, sample_rate_hz: float | None = None) -> Analysis
     if mass_g < 0 or baseline < 0:
         raise ParameterError(f"{row['file']}: mass below gauge and baseline loss factor must "
                              "be >= 0")
+    inverted = str(row.get("inverted channels", "") or "")
     return AnalysisOptions(
         force=channel(row["force channel"]), velocity=channel(row["velocity channel"]),
         acceleration=channel(row["acceleration channel"]),
+        invert=tuple(n.strip() for n in inverted.split(";") if n.strip()),
         velocity_delay_s=number(row["vibrometer delay [µs]"], "vibrometer delay [µs]") * 1e-6,
         mass_below_gauge_kg=mass_g * 1e-3, baseline_loss_factor=baseline,
         sample_rate_hz=sample_rate_hz)

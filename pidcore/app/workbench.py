@@ -20,7 +20,22 @@ from ..compare.case import (
     headline,
     sdc_points,
 )
-from ..signal.loops import LoopCurve, dem_loop_from_arrays, loop_frame
+from ..loop import ForceDisplacementLoop
+
+#: Columns of :func:`loop_frame`.
+LOOP_COLUMNS = ("series", "displacement [m]", "force [N]", "order")
+
+
+def loop_frame(loops: Sequence[ForceDisplacementLoop]) -> pd.DataFrame:
+    """Closed loops as one long table (SI units), one row per point in drawing order, for the
+    app's chart: columns :data:`LOOP_COLUMNS`, ``series`` the loop's label."""
+    parts = []
+    for loop in loops:
+        x, f = loop.closed()
+        parts.append(pd.DataFrame({"series": loop.label, "displacement [m]": x,
+                                   "force [N]": f, "order": range(x.size)}))
+    return (pd.concat(parts, ignore_index=True) if parts
+            else pd.DataFrame(columns=list(LOOP_COLUMNS)))
 
 
 def saved_entries(path: str | os.PathLike, rows: pd.DataFrame) -> list[MeasuredEntry]:
@@ -56,9 +71,12 @@ def group_label(entries: Sequence[MeasuredEntry], group: Sequence[int]) -> str:
 
 
 def dem_loop(paths: Sequence[str | os.PathLike | None],
-             comparison: CaseComparison) -> LoopCurve | str | None:
+             comparison: CaseComparison) -> ForceDisplacementLoop | str | None:
     """Our DEM's loop at the comparison's grid case (first store that holds the run), a note
     why it cannot be drawn, or None where there is no DEM run at the case."""
+    from dataclasses import replace
+
+    from ..report.comparison_figures import dem_loop_from_arrays
     from ..store import Store
 
     grid = getattr(comparison.aligned, "grid_case", None)
@@ -71,7 +89,7 @@ def dem_loop(paths: Sequence[str | os.PathLike | None],
             found = dem_loop_from_arrays(entry.arrays, entry.record)
             if isinstance(found, str):
                 return f"DEM run {key}: {found}"
-            return LoopCurve(f"our DEM: {key.split('_seed')[0]}", *found)
+            return replace(found, label=f"our DEM: {key.split('_seed')[0]}")
     return None
 
 

@@ -15,7 +15,8 @@ from .. import __version__
 from ..errors import PidcoreError
 
 #: Sub-command modules, each exposing ``register(subparsers) -> None``.
-_COMMAND_MODULES = ("analyze", "dem", "bench", "report", "model", "app", "samples")
+_COMMAND_MODULES = ("analyze", "dem", "specimen", "bench", "report", "model", "app",
+                    "samples")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -26,13 +27,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"pidcore {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     for name in _COMMAND_MODULES:
-        try:
-            module = importlib.import_module(f"{__name__}.{name}")
-        except ModuleNotFoundError as exc:
-            if exc.name == f"{__name__}.{name}":
-                continue  # command not built yet
-            raise
-        module.register(sub)
+        importlib.import_module(f"{__name__}.{name}").register(sub)
     return parser
 
 
@@ -48,6 +43,11 @@ def main(argv: list[str] | None = None) -> int:
         print(f"pidcore {args.command}: interrupted; finished results are saved",
               file=sys.stderr)
         return 130
+    except BrokenPipeError:  # the reader of stdout (| head) stopped: end quietly
+        import os
+
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 141
 
 
 if __name__ == "__main__":  # pragma: no cover

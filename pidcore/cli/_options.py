@@ -25,9 +25,20 @@ def add_measurement_options(p: argparse.ArgumentParser) -> None:
     g.add_argument("--harmonics", metavar="N", type=int, default=defaults.N_HARMONICS,
                    help=f"drive harmonics fitted (default {defaults.N_HARMONICS})")
     g.add_argument("--sample-rate", metavar="HZ", type=float, default=None,
-                   help="sample rate for CSV/TXT files without a time column, Hz")
+                   help="sample rate, Hz, for CSV/TXT/MAT files; overrides a time column "
+                        "(noted in the output)")
     g.add_argument("--allow-clipped", action="store_true",
                    help="analyse clipped channels anyway (reported in the output)")
+    g.add_argument("--force-unit", metavar="UNIT", default=None,
+                   help="unit of the force channel's values (N, kN, lbf, ...) when the file "
+                        "gives none or a wrong one")
+    g.add_argument("--velocity-unit", metavar="UNIT", default=None,
+                   help="unit of the velocity channel's values (m/s, mm/s, in/s, ...)")
+    g.add_argument("--acceleration-unit", metavar="UNIT", default=None,
+                   help="unit of the acceleration channel's values (m/s^2, g, ...)")
+    g.add_argument("--invert", metavar="NAME", action="append", default=[],
+                   help="invert the sign of this channel (a sensor mounted the other way); "
+                        "repeatable")
 
 
 def analysis_options(args: argparse.Namespace) -> AnalysisOptions:
@@ -37,5 +48,7 @@ def analysis_options(args: argparse.Namespace) -> AnalysisOptions:
         velocity_delay_s=args.velocity_delay, mass_below_gauge_kg=args.mass_below_gauge,
         baseline_loss_factor=args.baseline_loss_factor, frequency_hz=args.frequency,
         n_harmonics=args.harmonics, sample_rate_hz=args.sample_rate,
-        allow_clipped=args.allow_clipped,
+        allow_clipped=args.allow_clipped, force_unit=args.force_unit,
+        velocity_unit=args.velocity_unit, acceleration_unit=args.acceleration_unit,
+        invert=tuple(args.invert),
     )

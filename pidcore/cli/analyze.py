@@ -31,14 +31,19 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     options = analysis_options(args)
-    # Analyse everything before writing anything: one bad file leaves the store untouched.
-    results = [analyze_file(path, options) for path in args.paths]
-    if not args.no_store:
-        from ..measure import save_analyses
+    try:
+        # Analyse everything before writing anything: one bad file leaves the store untouched.
+        results = [analyze_file(path, options) for path in args.paths]
+        if not args.no_store:
+            from ..measure import save_analyses
 
-        save_analyses(args.store, results, options)
+            save_analyses(args.store, results, options)  # one transaction: all or nothing
+    except KeyboardInterrupt:
+        print("pidcore analyze: interrupted; nothing saved, the store is unchanged",
+              file=sys.stderr)
+        return 130
     if args.json:
-        json.dump({"records": [r.analysis.to_dict() for r in results]}, sys.stdout)
+        json.dump({"records": [r.to_dict() for r in results]}, sys.stdout)
         sys.stdout.write("\n")
     else:
         print(format_table(results))

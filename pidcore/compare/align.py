@@ -337,7 +337,9 @@ def dem_cases(dem_runs: pd.DataFrame, *, tolerances: Tolerances | None = None,
                 ppc = float(unique[0])
         key_column = "case_key" if "case_key" in sub else "key"
         keys = tuple(str(k) for k in sub[key_column]) if key_column in sub else ()
-        m_c = float(sub["m_c_kg"].astype(float).mean()) if "m_c_kg" in sub else math.nan
+        # "m_c_kg": the column's name in stores written by pidcore 0.1
+        mass_column = next((c for c in ("vibrated_mass_kg", "m_c_kg") if c in sub), None)
+        m_c = float(sub[mass_column].astype(float).mean()) if mass_column else math.nan
         out.append(DemCase(case, sdc, stderr, len(members), ppc, keys, m_c, settings,
                            cells_of.get(settings, math.nan)))
     return sorted(out, key=lambda c: (*_sort_key(c.load_case), c.settings))

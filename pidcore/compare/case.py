@@ -10,7 +10,6 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 import numpy as np
 import pandas as pd
@@ -20,19 +19,17 @@ from ..errors import ParameterError, PidcoreError
 from .align import Aligner, Tolerances, consistency_chi2, pooled_mean, pooled_sdc_eq10
 from .loadcase import LoadCase, StatedLoadCase
 
-if TYPE_CHECKING:
-    from ..measure import AnalyzedRecord
-
-#: Fill (packing ratio, %) proposed for a file whose name states none (the paper's experiments
-#: were all at 50 %); the user confirms or corrects it.
-PROPOSED_FILL_PERCENT = 50.0
+#: Fill (packing ratio, %) proposed for a file whose name states none; the user confirms or
+#: corrects it.
+PROPOSED_FILL_PERCENT = defaults.APP_DEFAULT_FILL_PERCENT
 #: How many standard errors apart measured and DEM may lie and still "agree".
 AGREEMENT_SIGMAS = 2.0
 
 
-def load_case_of(record: AnalyzedRecord, *, fill_percent: float, material: str,
+def load_case_of(record, *, fill_percent: float, material: str,
                  direction: str = defaults.COMPARE_DEFAULT_DIRECTION) -> LoadCase:
-    """Load case of an analysed record: measured frequency and acceleration, stated fill etc."""
+    """Load case of an analysed record (:class:`pidcore.measure.AnalyzedRecord`, which sits
+    above this layer): measured frequency and acceleration, stated fill, material, direction."""
     a = record.analysis
     return LoadCase(float(a.frequency_hz), float(a.acceleration_g), float(fill_percent),
                     material, direction)
@@ -194,10 +191,10 @@ class MeasuredEntry:
     corrections: str = ""
 
     @classmethod
-    def from_record(cls, record: AnalyzedRecord, load_case: LoadCase, *,
+    def from_record(cls, record, load_case: LoadCase, *,
                     specimen: str = "", options=None) -> MeasuredEntry:
-        """Entry of a fresh (unsaved) analysis; ``options`` (AnalysisOptions) names the
-        corrections."""
+        """Entry of a fresh (unsaved) analysis (:class:`pidcore.measure.AnalyzedRecord`);
+        ``options`` (:class:`pidcore.measure.AnalysisOptions`) names the corrections."""
         a = record.analysis
         return cls(f"upload:{record.measurement.sha256}", Path(record.measurement.source).name,
                    "this session (unsaved)", load_case, float(a.frequency_hz),
@@ -226,16 +223,16 @@ class MeasuredEntry:
                    describe_corrections(_json_dict(row.get("parameters_json"))))
 
     def loop(self):
-        """The measured loop (:class:`pidcore.signal.loops.LoopCurve`), or a note why none."""
-        from ..signal.loops import LoopCurve, loop_from_phasors
+        """The measured loop (:class:`pidcore.loop.ForceDisplacementLoop`, labelled
+        ``"measured: <file>"``), or a note why there is none."""
+        from ..loop import ForceDisplacementLoop
 
-        found = loop_from_phasors({"harmonics": self.harmonics,
-                                   "force_phasors_n": self.force_phasors_n,
-                                   "velocity_phasors_m_s": self.velocity_phasors_m_s},
-                                  self.frequency_hz)
-        if isinstance(found, str):
-            return found
-        return LoopCurve(f"measured: {self.file}", *found)
+        if not (np.size(self.harmonics) and np.isfinite(self.frequency_hz)
+                and self.frequency_hz > 0):
+            return "no harmonic phasors stored with this analysis"
+        return ForceDisplacementLoop.from_phasors(
+            self.harmonics, self.force_phasors_n, self.velocity_phasors_m_s, self.frequency_hz,
+            label=f"measured: {self.file}")
 
     def spectrum(self) -> pd.DataFrame:
         """Amplitudes of the fitted force and velocity harmonics (units in the columns)."""

@@ -1,4 +1,5 @@
-"""Load cases: the (frequency, acceleration, fill, material, direction) a result belongs to.
+"""What a measurement states about its load case (the :class:`~pidcore.loadcase.LoadCase` type
+itself is :mod:`pidcore.loadcase`, shared with the DEM, store, reports and app).
 
 A DEM run knows its load case from its parameters. A measurement knows only its frequency and
 acceleration (both measured, from the power analysis); fill, particle material and drive direction
@@ -24,7 +25,6 @@ default: a measurement without a stated fill raises :class:`LoadCaseError`.
 
 from __future__ import annotations
 
-import math
 import re
 from dataclasses import dataclass
 from pathlib import Path
@@ -32,8 +32,13 @@ from pathlib import Path
 import pandas as pd
 
 from .. import defaults
-from ..constants import DRIVE_DIRECTIONS, PARTICLE_MATERIALS
-from ..errors import ParameterError
+from ..loadcase import (
+    LoadCase,
+    LoadCaseError,
+    normalize_direction,
+    normalize_material,
+)
+from ..loadcase import check_fill as _check_fill
 
 #: Name of the sidecar table looked for beside each measurement file.
 SIDECAR_NAME = "loadcases.csv"
@@ -54,70 +59,6 @@ MATERIAL_PATTERN = re.compile(_SEP + r"(?P<material>acrylic|pmma|aluminium|alumi
 #: Drive direction token in a file name: ``dirz``, ``dir-x``, ``dir_y``, ``zdir``.
 DIRECTION_PATTERN = re.compile(
     _SEP + r"(?:dir[_\-]?(?P<d1>[xyz])|(?P<d2>[xyz])[_\-]?dir)" + _END, re.IGNORECASE)
-
-_MATERIAL_ALIASES = {"pmma": "acrylic", "aluminum": "aluminium"}
-
-
-class LoadCaseError(ParameterError):
-    """A measurement's load case is not stated, stated twice differently, or out of range."""
-
-
-@dataclass(frozen=True)
-class LoadCase:
-    """One load case of the paper's grid (or between its points).
-
-    Attributes
-    ----------
-    frequency_hz : float
-        Drive frequency, Hz.
-    acceleration_g : float
-        Acceleration amplitude of the drive, g (standard gravity).
-    fill_percent : float
-        Packing ratio: particles per cell over the full-cell count, %.
-    material : str
-        Particle material (:data:`pidcore.constants.ParticleMaterial`).
-    direction : str
-        Drive direction in the cell frame (:data:`pidcore.constants.DriveDirection`).
-
-    Examples
-    --------
-    >>> LoadCase(500.0, 5.0, 50.0).key
-    'f500Hz_a5g_fill50pct_acrylic_z'
-    """
-
-    frequency_hz: float
-    acceleration_g: float
-    fill_percent: float
-    material: str = defaults.COMPARE_DEFAULT_MATERIAL
-    direction: str = defaults.COMPARE_DEFAULT_DIRECTION
-
-    def __post_init__(self) -> None:
-        for name in ("frequency_hz", "acceleration_g"):
-            value = getattr(self, name)
-            if not (math.isfinite(value) and value > 0):
-                raise LoadCaseError(f"load case: {name} must be a positive finite number, "
-                                    f"got {value!r}")
-        _check_fill(self.fill_percent, "load case")
-        object.__setattr__(self, "material", normalize_material(self.material, "load case"))
-        object.__setattr__(self, "direction", normalize_direction(self.direction, "load case"))
-
-    @property
-    def key(self) -> str:
-        """Stable text key; numbers to 6 significant digits so float noise does not split keys."""
-        return (f"f{self.frequency_hz:.6g}Hz_a{self.acceleration_g:.6g}g_"
-                f"fill{self.fill_percent:.6g}pct_{self.material}_{self.direction}")
-
-    def as_record(self, origin: str) -> dict[str, object]:
-        """The fields a stored analysis carries about its load case; ``origin`` says who stated
-        fill, material and direction."""
-        return {"fill_percent": self.fill_percent, "material": self.material,
-                "direction": self.direction, "load_case_key": self.key,
-                "load_case_origin": origin}
-
-    def label(self) -> str:
-        """Short human label, e.g. ``'500 Hz, 5 g, 50 %'``."""
-        return f"{self.frequency_hz:.4g} Hz, {self.acceleration_g:.3g} g, {self.fill_percent:.3g} %"
-
 
 @dataclass(frozen=True)
 class StatedLoadCase:
@@ -142,36 +83,6 @@ class StatedLoadCase:
         """The full load case with the measured frequency (Hz) and acceleration (g)."""
         return LoadCase(float(frequency_hz), float(acceleration_g), self.fill_percent,
                         self.material, self.direction)
-
-
-def normalize_material(value: str, what: str) -> str:
-    """Canonical material name (``aluminum`` -> ``aluminium``, ``pmma`` -> ``acrylic``)."""
-    text = str(value).strip().lower()
-    text = _MATERIAL_ALIASES.get(text, text)
-    if text not in PARTICLE_MATERIALS:
-        raise LoadCaseError(f"{what}: unknown particle material {value!r}; expected one of "
-                            f"{', '.join(PARTICLE_MATERIALS)}")
-    return text
-
-
-def normalize_direction(value: str, what: str) -> str:
-    """Canonical drive direction (``'Z'`` -> ``'z'``)."""
-    text = str(value).strip().lower()
-    if text not in DRIVE_DIRECTIONS:
-        raise LoadCaseError(f"{what}: unknown drive direction {value!r}; expected one of "
-                            f"{', '.join(DRIVE_DIRECTIONS)}")
-    return text
-
-
-def _check_fill(value: float, what: str) -> float:
-    try:
-        fill = float(value)
-    except (TypeError, ValueError):
-        raise LoadCaseError(f"{what}: fill {value!r} is not a number (packing ratio in %)") \
-            from None
-    if not (math.isfinite(fill) and 0.0 < fill <= 100.0):
-        raise LoadCaseError(f"{what}: fill must be in (0, 100] % (packing ratio), got {value!r}")
-    return fill
 
 
 def parse_file_name(name: str | Path) -> dict[str, float | str]:

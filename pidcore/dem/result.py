@@ -9,8 +9,10 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .. import defaults
+from ..loop import ForceDisplacementLoop
 
 if TYPE_CHECKING:  # pragma: no cover
+    from ..specimen import Specimen
     from .contact import ContactLaw
     from .simulate import DemConfig, LoadCase
 
@@ -18,17 +20,20 @@ if TYPE_CHECKING:  # pragma: no cover
 UNITS: dict[str, str] = {
     "sdc": "-", "sdc_stderr": "-", "loss_factor": "-",
     "energy_per_cycle_j": "J", "energy_dissipated_normal_j": "J",
-    "energy_dissipated_friction_j": "J", "max_kinetic_energy_j": "J", "work_per_cycle_j": "J",
+    "energy_dissipated_friction_j": "J", "energy_dissipated_rolling_j": "J",
+    "max_kinetic_energy_j": "J", "work_per_cycle_j": "J",
     "stored_energy_change_per_cycle_j": "J",
     "particles_per_cell": "1", "particles_full_cell": "1", "cells_simulated": "1",
-    "m_c_kg": "kg", "coupon_mass_kg": "kg", "energy_balance_error": "-", "steps": "1",
+    "vibrated_mass_kg": "kg", "coupon_mass_kg": "kg", "energy_balance_error": "-", "steps": "1",
     "wall_s": "s", "particle_steps_per_s": "1/s", "time_step_s": "s",
     "steady_start_cycle": "1", "steady_cycles": "1", "cycles_simulated": "1",
     "settle_time_s": "s", "frequency_hz": "Hz", "acceleration_g": "g", "fill_percent": "%",
     "sdc_per_cell": "-", "dissipation_per_cycle_j": "J", "sample_time_s": "s",
     "wall_force_n": "N", "shaker_force_n": "N", "velocity_m_s": "m/s",
     "sample_rate_hz": "Hz", "work_walls_j": "J", "dissipated_total_j": "J",
-    "mechanical_energy_change_j": "J",
+    "mechanical_energy_change_j": "J", "dissipation_per_cell_cycle_j": "J",
+    "coupon_cells": "1", "samples_per_cycle": "1", "fixture_mass_kg": "kg",
+    "particle_mass_kg": "kg",
 }
 
 
@@ -36,14 +41,18 @@ UNITS: dict[str, str] = {
 class DemResult:
     """Outcome of :func:`~pidcore.dem.simulate.simulate_load_case` (SI units, see UNITS).
 
-    Coupon-level quantities scale the K-cell mean to the coupon's 441 cells.
-    ``energy_dissipated_normal_j`` / ``_friction_j`` split ``energy_per_cycle_j`` (steady
-    state, per cycle, coupon); ``work_per_cycle_j`` is the walls' work on the particles per
-    steady cycle; it equals the dissipation plus ``stored_energy_change_per_cycle_j`` (the
-    change of the particles' mechanical energy over the steady window divided by its cycles,
-    e.g. a bed compacting). ``energy_balance_error`` is (W_walls - dE_mech - D) / W_walls
-    over the whole driven run (all cells), with dE_mech = kinetic (incl. rotation) + gravity +
-    Hertz elastic energy change. ``particle_steps_per_s`` counts settling and driven steps
+    Coupon-level quantities scale the K-cell mean to the coupon's ``coupon_cells`` cells
+    (the specimen's ``[cell] count``, 441 for the paper's). ``specimen`` is the
+    :class:`~pidcore.specimen.Specimen` simulated (its canonical text and hash are stored with
+    the run); ``coupon_mass_kg`` is the rigid mass the shaker moves, coupon plus fixture.
+    ``energy_dissipated_normal_j`` / ``_friction_j`` / ``_rolling_j`` split
+    ``energy_per_cycle_j`` (steady state, per cycle, coupon); ``work_per_cycle_j`` is the
+    walls' work on the particles per steady cycle; it equals the dissipation plus
+    ``stored_energy_change_per_cycle_j`` (the change of the particles' mechanical energy over
+    the steady window divided by its cycles, e.g. a bed compacting).
+    ``energy_balance_error`` is (W_walls - dE_mech - D) / W_walls over the whole driven run
+    (all cells), with dE_mech = kinetic (incl. rotation) + gravity + elastic (Hertz and
+    contact springs) energy change. ``particle_steps_per_s`` counts settling and driven steps
     over the time spent in the kernel (all threads); ``wall_s`` is the whole call.
 
     ``dissipation_per_cycle_j`` (cycles,) is the coupon dissipation of every driven cycle;
@@ -61,13 +70,14 @@ class DemResult:
     energy_per_cycle_j: float
     energy_dissipated_normal_j: float
     energy_dissipated_friction_j: float
+    energy_dissipated_rolling_j: float
     work_per_cycle_j: float
     stored_energy_change_per_cycle_j: float
     max_kinetic_energy_j: float
     particles_per_cell: int
     particles_full_cell: int
     cells_simulated: int
-    m_c_kg: float
+    vibrated_mass_kg: float
     coupon_mass_kg: float
     energy_balance_error: float
     work_walls_j: float
@@ -89,26 +99,30 @@ class DemResult:
     shaker_force_n: np.ndarray
     velocity_m_s: np.ndarray
     samples_per_cycle: int
+    specimen: Specimen | None = None
+    coupon_cells: int = defaults.COUPON_CELLS
 
     @classmethod
     def from_run(cls, *, case: LoadCase, config: DemConfig, law: ContactLaw,
                  tally: np.ndarray, wall_force: np.ndarray, steady_start_cycle: int,
                  steady_detected: bool, particles_per_cell: int, full_count: int,
-                 m_c_kg: float, coupon_mass_kg: float, dt_s: float, steps_per_cycle: int,
+                 vibrated_mass_kg: float, coupon_mass_kg: float, dt_s: float, steps_per_cycle: int,
                  sample_every: int, energy_start: np.ndarray, energy_end: np.ndarray,
                  stored_energy_change_steady: np.ndarray,
                  settle_time_s: float, steps: int, wall_s: float, kernel_s: float,
-                 particle_steps: int) -> DemResult:
-        n_coupon = defaults.COUPON_CELLS
+                 particle_steps: int, specimen: Specimen | None = None) -> DemResult:
+        n_coupon = specimen.cell.count if specimen is not None else defaults.COUPON_CELLS
         k = tally.shape[0]
         steady = tally[:, steady_start_cycle:, :]
-        per_cell_cycle = tally[:, :, 1] + tally[:, :, 2]
-        e_max = m_c_kg * case.acceleration_m_s2**2 / (2 * case.omega_rad_s**2)
+        # normal + friction + rolling (kernel tally columns 1, 2, 3)
+        per_cell_cycle = tally[:, :, 1] + tally[:, :, 2] + tally[:, :, 3]
+        e_max = vibrated_mass_kg * case.acceleration_m_s2**2 / (2 * case.omega_rad_s**2)
         per_cell = n_coupon * steady[:, :, 1:].sum(axis=2).mean(axis=1)  # coupon J / cycle
         sdc_cells = per_cell / e_max if e_max > 0 else np.full(k, np.nan)
         stderr = float(np.std(sdc_cells, ddof=1) / math.sqrt(k)) if k > 1 else float("nan")
         work = float(tally[:, :, 0].sum())
-        dissipated = float(tally[:, :, 1:].sum())
+        # friction and normal summed as before rolling existed (same rounding), rolling added
+        dissipated = float(tally[:, :, 1:3].sum()) + float(tally[:, :, 3:].sum())
         d_mech = float(np.sum(energy_end[:, 3] - energy_start[:, 3]))
         scale = max(abs(work), dissipated, 1e-300)
         # virtual shaker record, sample interval j covers force evaluations at t=(step+1) dt
@@ -127,12 +141,14 @@ class DemResult:
             energy_per_cycle_j=float(np.mean(per_cell)),
             energy_dissipated_normal_j=float(n_coupon * steady[:, :, 1].mean()),
             energy_dissipated_friction_j=float(n_coupon * steady[:, :, 2].mean()),
+            energy_dissipated_rolling_j=float(n_coupon * steady[:, :, 3].mean()),
             work_per_cycle_j=float(n_coupon * steady[:, :, 0].mean()),
             stored_energy_change_per_cycle_j=float(
                 n_coupon * np.mean(stored_energy_change_steady) / max(steady.shape[1], 1)),
             max_kinetic_energy_j=float(e_max),
             particles_per_cell=int(particles_per_cell), particles_full_cell=int(full_count),
-            cells_simulated=int(k), m_c_kg=float(m_c_kg), coupon_mass_kg=float(coupon_mass_kg),
+            cells_simulated=int(k), vibrated_mass_kg=float(vibrated_mass_kg),
+            coupon_mass_kg=float(coupon_mass_kg),
             energy_balance_error=float((work - d_mech - dissipated) / scale),
             work_walls_j=work, dissipated_total_j=dissipated, mechanical_energy_change_j=d_mech,
             steps=int(steps), wall_s=float(wall_s),
@@ -146,7 +162,7 @@ class DemResult:
             dissipation_per_cell_cycle_j=per_cell_cycle,
             sample_rate_hz=1.0 / h, sample_time_s=0.5 * (t0 + t1), wall_force_n=wall_n,
             shaker_force_n=coupon_mass_kg * acc + wall_n, velocity_m_s=vel,
-            samples_per_cycle=int(spc),
+            samples_per_cycle=int(spc), specimen=specimen, coupon_cells=int(n_coupon),
         )
 
     @property
@@ -170,11 +186,12 @@ class DemResult:
     def to_dict(self, *, include_arrays: bool = False) -> dict[str, Any]:
         """JSON-safe dict: scalars (and arrays as lists when ``include_arrays``)."""
         out: dict[str, Any] = {
-            "case_key": self.case.key(),
+            "case_key": self.case.key,
             "frequency_hz": self.case.frequency_hz,
             "acceleration_g": self.case.acceleration_g,
             "fill_percent": self.case.fill_percent,
-            "material": self.case.material,
+            "material": (self.specimen.particles.material if self.specimen is not None
+                         else self.case.material),
             "direction": self.case.direction,
             "normal_damping_mode": self.config.normal_damping_mode,
             "vibrated_mass_convention": self.config.vibrated_mass,
@@ -183,16 +200,25 @@ class DemResult:
             "tangential_model": self.config.tangential_model,
             "fill_reference": self.config.fill_reference,
             "seed": self.config.seed,
+            "coupon_cells": self.coupon_cells,
         }
+        if self.specimen is not None:
+            out.update({"specimen_name": self.specimen.name,
+                        "specimen_sha256": self.specimen.hash,
+                        "specimen_is_paper": self.specimen.is_paper(),
+                        "fixture_mass_kg": self.specimen.coupon.fixture_mass_kg,
+                        "particle_mass_kg": self.specimen.particles.mass_kg})
         for name in ("sdc", "sdc_stderr", "loss_factor", "energy_per_cycle_j", "work_per_cycle_j",
                      "stored_energy_change_per_cycle_j",
                      "energy_dissipated_normal_j", "energy_dissipated_friction_j",
-                     "max_kinetic_energy_j", "particles_per_cell", "particles_full_cell",
-                     "cells_simulated", "m_c_kg", "coupon_mass_kg", "energy_balance_error",
+                     "energy_dissipated_rolling_j", "max_kinetic_energy_j",
+                     "particles_per_cell", "particles_full_cell",
+                     "cells_simulated", "vibrated_mass_kg", "coupon_mass_kg",
+                     "energy_balance_error",
                      "work_walls_j", "dissipated_total_j", "mechanical_energy_change_j",
                      "steps", "wall_s", "particle_steps_per_s", "time_step_s",
                      "steady_start_cycle", "steady_detected", "steady_cycles",
-                     "settle_time_s", "sample_rate_hz"):
+                     "settle_time_s", "sample_rate_hz", "samples_per_cycle"):
             value = getattr(self, name)
             if isinstance(value, float) and not math.isfinite(value):
                 value = None
@@ -204,34 +230,71 @@ class DemResult:
 
     @staticmethod
     def array_names() -> tuple[str, ...]:
-        return ("sdc_per_cell", "dissipation_per_cycle_j", "sample_time_s", "wall_force_n",
-                "shaker_force_n", "velocity_m_s")
+        return ("sdc_per_cell", "dissipation_per_cycle_j", "dissipation_per_cell_cycle_j",
+                "sample_time_s", "wall_force_n", "shaker_force_n", "velocity_m_s")
 
     def arrays(self) -> dict[str, np.ndarray]:
         return {name: np.asarray(getattr(self, name)) for name in self.array_names()}
 
-    def plot(self, ax=None):
-        """Per-cycle dissipation (top) and wall force over the last cycles (bottom).
+    def loop(self, n_points: int = defaults.LOOP_POINTS, *,
+             n_harmonics: int = defaults.N_HARMONICS) -> ForceDisplacementLoop:
+        """One period of the steady virtual shaker record's force-displacement loop.
+
+        Built exactly as a measurement's (:func:`virtual_shaker_loop`), so the two loops'
+        areas are comparable energies per cycle.
+        """
+        return virtual_shaker_loop(
+            self.shaker_force_n, self.velocity_m_s, sample_rate_hz=self.sample_rate_hz,
+            frequency_hz=self.case.frequency_hz, steady_start_cycle=self.steady_start_cycle,
+            n_points=n_points, n_harmonics=n_harmonics, label=f"DEM {self.case.key}")
+
+    def plot(self, ax: Any = None) -> Any:
+        """Per-cycle dissipation and forces (:func:`pidcore.report.figures_results.plot_dem_run`).
 
         ``ax``: a pair of matplotlib axes, or None for a new figure. Returns the axes.
         """
-        import matplotlib.pyplot as plt
+        from ..report.figures_results import plot_dem_run  # lazy: drawing is optional
 
-        if ax is None:
-            _, ax = plt.subplots(2, 1, figsize=(7, 6), constrained_layout=True)
-        a0, a1 = ax
-        cycles = np.arange(len(self.dissipation_per_cycle_j))
-        a0.plot(cycles, self.dissipation_per_cycle_j, ".-", label="coupon")
-        a0.axvline(self.steady_start_cycle, color="k", ls="--", label="steady from")
-        a0.set_xlabel("cycle [-]")
-        a0.set_ylabel("dissipated per cycle [J]")
-        a0.legend()
-        n = 5 * self.samples_per_cycle
-        a1.plot(self.sample_time_s[-n:], self.wall_force_n[-n:], label="walls on particles")
-        a1.plot(self.sample_time_s[-n:], self.shaker_force_n[-n:], label="shaker force")
-        a1.set_xlabel("time [s]")
-        a1.set_ylabel("force [N]")
-        a1.legend()
-        a0.set_title(f"{self.case.key()}: SDC {self.sdc:.4g} +- {self.sdc_stderr:.2g}, "
-                     f"{self.particles_per_cell} particles/cell")
-        return ax
+        return plot_dem_run(self, ax=ax)
+
+
+def virtual_shaker_loop(force_n: np.ndarray, velocity_m_s: np.ndarray, *,
+                        sample_rate_hz: float, frequency_hz: float,
+                        steady_start_cycle: float = 0,
+                        n_points: int = defaults.LOOP_POINTS,
+                        n_harmonics: int = defaults.N_HARMONICS,
+                        label: str = "DEM") -> ForceDisplacementLoop:
+    """Force-displacement loop of a DEM run's virtual shaker record (arrays in SI units).
+
+    The record from ``steady_start_cycle`` on goes through the same harmonic analysis as a
+    measurement (:func:`pidcore.signal.analyze_power`); a short record (fewer than
+    :data:`pidcore.defaults.MIN_PERIODS` steady cycles, at least 2) is accepted with fewer
+    uncertainty blocks, as the loop needs no standard error.
+
+    Raises
+    ------
+    ParameterError
+        Arrays of different shapes, or fewer than 2 steady cycles.
+    SignalError
+        The record cannot be analysed (no dominant drive frequency).
+    """
+    from ..errors import ParameterError
+    from ..signal import analyze_power
+
+    force = np.asarray(force_n, dtype=np.float64)
+    velocity = np.asarray(velocity_m_s, dtype=np.float64)
+    if force.ndim != 1 or force.shape != velocity.shape:
+        raise ParameterError(f"{label}: force and velocity records differ in shape "
+                             f"({force.shape} vs {velocity.shape})")
+    per_cycle = float(sample_rate_hz) / float(frequency_hz)
+    start = int(round(float(steady_start_cycle or 0) * per_cycle))
+    cycles = int((force.size - start) / per_cycle)
+    if cycles < 2:
+        raise ParameterError(f"{label}: {cycles} steady cycles in the virtual shaker record, "
+                             "expected at least 2")
+    analysis = analyze_power(force[start:], velocity[start:], float(sample_rate_hz),
+                             frequency_hz=float(frequency_hz), n_harmonics=n_harmonics,
+                             min_periods=min(defaults.MIN_PERIODS, cycles),
+                             n_blocks=max(2, min(defaults.N_UNCERTAINTY_BLOCKS, cycles)),
+                             source=label)
+    return analysis.loop(n_points)

@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import os
 import re
+from dataclasses import replace
 from pathlib import Path
 
 from ..constants import FileFormat
@@ -41,6 +42,7 @@ from .uff import read_uff, write_uff
 
 __all__ = [
     "FILE_FORMAT_EXTENSIONS", "RoleAssignment", "assign_roles", "detect_file_format",
+    "display_path",
     "hdf5_keys", "name_suggests", "read_csv", "read_hdf5", "read_mat", "read_measurement",
     "read_measurements", "read_uff", "write_csv", "write_hdf5", "write_mat",
     "write_measurement", "write_uff",
@@ -93,6 +95,31 @@ def detect_file_format(path: str | os.PathLike[str]) -> str:
                          "MATLAB (.mat) or pidcore HDF5 (.h5)")
 
 
+def display_path(path: str | os.PathLike[str]) -> str:
+    """The path as text that can be printed and stored: bytes that are not UTF-8 (a file name
+    from another system) become ``\\xNN`` escapes instead of failing later.
+
+    >>> display_path(b"run_\\xff.csv".decode("utf-8", "surrogateescape"))
+    'run_\\\\xff.csv'
+    """
+    text = os.fsdecode(path)
+    try:
+        text.encode("utf-8")
+        return text
+    except UnicodeEncodeError:
+        return os.fsencode(text).decode("utf-8", "backslashreplace")
+
+
+def _displayed(measurement: Measurement, path: str | os.PathLike[str]) -> Measurement:
+    shown = display_path(path)
+    if shown == measurement.source or measurement.source != os.fsdecode(path):
+        return measurement
+    notes = [*measurement.metadata.get("reader_notes", ()),
+             f"{shown}: the file name is not valid UTF-8; stored with \\x escapes"]
+    return replace(measurement, source=shown,
+                   metadata={**measurement.metadata, "reader_notes": notes})
+
+
 def _check_format(file_format: str | None) -> None:
     if file_format is not None and file_format not in _FORMATS:
         raise ParameterError(f"file_format must be one of {', '.join(_FORMATS)}; "
@@ -108,7 +135,7 @@ def read_measurements(path: str | os.PathLike[str], *, sample_rate_hz: float | N
     _check_format(file_format)
     fmt = file_format or detect_file_format(path)
     if fmt == "hdf5":
-        return read_hdf5(path)
+        return [_displayed(m, path) for m in read_hdf5(path)]
     return [read_measurement(path, sample_rate_hz=sample_rate_hz, file_format=fmt)]
 
 
@@ -147,16 +174,16 @@ def read_measurement(path: str | os.PathLike[str], *, sample_rate_hz: float | No
     if sample_rate_hz is not None and not sample_rate_hz > 0:
         raise ParameterError(f"sample_rate_hz must be positive, got {sample_rate_hz!r}")
     if fmt == "uff":
-        return read_uff(path)
+        return _displayed(read_uff(path), path)
     if fmt == "csv":
-        return read_csv(path, sample_rate_hz=sample_rate_hz)
+        return _displayed(read_csv(path, sample_rate_hz=sample_rate_hz), path)
     if fmt == "mat":
-        return read_mat(path, sample_rate_hz=sample_rate_hz)
+        return _displayed(read_mat(path, sample_rate_hz=sample_rate_hz), path)
     keys = hdf5_keys(path)
     if key is None and len(keys) > 1:
-        raise InputFileError(f"{path}: holds {len(keys)} measurements ({', '.join(keys)}); "
-                             "choose one with key=")
-    return read_hdf5(path, key=key)[0]
+        raise InputFileError(f"{display_path(path)}: holds {len(keys)} measurements "
+                             f"({', '.join(keys)}); choose one with key=")
+    return _displayed(read_hdf5(path, key=key)[0], path)
 
 
 def write_measurement(measurement: Measurement, path: str | os.PathLike[str],

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import contextlib
 import hashlib
+import math
 import os
 import tempfile
 from collections.abc import Iterator, Sequence
@@ -23,6 +24,19 @@ EVEN_SPACING_TOLERANCE = 0.05
 #: Relative distance within which a sample rate read from float64 data is snapped to whole Hz
 #: (removes only representation noise such as 1/0.0001).
 FLOAT64_RATE_RESOLUTION = 1e-9
+
+
+def reraise_interrupt(exc: BaseException) -> None:
+    """Raise :class:`KeyboardInterrupt` when ``exc`` was caused by one.
+
+    pyuff and scipy turn every failure, Ctrl-C included, into a plain ``Exception``; a reader
+    that reported those as a corrupt file would turn an interruption into a wrong diagnosis.
+    """
+    seen = exc
+    while seen is not None:
+        if isinstance(seen, KeyboardInterrupt):
+            raise KeyboardInterrupt from None
+        seen = seen.__cause__ or seen.__context__
 
 
 def file_sha256(path: str | os.PathLike[str]) -> str:
@@ -68,11 +82,22 @@ def snap_rate(rate_hz: float, relative_resolution: float) -> float:
     return float(rate_hz)
 
 
-def rate_from_times(times: np.ndarray, *, what: str) -> tuple[float, float]:
+#: Fewest significant digits a printed time column is assumed to keep (MATLAB csvwrite: 5).
+PRINTED_TIME_DIGITS = 5
+
+
+def rate_from_times(times: np.ndarray, *, what: str, with_note: bool = False):
     """Sample rate (Hz) and start time (s) of an evenly spaced time vector.
 
+    The samples must lie on an even grid within :data:`EVEN_SPACING_TOLERANCE` of the interval,
+    or within the precision the column was printed with: a time printed with
+    :data:`PRINTED_TIME_DIGITS` significant digits (MATLAB ``csvwrite``, UFF E13.5 abscissas)
+    is off the grid by up to half a unit in its last digit. Such a column gives the rate and
+    start of a least-squares line through it, snapped to whole Hz within its resolution, and
+    (``with_note=True``) a note saying so, returned as a third element ('' otherwise).
+
     Raises :class:`InputFileError` naming ``what`` when the vector is too short, not
-    increasing or not evenly spaced (see :data:`EVEN_SPACING_TOLERANCE`).
+    increasing or not evenly spaced within either tolerance.
     """
     t = np.asarray(times, dtype=np.float64)
     if t.ndim != 1 or t.size < 2:
@@ -82,13 +107,37 @@ def rate_from_times(times: np.ndarray, *, what: str) -> tuple[float, float]:
     dt = (t[-1] - t[0]) / (t.size - 1)
     if not dt > 0:
         raise InputFileError(f"{what}: time does not increase (first {t[0]!r}, last {t[-1]!r})")
-    residual = np.max(np.abs(t - (t[0] + dt * np.arange(t.size))))
-    if residual > EVEN_SPACING_TOLERANCE * dt:
-        worst = int(np.argmax(np.abs(np.diff(t) - dt)))
-        raise InputFileError(
-            f"{what}: time is not evenly spaced (mean interval {dt:.6g} s, interval after sample "
-            f"{worst} is {t[worst + 1] - t[worst]:.6g} s); expected a constant sample interval")
-    return snap_rate(1.0 / dt, FLOAT64_RATE_RESOLUTION), float(t[0])
+    index = np.arange(t.size, dtype=np.float64)
+    residual = np.max(np.abs(t - (t[0] + dt * index)))
+    note = ""
+    if residual <= EVEN_SPACING_TOLERANCE * dt:
+        rate, start = snap_rate(1.0 / dt, FLOAT64_RATE_RESOLUTION), float(t[0])
+    else:
+        # half a unit in the last printed digit of the largest time
+        magnitude = float(np.max(np.abs(t[[0, -1]])))
+        printed = 0.5 * 10.0 ** (math.floor(math.log10(magnitude)) - (PRINTED_TIME_DIGITS - 1))
+        slope, intercept = np.polyfit(index, t, 1)
+        fitted_residual = float(np.max(np.abs(t - (intercept + slope * index))))
+        # a dropped or repeated sample in a column whose rounding is finer than the interval
+        # leaves ~1/4 interval off the fitted line: still refused
+        if not (slope > 0 and fitted_residual <= printed + EVEN_SPACING_TOLERANCE * dt
+                and np.all(np.diff(t) >= 0)):
+            worst = int(np.argmax(np.abs(np.diff(t) - dt)))
+            raise InputFileError(
+                f"{what}: time is not evenly spaced (mean interval {dt:.6g} s, interval after "
+                f"sample {worst} is {t[worst + 1] - t[worst]:.6g} s); expected a constant sample "
+                "interval")
+        span = float(slope) * (t.size - 1)
+        rate = snap_rate(1.0 / float(slope), max(printed / span, FLOAT64_RATE_RESOLUTION))
+        start = float(intercept)
+        if t[0] == 0.0 and abs(start) <= printed:
+            start = 0.0  # a record that starts at 0 as printed
+        note = (f"{what}: time printed with about {PRINTED_TIME_DIGITS} significant digits "
+                f"(off an even grid by up to {fitted_residual:.3g} s); rate {rate:.9g} Hz from a "
+                "line fitted through it")
+    if with_note:
+        return rate, start, note
+    return rate, start
 
 
 def interpret_unit(unit_text: str) -> tuple[str, float]:

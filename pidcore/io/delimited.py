@@ -1,20 +1,30 @@
-"""Delimited text (CSV/TXT) with one header row of names and units.
+"""Delimited text (CSV/TXT) of channels: names, optionally units, then numbers.
 
-Supported header cells: ``Time [s]``, ``Force (kN)``, ``Velocity [mm/s]``, ``Acceleration [g]``
-or a bare name (quantity ``"unknown"``, values kept as written). Delimiters: comma, semicolon,
-tab or runs of blanks, detected from the header line. A decimal comma is recognised when the
-delimiter is not a comma. Lines before the header that start with ``#`` are skipped.
+Understood as spreadsheet tools, MATLAB and acquisition software write them:
 
-The time base is the first column whose unit is a time unit or whose name is ``time``/``t``;
-it must be evenly spaced. Without one, ``sample_rate_hz`` must be given.
+* header cells ``Time [s]``, ``Force (kN)``, ``Velocity [mm/s]``, or a bare name with the units
+  in a **unit row** under the names (``s;N;mm/s`` or ``[s];[N];[mm/s]``); a bare name without a
+  unit has quantity ``"unknown"`` (the analysis asks for its unit, never takes it as SI);
+* **free-text lines** before the header (title, date, comments, ``#`` lines) are skipped: the
+  header is the last text line before the numbers;
+* delimiters comma, semicolon, tab or runs of blanks; a **decimal comma** when the delimiter is
+  not a comma, recognised from any of the first data rows (the first may hold integers only);
+* encodings UTF-8 (with or without BOM), **UTF-16** (BOM or NUL pattern), else Latin-1.
+
+The time base is the first column whose unit is a time unit or whose name is ``time``/``t``.
+It must be evenly spaced within the precision it was printed with (a column printed with 5-6
+significant digits is fitted, see :func:`pidcore.io._common.rate_from_times`). Without one,
+``sample_rate_hz`` must be given; with one, ``sample_rate_hz`` overrides it (noted).
+
+The numbers are parsed by pandas' C parser straight from the file, in chunks, so that reading
+needs about the size of the resulting float64 arrays (well under 3x the file size).
 """
 
 from __future__ import annotations
 
-import io
+import codecs
 import os
 import re
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -32,7 +42,12 @@ from ._common import (
 
 _HEADER_CELL = re.compile(r"^\s*(?P<name>.*?)\s*(?:[\[(](?P<unit>[^\[\]()]*(?:\([^)]*\))?"
                           r"[^\[\]()]*)[\])])?\s*$")
-_TIME_NAMES = {"time", "t", "zeit", "temps"}
+_TIME_NAMES = {"time", "t", "zeit", "temps", "x"}
+#: Bytes read to find the header, the unit row and the number format.
+_HEAD_BYTES = 1 << 16
+_NUMBER = re.compile(r"^[+-]?(?:\d+(?:[.,]\d*)?|[.,]\d+)(?:[eE][+-]?\d+)?$|^[+-]?(?:nan|inf)$",
+                     re.IGNORECASE)
+_LINE_BREAK = re.compile(r"\r\n|\n|\r")
 
 
 def _split_header(cell: str) -> tuple[str, str]:
@@ -44,22 +59,87 @@ def _split_header(cell: str) -> tuple[str, str]:
     return match.group("name"), (match.group("unit") or "").strip()
 
 
-def _decode(raw: bytes) -> str:
-    for encoding in ("utf-8-sig", "latin-1"):
-        try:
-            return raw.decode(encoding)
-        except UnicodeDecodeError:
-            continue
-    raise AssertionError("latin-1 decodes every byte")  # pragma: no cover
+def _encoding(head: bytes) -> str:
+    """Encoding from a BOM, the NUL pattern of UTF-16 without BOM, or a UTF-8 trial."""
+    if head.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):
+        return "utf-16"
+    if head.startswith(codecs.BOM_UTF8):
+        return "utf-8-sig"
+    sample = head[:512]
+    if len(sample) >= 4 and sample[1::2].count(0) > 0.4 * len(sample) / 2 \
+            and sample[0::2].count(0) == 0:
+        return "utf-16-le"
+    if len(sample) >= 4 and sample[0::2].count(0) > 0.4 * len(sample) / 2 \
+            and sample[1::2].count(0) == 0:
+        return "utf-16-be"
+    try:
+        head.decode("utf-8")
+        return "utf-8"
+    except UnicodeDecodeError as exc:
+        if exc.start >= len(head) - 3:  # a character cut at the end of the head
+            return "utf-8"
+        return "latin-1"
 
 
-def _sniff(header: str, first_data: str) -> tuple[str, str]:
-    """Delimiter (regex for blanks) and decimal mark from the header and a data line."""
+def _cells(line: str, delimiter: str) -> list[str]:
+    if delimiter == r"\s+":
+        return line.split()
+    return [c.strip().strip('"').strip() for c in line.split(delimiter)]
+
+
+def _delimiter(lines: list[str]) -> str:
     for delimiter in ("\t", ";", ","):
-        if delimiter in header:
-            decimal = "," if delimiter != "," and "," in first_data else "."
-            return delimiter, decimal
-    return r"\s+", "."
+        if all(delimiter in ln for ln in lines):
+            return delimiter
+    return r"\s+"
+
+
+def _is_numeric_row(line: str, delimiter: str) -> bool:
+    cells = [c for c in _cells(line, delimiter) if c]
+    return bool(cells) and all(_NUMBER.match(c) for c in cells)
+
+
+def _looks_like_unit(cell: str) -> bool:
+    text = cell.strip().strip("[]()").strip()
+    return not text or text.lower() in {"-", "1", "none"} or interpret_unit(text)[0] != "unknown"
+
+
+def _layout(lines: list[str], where: str) -> tuple[int, str, list[str], list[str], str]:
+    """Index of the first data line, delimiter, names, units and decimal mark."""
+    candidates = [i for i, ln in enumerate(lines) if ln.strip()]
+    first = None
+    for pos, i in enumerate(candidates):
+        window = [lines[j] for j in candidates[pos:pos + 3]]
+        delimiter = _delimiter(window)
+        if all(_is_numeric_row(ln, delimiter) for ln in window):
+            first = i
+            break
+    if first is None:  # a bad cell in the first rows: let the parser name it
+        first = next((i for i in candidates if _is_numeric_row(lines[i], _delimiter([lines[i]]))),
+                     None)
+    if first is None:
+        what = "header but no data rows" if candidates else "no rows of numbers"
+        raise InputFileError(f"{where}: {what}; expected a header row such as "
+                             "'Time [s],Force [N],Velocity [m/s]' and data rows")
+    data = [lines[j] for j in candidates if j >= first][:200]
+    delimiter = _delimiter(data[:3])
+    n_cols = len(_cells(data[0], delimiter))
+    text_rows = [lines[j] for j in candidates if j < first and not lines[j].lstrip()
+                 .startswith("#")]
+    text_rows = [r for r in text_rows if len(_cells(r, delimiter)) >= n_cols
+                 or (delimiter == r"\s+" and len(_cells(r, delimiter)) >= 1)]
+    if not text_rows:
+        raise InputFileError(f"{where}: no header row before the numbers; expected names such "
+                             "as 'Time [s],Force [N],Velocity [m/s]'")
+    names = _cells(text_rows[-1], delimiter)
+    units = [""] * len(names)
+    if len(text_rows) >= 2 and all(_looks_like_unit(c) for c in names) \
+            and any(c.strip() for c in names):
+        units = [c.strip().strip("[]()").strip() for c in names]  # a unit row under the names
+        names = _cells(text_rows[-2], delimiter)
+        units = (units + [""] * len(names))[:len(names)]
+    decimal = "," if delimiter != "," and any("," in ln for ln in data) else "."
+    return first, delimiter, names, units, decimal
 
 
 def read_csv(path: str | os.PathLike[str], *, sample_rate_hz: float | None = None) -> Measurement:
@@ -69,8 +149,8 @@ def read_csv(path: str | os.PathLike[str], *, sample_rate_hz: float | None = Non
     ----------
     path : str or path-like
     sample_rate_hz : float, optional
-        Sample rate, Hz, for files without a time column. With a time column it must agree
-        with the column (relative 1e-6) or :class:`ParameterError` is raised.
+        Sample rate, Hz, for files without a time column; with a time column it overrides the
+        column (the measurement's ``reader_notes`` say so).
 
     Examples
     --------
@@ -78,46 +158,47 @@ def read_csv(path: str | os.PathLike[str], *, sample_rate_hz: float | None = Non
     quantity ``force`` in N sampled at 1000 Hz.
     """
     where = str(path)
-    text = _decode(Path(path).read_bytes())
-    lines = text.splitlines()
-    start = 0
-    while start < len(lines) and (not lines[start].strip() or lines[start].lstrip()
-                                  .startswith("#")):
-        start += 1
-    if start >= len(lines):
+    with open(path, "rb") as fh:
+        head = fh.read(_HEAD_BYTES)
+        complete = not fh.read(1)
+    if not head.strip():
         raise InputFileError(f"{where}: empty file; expected a header row such as "
                              "'Time [s],Force [N],Velocity [m/s]' and data rows")
-    header = lines[start]
-    data_lines = [ln for ln in lines[start + 1:] if ln.strip()]
-    if not data_lines:
-        raise InputFileError(f"{where}: header but no data rows")
-    if "\x00" in text[:4096]:
+    encoding = _encoding(head)
+    if "\x00" in head[:4096].decode("latin-1") and not encoding.startswith("utf-16"):
         raise InputFileError(f"{where}: binary content; expected delimited text")
-    delimiter, decimal = _sniff(header, data_lines[0])
-    engine = "python" if delimiter == r"\s+" else "c"
+    text = codecs.getincrementaldecoder(encoding)(errors="replace").decode(head, final=complete)
+    lines = _LINE_BREAK.split(text)
+    if not complete:
+        lines = lines[:-1]  # possibly cut
+    first, delimiter, header_cells, unit_cells, decimal = _layout(lines, where)
+    notes: list[str] = []
     try:
-        # The header is read apart so that repeated names stay as written (pandas would
-        # rename them 'a.1') and the data columns parse natively as float64 ('nan', 'inf' and
-        # empty cells become NaN; the analysis judges them, not the reader).
-        header_cells = [str(c) for c in pd.read_csv(
-            io.StringIO(header), sep=delimiter, engine=engine, header=None, dtype=str,
-            keep_default_na=False, skipinitialspace=True).iloc[0]]
-        values = pd.read_csv(io.StringIO("\n".join(data_lines)), sep=delimiter, engine=engine,
-                             decimal=decimal, header=None, dtype=np.float64,
-                             skipinitialspace=True).to_numpy(dtype=np.float64)
-    except (pd.errors.ParserError, ValueError) as exc:
+        # skiprows skips raw lines (blank ones included), as counted by _LINE_BREAK
+        frame = pd.read_csv(path, sep=delimiter, decimal=decimal, header=None, skiprows=first,
+                            dtype=np.float64, encoding=encoding, skipinitialspace=True,
+                            skip_blank_lines=True, engine="c", comment="#")
+    except (pd.errors.ParserError, ValueError, UnicodeDecodeError) as exc:
         first_line = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         raise InputFileError(f"{where}: not a numeric delimited table ({first_line}); expected "
                              "one header row of names and units followed by numbers") from None
+    values = frame.to_numpy(dtype=np.float64, copy=False)
+    del frame
     # A trailing delimiter makes an empty last column; drop it.
     while header_cells and not header_cells[-1].strip() and values.shape[1] == len(header_cells) \
             and np.all(np.isnan(values[:, -1])):
         header_cells.pop()
+        unit_cells = unit_cells[:len(header_cells)]
+        values = values[:, :-1]
+    while values.shape[1] > len(header_cells) and np.all(np.isnan(values[:, -1])):
         values = values[:, :-1]
     if values.shape[1] != len(header_cells):
         raise InputFileError(f"{where}: the header has {len(header_cells)} columns but the data "
                              f"rows have {values.shape[1]}")
-    cells = [_split_header(c) for c in header_cells]
+    cells = []
+    for cell, unit in zip(header_cells, unit_cells, strict=True):
+        name, own = _split_header(cell)
+        cells.append((name, own or unit))
     if len(cells) < 1 or values.shape[0] < 2:
         raise InputFileError(f"{where}: expected at least one channel and two data rows")
 
@@ -127,21 +208,27 @@ def read_csv(path: str | os.PathLike[str], *, sample_rate_hz: float | None = Non
         if quantity == "time" or (not unit and name.strip().lower() in _TIME_NAMES):
             time_index = i
             break
-    if time_index is not None:
-        name, unit = cells[time_index]
-        _, factor = interpret_unit(unit) if unit else ("time", 1.0)
-        rate, start_time = rate_from_times(values[:, time_index] * factor,
-                                           what=f"{where}: column {name!r}")
-        if sample_rate_hz is not None and abs(rate - sample_rate_hz) > 1e-6 * rate:
-            raise ParameterError(f"{where}: the time column gives {rate:.9g} Hz but "
-                                 f"sample_rate_hz={sample_rate_hz:.9g} was given")
-    elif sample_rate_hz is None:
-        raise InputFileError(f"{where}: no time column (e.g. 'Time [s]') and no sample rate; "
-                             "add a time column or give the sample rate (--sample-rate)")
-    else:
+    if sample_rate_hz is not None:
         if not sample_rate_hz > 0:
             raise ParameterError(f"sample_rate_hz must be positive, got {sample_rate_hz!r}")
         rate, start_time = float(sample_rate_hz), 0.0
+        if time_index is not None:
+            name, unit = cells[time_index]
+            _, factor = interpret_unit(unit) if unit else ("time", 1.0)
+            start_time = float(values[0, time_index]) * factor
+            notes.append(f"{where}: time column {name!r} ignored: the sample rate "
+                         f"{rate:g} Hz was given (--sample-rate)")
+    elif time_index is not None:
+        name, unit = cells[time_index]
+        _, factor = interpret_unit(unit) if unit else ("time", 1.0)
+        rate, start_time, note = rate_from_times(values[:, time_index] * factor,
+                                                 what=f"{where}: column {name!r}",
+                                                 with_note=True)
+        if note:
+            notes.append(note)
+    else:
+        raise InputFileError(f"{where}: no time column (e.g. 'Time [s]') and no sample rate; "
+                             "add a time column or give the sample rate (--sample-rate)")
 
     keep = [i for i in range(len(cells)) if i != time_index]
     if not keep:
@@ -150,8 +237,11 @@ def read_csv(path: str | os.PathLike[str], *, sample_rate_hz: float | None = Non
     channels = tuple(make_channel(n, values[:, i], sample_rate_hz=rate, unit=cells[i][1],
                                   start_time_s=start_time)
                      for n, i in zip(names, keep, strict=True))
+    metadata: dict = {"csv_encoding": encoding}
+    if notes:
+        metadata["reader_notes"] = notes
     return Measurement(source=where, channels=channels, sha256=file_sha256(path),
-                       file_format="csv", metadata={})
+                       file_format="csv", metadata=metadata)
 
 
 def write_csv(measurement: Measurement, path: str | os.PathLike[str]) -> None:

@@ -15,6 +15,7 @@ import h5py
 from ..errors import InputFileError, ParameterError
 from ..records import Measurement
 from ._common import atomic_path, file_sha256
+from ._hdf5_safety import check_hdf5_input
 from .hdf5_layout import LAYOUT_TAG, read_measurement_group, write_measurement_group
 
 MEASUREMENTS_GROUP = "measurements"
@@ -34,8 +35,13 @@ def _as_read(measurement: Measurement, where: str, sha256: str) -> Measurement:
 
 
 def hdf5_keys(path: str | os.PathLike[str]) -> list[str]:
-    """Keys of the measurements in a pidcore HDF5 file (``[""]`` for a root measurement)."""
+    """Keys of the measurements in a pidcore HDF5 file (``[""]`` for a root measurement).
+
+    The file is checked first (:func:`pidcore.io._hdf5_safety.check_hdf5_input`): external
+    storage, external links and virtual datasets are refused before any data is read.
+    """
     where = str(path)
+    check_hdf5_input(where)
     try:
         with h5py.File(where, "r") as h5:
             if _is_measurement(h5):

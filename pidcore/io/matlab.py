@@ -9,8 +9,10 @@ Three layouts are understood, tried in this order:
    ``x_values.start_value``, ``x_values.increment`` (s), ``x_values.number_of_values``,
    ``y_values.values`` (one column per channel) and, where present,
    ``function_record.name`` (channel name; a cell of names for several columns) and the unit in
-   ``y_values.quantity`` (fields ``unit``/``units``/``unit_label``; a bare ``label`` such as
-   ``'Acceleration'`` is taken as that quantity in SI, the unit Test.Lab exports in).
+   ``y_values.quantity`` (fields ``unit``/``units``/``unit_label``, a unit struct
+   ``unit.label``, or ``quantity_terms(k).unit.label`` with exponents; only a bare ``label``
+   such as ``'Acceleration'`` is taken as that quantity in SI, the unit Test.Lab exports in).
+   v7.3 struct *arrays* (``Signal(1)``, ``Signal(2)``, ...) are read like v5 ones.
 3. **simple layout**: a time vector ``time`` or ``t`` (s) plus one numeric vector per channel
    (the variable name is the channel name), optionally ``units`` as a struct
    (``units.Force = 'kN'``) or a cell of unit strings in the order of the channel variables.
@@ -38,8 +40,10 @@ from ._common import (
     file_sha256,
     make_channel,
     rate_from_times,
+    reraise_interrupt,
     unique_names,
 )
+from ._hdf5_safety import check_hdf5_input
 
 _TIME_VARIABLES = ("time", "t", "Time", "T")
 _RATE_VARIABLES = ("sample_rate_hz", "fs", "Fs", "sample_rate")
@@ -83,8 +87,39 @@ def _numeric_vector(value: object) -> np.ndarray | None:
 # --- v7.3 (HDF5) -> the same nested dict/list/array shape loadmat(simplify_cells=True) gives
 
 
+def _struct_array_fields(group: h5py.Group) -> list[str] | None:
+    """Field names when ``group`` is a MATLAB struct *array* (not 1x1), else None.
+
+    v7.3 stores a 1x1 struct as a group of its field values, but a struct array as a group
+    whose every field is an array of object references (one per element) without a
+    ``MATLAB_class`` of its own.
+    """
+    if _attr_text(group, "MATLAB_class") != "struct":
+        return None
+    fields = [k for k in group if not k.startswith("#")]
+    shapes = set()
+    for k in fields:
+        item = group[k]
+        if not isinstance(item, h5py.Dataset) or item.dtype != h5py.ref_dtype \
+                or _attr_text(item, "MATLAB_class"):
+            return None
+        shapes.add(item.shape)
+    return fields if fields and len(shapes) == 1 else None
+
+
+def _attr_text(obj: h5py.Group | h5py.Dataset, name: str) -> str:
+    value = obj.attrs.get(name, b"")
+    return value.decode() if isinstance(value, bytes) else str(value)
+
+
 def _h5_value(obj: h5py.Group | h5py.Dataset, file: h5py.File) -> object:
     if isinstance(obj, h5py.Group):
+        fields = _struct_array_fields(obj)
+        if fields is not None:  # struct array -> list of dicts, as loadmat gives
+            columns = {k: [_h5_value(file[ref], file) for ref in np.asarray(obj[k][()]).T.ravel()]
+                       for k in fields}
+            n = len(next(iter(columns.values())))
+            return [{k: columns[k][i] for k in fields} for i in range(n)]
         return {k: _h5_value(obj[k], file) for k in obj if not k.startswith("#")}
     matlab_class = obj.attrs.get("MATLAB_class", b"")
     matlab_class = matlab_class.decode() if isinstance(matlab_class, bytes) else matlab_class
@@ -100,6 +135,7 @@ def _h5_value(obj: h5py.Group | h5py.Dataset, file: h5py.File) -> object:
 
 
 def _load_v73(path: str) -> dict:
+    check_hdf5_input(path, what="MATLAB v7.3 (HDF5)")
     with h5py.File(path, "r") as h5:
         return {k: _h5_value(h5[k], h5) for k in h5 if not k.startswith("#")}
 
@@ -119,6 +155,7 @@ def _load(path: str) -> dict:
     except NotImplementedError:
         return _load_v73(path)
     except Exception as exc:  # scipy raises ValueError, TypeError, MatReadError, ...
+        reraise_interrupt(exc)
         raise InputFileError(f"{path}: not a readable MATLAB .mat file ({exc})") from None
 
 
@@ -143,13 +180,46 @@ def _pidcore_layout(variables: Mapping, where: str) -> list[Channel]:
     return channels
 
 
+def _unit_text(value: object) -> str:
+    """A unit from text or from a unit struct (``unit.label``)."""
+    if isinstance(value, Mapping):
+        for key in ("label", "name", "unit", "symbol"):
+            text = _text(value.get(key))
+            if text:
+                return text
+        return ""
+    return _text(value)
+
+
+def _terms_unit(terms: object) -> str:
+    """Unit of Test.Lab ``quantity_terms``: one term (``unit.label``) or a product of terms
+    with ``unit_exponent`` / ``exponent`` (``m^1*s^-2``)."""
+    parts = []
+    for term in _as_list(terms):
+        if not isinstance(term, Mapping):
+            continue
+        text = _unit_text(term.get("unit", term))
+        if not text:
+            continue
+        exponent = term.get("unit_exponent", term.get("exponent"))
+        try:
+            power = 1.0 if exponent is None else _scalar(exponent, "exponent")
+        except InputFileError:
+            power = 1.0
+        parts.append(text if power == 1 else f"{text}^{power:g}")
+    return "*".join(parts)
+
+
 def _lms_unit(quantity_struct: object) -> str:
     if not isinstance(quantity_struct, Mapping):
         return _text(quantity_struct)
     for key in ("unit", "units", "unit_label", "unit_name"):
-        text = _text(quantity_struct.get(key))
+        text = _unit_text(quantity_struct.get(key))
         if text:
             return text
+    text = _terms_unit(quantity_struct.get("quantity_terms"))
+    if text:
+        return text
     label = _text(quantity_struct.get("label")).strip().lower()
     if label in SI_UNITS and label not in ("unknown", "time"):
         return SI_UNITS[label]  # Test.Lab exports values in SI; the label names the quantity
@@ -194,15 +264,23 @@ def _lms_layout(signal: object, where: str) -> list[Channel]:
 
 
 def _simple_layout(variables: Mapping, where: str,
-                   sample_rate_hz: float | None) -> list[Channel]:
+                   sample_rate_hz: float | None) -> tuple[list[Channel], list[str]]:
     public = {k: v for k, v in variables.items() if not k.startswith("__")}
     time_key = next((k for k in _TIME_VARIABLES if _numeric_vector(public.get(k)) is not None),
                     None)
     rate_key = next((k for k in _RATE_VARIABLES if k in public), None)
-    if time_key is not None:
-        rate, start = rate_from_times(_numeric_vector(public[time_key]),
-                                      what=f"{where}: variable {time_key!r}")
+    notes: list[str] = []
+    if time_key is not None and sample_rate_hz is not None:
+        rate, start = float(sample_rate_hz), float(_numeric_vector(public[time_key])[0])
         n = _numeric_vector(public[time_key]).size
+        notes.append(f"{where}: time vector {time_key!r} ignored: the sample rate "
+                     f"{rate:g} Hz was given (--sample-rate)")
+    elif time_key is not None:
+        rate, start, note = rate_from_times(_numeric_vector(public[time_key]),
+                                            what=f"{where}: variable {time_key!r}",
+                                            with_note=True)
+        n = _numeric_vector(public[time_key]).size
+        notes += [note] if note else []
     elif rate_key is not None or sample_rate_hz is not None:
         rate = (_scalar(public[rate_key], f"{where}: {rate_key}") if rate_key is not None
                 else float(sample_rate_hz))
@@ -211,8 +289,9 @@ def _simple_layout(variables: Mapping, where: str,
         raise InputFileError(f"{where}: no time vector ('time' or 't') and no sample rate "
                              "('fs' or 'sample_rate_hz'); give the sample rate (--sample-rate)")
     if sample_rate_hz is not None and abs(rate - sample_rate_hz) > 1e-6 * rate:
-        raise ParameterError(f"{where}: the file gives {rate:.9g} Hz but "
-                             f"sample_rate_hz={sample_rate_hz:.9g} was given")
+        notes.append(f"{where}: the file's sample rate {rate:.9g} Hz overridden by "
+                     f"{sample_rate_hz:.9g} Hz (--sample-rate)")
+        rate = float(sample_rate_hz)
     skip = {time_key, rate_key, "units"}
     vectors = {k: _numeric_vector(v) for k, v in public.items() if k not in skip}
     vectors = {k: v for k, v in vectors.items() if v is not None and (n is None or v.size == n)}
@@ -224,7 +303,7 @@ def _simple_layout(variables: Mapping, where: str,
         units = {k: (unit_list[i] if i < len(unit_list) else "")
                  for i, k in enumerate(vectors)}
     return [make_channel(k, v, sample_rate_hz=rate, unit=units[k], start_time_s=start)
-            for k, v in vectors.items()]
+            for k, v in vectors.items()], notes
 
 
 def read_mat(path: str | os.PathLike[str], *, sample_rate_hz: float | None = None) -> Measurement:
@@ -237,6 +316,7 @@ def read_mat(path: str | os.PathLike[str], *, sample_rate_hz: float | None = Non
     """
     where = str(path)
     variables = _load(where)
+    notes: list[str] = []
     if _text(variables.get("pidcore_layout")) == "measurement":
         channels = _pidcore_layout(variables, where)
         layout = "pidcore"
@@ -244,7 +324,7 @@ def read_mat(path: str | os.PathLike[str], *, sample_rate_hz: float | None = Non
         channels = _lms_layout(variables["Signal"], where)
         layout = "lms_testlab"
     else:
-        channels = _simple_layout(variables, where, sample_rate_hz)
+        channels, notes = _simple_layout(variables, where, sample_rate_hz)
         layout = "simple"
     if not channels:
         names = ", ".join(k for k in variables if not k.startswith("__")) or "none"
@@ -254,8 +334,11 @@ def read_mat(path: str | os.PathLike[str], *, sample_rate_hz: float | None = Non
     channels = [c if c.name == nm else Channel(nm, c.quantity, c.data, c.sample_rate_hz,
                                                c.source_unit, c.start_time_s)
                 for c, nm in zip(channels, names, strict=True)]
+    metadata: dict = {"mat_layout": layout}
+    if notes:
+        metadata["reader_notes"] = notes
     return Measurement(source=where, channels=tuple(channels), sha256=file_sha256(path),
-                       file_format="mat", metadata={"mat_layout": layout})
+                       file_format="mat", metadata=metadata)
 
 
 def write_mat(measurement: Measurement, path: str | os.PathLike[str]) -> None:

@@ -11,10 +11,15 @@ Rules, in order, for each role not named by the user:
 
 Explicit names (``force=``, ``velocity=``, ``acceleration=``) override detection. A named
 channel must exist (else the error lists the channels) and must be of the role's quantity or
-of quantity ``"unknown"`` (taken as SI, e.g. a voltage-less export without units); a channel
-of another known quantity (``--force`` naming an acceleration channel) is refused.
+of quantity ``"unknown"`` (the analysis then asks for its unit); a channel of another known
+quantity (``--force`` naming an acceleration channel) is refused.
 
-A force channel and at least one of velocity or acceleration are required.
+A force channel and at least one of velocity or acceleration are required. An acceleration
+channel is only looked for when it is needed: as the motion when there is no velocity, or for
+mass cancellation (``mass_cancellation=True``), where it must be the acceleration *at the drive
+point*: with several acceleration channels, or one named like a reference or shaker
+accelerometer (``"Ref"``, ``"Shaker"``, ``"Table"``, ...), it must be named. Channels no role
+uses are listed in :attr:`RoleAssignment.ignored`.
 """
 
 from __future__ import annotations
@@ -38,6 +43,19 @@ _NAME_PREFIXES = {
     "acceleration": ("accel", "acc", "beschl"),
 }
 _OPTIONS = {"force": "--force", "velocity": "--velocity", "acceleration": "--acceleration"}
+#: Name tokens of accelerometers that are not at the drive point.
+_REFERENCE_TOKENS = {"ref", "reference", "shaker", "table", "armature", "base", "control",
+                     "ctrl", "fixture", "slip", "head", "kopf", "referenz"}
+
+
+def is_reference_name(name: str) -> bool:
+    """Whether a channel name says a reference/shaker accelerometer (``"Ref acc"``).
+
+    >>> is_reference_name("Shaker table acc"), is_reference_name("Acc drive point")
+    (True, False)
+    """
+    tokens = re.findall(r"[a-zäöüß]+", name.lower())
+    return any(t in _REFERENCE_TOKENS or t.startswith("ref") for t in tokens)
 
 
 @dataclass(frozen=True)
@@ -52,11 +70,14 @@ class RoleAssignment:
         Drive-point velocity, m/s.
     acceleration : Channel or None
         Drive-point acceleration, m/s^2.
+    ignored : tuple of str
+        Names of the channels no role uses.
     """
 
     force: Channel
     velocity: Channel | None
     acceleration: Channel | None
+    ignored: tuple[str, ...] = ()
 
 
 def name_suggests(name: str, role: str) -> bool:
@@ -73,6 +94,29 @@ def name_suggests(name: str, role: str) -> bool:
 
 def _names(channels: list[Channel]) -> str:
     return ", ".join(repr(c.name) for c in channels) or "none"
+
+
+def _candidates(measurement: Measurement, role: str, taken: set[str]) -> list[Channel]:
+    free = [c for c in measurement.channels if c.name not in taken]
+    by_quantity = [c for c in free if c.quantity == role]
+    if by_quantity:
+        return by_quantity
+    return [c for c in free if c.quantity == "unknown" and name_suggests(c.name, role)]
+
+
+def _drive_point_acceleration(measurement: Measurement, taken: set[str],
+                              why: str) -> Channel | None:
+    found = _candidates(measurement, "acceleration", taken)
+    if len(found) > 1:
+        raise ChannelError(f"{measurement.source}: {len(found)} acceleration channels "
+                           f"({_names(found)}); {why} needs the acceleration at the drive point:"
+                           " choose it with --acceleration NAME")
+    if found and is_reference_name(found[0].name):
+        raise ChannelError(f"{measurement.source}: the only acceleration channel "
+                           f"{found[0].name!r} is named like a reference/shaker accelerometer; "
+                           f"{why} needs the acceleration at the drive point: confirm it with "
+                           f"--acceleration {found[0].name!r} or remove the option")
+    return found[0] if found else None
 
 
 def _detect(measurement: Measurement, role: str, taken: set[str]) -> Channel | None:
@@ -105,8 +149,8 @@ def _named(measurement: Measurement, role: str, name: str) -> Channel:
 
 
 def assign_roles(measurement: Measurement, *, force: str | None = None,
-                 velocity: str | None = None, acceleration: str | None = None
-                 ) -> RoleAssignment:
+                 velocity: str | None = None, acceleration: str | None = None,
+                 mass_cancellation: bool = False) -> RoleAssignment:
     """Find the force, velocity and acceleration channels of ``measurement``.
 
     Parameters
@@ -114,6 +158,9 @@ def assign_roles(measurement: Measurement, *, force: str | None = None,
     measurement : Measurement
     force, velocity, acceleration : str, optional
         Channel names that override detection.
+    mass_cancellation : bool
+        The drive-point acceleration is needed (``--mass-below-gauge``): it is looked for
+        although there is a velocity channel, and must be unambiguous.
 
     Returns
     -------
@@ -147,7 +194,19 @@ def assign_roles(measurement: Measurement, *, force: str | None = None,
                            f"({', '.join(repeated)})")
     for role in ("force", "velocity", "acceleration"):
         if role not in chosen:
-            chosen[role] = _detect(measurement, role, taken)
+            if role == "acceleration" and chosen["velocity"] is not None:
+                # not needed as the motion: only for mass cancellation, at the drive point
+                chosen[role] = (_drive_point_acceleration(measurement, taken,
+                                                          "--mass-below-gauge")
+                                if mass_cancellation else None)
+            else:
+                chosen[role] = _detect(measurement, role, taken)
+                if role == "acceleration" and chosen[role] is not None and \
+                        is_reference_name(chosen[role].name):
+                    raise ChannelError(
+                        f"{measurement.source}: no velocity channel and the acceleration "
+                        f"channel {chosen[role].name!r} is named like a reference/shaker "
+                        f"accelerometer; confirm it with --acceleration {chosen[role].name!r}")
             if chosen[role] is not None:
                 taken.add(chosen[role].name)
         if role == "force" and chosen["force"] is None:
@@ -159,5 +218,8 @@ def assign_roles(measurement: Measurement, *, force: str | None = None,
         raise ChannelError(f"{measurement.source}: no velocity or acceleration channel among "
                            f"{_names(list(measurement.channels))}; name one with --velocity NAME "
                            "or --acceleration NAME")
+    used = {c.name for c in chosen.values() if c is not None}
     return RoleAssignment(force=chosen["force"], velocity=chosen["velocity"],
-                          acceleration=chosen["acceleration"])
+                          acceleration=chosen["acceleration"],
+                          ignored=tuple(c.name for c in measurement.channels
+                                        if c.name not in used))

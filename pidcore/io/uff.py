@@ -7,8 +7,12 @@ Reading and writing go through :mod:`pyuff`. What this module adds on top:
   refused with a message listing what the file holds.
 * One file is one :class:`~pidcore.records.Measurement`; its time records are the channels, in
   file order. Records of different sample rates are kept; the analysis refuses them.
-* Channel name: the response entity name (``"1+Z"``, ``"Mic 01"``), else ID line 1, else
-  node and direction (``"12+Z"``), else ``"record <k>"``. Repeated names get ``" (2)"``, ...
+* Channel name: the response entity name (``"1+Z"``, ``"Mic 01"``); where the entity names do
+  not tell the records apart (``"pt"`` on every record) and the ID lines 1 do, ID line 1;
+  else ID line 1, node and direction (``"12+Z"``), ``"record <k>"``. Repeated names get
+  ``" (2)"``, ...
+* Direction: a record measured in a negative direction (record 6 ``-Z`` etc.) is negated, so
+  that every channel follows the +axis convention (noted in ``reader_notes``).
 * Units: the ordinate units label when :mod:`pidcore.units` recognises it (``"m/s2"``, ``"g"``,
   ``"N"``, ``"Pa"``); otherwise the specific data type code (8, 9, 11, 12, 13, 15) with the
   dataset 164 unit factors of the file (SI when the file has no dataset 164); otherwise the
@@ -26,6 +30,7 @@ from __future__ import annotations
 import datetime as _dt
 import os
 import re
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -39,6 +44,7 @@ from ._common import (
     file_sha256,
     interpret_unit,
     rate_from_times,
+    reraise_interrupt,
     snap_rate,
     unique_names,
 )
@@ -87,6 +93,22 @@ def _channel_name(dset: dict, index: int) -> str:
     if node:
         return f"{node}{_DIRECTIONS.get(int(dset.get('rsp_dir', 0) or 0), '')}"
     return f"record {index + 1}"
+
+
+def _described_names(records: list[dict]) -> list[str] | None:
+    """Names from ID line 1 when the entity names do not tell the records apart.
+
+    Test.Lab and other tools write a bare point name (``"pt"``) as the response entity of
+    every record and the channel's description in ID line 1 (``"Point1:+Z Force"``); a name
+    shown to the user must be that description, not ``"pt (2)"``.
+    """
+    entities = [_label(d.get("rsp_ent_name")) for d in records]
+    if all(entities) and len(set(entities)) == len(entities):
+        return None
+    ids = [_label(d.get("id1")) for d in records]
+    if all(ids) and len(set(ids)) == len(ids):
+        return ids
+    return None
 
 
 def _ordinate_unit(dset: dict, unit_factors: tuple[float, float]) -> tuple[str, float, str]:
@@ -210,11 +232,13 @@ def read_uff(path: str | os.PathLike[str]) -> Measurement:
         uff = pyuff.UFF(where)
         set_types = [int(t) for t in uff.get_set_types()]
     except Exception as exc:  # pyuff raises bare Exception for every failure
+        reraise_interrupt(exc)
         raise InputFileError(f"{where}: cannot parse as UFF ({exc})") from None
     if not set_types:
         raise InputFileError(f"{where}: no UFF dataset found (expected blocks that start and "
                              "end with a '    -1' line)")
     unit_factors = (1.0, 1.0)
+    has_units_dataset = 164 in set_types
     records: list[dict] = []
     fallback: list[dict] | None = None
     n58 = 0
@@ -224,6 +248,7 @@ def read_uff(path: str | os.PathLike[str]) -> Measurement:
         try:
             dset = uff.read_sets(i)
         except Exception as exc:
+            reraise_interrupt(exc)
             if set_type != 58 or _BINARY_58.search(raw):
                 raise InputFileError(f"{where}: dataset {set_type} (block {i + 1}) is corrupt "
                                      f"({exc})") from None
@@ -242,11 +267,32 @@ def read_uff(path: str | os.PathLike[str]) -> Measurement:
         raise InputFileError(f"{where}: holds {what} but no UFF58 time record "
                              "(function type 1); expected time histories")
     channels = [_record_channel(d, k, where, unit_factors) for k, d in enumerate(time_records)]
+    notes: list[str] = []
+    for k, c in enumerate(channels):
+        if c.source_unit.startswith("UFF data type"):
+            basis = ("the file's dataset 164 unit factors" if has_units_dataset
+                     else "SI (no dataset 164 in the file)")
+            notes.append(f"{where}: record {k + 1} ({c.name!r}) has no unit label; unit from "
+                         f"its {c.source_unit} ({c.quantity}) in {basis}")
+    described = _described_names(time_records)
+    if described is not None:
+        channels = [replace(c, name=n) for c, n in zip(channels, described, strict=True)]
+    for k, (c, d) in enumerate(zip(channels, time_records, strict=True)):
+        direction = int(d.get("rsp_dir", 0) or 0)
+        if direction < 0:
+            # the record holds the component along -X/-Y/-Z: in the +axis convention of the
+            # other channels its sign is the opposite
+            channels[k] = replace(c, data=-c.data)
+            notes.append(f"{where}: record {k + 1} ({c.name!r}) is measured in direction "
+                         f"{_DIRECTIONS.get(direction, direction)}: sign applied (values "
+                         f"negated to {_DIRECTIONS.get(-direction, -direction)})")
     names = unique_names([c.name for c in channels])
     channels = [c if c.name == n else Channel(n, c.quantity, c.data, c.sample_rate_hz,
                                               c.source_unit, c.start_time_s)
                 for c, n in zip(channels, names, strict=True)]
-    metadata: dict[str, str | float | int] = {"uff_time_records": len(channels)}
+    metadata: dict = {"uff_time_records": len(channels)}
+    if notes:
+        metadata["reader_notes"] = notes
     date = _label(time_records[0].get("id3"))
     if date:
         metadata["uff_id3"] = date
@@ -319,4 +365,5 @@ def write_uff(measurement: Measurement, path: str | os.PathLike[str], *,
         try:
             pyuff.UFF(str(tmp)).write_sets(sets, mode="add", force_double=True)
         except Exception as exc:  # pyuff raises bare Exception
+            reraise_interrupt(exc)
             raise ParameterError(f"{path}: cannot write UFF ({exc})") from None

@@ -9,13 +9,13 @@
 * Figures: :mod:`.figures` (model families, paper Figs. 8-14) and :mod:`.comparison_figures`.
 """
 
-from .pipeline import MeasuredResult, ReportResult, analyse_files, make_report, open_verified_store
+from .pipeline import MeasuredResult, ReportResult, analyze_files, make_report, open_verified_store
 from .provenance import Provenance, collect_provenance, sha256_file
 from .render import RENDERERS, REPORT_MARKER, parse_formats, write_report
 from .table import ALIGNMENT_COLUMN, REPORT_COLUMNS, build_report_table
 
 __all__ = [
     "ALIGNMENT_COLUMN", "RENDERERS", "REPORT_COLUMNS", "REPORT_MARKER", "MeasuredResult",
-    "Provenance", "ReportResult", "analyse_files", "build_report_table", "collect_provenance",
+    "Provenance", "ReportResult", "analyze_files", "build_report_table", "collect_provenance",
     "make_report", "open_verified_store", "parse_formats", "sha256_file", "write_report",
 ]

@@ -2,7 +2,7 @@
 corrections each file was analysed with.
 
 Drawn with matplotlib from the same frames the app's charts draw
-(:func:`pidcore.compare.case.sdc_points`, :func:`pidcore.signal.loops.loop_frame`).
+(:func:`pidcore.compare.case.sdc_points`, :func:`pidcore.app.workbench.loop_frame`).
 """
 
 from __future__ import annotations
@@ -32,7 +32,7 @@ def plot_sdc_points(points: pd.DataFrame, ax) -> None:
 
 
 def plot_loops(loops: pd.DataFrame, ax) -> None:
-    """Force-displacement loops of a :func:`pidcore.signal.loops.loop_frame`, in µm and N."""
+    """Force-displacement loops of a :func:`pidcore.app.workbench.loop_frame`, in µm and N."""
     for series, group in loops.groupby("series", sort=False):
         ax.plot(group["displacement [m]"].to_numpy(float) * 1e6,
                 group["force [N]"].to_numpy(float), label=series)

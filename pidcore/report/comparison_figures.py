@@ -4,18 +4,30 @@
   standard error, the paper's DEM and experimental values.
 * :func:`plot_loop_overlay` - force-displacement loop of a measurement over the DEM's loop at
   the same load case.
-
-Loops come as data from :mod:`pidcore.signal.loops` (the app's charts draw the same data).
+* :func:`dem_loop_from_arrays` - the DEM loop from a stored run's decimated time series.
 
 The model families (paper Figs. 8-14) are in :mod:`pidcore.report.figures`.
 """
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 import numpy as np
 import pandas as pd
 
+from .. import defaults
+from ..loop import ForceDisplacementLoop
 from .table import ALIGNMENT_COLUMN
+
+#: Force arrays looked for in a DEM run, in order: the force a shaker's gauge would measure
+#: (coupon inertia + particles, :class:`pidcore.dem.result.DemResult`), comparable with a
+#: measured force; then the particles' force on the walls alone.
+DEM_FORCE_ARRAYS: tuple[str, ...] = ("shaker_force_n", "wall_force_n")
+#: Coupon velocity arrays looked for in a DEM run.
+DEM_VELOCITY_ARRAYS: tuple[str, ...] = ("velocity_m_s",)
+#: Time arrays (sample instants) looked for in a DEM run.
+DEM_TIME_ARRAYS: tuple[str, ...] = ("sample_time_s",)
 
 
 def _new_figure(width: float, height: float):
@@ -74,15 +86,89 @@ def plot_sdc_comparison(table: pd.DataFrame, *, ax=None):
     return fig
 
 
-def loop_arrays(loop: object) -> tuple[np.ndarray, np.ndarray]:
-    """(displacement m, force N) from a ``(displacement, force)`` tuple (as
-    :meth:`PowerAnalysis.force_displacement_loop` returns) or a
-    :class:`pidcore.signal.loops.LoopCurve`.
+def _first(arrays: Mapping[str, np.ndarray], names: tuple[str, ...]) -> np.ndarray | None:
+    for name in names:
+        if name in arrays:
+            return np.asarray(arrays[name], dtype=float)
+    return None
+
+
+def dem_loop_from_arrays(arrays: Mapping[str, np.ndarray],
+                         record: Mapping[str, object] | None = None,
+                         ) -> ForceDisplacementLoop | str:
+    """One period of a DEM run's force-displacement loop, or a note why there is none.
+
+    The stored virtual shaker record (force :data:`DEM_FORCE_ARRAYS`, coupon velocity
+    :data:`DEM_VELOCITY_ARRAYS`) from the steady state on (``steady_start_cycle`` of the record)
+    is analysed like a measurement (:func:`pidcore.signal.analyze_power`) and the loop
+    synthesised from its harmonics, so measured and DEM loops are drawn the same way.
+
+    Parameters
+    ----------
+    arrays : mapping
+        The run's arrays (:attr:`pidcore.store.StoredEntry.arrays`).
+    record : mapping, optional
+        The run's scalars: ``frequency_hz``, ``sample_rate_hz`` (else from the time array),
+        ``steady_start_cycle`` (default 0).
+
+    Returns
+    -------
+    ForceDisplacementLoop or str
     """
+    from ..errors import PidcoreError
+    from ..signal import analyze_power
+
+    record = record or {}
+    force = _first(arrays, DEM_FORCE_ARRAYS)
+    velocity = _first(arrays, DEM_VELOCITY_ARRAYS)
+    if force is None or velocity is None:
+        return (f"DEM run keeps no force ({', '.join(DEM_FORCE_ARRAYS)}) or velocity "
+                f"({', '.join(DEM_VELOCITY_ARRAYS)}) time series")
+    if force.shape != velocity.shape or force.ndim != 1:
+        return "DEM run's force and velocity arrays differ in shape"
+    rate = record.get("sample_rate_hz")
+    time = _first(arrays, DEM_TIME_ARRAYS)
+    if not isinstance(rate, int | float) and time is not None and time.size > 1:
+        rate = 1.0 / float(np.mean(np.diff(time)))
+    freq = record.get("frequency_hz")
+    if not isinstance(rate, int | float) or not isinstance(freq, int | float):
+        return "DEM run lacks sample_rate_hz or frequency_hz"
+    start_cycle = record.get("steady_start_cycle") or 0
+    start = int(round(float(start_cycle) * float(rate) / float(freq)))
+    try:
+        analysis = analyze_power(force[start:], velocity[start:], float(rate),
+                                 frequency_hz=float(freq), source="DEM run")
+    except PidcoreError as exc:
+        return f"DEM time series cannot be analysed ({exc})"
+    return analysis.loop()
+
+
+def loop_from_phasors(arrays: Mapping[str, np.ndarray], frequency_hz: object, *,
+                      n_points: int = defaults.LOOP_POINTS) -> ForceDisplacementLoop | str:
+    """One period of a stored analysis' force-displacement loop, or a note why there is none.
+
+    Reads the stored harmonic phasors (``harmonics``, ``force_phasors_n``,
+    ``velocity_phasors_m_s``, as :func:`pidcore.measure.analysis_arrays` stores them) into
+    :meth:`pidcore.loop.ForceDisplacementLoop.from_phasors`, the synthesis behind
+    :meth:`pidcore.signal.PowerAnalysis.loop`.
+    """
+    needed = ("harmonics", "force_phasors_n", "velocity_phasors_m_s")
+    if any(name not in arrays for name in needed):
+        return f"stored analysis keeps no harmonic phasors ({', '.join(needed)})"
+    if not isinstance(frequency_hz, int | float) or not frequency_hz > 0:
+        return "stored analysis has no drive frequency"
+    return ForceDisplacementLoop.from_phasors(
+        arrays["harmonics"], arrays["force_phasors_n"], arrays["velocity_phasors_m_s"],
+        float(frequency_hz), n_points=n_points)
+
+
+def loop_arrays(loop: ForceDisplacementLoop | tuple) -> tuple[np.ndarray, np.ndarray]:
+    """(displacement m, force N) from a :class:`~pidcore.loop.ForceDisplacementLoop` or a
+    ``(displacement, force)`` 2-tuple."""
+    if isinstance(loop, ForceDisplacementLoop):
+        return loop.displacement_m, loop.force_n
     if isinstance(loop, tuple) and len(loop) == 2:
         return np.asarray(loop[0], dtype=float), np.asarray(loop[1], dtype=float)
-    if hasattr(loop, "displacement_m") and hasattr(loop, "force_n"):
-        return (np.asarray(loop.displacement_m, dtype=float), np.asarray(loop.force_n, dtype=float))
     raise TypeError(f"cannot read a force-displacement loop from {type(loop).__name__}")
 
 
@@ -91,17 +177,17 @@ def _closed(x: np.ndarray, f: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.append(x, x[:1]), np.append(f, f[:1])
 
 
-def plot_loop_overlay(measured: object, dem: tuple[np.ndarray, np.ndarray] | None, *,
+def plot_loop_overlay(measured: ForceDisplacementLoop | tuple,
+                      dem: ForceDisplacementLoop | tuple | None, *,
                       title: str = "", ax=None):
     """Force-displacement loop of a measurement, with the DEM's at the same load case.
 
     Parameters
     ----------
-    measured : loop or (displacement m, force N)
+    measured : ForceDisplacementLoop or (displacement m, force N)
         The measured loop (see :func:`loop_arrays`).
-    dem : (displacement m, force N) or None
-        The DEM loop (:func:`pidcore.signal.loops.dem_loop_from_arrays`), or None to draw
-        the measurement alone.
+    dem : ForceDisplacementLoop or (displacement m, force N) or None
+        The DEM loop (:func:`dem_loop_from_arrays`), or None to draw the measurement alone.
     title : str
     ax : matplotlib Axes, optional
 

@@ -32,6 +32,7 @@ from .render import check_out_dir, parse_formats, write_report
 from .table import build_report_table
 
 if TYPE_CHECKING:  # pragma: no cover
+    from ..loop import ForceDisplacementLoop
     from ..measure import AnalysisOptions, AnalyzedRecord
 
 # pidcore.measure (readers, signal analysis) is imported where used: `import pidcore.report`
@@ -125,11 +126,11 @@ def open_verified_store(path: str | Path, *, must_exist: bool):
     return store
 
 
-def analyse_files(paths: Sequence[str | Path], *, fill_percent: float | None = None,
+def analyze_files(paths: Sequence[str | Path], *, fill_percent: float | None = None,
                   material: str | None = None, direction: str | None = None,
                   sidecar: str | Path | None = None,
                   options: AnalysisOptions | None = None) -> list[MeasuredResult]:
-    """Read, assign roles, analyse (Eq. 11) and attach the load case of every file.
+    """Read, assign roles, analyze (Eq. 11) and attach the load case of every file.
 
     The load case is resolved first for every file, so a missing fill is reported before any
     (slow) analysis runs. Files with identical contents are one measurement: kept once, and
@@ -189,13 +190,13 @@ def _store_results(store, results: list[MeasuredResult], options: AnalysisOption
 
 
 def _measured_loops(results: list[MeasuredResult], analyses: pd.DataFrame, store,
-                    notes: list[str]) -> list[tuple[str, LoadCase, tuple]]:
+                    notes: list[str]) -> list[tuple[str, LoadCase, ForceDisplacementLoop]]:
     """(name, load case, loop) per measurement: from the fresh analyses, else from the store's
     harmonic phasors (store-only reports)."""
-    from ..signal.loops import loop_from_phasors
+    from .comparison_figures import loop_from_phasors
 
     if results:
-        return [(r.path.name, r.load_case, r.analysis.force_displacement_loop())
+        return [(r.path.name, r.load_case, r.analysis.loop())
                 for r in results]
     loops = []
     if store is None or analyses.empty or "key" not in analyses.columns:
@@ -215,10 +216,9 @@ def _measured_loops(results: list[MeasuredResult], analyses: pd.DataFrame, store
 
 
 def _figures(table: pd.DataFrame, dem_runs: pd.DataFrame | None, aligner: Aligner,
-             loops: list[tuple[str, LoadCase, tuple]], dem_store,
+             loops: list[tuple[str, LoadCase, ForceDisplacementLoop]], dem_store,
              notes: list[str]) -> dict[str, object]:
-    from ..signal.loops import dem_loop_from_arrays
-    from .comparison_figures import plot_loop_overlay, plot_sdc_comparison
+    from .comparison_figures import dem_loop_from_arrays, plot_loop_overlay, plot_sdc_comparison
 
     figures: dict[str, object] = {}
     if not table.empty:
@@ -260,7 +260,8 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
                 fill_percent: float | None = None, material: str | None = None,
                 direction: str | None = None, sidecar: str | Path | None = None,
                 options: AnalysisOptions | None = None,
-                tolerances: Tolerances | None = None, pool: bool = False) -> ReportResult:
+                tolerances: Tolerances | None = None, specimen=None,
+                pool: bool = False) -> ReportResult:
     """Analyse files, store them, align with DEM and the paper, and write the report.
 
     Parameters
@@ -283,6 +284,9 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         cancellation, baseline, sample rate for CSV without time column).
     tolerances : Tolerances, optional
         Grid-match tolerances.
+    specimen : pidcore.specimen.Specimen, optional
+        Only DEM runs of this specimen are compared (default: the paper's coupon); the
+        paper's Table 3 only when it is the paper's coupon.
     pool : bool
         Pool DEM runs of different settings and measurements of different specimens at one
         load case (default: separate rows; see :func:`pidcore.report.build_report_table`).
@@ -311,7 +315,7 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
 
     options = options or AnalysisOptions()
     parameters = options.parameters()
-    results = analyse_files(files, fill_percent=fill_percent, material=material,
+    results = analyze_files(files, fill_percent=fill_percent, material=material,
                             direction=direction, sidecar=sidecar,
                             options=options) if files else []
     notes: list[str] = [f"{r.path.name}: load case {r.load_case.key} ({r.stated.origin})"
@@ -337,10 +341,21 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         analyses = measured_frame(results)
 
     dem_runs = dem.list_dem_runs() if dem is not None else None
+    if dem_runs is not None and not dem_runs.empty:
+        from ..dem.persist import runs_of_specimen
+
+        dem_runs = runs_of_specimen(dem_runs, specimen)
+        if dem_runs.empty:
+            notes.append(f"{dem_path}: holds no DEM runs of specimen "
+                         f"{specimen.name if specimen is not None else 'paper_coupon'}")
     if dem_runs is not None and dem_runs.empty:
         notes.append(f"{dem_path}: holds no DEM runs")
         dem_runs = None
     paper = load_paper_table3()
+    if specimen is not None and not specimen.is_paper():
+        paper = None
+        notes.append(f"specimen {specimen.name} is not the paper's coupon: the paper's "
+                     "Table 3 is not compared")
     table = build_report_table(dem_runs, analyses, paper, tolerances=tolerances, pool=pool)
     notes.extend(table.attrs.get("notes", []))
     aligner = Aligner(dem_cases(dem_runs, tolerances=tolerances, pool_settings=pool)

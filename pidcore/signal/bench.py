@@ -81,3 +81,57 @@ def run_signal_bench(n_samples: int = 10_000_000, *, repeat: int = 3) -> dict:
         "frequency_hz": result.frequency_hz,
         "loss_factor": result.loss_factor,
     }
+
+
+_CSV_READ_SCRIPT = """
+import json, sys, time
+import numpy, pandas, pidcore.io
+def hwm():  # VmHWM belongs to this process image (ru_maxrss survives exec from the parent)
+    for line in open("/proc/self/status"):
+        if line.startswith("VmHWM:"):
+            return int(line.split()[1]) * 1024
+base = hwm()
+t0 = time.perf_counter()
+m = pidcore.io.read_measurement(sys.argv[1])
+wall = time.perf_counter() - t0
+peak = hwm()
+print(json.dumps({"wall_s": wall, "rss_growth_bytes": peak - base,
+                  "n_samples": m.channels[0].n_samples}))
+"""
+
+
+def run_csv_read_bench(n_samples: int = 5_000_000, *, directory: str | None = None) -> dict:
+    """Peak memory of reading a ``Time [s],Force [N],Velocity [m/s]`` CSV export of
+    ``n_samples`` rows (9 significant digits), in a fresh process (resident set growth after
+    the imports, so that the C parser's buffers count too).
+
+    Target (issue 9): ``rss_ratio`` = growth / file size <= 3.
+    """
+    import json
+    import subprocess
+    import sys
+    import tempfile
+    from pathlib import Path
+
+    import numpy as np
+
+    fs = 51_200.0
+    rec = synthesize_shaker_record(mass_kg=0.25, acceleration_amplitude_m_s2=30.0,
+                                   frequency_hz=100.0, sample_rate_hz=fs,
+                                   n_periods=n_samples * 100.0 / fs, viscous_damping_n_s_m=2.0,
+                                   snr_db=60.0, seed=1)
+    with tempfile.TemporaryDirectory(dir=directory) as tmp:
+        path = Path(tmp) / "export.csv"
+        table = np.column_stack([np.arange(rec.force_n.size) / fs, rec.force_n,
+                                 rec.velocity_m_s])
+        np.savetxt(path, table, delimiter=",", fmt="%.9g",
+                   header="Time [s],Force [N],Velocity [m/s]", comments="")
+        size = path.stat().st_size
+        root = str(Path(__file__).resolve().parents[2])
+        env = {**os.environ, "PYTHONPATH": root + os.pathsep + os.environ.get("PYTHONPATH", "")}
+        out = subprocess.run([sys.executable, "-c", _CSV_READ_SCRIPT, str(path)], env=env,
+                             capture_output=True, text=True, check=True).stdout
+    result = json.loads(out)
+    return {**result, "file_bytes": size, "rss_ratio": result["rss_growth_bytes"] / size,
+            "target_rss_ratio": TARGET_PEAK_MEMORY_RATIO,
+            "meets_memory_target": result["rss_growth_bytes"] / size <= TARGET_PEAK_MEMORY_RATIO}

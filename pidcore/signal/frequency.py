@@ -26,6 +26,10 @@ from .. import defaults
 from ..errors import SignalError
 from .harmonics import fit_harmonics
 
+#: With a hint, a line outside the search window whose power exceeds the best peak inside the
+#: window by more than 1/this factor (10 dB) means the hint is wrong.
+HINT_MIN_FRACTION_OF_LINE = 0.1
+
 
 def _coarse_spectrum(x: np.ndarray, sample_rate_hz: float,
                      max_samples: int) -> tuple[np.ndarray, float]:
@@ -79,7 +83,9 @@ def estimate_drive_frequency(x: np.ndarray, sample_rate_hz: float, *,
         Sample rate, Hz.
     frequency_hint_hz : float, optional
         Nominal frequency; the peak is searched within +-
-        :data:`~pidcore.defaults.FREQUENCY_SEARCH_RELATIVE_WIDTH` of it.
+        :data:`~pidcore.defaults.FREQUENCY_SEARCH_RELATIVE_WIDTH` of it. A dominant line
+        outside that window, or an estimate that ends outside it, raises :class:`SignalError`
+        saying where the line is: a wrong hint never moves the estimate silently.
     what : str
         Names the record and channel in error messages.
 
@@ -102,13 +108,31 @@ def estimate_drive_frequency(x: np.ndarray, sample_rate_hz: float, *,
     if x.shape[0] > max_samples and k < 8:
         power, bin_hz = _decimated_spectrum(x, sample_rate_hz, max_samples)
         f0, ratio, k = _peak(power, bin_hz, frequency_hint_hz, rel)
+    if frequency_hint_hz is not None and power.shape[0] > 4:
+        # A wrong hint must not pull the estimate onto the skirt of the real line: look at the
+        # whole spectrum, and refuse when the dominant line lies outside the search window.
+        k_all = 2 + int(np.argmax(power[2:-2]))
+        if power[k] < HINT_MIN_FRACTION_OF_LINE * power[k_all]:
+            f_all, ratio_all, _ = _peak(power, bin_hz, None, rel)
+            outside = abs(f_all - frequency_hint_hz) > rel * frequency_hint_hz + 3 * bin_hz
+            if outside and ratio_all >= defaults.DOMINANT_PEAK_MIN_POWER_RATIO:
+                raise SignalError(
+                    f"{what}: the drive line is at {f_all:.6g} Hz, outside +-{100 * rel:g} % of "
+                    f"the frequency hint {frequency_hint_hz:g} Hz; correct the hint "
+                    "(--frequency) or leave it out")
     if not np.isfinite(f0) or ratio < defaults.DOMINANT_PEAK_MIN_POWER_RATIO:
         near = f" near the hint {frequency_hint_hz:g} Hz" if frequency_hint_hz else ""
         raise SignalError(
             f"{what}: no dominant drive frequency{near}: the largest spectral peak is "
             f"{10 * np.log10(max(ratio, 1e-30)):.1f} dB above the median, expected >= "
             f"{10 * np.log10(defaults.DOMINANT_PEAK_MIN_POWER_RATIO):.0f} dB")
-    return refine_frequency(x, sample_rate_hz, f0)
+    f = refine_frequency(x, sample_rate_hz, f0)
+    if frequency_hint_hz is not None and \
+            abs(f - frequency_hint_hz) > rel * frequency_hint_hz + 3 * bin_hz:
+        raise SignalError(f"{what}: the drive frequency {f:.6g} Hz lies outside "
+                          f"+-{100 * rel:g} % of the frequency hint {frequency_hint_hz:g} Hz; "
+                          "correct the hint (--frequency) or leave it out")
+    return f
 
 
 def refine_frequency(x: np.ndarray, sample_rate_hz: float, frequency_hz: float, *,

@@ -1,5 +1,11 @@
 """Multi-harmonic least-squares fit at a known frequency (IEEE Std 1057 three-parameter fit,
-extended to H harmonics), without ever forming the N x (2H+1) design matrix.
+extended to H harmonics and a linear trend), without ever forming the N x (2H+2) design matrix.
+
+The model of every segment is ``x_i ~ dc + slope u_i + sum_n Re(X_n exp(j n theta i))`` with
+``u_i`` the centred, length-normalised sample index. The trend term takes up slow drift
+(charge-amplifier or vibrometer drift, a slowly moving table): without it a drift leaks into the
+phasors of a record that does not hold a whole number of periods and, worse, differs from block
+to block, so that the standard error underestimates the error.
 
 The normal equations ``G c = r`` of the fit are split in two parts:
 
@@ -29,13 +35,16 @@ _CHUNK = 2048
 def _project_segments(x, y, use_y, theta, n_harm, edges):  # pragma: no cover - numba
     """Projections of x (and y) on exp(-j n theta i), n = 0..n_harm, per segment of ``edges``.
 
-    Returns real and imaginary parts, shape (n_channels, n_segments, n_harm + 1).
-    ``reassoc`` lets LLVM vectorise the reductions; inputs are checked finite beforehand.
+    Returns real and imaginary parts, shape (n_channels, n_segments, n_harm + 1), and the
+    projections on the local sample index ``sum_k x_(a+k) k`` per segment (for the trend),
+    shape (n_channels, n_segments). ``reassoc`` lets LLVM vectorise the reductions; inputs are
+    checked finite beforehand.
     """
     n_seg = edges.shape[0] - 1
     n_ch = 2 if use_y else 1
     out_re = np.zeros((n_ch, n_seg, n_harm + 1))
     out_im = np.zeros((n_ch, n_seg, n_harm + 1))
+    out_t = np.zeros((n_ch, n_seg))
     wr = np.empty(_CHUNK)
     wi = np.empty(_CHUNK)
     pr = np.empty(_CHUNK)
@@ -58,14 +67,23 @@ def _project_segments(x, y, use_y, theta, n_harm, edges):  # pragma: no cover - 
                 cr, ci = cr * c1 - ci * s1, cr * s1 + ci * c1
             sx = 0.0
             sy = 0.0
+            tx = 0.0
+            ty = 0.0
+            k0 = i - a
             for k in range(n):
-                sx += x[i + k]
+                xv = x[i + k]
+                sx += xv
+                tx += xv * (k0 + k)
             if use_y:
                 for k in range(n):
-                    sy += y[i + k]
+                    yv = y[i + k]
+                    sy += yv
+                    ty += yv * (k0 + k)
             out_re[0, s, 0] += sx
+            out_t[0, s] += tx
             if use_y:
                 out_re[1, s, 0] += sy
+                out_t[1, s] += ty
             for k in range(n):
                 pr[k] = wr[k]
                 pi[k] = wi[k]
@@ -94,7 +112,7 @@ def _project_segments(x, y, use_y, theta, n_harm, edges):  # pragma: no cover - 
                         pi[k] = pr[k] * wi[k] + pi[k] * wr[k]
                         pr[k] = tr
             i = stop
-    return out_re, out_im
+    return out_re, out_im, out_t
 
 
 def _geometric_sums(theta: float, start: int, length: int, m_max: int) -> np.ndarray:
@@ -110,24 +128,48 @@ def _geometric_sums(theta: float, start: int, length: int, m_max: int) -> np.nda
     return za * out
 
 
+def _index_sums(theta: float, start: int, length: int, m_max: int) -> np.ndarray:
+    """``T(m) = sum_i u_i exp(j m theta i)`` over the segment, m = 1..m_max (closed form).
+
+    ``u_i = (i - start - (length - 1)/2) / length`` is the centred, normalised index of the
+    trend term. With ``z = exp(j m theta)``, ``sum_k k z^k = z (1 - z^L)/(1 - z)^2 -
+    L z^L/(1 - z)`` (k = 0..L-1); harmonics stay below 0.9 x Nyquist, so ``1 - z`` is never 0.
+    """
+    m = np.arange(1, m_max + 1)
+    z = np.exp(1j * np.mod(m * theta, 2 * np.pi))
+    zl = np.exp(1j * np.mod(m * theta * length, 2 * np.pi))
+    za = np.exp(1j * np.mod(m * theta * start, 2 * np.pi))
+    den = 1.0 - z
+    s0 = (1.0 - zl) / den
+    s1 = z * (1.0 - zl) / den**2 - length * zl / den
+    return za * (s1 - 0.5 * (length - 1) * s0) / length
+
+
 def _gram(theta: float, start: int, length: int, n_harm: int) -> np.ndarray:
-    """Gram matrix of the basis [1, cos(n theta i), sin(n theta i)] (n = 1..n_harm)."""
+    """Gram matrix of the basis [1, u, cos(n theta i), sin(n theta i)] (n = 1..n_harm)."""
     s = _geometric_sums(theta, start, length, 2 * n_harm)
+    tr = _index_sums(theta, start, length, n_harm)
 
     def sm(k: int) -> complex:  # S(-k) = conj(S(k))
         return s[k] if k >= 0 else np.conj(s[-k])
 
-    size = 2 * n_harm + 1
+    size = 2 * n_harm + 2
     g = np.empty((size, size))
     g[0, 0] = length
+    g[0, 1] = g[1, 0] = 0.0  # u is centred
+    g[1, 1] = (length * length - 1.0) / (12.0 * length)
     for p in range(1, n_harm + 1):
-        g[0, p] = g[p, 0] = s[p].real
-        g[0, n_harm + p] = g[n_harm + p, 0] = s[p].imag
+        cp, sp = p + 1, n_harm + p + 1
+        g[0, cp] = g[cp, 0] = s[p].real
+        g[0, sp] = g[sp, 0] = s[p].imag
+        g[1, cp] = g[cp, 1] = tr[p - 1].real
+        g[1, sp] = g[sp, 1] = tr[p - 1].imag
         for q in range(1, n_harm + 1):
-            g[p, q] = 0.5 * (sm(p - q).real + s[p + q].real)
-            g[n_harm + p, n_harm + q] = 0.5 * (sm(p - q).real - s[p + q].real)
+            cq, sq = q + 1, n_harm + q + 1
+            g[cp, cq] = 0.5 * (sm(p - q).real + s[p + q].real)
+            g[sp, sq] = 0.5 * (sm(p - q).real - s[p + q].real)
             cs = 0.5 * (s[q + p].imag + sm(q - p).imag)  # sum cos(p.) sin(q.)
-            g[p, n_harm + q] = g[n_harm + q, p] = cs
+            g[cp, sq] = g[sq, cp] = cs
     return g
 
 
@@ -145,18 +187,19 @@ class HarmonicFit:
     dc_total: np.ndarray
 
 
-def _solve(g: np.ndarray, re: np.ndarray, im: np.ndarray, n_harm: int) -> tuple[complex, ...]:
-    # sum x cos = Re P_n ; sum x sin = -Im P_n
-    rhs = np.concatenate(([re[0]], re[1:], -im[1:]))
+def _solve(g: np.ndarray, re: np.ndarray, im: np.ndarray, trend: float,
+           n_harm: int) -> tuple[float, np.ndarray]:
+    # sum x cos = Re P_n ; sum x sin = -Im P_n ; trend = sum x u
+    rhs = np.concatenate(([re[0], trend], re[1:], -im[1:]))
     c = np.linalg.solve(g, rhs)
-    a = c[1:n_harm + 1]
-    b = c[n_harm + 1:]
+    a = c[2:n_harm + 2]
+    b = c[n_harm + 2:]
     return c[0], a - 1j * b  # x = a cos - ... : Re(X e^{j.}) = Re X cos - Im X sin
 
 
 def fit_harmonics(x: np.ndarray, y: np.ndarray | None, theta: float, n_harm: int,
                   edges: np.ndarray) -> HarmonicFit:
-    """Least-squares fit of DC + ``n_harm`` harmonics of ``theta`` (rad/sample).
+    """Least-squares fit of DC, a linear trend and ``n_harm`` harmonics of ``theta`` (rad/sample).
 
     Parameters
     ----------
@@ -172,20 +215,28 @@ def fit_harmonics(x: np.ndarray, y: np.ndarray | None, theta: float, n_harm: int
     """
     edges = np.asarray(edges, dtype=np.int64)
     use_y = y is not None
-    re, im = _project_segments(x, y if use_y else x, use_y, float(theta), int(n_harm), edges)
+    re, im, tk = _project_segments(x, y if use_y else x, use_y, float(theta), int(n_harm),
+                                   edges)
     n_ch, n_seg = re.shape[0], re.shape[1]
+    lengths = np.diff(edges).astype(np.float64)
     phasors = np.zeros((n_ch, n_seg, n_harm), dtype=complex)
     for s in range(n_seg):
-        length = int(edges[s + 1] - edges[s])
-        if length < 2 * n_harm + 1:
+        length = int(lengths[s])
+        if length < 2 * n_harm + 2:
             phasors[:, s, :] = np.nan
             continue
         g = _gram(theta, int(edges[s]), length, n_harm)
         for c in range(n_ch):
-            phasors[c, s] = _solve(g, re[c, s], im[c, s], n_harm)[1]
-    g_all = _gram(theta, int(edges[0]), int(edges[-1] - edges[0]), n_harm)
+            # sum x u with u = (k - (L-1)/2)/L from sum x k and sum x
+            trend = (tk[c, s] - 0.5 * (length - 1) * re[c, s, 0]) / length
+            phasors[c, s] = _solve(g, re[c, s], im[c, s], trend, n_harm)[1]
+    total_length = int(edges[-1] - edges[0])
+    g_all = _gram(theta, int(edges[0]), total_length, n_harm)
     total = np.zeros((n_ch, n_harm), dtype=complex)
     dc = np.zeros(n_ch)
+    # index of each segment's first sample relative to the centre of the union
+    offsets = edges[:-1] - edges[0] - 0.5 * (total_length - 1)
     for c in range(n_ch):
-        dc[c], total[c] = _solve(g_all, re[c].sum(axis=0), im[c].sum(axis=0), n_harm)
+        trend = float(np.sum(tk[c] + offsets * re[c, :, 0])) / total_length
+        dc[c], total[c] = _solve(g_all, re[c].sum(axis=0), im[c].sum(axis=0), trend, n_harm)
     return HarmonicFit(phasors=phasors, total=total, dc_total=dc)

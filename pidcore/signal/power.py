@@ -46,10 +46,12 @@ from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
+import pandas as pd
 
 from .. import defaults
 from ..constants import STANDARD_GRAVITY
-from ..errors import ParameterError, SignalError
+from ..errors import ChannelError, ParameterError, SignalError
+from ..loop import ForceDisplacementLoop
 from ..records import Channel
 from . import validate
 from .frequency import estimate_drive_frequency
@@ -148,18 +150,44 @@ class PowerAnalysis:
         """Drive period, s."""
         return 1.0 / self.frequency_hz
 
-    def force_displacement_loop(self, n_points: int = 256) -> tuple[np.ndarray, np.ndarray]:
+    def loop(self, n_points: int = defaults.LOOP_POINTS, *,
+             label: str | None = None) -> ForceDisplacementLoop:
         """One period of the reconstructed force-displacement loop (harmonic synthesis).
 
-        Returns ``(displacement_m, force_n)`` at ``n_points`` equally spaced phases (the curve
-        is closed: the point after the last is the first). DC is left out. The loop's area,
-        ``oint f dx``, equals ``complex_power_w.real * period_s`` (the energy per cycle before
-        baseline subtraction).
+        ``n_points`` equally spaced phases; DC is left out. The loop's area
+        (``energy_per_cycle_j``) equals ``complex_power_w.real * period_s`` (the energy per
+        cycle before baseline subtraction). ``label`` defaults to :attr:`source`.
         """
-        phase = 2 * np.pi * np.arange(n_points) / n_points
-        rot = np.exp(1j * np.outer(self.harmonics, phase))
-        disp = self.velocity_phasors_m_s / (1j * self.harmonics * self.omega_rad_s)
-        return (np.real(disp @ rot), np.real(self.force_phasors_n @ rot))
+        return ForceDisplacementLoop.from_phasors(
+            self.harmonics, self.force_phasors_n, self.velocity_phasors_m_s, self.frequency_hz,
+            n_points=n_points, label=self.source if label is None else label)
+
+    def force_displacement_loop(self, n_points: int = defaults.LOOP_POINTS,
+                                ) -> tuple[np.ndarray, np.ndarray]:
+        """``(displacement_m, force_n)`` of :meth:`loop` (kept for callers of pidcore 0.1)."""
+        loop = self.loop(n_points)
+        return loop.displacement_m, loop.force_n
+
+    def spectrum_frame(self) -> pd.DataFrame:
+        """Fitted harmonics, one row each: order, frequency, amplitudes and phases (SI units).
+
+        Columns ``harmonic [-]``, ``frequency [Hz]``, ``force amplitude [N]``,
+        ``velocity amplitude [m/s]``, ``force phase [rad]``, ``velocity phase [rad]``
+        (``|F_n|`` and ``arg F_n`` of the one-sided phasors, after corrections).
+        """
+        n = np.asarray(self.harmonics, dtype=int)
+        f = np.asarray(self.force_phasors_n, dtype=complex)
+        v = np.asarray(self.velocity_phasors_m_s, dtype=complex)
+        frame = pd.DataFrame({
+            "harmonic [-]": n,
+            "frequency [Hz]": n.astype(float) * self.frequency_hz,
+            "force amplitude [N]": np.abs(f),
+            "velocity amplitude [m/s]": np.abs(v),
+            "force phase [rad]": np.angle(f),
+            "velocity phase [rad]": np.angle(v),
+        })
+        frame.attrs.update(source=self.source, frequency_hz=self.frequency_hz, sdc=self.sdc)
+        return frame
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-safe scalars (NaN -> None); includes the CLI keys."""
@@ -199,24 +227,11 @@ class PowerAnalysis:
         }
 
     def plot(self, ax: Any = None) -> Any:
-        """Harmonic spectrum: |F_n| (N, left axis) and |V_n| (m/s, right axis). Returns ``ax``."""
-        import matplotlib.pyplot as plt  # lazy: plotting is optional
+        """Harmonic spectrum (:func:`pidcore.report.figures_results.plot_spectrum`); returns ``ax``.
+        """
+        from ..report.figures_results import plot_spectrum  # lazy: drawing is optional
 
-        if ax is None:
-            _, ax = plt.subplots()
-        n = self.harmonics
-        ax.bar(n - 0.2, np.abs(self.force_phasors_n), width=0.4, color="C0", label="|F_n| [N]")
-        ax.set_xlabel("harmonic order n [-]")
-        ax.set_ylabel("force amplitude [N]")
-        ax.set_yscale("log")
-        ax2 = ax.twinx()
-        ax2.bar(n + 0.2, np.abs(self.velocity_phasors_m_s), width=0.4, color="C1",
-                label="|V_n| [m/s]")
-        ax2.set_ylabel("velocity amplitude [m/s]")
-        ax2.set_yscale("log")
-        ax.set_xticks(n)
-        ax.set_title(f"{self.source} {self.frequency_hz:.4g} Hz, sdc = {self.sdc:.4g}")
-        return ax
+        return plot_spectrum(self.spectrum_frame(), ax=ax)
 
 
 def _damping_ratio(sdc: float, loss_factor: float) -> tuple[float | None, str]:
@@ -404,8 +419,17 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
                                      None if a_fit is None else a_fit.total[0],
                                      harmonics, omega, **kw)
     p_c = complex(p_c)
+    if not p_c.imag > 0:
+        # There is no negative mass: a driven structure above its suspension resonance is
+        # mass-like, Im(P_c) > 0. A negative reactive power is almost always one channel with
+        # the wrong sign (sensor mounted the other way, a -Z direction not applied).
+        raise SignalError(
+            f"{source or 'record'}: reactive power Im(P_c) = {p_c.imag:.4g} var <= 0 (no "
+            "positive kinetic energy: a mass-like structure gives Im(P_c) > 0); "
+            f"one of the channels {force_name!r} / {motion_name!r} is probably inverted: check "
+            "the sensor directions, or pass --invert NAME for the inverted channel")
 
-    loss_raw = p_c.real / p_c.imag if p_c.imag > 0 else float("nan")
+    loss_raw = p_c.real / p_c.imag
     loss = loss_raw - baseline_loss_factor
     sdc = 2 * np.pi * loss
     lf_stderr = float("nan")
@@ -473,38 +497,92 @@ def analyze_channels(force: Channel, velocity: Channel | None, *,
     """:func:`analyze_power` on :class:`~pidcore.records.Channel` records, after validation.
 
     Checks, each a one-line :class:`~pidcore.errors.ChannelError` naming ``source`` and the
-    channel: quantity of each channel, NaN/inf samples, all-equal (zero) channels, clipping
-    (unless ``allow_clipped``), equal sample rates and lengths; then fewer than ``min_periods``
+    channel: quantity of each channel, NaN/inf samples, all-equal (zero) channels, equal sample
+    rates and lengths, clipping (unless ``allow_clipped``); then fewer than ``min_periods``
     periods or no dominant frequency raise :class:`~pidcore.errors.SignalError`.
+
+    Dropouts (runs of identical samples away from the extremes, :func:`validate.dropout_runs`)
+    are cut out: only the longest stretch free of them in every channel is analysed, and a note
+    says which samples were kept (``corrections["analysed_samples"]``).
     """
     if velocity is None and acceleration is None:
         raise ParameterError(f"{source}: neither a velocity nor an acceleration channel given; "
                              "expected at least one")
     roles = [("force", force), ("velocity", velocity), ("acceleration", acceleration)]
     present = [(role, ch) for role, ch in roles if ch is not None]
-    clipping_notes: list[str] = []
+    datas = []
     for role, ch in present:
         validate.check_quantity(ch.quantity, role, source=source, channel=ch.name)
         data = np.asarray(ch.data, dtype=np.float64)
         validate.check_length(data, source=source, channel=ch.name, min_samples=8)
         validate.check_finite(data, source=source, channel=ch.name)
         validate.check_not_constant(data, source=source, channel=ch.name, unit=ch.unit)
+        datas.append(data)
+    validate.check_same_sampling([ch.name for _, ch in present],
+                                 [ch.sample_rate_hz for _, ch in present],
+                                 [ch.n_samples for _, ch in present], source=source)
+    datas, dropout_notes, kept = _cut_dropouts([ch for _, ch in present], datas, source=source)
+    clipping_notes: list[str] = []
+    for (_, ch), data in zip(present, datas, strict=True):
         if not allow_clipped:
             validate.check_clipping(data, source=source, channel=ch.name, unit=ch.unit)
         else:  # analysed on request, but reported, never silently used
             clipping_notes.append(validate.clipping_description(
                 data, source=source, channel=ch.name, unit=ch.unit))
-    validate.check_same_sampling([ch.name for _, ch in present],
-                                 [ch.sample_rate_hz for _, ch in present],
-                                 [ch.n_samples for _, ch in present], source=source)
+    by_role = {role: data for (role, _), data in zip(present, datas, strict=True)}
     motion = velocity if velocity is not None else acceleration
     assert motion is not None
-    result = analyze_power(
-        force.data, None if velocity is None else velocity.data, force.sample_rate_hz,
-        acceleration=None if acceleration is None else acceleration.data,
-        frequency_hz=frequency_hz, n_harmonics=n_harmonics, velocity_delay_s=velocity_delay_s,
-        mass_below_gauge_kg=mass_below_gauge_kg, baseline_loss_factor=baseline_loss_factor,
-        n_blocks=n_blocks, min_periods=min_periods, source=source, force_name=force.name,
-        velocity_name=motion.name)
-    clipped = tuple(n for n in clipping_notes if n)
-    return replace(result, notes=result.notes + clipped) if clipped else result
+    try:
+        result = analyze_power(
+            by_role["force"], by_role.get("velocity"), force.sample_rate_hz,
+            acceleration=by_role.get("acceleration"),
+            frequency_hz=frequency_hz, n_harmonics=n_harmonics,
+            velocity_delay_s=velocity_delay_s,
+            mass_below_gauge_kg=mass_below_gauge_kg, baseline_loss_factor=baseline_loss_factor,
+            n_blocks=n_blocks, min_periods=min_periods, source=source, force_name=force.name,
+            velocity_name=motion.name)
+    except SignalError as exc:
+        if dropout_notes:
+            raise SignalError(f"{exc} (after cutting out dropouts: {dropout_notes[0]})") from None
+        raise
+    extra = tuple(n for n in clipping_notes if n) + tuple(dropout_notes)
+    if kept is not None:
+        result = replace(result, corrections={**result.corrections,
+                                              "analysed_samples": [int(kept[0]), int(kept[1])]})
+    return replace(result, notes=result.notes + extra) if extra else result
+
+
+def _cut_dropouts(channels: list[Channel], datas: list[np.ndarray], *, source: str
+                  ) -> tuple[list[np.ndarray], list[str], tuple[int, int] | None]:
+    """Keep the longest stretch free of dropouts in every channel (see
+    :func:`validate.dropout_runs`); returns the data, the notes and the kept ``[start, stop)``."""
+    bad: list[tuple[int, int]] = []
+    described: list[str] = []
+    for ch, data in zip(channels, datas, strict=True):
+        runs = validate.dropout_runs(data)
+        bad.extend((start, start + length) for start, length, _ in runs)
+        if runs:
+            start, length, value = max(runs, key=lambda r: r[1])
+            at = ch.start_time_s + start / ch.sample_rate_hz
+            described.append(
+                f"channel {ch.name!r}: {len(runs)} dropout(s), longest {length} samples stuck at "
+                f"{value:+.6g} {ch.unit} from t = {at:.6g} s")
+    if not bad:
+        return datas, [], None
+    n = datas[0].shape[0]
+    bounds = sorted(bad)
+    clean: list[tuple[int, int]] = []
+    pos = 0
+    for a, b in bounds:
+        if a > pos:
+            clean.append((pos, a))
+        pos = max(pos, b)
+    if pos < n:
+        clean.append((pos, n))
+    if not clean:
+        raise ChannelError(f"{source}: {'; '.join(described)}; no sample is free of dropouts")
+    lo, hi = max(clean, key=lambda c: c[1] - c[0])
+    rate = channels[0].sample_rate_hz
+    note = (f"{source}: {'; '.join(described)}; analysed only the longest clean stretch, "
+            f"samples {lo}..{hi} ({(hi - lo) / rate:.6g} s of {n / rate:.6g} s)")
+    return [d[lo:hi] for d in datas], [note], (lo, hi)

@@ -6,10 +6,100 @@ saying what was found and what was expected; it returns None when the channel pa
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
+from numba import njit
 
 from .. import defaults
 from ..errors import ChannelError
+
+#: A run of identical samples longer than this fraction of a drive period, away from the
+#: channel's extremes, is a dropout (a sampled sine changes value at every sample except within
+#: one quantisation step of its peaks, see :func:`dropout_runs`).
+DROPOUT_MIN_PERIOD_FRACTION = 0.125
+#: ... and at least this many samples.
+DROPOUT_MIN_RUN = 16
+#: Quantisation coarser than this fraction of the amplitude is not allowed for when judging
+#: clipping (at 1/4 of the amplitude a flat top can no longer be told from a clipped one).
+QUANTISATION_MAX_STEP_FRACTION = 0.25
+
+
+@njit(cache=True)
+def _scan(x, min_run, max_runs):  # pragma: no cover - numba
+    """One pass: smallest non-zero step, hysteresis mean crossings, runs of equal samples.
+
+    Returns (min_step, n_crossings, starts, lengths) with runs of >= ``min_run`` samples
+    (at most ``max_runs``).
+    """
+    n = x.shape[0]
+    lo = x[0]
+    hi = x[0]
+    total = 0.0
+    for i in range(n):
+        v = x[i]
+        total += v
+        if v < lo:
+            lo = v
+        if v > hi:
+            hi = v
+    mean = total / n
+    h = 0.1 * (hi - lo)
+    step = np.inf
+    crossings = 0
+    state = 0
+    starts = np.empty(max_runs, dtype=np.int64)
+    lengths = np.empty(max_runs, dtype=np.int64)
+    n_runs = 0
+    run_start = 0
+    for i in range(n):
+        v = x[i]
+        if v > mean + h:
+            if state < 0:
+                crossings += 1
+            state = 1
+        elif v < mean - h:
+            if state > 0:
+                crossings += 1
+            state = -1
+        if i > 0:
+            d = abs(v - x[i - 1])
+            if d > 0.0:
+                if d < step:
+                    step = d
+                if i - run_start >= min_run and n_runs < max_runs:
+                    starts[n_runs] = run_start
+                    lengths[n_runs] = i - run_start
+                    n_runs += 1
+                run_start = i
+    if n - run_start >= min_run and n_runs < max_runs:
+        starts[n_runs] = run_start
+        lengths[n_runs] = n - run_start
+        n_runs += 1
+    return step, crossings, starts[:n_runs], lengths[:n_runs]
+
+
+def samples_per_period(data: np.ndarray) -> float:
+    """Rough samples per period from hysteresis crossings of the mean (N when none)."""
+    _, crossings, _, _ = _scan(data, data.shape[0] + 1, 0)
+    return 2.0 * data.shape[0] / crossings if crossings >= 2 else float(data.shape[0])
+
+
+def dropout_runs(data: np.ndarray) -> list[tuple[int, int, float]]:
+    """Runs of identical samples that no sampled vibration produces: ``(start, length, value)``.
+
+    A run counts when it is at least :data:`DROPOUT_MIN_RUN` samples and
+    :data:`DROPOUT_MIN_PERIOD_FRACTION` of a period long and its value is not the channel's
+    maximum or minimum (flat extremes are clipping, see :func:`clipped_samples`). Exact zeros
+    of a disconnected or dropped-out channel and a stuck ADC both show as such runs.
+    """
+    x = np.asarray(data, dtype=np.float64)
+    period = samples_per_period(x)
+    min_run = max(DROPOUT_MIN_RUN, int(math.ceil(DROPOUT_MIN_PERIOD_FRACTION * period)))
+    _, _, starts, lengths = _scan(x, min_run, 10_000)
+    hi, lo = float(np.max(x)), float(np.min(x))
+    return [(int(a), int(n), float(x[a])) for a, n in zip(starts, lengths, strict=True)
+            if x[a] != hi and x[a] != lo]
 
 
 def _label(source: str, channel: str) -> str:
@@ -64,7 +154,9 @@ def clipped_samples(data: np.ndarray, *, min_run: int = defaults.CLIPPING_MIN_RU
 
     Returns the count and the clipping level (the extreme with more clipped samples; 0 and NaN
     when nothing is clipped). A sampled sine reaches its extreme at isolated samples only, so a
-    run of identical extreme values means the amplifier or ADC saturated.
+    run of identical extreme values means the amplifier or ADC saturated -- unless the samples
+    are coarsely quantised: then runs as long as a sine spends within one quantisation step of
+    its peak are expected and not counted.
 
     Examples
     --------
@@ -74,6 +166,11 @@ def clipped_samples(data: np.ndarray, *, min_run: int = defaults.CLIPPING_MIN_RU
     best = (0, float("nan"))
     hi, lo = float(np.max(data)), float(np.min(data))
     span = hi - lo
+    # A coarsely quantised sine stays on its extreme level for a while without being clipped:
+    # within one step q of the peak for a fraction acos(1 - q/A)/pi of a period. Runs up to
+    # 1.5x that (+1 sample) are quantisation, not saturation.
+    step = _scan(data, data.shape[0] + 1, 0)[0] if data.shape[0] > 1 else math.inf
+    amplitude = 0.5 * span
     for level, sign in ((hi, 1.0), (lo, -1.0)):
         tol = relative_tolerance * max(span, abs(level))
         # one boolean temporary (N bytes) instead of |data - level| (two float temporaries)
@@ -82,7 +179,12 @@ def clipped_samples(data: np.ndarray, *, min_run: int = defaults.CLIPPING_MIN_RU
         padded[1:-1] = at
         edges = np.flatnonzero(np.diff(padded))
         runs = edges[1::2] - edges[::2]
-        count = int(runs[runs >= min_run].sum())
+        needed = min_run
+        if amplitude > 0 and step < QUANTISATION_MAX_STEP_FRACTION * amplitude and runs.size:
+            period = data.shape[0] / runs.size  # one visit of the extreme per period
+            flat = period * math.acos(1.0 - step / amplitude) / math.pi
+            needed = max(min_run, int(math.ceil(1.5 * flat)) + 1)
+        count = int(runs[runs >= needed].sum())
         if count > best[0]:
             best = (count, level)
     return best

@@ -55,6 +55,8 @@ def _settings_editor(measurements, tables: dict[str, pd.DataFrame], channel_name
                 help="loss factor of the empty coupon, subtracted"),
             **{f"{role} channel": st.column_config.SelectboxColumn(options=channels)
                for role in ("force", "velocity", "acceleration")},
+            "inverted channels": st.column_config.TextColumn(
+                help="channels whose sign is flipped, separated by ';' (e.g. Force)"),
         })
     ss["settings_current"] = edited
     st.download_button("Download these settings as a CSV template", uploads.settings_template(

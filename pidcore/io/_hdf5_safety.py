@@ -1,0 +1,84 @@
+"""Checks of an HDF5 (or MATLAB v7.3) file from someone else, made before any data is read.
+
+HDF5 lets a file make the library read *other* files on the machine: a dataset whose raw data
+lives in an external file (``external=`` storage), an external link to an object of another
+file, a virtual dataset mapping other files. A file uploaded to the app, or handed over with a
+measurement, must never do that: :func:`check_hdf5_input` refuses all three. It also refuses a
+file whose datasets declare far more bytes than the file holds (a compressed "bomb", or a
+contiguous dataset larger than the file), before anything is decompressed into memory.
+"""
+
+from __future__ import annotations
+
+import os
+
+import h5py
+
+from ..errors import InputFileError
+
+#: Declared dataset bytes may exceed the file size by this factor (compressed data; measured
+#: signals compress 1-3x, constant blocks far more).
+MAX_EXPANSION_FACTOR = 50.0
+#: ... and may always reach this many bytes (small files of constant data).
+EXPANSION_ALLOWANCE_BYTES = 64 * 2**20
+#: Declared dataset bytes never read, whatever the file size (the upload limit of the app is
+#: far below it).
+MAX_DECLARED_BYTES = 4 * 2**30
+#: Deepest group nesting and most objects walked (a file can hard-link a group into itself).
+MAX_DEPTH = 32
+MAX_OBJECTS = 100_000
+
+
+def _walk(group: h5py.Group, where: str, depth: int, counter: list[int]) -> int:
+    """Declared bytes of the datasets below ``group``; raises on links out of the file."""
+    if depth > MAX_DEPTH:
+        raise InputFileError(f"{where}: groups nested deeper than {MAX_DEPTH} levels at "
+                             f"{group.name!r}; refused (a group linked into itself?)")
+    total = 0
+    for name in group:
+        counter[0] += 1
+        if counter[0] > MAX_OBJECTS:
+            raise InputFileError(f"{where}: more than {MAX_OBJECTS} HDF5 objects; refused")
+        path = f"{group.name.rstrip('/')}/{name}"
+        link = group.get(name, getlink=True)
+        if isinstance(link, h5py.ExternalLink):
+            raise InputFileError(f"{where}: {path!r} is an external link to "
+                                 f"{link.filename!r}; refused: a measurement file must not make "
+                                 "pidcore read other files")
+        if isinstance(link, h5py.SoftLink):
+            continue  # a path inside this file; its target is walked where it lives
+        obj = group.get(name)
+        if isinstance(obj, h5py.Group):
+            total += _walk(obj, where, depth + 1, counter)
+        elif isinstance(obj, h5py.Dataset):
+            if obj.is_virtual:
+                raise InputFileError(f"{where}: dataset {path!r} is a virtual dataset (data "
+                                     "mapped from other files); refused")
+            if obj.id.get_create_plist().get_external_count() > 0:
+                raise InputFileError(f"{where}: dataset {path!r} keeps its data in external "
+                                     "file(s); refused: a measurement file must not make "
+                                     "pidcore read other files")
+            total += int(obj.size) * int(obj.dtype.itemsize)
+    return total
+
+
+def check_hdf5_input(path: str | os.PathLike[str], *, what: str = "HDF5") -> None:
+    """Refuse external storage, external links, virtual datasets and oversized declarations.
+
+    Raises
+    ------
+    InputFileError
+        Naming the file and the offending object, before any dataset is read.
+    """
+    where = str(path)
+    size = os.path.getsize(path)
+    try:
+        with h5py.File(path, "r") as h5:
+            declared = _walk(h5, where, 0, [0])
+    except OSError as exc:
+        raise InputFileError(f"{where}: not a readable {what} file ({exc})") from None
+    limit = min(MAX_DECLARED_BYTES, max(MAX_EXPANSION_FACTOR * size, EXPANSION_ALLOWANCE_BYTES))
+    if declared > limit:
+        raise InputFileError(f"{where}: its datasets declare {declared / 2**20:.1f} MiB in a "
+                             f"{size / 2**20:.2f} MiB file (limit {limit / 2**20:.0f} MiB); "
+                             "refused before reading")

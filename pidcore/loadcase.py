@@ -1,0 +1,182 @@
+"""The load case: the (frequency, acceleration, fill, material, direction) a result belongs to.
+
+One type for the DEM (what to simulate), measurements (what was stated about them), the
+store, the CLI, reports and the app, with one text key (:attr:`LoadCase.key`,
+``f50Hz_a5g_fill50pct_acrylic_z``). Stores written by pidcore 0.1 named DEM runs with the
+older key ``acrylic_z_f50_a5_fill50``; :func:`parse_key` reads both.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass
+
+from . import defaults
+from .constants import DRIVE_DIRECTIONS, PARTICLE_MATERIALS, STANDARD_GRAVITY
+from .errors import ParameterError
+
+_MATERIAL_ALIASES = {"pmma": "acrylic", "aluminum": "aluminium"}
+
+_NUMBER = r"\d+(?:\.\d+)?(?:e[+-]?\d+)?"
+#: :attr:`LoadCase.key`, e.g. ``f500Hz_a5g_fill50pct_acrylic_z`` (a run key may follow).
+KEY_PATTERN = re.compile(
+    rf"^f(?P<f>{_NUMBER})Hz_a(?P<a>{_NUMBER})g_fill(?P<p>{_NUMBER})pct_"
+    r"(?P<material>[a-z][a-z0-9_]*?)_(?P<direction>[xyz])(?=$|_)")
+#: The DEM run key of pidcore 0.1, e.g. ``acrylic_z_f50_a5_fill50`` (read, never written).
+KEY_PATTERN_0_1 = re.compile(
+    rf"^(?P<material>[a-z][a-z0-9_]*?)_(?P<direction>[xyz])_f(?P<f>{_NUMBER})_a(?P<a>{_NUMBER})"
+    rf"_fill(?P<p>{_NUMBER})(?=$|_)")
+
+
+class LoadCaseError(ParameterError):
+    """A load case is not stated, stated twice differently, or out of range."""
+
+
+#: Form of a particle material name in a load case: the table's materials and a specimen's
+#: own (inline) materials such as ``steel`` or ``tungsten_carbide``.
+_MATERIAL_NAME = re.compile(r"^[a-z][a-z0-9_]*$")
+
+
+def normalize_material(value: str, what: str,
+                       known: tuple[str, ...] | None = PARTICLE_MATERIALS) -> str:
+    """Canonical material name (``aluminum`` -> ``aluminium``, ``pmma`` -> ``acrylic``).
+
+    ``known``: the names accepted (the materials table by default, plus a specimen's own
+    material where one is given); ``None`` accepts any lower-case identifier.
+    """
+    text = str(value).strip().lower()
+    text = _MATERIAL_ALIASES.get(text, text)
+    if known is not None and text not in known:
+        raise LoadCaseError(f"{what}: unknown particle material {value!r}; expected one of "
+                            f"{', '.join(known)}")
+    if not _MATERIAL_NAME.match(text):
+        raise LoadCaseError(f"{what}: particle material {value!r} is not a name (expected "
+                            "lower-case letters, digits and '_', e.g. 'acrylic')")
+    return text
+
+
+def normalize_direction(value: str, what: str) -> str:
+    """Canonical drive direction (``'Z'`` -> ``'z'``)."""
+    text = str(value).strip().lower()
+    if text not in DRIVE_DIRECTIONS:
+        raise LoadCaseError(f"{what}: unknown drive direction {value!r}; expected one of "
+                            f"{', '.join(DRIVE_DIRECTIONS)}")
+    return text
+
+
+def check_fill(value: float, what: str) -> float:
+    """``value`` as a fill in (0, 100] % (packing ratio), or :class:`LoadCaseError`."""
+    try:
+        fill = float(value)
+    except (TypeError, ValueError):
+        raise LoadCaseError(f"{what}: fill {value!r} is not a number (packing ratio in %)") \
+            from None
+    if not (math.isfinite(fill) and 0.0 < fill <= 100.0):
+        raise LoadCaseError(f"{what}: fill must be in (0, 100] % (packing ratio), got {value!r}")
+    return fill
+
+
+@dataclass(frozen=True)
+class LoadCase:
+    """One harmonic load case of the paper's grid (or between its points).
+
+    Attributes
+    ----------
+    frequency_hz : float
+        Drive frequency, Hz (> 0).
+    acceleration_g : float
+        Acceleration amplitude of the drive, g (standard gravity, > 0).
+    fill_percent : float
+        Packing ratio: particles per cell over the full-cell count, % (0 < fill <= 100).
+    material : str
+        Particle material (:data:`pidcore.constants.ParticleMaterial`; ``pmma`` and
+        ``aluminum`` are read as ``acrylic`` and ``aluminium``).
+    direction : str
+        Drive direction in the cell frame (:data:`pidcore.constants.DriveDirection`).
+
+    Examples
+    --------
+    >>> LoadCase(500.0, 5.0, 50.0).key
+    'f500Hz_a5g_fill50pct_acrylic_z'
+    """
+
+    frequency_hz: float
+    acceleration_g: float
+    fill_percent: float
+    material: str = defaults.COMPARE_DEFAULT_MATERIAL
+    direction: str = defaults.COMPARE_DEFAULT_DIRECTION
+
+    def __post_init__(self) -> None:
+        for name in ("frequency_hz", "acceleration_g"):
+            value = getattr(self, name)
+            try:
+                number = float(value)
+            except (TypeError, ValueError):
+                number = math.nan
+            if not (math.isfinite(number) and number > 0):
+                raise LoadCaseError(f"load case: {name} must be a positive finite number, "
+                                    f"got {value!r}")
+            object.__setattr__(self, name, number)
+        object.__setattr__(self, "fill_percent", check_fill(self.fill_percent, "load case"))
+        # any material name: a specimen may define its own (the edges check the vocabulary)
+        object.__setattr__(self, "material",
+                           normalize_material(self.material, "load case", known=None))
+        object.__setattr__(self, "direction", normalize_direction(self.direction, "load case"))
+
+    @property
+    def omega_rad_s(self) -> float:
+        """Drive angular frequency ``2 pi f``, rad/s."""
+        return 2.0 * math.pi * self.frequency_hz
+
+    @property
+    def acceleration_m_s2(self) -> float:
+        """Acceleration amplitude, m/s^2."""
+        return self.acceleration_g * STANDARD_GRAVITY
+
+    @property
+    def key(self) -> str:
+        """Stable text key; numbers to 6 significant digits so float noise does not split keys."""
+        return (f"f{self.frequency_hz:.6g}Hz_a{self.acceleration_g:.6g}g_"
+                f"fill{self.fill_percent:.6g}pct_{self.material}_{self.direction}")
+
+    def as_record(self, origin: str) -> dict[str, object]:
+        """The fields a stored analysis carries about its load case; ``origin`` says who stated
+        fill, material and direction."""
+        return {"fill_percent": self.fill_percent, "material": self.material,
+                "direction": self.direction, "load_case_key": self.key,
+                "load_case_origin": origin}
+
+    def label(self) -> str:
+        """Short human label, e.g. ``'500 Hz, 5 g, 50 %'``."""
+        return f"{self.frequency_hz:.4g} Hz, {self.acceleration_g:.3g} g, {self.fill_percent:.3g} %"
+
+
+def parse_key(text: str) -> LoadCase:
+    """The load case a key (or a DEM run key starting with one) names.
+
+    Reads :attr:`LoadCase.key` and the DEM run key of pidcore 0.1 (``acrylic_z_f50_a5_fill50``
+    followed by ``_seed...``).
+
+    Examples
+    --------
+    >>> parse_key("acrylic_z_f50_a5_fill50_seed12345_cells8_0123456789").key
+    'f50Hz_a5g_fill50pct_acrylic_z'
+    """
+    for pattern in (KEY_PATTERN, KEY_PATTERN_0_1):
+        m = pattern.match(str(text))
+        if m:
+            return LoadCase(float(m["f"]), float(m["a"]), float(m["p"]), m["material"],
+                            m["direction"])
+    raise LoadCaseError(f"load case key {text!r}: expected e.g. 'f50Hz_a5g_fill50pct_acrylic_z' "
+                        "(or 0.1's 'acrylic_z_f50_a5_fill50')")
+
+
+def key_0_1(case: LoadCase) -> str:
+    """The DEM run key prefix pidcore 0.1 wrote for ``case`` (to find runs of old stores)."""
+    return (f"{case.material}_{case.direction}_f{case.frequency_hz:g}"
+            f"_a{case.acceleration_g:g}_fill{case.fill_percent:g}")
+
+
+__all__ = ["KEY_PATTERN", "KEY_PATTERN_0_1", "LoadCase", "LoadCaseError", "check_fill",
+           "key_0_1", "normalize_material", "normalize_direction", "parse_key"]
