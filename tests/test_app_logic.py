@@ -674,3 +674,23 @@ def test_a_file_saved_again_with_other_corrections_counts_once(tmp_path, good_cs
     assert saved["file"].tolist() == ["c_fill50.csv"]
     table = store_report_table(store_file)
     assert table["SDC measured [-]"].dropna().tolist() == [rec2.analysis.sdc]
+
+
+def test_dem_jobs_run_on_the_chosen_specimen(tmp_path):
+    from pidcore.dem import DemConfig
+    from pidcore.dem.persist import run_key
+    from pidcore.specimen import load_specimen
+
+    steel = load_specimen(REPO / "data_samples" / "specimens" / "steel_6mm.toml")
+    (case,) = jobs.plan_dem_cases([100.0], [5.0], [50.0], material=steel.particles.material,
+                                  direction="z")
+    config = DemConfig(cells=1, steady_cycles=4)
+    runner = jobs.DemJobRunner(tmp_path / "s.h5")
+    (job,) = runner.submit([case], config, steel)
+    runner.cancel()
+    _wait(runner)
+    # the run is keyed (and would be stored) as the specimen's, not the paper coupon's
+    assert job.run_key == run_key(case, config, steel) != run_key(
+        jobs.plan_dem_cases([100.0], [5.0], [50.0], material="acrylic", direction="z")[0],
+        config)
+    assert job.specimen is steel

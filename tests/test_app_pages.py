@@ -527,3 +527,23 @@ def test_report_chooses_among_the_saved_records(store_file):
     at.run()
     table = _table(at, "SDC measured [-]")
     assert [s for s in table["source file(s)"] if s] == ["b_fill75.csv"]
+
+
+def test_dem_page_offers_the_specimen_files_and_takes_their_material(store_file, tmp_path):
+    import shutil
+
+    from pidcore.specimen import load_specimen
+
+    source = REPO / "data_samples" / "specimens" / "steel_6mm.toml"
+    folder = tmp_path / "data_samples" / "specimens"  # the app runs in tmp_path
+    folder.mkdir(parents=True)
+    shutil.copy(source, folder)
+    at = _app()
+    box = at.selectbox(key="dem_specimen")
+    assert box.options[0] == "paper coupon (default)"
+    chosen = next(o for o in box.options if o.endswith("steel_6mm.toml"))
+    box.set_value(chosen)
+    at.run()
+    assert not at.exception
+    want = load_specimen(source).particles.material
+    assert at.text_input(key="dem_material_specimen").value == want

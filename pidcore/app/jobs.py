@@ -40,6 +40,7 @@ class DemJob:
     case: object
     config: object
     run_key: str
+    specimen: object = None
     state: str = "queued"
     submitted: float = field(default_factory=time.time)
     started: float | None = None
@@ -80,7 +81,7 @@ class DemJob:
                 "store key": self.run_key, "message": self.message}
 
 
-def _child(case, config, conn) -> None:
+def _child(case, config, specimen, conn) -> None:
     """Worker process: simulate one case, report progress, send the store entry back."""
     try:
         import numba
@@ -90,7 +91,8 @@ def _child(case, config, conn) -> None:
         from ..dem.simulate import simulate_load_case
 
         result = simulate_load_case(
-            case, config, on_block=lambda done, expected: conn.send(("progress", done, expected)))
+            case, config, specimen=specimen,
+            on_block=lambda done, expected: conn.send(("progress", done, expected)))
         conn.send(("done", dem_run_entry(result)))
     except BaseException as exc:  # noqa: BLE001 - reported to the parent as the job's error
         conn.send(("error", f"{type(exc).__name__}: {exc}"))
@@ -119,9 +121,10 @@ class DemJobRunner:
 
     # --- used by the page ---------------------------------------------------------------------
 
-    def submit(self, cases: Sequence, config) -> list[DemJob]:
-        """Queue ``cases`` with ``config``; returns the jobs created (duplicates are skipped:
-        a run queued, running or already in the store is not submitted again)."""
+    def submit(self, cases: Sequence, config, specimen=None) -> list[DemJob]:
+        """Queue ``cases`` with ``config`` on ``specimen`` (:class:`pidcore.specimen.Specimen`;
+        None: the paper's coupon); returns the jobs created (duplicates are skipped: a run
+        queued, running or already in the store is not submitted again)."""
         from ..dem.persist import run_key
         from ..store import Store
 
@@ -130,11 +133,11 @@ class DemJobRunner:
         with self._lock:
             active = {j.run_key for j in self._jobs if j.state in ("queued", "running")}
             for case in cases:
-                key = run_key(case, config)
+                key = run_key(case, config, specimen)
                 if key in active:
                     continue
                 self._counter += 1
-                job = DemJob(f"job{self._counter:04d}", case, config, key)
+                job = DemJob(f"job{self._counter:04d}", case, config, key, specimen)
                 if stored is not None and stored.has_dem_run(key):
                     job.state, job.message = "in store", "already in the store; not run again"
                     job.finished = time.time()
@@ -207,7 +210,8 @@ class DemJobRunner:
 
         ctx = multiprocessing.get_context("spawn")
         parent, child = ctx.Pipe(duplex=False)
-        proc = ctx.Process(target=_child, args=(job.case, job.config, child), daemon=True,
+        proc = ctx.Process(target=_child, args=(job.case, job.config, job.specimen, child),
+                           daemon=True,
                            name=f"pidcore-dem-{job.job_id}")
         proc.start()
         child.close()

@@ -7,6 +7,8 @@ refreshes itself every second (a fragment), and every finished case is saved by 
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pandas as pd
 import streamlit as st
 
@@ -57,12 +59,44 @@ def _job_table(stores) -> None:
             st.rerun(scope="app")
 
 
+#: Folders searched for specimen files (relative to the working folder), besides uploads.
+SPECIMEN_FOLDERS = (Path("data_samples") / "specimens", Path("specimens"))
+_PAPER = "paper coupon (default)"
+
+
+def _specimen_choice():
+    """The specimen chosen (None: the paper's coupon): a file of SPECIMEN_FOLDERS or an
+    uploaded TOML (parsed by :func:`pidcore.specimen.load_specimen`, never executed)."""
+    import tempfile
+
+    from pidcore.errors import PidcoreError
+    from pidcore.specimen import load_specimen
+
+    files = sorted(p for folder in SPECIMEN_FOLDERS if folder.is_dir()
+                   for p in folder.glob("*.toml"))
+    c1, c2 = st.columns(2)
+    upload = c2.file_uploader("or a specimen file (TOML)", type=["toml"], key="dem_specimen_file")
+    choice = c1.selectbox("specimen", [_PAPER, *map(str, files)], key="dem_specimen",
+                          disabled=upload is not None)
+    try:
+        if upload is not None:
+            with tempfile.TemporaryDirectory(prefix="pidcore_specimen_") as folder:
+                path = Path(folder) / "specimen.toml"
+                path.write_bytes(upload.getvalue())
+                return load_specimen(path)
+        return None if choice == _PAPER else load_specimen(choice)
+    except (PidcoreError, OSError, ValueError) as exc:
+        name = upload.name if upload is not None else choice
+        st.error(f"{name}: {exc}")
+        return None
+
+
 def render(stores) -> None:
     """The page."""
     from pidcore.errors import PidcoreError
 
     st.subheader("DEM: run load cases")
-    st.caption(f"Any frequencies, accelerations and fills (at most "
+    st.caption(f"Any frequencies, accelerations and fills, on any specimen (at most "
                f"{defaults.APP_MAX_DEM_CASES} cases at a time). Cases run in the background, "
                "one after the other, each saved to the store as it finishes; you can switch "
                "tabs or reload meanwhile. Larger grids: `pidcore dem`.")
@@ -71,8 +105,14 @@ def render(stores) -> None:
                           help="one or more values, e.g. 50, 100, 333")
     accs = c2.text_input("accelerations [g]", "5", key="dem_accs", help="e.g. 1, 5, 7.5")
     fills = c3.text_input("fills [%]", "50", key="dem_fills", help="e.g. 25, 50")
+    specimen = _specimen_choice()
     c4, c5 = st.columns(2)
-    material = c4.selectbox("particle material", PARTICLE_MATERIALS, key="dem_material")
+    if specimen is None:
+        material = c4.selectbox("particle material", PARTICLE_MATERIALS, key="dem_material")
+    else:
+        material = specimen.particles.material
+        c4.text_input("particle material (the specimen's)", material, disabled=True,
+                      key="dem_material_specimen")
     direction = c5.selectbox("drive direction", DRIVE_DIRECTIONS, key="dem_direction")
     with st.expander("numerical settings", expanded=False):
         d1, d2, d3 = st.columns(3)
@@ -97,7 +137,7 @@ def render(stores) -> None:
         except PidcoreError as exc:
             st.session_state["dem_message"] = ("error", str(exc))
         else:
-            created = jobs.runner_for(stores.path).submit(cases, config)
+            created = jobs.runner_for(stores.path).submit(cases, config, specimen)
             skipped = len(cases) - len(created)
             st.session_state["dem_message"] = (
                 "info", f"{len(created)} job(s) submitted"
