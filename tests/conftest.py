@@ -1,14 +1,22 @@
 """Fixtures shared by several test modules, and the Numba cache shared by pytest-xdist workers.
 
-Numba kernels (``@njit(cache=True)``) compile in ~1-2 min from a cold cache. The cache lives in
+Numba kernels (``@njit(cache=True)``) compile in ~1 min from a cold cache. The cache lives in
 ``.numba_cache/`` of this checkout (``NUMBA_CACHE_DIR``, set here before anything imports
-numba; an explicit ``NUMBA_CACHE_DIR`` wins), and with ``-n N`` the controller process compiles
-the kernels once in ``pytest_configure`` -- before pytest-xdist starts its workers, which then
-inherit the variable and load the compiled kernels instead of each compiling them again.
-``PIDCORE_NUMBA_WARMUP=0`` skips the warm-up.
+numba; an explicit ``NUMBA_CACHE_DIR`` wins). With ``-n N`` the controller process starts
+``tests/_numba_warmup.py`` in the background in ``pytest_configure``, before pytest-xdist starts
+its workers (``DSession.pytest_sessionstart``); the workers inherit the cache location and a
+path that the warm-up writes when it is done. Workers run the tests that call the DEM kernel
+last (:data:`DEM_KERNEL_TESTS`) and wait for the warm-up before the first of them, so the
+kernel is compiled once, while the other tests run, instead of once per worker.
+``PIDCORE_NUMBA_WARMUP=0`` skips all this.
 """
 
 import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -20,49 +28,67 @@ import pytest  # noqa: E402
 
 from pidcore.model import SdcModel, load_paper_table3  # noqa: E402
 
-_WARMUP_SECONDS = pytest.StashKey[float]()
+#: Test modules that call the DEM kernel (directly, through the CLI, sweeps or the app).
+DEM_KERNEL_TESTS = re.compile(r"^test_(dem_|app_|samples|specimen|calibrat)")
+#: Environment variable naming the file the background warm-up writes when it is done.
+WARMUP_DONE_ENV = "PIDCORE_NUMBA_WARMUP_DONE"
+#: Longest wait for the warm-up before a worker compiles on its own, s.
+WARMUP_TIMEOUT_S = 900.0
 
-
-def warm_numba_kernels() -> None:
-    """Compile (or load from the cache) every Numba kernel the suite calls, with the argument
-    types the library passes: one DEM step loop (both specialisations of the cell kernel, via
-    a tiny load case and a single impact) and the harmonic fit."""
-    import numpy as np
-
-    from pidcore.dem import DemConfig, LoadCase, simulate_impact, simulate_load_case
-    from pidcore.signal import analyze_power
-
-    simulate_impact(impact_speed_m_s=0.3, dt_s=1e-6)
-    simulate_load_case(LoadCase(500.0, 5.0, 50.0),
-                       DemConfig(cells=1, steady_cycles=2, block_cycles=1,
-                                 max_transient_cycles=1))
-    t = np.arange(2000) / 1000.0
-    analyze_power(np.sin(100 * t), np.cos(100 * t), 1000.0)
+_WARMUP = pytest.StashKey[subprocess.Popen]()
+_waited = False
 
 
 def pytest_configure(config: pytest.Config) -> None:
-    # Only the xdist controller warms up: it runs before the workers are started
-    # (DSession.pytest_sessionstart), so they find a warm cache. A single process compiles
-    # on first use anyway, and a run of a few test files need not compile the DEM at all.
+    # Only the xdist controller starts the warm-up; a single process compiles on first use.
     if hasattr(config, "workerinput") or os.environ.get("PIDCORE_NUMBA_WARMUP") == "0":
         return
     if not getattr(config.option, "numprocesses", None):
         return
-    start = time.perf_counter()
-    try:
-        warm_numba_kernels()
-    except Exception as exc:  # the tests that call the kernel will report it properly
-        config.issue_config_time_warning(
-            pytest.PytestWarning(f"numba warm-up failed, workers compile on their own: {exc}"),
-            stacklevel=2)
+    done = Path(tempfile.mkdtemp(prefix="pidcore-numba-warmup-")) / "done"
+    os.environ[WARMUP_DONE_ENV] = str(done)  # inherited by the workers started after this
+    config.stash[_WARMUP] = subprocess.Popen(
+        [sys.executable, str(Path(__file__).with_name("_numba_warmup.py")), str(done)],
+        stdout=subprocess.DEVNULL)
+
+
+def pytest_unconfigure(config: pytest.Config) -> None:
+    process = config.stash.get(_WARMUP, None)
+    if process is None:
         return
-    config.stash[_WARMUP_SECONDS] = time.perf_counter() - start
+    if process.poll() is None:  # the session ended first (e.g. -x); nothing is half-cached:
+        process.kill()           # numba writes each cache file whole
+    process.wait()
+    shutil.rmtree(Path(os.environ.pop(WARMUP_DONE_ENV)).parent, ignore_errors=True)
 
 
 def pytest_report_header(config: pytest.Config) -> str:
-    seconds = config.stash.get(_WARMUP_SECONDS, None)
-    warmed = "" if seconds is None else f", kernels warmed in {seconds:.1f} s"
-    return f"numba cache: {os.environ['NUMBA_CACHE_DIR']}{warmed}"
+    process = config.stash.get(_WARMUP, None)
+    background = "" if process is None else \
+        f", kernels compiled once in the background (pid {process.pid})"
+    return f"numba cache: {os.environ['NUMBA_CACHE_DIR']}{background}"
+
+
+def _calls_dem_kernel(item: pytest.Item) -> bool:
+    return bool(DEM_KERNEL_TESTS.match(item.path.name))
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    # In xdist workers while the warm-up runs: DEM kernel tests last (a stable sort, the same
+    # in every worker, so their collections still agree; modules stay contiguous).
+    if WARMUP_DONE_ENV in os.environ and hasattr(config, "workerinput"):
+        items.sort(key=_calls_dem_kernel)
+
+
+def pytest_runtest_setup(item: pytest.Item) -> None:
+    global _waited
+    if _waited or WARMUP_DONE_ENV not in os.environ or not _calls_dem_kernel(item):
+        return
+    done = Path(os.environ[WARMUP_DONE_ENV])
+    deadline = time.monotonic() + WARMUP_TIMEOUT_S
+    while not done.exists() and time.monotonic() < deadline:
+        time.sleep(0.2)
+    _waited = True  # ready, failed (the test will say why) or timed out: compile here
 
 
 @pytest.fixture(scope="session")
