@@ -51,7 +51,7 @@ def test_key_is_stable_against_float_noise_and_distinguishes_cases():
 
 @pytest.mark.parametrize("kwargs", [
     {"frequency_hz": 0.0}, {"acceleration_g": -1.0}, {"fill_percent": 0.0},
-    {"material": "steel"}, {"direction": "w"},
+    {"material": "Steel!"}, {"direction": "w"},
 ])
 def test_invalid_load_case_is_refused(kwargs):
     values = {"frequency_hz": 50.0, "acceleration_g": 1.0, "fill_percent": 50.0, **kwargs}
