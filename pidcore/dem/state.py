@@ -9,7 +9,7 @@ import numpy as np
 from .. import defaults
 from ..constants import DRIVE_DIRECTIONS, STANDARD_GRAVITY
 from ..errors import SimulationError
-from .contact import ContactLaw, check_tangential_model
+from .contact import LAW_ROLLING_STIFFNESS, ContactLaw, check_tangential_model
 from .geometry import WALL_NAMES, CellGeometry
 from .kernel import (
     N_HISTORY,
@@ -178,6 +178,7 @@ def advance(state: CellsState, settings: KernelSettings, n_steps: int, *,
                   law.radius_m, law.mass_kg, law.inertia_kg_m2, law_pp, law_pw,
                   settings.friction_regularisation_m_s, settings.clip_attraction,
                   settings.gravity_m_s2, settings.tangential_model == "stick_slip",
+                  bool(law_pp[LAW_ROLLING_STIFFNESS] > 0 or law_pw[LAW_ROLLING_STIFFNESS] > 0),
                   state.spring_pp, state.spring_pw,
                   settings.dt_s, np.int64(state.step), np.int64(n_steps),
                   settings.omega_rad_s, settings.accel_m_s2,
