@@ -14,7 +14,7 @@ drawn as open markers labelled ``"... filled"``.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -74,6 +74,32 @@ def _default(values: Sequence[float] | None, axis: np.ndarray) -> list[float]:
     return [float(v) for v in (axis if values is None else values)]
 
 
+def _draw_panels(axes, pts: pd.DataFrame, *, x: np.ndarray, x_column: str,
+                 panels: Sequence[float], panel_column: str,
+                 curves: Sequence[float], curve_column: str,
+                 curve: Callable[[float, float], np.ndarray],
+                 curve_label: Callable[[float], str], title: Callable[[float], str],
+                 xlabel: str, log_x: bool) -> None:
+    """One panel per value of ``panels``, in it one curve per value of ``curves``.
+
+    ``curve(panel_value, curve_value)`` is the model along ``x``; the data points at the same
+    panel and curve value are marked right after each curve (see :func:`_mark`).
+    """
+    for panel, panel_value in zip(axes, panels, strict=True):
+        for curve_value in curves:
+            label = curve_label(curve_value)
+            (line,) = panel.plot(x, curve(panel_value, curve_value), label=label)
+            sel = pts[np.isclose(pts[panel_column], panel_value)
+                      & np.isclose(pts[curve_column], curve_value)]
+            _mark(panel, sel, x_column, line.get_color(), label)
+        if log_x:
+            panel.set_xscale("log")
+        panel.set_title(title(panel_value))
+        panel.set_xlabel(xlabel)
+        panel.set_ylabel("SDC [-]")
+        panel.legend(fontsize="small", ncols=2)
+
+
 def plot_sdc_vs_acceleration(model: SdcModel, *, fills: Sequence[float] | None = None,
                              frequencies: Sequence[float] | None = None, ax=None,
                              table: pd.DataFrame | None = None, value: str | None = None):
@@ -104,16 +130,13 @@ def plot_sdc_vs_acceleration(model: SdcModel, *, fills: Sequence[float] | None =
     pts = _points(model, table, value)
     lo, hi = model.bounds["acceleration_g"]
     acc = np.linspace(lo, hi, _CURVE_POINTS)
-    for panel, fill in zip(axes, fills, strict=True):
-        for freq in frequencies:
-            (line,) = panel.plot(acc, model(fill, acc, freq), label=f"{freq:g} Hz")
-            sel = pts[np.isclose(pts["fill_percent"], fill)
-                      & np.isclose(pts["frequency_hz"], freq)]
-            _mark(panel, sel, "acceleration_g", line.get_color(), f"{freq:g} Hz")
-        panel.set_title(f"SDC at {fill:g} % fill")
-        panel.set_xlabel("acceleration amplitude [g]")
-        panel.set_ylabel("SDC [-]")
-        panel.legend(fontsize="small", ncols=2)
+    _draw_panels(axes, pts, x=acc, x_column="acceleration_g",
+                 panels=fills, panel_column="fill_percent",
+                 curves=frequencies, curve_column="frequency_hz",
+                 curve=lambda fill, freq: model(fill, acc, freq),
+                 curve_label=lambda freq: f"{freq:g} Hz",
+                 title=lambda fill: f"SDC at {fill:g} % fill",
+                 xlabel="acceleration amplitude [g]", log_x=False)
     return fig
 
 
@@ -148,18 +171,13 @@ def plot_sdc_vs_frequency(model: SdcModel, *, accelerations: Sequence[float] | N
     pts = _points(model, table, value)
     lo, hi = model.bounds["frequency_hz"]
     freq = np.geomspace(lo, hi, _CURVE_POINTS) if log_x else np.linspace(lo, hi, _CURVE_POINTS)
-    for panel, acc in zip(axes, accelerations, strict=True):
-        for fill in fills:
-            (line,) = panel.plot(freq, model(fill, acc, freq), label=f"{fill:g} %")
-            sel = pts[np.isclose(pts["fill_percent"], fill)
-                      & np.isclose(pts["acceleration_g"], acc)]
-            _mark(panel, sel, "frequency_hz", line.get_color(), f"{fill:g} %")
-        if log_x:
-            panel.set_xscale("log")
-        panel.set_title(f"SDC at {acc:g} g")
-        panel.set_xlabel("frequency [Hz]")
-        panel.set_ylabel("SDC [-]")
-        panel.legend(fontsize="small", ncols=2)
+    _draw_panels(axes, pts, x=freq, x_column="frequency_hz",
+                 panels=accelerations, panel_column="acceleration_g",
+                 curves=fills, curve_column="fill_percent",
+                 curve=lambda acc, fill: model(fill, acc, freq),
+                 curve_label=lambda fill: f"{fill:g} %",
+                 title=lambda acc: f"SDC at {acc:g} g",
+                 xlabel="frequency [Hz]", log_x=log_x)
     return fig
 
 
