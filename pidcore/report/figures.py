@@ -74,21 +74,24 @@ def _default(values: Sequence[float] | None, axis: np.ndarray) -> list[float]:
     return [float(v) for v in (axis if values is None else values)]
 
 
-def _draw_panels(axes, pts: pd.DataFrame, *, x: np.ndarray, x_column: str,
-                 panels: Sequence[float], panel_column: str,
-                 curves: Sequence[float], curve_column: str,
-                 curve: Callable[[float, float], np.ndarray],
+def _draw_family(model: SdcModel, *, panels: Sequence[float], panel_column: str,
+                 curves: Sequence[float], curve_column: str, x_column: str, log_x: bool,
+                 ax, table: pd.DataFrame | None, value: str | None,
                  curve_label: Callable[[float], str], title: Callable[[float], str],
-                 xlabel: str, log_x: bool) -> None:
-    """One panel per value of ``panels``, in it one curve per value of ``curves``.
-
-    ``curve(panel_value, curve_value)`` is the model along ``x``; the data points at the same
-    panel and curve value are marked right after each curve (see :func:`_mark`).
-    """
+                 xlabel: str):
+    """One panel per value of ``panels``, in it one curve per value of ``curves`` along
+    ``x_column`` over the model's bounds; the data points at the same panel and curve value
+    are marked right after each curve (see :func:`_mark`). Returns the figure."""
+    fig, axes = _figure_and_axes(len(panels), ax)
+    pts = _points(model, table, value)
+    lo, hi = model.bounds[x_column]
+    x = np.geomspace(lo, hi, _CURVE_POINTS) if log_x else np.linspace(lo, hi, _CURVE_POINTS)
     for panel, panel_value in zip(axes, panels, strict=True):
         for curve_value in curves:
+            point = {panel_column: panel_value, curve_column: curve_value, x_column: x}
             label = curve_label(curve_value)
-            (line,) = panel.plot(x, curve(panel_value, curve_value), label=label)
+            (line,) = panel.plot(x, model(point["fill_percent"], point["acceleration_g"],
+                                          point["frequency_hz"]), label=label)
             sel = pts[np.isclose(pts[panel_column], panel_value)
                       & np.isclose(pts[curve_column], curve_value)]
             _mark(panel, sel, x_column, line.get_color(), label)
@@ -98,6 +101,7 @@ def _draw_panels(axes, pts: pd.DataFrame, *, x: np.ndarray, x_column: str,
         panel.set_xlabel(xlabel)
         panel.set_ylabel("SDC [-]")
         panel.legend(fontsize="small", ncols=2)
+    return fig
 
 
 def plot_sdc_vs_acceleration(model: SdcModel, *, fills: Sequence[float] | None = None,
@@ -124,20 +128,12 @@ def plot_sdc_vs_acceleration(model: SdcModel, *, fills: Sequence[float] | None =
     -------
     matplotlib.figure.Figure
     """
-    fills = _default(fills, model.axes[0])
-    frequencies = _default(frequencies, model.axes[2])
-    fig, axes = _figure_and_axes(len(fills), ax)
-    pts = _points(model, table, value)
-    lo, hi = model.bounds["acceleration_g"]
-    acc = np.linspace(lo, hi, _CURVE_POINTS)
-    _draw_panels(axes, pts, x=acc, x_column="acceleration_g",
-                 panels=fills, panel_column="fill_percent",
-                 curves=frequencies, curve_column="frequency_hz",
-                 curve=lambda fill, freq: model(fill, acc, freq),
-                 curve_label=lambda freq: f"{freq:g} Hz",
-                 title=lambda fill: f"SDC at {fill:g} % fill",
-                 xlabel="acceleration amplitude [g]", log_x=False)
-    return fig
+    return _draw_family(model, panels=_default(fills, model.axes[0]), panel_column="fill_percent",
+                        curves=_default(frequencies, model.axes[2]),
+                        curve_column="frequency_hz", x_column="acceleration_g", log_x=False,
+                        ax=ax, table=table, value=value, curve_label=lambda f: f"{f:g} Hz",
+                        title=lambda fill: f"SDC at {fill:g} % fill",
+                        xlabel="acceleration amplitude [g]")
 
 
 def plot_sdc_vs_frequency(model: SdcModel, *, accelerations: Sequence[float] | None = None,
@@ -165,20 +161,12 @@ def plot_sdc_vs_frequency(model: SdcModel, *, accelerations: Sequence[float] | N
     -------
     matplotlib.figure.Figure
     """
-    accelerations = _default(accelerations, model.axes[1])
-    fills = _default(fills, model.axes[0])
-    fig, axes = _figure_and_axes(len(accelerations), ax)
-    pts = _points(model, table, value)
-    lo, hi = model.bounds["frequency_hz"]
-    freq = np.geomspace(lo, hi, _CURVE_POINTS) if log_x else np.linspace(lo, hi, _CURVE_POINTS)
-    _draw_panels(axes, pts, x=freq, x_column="frequency_hz",
-                 panels=accelerations, panel_column="acceleration_g",
-                 curves=fills, curve_column="fill_percent",
-                 curve=lambda acc, fill: model(fill, acc, freq),
-                 curve_label=lambda fill: f"{fill:g} %",
-                 title=lambda acc: f"SDC at {acc:g} g",
-                 xlabel="frequency [Hz]", log_x=log_x)
-    return fig
+    return _draw_family(model, panels=_default(accelerations, model.axes[1]),
+                        panel_column="acceleration_g", curves=_default(fills, model.axes[0]),
+                        curve_column="fill_percent", x_column="frequency_hz", log_x=log_x,
+                        ax=ax, table=table, value=value,
+                        curve_label=lambda fill: f"{fill:g} %",
+                        title=lambda acc: f"SDC at {acc:g} g", xlabel="frequency [Hz]")
 
 
 def save_figure(fig, out_dir: str | Path, stem: str) -> list[Path]:
