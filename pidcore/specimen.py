@@ -441,6 +441,21 @@ def _table_material(name: str, where: str, role: str | None):
     return row
 
 
+def _complete_from_material(table: dict[str, Any], where: str, name: str, role: str | None,
+                            columns: tuple[tuple[str, str], ...]) -> None:
+    """Fill each key of ``columns`` (key, materials.csv column) that ``table`` does not state
+    inline from material ``name``'s row; a key neither stated nor in the table is an error
+    naming ``where`` (the material key)."""
+    row = _table_material(name, where, role)
+    for key, column in columns:
+        if key not in table:
+            if row is None:
+                raise ParameterError(
+                    f"{where}: unknown material {name!r} (not in materials.csv) and no "
+                    f"inline {key}")
+            table[key] = getattr(row, column)
+
+
 def _from_mapping(data: Mapping[str, Any], *, source: str) -> Specimen:
     top = _take({k: v for k, v in data.items() if not isinstance(v, Mapping)}, "", "top level")
     for key, value in data.items():
@@ -456,28 +471,18 @@ def _from_mapping(data: Mapping[str, Any], *, source: str) -> Specimen:
             raise ParameterError(f"[{section}]: missing table")
 
     cell = _take(data["cell"], "cell", "[cell]")
-    wall = _table_material(cell["wall_material"], "[cell] wall_material", None)
-    for key, column in (("wall_youngs_modulus_pa", "youngs_modulus_pa"),
-                        ("wall_poisson_ratio", "poisson_ratio"),
-                        ("wall_density_kg_m3", "density_kg_m3")):
-        if key not in cell:
-            if wall is None:
-                raise ParameterError(
-                    f"[cell] wall_material: unknown material {cell['wall_material']!r} (not in "
-                    f"materials.csv) and no inline {key}")
-            cell[key] = getattr(wall, column)
+    _complete_from_material(cell, "[cell] wall_material", cell["wall_material"], None,
+                            (("wall_youngs_modulus_pa", "youngs_modulus_pa"),
+                             ("wall_poisson_ratio", "poisson_ratio"),
+                             ("wall_density_kg_m3", "density_kg_m3")))
 
     particles = _take(data["particles"], "particles", "[particles]")
-    row = _table_material(particles["material"], "[particles] material", "particle")
-    for key, column in (("density_kg_m3", "density_kg_m3"),
-                        ("youngs_modulus_pa", "youngs_modulus_pa"),
-                        ("poisson_ratio", "poisson_ratio"), ("radius_m", "default_radius_m")):
-        if key not in particles:
-            if row is None:
-                raise ParameterError(
-                    f"[particles] material: unknown material {particles['material']!r} (not "
-                    f"in materials.csv) and no inline {key}")
-            particles[key] = getattr(row, column)
+    _complete_from_material(particles, "[particles] material", particles["material"],
+                            "particle",
+                            (("density_kg_m3", "density_kg_m3"),
+                             ("youngs_modulus_pa", "youngs_modulus_pa"),
+                             ("poisson_ratio", "poisson_ratio"),
+                             ("radius_m", "default_radius_m")))
 
     pairs_table = data["pairs"]
     if not isinstance(pairs_table, Mapping):

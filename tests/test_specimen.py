@@ -69,7 +69,14 @@ def test_with_values_addresses_every_numeric_field_and_checks_the_result():
     ("radius_m = 0.00125", "radius_m = 0.003", r"radius_m: a sphere of radius 3 mm does not fit"),
     ("static_friction = 0.14", "static_friction = 0.1", r"particle_wall\] static_friction"),
     ('material = "acrylic"\nradius_m = 0.00125\ndensity_kg_m3 = 1180.0',
-     'material = "unobtainium"\nradius_m = 0.00125', "unknown material 'unobtainium'"),
+     'material = "unobtainium"\nradius_m = 0.00125',
+     r"\[particles\] material: unknown material 'unobtainium' \(not in materials.csv\) and no "
+     r"inline density_kg_m3"),
+    # the same rule for the cell wall: a key neither inline nor in materials.csv is named
+    ('wall_material = "aluminium_wall"\nwall_youngs_modulus_pa = 72000000000.0',
+     'wall_material = "unobtainium"',
+     r"\[cell\] wall_material: unknown material 'unobtainium' \(not in materials.csv\) and "
+     r"no inline wall_youngs_modulus_pa"),
     ("count = 441", "count = 441\ncolour = 3", r"\[cell\] colour: unknown key"),
     ('shape = "hexagonal"', 'shape = "round"', r"\[cell\] shape: expected one of"),
     ("poisson_ratio = 0.402", "poisson_ratio = 0.402\ncount_per_cell = 23",

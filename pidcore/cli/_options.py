@@ -3,9 +3,27 @@
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
 from .. import defaults
 from ..measure import AnalysisOptions
+
+#: Help of ``--store`` where it names the default store.
+STORE_HELP = f"HDF5 store (default ./{defaults.STORE_PATH})"
+
+
+def add_store_option(p: argparse.ArgumentParser, *, flag: str = "--store",
+                     default: Path | None = defaults.STORE_PATH,
+                     help: str = STORE_HELP) -> None:
+    """An HDF5 store file option (``--store``, ``--dem-store``) read as a :class:`Path`."""
+    p.add_argument(flag, metavar="FILE", type=Path, default=default, help=help)
+
+
+def add_json_option(p: argparse.ArgumentParser, *, progress: bool = False) -> None:
+    """``--json`` (one JSON document on stdout) and, with ``progress``, ``--no-progress``."""
+    p.add_argument("--json", action="store_true", help="one JSON document on stdout")
+    if progress:
+        p.add_argument("--no-progress", action="store_true", help="no progress bar")
 
 
 def add_measurement_options(p: argparse.ArgumentParser) -> None:

@@ -7,9 +7,8 @@ import json
 import sys
 from pathlib import Path
 
-from .. import defaults
 from ..measure import analyze_file
-from ._options import add_measurement_options, analysis_options
+from ._options import add_json_option, add_measurement_options, add_store_option, analysis_options
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -22,10 +21,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     p.add_argument("paths", nargs="+", metavar="PATH", type=Path, help="export files")
     add_measurement_options(p)
-    p.add_argument("--store", metavar="FILE", type=Path, default=defaults.STORE_PATH,
-                   help=f"HDF5 store (default ./{defaults.STORE_PATH})")
+    add_store_option(p)
     p.add_argument("--no-store", action="store_true", help="do not save to the store")
-    p.add_argument("--json", action="store_true", help="one JSON document on stdout")
+    add_json_option(p)
     p.set_defaults(func=run)
 
 

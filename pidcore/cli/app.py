@@ -12,6 +12,7 @@ from pathlib import Path
 
 from .. import defaults
 from ..errors import ParameterError
+from ._options import add_store_option
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -25,11 +26,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     p.add_argument("--port", type=int, default=defaults.APP_PORT,
                    help=f"TCP port on localhost (default {defaults.APP_PORT})")
-    p.add_argument("--store", metavar="FILE", type=Path, default=defaults.STORE_PATH,
-                   help=f"HDF5 store the app uses (default ./{defaults.STORE_PATH})")
-    p.add_argument("--dem-store", metavar="FILE", type=Path, default=None,
-                   help="read-only store of reference DEM runs shown next to the store's own "
-                        "(default: data_samples/dem_table3.h5 if it exists here)")
+    add_store_option(p, help=f"HDF5 store the app uses (default ./{defaults.STORE_PATH})")
+    add_store_option(p, flag="--dem-store", default=None,
+                     help="read-only store of reference DEM runs shown next to the store's own "
+                          "(default: data_samples/dem_table3.h5 if it exists here)")
     p.add_argument("--print-command", action="store_true",
                    help="print the streamlit command line instead of running it")
     p.set_defaults(func=run)

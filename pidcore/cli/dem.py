@@ -18,6 +18,7 @@ from ..constants import (
     VIBRATED_MASS_CONVENTIONS,
 )
 from ..errors import ParameterError
+from ._options import add_json_option, add_store_option
 
 #: Keys of ``pidcore dem run --json`` (more may follow them).
 JSON_KEYS = ("sdc", "sdc_stderr", "energy_per_cycle_j", "energy_dissipated_normal_j",
@@ -57,11 +58,10 @@ def _register_run(sub: argparse._SubParsersAction) -> None:
                    help="fill fraction, %% of the 100 %% count (see --fill-reference); "
                         "default: the specimen's count_per_cell or fill_percent")
     _add_config_options(p)
-    p.add_argument("--store", metavar="FILE", type=Path, default=None,
-                   help="run cache: reuse the run stored there with the same inputs, else "
-                        "simulate and save it")
-    p.add_argument("--json", action="store_true", help="one JSON document on stdout")
-    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    add_store_option(p, default=None,
+                     help="run cache: reuse the run stored there with the same inputs, else "
+                          "simulate and save it")
+    add_json_option(p, progress=True)
     p.set_defaults(func=run)
 
 
@@ -123,10 +123,8 @@ def _register_sweep(sub: argparse._SubParsersAction) -> None:
                    help="local processes (default: all cores)")
     p.add_argument("--scheduler", metavar="ADDR", default=None,
                    help="dask.distributed scheduler address (needs the 'distributed' extra)")
-    p.add_argument("--store", metavar="FILE", type=Path, default=defaults.STORE_PATH,
-                   help=f"HDF5 store (default ./{defaults.STORE_PATH})")
-    p.add_argument("--json", action="store_true", help="one JSON document on stdout")
-    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    add_store_option(p)
+    add_json_option(p, progress=True)
     p.set_defaults(func=sweep)
 
 

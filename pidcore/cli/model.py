@@ -14,6 +14,7 @@ from pathlib import Path
 from .. import defaults
 from ..constants import PARTICLE_MATERIALS, VIBRATED_MASS_CONVENTIONS
 from ..errors import ParameterError
+from ._options import add_store_option
 
 
 def _float_list(text: str) -> list[float]:
@@ -40,8 +41,7 @@ def _add_model_source(p: argparse.ArgumentParser) -> None:
     p.add_argument("--table", choices=("paper", "store"), default="paper",
                    help="SDC data: the paper's Table 3 DEM column or the store's DEM runs "
                         "(default paper)")
-    p.add_argument("--store", metavar="FILE", type=Path, default=defaults.STORE_PATH,
-                   help=f"HDF5 store for --table store (default ./{defaults.STORE_PATH})")
+    add_store_option(p, help=f"HDF5 store for --table store (default ./{defaults.STORE_PATH})")
     p.add_argument("--where", metavar="COLUMN=VALUE", action="append", default=[],
                    help="with --table store: keep runs whose COLUMN equals VALUE (repeatable), "
                         "e.g. --where material=acrylic")

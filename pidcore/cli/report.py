@@ -10,7 +10,7 @@ from pathlib import Path
 
 from ..constants import DRIVE_DIRECTIONS, PARTICLE_MATERIALS
 from ..report.render import format_cell
-from ._options import add_measurement_options, analysis_options
+from ._options import add_measurement_options, add_store_option, analysis_options
 
 #: Columns of the short table printed on stdout.
 _STDOUT_COLUMNS = (
@@ -33,11 +33,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help="measurement exports to analyse (UFF58, CSV/TXT, MAT, HDF5)")
     p.add_argument("--out", metavar="DIR", type=Path, required=True,
                    help="report folder (new, empty or an earlier report, replaced atomically)")
-    p.add_argument("--store", metavar="FILE", type=Path, default=None,
-                   help="HDF5 store: analyses of FILES are added to it; without FILES its "
-                        "analyses are reported")
-    p.add_argument("--dem-store", metavar="FILE", type=Path, default=None,
-                   help="HDF5 store holding the DEM runs (default: --store); only read")
+    add_store_option(p, default=None,
+                     help="HDF5 store: analyses of FILES are added to it; without FILES its "
+                          "analyses are reported")
+    add_store_option(p, flag="--dem-store", default=None,
+                     help="HDF5 store holding the DEM runs (default: --store); only read")
     p.add_argument("--format", metavar="FMT", default="all",
                    help="all or a comma-separated list of csv, md, html, tex, pdf (default all)")
     p.add_argument("--fill", metavar="PERCENT", type=float, default=None,

@@ -6,6 +6,8 @@ import argparse
 import json
 from pathlib import Path
 
+from ._options import add_json_option
+
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     p = subparsers.add_parser(
@@ -19,7 +21,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                     "negative mass, particles that do not fit, static below sliding friction, "
                     "an unknown material) and print what follows from it.")
     check.add_argument("file", metavar="FILE", type=Path, help="specimen TOML file")
-    check.add_argument("--json", action="store_true", help="one JSON document on stdout")
+    add_json_option(check)
     check.set_defaults(func=run_check)
 
 

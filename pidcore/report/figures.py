@@ -14,7 +14,7 @@ drawn as open markers labelled ``"... filled"``.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -74,6 +74,36 @@ def _default(values: Sequence[float] | None, axis: np.ndarray) -> list[float]:
     return [float(v) for v in (axis if values is None else values)]
 
 
+def _draw_family(model: SdcModel, *, panels: Sequence[float], panel_column: str,
+                 curves: Sequence[float], curve_column: str, x_column: str, log_x: bool,
+                 ax, table: pd.DataFrame | None, value: str | None,
+                 curve_label: Callable[[float], str], title: Callable[[float], str],
+                 xlabel: str):
+    """One panel per value of ``panels``, in it one curve per value of ``curves`` along
+    ``x_column`` over the model's bounds; the data points at the same panel and curve value
+    are marked right after each curve (see :func:`_mark`). Returns the figure."""
+    fig, axes = _figure_and_axes(len(panels), ax)
+    pts = _points(model, table, value)
+    lo, hi = model.bounds[x_column]
+    x = np.geomspace(lo, hi, _CURVE_POINTS) if log_x else np.linspace(lo, hi, _CURVE_POINTS)
+    for panel, panel_value in zip(axes, panels, strict=True):
+        for curve_value in curves:
+            point = {panel_column: panel_value, curve_column: curve_value, x_column: x}
+            label = curve_label(curve_value)
+            (line,) = panel.plot(x, model(point["fill_percent"], point["acceleration_g"],
+                                          point["frequency_hz"]), label=label)
+            sel = pts[np.isclose(pts[panel_column], panel_value)
+                      & np.isclose(pts[curve_column], curve_value)]
+            _mark(panel, sel, x_column, line.get_color(), label)
+        if log_x:
+            panel.set_xscale("log")
+        panel.set_title(title(panel_value))
+        panel.set_xlabel(xlabel)
+        panel.set_ylabel("SDC [-]")
+        panel.legend(fontsize="small", ncols=2)
+    return fig
+
+
 def plot_sdc_vs_acceleration(model: SdcModel, *, fills: Sequence[float] | None = None,
                              frequencies: Sequence[float] | None = None, ax=None,
                              table: pd.DataFrame | None = None, value: str | None = None):
@@ -98,23 +128,12 @@ def plot_sdc_vs_acceleration(model: SdcModel, *, fills: Sequence[float] | None =
     -------
     matplotlib.figure.Figure
     """
-    fills = _default(fills, model.axes[0])
-    frequencies = _default(frequencies, model.axes[2])
-    fig, axes = _figure_and_axes(len(fills), ax)
-    pts = _points(model, table, value)
-    lo, hi = model.bounds["acceleration_g"]
-    acc = np.linspace(lo, hi, _CURVE_POINTS)
-    for panel, fill in zip(axes, fills, strict=True):
-        for freq in frequencies:
-            (line,) = panel.plot(acc, model(fill, acc, freq), label=f"{freq:g} Hz")
-            sel = pts[np.isclose(pts["fill_percent"], fill)
-                      & np.isclose(pts["frequency_hz"], freq)]
-            _mark(panel, sel, "acceleration_g", line.get_color(), f"{freq:g} Hz")
-        panel.set_title(f"SDC at {fill:g} % fill")
-        panel.set_xlabel("acceleration amplitude [g]")
-        panel.set_ylabel("SDC [-]")
-        panel.legend(fontsize="small", ncols=2)
-    return fig
+    return _draw_family(model, panels=_default(fills, model.axes[0]), panel_column="fill_percent",
+                        curves=_default(frequencies, model.axes[2]),
+                        curve_column="frequency_hz", x_column="acceleration_g", log_x=False,
+                        ax=ax, table=table, value=value, curve_label=lambda f: f"{f:g} Hz",
+                        title=lambda fill: f"SDC at {fill:g} % fill",
+                        xlabel="acceleration amplitude [g]")
 
 
 def plot_sdc_vs_frequency(model: SdcModel, *, accelerations: Sequence[float] | None = None,
@@ -142,25 +161,12 @@ def plot_sdc_vs_frequency(model: SdcModel, *, accelerations: Sequence[float] | N
     -------
     matplotlib.figure.Figure
     """
-    accelerations = _default(accelerations, model.axes[1])
-    fills = _default(fills, model.axes[0])
-    fig, axes = _figure_and_axes(len(accelerations), ax)
-    pts = _points(model, table, value)
-    lo, hi = model.bounds["frequency_hz"]
-    freq = np.geomspace(lo, hi, _CURVE_POINTS) if log_x else np.linspace(lo, hi, _CURVE_POINTS)
-    for panel, acc in zip(axes, accelerations, strict=True):
-        for fill in fills:
-            (line,) = panel.plot(freq, model(fill, acc, freq), label=f"{fill:g} %")
-            sel = pts[np.isclose(pts["fill_percent"], fill)
-                      & np.isclose(pts["acceleration_g"], acc)]
-            _mark(panel, sel, "frequency_hz", line.get_color(), f"{fill:g} %")
-        if log_x:
-            panel.set_xscale("log")
-        panel.set_title(f"SDC at {acc:g} g")
-        panel.set_xlabel("frequency [Hz]")
-        panel.set_ylabel("SDC [-]")
-        panel.legend(fontsize="small", ncols=2)
-    return fig
+    return _draw_family(model, panels=_default(accelerations, model.axes[1]),
+                        panel_column="acceleration_g", curves=_default(fills, model.axes[0]),
+                        curve_column="fill_percent", x_column="frequency_hz", log_x=log_x,
+                        ax=ax, table=table, value=value,
+                        curve_label=lambda fill: f"{fill:g} %",
+                        title=lambda acc: f"SDC at {acc:g} g", xlabel="frequency [Hz]")
 
 
 def save_figure(fig, out_dir: str | Path, stem: str) -> list[Path]:
