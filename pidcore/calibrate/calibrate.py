@@ -120,7 +120,8 @@ def _requests(points: Sequence[MeasuredPoint], dem_specs: Sequence[ParameterSpec
     for point in points:
         case = LoadCase(point.frequency_hz, point.acceleration_g, point.fill_percent,
                         point.material)
-        out.append([RunRequest(case, tuple((s.name, float(v)) for s, v in zip(dem_specs, row)),
+        out.append([RunRequest(case, tuple((s.name, float(v))
+                                           for s, v in zip(dem_specs, row, strict=True)),
                                config) for row in design])
     return out
 

@@ -73,7 +73,7 @@ class ParameterSpec:
 #: Every parameter `--fit` accepts, with its default prior. The DEM defaults are the materials
 #: table's acrylic values (Table 1).
 CATALOGUE: dict[str, ParameterSpec] = {spec.name: spec for spec in (
-    ParameterSpec("fixture_mass_kg", "observation", 0.0, 0.0, 0.5,
+    ParameterSpec("fixture_mass_kg", "observation", 0.0, 0.0, 1.0,
                   "mass moving with the coupon above the force gauge"),
     ParameterSpec("baseline_loss_factor", "observation", 0.0, 0.0, 0.05,
                   "loss factor of the empty coupon and fixture"),

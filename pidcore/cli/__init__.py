@@ -15,7 +15,8 @@ from .. import __version__
 from ..errors import PidcoreError
 
 #: Sub-command modules, each exposing ``register(subparsers) -> None``.
-_COMMAND_MODULES = ("analyze", "dem", "bench", "report", "model", "app", "samples")
+_COMMAND_MODULES = ("analyze", "dem", "bench", "report", "model", "app", "samples",
+                    "calibrate")
 
 
 def build_parser() -> argparse.ArgumentParser:
