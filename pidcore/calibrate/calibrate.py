@@ -7,6 +7,7 @@ the measurement), but its measured value never enters the fold's likelihood.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 import time
@@ -133,12 +134,14 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: Sequence[str],
               cells: int = CALIBRATION_CELLS, seed: int = defaults.DEM_SEED,
               steady_cycles: int | None = None, design_size: int | None = None,
               workers: int = 2, cross_validate: str | None = None, method: str = "auto",
-              progress: bool = True, posterior_seed: int = 0) -> CalibrationResult:
+              progress: bool = True, posterior_seed: int = 0,
+              dem_config: DemConfig | None = None) -> CalibrationResult:
     """Fit ``fit`` parameters to measured SDCs (see the package docstring for the model).
 
     DEM runs go to (and are reused from) the store at ``store_path``. ``discrepancy``: fix the
     relative model discrepancy instead of fitting it. ``cross_validate="loo"``: also predict
-    every point from a fit without it.
+    every point from a fit without it. ``dem_config``: numerical DEM settings to start from
+    (cells, seed and steady cycles are then set from the arguments).
     """
     start = time.perf_counter()
     points = list(points)
@@ -160,7 +163,8 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: Sequence[str],
     if dem_specs and n_design < 2:
         raise ParameterError(f"--design-size: expected >= 2 with DEM parameters, got {n_design}")
     design = design_points(dem_specs, n_design, seed=seed)
-    config = DemConfig(cells=cells, seed=seed, steady_cycles=steady_cycles)
+    config = dataclasses.replace(dem_config or DemConfig(), cells=cells, seed=seed,
+                                 steady_cycles=steady_cycles)
     requests = _requests(points, dem_specs, design, config)
     runs = run_requests([r for row in requests for r in row], store_path=store_path,
                         workers=workers, progress=progress)
