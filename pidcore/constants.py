@@ -26,9 +26,14 @@ StartProtocol = Literal["rest", "with_cell"]
 #: Tangential contact force (Eq. 5): "stick_slip" = elastic tangential spring capped by
 #: mu |f_n| (Cundall-Strack); "coulomb" = Eq. 5 as written, regularised near v_t = 0.
 TangentialModel = Literal["stick_slip", "coulomb"]
+#: Tangential spring stiffness of the stick-slip model: "constant" = Mindlin's k_t at a
+#: reference overlap; "mindlin" = 8 G* sqrt(R* delta) of the current overlap.
+TangentialStiffnessModel = Literal["constant", "mindlin"]
 #: Packing the drive starts from: "dense" = settled without friction, then settled again
 #: with friction; "loose" = settled with friction from the random drop.
 StartPacking = Literal["dense", "loose"]
+#: Cell shape of a specimen (``[cell] shape``); cylindrical and rectangular cells may follow.
+CellShape = Literal["hexagonal"]
 #: Report output formats.
 ReportFormat = Literal["csv", "md", "html", "tex", "pdf"]
 
@@ -41,7 +46,9 @@ VIBRATED_MASS_CONVENTIONS: tuple[str, ...] = get_args(VibratedMassConvention)
 START_PROTOCOLS: tuple[str, ...] = get_args(StartProtocol)
 TANGENTIAL_MODELS: tuple[str, ...] = get_args(TangentialModel)
 START_PACKINGS: tuple[str, ...] = get_args(StartPacking)
+TANGENTIAL_STIFFNESS_MODELS: tuple[str, ...] = get_args(TangentialStiffnessModel)
 REPORT_FORMATS: tuple[str, ...] = get_args(ReportFormat)
+CELL_SHAPES: tuple[str, ...] = get_args(CellShape)
 
 #: Standard gravity, m/s^2 (ISO 80000-3); used for g <-> m/s^2 and for gravity on particles.
 STANDARD_GRAVITY = 9.80665

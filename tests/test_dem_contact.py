@@ -31,12 +31,14 @@ def test_hertz_constant_from_tables():
     e_star = 1 / ((1 - acr.poisson_ratio**2) / acr.youngs_modulus_pa
                   + (1 - wall.poisson_ratio**2) / wall.youngs_modulus_pa)
     law = ContactLaw.for_material("acrylic")
-    assert law.stiffness_pw == pytest.approx(4 / 3 * e_star * math.sqrt(1.25e-3), rel=1e-12)
+    assert law.pair_wall.stiffness == pytest.approx(4 / 3 * e_star * math.sqrt(1.25e-3), rel=1e-12)
     # particle pair: R* = r/2, E* = E / (2 (1 - nu^2))
     e_pp = acr.youngs_modulus_pa / (2 * (1 - acr.poisson_ratio**2))
-    assert law.stiffness_pp == pytest.approx(4 / 3 * e_pp * math.sqrt(0.625e-3), rel=1e-12)
+    assert law.pair_particle.stiffness == pytest.approx(4 / 3 * e_pp * math.sqrt(0.625e-3),
+                                                        rel=1e-12)
     assert effective_modulus(1.0, 0.0, 1.0, 0.0) == pytest.approx(0.5)
-    assert law.friction_pw == pair_properties("acrylic", "aluminium_wall").sliding_friction
+    assert law.pair_wall.sliding_friction == pair_properties(
+        "acrylic", "aluminium_wall").sliding_friction
 
 
 def test_damping_constant_eq3():
@@ -65,13 +67,14 @@ def test_no_attraction_clips_at_zero_literal_does_not():
 
 
 def test_elastic_impact_conserves_energy_and_reaches_hertz_overlap():
-    law = dataclasses.replace(ContactLaw.for_material("acrylic"), damping_pw=0.0,
-                              friction_pw=0.0)
+    base = ContactLaw.for_material("acrylic")
+    law = dataclasses.replace(base, pair_wall=dataclasses.replace(
+        base.pair_wall, damping=0.0, sliding_friction=0.0, static_friction=0.0))
     out = simulate_impact(impact_speed_m_s=0.5, dt_s=DT, law=law)
     # velocity Verlet on a conservative contact: energy error O((dt/t_c)^2) ~ 1e-3
     assert out.restitution == pytest.approx(1.0, abs=2e-3)
     assert out.dissipated_normal_j == 0.0
-    assert maximum_overlap(stiffness=law.stiffness_pw, mass_kg=law.mass_kg,
+    assert maximum_overlap(stiffness=law.pair_wall.stiffness, mass_kg=law.mass_kg,
                            impact_speed_m_s=0.5) < 0.05 * law.radius_m
 
 
@@ -81,7 +84,7 @@ def test_restitution_literal_matches_table(pair, speed):
     # Eq. 3 is the exact alpha of Hertz + Tsuji damping with the attractive end kept: the
     # measured e matches the table to 0.1 % at dt -> 0; >= 15 steps per contact adds < 1 %.
     law = ContactLaw.for_material("acrylic")
-    target = law.restitution_pw if pair == "wall" else law.restitution_pp
+    target = law.pair_wall.restitution if pair == "wall" else law.pair_particle.restitution
     e = measure_restitution(pair=pair, impact_speed_m_s=speed, dt_s=DT, mode="literal")
     assert e == pytest.approx(target, rel=0.01)
 
@@ -134,7 +137,7 @@ def test_sliding_friction_slows_but_never_reverses(model, vt):
                           tangential_model=model)
     after = out.tangential_velocity_after_m_s
     assert np.sign(after) == np.sign(vt)
-    drop = law.friction_pw * (1 + out.restitution) * vn
+    drop = law.pair_wall.sliding_friction * (1 + out.restitution) * vn
     # stick-slip: the spring needs a few steps to load up to mu |f_n| at contact start
     assert abs(after) == pytest.approx(abs(vt) - drop, rel=2e-3)
 
@@ -168,7 +171,8 @@ def test_stuck_contact_dissipates_nothing_but_regularised_coulomb_creeps():
         advance(state, rest, 20000)  # settle on the floor
         state.step = 0  # drive clock: the cell moves at -a/w when the drive starts
         omega = 2 * np.pi * 100
-        accel = 0.5 * law.friction_pw * 9.80665  # rolling needs 2/7 of it from friction
+        # rolling needs 2/7 of it from friction
+        accel = 0.5 * law.pair_wall.sliding_friction * 9.80665
         state.vel[0] += -accel / omega  # moving with the floor at the drive start
         shaken = dataclasses.replace(rest, omega_rad_s=omega, accel_m_s2=accel, direction="x")
         tally, _ = advance(state, shaken, 50000)
@@ -209,7 +213,7 @@ def test_particle_at_rest_on_floor_stays_at_rest():
     state = CellsState.from_positions(np.array([[[2e-4, -1e-4, z0]]]), mass_kg=law.mass_kg)
     settings = KernelSettings(law=law, geometry=geometry, dt_s=DT)
     advance(state, settings, 40000)  # 40 ms: many damped contact oscillation periods
-    delta_static = (law.mass_kg * 9.80665 / law.stiffness_pw) ** (2 / 3)
+    delta_static = (law.mass_kg * 9.80665 / law.pair_wall.stiffness) ** (2 / 3)
     assert state.pos[0, 0, 0] == 2e-4 and state.pos[1, 0, 0] == -1e-4  # no lateral drift
     assert state.pos[2, 0, 0] == pytest.approx(z0 - delta_static, rel=1e-9, abs=1e-3
                                                * delta_static)

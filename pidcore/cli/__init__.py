@@ -15,8 +15,8 @@ from .. import __version__
 from ..errors import PidcoreError
 
 #: Sub-command modules, each exposing ``register(subparsers) -> None``.
-_COMMAND_MODULES = ("analyze", "dem", "bench", "report", "model", "app", "samples",
-                    "calibrate")
+_COMMAND_MODULES = ("analyze", "dem", "specimen", "bench", "report", "model", "app",
+                    "samples", "calibrate")
 
 
 def build_parser() -> argparse.ArgumentParser:

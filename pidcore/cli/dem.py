@@ -17,6 +17,7 @@ from ..constants import (
     TANGENTIAL_MODELS,
     VIBRATED_MASS_CONVENTIONS,
 )
+from ..errors import ParameterError
 
 #: Keys of ``pidcore dem run --json`` (more may follow them).
 JSON_KEYS = ("sdc", "sdc_stderr", "energy_per_cycle_j", "energy_dissipated_normal_j",
@@ -45,17 +46,20 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 def _register_run(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "run", help="simulate one load case",
-        description="Simulate K independent cells of the 441 of a 100 x 100 mm coupon under "
+        description="Simulate K independent cells of the specimen's coupon (default: the "
+                    "paper's, 441 cells of a 100 x 100 mm coupon) under "
                     "harmonic drive and report the specific damping capacity (Eq. 8-10).")
     p.add_argument("--frequency", metavar="HZ", type=float, required=True,
                    help="drive frequency, Hz")
     p.add_argument("--acceleration", metavar="G", type=float, required=True,
                    help="acceleration amplitude, g")
-    p.add_argument("--fill", metavar="PERCENT", type=float, required=True,
-                   help="fill fraction, %% of the 100 %% count (see --fill-reference)")
+    p.add_argument("--fill", metavar="PERCENT", type=float, default=None,
+                   help="fill fraction, %% of the 100 %% count (see --fill-reference); "
+                        "default: the specimen's count_per_cell or fill_percent")
     _add_config_options(p)
     p.add_argument("--store", metavar="FILE", type=Path, default=None,
-                   help="also save the run to this HDF5 store")
+                   help="run cache: reuse the run stored there with the same inputs, else "
+                        "simulate and save it")
     p.add_argument("--json", action="store_true", help="one JSON document on stdout")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.set_defaults(func=run)
@@ -67,7 +71,12 @@ def _add_config_options(p: argparse.ArgumentParser) -> None:
                    help=f"independent cells simulated (default {defaults.DEM_CELLS})")
     p.add_argument("--seed", metavar="S", type=int, default=defaults.DEM_SEED,
                    help=f"random seed of the packings (default {defaults.DEM_SEED})")
-    p.add_argument("--material", choices=PARTICLE_MATERIALS, default="acrylic")
+    p.add_argument("--specimen", metavar="FILE", type=Path, default=None,
+                   help="specimen file (cell, coupon and fixture masses, particles, contact "
+                        "pairs; see 'pidcore specimen check'); default: the paper's coupon")
+    p.add_argument("--material", choices=PARTICLE_MATERIALS, default=None,
+                   help="particles of the paper's coupon (default acrylic; with --specimen: "
+                        "the specimen's)")
     p.add_argument("--direction", choices=DRIVE_DIRECTIONS, default="z",
                    help="drive direction in the cell frame (z normal to the face sheets)")
     p.add_argument("--cycles", metavar="N", type=int, default=None,
@@ -132,12 +141,26 @@ def _config(args: argparse.Namespace):
                      fill_reference=args.fill_reference, steady_cycles=args.cycles)
 
 
+def _specimen(args: argparse.Namespace):
+    """(specimen or None, load-case material) from --specimen and --material."""
+    if args.specimen is None:
+        return None, args.material or "acrylic"
+    from ..specimen import load_specimen
+
+    specimen = load_specimen(args.specimen)
+    own = specimen.particles.material
+    # a non-table material (inline properties) cannot be named by a load case: not used then
+    return specimen, args.material or (own if own in PARTICLE_MATERIALS else "acrylic")
+
+
 def sweep(args: argparse.Namespace) -> int:
     from ..dem.sweep import grid_cases, run_sweep
 
-    cases = grid_cases(args.grid, material=args.material, direction=args.direction)
+    specimen, material = _specimen(args)
+    cases = grid_cases(args.grid, material=material, direction=args.direction)
     summary = run_sweep(cases, _config(args), store_path=args.store, workers=args.workers,
-                        scheduler=args.scheduler, progress=not args.no_progress)
+                        scheduler=args.scheduler, progress=not args.no_progress,
+                        specimen=specimen)
     if args.json:
         print(json.dumps(summary.to_dict()))
     else:
@@ -146,43 +169,78 @@ def sweep(args: argparse.Namespace) -> int:
     return 0
 
 
+def _fill(args: argparse.Namespace, specimen) -> float:
+    if args.fill is not None:
+        return args.fill
+    p = specimen.particles if specimen is not None else None
+    if p is not None and p.fill_percent is not None:
+        return p.fill_percent
+    if p is not None and p.count_per_cell is not None:
+        return 100.0 * p.count_per_cell / specimen.capacity_per_cell()
+    raise ParameterError("--fill: required (the specimen states no count_per_cell or "
+                         "fill_percent)")
+
+
 def run(args: argparse.Namespace) -> int:
     from ..dem import LoadCase, simulate_load_case
 
-    case = LoadCase(args.frequency, args.acceleration, args.fill, material=args.material,
-                    direction=args.direction)
+    specimen, material = _specimen(args)
+    case = LoadCase(args.frequency, args.acceleration, _fill(args, specimen),
+                    material=material, direction=args.direction)
     config = _config(args)
-    result = simulate_load_case(case, config,
-                                progress=not args.no_progress and sys.stderr.isatty())
+    progress = not args.no_progress and sys.stderr.isatty()
     key = None
+    reused = False
     if args.store is not None:
-        from ..dem.persist import save_dem_result
+        from ..dem.persist import run_key, run_or_load
+        from ..store import Store
 
-        key = save_dem_result(args.store, result)
+        key = run_key(case, config, specimen)
+        store = Store(args.store)
+        reused = args.store.exists() and store.has_dem_run(key)
+        result = run_or_load(store, specimen, case, config, progress=progress)
+    else:
+        result = simulate_load_case(case, config, progress=progress, specimen=specimen)
     if args.json:
         out = {k: result.to_dict()[k] for k in JSON_KEYS}
         out.update(result.to_dict())
         if key is not None:
             out["store_key"] = key
+            out["reused_from_store"] = reused
         print(json.dumps(out))
         return 0
     print(format_summary(result))
     if key is not None:
-        print(f"saved to {args.store} as {key}")
+        print(f"{'reused from' if reused else 'saved to'} {args.store} as {key}")
     return 0
 
 
 def format_summary(result) -> str:
     """Readable multi-line summary with units."""
     c = result.case
+    s = result.specimen
+    material = s.particles.material if s is not None else c.material
     lines = [
         f"DEM load case   {c.frequency_hz:g} Hz, {c.acceleration_g:g} g, fill "
         f"{c.fill_percent:g} % ({result.particles_per_cell} of {result.particles_full_cell} "
-        f"{c.material} particles per cell, reference {result.config.fill_reference}), "
+        f"{material} particles per cell, reference {result.config.fill_reference}), "
         f"drive along {c.direction}",
+    ]
+    if s is not None:
+        kind = "the paper's coupon" if s.is_paper() else "own specimen"
+        particles = result.coupon_cells * result.particles_per_cell * s.particles.mass_kg
+        lines += [
+            f"specimen        {s.name} ({kind}, sha256 {s.hash[:12]}): {result.coupon_cells} "
+            f"{s.cell.shape} cells {s.cell.inscribed_diameter_m * 1e3:.4g} x "
+            f"{s.cell.height_m * 1e3:.4g} mm, particles r = {s.particles.radius_m * 1e3:.4g} mm",
+            f"masses          coupon {s.coupon.mass_kg * 1e3:.4g} g + fixture "
+            f"{s.coupon.fixture_mass_kg * 1e3:.4g} g + particles {particles * 1e3:.4g} g",
+        ]
+    lines += [
         f"SDC             {result.sdc:.4g} +- {result.sdc_stderr:.2g} [-] "
         f"(loss factor {result.loss_factor:.4g} [-]) over {result.cells_simulated} cells",
-        f"dissipated      {result.energy_per_cycle_j:.4g} J/cycle (coupon, 441 cells): normal "
+        f"dissipated      {result.energy_per_cycle_j:.4g} J/cycle (coupon, "
+        f"{result.coupon_cells} cells): normal "
         f"damping {result.energy_dissipated_normal_j:.4g} J, friction "
         f"{result.energy_dissipated_friction_j:.4g} J",
         f"E (Eq. 10)      {result.max_kinetic_energy_j:.4g} J with m_c = "

@@ -49,17 +49,23 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--sidecar", metavar="CSV", type=Path, default=None,
                    help="load case table (columns file, fill_percent, material, direction); "
                         "default: loadcases.csv beside each file")
+    p.add_argument("--specimen", metavar="FILE", type=Path, default=None,
+                   help="compare only DEM runs of this specimen file (default: the paper's "
+                        "coupon); the paper's Table 3 only for the paper's coupon")
     add_measurement_options(p)
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
     from ..report.pipeline import make_report
+    from ..specimen import load_specimen
 
+    specimen = load_specimen(args.specimen) if args.specimen is not None else None
     result = make_report(
         args.files, out_dir=args.out, store=args.store, dem_store=args.dem_store,
         formats=args.format, fill_percent=args.fill, material=args.material,
-        direction=args.direction, sidecar=args.sidecar, options=analysis_options(args))
+        direction=args.direction, sidecar=args.sidecar, options=analysis_options(args),
+        specimen=specimen)
     print(short_table(result.table))
     for note in result.notes:
         print(f"note: {note}")

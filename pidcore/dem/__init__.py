@@ -4,8 +4,8 @@ Public API
 ----------
 LoadCase, DemConfig, simulate_load_case
     One load case -> :class:`DemResult` (SDC, energy tallies, virtual shaker record).
-ContactLaw, CellGeometry
-    Contact parameters from the CSV tables; the hexagonal cell of Eq. 1.
+ContactLaw, PairLaw, PairParameters, MaterialProperties, CellGeometry
+    Contact parameters (from the CSV tables or explicit properties); the hexagonal cell.
 cell_capacity, particles_per_cell
     How many particles fit; fill percentage -> particle count.
 measure_restitution, calibrate_damping_coefficient, simulate_impact
@@ -15,12 +15,14 @@ run_dem_bench
 """
 
 from .bench import run_dem_bench
-from .contact import ContactLaw
+from .contact import ContactLaw, PairLaw
 from .geometry import CellGeometry, cell_capacity
 from .impact import calibrate_damping_coefficient, measure_restitution, simulate_impact
+from .materials import MaterialProperties, PairParameters
 from .result import DemResult
 from .simulate import DemConfig, LoadCase, particles_per_cell, simulate_load_case
 
 __all__ = ["CellGeometry", "ContactLaw", "DemConfig", "DemResult", "LoadCase",
+           "MaterialProperties", "PairLaw", "PairParameters",
            "calibrate_damping_coefficient", "cell_capacity", "measure_restitution",
            "particles_per_cell", "run_dem_bench", "simulate_impact", "simulate_load_case"]

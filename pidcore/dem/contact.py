@@ -25,14 +25,27 @@ the kernel against these functions.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
 
 from .. import defaults
-from ..constants import NORMAL_DAMPING_MODES, TANGENTIAL_MODELS, NormalDampingMode
+from ..constants import (
+    NORMAL_DAMPING_MODES,
+    TANGENTIAL_MODELS,
+    TANGENTIAL_STIFFNESS_MODELS,
+    NormalDampingMode,
+    TangentialStiffnessModel,
+)
 from ..errors import ParameterError
-from .materials import WALL_MATERIAL, material, pair_properties
+from .materials import (
+    WALL_MATERIAL,
+    MaterialProperties,
+    PairParameters,
+    material,
+    pair_properties,
+)
 
 
 def effective_modulus(e1_pa: float, nu1: float, e2_pa: float, nu2: float) -> float:
@@ -76,8 +89,8 @@ def damping_constant_from_restitution(restitution: float) -> float:
 
     Examples
     --------
-    >>> round(damping_constant_from_restitution(1.0), 12)
-    0.0
+    >>> damping_constant_from_restitution(1.0) == 0.0
+    True
     """
     if not 0.0 < restitution <= 1.0:
         raise ParameterError(f"normal_restitution: expected 0 < e <= 1, got {restitution}")
@@ -123,94 +136,249 @@ def maximum_overlap(*, stiffness: float, mass_kg: float, impact_speed_m_s: float
 
 
 @dataclass(frozen=True)
-class ContactLaw:
-    """All contact parameters of one particle material in an aluminium cell (SI units).
+class PairLaw:
+    """Contact law of one pair of bodies (particle-particle or particle-wall), SI units.
 
-    ``*_pp``: particle-particle; ``*_pw``: particle-wall. ``damping_*`` is
-    ``alpha sqrt(m* k_n)`` (N s / m^(5/4)); ``tangential_mass_*`` is the effective mass of
-    sliding at the contact point, 1/m_t = sum(1/m + arm^2/I) (arm = r), used to cap the
-    friction (at m_t |v_t| / (2 dt)) so it never reverses the slip within one step.
-    ``tangential_stiffness_*`` (N/m) is k_t of the stick-slip model (module docstring).
+    The dimensionless coefficients of :class:`~pidcore.dem.materials.PairParameters` plus
+    what follows from the materials and the particle:
+
+    ``stiffness``: Hertz k_n = 4/3 E* sqrt(R*), N/m^(3/2). ``alpha``: Eq. 3 damping constant
+    (or an override) [-]; ``damping``: alpha sqrt(m* k_n), N s / m^(5/4).
+    ``shear_modulus_pa``: Mindlin's G*, Pa. ``tangential_stiffness``: the constant k_t of the
+    stick-slip spring, Mindlin's 8 G* sqrt(R* delta_ref) at the largest overlap delta_ref of a
+    DEM_TANGENTIAL_REFERENCE_SPEED_M_S impact, N/m (the ``"mindlin"`` option uses
+    8 G* sqrt(R* delta) of the current overlap instead). ``tangential_mass_kg``: effective mass
+    of sliding at the contact point, 1/m_t = sum(1/m + arm^2/I), which caps Eq. 5's Coulomb
+    force (``coulomb`` model). ``rolling_stiffness``: k_r = 2.25 mu_r^2 R*^2 k_n' (Ai et al.
+    2011, with k_n' = 3/2 k_n sqrt(delta_ref) the Hertz tangent stiffness at delta_ref),
+    N m/rad; ``rolling_inertia_kg_m2``: I_r = 1/sum(1/(I + m r^2)); ``rolling_damping``:
+    eta_r 2 sqrt(I_r k_r), N m s/rad.
+    """
+
+    restitution: float
+    sliding_friction: float
+    static_friction: float
+    rolling_friction: float
+    rolling_damping_ratio: float
+    alpha: float
+    effective_radius_m: float
+    effective_mass_kg: float
+    stiffness: float
+    damping: float
+    shear_modulus_pa: float
+    tangential_stiffness: float
+    tangential_mass_kg: float
+    rolling_stiffness: float
+    rolling_inertia_kg_m2: float
+    rolling_damping: float
+
+    @property
+    def parameters(self) -> PairParameters:
+        """The dimensionless coefficients this law was built from."""
+        return PairParameters(restitution=self.restitution,
+                              sliding_friction=self.sliding_friction,
+                              static_friction=self.static_friction,
+                              rolling_friction=self.rolling_friction,
+                              rolling_damping_ratio=self.rolling_damping_ratio)
+
+    @property
+    def mindlin_factor(self) -> float:
+        """8 G* sqrt(R*): Mindlin's k_t = mindlin_factor sqrt(delta), N/m^(3/2)."""
+        return 8.0 * self.shear_modulus_pa * np.sqrt(self.effective_radius_m)
+
+    def contact_time(self, impact_speed_m_s: float) -> float:
+        """Hertz contact time of this pair at the given impact speed, s."""
+        return hertz_contact_time(stiffness=self.stiffness, mass_kg=self.effective_mass_kg,
+                                  impact_speed_m_s=impact_speed_m_s)
+
+    def spring_period(self) -> float:
+        """Shortest period of the stuck tangential and rolling springs, s (inf without)."""
+        period = 2.0 * np.pi * np.sqrt(self.tangential_mass_kg / self.tangential_stiffness)
+        if self.rolling_stiffness > 0.0:
+            period = min(period, 2.0 * np.pi * np.sqrt(self.rolling_inertia_kg_m2
+                                                       / self.rolling_stiffness))
+        return float(period)
+
+
+def pair_law(parameters: PairParameters, *, e_star_pa: float, g_star_pa: float,
+             r_star_m: float, m_star_kg: float, tangential_mass_kg: float,
+             rolling_inertia_kg_m2: float, alpha: float | None = None) -> PairLaw:
+    """Derive a :class:`PairLaw` from a pair's coefficients and effective properties.
+
+    ``alpha`` overrides Eq. 3 of ``parameters.restitution``.
+    """
+    k_n = hertz_stiffness(e_star_pa, r_star_m)
+    delta_ref = maximum_overlap(stiffness=k_n, mass_kg=m_star_kg,
+                                impact_speed_m_s=defaults.DEM_TANGENTIAL_REFERENCE_SPEED_M_S)
+    a = damping_constant_from_restitution(parameters.restitution) if alpha is None \
+        else float(alpha)
+    mu_r = parameters.rolling_friction
+    k_r = 2.25 * mu_r**2 * r_star_m**2 * 1.5 * k_n * np.sqrt(delta_ref)
+    return PairLaw(
+        restitution=parameters.restitution, sliding_friction=parameters.sliding_friction,
+        static_friction=parameters.static_friction, rolling_friction=mu_r,
+        rolling_damping_ratio=parameters.rolling_damping_ratio, alpha=a,
+        effective_radius_m=r_star_m, effective_mass_kg=m_star_kg, stiffness=k_n,
+        damping=a * np.sqrt(m_star_kg * k_n), shear_modulus_pa=g_star_pa,
+        tangential_stiffness=tangential_stiffness(g_star_pa, r_star_m, delta_ref),
+        tangential_mass_kg=tangential_mass_kg, rolling_stiffness=k_r,
+        rolling_inertia_kg_m2=rolling_inertia_kg_m2,
+        rolling_damping=parameters.rolling_damping_ratio * 2.0
+        * np.sqrt(rolling_inertia_kg_m2 * k_r))
+
+
+@dataclass(frozen=True)
+class ContactLaw:
+    """All contact parameters of one particle material in a cell (SI units).
+
+    ``pair_particle``: the particle-particle :class:`PairLaw`; ``pair_wall``: particle-wall.
+    ``particle`` and ``wall``: the materials they derive from. ``tangential_stiffness_model``:
+    ``"constant"`` (k_t of the reference overlap; default) or ``"mindlin"`` (k_t from the
+    current overlap, see :mod:`pidcore.dem.kernel`).
+
+    Build with :meth:`for_material` (the CSV tables, optionally overriding pair rows) or
+    :meth:`from_properties` (anything, e.g. a user's specimen).
     """
 
     particle_material: str
     radius_m: float
     mass_kg: float
     inertia_kg_m2: float
-    stiffness_pp: float
-    stiffness_pw: float
-    alpha_pp: float
-    alpha_pw: float
-    damping_pp: float
-    damping_pw: float
-    friction_pp: float
-    friction_pw: float
-    restitution_pp: float
-    restitution_pw: float
-    tangential_mass_pp: float
-    tangential_mass_pw: float
-    tangential_stiffness_pp: float
-    tangential_stiffness_pw: float
+    particle: MaterialProperties
+    wall: MaterialProperties
+    pair_particle: PairLaw
+    pair_wall: PairLaw
+    tangential_stiffness_model: TangentialStiffnessModel = "constant"
+
+    @classmethod
+    def from_properties(cls, *, particle: MaterialProperties, radius_m: float,
+                        wall: MaterialProperties, pair_particle: PairParameters,
+                        pair_wall: PairParameters, particle_material: str = "custom",
+                        alpha_pp: float | None = None, alpha_pw: float | None = None,
+                        tangential_stiffness_model: TangentialStiffnessModel = "constant",
+                        ) -> ContactLaw:
+        """Build from explicit material properties and pair coefficients.
+
+        Parameters
+        ----------
+        particle, wall : MaterialProperties
+            Density and elastic constants of the spheres and of the (flat, rigid-body) walls.
+        radius_m : float
+            Sphere radius, m.
+        pair_particle, pair_wall : PairParameters
+            Restitution and friction coefficients, particle-particle and particle-wall.
+        particle_material : str
+            Name shown in messages and records.
+        alpha_pp, alpha_pw : float, optional
+            Override Eq. 3's damping constant (particle-particle, particle-wall).
+        tangential_stiffness_model : {"constant", "mindlin"}
+
+        Examples
+        --------
+        >>> steel = MaterialProperties(density_kg_m3=7800, youngs_modulus_pa=200e9,
+        ...                            poisson_ratio=0.3)
+        >>> law = ContactLaw.from_properties(
+        ...     particle=steel, radius_m=1e-3, wall=steel, particle_material="steel",
+        ...     pair_particle=PairParameters(restitution=0.9, sliding_friction=0.2),
+        ...     pair_wall=PairParameters(restitution=0.9, sliding_friction=0.2,
+        ...                              static_friction=0.3))
+        >>> law.pair_wall.static_friction
+        0.3
+        """
+        if not (np.isfinite(radius_m) and radius_m > 0):
+            raise ParameterError(f"radius: expected > 0 m, got {radius_m}")
+        if tangential_stiffness_model not in TANGENTIAL_STIFFNESS_MODELS:
+            raise ParameterError(f"tangential_stiffness_model: expected one of "
+                                 f"{TANGENTIAL_STIFFNESS_MODELS}, "
+                                 f"got {tangential_stiffness_model!r}")
+        r = float(radius_m)
+        m = particle.sphere_mass(r)
+        inertia = 0.4 * m * r * r
+        e_p, nu_p = particle.youngs_modulus_pa, particle.poisson_ratio
+        e_w, nu_w = wall.youngs_modulus_pa, wall.poisson_ratio
+        rolling_one = inertia + m * r * r  # Ai et al.: I + m r^2 of one sphere
+        pp = pair_law(pair_particle, e_star_pa=effective_modulus(e_p, nu_p, e_p, nu_p),
+                      g_star_pa=effective_shear_modulus(e_p, nu_p, e_p, nu_p),
+                      r_star_m=effective_radius(r, r), m_star_kg=effective_mass(m, m),
+                      tangential_mass_kg=1.0 / (2.0 / m + 2.0 * r * r / inertia),
+                      rolling_inertia_kg_m2=0.5 * rolling_one, alpha=alpha_pp)
+        pw = pair_law(pair_wall, e_star_pa=effective_modulus(e_p, nu_p, e_w, nu_w),
+                      g_star_pa=effective_shear_modulus(e_p, nu_p, e_w, nu_w),
+                      r_star_m=effective_radius(r, None), m_star_kg=effective_mass(m, None),
+                      tangential_mass_kg=1.0 / (1.0 / m + r * r / inertia),
+                      rolling_inertia_kg_m2=rolling_one, alpha=alpha_pw)
+        return cls(particle_material=particle_material, radius_m=r, mass_kg=m,
+                   inertia_kg_m2=inertia, particle=particle, wall=wall,
+                   pair_particle=pp, pair_wall=pw,
+                   tangential_stiffness_model=tangential_stiffness_model)
 
     @classmethod
     def for_material(cls, name: str, *, radius_m: float | None = None,
-                     alpha_pp: float | None = None,
-                     alpha_pw: float | None = None) -> ContactLaw:
-        """Build from the CSV tables; ``alpha_*`` default to Eq. 3 of the table's e_n."""
+                     alpha_pp: float | None = None, alpha_pw: float | None = None,
+                     pair_particle: PairParameters | None = None,
+                     pair_wall: PairParameters | None = None,
+                     tangential_stiffness_model: TangentialStiffnessModel = "constant",
+                     ) -> ContactLaw:
+        """Build from the CSV tables (``pidcore/data``) for a particle material.
+
+        ``radius_m`` defaults to the table's radius, ``pair_particle``/``pair_wall`` to the
+        table's pair rows (with the aluminium wall), ``alpha_*`` to Eq. 3 of their e_n.
+
+        Examples
+        --------
+        >>> ContactLaw.for_material("acrylic").pair_particle.sliding_friction
+        0.096
+        """
         mat = material(name)
         if mat.role != "particle":
             raise ParameterError(f"material: {name!r} is not a particle material")
-        wall = material(WALL_MATERIAL)
         r = mat.default_radius_m if radius_m is None else float(radius_m)
-        if not r > 0:
-            raise ParameterError(f"radius: expected > 0 m, got {r}")
-        m = mat.sphere_mass(r)
-        inertia = 0.4 * m * r * r
-        pp = pair_properties(name, name)
-        pw = pair_properties(name, WALL_MATERIAL)
-        k_pp = hertz_stiffness(effective_modulus(mat.youngs_modulus_pa, mat.poisson_ratio,
-                                                 mat.youngs_modulus_pa, mat.poisson_ratio),
-                               effective_radius(r, r))
-        k_pw = hertz_stiffness(effective_modulus(mat.youngs_modulus_pa, mat.poisson_ratio,
-                                                 wall.youngs_modulus_pa, wall.poisson_ratio),
-                               effective_radius(r, None))
-        g_pp = effective_shear_modulus(mat.youngs_modulus_pa, mat.poisson_ratio,
-                                       mat.youngs_modulus_pa, mat.poisson_ratio)
-        g_pw = effective_shear_modulus(mat.youngs_modulus_pa, mat.poisson_ratio,
-                                       wall.youngs_modulus_pa, wall.poisson_ratio)
-        v_ref = defaults.DEM_TANGENTIAL_REFERENCE_SPEED_M_S
-        kt_pp = tangential_stiffness(g_pp, effective_radius(r, r), maximum_overlap(
-            stiffness=k_pp, mass_kg=effective_mass(m, m), impact_speed_m_s=v_ref))
-        kt_pw = tangential_stiffness(g_pw, effective_radius(r, None), maximum_overlap(
-            stiffness=k_pw, mass_kg=effective_mass(m, None), impact_speed_m_s=v_ref))
-        a_pp = damping_constant_from_restitution(pp.normal_restitution) \
-            if alpha_pp is None else float(alpha_pp)
-        a_pw = damping_constant_from_restitution(pw.normal_restitution) \
-            if alpha_pw is None else float(alpha_pw)
-        return cls(
-            particle_material=name, radius_m=r, mass_kg=m, inertia_kg_m2=inertia,
-            stiffness_pp=k_pp, stiffness_pw=k_pw, alpha_pp=a_pp, alpha_pw=a_pw,
-            damping_pp=a_pp * np.sqrt(effective_mass(m, m) * k_pp),
-            damping_pw=a_pw * np.sqrt(effective_mass(m, None) * k_pw),
-            friction_pp=pp.sliding_friction, friction_pw=pw.sliding_friction,
-            restitution_pp=pp.normal_restitution, restitution_pw=pw.normal_restitution,
-            tangential_mass_pp=1.0 / (2.0 / m + 2.0 * r * r / inertia),
-            tangential_mass_pw=1.0 / (1.0 / m + r * r / inertia),
-            tangential_stiffness_pp=kt_pp, tangential_stiffness_pw=kt_pw,
-        )
+        return cls.from_properties(
+            particle=mat.properties, radius_m=r, wall=material(WALL_MATERIAL).properties,
+            pair_particle=pair_properties(name, name) if pair_particle is None
+            else pair_particle,
+            pair_wall=pair_properties(name, WALL_MATERIAL) if pair_wall is None else pair_wall,
+            particle_material=name, alpha_pp=alpha_pp, alpha_pw=alpha_pw,
+            tangential_stiffness_model=tangential_stiffness_model)
+
+    def with_parameters(self, *, pair_particle: PairParameters | None = None,
+                        pair_wall: PairParameters | None = None,
+                        alpha_pp: float | None = None, alpha_pw: float | None = None,
+                        tangential_stiffness_model: TangentialStiffnessModel | None = None,
+                        ) -> ContactLaw:
+        """The same particle and walls with other pair coefficients (or alpha, k_t model).
+
+        A pair left unchanged keeps its alpha; a new pair gets Eq. 3 unless ``alpha_*``.
+        """
+        if alpha_pp is None and pair_particle is None:
+            alpha_pp = self.pair_particle.alpha
+        if alpha_pw is None and pair_wall is None:
+            alpha_pw = self.pair_wall.alpha
+        return ContactLaw.from_properties(
+            particle=self.particle, radius_m=self.radius_m, wall=self.wall,
+            pair_particle=pair_particle or self.pair_particle.parameters,
+            pair_wall=pair_wall or self.pair_wall.parameters,
+            particle_material=self.particle_material, alpha_pp=alpha_pp, alpha_pw=alpha_pw,
+            tangential_stiffness_model=tangential_stiffness_model
+            or self.tangential_stiffness_model)
+
+    def frictionless(self) -> ContactLaw:
+        """This law with every friction coefficient (sliding, static, rolling) at zero."""
+        def off(p: PairLaw) -> PairLaw:
+            return dataclasses.replace(p, sliding_friction=0.0, static_friction=0.0,
+                                       rolling_friction=0.0, rolling_stiffness=0.0,
+                                       rolling_damping=0.0)
+        return dataclasses.replace(self, pair_particle=off(self.pair_particle),
+                                   pair_wall=off(self.pair_wall))
 
     def contact_time(self, impact_speed_m_s: float) -> float:
         """Shortest Hertz contact time (wall or pair) at the given impact speed, s."""
-        return min(hertz_contact_time(stiffness=self.stiffness_pw, mass_kg=self.mass_kg,
-                                      impact_speed_m_s=impact_speed_m_s),
-                   hertz_contact_time(stiffness=self.stiffness_pp, mass_kg=self.mass_kg / 2,
-                                      impact_speed_m_s=impact_speed_m_s))
-
+        return min(self.pair_wall.contact_time(impact_speed_m_s),
+                   self.pair_particle.contact_time(impact_speed_m_s))
 
     def tangential_period(self) -> float:
-        """Shortest period of a stuck tangential spring, 2 pi sqrt(m_t / k_t) (pair or wall), s."""
-        return 2.0 * np.pi * min(np.sqrt(self.tangential_mass_pp / self.tangential_stiffness_pp),
-                                 np.sqrt(self.tangential_mass_pw / self.tangential_stiffness_pw))
+        """Shortest period of a stuck tangential or rolling spring (pair or wall), s."""
+        return min(self.pair_particle.spring_period(), self.pair_wall.spring_period())
 
 
 def check_damping_mode(mode: str) -> None:

@@ -1,24 +1,76 @@
-"""Saving DEM results to the HDF5 store (:mod:`pidcore.store`): one key, one entry layout."""
+"""DEM runs in the HDF5 store (:mod:`pidcore.store`): one key, one entry layout, one save path,
+and the run cache.
+
+A run's key holds every input that changes its numbers: the load case, the configuration
+(seed, cells, numerical options), the specimen (its hash: cell, masses, particles, contact
+pairs) and :data:`DEM_CODE_VERSION`. ``pidcore dem run --store``, sweeps, the app and the
+calibration all save through :func:`save_dem_entry` and find runs by :func:`run_key`, so a run
+stored by any of them is reused by the others (:func:`run_or_load`), never recomputed.
+"""
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import json
+import math
+import os
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
+import numpy as np
+
+from ..errors import StoreError
+from ..specimen import Specimen, paper_specimen
 from .result import UNITS, DemResult
-from .simulate import DemConfig, LoadCase, config_parameters
+from .simulate import (
+    DemConfig,
+    LoadCase,
+    config_parameters,
+    resolve_specimen,
+    simulate_load_case,
+)
+
+if TYPE_CHECKING:  # pragma: no cover
+    from ..store import Store, StoredEntry
+
+#: Version of the DEM's numbers: bump it with any change to the kernel, contact laws or
+#: run protocol that alters a result, so that stored runs of older code are not reused.
+#: (A code version, not the package version: that reads "0.0.0+unknown" from a source tree.)
+DEM_CODE_VERSION = 1
 
 
-def run_key(case: LoadCase, config: DemConfig) -> str:
+def _key_case(case: LoadCase, specimen: Specimen) -> str:
+    """Readable part of the key: the load case, named by the particles actually simulated."""
+    key = case.key()
+    if specimen.particles.material != case.material:
+        # an inline material (e.g. steel) the load case cannot name: the key says what ran
+        key = f"{specimen.particles.material}_{key.split('_', 1)[1]}"
+    return key
+
+
+def run_parameters(case: LoadCase, config: DemConfig,
+                   specimen: Specimen | None = None) -> dict[str, Any]:
+    """Every input of a run (JSON-safe): load case, configuration, specimen text and hash,
+    code version. Stored with the run as its provenance."""
+    specimen = resolve_specimen(case, specimen)
+    params = config_parameters(case, config)
+    params.update({"specimen_name": specimen.name, "specimen_sha256": specimen.hash,
+                   "specimen_text": specimen.text, "dem_code_version": DEM_CODE_VERSION})
+    return params
+
+
+def run_key(case: LoadCase, config: DemConfig, specimen: Specimen | None = None) -> str:
     """Store key of one DEM run: readable load case plus a hash of every other input.
 
-    The same for ``pidcore dem run --store``, sweeps and the app, so a sweep skips a run saved
-    by any of them, e.g. ``acrylic_z_f50_a5_fill50_seed12345_cells8_<hash>``.
+    E.g. ``acrylic_z_f50_a5_fill50_seed12345_cells8_<hash>``; ``specimen=None`` is the paper's
+    coupon with ``case.material`` particles.
     """
-    params = config_parameters(case, config)
+    specimen = resolve_specimen(case, specimen)
+    params = run_parameters(case, config, specimen)
+    params.pop("specimen_text")  # the hash stands for it
     digest = hashlib.sha256(json.dumps(params, sort_keys=True, default=str).encode()).hexdigest()
-    return f"{case.key()}_seed{config.seed}_cells{config.cells}_{digest[:10]}"
+    return f"{_key_case(case, specimen)}_seed{config.seed}_cells{config.cells}_{digest[:10]}"
 
 
 def dem_run_entry(result: DemResult) -> dict:
@@ -28,14 +80,178 @@ def dem_run_entry(result: DemResult) -> dict:
     arrays = result.arrays()
     units = {k: v for k, v in UNITS.items() if k in record or k in arrays}
     return {"record": record, "arrays": arrays,
-            "parameters": config_parameters(result.case, result.config), "units": units}
+            "parameters": run_parameters(result.case, result.config, result.specimen),
+            "units": units}
 
 
-def save_dem_result(store_path: str | Path, result: DemResult, *,
-                    replace: bool = False) -> str:
-    """Add ``result`` (scalars, arrays, every input, units) to the store; returns its key."""
+def _open(store: Store | str | os.PathLike[str]) -> Store:
     from ..store import Store
 
-    key = run_key(result.case, result.config)
-    Store(store_path).add_dem_run(key, **dem_run_entry(result), replace=replace)
+    return store if isinstance(store, Store) else Store(store)
+
+
+def save_dem_entry(store: Store | str | os.PathLike[str], key: str, entry: dict) -> bool:
+    """Add one run to the store unless its key is there already; True if it was added.
+
+    The one save path of every DEM run. A stored run is never replaced: the key holds every
+    input, so a run found under it is this run (a concurrent writer stored it first).
+    """
+    store = _open(store)
+    with store.transaction():
+        if store.has_dem_run(key):
+            return False
+        store.add_dem_run(key, **entry)
+    return True
+
+
+def save_dem_result(store: Store | str | os.PathLike[str], result: DemResult) -> str:
+    """Add ``result`` (scalars, arrays, every input, units) to the store; returns its key."""
+    key = run_key(result.case, result.config, result.specimen)
+    save_dem_entry(store, key, dem_run_entry(result))
     return key
+
+
+def _config_from(parameters: dict[str, Any]) -> DemConfig:
+    values = {}
+    for f in dataclasses.fields(DemConfig):
+        name = f"config_{f.name}"
+        if name in parameters:
+            value = parameters[name]
+            values[f.name] = None if value == "" else value  # config_parameters wrote None as ""
+    return DemConfig(**values)
+
+
+def load_dem_result(entry: StoredEntry) -> DemResult:
+    """Rebuild a :class:`DemResult` from a stored run (the numbers exactly as computed).
+
+    Runs stored before specimens existed are the paper's coupon; arrays they lack
+    (``dissipation_per_cell_cycle_j``) come back as NaN.
+    """
+    params = entry.parameters
+    case = LoadCase(**{k[5:]: v for k, v in params.items() if k.startswith("case_")})
+    config = _config_from(params)
+    text = params.get("specimen_text")
+    specimen = Specimen.from_text(text, source=f"stored run {entry.key}") if text \
+        else paper_specimen(case.material)
+    record = entry.record
+    values: dict[str, Any] = {"case": case, "config": config, "specimen": specimen}
+    for f in dataclasses.fields(DemResult):
+        if f.name in values:
+            continue
+        if f.name in entry.arrays:
+            values[f.name] = np.asarray(entry.arrays[f.name])
+        elif f.name in record:
+            value = record[f.name]
+            values[f.name] = float("nan") if value is None else value
+    values.setdefault("coupon_cells", specimen.cell.count)
+    values.setdefault("samples_per_cycle",
+                      int(round(record["sample_rate_hz"] / case.frequency_hz)))
+    values.setdefault("dissipation_per_cell_cycle_j", np.full(
+        (int(record["cells_simulated"]), len(entry.arrays["dissipation_per_cycle_j"])),
+        np.nan))
+    missing = [f.name for f in dataclasses.fields(DemResult) if f.name not in values]
+    if missing:
+        raise StoreError(f"DEM run {entry.key!r}: stored run lacks {missing}")
+    for name in ("particles_per_cell", "particles_full_cell", "cells_simulated", "steps",
+                 "steady_start_cycle", "steady_cycles", "samples_per_cycle", "coupon_cells"):
+        values[name] = int(values[name])
+    values["steady_detected"] = bool(values["steady_detected"])
+    for name in ("sdc", "sdc_stderr"):
+        if values[name] is None or not math.isfinite(float(values[name])):
+            values[name] = float("nan")
+    return DemResult(**values)
+
+
+def run_or_load(store: Store | str | os.PathLike[str], specimen: Specimen | None,
+                case: LoadCase, config: DemConfig | None = None, *,
+                progress: bool = False) -> DemResult:
+    """The run cache: the stored run of these inputs, or simulate, store and return it.
+
+    Parameters
+    ----------
+    store : Store or path
+        HDF5 store (created on the first save).
+    specimen : Specimen or None
+        None: the paper's coupon with ``case.material`` particles.
+    case, config
+        Load case and numerical settings (``DemConfig()`` by default).
+
+    Examples
+    --------
+    >>> r = run_or_load("runs.h5", None, LoadCase(500, 5, 50))  # doctest: +SKIP
+    """
+    config = config or DemConfig()
+    store = _open(store)
+    specimen = resolve_specimen(case, specimen)
+    key = run_key(case, config, specimen)
+    if store.path.exists() and store.has_dem_run(key):
+        return load_dem_result(store.get_dem_run(key))
+    result = simulate_load_case(case, config, specimen=specimen, progress=progress)
+    save_dem_entry(store, key, dem_run_entry(result))
+    return result
+
+
+def runs_of_specimen(runs, specimen: Specimen | None = None):
+    """Rows of a DEM-run listing (:meth:`pidcore.store.Store.list_dem_runs`) of one specimen.
+
+    ``specimen=None`` is the paper's coupon: its runs with any table particle material, and
+    runs stored before specimens existed (no ``specimen_sha256``), which are all the paper's.
+    """
+    if runs is None or runs.empty:
+        return runs
+    specimen = specimen or paper_specimen()
+    if "specimen_sha256" in runs.columns:
+        stated = runs["specimen_sha256"].map(lambda h: h if isinstance(h, str) and h else None)
+    else:
+        stated = runs["case_key"].map(lambda _: None)
+    if specimen.is_paper():
+        from ..constants import PARTICLE_MATERIALS
+
+        paper = {paper_specimen(m).hash for m in PARTICLE_MATERIALS}
+        keep = stated.map(lambda h: h is None or h in paper)
+    else:
+        keep = stated == specimen.hash
+    return runs[keep.astype(bool)].reset_index(drop=True)
+
+
+def rekey_dem_store(source: str | os.PathLike[str], target: str | os.PathLike[str]) -> int:
+    """Copy every DEM run of ``source`` into a new store ``target`` under today's key.
+
+    For stores written before specimens (runs without ``specimen_sha256``: the paper's coupon
+    with their particle material) or before a change of the key's inputs. Each run gets the
+    specimen's text and hash as provenance; its numbers are copied, not recomputed, so this
+    is only right while :data:`DEM_CODE_VERSION` is the one the runs were made with (checked
+    where a run states it; a run that does not is taken as version 1, the first versioned
+    code, which reproduces them bit for bit). ``source`` must hold DEM runs only (a store with
+    measurements or analyses is refused); ``target`` must not exist. Returns the run count.
+    """
+    from ..store import Store
+
+    source, target = Path(source), Path(target)
+    if target.exists():
+        raise StoreError(f"{target}: exists already; rekey_dem_store writes a new store")
+    old = Store(source)
+    if len(old.list_measurements()) or len(old.list_analyses()):
+        raise StoreError(f"{source}: holds measurements or analyses; only a store of DEM runs "
+                         "can be re-keyed")
+    items = []
+    for key in old.list_dem_runs()["case_key"]:
+        entry = old.get_dem_run(key)
+        version = entry.parameters.get("dem_code_version", 1)
+        if version != DEM_CODE_VERSION:
+            raise StoreError(f"{source}: DEM run {key!r} is from DEM code version {version}, "
+                             f"this is {DEM_CODE_VERSION}: simulate it again instead")
+        result = load_dem_result(entry)
+        new = dem_run_entry(result)  # the stored numbers, with today's provenance fields
+        new["arrays"] = dict(entry.arrays)  # not the NaN stand-ins for arrays it lacks
+        new["units"] = {k: v for k, v in new["units"].items()
+                        if k in new["record"] or k in new["arrays"]}
+        items.append({"case_key": run_key(result.case, result.config, result.specimen), **new})
+    Store(target).add_dem_runs(items)
+    return len(items)
+
+
+__all__ = ["DEM_CODE_VERSION", "dem_run_entry", "load_dem_result", "run_key", "run_or_load",
+           "run_parameters", "runs_of_specimen", "rekey_dem_store", "save_dem_entry",
+           "save_dem_result"]
+

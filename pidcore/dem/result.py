@@ -11,6 +11,7 @@ import numpy as np
 from .. import defaults
 
 if TYPE_CHECKING:  # pragma: no cover
+    from ..specimen import Specimen
     from .contact import ContactLaw
     from .simulate import DemConfig, LoadCase
 
@@ -28,7 +29,9 @@ UNITS: dict[str, str] = {
     "sdc_per_cell": "-", "dissipation_per_cycle_j": "J", "sample_time_s": "s",
     "wall_force_n": "N", "shaker_force_n": "N", "velocity_m_s": "m/s",
     "sample_rate_hz": "Hz", "work_walls_j": "J", "dissipated_total_j": "J",
-    "mechanical_energy_change_j": "J",
+    "mechanical_energy_change_j": "J", "dissipation_per_cell_cycle_j": "J",
+    "coupon_cells": "1", "samples_per_cycle": "1", "fixture_mass_kg": "kg",
+    "particle_mass_kg": "kg",
 }
 
 
@@ -36,7 +39,10 @@ UNITS: dict[str, str] = {
 class DemResult:
     """Outcome of :func:`~pidcore.dem.simulate.simulate_load_case` (SI units, see UNITS).
 
-    Coupon-level quantities scale the K-cell mean to the coupon's 441 cells.
+    Coupon-level quantities scale the K-cell mean to the coupon's ``coupon_cells`` cells
+    (the specimen's ``[cell] count``, 441 for the paper's). ``specimen`` is the
+    :class:`~pidcore.specimen.Specimen` simulated (its canonical text and hash are stored with
+    the run); ``coupon_mass_kg`` is the rigid mass the shaker moves, coupon plus fixture.
     ``energy_dissipated_normal_j`` / ``_friction_j`` split ``energy_per_cycle_j`` (steady
     state, per cycle, coupon); ``work_per_cycle_j`` is the walls' work on the particles per
     steady cycle; it equals the dissipation plus ``stored_energy_change_per_cycle_j`` (the
@@ -89,6 +95,8 @@ class DemResult:
     shaker_force_n: np.ndarray
     velocity_m_s: np.ndarray
     samples_per_cycle: int
+    specimen: Specimen | None = None
+    coupon_cells: int = defaults.COUPON_CELLS
 
     @classmethod
     def from_run(cls, *, case: LoadCase, config: DemConfig, law: ContactLaw,
@@ -98,8 +106,8 @@ class DemResult:
                  sample_every: int, energy_start: np.ndarray, energy_end: np.ndarray,
                  stored_energy_change_steady: np.ndarray,
                  settle_time_s: float, steps: int, wall_s: float, kernel_s: float,
-                 particle_steps: int) -> DemResult:
-        n_coupon = defaults.COUPON_CELLS
+                 particle_steps: int, specimen: Specimen | None = None) -> DemResult:
+        n_coupon = specimen.cell.count if specimen is not None else defaults.COUPON_CELLS
         k = tally.shape[0]
         steady = tally[:, steady_start_cycle:, :]
         per_cell_cycle = tally[:, :, 1] + tally[:, :, 2]
@@ -146,7 +154,7 @@ class DemResult:
             dissipation_per_cell_cycle_j=per_cell_cycle,
             sample_rate_hz=1.0 / h, sample_time_s=0.5 * (t0 + t1), wall_force_n=wall_n,
             shaker_force_n=coupon_mass_kg * acc + wall_n, velocity_m_s=vel,
-            samples_per_cycle=int(spc),
+            samples_per_cycle=int(spc), specimen=specimen, coupon_cells=int(n_coupon),
         )
 
     @property
@@ -174,7 +182,8 @@ class DemResult:
             "frequency_hz": self.case.frequency_hz,
             "acceleration_g": self.case.acceleration_g,
             "fill_percent": self.case.fill_percent,
-            "material": self.case.material,
+            "material": (self.specimen.particles.material if self.specimen is not None
+                         else self.case.material),
             "direction": self.case.direction,
             "normal_damping_mode": self.config.normal_damping_mode,
             "vibrated_mass_convention": self.config.vibrated_mass,
@@ -183,7 +192,14 @@ class DemResult:
             "tangential_model": self.config.tangential_model,
             "fill_reference": self.config.fill_reference,
             "seed": self.config.seed,
+            "coupon_cells": self.coupon_cells,
         }
+        if self.specimen is not None:
+            out.update({"specimen_name": self.specimen.name,
+                        "specimen_sha256": self.specimen.hash,
+                        "specimen_is_paper": self.specimen.is_paper(),
+                        "fixture_mass_kg": self.specimen.coupon.fixture_mass_kg,
+                        "particle_mass_kg": self.specimen.particles.mass_kg})
         for name in ("sdc", "sdc_stderr", "loss_factor", "energy_per_cycle_j", "work_per_cycle_j",
                      "stored_energy_change_per_cycle_j",
                      "energy_dissipated_normal_j", "energy_dissipated_friction_j",
@@ -192,7 +208,7 @@ class DemResult:
                      "work_walls_j", "dissipated_total_j", "mechanical_energy_change_j",
                      "steps", "wall_s", "particle_steps_per_s", "time_step_s",
                      "steady_start_cycle", "steady_detected", "steady_cycles",
-                     "settle_time_s", "sample_rate_hz"):
+                     "settle_time_s", "sample_rate_hz", "samples_per_cycle"):
             value = getattr(self, name)
             if isinstance(value, float) and not math.isfinite(value):
                 value = None
@@ -204,8 +220,8 @@ class DemResult:
 
     @staticmethod
     def array_names() -> tuple[str, ...]:
-        return ("sdc_per_cell", "dissipation_per_cycle_j", "sample_time_s", "wall_force_n",
-                "shaker_force_n", "velocity_m_s")
+        return ("sdc_per_cell", "dissipation_per_cycle_j", "dissipation_per_cell_cycle_j",
+                "sample_time_s", "wall_force_n", "shaker_force_n", "velocity_m_s")
 
     def arrays(self) -> dict[str, np.ndarray]:
         return {name: np.asarray(getattr(self, name)) for name in self.array_names()}

@@ -61,6 +61,7 @@ from ..constants import (
     VibratedMassConvention,
 )
 from ..errors import ParameterError, SimulationError
+from ..specimen import Specimen, contact_law, paper_specimen
 from .contact import ContactLaw, check_damping_mode, check_tangential_model
 from .geometry import CellGeometry, cell_capacity, random_packing
 from .result import DemResult
@@ -186,7 +187,10 @@ class DemConfig:
 
 
 def coupon_mass_kg() -> float:
-    """Mass of the empty coupon: two face sheets plus the honeycomb core (Table 2), kg."""
+    """Mass of the paper's empty coupon: two face sheets plus the honeycomb core (Table 2), kg.
+
+    Other specimens state theirs (``[coupon] mass_kg``, :mod:`pidcore.specimen`).
+    """
     area = defaults.COUPON_SIDE_M**2
     return (2 * area * defaults.FACE_SHEET_THICKNESS_M * defaults.FACE_SHEET_DENSITY_KG_M3
             + area * defaults.CELL_HEIGHT_M * defaults.CORE_DENSITY_KG_M3)
@@ -233,23 +237,31 @@ def choose_time_step(case: LoadCase, law: ContactLaw, geometry: CellGeometry,
     return float(requested)
 
 
-def particles_per_cell(fill_percent: float, material_name: str, *,
+def particles_per_cell(fill_percent: float, material_name: str | None = None, *,
+                       specimen: Specimen | None = None,
                        geometry: CellGeometry | None = None,
                        fill_reference: str = defaults.DEM_FILL_REFERENCE) -> tuple[int, int]:
     """(particles per cell, count taken as 100 %) for a fill percentage.
 
+    The particles and cell are the ``specimen``'s (default: the paper's coupon with
+    ``material_name`` particles); ``geometry`` overrides its cell.
     ``fill_reference="capacity"``: 100 % is :func:`~pidcore.dem.geometry.cell_capacity`;
     ``"paper"``: 36 particles, refused when 36 do not fit the cell.
     """
-    geometry = geometry or CellGeometry()
-    law = ContactLaw.for_material(material_name)
-    capacity = cell_capacity(geometry, law.radius_m)
+    specimen = specimen or paper_specimen(material_name or "acrylic")
+    material_name = specimen.particles.material
+    if geometry is None:
+        geometry = specimen.geometry()
+        capacity = specimen.capacity_per_cell()
+    else:
+        capacity = cell_capacity(geometry, specimen.particles.radius_m)
     if fill_reference == "paper":
         full = defaults.PAPER_PARTICLES_PER_FULL_CELL
         if full > capacity:
             raise ParameterError(
                 f"fill_reference='paper': {full} {material_name} particles (r = "
-                f"{law.radius_m * 1e3:g} mm) do not fit a {geometry.inscribed_diameter_m * 1e3:g}"
+                f"{specimen.particles.radius_m * 1e3:g} mm) do not fit a "
+                f"{geometry.inscribed_diameter_m * 1e3:g}"
                 f" x {geometry.height_m * 1e3:g} mm cell (capacity {capacity}); use "
                 "fill_reference='capacity'")
     elif fill_reference == "capacity":
@@ -303,8 +315,7 @@ def settle_bed(state: CellsState, settings: KernelSettings,
         raise ParameterError(f"start_packing: expected one of {START_PACKINGS}, got {packing!r}")
     elapsed = 0.0
     if packing == "dense":
-        frictionless = dataclasses.replace(settings.law, friction_pp=0.0, friction_pw=0.0)
-        elapsed += settle(state, dataclasses.replace(settings, law=frictionless))
+        elapsed += settle(state, dataclasses.replace(settings, law=settings.law.frictionless()))
         state.spring_pp[:] = 0.0  # none stretched without friction; start the springs clean
         state.spring_pw[:] = 0.0
     return elapsed + settle(state, settings)
@@ -348,9 +359,24 @@ def required_steady_cycles(case: LoadCase, config: DemConfig) -> int:
     return max(defaults.DEM_MIN_STEADY_CYCLES, config.block_cycles)
 
 
+def resolve_specimen(case: LoadCase, specimen: Specimen | None) -> Specimen:
+    """The specimen a load case runs on: the paper's coupon with ``case.material`` particles
+    by default; a given specimen's particles must not contradict ``case.material`` (a table
+    material other than the specimen's is refused; a non-table material such as inline steel
+    cannot be named by the load case, whose material is then not used).
+    """
+    if specimen is None:
+        return paper_specimen(case.material)
+    name = specimen.particles.material
+    if name in PARTICLE_MATERIALS and name != case.material:
+        raise ParameterError(f"material: the load case says {case.material!r} but specimen "
+                             f"{specimen.name!r} ({specimen.source}) holds {name!r} particles")
+    return specimen
+
+
 def simulate_load_case(case: LoadCase, config: DemConfig | None = None, *,
                        progress: bool = False,
-                       geometry: CellGeometry | None = None) -> DemResult:
+                       specimen: Specimen | None = None) -> DemResult:
     """Simulate K independent cells under one load case and return the SDC (Eq. 8-10).
 
     Parameters
@@ -361,8 +387,9 @@ def simulate_load_case(case: LoadCase, config: DemConfig | None = None, *,
         Numerical settings; ``DemConfig()`` by default.
     progress : bool
         Show a tqdm progress bar on stderr.
-    geometry : CellGeometry, optional
-        Cell shape; paper Table 2 by default.
+    specimen : Specimen, optional
+        Cell, coupon and fixture masses, particles and contact pairs
+        (:mod:`pidcore.specimen`); the paper's coupon with ``case.material`` by default.
 
     Returns
     -------
@@ -381,11 +408,11 @@ def simulate_load_case(case: LoadCase, config: DemConfig | None = None, *,
     ... # doctest: +SKIP
     """
     config = config or DemConfig()
-    geometry = geometry or CellGeometry()
+    specimen = resolve_specimen(case, specimen)
+    geometry = specimen.geometry()
     wall_clock = time.perf_counter()
-    law = ContactLaw.for_material(case.material, alpha_pp=config.alpha_pp,
-                                  alpha_pw=config.alpha_pw)
-    n, full = particles_per_cell(case.fill_percent, case.material, geometry=geometry,
+    law = contact_law(specimen, alpha_pp=config.alpha_pp, alpha_pw=config.alpha_pw)
+    n, full = particles_per_cell(case.fill_percent, specimen=specimen,
                                  fill_reference=config.fill_reference)
     dt_req = choose_time_step(case, law, geometry, config.time_step, config.tangential_model)
     spc_samples = config.samples_per_cycle
@@ -396,14 +423,23 @@ def simulate_load_case(case: LoadCase, config: DemConfig | None = None, *,
     if config.damping_coefficient == "calibrated":
         from .impact import calibrate_damping_coefficient
 
+        # the impact calibration builds its law from the tables by material name: refuse a
+        # specimen whose law differs from that (it would calibrate another contact)
+        if (case.material != specimen.particles.material
+                or law != ContactLaw.for_material(case.material, alpha_pp=config.alpha_pp,
+                                                  alpha_pw=config.alpha_pw)):
+            raise ParameterError(
+                f"damping_coefficient='calibrated': only for table particles with the "
+                f"tables' contact pairs, not specimen {specimen.name!r}; use 'eq3'")
+
         v_cal = defaults.DEM_CALIBRATION_SPEED_M_S
-        law = ContactLaw.for_material(
-            case.material,
+        law = contact_law(
+            specimen,
             alpha_pw=config.alpha_pw if config.alpha_pw is not None else
-            calibrate_damping_coefficient(law.restitution_pw, "wall", v_cal, dt,
+            calibrate_damping_coefficient(law.pair_wall.restitution, "wall", v_cal, dt,
                                           config.normal_damping_mode, material=case.material),
             alpha_pp=config.alpha_pp if config.alpha_pp is not None else
-            calibrate_damping_coefficient(law.restitution_pp, "particle", v_cal, dt,
+            calibrate_damping_coefficient(law.pair_particle.restitution, "particle", v_cal, dt,
                                           config.normal_damping_mode, material=case.material))
 
     rng = np.random.default_rng(config.seed)
@@ -482,14 +518,14 @@ def simulate_load_case(case: LoadCase, config: DemConfig | None = None, *,
                      gravity_m_s2=STANDARD_GRAVITY)
     stored_change = block_energy[-1] - block_energy[steady_start // b]  # (K,) J
     n_cycles = tally.shape[1]
-    m_c = vibrated_mass_kg(config.vibrated_mass, particles_per_cell=n,
-                           particle_mass_kg=law.mass_kg)
+    m_c = specimen.vibrated_mass_kg(n, config.vibrated_mass)
     wall = time.perf_counter() - wall_clock
     total_steps = n_cycles * steps_per_cycle
     return DemResult.from_run(
         case=case, config=config, law=law, tally=tally, wall_force=force,
         steady_start_cycle=int(steady_start), steady_detected=detected,
-        particles_per_cell=n, full_count=full, m_c_kg=m_c, coupon_mass_kg=coupon_mass_kg(),
+        particles_per_cell=n, full_count=full, m_c_kg=m_c,
+        coupon_mass_kg=specimen.coupon.moving_mass_kg, specimen=specimen,
         dt_s=dt, steps_per_cycle=steps_per_cycle, sample_every=sample_every,
         energy_start=e_start, energy_end=e_end, settle_time_s=settle_time,
         stored_energy_change_steady=stored_change,
@@ -504,6 +540,6 @@ def config_parameters(case: LoadCase, config: DemConfig) -> dict:
     return {k: ("" if v is None else v) for k, v in out.items()}
 
 
-__all__ = ["LoadCase", "DemConfig", "simulate_load_case", "choose_time_step",
+__all__ = ["LoadCase", "DemConfig", "simulate_load_case", "resolve_specimen", "choose_time_step",
            "particles_per_cell", "vibrated_mass_kg", "coupon_mass_kg", "max_impact_speed",
            "settle", "settle_bed", "config_parameters"]

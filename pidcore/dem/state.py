@@ -102,14 +102,16 @@ def energies(state: CellsState, law: ContactLaw, geometry: CellGeometry, *,
     pe = m * gravity_m_s2 * np.sum(state.pos[2], axis=1)
     p = np.moveaxis(state.pos, 0, -1)  # (K, N, 3)
     dist = geometry.signed_distances(p - wall_offset_m)
-    u_wall = 0.4 * law.stiffness_pw * np.maximum(law.radius_m - dist, 0.0) ** 2.5
+    u_wall = 0.4 * law.pair_wall.stiffness * np.maximum(law.radius_m - dist, 0.0) ** 2.5
     diff = p[:, :, None, :] - p[:, None, :, :]
     d = np.sqrt(np.sum(diff**2, axis=-1))
     overlap = np.maximum(2 * law.radius_m - d, 0.0)
     overlap[:, np.arange(p.shape[1]), np.arange(p.shape[1])] = 0.0
-    u_pair = 0.5 * np.sum(0.4 * law.stiffness_pp * overlap**2.5, axis=(1, 2))
-    u_spring = (0.5 * law.tangential_stiffness_pp * np.sum(state.spring_pp**2, axis=(0, 2, 3))
-                + 0.5 * law.tangential_stiffness_pw * np.sum(state.spring_pw**2, axis=(0, 2, 3)))
+    u_pair = 0.5 * np.sum(0.4 * law.pair_particle.stiffness * overlap**2.5, axis=(1, 2))
+    u_spring = (0.5 * law.pair_particle.tangential_stiffness
+                * np.sum(state.spring_pp**2, axis=(0, 2, 3))
+                + 0.5 * law.pair_wall.tangential_stiffness
+                * np.sum(state.spring_pw**2, axis=(0, 2, 3)))
     elastic = np.sum(u_wall, axis=(1, 2)) + u_pair + u_spring
     return np.column_stack([ke, pe, elastic, ke + pe + elastic])
 
@@ -161,6 +163,7 @@ def advance(state: CellsState, settings: KernelSettings, n_steps: int, *,
     spc = max(spc, 1)
     se = max(se, 1)
     law = settings.law
+    pp, pw = law.pair_particle, law.pair_wall
     g = settings.geometry
     k = state.n_cells
     tally = np.zeros((k, max(-(-n_steps // spc), 1), N_TALLIES))
@@ -170,12 +173,12 @@ def advance(state: CellsState, settings: KernelSettings, n_steps: int, *,
     advance_cells(state.pos, state.vel, state.omg, state.frc, state.trq,
                   g.wall_normals, g.wall_offsets,
                   law.radius_m, law.mass_kg, law.inertia_kg_m2,
-                  law.stiffness_pp, law.damping_pp, law.friction_pp, law.tangential_mass_pp,
-                  law.stiffness_pw, law.damping_pw, law.friction_pw, law.tangential_mass_pw,
+                  pp.stiffness, pp.damping, pp.sliding_friction, pp.tangential_mass_kg,
+                  pw.stiffness, pw.damping, pw.sliding_friction, pw.tangential_mass_kg,
                   settings.friction_regularisation_m_s, settings.clip_attraction,
                   settings.gravity_m_s2,
-                  settings.tangential_model == "stick_slip", law.tangential_stiffness_pp,
-                  law.tangential_stiffness_pw, state.spring_pp, state.spring_pw,
+                  settings.tangential_model == "stick_slip", pp.tangential_stiffness,
+                  pw.tangential_stiffness, state.spring_pp, state.spring_pw,
                   settings.dt_s, np.int64(state.step), np.int64(n_steps),
                   settings.omega_rad_s, settings.accel_m_s2,
                   AXIS_INDEX[settings.direction],

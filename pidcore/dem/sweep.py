@@ -3,7 +3,8 @@
 Every finished case is written to the store at once, in its own transaction, by the parent
 process (the store's lock serialises writers, but one writer is simpler and faster). An
 interrupted sweep therefore keeps every finished case, and a re-run skips them: the case key
-holds every input that changes the result (load case, cells, seed, numerical options).
+holds every input that changes the result (load case, cells, seed, numerical options,
+specimen, code version; :func:`pidcore.dem.persist.run_key`).
 """
 
 from __future__ import annotations
@@ -16,7 +17,8 @@ from pathlib import Path
 
 from ..constants import DriveDirection, ParticleMaterial
 from ..errors import ParameterError
-from .persist import dem_run_entry, run_key
+from ..specimen import Specimen
+from .persist import dem_run_entry, run_key, save_dem_entry
 from .simulate import DemConfig, LoadCase, simulate_load_case
 
 #: Named grids. ``table3`` is the paper's Table 3: 4 frequencies x 3 accelerations x 4 fills.
@@ -49,15 +51,18 @@ class CaseOutcome:
     units: dict
 
     def save_to(self, store) -> str:
-        """Add (or replace) this run in ``store``; returns its key."""
-        return store.add_dem_run(self.key, self.record, arrays=self.arrays,
-                                 parameters=self.parameters, units=self.units, replace=True)
+        """Add this run to ``store`` unless stored already (:func:`~.persist.save_dem_entry`);
+        returns its key."""
+        save_dem_entry(store, self.key, {"record": self.record, "arrays": self.arrays,
+                                         "parameters": self.parameters, "units": self.units})
+        return self.key
 
 
-def run_case(case: LoadCase, config: DemConfig) -> CaseOutcome:
+def run_case(case: LoadCase, config: DemConfig,
+             specimen: Specimen | None = None) -> CaseOutcome:
     """Simulate one case (in a worker) and package it for the store."""
-    return CaseOutcome(run_key(case, config),
-                       **dem_run_entry(simulate_load_case(case, config)))
+    return CaseOutcome(run_key(case, config, specimen),
+                       **dem_run_entry(simulate_load_case(case, config, specimen=specimen)))
 
 
 def _single_thread_worker() -> None:
@@ -84,7 +89,8 @@ class SweepSummary:
 def run_sweep(cases: Sequence[LoadCase], config: DemConfig, *,
               store_path: str | os.PathLike, workers: int | None = None,
               scheduler: str | None = None, progress: bool = True,
-              on_case: Callable[[CaseOutcome], None] | None = None) -> SweepSummary:
+              on_case: Callable[[CaseOutcome], None] | None = None,
+              specimen: Specimen | None = None) -> SweepSummary:
     """Run every case not yet in the store and save each one as soon as it finishes.
 
     Parameters
@@ -103,6 +109,8 @@ def run_sweep(cases: Sequence[LoadCase], config: DemConfig, *,
         tqdm bar on stderr.
     on_case : callable, optional
         Called with each finished :class:`CaseOutcome` after it is stored (the app's progress).
+    specimen : Specimen, optional
+        What every case simulates (:mod:`pidcore.specimen`); the paper's coupon by default.
     """
     from ..store import Store
 
@@ -111,8 +119,8 @@ def run_sweep(cases: Sequence[LoadCase], config: DemConfig, *,
     summary = SweepSummary(store_path=str(Path(store_path)))
     todo: list[tuple[LoadCase, str]] = []
     for case in cases:
-        key = run_key(case, config)
-        if store.has_dem_run(key):
+        key = run_key(case, config, specimen)
+        if store.path.exists() and store.has_dem_run(key):
             summary.skipped.append(key)
         else:
             todo.append((case, key))
@@ -133,9 +141,9 @@ def run_sweep(cases: Sequence[LoadCase], config: DemConfig, *,
 
     try:
         if todo and scheduler:
-            _run_dask(todo, config, scheduler, finish)
+            _run_dask(todo, config, scheduler, finish, specimen)
         elif todo:
-            _run_local(todo, config, workers, finish)
+            _run_local(todo, config, workers, finish, specimen)
     finally:
         if bar is not None:
             bar.close()
@@ -144,14 +152,14 @@ def run_sweep(cases: Sequence[LoadCase], config: DemConfig, *,
 
 
 def _run_local(todo: Iterable[tuple[LoadCase, str]], config: DemConfig, workers: int | None,
-               finish: Callable[[CaseOutcome], None]) -> None:
+               finish: Callable[[CaseOutcome], None], specimen: Specimen | None) -> None:
     todo = list(todo)
     workers = workers or os.cpu_count() or 1
     if workers < 1:
         raise ParameterError(f"--workers: expected a positive number of processes, got {workers}")
     if workers == 1 or len(todo) == 1:
         for case, _ in todo:
-            finish(run_case(case, config))
+            finish(run_case(case, config, specimen))
         return
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor, as_completed
@@ -162,7 +170,7 @@ def _run_local(todo: Iterable[tuple[LoadCase, str]], config: DemConfig, workers:
                                mp_context=multiprocessing.get_context("spawn"),
                                initializer=_single_thread_worker)
     try:
-        futures = [pool.submit(run_case, case, config) for case, _ in todo]
+        futures = [pool.submit(run_case, case, config, specimen) for case, _ in todo]
         for future in as_completed(futures):
             finish(future.result())
     except BaseException:
@@ -173,7 +181,7 @@ def _run_local(todo: Iterable[tuple[LoadCase, str]], config: DemConfig, workers:
 
 
 def _run_dask(todo: Iterable[tuple[LoadCase, str]], config: DemConfig, scheduler: str,
-              finish: Callable[[CaseOutcome], None]) -> None:
+              finish: Callable[[CaseOutcome], None], specimen: Specimen | None) -> None:
     try:
         from distributed import Client, as_completed
     except ImportError:
@@ -181,7 +189,8 @@ def _run_dask(todo: Iterable[tuple[LoadCase, str]], config: DemConfig, scheduler
                              "pip install 'pidcore[distributed]'") from None
     client = Client(scheduler)
     try:
-        futures = [client.submit(run_case, case, config, key=f"pidcore-{key}", pure=False)
+        futures = [client.submit(run_case, case, config, specimen, key=f"pidcore-{key}",
+                                 pure=False)
                    for case, key in todo]
         try:
             for future in as_completed(futures):

@@ -259,7 +259,7 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
                 fill_percent: float | None = None, material: str | None = None,
                 direction: str | None = None, sidecar: str | Path | None = None,
                 options: AnalysisOptions | None = None,
-                tolerances: Tolerances | None = None) -> ReportResult:
+                tolerances: Tolerances | None = None, specimen=None) -> ReportResult:
     """Analyse files, store them, align with DEM and the paper, and write the report.
 
     Parameters
@@ -282,6 +282,9 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         cancellation, baseline, sample rate for CSV without time column).
     tolerances : Tolerances, optional
         Grid-match tolerances.
+    specimen : pidcore.specimen.Specimen, optional
+        Only DEM runs of this specimen are compared (default: the paper's coupon); the
+        paper's Table 3 only when it is the paper's coupon.
 
     Returns
     -------
@@ -333,10 +336,21 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         analyses = measured_frame(results)
 
     dem_runs = dem.list_dem_runs() if dem is not None else None
+    if dem_runs is not None and not dem_runs.empty:
+        from ..dem.persist import runs_of_specimen
+
+        dem_runs = runs_of_specimen(dem_runs, specimen)
+        if dem_runs.empty:
+            notes.append(f"{dem_path}: holds no DEM runs of specimen "
+                         f"{specimen.name if specimen is not None else 'paper_coupon'}")
     if dem_runs is not None and dem_runs.empty:
         notes.append(f"{dem_path}: holds no DEM runs")
         dem_runs = None
     paper = load_paper_table3()
+    if specimen is not None and not specimen.is_paper():
+        paper = None
+        notes.append(f"specimen {specimen.name} is not the paper's coupon: the paper's "
+                     "Table 3 is not compared")
     table = build_report_table(dem_runs, analyses, paper, tolerances=tolerances)
     notes.extend(table.attrs.get("notes", []))
     aligner = Aligner(dem_cases(dem_runs, tolerances=tolerances) if dem_runs is not None else [],

@@ -1,0 +1,725 @@
+"""A test specimen: honeycomb cell, coupon masses, particles and contact pairs, read from TOML.
+
+A specimen file (TOML, read with the standard library's :mod:`tomllib`) describes what the DEM
+simulates and which mass a shaker moves. Units are in the key names (SI). Example (the paper's
+coupon, ``pidcore/data/specimens/paper_coupon.toml``)::
+
+    name = "paper_coupon"
+    description = "Ahmad, Ranganath & Ghosal: 100 x 100 mm coupon, acrylic spheres"
+
+    [cell]
+    shape = "hexagonal"                # closed vocabulary (constants.CellShape)
+    inscribed_diameter_m = 4.76e-3     # wall-to-wall distance across the flats
+    height_m = 25.4e-3                 # core height (face sheet to face sheet)
+    count = 441                        # cells in the coupon
+    wall_material = "aluminium_wall"   # a materials.csv row, or inline:
+    # wall_youngs_modulus_pa = 72e9
+    # wall_poisson_ratio = 0.33
+    # wall_density_kg_m3 = 2800.0      # walls move rigidly with the coupon: not used yet
+
+    [coupon]
+    mass_kg = 0.0221534                # face sheets + core, without particles
+    fixture_mass_kg = 0.0              # moves with the coupon above the force gauge
+    baseline_loss_factor = 0.0         # damping of the empty structure [-]
+
+    [particles]
+    material = "acrylic"               # a materials.csv row, or any name with inline:
+    radius_m = 1.25e-3
+    # density_kg_m3 = 1180.0
+    # youngs_modulus_pa = 2.84e9
+    # poisson_ratio = 0.402
+    # count_per_cell = 11              # or fill_percent = 50.0 (optional: the specimen's fill)
+
+    [pairs.particle_particle]
+    restitution = 0.70
+    sliding_friction = 0.096
+    static_friction = 0.096            # >= sliding_friction
+    rolling_friction = 0.0             # mu_r: largest rolling torque mu_r R* |f_n|
+    rolling_damping_ratio = 0.0        # rolling dashpot, fraction of critical
+
+    [pairs.particle_wall]
+    restitution = 0.70
+    sliding_friction = 0.14
+    static_friction = 0.14
+    rolling_friction = 0.0
+
+A material named in the table fills the properties not given inline; the parsed
+:class:`Specimen` always holds the resolved numbers, so its canonical text
+(:attr:`Specimen.text`) and :attr:`Specimen.hash` describe the physics completely, whatever the
+tables say later. Every numeric field is addressable by a dotted path
+(``"pairs.particle_wall.static_friction"``, ``"particles.radius_m"``) for
+:meth:`Specimen.with_values`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import hashlib
+import math
+import os
+import tomllib
+from collections.abc import Mapping
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+from .constants import CELL_SHAPES, CellShape
+from .errors import ParameterError
+
+#: Version of the specimen schema written by :meth:`Specimen.to_toml`.
+SCHEMA_VERSION = 1
+#: The paper's coupon, bundled with the package.
+PAPER_SPECIMEN_NAME = "paper_coupon"
+
+
+def _fail(where: str, message: str) -> ParameterError:
+    return ParameterError(f"{where}: {message}")
+
+
+def _positive(where: str, value: float, unit: str) -> None:
+    if not (math.isfinite(value) and value > 0):
+        raise _fail(where, f"expected > 0 {unit}, got {value!r}")
+
+
+def _non_negative(where: str, value: float, unit: str) -> None:
+    if not (math.isfinite(value) and value >= 0):
+        raise _fail(where, f"expected >= 0 {unit}, got {value!r}")
+
+
+def _poisson(where: str, value: float) -> None:
+    if not (math.isfinite(value) and -1.0 < value < 0.5):
+        raise _fail(where, f"expected -1 < nu < 0.5, got {value!r}")
+
+
+@dataclass(frozen=True)
+class CellSpec:
+    """The honeycomb cell (SI): shape, size, count in the coupon, wall elasticity."""
+
+    shape: CellShape
+    inscribed_diameter_m: float
+    height_m: float
+    count: int
+    wall_material: str
+    wall_youngs_modulus_pa: float
+    wall_poisson_ratio: float
+    wall_density_kg_m3: float
+
+    def __post_init__(self):
+        if self.shape not in CELL_SHAPES:
+            raise _fail("[cell] shape", f"expected one of {CELL_SHAPES}, got {self.shape!r}")
+        _positive("[cell] inscribed_diameter_m", self.inscribed_diameter_m, "m")
+        _positive("[cell] height_m", self.height_m, "m")
+        if isinstance(self.count, bool) or not isinstance(self.count, int) or self.count < 1:
+            raise _fail("[cell] count", f"expected a whole number >= 1, got {self.count!r}")
+        _positive("[cell] wall_youngs_modulus_pa", self.wall_youngs_modulus_pa, "Pa")
+        _poisson("[cell] wall_poisson_ratio", self.wall_poisson_ratio)
+        _positive("[cell] wall_density_kg_m3", self.wall_density_kg_m3, "kg/m^3")
+
+
+@dataclass(frozen=True)
+class CouponSpec:
+    """Masses a shaker moves besides the particles (kg) and the empty structure's damping."""
+
+    mass_kg: float
+    fixture_mass_kg: float = 0.0
+    baseline_loss_factor: float = 0.0
+
+    def __post_init__(self):
+        _positive("[coupon] mass_kg", self.mass_kg, "kg")
+        _non_negative("[coupon] fixture_mass_kg", self.fixture_mass_kg, "kg")
+        _non_negative("[coupon] baseline_loss_factor", self.baseline_loss_factor, "[-]")
+
+    @property
+    def moving_mass_kg(self) -> float:
+        """Coupon plus fixture: the rigid mass above the force gauge, kg."""
+        return self.mass_kg + self.fixture_mass_kg
+
+
+@dataclass(frozen=True)
+class ParticleSpec:
+    """Spherical particles (SI); the fill is optional (a load case usually states it)."""
+
+    material: str
+    radius_m: float
+    density_kg_m3: float
+    youngs_modulus_pa: float
+    poisson_ratio: float
+    count_per_cell: int | None = None
+    fill_percent: float | None = None
+
+    def __post_init__(self):
+        if not self.material or not isinstance(self.material, str):
+            raise _fail("[particles] material", f"expected a name, got {self.material!r}")
+        _positive("[particles] radius_m", self.radius_m, "m")
+        _positive("[particles] density_kg_m3", self.density_kg_m3, "kg/m^3")
+        _positive("[particles] youngs_modulus_pa", self.youngs_modulus_pa, "Pa")
+        _poisson("[particles] poisson_ratio", self.poisson_ratio)
+        if self.count_per_cell is not None and self.fill_percent is not None:
+            raise _fail("[particles]", "give count_per_cell or fill_percent, not both")
+        if self.count_per_cell is not None and (
+                isinstance(self.count_per_cell, bool) or not isinstance(self.count_per_cell, int)
+                or self.count_per_cell < 1):
+            raise _fail("[particles] count_per_cell",
+                        f"expected a whole number >= 1, got {self.count_per_cell!r}")
+        if self.fill_percent is not None and not (0 < self.fill_percent <= 100):
+            raise _fail("[particles] fill_percent",
+                        f"expected 0 < fill <= 100 %, got {self.fill_percent!r}")
+
+    @property
+    def mass_kg(self) -> float:
+        """Mass of one sphere, kg."""
+        return self.density_kg_m3 * 4.0 / 3.0 * math.pi * self.radius_m**3
+
+
+@dataclass(frozen=True)
+class PairSpec:
+    """Contact parameters of one pair of materials [-]."""
+
+    restitution: float
+    sliding_friction: float
+    static_friction: float
+    rolling_friction: float = 0.0
+    rolling_damping_ratio: float = 0.0
+
+    def check(self, where: str) -> None:
+        """Raise a ParameterError naming ``where`` if a value is out of range."""
+        if not (math.isfinite(self.restitution) and 0 < self.restitution <= 1):
+            raise _fail(f"{where} restitution",
+                        f"expected 0 < e <= 1, got {self.restitution!r}")
+        _non_negative(f"{where} sliding_friction", self.sliding_friction, "[-]")
+        _non_negative(f"{where} static_friction", self.static_friction, "[-]")
+        _non_negative(f"{where} rolling_friction", self.rolling_friction, "[-]")
+        _non_negative(f"{where} rolling_damping_ratio", self.rolling_damping_ratio, "[-]")
+        if self.static_friction < self.sliding_friction:
+            raise _fail(f"{where} static_friction",
+                        f"{self.static_friction!r} is below sliding_friction "
+                        f"{self.sliding_friction!r}; expected static >= sliding")
+
+
+@dataclass(frozen=True)
+class PairsSpec:
+    """The two contact pairs of a one-material bed: particle-particle and particle-wall."""
+
+    particle_particle: PairSpec
+    particle_wall: PairSpec
+
+    def __post_init__(self):
+        self.particle_particle.check("[pairs.particle_particle]")
+        self.particle_wall.check("[pairs.particle_wall]")
+
+
+@dataclass(frozen=True)
+class Specimen:
+    """A honeycomb specimen: cell, coupon, particles, contact pairs (see the module docstring).
+
+    Build with :func:`load_specimen`, :meth:`from_text` or :func:`paper_specimen`; derive
+    variants with :meth:`with_values`. ``source`` (where it was read from) is not part of the
+    specimen's identity: :attr:`hash` is that of the canonical text.
+    """
+
+    name: str
+    cell: CellSpec
+    coupon: CouponSpec
+    particles: ParticleSpec
+    pairs: PairsSpec
+    description: str = ""
+    source: str = dataclasses.field(default="<specimen>", compare=False)
+
+    def __post_init__(self):
+        if not isinstance(self.name, str) or not self.name:
+            raise _fail("name", f"expected a non-empty name, got {self.name!r}")
+        r = self.particles.radius_m
+        half_gap = 0.5 * self.cell.inscribed_diameter_m
+        if r > half_gap or 2 * r > self.cell.height_m:
+            raise _fail("[particles] radius_m",
+                        f"a sphere of radius {r * 1e3:.4g} mm does not fit a "
+                        f"{self.cell.inscribed_diameter_m * 1e3:.4g} x "
+                        f"{self.cell.height_m * 1e3:.4g} mm {self.cell.shape} cell")
+        if self.particles.count_per_cell is not None:
+            capacity = self.capacity_per_cell()
+            if self.particles.count_per_cell > capacity:
+                raise _fail("[particles] count_per_cell",
+                            f"{self.particles.count_per_cell} particles do not fit the cell "
+                            f"(capacity {capacity})")
+
+    # --- construction --------------------------------------------------------------------
+
+    @classmethod
+    def from_text(cls, text: str, *, source: str = "<specimen>") -> Specimen:
+        """Parse specimen TOML; errors are one line naming ``source`` and the key."""
+        try:
+            data = tomllib.loads(text)
+        except tomllib.TOMLDecodeError as exc:
+            raise ParameterError(f"{source}: not valid TOML ({exc})") from None
+        try:
+            return _from_mapping(data, source=source)
+        except ParameterError as exc:
+            raise ParameterError(f"{source}: {exc}") from None
+
+    def with_values(self, values: Mapping[str, Any]) -> Specimen:
+        """A new specimen with fields replaced by dotted path, checked like a file.
+
+        Examples
+        --------
+        >>> s = paper_specimen().with_values({"pairs.particle_wall.static_friction": 0.3})
+        >>> s.pairs.particle_wall.static_friction
+        0.3
+        """
+        data = self.to_mapping()
+        for path, value in values.items():
+            parts = path.split(".")
+            node: Any = data
+            for i, part in enumerate(parts):
+                last = i == len(parts) - 1
+                if not isinstance(node, dict) or part not in _allowed_keys(parts[:i]):
+                    raise ParameterError(f"{self.source}: unknown specimen field {path!r}; "
+                                         f"expected one of {numeric_fields(self)}")
+                if last:
+                    node[part] = value
+                else:
+                    node = node.setdefault(part, {})
+        try:
+            return _from_mapping(data, source=self.source)
+        except ParameterError as exc:
+            raise ParameterError(f"{self.source}: {exc}") from None
+
+    # --- identity ------------------------------------------------------------------------
+
+    def to_mapping(self) -> dict[str, Any]:
+        """Nested dict of the resolved specimen, as the TOML file would hold it."""
+        out: dict[str, Any] = {"schema_version": SCHEMA_VERSION, "name": self.name,
+                               "description": self.description}
+        for section in ("cell", "coupon", "particles"):
+            out[section] = {k: v for k, v in dataclasses.asdict(getattr(self, section)).items()
+                            if v is not None}
+        out["pairs"] = {k: dataclasses.asdict(v) for k, v in
+                        (("particle_particle", self.pairs.particle_particle),
+                         ("particle_wall", self.pairs.particle_wall))}
+        return out
+
+    def to_toml(self) -> str:
+        """Canonical TOML text (resolved values, fixed key order, floats as ``repr``).
+
+        Written by a small writer for this schema (scalars in at most two levels of tables):
+        no TOML writer is in the standard library, and none is a dependency of pidcore.
+        ``Specimen.from_text(s.to_toml()) == s`` for every specimen.
+        """
+        return _dump_toml(self.to_mapping())
+
+    @property
+    def text(self) -> str:
+        """Canonical text, stored with every DEM run as provenance."""
+        return self.to_toml()
+
+    @property
+    def hash(self) -> str:
+        """sha256 of the canonical text (hex): equal for equal physics, whatever the layout."""
+        return hashlib.sha256(self.text.encode("utf-8")).hexdigest()
+
+    def is_paper(self) -> bool:
+        """True for the paper's coupon (acrylic, or another table particle material): the
+        specimen of the paper's Table 3, so only its runs are compared with that table."""
+        return self.hash in _paper_hashes()
+
+    # --- what follows from it ------------------------------------------------------------
+
+    def capacity_per_cell(self) -> int:
+        """Spheres one cell holds (dense drop packing, :func:`pidcore.dem.cell_capacity`)."""
+        return _capacity(self.cell.shape, self.cell.inscribed_diameter_m, self.cell.height_m,
+                         self.particles.radius_m)
+
+    def geometry(self):
+        """The cell as a DEM geometry record (dispatch on ``cell.shape``)."""
+        return cell_geometry(self.cell)
+
+    def vibrated_mass_kg(self, particles_per_cell: int, convention: str =
+                         "coupon_plus_particles") -> float:
+        """m_c of Eq. 10, kg: coupon + fixture (+ all particles of ``cell.count`` cells)."""
+        particles = self.cell.count * particles_per_cell * self.particles.mass_kg
+        rigid = self.coupon.moving_mass_kg
+        if convention == "coupon_plus_particles":
+            return rigid + particles
+        if convention == "coupon":
+            return rigid
+        if convention == "particles":
+            return particles
+        raise ParameterError(f"vibrated_mass: unknown convention {convention!r}")
+
+
+# --- schema ---------------------------------------------------------------------------------
+
+#: Keys of each section: name -> (required, kind). kind: "float", "int", "str".
+SCHEMA: dict[str, dict[str, tuple[bool, str]]] = {
+    "": {"schema_version": (False, "int"), "name": (True, "str"),
+         "description": (False, "str")},
+    "cell": {"shape": (True, "str"), "inscribed_diameter_m": (True, "float"),
+             "height_m": (True, "float"), "count": (True, "int"),
+             "wall_material": (True, "str"), "wall_youngs_modulus_pa": (False, "float"),
+             "wall_poisson_ratio": (False, "float"), "wall_density_kg_m3": (False, "float")},
+    "coupon": {"mass_kg": (True, "float"), "fixture_mass_kg": (False, "float"),
+               "baseline_loss_factor": (False, "float")},
+    "particles": {"material": (True, "str"), "radius_m": (False, "float"),
+                  "density_kg_m3": (False, "float"), "youngs_modulus_pa": (False, "float"),
+                  "poisson_ratio": (False, "float"), "count_per_cell": (False, "int"),
+                  "fill_percent": (False, "float")},
+    "pair": {"restitution": (True, "float"), "sliding_friction": (True, "float"),
+             "static_friction": (False, "float"), "rolling_friction": (False, "float"),
+             "rolling_damping_ratio": (False, "float")},
+}
+PAIR_NAMES = ("particle_particle", "particle_wall")
+
+
+def _allowed_keys(prefix: list[str]) -> tuple[str, ...]:
+    if not prefix:
+        return (*SCHEMA[""], "cell", "coupon", "particles", "pairs")
+    if prefix == ["pairs"]:
+        return PAIR_NAMES
+    if len(prefix) == 2 and prefix[0] == "pairs":
+        return tuple(SCHEMA["pair"])
+    if len(prefix) == 1 and prefix[0] in SCHEMA:
+        return tuple(SCHEMA[prefix[0]])
+    return ()
+
+
+def numeric_fields(specimen: Specimen) -> list[str]:
+    """Dotted paths of every numeric field of ``specimen`` (for :meth:`Specimen.with_values`)."""
+    out = []
+
+    def walk(node: Mapping[str, Any], prefix: str) -> None:
+        for key, value in node.items():
+            if isinstance(value, Mapping):
+                walk(value, f"{prefix}{key}.")
+            elif isinstance(value, int | float) and not isinstance(value, bool) \
+                    and key != "schema_version":
+                out.append(prefix + key)
+
+    walk(specimen.to_mapping(), "")
+    return out
+
+
+def _take(table: Mapping[str, Any], section: str, where: str) -> dict[str, Any]:
+    """Check keys (unknown, missing, type) of one table; returns a plain dict."""
+    schema = SCHEMA[section]
+    if not isinstance(table, Mapping):
+        raise ParameterError(f"{where}: expected a table")
+    for key in table:
+        if key not in schema:
+            raise ParameterError(f"{where} {key}: unknown key; expected one of {list(schema)}")
+    out: dict[str, Any] = {}
+    for key, (required, kind) in schema.items():
+        if key not in table:
+            if required:
+                raise ParameterError(f"{where} {key}: missing key")
+            continue
+        value = table[key]
+        if kind == "float":
+            if isinstance(value, bool) or not isinstance(value, int | float):
+                raise ParameterError(f"{where} {key}: expected a number, got {value!r}")
+            value = float(value)
+        elif kind == "int":
+            if isinstance(value, float) and value.is_integer():
+                value = int(value)
+            if isinstance(value, bool) or not isinstance(value, int):
+                raise ParameterError(f"{where} {key}: expected a whole number, got {value!r}")
+        elif not isinstance(value, str):
+            raise ParameterError(f"{where} {key}: expected text, got {value!r}")
+        out[key] = value
+    return out
+
+
+def _table_material(name: str, where: str, role: str | None):
+    from .dem.materials import material, material_table
+
+    if name not in material_table().index:
+        return None
+    row = material(name)
+    if role is not None and row.role != role:
+        raise ParameterError(f"{where}: material {name!r} is a {row.role} material in "
+                             f"materials.csv, expected a {role} material")
+    return row
+
+
+def _from_mapping(data: Mapping[str, Any], *, source: str) -> Specimen:
+    top = _take({k: v for k, v in data.items() if not isinstance(v, Mapping)}, "", "top level")
+    for key, value in data.items():
+        if isinstance(value, Mapping) and key not in ("cell", "coupon", "particles", "pairs"):
+            raise ParameterError(f"[{key}]: unknown table; expected [cell], [coupon], "
+                                 "[particles], [pairs.particle_particle], [pairs.particle_wall]")
+    version = top.get("schema_version", SCHEMA_VERSION)
+    if version != SCHEMA_VERSION:
+        raise ParameterError(f"schema_version: this pidcore reads version {SCHEMA_VERSION}, "
+                             f"got {version}")
+    for section in ("cell", "coupon", "particles", "pairs"):
+        if section not in data:
+            raise ParameterError(f"[{section}]: missing table")
+
+    cell = _take(data["cell"], "cell", "[cell]")
+    wall = _table_material(cell["wall_material"], "[cell] wall_material", None)
+    for key, column in (("wall_youngs_modulus_pa", "youngs_modulus_pa"),
+                        ("wall_poisson_ratio", "poisson_ratio"),
+                        ("wall_density_kg_m3", "density_kg_m3")):
+        if key not in cell:
+            if wall is None:
+                raise ParameterError(
+                    f"[cell] wall_material: unknown material {cell['wall_material']!r} (not in "
+                    f"materials.csv) and no inline {key}")
+            cell[key] = getattr(wall, column)
+
+    particles = _take(data["particles"], "particles", "[particles]")
+    row = _table_material(particles["material"], "[particles] material", "particle")
+    for key, column in (("density_kg_m3", "density_kg_m3"),
+                        ("youngs_modulus_pa", "youngs_modulus_pa"),
+                        ("poisson_ratio", "poisson_ratio"), ("radius_m", "default_radius_m")):
+        if key not in particles:
+            if row is None:
+                raise ParameterError(
+                    f"[particles] material: unknown material {particles['material']!r} (not "
+                    f"in materials.csv) and no inline {key}")
+            particles[key] = getattr(row, column)
+
+    pairs_table = data["pairs"]
+    if not isinstance(pairs_table, Mapping):
+        raise ParameterError("[pairs]: expected tables [pairs.particle_particle] and "
+                             "[pairs.particle_wall]")
+    for key in pairs_table:
+        if key not in PAIR_NAMES:
+            raise ParameterError(f"[pairs.{key}]: unknown pair; expected one of {PAIR_NAMES}")
+    pairs = {}
+    for name in PAIR_NAMES:
+        if name not in pairs_table:
+            raise ParameterError(f"[pairs.{name}]: missing table")
+        pair = _take(pairs_table[name], "pair", f"[pairs.{name}]")
+        # static friction defaults to the sliding one (no stick beyond the slide limit)
+        pair.setdefault("static_friction", pair["sliding_friction"])
+        pairs[name] = PairSpec(**pair)
+
+    return Specimen(name=top["name"], description=top.get("description", ""),
+                    cell=CellSpec(**cell), coupon=CouponSpec(**_take(data["coupon"], "coupon",
+                                                                     "[coupon]")),
+                    particles=ParticleSpec(**particles), pairs=PairsSpec(**pairs), source=source)
+
+
+def _toml_value(value: Any) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int):
+        return str(value)
+    if isinstance(value, float):
+        if not math.isfinite(value):
+            raise ParameterError(f"specimen: cannot write non-finite value {value!r}")
+        return repr(value)  # shortest text that reads back to the same float
+    if isinstance(value, str):
+        escaped = value.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n")
+        return f'"{escaped}"'
+    raise ParameterError(f"specimen: cannot write {value!r} to TOML")
+
+
+def _dump_toml(data: Mapping[str, Any]) -> str:
+    lines: list[str] = []
+
+    def table(node: Mapping[str, Any], name: str) -> None:
+        scalars = [(k, v) for k, v in node.items() if not isinstance(v, Mapping)]
+        subtables = [(k, v) for k, v in node.items() if isinstance(v, Mapping)]
+        if name and scalars:
+            lines.append(f"\n[{name}]")
+        for key, value in scalars:
+            lines.append(f"{key} = {_toml_value(value)}")
+        for key, value in subtables:
+            table(value, f"{name}.{key}" if name else key)
+
+    table(data, "")
+    return "\n".join(lines).lstrip("\n") + "\n"
+
+
+# --- loading --------------------------------------------------------------------------------
+
+def load_specimen(path: str | os.PathLike[str]) -> Specimen:
+    """Read and check a specimen file; a bad file is one ParameterError line naming it."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise ParameterError(f"{path}: cannot read specimen file ({exc.strerror})") from None
+    return Specimen.from_text(text, source=str(path))
+
+
+@functools.cache
+def _paper_text() -> str:
+    ref = resources.files("pidcore") / "data" / "specimens" / f"{PAPER_SPECIMEN_NAME}.toml"
+    return ref.read_text(encoding="utf-8")
+
+
+@functools.cache
+def paper_specimen(material: str = "acrylic") -> Specimen:
+    """The paper's coupon (bundled file); ``material`` swaps in another table particle.
+
+    With another particle material, radius and contact pairs come from the tables
+    (``materials.csv``, ``material_pairs.csv``), which reproduces ``--material aluminium``
+    runs of earlier versions.
+    """
+    base = Specimen.from_text(_paper_text(), source=f"pidcore:{PAPER_SPECIMEN_NAME}.toml")
+    if material == base.particles.material:
+        return base
+    from .dem.materials import pair_properties
+
+    row = _table_material(material, "material", "particle")
+    if row is None:
+        raise ParameterError(f"material: unknown particle material {material!r}")
+    pp = pair_properties(material, material)
+    pw = pair_properties(material, base.cell.wall_material)
+    particles = ParticleSpec(material=material, radius_m=row.default_radius_m,
+                             density_kg_m3=row.density_kg_m3,
+                             youngs_modulus_pa=row.youngs_modulus_pa,
+                             poisson_ratio=row.poisson_ratio)
+    pairs = PairsSpec(**{name: PairSpec(restitution=t.restitution,
+                                        sliding_friction=t.sliding_friction,
+                                        static_friction=t.static_friction,
+                                        rolling_friction=t.rolling_friction,
+                                        rolling_damping_ratio=t.rolling_damping_ratio)
+                         for name, t in (("particle_particle", pp), ("particle_wall", pw))})
+    return dataclasses.replace(
+        base, name=f"{PAPER_SPECIMEN_NAME}_{material}", particles=particles, pairs=pairs,
+        description=f"the paper's coupon with {material} spheres from the tables")
+
+
+# --- contact law ----------------------------------------------------------------------------
+
+#: Whether the DEM kernel models static friction above the sliding one and rolling
+#: resistance. Until it does, a specimen asking for them is refused rather than simulated
+#: without them (set True when the kernel gains them; the contact law already carries them).
+KERNEL_HAS_STATIC_AND_ROLLING_FRICTION = False
+
+
+def contact_law(specimen: Specimen, *, alpha_pp: float | None = None,
+                alpha_pw: float | None = None):
+    """The DEM contact law of a specimen's particles in its cell (paper Eq. 2-5).
+
+    :meth:`pidcore.dem.contact.ContactLaw.from_properties` fed from the specimen's resolved
+    numbers (so the paper's specimen gives ``ContactLaw.for_material`` bit for bit).
+    ``alpha_*`` override Eq. 3's damping constants.
+    """
+    from .dem.contact import ContactLaw
+    from .dem.materials import MaterialProperties, PairParameters
+
+    if not KERNEL_HAS_STATIC_AND_ROLLING_FRICTION:
+        for name in PAIR_NAMES:
+            pair = getattr(specimen.pairs, name)
+            if pair.static_friction != pair.sliding_friction or pair.rolling_friction != 0:
+                raise ParameterError(
+                    f"{specimen.source}: [pairs.{name}] static_friction above sliding_friction"
+                    " or rolling_friction > 0 needs the static-friction/rolling-resistance "
+                    "kernel, which this build does not have yet")
+    p, c = specimen.particles, specimen.cell
+
+    def pair(spec: PairSpec) -> PairParameters:
+        return PairParameters(restitution=spec.restitution,
+                              sliding_friction=spec.sliding_friction,
+                              static_friction=spec.static_friction,
+                              rolling_friction=spec.rolling_friction,
+                              rolling_damping_ratio=spec.rolling_damping_ratio)
+
+    return ContactLaw.from_properties(
+        particle=MaterialProperties(density_kg_m3=p.density_kg_m3,
+                                    youngs_modulus_pa=p.youngs_modulus_pa,
+                                    poisson_ratio=p.poisson_ratio),
+        radius_m=p.radius_m,
+        wall=MaterialProperties(density_kg_m3=c.wall_density_kg_m3,  # rigid: mass unused
+                                youngs_modulus_pa=c.wall_youngs_modulus_pa,
+                                poisson_ratio=c.wall_poisson_ratio),
+        pair_particle=pair(specimen.pairs.particle_particle),
+        pair_wall=pair(specimen.pairs.particle_wall),
+        particle_material=p.material, alpha_pp=alpha_pp, alpha_pw=alpha_pw)
+
+
+@functools.cache
+def _paper_hashes() -> frozenset[str]:
+    from .constants import PARTICLE_MATERIALS
+
+    return frozenset(paper_specimen(m).hash for m in PARTICLE_MATERIALS)
+
+
+# --- what follows from a specimen ------------------------------------------------------------
+
+#: Load case whose impacts are the hardest of the paper's Table 3 grid (largest 2 a/w): the
+#: time step :func:`describe` reports is the one ``time_step="auto"`` picks for it.
+DESCRIBE_FREQUENCY_HZ = 50.0
+DESCRIBE_ACCELERATION_G = 10.0
+
+
+def describe(specimen: Specimen) -> dict[str, Any]:
+    """What follows from a specimen (units in the keys): capacity, masses, contact numbers.
+
+    Particle counts and masses are for the specimen's stated fill (``count_per_cell`` or
+    ``fill_percent`` of the capacity) where it states one, else for a full cell. Contact time
+    and time step are for the hardest impact of the Table 3 grid (50 Hz, 10 g).
+    """
+    from . import defaults
+    from .constants import PARTICLE_MATERIALS
+    from .dem.simulate import LoadCase, choose_time_step, max_impact_speed
+
+    law = contact_law(specimen)
+    geometry = specimen.geometry()
+    capacity = specimen.capacity_per_cell()
+    p = specimen.particles
+    if p.count_per_cell is not None:
+        count, basis = p.count_per_cell, "count_per_cell"
+    elif p.fill_percent is not None:
+        count, basis = int(round(p.fill_percent / 100.0 * capacity)), "fill_percent"
+    else:
+        count, basis = capacity, "capacity"
+    material = p.material if p.material in PARTICLE_MATERIALS else "acrylic"
+    case = LoadCase(DESCRIBE_FREQUENCY_HZ, DESCRIBE_ACCELERATION_G, 100.0, material=material)
+    speed = max_impact_speed(case, geometry)
+    return {
+        "name": specimen.name, "sha256": specimen.hash, "is_paper": specimen.is_paper(),
+        "cell_shape": specimen.cell.shape, "cells_per_coupon": specimen.cell.count,
+        "capacity_per_cell": capacity, "particles_per_cell": count,
+        "particles_per_cell_basis": basis,
+        "particle_mass_kg": p.mass_kg,
+        "particles_mass_kg": specimen.cell.count * count * p.mass_kg,
+        "coupon_mass_kg": specimen.coupon.mass_kg,
+        "fixture_mass_kg": specimen.coupon.fixture_mass_kg,
+        "vibrated_mass_kg": specimen.vibrated_mass_kg(count),
+        "wall_to_wall_gap_m": specimen.cell.inscribed_diameter_m - 2 * p.radius_m,
+        "floor_to_ceiling_gap_m": specimen.cell.height_m - 2 * p.radius_m,
+        "normal_stiffness_pp_n_m1_5": law.pair_particle.stiffness,
+        "normal_stiffness_pw_n_m1_5": law.pair_wall.stiffness,
+        "tangential_stiffness_pp_n_m": law.pair_particle.tangential_stiffness,
+        "tangential_stiffness_pw_n_m": law.pair_wall.tangential_stiffness,
+        "reference_impact_speed_m_s": speed,
+        "contact_time_s": law.contact_time(speed),
+        "tangential_period_s": law.tangential_period(),
+        "time_step_s": choose_time_step(case, law, geometry, "auto",
+                                        defaults.DEM_TANGENTIAL_MODEL),
+    }
+
+
+# --- geometry -------------------------------------------------------------------------------
+
+def cell_geometry(cell: CellSpec):
+    """DEM geometry of a cell, by shape (only ``"hexagonal"`` so far)."""
+    from .dem.geometry import CellGeometry
+
+    builders = {"hexagonal": lambda c: CellGeometry(inscribed_diameter_m=c.inscribed_diameter_m,
+                                                    height_m=c.height_m)}
+    if cell.shape not in builders:  # pragma: no cover - the vocabulary and builders agree
+        raise ParameterError(f"[cell] shape: no DEM geometry for {cell.shape!r} yet")
+    return builders[cell.shape](cell)
+
+
+@functools.cache
+def _capacity(shape: str, inscribed_diameter_m: float, height_m: float, radius_m: float) -> int:
+    from .dem.geometry import cell_capacity
+
+    cell = CellSpec(shape=shape, inscribed_diameter_m=inscribed_diameter_m, height_m=height_m,
+                    count=1, wall_material="-", wall_youngs_modulus_pa=1.0,
+                    wall_poisson_ratio=0.0, wall_density_kg_m3=1.0)
+    return cell_capacity(cell_geometry(cell), radius_m)
+
+
+__all__ = ["CellSpec", "CouponSpec", "PairSpec", "PairsSpec", "ParticleSpec", "Specimen",
+           "cell_geometry", "contact_law", "describe", "load_specimen", "numeric_fields",
+           "paper_specimen"]
+

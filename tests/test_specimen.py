@@ -1,0 +1,104 @@
+"""Specimen files: schema, checks with one-line errors, canonical text and hash, overrides."""
+
+from __future__ import annotations
+
+import pytest
+
+from pidcore.dem.contact import ContactLaw
+from pidcore.dem.geometry import CellGeometry, cell_capacity
+from pidcore.dem.simulate import coupon_mass_kg
+from pidcore.errors import ParameterError
+from pidcore.specimen import (
+    Specimen,
+    contact_law,
+    load_specimen,
+    numeric_fields,
+    paper_specimen,
+)
+
+PAPER = paper_specimen()
+
+
+def _edit(text: str, old: str, new: str) -> str:
+    assert old in text, old
+    return text.replace(old, new, 1)
+
+
+def test_paper_specimen_is_the_papers_coupon_to_the_last_bit():
+    # every earlier DEM result used these numbers; the specimen must give the same floats
+    assert PAPER.coupon.mass_kg == coupon_mass_kg()
+    assert PAPER.cell.count == 441
+    assert PAPER.geometry() == CellGeometry()
+    for material in ("acrylic", "aluminium"):
+        assert contact_law(paper_specimen(material)) == ContactLaw.for_material(material)
+    assert PAPER.capacity_per_cell() == cell_capacity(CellGeometry(), 1.25e-3)
+    # the paper's coupon with either table material is the specimen of the paper's Table 3
+    assert PAPER.is_paper() and paper_specimen("aluminium").is_paper()
+    assert not PAPER.with_values({"coupon.fixture_mass_kg": 0.01}).is_paper()
+
+
+def test_canonical_text_round_trips_and_hash_ignores_layout():
+    again = Specimen.from_text(PAPER.to_toml())
+    assert again == PAPER and again.hash == PAPER.hash
+    # comments, key order and number spelling are not physics: same hash
+    text = PAPER.to_toml()
+    text = _edit(text, "height_m = 0.0254", "# core height\nheight_m = 25.4e-3")
+    assert Specimen.from_text(text).hash == PAPER.hash
+    # a changed number is: different hash
+    other = PAPER.with_values({"coupon.fixture_mass_kg": 0.1})
+    assert other.hash != PAPER.hash
+    assert Specimen.from_text(other.to_toml()) == other
+
+
+def test_with_values_addresses_every_numeric_field_and_checks_the_result():
+    paths = numeric_fields(PAPER)
+    assert "pairs.particle_wall.static_friction" in paths and "cell.count" in paths
+    s = PAPER.with_values({"pairs.particle_wall.static_friction": 0.3,
+                           "particles.radius_m": 1.0e-3})
+    assert s.pairs.particle_wall.static_friction == 0.3 and s.particles.radius_m == 1.0e-3
+    assert PAPER.pairs.particle_wall.static_friction == 0.14  # the original is unchanged
+    with pytest.raises(ParameterError, match="unknown specimen field 'pairs.wall.mu'"):
+        PAPER.with_values({"pairs.wall.mu": 0.3})
+    with pytest.raises(ParameterError, match="static_friction.*below sliding_friction"):
+        PAPER.with_values({"pairs.particle_wall.static_friction": 0.1})
+
+
+@pytest.mark.parametrize(("old", "new", "message"), [
+    ("count = 441\n", "", r"\[cell\] count: missing key"),
+    ("mass_kg = 0.022153400000000004", "mass_kg = -0.02", r"\[coupon\] mass_kg: expected > 0"),
+    ("radius_m = 0.00125", "radius_m = 0.003", r"radius_m: a sphere of radius 3 mm does not fit"),
+    ("static_friction = 0.14", "static_friction = 0.1", r"particle_wall\] static_friction"),
+    ('material = "acrylic"\nradius_m = 0.00125\ndensity_kg_m3 = 1180.0',
+     'material = "unobtainium"\nradius_m = 0.00125', "unknown material 'unobtainium'"),
+    ("count = 441", "count = 441\ncolour = 3", r"\[cell\] colour: unknown key"),
+    ('shape = "hexagonal"', 'shape = "round"', r"\[cell\] shape: expected one of"),
+    ("poisson_ratio = 0.402", "poisson_ratio = 0.402\ncount_per_cell = 23",
+     r"count_per_cell: 23 particles do not fit the cell \(capacity 22\)"),
+    ("count = 441", "count = 44.5", r"\[cell\] count: expected a whole number"),
+])
+def test_bad_specimen_is_one_line_naming_file_and_key(tmp_path, old, new, message):
+    path = tmp_path / "bad.toml"
+    path.write_text(_edit(PAPER.to_toml(), old, new))
+    with pytest.raises(ParameterError, match=message) as info:
+        load_specimen(path)
+    text = str(info.value)
+    assert "\n" not in text and text.startswith(str(path))
+
+
+def test_inline_particle_properties_need_no_table_row():
+    text = _edit(PAPER.to_toml(), 'material = "acrylic"', 'material = "steel"')
+    text = _edit(text, "density_kg_m3 = 1180.0", "density_kg_m3 = 7850.0")
+    steel = Specimen.from_text(text)
+    assert steel.particles.material == "steel"
+    assert steel.particles.mass_kg == pytest.approx(7850 * 4 / 3 * 3.141592653589793
+                                                    * 1.25e-3**3, rel=1e-14)
+
+
+def test_vibrated_mass_counts_fixture_coupon_and_particles():
+    s = PAPER.with_values({"coupon.fixture_mass_kg": 0.5})
+    n = 11
+    particles = 441 * n * s.particles.mass_kg
+    assert s.vibrated_mass_kg(n) == pytest.approx(PAPER.coupon.mass_kg + 0.5 + particles,
+                                                  rel=1e-15)
+    assert s.vibrated_mass_kg(n, "coupon") == pytest.approx(PAPER.coupon.mass_kg + 0.5)
+    assert s.vibrated_mass_kg(n, "particles") == pytest.approx(particles)

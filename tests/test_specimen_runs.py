@@ -1,0 +1,185 @@
+"""DEM runs of a specimen: plumbing of masses and cell count, the run cache, provenance, CLI."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from pidcore.cli import main
+from pidcore.dem import persist
+from pidcore.dem.persist import (
+    dem_run_entry,
+    load_dem_result,
+    rekey_dem_store,
+    run_key,
+    run_or_load,
+)
+from pidcore.dem.simulate import DemConfig, LoadCase, simulate_load_case
+from pidcore.errors import ParameterError
+from pidcore.specimen import Specimen, describe, load_specimen, paper_specimen
+from pidcore.store import Store
+
+REPO = Path(__file__).resolve().parents[1]
+STEEL = REPO / "data_samples" / "specimens" / "steel_6mm.toml"
+# Bookkeeping tests: one cell, few cycles (physics is tested elsewhere).
+TINY = DemConfig(cells=1, steady_cycles=4, block_cycles=2, max_transient_cycles=2)
+CASE = LoadCase(1000.0, 5.0, 25.0)
+
+
+def _same_numbers(a, b) -> None:
+    da, db = a.to_dict(), b.to_dict()
+    assert da.keys() == db.keys()
+    for k in da:
+        assert da[k] == db[k] or (da[k] != da[k] and db[k] != db[k]), k  # NaN == NaN here
+    for name in a.array_names():
+        np.testing.assert_array_equal(getattr(a, name), getattr(b, name), err_msg=name)
+
+
+def test_run_cache_reuses_a_stored_run_and_never_recomputes(tmp_path, monkeypatch):
+    path = tmp_path / "cache.h5"
+    first = run_or_load(path, None, CASE, TINY)
+    assert Store(path).has_dem_run(run_key(CASE, TINY))
+
+    def no_simulation(*args, **kwargs):
+        raise AssertionError("run_or_load simulated a run that is in the store")
+
+    monkeypatch.setattr(persist, "simulate_load_case", no_simulation)
+    again = run_or_load(path, paper_specimen(), CASE, TINY)  # the default, stated
+    _same_numbers(first, again)
+    assert again.specimen == paper_specimen()
+    # another specimen is another run: not served from the cache
+    heavier = paper_specimen().with_values({"coupon.fixture_mass_kg": 0.05})
+    assert run_key(CASE, TINY, heavier) != run_key(CASE, TINY)
+    with pytest.raises(AssertionError, match="simulated"):
+        run_or_load(path, heavier, CASE, TINY)
+
+
+def test_stored_run_carries_specimen_text_and_hash(tmp_path):
+    path = tmp_path / "s.h5"
+    heavier = paper_specimen().with_values({"coupon.fixture_mass_kg": 0.05})
+    result = run_or_load(path, heavier, CASE, TINY)
+    entry = Store(path).get_dem_run(run_key(CASE, TINY, heavier))
+    stored = Specimen.from_text(entry.parameters["specimen_text"])
+    assert stored == heavier and stored.hash == entry.parameters["specimen_sha256"]
+    assert not entry.record["specimen_is_paper"]
+    assert entry.parameters["dem_code_version"] == persist.DEM_CODE_VERSION
+    _same_numbers(result, load_dem_result(entry))
+
+
+def test_fixture_mass_changes_only_the_vibrated_mass():
+    # the fixture moves rigidly with the cells: the particles see the same drive, so the
+    # tallies are identical bit for bit and the SDC scales with 1 / m_c (Eq. 10)
+    base = simulate_load_case(CASE, TINY)
+    heavy = simulate_load_case(CASE, TINY, specimen=paper_specimen().with_values(
+        {"coupon.fixture_mass_kg": 0.1}))
+    assert heavy.energy_per_cycle_j == base.energy_per_cycle_j
+    assert heavy.m_c_kg == pytest.approx(base.m_c_kg + 0.1, rel=1e-15)
+    assert heavy.sdc == pytest.approx(base.sdc * base.m_c_kg / heavy.m_c_kg, rel=1e-12)
+    # the virtual shaker carries the fixture too: F = (coupon + fixture) a + walls' force
+    extra = (heavy.shaker_force_n - heavy.wall_force_n) - (base.shaker_force_n - base.wall_force_n)
+    accel = (base.shaker_force_n - base.wall_force_n) / base.coupon_mass_kg
+    np.testing.assert_allclose(extra, 0.1 * accel, rtol=1e-9, atol=1e-12)
+
+
+def test_a_specimen_unlike_the_papers_runs_end_to_end():
+    steel = load_specimen(STEEL)
+    facts = describe(steel)
+    assert not facts["is_paper"] and facts["cells_per_coupon"] == 286
+    r = simulate_load_case(LoadCase(500.0, 5.0, 50.0), DemConfig(cells=2, steady_cycles=40),
+                           specimen=steel)
+    # particle count and masses follow from the specimen, not from the paper's coupon
+    assert r.particles_full_cell == facts["capacity_per_cell"]
+    assert r.particles_per_cell == round(0.5 * facts["capacity_per_cell"])
+    m_particle = 7850.0 * 4.0 / 3.0 * np.pi * 1e-3**3
+    assert r.m_c_kg == pytest.approx(0.0333 + 0.015 + 286 * r.particles_per_cell * m_particle,
+                                     rel=1e-12)
+    # coupon energies are 286 x the cell mean (not 441)
+    steady = r.dissipation_per_cell_cycle_j[:, r.steady_start_cycle:]
+    assert r.energy_per_cycle_j == pytest.approx(286 * steady.mean(), rel=1e-12)
+    assert r.to_dict()["material"] == "steel" and r.coupon_cells == 286
+    # closure: the walls' energy balance, and the virtual shaker's Eq. 11 energy per cycle
+    # against the tally (1 %: the issue's criterion; measured 0.3-0.5 % for 4 cells)
+    assert abs(r.energy_balance_error) < 0.01
+    shaker = r.power_analysis().energy_per_cycle_j
+    assert shaker == pytest.approx(r.energy_per_cycle_j + r.stored_energy_change_per_cycle_j,
+                                   rel=0.01)
+    assert r.sdc > 0
+
+
+def test_rekey_gives_legacy_runs_todays_key_and_provenance(tmp_path):
+    legacy = tmp_path / "legacy.h5"
+    result = simulate_load_case(CASE, TINY)
+    entry = dem_run_entry(result)
+    for name in ("specimen_text", "specimen_sha256", "specimen_name", "dem_code_version"):
+        entry["parameters"].pop(name)  # as stored before specimens existed
+    Store(legacy).add_dem_run("old_key", **entry)
+    assert rekey_dem_store(legacy, tmp_path / "new.h5") == 1
+    new = Store(tmp_path / "new.h5").get_dem_run(run_key(CASE, TINY))
+    assert new.parameters["specimen_sha256"] == paper_specimen().hash
+    _same_numbers(result, load_dem_result(new))
+
+
+def test_specimen_check_cli(capsys, tmp_path):
+    assert main(["specimen", "check", str(STEEL)]) == 0
+    out = capsys.readouterr().out
+    assert "capacity 46 particles per cell" in out and "vibrated" in out and "time step" in out
+    assert main(["specimen", "check", str(STEEL), "--json"]) == 0
+    facts = json.loads(capsys.readouterr().out)
+    assert facts["capacity_per_cell"] == 46 and facts["time_step_s"] < facts["contact_time_s"]
+    bad = tmp_path / "bad.toml"
+    bad.write_text(STEEL.read_text().replace("mass_kg = 0.0333", "mass_kg = -0.0333"))
+    assert main(["specimen", "check", str(bad)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and str(bad) in err and "[coupon] mass_kg" in err
+
+
+def test_dem_run_cli_with_specimen_and_run_cache(capsys, tmp_path):
+    store = tmp_path / "s.h5"
+    args = ["dem", "run", "--specimen", str(STEEL), "--frequency", "1000", "--acceleration",
+            "5", "--cells", "1", "--cycles", "4", "--no-progress", "--json", "--store",
+            str(store)]
+    assert main(args) == 0  # --fill from the specimen's fill_percent
+    first = json.loads(capsys.readouterr().out)
+    assert first["reused_from_store"] is False and first["store_key"].startswith("steel_z_")
+    assert first["fill_percent"] == 50.0 and first["coupon_cells"] == 286
+    before = store.read_bytes()
+    assert main(args) == 0
+    second = json.loads(capsys.readouterr().out)
+    assert second["reused_from_store"] is True and second["sdc"] == first["sdc"]
+    assert store.read_bytes() == before  # reused, nothing written
+
+
+def test_case_material_must_not_contradict_the_specimen():
+    with pytest.raises(ParameterError, match="holds 'acrylic' particles"):
+        simulate_load_case(LoadCase(1000, 5, 25, material="aluminium"), TINY,
+                           specimen=paper_specimen())
+
+
+def test_report_compares_runs_of_one_specimen_and_the_paper_only_for_its_coupon(tmp_path,
+                                                                                 capsys):
+    import pandas as pd
+
+    store = tmp_path / "runs.h5"
+    own = paper_specimen().with_values({"coupon.fixture_mass_kg": 0.05, "cell.count": 400})
+    own_file = tmp_path / "own.toml"
+    own_file.write_text(own.to_toml())
+    paper_run = run_or_load(store, None, CASE, TINY)
+    own_run = run_or_load(store, own, CASE, TINY)
+    assert own_run.sdc != paper_run.sdc
+
+    def report(*extra):
+        out = tmp_path / f"report{len(extra)}"
+        assert main(["report", "--dem-store", str(store), "--out", str(out), "--format", "csv",
+                     *extra]) == 0
+        capsys.readouterr()
+        return pd.read_csv(out / "report.csv", comment="#")
+
+    default = report()  # the paper's coupon: its run, beside the paper's Table 3
+    assert default["SDC DEM (ours) [-]"].tolist() == pytest.approx([paper_run.sdc])
+    assert default["SDC DEM (paper) [-]"].notna().all()
+    mine = report("--specimen", str(own_file))  # only the own specimen's run, no paper
+    assert mine["SDC DEM (ours) [-]"].tolist() == pytest.approx([own_run.sdc])
+    assert mine["SDC DEM (paper) [-]"].isna().all()
