@@ -12,6 +12,7 @@ from pidcore.calibrate import MeasuredPoint, calibrate
 from pidcore.calibrate.runner import RunRequest, run_requests
 from pidcore.cli import main
 from pidcore.dem.simulate import DemConfig, LoadCase
+from pidcore.specimen import load_specimen, paper_specimen
 from pidcore.store import Store
 
 HEADER = "frequency_hz,acceleration_g,fill_percent,sdc\n"
@@ -87,10 +88,11 @@ def test_json_document(capsys, tmp_path, tiny_store):
     for name in ("calibrated_specimen.toml", "summary.md", "summary.html", "predictions.png",
                  "posterior_pairs.png"):
         assert (out / name).stat().st_size > 0
-    import tomllib
-
-    spec = tomllib.loads((out / "calibrated_specimen.toml").read_text())
-    assert spec["calibrated"]["fixture_mass_kg"] == pytest.approx(p["median"], rel=1e-5)
+    # the calibrated specimen is a valid specimen file holding the fitted value, all else
+    # as the paper's coupon
+    spec = load_specimen(out / "calibrated_specimen.toml")
+    assert spec.coupon.fixture_mass_kg == pytest.approx(p["median"], rel=1e-12)
+    assert spec.with_values({"coupon.fixture_mass_kg": 0.0}).hash == paper_specimen().hash
 
 
 def test_loo_prediction_never_sees_the_held_out_value(tiny_store):
@@ -112,7 +114,8 @@ def test_loo_prediction_never_sees_the_held_out_value(tiny_store):
 
 def test_interrupt_keeps_finished_runs(tmp_path):
     config = DemConfig(cells=2, steady_cycles=10, block_cycles=5, max_transient_cycles=10)
-    requests = [RunRequest(LoadCase(f, 5, 50), (), config) for f in (500.0, 1000.0)]
+    requests = [RunRequest(LoadCase(f, 5, 50), paper_specimen(), config)
+                for f in (500.0, 1000.0)]
     store = tmp_path / "dem.h5"
 
     def interrupt(key):

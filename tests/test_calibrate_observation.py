@@ -12,6 +12,7 @@ from pidcore.calibrate.runner import RunRequest, simulate_request
 from pidcore.dem.persist import dem_run_entry
 from pidcore.dem.simulate import DemConfig, LoadCase
 from pidcore.signal import analyze_power
+from pidcore.specimen import paper_specimen
 
 F_HZ = 200.0
 FS_HZ = F_HZ * 128
@@ -63,7 +64,7 @@ def test_fixture_mass_and_baseline_equal_eq11_of_the_whole_shaker_force():
 def flying_run():
     case = LoadCase(500.0, 5.0, 50.0)
     config = DemConfig(cells=2, steady_cycles=20, block_cycles=5, max_transient_cycles=10)
-    return simulate_request(RunRequest(case, (), config))
+    return simulate_request(RunRequest(case, paper_specimen(), config))
 
 
 def test_dem_observation_is_eq11_of_the_virtual_shaker(flying_run):

@@ -1,21 +1,24 @@
 """Recovery: measurements synthesised by our own DEM with known parameter values (plus noise
 at their standard errors) are calibrated back with every true value inside its 95 % interval.
 
-Small, fast configuration: 2 cells, 10 steady cycles, three load cases where runs are cheap.
+Small, fast configuration: 4 cells, 10 steady cycles, three load cases where runs are cheap.
 """
 
 from __future__ import annotations
+
+import math
 
 import numpy as np
 import pytest
 
 from pidcore.calibrate import MeasuredPoint, calibrate, observation_from_run
-from pidcore.calibrate.runner import RunRequest, simulate_request
+from pidcore.calibrate.runner import RunRequest, simulate_request, specimen_with
 from pidcore.dem.persist import dem_run_entry
 from pidcore.dem.simulate import DemConfig, LoadCase
+from pidcore.specimen import paper_specimen
 
 CASES = ((500.0, 5.0), (1000.0, 5.0), (500.0, 1.0))
-BASE = DemConfig(cells=2, steady_cycles=10, block_cycles=5, max_transient_cycles=10)
+BASE = DemConfig(cells=4, steady_cycles=10, block_cycles=5, max_transient_cycles=10)
 #: Relative standard error given to the synthetic measurements (a good shaker test: 3 %).
 STDERR = 0.03
 
@@ -24,12 +27,19 @@ def _synthetic_points(truth: dict, dem_values: tuple, seed: int) -> list[Measure
     rng = np.random.default_rng(seed)
     points = []
     for f, a in CASES:
-        entry = dem_run_entry(simulate_request(RunRequest(LoadCase(f, a, 50.0), dem_values,
-                                                          BASE)))
+        entry = dem_run_entry(simulate_request(RunRequest(LoadCase(f, a, 50.0), specimen_with(
+            paper_specimen(), dict(dem_values)), BASE)))
         obs = observation_from_run(entry["record"], entry["arrays"])
-        sdc = float(obs.sdc(truth["fixture_mass_kg"], truth.get("baseline_loss_factor", 0.0)))
+        fixture = truth["fixture_mass_kg"]
+        sdc = float(obs.sdc(fixture, truth.get("baseline_loss_factor", 0.0)))
+        # the synthetic "truth" is one DEM realisation (4 cells): its own standard error
+        # belongs to the measurement's, beside the shaker test's STDERR
+        den = obs.reactive_mass_kg + obs.coupon_mass_kg + fixture
+        se_dem = math.hypot(2 * math.pi / den * obs.dissipative_mass_stderr_kg,
+                            sdc / den * obs.reactive_mass_stderr_kg)
         se = STDERR * sdc
-        points.append(MeasuredPoint(f, a, 50.0, sdc + se * rng.standard_normal(), se))
+        points.append(MeasuredPoint(f, a, 50.0, sdc + se * rng.standard_normal(),
+                                    math.hypot(se, se_dem)))
     return points
 
 

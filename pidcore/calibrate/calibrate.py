@@ -19,9 +19,10 @@ import numpy as np
 from .. import defaults
 from ..dem.simulate import DemConfig, LoadCase
 from ..errors import ParameterError
+from ..specimen import Specimen, paper_specimen
 from .data import MeasuredPoint, check_enough_points
 from .observation import Observation, observation_from_run
-from .parameters import CATALOGUE, DISCREPANCY, ParameterSpec, build_specs
+from .parameters import CATALOGUE, DISCREPANCY, ParameterSpec, build_specs, parameter_spec
 from .posterior import (
     DISCREPANCY_FLOOR,
     Model,
@@ -29,7 +30,7 @@ from .posterior import (
     sample_posterior,
     summarise,
 )
-from .runner import RunRequest, run_requests
+from .runner import RunRequest, run_requests, specimen_with
 from .surrogate import build_surrogate, default_design_size, design_points
 
 #: Cells per DEM run of a calibration: the ensemble scatter enters the likelihood, and 4
@@ -42,6 +43,7 @@ CROSS_VALIDATIONS = ("loo",)
 class CalibrationResult:
     """Outcome of :func:`calibrate`: posterior summary, predictions, LOO, run bookkeeping."""
 
+    specimen: Specimen
     specs: list[ParameterSpec]
     samples: np.ndarray
     parameters: dict
@@ -76,6 +78,15 @@ class CalibrationResult:
     def values(self) -> dict[str, float]:
         """Calibrated value (posterior median) of every fitted parameter."""
         return {name: p["median"] for name, p in self.parameters.items()}
+
+    def calibrated_specimen(self) -> Specimen:
+        """The starting specimen with every fitted specimen parameter at its median."""
+        dem = {s.name: self.parameters[s.name]["median"] for s in self.specs if s.kind == "dem"}
+        out = specimen_with(self.specimen, dem)
+        coupon = {f"coupon.{name}": self.parameters[name]["median"]
+                  for name in ("fixture_mass_kg", "baseline_loss_factor")
+                  if name in self.parameters}
+        return out.with_values(coupon) if coupon else out
 
     def document(self) -> dict:
         """The ``--json`` document: parameters, predictions, loo, loo_rms."""
@@ -116,15 +127,29 @@ def _public(row: dict) -> dict:
 
 
 def _requests(points: Sequence[MeasuredPoint], dem_specs: Sequence[ParameterSpec],
-              design: np.ndarray, config: DemConfig) -> list[list[RunRequest]]:
+              design: np.ndarray, config: DemConfig,
+              specimen: Specimen) -> list[list[RunRequest]]:
+    specimens = [specimen_with(specimen, {s.name: float(v)
+                                          for s, v in zip(dem_specs, row, strict=True)})
+                 for row in design]
     out = []
     for point in points:
         case = LoadCase(point.frequency_hz, point.acceleration_g, point.fill_percent,
                         point.material)
-        out.append([RunRequest(case, tuple((s.name, float(v))
-                                           for s, v in zip(dem_specs, row, strict=True)),
-                               config) for row in design])
+        out.append([RunRequest(case, s, config) for s in specimens])
     return out
+
+
+def base_specimen(points: Sequence[MeasuredPoint], specimen: Specimen | None) -> Specimen:
+    """The specimen to calibrate: the given one, or the paper's coupon with the points'
+    particle material (all points must name the same one)."""
+    materials = sorted({p.material for p in points})
+    if len(materials) > 1:
+        raise ParameterError(f"measured points name several particle materials {materials}; "
+                             "calibrate one specimen at a time")
+    if specimen is None:
+        return paper_specimen(materials[0])
+    return specimen
 
 
 def calibrate(points: Sequence[MeasuredPoint], *, fit: Sequence[str],
@@ -135,17 +160,20 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: Sequence[str],
               steady_cycles: int | None = None, design_size: int | None = None,
               workers: int = 2, cross_validate: str | None = None, method: str = "auto",
               progress: bool = True, posterior_seed: int = 0,
-              dem_config: DemConfig | None = None) -> CalibrationResult:
+              dem_config: DemConfig | None = None,
+              specimen: Specimen | None = None) -> CalibrationResult:
     """Fit ``fit`` parameters to measured SDCs (see the package docstring for the model).
 
     DEM runs go to (and are reused from) the store at ``store_path``. ``discrepancy``: fix the
     relative model discrepancy instead of fitting it. ``cross_validate="loo"``: also predict
     every point from a fit without it. ``dem_config``: numerical DEM settings to start from
-    (cells, seed and steady cycles are then set from the arguments).
+    (cells, seed and steady cycles are then set from the arguments). ``specimen``: the
+    specimen to start from (default: the paper's coupon).
     """
     start = time.perf_counter()
     points = list(points)
-    specs = build_specs(fit, priors, discrepancy=discrepancy)
+    specimen = base_specimen(points, specimen)
+    specs = build_specs(fit, priors, discrepancy=discrepancy, specimen=specimen)
     check_enough_points(points, len(specs))
     if cross_validate is not None and cross_validate not in CROSS_VALIDATIONS:
         raise ParameterError(f"--cross-validate: expected one of {CROSS_VALIDATIONS}, "
@@ -165,7 +193,7 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: Sequence[str],
     design = design_points(dem_specs, n_design, seed=seed)
     config = dataclasses.replace(dem_config or DemConfig(), cells=cells, seed=seed,
                                  steady_cycles=steady_cycles)
-    requests = _requests(points, dem_specs, design, config)
+    requests = _requests(points, dem_specs, design, config, specimen)
     runs = run_requests([r for row in requests for r in row], store_path=store_path,
                         workers=workers, progress=progress)
     from ..store import Store
@@ -176,11 +204,13 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: Sequence[str],
         obs = []
         for request in row:
             entry = store.get_dem_run(request.key())
-            obs.append(observation_from_run(entry.record, entry.arrays))
+            obs.append(observation_from_run(entry.record, entry.arrays,
+                                            coupon_mass_kg=specimen.coupon.mass_kg))
         observations.append(obs)
     surrogates = tuple(build_surrogate(obs, design, dem_specs) for obs in observations)
-    fixed = {name: spec.default for name, spec in CATALOGUE.items()
-             if name not in [s.name for s in specs]}
+    fitted = [s.name for s in specs]
+    fixed = {name: parameter_spec(name, specimen).default for name in CATALOGUE
+             if name not in fitted}
     if discrepancy is not None:
         fixed[DISCREPANCY] = float(discrepancy)
     model = Model(tuple(specs), surrogates, tuple(points), fixed, discrepancy_floor)
@@ -213,7 +243,7 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: Sequence[str],
                 "steady_cycles": steady_cycles, "design_size": n_design, "method": method,
                 "discrepancy_fixed": discrepancy, "discrepancy_floor": discrepancy_floor,
                 "cross_validate": cross_validate, "store": str(store_path)}
-    return CalibrationResult(specs=specs, samples=samples, parameters=parameters,
+    return CalibrationResult(specimen=specimen, specs=specs, samples=samples, parameters=parameters,
                              correlations=correlations, predictions=predictions, loo=loo,
                              fixed=fixed, design=design, observations=observations, runs=runs,
                              settings=settings, notes=notes,

@@ -40,24 +40,19 @@ def document_json(document: dict) -> str:
 
 
 def specimen_text(result: CalibrationResult) -> str:
-    """TOML text of the calibrated specimen: the calibrated values with their 95 % intervals.
-
-    Holds only what the calibration decided (fitted values as posterior medians); every other
-    specimen field keeps the default specimen's value.
+    """TOML text of the calibrated specimen (every fitted specimen field at its posterior
+    median), headed by comments with the 95 % intervals; any command takes it as --specimen.
     """
-    lines = ["# pidcore calibrated specimen: posterior medians of a `pidcore calibrate` run",
-             "# (95 % intervals in the comments; every other field as the default specimen).",
-             "", "[calibration]"]
-    settings = result.settings
-    lines.append(f'fit = [{", ".join(json.dumps(n) for n in settings["fit"])}]')
-    if result.loo_rms is not None:
-        lines.append(f"loo_rms = {result.loo_rms:.6g}")
-    lines.append(f"rms_in_sample = {result.rms:.6g}")
-    lines += ["", "[calibrated]"]
+    lines = ["# pidcore calibrated specimen: posterior medians of `pidcore calibrate`",
+             f"# started from {result.specimen.name} ({result.specimen.source}); "
+             f"fitted: {', '.join(result.settings['fit'])}"]
     for name, p in result.parameters.items():
-        lines.append(f"{name} = {p['median']:.6g}  # 95 %: {p['low95']:.4g} .. "
-                     f"{p['high95']:.4g}")
-    return "\n".join(lines) + "\n"
+        lines.append(f"#   {name} = {p['median']:.6g}  (95 %: {p['low95']:.4g} .. "
+                     f"{p['high95']:.4g})")
+    if result.loo_rms is not None:
+        lines.append(f"# leave-one-out RMS of the SDC: {result.loo_rms:.4g}")
+    lines.append(f"# in-sample RMS of the SDC: {result.rms:.4g}")
+    return "\n".join(lines) + "\n" + result.calibrated_specimen().to_toml()
 
 
 def _table_rows(rows: list[dict]) -> list[list[str]]:

@@ -2,8 +2,10 @@
 
 Two kinds:
 
-* ``"dem"``: changes the particle physics, so every value needs new DEM runs (friction,
-  restitution; the runner in :mod:`pidcore.calibrate.runner` says which exist);
+* ``"dem"``: changes the particle physics, so every value needs new DEM runs: named contact
+  parameters (``friction``, ``static_friction``, ``rolling_friction``, ``restitution``, each
+  for both pairs or suffixed ``_pp``/``_pw``) or any numeric specimen field by dotted path
+  (``particles.radius_m``);
 * ``"observation"``: enters only the observation model (:mod:`pidcore.calibrate.observation`),
   no DEM run: the fixture mass above the force gauge and the empty structure's loss factor.
 
@@ -70,41 +72,112 @@ class ParameterSpec:
         return np.where(inside, value, -np.inf)
 
 
-#: Every parameter `--fit` accepts, with its default prior. The DEM defaults are the materials
-#: table's acrylic values (Table 1).
+#: Named DEM parameters: specimen fields they set (both pairs where not suffixed), bounds.
+#: ``friction`` sets sliding and static friction to one value (one Coulomb coefficient);
+#: ``static_friction`` below a pair's sliding friction is taken as that sliding friction.
+_PAIR = {"pp": ("particle_particle",), "pw": ("particle_wall",),
+         "": ("particle_particle", "particle_wall")}
+_DEM_ALIASES: dict[str, tuple[str, float, float, str]] = {
+    "friction": ("sliding_friction", 0.05, 0.8, "sliding friction"),
+    "static_friction": ("static_friction", 0.1, 1.0, "static friction (stick limit)"),
+    "rolling_friction": ("rolling_friction", 0.0, 0.05, "rolling friction mu_r"),
+    "restitution": ("restitution", 0.3, 0.95, "normal restitution"),
+}
+
+
+def dem_alias_paths(name: str) -> tuple[str, tuple[str, ...]] | None:
+    """(specimen pair field, pair names) of a named DEM parameter, None if not an alias."""
+    for suffix in ("pp", "pw"):
+        if name.endswith("_" + suffix) and name[:-3] in _DEM_ALIASES:
+            return _DEM_ALIASES[name[:-3]][0], _PAIR[suffix]
+    if name in _DEM_ALIASES:
+        return _DEM_ALIASES[name][0], _PAIR[""]
+    return None
+
+
+def dem_parameter_names() -> list[str]:
+    """Named DEM parameters ``--fit`` accepts besides dotted specimen paths."""
+    return [f"{n}{s}" for n in _DEM_ALIASES for s in ("", "_pp", "_pw")]
+
+
+#: Parameters of the observation model (no DEM run) and the discrepancy hyperparameter.
 CATALOGUE: dict[str, ParameterSpec] = {spec.name: spec for spec in (
     ParameterSpec("fixture_mass_kg", "observation", 0.0, 0.0, 1.0,
                   "mass moving with the coupon above the force gauge"),
     ParameterSpec("baseline_loss_factor", "observation", 0.0, 0.0, 0.05,
                   "loss factor of the empty coupon and fixture"),
-    ParameterSpec("friction", "dem", 0.14, 0.05, 0.8,
-                  "sliding friction, particle-particle and particle-wall"),
-    ParameterSpec("friction_pp", "dem", 0.096, 0.05, 0.8, "sliding friction particle-particle"),
-    ParameterSpec("friction_pw", "dem", 0.14, 0.05, 0.8, "sliding friction particle-wall"),
-    ParameterSpec("restitution", "dem", 0.7, 0.3, 0.95,
-                  "normal restitution, particle-particle and particle-wall"),
-    ParameterSpec("restitution_pp", "dem", 0.7, 0.3, 0.95,
-                  "normal restitution particle-particle"),
-    ParameterSpec("restitution_pw", "dem", 0.7, 0.3, 0.95, "normal restitution particle-wall"),
     ParameterSpec(DISCREPANCY, "hyper", 0.2, 0.02, 2.0,
                   "relative standard deviation of the model error", prior="log-uniform"),
 )}
+#: Specimen fields that are observation parameters.
+OBSERVATION_PATHS = {"coupon.fixture_mass_kg": "fixture_mass_kg",
+                     "coupon.baseline_loss_factor": "baseline_loss_factor"}
 
 DEFAULT_FIT = ("fixture_mass_kg", "baseline_loss_factor")
 
 
-def parse_fit(text: str | Sequence[str] | None) -> list[str]:
+def _specimen(specimen):
+    if specimen is None:
+        from ..specimen import paper_specimen
+
+        return paper_specimen()
+    return specimen
+
+
+def parameter_spec(name: str, specimen=None) -> ParameterSpec:
+    """Default spec of a fittable name: an observation parameter, a named DEM parameter, or
+    any numeric specimen field by dotted path (default bounds 0.5x..1.5x its value)."""
+    from ..specimen import numeric_fields
+
+    name = OBSERVATION_PATHS.get(name, name)
+    specimen = _specimen(specimen)
+    if name in CATALOGUE:
+        spec = CATALOGUE[name]
+        if name == "fixture_mass_kg":
+            return replace(spec, default=specimen.coupon.fixture_mass_kg)
+        if name == "baseline_loss_factor":
+            return replace(spec, default=specimen.coupon.baseline_loss_factor)
+        return spec
+    alias = dem_alias_paths(name)
+    if alias is not None:
+        field, pairs = alias
+        base = name[:-3] if name.endswith(("_pp", "_pw")) else name
+        _, low, high, text = _DEM_ALIASES[base]
+        default = getattr(getattr(specimen.pairs, pairs[-1]), field)
+        where = "both pairs" if len(pairs) == 2 else pairs[0].replace("_", "-")
+        return ParameterSpec(name, "dem", float(default), low, high, f"{text}, {where}")
+    if name in numeric_fields(specimen):
+        value = float(_field_value(specimen, name))
+        if value > 0:
+            return ParameterSpec(name, "dem", value, 0.5 * value, 1.5 * value,
+                                 f"specimen field {name}")
+        return ParameterSpec(name, "dem", value, float("nan"), float("nan"),
+                             f"specimen field {name} (give --prior {name}=LOW:HIGH)")
+    raise ParameterError(f"--fit: unknown parameter {name!r}; expected fixture_mass_kg, "
+                         f"baseline_loss_factor, one of {', '.join(dem_parameter_names())}, or a "
+                         "numeric specimen field by dotted path (pidcore specimen check)")
+
+
+def _field_value(specimen, path: str):
+    node = specimen.to_mapping()
+    for part in path.split("."):
+        node = node[part]
+    return node
+
+
+def parse_fit(text: str | Sequence[str] | None, specimen=None) -> list[str]:
     """Names from ``--fit a,b``; unknown names are a one-line error."""
     if text is None:
         return list(DEFAULT_FIT)
     names = [n.strip() for n in (text.split(",") if isinstance(text, str) else text)]
-    names = [n for n in names if n]
+    names = [OBSERVATION_PATHS.get(n, n) for n in names if n]
     if not names:
         raise ParameterError("--fit: no parameter named")
     for name in names:
-        if name not in CATALOGUE or name == DISCREPANCY:
-            raise ParameterError(f"--fit: unknown parameter {name!r}; expected names from "
-                                 f"{', '.join(n for n in CATALOGUE if n != DISCREPANCY)}")
+        if name == DISCREPANCY:
+            raise ParameterError(f"--fit: {DISCREPANCY} is always fitted (fix it with "
+                                 "--discrepancy)")
+        parameter_spec(name, specimen)
     if len(set(names)) != len(names):
         raise ParameterError(f"--fit: a parameter is named twice in {','.join(names)}")
     return names
@@ -116,9 +189,7 @@ def parse_prior(text: str) -> tuple[str, dict]:
         raise ParameterError(f"--prior {text!r}: expected NAME=LOW:HIGH or "
                              "NAME=normal:MU:SD[:LOW:HIGH]")
     name, rhs = (s.strip() for s in text.split("=", 1))
-    if name not in CATALOGUE:
-        raise ParameterError(f"--prior: unknown parameter {name!r}; expected one of "
-                             f"{', '.join(CATALOGUE)}")
+    name = OBSERVATION_PATHS.get(name, name)
     parts = rhs.split(":")
     try:
         if parts[0] == "normal":
@@ -140,7 +211,7 @@ def parse_prior(text: str) -> tuple[str, dict]:
 
 
 def build_specs(fit: Sequence[str], priors: Sequence[str] = (), *,
-                discrepancy: float | None = None) -> list[ParameterSpec]:
+                discrepancy: float | None = None, specimen=None) -> list[ParameterSpec]:
     """Specs of the fitted parameters (order of ``fit``, then ``model_discrepancy`` unless
     fixed by ``discrepancy``), with ``--prior`` changes applied and checked."""
     changes: dict[str, dict] = {}
@@ -153,7 +224,7 @@ def build_specs(fit: Sequence[str], priors: Sequence[str] = (), *,
             raise ParameterError(f"--prior {name}: not a fitted parameter (add it to --fit)")
     specs = []
     for name in names:
-        spec = replace(CATALOGUE[name], **changes.get(name, {}))
+        spec = replace(parameter_spec(name, specimen), **changes.get(name, {}))
         spec.check()
         specs.append(spec)
     if discrepancy is not None and not discrepancy >= 0:

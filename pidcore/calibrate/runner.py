@@ -1,115 +1,80 @@
 """DEM runs for calibration: one callable (parameter values, load case, cells, seed) -> run,
 cached in the HDF5 store so that a calibration computes every design point once.
 
-The runner is the only place that knows how a named DEM parameter reaches the simulation.
-Today (before the specimen file) the contact law is built inside
-:func:`pidcore.dem.simulate.simulate_load_case`; restitution reaches it through
-``DemConfig.alpha_*`` (Eq. 3) and the sliding friction through a law factory swapped in for
-the duration of one run (:func:`_law_overrides`). Every run is stored with the standard DEM
-entry layout (so ``pidcore report`` and the app can read it) under a key holding the load
-case, the numerical settings and the parameter values.
+The runner is the only place that knows how a named DEM parameter reaches the simulation: it
+becomes a specimen (:meth:`pidcore.specimen.Specimen.with_values` by dotted path), and the run
+goes through the DEM's run cache key (:func:`pidcore.dem.persist.run_key`: load case,
+configuration, specimen hash, code version) and its one save path, so a run stored by
+``pidcore dem run``/``sweep`` or the app is reused here and vice versa.
 """
 
 from __future__ import annotations
 
-import contextlib
-import dataclasses
-import hashlib
-import json
 import os
 import time
-from collections.abc import Callable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 
-from ..dem.contact import damping_constant_from_restitution
-from ..dem.persist import dem_run_entry, run_key
+from ..dem.persist import dem_run_entry, run_key, save_dem_entry
 from ..dem.simulate import DemConfig, LoadCase, simulate_load_case
-from ..errors import ParameterError
+from ..specimen import Specimen
+from .parameters import dem_alias_paths
 
-#: DEM parameters the runner can set, and the ContactLaw/DemConfig field each one sets.
-DEM_PARAMETERS: dict[str, str] = {
-    "friction_pp": "sliding friction particle-particle [-]",
-    "friction_pw": "sliding friction particle-wall [-]",
-    "friction": "sliding friction of both pairs [-]",
-    "restitution_pp": "normal restitution particle-particle [-]",
-    "restitution_pw": "normal restitution particle-wall [-]",
-    "restitution": "normal restitution of both pairs [-]",
-}
+
+def specimen_with(specimen: Specimen, values: Mapping[str, float]) -> Specimen:
+    """``specimen`` with named DEM parameter values set (aliases or dotted paths).
+
+    ``friction`` sets the sliding friction and the static friction to the same value (one
+    Coulomb coefficient, today's model); a ``static_friction`` given as well is then the stick
+    limit, taken as the sliding friction where below it (static >= sliding always).
+    """
+    changes: dict[str, float] = {}
+    # sliding friction first: a static friction set in the same call is checked against it
+    order = sorted(values, key=lambda n: 0 if (dem_alias_paths(n) or ("",))[0]
+                   == "sliding_friction" else 1)
+    for name in order:
+        value = float(values[name])
+        alias = dem_alias_paths(name)
+        if alias is None:
+            changes[name] = value
+            continue
+        field, pairs = alias
+        for pair in pairs:
+            path = f"pairs.{pair}."
+            if field == "sliding_friction":
+                changes[path + "sliding_friction"] = value
+                changes[path + "static_friction"] = value
+            elif field == "static_friction":
+                sliding = changes.get(path + "sliding_friction",
+                                      getattr(specimen.pairs, pair).sliding_friction)
+                changes[path + field] = max(value, sliding)
+            else:
+                changes[path + field] = value
+    if not changes:
+        return specimen
+    return specimen.with_values(changes)
 
 
 @dataclass(frozen=True)
 class RunRequest:
-    """One DEM run of a calibration design: load case, DEM parameter values, settings."""
+    """One DEM run of a calibration design: load case, specimen (with the design's values)."""
 
     case: LoadCase
-    values: tuple[tuple[str, float], ...]
+    specimen: Specimen
     config: DemConfig
 
     def key(self) -> str:
-        """Store key: the standard DEM run key plus a hash of the parameter values."""
-        base = run_key(self.case, self.config)
-        if not self.values:
-            return base
-        text = json.dumps([[k, float(v)] for k, v in self.values])
-        return f"{base}_cal{hashlib.sha256(text.encode()).hexdigest()[:10]}"
-
-
-def _split_values(values: Mapping[str, float]) -> tuple[dict, dict]:
-    """(ContactLaw field overrides, DemConfig overrides) for named DEM parameter values."""
-    law: dict[str, float] = {}
-    config: dict[str, float] = {}
-    for name, value in values.items():
-        if name not in DEM_PARAMETERS:
-            raise ParameterError(f"DEM parameter {name!r}: expected one of "
-                                 f"{sorted(DEM_PARAMETERS)}")
-        pairs = ("pp", "pw") if name in ("friction", "restitution") else (name[-2:],)
-        base = name.split("_")[0]
-        for pair in pairs:
-            if base == "friction":
-                law[f"friction_{pair}"] = float(value)
-            else:
-                config[f"alpha_{pair}"] = damping_constant_from_restitution(float(value))
-    return law, config
-
-
-@contextlib.contextmanager
-def _law_overrides(fields: Mapping[str, float]) -> Iterator[None]:
-    """Build every ContactLaw of the DEM with ``fields`` replaced, for one run (this process)."""
-    from ..dem import simulate
-
-    if not fields:
-        yield
-        return
-    original = simulate.ContactLaw
-
-    class _Overridden:
-        @staticmethod
-        def for_material(*args, **kwargs):
-            return dataclasses.replace(original.for_material(*args, **kwargs), **fields)
-
-    simulate.ContactLaw = _Overridden
-    try:
-        yield
-    finally:
-        simulate.ContactLaw = original
+        """The DEM run cache key (:func:`pidcore.dem.persist.run_key`)."""
+        return run_key(self.case, self.config, self.specimen)
 
 
 def simulate_request(request: RunRequest):
     """Run one request (in this process); returns the DemResult."""
-    law_fields, config_fields = _split_values(dict(request.values))
-    config = dataclasses.replace(request.config, **config_fields) if config_fields \
-        else request.config
-    with _law_overrides(law_fields):
-        return simulate_load_case(request.case, config)
+    return simulate_load_case(request.case, request.config, specimen=request.specimen)
 
 
 def _run_entry(request: RunRequest) -> tuple[str, dict]:
-    result = simulate_request(request)
-    entry = dem_run_entry(result)
-    entry["parameters"] = dict(entry["parameters"])
-    for name, value in request.values:
-        entry["parameters"][f"calibrate_{name}"] = float(value)
-    return request.key(), entry
+    return request.key(), dem_run_entry(simulate_request(request))
 
 
 def _single_thread_worker() -> None:
@@ -131,10 +96,11 @@ def run_requests(requests: Sequence[RunRequest], *, store_path: str | os.PathLik
 
     start = time.perf_counter()
     store = Store(store_path)
+    exists = store.path.exists()
     todo, seen = [], set()
     for request in requests:
         key = request.key()
-        if key not in seen and not store.has_dem_run(key):
+        if key not in seen and not (exists and store.has_dem_run(key)):
             todo.append(request)
         seen.add(key)
     cached = len(seen) - len(todo)
@@ -145,7 +111,7 @@ def run_requests(requests: Sequence[RunRequest], *, store_path: str | os.PathLik
         bar = tqdm(total=len(todo), unit="run", desc="DEM runs", dynamic_ncols=True)
 
     def finish(key: str, entry: dict) -> None:
-        store.add_dem_run(key, **entry, replace=True)
+        save_dem_entry(store, key, entry)
         if bar is not None:
             bar.update(1)
         if on_done is not None:

@@ -1,13 +1,16 @@
 """Space-filling design of the DEM parameters and a surrogate per load case.
 
 Design: a Latin hypercube (:class:`scipy.stats.qmc.LatinHypercube`, centred, seeded) over the
-DEM parameters' bounds; no DEM parameter -> one run per load case at the uncalibrated values.
+DEM parameters' bounds; no DEM parameter -> one run per load case at the starting values.
 
-Surrogate: per load case, least squares of ``log d`` (dissipative mass) and ``m_p`` (reactive
-mass) on a polynomial in the design coordinates (quadratic where the design has room for it,
-else linear, else a constant). Its variance at a point is s^2 x leverage, with s^2 the larger
-of the residual variance and the DEM runs' own mean squared standard error (the ensemble
-scatter across cells and blocks): with one run, exactly that run's standard error.
+Surrogate: per load case, a Gaussian process of ``log d`` (dissipative mass) and of ``m_p``
+(reactive mass) over the design coordinates scaled to [0, 1]: constant mean, squared-
+exponential kernel, and the DEM runs' own standard errors (the ensemble scatter across cells
+and blocks) as known noise on each run. Kernel amplitude and length scale maximise the
+marginal likelihood over a small grid. Its predictive variance is the surrogate's uncertainty
+of the DEM's mean at a parameter value: small at a design point with many cells, larger
+between points where the response bends. With one run (no DEM parameter) it is that run's
+value and standard error.
 """
 
 from __future__ import annotations
@@ -24,6 +27,13 @@ from .parameters import ParameterSpec
 
 #: Smallest dissipative mass used in the log transform (kg): far below any measurable value.
 _MIN_DISSIPATIVE_MASS_KG = 1e-12
+#: Length scales (in units of the design range) and amplitude factors searched.
+_LENGTH_SCALES = (0.1, 0.15, 0.2, 0.3, 0.45, 0.7, 1.0, 1.5, 2.5)
+_AMPLITUDES = tuple(10.0 ** np.linspace(-3, 1.5, 19))
+#: Extra noise (fraction of the amplitude) searched: DEM scatter beyond the runs' own standard
+#: errors (a few cells give a poor estimate; a packing's stick-slip thresholds make the
+#: response rough from one parameter value to the next).
+_NUGGETS = (0.0, 1e-3, 1e-2, 0.03, 0.1, 0.3)
 
 
 def design_points(specs: Sequence[ParameterSpec], n_points: int, *,
@@ -41,51 +51,69 @@ def design_points(specs: Sequence[ParameterSpec], n_points: int, *,
 
 
 def default_design_size(n_dem: int) -> int:
-    """Design points for ``n_dem`` DEM parameters: room for a quadratic plus residual dof."""
+    """Design points for ``n_dem`` DEM parameters: 6 for one, 5 more per further one."""
     if n_dem == 0:
         return 1
-    n_terms = (n_dem + 1) * (n_dem + 2) // 2
-    return n_terms + 2
+    return 6 + 5 * (n_dem - 1)
 
 
-def _features(u: np.ndarray, degree: int) -> np.ndarray:
-    """Polynomial features of unit coordinates u (N, d) up to ``degree`` (<= 2)."""
-    n, d = u.shape
-    columns = [np.ones(n)]
-    if degree >= 1:
-        columns += [u[:, j] for j in range(d)]
-    if degree >= 2:
-        columns += [u[:, i] * u[:, j] for i, j in itertools.combinations_with_replacement(
-            range(d), 2)]
-    return np.column_stack(columns)
-
-
-def _n_terms(d: int, degree: int) -> int:
-    return 1 + (d if degree >= 1 else 0) + (d * (d + 1) // 2 if degree >= 2 else 0)
+def _kernel(a: np.ndarray, b: np.ndarray, length: float) -> np.ndarray:
+    d2 = np.sum((a[:, None, :] - b[None, :, :]) ** 2, axis=-1)
+    return np.exp(-0.5 * d2 / length**2)
 
 
 @dataclass(frozen=True)
-class _Fit:
-    coef: np.ndarray
-    cov_unscaled: np.ndarray  # (X^T X)^-1
-    variance: float  # s^2
+class _Process:
+    """A fitted 1-output Gaussian process (or a constant with its variance when n_dem = 0)."""
 
-    def predict(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        mean = x @ self.coef
-        leverage = np.einsum("ij,jk,ik->i", x, self.cov_unscaled, x)
-        return mean, self.variance * leverage
+    u: np.ndarray
+    mean: float
+    amplitude: float
+    length: float
+    weights: np.ndarray  # (K + N)^-1 (y - mean)
+    inverse: np.ndarray  # (K + N)^-1
+    constant_variance: float
+
+    def predict(self, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        if self.u.shape[1] == 0:
+            n = u.shape[0]
+            return np.full(n, self.mean), np.full(n, self.constant_variance)
+        k = self.amplitude * _kernel(u, self.u, self.length)
+        mean = self.mean + k @ self.weights
+        var = self.amplitude - np.einsum("ij,jk,ik->i", k, self.inverse, k)
+        return mean, np.maximum(var, 0.0)
 
 
-def _fit(x: np.ndarray, y: np.ndarray, se: np.ndarray) -> _Fit:
-    coef, *_ = np.linalg.lstsq(x, y, rcond=None)
-    n, p = x.shape
-    scatter = float(np.mean(se**2))
-    if n > p:
-        residual = float(np.sum((y - x @ coef) ** 2) / (n - p))
-        variance = max(residual, scatter)
-    else:
-        variance = scatter
-    return _Fit(coef, np.linalg.pinv(x.T @ x), variance)
+def _fit(u: np.ndarray, y: np.ndarray, se: np.ndarray) -> _Process:
+    n, d = u.shape
+    noise = np.maximum(se**2, 1e-12 * max(float(np.var(y)), 1e-30))
+    if d == 0 or n == 1:
+        w = 1.0 / noise
+        mean = float(np.sum(w * y) / np.sum(w))
+        return _Process(u, mean, 0.0, 1.0, np.zeros(n), np.zeros((n, n)),
+                        float(1.0 / np.sum(w)))
+    scale = max(float(np.var(y)), float(np.mean(noise)), 1e-30)
+    best = None
+    for length in _LENGTH_SCALES:
+        base = _kernel(u, u, length)
+        for factor, nugget in itertools.product(_AMPLITUDES, _NUGGETS):
+            amplitude = factor * scale
+            cov = amplitude * (base + nugget * np.eye(n)) + np.diag(noise)
+            try:
+                chol = np.linalg.cholesky(cov)
+            except np.linalg.LinAlgError:
+                continue
+            inv = np.linalg.inv(cov)
+            ones = np.ones(n)
+            mean = float(ones @ inv @ y / (ones @ inv @ ones))
+            r = y - mean
+            logml = -0.5 * r @ inv @ r - np.sum(np.log(np.diag(chol)))
+            if best is None or logml > best[0]:
+                best = (logml, amplitude, length, mean, inv, nugget)
+    _, amplitude, length, mean, inv, nugget = best
+    # the nugget is scatter of the runs, not of the DEM's mean: it widens the fit (through
+    # the inverse) but is not added to the predictive variance of the mean
+    return _Process(u, mean, amplitude, length, inv @ (y - mean), inv, 0.0)
 
 
 @dataclass(frozen=True)
@@ -98,9 +126,8 @@ class CaseSurrogate:
     coupon_mass_kg: float
     low: np.ndarray
     high: np.ndarray
-    degree: int
-    log_dissipative: _Fit
-    reactive: _Fit
+    log_dissipative: _Process
+    reactive: _Process
 
     def predict(self, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray,
                                                   np.ndarray]:
@@ -110,9 +137,8 @@ class CaseSurrogate:
             u = np.zeros((theta.shape[0], 0))
         else:
             u = (theta - self.low) / (self.high - self.low)
-        x = _features(u, self.degree)
-        log_d, var_log_d = self.log_dissipative.predict(x)
-        m_p, var_m = self.reactive.predict(x)
+        log_d, var_log_d = self.log_dissipative.predict(u)
+        m_p, var_m = self.reactive.predict(u)
         d = np.exp(log_d)
         return d, d**2 * var_log_d, m_p, var_m
 
@@ -122,15 +148,9 @@ def build_surrogate(observations: Sequence[Observation], theta: np.ndarray,
     """Surrogate of one load case from its runs at design points ``theta`` (n, n_dem)."""
     theta = np.atleast_2d(np.asarray(theta, dtype=float))
     n, d = theta.shape
-    degree = 0
-    for candidate in (2, 1):
-        if d and n >= _n_terms(d, candidate) + 1:
-            degree = candidate
-            break
     low = np.array([s.low for s in specs]) if d else np.zeros(0)
     high = np.array([s.high for s in specs]) if d else np.ones(0)
     u = (theta - low) / (high - low) if d else np.zeros((n, 0))
-    x = _features(u, degree)
     dm = np.array([max(o.dissipative_mass_kg, _MIN_DISSIPATIVE_MASS_KG) for o in observations])
     dm_se = np.array([o.dissipative_mass_stderr_kg for o in observations])
     mp = np.array([o.reactive_mass_kg for o in observations])
@@ -139,8 +159,8 @@ def build_surrogate(observations: Sequence[Observation], theta: np.ndarray,
     return CaseSurrogate(
         frequency_hz=first.frequency_hz, acceleration_g=first.acceleration_g,
         fill_percent=first.fill_percent, coupon_mass_kg=first.coupon_mass_kg,
-        low=low, high=high, degree=degree,
-        log_dissipative=_fit(x, np.log(dm), dm_se / dm), reactive=_fit(x, mp, mp_se))
+        low=low, high=high, log_dissipative=_fit(u, np.log(dm), dm_se / dm),
+        reactive=_fit(u, mp, mp_se))
 
 
 def predicted_sdc(surrogate: CaseSurrogate, theta: np.ndarray, fixture_mass_kg: np.ndarray,

@@ -12,10 +12,11 @@ DEFAULT_STORE = Path("calibration_store.h5")
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
-    from ..calibrate.parameters import CATALOGUE, DEFAULT_FIT, DISCREPANCY
+    from ..calibrate.parameters import DEFAULT_FIT, dem_parameter_names
     from ..calibrate.posterior import DISCREPANCY_FLOOR
 
-    names = ", ".join(n for n in CATALOGUE if n != DISCREPANCY)
+    names = ", ".join(["fixture_mass_kg", "baseline_loss_factor", *dem_parameter_names(),
+                       "any numeric specimen field by dotted path"])
     p = subparsers.add_parser(
         "calibrate", help="fit DEM/specimen parameters to measured SDCs",
         description="Fit chosen parameters to measured SDCs (Eq. 11 of the DEM's virtual "
@@ -66,11 +67,10 @@ def run(args: argparse.Namespace) -> int:
     from ..calibrate.outputs import document_json, write_outputs
     from ..calibrate.parameters import parse_fit
     from ..errors import ParameterError
+    from ..specimen import load_specimen
 
-    fit = parse_fit(args.fit)
-    if args.specimen is not None:
-        raise ParameterError("--specimen: specimen files are not available in this build yet; "
-                             "calibrating the paper's coupon")
+    specimen = load_specimen(args.specimen) if args.specimen is not None else None
+    fit = parse_fit(args.fit, specimen)
     cells = CALIBRATION_CELLS if args.cells is None else args.cells
     if cells < 2:
         raise ParameterError(f"--cells: expected >= 2 (the ensemble scatter needs two), "
@@ -82,7 +82,7 @@ def run(args: argparse.Namespace) -> int:
                        cells=cells, seed=args.seed, steady_cycles=args.steady_cycles,
                        design_size=args.design_size, workers=args.workers,
                        cross_validate=args.cross_validate, method=args.method,
-                       progress=not args.no_progress)
+                       progress=not args.no_progress, specimen=specimen)
     if args.out is not None:
         write_outputs(result, args.out)
     for note in result.notes:
