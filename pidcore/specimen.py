@@ -586,12 +586,6 @@ def paper_specimen(material: str = "acrylic") -> Specimen:
 
 # --- contact law ----------------------------------------------------------------------------
 
-#: Whether the DEM kernel models static friction above the sliding one and rolling
-#: resistance. Until it does, a specimen asking for them is refused rather than simulated
-#: without them (set True when the kernel gains them; the contact law already carries them).
-KERNEL_HAS_STATIC_AND_ROLLING_FRICTION = False
-
-
 def contact_law(specimen: Specimen, *, alpha_pp: float | None = None,
                 alpha_pw: float | None = None):
     """The DEM contact law of a specimen's particles in its cell (paper Eq. 2-5).
@@ -603,14 +597,6 @@ def contact_law(specimen: Specimen, *, alpha_pp: float | None = None,
     from .dem.contact import ContactLaw
     from .dem.materials import MaterialProperties, PairParameters
 
-    if not KERNEL_HAS_STATIC_AND_ROLLING_FRICTION:
-        for name in PAIR_NAMES:
-            pair = getattr(specimen.pairs, name)
-            if pair.static_friction != pair.sliding_friction or pair.rolling_friction != 0:
-                raise ParameterError(
-                    f"{specimen.source}: [pairs.{name}] static_friction above sliding_friction"
-                    " or rolling_friction > 0 needs the static-friction/rolling-resistance "
-                    "kernel, which this build does not have yet")
     p, c = specimen.particles, specimen.cell
 
     def pair(spec: PairSpec) -> PairParameters:

@@ -116,3 +116,23 @@ def test_a_run_saved_by_dem_run_is_skipped_by_a_sweep(tmp_path):
     assert summary.skipped == [key] and not summary.completed
     entry = Store(store_path).get_dem_run(key)
     assert entry.units["sdc"] == UNITS["sdc"] and entry.units["shaker_force_n"] == "N"
+
+
+def test_sweep_of_a_specimen_stores_its_runs_with_provenance_and_resumes(tmp_path):
+    from pidcore.specimen import paper_specimen
+
+    own = paper_specimen().with_values({"coupon.fixture_mass_kg": 0.02})
+    store_path = tmp_path / "s.h5"
+    first = run_sweep(CASES[:1], CONFIG, store_path=store_path, workers=1, progress=False,
+                      specimen=own)
+    key = run_key(CASES[0], CONFIG, own)
+    assert first.completed == [key] and key != run_key(CASES[0], CONFIG)
+    entry = Store(store_path).get_dem_run(key)
+    assert entry.parameters["specimen_sha256"] == own.hash
+    assert entry.record["m_c_kg"] > 0.02 + own.coupon.mass_kg  # fixture in the vibrated mass
+    again = run_sweep(CASES[:1], CONFIG, store_path=store_path, workers=1, progress=False,
+                      specimen=own)
+    assert again.skipped == [key] and not again.completed
+    # the paper's coupon is another run: not skipped
+    paper = run_sweep(CASES[:1], CONFIG, store_path=store_path, workers=1, progress=False)
+    assert paper.completed == [run_key(CASES[0], CONFIG)]

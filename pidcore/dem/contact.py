@@ -29,6 +29,7 @@ import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
 from .. import defaults
 from ..constants import (
@@ -98,24 +99,132 @@ def damping_constant_from_restitution(restitution: float) -> float:
     return float(-ln_e * np.sqrt(5.0 / (ln_e**2 + np.pi**2)))
 
 
+@njit(cache=True, inline="always")
+def hertz_normal_force(delta, delta_dot, k_n, c_n, clip_attraction):
+    """Eq. 2: elastic part k_n delta^1.5 and total with Tsuji damping c_n delta^0.25 ddelta/dt.
+
+    ``c_n`` is alpha sqrt(m* k_n) (Eq. 3-4); with ``clip_attraction`` the total may not pull
+    (no adhesion at the end of a contact). Returns (elastic, total), N, repulsive > 0.
+    """
+    sq = np.sqrt(delta)
+    f_el = k_n * delta * sq
+    f_n = f_el + c_n * np.sqrt(sq) * delta_dot
+    if clip_attraction and f_n < 0.0:
+        f_n = 0.0
+    return f_el, f_n
+
+
+@njit(cache=True, inline="always")
+def hertz_elastic_energy(delta, k_n):
+    """Energy stored in a Hertz contact, (2/5) k_n delta^(5/2) (0 when open), J."""
+    if delta <= 0.0:
+        return 0.0
+    return 0.4 * k_n * delta * delta * np.sqrt(delta)
+
+
+@njit(cache=True, inline="always")
+def mindlin_tangential_stiffness(delta, k_t, mindlin_factor):
+    """k_t of a contact: constant ``k_t``, or Mindlin's mindlin_factor sqrt(delta) when > 0."""
+    if mindlin_factor > 0.0:
+        return mindlin_factor * np.sqrt(delta)
+    return k_t
+
+
+@njit(cache=True, inline="always")
+def capped_spring(sx, sy, sz, dsx, dsy, dsz, nx, ny, nz, k, k_old, stick_limit, slide_limit,
+                  sliding):
+    """Elastic-plastic contact spring in the tangent plane (tangential and rolling laws).
+
+    ``s`` is the stretch held so far (stored at stiffness ``k_old``), ``ds`` the step's
+    relative displacement (tangential: of the contact points, m; rolling: rotation, rad),
+    ``n`` the contact normal. The stretch is turned into the current tangent plane (its
+    normal part is dropped and its energy counted as lost), rescaled if the stiffness changed
+    (Mindlin: ``k`` > ``k_old`` keeps the force, a smaller ``k`` keeps the stretch, LAMMPS
+    ``mindlin_rescale/force``; either way the stored energy can only fall, and the fall is
+    counted as lost), then ``ds`` is added. If the trial force k|s| exceeds the limit (the
+    static ``stick_limit``, or ``slide_limit`` when the contact was ``sliding`` already), the
+    contact slides: the stretch is cut to the sliding limit. Re-sticks once a trial stays
+    within the sliding limit (the slip stopped or turned).
+
+    Returns (sx, sy, sz, lost, slides): the new stretch, the energy dissipated this step
+    (work of the contact on the spring, trapezoidal force times ``ds`` as velocity Verlet
+    changes the kinetic energy, minus the energy the spring gained), J, and whether it slid.
+    """
+    sn = sx * nx + sy * ny + sz * nz
+    sx -= sn * nx
+    sy -= sn * ny
+    sz -= sn * nz
+    lost = 0.5 * k_old * sn * sn
+    old2 = sx * sx + sy * sy + sz * sz
+    if k != k_old:
+        held = 0.5 * k_old * old2
+        if k > k_old:
+            scale = k_old / k
+            sx *= scale
+            sy *= scale
+            sz *= scale
+            old2 = sx * sx + sy * sy + sz * sz
+        lost += held - 0.5 * k * old2
+    dn = dsx * nx + dsy * ny + dsz * nz
+    dsx -= dn * nx
+    dsy -= dn * ny
+    dsz -= dn * nz
+    ax = sx + dsx
+    ay = sy + dsy
+    az = sz + dsz
+    trial2 = ax * ax + ay * ay + az * az
+    limit = slide_limit if sliding else stick_limit
+    slides = False
+    if k * k * trial2 > limit * limit:
+        keep = slide_limit / (k * np.sqrt(trial2))
+        ax *= keep
+        ay *= keep
+        az *= keep
+        work = 0.5 * k * ((sx + ax) * dsx + (sy + ay) * dsy + (sz + az) * dsz)
+        gained = 0.5 * k * (ax * ax + ay * ay + az * az - old2)
+        lost = lost + work - gained
+        slides = True
+    return ax, ay, az, lost, slides
+
+
+@njit(cache=True, inline="always")
+def coulomb_friction_scale(f_n, vt, mu, v_reg, m_t, dt):
+    """Eq. 5 as a factor on the tangential slip velocity: f_t = scale * v_t (``vt`` > 0).
+
+    Coulomb mu |f_n| against the slip, scaled down linearly below ``v_reg`` (no chatter at
+    v_t -> 0) and capped at m_t v_t / (2 dt) so that one step can never reverse the slip
+    (friction never injects energy).
+    """
+    ft = mu * abs(f_n)
+    if vt < v_reg:
+        ft *= vt / v_reg
+    cap = 0.5 * m_t * vt / dt
+    if ft > cap:
+        ft = cap
+    return -ft / vt
+
+
 def normal_force(delta_m, delta_dot_m_s, *, stiffness: float, damping: float,
                  mode: NormalDampingMode):
-    """Eq. 2 normal force magnitude (repulsive positive), N.
+    """Eq. 2 normal force magnitude (repulsive positive), N, elementwise.
 
     ``damping`` is ``alpha sqrt(m* k_n)``. ``mode="no_attraction"`` clips the total at zero
-    (no adhesion at the end of a contact); ``"literal"`` keeps Eq. 2 as written.
+    (no adhesion at the end of a contact); ``"literal"`` keeps Eq. 2 as written. The same
+    law as the kernel's (:func:`hertz_normal_force`).
     """
-    delta = np.asarray(delta_m, dtype=float)
-    force = stiffness * delta**1.5 + damping * delta**0.25 * np.asarray(delta_dot_m_s)
-    if mode == "no_attraction":
-        force = np.maximum(force, 0.0)
-    return force
+    check_damping_mode(mode)
+    d, v = np.broadcast_arrays(np.asarray(delta_m, dtype=float),
+                               np.asarray(delta_dot_m_s, dtype=float))
+    out = np.array([hertz_normal_force(a, b, stiffness, damping, mode == "no_attraction")[1]
+                    for a, b in zip(d.ravel(), v.ravel(), strict=True)]).reshape(d.shape)
+    return out if out.ndim else float(out)
 
 
 def elastic_energy(delta_m, *, stiffness: float):
-    """Energy stored in a Hertz contact, (2/5) k_n delta^(5/2), J."""
-    delta = np.maximum(np.asarray(delta_m, dtype=float), 0.0)
-    return 0.4 * stiffness * delta**2.5
+    """Energy stored in a Hertz contact, (2/5) k_n delta^(5/2), J, elementwise."""
+    d = np.asarray(delta_m, dtype=float)
+    out = np.array([hertz_elastic_energy(a, stiffness) for a in d.ravel()]).reshape(d.shape)
+    return out if out.ndim else float(out)
 
 
 def hertz_contact_time(*, stiffness: float, mass_kg: float, impact_speed_m_s: float) -> float:
@@ -133,6 +242,20 @@ def hertz_contact_time(*, stiffness: float, mass_kg: float, impact_speed_m_s: fl
 def maximum_overlap(*, stiffness: float, mass_kg: float, impact_speed_m_s: float) -> float:
     """Largest overlap of an elastic Hertz impact, (5 m* v^2 / (4 k_n))^(2/5), m."""
     return (1.25 * mass_kg * impact_speed_m_s**2 / stiffness) ** 0.4
+
+
+#: Slots of the per-pair parameter vector the kernel reads (:meth:`PairLaw.kernel_vector`).
+LAW_STIFFNESS = 0  # Hertz k_n, N/m^1.5
+LAW_DAMPING = 1  # alpha sqrt(m* k_n), N s/m^1.25
+LAW_SLIDING = 2  # mu
+LAW_STATIC = 3  # mu_s
+LAW_TANGENTIAL_MASS = 4  # m_t, kg (Coulomb model's cap)
+LAW_TANGENTIAL_STIFFNESS = 5  # constant k_t, N/m
+LAW_MINDLIN_FACTOR = 6  # 8 G* sqrt(R*) when k_t follows the overlap, else 0
+LAW_ROLLING_STIFFNESS = 7  # k_r, N m/rad (0: no rolling resistance)
+LAW_ROLLING_ARM = 8  # mu_r R*, m: largest rolling torque per unit normal force
+LAW_ROLLING_DAMPING = 9  # C_r, N m s/rad
+N_LAW = 10
 
 
 @dataclass(frozen=True)
@@ -185,6 +308,21 @@ class PairLaw:
     def mindlin_factor(self) -> float:
         """8 G* sqrt(R*): Mindlin's k_t = mindlin_factor sqrt(delta), N/m^(3/2)."""
         return 8.0 * self.shear_modulus_pa * np.sqrt(self.effective_radius_m)
+
+    def kernel_vector(self, *, mindlin: bool = False) -> np.ndarray:
+        """The parameters as the kernel reads them (slots ``LAW_*``), SI units."""
+        v = np.zeros(N_LAW)
+        v[LAW_STIFFNESS] = self.stiffness
+        v[LAW_DAMPING] = self.damping
+        v[LAW_SLIDING] = self.sliding_friction
+        v[LAW_STATIC] = self.static_friction
+        v[LAW_TANGENTIAL_MASS] = self.tangential_mass_kg
+        v[LAW_TANGENTIAL_STIFFNESS] = self.tangential_stiffness
+        v[LAW_MINDLIN_FACTOR] = self.mindlin_factor if mindlin else 0.0
+        v[LAW_ROLLING_STIFFNESS] = self.rolling_stiffness
+        v[LAW_ROLLING_ARM] = self.rolling_friction * self.effective_radius_m
+        v[LAW_ROLLING_DAMPING] = self.rolling_damping
+        return v
 
     def contact_time(self, impact_speed_m_s: float) -> float:
         """Hertz contact time of this pair at the given impact speed, s."""
@@ -377,8 +515,17 @@ class ContactLaw:
                    self.pair_particle.contact_time(impact_speed_m_s))
 
     def tangential_period(self) -> float:
-        """Shortest period of a stuck tangential or rolling spring (pair or wall), s."""
-        return min(self.pair_particle.spring_period(), self.pair_wall.spring_period())
+        """Shortest period of a stuck tangential or rolling spring (pair or wall), s.
+
+        With Mindlin's k_t, at the largest overlap the kernel accepts
+        (DEM_MAX_OVERLAP_FRACTION of the radius).
+        """
+        pairs = (self.pair_particle, self.pair_wall)
+        if self.tangential_stiffness_model == "mindlin":
+            delta = defaults.DEM_MAX_OVERLAP_FRACTION * self.radius_m
+            pairs = tuple(dataclasses.replace(
+                p, tangential_stiffness=p.mindlin_factor * np.sqrt(delta)) for p in pairs)
+        return min(p.spring_period() for p in pairs)
 
 
 def check_damping_mode(mode: str) -> None:

@@ -28,7 +28,7 @@ ImpactPair = Literal["wall", "particle"]
 @dataclasses.dataclass(frozen=True)
 class ImpactOutcome:
     """Velocities before/after one impact (SI units), kinetic energies (translation and
-    rotation of both bodies) and the dissipated energy [J]."""
+    rotation of both bodies) and the dissipated energy (normal, friction, rolling) [J]."""
 
     normal_speed_before_m_s: float
     normal_speed_after_m_s: float
@@ -40,6 +40,7 @@ class ImpactOutcome:
     steps: int
     kinetic_energy_before_j: float
     kinetic_energy_after_j: float
+    dissipated_rolling_j: float = 0.0
 
 
 def simulate_impact(*, pair: ImpactPair = "wall", impact_speed_m_s: float, dt_s: float,
@@ -125,7 +126,7 @@ def simulate_impact(*, pair: ImpactPair = "wall", impact_speed_m_s: float, dt_s:
     return ImpactOutcome(impact_speed_m_s, vn_after, vt_before, vt_after,
                          vn_after / impact_speed_m_s, float(tally[..., 1].sum()),
                          float(tally[..., 2].sum()), steps, ke_before,
-                         kinetic())
+                         kinetic(), float(tally[..., 3].sum()))
 
 
 

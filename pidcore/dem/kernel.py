@@ -14,30 +14,53 @@ kinetic energy change to second order and the energy balance closes to ~0.2-0.6 
 steps per contact (with the half-step velocity it missed ~3 %). The walls move rigidly with
 the cell: u(t) = -(a/w^2) sin(w t) along the drive axis, wall velocity -(a/w) cos(w t).
 
+Contacts. Every contact, particle-particle or particle-wall, goes through one body
+(:func:`_contact`) that calls the laws of :mod:`pidcore.dem.contact` once each: Hertz + Tsuji
+normal force, the tangential law, rolling resistance. The body sees the contact from its first
+particle i: unit normal n from i towards the partner (for a wall, minus the wall's inward
+normal), overlap delta, contact point at arm n from i's centre; force on i -f_n n + f_t, on
+the partner the opposite; torque arm n x f_t on both particles of a pair; rolling torque M_r
+on i and -M_r on the partner. The parameters come per pair of materials as a vector (slots
+``LAW_*`` of :mod:`pidcore.dem.contact`), one for particle pairs and one for the walls.
+
 Energy tallies per cell and cycle (index ``[cell, cycle, k]``):
   0 work of the walls on the particles, sum f_wall_on_particle . v_wall dt
   1 dissipated by normal damping, sum f_damping * delta_dot(t) * dt
-  2 dissipated by friction (tangential model, see below)
+  2 dissipated by friction (tangential law, see below)
+  3 dissipated by rolling resistance (its spring's plastic slip and its dashpot)
 with the full-step velocities v(t) after the second kick (see above). Normal damping only
 needs the translational velocities: rotation moves a contact point within the tangent plane.
 Samples: sum over the sample interval of the drive-axis component of the force the walls
 exert on the particles (divide by ``sample_every`` for the interval mean).
 
-Tangential force, ``stick_slip`` true (default; :mod:`pidcore.dem.contact`): a spring per
-contact, stretched by the contact points' tangential displacement over each step (drift
-velocities, i.e. the displacement the positions really made, and the walls' displacement),
-projected into the current tangent plane, capped at mu |f_n|. The friction tally is the work
-of the contact on the spring minus the spring energy gained (trapezoidal force times
-displacement, which is what velocity Verlet changes the kinetic energy by): exactly zero
-while stuck. A spring left stretched when its contact opens is counted as dissipated, and its
-energy, 1/2 k_t |xi|^2, is part of the stored (elastic) energy until then. Pair springs live
-in an N x N table [i, j], wall springs in N x walls, so they survive neighbour-list rebuilds.
+Contact history (``hist``, per contact [i, j] for pairs i < j and [i, wall] for walls; slots
+``HIST_*``): the tangential spring's stretch xi (3), whether it slides (static friction), the
+stiffness k_t it is stored with, and the rolling spring's angle theta (3). A contact that
+opens takes its springs' energy with it (counted as dissipated, friction or rolling).
+
+Tangential force, ``stick_slip`` true (default; :func:`pidcore.dem.contact.capped_spring`): a
+spring per contact, stretched by the contact points' tangential displacement over each step
+(drift velocities, i.e. the displacement the positions really made, and the walls'
+displacement), projected into the current tangent plane. It sticks while k_t |xi| <= mu_s
+|f_n|; once over, it slides at mu |f_n| (xi cut to that length) until a step's trial force
+stays within mu |f_n| again (the slip stopped): static and sliding friction. The friction
+tally is the work of the contact on the spring minus the spring energy gained (trapezoidal
+force times displacement, which is what velocity Verlet changes the kinetic energy by):
+exactly zero while stuck. k_t is constant, or with the Mindlin option 8 G* sqrt(R* delta) of
+the current overlap (the stretch is rescaled as the overlap changes; the stored energy 1/2
+k_t |xi|^2 with the contact's current k_t can only fall by it, and the fall is tallied).
 
 ``stick_slip`` false, Eq. 5 as written: f_t = -mu |f_n| v_t/|v_t|, scaled linearly below
 ``v_reg`` and capped at m_t |v_t| / (2 dt) (m_t: effective tangential mass of the contact):
 the cap removes at most half the slip per step, so at the slide-to-stick transition the slip
 decays geometrically instead of chattering around zero, and friction never reverses the slip
-nor injects energy. Tally: sum -f_t . v_t(t) dt.
+nor injects energy. Tally: sum -f_t . v_t(t) dt. Static friction does not apply.
+
+Rolling resistance (Ai et al., Powder Technol. 206 (2011) 269, model C; LIGGGHTS ``epsd2``
+plus the optional dashpot of ``epsd``; LAMMPS ``rolling sds``): a rotational spring on the
+relative rolling angle theta (the tangent-plane part of the relative rotation (omega_i -
+omega_j) dt), M_r = -k_r theta, capped at mu_r R* |f_n| (the same elastic-plastic spring law
+as the tangential one), plus a dashpot -C_r omega_rel while below the cap.
 
 Status per cell: 0 ok; 1 overlap above ``max_overlap_fraction * r``; 2 a particle centre left
 the cell; 3 non-finite state. ``fail_step`` holds the step where it happened.
@@ -48,12 +71,41 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
+from .contact import (
+    LAW_DAMPING,
+    LAW_MINDLIN_FACTOR,
+    LAW_ROLLING_ARM,
+    LAW_ROLLING_DAMPING,
+    LAW_ROLLING_STIFFNESS,
+    LAW_SLIDING,
+    LAW_STATIC,
+    LAW_STIFFNESS,
+    LAW_TANGENTIAL_MASS,
+    LAW_TANGENTIAL_STIFFNESS,
+    capped_spring,
+    coulomb_friction_scale,
+    hertz_elastic_energy,
+    hertz_normal_force,
+    mindlin_tangential_stiffness,
+)
+
 STATUS_OK = 0
 STATUS_OVERLAP = 1
 STATUS_ESCAPED = 2
 STATUS_NONFINITE = 3
-N_TALLIES = 3
+#: Tally columns: walls' work, normal damping, friction, rolling resistance.
+N_TALLIES = 4
+TALLY_WORK = 0
+TALLY_NORMAL = 1
+TALLY_FRICTION = 2
+TALLY_ROLLING = 3
 
+#: Slots of the contact history (last axis of ``CellsState.spring_pp`` / ``spring_pw``).
+HIST_XI = 0  # tangential spring stretch xi, 3 slots, m
+HIST_SLIDING = 3  # 1.0 while the tangential spring slides (static friction broken)
+HIST_KT = 4  # k_t the stretch is stored with, N/m (0: no contact)
+HIST_ROLL = 5  # rolling spring angle theta, 3 slots, rad
+N_HISTORY = 8
 
 #: Verlet skin of the neighbour lists, as a fraction of the radius. Purely numerical: a pair
 #: (or a particle and a wall) is a candidate while closer than contact + skin, and the lists
@@ -63,126 +115,123 @@ NEIGHBOUR_SKIN_FRACTION = 0.3
 
 
 @njit(cache=True, inline="always")
-def _normal_force(delta, delta_dot, k_n, c_n, clip_attraction):
-    """Eq. 2: Hertz elastic part k delta^1.5 and total with Tsuji damping c delta^0.25 ddelta/dt.
+def _release(hist, a, b, k_r):
+    """Contact [a, b] is open: clear its history; returns (tangential, rolling) energy, J.
 
-    ``c_n`` is alpha sqrt(m* k_n) (Eq. 3-4); with ``clip_attraction`` the total may not pull.
-    Returns (elastic, total) normal force magnitudes, N.
+    The energy its springs still held leaves with the contact: counted as dissipated.
     """
-    sq = np.sqrt(delta)
-    f_el = k_n * delta * sq
-    f_n = f_el + c_n * np.sqrt(sq) * delta_dot
-    if clip_attraction and f_n < 0.0:
-        f_n = 0.0
-    return f_el, f_n
+    k_t = hist[a, b, HIST_KT]
+    if k_t == 0.0:
+        return 0.0, 0.0
+    held_t = 0.5 * k_t * (hist[a, b, 0] ** 2 + hist[a, b, 1] ** 2 + hist[a, b, 2] ** 2)
+    held_r = 0.0
+    if k_r > 0.0:
+        held_r = 0.5 * k_r * (hist[a, b, HIST_ROLL] ** 2 + hist[a, b, HIST_ROLL + 1] ** 2
+                              + hist[a, b, HIST_ROLL + 2] ** 2)
+    for q in range(hist.shape[2]):
+        hist[a, b, q] = 0.0
+    return held_t, held_r
 
 
 @njit(cache=True, inline="always")
-def _friction_scale(f_n, vt, mu, v_reg, m_t, dt):
-    """Eq. 5 as a factor on the tangential slip velocity: f_t = scale * v_t.
+def _contact(hist, a, b, law, nx, ny, nz, delta, arm,
+             rvx, rvy, rvz, hx, hy, hz, hpx, hpy, hpz, dsx, dsy, dsz,
+             rox, roy, roz, ropx, ropy, ropz, options):
+    """Forces of one contact (pair or wall) on its first particle i; updates its history.
 
-    Coulomb mu |f_n| against the slip, scaled down linearly below ``v_reg`` (no chatter at
-    v_t -> 0) and capped at m_t v_t / (2 dt) so that one step can never reverse the slip (friction
-    never injects energy). ``vt`` > 0.
+    ``n`` unit normal from i to the partner, ``delta`` overlap, ``arm`` centre to contact
+    point. ``rv``: predicted relative velocity of the centres, v_i - v_partner; ``h``/``hp``:
+    the angular velocity that moves the contact point tangentially (omega_i + omega_j for a
+    pair, omega_i at a wall), drift and predicted; ``ds``: tangential displacement of the
+    contact points over the step; ``ro``/``rop``: relative rotation over the step, (omega_i -
+    omega_j) dt with drift velocities, and the predicted relative angular velocity.
+    ``options``: (clip_attraction, stick_slip, v_reg, dt) as floats (Numba inlines at most
+    30 arguments).
+
+    Returns (f_el, f_n, gx, gy, gz, mx, my, mz, mdx, mdy, mdz, lost_t, lost_r): the Hertz and
+    total normal force, the tangential force on i, the rolling torque on i (spring and
+    dashpot; the partner gets the opposite) and its dashpot part alone, and the energy the
+    springs lost this step (friction, rolling), J.
     """
-    ft = mu * abs(f_n)
-    if vt < v_reg:
-        ft *= vt / v_reg
-    cap = 0.5 * m_t * vt / dt
-    if ft > cap:
-        ft = cap
-    return -ft / vt
-
-
-@njit(cache=True, inline="always")
-def _friction_force(rvx, rvy, rvz, vn, nx, ny, nz, f_n, mu, v_reg, m_t, dt):
-    """Eq. 5 friction vector on the contact from the relative contact-point velocity rv.
-
-    The slip is rv minus its normal part ``vn`` along n; no slip, no force. Returns (gx, gy, gz), N.
-    """
-    tvx = rvx - vn * nx
-    tvy = rvy - vn * ny
-    tvz = rvz - vn * nz
-    vt = np.sqrt(tvx * tvx + tvy * tvy + tvz * tvz)
-    if vt > 0.0:
-        scale = _friction_scale(f_n, vt, mu, v_reg, m_t, dt)
-        return scale * tvx, scale * tvy, scale * tvz
-    return 0.0, 0.0, 0.0
-
-
-@njit(cache=True, inline="always")
-def _spring_force(qx, qy, qz, live, a, b, dsx, dsy, dsz, nx, ny, nz, f_n, mu, k_t):
-    """Stick-slip tangential spring (Eq. 5 with a tangential spring, capped by mu |f_n|).
-
-    The spring of contact [a, b] lives in the tables ``qx``, ``qy``, ``qz`` (its stretch xi,
-    updated in place) and ``live`` (set). The stretch is projected into the current tangent
-    plane, the step's tangential displacement ds of the contact points is added, and the
-    force -k_t xi is capped at mu |f_n| by shortening xi (sliding).
-
-    Returns (gx, gy, gz, dissipated): the force on the contact's first body, N, and the
-    energy lost, J. Dissipated = work of the contact on the spring minus the spring energy
-    gained, with the work taken as the mean of the old and new spring forces times ds
-    (velocity Verlet changes the kinetic energy by exactly that mean force times the drift,
-    so the balance closes): zero while stuck, mu |f_n| |ds| while sliding steadily.
-    """
-    sx = qx[a, b]
-    sy = qy[a, b]
-    sz = qz[a, b]
-    # into the tangent plane: the normal part of xi (second order in the normal's turn per
-    # step) is dropped and its energy counted as lost, so the balance still closes
-    sn = sx * nx + sy * ny + sz * nz
-    sx -= sn * nx
-    sy -= sn * ny
-    sz -= sn * nz
-    turned = 0.5 * k_t * sn * sn
-    old2 = sx * sx + sy * sy + sz * sz
-    dn = dsx * nx + dsy * ny + dsz * nz
-    dsx -= dn * nx
-    dsy -= dn * ny
-    dsz -= dn * nz
-    ax = sx + dsx
-    ay = sy + dsy
-    az = sz + dsz
-    trial2 = ax * ax + ay * ay + az * az
-    limit = mu * abs(f_n)
-    lost = turned
-    if k_t * k_t * trial2 > limit * limit:
-        keep = limit / (k_t * np.sqrt(trial2))
-        ax *= keep
-        ay *= keep
-        az *= keep
-        work = 0.5 * k_t * ((sx + ax) * dsx + (sy + ay) * dsy + (sz + az) * dsz)
-        gained = 0.5 * k_t * (ax * ax + ay * ay + az * az - old2)
-        lost = turned + work - gained
-    qx[a, b] = ax
-    qy[a, b] = ay
-    qz[a, b] = az
-    live[a, b] = True
-    return -k_t * ax, -k_t * ay, -k_t * az, lost
-
-
-@njit(cache=True, inline="always")
-def _release_spring(qx, qy, qz, live, a, b, k_t):
-    """Contact [a, b] is open: clear its spring; returns the energy it still held, J.
-
-    That energy leaves with the contact, so it is counted as dissipated by friction.
-    """
-    if not live[a, b]:
-        return 0.0
-    held = 0.5 * k_t * (qx[a, b] ** 2 + qy[a, b] ** 2 + qz[a, b] ** 2)
-    qx[a, b] = 0.0
-    qy[a, b] = 0.0
-    qz[a, b] = 0.0
-    live[a, b] = False
-    return held
+    clip_attraction = options[0] != 0.0
+    stick_slip = options[1] != 0.0
+    delta_dot = rvx * nx + rvy * ny + rvz * nz
+    f_el, f_n = hertz_normal_force(delta, delta_dot, law[LAW_STIFFNESS], law[LAW_DAMPING],
+                                   clip_attraction)
+    lost_t = 0.0
+    k_t = mindlin_tangential_stiffness(delta, law[LAW_TANGENTIAL_STIFFNESS],
+                                       law[LAW_MINDLIN_FACTOR])
+    if stick_slip:
+        k_old = k_t
+        if law[LAW_MINDLIN_FACTOR] > 0.0:
+            k_old = hist[a, b, HIST_KT]
+        sliding = hist[a, b, HIST_SLIDING] != 0.0
+        fa = abs(f_n)
+        sx, sy, sz, lost_t, slides = capped_spring(
+            hist[a, b, 0], hist[a, b, 1], hist[a, b, 2], dsx, dsy, dsz, nx, ny, nz,
+            k_t, k_old, law[LAW_STATIC] * fa, law[LAW_SLIDING] * fa, sliding)
+        hist[a, b, 0] = sx
+        hist[a, b, 1] = sy
+        hist[a, b, 2] = sz
+        hist[a, b, HIST_SLIDING] = 1.0 if slides else 0.0
+        gx = -k_t * sx
+        gy = -k_t * sy
+        gz = -k_t * sz
+    else:
+        # slip velocity of the contact points: rv + arm hp x n, minus its normal part
+        tvx = rvx + arm * (hpy * nz - hpz * ny)
+        tvy = rvy + arm * (hpz * nx - hpx * nz)
+        tvz = rvz + arm * (hpx * ny - hpy * nx)
+        tvx -= delta_dot * nx
+        tvy -= delta_dot * ny
+        tvz -= delta_dot * nz
+        vt = np.sqrt(tvx * tvx + tvy * tvy + tvz * tvz)
+        gx = 0.0
+        gy = 0.0
+        gz = 0.0
+        if vt > 0.0:
+            scale = coulomb_friction_scale(f_n, vt, law[LAW_SLIDING], options[2],
+                                           law[LAW_TANGENTIAL_MASS], options[3])
+            gx = scale * tvx
+            gy = scale * tvy
+            gz = scale * tvz
+    hist[a, b, HIST_KT] = k_t
+    mx = 0.0
+    my = 0.0
+    mz = 0.0
+    mdx = 0.0
+    mdy = 0.0
+    mdz = 0.0
+    lost_r = 0.0
+    k_r = law[LAW_ROLLING_STIFFNESS]
+    if k_r > 0.0:
+        cap = law[LAW_ROLLING_ARM] * abs(f_n)
+        qx, qy, qz, lost_r, rolls = capped_spring(
+            hist[a, b, HIST_ROLL], hist[a, b, HIST_ROLL + 1], hist[a, b, HIST_ROLL + 2],
+            rox, roy, roz, nx, ny, nz, k_r, k_r, cap, cap, False)
+        hist[a, b, HIST_ROLL] = qx
+        hist[a, b, HIST_ROLL + 1] = qy
+        hist[a, b, HIST_ROLL + 2] = qz
+        mx = -k_r * qx
+        my = -k_r * qy
+        mz = -k_r * qz
+        c_r = law[LAW_ROLLING_DAMPING]
+        if c_r > 0.0 and not rolls:
+            # dashpot on the tangent-plane part of the relative angular velocity
+            wn = ropx * nx + ropy * ny + ropz * nz
+            mdx = -c_r * (ropx - wn * nx)
+            mdy = -c_r * (ropy - wn * ny)
+            mdz = -c_r * (ropz - wn * nz)
+            mx += mdx
+            my += mdy
+            mz += mdz
+    return f_el, f_n, gx, gy, gz, mx, my, mz, mdx, mdy, mdz, lost_t, lost_r
 
 
 @njit(cache=True, parallel=True)
 def advance_cells(pos, vel, omg, frc, trq, wall_n, wall_d,
-                  radius, mass, inertia,
-                  k_pp, c_pp, mu_pp, mt_pp, k_pw, c_pw, mu_pw, mt_pw,
-                  v_reg, clip_attraction, gravity,
-                  stick_slip, kt_pp, kt_pw, spr_pp, spr_pw,
+                  radius, mass, inertia, law_pp, law_pw,
+                  v_reg, clip_attraction, gravity, stick_slip, hist_pp, hist_pw,
                   dt, step0, n_steps, omega, accel_amp, drive_axis,
                   steps_per_cycle, sample_every, max_overlap_fraction,
                   tally, samples, status, fail_step):
@@ -191,10 +240,8 @@ def advance_cells(pos, vel, omg, frc, trq, wall_n, wall_d,
         if status[c] != STATUS_OK:
             continue
         _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
-                      radius, mass, inertia,
-                      k_pp, c_pp, mu_pp, mt_pp, k_pw, c_pw, mu_pw, mt_pw,
-                      v_reg, clip_attraction, gravity,
-                      stick_slip, kt_pp, kt_pw, spr_pp, spr_pw,
+                      radius, mass, inertia, law_pp, law_pw,
+                      v_reg, clip_attraction, gravity, stick_slip, hist_pp, hist_pw,
                       dt, step0, n_steps, omega, accel_amp, drive_axis,
                       steps_per_cycle, sample_every, max_overlap_fraction,
                       tally, samples, status, fail_step)
@@ -203,10 +250,8 @@ def advance_cells(pos, vel, omg, frc, trq, wall_n, wall_d,
 
 @njit(cache=True, error_model="numpy")
 def _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
-                  radius, mass, inertia,
-                  k_pp, c_pp, mu_pp, mt_pp, k_pw, c_pw, mu_pw, mt_pw,
-                  v_reg, clip_attraction, gravity,
-                  stick_slip, kt_pp, kt_pw, spr_pp, spr_pw,
+                  radius, mass, inertia, law_pp, law_pw,
+                  v_reg, clip_attraction, gravity, stick_slip, hist_pp, hist_pw,
                   dt, step0, n_steps, omega, accel_amp, drive_axis,
                   steps_per_cycle, sample_every, max_overlap_fraction,
                   tally, samples, status, fail_step):
@@ -229,6 +274,12 @@ def _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
     half_skin2 = 0.25 * skin * skin
     pair_reach2 = (two_r + skin) * (two_r + skin)
     wall_reach = radius + skin
+    kr_pp = law_pp[LAW_ROLLING_STIFFNESS]
+    kr_pw = law_pw[LAW_ROLLING_STIFFNESS]
+    # the rolling dashpot's loss is tallied after the second kick, like normal damping
+    roll_dashpot = law_pp[LAW_ROLLING_DAMPING] > 0.0 or law_pw[LAW_ROLLING_DAMPING] > 0.0
+    options = np.array([1.0 if clip_attraction else 0.0, 1.0 if stick_slip else 0.0,
+                        v_reg, dt])
     # contiguous per-cell copies (written back at the end of the chunk)
     px = pos[0, c].copy()
     py = pos[1, c].copy()
@@ -256,17 +307,9 @@ def _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
     wny = wall_n[:, 1].copy()
     wnz = wall_n[:, 2].copy()
     wd = wall_d.copy()
-    # tangential springs (stick-slip model): [i, j] for pairs i < j, [i, wall] for walls
-    qpx = spr_pp[0, c].copy()
-    qpy = spr_pp[1, c].copy()
-    qpz = spr_pp[2, c].copy()
-    qwx = spr_pw[0, c].copy()
-    qwy = spr_pw[1, c].copy()
-    qwz = spr_pw[2, c].copy()
-    # which springs may hold a stretch (one byte read per idle candidate instead of three
-    # floats): set on contact, cleared when the contact opens
-    live_p = (qpx != 0.0) | (qpy != 0.0) | (qpz != 0.0)
-    live_w = (qwx != 0.0) | (qwy != 0.0) | (qwz != 0.0)
+    # contact histories: [i, j] for pairs i < j, [i, wall] for walls
+    hp = hist_pp[c].copy()
+    hw = hist_pw[c].copy()
     u_prev = 0.0  # cell displacement along the drive axis at the previous step
     if omega > 0.0:
         t_prev = step0 * dt  # same rounding as t below, so chunking does not change bits
@@ -274,7 +317,8 @@ def _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
     max_pairs = n_part * (n_part - 1) // 2
     max_contacts = n_walls * n_part + max_pairs
     c_idx = np.empty((2, max_contacts), dtype=np.int64)  # i, j (j < 0: wall)
-    c_val = np.empty((8, max_contacts))  # n (3), arm, f_damping, friction force (3)
+    # n (3), arm, f_damping, friction force (3), rolling dashpot torque on i (3)
+    c_val = np.empty((11, max_contacts))
     # Verlet lists: pair candidates (i < j, brute-force order), wall candidates per particle
     nb_i = np.empty(max_pairs, dtype=np.int64)
     nb_j = np.empty(max_pairs, dtype=np.int64)
@@ -393,6 +437,7 @@ def _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
         w_wall = 0.0
         d_norm = 0.0
         d_fric = 0.0
+        d_roll = 0.0
         f_drive = 0.0
         n_c = 0
         # --- particle-wall contacts -----------------------------------------------------
@@ -404,56 +449,44 @@ def _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
                 status[c] = STATUS_NONFINITE
             for q in range(wl_start[i], wl_start[i + 1]):
                 w = wl_w[q]
-                nx = wnx[w]
-                ny = wny[w]
-                nz = wnz[w]
-                dist = nx * (pxi - ux) + ny * (pyi - uy) + nz * (pzi - uz) + wd[w]
+                dist = wnx[w] * (pxi - ux) + wny[w] * (pyi - uy) + wnz[w] * (pzi - uz) + wd[w]
                 delta = radius - dist
                 if delta <= 0.0:
-                    d_fric += _release_spring(qwx, qwy, qwz, live_w, i, w, kt_pw)
+                    lt, lr = _release(hw, i, w, kr_pw)
+                    d_fric += lt
+                    d_roll += lr
                     continue
                 if dist < 0.0:
                     status[c] = STATUS_ESCAPED
                 if delta > max_overlap:
                     status[c] = STATUS_OVERLAP
+                # normal from the particle towards the wall
+                nx = -wnx[w]
+                ny = -wny[w]
+                nz = -wnz[w]
                 arm = radius - delta
-                # contact point velocity relative to the wall (contact point at -arm*n); the
-                # rotation part lies in the tangent plane and is added only where needed
-                rvx = vpx[i] - wvx
-                rvy = vpy[i] - wvy
-                rvz = vpz[i] - wvz
-                vn = rvx * nx + rvy * ny + rvz * nz
-                delta_dot = -vn
-                f_el, f_n = _normal_force(delta, delta_dot, k_pw, c_pw, clip_attraction)
-                if stick_slip:
-                    # contact-point displacement relative to the wall over the step, with the
-                    # drift (half-step) velocities the positions moved with
-                    oxi = ox[i]
-                    oyi = oy[i]
-                    ozi = oz[i]
-                    gx, gy, gz, lost = _spring_force(
-                        qwx, qwy, qwz, live_w, i, w,
-                        dt * (vx[i] - arm * (oyi * nz - ozi * ny)) - dwx,
-                        dt * (vy[i] - arm * (ozi * nx - oxi * nz)) - dwy,
-                        dt * (vz[i] - arm * (oxi * ny - oyi * nx)) - dwz,
-                        nx, ny, nz, f_n, mu_pw, kt_pw)
-                    d_fric += lost
-                else:
-                    wxi = wpx[i]
-                    wyi = wpy[i]
-                    wzi = wpz[i]
-                    rvx -= arm * (wyi * nz - wzi * ny)
-                    rvy -= arm * (wzi * nx - wxi * nz)
-                    rvz -= arm * (wxi * ny - wyi * nx)
-                    gx, gy, gz = _friction_force(rvx, rvy, rvz, vn, nx, ny, nz, f_n, mu_pw,
-                                                 v_reg, mt_pw, dt)
-                cfx = f_n * nx + gx
-                cfy = f_n * ny + gy
-                cfz = f_n * nz + gz
-                # torque = (-arm n) x g
-                tx[i] -= arm * (ny * gz - nz * gy)
-                ty[i] -= arm * (nz * gx - nx * gz)
-                tz[i] -= arm * (nx * gy - ny * gx)
+                oxi = ox[i]
+                oyi = oy[i]
+                ozi = oz[i]
+                f_el, f_n, gx, gy, gz, mx, my, mz, mdx, mdy, mdz, lt, lr = _contact(
+                    hw, i, w, law_pw, nx, ny, nz, delta, arm,
+                    vpx[i] - wvx, vpy[i] - wvy, vpz[i] - wvz,
+                    oxi, oyi, ozi, wpx[i], wpy[i], wpz[i],
+                    # contact-point displacement relative to the wall over the step, with
+                    # the drift (half-step) velocities the positions moved with
+                    dt * (vx[i] + arm * (oyi * nz - ozi * ny)) - dwx,
+                    dt * (vy[i] + arm * (ozi * nx - oxi * nz)) - dwy,
+                    dt * (vz[i] + arm * (oxi * ny - oyi * nx)) - dwz,
+                    dt * oxi, dt * oyi, dt * ozi, wpx[i], wpy[i], wpz[i],
+                    options)
+                d_fric += lt
+                d_roll += lr
+                cfx = -f_n * nx + gx
+                cfy = -f_n * ny + gy
+                cfz = -f_n * nz + gz
+                tx[i] += arm * (ny * gz - nz * gy) + mx
+                ty[i] += arm * (nz * gx - nx * gz) + my
+                tz[i] += arm * (nx * gy - ny * gx) + mz
                 fx[i] += cfx
                 fy[i] += cfy
                 fz[i] += cfz
@@ -467,6 +500,9 @@ def _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
                 c_val[5, n_c] = gx
                 c_val[6, n_c] = gy
                 c_val[7, n_c] = gz
+                c_val[8, n_c] = mdx
+                c_val[9, n_c] = mdy
+                c_val[10, n_c] = mdz
                 n_c += 1
                 w_wall += (cfx * wvx + cfy * wvy + cfz * wvz) * dt
                 if drive_axis == 0:
@@ -487,7 +523,9 @@ def _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
                 d2 = dx * dx + dy * dy + dz * dz
                 touching = d2 < two_r * two_r
             if not touching:
-                d_fric += _release_spring(qpx, qpy, qpz, live_p, i, j, kt_pp)
+                lt, lr = _release(hp, i, j, kr_pp)
+                d_fric += lt
+                d_roll += lr
                 continue
             d = np.sqrt(d2)
             inv_d = 1.0 / d
@@ -498,46 +536,35 @@ def _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
             if delta > max_overlap:
                 status[c] = STATUS_OVERLAP
             arm = radius - 0.5 * delta
-            rvx = vpx[i] - vpx[j]
-            rvy = vpy[i] - vpy[j]
-            rvz = vpz[i] - vpz[j]
-            delta_dot = rvx * nx + rvy * ny + rvz * nz
-            f_el, f_n = _normal_force(delta, delta_dot, k_pp, c_pp, clip_attraction)
-            # force on i: -f_n n (+ friction g); on j: the opposite
-            if stick_slip:
-                hx = ox[i] + ox[j]
-                hy = oy[i] + oy[j]
-                hz = oz[i] + oz[j]
-                gx, gy, gz, lost = _spring_force(
-                    qpx, qpy, qpz, live_p, i, j,
-                    dt * (vx[i] - vx[j] + arm * (hy * nz - hz * ny)),
-                    dt * (vy[i] - vy[j] + arm * (hz * nx - hx * nz)),
-                    dt * (vz[i] - vz[j] + arm * (hx * ny - hy * nx)),
-                    nx, ny, nz, f_n, mu_pp, kt_pp)
-                d_fric += lost
-            else:
-                # omega_i x (arm n) - omega_j x (-arm n) = arm (omega_i + omega_j) x n
-                sx = wpx[i] + wpx[j]
-                sy = wpy[i] + wpy[j]
-                sz = wpz[i] + wpz[j]
-                rvx += arm * (sy * nz - sz * ny)
-                rvy += arm * (sz * nx - sx * nz)
-                rvz += arm * (sx * ny - sy * nx)
-                gx, gy, gz = _friction_force(rvx, rvy, rvz, delta_dot, nx, ny, nz, f_n, mu_pp,
-                                             v_reg, mt_pp, dt)
+            hx = ox[i] + ox[j]
+            hy = oy[i] + oy[j]
+            hz = oz[i] + oz[j]
+            f_el, f_n, gx, gy, gz, mx, my, mz, mdx, mdy, mdz, lt, lr = _contact(
+                hp, i, j, law_pp, nx, ny, nz, delta, arm,
+                vpx[i] - vpx[j], vpy[i] - vpy[j], vpz[i] - vpz[j],
+                hx, hy, hz, wpx[i] + wpx[j], wpy[i] + wpy[j], wpz[i] + wpz[j],
+                dt * (vx[i] - vx[j] + arm * (hy * nz - hz * ny)),
+                dt * (vy[i] - vy[j] + arm * (hz * nx - hx * nz)),
+                dt * (vz[i] - vz[j] + arm * (hx * ny - hy * nx)),
+                dt * (ox[i] - ox[j]), dt * (oy[i] - oy[j]), dt * (oz[i] - oz[j]),
+                wpx[i] - wpx[j], wpy[i] - wpy[j], wpz[i] - wpz[j],
+                options)
+            d_fric += lt
+            d_roll += lr
+            # force on i: -f_n n + g; on j: the opposite
             cfx = -f_n * nx + gx
             cfy = -f_n * ny + gy
             cfz = -f_n * nz + gz
-            # torque on i and on j: arm n x g (same for both)
+            # torque of g on i and on j: arm n x g (same for both); rolling: m on i, -m on j
             ctx = arm * (ny * gz - nz * gy)
             cty = arm * (nz * gx - nx * gz)
             ctz = arm * (nx * gy - ny * gx)
-            tx[i] += ctx
-            ty[i] += cty
-            tz[i] += ctz
-            tx[j] += ctx
-            ty[j] += cty
-            tz[j] += ctz
+            tx[i] += ctx + mx
+            ty[i] += cty + my
+            tz[i] += ctz + mz
+            tx[j] += ctx - mx
+            ty[j] += cty - my
+            tz[j] += ctz - mz
             fx[i] += cfx
             fy[i] += cfy
             fz[i] += cfz
@@ -554,6 +581,9 @@ def _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
             c_val[5, n_c] = gx
             c_val[6, n_c] = gy
             c_val[7, n_c] = gz
+            c_val[8, n_c] = mdx
+            c_val[9, n_c] = mdy
+            c_val[10, n_c] = mdz
             n_c += 1
         # --- second half kick ----------------------------------------------------------
         for i in range(n_part):
@@ -577,34 +607,39 @@ def _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
                 rvx = vx[i] - wvx
                 rvy = vy[i] - wvy
                 rvz = vz[i] - wvz
-                delta_dot = -(rvx * nx + rvy * ny + rvz * nz)
             else:
                 rvx = vx[i] - vx[j]
                 rvy = vy[i] - vy[j]
                 rvz = vz[i] - vz[j]
-                delta_dot = rvx * nx + rvy * ny + rvz * nz
+            delta_dot = rvx * nx + rvy * ny + rvz * nz
             d_norm += c_val[4, q] * delta_dot * dt
+            if roll_dashpot:
+                wx = ox[i]
+                wy = oy[i]
+                wz = oz[i]
+                if j >= 0:
+                    wx -= ox[j]
+                    wy -= oy[j]
+                    wz -= oz[j]
+                d_roll -= (c_val[8, q] * wx + c_val[9, q] * wy + c_val[10, q] * wz) * dt
             if stick_slip:
                 continue  # friction loss was tallied where the spring slid
             arm = c_val[3, q]
             sx = ox[i]
             sy = oy[i]
             sz = oz[i]
-            if j < 0:
-                rvx -= arm * (sy * nz - sz * ny)
-                rvy -= arm * (sz * nx - sx * nz)
-                rvz -= arm * (sx * ny - sy * nx)
-            else:
+            if j >= 0:
                 sx += ox[j]
                 sy += oy[j]
                 sz += oz[j]
-                rvx += arm * (sy * nz - sz * ny)
-                rvy += arm * (sz * nx - sx * nz)
-                rvz += arm * (sx * ny - sy * nx)
+            rvx += arm * (sy * nz - sz * ny)
+            rvy += arm * (sz * nx - sx * nz)
+            rvz += arm * (sx * ny - sy * nx)
             d_fric -= (c_val[5, q] * rvx + c_val[6, q] * rvy + c_val[7, q] * rvz) * dt
         tally[c, cyc, 0] += w_wall
         tally[c, cyc, 1] += d_norm
         tally[c, cyc, 2] += d_fric
+        tally[c, cyc, 3] += d_roll
         samples[c, smp] += f_drive
         if status[c] != STATUS_OK:
             fail_step[c] = step0 + s + 1
@@ -624,9 +659,44 @@ def _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
     trq[0, c] = tx
     trq[1, c] = ty
     trq[2, c] = tz
-    spr_pp[0, c] = qpx
-    spr_pp[1, c] = qpy
-    spr_pp[2, c] = qpz
-    spr_pw[0, c] = qwx
-    spr_pw[1, c] = qwy
-    spr_pw[2, c] = qwz
+    hist_pp[c] = hp
+    hist_pw[c] = hw
+
+
+@njit(cache=True)
+def contact_energy(pos, hist_pp, hist_pw, wall_n, wall_d, offset, radius, law_pp, law_pw):
+    """Elastic energy stored in the contacts of each cell, (K,), J.
+
+    Hertz energy of every overlap (:func:`pidcore.dem.contact.hertz_elastic_energy`, the
+    potential of the kernel's normal force) plus 1/2 k_t |xi|^2 of the tangential springs
+    (each at the k_t it is stored with) and 1/2 k_r |theta|^2 of the rolling springs.
+    ``offset`` (3,) is the cell's displacement.
+    """
+    n_cells = pos.shape[1]
+    n_part = pos.shape[2]
+    out = np.zeros(n_cells)
+    for c in range(n_cells):
+        e = 0.0
+        for i in range(n_part):
+            for w in range(wall_n.shape[0]):
+                dist = (wall_n[w, 0] * (pos[0, c, i] - offset[0])
+                        + wall_n[w, 1] * (pos[1, c, i] - offset[1])
+                        + wall_n[w, 2] * (pos[2, c, i] - offset[2]) + wall_d[w])
+                e += hertz_elastic_energy(radius - dist, law_pw[LAW_STIFFNESS])
+            for j in range(i + 1, n_part):
+                dx = pos[0, c, j] - pos[0, c, i]
+                dy = pos[1, c, j] - pos[1, c, i]
+                dz = pos[2, c, j] - pos[2, c, i]
+                d = np.sqrt(dx * dx + dy * dy + dz * dz)
+                e += hertz_elastic_energy(2.0 * radius - d, law_pp[LAW_STIFFNESS])
+        for hist, law in ((hist_pp, law_pp), (hist_pw, law_pw)):
+            k_r = law[LAW_ROLLING_STIFFNESS]
+            for a in range(hist.shape[1]):
+                for b in range(hist.shape[2]):
+                    h = hist[c, a, b]
+                    e += 0.5 * h[HIST_KT] * (h[0] * h[0] + h[1] * h[1] + h[2] * h[2])
+                    if k_r > 0.0:
+                        e += 0.5 * k_r * (h[HIST_ROLL] ** 2 + h[HIST_ROLL + 1] ** 2
+                                          + h[HIST_ROLL + 2] ** 2)
+        out[c] = e
+    return out

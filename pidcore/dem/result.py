@@ -19,7 +19,8 @@ if TYPE_CHECKING:  # pragma: no cover
 UNITS: dict[str, str] = {
     "sdc": "-", "sdc_stderr": "-", "loss_factor": "-",
     "energy_per_cycle_j": "J", "energy_dissipated_normal_j": "J",
-    "energy_dissipated_friction_j": "J", "max_kinetic_energy_j": "J", "work_per_cycle_j": "J",
+    "energy_dissipated_friction_j": "J", "energy_dissipated_rolling_j": "J",
+    "max_kinetic_energy_j": "J", "work_per_cycle_j": "J",
     "stored_energy_change_per_cycle_j": "J",
     "particles_per_cell": "1", "particles_full_cell": "1", "cells_simulated": "1",
     "m_c_kg": "kg", "coupon_mass_kg": "kg", "energy_balance_error": "-", "steps": "1",
@@ -43,13 +44,14 @@ class DemResult:
     (the specimen's ``[cell] count``, 441 for the paper's). ``specimen`` is the
     :class:`~pidcore.specimen.Specimen` simulated (its canonical text and hash are stored with
     the run); ``coupon_mass_kg`` is the rigid mass the shaker moves, coupon plus fixture.
-    ``energy_dissipated_normal_j`` / ``_friction_j`` split ``energy_per_cycle_j`` (steady
-    state, per cycle, coupon); ``work_per_cycle_j`` is the walls' work on the particles per
-    steady cycle; it equals the dissipation plus ``stored_energy_change_per_cycle_j`` (the
-    change of the particles' mechanical energy over the steady window divided by its cycles,
-    e.g. a bed compacting). ``energy_balance_error`` is (W_walls - dE_mech - D) / W_walls
-    over the whole driven run (all cells), with dE_mech = kinetic (incl. rotation) + gravity +
-    Hertz elastic energy change. ``particle_steps_per_s`` counts settling and driven steps
+    ``energy_dissipated_normal_j`` / ``_friction_j`` / ``_rolling_j`` split
+    ``energy_per_cycle_j`` (steady state, per cycle, coupon); ``work_per_cycle_j`` is the
+    walls' work on the particles per steady cycle; it equals the dissipation plus
+    ``stored_energy_change_per_cycle_j`` (the change of the particles' mechanical energy over
+    the steady window divided by its cycles, e.g. a bed compacting).
+    ``energy_balance_error`` is (W_walls - dE_mech - D) / W_walls over the whole driven run
+    (all cells), with dE_mech = kinetic (incl. rotation) + gravity + elastic (Hertz and
+    contact springs) energy change. ``particle_steps_per_s`` counts settling and driven steps
     over the time spent in the kernel (all threads); ``wall_s`` is the whole call.
 
     ``dissipation_per_cycle_j`` (cycles,) is the coupon dissipation of every driven cycle;
@@ -67,6 +69,7 @@ class DemResult:
     energy_per_cycle_j: float
     energy_dissipated_normal_j: float
     energy_dissipated_friction_j: float
+    energy_dissipated_rolling_j: float
     work_per_cycle_j: float
     stored_energy_change_per_cycle_j: float
     max_kinetic_energy_j: float
@@ -110,13 +113,15 @@ class DemResult:
         n_coupon = specimen.cell.count if specimen is not None else defaults.COUPON_CELLS
         k = tally.shape[0]
         steady = tally[:, steady_start_cycle:, :]
-        per_cell_cycle = tally[:, :, 1] + tally[:, :, 2]
+        # normal + friction + rolling (kernel tally columns 1, 2, 3)
+        per_cell_cycle = tally[:, :, 1] + tally[:, :, 2] + tally[:, :, 3]
         e_max = m_c_kg * case.acceleration_m_s2**2 / (2 * case.omega_rad_s**2)
         per_cell = n_coupon * steady[:, :, 1:].sum(axis=2).mean(axis=1)  # coupon J / cycle
         sdc_cells = per_cell / e_max if e_max > 0 else np.full(k, np.nan)
         stderr = float(np.std(sdc_cells, ddof=1) / math.sqrt(k)) if k > 1 else float("nan")
         work = float(tally[:, :, 0].sum())
-        dissipated = float(tally[:, :, 1:].sum())
+        # friction and normal summed as before rolling existed (same rounding), rolling added
+        dissipated = float(tally[:, :, 1:3].sum()) + float(tally[:, :, 3:].sum())
         d_mech = float(np.sum(energy_end[:, 3] - energy_start[:, 3]))
         scale = max(abs(work), dissipated, 1e-300)
         # virtual shaker record, sample interval j covers force evaluations at t=(step+1) dt
@@ -135,6 +140,7 @@ class DemResult:
             energy_per_cycle_j=float(np.mean(per_cell)),
             energy_dissipated_normal_j=float(n_coupon * steady[:, :, 1].mean()),
             energy_dissipated_friction_j=float(n_coupon * steady[:, :, 2].mean()),
+            energy_dissipated_rolling_j=float(n_coupon * steady[:, :, 3].mean()),
             work_per_cycle_j=float(n_coupon * steady[:, :, 0].mean()),
             stored_energy_change_per_cycle_j=float(
                 n_coupon * np.mean(stored_energy_change_steady) / max(steady.shape[1], 1)),
@@ -203,7 +209,8 @@ class DemResult:
         for name in ("sdc", "sdc_stderr", "loss_factor", "energy_per_cycle_j", "work_per_cycle_j",
                      "stored_energy_change_per_cycle_j",
                      "energy_dissipated_normal_j", "energy_dissipated_friction_j",
-                     "max_kinetic_energy_j", "particles_per_cell", "particles_full_cell",
+                     "energy_dissipated_rolling_j", "max_kinetic_energy_j",
+                     "particles_per_cell", "particles_full_cell",
                      "cells_simulated", "m_c_kg", "coupon_mass_kg", "energy_balance_error",
                      "work_walls_j", "dissipated_total_j", "mechanical_energy_change_j",
                      "steps", "wall_s", "particle_steps_per_s", "time_step_s",

@@ -495,7 +495,8 @@ def simulate_load_case(case: LoadCase, config: DemConfig | None = None, *,
                 bar.update(b)
             if steady_start is None:
                 all_t = np.concatenate(tallies, axis=1).mean(axis=0)  # (cycles, 3)
-                steady_start = _steady_start(all_t[:, 1] + all_t[:, 2], all_t[:, 0], config)
+                steady_start = _steady_start(all_t[:, 1] + all_t[:, 2] + all_t[:, 3],
+                                             all_t[:, 0], config)
                 detected = steady_start is not None
                 cap = config.transient_cap_cycles(case.frequency_hz)
                 if steady_start is None and done >= cap:

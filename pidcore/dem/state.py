@@ -12,12 +12,14 @@ from ..errors import SimulationError
 from .contact import ContactLaw, check_tangential_model
 from .geometry import WALL_NAMES, CellGeometry
 from .kernel import (
+    N_HISTORY,
     N_TALLIES,
     STATUS_ESCAPED,
     STATUS_NONFINITE,
     STATUS_OK,
     STATUS_OVERLAP,
     advance_cells,
+    contact_energy,
 )
 
 #: Array index of each drive direction (``DRIVE_DIRECTIONS`` is ordered z, x, y).
@@ -29,9 +31,10 @@ class CellsState:
     """Mutable structure-of-arrays state of K cells of N particles (SI units).
 
     ``pos``, ``vel``, ``omg``, ``frc``, ``trq`` have shape (3, K, N); ``step`` counts steps
-    since the drive clock's origin (t = step * dt). ``spring_pp`` (3, K, N, N; entry [i, j]
-    with i < j) and ``spring_pw`` (3, K, N, walls) hold the stretch of the tangential contact
-    springs of the stick-slip model, m (zero where there is no contact).
+    since the drive clock's origin (t = step * dt). ``spring_pp`` (K, N, N, N_HISTORY; entry
+    [i, j] with i < j) and ``spring_pw`` (K, N, walls, N_HISTORY) hold each contact's history
+    (slots ``HIST_*`` of :mod:`pidcore.dem.kernel`: tangential spring stretch, m, sliding
+    flag, its k_t, N/m, rolling spring angle, rad; all zero where there is no contact).
     """
 
     pos: np.ndarray
@@ -57,8 +60,8 @@ class CellsState:
         frc[2] = -mass_kg * gravity_m_s2
         k, n = pos.shape[1], pos.shape[2]
         return cls(pos=pos, vel=zeros.copy(), omg=zeros.copy(), frc=frc, trq=zeros.copy(),
-                   spring_pp=np.zeros((3, k, n, n)),
-                   spring_pw=np.zeros((3, k, n, len(WALL_NAMES))))
+                   spring_pp=np.zeros((k, n, n, N_HISTORY)),
+                   spring_pw=np.zeros((k, n, len(WALL_NAMES), N_HISTORY)))
 
     @property
     def n_cells(self) -> int:
@@ -88,31 +91,30 @@ def wall_velocity(t_s, *, accel_m_s2: float, omega_rad_s: float):
     return -accel_m_s2 / omega_rad_s * np.cos(omega_rad_s * np.asarray(t_s))
 
 
+def law_vectors(law: ContactLaw) -> tuple[np.ndarray, np.ndarray]:
+    """Kernel parameter vectors (particle pairs, walls) of a contact law."""
+    mindlin = law.tangential_stiffness_model == "mindlin"
+    return (law.pair_particle.kernel_vector(mindlin=mindlin),
+            law.pair_wall.kernel_vector(mindlin=mindlin))
+
+
 def energies(state: CellsState, law: ContactLaw, geometry: CellGeometry, *,
              wall_offset_m: np.ndarray, gravity_m_s2: float) -> np.ndarray:
     """Per-cell mechanical energy, (K, 4): kinetic (incl. rotation), potential, elastic, sum; J.
 
     ``wall_offset_m`` is the (3,) displacement of the cell at the state's time. The potential
     energy is m g z of the particle centres (absolute z); the elastic energy is the Hertz
-    energy of the overlaps plus 1/2 k_t |xi|^2 of the tangential springs.
+    energy of the overlaps plus that of the tangential and rolling springs
+    (:func:`pidcore.dem.kernel.contact_energy`, the same laws as the kernel's).
     """
     m = law.mass_kg
     ke = 0.5 * m * np.sum(state.vel**2, axis=(0, 2)) \
         + 0.5 * law.inertia_kg_m2 * np.sum(state.omg**2, axis=(0, 2))
     pe = m * gravity_m_s2 * np.sum(state.pos[2], axis=1)
-    p = np.moveaxis(state.pos, 0, -1)  # (K, N, 3)
-    dist = geometry.signed_distances(p - wall_offset_m)
-    u_wall = 0.4 * law.pair_wall.stiffness * np.maximum(law.radius_m - dist, 0.0) ** 2.5
-    diff = p[:, :, None, :] - p[:, None, :, :]
-    d = np.sqrt(np.sum(diff**2, axis=-1))
-    overlap = np.maximum(2 * law.radius_m - d, 0.0)
-    overlap[:, np.arange(p.shape[1]), np.arange(p.shape[1])] = 0.0
-    u_pair = 0.5 * np.sum(0.4 * law.pair_particle.stiffness * overlap**2.5, axis=(1, 2))
-    u_spring = (0.5 * law.pair_particle.tangential_stiffness
-                * np.sum(state.spring_pp**2, axis=(0, 2, 3))
-                + 0.5 * law.pair_wall.tangential_stiffness
-                * np.sum(state.spring_pw**2, axis=(0, 2, 3)))
-    elastic = np.sum(u_wall, axis=(1, 2)) + u_pair + u_spring
+    elastic = contact_energy(state.pos, state.spring_pp, state.spring_pw,
+                             geometry.wall_normals, geometry.wall_offsets,
+                             np.asarray(wall_offset_m, dtype=float), law.radius_m,
+                             *law_vectors(law))
     return np.column_stack([ke, pe, elastic, ke + pe + elastic])
 
 
@@ -153,7 +155,8 @@ class KernelSettings:
 def advance(state: CellsState, settings: KernelSettings, n_steps: int, *,
             steps_per_cycle: int | None = None, sample_every: int | None = None
             ) -> tuple[np.ndarray, np.ndarray]:
-    """Advance all cells ``n_steps``; returns (tally (K, cycles, 3) in J, samples (K, S) in N).
+    """Advance all cells ``n_steps``; returns (tally (K, cycles, N_TALLIES) in J, samples (K, S)
+    in N). Tally columns: walls' work, normal damping, friction, rolling resistance.
 
     ``samples`` are interval means of the drive-axis force of the walls on the particles.
     Raises SimulationError when a cell becomes unphysical.
@@ -163,7 +166,7 @@ def advance(state: CellsState, settings: KernelSettings, n_steps: int, *,
     spc = max(spc, 1)
     se = max(se, 1)
     law = settings.law
-    pp, pw = law.pair_particle, law.pair_wall
+    law_pp, law_pw = law_vectors(law)
     g = settings.geometry
     k = state.n_cells
     tally = np.zeros((k, max(-(-n_steps // spc), 1), N_TALLIES))
@@ -172,13 +175,10 @@ def advance(state: CellsState, settings: KernelSettings, n_steps: int, *,
     fail_step = np.zeros(k, dtype=np.int64)
     advance_cells(state.pos, state.vel, state.omg, state.frc, state.trq,
                   g.wall_normals, g.wall_offsets,
-                  law.radius_m, law.mass_kg, law.inertia_kg_m2,
-                  pp.stiffness, pp.damping, pp.sliding_friction, pp.tangential_mass_kg,
-                  pw.stiffness, pw.damping, pw.sliding_friction, pw.tangential_mass_kg,
+                  law.radius_m, law.mass_kg, law.inertia_kg_m2, law_pp, law_pw,
                   settings.friction_regularisation_m_s, settings.clip_attraction,
-                  settings.gravity_m_s2,
-                  settings.tangential_model == "stick_slip", pp.tangential_stiffness,
-                  pw.tangential_stiffness, state.spring_pp, state.spring_pw,
+                  settings.gravity_m_s2, settings.tangential_model == "stick_slip",
+                  state.spring_pp, state.spring_pw,
                   settings.dt_s, np.int64(state.step), np.int64(n_steps),
                   settings.omega_rad_s, settings.accel_m_s2,
                   AXIS_INDEX[settings.direction],
