@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import defaults
+from ..constants import STANDARD_GRAVITY
 from ..dem.simulate import DemConfig, LoadCase
 from ..errors import ParameterError
 from ..specimen import Specimen, paper_specimen
@@ -56,6 +57,7 @@ class CalibrationResult:
     runs: dict
     settings: dict
     notes: list[str] = field(default_factory=list)
+    energy_check: list[dict] = field(default_factory=list)
     wall_s: float = 0.0
 
     @property
@@ -111,6 +113,7 @@ class CalibrationResult:
             "design": {"names": [s.name for s in self.specs if s.kind == "dem"],
                        "points": self.design.tolist()},
             "runs": self.runs, "settings": self.settings, "notes": self.notes,
+            "energy_check": self.energy_check,
             "wall_s": self.wall_s,
             "units": {"frequency_hz": "Hz", "acceleration_g": "g", "fill_percent": "%",
                       "measured": "-", "predicted": "-", "low95": "-", "high95": "-",
@@ -219,6 +222,7 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: Sequence[str],
     parameters, correlations = summarise(specs, samples)
     rng = np.random.default_rng(posterior_seed + 1)
     predictions = [_row(points[i], predictive(model, samples, i, rng=rng)) for i in everything]
+    energy = energy_check(model, samples, specimen)
     loo = None
     if cross_validate == "loo":
         loo = []
@@ -246,8 +250,37 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: Sequence[str],
     return CalibrationResult(specimen=specimen, specs=specs, samples=samples, parameters=parameters,
                              correlations=correlations, predictions=predictions, loo=loo,
                              fixed=fixed, design=design, observations=observations, runs=runs,
-                             settings=settings, notes=notes,
+                             settings=settings, notes=notes, energy_check=energy,
                              wall_s=time.perf_counter() - start)
+
+
+def energy_check(model: Model, samples: np.ndarray, specimen: Specimen) -> list[dict]:
+    """Energy dissipated per cycle per cell (J) of every load case: the DEM at the starting
+    specimen's values against the calibrated DEM (posterior median and 95 % band).
+
+    Observation parameters do not change the DEM, so without DEM parameters both agree by
+    construction. ``within`` says whether the starting value lies inside the calibrated band,
+    i.e. whether the calibration's change of the physics is within its own uncertainty.
+    """
+    dem = [s for s in model.specs if s.kind == "dem"]
+    start = np.array([[s.default for s in dem]]) if dem else np.zeros((1, 0))
+    theta = model.dem_theta(samples)
+    out = []
+    for surrogate in model.surrogates:
+        omega = 2 * math.pi * surrogate.frequency_hz
+        velocity = surrogate.acceleration_g * STANDARD_GRAVITY / omega
+        per_cell = math.pi * velocity**2 / specimen.cell.count  # Re(P) T = d pi |V|^2
+        e0 = float(surrogate.predict(start)[0][0] * per_cell)
+        e = surrogate.predict(theta)[0] * per_cell
+        low, median, high = (float(v) for v in np.percentile(e, [2.5, 50, 97.5]))
+        out.append({"frequency_hz": surrogate.frequency_hz,
+                    "acceleration_g": surrogate.acceleration_g,
+                    "fill_percent": surrogate.fill_percent,
+                    "energy_per_cycle_per_cell_start_j": e0,
+                    "energy_per_cycle_per_cell_calibrated_j": median,
+                    "low95_j": low, "high95_j": high,
+                    "within": bool(low <= e0 <= high) if dem else True})
+    return out
 
 
 def _row(point: MeasuredPoint, prediction: dict) -> dict:

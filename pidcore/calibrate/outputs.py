@@ -97,6 +97,16 @@ def summary_markdown(result: CalibrationResult) -> str:
         lines += ["", f"## {title}: RMS {rms:.3f}, {inside}/{len(rows)} inside the 95 % band",
                   "", "| " + " | ".join(_HEAD) + " |", "|---" * len(_HEAD) + "|"]
         lines += ["| " + " | ".join(cells) + " |" for cells in _table_rows(rows)]
+    if any(s.kind == "dem" for s in result.specs):
+        lines += ["", "## Energy per cycle per cell: starting specimen vs calibrated DEM", "",
+                  "| f [Hz] | a [g] | start [J] | calibrated median [J] | 95 % band [J] | "
+                  "start inside |", "|---|---|---|---|---|---|"]
+        for r in result.energy_check:
+            lines.append(f"| {r['frequency_hz']:g} | {r['acceleration_g']:g} | "
+                         f"{r['energy_per_cycle_per_cell_start_j']:.3g} | "
+                         f"{r['energy_per_cycle_per_cell_calibrated_j']:.3g} | "
+                         f"{r['low95_j']:.3g} .. {r['high95_j']:.3g} | "
+                         f"{'yes' if r['within'] else '**no**'} |")
     if result.notes:
         lines += ["", "Notes:", ""] + [f"- {n}" for n in result.notes]
     return "\n".join(lines) + "\n"

@@ -51,10 +51,10 @@ def design_points(specs: Sequence[ParameterSpec], n_points: int, *,
 
 
 def default_design_size(n_dem: int) -> int:
-    """Design points for ``n_dem`` DEM parameters: 6 for one, 5 more per further one."""
+    """Design points for ``n_dem`` DEM parameters: 5 for one, 4 more per further one."""
     if n_dem == 0:
         return 1
-    return 6 + 5 * (n_dem - 1)
+    return 5 + 4 * (n_dem - 1)
 
 
 def _kernel(a: np.ndarray, b: np.ndarray, length: float) -> np.ndarray:
@@ -166,7 +166,12 @@ def build_surrogate(observations: Sequence[Observation], theta: np.ndarray,
 def predicted_sdc(surrogate: CaseSurrogate, theta: np.ndarray, fixture_mass_kg: np.ndarray,
                   baseline_loss_factor: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(SDC, its variance from the DEM surrogate) for N parameter sets (observation model)."""
-    d, var_d, m_p, var_m = surrogate.predict(theta)
+    theta = np.atleast_2d(np.asarray(theta, dtype=float))
+    if theta.shape[1] == 0 or len(theta) < 64:
+        d, var_d, m_p, var_m = surrogate.predict(theta)
+    else:  # a grid repeats each DEM point many times: evaluate the surrogate once per point
+        unique, inverse = np.unique(theta, axis=0, return_inverse=True)
+        d, var_d, m_p, var_m = (v[inverse.ravel()] for v in surrogate.predict(unique))
     structure = surrogate.coupon_mass_kg + np.asarray(fixture_mass_kg, dtype=float)
     denominator = m_p + structure
     sdc = 2 * math.pi * (d + baseline_loss_factor * structure) / denominator
