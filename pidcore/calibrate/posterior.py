@@ -193,7 +193,8 @@ def predictive(model: Model, samples: np.ndarray, index: int, *,
     """Posterior-predictive median and 95 % band of a measurement of load case ``index``."""
     sdc, variance = model.predict(samples, index)
     draws = sdc + rng.standard_normal(sdc.shape) * np.sqrt(variance)
-    low, high = np.percentile(draws, [2.5, 97.5])
+    # an SDC is >= 0 (dissipation): the normal error model's tail below 0 is cut there
+    low, high = np.percentile(np.maximum(draws, 0.0), [2.5, 97.5])
     return {"predicted": float(np.median(sdc)), "low95": float(low), "high95": float(high),
             "predicted_low95": float(np.percentile(sdc, 2.5)),
             "predicted_high95": float(np.percentile(sdc, 97.5))}
