@@ -24,7 +24,7 @@ import numpy as np
 from ..errors import ParameterError
 from .data import MeasuredPoint
 from .parameters import DISCREPANCY, ParameterSpec
-from .surrogate import CaseSurrogate, predicted_sdc
+from .surrogate import CaseSurrogate, predicted_sdc, unique_points
 
 GRID_MAX_DIMENSIONS = 4
 #: Grid points per dimension (coarse pass, fine pass) by number of dimensions.
@@ -55,12 +55,14 @@ class Model:
         cols = [i for i, s in enumerate(self.specs) if s.kind == "dem"]
         return samples[:, cols]
 
-    def predict(self, samples: np.ndarray, index: int) -> tuple[np.ndarray, np.ndarray]:
+    def predict(self, samples: np.ndarray, index: int, *,
+                unique=None) -> tuple[np.ndarray, np.ndarray]:
         """(predicted SDC, total predictive variance) of load case ``index`` per sample."""
         samples = np.atleast_2d(samples)
         sdc, var_dem = predicted_sdc(self.surrogates[index], self.dem_theta(samples),
                                      self._column(samples, "fixture_mass_kg"),
-                                     self._column(samples, "baseline_loss_factor"))
+                                     self._column(samples, "baseline_loss_factor"),
+                                     unique=unique)
         tau = self._column(samples, DISCREPANCY)
         variance = (self.points[index].sdc_stderr ** 2 + var_dem + (tau * sdc) ** 2
                     + self.discrepancy_floor ** 2)
@@ -68,8 +70,9 @@ class Model:
 
     def log_likelihood(self, samples: np.ndarray, indices: Sequence[int]) -> np.ndarray:
         total = np.zeros(np.atleast_2d(samples).shape[0])
+        unique = unique_points(self.dem_theta(np.atleast_2d(samples)))
         for i in indices:
-            sdc, variance = self.predict(samples, i)
+            sdc, variance = self.predict(samples, i, unique=unique)
             total += -0.5 * ((self.points[i].sdc - sdc) ** 2 / variance
                              + np.log(2 * math.pi * variance))
         return total

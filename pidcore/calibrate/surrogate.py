@@ -28,12 +28,12 @@ from .parameters import ParameterSpec
 #: Smallest dissipative mass used in the log transform (kg): far below any measurable value.
 _MIN_DISSIPATIVE_MASS_KG = 1e-12
 #: Length scales (in units of the design range) and amplitude factors searched.
-_LENGTH_SCALES = (0.1, 0.15, 0.2, 0.3, 0.45, 0.7, 1.0, 1.5, 2.5)
-_AMPLITUDES = tuple(10.0 ** np.linspace(-3, 1.5, 19))
+_LENGTH_SCALES = (0.1, 0.2, 0.35, 0.6, 1.0, 2.0)
+_AMPLITUDES = tuple(10.0 ** np.linspace(-3, 1.5, 10))
 #: Extra noise (fraction of the amplitude) searched: DEM scatter beyond the runs' own standard
 #: errors (a few cells give a poor estimate; a packing's stick-slip thresholds make the
 #: response rough from one parameter value to the next).
-_NUGGETS = (0.0, 1e-3, 1e-2, 0.03, 0.1, 0.3)
+_NUGGETS = (0.0, 1e-2, 0.03, 0.1, 0.3)
 
 
 def design_points(specs: Sequence[ParameterSpec], n_points: int, *,
@@ -163,15 +163,32 @@ def build_surrogate(observations: Sequence[Observation], theta: np.ndarray,
         reactive=_fit(u, mp, mp_se))
 
 
-def predicted_sdc(surrogate: CaseSurrogate, theta: np.ndarray, fixture_mass_kg: np.ndarray,
-                  baseline_loss_factor: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(SDC, its variance from the DEM surrogate) for N parameter sets (observation model)."""
-    theta = np.atleast_2d(np.asarray(theta, dtype=float))
+def unique_points(theta: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """(distinct rows, inverse index) of DEM parameter sets, or None when not worth it (few
+    rows or no DEM parameter). A posterior grid repeats each DEM point many times."""
+    theta = np.atleast_2d(theta)
     if theta.shape[1] == 0 or len(theta) < 64:
+        return None
+    if theta.shape[1] == 1:
+        unique, inverse = np.unique(theta[:, 0], return_inverse=True)
+        return unique[:, None], inverse.ravel()
+    unique, inverse = np.unique(theta, axis=0, return_inverse=True)
+    return unique, inverse.ravel()
+
+
+def predicted_sdc(surrogate: CaseSurrogate, theta: np.ndarray, fixture_mass_kg: np.ndarray,
+                  baseline_loss_factor: np.ndarray, *,
+                  unique: tuple[np.ndarray, np.ndarray] | None = None
+                  ) -> tuple[np.ndarray, np.ndarray]:
+    """(SDC, its variance from the DEM surrogate) for N parameter sets (observation model).
+
+    ``unique``: :func:`unique_points` of ``theta``, to evaluate the surrogate once per point.
+    """
+    if unique is None:
         d, var_d, m_p, var_m = surrogate.predict(theta)
-    else:  # a grid repeats each DEM point many times: evaluate the surrogate once per point
-        unique, inverse = np.unique(theta, axis=0, return_inverse=True)
-        d, var_d, m_p, var_m = (v[inverse.ravel()] for v in surrogate.predict(unique))
+    else:
+        points, inverse = unique
+        d, var_d, m_p, var_m = (v[inverse] for v in surrogate.predict(points))
     structure = surrogate.coupon_mass_kg + np.asarray(fixture_mass_kg, dtype=float)
     denominator = m_p + structure
     sdc = 2 * math.pi * (d + baseline_loss_factor * structure) / denominator
