@@ -85,6 +85,10 @@ def test_json_document(capsys, tmp_path, tiny_store):
     out = tmp_path / "out"
     full = json.loads((out / "calibration.json").read_text())
     assert full["loo_rms"] == doc["loo_rms"]
+    # no DEM parameter fitted: the calibrated DEM's energy per cycle is the starting one
+    for row in full["energy_check"]:
+        assert row["energy_per_cycle_per_cell_calibrated_j"] == pytest.approx(
+            row["energy_per_cycle_per_cell_start_j"], rel=1e-12)
     for name in ("calibrated_specimen.toml", "summary.md", "summary.html", "predictions.png",
                  "posterior_pairs.png"):
         assert (out / name).stat().st_size > 0
