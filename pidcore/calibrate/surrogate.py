@@ -81,6 +81,11 @@ class _Process:
         k = self.amplitude * _kernel(u, self.u, self.length)
         mean = self.mean + k @ self.weights
         var = self.amplitude - np.einsum("ij,jk,ik->i", k, self.inverse, k)
+        # the constant mean is estimated too (universal kriging): its variance where the
+        # runs do not pin the prediction down
+        ones = np.ones(self.u.shape[0])
+        precision = ones @ self.inverse @ ones
+        var = var + (1.0 - k @ (self.inverse @ ones)) ** 2 / precision
         return mean, np.maximum(var, 0.0)
 
 
