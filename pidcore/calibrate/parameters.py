@@ -80,7 +80,7 @@ _PAIR = {"pp": ("particle_particle",), "pw": ("particle_wall",),
 _DEM_ALIASES: dict[str, tuple[str, float, float, str]] = {
     "friction": ("sliding_friction", 0.05, 0.8, "sliding friction"),
     "static_friction": ("static_friction", 0.1, 1.0, "static friction (stick limit)"),
-    "rolling_friction": ("rolling_friction", 0.0, 0.05, "rolling friction mu_r"),
+    "rolling_friction": ("rolling_friction", 0.0, 0.1, "rolling friction mu_r"),
     "restitution": ("restitution", 0.3, 0.95, "normal restitution"),
 }
 
