@@ -88,7 +88,12 @@ class CalibrationResult:
         coupon = {f"coupon.{name}": self.parameters[name]["median"]
                   for name in ("fixture_mass_kg", "baseline_loss_factor")
                   if name in self.parameters}
-        return out.with_values(coupon) if coupon else out
+        out = out.with_values(coupon) if coupon else out
+        fitted = ", ".join(s.name for s in self.specs if s.kind != "hyper")
+        return dataclasses.replace(
+            out, name=f"{self.specimen.name}_calibrated",
+            description=f"{self.specimen.description} -- calibrated ({fitted}) by pidcore "
+                        "calibrate".strip(" -"))
 
     def document(self) -> dict:
         """The ``--json`` document: parameters, predictions, loo, loo_rms."""
