@@ -21,7 +21,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "calibrate", help="fit DEM/specimen parameters to measured SDCs",
         description="Fit chosen parameters to measured SDCs (Eq. 11 of the DEM's virtual "
                     "shaker, with fixture mass and baseline loss factor), with a posterior, "
-                    "95 %% intervals and optional leave-one-out cross-validation. DEM runs "
+                    "95 % intervals and optional leave-one-out cross-validation. DEM runs "
                     "over a space-filling design are cached in --dem-store.")
     source = p.add_mutually_exclusive_group(required=True)
     source.add_argument("--data", metavar="TABLE.csv", type=Path,
