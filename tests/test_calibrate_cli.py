@@ -134,3 +134,22 @@ def test_interrupt_keeps_finished_runs(tmp_path):
     assert not Store(store).has_dem_run(requests[1].key())
     again = run_requests(requests, store_path=store, workers=1, progress=False)
     assert (again["computed"], again["cached"]) == (1, 1)
+
+
+def test_store_measurements_are_grouped_per_load_case(monkeypatch, tmp_path):
+    # repeated tests of one load case (measured f and a scatter about the nominal ones) give
+    # their mean and the standard error of the mean; a single test keeps its own error
+    import pandas as pd
+
+    from pidcore.calibrate import measured_from_store
+
+    frame = pd.DataFrame({"frequency_hz": [50.02, 49.98, 500.1],
+                          "acceleration_g": [4.97, 5.02, 1.01],
+                          "fill_percent": [50.0, 50.0, 50.0],
+                          "sdc": [0.20, 0.26, 0.22], "sdc_stderr": [0.01, 0.01, 0.015]})
+    monkeypatch.setattr(Store, "list_analyses", lambda self: frame)
+    points = {(p.frequency_hz, p.acceleration_g): p for p in measured_from_store(tmp_path / "s.h5")}
+    assert set(points) == {(50.0, 5.0), (500.0, 1.0)}
+    assert points[(50.0, 5.0)].sdc == pytest.approx(0.23)
+    assert points[(50.0, 5.0)].sdc_stderr == pytest.approx(0.03)  # std 0.0424 / sqrt(2)
+    assert points[(500.0, 1.0)].sdc_stderr == pytest.approx(0.015)

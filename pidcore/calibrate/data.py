@@ -84,7 +84,9 @@ def measured_from_store(store_path: str | os.PathLike) -> list[MeasuredPoint]:
     """Analysed measurements of a store, grouped per load case (mean SDC, standard error).
 
     A load case measured several times gives the mean and the standard error of the mean
-    (or the analysis's own standard error when measured once).
+    (or the analysis's own standard error when measured once). Measured frequency and
+    acceleration are rounded to 3 and 2 significant digits to find the load case; the
+    analyses must carry ``fill_percent`` (from a sidecar).
     """
     from ..store import Store
 
@@ -97,6 +99,11 @@ def measured_from_store(store_path: str | os.PathLike) -> list[MeasuredPoint]:
             raise InputFileError(f"{store_path}: analyses carry no {column}; calibrate from a "
                                  "table (--data) instead")
     frame = frame.dropna(subset=["frequency_hz", "acceleration_g", "fill_percent", "sdc"])
+    # measured frequency and acceleration scatter about the nominal ones: a load case is the
+    # frequency to 3 significant digits, the acceleration to 2 (e.g. 50.02 Hz, 4.97 g -> 50, 5)
+    frame = frame.assign(
+        frequency_hz=frame["frequency_hz"].map(lambda v: float(f"{v:.3g}")),
+        acceleration_g=frame["acceleration_g"].map(lambda v: float(f"{v:.2g}")))
     points = []
     keys = ["frequency_hz", "acceleration_g", "fill_percent"]
     for (f, a, p), group in frame.groupby(keys):
