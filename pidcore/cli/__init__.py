@@ -16,7 +16,7 @@ from ..errors import PidcoreError
 
 #: Sub-command modules, each exposing ``register(subparsers) -> None``.
 _COMMAND_MODULES = ("analyze", "dem", "specimen", "bench", "report", "model", "app",
-                    "samples")
+                    "samples", "calibrate")
 
 
 def build_parser() -> argparse.ArgumentParser:

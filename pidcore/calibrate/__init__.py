@@ -1,0 +1,25 @@
+"""Calibration of the DEM against measured SDCs, with uncertainty and cross-validation.
+
+Modules, one concern each:
+
+* :mod:`~pidcore.calibrate.data`: measured points (table or store);
+* :mod:`~pidcore.calibrate.parameters`: what can be fitted, bounds and priors;
+* :mod:`~pidcore.calibrate.runner`: DEM runs for named parameter values, cached in the store;
+* :mod:`~pidcore.calibrate.observation`: the SDC a shaker test of the DEM would measure (Eq. 11
+  with fixture mass and baseline loss factor);
+* :mod:`~pidcore.calibrate.surrogate`: space-filling design and per-load-case surrogate;
+* :mod:`~pidcore.calibrate.posterior`: likelihood (measurement error, DEM scatter, model
+  discrepancy), exact grid or emcee;
+* :mod:`~pidcore.calibrate.calibrate`: the pipeline and leave-one-out;
+* :mod:`~pidcore.calibrate.outputs`: calibration.json, specimen file, figures, summary.
+"""
+
+from .calibrate import CalibrationResult, calibrate
+from .data import MeasuredPoint, measured_from_store, read_measured_table
+from .observation import Observation, observation_from_run
+from .outputs import write_outputs
+from .parameters import CATALOGUE, ParameterSpec, build_specs, parse_fit
+
+__all__ = ["calibrate", "CalibrationResult", "MeasuredPoint", "read_measured_table",
+           "measured_from_store", "Observation", "observation_from_run", "write_outputs",
+           "CATALOGUE", "ParameterSpec", "build_specs", "parse_fit"]

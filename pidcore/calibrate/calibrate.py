@@ -1,0 +1,300 @@
+"""Calibration pipeline: measured points -> DEM design runs (cached) -> surrogates ->
+posterior -> predictions, optionally leave-one-out cross-validation.
+
+In a leave-one-out fold the held-out load case's DEM runs are shared (they do not depend on
+the measurement), but its measured value never enters the fold's likelihood.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import os
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .. import defaults
+from ..constants import STANDARD_GRAVITY
+from ..dem.simulate import DemConfig, LoadCase
+from ..errors import ParameterError
+from ..specimen import Specimen, paper_specimen
+from .data import MeasuredPoint, check_enough_points
+from .observation import Observation, observation_from_run
+from .parameters import CATALOGUE, DISCREPANCY, ParameterSpec, build_specs, parameter_spec
+from .posterior import (
+    DISCREPANCY_FLOOR,
+    Model,
+    predictive,
+    sample_posterior,
+    summarise,
+)
+from .runner import RunRequest, run_requests, specimen_with
+from .surrogate import build_surrogate, default_design_size, design_points
+
+#: Cells per DEM run of a calibration: the ensemble scatter enters the likelihood, and 4
+#: cells keep a 12-case design within minutes on two cores.
+CALIBRATION_CELLS = 4
+CROSS_VALIDATIONS = ("loo",)
+
+
+@dataclass
+class CalibrationResult:
+    """Outcome of :func:`calibrate`: posterior summary, predictions, LOO, run bookkeeping."""
+
+    specimen: Specimen
+    specs: list[ParameterSpec]
+    samples: np.ndarray
+    parameters: dict
+    correlations: list
+    predictions: list[dict]
+    loo: list[dict] | None
+    fixed: dict
+    design: np.ndarray
+    observations: list[list[Observation]]
+    runs: dict
+    settings: dict
+    notes: list[str] = field(default_factory=list)
+    energy_check: list[dict] = field(default_factory=list)
+    wall_s: float = 0.0
+
+    @property
+    def loo_rms(self) -> float | None:
+        if not self.loo:
+            return None
+        return float(np.sqrt(np.mean([(r["predicted"] - r["measured"]) ** 2 for r in self.loo])))
+
+    @property
+    def loo_coverage(self) -> int | None:
+        if not self.loo:
+            return None
+        return int(sum(r["low95"] <= r["measured"] <= r["high95"] for r in self.loo))
+
+    @property
+    def rms(self) -> float:
+        return float(np.sqrt(np.mean([(r["predicted"] - r["measured"]) ** 2
+                                      for r in self.predictions])))
+
+    def values(self) -> dict[str, float]:
+        """Calibrated value (posterior median) of every fitted parameter."""
+        return {name: p["median"] for name, p in self.parameters.items()}
+
+    def calibrated_specimen(self) -> Specimen:
+        """The starting specimen with every fitted specimen parameter at its median."""
+        dem = {s.name: self.parameters[s.name]["median"] for s in self.specs if s.kind == "dem"}
+        out = specimen_with(self.specimen, dem)
+        coupon = {f"coupon.{name}": self.parameters[name]["median"]
+                  for name in ("fixture_mass_kg", "baseline_loss_factor")
+                  if name in self.parameters}
+        out = out.with_values(coupon) if coupon else out
+        fitted = ", ".join(s.name for s in self.specs if s.kind != "hyper")
+        return dataclasses.replace(
+            out, name=f"{self.specimen.name}_calibrated",
+            description=f"{self.specimen.description} -- calibrated ({fitted}) by pidcore "
+                        "calibrate".strip(" -"))
+
+    def document(self) -> dict:
+        """The ``--json`` document: parameters, predictions, loo, loo_rms."""
+        keep = ("median", "low95", "high95")
+        return {
+            "parameters": {n: {k: p[k] for k in keep} for n, p in self.parameters.items()},
+            "predictions": [_public(r) for r in self.predictions],
+            "loo": [_public(r) for r in self.loo] if self.loo is not None else None,
+            "loo_rms": self.loo_rms,
+        }
+
+    def full_document(self) -> dict:
+        """``calibration.json``: the document plus correlations, settings, runs, notes."""
+        out = self.document()
+        out.update({
+            "parameter_details": self.parameters,
+            "correlations": {"names": [s.name for s in self.specs],
+                             "matrix": self.correlations},
+            "fixed": self.fixed, "rms_in_sample": self.rms,
+            "loo_coverage95": self.loo_coverage,
+            "n_points": len(self.predictions),
+            "design": {"names": [s.name for s in self.specs if s.kind == "dem"],
+                       "points": self.design.tolist()},
+            "runs": self.runs, "settings": self.settings, "notes": self.notes,
+            "energy_check": self.energy_check,
+            "wall_s": self.wall_s,
+            "units": {"frequency_hz": "Hz", "acceleration_g": "g", "fill_percent": "%",
+                      "measured": "-", "predicted": "-", "low95": "-", "high95": "-",
+                      "fixture_mass_kg": "kg", "baseline_loss_factor": "-",
+                      DISCREPANCY: "-"},
+        })
+        return out
+
+
+def _public(row: dict) -> dict:
+    keys = ("frequency_hz", "acceleration_g", "fill_percent", "measured", "predicted",
+            "low95", "high95")
+    return {k: row[k] for k in keys}
+
+
+def _requests(points: Sequence[MeasuredPoint], dem_specs: Sequence[ParameterSpec],
+              design: np.ndarray, config: DemConfig,
+              specimen: Specimen) -> list[list[RunRequest]]:
+    specimens = [specimen_with(specimen, {s.name: float(v)
+                                          for s, v in zip(dem_specs, row, strict=True)})
+                 for row in design]
+    out = []
+    for point in points:
+        case = LoadCase(point.frequency_hz, point.acceleration_g, point.fill_percent,
+                        point.material)
+        out.append([RunRequest(case, s, config) for s in specimens])
+    return out
+
+
+def base_specimen(points: Sequence[MeasuredPoint], specimen: Specimen | None) -> Specimen:
+    """The specimen to calibrate: the given one, or the paper's coupon with the points'
+    particle material (all points must name the same one)."""
+    materials = sorted({p.material for p in points})
+    if len(materials) > 1:
+        raise ParameterError(f"measured points name several particle materials {materials}; "
+                             "calibrate one specimen at a time")
+    if specimen is None:
+        return paper_specimen(materials[0])
+    return specimen
+
+
+def calibrate(points: Sequence[MeasuredPoint], *, fit: Sequence[str],
+              store_path: str | os.PathLike, priors: Sequence[str] = (),
+              discrepancy: float | None = None,
+              discrepancy_floor: float = DISCREPANCY_FLOOR,
+              cells: int = CALIBRATION_CELLS, seed: int = defaults.DEM_SEED,
+              steady_cycles: int | None = None, design_size: int | None = None,
+              workers: int = 2, cross_validate: str | None = None, method: str = "auto",
+              progress: bool = True, posterior_seed: int = 0,
+              dem_config: DemConfig | None = None,
+              specimen: Specimen | None = None) -> CalibrationResult:
+    """Fit ``fit`` parameters to measured SDCs (see the package docstring for the model).
+
+    DEM runs go to (and are reused from) the store at ``store_path``. ``discrepancy``: fix the
+    relative model discrepancy instead of fitting it. ``cross_validate="loo"``: also predict
+    every point from a fit without it. ``dem_config``: numerical DEM settings to start from
+    (cells, seed and steady cycles are then set from the arguments). ``specimen``: the
+    specimen to start from (default: the paper's coupon).
+    """
+    start = time.perf_counter()
+    points = list(points)
+    specimen = base_specimen(points, specimen)
+    specs = build_specs(fit, priors, discrepancy=discrepancy, specimen=specimen)
+    check_enough_points(points, len(specs))
+    if cross_validate is not None and cross_validate not in CROSS_VALIDATIONS:
+        raise ParameterError(f"--cross-validate: expected one of {CROSS_VALIDATIONS}, "
+                             f"got {cross_validate!r}")
+    if cross_validate == "loo":
+        check_enough_points(points[1:], len(specs))
+    if not discrepancy_floor >= 0:
+        raise ParameterError(f"--discrepancy-floor: expected >= 0, got {discrepancy_floor}")
+    notes = []
+    if all(p.sdc_stderr == 0 for p in points):
+        notes.append("no sdc_stderr in the data: measurement error is carried by the "
+                     "model-discrepancy term alone")
+    dem_specs = [s for s in specs if s.kind == "dem"]
+    n_design = design_size or default_design_size(len(dem_specs))
+    if dem_specs and n_design < 2:
+        raise ParameterError(f"--design-size: expected >= 2 with DEM parameters, got {n_design}")
+    design = design_points(dem_specs, n_design, seed=seed)
+    config = dataclasses.replace(dem_config or DemConfig(), cells=cells, seed=seed,
+                                 steady_cycles=steady_cycles)
+    requests = _requests(points, dem_specs, design, config, specimen)
+    runs = run_requests([r for row in requests for r in row], store_path=store_path,
+                        workers=workers, progress=progress)
+    from ..store import Store
+
+    store = Store(store_path)
+    observations = []
+    for row in requests:
+        obs = []
+        for request in row:
+            entry = store.get_dem_run(request.key())
+            obs.append(observation_from_run(entry.record, entry.arrays,
+                                            coupon_mass_kg=specimen.coupon.mass_kg))
+        observations.append(obs)
+    surrogates = tuple(build_surrogate(obs, design, dem_specs) for obs in observations)
+    fitted = [s.name for s in specs]
+    fixed = {name: parameter_spec(name, specimen).default for name in CATALOGUE
+             if name not in fitted}
+    if discrepancy is not None:
+        fixed[DISCREPANCY] = float(discrepancy)
+    model = Model(tuple(specs), surrogates, tuple(points), fixed, discrepancy_floor)
+    everything = list(range(len(points)))
+    samples = sample_posterior(model, everything, seed=posterior_seed, method=method)
+    parameters, correlations = summarise(specs, samples)
+    rng = np.random.default_rng(posterior_seed + 1)
+    predictions = [_row(points[i], predictive(model, samples, i, rng=rng)) for i in everything]
+    energy = energy_check(model, samples, specimen)
+    loo = None
+    if cross_validate == "loo":
+        loo = []
+        folds = everything
+        bar = None
+        if progress:
+            from tqdm import tqdm
+
+            bar = tqdm(total=len(folds), unit="fold", desc="leave-one-out", dynamic_ncols=True)
+        try:
+            for i in folds:
+                others = [j for j in everything if j != i]
+                fold = sample_posterior(model, others, seed=posterior_seed + 1 + i,
+                                        method=method)
+                loo.append(_row(points[i], predictive(model, fold, i, rng=rng)))
+                if bar is not None:
+                    bar.update(1)
+        finally:
+            if bar is not None:
+                bar.close()
+    settings = {"fit": list(fit), "priors": list(priors), "cells": cells, "seed": seed,
+                "steady_cycles": steady_cycles, "design_size": n_design, "method": method,
+                "discrepancy_fixed": discrepancy, "discrepancy_floor": discrepancy_floor,
+                "cross_validate": cross_validate, "store": str(store_path)}
+    return CalibrationResult(specimen=specimen, specs=specs, samples=samples, parameters=parameters,
+                             correlations=correlations, predictions=predictions, loo=loo,
+                             fixed=fixed, design=design, observations=observations, runs=runs,
+                             settings=settings, notes=notes, energy_check=energy,
+                             wall_s=time.perf_counter() - start)
+
+
+def energy_check(model: Model, samples: np.ndarray, specimen: Specimen) -> list[dict]:
+    """Energy dissipated per cycle per cell (J) of every load case: the DEM at the starting
+    specimen's values against the calibrated DEM (posterior median and 95 % band).
+
+    Observation parameters do not change the DEM, so without DEM parameters both agree by
+    construction. ``within`` says whether the starting value lies inside the calibrated band,
+    i.e. whether the calibration's change of the physics is within its own uncertainty.
+    """
+    dem = [s for s in model.specs if s.kind == "dem"]
+    start = np.array([[s.default for s in dem]]) if dem else np.zeros((1, 0))
+    theta = model.dem_theta(samples)
+    out = []
+    for surrogate in model.surrogates:
+        omega = 2 * math.pi * surrogate.frequency_hz
+        velocity = surrogate.acceleration_g * STANDARD_GRAVITY / omega
+        per_cell = math.pi * velocity**2 / specimen.cell.count  # Re(P) T = d pi |V|^2
+        e0 = float(surrogate.predict(start)[0][0] * per_cell)
+        e = surrogate.predict(theta)[0] * per_cell
+        low, median, high = (float(v) for v in np.percentile(e, [2.5, 50, 97.5]))
+        out.append({"frequency_hz": surrogate.frequency_hz,
+                    "acceleration_g": surrogate.acceleration_g,
+                    "fill_percent": surrogate.fill_percent,
+                    "energy_per_cycle_per_cell_start_j": e0,
+                    "energy_per_cycle_per_cell_calibrated_j": median,
+                    "low95_j": low, "high95_j": high,
+                    "within": bool(low <= e0 <= high) if dem else True})
+    return out
+
+
+def _row(point: MeasuredPoint, prediction: dict) -> dict:
+    row = {"frequency_hz": point.frequency_hz, "acceleration_g": point.acceleration_g,
+           "fill_percent": point.fill_percent, "measured": point.sdc,
+           "measured_stderr": point.sdc_stderr}
+    row.update(prediction)
+    row["inside95"] = bool(row["low95"] <= point.sdc <= row["high95"])
+    row["error"] = row["predicted"] - point.sdc
+    if not all(math.isfinite(row[k]) for k in ("predicted", "low95", "high95")):
+        raise ParameterError(f"calibration: prediction at {point.label()} is not finite")
+    return row

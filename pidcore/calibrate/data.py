@@ -1,0 +1,126 @@
+"""Measured SDCs to calibrate against: a table (CSV) or the store's analysed measurements.
+
+Table columns (one row per load case): ``frequency_hz``, ``acceleration_g``, ``fill_percent``,
+``sdc`` and optionally ``sdc_stderr``, ``energy_per_cycle_j``, ``material``.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ..errors import InputFileError, ParameterError
+
+REQUIRED_COLUMNS = ("frequency_hz", "acceleration_g", "fill_percent", "sdc")
+OPTIONAL_COLUMNS = ("sdc_stderr", "energy_per_cycle_j", "material")
+
+
+@dataclass(frozen=True)
+class MeasuredPoint:
+    """One measured load case: SDC (Eq. 11) and its standard error (0: not given)."""
+
+    frequency_hz: float
+    acceleration_g: float
+    fill_percent: float
+    sdc: float
+    sdc_stderr: float = 0.0
+    material: str = "acrylic"
+
+    def label(self) -> str:
+        return f"{self.frequency_hz:g} Hz, {self.acceleration_g:g} g, {self.fill_percent:g} %"
+
+
+def read_measured_table(path: str | os.PathLike) -> list[MeasuredPoint]:
+    """Read a measured-SDC table; one-line errors for missing columns or bad values."""
+    path = Path(path)
+    if not path.is_file():
+        raise InputFileError(f"{path}: no such file")
+    try:
+        frame = pd.read_csv(path, comment="#")
+    except (pd.errors.ParserError, UnicodeDecodeError, pd.errors.EmptyDataError) as exc:
+        raise InputFileError(f"{path}: not a readable CSV table ({exc})") from None
+    missing = [c for c in REQUIRED_COLUMNS if c not in frame.columns]
+    if missing:
+        raise InputFileError(f"{path}: missing column(s) {', '.join(missing)}; expected "
+                             f"{', '.join(REQUIRED_COLUMNS)} (optional: "
+                             f"{', '.join(OPTIONAL_COLUMNS)})")
+    points = []
+    for i, row in frame.iterrows():
+        where = f"{path}: row {i + 2}"
+        values = {}
+        for column in REQUIRED_COLUMNS + ("sdc_stderr",):
+            raw = row.get(column, 0.0)
+            if column == "sdc_stderr" and (raw is None or (isinstance(raw, float)
+                                                           and math.isnan(raw))):
+                raw = 0.0
+            try:
+                value = float(raw)
+            except (TypeError, ValueError):
+                raise InputFileError(f"{where}: {column} {raw!r} is not a number") from None
+            if not math.isfinite(value):
+                raise InputFileError(f"{where}: {column} is empty or not finite")
+            values[column] = value
+        if values["frequency_hz"] <= 0 or values["acceleration_g"] <= 0:
+            raise InputFileError(f"{where}: frequency_hz and acceleration_g must be > 0")
+        if not 0 < values["fill_percent"] <= 100:
+            raise InputFileError(f"{where}: fill_percent must be in (0, 100]")
+        if values["sdc"] < 0 or values["sdc_stderr"] < 0:
+            raise InputFileError(f"{where}: sdc and sdc_stderr must be >= 0")
+        material = row.get("material", "acrylic")
+        if not isinstance(material, str) or not material.strip():
+            material = "acrylic"
+        points.append(MeasuredPoint(material=material.strip(), **values))
+    if not points:
+        raise InputFileError(f"{path}: no rows")
+    return points
+
+
+def measured_from_store(store_path: str | os.PathLike) -> list[MeasuredPoint]:
+    """Analysed measurements of a store, grouped per load case (mean SDC, standard error).
+
+    A load case measured several times gives the mean and the standard error of the mean
+    (or the analysis's own standard error when measured once). Measured frequency and
+    acceleration are rounded to 3 and 2 significant digits to find the load case; the
+    analyses must carry ``fill_percent`` (from a sidecar).
+    """
+    from ..store import Store
+
+    frame = Store(store_path).list_analyses()
+    need = {"frequency_hz", "sdc"}
+    if frame.empty or not need <= set(frame.columns):
+        raise InputFileError(f"{store_path}: no analysed measurements with frequency_hz and sdc")
+    for column in ("acceleration_g", "fill_percent"):
+        if column not in frame.columns:
+            raise InputFileError(f"{store_path}: analyses carry no {column}; calibrate from a "
+                                 "table (--data) instead")
+    frame = frame.dropna(subset=["frequency_hz", "acceleration_g", "fill_percent", "sdc"])
+    # measured frequency and acceleration scatter about the nominal ones: a load case is the
+    # frequency to 3 significant digits, the acceleration to 2 (e.g. 50.02 Hz, 4.97 g -> 50, 5)
+    frame = frame.assign(
+        frequency_hz=frame["frequency_hz"].map(lambda v: float(f"{v:.3g}")),
+        acceleration_g=frame["acceleration_g"].map(lambda v: float(f"{v:.2g}")))
+    points = []
+    keys = ["frequency_hz", "acceleration_g", "fill_percent"]
+    for (f, a, p), group in frame.groupby(keys):
+        sdc = group["sdc"].to_numpy(float)
+        if len(sdc) > 1:
+            se = float(np.std(sdc, ddof=1) / math.sqrt(len(sdc)))
+        else:
+            se = float(group.get("sdc_stderr", pd.Series([0.0])).fillna(0.0).iloc[0])
+        points.append(MeasuredPoint(float(f), float(a), float(p), float(sdc.mean()), se))
+    if not points:
+        raise InputFileError(f"{store_path}: no analysed measurement has a complete load case")
+    return points
+
+
+def check_enough_points(points: list[MeasuredPoint], n_parameters: int) -> None:
+    """Refuse fewer measured load cases than fitted parameters."""
+    if len(points) < n_parameters:
+        raise ParameterError(f"{len(points)} measured load case(s) cannot determine "
+                             f"{n_parameters} fitted parameter(s); give at least "
+                             f"{n_parameters} load cases or fit fewer parameters")

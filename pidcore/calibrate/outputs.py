@@ -1,0 +1,213 @@
+"""Outputs of a calibration: calibration.json, the calibrated specimen file, figures and a
+Markdown/HTML summary, written into one directory (each file complete or absent)."""
+
+from __future__ import annotations
+
+import html
+import json
+import math
+import os
+from pathlib import Path
+
+import numpy as np
+
+from .calibrate import CalibrationResult
+
+SPECIMEN_FILE = "calibrated_specimen.toml"
+
+
+def _write_text(path: Path, text: str) -> None:
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_text(text, encoding="utf-8")
+    os.replace(tmp, path)
+
+
+def _json_safe(value):
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    if isinstance(value, dict):
+        return {k: _json_safe(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_json_safe(v) for v in value]
+    if isinstance(value, np.generic):
+        return _json_safe(value.item())
+    return value
+
+
+def document_json(document: dict) -> str:
+    """JSON text of a calibration document (non-finite numbers as null)."""
+    return json.dumps(_json_safe(document), indent=2)
+
+
+def specimen_text(result: CalibrationResult) -> str:
+    """TOML text of the calibrated specimen (every fitted specimen field at its posterior
+    median), headed by comments with the 95 % intervals; any command takes it as --specimen.
+    """
+    lines = ["# pidcore calibrated specimen: posterior medians of `pidcore calibrate`",
+             f"# started from {result.specimen.name} ({result.specimen.source}); "
+             f"fitted: {', '.join(result.settings['fit'])}"]
+    for name, p in result.parameters.items():
+        lines.append(f"#   {name} = {p['median']:.6g}  (95 %: {p['low95']:.4g} .. "
+                     f"{p['high95']:.4g})")
+    if result.loo_rms is not None:
+        lines.append(f"# leave-one-out RMS of the SDC: {result.loo_rms:.4g}")
+    lines.append(f"# in-sample RMS of the SDC: {result.rms:.4g}")
+    return "\n".join(lines) + "\n" + result.calibrated_specimen().to_toml()
+
+
+def _table_rows(rows: list[dict]) -> list[list[str]]:
+    out = []
+    for r in rows:
+        out.append([f"{r['frequency_hz']:g}", f"{r['acceleration_g']:g}",
+                    f"{r['fill_percent']:g}", f"{r['measured']:.3f}", f"{r['predicted']:.3f}",
+                    f"{r['low95']:.3f} .. {r['high95']:.3f}",
+                    f"{r['predicted'] - r['measured']:+.3f}",
+                    "yes" if r["low95"] <= r["measured"] <= r["high95"] else "**no**"])
+    return out
+
+
+_HEAD = ["f [Hz]", "a [g]", "fill [%]", "measured SDC", "predicted SDC", "95 % band",
+         "error", "inside"]
+
+
+def summary_markdown(result: CalibrationResult) -> str:
+    """Markdown summary: parameters, correlations, predictions, LOO table."""
+    lines = ["# Calibration summary", ""]
+    lines.append(f"Fitted: {', '.join(s.name for s in result.specs)}; "
+                 f"{len(result.predictions)} measured load cases; "
+                 f"{result.settings['cells']} cells per DEM run, design of "
+                 f"{result.settings['design_size']} point(s); "
+                 f"runs computed {result.runs['computed']}, cached {result.runs['cached']}; "
+                 f"{result.wall_s:.1f} s.")
+    lines += ["", "| parameter | median | 95 % interval | prior bounds |", "|---|---|---|---|"]
+    for name, p in result.parameters.items():
+        lines.append(f"| {name} | {p['median']:.4g} | {p['low95']:.4g} .. {p['high95']:.4g} | "
+                     f"{p['prior_low']:g} .. {p['prior_high']:g} |")
+    names = [s.name for s in result.specs]
+    lines += ["", "Posterior correlations:", "", "| | " + " | ".join(names) + " |",
+              "|---" * (len(names) + 1) + "|"]
+    for name, row in zip(names, result.correlations, strict=True):
+        lines.append(f"| {name} | " + " | ".join(f"{c:+.2f}" for c in row) + " |")
+    for title, rows in (("In-sample posterior predictions", result.predictions),
+                        ("Leave-one-out predictions", result.loo)):
+        if not rows:
+            continue
+        rms = float(np.sqrt(np.mean([(r["predicted"] - r["measured"]) ** 2 for r in rows])))
+        inside = sum(r["low95"] <= r["measured"] <= r["high95"] for r in rows)
+        lines += ["", f"## {title}: RMS {rms:.3f}, {inside}/{len(rows)} inside the 95 % band",
+                  "", "| " + " | ".join(_HEAD) + " |", "|---" * len(_HEAD) + "|"]
+        lines += ["| " + " | ".join(cells) + " |" for cells in _table_rows(rows)]
+    if any(s.kind == "dem" for s in result.specs):
+        lines += ["", "## Energy per cycle per cell: starting specimen vs calibrated DEM", "",
+                  "| f [Hz] | a [g] | start [J] | calibrated median [J] | 95 % band [J] | "
+                  "start inside |", "|---|---|---|---|---|---|"]
+        for r in result.energy_check:
+            lines.append(f"| {r['frequency_hz']:g} | {r['acceleration_g']:g} | "
+                         f"{r['energy_per_cycle_per_cell_start_j']:.3g} | "
+                         f"{r['energy_per_cycle_per_cell_calibrated_j']:.3g} | "
+                         f"{r['low95_j']:.3g} .. {r['high95_j']:.3g} | "
+                         f"{'yes' if r['within'] else '**no**'} |")
+    if result.notes:
+        lines += ["", "Notes:", ""] + [f"- {n}" for n in result.notes]
+    return "\n".join(lines) + "\n"
+
+
+def summary_html(result: CalibrationResult) -> str:
+    """The Markdown summary's content as a standalone HTML page."""
+    parts = ["<!doctype html><html><head><meta charset='utf-8'><title>Calibration</title>",
+             "<style>body{font-family:sans-serif}td,th{border:1px solid #ccc;padding:2px 6px}"
+             "table{border-collapse:collapse}</style></head><body><h1>Calibration summary</h1>"]
+    parts.append("<table><tr><th>parameter</th><th>median</th><th>95 % interval</th></tr>")
+    for name, p in result.parameters.items():
+        parts.append(f"<tr><td>{html.escape(name)}</td><td>{p['median']:.4g}</td>"
+                     f"<td>{p['low95']:.4g} .. {p['high95']:.4g}</td></tr>")
+    parts.append("</table>")
+    for title, rows in (("In-sample predictions", result.predictions),
+                        ("Leave-one-out predictions", result.loo)):
+        if not rows:
+            continue
+        parts.append(f"<h2>{title}</h2><table><tr>"
+                     + "".join(f"<th>{html.escape(h)}</th>" for h in _HEAD) + "</tr>")
+        for cells in _table_rows(rows):
+            parts.append("<tr>" + "".join(f"<td>{html.escape(c.strip('*'))}</td>"
+                                          for c in cells) + "</tr>")
+        parts.append("</table>")
+    parts.append("<p><img src='predictions.png' alt='measured vs predicted'></p>"
+                 "<p><img src='posterior_pairs.png' alt='posterior pairs'></p></body></html>")
+    return "\n".join(parts)
+
+
+def plot_predictions(result: CalibrationResult, path: Path) -> None:
+    """Measured SDC per load case with the posterior-predictive 95 % bands (and LOO's)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    rows = result.predictions
+    x = np.arange(len(rows))
+    fig, ax = plt.subplots(figsize=(max(6, 0.7 * len(rows)), 4.5), constrained_layout=True)
+    for offset, data, label, color in ((-0.12, rows, "calibrated (all points)", "C0"),
+                                       (0.12, result.loo, "leave-one-out", "C1")):
+        if not data:
+            continue
+        pred = np.array([r["predicted"] for r in data])
+        low = np.array([r["low95"] for r in data])
+        high = np.array([r["high95"] for r in data])
+        ax.errorbar(x + offset, pred, yerr=[pred - low, high - pred], fmt="o", capsize=3,
+                    color=color, label=f"{label}, 95 % band")
+    ax.plot(x, [r["measured"] for r in rows], "k*", ms=10, label="measured")
+    ax.set_xticks(x, [f"{r['frequency_hz']:g} Hz\n{r['acceleration_g']:g} g" for r in rows],
+                  fontsize=8)
+    ax.set_ylabel("SDC [-]")
+    ax.legend(fontsize=8)
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def plot_pairs(result: CalibrationResult, path: Path) -> None:
+    """Posterior pairs: histograms on the diagonal, scatter below it."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    names = [s.name for s in result.specs]
+    k = len(names)
+    fig, axes = plt.subplots(k, k, figsize=(2.6 * k, 2.6 * k), squeeze=False,
+                             constrained_layout=True)
+    s = result.samples
+    for i in range(k):
+        for j in range(k):
+            ax = axes[i][j]
+            if j > i:
+                ax.axis("off")
+            elif i == j:
+                ax.hist(s[:, i], bins=40, color="C0")
+            else:
+                ax.plot(s[:, j], s[:, i], ".", ms=1, alpha=0.3)
+            if i == k - 1:
+                ax.set_xlabel(names[j], fontsize=8)
+            if j == 0 and i > 0:
+                ax.set_ylabel(names[i], fontsize=8)
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+
+
+def write_outputs(result: CalibrationResult, out_dir: str | os.PathLike) -> list[Path]:
+    """Write every output into ``out_dir`` (created); returns the paths written."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    written = []
+    for name, text in (("calibration.json", document_json(result.full_document())),
+                       (SPECIMEN_FILE, specimen_text(result)),
+                       ("summary.md", summary_markdown(result)),
+                       ("summary.html", summary_html(result))):
+        _write_text(out / name, text)
+        written.append(out / name)
+    for name, plot in (("predictions.png", plot_predictions), ("posterior_pairs.png", plot_pairs)):
+        tmp = out / f".{name}.tmp.png"
+        plot(result, tmp)
+        os.replace(tmp, out / name)
+        written.append(out / name)
+    return written

@@ -1,0 +1,143 @@
+"""DEM runs for calibration: one callable (parameter values, load case, cells, seed) -> run,
+cached in the HDF5 store so that a calibration computes every design point once.
+
+The runner is the only place that knows how a named DEM parameter reaches the simulation: it
+becomes a specimen (:meth:`pidcore.specimen.Specimen.with_values` by dotted path), and the run
+goes through the DEM's run cache key (:func:`pidcore.dem.persist.run_key`: load case,
+configuration, specimen hash, code version) and its one save path, so a run stored by
+``pidcore dem run``/``sweep`` or the app is reused here and vice versa.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+
+from ..dem.persist import dem_run_entry, run_key, save_dem_entry
+from ..dem.simulate import DemConfig, LoadCase, simulate_load_case
+from ..specimen import Specimen
+from .parameters import dem_alias_paths
+
+
+def specimen_with(specimen: Specimen, values: Mapping[str, float]) -> Specimen:
+    """``specimen`` with named DEM parameter values set (aliases or dotted paths).
+
+    ``friction`` sets the sliding friction and the static friction to the same value (one
+    Coulomb coefficient, today's model); a ``static_friction`` given as well is then the stick
+    limit, taken as the sliding friction where below it (static >= sliding always).
+    """
+    changes: dict[str, float] = {}
+    # sliding friction first: a static friction set in the same call is checked against it
+    order = sorted(values, key=lambda n: 0 if (dem_alias_paths(n) or ("",))[0]
+                   == "sliding_friction" else 1)
+    for name in order:
+        value = float(values[name])
+        alias = dem_alias_paths(name)
+        if alias is None:
+            changes[name] = value
+            continue
+        field, pairs = alias
+        for pair in pairs:
+            path = f"pairs.{pair}."
+            if field == "sliding_friction":
+                changes[path + "sliding_friction"] = value
+                changes[path + "static_friction"] = value
+            elif field == "static_friction":
+                sliding = changes.get(path + "sliding_friction",
+                                      getattr(specimen.pairs, pair).sliding_friction)
+                changes[path + field] = max(value, sliding)
+            else:
+                changes[path + field] = value
+    if not changes:
+        return specimen
+    return specimen.with_values(changes)
+
+
+@dataclass(frozen=True)
+class RunRequest:
+    """One DEM run of a calibration design: load case, specimen (with the design's values)."""
+
+    case: LoadCase
+    specimen: Specimen
+    config: DemConfig
+
+    def key(self) -> str:
+        """The DEM run cache key (:func:`pidcore.dem.persist.run_key`)."""
+        return run_key(self.case, self.config, self.specimen)
+
+
+def simulate_request(request: RunRequest):
+    """Run one request (in this process); returns the DemResult."""
+    return simulate_load_case(request.case, request.config, specimen=request.specimen)
+
+
+def _run_entry(request: RunRequest) -> tuple[str, dict]:
+    return request.key(), dem_run_entry(simulate_request(request))
+
+
+def _single_thread_worker() -> None:
+    # Parallel over runs; numba threads inside each would oversubscribe the cores.
+    import numba
+
+    numba.set_num_threads(1)
+
+
+def run_requests(requests: Sequence[RunRequest], *, store_path: str | os.PathLike,
+                 workers: int = 2, progress: bool = True,
+                 on_done: Callable[[str], None] | None = None) -> dict[str, float]:
+    """Run every request whose key is not yet in the store, saving each as it finishes.
+
+    An interrupted call (Ctrl-C) keeps every finished run; a re-run skips them. Returns
+    ``{"computed": n, "cached": n, "wall_s": s}``.
+    """
+    from ..store import Store
+
+    start = time.perf_counter()
+    store = Store(store_path)
+    exists = store.path.exists()
+    todo, seen = [], set()
+    for request in requests:
+        key = request.key()
+        if key not in seen and not (exists and store.has_dem_run(key)):
+            todo.append(request)
+        seen.add(key)
+    cached = len(seen) - len(todo)
+    bar = None
+    if progress and todo:
+        from tqdm import tqdm
+
+        bar = tqdm(total=len(todo), unit="run", desc="DEM runs", dynamic_ncols=True)
+
+    def finish(key: str, entry: dict) -> None:
+        save_dem_entry(store, key, entry)
+        if bar is not None:
+            bar.update(1)
+        if on_done is not None:
+            on_done(key)
+
+    try:
+        if workers <= 1 or len(todo) <= 1:
+            for request in todo:
+                finish(*_run_entry(request))
+        elif todo:
+            import multiprocessing
+            from concurrent.futures import ProcessPoolExecutor, as_completed
+
+            # spawn: forking after numba started its threads is unsafe (see dem.sweep)
+            pool = ProcessPoolExecutor(max_workers=min(workers, len(todo)),
+                                       mp_context=multiprocessing.get_context("spawn"),
+                                       initializer=_single_thread_worker)
+            try:
+                futures = [pool.submit(_run_entry, request) for request in todo]
+                for future in as_completed(futures):
+                    finish(*future.result())
+            except BaseException:
+                pool.shutdown(wait=False, cancel_futures=True)
+                raise
+            pool.shutdown()
+    finally:
+        if bar is not None:
+            bar.close()
+    return {"computed": len(todo), "cached": cached, "wall_s": time.perf_counter() - start}

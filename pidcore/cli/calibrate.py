@@ -1,0 +1,101 @@
+"""``pidcore calibrate``: fit specimen parameters to measured SDCs, with uncertainty."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from .. import defaults
+
+DEFAULT_STORE = Path("calibration_store.h5")
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    from ..calibrate.parameters import DEFAULT_FIT, dem_parameter_names
+    from ..calibrate.posterior import DISCREPANCY_FLOOR
+
+    names = ", ".join(["fixture_mass_kg", "baseline_loss_factor", *dem_parameter_names(),
+                       "any numeric specimen field by dotted path"])
+    p = subparsers.add_parser(
+        "calibrate", help="fit DEM/specimen parameters to measured SDCs",
+        description="Fit chosen parameters to measured SDCs (Eq. 11 of the DEM's virtual "
+                    "shaker, with fixture mass and baseline loss factor), with a posterior, "
+                    "95 % intervals and optional leave-one-out cross-validation. DEM runs "
+                    "over a space-filling design are cached in --dem-store.")
+    source = p.add_mutually_exclusive_group(required=True)
+    source.add_argument("--data", metavar="TABLE.csv", type=Path,
+                        help="measured SDCs: frequency_hz, acceleration_g, fill_percent, sdc "
+                             "[, sdc_stderr, energy_per_cycle_j, material]")
+    source.add_argument("--store", metavar="FILE", type=Path,
+                        help="use the analysed measurements of this store, per load case")
+    p.add_argument("--specimen", metavar="FILE", type=Path, default=None,
+                   help="specimen file to start from (default: the paper's coupon)")
+    p.add_argument("--fit", metavar="NAME,...", default=",".join(DEFAULT_FIT),
+                   help=f"parameters to fit (default %(default)s); from: {names}")
+    p.add_argument("--prior", metavar="NAME=LOW:HIGH", action="append", default=[],
+                   help="change a prior: NAME=LOW:HIGH (uniform) or "
+                        "NAME=normal:MU:SD[:LOW:HIGH]; repeatable")
+    p.add_argument("--discrepancy", metavar="TAU", type=float, default=None,
+                   help="fix the relative model discrepancy instead of fitting it")
+    p.add_argument("--discrepancy-floor", metavar="SDC", type=float, default=DISCREPANCY_FLOOR,
+                   help="absolute model-error floor on the SDC (default %(default)s)")
+    p.add_argument("--cells", metavar="K", type=int, default=None,
+                   help="cells per DEM run (default 4)")
+    p.add_argument("--steady-cycles", metavar="N", type=int, default=None,
+                   help="steady cycles measured per DEM run (default: the DEM's)")
+    p.add_argument("--design-size", metavar="N", type=int, default=None,
+                   help="DEM design points (default: enough for a quadratic surrogate)")
+    p.add_argument("--seed", type=int, default=defaults.DEM_SEED, help="DEM seed")
+    p.add_argument("--workers", type=int, default=2, help="DEM processes (default 2)")
+    p.add_argument("--method", choices=("auto", "grid", "emcee"), default="auto",
+                   help="posterior: exact grid (<= 3 quantities) or emcee; auto picks")
+    p.add_argument("--dem-store", metavar="FILE", type=Path, default=DEFAULT_STORE,
+                   help="HDF5 store caching the DEM runs (default %(default)s)")
+    p.add_argument("--cross-validate", choices=("loo",), default=None,
+                   help="leave-one-out: predict each load case from a fit without it")
+    p.add_argument("--out", metavar="DIR", type=Path, default=None,
+                   help="write calibration.json, the calibrated specimen, figures, summary")
+    p.add_argument("--json", action="store_true", help="print the result document on stdout")
+    p.add_argument("--no-progress", action="store_true", help="no progress bars")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..calibrate.calibrate import CALIBRATION_CELLS, calibrate
+    from ..calibrate.data import measured_from_store, read_measured_table
+    from ..calibrate.outputs import document_json, write_outputs
+    from ..calibrate.parameters import parse_fit
+    from ..errors import ParameterError
+    from ..specimen import load_specimen
+
+    specimen = load_specimen(args.specimen) if args.specimen is not None else None
+    fit = parse_fit(args.fit, specimen)
+    cells = CALIBRATION_CELLS if args.cells is None else args.cells
+    if cells < 2:
+        raise ParameterError(f"--cells: expected >= 2 (the ensemble scatter needs two), "
+                             f"got {cells}")
+    points = read_measured_table(args.data) if args.data is not None \
+        else measured_from_store(args.store)
+    result = calibrate(points, fit=fit, priors=args.prior, discrepancy=args.discrepancy,
+                       discrepancy_floor=args.discrepancy_floor, store_path=args.dem_store,
+                       cells=cells, seed=args.seed, steady_cycles=args.steady_cycles,
+                       design_size=args.design_size, workers=args.workers,
+                       cross_validate=args.cross_validate, method=args.method,
+                       progress=not args.no_progress, specimen=specimen)
+    if args.out is not None:
+        write_outputs(result, args.out)
+    for note in result.notes:
+        print(f"pidcore calibrate: note: {note}", file=sys.stderr)
+    if args.json:
+        print(document_json(result.document()))
+    else:
+        for name, p in result.parameters.items():
+            print(f"{name}: {p['median']:.4g} (95 % {p['low95']:.4g} .. {p['high95']:.4g})")
+        print(f"in-sample RMS {result.rms:.4f}")
+        if result.loo is not None:
+            print(f"leave-one-out RMS {result.loo_rms:.4f}, {result.loo_coverage}/"
+                  f"{len(result.loo)} inside the 95 % band")
+        if args.out is not None:
+            print(f"wrote {args.out}")
+    return 0

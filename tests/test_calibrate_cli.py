@@ -1,0 +1,155 @@
+"""``pidcore calibrate``: bad input refused in one line (exit 2, nothing written), the --json
+document, leave-one-out independence, and Ctrl-C keeping finished DEM runs."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import pytest
+
+from pidcore.calibrate import MeasuredPoint, calibrate
+from pidcore.calibrate.runner import RunRequest, run_requests
+from pidcore.cli import main
+from pidcore.dem.simulate import DemConfig, LoadCase
+from pidcore.specimen import load_specimen, paper_specimen
+from pidcore.store import Store
+
+HEADER = "frequency_hz,acceleration_g,fill_percent,sdc\n"
+ROWS = "500,5,50,0.6\n1000,5,50,0.6\n500,1,50,0.2\n"
+TINY = ["--cells", "2", "--steady-cycles", "10", "--workers", "1", "--no-progress"]
+
+
+def _table(tmp_path, text=HEADER + ROWS):
+    path = tmp_path / "m.csv"
+    path.write_text(text)
+    return path
+
+
+def _refused(capsys, tmp_path, argv, *words):
+    store = tmp_path / "dem.h5"
+    code = main(["calibrate", *argv, "--dem-store", str(store), *TINY])
+    err = capsys.readouterr().err.strip()
+    assert code == 2
+    assert len(err.splitlines()) == 1, err
+    for word in words:
+        assert word in err, err
+    assert not store.exists()  # nothing computed or written before the input was checked
+
+
+def test_missing_column_is_refused(capsys, tmp_path):
+    path = _table(tmp_path, "frequency_hz,acceleration_g,sdc\n500,5,0.6\n")
+    _refused(capsys, tmp_path, ["--data", str(path)], "m.csv", "fill_percent")
+
+
+def test_unknown_parameter_is_refused(capsys, tmp_path):
+    _refused(capsys, tmp_path, ["--data", str(_table(tmp_path)), "--fit", "fixture_mass,friction"],
+             "fixture_mass")
+
+
+def test_bounds_excluding_the_prior_are_refused(capsys, tmp_path):
+    _refused(capsys, tmp_path, ["--data", str(_table(tmp_path)), "--fit", "friction",
+                                "--prior", "friction=normal:0.9:0.1:0.05:0.8"],
+             "friction", "exclude")
+    _refused(capsys, tmp_path, ["--data", str(_table(tmp_path)), "--prior",
+                                "fixture_mass_kg=0.5:0.1"], "fixture_mass_kg", "empty")
+
+
+def test_fewer_load_cases_than_parameters_are_refused(capsys, tmp_path):
+    # two points cannot fix fixture mass, baseline and the model discrepancy
+    path = _table(tmp_path, HEADER + "500,5,50,0.6\n1000,5,50,0.6\n")
+    _refused(capsys, tmp_path, ["--data", str(path)], "2 measured load case")
+
+
+@pytest.fixture(scope="module")
+def tiny_store(tmp_path_factory):
+    return tmp_path_factory.mktemp("cal") / "dem.h5"
+
+
+def test_json_document(capsys, tmp_path, tiny_store):
+    code = main(["calibrate", "--data", str(_table(tmp_path)), "--fit", "fixture_mass_kg",
+                 "--discrepancy", "0.2", "--cross-validate", "loo", "--json",
+                 "--dem-store", str(tiny_store), "--out", str(tmp_path / "out"), *TINY])
+    assert code == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert set(doc) == {"parameters", "predictions", "loo", "loo_rms"}
+    assert set(doc["parameters"]) == {"fixture_mass_kg"}
+    p = doc["parameters"]["fixture_mass_kg"]
+    assert set(p) == {"median", "low95", "high95"} and p["low95"] <= p["median"] <= p["high95"]
+    keys = {"frequency_hz", "acceleration_g", "fill_percent", "measured", "predicted", "low95",
+            "high95"}
+    assert len(doc["predictions"]) == len(doc["loo"]) == 3
+    assert all(set(r) == keys for r in doc["predictions"] + doc["loo"])
+    rms = math.sqrt(sum((r["predicted"] - r["measured"]) ** 2 for r in doc["loo"]) / 3)
+    assert doc["loo_rms"] == pytest.approx(rms, rel=1e-12)
+    out = tmp_path / "out"
+    full = json.loads((out / "calibration.json").read_text())
+    assert full["loo_rms"] == doc["loo_rms"]
+    # no DEM parameter fitted: the calibrated DEM's energy per cycle is the starting one
+    for row in full["energy_check"]:
+        assert row["energy_per_cycle_per_cell_calibrated_j"] == pytest.approx(
+            row["energy_per_cycle_per_cell_start_j"], rel=1e-12)
+    for name in ("calibrated_specimen.toml", "summary.md", "summary.html", "predictions.png",
+                 "posterior_pairs.png"):
+        assert (out / name).stat().st_size > 0
+    # the calibrated specimen is a valid specimen file holding the fitted value, all else
+    # as the paper's coupon
+    spec = load_specimen(out / "calibrated_specimen.toml")
+    assert spec.coupon.fixture_mass_kg == pytest.approx(p["median"], rel=1e-12)
+    paper = paper_specimen()
+    assert (spec.cell, spec.particles, spec.pairs) == (paper.cell, paper.particles, paper.pairs)
+    assert spec.coupon.mass_kg == paper.coupon.mass_kg
+    assert spec.name == "paper_coupon_calibrated"
+
+
+def test_loo_prediction_never_sees_the_held_out_value(tiny_store):
+    # a fold's prediction must not move when the held-out measurement changes
+    config = DemConfig(steady_cycles=10)
+    points = [MeasuredPoint(500, 5, 50, 0.6), MeasuredPoint(1000, 5, 50, 0.6),
+              MeasuredPoint(500, 1, 50, 0.2)]
+    kw = dict(fit=["fixture_mass_kg"], store_path=tiny_store, discrepancy=0.2, cells=2,
+              steady_cycles=10, dem_config=config, workers=1, progress=False,
+              cross_validate="loo")
+    a = calibrate(points, **kw)
+    changed = list(points)
+    changed[0] = MeasuredPoint(500, 5, 50, 5.0)
+    b = calibrate(changed, **kw)
+    assert b.loo[0]["predicted"] == a.loo[0]["predicted"]
+    assert b.loo[0]["low95"] == a.loo[0]["low95"]
+    assert b.predictions[0]["predicted"] != a.predictions[0]["predicted"]  # the full fit sees it
+
+
+def test_interrupt_keeps_finished_runs(tmp_path):
+    config = DemConfig(cells=2, steady_cycles=10, block_cycles=5, max_transient_cycles=10)
+    requests = [RunRequest(LoadCase(f, 5, 50), paper_specimen(), config)
+                for f in (500.0, 1000.0)]
+    store = tmp_path / "dem.h5"
+
+    def interrupt(key):
+        raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        run_requests(requests, store_path=store, workers=1, progress=False, on_done=interrupt)
+    assert Store(store).has_dem_run(requests[0].key())
+    assert not Store(store).has_dem_run(requests[1].key())
+    again = run_requests(requests, store_path=store, workers=1, progress=False)
+    assert (again["computed"], again["cached"]) == (1, 1)
+
+
+def test_store_measurements_are_grouped_per_load_case(monkeypatch, tmp_path):
+    # repeated tests of one load case (measured f and a scatter about the nominal ones) give
+    # their mean and the standard error of the mean; a single test keeps its own error
+    import pandas as pd
+
+    from pidcore.calibrate import measured_from_store
+
+    frame = pd.DataFrame({"frequency_hz": [50.02, 49.98, 500.1],
+                          "acceleration_g": [4.97, 5.02, 1.01],
+                          "fill_percent": [50.0, 50.0, 50.0],
+                          "sdc": [0.20, 0.26, 0.22], "sdc_stderr": [0.01, 0.01, 0.015]})
+    monkeypatch.setattr(Store, "list_analyses", lambda self: frame)
+    points = {(p.frequency_hz, p.acceleration_g): p for p in measured_from_store(tmp_path / "s.h5")}
+    assert set(points) == {(50.0, 5.0), (500.0, 1.0)}
+    assert points[(50.0, 5.0)].sdc == pytest.approx(0.23)
+    assert points[(50.0, 5.0)].sdc_stderr == pytest.approx(0.03)  # std 0.0424 / sqrt(2)
+    assert points[(500.0, 1.0)].sdc_stderr == pytest.approx(0.015)

@@ -1,0 +1,86 @@
+"""Observation model of the calibration: the DEM's virtual shaker analysed like a measurement."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from pidcore.calibrate.observation import observation_from_run
+from pidcore.calibrate.runner import RunRequest, simulate_request
+from pidcore.dem.persist import dem_run_entry
+from pidcore.dem.simulate import DemConfig, LoadCase
+from pidcore.signal import analyze_power
+from pidcore.specimen import paper_specimen
+
+F_HZ = 200.0
+FS_HZ = F_HZ * 128
+CYCLES = 40
+
+
+def _synthetic(mass_kg: float, damping_n_s_m: float):
+    """Record, arrays of a 'bed' that is a mass plus a viscous damper on the cell."""
+    t = np.arange(CYCLES * 128) / FS_HZ
+    w = 2 * math.pi * F_HZ
+    a_amp = 5 * 9.80665
+    velocity = -a_amp / w * np.cos(w * t)
+    accel = a_amp * np.sin(w * t)
+    force = mass_kg * accel + damping_n_s_m * velocity
+    energy = math.pi * damping_n_s_m * (a_amp / w) ** 2  # per cycle of a viscous damper
+    record = {"frequency_hz": F_HZ, "acceleration_g": 5.0, "fill_percent": 50.0,
+              "sample_rate_hz": FS_HZ, "steady_start_cycle": 0, "coupon_mass_kg": 0.0222,
+              "max_kinetic_energy_j": 1.0, "energy_per_cycle_j": energy}
+    arrays = {"wall_force_n": force, "velocity_m_s": velocity,
+              "sdc_per_cell": np.full(4, energy)}  # x E_max = 1 J: per-cell energy
+    return record, arrays, t, velocity, accel
+
+
+def test_masses_of_a_mass_damper_bed_are_exact():
+    # P = 1/2 (c + i w m) |V|^2, so d = c / w and m_p = m exactly (sampled sine, whole periods)
+    m, c = 0.0153, 2.7
+    record, arrays, *_ = _synthetic(m, c)
+    obs = observation_from_run(record, arrays)
+    w = 2 * math.pi * F_HZ
+    assert obs.dissipative_mass_kg == pytest.approx(c / w, rel=1e-9)
+    assert obs.reactive_mass_kg == pytest.approx(m, rel=1e-9)
+    assert obs.dissipative_mass_stderr_kg == pytest.approx(0.0, abs=1e-12)
+
+
+def test_fixture_mass_and_baseline_equal_eq11_of_the_whole_shaker_force():
+    # a structure of mass m_s with loss factor eta_0 is a mass plus a damper eta_0 w m_s; the
+    # observation model must give what Eq. 11 (analyze_power) gives for the total gauge force
+    m, c, fixture, eta0 = 0.0153, 2.7, 0.08, 0.012
+    record, arrays, t, velocity, accel = _synthetic(m, c)
+    obs = observation_from_run(record, arrays)
+    w = 2 * math.pi * F_HZ
+    m_s = record["coupon_mass_kg"] + fixture
+    total = arrays["wall_force_n"] + m_s * accel + eta0 * w * m_s * velocity
+    measured = analyze_power(total, velocity, FS_HZ, frequency_hz=F_HZ).sdc
+    assert obs.sdc(fixture, eta0) == pytest.approx(measured, rel=1e-7)
+
+
+@pytest.fixture(scope="module")
+def flying_run():
+    case = LoadCase(500.0, 5.0, 50.0)
+    config = DemConfig(cells=2, steady_cycles=20, block_cycles=5, max_transient_cycles=10)
+    return simulate_request(RunRequest(case, paper_specimen(), config))
+
+
+def test_dem_observation_is_eq11_of_the_virtual_shaker(flying_run):
+    # without fixture and baseline the prediction is Eq. 11 of the DEM's own shaker record
+    entry = dem_run_entry(flying_run)
+    obs = observation_from_run(entry["record"], entry["arrays"])
+    sl = flying_run.steady_slice()
+    eq11 = analyze_power(flying_run.shaker_force_n[sl], flying_run.velocity_m_s[sl],
+                         flying_run.sample_rate_hz, frequency_hz=500.0, n_harmonics=1).sdc
+    assert obs.sdc() == pytest.approx(eq11, rel=1e-6)
+    # power closure: Re(P) x T is the dissipation tally per cycle (2 % as in test_dem_simulate)
+    w = 2 * math.pi * 500.0
+    v = 5 * 9.80665 / w
+    assert obs.dissipative_mass_kg * 0.5 * w * v**2 / 500.0 == pytest.approx(
+        flying_run.energy_per_cycle_j, rel=0.02)
+    # a flying bed moves less mass than it weighs: m_p below the particles' mass
+    particles = flying_run.m_c_kg - flying_run.coupon_mass_kg
+    assert obs.reactive_mass_kg < particles
+    assert obs.dissipative_mass_stderr_kg > 0
