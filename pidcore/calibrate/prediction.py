@@ -106,8 +106,19 @@ def load_calibration(path: str | os.PathLike) -> Calibration:
     if not path.is_file():
         raise ParameterError(f"{path}: no such calibration file (expected the calibration.json "
                              "written by pidcore calibrate --out)")
+    calibration = calibration_from_json(path.read_bytes(), path)
+    specimen = path.parent / "calibrated_specimen.toml"
+    return Calibration(path=path, parameters=calibration.parameters,
+                       predictions=calibration.predictions,
+                       specimen_path=specimen if specimen.is_file() else None)
+
+
+def calibration_from_json(text: str | bytes, source: str | os.PathLike) -> Calibration:
+    """A calibration from the text of a ``calibration.json`` (``source`` names it in errors
+    and in :attr:`Calibration.path`); checked as :func:`load_calibration` does."""
+    path = Path(source)
     try:
-        doc = json.loads(path.read_text(encoding="utf-8"))
+        doc = json.loads(text)
     except (UnicodeDecodeError, json.JSONDecodeError) as exc:
         raise ParameterError(f"{path}: not a calibration.json of pidcore calibrate "
                              f"(not JSON: {exc})") from None
@@ -129,6 +140,4 @@ def load_calibration(path: str | os.PathLike) -> Calibration:
         measured = float(measured) if isinstance(measured, (int, float)) else math.nan
         predictions.append(CalibratedPrediction(LoadCase(f, a, fill, str(material)), sdc, low,
                                                 high, measured))
-    specimen = path.parent / "calibrated_specimen.toml"
-    return Calibration(path=path, parameters=doc["parameters"], predictions=tuple(predictions),
-                       specimen_path=specimen if specimen.is_file() else None)
+    return Calibration(path=path, parameters=doc["parameters"], predictions=tuple(predictions))
