@@ -592,3 +592,51 @@ def test_compare_says_when_the_calibration_does_not_predict_the_case(store_file,
     assert not at.exception
     assert any("calibration not shown" in c.value and "calibration.json" in c.value
                for c in at.caption)
+
+
+#: DEM runs of the bundled calibration (`pidcore calibrate ... --dem-store calibration_store.h5`,
+#: ~10 min from empty, gitignored): with it the real library calibrates in seconds.
+CALIBRATION_CACHE = REPO / "calibration_store.h5"
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not CALIBRATION_CACHE.is_file(),
+                    reason="needs the cached DEM runs of calibration_store.h5 (see README)")
+def test_calibrate_page_runs_the_real_library_and_compare_shows_its_band(store_file,
+                                                                         monkeypatch):
+    import shutil
+
+    from pidcore.app.calibration import CALIBRATION_ENV_VAR, runner_for
+    from pidcore.cli import main
+
+    monkeypatch.delenv(CALIBRATION_ENV_VAR, raising=False)
+    shutil.copyfile(CALIBRATION_CACHE, store_file)
+    exports = sorted(str(p) for p in (SAMPLES / "exports").iterdir())
+    assert main(["report", *exports, "--store", str(store_file), "--sidecar",
+                 str(SAMPLES / "loadcases.csv"), "--velocity-delay", "5e-5",
+                 "--format", "csv", "--out", str(store_file.parent / "rep")]) == 0
+    at = _app()
+    fit = ["rolling_friction", "fixture_mass_kg", "baseline_loss_factor"]
+    assert set(fit) <= set(at.multiselect(key="calibration_fit").options)
+    assert "model_discrepancy" not in at.multiselect(key="calibration_fit").options
+    at.multiselect(key="calibration_fit").set_value(fit)
+    at.run()
+    at.button(key="calibration_run").click()
+    at.run()
+    deadline = time.monotonic() + 120  # cached: ~4 s; a cache miss would run DEM for minutes
+    while runner_for(store_file).task.state == "running":
+        assert time.monotonic() < deadline
+        time.sleep(0.2)
+    task = runner_for(store_file).task
+    assert task.state == "done", task.message
+    at.run()
+    assert not at.exception
+    assert "calibration.json" in task.outputs and "calibrated_specimen.toml" in task.outputs
+    # the Compare page now shows this calibration's band for the selected load case (50 Hz 5 g)
+    doc = json.loads(task.outputs["calibration.json"])
+    row = next(r for r in doc["predictions"] if r["frequency_hz"] == 50.0)
+    metrics = {m.label: m.value for m in at.metric}
+    assert metrics["SDC calibrated DEM, Eq. 11 [-]"] == f"{row['predicted']:.4f}"
+    assert any(f"calibrated 95 % band {row['low95']:.4f} .. {row['high95']:.4f}" in c.value
+               for c in at.caption)
+    assert any("Calibrate page" in m.value for m in at.markdown)
