@@ -10,7 +10,7 @@ import pytest
 
 PUBLIC_MODULES = ("pidcore.io", "pidcore.signal", "pidcore.store", "pidcore.dem",
                   "pidcore.model", "pidcore.compare", "pidcore.report", "pidcore.loadcase",
-                  "pidcore.loop")
+                  "pidcore.loop", "pidcore.calibrate")
 
 
 def _public_names() -> list[str]:
@@ -52,3 +52,9 @@ def test_unknown_keyword_arguments_are_rejected():
         DemConfig(cell=4)
     with pytest.raises(TypeError):
         SdcModel.from_table(load_paper_table3(), log_freq=True)
+    from pidcore.calibrate import calibrate, load_calibration
+
+    with pytest.raises(TypeError):  # refused at the call, before any DEM run
+        calibrate([], fit=["fixture_mass_kg"], store_path="unused.h5", cell=4)
+    with pytest.raises(TypeError):
+        load_calibration("calibration.json", tolerance=0.1)

@@ -547,3 +547,96 @@ def test_dem_page_offers_the_specimen_files_and_takes_their_material(store_file,
     assert not at.exception
     want = load_specimen(source).particles.material
     assert at.text_input(key="dem_material_specimen").value == want
+
+
+def _calibration_json(path, f, a, fill, predicted, low, high):
+    doc = {"parameters": {"fixture_mass_kg": {"median": 0.2, "low95": 0.1, "high95": 0.3}},
+           "predictions": [{"frequency_hz": f, "acceleration_g": a, "fill_percent": fill,
+                            "material": "acrylic", "measured": predicted,
+                            "predicted": predicted, "low95": low, "high95": high}]}
+    path.write_text(json.dumps(doc), encoding="utf-8")
+    return path
+
+
+# The mass-damper upload is 100 Hz, 5 g, fill 50 % with loss factor 0.05: Eq. 11 SDC = 2π·0.05
+# = 0.314, so a band 0.10..0.60 holds it and 0.50..0.90 does not (margins far above the noise).
+@pytest.mark.parametrize("predicted, band, verdict", [(0.3456, (0.10, 0.60), "inside"),
+                                                      (0.6789, (0.50, 0.90), "outside")])
+def test_compare_shows_the_calibrated_band_beside_raw_dem_and_measurement(
+        store_file, tmp_path, monkeypatch, predicted, band, verdict):
+    from pidcore.app.calibration import CALIBRATION_ENV_VAR
+
+    cal = _calibration_json(tmp_path / "calibration.json", 100, 5, 50, predicted, *band)
+    monkeypatch.setenv(CALIBRATION_ENV_VAR, str(cal))
+    at = _upload(_app(), [("c_fill50.csv", mass_damper_csv())])
+    metrics = {m.label: m.value for m in at.metric}
+    assert metrics["SDC calibrated DEM, Eq. 11 [-]"] == f"{predicted:.4f}"
+    assert "SDC DEM, raw [-]" in metrics and "SDC measured, Eq. 11 [-]" in metrics
+    captions = " ".join(c.value for c in at.caption)
+    assert f"calibrated 95 % band {band[0]:.4f} .. {band[1]:.4f}" in captions
+    assert f"the measured Eq. 11 SDC is {verdict}." in captions
+
+
+def test_compare_says_when_the_calibration_does_not_predict_the_case(store_file, tmp_path,
+                                                                      monkeypatch):
+    from pidcore.app.calibration import CALIBRATION_ENV_VAR
+
+    cal = _calibration_json(tmp_path / "calibration.json", 500, 5, 50, 0.3, 0.1, 0.6)
+    monkeypatch.setenv(CALIBRATION_ENV_VAR, str(cal))
+    at = _upload(_app(), [("c_fill50.csv", mass_damper_csv())])
+    assert "SDC calibrated DEM, Eq. 11 [-]" not in {m.label for m in at.metric}
+    assert any("calibration does not predict f100" in c.value for c in at.caption)
+    # a foreign file: said on the page, the rest of the page still there
+    cal.write_text('{"runs": 1}', encoding="utf-8")
+    at.run()
+    assert not at.exception
+    assert any("calibration not shown" in c.value and "calibration.json" in c.value
+               for c in at.caption)
+
+
+#: DEM runs of the bundled calibration (`pidcore calibrate ... --dem-store calibration_store.h5`,
+#: ~10 min from empty, gitignored): with it the real library calibrates in seconds.
+CALIBRATION_CACHE = REPO / "calibration_store.h5"
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not CALIBRATION_CACHE.is_file(),
+                    reason="needs the cached DEM runs of calibration_store.h5 (see README)")
+def test_calibrate_page_runs_the_real_library_and_compare_shows_its_band(store_file,
+                                                                         monkeypatch):
+    import shutil
+
+    from pidcore.app.calibration import CALIBRATION_ENV_VAR, runner_for
+    from pidcore.cli import main
+
+    monkeypatch.delenv(CALIBRATION_ENV_VAR, raising=False)
+    shutil.copyfile(CALIBRATION_CACHE, store_file)
+    exports = sorted(str(p) for p in (SAMPLES / "exports").iterdir())
+    assert main(["report", *exports, "--store", str(store_file), "--sidecar",
+                 str(SAMPLES / "loadcases.csv"), "--velocity-delay", "5e-5",
+                 "--format", "csv", "--out", str(store_file.parent / "rep")]) == 0
+    at = _app()
+    fit = ["rolling_friction", "fixture_mass_kg", "baseline_loss_factor"]
+    assert set(fit) <= set(at.multiselect(key="calibration_fit").options)
+    assert "model_discrepancy" not in at.multiselect(key="calibration_fit").options
+    at.multiselect(key="calibration_fit").set_value(fit)
+    at.run()
+    at.button(key="calibration_run").click()
+    at.run()
+    deadline = time.monotonic() + 120  # cached: ~4 s; a cache miss would run DEM for minutes
+    while runner_for(store_file).task.state == "running":
+        assert time.monotonic() < deadline
+        time.sleep(0.2)
+    task = runner_for(store_file).task
+    assert task.state == "done", task.message
+    at.run()
+    assert not at.exception
+    assert "calibration.json" in task.outputs and "calibrated_specimen.toml" in task.outputs
+    # the Compare page now shows this calibration's band for the selected load case (50 Hz 5 g)
+    doc = json.loads(task.outputs["calibration.json"])
+    row = next(r for r in doc["predictions"] if r["frequency_hz"] == 50.0)
+    metrics = {m.label: m.value for m in at.metric}
+    assert metrics["SDC calibrated DEM, Eq. 11 [-]"] == f"{row['predicted']:.4f}"
+    assert any(f"calibrated 95 % band {row['low95']:.4f} .. {row['high95']:.4f}" in c.value
+               for c in at.caption)
+    assert any("Calibrate page" in m.value for m in at.markdown)

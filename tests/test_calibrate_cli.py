@@ -76,8 +76,8 @@ def test_json_document(capsys, tmp_path, tiny_store):
     assert set(doc["parameters"]) == {"fixture_mass_kg"}
     p = doc["parameters"]["fixture_mass_kg"]
     assert set(p) == {"median", "low95", "high95"} and p["low95"] <= p["median"] <= p["high95"]
-    keys = {"frequency_hz", "acceleration_g", "fill_percent", "measured", "predicted", "low95",
-            "high95"}
+    keys = {"frequency_hz", "acceleration_g", "fill_percent", "material", "measured",
+            "predicted", "low95", "high95"}
     assert len(doc["predictions"]) == len(doc["loo"]) == 3
     assert all(set(r) == keys for r in doc["predictions"] + doc["loo"])
     rms = math.sqrt(sum((r["predicted"] - r["measured"]) ** 2 for r in doc["loo"]) / 3)

@@ -11,10 +11,11 @@ calibration started again reuses them.
 from __future__ import annotations
 
 import importlib
+import os
 import tempfile
 import threading
 import time
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -41,6 +42,14 @@ def calibration_api() -> tuple[object | None, str]:
     if missing:
         return None, f"{CALIBRATE_MODULE} lacks {', '.join(missing)}"
     return module, ""
+
+
+def fittable_names(api) -> list[str]:
+    """Names the page offers to fit: the library's observation parameters (not the
+    discrepancy hyperparameter, which is always fitted) and its named DEM parameters."""
+    names = [n for n, spec in api.CATALOGUE.items() if getattr(spec, "kind", "") != "hyper"]
+    dem = getattr(api, "dem_parameter_names", None)
+    return sorted(names) + (list(dem()) if dem is not None else [])
 
 
 @dataclass
@@ -104,3 +113,46 @@ def runner_for(store_path: str | Path) -> CalibrationRunner:
     key = str(Path(store_path).resolve())
     with _RUNNERS_LOCK:
         return _RUNNERS.setdefault(key, CalibrationRunner(key))
+
+
+#: Environment variable naming the calibration.json the Compare page shows (optional).
+CALIBRATION_ENV_VAR = "PIDCORE_CALIBRATION"
+#: The bundled calibration of the paper's 12 measured points, relative to the working folder.
+BUNDLED_CALIBRATION = Path("data_samples") / "paper_calibration" / "calibration.json"
+
+
+def calibration_path(environ: Mapping[str, str] | None = None, *,
+                     cwd: Path | None = None) -> Path | None:
+    """``$PIDCORE_CALIBRATION``, else the bundled :data:`BUNDLED_CALIBRATION` if it exists in
+    the working folder, else None."""
+    env = os.environ if environ is None else environ
+    value = env.get(CALIBRATION_ENV_VAR, "").strip()
+    if value:
+        return Path(value)
+    bundled = (cwd or Path.cwd()) / BUNDLED_CALIBRATION
+    return bundled if bundled.is_file() else None
+
+
+def active_calibration(task: CalibrationTask | None, environ: Mapping[str, str] | None = None,
+                       *, cwd: Path | None = None):
+    """``(calibration, label)`` the Compare page shows: the Calibrate page's finished
+    calibration of this store if there is one, else :func:`calibration_path`'s file; ``(None,
+    reason)`` when there is none or it cannot be read (the reason is shown)."""
+    from ..calibrate.prediction import calibration_from_json, load_calibration
+    from ..errors import PidcoreError
+
+    try:
+        if task is not None and task.state == "done" and "calibration.json" in task.outputs:
+            return (calibration_from_json(task.outputs["calibration.json"],
+                                          "calibration.json (Calibrate page)"),
+                    f"this store's calibration on the Calibrate page ({', '.join(task.fit)})")
+        path = calibration_path(environ, cwd=cwd)
+        if path is None:
+            return None, ("no calibration: run one on the Calibrate page (or set "
+                          f"{CALIBRATION_ENV_VAR})")
+        label = ("the bundled calibration of the paper's 12 measured points"
+                 if path.name == BUNDLED_CALIBRATION.name and path.parent.name ==
+                 BUNDLED_CALIBRATION.parent.name else str(path))
+        return load_calibration(path), label
+    except PidcoreError as exc:
+        return None, f"calibration not shown: {exc}"

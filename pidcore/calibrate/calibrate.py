@@ -129,8 +129,8 @@ class CalibrationResult:
 
 
 def _public(row: dict) -> dict:
-    keys = ("frequency_hz", "acceleration_g", "fill_percent", "measured", "predicted",
-            "low95", "high95")
+    keys = ("frequency_hz", "acceleration_g", "fill_percent", "material", "measured",
+            "predicted", "low95", "high95")
     return {k: row[k] for k in keys}
 
 
@@ -290,7 +290,8 @@ def energy_check(model: Model, samples: np.ndarray, specimen: Specimen) -> list[
 
 def _row(point: MeasuredPoint, prediction: dict) -> dict:
     row = {"frequency_hz": point.frequency_hz, "acceleration_g": point.acceleration_g,
-           "fill_percent": point.fill_percent, "measured": point.sdc,
+           "fill_percent": point.fill_percent, "material": point.material,
+           "measured": point.sdc,
            "measured_stderr": point.sdc_stderr}
     row.update(prediction)
     row["inside95"] = bool(row["low95"] <= point.sdc <= row["high95"])

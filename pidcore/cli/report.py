@@ -15,7 +15,8 @@ from ._options import add_measurement_options, add_store_option, analysis_option
 #: Columns of the short table printed on stdout.
 _STDOUT_COLUMNS = (
     "frequency [Hz]", "acceleration [g]", "packing ratio [%]", "SDC DEM (ours) [-]",
-    "SDC measured [-]", "SDC DEM (paper) [-]", "SDC measured (paper) [-]",
+    "SDC measured [-]", "SDC calibrated DEM (Eq. 11) [-]", "calibrated low 95 % [-]",
+    "calibrated high 95 % [-]", "SDC DEM (paper) [-]", "SDC measured (paper) [-]",
     "alignment [grid/interpolated/out_of_range]",
 )
 
@@ -56,6 +57,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help="pool DEM runs of different numerical settings and measurements of "
                         "different specimens at one load case into one row (default: a row "
                         "each)")
+    p.add_argument("--calibration", metavar="FILE", type=Path, default=None,
+                   help="calibration.json of pidcore calibrate: add the calibrated DEM's Eq. 11 "
+                        "SDC with its 95 %% band beside the raw DEM and the measurement")
     add_measurement_options(p)
     p.set_defaults(func=run)
 
@@ -69,7 +73,7 @@ def run(args: argparse.Namespace) -> int:
         args.files, out_dir=args.out, store=args.store, dem_store=args.dem_store,
         formats=args.format, fill_percent=args.fill, material=args.material,
         direction=args.direction, sidecar=args.sidecar, options=analysis_options(args),
-        specimen=specimen, pool=args.pool)
+        specimen=specimen, pool=args.pool, calibration=args.calibration)
     print(short_table(result.table))
     for note in result.notes:
         print(f"note: {note}")

@@ -29,7 +29,13 @@ from ..constants import REPORT_FORMATS
 from ..errors import StoreError
 from .provenance import collect_provenance
 from .render import check_out_dir, parse_formats, write_report
-from .table import build_report_table
+from .table import (
+    CALIBRATED_COLUMN,
+    CALIBRATED_INSIDE_COLUMN,
+    NOT_COMPARED,
+    add_calibration_columns,
+    build_report_table,
+)
 
 if TYPE_CHECKING:  # pragma: no cover
     from ..loop import ForceDisplacementLoop
@@ -261,7 +267,8 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
                 direction: str | None = None, sidecar: str | Path | None = None,
                 options: AnalysisOptions | None = None,
                 tolerances: Tolerances | None = None, specimen=None,
-                pool: bool = False) -> ReportResult:
+                pool: bool = False,
+                calibration: str | Path | None = None) -> ReportResult:
     """Analyse files, store them, align with DEM and the paper, and write the report.
 
     Parameters
@@ -290,6 +297,10 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
     pool : bool
         Pool DEM runs of different settings and measurements of different specimens at one
         load case (default: separate rows; see :func:`pidcore.report.build_report_table`).
+    calibration : path, optional
+        A ``calibration.json`` of ``pidcore calibrate``: each row it predicts gets the
+        calibrated DEM's Eq. 11 SDC with its 95 % band and whether the measured Eq. 11 SDC
+        lies inside (:func:`pidcore.report.table.add_calibration_columns`).
 
     Returns
     -------
@@ -299,6 +310,11 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
     from ..model import load_paper_table3
 
     formats = parse_formats(formats)
+    calibrated = None
+    if calibration is not None:  # checked before anything is analysed or written
+        from ..calibrate.prediction import load_calibration
+
+        calibrated = load_calibration(calibration)
     out_dir = Path(out_dir)
     check_out_dir(out_dir)
     tolerances = tolerances or Tolerances()
@@ -358,6 +374,14 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
                      "Table 3 is not compared")
     table = build_report_table(dem_runs, analyses, paper, tolerances=tolerances, pool=pool)
     notes.extend(table.attrs.get("notes", []))
+    if calibrated is not None:
+        table = add_calibration_columns(table, calibrated, tolerances=tolerances)
+        predicted = int(table[CALIBRATED_COLUMN].notna().sum())
+        verdict = table[CALIBRATED_INSIDE_COLUMN]
+        compared, inside = int((verdict != NOT_COMPARED).sum()), int((verdict == "yes").sum())
+        notes.append(f"calibration {calibrated.path}: predicts {predicted} of {len(table)} "
+                     f"row(s); measured Eq. 11 SDC inside the 95 % band at {inside} of "
+                     f"{compared} measured row(s)")
     aligner = Aligner(dem_cases(dem_runs, tolerances=tolerances, pool_settings=pool)
                       if dem_runs is not None else [],
                       paper, None, tolerances)

@@ -295,3 +295,68 @@ def _sort_like_table3(table: pd.DataFrame, aligner: Aligner, paper: pd.DataFrame
     })
     order = keys.sort_values(list(keys.columns), kind="stable").index
     return table.loc[order].reset_index(drop=True)
+
+
+#: Columns added by :func:`add_calibration_columns` (after "SDC measured [-]").
+CALIBRATED_COLUMN = "SDC calibrated DEM (Eq. 11) [-]"
+CALIBRATED_LOW_COLUMN = "calibrated low 95 % [-]"
+CALIBRATED_HIGH_COLUMN = "calibrated high 95 % [-]"
+#: ``not compared`` rather than ``n/a``: pandas.read_csv would read ``n/a`` back as NaN.
+NOT_COMPARED = "not compared"
+CALIBRATED_INSIDE_COLUMN = "measured in calibrated 95 % band [yes/no/not compared]"
+CALIBRATION_COLUMNS: tuple[str, ...] = (CALIBRATED_COLUMN, CALIBRATED_LOW_COLUMN,
+                                        CALIBRATED_HIGH_COLUMN, CALIBRATED_INSIDE_COLUMN)
+
+
+def add_calibration_columns(table: pd.DataFrame, calibration, *,
+                            tolerances=None) -> pd.DataFrame:
+    """A copy of a report table with the calibrated DEM's prediction beside each row.
+
+    Like for like: the calibration predicts the Eq. 11 SDC a shaker test of the DEM would
+    measure, so the band is compared with ``SDC measured [-]`` (Eq. 11), not with Eq. 10.
+    Rows whose load case the calibration does not predict (material, and frequency,
+    acceleration, fill within ``tolerances``) get empty numbers, ``not compared`` and a note
+    saying so.
+
+    Parameters
+    ----------
+    table : DataFrame
+        From :func:`build_report_table`.
+    calibration : pidcore.calibrate.prediction.Calibration
+        From :func:`pidcore.calibrate.prediction.load_calibration`.
+    tolerances : Tolerances, optional
+        Grid-match tolerances (default: the report's).
+    """
+    out = table.copy()
+    sdc, low, high, inside, notes = [], [], [], [], []
+    for _, row in out.iterrows():
+        note = str(row.get("note", "") or "")
+        case = LoadCase(float(row["frequency [Hz]"]), float(row["acceleration [g]"]),
+                        float(row["packing ratio [%]"]), str(row.get("material") or "acrylic"))
+        hit = calibration.lookup(case, tolerances=tolerances)
+        if hit is None:
+            sdc.append(math.nan)
+            low.append(math.nan)
+            high.append(math.nan)
+            inside.append(NOT_COMPARED)
+            extra = f"not predicted by the calibration {calibration.path.name}"
+        else:
+            sdc.append(hit.sdc)
+            low.append(hit.low95)
+            high.append(hit.high95)
+            measured = row.get("SDC measured [-]", math.nan)
+            if measured is None or not math.isfinite(float(measured)):
+                inside.append(NOT_COMPARED)
+                extra = "no Eq. 11 measurement to compare with the calibrated band"
+            else:
+                inside.append("yes" if hit.contains(float(measured)) else "no")
+                extra = ""
+        notes.append("; ".join(n for n in (note, extra) if n))
+    at = list(out.columns).index("SDC measured [-]") + 1 if "SDC measured [-]" in out.columns \
+        else len(out.columns)
+    for offset, (name, values) in enumerate(zip(CALIBRATION_COLUMNS, (sdc, low, high, inside),
+                                                strict=True)):
+        out.insert(at + offset, name, values)
+    out["note"] = notes
+    out.attrs = dict(table.attrs)
+    return out

@@ -9,7 +9,7 @@ from pathlib import Path
 import pandas as pd
 import streamlit as st
 
-from pidcore.app.calibration import calibration_api, runner_for
+from pidcore.app.calibration import calibration_api, fittable_names, runner_for
 
 
 @st.fragment(run_every=2.0)
@@ -67,13 +67,14 @@ def render(stores) -> None:
     st.dataframe(pd.DataFrame([dataclasses.asdict(p) for p in points]), hide_index=True,
                  width="stretch", key="calibration_points")
     c1, c2, c3 = st.columns(3)
-    chosen = c1.multiselect("parameters to fit", sorted(api.CATALOGUE),
-                            default=[n for n in api.parse_fit(None) if n in api.CATALOGUE],
+    fittable = fittable_names(api)
+    chosen = c1.multiselect("parameters to fit", fittable,
+                            default=[n for n in api.parse_fit(None) if n in fittable],
                             key="calibration_fit")
     extra = c1.text_input("more parameters (specimen fields, comma-separated)", "",
                           key="calibration_fit_extra",
                           help="e.g. friction, restitution (as `pidcore calibrate --fit`)")
-    cells = c2.number_input("cells per DEM run", min_value=1, max_value=64, value=4,
+    cells = c2.number_input("cells per DEM run", min_value=2, max_value=64, value=4,
                             key="calibration_cells")
     design = c3.number_input("design points (0 = default)", min_value=0, value=0,
                              key="calibration_design")

@@ -45,6 +45,34 @@ def _group_key(members) -> str:
     return "|".join(f"{e.key}:{e.load_case.key}:{e.specimen}:{e.sdc!r}" for e in members)
 
 
+def _calibrated(stores, comp, head) -> None:
+    """The calibrated DEM's Eq. 11 SDC with its 95 % band beside the raw DEM and the measured
+    Eq. 11 SDC (like for like: the calibration predicts what a shaker test of the DEM would
+    measure with Eq. 11)."""
+    from pidcore.app.calibration import active_calibration, runner_for
+
+    calibration, label = active_calibration(runner_for(stores.path).task)
+    if calibration is None:
+        st.caption(label)
+        return
+    hit = calibration.lookup(comp.load_case)
+    st.markdown("**calibrated DEM** (" + label + ")")
+    if hit is None:
+        st.caption(f"The calibration does not predict {comp.load_case.key} (it predicts "
+                   f"{len(calibration.predictions)} measured load case(s)).")
+        return
+    c1, c2, c3 = st.columns(3)
+    c1.metric("SDC measured, Eq. 11 [-]",
+              uploads.format_sdc(comp.measured_sdc, comp.measured_stderr))
+    c2.metric("SDC DEM, raw [-]", f"{head.dem:.4f}" if math.isfinite(head.dem) else "none")
+    c3.metric("SDC calibrated DEM, Eq. 11 [-]", f"{hit.sdc:.4f}",
+              help=f"95 % band {hit.low95:.4f} .. {hit.high95:.4f}")
+    verdict = ("inside" if hit.contains(comp.measured_sdc) else "outside") \
+        if math.isfinite(comp.measured_sdc) else "not compared (no Eq. 11 SDC)"
+    st.caption(f"calibrated 95 % band {hit.low95:.4f} .. {hit.high95:.4f}; the measured "
+               f"Eq. 11 SDC is {verdict}.")
+
+
 def render(stores, session_files: list) -> None:
     """The page."""
     from pidcore.errors import PidcoreError
@@ -99,6 +127,7 @@ def render(stores, session_files: list) -> None:
                   if math.isfinite(aligned.sdc_paper_dem) else "not a Table 3 case")
         c3.metric("SDC paper measured [-]", f"{aligned.sdc_paper_experimental:.4f}"
                   if math.isfinite(aligned.sdc_paper_experimental) else "not a Table 3 case")
+    _calibrated(stores, comp, head)
     for note in view["notes"]:
         st.caption(f"note: {note}")
     left, right = st.columns(2)

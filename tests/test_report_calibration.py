@@ -1,0 +1,157 @@
+"""``pidcore report --calibration``: the calibrated DEM's Eq. 11 SDC and 95 % band per row.
+
+The calibration files here are written by hand (three load cases, known bands), so every
+expected value is read off the file, not recomputed.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+from pidcore.calibrate.prediction import load_calibration
+from pidcore.cli import main
+from pidcore.compare import Tolerances
+from pidcore.errors import ParameterError
+from pidcore.loadcase import LoadCase
+from pidcore.report.table import (
+    CALIBRATED_COLUMN,
+    CALIBRATED_HIGH_COLUMN,
+    CALIBRATED_INSIDE_COLUMN,
+    CALIBRATED_LOW_COLUMN,
+    NOT_COMPARED,
+    add_calibration_columns,
+)
+
+ROOT = Path(__file__).resolve().parents[1]
+BUNDLED = ROOT / "data_samples" / "paper_calibration" / "calibration.json"
+
+
+def _prediction(f, a, fill, pred, low, high, material="acrylic"):
+    return {"frequency_hz": f, "acceleration_g": a, "fill_percent": fill, "material": material,
+            "measured": pred, "predicted": pred, "low95": low, "high95": high}
+
+
+def _write(path, predictions, **extra):
+    doc = {"parameters": {"rolling_friction": {"median": 0.05, "low95": 0.01, "high95": 0.1}},
+           "predictions": predictions, **extra}
+    path.write_text(json.dumps(doc), encoding="utf-8")
+    return path
+
+
+@pytest.fixture
+def calibration_file(tmp_path):
+    return _write(tmp_path / "calibration.json", [
+        _prediction(50, 5, 50, 0.24, 0.05, 0.43),
+        _prediction(500, 5, 50, 0.49, 0.12, 0.88),
+        _prediction(100, 1, 50, 0.09, 0.02, 0.20, material="steel"),
+    ])
+
+
+def test_lookup_within_tolerances_and_material(calibration_file):
+    cal = load_calibration(calibration_file)
+    # 1 % in frequency is COMPARE_FREQUENCY_RTOL: 50.4 Hz is the 50 Hz case, 51 Hz is not
+    hit = cal.lookup(LoadCase(50.4, 5.0, 50.0))
+    assert hit is not None and hit.sdc == 0.24 and (hit.low95, hit.high95) == (0.05, 0.43)
+    assert cal.lookup(LoadCase(51.0, 5.0, 50.0)) is None
+    assert cal.lookup(LoadCase(500.0, 5.0, 75.0)) is None          # other fill
+    assert cal.lookup(LoadCase(100.0, 1.0, 50.0)) is None          # acrylic vs steel
+    assert cal.lookup(LoadCase(100.0, 1.0, 50.0, "steel")).sdc == 0.09
+    # a wider tolerance admits 51 Hz
+    assert cal.lookup(LoadCase(51.0, 5.0, 50.0),
+                      tolerances=Tolerances(frequency_rtol=0.05)).sdc == 0.24
+
+
+def test_band_membership_bounds_included(calibration_file):
+    hit = load_calibration(calibration_file).lookup(LoadCase(50, 5, 50))
+    assert hit.contains(0.05) and hit.contains(0.43) and hit.contains(0.2)
+    assert not hit.contains(0.0499) and not hit.contains(0.431) and not hit.contains(math.nan)
+
+
+@pytest.mark.parametrize("content, words", [
+    (None, "no such calibration file"),
+    ("not json {", "not JSON"),
+    ('{"runs": []}', "non-empty 'predictions'"),
+    ('{"parameters": {}, "predictions": [{"frequency_hz": 50}]}', "must have"),
+    (json.dumps({"parameters": {}, "predictions": [_prediction(50, 5, 50, 0.5, 0.6, 0.9)]}),
+     "low95 <= predicted <= high95"),
+    (json.dumps({"parameters": {}, "predictions": [_prediction(50, 5, 50, None, 0.1, 0.9)]}),
+     "finite number"),
+])
+def test_bad_calibration_file_is_refused(tmp_path, content, words):
+    path = tmp_path / "calibration.json"
+    if content is not None:
+        path.write_text(content, encoding="utf-8")
+    with pytest.raises(ParameterError, match=words) as err:
+        load_calibration(path)
+    assert str(path) in str(err.value) and "\n" not in str(err.value)
+
+
+def _table():
+    return pd.DataFrame({
+        "frequency [Hz]": [50.0, 500.0, 1000.0, 50.0],
+        "acceleration [g]": [5.0, 5.0, 5.0, 5.0],
+        "packing ratio [%]": [50.0, 50.0, 50.0, 75.0],
+        "material": ["acrylic"] * 4,
+        "SDC measured [-]": [0.30, 1.2, 0.5, math.nan],
+        "SDC measured stderr [-]": [0.01] * 4,
+        "note": ["", "kept note", "", ""],
+    })
+
+
+def test_calibration_columns_per_row(calibration_file):
+    out = add_calibration_columns(_table(), load_calibration(calibration_file))
+    assert out[CALIBRATED_COLUMN].iloc[0] == 0.24
+    assert (out[CALIBRATED_LOW_COLUMN].iloc[1], out[CALIBRATED_HIGH_COLUMN].iloc[1]) == (0.12,
+                                                                                          0.88)
+    # 0.30 inside 0.05..0.43; 1.2 above 0.88; 1000 Hz not predicted; 75 % not predicted
+    assert out[CALIBRATED_INSIDE_COLUMN].tolist() == ["yes", "no", NOT_COMPARED, NOT_COMPARED]
+    assert math.isnan(out[CALIBRATED_COLUMN].iloc[2]) and math.isnan(out[CALIBRATED_COLUMN].iloc[3])
+    assert "not predicted by the calibration" in out["note"].iloc[2]
+    assert out["note"].iloc[1] == "kept note"
+    # the band sits right after the measured Eq. 11 SDC
+    cols = list(out.columns)
+    assert cols[cols.index("SDC measured [-]") + 1] == CALIBRATED_COLUMN
+
+
+def test_cli_report_csv_reads_back_with_band(tmp_path, calibration_file, capsys):
+    out = tmp_path / "report"
+    rc = main(["report", "--dem-store", str(ROOT / "data_samples" / "dem_table3.h5"),
+               "--calibration", str(calibration_file), "--format", "csv", "--out", str(out)])
+    assert rc == 0
+    table = pd.read_csv(out / "report.csv")
+    for col in (CALIBRATED_COLUMN, CALIBRATED_LOW_COLUMN, CALIBRATED_HIGH_COLUMN,
+                CALIBRATED_INSIDE_COLUMN):
+        assert col in table.columns
+    # every verdict reads back as text (no NaN from 'n/a'); no measurements: none compared
+    assert set(table[CALIBRATED_INSIDE_COLUMN]) == {NOT_COMPARED}
+    predicted = table[table[CALIBRATED_COLUMN].notna()]
+    assert len(predicted) == 2  # the two acrylic cases of the file
+    assert (predicted[CALIBRATED_LOW_COLUMN] <= predicted[CALIBRATED_COLUMN]).all()
+    assert table.loc[table[CALIBRATED_COLUMN].isna(), "note"].str.contains(
+        "not predicted by the calibration").all()
+
+
+def test_cli_refuses_foreign_file_and_writes_nothing(tmp_path, capsys):
+    out = tmp_path / "report"
+    foreign = _write(tmp_path / "x.json", [])
+    rc = main(["report", "--dem-store", str(ROOT / "data_samples" / "dem_table3.h5"),
+               "--calibration", str(foreign), "--out", str(out)])
+    err = capsys.readouterr().err.strip()
+    assert rc == 2 and not out.exists()
+    assert len(err.splitlines()) == 1 and "x.json" in err
+
+
+def test_bundled_calibration_predicts_the_paper_points():
+    cal = load_calibration(BUNDLED)
+    measured = pd.read_csv(ROOT / "data_samples" / "paper_measured_sdc.csv", comment="#")
+    assert len(cal.predictions) == len(measured) == 12
+    for _, row in measured.iterrows():
+        hit = cal.lookup(LoadCase(row.frequency_hz, row.acceleration_g, row.fill_percent,
+                                  row.material))
+        assert hit is not None and hit.measured == pytest.approx(row.sdc)
+    assert cal.specimen_path is not None and cal.specimen_path.is_file()
