@@ -7,6 +7,7 @@ import json
 import sys
 from pathlib import Path
 
+from .. import interrupt
 from ..measure import analyze_file
 from ._options import add_json_option, add_measurement_options, add_store_option, analysis_options
 
@@ -29,6 +30,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     options = analysis_options(args)
+    saved = False
     try:
         # Analyse everything before writing anything: one bad file leaves the store untouched.
         results = [analyze_file(path, options) for path in args.paths]
@@ -36,9 +38,14 @@ def run(args: argparse.Namespace) -> int:
             from ..measure import save_analyses
 
             save_analyses(args.store, results, options)  # one transaction: all or nothing
-    except KeyboardInterrupt:
-        print("pidcore analyze: interrupted; nothing saved, the store is unchanged",
-              file=sys.stderr)
+            saved = True
+        interrupt.raise_if_interrupted()  # an interrupt swallowed on the way still counts
+    except (KeyboardInterrupt, SystemError) as exc:
+        if not interrupt.is_interruption(exc):
+            raise
+        said = (f"interrupted after saving {len(results)} record(s) to {args.store}" if saved
+                else "interrupted; nothing saved, the store is unchanged")
+        print(f"pidcore analyze: {said}", file=sys.stderr)
         return 130
     if args.json:
         json.dump({"records": [r.to_dict() for r in results]}, sys.stdout)
