@@ -6,6 +6,7 @@ import argparse
 from pathlib import Path
 
 from .. import defaults
+from ..errors import ParameterError
 from ..measure import AnalysisOptions
 
 #: Help of ``--store`` where it names the default store.
@@ -61,6 +62,10 @@ def add_measurement_options(p: argparse.ArgumentParser) -> None:
 
 def analysis_options(args: argparse.Namespace) -> AnalysisOptions:
     """The :class:`AnalysisOptions` the options of :func:`add_measurement_options` state."""
+    if not args.velocity_delay >= 0:  # NaN too
+        # the library takes a signed delay (a late force); a vibrometer only ever lags
+        raise ParameterError(f"--velocity-delay {args.velocity_delay:g}: expected a delay "
+                             ">= 0 s (the vibrometer output lags the motion)")
     return AnalysisOptions(
         force=args.force, velocity=args.velocity, acceleration=args.acceleration,
         velocity_delay_s=args.velocity_delay, mass_below_gauge_kg=args.mass_below_gauge,

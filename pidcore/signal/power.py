@@ -285,6 +285,19 @@ def _check_parameters(sample_rate_hz: float, n_harmonics: int, n_blocks: int, mi
         raise ParameterError(f"baseline_loss_factor: {baseline_loss_factor!r}, expected finite")
 
 
+def _check_delay(velocity_delay_s: float, frequency_hz: float, duration_s: float) -> None:
+    # A vibrometer's output delay is tens of µs to a few ms; a value of several drive periods
+    # (or longer than the record) is a unit slip (ms typed as s): the phase correction wraps
+    # every period, so such a value cannot be told from a small one and must not pass.
+    limit = min(defaults.MAX_VELOCITY_DELAY_PERIODS / frequency_hz, duration_s)
+    if abs(velocity_delay_s) > limit:
+        raise ParameterError(
+            f"velocity_delay_s: {velocity_delay_s:g} s is longer than "
+            f"{defaults.MAX_VELOCITY_DELAY_PERIODS} drive periods of {frequency_hz:.6g} Hz "
+            f"({limit:.6g} s, record {duration_s:.6g} s); expected a vibrometer delay in s "
+            "(e.g. 2e-4)")
+
+
 def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz: float, *,
                   acceleration: np.ndarray | None = None,
                   frequency_hz: float | None = None,
@@ -384,6 +397,7 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
     if n_periods < min_periods - 0.005:
         raise SignalError(f"{what}: {n_periods:.2f} drive periods of {freq:.6g} Hz in "
                           f"{n_samples} samples, expected at least {min_periods}")
+    _check_delay(velocity_delay_s, freq, n_samples / sample_rate_hz)
     max_harm = int(defaults.HARMONIC_MAX_FRACTION_OF_NYQUIST * 0.5 * sample_rate_hz / freq)
     n_harm = min(int(n_harmonics), max_harm)
     if n_harm < 1:

@@ -1,0 +1,71 @@
+"""``pidcore analyze`` refuses out-of-range corrections and unusable inputs: one line naming
+the CLI flag, exit 2, the store byte-identical."""
+
+from __future__ import annotations
+
+import hashlib
+import math
+from pathlib import Path
+
+import pytest
+
+from pidcore.cli import main
+from pidcore.constants import STANDARD_GRAVITY
+from pidcore.io import write_measurement
+from pidcore.records import Channel, Measurement
+from pidcore.signal.synthetic import synthesize_shaker_record
+
+MASS, FREQ, FS = 0.25, 100.0, 25_600.0
+C_VISCOUS = 2.0
+ACCEL = 5 * STANDARD_GRAVITY
+
+
+def truth_loss_factor() -> float:
+    """Rigid mass with viscous damping: c / (m w)."""
+    return C_VISCOUS / (MASS * 2 * math.pi * FREQ)
+
+
+def export(path: Path, *, n_periods: float = 15.0) -> Path:
+    rec = synthesize_shaker_record(mass_kg=MASS, acceleration_amplitude_m_s2=ACCEL,
+                                   frequency_hz=FREQ, sample_rate_hz=FS, n_periods=n_periods,
+                                   viscous_damping_n_s_m=C_VISCOUS, snr_db=60, seed=5)
+    m = Measurement(path.name, (Channel("Force", "force", rec.force_n, FS, "N"),
+                                Channel("Velocity", "velocity", rec.velocity_m_s, FS, "m/s")))
+    write_measurement(m, path, "csv")
+    return path
+
+
+def _digest(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+@pytest.fixture
+def record_and_store(tmp_path, capsys):
+    path = export(tmp_path / "rec.csv")
+    store = tmp_path / "s.h5"
+    assert main(["analyze", str(path), "--store", str(store)]) == 0
+    capsys.readouterr()
+    return path, store
+
+
+def _refused(args: list[str], store: Path, capsys) -> str:
+    before = _digest(store)
+    assert main(["analyze", *args, "--store", str(store)]) == 2
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1, err
+    assert _digest(store) == before
+    return err
+
+
+# 15 periods of 100 Hz: 0.15 s, a drive period of 10 ms; 1 s is a unit slip (ms typed as s).
+@pytest.mark.parametrize("delay", ["-1", "-2e-4", "1", "0.15"])
+def test_velocity_delay_negative_or_beyond_a_few_periods_is_refused(record_and_store, capsys,
+                                                                    delay):
+    path, store = record_and_store
+    err = _refused([str(path), f"--velocity-delay={delay}"], store, capsys)
+    assert "--velocity-delay" in err or "velocity_delay" in err
+
+
+def test_a_real_vibrometer_delay_is_accepted(record_and_store, capsys):
+    path, store = record_and_store
+    assert main(["analyze", str(path), "--velocity-delay", "2e-4", "--no-store"]) == 0
