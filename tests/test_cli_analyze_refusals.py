@@ -69,3 +69,32 @@ def test_velocity_delay_negative_or_beyond_a_few_periods_is_refused(record_and_s
 def test_a_real_vibrometer_delay_is_accepted(record_and_store, capsys):
     path, store = record_and_store
     assert main(["analyze", str(path), "--velocity-delay", "2e-4", "--no-store"]) == 0
+
+
+@pytest.mark.parametrize("baseline", ["-3", "-0.001"])
+def test_negative_baseline_loss_factor_is_refused(record_and_store, capsys, baseline):
+    path, store = record_and_store
+    err = _refused([str(path), f"--baseline-loss-factor={baseline}"], store, capsys)
+    assert "baseline" in err.lower()
+
+
+# the record's loss factor is c / (m w) = 0.0127; 5 and a value 1 % above it leave no damping
+@pytest.mark.parametrize("factor", [5.0, 1.01])
+def test_baseline_at_or_above_the_measured_loss_factor_is_refused(record_and_store, capsys,
+                                                                  factor):
+    path, store = record_and_store
+    baseline = f"{factor * truth_loss_factor():.6g}"
+    err = _refused([str(path), f"--baseline-loss-factor={baseline}"], store, capsys)
+    assert "baseline" in err.lower() and "rec.csv" in err
+
+
+def test_a_baseline_below_the_loss_factor_is_subtracted(record_and_store, capsys):
+    path, _ = record_and_store
+    assert main(["analyze", str(path), "--no-store", "--json"]) == 0
+    import json
+
+    plain = json.loads(capsys.readouterr().out)["records"][0]["loss_factor"]
+    assert main(["analyze", str(path), "--no-store", "--json",
+                 "--baseline-loss-factor", "0.002"]) == 0
+    minus = json.loads(capsys.readouterr().out)["records"][0]["loss_factor"]
+    assert minus == pytest.approx(plain - 0.002, rel=1e-12)  # same record, exact arithmetic

@@ -281,8 +281,10 @@ def _check_parameters(sample_rate_hz: float, n_harmonics: int, n_blocks: int, mi
                              f"frequency {sample_rate_hz / 2:g} Hz")
     if not math.isfinite(velocity_delay_s):
         raise ParameterError(f"velocity_delay_s: {velocity_delay_s!r}, expected a finite time")
-    if not math.isfinite(baseline_loss_factor):
-        raise ParameterError(f"baseline_loss_factor: {baseline_loss_factor!r}, expected finite")
+    if not (math.isfinite(baseline_loss_factor) and baseline_loss_factor >= 0):
+        # the empty coupon dissipates energy: a negative baseline would add damping
+        raise ParameterError(f"baseline_loss_factor: {baseline_loss_factor!r}, expected a "
+                             "loss factor >= 0 (that of the empty coupon)")
 
 
 def _check_delay(velocity_delay_s: float, frequency_hz: float, duration_s: float) -> None:
@@ -444,6 +446,12 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
             "the sensor directions, or pass --invert NAME for the inverted channel")
 
     loss_raw = p_c.real / p_c.imag
+    if baseline_loss_factor > 0 and not loss_raw > baseline_loss_factor:
+        # subtracting it would give zero or negative damping: energy created per cycle
+        raise ParameterError(
+            f"{source or 'record'}: baseline_loss_factor {baseline_loss_factor:g} is not below "
+            f"the measured loss factor {loss_raw:.6g}; expected the empty coupon's loss factor, "
+            "smaller than that of the filled one")
     loss = loss_raw - baseline_loss_factor
     sdc = 2 * np.pi * loss
     lf_stderr = float("nan")
