@@ -98,3 +98,20 @@ def test_a_baseline_below_the_loss_factor_is_subtracted(record_and_store, capsys
                  "--baseline-loss-factor", "0.002"]) == 0
     minus = json.loads(capsys.readouterr().out)["records"][0]["loss_factor"]
     assert minus == pytest.approx(plain - 0.002, rel=1e-12)  # same record, exact arithmetic
+
+
+def test_a_store_without_measurements_says_what_it_holds(tmp_path, capsys):
+    import h5py
+
+    # the layout of a store that holds only DEM runs (data_samples/dem_table3.h5)
+    path = tmp_path / "dem_only.h5"
+    with h5py.File(path, "w") as h5:
+        h5.create_group("measurements")
+        h5.create_group("analyses")
+        runs = h5.create_group("dem_runs")
+        for i in range(3):
+            runs.create_group(f"run{i}")
+    assert main(["analyze", str(path), "--no-store"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1
+    assert "dem_only.h5" in err and "no measurements" in err and "3 dem_runs" in err
