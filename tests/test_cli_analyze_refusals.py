@@ -63,7 +63,7 @@ def test_velocity_delay_negative_or_beyond_a_few_periods_is_refused(record_and_s
                                                                     delay):
     path, store = record_and_store
     err = _refused([str(path), f"--velocity-delay={delay}"], store, capsys)
-    assert "--velocity-delay" in err or "velocity_delay" in err
+    assert "--velocity-delay" in err and "velocity_delay_s" not in err
 
 
 def test_a_real_vibrometer_delay_is_accepted(record_and_store, capsys):
@@ -115,3 +115,54 @@ def test_a_store_without_measurements_says_what_it_holds(tmp_path, capsys):
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1
     assert "dem_only.h5" in err and "no measurements" in err and "3 dem_runs" in err
+
+
+def test_a_store_with_several_measurements_names_the_key_option(tmp_path, capsys):
+    import json
+
+    a, b = export(tmp_path / "a.csv"), export(tmp_path / "b.csv", n_periods=20.0)
+    store = tmp_path / "s.h5"
+    assert main(["analyze", str(a), str(b), "--store", str(store)]) == 0
+    capsys.readouterr()
+    assert main(["analyze", str(store), "--no-store"]) == 2
+    err = capsys.readouterr().err
+    assert "--key NAME" in err and "key=" not in err and len(err.strip().splitlines()) == 1
+    keys = err.split("measurements (")[1].split(")")[0].split(", ")
+    assert len(keys) == 2
+    found = []
+    for key in keys:
+        assert main(["analyze", str(store), "--key", key, "--no-store", "--json"]) == 0
+        found.append(json.loads(capsys.readouterr().out)["records"][0]["n_periods"])
+    # the two keys read the two records (15 and 20 periods), not one of them twice
+    assert sorted(round(n) for n in found) == [15, 20]
+    assert main(["analyze", str(a), "--key", keys[0], "--no-store"]) == 2  # not a store
+    assert "--key" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("args,flag,keyword", [
+    (["--frequency", "20000"], "--frequency", "frequency_hz"),  # above Nyquist (12.8 kHz)
+    (["--harmonics", "0"], "--harmonics", "n_harmonics"),
+    (["--sample-rate=-5"], "--sample-rate", "sample_rate_hz"),
+    (["--mass-below-gauge=-1"], "--mass-below-gauge", "mass_below_gauge_kg"),
+])
+def test_errors_name_the_cli_flag_not_the_library_keyword(tmp_path, capsys, args, flag,
+                                                          keyword):
+    path = export(tmp_path / "rec.csv")
+    assert main(["analyze", str(path), "--no-store", *args]) == 2
+    err = capsys.readouterr().err
+    assert flag in err and keyword not in err, err
+
+
+def test_clipping_error_names_allow_clipped(tmp_path, capsys):
+    import numpy as np
+
+    rec = synthesize_shaker_record(mass_kg=MASS, acceleration_amplitude_m_s2=ACCEL,
+                                   frequency_hz=FREQ, sample_rate_hz=FS, n_periods=20)
+    force = np.minimum(rec.force_n, 0.9 * float(np.max(rec.force_n)))
+    path = tmp_path / "clipped.csv"
+    write_measurement(Measurement(path.name, (Channel("Force", "force", force, FS, "N"),
+                                              Channel("Velocity", "velocity", rec.velocity_m_s,
+                                                      FS, "m/s"))), path, "csv")
+    assert main(["analyze", str(path), "--no-store"]) == 2
+    err = capsys.readouterr().err
+    assert "--allow-clipped" in err and "allow_clipped" not in err

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import re
 from pathlib import Path
 
 from .. import defaults
@@ -75,3 +76,29 @@ def analysis_options(args: argparse.Namespace) -> AnalysisOptions:
         velocity_unit=args.velocity_unit, acceleration_unit=args.acceleration_unit,
         invert=tuple(args.invert),
     )
+
+
+#: Library keywords in error messages and the flags of :func:`add_measurement_options` that set
+#: them: the library keeps its names, the CLI user reads the flag to type.
+_FLAG_OF_KEYWORD = (
+    ("choose one with key=", "choose one with --key NAME"),
+    ("pass allow_clipped=True", "pass --allow-clipped"),
+    ("allow_clipped", "--allow-clipped"),
+    ("key=", "--key "),
+    ("velocity_delay_s", "--velocity-delay"),
+    ("mass_below_gauge_kg", "--mass-below-gauge"),
+    ("baseline_loss_factor", "--baseline-loss-factor"),
+    ("frequency_hz", "--frequency"),
+    ("n_harmonics", "--harmonics"),
+    ("sample_rate_hz", "--sample-rate"),
+)
+# whole words only: "my_frequency_hz_col" (a file's column) stays as it is
+_KEYWORD_PATTERN = re.compile("|".join(
+    rf"(?<![\w-]){re.escape(k)}" + (r"(?!\w)" if k[-1].isalnum() else "")
+    for k, _ in _FLAG_OF_KEYWORD))
+
+
+def with_cli_flags(message: str) -> str:
+    """``message`` with the library keywords of the measurement options named as CLI flags."""
+    flags = dict(_FLAG_OF_KEYWORD)
+    return _KEYWORD_PATTERN.sub(lambda m: flags[m.group(0)], message)

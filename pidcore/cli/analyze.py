@@ -8,8 +8,15 @@ import sys
 from pathlib import Path
 
 from .. import interrupt
+from ..errors import PidcoreError
 from ..measure import analyze_file
-from ._options import add_json_option, add_measurement_options, add_store_option, analysis_options
+from ._options import (
+    add_json_option,
+    add_measurement_options,
+    add_store_option,
+    analysis_options,
+    with_cli_flags,
+)
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -24,16 +31,26 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     add_measurement_options(p)
     add_store_option(p)
     p.add_argument("--no-store", action="store_true", help="do not save to the store")
+    p.add_argument("--key", metavar="NAME", default=None,
+                   help="which measurement of a pidcore HDF5 store to analyse, when it holds "
+                        "several (the error lists them)")
     add_json_option(p)
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
+    try:
+        return _run(args)
+    except PidcoreError as exc:  # library keywords -> the flags the user types
+        raise type(exc)(with_cli_flags(str(exc))) from None
+
+
+def _run(args: argparse.Namespace) -> int:
     options = analysis_options(args)
     saved = False
     try:
         # Analyse everything before writing anything: one bad file leaves the store untouched.
-        results = [analyze_file(path, options) for path in args.paths]
+        results = [analyze_file(path, options, key=args.key) for path in args.paths]
         if not args.no_store:
             from ..measure import save_analyses
 
