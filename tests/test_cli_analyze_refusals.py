@@ -166,3 +166,15 @@ def test_clipping_error_names_allow_clipped(tmp_path, capsys):
     assert main(["analyze", str(path), "--no-store"]) == 2
     err = capsys.readouterr().err
     assert "--allow-clipped" in err and "allow_clipped" not in err
+
+
+def test_too_large_mass_below_gauge_is_named_as_a_cause(tmp_path, capsys):
+    # the coupon is 0.25 kg: cancelling 10 kg of inertia leaves Im(P_c) < 0
+    path = export(tmp_path / "rec.csv")
+    assert main(["analyze", str(path), "--no-store", "--mass-below-gauge", "10"]) == 2
+    err = capsys.readouterr().err
+    assert "--mass-below-gauge 10 kg" in err and "larger" in err and "inverted" in err
+    # without mass cancellation an inverted channel is the only cause named
+    assert main(["analyze", str(path), "--no-store", "--invert", "Force"]) == 2
+    err = capsys.readouterr().err
+    assert "inverted" in err and "--mass-below-gauge" not in err

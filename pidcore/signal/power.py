@@ -438,12 +438,18 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
     if not p_c.imag > 0:
         # There is no negative mass: a driven structure above its suspension resonance is
         # mass-like, Im(P_c) > 0. A negative reactive power is almost always one channel with
-        # the wrong sign (sensor mounted the other way, a -Z direction not applied).
+        # the wrong sign (sensor mounted the other way, a -Z direction not applied), or, with
+        # mass cancellation, a mass below the gauge larger than the mass actually there: its
+        # subtracted inertia force then exceeds the structure's.
+        cause = (f"one of the channels {force_name!r} / {motion_name!r} is probably inverted: "
+                 "check the sensor directions, or pass --invert NAME for the inverted channel")
+        if mass_below_gauge_kg > 0:
+            cause = (f"mass_below_gauge_kg {mass_below_gauge_kg:g} kg is probably larger than "
+                     "the mass between gauge and structure (its cancelled inertia exceeds the "
+                     "structure's), or " + cause)
         raise SignalError(
             f"{source or 'record'}: reactive power Im(P_c) = {p_c.imag:.4g} var <= 0 (no "
-            "positive kinetic energy: a mass-like structure gives Im(P_c) > 0); "
-            f"one of the channels {force_name!r} / {motion_name!r} is probably inverted: check "
-            "the sensor directions, or pass --invert NAME for the inverted channel")
+            f"positive kinetic energy: a mass-like structure gives Im(P_c) > 0); {cause}")
 
     loss_raw = p_c.real / p_c.imag
     if baseline_loss_factor > 0 and not loss_raw > baseline_loss_factor:
