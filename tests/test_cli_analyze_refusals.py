@@ -178,3 +178,18 @@ def test_too_large_mass_below_gauge_is_named_as_a_cause(tmp_path, capsys):
     assert main(["analyze", str(path), "--no-store", "--invert", "Force"]) == 2
     err = capsys.readouterr().err
     assert "inverted" in err and "--mass-below-gauge" not in err
+
+
+@pytest.mark.parametrize("args,words", [
+    (["analyze", "x.csv", "--bogus"], ["pidcore analyze: error:", "--bogus"]),
+    (["analyze"], ["pidcore analyze: error:", "PATH"]),
+    (["analyze", "x.csv", "--harmonics", "z"], ["pidcore analyze: error:", "--harmonics"]),
+])
+def test_usage_errors_are_one_line_naming_the_sub_command(capsys, args, words):
+    with pytest.raises(SystemExit) as stop:
+        main(args)
+    assert stop.value.code == 2
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1, err  # no usage block
+    for word in words:
+        assert word in err

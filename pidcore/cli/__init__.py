@@ -19,10 +19,18 @@ _COMMAND_MODULES = ("analyze", "dem", "specimen", "bench", "report", "model", "a
                     "samples", "calibrate")
 
 
+class _OneLineParser(argparse.ArgumentParser):
+    """Usage errors as one line naming the sub-command (``pidcore analyze: error: ...``), exit 2;
+    the usage stays one ``--help`` away. Sub-parsers inherit the class."""
+
+    def error(self, message: str):
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
     from .. import __version__  # not at import: see pidcore.__getattr__
 
-    parser = argparse.ArgumentParser(
+    parser = _OneLineParser(
         prog="pidcore",
         description="Particle impact damping: measure, predict (DEM) and compare SDC.",
     )
@@ -51,7 +59,10 @@ def _run(argv: list[str] | None) -> int:
     started = False
     try:
         parser = build_parser()
-        args = parser.parse_args(argv)
+        args, unknown = parser.parse_known_args(argv)
+        if unknown:  # reported by the top parser, which would not name the sub-command
+            parser.exit(2, f"pidcore {args.command}: error: unrecognized arguments: "
+                           f"{' '.join(unknown)} (see pidcore {args.command} --help)\n")
         command, started = args.command, True
         rc = int(args.func(args) or 0)
         if rc != 130 and interrupt.interrupted():  # swallowed on the way: still 130
