@@ -81,3 +81,20 @@ def is_interruption(exc: BaseException) -> bool:
             return True
         seen = seen.__cause__ or seen.__context__
     return _interrupted.is_set()
+
+
+def mark_handled() -> None:
+    """Tell CPython the interrupt was handled, so that the exit status stays the CLI's 130.
+
+    A KeyboardInterrupt that passes through code a C extension runs with ``PyRun_String``
+    during an import sets CPython's ``_Py_UnhandledKeyboardInterrupt`` even when it is caught
+    later; at exit the interpreter then kills itself with SIGINT (status -2 instead of 130;
+    seen here with Ctrl-C during the sub-command imports). Clearing it is best effort: other
+    interpreters lack the symbol and need nothing.
+    """
+    try:
+        import ctypes
+
+        ctypes.c_int.in_dll(ctypes.pythonapi, "_Py_UnhandledKeyboardInterrupt").value = 0
+    except (ImportError, AttributeError, ValueError, OSError):
+        pass

@@ -51,7 +51,7 @@ def test_sigint_at_any_time_exits_130_with_one_line_and_commits_nothing(tmp_path
     interrupted = 0
     # Delays from the interpreter start-up (the handler is installed first thing in main)
     # through the sub-command imports to the analysis.
-    for delay in (0.05, 0.2, 0.5, 0.9):
+    for delay in (0.05, 0.3, 0.9, 1.6, 2.5):
         p = subprocess.Popen([*cmd, str(big), "--store", str(store)], env=env,
                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         time.sleep(delay)

@@ -76,6 +76,7 @@ def _run(argv: list[str] | None) -> int:
             raise
         said = "finished results are saved" if started else "nothing was done"
         print(f"pidcore {command}: interrupted; {said}", file=sys.stderr)
+        interrupt.mark_handled()
         return 130
     except BrokenPipeError:  # the reader of stdout (| head) stopped: end quietly
         import os

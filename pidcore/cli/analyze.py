@@ -63,6 +63,7 @@ def _run(args: argparse.Namespace) -> int:
         said = (f"interrupted after saving {len(results)} record(s) to {args.store}" if saved
                 else "interrupted; nothing saved, the store is unchanged")
         print(f"pidcore analyze: {said}", file=sys.stderr)
+        interrupt.mark_handled()
         return 130
     if args.json:
         json.dump({"records": [r.to_dict() for r in results]}, sys.stdout)
