@@ -98,3 +98,21 @@ def test_systemerror_from_an_interrupt_counts_as_interruption():
     except SystemError as exc:
         assert interrupt.is_interruption(exc)
     assert not interrupt.is_interruption(SystemError("unrelated"))
+
+
+def test_an_interrupted_in_process_run_leaves_no_flag_behind(tmp_path, capsys, monkeypatch):
+    # main() run in-process (tests, the app) must not leave the SIGINT flag set: later
+    # commits in the same process would all be refused.
+    import pidcore.cli.analyze as analyze_cli
+    from pidcore.cli import main
+
+    def interrupted(*args, **kwargs):
+        interrupt._interrupted.set()  # what the handler does
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(analyze_cli, "analyze_file", interrupted)
+    assert main(["analyze", str(tmp_path / "x.csv"), "--no-store"]) == 130
+    assert len(capsys.readouterr().err.strip().splitlines()) == 1
+    assert not interrupt.interrupted()
+    Store(tmp_path / "s.h5").add_dem_run("after", {"sdc": 0.1})  # commits again
+    assert Store(tmp_path / "s.h5").has_dem_run("after")

@@ -51,6 +51,7 @@ def main(argv: list[str] | None = None) -> int:
         return _run(argv)
     finally:
         restore()
+        interrupt.reset()  # an in-process caller (app, tests) may commit again afterwards
 
 
 def _run(argv: list[str] | None) -> int:
