@@ -17,6 +17,9 @@ STORE_LOCK_TIMEOUT_S = 60.0
 N_HARMONICS = 5
 #: Fewest whole drive periods accepted in a record.
 MIN_PERIODS = 10
+#: Longest velocity (vibrometer) delay accepted, in drive periods: real output delays are tens of
+#: µs to a few ms (under 4 periods up to ~2 kHz); longer is a unit slip.
+MAX_VELOCITY_DELAY_PERIODS = 4
 #: Number of blocks of whole periods for the standard error of the SDC.
 N_UNCERTAINTY_BLOCKS = 8
 #: A sample within this fraction of the channel's extreme value counts toward clipping detection.

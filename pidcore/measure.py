@@ -227,9 +227,11 @@ def analyze_measurement(measurement: Measurement, options: AnalysisOptions) -> A
                           detail, corrections)
 
 
-def analyze_file(path: str | os.PathLike, options: AnalysisOptions) -> AnalyzedRecord:
-    """Read one export file and analyse it."""
-    measurement = read_measurement(Path(path), sample_rate_hz=options.sample_rate_hz)
+def analyze_file(path: str | os.PathLike, options: AnalysisOptions, *,
+                 key: str | None = None) -> AnalyzedRecord:
+    """Read one export file and analyse it; ``key`` picks a measurement of a pidcore store
+    (:func:`pidcore.io.read_measurement`)."""
+    measurement = read_measurement(Path(path), sample_rate_hz=options.sample_rate_hz, key=key)
     return analyze_measurement(measurement, options)
 
 

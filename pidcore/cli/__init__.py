@@ -11,7 +11,7 @@ import argparse
 import importlib
 import sys
 
-from .. import __version__
+from .. import interrupt
 from ..errors import PidcoreError
 
 #: Sub-command modules, each exposing ``register(subparsers) -> None``.
@@ -19,8 +19,18 @@ _COMMAND_MODULES = ("analyze", "dem", "specimen", "bench", "report", "model", "a
                     "samples", "calibrate")
 
 
+class _OneLineParser(argparse.ArgumentParser):
+    """Usage errors as one line naming the sub-command (``pidcore analyze: error: ...``), exit 2;
+    the usage stays one ``--help`` away. Sub-parsers inherit the class."""
+
+    def error(self, message: str):
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    from .. import __version__  # not at import: see pidcore.__getattr__
+
+    parser = _OneLineParser(
         prog="pidcore",
         description="Particle impact damping: measure, predict (DEM) and compare SDC.",
     )
@@ -32,16 +42,42 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = build_parser()
-    args = parser.parse_args(argv)
+    # First thing: Ctrl-C during the imports below (every sub-command) or inside Numba must
+    # end as one line and exit 130, and an interrupt swallowed somewhere must still stop the
+    # store from committing (pidcore.interrupt).
+    restore = interrupt.install()
+    interrupt.reset()
     try:
-        return int(args.func(args) or 0)
+        return _run(argv)
+    finally:
+        restore()
+        interrupt.reset()  # an in-process caller (app, tests) may commit again afterwards
+
+
+def _run(argv: list[str] | None) -> int:
+    words = sys.argv[1:] if argv is None else argv
+    command = next((w for w in words if not w.startswith("-")), "COMMAND")
+    started = False
+    try:
+        parser = build_parser()
+        args, unknown = parser.parse_known_args(argv)
+        if unknown:  # reported by the top parser, which would not name the sub-command
+            parser.exit(2, f"pidcore {args.command}: error: unrecognized arguments: "
+                           f"{' '.join(unknown)} (see pidcore {args.command} --help)\n")
+        command, started = args.command, True
+        rc = int(args.func(args) or 0)
+        if rc != 130 and interrupt.interrupted():  # swallowed on the way: still 130
+            raise KeyboardInterrupt
+        return rc
     except PidcoreError as exc:
-        print(f"pidcore {args.command}: error: {exc}", file=sys.stderr)
+        print(f"pidcore {command}: error: {exc}", file=sys.stderr)
         return 2
-    except KeyboardInterrupt:
-        print(f"pidcore {args.command}: interrupted; finished results are saved",
-              file=sys.stderr)
+    except (KeyboardInterrupt, SystemError) as exc:
+        if not interrupt.is_interruption(exc):
+            raise
+        said = "finished results are saved" if started else "nothing was done"
+        print(f"pidcore {command}: interrupted; {said}", file=sys.stderr)
+        interrupt.mark_handled()
         return 130
     except BrokenPipeError:  # the reader of stdout (| head) stopped: end quietly
         import os

@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 import argparse
+import re
 from pathlib import Path
 
 from .. import defaults
+from ..errors import ParameterError
 from ..measure import AnalysisOptions
 
 #: Help of ``--store`` where it names the default store.
@@ -61,6 +63,10 @@ def add_measurement_options(p: argparse.ArgumentParser) -> None:
 
 def analysis_options(args: argparse.Namespace) -> AnalysisOptions:
     """The :class:`AnalysisOptions` the options of :func:`add_measurement_options` state."""
+    if not args.velocity_delay >= 0:  # NaN too
+        # the library takes a signed delay (a late force); a vibrometer only ever lags
+        raise ParameterError(f"--velocity-delay {args.velocity_delay:g}: expected a delay "
+                             ">= 0 s (the vibrometer output lags the motion)")
     return AnalysisOptions(
         force=args.force, velocity=args.velocity, acceleration=args.acceleration,
         velocity_delay_s=args.velocity_delay, mass_below_gauge_kg=args.mass_below_gauge,
@@ -70,3 +76,29 @@ def analysis_options(args: argparse.Namespace) -> AnalysisOptions:
         velocity_unit=args.velocity_unit, acceleration_unit=args.acceleration_unit,
         invert=tuple(args.invert),
     )
+
+
+#: Library keywords in error messages and the flags of :func:`add_measurement_options` that set
+#: them: the library keeps its names, the CLI user reads the flag to type.
+_FLAG_OF_KEYWORD = (
+    ("choose one with key=", "choose one with --key NAME"),
+    ("pass allow_clipped=True", "pass --allow-clipped"),
+    ("allow_clipped", "--allow-clipped"),
+    ("key=", "--key "),
+    ("velocity_delay_s", "--velocity-delay"),
+    ("mass_below_gauge_kg", "--mass-below-gauge"),
+    ("baseline_loss_factor", "--baseline-loss-factor"),
+    ("frequency_hz", "--frequency"),
+    ("n_harmonics", "--harmonics"),
+    ("sample_rate_hz", "--sample-rate"),
+)
+# whole words only: "my_frequency_hz_col" (a file's column) stays as it is
+_KEYWORD_PATTERN = re.compile("|".join(
+    rf"(?<![\w-]){re.escape(k)}" + (r"(?!\w)" if k[-1].isalnum() else "")
+    for k, _ in _FLAG_OF_KEYWORD))
+
+
+def with_cli_flags(message: str) -> str:
+    """``message`` with the library keywords of the measurement options named as CLI flags."""
+    flags = dict(_FLAG_OF_KEYWORD)
+    return _KEYWORD_PATTERN.sub(lambda m: flags[m.group(0)], message)

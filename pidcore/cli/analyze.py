@@ -7,8 +7,16 @@ import json
 import sys
 from pathlib import Path
 
+from .. import interrupt
+from ..errors import PidcoreError
 from ..measure import analyze_file
-from ._options import add_json_option, add_measurement_options, add_store_option, analysis_options
+from ._options import (
+    add_json_option,
+    add_measurement_options,
+    add_store_option,
+    analysis_options,
+    with_cli_flags,
+)
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -23,22 +31,39 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     add_measurement_options(p)
     add_store_option(p)
     p.add_argument("--no-store", action="store_true", help="do not save to the store")
+    p.add_argument("--key", metavar="NAME", default=None,
+                   help="which measurement of a pidcore HDF5 store to analyse, when it holds "
+                        "several (the error lists them)")
     add_json_option(p)
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
+    try:
+        return _run(args)
+    except PidcoreError as exc:  # library keywords -> the flags the user types
+        raise type(exc)(with_cli_flags(str(exc))) from None
+
+
+def _run(args: argparse.Namespace) -> int:
     options = analysis_options(args)
+    saved = False
     try:
         # Analyse everything before writing anything: one bad file leaves the store untouched.
-        results = [analyze_file(path, options) for path in args.paths]
+        results = [analyze_file(path, options, key=args.key) for path in args.paths]
         if not args.no_store:
             from ..measure import save_analyses
 
             save_analyses(args.store, results, options)  # one transaction: all or nothing
-    except KeyboardInterrupt:
-        print("pidcore analyze: interrupted; nothing saved, the store is unchanged",
-              file=sys.stderr)
+            saved = True
+        interrupt.raise_if_interrupted()  # an interrupt swallowed on the way still counts
+    except (KeyboardInterrupt, SystemError) as exc:
+        if not interrupt.is_interruption(exc):
+            raise
+        said = (f"interrupted after saving {len(results)} record(s) to {args.store}" if saved
+                else "interrupted; nothing saved, the store is unchanged")
+        print(f"pidcore analyze: {said}", file=sys.stderr)
+        interrupt.mark_handled()
         return 130
     if args.json:
         json.dump({"records": [r.to_dict() for r in results]}, sys.stdout)

@@ -173,6 +173,9 @@ def read_measurement(path: str | os.PathLike[str], *, sample_rate_hz: float | No
         raise InputFileError(f"{path}: file not found")
     if sample_rate_hz is not None and not sample_rate_hz > 0:
         raise ParameterError(f"sample_rate_hz must be positive, got {sample_rate_hz!r}")
+    if key is not None and fmt != "hdf5":
+        raise ParameterError(f"{display_path(path)}: key={key!r} picks a measurement of a "
+                             f"pidcore HDF5 store; this is a {fmt} file")
     if fmt == "uff":
         return _displayed(read_uff(path), path)
     if fmt == "csv":

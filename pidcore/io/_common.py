@@ -37,6 +37,9 @@ def reraise_interrupt(exc: BaseException) -> None:
         if isinstance(seen, KeyboardInterrupt):
             raise KeyboardInterrupt from None
         seen = seen.__cause__ or seen.__context__
+    from .. import interrupt
+
+    interrupt.raise_if_interrupted()  # converted without a chain: the SIGINT flag still says so
 
 
 def file_sha256(path: str | os.PathLike[str]) -> str:

@@ -48,11 +48,23 @@ def hdf5_keys(path: str | os.PathLike[str]) -> list[str]:
                 return [""]
             group = h5.get(MEASUREMENTS_GROUP)
             if isinstance(group, h5py.Group):
-                return sorted(k for k in group if _is_measurement(group[k]))
+                keys = sorted(k for k in group if _is_measurement(group[k]))
+                if keys:
+                    return keys
+            holds = _contents(h5)
     except OSError as exc:
         raise InputFileError(f"{where}: not a readable HDF5 file ({exc})") from None
-    raise InputFileError(f"{where}: HDF5 file without a pidcore measurement (expected a root "
-                         f"group with pidcore_layout='measurement' or '/{MEASUREMENTS_GROUP}/')")
+    raise InputFileError(f"{where}: holds no measurements ({holds}); expected a root group with "
+                         f"pidcore_layout='measurement' or measurements under "
+                         f"'/{MEASUREMENTS_GROUP}/'")
+
+
+def _contents(h5: h5py.File) -> str:
+    """What a file without measurements holds, for the message: ``48 dem_runs, ...``."""
+    parts = [f"{len(item)} {name}" if isinstance(item, h5py.Group) else name
+             for name, item in h5.items()]
+    nonempty = [p for p in parts if not p.startswith("0 ")]
+    return ", ".join(nonempty) if nonempty else "nothing"
 
 
 def read_hdf5(path: str | os.PathLike[str], *, key: str | None = None) -> list[Measurement]:

@@ -281,8 +281,23 @@ def _check_parameters(sample_rate_hz: float, n_harmonics: int, n_blocks: int, mi
                              f"frequency {sample_rate_hz / 2:g} Hz")
     if not math.isfinite(velocity_delay_s):
         raise ParameterError(f"velocity_delay_s: {velocity_delay_s!r}, expected a finite time")
-    if not math.isfinite(baseline_loss_factor):
-        raise ParameterError(f"baseline_loss_factor: {baseline_loss_factor!r}, expected finite")
+    if not (math.isfinite(baseline_loss_factor) and baseline_loss_factor >= 0):
+        # the empty coupon dissipates energy: a negative baseline would add damping
+        raise ParameterError(f"baseline_loss_factor: {baseline_loss_factor!r}, expected a "
+                             "loss factor >= 0 (that of the empty coupon)")
+
+
+def _check_delay(velocity_delay_s: float, frequency_hz: float, duration_s: float) -> None:
+    # A vibrometer's output delay is tens of µs to a few ms; a value of several drive periods
+    # (or longer than the record) is a unit slip (ms typed as s): the phase correction wraps
+    # every period, so such a value cannot be told from a small one and must not pass.
+    limit = min(defaults.MAX_VELOCITY_DELAY_PERIODS / frequency_hz, duration_s)
+    if abs(velocity_delay_s) > limit:
+        raise ParameterError(
+            f"velocity_delay_s: {velocity_delay_s:g} s is longer than "
+            f"{defaults.MAX_VELOCITY_DELAY_PERIODS} drive periods of {frequency_hz:.6g} Hz "
+            f"({limit:.6g} s, record {duration_s:.6g} s); expected a vibrometer delay in s "
+            "(e.g. 2e-4)")
 
 
 def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz: float, *,
@@ -384,6 +399,7 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
     if n_periods < min_periods - 0.005:
         raise SignalError(f"{what}: {n_periods:.2f} drive periods of {freq:.6g} Hz in "
                           f"{n_samples} samples, expected at least {min_periods}")
+    _check_delay(velocity_delay_s, freq, n_samples / sample_rate_hz)
     max_harm = int(defaults.HARMONIC_MAX_FRACTION_OF_NYQUIST * 0.5 * sample_rate_hz / freq)
     n_harm = min(int(n_harmonics), max_harm)
     if n_harm < 1:
@@ -422,14 +438,26 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
     if not p_c.imag > 0:
         # There is no negative mass: a driven structure above its suspension resonance is
         # mass-like, Im(P_c) > 0. A negative reactive power is almost always one channel with
-        # the wrong sign (sensor mounted the other way, a -Z direction not applied).
+        # the wrong sign (sensor mounted the other way, a -Z direction not applied), or, with
+        # mass cancellation, a mass below the gauge larger than the mass actually there: its
+        # subtracted inertia force then exceeds the structure's.
+        cause = (f"one of the channels {force_name!r} / {motion_name!r} is probably inverted: "
+                 "check the sensor directions, or pass --invert NAME for the inverted channel")
+        if mass_below_gauge_kg > 0:
+            cause = (f"mass_below_gauge_kg {mass_below_gauge_kg:g} kg is probably larger than "
+                     "the mass between gauge and structure (its cancelled inertia exceeds the "
+                     "structure's), or " + cause)
         raise SignalError(
             f"{source or 'record'}: reactive power Im(P_c) = {p_c.imag:.4g} var <= 0 (no "
-            "positive kinetic energy: a mass-like structure gives Im(P_c) > 0); "
-            f"one of the channels {force_name!r} / {motion_name!r} is probably inverted: check "
-            "the sensor directions, or pass --invert NAME for the inverted channel")
+            f"positive kinetic energy: a mass-like structure gives Im(P_c) > 0); {cause}")
 
     loss_raw = p_c.real / p_c.imag
+    if baseline_loss_factor > 0 and not loss_raw > baseline_loss_factor:
+        # subtracting it would give zero or negative damping: energy created per cycle
+        raise ParameterError(
+            f"{source or 'record'}: baseline_loss_factor {baseline_loss_factor:g} is not below "
+            f"the measured loss factor {loss_raw:.6g}; expected the empty coupon's loss factor, "
+            "smaller than that of the filled one")
     loss = loss_raw - baseline_loss_factor
     sdc = 2 * np.pi * loss
     lf_stderr = float("nan")

@@ -11,7 +11,7 @@ import fcntl
 import os
 import time
 from collections.abc import Iterator
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
 from pathlib import Path
 
 from ..errors import StoreError
@@ -25,9 +25,33 @@ def lock_path_for(store_path: Path) -> Path:
     return store_path.with_name(store_path.name + ".lock")
 
 
+def _open_lock_file(store_path: Path, lock_path: Path) -> int:
+    try:
+        return os.open(lock_path, os.O_RDWR | os.O_CREAT, 0o666)
+    except OSError as exc:
+        raise StoreError(f"{store_path}: cannot create the lock file {lock_path} "
+                         f"({exc.strerror or exc})") from None
+
+
+def _is_current(fd: int, lock_path: Path) -> bool:
+    """True if ``fd`` is the file now at ``lock_path`` (not one its holder removed)."""
+    try:
+        st = os.stat(lock_path)
+    except FileNotFoundError:
+        return False
+    mine = os.fstat(fd)
+    return (st.st_dev, st.st_ino) == (mine.st_dev, mine.st_ino)
+
+
 @contextmanager
 def exclusive_lock(store_path: Path, *, timeout_s: float) -> Iterator[None]:
     """Hold the exclusive write lock of ``store_path`` for the duration of the block.
+
+    The lock file is removed on release so that none is left beside the store. That is safe
+    because removal happens while the lock is held and every writer, once it has the lock,
+    checks that its file is still the one at the path: a writer that opened the file before
+    the previous holder removed it holds a lock on an orphan that newcomers cannot see, so it
+    starts again on the path's current file (the classic flock-and-unlink race).
 
     Parameters
     ----------
@@ -42,27 +66,33 @@ def exclusive_lock(store_path: Path, *, timeout_s: float) -> Iterator[None]:
         The lock could not be taken within ``timeout_s`` or the lock file cannot be created.
     """
     lock_path = lock_path_for(store_path)
-    try:
-        fd = os.open(lock_path, os.O_RDWR | os.O_CREAT, 0o666)
-    except OSError as exc:
-        raise StoreError(f"{store_path}: cannot create the lock file {lock_path} "
-                         f"({exc.strerror or exc})") from None
-    try:
-        deadline = time.monotonic() + timeout_s
-        while True:
-            try:
-                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-                break
-            except BlockingIOError:
-                if time.monotonic() >= deadline:
-                    raise StoreError(
-                        f"{store_path}: could not take the write lock {lock_path} within "
-                        f"{timeout_s:g} s; another pidcore process is writing to this store"
-                    ) from None
-                time.sleep(_POLL_INTERVAL_S)
+    deadline = time.monotonic() + timeout_s
+    while True:
+        fd = _open_lock_file(store_path, lock_path)
         try:
-            yield
-        finally:
-            fcntl.flock(fd, fcntl.LOCK_UN)
+            while True:
+                try:
+                    fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                    break
+                except BlockingIOError:
+                    if time.monotonic() >= deadline:
+                        raise StoreError(
+                            f"{store_path}: could not take the write lock {lock_path} within "
+                            f"{timeout_s:g} s; another pidcore process is writing to this "
+                            "store") from None
+                    time.sleep(_POLL_INTERVAL_S)
+            if _is_current(fd, lock_path):
+                break
+        except BaseException:
+            os.close(fd)
+            raise
+        os.close(fd)  # the lock of a removed file: try again on the current one
+    try:
+        yield
     finally:
-        os.close(fd)
+        try:
+            with suppress(OSError):  # still held: nobody can take the path's lock meanwhile
+                os.unlink(lock_path)
+            fcntl.flock(fd, fcntl.LOCK_UN)
+        finally:
+            os.close(fd)

@@ -41,7 +41,7 @@ import h5py
 import numpy as np
 import pandas as pd
 
-from .. import __version__, defaults
+from .. import __version__, defaults, interrupt
 from ..errors import InputFileError, ParameterError, StoreError
 from ..io.hdf5_layout import read_measurement_group, write_measurement_group
 from ..records import Measurement
@@ -387,6 +387,8 @@ class Store:
                 try:
                     h5.close()
                     _fsync_path(tmp)
+                    # A Ctrl-C swallowed on the way (weakref callback, Numba) never commits.
+                    interrupt.raise_if_interrupted()
                     os.replace(tmp, self.path)
                 except OSError as exc:
                     raise StoreError(f"{self.path}: cannot commit the changes ({exc}); "

@@ -1,0 +1,100 @@
+"""Ctrl-C that never half-commits: a SIGINT flag shared by the CLI and the store.
+
+Python's default SIGINT handler raises :class:`KeyboardInterrupt` at whatever bytecode runs
+next. Raised inside a weakref callback it is printed as "Exception ignored" and swallowed (the
+run carries on and commits); raised inside Numba's dispatcher it comes back as a
+:class:`SystemError`. :func:`install` replaces the handler with one that first records the
+interruption and then raises, so that a swallowed interrupt is still seen by
+:func:`raise_if_interrupted`, which the store calls right before its atomic rename.
+"""
+
+from __future__ import annotations
+
+import signal
+import sys
+import threading
+from collections.abc import Callable
+
+_interrupted = threading.Event()
+
+
+def _handler(signum, frame) -> None:  # noqa: ARG001 - signal handler signature
+    _interrupted.set()
+    raise KeyboardInterrupt
+
+
+def _unraisable_hook(unraisable) -> None:
+    # An interrupt raised inside a weakref callback or __del__ cannot propagate; the flag is
+    # already set, so say nothing here (the CLI prints its one line) instead of a traceback.
+    if unraisable.exc_type is not None and issubclass(unraisable.exc_type, KeyboardInterrupt):
+        return
+    sys.__unraisablehook__(unraisable)
+
+
+def install() -> Callable[[], None]:
+    """Route SIGINT through the flag (main thread only; a no-op elsewhere).
+
+    Returns a function that puts back the previous handler and unraisable hook (for callers
+    such as tests that run the CLI in-process).
+    """
+    if threading.current_thread() is not threading.main_thread():
+        return lambda: None
+    previous_handler = signal.signal(signal.SIGINT, _handler)
+    previous_hook = sys.unraisablehook
+    sys.unraisablehook = _unraisable_hook
+
+    def restore() -> None:
+        signal.signal(signal.SIGINT, previous_handler)
+        sys.unraisablehook = previous_hook
+
+    return restore
+
+
+def interrupted() -> bool:
+    """True once SIGINT has arrived since :func:`install` (or the last :func:`reset`)."""
+    return _interrupted.is_set()
+
+
+def reset() -> None:
+    """Forget an earlier interruption (a new CLI run in the same process)."""
+    _interrupted.clear()
+
+
+def raise_if_interrupted() -> None:
+    """Raise :class:`KeyboardInterrupt` if SIGINT arrived, even if it was swallowed since."""
+    if _interrupted.is_set():
+        raise KeyboardInterrupt
+
+
+def is_interruption(exc: BaseException) -> bool:
+    """True for a KeyboardInterrupt, or an error that an interrupt turned into (Numba's
+    ``SystemError: ... returned a result with an exception set``) once SIGINT has arrived."""
+    if isinstance(exc, KeyboardInterrupt):
+        return True
+    if not isinstance(exc, SystemError):
+        return False
+    seen: BaseException | None = exc
+    for _ in range(16):  # the chain of causes, bounded
+        if seen is None:
+            break
+        if isinstance(seen, KeyboardInterrupt):
+            return True
+        seen = seen.__cause__ or seen.__context__
+    return _interrupted.is_set()
+
+
+def mark_handled() -> None:
+    """Tell CPython the interrupt was handled, so that the exit status stays the CLI's 130.
+
+    A KeyboardInterrupt that passes through code a C extension runs with ``PyRun_String``
+    during an import sets CPython's ``_Py_UnhandledKeyboardInterrupt`` even when it is caught
+    later; at exit the interpreter then kills itself with SIGINT (status -2 instead of 130;
+    seen here with Ctrl-C during the sub-command imports). Clearing it is best effort: other
+    interpreters lack the symbol and need nothing.
+    """
+    try:
+        import ctypes
+
+        ctypes.c_int.in_dll(ctypes.pythonapi, "_Py_UnhandledKeyboardInterrupt").value = 0
+    except (ImportError, AttributeError, ValueError, OSError):
+        pass

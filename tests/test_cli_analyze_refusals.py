@@ -1,0 +1,195 @@
+"""``pidcore analyze`` refuses out-of-range corrections and unusable inputs: one line naming
+the CLI flag, exit 2, the store byte-identical."""
+
+from __future__ import annotations
+
+import hashlib
+import math
+from pathlib import Path
+
+import pytest
+
+from pidcore.cli import main
+from pidcore.constants import STANDARD_GRAVITY
+from pidcore.io import write_measurement
+from pidcore.records import Channel, Measurement
+from pidcore.signal.synthetic import synthesize_shaker_record
+
+MASS, FREQ, FS = 0.25, 100.0, 25_600.0
+C_VISCOUS = 2.0
+ACCEL = 5 * STANDARD_GRAVITY
+
+
+def truth_loss_factor() -> float:
+    """Rigid mass with viscous damping: c / (m w)."""
+    return C_VISCOUS / (MASS * 2 * math.pi * FREQ)
+
+
+def export(path: Path, *, n_periods: float = 15.0) -> Path:
+    rec = synthesize_shaker_record(mass_kg=MASS, acceleration_amplitude_m_s2=ACCEL,
+                                   frequency_hz=FREQ, sample_rate_hz=FS, n_periods=n_periods,
+                                   viscous_damping_n_s_m=C_VISCOUS, snr_db=60, seed=5)
+    m = Measurement(path.name, (Channel("Force", "force", rec.force_n, FS, "N"),
+                                Channel("Velocity", "velocity", rec.velocity_m_s, FS, "m/s")))
+    write_measurement(m, path, "csv")
+    return path
+
+
+def _digest(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+@pytest.fixture
+def record_and_store(tmp_path, capsys):
+    path = export(tmp_path / "rec.csv")
+    store = tmp_path / "s.h5"
+    assert main(["analyze", str(path), "--store", str(store)]) == 0
+    capsys.readouterr()
+    return path, store
+
+
+def _refused(args: list[str], store: Path, capsys) -> str:
+    before = _digest(store)
+    assert main(["analyze", *args, "--store", str(store)]) == 2
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1, err
+    assert _digest(store) == before
+    return err
+
+
+# 15 periods of 100 Hz: 0.15 s, a drive period of 10 ms; 1 s is a unit slip (ms typed as s).
+@pytest.mark.parametrize("delay", ["-1", "-2e-4", "1", "0.15"])
+def test_velocity_delay_negative_or_beyond_a_few_periods_is_refused(record_and_store, capsys,
+                                                                    delay):
+    path, store = record_and_store
+    err = _refused([str(path), f"--velocity-delay={delay}"], store, capsys)
+    assert "--velocity-delay" in err and "velocity_delay_s" not in err
+
+
+def test_a_real_vibrometer_delay_is_accepted(record_and_store, capsys):
+    path, store = record_and_store
+    assert main(["analyze", str(path), "--velocity-delay", "2e-4", "--no-store"]) == 0
+
+
+@pytest.mark.parametrize("baseline", ["-3", "-0.001"])
+def test_negative_baseline_loss_factor_is_refused(record_and_store, capsys, baseline):
+    path, store = record_and_store
+    err = _refused([str(path), f"--baseline-loss-factor={baseline}"], store, capsys)
+    assert "baseline" in err.lower()
+
+
+# the record's loss factor is c / (m w) = 0.0127; 5 and a value 1 % above it leave no damping
+@pytest.mark.parametrize("factor", [5.0, 1.01])
+def test_baseline_at_or_above_the_measured_loss_factor_is_refused(record_and_store, capsys,
+                                                                  factor):
+    path, store = record_and_store
+    baseline = f"{factor * truth_loss_factor():.6g}"
+    err = _refused([str(path), f"--baseline-loss-factor={baseline}"], store, capsys)
+    assert "baseline" in err.lower() and "rec.csv" in err
+
+
+def test_a_baseline_below_the_loss_factor_is_subtracted(record_and_store, capsys):
+    path, _ = record_and_store
+    assert main(["analyze", str(path), "--no-store", "--json"]) == 0
+    import json
+
+    plain = json.loads(capsys.readouterr().out)["records"][0]["loss_factor"]
+    assert main(["analyze", str(path), "--no-store", "--json",
+                 "--baseline-loss-factor", "0.002"]) == 0
+    minus = json.loads(capsys.readouterr().out)["records"][0]["loss_factor"]
+    assert minus == pytest.approx(plain - 0.002, rel=1e-12)  # same record, exact arithmetic
+
+
+def test_a_store_without_measurements_says_what_it_holds(tmp_path, capsys):
+    import h5py
+
+    # the layout of a store that holds only DEM runs (data_samples/dem_table3.h5)
+    path = tmp_path / "dem_only.h5"
+    with h5py.File(path, "w") as h5:
+        h5.create_group("measurements")
+        h5.create_group("analyses")
+        runs = h5.create_group("dem_runs")
+        for i in range(3):
+            runs.create_group(f"run{i}")
+    assert main(["analyze", str(path), "--no-store"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1
+    assert "dem_only.h5" in err and "no measurements" in err and "3 dem_runs" in err
+
+
+def test_a_store_with_several_measurements_names_the_key_option(tmp_path, capsys):
+    import json
+
+    a, b = export(tmp_path / "a.csv"), export(tmp_path / "b.csv", n_periods=20.0)
+    store = tmp_path / "s.h5"
+    assert main(["analyze", str(a), str(b), "--store", str(store)]) == 0
+    capsys.readouterr()
+    assert main(["analyze", str(store), "--no-store"]) == 2
+    err = capsys.readouterr().err
+    assert "--key NAME" in err and "key=" not in err and len(err.strip().splitlines()) == 1
+    keys = err.split("measurements (")[1].split(")")[0].split(", ")
+    assert len(keys) == 2
+    found = []
+    for key in keys:
+        assert main(["analyze", str(store), "--key", key, "--no-store", "--json"]) == 0
+        found.append(json.loads(capsys.readouterr().out)["records"][0]["n_periods"])
+    # the two keys read the two records (15 and 20 periods), not one of them twice
+    assert sorted(round(n) for n in found) == [15, 20]
+    assert main(["analyze", str(a), "--key", keys[0], "--no-store"]) == 2  # not a store
+    assert "--key" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("args,flag,keyword", [
+    (["--frequency", "20000"], "--frequency", "frequency_hz"),  # above Nyquist (12.8 kHz)
+    (["--harmonics", "0"], "--harmonics", "n_harmonics"),
+    (["--sample-rate=-5"], "--sample-rate", "sample_rate_hz"),
+    (["--mass-below-gauge=-1"], "--mass-below-gauge", "mass_below_gauge_kg"),
+])
+def test_errors_name_the_cli_flag_not_the_library_keyword(tmp_path, capsys, args, flag,
+                                                          keyword):
+    path = export(tmp_path / "rec.csv")
+    assert main(["analyze", str(path), "--no-store", *args]) == 2
+    err = capsys.readouterr().err
+    assert flag in err and keyword not in err, err
+
+
+def test_clipping_error_names_allow_clipped(tmp_path, capsys):
+    import numpy as np
+
+    rec = synthesize_shaker_record(mass_kg=MASS, acceleration_amplitude_m_s2=ACCEL,
+                                   frequency_hz=FREQ, sample_rate_hz=FS, n_periods=20)
+    force = np.minimum(rec.force_n, 0.9 * float(np.max(rec.force_n)))
+    path = tmp_path / "clipped.csv"
+    write_measurement(Measurement(path.name, (Channel("Force", "force", force, FS, "N"),
+                                              Channel("Velocity", "velocity", rec.velocity_m_s,
+                                                      FS, "m/s"))), path, "csv")
+    assert main(["analyze", str(path), "--no-store"]) == 2
+    err = capsys.readouterr().err
+    assert "--allow-clipped" in err and "allow_clipped" not in err
+
+
+def test_too_large_mass_below_gauge_is_named_as_a_cause(tmp_path, capsys):
+    # the coupon is 0.25 kg: cancelling 10 kg of inertia leaves Im(P_c) < 0
+    path = export(tmp_path / "rec.csv")
+    assert main(["analyze", str(path), "--no-store", "--mass-below-gauge", "10"]) == 2
+    err = capsys.readouterr().err
+    assert "--mass-below-gauge 10 kg" in err and "larger" in err and "inverted" in err
+    # without mass cancellation an inverted channel is the only cause named
+    assert main(["analyze", str(path), "--no-store", "--invert", "Force"]) == 2
+    err = capsys.readouterr().err
+    assert "inverted" in err and "--mass-below-gauge" not in err
+
+
+@pytest.mark.parametrize("args,words", [
+    (["analyze", "x.csv", "--bogus"], ["pidcore analyze: error:", "--bogus"]),
+    (["analyze"], ["pidcore analyze: error:", "PATH"]),
+    (["analyze", "x.csv", "--harmonics", "z"], ["pidcore analyze: error:", "--harmonics"]),
+])
+def test_usage_errors_are_one_line_naming_the_sub_command(capsys, args, words):
+    with pytest.raises(SystemExit) as stop:
+        main(args)
+    assert stop.value.code == 2
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1, err  # no usage block
+    for word in words:
+        assert word in err
