@@ -58,3 +58,21 @@ def test_store_round_trip(tmp_path, capsys):
     store = store_mod.Store(path)
     assert doc["store_key"].startswith("f500Hz_a5g_fill50pct_acrylic_z_seed12345_cells2")
     assert store.has_dem_run(doc["store_key"])
+
+
+def test_steady_window_longer_than_asked_is_announced(capsys):
+    # --cycles 5 with blocks of 10 cycles: the window measured is whole blocks, never 5
+    assert main(ARGS + ["--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["steady_cycles"] > 5 and doc["steady_cycles"] % 10 == 0
+    rounded = [n for n in doc["notes"] if n.startswith("steady window rounded up")]
+    assert rounded == [n for n in doc["notes"] if "steady window" in n]
+    assert f"{doc['steady_cycles']} cycles measured for the 5 asked" in rounded[0]
+    assert "blocks of 10 cycles" in rounded[0]
+    assert main(ARGS) == 0  # the readable summary says it too
+    assert f"{doc['steady_cycles']} cycles measured for the 5 asked" in capsys.readouterr().out
+    # two whole blocks asked: exactly what is measured, and no note
+    assert main(ARGS[:-3] + ["--cycles", "20", "--no-progress", "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["steady_cycles"] == 20
+    assert not [n for n in doc["notes"] if "steady window" in n]

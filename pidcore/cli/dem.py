@@ -200,6 +200,7 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         out = {k: result.to_dict()[k] for k in JSON_KEYS}
         out.update(result.to_dict())
+        out["notes"] = list(result.notes)
         if key is not None:
             out["store_key"] = key
             out["reused_from_store"] = reused
@@ -251,4 +252,5 @@ def format_summary(result) -> str:
         f"numerics        dt {result.time_step_s:.4g} s, {result.steps} steps, "
         f"{result.wall_s:.1f} s wall, {result.particle_steps_per_s:.3g} particle-steps/s",
     ]
+    lines += [f"note            {note}" for note in result.notes]
     return "\n".join(lines)

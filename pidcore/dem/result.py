@@ -166,6 +166,27 @@ class DemResult:
         )
 
     @property
+    def notes(self) -> tuple[str, ...]:
+        """What a reader of this run's numbers should know (not stored; derived from the run).
+
+        * the steady window measured is longer than asked (``config.steady_cycles``, else
+          DEM_MIN_STEADY_CYCLES): the kernel runs whole blocks of ``config.block_cycles``
+          cycles, and the two blocks that detect the steady state both belong to the window.
+        """
+        from .simulate import required_steady_cycles
+
+        notes = []
+        asked = required_steady_cycles(self.case, self.config)
+        if self.steady_cycles > asked:
+            b = self.config.block_cycles
+            why = f"the DEM runs whole blocks of {b} cycles"
+            if self.steady_detected:
+                why += ", and the two blocks that detected the steady state are both measured"
+            notes.append(f"steady window rounded up: {self.steady_cycles} cycles measured for "
+                         f"the {asked} asked ({why})")
+        return tuple(notes)
+
+    @property
     def loss_factor(self) -> float:
         """eta / (2 pi) (paper Sect. 3) [-]."""
         return self.sdc / (2 * math.pi)
