@@ -58,3 +58,77 @@ def test_store_round_trip(tmp_path, capsys):
     store = store_mod.Store(path)
     assert doc["store_key"].startswith("f500Hz_a5g_fill50pct_acrylic_z_seed12345_cells2")
     assert store.has_dem_run(doc["store_key"])
+
+
+def test_steady_window_longer_than_asked_is_announced(capsys):
+    # --cycles 5 with blocks of 10 cycles: the window measured is whole blocks, never 5
+    assert main(ARGS + ["--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["steady_cycles"] > 5 and doc["steady_cycles"] % 10 == 0
+    rounded = [n for n in doc["notes"] if n.startswith("steady window rounded up")]
+    assert rounded == [n for n in doc["notes"] if "steady window" in n]
+    assert f"{doc['steady_cycles']} cycles measured for the 5 asked" in rounded[0]
+    assert "blocks of 10 cycles" in rounded[0]
+    assert main(ARGS) == 0  # the readable summary says it too
+    assert f"{doc['steady_cycles']} cycles measured for the 5 asked" in capsys.readouterr().out
+    # two whole blocks asked: exactly what is measured, and no note
+    assert main(ARGS[:-3] + ["--cycles", "20", "--no-progress", "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["steady_cycles"] == 20
+    assert not [n for n in doc["notes"] if "steady window" in n]
+
+
+def _interrupt(*args, **kwargs):
+    raise KeyboardInterrupt
+
+
+def test_ctrl_c_before_a_run_finishes_says_nothing_saved(tmp_path, monkeypatch, capsys):
+    import pidcore.dem
+    import pidcore.dem.persist
+
+    monkeypatch.setattr(pidcore.dem, "simulate_load_case", _interrupt)
+    assert main(ARGS) == 130
+    err = capsys.readouterr().err
+    assert "nothing saved" in err and "are saved" not in err
+    monkeypatch.setattr(pidcore.dem.persist, "run_or_load", _interrupt)
+    path = tmp_path / "s.h5"
+    assert main(ARGS + ["--store", str(path)]) == 130
+    err = capsys.readouterr().err
+    assert f"nothing saved, {path} unchanged" in err and not path.exists()
+
+
+def test_ctrl_c_after_the_run_was_stored_says_it_was_saved(tmp_path, monkeypatch, capsys):
+    import pidcore.dem.persist
+    from pidcore.store import Store
+
+    real = pidcore.dem.persist.run_or_load
+
+    def run_then_interrupt(*args, **kwargs):
+        real(*args, **kwargs)
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(pidcore.dem.persist, "run_or_load", run_then_interrupt)
+    path = tmp_path / "s.h5"
+    assert main(ARGS + ["--store", str(path)]) == 130
+    err = capsys.readouterr().err
+    assert "1 finished run(s) saved to" in err and len(Store(path).list_dem_runs()) == 1
+
+
+def test_ctrl_c_in_a_sweep_counts_the_cases_stored(tmp_path, monkeypatch, capsys):
+    from types import SimpleNamespace
+
+    import pidcore.dem.sweep
+
+    def two_then_interrupt(cases, config, *, on_case, **kwargs):
+        for key in ("a", "b"):  # run_sweep calls on_case after each case is stored
+            on_case(SimpleNamespace(key=key))
+        raise KeyboardInterrupt
+
+    sweep = ["dem", "sweep", "--store", str(tmp_path / "s.h5"), "--no-progress"]
+    monkeypatch.setattr(pidcore.dem.sweep, "run_sweep", two_then_interrupt)
+    assert main(sweep) == 130
+    assert "interrupted; 2 finished run(s) saved to" in capsys.readouterr().err
+    monkeypatch.setattr(pidcore.dem.sweep, "run_sweep", _interrupt)
+    assert main(sweep) == 130
+    err = capsys.readouterr().err
+    assert "nothing saved" in err and "are saved" not in err

@@ -269,3 +269,50 @@ def test_loop_encloses_the_virtual_shaker_energy_per_cycle(run_500hz):
     assert loop.energy_per_cycle_j == pytest.approx(pa.complex_power_w.real / pa.frequency_hz,
                                                     rel=2e-4)
     assert loop.frequency_hz == pytest.approx(r.case.frequency_hz, rel=1e-3)
+
+
+def _fake_compiler(monkeypatch, *, compiles, sleep_s):
+    """Make kernel calls look like Numba compiling: the first (or every) call sleeps
+    ``sleep_s`` and adds a kernel specialisation. Returns the per-call log (particle-steps,
+    seconds, compiled) the wrapper measured around the real kernel."""
+    import time
+
+    import pidcore.dem.simulate as sim
+
+    real, count, log = sim.advance, [0], []
+
+    def advance(state, settings, n_steps, **kwargs):
+        compiled = compiles == "every" or not log
+        start = time.perf_counter()
+        if compiled:
+            time.sleep(sleep_s)
+            count[0] += 1
+        out = real(state, settings, n_steps, **kwargs)
+        log.append((n_steps * state.n_particles * state.n_cells,
+                    time.perf_counter() - start, compiled))
+        return out
+
+    monkeypatch.setattr(sim, "advance", advance)
+    monkeypatch.setattr(sim, "_kernel_specializations", lambda: count[0])
+    return log
+
+
+def test_throughput_leaves_out_kernel_calls_that_compiled(monkeypatch):
+    log = _fake_compiler(monkeypatch, compiles="first", sleep_s=1.0)
+    r = simulate_load_case(LoadCase(500, 5, 50), DemConfig(**FAST))
+    steps = sum(n for n, _, c in log if not c)
+    seconds = sum(t for _, t, c in log if not c)
+    # the clock brackets the same calls as this log, with only Python bookkeeping between
+    # (microseconds against milliseconds per call); with the 1 s "compile" counted the rate
+    # would drop by several times
+    assert r.particle_steps_per_s == pytest.approx(steps / seconds, rel=0.2)
+    assert sum(1 for *_, c in log if c) == 1 and r.wall_s > 1.0  # wall time keeps it
+    assert not [n for n in r.notes if "particle_steps_per_s" in n]
+
+
+def test_throughput_of_a_run_that_only_compiled_is_refused(monkeypatch):
+    _fake_compiler(monkeypatch, compiles="every", sleep_s=0.0)
+    r = simulate_load_case(LoadCase(500, 5, 50), DemConfig(**FAST))
+    assert math.isnan(r.particle_steps_per_s)
+    assert r.to_dict()["particle_steps_per_s"] is None
+    assert any("particle_steps_per_s not measured" in n for n in r.notes)

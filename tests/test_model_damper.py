@@ -107,6 +107,12 @@ def test_damper_table_content(model):
                                 frequencies=[100, 1000], vibrated_mass_kg=mass)
     assert list(t.columns) == list(DAMPER_COLUMNS)
     assert len(t) == 8
+    # every number column names its unit; the True/False flag has none to name
+    for column, unit in DAMPER_COLUMNS.items():
+        if pd.api.types.is_bool_dtype(t[column]):
+            assert "[" not in column and unit == "", column
+        else:
+            assert pd.api.types.is_float_dtype(t[column]) and column.endswith(f" [{unit}]")
     sdc = model(t["fill [%]"].to_numpy(), t["acceleration [g]"].to_numpy(),
                 t["frequency [Hz]"].to_numpy())
     np.testing.assert_array_equal(t["sdc [-]"], sdc)
@@ -119,7 +125,7 @@ def test_damper_table_content(model):
     # c_eq = dE / (pi w X^2) by definition of the equivalent damper
     np.testing.assert_allclose(t["c_eq [N s/m]"], t["energy_per_cycle [J]"] / (np.pi * w * x**2),
                                rtol=1e-13)
-    flagged = t[t["sdc_filled [-]"]]
+    flagged = t[t["sdc_filled"]]
     assert flagged[["fill [%]", "acceleration [g]", "frequency [Hz]"]].values.tolist() == [
         [90.0, 1.0, 1000.0]]
 

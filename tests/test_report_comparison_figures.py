@@ -92,7 +92,7 @@ def test_sdc_comparison_plots_the_table_values():
     measured = table[np.isfinite(table["SDC measured [-]"])]
     assert len(ax.get_xticks()) == len(measured) == 2
     by_label = {ln.get_label(): ln for ln in ax.get_lines()}
-    interp = by_label["DEM (ours), pchip-interpolated"].get_ydata()
+    interp = by_label["DEM (ours), SDC of Eq. 10 E, pchip-interpolated"].get_ydata()
     assert list(interp) == list(measured.loc[measured[ALIGNMENT_COLUMN] == "interpolated",
                                              "SDC DEM (ours) [-]"])
 
@@ -106,3 +106,40 @@ def test_loop_from_stored_phasors_equals_the_analysis_loop(dem_arrays):
     np.testing.assert_allclose(x, x0, rtol=1e-12, atol=1e-18)
     np.testing.assert_allclose(f, f0, rtol=1e-12, atol=1e-12)
     assert "phasors" in loop_from_phasors({}, 100.0)
+
+
+def test_sdc_comparison_sets_the_eq10_measured_sdc_beside_our_dem():
+    """The measurement drawn beside our DEM (Eq. 10 SDC) is the table's Eq. 10 measured SDC,
+    the value its difference column uses; the Eq. 11 SDC is drawn apart and labelled so."""
+    from pidcore.report.table import DIFFERENCE_COLUMN, MEASURED_EQ10_COLUMN
+
+    # one record whose Eq. 11 SDC (4.3) is ~3x its Eq. 10 SDC: the gap the old figure showed
+    m_c, energy = 0.069, 1.25e-5
+    dem = pd.DataFrame({"frequency_hz": [500.0], "acceleration_g": [5.0], "fill_percent": [50.0],
+                        "material": ["acrylic"], "direction": ["z"], "sdc": [1.5],
+                        "sdc_stderr": [0.03], "m_c_kg": [m_c]})
+    measured = pd.DataFrame({"frequency_hz": [500.2], "acceleration_g": [4.98],
+                             "fill_percent": [50.0], "sdc": [4.3], "sdc_stderr": [0.1],
+                             "energy_per_cycle_j": [energy], "source": ["x.csv"]})
+    table = build_report_table(dem, measured, None)
+    row = table.iloc[0]
+    fig = plot_sdc_comparison(table)
+    ax = fig.axes[0]
+    _, labels = ax.get_legend_handles_labels()
+    eq10 = [lb for lb in labels if lb.startswith("measured (ours)") and "Eq. 10" in lb
+            and "Eq. 11" not in lb]
+    eq11 = [lb for lb in labels if lb.startswith("measured (ours)") and "Eq. 11" in lb]
+    assert len(eq10) == 1 and len(eq11) == 1 and "different quantity" in eq11[0]
+    assert any(lb.startswith("DEM (ours)") and "Eq. 10" in lb for lb in labels)
+    # errorbar containers: (data line, caps, bars); find each series' drawn y value
+    drawn = {c.get_label(): c.lines[0].get_ydata() for c in ax.containers}
+    assert list(drawn[eq10[0]]) == [row[MEASURED_EQ10_COLUMN]]
+    assert list(drawn[eq11[0]]) == [row["SDC measured [-]"]]
+    # what the figure sets side by side is what the table subtracts
+    dem_label = next(lb for lb in drawn if lb.startswith("DEM (ours)"))
+    assert drawn[eq10[0]][0] - drawn[dem_label][0] == pytest.approx(row[DIFFERENCE_COLUMN],
+                                                                    rel=1e-12)
+    # Eq. 10 error bar keeps the Eq. 11 relative error: one record, only E differs
+    bars = next(c for c in ax.containers if c.get_label() == eq10[0]).lines[2][0]
+    (lo, hi), = [seg[:, 1] for seg in bars.get_segments()]
+    assert (hi - lo) / 2 == pytest.approx(0.1 / 4.3 * row[MEASURED_EQ10_COLUMN], rel=1e-12)

@@ -149,14 +149,28 @@ def _specimen(args: argparse.Namespace):
     return specimen, args.material or specimen.particles.material
 
 
+def _interrupted(command: str, saved: int, store) -> int:
+    """Ctrl-C: say what was saved (finished runs are, each in its own transaction), exit 130."""
+    if saved:
+        what = f"{saved} finished run(s) saved to {store}; re-run to resume"
+    else:
+        what = "nothing saved" + (f", {store} unchanged" if store is not None else "")
+    print(f"pidcore dem {command}: interrupted; {what}", file=sys.stderr)
+    return 130
+
+
 def sweep(args: argparse.Namespace) -> int:
     from ..dem.sweep import grid_cases, run_sweep
 
     specimen, material = _specimen(args)
     cases = grid_cases(args.grid, material=material, direction=args.direction)
-    summary = run_sweep(cases, _config(args), store_path=args.store, workers=args.workers,
-                        scheduler=args.scheduler, progress=not args.no_progress,
-                        specimen=specimen)
+    saved: list[str] = []  # keys run_sweep has stored (its on_case hook runs after each save)
+    try:
+        summary = run_sweep(cases, _config(args), store_path=args.store, workers=args.workers,
+                            scheduler=args.scheduler, progress=not args.no_progress,
+                            specimen=specimen, on_case=lambda outcome: saved.append(outcome.key))
+    except KeyboardInterrupt:
+        return _interrupted("sweep", len(saved), args.store)
     if args.json:
         print(json.dumps(summary.to_dict()))
     else:
@@ -187,19 +201,27 @@ def run(args: argparse.Namespace) -> int:
     progress = not args.no_progress and sys.stderr.isatty()
     key = None
     reused = False
-    if args.store is not None:
-        from ..dem.persist import run_key, run_or_load
-        from ..store import Store
+    store = None
+    try:
+        if args.store is not None:
+            from ..dem.persist import run_key, run_or_load
+            from ..store import Store
 
-        key = run_key(case, config, specimen)
-        store = Store(args.store)
-        reused = args.store.exists() and store.has_dem_run(key)
-        result = run_or_load(store, specimen, case, config, progress=progress)
-    else:
-        result = simulate_load_case(case, config, progress=progress, specimen=specimen)
+            key = run_key(case, config, specimen)
+            store = Store(args.store)
+            reused = args.store.exists() and store.has_dem_run(key)
+            result = run_or_load(store, specimen, case, config, progress=progress)
+        else:
+            result = simulate_load_case(case, config, progress=progress, specimen=specimen)
+    except KeyboardInterrupt:
+        # the run is saved in one transaction at its end: in the store now, or not at all
+        saved = (store is not None and key is not None and not reused
+                 and args.store.exists() and store.has_dem_run(key))
+        return _interrupted("run", int(saved), args.store)
     if args.json:
         out = {k: result.to_dict()[k] for k in JSON_KEYS}
         out.update(result.to_dict())
+        out["notes"] = list(result.notes)
         if key is not None:
             out["store_key"] = key
             out["reused_from_store"] = reused
@@ -251,4 +273,5 @@ def format_summary(result) -> str:
         f"numerics        dt {result.time_step_s:.4g} s, {result.steps} steps, "
         f"{result.wall_s:.1f} s wall, {result.particle_steps_per_s:.3g} particle-steps/s",
     ]
+    lines += [f"note            {note}" for note in result.notes]
     return "\n".join(lines)

@@ -53,7 +53,9 @@ class DemResult:
     ``energy_balance_error`` is (W_walls - dE_mech - D) / W_walls over the whole driven run
     (all cells), with dE_mech = kinetic (incl. rotation) + gravity + elastic (Hertz and
     contact springs) energy change. ``particle_steps_per_s`` counts settling and driven steps
-    over the time spent in the kernel (all threads); ``wall_s`` is the whole call.
+    over the time spent in the kernel (all threads), leaving out kernel calls that compiled
+    Numba code (NaN when every call did, see :attr:`notes`); ``wall_s`` is the whole call,
+    compilation included.
 
     ``dissipation_per_cycle_j`` (cycles,) is the coupon dissipation of every driven cycle;
     ``wall_force_n`` (samples,) the drive-axis force the walls exert on the particles of the
@@ -164,6 +166,31 @@ class DemResult:
             shaker_force_n=coupon_mass_kg * acc + wall_n, velocity_m_s=vel,
             samples_per_cycle=int(spc), specimen=specimen, coupon_cells=int(n_coupon),
         )
+
+    @property
+    def notes(self) -> tuple[str, ...]:
+        """What a reader of this run's numbers should know (not stored; derived from the run).
+
+        * the steady window measured is longer than asked (``config.steady_cycles``, else
+          DEM_MIN_STEADY_CYCLES): the kernel runs whole blocks of ``config.block_cycles``
+          cycles, and the two blocks that detect the steady state both belong to the window;
+        * ``particle_steps_per_s`` was not measured (NaN): every kernel call compiled code.
+        """
+        from .simulate import required_steady_cycles
+
+        notes = []
+        asked = required_steady_cycles(self.case, self.config)
+        if self.steady_cycles > asked:
+            b = self.config.block_cycles
+            why = f"the DEM runs whole blocks of {b} cycles"
+            if self.steady_detected:
+                why += ", and the two blocks that detected the steady state are both measured"
+            notes.append(f"steady window rounded up: {self.steady_cycles} cycles measured for "
+                         f"the {asked} asked ({why})")
+        if not math.isfinite(self.particle_steps_per_s):
+            notes.append("particle_steps_per_s not measured: every kernel call of this run "
+                         "included Numba compilation (run again for the compiled speed)")
+        return tuple(notes)
 
     @property
     def loss_factor(self) -> float:

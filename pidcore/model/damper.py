@@ -34,13 +34,14 @@ from ..constants import STANDARD_GRAVITY
 from ..errors import ParameterError
 from .sdc_model import SdcModel
 
-#: Output columns of :func:`equivalent_damper_table` and their units.
+#: Output columns of :func:`equivalent_damper_table` and their units. Every number column names
+#: its unit in brackets; ``sdc_filled`` is a True/False flag, so it has neither (unit ``""``).
 DAMPER_COLUMNS: dict[str, str] = {
     "frequency [Hz]": "Hz",
     "acceleration [g]": "g",
     "fill [%]": "%",
     "sdc [-]": "-",
-    "sdc_filled [-]": "-",
+    "sdc_filled": "",
     "loss_factor [-]": "-",
     "damping_ratio [-]": "-",
     "vibrated_mass [kg]": "kg",
@@ -221,8 +222,9 @@ def equivalent_damper_table(model: SdcModel, *, fills: Sequence[float],
     Returns
     -------
     pandas.DataFrame
-        Columns :data:`DAMPER_COLUMNS` (names carry units); ``sdc_filled [-]`` (bool) is True where
-        the point coincides with a filled hole of the model grid.
+        Columns :data:`DAMPER_COLUMNS` (number columns name their units); ``sdc_filled`` (a
+        bool flag, no unit) is True where the point coincides with a filled hole of the model
+        grid.
     """
     grid = pd.MultiIndex.from_product(
         [np.asarray(frequencies, float), np.asarray(accelerations, float),
@@ -250,7 +252,7 @@ def equivalent_damper_table(model: SdcModel, *, fills: Sequence[float],
         "acceleration [g]": a_g,
         "fill [%]": p,
         "sdc [-]": sdc,
-        "sdc_filled [-]": filled,
+        "sdc_filled": filled,
         "loss_factor [-]": loss_factor(sdc),
         "damping_ratio [-]": damping_ratio(sdc),
         "vibrated_mass [kg]": mass,

@@ -1,7 +1,8 @@
 """Report figures that compare measurement, our DEM and the paper (plotting only).
 
-* :func:`plot_sdc_comparison` - per load case: measured SDC ± standard error, our DEM mean ±
-  standard error, the paper's DEM and experimental values.
+* :func:`plot_sdc_comparison` - per load case: measured SDC over Eq. 10's E ± standard error
+  beside our DEM's (Eq. 10) SDC ± standard error, the paper's DEM and experimental values, and
+  the measured Eq. 11 SDC marked as the different quantity it is.
 * :func:`plot_loop_overlay` - force-displacement loop of a measurement over the DEM's loop at
   the same load case.
 * :func:`dem_loop_from_arrays` - the DEM loop from a stored run's decimated time series.
@@ -18,7 +19,7 @@ import pandas as pd
 
 from .. import defaults
 from ..loop import ForceDisplacementLoop
-from .table import ALIGNMENT_COLUMN
+from .table import ALIGNMENT_COLUMN, MEASURED_EQ10_COLUMN
 
 #: Force arrays looked for in a DEM run, in order: the force a shaker's gauge would measure
 #: (coupon inertia + particles, :class:`pidcore.dem.result.DemResult`), comparable with a
@@ -40,6 +41,13 @@ def _new_figure(width: float, height: float):
 def plot_sdc_comparison(table: pd.DataFrame, *, ax=None):
     """SDC per load case: measured, our DEM and the paper's values side by side.
 
+    Our DEM's SDC divides the energy dissipated per cycle by Eq. 10's ``E = m_c a^2 / (2 w^2)``,
+    so the measurement drawn beside it is the same SDC, the measured energy per cycle over that
+    E (:data:`pidcore.report.table.MEASURED_EQ10_COLUMN`, the value the table's difference column
+    uses). The Eq. 11 SDC (over the reactive energy ``Im(P_c)/w``) is a different quantity,
+    typically a few times larger; where the table has it, it is drawn apart as hollow markers
+    with a legend saying so.
+
     Parameters
     ----------
     table : pandas.DataFrame
@@ -50,39 +58,56 @@ def plot_sdc_comparison(table: pd.DataFrame, *, ax=None):
     Returns
     -------
     matplotlib.figure.Figure
-        Error bars are one standard error; interpolated DEM values are drawn as open markers
-        without error bars (the model carries none).
+        Error bars are one standard error; the Eq. 10 measured value carries the relative
+        standard error of the Eq. 11 value (only the reference energy differs; exact for a
+        single record, the pooled relative error for several). Interpolated DEM values are drawn
+        as open markers without error bars (the model carries none).
     """
     rows = table[np.isfinite(table["SDC measured [-]"].astype(float))]
     if rows.empty:
         rows = table
     n = len(rows)
     if ax is None:
-        fig = _new_figure(max(6.4, 0.55 * n + 2.0), 4.2)
+        fig = _new_figure(max(6.4, 0.65 * n + 2.0) + 3.6, 4.2)
         ax = fig.subplots()
     else:
         fig = ax.figure
     x = np.arange(n, dtype=float)
-    width = 0.18
+    width = 0.15
     labels = [f"{r['frequency [Hz]']:.4g} Hz\n{r['acceleration [g]']:.3g} g\n"
               f"{r['packing ratio [%]']:.3g} %" for _, r in rows.iterrows()]
-    ax.errorbar(x - 1.5 * width, rows["SDC measured [-]"], yerr=rows["SDC measured stderr [-]"],
-                fmt="o", color="C0", capsize=3, label="measured (ours) ± SE")
+    sdc11 = rows["SDC measured [-]"].astype(float).to_numpy()
+    sdc11_se = rows["SDC measured stderr [-]"].astype(float).to_numpy()
+    sdc10 = rows[MEASURED_EQ10_COLUMN].astype(float).to_numpy()
+    with np.errstate(divide="ignore", invalid="ignore"):
+        sdc10_se = sdc11_se * sdc10 / sdc11
+    has10 = np.isfinite(sdc10)
+    if has10.any():
+        ax.errorbar(x[has10] - 2 * width, sdc10[has10], yerr=sdc10_se[has10], fmt="o",
+                    color="C0", capsize=3, label="measured (ours), SDC of Eq. 10 E ± SE")
     on_grid = (rows[ALIGNMENT_COLUMN] == "grid").to_numpy()
-    ax.errorbar(x[on_grid] - 0.5 * width, rows["SDC DEM (ours) [-]"][on_grid],
+    ax.errorbar(x[on_grid] - width, rows["SDC DEM (ours) [-]"][on_grid],
                 yerr=rows["SDC DEM stderr [-]"][on_grid], fmt="s", color="C1", capsize=3,
-                label="DEM (ours) ± SE")
+                label="DEM (ours), SDC of Eq. 10 E ± SE")
     if (~on_grid).any():
-        ax.plot(x[~on_grid] - 0.5 * width, rows["SDC DEM (ours) [-]"][~on_grid], "s",
-                markerfacecolor="none", color="C1", label="DEM (ours), pchip-interpolated")
-    ax.plot(x + 0.5 * width, rows["SDC DEM (paper) [-]"], "D", color="C2", label="DEM (paper)")
-    ax.plot(x + 1.5 * width, rows["SDC measured (paper) [-]"], "^", color="C3",
+        ax.plot(x[~on_grid] - width, rows["SDC DEM (ours) [-]"][~on_grid], "s",
+                markerfacecolor="none", color="C1",
+                label="DEM (ours), SDC of Eq. 10 E, pchip-interpolated")
+    ax.plot(x, rows["SDC DEM (paper) [-]"], "D", color="C2", label="DEM (paper)")
+    ax.plot(x + width, rows["SDC measured (paper) [-]"], "^", color="C3",
             label="measured (paper)")
+    has11 = np.isfinite(sdc11)
+    if has11.any():
+        ax.errorbar(x[has11] + 2 * width, sdc11[has11], yerr=sdc11_se[has11], fmt="v",
+                    markerfacecolor="none", color="0.4", capsize=3,
+                    label="measured (ours), Eq. 11 SDC over Im(P_c)/w ± SE:\n"
+                          "a different quantity, not comparable with the Eq. 10 SDC")
     ax.set_xticks(x, labels, fontsize="small")
     ax.set_ylabel("SDC [-]")
-    ax.set_title("SDC per load case")
+    ax.set_title("SDC per load case (ours: dissipated energy over Eq. 10's E)")
     ax.grid(axis="y", alpha=0.3)
-    ax.legend(fontsize="small")
+    # outside the axes: six long entries would hide the markers they describe
+    ax.legend(fontsize="small", loc="upper left", bbox_to_anchor=(1.01, 1.0))
     return fig
 
 
