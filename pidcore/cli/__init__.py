@@ -75,7 +75,10 @@ def _run(argv: list[str] | None) -> int:
     except (KeyboardInterrupt, SystemError) as exc:
         if not interrupt.is_interruption(exc):
             raise
-        said = "finished results are saved" if started else "nothing was done"
+        # commands that count what they saved say so themselves (analyze, dem); here only
+        # what holds for every command: a store write is whole or absent, never half-done
+        said = ("no store write was left half-done (an output folder may hold part of this "
+                "run's files)" if started else "nothing was done")
         print(f"pidcore {command}: interrupted; {said}", file=sys.stderr)
         interrupt.mark_handled()
         return 130
