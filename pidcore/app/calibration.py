@@ -11,7 +11,6 @@ calibration started again reuses them.
 from __future__ import annotations
 
 import importlib
-import os
 import tempfile
 import threading
 import time
@@ -125,12 +124,10 @@ def calibration_path(environ: Mapping[str, str] | None = None, *,
                      cwd: Path | None = None) -> Path | None:
     """``$PIDCORE_CALIBRATION``, else the bundled :data:`BUNDLED_CALIBRATION` if it exists in
     the working folder, else None."""
-    env = os.environ if environ is None else environ
-    value = env.get(CALIBRATION_ENV_VAR, "").strip()
-    if value:
-        return Path(value)
-    bundled = (cwd or Path.cwd()) / BUNDLED_CALIBRATION
-    return bundled if bundled.is_file() else None
+    from .stores import path_from_env_or_bundled
+
+    return path_from_env_or_bundled(CALIBRATION_ENV_VAR, BUNDLED_CALIBRATION,
+                                    environ=environ, cwd=cwd)
 
 
 def active_calibration(task: CalibrationTask | None, environ: Mapping[str, str] | None = None,

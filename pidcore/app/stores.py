@@ -30,12 +30,21 @@ def dem_store_path(environ: Mapping[str, str] | None = None, *,
                    cwd: Path | None = None) -> Path | None:
     """Read-only store of reference DEM runs: ``$PIDCORE_DEM_STORE``, else the bundled
     :data:`BUNDLED_DEM_STORE` if it exists in the working folder, else None."""
+    return path_from_env_or_bundled(DEM_STORE_ENV_VAR, BUNDLED_DEM_STORE,
+                                    environ=environ, cwd=cwd)
+
+
+def path_from_env_or_bundled(variable: str, bundled: Path, *,
+                             environ: Mapping[str, str] | None = None,
+                             cwd: Path | None = None) -> Path | None:
+    """The file an environment variable names, else ``bundled`` (relative to the working
+    folder) if it exists there, else None."""
     env = os.environ if environ is None else environ
-    value = env.get(DEM_STORE_ENV_VAR, "").strip()
+    value = env.get(variable, "").strip()
     if value:
         return Path(value)
-    bundled = (cwd or Path.cwd()) / BUNDLED_DEM_STORE
-    return bundled if bundled.is_file() else None
+    found = (cwd or Path.cwd()) / bundled
+    return found if found.is_file() else None
 
 
 @dataclass(frozen=True)
