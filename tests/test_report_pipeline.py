@@ -219,3 +219,18 @@ def test_cli_pool_merges_dem_settings_that_are_separate_rows_by_default(tmp_path
     pooled = rows("--pool")
     assert len(pooled) == 1 and pooled["DEM runs [-]"].iloc[0] == 2
     assert "--pool" in pooled["note"].iloc[0]
+
+
+@pytest.mark.parametrize("content", [None, b""])
+def test_missing_or_empty_file_is_named_before_its_load_case(tmp_path, capsys, content):
+    # a new user's typo must read "file not found" / "empty file", not "no fill stated"
+    from pidcore.cli import main
+
+    path = tmp_path / "run.csv"
+    if content is not None:
+        path.write_bytes(content)
+    rc = main(["report", str(path), "--out", str(tmp_path / "out")])
+    err = capsys.readouterr().err
+    assert rc == 2 and err.count("\n") == 1 and str(path) in err
+    assert ("file not found" if content is None else "empty file") in err
+    assert not (tmp_path / "out").exists()

@@ -142,9 +142,12 @@ def analyze_files(paths: Sequence[str | Path], *, fill_percent: float | None = N
     (slow) analysis runs. Files with identical contents are one measurement: kept once, and
     refused if they state different load cases.
     """
+    from ..io import detect_file_format
     from ..measure import AnalysisOptions, analyze_file
 
     options = options or AnalysisOptions()
+    for path in paths:  # a missing or empty file is named as such, not as "no fill stated"
+        detect_file_format(path)
     stated = [resolve_load_case(p, fill_percent=fill_percent, material=material,
                                 direction=direction, sidecar=sidecar) for p in paths]
     out: list[MeasuredResult] = []
