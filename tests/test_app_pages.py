@@ -449,31 +449,18 @@ def test_bundled_samples_switch_load_cases_within_a_second(store_file, monkeypat
 
 
 def _fake_calibrate_module(calls: list):
-    """A stand-in for pidcore.calibrate (written on another branch) with the functions the
-    page uses, so the page's wiring is tested against that API."""
+    """pidcore.calibrate with its DEM-running ``calibrate`` and its file writer replaced by
+    recorders, so the page's wiring is tested in seconds (the real library's run is tested by
+    the real-library test below)."""
     import types
-    from dataclasses import dataclass
 
-    @dataclass(frozen=True)
-    class MeasuredPoint:
-        frequency_hz: float
-        acceleration_g: float
-        fill_percent: float
-        sdc: float
-        sdc_stderr: float = 0.0
+    from pidcore.calibrate.data import measured_from_store
 
     module = types.ModuleType("pidcore.calibrate")
     module.CATALOGUE = {"fixture_mass_kg": None, "baseline_loss_factor": None}
     module.parse_fit = lambda text=None, specimen=None: (
         ["fixture_mass_kg", "baseline_loss_factor"] if text is None
         else [n.strip() for n in text if n.strip()])
-
-    def measured_from_store(path):
-        from pidcore.store import Store
-
-        rows = Store(path).list_analyses()
-        return [MeasuredPoint(r.frequency_hz, r.acceleration_g, r.fill_percent, r.sdc,
-                              r.sdc_stderr) for r in rows.itertuples()]
 
     def calibrate(points, *, fit, store_path, cells, design_size, progress):
         calls.append((len(points), tuple(fit), cells))
