@@ -101,3 +101,21 @@ def paper_table() -> pd.DataFrame:
 def paper_model(paper_table) -> SdcModel:
     """The pchip SDC model over the paper's Table 3 DEM values."""
     return SdcModel.from_table(paper_table)
+
+
+@pytest.fixture
+def one_measured_case():
+    """One DEM run and one measurement of the same load case (500 Hz, 5 g, 50 %) as the
+    report table takes them: the measurement's Eq. 11 SDC (4.3) is ~3x its Eq. 10 SDC, the
+    gap between the two SDCs that report tests must not mix up."""
+    from types import SimpleNamespace
+
+    m_c, energy = 0.069, 1.25e-5
+    dem = pd.DataFrame({"frequency_hz": [500.0], "acceleration_g": [5.0], "fill_percent": [50.0],
+                        "material": ["acrylic"], "direction": ["z"], "sdc": [1.5],
+                        "sdc_stderr": [0.03], "m_c_kg": [m_c]})
+    measured = pd.DataFrame({"frequency_hz": [500.2], "acceleration_g": [4.98],
+                             "fill_percent": [50.0], "sdc": [4.3], "sdc_stderr": [0.1],
+                             "energy_per_cycle_j": [energy], "source": ["x.csv"]})
+    return SimpleNamespace(dem=dem, measured=measured, vibrated_mass_kg=m_c,
+                           energy_per_cycle_j=energy)

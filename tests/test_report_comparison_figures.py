@@ -108,19 +108,13 @@ def test_loop_from_stored_phasors_equals_the_analysis_loop(dem_arrays):
     assert "phasors" in loop_from_phasors({}, 100.0)
 
 
-def test_sdc_comparison_sets_the_eq10_measured_sdc_beside_our_dem():
+def test_sdc_comparison_sets_the_eq10_measured_sdc_beside_our_dem(one_measured_case):
     """The measurement drawn beside our DEM (Eq. 10 SDC) is the table's Eq. 10 measured SDC,
     the value its difference column uses; the Eq. 11 SDC is drawn apart and labelled so."""
     from pidcore.report.table import DIFFERENCE_COLUMN, MEASURED_EQ10_COLUMN
 
     # one record whose Eq. 11 SDC (4.3) is ~3x its Eq. 10 SDC: the gap the old figure showed
-    m_c, energy = 0.069, 1.25e-5
-    dem = pd.DataFrame({"frequency_hz": [500.0], "acceleration_g": [5.0], "fill_percent": [50.0],
-                        "material": ["acrylic"], "direction": ["z"], "sdc": [1.5],
-                        "sdc_stderr": [0.03], "m_c_kg": [m_c]})
-    measured = pd.DataFrame({"frequency_hz": [500.2], "acceleration_g": [4.98],
-                             "fill_percent": [50.0], "sdc": [4.3], "sdc_stderr": [0.1],
-                             "energy_per_cycle_j": [energy], "source": ["x.csv"]})
+    dem, measured = one_measured_case.dem, one_measured_case.measured
     table = build_report_table(dem, measured, None)
     row = table.iloc[0]
     fig = plot_sdc_comparison(table)

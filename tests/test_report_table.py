@@ -188,24 +188,18 @@ def test_measured_case_sorts_into_its_grid_block():
     assert list(t["acceleration [g]"][pos + 1:]) == [5.0, 5.0]
 
 
-def test_measured_sdc_with_eq10_energy_uses_the_dem_vibrated_mass():
+def test_measured_sdc_with_eq10_energy_uses_the_dem_vibrated_mass(one_measured_case):
     """ΔE_measured / (m_c a^2 / (2 w^2)) with m_c of the aligned DEM case, computed by hand."""
     import math
-
-    import pandas as pd
 
     from pidcore.constants import STANDARD_GRAVITY
     from pidcore.model import load_paper_table3
     from pidcore.report import build_report_table
     from pidcore.report.table import MEASURED_EQ10_COLUMN
 
-    m_c, energy = 0.069, 1.25e-5
-    dem = pd.DataFrame({"frequency_hz": [500.0], "acceleration_g": [5.0], "fill_percent": [50.0],
-                        "material": ["acrylic"], "direction": ["z"], "sdc": [1.5],
-                        "sdc_stderr": [0.03], "m_c_kg": [m_c]})
-    measured = pd.DataFrame({"frequency_hz": [500.2], "acceleration_g": [4.98],
-                             "fill_percent": [50.0], "sdc": [4.3], "sdc_stderr": [0.1],
-                             "energy_per_cycle_j": [energy], "source": ["x.csv"]})
+    case = one_measured_case
+    m_c, energy = case.vibrated_mass_kg, case.energy_per_cycle_j
+    dem, measured = case.dem, case.measured
     table = build_report_table(dem, measured, load_paper_table3())
     row = table[table["load case"].str.startswith("f500Hz_a5g_fill50")].iloc[0]
     w = 2 * math.pi * 500.2
