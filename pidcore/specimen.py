@@ -30,6 +30,10 @@ coupon, ``pidcore/data/specimens/paper_coupon.toml``)::
     # poisson_ratio = 0.402
     # count_per_cell = 11              # or fill_percent = 50.0 (optional: the specimen's fill)
 
+    [pairs]
+    # tangential_stiffness_model = "constant"  # or "mindlin": k_t = 8 G* sqrt(R* delta)
+    #                                          # of the current overlap (both pairs)
+
     [pairs.particle_particle]
     restitution = 0.70
     sliding_friction = 0.096
@@ -46,9 +50,11 @@ coupon, ``pidcore/data/specimens/paper_coupon.toml``)::
 A material named in the table fills the properties not given inline; the parsed
 :class:`Specimen` always holds the resolved numbers, so its canonical text
 (:attr:`Specimen.text`) and :attr:`Specimen.hash` describe the physics completely, whatever the
-tables say later. Every numeric field is addressable by a dotted path
-(``"pairs.particle_wall.static_friction"``, ``"particles.radius_m"``) for
-:meth:`Specimen.with_values`.
+tables say later. ``[pairs] tangential_stiffness_model`` (``"constant"``, the default, or
+``"mindlin"``) appears in the canonical text only when it is ``"mindlin"``: files that do not
+set it keep the hash they had before the key existed. Every numeric field (and that key) is
+addressable by a dotted path (``"pairs.particle_wall.static_friction"``, ``"particles.radius_m"``,
+``"pairs.tangential_stiffness_model"``) for :meth:`Specimen.with_values`.
 """
 
 from __future__ import annotations
@@ -65,11 +71,18 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
-from .constants import CELL_SHAPES, CellShape
+from .constants import (
+    CELL_SHAPES,
+    TANGENTIAL_STIFFNESS_MODELS,
+    CellShape,
+    TangentialStiffnessModel,
+)
 from .errors import ParameterError
 
 #: Version of the specimen schema written by :meth:`Specimen.to_toml`.
 SCHEMA_VERSION = 1
+#: k_t model of a specimen that states none; left out of the canonical text (hash unchanged).
+DEFAULT_TANGENTIAL_STIFFNESS_MODEL: TangentialStiffnessModel = "constant"
 #: The paper's coupon, bundled with the package.
 PAPER_SPECIMEN_NAME = "paper_coupon"
 
@@ -200,14 +213,24 @@ class PairSpec:
 
 @dataclass(frozen=True)
 class PairsSpec:
-    """The two contact pairs of a one-material bed: particle-particle and particle-wall."""
+    """The two contact pairs of a one-material bed: particle-particle and particle-wall.
+
+    ``tangential_stiffness_model``: k_t of both pairs' stick-slip spring, ``"constant"``
+    (Mindlin's 8 G* sqrt(R* delta_ref) at a reference overlap) or ``"mindlin"`` (of the
+    current overlap), see :class:`pidcore.dem.contact.ContactLaw`.
+    """
 
     particle_particle: PairSpec
     particle_wall: PairSpec
+    tangential_stiffness_model: TangentialStiffnessModel = DEFAULT_TANGENTIAL_STIFFNESS_MODEL
 
     def __post_init__(self):
         self.particle_particle.check("[pairs.particle_particle]")
         self.particle_wall.check("[pairs.particle_wall]")
+        if self.tangential_stiffness_model not in TANGENTIAL_STIFFNESS_MODELS:
+            raise _fail("[pairs] tangential_stiffness_model",
+                        f"expected one of {TANGENTIAL_STIFFNESS_MODELS}, "
+                        f"got {self.tangential_stiffness_model!r}")
 
 
 @dataclass(frozen=True)
@@ -294,9 +317,15 @@ class Specimen:
         for section in ("cell", "coupon", "particles"):
             out[section] = {k: v for k, v in dataclasses.asdict(getattr(self, section)).items()
                             if v is not None}
-        out["pairs"] = {k: dataclasses.asdict(v) for k, v in
-                        (("particle_particle", self.pairs.particle_particle),
-                         ("particle_wall", self.pairs.particle_wall))}
+        pairs: dict[str, Any] = {}
+        model = self.pairs.tangential_stiffness_model
+        if model != DEFAULT_TANGENTIAL_STIFFNESS_MODEL:
+            # only a non-default model is written: earlier files keep their text and hash
+            pairs["tangential_stiffness_model"] = model
+        pairs.update((k, dataclasses.asdict(v)) for k, v in
+                     (("particle_particle", self.pairs.particle_particle),
+                      ("particle_wall", self.pairs.particle_wall)))
+        out["pairs"] = pairs
         return out
 
     def to_toml(self) -> str:
@@ -367,6 +396,7 @@ SCHEMA: dict[str, dict[str, tuple[bool, str]]] = {
     "pair": {"restitution": (True, "float"), "sliding_friction": (True, "float"),
              "static_friction": (False, "float"), "rolling_friction": (False, "float"),
              "rolling_damping_ratio": (False, "float")},
+    "pairs": {"tangential_stiffness_model": (False, "str")},
 }
 PAIR_NAMES = ("particle_particle", "particle_wall")
 
@@ -375,7 +405,7 @@ def _allowed_keys(prefix: list[str]) -> tuple[str, ...]:
     if not prefix:
         return (*SCHEMA[""], "cell", "coupon", "particles", "pairs")
     if prefix == ["pairs"]:
-        return PAIR_NAMES
+        return (*SCHEMA["pairs"], *PAIR_NAMES)
     if len(prefix) == 2 and prefix[0] == "pairs":
         return tuple(SCHEMA["pair"])
     if len(prefix) == 1 and prefix[0] in SCHEMA:
@@ -488,8 +518,11 @@ def _from_mapping(data: Mapping[str, Any], *, source: str) -> Specimen:
     if not isinstance(pairs_table, Mapping):
         raise ParameterError("[pairs]: expected tables [pairs.particle_particle] and "
                              "[pairs.particle_wall]")
-    for key in pairs_table:
-        if key not in PAIR_NAMES:
+    # scalars of [pairs] hold what both pairs share; its tables are the pairs
+    shared = _take({k: v for k, v in pairs_table.items() if not isinstance(v, Mapping)},
+                   "pairs", "[pairs]")
+    for key, value in pairs_table.items():
+        if isinstance(value, Mapping) and key not in PAIR_NAMES:
             raise ParameterError(f"[pairs.{key}]: unknown pair; expected one of {PAIR_NAMES}")
     pairs = {}
     for name in PAIR_NAMES:
@@ -503,7 +536,8 @@ def _from_mapping(data: Mapping[str, Any], *, source: str) -> Specimen:
     return Specimen(name=top["name"], description=top.get("description", ""),
                     cell=CellSpec(**cell), coupon=CouponSpec(**_take(data["coupon"], "coupon",
                                                                      "[coupon]")),
-                    particles=ParticleSpec(**particles), pairs=PairsSpec(**pairs), source=source)
+                    particles=ParticleSpec(**particles), pairs=PairsSpec(**pairs, **shared),
+                    source=source)
 
 
 def _toml_value(value: Any) -> str:
@@ -597,7 +631,8 @@ def contact_law(specimen: Specimen, *, alpha_pp: float | None = None,
 
     :meth:`pidcore.dem.contact.ContactLaw.from_properties` fed from the specimen's resolved
     numbers (so the paper's specimen gives ``ContactLaw.for_material`` bit for bit).
-    ``alpha_*`` override Eq. 3's damping constants.
+    ``alpha_*`` override Eq. 3's damping constants. The k_t model is the specimen's
+    ``[pairs] tangential_stiffness_model``.
     """
     from .dem.contact import ContactLaw
     from .dem.materials import MaterialProperties, PairParameters
@@ -621,7 +656,8 @@ def contact_law(specimen: Specimen, *, alpha_pp: float | None = None,
                                 poisson_ratio=c.wall_poisson_ratio),
         pair_particle=pair(specimen.pairs.particle_particle),
         pair_wall=pair(specimen.pairs.particle_wall),
-        particle_material=p.material, alpha_pp=alpha_pp, alpha_pw=alpha_pw)
+        particle_material=p.material, alpha_pp=alpha_pp, alpha_pw=alpha_pw,
+        tangential_stiffness_model=specimen.pairs.tangential_stiffness_model)
 
 
 @functools.cache
@@ -645,9 +681,15 @@ def describe(specimen: Specimen) -> dict[str, Any]:
     Particle counts and masses are for the specimen's stated fill (``count_per_cell`` or
     ``fill_percent`` of the capacity) where it states one, else for a full cell. Contact time
     and time step are for the hardest impact of the Table 3 grid (50 Hz, 10 g).
+
+    ``tangential_stiffness_*_n_m`` is the constant k_t (Mindlin's at the overlap of a
+    DEM_TANGENTIAL_REFERENCE_SPEED_M_S impact); with ``tangential_stiffness_model = "mindlin"``
+    ``mindlin_tangential_stiffness_*_n_m`` is k_t = 8 G* sqrt(R* delta) at the Hertz overlap
+    ``reference_impact_overlap_*_m`` of that hardest impact (None for ``"constant"``).
     """
     from . import defaults
     from .constants import PARTICLE_MATERIALS
+    from .dem.contact import maximum_overlap
     from .dem.simulate import LoadCase, choose_time_step, max_impact_speed
 
     law = contact_law(specimen)
@@ -663,6 +705,14 @@ def describe(specimen: Specimen) -> dict[str, Any]:
     material = p.material if p.material in PARTICLE_MATERIALS else "acrylic"
     case = LoadCase(DESCRIBE_FREQUENCY_HZ, DESCRIBE_ACCELERATION_G, 100.0, material=material)
     speed = max_impact_speed(case, geometry)
+    mindlin = specimen.pairs.tangential_stiffness_model == "mindlin"
+    overlap = {name: float(maximum_overlap(stiffness=pair.stiffness,
+                                           mass_kg=pair.effective_mass_kg,
+                                           impact_speed_m_s=speed))
+               for name, pair in (("pp", law.pair_particle), ("pw", law.pair_wall))}
+    k_t_mindlin = {name: float(pair.mindlin_factor * math.sqrt(overlap[name])) if mindlin
+                   else None
+                   for name, pair in (("pp", law.pair_particle), ("pw", law.pair_wall))}
     return {
         "name": specimen.name, "sha256": specimen.hash, "is_paper": specimen.is_paper(),
         "cell_shape": specimen.cell.shape, "cells_per_coupon": specimen.cell.count,
@@ -679,6 +729,11 @@ def describe(specimen: Specimen) -> dict[str, Any]:
         "normal_stiffness_pw_n_m1_5": law.pair_wall.stiffness,
         "tangential_stiffness_pp_n_m": law.pair_particle.tangential_stiffness,
         "tangential_stiffness_pw_n_m": law.pair_wall.tangential_stiffness,
+        "tangential_stiffness_model": specimen.pairs.tangential_stiffness_model,
+        "reference_impact_overlap_pp_m": overlap["pp"],
+        "reference_impact_overlap_pw_m": overlap["pw"],
+        "mindlin_tangential_stiffness_pp_n_m": k_t_mindlin["pp"],
+        "mindlin_tangential_stiffness_pw_n_m": k_t_mindlin["pw"],
         "reference_impact_speed_m_s": speed,
         "contact_time_s": law.contact_time(speed),
         "tangential_period_s": law.tangential_period(),

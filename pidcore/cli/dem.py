@@ -15,6 +15,7 @@ from ..constants import (
     START_PACKINGS,
     START_PROTOCOLS,
     TANGENTIAL_MODELS,
+    TANGENTIAL_STIFFNESS_MODELS,
     VIBRATED_MASS_CONVENTIONS,
 )
 from ..errors import ParameterError
@@ -106,6 +107,11 @@ def _add_config_options(p: argparse.ArgumentParser) -> None:
                    help="friction: tangential spring capped by mu |f_n| (stick_slip) or Eq. 5 "
                         f"regularised near zero slip (coulomb) (default "
                         f"{defaults.DEM_TANGENTIAL_MODEL})")
+    p.add_argument("--tangential-stiffness", choices=TANGENTIAL_STIFFNESS_MODELS, default=None,
+                   help="k_t of the stick-slip spring: Mindlin's at a 0.3 m/s impact's overlap "
+                        "(constant) or 8 G* sqrt(R* delta) of the current overlap (mindlin); "
+                        "overrides the specimen's [pairs] tangential_stiffness_model (default: "
+                        "the specimen's, constant for the paper's coupon)")
     p.add_argument("--fill-reference", choices=("capacity", "paper"),
                    default=defaults.DEM_FILL_REFERENCE,
                    help="100 %% = cell capacity (dense packing) or the paper's 36 particles")
@@ -140,13 +146,20 @@ def _config(args: argparse.Namespace):
 
 
 def _specimen(args: argparse.Namespace):
-    """(specimen or None, load-case material) from --specimen and --material."""
-    if args.specimen is None:
-        return None, args.material or "acrylic"
-    from ..specimen import load_specimen
+    """(specimen or None, load-case material) from --specimen, --material and
+    --tangential-stiffness (a specimen value: the specimen's hash, and so the run's key and
+    provenance, say which k_t model ran)."""
+    from ..specimen import load_specimen, paper_specimen
 
-    specimen = load_specimen(args.specimen)
-    return specimen, args.material or specimen.particles.material
+    if args.specimen is None:
+        specimen, material = None, args.material or "acrylic"
+    else:
+        specimen = load_specimen(args.specimen)
+        material = args.material or specimen.particles.material
+    if args.tangential_stiffness is not None:
+        specimen = (specimen or paper_specimen(material)).with_values(
+            {"pairs.tangential_stiffness_model": args.tangential_stiffness})
+    return specimen, material
 
 
 def _interrupted(command: str, saved: int, store) -> int:
@@ -233,6 +246,11 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
+def _tangential_stiffness_model(result) -> str:
+    s = result.specimen
+    return s.pairs.tangential_stiffness_model if s is not None else "constant"
+
+
 def format_summary(result) -> str:
     """Readable multi-line summary with units."""
     c = result.case
@@ -267,7 +285,8 @@ def format_summary(result) -> str:
         f"steady state    from cycle {result.steady_start_cycle} "
         f"({'detected' if result.steady_detected else 'NOT converged, transient cap'}), "
         f"{result.steady_cycles} cycles measured",
-        f"model           friction {result.config.tangential_model}, normal damping "
+        f"model           friction {result.config.tangential_model} (k_t "
+        f"{_tangential_stiffness_model(result)}), normal damping "
         f"{result.config.normal_damping_mode}, start {result.config.start_packing} packing "
         f"{result.config.start_protocol.replace('_', ' ')}",
         f"numerics        dt {result.time_step_s:.4g} s, {result.steps} steps, "

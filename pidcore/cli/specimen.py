@@ -6,6 +6,7 @@ import argparse
 import json
 from pathlib import Path
 
+from .. import defaults
 from ._options import add_json_option
 
 
@@ -55,7 +56,22 @@ def format_facts(f: dict, source: str) -> str:
         f"{f['normal_stiffness_pp_n_m1_5']:.4g}, particle-wall "
         f"{f['normal_stiffness_pw_n_m1_5']:.4g} N/m^1.5; tangential "
         f"{f['tangential_stiffness_pp_n_m']:.4g}, {f['tangential_stiffness_pw_n_m']:.4g} N/m",
+        _tangential_line(f),
         f"contact time    {f['contact_time_s']:.4g} s at {f['reference_impact_speed_m_s']:.3g} "
         f"m/s (50 Hz, 10 g); stuck tangential period {f['tangential_period_s']:.4g} s",
         f"time step       {f['time_step_s']:.4g} s (auto, for that impact)",
     ])
+
+
+def _tangential_line(f: dict) -> str:
+    """The k_t model; for Mindlin's, k_t at the hardest impact's overlap beside the constant."""
+    if f["tangential_stiffness_model"] != "mindlin":
+        return ("k_t model       constant: Mindlin's k_t at the overlap of a "
+                f"{defaults.DEM_TANGENTIAL_REFERENCE_SPEED_M_S:g} m/s impact (values above)")
+    return (f"k_t model       mindlin: 8 G* sqrt(R* delta) of the current overlap; at the "
+            f"{f['reference_impact_speed_m_s']:.3g} m/s impact's overlap "
+            f"({f['reference_impact_overlap_pp_m'] * 1e6:.3g}, "
+            f"{f['reference_impact_overlap_pw_m'] * 1e6:.3g} um) "
+            f"{f['mindlin_tangential_stiffness_pp_n_m']:.4g}, "
+            f"{f['mindlin_tangential_stiffness_pw_n_m']:.4g} N/m (constant: "
+            f"{f['tangential_stiffness_pp_n_m']:.4g}, {f['tangential_stiffness_pw_n_m']:.4g} N/m)")

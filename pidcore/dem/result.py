@@ -233,6 +233,8 @@ class DemResult:
             out.update({"specimen_name": self.specimen.name,
                         "specimen_sha256": self.specimen.hash,
                         "specimen_is_paper": self.specimen.is_paper(),
+                        "tangential_stiffness_model":
+                            self.specimen.pairs.tangential_stiffness_model,
                         "fixture_mass_kg": self.specimen.coupon.fixture_mass_kg,
                         "particle_mass_kg": self.specimen.particles.mass_kg})
         for name in ("sdc", "sdc_stderr", "loss_factor", "energy_per_cycle_j", "work_per_cycle_j",

@@ -19,7 +19,7 @@ from ..constants import DriveDirection, ParticleMaterial
 from ..errors import ParameterError
 from ..specimen import Specimen
 from .persist import dem_run_entry, run_key, run_key_0_1, save_dem_entry
-from .simulate import DemConfig, LoadCase, simulate_load_case
+from .simulate import DemConfig, LoadCase, resolve_specimen, simulate_load_case
 
 #: Named grids. ``table3`` is the paper's Table 3: 4 frequencies x 3 accelerations x 4 fills.
 GRIDS: dict[str, dict[str, tuple[float, ...]]] = {
@@ -120,8 +120,11 @@ def run_sweep(cases: Sequence[LoadCase], config: DemConfig, *,
     todo: list[tuple[LoadCase, str]] = []
     for case in cases:
         key = run_key(case, config, specimen)
-        stored = [k for k in (key, run_key_0_1(case, config))
-                  if store.path.exists() and store.has_dem_run(k)]
+        # a 0.1 key names only the paper's coupon (with its constant k_t): another specimen's
+        # run, a Mindlin one of that coupon included, is never found under it
+        keys = (key, run_key_0_1(case, config)) if resolve_specimen(case, specimen).is_paper() \
+            else (key,)
+        stored = [k for k in keys if store.path.exists() and store.has_dem_run(k)]
         if stored:  # also under the key a 0.1 store holds it by
             summary.skipped.append(stored[0])
         else:

@@ -320,7 +320,8 @@ class SdcModel:
 #: Runs differing in any of them are not averaged into one model.
 DEM_CONDITION_COLUMNS: tuple[str, ...] = (
     "material", "direction", "normal_damping_mode", "vibrated_mass_convention",
-    "start_protocol", "start_packing", "tangential_model", "fill_reference",
+    "start_protocol", "start_packing", "tangential_model", "tangential_stiffness_model",
+    "fill_reference",
 )
 
 
