@@ -180,7 +180,7 @@ def test_dem_run_flag_overrides_the_specimen_both_ways(tmp_path, capsys):
     # and the file's own model holds without the flag
     assert run("--specimen", str(mindlin_file))["store_key"] == mindlin["store_key"]
     assert main([*base[:-3], "--tangential-stiffness", "mindlin"]) == 0
-    assert "(k_t mindlin)" in capsys.readouterr().out
+    assert ", k_t mindlin\n" in capsys.readouterr().out
 
 
 def test_mindlin_load_case_closes_its_energy_balance_and_differs_from_constant():

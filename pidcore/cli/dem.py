@@ -285,10 +285,10 @@ def format_summary(result) -> str:
         f"steady state    from cycle {result.steady_start_cycle} "
         f"({'detected' if result.steady_detected else 'NOT converged, transient cap'}), "
         f"{result.steady_cycles} cycles measured",
-        f"model           friction {result.config.tangential_model} (k_t "
-        f"{_tangential_stiffness_model(result)}), normal damping "
+        f"model           friction {result.config.tangential_model}, normal damping "
         f"{result.config.normal_damping_mode}, start {result.config.start_packing} packing "
-        f"{result.config.start_protocol.replace('_', ' ')}",
+        f"{result.config.start_protocol.replace('_', ' ')}, k_t "
+        f"{_tangential_stiffness_model(result)}",
         f"numerics        dt {result.time_step_s:.4g} s, {result.steps} steps, "
         f"{result.wall_s:.1f} s wall, {result.particle_steps_per_s:.3g} particle-steps/s",
     ]
