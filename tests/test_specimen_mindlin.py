@@ -197,3 +197,30 @@ def test_mindlin_load_case_closes_its_energy_balance_and_differs_from_constant()
     # measured 0.2 % for this case), with the Mindlin spring's energy in the mechanical part
     assert abs(mindlin.energy_balance_error) <= 0.01
     assert mindlin.energy_dissipated_friction_j > 0
+
+
+def test_calibrated_damping_accepts_mindlin_and_calibrates_the_same_head_on_impact(monkeypatch):
+    # alpha is tuned on a head-on impact, where no tangential spring acts: the k_t model must
+    # neither refuse the calibration nor change what is calibrated
+    from pidcore.dem import impact
+
+    calls = []
+
+    class Reached(Exception):
+        pass
+
+    def record(*args, **kwargs):
+        calls.append((args, kwargs))
+        raise Reached
+
+    monkeypatch.setattr(impact, "calibrate_damping_coefficient", record)
+    config = DemConfig(cells=1, steady_cycles=4, time_step=8e-7,
+                       damping_coefficient="calibrated")
+    for specimen in (PAPER, MINDLIN):
+        with pytest.raises(Reached):
+            simulate_load_case(CASE, config, specimen=specimen)
+    assert len(calls) == 2 and calls[0] == calls[1]
+    # a specimen whose contact differs from the tables' is still refused
+    with pytest.raises(ParameterError, match="calibrated'"):
+        simulate_load_case(CASE, config, specimen=MINDLIN.with_values(
+            {"pairs.particle_wall.restitution": 0.5}))

@@ -426,10 +426,12 @@ def simulate_load_case(case: LoadCase, config: DemConfig | None = None, *,
         from .impact import calibrate_damping_coefficient
 
         # the impact calibration builds its law from the tables by material name: refuse a
-        # specimen whose law differs from that (it would calibrate another contact)
+        # specimen whose law differs from that (it would calibrate another contact); the k_t
+        # model may differ, the calibrating impact is head-on (no tangential spring)
         if (case.material != specimen.particles.material
-                or law != ContactLaw.for_material(case.material, alpha_pp=config.alpha_pp,
-                                                  alpha_pw=config.alpha_pw)):
+                or law != ContactLaw.for_material(
+                    case.material, alpha_pp=config.alpha_pp, alpha_pw=config.alpha_pw,
+                    tangential_stiffness_model=law.tangential_stiffness_model)):
             raise ParameterError(
                 f"damping_coefficient='calibrated': only for table particles with the "
                 f"tables' contact pairs, not specimen {specimen.name!r}; use 'eq3'")
