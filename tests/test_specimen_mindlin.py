@@ -224,3 +224,17 @@ def test_calibrated_damping_accepts_mindlin_and_calibrates_the_same_head_on_impa
     with pytest.raises(ParameterError, match="calibrated'"):
         simulate_load_case(CASE, config, specimen=MINDLIN.with_values(
             {"pairs.particle_wall.restitution": 0.5}))
+
+
+def test_the_sdc_model_does_not_average_mindlin_with_constant_runs():
+    import pandas as pd
+
+    from pidcore.model.sdc_model import select_runs
+
+    runs = pd.DataFrame({"frequency_hz": [50.0, 50.0], "acceleration_g": [5.0, 5.0],
+                         "fill_percent": [50.0, 50.0], "sdc": [0.1, 0.2],
+                         "tangential_stiffness_model": ["constant", "mindlin"]})
+    with pytest.raises(ParameterError, match="differ in tangential_stiffness_model"):
+        select_runs(runs)
+    assert select_runs(runs, where={"tangential_stiffness_model": "mindlin"})["sdc"].tolist() \
+        == [0.2]
