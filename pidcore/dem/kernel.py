@@ -230,6 +230,32 @@ def _contact(hist, a, b, law, nx, ny, nz, delta, arm,
     return f_el, f_n, gx, gy, gz, mx, my, mz, mdx, mdy, mdz, lost_t, lost_r
 
 
+@njit(cache=True, inline="always")
+def _contact_force(f_n, nx, ny, nz, gx, gy, gz, arm):
+    """Force -f_n n + g of a contact on its first particle and the torque arm n x g of g."""
+    return (-f_n * nx + gx, -f_n * ny + gy, -f_n * nz + gz,
+            arm * (ny * gz - nz * gy), arm * (nz * gx - nx * gz), arm * (nx * gy - ny * gx))
+
+
+@njit(cache=True, inline="always")
+def _record_contact(c_idx, c_val, k, i, j, nx, ny, nz, arm, f_damping, gx, gy, gz,
+                    mdx, mdy, mdz):
+    """Keep contact ``k`` (partner j, -1 for a wall) for the dissipation tally after the kick."""
+    c_idx[0, k] = i
+    c_idx[1, k] = j
+    c_val[0, k] = nx
+    c_val[1, k] = ny
+    c_val[2, k] = nz
+    c_val[3, k] = arm
+    c_val[4, k] = f_damping
+    c_val[5, k] = gx
+    c_val[6, k] = gy
+    c_val[7, k] = gz
+    c_val[8, k] = mdx
+    c_val[9, k] = mdy
+    c_val[10, k] = mdz
+
+
 @njit(cache=True, parallel=True)
 def advance_cells(pos, vel, omg, frc, trq, wall_n, wall_d,
                   radius, mass, inertia, law_pp, law_pw,
@@ -487,28 +513,16 @@ def _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
                     options, rolling)
                 d_fric += lt
                 d_roll += lr
-                cfx = -f_n * nx + gx
-                cfy = -f_n * ny + gy
-                cfz = -f_n * nz + gz
-                tx[i] += arm * (ny * gz - nz * gy) + mx
-                ty[i] += arm * (nz * gx - nx * gz) + my
-                tz[i] += arm * (nx * gy - ny * gx) + mz
+                cfx, cfy, cfz, ctx, cty, ctz = _contact_force(f_n, nx, ny, nz, gx, gy, gz,
+                                                              arm)
+                tx[i] += ctx + mx
+                ty[i] += cty + my
+                tz[i] += ctz + mz
                 fx[i] += cfx
                 fy[i] += cfy
                 fz[i] += cfz
-                c_idx[0, n_c] = i
-                c_idx[1, n_c] = -1
-                c_val[0, n_c] = nx
-                c_val[1, n_c] = ny
-                c_val[2, n_c] = nz
-                c_val[3, n_c] = arm
-                c_val[4, n_c] = f_n - f_el
-                c_val[5, n_c] = gx
-                c_val[6, n_c] = gy
-                c_val[7, n_c] = gz
-                c_val[8, n_c] = mdx
-                c_val[9, n_c] = mdy
-                c_val[10, n_c] = mdz
+                _record_contact(c_idx, c_val, n_c, i, -1, nx, ny, nz, arm, f_n - f_el,
+                                gx, gy, gz, mdx, mdy, mdz)
                 n_c += 1
                 w_wall += (cfx * wvx + cfy * wvy + cfz * wvz) * dt
                 if drive_axis == 0:
@@ -557,14 +571,9 @@ def _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
                 options, rolling)
             d_fric += lt
             d_roll += lr
-            # force on i: -f_n n + g; on j: the opposite
-            cfx = -f_n * nx + gx
-            cfy = -f_n * ny + gy
-            cfz = -f_n * nz + gz
-            # torque of g on i and on j: arm n x g (same for both); rolling: m on i, -m on j
-            ctx = arm * (ny * gz - nz * gy)
-            cty = arm * (nz * gx - nx * gz)
-            ctz = arm * (nx * gy - ny * gx)
+            # force on i: -f_n n + g, on j the opposite; torque of g: arm n x g on both;
+            # rolling torque: m on i, -m on j
+            cfx, cfy, cfz, ctx, cty, ctz = _contact_force(f_n, nx, ny, nz, gx, gy, gz, arm)
             tx[i] += ctx + mx
             ty[i] += cty + my
             tz[i] += ctz + mz
@@ -577,19 +586,8 @@ def _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
             fx[j] -= cfx
             fy[j] -= cfy
             fz[j] -= cfz
-            c_idx[0, n_c] = i
-            c_idx[1, n_c] = j
-            c_val[0, n_c] = nx
-            c_val[1, n_c] = ny
-            c_val[2, n_c] = nz
-            c_val[3, n_c] = arm
-            c_val[4, n_c] = f_n - f_el
-            c_val[5, n_c] = gx
-            c_val[6, n_c] = gy
-            c_val[7, n_c] = gz
-            c_val[8, n_c] = mdx
-            c_val[9, n_c] = mdy
-            c_val[10, n_c] = mdz
+            _record_contact(c_idx, c_val, n_c, i, j, nx, ny, nz, arm, f_n - f_el,
+                            gx, gy, gz, mdx, mdy, mdz)
             n_c += 1
         # --- second half kick ----------------------------------------------------------
         for i in range(n_part):
