@@ -231,6 +231,17 @@ def _contact(hist, a, b, law, nx, ny, nz, delta, arm,
 
 
 @njit(cache=True, inline="always")
+def _half_kick(i, half_dt, vx, vy, vz, ox, oy, oz, fx, fy, fz, tx, ty, tz, inv_m, inv_i):
+    """Half a velocity-Verlet kick of particle i by its force and torque (``half_dt`` = dt/2)."""
+    vx[i] += half_dt * fx[i] * inv_m
+    vy[i] += half_dt * fy[i] * inv_m
+    vz[i] += half_dt * fz[i] * inv_m
+    ox[i] += half_dt * tx[i] * inv_i
+    oy[i] += half_dt * ty[i] * inv_i
+    oz[i] += half_dt * tz[i] * inv_i
+
+
+@njit(cache=True, inline="always")
 def _contact_force(f_n, nx, ny, nz, gx, gy, gz, arm):
     """Force -f_n n + g of a contact on its first particle and the torque arm n x g of g."""
     return (-f_n * nx + gx, -f_n * ny + gy, -f_n * nz + gz,
@@ -300,6 +311,7 @@ def _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
     n_walls = wall_n.shape[0]
     inv_m = 1.0 / mass
     inv_i = 1.0 / inertia
+    half_dt = 0.5 * dt
     two_r = 2.0 * radius
     max_overlap = max_overlap_fraction * radius
     skin = NEIGHBOUR_SKIN_FRACTION * radius
@@ -367,21 +379,16 @@ def _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
     for s in range(n_steps):
         # --- first half kick and drift -------------------------------------------------
         for i in range(n_part):
-            vx[i] += 0.5 * dt * fx[i] * inv_m
-            vy[i] += 0.5 * dt * fy[i] * inv_m
-            vz[i] += 0.5 * dt * fz[i] * inv_m
-            ox[i] += 0.5 * dt * tx[i] * inv_i
-            oy[i] += 0.5 * dt * ty[i] * inv_i
-            oz[i] += 0.5 * dt * tz[i] * inv_i
+            _half_kick(i, half_dt, vx, vy, vz, ox, oy, oz, fx, fy, fz, tx, ty, tz, inv_m, inv_i)
             px[i] += dt * vx[i]
             py[i] += dt * vy[i]
             pz[i] += dt * vz[i]
-            vpx[i] = vx[i] + 0.5 * dt * fx[i] * inv_m
-            vpy[i] = vy[i] + 0.5 * dt * fy[i] * inv_m
-            vpz[i] = vz[i] + 0.5 * dt * fz[i] * inv_m
-            wpx[i] = ox[i] + 0.5 * dt * tx[i] * inv_i
-            wpy[i] = oy[i] + 0.5 * dt * ty[i] * inv_i
-            wpz[i] = oz[i] + 0.5 * dt * tz[i] * inv_i
+            vpx[i] = vx[i] + half_dt * fx[i] * inv_m
+            vpy[i] = vy[i] + half_dt * fy[i] * inv_m
+            vpz[i] = vz[i] + half_dt * fz[i] * inv_m
+            wpx[i] = ox[i] + half_dt * tx[i] * inv_i
+            wpy[i] = oy[i] + half_dt * ty[i] * inv_i
+            wpz[i] = oz[i] + half_dt * tz[i] * inv_i
             fx[i] = 0.0
             fy[i] = 0.0
             fz[i] = -mass * gravity
@@ -591,12 +598,7 @@ def _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
             n_c += 1
         # --- second half kick ----------------------------------------------------------
         for i in range(n_part):
-            vx[i] += 0.5 * dt * fx[i] * inv_m
-            vy[i] += 0.5 * dt * fy[i] * inv_m
-            vz[i] += 0.5 * dt * fz[i] * inv_m
-            ox[i] += 0.5 * dt * tx[i] * inv_i
-            oy[i] += 0.5 * dt * ty[i] * inv_i
-            oz[i] += 0.5 * dt * tz[i] * inv_i
+            _half_kick(i, half_dt, vx, vy, vz, ox, oy, oz, fx, fy, fz, tx, ty, tz, inv_m, inv_i)
         # --- dissipation with the new full-step velocities ---------------------------
         # v(t) is what the kicks of this step's force act on (sum_t F(t).v(t) dt is the
         # kinetic energy change to second order), so the tally closes the energy balance.
