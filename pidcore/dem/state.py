@@ -152,6 +152,25 @@ class KernelSettings:
         check_tangential_model(self.tangential_model)
 
 
+def _advance_on_threads(args: tuple, n_cells: int) -> None:
+    """Run the kernel over all cells, in contiguous slices on ``numba.get_num_threads()``
+    threads (the kernel releases the GIL; each thread writes only its own cells)."""
+    import numba
+
+    n_threads = max(min(numba.get_num_threads(), n_cells), 1)
+    bounds = [round(n_cells * t / n_threads) for t in range(n_threads + 1)]
+    if n_threads == 1:
+        advance_cells(*args, np.int64(0), np.int64(n_cells))
+        return
+    from concurrent.futures import ThreadPoolExecutor
+
+    with ThreadPoolExecutor(max_workers=n_threads, thread_name_prefix="pidcore-dem") as pool:
+        futures = [pool.submit(advance_cells, *args, np.int64(lo), np.int64(hi))
+                   for lo, hi in zip(bounds[:-1], bounds[1:], strict=True)]
+        for future in futures:
+            future.result()
+
+
 def advance(state: CellsState, settings: KernelSettings, n_steps: int, *,
             steps_per_cycle: int | None = None, sample_every: int | None = None
             ) -> tuple[np.ndarray, np.ndarray]:
@@ -173,18 +192,19 @@ def advance(state: CellsState, settings: KernelSettings, n_steps: int, *,
     samples = np.zeros((k, max(-(-n_steps // se), 1)))
     status = np.zeros(k, dtype=np.int64)
     fail_step = np.zeros(k, dtype=np.int64)
-    advance_cells(state.pos, state.vel, state.omg, state.frc, state.trq,
-                  g.wall_normals, g.wall_offsets,
-                  law.radius_m, law.mass_kg, law.inertia_kg_m2, law_pp, law_pw,
-                  settings.friction_regularisation_m_s, settings.clip_attraction,
-                  settings.gravity_m_s2, settings.tangential_model == "stick_slip",
-                  bool(law_pp[LAW_ROLLING_STIFFNESS] > 0 or law_pw[LAW_ROLLING_STIFFNESS] > 0),
-                  state.spring_pp, state.spring_pw,
-                  settings.dt_s, np.int64(state.step), np.int64(n_steps),
-                  settings.omega_rad_s, settings.accel_m_s2,
-                  AXIS_INDEX[settings.direction],
-                  np.int64(spc), np.int64(se), settings.max_overlap_fraction,
-                  tally, samples, status, fail_step)
+    args = (state.pos, state.vel, state.omg, state.frc, state.trq,
+            g.wall_normals, g.wall_offsets,
+            law.radius_m, law.mass_kg, law.inertia_kg_m2, law_pp, law_pw,
+            settings.friction_regularisation_m_s, settings.clip_attraction,
+            settings.gravity_m_s2, settings.tangential_model == "stick_slip",
+            bool(law_pp[LAW_ROLLING_STIFFNESS] > 0 or law_pw[LAW_ROLLING_STIFFNESS] > 0),
+            state.spring_pp, state.spring_pw,
+            settings.dt_s, np.int64(state.step), np.int64(n_steps),
+            settings.omega_rad_s, settings.accel_m_s2,
+            AXIS_INDEX[settings.direction],
+            np.int64(spc), np.int64(se), settings.max_overlap_fraction,
+            tally, samples, status, fail_step)
+    _advance_on_threads(args, k)
     state.step += n_steps
     if np.any(status != STATUS_OK):
         c = int(np.flatnonzero(status != STATUS_OK)[0])
