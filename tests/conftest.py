@@ -9,6 +9,11 @@ path that the warm-up writes when it is done. Workers run the tests that call th
 last (:data:`DEM_KERNEL_TESTS`) and wait for the warm-up before the first of them, so the
 kernel is compiled once, while the other tests run, instead of once per worker.
 ``PIDCORE_NUMBA_WARMUP=0`` skips all this.
+
+Two more settings for ``-n 2`` on two cores: OpenMP threads of the parallel kernel sleep
+instead of spinning when idle (``OMP_WAIT_POLICY=PASSIVE``; a spinning thread takes the other
+worker's core for milliseconds after every kernel call, and tests that call the kernel
+thousands of times for a few steps each slowed down tenfold).
 """
 
 import os
@@ -22,6 +27,7 @@ from pathlib import Path
 
 os.environ.setdefault("NUMBA_CACHE_DIR",
                       str(Path(__file__).resolve().parents[1] / ".numba_cache"))
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 
 import pandas as pd  # noqa: E402  (NUMBA_CACHE_DIR must be set before numba is imported)
 import pytest  # noqa: E402
@@ -60,6 +66,18 @@ def pytest_unconfigure(config: pytest.Config) -> None:
         process.kill()           # numba writes each cache file whole
     process.wait()
     shutil.rmtree(Path(os.environ.pop(WARMUP_DONE_ENV)).parent, ignore_errors=True)
+
+
+def pytest_terminal_summary(terminalreporter, config: pytest.Config) -> None:
+    # A warm-up that fails (it did once, silently: a refused synthetic record stopped it
+    # before the DEM kernel) costs a compile in every worker; say so rather than be slow.
+    if config.stash.get(_WARMUP, None) is None:
+        return
+    done = Path(os.environ[WARMUP_DONE_ENV])
+    status = done.read_text(encoding="utf-8") if done.exists() else "did not finish"
+    if status != "ok":
+        terminalreporter.write_line(f"numba warm-up {status}: each worker compiled on its own",
+                                    yellow=True)
 
 
 def pytest_report_header(config: pytest.Config) -> str:
