@@ -137,3 +137,32 @@ def one_measured_case():
                              "energy_per_cycle_j": [energy], "source": ["x.csv"]})
     return SimpleNamespace(dem=dem, measured=measured, vibrated_mass_kg=m_c,
                            energy_per_cycle_j=energy)
+
+
+@pytest.fixture
+def undrawn_report_figures(monkeypatch):
+    """Report figures saved as a 1x1 PNG and a minimal SVG instead of being drawn.
+
+    For report tests that check tables, text and which files exist, not pictures: drawing and
+    saving the report's figures (PNG and SVG, tight bounding boxes) takes seconds per report.
+    The figures are still built, named and listed; tests/test_report_render.py and
+    test_report_end_to_end save them for real.
+    """
+    import io
+
+    from matplotlib.image import imsave
+
+    from pidcore.report import render
+
+    buffer = io.BytesIO()
+    imsave(buffer, [[0.0]], format="png")
+    png_bytes = buffer.getvalue()
+
+    def save_figure_files(fig, folder: Path, stem: str, **_) -> tuple[Path, Path]:
+        folder.mkdir(parents=True, exist_ok=True)
+        png, svg = folder / f"{stem}.png", folder / f"{stem}.svg"
+        png.write_bytes(png_bytes)
+        svg.write_text('<svg xmlns="http://www.w3.org/2000/svg"/>', encoding="utf-8")
+        return png, svg
+
+    monkeypatch.setattr(render, "save_figure_files", save_figure_files)
