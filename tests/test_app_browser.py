@@ -22,7 +22,7 @@ from _app_samples import mass_damper_csv
 from pidcore.app import uploads
 from pidcore.app.stores import STORE_ENV_VAR
 
-pytestmark = [pytest.mark.browser, pytest.mark.slow]
+pytestmark = [pytest.mark.browser, pytest.mark.slow, pytest.mark.dem_subprocess]
 
 REPO = Path(__file__).resolve().parents[1]
 SHIM = REPO / "app" / "pidcore_app.py"
