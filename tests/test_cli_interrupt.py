@@ -37,6 +37,7 @@ def _digest(path: Path) -> str:
     return hashlib.sha256(path.read_bytes()).hexdigest()
 
 
+@pytest.mark.slow
 def test_sigint_at_any_time_exits_130_with_one_line_and_commits_nothing(tmp_path):
     small = _export(tmp_path / "small.csv", 40)
     # 2000 periods at 25.6 kHz: 512k rows, ~30 MB, a run of ~2 s here, so that the signals

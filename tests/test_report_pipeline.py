@@ -108,7 +108,6 @@ def test_report_end_to_end(e2e, dem_store):
     assert sha256_file(file) in text and sha256_file(store) in text and dem_sha in text
 
 
-@pytest.mark.slow
 @pytest.mark.usefixtures("undrawn_report_figures")
 def test_report_from_store_only_uses_stored_analyses(e2e, dem_store, tmp_path):
     _, store, _, first = e2e
@@ -121,7 +120,6 @@ def test_report_from_store_only_uses_stored_analyses(e2e, dem_store, tmp_path):
     assert not any("without DEM overlay" in n for n in again.notes)
 
 
-@pytest.mark.slow
 @pytest.mark.usefixtures("undrawn_report_figures")
 def test_cli_with_dem_store_only_stores_nothing(tmp_path, dem_store, capsys):
     file = _write_measurement(tmp_path / "coupon2_75pct.csv", seed=3)
