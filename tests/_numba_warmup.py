@@ -12,17 +12,25 @@ import sys
 from pathlib import Path
 
 
-def warm_numba_kernels() -> None:
-    """Compile (or load from the cache) every Numba kernel the suite calls, with the argument
-    types the library passes: the harmonic fit first (most tests analyse a record, it takes
-    seconds), then the DEM step loop (both specialisations of the cell kernel, via a single
-    impact and a tiny load case)."""
+def warm_signal_kernels() -> None:
+    """The harmonic fit and the clipping scan, on a record the analysis accepts."""
     import numpy as np
 
     from pidcore.signal import analyze_power
+    from pidcore.signal.validate import clipped_samples
 
+    # a damped mass: force leads velocity by a little less than 90 degrees (Im P > 0, loss
+    # factor 0.1); a record the analysis refuses would stop the warm-up before the DEM kernel
     t = np.arange(2000) / 1000.0
-    analyze_power(np.sin(100 * t), np.cos(100 * t), 1000.0)
+    analyze_power(np.cos(100 * t) + 0.1 * np.sin(100 * t), np.sin(100 * t), 1000.0)
+    clipped_samples(np.sin(100 * t))
+
+
+def warm_numba_kernels() -> None:
+    """Compile (or load from the cache) every Numba kernel the suite calls, with the argument
+    types the library passes: the signal kernels first (most tests analyse a record, they
+    take seconds), then the DEM step loop (via a single impact and a tiny load case)."""
+    warm_signal_kernels()
 
     from pidcore.dem import DemConfig, LoadCase, simulate_impact, simulate_load_case
 

@@ -5,10 +5,18 @@ Numba kernels (``@njit(cache=True)``) compile in ~1 min from a cold cache. The c
 numba; an explicit ``NUMBA_CACHE_DIR`` wins). With ``-n N`` the controller process starts
 ``tests/_numba_warmup.py`` in the background in ``pytest_configure``, before pytest-xdist starts
 its workers (``DSession.pytest_sessionstart``); the workers inherit the cache location and a
-path that the warm-up writes when it is done. Workers run the tests that call the DEM kernel
-last (:data:`DEM_KERNEL_TESTS`) and wait for the warm-up before the first of them, so the
-kernel is compiled once, while the other tests run, instead of once per worker.
-``PIDCORE_NUMBA_WARMUP=0`` skips all this.
+path that the warm-up writes when it is done. Workers run the tests of the DEM modules last
+(:data:`DEM_KERNEL_TESTS`) and wait for the warm-up only where it is needed, so the kernel is
+compiled once, while the other tests run, instead of once per worker: a worker about to
+compile a ``pidcore.dem`` function waits for the warm-up first (and then loads it from the
+cache), and a test marked ``dem_subprocess`` (it runs the kernel in a process of its own: app
+jobs, process pools, a served app) waits before it starts. ``PIDCORE_NUMBA_WARMUP=0`` skips
+all this.
+
+Two more settings for ``-n 2`` on two cores: OpenMP threads of the parallel kernel sleep
+instead of spinning when idle (``OMP_WAIT_POLICY=PASSIVE``; a spinning thread takes the other
+worker's core for milliseconds after every kernel call, and tests that call the kernel
+thousands of times for a few steps each slowed down tenfold).
 """
 
 import os
@@ -22,13 +30,15 @@ from pathlib import Path
 
 os.environ.setdefault("NUMBA_CACHE_DIR",
                       str(Path(__file__).resolve().parents[1] / ".numba_cache"))
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 
 import pandas as pd  # noqa: E402  (NUMBA_CACHE_DIR must be set before numba is imported)
 import pytest  # noqa: E402
 
 from pidcore.model import SdcModel, load_paper_table3  # noqa: E402
 
-#: Test modules that call the DEM kernel (directly, through the CLI, sweeps or the app).
+#: Test modules that call the DEM kernel (directly, through the CLI, sweeps or the app): run
+#: after the others, whose tests need no wait.
 DEM_KERNEL_TESTS = re.compile(r"^test_(dem_|app_|samples|specimen|calibrat)")
 #: Environment variable naming the file the background warm-up writes when it is done.
 WARMUP_DONE_ENV = "PIDCORE_NUMBA_WARMUP_DONE"
@@ -62,6 +72,18 @@ def pytest_unconfigure(config: pytest.Config) -> None:
     shutil.rmtree(Path(os.environ.pop(WARMUP_DONE_ENV)).parent, ignore_errors=True)
 
 
+def pytest_terminal_summary(terminalreporter, config: pytest.Config) -> None:
+    # A warm-up that fails (it did once, silently: a refused synthetic record stopped it
+    # before the DEM kernel) costs a compile in every worker; say so rather than be slow.
+    if config.stash.get(_WARMUP, None) is None:
+        return
+    done = Path(os.environ[WARMUP_DONE_ENV])
+    status = done.read_text(encoding="utf-8") if done.exists() else "did not finish"
+    if status != "ok":
+        terminalreporter.write_line(f"numba warm-up {status}: each worker compiled on its own",
+                                    yellow=True)
+
+
 def pytest_report_header(config: pytest.Config) -> str:
     process = config.stash.get(_WARMUP, None)
     background = "" if process is None else \
@@ -78,17 +100,47 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
     # in every worker, so their collections still agree; modules stay contiguous).
     if WARMUP_DONE_ENV in os.environ and hasattr(config, "workerinput"):
         items.sort(key=_calls_dem_kernel)
+        _wait_before_compiling_dem_functions()
 
 
-def pytest_runtest_setup(item: pytest.Item) -> None:
+def _wait_for_warmup() -> None:
     global _waited
-    if _waited or WARMUP_DONE_ENV not in os.environ or not _calls_dem_kernel(item):
+    if _waited:
         return
     done = Path(os.environ[WARMUP_DONE_ENV])
     deadline = time.monotonic() + WARMUP_TIMEOUT_S
     while not done.exists() and time.monotonic() < deadline:
         time.sleep(0.2)
     _waited = True  # ready, failed (the test will say why) or timed out: compile here
+
+
+def _wait_before_compiling_dem_functions() -> None:
+    """Make this worker wait for the warm-up before Numba compiles (or looks up in the cache)
+    a function of ``pidcore.dem`` for the first time; any other function compiles at once.
+
+    Hooks ``numba``'s ``Dispatcher.compile`` (where a call with new argument types goes,
+    before the disk cache is tried); where a Numba version lacks it, the worker compiles on its
+    own as before the warm-up existed: slower, never wrong.
+    """
+    try:
+        from numba.core.dispatcher import Dispatcher
+    except ImportError:
+        return
+    compile_now = getattr(Dispatcher, "compile", None)
+    if compile_now is None:
+        return
+
+    def compile_after_warmup(self, sig):
+        if getattr(self.py_func, "__module__", "").startswith("pidcore.dem"):
+            _wait_for_warmup()
+        return compile_now(self, sig)
+
+    Dispatcher.compile = compile_after_warmup
+
+
+def pytest_runtest_setup(item: pytest.Item) -> None:
+    if WARMUP_DONE_ENV in os.environ and item.get_closest_marker("dem_subprocess"):
+        _wait_for_warmup()
 
 
 @pytest.fixture(scope="session")
@@ -119,3 +171,32 @@ def one_measured_case():
                              "energy_per_cycle_j": [energy], "source": ["x.csv"]})
     return SimpleNamespace(dem=dem, measured=measured, vibrated_mass_kg=m_c,
                            energy_per_cycle_j=energy)
+
+
+@pytest.fixture
+def undrawn_report_figures(monkeypatch):
+    """Report figures saved as a 1x1 PNG and a minimal SVG instead of being drawn.
+
+    For report tests that check tables, text and which files exist, not pictures: drawing and
+    saving the report's figures (PNG and SVG, tight bounding boxes) takes seconds per report.
+    The figures are still built, named and listed; tests/test_report_render.py and
+    test_report_end_to_end save them for real.
+    """
+    import io
+
+    from matplotlib.image import imsave
+
+    from pidcore.report import render
+
+    buffer = io.BytesIO()
+    imsave(buffer, [[0.0]], format="png")
+    png_bytes = buffer.getvalue()
+
+    def save_figure_files(fig, folder: Path, stem: str, **_) -> tuple[Path, Path]:
+        folder.mkdir(parents=True, exist_ok=True)
+        png, svg = folder / f"{stem}.png", folder / f"{stem}.svg"
+        png.write_bytes(png_bytes)
+        svg.write_text('<svg xmlns="http://www.w3.org/2000/svg"/>', encoding="utf-8")
+        return png, svg
+
+    monkeypatch.setattr(render, "save_figure_files", save_figure_files)

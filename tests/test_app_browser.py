@@ -22,7 +22,7 @@ from _app_samples import mass_damper_csv
 from pidcore.app import uploads
 from pidcore.app.stores import STORE_ENV_VAR
 
-pytestmark = [pytest.mark.browser, pytest.mark.slow]
+pytestmark = [pytest.mark.browser, pytest.mark.slow, pytest.mark.dem_subprocess]
 
 REPO = Path(__file__).resolve().parents[1]
 SHIM = REPO / "app" / "pidcore_app.py"
@@ -68,13 +68,18 @@ def _sample(tmp_path: Path) -> Path:
     return path
 
 
-@pytest.fixture
-def sample(tmp_path):
-    return _sample(tmp_path)
+# One Streamlit server per store and one chromium for the module (each start costs seconds of
+# imports); every test opens its own page, hence its own Streamlit session: uploads and
+# widget state are per session, only what a test saves to the store is shared.
 
 
-@pytest.fixture
-def store_with_dem_run(tmp_path, sample):
+@pytest.fixture(scope="module")
+def sample(tmp_path_factory):
+    return _sample(tmp_path_factory.mktemp("sample"))
+
+
+@pytest.fixture(scope="module")
+def store_with_dem_run(tmp_path_factory, sample):
     """A store holding one short DEM run at the sample's load case (for the loop overlay)."""
     from pidcore.compare import parse_file_name
     from pidcore.compare.case import PROPOSED_FILL_PERCENT
@@ -89,15 +94,15 @@ def store_with_dem_run(tmp_path, sample):
     case = DemLoadCase(analysis.frequency_hz, analysis.acceleration_g,
                        stated.get("fill_percent", PROPOSED_FILL_PERCENT),
                        stated.get("material", "acrylic"), stated.get("direction", "z"))
-    path = tmp_path / "e2e_store.h5"
+    path = tmp_path_factory.mktemp("dem_store") / "e2e_store.h5"
     run_case(case, DemConfig(cells=2, steady_cycles=10, max_transient_cycles=4)).save_to(
         Store(path))
     return path
 
 
-@pytest.fixture
-def empty_store(tmp_path):
-    return tmp_path / "e2e_empty_store.h5"
+@pytest.fixture(scope="module")
+def empty_store(tmp_path_factory):
+    return tmp_path_factory.mktemp("empty_store") / "e2e_empty_store.h5"
 
 
 def _serve(tmp_path: Path, store: Path):
@@ -139,26 +144,26 @@ def _stop(proc, log) -> None:
     log.close()
 
 
-@pytest.fixture
-def app_url(tmp_path, store_with_dem_run):
-    proc, log, url = _serve(tmp_path, store_with_dem_run)
+@pytest.fixture(scope="module")
+def app_url(tmp_path_factory, store_with_dem_run):
+    proc, log, url = _serve(tmp_path_factory.mktemp("app"), store_with_dem_run)
     try:
         yield url
     finally:
         _stop(proc, log)
 
 
-@pytest.fixture
-def empty_app(tmp_path, empty_store):
-    proc, log, url = _serve(tmp_path, empty_store)
+@pytest.fixture(scope="module")
+def empty_app(tmp_path_factory, empty_store):
+    proc, log, url = _serve(tmp_path_factory.mktemp("empty_app"), empty_store)
     try:
         yield url, empty_store
     finally:
         _stop(proc, log)
 
 
-@pytest.fixture
-def browser_page():
+@pytest.fixture(scope="module")
+def browser():
     if not CHROMIUM.exists():
         pytest.skip(f"{CHROMIUM} not installed (apt-get install chromium)")
     sync_api = pytest.importorskip("playwright.sync_api",
@@ -167,12 +172,20 @@ def browser_page():
     with sync_api.sync_playwright() as pw:
         browser = pw.chromium.launch(executable_path=str(CHROMIUM), args=CHROMIUM_ARGS)
         try:
-            page = browser.new_page(viewport={"width": 1500, "height": 1600},
-                                    accept_downloads=True)
-            yield page
-            assert not page.locator('[data-testid="stException"]').count()
+            yield browser
         finally:
             browser.close()
+
+
+@pytest.fixture
+def browser_page(browser):
+    # a fresh context per test: no cookies, storage or Streamlit session carried over
+    page = browser.new_page(viewport={"width": 1500, "height": 1600}, accept_downloads=True)
+    try:
+        yield page
+        assert not page.locator('[data-testid="stException"]').count()
+    finally:
+        page.context.close()
 
 
 def _open(page, url: str) -> None:
@@ -278,6 +291,7 @@ def test_cancel_stops_a_running_case_within_two_seconds_and_nothing_runs_twice(
     url, store = empty_app
     page = browser_page
     _open(page, url)
+    before = _saved_runs(store)  # the server's store is shared by this module's tests
     # 1) a short case, Run clicked twice while it runs: one job, one saved run
     _fill_dem(page, freqs="100", accs="5", fills="50", cells=1, steady=10)
     run = page.get_by_role("button", name="Run", exact=True)
@@ -287,11 +301,11 @@ def test_cancel_stops_a_running_case_within_two_seconds_and_nothing_runs_twice(
     page.get_by_text("already queued or running, not submitted again").or_(
         page.get_by_text("1 job(s) submitted")).first.wait_for(timeout=RESULT_TIMEOUT_MS)
     deadline = time.monotonic() + 120
-    while _saved_runs(store) < 1:
+    while _saved_runs(store) < before + 1:
         assert time.monotonic() < deadline, _job_states(page)
         time.sleep(0.2)
     time.sleep(1.5)  # a second start would show up as another saved run or job
-    assert _saved_runs(store) == 1
+    assert _saved_runs(store) == before + 1
     # 2) a long sweep of two cases; Cancel while the first runs
     _fill_dem(page, freqs="100", accs="5", fills="25, 50", cells=1, steady=5000)
     run.click()
@@ -313,7 +327,7 @@ def test_cancel_stops_a_running_case_within_two_seconds_and_nothing_runs_twice(
     assert "2 cancelled" in states and "1 saved" in states, states
     page.screenshot(path=str(ARTIFACTS / "app_e2e_dem_cancelled.png"), full_page=True)
     time.sleep(1.5)
-    assert _saved_runs(store) == 1  # the cancelled cases saved nothing, nothing ran twice
+    assert _saved_runs(store) == before + 1  # the cancelled cases saved nothing, nothing ran twice
     (ARTIFACTS / "app_e2e_cancel_timing.txt").write_text(
         f"Cancel click to the job table showing both jobs cancelled: {stopped_s:.2f} s "
         "(includes up to one 1 s table refresh)\n")

@@ -442,6 +442,7 @@ def _wait(runner, timeout_s: float = 300.0) -> None:
         time.sleep(0.1)
 
 
+@pytest.mark.dem_subprocess
 def test_dem_job_is_saved_once_and_its_loop_area_is_the_shaker_work(tmp_path):
     from pidcore.dem import DemConfig, simulate_load_case
     from pidcore.store import Store
@@ -472,6 +473,7 @@ def test_dem_job_is_saved_once_and_its_loop_area_is_the_shaker_work(tmp_path):
     assert loop.energy_per_cycle_j == pytest.approx(entry.record["energy_per_cycle_j"], rel=5e-2)
 
 
+@pytest.mark.dem_subprocess
 def test_cancel_stops_a_running_dem_case_within_two_seconds_and_saves_nothing(tmp_path):
     import time
 
@@ -682,6 +684,7 @@ def test_a_file_saved_again_with_other_corrections_counts_once(tmp_path, good_cs
     assert table["SDC measured [-]"].dropna().tolist() == [rec2.analysis.sdc]
 
 
+@pytest.mark.dem_subprocess
 def test_dem_jobs_run_on_the_chosen_specimen(tmp_path):
     from pidcore.dem import DemConfig
     from pidcore.dem.persist import run_key

@@ -288,6 +288,7 @@ def test_report_tab_shows_the_table_and_offers_clean_downloads(store_file):
     assert len(back) == 1 and back["SDC measured [-]"].iloc[0] == shown_sdc
 
 
+@pytest.mark.dem_subprocess
 def test_dem_tab_runs_in_the_background_and_the_compare_tab_uses_the_run(store_file):
     from pidcore.dem import DemConfig, LoadCase, simulate_load_case
     from pidcore.store import Store
@@ -328,6 +329,7 @@ def test_dem_tab_runs_in_the_background_and_the_compare_tab_uses_the_run(store_f
     assert len(Store(store_file).list_dem_runs()) == 1
 
 
+@pytest.mark.dem_subprocess
 def test_dem_cancel_stops_the_running_case(store_file):
     from pidcore.store import Store
 
@@ -586,6 +588,7 @@ def test_compare_says_when_the_calibration_does_not_predict_the_case(store_file,
 CALIBRATION_CACHE = REPO / "calibration_store.h5"
 
 
+@pytest.mark.dem_subprocess
 @pytest.mark.slow
 @pytest.mark.skipif(not CALIBRATION_CACHE.is_file(),
                     reason="needs the cached DEM runs of calibration_store.h5 (see README)")

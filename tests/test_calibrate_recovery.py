@@ -64,6 +64,7 @@ def test_fixture_mass_and_baseline_are_recovered(tmp_path):
     assert result.rms < 3 * STDERR * max(pt.sdc for pt in points)
 
 
+@pytest.mark.slow
 def test_dem_parameter_is_recovered_through_the_surrogate(tmp_path):
     truth = {"friction": 0.4, "fixture_mass_kg": 0.06}
     points = _synthetic_points({"fixture_mass_kg": 0.06}, (("friction", 0.4),), seed=2)

@@ -82,6 +82,7 @@ def test_stored_record_carries_parameters_seed_and_units(tmp_path):
     assert "shaker_force_n" in entry.arrays
 
 
+@pytest.mark.dem_subprocess
 @pytest.mark.slow
 def test_process_pool_gives_the_same_numbers_as_serial(tmp_path):
     serial = run_sweep(CASES[:2], CONFIG, store_path=tmp_path / "a.h5", workers=1,

@@ -118,6 +118,7 @@ def test_calibration_columns_per_row(calibration_file):
     assert cols[cols.index("SDC measured [-]") + 1] == CALIBRATED_COLUMN
 
 
+@pytest.mark.usefixtures("undrawn_report_figures")
 def test_cli_report_csv_reads_back_with_band(tmp_path, calibration_file, capsys):
     out = tmp_path / "report"
     rc = main(["report", "--dem-store", str(ROOT / "data_samples" / "dem_table3.h5"),

@@ -108,7 +108,7 @@ def test_report_end_to_end(e2e, dem_store):
     assert sha256_file(file) in text and sha256_file(store) in text and dem_sha in text
 
 
-@pytest.mark.slow
+@pytest.mark.usefixtures("undrawn_report_figures")
 def test_report_from_store_only_uses_stored_analyses(e2e, dem_store, tmp_path):
     _, store, _, first = e2e
     again = make_report([], out_dir=tmp_path / "r2", store=store, dem_store=dem_store,
@@ -120,7 +120,7 @@ def test_report_from_store_only_uses_stored_analyses(e2e, dem_store, tmp_path):
     assert not any("without DEM overlay" in n for n in again.notes)
 
 
-@pytest.mark.slow
+@pytest.mark.usefixtures("undrawn_report_figures")
 def test_cli_with_dem_store_only_stores_nothing(tmp_path, dem_store, capsys):
     file = _write_measurement(tmp_path / "coupon2_75pct.csv", seed=3)
     code = main(["report", str(file), "--dem-store", str(dem_store), "--out",
@@ -188,6 +188,7 @@ def test_missing_dem_store_is_an_error(tmp_path):
     assert not (tmp_path / "out").exists()
 
 
+@pytest.mark.usefixtures("undrawn_report_figures")
 def test_cli_pool_merges_dem_settings_that_are_separate_rows_by_default(tmp_path, dem_store):
     import shutil
 

@@ -322,3 +322,11 @@ def test_zero_motion_array_has_no_dominant_frequency():
     with pytest.raises(SignalError, match="'vel0'.*no dominant drive frequency"):
         analyze_power(rec.force_n, np.zeros_like(rec.velocity_m_s), 10240.0, source="z",
                       velocity_name="vel0")
+
+
+def test_the_numba_warm_up_record_is_accepted():
+    # tests/_numba_warmup.py stops at the first refused record, before the DEM kernel it is
+    # there for (it once used sin/cos the wrong way round: an "inverted" record, refused)
+    from _numba_warmup import warm_signal_kernels
+
+    warm_signal_kernels()

@@ -160,6 +160,7 @@ def test_case_material_must_not_contradict_the_specimen():
                            specimen=paper_specimen())
 
 
+@pytest.mark.usefixtures("undrawn_report_figures")
 def test_report_compares_runs_of_one_specimen_and_the_paper_only_for_its_coupon(tmp_path,
                                                                                  capsys):
     import pandas as pd
