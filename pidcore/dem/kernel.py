@@ -136,6 +136,29 @@ def _release(hist, a, b, k_r):
     return held_t, held_r
 
 
+@njit(cache=True, inline="never")
+def _coulomb_force(law, nx, ny, nz, arm, rvx, rvy, rvz, hpx, hpy, hpz, delta_dot, f_n,
+                   v_reg, dt):
+    """Eq. 5 friction on i (``tangential_model="coulomb"``): (gx, gy, gz), N.
+
+    Out of line (not inlined into the contact body) so that the default stick-slip path's
+    machine code stays small: an unused branch inlined into the hot loop cost it ~25 %.
+    """
+    # slip velocity of the contact points: rv + arm hp x n, minus its normal part
+    tvx = rvx + arm * (hpy * nz - hpz * ny)
+    tvy = rvy + arm * (hpz * nx - hpx * nz)
+    tvz = rvz + arm * (hpx * ny - hpy * nx)
+    tvx -= delta_dot * nx
+    tvy -= delta_dot * ny
+    tvz -= delta_dot * nz
+    vt = np.sqrt(tvx * tvx + tvy * tvy + tvz * tvz)
+    if vt > 0.0:
+        scale = coulomb_friction_scale(f_n, vt, law[LAW_SLIDING], v_reg,
+                                       law[LAW_TANGENTIAL_MASS], dt)
+        return scale * tvx, scale * tvy, scale * tvz
+    return 0.0, 0.0, 0.0
+
+
 @njit(cache=True, inline="always")
 def _contact(hist, a, b, law, nx, ny, nz, delta, arm,
              rvx, rvy, rvz, hx, hy, hz, hpx, hpy, hpz, dsx, dsy, dsz,
@@ -149,10 +172,13 @@ def _contact(hist, a, b, law, nx, ny, nz, delta, arm,
     contact points over the step; ``ro``/``rop``: relative rotation over the step, (omega_i -
     omega_j) dt with drift velocities, and the predicted relative angular velocity.
     ``options``: (clip_attraction, stick_slip, v_reg, dt) (Numba inlines at most 30
-    arguments); ``rolling``: whether any pair has rolling resistance. ``stick_slip`` and
-    ``rolling`` are compile-time literals (:func:`numba.literally` in the callers): each
-    combination gets its own machine code without the unused laws, which keeps the hot
-    loop small (the coulomb and rolling branches alone cost 30 % on a resting bed).
+    arguments); ``rolling``: whether any pair has rolling resistance.
+
+    Code size of the hot loop is speed here (unused branches inlined into it cost the
+    resting bed ~25 %): ``rolling`` is a compile-time constant (:func:`numba.literally` in
+    :func:`_advance_cell`, which :func:`advance_cells` calls with a constant True or False,
+    so a call from Python pays no literal dispatch: ~0.1 ms instead of ~12 ms), and the
+    Coulomb law, off by default, is called out of line (:func:`_coulomb_force`).
 
     Returns (f_el, f_n, gx, gy, gz, mx, my, mz, mdx, mdy, mdz, lost_t, lost_r): the Hertz and
     total normal force, the tangential force on i, the rolling torque on i (spring and
@@ -183,23 +209,8 @@ def _contact(hist, a, b, law, nx, ny, nz, delta, arm,
         gy = -k_t * sy
         gz = -k_t * sz
     else:
-        # slip velocity of the contact points: rv + arm hp x n, minus its normal part
-        tvx = rvx + arm * (hpy * nz - hpz * ny)
-        tvy = rvy + arm * (hpz * nx - hpx * nz)
-        tvz = rvz + arm * (hpx * ny - hpy * nx)
-        tvx -= delta_dot * nx
-        tvy -= delta_dot * ny
-        tvz -= delta_dot * nz
-        vt = np.sqrt(tvx * tvx + tvy * tvy + tvz * tvz)
-        gx = 0.0
-        gy = 0.0
-        gz = 0.0
-        if vt > 0.0:
-            scale = coulomb_friction_scale(f_n, vt, law[LAW_SLIDING], options[2],
-                                           law[LAW_TANGENTIAL_MASS], options[3])
-            gx = scale * tvx
-            gy = scale * tvy
-            gz = scale * tvz
+        gx, gy, gz = _coulomb_force(law, nx, ny, nz, arm, rvx, rvy, rvz, hpx, hpy, hpz,
+                                    delta_dot, f_n, options[2], options[3])
     hist[a, b, HIST_KT] = k_t
     mx = 0.0
     my = 0.0
@@ -277,17 +288,25 @@ def advance_cells(pos, vel, omg, frc, trq, wall_n, wall_d,
                   dt, step0, n_steps, omega, accel_amp, drive_axis,
                   steps_per_cycle, sample_every, max_overlap_fraction,
                   tally, samples, status, fail_step, first_cell, end_cell):
-    literally(stick_slip)
-    literally(rolling)
+    # rolling resistance as a compile-time constant: two machine codes, the one without
+    # rolling free of its code (smaller hot loop); chosen here, per call, at no dispatch cost
     for c in range(first_cell, end_cell):
         if status[c] != STATUS_OK:
             continue
-        _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
-                      radius, mass, inertia, law_pp, law_pw,
-                      v_reg, clip_attraction, gravity, stick_slip, rolling, hist_pp, hist_pw,
-                      dt, step0, n_steps, omega, accel_amp, drive_axis,
-                      steps_per_cycle, sample_every, max_overlap_fraction,
-                      tally, samples, status, fail_step)
+        if rolling:
+            _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
+                          radius, mass, inertia, law_pp, law_pw,
+                          v_reg, clip_attraction, gravity, stick_slip, True, hist_pp,
+                          hist_pw, dt, step0, n_steps, omega, accel_amp, drive_axis,
+                          steps_per_cycle, sample_every, max_overlap_fraction,
+                          tally, samples, status, fail_step)
+        else:
+            _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
+                          radius, mass, inertia, law_pp, law_pw,
+                          v_reg, clip_attraction, gravity, stick_slip, False, hist_pp,
+                          hist_pw, dt, step0, n_steps, omega, accel_amp, drive_axis,
+                          steps_per_cycle, sample_every, max_overlap_fraction,
+                          tally, samples, status, fail_step)
     return 0
 
 
@@ -307,7 +326,6 @@ def _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
     rebuilt whenever a particle has moved skin/2 since the last build (relative to the
     cell for the walls, which move with it).
     """
-    literally(stick_slip)
     literally(rolling)
     n_part = pos.shape[2]
     n_walls = wall_n.shape[0]
