@@ -89,5 +89,20 @@ def _run(argv: list[str] | None) -> int:
         return 141
 
 
+def console_main(argv: list[str] | None = None) -> int:
+    """Entry point of the ``pidcore`` command and of ``python -m pidcore``: :func:`main`, then
+    Ctrl-C ignored for the rest of the process.
+
+    The command is over by then (whatever it saved is committed and reported); a Ctrl-C that
+    lands while the interpreter shuts down would otherwise end the process by the signal
+    (exit status -2) instead of the command's own status.
+    """
+    import signal
+
+    rc = main(argv)
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    return rc
+
+
 if __name__ == "__main__":  # pragma: no cover
-    sys.exit(main())
+    sys.exit(console_main())
