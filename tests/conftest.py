@@ -53,6 +53,11 @@ _waited = False
 def pytest_configure(config: pytest.Config) -> None:
     if hasattr(config, "workerinput"):
         _one_kernel_thread_per_worker()
+        if WARMUP_DONE_ENV in os.environ:
+            # The warm-up (one core, ~30 s) must not share a core with the workers: they run
+            # out of tests that need no DEM kernel at about the time it ends, and each idle
+            # second then is a core idle. Nice 5 leaves it a whole core, the workers the rest.
+            os.nice(5)
     # Only the xdist controller starts the warm-up; a single process compiles on first use.
     if hasattr(config, "workerinput") or os.environ.get("PIDCORE_NUMBA_WARMUP") == "0":
         return
