@@ -13,7 +13,8 @@ cache), and a test marked ``dem_subprocess`` (it runs the kernel in a process of
 jobs, process pools, a served app) waits before it starts. ``PIDCORE_NUMBA_WARMUP=0`` skips
 all this.
 
-Two more settings for ``-n 2`` on two cores: OpenMP threads of the parallel kernel sleep
+Settings for ``-n 2`` on two cores: one DEM kernel thread per worker (see
+:func:`_one_kernel_thread_per_worker`), and OpenMP threads of the parallel kernel sleep
 instead of spinning when idle (``OMP_WAIT_POLICY=PASSIVE``; a spinning thread takes the other
 worker's core for milliseconds after every kernel call, and tests that call the kernel
 thousands of times for a few steps each slowed down tenfold).
@@ -50,6 +51,13 @@ _waited = False
 
 
 def pytest_configure(config: pytest.Config) -> None:
+    if hasattr(config, "workerinput"):
+        _one_kernel_thread_per_worker()
+        if WARMUP_DONE_ENV in os.environ:
+            # The warm-up (one core, ~30 s) must not share a core with the workers: they run
+            # out of tests that need no DEM kernel at about the time it ends, and each idle
+            # second then is a core idle. Nice 5 leaves it a whole core, the workers the rest.
+            os.nice(5)
     # Only the xdist controller starts the warm-up; a single process compiles on first use.
     if hasattr(config, "workerinput") or os.environ.get("PIDCORE_NUMBA_WARMUP") == "0":
         return
@@ -60,6 +68,19 @@ def pytest_configure(config: pytest.Config) -> None:
     config.stash[_WARMUP] = subprocess.Popen(
         [sys.executable, str(Path(__file__).with_name("_numba_warmup.py")), str(done)],
         stdout=subprocess.DEVNULL)
+
+
+def _one_kernel_thread_per_worker() -> None:
+    """In a pytest-xdist worker, run the DEM kernel of in-process tests on one thread.
+
+    ``-n N`` already keeps N cores busy; the kernel's threads (one per core, a new thread pool
+    per kernel call in ``pidcore.dem.state``) would only compete with the other workers: ~10 %
+    more CPU time for the same numbers (the results do not depend on the thread count,
+    test_dem_simulate checks that). Subprocesses (app jobs, the CLI) keep their default.
+    """
+    import numba
+
+    numba.set_num_threads(1)
 
 
 def pytest_unconfigure(config: pytest.Config) -> None:
