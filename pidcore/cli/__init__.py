@@ -27,7 +27,11 @@ class _OneLineParser(argparse.ArgumentParser):
         self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(command: str | None = None) -> argparse.ArgumentParser:
+    """The ``pidcore`` parser; with a known sub-command ``command``, only that one's module is
+    imported and registered (a command's start-up should not pay for the imports of all the
+    others: numba, scipy.optimize, the DEM and calibration code take ~0.5 s); otherwise all,
+    so that ``pidcore --help`` and an unknown command's error list every command."""
     from .. import __version__  # not at import: see pidcore.__getattr__
 
     parser = _OneLineParser(
@@ -36,7 +40,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--version", action="version", version=f"pidcore {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
-    for name in _COMMAND_MODULES:
+    for name in (command,) if command in _COMMAND_MODULES else _COMMAND_MODULES:
         importlib.import_module(f"{__name__}.{name}").register(sub)
     return parser
 
@@ -59,7 +63,7 @@ def _run(argv: list[str] | None) -> int:
     command = next((w for w in words if not w.startswith("-")), "COMMAND")
     started = False
     try:
-        parser = build_parser()
+        parser = build_parser(command)
         args, unknown = parser.parse_known_args(argv)
         if unknown:  # reported by the top parser, which would not name the sub-command
             parser.exit(2, f"pidcore {args.command}: error: unrecognized arguments: "
