@@ -514,14 +514,15 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
 def analyze_channels(force: Channel, velocity: Channel | None, *,
                      acceleration: Channel | None = None,
                      source: str,
-                     allow_clipped: bool = False,
-                     **power_options: Any) -> PowerAnalysis:
+                     frequency_hz: float | None = None,
+                     n_harmonics: int = defaults.N_HARMONICS,
+                     velocity_delay_s: float = 0.0,
+                     mass_below_gauge_kg: float = 0.0,
+                     baseline_loss_factor: float = 0.0,
+                     n_blocks: int = defaults.N_UNCERTAINTY_BLOCKS,
+                     min_periods: int = defaults.MIN_PERIODS,
+                     allow_clipped: bool = False) -> PowerAnalysis:
     """:func:`analyze_power` on :class:`~pidcore.records.Channel` records, after validation.
-
-    ``power_options`` are :func:`analyze_power`'s keywords (``frequency_hz``,
-    ``n_harmonics``, ``velocity_delay_s``, ``mass_below_gauge_kg``,
-    ``baseline_loss_factor``, ``n_blocks``, ``min_periods``), passed on unchanged; an unknown
-    one is refused there (TypeError).
 
     Checks, each a one-line :class:`~pidcore.errors.ChannelError` naming ``source`` and the
     channel: quantity of each channel, NaN/inf samples, all-equal (zero) channels, equal sample
@@ -562,8 +563,12 @@ def analyze_channels(force: Channel, velocity: Channel | None, *,
     try:
         result = analyze_power(
             by_role["force"], by_role.get("velocity"), force.sample_rate_hz,
-            acceleration=by_role.get("acceleration"), source=source, force_name=force.name,
-            velocity_name=motion.name, **power_options)
+            acceleration=by_role.get("acceleration"),
+            frequency_hz=frequency_hz, n_harmonics=n_harmonics,
+            velocity_delay_s=velocity_delay_s,
+            mass_below_gauge_kg=mass_below_gauge_kg, baseline_loss_factor=baseline_loss_factor,
+            n_blocks=n_blocks, min_periods=min_periods, source=source, force_name=force.name,
+            velocity_name=motion.name)
     except SignalError as exc:
         if dropout_notes:
             raise SignalError(f"{exc} (after cutting out dropouts: {dropout_notes[0]})") from None
