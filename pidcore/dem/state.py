@@ -158,11 +158,12 @@ def _advance_on_threads(args: tuple, n_cells: int) -> None:
     import numba
 
     n_threads = max(min(numba.get_num_threads(), n_cells), 1)
-    bounds = [round(n_cells * t / n_threads) for t in range(n_threads + 1)]
     if n_threads == 1:
         advance_cells(*args, np.int64(0), np.int64(n_cells))
         return
     from concurrent.futures import ThreadPoolExecutor
+
+    bounds = [round(n_cells * t / n_threads) for t in range(n_threads + 1)]
 
     with ThreadPoolExecutor(max_workers=n_threads, thread_name_prefix="pidcore-dem") as pool:
         futures = [pool.submit(advance_cells, *args, np.int64(lo), np.int64(hi))
