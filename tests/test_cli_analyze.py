@@ -2,13 +2,13 @@
 
 from __future__ import annotations
 
-import hashlib
 import json
 import math
 from pathlib import Path
 
 import numpy as np
 import pytest
+from _shaker_files import file_sha256, write_force_velocity
 
 from pidcore.cli import main
 from pidcore.constants import STANDARD_GRAVITY
@@ -40,9 +40,7 @@ def export(path: Path, *, fmt: str, force_unit_scale: float = 1.0, binary: bool 
     velocity = rec.velocity_m_s.copy()
     if corrupt_velocity:
         velocity[100] = np.nan
-    m = Measurement(path.name, (Channel("Force", "force", rec.force_n, FS, "N"),
-                                Channel("Velocity", "velocity", velocity, FS, "m/s")))
-    write_measurement(m, path, fmt, binary=binary)
+    write_force_velocity(path, rec.force_n, velocity, FS, fmt, binary=binary)
     return path
 
 
@@ -97,7 +95,7 @@ def test_bad_file_leaves_store_untouched_and_exits_nonzero(tmp_path, capsys):
     store_path = tmp_path / "s.h5"
     good = export(tmp_path / "good.csv", fmt="csv")
     run_json([str(good), "--store", str(store_path)], capsys)
-    before = hashlib.sha256(store_path.read_bytes()).hexdigest()
+    before = file_sha256(store_path)
 
     bad_nan = export(tmp_path / "nan.csv", fmt="csv", corrupt_velocity=True)
     garbage = tmp_path / "garbage.uff"
@@ -107,7 +105,7 @@ def test_bad_file_leaves_store_untouched_and_exits_nonzero(tmp_path, capsys):
         err = capsys.readouterr().err.strip()
         assert code != 0
         assert len(err.splitlines()) == 1 and bad.name in err
-        assert hashlib.sha256(store_path.read_bytes()).hexdigest() == before
+        assert file_sha256(store_path) == before
     assert "Velocity" in _last_error(main, ["analyze", str(bad_nan), "--no-store"], capsys)
 
 
@@ -140,9 +138,7 @@ def test_allow_clipped_analyses_and_reports_the_clipping(tmp_path, capsys):
     level = 0.9 * float(np.max(rec.force_n))
     force = np.minimum(rec.force_n, level)
     path = tmp_path / "clipped.csv"
-    write_measurement(Measurement(path.name, (Channel("Force", "force", force, FS, "N"),
-                                              Channel("Velocity", "velocity", rec.velocity_m_s,
-                                                      FS, "m/s"))), path, "csv")
+    write_force_velocity(path, force, rec.velocity_m_s, FS)
     assert main(["analyze", str(path), "--no-store"]) != 0  # refused by default
     assert "clipped" in capsys.readouterr().err
     assert main(["analyze", str(path), "--no-store", "--allow-clipped"]) == 0

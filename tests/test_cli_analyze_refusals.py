@@ -3,16 +3,14 @@ the CLI flag, exit 2, the store byte-identical."""
 
 from __future__ import annotations
 
-import hashlib
 import math
 from pathlib import Path
 
 import pytest
+from _shaker_files import file_sha256, write_force_velocity
 
 from pidcore.cli import main
 from pidcore.constants import STANDARD_GRAVITY
-from pidcore.io import write_measurement
-from pidcore.records import Channel, Measurement
 from pidcore.signal.synthetic import synthesize_shaker_record
 
 MASS, FREQ, FS = 0.25, 100.0, 25_600.0
@@ -29,14 +27,7 @@ def export(path: Path, *, n_periods: float = 15.0) -> Path:
     rec = synthesize_shaker_record(mass_kg=MASS, acceleration_amplitude_m_s2=ACCEL,
                                    frequency_hz=FREQ, sample_rate_hz=FS, n_periods=n_periods,
                                    viscous_damping_n_s_m=C_VISCOUS, snr_db=60, seed=5)
-    m = Measurement(path.name, (Channel("Force", "force", rec.force_n, FS, "N"),
-                                Channel("Velocity", "velocity", rec.velocity_m_s, FS, "m/s")))
-    write_measurement(m, path, "csv")
-    return path
-
-
-def _digest(path: Path) -> str:
-    return hashlib.sha256(path.read_bytes()).hexdigest()
+    return write_force_velocity(path, rec.force_n, rec.velocity_m_s, FS)
 
 
 @pytest.fixture
@@ -49,11 +40,11 @@ def record_and_store(tmp_path, capsys):
 
 
 def _refused(args: list[str], store: Path, capsys) -> str:
-    before = _digest(store)
+    before = file_sha256(store)
     assert main(["analyze", *args, "--store", str(store)]) == 2
     err = capsys.readouterr().err
     assert len(err.strip().splitlines()) == 1, err
-    assert _digest(store) == before
+    assert file_sha256(store) == before
     return err
 
 
@@ -160,9 +151,7 @@ def test_clipping_error_names_allow_clipped(tmp_path, capsys):
                                    frequency_hz=FREQ, sample_rate_hz=FS, n_periods=20)
     force = np.minimum(rec.force_n, 0.9 * float(np.max(rec.force_n)))
     path = tmp_path / "clipped.csv"
-    write_measurement(Measurement(path.name, (Channel("Force", "force", force, FS, "N"),
-                                              Channel("Velocity", "velocity", rec.velocity_m_s,
-                                                      FS, "m/s"))), path, "csv")
+    write_force_velocity(path, force, rec.velocity_m_s, FS)
     assert main(["analyze", str(path), "--no-store"]) == 2
     err = capsys.readouterr().err
     assert "--allow-clipped" in err and "allow_clipped" not in err

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import hashlib
 import os
 import re
 import signal
@@ -12,10 +11,9 @@ import time
 from pathlib import Path
 
 import pytest
+from _shaker_files import file_sha256, write_force_velocity
 
 from pidcore import interrupt
-from pidcore.io import write_measurement
-from pidcore.records import Channel, Measurement
 from pidcore.signal.synthetic import synthesize_shaker_record
 from pidcore.store import Store
 
@@ -28,14 +26,7 @@ def _export(path: Path, n_periods: float) -> Path:
                                    frequency_hz=100.0, sample_rate_hz=FS, n_periods=n_periods,
                                    viscous_damping_n_s_m=2.0, coulomb_friction_n=0.3,
                                    snr_db=50, seed=3)
-    m = Measurement(path.name, (Channel("Force", "force", rec.force_n, FS, "N"),
-                                Channel("Velocity", "velocity", rec.velocity_m_s, FS, "m/s")))
-    write_measurement(m, path, "csv")
-    return path
-
-
-def _digest(path: Path) -> str:
-    return hashlib.sha256(path.read_bytes()).hexdigest()
+    return write_force_velocity(path, rec.force_n, rec.velocity_m_s, FS)
 
 
 @pytest.mark.slow
@@ -51,7 +42,7 @@ def test_sigint_at_any_time_exits_130_with_one_line_and_commits_nothing(tmp_path
     cmd = [sys.executable, "-m", "pidcore", "analyze"]
     subprocess.run([*cmd, str(small), "--store", str(store)], env=env, check=True,
                    capture_output=True)
-    before = _digest(store)
+    before = file_sha256(store)
     interrupted = 0
     # Delays from the interpreter start-up (the handler is installed first thing in main)
     # through the sub-command imports (early, mid) to the parsing and the fit (late).
@@ -62,7 +53,7 @@ def test_sigint_at_any_time_exits_130_with_one_line_and_commits_nothing(tmp_path
         p.send_signal(signal.SIGINT)
         out, err = p.communicate(timeout=120)
         if "saved 1 record" in out:  # a fast machine finished first: a legitimate commit
-            before = _digest(store)
+            before = file_sha256(store)
             continue
         in_pidcore_main = re.search(r'pidcore[/\\]cli[/\\]__init__\.py", line \d+, in '
                                     r'(main|_run)\n', err)
@@ -73,13 +64,13 @@ def test_sigint_at_any_time_exits_130_with_one_line_and_commits_nothing(tmp_path
             # the traceback then names pidcore's __init__ files; or site.py's own main(),
             # "Fatal Python error: init_import_site"): no code that could handle it has run,
             # and nothing can have been committed
-            assert _digest(store) == before, delay
+            assert file_sha256(store) == before, delay
             continue
         interrupted += 1
         assert p.returncode == 130, (delay, err)
         lines = err.splitlines()
         assert len(lines) == 1 and "interrupted" in lines[0], (delay, err)
-        assert _digest(store) == before, delay
+        assert file_sha256(store) == before, delay
     assert interrupted >= 2  # at least the early signals must have hit a running analysis
 
 
@@ -89,7 +80,7 @@ def test_a_swallowed_interrupt_still_never_commits(tmp_path):
     store = Store(tmp_path / "s.h5")
     with store.transaction() as h5:
         h5.attrs["probe"] = 1
-    before = _digest(store.path)
+    before = file_sha256(store.path)
     interrupt.reset()
     interrupt._interrupted.set()  # what the handler does before raising
     try:
@@ -97,7 +88,7 @@ def test_a_swallowed_interrupt_still_never_commits(tmp_path):
             h5.attrs["probe"] = 2
     finally:
         interrupt.reset()
-    assert _digest(store.path) == before
+    assert file_sha256(store.path) == before
     assert not list(tmp_path.glob(".s.h5.*.tmp"))  # the working copy is discarded
 
 

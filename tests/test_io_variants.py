@@ -10,7 +10,6 @@ Every file is generated here; no binary is committed.
 
 from __future__ import annotations
 
-import hashlib
 import json
 import math
 import os
@@ -23,6 +22,7 @@ import numpy as np
 import pytest
 import pyuff
 import scipy.io
+from _shaker_files import file_sha256
 
 from pidcore.cli import main
 from pidcore.errors import ChannelError, InputFileError, SignalError
@@ -55,10 +55,6 @@ def _cli(args: list[str], capsys) -> tuple[int, str, str]:
     code = main(["analyze", *args])
     out, err = capsys.readouterr()
     return code, out, err
-
-
-def _sha(path: Path) -> str:
-    return hashlib.sha256(path.read_bytes()).hexdigest()
 
 
 def _write_uff(path: Path, channels: list[Channel], **per_record) -> Path:
@@ -548,7 +544,7 @@ def test_ctrl_c_while_reading_or_writing_leaves_the_store(tmp_path, capsys, monk
                                                 "m/s"))), path)
     store = tmp_path / "s.h5"
     assert _cli([str(path), "--store", str(store)], capsys)[0] == 0
-    before = _sha(store)
+    before = file_sha256(store)
     import pyuff as pyuff_module
 
     from pidcore.store import Store
@@ -572,7 +568,7 @@ def test_ctrl_c_while_reading_or_writing_leaves_the_store(tmp_path, capsys, monk
         mp.setattr(Store, "add_analysis", interrupted)  # inside the store transaction
         code, out, err = _cli([str(path), "--store", str(store), "--harmonics", "3"], capsys)
         assert code == 130 and "nothing saved" in err and len(err.strip().splitlines()) == 1
-    assert _sha(store) == before
+    assert file_sha256(store) == before
     assert not [p for p in tmp_path.iterdir() if p.name.endswith(".tmp")]
 
 

@@ -11,6 +11,7 @@ import threading
 
 import numpy as np
 import pytest
+from _shaker_files import file_sha256
 
 from pidcore.errors import StoreError
 from pidcore.records import Channel, Measurement
@@ -23,10 +24,6 @@ def make_measurement(seed: int) -> Measurement:
         Channel("force", "force", rng.normal(size=128), 1024.0, "N"),
         Channel("accel", "acceleration", rng.normal(size=128), 1024.0, "g"),
     ), sha256=hashlib.sha256(f"run{seed}".encode()).hexdigest(), file_format="uff")
-
-
-def sha256_of(path) -> str:
-    return hashlib.sha256(path.read_bytes()).hexdigest()
 
 
 def leftovers(directory) -> list[str]:
@@ -45,7 +42,7 @@ def store(tmp_path):
 
 
 def test_exception_inside_transaction_leaves_file_identical(store, tmp_path):
-    digest = sha256_of(store.path)
+    digest = file_sha256(store.path)
     with pytest.raises(RuntimeError, match="boom"):
         with store.transaction() as h5:
             store.add_dem_run("new", {"sdc": 0.4})
@@ -53,13 +50,13 @@ def test_exception_inside_transaction_leaves_file_identical(store, tmp_path):
             h5.attrs["scribble"] = 1
             assert store.has_dem_run("new")  # the batch sees its own writes
             raise RuntimeError("boom")
-    assert sha256_of(store.path) == digest
+    assert file_sha256(store.path) == digest
     assert leftovers(tmp_path) == []
     assert not store.has_dem_run("new") and len(store.list_measurements()) == 1
 
 
 def test_unconvertible_channel_in_batch_rolls_back_everything(store, tmp_path):
-    digest = sha256_of(store.path)
+    digest = file_sha256(store.path)
     bad = Measurement("bad.csv", (
         Channel("ok", "force", np.ones(8), 100.0),
         Channel("garbled", "force", np.array(["1.0", "x"], dtype=object), 100.0),
@@ -68,21 +65,21 @@ def test_unconvertible_channel_in_batch_rolls_back_everything(store, tmp_path):
         with store.transaction():
             assert store.add_measurement(make_measurement(2))[1]  # written to the copy first
             store.add_measurement(bad)
-    assert sha256_of(store.path) == digest
+    assert file_sha256(store.path) == digest
     assert leftovers(tmp_path) == []
     # Outside a batch the bad measurement alone is refused the same way.
     with pytest.raises(StoreError, match="garbled"):
         store.add_measurement(bad)
-    assert sha256_of(store.path) == digest
+    assert file_sha256(store.path) == digest
 
 
 def test_keyboard_interrupt_inside_transaction_leaves_original(store, tmp_path):
-    digest = sha256_of(store.path)
+    digest = file_sha256(store.path)
     with pytest.raises(KeyboardInterrupt):
         with store.transaction():
             store.add_dem_runs([{"case_key": f"k{i}", "record": {"sdc": 0.1}} for i in range(5)])
             raise KeyboardInterrupt
-    assert sha256_of(store.path) == digest
+    assert file_sha256(store.path) == digest
     assert leftovers(tmp_path) == []
     assert store.verify() == []
 
@@ -181,7 +178,7 @@ def _killed_writer(path: str, ready) -> None:
 
 
 def test_writer_killed_mid_transaction_loses_only_its_own_batch(store, tmp_path):
-    digest = sha256_of(store.path)
+    digest = file_sha256(store.path)
     context = multiprocessing.get_context("fork")
     ready = context.Event()
     process = context.Process(target=_killed_writer, args=(str(store.path), ready))
@@ -190,7 +187,7 @@ def test_writer_killed_mid_transaction_loses_only_its_own_batch(store, tmp_path)
     assert leftovers(tmp_path)  # its working copy exists while it runs
     os.kill(process.pid, signal.SIGKILL)
     process.join(30)
-    assert sha256_of(store.path) == digest and store.verify() == []
+    assert file_sha256(store.path) == digest and store.verify() == []
     # The kernel released its lock: the next writer gets in at once and removes the orphan copy.
     Store(store.path, lock_timeout_s=5).add_dem_run("next", {"sdc": 0.5})
     assert leftovers(tmp_path) == []
