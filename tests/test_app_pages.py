@@ -288,6 +288,15 @@ def test_report_tab_shows_the_table_and_offers_clean_downloads(store_file):
     assert len(back) == 1 and back["SDC measured [-]"].iloc[0] == shown_sdc
 
 
+
+def _fill_dem(at, *, freqs: str, accs: str, fills: str, cells: int, steady: int) -> None:
+    """Fill the DEM page's load-case grid and run settings."""
+    at.text_input(key="dem_freqs").set_value(freqs)
+    at.text_input(key="dem_accs").set_value(accs)
+    at.text_input(key="dem_fills").set_value(fills)
+    at.number_input(key="dem_cells").set_value(cells)
+    at.number_input(key="dem_steady").set_value(steady)
+
 @pytest.mark.dem_subprocess
 def test_dem_tab_runs_in_the_background_and_the_compare_tab_uses_the_run(store_file):
     from pidcore.dem import DemConfig, LoadCase, simulate_load_case
@@ -296,11 +305,7 @@ def test_dem_tab_runs_in_the_background_and_the_compare_tab_uses_the_run(store_f
     at = _upload(_app(), [("coupon_fill50.csv", mass_damper_csv(frequency_hz=100.0,
                                                                  acceleration_g=5.0))])
     assert "vs our DEM none" in _headline(at)
-    at.text_input(key="dem_freqs").set_value("100")
-    at.text_input(key="dem_accs").set_value("5")
-    at.text_input(key="dem_fills").set_value("50")
-    at.number_input(key="dem_cells").set_value(2)
-    at.number_input(key="dem_steady").set_value(20)
+    _fill_dem(at, freqs="100", accs="5", fills="50", cells=2, steady=20)
     at.run()
     assert not store_file.exists()
     assert not at.button(key="dem_cancel").disabled  # Cancel is always enabled
@@ -334,11 +339,7 @@ def test_dem_cancel_stops_the_running_case(store_file):
     from pidcore.store import Store
 
     at = _app()
-    at.text_input(key="dem_freqs").set_value("50")
-    at.text_input(key="dem_accs").set_value("5")
-    at.text_input(key="dem_fills").set_value("25, 50")
-    at.number_input(key="dem_cells").set_value(4)
-    at.number_input(key="dem_steady").set_value(5000)
+    _fill_dem(at, freqs="50", accs="5", fills="25, 50", cells=4, steady=5000)
     at.run()
     at.button(key="dem_run").click()
     at.run()
