@@ -288,7 +288,6 @@ def test_report_tab_shows_the_table_and_offers_clean_downloads(store_file):
     assert len(back) == 1 and back["SDC measured [-]"].iloc[0] == shown_sdc
 
 
-
 def _fill_dem(at, *, freqs: str, accs: str, fills: str, cells: int, steady: int) -> None:
     """Fill the DEM page's load-case grid and run settings."""
     at.text_input(key="dem_freqs").set_value(freqs)
@@ -296,6 +295,7 @@ def _fill_dem(at, *, freqs: str, accs: str, fills: str, cells: int, steady: int)
     at.text_input(key="dem_fills").set_value(fills)
     at.number_input(key="dem_cells").set_value(cells)
     at.number_input(key="dem_steady").set_value(steady)
+
 
 @pytest.mark.dem_subprocess
 def test_dem_tab_runs_in_the_background_and_the_compare_tab_uses_the_run(store_file):
