@@ -14,10 +14,7 @@ jobs, process pools, a served app) waits before it starts. ``PIDCORE_NUMBA_WARMU
 all this.
 
 Settings for ``-n 2`` on two cores: one DEM kernel thread per worker (see
-:func:`_one_kernel_thread_per_worker`), and OpenMP threads of the parallel kernel sleep
-instead of spinning when idle (``OMP_WAIT_POLICY=PASSIVE``; a spinning thread takes the other
-worker's core for milliseconds after every kernel call, and tests that call the kernel
-thousands of times for a few steps each slowed down tenfold).
+:func:`_one_kernel_thread_per_worker`).
 """
 
 import os
@@ -31,7 +28,6 @@ from pathlib import Path
 
 os.environ.setdefault("NUMBA_CACHE_DIR",
                       str(Path(__file__).resolve().parents[1] / ".numba_cache"))
-os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 
 import pandas as pd  # noqa: E402  (NUMBA_CACHE_DIR must be set before numba is imported)
 import pytest  # noqa: E402

@@ -169,8 +169,9 @@ def _run_local(todo: Iterable[tuple[LoadCase, str]], config: DemConfig, workers:
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor, as_completed
 
-    # spawn, not fork: forking a process whose numba kernels already started OpenMP threads
-    # is unsafe (the child aborts). Spawned workers load the kernels from numba's disk cache.
+    # spawn, not fork: forking a process that has started threads (Numba's threading layer,
+    # which numba.get_num_threads launches) is unsafe. Spawned workers load the kernels from
+    # numba's disk cache.
     pool = ProcessPoolExecutor(max_workers=min(workers, len(todo)),
                                mp_context=multiprocessing.get_context("spawn"),
                                initializer=_single_thread_worker)
