@@ -161,14 +161,14 @@ def _coulomb_force(law, nx, ny, nz, arm, rvx, rvy, rvz, hpx, hpy, hpz, delta_dot
 
 @njit(cache=True, inline="always")
 def _contact(hist, a, b, law, nx, ny, nz, delta, arm,
-             rvx, rvy, rvz, hx, hy, hz, hpx, hpy, hpz, dsx, dsy, dsz,
+             rvx, rvy, rvz, hpx, hpy, hpz, dsx, dsy, dsz,
              rox, roy, roz, ropx, ropy, ropz, options, rolling):
     """Forces of one contact (pair or wall) on its first particle i; updates its history.
 
     ``n`` unit normal from i to the partner, ``delta`` overlap, ``arm`` centre to contact
-    point. ``rv``: predicted relative velocity of the centres, v_i - v_partner; ``h``/``hp``:
-    the angular velocity that moves the contact point tangentially (omega_i + omega_j for a
-    pair, omega_i at a wall), drift and predicted; ``ds``: tangential displacement of the
+    point. ``rv``: predicted relative velocity of the centres, v_i - v_partner; ``hp``: the
+    predicted angular velocity that moves the contact point tangentially (omega_i + omega_j
+    for a pair, omega_i at a wall); ``ds``: tangential displacement of the
     contact points over the step; ``ro``/``rop``: relative rotation over the step, (omega_i -
     omega_j) dt with drift velocities, and the predicted relative angular velocity.
     ``options``: (clip_attraction, stick_slip, v_reg, dt) (Numba inlines at most 30
@@ -530,7 +530,7 @@ def _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
                 f_el, f_n, gx, gy, gz, mx, my, mz, mdx, mdy, mdz, lt, lr = _contact(
                     hw, i, w, law_pw, nx, ny, nz, delta, arm,
                     vpx[i] - wvx, vpy[i] - wvy, vpz[i] - wvz,
-                    oxi, oyi, ozi, wpx[i], wpy[i], wpz[i],
+                    wpx[i], wpy[i], wpz[i],
                     # contact-point displacement relative to the wall over the step, with
                     # the drift (half-step) velocities the positions moved with
                     dt * (vx[i] + arm * (oyi * nz - ozi * ny)) - dwx,
@@ -589,7 +589,7 @@ def _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
             f_el, f_n, gx, gy, gz, mx, my, mz, mdx, mdy, mdz, lt, lr = _contact(
                 hp, i, j, law_pp, nx, ny, nz, delta, arm,
                 vpx[i] - vpx[j], vpy[i] - vpy[j], vpz[i] - vpz[j],
-                hx, hy, hz, wpx[i] + wpx[j], wpy[i] + wpy[j], wpz[i] + wpz[j],
+                wpx[i] + wpx[j], wpy[i] + wpy[j], wpz[i] + wpz[j],
                 dt * (vx[i] - vx[j] + arm * (hy * nz - hz * ny)),
                 dt * (vy[i] - vy[j] + arm * (hz * nx - hx * nz)),
                 dt * (vz[i] - vz[j] + arm * (hx * ny - hy * nx)),
