@@ -13,7 +13,9 @@ from pidcore.dem import DemConfig, LoadCase, simulate_load_case
 from pidcore.dem.contact import ContactLaw
 from pidcore.dem.geometry import CellGeometry, cell_capacity, drop_packing, random_packing
 from pidcore.dem.simulate import (
+    FRICTIONLESS_BEDS_KEPT,
     choose_time_step,
+    clear_settled_beds,
     coupon_mass_kg,
     max_impact_speed,
     particles_per_cell,
@@ -129,6 +131,7 @@ def test_reproducible_with_seed_and_thread_count(run_500hz):
     if other_count > numba.config.NUMBA_NUM_THREADS:
         pytest.skip("NUMBA_NUM_THREADS=1: no other thread count to compare with")
     numba.set_num_threads(other_count)
+    clear_settled_beds()  # settle again too, on the other thread count
     try:
         again = simulate_load_case(LoadCase(500, 5, 50), cfg)
     finally:
@@ -138,6 +141,35 @@ def test_reproducible_with_seed_and_thread_count(run_500hz):
     other = simulate_load_case(LoadCase(500, 5, 50), DemConfig(**{**FAST, "seed": 7}))
     assert not np.array_equal(other.dissipation_per_cell_cycle_j,
                               run_500hz.dissipation_per_cell_cycle_j)
+
+
+def test_a_kept_settled_bed_gives_the_same_run_bit_for_bit(run_500hz):
+    from pidcore.calibrate.runner import specimen_with
+    from pidcore.dem import simulate as sim
+    from pidcore.specimen import paper_specimen
+
+    clear_settled_beds()
+    fresh = simulate_load_case(LoadCase(500, 5, 50), DemConfig(**FAST))
+    assert len(sim._FRICTIONLESS_BEDS) == 1
+    kept = simulate_load_case(LoadCase(500, 5, 50), DemConfig(**FAST))
+    for name, value in vars(fresh).items():
+        if isinstance(value, np.ndarray):
+            np.testing.assert_array_equal(getattr(kept, name), value, err_msg=name)
+    assert kept.sdc == fresh.sdc == run_500hz.sdc
+    # friction does not enter the frictionless stage: the same bed serves another friction
+    # (what a calibration over friction does), and that run equals one settled afresh
+    grippy = specimen_with(paper_specimen(), {"friction": 0.4})
+    reused = simulate_load_case(LoadCase(500, 5, 50), DemConfig(**FAST), specimen=grippy)
+    assert len(sim._FRICTIONLESS_BEDS) == 1
+    clear_settled_beds()
+    afresh = simulate_load_case(LoadCase(500, 5, 50), DemConfig(**FAST), specimen=grippy)
+    np.testing.assert_array_equal(reused.dissipation_per_cell_cycle_j,
+                                  afresh.dissipation_per_cell_cycle_j)
+    assert reused.sdc != fresh.sdc
+    # what does enter it (here the seed, i.e. the start packing) gets a bed of its own, and
+    # only the last FRICTIONLESS_BEDS_KEPT are kept
+    simulate_load_case(LoadCase(500, 5, 50), DemConfig(**{**FAST, "seed": 3}))
+    assert len(sim._FRICTIONLESS_BEDS) == min(2, FRICTIONLESS_BEDS_KEPT)
 
 
 def test_one_g_dissipates_far_less_than_five_g_at_50hz():

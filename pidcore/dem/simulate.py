@@ -42,8 +42,11 @@ Method (choices and why):
 from __future__ import annotations
 
 import dataclasses
+import hashlib
 import math
+import threading
 import time
+from collections import OrderedDict
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
 
@@ -76,6 +79,7 @@ from .state import (
     advance,
     assert_no_overlap,
     energies,
+    law_vectors,
     wall_displacement,
 )
 
@@ -305,18 +309,81 @@ def settle(state: CellsState, settings: KernelSettings, *,
                 f"after {elapsed:.3g} s")
 
 
+#: Beds settled without friction, keyed by everything that settling reads (see
+#: :func:`settle_bed`), most recent last. The dense start's frictionless stage is ~80 % of a
+#: short run and does not depend on friction or rolling resistance, so a calibration that
+#: varies those settles each load case once instead of once per design point.
+_FRICTIONLESS_BEDS: OrderedDict[str, tuple] = OrderedDict()
+_FRICTIONLESS_BEDS_LOCK = threading.Lock()
+#: Beds kept (each a few (3, K, N) arrays; 16 x 8 cells x 55 particles is ~1 MB).
+FRICTIONLESS_BEDS_KEPT = 16
+
+
+def _bed_key(state: CellsState, settings: KernelSettings) -> str:
+    """Digest of every input of :func:`settle` for this state and settings (exact bytes)."""
+    digest = hashlib.sha256(repr((settings, state.step)).encode())
+    for array in (state.pos, state.vel, state.omg, state.frc, state.trq, state.spring_pp,
+                  state.spring_pw, *law_vectors(settings.law), settings.geometry.wall_normals,
+                  settings.geometry.wall_offsets):
+        digest.update(repr((array.dtype.str, array.shape)).encode())
+        digest.update(np.ascontiguousarray(array).tobytes())
+    return digest.hexdigest()
+
+
+def clear_settled_beds() -> None:
+    """Forget the beds :func:`settle_bed` keeps (the next settle runs the kernel again)."""
+    with _FRICTIONLESS_BEDS_LOCK:
+        _FRICTIONLESS_BEDS.clear()
+
+
+def _settle_frictionless(state: CellsState, settings: KernelSettings,
+                         clock: _KernelClock | None) -> float:
+    """The dense start's first stage: settle without friction (springs cleared), s.
+
+    A bed settled before from the very same inputs is copied instead of settled again: the
+    kernel is deterministic, so the copy is bit for bit what settling would give
+    (tests/test_dem_simulate.py compares the two).
+    """
+    frictionless = dataclasses.replace(settings, law=settings.law.frictionless())
+    key = _bed_key(state, frictionless)
+    with _FRICTIONLESS_BEDS_LOCK:
+        kept = _FRICTIONLESS_BEDS.get(key)
+        if kept is not None:
+            _FRICTIONLESS_BEDS.move_to_end(key)
+    if kept is None:
+        elapsed = settle(state, frictionless, clock=clock)
+        state.spring_pp[:] = 0.0  # none stretched without friction; start the springs clean
+        state.spring_pw[:] = 0.0
+        kept = (elapsed, state.pos.copy(), state.vel.copy(), state.omg.copy(),
+                state.frc.copy(), state.trq.copy())
+        with _FRICTIONLESS_BEDS_LOCK:
+            _FRICTIONLESS_BEDS[key] = kept
+            while len(_FRICTIONLESS_BEDS) > FRICTIONLESS_BEDS_KEPT:
+                _FRICTIONLESS_BEDS.popitem(last=False)
+        return elapsed
+    elapsed, pos, vel, omg, frc, trq = kept
+    state.pos[:], state.vel[:], state.omg[:] = pos, vel, omg
+    state.frc[:], state.trq[:] = frc, trq
+    state.spring_pp[:] = 0.0
+    state.spring_pw[:] = 0.0
+    state.step = 0
+    return elapsed
+
+
 def settle_bed(state: CellsState, settings: KernelSettings,
                packing: StartPacking = defaults.DEM_START_PACKING, *,
                clock: _KernelClock | None = None) -> float:
-    """Settle the start packing (``"dense"`` or ``"loose"``, see the module docstring), s."""
+    """Settle the start packing (``"dense"`` or ``"loose"``, see the module docstring), s.
+
+    The dense start's frictionless stage is kept in memory per process (the last
+    :data:`FRICTIONLESS_BEDS_KEPT` beds) and reused for the same inputs; see
+    :func:`clear_settled_beds`.
+    """
     if packing not in START_PACKINGS:
         raise ParameterError(f"start_packing: expected one of {START_PACKINGS}, got {packing!r}")
     elapsed = 0.0
     if packing == "dense":
-        elapsed += settle(state, dataclasses.replace(settings, law=settings.law.frictionless()),
-                          clock=clock)
-        state.spring_pp[:] = 0.0  # none stretched without friction; start the springs clean
-        state.spring_pw[:] = 0.0
+        elapsed += _settle_frictionless(state, settings, clock)
     return elapsed + settle(state, settings, clock=clock)
 
 
@@ -546,4 +613,4 @@ def config_parameters(case: LoadCase, config: DemConfig) -> dict:
 
 __all__ = ["LoadCase", "DemConfig", "simulate_load_case", "resolve_specimen", "choose_time_step",
            "particles_per_cell", "vibrated_mass_kg", "coupon_mass_kg", "max_impact_speed",
-           "settle", "settle_bed", "config_parameters"]
+           "settle", "settle_bed", "clear_settled_beds", "config_parameters"]
