@@ -68,7 +68,7 @@ def _sample(tmp_path: Path) -> Path:
     return path
 
 
-# One Streamlit server per store and one chromium for the module (each start costs seconds of
+# One Streamlit server and one chromium for the module (each start costs seconds of
 # imports); every test opens its own page, hence its own Streamlit session: uploads and
 # widget state are per session, only what a test saves to the store is shared.
 
@@ -98,11 +98,6 @@ def store_with_dem_run(tmp_path_factory, sample):
     run_case(case, DemConfig(cells=2, steady_cycles=10, max_transient_cycles=4)).save_to(
         Store(path))
     return path
-
-
-@pytest.fixture(scope="module")
-def empty_store(tmp_path_factory):
-    return tmp_path_factory.mktemp("empty_store") / "e2e_empty_store.h5"
 
 
 def _serve(tmp_path: Path, store: Path):
@@ -146,18 +141,11 @@ def _stop(proc, log) -> None:
 
 @pytest.fixture(scope="module")
 def app_url(tmp_path_factory, store_with_dem_run):
+    # one server for the module (a start costs seconds of CPU on a 2-core CI machine); what a
+    # test saves stays in its store, so tests compare against the store's own content
     proc, log, url = _serve(tmp_path_factory.mktemp("app"), store_with_dem_run)
     try:
         yield url
-    finally:
-        _stop(proc, log)
-
-
-@pytest.fixture(scope="module")
-def empty_app(tmp_path_factory, empty_store):
-    proc, log, url = _serve(tmp_path_factory.mktemp("empty_app"), empty_store)
-    try:
-        yield url, empty_store
     finally:
         _stop(proc, log)
 
@@ -287,8 +275,8 @@ def _fill_dem(page, *, freqs: str, accs: str, fills: str, cells: int, steady: in
 
 
 def test_cancel_stops_a_running_case_within_two_seconds_and_nothing_runs_twice(
-        empty_app, browser_page):
-    url, store = empty_app
+        app_url, store_with_dem_run, browser_page):
+    url, store = app_url, store_with_dem_run
     page = browser_page
     _open(page, url)
     before = _saved_runs(store)  # the server's store is shared by this module's tests
@@ -298,14 +286,17 @@ def test_cancel_stops_a_running_case_within_two_seconds_and_nothing_runs_twice(
     run.click()
     page.get_by_text("1 job(s) submitted").wait_for(timeout=RESULT_TIMEOUT_MS)
     run.click()
-    page.get_by_text("already queued or running, not submitted again").or_(
-        page.get_by_text("1 job(s) submitted")).first.wait_for(timeout=RESULT_TIMEOUT_MS)
+    # the second click is answered in its own script run: skipped while the case is queued
+    # or running, a job marked "in store" once it is saved; a second start would be a job
+    # "queued", "running" or a second "saved" in the job table
+    page.get_by_text("0 job(s) submitted; 1 already queued or running").or_(
+        page.get_by_text("1 in store")).first.wait_for(timeout=RESULT_TIMEOUT_MS)
     deadline = time.monotonic() + 120
-    while _saved_runs(store) < before + 1:
+    while _saved_runs(store) < before + 1 or "running" in _job_states(page):
         assert time.monotonic() < deadline, _job_states(page)
         time.sleep(0.2)
-    time.sleep(1.5)  # a second start would show up as another saved run or job
     assert _saved_runs(store) == before + 1
+    assert "1 saved" in _job_states(page) and "queued" not in _job_states(page)
     # 2) a long sweep of two cases; Cancel while the first runs
     _fill_dem(page, freqs="100", accs="5", fills="25, 50", cells=1, steady=5000)
     run.click()
@@ -326,7 +317,8 @@ def test_cancel_stops_a_running_case_within_two_seconds_and_nothing_runs_twice(
     states = _job_states(page)
     assert "2 cancelled" in states and "1 saved" in states, states
     page.screenshot(path=str(ARTIFACTS / "app_e2e_dem_cancelled.png"), full_page=True)
-    time.sleep(1.5)
+    # a job is marked cancelled only once its process is gone (terminated, or its result
+    # dropped): nothing can be saved after this
     assert _saved_runs(store) == before + 1  # the cancelled cases saved nothing, nothing ran twice
     (ARTIFACTS / "app_e2e_cancel_timing.txt").write_text(
         f"Cancel click to the job table showing both jobs cancelled: {stopped_s:.2f} s "
@@ -341,8 +333,8 @@ def _two_files(tmp_path: Path) -> tuple[Path, Path]:
     return a, b
 
 
-def test_reload_shows_the_saved_records_on_compare(empty_app, browser_page, tmp_path):
-    url, store = empty_app
+def test_reload_shows_the_saved_records_on_compare(app_url, browser_page, tmp_path):
+    url = app_url
     page = browser_page
     _open(page, url)
     a, b = _two_files(tmp_path)
@@ -365,9 +357,9 @@ def test_reload_shows_the_saved_records_on_compare(empty_app, browser_page, tmp_
     page.screenshot(path=str(ARTIFACTS / "app_e2e_reload_compare.png"), full_page=True)
 
 
-def test_two_files_with_different_vibrometer_delays_in_one_session(empty_app, browser_page,
+def test_two_files_with_different_vibrometer_delays_in_one_session(app_url, browser_page,
                                                                     tmp_path):
-    url, _ = empty_app
+    url = app_url
     page = browser_page
     _open(page, url)
     a, b = _two_files(tmp_path)
@@ -388,8 +380,8 @@ def test_two_files_with_different_vibrometer_delays_in_one_session(empty_app, br
     page.screenshot(path=str(ARTIFACTS / "app_e2e_two_delays.png"), full_page=True)
 
 
-def test_negative_loss_factor_shows_the_warning(empty_app, browser_page, tmp_path):
-    url, _ = empty_app
+def test_negative_loss_factor_shows_the_warning(app_url, browser_page, tmp_path):
+    url = app_url
     page = browser_page
     _open(page, url)
     odd = tmp_path / "odd_fill50.csv"

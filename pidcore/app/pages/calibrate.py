@@ -10,13 +10,24 @@ import pandas as pd
 import streamlit as st
 
 from pidcore.app.calibration import calibration_api, fittable_names, runner_for
+from pidcore.app.pages import draw_polling
+
+#: Seconds between refreshes of the calibration's state while it runs.
+REFRESH_S = 2.0
 
 
-@st.fragment(run_every=2.0)
-def _task(stores) -> None:
+def _running(stores) -> bool:
+    task = runner_for(stores.path).task
+    return task is not None and task.state == "running"
+
+
+def _task(stores, polling: bool) -> None:
+    # a fragment (see draw_polling): rerun every REFRESH_S while the calibration runs
     task = runner_for(stores.path).task
     if task is None:
         return
+    if polling and task.state != "running":  # it ended: draw the page again, without the timer
+        st.rerun(scope="app")
     if task.state == "running":
         st.info(f"calibrating ({', '.join(task.fit)}, {task.n_points} load case(s)): "
                 f"{task.elapsed_s():.0f} s elapsed; DEM runs are saved in the store as they "
@@ -89,4 +100,4 @@ def render(stores) -> None:
         else:
             if started is None:
                 st.warning("a calibration is running already; wait for it to finish")
-    _task(stores)
+    draw_polling(_task, stores, polling=_running(stores), every_s=REFRESH_S)

@@ -2,7 +2,8 @@
 runner (:mod:`pidcore.app.jobs`), watch progress with elapsed time and ETA, cancel at any time.
 
 The page never computes: a click submits or cancels and returns at once, the job table
-refreshes itself every second (a fragment), and every finished case is saved by the runner.
+refreshes itself every second while jobs run (a fragment), and every finished case is saved
+by the runner.
 """
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ import streamlit as st
 
 from pidcore import defaults
 from pidcore.app import jobs, state
+from pidcore.app.pages import draw_polling
 from pidcore.constants import DRIVE_DIRECTIONS, PARTICLE_MATERIALS
 
 #: Seconds between refreshes of the job table while jobs run.
@@ -34,8 +36,8 @@ def _cancel(stores) -> None:
                                                   "cases stay saved")
 
 
-@st.fragment(run_every=REFRESH_S)
-def _job_table(stores) -> None:
+def _job_table(stores, polling: bool) -> None:
+    # a fragment (see draw_polling): rerun every REFRESH_S while jobs are queued or running
     runner = jobs.runner_for(stores.path)
     rows = [j.row() for j in runner.jobs()]
     busy = runner.busy()
@@ -57,6 +59,8 @@ def _job_table(stores) -> None:
         st.session_state["_dem_saved_seen"] = done
         if done:
             st.rerun(scope="app")
+    if polling and not busy:  # the last job ended: draw the page again, without the timer
+        st.rerun(scope="app")
 
 
 #: Folders searched for specimen files (relative to the working folder), besides uploads.
@@ -146,7 +150,8 @@ def render(stores) -> None:
     message = st.session_state.get("dem_message")
     if message:
         getattr(st, message[0])(message[1])
-    _job_table(stores)
+    draw_polling(_job_table, stores, polling=jobs.runner_for(stores.path).busy(),
+                 every_s=REFRESH_S)
     try:
         runs = state.store_listing("dem_runs", stores.stamp(), stores)
     except PidcoreError as exc:
