@@ -3,10 +3,11 @@
 Streamlit reruns the page script on every click, so a computation inside a script run is
 interrupted or repeated by the next click. Here cases run in a worker thread owned by a
 module-level registry (one :class:`DemJobRunner` per store, living as long as the server
-process); the page only submits, cancels and reads snapshots. Each case runs in its own
-``spawn``-ed process, so *Cancel* terminates it at once (a Numba kernel cannot be interrupted
-from inside); its result comes back through a pipe and the worker thread saves it to the store
-in its own transaction, so a killed case never leaves a half-written store.
+process); the page only submits, cancels and reads snapshots. Each case runs in a process of
+its own (:func:`pidcore.dem.sweep.dem_process_context`), so *Cancel* terminates it at once (a
+Numba kernel cannot be interrupted from inside); its result comes back through a pipe and the
+worker thread saves it to the store in its own transaction, so a killed case never leaves a
+half-written store.
 
 A case is never started twice: a submission is dropped when the same run (same store key: load
 case and every numerical setting) is queued, running, or already in the store.
@@ -14,7 +15,6 @@ case and every numerical setting) is queued, running, or already in the store.
 
 from __future__ import annotations
 
-import multiprocessing
 import threading
 import time
 from collections.abc import Sequence
@@ -205,10 +205,10 @@ class DemJobRunner:
             self._cancel.discard(job.job_id)
 
     def _run(self, job: DemJob) -> None:
-        from ..dem.sweep import CaseOutcome
+        from ..dem.sweep import CaseOutcome, dem_process_context
         from ..store import Store
 
-        ctx = multiprocessing.get_context("spawn")
+        ctx = dem_process_context()
         parent, child = ctx.Pipe(duplex=False)
         proc = ctx.Process(target=_child, args=(job.case, job.config, job.specimen, child),
                            daemon=True,

@@ -122,12 +122,12 @@ def run_requests(requests: Sequence[RunRequest], *, store_path: str | os.PathLik
             for request in todo:
                 finish(*_run_entry(request))
         elif todo:
-            import multiprocessing
             from concurrent.futures import ProcessPoolExecutor, as_completed
 
-            # spawn: forking after numba started its threads is unsafe (see dem.sweep)
+            from ..dem.sweep import dem_process_context
+
             pool = ProcessPoolExecutor(max_workers=min(workers, len(todo)),
-                                       mp_context=multiprocessing.get_context("spawn"),
+                                       mp_context=dem_process_context(),
                                        initializer=_single_thread_worker)
             try:
                 futures = [pool.submit(_run_entry, request) for request in todo]

@@ -65,6 +65,31 @@ def run_case(case: LoadCase, config: DemConfig,
                        **dem_run_entry(simulate_load_case(case, config, specimen=specimen)))
 
 
+#: Modules a DEM worker process needs, imported once by the fork server (see
+#: :func:`dem_process_context`).
+_WORKER_MODULES = ["pidcore.dem.simulate", "pidcore.dem.persist", "pidcore.dem.sweep"]
+
+
+def dem_process_context():
+    """The :mod:`multiprocessing` context for processes that run DEM cases.
+
+    Never ``fork`` from the calling process: forking a process that has started threads
+    (Numba's threading layer, a Streamlit server, a thread pool) is unsafe. Where the
+    platform has it, a fork *server*: one clean process started on first use that imports
+    the DEM modules once and forks every worker from itself, so a worker starts in
+    milliseconds instead of re-importing numpy, scipy, pandas and numba (~1 s each time);
+    elsewhere ``spawn``. Workers load the kernels from Numba's disk cache. Note that a fork
+    server keeps the environment it was started with.
+    """
+    import multiprocessing
+
+    if "forkserver" not in multiprocessing.get_all_start_methods():
+        return multiprocessing.get_context("spawn")
+    context = multiprocessing.get_context("forkserver")
+    context.set_forkserver_preload(_WORKER_MODULES)
+    return context
+
+
 def _single_thread_worker() -> None:
     # Parallelism is across load cases; threads inside each would oversubscribe the cores.
     import numba
@@ -166,14 +191,10 @@ def _run_local(todo: Iterable[tuple[LoadCase, str]], config: DemConfig, workers:
         for case, _ in todo:
             finish(run_case(case, config, specimen))
         return
-    import multiprocessing
     from concurrent.futures import ProcessPoolExecutor, as_completed
 
-    # spawn, not fork: forking a process that has started threads (Numba's threading layer,
-    # which numba.get_num_threads launches) is unsafe. Spawned workers load the kernels from
-    # numba's disk cache.
     pool = ProcessPoolExecutor(max_workers=min(workers, len(todo)),
-                               mp_context=multiprocessing.get_context("spawn"),
+                               mp_context=dem_process_context(),
                                initializer=_single_thread_worker)
     try:
         futures = [pool.submit(run_case, case, config, specimen) for case, _ in todo]
