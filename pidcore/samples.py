@@ -17,7 +17,6 @@ from fractions import Fraction
 from pathlib import Path
 
 import numpy as np
-from scipy.signal import resample_poly
 
 from .errors import StoreError
 from .records import Channel, Measurement
@@ -73,6 +72,8 @@ def virtual_shaker_measurement(
     """
     fs_in = 1.0 / float(np.median(np.diff(time_s)))
     ratio = Fraction(sample_rate_hz / fs_in).limit_denominator(1000)
+    from scipy.signal import resample_poly  # here: importing scipy.signal takes ~0.8 s
+
     force = resample_poly(shaker_force_n, ratio.numerator, ratio.denominator)
     t = time_s[0] + np.arange(force.size) / sample_rate_hz
     trim = int(round(2 * sample_rate_hz / frequency_hz))  # two periods each end
