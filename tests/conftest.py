@@ -29,10 +29,10 @@ from pathlib import Path
 os.environ.setdefault("NUMBA_CACHE_DIR",
                       str(Path(__file__).resolve().parents[1] / ".numba_cache"))
 
-import pandas as pd  # noqa: E402  (NUMBA_CACHE_DIR must be set before numba is imported)
 import pytest  # noqa: E402
 
-from pidcore.model import SdcModel, load_paper_table3  # noqa: E402
+# pandas and pidcore are imported inside the fixtures: the xdist controller imports this file
+# too and needs neither (~1 s of imports); NUMBA_CACHE_DIR must be set before numba is imported
 
 #: Test modules that call the DEM kernel (directly, through the CLI, sweeps or the app): run
 #: after the others, whose tests need no wait.
@@ -161,14 +161,18 @@ def pytest_runtest_setup(item: pytest.Item) -> None:
 
 
 @pytest.fixture(scope="session")
-def paper_table() -> pd.DataFrame:
-    """The paper's Table 3 as bundled with pidcore."""
+def paper_table():
+    """The paper's Table 3 as bundled with pidcore (a pandas DataFrame)."""
+    from pidcore.model import load_paper_table3
+
     return load_paper_table3()
 
 
 @pytest.fixture(scope="session")
-def paper_model(paper_table) -> SdcModel:
-    """The pchip SDC model over the paper's Table 3 DEM values."""
+def paper_model(paper_table):
+    """The pchip SDC model over the paper's Table 3 DEM values (a pidcore.model.SdcModel)."""
+    from pidcore.model import SdcModel
+
     return SdcModel.from_table(paper_table)
 
 
@@ -178,6 +182,8 @@ def one_measured_case():
     report table takes them: the measurement's Eq. 11 SDC (4.3) is ~3x its Eq. 10 SDC, the
     gap between the two SDCs that report tests must not mix up."""
     from types import SimpleNamespace
+
+    import pandas as pd
 
     m_c, energy = 0.069, 1.25e-5
     dem = pd.DataFrame({"frequency_hz": [500.0], "acceleration_g": [5.0], "fill_percent": [50.0],

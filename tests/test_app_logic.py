@@ -484,8 +484,9 @@ def test_cancel_stops_a_running_dem_case_within_two_seconds_and_saves_nothing(tm
     runner = jobs.DemJobRunner(store_file)
     cases = jobs.plan_dem_cases([50.0], [5.0], [50.0, 75.0], material="acrylic",
                                 direction="z")
-    # long enough to be running when cancelled (thousands of steady cycles)
-    runner.submit(cases, DemConfig(cells=4, steady_cycles=5000))
+    # long enough to be running when cancelled (thousands of steady cycles); one cell: the
+    # wait for the first block of cycles is the test's cost
+    runner.submit(cases, DemConfig(cells=1, steady_cycles=5000))
     deadline = time.monotonic() + 120
     while not any(j.state == "running" and j.cycles_done > 0 for j in runner.jobs()):
         assert time.monotonic() < deadline

@@ -339,7 +339,8 @@ def test_dem_cancel_stops_the_running_case(store_file):
     from pidcore.store import Store
 
     at = _app()
-    _fill_dem(at, freqs="50", accs="5", fills="25, 50", cells=4, steady=5000)
+    # thousands of cycles: running when cancelled; one cell: a cheap wait for the first block
+    _fill_dem(at, freqs="50", accs="5", fills="25, 50", cells=1, steady=5000)
     at.run()
     at.button(key="dem_run").click()
     at.run()
