@@ -14,7 +14,8 @@ jobs, process pools, a served app) waits before it starts. ``PIDCORE_NUMBA_WARMU
 all this.
 
 Settings for ``-n 2`` on two cores: one DEM kernel thread per worker (see
-:func:`_one_kernel_thread_per_worker`).
+:func:`_one_kernel_thread_per_worker`) and one BLAS thread per process (see
+:data:`ONE_BLAS_THREAD`).
 """
 
 import os
@@ -28,6 +29,15 @@ from pathlib import Path
 
 os.environ.setdefault("NUMBA_CACHE_DIR",
                       str(Path(__file__).resolve().parents[1] / ".numba_cache"))
+#: One BLAS thread in the test processes and everything they start (workers, the warm-up,
+#: CLI runs, servers): the xdist workers already keep the cores busy, and OpenBLAS's extra
+#: threads spin-wait after every call (the harmonic fits' least squares, the calibration's
+#: linear algebra), taking the core from the other worker: with them the suite needed ~17
+#: more CPU-seconds (160 against 143, warm cache, 2 cores) for the same results. Read when
+#: numpy loads its BLAS, hence set before anything imports numpy; an explicit value wins.
+ONE_BLAS_THREAD = {"OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
+for _name, _value in ONE_BLAS_THREAD.items():
+    os.environ.setdefault(_name, _value)
 
 import pytest  # noqa: E402
 
