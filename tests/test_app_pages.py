@@ -334,11 +334,32 @@ def test_dem_tab_runs_in_the_background_and_the_compare_tab_uses_the_run(store_f
     assert len(Store(store_file).list_dem_runs()) == 1
 
 
+def _record_fragment_timers(monkeypatch) -> list[tuple[str, float | None]]:
+    """(function name, run_every) of every fragment drawn from now on."""
+    import streamlit as st
+
+    drawn, fragment = [], st.fragment
+
+    def recording(func=None, *, run_every=None):
+        if func is None:  # st.fragment(run_every=...) returns the decorator
+            return lambda f: recording(f, run_every=run_every)
+        drawn.append((func.__name__, run_every))
+        return fragment(func, run_every=run_every)
+
+    monkeypatch.setattr(st, "fragment", recording)
+    return drawn
+
+
 @pytest.mark.dem_subprocess
-def test_dem_cancel_stops_the_running_case(store_file):
+def test_dem_cancel_stops_the_running_case(store_file, monkeypatch):
+    from pidcore.app.pages import dem as dem_page
     from pidcore.store import Store
 
+    timers = _record_fragment_timers(monkeypatch)
     at = _app()
+    # an idle page polls nothing (a timer would rerun the job table every second for as long
+    # as the page is open)
+    assert timers == [("_job_table", None)]
     # thousands of cycles: running when cancelled; one cell: a cheap wait for the first block
     _fill_dem(at, freqs="50", accs="5", fills="25, 50", cells=1, steady=5000)
     at.run()
@@ -349,6 +370,9 @@ def test_dem_cancel_stops_the_running_case(store_file):
     while not any(j.state == "running" and j.cycles_done > 0 for j in runner.jobs()):
         assert time.monotonic() < deadline
         time.sleep(0.05)
+    timers.clear()
+    at.run()
+    assert timers == [("_job_table", dem_page.REFRESH_S)]  # jobs run: it refreshes itself
     at.button(key="dem_cancel").click()
     t0 = time.monotonic()
     at.run()
@@ -358,6 +382,9 @@ def test_dem_cancel_stops_the_running_case(store_file):
     assert [j.state for j in runner.jobs()] == ["cancelled", "cancelled"]
     assert any("cancel requested for 2 job(s)" in w.value for w in at.warning)
     assert not store_file.exists() or Store(store_file).list_dem_runs().empty
+    timers.clear()
+    at.run()
+    assert timers == [("_job_table", None)]  # idle again: no timer
 
 
 def test_upload_limit_is_shown_and_enforced_per_file(store_file, monkeypatch):

@@ -82,6 +82,18 @@ def test_stored_record_carries_parameters_seed_and_units(tmp_path):
     assert "shaker_force_n" in entry.arrays
 
 
+def test_dem_worker_processes_are_never_forked_from_the_caller():
+    import multiprocessing
+
+    from pidcore.dem.sweep import dem_process_context
+
+    # forking a process that runs threads (Numba's, a Streamlit server's) is unsafe: a fork
+    # server (one clean process that imported the DEM modules) or spawn, never fork
+    context = dem_process_context()
+    want = "forkserver" if "forkserver" in multiprocessing.get_all_start_methods() else "spawn"
+    assert context.get_start_method() == want
+
+
 @pytest.mark.dem_subprocess
 @pytest.mark.slow
 def test_process_pool_gives_the_same_numbers_as_serial(tmp_path):
