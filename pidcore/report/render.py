@@ -214,7 +214,9 @@ def _write_pdf(table: pd.DataFrame, figures: Mapping[str, Path], prov: Provenanc
             pdf.savefig(fig)
             plt.close(fig)
         for fig in (figure_objects or {}).values():
-            pdf.savefig(fig)
+            # cropped to the drawing like the PNG and SVG: the layout kept from the PNG
+            # (see save_figure_files) would put a legend past a fixed page's edge
+            pdf.savefig(fig, bbox_inches="tight")
         fig = plt.figure(figsize=(11.69, 8.27))
         lines = [part for line in prov.lines()
                  for part in textwrap.wrap(line, 150, subsequent_indent="    ") or [""]]
@@ -239,6 +241,8 @@ def save_figure_files(fig: object, folder: Path, stem: str, *,
     The figure's layout is solved once, for the PNG, and then kept (the figure's layout
     engine is set to none): the SVG, and the report's PDF page of the same figure, reuse it
     instead of solving the constrained layout again per format (a third of a report's time).
+    Each is cropped to what is drawn (``bbox_inches="tight"``, the PDF page too), so text
+    that measures a little wider in another format is never cut at the edge.
     """
     folder.mkdir(parents=True, exist_ok=True)
     png, svg = folder / f"{stem}.png", folder / f"{stem}.svg"
