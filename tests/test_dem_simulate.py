@@ -172,6 +172,21 @@ def test_a_kept_settled_bed_gives_the_same_run_bit_for_bit(run_500hz):
     assert len(sim._FRICTIONLESS_BEDS) == min(2, FRICTIONLESS_BEDS_KEPT)
 
 
+def test_a_swallowed_ctrl_c_stops_a_run_at_its_next_kernel_call():
+    from pidcore import interrupt
+
+    # what pidcore.interrupt's handler leaves behind when Numba swallowed the KeyboardInterrupt
+    # (the CLI and the DEM pool workers route SIGINT through it): the run must not go on to
+    # its end (a sweep's worker did, for up to a minute after Ctrl-C)
+    interrupt.reset()
+    interrupt._interrupted.set()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            simulate_load_case(LoadCase(500, 5, 50), DemConfig(**FAST))
+    finally:
+        interrupt.reset()
+
+
 def test_one_g_dissipates_far_less_than_five_g_at_50hz():
     # At <= 1 g the bed never leaves the floor along z (gravity holds it): no impacts, only
     # slight rocking and sliding of loose particles (measured with 8 cells: SDC 0.005 at 1 g

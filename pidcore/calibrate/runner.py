@@ -77,13 +77,6 @@ def _run_entry(request: RunRequest) -> tuple[str, dict]:
     return request.key(), dem_run_entry(simulate_request(request))
 
 
-def _single_thread_worker() -> None:
-    # Parallel over runs; numba threads inside each would oversubscribe the cores.
-    import numba
-
-    numba.set_num_threads(1)
-
-
 def run_requests(requests: Sequence[RunRequest], *, store_path: str | os.PathLike,
                  workers: int = 2, progress: bool = True,
                  on_done: Callable[[str], None] | None = None) -> dict[str, float]:
@@ -124,11 +117,11 @@ def run_requests(requests: Sequence[RunRequest], *, store_path: str | os.PathLik
         elif todo:
             from concurrent.futures import ProcessPoolExecutor, as_completed
 
-            from ..dem.sweep import dem_process_context
+            from ..dem.sweep import dem_process_context, init_dem_worker
 
             pool = ProcessPoolExecutor(max_workers=min(workers, len(todo)),
                                        mp_context=dem_process_context(),
-                                       initializer=_single_thread_worker)
+                                       initializer=init_dem_worker)
             try:
                 futures = [pool.submit(_run_entry, request) for request in todo]
                 for future in as_completed(futures):

@@ -52,7 +52,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from .. import defaults
+from .. import defaults, interrupt
 from ..constants import (
     DAMPING_COEFFICIENTS,
     FILL_REFERENCES,
@@ -271,6 +271,10 @@ class _KernelClock:
         else:
             self.seconds += elapsed
             self.particle_steps += n_steps * state.n_particles * state.n_cells
+        # A Ctrl-C that arrived during the call may have been swallowed on its way out of
+        # Numba; where pidcore.interrupt routes SIGINT (the CLI, DEM worker processes), stop
+        # here instead of running the case to its end (a sweep's worker kept going ~80 s)
+        interrupt.raise_if_interrupted()
         return out
 
 

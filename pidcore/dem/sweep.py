@@ -90,11 +90,20 @@ def dem_process_context():
     return context
 
 
-def _single_thread_worker() -> None:
-    # Parallelism is across load cases; threads inside each would oversubscribe the cores.
+def init_dem_worker() -> None:
+    """Set up a pool process that runs DEM cases (sweeps, calibration design runs).
+
+    One kernel thread: the parallelism is across cases, threads inside each would
+    oversubscribe the cores. Ctrl-C routed through :mod:`pidcore.interrupt`, so that a case
+    stops at its next block of cycles even when the interrupt was swallowed inside Numba
+    (a worker used to run its case to the end, up to a minute and more).
+    """
     import numba
 
+    from .. import interrupt
+
     numba.set_num_threads(1)
+    interrupt.install()
 
 
 @dataclass
@@ -195,7 +204,7 @@ def _run_local(todo: Iterable[tuple[LoadCase, str]], config: DemConfig, workers:
 
     pool = ProcessPoolExecutor(max_workers=min(workers, len(todo)),
                                mp_context=dem_process_context(),
-                               initializer=_single_thread_worker)
+                               initializer=init_dem_worker)
     try:
         futures = [pool.submit(run_case, case, config, specimen) for case, _ in todo]
         for future in as_completed(futures):
