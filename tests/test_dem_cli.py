@@ -132,3 +132,29 @@ def test_ctrl_c_in_a_sweep_counts_the_cases_stored(tmp_path, monkeypatch, capsys
     assert main(sweep) == 130
     err = capsys.readouterr().err
     assert "nothing saved" in err and "are saved" not in err
+
+
+def test_sweep_runs_the_values_given_in_place_of_the_grids(tmp_path, capsys):
+    from pidcore.loadcase import parse_key
+    from pidcore.store import Store
+
+    path = tmp_path / "s.h5"
+    # fills given, frequencies and accelerations given: 1 x 1 x 2 cases, not the 48 of table3
+    assert main(["dem", "sweep", "--frequencies", "500", "--accelerations", "5",
+                 "--fills", "50,25,50", "--cells", "1", "--cycles", "2", "--workers", "1",
+                 "--store", str(path), "--no-progress", "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    runs = Store(path).list_dem_runs()
+    assert len(runs) == 2 and doc["completed"] == 2  # the repeated 50 runs once
+    assert sorted((c.frequency_hz, c.acceleration_g, c.fill_percent)
+                  for c in map(parse_key, runs["case_key"])) == [(500, 5, 25), (500, 5, 50)]
+
+
+@pytest.mark.parametrize("value", ["25,x", "25,-5", "nan", ""])
+def test_sweep_refuses_a_bad_value_list_in_one_line(tmp_path, capsys, value):
+    with pytest.raises(SystemExit) as exit_info:
+        main(["dem", "sweep", "--fills", value, "--store", str(tmp_path / "s.h5")])
+    assert exit_info.value.code == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--fills" in err[0]
+    assert not (tmp_path / "s.h5").exists()

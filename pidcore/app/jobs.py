@@ -284,13 +284,10 @@ def plan_dem_cases(frequencies_hz: Sequence[float], accelerations_g: Sequence[fl
     Any positive frequency and acceleration is accepted, not only grid values. Raises
     :class:`ParameterError` for an empty choice or more than ``max_cases`` cases.
     """
-    from ..dem import LoadCase as DemLoadCase
+    from ..dem.sweep import cross_cases
 
-    cases = [DemLoadCase(float(f), float(a), float(p), material, direction)
-             for f in sorted(set(frequencies_hz)) for a in sorted(set(accelerations_g))
-             for p in sorted(set(fills_percent))]
-    if not cases:
-        raise ParameterError("choose at least one frequency, acceleration and fill")
+    cases = cross_cases(frequencies_hz, accelerations_g, fills_percent, material=material,
+                        direction=direction)
     if len(cases) > max_cases:
         raise ParameterError(f"{len(cases)} load cases chosen; the app runs at most "
                              f"{max_cases} at a time (use `pidcore dem` for larger sweeps)")

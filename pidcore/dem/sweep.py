@@ -30,14 +30,34 @@ GRIDS: dict[str, dict[str, tuple[float, ...]]] = {
     },
 }
 
+def grid_axes(grid: str = "table3") -> dict[str, tuple[float, ...]]:
+    """The values of a named grid: ``frequency_hz``, ``acceleration_g``, ``fill_percent``."""
+    if grid not in GRIDS:
+        raise ParameterError(f"--grid: unknown grid {grid!r}; expected one of {sorted(GRIDS)}")
+    return GRIDS[grid]
+
+
+def cross_cases(frequencies_hz: Iterable[float], accelerations_g: Iterable[float],
+                fills_percent: Iterable[float], *, material: ParticleMaterial = "acrylic",
+                direction: DriveDirection = "z") -> list[LoadCase]:
+    """Every combination of the values, each once, ordered like the paper's Table 3
+    (frequency, then acceleration, then fill, each ascending)."""
+    axes = {"frequency": sorted(set(map(float, frequencies_hz))),
+            "acceleration": sorted(set(map(float, accelerations_g))),
+            "fill": sorted(set(map(float, fills_percent)))}
+    for name, values in axes.items():
+        if not values:
+            raise ParameterError(f"choose at least one {name}")
+    return [LoadCase(f, a, p, material, direction) for f in axes["frequency"]
+            for a in axes["acceleration"] for p in axes["fill"]]
+
+
 def grid_cases(grid: str = "table3", *, material: ParticleMaterial = "acrylic",
                direction: DriveDirection = "z") -> list[LoadCase]:
     """Load cases of a named grid, ordered like the paper's Table 3 (f, a, fill)."""
-    if grid not in GRIDS:
-        raise ParameterError(f"--grid: unknown grid {grid!r}; expected one of {sorted(GRIDS)}")
-    g = GRIDS[grid]
-    return [LoadCase(f, a, p, material, direction)
-            for f in g["frequency_hz"] for a in g["acceleration_g"] for p in g["fill_percent"]]
+    g = grid_axes(grid)
+    return cross_cases(g["frequency_hz"], g["acceleration_g"], g["fill_percent"],
+                       material=material, direction=direction)
 
 
 @dataclass(frozen=True)
