@@ -178,5 +178,23 @@ def key_0_1(case: LoadCase) -> str:
             f"_a{case.acceleration_g:g}_fill{case.fill_percent:g}")
 
 
+def parse_values(text: str, *, name: str) -> list[float]:
+    """Numbers typed as ``"50, 100 500"``: positive floats, or a one-line error naming
+    ``name``."""
+    values = []
+    for token in text.replace(",", " ").replace(";", " ").split():
+        try:
+            value = float(token)
+        except ValueError:
+            raise ParameterError(f"{name}: {token!r} is not a number") from None
+        if not value > 0 or value != value or value == float("inf"):
+            raise ParameterError(f"{name}: {token!r}, expected a positive number")
+        values.append(value)
+    if not values:
+        raise ParameterError(f"{name}: give at least one value")
+    return values
+
+
 __all__ = ["KEY_PATTERN", "KEY_PATTERN_0_1", "LoadCase", "LoadCaseError", "check_fill",
-           "key_0_1", "normalize_material", "normalize_direction", "parse_key"]
+           "key_0_1", "normalize_material", "normalize_direction", "parse_key",
+           "parse_values"]

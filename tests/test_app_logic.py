@@ -501,11 +501,13 @@ def test_cancel_stops_a_running_dem_case_within_two_seconds_and_saves_nothing(tm
 
 
 def test_dem_values_are_any_positive_numbers():
-    assert jobs.parse_values("50, 123.5;7", name="f") == [50.0, 123.5, 7.0]
+    from pidcore.loadcase import parse_values
+
+    assert parse_values("50, 123.5;7", name="f") == [50.0, 123.5, 7.0]
     with pytest.raises(ParameterError, match="f: 'x' is not a number"):
-        jobs.parse_values("50 x", name="f")
+        parse_values("50 x", name="f")
     with pytest.raises(ParameterError, match="positive"):
-        jobs.parse_values("-5", name="f")
+        parse_values("-5", name="f")
 
 
 def test_pidcore_app_serves_on_localhost_until_stopped(tmp_path):

@@ -292,20 +292,3 @@ def plan_dem_cases(frequencies_hz: Sequence[float], accelerations_g: Sequence[fl
         raise ParameterError(f"{len(cases)} load cases chosen; the app runs at most "
                              f"{max_cases} at a time (use `pidcore dem` for larger sweeps)")
     return cases
-
-
-def parse_values(text: str, *, name: str) -> list[float]:
-    """Numbers typed as ``"50, 100 500"``: positive floats, or a one-line error naming
-    ``name``."""
-    values = []
-    for token in text.replace(",", " ").replace(";", " ").split():
-        try:
-            value = float(token)
-        except ValueError:
-            raise ParameterError(f"{name}: {token!r} is not a number") from None
-        if not value > 0 or value != value or value == float("inf"):
-            raise ParameterError(f"{name}: {token!r}, expected a positive number")
-        values.append(value)
-    if not values:
-        raise ParameterError(f"{name}: give at least one value")
-    return values

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import sys
 from pathlib import Path
 
@@ -128,7 +127,7 @@ def _register_sweep(sub: argparse._SubParsersAction) -> None:
     for flag, what in (("--frequencies", "drive frequencies, Hz"),
                        ("--accelerations", "acceleration amplitudes, g"),
                        ("--fills", "fills (packing ratios), %")):
-        p.add_argument(flag, metavar="X,X", type=_positive_list(flag), default=None,
+        p.add_argument(flag, metavar="X,X", default=None,
                        help=f"{what}, comma-separated, in place of the grid's (every "
                             "combination is run)")
     _add_config_options(p)
@@ -139,25 +138,6 @@ def _register_sweep(sub: argparse._SubParsersAction) -> None:
     add_store_option(p)
     add_json_option(p, progress=True)
     p.set_defaults(func=sweep)
-
-
-def _positive_list(flag: str):
-    """argparse type: ``"50,100.5"`` -> [50.0, 100.5], or a one-line error naming ``flag``."""
-    def parse(text: str) -> list[float]:
-        values = []
-        for token in text.split(","):
-            try:
-                value = float(token)
-            except ValueError:
-                raise argparse.ArgumentTypeError(
-                    f"{token.strip()!r} is not a number (expected e.g. 50,100)") from None
-            if not (value > 0 and math.isfinite(value)):
-                raise argparse.ArgumentTypeError(f"{token.strip()!r}: expected positive numbers")
-            values.append(value)
-        return values
-
-    parse.__name__ = flag  # argparse names the option in its error
-    return parse
 
 
 def _config(args: argparse.Namespace):
@@ -200,13 +180,16 @@ def _interrupted(command: str, saved: int, store) -> int:
 
 def sweep(args: argparse.Namespace) -> int:
     from ..dem.sweep import cross_cases, grid_axes, run_sweep
+    from ..loadcase import parse_values
 
-    specimen, material = _specimen(args)
     axes = grid_axes(args.grid)
-    cases = cross_cases(args.frequencies or axes["frequency_hz"],
-                        args.accelerations or axes["acceleration_g"],
-                        args.fills or axes["fill_percent"], material=material,
-                        direction=args.direction)
+    values = [axes[axis] if given is None else parse_values(given, name=flag)
+              for axis, given, flag in (("frequency_hz", args.frequencies, "--frequencies"),
+                                        ("acceleration_g", args.accelerations,
+                                         "--accelerations"),
+                                        ("fill_percent", args.fills, "--fills"))]
+    specimen, material = _specimen(args)
+    cases = cross_cases(*values, material=material, direction=args.direction)
     saved: list[str] = []  # keys run_sweep has stored (its on_case hook runs after each save)
     try:
         summary = run_sweep(cases, _config(args), store_path=args.store, workers=args.workers,

@@ -17,6 +17,7 @@ from pidcore import defaults
 from pidcore.app import jobs, state
 from pidcore.app.pages import draw_polling
 from pidcore.constants import DRIVE_DIRECTIONS, PARTICLE_MATERIALS
+from pidcore.loadcase import parse_values
 
 #: Seconds between refreshes of the job table while jobs run.
 REFRESH_S = 1.0
@@ -134,9 +135,9 @@ def render(stores) -> None:
         try:
             config = _config(cells, seed, steady)
             cases = jobs.plan_dem_cases(
-                jobs.parse_values(freqs, name="frequencies [Hz]"),
-                jobs.parse_values(accs, name="accelerations [g]"),
-                jobs.parse_values(fills, name="fills [%]"), material=material,
+                parse_values(freqs, name="frequencies [Hz]"),
+                parse_values(accs, name="accelerations [g]"),
+                parse_values(fills, name="fills [%]"), material=material,
                 direction=direction)
         except PidcoreError as exc:
             st.session_state["dem_message"] = ("error", str(exc))
