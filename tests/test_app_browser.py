@@ -68,8 +68,8 @@ def _sample(tmp_path: Path) -> Path:
     return path
 
 
-# One Streamlit server and one chromium for the module (each start costs seconds of
-# imports); every test opens its own page, hence its own Streamlit session: uploads and
+# One Streamlit server, one chromium and one page for the module (each start costs seconds of
+# imports); every test opens the app anew, hence its own Streamlit session: uploads and
 # widget state are per session, only what a test saves to the store is shared.
 
 
