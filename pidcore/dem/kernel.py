@@ -290,34 +290,25 @@ def advance_cells(pos, vel, omg, frc, trq, wall_n, wall_d,
                   tally, samples, status, fail_step, first_cell, end_cell):
     # rolling resistance as a compile-time constant: two machine codes, the one without
     # rolling free of its code (smaller hot loop); chosen here, per call, at no dispatch cost
+    args = (pos, vel, omg, frc, trq, wall_n, wall_d, radius, mass, inertia, law_pp, law_pw,
+            v_reg, clip_attraction, gravity, stick_slip, hist_pp, hist_pw,
+            dt, step0, n_steps, omega, accel_amp, drive_axis,
+            steps_per_cycle, sample_every, max_overlap_fraction,
+            tally, samples, status, fail_step)
     for c in range(first_cell, end_cell):
         if status[c] != STATUS_OK:
             continue
         if rolling:
-            _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
-                          radius, mass, inertia, law_pp, law_pw,
-                          v_reg, clip_attraction, gravity, stick_slip, True, hist_pp,
-                          hist_pw, dt, step0, n_steps, omega, accel_amp, drive_axis,
-                          steps_per_cycle, sample_every, max_overlap_fraction,
-                          tally, samples, status, fail_step)
+            _advance_cell(True, c, args)
         else:
-            _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
-                          radius, mass, inertia, law_pp, law_pw,
-                          v_reg, clip_attraction, gravity, stick_slip, False, hist_pp,
-                          hist_pw, dt, step0, n_steps, omega, accel_amp, drive_axis,
-                          steps_per_cycle, sample_every, max_overlap_fraction,
-                          tally, samples, status, fail_step)
+            _advance_cell(False, c, args)
     return 0
 
 
 @njit(cache=True, error_model="numpy")
-def _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
-                  radius, mass, inertia, law_pp, law_pw,
-                  v_reg, clip_attraction, gravity, stick_slip, rolling, hist_pp, hist_pw,
-                  dt, step0, n_steps, omega, accel_amp, drive_axis,
-                  steps_per_cycle, sample_every, max_overlap_fraction,
-                  tally, samples, status, fail_step):
-    """Advance cell ``c`` by ``n_steps`` (see the module docstring).
+def _advance_cell(rolling, c, args):
+    """Advance cell ``c`` by ``n_steps`` (see the module docstring); ``args`` are
+    :func:`advance_cells`'s arguments from ``pos`` to ``fail_step`` but ``rolling``.
 
     Speed (results are bit-identical to a brute-force search over all pairs and walls):
     the cell's state is copied into contiguous 1-D arrays for the chunk; particle pairs
@@ -327,6 +318,11 @@ def _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
     cell for the walls, which move with it).
     """
     literally(rolling)
+    (pos, vel, omg, frc, trq, wall_n, wall_d, radius, mass, inertia, law_pp, law_pw,
+     v_reg, clip_attraction, gravity, stick_slip, hist_pp, hist_pw,
+     dt, step0, n_steps, omega, accel_amp, drive_axis,
+     steps_per_cycle, sample_every, max_overlap_fraction,
+     tally, samples, status, fail_step) = args
     n_part = pos.shape[2]
     n_walls = wall_n.shape[0]
     inv_m = 1.0 / mass
@@ -670,23 +666,29 @@ def _advance_cell(c, pos, vel, omg, frc, trq, wall_n, wall_d,
         if status[c] != STATUS_OK:
             fail_step[c] = step0 + s + 1
             break
-    pos[0, c] = px
-    pos[1, c] = py
-    pos[2, c] = pz
-    vel[0, c] = vx
-    vel[1, c] = vy
-    vel[2, c] = vz
-    omg[0, c] = ox
-    omg[1, c] = oy
-    omg[2, c] = oz
-    frc[0, c] = fx
-    frc[1, c] = fy
-    frc[2, c] = fz
-    trq[0, c] = tx
-    trq[1, c] = ty
-    trq[2, c] = tz
-    hist_pp[c] = hp
-    hist_pw[c] = hw
+    # element loops: a slice assignment compiles a shape-check helper of its own (~0.1 s
+    # each, 16 per variant: ~6 s of a cold compile)
+    for i in range(n_part):
+        pos[0, c, i] = px[i]
+        pos[1, c, i] = py[i]
+        pos[2, c, i] = pz[i]
+        vel[0, c, i] = vx[i]
+        vel[1, c, i] = vy[i]
+        vel[2, c, i] = vz[i]
+        omg[0, c, i] = ox[i]
+        omg[1, c, i] = oy[i]
+        omg[2, c, i] = oz[i]
+        frc[0, c, i] = fx[i]
+        frc[1, c, i] = fy[i]
+        frc[2, c, i] = fz[i]
+        trq[0, c, i] = tx[i]
+        trq[1, c, i] = ty[i]
+        trq[2, c, i] = tz[i]
+    for hist, h in ((hist_pp, hp), (hist_pw, hw)):
+        for a in range(h.shape[0]):
+            for b in range(h.shape[1]):
+                for q in range(h.shape[2]):
+                    hist[c, a, b, q] = h[a, b, q]
 
 
 @njit(cache=True)
