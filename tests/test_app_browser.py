@@ -11,7 +11,6 @@ import os
 import re
 import socket
 import subprocess
-import sys
 import time
 import urllib.request
 from pathlib import Path
@@ -21,11 +20,11 @@ from _app_samples import mass_damper_csv
 
 from pidcore.app import uploads
 from pidcore.app.stores import STORE_ENV_VAR
+from pidcore.cli.app import streamlit_command
 
 pytestmark = [pytest.mark.browser, pytest.mark.slow, pytest.mark.dem_subprocess]
 
 REPO = Path(__file__).resolve().parents[1]
-SHIM = REPO / "app" / "pidcore_app.py"
 ARTIFACTS = REPO / "test-artifacts"
 CHROMIUM = Path("/usr/bin/chromium")
 CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
@@ -107,11 +106,9 @@ def _serve(tmp_path: Path, store: Path):
            "PYTHONPATH": os.pathsep.join([str(REPO), os.environ.get("PYTHONPATH", "")])}
     env.pop("PIDCORE_DEM_STORE", None)
     log = (tmp_path / "streamlit.log").open("wb")
-    proc = subprocess.Popen(
-        [sys.executable, "-m", "streamlit", "run", str(SHIM), "--server.headless", "true",
-         "--server.address", "localhost", "--server.port", str(port),
-         "--browser.gatherUsageStats", "false", "--server.fileWatcherType", "none"],
-        cwd=tmp_path, env=env, stdout=log, stderr=subprocess.STDOUT)
+    # the command `pidcore app` runs (its settings included), without the file watcher
+    proc = subprocess.Popen(streamlit_command(port) + ["--server.fileWatcherType", "none"],
+                            cwd=tmp_path, env=env, stdout=log, stderr=subprocess.STDOUT)
     url = f"http://localhost:{port}"
     deadline = time.monotonic() + START_TIMEOUT_S
     while True:

@@ -54,6 +54,10 @@ def streamlit_command(port: int, *, python: str | None = None) -> list[str]:
         "--browser.gatherUsageStats", "false",
         "--client.toolbarMode", "minimal",
         "--global.developmentMode", "false",
+        # Streamlit runs a full garbage collection after every script run by default: ~0.1 s
+        # per click with numpy/pandas/numba loaded, for memory that Python's own collector
+        # frees anyway (the served browser tests: 8.5 -> 6.2 CPU-s on the server)
+        "--runner.postScriptGC", "false",
     ]
 
 
