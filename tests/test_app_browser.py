@@ -230,6 +230,14 @@ def test_upload_compare_save_reload_and_the_report_csv(app_url, sample, tmp_path
     # Both loops are drawn: the measurement's and our DEM run's at this load case.
     energies = page.get_by_text("energy per cycle (loop area)")
     assert "measured" in energies.inner_text() and "our DEM" in energies.inner_text()
+    # No chart is drawn over a table (the spectra once ran into the one beside them).
+    drawn = [c.locator("canvas, svg").first.bounding_box() for c in charts.all()]
+    tables = [box for t in page.locator('[data-testid="stDataFrame"]').all()
+              if (box := t.bounding_box())]  # None: on a tab not shown
+    assert all(drawn) and len(tables) >= 2  # the harmonics and the measured table
+    for a in drawn:
+        for b in tables:
+            assert not _overlap(a, b), (a, b)
     headline = page.get_by_role("heading").filter(has_text="vs our DEM")
     assert "±" in headline.first.inner_text() and "σ" in headline.first.inner_text()
     page.screenshot(path=str(ARTIFACTS / "app_e2e.png"), full_page=True)
@@ -304,6 +312,12 @@ def _saved_runs(store: Path) -> int:
     from pidcore.store import Store
 
     return 0 if not store.exists() else len(Store(store).list_dem_runs())
+
+
+def _overlap(a: dict, b: dict) -> bool:
+    """Whether two bounding boxes (Playwright's x, y, width, height) share any area."""
+    return (a["x"] < b["x"] + b["width"] and b["x"] < a["x"] + a["width"]
+            and a["y"] < b["y"] + b["height"] and b["y"] < a["y"] + a["height"])
 
 
 def _fill_dem(page, *, freqs: str, accs: str, fills: str, cells: int, steady: int) -> None:

@@ -1,4 +1,4 @@
-"""Vega-Lite (Altair) charts of the app: layout only; they draw the frames of the library
+"""Vega-Lite charts of the app, as JSON specs: layout only; they draw the frames of the library
 (:func:`pidcore.compare.case.sdc_points`, :func:`pidcore.app.workbench.loop_frame`,
 :meth:`pidcore.compare.case.MeasuredEntry.spectrum`), the same data the report's matplotlib
 figures draw.
@@ -6,14 +6,24 @@ figures draw.
 Drawn in the browser, so switching load cases costs the server only the (small) chart data.
 Vega-Lite reads ``[`` and ``.`` in field names as nested access, so the unit-suffixed columns
 are renamed to plain identifiers here and the units go into axis titles.
+
+Written as the Vega-Lite dictionaries ``st.vega_lite_chart`` takes, not through Altair:
+Altair's object model (built, deep-copied and serialised to this same dictionary) took ~0.1 s
+per load case, most of a Compare view's server time. The tests validate every spec against
+the Vega-Lite schema that Altair ships.
 """
 
 from __future__ import annotations
 
-import altair as alt
+import math
+from typing import Any
+
 import pandas as pd
 
 from pidcore.compare.case import SDC_SERIES
+
+#: The Vega-Lite major version the specs are written for (Streamlit >= 1.56 draws v6).
+VEGA_LITE_SCHEMA = "https://vega.github.io/schema/vega-lite/v6.json"
 
 _MODEL = SDC_SERIES[0]
 #: One fixed, clearly distinct colour per series of SDC_SERIES (no two blues).
@@ -28,10 +38,28 @@ _SDC_SHAPES = dict(zip(SDC_SERIES, ("stroke", "square", "triangle-up", "diamond"
 _LEGEND = {"orient": "bottom", "columns": 1, "labelLimit": 0, "title": None}
 #: Fit the width to the column, keep the plot's height: the legend below adds to it (with
 #: "fit" on both axes a long legend squeezes the plot away).
-_AUTOSIZE = alt.AutoSizeParams(type="fit-x", contains="padding")
+_AUTOSIZE = {"type": "fit-x", "contains": "padding"}
+#: Size of a continuous view without an explicit width or height (Altair's default theme).
+_CONFIG = {"view": {"continuousHeight": 300, "continuousWidth": 300}}
 
 
-def sdc_chart(data: pd.DataFrame) -> alt.LayerChart:
+def _records(frame: pd.DataFrame) -> list[dict[str, Any]]:
+    """Rows as JSON-ready dicts: Python numbers, NaN as null (JSON has no NaN)."""
+    return [{k: None if isinstance(v, float) and math.isnan(v) else v for k, v in row.items()}
+            for row in frame.to_dict(orient="records")]
+
+
+def _field(name: str, kind: str, **more: Any) -> dict[str, Any]:
+    return {"field": name, "type": kind, **more}
+
+
+def _top(name: str, frame: pd.DataFrame, **spec: Any) -> dict[str, Any]:
+    """A top-level spec whose data is ``frame``, sent as the named dataset ``name``."""
+    return {"$schema": VEGA_LITE_SCHEMA, "config": _CONFIG, "data": {"name": name},
+            "datasets": {name: _records(frame)}, **spec}
+
+
+def sdc_chart(data: pd.DataFrame) -> dict[str, Any]:
     """SDC against fill: model curve, paper points, our DEM and measured with error bars.
 
     The legend lists exactly the series present (the model curve included), one per line so
@@ -40,39 +68,42 @@ def sdc_chart(data: pd.DataFrame) -> alt.LayerChart:
     present = [s for s in SDC_SERIES if s in set(data["series"])]
     plain = data.rename(columns={"fill [%]": "fill", "SDC [-]": "sdc", "low [-]": "low",
                                  "high [-]": "high"})
-    colour = alt.Color("series:N", scale=alt.Scale(domain=present,
-                                                   range=[_SDC_COLOURS[s] for s in present]),
-                       legend=alt.Legend(**_LEGEND))
-    base = alt.Chart(plain).encode(x=alt.X("fill:Q", title="packing ratio (fill) [%]"),
-                                   color=colour)
-    curve = base.transform_filter(alt.datum.series == _MODEL).mark_line().encode(
-        y=alt.Y("sdc:Q", title="SDC [-]"))
-    others = base.transform_filter(alt.datum.series != _MODEL)
-    bars = others.mark_errorbar(ticks=True).encode(y=alt.Y("low:Q", title="SDC [-]"),
-                                                   y2="high:Q")
+    x = _field("fill", "quantitative", title="packing ratio (fill) [%]")
+    colour = _field("series", "nominal", legend=_LEGEND,
+                    scale={"domain": present, "range": [_SDC_COLOURS[s] for s in present]})
+    model = {"field": "series", "equal": _MODEL}
+    curve = {"mark": {"type": "line"}, "transform": [{"filter": model}],
+             "encoding": {"x": x, "color": colour,
+                          "y": _field("sdc", "quantitative", title="SDC [-]")}}
+    others = [{"filter": {"not": model}}]
+    bars = {"mark": {"type": "errorbar", "ticks": True}, "transform": others,
+            "encoding": {"x": x, "color": colour,
+                         "y": _field("low", "quantitative", title="SDC [-]"),
+                         "y2": {"field": "high"}}}
     # colour and shape share domain and legend, so the legend lists every series present,
     # the model curve (drawn as a line symbol) included
-    shape = alt.Shape("series:N", scale=alt.Scale(domain=present,
-                                                  range=[_SDC_SHAPES[s] for s in present]),
-                      legend=alt.Legend(**_LEGEND))
-    points = others.mark_point(size=90, filled=True).encode(
-        y="sdc:Q", shape=shape,
-        tooltip=[alt.Tooltip("series:N"), alt.Tooltip("fill:Q", title="fill [%]"),
-                 alt.Tooltip("sdc:Q", title="SDC [-]", format=".4f"),
-                 alt.Tooltip("low:Q", title="- stderr", format=".4f"),
-                 alt.Tooltip("high:Q", title="+ stderr", format=".4f")])
-    return alt.layer(curve, bars, points).properties(height=300, title="SDC against fill",
-                                                     autosize=_AUTOSIZE)
+    shape = _field("series", "nominal", legend=_LEGEND,
+                   scale={"domain": present, "range": [_SDC_SHAPES[s] for s in present]})
+    points = {"mark": {"type": "point", "size": 90, "filled": True}, "transform": others,
+              "encoding": {"x": x, "color": colour, "y": _field("sdc", "quantitative"),
+                           "shape": shape, "tooltip": [
+                               _field("series", "nominal"),
+                               _field("fill", "quantitative", title="fill [%]"),
+                               _field("sdc", "quantitative", title="SDC [-]", format=".4f"),
+                               _field("low", "quantitative", title="- stderr", format=".4f"),
+                               _field("high", "quantitative", title="+ stderr",
+                                      format=".4f")]}}
+    return _top("sdc", plain, layer=[curve, bars, points], height=300,
+                title="SDC against fill", autosize=_AUTOSIZE)
 
 
-def loop_chart(frame: pd.DataFrame) -> alt.Chart:
+def loop_chart(frame: pd.DataFrame) -> dict[str, Any]:
     """Force-displacement loops overlaid, displacement in µm (a coupon moves micrometres).
 
     ``frame`` is :func:`pidcore.app.workbench.loop_frame` (SI). Legend labels are the loops'
     names only (the page prints their energies per cycle below), so none is cut.
     """
     series = list(dict.fromkeys(frame["series"]))
-    labels = {s: s for s in series}
     colours, k = [], 0
     for s in series:
         if s.startswith("our DEM"):
@@ -80,43 +111,48 @@ def loop_chart(frame: pd.DataFrame) -> alt.Chart:
         else:
             colours.append(_LOOP_COLOURS[k % len(_LOOP_COLOURS)])
             k += 1
-    plain = pd.DataFrame({"series": frame["series"].map(labels),
+    plain = pd.DataFrame({"series": frame["series"],
                           "displacement_um": frame["displacement [m]"].astype(float) * 1e6,
                           "force_n": frame["force [N]"].astype(float),
                           "order": frame["order"]})
-    return alt.Chart(plain).mark_line().encode(
-        x=alt.X("displacement_um:Q", title="displacement [µm]", axis=alt.Axis(format=".4~r")),
-        y=alt.Y("force_n:Q", title="force [N]", axis=alt.Axis(format=".4~r")),
-        order="order:Q",
-        color=alt.Color("series:N", scale=alt.Scale(domain=[labels[s] for s in series],
-                                                    range=colours),
-                        legend=alt.Legend(**_LEGEND)),
-    ).properties(height=300, title="force-displacement loop (area = energy per cycle)",
-                 autosize=_AUTOSIZE)
+    axis = {"format": ".4~r"}
+    return _top("loop", plain, mark={"type": "line"}, encoding={
+        "x": _field("displacement_um", "quantitative", title="displacement [µm]", axis=axis),
+        "y": _field("force_n", "quantitative", title="force [N]", axis=axis),
+        "order": _field("order", "quantitative"),
+        "color": _field("series", "nominal", legend=_LEGEND,
+                        scale={"domain": series, "range": colours})},
+        height=300, title="force-displacement loop (area = energy per cycle)",
+        autosize=_AUTOSIZE)
 
 
-def spectrum_chart(table: pd.DataFrame) -> alt.HConcatChart:
+def spectrum_chart(table: pd.DataFrame) -> dict[str, Any]:
     """Force and velocity harmonic amplitudes (log scale), side by side."""
     plain = pd.DataFrame({
         "harmonic": table["harmonic [-]"], "frequency": table["frequency [Hz]"],
         "force": table["force amplitude [N]"],
         "velocity": table["velocity amplitude [m/s]"] * 1e3,
     })
+    datasets = {}
 
-    def stems(column: str, title: str, color: str) -> alt.LayerChart:
+    def stems(column: str, title: str, color: str) -> dict[str, Any]:
         # Bars cannot start at 0 on a log axis: stems from a floor a decade below the smallest
         # amplitude, with a dot on top.
         positive = plain[column][plain[column] > 0]
         floor = float(positive.min()) / 10 if len(positive) else 1e-12
-        base = alt.Chart(plain.assign(floor=floor)).encode(
-            x=alt.X("harmonic:O", title="harmonic [-]"))
-        y = alt.Y(f"{column}:Q", title=title, scale=alt.Scale(type="log"))
-        rule = base.mark_rule(color=color, strokeWidth=3).encode(y=y, y2="floor:Q")
-        dots = base.mark_point(color=color, filled=True, size=70).encode(
-            y=y, tooltip=[alt.Tooltip("harmonic:O"), alt.Tooltip("frequency:Q", title="[Hz]"),
-                          alt.Tooltip(f"{column}:Q", title=title, format=".4g")])
-        return alt.layer(rule, dots).properties(width=220, height=220)
+        datasets[column] = _records(plain.assign(floor=floor))
+        x = _field("harmonic", "ordinal", title="harmonic [-]")
+        y = _field(column, "quantitative", title=title, scale={"type": "log"})
+        rule = {"mark": {"type": "rule", "color": color, "strokeWidth": 3},
+                "encoding": {"x": x, "y": y, "y2": {"field": "floor"}}}
+        dots = {"mark": {"type": "point", "color": color, "filled": True, "size": 70},
+                "encoding": {"x": x, "y": y, "tooltip": [
+                    _field("harmonic", "ordinal"),
+                    _field("frequency", "quantitative", title="[Hz]"),
+                    _field(column, "quantitative", title=title, format=".4g")]}}
+        return {"data": {"name": column}, "layer": [rule, dots], "width": 220, "height": 220}
 
-    return alt.hconcat(stems("force", "force amplitude [N]", "#e67e22"),
-                       stems("velocity", "velocity amplitude [mm/s]", "#8e44ad")) \
-        .properties(title="harmonic spectrum of force and velocity")
+    charts = [stems("force", "force amplitude [N]", "#e67e22"),
+              stems("velocity", "velocity amplitude [mm/s]", "#8e44ad")]
+    return {"$schema": VEGA_LITE_SCHEMA, "config": _CONFIG, "datasets": datasets,
+            "hconcat": charts, "title": "harmonic spectrum of force and velocity"}

@@ -136,9 +136,9 @@ def render(stores, session_files: list) -> None:
     if view["energies"]:
         st.markdown("energy per cycle (loop area): " + " · ".join(
             f"{label}: **{energy:.4e} J**" for label, energy in view["energies"].items()))
-    left2, right2 = st.columns(2)
-    left2.vega_lite_chart(spec=view["spectrum_spec"], key="spectrum_chart")
-    right2.dataframe(view["spectrum"], hide_index=True, width="stretch")
+    # the two fixed-width spectra (~600 px) overflowed half a page into the table beside them
+    st.vega_lite_chart(spec=view["spectrum_spec"], key="spectrum_chart")
+    st.dataframe(view["spectrum"], hide_index=True, width="stretch")
     st.dataframe(comp.measured, hide_index=True, width="stretch", key="compare_measured")
     if st.button("PDF of this load case (plots and corrections)", key="case_pdf"):
         from pidcore.report.case_sheet import case_pdf
