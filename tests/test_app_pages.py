@@ -39,9 +39,18 @@ def store_file(tmp_path, monkeypatch):
     st.cache_resource.clear()
 
 
+#: Streamlit scans every installed distribution for custom components once per AppTest
+#: (~0.1 s each; the app uses none): the first scan's result serves every AppTest of the module.
+_COMPONENTS: dict = {}
+
+
 def _app() -> AppTest:
     at = AppTest.from_file(str(SHIM), default_timeout=RUN_TIMEOUT_S)
+    if _COMPONENTS and hasattr(at, "_bidi_component_manager"):  # a private attribute: where
+        at._bidi_component_manager = _COMPONENTS["manager"]     # it is missing, scan anew
     at.run()
+    if getattr(at, "_bidi_component_manager", None) is not None:
+        _COMPONENTS.setdefault("manager", at._bidi_component_manager)
     assert not at.exception, at.exception
     return at
 
