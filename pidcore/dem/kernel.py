@@ -668,22 +668,12 @@ def _advance_cell(rolling, c, args):
             break
     # element loops: a slice assignment compiles a shape-check helper of its own (~0.1 s
     # each, 16 per variant: ~6 s of a cold compile)
-    for i in range(n_part):
-        pos[0, c, i] = px[i]
-        pos[1, c, i] = py[i]
-        pos[2, c, i] = pz[i]
-        vel[0, c, i] = vx[i]
-        vel[1, c, i] = vy[i]
-        vel[2, c, i] = vz[i]
-        omg[0, c, i] = ox[i]
-        omg[1, c, i] = oy[i]
-        omg[2, c, i] = oz[i]
-        frc[0, c, i] = fx[i]
-        frc[1, c, i] = fy[i]
-        frc[2, c, i] = fz[i]
-        trq[0, c, i] = tx[i]
-        trq[1, c, i] = ty[i]
-        trq[2, c, i] = tz[i]
+    for dst, rows in ((pos, (px, py, pz)), (vel, (vx, vy, vz)), (omg, (ox, oy, oz)),
+                      (frc, (fx, fy, fz)), (trq, (tx, ty, tz))):
+        for k in range(3):
+            row = rows[k]
+            for i in range(n_part):
+                dst[k, c, i] = row[i]
     for hist, h in ((hist_pp, hp), (hist_pw, hw)):
         for a in range(h.shape[0]):
             for b in range(h.shape[1]):
