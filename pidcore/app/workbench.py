@@ -62,12 +62,15 @@ def group_entries(entries: Sequence[MeasuredEntry]) -> list[list[int]]:
     return out
 
 
-def group_label(entries: Sequence[MeasuredEntry], group: Sequence[int]) -> str:
-    """E.g. ``'500 Hz, 5 g, 50 %, acrylic, z, specimen A (2 file(s))'``."""
+def group_name(entries: Sequence[MeasuredEntry], group: Sequence[int]) -> str:
+    """The group's load case, e.g. ``'500 Hz, 5 g, 50 %, acrylic, z, specimen A'``.
+
+    Stays the same when records are added to the group or the groups are listed in another
+    order (a save re-sorts them), so it can name the user's choice of group.
+    """
     e = entries[group[0]]
     specimen = f", specimen {e.specimen}" if e.specimen else ""
-    return (f"{e.load_case.label()}, {e.load_case.material}, {e.load_case.direction}{specimen} "
-            f"({len(group)} file(s))")
+    return f"{e.load_case.label()}, {e.load_case.material}, {e.load_case.direction}{specimen}"
 
 
 def dem_loop(paths: Sequence[str | os.PathLike | None],

@@ -89,11 +89,20 @@ def render(stores, session_files: list) -> None:
                 "Upload and save measurements on the Analyse tab.")
         return
     groups = workbench.group_entries(entries)
-    labels = [workbench.group_label(entries, g) for g in groups]
-    choice = st.selectbox("load case", range(len(groups)), format_func=labels.__getitem__,
+    # The choice is the group's name, not its position: saving re-sorts the groups, and a
+    # position would then show another load case's numbers under the chosen one's label.
+    by_name: dict[str, list[int]] = {}
+    for g in groups:  # two groups whose rounded names agree stay apart
+        name = base = workbench.group_name(entries, g)
+        while name in by_name:
+            name = f"{base} #{len(by_name)}"
+        by_name[name] = g
+    labels = {name: f"{name} ({len(g)} file(s))" for name, g in by_name.items()}
+    choice = st.selectbox("load case", list(by_name), format_func=labels.__getitem__,
                           key="compare_case")
-    choice = min(choice or 0, len(groups) - 1)
-    members = [entries[i] for i in groups[choice]]
+    if choice not in by_name:
+        choice = next(iter(by_name))
+    members = [entries[i] for i in by_name[choice]]
     stamp = stores.stamp()
     try:
         view = state.case_view(_group_key(members), stamp, members, stores)
