@@ -203,6 +203,9 @@ def test_upload_compare_save_reload_and_the_report_csv(app_url, sample, tmp_path
     expected = _analysis_of(sample)
     expected_text = uploads.format_sdc(expected.sdc, expected.sdc_stderr)
     _open(page, app_url)
+    # one page with tabs: no sidebar links to extra pages (a `pages/` folder beside the entry
+    # script once added five that opened blank)
+    assert page.locator('[data-testid="stSidebarNav"]').count() == 0
     bad = tmp_path / "corrupt_export.uff"
     bad.write_bytes(b"    -1\n    58\nnot a dataset\n")
     page.locator("input[type=file]").first.set_input_files([str(sample), str(bad)])

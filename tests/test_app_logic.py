@@ -400,6 +400,9 @@ def test_app_command_serves_the_packaged_entry_on_localhost(tmp_path):
     entry = Path(cmd[4])
     # Inside the installed package, so a non-editable install finds it too.
     assert entry == ENTRY_SCRIPT and entry.is_file()
+    # Streamlit lists the scripts of a pages/ folder beside the entry as pages of their own
+    for script in (entry, REPO / "app" / "pidcore_app.py"):
+        assert not (script.parent / "pages").exists(), script
     assert entry.parent.parent == Path(pidcore.__file__).parent
     opts = dict(zip(cmd[5::2], cmd[6::2], strict=True))
     assert opts["--server.address"] == "localhost"

@@ -389,7 +389,7 @@ def _record_fragment_timers(monkeypatch) -> list[tuple[str, float | None]]:
 
 @pytest.mark.dem_subprocess
 def test_dem_cancel_stops_the_running_case(store_file, monkeypatch):
-    from pidcore.app.pages import dem as dem_page
+    from pidcore.app.tabs import dem as dem_page
     from pidcore.store import Store
 
     timers = _record_fragment_timers(monkeypatch)
@@ -492,11 +492,13 @@ def test_bundled_samples_switch_load_cases_within_a_second(store_file, monkeypat
     shown = _table(at, "warnings")
     assert dict(zip(shown["file"], shown["SDC [-]"], strict=True)) == pytest.approx(want,
                                                                                    rel=1e-12)
-    n_cases = len(at.selectbox(key="compare_case").options)
+    # the choices are the load cases' names: the labels without their file counts
+    names = [o.rsplit(" (", 1)[0] for o in at.selectbox(key="compare_case").options]
+    n_cases = len(names)
     assert n_cases == len(exports)  # one load case per sample export
     timings = []
     for _ in range(2):
-        for choice in range(n_cases):
+        for choice in names:
             at.selectbox(key="compare_case").set_value(choice)
             start = time.perf_counter()
             at.run()

@@ -1,8 +1,9 @@
 """The Streamlit app of pidcore (``pidcore app``), shipped inside the package.
 
-Layout: :mod:`.main` lays out the tabs, :mod:`.pages` holds one module per page (analyse,
-compare, dem, calibrate, report), :mod:`.charts` the Vega-Lite charts and :mod:`.state` the
-cached reads. The logic the pages call is free of Streamlit and tested directly:
+Layout: :mod:`.main` lays out the tabs, :mod:`.tabs` holds one module per tab (analyse,
+compare, dem, calibrate, report; not ``pages/``, which Streamlit would list as extra pages
+beside :data:`ENTRY_SCRIPT`), :mod:`.charts` the Vega-Lite charts and :mod:`.state` the
+cached reads. The logic the tabs call is free of Streamlit and tested directly:
 :mod:`.uploads` (uploads, per-file settings, saving), :mod:`.stores` (which stores the app
 uses), :mod:`.jobs` (the DEM job runner); comparison, loops, store listings and report files
 live in :mod:`pidcore.compare.case`, :mod:`pidcore.loop`, :mod:`pidcore.store.listing`

@@ -1,4 +1,4 @@
-"""Layout of the pidcore Streamlit app: sidebar and five tabs, one page module each.
+"""Layout of the pidcore Streamlit app: sidebar and five tabs, one module each.
 
 Tabs rather than separate pages: every tab is drawn on each run, so uploads and their
 per-file settings live as long as the session without copying widget state around, and a tab
@@ -10,8 +10,8 @@ from __future__ import annotations
 import streamlit as st
 
 from pidcore import __version__, defaults
-from pidcore.app.pages import analyse, calibrate, compare, dem, report
 from pidcore.app.stores import AppStores
+from pidcore.app.tabs import analyse, calibrate, compare, dem, report
 
 
 def main() -> None:

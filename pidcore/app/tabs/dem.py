@@ -15,7 +15,7 @@ import streamlit as st
 
 from pidcore import defaults
 from pidcore.app import jobs, state
-from pidcore.app.pages import draw_polling
+from pidcore.app.tabs import draw_polling
 from pidcore.constants import DRIVE_DIRECTIONS, PARTICLE_MATERIALS
 from pidcore.loadcase import parse_values
 

@@ -10,7 +10,7 @@ import pandas as pd
 import streamlit as st
 
 from pidcore.app.calibration import calibration_api, fittable_names, runner_for
-from pidcore.app.pages import draw_polling
+from pidcore.app.tabs import draw_polling
 
 #: Seconds between refreshes of the calibration's state while it runs.
 REFRESH_S = 2.0

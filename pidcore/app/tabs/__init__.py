@@ -1,4 +1,4 @@
-"""One module per page of the app, each with ``render(stores, ...)``; and what they share."""
+"""One module per tab of the app, each with ``render(stores, ...)``; and what they share."""
 
 from __future__ import annotations
 
