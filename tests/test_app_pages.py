@@ -622,6 +622,7 @@ def _calibration_json(path, f, a, fill, predicted, low, high):
 def test_compare_shows_the_calibrated_band_beside_raw_dem_and_measurement(
         store_file, tmp_path, monkeypatch, predicted, band, verdict):
     from pidcore.app.calibration import CALIBRATION_ENV_VAR
+    from pidcore.report.table import CALIBRATED_INSIDE_COLUMN
 
     cal = _calibration_json(tmp_path / "calibration.json", 100, 5, 50, predicted, *band)
     monkeypatch.setenv(CALIBRATION_ENV_VAR, str(cal))
@@ -632,6 +633,14 @@ def test_compare_shows_the_calibrated_band_beside_raw_dem_and_measurement(
     captions = " ".join(c.value for c in at.caption)
     assert f"calibrated 95 % band {band[0]:.4f} .. {band[1]:.4f}" in captions
     assert f"the measured Eq. 11 SDC is {verdict}." in captions
+    # the Report tab's table has the same prediction and verdict once the record is saved
+    # (columns of `pidcore report --calibration`; they were missing in the app)
+    at.button(key="save").click()
+    at.run()
+    table = _table(at, "SDC calibrated DEM (Eq. 11) [-]")
+    row = table[table["SDC measured [-]"].notna()]
+    assert row["SDC calibrated DEM (Eq. 11) [-]"].tolist() == [predicted]
+    assert row[CALIBRATED_INSIDE_COLUMN].tolist() == [{"inside": "yes", "outside": "no"}[verdict]]
 
 
 def test_compare_says_when_the_calibration_does_not_predict_the_case(store_file, tmp_path,

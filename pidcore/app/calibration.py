@@ -130,6 +130,16 @@ def calibration_path(environ: Mapping[str, str] | None = None, *,
                                     environ=environ, cwd=cwd)
 
 
+def calibration_digest(calibration) -> str:
+    """A short digest of a calibration's content ("" for none): what cached views key on
+    (a new calibration object is read on every script run)."""
+    import hashlib
+
+    if calibration is None:
+        return ""
+    return hashlib.sha256(repr(calibration).encode()).hexdigest()[:16]
+
+
 def active_calibration(task: CalibrationTask | None, environ: Mapping[str, str] | None = None,
                        *, cwd: Path | None = None):
     """``(calibration, label)`` the Compare page shows: the Calibrate page's finished

@@ -9,11 +9,15 @@ from __future__ import annotations
 import os
 import tempfile
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pandas as pd
 
 from ..constants import REPORT_FORMATS
 from ..errors import ParameterError
+
+if TYPE_CHECKING:  # pragma: no cover
+    from ..calibrate.prediction import Calibration
 
 #: MIME type of each report format (:data:`pidcore.constants.REPORT_FORMATS`).
 REPORT_MIME_TYPES: dict[str, str] = {
@@ -25,17 +29,18 @@ DOWNLOAD_STEM = "pidcore_report"
 
 
 def store_report_table(path: str | os.PathLike, dem_store: str | os.PathLike | None = None, *,
-                       analysis_keys: list[str] | None = None,
-                       pool: bool = False) -> pd.DataFrame:
+                       analysis_keys: list[str] | None = None, pool: bool = False,
+                       calibration: Calibration | None = None) -> pd.DataFrame:
     """The Table 3-style report table of what the stores hold (empty if they hold nothing).
 
     Measurements: the newest analysis per measurement and parameters of the store that states
     a fill (:func:`pidcore.store.listing.saved_analyses`), or only ``analysis_keys``. DEM: the
-    runs of both stores.
+    runs of both stores. ``calibration``: add the calibrated DEM's columns, as ``pidcore
+    report --calibration`` does (:func:`pidcore.report.table.add_calibration_columns`).
     """
     from ..compare.case import paper_table
     from ..store.listing import list_dem_runs, saved_analyses
-    from .table import build_report_table
+    from .table import add_calibration_columns, build_report_table
 
     analyses = saved_analyses(path)
     if analysis_keys is not None and not analyses.empty:
@@ -43,13 +48,15 @@ def store_report_table(path: str | os.PathLike, dem_store: str | os.PathLike | N
     dem_runs = list_dem_runs(path, dem_store)
     if analyses.empty and dem_runs.empty:
         return pd.DataFrame()
-    return build_report_table(dem_runs if not dem_runs.empty else None,
-                              analyses if not analyses.empty else None, paper_table(),
-                              pool=pool)
+    table = build_report_table(dem_runs if not dem_runs.empty else None,
+                               analyses if not analyses.empty else None, paper_table(),
+                               pool=pool)
+    return table if calibration is None else add_calibration_columns(table, calibration)
 
 
 def report_files(path: str | os.PathLike, dem_store: str | os.PathLike | None = None, *,
                  analysis_keys: list[str] | None = None, pool: bool = False,
+                 calibration: Calibration | None = None,
                  ) -> dict[str, tuple[str, bytes, str]]:
     """The report of :func:`store_report_table` as downloads: format -> (file name, bytes,
     MIME type), plus ``"csv_provenance"`` (the CSV's notes sidecar).
@@ -67,7 +74,8 @@ def report_files(path: str | os.PathLike, dem_store: str | os.PathLike | None = 
     stores = [Path(p) for p in (path, dem_store) if p is not None and Path(p).is_file()]
     for p in stores:
         open_verified_store(p, must_exist=True)
-    table = store_report_table(path, dem_store, analysis_keys=analysis_keys, pool=pool)
+    table = store_report_table(path, dem_store, analysis_keys=analysis_keys, pool=pool,
+                               calibration=calibration)
     if table.empty:
         raise ParameterError("nothing to report: the stores hold no saved analyses with a "
                              "load case and no DEM runs")

@@ -29,13 +29,7 @@ from ..constants import REPORT_FORMATS
 from ..errors import StoreError
 from .provenance import collect_provenance
 from .render import check_out_dir, parse_formats, write_report
-from .table import (
-    CALIBRATED_COLUMN,
-    CALIBRATED_INSIDE_COLUMN,
-    NOT_COMPARED,
-    add_calibration_columns,
-    build_report_table,
-)
+from .table import add_calibration_columns, build_report_table
 
 if TYPE_CHECKING:  # pragma: no cover
     from ..loop import ForceDisplacementLoop
@@ -376,15 +370,9 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         notes.append(f"specimen {specimen.name} is not the paper's coupon: the paper's "
                      "Table 3 is not compared")
     table = build_report_table(dem_runs, analyses, paper, tolerances=tolerances, pool=pool)
-    notes.extend(table.attrs.get("notes", []))
     if calibrated is not None:
         table = add_calibration_columns(table, calibrated, tolerances=tolerances)
-        predicted = int(table[CALIBRATED_COLUMN].notna().sum())
-        verdict = table[CALIBRATED_INSIDE_COLUMN]
-        compared, inside = int((verdict != NOT_COMPARED).sum()), int((verdict == "yes").sum())
-        notes.append(f"calibration {calibrated.path}: predicts {predicted} of {len(table)} "
-                     f"row(s); measured Eq. 11 SDC inside the 95 % band at {inside} of "
-                     f"{compared} measured row(s)")
+    notes.extend(table.attrs.get("notes", []))
     aligner = Aligner(dem_cases(dem_runs, tolerances=tolerances, pool_settings=pool)
                       if dem_runs is not None else [],
                       paper, None, tolerances)

@@ -316,7 +316,8 @@ def add_calibration_columns(table: pd.DataFrame, calibration, *,
     measure, so the band is compared with ``SDC measured [-]`` (Eq. 11), not with Eq. 10.
     Rows whose load case the calibration does not predict (material, and frequency,
     acceleration, fill within ``tolerances``) get empty numbers, ``not compared`` and a note
-    saying so.
+    saying so. The table's notes (``attrs["notes"]``) gain one that counts the predicted rows
+    and the measured rows inside the band.
 
     Parameters
     ----------
@@ -358,5 +359,9 @@ def add_calibration_columns(table: pd.DataFrame, calibration, *,
                                                 strict=True)):
         out.insert(at + offset, name, values)
     out["note"] = notes
-    out.attrs = dict(table.attrs)
+    compared = sum(v != NOT_COMPARED for v in inside)
+    summary = (f"calibration {calibration.path}: predicts {sum(math.isfinite(v) for v in sdc)} "
+               f"of {len(out)} row(s); measured Eq. 11 SDC inside the 95 % band at "
+               f"{inside.count('yes')} of {compared} measured row(s)")
+    out.attrs = {**table.attrs, "notes": [*table.attrs.get("notes", []), summary]}
     return out

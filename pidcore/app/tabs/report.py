@@ -9,6 +9,7 @@ from pidcore.app import state
 
 def render(stores) -> None:
     """The page."""
+    from pidcore.app.calibration import active_calibration, calibration_digest, runner_for
     from pidcore.errors import PidcoreError
     from pidcore.report.downloads import report_files
 
@@ -27,8 +28,12 @@ def render(stores) -> None:
                        key="report_pool", help="default: a row per DEM setting and per specimen")
     keys = (tuple(saved[saved["file"].isin(chosen)]["key"]) if chosen and not saved.empty
             else None)
+    # the calibration the Compare tab shows, in the same columns as `pidcore report
+    # --calibration`
+    calibration, label = active_calibration(runner_for(stores.path).task)
+    digest = calibration_digest(calibration)
     try:
-        table = state.report_table(stamp, pool, keys, stores)
+        table = state.report_table(stamp, pool, keys, digest, stores, calibration)
     except PidcoreError as exc:
         st.error(f"cannot read the store: {exc}")
         return
@@ -36,19 +41,21 @@ def render(stores) -> None:
         st.info(f"{stores.path} holds no saved analyses with a load case and no DEM runs yet: "
                 "save analysed files (tab Analyse) or run DEM cases (tab DEM).")
         return
+    st.caption(f"calibrated DEM columns: {label}" if calibration is not None else label)
     st.dataframe(table, hide_index=True, key="report_table", width="stretch")
     for note in table.attrs.get("notes", []):
         st.caption(f"note: {note}")
     if st.button("Build report files (CSV, Markdown, HTML, LaTeX, PDF)", key="build_report"):
         try:
             with st.spinner("Writing the report ..."):
-                st.session_state["report_files"] = ((stamp, pool, keys), report_files(
+                st.session_state["report_files"] = ((stamp, pool, keys, digest), report_files(
                     stores.path, stores.dem_reference, pool=pool,
-                    analysis_keys=None if keys is None else list(keys)))
+                    analysis_keys=None if keys is None else list(keys),
+                    calibration=calibration))
         except PidcoreError as exc:
             st.error(f"no report: {exc}")
     made, files = st.session_state.get("report_files") or (None, None)
-    if files and made == (stamp, pool, keys):  # files of an older state are not offered
+    if files and made == (stamp, pool, keys, digest):  # files of an older state are not offered
         cols = st.columns(len(files))
         for col, (fmt, (name, data, mime)) in zip(cols, files.items(), strict=True):
             label = "CSV notes" if fmt == "csv_provenance" else fmt.upper()
