@@ -205,7 +205,7 @@ def test_sdc_above_one_has_no_damping_ratio():
     res = analyze_power(rec.force_n, rec.velocity_m_s, fs)
     assert res.sdc == pytest.approx(2 * np.pi * 0.3, rel=1e-9)
     assert res.damping_ratio is None
-    assert "sdc" in res.damping_ratio_note and ">= 1" in res.damping_ratio_note
+    assert "SDC" in res.damping_ratio_note and ">= 1" in res.damping_ratio_note
 
 
 def test_damping_ratio_formula_of_paper():

@@ -68,7 +68,10 @@ def sdc_chart(data: pd.DataFrame) -> dict[str, Any]:
     present = [s for s in SDC_SERIES if s in set(data["series"])]
     plain = data.rename(columns={"fill [%]": "fill", "SDC [-]": "sdc", "low [-]": "low",
                                  "high [-]": "high"})
-    x = _field("fill", "quantitative", title="packing ratio (fill) [%]")
+    # ticks at the fills that carry points (Vega's own ticks left 25 % unlabelled)
+    fills = sorted({float(f) for f in plain.loc[plain["series"] != _MODEL, "fill"]})
+    x = _field("fill", "quantitative", title="packing ratio (fill) [%]",
+               **({"axis": {"values": fills}} if fills else {}))
     colour = _field("series", "nominal", legend=_LEGEND,
                     scale={"domain": present, "range": [_SDC_COLOURS[s] for s in present]})
     model = {"field": "series", "equal": _MODEL}
@@ -150,7 +153,8 @@ def spectrum_chart(table: pd.DataFrame) -> dict[str, Any]:
                     _field("harmonic", "ordinal"),
                     _field("frequency", "quantitative", title="[Hz]"),
                     _field(column, "quantitative", title=title, format=".4g")]}}
-        return {"data": {"name": column}, "layer": [rule, dots], "width": 220, "height": 220}
+        # 2 x 170 px plots with their axes fit a 1024 px wide window beside the sidebar
+        return {"data": {"name": column}, "layer": [rule, dots], "width": 170, "height": 200}
 
     charts = [stems("force", "force amplitude [N]", "#e67e22"),
               stems("velocity", "velocity amplitude [mm/s]", "#8e44ad")]

@@ -240,7 +240,8 @@ def _damping_ratio(sdc: float, loss_factor: float) -> tuple[float | None, str]:
     if loss_factor < 0:
         return None, f"loss factor {loss_factor:.4g} < 0: no equivalent positive damping"
     if sdc >= 1:
-        return None, f"sdc {sdc:.4g} >= 1: -ln(1 - sdc)/(4 pi) is undefined"
+        return None, (f"no equivalent damping ratio: SDC {sdc:.4g} >= 1, more than the "
+                      "stored energy lost per cycle (zeta = -ln(1 - SDC)/(4 pi) needs SDC < 1)")
     return -math.log1p(-sdc) / (4 * math.pi), ""
 
 

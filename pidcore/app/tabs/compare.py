@@ -147,7 +147,11 @@ def render(stores, session_files: list) -> None:
             f"{label}: **{energy:.4e} J**" for label, energy in view["energies"].items()))
     # the two fixed-width spectra (~600 px) overflowed half a page into the table beside them
     st.vega_lite_chart(spec=view["spectrum_spec"], key="spectrum_chart")
-    st.dataframe(view["spectrum"], hide_index=True, width="stretch")
+    # in the chart's unit: harmonics of a few µm/s read as 0.0000 in m/s
+    spectrum = view["spectrum"]
+    st.dataframe(spectrum.drop(columns="velocity amplitude [m/s]").assign(
+        **{"velocity amplitude [mm/s]": spectrum["velocity amplitude [m/s]"] * 1e3}),
+        hide_index=True, width="stretch")
     st.dataframe(comp.measured, hide_index=True, width="stretch", key="compare_measured")
     if st.button("PDF of this load case (plots and corrections)", key="case_pdf"):
         from pidcore.report.case_sheet import case_pdf

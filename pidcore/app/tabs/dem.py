@@ -23,6 +23,15 @@ from pidcore.loadcase import parse_values
 REFRESH_S = 1.0
 
 
+#: Columns of the store's DEM run listing shown on the tab, and their names there (units in
+#: the names, as on every other table of the app).
+_RUN_COLUMNS = {"case_key": "run", "frequency_hz": "frequency [Hz]",
+                "acceleration_g": "acceleration [g]", "fill_percent": "fill [%]",
+                "material": "material", "direction": "direction", "sdc": "SDC [-]",
+                "sdc_stderr": "SDC stderr [-]", "cells_simulated": "cells simulated",
+                "seed": "seed", "wall_s": "wall time [s]", "store": "store"}
+
+
 def _config(cells: int, seed: int, steady_cycles: int):
     from pidcore.dem import DemConfig
 
@@ -159,8 +168,7 @@ def render(stores) -> None:
         st.error(f"cannot read the DEM runs: {exc}")
         return
     if not runs.empty:
-        cols = [c for c in ("case_key", "frequency_hz", "acceleration_g", "fill_percent",
-                            "material", "direction", "sdc", "sdc_stderr", "cells_simulated",
-                            "seed", "wall_s", "store") if c in runs.columns]
+        shown = {c: name for c, name in _RUN_COLUMNS.items() if c in runs.columns}
         st.markdown(f"**DEM runs in the stores** ({len(runs)})")
-        st.dataframe(runs[cols], hide_index=True, width="stretch", key="dem_runs_table")
+        st.dataframe(runs[list(shown)].rename(columns=shown), hide_index=True, width="stretch",
+                     key="dem_runs_table")

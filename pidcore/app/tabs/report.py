@@ -20,12 +20,13 @@ def render(stores) -> None:
     except PidcoreError as exc:
         st.error(f"cannot read the store: {exc}")
         return
-    c1, c2 = st.columns([3, 1])
+    c1, c2 = st.columns([2, 1])  # room for the checkbox's label at 1280-1500 px
     chosen = c1.multiselect("measurements in the report (all when none chosen)",
                             sorted(set(saved["file"])) if not saved.empty else [],
                             key="report_filter_files")
-    pool = c2.checkbox("pool DEM settings and specimens at one load case", value=False,
-                       key="report_pool", help="default: a row per DEM setting and per specimen")
+    pool = c2.checkbox("pool DEM settings and specimens", value=False, key="report_pool",
+                       help="one row per load case (default: a row per DEM setting and per "
+                            "specimen)")
     keys = (tuple(saved[saved["file"].isin(chosen)]["key"]) if chosen and not saved.empty
             else None)
     # the calibration the Compare tab shows, in the same columns as `pidcore report
