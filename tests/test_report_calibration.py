@@ -119,12 +119,24 @@ def test_calibration_columns_per_row(calibration_file):
 
 
 @pytest.mark.usefixtures("undrawn_report_figures")
-def test_cli_report_csv_reads_back_with_band(tmp_path, calibration_file, capsys):
+def test_cli_report_csv_reads_back_with_band(tmp_path, calibration_file, capsys, monkeypatch):
+    import io
+
+    from pidcore.report.downloads import store_report_table
+
+    monkeypatch.chdir(tmp_path)  # no default store here: only the DEM store is reported
+    dem = ROOT / "data_samples" / "dem_table3.h5"
     out = tmp_path / "report"
-    rc = main(["report", "--dem-store", str(ROOT / "data_samples" / "dem_table3.h5"),
-               "--calibration", str(calibration_file), "--format", "csv", "--out", str(out)])
+    rc = main(["report", "--dem-store", str(dem), "--calibration", str(calibration_file),
+               "--format", "csv", "--out", str(out)])
     assert rc == 0
     table = pd.read_csv(out / "report.csv")
+    # the app's Report tab shows and writes the same table (report_files writes this one)
+    app = store_report_table(tmp_path / "none.h5", dem,
+                             calibration=load_calibration(calibration_file))
+    csv = io.StringIO(app.to_csv(index=False))
+    pd.testing.assert_frame_equal(pd.read_csv(csv), table)
+    assert any("predicts 2 of" in note for note in app.attrs["notes"])
     for col in (CALIBRATED_COLUMN, CALIBRATED_LOW_COLUMN, CALIBRATED_HIGH_COLUMN,
                 CALIBRATED_INSIDE_COLUMN):
         assert col in table.columns
@@ -135,27 +147,6 @@ def test_cli_report_csv_reads_back_with_band(tmp_path, calibration_file, capsys)
     assert (predicted[CALIBRATED_LOW_COLUMN] <= predicted[CALIBRATED_COLUMN]).all()
     assert table.loc[table[CALIBRATED_COLUMN].isna(), "note"].str.contains(
         "not predicted by the calibration").all()
-
-
-@pytest.mark.usefixtures("undrawn_report_figures")
-def test_app_downloads_have_the_cli_reports_calibrated_columns(tmp_path, calibration_file,
-                                                                monkeypatch):
-    import io
-
-    from pidcore.report.downloads import report_files
-
-    monkeypatch.chdir(tmp_path)  # no default store here: only the DEM store is reported
-    dem = ROOT / "data_samples" / "dem_table3.h5"
-    out = tmp_path / "report"
-    assert main(["report", "--dem-store", str(dem), "--calibration", str(calibration_file),
-                 "--format", "csv", "--out", str(out)]) == 0
-    files = report_files(tmp_path / "none.h5", dem,
-                         calibration=load_calibration(calibration_file))
-    app = pd.read_csv(io.BytesIO(files["csv"][1]))
-    pd.testing.assert_frame_equal(app, pd.read_csv(out / "report.csv"))
-    assert CALIBRATED_COLUMN in app.columns
-    # the count of predicted rows is among the report's notes
-    assert "predicts 2 of" in files["csv_provenance"][1].decode()
 
 
 def test_cli_refuses_foreign_file_and_writes_nothing(tmp_path, capsys):
