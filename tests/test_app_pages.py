@@ -213,7 +213,7 @@ def test_compare_shows_dem_model_and_paper_and_switching_uses_the_cache(store_fi
     assert calls == ["a_fill50.csv", "b_fill90.csv"]
     # like for like: measured with the DEM case's m_c (Eq. 10) beside our DEM 0.21 ± 0.01
     assert "vs our DEM 0.2100 ± 0.0100" in _headline(at)
-    assert "σ" in _headline(at)
+    assert "σ" in _headline(at) and _headline(at).startswith("### measured (Eq. 10) ")
     assert _metric(at, "SDC paper DEM [-]") == ["0.1891"]
     specs = [json.loads(c.proto.spec) for c in at.get("vega_lite_chart")]
     titles = sorted(json.dumps(s.get("title", "")) for s in specs)

@@ -113,7 +113,9 @@ def render(stores, session_files: list) -> None:
     aligned = comp.aligned
     dem_text = (uploads.format_sdc(head.dem, head.dem_stderr) if math.isfinite(head.dem)
                 else "none")
-    st.markdown(f"### measured {uploads.format_sdc(head.measured, head.measured_stderr)} "
+    # the headline names its SDC: the calibrated section below shows the Eq. 11 one
+    st.markdown(f"### measured ({head.measured_kind.split(' (')[0]}) "
+                f"{uploads.format_sdc(head.measured, head.measured_stderr)} "
                 f"vs our DEM {dem_text} — {head.verdict}")
     st.caption(f"Measured SDC: {head.measured_kind}"
                + (" (energy per cycle over the DEM case's m_c a²/(2ω²), as our DEM SDC is "
