@@ -726,3 +726,23 @@ def test_dem_jobs_run_on_the_chosen_specimen(tmp_path):
         jobs.plan_dem_cases([100.0], [5.0], [50.0], material="acrylic", direction="z")[0],
         config)
     assert job.specimen is steel
+
+
+def test_calibration_digest_follows_the_content():
+    # The Report tab's cached table is keyed by this digest: a new calibration (another band)
+    # must give another key, the same file read again the same key.
+    from pidcore.app.calibration import calibration_digest
+    from pidcore.calibrate.prediction import calibration_from_json
+
+    def doc(high95: float) -> str:
+        return json.dumps({
+            "parameters": {"rolling_friction": {"median": 0.05, "low95": 0.01, "high95": 0.1}},
+            "predictions": [{"frequency_hz": 50, "acceleration_g": 5, "fill_percent": 50,
+                             "material": "acrylic", "measured": 0.2, "predicted": 0.24,
+                             "low95": 0.05, "high95": high95}]})
+
+    first = calibration_from_json(doc(0.43), "calibration.json")
+    again = calibration_from_json(doc(0.43), "calibration.json")
+    other = calibration_from_json(doc(0.44), "calibration.json")
+    assert calibration_digest(None) == ""
+    assert calibration_digest(first) == calibration_digest(again) != calibration_digest(other)
