@@ -165,6 +165,18 @@ class DemJobRunner:
             self._wake.notify_all()
         return n
 
+    def wait_cancelled(self, timeout_s: float) -> bool:
+        """Wait until no running job awaits its cancellation (its process is gone), at most
+        ``timeout_s``; returns whether none does."""
+        deadline = time.monotonic() + timeout_s
+        with self._lock:
+            while any(j.state == "running" and j.job_id in self._cancel for j in self._jobs):
+                remaining = deadline - time.monotonic()
+                if remaining <= 0:
+                    return False
+                self._wake.wait(remaining)
+            return True
+
     def jobs(self) -> list[DemJob]:
         """Copies of every job, oldest first (safe to read while the worker runs)."""
         with self._lock:
@@ -203,6 +215,7 @@ class DemJobRunner:
         with self._lock:
             job.state, job.message, job.finished = state, message, time.time()
             self._cancel.discard(job.job_id)
+            self._wake.notify_all()  # wait_cancelled
 
     def _run(self, job: DemJob) -> None:
         from ..dem.sweep import CaseOutcome, dem_process_context
@@ -257,6 +270,7 @@ class DemJobRunner:
                 job.state, job.finished = "cancelled", time.time()
                 job.message = "cancelled as it finished; nothing saved"
                 self._cancel.discard(job.job_id)
+                self._wake.notify_all()  # wait_cancelled
                 return
         CaseOutcome(job.run_key, **outcome).save_to(Store(self.store_path))
         self._finish(job, "saved", f"saved as {job.run_key}")

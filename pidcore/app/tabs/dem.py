@@ -21,6 +21,9 @@ from pidcore.loadcase import parse_values
 
 #: Seconds between refreshes of the job table while jobs run.
 REFRESH_S = 1.0
+#: Longest wait of the Cancel button for the running case's process to end, s (a process
+#: that does not stop at once is killed after the runner's grace time).
+CANCEL_WAIT_S = 1.5
 
 
 #: Columns of the store's DEM run listing shown on the tab, and their names there (units in
@@ -40,8 +43,12 @@ def _config(cells: int, seed: int, steady_cycles: int):
 
 
 def _cancel(stores) -> None:
-    # Button callback: runs before the script, so the cancel reaches the runner at once.
-    n = jobs.runner_for(stores.path).cancel()
+    # Button callback: runs before the script, so the cancel reaches the runner at once; it
+    # waits (briefly) for the running case's process to end, so that this very script run
+    # shows the jobs cancelled instead of the next table refresh a second later
+    runner = jobs.runner_for(stores.path)
+    n = runner.cancel()
+    runner.wait_cancelled(CANCEL_WAIT_S)
     st.session_state["dem_message"] = ("warning", f"cancel requested for {n} job(s); finished "
                                                   "cases stay saved")
 
