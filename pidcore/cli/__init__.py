@@ -76,7 +76,13 @@ def _run(argv: list[str] | None) -> int:
     except PidcoreError as exc:
         print(f"pidcore {command}: error: {exc}", file=sys.stderr)
         return 2
-    except (KeyboardInterrupt, SystemError) as exc:
+    except BrokenPipeError:  # the reader of stdout (| head) stopped: end quietly
+        import os
+
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 141
+    except (KeyboardInterrupt, Exception) as exc:
+        # an interrupt, or what one turned into inside C code (pidcore.interrupt)
         if not interrupt.is_interruption(exc):
             raise
         # commands that count what they saved say so themselves (analyze, dem); here only
@@ -86,11 +92,6 @@ def _run(argv: list[str] | None) -> int:
         print(f"pidcore {command}: interrupted; {said}", file=sys.stderr)
         interrupt.mark_handled()
         return 130
-    except BrokenPipeError:  # the reader of stdout (| head) stopped: end quietly
-        import os
-
-        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
-        return 141
 
 
 def console_main(argv: list[str] | None = None) -> int:
