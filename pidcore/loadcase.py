@@ -187,7 +187,7 @@ def parse_values(text: str, *, name: str) -> list[float]:
             value = float(token)
         except ValueError:
             raise ParameterError(f"{name}: {token!r} is not a number") from None
-        if not value > 0 or value != value or value == float("inf"):
+        if not (math.isfinite(value) and value > 0):
             raise ParameterError(f"{name}: {token!r}, expected a positive number")
         values.append(value)
     if not values:

@@ -30,6 +30,7 @@ GRIDS: dict[str, dict[str, tuple[float, ...]]] = {
     },
 }
 
+
 def grid_axes(grid: str = "table3") -> dict[str, tuple[float, ...]]:
     """The values of a named grid: ``frequency_hz``, ``acceleration_g``, ``fill_percent``."""
     if grid not in GRIDS:

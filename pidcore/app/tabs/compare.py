@@ -45,13 +45,11 @@ def _group_key(members) -> str:
     return "|".join(f"{e.key}:{e.load_case.key}:{e.specimen}:{e.sdc!r}" for e in members)
 
 
-def _calibrated(stores, comp, head) -> None:
+def _calibrated(active, comp, head) -> None:
     """The calibrated DEM's Eq. 11 SDC with its 95 % band beside the raw DEM and the measured
     Eq. 11 SDC (like for like: the calibration predicts what a shaker test of the DEM would
-    measure with Eq. 11)."""
-    from pidcore.app.calibration import active_calibration, runner_for
-
-    calibration, label = active_calibration(runner_for(stores.path).task)
+    measure with Eq. 11). ``active``: (calibration or None, label), see :func:`render`."""
+    calibration, label = active
     if calibration is None:
         st.caption(label)
         return
@@ -73,8 +71,9 @@ def _calibrated(stores, comp, head) -> None:
                f"Eq. 11 SDC is {verdict}.")
 
 
-def render(stores, session_files: list) -> None:
-    """The page."""
+def render(stores, session_files: list, active_calibration: tuple) -> None:
+    """The page. ``active_calibration``: :func:`pidcore.app.calibration.active_calibration`'s
+    (calibration or None, label), read once per script run for this tab and the Report tab."""
     from pidcore.errors import PidcoreError
 
     st.subheader("Compare per load case")
@@ -138,7 +137,7 @@ def render(stores, session_files: list) -> None:
                   if math.isfinite(aligned.sdc_paper_dem) else "not a Table 3 case")
         c3.metric("SDC paper measured [-]", f"{aligned.sdc_paper_experimental:.4f}"
                   if math.isfinite(aligned.sdc_paper_experimental) else "not a Table 3 case")
-    _calibrated(stores, comp, head)
+    _calibrated(active_calibration, comp, head)
     for note in view["notes"]:
         st.caption(f"note: {note}")
     left, right = st.columns(2)

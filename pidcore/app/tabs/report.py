@@ -7,9 +7,9 @@ import streamlit as st
 from pidcore.app import state
 
 
-def render(stores) -> None:
-    """The page."""
-    from pidcore.app.calibration import active_calibration, calibration_digest, runner_for
+def render(stores, active_calibration: tuple) -> None:
+    """The page. ``active_calibration``: (calibration or None, label), as the Compare tab's."""
+    from pidcore.app.calibration import calibration_digest
     from pidcore.errors import PidcoreError
     from pidcore.report.downloads import report_files
 
@@ -31,7 +31,7 @@ def render(stores) -> None:
             else None)
     # the calibration the Compare tab shows, in the same columns as `pidcore report
     # --calibration`
-    calibration, label = active_calibration(runner_for(stores.path).task)
+    calibration, label = active_calibration
     digest = calibration_digest(calibration)
     try:
         table = state.report_table(stamp, pool, keys, digest, stores, calibration)
