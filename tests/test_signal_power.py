@@ -196,6 +196,22 @@ def test_too_few_periods_for_blocks_gives_nan_with_note():
     assert res.to_dict()["sdc_stderr"] is None
 
 
+def test_block_that_is_not_mass_like_gives_nan_with_note():
+    # 40 periods in 8 blocks; the first 5 periods are a stiff spring (Im(P) < 0), the rest a
+    # mass with a damper, so the record as a whole is mass-like. The first block's loss
+    # factor is meaningless: the standard error must be refused, not computed over it.
+    fs, f, m, c, k = 10240.0, 100.0, 0.5, 3.0, 5e5
+    w = 2 * np.pi * f
+    t = np.arange(int(40 * fs / f)) / fs
+    v = 0.01 * np.sin(w * t)
+    x = -0.01 / w * np.cos(w * t)
+    force = np.where(t < 5 / f, k * x, m * 0.01 * w * np.cos(w * t) + c * v)
+    res = analyze_power(force, v, fs, n_blocks=8)
+    assert math.isnan(res.loss_factor_stderr) and math.isnan(res.sdc_stderr)
+    assert "block 1 of 8" in res.uncertainty_note
+    assert res.complex_power_w.imag > 0 and math.isfinite(res.sdc)
+
+
 def test_sdc_above_one_has_no_damping_ratio():
     fs, f, m = 10240.0, 100.0, 0.2
     w = 2 * np.pi * f

@@ -466,10 +466,15 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
         _, _, p_blocks = _complex_power(fit.phasors[0, :k_blocks], fit.phasors[1, :k_blocks],
                                         None if a_fit is None else a_fit.phasors[0, :k_blocks],
                                         harmonics, omega, **kw)
-        lf_blocks = p_blocks.real / p_blocks.imag
-        lf_stderr = float(np.std(lf_blocks, ddof=1) / np.sqrt(k_blocks))
-        if not math.isfinite(lf_stderr):
-            uncertainty_note = "no standard error: a block's reactive power is <= 0"
+        if np.all(p_blocks.imag > 0):
+            lf_blocks = p_blocks.real / p_blocks.imag
+            lf_stderr = float(np.std(lf_blocks, ddof=1) / np.sqrt(k_blocks))
+        else:
+            # such a block is not mass-like (a transient, a resonance passed): its loss
+            # factor means nothing, and a scatter taken over it would be a wrong error bar
+            bad = int(np.flatnonzero(p_blocks.imag <= 0)[0])
+            uncertainty_note = (f"no standard error: block {bad + 1} of {k_blocks} has "
+                                "reactive power Im(P) <= 0")
     zeta, zeta_note = _damping_ratio(sdc, loss)
     period = 1.0 / freq
     v1 = abs(v_ph[0])
