@@ -126,7 +126,7 @@ def _register_sweep(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--grid", default="table3", help="named grid (default table3: 48 cases)")
     for flag, what in (("--frequencies", "drive frequencies, Hz"),
                        ("--accelerations", "acceleration amplitudes, g"),
-                       ("--fills", "fills (packing ratios), %")):
+                       ("--fills", "fills (packing ratios), %%")):
         p.add_argument(flag, metavar="X,X", default=None,
                        help=f"{what}, comma-separated, in place of the grid's (every "
                             "combination is run)")
