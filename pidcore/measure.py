@@ -98,12 +98,15 @@ def _with_unit(ch: Channel, role: str, unit: str | None, source: str,
     info = lookup_unit(unit)
     if info is None or info.quantity != role:
         raise ParameterError(f"{_UNIT_OPTIONS[role]} {unit!r}: not a {role} unit")
-    if ch.quantity == role:
+    if ch.quantity != "unknown":
+        # the reader scaled the file's numbers to SI by the file's unit, of whatever quantity
+        # (a force exported as "m/s"): undo that, then apply the unit the user gives
         old = lookup_unit(ch.source_unit)
-        old_factor = old.factor if old is not None and old.quantity == role else 1.0
+        old_factor = old.factor if old is not None and old.quantity == ch.quantity else 1.0
         raw = np.asarray(ch.data) / old_factor
-        notes.append(f"channel {ch.name!r}: the file says {ch.source_unit!r}; taken as {unit!r} "
-                     f"({_UNIT_OPTIONS[role]})")
+        kind = "" if ch.quantity == role else f", a {ch.quantity} unit"
+        notes.append(f"channel {ch.name!r}: the file says {ch.source_unit!r}{kind}; taken as "
+                     f"{unit!r} ({_UNIT_OPTIONS[role]})")
     else:
         raw = np.asarray(ch.data)
         notes.append(f"channel {ch.name!r}: no unit in the file; taken as {unit!r} "
@@ -193,11 +196,12 @@ def analyze_measurement(measurement: Measurement, options: AnalysisOptions) -> A
     measurement = _invert(measurement, options.invert, notes)
     if options.invert:
         corrections["inverted_channels"] = list(options.invert)
-    roles = assign_roles(measurement, force=options.force, velocity=options.velocity,
-                         acceleration=options.acceleration,
-                         mass_cancellation=options.mass_below_gauge_kg > 0)
     units = {"force": options.force_unit, "velocity": options.velocity_unit,
              "acceleration": options.acceleration_unit}
+    roles = assign_roles(measurement, force=options.force, velocity=options.velocity,
+                         acceleration=options.acceleration,
+                         mass_cancellation=options.mass_below_gauge_kg > 0,
+                         retyped={role for role, unit in units.items() if unit is not None})
     chosen = {role: _with_unit(ch, role, units[role], measurement.source, notes, corrections)
               for role, ch in (("force", roles.force), ("velocity", roles.velocity),
                                ("acceleration", roles.acceleration)) if ch is not None}

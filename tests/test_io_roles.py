@@ -89,8 +89,12 @@ def test_override_unknown_name_lists_channels():
 
 def test_override_of_other_quantity_refused_unknown_accepted():
     m = _m(_ch("F", "force", "N"), _ch("acc", "acceleration", "g"), _ch("raw", "unknown", "V^2"))
-    with pytest.raises(ChannelError, match=r"--force 'acc' is a acceleration channel"):
+    with pytest.raises(ChannelError, match=r"--force 'acc' is an acceleration channel"):
         assign_roles(m, force="acc")
+    # with the role's unit given (--force-unit) the file's unit is taken as wrong
+    wrong = _m(_ch("Force", "velocity", "m/s"), _ch("LDV", "velocity", "m/s"))
+    roles = assign_roles(wrong, force="Force", retyped={"force"})
+    assert roles.force.name == "Force" and roles.velocity.name == "LDV"
     roles = assign_roles(m, force="raw")  # accepted here; the analysis asks for its unit
     assert roles.force.name == "raw" and roles.acceleration.name == "acc"  # no velocity
 

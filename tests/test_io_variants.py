@@ -181,6 +181,29 @@ def test_unknown_units_never_taken_as_si(tmp_path, capsys):
     assert any("taken as 'mm/s' (--velocity-unit)" in n for n in result.notes)
 
 
+def test_unit_option_overrides_a_unit_of_another_kind(tmp_path, capsys):
+    """A force exported under a velocity's unit: refused, naming --force-unit; with
+    ``--force Force --force-unit N`` the truth, and a note saying what was overridden."""
+    rec = _record()
+    t = np.arange(rec.force_n.size) / FS
+    path = tmp_path / "wrong.csv"
+    path.write_text("Time [s],Force [m/s],Velocity [m/s],Accel [m/s^2]\n" + "".join(
+        f"{a:.10g},{b:.10g},{c:.10g},0\n"
+        for a, b, c in zip(t, rec.force_n, rec.velocity_m_s, strict=True)))
+    code, _, err = _cli([str(path), "--no-store", "--force", "Force"], capsys)
+    assert code == 2 and "is a velocity channel" in err and "--force-unit UNIT" in err
+    code, _, err = _cli([str(path), "--no-store", "--force", "Accel"], capsys)
+    assert code == 2 and "is an acceleration channel" in err
+    result = analyze_file(path, AnalysisOptions(force="Force", force_unit="N"))
+    _assert_truth(result.analysis)
+    assert any("says 'm/s', a velocity unit; taken as 'N' (--force-unit)" in n
+               for n in result.notes)
+    # kN under a velocity's name: the option's factor, not the file's, scales the numbers
+    result = analyze_file(path, AnalysisOptions(force="Force", force_unit="kN"))
+    assert result.analysis.energy_per_cycle_j == pytest.approx(
+        1e3 * ENERGY, rel=0.03)  # the accuracy target of this module, scaled by 1000
+
+
 def test_drift_is_in_the_model_and_covered_by_the_standard_error(tmp_path):
     """10 % of the amplitude of linear drift over 20 periods on both channels."""
     rec = _record(n_periods=20.4)

@@ -12,7 +12,9 @@ Rules, in order, for each role not named by the user:
 Explicit names (``force=``, ``velocity=``, ``acceleration=``) override detection. A named
 channel must exist (else the error lists the channels) and must be of the role's quantity or
 of quantity ``"unknown"`` (the analysis then asks for its unit); a channel of another known
-quantity (``--force`` naming an acceleration channel) is refused.
+quantity (``--force`` naming an acceleration channel) is refused, unless its unit is given
+for the role (``retyped``: ``--force NAME --force-unit N`` for a force exported under a wrong
+unit).
 
 A force channel and at least one of velocity or acceleration are required. An acceleration
 channel is only looked for when it is needed: as the motion when there is no velocity, or for
@@ -25,6 +27,7 @@ uses are listed in :attr:`RoleAssignment.ignored`.
 from __future__ import annotations
 
 import re
+from collections.abc import Collection
 from dataclasses import dataclass
 
 from ..errors import ChannelError
@@ -139,18 +142,21 @@ def _detect(measurement: Measurement, role: str, taken: set[str]) -> Channel | N
     return None
 
 
-def _named(measurement: Measurement, role: str, name: str) -> Channel:
+def _named(measurement: Measurement, role: str, name: str, retyped: bool) -> Channel:
     channel = measurement.channel(name)  # ChannelError listing the channels there are
-    if channel.quantity not in (role, "unknown"):
-        raise ChannelError(f"{measurement.source}: {_OPTIONS[role]} {name!r} is a "
+    if channel.quantity not in (role, "unknown") and not retyped:
+        article = "an" if channel.quantity[0] in "aeiou" else "a"
+        raise ChannelError(f"{measurement.source}: {_OPTIONS[role]} {name!r} is {article} "
                            f"{channel.quantity} channel ({channel.source_unit or channel.unit});"
-                           f" expected a {role} channel or one without a unit")
+                           f" expected a {role} channel or one without a unit, or give its "
+                           f"unit with {_OPTIONS[role]}-unit UNIT if the file's is wrong")
     return channel
 
 
 def assign_roles(measurement: Measurement, *, force: str | None = None,
                  velocity: str | None = None, acceleration: str | None = None,
-                 mass_cancellation: bool = False) -> RoleAssignment:
+                 mass_cancellation: bool = False,
+                 retyped: Collection[str] = ()) -> RoleAssignment:
     """Find the force, velocity and acceleration channels of ``measurement``.
 
     Parameters
@@ -161,6 +167,9 @@ def assign_roles(measurement: Measurement, *, force: str | None = None,
     mass_cancellation : bool
         The drive-point acceleration is needed (``--mass-below-gauge``): it is looked for
         although there is a velocity channel, and must be unambiguous.
+    retyped : collection of str
+        Roles whose unit the user gives (``--force-unit`` ...): a channel named for such a
+        role may carry another quantity's unit (the file's unit is wrong).
 
     Returns
     -------
@@ -185,7 +194,7 @@ def assign_roles(measurement: Measurement, *, force: str | None = None,
     chosen: dict[str, Channel | None] = {}
     for role, name in explicit.items():
         if name is not None:
-            chosen[role] = _named(measurement, role, name)
+            chosen[role] = _named(measurement, role, name, role in retyped)
     taken = {c.name for c in chosen.values() if c is not None}
     repeated = [r for r, c in chosen.items()
                 if c is not None and sum(o is c for o in chosen.values()) > 1]
