@@ -182,6 +182,18 @@ def test_a_settings_table_is_detected_by_its_columns_under_any_name():
         uploads.read_settings_table("t.csv", b"file,velocity_delay_us\na.csv,x\n")
 
 
+def test_an_own_specimens_material_is_offered_once_its_dem_runs_are_stored():
+    # a steel-sphere measurement must be labelled steel to meet its steel DEM runs; the
+    # store's runs make the name known (the table's materials come first)
+    materials = uploads.measurement_materials(["steel_440c", "acrylic", "steel_440c", "", "Cu"])
+    assert materials == ("acrylic", "aluminium", "cu", "steel_440c")
+    table = b"file,material\nx_fill40.csv,steel_440c\n"
+    with pytest.raises(ParameterError, match="unknown particle material 'steel_440c'"):
+        uploads.read_settings_table("t.csv", table)
+    assert uploads.read_settings_table("t.csv", table, materials)["material"].tolist() == [
+        "steel_440c"]
+
+
 # --- load cases, loops, spectrum -----------------------------------------------------------------
 
 def _record(data: bytes, options, name="x.csv"):

@@ -105,6 +105,30 @@ def test_sidecar_errors_name_the_file(tmp_path):
         resolve_load_case(tmp_path / "x.uff", sidecar=tmp_path / "missing.csv")
 
 
+def test_a_specimens_own_material_is_accepted_and_the_default_with_its_specimen(tmp_path):
+    # a steel-sphere specimen's measurement must reach the steel DEM runs: its material is
+    # accepted in the sidecar and by --material only with the specimen, and is the default
+    _write_sidecar(tmp_path, "file,fill_percent,material\nsteel.uff,40,steel_440c\n"
+                             "plain.uff,40,\n")
+    with pytest.raises(LoadCaseError, match=r"'steel_440c'.*needs --specimen FILE"):
+        resolve_load_case(tmp_path / "steel.uff")
+    stated = resolve_load_case(tmp_path / "steel.uff", specimen_material="steel_440c")
+    assert stated.material == "steel_440c" and "material: loadcases.csv" in stated.origin
+    stated = resolve_load_case(tmp_path / "plain.uff", specimen_material="steel_440c")
+    assert stated.material == "steel_440c" and "material: specimen" in stated.origin
+    assert stated.load_case(500.0, 1.0).key.endswith("_steel_440c_z")
+    assert resolve_load_case(tmp_path / "plain.uff").material == "acrylic"  # no specimen
+    with pytest.raises(LoadCaseError, match="--specimen FILE"):
+        resolve_load_case(tmp_path / "plain.uff", material="steel_440c")
+    # the table's materials stay accepted beside the specimen's
+    stated = resolve_load_case(tmp_path / "plain.uff", material="aluminum",
+                               specimen_material="steel_440c")
+    assert stated.material == "aluminium" and "material: option" in stated.origin
+    with pytest.raises(LoadCaseError, match="steel_440c"):  # the list names the specimen's
+        resolve_load_case(tmp_path / "plain.uff", material="brass",
+                          specimen_material="steel_440c")
+
+
 def test_missing_fill_names_file_and_the_three_ways(tmp_path):
     with pytest.raises(LoadCaseError) as info:
         resolve_load_case(tmp_path / "run_500Hz_acrylic.uff")

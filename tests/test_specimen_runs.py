@@ -188,6 +188,44 @@ def test_report_compares_runs_of_one_specimen_and_the_paper_only_for_its_coupon(
     assert mine["SDC DEM (paper) [-]"].isna().all()
 
 
+@pytest.mark.usefixtures("undrawn_report_figures")
+def test_a_measurement_of_an_own_specimen_meets_its_dem_run_in_the_report(tmp_path, capsys):
+    # steel spheres: with --specimen the measurement's material is the specimen's, so it
+    # shares a row with the steel DEM run; without, it is an acrylic case of its own
+    import pandas as pd
+
+    from pidcore.constants import STANDARD_GRAVITY
+    from pidcore.io import write_measurement
+    from pidcore.records import Channel, Measurement
+    from pidcore.signal import synthesize_shaker_record
+
+    steel = load_specimen(STEEL)
+    store = tmp_path / "runs.h5"
+    run = run_or_load(store, steel, LoadCase(1000.0, 5.0, 50.0, material="steel"), TINY)
+    rate = 51200.0
+    rec = synthesize_shaker_record(mass_kg=0.05, acceleration_amplitude_m_s2=5 * STANDARD_GRAVITY,
+                                   frequency_hz=1000.0, sample_rate_hz=rate, n_periods=40,
+                                   viscous_damping_n_s_m=5.0)
+    meas = tmp_path / "steel_run_fill50.csv"
+    write_measurement(Measurement("m", (Channel("Force", "force", rec.force_n, rate, "N"),
+                                        Channel("LDV", "velocity", rec.velocity_m_s, rate,
+                                                "m/s"))), meas)
+
+    def report(*extra):
+        out = tmp_path / f"report{len(extra)}"
+        assert main(["report", str(meas), "--dem-store", str(store), "--out", str(out),
+                     "--format", "csv", *extra]) == 0
+        return pd.read_csv(out / "report.csv", comment="#"), capsys.readouterr().out
+
+    table, out = report("--specimen", str(STEEL))
+    assert "material: specimen" in out
+    both = table[table["SDC measured [-]"].notna()]
+    assert len(table) == 1 and len(both) == 1  # one row: measurement and run together
+    assert both["SDC DEM (ours) [-]"].tolist() == pytest.approx([run.sdc])
+    table, _ = report()  # the paper's coupon: an acrylic measurement, no steel run
+    assert table["SDC DEM (ours) [-]"].isna().all()
+
+
 def test_static_and_rolling_friction_of_a_specimen_reach_the_kernel():
     sticky = paper_specimen().with_values({"pairs.particle_wall.static_friction": 0.5,
                                            "pairs.particle_particle.static_friction": 0.5,

@@ -18,7 +18,7 @@ import math
 import os
 import re
 import tempfile
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -26,6 +26,7 @@ from typing import TYPE_CHECKING
 import pandas as pd
 
 from .. import defaults
+from ..constants import PARTICLE_MATERIALS
 from ..errors import ParameterError, PidcoreError
 
 if TYPE_CHECKING:
@@ -230,13 +231,31 @@ def is_settings_table(data: bytes) -> bool:
     return "file" in names and len(names & known) >= 2
 
 
-def read_settings_table(name: str, data: bytes) -> pd.DataFrame:
+def measurement_materials(extra: Iterable[object] = ()) -> tuple[str, ...]:
+    """Particle materials a measurement may state: the table's, then the ``extra`` names
+    (the materials of the store's DEM runs, i.e. of the user's own specimens) that are
+    valid material names, once each."""
+    from ..compare.loadcase import normalize_material
+
+    names = list(PARTICLE_MATERIALS)
+    for value in extra:
+        try:
+            name = normalize_material(str(value), "material", None)
+        except PidcoreError:
+            continue  # not a material name (e.g. an empty cell of an old store)
+        if name not in names:
+            names.append(name)
+    return (*names[:len(PARTICLE_MATERIALS)], *sorted(names[len(PARTICLE_MATERIALS):]))
+
+
+def read_settings_table(name: str, data: bytes,
+                        materials: tuple[str, ...] = PARTICLE_MATERIALS) -> pd.DataFrame:
     """An uploaded settings table as rows of :data:`FILE_TABLE_COLUMNS` (app column names).
 
     Columns may be given by their template or app names; missing ones stay empty (NaN or "")
     and leave a file's other settings alone (``attrs["given"]`` lists the columns given).
     Raises :class:`ParameterError` naming the table, row and column for a value that is not a
-    number, material or direction.
+    number, material (one of ``materials``) or direction.
     """
     from ..compare.loadcase import normalize_direction, normalize_material
 
@@ -262,9 +281,10 @@ def read_settings_table(name: str, data: bytes) -> pd.DataFrame:
                 raise ParameterError(f"{name}, line {i}: {FILE_TABLE_COLUMNS[column]} "
                                      f"{text!r} is not a number") from None
         out[column] = values
-    for column, normalize in (("material", normalize_material),
-                              ("direction", normalize_direction)):
-        out[column] = [normalize(v, f"{name}: {column}") if v else "" for v in out[column]]
+    out["material"] = [normalize_material(v, f"{name}: material", materials) if v else ""
+                       for v in out["material"]]
+    out["direction"] = [normalize_direction(v, f"{name}: direction") if v else ""
+                        for v in out["direction"]]
     if (out["file"] == "").any():
         raise ParameterError(f"{name}: every row needs a file name")
     out.attrs["given"] = [c for c in FILE_TABLE_COLUMNS if c in raw.columns and c != "file"]

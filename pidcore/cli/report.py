@@ -43,8 +43,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help="all or a comma-separated list of csv, md, html, tex, pdf (default all)")
     p.add_argument("--fill", metavar="PERCENT", type=float, default=None,
                    help="packing ratio of every FILE, %% (overrides file name and sidecar)")
-    p.add_argument("--material", choices=PARTICLE_MATERIALS, default=None,
-                   help="particle material of every FILE (default: stated or acrylic)")
+    p.add_argument("--material", metavar="NAME", default=None,
+                   help=f"particle material of every FILE: {', '.join(PARTICLE_MATERIALS)} or "
+                        "the --specimen's (default: stated, else the specimen's, else acrylic)")
     p.add_argument("--direction", choices=DRIVE_DIRECTIONS, default=None,
                    help="drive direction of every FILE (default: stated or z)")
     p.add_argument("--sidecar", metavar="CSV", type=Path, default=None,

@@ -32,6 +32,7 @@ from pathlib import Path
 import pandas as pd
 
 from .. import defaults
+from ..constants import PARTICLE_MATERIALS
 from ..loadcase import (
     LoadCase,
     LoadCaseError,
@@ -167,7 +168,20 @@ def read_sidecar(path: str | Path) -> pd.DataFrame:
     return table.reset_index(drop=True)
 
 
-def _sidecar_entry(table: pd.DataFrame, file_name: str, where: Path) -> dict[str, float | str]:
+def _material(value: str, what: str, known: tuple[str, ...]) -> str:
+    """:func:`normalize_material` of a measurement's stated material; an unknown name gets
+    the hint that a specimen's own material is known only with its specimen file."""
+    try:
+        return normalize_material(value, what, known)
+    except LoadCaseError as exc:
+        if known != PARTICLE_MATERIALS:
+            raise
+        raise LoadCaseError(f"{exc} (a specimen's own material, e.g. steel, needs "
+                            "--specimen FILE)") from None
+
+
+def _sidecar_entry(table: pd.DataFrame, file_name: str, where: Path,
+                   known: tuple[str, ...] = PARTICLE_MATERIALS) -> dict[str, float | str]:
     rows = table[table["file"] == file_name]
     if rows.empty:  # exporters and file systems disagree on case; accept a unique case-fold match
         rows = table[table["file"].str.casefold() == file_name.casefold()]
@@ -179,7 +193,7 @@ def _sidecar_entry(table: pd.DataFrame, file_name: str, where: Path) -> dict[str
     if row["fill_percent"]:
         found["fill_percent"] = _check_fill(row["fill_percent"], what)
     if row["material"]:
-        found["material"] = normalize_material(row["material"], what)
+        found["material"] = _material(row["material"], what, known)
     if row["direction"]:
         found["direction"] = normalize_direction(row["direction"], what)
     return found
@@ -200,6 +214,7 @@ def resolve_load_case(
     material: str | None = None,
     direction: str | None = None,
     sidecar: str | Path | pd.DataFrame | None = None,
+    specimen_material: str | None = None,
 ) -> StatedLoadCase:
     """What the user states about a measurement file: file name < sidecar < options.
 
@@ -213,6 +228,9 @@ def resolve_load_case(
         Particle material and drive direction from the command line; override the others.
     sidecar : path or DataFrame, optional
         Sidecar table to use instead of ``loadcases.csv`` beside the file.
+    specimen_material : str, optional
+        Particle material of the specimen the measurement is compared with (``--specimen``):
+        accepted besides the table's materials, and the default when none is stated.
 
     Returns
     -------
@@ -241,19 +259,26 @@ def resolve_load_case(
             values[name] = value
             origin[name] = where
 
+    known = PARTICLE_MATERIALS
+    if specimen_material is not None:
+        specimen_material = normalize_material(specimen_material, "specimen", None)
+        if specimen_material not in known:
+            known = (*known, specimen_material)
+        origin["material"] = "specimen"
+        values["material"] = specimen_material
     take(parse_file_name(path), "file name")
     if isinstance(sidecar, pd.DataFrame):
-        take(_sidecar_entry(sidecar, path.name, Path("sidecar")), "sidecar table")
+        take(_sidecar_entry(sidecar, path.name, Path("sidecar"), known), "sidecar table")
     else:
         sidecar_path = Path(sidecar) if sidecar is not None else path.parent / SIDECAR_NAME
         if sidecar is not None or sidecar_path.is_file():
-            take(_sidecar_entry(read_sidecar(sidecar_path), path.name, sidecar_path),
+            take(_sidecar_entry(read_sidecar(sidecar_path), path.name, sidecar_path, known),
                  f"{sidecar_path.name}")
     options: dict[str, float | str] = {}
     if fill_percent is not None:
         options["fill_percent"] = _check_fill(fill_percent, "--fill")
     if material is not None:
-        options["material"] = normalize_material(material, "--material")
+        options["material"] = _material(material, "--material", known)
     if direction is not None:
         options["direction"] = normalize_direction(direction, "--direction")
     take(options, "option")

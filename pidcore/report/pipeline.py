@@ -129,12 +129,14 @@ def open_verified_store(path: str | Path, *, must_exist: bool):
 def analyze_files(paths: Sequence[str | Path], *, fill_percent: float | None = None,
                   material: str | None = None, direction: str | None = None,
                   sidecar: str | Path | None = None,
-                  options: AnalysisOptions | None = None) -> list[MeasuredResult]:
+                  options: AnalysisOptions | None = None,
+                  specimen_material: str | None = None) -> list[MeasuredResult]:
     """Read, assign roles, analyze (Eq. 11) and attach the load case of every file.
 
     The load case is resolved first for every file, so a missing fill is reported before any
     (slow) analysis runs. Files with identical contents are one measurement: kept once, and
-    refused if they state different load cases.
+    refused if they state different load cases. ``specimen_material``: the particle material
+    of the specimen compared with (accepted besides the table's, and the default).
     """
     from ..io import detect_file_format
     from ..measure import AnalysisOptions, analyze_file
@@ -143,7 +145,8 @@ def analyze_files(paths: Sequence[str | Path], *, fill_percent: float | None = N
     for path in paths:  # a missing or empty file is named as such, not as "no fill stated"
         detect_file_format(path)
     stated = [resolve_load_case(p, fill_percent=fill_percent, material=material,
-                                direction=direction, sidecar=sidecar) for p in paths]
+                                direction=direction, sidecar=sidecar,
+                                specimen_material=specimen_material) for p in paths]
     out: list[MeasuredResult] = []
     seen: dict[str, MeasuredResult] = {}
     for path, st in zip(paths, stated, strict=True):
@@ -282,7 +285,8 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
     formats : str or iterable of str
         ``csv, md, html, tex, pdf`` or ``"all"``.
     fill_percent, material, direction, sidecar
-        Load case statements (:func:`pidcore.compare.resolve_load_case`).
+        Load case statements (:func:`pidcore.compare.resolve_load_case`); the material
+        defaults to the ``specimen``'s particles (else acrylic), and may be the specimen's own.
     options : AnalysisOptions, optional
         Channel mapping and corrections of the Eq. 11 analysis (vibrometer delay, mass
         cancellation, baseline, sample rate for CSV without time column).
@@ -328,9 +332,11 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
 
     options = options or AnalysisOptions()
     parameters = options.parameters()
-    results = analyze_files(files, fill_percent=fill_percent, material=material,
-                            direction=direction, sidecar=sidecar,
-                            options=options) if files else []
+    results = analyze_files(
+        files, fill_percent=fill_percent, material=material, direction=direction,
+        sidecar=sidecar, options=options,
+        specimen_material=specimen.particles.material if specimen is not None else None,
+    ) if files else []
     notes: list[str] = [f"{r.path.name}: load case {r.load_case.key} ({r.stated.origin})"
                         for r in results]
     if len(results) < len(files):

@@ -11,7 +11,7 @@ import streamlit as st
 
 from pidcore import defaults
 from pidcore.app import state, uploads
-from pidcore.constants import DRIVE_DIRECTIONS, PARTICLE_MATERIALS
+from pidcore.constants import DRIVE_DIRECTIONS
 
 
 def _size(n: int) -> str:
@@ -19,7 +19,8 @@ def _size(n: int) -> str:
             else f"{n} bytes")
 
 
-def _settings_editor(measurements, tables: dict[str, pd.DataFrame], channel_names: list[str]):
+def _settings_editor(measurements, tables: dict[str, pd.DataFrame], channel_names: list[str],
+                     materials: tuple[str, ...]):
     """The editable per-file settings table; returns the edited frame."""
     from pidcore.compare.case import stated_case
 
@@ -42,8 +43,9 @@ def _settings_editor(measurements, tables: dict[str, pd.DataFrame], channel_name
         width="stretch", disabled=["file"],
         column_config={
             "fill [%]": st.column_config.NumberColumn(min_value=0.1, max_value=100.0, step=1.0),
-            "material": st.column_config.SelectboxColumn(options=list(PARTICLE_MATERIALS),
-                                                         required=True),
+            "material": st.column_config.SelectboxColumn(
+                options=list(materials), required=True,
+                help="the table's materials and those of the store's DEM runs (own specimens)"),
             "direction": st.column_config.SelectboxColumn(options=list(DRIVE_DIRECTIONS),
                                                           required=True),
             "vibrometer delay [µs]": st.column_config.NumberColumn(
@@ -142,6 +144,9 @@ def render(stores) -> list:
                                help="only for CSV/TXT files without a time column; 0 = none")
     sample_rate_hz = rate if rate > 0 else None
     measurements, tables = [], {}
+    runs = state.store_listing("dem_runs", stores.stamp(), stores)
+    materials = uploads.measurement_materials(
+        runs["material"] if "material" in getattr(runs, "columns", ()) else ())
     for upload in files or []:
         try:
             uploads.check_upload_size(upload.name, upload.size)
@@ -151,7 +156,7 @@ def render(stores) -> list:
         data = upload.getvalue()
         if uploads.is_settings_table(data):
             try:
-                table = uploads.read_settings_table(upload.name, data)
+                table = uploads.read_settings_table(upload.name, data, materials)
             except PidcoreError as exc:
                 st.error(str(exc))
                 continue
@@ -168,7 +173,7 @@ def render(stores) -> list:
         if found.channels is not None:
             channel_names += [n for n in found.channels.names if n not in channel_names]
     st.markdown("**Per-file settings** (edit the cells; each file is analysed with its own row)")
-    settings = _settings_editor(measurements, tables, channel_names)
+    settings = _settings_editor(measurements, tables, channel_names, materials)
     analysed = []
     for upload, (_, row) in zip(measurements, settings.iterrows(), strict=True):
         result = _card(upload, row, sample_rate_hz)
