@@ -84,3 +84,19 @@ def test_dem_observation_is_eq11_of_the_virtual_shaker(flying_run):
     particles = flying_run.vibrated_mass_kg - flying_run.coupon_mass_kg
     assert obs.reactive_mass_kg < particles
     assert obs.dissipative_mass_stderr_kg > 0
+
+
+def test_bound_notes_flag_a_posterior_piled_against_a_prior_bound():
+    from pidcore.calibrate.parameters import parameter_spec
+    from pidcore.calibrate.posterior import bound_notes
+
+    spec = parameter_spec("fixture_mass_kg")  # prior 0 .. 1 kg
+    rng = np.random.default_rng(0)
+    flat = rng.uniform(spec.low, spec.high, (4000, 1))  # ~5 % per edge: the prior itself
+    inside = rng.normal(0.5, 0.05, (4000, 1))
+    assert bound_notes([spec], flat) == [] and bound_notes([spec], inside) == []
+    high = spec.high - (spec.high - spec.low) * rng.beta(1, 8, (4000, 1))  # 34 % in the top 5 %
+    (note,) = bound_notes([spec], high)
+    assert "upper bound 1" in note and "--prior fixture_mass_kg=LOW:HIGH" in note
+    (note,) = bound_notes([spec], spec.high - high)
+    assert "lower bound 0" in note

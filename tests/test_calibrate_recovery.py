@@ -62,6 +62,23 @@ def test_fixture_mass_and_baseline_are_recovered(tmp_path):
     assert p["high95"] - p["low95"] < 0.1
     # the synthetic runs are the design's runs (same key): the fit reproduces the points
     assert result.rms < 3 * STDERR * max(pt.sdc for pt in points)
+    assert not any("piles against" in n for n in result.notes)  # the data decide inside
+    # a prior that excludes the truth (0.06 kg): the posterior piles against its upper bound,
+    # and the result says so instead of presenting the bound as a fitted value (same runs)
+    capped = calibrate(points, fit=["fixture_mass_kg", "baseline_loss_factor"],
+                       priors=["fixture_mass_kg=0:0.03"], store_path=tmp_path / "s.h5",
+                       discrepancy=0.0, discrepancy_floor=0.0, cells=BASE.cells,
+                       steady_cycles=BASE.steady_cycles, dem_config=BASE, workers=1,
+                       progress=False)
+    piled = [n for n in capped.notes if "piles against" in n]
+    assert any(n.startswith("fixture_mass_kg:") and "upper bound 0.03" in n for n in piled)
+    # the calibrated specimen file carries the warning, and still reads
+    from pidcore.calibrate.outputs import specimen_text
+    from pidcore.specimen import Specimen
+
+    text = specimen_text(capped)
+    assert "# note: fixture_mass_kg: the posterior piles against" in text
+    assert Specimen.from_text(text) == capped.calibrated_specimen()
 
 
 @pytest.mark.slow

@@ -27,6 +27,7 @@ from .parameters import CATALOGUE, DISCREPANCY, ParameterSpec, build_specs, para
 from .posterior import (
     DISCREPANCY_FLOOR,
     Model,
+    bound_notes,
     predictive,
     sample_posterior,
     summarise,
@@ -225,6 +226,7 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: Sequence[str],
     everything = list(range(len(points)))
     samples = sample_posterior(model, everything, seed=posterior_seed, method=method)
     parameters, correlations = summarise(specs, samples)
+    notes += bound_notes(specs, samples)
     rng = np.random.default_rng(posterior_seed + 1)
     predictions = [_row(points[i], predictive(model, samples, i, rng=rng)) for i in everything]
     energy = energy_check(model, samples, specimen)

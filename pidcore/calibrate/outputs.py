@@ -52,6 +52,7 @@ def specimen_text(result: CalibrationResult) -> str:
     if result.loo_rms is not None:
         lines.append(f"# leave-one-out RMS of the SDC: {result.loo_rms:.4g}")
     lines.append(f"# in-sample RMS of the SDC: {result.rms:.4g}")
+    lines += [f"# note: {note}" for note in result.notes]  # e.g. a value set by its prior
     return "\n".join(lines) + "\n" + result.calibrated_specimen().to_toml()
 
 

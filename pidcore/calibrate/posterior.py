@@ -217,3 +217,38 @@ def summarise(specs: Sequence[ParameterSpec], samples: np.ndarray) -> tuple[dict
     else:
         corr = np.ones((1, 1))
     return out, np.round(corr, 4).tolist()
+
+
+#: Share of the prior range, at each finite bound, that :func:`bound_notes` inspects, and the
+#: share of the samples in it above which the posterior is said to pile against the bound: a
+#: posterior that ignored the bound would put about EDGE_SHARE of its samples there if flat,
+#: and less if peaked inside, so four times that is the data pressing on the bound.
+EDGE_SHARE = 0.05
+PILED_SHARE = 0.2
+
+
+def bound_notes(specs: Sequence[ParameterSpec], samples: np.ndarray) -> list[str]:
+    """A note for each parameter whose posterior piles against a finite prior bound.
+
+    Its value is then set by the prior, not the data (the data ask for more, or less, than
+    the prior allows): a stated value that is off (a fixture mass, a baseline) or a prior
+    that is too narrow. The median is still reported; the note says not to trust it.
+    """
+    notes = []
+    for j, spec in enumerate(specs):
+        low, high = float(spec.low), float(spec.high)
+        if not (math.isfinite(low) and math.isfinite(high) and high > low):
+            continue
+        x = samples[:, j]
+        edge = EDGE_SHARE * (high - low)
+        for side, bound, share in (("lower", low, float(np.mean(x < low + edge))),
+                                   ("upper", high, float(np.mean(x > high - edge)))):
+            if share > PILED_SHARE:
+                notes.append(
+                    f"{spec.name}: the posterior piles against its prior's {side} bound "
+                    f"{bound:g} ({share:.0%} of the samples in the {EDGE_SHARE:.0%} of the range "
+                    f"next to it): the data ask for a value at or beyond it, so its median "
+                    f"{float(np.median(x)):.4g} is set by the prior, not the data; check the "
+                    f"stated values, and widen the prior (--prior {spec.name}=LOW:HIGH) unless "
+                    "the bound is physical")
+    return notes
