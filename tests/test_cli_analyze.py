@@ -124,12 +124,18 @@ def test_missing_velocity_names_the_option(tmp_path, capsys):
     assert "force_only.csv" in err and "velocity" in err.lower()
 
 
-def test_table_output_names_units(tmp_path, capsys):
-    path = export(tmp_path / "rec.csv", fmt="csv")
+def test_table_output_names_units_and_whole_file_names(tmp_path, capsys):
+    # a long name's start says the load case; it was cut to its last 40 characters
+    path = export(tmp_path / "synthetic_f100Hz_a10g_fill50_acrylic_run_0042_58b.csv", fmt="csv")
     assert main(["analyze", str(path), "--no-store"]) == 0
     out = capsys.readouterr().out
     for unit in ("[Hz]", "[g]", "[-]", "[J]"):
         assert unit in out
+    header, rule, row = out.splitlines()[:3]
+    assert row.startswith(path.name + " ") and len(rule) == len(header)
+    value = row[len(path.name):].split()[0]  # the frequency, right-aligned under its head
+    end = row.index(value, len(path.name)) + len(value)
+    assert end == header.index("frequency [Hz]") + len("frequency [Hz]")
 
 
 def test_allow_clipped_analyses_and_reports_the_clipping(tmp_path, capsys):

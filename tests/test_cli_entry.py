@@ -6,6 +6,8 @@ import argparse
 import signal
 from pathlib import Path
 
+import pytest
+
 from pidcore.cli import build_parser, console_main
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -41,3 +43,19 @@ def test_every_help_page_renders():
     for parser in parsers:
         text = parser.format_help()
         assert parser.prog in text
+
+
+def test_errors_name_the_sub_command_and_its_action(capsys):
+    # the message points at the --help that explains the option: `pidcore dem sweep --help`,
+    # not `pidcore dem --help`, which lists no sweep option
+    with pytest.raises(SystemExit) as exited:  # argparse's exit, as from the shell
+        console_main(["dem", "sweep", "--bogus"])
+    assert exited.value.code == 2
+    err = capsys.readouterr().err
+    assert err == ("pidcore dem sweep: error: unrecognized arguments: --bogus "
+                   "(see pidcore dem sweep --help)\n")
+    assert console_main(["dem", "sweep", "--fills", "0", "--no-progress"]) == 2
+    assert capsys.readouterr().err.startswith("pidcore dem sweep: error: --fills: '0'")
+    with pytest.raises(SystemExit):
+        console_main(["analyze", "--bogus", "x.csv"])
+    assert capsys.readouterr().err.startswith("pidcore analyze: error: unrecognized")

@@ -65,10 +65,11 @@ def _run(argv: list[str] | None) -> int:
     try:
         parser = build_parser(command)
         args, unknown = parser.parse_known_args(argv)
+        command = _command_name(args)
         if unknown:  # reported by the top parser, which would not name the sub-command
-            parser.exit(2, f"pidcore {args.command}: error: unrecognized arguments: "
-                           f"{' '.join(unknown)} (see pidcore {args.command} --help)\n")
-        command, started = args.command, True
+            parser.exit(2, f"pidcore {command}: error: unrecognized arguments: "
+                           f"{' '.join(unknown)} (see pidcore {command} --help)\n")
+        started = True
         rc = int(args.func(args) or 0)
         if rc != 130 and interrupt.interrupted():  # swallowed on the way: still 130
             raise KeyboardInterrupt
@@ -92,6 +93,13 @@ def _run(argv: list[str] | None) -> int:
         print(f"pidcore {command}: interrupted; {said}", file=sys.stderr)
         interrupt.mark_handled()
         return 130
+
+
+def _command_name(args: argparse.Namespace) -> str:
+    """``dem sweep`` for ``pidcore dem sweep ...``: the command with its action, if it has one
+    (errors name the parser whose --help explains them)."""
+    action = getattr(args, f"{args.command}_command", None)
+    return f"{args.command} {action}" if isinstance(action, str) else args.command
 
 
 def console_main(argv: list[str] | None = None) -> int:

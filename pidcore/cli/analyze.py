@@ -76,14 +76,17 @@ def _run(args: argparse.Namespace) -> int:
 
 
 def format_table(results: list) -> str:
-    header = (f"{'source':<40} {'frequency [Hz]':>14} {'accel. [g]':>10} {'loss factor [-]':>15} "
-              f"{'SDC [-]':>9} {'± SE [-]':>9} {'zeta [-]':>9} {'dE/cycle [J]':>12}")
+    # the whole file name: a cut one may no longer say which load case a row is
+    names = [Path(r.analysis.source).name for r in results]
+    width = max([40, *map(len, names)])
+    header = (f"{'source':<{width}} {'frequency [Hz]':>14} {'accel. [g]':>10} "
+              f"{'loss factor [-]':>15} {'SDC [-]':>9} {'± SE [-]':>9} {'zeta [-]':>9} "
+              f"{'dE/cycle [J]':>12}")
     lines = [header, "-" * len(header)]
-    for r in results:
+    for r, name in zip(results, names, strict=True):
         a = r.analysis
         zeta = "n/a" if a.damping_ratio is None else f"{a.damping_ratio:9.5f}"
-        name = Path(a.source).name
-        lines.append(f"{name[-40:]:<40} {a.frequency_hz:14.4f} {a.acceleration_g:10.4f} "
+        lines.append(f"{name:<{width}} {a.frequency_hz:14.4f} {a.acceleration_g:10.4f} "
                      f"{a.loss_factor:15.6f} {a.sdc:9.5f} {a.sdc_stderr:9.5f} {zeta:>9} "
                      f"{a.energy_per_cycle_j:12.4e}")
         for note in r.notes:

@@ -8,7 +8,7 @@ import json
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     p = subparsers.add_parser("bench", help="speed and memory benchmarks")
-    sub = p.add_subparsers(dest="bench", metavar="WHAT", required=True)
+    sub = p.add_subparsers(dest="bench_command", metavar="WHAT", required=True)
     s = sub.add_parser("signal", help="Eq. 11 analysis throughput on a two-channel record")
     s.add_argument("--samples", type=int, default=10_000_000,
                    help="samples per channel (default 10 000 000)")

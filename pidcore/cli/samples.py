@@ -8,7 +8,7 @@ from pathlib import Path
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     p = subparsers.add_parser("samples", help="regenerate the bundled sample data")
-    sub = p.add_subparsers(dest="samples", metavar="ACTION", required=True)
+    sub = p.add_subparsers(dest="samples_command", metavar="ACTION", required=True)
     m = sub.add_parser("make", help="Table 3 CSV, DEM grid store and virtual shaker exports",
                        description="Regenerate data_samples/: the paper's Table 3 as CSV, a DEM "
                                    "store of the whole Table 3 grid (sweep, resumable) and "
