@@ -101,9 +101,81 @@ def _non_negative(where: str, value: float, unit: str) -> None:
         raise _fail(where, f"expected >= 0 {unit}, got {value!r}")
 
 
+@dataclass(frozen=True)
+class PlausibleRange:
+    """Bounds (SI) a specimen value must lie within, and the unit slip a value beyond suggests."""
+
+    low: float
+    high: float
+    unit: str
+    what: str
+    below: str = ""  # likely slip of a value below ``low``
+    above: str = ""  # likely slip of a value above ``high``
+
+
+#: Generous physical bounds of specimen values. A value outside is almost surely in the wrong
+#: unit (mm for m, g for kg, MPa for Pa, g/cm^3 for kg/m^3): it would give numbers that look
+#: fine but are wrong, or a packing too large to compute, so it is refused. The bounds hold
+#: every real honeycomb specimen and particle material with room to spare:
+PLAUSIBLE_RANGES: dict[str, PlausibleRange] = {
+    # cells: from micro-cell cores (~1 mm) to a single large cavity; 0.5 mm-1 m
+    "inscribed_diameter_m": PlausibleRange(0.5e-3, 1.0, "m", "a cell is 0.5 mm-1 m across",
+                                           above="was it mm?"),
+    "height_m": PlausibleRange(0.5e-3, 1.0, "m", "a core is 0.5 mm-1 m high",
+                               above="was it mm?"),
+    # particles: fine shot (0.1 mm) to large balls (50 mm); finer powder is not DEM territory
+    "radius_m": PlausibleRange(0.05e-3, 25e-3, "m", "a particle radius is 0.05-25 mm",
+                               above="was it mm?"),
+    # densities: polymer foam beads (~15 kg/m^3) to osmium (22590 kg/m^3)
+    "density_kg_m3": PlausibleRange(10.0, 25000.0, "kg/m^3",
+                                    "a solid is 10-25000 kg/m^3", below="was it g/cm^3?"),
+    # Young's modulus: soft rubber (~1 MPa) to diamond (1.2e12 Pa); a softer sphere overlaps
+    # by a sizeable part of its radius at shaker-test impact speeds, where Hertz's law fails
+    "youngs_modulus_pa": PlausibleRange(1e6, 1.5e12, "Pa", "a solid is 1e6-1.5e12 Pa",
+                                        below="was it MPa or GPa?"),
+    # a coupon a shaker carries weighs grams to kilograms; 100 kg is a large panel
+    "mass_kg": PlausibleRange(0.0, 100.0, "kg", "a coupon is up to 100 kg", above="was it g?"),
+    # a fixture (adapter plate, head expander) may be heavy, but not more than a shaker lifts
+    "fixture_mass_kg": PlausibleRange(0.0, 1000.0, "kg", "a fixture is up to 1000 kg",
+                                      above="was it g?"),
+}
+#: Most coupon mass per coupon area (``[cell] count`` cells' cross-section), kg/m^2: a 127 mm
+#: steel plate. Sandwich panels weigh 1-20 kg/m^2 (the paper's 2.6); more is a mass in grams
+#: or a cell count that does not describe the coupon.
+MAX_COUPON_AREAL_MASS_KG_M2 = 1000.0
+PLAUSIBLE_RANGES["wall_density_kg_m3"] = PLAUSIBLE_RANGES["density_kg_m3"]
+PLAUSIBLE_RANGES["wall_youngs_modulus_pa"] = PLAUSIBLE_RANGES["youngs_modulus_pa"]
+
+
+def _plausible(where: str, key: str, value: float) -> None:
+    """Refuse a (finite, signed-checked) value outside :data:`PLAUSIBLE_RANGES` of ``key``."""
+    r = PLAUSIBLE_RANGES[key]
+    if r.low <= value <= r.high:
+        return
+    hint = r.below if value < r.low else r.above
+    unit = {"m": "metres", "kg": "kilograms", "Pa": "pascals"}.get(r.unit, r.unit)
+    raise _fail(where, f"{value:g} {r.unit}: expected {unit} ({r.what})"
+                       + (f"; {hint}" if hint else ""))
+
+
 def _poisson(where: str, value: float) -> None:
     if not (math.isfinite(value) and -1.0 < value < 0.5):
         raise _fail(where, f"expected -1 < nu < 0.5, got {value!r}")
+
+
+def particles_for_fill(fill_percent: float, full: int) -> int:
+    """Particles per cell of a fill percentage of ``full`` (the count taken as 100 %).
+
+    The one rounding rule of a fill, for ``specimen check`` and ``dem run`` alike: a fill that
+    rounds to no particle is refused (an empty cell damps nothing, and its SDC is 0/0).
+    """
+    n = int(round(fill_percent / 100.0 * full))
+    if n < 1:
+        # the smallest fill shown on a 0.01 % step strictly above half a particle: rounds to 1
+        least = math.floor(5000.0 / full) / 100 + 0.01
+        raise ParameterError(f"fill {fill_percent:g} % of {full} particles rounds to none; "
+                             f"expected >= {least:.2f} %")
+    return n
 
 
 @dataclass(frozen=True)
@@ -123,12 +195,18 @@ class CellSpec:
         if self.shape not in CELL_SHAPES:
             raise _fail("[cell] shape", f"expected one of {CELL_SHAPES}, got {self.shape!r}")
         _positive("[cell] inscribed_diameter_m", self.inscribed_diameter_m, "m")
+        _plausible("[cell] inscribed_diameter_m", "inscribed_diameter_m",
+                   self.inscribed_diameter_m)
         _positive("[cell] height_m", self.height_m, "m")
+        _plausible("[cell] height_m", "height_m", self.height_m)
         if isinstance(self.count, bool) or not isinstance(self.count, int) or self.count < 1:
             raise _fail("[cell] count", f"expected a whole number >= 1, got {self.count!r}")
         _positive("[cell] wall_youngs_modulus_pa", self.wall_youngs_modulus_pa, "Pa")
+        _plausible("[cell] wall_youngs_modulus_pa", "wall_youngs_modulus_pa",
+                   self.wall_youngs_modulus_pa)
         _poisson("[cell] wall_poisson_ratio", self.wall_poisson_ratio)
         _positive("[cell] wall_density_kg_m3", self.wall_density_kg_m3, "kg/m^3")
+        _plausible("[cell] wall_density_kg_m3", "wall_density_kg_m3", self.wall_density_kg_m3)
 
 
 @dataclass(frozen=True)
@@ -141,7 +219,9 @@ class CouponSpec:
 
     def __post_init__(self):
         _positive("[coupon] mass_kg", self.mass_kg, "kg")
+        _plausible("[coupon] mass_kg", "mass_kg", self.mass_kg)
         _non_negative("[coupon] fixture_mass_kg", self.fixture_mass_kg, "kg")
+        _plausible("[coupon] fixture_mass_kg", "fixture_mass_kg", self.fixture_mass_kg)
         _non_negative("[coupon] baseline_loss_factor", self.baseline_loss_factor, "[-]")
 
     @property
@@ -166,8 +246,11 @@ class ParticleSpec:
         if not self.material or not isinstance(self.material, str):
             raise _fail("[particles] material", f"expected a name, got {self.material!r}")
         _positive("[particles] radius_m", self.radius_m, "m")
+        _plausible("[particles] radius_m", "radius_m", self.radius_m)
         _positive("[particles] density_kg_m3", self.density_kg_m3, "kg/m^3")
+        _plausible("[particles] density_kg_m3", "density_kg_m3", self.density_kg_m3)
         _positive("[particles] youngs_modulus_pa", self.youngs_modulus_pa, "Pa")
+        _plausible("[particles] youngs_modulus_pa", "youngs_modulus_pa", self.youngs_modulus_pa)
         _poisson("[particles] poisson_ratio", self.poisson_ratio)
         if self.count_per_cell is not None and self.fill_percent is not None:
             raise _fail("[particles]", "give count_per_cell or fill_percent, not both")
@@ -260,6 +343,27 @@ class Specimen:
                         f"a sphere of radius {r * 1e3:.4g} mm does not fit a "
                         f"{self.cell.inscribed_diameter_m * 1e3:.4g} x "
                         f"{self.cell.height_m * 1e3:.4g} mm {self.cell.shape} cell")
+        area = self.cell.count * self.geometry().volume_m3() / self.cell.height_m
+        if self.coupon.mass_kg / area > MAX_COUPON_AREAL_MASS_KG_M2:
+            raise _fail("[coupon] mass_kg",
+                        f"{self.coupon.mass_kg:g} kg on {self.cell.count} cells "
+                        f"({area * 1e4:.4g} cm^2) is {self.coupon.mass_kg / area:.4g} kg/m^2; "
+                        f"expected kilograms (a coupon is up to "
+                        f"{MAX_COUPON_AREAL_MASS_KG_M2:g} kg/m^2); was it g, or is [cell] "
+                        "count wrong?")
+        from .dem.geometry import check_packing_size
+
+        try:
+            # before any packing is laid out: a size in the wrong unit would ask for GiBs
+            check_packing_size(self.geometry(), r)
+        except ParameterError as exc:
+            raise _fail("[particles] radius_m", str(exc)) from None
+        if self.particles.fill_percent is not None:
+            try:
+                particles_for_fill(self.particles.fill_percent, self.capacity_per_cell())
+            except ParameterError as exc:
+                raise _fail("[particles] fill_percent", f"{exc} (the cell's capacity)") \
+                    from None
         if self.particles.count_per_cell is not None:
             capacity = self.capacity_per_cell()
             if self.particles.count_per_cell > capacity:
@@ -471,13 +575,29 @@ def _table_material(name: str, where: str, role: str | None):
     return row
 
 
+#: materials.csv columns that define a table material: inline values must equal them (a
+#: particle's radius is a default, free to differ).
+_TABLE_PROPERTIES = ("density_kg_m3", "youngs_modulus_pa", "poisson_ratio")
+
+
 def _complete_from_material(table: dict[str, Any], where: str, name: str, role: str | None,
                             columns: tuple[tuple[str, str], ...]) -> None:
     """Fill each key of ``columns`` (key, materials.csv column) that ``table`` does not state
     inline from material ``name``'s row; a key neither stated nor in the table is an error
-    naming ``where`` (the material key)."""
+    naming ``where`` (the material key), and so is an inline property of a table material
+    that differs from the table's (the name would claim one material, the numbers another)."""
     row = _table_material(name, where, role)
     for key, column in columns:
+        if row is not None and key in table and column in _TABLE_PROPERTIES:
+            listed = float(getattr(row, column))
+            # relative 1e-9: the CSV and TOML float parsers may differ in the last digit; a
+            # different material differs in the first few
+            if not math.isclose(table[key], listed, rel_tol=1e-9):
+                section = where.split(" ")[0]
+                raise ParameterError(
+                    f"{section} {key}: {table[key]:g} differs from {listed:g} of material "
+                    f"{name!r} in materials.csv; give your own material another name, or "
+                    "leave the key out to use the table's")
         if key not in table:
             if row is None:
                 raise ParameterError(
@@ -491,7 +611,8 @@ def _from_mapping(data: Mapping[str, Any], *, source: str) -> Specimen:
     for key, value in data.items():
         if isinstance(value, Mapping) and key not in ("cell", "coupon", "particles", "pairs"):
             raise ParameterError(f"[{key}]: unknown table; expected [cell], [coupon], "
-                                 "[particles], [pairs.particle_particle], [pairs.particle_wall]")
+                                 "[particles], [pairs], [pairs.particle_particle], "
+                                 "[pairs.particle_wall]")
     version = top.get("schema_version", SCHEMA_VERSION)
     if version != SCHEMA_VERSION:
         raise ParameterError(f"schema_version: this pidcore reads version {SCHEMA_VERSION}, "
@@ -699,7 +820,7 @@ def describe(specimen: Specimen) -> dict[str, Any]:
     if p.count_per_cell is not None:
         count, basis = p.count_per_cell, "count_per_cell"
     elif p.fill_percent is not None:
-        count, basis = int(round(p.fill_percent / 100.0 * capacity)), "fill_percent"
+        count, basis = particles_for_fill(p.fill_percent, capacity), "fill_percent"
     else:
         count, basis = capacity, "capacity"
     material = p.material if p.material in PARTICLE_MATERIALS else "acrylic"
@@ -722,6 +843,7 @@ def describe(specimen: Specimen) -> dict[str, Any]:
         "particles_mass_kg": specimen.cell.count * count * p.mass_kg,
         "coupon_mass_kg": specimen.coupon.mass_kg,
         "fixture_mass_kg": specimen.coupon.fixture_mass_kg,
+        "moving_mass_kg": specimen.coupon.moving_mass_kg,
         "vibrated_mass_kg": specimen.vibrated_mass_kg(count),
         "wall_to_wall_gap_m": specimen.cell.inscribed_diameter_m - 2 * p.radius_m,
         "floor_to_ceiling_gap_m": specimen.cell.height_m - 2 * p.radius_m,
@@ -760,12 +882,12 @@ def _capacity(shape: str, inscribed_diameter_m: float, height_m: float, radius_m
     from .dem.geometry import cell_capacity
 
     cell = CellSpec(shape=shape, inscribed_diameter_m=inscribed_diameter_m, height_m=height_m,
-                    count=1, wall_material="-", wall_youngs_modulus_pa=1.0,
-                    wall_poisson_ratio=0.0, wall_density_kg_m3=1.0)
+                    count=1, wall_material="-", wall_youngs_modulus_pa=72e9,
+                    wall_poisson_ratio=0.0, wall_density_kg_m3=2800.0)  # walls: no effect
     return cell_capacity(cell_geometry(cell), radius_m)
 
 
 __all__ = ["CellSpec", "CouponSpec", "PairSpec", "PairsSpec", "ParticleSpec", "Specimen",
            "cell_geometry", "contact_law", "describe", "load_specimen", "numeric_fields",
-           "paper_specimen"]
+           "paper_specimen", "particles_for_fill"]
 

@@ -81,7 +81,7 @@ def test_dem_observation_is_eq11_of_the_virtual_shaker(flying_run):
     assert obs.dissipative_mass_kg * 0.5 * w * v**2 / 500.0 == pytest.approx(
         flying_run.energy_per_cycle_j, rel=0.02)
     # a flying bed moves less mass than it weighs: m_p below the particles' mass
-    particles = flying_run.vibrated_mass_kg - flying_run.coupon_mass_kg
+    particles = flying_run.vibrated_mass_kg - flying_run.moving_mass_kg
     assert obs.reactive_mass_kg < particles
     assert obs.dissipative_mass_stderr_kg > 0
 

@@ -295,7 +295,7 @@ def test_virtual_shaker_record_is_consistent(run_500hz):
     h = 1 / r.sample_rate_hz
     w = 2 * math.pi * 500
     acc = 5 * 9.80665 * (np.cos(w * (t - h / 2)) - np.cos(w * (t + h / 2))) / (w * h)
-    np.testing.assert_allclose(r.shaker_force_n, r.coupon_mass_kg * acc + r.wall_force_n,
+    np.testing.assert_allclose(r.shaker_force_n, r.moving_mass_kg * acc + r.wall_force_n,
                                atol=1e-12)
 
 

@@ -133,7 +133,7 @@ def test_off_grid_measurement_is_interpolated_within_its_neighbours(table):
     corners = [_sdc(f, a, z) for f in FILLS for a in ACCS for z in FREQS]
     assert min(corners) <= row["SDC DEM (ours) [-]"] <= max(corners)
     assert math.isnan(row["SDC DEM (paper) [-]"])  # 70 Hz is no Table 3 point
-    assert math.isnan(row["particles per cell [-]"]) and row["DEM runs [-]"] == 0
+    assert pd.isna(row["particles per cell [-]"]) and row["DEM runs [-]"] == 0
 
 
 def test_out_of_range_measurement_has_no_dem_value(table):
@@ -267,3 +267,15 @@ def test_specimens_are_separate_rows_and_pooled_files_get_a_consistency_check():
     assert len(pooled) == 1 and pooled.iloc[0]["source file(s)"] == "a1.csv; a2.csv; b.csv"
     # 0.9 lies 29 sigma off the others: flagged in the note
     assert pooled.iloc[0][CONSISTENCY_COLUMN] > 3 and "scatter" in pooled.iloc[0]["note"]
+
+
+def test_particles_per_cell_is_written_as_a_whole_number(table, tmp_path):
+    # a count: the CSV wrote 18.0 (a float column, NaN where no DEM ran); now 18, and empty
+    from pidcore.report.render import format_cell
+
+    path = tmp_path / "t.csv"
+    table.to_csv(path, index=False)
+    column = pd.read_csv(path, dtype=str, keep_default_na=False)["particles per cell [-]"]
+    assert set(column) - {""} <= {"9", "18"} and "" in set(column)
+    missing = table[table["DEM runs [-]"] == 0]["particles per cell [-]"].iloc[0]
+    assert format_cell(missing) == ""

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -151,6 +152,14 @@ def test_dem_run_cli_with_specimen_and_run_cache(capsys, tmp_path):
     assert main(args) == 0
     second = json.loads(capsys.readouterr().out)
     assert second["reused_from_store"] is True and second["sdc"] == first["sdc"]
+    # one meaning per key, as in `specimen check --json`: the coupon alone, and the sum apart
+    # (exact: the numbers are the file's, passed through)
+    for out in (first, second):
+        assert out["coupon_mass_kg"] == 0.0333 and out["fixture_mass_kg"] == 0.015
+        assert out["moving_mass_kg"] == 0.0333 + 0.015
+    assert main(["specimen", "check", str(STEEL), "--json"]) == 0
+    facts = json.loads(capsys.readouterr().out)
+    assert (facts["coupon_mass_kg"], facts["moving_mass_kg"]) == (0.0333, 0.0333 + 0.015)
     assert store.read_bytes() == before  # reused, nothing written
 
 
@@ -239,3 +248,17 @@ def test_static_and_rolling_friction_of_a_specimen_reach_the_kernel():
     # the static friction and rolling resistance acting in the kernel
     assert r.energy_per_cycle_j != base.energy_per_cycle_j
     assert abs(r.energy_balance_error) < 0.01  # the energy bookkeeping still closes
+
+
+def test_run_stored_before_moving_mass_kg_reads_its_coupon_mass_kg_as_the_sum():
+    # such stores held coupon + fixture under coupon_mass_kg; it is the rigid mass of the run
+    steel = load_specimen(STEEL)
+    case = LoadCase(1000.0, 5.0, 50.0, material="steel")
+    entry = dem_run_entry(simulate_load_case(case, TINY, specimen=steel))
+    record = dict(entry["record"])
+    record["coupon_mass_kg"] = record.pop("moving_mass_kg")
+    stored = SimpleNamespace(key="old", record=record, arrays=entry["arrays"],
+                             parameters=entry["parameters"])
+    old = load_dem_result(stored)
+    assert old.moving_mass_kg == 0.0333 + 0.015 and old.coupon_mass_kg == 0.0333
+    assert old.to_dict()["coupon_mass_kg"] == 0.0333

@@ -19,8 +19,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     check = sub.add_parser(
         "check", help="validate a specimen file and print capacity, masses, contact numbers",
         description="Validate FILE (one-line error, exit 2, on a missing or unknown key, a "
-                    "negative mass, particles that do not fit, static below sliding friction, "
-                    "an unknown material) and print what follows from it.")
+                    "negative mass, a value outside its plausible range (a unit slip), "
+                    "particles that do not fit, a fill of no particle, static below sliding "
+                    "friction, an unknown material or one whose inline properties differ "
+                    "from the table's) and print what follows from it.")
     check.add_argument("file", metavar="FILE", type=Path, help="specimen TOML file")
     add_json_option(check)
     check.set_defaults(func=run_check)
@@ -41,7 +43,8 @@ def format_facts(f: dict, source: str) -> str:
     """Readable lines with units."""
     kind = "the paper's coupon" if f["is_paper"] else "not the paper's coupon"
     return "\n".join([
-        f"specimen        {f['name']} ({source}): OK, {kind}; sha256 {f['sha256'][:16]}",
+        f"specimen        {f['name']} ({source}): OK, {kind}; sha256 {f['sha256'][:16]} "
+        "(of every value, name and description included)",
         f"cells           {f['cells_per_coupon']} {f['cell_shape']}, capacity "
         f"{f['capacity_per_cell']} particles per cell (dense drop packing)",
         f"gaps            wall to wall {f['wall_to_wall_gap_m'] * 1e3:.4g} mm, floor to "

@@ -63,14 +63,51 @@ class CellGeometry:
         return 2.0 * np.sqrt(3.0) * self.apothem_m**2 * self.height_m
 
 
-def _candidate_grid(geometry: CellGeometry, radius_m: float, spacing_m: float) -> np.ndarray:
-    """xy points where a sphere centre may sit (inside the hexagon shrunk by the radius)."""
+#: Most candidate points :func:`drop_packing` lays out: it holds (n, 3) points and (n, 6) wall
+#: distances in float64, 0.15 GB at this size. Enough for a cell some 50 particle radii across
+#: (the paper's is 3.8); a larger ratio is almost surely a unit slip, and would ask for GiBs.
+MAX_PACKING_GRID_POINTS = 2_000_000
+#: Most spheres :func:`drop_packing` places in one cell (each scans every candidate point): a
+#: cell of 10^5 spheres is far beyond what the DEM simulates, and a larger estimate again
+#: points at a unit slip in the cell's or the particles' size.
+MAX_PACKED_PARTICLES = 100_000
+#: Densest packing of equal spheres (Kepler, pi / sqrt(18)): no cell holds more.
+_DENSEST_PACKING_FRACTION = np.pi / np.sqrt(18.0)
+#: Default candidate-grid spacing of :func:`drop_packing`, in particle radii.
+GRID_FRACTION = 0.04
+
+
+def check_packing_size(geometry: CellGeometry, radius_m: float,
+                       grid_fraction: float = GRID_FRACTION) -> None:
+    """Refuse (ParameterError) a packing whose candidate grid or sphere count would be huge.
+
+    Called before :func:`drop_packing` allocates anything, so that a cell or radius in the
+    wrong unit is one error line instead of a multi-GiB allocation or an endless loop.
+    """
     inner = geometry.apothem_m - radius_m
     if inner < 0:
         raise ParameterError(
             f"particle radius {radius_m * 1e3:.3g} mm does not fit a cell of inscribed "
             f"diameter {geometry.inscribed_diameter_m * 1e3:.3g} mm")
-    rc = inner * 2.0 / np.sqrt(3.0)
+    size = (f"a {radius_m * 1e3:.3g} mm radius sphere in a "
+            f"{geometry.inscribed_diameter_m * 1e3:.4g} x {geometry.height_m * 1e3:.4g} mm cell")
+    per_side = 2.0 * inner * 2.0 / np.sqrt(3.0) / (grid_fraction * radius_m) + 2.0
+    if per_side**2 > MAX_PACKING_GRID_POINTS:
+        raise ParameterError(
+            f"{size} needs a packing grid of {per_side**2:.3g} points (limit "
+            f"{MAX_PACKING_GRID_POINTS:.3g}, a cell up to about 50 radii across); check the "
+            "units of the cell's and the particles' size")
+    most = _DENSEST_PACKING_FRACTION * geometry.volume_m3() / (4.0 / 3.0 * np.pi * radius_m**3)
+    if most > MAX_PACKED_PARTICLES:
+        raise ParameterError(
+            f"{size} holds up to {most:.3g} spheres (limit {MAX_PACKED_PARTICLES:.3g} per "
+            "cell); check the units of the cell's and the particles' size")
+
+
+def _candidate_grid(geometry: CellGeometry, radius_m: float, spacing_m: float) -> np.ndarray:
+    """xy points where a sphere centre may sit (inside the hexagon shrunk by the radius)."""
+    check_packing_size(geometry, radius_m, spacing_m / radius_m)
+    rc = (geometry.apothem_m - radius_m) * 2.0 / np.sqrt(3.0)
     g = np.arange(-rc, rc + spacing_m / 2, spacing_m)
     xx, yy = np.meshgrid(g, g)
     pts = np.column_stack([xx.ravel(), yy.ravel(), np.zeros(xx.size)])
@@ -81,7 +118,7 @@ def _candidate_grid(geometry: CellGeometry, radius_m: float, spacing_m: float) -
 
 def drop_packing(geometry: CellGeometry, radius_m: float, n_particles: int | None, *,
                  rng: np.random.Generator | None = None, gap_fraction: float = 1e-4,
-                 grid_fraction: float = 0.04,
+                 grid_fraction: float = GRID_FRACTION,
                  random_band_fraction: float = 0.5) -> np.ndarray:
     """Place spheres one by one, each dropped vertically onto floor and spheres below.
 

@@ -153,6 +153,9 @@ def load_dem_result(entry: StoredEntry) -> DemResult:
         elif f.name in record:
             value = record[f.name]
             values[f.name] = float("nan") if value is None else value
+    if "moving_mass_kg" not in record:
+        # stored before the key existed: coupon_mass_kg held coupon + fixture then
+        values["moving_mass_kg"] = record["coupon_mass_kg"]
     values.setdefault("coupon_cells", specimen.cell.count)
     if "energy_dissipated_rolling_j" not in record and not any(
             pair.rolling_friction for pair in (specimen.pairs.particle_particle,

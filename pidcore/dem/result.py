@@ -24,7 +24,8 @@ UNITS: dict[str, str] = {
     "max_kinetic_energy_j": "J", "work_per_cycle_j": "J",
     "stored_energy_change_per_cycle_j": "J",
     "particles_per_cell": "1", "particles_full_cell": "1", "cells_simulated": "1",
-    "vibrated_mass_kg": "kg", "coupon_mass_kg": "kg", "energy_balance_error": "-", "steps": "1",
+    "vibrated_mass_kg": "kg", "coupon_mass_kg": "kg", "moving_mass_kg": "kg",
+    "energy_balance_error": "-", "steps": "1",
     "wall_s": "s", "particle_steps_per_s": "1/s", "time_step_s": "s",
     "steady_start_cycle": "1", "steady_cycles": "1", "cycles_simulated": "1",
     "settle_time_s": "s", "frequency_hz": "Hz", "acceleration_g": "g", "fill_percent": "%",
@@ -44,7 +45,8 @@ class DemResult:
     Coupon-level quantities scale the K-cell mean to the coupon's ``coupon_cells`` cells
     (the specimen's ``[cell] count``, 441 for the paper's). ``specimen`` is the
     :class:`~pidcore.specimen.Specimen` simulated (its canonical text and hash are stored with
-    the run); ``coupon_mass_kg`` is the rigid mass the shaker moves, coupon plus fixture.
+    the run); ``moving_mass_kg`` is the rigid mass the shaker moves, coupon plus fixture
+    (``coupon_mass_kg`` is the coupon alone, as in the specimen's ``[coupon] mass_kg``).
     ``energy_dissipated_normal_j`` / ``_friction_j`` / ``_rolling_j`` split
     ``energy_per_cycle_j`` (steady state, per cycle, coupon); ``work_per_cycle_j`` is the
     walls' work on the particles per steady cycle; it equals the dissipation plus
@@ -80,7 +82,7 @@ class DemResult:
     particles_full_cell: int
     cells_simulated: int
     vibrated_mass_kg: float
-    coupon_mass_kg: float
+    moving_mass_kg: float
     energy_balance_error: float
     work_walls_j: float
     dissipated_total_j: float
@@ -108,7 +110,7 @@ class DemResult:
     def from_run(cls, *, case: LoadCase, config: DemConfig, law: ContactLaw,
                  tally: np.ndarray, wall_force: np.ndarray, steady_start_cycle: int,
                  steady_detected: bool, particles_per_cell: int, full_count: int,
-                 vibrated_mass_kg: float, coupon_mass_kg: float, dt_s: float, steps_per_cycle: int,
+                 vibrated_mass_kg: float, moving_mass_kg: float, dt_s: float, steps_per_cycle: int,
                  sample_every: int, energy_start: np.ndarray, energy_end: np.ndarray,
                  stored_energy_change_steady: np.ndarray,
                  settle_time_s: float, steps: int, wall_s: float, kernel_s: float,
@@ -150,7 +152,7 @@ class DemResult:
             max_kinetic_energy_j=float(e_max),
             particles_per_cell=int(particles_per_cell), particles_full_cell=int(full_count),
             cells_simulated=int(k), vibrated_mass_kg=float(vibrated_mass_kg),
-            coupon_mass_kg=float(coupon_mass_kg),
+            moving_mass_kg=float(moving_mass_kg),
             energy_balance_error=float((work - d_mech - dissipated) / scale),
             work_walls_j=work, dissipated_total_j=dissipated, mechanical_energy_change_j=d_mech,
             steps=int(steps), wall_s=float(wall_s),
@@ -163,9 +165,16 @@ class DemResult:
             dissipation_per_cycle_j=n_coupon * per_cell_cycle.mean(axis=0),
             dissipation_per_cell_cycle_j=per_cell_cycle,
             sample_rate_hz=1.0 / h, sample_time_s=0.5 * (t0 + t1), wall_force_n=wall_n,
-            shaker_force_n=coupon_mass_kg * acc + wall_n, velocity_m_s=vel,
+            shaker_force_n=moving_mass_kg * acc + wall_n, velocity_m_s=vel,
             samples_per_cycle=int(spc), specimen=specimen, coupon_cells=int(n_coupon),
         )
+
+    @property
+    def coupon_mass_kg(self) -> float:
+        """The coupon alone (``[coupon] mass_kg``), kg: the fixture is in ``moving_mass_kg``."""
+        if self.specimen is None:  # no specimen, no fixture: the rigid mass is the coupon
+            return self.moving_mass_kg
+        return self.specimen.coupon.mass_kg
 
     @property
     def notes(self) -> tuple[str, ...]:
@@ -242,7 +251,7 @@ class DemResult:
                      "energy_dissipated_normal_j", "energy_dissipated_friction_j",
                      "energy_dissipated_rolling_j", "max_kinetic_energy_j",
                      "particles_per_cell", "particles_full_cell",
-                     "cells_simulated", "vibrated_mass_kg", "coupon_mass_kg",
+                     "cells_simulated", "vibrated_mass_kg", "coupon_mass_kg", "moving_mass_kg",
                      "energy_balance_error",
                      "work_walls_j", "dissipated_total_j", "mechanical_energy_change_j",
                      "steps", "wall_s", "particle_steps_per_s", "time_step_s",

@@ -68,7 +68,7 @@ from ..constants import (
 )
 from ..errors import ParameterError, SimulationError
 from ..loadcase import LoadCase
-from ..specimen import Specimen, contact_law, paper_specimen
+from ..specimen import Specimen, contact_law, paper_specimen, particles_for_fill
 from .contact import ContactLaw, check_damping_mode, check_tangential_model
 from .geometry import CellGeometry, cell_capacity, random_packing
 from .result import DemResult
@@ -234,10 +234,7 @@ def particles_per_cell(fill_percent: float, material_name: str | None = None, *,
     else:
         raise ParameterError(f"fill_reference: expected one of {FILL_REFERENCES}, "
                              f"got {fill_reference!r}")
-    n = int(round(fill_percent / 100.0 * full))
-    if n < 1:
-        raise ParameterError(f"fill {fill_percent:g} % of {full} particles rounds to none")
-    return n, full
+    return particles_for_fill(fill_percent, full), full
 
 
 def _kernel_specializations() -> int:
@@ -600,7 +597,7 @@ def simulate_load_case(case: LoadCase, config: DemConfig | None = None, *,
         case=case, config=config, law=law, tally=tally, wall_force=force,
         steady_start_cycle=int(steady_start), steady_detected=detected,
         particles_per_cell=n, full_count=full, vibrated_mass_kg=m_c,
-        coupon_mass_kg=specimen.coupon.moving_mass_kg, specimen=specimen,
+        moving_mass_kg=specimen.coupon.moving_mass_kg, specimen=specimen,
         dt_s=dt, steps_per_cycle=steps_per_cycle, sample_every=sample_every,
         energy_start=e_start, energy_end=e_end, settle_time_s=settle_time,
         stored_energy_change_steady=stored_change,

@@ -47,7 +47,7 @@ def format_cell(value: object) -> str:
     """Display text of one cell: 4 significant digits, empty for NaN."""
     if isinstance(value, float):
         return "" if math.isnan(value) else f"{value:.4g}"
-    if value is None:
+    if value is None or value is pd.NA:  # pd.NA: a missing whole number (Int64 column)
         return ""
     return str(value)
 

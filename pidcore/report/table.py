@@ -229,7 +229,7 @@ def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | N
             "packing ratio [%]": lc.fill_percent,
             "material": lc.material,
             "direction": lc.direction,
-            "particles per cell [-]": row.dem.particles_per_cell if row.dem else math.nan,
+            "particles per cell [-]": row.dem.particles_per_cell if row.dem else None,
             "DEM runs [-]": row.dem.n_runs if row.dem else 0,
             "SDC DEM (ours) [-]": row.sdc_dem,
             "SDC DEM stderr [-]": row.sdc_dem_stderr,
@@ -252,6 +252,8 @@ def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | N
         })
     table = pd.DataFrame.from_records(records, columns=list(REPORT_COLUMNS))
     table["DEM runs [-]"] = table["DEM runs [-]"].astype(int)
+    # a count: whole numbers in every format (the CSV wrote 18.0), empty where no DEM ran
+    table["particles per cell [-]"] = table["particles per cell [-]"].astype("Int64")
     table = _sort_like_table3(table, aligner, paper, tolerances)
     table.attrs["notes"] = notes
     return table

@@ -1,0 +1,166 @@
+"""Specimen values in the wrong unit, fills of no particle, overridden table materials: refused
+with one line naming the key, before anything large is computed."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from pidcore.cli import main
+from pidcore.dem.geometry import (
+    MAX_PACKING_GRID_POINTS,
+    CellGeometry,
+    check_packing_size,
+    drop_packing,
+)
+from pidcore.dem.simulate import particles_per_cell
+from pidcore.errors import ParameterError
+from pidcore.specimen import (
+    PAPER_SPECIMEN_NAME,
+    PLAUSIBLE_RANGES,
+    Specimen,
+    describe,
+    load_specimen,
+    paper_specimen,
+)
+
+REPO = Path(__file__).resolve().parents[1]
+STEEL = REPO / "data_samples" / "specimens" / "steel_6mm.toml"
+TEXT = STEEL.read_text(encoding="utf-8")
+#: The paper coupon's hash: the bundled stores (data_samples/dem_table3.h5, the calibration
+#: bundle) hold its runs under keys made from it.
+PAPER_SHA256 = "720ba2da93f08f5f54695ae784c140ce3fb7c42c155adce50f224cd8a0e644c9"
+
+
+def _edit(old: str, new: str, text: str = TEXT) -> str:
+    assert old in text, old
+    return text.replace(old, new, 1)
+
+
+@pytest.mark.parametrize("old, new, message", [
+    ("inscribed_diameter_m = 6.35e-3", "inscribed_diameter_m = 6.35",
+     r"\[cell\] inscribed_diameter_m: 6.35 m: expected metres .*was it mm\?"),
+    ("height_m = 12.7e-3", "height_m = 12.7",
+     r"\[cell\] height_m: 12.7 m: expected metres \(a core is 0.5 mm-1 m high\); was it mm\?"),
+    ("radius_m = 1.0e-3", "radius_m = 1.0", r"\[particles\] radius_m: 1 m: .*was it mm\?"),
+    ("radius_m = 1.0e-3", "radius_m = 1.0e-6", r"\[particles\] radius_m: 1e-06 m: expected"),
+    ("mass_kg = 0.0333", "mass_kg = 333.0", r"\[coupon\] mass_kg: 333 kg: .*was it g\?"),
+    ("mass_kg = 0.0333", "mass_kg = 33.3",  # under 100 kg, but 3340 kg/m^2 of coupon
+     r"\[coupon\] mass_kg: 33.3 kg on 286 cells .*was it g, or is \[cell\] count wrong\?"),
+    ("fixture_mass_kg = 0.015", "fixture_mass_kg = 1500.0",
+     r"\[coupon\] fixture_mass_kg: 1500 kg: .*was it g\?"),
+    ("youngs_modulus_pa = 200e9", "youngs_modulus_pa = 200000",
+     r"\[particles\] youngs_modulus_pa: 200000 Pa: .*was it MPa or GPa\?"),
+    ("density_kg_m3 = 7850.0", "density_kg_m3 = 7.85",
+     r"\[particles\] density_kg_m3: 7.85 kg/m\^3: .*was it g/cm\^3\?"),
+    ('wall_material = "aluminium_wall"',
+     'wall_material = "nomex"\nwall_youngs_modulus_pa = 3.4e3\nwall_poisson_ratio = 0.3\n'
+     'wall_density_kg_m3 = 48.0', r"\[cell\] wall_youngs_modulus_pa: 3400 Pa"),
+])
+def test_a_value_in_the_wrong_unit_is_refused_naming_key_value_unit_and_slip(old, new,
+                                                                             message):
+    with pytest.raises(ParameterError, match=message):
+        Specimen.from_text(_edit(old, new), source="s.toml")
+
+
+def test_ranges_hold_the_bundled_specimens():
+    for path in [*(REPO / "data_samples" / "specimens").glob("*.toml"),
+                 REPO / "data_samples" / "paper_calibrated_specimen.toml",
+                 REPO / "data_samples" / "paper_calibration" / "calibrated_specimen.toml"]:
+        load_specimen(path)
+    for material in ("acrylic", "aluminium"):
+        paper_specimen(material).with_values({})  # re-parsed like a file
+    assert all(r.low < r.high for r in PLAUSIBLE_RANGES.values())
+
+
+def test_a_cell_of_many_radii_is_refused_before_the_packing_grid_is_allocated():
+    # 0.635 m cell, 1 mm spheres: the grid would be 3.3e8 points (2.5 GiB); refused by size
+    cell = CellGeometry(inscribed_diameter_m=0.635, height_m=12.7e-3)
+    with pytest.raises(ParameterError, match="packing grid of 3.3.e\\+08 points"):
+        check_packing_size(cell, 1e-3)
+    with pytest.raises(ParameterError, match="packing grid"):
+        drop_packing(cell, 1e-3, None)
+    with pytest.raises(ParameterError, match=r"\[particles\] radius_m: .*packing grid"):
+        Specimen.from_text(_edit("inscribed_diameter_m = 6.35e-3",
+                                 "inscribed_diameter_m = 0.635"), source="s.toml")
+    # a tall cell of small spheres: few grid points, but millions of spheres to place
+    with pytest.raises(ParameterError, match="holds up to .* spheres"):
+        check_packing_size(CellGeometry(5e-3, 1.0), 0.1e-3)
+    # the limit still admits a cell 50 radii across (the paper's is 3.8)
+    check_packing_size(CellGeometry(50e-3, 10e-3), 1e-3)
+    assert MAX_PACKING_GRID_POINTS <= 2_000_000
+
+
+def test_unit_slips_are_one_line_and_exit_2_in_the_cli(tmp_path, capsys):
+    for old, new in (("inscribed_diameter_m = 6.35e-3", "inscribed_diameter_m = 6.35"),
+                     ("inscribed_diameter_m = 6.35e-3", "inscribed_diameter_m = 0.635")):
+        bad = tmp_path / "bad.toml"
+        bad.write_text(_edit(old, new), encoding="utf-8")
+        assert main(["specimen", "check", str(bad)]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and str(bad) in err and "Traceback" not in err
+        assert main(["dem", "run", "--specimen", str(bad), "--frequency", "100",
+                     "--acceleration", "5", "--no-progress"]) == 2
+        assert str(bad) in capsys.readouterr().err
+
+
+def test_a_fill_of_no_particle_is_refused_by_check_as_by_dem_run():
+    text = _edit("fill_percent = 50.0", "fill_percent = 1.0")
+    with pytest.raises(ParameterError, match=r"\[particles\] fill_percent: fill 1 % of "
+                                             r"(\d+) particles rounds to none"):
+        Specimen.from_text(text, source="s.toml")
+    steel = load_specimen(STEEL)
+    capacity = steel.capacity_per_cell()
+    with pytest.raises(ParameterError, match=f"fill 1 % of {capacity} particles rounds to none"):
+        particles_per_cell(1.0, specimen=steel, fill_reference="capacity")
+    # the least fill the message names does give one particle
+    least = float(str(pytest.raises(ParameterError, particles_per_cell, 1.0, specimen=steel,
+                                    fill_reference="capacity").value).split(">= ")[1][:-2])
+    assert particles_per_cell(least, specimen=steel, fill_reference="capacity")[0] == 1
+    ok = Specimen.from_text(_edit("fill_percent = 50.0", f"fill_percent = {least}"))
+    assert describe(ok)["particles_per_cell"] == 1
+
+
+def test_a_table_material_with_other_inline_properties_is_refused():
+    acrylic = _edit('material = "steel"', 'material = "acrylic"')
+    with pytest.raises(ParameterError, match=r"\[particles\] density_kg_m3: 7850 differs "
+                                             r"from 1180 of material 'acrylic'.*another name"):
+        Specimen.from_text(acrylic)
+    wall = _edit('wall_material = "aluminium_wall"',
+                 'wall_material = "aluminium_wall"\nwall_youngs_modulus_pa = 200e9')
+    with pytest.raises(ParameterError, match=r"\[cell\] wall_youngs_modulus_pa: 2e\+11 differs"):
+        Specimen.from_text(wall)
+    # the table's own values inline are fine (the paper's file states them)
+    same = _edit("density_kg_m3 = 7850.0\nyoungs_modulus_pa = 200e9\npoisson_ratio = 0.29",
+                 "density_kg_m3 = 1180.0\nyoungs_modulus_pa = 2.84e9\npoisson_ratio = 0.402",
+                 acrylic)
+    assert Specimen.from_text(same).particles.density_kg_m3 == 1180.0
+    # a radius other than the table's default is the user's choice, not a conflict
+    assert Specimen.from_text(same).particles.radius_m == 1.0e-3
+
+
+def test_hash_covers_name_and_description_and_the_papers_is_unchanged():
+    # bundled runs are keyed by this hash: it must not move (so name/description stay in it)
+    assert paper_specimen().hash == PAPER_SHA256
+    assert paper_specimen().name == PAPER_SPECIMEN_NAME
+    steel = load_specimen(STEEL)
+    renamed = Specimen.from_text(_edit('description = "', 'description = "edited: '))
+    assert renamed.hash != steel.hash  # as README and `specimen check` now say
+
+
+def test_check_names_pairs_among_the_tables_and_says_what_the_hash_covers(tmp_path, capsys):
+    bad = tmp_path / "t.toml"
+    bad.write_text(TEXT + "\n[damping]\nfoo = 1\n", encoding="utf-8")
+    assert main(["specimen", "check", str(bad)]) == 2
+    assert "[particles], [pairs], [pairs.particle_particle]" in capsys.readouterr().err
+    assert main(["specimen", "check", str(STEEL)]) == 0
+    out = capsys.readouterr().out
+    assert "(of every value, name and description included)" in out
+
+
+def test_dem_run_cycles_0_names_the_option(capsys):
+    assert main(["dem", "run", "--frequency", "100", "--acceleration", "5", "--fill", "50",
+                 "--cycles", "0", "--no-progress"]) == 2
+    err = capsys.readouterr().err
+    assert "--cycles 0: expected a whole number >= 1" in err and "steady_cycles" not in err
