@@ -575,29 +575,46 @@ def _table_material(name: str, where: str, role: str | None):
     return row
 
 
-#: materials.csv columns that define a table material: inline values must equal them (a
-#: particle's radius is a default, free to differ).
-_TABLE_PROPERTIES = ("density_kg_m3", "youngs_modulus_pa", "poisson_ratio")
+#: (section, key, materials.csv column, attribute holding the material name) of each inline
+#: property that may differ from its table material's (:func:`table_overrides`; a particle's
+#: radius is only a default, free to differ).
+_OVERRIDABLE = (("particles", "density_kg_m3", "density_kg_m3", "material"),
+                ("particles", "youngs_modulus_pa", "youngs_modulus_pa", "material"),
+                ("particles", "poisson_ratio", "poisson_ratio", "material"),
+                ("cell", "wall_density_kg_m3", "density_kg_m3", "wall_material"),
+                ("cell", "wall_youngs_modulus_pa", "youngs_modulus_pa", "wall_material"),
+                ("cell", "wall_poisson_ratio", "poisson_ratio", "wall_material"))
+
+
+def table_overrides(specimen: Specimen) -> tuple[str, ...]:
+    """A note for each property that differs from its table material's row.
+
+    Kept, not refused: a calibration fits such fields (``--fit particles.youngs_modulus_pa``)
+    and a user may state a grade of a table material; but the name then claims one material
+    and the numbers another, so every output that shows the specimen says so.
+    """
+    notes = []
+    for section, key, column, name_key in _OVERRIDABLE:
+        part = getattr(specimen, section)
+        name = getattr(part, name_key)
+        row = _table_material(name, f"[{section}] {name_key}", None)
+        if row is None:
+            continue
+        value, listed = float(getattr(part, key)), float(getattr(row, column))
+        # relative 1e-9: the CSV and TOML float parsers may differ in the last digit
+        if not math.isclose(value, listed, rel_tol=1e-9):
+            notes.append(f"[{section}] {key} {value:g} overrides {listed:g} of table material "
+                         f"{name!r} (materials.csv): the numbers, not the name, are simulated")
+    return tuple(notes)
 
 
 def _complete_from_material(table: dict[str, Any], where: str, name: str, role: str | None,
                             columns: tuple[tuple[str, str], ...]) -> None:
     """Fill each key of ``columns`` (key, materials.csv column) that ``table`` does not state
     inline from material ``name``'s row; a key neither stated nor in the table is an error
-    naming ``where`` (the material key), and so is an inline property of a table material
-    that differs from the table's (the name would claim one material, the numbers another)."""
+    naming ``where`` (the material key)."""
     row = _table_material(name, where, role)
     for key, column in columns:
-        if row is not None and key in table and column in _TABLE_PROPERTIES:
-            listed = float(getattr(row, column))
-            # relative 1e-9: the CSV and TOML float parsers may differ in the last digit; a
-            # different material differs in the first few
-            if not math.isclose(table[key], listed, rel_tol=1e-9):
-                section = where.split(" ")[0]
-                raise ParameterError(
-                    f"{section} {key}: {table[key]:g} differs from {listed:g} of material "
-                    f"{name!r} in materials.csv; give your own material another name, or "
-                    "leave the key out to use the table's")
         if key not in table:
             if row is None:
                 raise ParameterError(
@@ -836,6 +853,7 @@ def describe(specimen: Specimen) -> dict[str, Any]:
                    for name, pair in (("pp", law.pair_particle), ("pw", law.pair_wall))}
     return {
         "name": specimen.name, "sha256": specimen.hash, "is_paper": specimen.is_paper(),
+        "notes": list(table_overrides(specimen)),
         "cell_shape": specimen.cell.shape, "cells_per_coupon": specimen.cell.count,
         "capacity_per_cell": capacity, "particles_per_cell": count,
         "particles_per_cell_basis": basis,

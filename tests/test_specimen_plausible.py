@@ -122,22 +122,34 @@ def test_a_fill_of_no_particle_is_refused_by_check_as_by_dem_run():
     assert describe(ok)["particles_per_cell"] == 1
 
 
-def test_a_table_material_with_other_inline_properties_is_refused():
-    acrylic = _edit('material = "steel"', 'material = "acrylic"')
-    with pytest.raises(ParameterError, match=r"\[particles\] density_kg_m3: 7850 differs "
-                                             r"from 1180 of material 'acrylic'.*another name"):
-        Specimen.from_text(acrylic)
-    wall = _edit('wall_material = "aluminium_wall"',
-                 'wall_material = "aluminium_wall"\nwall_youngs_modulus_pa = 200e9')
-    with pytest.raises(ParameterError, match=r"\[cell\] wall_youngs_modulus_pa: 2e\+11 differs"):
-        Specimen.from_text(wall)
-    # the table's own values inline are fine (the paper's file states them)
-    same = _edit("density_kg_m3 = 7850.0\nyoungs_modulus_pa = 200e9\npoisson_ratio = 0.29",
-                 "density_kg_m3 = 1180.0\nyoungs_modulus_pa = 2.84e9\npoisson_ratio = 0.402",
-                 acrylic)
-    assert Specimen.from_text(same).particles.density_kg_m3 == 1180.0
-    # a radius other than the table's default is the user's choice, not a conflict
-    assert Specimen.from_text(same).particles.radius_m == 1.0e-3
+def test_a_table_material_with_other_inline_properties_is_kept_and_said():
+    # kept (a calibration fits such fields, e.g. --fit particles.youngs_modulus_pa), but the
+    # name then claims one material and the numbers another: check and every run say so
+    from pidcore.calibrate.runner import specimen_with
+    from pidcore.specimen import table_overrides
+
+    acrylic = Specimen.from_text(_edit('material = "steel"', 'material = "acrylic"'))
+    assert acrylic.particles.density_kg_m3 == 7850.0  # the numbers are simulated
+    notes = describe(acrylic)["notes"]
+    assert any(n.startswith("[particles] density_kg_m3 7850 overrides 1180 of table material "
+                            "'acrylic'") for n in notes)
+    wall = Specimen.from_text(_edit('wall_material = "aluminium_wall"',
+                                    'wall_material = "aluminium_wall"\n'
+                                    'wall_youngs_modulus_pa = 200e9'))
+    assert any(n.startswith("[cell] wall_youngs_modulus_pa 2e+11 overrides")
+               for n in table_overrides(wall))
+    # the table's own values inline are no override (the paper's file states them)
+    same = Specimen.from_text(_edit(
+        "density_kg_m3 = 7850.0\nyoungs_modulus_pa = 200e9\npoisson_ratio = 0.29",
+        "density_kg_m3 = 1180.0\nyoungs_modulus_pa = 2.84e9\npoisson_ratio = 0.402",
+        _edit('material = "steel"', 'material = "acrylic"')))
+    assert table_overrides(same) == () and table_overrides(paper_specimen()) == ()
+    # a radius other than the table's default is the user's choice, not an override
+    assert same.particles.radius_m == 1.0e-3
+    # a calibration of a table material's modulus builds its specimen, and says what it did
+    fitted = specimen_with(paper_specimen(), {"particles.youngs_modulus_pa": 3.0e9})
+    assert [n.split(" overrides")[0] for n in table_overrides(fitted)] == [
+        "[particles] youngs_modulus_pa 3e+09"]
 
 
 def test_hash_covers_name_and_description_and_the_papers_is_unchanged():

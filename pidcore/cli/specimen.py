@@ -63,6 +63,7 @@ def format_facts(f: dict, source: str) -> str:
         f"contact time    {f['contact_time_s']:.4g} s at {f['reference_impact_speed_m_s']:.3g} "
         f"m/s (50 Hz, 10 g); stuck tangential period {f['tangential_period_s']:.4g} s",
         f"time step       {f['time_step_s']:.4g} s (auto, for that impact)",
+        *(f"note: {note}" for note in f["notes"]),
     ])
 
 

@@ -183,8 +183,11 @@ class DemResult:
         * the steady window measured is longer than asked (``config.steady_cycles``, else
           DEM_MIN_STEADY_CYCLES): the kernel runs whole blocks of ``config.block_cycles``
           cycles, and the two blocks that detect the steady state both belong to the window;
-        * ``particle_steps_per_s`` was not measured (NaN): every kernel call compiled code.
+        * ``particle_steps_per_s`` was not measured (NaN): every kernel call compiled code;
+        * a property of the specimen overrides its table material's
+          (:func:`pidcore.specimen.table_overrides`).
         """
+        from ..specimen import table_overrides
         from .simulate import required_steady_cycles
 
         notes = []
@@ -199,6 +202,8 @@ class DemResult:
         if not math.isfinite(self.particle_steps_per_s):
             notes.append("particle_steps_per_s not measured: every kernel call of this run "
                          "included Numba compilation (run again for the compiled speed)")
+        if self.specimen is not None:
+            notes += table_overrides(self.specimen)
         return tuple(notes)
 
     @property
