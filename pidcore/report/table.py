@@ -192,6 +192,7 @@ def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | N
         row.measured.append(entry)
 
     records = []
+    unconverged_rows = 0
     for row in (r for group in rows.values() for r in group):
         lc = row.case
         sdc_m = sdc_m_se = f_m = a_m = chi2_dof = math.nan
@@ -219,6 +220,9 @@ def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | N
                            if chi2_dof > 3 else ""))
         if row.dem is not None and row.dem.n_runs > 1:
             note.append(f"{row.dem.n_runs} DEM runs pooled")
+        if row.dem is not None and row.dem.not_converged:
+            note.append(_not_converged_note(row.dem))
+            unconverged_rows += 1
         if pool:
             note.append("pooled across specimens and DEM settings (--pool)")
         if row.measured and math.isfinite(row.sdc_dem) and not math.isfinite(sdc_m10):
@@ -253,8 +257,23 @@ def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | N
     table = pd.DataFrame.from_records(records, columns=list(REPORT_COLUMNS))
     table["DEM runs [-]"] = table["DEM runs [-]"].astype(int)
     table = _sort_like_table3(table, aligner, paper, tolerances)
+    if unconverged_rows:
+        notes.append(f"{unconverged_rows} row(s) rest on DEM runs that did not converge (no "
+                     "steady state before the transient cap): their DEM SDC may include the "
+                     "transient; see each row's note")
     table.attrs["notes"] = notes
     return table
+
+
+def _not_converged_note(dem: DemCase) -> str:
+    """The row note for a DEM case with runs whose steady state was never detected, in the
+    words ``pidcore dem run`` prints for such a run."""
+    runs = "; ".join(f"steady state from cycle {start} (NOT converged, transient cap), "
+                     f"{cycles} cycles measured" if start >= 0 and cycles >= 0
+                     else "steady state NOT converged (transient cap)"
+                     for start, cycles in dem.not_converged)
+    which = "DEM run" if dem.n_runs == 1 else f"{len(dem.not_converged)} of {dem.n_runs} DEM runs"
+    return f"{which} did not converge: {runs}; the DEM SDC may include the transient"
 
 
 def _snap(values: pd.Series, grid: np.ndarray, *, rtol: float = 0.0,
