@@ -188,6 +188,30 @@ def test_report_compares_runs_of_one_specimen_and_the_paper_only_for_its_coupon(
     assert mine["SDC DEM (paper) [-]"].isna().all()
 
 
+@pytest.mark.usefixtures("undrawn_report_figures")
+def test_report_notes_name_the_dem_runs_of_other_specimens(tmp_path):
+    """A store of another specimen's runs was reported as holding "no DEM runs"."""
+    from pidcore.report import make_report
+
+    store = tmp_path / "runs.h5"
+    own = paper_specimen().with_values({"coupon.fixture_mass_kg": 0.05, "cell.count": 400})
+    other = paper_specimen().with_values({"cell.count": 300})
+    run_or_load(store, None, CASE, TINY)
+    run_or_load(store, own, CASE, TINY)
+
+    none = make_report([], out_dir=tmp_path / "none", dem_store=store, formats="csv",
+                       specimen=other)
+    assert f"{store}: holds no DEM runs of specimen paper_coupon [{other.hash[:6]}] (2 run(s) " \
+           f"of other specimens: 1 of paper_coupon [{paper_specimen().hash[:6]}], 1 of " \
+           f"paper_coupon [{own.hash[:6]}])" in none.notes
+    assert not any(n.endswith("holds no DEM runs") for n in none.notes)
+    mine = make_report([], out_dir=tmp_path / "mine", dem_store=store, formats="csv",
+                       specimen=own)
+    assert f"{store}: 1 run(s) of other specimens: 1 of paper_coupon " \
+           f"[{paper_specimen().hash[:6]}]; not compared (the report is of specimen " \
+           f"paper_coupon [{own.hash[:6]}])" in mine.notes
+
+
 def test_static_and_rolling_friction_of_a_specimen_reach_the_kernel():
     sticky = paper_specimen().with_values({"pairs.particle_wall.static_friction": 0.5,
                                            "pairs.particle_particle.static_friction": 0.5,

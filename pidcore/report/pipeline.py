@@ -218,6 +218,26 @@ def _measured_loops(results: list[MeasuredResult], analyses: pd.DataFrame, store
     return loops
 
 
+def _other_specimens(stored: pd.DataFrame, kept: pd.DataFrame) -> str:
+    """"4 run(s) of other specimens: 3 of a [1b8b5d], 1 of b [b0826e]" for the runs of
+    ``stored`` not in ``kept``; "" if none. The hash is named too: an edited specimen file
+    keeps its name but is another specimen."""
+    left_out = stored[~stored["case_key"].isin(set(kept["case_key"]))]
+    if left_out.empty:
+        return ""
+
+    def column(name: str) -> pd.Series:
+        if name not in left_out.columns:
+            return pd.Series([""] * len(left_out), index=left_out.index)
+        return left_out[name].fillna("").astype(str)
+
+    labels = [f"{n or 'unnamed'} [{h[:6]}]" if h else (n or "unnamed")
+              for n, h in zip(column("specimen_name"), column("specimen_sha256"), strict=True)]
+    counts = pd.Series(labels).value_counts(sort=False)
+    return (f"{len(left_out)} run(s) of other specimens: "
+            + ", ".join(f"{n} of {label}" for label, n in counts.items()))
+
+
 def _figures(table: pd.DataFrame, dem_runs: pd.DataFrame | None, aligner: Aligner,
              loops: list[tuple[str, LoadCase, ForceDisplacementLoop]], dem_store,
              notes: list[str]) -> dict[str, object]:
@@ -357,11 +377,21 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
     if dem_runs is not None and not dem_runs.empty:
         from ..dem.persist import runs_of_specimen
 
-        dem_runs = runs_of_specimen(dem_runs, specimen)
+        stored = dem_runs
+        dem_runs = runs_of_specimen(stored, specimen)
+        others = _other_specimens(stored, dem_runs)
+        from ..specimen import paper_specimen
+
+        # the default takes the paper's coupon with either table material: no one hash
+        name = (f"{specimen.name} [{specimen.hash[:6]}]" if specimen is not None else
+                f"{paper_specimen().name} (the default; --specimen FILE for another)")
         if dem_runs.empty:
-            notes.append(f"{dem_path}: holds no DEM runs of specimen "
-                         f"{specimen.name if specimen is not None else 'paper_coupon'}")
-    if dem_runs is not None and dem_runs.empty:
+            notes.append(f"{dem_path}: holds no DEM runs of specimen {name} ({others})")
+            dem_runs = None
+        elif others:
+            notes.append(f"{dem_path}: {others}; not compared (the report is of specimen "
+                         f"{name})")
+    elif dem_runs is not None:
         notes.append(f"{dem_path}: holds no DEM runs")
         dem_runs = None
     paper = load_paper_table3()
