@@ -218,6 +218,18 @@ def _measured_loops(results: list[MeasuredResult], analyses: pd.DataFrame, store
     return loops
 
 
+def _specimen_provenance(specimen) -> list[tuple[str, str]]:
+    """(label, SHA-256) of the specimen(s) whose DEM runs a report compares."""
+    from ..constants import PARTICLE_MATERIALS
+    from ..specimen import paper_specimen
+
+    if specimen is not None:
+        return [(f"{specimen.name} ({specimen.source})", specimen.hash)]
+    # the default compares the paper's coupon with either of its particle materials
+    return [(f"{paper_specimen(m).name} (the default, {m} particles)", paper_specimen(m).hash)
+            for m in PARTICLE_MATERIALS]
+
+
 def _other_specimens(stored: pd.DataFrame, kept: pd.DataFrame) -> str:
     """"4 run(s) of other specimens: 3 of a [1b8b5d], 1 of b [b0826e]" for the runs of
     ``stored`` not in ``kept``; "" if none. The hash is named too: an edited specimen file
@@ -400,6 +412,10 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         notes.append(f"specimen {specimen.name} is not the paper's coupon: the paper's "
                      "Table 3 is not compared")
     table = build_report_table(dem_runs, analyses, paper, tolerances=tolerances, pool=pool)
+    if specimen is not None and not pool:
+        # every DEM row is this specimen's (runs_of_specimen) and the files are its tests; a
+        # measurement stored with a specimen of its own (the app's uploads) keeps that one
+        table["specimen"] = table["specimen"].mask(table["specimen"] == "", specimen.name)
     if calibrated is not None:
         table = add_calibration_columns(table, calibrated, tolerances=tolerances)
     notes.extend(table.attrs.get("notes", []))
@@ -422,7 +438,7 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
                         "fill_atol_percent": tolerances.fill_atol_percent},
             seeds=seeds, inputs=[r.path for r in results],
             input_hashes={str(r.path): getattr(r.measurement, "sha256", "") for r in results},
-            stores=stores, notes=notes)
+            stores=stores, notes=notes, specimens=_specimen_provenance(specimen))
         paths = write_report(table, figures, provenance, out_dir, formats)
     finally:
         for fig in figures.values():  # bare Figures: drop references to free Agg buffers
