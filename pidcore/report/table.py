@@ -328,15 +328,17 @@ CALIBRATION_COLUMNS: tuple[str, ...] = (CALIBRATED_COLUMN, CALIBRATED_LOW_COLUMN
 
 
 def add_calibration_columns(table: pd.DataFrame, calibration, *,
-                            tolerances=None) -> pd.DataFrame:
+                            tolerances=None, specimen=None) -> pd.DataFrame:
     """A copy of a report table with the calibrated DEM's prediction beside each row.
 
     Like for like: the calibration predicts the Eq. 11 SDC a shaker test of the DEM would
     measure, so the band is compared with ``SDC measured [-]`` (Eq. 11), not with Eq. 10.
     Rows whose load case the calibration does not predict (material, and frequency,
     acceleration, fill within ``tolerances``) get empty numbers, ``not compared`` and a note
-    saying so. The table's notes (``attrs["notes"]``) gain one that counts the predicted rows
-    and the measured rows inside the band.
+    saying so and why (:meth:`~pidcore.calibrate.prediction.Calibration.why_not_predicted`:
+    another specimen, another material, outside its range, not a calibrated load case). The
+    table's notes (``attrs["notes"]``) gain one that counts the predicted rows and the
+    measured rows inside the band.
 
     Parameters
     ----------
@@ -346,6 +348,8 @@ def add_calibration_columns(table: pd.DataFrame, calibration, *,
         From :func:`pidcore.calibrate.prediction.load_calibration`.
     tolerances : Tolerances, optional
         Grid-match tolerances (default: the report's).
+    specimen : pidcore.specimen.Specimen, optional
+        The specimen the table is of, checked against the calibration's (unchecked if None).
     """
     out = table.copy()
     sdc, low, high, inside, notes = [], [], [], [], []
@@ -359,7 +363,8 @@ def add_calibration_columns(table: pd.DataFrame, calibration, *,
             low.append(math.nan)
             high.append(math.nan)
             inside.append(NOT_COMPARED)
-            extra = f"not predicted by the calibration {calibration.path.name}"
+            why = calibration.why_not_predicted(case, specimen=specimen, tolerances=tolerances)
+            extra = f"not predicted by the calibration {calibration.path.name}: {why}"
         else:
             sdc.append(hit.sdc)
             low.append(hit.low95)
