@@ -35,6 +35,13 @@ def test_damper_writes_the_paper_grid(tmp_path):
     doc = json.loads((tmp_path / "equivalent_damper.json").read_text())
     assert len(doc["records"]) == 48
     assert doc["provenance"]["filled_grid_points"][0]["frequency_hz"] == 1000.0
+    # the flag reads back as bool under its bracketed name, in the CSV as in the JSON
+    assert table["sdc_filled [True/False]"].dtype == bool
+    flagged = table[table["sdc_filled [True/False]"]]
+    assert flagged[["frequency [Hz]", "acceleration [g]", "fill [%]"]].values.tolist() == [
+        [1000.0, 1.0, 90.0]]
+    assert doc["units"]["sdc_filled [True/False]"] == "True/False"
+    assert sum(r["sdc_filled [True/False]"] is True for r in doc["records"]) == 1
 
 
 def test_damper_options(tmp_path):

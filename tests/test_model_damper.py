@@ -13,6 +13,7 @@ from pidcore.constants import STANDARD_GRAVITY
 from pidcore.errors import ParameterError
 from pidcore.model import (
     DAMPER_COLUMNS,
+    SDC_FILLED_COLUMN,
     SdcModel,
     coupon_vibrated_mass_kg,
     damping_ratio,
@@ -107,12 +108,14 @@ def test_damper_table_content(model):
                                 frequencies=[100, 1000], vibrated_mass_kg=mass)
     assert list(t.columns) == list(DAMPER_COLUMNS)
     assert len(t) == 8
-    # every number column names its unit; the True/False flag has none to name
+    # every column names its unit; the flag's brackets name its values, as the report's
+    # category columns do (it had no brackets: the one column without a unit marker)
     for column, unit in DAMPER_COLUMNS.items():
+        assert column.endswith(f" [{unit}]"), column
         if pd.api.types.is_bool_dtype(t[column]):
-            assert "[" not in column and unit == "", column
+            assert column == SDC_FILLED_COLUMN and unit == "True/False"
         else:
-            assert pd.api.types.is_float_dtype(t[column]) and column.endswith(f" [{unit}]")
+            assert pd.api.types.is_float_dtype(t[column])
     sdc = model(t["fill [%]"].to_numpy(), t["acceleration [g]"].to_numpy(),
                 t["frequency [Hz]"].to_numpy())
     np.testing.assert_array_equal(t["sdc [-]"], sdc)
@@ -125,7 +128,7 @@ def test_damper_table_content(model):
     # c_eq = dE / (pi w X^2) by definition of the equivalent damper
     np.testing.assert_allclose(t["c_eq [N s/m]"], t["energy_per_cycle [J]"] / (np.pi * w * x**2),
                                rtol=1e-13)
-    flagged = t[t["sdc_filled"]]
+    flagged = t[t[SDC_FILLED_COLUMN]]
     assert flagged[["fill [%]", "acceleration [g]", "frequency [Hz]"]].values.tolist() == [
         [90.0, 1.0, 1000.0]]
 

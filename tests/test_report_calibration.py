@@ -168,3 +168,51 @@ def test_bundled_calibration_predicts_the_paper_points():
                                   row.material))
         assert hit is not None and hit.measured == pytest.approx(row.sdc)
     assert cal.specimen_path is not None and cal.specimen_path.is_file()
+
+
+def test_not_predicted_rows_say_why(calibration_file):
+    """The note said only "not predicted by the calibration X" (README: "and why")."""
+    table = pd.DataFrame({
+        "frequency [Hz]": [1000.0, 50.0, 100.0, 100.0],
+        "acceleration [g]": [5.0, 5.0, 5.0, 1.0],
+        "packing ratio [%]": [50.0, 75.0, 50.0, 50.0],
+        "material": ["acrylic", "acrylic", "acrylic", "aluminium"],
+        "SDC measured [-]": [math.nan] * 4, "SDC measured stderr [-]": [math.nan] * 4,
+        "note": [""] * 4})
+    notes = add_calibration_columns(table, load_calibration(calibration_file))["note"].tolist()
+    head = "not predicted by the calibration calibration.json: "
+    # acrylic predictions at 50 and 500 Hz, 5 g, 50 % (1 % / 5 % / 0.5 points tolerances)
+    assert notes == [
+        head + "outside its calibrated range (frequency 1000 Hz not in its 50-500 Hz)",
+        head + "outside its calibrated range (fill 75 % not in its 50 %)",
+        head + "not one of its 2 calibrated acrylic load cases (it predicts only where it was "
+               "fitted)",
+        head + "it calibrates acrylic and steel particles, not aluminium"]
+
+
+def test_not_predicted_rows_name_another_specimen(calibration_file):
+    from pidcore.specimen import paper_specimen
+
+    paper = paper_specimen()
+    calibrated = paper.with_values({"coupon.fixture_mass_kg": 0.25})
+    (calibration_file.parent / "calibrated_specimen.toml").write_text(
+        calibrated.to_toml().replace('name = "paper_coupon"', 'name = "paper_coupon_calibrated"'))
+    cal = load_calibration(calibration_file)
+    assert cal.calibrated_specimen().name == "paper_coupon_calibrated"
+    table = _table().iloc[[2]]  # 1000 Hz: outside the range too, the specimen comes first
+    own = paper.with_values({"cell.inscribed_diameter_m": 6.35e-3})
+    renamed = own.to_toml().replace('name = "paper_coupon"', 'name = "hc635"')
+    from pidcore.specimen import Specimen
+
+    def note(specimen):
+        return add_calibration_columns(table, cal, specimen=specimen)["note"].iloc[0]
+
+    assert note(Specimen.from_text(renamed)).endswith(
+        ": it calibrates specimen paper_coupon, not hc635")
+    assert note(own).endswith(": it calibrates another specimen named paper_coupon (its cell "
+                              "differ)")
+    # its own specimen, before or after calibration: the other reasons only
+    as_file = Specimen.from_text(cal.specimen_path.read_text())  # README: use it as --specimen
+    for same in (paper, calibrated, as_file):
+        assert note(same).endswith(": outside its calibrated range (frequency 1000 Hz not in "
+                                   "its 50-500 Hz)")

@@ -89,12 +89,64 @@ def test_sdc_comparison_plots_the_table_values():
     table = build_report_table(dem, analyses, None)
     fig = plot_sdc_comparison(table)
     ax = fig.axes[0]
-    measured = table[np.isfinite(table["SDC measured [-]"])]
-    assert len(ax.get_xticks()) == len(measured) == 2
+    # every row has a value: 8 DEM rows (one shared with the 50.1 Hz measurement) + 75 Hz
+    assert len(table) == 9
+    assert len(ax.get_xticks()) == len(table)
     by_label = {ln.get_label(): ln for ln in ax.get_lines()}
     interp = by_label["DEM (ours), SDC of Eq. 10 E, pchip-interpolated"].get_ydata()
-    assert list(interp) == list(measured.loc[measured[ALIGNMENT_COLUMN] == "interpolated",
-                                             "SDC DEM (ours) [-]"])
+    assert list(interp) == list(table.loc[table[ALIGNMENT_COLUMN] == "interpolated",
+                                          "SDC DEM (ours) [-]"])
+
+
+def _own_specimen_table():
+    """As an own specimen's report: steel DEM runs at 3 load cases, no paper, and one measured
+    row the DEM does not cover (acrylic: out of range), which alone has an Eq. 11 value."""
+    dem = pd.DataFrame({"frequency_hz": [100.0, 200.0, 500.0], "acceleration_g": [5.0, 5.0, 1.0],
+                        "fill_percent": [40.0] * 3, "material": ["steel_440c"] * 3,
+                        "direction": ["z"] * 3, "sdc": [1.09, 0.93, 0.0059],
+                        "sdc_stderr": [0.03, 0.04, 0.0002]})
+    analyses = pd.DataFrame({"frequency_hz": [500.0], "acceleration_g": [1.0],
+                             "fill_percent": [40.0], "sdc": [1.135], "sdc_stderr": [0.003],
+                             "source": ["run_200Hz.csv"]})
+    return build_report_table(dem, analyses, None)
+
+
+def test_sdc_comparison_draws_every_row_under_its_tick_with_only_drawn_legend():
+    """The own-specimen figure the trial found: the DEM-only rows were dropped once a row was
+    measured, the legend named the paper's series and an interpolation never drawn, and the
+    one tick sat at the left edge while its marker sat at the right one."""
+    table = _own_specimen_table()
+    ax = plot_sdc_comparison(table).axes[0]
+    assert len(table) == 4
+    ticks = ax.get_xticks()
+    assert list(ticks) == [0.0, 1.0, 2.0, 3.0]
+    labels = [t.get_text() for t in ax.get_xticklabels()]
+    # same frequency, acceleration and fill, different material: the ticks must differ
+    assert len(set(labels)) == 4 and "acrylic" in labels[2] and "steel_440c" in labels[3]
+    _, legend = ax.get_legend_handles_labels()
+    assert not [lb for lb in legend if "paper" in lb or "pchip" in lb]
+    assert sorted(lb.split(",")[0] for lb in legend) == ["DEM (ours)", "measured (ours)"]
+    lo, hi = ax.get_xlim()
+    # half a category either side: every marker (at most 2 x 0.15 off its tick) lies inside
+    # its own category, and so closer to its tick than to any other
+    assert (lo, hi) == (-0.5, 3.5)
+    for container in ax.containers:
+        for x in container.lines[0].get_xdata():
+            assert min(abs(ticks - x)) <= 0.3
+
+
+def test_sdc_comparison_wraps_long_tables_onto_panels():
+    from pidcore.report.comparison_figures import SDC_FIGURE_ROWS_PER_PANEL
+
+    n = 2 * SDC_FIGURE_ROWS_PER_PANEL + 3
+    dem = pd.DataFrame({"frequency_hz": np.arange(1.0, n + 1) * 10, "acceleration_g": [5.0] * n,
+                        "fill_percent": [50.0] * n, "material": ["acrylic"] * n,
+                        "direction": ["z"] * n, "sdc": np.linspace(0.1, 1.0, n),
+                        "sdc_stderr": [0.01] * n})
+    fig = plot_sdc_comparison(build_report_table(dem, None, None))
+    assert len(fig.axes) == 3
+    assert sum(len(a.get_xticks()) for a in fig.axes) == n
+    assert all(len(a.get_xticks()) <= SDC_FIGURE_ROWS_PER_PANEL for a in fig.axes)
 
 
 def test_loop_from_stored_phasors_equals_the_analysis_loop(dem_arrays):

@@ -235,6 +235,69 @@ def test_a_measurement_of_an_own_specimen_meets_its_dem_run_in_the_report(tmp_pa
     assert table["SDC DEM (ours) [-]"].isna().all()
 
 
+@pytest.fixture(scope="module")
+def two_specimen_store(tmp_path_factory):
+    """A store with one run of the paper's coupon and one of an own specimen (same name, other
+    coupon: another hash), and that own specimen's file."""
+    from types import SimpleNamespace
+
+    where = tmp_path_factory.mktemp("two_specimens")
+    own = paper_specimen().with_values({"coupon.fixture_mass_kg": 0.05, "cell.count": 400})
+    own_file = where / "own.toml"
+    own_file.write_text(own.to_toml())
+    run_or_load(where / "runs.h5", None, CASE, TINY)
+    run_or_load(where / "runs.h5", own, CASE, TINY)
+    return SimpleNamespace(store=where / "runs.h5", own=own, own_file=own_file)
+
+
+@pytest.mark.usefixtures("undrawn_report_figures")
+def test_report_notes_name_the_dem_runs_of_other_specimens(tmp_path, two_specimen_store):
+    """A store of another specimen's runs was reported as holding "no DEM runs"."""
+    from pidcore.report import make_report
+
+    store, own = two_specimen_store.store, two_specimen_store.own
+    other = paper_specimen().with_values({"cell.count": 300})
+    none = make_report([], out_dir=tmp_path / "none", dem_store=store, formats="csv",
+                       specimen=other)
+    assert f"{store}: holds no DEM runs of specimen paper_coupon [{other.hash[:6]}] (2 run(s) " \
+           f"of other specimens: 1 of paper_coupon [{paper_specimen().hash[:6]}], 1 of " \
+           f"paper_coupon [{own.hash[:6]}])" in none.notes
+    assert not any(n.endswith("holds no DEM runs") for n in none.notes)
+    mine = make_report([], out_dir=tmp_path / "mine", dem_store=store, formats="csv",
+                       specimen=own)
+    assert f"{store}: 1 run(s) of other specimens: 1 of paper_coupon " \
+           f"[{paper_specimen().hash[:6]}]; not compared (the report is of specimen " \
+           f"paper_coupon [{own.hash[:6]}])" in mine.notes
+
+
+@pytest.mark.usefixtures("undrawn_report_figures")
+def test_report_names_its_specimen_in_the_table_and_its_hash_in_the_provenance(
+        tmp_path, capsys, two_specimen_store):
+    """With --specimen the CSV's specimen column was empty and the provenance had no hash of
+    the specimen whose runs were compared."""
+    import pandas as pd
+
+    own, out = two_specimen_store.own, tmp_path / "rep"
+    assert main(["report", "--dem-store", str(two_specimen_store.store), "--specimen",
+                 str(two_specimen_store.own_file), "--out", str(out), "--format", "csv"]) == 0
+    capsys.readouterr()
+    table = pd.read_csv(out / "report.csv", comment="#", keep_default_na=False)
+    assert table["specimen"].tolist() == [own.name]
+    provenance = (out / "report.provenance.txt").read_text(encoding="utf-8").splitlines()
+    assert f"specimen: {own.name} ({two_specimen_store.own_file}) sha256 {own.hash}" \
+        in provenance
+    # the default names the paper's coupon (either particle material), the CSV column stays
+    # empty: the bundled report's CSV is unchanged
+    default = tmp_path / "default"
+    assert main(["report", "--dem-store", str(two_specimen_store.store), "--out", str(default),
+                 "--format", "csv"]) == 0
+    capsys.readouterr()
+    text = (default / "report.provenance.txt").read_text(encoding="utf-8")
+    assert f"specimen: paper_coupon (the default, acrylic particles) sha256 " \
+           f"{paper_specimen('acrylic').hash}" in text
+    assert pd.read_csv(default / "report.csv", keep_default_na=False)["specimen"].tolist() == [""]
+
+
 def test_static_and_rolling_friction_of_a_specimen_reach_the_kernel():
     sticky = paper_specimen().with_values({"pairs.particle_wall.static_friction": 0.5,
                                            "pairs.particle_particle.static_friction": 0.5,

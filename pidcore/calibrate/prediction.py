@@ -84,6 +84,80 @@ class Calibration:
                                         abs(p.load_case.acceleration_g - case.acceleration_g),
                                         abs(p.load_case.fill_percent - case.fill_percent)))
 
+    def calibrated_specimen(self):
+        """The specimen file beside the calibration (:attr:`specimen_path`), or None where
+        there is none or it cannot be read (then which specimen it calibrates is unknown)."""
+        from ..errors import PidcoreError
+        from ..specimen import load_specimen
+
+        if self.specimen_path is None:
+            return None
+        try:
+            return load_specimen(self.specimen_path)
+        except (PidcoreError, OSError):
+            return None
+
+    def why_not_predicted(self, case: LoadCase, *, specimen=None,
+                          tolerances: Tolerances | None = None) -> str:
+        """Why :meth:`lookup` finds no prediction at ``case``: another specimen, another
+        particle material, outside the calibrated range, or not one of the calibrated load
+        cases (it predicts only where it was fitted).
+
+        Parameters
+        ----------
+        case : LoadCase
+        specimen : pidcore.specimen.Specimen, optional
+            The specimen the row is of; the specimen check is skipped without it, or where the
+            calibration's own specimen is unknown (:meth:`calibrated_specimen`).
+        tolerances : Tolerances, optional
+            As for :meth:`lookup`.
+        """
+        tolerances = tolerances or Tolerances()
+        other = _other_specimen(self.calibrated_specimen(), specimen)
+        if other:
+            return other
+        materials = sorted({p.load_case.material for p in self.predictions})
+        if case.material not in materials:
+            return f"it calibrates {' and '.join(materials)} particles, not {case.material}"
+        same = [p.load_case for p in self.predictions if p.load_case.material == case.material]
+        outside = []
+        for name, unit, attr, slack in (
+                ("frequency", "Hz", "frequency_hz", lambda v: tolerances.frequency_rtol * v),
+                ("acceleration", "g", "acceleration_g",
+                 lambda v: tolerances.acceleration_rtol * v),
+                ("fill", "%", "fill_percent", lambda v: tolerances.fill_atol_percent)):
+            lo = min(getattr(c, attr) for c in same)
+            hi = max(getattr(c, attr) for c in same)
+            value = getattr(case, attr)
+            if value < lo - slack(lo) or value > hi + slack(hi):
+                span = f"{lo:g} {unit}" if lo == hi else f"{lo:g}-{hi:g} {unit}"
+                outside.append(f"{name} {value:.4g} {unit} not in its {span}")
+        if outside:
+            return "outside its calibrated range (" + "; ".join(outside) + ")"
+        return (f"not one of its {len(same)} calibrated {case.material} load cases (it predicts "
+                "only where it was fitted)")
+
+
+def _other_specimen(calibrated, specimen) -> str:
+    """Why a calibration of ``calibrated`` (its calibrated specimen file) does not speak for
+    ``specimen``; "" where it does, or where either is unknown."""
+    if calibrated is None or specimen is None:
+        return ""
+    # the calibrated file is the starting specimen renamed "<name>_calibrated" with fitted
+    # contact, coupon or mass values: the cell and the particles say which specimen it is
+    base = calibrated.name.removesuffix("_calibrated")
+    names = {calibrated.name, base}
+    shape = ("shape", "inscribed_diameter_m", "height_m")
+    same_cell = all(getattr(calibrated.cell, a) == getattr(specimen.cell, a) for a in shape)
+    same_particles = (calibrated.particles.material == specimen.particles.material
+                      and calibrated.particles.radius_m == specimen.particles.radius_m)
+    if specimen.name not in names:
+        return f"it calibrates specimen {base}, not {specimen.name}"
+    if not (same_cell and same_particles):
+        what = "cell" if not same_cell else "particles"
+        return f"it calibrates another specimen named {base} (its {what} differ)"
+    return ""
+
 
 def _number(value, what: str, path: Path) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)) \

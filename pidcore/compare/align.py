@@ -122,6 +122,11 @@ class DemCase:
     cells_simulated : float
         Cells simulated per run (NaN if unknown); the preferred case of several settings at one
         load case is the one with the most cells.
+    not_converged : tuple of (int, int)
+        ``(steady_start_cycle, steady_cycles)`` of each run whose steady state was never
+        detected (``steady_detected`` false: measured from the transient cap, as ``pidcore dem
+        run`` prints "NOT converged, transient cap"); empty where every run converged or the
+        runs do not record it.
     """
 
     load_case: LoadCase
@@ -133,6 +138,7 @@ class DemCase:
     vibrated_mass_kg: float = math.nan
     settings: str = ""
     cells_simulated: float = math.nan
+    not_converged: tuple[tuple[int, int], ...] = ()
 
 
 @dataclass(frozen=True)
@@ -341,8 +347,28 @@ def dem_cases(dem_runs: pd.DataFrame, *, tolerances: Tolerances | None = None,
         mass_column = next((c for c in ("vibrated_mass_kg", "m_c_kg") if c in sub), None)
         m_c = float(sub[mass_column].astype(float).mean()) if mass_column else math.nan
         out.append(DemCase(case, sdc, stderr, len(members), ppc, keys, m_c, settings,
-                           cells_of.get(settings, math.nan)))
+                           cells_of.get(settings, math.nan), _not_converged(sub)))
     return sorted(out, key=lambda c: (*_sort_key(c.load_case), c.settings))
+
+
+def _not_converged(runs: pd.DataFrame) -> tuple[tuple[int, int], ...]:
+    """(steady_start_cycle, steady_cycles) of the runs that state steady_detected false."""
+    if "steady_detected" not in runs:
+        return ()
+    out = []
+    for _, run in runs.iterrows():
+        detected = run["steady_detected"]
+        # None/NaN: a run that does not say (older stores); only a stated False is flagged
+        if detected is None or (isinstance(detected, float) and math.isnan(detected)) \
+                or bool(detected):
+            continue
+        start, cycles = (run.get(name) for name in ("steady_start_cycle", "steady_cycles"))
+        out.append((int(start) if _finite(start) else -1, int(cycles) if _finite(cycles) else -1))
+    return tuple(out)
+
+
+def _finite(value) -> bool:
+    return isinstance(value, int | float | np.integer | np.floating) and math.isfinite(value)
 
 
 def _sort_key(case: LoadCase) -> tuple:

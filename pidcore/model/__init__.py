@@ -7,6 +7,7 @@ response of a structure treated with it (:mod:`.response`).
 
 from .damper import (
     DAMPER_COLUMNS,
+    SDC_FILLED_COLUMN,
     coupon_area_m2,
     coupon_vibrated_mass_kg,
     damping_ratio,
@@ -32,7 +33,8 @@ from .sdc_model import AXIS_NAMES, DEM_CONDITION_COLUMNS, SdcModel, select_runs
 from .table3 import TABLE3_COLUMNS, load_paper_table3
 
 __all__ = [
-    "AXIS_NAMES", "DAMPER_COLUMNS", "DEM_CONDITION_COLUMNS", "HarmonicResponse", "SdcModel",
+    "AXIS_NAMES", "DAMPER_COLUMNS", "DEM_CONDITION_COLUMNS", "HarmonicResponse",
+    "SDC_FILLED_COLUMN", "SdcModel",
     "TABLE3_COLUMNS", "TimeDomainSteadyState", "TreatedMode", "coupon_area_m2",
     "coupon_vibrated_mass_kg", "damping_ratio", "displacement_amplitude", "energy_per_cycle",
     "equivalent_damper_table", "equivalent_damping_coefficient", "harmonic_response",

@@ -34,14 +34,18 @@ from ..constants import STANDARD_GRAVITY
 from ..errors import ParameterError
 from .sdc_model import SdcModel
 
-#: Output columns of :func:`equivalent_damper_table` and their units. Every number column names
-#: its unit in brackets; ``sdc_filled`` is a True/False flag, so it has neither (unit ``""``).
+#: The flag of :func:`equivalent_damper_table` marking points at a filled hole of the model grid.
+#: Like the report's category columns (``alignment [grid/interpolated/out_of_range]``) its
+#: brackets list the values it takes, as pandas writes and reads them back (bool).
+SDC_FILLED_COLUMN = "sdc_filled [True/False]"
+#: Output columns of :func:`equivalent_damper_table` and their units, each named in the
+#: column's brackets (the flag's "unit" is its values).
 DAMPER_COLUMNS: dict[str, str] = {
     "frequency [Hz]": "Hz",
     "acceleration [g]": "g",
     "fill [%]": "%",
     "sdc [-]": "-",
-    "sdc_filled": "",
+    SDC_FILLED_COLUMN: "True/False",
     "loss_factor [-]": "-",
     "damping_ratio [-]": "-",
     "vibrated_mass [kg]": "kg",
@@ -222,9 +226,8 @@ def equivalent_damper_table(model: SdcModel, *, fills: Sequence[float],
     Returns
     -------
     pandas.DataFrame
-        Columns :data:`DAMPER_COLUMNS` (number columns name their units); ``sdc_filled`` (a
-        bool flag, no unit) is True where the point coincides with a filled hole of the model
-        grid.
+        Columns :data:`DAMPER_COLUMNS` (each names its unit); :data:`SDC_FILLED_COLUMN` (a
+        bool flag) is True where the point coincides with a filled hole of the model grid.
     """
     grid = pd.MultiIndex.from_product(
         [np.asarray(frequencies, float), np.asarray(accelerations, float),
@@ -252,7 +255,7 @@ def equivalent_damper_table(model: SdcModel, *, fills: Sequence[float],
         "acceleration [g]": a_g,
         "fill [%]": p,
         "sdc [-]": sdc,
-        "sdc_filled": filled,
+        SDC_FILLED_COLUMN: filled,
         "loss_factor [-]": loss_factor(sdc),
         "damping_ratio [-]": damping_ratio(sdc),
         "vibrated_mass [kg]": mass,

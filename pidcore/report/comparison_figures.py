@@ -38,6 +38,14 @@ def _new_figure(width: float, height: float):
     return Figure(figsize=(width, height), layout="constrained")
 
 
+#: Most load cases on one panel of the SDC-per-load-case figure; more wrap onto further panels.
+SDC_FIGURE_ROWS_PER_PANEL = 16
+#: Table columns the SDC-per-load-case figure draws: a row with a finite value in any is drawn.
+_DRAWN_COLUMNS: tuple[str, ...] = (MEASURED_EQ10_COLUMN, "SDC DEM (ours) [-]",
+                                   "SDC DEM (paper) [-]", "SDC measured (paper) [-]",
+                                   "SDC measured [-]")
+
+
 def plot_sdc_comparison(table: pd.DataFrame, *, ax=None):
     """SDC per load case: measured, our DEM and the paper's values side by side.
 
@@ -51,8 +59,10 @@ def plot_sdc_comparison(table: pd.DataFrame, *, ax=None):
     Parameters
     ----------
     table : pandas.DataFrame
-        The report table (:func:`pidcore.report.build_report_table`). Rows with a measured
-        value are drawn; if there is none, every row is.
+        The report table (:func:`pidcore.report.build_report_table`). Every row with a value
+        to draw (measured, our DEM, the paper's) is drawn, in the table's order; a series with
+        no value in any row is left out, and so is its legend entry. More rows than
+        :data:`SDC_FIGURE_ROWS_PER_PANEL` wrap onto panels stacked below (not with ``ax``).
     ax : matplotlib Axes, optional
 
     Returns
@@ -63,39 +73,70 @@ def plot_sdc_comparison(table: pd.DataFrame, *, ax=None):
         single record, the pooled relative error for several). Interpolated DEM values are drawn
         as open markers without error bars (the model carries none).
     """
-    rows = table[np.isfinite(table["SDC measured [-]"].astype(float))]
-    if rows.empty:
-        rows = table
-    n = len(rows)
-    if ax is None:
-        fig = _new_figure(max(6.4, 0.65 * n + 2.0) + 3.6, 4.2)
-        ax = fig.subplots()
+    drawn = np.column_stack([table[c].astype(float).to_numpy() for c in _DRAWN_COLUMNS])
+    rows = table[np.isfinite(drawn).any(axis=1)]
+    # the material only where rows differ in it: else two ticks could read the same
+    # (an acrylic measurement beside a steel DEM run at one frequency, acceleration and fill)
+    several = "material" in rows and rows["material"].nunique() > 1
+    if ax is not None:
+        _draw_sdc_rows(ax, rows, several)
+        axes = [ax]
     else:
-        fig = ax.figure
+        # the paper's 48 load cases in one row of ticks made a 37-inch strip, unreadable in the
+        # HTML and PDF: long tables wrap onto panels of at most SDC_FIGURE_ROWS_PER_PANEL
+        n_panels = max(1, -(-len(rows) // SDC_FIGURE_ROWS_PER_PANEL))
+        per_panel = -(-len(rows) // n_panels) if len(rows) else 0
+        fig = _new_figure(max(6.4, 0.65 * per_panel + 2.0) + 3.6, 4.2 * n_panels)
+        axes = list(fig.subplots(n_panels, 1, squeeze=False)[:, 0])
+        for i, panel in enumerate(axes):
+            _draw_sdc_rows(panel, rows.iloc[i * per_panel:(i + 1) * per_panel], several)
+    axes[0].set_title("SDC per load case (ours: dissipated energy over Eq. 10's E)")
+    handles: dict[str, object] = {}
+    for panel in axes:  # a series may be drawn on a later panel only
+        for handle, label in zip(*panel.get_legend_handles_labels(), strict=True):
+            handles.setdefault(label, handle)
+    # outside the axes: six long entries would hide the markers they describe
+    if handles:
+        axes[0].legend(list(handles.values()), list(handles), fontsize="small",
+                       loc="upper left", bbox_to_anchor=(1.01, 1.0))
+    return axes[0].figure
+
+
+def _draw_sdc_rows(ax, rows: pd.DataFrame, several_materials: bool) -> None:
+    """One panel of :func:`plot_sdc_comparison`: a tick per row, the row's values beside it."""
+    n = len(rows)
     x = np.arange(n, dtype=float)
     width = 0.15
     labels = [f"{r['frequency [Hz]']:.4g} Hz\n{r['acceleration [g]']:.3g} g\n"
-              f"{r['packing ratio [%]']:.3g} %" for _, r in rows.iterrows()]
+              f"{r['packing ratio [%]']:.3g} %"
+              + (f"\n{r['material']}" if several_materials else "")
+              for _, r in rows.iterrows()]
     sdc11 = rows["SDC measured [-]"].astype(float).to_numpy()
     sdc11_se = rows["SDC measured stderr [-]"].astype(float).to_numpy()
     sdc10 = rows[MEASURED_EQ10_COLUMN].astype(float).to_numpy()
     with np.errstate(divide="ignore", invalid="ignore"):
         sdc10_se = sdc11_se * sdc10 / sdc11
     has10 = np.isfinite(sdc10)
+    # a series without a finite value is not drawn, so the legend names only what is drawn
     if has10.any():
         ax.errorbar(x[has10] - 2 * width, sdc10[has10], yerr=sdc10_se[has10], fmt="o",
                     color="C0", capsize=3, label="measured (ours), SDC of Eq. 10 E ± SE")
-    on_grid = (rows[ALIGNMENT_COLUMN] == "grid").to_numpy()
-    ax.errorbar(x[on_grid] - width, rows["SDC DEM (ours) [-]"][on_grid],
-                yerr=rows["SDC DEM stderr [-]"][on_grid], fmt="s", color="C1", capsize=3,
-                label="DEM (ours), SDC of Eq. 10 E ± SE")
-    if (~on_grid).any():
-        ax.plot(x[~on_grid] - width, rows["SDC DEM (ours) [-]"][~on_grid], "s",
-                markerfacecolor="none", color="C1",
-                label="DEM (ours), SDC of Eq. 10 E, pchip-interpolated")
-    ax.plot(x, rows["SDC DEM (paper) [-]"], "D", color="C2", label="DEM (paper)")
-    ax.plot(x + width, rows["SDC measured (paper) [-]"], "^", color="C3",
-            label="measured (paper)")
+    ours = rows["SDC DEM (ours) [-]"].astype(float).to_numpy()
+    ours_se = rows["SDC DEM stderr [-]"].astype(float).to_numpy()
+    on_grid = (rows[ALIGNMENT_COLUMN] == "grid").to_numpy() & np.isfinite(ours)
+    if on_grid.any():
+        ax.errorbar(x[on_grid] - width, ours[on_grid], yerr=ours_se[on_grid], fmt="s",
+                    color="C1", capsize=3, label="DEM (ours), SDC of Eq. 10 E ± SE")
+    interpolated = ~on_grid & np.isfinite(ours)
+    if interpolated.any():
+        ax.plot(x[interpolated] - width, ours[interpolated], "s", markerfacecolor="none",
+                color="C1", label="DEM (ours), SDC of Eq. 10 E, pchip-interpolated")
+    for offset, column, marker, color, label in (
+            (0.0, "SDC DEM (paper) [-]", "D", "C2", "DEM (paper)"),
+            (width, "SDC measured (paper) [-]", "^", "C3", "measured (paper)")):
+        values = rows[column].astype(float).to_numpy()
+        if np.isfinite(values).any():
+            ax.plot(x + offset, values, marker, color=color, label=label)
     has11 = np.isfinite(sdc11)
     if has11.any():
         ax.errorbar(x[has11] + 2 * width, sdc11[has11], yerr=sdc11_se[has11], fmt="v",
@@ -103,12 +144,12 @@ def plot_sdc_comparison(table: pd.DataFrame, *, ax=None):
                     label="measured (ours), Eq. 11 SDC over Im(P_c)/w ± SE:\n"
                           "a different quantity, not comparable with the Eq. 10 SDC")
     ax.set_xticks(x, labels, fontsize="small")
+    # autoscaling fits the markers, which sit up to 2 widths off their tick: with one load case
+    # its tick landed on the axes' left edge and its marker on the right one
+    if n:
+        ax.set_xlim(-0.5, n - 0.5)
     ax.set_ylabel("SDC [-]")
-    ax.set_title("SDC per load case (ours: dissipated energy over Eq. 10's E)")
     ax.grid(axis="y", alpha=0.3)
-    # outside the axes: six long entries would hide the markers they describe
-    ax.legend(fontsize="small", loc="upper left", bbox_to_anchor=(1.01, 1.0))
-    return fig
 
 
 def _first(arrays: Mapping[str, np.ndarray], names: tuple[str, ...]) -> np.ndarray | None:

@@ -221,6 +221,38 @@ def _measured_loops(results: list[MeasuredResult], analyses: pd.DataFrame, store
     return loops
 
 
+def _specimen_provenance(specimen) -> list[tuple[str, str]]:
+    """(label, SHA-256) of the specimen(s) whose DEM runs a report compares."""
+    from ..constants import PARTICLE_MATERIALS
+    from ..specimen import paper_specimen
+
+    if specimen is not None:
+        return [(f"{specimen.name} ({specimen.source})", specimen.hash)]
+    # the default compares the paper's coupon with either of its particle materials
+    return [(f"{paper_specimen(m).name} (the default, {m} particles)", paper_specimen(m).hash)
+            for m in PARTICLE_MATERIALS]
+
+
+def _other_specimens(stored: pd.DataFrame, kept: pd.DataFrame) -> str:
+    """"4 run(s) of other specimens: 3 of a [1b8b5d], 1 of b [b0826e]" for the runs of
+    ``stored`` not in ``kept``; "" if none. The hash is named too: an edited specimen file
+    keeps its name but is another specimen."""
+    left_out = stored[~stored["case_key"].isin(set(kept["case_key"]))]
+    if left_out.empty:
+        return ""
+
+    def column(name: str) -> pd.Series:
+        if name not in left_out.columns:
+            return pd.Series([""] * len(left_out), index=left_out.index)
+        return left_out[name].fillna("").astype(str)
+
+    labels = [f"{n or 'unnamed'} [{h[:6]}]" if h else (n or "unnamed")
+              for n, h in zip(column("specimen_name"), column("specimen_sha256"), strict=True)]
+    counts = pd.Series(labels).value_counts(sort=False)
+    return (f"{len(left_out)} run(s) of other specimens: "
+            + ", ".join(f"{n} of {label}" for label, n in counts.items()))
+
+
 def _figures(table: pd.DataFrame, dem_runs: pd.DataFrame | None, aligner: Aligner,
              loops: list[tuple[str, LoadCase, ForceDisplacementLoop]], dem_store,
              notes: list[str]) -> dict[str, object]:
@@ -363,11 +395,21 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
     if dem_runs is not None and not dem_runs.empty:
         from ..dem.persist import runs_of_specimen
 
-        dem_runs = runs_of_specimen(dem_runs, specimen)
+        stored = dem_runs
+        dem_runs = runs_of_specimen(stored, specimen)
+        others = _other_specimens(stored, dem_runs)
+        from ..specimen import paper_specimen
+
+        # the default takes the paper's coupon with either table material: no one hash
+        name = (f"{specimen.name} [{specimen.hash[:6]}]" if specimen is not None else
+                f"{paper_specimen().name} (the default; --specimen FILE for another)")
         if dem_runs.empty:
-            notes.append(f"{dem_path}: holds no DEM runs of specimen "
-                         f"{specimen.name if specimen is not None else 'paper_coupon'}")
-    if dem_runs is not None and dem_runs.empty:
+            notes.append(f"{dem_path}: holds no DEM runs of specimen {name} ({others})")
+            dem_runs = None
+        elif others:
+            notes.append(f"{dem_path}: {others}; not compared (the report is of specimen "
+                         f"{name})")
+    elif dem_runs is not None:
         notes.append(f"{dem_path}: holds no DEM runs")
         dem_runs = None
     paper = load_paper_table3()
@@ -376,8 +418,15 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         notes.append(f"specimen {specimen.name} is not the paper's coupon: the paper's "
                      "Table 3 is not compared")
     table = build_report_table(dem_runs, analyses, paper, tolerances=tolerances, pool=pool)
+    if specimen is not None and not pool:
+        # every DEM row is this specimen's (runs_of_specimen) and the files are its tests; a
+        # measurement stored with a specimen of its own (the app's uploads) keeps that one
+        table["specimen"] = table["specimen"].mask(table["specimen"] == "", specimen.name)
     if calibrated is not None:
-        table = add_calibration_columns(table, calibrated, tolerances=tolerances)
+        from ..specimen import paper_specimen
+
+        table = add_calibration_columns(table, calibrated, tolerances=tolerances,
+                                        specimen=specimen or paper_specimen())
     notes.extend(table.attrs.get("notes", []))
     aligner = Aligner(dem_cases(dem_runs, tolerances=tolerances, pool_settings=pool)
                       if dem_runs is not None else [],
@@ -398,7 +447,7 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
                         "fill_atol_percent": tolerances.fill_atol_percent},
             seeds=seeds, inputs=[r.path for r in results],
             input_hashes={str(r.path): getattr(r.measurement, "sha256", "") for r in results},
-            stores=stores, notes=notes)
+            stores=stores, notes=notes, specimens=_specimen_provenance(specimen))
         paths = write_report(table, figures, provenance, out_dir, formats)
     finally:
         for fig in figures.values():  # bare Figures: drop references to free Agg buffers

@@ -48,6 +48,9 @@ class Provenance:
         Store paths and their SHA-256 (at the time the report was made).
     created_utc : str
         ISO 8601 time stamp, UTC.
+    specimens : tuple of (str, str)
+        The specimens whose DEM runs the report compares: a label (name, and where it was read
+        from) and its SHA-256 (:attr:`pidcore.specimen.Specimen.hash`).
     notes : tuple of str
         Records left out and why, and other remarks.
     """
@@ -59,6 +62,7 @@ class Provenance:
     stores: tuple[tuple[str, str], ...] = ()
     created_utc: str = ""
     notes: tuple[str, ...] = ()
+    specimens: tuple[tuple[str, str], ...] = ()
 
     def lines(self) -> list[str]:
         """The provenance as plain text lines (the footer of every format)."""
@@ -67,6 +71,8 @@ class Provenance:
         if self.parameters:
             out.append("parameters: " + ", ".join(f"{k}={v}" for k, v in self.parameters.items()))
         out.append("seeds: " + (", ".join(str(s) for s in self.seeds) or "none"))
+        for name, digest in self.specimens:
+            out.append(f"specimen: {name} sha256 {digest}")
         for name, digest in self.stores:
             out.append(f"store: {name} sha256 {digest}")
         for name, digest in self.inputs:
@@ -78,14 +84,15 @@ class Provenance:
         return {"versions": dict(self.versions), "parameters": dict(self.parameters),
                 "seeds": list(self.seeds), "inputs": [list(i) for i in self.inputs],
                 "stores": [list(s) for s in self.stores], "created_utc": self.created_utc,
-                "notes": list(self.notes)}
+                "notes": list(self.notes), "specimens": [list(s) for s in self.specimens]}
 
 
 def collect_provenance(*, parameters: Mapping[str, object] | None = None,
                        seeds: Iterable[int] = (), inputs: Iterable[str | Path] = (),
                        input_hashes: Mapping[str, str] | None = None,
                        stores: Iterable[str | Path] = (), notes: Iterable[str] = (),
-                       created_utc: datetime | None = None) -> Provenance:
+                       created_utc: datetime | None = None,
+                       specimens: Iterable[tuple[str, str]] = ()) -> Provenance:
     """Collect versions, hashes and a time stamp into a :class:`Provenance`.
 
     Parameters
@@ -103,6 +110,8 @@ def collect_provenance(*, parameters: Mapping[str, object] | None = None,
     notes : iterable of str
     created_utc : datetime, optional
         Time stamp (default: now).
+    specimens : iterable of (str, str)
+        (label, SHA-256) of each specimen compared.
     """
     from .. import __version__
 
@@ -118,4 +127,4 @@ def collect_provenance(*, parameters: Mapping[str, object] | None = None,
     return Provenance(versions=versions, parameters=dict(parameters or {}),
                       seeds=tuple(sorted({int(s) for s in seeds})), inputs=tuple(hashed_inputs),
                       stores=hashed_stores, created_utc=stamp.isoformat(timespec="seconds"),
-                      notes=tuple(notes))
+                      notes=tuple(notes), specimens=tuple(specimens))

@@ -192,6 +192,7 @@ def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | N
         row.measured.append(entry)
 
     records = []
+    unconverged_rows = 0
     for row in (r for group in rows.values() for r in group):
         lc = row.case
         sdc_m = sdc_m_se = f_m = a_m = chi2_dof = math.nan
@@ -219,6 +220,9 @@ def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | N
                            if chi2_dof > 3 else ""))
         if row.dem is not None and row.dem.n_runs > 1:
             note.append(f"{row.dem.n_runs} DEM runs pooled")
+        if row.dem is not None and row.dem.not_converged:
+            note.append(_not_converged_note(row.dem))
+            unconverged_rows += 1
         if pool:
             note.append("pooled across specimens and DEM settings (--pool)")
         if row.measured and math.isfinite(row.sdc_dem) and not math.isfinite(sdc_m10):
@@ -255,8 +259,23 @@ def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | N
     # a count: whole numbers in every format (the CSV wrote 18.0), empty where no DEM ran
     table["particles per cell [-]"] = table["particles per cell [-]"].astype("Int64")
     table = _sort_like_table3(table, aligner, paper, tolerances)
+    if unconverged_rows:
+        notes.append(f"{unconverged_rows} row(s) rest on DEM runs that did not converge (no "
+                     "steady state before the transient cap): their DEM SDC may include the "
+                     "transient; see each row's note")
     table.attrs["notes"] = notes
     return table
+
+
+def _not_converged_note(dem: DemCase) -> str:
+    """The row note for a DEM case with runs whose steady state was never detected, in the
+    words ``pidcore dem run`` prints for such a run."""
+    runs = "; ".join(f"steady state from cycle {start} (NOT converged, transient cap), "
+                     f"{cycles} cycles measured" if start >= 0 and cycles >= 0
+                     else "steady state NOT converged (transient cap)"
+                     for start, cycles in dem.not_converged)
+    which = "DEM run" if dem.n_runs == 1 else f"{len(dem.not_converged)} of {dem.n_runs} DEM runs"
+    return f"{which} did not converge: {runs}; the DEM SDC may include the transient"
 
 
 def _snap(values: pd.Series, grid: np.ndarray, *, rtol: float = 0.0,
@@ -311,15 +330,17 @@ CALIBRATION_COLUMNS: tuple[str, ...] = (CALIBRATED_COLUMN, CALIBRATED_LOW_COLUMN
 
 
 def add_calibration_columns(table: pd.DataFrame, calibration, *,
-                            tolerances=None) -> pd.DataFrame:
+                            tolerances=None, specimen=None) -> pd.DataFrame:
     """A copy of a report table with the calibrated DEM's prediction beside each row.
 
     Like for like: the calibration predicts the Eq. 11 SDC a shaker test of the DEM would
     measure, so the band is compared with ``SDC measured [-]`` (Eq. 11), not with Eq. 10.
     Rows whose load case the calibration does not predict (material, and frequency,
     acceleration, fill within ``tolerances``) get empty numbers, ``not compared`` and a note
-    saying so. The table's notes (``attrs["notes"]``) gain one that counts the predicted rows
-    and the measured rows inside the band.
+    saying so and why (:meth:`~pidcore.calibrate.prediction.Calibration.why_not_predicted`:
+    another specimen, another material, outside its range, not a calibrated load case). The
+    table's notes (``attrs["notes"]``) gain one that counts the predicted rows and the
+    measured rows inside the band.
 
     Parameters
     ----------
@@ -329,6 +350,8 @@ def add_calibration_columns(table: pd.DataFrame, calibration, *,
         From :func:`pidcore.calibrate.prediction.load_calibration`.
     tolerances : Tolerances, optional
         Grid-match tolerances (default: the report's).
+    specimen : pidcore.specimen.Specimen, optional
+        The specimen the table is of, checked against the calibration's (unchecked if None).
     """
     out = table.copy()
     sdc, low, high, inside, notes = [], [], [], [], []
@@ -342,7 +365,8 @@ def add_calibration_columns(table: pd.DataFrame, calibration, *,
             low.append(math.nan)
             high.append(math.nan)
             inside.append(NOT_COMPARED)
-            extra = f"not predicted by the calibration {calibration.path.name}"
+            why = calibration.why_not_predicted(case, specimen=specimen, tolerances=tolerances)
+            extra = f"not predicted by the calibration {calibration.path.name}: {why}"
         else:
             sdc.append(hit.sdc)
             low.append(hit.low95)
