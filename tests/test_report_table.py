@@ -269,7 +269,6 @@ def test_specimens_are_separate_rows_and_pooled_files_get_a_consistency_check():
     assert pooled.iloc[0][CONSISTENCY_COLUMN] > 3 and "scatter" in pooled.iloc[0]["note"]
 
 
-<<<<<<< HEAD
 def test_particles_per_cell_is_written_as_a_whole_number(table, tmp_path):
     # a count: the CSV wrote 18.0 (a float column, NaN where no DEM ran); now 18, and empty
     from pidcore.report.render import format_cell
@@ -280,7 +279,8 @@ def test_particles_per_cell_is_written_as_a_whole_number(table, tmp_path):
     assert set(column) - {""} <= {"9", "18"} and "" in set(column)
     missing = table[table["DEM runs [-]"] == 0]["particles per cell [-]"].iloc[0]
     assert format_cell(missing) == ""
-=======
+
+
 def test_dem_runs_that_did_not_converge_are_named_in_the_row_note_and_counted():
     """A run measured from the transient cap (`dem run`: "NOT converged, transient cap") had an
     empty note: its SDC, possibly still holding the transient, read like any other."""
@@ -302,4 +302,3 @@ def test_dem_runs_that_did_not_converge_are_named_in_the_row_note_and_counted():
     # a store that does not record convergence is not flagged
     quiet = build_report_table(dem.drop(columns="steady_detected"), None, None)
     assert not any("converge" in n for n in [*quiet["note"], *quiet.attrs["notes"]])
->>>>>>> fixrep
