@@ -164,14 +164,20 @@ def test_velocity_units_spelled_by_other_tools(tmp_path, unit, scale):
     _assert_truth(analyze_file(path, AnalysisOptions()).analysis)
 
 
+def _write_csv(path, header: str, rec, *, velocity_scale: float = 1.0, extra: str = ""):
+    """``rec`` as a CSV of time, force and velocity (times ``velocity_scale``) under
+    ``header``, each row ending in ``extra``."""
+    t = np.arange(rec.force_n.size) / FS
+    path.write_text(header + "\n" + "".join(
+        f"{a:.10g},{b:.10g},{c * velocity_scale:.10g}{extra}\n"
+        for a, b, c in zip(t, rec.force_n, rec.velocity_m_s, strict=True)))
+    return path
+
+
 def test_unknown_units_never_taken_as_si(tmp_path, capsys):
     """Bare column names: an error asking for the unit options; with them, the truth."""
     rec = _record()
-    t = np.arange(rec.force_n.size) / FS
-    path = tmp_path / "bare.csv"
-    path.write_text("Time,Force,Velocity\n" + "".join(
-        f"{a:.10g},{b:.10g},{c * 1e3:.10g}\n"
-        for a, b, c in zip(t, rec.force_n, rec.velocity_m_s, strict=True)))
+    path = _write_csv(tmp_path / "bare.csv", "Time,Force,Velocity", rec, velocity_scale=1e3)
     code, _, err = _cli([str(path), "--no-store"], capsys)
     assert code == 2 and "--force-unit UNIT" in err and "'Force'" in err
     code, _, err = _cli([str(path), "--no-store", "--force-unit", "N"], capsys)
@@ -185,11 +191,8 @@ def test_unit_option_overrides_a_unit_of_another_kind(tmp_path, capsys):
     """A force exported under a velocity's unit: refused, naming --force-unit; with
     ``--force Force --force-unit N`` the truth, and a note saying what was overridden."""
     rec = _record()
-    t = np.arange(rec.force_n.size) / FS
-    path = tmp_path / "wrong.csv"
-    path.write_text("Time [s],Force [m/s],Velocity [m/s],Accel [m/s^2]\n" + "".join(
-        f"{a:.10g},{b:.10g},{c:.10g},0\n"
-        for a, b, c in zip(t, rec.force_n, rec.velocity_m_s, strict=True)))
+    path = _write_csv(tmp_path / "wrong.csv", "Time [s],Force [m/s],Velocity [m/s],Accel [m/s^2]",
+                      rec, extra=",0")
     code, _, err = _cli([str(path), "--no-store", "--force", "Force"], capsys)
     assert code == 2 and "is a velocity channel" in err and "--force-unit UNIT" in err
     code, _, err = _cli([str(path), "--no-store", "--force", "Accel"], capsys)
