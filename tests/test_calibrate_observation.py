@@ -60,6 +60,18 @@ def test_fixture_mass_and_baseline_equal_eq11_of_the_whole_shaker_force():
     assert obs.sdc(fixture, eta0) == pytest.approx(measured, rel=1e-7)
 
 
+def test_the_coupon_is_read_without_its_fixture_from_old_and_new_records():
+    # coupon_mass_kg holds the coupon alone since moving_mass_kg exists; before, it held coupon
+    # + fixture: the same run must give the same observation from either store
+    record, arrays, *_ = _synthetic(0.0153, 2.7)
+    new = {**record, "fixture_mass_kg": 0.05, "moving_mass_kg": 0.0722}
+    old = {**record, "fixture_mass_kg": 0.05, "coupon_mass_kg": 0.0722}
+    assert observation_from_run(new, arrays).coupon_mass_kg == pytest.approx(0.0222, rel=1e-12)
+    assert observation_from_run(old, arrays).coupon_mass_kg == pytest.approx(0.0222, rel=1e-12)
+    # an old record of the paper's coupon (no fixture key): its coupon_mass_kg as stored
+    assert observation_from_run(record, arrays).coupon_mass_kg == 0.0222
+
+
 @pytest.fixture(scope="module")
 def flying_run():
     case = LoadCase(500.0, 5.0, 50.0)

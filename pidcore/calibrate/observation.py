@@ -28,6 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..dem.persist import record_coupon_mass_kg
 from ..errors import SimulationError
 
 
@@ -73,7 +74,8 @@ def observation_from_run(record: dict, arrays: dict, *, n_blocks: int = 8,
     """Observation of a stored DEM run (record and arrays as :func:`dem_run_entry` writes them).
 
     ``coupon_mass_kg``: the structure's mass without the fixture (the calibration adds its own
-    fixture mass); default: the run's moving mass (coupon plus the specimen's fixture).
+    fixture mass); default: the run's coupon (:func:`pidcore.dem.persist.record_coupon_mass_kg`,
+    which also reads runs stored when ``coupon_mass_kg`` held coupon + fixture).
 
     The central complex power goes through :func:`pidcore.signal.analyze_power` (the same
     Eq. 11 code as a measurement); the reactive mass's standard error comes from ``n_blocks``
@@ -113,6 +115,6 @@ def observation_from_run(record: dict, arrays: dict, *, n_blocks: int = 8,
         dissipative_mass_kg=p.real / scale,
         dissipative_mass_stderr_kg=max(re_se_cells, re_se_blocks) / scale,
         reactive_mass_kg=p.imag / scale, reactive_mass_stderr_kg=im_se / scale,
-        coupon_mass_kg=float(record["coupon_mass_kg"] if coupon_mass_kg is None
+        coupon_mass_kg=float(record_coupon_mass_kg(record) if coupon_mass_kg is None
                              else coupon_mass_kg),
         energy_per_cycle_j=float(record["energy_per_cycle_j"]))

@@ -15,6 +15,7 @@ import hashlib
 import json
 import math
 import os
+from collections.abc import Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -127,6 +128,19 @@ def _config_from(parameters: dict[str, Any]) -> DemConfig:
             value = parameters[name]
             values[f.name] = None if value == "" else value  # config_parameters wrote None as ""
     return DemConfig(**values)
+
+
+def record_coupon_mass_kg(record: Mapping[str, Any]) -> float:
+    """The coupon's mass without its fixture, kg, from a stored DEM run's record.
+
+    Runs stored before ``moving_mass_kg`` existed held coupon + fixture under
+    ``coupon_mass_kg``; their ``fixture_mass_kg`` (0 where not stored: the paper's coupon) is
+    taken off.
+    """
+    coupon = float(record["coupon_mass_kg"])
+    if "moving_mass_kg" not in record:
+        coupon -= float(record.get("fixture_mass_kg") or 0.0)
+    return coupon
 
 
 def load_dem_result(entry: StoredEntry) -> DemResult:
