@@ -457,6 +457,31 @@ def test_reference_dem_store_is_compared_but_never_written(store_file, tmp_path,
     assert ref.read_bytes() == ref_bytes
 
 
+def test_the_materials_of_stored_dem_runs_are_offered_and_a_bad_store_only_warns(
+        store_file, tmp_path, monkeypatch):
+    from pidcore.store import Store
+
+    ref = tmp_path / "reference.h5"
+    Store(ref).add_dem_run("steel_run", {"frequency_hz": 100.0, "acceleration_g": 5.0,
+                                         "fill_percent": 50.0, "material": "steel",
+                                         "direction": "z", "sdc": 0.25, "sdc_stderr": 0.02})
+    monkeypatch.setenv(stores.DEM_STORE_ENV_VAR, str(ref))
+    at = _upload(_app(), [("coupon_fill50.csv", mass_damper_csv())])
+    column = at.session_state["settings_base"]["material"]
+    assert column.tolist() == ["acrylic"]  # stated by nobody: the default
+    # the editor offers the store's steel after the table's materials (its column config)
+    offered = '\\"options\\": [\\"acrylic\\", \\"aluminium\\", \\"steel\\"]'
+    assert sum(offered in str(df.proto) for df in at.dataframe) == 1
+    # a store that cannot be read: the page still works, with a warning naming it
+    ref.write_bytes(b"not an HDF5 file" * 64)
+    import streamlit as st
+
+    st.cache_data.clear()
+    at = _upload(_app(), [("coupon_fill50.csv", mass_damper_csv())])
+    assert not at.exception
+    assert any("DEM runs not read" in w.value for w in at.warning)
+
+
 def test_calibrate_page_says_when_the_library_is_missing(store_file):
     import importlib.util
 

@@ -144,7 +144,11 @@ def render(stores) -> list:
                                help="only for CSV/TXT files without a time column; 0 = none")
     sample_rate_hz = rate if rate > 0 else None
     measurements, tables = [], {}
-    runs = state.store_listing("dem_runs", stores.stamp(), stores)
+    try:
+        runs = state.store_listing("dem_runs", stores.stamp(), stores)
+    except PidcoreError as exc:  # the uploads work without it: only the table's materials
+        st.warning(f"DEM runs not read ({exc}): only the table's particle materials offered")
+        runs = None
     materials = uploads.measurement_materials(
         runs["material"] if "material" in getattr(runs, "columns", ()) else ())
     for upload in files or []:
