@@ -120,6 +120,19 @@ def test_report_from_store_only_uses_stored_analyses(e2e, dem_store, tmp_path):
     assert not any("without DEM overlay" in n for n in again.notes)
 
 
+@pytest.mark.parametrize("flag", [["--material", "stel"], ["--fill", "40"],
+                                  ["--velocity-delay", "5e-5"]])
+def test_load_case_and_analysis_options_without_files_are_refused(tmp_path, dem_store, capsys,
+                                                                  flag):
+    # a report of stored analyses keeps their load cases and corrections: such an option
+    # was silently ignored (a typo in --material too, once its choices were opened)
+    out = tmp_path / "out"
+    assert main(["report", "--dem-store", str(dem_store), "--out", str(out), *flag]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "only with measurement FILES" in err
+    assert not out.exists()
+
+
 @pytest.mark.usefixtures("undrawn_report_figures")
 def test_cli_with_dem_store_only_stores_nothing(tmp_path, dem_store, capsys):
     file = _write_measurement(tmp_path / "coupon2_75pct.csv", seed=3)

@@ -26,7 +26,7 @@ import pandas as pd
 from ..compare.align import Aligner, Tolerances, dem_cases
 from ..compare.loadcase import LoadCase, LoadCaseError, StatedLoadCase, resolve_load_case
 from ..constants import REPORT_FORMATS
-from ..errors import StoreError
+from ..errors import ParameterError, StoreError
 from .provenance import collect_provenance
 from .render import check_out_dir, parse_formats, write_report
 from .table import add_calibration_columns, build_report_table
@@ -354,13 +354,23 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
     files = [Path(f) for f in files]
     if not files and store is None and dem_store is None:
         raise StoreError("nothing to report: give measurement files, --store or --dem-store")
+    if not files:
+        # they would be ignored: stored analyses keep the load case and corrections they had
+        stated = [flag for flag, value in (("--fill", fill_percent), ("--material", material),
+                                           ("--direction", direction), ("--sidecar", sidecar))
+                  if value is not None]
+        if options is not None and options != AnalysisOptions():
+            stated.append("analysis options (--velocity-delay, --force, ...)")
+        if stated:
+            raise ParameterError(f"{', '.join(stated)}: only with measurement FILES (stored "
+                                 "analyses keep the load case and corrections they were "
+                                 "saved with)")
     main = open_verified_store(store, must_exist=not files) if store is not None else None
     dem_path = Path(dem_store) if dem_store is not None else (Path(store) if store else None)
     dem = None
     if dem_path is not None:
         dem = main if (main is not None and dem_path == Path(store)) else \
             open_verified_store(dem_path, must_exist=True)
-
 
     options = options or AnalysisOptions()
     parameters = options.parameters()
