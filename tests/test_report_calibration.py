@@ -216,3 +216,33 @@ def test_not_predicted_rows_name_another_specimen(calibration_file):
     for same in (paper, calibrated, as_file):
         assert note(same).endswith(": outside its calibrated range (frequency 1000 Hz not in "
                                    "its 50-500 Hz)")
+
+
+def test_a_calibration_of_another_specimen_predicts_no_row_even_at_its_load_cases(
+        calibration_file):
+    # lookup matches load cases only: the specimen must be checked first, or a calibration of
+    # another coupon would put its band (and a yes/no) on a row at one of its load cases
+    from pidcore.specimen import paper_specimen
+
+    own = paper_specimen().with_values({"cell.inscribed_diameter_m": 6.35e-3})
+    (calibration_file.parent / "calibrated_specimen.toml").write_text(
+        own.to_toml().replace('name = "paper_coupon"', 'name = "hc635_calibrated"'))
+    cal = load_calibration(calibration_file)
+    table = _table().iloc[[0]]  # 50 Hz, 5 g, 50 % acrylic: a load case it predicts
+    assert cal.lookup(LoadCase(50.0, 5.0, 50.0, "acrylic")) is not None
+    for kwargs in ({"specimen": paper_specimen()}, {"paper": True}):
+        out = add_calibration_columns(table, cal, **kwargs)
+        assert math.isnan(out[CALIBRATED_COLUMN].iloc[0])
+        assert out["note"].iloc[0].endswith(": it calibrates specimen hc635, not paper_coupon")
+        assert "predicts 0 of 1 row(s)" in out.attrs["notes"][-1]
+    # the default report (paper=True) checks each row against the paper's coupon with its own
+    # particles: an aluminium row is the aluminium coupon, not the acrylic one
+    (calibration_file.parent / "calibrated_specimen.toml").write_text(
+        paper_specimen().to_toml().replace('name = "paper_coupon"',
+                                           'name = "paper_coupon_calibrated"'))
+    cal = load_calibration(calibration_file)
+    rows = _table().iloc[[0, 0]].assign(material=["acrylic", "aluminium"])
+    out = add_calibration_columns(rows, cal, paper=True)
+    assert out[CALIBRATED_COLUMN].iloc[0] == 0.24
+    assert out["note"].iloc[1].endswith(
+        ": it calibrates specimen paper_coupon, not paper_coupon_aluminium")

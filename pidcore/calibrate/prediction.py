@@ -97,6 +97,13 @@ class Calibration:
         except (PidcoreError, OSError):
             return None
 
+    def other_specimen_reason(self, specimen) -> str:
+        """Why this calibration does not speak for ``specimen`` (another specimen, or one of
+        the same name with another cell or particles); "" where it does, or where either is
+        unknown (``specimen`` None, or no readable :meth:`calibrated_specimen`). A report
+        checks this before :meth:`lookup`, which matches load cases only."""
+        return _other_specimen(self.calibrated_specimen(), specimen)
+
     def why_not_predicted(self, case: LoadCase, *, specimen=None,
                           tolerances: Tolerances | None = None) -> str:
         """Why :meth:`lookup` finds no prediction at ``case``: another specimen, another
@@ -113,7 +120,7 @@ class Calibration:
             As for :meth:`lookup`.
         """
         tolerances = tolerances or Tolerances()
-        other = _other_specimen(self.calibrated_specimen(), specimen)
+        other = self.other_specimen_reason(specimen)
         if other:
             return other
         materials = sorted({p.load_case.material for p in self.predictions})

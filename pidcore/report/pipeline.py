@@ -433,10 +433,8 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         # measurement stored with a specimen of its own (the app's uploads) keeps that one
         table["specimen"] = table["specimen"].mask(table["specimen"] == "", specimen.name)
     if calibrated is not None:
-        from ..specimen import paper_specimen
-
         table = add_calibration_columns(table, calibrated, tolerances=tolerances,
-                                        specimen=specimen or paper_specimen())
+                                        specimen=specimen, paper=specimen is None)
     notes.extend(table.attrs.get("notes", []))
     aligner = Aligner(dem_cases(dem_runs, tolerances=tolerances, pool_settings=pool)
                       if dem_runs is not None else [],

@@ -330,7 +330,7 @@ CALIBRATION_COLUMNS: tuple[str, ...] = (CALIBRATED_COLUMN, CALIBRATED_LOW_COLUMN
 
 
 def add_calibration_columns(table: pd.DataFrame, calibration, *,
-                            tolerances=None, specimen=None) -> pd.DataFrame:
+                            tolerances=None, specimen=None, paper: bool = False) -> pd.DataFrame:
     """A copy of a report table with the calibrated DEM's prediction beside each row.
 
     Like for like: the calibration predicts the Eq. 11 SDC a shaker test of the DEM would
@@ -351,21 +351,36 @@ def add_calibration_columns(table: pd.DataFrame, calibration, *,
     tolerances : Tolerances, optional
         Grid-match tolerances (default: the report's).
     specimen : pidcore.specimen.Specimen, optional
-        The specimen the table is of, checked against the calibration's (unchecked if None).
+        The specimen the table is of, checked against the calibration's before any load case
+        is looked up (a calibration of another specimen predicts no row of it).
+    paper : bool
+        Without ``specimen``: the rows are the paper's coupon with their own particle
+        material (the default report), each checked against the calibration's specimen.
+        Neither: unchecked.
     """
+    from ..constants import PARTICLE_MATERIALS
+    from ..specimen import paper_specimen
+
     out = table.copy()
     sdc, low, high, inside, notes = [], [], [], [], []
+    reasons: dict[str, str] = {}  # per material: why the calibration is of another specimen
     for _, row in out.iterrows():
         note = str(row.get("note", "") or "")
         case = LoadCase(float(row["frequency [Hz]"]), float(row["acceleration [g]"]),
                         float(row["packing ratio [%]"]), str(row.get("material") or "acrylic"))
-        hit = calibration.lookup(case, tolerances=tolerances)
+        if case.material not in reasons:
+            of_row = specimen
+            if of_row is None and paper and case.material in PARTICLE_MATERIALS:
+                of_row = paper_specimen(case.material)
+            reasons[case.material] = calibration.other_specimen_reason(of_row)
+        other = reasons[case.material]
+        hit = None if other else calibration.lookup(case, tolerances=tolerances)
         if hit is None:
             sdc.append(math.nan)
             low.append(math.nan)
             high.append(math.nan)
             inside.append(NOT_COMPARED)
-            why = calibration.why_not_predicted(case, specimen=specimen, tolerances=tolerances)
+            why = other or calibration.why_not_predicted(case, tolerances=tolerances)
             extra = f"not predicted by the calibration {calibration.path.name}: {why}"
         else:
             sdc.append(hit.sdc)
