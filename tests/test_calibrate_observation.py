@@ -112,3 +112,13 @@ def test_bound_notes_flag_a_posterior_piled_against_a_prior_bound():
     assert "upper bound 1" in note and "--prior fixture_mass_kg=LOW:HIGH" in note
     (note,) = bound_notes([spec], spec.high - high)
     assert "lower bound 0" in note
+    # a log-uniform prior's edges are measured in log: a model error of ~8 % lies in the
+    # lowest 5 % of its 0.02-2 range taken linearly (39 % of the prior's mass), not in log
+    from pidcore.calibrate.parameters import DISCREPANCY
+
+    tau = parameter_spec(DISCREPANCY)
+    assert (tau.prior, tau.low, tau.high) == ("log-uniform", 0.02, 2.0)
+    good = np.exp(rng.normal(math.log(0.08), 0.2, (4000, 1)))
+    assert bound_notes([tau], good) == []
+    low = np.exp(rng.uniform(math.log(0.02), math.log(0.025), (4000, 1)))  # lowest 5 % in log
+    assert "lower bound 0.02" in bound_notes([tau], low)[0]

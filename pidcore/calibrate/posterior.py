@@ -240,14 +240,14 @@ def bound_notes(specs: Sequence[ParameterSpec], samples: np.ndarray) -> list[str
         if not (math.isfinite(low) and math.isfinite(high) and high > low):
             continue
         x = samples[:, j]
-        edge = EDGE_SHARE * (high - low)
-        for side, bound, share in (("lower", low, float(np.mean(x < low + edge))),
-                                   ("upper", high, float(np.mean(x > high - edge)))):
+        u = _to_unit(spec, x)  # the prior's own scale: log for a log-uniform prior
+        for side, bound, share in (("lower", low, float(np.mean(u < EDGE_SHARE))),
+                                   ("upper", high, float(np.mean(u > 1.0 - EDGE_SHARE)))):
             if share > PILED_SHARE:
                 notes.append(
                     f"{spec.name}: the posterior piles against its prior's {side} bound "
-                    f"{bound:g} ({share:.0%} of the samples in the {EDGE_SHARE:.0%} of the range "
-                    f"next to it): the data ask for a value at or beyond it, so its median "
+                    f"{bound:g} ({share:.0%} of the samples in the {EDGE_SHARE:.0%} of the prior's "
+                    f"range next to it): the data ask for a value at or beyond it, so its median "
                     f"{float(np.median(x)):.4g} is set by the prior, not the data; check the "
                     f"stated values, and widen the prior (--prior {spec.name}=LOW:HIGH) unless "
                     "the bound is physical")
