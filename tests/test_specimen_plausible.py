@@ -87,8 +87,15 @@ def test_a_cell_of_many_radii_is_refused_before_the_packing_grid_is_allocated():
     # a tall cell of small spheres: few grid points, but millions of spheres to place
     with pytest.raises(ParameterError, match="holds up to .* spheres"):
         check_packing_size(CellGeometry(5e-3, 1.0), 0.1e-3)
-    # the limit still admits a cell 50 radii across (the paper's is 3.8)
-    check_packing_size(CellGeometry(50e-3, 10e-3), 1e-3)
+    # 0.25 mm shot in a 1/4 inch x 1 inch core: each limit alone admitted it, and its packing
+    # ran for an hour; ~8e4 spheres are beyond the DEM's pair history (N^2 per cell)
+    with pytest.raises(ParameterError, match=r"at most 2000 per cell"):
+        check_packing_size(CellGeometry(6.35e-3, 25.4e-3), 0.125e-3)
+    # a wide flat cell: a few hundred spheres, but 1.9e6 candidate points each scans
+    with pytest.raises(ParameterError, match="too fine to pack"):
+        check_packing_size(CellGeometry(50e-3, 2e-3), 1e-3)
+    # the limits still admit a cell 25 radii across (the paper's is 3.8)
+    check_packing_size(CellGeometry(25e-3, 5e-3), 1e-3)
     assert MAX_PACKING_GRID_POINTS <= 2_000_000
 
 

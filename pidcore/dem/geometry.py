@@ -67,10 +67,14 @@ class CellGeometry:
 #: distances in float64, 0.15 GB at this size. Enough for a cell some 50 particle radii across
 #: (the paper's is 3.8); a larger ratio is almost surely a unit slip, and would ask for GiBs.
 MAX_PACKING_GRID_POINTS = 2_000_000
-#: Most spheres :func:`drop_packing` places in one cell (each scans every candidate point): a
-#: cell of 10^5 spheres is far beyond what the DEM simulates, and a larger estimate again
-#: points at a unit slip in the cell's or the particles' size.
-MAX_PACKED_PARTICLES = 100_000
+#: Most spheres a cell may hold (densest-packing estimate). The DEM keeps a contact history
+#: for every pair of a cell's particles, N^2 slots of 64 bytes: 2000 particles are 256 MB per
+#: cell. More is beyond this DEM (and usually a unit slip in the cell's or particles' size).
+MAX_PACKED_PARTICLES = 2_000
+#: Most (candidate point x sphere) steps of :func:`drop_packing` (each sphere scans every
+#: point): some 5-15 s (2.6 s for the 2e8 steps of a cell 25 radii across, 2026-11-30). The two limits above hold each factor, not the product:
+#: fine shot in a tall cell passed both and packed for an hour.
+MAX_PACKING_WORK = 5e8
 #: Densest packing of equal spheres (Kepler, pi / sqrt(18)): no cell holds more.
 _DENSEST_PACKING_FRACTION = np.pi / np.sqrt(18.0)
 #: Default candidate-grid spacing of :func:`drop_packing`, in particle radii.
@@ -100,8 +104,14 @@ def check_packing_size(geometry: CellGeometry, radius_m: float,
     most = _DENSEST_PACKING_FRACTION * geometry.volume_m3() / (4.0 / 3.0 * np.pi * radius_m**3)
     if most > MAX_PACKED_PARTICLES:
         raise ParameterError(
-            f"{size} holds up to {most:.3g} spheres (limit {MAX_PACKED_PARTICLES:.3g} per "
-            "cell); check the units of the cell's and the particles' size")
+            f"{size} holds up to {most:.3g} spheres; this DEM keeps a contact history for every "
+            f"pair of a cell's particles and takes at most {MAX_PACKED_PARTICLES} per cell "
+            "(check the units of the sizes, or simulate larger particles)")
+    if per_side**2 * most > MAX_PACKING_WORK:
+        raise ParameterError(
+            f"{size} is too fine to pack: {per_side**2:.3g} candidate points for up to "
+            f"{most:.3g} spheres (limit {MAX_PACKING_WORK:.3g} point-sphere steps); "
+            "check the units of the sizes, or simulate larger particles")
 
 
 def _candidate_grid(geometry: CellGeometry, radius_m: float, spacing_m: float) -> np.ndarray:
