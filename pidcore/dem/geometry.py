@@ -71,9 +71,10 @@ MAX_PACKING_GRID_POINTS = 2_000_000
 #: for every pair of a cell's particles, N^2 slots of 64 bytes: 2000 particles are 256 MB per
 #: cell. More is beyond this DEM (and usually a unit slip in the cell's or particles' size).
 MAX_PACKED_PARTICLES = 2_000
-#: Most (candidate point x sphere) steps of :func:`drop_packing` (each sphere scans every
-#: point): some 5-15 s (2.6 s for the 2e8 steps of a cell 25 radii across, 2026-11-30). The two limits above hold each factor, not the product:
-#: fine shot in a tall cell passed both and packed for an hour.
+#: Most (candidate point x sphere) steps of :func:`drop_packing`, as each sphere scans every
+#: point: some seconds (2.6 s for the 2e8 steps of a cell 25 radii across, 2026-11-30). The
+#: two limits above hold each factor, not the product: fine shot in a tall cell passed both
+#: and packed for an hour.
 MAX_PACKING_WORK = 5e8
 #: Densest packing of equal spheres (Kepler, pi / sqrt(18)): no cell holds more.
 _DENSEST_PACKING_FRACTION = np.pi / np.sqrt(18.0)
