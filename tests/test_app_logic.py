@@ -759,3 +759,117 @@ def test_calibration_digest_follows_the_content():
     other = calibration_from_json(doc(0.44), "calibration.json")
     assert calibration_digest(None) == ""
     assert calibration_digest(first) == calibration_digest(again) != calibration_digest(other)
+
+
+# --- which DEM runs a measurement meets ----------------------------------------------------------
+
+def _two_specimens_runs() -> pd.DataFrame:
+    """One DEM run each of two specimens at one load case (as the new-user trial stored them:
+    steel_6mm and its copy steel_6mm_b, both steel); b's never converged."""
+    return pd.DataFrame({
+        "case_key": ["run_a", "run_b"], "frequency_hz": [100.0, 100.0],
+        "acceleration_g": [5.0, 5.0], "fill_percent": [50.0, 50.0],
+        "material": ["steel", "steel"], "direction": ["z", "z"],
+        "sdc": [0.0197, 0.02308], "sdc_stderr": [0.001, 0.001],
+        "steady_detected": [True, False], "steady_start_cycle": [40, 200],
+        "steady_cycles": [30, 12],
+        "specimen_name": ["steel_6mm", "steel_6mm_b"],
+        "specimen_sha256": ["a" * 64, "b" * 64]})
+
+
+def _steel_entry(rec, specimen=""):
+    return MeasuredEntry.from_record(rec, load_case_of(rec, fill_percent=50.0, material="steel"),
+                                     specimen=specimen)
+
+
+def test_a_measurement_meets_only_the_dem_runs_of_its_specimen(good_csv, options):
+    from pidcore.app.workbench import case_view
+
+    rec = _record(good_csv, options)
+    runs = _two_specimens_runs()
+    # named: that specimen's run only (the old code took steel_6mm's 0.0197 for either)
+    for name, sdc in (("steel_6mm_b", 0.02308), ("steel_6mm", 0.0197)):
+        view = case_view([_steel_entry(rec, name)], runs, paper_table(), ())
+        assert view["headline"].dem == sdc
+        assert view["dem_specimen"].startswith(f"{name} [")
+        assert view["dem_refused"] == ""
+    # not named, two specimens' runs at the case: neither is met, and the page says which
+    view = case_view([_steel_entry(rec)], runs, paper_table(), ())
+    assert math.isnan(view["headline"].dem)
+    assert "steel_6mm [aaaaaa]" in view["dem_refused"]
+    assert "steel_6mm_b [bbbbbb]" in view["dem_refused"] and "specimen" in view["dem_refused"]
+    # not named, one specimen's runs: those
+    view = case_view([_steel_entry(rec)], runs.iloc[:1], paper_table(), ())
+    assert view["headline"].dem == 0.0197 and view["dem_specimen"] == "steel_6mm [aaaaaa]"
+    # a name no run has: no DEM value, and why
+    view = case_view([_steel_entry(rec, "brass_4mm")], runs, paper_table(), ())
+    assert math.isnan(view["headline"].dem)
+    assert any("no DEM runs of specimen brass_4mm" in n for n in view["notes"])
+
+
+def test_unnamed_acrylic_measurements_still_meet_the_papers_coupon(good_csv, options):
+    from pidcore.app.workbench import case_view
+    from pidcore.specimen import paper_specimen
+
+    rec = _record(good_csv, options)
+    # a run stored before specimens (no hash) and one of the bundled paper coupon: one specimen
+    runs = pd.DataFrame({
+        "case_key": ["old", "new"], "frequency_hz": [100.0, 100.0],
+        "acceleration_g": [5.0, 5.0], "fill_percent": [50.0, 50.0],
+        "material": ["acrylic"] * 2, "direction": ["z"] * 2, "sdc": [0.20, 0.22],
+        "sdc_stderr": [0.01, 0.01], "specimen_name": [None, "paper_coupon"],
+        "specimen_sha256": [None, paper_specimen().hash]})
+    view = case_view([_entry(rec)], runs, paper_table(), ())
+    assert view["headline"].dem == pytest.approx(0.21)  # both pooled, as before
+    assert view["dem_specimen"] == "paper_coupon" and view["dem_refused"] == ""
+
+
+def test_compare_and_report_say_a_dem_run_did_not_converge_alike(good_csv, options):
+    from pidcore.app.workbench import case_view
+    from pidcore.measure import analysis_record
+    from pidcore.report import build_report_table
+
+    rec = _record(good_csv, options)
+    runs = _two_specimens_runs()
+    view = case_view([_steel_entry(rec, "steel_6mm_b")], runs, paper_table(), ())
+    assert view["dem_warning"] == ("DEM run did not converge: steady state from cycle 200 (NOT "
+                                   "converged, transient cap), 12 cycles measured; the DEM SDC "
+                                   "may include the transient")
+    assert case_view([_steel_entry(rec, "steel_6mm")], runs, paper_table(),
+                     ())["dem_warning"] == ""
+    # the report table's row of that run says the same words
+    analyses = pd.DataFrame([{**analysis_record(rec), "fill_percent": 50.0, "material": "steel",
+                              "direction": "z", "specimen": "steel_6mm_b"}])
+    table = build_report_table(runs, analyses, paper_table())
+    row = table[table["SDC measured [-]"].notna()]
+    assert view["dem_warning"] in row["note"].iloc[0]
+
+
+def test_the_report_table_pairs_a_measurement_with_its_specimens_dem_run(good_csv, options):
+    from pidcore.measure import analysis_record
+    from pidcore.report import build_report_table
+
+    rec = _record(good_csv, options)
+    runs = _two_specimens_runs()
+
+    def measured_row(specimen):
+        analyses = pd.DataFrame([{**analysis_record(rec), "fill_percent": 50.0,
+                                  "material": "steel", "direction": "z",
+                                  "specimen": specimen}])
+        table = build_report_table(runs, analyses, paper_table())
+        return table[table["SDC measured [-]"].notna()].iloc[0]
+
+    assert measured_row("steel_6mm_b")["SDC DEM (ours) [-]"] == 0.02308
+    assert measured_row("steel_6mm")["SDC DEM (ours) [-]"] == 0.0197
+    unnamed = measured_row("")
+    assert math.isnan(unnamed["SDC DEM (ours) [-]"]) and "not pooled" in unnamed["note"]
+
+
+def test_sdc_chart_ticks_are_plain_numbers():
+    from pidcore.app.charts import sdc_chart
+
+    data = pd.DataFrame({"series": ["paper DEM"], "fill [%]": [40.0], "SDC [-]": [0.2],
+                         "low [-]": [0.2], "high [-]": [0.2]})
+    x = sdc_chart(data)["layer"][0]["encoding"]["x"]
+    # "~g": 40 and 37.5 (Vega wrote 40.000000 for the list of floats)
+    assert x["axis"] == {"values": [40.0], "format": "~g"}

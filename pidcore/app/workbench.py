@@ -70,7 +70,13 @@ def group_name(entries: Sequence[MeasuredEntry], group: Sequence[int]) -> str:
     """
     e = entries[group[0]]
     specimen = f", specimen {e.specimen}" if e.specimen else ""
-    return f"{e.load_case.label()}, {e.load_case.material}, {e.load_case.direction}{specimen}"
+    return f"{case_label(e.load_case)}{specimen}"
+
+
+def case_label(case) -> str:
+    """A load case as the page names it, rounded: ``'500 Hz, 1 g, 40 %, steel, z'`` (its
+    ``key`` spells the measured values out, f500Hz_a1.00003g_...)."""
+    return f"{case.label()}, {case.material}, {case.direction}"
 
 
 def dem_loop(paths: Sequence[str | os.PathLike | None],
@@ -101,10 +107,24 @@ def case_view(entries: Sequence[MeasuredEntry], dem_runs: pd.DataFrame | None,
     """Everything the Compare page draws for one load case, as plain data.
 
     Keys: ``comparison``, ``headline``, ``sdc_points`` (frame), ``loops`` (frame, SI),
-    ``energies`` (series -> J per cycle), ``spectrum`` (frame of the first record), ``notes``.
+    ``energies`` (series -> J per cycle), ``spectrum`` (frame of the first record), ``notes``,
+    ``dem_specimen`` (the specimen of the DEM runs met, e.g. ``"steel_6mm_b [3e945a]"``; empty
+    where none), ``dem_refused`` (why no DEM run is met although there are runs: several
+    specimens' runs would be pooled; empty otherwise) and ``dem_warning`` (the report's note
+    for a DEM case with unconverged runs; empty otherwise).
     """
-    comparison = compare_case(entries, dem_runs, paper)
+    from ..compare.specimens import runs_for_measurement
+    from ..report.table import not_converged_note
+
+    # group_entries never pools specimens: the first entry names the group's
+    first = entries[0]
+    met = runs_for_measurement(dem_runs, first.specimen, first.load_case.material,
+                               first.load_case.direction)
+    comparison = compare_case(entries, met.runs, paper)
     notes = list(comparison.notes)
+    if met.note and not met.refused:
+        notes.append(met.note)
+    grid = getattr(comparison.aligned, "grid_case", None)
     loops = []
     for e in entries:
         found = e.loop()
@@ -120,4 +140,7 @@ def case_view(entries: Sequence[MeasuredEntry], dem_runs: pd.DataFrame | None,
     return {"comparison": comparison, "headline": headline(comparison),
             "sdc_points": sdc_points(comparison), "loops": loop_frame(loops),
             "energies": {loop.label: loop.energy_per_cycle_j for loop in loops},
-            "spectrum": entries[0].spectrum(), "notes": notes}
+            "spectrum": entries[0].spectrum(), "notes": notes,
+            "dem_specimen": met.specimen, "dem_refused": met.note if met.refused else "",
+            "dem_warning": (not_converged_note(grid) if grid is not None and grid.not_converged
+                            else "")}

@@ -31,6 +31,7 @@ from ..compare.align import (
     pooled_sdc_eq10,
 )
 from ..compare.loadcase import LoadCase, LoadCaseError
+from ..compare.specimens import runs_for_measurement
 from ..units import g_to_si
 
 #: Measured energy per cycle over the DEM case's E = m_c a^2 / (2 w^2) (Eq. 10): the like-for-like
@@ -166,21 +167,42 @@ def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | N
         paper_dem, paper_exp, _ = match_paper(dem.load_case, paper, tolerances=tolerances)
         rows.setdefault(dem.load_case.key, []).append(
             _Row(dem.load_case, "grid", dem, dem.sdc, dem.sdc_stderr, paper_dem, paper_exp))
+    # a measurement meets only the DEM runs of its specimen (pidcore.compare.specimens); one
+    # aligner per (specimen, material, direction) over those runs
+    aligners: dict[tuple[str, str, str], tuple[Aligner, str]] = {}
     for case, rec in _measured_rows(analyses, notes):
-        aligned = aligner.align(case)
         specimen = "" if pool else str(rec.get("specimen", "") or "")
+        met_note = ""
+        if pool or dem_runs is None or dem_runs.empty:
+            own = aligner
+        else:
+            which = (specimen, case.material, case.direction)
+            if which not in aligners:
+                met = runs_for_measurement(dem_runs, *which)
+                aligners[which] = (Aligner.from_tables(met.runs, paper, model=model,
+                                                       tolerances=tolerances),
+                                   met.note if met.runs is None else "")
+            own, met_note = aligners[which]
+        aligned = own.align(case)
         entry = _Measured(float(rec["sdc"]), float(rec["sdc_stderr"]), case.frequency_hz,
                           case.acceleration_g, str(rec.get("source", "")),
                           float(rec.get("energy_per_cycle_j", math.nan)), specimen)
+        base = None
         if aligned.status == "grid" and aligned.grid_case is not None:
             dem = aligned.grid_case
             group = rows[dem.load_case.key]
-            base = next(r for r in group if r.dem is dem)
-        else:
+            # the same runs, grouped alike (settings name the specimen's hash)
+            base = next((r for r in group if r.dem is not None and (
+                r.dem.run_keys, r.dem.settings, r.dem.n_runs, r.dem.sdc) == (
+                dem.run_keys, dem.settings, dem.n_runs, dem.sdc)), None)
+            if base is None:
+                base = _Row(dem.load_case, "grid", dem, dem.sdc, dem.sdc_stderr,
+                            *match_paper(dem.load_case, paper, tolerances=tolerances)[:2])
+        if base is None:
             group = rows.setdefault(case.key, [])
             base = _Row(case, aligned.status, None, aligned.sdc_dem, aligned.sdc_dem_stderr,
                         aligned.sdc_paper_dem, aligned.sdc_paper_experimental,
-                        notes=[aligned.message])
+                        notes=[aligned.message] + ([met_note] if met_note else []))
         row = next((r for r in group if r.dem is base.dem and r.specimen == specimen), None)
         if row is None:
             row = next((r for r in group if r.dem is base.dem and r.specimen is None), None)
@@ -221,7 +243,7 @@ def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | N
         if row.dem is not None and row.dem.n_runs > 1:
             note.append(f"{row.dem.n_runs} DEM runs pooled")
         if row.dem is not None and row.dem.not_converged:
-            note.append(_not_converged_note(row.dem))
+            note.append(not_converged_note(row.dem))
             unconverged_rows += 1
         if pool:
             note.append("pooled across specimens and DEM settings (--pool)")
@@ -267,9 +289,10 @@ def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | N
     return table
 
 
-def _not_converged_note(dem: DemCase) -> str:
+def not_converged_note(dem: DemCase) -> str:
     """The row note for a DEM case with runs whose steady state was never detected, in the
-    words ``pidcore dem run`` prints for such a run."""
+    words ``pidcore dem run`` prints for such a run (the report table and the app's Compare tab
+    say it alike)."""
     runs = "; ".join(f"steady state from cycle {start} (NOT converged, transient cap), "
                      f"{cycles} cycles measured" if start >= 0 and cycles >= 0
                      else "steady state NOT converged (transient cap)"

@@ -56,7 +56,8 @@ def _calibrated(active, comp, head) -> None:
     hit = calibration.lookup(comp.load_case)
     st.markdown("**calibrated DEM** (" + label + ")")
     if hit is None:
-        st.caption(f"The calibration does not predict {comp.load_case.key} (it predicts "
+        st.caption(f"The calibration does not predict {workbench.case_label(comp.load_case)} "
+                   f"(it predicts "
                    f"{len(calibration.predictions)} measured load case(s)).")
         return
     c1, c2, c3 = st.columns(3)
@@ -110,12 +111,18 @@ def render(stores, session_files: list, active_calibration: tuple) -> None:
         return
     comp, head = view["comparison"], view["headline"]
     aligned = comp.aligned
-    dem_text = (uploads.format_sdc(head.dem, head.dem_stderr) if math.isfinite(head.dem)
-                else "none")
+    # the DEM number names its specimen: runs of another specimen are never met
+    dem_text = (uploads.format_sdc(head.dem, head.dem_stderr)
+                + (f" (specimen {view['dem_specimen']})" if view["dem_specimen"] else "")
+                if math.isfinite(head.dem) else "none")
     # the headline names its SDC: the calibrated section below shows the Eq. 11 one
     st.markdown(f"### measured ({head.measured_kind.split(' (')[0]}) "
                 f"{uploads.format_sdc(head.measured, head.measured_stderr)} "
                 f"vs our DEM {dem_text} — {head.verdict}")
+    if view["dem_refused"]:
+        st.warning(f"No DEM value: {view['dem_refused']}.", icon="⚠️")
+    if view["dem_warning"] and math.isfinite(head.dem):
+        st.warning(view["dem_warning"], icon="⚠️")
     st.caption(f"Measured SDC: {head.measured_kind}"
                + (" (energy per cycle over the DEM case's m_c a²/(2ω²), as our DEM SDC is "
                   "defined)" if head.measured_kind.startswith("Eq. 10") else "")
@@ -133,10 +140,15 @@ def render(stores, session_files: list, active_calibration: tuple) -> None:
         c1.metric("SDC measured, Eq. 11 ± stderr [-]",
                   uploads.format_sdc(comp.measured_sdc, comp.measured_stderr),
                   help="energy per cycle over the reactive energy Im(P)/w")
+        # "none" fits the metric's width ("not a Table 3 case" was cut); the caption says why
         c2.metric("SDC paper DEM [-]", f"{aligned.sdc_paper_dem:.4f}"
-                  if math.isfinite(aligned.sdc_paper_dem) else "not a Table 3 case")
+                  if math.isfinite(aligned.sdc_paper_dem) else "none")
         c3.metric("SDC paper measured [-]", f"{aligned.sdc_paper_experimental:.4f}"
-                  if math.isfinite(aligned.sdc_paper_experimental) else "not a Table 3 case")
+                  if math.isfinite(aligned.sdc_paper_experimental) else "none")
+        if not (math.isfinite(aligned.sdc_paper_dem)
+                and math.isfinite(aligned.sdc_paper_experimental)):
+            st.caption("paper: none where Table 3 has no value at this case (it tabulates "
+                       "acrylic spheres driven along z at its grid of load cases)")
     _calibrated(active_calibration, comp, head)
     for note in view["notes"]:
         st.caption(f"note: {note}")

@@ -1,0 +1,116 @@
+"""Which DEM runs a measurement meets: the runs of its specimen, never another's.
+
+A measurement may name its specimen (the ``specimen`` of a saved analysis: a specimen file's
+``name``); a stored DEM run states ``specimen_name`` and ``specimen_sha256``. A named
+measurement meets only the runs of that name; an unnamed one meets the runs of its material and
+direction when they all come from one specimen, and none when they come from several (they are
+not pooled: which specimen was tested is the user's to say). Runs stored before specimens
+existed (no hash) and runs of the paper's coupon with either table material are the paper's
+coupon, as in :func:`pidcore.dem.persist.runs_of_specimen`.
+
+Both the app's Compare tab and the report table choose their runs here.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import pandas as pd
+
+
+@dataclass(frozen=True)
+class SpecimenRuns:
+    """The DEM runs one measurement meets.
+
+    Attributes
+    ----------
+    runs : pandas.DataFrame or None
+        The runs to compare with (None: none).
+    specimen : str
+        The runs' specimen, e.g. ``"steel_6mm_b [3e945a]"``; empty where no run is met.
+    note : str
+        Why runs were left out (empty where none was); ``refused`` says whether the note asks
+        the user to name the specimen.
+    refused : bool
+        True where the runs of several specimens would have been pooled: none is met.
+    """
+
+    runs: pd.DataFrame | None
+    specimen: str = ""
+    note: str = ""
+    refused: bool = False
+
+
+def _paper_hashes() -> frozenset[str]:
+    from ..constants import PARTICLE_MATERIALS
+    from ..specimen import paper_specimen
+
+    return frozenset(paper_specimen(m).hash for m in PARTICLE_MATERIALS)
+
+
+def run_specimen_labels(runs: pd.DataFrame) -> pd.Series:
+    """One label per run: ``"name [hash6]"``; the paper's coupon (either table material, or
+    a run stored before specimens existed) is ``"paper_coupon"``: one specimen."""
+    from ..specimen import PAPER_SPECIMEN_NAME
+
+    def column(name: str) -> pd.Series:
+        if name not in runs.columns:
+            return pd.Series([""] * len(runs), index=runs.index)
+        return runs[name].map(lambda v: v if isinstance(v, str) else "")
+
+    paper = _paper_hashes()
+    return pd.Series([PAPER_SPECIMEN_NAME if not h or h in paper else f"{n or 'unnamed'} [{h[:6]}]"
+                      for n, h in zip(column("specimen_name"), column("specimen_sha256"),
+                                      strict=True)], index=runs.index, dtype=object)
+
+
+def _names(runs: pd.DataFrame, labels: pd.Series) -> pd.Series:
+    """The specimen name of each run (the paper's coupon for every paper run)."""
+    from ..specimen import PAPER_SPECIMEN_NAME
+
+    if "specimen_name" not in runs.columns:
+        return pd.Series([PAPER_SPECIMEN_NAME] * len(runs), index=runs.index, dtype=object)
+    return pd.Series([PAPER_SPECIMEN_NAME if label == PAPER_SPECIMEN_NAME else str(name)
+                      for label, name in zip(labels, runs["specimen_name"], strict=True)],
+                     index=runs.index, dtype=object)
+
+
+def _listed(labels: pd.Series) -> str:
+    counts = labels.value_counts(sort=False)
+    return ", ".join(f"{label} ({n} run(s))" for label, n in counts.items())
+
+
+def runs_for_measurement(runs: pd.DataFrame | None, specimen: str, material: str,
+                         direction: str) -> SpecimenRuns:
+    """The DEM runs a measurement of ``specimen`` (may be empty: not named) at ``material``
+    and ``direction`` meets (see the module's docstring)."""
+    if runs is None or runs.empty:
+        return SpecimenRuns(None)
+    same = runs
+    if "material" in runs.columns and "direction" in runs.columns:
+        same = runs[(runs["material"] == material) & (runs["direction"] == direction)]
+    if same.empty:
+        return SpecimenRuns(None)
+    labels = run_specimen_labels(same)
+    specimen = (specimen or "").strip()
+    if specimen:
+        mine = (_names(same, labels) == specimen).to_numpy(bool)
+        kept, others = labels[mine], labels[~mine]
+        left_out = (f"DEM runs of other specimens not compared: {_listed(others)}"
+                    if len(others) else "")
+        if kept.empty:
+            return SpecimenRuns(None, "", f"no DEM runs of specimen {specimen} at {material}, "
+                                          f"{direction}" + (f"; {left_out}" if left_out else ""))
+        if kept.nunique() > 1:  # an edited file keeps its name but is another specimen
+            return SpecimenRuns(None, "", f"DEM runs of {kept.nunique()} different specimen "
+                                          f"files named {specimen}: {_listed(kept)}; not pooled "
+                                          "(keep one version's runs, or rename the other)",
+                                refused=True)
+        return SpecimenRuns(same[mine].reset_index(drop=True), str(kept.iloc[0]), left_out)
+    if labels.nunique() > 1:
+        return SpecimenRuns(None, "", f"the DEM runs at {material}, {direction} are of "
+                                      f"{labels.nunique()} specimens: {_listed(labels)}; not "
+                                      "pooled. Name the file's specimen (column `specimen` of "
+                                      "the settings table) to compare it with one of them",
+                            refused=True)
+    return SpecimenRuns(same.reset_index(drop=True), str(labels.iloc[0]))
