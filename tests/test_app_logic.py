@@ -865,6 +865,32 @@ def test_the_report_table_pairs_a_measurement_with_its_specimens_dem_run(good_cs
     assert math.isnan(unnamed["SDC DEM (ours) [-]"]) and "not pooled" in unnamed["note"]
 
 
+def test_a_job_before_its_first_block_shows_starting_and_no_eta(tmp_path):
+    from pidcore.dem import DemConfig, LoadCase
+
+    case = LoadCase(100.0, 5.0, 50.0, "acrylic", "z")
+    job = jobs.DemJob("job0001", case, DemConfig(cells=1), "key")
+    row = job.row()
+    assert row["cycles [-]"] == "" and row["ETA [s]"] == ""  # queued: blank, not "0/?"/None
+    assert row["specimen"] == "paper_coupon"
+    job.state, job.started = "running", 100.0
+    row = job.row(now=103.0)
+    assert row["cycles [-]"] == "starting" and row["ETA [s]"] == ""
+    assert job.progress_text(now=103.0) == f"job0001 {case.key}: starting, 3 s elapsed"
+    job.cycles_done, job.cycles_expected = 10, 40
+    # 10 of 40 cycles in 3 s: 9 s left
+    assert job.progress_text(now=103.0) == (f"job0001 {case.key}: 10/40 cycles, 3 s elapsed, "
+                                             "ETA 9 s")
+    assert list(row)[:4] == ["job", "state", "specimen", "load case"]
+
+
+def test_an_uploaded_specimen_error_names_the_users_file():
+    with pytest.raises(ParameterError, match=r"^syntax\.toml: not valid TOML"):
+        jobs.specimen_from_upload("syntax.toml", b"name = 'x'\n[cell\n")
+    with pytest.raises(ParameterError, match="syntax.toml: not a text file"):
+        jobs.specimen_from_upload("syntax.toml", b"\xff\xfe")
+
+
 def test_sdc_chart_ticks_are_plain_numbers():
     from pidcore.app.charts import sdc_chart
 

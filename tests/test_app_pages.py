@@ -766,6 +766,12 @@ def test_compare_meets_the_dem_run_of_the_files_specimen_and_says_it_did_not_con
     # the old page showed steel_6mm's 0.0197 for a file of steel_6mm_b
     assert "vs our DEM 0.0231 ± 0.0010 (specimen steel_6mm_b [bbbbbb])" in _headline(at)
     assert any("DEM run did not converge" in w.value for w in at.warning)
+    # the DEM tab's runs table names the specimens and which run did not converge
+    runs = _table(at, "steady state")
+    assert runs["specimen"].tolist() == ["steel_6mm [aaaaaa]", "steel_6mm_b [bbbbbb]"]
+    assert runs["steady state"].tolist() == ["converged", "NOT converged, transient cap"]
+    assert list(runs.columns[:7]) == ["specimen", "frequency [Hz]", "acceleration [g]",
+                                      "fill [%]", "material", "SDC [-]", "SDC stderr [-]"]
     # no specimen named, runs of two: no DEM value, and the page says which and what to do
     at = _upload(_app(), [("m_fill50.csv", data), ("settings.csv", _steel_settings(None))])
     assert "vs our DEM none" in _headline(at)
@@ -773,3 +779,16 @@ def test_compare_meets_the_dem_run_of_the_files_specimen_and_says_it_did_not_con
     assert "steel_6mm [aaaaaa]" in said and "steel_6mm_b [bbbbbb]" in said
     assert "Name the file's specimen" in said
 
+
+def test_an_invalid_specimen_file_turns_run_off_and_names_the_users_file(store_file):
+    at = _app()
+    at.file_uploader(key="dem_specimen_file").set_value(
+        [("syntax.toml", b"name = 'x'\n[cell\n", "application/toml")])
+    at.run()
+    assert not at.exception
+    errors = [e.value for e in at.error]
+    assert any(e.startswith("syntax.toml: not valid TOML") for e in errors), errors
+    assert not any("/tmp" in e or "pidcore_specimen_" in e for e in errors), errors
+    # the old page fell back to acrylic on the paper's coupon and ran it
+    assert at.button(key="dem_run").disabled
+    assert "dem_material" not in {s.key for s in at.selectbox}

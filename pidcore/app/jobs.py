@@ -70,15 +70,44 @@ class DemJob:
         f = self.fraction()
         return self.elapsed_s(now) * (1.0 - f) / f if f > 0 else None
 
-    def row(self, now: float | None = None) -> dict:
-        """One row of the job table shown in the app (units in the column names)."""
+    def specimen_label(self) -> str:
+        """The job's specimen as the DEM runs table names it (``"steel_6mm_b [3e945a]"``;
+        ``"paper_coupon"`` for the paper's)."""
+        from ..specimen import PAPER_SPECIMEN_NAME
+
+        s = self.specimen
+        if s is None or s.is_paper():
+            return PAPER_SPECIMEN_NAME
+        return f"{s.name} [{s.hash[:6]}]"
+
+    def cycles_text(self) -> str:
+        """``"120/300"`` cycles done of expected; ``"starting"`` while running before the
+        first block reports (the expected count is not known yet); empty otherwise."""
+        if self.cycles_expected > 0:
+            return f"{self.cycles_done}/{self.cycles_expected}"
+        return "starting" if self.state == "running" else ""
+
+    def progress_text(self, now: float | None = None) -> str:
+        """The progress bar's line, e.g. ``"job0001 f100Hz_...: 120/300 cycles, 12 s elapsed,
+        ETA 18 s"``."""
         eta = self.eta_s(now)
-        return {"job": self.job_id, "load case": self.case.key, "state": self.state,
-                "progress [%]": round(100 * self.fraction(), 1),
-                "cycles [-]": f"{self.cycles_done}/{self.cycles_expected or '?'}",
+        cycles = self.cycles_text()
+        done = f"{cycles} cycles" if "/" in cycles else cycles or self.state
+        return (f"{self.job_id} {self.case.key}: {done}, {self.elapsed_s(now):.0f} s elapsed"
+                + (f", ETA {eta:.0f} s" if eta is not None else ""))
+
+    def row(self, now: float | None = None) -> dict:
+        """One row of the job table shown in the app (units in the column names), the
+        specimen and the progress first so that they show without scrolling. Unknowns are
+        blank, never "None" (the ETA before the first block of cycles)."""
+        eta = self.eta_s(now)
+        return {"job": self.job_id, "state": self.state, "specimen": self.specimen_label(),
+                "load case": self.case.key, "progress [%]": round(100 * self.fraction(), 1),
+                "cycles [-]": self.cycles_text(),
                 "elapsed [s]": round(self.elapsed_s(now), 1),
-                "ETA [s]": None if eta is None else round(eta, 1),
-                "store key": self.run_key, "message": self.message}
+                # text: a blank beside numbers would make the column "None" or mixed
+                "ETA [s]": "" if eta is None else f"{eta:.0f}",
+                "message": self.message, "store key": self.run_key}
 
 
 def _child(case, config, specimen, conn) -> None:
@@ -306,3 +335,48 @@ def plan_dem_cases(frequencies_hz: Sequence[float], accelerations_g: Sequence[fl
         raise ParameterError(f"{len(cases)} load cases chosen; the app runs at most "
                              f"{max_cases} at a time (use `pidcore dem` for larger sweeps)")
     return cases
+
+
+#: Columns of :func:`dem_runs_table`: store listing column -> name shown (units in the names).
+#: The specimen, the load case and the result come first: at 1280 px the table shows about
+#: eight columns before it scrolls, and the SDC was cut off behind the run key.
+DEM_RUN_COLUMNS = {"specimen": "specimen", "frequency_hz": "frequency [Hz]",
+                   "acceleration_g": "acceleration [g]", "fill_percent": "fill [%]",
+                   "material": "material", "sdc": "SDC [-]", "sdc_stderr": "SDC stderr [-]",
+                   "steady state": "steady state", "direction": "direction",
+                   "cells_simulated": "cells simulated", "seed": "seed",
+                   "wall_s": "wall time [s]", "case_key": "run", "store": "store"}
+
+
+def steady_state_text(detected) -> str:
+    """A run's ``steady_detected`` in words: the words ``pidcore dem run`` prints ("NOT
+    converged, transient cap") for a stated False, empty where the run does not say."""
+    if detected is None or (isinstance(detected, float) and detected != detected):
+        return ""
+    return "converged" if bool(detected) else "NOT converged, transient cap"
+
+
+def dem_runs_table(runs):
+    """The DEM tab's table of stored runs (:func:`pidcore.store.listing.list_dem_runs`):
+    columns :data:`DEM_RUN_COLUMNS` present, with each run's specimen
+    (:func:`pidcore.compare.specimens.run_specimen_labels`) and whether it converged."""
+    from ..compare.specimens import run_specimen_labels
+
+    runs = runs.assign(
+        specimen=run_specimen_labels(runs),
+        **{"steady state": runs["steady_detected"].map(steady_state_text)
+           if "steady_detected" in runs.columns else ""})
+    shown = {c: name for c, name in DEM_RUN_COLUMNS.items() if c in runs.columns}
+    return runs[list(shown)].rename(columns=shown)
+
+
+def specimen_from_upload(name: str, data: bytes):
+    """The specimen of an uploaded TOML file (parsed, never executed); a bad file raises
+    :class:`ParameterError` naming the user's file, not a temporary copy."""
+    from ..specimen import Specimen
+
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError:
+        raise ParameterError(f"{name}: not a text file (UTF-8)") from None
+    return Specimen.from_text(text, source=name)

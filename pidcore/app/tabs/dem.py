@@ -26,15 +26,6 @@ REFRESH_S = 1.0
 CANCEL_WAIT_S = 1.5
 
 
-#: Columns of the store's DEM run listing shown on the tab, and their names there (units in
-#: the names, as on every other table of the app).
-_RUN_COLUMNS = {"case_key": "run", "frequency_hz": "frequency [Hz]",
-                "acceleration_g": "acceleration [g]", "fill_percent": "fill [%]",
-                "material": "material", "direction": "direction", "sdc": "SDC [-]",
-                "sdc_stderr": "SDC stderr [-]", "cells_simulated": "cells simulated",
-                "seed": "seed", "wall_s": "wall time [s]", "store": "store"}
-
-
 def _config(cells: int, seed: int, steady_cycles: int):
     from pidcore.dem import DemConfig
 
@@ -58,13 +49,9 @@ def _job_table(stores, polling: bool) -> None:
     runner = jobs.runner_for(stores.path)
     rows = [j.row() for j in runner.jobs()]
     busy = runner.busy()
-    running = [r for r in rows if r["state"] == "running"]
+    running = [j for j in runner.jobs() if j.state == "running"]
     if running:
-        r = running[0]
-        eta = "…" if r["ETA [s]"] is None else f"{r['ETA [s]']:.0f} s"
-        st.progress(r["progress [%]"] / 100,
-                    text=f"{r['job']} {r['load case']}: {r['cycles [-]']} cycles, "
-                         f"{r['elapsed [s]']:.0f} s elapsed, ETA {eta}")
+        st.progress(running[0].fraction(), text=running[0].progress_text())
     if rows:
         st.dataframe(pd.DataFrame(rows), hide_index=True, width="stretch", key="dem_jobs")
         counts = pd.Series([r["state"] for r in rows]).value_counts()
@@ -86,10 +73,9 @@ _PAPER = "paper coupon (default)"
 
 
 def _specimen_choice():
-    """The specimen chosen (None: the paper's coupon): a file of SPECIMEN_FOLDERS or an
-    uploaded TOML (parsed by :func:`pidcore.specimen.load_specimen`, never executed)."""
-    import tempfile
-
+    """(specimen, error): the specimen chosen (None: the paper's coupon), a file of
+    SPECIMEN_FOLDERS or an uploaded TOML (parsed by :func:`pidcore.specimen.Specimen.from_text`,
+    never executed); ``error`` is why the chosen file is refused (None when it is not)."""
     from pidcore.errors import PidcoreError
     from pidcore.specimen import load_specimen
 
@@ -101,15 +87,13 @@ def _specimen_choice():
                           disabled=upload is not None)
     try:
         if upload is not None:
-            with tempfile.TemporaryDirectory(prefix="pidcore_specimen_") as folder:
-                path = Path(folder) / "specimen.toml"
-                path.write_bytes(upload.getvalue())
-                return load_specimen(path)
-        return None if choice == _PAPER else load_specimen(choice)
+            return jobs.specimen_from_upload(upload.name, upload.getvalue()), None
+        return (None if choice == _PAPER else load_specimen(choice)), None
     except (PidcoreError, OSError, ValueError) as exc:
         name = upload.name if upload is not None else choice
-        st.error(f"{name}: {exc}")
-        return None
+        message = str(exc) if str(exc).startswith(name) else f"{name}: {exc}"
+        st.error(message)
+        return None, message
 
 
 def render(stores) -> None:
@@ -126,9 +110,12 @@ def render(stores) -> None:
                           help="one or more values, e.g. 50, 100, 333")
     accs = c2.text_input("accelerations [g]", "5", key="dem_accs", help="e.g. 1, 5, 7.5")
     fills = c3.text_input("fills [%]", "50", key="dem_fills", help="e.g. 25, 50")
-    specimen = _specimen_choice()
+    specimen, refused = _specimen_choice()
     c4, c5 = st.columns(2)
-    if specimen is None:
+    if refused is not None:  # no fallback to the paper's coupon: nothing runs until fixed
+        c4.text_input("particle material", "(the specimen file is refused)", disabled=True,
+                      key="dem_material_refused")
+    elif specimen is None:
         material = c4.selectbox("particle material", PARTICLE_MATERIALS, key="dem_material")
     else:
         material = specimen.particles.material
@@ -144,10 +131,14 @@ def render(stores) -> None:
         steady = d3.number_input("steady cycles (0 = automatic)", min_value=0, value=0, step=1,
                                  key="dem_steady")
     b1, b2 = st.columns(2)
-    start = b1.button("Run", type="primary", key="dem_run")
+    start = b1.button("Run", type="primary", key="dem_run", disabled=refused is not None,
+                      help="off while the chosen specimen file is refused"
+                      if refused is not None else None)
     b2.button("Cancel", key="dem_cancel", on_click=_cancel, args=(stores,),
               help="stops the running case within a second and drops the queued ones")
-    if start:
+    if start and refused is not None:  # a click that raced the disabling
+        st.session_state["dem_message"] = ("error", f"not run: {refused}")
+    elif start:
         try:
             config = _config(cells, seed, steady)
             cases = jobs.plan_dem_cases(
@@ -175,7 +166,11 @@ def render(stores) -> None:
         st.error(f"cannot read the DEM runs: {exc}")
         return
     if not runs.empty:
-        shown = {c: name for c, name in _RUN_COLUMNS.items() if c in runs.columns}
         st.markdown(f"**DEM runs in the stores** ({len(runs)})")
-        st.dataframe(runs[list(shown)].rename(columns=shown), hide_index=True, width="stretch",
-                     key="dem_runs_table")
+        table = jobs.dem_runs_table(runs)
+        st.dataframe(table, hide_index=True, width="stretch", key="dem_runs_table")
+        unconverged = int(table["steady state"].str.startswith("NOT").sum())
+        if unconverged:
+            st.warning(f"{unconverged} run(s) did not converge (steady state NOT detected "
+                       "before the transient cap): their SDC may include the transient; see "
+                       "the column steady state.", icon="⚠️")
