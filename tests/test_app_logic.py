@@ -759,3 +759,31 @@ def test_calibration_digest_follows_the_content():
     other = calibration_from_json(doc(0.44), "calibration.json")
     assert calibration_digest(None) == ""
     assert calibration_digest(first) == calibration_digest(again) != calibration_digest(other)
+
+
+def test_calibrate_page_keeps_saved_materials_apart_and_refuses_a_mixed_or_unknown_one(
+        tmp_path, options):
+    # a saved steel record (specimen steel_6mm_b) and an acrylic one of one load case: the
+    # page's points name their material and are not averaged; the page calibrates the paper's
+    # coupon, so steel points are refused before a background run starts (as the CLI does)
+    import pidcore.calibrate as api
+    from pidcore.app.calibration import points_by_material, runner_for
+
+    store_file = tmp_path / "s.h5"
+    acrylic = _record(mass_damper_csv(frequency_hz=100.0), options, name="a_fill50.csv")
+    steel = _record(mass_damper_csv(frequency_hz=100.0, seed=3), options, name="b_fill50.csv")
+    steel_case = load_case_of(steel, fill_percent=50.0, material="steel")
+    uploads.save_records(store_file, [_file(acrylic, options),
+                                      AnalysedFile(steel, steel_case, options, "steel_6mm_b")])
+    points = api.measured_from_store(store_file)
+    by = points_by_material(points)
+    assert list(by) == ["acrylic", "steel"]
+    assert by["steel"][0].specimen == "steel_6mm_b"
+    assert by["steel"][0].sdc == steel.analysis.sdc  # its own value, not a mean with acrylic
+    assert by["acrylic"][0].sdc == acrylic.analysis.sdc
+    runner = runner_for(store_file)
+    for chosen, words in ((points, "several particle materials"),
+                          (by["steel"], "steel particles, which are not in the materials")):
+        with pytest.raises(ParameterError, match=words):
+            runner.start(api, chosen, fit=["fixture_mass_kg"], cells=2, design_size=None)
+    assert runner.task is None  # nothing started
