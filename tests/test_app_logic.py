@@ -320,7 +320,7 @@ def test_save_writes_the_load_case_and_the_report_reads_it(tmp_path, good_csv, o
 
     rec = _record(good_csv, options, name="coupon_fill50.csv")
     store_file = tmp_path / "store.h5"
-    keys = uploads.save_records(store_file, [_file(rec, options, specimen="S1")])
+    keys = uploads.save_records(store_file, [_file(rec, options, specimen="S1")]).keys
     listed = Store(store_file).list_analyses()
     assert listed["key"].tolist() == keys
     row = listed.iloc[0]
@@ -787,3 +787,43 @@ def test_calibrate_page_keeps_saved_materials_apart_and_refuses_a_mixed_or_unkno
         with pytest.raises(ParameterError, match=words):
             runner.start(api, chosen, fit=["fixture_mass_kg"], cells=2, design_size=None)
     assert runner.task is None  # nothing started
+
+
+def test_a_byte_identical_file_under_another_name_says_what_it_replaces(tmp_path, good_csv,
+                                                                        options):
+    # the store keys a measurement by its bytes: saving a copy under another name (and another
+    # load case) is one record; the save names the record it replaces and keeps the new name
+    from pidcore.store.listing import saved_analyses
+
+    store_file = tmp_path / "s.h5"
+    first = _record(good_csv, options, name="a_fill50.csv")
+    assert uploads.save_records(store_file, [_file(first, options)]).notes == ()
+    copy = _record(good_csv, options, name="b_fill75.csv")
+    saved = uploads.save_records(store_file, [_file(copy, options, fill=75.0)])
+    (note,) = saved.notes
+    assert "b_fill75.csv has the same contents as the saved record a_fill50.csv" in note
+    assert ", 50 %, acrylic, z)" in note and ", 75 %, acrylic, z) replaces it" in note
+    rows = saved_analyses(store_file)
+    assert rows["file"].tolist() == ["b_fill75.csv"]
+    assert rows["fill_percent"].tolist() == [75.0]
+    assert uploads.identical_uploads([("a.csv", "1"), ("b.csv", "1"), ("c.csv", "2")]) == [
+        "b.csv has the same contents as a.csv: one measurement, saved as one record (under "
+        "the name saved last) and counted once"]
+
+
+def test_identical_contents_are_pooled_once(tmp_path, good_csv, options):
+    # the saved a.csv and this session's b.csv (same bytes) and a second session copy: one
+    # measurement; pooling them would count the data three times (stderr / sqrt(3))
+    from pidcore.app.workbench import saved_entries
+    from pidcore.compare.case import unique_entries
+    from pidcore.store.listing import saved_analyses
+
+    store_file = tmp_path / "s.h5"
+    uploads.save_records(store_file, [_file(_record(good_csv, options, name="a.csv"), options)])
+    saved = saved_entries(store_file, saved_analyses(store_file))
+    session = [_entry(_record(good_csv, options, name=n)) for n in ("b.csv", "c.csv")]
+    other = _entry(_record(mass_damper_csv(seed=7), options, name="d.csv"))
+    kept, notes = unique_entries([*saved, *session, other])
+    assert [e.file for e in kept] == ["a.csv", "d.csv"]
+    assert notes == [f"{n} left out, this session (unsaved): the same contents as a.csv "
+                     "(saved); the same data are counted once" for n in ("b.csv", "c.csv")]

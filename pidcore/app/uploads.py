@@ -218,6 +218,20 @@ def options_from_json(text: str) -> AnalysisOptions:
     return AnalysisOptions(**json.loads(text))
 
 
+def identical_uploads(uploads: Sequence[tuple[str, str]]) -> list[str]:
+    """A note per upload whose bytes equal an earlier one's (``(name, sha256)`` pairs): the
+    store keeps one record of them and Compare counts them once."""
+    first: dict[str, str] = {}
+    notes = []
+    for name, sha in uploads:
+        if sha in first:
+            notes.append(f"{name} has the same contents as {first[sha]}: one measurement, "
+                         "saved as one record (under the name saved last) and counted once")
+        else:
+            first[sha] = name
+    return notes
+
+
 # --- per-file settings --------------------------------------------------------------------------
 
 def is_settings_table(data: bytes) -> bool:
@@ -410,13 +424,61 @@ def format_sdc(sdc: float, stderr: float) -> str:
     return f"{sdc:.4f} ± {stderr:.4f}" if math.isfinite(stderr) else f"{sdc:.4f}"
 
 
+@dataclass(frozen=True)
+class SavedRecords:
+    """What a save wrote: the analysis ``keys`` and ``notes`` naming each saved record it
+    replaced (a byte-identical file is one record, under the name saved last)."""
+
+    keys: list[str]
+    notes: tuple[str, ...] = ()
+
+
+def _stored_case_label(row) -> str:
+    from ..compare.align import _row_case
+
+    try:
+        case = _row_case(row)
+    except (KeyError, TypeError, ValueError):
+        return "no load case"
+    return f"{case.label()}, {case.material}, {case.direction}"
+
+
+def replacement_notes(analyses: pd.DataFrame, files: Sequence[AnalysedFile]) -> list[str]:
+    """Which saved records (file name, load case) saving ``files`` replaces: the store keys a
+    measurement by its contents, so a byte-identical file under another name, or a second
+    copy in the same save, is the same record, and only the last one saved is kept.
+
+    ``analyses`` is :meth:`pidcore.store.Store.list_analyses` before the save.
+    """
+    from ..store import measurement_key
+
+    notes = []
+    saved = {}  # measurement key -> (file, load case) it holds now
+    if not analyses.empty and {"measurement_key", "created_utc"} <= set(analyses.columns):
+        for _, row in analyses.sort_values("created_utc", kind="stable").iterrows():
+            saved[str(row["measurement_key"])] = (Path(str(row.get("source", ""))).name,
+                                                  _stored_case_label(row))
+    for f in files:
+        name = Path(f.record.measurement.source).name
+        key = measurement_key(f.record.measurement)
+        case = f"{f.load_case.label()}, {f.load_case.material}, {f.load_case.direction}"
+        if key in saved:
+            old_name, old_case = saved[key]
+            if (old_name, old_case) != (name, case):
+                notes.append(f"{name} has the same contents as the saved record {old_name} "
+                             f"({old_case}); saved as one record: {name} ({case}) replaces it")
+        saved[key] = (name, case)
+    return notes
+
+
 def save_records(path: str | os.PathLike, files: Sequence[AnalysedFile], *,
-                 confirm_implausible: bool = False) -> list[str]:
+                 confirm_implausible: bool = False) -> SavedRecords:
     """Save analysed files with their load cases to the store in one locked transaction.
 
     Each file's own corrections are its analysis parameters (with its channel mapping); the
     load case fields and the specimen go into its record. A file with plausibility warnings is
-    only saved with ``confirm_implausible`` (the user's explicit confirmation).
+    only saved with ``confirm_implausible`` (the user's explicit confirmation). The notes say
+    which saved record each byte-identical file replaces (:func:`replacement_notes`).
     """
     from ..measure import store_analysis
     from ..store import Store
@@ -429,6 +491,7 @@ def save_records(path: str | os.PathLike, files: Sequence[AnalysedFile], *,
                              "them anyway")
     store = Store(path)
     with store.transaction():
+        notes = replacement_notes(store.list_analyses(), files)
         keys = []
         for f in files:
             parameters = replace(f.options, force=None, velocity=None,
@@ -440,4 +503,4 @@ def save_records(path: str | os.PathLike, files: Sequence[AnalysedFile], *,
                 fields = {**fields, "plausibility_warnings": "; ".join(str(w)
                                                                        for w in f.warnings)}
             keys.append(store_analysis(store, f.record, parameters, fields=fields))
-        return keys
+        return SavedRecords(keys, tuple(notes))

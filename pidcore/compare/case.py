@@ -171,6 +171,10 @@ class MeasuredEntry:
     corrections : str
         The corrections the analysis ran with, e.g. ``"vibrometer delay 50 µs, mass below
         gauge 0 g, baseline loss factor 0"`` (empty where unknown).
+    measurement_key : str
+        The store's key of the measured data (:func:`pidcore.store.measurement_key`): equal
+        for byte-identical files under any name, so :func:`unique_entries` counts them once
+        (empty where unknown).
     """
 
     key: str
@@ -189,20 +193,28 @@ class MeasuredEntry:
     specimen: str = ""
     created_utc: str = ""
     corrections: str = ""
+    measurement_key: str = ""
 
     @classmethod
     def from_record(cls, record, load_case: LoadCase, *,
                     specimen: str = "", options=None) -> MeasuredEntry:
         """Entry of a fresh (unsaved) analysis (:class:`pidcore.measure.AnalyzedRecord`);
         ``options`` (:class:`pidcore.measure.AnalysisOptions`) names the corrections."""
+        from ..store import measurement_key
+
         a = record.analysis
+        try:
+            content = measurement_key(record.measurement)
+        except PidcoreError:  # a malformed digest: the entry is never taken for a copy
+            content = ""
         return cls(f"upload:{record.measurement.sha256}", Path(record.measurement.source).name,
                    "this session (unsaved)", load_case, float(a.frequency_hz),
                    float(a.acceleration_amplitude_m_s2), float(a.loss_factor), float(a.sdc),
                    float(a.sdc_stderr), float(a.energy_per_cycle_j),
                    np.asarray(a.harmonics), np.asarray(a.force_phasors_n),
                    np.asarray(a.velocity_phasors_m_s), specimen,
-                   corrections=describe_corrections(vars(options)) if options else "")
+                   corrections=describe_corrections(vars(options)) if options else "",
+                   measurement_key=content)
 
     @classmethod
     def from_store(cls, row: pd.Series, arrays: dict) -> MeasuredEntry:
@@ -220,7 +232,8 @@ class MeasuredEntry:
                    np.asarray(arrays.get("force_phasors_n", empty)),
                    np.asarray(arrays.get("velocity_phasors_m_s", empty)),
                    str(row.get("specimen", "") or ""), str(row.get("created_utc", "")),
-                   describe_corrections(_json_dict(row.get("parameters_json"))))
+                   describe_corrections(_json_dict(row.get("parameters_json"))),
+                   str(row.get("measurement_key", "") or ""))
 
     def loop(self):
         """The measured loop (:class:`pidcore.loop.ForceDisplacementLoop`, labelled
@@ -243,6 +256,31 @@ class MeasuredEntry:
             "force amplitude [N]": np.abs(np.asarray(self.force_phasors_n)),
             "velocity amplitude [m/s]": np.abs(np.asarray(self.velocity_phasors_m_s)),
         })
+
+
+def unique_entries(entries: Sequence[MeasuredEntry]) -> tuple[list[MeasuredEntry], list[str]]:
+    """``entries`` with each measured data set once, and a note per entry left out.
+
+    Byte-identical files (one saved, one uploaded again under another name, or two uploads)
+    are one measurement: pooling both would count the same data twice and shrink the standard
+    error by about sqrt(2). The first entry of each :attr:`MeasuredEntry.measurement_key` is
+    kept (list saved records first: the store's copy is the one Compare and Report share);
+    entries without a key are all kept.
+    """
+    kept: list[MeasuredEntry] = []
+    notes: list[str] = []
+    first: dict[str, MeasuredEntry] = {}
+    for e in entries:
+        other = first.get(e.measurement_key) if e.measurement_key else None
+        if other is None:
+            if e.measurement_key:
+                first[e.measurement_key] = e
+            kept.append(e)
+            continue
+        where = "saved" if other.origin == "store" else "this session"
+        notes.append(f"{e.file} left out, {e.origin}: the same contents as {other.file} "
+                     f"({where}); the same data are counted once")
+    return kept, notes
 
 
 def _json_dict(text) -> dict:

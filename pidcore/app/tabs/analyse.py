@@ -171,6 +171,9 @@ def render(stores) -> list:
             measurements.append(upload)
     if not measurements:
         return []
+    for note in uploads.identical_uploads([(u.name, state.upload_sha256(u))
+                                           for u in measurements]):
+        st.warning(note)
     channel_names = []
     for upload in measurements:
         found = state.parsed(state.upload_sha256(upload), upload.name, sample_rate_hz, upload)
@@ -195,9 +198,11 @@ def render(stores) -> list:
     if st.button(f"Save {len(analysed)} record(s) to the store", disabled=not analysed,
                  type="primary", key="save"):
         try:
-            keys = uploads.save_records(stores.path, analysed, confirm_implausible=confirm)
+            saved = uploads.save_records(stores.path, analysed, confirm_implausible=confirm)
         except PidcoreError as exc:
             st.error(f"not saved: {exc}")
         else:
-            st.success(f"saved {len(keys)} analysis record(s) to {stores.path}")
+            st.success(f"saved {len(saved.keys)} analysis record(s) to {stores.path}")
+            for note in saved.notes:
+                st.warning(note)
     return analysed
