@@ -827,3 +827,27 @@ def test_identical_contents_are_pooled_once(tmp_path, good_csv, options):
     assert [e.file for e in kept] == ["a.csv", "d.csv"]
     assert notes == [f"{n} left out, this session (unsaved): the same contents as a.csv "
                      "(saved); the same data are counted once" for n in ("b.csv", "c.csv")]
+
+
+def test_specimen_files_offer_their_material_and_an_unknown_one_says_how(tmp_path):
+    # a settings table stating brass: refused with the way to make brass known; a specimen
+    # file of steel makes steel a material to state before any DEM run of it is saved
+    from pidcore.compare.case import stated_case
+
+    folder = tmp_path / "specimens"
+    folder.mkdir()
+    (folder / "steel.toml").write_bytes(
+        (REPO / "data_samples" / "specimens" / "steel_6mm.toml").read_bytes())
+    (folder / "broken.toml").write_text("not = [toml")
+    found = uploads.specimen_materials([folder, tmp_path / "missing"])
+    assert found == ["steel"]
+    assert "steel" in uploads.measurement_materials(found)
+    table = b"file,material\nx.csv,brass\n"
+    with pytest.raises(ParameterError, match=r"unknown particle material 'brass'.*once a "
+                                             r"specimen file of it is in the specimen folders"):
+        uploads.read_settings_table("settings_brass.csv", table)
+    row = {"fill [%]": 50.0, "material": "acrylic"}
+    stated = stated_case("coupon.csv")
+    assert uploads.assumed_note(stated, row) == ("fill: not stated, 50 % proposed; "
+                                                 "material: not stated, acrylic assumed")
+    assert uploads.assumed_note(stated, {"fill [%]": 62.0, "material": "steel"}) == ""

@@ -262,6 +262,31 @@ def measurement_materials(extra: Iterable[object] = ()) -> tuple[str, ...]:
     return (*names[:len(PARTICLE_MATERIALS)], *sorted(names[len(PARTICLE_MATERIALS):]))
 
 
+def specimen_materials(folders: Iterable[str | os.PathLike]) -> list[str]:
+    """Particle materials of the specimen files (``*.toml``) in ``folders`` (the DEM page's
+    specimen folders): a measurement of an own specimen may state its material before any DEM
+    run of it is saved. Unreadable files are skipped (the DEM page reports them)."""
+    from ..specimen import load_specimen
+
+    found = []
+    for folder in folders:
+        folder = Path(folder)
+        if not folder.is_dir():
+            continue
+        for path in sorted(folder.glob("*.toml")):
+            try:
+                found.append(load_specimen(path).particles.material)
+            except (PidcoreError, OSError, ValueError):
+                continue
+    return found
+
+
+#: Appended to an unknown material's error: how an own material becomes one to state.
+MATERIAL_HINT = ("an own material can be stated once a specimen file of it is in the "
+                 "specimen folders (data_samples/specimens/, specimens/) or a DEM run of it "
+                 "is saved")
+
+
 def read_settings_table(name: str, data: bytes,
                         materials: tuple[str, ...] = PARTICLE_MATERIALS) -> pd.DataFrame:
     """An uploaded settings table as rows of :data:`FILE_TABLE_COLUMNS` (app column names).
@@ -295,8 +320,11 @@ def read_settings_table(name: str, data: bytes,
                 raise ParameterError(f"{name}, line {i}: {FILE_TABLE_COLUMNS[column]} "
                                      f"{text!r} is not a number") from None
         out[column] = values
-    out["material"] = [normalize_material(v, f"{name}: material", materials) if v else ""
-                       for v in out["material"]]
+    try:
+        out["material"] = [normalize_material(v, f"{name}: material", materials) if v else ""
+                           for v in out["material"]]
+    except PidcoreError as exc:
+        raise ParameterError(f"{exc} ({MATERIAL_HINT})") from None
     out["direction"] = [normalize_direction(v, f"{name}: direction") if v else ""
                         for v in out["direction"]]
     if (out["file"] == "").any():
@@ -312,6 +340,27 @@ def default_settings_row(name: str, stated) -> dict:
             "mass below gauge [g]": 0.0, "baseline loss factor [-]": 0.0,
             "force channel": AUTO_CHANNEL, "velocity channel": AUTO_CHANNEL,
             "acceleration channel": AUTO_CHANNEL, "inverted channels": ""}
+
+
+def assumed_note(stated, row: Mapping) -> str:
+    """What a file's settings row still takes from no statement, e.g. ``'material: not
+    stated, acrylic assumed'`` (:func:`pidcore.compare.case.unstated_note`), shown with its
+    result; a value the user has set in the row since is no longer assumed."""
+    parts = []
+    if "fill: not stated" in stated.origin and _same_number(row.get("fill [%]"),
+                                                            stated.fill_percent):
+        parts.append(f"fill: not stated, {stated.fill_percent:g} % proposed")
+    if "material: default" in stated.origin and str(row.get("material", "")) == \
+            stated.material:
+        parts.append(f"material: not stated, {stated.material} assumed")
+    return "; ".join(parts)
+
+
+def _same_number(value, number: float) -> bool:
+    try:
+        return float(value) == float(number)
+    except (TypeError, ValueError):
+        return False
 
 
 def merge_settings(names: Sequence[str], stated: Sequence, previous: pd.DataFrame | None,
