@@ -320,7 +320,7 @@ def test_save_writes_the_load_case_and_the_report_reads_it(tmp_path, good_csv, o
 
     rec = _record(good_csv, options, name="coupon_fill50.csv")
     store_file = tmp_path / "store.h5"
-    keys = uploads.save_records(store_file, [_file(rec, options, specimen="S1")])
+    keys = uploads.save_records(store_file, [_file(rec, options, specimen="S1")]).keys
     listed = Store(store_file).list_analyses()
     assert listed["key"].tolist() == keys
     row = listed.iloc[0]
@@ -899,3 +899,98 @@ def test_sdc_chart_ticks_are_plain_numbers():
     x = sdc_chart(data)["layer"][0]["encoding"]["x"]
     # "~g": 40 and 37.5 (Vega wrote 40.000000 for the list of floats)
     assert x["axis"] == {"values": [40.0], "format": "~g"}
+
+
+def test_calibrate_page_keeps_saved_materials_apart_and_refuses_a_mixed_or_unknown_one(
+        tmp_path, options):
+    # a saved steel record (specimen steel_6mm_b) and an acrylic one of one load case: the
+    # page's points name their material and are not averaged; the page calibrates the paper's
+    # coupon, so steel points are refused before a background run starts (as the CLI does)
+    import pidcore.calibrate as api
+    from pidcore.app.calibration import points_by_material, runner_for
+
+    store_file = tmp_path / "s.h5"
+    acrylic = _record(mass_damper_csv(frequency_hz=100.0), options, name="a_fill50.csv")
+    steel = _record(mass_damper_csv(frequency_hz=100.0, seed=3), options, name="b_fill50.csv")
+    steel_case = load_case_of(steel, fill_percent=50.0, material="steel")
+    uploads.save_records(store_file, [_file(acrylic, options),
+                                      AnalysedFile(steel, steel_case, options, "steel_6mm_b")])
+    points = api.measured_from_store(store_file)
+    by = points_by_material(points)
+    assert list(by) == ["acrylic", "steel"]
+    assert by["steel"][0].specimen == "steel_6mm_b"
+    assert by["steel"][0].sdc == steel.analysis.sdc  # its own value, not a mean with acrylic
+    assert by["acrylic"][0].sdc == acrylic.analysis.sdc
+    runner = runner_for(store_file)
+    for chosen, words in ((points, "several particle materials"),
+                          (by["steel"], "steel particles, which are not in the materials")):
+        with pytest.raises(ParameterError, match=words):
+            runner.start(api, chosen, fit=["fixture_mass_kg"], cells=2, design_size=None)
+    assert runner.task is None  # nothing started
+
+
+def test_a_byte_identical_file_under_another_name_says_what_it_replaces(tmp_path, good_csv,
+                                                                        options):
+    # the store keys a measurement by its bytes: saving a copy under another name (and another
+    # load case) is one record; the save names the record it replaces and keeps the new name
+    from pidcore.store.listing import saved_analyses
+
+    store_file = tmp_path / "s.h5"
+    first = _record(good_csv, options, name="a_fill50.csv")
+    assert uploads.save_records(store_file, [_file(first, options)]).notes == ()
+    copy = _record(good_csv, options, name="b_fill75.csv")
+    saved = uploads.save_records(store_file, [_file(copy, options, fill=75.0)])
+    (note,) = saved.notes
+    assert "b_fill75.csv has the same contents as the saved record a_fill50.csv" in note
+    assert ", 50 %, acrylic, z)" in note and ", 75 %, acrylic, z) replaces it" in note
+    rows = saved_analyses(store_file)
+    assert rows["file"].tolist() == ["b_fill75.csv"]
+    assert rows["fill_percent"].tolist() == [75.0]
+    assert uploads.identical_uploads([("a.csv", "1"), ("b.csv", "1"), ("c.csv", "2")]) == [
+        "b.csv has the same contents as a.csv: one measurement, saved as one record (under "
+        "the name saved last) and counted once"]
+
+
+def test_identical_contents_are_pooled_once(tmp_path, good_csv, options):
+    # the saved a.csv and this session's b.csv (same bytes) and a second session copy: one
+    # measurement; pooling them would count the data three times (stderr / sqrt(3))
+    from pidcore.app.workbench import saved_entries
+    from pidcore.compare.case import unique_entries
+    from pidcore.store.listing import saved_analyses
+
+    store_file = tmp_path / "s.h5"
+    uploads.save_records(store_file, [_file(_record(good_csv, options, name="a.csv"), options)])
+    saved = saved_entries(store_file, saved_analyses(store_file))
+    session = [_entry(_record(good_csv, options, name=n)) for n in ("b.csv", "c.csv")]
+    other = _entry(_record(mass_damper_csv(seed=7), options, name="d.csv"))
+    kept, notes = unique_entries([*saved, *session, other])
+    assert [e.file for e in kept] == ["a.csv", "d.csv"]
+    assert notes == [f"{n} left out, this session (unsaved): the same contents as a.csv "
+                     "(saved); the same data are counted once" for n in ("b.csv", "c.csv")]
+    # a.csv still in the session after its Save is its own saved copy: left out silently
+    kept, notes = unique_entries([*saved, _entry(_record(good_csv, options, name="a.csv"))])
+    assert [e.file for e in kept] == ["a.csv"] and notes == []
+
+
+def test_specimen_files_offer_their_material_and_an_unknown_one_says_how(tmp_path):
+    # a settings table stating brass: refused with the way to make brass known; a specimen
+    # file of steel makes steel a material to state before any DEM run of it is saved
+    from pidcore.compare.case import stated_case
+
+    folder = tmp_path / "specimens"
+    folder.mkdir()
+    (folder / "steel.toml").write_bytes(
+        (REPO / "data_samples" / "specimens" / "steel_6mm.toml").read_bytes())
+    (folder / "broken.toml").write_text("not = [toml")
+    found = uploads.specimen_materials([folder, tmp_path / "missing"])
+    assert found == ["steel"]
+    assert "steel" in uploads.measurement_materials(found)
+    table = b"file,material\nx.csv,brass\n"
+    with pytest.raises(ParameterError, match=r"unknown particle material 'brass'.*once a "
+                                             r"specimen file of it is in the specimen folders"):
+        uploads.read_settings_table("settings_brass.csv", table)
+    row = {"fill [%]": 50.0, "material": "acrylic"}
+    stated = stated_case("coupon.csv")
+    assert uploads.assumed_note(stated, row) == ("fill: not stated, 50 % proposed; "
+                                                 "material: not stated, acrylic assumed")
+    assert uploads.assumed_note(stated, {"fill [%]": 62.0, "material": "steel"}) == ""

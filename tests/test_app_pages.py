@@ -269,6 +269,21 @@ def test_the_chosen_load_case_stays_chosen_when_a_save_reorders_the_list(store_f
     assert shown() == {"hi_fill50.csv"}
 
 
+def test_an_identical_file_under_another_name_is_compared_once(store_file):
+    # the trial pooled a saved file and its copy as "2 files pooled" (stderr / sqrt(2))
+    data = mass_damper_csv(frequency_hz=100.0)
+    at = _upload(_app(), [("a_fill50.csv", data)])
+    at.button(key="save").click()
+    at.run()
+    at = _upload(at, [("a_fill50.csv", data), ("copy_fill50.csv", data)])
+    assert at.selectbox(key="compare_case").options == [
+        "100 Hz, 5 g, 50 %, acrylic, z (1 file(s))"]
+    said = [c.value for c in at.caption]
+    assert any(c.startswith("copy_fill50.csv left out") and "a_fill50.csv (saved)" in c
+               for c in said)
+    assert not any(c.startswith("a_fill50.csv left out") for c in said)  # its own saved copy
+
+
 def test_saved_records_are_compared_after_a_reload_and_filtered(store_file):
     _dem_store_with_runs(store_file)
     files = [("s1_fill50.csv", mass_damper_csv(frequency_hz=100.0)),

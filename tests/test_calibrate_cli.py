@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import math
+from pathlib import Path
 
 import pytest
 
@@ -15,6 +16,7 @@ from pidcore.dem.simulate import DemConfig, LoadCase
 from pidcore.specimen import load_specimen, paper_specimen
 from pidcore.store import Store
 
+REPO = Path(__file__).resolve().parents[1]
 HEADER = "frequency_hz,acceleration_g,fill_percent,sdc\n"
 ROWS = "500,5,50,0.6\n1000,5,50,0.6\n500,1,50,0.2\n"
 TINY = ["--cells", "2", "--steady-cycles", "10", "--workers", "1", "--no-progress"]
@@ -153,3 +155,65 @@ def test_store_measurements_are_grouped_per_load_case(monkeypatch, tmp_path):
     assert points[(50.0, 5.0)].sdc == pytest.approx(0.23)
     assert points[(50.0, 5.0)].sdc_stderr == pytest.approx(0.03)  # std 0.0424 / sqrt(2)
     assert points[(500.0, 1.0)].sdc_stderr == pytest.approx(0.015)
+
+
+def test_store_measurements_of_other_materials_are_other_points(monkeypatch, tmp_path):
+    # acrylic and steel particles at one load case are two specimens: averaging them would fit
+    # neither; the material and specimen label saved with each record are kept
+    import pandas as pd
+
+    from pidcore.calibrate import measured_from_store
+
+    frame = pd.DataFrame({"frequency_hz": [500.0, 500.0, 500.0],
+                          "acceleration_g": [1.0, 1.0, 1.0], "fill_percent": [50.0] * 3,
+                          "sdc": [0.20, 0.40, 0.42], "sdc_stderr": [0.01, 0.01, 0.01],
+                          "material": ["acrylic", "steel", "steel"],
+                          "specimen": ["", "steel_6mm_b", "steel_6mm_c"]})
+    monkeypatch.setattr(Store, "list_analyses", lambda self: frame)
+    points = {(p.material, p.specimen): p for p in measured_from_store(tmp_path / "s.h5")}
+    assert set(points) == {("acrylic", ""), ("steel", "steel_6mm_b"), ("steel", "steel_6mm_c")}
+    assert points[("acrylic", "")].sdc == 0.20  # its own value, not a mean with steel
+    assert points[("steel", "steel_6mm_b")].label() == \
+        "500 Hz, 1 g, 50 %, steel, specimen steel_6mm_b"
+
+
+def test_a_point_of_another_material_than_the_specimens_is_refused():
+    # a steel measurement fitted with acrylic particles (or the reverse) would be fitted
+    # silently against the wrong DEM; the error names both materials and the way out
+    from pidcore.calibrate import base_specimen
+    from pidcore.errors import ParameterError
+
+    steel = load_specimen(REPO / "data_samples" / "specimens" / "steel_6mm.toml")
+    acrylic_point = MeasuredPoint(500, 1, 50, 0.2)
+    steel_point = MeasuredPoint(500, 1, 50, 0.4, material="steel")
+    with pytest.raises(ParameterError, match="acrylic particles, the specimen .* holds steel"):
+        base_specimen([acrylic_point], steel)
+    with pytest.raises(ParameterError, match="steel particles, which are not in the materials "
+                                             "table: give the specimen file"):
+        base_specimen([steel_point], None)
+    with pytest.raises(ParameterError, match="several particle materials"):
+        base_specimen([acrylic_point, steel_point], steel)
+    assert base_specimen([steel_point], steel) is steel
+    assert base_specimen([acrylic_point], None).particles.material == "acrylic"
+
+
+def test_a_table_without_materials_is_of_the_specimen_given(tmp_path):
+    # as `pidcore compare --specimen`: a row stating no material is of the specimen's
+    # particles; a row stating another one keeps it (and is then refused by base_specimen)
+    from pidcore.calibrate import read_measured_table
+
+    table = tmp_path / "m.csv"
+    table.write_text("frequency_hz,acceleration_g,fill_percent,sdc,material\n"
+                     "500,1,50,0.4,\n500,5,50,0.5,acrylic\n")
+    points = read_measured_table(table, default_material="steel")
+    assert [p.material for p in points] == ["steel", "acrylic"]
+    assert [p.material for p in read_measured_table(table)] == ["acrylic", "acrylic"]
+
+
+def test_cli_refuses_measurements_of_another_material_than_the_specimens(capsys, tmp_path):
+    # the same check as the app's (base_specimen, inside calibrate): before any DEM run
+    steel = REPO / "data_samples" / "specimens" / "steel_6mm.toml"
+    path = _table(tmp_path, HEADER.strip() + ",material\n" +
+                  ROWS.replace("\n", ",acrylic\n"))
+    _refused(capsys, tmp_path, ["--data", str(path), "--specimen", str(steel)],
+             "acrylic particles", "holds steel particles")

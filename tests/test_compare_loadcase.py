@@ -143,3 +143,18 @@ def test_stated_load_case_takes_measured_frequency_and_acceleration():
     stated = resolve_load_case("x_fill50.uff", sidecar=None)
     case = stated.load_case(499.7, 5.1)
     assert case == LoadCase(499.7, 5.1, 50.0, "acrylic", "z")
+
+
+def test_an_own_material_in_the_file_name_is_recognised_when_known():
+    # steel (a user's specimen material) is stated by the name once it is a known material;
+    # unknown, the name states none and the default is said to be assumed
+    from pidcore.compare.case import stated_case, unstated_note
+
+    name = "coupon2_f500Hz_a1g_fill50_steel.csv"
+    assert parse_file_name(name, ("acrylic", "aluminium", "steel"))["material"] == "steel"
+    assert "material" not in parse_file_name("coupon_steelcase_fill50.csv", ("steel",))
+    stated = stated_case(name, materials=("steel",))
+    assert (stated.material, unstated_note(stated)) == ("steel", "")
+    plain = stated_case("coupon_500Hz.csv")
+    assert unstated_note(plain) == "fill: not stated, 50 % proposed; material: not stated, " \
+                                   "acrylic assumed"

@@ -51,6 +51,24 @@ def fittable_names(api) -> list[str]:
     return sorted(names) + (list(dem()) if dem is not None else [])
 
 
+def points_by_material(points: Sequence) -> dict[str, list]:
+    """The measured points per particle material (sorted by name): the page calibrates one
+    material at a time, as :func:`pidcore.calibrate.calibrate.base_specimen` requires."""
+    out: dict[str, list] = {}
+    for point in points:
+        out.setdefault(str(point.material), []).append(point)
+    return dict(sorted(out.items()))
+
+
+def check_points(api, points: Sequence) -> None:
+    """Raise the library's one-line error for points it would refuse (several materials, or
+    one without a specimen: the page calibrates the paper's coupon), before a background run
+    is started; a library without ``base_specimen`` checks in the run."""
+    check = getattr(api, "base_specimen", None)
+    if check is not None:
+        check(list(points), None)
+
+
 @dataclass
 class CalibrationTask:
     """One calibration: its state (``running``, ``done``, ``failed``) and outputs."""
@@ -78,7 +96,9 @@ class CalibrationRunner:
 
     def start(self, api, points: Sequence, *, fit: Sequence[str], cells: int,
               design_size: int | None) -> CalibrationTask | None:
-        """Start a calibration; None (nothing started) while one is running."""
+        """Start a calibration; None (nothing started) while one is running. Points the library
+        refuses raise its error here (:func:`check_points`), not in the background."""
+        check_points(api, points)
         with self._lock:
             if self.task is not None and self.task.state == "running":
                 return None

@@ -218,6 +218,20 @@ def options_from_json(text: str) -> AnalysisOptions:
     return AnalysisOptions(**json.loads(text))
 
 
+def identical_uploads(uploads: Sequence[tuple[str, str]]) -> list[str]:
+    """A note per upload whose bytes equal an earlier one's (``(name, sha256)`` pairs): the
+    store keeps one record of them and Compare counts them once."""
+    first: dict[str, str] = {}
+    notes = []
+    for name, sha in uploads:
+        if sha in first:
+            notes.append(f"{name} has the same contents as {first[sha]}: one measurement, "
+                         "saved as one record (under the name saved last) and counted once")
+        else:
+            first[sha] = name
+    return notes
+
+
 # --- per-file settings --------------------------------------------------------------------------
 
 def is_settings_table(data: bytes) -> bool:
@@ -246,6 +260,31 @@ def measurement_materials(extra: Iterable[object] = ()) -> tuple[str, ...]:
         if name not in names:
             names.append(name)
     return (*names[:len(PARTICLE_MATERIALS)], *sorted(names[len(PARTICLE_MATERIALS):]))
+
+
+def specimen_materials(folders: Iterable[str | os.PathLike]) -> list[str]:
+    """Particle materials of the specimen files (``*.toml``) in ``folders`` (the DEM page's
+    specimen folders): a measurement of an own specimen may state its material before any DEM
+    run of it is saved. Unreadable files are skipped (the DEM page reports them)."""
+    from ..specimen import load_specimen
+
+    found = []
+    for folder in folders:
+        folder = Path(folder)
+        if not folder.is_dir():
+            continue
+        for path in sorted(folder.glob("*.toml")):
+            try:
+                found.append(load_specimen(path).particles.material)
+            except (PidcoreError, OSError, ValueError):
+                continue
+    return found
+
+
+#: Appended to an unknown material's error: how an own material becomes one to state.
+MATERIAL_HINT = ("an own material can be stated once a specimen file of it is in the "
+                 "specimen folders (data_samples/specimens/, specimens/) or a DEM run of it "
+                 "is saved")
 
 
 def read_settings_table(name: str, data: bytes,
@@ -281,8 +320,11 @@ def read_settings_table(name: str, data: bytes,
                 raise ParameterError(f"{name}, line {i}: {FILE_TABLE_COLUMNS[column]} "
                                      f"{text!r} is not a number") from None
         out[column] = values
-    out["material"] = [normalize_material(v, f"{name}: material", materials) if v else ""
-                       for v in out["material"]]
+    try:
+        out["material"] = [normalize_material(v, f"{name}: material", materials) if v else ""
+                           for v in out["material"]]
+    except PidcoreError as exc:
+        raise ParameterError(f"{exc} ({MATERIAL_HINT})") from None
     out["direction"] = [normalize_direction(v, f"{name}: direction") if v else ""
                         for v in out["direction"]]
     if (out["file"] == "").any():
@@ -298,6 +340,27 @@ def default_settings_row(name: str, stated) -> dict:
             "mass below gauge [g]": 0.0, "baseline loss factor [-]": 0.0,
             "force channel": AUTO_CHANNEL, "velocity channel": AUTO_CHANNEL,
             "acceleration channel": AUTO_CHANNEL, "inverted channels": ""}
+
+
+def assumed_note(stated, row: Mapping) -> str:
+    """What a file's settings row still takes from no statement, e.g. ``'material: not
+    stated, acrylic assumed'`` (:func:`pidcore.compare.case.unstated_note`), shown with its
+    result; a value the user has set in the row since is no longer assumed."""
+    parts = []
+    if "fill: not stated" in stated.origin and _same_number(row.get("fill [%]"),
+                                                            stated.fill_percent):
+        parts.append(f"fill: not stated, {stated.fill_percent:g} % proposed")
+    if "material: default" in stated.origin and str(row.get("material", "")) == \
+            stated.material:
+        parts.append(f"material: not stated, {stated.material} assumed")
+    return "; ".join(parts)
+
+
+def _same_number(value, number: float) -> bool:
+    try:
+        return float(value) == float(number)
+    except (TypeError, ValueError):
+        return False
 
 
 def merge_settings(names: Sequence[str], stated: Sequence, previous: pd.DataFrame | None,
@@ -410,13 +473,61 @@ def format_sdc(sdc: float, stderr: float) -> str:
     return f"{sdc:.4f} ± {stderr:.4f}" if math.isfinite(stderr) else f"{sdc:.4f}"
 
 
+@dataclass(frozen=True)
+class SavedRecords:
+    """What a save wrote: the analysis ``keys`` and ``notes`` naming each saved record it
+    replaced (a byte-identical file is one record, under the name saved last)."""
+
+    keys: list[str]
+    notes: tuple[str, ...] = ()
+
+
+def _stored_case_label(row) -> str:
+    from ..compare.align import _row_case
+
+    try:
+        case = _row_case(row)
+    except (KeyError, TypeError, ValueError):
+        return "no load case"
+    return f"{case.label()}, {case.material}, {case.direction}"
+
+
+def replacement_notes(analyses: pd.DataFrame, files: Sequence[AnalysedFile]) -> list[str]:
+    """Which saved records (file name, load case) saving ``files`` replaces: the store keys a
+    measurement by its contents, so a byte-identical file under another name, or a second
+    copy in the same save, is the same record, and only the last one saved is kept.
+
+    ``analyses`` is :meth:`pidcore.store.Store.list_analyses` before the save.
+    """
+    from ..store import measurement_key
+
+    notes = []
+    saved = {}  # measurement key -> (file, load case) it holds now
+    if not analyses.empty and {"measurement_key", "created_utc"} <= set(analyses.columns):
+        for _, row in analyses.sort_values("created_utc", kind="stable").iterrows():
+            saved[str(row["measurement_key"])] = (Path(str(row.get("source", ""))).name,
+                                                  _stored_case_label(row))
+    for f in files:
+        name = Path(f.record.measurement.source).name
+        key = measurement_key(f.record.measurement)
+        case = f"{f.load_case.label()}, {f.load_case.material}, {f.load_case.direction}"
+        if key in saved:
+            old_name, old_case = saved[key]
+            if (old_name, old_case) != (name, case):
+                notes.append(f"{name} has the same contents as the saved record {old_name} "
+                             f"({old_case}); saved as one record: {name} ({case}) replaces it")
+        saved[key] = (name, case)
+    return notes
+
+
 def save_records(path: str | os.PathLike, files: Sequence[AnalysedFile], *,
-                 confirm_implausible: bool = False) -> list[str]:
+                 confirm_implausible: bool = False) -> SavedRecords:
     """Save analysed files with their load cases to the store in one locked transaction.
 
     Each file's own corrections are its analysis parameters (with its channel mapping); the
     load case fields and the specimen go into its record. A file with plausibility warnings is
-    only saved with ``confirm_implausible`` (the user's explicit confirmation).
+    only saved with ``confirm_implausible`` (the user's explicit confirmation). The notes say
+    which saved record each byte-identical file replaces (:func:`replacement_notes`).
     """
     from ..measure import store_analysis
     from ..store import Store
@@ -429,6 +540,7 @@ def save_records(path: str | os.PathLike, files: Sequence[AnalysedFile], *,
                              "them anyway")
     store = Store(path)
     with store.transaction():
+        notes = replacement_notes(store.list_analyses(), files)
         keys = []
         for f in files:
             parameters = replace(f.options, force=None, velocity=None,
@@ -440,4 +552,4 @@ def save_records(path: str | os.PathLike, files: Sequence[AnalysedFile], *,
                 fields = {**fields, "plausibility_warnings": "; ".join(str(w)
                                                                        for w in f.warnings)}
             keys.append(store_analysis(store, f.record, parameters, fields=fields))
-        return keys
+        return SavedRecords(keys, tuple(notes))

@@ -16,14 +16,15 @@ Modules, one concern each:
   calibrated prediction of a load case (reports, app).
 """
 
-from .calibrate import CalibrationResult, calibrate
+from .calibrate import CalibrationResult, base_specimen, calibrate
 from .data import MeasuredPoint, measured_from_store, read_measured_table
 from .observation import Observation, observation_from_run
 from .outputs import write_outputs
 from .parameters import CATALOGUE, ParameterSpec, build_specs, dem_parameter_names, parse_fit
 from .prediction import CalibratedPrediction, Calibration, calibration_from_json, load_calibration
 
-__all__ = ["calibrate", "CalibrationResult", "MeasuredPoint", "read_measured_table",
-           "measured_from_store", "Observation", "observation_from_run", "write_outputs",
+__all__ = ["calibrate", "base_specimen", "CalibrationResult", "MeasuredPoint",
+           "read_measured_table", "measured_from_store", "Observation", "observation_from_run",
+           "write_outputs",
            "CATALOGUE", "ParameterSpec", "build_specs", "parse_fit", "dem_parameter_names",
            "Calibration", "CalibratedPrediction", "load_calibration", "calibration_from_json"]

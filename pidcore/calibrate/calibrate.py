@@ -151,13 +151,34 @@ def _requests(points: Sequence[MeasuredPoint], dem_specs: Sequence[ParameterSpec
 
 def base_specimen(points: Sequence[MeasuredPoint], specimen: Specimen | None) -> Specimen:
     """The specimen to calibrate: the given one, or the paper's coupon with the points'
-    particle material (all points must name the same one)."""
+    particle material.
+
+    Every point must be of the specimen's particle material. A point of another material would
+    be run with the specimen's particles under its own material's name and fitted silently
+    (steel measurements against acrylic DEM runs), so it is refused with the way out: choose
+    the points of one material, or give the specimen file of theirs.
+    """
+    if not points:
+        raise ParameterError("no measured points to calibrate against")
     materials = sorted({p.material for p in points})
     if len(materials) > 1:
         raise ParameterError(f"measured points name several particle materials {materials}; "
-                             "calibrate one specimen at a time")
+                             "calibrate one specimen at a time (choose the points of one "
+                             "material)")
+    material = materials[0]
     if specimen is None:
-        return paper_specimen(materials[0])
+        try:
+            return paper_specimen(material)
+        except ParameterError:
+            raise ParameterError(f"the measured points are of {material} particles, which are "
+                                 "not in the materials table: give the specimen file of these "
+                                 "particles (pidcore calibrate --specimen FILE)") from None
+    own = specimen.particles.material
+    if material != own:
+        raise ParameterError(f"the measured points are of {material} particles, the specimen "
+                             f"{specimen.name!r} holds {own} particles; calibrate {own} "
+                             "measurements with it (or give the specimen file of the "
+                             f"{material} particles)")
     return specimen
 
 

@@ -1,7 +1,12 @@
 """Measured SDCs to calibrate against: a table (CSV) or the store's analysed measurements.
 
 Table columns (one row per load case): ``frequency_hz``, ``acceleration_g``, ``fill_percent``,
-``sdc`` and optionally ``sdc_stderr``, ``energy_per_cycle_j``, ``material``.
+``sdc`` and optionally ``sdc_stderr``, ``energy_per_cycle_j``, ``material``, ``specimen``.
+
+A measured point carries its particle material and specimen label: measurements of acrylic and
+steel particles (or of two specimens) at one load case are different points, never averaged;
+:func:`pidcore.calibrate.calibrate.base_specimen` refuses points that are not of the calibrated
+specimen.
 """
 
 from __future__ import annotations
@@ -17,26 +22,46 @@ import pandas as pd
 from ..errors import InputFileError, ParameterError
 
 REQUIRED_COLUMNS = ("frequency_hz", "acceleration_g", "fill_percent", "sdc")
-OPTIONAL_COLUMNS = ("sdc_stderr", "energy_per_cycle_j", "material")
+OPTIONAL_COLUMNS = ("sdc_stderr", "energy_per_cycle_j", "material", "specimen")
+#: Material of a measurement that states none (the paper's particles).
+DEFAULT_MATERIAL = "acrylic"
 
 
 @dataclass(frozen=True)
 class MeasuredPoint:
-    """One measured load case: SDC (Eq. 11) and its standard error (0: not given)."""
+    """One measured load case: SDC (Eq. 11) and its standard error (0: not given), with the
+    particle material and the specimen label ("": none named) it was measured on."""
 
     frequency_hz: float
     acceleration_g: float
     fill_percent: float
     sdc: float
     sdc_stderr: float = 0.0
-    material: str = "acrylic"
+    material: str = DEFAULT_MATERIAL
+    specimen: str = ""
 
     def label(self) -> str:
-        return f"{self.frequency_hz:g} Hz, {self.acceleration_g:g} g, {self.fill_percent:g} %"
+        """E.g. ``'500 Hz, 1 g, 50 %, steel, specimen steel_6mm_b'``: material and specimen
+        named, since points differing only in them are different points."""
+        specimen = f", specimen {self.specimen}" if self.specimen else ""
+        return (f"{self.frequency_hz:g} Hz, {self.acceleration_g:g} g, {self.fill_percent:g} %, "
+                f"{self.material}{specimen}")
 
 
-def read_measured_table(path: str | os.PathLike) -> list[MeasuredPoint]:
-    """Read a measured-SDC table; one-line errors for missing columns or bad values."""
+def _text_cell(value, default: str) -> str:
+    """A table or store cell as text; empty, NaN or missing cells give ``default``."""
+    if not isinstance(value, str) or not value.strip():
+        return default
+    return value.strip()
+
+
+def read_measured_table(path: str | os.PathLike, *,
+                        default_material: str = DEFAULT_MATERIAL) -> list[MeasuredPoint]:
+    """Read a measured-SDC table; one-line errors for missing columns or bad values.
+
+    A row without a ``material`` takes ``default_material`` (the calibrated specimen's when
+    one is given, as a measurement compared with a specimen does; else the paper's acrylic).
+    """
     path = Path(path)
     if not path.is_file():
         raise InputFileError(f"{path}: no such file")
@@ -71,20 +96,22 @@ def read_measured_table(path: str | os.PathLike) -> list[MeasuredPoint]:
             raise InputFileError(f"{where}: fill_percent must be in (0, 100]")
         if values["sdc"] < 0 or values["sdc_stderr"] < 0:
             raise InputFileError(f"{where}: sdc and sdc_stderr must be >= 0")
-        material = row.get("material", "acrylic")
-        if not isinstance(material, str) or not material.strip():
-            material = "acrylic"
-        points.append(MeasuredPoint(material=material.strip(), **values))
+        points.append(MeasuredPoint(material=_text_cell(row.get("material"), default_material),
+                                    specimen=_text_cell(row.get("specimen"), ""), **values))
     if not points:
         raise InputFileError(f"{path}: no rows")
     return points
 
 
 def measured_from_store(store_path: str | os.PathLike) -> list[MeasuredPoint]:
-    """Analysed measurements of a store, grouped per load case (mean SDC, standard error).
+    """Analysed measurements of a store, grouped per load case, particle material and specimen
+    label (mean SDC, standard error).
 
-    A load case measured several times gives the mean and the standard error of the mean
-    (or the analysis's own standard error when measured once). Measured frequency and
+    Records of other materials or specimens at one load case are kept apart (averaging acrylic
+    and steel particles would fit neither); a record without a material is the paper's acrylic,
+    one without a specimen label has none (""). A load case measured several times gives the
+    mean and the standard error of the mean (or the analysis's own standard error when
+    measured once). Measured frequency and
     acceleration are rounded to 3 and 2 significant digits to find the load case; the
     analyses must carry ``fill_percent`` (from a sidecar).
     """
@@ -103,16 +130,21 @@ def measured_from_store(store_path: str | os.PathLike) -> list[MeasuredPoint]:
     # frequency to 3 significant digits, the acceleration to 2 (e.g. 50.02 Hz, 4.97 g -> 50, 5)
     frame = frame.assign(
         frequency_hz=frame["frequency_hz"].map(lambda v: float(f"{v:.3g}")),
-        acceleration_g=frame["acceleration_g"].map(lambda v: float(f"{v:.2g}")))
+        acceleration_g=frame["acceleration_g"].map(lambda v: float(f"{v:.2g}")),
+        material=[_text_cell(v, DEFAULT_MATERIAL) for v in frame.get(
+            "material", pd.Series([None] * len(frame), index=frame.index))],
+        specimen=[_text_cell(v, "") for v in frame.get(
+            "specimen", pd.Series([None] * len(frame), index=frame.index))])
     points = []
-    keys = ["frequency_hz", "acceleration_g", "fill_percent"]
-    for (f, a, p), group in frame.groupby(keys):
+    keys = ["frequency_hz", "acceleration_g", "fill_percent", "material", "specimen"]
+    for (f, a, p, material, specimen), group in frame.groupby(keys):
         sdc = group["sdc"].to_numpy(float)
         if len(sdc) > 1:
             se = float(np.std(sdc, ddof=1) / math.sqrt(len(sdc)))
         else:
             se = float(group.get("sdc_stderr", pd.Series([0.0])).fillna(0.0).iloc[0])
-        points.append(MeasuredPoint(float(f), float(a), float(p), float(sdc.mean()), se))
+        points.append(MeasuredPoint(float(f), float(a), float(p), float(sdc.mean()), se,
+                                    str(material), str(specimen)))
     if not points:
         raise InputFileError(f"{store_path}: no analysed measurement has a complete load case")
     return points

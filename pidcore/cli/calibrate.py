@@ -26,7 +26,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     source = p.add_mutually_exclusive_group(required=True)
     source.add_argument("--data", metavar="TABLE.csv", type=Path,
                         help="measured SDCs: frequency_hz, acceleration_g, fill_percent, sdc "
-                             "[, sdc_stderr, energy_per_cycle_j, material]")
+                             "[, sdc_stderr, energy_per_cycle_j, material, specimen]; a row "
+                             "without a material is of --specimen's particles (else acrylic); "
+                             "one of another material than the specimen's is refused")
     source.add_argument("--store", metavar="FILE", type=Path,
                         help="use the analysed measurements of this store, per load case")
     p.add_argument("--specimen", metavar="FILE", type=Path, default=None,
@@ -75,8 +77,11 @@ def run(args: argparse.Namespace) -> int:
     if cells < 2:
         raise ParameterError(f"--cells: expected >= 2 (the ensemble scatter needs two), "
                              f"got {cells}")
-    points = read_measured_table(args.data) if args.data is not None \
-        else measured_from_store(args.store)
+    # a table row without a material is of the specimen given (as in `pidcore compare
+    # --specimen`); a stated material other than the specimen's is refused by calibrate()
+    default_material = specimen.particles.material if specimen is not None else "acrylic"
+    points = read_measured_table(args.data, default_material=default_material) \
+        if args.data is not None else measured_from_store(args.store)
     result = calibrate(points, fit=fit, priors=args.prior, discrepancy=args.discrepancy,
                        discrepancy_floor=args.discrepancy_floor, store_path=args.dem_store,
                        cells=cells, seed=args.seed, steady_cycles=args.steady_cycles,

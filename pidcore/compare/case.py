@@ -35,25 +35,52 @@ def load_case_of(record, *, fill_percent: float, material: str,
                     material, direction)
 
 
-def stated_case(name: str, sidecar: pd.DataFrame | None = None) -> StatedLoadCase:
+def stated_case(name: str, sidecar: pd.DataFrame | None = None,
+                materials: tuple[str, ...] = ()) -> StatedLoadCase:
     """What the file name and a load-case table state about a file (the table wins).
 
-    Without a stated fill, :data:`PROPOSED_FILL_PERCENT` is proposed and the origin says so.
+    ``materials``: own materials recognised in the name besides the table's (e.g. ``steel``
+    of the user's specimens: ``..._steel.csv``). Without a stated fill,
+    :data:`PROPOSED_FILL_PERCENT` is proposed; the origin says so, and says which values are
+    the defaults (:func:`unstated_note`).
     """
+    from ..constants import PARTICLE_MATERIALS
     from .loadcase import SIDECAR_COLUMNS, parse_file_name, resolve_load_case
 
+    known = (*PARTICLE_MATERIALS, *(m for m in materials if m not in PARTICLE_MATERIALS))
     table = sidecar if sidecar is not None else pd.DataFrame(columns=list(SIDECAR_COLUMNS))
     try:
-        return resolve_load_case(Path(Path(name).name), sidecar=table)
+        found = parse_file_name(Path(name).name, known)
     except PidcoreError:
-        try:  # no fill stated (or a bad table row): keep what the name states, propose a fill
-            found = parse_file_name(Path(name).name)
-        except PidcoreError:
-            found = {}
-        return StatedLoadCase(PROPOSED_FILL_PERCENT,
-                              str(found.get("material", defaults.COMPARE_DEFAULT_MATERIAL)),
-                              str(found.get("direction", defaults.COMPARE_DEFAULT_DIRECTION)),
-                              f"fill: not stated, {PROPOSED_FILL_PERCENT:g} % proposed")
+        found = {}
+    try:
+        stated = resolve_load_case(Path(Path(name).name), sidecar=table)
+    except PidcoreError:  # no fill stated (or a bad table row): keep what the name states
+        stated = StatedLoadCase(
+            PROPOSED_FILL_PERCENT,
+            str(found.get("material", defaults.COMPARE_DEFAULT_MATERIAL)),
+            str(found.get("direction", defaults.COMPARE_DEFAULT_DIRECTION)),
+            f"fill: not stated, {PROPOSED_FILL_PERCENT:g} % proposed; material: "
+            f"{'file name' if 'material' in found else 'default'}; direction: "
+            f"{'file name' if 'direction' in found else 'default'}")
+    if "material" in found and "material: default" in stated.origin:
+        # an own material (steel) the table's parser does not know: the name states it
+        stated = replace(stated, material=str(found["material"]),
+                         origin=stated.origin.replace("material: default",
+                                                      "material: file name"))
+    return stated
+
+
+def unstated_note(stated: StatedLoadCase) -> str:
+    """What the file did not state and what is used instead, e.g. ``'fill: not stated, 50 %
+    proposed; material: not stated, acrylic assumed'`` ("" when it stated fill and material).
+    The drive direction is left out: the paper's z is every set-up's default."""
+    parts = []
+    if "fill: not stated" in stated.origin:
+        parts.append(f"fill: not stated, {stated.fill_percent:g} % proposed")
+    if "material: default" in stated.origin:
+        parts.append(f"material: not stated, {stated.material} assumed")
+    return "; ".join(parts)
 
 
 def group_load_cases(cases: Sequence[LoadCase]) -> list[list[int]]:
@@ -171,6 +198,10 @@ class MeasuredEntry:
     corrections : str
         The corrections the analysis ran with, e.g. ``"vibrometer delay 50 µs, mass below
         gauge 0 g, baseline loss factor 0"`` (empty where unknown).
+    measurement_key : str
+        The store's key of the measured data (:func:`pidcore.store.measurement_key`): equal
+        for byte-identical files under any name, so :func:`unique_entries` counts them once
+        (empty where unknown).
     """
 
     key: str
@@ -189,20 +220,28 @@ class MeasuredEntry:
     specimen: str = ""
     created_utc: str = ""
     corrections: str = ""
+    measurement_key: str = ""
 
     @classmethod
     def from_record(cls, record, load_case: LoadCase, *,
                     specimen: str = "", options=None) -> MeasuredEntry:
         """Entry of a fresh (unsaved) analysis (:class:`pidcore.measure.AnalyzedRecord`);
         ``options`` (:class:`pidcore.measure.AnalysisOptions`) names the corrections."""
+        from ..store import measurement_key
+
         a = record.analysis
+        try:
+            content = measurement_key(record.measurement)
+        except PidcoreError:  # a malformed digest: the entry is never taken for a copy
+            content = ""
         return cls(f"upload:{record.measurement.sha256}", Path(record.measurement.source).name,
                    "this session (unsaved)", load_case, float(a.frequency_hz),
                    float(a.acceleration_amplitude_m_s2), float(a.loss_factor), float(a.sdc),
                    float(a.sdc_stderr), float(a.energy_per_cycle_j),
                    np.asarray(a.harmonics), np.asarray(a.force_phasors_n),
                    np.asarray(a.velocity_phasors_m_s), specimen,
-                   corrections=describe_corrections(vars(options)) if options else "")
+                   corrections=describe_corrections(vars(options)) if options else "",
+                   measurement_key=content)
 
     @classmethod
     def from_store(cls, row: pd.Series, arrays: dict) -> MeasuredEntry:
@@ -220,7 +259,8 @@ class MeasuredEntry:
                    np.asarray(arrays.get("force_phasors_n", empty)),
                    np.asarray(arrays.get("velocity_phasors_m_s", empty)),
                    str(row.get("specimen", "") or ""), str(row.get("created_utc", "")),
-                   describe_corrections(_json_dict(row.get("parameters_json"))))
+                   describe_corrections(_json_dict(row.get("parameters_json"))),
+                   str(row.get("measurement_key", "") or ""))
 
     def loop(self):
         """The measured loop (:class:`pidcore.loop.ForceDisplacementLoop`, labelled
@@ -243,6 +283,34 @@ class MeasuredEntry:
             "force amplitude [N]": np.abs(np.asarray(self.force_phasors_n)),
             "velocity amplitude [m/s]": np.abs(np.asarray(self.velocity_phasors_m_s)),
         })
+
+
+def unique_entries(entries: Sequence[MeasuredEntry]) -> tuple[list[MeasuredEntry], list[str]]:
+    """``entries`` with each measured data set once, and a note per entry left out.
+
+    Byte-identical files (one saved, one uploaded again under another name, or two uploads)
+    are one measurement: pooling both would count the same data twice and shrink the standard
+    error by about sqrt(2). The first entry of each :attr:`MeasuredEntry.measurement_key` is
+    kept (list saved records first: the store's copy is the one Compare and Report share);
+    entries without a key are all kept. An entry that is the saved copy of itself (same file
+    and SDC: an upload still in the session after Save) is left out without a note.
+    """
+    kept: list[MeasuredEntry] = []
+    notes: list[str] = []
+    first: dict[str, MeasuredEntry] = {}
+    for e in entries:
+        other = first.get(e.measurement_key) if e.measurement_key else None
+        if other is None:
+            if e.measurement_key:
+                first[e.measurement_key] = e
+            kept.append(e)
+            continue
+        if (e.file, e.sdc) == (other.file, other.sdc):
+            continue  # the saved copy of this very analysis: nothing to say
+        where = "saved" if other.origin == "store" else "this session"
+        notes.append(f"{e.file} left out, {e.origin}: the same contents as {other.file} "
+                     f"({where}); the same data are counted once")
+    return kept, notes
 
 
 def _json_dict(text) -> dict:

@@ -86,13 +86,28 @@ class StatedLoadCase:
                         self.material, self.direction)
 
 
-def parse_file_name(name: str | Path) -> dict[str, float | str]:
+def _own_material_tokens(stem: str, materials: tuple[str, ...]) -> set[str]:
+    """Tokens of ``stem`` that name one of ``materials`` beyond the table's (e.g. ``steel``
+    of a user's specimen): a whole token only, so ``steel`` is not found in ``steelcase``."""
+    own = [m for m in materials if m not in PARTICLE_MATERIALS]
+    if not own:
+        return set()
+    pattern = re.compile(_SEP + "(?P<material>" + "|".join(map(re.escape, own)) + ")" + _END,
+                         re.IGNORECASE)
+    return {m.group("material").lower() for m in pattern.finditer(stem)}
+
+
+def parse_file_name(name: str | Path,
+                    materials: tuple[str, ...] = PARTICLE_MATERIALS) -> dict[str, float | str]:
     """Fill, material and direction stated in a file name (only those found).
 
     Parameters
     ----------
     name : str or Path
         File name or path; only the name without its last suffix is searched.
+    materials : tuple of str
+        Materials recognised besides the table's (:data:`MATERIAL_PATTERN`): the user's own,
+        e.g. ``steel`` of a specimen file or a saved DEM run, as ``..._steel.csv``.
 
     Returns
     -------
@@ -115,12 +130,12 @@ def parse_file_name(name: str | Path) -> dict[str, float | str]:
                             f"{sorted(fills)}; state one (or use --fill)")
     if fills:
         found["fill_percent"] = _check_fill(fills.pop(), path.name)
-    materials = {normalize_material(m.group("material"), path.name)
-                 for m in MATERIAL_PATTERN.finditer(stem)}
-    if len(materials) > 1:
-        raise LoadCaseError(f"{path.name}: file name states several materials {sorted(materials)}")
-    if materials:
-        found["material"] = materials.pop()
+    stated = {normalize_material(m.group("material"), path.name)
+              for m in MATERIAL_PATTERN.finditer(stem)} | _own_material_tokens(stem, materials)
+    if len(stated) > 1:
+        raise LoadCaseError(f"{path.name}: file name states several materials {sorted(stated)}")
+    if stated:
+        found["material"] = stated.pop()
     directions = {(m.group("d1") or m.group("d2")).lower()
                   for m in DIRECTION_PATTERN.finditer(stem)}
     if len(directions) > 1:

@@ -229,6 +229,12 @@ def _measurement_key(measurement: Measurement) -> tuple[str, str]:
     return digest.hexdigest()[:16], "content_sha256"
 
 
+def measurement_key(measurement: Measurement) -> str:
+    """The key :meth:`Store.add_measurement` stores ``measurement`` under: byte-identical files
+    (under any name) share it, so it is also what says two records hold the same data."""
+    return _measurement_key(measurement)[0]
+
+
 def _check_measurement(measurement: Measurement) -> None:
     if not isinstance(measurement, Measurement):
         raise StoreError("expected a pidcore.records.Measurement, "
@@ -441,18 +447,23 @@ class Store:
             First 16 hex digits of the file's SHA-256 (of the channel contents when the
             measurement has no ``sha256``).
         added : bool
-            False when the measurement was stored before (nothing was written).
+            False when the measurement was stored before (its channels are not written
+            again; a byte-identical file saved under another name takes that name, so the
+            store names the file the user saved last).
         """
         _check_measurement(measurement)
         key, basis = _measurement_key(measurement)
         with self._reading() as h5:
             if h5 is not None and key in h5.get(_MEASUREMENTS, {}):
-                self._check_same_measurement(h5[_MEASUREMENTS][key], measurement, key)
-                return key, False
+                group = h5[_MEASUREMENTS][key]
+                self._check_same_measurement(group, measurement, key)
+                if _text(group.attrs.get("source", "")) == measurement.source:
+                    return key, False
         with self.transaction() as h5:
             parent = h5[_MEASUREMENTS]
-            if key in parent:  # stored by another process since the check above
+            if key in parent:  # stored before (or by another process since the check above)
                 self._check_same_measurement(parent[key], measurement, key)
+                parent[key].attrs["source"] = measurement.source
                 return key, False
             group = parent.create_group(key)
             try:

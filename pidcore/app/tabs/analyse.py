@@ -32,7 +32,8 @@ def _settings_editor(measurements, tables: dict[str, pd.DataFrame], channel_name
         earlier = [t for sha, t in tables.items() if sha in applied]
         new = [t for sha, t in tables.items() if sha not in applied]
         ss["settings_base"] = uploads.merge_settings(
-            names, [stated_case(n) for n in names], ss.get("settings_current"), new,
+            names, [stated_case(n, materials=materials) for n in names],
+            ss.get("settings_current"), new,
             earlier_tables=earlier)
         ss["settings_tables_applied"] = set(tables)
         ss["settings_sig"] = sig
@@ -45,7 +46,8 @@ def _settings_editor(measurements, tables: dict[str, pd.DataFrame], channel_name
             "fill [%]": st.column_config.NumberColumn(min_value=0.1, max_value=100.0, step=1.0),
             "material": st.column_config.SelectboxColumn(
                 options=list(materials), required=True,
-                help="the table's materials and those of the store's DEM runs (own specimens)"),
+                help="the table's materials, those of the specimen files and of the store's "
+                     "DEM runs (own specimens)"),
             "direction": st.column_config.SelectboxColumn(options=list(DRIVE_DIRECTIONS),
                                                           required=True),
             "vibrometer delay [µs]": st.column_config.NumberColumn(
@@ -67,15 +69,18 @@ def _settings_editor(measurements, tables: dict[str, pd.DataFrame], channel_name
     return edited
 
 
-def _card(upload, row, sample_rate_hz):
+def _card(upload, row, sample_rate_hz, materials):
     """Results of one file; returns an AnalysedFile or None."""
-    from pidcore.compare.case import load_case_of
+    from pidcore.compare.case import load_case_of, stated_case
     from pidcore.compare.plausibility import check_analysis
     from pidcore.errors import PidcoreError
 
     name = upload.name
     with st.container(border=True):
         st.markdown(f"**{name}** · {_size(upload.size)}")
+        assumed = uploads.assumed_note(stated_case(name, materials=materials), row)
+        if assumed:  # a default the user has not confirmed: say so next to the numbers
+            st.info(f"{assumed} (set it in the settings table)")
         sha = state.upload_sha256(upload)
         found = state.parsed(sha, name, sample_rate_hz, upload)
         if found.error is not None:
@@ -149,8 +154,11 @@ def render(stores) -> list:
     except PidcoreError as exc:  # the uploads work without it: only the table's materials
         st.warning(f"DEM runs not read ({exc}): only the table's particle materials offered")
         runs = None
+    from pidcore.app.tabs.dem import SPECIMEN_FOLDERS
+
     materials = uploads.measurement_materials(
-        runs["material"] if "material" in getattr(runs, "columns", ()) else ())
+        [*(runs["material"] if "material" in getattr(runs, "columns", ()) else ()),
+         *uploads.specimen_materials(SPECIMEN_FOLDERS)])
     for upload in files or []:
         try:
             uploads.check_upload_size(upload.name, upload.size)
@@ -171,6 +179,9 @@ def render(stores) -> list:
             measurements.append(upload)
     if not measurements:
         return []
+    for note in uploads.identical_uploads([(u.name, state.upload_sha256(u))
+                                           for u in measurements]):
+        st.warning(note)
     channel_names = []
     for upload in measurements:
         found = state.parsed(state.upload_sha256(upload), upload.name, sample_rate_hz, upload)
@@ -180,7 +191,7 @@ def render(stores) -> list:
     settings = _settings_editor(measurements, tables, channel_names, materials)
     analysed = []
     for upload, (_, row) in zip(measurements, settings.iterrows(), strict=True):
-        result = _card(upload, row, sample_rate_hz)
+        result = _card(upload, row, sample_rate_hz, materials)
         if result is not None:
             analysed.append(result)
     if analysed:
@@ -195,9 +206,11 @@ def render(stores) -> list:
     if st.button(f"Save {len(analysed)} record(s) to the store", disabled=not analysed,
                  type="primary", key="save"):
         try:
-            keys = uploads.save_records(stores.path, analysed, confirm_implausible=confirm)
+            saved = uploads.save_records(stores.path, analysed, confirm_implausible=confirm)
         except PidcoreError as exc:
             st.error(f"not saved: {exc}")
         else:
-            st.success(f"saved {len(keys)} analysis record(s) to {stores.path}")
+            st.success(f"saved {len(saved.keys)} analysis record(s) to {stores.path}")
+            for note in saved.notes:
+                st.warning(note)
     return analysed

@@ -9,7 +9,12 @@ from pathlib import Path
 import pandas as pd
 import streamlit as st
 
-from pidcore.app.calibration import calibration_api, fittable_names, runner_for
+from pidcore.app.calibration import (
+    calibration_api,
+    fittable_names,
+    points_by_material,
+    runner_for,
+)
 from pidcore.app.tabs import draw_polling
 
 #: Seconds between refreshes of the calibration's state while it runs.
@@ -70,10 +75,16 @@ def render(stores) -> None:
     if not points:
         st.info(f"{stores.path} holds no saved measurements with a load case yet.")
         return
-    labels = [f"{p.frequency_hz:g} Hz, {p.acceleration_g:g} g, {p.fill_percent:g} %"
-              for p in points]
+    by_material = points_by_material(points)
+    cases_key = "calibration_cases"
+    if len(by_material) > 1:  # one specimen at a time: its particle material first
+        material = st.selectbox("particle material (one calibration per material)",
+                                list(by_material), key="calibration_material")
+        points = by_material[material]
+        cases_key = f"calibration_cases_{material}"  # each material keeps its own choice
+    labels = [p.label() for p in points]
     chosen_cases = st.multiselect("measured load cases to calibrate against (from the store)",
-                                  labels, default=labels, key="calibration_cases")
+                                  labels, default=labels, key=cases_key)
     points = [p for p, label in zip(points, labels, strict=True) if label in chosen_cases]
     st.dataframe(pd.DataFrame([dataclasses.asdict(p) for p in points]), hide_index=True,
                  width="stretch", key="calibration_points")

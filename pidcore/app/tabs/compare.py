@@ -13,7 +13,7 @@ from pidcore.app import state, uploads, workbench
 
 def _entries(stores, session_files):
     """Saved entries (filtered by the user) + this session's unsaved ones."""
-    from pidcore.compare.case import MeasuredEntry
+    from pidcore.compare.case import MeasuredEntry, unique_entries
     from pidcore.store.listing import filter_analyses
 
     stamp = stores.stamp()
@@ -32,12 +32,12 @@ def _entries(stores, session_files):
     include = st.checkbox("include this session's unsaved analyses", value=True,
                           key="include_session")
     if include:
-        known = {(e.file, e.sdc) for e in entries}
-        for f in session_files:
-            e = MeasuredEntry.from_record(f.record, f.load_case, specimen=f.specimen,
-                                          options=f.options)
-            if (e.file, e.sdc) not in known:
-                entries.append(e)
+        entries += [MeasuredEntry.from_record(f.record, f.load_case, specimen=f.specimen,
+                                              options=f.options) for f in session_files]
+    # one data set counted once (a saved file uploaded again, or under another name)
+    entries, notes = unique_entries(entries)
+    for note in notes:
+        st.caption(note)
     return entries
 
 
