@@ -6,13 +6,14 @@ downstream of a reader knows about file formats.
 
 from __future__ import annotations
 
+import hashlib
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from .constants import SI_UNITS
-from .errors import ChannelError
+from .errors import ChannelError, StoreError
 
 
 @dataclass(frozen=True)
@@ -90,3 +91,29 @@ class Measurement:
     @property
     def channel_names(self) -> list[str]:
         return [c.name for c in self.channels]
+
+
+def measurement_key_and_basis(measurement: Measurement) -> tuple[str, str]:
+    """``(key, basis)``: the file's SHA-256 when known, else a hash of the channel contents."""
+    sha = measurement.sha256.strip().lower()
+    if sha:
+        if len(sha) < 16 or any(c not in "0123456789abcdef" for c in sha):
+            raise StoreError(f"{measurement.source}: sha256 {measurement.sha256!r} is not a hex "
+                             "digest of at least 16 digits")
+        return sha[:16], "file_sha256"
+    # Measurements built in memory (simulations, tests) have no file; hash what defines them so
+    # that storing the same one twice still deduplicates.
+    digest = hashlib.sha256()
+    digest.update(measurement.source.encode("utf-8"))
+    for ch in measurement.channels:
+        header = f"\0{ch.name}\0{ch.quantity}\0{ch.sample_rate_hz!r}\0{ch.start_time_s!r}\0"
+        digest.update(header.encode("utf-8"))
+        digest.update(np.ascontiguousarray(ch.data, dtype=np.float64).tobytes())
+    return digest.hexdigest()[:16], "content_sha256"
+
+
+def measurement_key(measurement: Measurement) -> str:
+    """The key a store keeps ``measurement`` under (:meth:`pidcore.store.Store.add_measurement`):
+    byte-identical files (under any name) share it, so it is also what says two records hold
+    the same data (here, below the store, so that the comparison layer can ask it too)."""
+    return measurement_key_and_basis(measurement)[0]

@@ -499,7 +499,7 @@ def replacement_notes(analyses: pd.DataFrame, files: Sequence[AnalysedFile]) -> 
 
     ``analyses`` is :meth:`pidcore.store.Store.list_analyses` before the save.
     """
-    from ..store import measurement_key
+    from ..records import measurement_key
 
     notes = []
     saved = {}  # measurement key -> (file, load case) it holds now

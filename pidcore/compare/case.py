@@ -227,7 +227,7 @@ class MeasuredEntry:
                     specimen: str = "", options=None) -> MeasuredEntry:
         """Entry of a fresh (unsaved) analysis (:class:`pidcore.measure.AnalyzedRecord`);
         ``options`` (:class:`pidcore.measure.AnalysisOptions`) names the corrections."""
-        from ..store import measurement_key
+        from ..records import measurement_key
 
         a = record.analysis
         try:

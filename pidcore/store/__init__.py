@@ -3,6 +3,7 @@
 See :mod:`pidcore.store.store` for the file layout and the transaction protocol.
 """
 
-from .store import STORE_VERSION, Store, StoredEntry, measurement_key
+from ..records import measurement_key
+from .store import STORE_VERSION, Store, StoredEntry
 
 __all__ = ["STORE_VERSION", "Store", "StoredEntry", "measurement_key"]

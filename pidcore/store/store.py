@@ -24,7 +24,6 @@ works, instead of waiting for it.
 
 from __future__ import annotations
 
-import hashlib
 import json
 import os
 import secrets
@@ -45,6 +44,7 @@ from .. import __version__, defaults, interrupt
 from ..errors import InputFileError, ParameterError, StoreError
 from ..io.hdf5_layout import read_measurement_group, write_measurement_group
 from ..records import Measurement
+from ..records import measurement_key_and_basis as _measurement_key
 from .lock import exclusive_lock, lock_path_for
 from .values import (
     RESERVED_FIELDS,
@@ -208,31 +208,6 @@ def _read_entry(group: h5py.Group, key: str) -> StoredEntry:
     parameters = json.loads(_text(group.attrs.get("parameters_json", "{}")))
     return StoredEntry(key=key, record=record, arrays=arrays, parameters=parameters, attrs=attrs,
                        units=units)
-
-
-def _measurement_key(measurement: Measurement) -> tuple[str, str]:
-    """``(key, basis)``: the file's SHA-256 when known, else a hash of the channel contents."""
-    sha = measurement.sha256.strip().lower()
-    if sha:
-        if len(sha) < 16 or any(c not in "0123456789abcdef" for c in sha):
-            raise StoreError(f"{measurement.source}: sha256 {measurement.sha256!r} is not a hex "
-                             "digest of at least 16 digits")
-        return sha[:16], "file_sha256"
-    # Measurements built in memory (simulations, tests) have no file; hash what defines them so
-    # that storing the same one twice still deduplicates.
-    digest = hashlib.sha256()
-    digest.update(measurement.source.encode("utf-8"))
-    for ch in measurement.channels:
-        header = f"\0{ch.name}\0{ch.quantity}\0{ch.sample_rate_hz!r}\0{ch.start_time_s!r}\0"
-        digest.update(header.encode("utf-8"))
-        digest.update(np.ascontiguousarray(ch.data, dtype=np.float64).tobytes())
-    return digest.hexdigest()[:16], "content_sha256"
-
-
-def measurement_key(measurement: Measurement) -> str:
-    """The key :meth:`Store.add_measurement` stores ``measurement`` under: byte-identical files
-    (under any name) share it, so it is also what says two records hold the same data."""
-    return _measurement_key(measurement)[0]
 
 
 def _check_measurement(measurement: Measurement) -> None:
