@@ -922,8 +922,14 @@ def test_calibrate_page_keeps_saved_materials_apart_and_refuses_a_mixed_or_unkno
     assert by["steel"][0].sdc == steel.analysis.sdc  # its own value, not a mean with acrylic
     assert by["acrylic"][0].sdc == acrylic.analysis.sdc
     runner = runner_for(store_file)
-    for chosen, words in ((points, "several particle materials"),
-                          (by["steel"], "steel particles, which are not in the materials")):
+    import dataclasses
+
+    mixed = [*by["acrylic"], dataclasses.replace(by["acrylic"][0], material="aluminium")]
+    # steel: this page has no specimen chooser, so the message says what the page does and
+    # where steel is calibrated (the library's names a flag the page does not have)
+    own = r"calibrates the paper's coupon .* of steel particles.*pidcore calibrate --specimen"
+    for chosen, words in ((mixed, "several particle materials"), (points, own),
+                          (by["steel"], own)):
         with pytest.raises(ParameterError, match=words):
             runner.start(api, chosen, fit=["fixture_mass_kg"], cells=2, design_size=None)
     assert runner.task is None  # nothing started
@@ -994,3 +1000,41 @@ def test_specimen_files_offer_their_material_and_an_unknown_one_says_how(tmp_pat
     assert uploads.assumed_note(stated, row) == ("fill: not stated, 50 % proposed; "
                                                  "material: not stated, acrylic assumed")
     assert uploads.assumed_note(stated, {"fill [%]": 62.0, "material": "steel"}) == ""
+
+
+def test_one_name_is_one_file_and_a_table_statement_is_not_assumed():
+    # the same file selected again made the settings table a row shorter than the uploads (a
+    # traceback); two different files under one name: the last is used, and said
+    kept, notes = uploads.distinct_uploads([("a.csv", "1"), ("b.csv", "2"), ("a.csv", "1")])
+    assert kept == [1, 2] and notes == []
+    kept, notes = uploads.distinct_uploads([("a.csv", "1"), ("a.csv", "3")])
+    assert kept == [1] and notes == ["a.csv: uploaded twice with different contents; the last "
+                                     "upload is used (give the files different names to "
+                                     "analyse both)"]
+    # a table stating the default value (50 %, acrylic) states it: no "not stated" note
+    table = uploads.read_settings_table("t.csv", b"file,fill_percent,material\n"
+                                                 b"run.csv,50,acrylic\nother.csv,,steel\n",
+                                        ("acrylic", "aluminium", "steel"))
+    given = uploads.columns_given([table], "run.csv")
+    assert given == {"fill [%]", "material"}
+    row = {"fill [%]": 50.0, "material": "acrylic"}
+    assert uploads.assumed_note(stated_case("run.csv"), row, given) == ""
+    assert uploads.assumed_note(stated_case("run.csv"), row) != ""  # nothing given: said
+    assert uploads.columns_given([table], "other.csv") == {"material"}
+
+
+def test_identical_files_stating_different_load_cases_are_not_saved_together(tmp_path,
+                                                                             good_csv, options):
+    # one content is one record: saving both would keep one statement and drop the other
+    from pidcore.store import Store
+
+    a = _record(good_csv, options, name="a_fill50.csv")
+    b = _record(good_csv, options, name="b_fill75.csv")
+    both = [_file(a, options), _file(b, options, fill=75.0)]
+    assert uploads.saved_count(both) == 1
+    with pytest.raises(ParameterError, match=r"b_fill75\.csv and a_fill50\.csv have identical "
+                                             r"contents but state different load cases"):
+        uploads.save_records(tmp_path / "s.h5", both)
+    assert not (tmp_path / "s.h5").exists() or Store(tmp_path / "s.h5").list_analyses().empty
+    same = [_file(a, options), _file(_record(good_csv, options, name="copy.csv"), options)]
+    assert len(set(uploads.save_records(tmp_path / "s.h5", same).keys)) == 1

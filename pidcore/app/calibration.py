@@ -64,6 +64,16 @@ def check_points(api, points: Sequence) -> None:
     """Raise the library's one-line error for points it would refuse (several materials, or
     one without a specimen: the page calibrates the paper's coupon), before a background run
     is started; a library without ``base_specimen`` checks in the run."""
+    from ..constants import PARTICLE_MATERIALS
+    from ..errors import ParameterError
+
+    own = sorted({str(p.material) for p in points} - set(PARTICLE_MATERIALS))
+    if own:  # the library's message names a command-line flag this page does not have
+        raise ParameterError(
+            f"this page calibrates the paper's coupon (acrylic or aluminium particles); the "
+            f"chosen points are of {', '.join(own)} particles: calibrate them with their "
+            "specimen file on the command line (pidcore calibrate --specimen FILE --store "
+            "STORE)")
     check = getattr(api, "base_specimen", None)
     if check is not None:
         check(list(points), None)

@@ -349,11 +349,12 @@ DEM_RUN_COLUMNS = {"specimen": "specimen", "frequency_hz": "frequency [Hz]",
 
 
 def steady_state_text(detected) -> str:
-    """A run's ``steady_detected`` in words: the words ``pidcore dem run`` prints ("NOT
-    converged, transient cap") for a stated False, empty where the run does not say."""
+    """A run's ``steady_detected`` in a word that fits its column at 1280 px: "reached", or
+    "NOT reached" (``pidcore dem run``: "NOT converged, transient cap"); empty where the run
+    does not say."""
     if detected is None or (isinstance(detected, float) and detected != detected):
         return ""
-    return "converged" if bool(detected) else "NOT converged, transient cap"
+    return "reached" if bool(detected) else "NOT reached"
 
 
 def dem_runs_table(runs):
@@ -366,6 +367,10 @@ def dem_runs_table(runs):
         specimen=run_specimen_labels(runs),
         **{"steady state": runs["steady_detected"].map(steady_state_text)
            if "steady_detected" in runs.columns else ""})
+    import pandas as pd
+
+    if "sdc_stderr" in runs.columns:  # None in an object column showed as "None"
+        runs = runs.assign(sdc_stderr=pd.to_numeric(runs["sdc_stderr"], errors="coerce"))
     shown = {c: name for c, name in DEM_RUN_COLUMNS.items() if c in runs.columns}
     return runs[list(shown)].rename(columns=shown)
 

@@ -218,6 +218,25 @@ def options_from_json(text: str) -> AnalysisOptions:
     return AnalysisOptions(**json.loads(text))
 
 
+def distinct_uploads(uploads: Sequence[tuple[str, str]]) -> tuple[list[int], list[str]]:
+    """Indices of the uploads to analyse (``(name, sha256)`` pairs) and a note per one left out.
+
+    Settings are kept per file name, so one name is one file: the same file selected again is
+    analysed once (it made the settings table one row shorter than the uploads: a traceback),
+    and of two different files under one name the last is used, and the note says so.
+    """
+    last: dict[str, int] = {}
+    for i, (name, _) in enumerate(uploads):
+        last[name] = i
+    notes = []
+    for i, (name, sha) in enumerate(uploads):
+        j = last[name]
+        if j != i and uploads[j][1] != sha:
+            notes.append(f"{name}: uploaded twice with different contents; the last upload is "
+                         "used (give the files different names to analyse both)")
+    return sorted(set(last.values())), notes
+
+
 def identical_uploads(uploads: Sequence[tuple[str, str]]) -> list[str]:
     """A note per upload whose bytes equal an earlier one's (``(name, sha256)`` pairs): the
     store keeps one record of them and Compare counts them once."""
@@ -342,18 +361,38 @@ def default_settings_row(name: str, stated) -> dict:
             "acceleration channel": AUTO_CHANNEL, "inverted channels": ""}
 
 
-def assumed_note(stated, row: Mapping) -> str:
+def assumed_note(stated, row: Mapping, given: Iterable[str] = ()) -> str:
     """What a file's settings row still takes from no statement, e.g. ``'material: not
     stated, acrylic assumed'`` (:func:`pidcore.compare.case.unstated_note`), shown with its
-    result; a value the user has set in the row since is no longer assumed."""
+    result; a value the user has set in the row since, or that a settings table states
+    (``given``: its columns with a value for this file, :func:`columns_given`), is not
+    assumed."""
+    given = set(given)
     parts = []
-    if "fill: not stated" in stated.origin and _same_number(row.get("fill [%]"),
-                                                            stated.fill_percent):
+    if "fill: not stated" in stated.origin and "fill [%]" not in given and _same_number(
+            row.get("fill [%]"), stated.fill_percent):
         parts.append(f"fill: not stated, {stated.fill_percent:g} % proposed")
-    if "material: default" in stated.origin and str(row.get("material", "")) == \
-            stated.material:
+    if "material: default" in stated.origin and "material" not in given and str(
+            row.get("material", "")) == stated.material:
         parts.append(f"material: not stated, {stated.material} assumed")
     return "; ".join(parts)
+
+
+def columns_given(tables: Sequence[pd.DataFrame], name: str) -> set[str]:
+    """The settings columns that uploaded ``tables`` give a value for file ``name`` (matched
+    as :func:`merge_settings` matches it: the name, else its base name)."""
+    given: set[str] = set()
+    for table in tables:
+        for _, row in table.iterrows():
+            file = str(row["file"])
+            if file != name and Path(file).name != Path(name).name:
+                continue
+            given |= {k for k in FILE_TABLE_COLUMNS if k != "file" and not _empty(row.get(k))}
+    return given
+
+
+def _empty(value) -> bool:
+    return value is None or value == "" or (isinstance(value, float) and math.isnan(value))
 
 
 def _same_number(value, number: float) -> bool:
@@ -391,8 +430,7 @@ def _apply_tables(rows: dict[str, dict], tables: Sequence[pd.DataFrame]) -> None
                 continue
             for k in FILE_TABLE_COLUMNS:
                 value = new.get(k, "")
-                if k != "file" and not (value == "" or (isinstance(value, float)
-                                                        and math.isnan(value))):
+                if k != "file" and not _empty(value):
                     rows[target][k] = value
 
 
@@ -520,6 +558,33 @@ def replacement_notes(analyses: pd.DataFrame, files: Sequence[AnalysedFile]) -> 
     return notes
 
 
+def check_one_load_case_per_content(files: Sequence[AnalysedFile]) -> None:
+    """Refuse byte-identical files that state different load cases (or specimens): the store
+    keeps one record of them, so one statement would silently replace the other (as
+    ``pidcore report`` refuses them)."""
+    from ..records import measurement_key
+
+    first: dict[str, AnalysedFile] = {}
+    for f in files:
+        key = measurement_key(f.record.measurement)
+        other = first.setdefault(key, f)
+        if other is not f and (other.load_case.key, other.specimen) != (f.load_case.key,
+                                                                        f.specimen):
+            raise ParameterError(
+                f"{Path(f.record.measurement.source).name} and "
+                f"{Path(other.record.measurement.source).name} have identical contents but "
+                f"state different load cases ({f.load_case.label()}, {f.load_case.material} vs "
+                f"{other.load_case.label()}, {other.load_case.material}); one measurement is "
+                "one record: state one load case, or remove one of the files")
+
+
+def saved_count(files: Sequence[AnalysedFile]) -> int:
+    """How many records saving ``files`` keeps: byte-identical files are one."""
+    from ..records import measurement_key
+
+    return len({measurement_key(f.record.measurement) for f in files})
+
+
 def save_records(path: str | os.PathLike, files: Sequence[AnalysedFile], *,
                  confirm_implausible: bool = False) -> SavedRecords:
     """Save analysed files with their load cases to the store in one locked transaction.
@@ -538,6 +603,7 @@ def save_records(path: str | os.PathLike, files: Sequence[AnalysedFile], *,
     if flagged and not confirm_implausible:
         raise ParameterError(f"{', '.join(flagged)}: implausible result(s); confirm to save "
                              "them anyway")
+    check_one_load_case_per_content(files)
     store = Store(path)
     with store.transaction():
         notes = replacement_notes(store.list_analyses(), files)

@@ -69,7 +69,7 @@ def _settings_editor(measurements, tables: dict[str, pd.DataFrame], channel_name
     return edited
 
 
-def _card(upload, row, sample_rate_hz, materials):
+def _card(upload, row, sample_rate_hz, materials, given=()):
     """Results of one file; returns an AnalysedFile or None."""
     from pidcore.compare.case import load_case_of, stated_case
     from pidcore.compare.plausibility import check_analysis
@@ -78,7 +78,7 @@ def _card(upload, row, sample_rate_hz, materials):
     name = upload.name
     with st.container(border=True):
         st.markdown(f"**{name}** · {_size(upload.size)}")
-        assumed = uploads.assumed_note(stated_case(name, materials=materials), row)
+        assumed = uploads.assumed_note(stated_case(name, materials=materials), row, given)
         if assumed:  # a default the user has not confirmed: say so next to the numbers
             st.info(f"{assumed} (set it in the settings table)")
         sha = state.upload_sha256(upload)
@@ -179,8 +179,11 @@ def render(stores) -> list:
             measurements.append(upload)
     if not measurements:
         return []
-    for note in uploads.identical_uploads([(u.name, state.upload_sha256(u))
-                                           for u in measurements]):
+    kept, notes = uploads.distinct_uploads([(u.name, state.upload_sha256(u))
+                                            for u in measurements])
+    measurements = [measurements[i] for i in kept]
+    for note in [*notes, *uploads.identical_uploads([(u.name, state.upload_sha256(u))
+                                                     for u in measurements])]:
         st.warning(note)
     channel_names = []
     for upload in measurements:
@@ -191,7 +194,8 @@ def render(stores) -> list:
     settings = _settings_editor(measurements, tables, channel_names, materials)
     analysed = []
     for upload, (_, row) in zip(measurements, settings.iterrows(), strict=True):
-        result = _card(upload, row, sample_rate_hz, materials)
+        result = _card(upload, row, sample_rate_hz, materials,
+                       uploads.columns_given(list(tables.values()), upload.name))
         if result is not None:
             analysed.append(result)
     if analysed:
@@ -203,7 +207,8 @@ def render(stores) -> list:
     if flagged:
         confirm = st.checkbox(f"Save the {len(flagged)} implausible record(s) anyway (their "
                               "warnings are saved with them)", key="confirm_implausible")
-    if st.button(f"Save {len(analysed)} record(s) to the store", disabled=not analysed,
+    if st.button(f"Save {uploads.saved_count(analysed)} record(s) to the store",
+                 disabled=not analysed,
                  type="primary", key="save"):
         try:
             saved = uploads.save_records(stores.path, analysed, confirm_implausible=confirm)
