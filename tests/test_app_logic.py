@@ -1038,3 +1038,13 @@ def test_identical_files_stating_different_load_cases_are_not_saved_together(tmp
     assert not (tmp_path / "s.h5").exists() or Store(tmp_path / "s.h5").list_analyses().empty
     same = [_file(a, options), _file(_record(good_csv, options, name="copy.csv"), options)]
     assert len(set(uploads.save_records(tmp_path / "s.h5", same).keys)) == 1
+
+
+def test_run_says_which_cases_are_already_stored():
+    # re-running a stored case said "1 job(s) submitted" while the job said "in store"
+    queued = jobs.DemJob("job0001", None, None, "k1", None)
+    stored = jobs.DemJob("job0002", None, None, "k2", None, state="in store")
+    assert jobs.submitted_text(3, [queued, stored]) == (
+        "1 job(s) submitted; 1 already in the store, not run again; 1 already queued or "
+        "running, not submitted again")
+    assert jobs.submitted_text(1, [queued]) == "1 job(s) submitted"

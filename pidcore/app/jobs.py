@@ -348,6 +348,19 @@ DEM_RUN_COLUMNS = {"specimen": "specimen", "frequency_hz": "frequency [Hz]",
                    "wall_s": "wall time [s]", "case_key": "run", "store": "store"}
 
 
+def submitted_text(n_cases: int, created: Sequence[DemJob]) -> str:
+    """What a click on Run did: jobs that will run, runs already in the store (not run
+    again), and cases already queued or running (not submitted again)."""
+    stored = sum(j.state == "in store" for j in created)
+    parts = [f"{len(created) - stored} job(s) submitted"]
+    if stored:
+        parts.append(f"{stored} already in the store, not run again")
+    skipped = n_cases - len(created)
+    if skipped:
+        parts.append(f"{skipped} already queued or running, not submitted again")
+    return "; ".join(parts)
+
+
 def steady_state_text(detected) -> str:
     """A run's ``steady_detected`` in a word that fits its column at 1280 px: "reached", or
     "NOT reached" (``pidcore dem run``: "NOT converged, transient cap"); empty where the run

@@ -150,11 +150,8 @@ def render(stores) -> None:
             st.session_state["dem_message"] = ("error", str(exc))
         else:
             created = jobs.runner_for(stores.path).submit(cases, config, specimen)
-            skipped = len(cases) - len(created)
-            st.session_state["dem_message"] = (
-                "info", f"{len(created)} job(s) submitted"
-                + (f"; {skipped} already queued or running, not submitted again"
-                   if skipped else ""))
+            st.session_state["dem_message"] = ("info", jobs.submitted_text(len(cases),
+                                                                           created))
     message = st.session_state.get("dem_message")
     if message:
         getattr(st, message[0])(message[1])
