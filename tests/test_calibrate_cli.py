@@ -210,6 +210,40 @@ def test_a_table_without_materials_is_of_the_specimen_given(tmp_path):
     assert [p.material for p in read_measured_table(table)] == ["acrylic", "acrylic"]
 
 
+def test_repeated_rows_of_one_load_case_are_refused(tmp_path):
+    # three rows of 500 Hz, 1 g, 40 % passed as three load cases: a 3-parameter fit ran on
+    # one case (two distinct cases were refused as too few)
+    from pidcore.calibrate import read_measured_table
+    from pidcore.errors import InputFileError
+
+    table = tmp_path / "dup.csv"
+    table.write_text("frequency_hz,acceleration_g,fill_percent,sdc\n"
+                     "500,1,40,0.21\n500,5,40,0.3\n500,1,40,0.22\n")
+    with pytest.raises(InputFileError, match=r"rows 1 and 3 state the same load case "
+                                             r"\(500 Hz, 1 g, 40 %, acrylic\)"):
+        read_measured_table(table)
+    # another material at the same load case is another point
+    table.write_text("frequency_hz,acceleration_g,fill_percent,sdc,material\n"
+                     "500,1,40,0.21,acrylic\n500,1,40,0.3,aluminium\n")
+    assert len(read_measured_table(table)) == 2
+
+
+def test_too_few_load_cases_name_the_fitted_parameters():
+    # "cannot determine 3 fitted parameter(s)" with 2 asked for: the third, the model
+    # discrepancy, is fitted unless fixed, and the message now says so and how
+    from pidcore.calibrate.data import MeasuredPoint, check_enough_points
+    from pidcore.errors import ParameterError
+
+    points = [MeasuredPoint(500.0, 1.0, 50.0, 0.3), MeasuredPoint(500.0, 5.0, 50.0, 0.5)]
+    with pytest.raises(ParameterError, match=r"2 measured load case\(s\) cannot determine 3 "
+                                             r"fitted parameter\(s\): fixture_mass_kg, "
+                                             r"baseline_loss_factor, model_discrepancy; .*"
+                                             r"--discrepancy TAU"):
+        check_enough_points(points, ["fixture_mass_kg", "baseline_loss_factor",
+                                     "model_discrepancy"])
+    check_enough_points(points, ["fixture_mass_kg", "baseline_loss_factor"])
+
+
 def test_cli_refuses_measurements_of_another_material_than_the_specimens(capsys, tmp_path):
     # the same check as the app's (base_specimen, inside calibrate): before any DEM run
     steel = REPO / "data_samples" / "specimens" / "steel_6mm.toml"

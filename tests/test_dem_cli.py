@@ -27,6 +27,14 @@ def test_readable_summary_names_units_and_particle_count(capsys):
     assert "friction stick_slip, normal damping literal, start dense packing rest" in out
 
 
+def test_one_cell_has_no_standard_error_and_says_why(capsys):
+    # the SDC's error is the cells' scatter: one cell printed "+- nan"
+    one = [a if a != "2" else "1" for a in ARGS]
+    assert main(one) == 0
+    out = capsys.readouterr().out
+    assert "nan" not in out and "no standard error (the cells' scatter; simulate --cells 2" in out
+
+
 def test_model_options_reach_the_simulation(capsys):
     # the named options land in the result (and so in the store): not silently defaults
     assert main(ARGS + ["--json", "--tangential-model", "coulomb", "--packing", "loose"]) == 0

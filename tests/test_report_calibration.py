@@ -246,3 +246,13 @@ def test_a_calibration_of_another_specimen_predicts_no_row_even_at_its_load_case
     assert out[CALIBRATED_COLUMN].iloc[0] == 0.24
     assert out["note"].iloc[1].endswith(
         ": it calibrates specimen paper_coupon, not paper_coupon_aluminium")
+
+
+def test_the_calibration_folder_is_accepted_and_another_folder_is_named(tmp_path):
+    # `--calibration DIR` said "no such calibration file" for an existing folder
+    from pidcore.errors import ParameterError
+
+    folder = BUNDLED.parent
+    assert load_calibration(folder).path == BUNDLED
+    with pytest.raises(ParameterError, match="a folder without calibration.json"):
+        load_calibration(tmp_path)

@@ -141,6 +141,11 @@ def test_cli_with_dem_store_only_stores_nothing(tmp_path, dem_store, capsys):
     out = capsys.readouterr().out
     assert code == 0
     assert "wrote md:" in out and "wrote html:" in out and "out_of_range" in out
+    # the console shows the like-for-like (Eq. 10) measured SDC beside ours, and names the
+    # Eq. 11 one as such (it showed only "SDC measured", the Eq. 11 value)
+    header = out.splitlines()[0]
+    assert header.index("SDC DEM (ours) [-]") < header.index("SDC measured (Eq. 10) [-]") \
+        < header.index("SDC measured (Eq. 11) [-]")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["coupon2_75pct.csv", "out"]
     # 75 % is above our DEM fills (25, 50): never extrapolated
     html = (tmp_path / "out" / "report.html").read_text(encoding="utf-8")

@@ -183,3 +183,16 @@ def test_dem_run_cycles_0_names_the_option(capsys):
                  "--cycles", "0", "--no-progress"]) == 2
     err = capsys.readouterr().err
     assert "--cycles 0: expected a whole number >= 1" in err and "steady_cycles" not in err
+
+
+def test_a_file_not_in_utf8_is_one_line_and_a_byte_order_mark_is_accepted(tmp_path, capsys):
+    # a Latin-1 "µ" in the description gave a UnicodeDecodeError traceback (exit 1); a BOM
+    # (Windows editors) gave "not valid TOML at line 1, column 1" for a file that looks fine
+    latin = tmp_path / "latin1.toml"
+    latin.write_bytes(TEXT.replace('description = "', 'description = "\xb5 ').encode("latin-1"))
+    assert main(["specimen", "check", str(latin)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "not UTF-8 text (byte 0xb5 on line" in err
+    bom = tmp_path / "bom.toml"
+    bom.write_bytes(b"\xef\xbb\xbf" + TEXT.encode("utf-8"))
+    assert load_specimen(bom) == load_specimen(STEEL)

@@ -204,12 +204,12 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: Sequence[str],
     points = list(points)
     specimen = base_specimen(points, specimen)
     specs = build_specs(fit, priors, discrepancy=discrepancy, specimen=specimen)
-    check_enough_points(points, len(specs))
+    check_enough_points(points, [spec.name for spec in specs])
     if cross_validate is not None and cross_validate not in CROSS_VALIDATIONS:
         raise ParameterError(f"--cross-validate: expected one of {CROSS_VALIDATIONS}, "
                              f"got {cross_validate!r}")
     if cross_validate == "loo":
-        check_enough_points(points[1:], len(specs))
+        check_enough_points(points[1:], [spec.name for spec in specs])
     if not discrepancy_floor >= 0:
         raise ParameterError(f"--discrepancy-floor: expected >= 0, got {discrepancy_floor}")
     notes = []

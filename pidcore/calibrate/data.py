@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import math
 import os
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -100,6 +101,16 @@ def read_measured_table(path: str | os.PathLike, *,
                                     specimen=_text_cell(row.get("specimen"), ""), **values))
     if not points:
         raise InputFileError(f"{path}: no rows")
+    seen: dict[tuple, int] = {}
+    for i, p in enumerate(points):
+        key = (p.frequency_hz, p.acceleration_g, p.fill_percent, p.material, p.specimen)
+        if key in seen:
+            # rows counted as load cases of their own would pass the count of load cases a
+            # fit needs, and weigh one case several times
+            raise InputFileError(f"{path}: rows {seen[key] + 1} and {i + 1} state the same load "
+                                 f"case ({p.label()}); give one row per load case (the mean "
+                                 "SDC of repeated tests and its standard error)")
+        seen[key] = i
     return points
 
 
@@ -150,9 +161,14 @@ def measured_from_store(store_path: str | os.PathLike) -> list[MeasuredPoint]:
     return points
 
 
-def check_enough_points(points: list[MeasuredPoint], n_parameters: int) -> None:
-    """Refuse fewer measured load cases than fitted parameters."""
+def check_enough_points(points: list[MeasuredPoint], names: Sequence[str] | int) -> None:
+    """Refuse fewer measured load cases than fitted parameters (``names``, or their count);
+    the message lists them, since one (the model discrepancy) is fitted unless fixed."""
+    n_parameters = names if isinstance(names, int) else len(names)
     if len(points) < n_parameters:
+        listed = "" if isinstance(names, int) else f": {', '.join(names)}"
+        fixed = "" if isinstance(names, int) or "model_discrepancy" not in names else \
+            " (fix model_discrepancy with --discrepancy TAU)"
         raise ParameterError(f"{len(points)} measured load case(s) cannot determine "
-                             f"{n_parameters} fitted parameter(s); give at least "
-                             f"{n_parameters} load cases or fit fewer parameters")
+                             f"{n_parameters} fitted parameter(s){listed}; give at least "
+                             f"{n_parameters} load cases or fit fewer parameters{fixed}")

@@ -174,7 +174,8 @@ def _number(value, what: str, path: Path) -> float:
 
 
 def load_calibration(path: str | os.PathLike) -> Calibration:
-    """Read and check a ``calibration.json`` of ``pidcore calibrate``.
+    """Read and check a ``calibration.json`` of ``pidcore calibrate`` (or the ``--out`` folder
+    holding it).
 
     Raises
     ------
@@ -184,6 +185,12 @@ def load_calibration(path: str | os.PathLike) -> Calibration:
         non-finite field or ``low95 > high95``.
     """
     path = Path(path)
+    if path.is_dir() and (path / "calibration.json").is_file():
+        path = path / "calibration.json"  # the folder `pidcore calibrate --out` wrote
+    if path.is_dir():
+        raise ParameterError(f"{path}: a folder without calibration.json (expected the "
+                             "calibration.json written by pidcore calibrate --out, or its "
+                             "folder)")
     if not path.is_file():
         raise ParameterError(f"{path}: no such calibration file (expected the calibration.json "
                              "written by pidcore calibrate --out)")

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 from pathlib import Path
 
@@ -289,8 +290,12 @@ def format_summary(result) -> str:
             f"{s.coupon.fixture_mass_kg * 1e3:.4g} g + particles {particles * 1e3:.4g} g",
         ]
     lines += [
-        f"SDC             {result.sdc:.4g} +- {result.sdc_stderr:.2g} [-] "
-        f"(loss factor {result.loss_factor:.4g} [-]) over {result.cells_simulated} cells",
+        (f"SDC             {result.sdc:.4g} +- {result.sdc_stderr:.2g} [-] (loss factor "
+         f"{result.loss_factor:.4g} [-]) over {result.cells_simulated} cells"
+         if math.isfinite(result.sdc_stderr) else
+         f"SDC             {result.sdc:.4g} [-] (loss factor {result.loss_factor:.4g} [-]) over "
+         f"{result.cells_simulated} cell(s): no standard error (the cells' scatter; simulate "
+         "--cells 2 or more)"),
         f"dissipated      {result.energy_per_cycle_j:.4g} J/cycle (coupon, "
         f"{result.coupon_cells} cells): normal "
         f"damping {result.energy_dissipated_normal_j:.4g} J, friction "

@@ -13,9 +13,12 @@ from ..report.render import format_cell
 from ._options import add_measurement_options, add_store_option, analysis_options
 
 #: Columns of the short table printed on stdout.
+#: The like-for-like measured SDC (Eq. 10's E, as our DEM's) stands beside our DEM's; the
+#: Eq. 11 one beside the calibrated DEM's, which predicts it.
 _STDOUT_COLUMNS = (
     "frequency [Hz]", "acceleration [g]", "packing ratio [%]", "SDC DEM (ours) [-]",
-    "SDC measured [-]", "SDC calibrated DEM (Eq. 11) [-]", "calibrated low 95 % [-]",
+    "SDC measured, E of Eq. 10 [-]", "SDC measured [-]", "SDC calibrated DEM (Eq. 11) [-]",
+    "calibrated low 95 % [-]",
     "calibrated high 95 % [-]", "SDC DEM (paper) [-]", "SDC measured (paper) [-]",
     "alignment [grid/interpolated/out_of_range]",
 )
@@ -86,7 +89,10 @@ def run(args: argparse.Namespace) -> int:
 def short_table(table) -> str:
     """A fixed-width text table of the main columns."""
     cols = [c for c in _STDOUT_COLUMNS if c in table.columns]
-    heads = [c.replace("alignment [grid/interpolated/out_of_range]", "alignment") for c in cols]
+    short = {"alignment [grid/interpolated/out_of_range]": "alignment",
+             "SDC measured, E of Eq. 10 [-]": "SDC measured (Eq. 10) [-]",
+             "SDC measured [-]": "SDC measured (Eq. 11) [-]"}
+    heads = [short.get(c, c) for c in cols]
     rows = [[format_cell(v) for v in row] for row in table.loc[:, cols].itertuples(index=False)]
     widths = [max([len(h), *(len(r[i]) for r in rows)]) for i, h in enumerate(heads)]
     lines = ["  ".join(h.rjust(w) for h, w in zip(heads, widths, strict=True))]
