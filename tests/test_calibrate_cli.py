@@ -244,6 +244,19 @@ def test_too_few_load_cases_name_the_fitted_parameters():
     check_enough_points(points, ["fixture_mass_kg", "baseline_loss_factor"])
 
 
+def test_a_semicolon_table_with_decimal_commas_and_capitalised_headers_reads(tmp_path):
+    # a spreadsheet's export ("Frequency_Hz;...;0,21") was refused as missing every column
+    from pidcore.calibrate import read_measured_table
+
+    comma = tmp_path / "comma.csv"
+    comma.write_text("frequency_hz,acceleration_g,fill_percent,sdc,sdc_stderr\n"
+                     "500,1,40,0.21,0.01\n1000,5,40,0.5,0.02\n")
+    semi = tmp_path / "semi.csv"
+    semi.write_text("Frequency_Hz;Acceleration_g;Fill_Percent;SDC;SDC_stderr\n"
+                    "500;1;40;0,21;0,01\n1000;5;40;0,5;0,02\n", encoding="utf-8-sig")
+    assert read_measured_table(semi) == read_measured_table(comma)
+
+
 def test_cli_refuses_measurements_of_another_material_than_the_specimens(capsys, tmp_path):
     # the same check as the app's (base_specimen, inside calibrate): before any DEM run
     steel = REPO / "data_samples" / "specimens" / "steel_6mm.toml"

@@ -69,7 +69,11 @@ def test_fixture_mass_and_baseline_are_recovered(tmp_path):
                        priors=["fixture_mass_kg=0:0.03"], store_path=tmp_path / "s.h5",
                        discrepancy=0.0, discrepancy_floor=0.0, cells=BASE.cells,
                        steady_cycles=BASE.steady_cycles, dem_config=BASE, workers=1,
-                       progress=False)
+                       progress=False, design_size=3)
+    # no DEM parameter fitted: a design size is ignored, and said (the summary claimed a
+    # design of 3 points while one run per load case was made)
+    assert "--design-size 3 ignored: no DEM parameter is fitted" in " ".join(capped.notes)
+    assert capped.settings["design_size"] == 1
     piled = [n for n in capped.notes if "piles against" in n]
     assert any(n.startswith("fixture_mass_kg:") and "upper bound 0.03" in n for n in piled)
     # the calibrated specimen file carries the warning, and still reads

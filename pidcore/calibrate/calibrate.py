@@ -217,6 +217,11 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: Sequence[str],
         notes.append("no sdc_stderr in the data: measurement error is carried by the "
                      "model-discrepancy term alone")
     dem_specs = [s for s in specs if s.kind == "dem"]
+    if not dem_specs and design_size not in (None, 1):
+        # nothing varies between DEM runs: one run per load case, whatever the design asks
+        notes.append(f"--design-size {design_size} ignored: no DEM parameter is fitted, so "
+                     "each load case needs one DEM run")
+        design_size = None
     n_design = design_size or default_design_size(len(dem_specs))
     if dem_specs and n_design < 2:
         raise ParameterError(f"--design-size: expected >= 2 with DEM parameters, got {n_design}")

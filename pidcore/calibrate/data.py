@@ -67,9 +67,15 @@ def read_measured_table(path: str | os.PathLike, *,
     if not path.is_file():
         raise InputFileError(f"{path}: no such file")
     try:
-        frame = pd.read_csv(path, comment="#")
+        head = next((line for line in path.read_text(encoding="utf-8-sig").splitlines()
+                     if line.strip() and not line.lstrip().startswith("#")), "")
+        # European spreadsheets write ';' between columns and ',' as the decimal mark
+        semicolons = ";" in head and "," not in head
+        frame = pd.read_csv(path, comment="#", encoding="utf-8-sig",
+                            sep=";" if semicolons else ",", decimal="," if semicolons else ".")
     except (pd.errors.ParserError, UnicodeDecodeError, pd.errors.EmptyDataError) as exc:
         raise InputFileError(f"{path}: not a readable CSV table ({exc})") from None
+    frame.columns = [str(c).strip().lower() for c in frame.columns]  # Frequency_Hz too
     missing = [c for c in REQUIRED_COLUMNS if c not in frame.columns]
     if missing:
         raise InputFileError(f"{path}: missing column(s) {', '.join(missing)}; expected "
