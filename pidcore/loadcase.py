@@ -151,6 +151,11 @@ class LoadCase:
         """Short human label, e.g. ``'500 Hz, 5 g, 50 %'``."""
         return f"{self.frequency_hz:.4g} Hz, {self.acceleration_g:.3g} g, {self.fill_percent:.3g} %"
 
+    def full_label(self) -> str:
+        """:meth:`label` with material and direction, e.g. ``'500 Hz, 1 g, 40 %, steel, z'``
+        (rounded; :attr:`key` spells the measured values out, f500Hz_a1.00003g_...)."""
+        return f"{self.label()}, {self.material}, {self.direction}"
+
 
 def parse_key(text: str) -> LoadCase:
     """The load case a key (or a DEM run key starting with one) names.

@@ -527,7 +527,7 @@ def _stored_case_label(row) -> str:
         case = _row_case(row)
     except (KeyError, TypeError, ValueError):
         return "no load case"
-    return f"{case.label()}, {case.material}, {case.direction}"
+    return case.full_label()
 
 
 def replacement_notes(analyses: pd.DataFrame, files: Sequence[AnalysedFile]) -> list[str]:
@@ -548,7 +548,7 @@ def replacement_notes(analyses: pd.DataFrame, files: Sequence[AnalysedFile]) -> 
     for f in files:
         name = Path(f.record.measurement.source).name
         key = measurement_key(f.record.measurement)
-        case = f"{f.load_case.label()}, {f.load_case.material}, {f.load_case.direction}"
+        case = f.load_case.full_label()
         if key in saved:
             old_name, old_case = saved[key]
             if (old_name, old_case) != (name, case):
@@ -573,8 +573,8 @@ def check_one_load_case_per_content(files: Sequence[AnalysedFile]) -> None:
             raise ParameterError(
                 f"{Path(f.record.measurement.source).name} and "
                 f"{Path(other.record.measurement.source).name} have identical contents but "
-                f"state different load cases ({f.load_case.label()}, {f.load_case.material} vs "
-                f"{other.load_case.label()}, {other.load_case.material}); one measurement is "
+                f"state different load cases ({f.load_case.full_label()} vs "
+                f"{other.load_case.full_label()}); one measurement is "
                 "one record: state one load case, or remove one of the files")
 
 

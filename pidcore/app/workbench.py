@@ -70,13 +70,7 @@ def group_name(entries: Sequence[MeasuredEntry], group: Sequence[int]) -> str:
     """
     e = entries[group[0]]
     specimen = f", specimen {e.specimen}" if e.specimen else ""
-    return f"{case_label(e.load_case)}{specimen}"
-
-
-def case_label(case) -> str:
-    """A load case as the page names it, rounded: ``'500 Hz, 1 g, 40 %, steel, z'`` (its
-    ``key`` spells the measured values out, f500Hz_a1.00003g_...)."""
-    return f"{case.label()}, {case.material}, {case.direction}"
+    return f"{e.load_case.full_label()}{specimen}"
 
 
 def dem_loop(paths: Sequence[str | os.PathLike | None],

@@ -56,7 +56,7 @@ def _calibrated(active, comp, head) -> None:
     hit = calibration.lookup(comp.load_case)
     st.markdown("**calibrated DEM** (" + label + ")")
     if hit is None:
-        st.caption(f"The calibration does not predict {workbench.case_label(comp.load_case)} "
+        st.caption(f"The calibration does not predict {comp.load_case.full_label()} "
                    f"(it predicts "
                    f"{len(calibration.predictions)} measured load case(s)).")
         return
