@@ -454,7 +454,7 @@ class Specimen:
     def is_paper(self) -> bool:
         """True for the paper's coupon (acrylic, or another table particle material): the
         specimen of the paper's Table 3, so only its runs are compared with that table."""
-        return self.hash in _paper_hashes()
+        return self.hash in paper_hashes()
 
     # --- what follows from it ------------------------------------------------------------
 
@@ -804,7 +804,9 @@ def contact_law(specimen: Specimen, *, alpha_pp: float | None = None,
 
 
 @functools.cache
-def _paper_hashes() -> frozenset[str]:
+def paper_hashes() -> frozenset[str]:
+    """Hashes of the paper's coupon with each table particle material: one specimen (its
+    runs with either material are the paper's)."""
     from .constants import PARTICLE_MATERIALS
 
     return frozenset(paper_specimen(m).hash for m in PARTICLE_MATERIALS)

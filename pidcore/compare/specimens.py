@@ -41,24 +41,17 @@ class SpecimenRuns:
     refused: bool = False
 
 
-def _paper_hashes() -> frozenset[str]:
-    from ..constants import PARTICLE_MATERIALS
-    from ..specimen import paper_specimen
-
-    return frozenset(paper_specimen(m).hash for m in PARTICLE_MATERIALS)
-
-
 def run_specimen_labels(runs: pd.DataFrame) -> pd.Series:
     """One label per run: ``"name [hash6]"``; the paper's coupon (either table material, or
     a run stored before specimens existed) is ``"paper_coupon"``: one specimen."""
-    from ..specimen import PAPER_SPECIMEN_NAME
+    from ..specimen import PAPER_SPECIMEN_NAME, paper_hashes
 
     def column(name: str) -> pd.Series:
         if name not in runs.columns:
             return pd.Series([""] * len(runs), index=runs.index)
         return runs[name].map(lambda v: v if isinstance(v, str) else "")
 
-    paper = _paper_hashes()
+    paper = paper_hashes()
     return pd.Series([PAPER_SPECIMEN_NAME if not h or h in paper else f"{n or 'unnamed'} [{h[:6]}]"
                       for n, h in zip(column("specimen_name"), column("specimen_sha256"),
                                       strict=True)], index=runs.index, dtype=object)

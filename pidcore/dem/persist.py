@@ -23,7 +23,7 @@ import numpy as np
 
 from ..errors import StoreError
 from ..loadcase import key_0_1
-from ..specimen import Specimen, paper_specimen
+from ..specimen import Specimen, paper_hashes, paper_specimen
 from .result import UNITS, DemResult
 from .simulate import (
     DemConfig,
@@ -237,9 +237,7 @@ def runs_of_specimen(runs, specimen: Specimen | None = None):
     else:
         stated = runs["case_key"].map(lambda _: None)
     if specimen.is_paper():
-        from ..constants import PARTICLE_MATERIALS
-
-        paper = {paper_specimen(m).hash for m in PARTICLE_MATERIALS}
+        paper = paper_hashes()
         keep = stated.map(lambda h: h is None or h in paper)
     else:
         keep = stated == specimen.hash
