@@ -102,27 +102,24 @@ class Calibration:
         the same name with another cell or particles); "" where it does, or where either is
         unknown (``specimen`` None, or no readable :meth:`calibrated_specimen`). A report
         checks this before :meth:`lookup`, which matches load cases only."""
+        if specimen is None:  # nothing to check: do not read the specimen file
+            return ""
         return _other_specimen(self.calibrated_specimen(), specimen)
 
-    def why_not_predicted(self, case: LoadCase, *, specimen=None,
+    def why_not_predicted(self, case: LoadCase, *,
                           tolerances: Tolerances | None = None) -> str:
-        """Why :meth:`lookup` finds no prediction at ``case``: another specimen, another
-        particle material, outside the calibrated range, or not one of the calibrated load
-        cases (it predicts only where it was fitted).
+        """Why :meth:`lookup` finds no prediction at ``case``: another particle material,
+        outside the calibrated range, or not one of the calibrated load cases (it predicts
+        only where it was fitted). Another specimen is :meth:`other_specimen_reason`'s, asked
+        first.
 
         Parameters
         ----------
         case : LoadCase
-        specimen : pidcore.specimen.Specimen, optional
-            The specimen the row is of; the specimen check is skipped without it, or where the
-            calibration's own specimen is unknown (:meth:`calibrated_specimen`).
         tolerances : Tolerances, optional
             As for :meth:`lookup`.
         """
         tolerances = tolerances or Tolerances()
-        other = self.other_specimen_reason(specimen)
-        if other:
-            return other
         materials = sorted({p.load_case.material for p in self.predictions})
         if case.material not in materials:
             return f"it calibrates {' and '.join(materials)} particles, not {case.material}"

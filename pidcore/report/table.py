@@ -360,8 +360,9 @@ def add_calibration_columns(table: pd.DataFrame, calibration, *,
     measure, so the band is compared with ``SDC measured [-]`` (Eq. 11), not with Eq. 10.
     Rows whose load case the calibration does not predict (material, and frequency,
     acceleration, fill within ``tolerances``) get empty numbers, ``not compared`` and a note
-    saying so and why (:meth:`~pidcore.calibrate.prediction.Calibration.why_not_predicted`:
-    another specimen, another material, outside its range, not a calibrated load case). The
+    saying so and why (another specimen:
+    :meth:`~pidcore.calibrate.prediction.Calibration.other_specimen_reason`; another material,
+    outside its range, not a calibrated load case: ``why_not_predicted``). The
     table's notes (``attrs["notes"]``) gain one that counts the predicted rows and the
     measured rows inside the band.
 
