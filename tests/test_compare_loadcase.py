@@ -120,6 +120,11 @@ def test_a_specimens_own_material_is_accepted_and_the_default_with_its_specimen(
     assert resolve_load_case(tmp_path / "plain.uff").material == "acrylic"  # no specimen
     with pytest.raises(LoadCaseError, match="--specimen FILE"):
         resolve_load_case(tmp_path / "plain.uff", material="steel_440c")
+    # the specimen's material in the file name is read too (it was the sidecar and option
+    # only, and the name's "_steel" was passed over)
+    stated = resolve_load_case(tmp_path / "run_fill40_steel_440c.uff",
+                               specimen_material="steel_440c")
+    assert stated.material == "steel_440c" and "material: file name" in stated.origin
     # the table's materials stay accepted beside the specimen's
     stated = resolve_load_case(tmp_path / "plain.uff", material="aluminum",
                                specimen_material="steel_440c")
@@ -148,7 +153,12 @@ def test_stated_load_case_takes_measured_frequency_and_acceleration():
 def test_an_own_material_in_the_file_name_is_recognised_when_known():
     # steel (a user's specimen material) is stated by the name once it is a known material;
     # unknown, the name states none and the default is said to be assumed
-    from pidcore.compare.case import stated_case, unstated_note
+    from pidcore.app.uploads import assumed_note
+    from pidcore.compare.case import stated_case
+
+    def unstated_note(stated):  # what the app says of a row holding the stated values
+        return assumed_note(stated, {"fill [%]": stated.fill_percent,
+                                     "material": stated.material})
 
     name = "coupon2_f500Hz_a1g_fill50_steel.csv"
     assert parse_file_name(name, ("acrylic", "aluminium", "steel"))["material"] == "steel"

@@ -363,8 +363,8 @@ def default_settings_row(name: str, stated) -> dict:
 
 def assumed_note(stated, row: Mapping, given: Iterable[str] = ()) -> str:
     """What a file's settings row still takes from no statement, e.g. ``'material: not
-    stated, acrylic assumed'`` (:func:`pidcore.compare.case.unstated_note`), shown with its
-    result; a value the user has set in the row since, or that a settings table states
+    stated, acrylic assumed'`` (``stated``: :func:`pidcore.compare.case.stated_case`), shown
+    with its result; a value the user has set in the row since, or that a settings table states
     (``given``: its columns with a value for this file, :func:`columns_given`), is not
     assumed."""
     given = set(given)

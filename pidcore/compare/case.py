@@ -39,48 +39,30 @@ def stated_case(name: str, sidecar: pd.DataFrame | None = None,
                 materials: tuple[str, ...] = ()) -> StatedLoadCase:
     """What the file name and a load-case table state about a file (the table wins).
 
-    ``materials``: own materials recognised in the name besides the table's (e.g. ``steel``
-    of the user's specimens: ``..._steel.csv``). Without a stated fill,
-    :data:`PROPOSED_FILL_PERCENT` is proposed; the origin says so, and says which values are
-    the defaults (:func:`unstated_note`).
+    ``materials``: own materials recognised besides the table's (e.g. ``steel`` of the user's
+    specimens: ``..._steel.csv``). Without a stated fill, :data:`PROPOSED_FILL_PERCENT` is
+    proposed; the origin says so, and which values are defaults.
     """
     from ..constants import PARTICLE_MATERIALS
     from .loadcase import SIDECAR_COLUMNS, parse_file_name, resolve_load_case
 
-    known = (*PARTICLE_MATERIALS, *(m for m in materials if m not in PARTICLE_MATERIALS))
     table = sidecar if sidecar is not None else pd.DataFrame(columns=list(SIDECAR_COLUMNS))
+    try:
+        return resolve_load_case(Path(Path(name).name), sidecar=table, materials=materials)
+    except PidcoreError:  # no fill stated (or a bad table row): keep what the name states
+        pass
+    known = (*PARTICLE_MATERIALS, *(m for m in materials if m not in PARTICLE_MATERIALS))
     try:
         found = parse_file_name(Path(name).name, known)
     except PidcoreError:
         found = {}
-    try:
-        stated = resolve_load_case(Path(Path(name).name), sidecar=table)
-    except PidcoreError:  # no fill stated (or a bad table row): keep what the name states
-        stated = StatedLoadCase(
-            PROPOSED_FILL_PERCENT,
-            str(found.get("material", defaults.COMPARE_DEFAULT_MATERIAL)),
-            str(found.get("direction", defaults.COMPARE_DEFAULT_DIRECTION)),
-            f"fill: not stated, {PROPOSED_FILL_PERCENT:g} % proposed; material: "
-            f"{'file name' if 'material' in found else 'default'}; direction: "
-            f"{'file name' if 'direction' in found else 'default'}")
-    if "material" in found and "material: default" in stated.origin:
-        # an own material (steel) the table's parser does not know: the name states it
-        stated = replace(stated, material=str(found["material"]),
-                         origin=stated.origin.replace("material: default",
-                                                      "material: file name"))
-    return stated
-
-
-def unstated_note(stated: StatedLoadCase) -> str:
-    """What the file did not state and what is used instead, e.g. ``'fill: not stated, 50 %
-    proposed; material: not stated, acrylic assumed'`` ("" when it stated fill and material).
-    The drive direction is left out: the paper's z is every set-up's default."""
-    parts = []
-    if "fill: not stated" in stated.origin:
-        parts.append(f"fill: not stated, {stated.fill_percent:g} % proposed")
-    if "material: default" in stated.origin:
-        parts.append(f"material: not stated, {stated.material} assumed")
-    return "; ".join(parts)
+    return StatedLoadCase(
+        PROPOSED_FILL_PERCENT,
+        str(found.get("material", defaults.COMPARE_DEFAULT_MATERIAL)),
+        str(found.get("direction", defaults.COMPARE_DEFAULT_DIRECTION)),
+        f"fill: not stated, {PROPOSED_FILL_PERCENT:g} % proposed; material: "
+        f"{'file name' if 'material' in found else 'default'}; direction: "
+        f"{'file name' if 'direction' in found else 'default'}")
 
 
 def group_load_cases(cases: Sequence[LoadCase]) -> list[list[int]]:

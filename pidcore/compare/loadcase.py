@@ -230,6 +230,7 @@ def resolve_load_case(
     direction: str | None = None,
     sidecar: str | Path | pd.DataFrame | None = None,
     specimen_material: str | None = None,
+    materials: tuple[str, ...] = (),
 ) -> StatedLoadCase:
     """What the user states about a measurement file: file name < sidecar < options.
 
@@ -246,6 +247,9 @@ def resolve_load_case(
     specimen_material : str, optional
         Particle material of the specimen the measurement is compared with (``--specimen``):
         accepted besides the table's materials, and the default when none is stated.
+    materials : tuple of str, optional
+        Further own materials accepted (in the name, the sidecar and ``material``), e.g. those
+        of the user's specimen files and saved DEM runs (the app's).
 
     Returns
     -------
@@ -274,14 +278,14 @@ def resolve_load_case(
             values[name] = value
             origin[name] = where
 
-    known = PARTICLE_MATERIALS
+    known = (*PARTICLE_MATERIALS, *(m for m in materials if m not in PARTICLE_MATERIALS))
     if specimen_material is not None:
         specimen_material = normalize_material(specimen_material, "specimen", None)
         if specimen_material not in known:
             known = (*known, specimen_material)
         origin["material"] = "specimen"
         values["material"] = specimen_material
-    take(parse_file_name(path), "file name")
+    take(parse_file_name(path, known), "file name")
     if isinstance(sidecar, pd.DataFrame):
         take(_sidecar_entry(sidecar, path.name, Path("sidecar"), known), "sidecar table")
     else:
