@@ -215,7 +215,7 @@ def test_a_measurement_of_an_own_specimen_meets_its_dem_run_in_the_report(tmp_pa
     rec = synthesize_shaker_record(mass_kg=0.05, acceleration_amplitude_m_s2=5 * STANDARD_GRAVITY,
                                    frequency_hz=1000.0, sample_rate_hz=rate, n_periods=40,
                                    viscous_damping_n_s_m=5.0)
-    meas = tmp_path / "steel_run_fill50.csv"
+    meas = tmp_path / "own_run_fill50.csv"  # no material in the name: the specimen's
     write_measurement(Measurement("m", (Channel("Force", "force", rec.force_n, rate, "N"),
                                         Channel("LDV", "velocity", rec.velocity_m_s, rate,
                                                 "m/s"))), meas)
