@@ -72,13 +72,11 @@ class DemJob:
 
     def specimen_label(self) -> str:
         """The job's specimen as the DEM runs table names it (``"steel_6mm_b [3e945a]"``;
-        ``"paper_coupon"`` for the paper's)."""
-        from ..specimen import PAPER_SPECIMEN_NAME
+        ``"paper_coupon"`` for the paper's: :func:`pidcore.compare.specimens.specimen_label`)."""
+        from ..compare.specimens import specimen_label
 
         s = self.specimen
-        if s is None or s.is_paper():
-            return PAPER_SPECIMEN_NAME
-        return f"{s.name} [{s.hash[:6]}]"
+        return specimen_label("", "") if s is None else specimen_label(s.name, s.hash)
 
     def cycles_text(self) -> str:
         """``"120/300"`` cycles done of expected; ``"starting"`` while running before the

@@ -41,20 +41,27 @@ class SpecimenRuns:
     refused: bool = False
 
 
-def run_specimen_labels(runs: pd.DataFrame) -> pd.Series:
-    """One label per run: ``"name [hash6]"``; the paper's coupon (either table material, or
-    a run stored before specimens existed) is ``"paper_coupon"``: one specimen."""
+def specimen_label(name: str, sha256: str) -> str:
+    """A specimen as the pages name it: ``"name [hash6]"``; the paper's coupon (either table
+    material, or no hash: a run stored before specimens existed) is ``"paper_coupon"``."""
     from ..specimen import PAPER_SPECIMEN_NAME, paper_hashes
+
+    if not sha256 or sha256 in paper_hashes():
+        return PAPER_SPECIMEN_NAME
+    return f"{name or 'unnamed'} [{sha256[:6]}]"
+
+
+def run_specimen_labels(runs: pd.DataFrame) -> pd.Series:
+    """One :func:`specimen_label` per run (the paper's coupon is one specimen)."""
 
     def column(name: str) -> pd.Series:
         if name not in runs.columns:
             return pd.Series([""] * len(runs), index=runs.index)
         return runs[name].map(lambda v: v if isinstance(v, str) else "")
 
-    paper = paper_hashes()
-    return pd.Series([PAPER_SPECIMEN_NAME if not h or h in paper else f"{n or 'unnamed'} [{h[:6]}]"
-                      for n, h in zip(column("specimen_name"), column("specimen_sha256"),
-                                      strict=True)], index=runs.index, dtype=object)
+    return pd.Series([specimen_label(n, h) for n, h in zip(
+        column("specimen_name"), column("specimen_sha256"), strict=True)],
+        index=runs.index, dtype=object)
 
 
 def _names(runs: pd.DataFrame, labels: pd.Series) -> pd.Series:
