@@ -716,13 +716,15 @@ def load_specimen(path: str | os.PathLike[str]) -> Specimen:
     """Read and check a specimen file; a bad file is one ParameterError line naming it."""
     path = Path(path)
     try:
-        # utf-8-sig: Windows editors write a byte-order mark, which TOML does not allow
-        text = path.read_bytes().decode("utf-8-sig")
+        data = path.read_bytes()
     except OSError as exc:
         raise ParameterError(f"{path}: cannot read specimen file ({exc.strerror})") from None
+    try:
+        # utf-8-sig: Windows editors write a byte-order mark, which TOML does not allow
+        text = data.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
-        line = path.read_bytes()[:exc.start].count(b"\n") + 1
-        raise ParameterError(f"{path}: not UTF-8 text (byte 0x{exc.object[exc.start]:02x} on "
+        line = data[:exc.start].count(b"\n") + 1
+        raise ParameterError(f"{path}: not UTF-8 text (byte 0x{data[exc.start]:02x} on "
                              f"line {line}); save the specimen file as UTF-8") from None
     return Specimen.from_text(text, source=str(path))
 
