@@ -123,6 +123,9 @@ APP_MAX_DEM_CASES = 12
 #: Fill (packing ratio, %) the app proposes for an upload whose name states none (the paper's
 #: experiments were all at 50 %).
 APP_DEFAULT_FILL_PERCENT = 50.0
+#: Folders (relative to the working folder) the app searches for specimen files: the DEM page
+#: offers them, and their particle materials are materials a measurement may state.
+APP_SPECIMEN_FOLDERS: tuple[Path, ...] = (Path("data_samples") / "specimens", Path("specimens"))
 
 # --- Compare (measured vs DEM vs paper) -----------------------------------------------------
 #: A measured case sits on a DEM grid point when its frequency is within this relative

@@ -302,8 +302,9 @@ def specimen_materials(folders: Iterable[str | os.PathLike]) -> list[str]:
 
 #: Appended to an unknown material's error: how an own material becomes one to state.
 MATERIAL_HINT = ("an own material can be stated once a specimen file of it is in the "
-                 "specimen folders (data_samples/specimens/, specimens/) or a DEM run of it "
-                 "is saved")
+                 "specimen folders ("
+                 + ", ".join(f"{folder.as_posix()}/" for folder in defaults.APP_SPECIMEN_FOLDERS)
+                 + ") or a DEM run of it is saved")
 
 
 def read_settings_table(name: str, data: bytes,

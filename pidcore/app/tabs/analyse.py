@@ -154,11 +154,9 @@ def render(stores) -> list:
     except PidcoreError as exc:  # the uploads work without it: only the table's materials
         st.warning(f"DEM runs not read ({exc}): only the table's particle materials offered")
         runs = None
-    from pidcore.app.tabs.dem import SPECIMEN_FOLDERS
-
     materials = uploads.measurement_materials(
         [*(runs["material"] if "material" in getattr(runs, "columns", ()) else ()),
-         *uploads.specimen_materials(SPECIMEN_FOLDERS)])
+         *uploads.specimen_materials(defaults.APP_SPECIMEN_FOLDERS)])
     for upload in files or []:
         try:
             uploads.check_upload_size(upload.name, upload.size)

@@ -8,8 +8,6 @@ by the runner.
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import pandas as pd
 import streamlit as st
 
@@ -67,8 +65,8 @@ def _job_table(stores, polling: bool) -> None:
         st.rerun(scope="app")
 
 
-#: Folders searched for specimen files (relative to the working folder), besides uploads.
-SPECIMEN_FOLDERS = (Path("data_samples") / "specimens", Path("specimens"))
+#: Folders searched for specimen files, besides uploads.
+SPECIMEN_FOLDERS = defaults.APP_SPECIMEN_FOLDERS
 _PAPER = "paper coupon (default)"
 
 
