@@ -65,19 +65,18 @@ def _job_table(stores, polling: bool) -> None:
         st.rerun(scope="app")
 
 
-#: Folders searched for specimen files, besides uploads.
-SPECIMEN_FOLDERS = defaults.APP_SPECIMEN_FOLDERS
 _PAPER = "paper coupon (default)"
 
 
 def _specimen_choice():
     """(specimen, error): the specimen chosen (None: the paper's coupon), a file of
-    SPECIMEN_FOLDERS or an uploaded TOML (parsed by :func:`pidcore.specimen.Specimen.from_text`,
-    never executed); ``error`` is why the chosen file is refused (None when it is not)."""
+    ``defaults.APP_SPECIMEN_FOLDERS`` or an uploaded TOML (parsed by
+    :func:`pidcore.specimen.Specimen.from_text`, never executed); ``error`` is why the chosen
+    file is refused (None when it is not)."""
     from pidcore.errors import PidcoreError
     from pidcore.specimen import load_specimen
 
-    files = sorted(p for folder in SPECIMEN_FOLDERS if folder.is_dir()
+    files = sorted(p for folder in defaults.APP_SPECIMEN_FOLDERS if folder.is_dir()
                    for p in folder.glob("*.toml"))
     c1, c2 = st.columns(2)
     upload = c2.file_uploader("or a specimen file (TOML)", type=["toml"], key="dem_specimen_file")
