@@ -9,7 +9,7 @@ import time
 import numpy as np
 
 from .. import defaults
-from .contact import ContactLaw
+from .contact import LAW_DAMPING, LAW_SLIDING, LAW_STIFFNESS, ContactLaw
 from .geometry import CellGeometry, random_packing
 from .simulate import LoadCase, choose_time_step, settle_bed
 from .state import CellsState, KernelSettings, advance
@@ -19,7 +19,8 @@ def run_dem_bench(*, particles_per_cell: int = 20, cells: int = 8, steps: int = 
                   threads: int = 1, frequency_hz: float = 100.0, acceleration_g: float = 5.0,
                   material: str = "acrylic", seed: int = defaults.DEM_SEED,
                   static_friction: float | None = None, rolling_friction: float = 0.0,
-                  repeat: int = 1, grid: bool = False, workers: int | None = None) -> dict:
+                  repeat: int = 1, grid: bool = False, workers: int | None = None,
+                  reference: bool = False) -> dict:
     """Measure kernel throughput on a driven bed in steady motion (compile time excluded).
 
     The bed is settled as a load case starts (dense packing by default) and driven for one
@@ -28,13 +29,17 @@ def run_dem_bench(*, particles_per_cell: int = 20, cells: int = 8, steps: int = 
     are timed ``repeat`` times with ``threads`` Numba threads, and the fastest run is kept (on
     a shared machine the others were slowed by other processes). ``static_friction`` and
     ``rolling_friction`` (both pairs; None: the table's) switch those laws on.
+    ``reference=True`` also times :func:`~.bench_reference.all_pairs_reference` (a plain
+    all-pairs kernel without contact history: the yardstick of issue 11's targets) from the
+    same state, the same number of steps and repetitions.
 
     Returns
     -------
     dict with ``particle_steps_per_s`` [1/s] (fastest wall time), ``particle_steps_per_s_cpu``
     [1/s] (fastest process CPU time: the kernel's own speed when other processes share the
     core), ``particle_steps_per_s_per_thread`` [1/s], ``wall_s`` [s], ``particles_per_cell``,
-    ``cells``, ``steps``, ``threads``, ``repeat``, ``time_step_s``;
+    ``cells``, ``steps``, ``threads``, ``repeat``, ``time_step_s``; with ``reference=True``
+    also ``reference_particle_steps_per_s`` [1/s] (fastest process CPU time, like ``_cpu``);
     with ``grid=True`` also ``grid_cases`` and ``grid_wall_s`` [s]: the paper's Table 3 grid
     run with default settings by :func:`pidcore.dem.sweep.run_sweep` (``workers`` processes)
     into a temporary store.
@@ -75,6 +80,9 @@ def run_dem_bench(*, particles_per_cell: int = 20, cells: int = 8, steps: int = 
         numba.set_num_threads(previous)
     rate = steps * cells * particles_per_cell / wall
     extra = run_grid_bench(material=material, seed=seed, workers=workers) if grid else {}
+    if reference:
+        extra["reference_particle_steps_per_s"] = steps * cells * particles_per_cell / \
+            _time_reference(state, settings, steps, repeat)
     return extra | {"particle_steps_per_s": rate,
             "particle_steps_per_s_cpu": steps * cells * particles_per_cell / cpu,
             "particle_steps_per_s_per_thread": rate / max(threads, 1),
@@ -82,6 +90,30 @@ def run_dem_bench(*, particles_per_cell: int = 20, cells: int = 8, steps: int = 
             "steps": steps, "threads": threads, "repeat": repeat, "time_step_s": dt,
             "material": material, "static_friction": static_friction,
             "rolling_friction": rolling_friction}
+
+
+def _time_reference(state: CellsState, settings: KernelSettings, steps: int,
+                    repeat: int) -> float:
+    """Fastest process CPU time of the all-pairs yardstick over ``steps`` from ``state``, s."""
+    from .bench_reference import all_pairs_reference
+    from .state import law_vectors
+
+    law = settings.law
+    pair_law, wall_law = (vector[[LAW_STIFFNESS, LAW_DAMPING, LAW_SLIDING]].copy()
+                          for vector in law_vectors(law))
+
+    def run(n: int) -> float:
+        copy = state.copy()
+        start = time.process_time()
+        all_pairs_reference(copy.pos, copy.vel, copy.omg, settings.geometry.wall_normals,
+                            settings.geometry.wall_offsets, law.radius_m, law.mass_kg,
+                            law.inertia_kg_m2, pair_law, wall_law, settings.gravity_m_s2,
+                            settings.dt_s, n, settings.omega_rad_s, settings.accel_m_s2,
+                            settings.friction_regularisation_m_s)
+        return time.process_time() - start
+
+    run(1)  # compile or load from the cache
+    return min(run(steps) for _ in range(max(repeat, 1)))
 
 
 def run_grid_bench(*, material: str = "acrylic", seed: int = defaults.DEM_SEED,
