@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import json
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -75,7 +76,7 @@ def test_damper_from_store_runs(tmp_path, monkeypatch):
             str(tmp_path / "s.h5"), "--format", "csv"]
     with pytest.raises(ParameterError, match="differ in material"):
         _run(argv)
-    _run([*argv, "--where", "material=acrylic"])
+    _run([*argv, "--where", "material=acrylic", "--vibrated-mass", "0.1"])
     table = pd.read_csv(tmp_path / "equivalent_damper.csv")
     # duplicates averaged: mean of 0.9 x and 1.1 x is the paper value
     expected = SdcModel.from_table(load_paper_table3())
@@ -101,3 +102,110 @@ def test_figures_writes_every_family(tmp_path, monkeypatch):
     names = sorted(p.name for p in tmp_path.iterdir())
     assert len(names) == 2 * (4 + 3)
     assert "sdc_vs_acceleration_fill90.svg" in names and "sdc_vs_frequency_10g.png" in names
+
+
+BUNDLED_GRID = Path(__file__).resolve().parents[1] / "data_samples" / "dem_table3.h5"
+
+
+def test_damper_from_store_runs_gives_back_their_dissipated_energy(tmp_path):
+    # c_eq = SDC m_c w / (2 pi) is the dissipation only with the m_c the SDC was divided by:
+    # at every grid point the damper's energy per cycle must be the run's own (it used the
+    # paper's count of 36 per full cell, 27-43 % above the runs' m_c, capacity 22 per cell)
+    from pidcore.store import Store
+
+    assert _run(["model", "damper", "--out", str(tmp_path), "--table", "store", "--store",
+                 str(BUNDLED_GRID), "--format", "csv,json"]) == 0
+    table = pd.read_csv(tmp_path / "equivalent_damper.csv")
+    runs = Store(BUNDLED_GRID).list_dem_runs()
+    merged = table.merge(runs, left_on=["frequency [Hz]", "acceleration [g]", "fill [%]"],
+                         right_on=["frequency_hz", "acceleration_g", "fill_percent"])
+    assert len(merged) == len(runs) == 48
+    # the same sums of the same stored numbers: equal to rounding
+    np.testing.assert_allclose(merged["vibrated_mass [kg]"], merged["vibrated_mass_kg"],
+                               rtol=1e-12)
+    np.testing.assert_allclose(merged["energy_per_cycle [J]"], merged["energy_per_cycle_j"],
+                               rtol=1e-9)
+    provenance = json.loads((tmp_path / "equivalent_damper.json").read_text())["provenance"]
+    assert "the m_c the DEM runs divided their SDC by" in provenance["vibrated_mass"]
+    # the runs' m_c convention is the only one that gives their energy back
+    with pytest.raises(ParameterError, match="--mass-convention coupon: the DEM runs in .* "
+                                             "are coupon_plus_particles"):
+        _run(["model", "damper", "--out", str(tmp_path), "--table", "store", "--store",
+              str(BUNDLED_GRID), "--mass-convention", "coupon"])
+    with pytest.raises(ParameterError, match="--material aluminium: the DEM runs"):
+        _run(["model", "damper", "--out", str(tmp_path), "--table", "store", "--store",
+              str(BUNDLED_GRID), "--material", "aluminium"])
+
+
+def _specimen_runs(name: str, sha: str, *, coupon_kg: float, fixture_kg: float,
+                   sdc_scale: float) -> pd.DataFrame:
+    """A full grid of runs of one specimen, as a store lists them (m_c of its masses)."""
+    base = load_paper_table3().dropna(subset=["sdc_dem"])
+    full, cells, particle_kg = 10, 100, 3.3e-5
+    count = np.round(base["fill_percent"].to_numpy() / 100 * full)
+    return base.rename(columns={"sdc_dem": "sdc"}).assign(
+        sdc=base["sdc_dem"] * sdc_scale, material="acrylic", case_key=f"{name}-run",
+        specimen_name=name, specimen_sha256=sha, specimen_is_paper=False,
+        vibrated_mass_convention="coupon_plus_particles", coupon_mass_kg=coupon_kg,
+        fixture_mass_kg=fixture_kg, coupon_cells=cells, particle_mass_kg=particle_kg,
+        particles_full_cell=full, sdc_stderr=0.01,
+        vibrated_mass_kg=coupon_kg + fixture_kg + cells * count * particle_kg)
+
+
+def test_damper_takes_one_specimens_runs_with_its_masses_and_a_given_area(tmp_path,
+                                                                          monkeypatch):
+    import pidcore.store
+
+    mine = _specimen_runs("steel_6mm", "a" * 64, coupon_kg=0.05, fixture_kg=0.12,
+                          sdc_scale=0.5)
+    other = _specimen_runs("steel_6mm", "b" * 64, coupon_kg=0.07, fixture_kg=0.0,
+                           sdc_scale=2.0)
+    listing = pd.concat([mine, other.assign(specimen_name="thick_core")])
+
+    class FakeStore:
+        def __init__(self, path):
+            self.path = path
+
+        def list_dem_runs(self):
+            return listing
+
+    monkeypatch.setattr(pidcore.store, "Store", FakeStore, raising=False)
+    argv = ["model", "damper", "--out", str(tmp_path), "--table", "store", "--store",
+            str(tmp_path / "s.h5"), "--format", "csv"]
+    # two specimens' SDCs would be averaged into one model of neither
+    with pytest.raises(ParameterError, match=r"DEM runs are of 2 specimens: steel_6mm \[aaaaaa\] "
+                                             r"\(47 runs\), thick_core \[bbbbbb\] \(47 runs\); "
+                                             "select one.*--where specimen_name=steel_6mm"):
+        _run(argv)
+    # its file states no coupon area: per-area damping is refused, not taken from the paper
+    with pytest.raises(ParameterError, match="--area M2: the DEM runs are of specimen "
+                                             "steel_6mm"):
+        _run([*argv, "--where", "specimen_name=steel_6mm"])
+    _run([*argv, "--where", "specimen_name=steel_6mm", "--area", "0.02"])
+    table = pd.read_csv(tmp_path / "equivalent_damper.csv")
+    at_grid = table.merge(mine, left_on=["frequency [Hz]", "acceleration [g]", "fill [%]"],
+                          right_on=["frequency_hz", "acceleration_g", "fill_percent"])
+    assert len(at_grid) == 47
+    np.testing.assert_allclose(at_grid["vibrated_mass [kg]"], at_grid["vibrated_mass_kg"],
+                               rtol=1e-12)
+    np.testing.assert_allclose(at_grid["sdc [-]"], at_grid["sdc"], rtol=1e-12)
+    np.testing.assert_allclose(table["c_eq_per_area [N s/m^3]"], table["c_eq [N s/m]"] / 0.02,
+                               rtol=1e-12)
+    # two files of one name are two specimens: told apart by hash
+    listing = pd.concat([mine, other])
+    with pytest.raises(ParameterError, match="--where specimen_sha256=a{64}"):
+        _run(argv)
+
+
+def test_runs_vibrated_mass_refuses_a_run_its_specimen_columns_do_not_give():
+    from pidcore.model import runs_vibrated_mass
+
+    runs = _specimen_runs("steel_6mm", "a" * 64, coupon_kg=0.05, fixture_kg=0.12,
+                          sdc_scale=1.0)
+    mass = runs_vibrated_mass(runs)
+    # 50 % of 10 per cell in 100 cells of 33 mg, plus coupon and fixture
+    assert mass(50.0) == pytest.approx(0.05 + 0.12 + 100 * 5 * 3.3e-5, rel=1e-12)
+    # a store written when coupon_mass_kg held coupon + fixture: the fixture counted twice
+    old = runs.assign(vibrated_mass_kg=runs["vibrated_mass_kg"] - 0.12)
+    with pytest.raises(ParameterError, match="stored m_c .* but its specimen columns give"):
+        runs_vibrated_mass(old)

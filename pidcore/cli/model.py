@@ -67,15 +67,21 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     d.add_argument("--accelerations", metavar="LIST", type=_float_list,
                    help="acceleration amplitudes, g")
     d.add_argument("--frequencies", metavar="LIST", type=_float_list, help="frequencies, Hz")
-    d.add_argument("--mass-convention", choices=VIBRATED_MASS_CONVENTIONS,
-                   default=defaults.MODEL_VIBRATED_MASS_CONVENTION,
-                   help="mass m_c in E = m_c a^2/(2 w^2) (default "
-                        f"{defaults.MODEL_VIBRATED_MASS_CONVENTION}; particles by the paper's "
-                        "count of 36 per full cell)")
-    d.add_argument("--material", choices=PARTICLE_MATERIALS,
-                   default=defaults.MODEL_PARTICLE_MATERIAL, help="particle material")
+    d.add_argument("--mass-convention", choices=VIBRATED_MASS_CONVENTIONS, default=None,
+                   help="mass m_c in E = m_c a^2/(2 w^2): --table paper: default "
+                        f"{defaults.MODEL_VIBRATED_MASS_CONVENTION}, particles by the paper's "
+                        "count of 36 per full cell; --table store: the m_c the runs divided "
+                        "their SDC by (their specimen's masses and count; another convention "
+                        "is refused)")
+    d.add_argument("--material", choices=PARTICLE_MATERIALS, default=None,
+                   help="particle material of --table paper's masses (default "
+                        f"{defaults.MODEL_PARTICLE_MATERIAL}); --table store: the runs' own")
     d.add_argument("--vibrated-mass", metavar="KG", type=float, default=None,
                    help="explicit m_c, kg (overrides --mass-convention)")
+    d.add_argument("--area", metavar="M2", type=float, default=None,
+                   help="coupon area for c_eq per area, m^2 (default: the paper's 0.1 m x "
+                        "0.1 m; required for runs of another specimen, whose file has no "
+                        "coupon area)")
     d.set_defaults(func=run_damper)
 
     f = sub.add_parser("figures", help="SDC figures (paper Figs. 8-14), PNG and SVG")
@@ -84,13 +90,16 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def build_model(args: argparse.Namespace):
-    """The SDC model selected by --table/--store/--log-frequency."""
+    """(SDC model, the DEM runs it is built on or None for the paper's table) selected by
+    --table/--store/--where/--log-frequency."""
     from ..model import SdcModel, load_paper_table3
 
     if args.table == "paper":
+        if args.where:
+            raise ParameterError("--where selects DEM runs: use it with --table store")
         return SdcModel.from_table(load_paper_table3(), value="sdc_dem",
                                    log_frequency=args.log_frequency,
-                                   source="paper Table 3 (DEM)")
+                                   source="paper Table 3 (DEM)"), None
     from ..model import select_runs
     from ..store import Store
 
@@ -106,42 +115,74 @@ def build_model(args: argparse.Namespace):
                              f"--table paper")
     runs = select_runs(runs, where=where)
     text = f"DEM runs in {args.store}" + (f" where {where}" if where else "")
-    return SdcModel.from_table(runs, value="sdc", log_frequency=args.log_frequency, source=text)
+    return SdcModel.from_table(runs, value="sdc", log_frequency=args.log_frequency,
+                               source=text), runs
 
 
 def run_damper(args: argparse.Namespace) -> int:
     from ..model.damper import (
+        coupon_area_m2,
         coupon_vibrated_mass_kg,
         equivalent_damper_table,
         paper_particles_mass_kg,
+        runs_vibrated_mass,
         write_damper_table,
     )
 
-    model = build_model(args)
+    model, runs = build_model(args)
+    if runs is not None:
+        for option, column, given in (("--mass-convention", "vibrated_mass_convention",
+                                       args.mass_convention),
+                                      ("--material", "material", args.material)):
+            stated = sorted(runs[column].dropna().astype(str).unique()) \
+                if column in runs.columns else []
+            if given is not None and stated and stated != [given]:
+                why = " (their SDC is divided by that m_c)" \
+                    if option == "--mass-convention" else ""
+                raise ParameterError(
+                    f"{option} {given}: the DEM runs in {args.store} are {', '.join(stated)}"
+                    f"{why}; leave {option} out or select runs with --where")
     if args.vibrated_mass is not None:
         mass = args.vibrated_mass
         mass_text = f"{mass} kg (given)"
+    elif runs is not None:
+        mass = runs_vibrated_mass(runs)
+        mass_text = (f"{runs['vibrated_mass_convention'].iloc[0]}: the m_c the DEM runs "
+                     "divided their SDC by (their specimen's coupon, fixture and particle "
+                     "masses and count per cell)")
     else:
-        convention = args.mass_convention
+        convention = args.mass_convention or defaults.MODEL_VIBRATED_MASS_CONVENTION
+        material = args.material or defaults.MODEL_PARTICLE_MATERIAL
 
         def mass(fill: float) -> float:
-            particles = paper_particles_mass_kg(fill, args.material)
+            particles = paper_particles_mass_kg(fill, material)
             if convention == "particles":
                 return particles
             if convention == "coupon":
                 return coupon_vibrated_mass_kg()
             return coupon_vibrated_mass_kg(particles_mass_kg=particles)
 
-        mass_text = f"{convention} ({args.material}, paper count per cell)"
+        mass_text = f"{convention} ({material}, paper count per cell)"
+    if args.area is not None:
+        area, area_text = args.area, f"{args.area} m^2 (given)"
+    elif runs is not None and "specimen_is_paper" in runs.columns \
+            and not runs["specimen_is_paper"].fillna(True).astype(bool).all():
+        name = runs["specimen_name"].iloc[0] if "specimen_name" in runs.columns else "?"
+        raise ParameterError(f"--area M2: the DEM runs are of specimen {name}, whose file "
+                             "states no coupon area; give the area c_eq per area is taken "
+                             "over, e.g. --area 0.01")
+    else:
+        area, area_text = None, f"{coupon_area_m2()} m^2 (the paper's 0.1 m x 0.1 m coupon)"
     table = equivalent_damper_table(
         model, fills=args.fills if args.fills else model.axes[0],
         accelerations=args.accelerations if args.accelerations else model.axes[1],
         frequencies=args.frequencies if args.frequencies else model.axes[2],
-        vibrated_mass_kg=mass)
+        vibrated_mass_kg=mass, area_m2=area)
     provenance = {
         "sdc_source": model.source, "sdc_value": model.value_name,
         "interpolation": "tensor-product pchip (frequency, fill, acceleration passes)",
         "log_frequency": model.log_frequency, "vibrated_mass": mass_text,
+        "area": area_text,
         "filled_grid_points": model.filled_points().to_dict(orient="records"),
     }
     paths = write_damper_table(table, args.out, formats=args.format, provenance=provenance)
@@ -153,7 +194,7 @@ def run_damper(args: argparse.Namespace) -> int:
 def run_figures(args: argparse.Namespace) -> int:
     from ..report.figures import plot_sdc_vs_acceleration, plot_sdc_vs_frequency, save_figure
 
-    model = build_model(args)
+    model, _ = build_model(args)
 
     def curves(extra: tuple[float, ...], axis) -> list[float]:
         # grid values (data) plus interpolated ones inside the model's range

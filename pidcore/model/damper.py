@@ -202,6 +202,64 @@ def paper_particles_mass_kg(fill_percent: float, material: str = "acrylic", *,
     return cells * per_cell * _particle_mass_kg(material)
 
 
+#: Columns of a DEM-run listing that fix m_c(fill) as the runs normalised their SDC.
+RUN_MASS_COLUMNS: tuple[str, ...] = (
+    "vibrated_mass_convention", "coupon_mass_kg", "fixture_mass_kg", "coupon_cells",
+    "particle_mass_kg", "particles_full_cell")
+
+
+def runs_vibrated_mass(runs: pd.DataFrame) -> Callable[[float], float]:
+    """m_c [kg] of Eq. 10 against fill [%], as the DEM runs of one specimen normalised their SDC.
+
+    c_eq = SDC m_c w / (2 pi) recovers the dissipated energy only with the m_c the SDC was
+    divided by. The runs' own specimen fixes it (their coupon and fixture masses, cell count,
+    particle mass and the count taken as 100 % fill); the result is checked against each
+    run's stored ``vibrated_mass_kg`` (a run of another specimen, or of a store written
+    before these columns meant what they mean now, is refused, not mixed in).
+    """
+    from ..specimen import particles_for_fill
+
+    missing = [c for c in (*RUN_MASS_COLUMNS, "fill_percent", "vibrated_mass_kg")
+               if c not in runs.columns]
+    if missing:
+        raise ParameterError(f"DEM runs: no {', '.join(missing)} column(s) to take the vibrated "
+                             "mass m_c from; give --vibrated-mass KG")
+    values = {}
+    for column in RUN_MASS_COLUMNS:
+        distinct = runs[column].dropna().unique()
+        if len(distinct) != 1:
+            raise ParameterError(
+                f"DEM runs: {column} is {sorted(map(str, distinct)) or 'not stored'}; the "
+                "vibrated mass m_c needs the runs of one specimen (select with --where)")
+        values[column] = distinct[0]
+    convention = str(values["vibrated_mass_convention"])
+    rigid = float(values["coupon_mass_kg"]) + float(values["fixture_mass_kg"])
+    per_particle = int(values["coupon_cells"]) * float(values["particle_mass_kg"])
+    full = int(values["particles_full_cell"])
+    if convention not in ("coupon_plus_particles", "coupon", "particles"):
+        raise ParameterError(f"DEM runs: unknown vibrated_mass_convention {convention!r}")
+
+    def mass(fill_percent: float) -> float:
+        particles = per_particle * particles_for_fill(float(fill_percent), full)
+        if convention == "coupon":
+            return rigid
+        if convention == "particles":
+            return particles
+        return rigid + particles
+
+    stored = runs["vibrated_mass_kg"].to_numpy(float)
+    rebuilt = np.array([mass(f) for f in runs["fill_percent"].to_numpy(float)])
+    # the same sums of the same stored numbers: equal to rounding
+    bad = ~np.isclose(rebuilt, stored, rtol=1e-9, atol=0.0)
+    if bad.any():
+        k = int(np.flatnonzero(bad)[0])
+        raise ParameterError(
+            f"DEM run {runs['case_key'].iloc[k] if 'case_key' in runs else k}: stored m_c "
+            f"{stored[k]:.6g} kg, but its specimen columns give {rebuilt[k]:.6g} kg; give "
+            "--vibrated-mass KG or re-run it")
+    return mass
+
+
 def equivalent_damper_table(model: SdcModel, *, fills: Sequence[float],
                             accelerations: Sequence[float], frequencies: Sequence[float],
                             vibrated_mass_kg: float | Callable[[float], float],

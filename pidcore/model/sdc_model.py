@@ -347,4 +347,30 @@ def select_runs(runs: pd.DataFrame, *, where: Mapping[str, str] | None = None) -
                 raise ParameterError(
                     f"DEM runs differ in {column} ({', '.join(distinct)}); select one, e.g. "
                     f"where={{{column!r}: {distinct[0]!r}}} (CLI: --where {column}={distinct[0]})")
+    _check_one_specimen(selected)
     return selected
+
+
+def _check_one_specimen(runs: pd.DataFrame) -> None:
+    """Refuse runs of several specimens: their SDCs describe different structures.
+
+    The paper's coupon is one specimen (either table material; runs stored before specimens
+    had no hash); two files of one name are two specimens.
+    """
+    from ..compare.specimens import run_specimen_labels
+
+    labels = run_specimen_labels(runs)
+    counts = labels.value_counts(sort=False)
+    if len(counts) < 2:
+        return
+    listed = ", ".join(f"{label} ({n} runs)" for label, n in counts.items())
+    # a specimen of the user's (the paper's coupon has no hash in its label), by name unless
+    # two files share it
+    k = next(k for k, label in enumerate(labels) if label.endswith("]"))
+    name = str(runs["specimen_name"].iloc[k])
+    same_name = sum(label.rsplit(" [", 1)[0] == name for label in counts.index)
+    column, value = ("specimen_name", name) if same_name == 1 else \
+        ("specimen_sha256", str(runs["specimen_sha256"].iloc[k]))
+    raise ParameterError(
+        f"DEM runs are of {len(counts)} specimens: {listed}; select one, e.g. "
+        f"where={{{column!r}: {value!r}}} (CLI: --where {column}={value})")
