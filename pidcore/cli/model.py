@@ -122,9 +122,8 @@ def build_model(args: argparse.Namespace):
 def run_damper(args: argparse.Namespace) -> int:
     from ..model.damper import (
         coupon_area_m2,
-        coupon_vibrated_mass_kg,
         equivalent_damper_table,
-        paper_particles_mass_kg,
+        paper_vibrated_mass,
         runs_vibrated_mass,
         write_damper_table,
     )
@@ -153,15 +152,7 @@ def run_damper(args: argparse.Namespace) -> int:
     else:
         convention = args.mass_convention or defaults.MODEL_VIBRATED_MASS_CONVENTION
         material = args.material or defaults.MODEL_PARTICLE_MATERIAL
-
-        def mass(fill: float) -> float:
-            particles = paper_particles_mass_kg(fill, material)
-            if convention == "particles":
-                return particles
-            if convention == "coupon":
-                return coupon_vibrated_mass_kg()
-            return coupon_vibrated_mass_kg(particles_mass_kg=particles)
-
+        mass = paper_vibrated_mass(convention, material)
         mass_text = f"{convention} ({material}, paper count per cell)"
     if args.area is not None:
         area, area_text = args.area, f"{args.area} m^2 (given)"

@@ -202,6 +202,25 @@ def paper_particles_mass_kg(fill_percent: float, material: str = "acrylic", *,
     return cells * per_cell * _particle_mass_kg(material)
 
 
+def paper_vibrated_mass(convention: str = D.MODEL_VIBRATED_MASS_CONVENTION,
+                        material: str = D.MODEL_PARTICLE_MATERIAL) -> Callable[[float], float]:
+    """m_c [kg] of Eq. 10 against fill [%] for the paper's coupon (Table 2 masses) with the
+    paper's count of particles (:func:`paper_particles_mass_kg`), by ``convention``."""
+    if convention not in ("coupon_plus_particles", "coupon", "particles"):
+        raise ParameterError(f"vibrated mass convention: expected coupon_plus_particles, "
+                             f"coupon or particles, got {convention!r}")
+
+    def mass(fill_percent: float) -> float:
+        particles = paper_particles_mass_kg(fill_percent, material)
+        if convention == "particles":
+            return particles
+        if convention == "coupon":
+            return coupon_vibrated_mass_kg()
+        return coupon_vibrated_mass_kg(particles_mass_kg=particles)
+
+    return mass
+
+
 #: Columns of a DEM-run listing that fix m_c(fill) as the runs normalised their SDC.
 RUN_MASS_COLUMNS: tuple[str, ...] = (
     "vibrated_mass_convention", "coupon_mass_kg", "fixture_mass_kg", "coupon_cells",
