@@ -164,3 +164,17 @@ def test_sweep_refuses_a_bad_value_list_in_one_line(tmp_path, capsys, value):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "--fills" in err[0]
     assert not (tmp_path / "s.h5").exists()
+
+
+@pytest.mark.parametrize("command", [
+    ["dem", "run", "--frequency", "500", "--acceleration", "5", "--fill", "1"],
+    ["dem", "sweep", "--frequencies", "500", "--accelerations", "5", "--fills", "50,1"]])
+def test_a_fill_of_no_particle_names_its_option_and_writes_nothing(tmp_path, capsys, command):
+    # 1 % of the 22 acrylic spheres a cell holds rounds to none: refused before anything runs
+    store = tmp_path / "s.h5"
+    code = main([*command, "--store", str(store), "--no-progress"])
+    err = capsys.readouterr().err
+    option = command[-2]
+    assert code == 2 and err.count("\n") == 1
+    assert f"{option} 1: fill 1 % of 22 particles rounds to none; expected >= 2.28 %" in err
+    assert not store.exists()

@@ -193,6 +193,8 @@ def sweep(args: argparse.Namespace) -> int:
                                          "--accelerations"),
                                         ("fill_percent", args.fills, "--fills"))]
     specimen, material = _specimen(args)
+    for fill in values[2]:
+        _check_fill(fill, "--fills", args, specimen, material)
     cases = cross_cases(*values, material=material, direction=args.direction)
     saved: list[str] = []  # keys run_sweep has stored (its on_case hook runs after each save)
     try:
@@ -209,8 +211,21 @@ def sweep(args: argparse.Namespace) -> int:
     return 0
 
 
-def _fill(args: argparse.Namespace, specimen) -> float:
+def _check_fill(fill: float, option: str, args: argparse.Namespace, specimen,
+                material: str) -> None:
+    """A fill that rounds to no particle (or more than fit) is refused naming the option."""
+    from ..dem.simulate import particles_per_cell
+
+    try:
+        particles_per_cell(fill, material, specimen=specimen,
+                           fill_reference=args.fill_reference)
+    except ParameterError as exc:
+        raise ParameterError(f"{option} {fill:g}: {exc}") from None
+
+
+def _fill(args: argparse.Namespace, specimen, material: str) -> float:
     if args.fill is not None:
+        _check_fill(args.fill, "--fill", args, specimen, material)
         return args.fill
     p = specimen.particles if specimen is not None else None
     if p is not None and p.fill_percent is not None:
@@ -225,7 +240,7 @@ def run(args: argparse.Namespace) -> int:
     from ..dem import LoadCase, simulate_load_case
 
     specimen, material = _specimen(args)
-    case = LoadCase(args.frequency, args.acceleration, _fill(args, specimen),
+    case = LoadCase(args.frequency, args.acceleration, _fill(args, specimen, material),
                     material=material, direction=args.direction)
     config = _config(args)
     progress = not args.no_progress and sys.stderr.isatty()
