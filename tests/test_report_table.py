@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 import pandas as pd
@@ -236,6 +237,11 @@ def test_dem_runs_of_different_settings_are_separate_rows_unless_pooled():
     assert by_cells["cells 2"]["SDC DEM (ours) [-]"] == 0.9  # not averaged with the 32-cell runs
     assert by_cells["cells 32"]["SDC DEM (ours) [-]"] == pytest.approx(0.51)
     assert by_cells["cells 32"]["DEM runs [-]"] == 2
+    # the settings' hash says what it is: beside the specimen's "name [hash]" a bare
+    # "[hash]" read as a second specimen hash
+    settings = by_cells["cells 32"]["DEM settings"]
+    assert re.fullmatch(r"cells 32, steady cycles auto, settings hash [0-9a-f]{6}", settings)
+    assert "[" not in settings
     pooled = build_report_table(dem, None, None, pool=True)
     assert len(pooled) == 1 and pooled.iloc[0]["DEM runs [-]"] == 3
     assert "--pool" in pooled.iloc[0]["note"]

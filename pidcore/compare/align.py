@@ -116,9 +116,10 @@ class DemCase:
     vibrated_mass_kg : float
         Mean m_c of the runs (the mass in E = m_c a^2 / (2 w^2), Eq. 10), kg; NaN if unknown.
     settings : str
-        The numerical settings the runs share, e.g. ``"cells 8, steady cycles auto [3fa2c1]"``
-        (every input but the load case and the seed); runs of different settings are separate
-        cases unless pooled explicitly. Empty where the runs do not record their settings.
+        The numerical settings the runs share, e.g.
+        ``"cells 8, steady cycles auto, settings hash 3fa2c1"`` (every input but the load
+        case and the seed); runs of different settings are separate cases unless pooled
+        explicitly. Empty where the runs do not record their settings.
     cells_simulated : float
         Cells simulated per run (NaN if unknown); the preferred case of several settings at one
         load case is the one with the most cells.
@@ -291,8 +292,9 @@ def _settings_of(row: pd.Series) -> tuple[str, float]:
         cells = float(settings["config_cells"])
     steady = settings.get("config_steady_cycles", "")
     digest = hashlib.sha256(json.dumps(settings, sort_keys=True, default=str).encode())
-    return (f"cells {cells:g}, steady cycles {steady if steady not in ('', None) else 'auto'} "
-            f"[{digest.hexdigest()[:6]}]"), cells
+    # "settings hash": the specimen is named "name [hash]" beside it, another hash
+    return (f"cells {cells:g}, steady cycles {steady if steady not in ('', None) else 'auto'}, "
+            f"settings hash {digest.hexdigest()[:6]}"), cells
 
 
 def dem_cases(dem_runs: pd.DataFrame, *, tolerances: Tolerances | None = None,
