@@ -907,7 +907,7 @@ def test_calibrate_page_keeps_saved_materials_apart_and_refuses_a_mixed_or_unkno
     # page's points name their material and are not averaged; the page calibrates the paper's
     # coupon, so steel points are refused before a background run starts (as the CLI does)
     import pidcore.calibrate as api
-    from pidcore.app.calibration import points_by_material, runner_for
+    from pidcore.app.calibration import points_by_material, points_for_specimen, runner_for
 
     store_file = tmp_path / "s.h5"
     acrylic = _record(mass_damper_csv(frequency_hz=100.0), options, name="a_fill50.csv")
@@ -925,14 +925,31 @@ def test_calibrate_page_keeps_saved_materials_apart_and_refuses_a_mixed_or_unkno
     import dataclasses
 
     mixed = [*by["acrylic"], dataclasses.replace(by["acrylic"][0], material="aluminium")]
-    # steel: this page has no specimen chooser, so the message says what the page does and
-    # where steel is calibrated (the library's names a flag the page does not have)
-    own = r"calibrates the paper's coupon .* of steel particles.*pidcore calibrate --specimen"
+    # steel without its specimen file: the message points to the page's specimen chooser
+    # (the library's names a command-line flag the page does not have)
+    own = r"paper's coupon holds acrylic or aluminium .* of steel particles: choose their " \
+          r"specimen file above"
     for chosen, words in ((mixed, "several particle materials"), (points, own),
                           (by["steel"], own)):
         with pytest.raises(ParameterError, match=words):
             runner.start(api, chosen, fit=["fixture_mass_kg"], cells=2, design_size=None)
+    # with a specimen file, its particles must be the points': acrylic points are refused
+    from pidcore.specimen import load_specimen
+
+    steel_file = load_specimen(Path(__file__).resolve().parents[1] / "data_samples"
+                               / "specimens" / "steel_6mm.toml")
+    with pytest.raises(ParameterError, match="are of acrylic particles, the specimen "
+                                             "'steel_6mm' holds steel particles"):
+        runner.start(api, by["acrylic"], fit=["fixture_mass_kg"], cells=2, design_size=None,
+                     specimen=steel_file)
     assert runner.task is None  # nothing started
+    # the points a specimen is calibrated on: its particles, measured on it or on no named one
+    kept, note = points_for_specimen(points, steel_file)
+    assert kept == [] and note.startswith("2 measured load case(s) of other specimens")
+    named = dataclasses.replace(by["steel"][0], specimen="steel_6mm")
+    unnamed = dataclasses.replace(by["steel"][0], specimen="")
+    kept, note = points_for_specimen([*points, named, unnamed], steel_file)
+    assert kept == [named, unnamed] and note.startswith("2 measured load case(s)")
 
 
 def test_a_byte_identical_file_under_another_name_says_what_it_replaces(tmp_path, good_csv,

@@ -585,8 +585,13 @@ def _fake_calibrate_module(calls: list):
         ["fixture_mass_kg", "baseline_loss_factor"] if text is None
         else [n.strip() for n in text if n.strip()])
 
-    def calibrate(points, *, fit, store_path, cells, design_size, progress):
-        calls.append((len(points), tuple(fit), cells))
+    def calibrate(points, *, fit, store_path, cells, design_size, progress, **given):
+        # the paper's coupon is the library's default: the page names only another specimen
+        specimen = given.pop("specimen", None)
+        assert not given  # nothing but the specimen beyond the page's own arguments
+        calls.append((len(points), tuple(fit), cells)
+                     + ((specimen.name, tuple(p.material for p in points))
+                        if specimen is not None else ()))
         return {"fit": fit}
 
     def write_outputs(result, out_dir):
@@ -622,6 +627,48 @@ def test_calibrate_page_runs_the_library_on_the_stores_measurements(store_file, 
     assert any("Calibration summary" in m.value for m in at.markdown)
     labels = [b.label for b in at.get("download_button")]
     assert "calibrated specimen (calibrated_specimen.toml)" in labels
+
+
+def test_calibrate_page_calibrates_a_chosen_specimen_file_on_its_own_measurements(
+        store_file, tmp_path, monkeypatch):
+    # it calibrated the paper's coupon only and sent steel measurements to the command line
+    import shutil
+    import sys
+
+    from pidcore.app.calibration import runner_for
+
+    folder = tmp_path / "data_samples" / "specimens"  # the app runs in tmp_path
+    folder.mkdir(parents=True)
+    shutil.copy(REPO / "data_samples" / "specimens" / "steel_6mm.toml", folder)
+    calls: list = []
+    monkeypatch.setitem(sys.modules, "pidcore.calibrate", _fake_calibrate_module(calls))
+    steel = mass_damper_csv(frequency_hz=100.0, acceleration_g=5.0)
+    acrylic = mass_damper_csv(frequency_hz=500.0, acceleration_g=5.0, seed=3)
+    table = b"file,fill_percent,material,specimen\nm_fill50.csv,50,steel,steel_6mm\n" \
+            b"a_fill50.csv,50,acrylic,\n"
+    at = _upload(_app(), [("m_fill50.csv", steel), ("a_fill50.csv", acrylic),
+                          ("settings.csv", table)])
+    at.button(key="save").click()
+    at.run()
+    at.run()
+    box = at.selectbox(key="calibration_specimen")
+    box.set_value(next(o for o in box.options if o.endswith("steel_6mm.toml")))
+    at.run()
+    assert not at.exception
+    # only the steel measurement of this specimen; the acrylic one is named as left out
+    cases = next(m for m in at.multiselect if (m.key or "").startswith("calibration_cases_"))
+    assert cases.options == cases.value == ["100 Hz, 5 g, 50 %, steel, specimen steel_6mm"]
+    assert any("1 measured load case(s) of other specimens or particle materials are not used"
+               in c.value for c in at.caption)
+    at.button(key="calibration_run").click()
+    at.run()
+    deadline = time.monotonic() + 10
+    while runner_for(store_file).task.state == "running":
+        assert time.monotonic() < deadline
+        time.sleep(0.05)
+    at.run()
+    assert calls == [(1, ("fixture_mass_kg", "baseline_loss_factor"), 4, "steel_6mm",
+                      ("steel",))]
 
 
 def test_report_chooses_among_the_saved_records(store_file):

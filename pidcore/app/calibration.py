@@ -60,23 +60,34 @@ def points_by_material(points: Sequence) -> dict[str, list]:
     return dict(sorted(out.items()))
 
 
-def check_points(api, points: Sequence) -> None:
+def points_for_specimen(points: Sequence, specimen) -> tuple[list, str]:
+    """(points, note): the measured points a specimen file is calibrated against, those of its
+    particle material measured on it (their specimen label is its name) or on no named
+    specimen; ``note`` names what is left out ("" if nothing)."""
+    kept = [p for p in points if str(p.material) == specimen.particles.material
+            and str(p.specimen) in ("", specimen.name)]
+    left = len(points) - len(kept)
+    note = (f"{left} measured load case(s) of other specimens or particle materials are not "
+            f"used: {specimen.name} holds {specimen.particles.material} particles"
+            if left else "")
+    return kept, note
+
+
+def check_points(api, points: Sequence, specimen=None) -> None:
     """Raise the library's one-line error for points it would refuse (several materials, or
-    one without a specimen: the page calibrates the paper's coupon), before a background run
-    is started; a library without ``base_specimen`` checks in the run."""
+    points of particles not in the materials table without their specimen file), before a
+    background run is started; a library without ``base_specimen`` checks in the run."""
     from ..constants import PARTICLE_MATERIALS
     from ..errors import ParameterError
 
     own = sorted({str(p.material) for p in points} - set(PARTICLE_MATERIALS))
-    if own:  # the library's message names a command-line flag this page does not have
+    if own and specimen is None:  # the library's message names a command-line flag
         raise ParameterError(
-            f"this page calibrates the paper's coupon (acrylic or aluminium particles); the "
-            f"chosen points are of {', '.join(own)} particles: calibrate them with their "
-            "specimen file on the command line (pidcore calibrate --specimen FILE --store "
-            "STORE)")
+            f"the paper's coupon holds acrylic or aluminium particles; the chosen points are "
+            f"of {', '.join(own)} particles: choose their specimen file above")
     check = getattr(api, "base_specimen", None)
     if check is not None:
-        check(list(points), None)
+        check(list(points), specimen)
 
 
 @dataclass
@@ -105,23 +116,27 @@ class CalibrationRunner:
         self.task: CalibrationTask | None = None
 
     def start(self, api, points: Sequence, *, fit: Sequence[str], cells: int,
-              design_size: int | None) -> CalibrationTask | None:
-        """Start a calibration; None (nothing started) while one is running. Points the library
-        refuses raise its error here (:func:`check_points`), not in the background."""
-        check_points(api, points)
+              design_size: int | None, specimen=None) -> CalibrationTask | None:
+        """Start a calibration of ``specimen`` (None: the paper's coupon); None (nothing
+        started) while one is running. Points the library refuses raise its error here
+        (:func:`check_points`), not in the background."""
+        check_points(api, points, specimen)
         with self._lock:
             if self.task is not None and self.task.state == "running":
                 return None
             task = self.task = CalibrationTask(tuple(fit), len(points))
         threading.Thread(target=self._run, args=(api, task, list(points), list(fit), cells,
-                                                 design_size),
+                                                 design_size, specimen),
                          name="pidcore-calibration", daemon=True).start()
         return task
 
-    def _run(self, api, task: CalibrationTask, points, fit, cells, design_size) -> None:
+    def _run(self, api, task: CalibrationTask, points, fit, cells, design_size,
+             specimen) -> None:
+        # the paper's coupon is the library's default: no specimen argument for it
+        given = {} if specimen is None else {"specimen": specimen}
         try:
             result = api.calibrate(points, fit=fit, store_path=self.store_path, cells=cells,
-                                   design_size=design_size, progress=False)
+                                   design_size=design_size, progress=False, **given)
             with tempfile.TemporaryDirectory(prefix="pidcore_calibration_") as folder:
                 paths = api.write_outputs(result, folder)
                 outputs = {Path(p).name: Path(p).read_bytes() for p in paths}

@@ -17,3 +17,36 @@ def draw_polling(body: Callable[..., None], *args, polling: bool, every_s: float
     the timer.
     """
     st.fragment(run_every=every_s if polling else None)(body)(*args, polling)
+
+
+#: The choice of the paper's coupon in :func:`specimen_choice`.
+PAPER_CHOICE = "paper coupon (default)"
+
+
+def specimen_choice(key: str):
+    """(specimen, error): the specimen chosen on a page (None: the paper's coupon), a file of
+    ``defaults.APP_SPECIMEN_FOLDERS`` or an uploaded TOML (parsed by
+    :func:`pidcore.specimen.Specimen.from_text`, never executed); ``error`` is why the chosen
+    file is refused (None when it is not). Widget keys ``{key}_specimen`` and
+    ``{key}_specimen_file``."""
+    from pidcore import defaults
+    from pidcore.app import jobs
+    from pidcore.errors import PidcoreError
+    from pidcore.specimen import load_specimen
+
+    files = sorted(p for folder in defaults.APP_SPECIMEN_FOLDERS if folder.is_dir()
+                   for p in folder.glob("*.toml"))
+    c1, c2 = st.columns(2)
+    upload = c2.file_uploader("or a specimen file (TOML)", type=["toml"],
+                              key=f"{key}_specimen_file")
+    choice = c1.selectbox("specimen", [PAPER_CHOICE, *map(str, files)], key=f"{key}_specimen",
+                          disabled=upload is not None)
+    try:
+        if upload is not None:
+            return jobs.specimen_from_upload(upload.name, upload.getvalue()), None
+        return (None if choice == PAPER_CHOICE else load_specimen(choice)), None
+    except (PidcoreError, OSError, ValueError) as exc:
+        name = upload.name if upload is not None else choice
+        message = str(exc) if str(exc).startswith(name) else f"{name}: {exc}"
+        st.error(message)
+        return None, message

@@ -13,9 +13,10 @@ from pidcore.app.calibration import (
     calibration_api,
     fittable_names,
     points_by_material,
+    points_for_specimen,
     runner_for,
 )
-from pidcore.app.tabs import draw_polling
+from pidcore.app.tabs import draw_polling, specimen_choice
 
 #: Seconds between refreshes of the calibration's state while it runs.
 REFRESH_S = 2.0
@@ -75,8 +76,19 @@ def render(stores) -> None:
     if not points:
         st.info(f"{stores.path} holds no saved measurements with a load case yet.")
         return
-    by_material = points_by_material(points)
+    specimen, refused = specimen_choice("calibration")
     cases_key = "calibration_cases"
+    if specimen is not None:
+        points, note = points_for_specimen(points, specimen)
+        if note:
+            st.caption(note)
+        if not points:
+            st.info(f"No saved measurement is of specimen {specimen.name} "
+                    f"({specimen.particles.material} particles) or of an unnamed specimen of "
+                    "them.")
+            return
+        cases_key = f"calibration_cases_{specimen.hash[:12]}"  # its own choice of cases
+    by_material = points_by_material(points)
     if len(by_material) > 1:  # one specimen at a time: its particle material first
         material = st.selectbox("particle material (one calibration per material)",
                                 list(by_material), key="calibration_material")
@@ -101,11 +113,13 @@ def render(stores) -> None:
     design = c3.number_input("design points (0 = default)", min_value=0, value=0,
                              key="calibration_design")
     if st.button("Run calibration", type="primary", key="calibration_run",
-                 disabled=not points or not (chosen or extra.strip())):
+                 disabled=not points or not (chosen or extra.strip()) or refused is not None,
+                 help="off while the chosen specimen file is refused" if refused else None):
         try:
-            fit = api.parse_fit([*chosen, *extra.split(",")])
+            fit = api.parse_fit([*chosen, *extra.split(",")], specimen)
             started = runner_for(stores.path).start(api, points, fit=fit, cells=int(cells),
-                                                    design_size=int(design) or None)
+                                                    design_size=int(design) or None,
+                                                    specimen=specimen)
         except PidcoreError as exc:
             st.error(str(exc))
         else:

@@ -13,7 +13,7 @@ import streamlit as st
 
 from pidcore import defaults
 from pidcore.app import jobs, state
-from pidcore.app.tabs import draw_polling
+from pidcore.app.tabs import draw_polling, specimen_choice
 from pidcore.constants import DRIVE_DIRECTIONS, PARTICLE_MATERIALS
 from pidcore.loadcase import parse_values
 
@@ -65,34 +65,6 @@ def _job_table(stores, polling: bool) -> None:
         st.rerun(scope="app")
 
 
-_PAPER = "paper coupon (default)"
-
-
-def _specimen_choice():
-    """(specimen, error): the specimen chosen (None: the paper's coupon), a file of
-    ``defaults.APP_SPECIMEN_FOLDERS`` or an uploaded TOML (parsed by
-    :func:`pidcore.specimen.Specimen.from_text`, never executed); ``error`` is why the chosen
-    file is refused (None when it is not)."""
-    from pidcore.errors import PidcoreError
-    from pidcore.specimen import load_specimen
-
-    files = sorted(p for folder in defaults.APP_SPECIMEN_FOLDERS if folder.is_dir()
-                   for p in folder.glob("*.toml"))
-    c1, c2 = st.columns(2)
-    upload = c2.file_uploader("or a specimen file (TOML)", type=["toml"], key="dem_specimen_file")
-    choice = c1.selectbox("specimen", [_PAPER, *map(str, files)], key="dem_specimen",
-                          disabled=upload is not None)
-    try:
-        if upload is not None:
-            return jobs.specimen_from_upload(upload.name, upload.getvalue()), None
-        return (None if choice == _PAPER else load_specimen(choice)), None
-    except (PidcoreError, OSError, ValueError) as exc:
-        name = upload.name if upload is not None else choice
-        message = str(exc) if str(exc).startswith(name) else f"{name}: {exc}"
-        st.error(message)
-        return None, message
-
-
 def render(stores) -> None:
     """The page."""
     from pidcore.errors import PidcoreError
@@ -107,7 +79,7 @@ def render(stores) -> None:
                           help="one or more values, e.g. 50, 100, 333")
     accs = c2.text_input("accelerations [g]", "5", key="dem_accs", help="e.g. 1, 5, 7.5")
     fills = c3.text_input("fills [%]", "50", key="dem_fills", help="e.g. 25, 50")
-    specimen, refused = _specimen_choice()
+    specimen, refused = specimen_choice("dem")
     c4, c5 = st.columns(2)
     if refused is not None:  # no fallback to the paper's coupon: nothing runs until fixed
         c4.text_input("particle material", "(the specimen file is refused)", disabled=True,
