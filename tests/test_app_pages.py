@@ -606,6 +606,19 @@ def _fake_calibrate_module(calls: list):
     return module
 
 
+def _run_calibration(at: AppTest, store_file) -> None:
+    """Click Run calibration and wait (10 s at most: the library is a recorder) for its end."""
+    from pidcore.app.calibration import runner_for
+
+    at.button(key="calibration_run").click()
+    at.run()
+    deadline = time.monotonic() + 10
+    while runner_for(store_file).task.state == "running":
+        assert time.monotonic() < deadline
+        time.sleep(0.05)
+    at.run()
+
+
 def test_calibrate_page_runs_the_library_on_the_stores_measurements(store_file, monkeypatch):
     import sys
 
@@ -614,15 +627,7 @@ def test_calibrate_page_runs_the_library_on_the_stores_measurements(store_file, 
     at = _upload(_app(), [("c_fill50.csv", mass_damper_csv())])
     at.button(key="save").click()
     at.run()
-    at.button(key="calibration_run").click()
-    at.run()
-    from pidcore.app.calibration import runner_for
-
-    deadline = time.monotonic() + 10
-    while runner_for(store_file).task.state == "running":
-        assert time.monotonic() < deadline
-        time.sleep(0.05)
-    at.run()
+    _run_calibration(at, store_file)
     assert calls == [(1, ("fixture_mass_kg", "baseline_loss_factor"), 4)]
     assert any("Calibration summary" in m.value for m in at.markdown)
     labels = [b.label for b in at.get("download_button")]
@@ -634,8 +639,6 @@ def test_calibrate_page_calibrates_a_chosen_specimen_file_on_its_own_measurement
     # it calibrated the paper's coupon only and sent steel measurements to the command line
     import shutil
     import sys
-
-    from pidcore.app.calibration import runner_for
 
     folder = tmp_path / "data_samples" / "specimens"  # the app runs in tmp_path
     folder.mkdir(parents=True)
@@ -660,13 +663,7 @@ def test_calibrate_page_calibrates_a_chosen_specimen_file_on_its_own_measurement
     assert cases.options == cases.value == ["100 Hz, 5 g, 50 %, steel, specimen steel_6mm"]
     assert any("1 measured load case(s) of other specimens or particle materials are not used"
                in c.value for c in at.caption)
-    at.button(key="calibration_run").click()
-    at.run()
-    deadline = time.monotonic() + 10
-    while runner_for(store_file).task.state == "running":
-        assert time.monotonic() < deadline
-        time.sleep(0.05)
-    at.run()
+    _run_calibration(at, store_file)
     assert calls == [(1, ("fixture_mass_kg", "baseline_loss_factor"), 4, "steel_6mm",
                       ("steel",))]
 

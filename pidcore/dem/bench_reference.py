@@ -79,12 +79,7 @@ def all_pairs_reference(pos: np.ndarray, vel: np.ndarray, omg: np.ndarray,
                             -wall_normals[m, 0], -wall_normals[m, 1], -wall_normals[m, 2],
                             overlap, radius - overlap, v[0, i], v[1, i], v[2, i] - lift_speed,
                             w[0, i], w[1, i], w[2, i], wall_k, wall_c, wall_mu, v_reg)
-                        force[0, i] += fx
-                        force[1, i] += fy
-                        force[2, i] += fz
-                        torque[0, i] += mx
-                        torque[1, i] += my
-                        torque[2, i] += mz
+                        _add(force, torque, i, fx, fy, fz, mx, my, mz)
                 for j in range(i + 1, n_part):
                     dx = x[0, j] - x[0, i]
                     dy = x[1, j] - x[1, i]
@@ -98,18 +93,9 @@ def all_pairs_reference(pos: np.ndarray, vel: np.ndarray, omg: np.ndarray,
                             v[0, i] - v[0, j], v[1, i] - v[1, j], v[2, i] - v[2, j],
                             w[0, i] + w[0, j], w[1, i] + w[1, j], w[2, i] + w[2, j],
                             pair_k, pair_c, pair_mu, v_reg)
-                        force[0, i] += fx
-                        force[1, i] += fy
-                        force[2, i] += fz
-                        force[0, j] -= fx
-                        force[1, j] -= fy
-                        force[2, j] -= fz
-                        torque[0, i] += mx
-                        torque[1, i] += my
-                        torque[2, i] += mz
-                        torque[0, j] += mx
-                        torque[1, j] += my
-                        torque[2, j] += mz
+                        # the partner: the opposite force, the same friction torque
+                        _add(force, torque, i, fx, fy, fz, mx, my, mz)
+                        _add(force, torque, j, -fx, -fy, -fz, mx, my, mz)
             for i in range(n_part):
                 for k in range(3):
                     v[k, i] += 0.5 * dt * force[k, i] / mass
@@ -146,3 +132,14 @@ def _contact(nx, ny, nz, overlap, arm, rvx, rvy, rvz, sx, sy, sz, k_n, c_n, mu, 
         gz = -f_t * tz / slip
     return (-f_n * nx + gx, -f_n * ny + gy, -f_n * nz + gz,
             arm * (ny * gz - nz * gy), arm * (nz * gx - nx * gz), arm * (nx * gy - ny * gx))
+
+
+@njit(cache=True, inline="always")
+def _add(force, torque, i, fx, fy, fz, mx, my, mz):
+    """Add a force and a torque to particle ``i``."""
+    force[0, i] += fx
+    force[1, i] += fy
+    force[2, i] += fz
+    torque[0, i] += mx
+    torque[1, i] += my
+    torque[2, i] += mz
