@@ -169,6 +169,8 @@ def particles_for_fill(fill_percent: float, full: int) -> int:
     The one rounding rule of a fill, for ``specimen check`` and ``dem run`` alike: a fill that
     rounds to no particle is refused (an empty cell damps nothing, and its SDC is 0/0).
     """
+    if not math.isfinite(fill_percent):
+        raise ParameterError(f"fill {fill_percent} %: expected a finite percentage")
     n = int(round(fill_percent / 100.0 * full))
     if n < 1:
         # the smallest fill shown on a 0.01 % step strictly above half a particle: rounds to 1

@@ -891,14 +891,21 @@ def test_an_uploaded_specimen_error_names_the_users_file():
         jobs.specimen_from_upload("syntax.toml", b"\xff\xfe")
 
 
-def test_sdc_chart_ticks_are_plain_numbers():
+@pytest.mark.parametrize("fills", [[40.0], [25.0, 50.0, 75.0, 90.0], [37.5, 39.13, 50.0]])
+def test_sdc_chart_ticks_read_the_fills(fills):
+    # Rendered by Vega itself (vl-convert), as the browser draws it: with "~g" Vega took the
+    # precision from the tick step and labelled 25, 50, 75, 90 % "3e+1, 5e+1, 8e+1, 9e+1"
+    # (before that, 40.000000 for a list of floats)
+    vl_convert = pytest.importorskip("vl_convert")
     from pidcore.app.charts import sdc_chart
 
-    data = pd.DataFrame({"series": ["paper DEM"], "fill [%]": [40.0], "SDC [-]": [0.2],
-                         "low [-]": [0.2], "high [-]": [0.2]})
-    x = sdc_chart(data)["layer"][0]["encoding"]["x"]
-    # "~g": 40 and 37.5 (Vega wrote 40.000000 for the list of floats)
-    assert x["axis"] == {"values": [40.0], "format": "~g"}
+    data = pd.DataFrame({"series": ["paper DEM"] * len(fills), "fill [%]": fills,
+                         "SDC [-]": [0.2] * len(fills), "low [-]": [0.2] * len(fills),
+                         "high [-]": [0.2] * len(fills)})
+    svg = vl_convert.vegalite_to_svg(json.dumps(sdc_chart(data)))
+    labels = re.findall(r'<text[^>]*>([^<]*)</text>', svg)
+    title = labels.index("packing ratio (fill) [%]")
+    assert labels[title - len(fills):title] == [f"{f:g}" for f in fills]
 
 
 def test_calibrate_page_keeps_saved_materials_apart_and_refuses_a_mixed_or_unknown_one(

@@ -178,3 +178,12 @@ def test_a_fill_of_no_particle_names_its_option_and_writes_nothing(tmp_path, cap
     assert code == 2 and err.count("\n") == 1
     assert f"{option} 1: fill 1 % of 22 particles rounds to none; expected >= 2.28 %" in err
     assert not store.exists()
+
+
+@pytest.mark.parametrize("fill", ["nan", "inf", "0", "150"])
+def test_a_fill_outside_0_100_is_one_line_naming_the_option(capsys, fill):
+    # "nan" and "inf" raised a traceback from the particle count's rounding
+    code = main(["dem", "run", "--frequency", "500", "--acceleration", "5", "--fill", fill])
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("\n") == 1
+    assert f"--fill {fill}: expected a fill in (0, 100] %" in err

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import re
 from pathlib import Path
 
 import numpy as np
@@ -51,7 +52,7 @@ def test_damper_options(tmp_path):
     assert not (tmp_path / "equivalent_damper.json").exists()
     table = pd.read_csv(tmp_path / "equivalent_damper.csv")
     assert len(table) == 4 and set(table["vibrated_mass [kg]"]) == {0.5}
-    with pytest.raises(ParameterError, match="outside the model range"):
+    with pytest.raises(ParameterError, match="--fills 95: outside the model's range 25 .. 90"):
         _run(["model", "damper", "--out", str(tmp_path), "--fills", "95"])
     with pytest.raises(SystemExit):
         _run(["model", "damper", "--out", str(tmp_path), "--format", "xlsx"])
@@ -63,6 +64,11 @@ def test_damper_from_store_runs(tmp_path, monkeypatch):
     base = load_paper_table3().dropna(subset=["sdc_dem"]).rename(columns={"sdc_dem": "sdc"})
     runs = pd.concat([base.assign(sdc=base.sdc * 0.9), base.assign(sdc=base.sdc * 1.1)])
     runs = pd.concat([runs.assign(material="acrylic"), base.assign(material="aluminium", sdc=0.7)])
+    # the paper coupon's masses as the runs store them (m_c with a capacity of 22 per cell)
+    count = np.round(runs["fill_percent"].to_numpy() / 100 * 22)
+    runs = runs.assign(vibrated_mass_convention="coupon_plus_particles", coupon_mass_kg=0.0222,
+                       fixture_mass_kg=0.0, coupon_cells=441, particle_mass_kg=9.7e-6,
+                       particles_full_cell=22, vibrated_mass_kg=0.0222 + 441 * count * 9.7e-6)
 
     class FakeStore:
         def __init__(self, path):
@@ -76,7 +82,7 @@ def test_damper_from_store_runs(tmp_path, monkeypatch):
             str(tmp_path / "s.h5"), "--format", "csv"]
     with pytest.raises(ParameterError, match="differ in material"):
         _run(argv)
-    _run([*argv, "--where", "material=acrylic", "--vibrated-mass", "0.1"])
+    _run([*argv, "--where", "material=acrylic"])
     table = pd.read_csv(tmp_path / "equivalent_damper.csv")
     # duplicates averaged: mean of 0.9 x and 1.1 x is the paper value
     expected = SdcModel.from_table(load_paper_table3())
@@ -209,3 +215,63 @@ def test_runs_vibrated_mass_refuses_a_run_its_specimen_columns_do_not_give():
     old = runs.assign(vibrated_mass_kg=runs["vibrated_mass_kg"] - 0.12)
     with pytest.raises(ParameterError, match="stored m_c .* but its specimen columns give"):
         runs_vibrated_mass(old)
+
+
+def test_runs_of_two_numerical_settings_are_refused_and_chosen_by_settings_hash(tmp_path,
+                                                                               monkeypatch):
+    # one grid run with Eq. 3's damping and one with the calibrated coefficient: their SDCs
+    # were averaged into a model of neither (0.87 from 0.71 and 1.02 in a trial)
+    import pidcore.store
+    from pidcore.compare.align import settings_hash
+
+    def params(damping: str, seed: int) -> str:
+        return json.dumps({"case_frequency_hz": 100.0, "config_seed": seed,
+                           "config_damping_coefficient": damping, "config_cells": 8})
+
+    eq3 = _specimen_runs("steel_6mm", "a" * 64, coupon_kg=0.05, fixture_kg=0.0, sdc_scale=1.0)
+    listing = pd.concat([eq3.assign(parameters_json=params("eq3", 1)),
+                         eq3.assign(parameters_json=params("eq3", 2)),  # a second seed: pooled
+                         eq3.assign(parameters_json=params("calibrated", 1), sdc=eq3.sdc * 3)])
+
+    class FakeStore:
+        def __init__(self, path):
+            self.path = path
+
+        def list_dem_runs(self):
+            return listing
+
+    monkeypatch.setattr(pidcore.store, "Store", FakeStore, raising=False)
+    argv = ["model", "damper", "--out", str(tmp_path), "--table", "store", "--store",
+            str(tmp_path / "s.h5"), "--format", "csv", "--area", "0.01"]
+    wanted = settings_hash(params("eq3", 7))  # the seed is not a setting
+    other = settings_hash(params("calibrated", 7))
+    with pytest.raises(ParameterError, match=f"DEM runs of 2 different numerical settings "
+                                             f"\\(settings hash {wanted} \\(94 runs\\), {other} "
+                                             "\\(47 runs\\)"):
+        _run(argv)
+    _run([*argv, "--where", f"settings_hash={wanted}"])
+    table = pd.read_csv(tmp_path / "equivalent_damper.csv")
+    at_grid = table.merge(eq3, left_on=["frequency [Hz]", "acceleration [g]", "fill [%]"],
+                          right_on=["frequency_hz", "acceleration_g", "fill_percent"])
+    np.testing.assert_allclose(at_grid["sdc [-]"], at_grid["sdc"], rtol=1e-12)
+    # the runs' own m_c is the only one: an explicit one is refused, not used
+    with pytest.raises(ParameterError, match="--vibrated-mass 1: the DEM runs in .* divided "
+                                             "their SDC by their own m_c"):
+        _run([*argv, "--where", f"settings_hash={wanted}", "--vibrated-mass", "1"])
+
+
+def test_damper_and_figures_refuse_an_out_file_and_non_finite_values(tmp_path, capsys):
+    from pidcore.cli import main
+
+    afile = tmp_path / "afile"
+    afile.write_text("keep me")
+    for command in (["model", "damper"], ["model", "figures"]):
+        assert main([*command, "--out", str(afile)]) == 2
+        assert capsys.readouterr().err.count("\n") == 1
+    assert afile.read_text() == "keep me"
+    for option, value in (("--fills", "nan"), ("--area", "-1"), ("--vibrated-mass", "inf")):
+        with pytest.raises(SystemExit) as exit_code:  # argparse's own refusal
+            main(["model", "damper", "--out", str(tmp_path / "d"), option, value])
+        assert exit_code.value.code == 2
+        assert re.search(f"argument {option}: expected (a )?finite", capsys.readouterr().err)
+    assert not (tmp_path / "d").exists()

@@ -71,8 +71,9 @@ def sdc_chart(data: pd.DataFrame) -> dict[str, Any]:
     # ticks at the fills that carry points (Vega's own ticks left 25 % unlabelled)
     fills = sorted({float(f) for f in plain.loc[plain["series"] != _MODEL, "fill"]})
     x = _field("fill", "quantitative", title="packing ratio (fill) [%]",
-               # "~g": 40 and 37.5, not Vega's 40.000000 for a list of floats
-               **({"axis": {"values": fills, "format": "~g"}} if fills else {}))
+               # ".6~g": 40 and 37.5, not Vega's 40.000000 for a list of floats; the precision
+               # stated, or Vega takes it from the tick step and writes 25 as "3e+1"
+               **({"axis": {"values": fills, "format": ".6~g"}} if fills else {}))
     colour = _field("series", "nominal", legend=_LEGEND,
                     scale={"domain": present, "range": [_SDC_COLOURS[s] for s in present]})
     model = {"field": "series", "equal": _MODEL}

@@ -14,6 +14,17 @@ from ..measure import AnalysisOptions
 STORE_HELP = f"HDF5 store (default ./{defaults.STORE_PATH})"
 
 
+def positive_int(text: str) -> int:
+    """argparse type: a whole number >= 1 (a count of repetitions, samples or processes)."""
+    try:
+        value = int(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from exc
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {text!r}")
+    return value
+
+
 def add_store_option(p: argparse.ArgumentParser, *, flag: str = "--store",
                      default: Path | None = defaults.STORE_PATH,
                      help: str = STORE_HELP) -> None:

@@ -20,7 +20,7 @@ from ..constants import (
     VIBRATED_MASS_CONVENTIONS,
 )
 from ..errors import ParameterError
-from ._options import add_json_option, add_store_option
+from ._options import add_json_option, add_store_option, positive_int
 
 #: Keys of ``pidcore dem run --json`` (more may follow them).
 JSON_KEYS = ("sdc", "sdc_stderr", "energy_per_cycle_j", "energy_dissipated_normal_j",
@@ -132,7 +132,7 @@ def _register_sweep(sub: argparse._SubParsersAction) -> None:
                        help=f"{what}, comma-separated, in place of the grid's (every "
                             "combination is run)")
     _add_config_options(p)
-    p.add_argument("--workers", metavar="N", type=int, default=None,
+    p.add_argument("--workers", metavar="N", type=positive_int, default=None,
                    help="local processes (default: all cores)")
     p.add_argument("--scheduler", metavar="ADDR", default=None,
                    help="dask.distributed scheduler address (needs the 'distributed' extra)")
@@ -216,10 +216,14 @@ def _check_fill(fill: float, option: str, args: argparse.Namespace, specimen,
     """A fill that rounds to no particle (or more than fit) is refused naming the option."""
     from ..dem.simulate import particles_per_cell
 
+    if not (math.isfinite(fill) and 0.0 < fill <= 100.0):
+        raise ParameterError(f"{option} {fill:g}: expected a fill in (0, 100] %")
     try:
         particles_per_cell(fill, material, specimen=specimen,
                            fill_reference=args.fill_reference)
     except ParameterError as exc:
+        if not str(exc).startswith("fill "):  # not about this fill (e.g. --fill-reference)
+            raise
         raise ParameterError(f"{option} {fill:g}: {exc}") from None
 
 

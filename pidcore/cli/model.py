@@ -9,6 +9,7 @@ families (paper Figs. 8-14) as PNG and SVG. All logic is in :mod:`pidcore.model`
 from __future__ import annotations
 
 import argparse
+import math
 from pathlib import Path
 
 from .. import defaults
@@ -25,7 +26,25 @@ def _float_list(text: str) -> list[float]:
             from exc
     if not values:
         raise argparse.ArgumentTypeError("expected at least one number")
+    if not all(math.isfinite(v) for v in values):
+        raise argparse.ArgumentTypeError(f"expected finite numbers, got {text!r}")
     return values
+
+
+def _positive_float(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from exc
+    if not (math.isfinite(value) and value > 0):
+        raise argparse.ArgumentTypeError(f"expected a finite number > 0, got {text!r}")
+    return value
+
+
+def _check_out(out: Path) -> None:
+    """``--out`` must be a folder or not exist yet (a file there would be half-overwritten)."""
+    if out.exists() and not out.is_dir():
+        raise ParameterError(f"--out {out}: exists and is not a folder")
 
 
 def _formats(text: str) -> list[str]:
@@ -76,9 +95,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     d.add_argument("--material", choices=PARTICLE_MATERIALS, default=None,
                    help="particle material of --table paper's masses (default "
                         f"{defaults.MODEL_PARTICLE_MATERIAL}); --table store: the runs' own")
-    d.add_argument("--vibrated-mass", metavar="KG", type=float, default=None,
-                   help="explicit m_c, kg (overrides --mass-convention)")
-    d.add_argument("--area", metavar="M2", type=float, default=None,
+    d.add_argument("--vibrated-mass", metavar="KG", type=_positive_float, default=None,
+                   help="explicit m_c, kg (overrides --mass-convention; --table paper only: "
+                        "stored runs divided their SDC by their own m_c)")
+    d.add_argument("--area", metavar="M2", type=_positive_float, default=None,
                    help="coupon area for c_eq per area, m^2 (default: the paper's 0.1 m x "
                         "0.1 m; required for runs of another specimen, whose file has no "
                         "coupon area)")
@@ -128,7 +148,21 @@ def run_damper(args: argparse.Namespace) -> int:
         write_damper_table,
     )
 
+    _check_out(args.out)
     model, runs = build_model(args)
+    if runs is not None and args.vibrated_mass is not None:
+        raise ParameterError(
+            f"--vibrated-mass {args.vibrated_mass:g}: the DEM runs in {args.store} divided "
+            "their SDC by their own m_c, which c_eq = SDC m_c w / (2 pi) must use; leave "
+            "--vibrated-mass out")
+    for option, axis, values in (("--fills", 0, args.fills), ("--accelerations", 1,
+                                                                args.accelerations),
+                                 ("--frequencies", 2, args.frequencies)):
+        lo, hi = model.axes[axis][0], model.axes[axis][-1]
+        outside = [v for v in values or () if not lo <= v <= hi]
+        if outside:
+            raise ParameterError(f"{option} {','.join(f'{v:g}' for v in outside)}: outside "
+                                 f"the model's range {lo:g} .. {hi:g} (never extrapolated)")
     if runs is not None:
         for option, column, given in (("--mass-convention", "vibrated_mass_convention",
                                        args.mass_convention),
@@ -185,6 +219,7 @@ def run_damper(args: argparse.Namespace) -> int:
 def run_figures(args: argparse.Namespace) -> int:
     from ..report.figures import plot_sdc_vs_acceleration, plot_sdc_vs_frequency, save_figure
 
+    _check_out(args.out)
     model, _ = build_model(args)
 
     def curves(extra: tuple[float, ...], axis) -> list[float]:

@@ -271,30 +271,43 @@ def consistency_chi2(values: np.ndarray, stderrs: np.ndarray) -> tuple[float, in
     return float(np.sum(w * (v[ok] - mean) ** 2)), int(ok.sum() - 1)
 
 
+def settings_hash(parameters_json: object) -> str:
+    """Hash (6 hex digits) of a DEM run's numerical settings: every stored input except the
+    load case and the seed, from its ``parameters_json``; "" where it is not stored."""
+    import hashlib
+    import json
+
+    if not isinstance(parameters_json, str) or not parameters_json:
+        return ""
+    try:
+        params = json.loads(parameters_json)
+    except ValueError:
+        return ""
+    settings = {k: v for k, v in params.items()
+                if not k.startswith("case_") and k != "config_seed"}
+    return hashlib.sha256(json.dumps(settings, sort_keys=True, default=str).encode()) \
+        .hexdigest()[:6]
+
+
 def _settings_of(row: pd.Series) -> tuple[str, float]:
     """(label, cells) of the numerical settings of one DEM run: every stored input except the
-    load case and the seed (a hash of them), with the cells and steady cycles spelled out."""
-    import hashlib
+    load case and the seed (:func:`settings_hash`), with the cells and steady cycles spelled
+    out."""
     import json
 
     cells = float(row.get("cells_simulated", math.nan) or math.nan) \
         if "cells_simulated" in row else math.nan
     text = row.get("parameters_json")
-    if not isinstance(text, str) or not text:
+    digest = settings_hash(text)
+    if not digest:
         return (f"cells {cells:g}" if math.isfinite(cells) else ""), cells
-    try:
-        params = json.loads(text)
-    except ValueError:
-        return "", cells
-    settings = {k: v for k, v in params.items()
-                if not k.startswith("case_") and k != "config_seed"}
-    if not math.isfinite(cells) and isinstance(settings.get("config_cells"), int | float):
-        cells = float(settings["config_cells"])
-    steady = settings.get("config_steady_cycles", "")
-    digest = hashlib.sha256(json.dumps(settings, sort_keys=True, default=str).encode())
+    params = json.loads(text)
+    if not math.isfinite(cells) and isinstance(params.get("config_cells"), int | float):
+        cells = float(params["config_cells"])
+    steady = params.get("config_steady_cycles", "")
     # "settings hash": the specimen is named "name [hash]" beside it, another hash
     return (f"cells {cells:g}, steady cycles {steady if steady not in ('', None) else 'auto'}, "
-            f"settings hash {digest.hexdigest()[:6]}"), cells
+            f"settings hash {digest}"), cells
 
 
 def dem_cases(dem_runs: pd.DataFrame, *, tolerances: Tolerances | None = None,

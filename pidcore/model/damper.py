@@ -242,7 +242,7 @@ def runs_vibrated_mass(runs: pd.DataFrame) -> Callable[[float], float]:
                if c not in runs.columns]
     if missing:
         raise ParameterError(f"DEM runs: no {', '.join(missing)} column(s) to take the vibrated "
-                             "mass m_c from; give --vibrated-mass KG")
+                             "mass m_c from (runs of an older pidcore); run them again")
     values = {}
     for column in RUN_MASS_COLUMNS:
         distinct = runs[column].dropna().unique()
@@ -274,8 +274,8 @@ def runs_vibrated_mass(runs: pd.DataFrame) -> Callable[[float], float]:
         k = int(np.flatnonzero(bad)[0])
         raise ParameterError(
             f"DEM run {runs['case_key'].iloc[k] if 'case_key' in runs else k}: stored m_c "
-            f"{stored[k]:.6g} kg, but its specimen columns give {rebuilt[k]:.6g} kg; give "
-            "--vibrated-mass KG or re-run it")
+            f"{stored[k]:.6g} kg, but its specimen columns give {rebuilt[k]:.6g} kg; run it "
+            "again")
     return mass
 
 

@@ -329,10 +329,17 @@ def select_runs(runs: pd.DataFrame, *, where: Mapping[str, str] | None = None) -
     """Runs matching ``where`` (column -> value, compared as text), checked to be homogeneous.
 
     Raises :class:`ParameterError` if a column of ``where`` is missing, nothing matches, or the
-    remaining runs differ in a :data:`DEM_CONDITION_COLUMNS` column (averaging acrylic with
-    aluminium runs, say, would make a meaningless model).
+    remaining runs are of several specimens, differ in a :data:`DEM_CONDITION_COLUMNS`
+    column or in their numerical settings (averaging acrylic with aluminium runs, or runs of
+    two damping coefficients, would make a model of neither). ``settings_hash`` (6 hex digits,
+    as the report's "DEM settings" column shows it) can be selected on like a column; runs of
+    one settings hash differ only in their seed.
     """
+    from ..compare.align import settings_hash
+
     selected = runs
+    if "parameters_json" in runs.columns:
+        selected = runs = runs.assign(settings_hash=runs["parameters_json"].map(settings_hash))
     for column, wanted in (where or {}).items():
         if column not in runs.columns:
             raise ParameterError(f"DEM runs: no column {column!r} to select on; columns are "
@@ -340,6 +347,7 @@ def select_runs(runs: pd.DataFrame, *, where: Mapping[str, str] | None = None) -
         selected = selected[selected[column].astype(str) == str(wanted)]
     if selected.empty:
         raise ParameterError(f"DEM runs: none match {dict(where or {})}")
+    _check_one_specimen(selected)  # first: a specimen fixes the material and more
     for column in DEM_CONDITION_COLUMNS:
         if column in selected.columns:
             distinct = sorted(selected[column].dropna().astype(str).unique())
@@ -347,7 +355,15 @@ def select_runs(runs: pd.DataFrame, *, where: Mapping[str, str] | None = None) -
                 raise ParameterError(
                     f"DEM runs differ in {column} ({', '.join(distinct)}); select one, e.g. "
                     f"where={{{column!r}: {distinct[0]!r}}} (CLI: --where {column}={distinct[0]})")
-    _check_one_specimen(selected)
+    if "settings_hash" in selected.columns:
+        counts = selected.loc[selected["settings_hash"] != "", "settings_hash"].value_counts()
+        if len(counts) > 1:
+            listed = ", ".join(f"{h} ({n} runs)" for h, n in counts.items())
+            raise ParameterError(
+                f"DEM runs of {len(counts)} different numerical settings (settings hash "
+                f"{listed}: cells, steady cycles, damping coefficient, ...); select one, e.g. "
+                f"where={{'settings_hash': {counts.index[0]!r}}} (CLI: --where "
+                f"settings_hash={counts.index[0]})")
     return selected
 
 
