@@ -7,6 +7,7 @@ import json
 import math
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from pidcore.calibrate import MeasuredPoint, calibrate
@@ -264,3 +265,27 @@ def test_cli_refuses_measurements_of_another_material_than_the_specimens(capsys,
                   ROWS.replace("\n", ",acrylic\n"))
     _refused(capsys, tmp_path, ["--data", str(path), "--specimen", str(steel)],
              "acrylic particles", "holds steel particles")
+
+
+def test_runs_that_never_reached_steady_state_are_named_in_the_notes(tiny_store, tmp_path,
+                                                                     monkeypatch):
+    # a trial's calibration used a DEM run the DEM tab flagged "NOT reached" and said nothing
+    from pidcore.calibrate.data import read_measured_table
+
+    points = read_measured_table(_table(tmp_path))
+    settings = {"fit": ["fixture_mass_kg"], "discrepancy": 0.2, "store_path": tiny_store,
+                "cells": 2, "steady_cycles": 10, "workers": 1, "progress": False}
+    quiet = calibrate(points, **settings)
+    assert not any("steady state" in note for note in quiet.notes)
+    stored = Store.get_dem_run
+
+    def one_unsteady(self, key):
+        entry = stored(self, key)
+        if key.startswith("f500Hz_a1g"):
+            entry.record["steady_detected"] = np.False_  # as h5py reads a bool back
+        return entry
+
+    monkeypatch.setattr(Store, "get_dem_run", one_unsteady)
+    flagged = calibrate(points, **settings)
+    assert "1 of 3 DEM run(s) never reached steady state" in " ".join(flagged.notes)
+    assert "500 Hz, 1 g, 50 %, acrylic (1)" in " ".join(flagged.notes)

@@ -235,13 +235,21 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: Sequence[str],
 
     store = Store(store_path)
     observations = []
-    for row in requests:
+    unsteady: dict[str, int] = {}  # point label -> its runs that never reached steady state
+    for point, row in zip(points, requests, strict=True):
         obs = []
         for request in row:
             entry = store.get_dem_run(request.key())
             obs.append(observation_from_run(entry.record, entry.arrays,
                                             coupon_mass_kg=specimen.coupon.mass_kg))
+            if str(entry.record.get("steady_detected", True)).lower() == "false":  # np.bool_
+                unsteady[point.label()] = unsteady.get(point.label(), 0) + 1
         observations.append(obs)
+    if unsteady:
+        notes.append(f"{sum(unsteady.values())} of {sum(len(r) for r in requests)} DEM run(s) "
+                     "never reached steady state (their SDC is that of the last cycles, less "
+                     "certain than the error bar says): "
+                     + "; ".join(f"{label} ({n})" for label, n in unsteady.items()))
     surrogates = tuple(build_surrogate(obs, design, dem_specs) for obs in observations)
     fitted = [s.name for s in specs]
     fixed = {name: parameter_spec(name, specimen).default for name in CATALOGUE
