@@ -624,14 +624,31 @@ def test_calibrate_page_runs_the_library_on_the_stores_measurements(store_file, 
 
     calls: list = []
     monkeypatch.setitem(sys.modules, "pidcore.calibrate", _fake_calibrate_module(calls))
-    at = _upload(_app(), [("c_fill50.csv", mass_damper_csv())])
+    one = [("c_fill50.csv", mass_damper_csv())]
+    at = _upload(_app(), one)
     at.button(key="save").click()
     at.run()
+    at.run()
+    # two parameters and the model discrepancy: one load case cannot determine them, and
+    # the page says so before anything starts (the library's message named a CLI flag)
+    assert at.button(key="calibration_run").disabled
+    assert any("1 measured load case(s) cannot determine fixture_mass_kg, "
+               "baseline_loss_factor and the model discrepancy (always fitted here): choose "
+               "at least 3 load cases" in c.value for c in at.caption)
+    more = [(f"c{f:g}_fill50.csv", mass_damper_csv(frequency_hz=f, seed=int(f)))
+            for f in (200.0, 400.0)]
+    at = _upload(at, one + more)
+    at.button(key="save").click()
+    at.run()
+    at.run()
+    # the cases saved since are chosen too (the earlier choice of one case was kept)
+    cases = next(m for m in at.multiselect if (m.key or "").startswith("calibration_cases"))
+    assert len(cases.value) == 3
     _run_calibration(at, store_file)
-    assert calls == [(1, ("fixture_mass_kg", "baseline_loss_factor"), 4)]
+    assert calls == [(3, ("fixture_mass_kg", "baseline_loss_factor"), 4)]
     assert any("Calibration summary" in m.value for m in at.markdown)
     labels = [b.label for b in at.get("download_button")]
-    assert "calibrated specimen (calibrated_specimen.toml)" in labels
+    assert "calibrated specimen (TOML)" in labels
 
 
 def test_calibrate_page_calibrates_a_chosen_specimen_file_on_its_own_measurements(
@@ -645,12 +662,12 @@ def test_calibrate_page_calibrates_a_chosen_specimen_file_on_its_own_measurement
     shutil.copy(REPO / "data_samples" / "specimens" / "steel_6mm.toml", folder)
     calls: list = []
     monkeypatch.setitem(sys.modules, "pidcore.calibrate", _fake_calibrate_module(calls))
-    steel = mass_damper_csv(frequency_hz=100.0, acceleration_g=5.0)
+    steel = [(f"m{f:g}_fill50.csv", mass_damper_csv(frequency_hz=f, acceleration_g=5.0,
+                                                      seed=int(f))) for f in (100.0, 200.0)]
     acrylic = mass_damper_csv(frequency_hz=500.0, acceleration_g=5.0, seed=3)
-    table = b"file,fill_percent,material,specimen\nm_fill50.csv,50,steel,steel_6mm\n" \
-            b"a_fill50.csv,50,acrylic,\n"
-    at = _upload(_app(), [("m_fill50.csv", steel), ("a_fill50.csv", acrylic),
-                          ("settings.csv", table)])
+    table = (b"file,fill_percent,material,specimen\nm100_fill50.csv,50,steel,steel_6mm\n"
+             b"m200_fill50.csv,50,steel,\na_fill50.csv,50,acrylic,\n")
+    at = _upload(_app(), [*steel, ("a_fill50.csv", acrylic), ("settings.csv", table)])
     at.button(key="save").click()
     at.run()
     at.run()
@@ -660,12 +677,25 @@ def test_calibrate_page_calibrates_a_chosen_specimen_file_on_its_own_measurement
     assert not at.exception
     # only the steel measurement of this specimen; the acrylic one is named as left out
     cases = next(m for m in at.multiselect if (m.key or "").startswith("calibration_cases_"))
-    assert cases.options == cases.value == ["100 Hz, 5 g, 50 %, steel, specimen steel_6mm"]
-    assert any("1 measured load case(s) of other specimens or particle materials are not used"
-               in c.value for c in at.caption)
+    assert cases.options == cases.value == ["100 Hz, 5 g, 50 %, steel, specimen steel_6mm",
+                                            "200 Hz, 5 g, 50 %, steel"]
+    assert any("not used for steel_6mm (steel particles): 1 of acrylic particles" in c.value
+               for c in at.caption)
+    at.multiselect(key="calibration_fit").set_value(["fixture_mass_kg"])
+    at.run()
     _run_calibration(at, store_file)
-    assert calls == [(1, ("fixture_mass_kg", "baseline_loss_factor"), 4, "steel_6mm",
-                      ("steel",))]
+    assert calls == [(2, ("fixture_mass_kg",), 4, "steel_6mm", ("steel", "steel"))]
+    assert "calibrated steel_6mm in" in " ".join(m.value for m in at.success)
+    toml = next(b for b in at.get("download_button") if b.label == "calibrated specimen (TOML)")
+    assert toml.proto.help == "steel_6mm_calibrated.toml"
+    # back to the paper's coupon: the result stays, and says whose it is; the steel cases
+    # are not offered for the paper's coupon
+    at.selectbox(key="calibration_specimen").set_value("paper coupon (default)")
+    at.run()
+    assert any("The calibration below is of steel_6mm; paper_coupon is chosen now." in c.value
+               for c in at.caption)
+    assert any("Measurements of steel particles are calibrated with their specimen file"
+               in c.value for c in at.caption)
 
 
 def test_report_chooses_among_the_saved_records(store_file):

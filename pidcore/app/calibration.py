@@ -63,17 +63,31 @@ def points_by_material(points: Sequence) -> dict[str, list]:
 def points_for_specimen(points: Sequence, specimen) -> tuple[list, str]:
     """(points, note): the measured points a specimen file is calibrated against, those of its
     particle material measured on it (their specimen label is its name) or on no named
-    specimen; ``note`` names what is left out ("" if nothing)."""
-    kept = [p for p in points if str(p.material) == specimen.particles.material
-            and str(p.specimen) in ("", specimen.name)]
-    left = len(points) - len(kept)
-    note = (f"{left} measured load case(s) of other specimens or particle materials are not "
-            f"used: {specimen.name} holds {specimen.particles.material} particles"
-            if left else "")
+    specimen; ``note`` says what is left out and why ("" if nothing)."""
+    material = specimen.particles.material
+    kept, other_material, other_specimen = [], {}, {}
+    for p in points:
+        if str(p.material) != material:
+            other_material[str(p.material)] = other_material.get(str(p.material), 0) + 1
+        elif str(p.specimen) not in ("", specimen.name):
+            other_specimen[str(p.specimen)] = other_specimen.get(str(p.specimen), 0) + 1
+        else:
+            kept.append(p)
+    reasons = [f"{n} measured on specimen {name}" for name, n in other_specimen.items()]
+    reasons += [f"{n} of {name} particles" for name, n in other_material.items()]
+    note = (f"not used for {specimen.name} ({material} particles): "
+            + "; ".join(reasons) + " (measured load cases)") if reasons else ""
     return kept, note
 
 
-def check_points(api, points: Sequence, specimen=None) -> None:
+def specimen_label(specimen) -> str:
+    """The name a calibration's result goes by: the specimen's, or the paper's coupon."""
+    from ..specimen import PAPER_SPECIMEN_NAME
+
+    return PAPER_SPECIMEN_NAME if specimen is None else specimen.name
+
+
+def check_points(api, points: Sequence, specimen=None, fit: Sequence[str] = ()) -> None:
     """Raise the library's one-line error for points it would refuse (several materials, or
     points of particles not in the materials table without their specimen file), before a
     background run is started; a library without ``base_specimen`` checks in the run."""
@@ -88,6 +102,22 @@ def check_points(api, points: Sequence, specimen=None) -> None:
     check = getattr(api, "base_specimen", None)
     if check is not None:
         check(list(points), specimen)
+    needed = points_needed(fit)
+    if len(points) < needed:  # the library's message names --discrepancy, not on this page
+        raise ParameterError(points_needed_text(len(points), fit))
+
+
+def points_needed(fit: Sequence[str]) -> int:
+    """Measured load cases a calibration of ``fit`` needs on this page: one per parameter,
+    and one for the model discrepancy, which the page always fits."""
+    return len(set(fit)) + 1
+
+
+def points_needed_text(n_points: int, fit: Sequence[str]) -> str:
+    """Why ``n_points`` load cases are too few for ``fit``, in the page's terms."""
+    return (f"{n_points} measured load case(s) cannot determine {', '.join(fit)} and the "
+            f"model discrepancy (always fitted here): choose at least {points_needed(fit)} "
+            "load cases or fit fewer parameters")
 
 
 @dataclass
@@ -96,6 +126,7 @@ class CalibrationTask:
 
     fit: tuple[str, ...]
     n_points: int
+    specimen: str = ""  # :func:`specimen_label` of the specimen calibrated
     state: str = "running"
     started: float = field(default_factory=time.time)
     finished: float | None = None
@@ -120,11 +151,12 @@ class CalibrationRunner:
         """Start a calibration of ``specimen`` (None: the paper's coupon); None (nothing
         started) while one is running. Points the library refuses raise its error here
         (:func:`check_points`), not in the background."""
-        check_points(api, points, specimen)
+        check_points(api, points, specimen, fit)
         with self._lock:
             if self.task is not None and self.task.state == "running":
                 return None
-            task = self.task = CalibrationTask(tuple(fit), len(points))
+            task = self.task = CalibrationTask(tuple(fit), len(points),
+                                               specimen_label(specimen))
         threading.Thread(target=self._run, args=(api, task, list(points), list(fit), cells,
                                                  design_size, specimen),
                          name="pidcore-calibration", daemon=True).start()
@@ -197,7 +229,8 @@ def active_calibration(task: CalibrationTask | None, environ: Mapping[str, str] 
         if task is not None and task.state == "done" and "calibration.json" in task.outputs:
             return (calibration_from_json(task.outputs["calibration.json"],
                                           "calibration.json (Calibrate page)"),
-                    f"this store's calibration on the Calibrate page ({', '.join(task.fit)})")
+                    f"this store's calibration of {task.specimen or 'the paper coupon'} on "
+                    f"the Calibrate page ({', '.join(task.fit)})")
         path = calibration_path(environ, cwd=cwd)
         if path is None:
             return None, ("no calibration: run one on the Calibrate page (or set "

@@ -4,6 +4,8 @@ show the posterior and the measured-vs-predicted plot with bands, download the s
 from __future__ import annotations
 
 import dataclasses
+import hashlib
+import re
 from pathlib import Path
 
 import pandas as pd
@@ -14,7 +16,10 @@ from pidcore.app.calibration import (
     fittable_names,
     points_by_material,
     points_for_specimen,
+    points_needed,
+    points_needed_text,
     runner_for,
+    specimen_label,
 )
 from pidcore.app.tabs import draw_polling, specimen_choice
 
@@ -27,25 +32,29 @@ def _running(stores) -> bool:
     return task is not None and task.state == "running"
 
 
-def _task(stores, polling: bool) -> None:
+def _task(stores, chosen: str, polling: bool) -> None:
     # a fragment (see draw_polling): rerun every REFRESH_S while the calibration runs
     task = runner_for(stores.path).task
     if task is None:
         return
     if polling and task.state != "running":  # it ended: draw the page again, without the timer
         st.rerun(scope="app")
+    if task.specimen and task.specimen != chosen:  # the result stays; say whose it is
+        st.caption(f"The calibration below is of {task.specimen}; {chosen} is chosen now.")
     if task.state == "running":
-        st.info(f"calibrating ({', '.join(task.fit)}, {task.n_points} load case(s)): "
-                f"{task.elapsed_s():.0f} s elapsed; DEM runs are saved in the store as they "
-                "finish")
+        st.info(f"calibrating {task.specimen} ({', '.join(task.fit)}, {task.n_points} load "
+                f"case(s)): {task.elapsed_s():.0f} s elapsed; DEM runs are saved in the store "
+                "as they finish")
         return
     if task.state == "failed":
-        st.error(f"calibration failed: {task.message}")
+        st.error(f"calibration of {task.specimen} failed: {task.message}")
         return
-    st.success(f"calibrated in {task.elapsed_s():.0f} s: {task.message}")
+    st.success(f"calibrated {task.specimen} in {task.elapsed_s():.0f} s: {task.message}")
     out = task.outputs
     if "summary.md" in out:
-        st.markdown(out["summary.md"].decode())
+        # its headings below the page's own (# and ## would dwarf the page title)
+        st.markdown(re.sub(r"^(#{1,3}) ", lambda m: "#" * (len(m[1]) + 3) + " ",
+                           out["summary.md"].decode(), flags=re.MULTILINE))
     c1, c2 = st.columns(2)
     if "predictions.png" in out:
         c1.image(out["predictions.png"], caption="measured vs predicted SDC, 95 % bands")
@@ -54,9 +63,13 @@ def _task(stores, polling: bool) -> None:
     mimes = {".toml": "application/toml", ".json": "application/json", ".html": "text/html"}
     files = [n for n in sorted(out) if Path(n).suffix in mimes]
     for col, name in zip(st.columns(max(len(files), 1)), files, strict=False):
-        label = f"calibrated specimen ({name})" if name.endswith(".toml") else name
-        col.download_button(label, out[name], file_name=name, mime=mimes[Path(name).suffix],
-                            key=f"calibration_{name}")
+        # the calibrated specimen file saves under its specimen's name
+        file_name = f"{task.specimen}_calibrated.toml" \
+            if name.endswith(".toml") and task.specimen else name
+        label = "calibrated specimen (TOML)" if name.endswith(".toml") else name
+        col.download_button(label, out[name], file_name=file_name,
+                            mime=mimes[Path(name).suffix], key=f"calibration_{name}",
+                            help=file_name)
 
 
 def render(stores) -> None:
@@ -74,9 +87,15 @@ def render(stores) -> None:
         st.info(f"Nothing to calibrate against: {exc}")
         return
     if not points:
-        st.info(f"{stores.path} holds no saved measurements with a load case yet.")
+        st.info(f"{stores.path} holds no saved measurements with a load case yet: analyse "
+                "files on the Analyse tab and Save them.")
         return
     specimen, refused = specimen_choice("calibration")
+    chosen_label = specimen_label(specimen)
+    if refused is not None:  # nothing runs, and no fallback to the paper's coupon
+        st.info("Run is off until the specimen file is fixed or another is chosen.")
+        draw_polling(_task, stores, chosen_label, polling=_running(stores), every_s=REFRESH_S)
+        return
     cases_key = "calibration_cases"
     if specimen is not None:
         points, note = points_for_specimen(points, specimen)
@@ -89,17 +108,35 @@ def render(stores) -> None:
             return
         cases_key = f"calibration_cases_{specimen.hash[:12]}"  # its own choice of cases
     by_material = points_by_material(points)
+    if specimen is None:  # the paper's coupon holds table particles only
+        from pidcore.constants import PARTICLE_MATERIALS
+
+        own = [m for m in by_material if m not in PARTICLE_MATERIALS]
+        if own:
+            st.caption(f"Measurements of {', '.join(own)} particles are calibrated with their "
+                       "specimen file: choose it above.")
+        by_material = {m: p for m, p in by_material.items() if m in PARTICLE_MATERIALS}
+        if not by_material:
+            draw_polling(_task, stores, chosen_label, polling=_running(stores),
+                         every_s=REFRESH_S)
+            return
+        points = [p for group in by_material.values() for p in group]
     if len(by_material) > 1:  # one specimen at a time: its particle material first
         material = st.selectbox("particle material (one calibration per material)",
                                 list(by_material), key="calibration_material")
         points = by_material[material]
         cases_key = f"calibration_cases_{material}"  # each material keeps its own choice
     labels = [p.label() for p in points]
+    # a choice per set of saved cases: cases saved since are chosen, not left out unseen
+    cases_key += "_" + hashlib.sha256("\n".join(labels).encode()).hexdigest()[:12]
     chosen_cases = st.multiselect("measured load cases to calibrate against (from the store)",
                                   labels, default=labels, key=cases_key)
     points = [p for p, label in zip(points, labels, strict=True) if label in chosen_cases]
-    st.dataframe(pd.DataFrame([dataclasses.asdict(p) for p in points]), hide_index=True,
-                 width="stretch", key="calibration_points")
+    st.dataframe(pd.DataFrame([dataclasses.asdict(p) for p in points]).rename(columns={
+        "frequency_hz": "frequency [Hz]", "acceleration_g": "acceleration [g]",
+        "fill_percent": "fill [%]", "sdc": "SDC measured, Eq. 11 [-]",
+        "sdc_stderr": "SDC stderr [-]"}), hide_index=True, width="stretch",
+        key="calibration_points")
     c1, c2, c3 = st.columns(3)
     fittable = fittable_names(api)
     chosen = c1.multiselect("parameters to fit", fittable,
@@ -112,11 +149,14 @@ def render(stores) -> None:
                             key="calibration_cells")
     design = c3.number_input("design points (0 = default)", min_value=0, value=0,
                              key="calibration_design")
+    wanted = [*chosen, *(n.strip() for n in extra.split(",") if n.strip())]
+    too_few = bool(wanted) and len(points) < points_needed(wanted)
+    if too_few:
+        st.caption(points_needed_text(len(points), wanted))
     if st.button("Run calibration", type="primary", key="calibration_run",
-                 disabled=not points or not (chosen or extra.strip()) or refused is not None,
-                 help="off while the chosen specimen file is refused" if refused else None):
+                 disabled=not points or not wanted or too_few):
         try:
-            fit = api.parse_fit([*chosen, *extra.split(",")], specimen)
+            fit = api.parse_fit(wanted, specimen)
             started = runner_for(stores.path).start(api, points, fit=fit, cells=int(cells),
                                                     design_size=int(design) or None,
                                                     specimen=specimen)
@@ -125,4 +165,4 @@ def render(stores) -> None:
         else:
             if started is None:
                 st.warning("a calibration is running already; wait for it to finish")
-    draw_polling(_task, stores, polling=_running(stores), every_s=REFRESH_S)
+    draw_polling(_task, stores, chosen_label, polling=_running(stores), every_s=REFRESH_S)
