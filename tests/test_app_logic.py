@@ -436,6 +436,25 @@ def test_app_command_serves_the_packaged_entry_on_localhost(tmp_path):
     assert "from pidcore.app.main import main" in shim
 
 
+@pytest.mark.parametrize("script", ["pidcore/app/entry.py", "app/pidcore_app.py"])
+def test_a_worker_process_rerunning_the_entry_script_draws_nothing(script, monkeypatch):
+    # multiprocessing re-runs the parent's main script in each worker as "__mp_main__";
+    # during a Streamlit script run that is the entry script, which drew the whole page in
+    # every DEM worker (hundreds of warnings per job in the server log)
+    import runpy
+    import sys
+    import types
+
+    drawn = []
+    fake = types.ModuleType("pidcore.app.main")
+    fake.main = lambda: drawn.append(True)
+    monkeypatch.setitem(sys.modules, "pidcore.app.main", fake)
+    runpy.run_path(str(REPO / script), run_name="__mp_main__")
+    assert drawn == []
+    runpy.run_path(str(REPO / script), run_name="__main__")  # what `streamlit run` does
+    assert drawn == [True]
+
+
 # --- DEM from the app ----------------------------------------------------------------------------
 
 def test_dem_sweep_plan_is_the_product_and_is_kept_small():
