@@ -103,6 +103,9 @@ def test_json_document(capsys, tmp_path, tiny_store):
     assert (spec.cell, spec.particles, spec.pairs) == (paper.cell, paper.particles, paper.pairs)
     assert spec.coupon.mass_kg == paper.coupon.mass_kg
     assert spec.name == "paper_coupon_calibrated"
+    # the description states the fitted values, not only the starting file's words
+    assert (f"calibrated by pidcore calibrate: fixture_mass_kg {p['median']:.4g} "
+            f"(95 % {p['low95']:.4g} .. {p['high95']:.4g})") in spec.description
 
 
 def test_loo_prediction_never_sees_the_held_out_value(tiny_store):

@@ -90,11 +90,16 @@ class CalibrationResult:
                   for name in ("fixture_mass_kg", "baseline_loss_factor")
                   if name in self.parameters}
         out = out.with_values(coupon) if coupon else out
-        fitted = ", ".join(s.name for s in self.specs if s.kind != "hyper")
+        # the values themselves: a description written for the start ("15 g fixture") would
+        # otherwise contradict the fitted numbers below it
+        fitted = "; ".join(
+            f"{s.name} {p['median']:.4g} (95 % {p['low95']:.4g} .. {p['high95']:.4g})"
+            for s in self.specs if s.kind != "hyper"
+            for p in (self.parameters[s.name],))
         return dataclasses.replace(
             out, name=f"{self.specimen.name}_calibrated",
-            description=f"{self.specimen.description} -- calibrated ({fitted}) by pidcore "
-                        "calibrate".strip(" -"))
+            description=f"{self.specimen.description} -- calibrated by pidcore calibrate: "
+                        f"{fitted} (these replace any value stated above)".strip(" -"))
 
     def document(self) -> dict:
         """The ``--json`` document: parameters, predictions, loo, loo_rms."""
