@@ -1095,3 +1095,29 @@ def test_run_says_which_cases_are_already_stored():
         "1 job(s) submitted; 1 already in the store, not run again; 1 already queued or "
         "running, not submitted again")
     assert jobs.submitted_text(1, [queued]) == "1 job(s) submitted"
+
+
+def test_available_calibrations_list_this_stores_first_and_say_what_cannot_be_read(tmp_path):
+    from pidcore.app.calibration import CALIBRATION_ENV_VAR, CalibrationTask, available_calibrations
+
+    doc = {"parameters": {"fixture_mass_kg": {"median": 0.2, "low95": 0.1, "high95": 0.3}},
+           "predictions": [{"frequency_hz": 100.0, "acceleration_g": 5.0, "fill_percent": 50.0,
+                            "material": "acrylic", "measured": 0.3, "predicted": 0.3,
+                            "low95": 0.1, "high95": 0.6}]}
+    path = tmp_path / "calibration.json"
+    path.write_text(json.dumps(doc))
+    env = {CALIBRATION_ENV_VAR: str(path)}
+    done = CalibrationTask(("fixture_mass_kg",), 1, "steel_6mm", state="done",
+                           outputs={"calibration.json": json.dumps(doc).encode()})
+    found = available_calibrations(done, env)
+    assert [label.split(" (")[0] for _, label in found] == [
+        "this store's calibration of steel_6mm on the Calibrate page", str(path)]
+    assert all(c is not None for c, _ in found)
+    # this store's cannot be read: the file's is still offered, and the problem is said last
+    broken = CalibrationTask(("fixture_mass_kg",), 1, "steel_6mm", state="done",
+                             outputs={"calibration.json": b'{"runs": 1}'})
+    found = available_calibrations(broken, env)
+    assert found[0][1] == str(path) and found[-1][0] is None
+    assert found[-1][1].startswith("calibration not shown: ")
+    assert available_calibrations(None, {CALIBRATION_ENV_VAR: str(tmp_path / "none.json")})[0][0] \
+        is None

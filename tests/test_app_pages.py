@@ -779,7 +779,7 @@ def test_compare_says_when_the_calibration_does_not_predict_the_case(store_file,
     at = _upload(_app(), [("c_fill50.csv", mass_damper_csv())])
     assert "SDC calibrated DEM, Eq. 11 [-]" not in {m.label for m in at.metric}
     # the load case rounded, as the page names it elsewhere (not f100.00002Hz_a4.9998g_...)
-    assert any("calibration does not predict 100 Hz, 5 g, 50 %, acrylic, z (" in c.value
+    assert any("No calibration predicts 100 Hz, 5 g, 50 %, acrylic, z: " in c.value
                for c in at.caption)
     # a foreign file: said on the page, the rest of the page still there
     cal.write_text('{"runs": 1}', encoding="utf-8")
@@ -787,6 +787,38 @@ def test_compare_says_when_the_calibration_does_not_predict_the_case(store_file,
     assert not at.exception
     assert any("calibration not shown" in c.value and "calibration.json" in c.value
                for c in at.caption)
+
+
+def test_a_calibration_of_another_specimen_does_not_hide_the_papers_band(store_file, tmp_path,
+                                                                         monkeypatch):
+    # a steel calibration on the Calibrate page took over Compare and Report for every case:
+    # the acrylic paper cases lost the bundled calibration's bands
+    from pidcore.app.calibration import CALIBRATION_ENV_VAR, CalibrationTask, runner_for
+
+    paper = _calibration_json(tmp_path / "calibration.json", 100, 5, 50, 0.3456, 0.10, 0.60)
+    monkeypatch.setenv(CALIBRATION_ENV_VAR, str(paper))
+    steel = json.loads(paper.read_text())
+    steel["predictions"][0].update(material="steel", frequency_hz=500.0, predicted=0.5)
+    runner_for(store_file).task = CalibrationTask(
+        ("fixture_mass_kg",), 1, "steel_6mm", state="done",
+        outputs={"calibration.json": json.dumps(steel).encode()})
+    at = _upload(_app(), [("c_fill50.csv", mass_damper_csv())])
+    metrics = {m.label: m.value for m in at.metric}
+    assert metrics["SDC calibrated DEM, Eq. 11 [-]"] == "0.3456"  # the paper's, not none
+    assert any("the bundled calibration" in m.value or str(paper) in m.value
+               for m in at.markdown if "calibrated DEM" in m.value)
+    # the Report tab offers both, this store's first; the paper's gives the acrylic row
+    at.button(key="save").click()
+    at.run()
+    box = at.selectbox(key="report_calibration")
+    assert box.options[0].startswith("this store's calibration of steel_6mm")
+    assert _table(at, "SDC calibrated DEM (Eq. 11) [-]")["SDC calibrated DEM (Eq. 11) [-]"] \
+        .isna().all()
+    box.set_value(box.options[1])
+    at.run()
+    table = _table(at, "SDC calibrated DEM (Eq. 11) [-]")
+    assert table.loc[table["SDC measured [-]"].notna(), "SDC calibrated DEM (Eq. 11) [-]"] \
+        .tolist() == [0.3456]
 
 
 #: DEM runs of the bundled calibration (`pidcore calibrate ... --dem-store calibration_store.h5`,

@@ -217,27 +217,47 @@ def calibration_digest(calibration) -> str:
     return hashlib.sha256(repr(calibration).encode()).hexdigest()[:16]
 
 
-def active_calibration(task: CalibrationTask | None, environ: Mapping[str, str] | None = None,
-                       *, cwd: Path | None = None):
-    """``(calibration, label)`` the Compare page shows: the Calibrate page's finished
-    calibration of this store if there is one, else :func:`calibration_path`'s file; ``(None,
-    reason)`` when there is none or it cannot be read (the reason is shown)."""
+def available_calibrations(task: CalibrationTask | None,
+                           environ: Mapping[str, str] | None = None, *,
+                           cwd: Path | None = None) -> list[tuple[object | None, str]]:
+    """The calibrations the Compare and Report pages offer, as ``(calibration, label)``: the
+    Calibrate page's finished calibration of this store first, then :func:`calibration_path`'s
+    file (the bundled paper calibration by default). A calibration of one specimen does not
+    hide the other's bands: Compare takes the first that predicts a case. One that cannot be
+    read comes last as ``(None, reason)``; ``[(None, reason)]`` when there is none or none can
+    be read (the reason is shown)."""
     from ..calibrate.prediction import calibration_from_json, load_calibration
     from ..errors import PidcoreError
 
-    try:
-        if task is not None and task.state == "done" and "calibration.json" in task.outputs:
-            return (calibration_from_json(task.outputs["calibration.json"],
-                                          "calibration.json (Calibrate page)"),
-                    f"this store's calibration of {task.specimen or 'the paper coupon'} on "
-                    f"the Calibrate page ({', '.join(task.fit)})")
-        path = calibration_path(environ, cwd=cwd)
-        if path is None:
-            return None, ("no calibration: run one on the Calibrate page (or set "
-                          f"{CALIBRATION_ENV_VAR})")
+    found: list[tuple[object | None, str]] = []
+    problems: list[str] = []
+    if task is not None and task.state == "done" and "calibration.json" in task.outputs:
+        try:
+            found.append((calibration_from_json(task.outputs["calibration.json"],
+                                                "calibration.json (Calibrate page)"),
+                          f"this store's calibration of {task.specimen or 'the paper coupon'} "
+                          f"on the Calibrate page ({', '.join(task.fit)})"))
+        except PidcoreError as exc:
+            problems.append(f"calibration not shown: {exc}")
+    path = calibration_path(environ, cwd=cwd)
+    if path is not None:
         label = ("the bundled calibration of the paper's 12 measured points"
                  if path.name == BUNDLED_CALIBRATION.name and path.parent.name ==
                  BUNDLED_CALIBRATION.parent.name else str(path))
-        return load_calibration(path), label
-    except PidcoreError as exc:
-        return None, f"calibration not shown: {exc}"
+        try:
+            found.append((load_calibration(path), label))
+        except PidcoreError as exc:
+            problems.append(f"calibration not shown: {exc}")
+    if found:  # a calibration that cannot be read is still said, after those that can
+        return found + [(None, problem) for problem in problems]
+    if problems:
+        return [(None, problems[0])]
+    return [(None, "no calibration: run one on the Calibrate page (or set "
+                   f"{CALIBRATION_ENV_VAR})")]
+
+
+def active_calibration(task: CalibrationTask | None, environ: Mapping[str, str] | None = None,
+                       *, cwd: Path | None = None):
+    """The first of :func:`available_calibrations`: ``(calibration, label)``, or ``(None,
+    reason)``."""
+    return available_calibrations(task, environ, cwd=cwd)[0]

@@ -10,7 +10,7 @@ from __future__ import annotations
 import streamlit as st
 
 from pidcore import __version__, defaults
-from pidcore.app.calibration import active_calibration, runner_for
+from pidcore.app.calibration import available_calibrations, runner_for
 from pidcore.app.stores import AppStores
 from pidcore.app.tabs import analyse, calibrate, compare, dem, report
 
@@ -26,17 +26,17 @@ def main() -> None:
             st.markdown(f"**reference DEM runs** (read-only): `{stores.dem_reference}`")
         st.markdown(f"**upload limit**: {defaults.APP_MAX_UPLOAD_MB} MB per file")
         st.caption(f"pidcore {__version__}")
-    # read once per run: the Compare and Report tabs show the same calibration
-    calibration = active_calibration(runner_for(stores.path).task)
+    # read once per run: the Compare and Report tabs offer the same calibrations
+    calibrations = available_calibrations(runner_for(stores.path).task)
     t_analyse, t_compare, t_dem, t_cal, t_report = st.tabs(
         ["Analyse", "Compare", "DEM", "Calibrate", "Report"])
     with t_analyse:
         analysed = analyse.render(stores)
     with t_compare:
-        compare.render(stores, analysed, calibration)
+        compare.render(stores, analysed, calibrations)
     with t_dem:
         dem.render(stores)
     with t_cal:
         calibrate.render(stores)
     with t_report:
-        report.render(stores, calibration)
+        report.render(stores, calibrations)

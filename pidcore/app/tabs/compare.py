@@ -45,20 +45,25 @@ def _group_key(members) -> str:
     return "|".join(f"{e.key}:{e.load_case.key}:{e.specimen}:{e.sdc!r}" for e in members)
 
 
-def _calibrated(active, comp, head) -> None:
+def _calibrated(calibrations, comp, head) -> None:
     """The calibrated DEM's Eq. 11 SDC with its 95 % band beside the raw DEM and the measured
     Eq. 11 SDC (like for like: the calibration predicts what a shaker test of the DEM would
-    measure with Eq. 11). ``active``: (calibration or None, label), see :func:`render`."""
-    calibration, label = active
-    if calibration is None:
-        st.caption(label)
+    measure with Eq. 11). ``calibrations``: [(calibration or None, label)], see :func:`render`;
+    the first that predicts the case is shown (a calibration of one specimen does not hide
+    another's)."""
+    usable = [(c, label) for c, label in calibrations if c is not None]
+    for c, reason in calibrations:
+        if c is None:  # none at all, or one that cannot be read
+            st.caption(reason)
+    if not usable:
         return
-    hit = calibration.lookup(comp.load_case)
+    hits = [(c, label, c.lookup(comp.load_case)) for c, label in usable]
+    calibration, label, hit = next((h for h in hits if h[2] is not None), hits[0])
     st.markdown("**calibrated DEM** (" + label + ")")
     if hit is None:
-        st.caption(f"The calibration does not predict {comp.load_case.full_label()} "
-                   f"(it predicts "
-                   f"{len(calibration.predictions)} measured load case(s)).")
+        st.caption(f"No calibration predicts {comp.load_case.full_label()}: "
+                   + "; ".join(f"{label} predicts {len(c.predictions)} measured load case(s)"
+                               for c, label, _ in hits) + ".")
         return
     c1, c2, c3 = st.columns(3)
     c1.metric("SDC measured, Eq. 11 [-]",
@@ -72,9 +77,10 @@ def _calibrated(active, comp, head) -> None:
                f"Eq. 11 SDC is {verdict}.")
 
 
-def render(stores, session_files: list, active_calibration: tuple) -> None:
-    """The page. ``active_calibration``: :func:`pidcore.app.calibration.active_calibration`'s
-    (calibration or None, label), read once per script run for this tab and the Report tab."""
+def render(stores, session_files: list, calibrations: list) -> None:
+    """The page. ``calibrations``: :func:`pidcore.app.calibration.available_calibrations`'s
+    [(calibration or None, label)], read once per script run for this tab and the Report
+    tab."""
     from pidcore.errors import PidcoreError
 
     st.subheader("Compare per load case")
@@ -149,7 +155,7 @@ def render(stores, session_files: list, active_calibration: tuple) -> None:
                 and math.isfinite(aligned.sdc_paper_experimental)):
             st.caption("paper: none where Table 3 has no value at this case (it tabulates "
                        "acrylic spheres driven along z at its grid of load cases)")
-    _calibrated(active_calibration, comp, head)
+    _calibrated(calibrations, comp, head)
     for note in view["notes"]:
         st.caption(f"note: {note}")
     left, right = st.columns(2)

@@ -7,8 +7,9 @@ import streamlit as st
 from pidcore.app import state
 
 
-def render(stores, active_calibration: tuple) -> None:
-    """The page. ``active_calibration``: (calibration or None, label), as the Compare tab's."""
+def render(stores, calibrations: list) -> None:
+    """The page. ``calibrations``: [(calibration or None, label)], as the Compare tab's; the
+    calibrated columns show the one chosen (the first by default)."""
     from pidcore.app.calibration import calibration_digest
     from pidcore.errors import PidcoreError
     from pidcore.report.downloads import report_files
@@ -31,7 +32,14 @@ def render(stores, active_calibration: tuple) -> None:
             else None)
     # the calibration the Compare tab shows, in the same columns as `pidcore report
     # --calibration`
-    calibration, label = active_calibration
+    usable = [(c, text) for c, text in calibrations if c is not None]
+    calibration, label = usable[0] if usable else calibrations[0]
+    if len(usable) > 1:  # e.g. this store's steel calibration and the paper's bundled one
+        labels = [text for _, text in usable]
+        chosen_label = st.selectbox("calibration for the calibrated DEM columns", labels,
+                                    key="report_calibration")
+        calibration, label = usable[labels.index(chosen_label)] \
+            if chosen_label in labels else usable[0]
     digest = calibration_digest(calibration)
     try:
         table = state.report_table(stamp, pool, keys, digest, stores, calibration)
