@@ -292,3 +292,41 @@ def test_runs_that_never_reached_steady_state_are_named_in_the_notes(tiny_store,
     flagged = calibrate(points, **settings)
     assert "1 of 3 DEM run(s) never reached steady state" in " ".join(flagged.notes)
     assert "500 Hz, 1 g, 50 %, acrylic (1)" in " ".join(flagged.notes)
+
+
+def test_energy_check_calls_a_start_outside_only_beyond_its_own_uncertainty():
+    # a trial's table read "start 2.06e-05, band 2.06e-05 .. 2.06e-05, start inside: no":
+    # the fitted parameter does not move that load case, and the start missed the
+    # zero-width band by a last digit
+    from types import SimpleNamespace
+
+    from pidcore.calibrate.calibrate import energy_check
+
+    class Surrogate:
+        frequency_hz, acceleration_g, fill_percent = 50.0, 1.0, 50.0
+
+        def __init__(self, slope):
+            self.slope = slope
+
+        def predict(self, theta):
+            d = 1e-3 * (1.0 + self.slope * theta[:, 0])
+            # a wide variance, as an extrapolation to a start outside the prior gives
+            return d, np.full(d.shape, 1e-6), d, d
+
+    samples = np.linspace(0.01, 0.1, 201)[:, None]  # the posterior of a rolling friction
+    specimen = SimpleNamespace(cell=SimpleNamespace(count=441))
+
+    def within(slope):
+        model = SimpleNamespace(specs=[SimpleNamespace(kind="dem", default=0.0)],
+                                dem_theta=lambda s: s, surrogates=[Surrogate(slope)])
+        return energy_check(model, samples, specimen)[0]["within"]
+
+    # a trend of 1e-7 per unit of the parameter: the start misses the band by 1e-9 relative
+    assert within(1e-7)
+    # the physics moved (the paper's 500 Hz, 1 g: 2.0e-9 J at the start, band 0.25e-9 ..
+    # 1.5e-9 J): outside, however uncertain the surrogate is at the start
+    assert not within(5.0)
+    # the band's low end (2.5 % of the posterior, theta 0.012) 0.25 % above the start:
+    # outside the 0.1 % resolution; 0.06 % above it: inside
+    assert not within(0.2)
+    assert within(0.05)
