@@ -972,9 +972,13 @@ def test_calibrate_page_keeps_saved_materials_apart_and_refuses_a_mixed_or_unkno
     # the points a specimen is calibrated on: its particles, measured on it or on no named one
     kept, note = points_for_specimen(points, steel_file)
     # each left out with its reason (another specimen's steel is not this specimen's)
-    assert kept == [] and note == ("not used for steel_6mm (steel particles): 1 measured on "
-                                   "specimen steel_6mm_b; 1 of acrylic particles (measured "
-                                   "load cases)")
+    assert kept == [] and note == ("Not used for steel_6mm (steel particles): 1 measured load "
+                                   "case(s) of specimen steel_6mm_b; 1 measured load case(s) "
+                                   "of acrylic particles.")
+    # the calibrated file of a specimen is calibrated again on that specimen's measurements
+    calibrated = dataclasses.replace(steel_file, name="steel_6mm_calibrated")
+    named_b = dataclasses.replace(by["steel"][0], specimen="steel_6mm")
+    assert points_for_specimen([named_b], calibrated) == ([named_b], "")
     named = dataclasses.replace(by["steel"][0], specimen="steel_6mm")
     unnamed = dataclasses.replace(by["steel"][0], specimen="")
     kept, _ = points_for_specimen([*points, named, unnamed], steel_file)

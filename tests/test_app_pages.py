@@ -679,8 +679,8 @@ def test_calibrate_page_calibrates_a_chosen_specimen_file_on_its_own_measurement
     cases = next(m for m in at.multiselect if (m.key or "").startswith("calibration_cases_"))
     assert cases.options == cases.value == ["100 Hz, 5 g, 50 %, steel, specimen steel_6mm",
                                             "200 Hz, 5 g, 50 %, steel"]
-    assert any("not used for steel_6mm (steel particles): 1 of acrylic particles" in c.value
-               for c in at.caption)
+    assert any("Not used for steel_6mm (steel particles): 1 measured load case(s) of acrylic "
+               "particles." in c.value for c in at.caption)
     at.multiselect(key="calibration_fit").set_value(["fixture_mass_kg"])
     at.run()
     _run_calibration(at, store_file)

@@ -187,3 +187,10 @@ def test_a_fill_outside_0_100_is_one_line_naming_the_option(capsys, fill):
     err = capsys.readouterr().err
     assert code == 2 and err.count("\n") == 1
     assert f"--fill {fill}: expected a fill in (0, 100] %" in err
+
+
+def test_no_fill_and_no_specimen_says_what_to_give(capsys):
+    # it said "the specimen states no count_per_cell" where no specimen was given
+    code = main(["dem", "run", "--frequency", "500", "--acceleration", "5"])
+    err = capsys.readouterr().err
+    assert code == 2 and "--fill: required (or a --specimen file stating count_per_cell" in err

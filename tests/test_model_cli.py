@@ -184,7 +184,7 @@ def test_damper_takes_one_specimens_runs_with_its_masses_and_a_given_area(tmp_pa
                                              "select one.*--where specimen_name=steel_6mm"):
         _run(argv)
     # its file states no coupon area: per-area damping is refused, not taken from the paper
-    with pytest.raises(ParameterError, match="--area M2: the DEM runs are of specimen "
+    with pytest.raises(ParameterError, match="--area: the DEM runs are of specimen "
                                              "steel_6mm"):
         _run([*argv, "--where", "specimen_name=steel_6mm"])
     _run([*argv, "--where", "specimen_name=steel_6mm", "--area", "0.02"])
@@ -245,9 +245,12 @@ def test_runs_of_two_numerical_settings_are_refused_and_chosen_by_settings_hash(
             str(tmp_path / "s.h5"), "--format", "csv", "--area", "0.01"]
     wanted = settings_hash(params("eq3", 7))  # the seed is not a setting
     other = settings_hash(params("calibrated", 7))
+    # each hash with what sets it apart (a trial could not tell which run was which)
     with pytest.raises(ParameterError, match=f"DEM runs of 2 different numerical settings "
-                                             f"\\(settings hash {wanted} \\(94 runs\\), {other} "
-                                             "\\(47 runs\\)"):
+                                             f"\\(settings hash {wanted} \\(94 runs\\): "
+                                             f"config_damping_coefficient eq3; {other} "
+                                             "\\(47 runs\\): config_damping_coefficient "
+                                             "calibrated\\)"):
         _run(argv)
     _run([*argv, "--where", f"settings_hash={wanted}"])
     table = pd.read_csv(tmp_path / "equivalent_damper.csv")

@@ -62,21 +62,27 @@ def points_by_material(points: Sequence) -> dict[str, list]:
 
 def points_for_specimen(points: Sequence, specimen) -> tuple[list, str]:
     """(points, note): the measured points a specimen file is calibrated against, those of its
-    particle material measured on it (their specimen label is its name) or on no named
-    specimen; ``note`` says what is left out and why ("" if nothing)."""
+    particle material measured on it (their specimen label is its name, or the name it was
+    calibrated from) or on no named specimen; ``note`` says what is left out and why ("" if
+    nothing)."""
     material = specimen.particles.material
+    # a calibrated file ("<name>_calibrated", as pidcore calibrate names it) is the specimen
+    # its measurements were made on
+    names = {"", specimen.name, specimen.name.removesuffix("_calibrated")}
     kept, other_material, other_specimen = [], {}, {}
     for p in points:
         if str(p.material) != material:
             other_material[str(p.material)] = other_material.get(str(p.material), 0) + 1
-        elif str(p.specimen) not in ("", specimen.name):
+        elif str(p.specimen) not in names:
             other_specimen[str(p.specimen)] = other_specimen.get(str(p.specimen), 0) + 1
         else:
             kept.append(p)
-    reasons = [f"{n} measured on specimen {name}" for name, n in other_specimen.items()]
-    reasons += [f"{n} of {name} particles" for name, n in other_material.items()]
-    note = (f"not used for {specimen.name} ({material} particles): "
-            + "; ".join(reasons) + " (measured load cases)") if reasons else ""
+    reasons = [f"{n} measured load case(s) of specimen {name}"
+               for name, n in other_specimen.items()]
+    reasons += [f"{n} measured load case(s) of {name} particles"
+                for name, n in other_material.items()]
+    note = (f"Not used for {specimen.name} ({material} particles): " + "; ".join(reasons)
+            + ".") if reasons else ""
     return kept, note
 
 

@@ -236,7 +236,10 @@ def _fill(args: argparse.Namespace, specimen, material: str) -> float:
         return p.fill_percent
     if p is not None and p.count_per_cell is not None:
         return 100.0 * p.count_per_cell / specimen.capacity_per_cell()
-    raise ParameterError("--fill: required (the specimen states no count_per_cell or "
+    if specimen is None:
+        raise ParameterError("--fill: required (or a --specimen file stating count_per_cell "
+                             "or fill_percent)")
+    raise ParameterError(f"--fill: required ({specimen.name} states no count_per_cell or "
                          "fill_percent)")
 
 

@@ -193,7 +193,7 @@ def run_damper(args: argparse.Namespace) -> int:
     elif runs is not None and "specimen_is_paper" in runs.columns \
             and not runs["specimen_is_paper"].fillna(True).astype(bool).all():
         name = runs["specimen_name"].iloc[0] if "specimen_name" in runs.columns else "?"
-        raise ParameterError(f"--area M2: the DEM runs are of specimen {name}, whose file "
+        raise ParameterError(f"--area: the DEM runs are of specimen {name}, whose file "
                              "states no coupon area; give the area c_eq per area is taken "
                              "over, e.g. --area 0.01")
     else:

@@ -358,13 +358,34 @@ def select_runs(runs: pd.DataFrame, *, where: Mapping[str, str] | None = None) -
     if "settings_hash" in selected.columns:
         counts = selected.loc[selected["settings_hash"] != "", "settings_hash"].value_counts()
         if len(counts) > 1:
-            listed = ", ".join(f"{h} ({n} runs)" for h, n in counts.items())
             raise ParameterError(
-                f"DEM runs of {len(counts)} different numerical settings (settings hash "
-                f"{listed}: cells, steady cycles, damping coefficient, ...); select one, e.g. "
+                f"DEM runs of {len(counts)} different numerical settings "
+                f"({_settings_difference(selected, counts)}); select one, e.g. "
                 f"where={{'settings_hash': {counts.index[0]!r}}} (CLI: --where "
                 f"settings_hash={counts.index[0]})")
     return selected
+
+
+def _settings_difference(runs: pd.DataFrame, counts: pd.Series) -> str:
+    """Each settings hash with its run count and the settings in which the hashes differ,
+    e.g. ``"settings hash 108aa6 (2 runs): config_damping_coefficient eq3; eb7961 (1 run):
+    config_damping_coefficient calibrated"``."""
+    import json
+
+    params = {}
+    for digest in counts.index:
+        text = runs.loc[runs["settings_hash"] == digest, "parameters_json"].iloc[0]
+        params[digest] = {k: v for k, v in json.loads(text).items()
+                          if not k.startswith("case_") and k != "config_seed"}
+    keys = sorted({k for p in params.values() for k in p})
+    differ = [k for k in keys if len({json.dumps(p.get(k), default=str)
+                                      for p in params.values()}) > 1]
+    parts = []
+    for digest, n in counts.items():
+        shown = ", ".join(f"{k} {params[digest].get(k)}" for k in differ[:4])
+        parts.append(f"{digest} ({n} run{'s' if n != 1 else ''})" + (f": {shown}" if shown
+                                                                       else ""))
+    return "settings hash " + "; ".join(parts)
 
 
 def _check_one_specimen(runs: pd.DataFrame) -> None:

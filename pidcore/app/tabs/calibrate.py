@@ -91,7 +91,8 @@ def render(stores) -> None:
                 "files on the Analyse tab and Save them.")
         return
     specimen, refused = specimen_choice("calibration")
-    chosen_label = specimen_label(specimen)
+    chosen_label = "a refused specimen file" if refused is not None else \
+        specimen_label(specimen)
     if refused is not None:  # nothing runs, and no fallback to the paper's coupon
         st.info("Run is off until the specimen file is fixed or another is chosen.")
         draw_polling(_task, stores, chosen_label, polling=_running(stores), every_s=REFRESH_S)
@@ -105,6 +106,8 @@ def render(stores) -> None:
             st.info(f"No saved measurement is of specimen {specimen.name} "
                     f"({specimen.particles.material} particles) or of an unnamed specimen of "
                     "them.")
+            draw_polling(_task, stores, chosen_label, polling=_running(stores),
+                         every_s=REFRESH_S)
             return
         cases_key = f"calibration_cases_{specimen.hash[:12]}"  # its own choice of cases
     by_material = points_by_material(points)
