@@ -24,6 +24,20 @@ def _run(argv: list[str]) -> int:
     return args.func(args)
 
 
+def _fake_store(monkeypatch, listing) -> None:
+    """``pidcore.store.Store`` replaced by one whose DEM-run listing is ``listing()``."""
+    import pidcore.store
+
+    class FakeStore:
+        def __init__(self, path):
+            self.path = path
+
+        def list_dem_runs(self):
+            return listing()
+
+    monkeypatch.setattr(pidcore.store, "Store", FakeStore, raising=False)
+
+
 def test_damper_writes_the_paper_grid(tmp_path):
     assert _run(["model", "damper", "--out", str(tmp_path), "--mass-convention", "coupon"]) == 0
     table = pd.read_csv(tmp_path / "equivalent_damper.csv")
@@ -59,8 +73,6 @@ def test_damper_options(tmp_path):
 
 
 def test_damper_from_store_runs(tmp_path, monkeypatch):
-    import pidcore.store
-
     base = load_paper_table3().dropna(subset=["sdc_dem"]).rename(columns={"sdc_dem": "sdc"})
     runs = pd.concat([base.assign(sdc=base.sdc * 0.9), base.assign(sdc=base.sdc * 1.1)])
     runs = pd.concat([runs.assign(material="acrylic"), base.assign(material="aluminium", sdc=0.7)])
@@ -70,14 +82,7 @@ def test_damper_from_store_runs(tmp_path, monkeypatch):
                        fixture_mass_kg=0.0, coupon_cells=441, particle_mass_kg=9.7e-6,
                        particles_full_cell=22, vibrated_mass_kg=0.0222 + 441 * count * 9.7e-6)
 
-    class FakeStore:
-        def __init__(self, path):
-            self.path = path
-
-        def list_dem_runs(self):
-            return runs.assign(sdc_stderr=0.01, case_key="k")
-
-    monkeypatch.setattr(pidcore.store, "Store", FakeStore, raising=False)
+    _fake_store(monkeypatch, lambda: runs.assign(sdc_stderr=0.01, case_key="k"))
     argv = ["model", "damper", "--out", str(tmp_path), "--table", "store", "--store",
             str(tmp_path / "s.h5"), "--format", "csv"]
     with pytest.raises(ParameterError, match="differ in material"):
@@ -160,7 +165,6 @@ def _specimen_runs(name: str, sha: str, *, coupon_kg: float, fixture_kg: float,
 
 def test_damper_takes_one_specimens_runs_with_its_masses_and_a_given_area(tmp_path,
                                                                           monkeypatch):
-    import pidcore.store
 
     mine = _specimen_runs("steel_6mm", "a" * 64, coupon_kg=0.05, fixture_kg=0.12,
                           sdc_scale=0.5)
@@ -168,14 +172,8 @@ def test_damper_takes_one_specimens_runs_with_its_masses_and_a_given_area(tmp_pa
                            sdc_scale=2.0)
     listing = pd.concat([mine, other.assign(specimen_name="thick_core")])
 
-    class FakeStore:
-        def __init__(self, path):
-            self.path = path
-
-        def list_dem_runs(self):
-            return listing
-
-    monkeypatch.setattr(pidcore.store, "Store", FakeStore, raising=False)
+    listed = {"runs": listing}
+    _fake_store(monkeypatch, lambda: listed["runs"])
     argv = ["model", "damper", "--out", str(tmp_path), "--table", "store", "--store",
             str(tmp_path / "s.h5"), "--format", "csv"]
     # two specimens' SDCs would be averaged into one model of neither
@@ -198,7 +196,7 @@ def test_damper_takes_one_specimens_runs_with_its_masses_and_a_given_area(tmp_pa
     np.testing.assert_allclose(table["c_eq_per_area [N s/m^3]"], table["c_eq [N s/m]"] / 0.02,
                                rtol=1e-12)
     # two files of one name are two specimens: told apart by hash
-    listing = pd.concat([mine, other])
+    listed["runs"] = pd.concat([mine, other])
     with pytest.raises(ParameterError, match="--where specimen_sha256=a{64}"):
         _run(argv)
 
@@ -221,7 +219,6 @@ def test_runs_of_two_numerical_settings_are_refused_and_chosen_by_settings_hash(
                                                                                monkeypatch):
     # one grid run with Eq. 3's damping and one with the calibrated coefficient: their SDCs
     # were averaged into a model of neither (0.87 from 0.71 and 1.02 in a trial)
-    import pidcore.store
     from pidcore.compare.align import settings_hash
 
     def params(damping: str, seed: int) -> str:
@@ -233,14 +230,7 @@ def test_runs_of_two_numerical_settings_are_refused_and_chosen_by_settings_hash(
                          eq3.assign(parameters_json=params("eq3", 2)),  # a second seed: pooled
                          eq3.assign(parameters_json=params("calibrated", 1), sdc=eq3.sdc * 3)])
 
-    class FakeStore:
-        def __init__(self, path):
-            self.path = path
-
-        def list_dem_runs(self):
-            return listing
-
-    monkeypatch.setattr(pidcore.store, "Store", FakeStore, raising=False)
+    _fake_store(monkeypatch, lambda: listing)
     argv = ["model", "damper", "--out", str(tmp_path), "--table", "store", "--store",
             str(tmp_path / "s.h5"), "--format", "csv", "--area", "0.01"]
     wanted = settings_hash(params("eq3", 7))  # the seed is not a setting
