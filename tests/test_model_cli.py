@@ -165,7 +165,6 @@ def _specimen_runs(name: str, sha: str, *, coupon_kg: float, fixture_kg: float,
 
 def test_damper_takes_one_specimens_runs_with_its_masses_and_a_given_area(tmp_path,
                                                                           monkeypatch):
-
     mine = _specimen_runs("steel_6mm", "a" * 64, coupon_kg=0.05, fixture_kg=0.12,
                           sdc_scale=0.5)
     other = _specimen_runs("steel_6mm", "b" * 64, coupon_kg=0.07, fixture_kg=0.0,
