@@ -821,6 +821,28 @@ def test_a_calibration_of_another_specimen_does_not_hide_the_papers_band(store_f
         .tolist() == [0.3456]
 
 
+def test_compare_shows_no_band_of_another_specimens_calibration(store_file, tmp_path,
+                                                               monkeypatch):
+    # a measurement of one's own acrylic panel was shown the paper coupon's calibrated band
+    # (the report already refused it: the calibration speaks for the paper's coupon only)
+    import shutil
+
+    from pidcore.app.calibration import CALIBRATION_ENV_VAR
+
+    cal = _calibration_json(tmp_path / "calibration.json", 100, 5, 50, 0.3456, 0.10, 0.60)
+    shutil.copy(REPO / "data_samples" / "paper_calibrated_specimen.toml",
+                tmp_path / "calibrated_specimen.toml")  # says which specimen it calibrates
+    monkeypatch.setenv(CALIBRATION_ENV_VAR, str(cal))
+    for named, shown in (("my_panel", False), ("paper_coupon", True)):
+        table = f"file,fill_percent,material,specimen\nc_fill50.csv,50,acrylic,{named}\n"
+        at = _upload(_app(), [("c_fill50.csv", mass_damper_csv()),
+                              ("settings.csv", table.encode())])
+        metrics = {m.label: m.value for m in at.metric}
+        assert ("SDC calibrated DEM, Eq. 11 [-]" in metrics) == shown, named
+        said = any(f"No calibration is of specimen {named}" in c.value for c in at.caption)
+        assert said == (not shown)
+
+
 #: DEM runs of the bundled calibration (`pidcore calibrate ... --dem-store calibration_store.h5`,
 #: ~10 min from empty, gitignored): with it the real library calibrates in seconds.
 CALIBRATION_CACHE = REPO / "calibration_store.h5"

@@ -256,3 +256,22 @@ def test_the_calibration_folder_is_accepted_and_another_folder_is_named(tmp_path
     assert load_calibration(folder).path == BUNDLED
     with pytest.raises(ParameterError, match="a folder without calibration.json"):
         load_calibration(tmp_path)
+
+
+def test_a_calibration_speaks_for_its_own_specimen_or_an_unnamed_one(tmp_path):
+    # the app's Compare asks this by name (its measurements carry a specimen label only)
+    import shutil
+
+    from pidcore.calibrate.prediction import calibration_from_json, load_calibration
+
+    shutil.copy(BUNDLED, tmp_path / "calibration.json")
+    bare = load_calibration(tmp_path / "calibration.json")  # no specimen file: unknown
+    assert bare.speaks_for("my_panel")
+    shutil.copy(ROOT / "data_samples" / "paper_calibrated_specimen.toml",
+                tmp_path / "calibrated_specimen.toml")
+    paper = load_calibration(tmp_path / "calibration.json")
+    assert paper.speaks_for("") and paper.speaks_for("paper_coupon")
+    assert paper.speaks_for("paper_coupon_calibrated")
+    assert not paper.speaks_for("my_panel")
+    app = calibration_from_json(BUNDLED.read_bytes(), "app", specimen_name="steel_6mm")
+    assert app.speaks_for("steel_6mm") and not app.speaks_for("paper_coupon")

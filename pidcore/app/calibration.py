@@ -240,7 +240,8 @@ def available_calibrations(task: CalibrationTask | None,
     if task is not None and task.state == "done" and "calibration.json" in task.outputs:
         try:
             found.append((calibration_from_json(task.outputs["calibration.json"],
-                                                "calibration.json (Calibrate page)"),
+                                                "calibration.json (Calibrate page)",
+                                                specimen_name=task.specimen),
                           f"this store's calibration of {task.specimen or 'the paper coupon'} "
                           f"on the Calibrate page ({', '.join(task.fit)})"))
         except PidcoreError as exc:

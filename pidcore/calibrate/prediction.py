@@ -62,12 +62,16 @@ class Calibration:
         In-sample posterior-predictive predictions, one per measured load case.
     specimen_path : Path or None
         The calibrated specimen file beside it, if present.
+    specimen_name : str
+        The name of the specimen it calibrates where known without a file (a calibration
+        held in memory by the app); "" otherwise.
     """
 
     path: Path
     parameters: dict
     predictions: tuple[CalibratedPrediction, ...]
     specimen_path: Path | None = None
+    specimen_name: str = ""
 
     def lookup(self, case: LoadCase, *,
                tolerances: Tolerances | None = None) -> CalibratedPrediction | None:
@@ -96,6 +100,19 @@ class Calibration:
             return load_specimen(self.specimen_path)
         except (PidcoreError, OSError):
             return None
+
+    def speaks_for(self, specimen_name: str) -> bool:
+        """Whether this calibration may predict a measurement of the specimen named
+        ``specimen_name`` ("" : not named): the same name as the specimen it calibrates (its
+        calibrated file is "<name>_calibrated"), or either unknown."""
+        calibrated = self.specimen_name
+        if not calibrated and specimen_name:
+            spec = self.calibrated_specimen()
+            calibrated = spec.name if spec is not None else ""
+        if not specimen_name or not calibrated:
+            return True
+        return calibrated.removesuffix("_calibrated") == specimen_name.removesuffix(
+            "_calibrated")
 
     def other_specimen_reason(self, specimen) -> str:
         """Why this calibration does not speak for ``specimen`` (another specimen, or one of
@@ -198,9 +215,11 @@ def load_calibration(path: str | os.PathLike) -> Calibration:
                        specimen_path=specimen if specimen.is_file() else None)
 
 
-def calibration_from_json(text: str | bytes, source: str | os.PathLike) -> Calibration:
+def calibration_from_json(text: str | bytes, source: str | os.PathLike, *,
+                          specimen_name: str = "") -> Calibration:
     """A calibration from the text of a ``calibration.json`` (``source`` names it in errors
-    and in :attr:`Calibration.path`); checked as :func:`load_calibration` does."""
+    and in :attr:`Calibration.path`); checked as :func:`load_calibration` does.
+    ``specimen_name``: the specimen it calibrates, where the caller knows it."""
     path = Path(source)
     try:
         doc = json.loads(text)
@@ -225,4 +244,5 @@ def calibration_from_json(text: str | bytes, source: str | os.PathLike) -> Calib
         measured = float(measured) if isinstance(measured, (int, float)) else math.nan
         predictions.append(CalibratedPrediction(LoadCase(f, a, fill, str(material)), sdc, low,
                                                 high, measured))
-    return Calibration(path=path, parameters=doc["parameters"], predictions=tuple(predictions))
+    return Calibration(path=path, parameters=doc["parameters"], predictions=tuple(predictions),
+                       specimen_name=specimen_name)

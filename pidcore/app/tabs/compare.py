@@ -45,18 +45,24 @@ def _group_key(members) -> str:
     return "|".join(f"{e.key}:{e.load_case.key}:{e.specimen}:{e.sdc!r}" for e in members)
 
 
-def _calibrated(calibrations, comp, head) -> None:
+def _calibrated(calibrations, comp, head, specimen: str) -> None:
     """The calibrated DEM's Eq. 11 SDC with its 95 % band beside the raw DEM and the measured
     Eq. 11 SDC (like for like: the calibration predicts what a shaker test of the DEM would
     measure with Eq. 11). ``calibrations``: [(calibration or None, label)], see :func:`render`;
     the first that predicts the case is shown (a calibration of one specimen does not hide
-    another's)."""
+    another's), of those that speak for the measurement's ``specimen`` ("": not named)."""
     usable = [(c, label) for c, label in calibrations if c is not None]
     for c, reason in calibrations:
         if c is None:  # none at all, or one that cannot be read
             st.caption(reason)
     if not usable:
         return
+    mine = [(c, label) for c, label in usable if c.speaks_for(specimen)]
+    if not mine:  # the report refuses another specimen's calibration too
+        st.caption(f"No calibration is of specimen {specimen}: "
+                   + "; ".join(label for _, label in usable) + ".")
+        return
+    usable = mine
     hits = [(c, label, c.lookup(comp.load_case)) for c, label in usable]
     calibration, label, hit = next((h for h in hits if h[2] is not None), hits[0])
     st.markdown("**calibrated DEM** (" + label + ")")
@@ -155,7 +161,7 @@ def render(stores, session_files: list, calibrations: list) -> None:
                 and math.isfinite(aligned.sdc_paper_experimental)):
             st.caption("paper: none where Table 3 has no value at this case (it tabulates "
                        "acrylic spheres driven along z at its grid of load cases)")
-    _calibrated(calibrations, comp, head)
+    _calibrated(calibrations, comp, head, members[0].specimen)
     for note in view["notes"]:
         st.caption(f"note: {note}")
     left, right = st.columns(2)
