@@ -198,6 +198,10 @@ def test_damper_takes_one_specimens_runs_with_its_masses_and_a_given_area(tmp_pa
     listed["runs"] = pd.concat([mine, other])
     with pytest.raises(ParameterError, match="--where specimen_sha256=a{64}"):
         _run(argv)
+    # by the hash's first digits, as `specimen check` prints 16 of them
+    _run([*argv, "--where", "specimen_sha256=aaaaaaaaaaaaaaaa", "--area", "0.02"])
+    assert pd.read_csv(tmp_path / "equivalent_damper.csv")["vibrated_mass [kg]"].max() \
+        == pytest.approx(mine["vibrated_mass_kg"].max(), rel=1e-12)
 
 
 def test_runs_vibrated_mass_refuses_a_run_its_specimen_columns_do_not_give():

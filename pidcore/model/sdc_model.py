@@ -326,7 +326,8 @@ DEM_CONDITION_COLUMNS: tuple[str, ...] = (
 
 
 def select_runs(runs: pd.DataFrame, *, where: Mapping[str, str] | None = None) -> pd.DataFrame:
-    """Runs matching ``where`` (column -> value, compared as text), checked to be homogeneous.
+    """Runs matching ``where`` (column -> value, compared as text; a ``*sha256`` column also by
+    its first 6 or more digits), checked to be homogeneous.
 
     Raises :class:`ParameterError` if a column of ``where`` is missing, nothing matches, or the
     remaining runs are of several specimens, differ in a :data:`DEM_CONDITION_COLUMNS`
@@ -344,7 +345,11 @@ def select_runs(runs: pd.DataFrame, *, where: Mapping[str, str] | None = None) -
         if column not in runs.columns:
             raise ParameterError(f"DEM runs: no column {column!r} to select on; columns are "
                                  f"{sorted(runs.columns)}")
-        selected = selected[selected[column].astype(str) == str(wanted)]
+        text = selected[column].astype(str)
+        # a hash may be given by its first digits, as `specimen check` and labels show it
+        hashed = column.endswith("sha256") and len(str(wanted)) >= 6
+        selected = selected[text.str.startswith(str(wanted)) if hashed
+                            else text == str(wanted)]
     if selected.empty:
         raise ParameterError(f"DEM runs: none match {dict(where or {})}")
     _check_one_specimen(selected)  # first: a specimen fixes the material and more
