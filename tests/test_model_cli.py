@@ -271,3 +271,19 @@ def test_damper_and_figures_refuse_an_out_file_and_non_finite_values(tmp_path, c
         assert exit_code.value.code == 2
         assert re.search(f"argument {option}: expected (a )?finite", capsys.readouterr().err)
     assert not (tmp_path / "d").exists()
+
+
+def test_figures_of_stored_runs_name_their_specimen(tmp_path, monkeypatch):
+    # steel and paper-coupon figures looked alike ("SDC at 50 % fill")
+    from matplotlib.figure import Figure
+
+    built = []
+    monkeypatch.setattr(Figure, "savefig", lambda fig, path, **_: built.append(fig))
+    mine = _specimen_runs("steel_6mm", "a" * 64, coupon_kg=0.05, fixture_kg=0.12,
+                          sdc_scale=0.5)
+    _fake_store(monkeypatch, lambda: mine)
+    assert _run(["model", "figures", "--out", str(tmp_path), "--table", "store", "--store",
+                 str(tmp_path / "s.h5")]) == 0
+    titles = {fig._suptitle.get_text() for fig in built if fig._suptitle is not None}
+    assert titles == {f"DEM runs of steel_6mm [aaaaaa] in {tmp_path / 's.h5'}"}
+    assert len(built) == 2 * (4 + 3)  # every figure titled, each saved as PNG and SVG

@@ -134,7 +134,11 @@ def build_model(args: argparse.Namespace):
         raise ParameterError(f"{args.store}: no DEM runs stored; run `pidcore dem` first or use "
                              f"--table paper")
     runs = select_runs(runs, where=where)
-    text = f"DEM runs in {args.store}" + (f" where {where}" if where else "")
+    from ..compare.specimens import run_specimen_labels
+
+    # the specimen named: steel and paper-coupon figures looked alike
+    specimen = run_specimen_labels(runs).iloc[0]
+    text = f"DEM runs of {specimen} in {args.store}" + (f" where {where}" if where else "")
     return SdcModel.from_table(runs, value="sdc", log_frequency=args.log_frequency,
                                source=text), runs
 

@@ -101,6 +101,8 @@ def _draw_family(model: SdcModel, *, panels: Sequence[float], panel_column: str,
         panel.set_xlabel(xlabel)
         panel.set_ylabel("SDC [-]")
         panel.legend(fontsize="small", ncols=2)
+    if ax is None and model.source:  # a figure of its own says what it draws
+        fig.suptitle(model.source, fontsize="small")
     return fig
 
 
