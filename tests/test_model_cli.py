@@ -138,6 +138,10 @@ def test_damper_from_store_runs_gives_back_their_dissipated_energy(tmp_path):
                                rtol=1e-9)
     provenance = json.loads((tmp_path / "equivalent_damper.json").read_text())["provenance"]
     assert "the m_c the DEM runs divided their SDC by" in provenance["vibrated_mass"]
+    # the rows with SDC >= 1 have no damping ratio, and the output says why (it was blank)
+    undefined = int((table["sdc [-]"] >= 1).sum())
+    assert undefined > 0 and table["damping_ratio [-]"].isna().sum() == undefined
+    assert "undefined where SDC >= 1" in provenance["damping_ratio"]
     # the runs' m_c convention is the only one that gives their energy back
     with pytest.raises(ParameterError, match="--mass-convention coupon: the DEM runs in .* "
                                              "are coupon_plus_particles"):

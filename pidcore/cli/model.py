@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import sys
 from pathlib import Path
 
 from .. import defaults
@@ -214,9 +215,17 @@ def run_damper(args: argparse.Namespace) -> int:
         "area": area_text,
         "filled_grid_points": model.filled_points().to_dict(orient="records"),
     }
+    undefined = int((table["sdc [-]"] >= 1.0).sum())
+    why = ("damping ratio -ln(1 - SDC) / (4 pi) is undefined where SDC >= 1 (a free decay "
+           "would lose all its energy within a cycle): left empty")
+    if undefined:
+        provenance["damping_ratio"] = why
     paths = write_damper_table(table, args.out, formats=args.format, provenance=provenance)
     for path in paths:
         print(path)
+    if undefined:
+        print(f"pidcore model damper: note: {why} in {undefined} of {len(table)} row(s)",
+              file=sys.stderr)
     return 0
 
 
