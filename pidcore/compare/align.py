@@ -271,40 +271,48 @@ def consistency_chi2(values: np.ndarray, stderrs: np.ndarray) -> tuple[float, in
     return float(np.sum(w * (v[ok] - mean) ** 2)), int(ok.sum() - 1)
 
 
-def settings_hash(parameters_json: object) -> str:
-    """Hash (6 hex digits) of a DEM run's numerical settings: every stored input except the
-    load case and the seed, from its ``parameters_json``; "" where it is not stored."""
-    import hashlib
+def run_settings(parameters_json: object) -> dict | None:
+    """A DEM run's numerical settings: every stored input (its ``parameters_json``) except the
+    load case and the seed; None where they are not stored or not readable."""
     import json
 
     if not isinstance(parameters_json, str) or not parameters_json:
-        return ""
+        return None
     try:
         params = json.loads(parameters_json)
     except ValueError:
-        return ""
-    settings = {k: v for k, v in params.items()
-                if not k.startswith("case_") and k != "config_seed"}
+        return None
+    return {k: v for k, v in params.items() if not k.startswith("case_") and k != "config_seed"}
+
+
+def _settings_digest(settings: dict) -> str:
+    import hashlib
+    import json
+
     return hashlib.sha256(json.dumps(settings, sort_keys=True, default=str).encode()) \
         .hexdigest()[:6]
+
+
+def settings_hash(parameters_json: object) -> str:
+    """Hash (6 hex digits) of a DEM run's :func:`run_settings`; "" where they are not
+    stored."""
+    settings = run_settings(parameters_json)
+    return "" if settings is None else _settings_digest(settings)
 
 
 def _settings_of(row: pd.Series) -> tuple[str, float]:
     """(label, cells) of the numerical settings of one DEM run: every stored input except the
     load case and the seed (:func:`settings_hash`), with the cells and steady cycles spelled
     out."""
-    import json
-
     cells = float(row.get("cells_simulated", math.nan) or math.nan) \
         if "cells_simulated" in row else math.nan
-    text = row.get("parameters_json")
-    digest = settings_hash(text)
-    if not digest:
+    settings = run_settings(row.get("parameters_json"))
+    if settings is None:
         return (f"cells {cells:g}" if math.isfinite(cells) else ""), cells
-    params = json.loads(text)
-    if not math.isfinite(cells) and isinstance(params.get("config_cells"), int | float):
-        cells = float(params["config_cells"])
-    steady = params.get("config_steady_cycles", "")
+    digest = _settings_digest(settings)
+    if not math.isfinite(cells) and isinstance(settings.get("config_cells"), int | float):
+        cells = float(settings["config_cells"])
+    steady = settings.get("config_steady_cycles", "")
     # "settings hash": the specimen is named "name [hash]" beside it, another hash
     return (f"cells {cells:g}, steady cycles {steady if steady not in ('', None) else 'auto'}, "
             f"settings hash {digest}"), cells

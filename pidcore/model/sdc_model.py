@@ -377,11 +377,11 @@ def _settings_difference(runs: pd.DataFrame, counts: pd.Series) -> str:
     config_damping_coefficient calibrated"``."""
     import json
 
-    params = {}
-    for digest in counts.index:
-        text = runs.loc[runs["settings_hash"] == digest, "parameters_json"].iloc[0]
-        params[digest] = {k: v for k, v in json.loads(text).items()
-                          if not k.startswith("case_") and k != "config_seed"}
+    from ..compare.align import run_settings
+
+    params = {digest: run_settings(runs.loc[runs["settings_hash"] == digest,
+                                            "parameters_json"].iloc[0])
+              for digest in counts.index}
     keys = sorted({k for p in params.values() for k in p})
     differ = [k for k in keys if len({json.dumps(p.get(k), default=str)
                                       for p in params.values()}) > 1]
