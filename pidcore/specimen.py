@@ -473,14 +473,32 @@ class Specimen:
                          "coupon_plus_particles") -> float:
         """m_c of Eq. 10, kg: coupon + fixture (+ all particles of ``cell.count`` cells)."""
         particles = self.cell.count * particles_per_cell * self.particles.mass_kg
-        rigid = self.coupon.moving_mass_kg
-        if convention == "coupon_plus_particles":
-            return rigid + particles
-        if convention == "coupon":
-            return rigid
-        if convention == "particles":
-            return particles
-        raise ParameterError(f"vibrated_mass: unknown convention {convention!r}")
+        return vibrated_mass_by_convention(convention, rigid_kg=self.coupon.moving_mass_kg,
+                                           particles_kg=particles)
+
+
+def vibrated_mass_by_convention(convention: str, *, rigid_kg: float,
+                                particles_kg: float) -> float:
+    """m_c of Eq. 10, kg, by a named convention (:data:`pidcore.constants.
+    VIBRATED_MASS_CONVENTIONS`): the rigid mass (coupon and fixture) plus the particles, the
+    rigid mass alone, or the particles alone."""
+    if convention == "coupon_plus_particles":
+        return rigid_kg + particles_kg
+    if convention == "coupon":
+        return rigid_kg
+    if convention == "particles":
+        return particles_kg
+    raise ParameterError(f"vibrated_mass: unknown convention {convention!r}")
+
+
+#: What ``pidcore calibrate`` appends to the name of the specimen it calibrates.
+CALIBRATED_SUFFIX = "_calibrated"
+
+
+def uncalibrated_name(name: str) -> str:
+    """The name of the specimen a calibrated one was made from ("x_calibrated" -> "x"); other
+    names unchanged."""
+    return name.removesuffix(CALIBRATED_SUFFIX)
 
 
 # --- schema ---------------------------------------------------------------------------------

@@ -20,7 +20,7 @@ from .. import defaults
 from ..constants import STANDARD_GRAVITY
 from ..dem.simulate import DemConfig, LoadCase
 from ..errors import ParameterError
-from ..specimen import Specimen, paper_specimen
+from ..specimen import CALIBRATED_SUFFIX, Specimen, paper_specimen
 from .data import MeasuredPoint, check_enough_points
 from .observation import Observation, observation_from_run
 from .parameters import CATALOGUE, DISCREPANCY, ParameterSpec, build_specs, parameter_spec
@@ -97,7 +97,7 @@ class CalibrationResult:
             for s in self.specs if s.kind != "hyper"
             for p in (self.parameters[s.name],))
         return dataclasses.replace(
-            out, name=f"{self.specimen.name}_calibrated",
+            out, name=f"{self.specimen.name}{CALIBRATED_SUFFIX}",
             description=f"{self.specimen.description} -- calibrated by pidcore calibrate: "
                         f"{fitted} (these replace any value stated above)".strip(" -"))
 

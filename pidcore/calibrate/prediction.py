@@ -105,14 +105,15 @@ class Calibration:
         """Whether this calibration may predict a measurement of the specimen named
         ``specimen_name`` ("" : not named): the same name as the specimen it calibrates (its
         calibrated file is "<name>_calibrated"), or either unknown."""
+        from ..specimen import uncalibrated_name
+
         calibrated = self.specimen_name
         if not calibrated and specimen_name:
             spec = self.calibrated_specimen()
             calibrated = spec.name if spec is not None else ""
         if not specimen_name or not calibrated:
             return True
-        return calibrated.removesuffix("_calibrated") == specimen_name.removesuffix(
-            "_calibrated")
+        return uncalibrated_name(calibrated) == uncalibrated_name(specimen_name)
 
     def other_specimen_reason(self, specimen) -> str:
         """Why this calibration does not speak for ``specimen`` (another specimen, or one of
@@ -166,7 +167,9 @@ def _other_specimen(calibrated, specimen) -> str:
         return ""
     # the calibrated file is the starting specimen renamed "<name>_calibrated" with fitted
     # contact, coupon or mass values: the cell and the particles say which specimen it is
-    base = calibrated.name.removesuffix("_calibrated")
+    from ..specimen import uncalibrated_name
+
+    base = uncalibrated_name(calibrated.name)
     names = {calibrated.name, base}
     shape = ("shape", "inscribed_diameter_m", "height_m")
     same_cell = all(getattr(calibrated.cell, a) == getattr(specimen.cell, a) for a in shape)

@@ -68,7 +68,13 @@ from ..constants import (
 )
 from ..errors import ParameterError, SimulationError
 from ..loadcase import LoadCase
-from ..specimen import Specimen, contact_law, paper_specimen, particles_for_fill
+from ..specimen import (
+    Specimen,
+    contact_law,
+    paper_specimen,
+    particles_for_fill,
+    vibrated_mass_by_convention,
+)
 from .contact import ContactLaw, check_damping_mode, check_tangential_model
 from .geometry import CellGeometry, cell_capacity, random_packing
 from .result import DemResult
@@ -163,10 +169,11 @@ def coupon_mass_kg() -> float:
 
 def vibrated_mass_kg(convention: VibratedMassConvention, *, particles_per_cell: int,
                      particle_mass_kg: float, cells: int = defaults.COUPON_CELLS) -> float:
-    """m_c of Eq. 10 under a named convention, kg."""
-    particles = cells * particles_per_cell * particle_mass_kg
-    return {"coupon_plus_particles": coupon_mass_kg() + particles,
-            "coupon": coupon_mass_kg(), "particles": particles}[convention]
+    """m_c of Eq. 10 of the paper's coupon under a named convention, kg
+    (:func:`pidcore.specimen.vibrated_mass_by_convention`)."""
+    return vibrated_mass_by_convention(convention, rigid_kg=coupon_mass_kg(),
+                                       particles_kg=cells * particles_per_cell
+                                       * particle_mass_kg)
 
 
 def max_impact_speed(case: LoadCase, geometry: CellGeometry) -> float:

@@ -30,7 +30,7 @@ import pandas as pd
 
 from .. import __version__
 from .. import defaults as D
-from ..constants import STANDARD_GRAVITY
+from ..constants import STANDARD_GRAVITY, VIBRATED_MASS_CONVENTIONS
 from ..errors import ParameterError
 from .sdc_model import SdcModel
 
@@ -206,17 +206,17 @@ def paper_vibrated_mass(convention: str = D.MODEL_VIBRATED_MASS_CONVENTION,
                         material: str = D.MODEL_PARTICLE_MATERIAL) -> Callable[[float], float]:
     """m_c [kg] of Eq. 10 against fill [%] for the paper's coupon (Table 2 masses) with the
     paper's count of particles (:func:`paper_particles_mass_kg`), by ``convention``."""
-    if convention not in ("coupon_plus_particles", "coupon", "particles"):
-        raise ParameterError(f"vibrated mass convention: expected coupon_plus_particles, "
-                             f"coupon or particles, got {convention!r}")
+    from ..specimen import vibrated_mass_by_convention
+
+    if convention not in VIBRATED_MASS_CONVENTIONS:
+        raise ParameterError(f"vibrated mass convention: expected one of "
+                             f"{', '.join(VIBRATED_MASS_CONVENTIONS)}, got {convention!r}")
+    rigid = coupon_vibrated_mass_kg()
 
     def mass(fill_percent: float) -> float:
-        particles = paper_particles_mass_kg(fill_percent, material)
-        if convention == "particles":
-            return particles
-        if convention == "coupon":
-            return coupon_vibrated_mass_kg()
-        return coupon_vibrated_mass_kg(particles_mass_kg=particles)
+        return vibrated_mass_by_convention(
+            convention, rigid_kg=rigid,
+            particles_kg=paper_particles_mass_kg(fill_percent, material))
 
     return mass
 
@@ -236,7 +236,7 @@ def runs_vibrated_mass(runs: pd.DataFrame) -> Callable[[float], float]:
     run's stored ``vibrated_mass_kg`` (a run of another specimen, or of a store written
     before these columns meant what they mean now, is refused, not mixed in).
     """
-    from ..specimen import particles_for_fill
+    from ..specimen import particles_for_fill, vibrated_mass_by_convention
 
     missing = [c for c in (*RUN_MASS_COLUMNS, "fill_percent", "vibrated_mass_kg")
                if c not in runs.columns]
@@ -255,16 +255,13 @@ def runs_vibrated_mass(runs: pd.DataFrame) -> Callable[[float], float]:
     rigid = float(values["coupon_mass_kg"]) + float(values["fixture_mass_kg"])
     per_particle = int(values["coupon_cells"]) * float(values["particle_mass_kg"])
     full = int(values["particles_full_cell"])
-    if convention not in ("coupon_plus_particles", "coupon", "particles"):
+    if convention not in VIBRATED_MASS_CONVENTIONS:
         raise ParameterError(f"DEM runs: unknown vibrated_mass_convention {convention!r}")
 
     def mass(fill_percent: float) -> float:
-        particles = per_particle * particles_for_fill(float(fill_percent), full)
-        if convention == "coupon":
-            return rigid
-        if convention == "particles":
-            return particles
-        return rigid + particles
+        return vibrated_mass_by_convention(
+            convention, rigid_kg=rigid,
+            particles_kg=per_particle * particles_for_fill(float(fill_percent), full))
 
     stored = runs["vibrated_mass_kg"].to_numpy(float)
     rebuilt = np.array([mass(f) for f in runs["fill_percent"].to_numpy(float)])
