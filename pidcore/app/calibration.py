@@ -65,10 +65,12 @@ def points_for_specimen(points: Sequence, specimen) -> tuple[list, str]:
     particle material measured on it (their specimen label is its name, or the name it was
     calibrated from) or on no named specimen; ``note`` says what is left out and why ("" if
     nothing)."""
+    from ..specimen import uncalibrated_name
+
     material = specimen.particles.material
-    # a calibrated file ("<name>_calibrated", as pidcore calibrate names it) is the specimen
-    # its measurements were made on
-    names = {"", specimen.name, specimen.name.removesuffix("_calibrated")}
+    # a calibrated file (as pidcore calibrate names it) is the specimen its measurements
+    # were made on
+    names = {"", specimen.name, uncalibrated_name(specimen.name)}
     kept, other_material, other_specimen = [], {}, {}
     for p in points:
         if str(p.material) != material:
@@ -262,9 +264,3 @@ def available_calibrations(task: CalibrationTask | None,
     return [(None, "no calibration: run one on the Calibrate page (or set "
                    f"{CALIBRATION_ENV_VAR})")]
 
-
-def active_calibration(task: CalibrationTask | None, environ: Mapping[str, str] | None = None,
-                       *, cwd: Path | None = None):
-    """The first of :func:`available_calibrations`: ``(calibration, label)``, or ``(None,
-    reason)``."""
-    return available_calibrations(task, environ, cwd=cwd)[0]

@@ -22,6 +22,7 @@ from pidcore.app.calibration import (
     specimen_label,
 )
 from pidcore.app.tabs import draw_polling, specimen_choice
+from pidcore.specimen import CALIBRATED_SUFFIX
 
 #: Seconds between refreshes of the calibration's state while it runs.
 REFRESH_S = 2.0
@@ -64,7 +65,7 @@ def _task(stores, chosen: str, polling: bool) -> None:
     files = [n for n in sorted(out) if Path(n).suffix in mimes]
     for col, name in zip(st.columns(max(len(files), 1)), files, strict=False):
         # the calibrated specimen file saves under its specimen's name
-        file_name = f"{task.specimen}_calibrated.toml" \
+        file_name = f"{task.specimen}{CALIBRATED_SUFFIX}.toml" \
             if name.endswith(".toml") and task.specimen else name
         label = "calibrated specimen (TOML)" if name.endswith(".toml") else name
         col.download_button(label, out[name], file_name=file_name,
@@ -90,13 +91,21 @@ def render(stores) -> None:
         st.info(f"{stores.path} holds no saved measurements with a load case yet: analyse "
                 "files on the Analyse tab and Save them.")
         return
+    chosen_label = _form(stores, api, points)
+    # the running or finished calibration, whichever specimen is chosen now
+    draw_polling(_task, stores, chosen_label, polling=_running(stores), every_s=REFRESH_S)
+
+
+def _form(stores, api, points: list) -> str:
+    """The specimen, cases and parameters to calibrate, and Run; returns the chosen
+    specimen's name as the result below is compared with it."""
+    from pidcore.errors import PidcoreError
+
     specimen, refused = specimen_choice("calibration")
-    chosen_label = "a refused specimen file" if refused is not None else \
-        specimen_label(specimen)
     if refused is not None:  # nothing runs, and no fallback to the paper's coupon
         st.info("Run is off until the specimen file is fixed or another is chosen.")
-        draw_polling(_task, stores, chosen_label, polling=_running(stores), every_s=REFRESH_S)
-        return
+        return "a refused specimen file"
+    chosen_label = specimen_label(specimen)
     cases_key = "calibration_cases"
     if specimen is not None:
         points, note = points_for_specimen(points, specimen)
@@ -106,9 +115,7 @@ def render(stores) -> None:
             st.info(f"No saved measurement is of specimen {specimen.name} "
                     f"({specimen.particles.material} particles) or of an unnamed specimen of "
                     "them.")
-            draw_polling(_task, stores, chosen_label, polling=_running(stores),
-                         every_s=REFRESH_S)
-            return
+            return chosen_label
         cases_key = f"calibration_cases_{specimen.hash[:12]}"  # its own choice of cases
     by_material = points_by_material(points)
     if specimen is None:  # the paper's coupon holds table particles only
@@ -120,9 +127,7 @@ def render(stores) -> None:
                        "specimen file: choose it above.")
         by_material = {m: p for m, p in by_material.items() if m in PARTICLE_MATERIALS}
         if not by_material:
-            draw_polling(_task, stores, chosen_label, polling=_running(stores),
-                         every_s=REFRESH_S)
-            return
+            return chosen_label
         points = [p for group in by_material.values() for p in group]
     if len(by_material) > 1:  # one specimen at a time: its particle material first
         material = st.selectbox("particle material (one calibration per material)",
@@ -168,4 +173,4 @@ def render(stores) -> None:
         else:
             if started is None:
                 st.warning("a calibration is running already; wait for it to finish")
-    draw_polling(_task, stores, chosen_label, polling=_running(stores), every_s=REFRESH_S)
+    return chosen_label
