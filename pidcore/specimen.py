@@ -387,6 +387,19 @@ class Specimen:
         except ParameterError as exc:
             raise ParameterError(f"{source}: {exc}") from None
 
+    @classmethod
+    def from_bytes(cls, data: bytes, *, source: str = "<specimen>") -> Specimen:
+        """Decode (UTF-8, a byte-order mark allowed) and parse a specimen file's bytes; a file
+        that is not UTF-8 is one line naming ``source`` and the line of the bad byte."""
+        try:
+            # utf-8-sig: Windows editors write a byte-order mark, which TOML does not allow
+            text = data.decode("utf-8-sig")
+        except UnicodeDecodeError as exc:
+            line = data[:exc.start].count(b"\n") + 1
+            raise ParameterError(f"{source}: not UTF-8 text (byte 0x{data[exc.start]:02x} on "
+                                 f"line {line}); save the specimen file as UTF-8") from None
+        return cls.from_text(text, source=source)
+
     def with_values(self, values: Mapping[str, Any]) -> Specimen:
         """A new specimen with fields replaced by dotted path, checked like a file.
 
@@ -739,14 +752,7 @@ def load_specimen(path: str | os.PathLike[str]) -> Specimen:
         data = path.read_bytes()
     except OSError as exc:
         raise ParameterError(f"{path}: cannot read specimen file ({exc.strerror})") from None
-    try:
-        # utf-8-sig: Windows editors write a byte-order mark, which TOML does not allow
-        text = data.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        line = data[:exc.start].count(b"\n") + 1
-        raise ParameterError(f"{path}: not UTF-8 text (byte 0x{data[exc.start]:02x} on "
-                             f"line {line}); save the specimen file as UTF-8") from None
-    return Specimen.from_text(text, source=str(path))
+    return Specimen.from_bytes(data, source=str(path))
 
 
 @functools.cache

@@ -906,8 +906,16 @@ def test_a_job_before_its_first_block_shows_starting_and_no_eta(tmp_path):
 def test_an_uploaded_specimen_error_names_the_users_file():
     with pytest.raises(ParameterError, match=r"^syntax\.toml: not valid TOML"):
         jobs.specimen_from_upload("syntax.toml", b"name = 'x'\n[cell\n")
-    with pytest.raises(ParameterError, match="syntax.toml: not a text file"):
+    with pytest.raises(ParameterError, match=r"syntax\.toml: not UTF-8 text \(byte 0xff on "
+                                             r"line 1\)"):
         jobs.specimen_from_upload("syntax.toml", b"\xff\xfe")
+    # decoded as a file on disk is: an editor's byte-order mark was refused as "not valid
+    # TOML" on upload while the same file loaded from disk
+    from pidcore.specimen import load_specimen
+
+    path = Path(__file__).resolve().parents[1] / "data_samples" / "specimens" / "steel_6mm.toml"
+    uploaded = jobs.specimen_from_upload("steel_6mm.toml", b"\xef\xbb\xbf" + path.read_bytes())
+    assert uploaded.hash == load_specimen(path).hash
 
 
 @pytest.mark.parametrize("fills", [[40.0], [25.0, 50.0, 75.0, 90.0], [37.5, 39.13, 50.0]])

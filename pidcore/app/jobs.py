@@ -391,8 +391,5 @@ def specimen_from_upload(name: str, data: bytes):
     :class:`ParameterError` naming the user's file, not a temporary copy."""
     from ..specimen import Specimen
 
-    try:
-        text = data.decode("utf-8")
-    except UnicodeDecodeError:
-        raise ParameterError(f"{name}: not a text file (UTF-8)") from None
-    return Specimen.from_text(text, source=name)
+    # decoded as a file on disk is (a byte-order mark allowed): an upload refused it
+    return Specimen.from_bytes(data, source=name)
