@@ -20,12 +20,13 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from .. import defaults
 from ..errors import InputFileError, ParameterError
 
 REQUIRED_COLUMNS = ("frequency_hz", "acceleration_g", "fill_percent", "sdc")
 OPTIONAL_COLUMNS = ("sdc_stderr", "energy_per_cycle_j", "material", "specimen")
 #: Material of a measurement that states none (the paper's particles).
-DEFAULT_MATERIAL = "acrylic"
+DEFAULT_MATERIAL = defaults.COMPARE_DEFAULT_MATERIAL
 
 
 @dataclass(frozen=True)
@@ -167,14 +168,14 @@ def measured_from_store(store_path: str | os.PathLike) -> list[MeasuredPoint]:
     return points
 
 
-def check_enough_points(points: list[MeasuredPoint], names: Sequence[str] | int) -> None:
-    """Refuse fewer measured load cases than fitted parameters (``names``, or their count);
-    the message lists them, since one (the model discrepancy) is fitted unless fixed."""
-    n_parameters = names if isinstance(names, int) else len(names)
+def check_enough_points(points: list[MeasuredPoint], names: Sequence[str]) -> None:
+    """Refuse fewer measured load cases than fitted parameters (``names``); the message lists
+    them, since one (the model discrepancy) is fitted unless fixed."""
+    n_parameters = len(names)
     if len(points) < n_parameters:
-        listed = "" if isinstance(names, int) else f": {', '.join(names)}"
-        fixed = "" if isinstance(names, int) or "model_discrepancy" not in names else \
-            " (fix model_discrepancy with --discrepancy TAU)"
+        listed = f": {', '.join(names)}"
+        fixed = " (fix model_discrepancy with --discrepancy TAU)" \
+            if "model_discrepancy" in names else ""
         raise ParameterError(f"{len(points)} measured load case(s) cannot determine "
                              f"{n_parameters} fitted parameter(s){listed}; give at least "
                              f"{n_parameters} load cases or fit fewer parameters{fixed}")
