@@ -65,7 +65,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from ..calibrate.calibrate import CALIBRATION_CELLS, calibrate
-    from ..calibrate.data import measured_from_store, read_measured_table
+    from ..calibrate.data import DEFAULT_MATERIAL, measured_from_store, read_measured_table
     from ..calibrate.outputs import document_json, write_outputs
     from ..calibrate.parameters import parse_fit
     from ..errors import ParameterError
@@ -79,7 +79,8 @@ def run(args: argparse.Namespace) -> int:
                              f"got {cells}")
     # a table row without a material is of the specimen given (as in `pidcore compare
     # --specimen`); a stated material other than the specimen's is refused by calibrate()
-    default_material = specimen.particles.material if specimen is not None else "acrylic"
+    default_material = specimen.particles.material if specimen is not None \
+        else DEFAULT_MATERIAL
     points = read_measured_table(args.data, default_material=default_material) \
         if args.data is not None else measured_from_store(args.store)
     result = calibrate(points, fit=fit, priors=args.prior, discrepancy=args.discrepancy,

@@ -21,6 +21,7 @@ from typing import NamedTuple
 import numpy as np
 import pandas as pd
 
+from .. import defaults
 from ..compare.align import (
     Aligner,
     DemCase,
@@ -391,7 +392,8 @@ def add_calibration_columns(table: pd.DataFrame, calibration, *,
     for _, row in out.iterrows():
         note = str(row.get("note", "") or "")
         case = LoadCase(float(row["frequency [Hz]"]), float(row["acceleration [g]"]),
-                        float(row["packing ratio [%]"]), str(row.get("material") or "acrylic"))
+                        float(row["packing ratio [%]"]),
+                        str(row.get("material") or defaults.COMPARE_DEFAULT_MATERIAL))
         if case.material not in reasons:
             of_row = specimen
             if of_row is None and paper and case.material in PARTICLE_MATERIALS:
