@@ -281,6 +281,13 @@ def measurement_materials(extra: Iterable[object] = ()) -> tuple[str, ...]:
     return (*names[:len(PARTICLE_MATERIALS)], *sorted(names[len(PARTICLE_MATERIALS):]))
 
 
+def specimen_files(folders: Iterable[str | os.PathLike]) -> list[Path]:
+    """The specimen files (``*.toml``) in ``folders``, folder by folder, each sorted; a folder
+    that does not exist has none."""
+    return [path for folder in map(Path, folders) if folder.is_dir()
+            for path in sorted(folder.glob("*.toml"))]
+
+
 def specimen_materials(folders: Iterable[str | os.PathLike]) -> list[str]:
     """Particle materials of the specimen files (``*.toml``) in ``folders`` (the DEM page's
     specimen folders): a measurement of an own specimen may state its material before any DEM
@@ -288,15 +295,11 @@ def specimen_materials(folders: Iterable[str | os.PathLike]) -> list[str]:
     from ..specimen import load_specimen
 
     found = []
-    for folder in folders:
-        folder = Path(folder)
-        if not folder.is_dir():
+    for path in specimen_files(folders):
+        try:
+            found.append(load_specimen(path).particles.material)
+        except (PidcoreError, OSError, ValueError):
             continue
-        for path in sorted(folder.glob("*.toml")):
-            try:
-                found.append(load_specimen(path).particles.material)
-            except (PidcoreError, OSError, ValueError):
-                continue
     return found
 
 

@@ -31,11 +31,11 @@ def specimen_choice(key: str):
     ``{key}_specimen_file``."""
     from pidcore import defaults
     from pidcore.app import jobs
+    from pidcore.app.uploads import specimen_files
     from pidcore.errors import PidcoreError
     from pidcore.specimen import load_specimen
 
-    files = sorted(p for folder in defaults.APP_SPECIMEN_FOLDERS if folder.is_dir()
-                   for p in folder.glob("*.toml"))
+    files = sorted(specimen_files(defaults.APP_SPECIMEN_FOLDERS))
     c1, c2 = st.columns(2)
     upload = c2.file_uploader("or a specimen file (TOML)", type=["toml"],
                               key=f"{key}_specimen_file")
