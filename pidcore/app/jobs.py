@@ -363,9 +363,10 @@ def steady_state_text(detected) -> str:
     """A run's ``steady_detected`` in a word that fits its column at 1280 px: "reached", or
     "NOT reached" (``pidcore dem run``: "NOT converged, transient cap"); empty where the run
     does not say."""
-    if detected is None or (isinstance(detected, float) and detected != detected):
-        return ""
-    return "reached" if bool(detected) else "NOT reached"
+    from ..compare.align import steady_stated
+
+    stated = steady_stated(detected)
+    return "" if stated is None else "reached" if stated else "NOT reached"
 
 
 def dem_runs_table(runs):

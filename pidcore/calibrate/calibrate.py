@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import defaults
+from ..compare.align import steady_stated
 from ..constants import STANDARD_GRAVITY
 from ..dem.simulate import DemConfig, LoadCase
 from ..errors import ParameterError
@@ -247,7 +248,7 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: Sequence[str],
             entry = store.get_dem_run(request.key())
             obs.append(observation_from_run(entry.record, entry.arrays,
                                             coupon_mass_kg=specimen.coupon.mass_kg))
-            if str(entry.record.get("steady_detected", True)).lower() == "false":  # np.bool_
+            if steady_stated(entry.record.get("steady_detected")) is False:
                 unsteady[point.label()] = unsteady.get(point.label(), 0) + 1
         observations.append(obs)
     if unsteady:

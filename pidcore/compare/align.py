@@ -374,16 +374,21 @@ def dem_cases(dem_runs: pd.DataFrame, *, tolerances: Tolerances | None = None,
     return sorted(out, key=lambda c: (*_sort_key(c.load_case), c.settings))
 
 
+def steady_stated(detected) -> bool | None:
+    """A DEM run's ``steady_detected`` as stored (bool, or 0/1 as the store reads it back):
+    True/False, or None where the run does not say (None/NaN: older stores)."""
+    if detected is None or (isinstance(detected, float) and math.isnan(detected)):
+        return None
+    return bool(detected)
+
+
 def _not_converged(runs: pd.DataFrame) -> tuple[tuple[int, int], ...]:
     """(steady_start_cycle, steady_cycles) of the runs that state steady_detected false."""
     if "steady_detected" not in runs:
         return ()
     out = []
     for _, run in runs.iterrows():
-        detected = run["steady_detected"]
-        # None/NaN: a run that does not say (older stores); only a stated False is flagged
-        if detected is None or (isinstance(detected, float) and math.isnan(detected)) \
-                or bool(detected):
+        if steady_stated(run["steady_detected"]) is not False:  # only a stated False
             continue
         start, cycles = (run.get(name) for name in ("steady_start_cycle", "steady_cycles"))
         out.append((int(start) if _finite(start) else -1, int(cycles) if _finite(cycles) else -1))
