@@ -45,9 +45,10 @@ def _cancel(stores) -> None:
 def _job_table(stores, polling: bool) -> None:
     # a fragment (see draw_polling): rerun every REFRESH_S while jobs are queued or running
     runner = jobs.runner_for(stores.path)
-    rows = [j.row() for j in runner.jobs()]
+    listed = runner.jobs()  # one locked copy for the table and the progress bar
+    rows = [j.row() for j in listed]
     busy = runner.busy()
-    running = [j for j in runner.jobs() if j.state == "running"]
+    running = [j for j in listed if j.state == "running"]
     if running:
         st.progress(running[0].fraction(), text=running[0].progress_text())
     if rows:
