@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 import re
+from collections.abc import Hashable, Iterable
 from dataclasses import dataclass
 
 from . import defaults
@@ -203,3 +204,23 @@ def parse_values(text: str, *, name: str) -> list[float]:
 __all__ = ["KEY_PATTERN", "KEY_PATTERN_0_1", "LoadCase", "LoadCaseError", "check_fill",
            "key_0_1", "normalize_material", "normalize_direction", "parse_key",
            "parse_values"]
+
+
+def refuse_identical_contents_stating_apart(files: Iterable[tuple[str, str, Hashable, str]],
+                                            *, remedy: str = "") -> None:
+    """Refuse byte-identical files that state different load cases, as :class:`LoadCaseError`.
+
+    ``files``: per file (name, content key, what it states, that statement in words); the
+    content key is the file's SHA-256 or the store's key of it ("" when unknown: not
+    compared). Identical bytes are one measurement (the store keeps one record of them), so
+    two statements about it cannot both hold; ``remedy`` ends the message.
+    """
+    first: dict[str, tuple[str, Hashable, str]] = {}
+    for name, key, stated, words in files:
+        if not key:
+            continue
+        other = first.setdefault(key, (name, stated, words))
+        if other[1] != stated:
+            raise LoadCaseError(f"{name} and {other[0]} have identical contents but state "
+                                f"different load cases ({words} vs {other[2]})"
+                                + (f"; {remedy}" if remedy else ""))

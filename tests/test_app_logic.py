@@ -1095,6 +1095,11 @@ def test_identical_files_stating_different_load_cases_are_not_saved_together(tmp
                                              r"contents but state different load cases"):
         uploads.save_records(tmp_path / "s.h5", both)
     assert not (tmp_path / "s.h5").exists() or Store(tmp_path / "s.h5").list_analyses().empty
+    # the same load case stated on two specimens: the message tells the statements apart
+    # (it read "(case vs case)" when only the specimen differed)
+    apart = [_file(a, options, specimen="panel_A"), _file(b, options, specimen="panel_B")]
+    with pytest.raises(ParameterError, match=r"on panel_B vs .* on panel_A\)"):
+        uploads.save_records(tmp_path / "s.h5", apart)
     same = [_file(a, options), _file(_record(good_csv, options, name="copy.csv"), options)]
     assert len(set(uploads.save_records(tmp_path / "s.h5", same).keys)) == 1
 

@@ -566,20 +566,16 @@ def check_one_load_case_per_content(files: Sequence[AnalysedFile]) -> None:
     """Refuse byte-identical files that state different load cases (or specimens): the store
     keeps one record of them, so one statement would silently replace the other (as
     ``pidcore report`` refuses them)."""
+    from ..loadcase import refuse_identical_contents_stating_apart
     from ..records import measurement_key
 
-    first: dict[str, AnalysedFile] = {}
-    for f in files:
-        key = measurement_key(f.record.measurement)
-        other = first.setdefault(key, f)
-        if other is not f and (other.load_case.key, other.specimen) != (f.load_case.key,
-                                                                        f.specimen):
-            raise ParameterError(
-                f"{Path(f.record.measurement.source).name} and "
-                f"{Path(other.record.measurement.source).name} have identical contents but "
-                f"state different load cases ({f.load_case.full_label()} vs "
-                f"{other.load_case.full_label()}); one measurement is "
-                "one record: state one load case, or remove one of the files")
+    def words(f: AnalysedFile) -> str:
+        return f.load_case.full_label() + (f" on {f.specimen}" if f.specimen else "")
+
+    refuse_identical_contents_stating_apart(
+        ((Path(f.record.measurement.source).name, measurement_key(f.record.measurement),
+          (f.load_case.key, f.specimen), words(f)) for f in files),
+        remedy="one measurement is one record: state one load case, or remove one of the files")
 
 
 def saved_count(files: Sequence[AnalysedFile]) -> int:

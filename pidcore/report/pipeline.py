@@ -24,9 +24,10 @@ import numpy as np
 import pandas as pd
 
 from ..compare.align import Aligner, Tolerances, dem_cases
-from ..compare.loadcase import LoadCase, LoadCaseError, StatedLoadCase, resolve_load_case
+from ..compare.loadcase import LoadCase, StatedLoadCase, resolve_load_case
 from ..constants import REPORT_FORMATS
 from ..errors import ParameterError, StoreError
+from ..loadcase import refuse_identical_contents_stating_apart
 from .provenance import collect_provenance
 from .render import check_out_dir, parse_formats, write_report
 from .table import add_calibration_columns, build_report_table
@@ -147,26 +148,24 @@ def analyze_files(paths: Sequence[str | Path], *, fill_percent: float | None = N
     stated = [resolve_load_case(p, fill_percent=fill_percent, material=material,
                                 direction=direction, sidecar=sidecar,
                                 specimen_material=specimen_material) for p in paths]
-    out: list[MeasuredResult] = []
-    seen: dict[str, MeasuredResult] = {}
+    results = []
     for path, st in zip(paths, stated, strict=True):
         analyzed = analyze_file(path, options)
         a = analyzed.analysis
-        result = MeasuredResult(Path(path), analyzed, st,
-                                st.load_case(a.frequency_hz, a.acceleration_g))
-        sha = analyzed.measurement.sha256
-        twin = seen.get(sha) if sha else None
-        if twin is not None:
-            # Identical bytes are one measurement (the store keeps it once); it cannot belong to
-            # two load cases, and counting it twice would shrink the pooled standard error.
-            if twin.load_case.key != result.load_case.key:
-                raise LoadCaseError(f"{Path(path).name} and {twin.path.name} have identical "
-                                    f"contents but state different load cases "
-                                    f"({result.load_case.key} vs {twin.load_case.key})")
+        results.append(MeasuredResult(Path(path), analyzed, st,
+                                      st.load_case(a.frequency_hz, a.acceleration_g)))
+    # Identical bytes are one measurement (the store keeps it once); it cannot belong to two
+    # load cases, and counting it twice would shrink the pooled standard error.
+    refuse_identical_contents_stating_apart(
+        (r.path.name, r.measurement.sha256, r.load_case.key, r.load_case.key) for r in results)
+    out: list[MeasuredResult] = []
+    seen: set[str] = set()
+    for r in results:
+        sha = r.measurement.sha256
+        if sha and sha in seen:
             continue
-        if sha:
-            seen[sha] = result
-        out.append(result)
+        seen.add(sha)
+        out.append(r)
     return out
 
 
@@ -234,21 +233,16 @@ def _specimen_provenance(specimen) -> list[tuple[str, str]]:
 
 
 def _other_specimens(stored: pd.DataFrame, kept: pd.DataFrame) -> str:
-    """"4 run(s) of other specimens: 3 of a [1b8b5d], 1 of b [b0826e]" for the runs of
-    ``stored`` not in ``kept``; "" if none. The hash is named too: an edited specimen file
-    keeps its name but is another specimen."""
+    """"4 run(s) of other specimens: 3 of a [1b8b5d], 1 of paper_coupon" for the runs of
+    ``stored`` not in ``kept``; "" if none. Labelled as Compare labels them
+    (:func:`~pidcore.compare.specimens.run_specimen_labels`): the hash is named too, as an
+    edited specimen file keeps its name but is another specimen."""
+    from ..compare.specimens import run_specimen_labels
+
     left_out = stored[~stored["case_key"].isin(set(kept["case_key"]))]
     if left_out.empty:
         return ""
-
-    def column(name: str) -> pd.Series:
-        if name not in left_out.columns:
-            return pd.Series([""] * len(left_out), index=left_out.index)
-        return left_out[name].fillna("").astype(str)
-
-    labels = [f"{n or 'unnamed'} [{h[:6]}]" if h else (n or "unnamed")
-              for n, h in zip(column("specimen_name"), column("specimen_sha256"), strict=True)]
-    counts = pd.Series(labels).value_counts(sort=False)
+    counts = run_specimen_labels(left_out).value_counts(sort=False)
     return (f"{len(left_out)} run(s) of other specimens: "
             + ", ".join(f"{n} of {label}" for label, n in counts.items()))
 
@@ -408,10 +402,11 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         stored = dem_runs
         dem_runs = runs_of_specimen(stored, specimen)
         others = _other_specimens(stored, dem_runs)
+        from ..compare.specimens import specimen_label
         from ..specimen import paper_specimen
 
         # the default takes the paper's coupon with either table material: no one hash
-        name = (f"{specimen.name} [{specimen.hash[:6]}]" if specimen is not None else
+        name = (specimen_label(specimen.name, specimen.hash) if specimen is not None else
                 f"{paper_specimen().name} (the default; --specimen FILE for another)")
         if dem_runs.empty:
             notes.append(f"{dem_path}: holds no DEM runs of specimen {name} ({others})")
