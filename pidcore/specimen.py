@@ -611,12 +611,19 @@ def _table_material(name: str, where: str, role: str | None):
 #: (section, key, materials.csv column, attribute holding the material name) of each inline
 #: property that may differ from its table material's (:func:`table_overrides`; a particle's
 #: radius is only a default, free to differ).
-_OVERRIDABLE = (("particles", "density_kg_m3", "density_kg_m3", "material"),
-                ("particles", "youngs_modulus_pa", "youngs_modulus_pa", "material"),
-                ("particles", "poisson_ratio", "poisson_ratio", "material"),
-                ("cell", "wall_density_kg_m3", "density_kg_m3", "wall_material"),
-                ("cell", "wall_youngs_modulus_pa", "youngs_modulus_pa", "wall_material"),
-                ("cell", "wall_poisson_ratio", "poisson_ratio", "wall_material"))
+#: Keys a material's row completes (key, materials.csv column), in the order a missing one
+#: is named: the cell's walls and the particles; the particles' radius is the row's default.
+_WALL_FROM_MATERIAL = (("wall_youngs_modulus_pa", "youngs_modulus_pa"),
+                       ("wall_poisson_ratio", "poisson_ratio"),
+                       ("wall_density_kg_m3", "density_kg_m3"))
+_PARTICLE_FROM_MATERIAL = (("density_kg_m3", "density_kg_m3"),
+                           ("youngs_modulus_pa", "youngs_modulus_pa"),
+                           ("poisson_ratio", "poisson_ratio"))
+#: (section, key, column, material key) of the properties a table material's name claims.
+_OVERRIDABLE = (tuple(("particles", key, column, "material")
+                      for key, column in _PARTICLE_FROM_MATERIAL)
+                + tuple(("cell", key, column, "wall_material")
+                        for key, column in _WALL_FROM_MATERIAL))
 
 
 def table_overrides(specimen: Specimen) -> tuple[str, ...]:
@@ -673,17 +680,12 @@ def _from_mapping(data: Mapping[str, Any], *, source: str) -> Specimen:
 
     cell = _take(data["cell"], "cell", "[cell]")
     _complete_from_material(cell, "[cell] wall_material", cell["wall_material"], None,
-                            (("wall_youngs_modulus_pa", "youngs_modulus_pa"),
-                             ("wall_poisson_ratio", "poisson_ratio"),
-                             ("wall_density_kg_m3", "density_kg_m3")))
+                            _WALL_FROM_MATERIAL)
 
     particles = _take(data["particles"], "particles", "[particles]")
     _complete_from_material(particles, "[particles] material", particles["material"],
                             "particle",
-                            (("density_kg_m3", "density_kg_m3"),
-                             ("youngs_modulus_pa", "youngs_modulus_pa"),
-                             ("poisson_ratio", "poisson_ratio"),
-                             ("radius_m", "default_radius_m")))
+                            _PARTICLE_FROM_MATERIAL + (("radius_m", "default_radius_m"),))
 
     pairs_table = data["pairs"]
     if not isinstance(pairs_table, Mapping):
