@@ -47,6 +47,25 @@ def test_masses_of_a_mass_damper_bed_are_exact():
     assert obs.dissipative_mass_stderr_kg == pytest.approx(0.0, abs=1e-12)
 
 
+def test_a_bed_pulling_against_the_walls_is_observed_not_refused():
+    # A bed moving against the cell (reactive part < 0, e.g. near its column resonance) is
+    # no inverted sensor: the calibration adds the coupon's and fixture's inertia itself.
+    # It was refused as "probably inverted" and stopped the README's calibration (500 Hz,
+    # 10 g, 4 cells). Analytic truth: m_p = -m exactly, and the whole shaker force is
+    # mass-like again, so Eq. 11 of it must equal the observation's SDC.
+    m, c, fixture, eta0 = -0.0153, 2.7, 0.08, 0.012
+    record, arrays, t, velocity, accel = _synthetic(m, c)
+    obs = observation_from_run(record, arrays)
+    assert obs.reactive_mass_kg == pytest.approx(m, rel=1e-9)
+    m_s = record["coupon_mass_kg"] + fixture
+    total = arrays["wall_force_n"] + m_s * accel + eta0 * 2 * math.pi * F_HZ * m_s * velocity
+    measured = analyze_power(total, velocity, FS_HZ, frequency_hz=F_HZ).sdc
+    assert obs.sdc(fixture, eta0) == pytest.approx(measured, rel=1e-7)
+    # a measurement of such a force alone is still refused (an inverted channel)
+    with pytest.raises(Exception, match="probably inverted"):
+        analyze_power(arrays["wall_force_n"], velocity, FS_HZ, frequency_hz=F_HZ)
+
+
 def test_fixture_mass_and_baseline_equal_eq11_of_the_whole_shaker_force():
     # a structure of mass m_s with loss factor eta_0 is a mass plus a damper eta_0 w m_s; the
     # observation model must give what Eq. 11 (analyze_power) gives for the total gauge force

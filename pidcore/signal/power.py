@@ -312,7 +312,8 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
                   min_periods: int = defaults.MIN_PERIODS,
                   source: str = "",
                   force_name: str = "force",
-                  velocity_name: str = "velocity") -> PowerAnalysis:
+                  velocity_name: str = "velocity",
+                  require_mass_like: bool = True) -> PowerAnalysis:
     """Complex power, loss factor and SDC of a sine-driven force/velocity record (Eq. 8-11).
 
     Parameters
@@ -343,7 +344,11 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
         Fewest drive periods accepted.
     source, force_name, velocity_name : str
         Names used in messages and in the result.
-
+    require_mass_like : bool
+        Refuse a reactive power Im(P_c) <= 0 (default; a measured structure is mass-like, so
+        it means an inverted channel). False for a DEM particle bed's own wall force, whose
+        reactive part may be either sign (the structure's mass is added by the caller); the
+        loss factor, SDC and damping ratio are then NaN or negative and say so.
     Returns
     -------
     PowerAnalysis
@@ -436,7 +441,7 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
                                      None if a_fit is None else a_fit.total[0],
                                      harmonics, omega, **kw)
     p_c = complex(p_c)
-    if not p_c.imag > 0:
+    if require_mass_like and not p_c.imag > 0:
         # There is no negative mass: a driven structure above its suspension resonance is
         # mass-like, Im(P_c) > 0. A negative reactive power is almost always one channel with
         # the wrong sign (sensor mounted the other way, a -Z direction not applied), or, with
@@ -452,7 +457,7 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
             f"{source or 'record'}: reactive power Im(P_c) = {p_c.imag:.4g} var <= 0 (no "
             f"positive kinetic energy: a mass-like structure gives Im(P_c) > 0); {cause}")
 
-    loss_raw = p_c.real / p_c.imag
+    loss_raw = p_c.real / p_c.imag if p_c.imag != 0 else math.nan
     if baseline_loss_factor > 0 and not loss_raw > baseline_loss_factor:
         # subtracting it would give zero or negative damping: energy created per cycle
         raise ParameterError(
