@@ -58,6 +58,23 @@ def test_bounds_excluding_the_prior_are_refused(capsys, tmp_path):
                                 "fixture_mass_kg=0.5:0.1"], "fixture_mass_kg", "empty")
 
 
+def test_an_out_that_is_a_file_and_a_negative_seed_are_refused_before_any_run(capsys,
+                                                                              tmp_path):
+    # --out FILE gave a FileExistsError traceback after the whole calibration had run;
+    # --seed -1 a traceback from numpy's generator
+    existing = tmp_path / "existing.txt"
+    existing.write_text("keep")
+    _refused(capsys, tmp_path, ["--data", str(_table(tmp_path)), "--fit", "fixture_mass_kg",
+                                "--out", str(existing)], "--out", "existing.txt", "not a folder")
+    assert existing.read_text() == "keep"
+    with pytest.raises(SystemExit) as stop:  # argparse's own refusal, as from the shell
+        main(["calibrate", "--data", str(_table(tmp_path)), "--fit", "fixture_mass_kg",
+              "--seed", "-1", "--dem-store", str(tmp_path / "dem.h5"), *TINY])
+    assert stop.value.code == 2 and "--seed: expected a whole number >= 0" in \
+        capsys.readouterr().err
+    assert not (tmp_path / "dem.h5").exists()
+
+
 def test_fewer_load_cases_than_parameters_are_refused(capsys, tmp_path):
     # two points cannot fix fixture mass, baseline and the model discrepancy
     path = _table(tmp_path, HEADER + "500,5,50,0.6\n1000,5,50,0.6\n")

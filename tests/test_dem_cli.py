@@ -189,6 +189,27 @@ def test_a_fill_outside_0_100_is_one_line_naming_the_option(capsys, fill):
     assert f"--fill {fill}: expected a fill in (0, 100] %" in err
 
 
+@pytest.mark.parametrize("command", [
+    ["dem", "run", "--frequency", "500", "--acceleration", "5", "--fill", "50"],
+    ["dem", "sweep", "--frequencies", "500", "--accelerations", "5", "--fills", "50"]])
+def test_a_negative_seed_is_one_line_naming_the_option(tmp_path, capsys, command):
+    # numpy's generators take no negative seed: it was a traceback from inside the run
+    store = tmp_path / "s.h5"
+    with pytest.raises(SystemExit) as stop:  # argparse's own refusal, as from the shell
+        main([*command, "--seed", "-1", "--store", str(store), "--no-progress"])
+    err = capsys.readouterr().err
+    assert stop.value.code == 2 and "--seed: expected a whole number >= 0" in err
+    assert not store.exists()
+
+
+def test_a_negative_seed_is_refused_by_the_library_too():
+    from pidcore.dem.simulate import DemConfig
+    from pidcore.errors import ParameterError
+
+    with pytest.raises(ParameterError, match="seed: expected a whole number >= 0, got -1"):
+        DemConfig(seed=-1)
+
+
 def test_no_fill_and_no_specimen_says_what_to_give(capsys):
     # it said "the specimen states no count_per_cell" where no specimen was given
     code = main(["dem", "run", "--frequency", "500", "--acceleration", "5"])

@@ -7,6 +7,7 @@ import sys
 from pathlib import Path
 
 from .. import defaults
+from ._options import non_negative_int
 
 DEFAULT_STORE = Path("calibration_store.h5")
 
@@ -48,7 +49,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help="steady cycles measured per DEM run (default: the DEM's)")
     p.add_argument("--design-size", metavar="N", type=int, default=None,
                    help="DEM design points (default: enough for a quadratic surrogate)")
-    p.add_argument("--seed", type=int, default=defaults.DEM_SEED, help="DEM seed")
+    p.add_argument("--seed", type=non_negative_int, default=defaults.DEM_SEED,
+                   help="DEM seed")
     p.add_argument("--workers", type=int, default=2, help="DEM processes (default 2)")
     p.add_argument("--method", choices=("auto", "grid", "emcee"), default="auto",
                    help="posterior: exact grid (<= 3 quantities) or emcee; auto picks")
@@ -71,6 +73,9 @@ def run(args: argparse.Namespace) -> int:
     from ..errors import ParameterError
     from ..specimen import load_specimen
 
+    if args.out is not None and args.out.exists() and not args.out.is_dir():
+        # said before the DEM runs and the fit, not after them
+        raise ParameterError(f"--out {args.out}: exists and is not a folder")
     specimen = load_specimen(args.specimen) if args.specimen is not None else None
     fit = parse_fit(args.fit, specimen)
     cells = CALIBRATION_CELLS if args.cells is None else args.cells

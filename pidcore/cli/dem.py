@@ -20,7 +20,7 @@ from ..constants import (
     VIBRATED_MASS_CONVENTIONS,
 )
 from ..errors import ParameterError
-from ._options import add_json_option, add_store_option, positive_int
+from ._options import add_json_option, add_store_option, non_negative_int, positive_int
 
 #: Keys of ``pidcore dem run --json`` (more may follow them).
 JSON_KEYS = ("sdc", "sdc_stderr", "energy_per_cycle_j", "energy_dissipated_normal_j",
@@ -71,7 +71,7 @@ def _add_config_options(p: argparse.ArgumentParser) -> None:
     """Options of DemConfig and of the load case shared by ``run`` and ``sweep``."""
     p.add_argument("--cells", metavar="K", type=int, default=defaults.DEM_CELLS,
                    help=f"independent cells simulated (default {defaults.DEM_CELLS})")
-    p.add_argument("--seed", metavar="S", type=int, default=defaults.DEM_SEED,
+    p.add_argument("--seed", metavar="S", type=non_negative_int, default=defaults.DEM_SEED,
                    help=f"random seed of the packings (default {defaults.DEM_SEED})")
     p.add_argument("--specimen", metavar="FILE", type=Path, default=None,
                    help="specimen file (cell, coupon and fixture masses, particles, contact "

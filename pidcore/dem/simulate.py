@@ -124,6 +124,8 @@ class DemConfig:
     def __post_init__(self):
         if self.cells < 1:
             raise ParameterError(f"cells: expected >= 1, got {self.cells}")
+        if not 0 <= self.seed < 2**63:  # numpy's generators take no negative seed
+            raise ParameterError(f"seed: expected a whole number >= 0, got {self.seed}")
         check_damping_mode(self.normal_damping_mode)
         check_tangential_model(self.tangential_model)
         for name, value, allowed in (
