@@ -314,6 +314,32 @@ def test_static_and_rolling_friction_of_a_specimen_reach_the_kernel():
     assert abs(r.energy_balance_error) < 0.01  # the energy bookkeeping still closes
 
 
+def test_dem_run_text_breaks_the_dissipation_down_into_parts_that_add_up(tmp_path, capsys):
+    # the rolling-resistance part was missing from the line, so its parts did not add up
+    import re
+
+    from pidcore.cli import main
+
+    sticky = paper_specimen().with_values({"pairs.particle_wall.static_friction": 0.5,
+                                           "pairs.particle_particle.static_friction": 0.5,
+                                           "pairs.particle_wall.rolling_friction": 0.05,
+                                           "pairs.particle_particle.rolling_friction": 0.05})
+    path = tmp_path / "sticky.toml"
+    path.write_text(sticky.text, encoding="utf-8")
+    code = main(["dem", "run", "--specimen", str(path), "--frequency", "500",
+                 "--acceleration", "5", "--fill", "50", "--cells", "1", "--cycles", "10",
+                 "--store", str(tmp_path / "s.h5"), "--no-progress"])
+    out = capsys.readouterr().out
+    assert code == 0
+    line = next(x for x in out.splitlines() if x.startswith("dissipated"))
+    total, normal, friction, rolling = (float(v) for v in re.findall(
+        r"dissipated\s+(\S+) J/cycle.*normal damping (\S+) J, friction (\S+) J, "
+        r"rolling (\S+) J", line)[0])
+    assert rolling > 0
+    # printed to 4 significant digits: the parts add up to the total within their rounding
+    assert normal + friction + rolling == pytest.approx(total, rel=2e-3)
+
+
 def test_run_stored_before_moving_mass_kg_reads_its_coupon_mass_kg_as_the_sum():
     # such stores held coupon + fixture under coupon_mass_kg; it is the rigid mass of the run
     steel = load_specimen(STEEL)

@@ -240,6 +240,18 @@ def test_verify_detects_flipped_bits_in_array(store):
     assert len(problems) == 1 and akey in problems[0]
 
 
+def test_a_folder_as_the_store_is_one_line_naming_it(tmp_path):
+    # HDF5's own message was two lines of C-library internals (time, descriptor, buffer)
+    folder = tmp_path / "dirstore"
+    folder.mkdir()
+    (folder / "keep.txt").write_text("mine")
+    with pytest.raises(StoreError) as refused:
+        Store(folder)
+    message = str(refused.value)
+    assert message == f"{folder}: is a folder; expected a store file (e.g. pid_store.h5)"
+    assert "\n" not in message and (folder / "keep.txt").read_text() == "mine"
+
+
 def test_corrupt_file_is_refused_and_never_overwritten(tmp_path):
     path = tmp_path / "pid_store.h5"
     store = Store(path)  # no file yet: fine, created on first write

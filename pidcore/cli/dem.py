@@ -321,7 +321,8 @@ def format_summary(result) -> str:
         f"dissipated      {result.energy_per_cycle_j:.4g} J/cycle (coupon, "
         f"{result.coupon_cells} cells): normal "
         f"damping {result.energy_dissipated_normal_j:.4g} J, friction "
-        f"{result.energy_dissipated_friction_j:.4g} J",
+        f"{result.energy_dissipated_friction_j:.4g} J, rolling "
+        f"{result.energy_dissipated_rolling_j:.4g} J",
         f"E (Eq. 10)      {result.max_kinetic_energy_j:.4g} J with m_c = "
         f"{result.vibrated_mass_kg:.4g} kg ({result.config.vibrated_mass})",
         f"energy balance  closure error {result.energy_balance_error:.2%}",

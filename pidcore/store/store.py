@@ -263,6 +263,9 @@ class Store:
         self.lock_timeout_s = timeout
         self._active: h5py.File | None = None
         self._active_thread: int | None = None
+        if self.path.is_dir():  # HDF5's own message is two lines of C-library internals
+            raise StoreError(f"{self.path}: is a folder; expected a store file (e.g. "
+                             f"{defaults.STORE_PATH})")
         if self.path.exists():
             with self._reading():
                 pass  # refuse a corrupt or foreign file now rather than at first use
