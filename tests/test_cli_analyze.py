@@ -91,6 +91,19 @@ def test_store_keeps_one_copy_per_file_and_the_numbers(tmp_path, capsys):
     assert analyses["frequency_hz"].iloc[0] == first["records"][0]["frequency_hz"]
 
 
+def test_the_saved_count_is_of_records_not_of_files(tmp_path, capsys):
+    # two byte-identical files are one record: it said "saved 2 record(s)"
+    path = export(tmp_path / "a.csv", fmt="csv")
+    (tmp_path / "b.csv").write_bytes(path.read_bytes())
+    store_path = tmp_path / "s.h5"
+    assert main(["analyze", str(path), str(tmp_path / "b.csv"), "--store",
+                 str(store_path)]) == 0
+    out = capsys.readouterr().out
+    assert len(Store(store_path).list_analyses()) == 1
+    assert (f"saved 1 record(s) (1 file(s) with the same contents as another file given: "
+            f"one record) to {store_path}") in out
+
+
 def test_bad_file_leaves_store_untouched_and_exits_nonzero(tmp_path, capsys):
     store_path = tmp_path / "s.h5"
     good = export(tmp_path / "good.csv", fmt="csv")

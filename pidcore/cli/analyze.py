@@ -48,19 +48,20 @@ def run(args: argparse.Namespace) -> int:
 def _run(args: argparse.Namespace) -> int:
     options = analysis_options(args)
     saved = False
+    keys: list[str] = []
     try:
         # Analyse everything before writing anything: one bad file leaves the store untouched.
         results = [analyze_file(path, options, key=args.key) for path in args.paths]
         if not args.no_store:
             from ..measure import save_analyses
 
-            save_analyses(args.store, results, options)  # one transaction: all or nothing
+            keys = save_analyses(args.store, results, options)  # one transaction
             saved = True
         interrupt.raise_if_interrupted()  # an interrupt swallowed on the way still counts
     except (KeyboardInterrupt, SystemError) as exc:
         if not interrupt.is_interruption(exc):
             raise
-        said = (f"interrupted after saving {len(results)} record(s) to {args.store}" if saved
+        said = (f"interrupted after saving {_saved(results, keys)} to {args.store}" if saved
                 else "interrupted; nothing saved, the store is unchanged")
         print(f"pidcore analyze: {said}", file=sys.stderr)
         interrupt.mark_handled()
@@ -71,8 +72,16 @@ def _run(args: argparse.Namespace) -> int:
     else:
         print(format_table(results))
         if not args.no_store:
-            print(f"saved {len(results)} record(s) to {args.store}")
+            print(f"saved {_saved(results, keys)} to {args.store}")
     return 0
+
+
+def _saved(results: list, keys: list[str]) -> str:
+    """"3 record(s)", saying so when byte-identical files made fewer records than files."""
+    n = len(set(keys))
+    same = len(results) - n
+    return f"{n} record(s)" + (f" ({same} file(s) with the same contents as another file "
+                               "given: one record)" if same > 0 else "")
 
 
 def format_table(results: list) -> str:
