@@ -11,6 +11,7 @@ import os
 from collections.abc import Mapping, Sequence
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -20,6 +21,9 @@ from .io import assign_roles, read_measurement
 from .records import Channel, Measurement
 from .signal import PowerAnalysis, analyze_channels
 from .units import lookup_unit
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 #: Largest fractional-sample offset between the start times of the force channel and an
 #: acceleration channel that is ignored (the velocity's is corrected as a delay instead).
@@ -263,6 +267,43 @@ def save_analyses(store_path: str | os.PathLike, results: Sequence[AnalyzedRecor
     store = Store(store_path)
     with store.transaction():
         return [store_analysis(store, r, options.parameters()) for r in results]
+
+
+def _stored_case_label(row) -> str:
+    from .compare.align import _row_case
+
+    try:
+        case = _row_case(row)
+    except (KeyError, TypeError, ValueError):
+        return "no load case"
+    return case.full_label()
+
+
+def replacement_notes(analyses: pd.DataFrame,
+                      incoming: Sequence[tuple[str, str, str]]) -> list[str]:
+    """Which saved records (file name, load case) saving ``incoming`` replaces.
+
+    ``incoming``: per file to be saved, (file name, measurement key
+    (:func:`pidcore.records.measurement_key`), load case in words). The store keeps a
+    measurement by its contents, so a byte-identical file under another name, or a second copy
+    in the same save, is the same record and only the last one saved is kept: each such
+    replacement of another name or load case is said, never silent. ``analyses`` is
+    :meth:`pidcore.store.Store.list_analyses` before the save.
+    """
+    notes = []
+    saved = {}  # measurement key -> (file, load case) it holds now
+    if not analyses.empty and {"measurement_key", "created_utc"} <= set(analyses.columns):
+        for _, row in analyses.sort_values("created_utc", kind="stable").iterrows():
+            saved[str(row["measurement_key"])] = (Path(str(row.get("source", ""))).name,
+                                                  _stored_case_label(row))
+    for name, key, case in incoming:
+        if key in saved:
+            old_name, old_case = saved[key]
+            if (old_name, old_case) != (name, case):
+                notes.append(f"{name} has the same contents as the saved record {old_name} "
+                             f"({old_case}); saved as one record: {name} ({case}) replaces it")
+        saved[key] = (name, case)
+    return notes
 
 
 #: Units of the scalar fields stored per analysis.

@@ -199,6 +199,22 @@ def test_identical_files_with_different_load_cases_are_refused(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a_fill50.csv", "b_fill75.csv"]
 
 
+def test_a_later_report_replacing_a_saved_record_says_so(tmp_path):
+    # The same bytes reported again under another name and fill moved the stored measurement
+    # to the new load case with no word (given together, the two are refused, above).
+    a = _write_measurement(tmp_path / "a_fill50.csv")
+    b = tmp_path / "b_fill75.csv"
+    b.write_bytes(a.read_bytes())
+    store = tmp_path / "s.h5"
+    first = make_report([a], out_dir=tmp_path / "one", store=store, formats="csv")
+    assert not any("replaces" in n for n in first.notes)
+    second = make_report([b], out_dir=tmp_path / "two", store=store, formats="csv")
+    (note,) = [n for n in second.notes if "replaces" in n]
+    assert note.startswith("b_fill75.csv has the same contents as the saved record a_fill50.csv")
+    assert "50 %" in note and "75 %" in note
+    assert Store(store).list_analyses()["fill_percent"].tolist() == [75.0]
+
+
 def test_missing_dem_store_is_an_error(tmp_path):
     file = _write_measurement(tmp_path / "x_fill50.csv")
     with pytest.raises(StoreError, match="not found"):

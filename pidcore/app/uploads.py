@@ -524,42 +524,15 @@ class SavedRecords:
     notes: tuple[str, ...] = ()
 
 
-def _stored_case_label(row) -> str:
-    from ..compare.align import _row_case
-
-    try:
-        case = _row_case(row)
-    except (KeyError, TypeError, ValueError):
-        return "no load case"
-    return case.full_label()
-
-
 def replacement_notes(analyses: pd.DataFrame, files: Sequence[AnalysedFile]) -> list[str]:
-    """Which saved records (file name, load case) saving ``files`` replaces: the store keys a
-    measurement by its contents, so a byte-identical file under another name, or a second
-    copy in the same save, is the same record, and only the last one saved is kept.
-
-    ``analyses`` is :meth:`pidcore.store.Store.list_analyses` before the save.
-    """
+    """Which saved records saving ``files`` replaces (:func:`pidcore.measure.replacement_notes`);
+    ``analyses`` is :meth:`pidcore.store.Store.list_analyses` before the save."""
+    from ..measure import replacement_notes as notes_of
     from ..records import measurement_key
 
-    notes = []
-    saved = {}  # measurement key -> (file, load case) it holds now
-    if not analyses.empty and {"measurement_key", "created_utc"} <= set(analyses.columns):
-        for _, row in analyses.sort_values("created_utc", kind="stable").iterrows():
-            saved[str(row["measurement_key"])] = (Path(str(row.get("source", ""))).name,
-                                                  _stored_case_label(row))
-    for f in files:
-        name = Path(f.record.measurement.source).name
-        key = measurement_key(f.record.measurement)
-        case = f.load_case.full_label()
-        if key in saved:
-            old_name, old_case = saved[key]
-            if (old_name, old_case) != (name, case):
-                notes.append(f"{name} has the same contents as the saved record {old_name} "
-                             f"({old_case}); saved as one record: {name} ({case}) replaces it")
-        saved[key] = (name, case)
-    return notes
+    return notes_of(analyses, [(Path(f.record.measurement.source).name,
+                                measurement_key(f.record.measurement),
+                                f.load_case.full_label()) for f in files])
 
 
 def check_one_load_case_per_content(files: Sequence[AnalysedFile]) -> None:

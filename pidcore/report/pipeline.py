@@ -184,12 +184,18 @@ def latest_per_measurement(analyses: pd.DataFrame) -> pd.DataFrame:
             .groupby("measurement_key", sort=False).tail(1).reset_index(drop=True))
 
 
-def _store_results(store, results: list[MeasuredResult], options: AnalysisOptions) -> list[str]:
+def _store_results(store, results: list[MeasuredResult], options: AnalysisOptions,
+                   notes: list[str]) -> list[str]:
     # Same entry as `pidcore analyze` for the same file and options (replaced, not
-    # duplicated), plus the load case fields.
-    from ..measure import store_analysis
+    # duplicated), plus the load case fields; a saved record of the same contents under
+    # another name or load case is replaced, and the notes say so.
+    from ..measure import replacement_notes, store_analysis
+    from ..records import measurement_key
 
     with store.transaction():
+        notes += replacement_notes(store.list_analyses(), [
+            (r.path.name, measurement_key(r.measurement), r.load_case.full_label())
+            for r in results])
         return [store_analysis(store, r.analyzed, options.parameters(),
                                fields=r.load_case.as_record(r.stated.origin)) for r in results]
 
@@ -380,7 +386,7 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         notes += [f"{f.name}: identical contents to another file given; counted once"
                   for f in files if f not in kept]
     if main is not None and results:
-        keys = _store_results(main, results, options)
+        keys = _store_results(main, results, options, notes)
         listed = main.list_analyses()
         analyses = listed[listed["key"].isin(keys)]
         analyses = analyses.set_index("key").loc[keys].reset_index()  # order of the files
