@@ -116,7 +116,10 @@ def _with_unit(ch: Channel, role: str, unit: str | None, source: str,
         notes.append(f"channel {ch.name!r}: no unit in the file; taken as {unit!r} "
                      f"({_UNIT_OPTIONS[role]})")
     corrections[f"{role}_unit"] = unit
-    return Channel(ch.name, role, raw * info.factor, ch.sample_rate_hz, unit, ch.start_time_s)
+    # source_unit stays the file's (what the output calls it); the option's is in the notes
+    # and the corrections
+    return Channel(ch.name, role, raw * info.factor, ch.sample_rate_hz, ch.source_unit,
+                   ch.start_time_s)
 
 
 def _align(channels: dict[str, Channel], source: str, notes: list[str],

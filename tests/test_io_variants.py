@@ -201,6 +201,10 @@ def test_unit_option_overrides_a_unit_of_another_kind(tmp_path, capsys):
     _assert_truth(result.analysis)
     assert any("says 'm/s', a velocity unit; taken as 'N' (--force-unit)" in n
                for n in result.notes)
+    # the output's "source_unit" is the file's, as documented (it showed the option's)
+    (force,) = [c for c in result.channels if c["role"] == "force"]
+    assert force["source_unit"] == "m/s" and force["unit"] == "N"
+    assert result.corrections["force_unit"] == "N"
     # kN under a velocity's name: the option's factor, not the file's, scales the numbers
     result = analyze_file(path, AnalysisOptions(force="Force", force_unit="kN"))
     assert result.analysis.energy_per_cycle_j == pytest.approx(
