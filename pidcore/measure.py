@@ -263,13 +263,21 @@ def store_analysis(store, result: AnalyzedRecord, parameters: Mapping, *,
 
 
 def save_analyses(store_path: str | os.PathLike, results: Sequence[AnalyzedRecord],
-                  options: AnalysisOptions) -> list[str]:
-    """Save measurements and their analyses to the store in one transaction."""
+                  options: AnalysisOptions,
+                  fields: Sequence[Mapping | None] | None = None) -> list[str]:
+    """Save measurements and their analyses to the store in one transaction; ``fields``: per
+    result, record fields to add (its load case, :meth:`pidcore.loadcase.LoadCase.as_record`)
+    or None."""
     from .store import Store
 
+    fields = list(fields) if fields is not None else [None] * len(results)
+    if len(fields) != len(results):
+        raise ParameterError(f"fields: expected one per result ({len(results)}), got "
+                             f"{len(fields)}")
     store = Store(store_path)
     with store.transaction():
-        return [store_analysis(store, r, options.parameters()) for r in results]
+        return [store_analysis(store, r, options.parameters(), fields=f)
+                for r, f in zip(results, fields, strict=True)]
 
 
 def _stored_case_label(row) -> str:

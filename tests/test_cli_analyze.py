@@ -104,6 +104,44 @@ def test_the_saved_count_is_of_records_not_of_files(tmp_path, capsys):
             f"one record) to {store_path}") in out
 
 
+def test_a_stated_load_case_is_saved_so_that_a_store_report_places_it(tmp_path, capsys):
+    # `analyze` saved no load case (it had no way to), so `report --store` never showed a
+    # measured row: "stored measurement(s) have no analysis stating a fill"
+    from pidcore.report import make_report
+
+    named = export(tmp_path / "coupon_fill50_acrylic.csv", fmt="csv")
+    # no fill stated: still analysed and saved, without a case (its line ends differ, so its
+    # bytes are another measurement's, not the named file's stating nothing)
+    bare = tmp_path / "bare.csv"
+    bare.write_bytes(named.read_bytes().replace(b"\n", b"\r\n"))
+    store_path = tmp_path / "s.h5"
+    assert main(["analyze", str(named), str(bare), "--store", str(store_path)]) == 0
+    out = capsys.readouterr().out
+    assert "coupon_fill50_acrylic.csv: load case f100Hz_a" in out and "fill: file name" in out
+    assert "bare.csv: no fill stated: saved without a load case" in out
+    stored = Store(store_path).list_analyses().set_index("source")
+    assert stored.loc[str(named), "fill_percent"] == 50.0
+    assert not np.isfinite(float(stored.loc[str(bare), "fill_percent"]))
+    report = make_report([], out_dir=tmp_path / "rep", store=store_path, formats="csv")
+    assert report.table["SDC measured [-]"].notna().sum() == 1
+    # --fill states it for every file; the JSON names each record's load case
+    doc = run_json([str(bare), "--fill", "75", "--no-store"], capsys)
+    assert doc["records"][0]["load_case"].startswith("f100Hz_a") and \
+        "_fill75pct_acrylic_z" in doc["records"][0]["load_case"]
+
+
+def test_identical_files_stating_different_load_cases_are_refused_before_saving(tmp_path,
+                                                                                capsys):
+    a = export(tmp_path / "a_fill50.csv", fmt="csv")
+    b = tmp_path / "b_fill75.csv"
+    b.write_bytes(a.read_bytes())
+    store_path = tmp_path / "s.h5"
+    assert main(["analyze", str(a), str(b), "--store", str(store_path)]) == 2
+    err = capsys.readouterr().err
+    assert "identical contents but state different load cases" in err and err.count("\n") == 1
+    assert not store_path.exists()
+
+
 def test_bad_file_leaves_store_untouched_and_exits_nonzero(tmp_path, capsys):
     store_path = tmp_path / "s.h5"
     good = export(tmp_path / "good.csv", fmt="csv")

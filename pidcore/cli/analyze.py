@@ -8,6 +8,7 @@ import sys
 from pathlib import Path
 
 from .. import interrupt
+from ..constants import DRIVE_DIRECTIONS, PARTICLE_MATERIALS
 from ..errors import PidcoreError
 from ..measure import analyze_file
 from ._options import (
@@ -31,6 +32,19 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     add_measurement_options(p)
     add_store_option(p)
     p.add_argument("--no-store", action="store_true", help="do not save to the store")
+    g = p.add_argument_group(
+        "load case (saved with each analysis, so that `pidcore report --store` places it; "
+        "a file with no fill stated is saved without one)")
+    g.add_argument("--fill", metavar="PERCENT", type=float, default=None,
+                   help="packing ratio of every PATH, %% (overrides file name and sidecar)")
+    g.add_argument("--material", metavar="NAME", default=None,
+                   help=f"particle material of every PATH: {', '.join(PARTICLE_MATERIALS)} "
+                        "(default: stated, else acrylic)")
+    g.add_argument("--direction", choices=DRIVE_DIRECTIONS, default=None,
+                   help="drive direction of every PATH (default: stated or z)")
+    g.add_argument("--sidecar", metavar="CSV", type=Path, default=None,
+                   help="load case table (columns file, fill_percent, material, direction); "
+                        "default: loadcases.csv beside each file")
     p.add_argument("--key", metavar="NAME", default=None,
                    help="which measurement of a pidcore HDF5 store to analyse, when it holds "
                         "several (the error lists them)")
@@ -45,17 +59,45 @@ def run(args: argparse.Namespace) -> int:
         raise type(exc)(with_cli_flags(str(exc))) from None
 
 
+def _stated_load_cases(args: argparse.Namespace) -> list:
+    """What each path states about its load case (None: no fill stated), resolved before any
+    analysis so that a bad sidecar or option is refused at once."""
+    from ..compare.loadcase import FillNotStated, resolve_load_case
+
+    stated = []
+    for path in args.paths:  # (a missing file is named by its analysis)
+        try:
+            stated.append(resolve_load_case(path, fill_percent=args.fill,
+                                            material=args.material, direction=args.direction,
+                                            sidecar=args.sidecar))
+        except FillNotStated:
+            stated.append(None)
+    return stated
+
+
 def _run(args: argparse.Namespace) -> int:
+    from ..loadcase import refuse_identical_contents_stating_apart
+
     options = analysis_options(args)
+    stated = _stated_load_cases(args)
     saved = False
     keys: list[str] = []
     try:
         # Analyse everything before writing anything: one bad file leaves the store untouched.
         results = [analyze_file(path, options, key=args.key) for path in args.paths]
+        cases = [st.load_case(r.analysis.frequency_hz, r.analysis.acceleration_g)
+                 if st is not None else None for r, st in zip(results, stated, strict=True)]
+        refuse_identical_contents_stating_apart(
+            (Path(path).name, r.measurement.sha256, c.key if c else None,
+             c.full_label() if c else "no load case")
+            for path, r, c in zip(args.paths, results, cases, strict=True))
         if not args.no_store:
             from ..measure import save_analyses
 
-            keys = save_analyses(args.store, results, options)  # one transaction
+            keys = save_analyses(  # one transaction
+                args.store, results, options,
+                fields=[c.as_record(st.origin) if c is not None else None
+                        for c, st in zip(cases, stated, strict=True)])
             saved = True
         interrupt.raise_if_interrupted()  # an interrupt swallowed on the way still counts
     except (KeyboardInterrupt, SystemError) as exc:
@@ -67,10 +109,16 @@ def _run(args: argparse.Namespace) -> int:
         interrupt.mark_handled()
         return 130
     if args.json:
-        json.dump({"records": [r.to_dict() for r in results]}, sys.stdout)
+        json.dump({"records": [{**r.to_dict(), "load_case": c.key if c else None}
+                               for r, c in zip(results, cases, strict=True)]}, sys.stdout)
         sys.stdout.write("\n")
     else:
         print(format_table(results))
+        for path, c, st in zip(args.paths, cases, stated, strict=True):
+            print(f"{Path(path).name}: " + (f"load case {c.key} ({st.origin})" if c else
+                  "no fill stated: saved without a load case (state it in the file name, "
+                  "a sidecar or --fill for `pidcore report --store` to place it)"
+                  if not args.no_store else "no fill stated"))
         if not args.no_store:
             print(f"saved {_saved(results, keys)} to {args.store}")
     return 0

@@ -41,6 +41,13 @@ from ..loadcase import (
 )
 from ..loadcase import check_fill as _check_fill
 
+
+class FillNotStated(LoadCaseError):
+    """No fill is stated for a measurement file (by name, sidecar or option): the one
+    :class:`LoadCaseError` a caller may accept (``pidcore analyze`` saves the analysis without
+    a load case)."""
+
+
 #: Name of the sidecar table looked for beside each measurement file.
 SIDECAR_NAME = "loadcases.csv"
 #: Columns of the sidecar table (``file`` and ``fill_percent`` required).
@@ -303,7 +310,7 @@ def resolve_load_case(
     take(options, "option")
 
     if "fill_percent" not in values:
-        raise LoadCaseError(missing_fill_message(path))
+        raise FillNotStated(missing_fill_message(path))
     values.setdefault("material", defaults.COMPARE_DEFAULT_MATERIAL)
     values.setdefault("direction", defaults.COMPARE_DEFAULT_DIRECTION)
     text = "; ".join(f"{name.split('_')[0]}: {origin.get(name, 'default')}"
