@@ -14,26 +14,43 @@ from ..measure import AnalysisOptions
 STORE_HELP = f"HDF5 store (default ./{defaults.STORE_PATH})"
 
 
-def positive_int(text: str) -> int:
-    """argparse type: a whole number >= 1 (a count of repetitions, samples or processes)."""
+def _whole_number(text: str, minimum: int) -> int:
     try:
         value = int(text)
     except ValueError as exc:
         raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from exc
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {text!r}")
+    if value < minimum:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= {minimum}, got {text!r}")
     return value
+
+
+def positive_int(text: str) -> int:
+    """argparse type: a whole number >= 1 (a count of repetitions, samples or processes)."""
+    return _whole_number(text, 1)
 
 
 def non_negative_int(text: str) -> int:
     """argparse type: a whole number >= 0 (a random seed)."""
-    try:
-        value = int(text)
-    except ValueError as exc:
-        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from exc
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"expected a whole number >= 0, got {text!r}")
-    return value
+    return _whole_number(text, 0)
+
+
+def add_load_case_options(p: argparse._ActionsContainer, *, what: str,
+                          material_help: str) -> None:
+    """``--fill``, ``--material``, ``--direction``, ``--sidecar``: the load case of every
+    ``what`` (the positional's name), as :func:`pidcore.compare.loadcase.resolve_load_case`
+    reads them; ``material_help`` ends the help of ``--material`` (its default)."""
+    from ..constants import DRIVE_DIRECTIONS, PARTICLE_MATERIALS
+
+    p.add_argument("--fill", metavar="PERCENT", type=float, default=None,
+                   help=f"packing ratio of every {what}, %% (overrides file name and sidecar)")
+    p.add_argument("--material", metavar="NAME", default=None,
+                   help=f"particle material of every {what}: {', '.join(PARTICLE_MATERIALS)}"
+                        f"{material_help}")
+    p.add_argument("--direction", choices=DRIVE_DIRECTIONS, default=None,
+                   help=f"drive direction of every {what} (default: stated or z)")
+    p.add_argument("--sidecar", metavar="CSV", type=Path, default=None,
+                   help="load case table (columns file, fill_percent, material, direction); "
+                        "default: loadcases.csv beside each file")
 
 
 def add_store_option(p: argparse.ArgumentParser, *, flag: str = "--store",

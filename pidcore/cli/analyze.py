@@ -8,11 +8,11 @@ import sys
 from pathlib import Path
 
 from .. import interrupt
-from ..constants import DRIVE_DIRECTIONS, PARTICLE_MATERIALS
 from ..errors import PidcoreError
 from ..measure import analyze_file
 from ._options import (
     add_json_option,
+    add_load_case_options,
     add_measurement_options,
     add_store_option,
     analysis_options,
@@ -35,16 +35,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     g = p.add_argument_group(
         "load case (saved with each analysis, so that `pidcore report --store` places it; "
         "a file with no fill stated is saved without one)")
-    g.add_argument("--fill", metavar="PERCENT", type=float, default=None,
-                   help="packing ratio of every PATH, %% (overrides file name and sidecar)")
-    g.add_argument("--material", metavar="NAME", default=None,
-                   help=f"particle material of every PATH: {', '.join(PARTICLE_MATERIALS)} "
-                        "(default: stated, else acrylic)")
-    g.add_argument("--direction", choices=DRIVE_DIRECTIONS, default=None,
-                   help="drive direction of every PATH (default: stated or z)")
-    g.add_argument("--sidecar", metavar="CSV", type=Path, default=None,
-                   help="load case table (columns file, fill_percent, material, direction); "
-                        "default: loadcases.csv beside each file")
+    add_load_case_options(g, what="PATH", material_help=" (default: stated, else acrylic)")
     p.add_argument("--key", metavar="NAME", default=None,
                    help="which measurement of a pidcore HDF5 store to analyse, when it holds "
                         "several (the error lists them)")

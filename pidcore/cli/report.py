@@ -8,9 +8,13 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..constants import DRIVE_DIRECTIONS, PARTICLE_MATERIALS
 from ..report.render import format_cell
-from ._options import add_measurement_options, add_store_option, analysis_options
+from ._options import (
+    add_load_case_options,
+    add_measurement_options,
+    add_store_option,
+    analysis_options,
+)
 
 #: Columns of the short table printed on stdout.
 #: The like-for-like measured SDC (Eq. 10's E, as our DEM's) stands beside our DEM's; the
@@ -44,16 +48,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                      help="HDF5 store holding the DEM runs (default: --store); only read")
     p.add_argument("--format", metavar="FMT", default="all",
                    help="all or a comma-separated list of csv, md, html, tex, pdf (default all)")
-    p.add_argument("--fill", metavar="PERCENT", type=float, default=None,
-                   help="packing ratio of every FILE, %% (overrides file name and sidecar)")
-    p.add_argument("--material", metavar="NAME", default=None,
-                   help=f"particle material of every FILE: {', '.join(PARTICLE_MATERIALS)} or "
-                        "the --specimen's (default: stated, else the specimen's, else acrylic)")
-    p.add_argument("--direction", choices=DRIVE_DIRECTIONS, default=None,
-                   help="drive direction of every FILE (default: stated or z)")
-    p.add_argument("--sidecar", metavar="CSV", type=Path, default=None,
-                   help="load case table (columns file, fill_percent, material, direction); "
-                        "default: loadcases.csv beside each file")
+    add_load_case_options(p, what="FILE", material_help=" or the --specimen's (default: "
+                                                         "stated, else the specimen's, else "
+                                                         "acrylic)")
     p.add_argument("--specimen", metavar="FILE", type=Path, default=None,
                    help="compare only DEM runs of this specimen file (default: the paper's "
                         "coupon); the paper's Table 3 only for the paper's coupon")
