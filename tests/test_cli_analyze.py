@@ -124,6 +124,13 @@ def test_a_stated_load_case_is_saved_so_that_a_store_report_places_it(tmp_path, 
     assert not np.isfinite(float(stored.loc[str(bare), "fill_percent"]))
     report = make_report([], out_dir=tmp_path / "rep", store=store_path, formats="csv")
     assert report.table["SDC measured [-]"].notna().sum() == 1
+    # analysed again stating another fill: the saved record is replaced, and that is said
+    assert main(["analyze", str(named), "--fill", "75", "--store", str(store_path)]) == 0
+    out = capsys.readouterr().out
+    assert "note: coupon_fill50_acrylic.csv has the same contents as the saved record " \
+           "coupon_fill50_acrylic.csv (100 Hz, 5 g, 50 %, acrylic, z); saved as one record" in out
+    assert Store(store_path).list_analyses().set_index("source").loc[
+        str(named), "fill_percent"] == 75.0
     # --fill states it for every file; the JSON names each record's load case
     doc = run_json([str(bare), "--fill", "75", "--no-store"], capsys)
     assert doc["records"][0]["load_case"].startswith("f100Hz_a") and \

@@ -82,9 +82,18 @@ def _run(args: argparse.Namespace) -> int:
             (Path(path).name, r.measurement.sha256, c.key if c else None,
              c.full_label() if c else "no load case")
             for path, r, c in zip(args.paths, results, cases, strict=True))
+        replaced: list[str] = []
         if not args.no_store:
-            from ..measure import save_analyses
+            from ..measure import replacement_notes, save_analyses
+            from ..records import measurement_key
+            from ..store import Store
 
+            # a saved record of the same bytes under another name or load case is replaced:
+            # said, never silent (as the report and the app say it)
+            replaced = replacement_notes(Store(args.store).list_analyses(), [
+                (Path(path).name, measurement_key(r.measurement),
+                 c.full_label() if c else "no load case")
+                for path, r, c in zip(args.paths, results, cases, strict=True)])
             keys = save_analyses(  # one transaction
                 args.store, results, options,
                 fields=[c.as_record(st.origin) if c is not None else None
@@ -110,6 +119,8 @@ def _run(args: argparse.Namespace) -> int:
                   "no fill stated: saved without a load case (state it in the file name, "
                   "a sidecar or --fill for `pidcore report --store` to place it)"
                   if not args.no_store else "no fill stated"))
+        for note in replaced:
+            print(f"note: {note}")
         if not args.no_store:
             print(f"saved {_saved(results, keys)} to {args.store}")
     return 0
