@@ -215,7 +215,7 @@ def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | N
         row.measured.append(entry)
 
     records = []
-    unconverged_rows = 0
+    unconverged_rows: list[str] = []
     for row in (r for group in rows.values() for r in group):
         lc = row.case
         sdc_m = sdc_m_se = f_m = a_m = chi2_dof = math.nan
@@ -245,7 +245,7 @@ def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | N
             note.append(f"{row.dem.n_runs} DEM runs pooled")
         if row.dem is not None and row.dem.not_converged:
             note.append(not_converged_note(row.dem))
-            unconverged_rows += 1
+            unconverged_rows.append(lc.label())
         if pool:
             note.append("pooled across specimens and DEM settings (--pool)")
         if row.measured and math.isfinite(row.sdc_dem) and not math.isfinite(sdc_m10):
@@ -283,9 +283,10 @@ def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | N
     table["particles per cell [-]"] = table["particles per cell [-]"].astype("Int64")
     table = _sort_like_table3(table, aligner, paper, tolerances)
     if unconverged_rows:
-        notes.append(f"{unconverged_rows} row(s) rest on DEM runs that did not converge (no "
-                     "steady state before the transient cap): their DEM SDC may include the "
-                     "transient; see each row's note")
+        # named here: the console's short table has no note column
+        notes.append(f"{len(unconverged_rows)} row(s) rest on DEM runs that did not converge "
+                     "(no steady state before the transient cap): their DEM SDC may include "
+                     f"the transient: {'; '.join(unconverged_rows)}")
     table.attrs["notes"] = notes
     return table
 
