@@ -216,11 +216,13 @@ def refuse_identical_contents_stating_apart(files: Iterable[tuple[str, str, Hash
     two statements about it cannot both hold; ``remedy`` ends the message.
     """
     first: dict[str, tuple[str, Hashable, str]] = {}
+    clashes = []
     for name, key, stated, words in files:
         if not key:
             continue
         other = first.setdefault(key, (name, stated, words))
         if other[1] != stated:
-            raise LoadCaseError(f"{name} and {other[0]} have identical contents but state "
-                                f"different load cases ({words} vs {other[2]})"
-                                + (f"; {remedy}" if remedy else ""))
+            clashes.append(f"{name} and {other[0]} have identical contents but state "
+                           f"different load cases ({words} vs {other[2]})")
+    if clashes:  # every one named: fixing one should not reveal the next
+        raise LoadCaseError("; ".join(clashes) + (f"; {remedy}" if remedy else ""))

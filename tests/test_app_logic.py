@@ -1082,6 +1082,26 @@ def test_one_name_is_one_file_and_a_table_statement_is_not_assumed():
     assert uploads.columns_given([table], "other.csv") == {"material"}
 
 
+def test_an_unset_vibrometer_delay_is_said_where_a_velocity_channel_is_used():
+    # the bundled samples (50 µs) were analysed at 0 µs in the app, SDC 2.80 instead of 4.09,
+    # with no word; a fill or material not stated was said, a delay not
+    row = {"vibrometer delay [µs]": 0.0}
+    note = uploads.delay_note(row, velocity_used=True)
+    assert note.startswith("vibrometer delay: none given, 0 µs assumed")
+    assert uploads.delay_note({"vibrometer delay [µs]": float("nan")}, velocity_used=True)
+    # given in the row or by a settings table (even as 0), or no vibrometer: nothing to say
+    assert uploads.delay_note({"vibrometer delay [µs]": 50.0}, velocity_used=True) == ""
+    assert uploads.delay_note(row, {"vibrometer delay [µs]"}, velocity_used=True) == ""
+    assert uploads.delay_note(row, velocity_used=False) == ""
+
+
+def test_the_bundled_sample_table_gives_the_samples_delay_to_the_app():
+    # data_samples/loadcases.csv is the app's settings table for the samples: 50 µs each
+    table = uploads.read_settings_table(
+        "loadcases.csv", (REPO / "data_samples" / "loadcases.csv").read_bytes())
+    assert table["vibrometer delay [µs]"].astype(float).tolist() == [50.0] * 5
+
+
 def test_identical_files_stating_different_load_cases_are_not_saved_together(tmp_path,
                                                                              good_csv, options):
     # one content is one record: saving both would keep one statement and drop the other
@@ -1095,6 +1115,13 @@ def test_identical_files_stating_different_load_cases_are_not_saved_together(tmp
                                              r"contents but state different load cases"):
         uploads.save_records(tmp_path / "s.h5", both)
     assert not (tmp_path / "s.h5").exists() or Store(tmp_path / "s.h5").list_analyses().empty
+    # said before Save (the page promised "one record", then Save refused), naming every
+    # clash: a third copy at 90 % was only found after the first was fixed
+    c = _record(good_csv, options, name="c_fill90.csv")
+    three = [*both, _file(c, options, fill=90.0)]
+    said = uploads.load_case_conflict(three)
+    assert "b_fill75.csv and a_fill50.csv" in said and "c_fill90.csv and a_fill50.csv" in said
+    assert uploads.load_case_conflict([both[0]]) == ""
     # the same load case stated on two specimens: the message tells the statements apart
     # (it read "(case vs case)" when only the specimen differed)
     apart = [_file(a, options, specimen="panel_A"), _file(b, options, specimen="panel_B")]
@@ -1102,6 +1129,19 @@ def test_identical_files_stating_different_load_cases_are_not_saved_together(tmp
         uploads.save_records(tmp_path / "s.h5", apart)
     same = [_file(a, options), _file(_record(good_csv, options, name="copy.csv"), options)]
     assert len(set(uploads.save_records(tmp_path / "s.h5", same).keys)) == 1
+
+
+def test_the_dem_runs_table_says_why_a_run_has_no_standard_error():
+    # a one-cell run's missing stderr showed as a literal "None" in the grid
+    import pandas as pd
+
+    runs = pd.DataFrame({"frequency_hz": [100.0, 100.0, 50.0], "acceleration_g": [5.0] * 3,
+                         "fill_percent": [50.0] * 3, "material": ["acrylic"] * 3,
+                         "sdc": [1.09, 1.10, 0.6], "sdc_stderr": [None, 0.0123456, float("nan")],
+                         "cells_simulated": [1, 8, 4], "case_key": ["a", "b", "c"]})
+    table = jobs.dem_runs_table(runs)
+    assert table["SDC stderr [-]"].tolist() == ["n/a (1 cell)", "0.0123", "n/a"]
+    assert table["SDC [-]"].tolist() == [1.09, 1.10, 0.6]  # the values stay numbers
 
 
 def test_run_says_which_cases_are_already_stored():

@@ -15,6 +15,7 @@ case and every numerical setting) is queued, running, or already in the store.
 
 from __future__ import annotations
 
+import math
 import threading
 import time
 from collections.abc import Sequence
@@ -381,8 +382,15 @@ def dem_runs_table(runs):
            if "steady_detected" in runs.columns else ""})
     import pandas as pd
 
-    if "sdc_stderr" in runs.columns:  # None in an object column showed as "None"
-        runs = runs.assign(sdc_stderr=pd.to_numeric(runs["sdc_stderr"], errors="coerce"))
+    if "sdc_stderr" in runs.columns:
+        # the grid shows a missing number as "None", which read as a fault: say why instead
+        # (one cell simulated has no scatter to take a standard error from)
+        cells = pd.to_numeric(runs["cells_simulated"], errors="coerce") \
+            if "cells_simulated" in runs.columns else pd.Series(math.nan, index=runs.index)
+        stderr = pd.to_numeric(runs["sdc_stderr"], errors="coerce")
+        runs = runs.assign(sdc_stderr=[
+            f"{v:.3g}" if math.isfinite(v) else "n/a (1 cell)" if n == 1 else "n/a"
+            for v, n in zip(stderr, cells, strict=True)])
     shown = {c: name for c, name in DEM_RUN_COLUMNS.items() if c in runs.columns}
     return runs[list(shown)].rename(columns=shown)
 

@@ -382,6 +382,21 @@ def assumed_note(stated, row: Mapping, given: Iterable[str] = ()) -> str:
     return "; ".join(parts)
 
 
+def delay_note(row: Mapping, given: Iterable[str] = (), *, velocity_used: bool) -> str:
+    """``'vibrometer delay: none given, 0 µs assumed ...'`` where a file's velocity channel is
+    used and neither its settings row nor a settings table gives a delay: a laser
+    vibrometer's output delay (tens of µs) shifts the phase of every harmonic, and an unset
+    one changes the loss factor without a word (the bundled samples, 50 µs: SDC 2.80 instead
+    of 4.09). "" otherwise."""
+    if not velocity_used or "vibrometer delay [µs]" in set(given):
+        return ""
+    value = row.get("vibrometer delay [µs]")
+    if not (_empty(value) or _same_number(value, 0.0)):
+        return ""
+    return ("vibrometer delay: none given, 0 µs assumed; a laser vibrometer's output delay "
+            "(typically tens of µs, from its data sheet) changes the loss factor read")
+
+
 def columns_given(tables: Sequence[pd.DataFrame], name: str) -> set[str]:
     """The settings columns that uploaded ``tables`` give a value for file ``name`` (matched
     as :func:`merge_settings` matches it: the name, else its base name)."""
@@ -549,6 +564,16 @@ def check_one_load_case_per_content(files: Sequence[AnalysedFile]) -> None:
         ((Path(f.record.measurement.source).name, measurement_key(f.record.measurement),
           (f.load_case.key, f.specimen), words(f)) for f in files),
         remedy="one measurement is one record: state one load case, or remove one of the files")
+
+
+def load_case_conflict(files: Sequence[AnalysedFile]) -> str:
+    """Why saving ``files`` would be refused (:func:`check_one_load_case_per_content`), to
+    show before Save; "" when it would not."""
+    try:
+        check_one_load_case_per_content(files)
+    except ParameterError as exc:
+        return str(exc)
+    return ""
 
 
 def saved_count(files: Sequence[AnalysedFile]) -> int:

@@ -103,6 +103,9 @@ def _card(upload, row, sample_rate_hz, materials, given=()):
             st.error(outcome.error)
             return None
         record = outcome.record
+        delay = uploads.delay_note(row, given, velocity_used="velocity" in record.channels_used)
+        if delay:
+            st.info(f"{delay} (set it in the settings table)")
         try:
             fill = float(row["fill [%]"])
             if not math.isfinite(fill):
@@ -205,8 +208,11 @@ def render(stores) -> list:
     if flagged:
         confirm = st.checkbox(f"Save the {len(flagged)} implausible record(s) anyway (their "
                               "warnings are saved with them)", key="confirm_implausible")
+    conflict = uploads.load_case_conflict(analysed)
+    if conflict:  # said before Save, which would refuse it
+        st.error(f"cannot save: {conflict}")
     if st.button(f"Save {uploads.saved_count(analysed)} record(s) to the store",
-                 disabled=not analysed,
+                 disabled=not analysed or bool(conflict),
                  type="primary", key="save"):
         try:
             saved = uploads.save_records(stores.path, analysed, confirm_implausible=confirm)

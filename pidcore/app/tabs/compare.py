@@ -79,7 +79,7 @@ def _calibrated(calibrations, comp, head, specimen: str) -> None:
               help=f"95 % band {hit.low95:.4f} .. {hit.high95:.4f}")
     verdict = ("inside" if hit.contains(comp.measured_sdc) else "outside") \
         if math.isfinite(comp.measured_sdc) else "not compared (no Eq. 11 SDC)"
-    st.caption(f"calibrated 95 % band {hit.low95:.4f} .. {hit.high95:.4f}; the measured "
+    st.caption(f"calibrated 95 % band {hit.low95:.4f} .. {hit.high95:.4f} [-]; the measured "
                f"Eq. 11 SDC is {verdict}.")
 
 
