@@ -262,22 +262,45 @@ def store_analysis(store, result: AnalyzedRecord, parameters: Mapping, *,
         units={k: v for k, v in ANALYSIS_UNITS.items() if k in record})
 
 
-def save_analyses(store_path: str | os.PathLike, results: Sequence[AnalyzedRecord],
-                  options: AnalysisOptions,
-                  fields: Sequence[Mapping | None] | None = None) -> list[str]:
-    """Save measurements and their analyses to the store in one transaction; ``fields``: per
-    result, record fields to add (its load case, :meth:`pidcore.loadcase.LoadCase.as_record`)
-    or None."""
+#: How a saved analysis without a load case is named in notes.
+NO_LOAD_CASE = "no load case"
+
+
+@dataclass(frozen=True)
+class SavedAnalyses:
+    """What :func:`save_analyses` wrote: the analysis ``keys`` (one per result; byte-identical
+    files share one) and ``notes`` naming each saved record it replaced."""
+
+    keys: list[str]
+    notes: list[str]
+
+
+def save_analyses(store, results: Sequence[AnalyzedRecord], options: AnalysisOptions,
+                  stated: Sequence[tuple[str, object, str]]) -> SavedAnalyses:
+    """Save measurements and their analyses in one transaction of ``store`` (a
+    :class:`~pidcore.store.Store` or its path).
+
+    ``stated``: per result, (file name, its :class:`~pidcore.loadcase.LoadCase` or None, who
+    stated it); the load case goes into the record (:meth:`~pidcore.loadcase.LoadCase.as_record`).
+    A saved record of the same bytes under another name or load case is replaced, and the
+    notes say so (:func:`replacement_notes`).
+    """
+    from .records import measurement_key
     from .store import Store
 
-    fields = list(fields) if fields is not None else [None] * len(results)
-    if len(fields) != len(results):
-        raise ParameterError(f"fields: expected one per result ({len(results)}), got "
-                             f"{len(fields)}")
-    store = Store(store_path)
+    if len(stated) != len(results):
+        raise ParameterError(f"stated: expected one per result ({len(results)}), got "
+                             f"{len(stated)}")
+    store = store if isinstance(store, Store) else Store(store)
     with store.transaction():
-        return [store_analysis(store, r, options.parameters(), fields=f)
-                for r, f in zip(results, fields, strict=True)]
+        notes = replacement_notes(store.list_analyses(), [
+            (name, measurement_key(r.measurement),
+             case.full_label() if case is not None else NO_LOAD_CASE)
+            for r, (name, case, _) in zip(results, stated, strict=True)])
+        keys = [store_analysis(store, r, options.parameters(),
+                               fields=case.as_record(origin) if case is not None else None)
+                for r, (_, case, origin) in zip(results, stated, strict=True)]
+    return SavedAnalyses(keys, notes)
 
 
 def _stored_case_label(row) -> str:
@@ -286,7 +309,7 @@ def _stored_case_label(row) -> str:
     try:
         case = _row_case(row)
     except (KeyError, TypeError, ValueError):
-        return "no load case"
+        return NO_LOAD_CASE
     return case.full_label()
 
 

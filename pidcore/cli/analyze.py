@@ -9,7 +9,7 @@ from pathlib import Path
 
 from .. import interrupt
 from ..errors import PidcoreError
-from ..measure import analyze_file
+from ..measure import NO_LOAD_CASE, analyze_file
 from ._options import (
     add_json_option,
     add_load_case_options,
@@ -80,24 +80,17 @@ def _run(args: argparse.Namespace) -> int:
                  if st is not None else None for r, st in zip(results, stated, strict=True)]
         refuse_identical_contents_stating_apart(
             (Path(path).name, r.measurement.sha256, c.key if c else None,
-             c.full_label() if c else "no load case")
+             c.full_label() if c else NO_LOAD_CASE)
             for path, r, c in zip(args.paths, results, cases, strict=True))
         replaced: list[str] = []
         if not args.no_store:
-            from ..measure import replacement_notes, save_analyses
-            from ..records import measurement_key
-            from ..store import Store
+            from ..measure import save_analyses
 
-            # a saved record of the same bytes under another name or load case is replaced:
-            # said, never silent (as the report and the app say it)
-            replaced = replacement_notes(Store(args.store).list_analyses(), [
-                (Path(path).name, measurement_key(r.measurement),
-                 c.full_label() if c else "no load case")
-                for path, r, c in zip(args.paths, results, cases, strict=True)])
-            keys = save_analyses(  # one transaction
+            saved_now = save_analyses(  # one transaction
                 args.store, results, options,
-                fields=[c.as_record(st.origin) if c is not None else None
-                        for c, st in zip(cases, stated, strict=True)])
+                [(Path(path).name, c, st.origin if st is not None else "")
+                 for path, c, st in zip(args.paths, cases, stated, strict=True)])
+            keys, replaced = saved_now.keys, saved_now.notes
             saved = True
         interrupt.raise_if_interrupted()  # an interrupt swallowed on the way still counts
     except (KeyboardInterrupt, SystemError) as exc:

@@ -184,22 +184,6 @@ def latest_per_measurement(analyses: pd.DataFrame) -> pd.DataFrame:
             .groupby("measurement_key", sort=False).tail(1).reset_index(drop=True))
 
 
-def _store_results(store, results: list[MeasuredResult], options: AnalysisOptions,
-                   notes: list[str]) -> list[str]:
-    # Same entry as `pidcore analyze` for the same file and options (replaced, not
-    # duplicated), plus the load case fields; a saved record of the same contents under
-    # another name or load case is replaced, and the notes say so.
-    from ..measure import replacement_notes, store_analysis
-    from ..records import measurement_key
-
-    with store.transaction():
-        notes += replacement_notes(store.list_analyses(), [
-            (r.path.name, measurement_key(r.measurement), r.load_case.full_label())
-            for r in results])
-        return [store_analysis(store, r.analyzed, options.parameters(),
-                               fields=r.load_case.as_record(r.stated.origin)) for r in results]
-
-
 def _measured_loops(results: list[MeasuredResult], analyses: pd.DataFrame, store,
                     notes: list[str]) -> list[tuple[str, LoadCase, ForceDisplacementLoop]]:
     """(name, load case, loop) per measurement: from the fresh analyses, else from the store's
@@ -339,7 +323,7 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
     -------
     ReportResult
     """
-    from ..measure import AnalysisOptions
+    from ..measure import AnalysisOptions, save_analyses
     from ..model import load_paper_table3
 
     formats = parse_formats(formats)
@@ -386,7 +370,12 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         notes += [f"{f.name}: identical contents to another file given; counted once"
                   for f in files if f not in kept]
     if main is not None and results:
-        keys = _store_results(main, results, options, notes)
+        # Same entry as `pidcore analyze` for the same file and options (replaced, not
+        # duplicated), with the load case fields
+        saved = save_analyses(main, [r.analyzed for r in results], options,
+                              [(r.path.name, r.load_case, r.stated.origin) for r in results])
+        keys = saved.keys
+        notes += saved.notes
         listed = main.list_analyses()
         analyses = listed[listed["key"].isin(keys)]
         analyses = analyses.set_index("key").loc[keys].reset_index()  # order of the files
