@@ -53,6 +53,13 @@ def add_load_case_options(p: argparse._ActionsContainer, *, what: str,
                         "default: loadcases.csv beside each file")
 
 
+def check_out_folder(out: Path) -> None:
+    """``--out`` must be a folder or not exist yet (a file there would be half-overwritten);
+    checked before any work, so a long run is not thrown away at the end."""
+    if out.exists() and not out.is_dir():
+        raise ParameterError(f"--out {out}: exists and is not a folder")
+
+
 def add_store_option(p: argparse.ArgumentParser, *, flag: str = "--store",
                      default: Path | None = defaults.STORE_PATH,
                      help: str = STORE_HELP) -> None:

@@ -7,7 +7,7 @@ import sys
 from pathlib import Path
 
 from .. import defaults
-from ._options import non_negative_int
+from ._options import check_out_folder, non_negative_int
 
 DEFAULT_STORE = Path("calibration_store.h5")
 
@@ -73,9 +73,8 @@ def run(args: argparse.Namespace) -> int:
     from ..errors import ParameterError
     from ..specimen import load_specimen
 
-    if args.out is not None and args.out.exists() and not args.out.is_dir():
-        # said before the DEM runs and the fit, not after them
-        raise ParameterError(f"--out {args.out}: exists and is not a folder")
+    if args.out is not None:  # said before the DEM runs and the fit, not after them
+        check_out_folder(args.out)
     specimen = load_specimen(args.specimen) if args.specimen is not None else None
     fit = parse_fit(args.fit, specimen)
     cells = CALIBRATION_CELLS if args.cells is None else args.cells

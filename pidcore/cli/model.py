@@ -16,7 +16,7 @@ from pathlib import Path
 from .. import defaults
 from ..constants import PARTICLE_MATERIALS, VIBRATED_MASS_CONVENTIONS
 from ..errors import ParameterError
-from ._options import add_store_option
+from ._options import add_store_option, check_out_folder
 
 
 def _float_list(text: str) -> list[float]:
@@ -40,12 +40,6 @@ def _positive_float(text: str) -> float:
     if not (math.isfinite(value) and value > 0):
         raise argparse.ArgumentTypeError(f"expected a finite number > 0, got {text!r}")
     return value
-
-
-def _check_out(out: Path) -> None:
-    """``--out`` must be a folder or not exist yet (a file there would be half-overwritten)."""
-    if out.exists() and not out.is_dir():
-        raise ParameterError(f"--out {out}: exists and is not a folder")
 
 
 def _formats(text: str) -> list[str]:
@@ -153,7 +147,7 @@ def run_damper(args: argparse.Namespace) -> int:
         write_damper_table,
     )
 
-    _check_out(args.out)
+    check_out_folder(args.out)
     model, runs = build_model(args)
     if runs is not None and args.vibrated_mass is not None:
         raise ParameterError(
@@ -232,7 +226,7 @@ def run_damper(args: argparse.Namespace) -> int:
 def run_figures(args: argparse.Namespace) -> int:
     from ..report.figures import plot_sdc_vs_acceleration, plot_sdc_vs_frequency, save_figure
 
-    _check_out(args.out)
+    check_out_folder(args.out)
     model, _ = build_model(args)
 
     def curves(extra: tuple[float, ...], axis) -> list[float]:
