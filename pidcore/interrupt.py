@@ -13,13 +13,18 @@ from __future__ import annotations
 import signal
 import sys
 import threading
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 
 _interrupted = threading.Event()
+#: Depth of :func:`deferred` blocks the main thread is in (the handler runs in that thread).
+_deferring = 0
 
 
 def _handler(signum, frame) -> None:  # noqa: ARG001 - signal handler signature
     _interrupted.set()
+    if _deferring:
+        return  # raised by the deferred block's owner once its step is whole
     raise KeyboardInterrupt
 
 
@@ -64,6 +69,26 @@ def raise_if_interrupted() -> None:
     """Raise :class:`KeyboardInterrupt` if SIGINT arrived, even if it was swallowed since."""
     if _interrupted.is_set():
         raise KeyboardInterrupt
+
+
+@contextmanager
+def deferred() -> Iterator[None]:
+    """A block that SIGINT cannot cut in two: inside it the handler only records the
+    interruption; :func:`raise_if_interrupted` after the block delivers it.
+
+    For a commit and its bookkeeping (the store's rename and its commit count): an interrupt
+    landing between the two would leave the caller unable to say whether its work was
+    saved. Only the main thread defers (the handler runs there); elsewhere a no-op.
+    """
+    global _deferring
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    _deferring += 1
+    try:
+        yield
+    finally:
+        _deferring -= 1
 
 
 def is_interruption(exc: BaseException) -> bool:

@@ -148,3 +148,32 @@ def test_an_interrupted_in_process_run_leaves_no_flag_behind(tmp_path, capsys, m
     assert not interrupt.interrupted()
     Store(tmp_path / "s.h5").add_dem_run("after", {"sdc": 0.1})  # commits again
     assert Store(tmp_path / "s.h5").has_dem_run("after")
+
+
+def test_a_ctrl_c_during_the_commit_is_delivered_after_it_is_counted(tmp_path, monkeypatch):
+    # SIGINT right as the rename returns: before the deferral the KeyboardInterrupt came
+    # between the rename and the commit count, so a caller said "nothing saved" of a store
+    # that had changed. Now the rename and its count are one step and the interrupt follows.
+    import pidcore.store.store as store_module
+
+    store = Store(tmp_path / "s.h5")
+    real_replace = os.replace
+
+    def replace_then_sigint(src, dst):
+        real_replace(src, dst)
+        signal.raise_signal(signal.SIGINT)  # the handler runs at the next bytecode
+
+    restore = interrupt.install()
+    interrupt.reset()
+    monkeypatch.setattr(store_module.os, "replace", replace_then_sigint)
+    try:
+        with pytest.raises(KeyboardInterrupt), store.transaction() as h5:
+            h5.attrs["probe"] = 1
+    finally:
+        monkeypatch.undo()
+        restore()
+        interrupt.reset()
+    assert store.commits == 1  # counted: the caller can tell the work was saved
+    with store.transaction() as h5:
+        assert h5.attrs["probe"] == 1  # ... and it was
+    assert store.commits == 2

@@ -263,6 +263,8 @@ class Store:
         self.lock_timeout_s = timeout
         self._active: h5py.File | None = None
         self._active_thread: int | None = None
+        #: Transactions this object has committed (read after a Ctrl-C: was anything saved?)
+        self.commits = 0
         if self.path.is_dir():  # HDF5's own message is two lines of C-library internals
             raise StoreError(f"{self.path}: is a folder; expected a store file (e.g. "
                              f"{defaults.STORE_PATH})")
@@ -371,9 +373,13 @@ class Store:
                 try:
                     h5.close()
                     _fsync_path(tmp)
-                    # A Ctrl-C swallowed on the way (weakref callback, Numba) never commits.
-                    interrupt.raise_if_interrupted()
-                    os.replace(tmp, self.path)
+                    # The rename and its count are one step for Ctrl-C (a caller reads
+                    # `commits` to say whether its work was saved); a Ctrl-C swallowed on the
+                    # way (weakref callback, Numba) never commits.
+                    with interrupt.deferred():
+                        interrupt.raise_if_interrupted()
+                        os.replace(tmp, self.path)
+                        self.commits += 1
                 except OSError as exc:
                     raise StoreError(f"{self.path}: cannot commit the changes ({exc}); "
                                      "the store is unchanged") from None
@@ -381,6 +387,7 @@ class Store:
                 # file systems cannot fsync a directory, so a failure here is not an error.
                 with suppress(OSError):
                     _fsync_path(directory, directory=True)
+                interrupt.raise_if_interrupted()  # one that came during the commit
             except BaseException:
                 tmp.unlink(missing_ok=True)
                 raise
