@@ -123,19 +123,37 @@ def test_ctrl_c_after_the_run_was_stored_says_it_was_saved(tmp_path, monkeypatch
 
 
 def test_ctrl_c_in_a_sweep_counts_the_cases_stored(tmp_path, monkeypatch, capsys):
-    from types import SimpleNamespace
-
     import pidcore.dem.sweep
+    from pidcore.dem.persist import run_key
+    from pidcore.store import Store
 
-    def two_then_interrupt(cases, config, *, on_case, **kwargs):
-        for key in ("a", "b"):  # run_sweep calls on_case after each case is stored
-            on_case(SimpleNamespace(key=key))
+    path = tmp_path / "s.h5"
+
+    def store_cases(cases, config, n, specimen=None):
+        for case in cases[:n]:
+            key = run_key(case, config, specimen)
+            if not (path.exists() and Store(path).has_dem_run(key)):  # the sweep skips those
+                Store(path).add_dem_run(key, {"sdc": 0.1})
+
+    def three_then_interrupt(cases, config, *, store_path, specimen, **kwargs):
+        # the first case was in the store before the sweep; two more are stored, and the
+        # interrupt comes as the last save commits (no hook after it could count that one)
+        store_cases(cases, config, 3, specimen)
         raise KeyboardInterrupt
 
-    sweep = ["dem", "sweep", "--store", str(tmp_path / "s.h5"), "--no-progress"]
-    monkeypatch.setattr(pidcore.dem.sweep, "run_sweep", two_then_interrupt)
+    sweep = ["dem", "sweep", "--store", str(path), "--no-progress"]
+
+    def first_only(cases, config, *, store_path, specimen, **kwargs):
+        store_cases(cases, config, 1, specimen)
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(pidcore.dem.sweep, "run_sweep", first_only)
+    assert main(sweep) == 130
+    assert "interrupted; 1 finished run(s) saved to" in capsys.readouterr().err
+    monkeypatch.setattr(pidcore.dem.sweep, "run_sweep", three_then_interrupt)
     assert main(sweep) == 130
     assert "interrupted; 2 finished run(s) saved to" in capsys.readouterr().err
+    assert len(Store(path).list_dem_runs()) == 3
     monkeypatch.setattr(pidcore.dem.sweep, "run_sweep", _interrupt)
     assert main(sweep) == 130
     err = capsys.readouterr().err

@@ -196,12 +196,16 @@ def sweep(args: argparse.Namespace) -> int:
     for fill in values[2]:
         _check_fill(fill, "--fills", args, specimen, material)
     cases = cross_cases(*values, material=material, direction=args.direction)
-    saved: list[str] = []  # keys run_sweep has stored (its on_case hook runs after each save)
+    config = _config(args)
+    # What a Ctrl-C leaves saved is read from the store itself: a count kept beside the saves
+    # could miss one that committed as the interrupt came.
+    before = _stored_runs(args.store, cases, config, specimen)
     try:
-        summary = run_sweep(cases, _config(args), store_path=args.store, workers=args.workers,
+        summary = run_sweep(cases, config, store_path=args.store, workers=args.workers,
                             scheduler=args.scheduler, progress=not args.no_progress,
-                            specimen=specimen, on_case=lambda outcome: saved.append(outcome.key))
+                            specimen=specimen)
     except KeyboardInterrupt:
+        saved = _stored_runs(args.store, cases, config, specimen) - before
         return _interrupted("sweep", len(saved), args.store)
     if args.json:
         print(json.dumps(summary.to_dict()))
@@ -209,6 +213,18 @@ def sweep(args: argparse.Namespace) -> int:
         print(f"{len(summary.completed)} case(s) simulated, {len(summary.skipped)} already in "
               f"{args.store}; wall time {summary.wall_s:.1f} s")
     return 0
+
+
+def _stored_runs(store_path: Path, cases, config, specimen) -> set[str]:
+    """The run keys of ``cases`` that the store at ``store_path`` holds now."""
+    from ..dem.persist import run_key
+    from ..store import Store
+
+    if not store_path.exists():
+        return set()
+    store = Store(store_path)
+    return {key for key in (run_key(case, config, specimen) for case in cases)
+            if store.has_dem_run(key)}
 
 
 def _check_fill(fill: float, option: str, args: argparse.Namespace, specimen,
