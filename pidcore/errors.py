@@ -25,6 +25,12 @@ class ParameterError(PidcoreError, ValueError):
     """A parameter is out of range or of the wrong kind."""
 
 
+class SettingsTableError(ParameterError):
+    """A settings table (a sidecar ``loadcases.csv``) has an unknown column or a bad value. The
+    message names the table's own columns (``baseline_loss_factor``), which the CLI must not
+    translate to its options (``--baseline-loss-factor``)."""
+
+
 class StoreError(PidcoreError):
     """The HDF5 store is missing, corrupt, locked or lacks the requested entry."""
 

@@ -275,31 +275,42 @@ class SavedAnalyses:
     notes: list[str]
 
 
-def save_analyses(store, results: Sequence[AnalyzedRecord], options: AnalysisOptions,
-                  stated: Sequence[tuple[str, object, str]]) -> SavedAnalyses:
+def save_analyses(store, results: Sequence[AnalyzedRecord],
+                  options: AnalysisOptions | Sequence[AnalysisOptions],
+                  stated: Sequence[tuple[str, object, str]], *,
+                  fields: Sequence[Mapping | None] | None = None) -> SavedAnalyses:
     """Save measurements and their analyses in one transaction of ``store`` (a
     :class:`~pidcore.store.Store` or its path).
 
+    ``options``: per result, the options it was analysed with (their parameters are its
+    record's, so that each record says how it was made: files of one call may have different
+    settings, :mod:`pidcore.file_settings`); one :class:`AnalysisOptions` stands for all.
     ``stated``: per result, (file name, its :class:`~pidcore.loadcase.LoadCase` or None, who
     stated it); the load case goes into the record (:meth:`~pidcore.loadcase.LoadCase.as_record`).
+    ``fields``: per result, further record fields or None (the ``specimen`` a sidecar names).
     A saved record of the same bytes under another name or load case is replaced, and the
     notes say so (:func:`replacement_notes`).
     """
     from .records import measurement_key
     from .store import Store
 
-    if len(stated) != len(results):
-        raise ParameterError(f"stated: expected one per result ({len(results)}), got "
-                             f"{len(stated)}")
+    per_result = ([options] * len(results) if isinstance(options, AnalysisOptions)
+                  else list(options))
+    extra = list(fields) if fields is not None else [None] * len(results)
+    for name, given in (("options", per_result), ("stated", stated), ("fields", extra)):
+        if len(given) != len(results):
+            raise ParameterError(f"{name}: expected one per result ({len(results)}), got "
+                                 f"{len(given)}")
     store = store if isinstance(store, Store) else Store(store)
     with store.transaction():
         notes = replacement_notes(store.list_analyses(), [
             (name, measurement_key(r.measurement),
              case.full_label() if case is not None else NO_LOAD_CASE)
             for r, (name, case, _) in zip(results, stated, strict=True)])
-        keys = [store_analysis(store, r, options.parameters(),
-                               fields=case.as_record(origin) if case is not None else None)
-                for r, (_, case, origin) in zip(results, stated, strict=True)]
+        keys = [store_analysis(store, r, o.parameters(), fields={
+                    **(case.as_record(origin) if case is not None else {}), **(more or {})})
+                for r, o, (_, case, origin), more in zip(results, per_result, stated, extra,
+                                                         strict=True)]
     return SavedAnalyses(keys, notes)
 
 

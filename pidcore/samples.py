@@ -155,7 +155,10 @@ def make_samples(out_dir: str | os.PathLike = "data_samples", *, run_sweep: bool
         write_measurement(m, path, fmt, binary=sample.file_format == "uff58b")
         written[sample.file_name] = path
     sidecar = out / "loadcases.csv"
-    sidecar.write_text("file,fill_percent,material,direction\n" + "".join(
-        f"{s.file_name},{s.fill_percent:g},acrylic,z\n" for s in SAMPLE_CASES))
+    # the exports' vibrometer delay too: `--sidecar loadcases.csv` (CLI) and the app's settings
+    # table analyse them at it without a --velocity-delay
+    sidecar.write_text("file,fill_percent,material,direction,velocity_delay_us\n" + "".join(
+        f"{s.file_name},{s.fill_percent:g},acrylic,z,{EXPORT_VELOCITY_DELAY_S * 1e6:g}\n"
+        for s in SAMPLE_CASES))
     written["loadcases"] = sidecar
     return written

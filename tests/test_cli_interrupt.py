@@ -118,7 +118,7 @@ def test_an_import_broken_by_the_interrupt_still_exits_130(tmp_path, capsys, mon
         interrupt._interrupted.set()  # what the handler does before raising inside the import
         raise ImportError("numba._devicearray failed to import")
 
-    monkeypatch.setattr(analyze_cli, "analyze_file", broken_import)
+    monkeypatch.setattr(analyze_cli, "analyze_with_settings", broken_import)
     assert main(["analyze", str(tmp_path / "x.csv"), "--no-store"]) == 130
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "interrupted" in err[0]
@@ -126,7 +126,7 @@ def test_an_import_broken_by_the_interrupt_still_exits_130(tmp_path, capsys, mon
     def really_missing(*args, **kwargs):
         raise ImportError("no module named numba")
 
-    monkeypatch.setattr(analyze_cli, "analyze_file", really_missing)
+    monkeypatch.setattr(analyze_cli, "analyze_with_settings", really_missing)
     with pytest.raises(ImportError, match="no module named numba"):
         main(["analyze", str(tmp_path / "x.csv"), "--no-store"])
     assert not interrupt.is_interruption(ImportError("unrelated"))
@@ -142,7 +142,7 @@ def test_an_interrupted_in_process_run_leaves_no_flag_behind(tmp_path, capsys, m
         interrupt._interrupted.set()  # what the handler does
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(analyze_cli, "analyze_file", interrupted)
+    monkeypatch.setattr(analyze_cli, "analyze_with_settings", interrupted)
     assert main(["analyze", str(tmp_path / "x.csv"), "--no-store"]) == 130
     assert len(capsys.readouterr().err.strip().splitlines()) == 1
     assert not interrupt.interrupted()

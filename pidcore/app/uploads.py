@@ -26,6 +26,7 @@ from typing import TYPE_CHECKING
 import pandas as pd
 
 from .. import defaults
+from ..compare.loadcase import FREE_TEXT_COLUMNS
 from ..constants import PARTICLE_MATERIALS
 from ..errors import ParameterError, PidcoreError
 
@@ -39,7 +40,8 @@ NO_CHANNEL = "(none)"
 #: Label of "the channel the readers detect".
 AUTO_CHANNEL = "(auto)"
 
-#: Per-file settings: column shown in the app -> column of the CSV template / uploaded table.
+#: Per-file settings: column shown in the app -> column of the CSV template / uploaded table
+#: (:data:`pidcore.compare.loadcase.SETTINGS_COLUMNS`, the sidecar's columns of the CLI).
 FILE_TABLE_COLUMNS: dict[str, str] = {
     "file": "file",
     "fill [%]": "fill_percent",
@@ -329,10 +331,13 @@ def read_settings_table(name: str, data: bytes,
     by_name = {k.lower(): k for k in FILE_TABLE_COLUMNS} | {
         v: k for k, v in FILE_TABLE_COLUMNS.items()}
     raw.columns = [by_name.get(str(c).strip().lower(), str(c).strip()) for c in raw.columns]
+    # free-text remarks are accepted and ignored, as by `pidcore analyze` (one table for both)
+    raw = raw.loc[:, [c for c in raw.columns if c.lower() not in FREE_TEXT_COLUMNS]]
     unknown = [c for c in raw.columns if c not in FILE_TABLE_COLUMNS]
     if unknown:
         raise ParameterError(f"{name}: unknown column(s) {unknown}; expected some of "
-                             f"{list(FILE_TABLE_COLUMNS.values())}")
+                             f"{list(FILE_TABLE_COLUMNS.values())} (and free text: "
+                             f"{', '.join(FREE_TEXT_COLUMNS)})")
     out = pd.DataFrame({c: raw[c].str.strip() if c in raw else "" for c in FILE_TABLE_COLUMNS})
     for column in _NUMERIC:
         values = []
@@ -459,31 +464,21 @@ def settings_template(settings: pd.DataFrame) -> bytes:
 
 
 def options_of(row: Mapping, *, sample_rate_hz: float | None = None) -> AnalysisOptions:
-    """Analysis options of one file's settings row (SI inside: µs and g converted here)."""
+    """Analysis options of one file's settings row (SI inside: µs and g converted by
+    :func:`pidcore.file_settings.analysis_overrides`, the parsing ``pidcore analyze`` applies
+    to a sidecar row: one set of checks, errors naming the file and the column)."""
+    from ..file_settings import analysis_overrides
     from ..measure import AnalysisOptions
 
     def channel(value) -> str | None:
         return None if value in (None, "", AUTO_CHANNEL, NO_CHANNEL) else str(value)
 
-    def number(value, name: str) -> float:
-        v = float(value) if value not in (None, "") else 0.0
-        if not math.isfinite(v):
-            raise ParameterError(f"{row['file']}: {name} {value!r}, expected a number")
-        return v
-
-    mass_g = number(row["mass below gauge [g]"], "mass below gauge [g]")
-    baseline = number(row["baseline loss factor [-]"], "baseline loss factor [-]")
-    if mass_g < 0 or baseline < 0:
-        raise ParameterError(f"{row['file']}: mass below gauge and baseline loss factor must "
-                             "be >= 0")
-    inverted = str(row.get("inverted channels", "") or "")
-    return AnalysisOptions(
-        force=channel(row["force channel"]), velocity=channel(row["velocity channel"]),
-        acceleration=channel(row["acceleration channel"]),
-        invert=tuple(n.strip() for n in inverted.split(";") if n.strip()),
-        velocity_delay_s=number(row["vibrometer delay [µs]"], "vibrometer delay [µs]") * 1e-6,
-        mass_below_gauge_kg=mass_g * 1e-3, baseline_loss_factor=baseline,
-        sample_rate_hz=sample_rate_hz)
+    labels = {v: k for k, v in FILE_TABLE_COLUMNS.items()}  # errors name the app's columns
+    cells = {column: row.get(label) for column, label in labels.items()}
+    for role in ("force", "velocity", "acceleration"):
+        cells[role] = channel(cells[role])
+    return AnalysisOptions(**analysis_overrides(cells, str(row["file"]), labels=labels),
+                           sample_rate_hz=sample_rate_hz)
 
 
 # --- results and saving ------------------------------------------------------------------------

@@ -49,8 +49,11 @@ def add_load_case_options(p: argparse._ActionsContainer, *, what: str,
     p.add_argument("--direction", choices=DRIVE_DIRECTIONS, default=None,
                    help=f"drive direction of every {what} (default: stated or z)")
     p.add_argument("--sidecar", metavar="CSV", type=Path, default=None,
-                   help="load case table (columns file, fill_percent, material, direction); "
-                        "default: loadcases.csv beside each file")
+                   help="per-file table: load case (file, fill_percent, material, direction) "
+                        "and analysis settings (velocity_delay_us, mass_below_gauge_g, "
+                        "baseline_loss_factor, force, velocity, acceleration, invert, "
+                        "specimen); options given override it; default: loadcases.csv beside "
+                        "each file")
 
 
 def check_out_folder(out: Path) -> None:
@@ -77,15 +80,22 @@ def add_json_option(p: argparse.ArgumentParser, *, progress: bool = False) -> No
 def add_measurement_options(p: argparse.ArgumentParser) -> None:
     """Channel mapping and corrections of the Eq. 11 analysis (``analyze``, ``report``)."""
     g = p.add_argument_group("measurement analysis")
-    g.add_argument("--force", metavar="NAME", help="force channel name (default: detected)")
+    # Defaults None: an option given overrides a sidecar's value for every file, one not
+    # given leaves it (analysis_options fills in the defaults, given_options says which were
+    # given)
+    g.add_argument("--force", metavar="NAME",
+                   help="force channel name (default: sidecar's, else detected)")
     g.add_argument("--velocity", metavar="NAME", help="velocity channel name")
     g.add_argument("--acceleration", metavar="NAME", help="acceleration channel name")
-    g.add_argument("--velocity-delay", metavar="SECONDS", type=float, default=0.0,
-                   help="vibrometer output delay to remove, s (default 0)")
-    g.add_argument("--mass-below-gauge", metavar="KG", type=float, default=0.0,
-                   help="mass between force gauge and structure to cancel, kg (default 0)")
-    g.add_argument("--baseline-loss-factor", metavar="ETA", type=float, default=0.0,
-                   help="loss factor of the empty coupon to subtract (default 0)")
+    g.add_argument("--velocity-delay", metavar="SECONDS", type=float, default=None,
+                   help="vibrometer output delay to remove, s (default: the sidecar's "
+                        "velocity_delay_us, else 0)")
+    g.add_argument("--mass-below-gauge", metavar="KG", type=float, default=None,
+                   help="mass between force gauge and structure to cancel, kg (default: the "
+                        "sidecar's mass_below_gauge_g, else 0)")
+    g.add_argument("--baseline-loss-factor", metavar="ETA", type=float, default=None,
+                   help="loss factor of the empty coupon to subtract (default: the sidecar's, "
+                        "else 0)")
     g.add_argument("--frequency", metavar="HZ", type=float, default=None,
                    help="drive frequency hint, Hz (estimated from the data anyway)")
     g.add_argument("--harmonics", metavar="N", type=int, default=defaults.N_HARMONICS,
@@ -102,25 +112,45 @@ def add_measurement_options(p: argparse.ArgumentParser) -> None:
                    help="unit of the velocity channel's values (m/s, mm/s, in/s, ...)")
     g.add_argument("--acceleration-unit", metavar="UNIT", default=None,
                    help="unit of the acceleration channel's values (m/s^2, g, ...)")
-    g.add_argument("--invert", metavar="NAME", action="append", default=[],
+    g.add_argument("--invert", metavar="NAME", action="append", default=None,
                    help="invert the sign of this channel (a sensor mounted the other way); "
-                        "repeatable")
+                        "repeatable; replaces the sidecar's invert column")
+
+
+#: Options fields of :func:`add_measurement_options` a sidecar may also state, and their flags.
+SIDECAR_OPTION_FLAGS: dict[str, str] = {
+    "force": "--force", "velocity": "--velocity", "acceleration": "--acceleration",
+    "velocity_delay_s": "--velocity-delay", "mass_below_gauge_kg": "--mass-below-gauge",
+    "baseline_loss_factor": "--baseline-loss-factor", "invert": "--invert",
+}
+
+
+def given_options(args: argparse.Namespace) -> dict[str, str]:
+    """The options fields given on the command line -> their flags: these override a
+    sidecar's values (:func:`pidcore.file_settings.resolve_file_settings`)."""
+    return {name: flag for name, flag in SIDECAR_OPTION_FLAGS.items()
+            if getattr(args, flag[2:].replace("-", "_")) is not None}
 
 
 def analysis_options(args: argparse.Namespace) -> AnalysisOptions:
-    """The :class:`AnalysisOptions` the options of :func:`add_measurement_options` state."""
-    if not args.velocity_delay >= 0:  # NaN too
+    """The :class:`AnalysisOptions` the options of :func:`add_measurement_options` state
+    (defaults filled in for those not given)."""
+    def given(value: float | None) -> float:
+        return 0.0 if value is None else value
+
+    delay = given(args.velocity_delay)
+    if not delay >= 0:  # NaN too
         # the library takes a signed delay (a late force); a vibrometer only ever lags
-        raise ParameterError(f"--velocity-delay {args.velocity_delay:g}: expected a delay "
+        raise ParameterError(f"--velocity-delay {delay:g}: expected a delay "
                              ">= 0 s (the vibrometer output lags the motion)")
     return AnalysisOptions(
         force=args.force, velocity=args.velocity, acceleration=args.acceleration,
-        velocity_delay_s=args.velocity_delay, mass_below_gauge_kg=args.mass_below_gauge,
-        baseline_loss_factor=args.baseline_loss_factor, frequency_hz=args.frequency,
+        velocity_delay_s=delay, mass_below_gauge_kg=given(args.mass_below_gauge),
+        baseline_loss_factor=given(args.baseline_loss_factor), frequency_hz=args.frequency,
         n_harmonics=args.harmonics, sample_rate_hz=args.sample_rate,
         allow_clipped=args.allow_clipped, force_unit=args.force_unit,
         velocity_unit=args.velocity_unit, acceleration_unit=args.acceleration_unit,
-        invert=tuple(args.invert),
+        invert=tuple(args.invert or ()),
     )
 
 
@@ -138,9 +168,10 @@ _FLAG_OF_KEYWORD = (
     ("n_harmonics", "--harmonics"),
     ("sample_rate_hz", "--sample-rate"),
 )
-# whole words only: "my_frequency_hz_col" (a file's column) stays as it is
+# whole words only: "my_frequency_hz_col" (a file's column) stays as it is, and so does a
+# sidecar's column of the same name ("column baseline_loss_factor '-1' of loadcases.csv")
 _KEYWORD_PATTERN = re.compile("|".join(
-    rf"(?<![\w-]){re.escape(k)}" + (r"(?!\w)" if k[-1].isalnum() else "")
+    rf"(?<![\w-])(?<!column ){re.escape(k)}" + (r"(?!\w)" if k[-1].isalnum() else "")
     for k, _ in _FLAG_OF_KEYWORD))
 
 

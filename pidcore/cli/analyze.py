@@ -9,13 +9,15 @@ from pathlib import Path
 
 from .. import interrupt
 from ..errors import PidcoreError
-from ..measure import NO_LOAD_CASE, analyze_file
+from ..file_settings import analyze_with_settings
+from ..measure import NO_LOAD_CASE
 from ._options import (
     add_json_option,
     add_load_case_options,
     add_measurement_options,
     add_store_option,
     analysis_options,
+    given_options,
     with_cli_flags,
 )
 
@@ -26,7 +28,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="loss factor and SDC from force/velocity exports (Eq. 11)",
         description="Analyse shaker-test exports (UFF58/58b, CSV/TXT, MAT, HDF5): complex power "
                     "(Eq. 11), loss factor, specific damping capacity, one record per load case. "
-                    "Results are saved to the store unless --no-store.",
+                    "Each file is analysed with its sidecar row's settings (vibrometer delay, "
+                    "channels, ...) unless an option overrides them. Results are saved to the "
+                    "store unless --no-store.",
     )
     p.add_argument("paths", nargs="+", metavar="PATH", type=Path, help="export files")
     add_measurement_options(p)
@@ -44,18 +48,25 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..errors import SettingsTableError
+
     try:
         return _run(args)
+    except SettingsTableError:  # names the sidecar's columns, which are not flags
+        raise
     except PidcoreError as exc:  # library keywords -> the flags the user types
         raise type(exc)(with_cli_flags(str(exc))) from None
 
 
-def _stated_load_cases(args: argparse.Namespace) -> list:
-    """What each path states about its load case (None: no fill stated), resolved before any
-    analysis so that a bad sidecar or option is refused at once."""
+def _stated(args: argparse.Namespace) -> tuple[list, list]:
+    """What each path states about its load case (None: no fill stated) and how it is analysed
+    (:class:`~pidcore.file_settings.FileSettings`), resolved before any analysis so that a bad
+    sidecar or option is refused at once."""
     from ..compare.loadcase import FillNotStated, resolve_load_case
+    from ..file_settings import resolve_file_settings
 
-    stated = []
+    options, given = analysis_options(args), given_options(args)
+    stated, settings = [], []
     for path in args.paths:  # (a missing file is named by its analysis)
         try:
             stated.append(resolve_load_case(path, fill_percent=args.fill,
@@ -63,33 +74,38 @@ def _stated_load_cases(args: argparse.Namespace) -> list:
                                             sidecar=args.sidecar))
         except FillNotStated:
             stated.append(None)
-    return stated
+        settings.append(resolve_file_settings(path, options, given=given, sidecar=args.sidecar))
+    return stated, settings
 
 
 def _run(args: argparse.Namespace) -> int:
     from ..loadcase import refuse_identical_contents_stating_apart
 
-    options = analysis_options(args)
-    stated = _stated_load_cases(args)
+    stated, settings = _stated(args)
     saved = False
     keys: list[str] = []
+    results: list = []
     try:
         # Analyse everything before writing anything: one bad file leaves the store untouched.
-        results = [analyze_file(path, options, key=args.key) for path in args.paths]
+        results = [analyze_with_settings(path, fs, key=args.key)
+                   for path, fs in zip(args.paths, settings, strict=True)]
         cases = [st.load_case(r.analysis.frequency_hz, r.analysis.acceleration_g)
                  if st is not None else None for r, st in zip(results, stated, strict=True)]
+        # one content is one measurement: two statements (load case, specimen, settings) about
+        # it cannot both be saved
         refuse_identical_contents_stating_apart(
-            (Path(path).name, r.measurement.sha256, c.key if c else None,
-             c.full_label() if c else NO_LOAD_CASE)
-            for path, r, c in zip(args.paths, results, cases, strict=True))
+            (Path(path).name, r.measurement.sha256, (c.key if c else None, fs.statement()),
+             ", ".join(w for w in (c.full_label() if c else NO_LOAD_CASE, fs.label()) if w))
+            for path, r, c, fs in zip(args.paths, results, cases, settings, strict=True))
         replaced: list[str] = []
         if not args.no_store:
             from ..measure import save_analyses
 
             saved_now = save_analyses(  # one transaction
-                args.store, results, options,
+                args.store, results, [fs.options for fs in settings],
                 [(Path(path).name, c, st.origin if st is not None else "")
-                 for path, c, st in zip(args.paths, cases, stated, strict=True)])
+                 for path, c, st in zip(args.paths, cases, stated, strict=True)],
+                fields=[{"specimen": fs.specimen} if fs.specimen else None for fs in settings])
             keys, replaced = saved_now.keys, saved_now.notes
             saved = True
         interrupt.raise_if_interrupted()  # an interrupt swallowed on the way still counts
@@ -101,18 +117,25 @@ def _run(args: argparse.Namespace) -> int:
         print(f"pidcore analyze: {said}", file=sys.stderr)
         interrupt.mark_handled()
         return 130
+    overrides = [note for fs in settings for note in fs.notes]
     if args.json:
-        json.dump({"records": [{**r.to_dict(), "load_case": c.key if c else None}
-                               for r, c in zip(results, cases, strict=True)]}, sys.stdout)
+        json.dump({"records": [{**r.to_dict(), "load_case": c.key if c else None,
+                                "specimen": fs.specimen or None,
+                                "parameters": fs.options.parameters(),
+                                "settings_from": dict(fs.sources),
+                                "overridden": list(fs.notes)}
+                               for r, c, fs in zip(results, cases, settings, strict=True)],
+                   "notes": [*overrides, *replaced]}, sys.stdout)
         sys.stdout.write("\n")
     else:
         print(format_table(results))
-        for path, c, st in zip(args.paths, cases, stated, strict=True):
+        for path, c, st, fs in zip(args.paths, cases, stated, settings, strict=True):
+            said = fs.summary()
             print(f"{Path(path).name}: " + (f"load case {c.key} ({st.origin})" if c else
                   "no fill stated: saved without a load case (state it in the file name, "
                   "a sidecar or --fill for `pidcore report --store` to place it)"
-                  if not args.no_store else "no fill stated"))
-        for note in replaced:
+                  if not args.no_store else "no fill stated") + (f"; {said}" if said else ""))
+        for note in [*overrides, *replaced]:
             print(f"note: {note}")
         if not args.no_store:
             print(f"saved {_saved(results, keys)} to {args.store}")

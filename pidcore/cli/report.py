@@ -14,6 +14,7 @@ from ._options import (
     add_measurement_options,
     add_store_option,
     analysis_options,
+    given_options,
 )
 
 #: Columns of the short table printed on stdout.
@@ -36,7 +37,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                     "and with the paper's Table 3, and write a report (CSV, Markdown, "
                     "self-contained HTML, LaTeX, PDF, figures as PNG and SVG) into --out. "
                     "Fill is stated in the file name (..._fill50_... or ..._50pct_...), in "
-                    "a sidecar loadcases.csv, or with --fill.")
+                    "a sidecar loadcases.csv, or with --fill; the sidecar may also state each "
+                    "file's analysis settings (velocity_delay_us, ...), which options given "
+                    "override.")
     p.add_argument("files", nargs="*", metavar="FILE", type=Path,
                    help="measurement exports to analyse (UFF58, CSV/TXT, MAT, HDF5)")
     p.add_argument("--out", metavar="DIR", type=Path, required=True,
@@ -74,6 +77,7 @@ def run(args: argparse.Namespace) -> int:
         args.files, out_dir=args.out, store=args.store, dem_store=args.dem_store,
         formats=args.format, fill_percent=args.fill, material=args.material,
         direction=args.direction, sidecar=args.sidecar, options=analysis_options(args),
+        options_given=given_options(args),
         specimen=specimen, pool=args.pool, calibration=args.calibration)
     print(short_table(result.table))
     for note in result.notes:

@@ -240,7 +240,7 @@ class MeasuredEntry:
                    np.asarray(arrays.get("harmonics", empty)),
                    np.asarray(arrays.get("force_phasors_n", empty)),
                    np.asarray(arrays.get("velocity_phasors_m_s", empty)),
-                   str(row.get("specimen", "") or ""), str(row.get("created_utc", "")),
+                   _specimen_of(row), str(row.get("created_utc", "")),
                    describe_corrections(_json_dict(row.get("parameters_json"))),
                    str(row.get("measurement_key", "") or ""))
 
@@ -293,6 +293,13 @@ def unique_entries(entries: Sequence[MeasuredEntry]) -> tuple[list[MeasuredEntry
         notes.append(f"{e.file} left out, {e.origin}: the same contents as {other.file} "
                      f"({where}); the same data are counted once")
     return kept, notes
+
+
+def _specimen_of(row) -> str:
+    """The specimen a stored analysis names ("" for none): a store's listing holds NaN where a
+    record names none and another does (``str(NaN)`` would be a specimen "nan")."""
+    named = row.get("specimen", "")
+    return named if isinstance(named, str) else ""
 
 
 def _json_dict(text) -> dict:

@@ -15,7 +15,8 @@ are what the user *states*, in one of three ways (later ones override earlier on
    Example: ``coupon3_fill50_acrylic_dirz_500Hz_5g.uff``.
 2. **Sidecar table** ``loadcases.csv`` beside the file (or given explicitly) with columns
    ``file, fill_percent, material, direction``; rows are looked up by file name (no folder).
-   Empty cells state nothing.
+   Empty cells state nothing. The same row may state how the file is analysed (vibrometer
+   delay, channels, specimen, ...: :mod:`pidcore.file_settings`); any other column is refused.
 3. **Options** ``--fill``, ``--material``, ``--direction`` (keyword arguments here).
 
 Material and direction default to the paper's acrylic particles driven along z
@@ -29,10 +30,12 @@ import re
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 
 from .. import defaults
 from ..constants import PARTICLE_MATERIALS
+from ..errors import SettingsTableError
 from ..loadcase import (
     LoadCase,
     LoadCaseError,
@@ -50,8 +53,20 @@ class FillNotStated(LoadCaseError):
 
 #: Name of the sidecar table looked for beside each measurement file.
 SIDECAR_NAME = "loadcases.csv"
-#: Columns of the sidecar table (``file`` and ``fill_percent`` required).
+#: Load case columns of the sidecar table (``file`` and ``fill_percent`` required).
 SIDECAR_COLUMNS: tuple[str, ...] = ("file", "fill_percent", "material", "direction")
+#: Column naming the specimen tested (a name, saved with the analysis record as ``specimen``).
+SPECIMEN_COLUMN = "specimen"
+#: Columns stating how a file is analysed (read by :mod:`pidcore.file_settings`).
+ANALYSIS_SETTINGS_COLUMNS: tuple[str, ...] = (
+    "velocity_delay_us", "mass_below_gauge_g", "baseline_loss_factor", "force", "velocity",
+    "acceleration", "invert")
+#: Every column of a sidecar / the app's settings table (its template's columns, in its order).
+SETTINGS_COLUMNS: tuple[str, ...] = (*SIDECAR_COLUMNS, SPECIMEN_COLUMN,
+                                     *ANALYSIS_SETTINGS_COLUMNS)
+#: Free-text columns accepted and ignored: a lab's table keeps its remarks beside the values,
+#: and refusing them would make users delete documentation to run an analysis.
+FREE_TEXT_COLUMNS: tuple[str, ...] = ("note", "notes", "comment", "comments")
 
 _SEP = r"(?:^|(?<=[_\-. ]))"  # token start: beginning of the stem or after a separator
 _END = r"(?=$|[_\-. ])"  # token end
@@ -153,19 +168,46 @@ def parse_file_name(name: str | Path,
     return found
 
 
+def check_columns(columns, where: str) -> None:
+    """Refuse a column that is neither in :data:`SETTINGS_COLUMNS` nor free text
+    (:data:`FREE_TEXT_COLUMNS`): a misspelt ``velocity_delay_ms`` would otherwise be ignored,
+    and the files analysed without their delay.
+
+    Raises
+    ------
+    SettingsTableError
+        One line naming the table (``where``), the unknown column(s) and the known ones.
+    """
+    unknown = [str(c) for c in columns
+               if c not in SETTINGS_COLUMNS and c not in FREE_TEXT_COLUMNS]
+    if unknown:
+        raise SettingsTableError(
+            f"{where}: unknown column(s) {', '.join(map(repr, unknown))}; known columns are "
+            f"{', '.join(SETTINGS_COLUMNS)} (and free text: {', '.join(FREE_TEXT_COLUMNS)})")
+
+
 def read_sidecar(path: str | Path) -> pd.DataFrame:
     """Read a ``loadcases.csv`` sidecar table.
 
     Parameters
     ----------
     path : str or Path
-        CSV with a header row; columns ``file`` and ``fill_percent`` required, ``material`` and
-        ``direction`` optional. ``#`` starts a comment line.
+        CSV with a header row; columns ``file`` and ``fill_percent`` required, the other
+        columns of :data:`SETTINGS_COLUMNS` optional, free-text
+        ``note``/``comment`` columns ignored. ``#`` starts a comment line.
 
     Returns
     -------
     pandas.DataFrame
-        One row per file, columns :data:`SIDECAR_COLUMNS` (missing optional ones empty).
+        One row per file, columns :data:`SETTINGS_COLUMNS` (missing
+        optional ones empty), text stripped.
+
+    Raises
+    ------
+    LoadCaseError
+        Not found, not a CSV table, a required column missing, a file listed twice.
+    SettingsTableError
+        A column neither the CLI nor the app knows (:func:`check_columns`).
     """
     path = Path(path)
     try:
@@ -180,14 +222,63 @@ def read_sidecar(path: str | Path) -> pd.DataFrame:
         if required not in table.columns:
             raise LoadCaseError(f"{path}: sidecar table lacks column {required!r}; expected "
                                 f"columns {', '.join(SIDECAR_COLUMNS)}")
-    for optional in ("material", "direction"):
+    check_columns(table.columns, f"{path} (sidecar table)")
+    for optional in SETTINGS_COLUMNS:
         if optional not in table.columns:
             table[optional] = ""
-    table = table.loc[:, list(SIDECAR_COLUMNS)].apply(lambda col: col.str.strip())
+    table = table.loc[:, list(SETTINGS_COLUMNS)].apply(lambda col: col.str.strip())
     duplicated = table["file"][table["file"].duplicated()].tolist()
     if duplicated:
         raise LoadCaseError(f"{path}: sidecar table lists {duplicated[0]!r} more than once")
     return table.reset_index(drop=True)
+
+
+@dataclass(frozen=True)
+class SidecarRow:
+    """The sidecar row of one measurement file.
+
+    Attributes
+    ----------
+    values : dict of str to str
+        Cell text by column ("" for an empty cell or a column the table lacks).
+    name : str
+        The table as an origin is named: its file name (``"loadcases.csv"``), or
+        ``"sidecar table"`` for a table given as a DataFrame.
+    where : str
+        The row as errors name it: ``"data/loadcases.csv, row 2 (a.uff)"`` (rows counted from
+        1 below the header, comment lines not counted; the file name makes it unambiguous).
+    """
+
+    values: dict[str, str]
+    name: str
+    where: str
+
+
+def sidecar_row(path: str | Path,
+                sidecar: str | Path | pd.DataFrame | None = None) -> SidecarRow | None:
+    """The row of ``path``'s file name in its sidecar table (None: no table, or no row).
+
+    ``sidecar``: the table (a path, read with :func:`read_sidecar`, or a DataFrame), else
+    ``loadcases.csv`` beside the file if there is one. Rows are matched by file name; exporters
+    and file systems disagree on case, so a unique case-folded match is accepted too.
+    """
+    path = Path(path)
+    if isinstance(sidecar, pd.DataFrame):
+        table, shown, name = sidecar, "sidecar table", "sidecar table"
+    else:
+        sidecar_path = Path(sidecar) if sidecar is not None else path.parent / SIDECAR_NAME
+        if sidecar is None and not sidecar_path.is_file():
+            return None
+        table, shown, name = read_sidecar(sidecar_path), str(sidecar_path), sidecar_path.name
+    files = table["file"].astype(str)
+    found = np.flatnonzero((files == path.name).to_numpy())
+    if not found.size:
+        found = np.flatnonzero((files.str.casefold() == path.name.casefold()).to_numpy())
+    if not found.size:
+        return None
+    row = table.iloc[int(found[0])]
+    values = {str(c): ("" if v is None else str(v)) for c, v in row.items()}
+    return SidecarRow(values, name, f"{shown}, row {int(found[0]) + 1} ({path.name})")
 
 
 def _material(value: str, what: str, known: tuple[str, ...]) -> str:
@@ -202,22 +293,16 @@ def _material(value: str, what: str, known: tuple[str, ...]) -> str:
                             "--specimen FILE)") from None
 
 
-def _sidecar_entry(table: pd.DataFrame, file_name: str, where: Path,
+def _sidecar_entry(row: SidecarRow,
                    known: tuple[str, ...] = PARTICLE_MATERIALS) -> dict[str, float | str]:
-    rows = table[table["file"] == file_name]
-    if rows.empty:  # exporters and file systems disagree on case; accept a unique case-fold match
-        rows = table[table["file"].str.casefold() == file_name.casefold()]
-    if rows.empty:
-        return {}
-    row = rows.iloc[0]
-    what = f"{where} (row {file_name!r})"
+    what = row.where
     found: dict[str, float | str] = {}
-    if row["fill_percent"]:
-        found["fill_percent"] = _check_fill(row["fill_percent"], what)
-    if row["material"]:
-        found["material"] = _material(row["material"], what, known)
-    if row["direction"]:
-        found["direction"] = normalize_direction(row["direction"], what)
+    if row.values.get("fill_percent", ""):
+        found["fill_percent"] = _check_fill(row.values["fill_percent"], what)
+    if row.values.get("material", ""):
+        found["material"] = _material(row.values["material"], what, known)
+    if row.values.get("direction", ""):
+        found["direction"] = normalize_direction(row.values["direction"], what)
     return found
 
 
@@ -293,13 +378,9 @@ def resolve_load_case(
         origin["material"] = "specimen"
         values["material"] = specimen_material
     take(parse_file_name(path, known), "file name")
-    if isinstance(sidecar, pd.DataFrame):
-        take(_sidecar_entry(sidecar, path.name, Path("sidecar"), known), "sidecar table")
-    else:
-        sidecar_path = Path(sidecar) if sidecar is not None else path.parent / SIDECAR_NAME
-        if sidecar is not None or sidecar_path.is_file():
-            take(_sidecar_entry(read_sidecar(sidecar_path), path.name, sidecar_path, known),
-                 f"{sidecar_path.name}")
+    row = sidecar_row(path, sidecar)
+    if row is not None:
+        take(_sidecar_entry(row, known), row.name)
     options: dict[str, float | str] = {}
     if fill_percent is not None:
         options["fill_percent"] = _check_fill(fill_percent, "--fill")

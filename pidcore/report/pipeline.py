@@ -15,7 +15,7 @@ Order matters for the guarantees of the command:
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -33,6 +33,7 @@ from .render import check_out_dir, parse_formats, write_report
 from .table import add_calibration_columns, build_report_table
 
 if TYPE_CHECKING:  # pragma: no cover
+    from ..file_settings import FileSettings
     from ..loop import ForceDisplacementLoop
     from ..measure import AnalysisOptions, AnalyzedRecord
 
@@ -56,12 +57,16 @@ class MeasuredResult:
         Fill, material, direction as stated, and where from.
     load_case : LoadCase
         Measured frequency and acceleration with the stated fill/material/direction.
+    settings : FileSettings, optional
+        The options it was analysed with and who stated them (sidecar row, options), and the
+        specimen its sidecar row names.
     """
 
     path: Path
     analyzed: AnalyzedRecord
     stated: StatedLoadCase
     load_case: LoadCase
+    settings: FileSettings | None = None
 
     @property
     def measurement(self):
@@ -72,10 +77,17 @@ class MeasuredResult:
         return self.analyzed.analysis
 
     def record(self) -> dict[str, object]:
-        """The record ``pidcore analyze`` stores, plus the load case."""
+        """The record ``pidcore analyze`` stores, plus the load case (and the specimen the
+        sidecar names)."""
         from ..measure import analysis_record
 
-        return {**analysis_record(self.analyzed), **self.load_case.as_record(self.stated.origin)}
+        return {**analysis_record(self.analyzed), **self.load_case.as_record(self.stated.origin),
+                **self.fields()}
+
+    def fields(self) -> dict[str, object]:
+        """Record fields beyond the analysis and load case: the sidecar's ``specimen``."""
+        specimen = self.settings.specimen if self.settings is not None else ""
+        return {"specimen": specimen} if specimen else {}
 
 
 @dataclass(frozen=True)
@@ -131,16 +143,22 @@ def analyze_files(paths: Sequence[str | Path], *, fill_percent: float | None = N
                   material: str | None = None, direction: str | None = None,
                   sidecar: str | Path | None = None,
                   options: AnalysisOptions | None = None,
+                  options_given: Mapping[str, str] | None = None,
                   specimen_material: str | None = None) -> list[MeasuredResult]:
     """Read, assign roles, analyze (Eq. 11) and attach the load case of every file.
 
-    The load case is resolved first for every file, so a missing fill is reported before any
-    (slow) analysis runs. Files with identical contents are one measurement: kept once, and
-    refused if they state different load cases. ``specimen_material``: the particle material
-    of the specimen compared with (accepted besides the table's, and the default).
+    The load case and the analysis settings are resolved first for every file, so a missing
+    fill or a bad sidecar value is reported before any (slow) analysis runs. Each file is
+    analysed with its own settings: ``options`` < its sidecar row < the fields of ``options``
+    named in ``options_given`` (:func:`pidcore.file_settings.resolve_file_settings`; default:
+    those that differ from the defaults). Files with identical contents are one measurement:
+    kept once, and refused if they state different load cases, specimens or settings.
+    ``specimen_material``: the particle material of the specimen compared with (accepted
+    besides the table's, and the default).
     """
+    from ..file_settings import analyze_with_settings, resolve_file_settings
     from ..io import detect_file_format
-    from ..measure import AnalysisOptions, analyze_file
+    from ..measure import AnalysisOptions
 
     options = options or AnalysisOptions()
     for path in paths:  # a missing or empty file is named as such, not as "no fill stated"
@@ -148,16 +166,21 @@ def analyze_files(paths: Sequence[str | Path], *, fill_percent: float | None = N
     stated = [resolve_load_case(p, fill_percent=fill_percent, material=material,
                                 direction=direction, sidecar=sidecar,
                                 specimen_material=specimen_material) for p in paths]
+    settings = [resolve_file_settings(p, options, given=options_given, sidecar=sidecar)
+                for p in paths]
     results = []
-    for path, st in zip(paths, stated, strict=True):
-        analyzed = analyze_file(path, options)
+    for path, st, fs in zip(paths, stated, settings, strict=True):
+        analyzed = analyze_with_settings(path, fs)
         a = analyzed.analysis
         results.append(MeasuredResult(Path(path), analyzed, st,
-                                      st.load_case(a.frequency_hz, a.acceleration_g)))
+                                      st.load_case(a.frequency_hz, a.acceleration_g), fs))
     # Identical bytes are one measurement (the store keeps it once); it cannot belong to two
-    # load cases, and counting it twice would shrink the pooled standard error.
+    # load cases (or specimens, or be analysed two ways), and counting it twice would shrink
+    # the pooled standard error.
     refuse_identical_contents_stating_apart(
-        (r.path.name, r.measurement.sha256, r.load_case.key, r.load_case.key) for r in results)
+        (r.path.name, r.measurement.sha256, (r.load_case.key, fs.statement()),
+         ", ".join(w for w in (r.load_case.key, fs.label()) if w))
+        for r, fs in zip(results, settings, strict=True))
     out: list[MeasuredResult] = []
     seen: set[str] = set()
     for r in results:
@@ -166,6 +189,23 @@ def analyze_files(paths: Sequence[str | Path], *, fill_percent: float | None = N
             continue
         seen.add(sha)
         out.append(r)
+    return out
+
+
+def _parameters(results: Sequence[MeasuredResult], options: AnalysisOptions) -> dict:
+    """The analysis parameters for the provenance: each one the files share as it is, one
+    that differs between them as ``"a.uff: 5e-05; b.uff: 0"`` (per-file sidecar settings)."""
+    if not results:
+        return options.parameters()
+    per_file = [(r.path.name, (r.settings.options if r.settings is not None else options)
+                 .parameters()) for r in results]
+    names = list(dict.fromkeys(k for _, p in per_file for k in p))
+    out: dict[str, object] = {}
+    for name in names:
+        values = [p.get(name) for _, p in per_file]
+        out[name] = values[0] if all(v == values[0] for v in values) else "; ".join(
+            f"{file}: {'-' if v is None else v}" for (file, _), v in zip(per_file, values,
+                                                                      strict=True))
     return out
 
 
@@ -282,6 +322,7 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
                 fill_percent: float | None = None, material: str | None = None,
                 direction: str | None = None, sidecar: str | Path | None = None,
                 options: AnalysisOptions | None = None,
+                options_given: Mapping[str, str] | None = None,
                 tolerances: Tolerances | None = None, specimen=None,
                 pool: bool = False,
                 calibration: str | Path | None = None) -> ReportResult:
@@ -305,7 +346,13 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         defaults to the ``specimen``'s particles (else acrylic), and may be the specimen's own.
     options : AnalysisOptions, optional
         Channel mapping and corrections of the Eq. 11 analysis (vibrometer delay, mass
-        cancellation, baseline, sample rate for CSV without time column).
+        cancellation, baseline, sample rate for CSV without time column). A file's sidecar
+        row may state its own (:mod:`pidcore.file_settings`); they replace these except the
+        fields named in ``options_given``.
+    options_given : mapping, optional
+        Fields of ``options`` given explicitly -> their names in notes (``--velocity-delay``):
+        they override the sidecar's values, and a note says where one differs. Default: the
+        fields of ``options`` that differ from the defaults.
     tolerances : Tolerances, optional
         Grid-match tolerances.
     specimen : pidcore.specimen.Specimen, optional
@@ -357,14 +404,25 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
             open_verified_store(dem_path, must_exist=True)
 
     options = options or AnalysisOptions()
-    parameters = options.parameters()
     results = analyze_files(
         files, fill_percent=fill_percent, material=material, direction=direction,
-        sidecar=sidecar, options=options,
+        sidecar=sidecar, options=options, options_given=options_given,
         specimen_material=specimen.particles.material if specimen is not None else None,
     ) if files else []
-    notes: list[str] = [f"{r.path.name}: load case {r.load_case.key} ({r.stated.origin})"
-                        for r in results]
+    parameters = _parameters(results, options)
+    notes: list[str] = []
+    for r in results:
+        said = r.settings.summary() if r.settings is not None else ""
+        notes.append(f"{r.path.name}: load case {r.load_case.key} ({r.stated.origin})"
+                     + (f"; {said}" if said else ""))
+        if r.settings is not None:
+            notes.extend(r.settings.notes)
+            named = r.settings.specimen
+            if specimen is not None and named and named != specimen.name:
+                # the sidecar's specimen is the file's (as an app upload's is kept): it meets
+                # only DEM runs of that name, not the --specimen's
+                notes.append(f"{r.path.name}: its sidecar row names specimen {named!r}, not "
+                             f"{specimen.name!r} of --specimen; compared as {named!r}")
     if len(results) < len(files):
         kept = {r.path for r in results}
         notes += [f"{f.name}: identical contents to another file given; counted once"
@@ -372,8 +430,11 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
     if main is not None and results:
         # Same entry as `pidcore analyze` for the same file and options (replaced, not
         # duplicated), with the load case fields
-        saved = save_analyses(main, [r.analyzed for r in results], options,
-                              [(r.path.name, r.load_case, r.stated.origin) for r in results])
+        saved = save_analyses(main, [r.analyzed for r in results],
+                              [r.settings.options if r.settings is not None else options
+                               for r in results],
+                              [(r.path.name, r.load_case, r.stated.origin) for r in results],
+                              fields=[r.fields() or None for r in results])
         keys = saved.keys
         notes += saved.notes
         listed = main.list_analyses()

@@ -172,7 +172,10 @@ def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | N
     # aligner per (specimen, material, direction) over those runs
     aligners: dict[tuple[str, str, str], tuple[Aligner, str]] = {}
     for case, rec in _measured_rows(analyses, notes):
-        specimen = "" if pool else str(rec.get("specimen", "") or "")
+        # a store's listing holds NaN where a record names no specimen and another does
+        # (str(NaN) is "nan", a specimen of its own meeting no DEM run)
+        named = rec.get("specimen", "")
+        specimen = "" if pool or not isinstance(named, str) else named
         met_note = ""
         if pool or dem_runs is None or dem_runs.empty:
             own = aligner

@@ -1,0 +1,358 @@
+"""Per-file settings of a sidecar / settings table: how each measurement file is analysed.
+
+One table, two readers: the sidecar ``loadcases.csv`` of ``pidcore analyze`` and ``pidcore
+report`` (beside the files or ``--sidecar CSV``) and the app's uploaded settings table have the
+same columns (:data:`SETTINGS_COLUMNS`). Besides the load case (``file, fill_percent, material,
+direction``: :mod:`pidcore.compare.loadcase`) a row states:
+
+=========================  ==================================================================
+column                     meaning (:class:`~pidcore.measure.AnalysisOptions` field)
+=========================  ==================================================================
+``velocity_delay_us``      vibrometer output delay, µs, >= 0 (``velocity_delay_s``)
+``mass_below_gauge_g``     mass between force gauge and coupon, g, >= 0 (``mass_below_gauge_kg``)
+``baseline_loss_factor``   loss factor of the empty coupon, >= 0 (``baseline_loss_factor``)
+``force``, ``velocity``,   channel names (``force``, ``velocity``, ``acceleration``)
+``acceleration``
+``invert``                 channels whose sign is flipped, ``;``-separated (``invert``)
+``specimen``               the specimen tested (a name, saved with the analysis record)
+``note``, ``notes``,       free text for the user's own remarks: read and ignored
+``comment``, ``comments``
+=========================  ==================================================================
+
+Any other column is refused (:func:`~pidcore.compare.loadcase.check_columns`): a misspelt
+``velocity_delay_ms`` would otherwise be ignored and the file analysed at 0 µs without a word.
+An empty cell states nothing. Precedence is that of the load case: file name (states no
+analysis setting) < table < options given explicitly (the command line's ``--velocity-delay``
+etc.), and an explicit option that overrides a different table value is said in a note
+(:func:`resolve_file_settings`).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+from collections.abc import Mapping
+from dataclasses import dataclass, field, fields, replace
+from numbers import Real
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from .compare.loadcase import (
+    ANALYSIS_SETTINGS_COLUMNS,
+    FREE_TEXT_COLUMNS,
+    SETTINGS_COLUMNS,
+    SPECIMEN_COLUMN,
+    check_columns,
+    sidecar_row,
+)
+from .errors import PidcoreError, SettingsTableError
+
+if TYPE_CHECKING:
+    import os
+
+    import pandas as pd
+
+    from .measure import AnalysisOptions, AnalyzedRecord
+
+__all__ = ["ANALYSIS_COLUMNS", "ANALYSIS_SETTINGS_COLUMNS", "FREE_TEXT_COLUMNS",
+           "SETTINGS_COLUMNS", "SPECIMEN_COLUMN", "FileSettings", "SettingsColumn",
+           "analysis_overrides", "analyze_with_settings", "check_columns",
+           "resolve_file_settings"]
+
+
+@dataclass(frozen=True)
+class SettingsColumn:
+    """A table column that sets one :class:`~pidcore.measure.AnalysisOptions` field.
+
+    Attributes
+    ----------
+    field : str
+        The options field it sets.
+    kind : str
+        ``"number"`` (finite, >= 0), ``"channel"`` (a name) or ``"channels"`` (``;``-separated).
+    scale : float
+        Column value / ``scale`` = the field's SI value (µs -> s: 1e6). A division, not a
+        product with 1e-6: 50 / 1e6 is the double nearest 5e-5, as the literal ``5e-5`` of
+        ``--velocity-delay 5e-5`` is, so both give the same analysis to the last bit.
+    expected : str
+        What a valid value is, for the error message.
+    """
+
+    field: str
+    kind: str
+    scale: float = 1.0
+    expected: str = ""
+
+
+#: How each column of :data:`~pidcore.compare.loadcase.ANALYSIS_SETTINGS_COLUMNS` sets its
+#: options field.
+ANALYSIS_COLUMNS: dict[str, SettingsColumn] = {
+    "velocity_delay_us": SettingsColumn("velocity_delay_s", "number", 1e6,
+                                        "a vibrometer output delay in µs >= 0"),
+    "mass_below_gauge_g": SettingsColumn("mass_below_gauge_kg", "number", 1e3,
+                                         "a mass in g >= 0"),
+    "baseline_loss_factor": SettingsColumn("baseline_loss_factor", "number", 1.0,
+                                           "the empty coupon's loss factor >= 0"),
+    "force": SettingsColumn("force", "channel"),
+    "velocity": SettingsColumn("velocity", "channel"),
+    "acceleration": SettingsColumn("acceleration", "channel"),
+    "invert": SettingsColumn("invert", "channels"),
+}
+
+_COLUMN_OF_FIELD = {c.field: name for name, c in ANALYSIS_COLUMNS.items()}
+#: How each setting is said in words (units as the table's, not SI).
+_WORDS = {"velocity_delay_s": ("vibrometer delay", 1e6, " µs"),
+          "mass_below_gauge_kg": ("mass below gauge", 1e3, " g"),
+          "baseline_loss_factor": ("baseline loss factor", 1.0, "")}
+
+
+def _stated(value: object) -> bool:
+    """Whether a cell states something: None and blank text state nothing (NaN does: it is
+    refused as a value, since a float cell that is NaN is no setting anyone meant)."""
+    return value is not None and not (isinstance(value, str) and not value.strip())
+
+
+def _number(value: object, column: str, spec: SettingsColumn, where: str) -> float:
+    shown = value.strip() if isinstance(value, str) else value
+    if isinstance(value, bool) or not isinstance(value, (str, Real)):
+        raise SettingsTableError(f"{where}, column {column}: {shown!r} is not a number; "
+                             f"expected {spec.expected}")
+    try:
+        number = float(value)
+    except ValueError:
+        raise SettingsTableError(f"{where}, column {column}: {shown!r} is not a number; "
+                             f"expected {spec.expected}") from None
+    if not math.isfinite(number):
+        raise SettingsTableError(f"{where}, column {column}: {shown!r} is not a finite number; "
+                             f"expected {spec.expected}")
+    if number < 0:
+        # the library takes a signed delay (a late force); a vibrometer only ever lags, and
+        # a negative mass or baseline would add what they are meant to remove
+        raise SettingsTableError(f"{where}, column {column}: {shown!r} is negative; "
+                             f"expected {spec.expected}")
+    return number / spec.scale
+
+
+def analysis_overrides(values: Mapping[str, object], where: str, *,
+                       labels: Mapping[str, str] | None = None) -> dict[str, object]:
+    """The :class:`~pidcore.measure.AnalysisOptions` fields one settings row states.
+
+    Parameters
+    ----------
+    values : mapping
+        Cells of the row by column (:data:`ANALYSIS_COLUMNS`; other keys are ignored): text as
+        read from a CSV, or numbers / names as the app's editor holds them. ``None`` or blank
+        text states nothing.
+    where : str
+        The row, as errors name it, e.g. ``"loadcases.csv, row 2 (a.uff)"``.
+    labels : mapping, optional
+        Column -> the name errors use for it (the app's ``"vibrometer delay [µs]"``).
+
+    Returns
+    -------
+    dict
+        Field -> value in SI (µs -> s, g -> kg); ``invert`` as a tuple of names.
+
+    Raises
+    ------
+    SettingsTableError
+        One line naming ``where``, the column, the value and what was expected: not a
+        number, NaN or infinite, negative.
+
+    Examples
+    --------
+    >>> analysis_overrides({"velocity_delay_us": "50", "invert": "Force; Accel"}, "t.csv")
+    {'velocity_delay_s': 5e-05, 'invert': ('Force', 'Accel')}
+    """
+    labels = labels or {}
+    out: dict[str, object] = {}
+    for column, spec in ANALYSIS_COLUMNS.items():
+        value = values.get(column)
+        if not _stated(value):
+            continue
+        name = labels.get(column, column)
+        if spec.kind == "number":
+            out[spec.field] = _number(value, name, spec, where)
+            continue
+        if isinstance(value, float) and math.isnan(value):
+            continue  # a text column's empty cell, as pandas holds it
+        if spec.kind == "channel":
+            out[spec.field] = str(value).strip()
+        else:
+            names = value.split(";") if isinstance(value, str) else (
+                list(value) if isinstance(value, (list, tuple)) else [value])
+            found = tuple(n for n in (str(x).strip() for x in names) if n)
+            if found:
+                out[spec.field] = found
+    return out
+
+
+def _same(a: object, b: object) -> bool:
+    if isinstance(a, float) and isinstance(b, float):
+        # µs / 1e6 and a delay typed in s meet in the last bit at most
+        return math.isclose(a, b, rel_tol=1e-9, abs_tol=1e-15)
+    if isinstance(a, tuple) and isinstance(b, tuple):
+        return set(a) == set(b)  # the channels inverted, in any order
+    return a == b
+
+
+def _words(name: str, value: object) -> str:
+    if name in _WORDS:
+        label, factor, unit = _WORDS[name]
+        return f"{label} {float(value) * factor:g}{unit}"
+    if name == "invert":
+        return "inverted " + ", ".join(map(repr, value))  # type: ignore[arg-type]
+    if name == SPECIMEN_COLUMN:
+        return f"specimen {value!r}"
+    return f"{name} channel {value!r}"
+
+
+@dataclass(frozen=True)
+class FileSettings:
+    """How one measurement file is analysed, and who said so.
+
+    Attributes
+    ----------
+    options : AnalysisOptions
+        The options to analyse it with.
+    specimen : str
+        The specimen its table row names ("" for none).
+    sources : dict of str to str
+        Setting (options field or ``"specimen"``) -> the table that stated it (e.g.
+        ``"loadcases.csv"``), for the values the table set.
+    notes : tuple of str
+        Explicit options that override a different table value, one line each.
+    cells : dict of str to tuple
+        Options field -> (column, cell text, row) of each value the table set (errors of the
+        analysis name the cell, not the option it became).
+    """
+
+    options: AnalysisOptions
+    specimen: str = ""
+    sources: dict[str, str] = field(default_factory=dict)
+    notes: tuple[str, ...] = ()
+    cells: dict[str, tuple[str, str, str]] = field(default_factory=dict)
+
+    def summary(self) -> str:
+        """The settings the table set, in words with their table, e.g. ``'vibrometer delay
+        50 µs, specimen 'B' (loadcases.csv)'``; "" when it set none."""
+        by_source: dict[str, list[str]] = {}
+        for name, source in self.sources.items():
+            value = self.specimen if name == SPECIMEN_COLUMN else getattr(self.options, name)
+            by_source.setdefault(source, []).append(_words(name, value))
+        return "; ".join(f"{', '.join(words)} ({source})" for source, words in by_source.items())
+
+    def statement(self) -> tuple[str, str]:
+        """What this file's settings state, comparable between files: (specimen, options)."""
+        return self.specimen, json.dumps(self.options.parameters(), sort_keys=True)
+
+    def label(self) -> str:
+        """The specimen and every option not at its default, in words ("" for none)."""
+        from .measure import AnalysisOptions
+
+        default = AnalysisOptions()
+        parts = [_words(SPECIMEN_COLUMN, self.specimen)] if self.specimen else []
+        for f in fields(default):
+            value = getattr(self.options, f.name)
+            if value != getattr(default, f.name) and (f.name in _WORDS or f.name in (
+                    "force", "velocity", "acceleration", "invert")):
+                parts.append(_words(f.name, value))
+        return ", ".join(parts)
+
+    def explain(self, message: str) -> str:
+        """``message`` (an analysis error) saying which values came from the table: the
+        options keyword of a number it set is its words and its cell (``velocity_delay_s``
+        becomes ``vibrometer delay (column velocity_delay_us '1e6' of loadcases.csv, row 2
+        (a.uff))``), not the option the CLI would translate the keyword to; a channel name it
+        set that the message quotes gets its cell appended."""
+        appended = []
+        for name, (column, text, where) in self.cells.items():
+            cell = f"column {column} {text!r} of {where}"
+            if name in _WORDS:
+                message = re.sub(rf"(?<![\w-]){re.escape(name)}(?!\w)",
+                                 lambda _, n=name, c=cell: f"{_WORDS[n][0]} ({c})", message)
+                continue
+            value = getattr(self.options, name)
+            names = value if isinstance(value, tuple) else (value,)
+            if any(f"{n!r}" in message for n in names):
+                appended.append(cell)
+        return message + "".join(f"; {cell}" for cell in appended)
+
+
+def resolve_file_settings(path: str | os.PathLike, options: AnalysisOptions | None = None, *,
+                          given: Mapping[str, str] | None = None,
+                          sidecar: str | os.PathLike | pd.DataFrame | None = None) -> FileSettings:
+    """The analysis settings of one measurement file: table row < explicit options.
+
+    Parameters
+    ----------
+    path : path
+        The measurement file (its name is looked up in the table; its folder holds the default
+        ``loadcases.csv``).
+    options : AnalysisOptions, optional
+        The options for every file (the command line's, its defaults filled in).
+    given : mapping, optional
+        Options fields given explicitly -> how to name them in notes (``{"velocity_delay_s":
+        "--velocity-delay"}``): these override the table. Default: the fields of ``options``
+        that differ from :class:`~pidcore.measure.AnalysisOptions`'s defaults.
+    sidecar : path or DataFrame, optional
+        The table to use instead of ``loadcases.csv`` beside the file
+        (:func:`pidcore.compare.loadcase.sidecar_row`).
+
+    Returns
+    -------
+    FileSettings
+
+    Raises
+    ------
+    SettingsTableError
+        A table with an unknown column (:func:`check_columns`) or a bad value in this file's
+        row (:func:`analysis_overrides`).
+    """
+    from .measure import AnalysisOptions
+
+    options = options if options is not None else AnalysisOptions()
+    if given is None:
+        default = AnalysisOptions()
+        given = {f.name: f.name for f in fields(default)
+                 if getattr(options, f.name) != getattr(default, f.name)}
+    row = sidecar_row(path, sidecar)
+    if row is None:
+        return FileSettings(options)
+    stated = analysis_overrides(row.values, row.where)
+    changes: dict[str, object] = {}
+    sources: dict[str, str] = {}
+    cells: dict[str, tuple[str, str, str]] = {}
+    notes = []
+    for name, value in stated.items():
+        column = _COLUMN_OF_FIELD[name]
+        text = str(row.values[column]).strip()
+        if name in given:
+            mine = getattr(options, name)
+            if not _same(value, mine):
+                notes.append(f"{Path(path).name}: {given[name]} ({_words(name, mine)}) "
+                             f"overrides column {column} {text!r} of {row.where}")
+            continue
+        changes[name] = value
+        sources[name] = row.name
+        cells[name] = (column, text, row.where)
+    specimen = str(row.values.get(SPECIMEN_COLUMN, "") or "").strip()
+    if specimen:
+        sources[SPECIMEN_COLUMN] = row.name
+    return FileSettings(replace(options, **changes), specimen, sources, tuple(notes), cells)
+
+
+def analyze_with_settings(path: str | os.PathLike, settings: FileSettings, *,
+                          key: str | None = None) -> AnalyzedRecord:
+    """:func:`pidcore.measure.analyze_file` with ``settings.options``; an error that names an
+    option the table set names the table's cell instead (:meth:`FileSettings.explain`)."""
+    from .measure import analyze_file
+
+    try:
+        return analyze_file(path, settings.options, key=key)
+    except PidcoreError as exc:
+        explained = settings.explain(str(exc))
+        if explained == str(exc):
+            raise
+        raise type(exc)(explained) from None
