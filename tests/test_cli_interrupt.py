@@ -55,6 +55,10 @@ def test_sigint_at_any_time_exits_130_with_one_line_and_commits_nothing(tmp_path
         if "saved 1 record" in out:  # a fast machine finished first: a legitimate commit
             before = file_sha256(store)
             continue
+        if "interrupted after saving 1 record" in err:  # came after the commit, and says so
+            assert p.returncode == 130 and len(err.splitlines()) == 1, (delay, err)
+            before = file_sha256(store)
+            continue
         in_pidcore_main = re.search(r'pidcore[/\\]cli[/\\]__init__\.py", line \d+, in '
                                     r'(main|_run)\n', err)
         if p.returncode != 0 and "KeyboardInterrupt" in err and not in_pidcore_main:
@@ -177,3 +181,34 @@ def test_a_ctrl_c_during_the_commit_is_delivered_after_it_is_counted(tmp_path, m
     with store.transaction() as h5:
         assert h5.attrs["probe"] == 1  # ... and it was
     assert store.commits == 2
+
+
+@pytest.mark.parametrize("moment", ["as the commit returns", "while the results are printed"])
+def test_a_ctrl_c_after_the_commit_says_what_was_saved(tmp_path, capsys, monkeypatch, moment):
+    # Both moments used to say "nothing saved, the store is unchanged" (the first) or only
+    # that no write was left half-done (the second) of a store that had the new record.
+    import pidcore.cli.analyze as analyze_cli
+    import pidcore.store.store as store_module
+    from pidcore.cli import main
+
+    export = _export(tmp_path / "small.csv", 40)
+    store = tmp_path / "s.h5"
+    if moment == "as the commit returns":
+        real_replace = os.replace
+
+        def replace_then_sigint(src, dst):
+            real_replace(src, dst)
+            signal.raise_signal(signal.SIGINT)
+
+        monkeypatch.setattr(store_module.os, "replace", replace_then_sigint)
+    else:
+        def table_then_sigint(results):
+            signal.raise_signal(signal.SIGINT)
+            return ""
+
+        monkeypatch.setattr(analyze_cli, "format_table", table_then_sigint)
+    assert main(["analyze", str(export), "--store", str(store), "--fill", "50"]) == 130
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == [f"pidcore analyze: interrupted after saving 1 record(s) to {store}"]
+    monkeypatch.undo()
+    assert len(Store(store).list_analyses()) == 1  # ... which it was

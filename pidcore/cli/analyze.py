@@ -80,10 +80,12 @@ def _stated(args: argparse.Namespace) -> tuple[list, list]:
 
 def _run(args: argparse.Namespace) -> int:
     from ..loadcase import refuse_identical_contents_stating_apart
+    from ..store import Store
 
     stated, settings = _stated(args)
-    saved = False
-    keys: list[str] = []
+    # refused before any analysis (a folder, a foreign file); its commit count says after a
+    # Ctrl-C whether the records were saved, even if it came as the commit returned
+    store = None if args.no_store else Store(args.store)
     results: list = []
     try:
         # Analyse everything before writing anything: one bad file leaves the store untouched.
@@ -98,25 +100,33 @@ def _run(args: argparse.Namespace) -> int:
              ", ".join(w for w in (c.full_label() if c else NO_LOAD_CASE, fs.label()) if w))
             for path, r, c, fs in zip(args.paths, results, cases, settings, strict=True))
         replaced: list[str] = []
-        if not args.no_store:
+        if store is not None:
             from ..measure import save_analyses
 
-            saved_now = save_analyses(  # one transaction
-                args.store, results, [fs.options for fs in settings],
+            replaced = save_analyses(  # one transaction
+                store, results, [fs.options for fs in settings],
                 [(Path(path).name, c, st.origin if st is not None else "")
                  for path, c, st in zip(args.paths, cases, stated, strict=True)],
-                fields=[{"specimen": fs.specimen} if fs.specimen else None for fs in settings])
-            keys, replaced = saved_now.keys, saved_now.notes
-            saved = True
+                fields=[{"specimen": fs.specimen} if fs.specimen else None
+                        for fs in settings]).notes
         interrupt.raise_if_interrupted()  # an interrupt swallowed on the way still counts
+        # inside: a Ctrl-C while the results are written out still says what was saved
+        _print_results(args, results, cases, stated, settings, replaced)
     except (KeyboardInterrupt, SystemError) as exc:
         if not interrupt.is_interruption(exc):
             raise
-        said = (f"interrupted after saving {_saved(results, keys)} to {args.store}" if saved
-                else "interrupted; nothing saved, the store is unchanged")
+        said = (f"interrupted after saving {_saved(results)} to {args.store}"
+                if store is not None and store.commits else
+                "interrupted; nothing saved, the store is unchanged")
         print(f"pidcore analyze: {said}", file=sys.stderr)
         interrupt.mark_handled()
         return 130
+    return 0
+
+
+def _print_results(args: argparse.Namespace, results: list, cases: list, stated: list,
+                   settings: list, replaced: list[str]) -> None:
+    """The results table (or JSON document), each file's load case and settings, notes."""
     overrides = [note for fs in settings for note in fs.notes]
     if args.json:
         json.dump({"records": [{**r.to_dict(), "load_case": c.key if c else None,
@@ -127,24 +137,25 @@ def _run(args: argparse.Namespace) -> int:
                                for r, c, fs in zip(results, cases, settings, strict=True)],
                    "notes": [*overrides, *replaced]}, sys.stdout)
         sys.stdout.write("\n")
-    else:
-        print(format_table(results))
-        for path, c, st, fs in zip(args.paths, cases, stated, settings, strict=True):
-            said = fs.summary()
-            print(f"{Path(path).name}: " + (f"load case {c.key} ({st.origin})" if c else
-                  "no fill stated: saved without a load case (state it in the file name, "
-                  "a sidecar or --fill for `pidcore report --store` to place it)"
-                  if not args.no_store else "no fill stated") + (f"; {said}" if said else ""))
-        for note in [*overrides, *replaced]:
-            print(f"note: {note}")
-        if not args.no_store:
-            print(f"saved {_saved(results, keys)} to {args.store}")
-    return 0
+        return
+    print(format_table(results))
+    for path, c, st, fs in zip(args.paths, cases, stated, settings, strict=True):
+        said = fs.summary()
+        print(f"{Path(path).name}: " + (f"load case {c.key} ({st.origin})" if c else
+              "no fill stated: saved without a load case (state it in the file name, "
+              "a sidecar or --fill for `pidcore report --store` to place it)"
+              if not args.no_store else "no fill stated") + (f"; {said}" if said else ""))
+    for note in [*overrides, *replaced]:
+        print(f"note: {note}")
+    if not args.no_store:
+        print(f"saved {_saved(results)} to {args.store}")
 
 
-def _saved(results: list, keys: list[str]) -> str:
+def _saved(results: list) -> str:
     """"3 record(s)", saying so when byte-identical files made fewer records than files."""
-    n = len(set(keys))
+    from ..records import measurement_key
+
+    n = len({measurement_key(r.measurement) for r in results})
     same = len(results) - n
     return f"{n} record(s)" + (f" ({same} file(s) with the same contents as another file "
                                "given: one record)" if same > 0 else "")
