@@ -42,6 +42,14 @@ FillReference = Literal["capacity", "paper"]
 #: root-found so that a simulated head-on impact gives the table's e_n exactly.
 DampingCoefficient = Literal["eq3", "calibrated"]
 
+#: Particle materials in use for particle dampers that the material table does not hold: a
+#: file name stating one (``..._fill50_steel.csv``) is refused unless a specimen file gives
+#: the material, instead of being read as the default acrylic.
+UNTABULATED_PARTICLE_MATERIALS: tuple[str, ...] = (
+    "steel", "stainless", "tungsten", "carbide", "glass", "brass", "bronze", "copper", "lead",
+    "titanium", "nylon", "ptfe", "teflon", "delrin", "polyurethane", "rubber", "ceramic",
+    "zirconia", "alumina")
+
 QUANTITIES: tuple[str, ...] = get_args(Quantity)
 CHANNEL_ROLES: tuple[str, ...] = get_args(ChannelRole)
 DRIVE_DIRECTIONS: tuple[str, ...] = get_args(DriveDirection)

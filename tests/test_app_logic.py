@@ -636,6 +636,16 @@ def test_load_case_is_proposed_from_the_name_or_a_fill_proposed():
     unstated = stated_case("plain.csv")
     assert unstated.fill_percent == PROPOSED_FILL_PERCENT
     assert "not stated" in unstated.origin
+    # a material the table lacks is not passed off as acrylic: the row says what to set, and
+    # the fill the name states is kept; with a steel specimen known it is steel
+    steel = stated_case("coupon_fill20_steel.csv")
+    assert steel.fill_percent == 20.0 and "says 'steel'" in steel.origin
+    assert "--" not in steel.origin  # in the app's words, not the command line's
+    assert stated_case("coupon_fill20_steel.csv", materials=("steel",)).material == "steel"
+    row = uploads.default_settings_row("coupon_fill20_steel.csv", steel)
+    note = uploads.assumed_note(steel, row)
+    assert note.startswith("material: acrylic assumed: the file name says 'steel'")
+    assert uploads.assumed_note(steel, {**row, "material": "aluminium"}) == ""  # set by the user
 
 
 def test_chart_specs_are_valid_vega_lite(good_csv, options):

@@ -208,3 +208,63 @@ def test_allow_clipped_analyses_and_reports_the_clipping(tmp_path, capsys):
     assert main(["analyze", str(path), "--no-store", "--allow-clipped"]) == 0
     out = capsys.readouterr().out
     assert "note:" in out and "'Force' clipped" in out
+
+
+def test_a_file_naming_an_untabulated_material_needs_its_specimen(tmp_path, capsys):
+    # "..._fill20_steel.csv" was saved as acrylic (the default): steel is not in the material
+    # table, so the name's token went unread, and analyze had no --specimen to make it known
+    steel = export(tmp_path / "coupon_fill20_steel.csv", fmt="csv")
+    store_path = tmp_path / "s.h5"
+    assert main(["analyze", str(steel), "--store", str(store_path)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "coupon_fill20_steel.csv" in err \
+        and "particle material 'steel'" in err and "--specimen" in err
+    assert not store_path.exists()
+    # the paper's coupon (acrylic) does not make it steel either
+    paper = Path(__file__).resolve().parents[1] / "pidcore" / "data" / "specimens" / \
+        "paper_coupon.toml"
+    assert main(["analyze", str(steel), "--specimen", str(paper), "--no-store"]) == 2
+    assert "particle material 'steel'" in capsys.readouterr().err
+    spec = tmp_path / "steel.toml"
+    spec.write_text(STEEL_SPECIMEN)
+    doc = run_json([str(steel), "--specimen", str(spec), "--store", str(store_path)], capsys)
+    assert doc["records"][0]["load_case"].endswith("_fill20pct_steel_z")
+    assert Store(store_path).list_analyses()["material"].tolist() == ["steel"]
+    # a material stated explicitly is the user's word
+    doc = run_json([str(steel), "--material", "acrylic", "--no-store"], capsys)
+    assert doc["records"][0]["load_case"].endswith("_fill20pct_acrylic_z")
+    # a name stating a tabulated material beside the word is read as before
+    both = export(tmp_path / "steel_fixture_fill20_acrylic.csv", fmt="csv")
+    doc = run_json([str(both), "--no-store"], capsys)
+    assert doc["records"][0]["load_case"].endswith("_fill20pct_acrylic_z")
+
+
+STEEL_SPECIMEN = """schema_version = 1
+name = "my_steel"
+
+[cell]
+shape = "hexagonal"
+inscribed_diameter_m = 6.35e-3
+height_m = 12.7e-3
+count = 286
+wall_material = "aluminium_wall"
+
+[coupon]
+mass_kg = 0.0333
+
+[particles]
+material = "steel"
+radius_m = 1.0e-3
+density_kg_m3 = 7850.0
+youngs_modulus_pa = 200e9
+poisson_ratio = 0.29
+count_per_cell = 10
+
+[pairs.particle_particle]
+restitution = 0.9
+sliding_friction = 0.3
+
+[pairs.particle_wall]
+restitution = 0.8
+sliding_friction = 0.35
+"""

@@ -381,9 +381,13 @@ def assumed_note(stated, row: Mapping, given: Iterable[str] = ()) -> str:
     if "fill: not stated" in stated.origin and "fill [%]" not in given and _same_number(
             row.get("fill [%]"), stated.fill_percent):
         parts.append(f"fill: not stated, {stated.fill_percent:g} % proposed")
-    if "material: default" in stated.origin and "material" not in given and str(
-            row.get("material", "")) == stated.material:
-        parts.append(f"material: not stated, {stated.material} assumed")
+    if "material" not in given and str(row.get("material", "")) == stated.material:
+        said = next((part for part in stated.origin.split("; ")
+                     if part.startswith("material: ")), "")
+        if said == "material: default":
+            parts.append(f"material: not stated, {stated.material} assumed")
+        elif " proposed: " in said:  # a material the table lacks, e.g. "..._steel.csv"
+            parts.append(said.replace(" proposed: ", " assumed: ", 1))
     return "; ".join(parts)
 
 

@@ -39,7 +39,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     g = p.add_argument_group(
         "load case (saved with each analysis, so that `pidcore report --store` places it; "
         "a file with no fill stated is saved without one)")
-    add_load_case_options(g, what="PATH", material_help=" (default: stated, else acrylic)")
+    add_load_case_options(g, what="PATH", material_help=" or the --specimen's (default: "
+                                                         "stated, else the specimen's, else "
+                                                         "acrylic)")
+    g.add_argument("--specimen", metavar="FILE", type=Path, default=None,
+                   help="specimen file whose particle material the files may state (e.g. "
+                        "steel, which the material table lacks) and which is the default "
+                        "material")
     p.add_argument("--key", metavar="NAME", default=None,
                    help="which measurement of a pidcore HDF5 store to analyse, when it holds "
                         "several (the error lists them)")
@@ -66,12 +72,18 @@ def _stated(args: argparse.Namespace) -> tuple[list, list]:
     from ..file_settings import resolve_file_settings
 
     options, given = analysis_options(args), given_options(args)
+    specimen_material = None
+    if args.specimen is not None:
+        from ..specimen import load_specimen
+
+        specimen_material = load_specimen(args.specimen).particles.material
     stated, settings = [], []
     for path in args.paths:  # (a missing file is named by its analysis)
         try:
             stated.append(resolve_load_case(path, fill_percent=args.fill,
                                             material=args.material, direction=args.direction,
-                                            sidecar=args.sidecar))
+                                            sidecar=args.sidecar,
+                                            specimen_material=specimen_material))
         except FillNotStated:
             stated.append(None)
         settings.append(resolve_file_settings(path, options, given=given, sidecar=args.sidecar))

@@ -44,11 +44,21 @@ def stated_case(name: str, sidecar: pd.DataFrame | None = None,
     proposed; the origin says so, and which values are defaults.
     """
     from ..constants import PARTICLE_MATERIALS
-    from .loadcase import SIDECAR_COLUMNS, parse_file_name, resolve_load_case
+    from .loadcase import (
+        SIDECAR_COLUMNS,
+        UntabulatedMaterial,
+        parse_file_name,
+        resolve_load_case,
+    )
 
     table = sidecar if sidecar is not None else pd.DataFrame(columns=list(SIDECAR_COLUMNS))
+    untabulated = ""
     try:
         return resolve_load_case(Path(Path(name).name), sidecar=table, materials=materials)
+    except UntabulatedMaterial as exc:  # "..._steel.csv" without a steel specimen
+        untabulated = (f"the file name says {exc.material!r}, which neither the material "
+                       "table nor a specimen gives; set the material, or the specimen of "
+                       f"{exc.material} particles")
     except PidcoreError:  # no fill stated (or a bad table row): keep what the name states
         pass
     known = (*PARTICLE_MATERIALS, *(m for m in materials if m not in PARTICLE_MATERIALS))
@@ -56,12 +66,16 @@ def stated_case(name: str, sidecar: pd.DataFrame | None = None,
         found = parse_file_name(Path(name).name, known)
     except PidcoreError:
         found = {}
+    fill = found.get("fill_percent")
+    material = (f"{defaults.COMPARE_DEFAULT_MATERIAL} proposed: {untabulated}" if untabulated
+                else "file name" if "material" in found else "default")
     return StatedLoadCase(
-        PROPOSED_FILL_PERCENT,
+        float(fill) if untabulated and fill is not None else PROPOSED_FILL_PERCENT,
         str(found.get("material", defaults.COMPARE_DEFAULT_MATERIAL)),
         str(found.get("direction", defaults.COMPARE_DEFAULT_DIRECTION)),
-        f"fill: not stated, {PROPOSED_FILL_PERCENT:g} % proposed; material: "
-        f"{'file name' if 'material' in found else 'default'}; direction: "
+        ("fill: file name" if untabulated and fill is not None else
+         f"fill: not stated, {PROPOSED_FILL_PERCENT:g} % proposed")
+        + f"; material: {material}; direction: "
         f"{'file name' if 'direction' in found else 'default'}")
 
 

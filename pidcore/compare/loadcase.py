@@ -34,7 +34,7 @@ import numpy as np
 import pandas as pd
 
 from .. import defaults
-from ..constants import PARTICLE_MATERIALS
+from ..constants import PARTICLE_MATERIALS, UNTABULATED_PARTICLE_MATERIALS
 from ..errors import SettingsTableError
 from ..loadcase import (
     LoadCase,
@@ -49,6 +49,16 @@ class FillNotStated(LoadCaseError):
     """No fill is stated for a measurement file (by name, sidecar or option): the one
     :class:`LoadCaseError` a caller may accept (``pidcore analyze`` saves the analysis without
     a load case)."""
+
+
+class UntabulatedMaterial(LoadCaseError):
+    """A file name states a particle material that neither the material table nor a specimen
+    gives (``..._steel.csv``): it is not read as the default material. ``material``: that
+    material."""
+
+    def __init__(self, message: str, material: str) -> None:
+        super().__init__(message)
+        self.material = material
 
 
 #: Name of the sidecar table looked for beside each measurement file.
@@ -117,6 +127,23 @@ def _own_material_tokens(stem: str, materials: tuple[str, ...]) -> set[str]:
     pattern = re.compile(_SEP + "(?P<material>" + "|".join(map(re.escape, own)) + ")" + _END,
                          re.IGNORECASE)
     return {m.group("material").lower() for m in pattern.finditer(stem)}
+
+
+def _refuse_untabulated_material(path: Path, known: tuple[str, ...]) -> None:
+    """A file name naming a particle material that neither the table nor a specimen knows
+    (``..._steel.csv``) would be read as the default or the specimen's material: refused."""
+    pattern = re.compile(_SEP + "(?P<material>" + "|".join(UNTABULATED_PARTICLE_MATERIALS)
+                         + ")" + _END, re.IGNORECASE)
+    # a specimen's "steel_440c" is the file name's "steel"
+    parts = {part for k in known for part in k.split("_")}
+    named = sorted({m.group("material").lower() for m in pattern.finditer(path.stem)}
+                   - parts)
+    if named:
+        raise UntabulatedMaterial(
+            f"{path.name}: file name states particle material {named[0]!r}, which the "
+            f"material table ({', '.join(PARTICLE_MATERIALS)}) lacks; give --specimen FILE "
+            f"whose particles are {named[0]}, or state the material with --material or a "
+            "sidecar", named[0])
 
 
 def parse_file_name(name: str | Path,
@@ -381,6 +408,9 @@ def resolve_load_case(
     row = sidecar_row(path, sidecar)
     if row is not None:
         take(_sidecar_entry(row, known), row.name)
+    stated_by_user = {"file name"} | ({row.name} if row is not None else set())
+    if origin.get("material") not in stated_by_user and material is None:
+        _refuse_untabulated_material(path, known)
     options: dict[str, float | str] = {}
     if fill_percent is not None:
         options["fill_percent"] = _check_fill(fill_percent, "--fill")
