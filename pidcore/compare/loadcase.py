@@ -56,7 +56,8 @@ class UntabulatedMaterial(LoadCaseError):
     gives (``..._steel.csv``): it is not read as the default material. ``material``: that
     material."""
 
-    def __init__(self, message: str, material: str) -> None:
+    # ``material`` has a default: the CLI re-raises errors from their message alone
+    def __init__(self, message: str, material: str = "") -> None:
         super().__init__(message)
         self.material = material
 
