@@ -338,13 +338,15 @@ class Specimen:
     def __post_init__(self):
         if not isinstance(self.name, str) or not self.name:
             raise _fail("name", f"expected a non-empty name, got {self.name!r}")
+        from .dem.geometry import check_packing_size, check_sphere_fits
+
         r = self.particles.radius_m
-        half_gap = 0.5 * self.cell.inscribed_diameter_m
-        if r > half_gap or 2 * r > self.cell.height_m:
-            raise _fail("[particles] radius_m",
-                        f"a sphere of radius {r * 1e3:.4g} mm does not fit a "
-                        f"{self.cell.inscribed_diameter_m * 1e3:.4g} x "
-                        f"{self.cell.height_m * 1e3:.4g} mm {self.cell.shape} cell")
+        try:
+            # the packing's own limit (a sphere strictly narrower than the cell, clearing
+            # floor and ceiling by its gap): a looser one let a near fit through to fail there
+            check_sphere_fits(self.geometry(), r)
+        except ParameterError as exc:
+            raise _fail("[particles] radius_m", str(exc)) from None
         area = self.cell.count * self.geometry().volume_m3() / self.cell.height_m
         if self.coupon.mass_kg / area > MAX_COUPON_AREAL_MASS_KG_M2:
             raise _fail("[coupon] mass_kg",
@@ -353,8 +355,6 @@ class Specimen:
                         f"expected kilograms (a coupon is up to "
                         f"{MAX_COUPON_AREAL_MASS_KG_M2:g} kg/m^2); was it g, or is [cell] "
                         "count wrong?")
-        from .dem.geometry import check_packing_size
-
         try:
             # before any packing is laid out: a size in the wrong unit would ask for GiBs
             check_packing_size(self.geometry(), r)

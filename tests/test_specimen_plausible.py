@@ -91,9 +91,10 @@ def test_a_cell_of_many_radii_is_refused_before_the_packing_grid_is_allocated():
     # ran for an hour; ~8e4 spheres are beyond the DEM's pair history (N^2 per cell)
     with pytest.raises(ParameterError, match=r"at most 2000 per cell"):
         check_packing_size(CellGeometry(6.35e-3, 25.4e-3), 0.125e-3)
-    # a wide flat cell: a few hundred spheres, but 1.9e6 candidate points each scans
+    # a wide flat cell: a few hundred spheres, but 1.9e6 candidate points each scans (2.1 mm
+    # high: a 2 mm core holds no 1 mm sphere beside the packing's gap, refused before this)
     with pytest.raises(ParameterError, match="too fine to pack"):
-        check_packing_size(CellGeometry(50e-3, 2e-3), 1e-3)
+        check_packing_size(CellGeometry(50e-3, 2.1e-3), 1e-3)
     # the limits still admit a cell 25 radii across (the paper's is 3.8)
     check_packing_size(CellGeometry(25e-3, 5e-3), 1e-3)
     assert MAX_PACKING_GRID_POINTS <= 2_000_000
