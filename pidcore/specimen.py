@@ -489,6 +489,23 @@ class Specimen:
         return _capacity(self.cell.shape, self.cell.inscribed_diameter_m, self.cell.height_m,
                          self.particles.radius_m)
 
+    def stated_fill(self) -> tuple[float, str] | None:
+        """The specimen's own fill (% of :meth:`capacity_per_cell`) and where it comes from
+        in words, or None when it states neither ``count_per_cell`` nor ``fill_percent``.
+
+        What a DEM run of this specimen simulates when no fill is given (``pidcore dem run
+        --specimen`` without ``--fill``, the app's DEM page with its fills field empty). A
+        count is its share of the capacity, which rounds back to that count.
+        """
+        p = self.particles
+        if p.fill_percent is not None:
+            return p.fill_percent, "[particles] fill_percent"
+        if p.count_per_cell is not None:
+            capacity = self.capacity_per_cell()
+            return (100.0 * p.count_per_cell / capacity,
+                    f"[particles] count_per_cell {p.count_per_cell} of capacity {capacity}")
+        return None
+
     def geometry(self):
         """The cell as a DEM geometry record (dispatch on ``cell.shape``)."""
         return cell_geometry(self.cell)
