@@ -138,6 +138,14 @@ PLAUSIBLE_RANGES: dict[str, PlausibleRange] = {
     # a fixture (adapter plate, head expander) may be heavy, but not more than a shaker lifts
     "fixture_mass_kg": PlausibleRange(0.0, 1000.0, "kg", "a fixture is up to 1000 kg",
                                       above="was it g?"),
+    # the empty coupon's loss factor (Re/Im of its complex power, 2 x damping ratio): metal
+    # honeycomb sandwiches are ~0.001-0.01, and even the most lossy viscoelastic layers reach
+    # about 1 only at their glass transition. Above 1 the empty coupon would dissipate more
+    # per radian than it stores, a damper rather than the mass-like structure the analysis
+    # assumes; such a value is a percentage (5 for 0.05; calibrate's prior is 0-0.05)
+    "baseline_loss_factor": PlausibleRange(0.0, 1.0, "", "the empty coupon's loss factor is "
+                                           "0-1, metal sandwiches ~0.001-0.01",
+                                           above="was it %?"),
 }
 #: Most coupon mass per coupon area (``[cell] count`` cells' cross-section), kg/m^2: a 127 mm
 #: steel plate. Sandwich panels weigh 1-20 kg/m^2 (the paper's 2.6); more is a mass in grams
@@ -153,9 +161,10 @@ def _plausible(where: str, key: str, value: float) -> None:
     if r.low <= value <= r.high:
         return
     hint = r.below if value < r.low else r.above
-    unit = {"m": "metres", "kg": "kilograms", "Pa": "pascals"}.get(r.unit, r.unit)
-    raise _fail(where, f"{value:g} {r.unit}: expected {unit} ({r.what})"
-                       + (f"; {hint}" if hint else ""))
+    unit = {"m": "metres", "kg": "kilograms", "Pa": "pascals",
+            "": "a fraction"}.get(r.unit, r.unit)
+    shown = f"{value:g} {r.unit}".rstrip()  # a ratio has no unit to show
+    raise _fail(where, f"{shown}: expected {unit} ({r.what})" + (f"; {hint}" if hint else ""))
 
 
 def _poisson(where: str, value: float) -> None:
@@ -225,6 +234,8 @@ class CouponSpec:
         _non_negative("[coupon] fixture_mass_kg", self.fixture_mass_kg, "kg")
         _plausible("[coupon] fixture_mass_kg", "fixture_mass_kg", self.fixture_mass_kg)
         _non_negative("[coupon] baseline_loss_factor", self.baseline_loss_factor, "[-]")
+        _plausible("[coupon] baseline_loss_factor", "baseline_loss_factor",
+                   self.baseline_loss_factor)
 
     @property
     def moving_mass_kg(self) -> float:
@@ -338,13 +349,15 @@ class Specimen:
     def __post_init__(self):
         if not isinstance(self.name, str) or not self.name:
             raise _fail("name", f"expected a non-empty name, got {self.name!r}")
+        from .dem.geometry import check_packing_size, check_sphere_fits
+
         r = self.particles.radius_m
-        half_gap = 0.5 * self.cell.inscribed_diameter_m
-        if r > half_gap or 2 * r > self.cell.height_m:
-            raise _fail("[particles] radius_m",
-                        f"a sphere of radius {r * 1e3:.4g} mm does not fit a "
-                        f"{self.cell.inscribed_diameter_m * 1e3:.4g} x "
-                        f"{self.cell.height_m * 1e3:.4g} mm {self.cell.shape} cell")
+        try:
+            # the packing's own limit (a sphere strictly narrower than the cell, clearing
+            # floor and ceiling by its gap): a looser one let a near fit through to fail there
+            check_sphere_fits(self.geometry(), r)
+        except ParameterError as exc:
+            raise _fail("[particles] radius_m", str(exc)) from None
         area = self.cell.count * self.geometry().volume_m3() / self.cell.height_m
         if self.coupon.mass_kg / area > MAX_COUPON_AREAL_MASS_KG_M2:
             raise _fail("[coupon] mass_kg",
@@ -353,8 +366,6 @@ class Specimen:
                         f"expected kilograms (a coupon is up to "
                         f"{MAX_COUPON_AREAL_MASS_KG_M2:g} kg/m^2); was it g, or is [cell] "
                         "count wrong?")
-        from .dem.geometry import check_packing_size
-
         try:
             # before any packing is laid out: a size in the wrong unit would ask for GiBs
             check_packing_size(self.geometry(), r)
@@ -477,6 +488,23 @@ class Specimen:
         """Spheres one cell holds (dense drop packing, :func:`pidcore.dem.cell_capacity`)."""
         return _capacity(self.cell.shape, self.cell.inscribed_diameter_m, self.cell.height_m,
                          self.particles.radius_m)
+
+    def stated_fill(self) -> tuple[float, str] | None:
+        """The specimen's own fill (% of :meth:`capacity_per_cell`) and where it comes from
+        in words, or None when it states neither ``count_per_cell`` nor ``fill_percent``.
+
+        What a DEM run of this specimen simulates when no fill is given (``pidcore dem run
+        --specimen`` without ``--fill``, the app's DEM page with its fills field empty). A
+        count is its share of the capacity, which rounds back to that count.
+        """
+        p = self.particles
+        if p.fill_percent is not None:
+            return p.fill_percent, "[particles] fill_percent"
+        if p.count_per_cell is not None:
+            capacity = self.capacity_per_cell()
+            return (100.0 * p.count_per_cell / capacity,
+                    f"[particles] count_per_cell {p.count_per_cell} of capacity {capacity}")
+        return None
 
     def geometry(self):
         """The cell as a DEM geometry record (dispatch on ``cell.shape``)."""
@@ -603,8 +631,11 @@ def _table_material(name: str, where: str, role: str | None):
         return None
     row = material(name)
     if role is not None and row.role != role:
+        table = material_table()
+        names = ", ".join(table.index[table["role"] == role])
         raise ParameterError(f"{where}: material {name!r} is a {row.role} material in "
-                             f"materials.csv, expected a {role} material")
+                             f"materials.csv, expected a {role} material ({names}), or "
+                             "another name with inline properties")
     return row
 
 
@@ -679,7 +710,9 @@ def _from_mapping(data: Mapping[str, Any], *, source: str) -> Specimen:
             raise ParameterError(f"[{section}]: missing table")
 
     cell = _take(data["cell"], "cell", "[cell]")
-    _complete_from_material(cell, "[cell] wall_material", cell["wall_material"], None,
+    # a particle row is refused as a wall: its numbers are another material's (materials.csv
+    # "aluminium" is the particles' alloy, E 70 GPa, the walls' "aluminium_wall" 72 GPa)
+    _complete_from_material(cell, "[cell] wall_material", cell["wall_material"], "wall",
                             _WALL_FROM_MATERIAL)
 
     particles = _take(data["particles"], "particles", "[particles]")

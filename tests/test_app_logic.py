@@ -749,6 +749,44 @@ def test_a_file_saved_again_with_other_corrections_counts_once(tmp_path, good_cs
     assert table["SDC measured [-]"].dropna().tolist() == [rec2.analysis.sdc]
 
 
+def test_an_empty_fills_field_takes_the_specimens_own_fill_as_the_cli_does():
+    from pidcore.dem.simulate import particles_per_cell
+    from pidcore.specimen import Specimen
+
+    text = (REPO / "data_samples" / "specimens" / "steel_6mm.toml").read_text(encoding="utf-8")
+    steel = Specimen.from_text(text)
+    assert steel.particles.fill_percent == 50.0
+    assert jobs.dem_fills("", steel) == (
+        [50.0], "fills [%] empty: the specimen's own fill, 50 % ([particles] fill_percent)")
+    # a count is its share of the capacity (what `pidcore dem run --specimen` runs), which
+    # rounds back to that count
+    counted = Specimen.from_text(text.replace("fill_percent = 50.0", "count_per_cell = 10"))
+    capacity = counted.capacity_per_cell()
+    (fill,), note = jobs.dem_fills("  ", counted)
+    assert fill == 100.0 * 10 / capacity
+    assert note == (f"fills [%] empty: the specimen's own fill, {fill:.4g} % ([particles] "
+                    f"count_per_cell 10 of capacity {capacity})")
+    assert particles_per_cell(fill, specimen=counted, fill_reference="capacity")[0] == 10
+    # the very fill `pidcore dem run --specimen` runs without --fill
+    from argparse import Namespace
+
+    from pidcore.cli.dem import _fill
+
+    for specimen in (steel, counted):
+        assert [_fill(Namespace(fill=None), specimen, "steel")] == jobs.dem_fills("",
+                                                                                 specimen)[0]
+    # typed values win over the specimen's; an empty field with nothing to fall back on is
+    # one line that says where a fill could come from
+    assert jobs.dem_fills("25, 75", counted) == ([25.0, 75.0], None)
+    bare = Specimen.from_text(text.replace("fill_percent = 50.0", ""))
+    for specimen in (None, bare):
+        with pytest.raises(ParameterError, match=r"^fills \[%\]: give at least one value \(or "
+                                                 r"choose a specimen file stating count_per"):
+            jobs.dem_fills("", specimen)
+    with pytest.raises(ParameterError, match=r"^fills \[%\]: 'x' is not a number$"):
+        jobs.dem_fills("x", steel)
+
+
 @pytest.mark.dem_subprocess
 def test_dem_jobs_run_on_the_chosen_specimen(tmp_path):
     from pidcore.dem import DemConfig

@@ -733,6 +733,33 @@ def test_dem_page_offers_the_specimen_files_and_takes_their_material(store_file,
     assert at.text_input(key="dem_material_specimen").value == want
 
 
+def test_dem_page_runs_the_specimens_own_fill_when_the_fills_field_is_empty(
+        store_file, tmp_path, monkeypatch):
+    import shutil
+
+    folder = tmp_path / "data_samples" / "specimens"  # the app runs in tmp_path
+    folder.mkdir(parents=True)
+    shutil.copy(REPO / "data_samples" / "specimens" / "steel_6mm.toml", folder)  # fill 50 %
+    submitted = []
+
+    def submit(self, cases, config, specimen=None):  # record, do not simulate
+        submitted.extend((c.fill_percent, c.material, specimen.name) for c in cases)
+        return []
+
+    monkeypatch.setattr(jobs.DemJobRunner, "submit", submit)
+    at = _app()
+    box = at.selectbox(key="dem_specimen")
+    box.set_value(next(o for o in box.options if o.endswith("steel_6mm.toml")))
+    at.text_input(key="dem_fills").set_value("")
+    at.run()
+    at.button(key="dem_run").click()
+    at.run()
+    assert not at.exception and not at.error, [e.value for e in at.error]
+    assert submitted == [(50.0, "steel", "steel_6mm")]
+    assert any(i.value.startswith("fills [%] empty: the specimen's own fill, 50 % ([particles] "
+                                  "fill_percent); ") for i in at.info)
+
+
 def _calibration_json(path, f, a, fill, predicted, low, high):
     doc = {"parameters": {"fixture_mass_kg": {"median": 0.2, "low95": 0.1, "high95": 0.3}},
            "predictions": [{"frequency_hz": f, "acceleration_g": a, "fill_percent": fill,

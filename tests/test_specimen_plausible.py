@@ -57,6 +57,9 @@ def _edit(old: str, new: str, text: str = TEXT) -> str:
     ('wall_material = "aluminium_wall"',
      'wall_material = "nomex"\nwall_youngs_modulus_pa = 3.4e3\nwall_poisson_ratio = 0.3\n'
      'wall_density_kg_m3 = 48.0', r"\[cell\] wall_youngs_modulus_pa: 3400 Pa"),
+    ("baseline_loss_factor = 0.0", "baseline_loss_factor = 5.0",  # 5 % typed as 5
+     r"\[coupon\] baseline_loss_factor: 5: expected a fraction \(the empty coupon's loss "
+     r"factor is 0-1, .*\); was it %\?$"),
 ])
 def test_a_value_in_the_wrong_unit_is_refused_naming_key_value_unit_and_slip(old, new,
                                                                              message):
@@ -91,12 +94,50 @@ def test_a_cell_of_many_radii_is_refused_before_the_packing_grid_is_allocated():
     # ran for an hour; ~8e4 spheres are beyond the DEM's pair history (N^2 per cell)
     with pytest.raises(ParameterError, match=r"at most 2000 per cell"):
         check_packing_size(CellGeometry(6.35e-3, 25.4e-3), 0.125e-3)
-    # a wide flat cell: a few hundred spheres, but 1.9e6 candidate points each scans
+    # a wide flat cell: a few hundred spheres, but 1.9e6 candidate points each scans (2.1 mm
+    # high: a 2 mm core holds no 1 mm sphere beside the packing's gap, refused before this)
     with pytest.raises(ParameterError, match="too fine to pack"):
-        check_packing_size(CellGeometry(50e-3, 2e-3), 1e-3)
+        check_packing_size(CellGeometry(50e-3, 2.1e-3), 1e-3)
     # the limits still admit a cell 25 radii across (the paper's is 3.8)
     check_packing_size(CellGeometry(25e-3, 5e-3), 1e-3)
     assert MAX_PACKING_GRID_POINTS <= 2_000_000
+
+
+def test_a_baseline_loss_factor_up_to_1_is_kept_and_a_calibration_prior_beyond_refused():
+    from pidcore.calibrate.parameters import build_specs
+
+    # 1 is the bound itself (a lossy viscoelastic layer near its glass transition); 0.05 the
+    # top of calibrate's default prior
+    for value in (0.05, 1.0):
+        spec = Specimen.from_text(_edit("baseline_loss_factor = 0.0",
+                                        f"baseline_loss_factor = {value}"))
+        assert spec.coupon.baseline_loss_factor == value
+    # a calibration writes its fit to the calibrated specimen, which would refuse it: the
+    # prior is refused before any DEM run
+    with pytest.raises(ParameterError, match=r"^--prior baseline_loss_factor: upper bound 2 "
+                                             r"is above 1, .*was it %\?$"):
+        build_specs(["baseline_loss_factor"], ["baseline_loss_factor=0:2"])
+    assert build_specs(["baseline_loss_factor"], ["baseline_loss_factor=0:1"])[0].high == 1.0
+
+
+def test_a_particle_material_row_is_refused_as_the_wall_naming_the_wall_materials(tmp_path,
+                                                                                   capsys):
+    # "aluminium" is the particles' alloy (E 70 GPa): as a wall it silently gave another k_n
+    # than "aluminium_wall" (72 GPa); the reverse was already refused
+    bad = tmp_path / "wall.toml"
+    bad.write_text(_edit('wall_material = "aluminium_wall"', 'wall_material = "aluminium"'),
+                   encoding="utf-8")
+    assert main(["specimen", "check", str(bad)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and (
+        f"{bad}: [cell] wall_material: material 'aluminium' is a particle material in "
+        "materials.csv, expected a wall material (aluminium_wall), or another name with "
+        "inline properties") in err
+    with pytest.raises(ParameterError, match=r"\[particles\] material: material "
+                                             r"'aluminium_wall' is a wall material in "
+                                             r"materials.csv, expected a particle material "
+                                             r"\(acrylic, aluminium\)"):
+        Specimen.from_text(_edit('material = "steel"', 'material = "aluminium_wall"'))
 
 
 def test_unit_slips_are_one_line_and_exit_2_in_the_cli(tmp_path, capsys):

@@ -318,6 +318,30 @@ def runner_for(store_path: str | Path) -> DemJobRunner:
         return _RUNNERS[key]
 
 
+def dem_fills(text: str, specimen=None) -> tuple[list[float], str | None]:
+    """The fills [%] typed on the DEM page, and a note when they are not what was typed.
+
+    An empty field takes the chosen specimen's own fill (:meth:`pidcore.specimen.Specimen.
+    stated_fill`), as ``pidcore dem run --specimen`` does without ``--fill``; the note says
+    so. Otherwise the typed values (:func:`pidcore.loadcase.parse_values`), or a one-line
+    error naming the field.
+    """
+    from ..loadcase import parse_values
+
+    stated = specimen.stated_fill() if specimen is not None and not text.strip() else None
+    if stated is None:
+        try:
+            return parse_values(text, name="fills [%]"), None
+        except ParameterError as exc:
+            if text.strip():
+                raise
+            # empty, and no specimen fill to fall back on: say where one could come from
+            raise ParameterError(f"{exc} (or choose a specimen file stating count_per_cell "
+                                 "or fill_percent)") from None
+    fill, source = stated
+    return [fill], f"fills [%] empty: the specimen's own fill, {fill:.4g} % ({source})"
+
+
 def plan_dem_cases(frequencies_hz: Sequence[float], accelerations_g: Sequence[float],
                    fills_percent: Sequence[float], *, material: str, direction: str,
                    max_cases: int = defaults.APP_MAX_DEM_CASES) -> list:

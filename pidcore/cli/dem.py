@@ -247,11 +247,9 @@ def _fill(args: argparse.Namespace, specimen, material: str) -> float:
     if args.fill is not None:
         _check_fill(args.fill, "--fill", args, specimen, material)
         return args.fill
-    p = specimen.particles if specimen is not None else None
-    if p is not None and p.fill_percent is not None:
-        return p.fill_percent
-    if p is not None and p.count_per_cell is not None:
-        return 100.0 * p.count_per_cell / specimen.capacity_per_cell()
+    stated = specimen.stated_fill() if specimen is not None else None
+    if stated is not None:
+        return stated[0]
     if specimen is None:
         raise ParameterError("--fill: required (or a --specimen file stating count_per_cell "
                              "or fill_percent)")

@@ -80,6 +80,34 @@ MAX_PACKING_WORK = 5e8
 _DENSEST_PACKING_FRACTION = np.pi / np.sqrt(18.0)
 #: Default candidate-grid spacing of :func:`drop_packing`, in particle radii.
 GRID_FRACTION = 0.04
+#: Default gap :func:`drop_packing` keeps between spheres and to floor and ceiling, in radii.
+PACKING_GAP_FRACTION = 1e-4
+
+
+def check_sphere_fits(geometry: CellGeometry, radius_m: float) -> None:
+    """Refuse (ParameterError, one line with the limit) a sphere :func:`drop_packing` cannot
+    place, so that a capacity is never computed as nothing (or fails).
+
+    Across the flats the sphere must be strictly narrower than the cell: its centre then has
+    room on the cell axis, exactly one apothem from every side wall (no rounding). Up the
+    core it must clear floor and ceiling by the packing's gap (``PACKING_GAP_FRACTION`` r
+    each), or the packing places no sphere at all; tested with the packing's own arithmetic.
+    """
+    r = float(radius_m)
+    width, height = geometry.inscribed_diameter_m, geometry.height_m
+    clearance = r * (1 + PACKING_GAP_FRACTION)
+    if r < geometry.apothem_m and -0.5 * height + clearance <= 0.5 * height - clearance:
+        return
+    # 6 digits: a radius just past the limit must not print equal to it
+    if r >= geometry.apothem_m:
+        expected = (f"expected a radius below {geometry.apothem_m * 1e3:.6g} mm, half the "
+                    f"{width * 1e3:.6g} mm flat-to-flat width")
+    else:
+        expected = (f"expected a radius up to {0.5 * height / (1 + PACKING_GAP_FRACTION) * 1e3:.6g}"
+                    f" mm, half the {height * 1e3:.6g} mm core height less the packing's gap "
+                    f"of {PACKING_GAP_FRACTION:g} radii to floor and ceiling")
+    raise ParameterError(f"a sphere of radius {r * 1e3:.6g} mm does not fit a "
+                         f"{width * 1e3:.6g} x {height * 1e3:.6g} mm cell; {expected}")
 
 
 def check_packing_size(geometry: CellGeometry, radius_m: float,
@@ -89,11 +117,8 @@ def check_packing_size(geometry: CellGeometry, radius_m: float,
     Called before :func:`drop_packing` allocates anything, so that a cell or radius in the
     wrong unit is one error line instead of a multi-GiB allocation or an endless loop.
     """
+    check_sphere_fits(geometry, radius_m)
     inner = geometry.apothem_m - radius_m
-    if inner < 0:
-        raise ParameterError(
-            f"particle radius {radius_m * 1e3:.3g} mm does not fit a cell of inscribed "
-            f"diameter {geometry.inscribed_diameter_m * 1e3:.3g} mm")
     size = (f"a {radius_m * 1e3:.3g} mm radius sphere in a "
             f"{geometry.inscribed_diameter_m * 1e3:.4g} x {geometry.height_m * 1e3:.4g} mm cell")
     per_side = 2.0 * inner * 2.0 / np.sqrt(3.0) / (grid_fraction * radius_m) + 2.0
@@ -124,11 +149,26 @@ def _candidate_grid(geometry: CellGeometry, radius_m: float, spacing_m: float) -
     pts = np.column_stack([xx.ravel(), yy.ravel(), np.zeros(xx.size)])
     sd = pts @ geometry.wall_normals[:6].T + geometry.wall_offsets[:6]
     ok = np.all(sd >= radius_m * (1 + 1e-9), axis=1)
+    if ok.any():
+        return pts[ok, :2]
+    # A near fit (sphere diameter within about a grid step, ~2 %, of the cell's width): the region
+    # where a centre may sit, a hexagon of apothem (a - r), is narrower than a grid step, and
+    # the grid above, anchored at its corner -rc rather than at the axis, can miss it. Lay the
+    # same spacing out from the axis instead, so a node is where the room is. The axis node
+    # is kept whatever the 1e-9 margin says: its distance from every side wall is the apothem
+    # itself, with no rounding, and check_sphere_fits has made sure that exceeds r. (Cells
+    # whose grid finds room keep the grid above, so their packings do not change.)
+    k = np.arange(-np.floor(rc / spacing_m), np.floor(rc / spacing_m) + 1.0)
+    xx, yy = np.meshgrid(k * spacing_m, k * spacing_m)
+    pts = np.column_stack([xx.ravel(), yy.ravel(), np.zeros(xx.size)])
+    sd = pts @ geometry.wall_normals[:6].T + geometry.wall_offsets[:6]
+    ok = np.all(sd >= radius_m * (1 + 1e-9), axis=1) | ((xx.ravel() == 0) & (yy.ravel() == 0))
     return pts[ok, :2]
 
 
 def drop_packing(geometry: CellGeometry, radius_m: float, n_particles: int | None, *,
-                 rng: np.random.Generator | None = None, gap_fraction: float = 1e-4,
+                 rng: np.random.Generator | None = None,
+                 gap_fraction: float = PACKING_GAP_FRACTION,
                  grid_fraction: float = GRID_FRACTION,
                  random_band_fraction: float = 0.5) -> np.ndarray:
     """Place spheres one by one, each dropped vertically onto floor and spheres below.
@@ -177,7 +217,9 @@ def cell_capacity(geometry: CellGeometry, radius_m: float) -> int:
     """Number of spheres the cell holds (dense greedy drop packing, :func:`drop_packing`).
 
     A sequential estimate, not a proven optimum; it is the reference of ``fill_reference=
-    "capacity"`` (100 % fill).
+    "capacity"`` (100 % fill). A sphere just narrower than the cell stacks up its axis (a
+    column); one the cell cannot hold is a ParameterError naming the limit
+    (:func:`check_sphere_fits`), never a capacity of 0.
     """
     return len(drop_packing(geometry, radius_m, None))
 

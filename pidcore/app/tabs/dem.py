@@ -79,7 +79,9 @@ def render(stores) -> None:
     freqs = c1.text_input("frequencies [Hz]", "100", key="dem_freqs",
                           help="one or more values, e.g. 50, 100, 333")
     accs = c2.text_input("accelerations [g]", "5", key="dem_accs", help="e.g. 1, 5, 7.5")
-    fills = c3.text_input("fills [%]", "50", key="dem_fills", help="e.g. 25, 50")
+    fills = c3.text_input("fills [%]", "50", key="dem_fills",
+                          help="e.g. 25, 50; empty: the specimen file's own count_per_cell or "
+                               "fill_percent")
     specimen, refused = specimen_choice("dem")
     c4, c5 = st.columns(2)
     if refused is not None:  # no fallback to the paper's coupon: nothing runs until fixed
@@ -111,17 +113,18 @@ def render(stores) -> None:
     elif start:
         try:
             config = _config(cells, seed, steady)
+            fill_values, fill_note = jobs.dem_fills(fills, specimen)
             cases = jobs.plan_dem_cases(
                 parse_values(freqs, name="frequencies [Hz]"),
                 parse_values(accs, name="accelerations [g]"),
-                parse_values(fills, name="fills [%]"), material=material,
-                direction=direction)
+                fill_values, material=material, direction=direction)
         except PidcoreError as exc:
             st.session_state["dem_message"] = ("error", str(exc))
         else:
             created = jobs.runner_for(stores.path).submit(cases, config, specimen)
-            st.session_state["dem_message"] = ("info", jobs.submitted_text(len(cases),
-                                                                           created))
+            text = jobs.submitted_text(len(cases), created)
+            st.session_state["dem_message"] = (
+                "info", text if fill_note is None else f"{fill_note}; {text}")
     message = st.session_state.get("dem_message")
     if message:
         getattr(st, message[0])(message[1])
