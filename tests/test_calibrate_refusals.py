@@ -104,6 +104,24 @@ def test_a_prior_box_is_checked_at_its_corners():
         build_specs(fit, wider)
 
 
+def test_a_static_friction_range_below_the_sliding_friction_is_refused():
+    # static >= sliding (the specimen file's rule): below it a value is taken as the sliding
+    # friction, so such a range ran a design whose runs were all alike
+    paper = paper_specimen().pairs  # sliding friction 0.096 particle-particle, 0.14 wall
+    assert (paper.particle_particle.sliding_friction, paper.particle_wall.sliding_friction) \
+        == (0.096, 0.14)
+    with pytest.raises(ParameterError, match=r"^--prior static_friction_pw=0.01:0.12: static "
+                                             r"friction below the sliding friction \(at least "
+                                             r"0.14 particle-wall\)"):
+        build_specs(["static_friction_pw"], ["static_friction_pw=0.01:0.12"])
+    # with friction fitted, its lower bound is the floor
+    with pytest.raises(ParameterError, match="at least 0.3 particle-particle, 0.3 particle"):
+        build_specs(["friction", "static_friction"],
+                    ["friction=0.3:0.5", "static_friction=0.1:0.3"])
+    build_specs(["static_friction_pp"], ["static_friction_pp=0.01:0.12"])  # reaches above
+    build_specs(["static_friction"])  # the default bounds (0.1..1.0) reach above both
+
+
 def test_a_design_point_outside_the_domain_names_it_not_the_specimen_file():
     # a constraint the corners cannot see would fail inside the design: the design point is
     # named, not the bundled specimen file

@@ -322,6 +322,7 @@ def check_domains(specs: Sequence[ParameterSpec], specimen=None,
                 if complaint:
                     raise outside(spec, bound, complaint)
     dem = [s for s in specs if s.kind == "dem"]
+    _check_static_friction(dem, specimen, given)
     if len(dem) > _MAX_CORNER_PARAMETERS:
         # too many corners: each bound with the other parameters at their starting values
         for spec in dem:
@@ -346,3 +347,31 @@ def check_domains(specs: Sequence[ParameterSpec], specimen=None,
     priors = "; ".join(_prior_words(s, given) for s in dem)
     raise ParameterError(f"{priors}: the prior corner {values} is outside the physical "
                          f"domain ({complaint}); narrow the ranges")
+
+
+def _check_static_friction(dem: Sequence[ParameterSpec], specimen,
+                           given: Mapping[str, str]) -> None:
+    """Refuse a static friction range wholly at or below the sliding friction it stands on.
+
+    Static friction is at least the sliding one (the specimen file's rule): a value below it
+    is taken as it (:func:`pidcore.calibrate.runner.specimen_with`), so a range below the
+    lowest sliding friction of the pairs it sets (the specimen's, or a fitted friction's lower
+    bound) changes no DEM run, and the fit learns nothing from it.
+    """
+    lowest = {pair: getattr(specimen.pairs, pair).sliding_friction
+              for pair in ("particle_particle", "particle_wall")}
+    for spec in dem:
+        alias = dem_alias_paths(spec.name)
+        if alias is not None and alias[0] == "sliding_friction":
+            lowest.update((pair, spec.low) for pair in alias[1])
+    for spec in dem:
+        alias = dem_alias_paths(spec.name)
+        if alias is None or alias[0] != "static_friction":
+            continue
+        floor = {pair: lowest[pair] for pair in alias[1]}
+        if spec.high <= min(floor.values()):
+            stated = ", ".join(f"{v:g} {pair.replace('_', '-')}" for pair, v in floor.items())
+            raise ParameterError(f"{_prior_words(spec, given)}: static friction below the "
+                                 f"sliding friction (at least {stated}) is taken as the "
+                                 "sliding friction, so this range changes no DEM run; give a "
+                                 "range above it")
