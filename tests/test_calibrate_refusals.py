@@ -176,6 +176,13 @@ def test_rows_of_another_specimen_are_refused(capsys, tmp_path):
     assert base_specimen(named, specimen) is specimen
     calibrated = dataclasses.replace(specimen, name="my_coupon_calibrated")
     assert base_specimen(named, calibrated) is calibrated
+    # a store's load cases have no rows: they are counted
+    stored = [MeasuredPoint(500, 5, 50, 0.6, specimen="steel_6mm_b", source="s.h5"),
+              MeasuredPoint(500, 1, 50, 0.2, specimen="steel_6mm_b", source="s.h5")]
+    with pytest.raises(ParameterError, match=r"^2 measured load case\(s\) of s.h5 name specimen "
+                                             r"'steel_6mm_b', not 'my_coupon', the specimen "
+                                             r"calibrated"):
+        base_specimen(stored, specimen)
 
 
 def test_loo_says_it_needs_one_case_more_than_parameters(capsys, tmp_path):

@@ -229,10 +229,11 @@ def check_point_specimens(points: Sequence[MeasuredPoint], specimen: Specimen) -
         return
     said = []
     for (source, name), rows in others.items():
-        where = source or "the measured points"
         numbered = [str(r) for r in rows if r is not None]
-        if numbered:
-            where += f" row{'s' if len(numbered) > 1 else ''} {', '.join(numbered)}"
+        if numbered:  # a table's rows
+            where = f"{source} row{'s' if len(numbered) > 1 else ''} {', '.join(numbered)}"
+        else:  # a store's load cases (or points made in code)
+            where = f"{len(rows)} measured load case(s)" + (f" of {source}" if source else "")
         said.append(f"{where} name specimen {name!r}")
     raise ParameterError(f"{'; '.join(said)}, not {specimen.name!r}, the specimen calibrated; "
                          "calibrate them with their own specimen file (--specimen FILE), or "
