@@ -1226,3 +1226,52 @@ def test_available_calibrations_list_this_stores_first_and_say_what_cannot_be_re
     assert found[-1][1].startswith("calibration not shown: ")
     assert available_calibrations(None, {CALIBRATION_ENV_VAR: str(tmp_path / "none.json")})[0][0] \
         is None
+
+
+def test_a_failed_calibration_says_the_librarys_line_in_the_pages_terms(tmp_path):
+    # it showed "calibration of paper_coupon failed: ParameterError: pidcore:paper_coupon.toml:
+    # ...", and the library's notes and errors advised command-line flags the page lacks
+    import types
+
+    from pidcore.app.calibration import CalibrationRunner, CalibrationTask, page_words
+
+    def failing(error):
+        def calibrate(points, **kw):
+            raise error
+        return types.SimpleNamespace(calibrate=calibrate)
+
+    runner = CalibrationRunner(tmp_path / "s.h5")
+    for error, said in (
+            (ParameterError("--fit: unknown parameter 'frction'; expected ... "
+                            "(pidcore specimen check)"),
+             "parameters to fit: unknown parameter 'frction'; expected ... (as `pidcore "
+             "specimen check` lists them)"),
+            (KeyError("x"), "KeyError: 'x'")):  # an unexpected error keeps its name
+        task = CalibrationTask(("friction",), 3)
+        runner._run(failing(error), task, [], ["friction"], 2, None, None)
+        assert (task.state, task.message) == ("failed", said)
+    # a bound note (summary.md) advises the page's default prior, not a flag to type here
+    from pidcore.calibrate.parameters import build_specs
+    from pidcore.calibrate.posterior import bound_notes
+
+    (spec,) = build_specs(["fixture_mass_kg"], discrepancy=0.2)
+    (note,) = bound_notes([spec], np.zeros((100, 1)))  # piled on the lower bound 0
+    assert "(--prior fixture_mass_kg=LOW:HIGH)" in note
+    assert "(the page fits the default prior; `pidcore calibrate --prior fixture_mass_kg=LOW:" \
+           "HIGH` widens it)" in page_words(note)
+    assert page_words("--design-size 5 ignored: no DEM parameter") == \
+        "design points 5 ignored: no DEM parameter"
+
+
+def test_the_paper_coupon_page_leaves_out_measurements_of_another_specimen():
+    # the library refuses them for the paper's coupon; the page leaves them out and says so
+    from pidcore.app.calibration import points_for_paper
+    from pidcore.calibrate import MeasuredPoint
+
+    mine = [MeasuredPoint(100, 1, 50, 0.2), MeasuredPoint(200, 1, 50, 0.2,
+                                                          specimen="paper_coupon")]
+    other = MeasuredPoint(300, 1, 50, 0.2, specimen="steel_6mm_b")
+    assert points_for_paper([*mine, other]) == (mine, "Not used for the paper's coupon: 1 "
+                                                "measured load case(s) of specimen steel_6mm_b "
+                                                "(choose their specimen file above).")
+    assert points_for_paper(mine) == (mine, "")

@@ -88,6 +88,26 @@ def points_for_specimen(points: Sequence, specimen) -> tuple[list, str]:
     return kept, note
 
 
+def points_for_paper(points: Sequence) -> tuple[list, str]:
+    """(points, note): the measured points the paper's coupon is calibrated against, those
+    naming no specimen or the paper's coupon (the library refuses others:
+    :func:`pidcore.calibrate.calibrate.check_point_specimens`); ``note`` says what is left out
+    ("" if nothing)."""
+    from ..specimen import PAPER_SPECIMEN_NAME, uncalibrated_name
+
+    kept, others = [], {}
+    for p in points:
+        name = str(p.specimen)
+        if name and uncalibrated_name(name) != PAPER_SPECIMEN_NAME:
+            others[name] = others.get(name, 0) + 1
+        else:
+            kept.append(p)
+    note = ("Not used for the paper's coupon: " + "; ".join(
+        f"{n} measured load case(s) of specimen {name}" for name, n in others.items())
+        + " (choose their specimen file above).") if others else ""
+    return kept, note
+
+
 def specimen_label(specimen) -> str:
     """The name a calibration's result goes by: the specimen's, or the paper's coupon."""
     from ..specimen import PAPER_SPECIMEN_NAME
@@ -126,6 +146,34 @@ def points_needed_text(n_points: int, fit: Sequence[str]) -> str:
     return (f"{n_points} measured load case(s) cannot determine {', '.join(fit)} and the "
             f"model discrepancy (always fitted here): choose at least {points_needed(fit)} "
             "load cases or fit fewer parameters")
+
+
+#: The library's words for command-line options, and the page's for the same thing (as
+#: :func:`pidcore.app.uploads.error_message` rewords the analysis's hints). The page fits the
+#: default priors and the parameters chosen in its form; it has no --prior input.
+_PAGE_WORDS: tuple[tuple[str, str], ...] = (
+    (r"\(give --prior (\S+)=LOW:HIGH\)",
+     r"(the page fits the default prior; `pidcore calibrate --prior \1=LOW:HIGH` changes it)"),
+    (r"\(--prior (\S+)=LOW:HIGH\)",
+     r"(the page fits the default prior; `pidcore calibrate --prior \1=LOW:HIGH` widens it)"),
+    (r"--fit/--prior: ", ""),
+    (r"--fit (\S+): ", r"parameter to fit \1: "),
+    (r"--fit: ", "parameters to fit: "),
+    (r"--design-size (\d+)", r"design points \1"),
+    (r"--design-size", "design points"),
+    (r"\(--specimen FILE\)", "(choose their specimen file above)"),
+    (r"\(pidcore calibrate --specimen FILE\)", "(choose their specimen file above)"),
+    (r"\(pidcore specimen check\)", "(as `pidcore specimen check` lists them)"),
+)
+
+
+def page_words(text: str) -> str:
+    """A library message or note in the page's terms: its options, not the command line's."""
+    import re
+
+    for pattern, replacement in _PAGE_WORDS:
+        text = re.sub(pattern, replacement, text)
+    return text
 
 
 @dataclass
@@ -172,6 +220,8 @@ class CalibrationRunner:
 
     def _run(self, api, task: CalibrationTask, points, fit, cells, design_size,
              specimen) -> None:
+        from ..errors import PidcoreError
+
         # the paper's coupon is the library's default: no specimen argument for it
         given = {} if specimen is None else {"specimen": specimen}
         try:
@@ -182,7 +232,11 @@ class CalibrationRunner:
                 outputs = {Path(p).name: Path(p).read_bytes() for p in paths}
             state, message = "done", f"{len(points)} load case(s), fitted {', '.join(fit)}"
         except Exception as exc:  # noqa: BLE001 - shown on the page as the task's error
-            outputs, state, message = {}, "failed", f"{type(exc).__name__}: {exc}"
+            # a library refusal is its one line (the class name is no news to a user); an
+            # unexpected error keeps its name, without which "KeyError: 'x'" says nothing
+            outputs, state = {}, "failed"
+            message = page_words(str(exc)) if isinstance(exc, PidcoreError) \
+                else f"{type(exc).__name__}: {exc}"
         with self._lock:
             task.outputs, task.state, task.message = outputs, state, message
             task.finished = time.time()

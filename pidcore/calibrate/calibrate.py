@@ -11,7 +11,7 @@ import dataclasses
 import math
 import os
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -21,7 +21,7 @@ from ..compare.align import steady_stated
 from ..constants import STANDARD_GRAVITY
 from ..dem.simulate import DemConfig, LoadCase
 from ..errors import ParameterError
-from ..specimen import CALIBRATED_SUFFIX, Specimen, paper_specimen
+from ..specimen import CALIBRATED_SUFFIX, Specimen, paper_specimen, uncalibrated_name
 from .data import MeasuredPoint, check_enough_points
 from .observation import Observation, observation_from_run
 from .parameters import CATALOGUE, DISCREPANCY, ParameterSpec, build_specs, parameter_spec
@@ -127,11 +127,22 @@ class CalibrationResult:
             "runs": self.runs, "settings": self.settings, "notes": self.notes,
             "energy_check": self.energy_check,
             "wall_s": self.wall_s,
-            "units": {"frequency_hz": "Hz", "acceleration_g": "g", "fill_percent": "%",
-                      "measured": "-", "predicted": "-", "low95": "-", "high95": "-",
-                      "fixture_mass_kg": "kg", "baseline_loss_factor": "-",
-                      DISCREPANCY: "-"},
+            "units": self.units(),
         })
+        return out
+
+    def units(self) -> dict[str, str]:
+        """Units of what calibration.json reports: the load case, the SDCs, the energies, and
+        exactly the fitted parameters and the fixed ones (from their definitions,
+        :attr:`ParameterSpec.unit`)."""
+        out = {"frequency_hz": "Hz", "acceleration_g": "g", "fill_percent": "%",
+               "measured": "-", "predicted": "-", "low95": "-", "high95": "-",
+               "rms_in_sample": "-", "loo_rms": "-", "energy_per_cycle_per_cell_start_j": "J",
+               "energy_per_cycle_per_cell_calibrated_j": "J", "low95_j": "J", "high95_j": "J",
+               "wall_s": "s"}
+        for name in self.fixed:
+            out[name] = parameter_spec(name, self.specimen).unit
+        out.update((s.name, s.unit) for s in self.specs)
         return out
 
 
@@ -144,9 +155,19 @@ def _public(row: dict) -> dict:
 def _requests(points: Sequence[MeasuredPoint], dem_specs: Sequence[ParameterSpec],
               design: np.ndarray, config: DemConfig,
               specimen: Specimen) -> list[list[RunRequest]]:
-    specimens = [specimen_with(specimen, {s.name: float(v)
-                                          for s, v in zip(dem_specs, row, strict=True)})
-                 for row in design]
+    specimens = []
+    for row in design:
+        values = {s.name: float(v) for s, v in zip(dem_specs, row, strict=True)}
+        try:
+            specimens.append(specimen_with(specimen, values))
+        except ParameterError as exc:
+            # the design point's fault, not the specimen file's (check_domains catches the
+            # prior's corners; a constraint that is not monotone could still fail inside)
+            at = ", ".join(f"{n}={v:g}" for n, v in values.items())
+            raise ParameterError(
+                f"--fit/--prior: the design point {at} is outside the physical domain "
+                f"({str(exc).removeprefix(f'{specimen.source}: ')}); narrow the --prior "
+                "ranges") from None
     out = []
     for point in points:
         case = LoadCase(point.frequency_hz, point.acceleration_g, point.fill_percent,
@@ -174,18 +195,49 @@ def base_specimen(points: Sequence[MeasuredPoint], specimen: Specimen | None) ->
     material = materials[0]
     if specimen is None:
         try:
-            return paper_specimen(material)
+            chosen = paper_specimen(material)
         except ParameterError:
             raise ParameterError(f"the measured points are of {material} particles, which are "
                                  "not in the materials table: give the specimen file of these "
                                  "particles (pidcore calibrate --specimen FILE)") from None
-    own = specimen.particles.material
-    if material != own:
-        raise ParameterError(f"the measured points are of {material} particles, the specimen "
-                             f"{specimen.name!r} holds {own} particles; calibrate {own} "
-                             "measurements with it (or give the specimen file of the "
-                             f"{material} particles)")
-    return specimen
+    else:
+        chosen = specimen
+        own = specimen.particles.material
+        if material != own:
+            raise ParameterError(f"the measured points are of {material} particles, the "
+                                 f"specimen {specimen.name!r} holds {own} particles; calibrate "
+                                 f"{own} measurements with it (or give the specimen file of "
+                                 f"the {material} particles)")
+    check_point_specimens(points, chosen)
+    return chosen
+
+
+def check_point_specimens(points: Sequence[MeasuredPoint], specimen: Specimen) -> None:
+    """Refuse points measured on another specimen than ``specimen``, the one calibrated.
+
+    A point naming no specimen is of the one calibrated; one naming it, or the specimen it was
+    calibrated from (``x_calibrated`` is ``x``), is too, as a calibration speaks for a
+    measurement in the report and the app (:meth:`pidcore.calibrate.prediction.Calibration.
+    speaks_for`). Any other was fitted silently against this specimen's DEM runs.
+    """
+    own = uncalibrated_name(specimen.name)
+    others: dict[tuple[str, str], list[int | None]] = {}
+    for p in points:
+        if p.specimen and uncalibrated_name(p.specimen) != own:
+            others.setdefault((p.source, p.specimen), []).append(p.row)
+    if not others:
+        return
+    said = []
+    for (source, name), rows in others.items():
+        numbered = [str(r) for r in rows if r is not None]
+        if numbered:  # a table's rows
+            where = f"{source} row{'s' if len(numbered) > 1 else ''} {', '.join(numbered)}"
+        else:  # a store's load cases (or points made in code)
+            where = f"{len(rows)} measured load case(s)" + (f" of {source}" if source else "")
+        said.append(f"{where} name specimen {name!r}")
+    raise ParameterError(f"{'; '.join(said)}, not {specimen.name!r}, the specimen calibrated; "
+                         "calibrate them with their own specimen file (--specimen FILE), or "
+                         "leave those rows out")
 
 
 def calibrate(points: Sequence[MeasuredPoint], *, fit: Sequence[str],
@@ -197,14 +249,17 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: Sequence[str],
               workers: int = 2, cross_validate: str | None = None, method: str = "auto",
               progress: bool = True, posterior_seed: int = 0,
               dem_config: DemConfig | None = None,
-              specimen: Specimen | None = None) -> CalibrationResult:
+              specimen: Specimen | None = None,
+              on_design: Callable[[list[str]], None] | None = None) -> CalibrationResult:
     """Fit ``fit`` parameters to measured SDCs (see the package docstring for the model).
 
     DEM runs go to (and are reused from) the store at ``store_path``. ``discrepancy``: fix the
     relative model discrepancy instead of fitting it. ``cross_validate="loo"``: also predict
     every point from a fit without it. ``dem_config``: numerical DEM settings to start from
     (cells, seed and steady cycles are then set from the arguments). ``specimen``: the
-    specimen to start from (default: the paper's coupon).
+    specimen to start from (default: the paper's coupon). ``on_design``: called with the DEM
+    run keys of the design before any run starts (:class:`pidcore.calibrate.runner.RunTally`
+    counts from them what a Ctrl-C kept).
     """
     start = time.perf_counter()
     points = list(points)
@@ -215,7 +270,7 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: Sequence[str],
         raise ParameterError(f"--cross-validate: expected one of {CROSS_VALIDATIONS}, "
                              f"got {cross_validate!r}")
     if cross_validate == "loo":
-        check_enough_points(points[1:], [spec.name for spec in specs])
+        check_enough_points(points, [spec.name for spec in specs], leave_one_out=True)
     if not discrepancy_floor >= 0:
         raise ParameterError(f"--discrepancy-floor: expected >= 0, got {discrepancy_floor}")
     notes = []
@@ -235,6 +290,8 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: Sequence[str],
     config = dataclasses.replace(dem_config or DemConfig(), cells=cells, seed=seed,
                                  steady_cycles=steady_cycles)
     requests = _requests(points, dem_specs, design, config, specimen)
+    if on_design is not None:
+        on_design([r.key() for row in requests for r in row])
     runs = run_requests([r for row in requests for r in row], store_path=store_path,
                         workers=workers, progress=progress)
     from ..store import Store

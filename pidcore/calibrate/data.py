@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 import os
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -41,6 +41,10 @@ class MeasuredPoint:
     sdc_stderr: float = 0.0
     material: str = DEFAULT_MATERIAL
     specimen: str = ""
+    # where the point was read (a table and its row, or a store), for messages naming it; not
+    # part of the point's identity
+    source: str = field(default="", compare=False)
+    row: int | None = field(default=None, compare=False)
 
     def label(self) -> str:
         """E.g. ``'500 Hz, 1 g, 50 %, steel, specimen steel_6mm_b'``: material and specimen
@@ -105,7 +109,8 @@ def read_measured_table(path: str | os.PathLike, *,
         if values["sdc"] < 0 or values["sdc_stderr"] < 0:
             raise InputFileError(f"{where}: sdc and sdc_stderr must be >= 0")
         points.append(MeasuredPoint(material=_text_cell(row.get("material"), default_material),
-                                    specimen=_text_cell(row.get("specimen"), ""), **values))
+                                    specimen=_text_cell(row.get("specimen"), ""),
+                                    source=str(path), row=int(i) + 2, **values))
     if not points:
         raise InputFileError(f"{path}: no rows")
     seen: dict[tuple, int] = {}
@@ -162,20 +167,30 @@ def measured_from_store(store_path: str | os.PathLike) -> list[MeasuredPoint]:
         else:
             se = float(group.get("sdc_stderr", pd.Series([0.0])).fillna(0.0).iloc[0])
         points.append(MeasuredPoint(float(f), float(a), float(p), float(sdc.mean()), se,
-                                    str(material), str(specimen)))
+                                    str(material), str(specimen), source=str(store_path)))
     if not points:
         raise InputFileError(f"{store_path}: no analysed measurement has a complete load case")
     return points
 
 
-def check_enough_points(points: list[MeasuredPoint], names: Sequence[str]) -> None:
+def check_enough_points(points: list[MeasuredPoint], names: Sequence[str], *,
+                        leave_one_out: bool = False) -> None:
     """Refuse fewer measured load cases than fitted parameters (``names``); the message lists
-    them, since one (the model discrepancy) is fitted unless fixed."""
+    them, since one (the model discrepancy) is fitted unless fixed. ``leave_one_out``: every
+    fold is fitted on all cases but one, so one more case is needed (said as such: "2 load
+    cases cannot determine 3 parameters" read wrong to a user who gave 3)."""
     n_parameters = len(names)
-    if len(points) < n_parameters:
+    need = n_parameters + (1 if leave_one_out else 0)
+    if len(points) < need:
         listed = f": {', '.join(names)}"
         fixed = " (fix model_discrepancy with --discrepancy TAU)" \
             if "model_discrepancy" in names else ""
+        if leave_one_out:
+            raise ParameterError(
+                f"--cross-validate loo: leave-one-out fits each fold on {len(points) - 1} of the "
+                f"{len(points)} measured load case(s), which cannot determine {n_parameters} "
+                f"fitted parameter(s){listed}; it needs at least {need} load cases (parameters "
+                f"+ 1): give more, fit fewer parameters{fixed}, or leave out --cross-validate")
         raise ParameterError(f"{len(points)} measured load case(s) cannot determine "
                              f"{n_parameters} fitted parameter(s){listed}; give at least "
                              f"{n_parameters} load cases or fit fewer parameters{fixed}")

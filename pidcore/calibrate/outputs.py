@@ -198,12 +198,15 @@ def plot_pairs(result: CalibrationResult, path: Path) -> None:
 def write_outputs(result: CalibrationResult, out_dir: str | os.PathLike) -> list[Path]:
     """Write every output into ``out_dir`` (created); returns the paths written."""
     out = Path(out_dir)
+    # every text first: one that cannot be made (a calibrated specimen outside the domain)
+    # refuses before the folder is created, not after, leaving it empty
+    texts = (("calibration.json", document_json(result.full_document())),
+             (SPECIMEN_FILE, specimen_text(result)),
+             ("summary.md", summary_markdown(result)),
+             ("summary.html", summary_html(result)))
     out.mkdir(parents=True, exist_ok=True)
     written = []
-    for name, text in (("calibration.json", document_json(result.full_document())),
-                       (SPECIMEN_FILE, specimen_text(result)),
-                       ("summary.md", summary_markdown(result)),
-                       ("summary.html", summary_html(result))):
+    for name, text in texts:
         _write_text(out / name, text)
         written.append(out / name)
     for name, plot in (("predictions.png", plot_predictions), ("posterior_pairs.png", plot_pairs)):

@@ -20,8 +20,9 @@ Priors: uniform between the bounds (default), or ``normal:MU:SD`` truncated to t
 
 from __future__ import annotations
 
+import itertools
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -44,6 +45,7 @@ class ParameterSpec:
     prior: str = "uniform"  # "uniform" | "normal" | "log-uniform"
     prior_mean: float = float("nan")
     prior_sd: float = float("nan")
+    unit: str = "-"  # of the value, as calibration.json's "units" states it
 
     def check(self) -> None:
         if not (math.isfinite(self.low) and math.isfinite(self.high) and self.low < self.high):
@@ -103,7 +105,7 @@ def dem_parameter_names() -> list[str]:
 #: Parameters of the observation model (no DEM run) and the discrepancy hyperparameter.
 CATALOGUE: dict[str, ParameterSpec] = {spec.name: spec for spec in (
     ParameterSpec("fixture_mass_kg", "observation", 0.0, 0.0, 1.0,
-                  "mass moving with the coupon above the force gauge"),
+                  "mass moving with the coupon above the force gauge", unit="kg"),
     ParameterSpec("baseline_loss_factor", "observation", 0.0, 0.0, 0.05,
                   "loss factor of the empty coupon and fixture"),
     ParameterSpec(DISCREPANCY, "hyper", 0.2, 0.02, 2.0,
@@ -114,6 +116,17 @@ OBSERVATION_PATHS = {"coupon.fixture_mass_kg": "fixture_mass_kg",
                      "coupon.baseline_loss_factor": "baseline_loss_factor"}
 
 DEFAULT_FIT = ("fixture_mass_kg", "baseline_loss_factor")
+
+
+#: Unit of a specimen field by the suffix of its name (the schema's naming rule: SI, the unit
+#: in the name); a field without one (ratios, coefficients) is dimensionless.
+_FIELD_UNITS = (("_kg_m3", "kg/m^3"), ("_pa", "Pa"), ("_kg", "kg"), ("_m", "m"),
+                ("_percent", "%"))
+
+
+def field_unit(path: str) -> str:
+    """Unit of a specimen field by dotted path, e.g. ``"m"`` for ``particles.radius_m``."""
+    return next((unit for suffix, unit in _FIELD_UNITS if path.endswith(suffix)), "-")
 
 
 def _specimen(specimen):
@@ -148,14 +161,29 @@ def parameter_spec(name: str, specimen=None) -> ParameterSpec:
         return ParameterSpec(name, "dem", float(default), low, high, f"{text}, {where}")
     if name in numeric_fields(specimen):
         value = float(_field_value(specimen, name))
+        unit = field_unit(name)
         if value > 0:
             return ParameterSpec(name, "dem", value, 0.5 * value, 1.5 * value,
-                                 f"specimen field {name}")
+                                 f"specimen field {name}", unit=unit)
         return ParameterSpec(name, "dem", value, float("nan"), float("nan"),
-                             f"specimen field {name} (give --prior {name}=LOW:HIGH)")
+                             f"specimen field {name} (give --prior {name}=LOW:HIGH)",
+                             unit=unit)
     raise ParameterError(f"--fit: unknown parameter {name!r}; expected fixture_mass_kg, "
                          f"baseline_loss_factor, one of {', '.join(dem_parameter_names())}, or a "
                          "numeric specimen field by dotted path (pidcore specimen check)")
+
+
+def _refuse_whole_number(name: str, specimen) -> None:
+    """A whole-number specimen field (``cell.count``, ``particles.count_per_cell``) cannot be
+    fitted: the design and the posterior vary parameters continuously, and a fractional count
+    is no specimen (it failed mid-run with an error blaming the specimen file)."""
+    from ..specimen import numeric_fields
+
+    specimen = _specimen(specimen)
+    if name in numeric_fields(specimen) and isinstance(_field_value(specimen, name), int):
+        raise ParameterError(f"--fit {name}: a whole-number field cannot be fitted (the fit "
+                             "varies parameters continuously); set it in the specimen file and "
+                             "calibrate once per value instead")
 
 
 def _field_value(specimen, path: str):
@@ -178,6 +206,7 @@ def parse_fit(text: str | Sequence[str] | None, specimen=None) -> list[str]:
             raise ParameterError(f"--fit: {DISCREPANCY} is always fitted (fix it with "
                                  "--discrepancy)")
         parameter_spec(name, specimen)
+        _refuse_whole_number(name, specimen)
     if len(set(names)) != len(names):
         raise ParameterError(f"--fit: a parameter is named twice in {','.join(names)}")
     return names
@@ -215,9 +244,11 @@ def build_specs(fit: Sequence[str], priors: Sequence[str] = (), *,
     """Specs of the fitted parameters (order of ``fit``, then ``model_discrepancy`` unless
     fixed by ``discrepancy``), with ``--prior`` changes applied and checked."""
     changes: dict[str, dict] = {}
+    given: dict[str, str] = {}  # name -> the --prior text that set its bounds last
     for text in priors:
         name, fields = parse_prior(text)
         changes.setdefault(name, {}).update(fields)
+        given[name] = text.strip()
     names = list(fit) + ([] if discrepancy is not None else [DISCREPANCY])
     for name in changes:
         if name not in names:
@@ -240,4 +271,118 @@ def build_specs(fit: Sequence[str], priors: Sequence[str] = (), *,
         specs.append(spec)
     if discrepancy is not None and not discrepancy >= 0:
         raise ParameterError(f"--discrepancy: expected >= 0, got {discrepancy}")
+    check_domains(specs, specimen, given)
     return specs
+
+
+#: Most DEM parameters whose prior box is checked corner by corner (2**k specimens, each a
+#: few milliseconds); beyond, each parameter's own bounds are still checked.
+_MAX_CORNER_PARAMETERS = 6
+
+
+def _prior_words(spec: ParameterSpec, given: Mapping[str, str]) -> str:
+    """How the message names a prior: the ``--prior`` given, or the default bounds."""
+    if spec.name in given:
+        return f"--prior {given[spec.name]}"
+    return (f"the default prior bounds {spec.name}={spec.low:g}:{spec.high:g} (give --prior "
+            f"{spec.name}=LOW:HIGH)")
+
+
+def check_domains(specs: Sequence[ParameterSpec], specimen=None,
+                  given: Mapping[str, str] | None = None) -> None:
+    """Refuse a prior range that leaves a parameter's physical domain, before any DEM run.
+
+    The domain is the one the specimen file enforces (masses, loss factors and frictions
+    >= 0, 0 < restitution <= 1, a particle that fits its cell, ...): the starting specimen is
+    built with each parameter at each of its bounds, then with the DEM parameters at every
+    corner of their prior box (e.g. a cell diameter and a particle radius fitted together), and
+    the specimen's own one-line complaint is said naming the prior. Without this a negative
+    baseline loss factor was fitted and reported (a negative predicted SDC), and a design point
+    outside the domain failed mid-run blaming the bundled specimen file.
+    """
+    from .runner import specimen_with
+
+    given = given or {}
+    specimen = _specimen(specimen)
+    prefix = f"{specimen.source}: "
+
+    def build(values: Mapping[str, float]) -> str:
+        """The specimen's complaint about ``values`` ("" where they make a valid one)."""
+        dem = {n: v for n, v in values.items() if n not in CATALOGUE}
+        coupon = {f"coupon.{n}": v for n, v in values.items()
+                  if n in ("fixture_mass_kg", "baseline_loss_factor")}
+        try:
+            built = specimen_with(specimen, dem)
+            if coupon:
+                built.with_values(coupon)
+        except ParameterError as exc:
+            return str(exc).removeprefix(prefix)
+        return ""
+
+    def outside(spec: ParameterSpec, bound: float, complaint: str) -> ParameterError:
+        return ParameterError(f"{_prior_words(spec, given)}: {spec.name}={bound:g} is outside "
+                              f"its physical domain ({complaint}); give a range inside it")
+
+    for spec in specs:
+        if spec.kind == "hyper" and spec.low < 0:  # a relative standard deviation
+            raise ParameterError(f"{_prior_words(spec, given)}: {spec.name} is a relative "
+                                 "standard deviation; expected bounds >= 0")
+        if spec.kind == "observation":  # enters no DEM run: its own bounds are its domain
+            for bound in (spec.low, spec.high):
+                complaint = build({spec.name: bound})
+                if complaint:
+                    raise outside(spec, bound, complaint)
+    dem = [s for s in specs if s.kind == "dem"]
+    _check_static_friction(dem, specimen, given)
+    if len(dem) > _MAX_CORNER_PARAMETERS:
+        # too many corners: each bound with the other parameters at their starting values
+        for spec in dem:
+            for bound in (spec.low, spec.high):
+                complaint = build({spec.name: bound})
+                if complaint:
+                    raise outside(spec, bound, complaint)
+        return
+    corners = list(itertools.product(*((s.low, s.high) for s in dem)))
+    complaints = [build(dict(zip((s.name for s in dem), c, strict=True))) for c in corners]
+    if not any(complaints):
+        return
+    # a bound invalid at every corner is that parameter's own fault (a negative friction):
+    # named alone; else the combination is (a particle radius the cell diameter cannot hold)
+    for i, spec in enumerate(dem):
+        for bound in (spec.low, spec.high):
+            at = [c for c, corner in zip(complaints, corners, strict=True) if corner[i] == bound]
+            if all(at):
+                raise outside(spec, bound, at[0])
+    corner, complaint = next((c, m) for c, m in zip(corners, complaints, strict=True) if m)
+    values = ", ".join(f"{s.name}={v:g}" for s, v in zip(dem, corner, strict=True))
+    priors = "; ".join(_prior_words(s, given) for s in dem)
+    raise ParameterError(f"{priors}: the prior corner {values} is outside the physical "
+                         f"domain ({complaint}); narrow the ranges")
+
+
+def _check_static_friction(dem: Sequence[ParameterSpec], specimen,
+                           given: Mapping[str, str]) -> None:
+    """Refuse a static friction range wholly at or below the sliding friction it stands on.
+
+    Static friction is at least the sliding one (the specimen file's rule): a value below it
+    is taken as it (:func:`pidcore.calibrate.runner.specimen_with`), so a range below the
+    lowest sliding friction of the pairs it sets (the specimen's, or a fitted friction's lower
+    bound) changes no DEM run, and the fit learns nothing from it.
+    """
+    lowest = {pair: getattr(specimen.pairs, pair).sliding_friction
+              for pair in ("particle_particle", "particle_wall")}
+    for spec in dem:
+        alias = dem_alias_paths(spec.name)
+        if alias is not None and alias[0] == "sliding_friction":
+            lowest.update((pair, spec.low) for pair in alias[1])
+    for spec in dem:
+        alias = dem_alias_paths(spec.name)
+        if alias is None or alias[0] != "static_friction":
+            continue
+        floor = {pair: lowest[pair] for pair in alias[1]}
+        if spec.high <= min(floor.values()):
+            stated = ", ".join(f"{v:g} {pair.replace('_', '-')}" for pair, v in floor.items())
+            raise ParameterError(f"{_prior_words(spec, given)}: static friction below the "
+                                 f"sliding friction (at least {stated}) is taken as the "
+                                 "sliding friction, so this range changes no DEM run; give a "
+                                 "range above it")

@@ -13,7 +13,8 @@ from __future__ import annotations
 import os
 import time
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from pathlib import Path
 
 from ..dem.persist import dem_run_entry, run_key, save_dem_entry
 from ..dem.simulate import DemConfig, LoadCase, simulate_load_case
@@ -134,3 +135,53 @@ def run_requests(requests: Sequence[RunRequest], *, store_path: str | os.PathLik
         if bar is not None:
             bar.close()
     return {"computed": len(todo), "cached": cached, "wall_s": time.perf_counter() - start}
+
+
+def stored_keys(store_path: str | os.PathLike, keys: Sequence[str]) -> set[str]:
+    """The run keys of ``keys`` that the store at ``store_path`` holds now (read from the
+    store itself: a hook called after each save could miss the one committed as Ctrl-C came)."""
+    from ..store import Store
+
+    if not Path(store_path).exists():
+        return set()
+    store = Store(store_path)
+    return {key for key in keys if store.has_dem_run(key)}
+
+
+@dataclass
+class RunTally:
+    """The DEM runs a calibration asks for and those its store held before: after Ctrl-C,
+    :meth:`interrupted` says how many finished runs are kept, and where.
+
+    Pass :meth:`design` as ``calibrate(on_design=...)``.
+    """
+
+    store_path: Path
+    keys: list[str] = field(default_factory=list)
+    before: set[str] = field(default_factory=set)
+    known: bool = False
+
+    def design(self, keys: Sequence[str]) -> None:
+        """Called with the run keys of the design before any run starts."""
+        self.keys = list(dict.fromkeys(keys))
+        self.before = stored_keys(self.store_path, self.keys)
+        self.known = True
+
+    def interrupted(self) -> str:
+        """What an interrupted calibration kept, e.g. ``"3 DEM run(s) finished before the
+        interrupt are saved in dem.h5 (10 of the calibration's 24 stored now); re-run the same
+        command to resume: stored runs are reused"``."""
+        if not self.known:
+            return f"no DEM run was started; {self.store_path} unchanged"
+        now = stored_keys(self.store_path, self.keys)
+        saved = len(now - self.before)
+        held = f"{len(now)} of the calibration's {len(self.keys)} stored now"
+        if saved:
+            what = (f"{saved} DEM run(s) finished before the interrupt are saved in "
+                    f"{self.store_path} ({held})")
+        else:
+            what = f"no DEM run finished in this call; {self.store_path} holds {held}"
+        if len(now) == len(self.keys):
+            return f"{what}; a re-run of the same command computes no DEM run again"
+        return f"{what}; re-run the same command to resume: stored runs are reused, the " \
+               f"other {len(self.keys) - len(now)} computed"

@@ -6,7 +6,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from .. import defaults
+from .. import defaults, interrupt
 from ._options import check_out_folder, non_negative_int
 
 DEFAULT_STORE = Path("calibration_store.h5")
@@ -70,6 +70,7 @@ def run(args: argparse.Namespace) -> int:
     from ..calibrate.data import DEFAULT_MATERIAL, measured_from_store, read_measured_table
     from ..calibrate.outputs import document_json, write_outputs
     from ..calibrate.parameters import parse_fit
+    from ..calibrate.runner import RunTally
     from ..errors import ParameterError
     from ..specimen import load_specimen
 
@@ -87,12 +88,22 @@ def run(args: argparse.Namespace) -> int:
         else DEFAULT_MATERIAL
     points = read_measured_table(args.data, default_material=default_material) \
         if args.data is not None else measured_from_store(args.store)
-    result = calibrate(points, fit=fit, priors=args.prior, discrepancy=args.discrepancy,
-                       discrepancy_floor=args.discrepancy_floor, store_path=args.dem_store,
-                       cells=cells, seed=args.seed, steady_cycles=args.steady_cycles,
-                       design_size=args.design_size, workers=args.workers,
-                       cross_validate=args.cross_validate, method=args.method,
-                       progress=not args.no_progress, specimen=specimen)
+    tally = RunTally(args.dem_store)
+    try:
+        result = calibrate(points, fit=fit, priors=args.prior, discrepancy=args.discrepancy,
+                           discrepancy_floor=args.discrepancy_floor, store_path=args.dem_store,
+                           cells=cells, seed=args.seed, steady_cycles=args.steady_cycles,
+                           design_size=args.design_size, workers=args.workers,
+                           cross_validate=args.cross_validate, method=args.method,
+                           progress=not args.no_progress, specimen=specimen,
+                           on_design=tally.design)
+    except BaseException as exc:  # noqa: BLE001 - an interrupt, or what one became in C code
+        if not interrupt.is_interruption(exc):
+            raise
+        # finished runs are each saved in their own transaction: counted from the store
+        print(f"pidcore calibrate: interrupted; {tally.interrupted()}", file=sys.stderr)
+        interrupt.mark_handled()
+        return 130
     if args.out is not None:
         write_outputs(result, args.out)
     for note in result.notes:

@@ -14,7 +14,9 @@ import streamlit as st
 from pidcore.app.calibration import (
     calibration_api,
     fittable_names,
+    page_words,
     points_by_material,
+    points_for_paper,
     points_for_specimen,
     points_needed,
     points_needed_text,
@@ -54,8 +56,9 @@ def _task(stores, chosen: str, polling: bool) -> None:
     out = task.outputs
     if "summary.md" in out:
         # its headings below the page's own (# and ## would dwarf the page title)
+        # its notes in the page's terms (they advise command-line options)
         st.markdown(re.sub(r"^(#{1,3}) ", lambda m: "#" * (len(m[1]) + 3) + " ",
-                           out["summary.md"].decode(), flags=re.MULTILINE))
+                           page_words(out["summary.md"].decode()), flags=re.MULTILINE))
     c1, c2 = st.columns(2)
     if "predictions.png" in out:
         c1.image(out["predictions.png"], caption="measured vs predicted SDC, 95 % bands")
@@ -117,6 +120,12 @@ def _form(stores, api, points: list) -> str:
                     "them.")
             return chosen_label
         cases_key = f"calibration_cases_{specimen.hash[:12]}"  # its own choice of cases
+    if specimen is None:  # measurements named after another specimen are not the paper's
+        points, note = points_for_paper(points)
+        if note:
+            st.caption(note)
+        if not points:
+            return chosen_label
     by_material = points_by_material(points)
     if specimen is None:  # the paper's coupon holds table particles only
         from pidcore.constants import PARTICLE_MATERIALS
@@ -140,7 +149,8 @@ def _form(stores, api, points: list) -> str:
     chosen_cases = st.multiselect("measured load cases to calibrate against (from the store)",
                                   labels, default=labels, key=cases_key)
     points = [p for p, label in zip(points, labels, strict=True) if label in chosen_cases]
-    st.dataframe(pd.DataFrame([dataclasses.asdict(p) for p in points]).rename(columns={
+    st.dataframe(pd.DataFrame([dataclasses.asdict(p) for p in points]).drop(
+        columns=["source", "row"], errors="ignore").rename(columns={
         "frequency_hz": "frequency [Hz]", "acceleration_g": "acceleration [g]",
         "fill_percent": "fill [%]", "sdc": "SDC measured, Eq. 11 [-]",
         "sdc_stderr": "SDC stderr [-]"}), hide_index=True, width="stretch",
@@ -169,7 +179,7 @@ def _form(stores, api, points: list) -> str:
                                                     design_size=int(design) or None,
                                                     specimen=specimen)
         except PidcoreError as exc:
-            st.error(str(exc))
+            st.error(page_words(str(exc)))
         else:
             if started is None:
                 st.warning("a calibration is running already; wait for it to finish")

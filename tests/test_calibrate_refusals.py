@@ -1,0 +1,259 @@
+"""``pidcore calibrate``: priors outside a parameter's physical domain, whole-number fields,
+measurements of another specimen and too few cases for leave-one-out are refused up front in
+one line naming the option; Ctrl-C says what it kept; calibration.json's units are those of
+the parameters fitted."""
+
+from __future__ import annotations
+
+import dataclasses
+import importlib
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from pidcore.calibrate import MeasuredPoint, calibrate
+from pidcore.calibrate.calibrate import CalibrationResult, base_specimen
+from pidcore.calibrate.data import check_enough_points
+from pidcore.calibrate.parameters import build_specs, field_unit
+from pidcore.calibrate.runner import run_requests
+from pidcore.cli import main
+from pidcore.errors import ParameterError
+from pidcore.specimen import paper_specimen
+from pidcore.store import Store
+
+HEADER = "frequency_hz,acceleration_g,fill_percent,sdc\n"
+ROWS = "500,5,50,0.6\n1000,5,50,0.6\n500,1,50,0.2\n"
+# the module, not the function pidcore.calibrate exports under its name
+calibrate_module = importlib.import_module("pidcore.calibrate.calibrate")
+TINY = ["--cells", "2", "--steady-cycles", "10", "--workers", "1", "--no-progress"]
+
+
+def _table(tmp_path: Path, text: str = HEADER + ROWS, name: str = "m.csv") -> Path:
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+def _refused(capsys, tmp_path: Path, argv: list[str], *words: str) -> str:
+    """Exit 2, one line holding ``words``, no DEM store and no --out folder made."""
+    store = tmp_path / "dem.h5"
+    out = tmp_path / "out"
+    code = main(["calibrate", *argv, "--dem-store", str(store), "--out", str(out), *TINY])
+    err = capsys.readouterr().err.strip()
+    assert code == 2, err
+    assert len(err.splitlines()) == 1, err
+    for word in words:
+        assert word in err, err
+    # refused before any DEM run, and before the output folder was made
+    assert not store.exists() and not out.exists()
+    return err
+
+
+@pytest.mark.parametrize("prior, words", [
+    # a negative loss factor was fitted and reported (a negative predicted SDC)
+    ("baseline_loss_factor=-0.5:-0.1", ("baseline_loss_factor=-0.5", "expected >= 0")),
+    # a negative fixture mass ran the whole fit, then failed writing --out blaming the
+    # bundled specimen file, with an empty folder left behind
+    ("fixture_mass_kg=-1:-0.5", ("fixture_mass_kg=-1", "expected >= 0 kg")),
+    # a range reaching below 0 was accepted silently
+    ("fixture_mass_kg=-1:0.5", ("fixture_mass_kg=-1", "expected >= 0 kg")),
+])
+def test_an_observation_prior_outside_its_domain_is_refused_naming_it(capsys, tmp_path, prior,
+                                                                      words):
+    err = _refused(capsys, tmp_path, ["--data", str(_table(tmp_path)), "--prior", prior],
+                   f"--prior {prior}", *words)
+    assert "paper_coupon.toml" not in err  # the prior's fault, not the specimen file's
+
+
+@pytest.mark.parametrize("fit, prior, words", [
+    ("friction", "friction=-0.1:0.5", ("friction=-0.1", "sliding_friction: expected >= 0")),
+    ("restitution", "restitution=0.5:1.2", ("restitution=1.2", "expected 0 < e <= 1")),
+    # the particle (radius 1.25 mm) does not fit a 2 mm cell: failed mid-run, blaming the
+    # bundled specimen file
+    ("cell.inscribed_diameter_m", "cell.inscribed_diameter_m=2.0e-3:2.6e-3",
+     ("cell.inscribed_diameter_m=0.002", "does not fit")),
+])
+def test_a_dem_prior_outside_its_domain_is_refused_before_any_run(capsys, tmp_path, fit, prior,
+                                                                  words):
+    err = _refused(capsys, tmp_path, ["--data", str(_table(tmp_path)), "--fit", fit,
+                                      "--prior", prior], f"--prior {prior}", *words)
+    assert "paper_coupon.toml" not in err
+
+
+def test_default_bounds_outside_the_domain_name_them_and_the_way_out():
+    # 0.5x the cell diameter holds no particle: the default bounds are said, with --prior
+    with pytest.raises(ParameterError) as refused:
+        build_specs(["cell.inscribed_diameter_m"])
+    text = str(refused.value)
+    assert "the default prior bounds cell.inscribed_diameter_m=" in text
+    assert "--prior cell.inscribed_diameter_m=LOW:HIGH" in text and "does not fit" in text
+
+
+def test_a_prior_box_is_checked_at_its_corners():
+    # each range alone holds a valid specimen (a 1.1 mm particle fits a 2.3 mm cell), but the
+    # corner of the largest particle in the smallest cell does not
+    priors = ["particles.radius_m=1e-3:1.1e-3", "cell.inscribed_diameter_m=2.3e-3:3e-3"]
+    fit = ["particles.radius_m", "cell.inscribed_diameter_m"]
+    build_specs(fit, priors)  # every corner valid
+    wider = ["particles.radius_m=1e-3:1.2e-3", priors[1]]
+    with pytest.raises(ParameterError, match=r"--prior particles.radius_m=1e-3:1.2e-3; --prior "
+                                             r"cell.inscribed_diameter_m=2.3e-3:3e-3: the prior "
+                                             r"corner particles.radius_m=0.0012, "
+                                             r"cell.inscribed_diameter_m=0.0023 is outside"):
+        build_specs(fit, wider)
+
+
+def test_a_static_friction_range_below_the_sliding_friction_is_refused():
+    # static >= sliding (the specimen file's rule): below it a value is taken as the sliding
+    # friction, so such a range ran a design whose runs were all alike
+    paper = paper_specimen().pairs  # sliding friction 0.096 particle-particle, 0.14 wall
+    assert (paper.particle_particle.sliding_friction, paper.particle_wall.sliding_friction) \
+        == (0.096, 0.14)
+    with pytest.raises(ParameterError, match=r"^--prior static_friction_pw=0.01:0.12: static "
+                                             r"friction below the sliding friction \(at least "
+                                             r"0.14 particle-wall\)"):
+        build_specs(["static_friction_pw"], ["static_friction_pw=0.01:0.12"])
+    # with friction fitted, its lower bound is the floor
+    with pytest.raises(ParameterError, match="at least 0.3 particle-particle, 0.3 particle"):
+        build_specs(["friction", "static_friction"],
+                    ["friction=0.3:0.5", "static_friction=0.1:0.3"])
+    build_specs(["static_friction_pp"], ["static_friction_pp=0.01:0.12"])  # reaches above
+    build_specs(["static_friction"])  # the default bounds (0.1..1.0) reach above both
+
+
+def test_a_design_point_outside_the_domain_names_it_not_the_specimen_file():
+    # a constraint the corners cannot see would fail inside the design: the design point is
+    # named, not the bundled specimen file
+    specimen = paper_specimen()
+    (spec,) = build_specs(["cell.inscribed_diameter_m"], ["cell.inscribed_diameter_m=3e-3:4e-3"],
+                          discrepancy=0.2)
+    point = MeasuredPoint(500, 5, 50, 0.6)
+    from pidcore.dem.simulate import DemConfig
+
+    with pytest.raises(ParameterError) as refused:
+        calibrate_module._requests([point], [spec], np.array([[2.1e-3]]), DemConfig(), specimen)
+    text = str(refused.value)
+    assert text.startswith("--fit/--prior: the design point cell.inscribed_diameter_m=0.0021 ")
+    assert "does not fit" in text and specimen.source not in text
+
+
+@pytest.mark.parametrize("field", ["cell.count", "particles.count_per_cell"])
+def test_a_whole_number_field_cannot_be_fitted(capsys, tmp_path, field):
+    argv = ["--data", str(_table(tmp_path)), "--fit", field]
+    if field == "particles.count_per_cell":  # the paper's coupon states a fill, not a count
+        spec = tmp_path / "counted.toml"
+        text = paper_specimen().to_toml().replace("[particles]\n",
+                                                  "[particles]\ncount_per_cell = 10\n")
+        spec.write_text(text)
+        argv += ["--specimen", str(spec)]
+    _refused(capsys, tmp_path, argv, f"--fit {field}", "whole-number field cannot be fitted")
+
+
+def test_rows_of_another_specimen_are_refused(capsys, tmp_path):
+    # they were fitted against the paper's coupon with no note
+    table = _table(tmp_path, "frequency_hz,acceleration_g,fill_percent,sdc,specimen\n"
+                             "500,5,50,0.6,someone_elses_coupon\n1000,5,50,0.6,\n"
+                             "500,1,50,0.2,someone_elses_coupon\n")
+    _refused(capsys, tmp_path, ["--data", str(table)],
+             "m.csv rows 2, 4 name specimen 'someone_elses_coupon'", "not 'paper_coupon'")
+    # with --specimen: rows naming another one are refused, its own name is its (and its
+    # calibrated file's name is the specimen it was calibrated from)
+    mine = tmp_path / "my.toml"
+    mine.write_text(paper_specimen().to_toml().replace('name = "paper_coupon"',
+                                                       'name = "my_coupon"'))
+    table = _table(tmp_path, "frequency_hz,acceleration_g,fill_percent,sdc,specimen\n"
+                             "500,5,50,0.6,my_coupon\n1000,5,50,0.6,other_specimen\n"
+                             "500,1,50,0.2,my_coupon_calibrated\n", name="n.csv")
+    _refused(capsys, tmp_path, ["--data", str(table), "--specimen", str(mine)],
+             "n.csv row 3 name specimen 'other_specimen'", "not 'my_coupon'")
+    from pidcore.specimen import load_specimen
+
+    specimen = load_specimen(mine)
+    named = [MeasuredPoint(500, 5, 50, 0.6, specimen="my_coupon"),
+             MeasuredPoint(500, 1, 50, 0.2, specimen="my_coupon_calibrated"),
+             MeasuredPoint(1000, 5, 50, 0.6)]
+    assert base_specimen(named, specimen) is specimen
+    calibrated = dataclasses.replace(specimen, name="my_coupon_calibrated")
+    assert base_specimen(named, calibrated) is calibrated
+    # a store's load cases have no rows: they are counted
+    stored = [MeasuredPoint(500, 5, 50, 0.6, specimen="steel_6mm_b", source="s.h5"),
+              MeasuredPoint(500, 1, 50, 0.2, specimen="steel_6mm_b", source="s.h5")]
+    with pytest.raises(ParameterError, match=r"^2 measured load case\(s\) of s.h5 name specimen "
+                                             r"'steel_6mm_b', not 'my_coupon', the specimen "
+                                             r"calibrated"):
+        base_specimen(stored, specimen)
+
+
+def test_loo_says_it_needs_one_case_more_than_parameters(capsys, tmp_path):
+    # 3 cases given, 3 fitted quantities: it said "2 measured load case(s) ... give at least
+    # 3 load cases" although 3 were given
+    _refused(capsys, tmp_path, ["--data", str(_table(tmp_path)), "--cross-validate", "loo"],
+             "leave-one-out fits each fold on 2 of the 3 measured load case(s)",
+             "at least 4 load cases (parameters + 1)")
+    points = [MeasuredPoint(f, 5, 50, 0.6) for f in (100, 200, 300)]
+    check_enough_points(points, ["a", "b"], leave_one_out=True)  # 2 per fold fit 2
+
+
+def test_interrupt_says_how_many_runs_are_kept_where_and_that_a_rerun_resumes(
+        capsys, tmp_path, monkeypatch):
+    # it printed only the generic "no store write was left half-done"
+    store = tmp_path / "dem.h5"
+
+    def interrupted_after_one(requests, **kw):
+        def stop(key):
+            raise KeyboardInterrupt
+
+        return run_requests(requests, **kw, on_done=stop)
+
+    monkeypatch.setattr(calibrate_module, "run_requests", interrupted_after_one)
+    argv = ["calibrate", "--data", str(_table(tmp_path)), "--fit", "fixture_mass_kg",
+            "--discrepancy", "0.2", "--dem-store", str(store), *TINY]
+    assert main(argv) == 130
+    err = capsys.readouterr().err.strip()
+    assert err == (f"pidcore calibrate: interrupted; 1 DEM run(s) finished before the interrupt "
+                   f"are saved in {store} (1 of the calibration's 3 stored now); re-run the same "
+                   "command to resume: stored runs are reused, the other 2 computed"), err
+    assert len(Store(store).list_dem_runs()) == 1
+    monkeypatch.undo()
+    points = [MeasuredPoint(500, 5, 50, 0.6), MeasuredPoint(1000, 5, 50, 0.6),
+              MeasuredPoint(500, 1, 50, 0.2)]
+    again = calibrate(points, fit=["fixture_mass_kg"], store_path=store, discrepancy=0.2,
+                      cells=2, steady_cycles=10, workers=1, progress=False)
+    assert (again.runs["computed"], again.runs["cached"]) == (2, 1)
+
+
+def test_units_are_those_of_the_fitted_and_fixed_parameters():
+    # a fixed table: rolling_friction and particles.radius_m had none, and parameters that
+    # were not fitted were listed
+    specimen = paper_specimen()
+    specs = build_specs(["rolling_friction", "particles.radius_m"], specimen=specimen)
+    result = CalibrationResult(
+        specimen=specimen, specs=specs, samples=np.zeros((1, len(specs))), parameters={},
+        correlations=[], predictions=[], loo=None,
+        fixed={"fixture_mass_kg": 0.0, "baseline_loss_factor": 0.0}, design=np.zeros((1, 2)),
+        observations=[], runs={}, settings={})
+    units = result.units()
+    assert units["rolling_friction"] == "-" and units["particles.radius_m"] == "m"
+    assert units["model_discrepancy"] == "-"
+    assert units["fixture_mass_kg"] == "kg" and units["baseline_loss_factor"] == "-"  # fixed
+    assert units["frequency_hz"] == "Hz" and units["low95_j"] == "J"
+    assert "friction" not in units and "restitution" not in units
+    # one rule for every specimen field: the unit its name ends in
+    assert [field_unit(p) for p in ("cell.wall_youngs_modulus_pa", "particles.density_kg_m3",
+                                    "coupon.mass_kg", "cell.height_m",
+                                    "particles.poisson_ratio", "particles.fill_percent")] \
+        == ["Pa", "kg/m^3", "kg", "m", "-", "%"]
+
+
+def test_outputs_that_cannot_be_made_leave_no_folder(tmp_path):
+    from pidcore.calibrate.outputs import write_outputs
+
+    class Broken:
+        def full_document(self):
+            raise ParameterError("cannot be written")
+
+    out = tmp_path / "out"
+    with pytest.raises(ParameterError):
+        write_outputs(Broken(), out)
+    assert not out.exists()
