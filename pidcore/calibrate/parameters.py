@@ -257,17 +257,6 @@ def build_specs(fit: Sequence[str], priors: Sequence[str] = (), *,
     for name in names:
         spec = replace(parameter_spec(name, specimen), **changes.get(name, {}))
         spec.check()
-        if name == "baseline_loss_factor":
-            from ..specimen import PLAUSIBLE_RANGES
-
-            # the fit is written to the calibrated specimen, which refuses a loss factor
-            # above this bound: refuse the prior now, not after the DEM runs
-            most = PLAUSIBLE_RANGES["baseline_loss_factor"].high
-            if spec.high > most:
-                raise ParameterError(
-                    f"--prior baseline_loss_factor: upper bound {spec.high:g} is above {most:g}, "
-                    "the most an empty coupon's loss factor may be (a specimen refuses more); "
-                    "was it %?")
         specs.append(spec)
     if discrepancy is not None and not discrepancy >= 0:
         raise ParameterError(f"--discrepancy: expected >= 0, got {discrepancy}")
