@@ -4,7 +4,9 @@ Rows are the union of our DEM grid cases and the measured cases. A measured case
 DEM grid case (:mod:`pidcore.compare.align`) shares its row; one that does not gets its own row
 with our DEM value interpolated by the pchip model (or none, out of range). Numbers are copied
 from the inputs unchanged; only runs of one case and settings (seeds) and measurements of one
-case and specimen are pooled (:func:`pidcore.compare.pooled_mean`). DEM runs of different
+case and specimen are pooled (:func:`pidcore.compare.pooled_mean`); stored runs that are the
+same simulation (:func:`pidcore.compare.align.simulation_identity`) count once, which the row's
+note says. DEM runs of different
 numerical settings and measurements of different specimens get rows of their own unless
 ``pool=True`` (``pidcore report --pool``), which the row's note then says.
 
@@ -27,6 +29,7 @@ from ..compare.align import (
     DemCase,
     Tolerances,
     consistency_chi2,
+    duplicates_note,
     match_paper,
     pooled_mean,
     pooled_sdc_eq10,
@@ -246,6 +249,8 @@ def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | N
                            if chi2_dof > 3 else ""))
         if row.dem is not None and row.dem.n_runs > 1:
             note.append(f"{row.dem.n_runs} DEM runs pooled")
+        if row.dem is not None and row.dem.duplicate_keys:
+            note.append(duplicates_note(row.dem))
         if row.dem is not None and row.dem.not_converged:
             note.append(not_converged_note(row.dem))
             unconverged_rows.append(lc.label())
