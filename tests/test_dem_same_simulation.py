@@ -67,6 +67,9 @@ def test_the_same_simulation_under_two_keys_is_counted_once():
     note = table["note"].iloc[0]
     assert "1 stored DEM run(s) counted once" in note and "fill 50.2 %" in note
     assert "DEM runs pooled" not in note
+    # and in the notes the console prints (its short table has no note column)
+    assert any("1 row(s) have stored DEM runs counted once" in n
+               for n in table.attrs["notes"])
     # the app's Compare tab aligns through the same cases and says it too
     aligned = Aligner.from_tables(runs).align(LoadCase(1000.0, 5.0, 50.0))
     assert aligned.sdc_dem_stderr == 0.010788269155923347 and "counted once" in aligned.message

@@ -222,6 +222,7 @@ def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | N
 
     records = []
     unconverged_rows: list[str] = []
+    duplicate_rows: list[str] = []
     for row in (r for group in rows.values() for r in group):
         lc = row.case
         sdc_m = sdc_m_se = f_m = a_m = chi2_dof = math.nan
@@ -251,6 +252,7 @@ def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | N
             note.append(f"{row.dem.n_runs} DEM runs pooled")
         if row.dem is not None and row.dem.duplicate_keys:
             note.append(duplicates_note(row.dem))
+            duplicate_rows.append(f"{lc.label()} ({len(row.dem.duplicate_keys)} duplicate)")
         if row.dem is not None and row.dem.not_converged:
             note.append(not_converged_note(row.dem))
             unconverged_rows.append(lc.label())
@@ -295,6 +297,12 @@ def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | N
         notes.append(f"{len(unconverged_rows)} row(s) rest on DEM runs that did not converge "
                      "(no steady state before the transient cap): their DEM SDC may include "
                      f"the transient: {'; '.join(unconverged_rows)}")
+    if duplicate_rows:
+        # named here too: the console's short table has no note column
+        notes.append(f"{len(duplicate_rows)} row(s) have stored DEM runs counted once, "
+                     "being the same simulation as a run counted (same particles per cell, "
+                     "seed, settings and specimen under another stated fill): "
+                     f"{'; '.join(duplicate_rows)}")
     table.attrs["notes"] = notes
     return table
 
