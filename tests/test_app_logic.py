@@ -1275,3 +1275,20 @@ def test_the_paper_coupon_page_leaves_out_measurements_of_another_specimen():
                                                 "measured load case(s) of specimen steel_6mm_b "
                                                 "(choose their specimen file above).")
     assert points_for_paper(mine) == (mine, "")
+
+
+def test_dem_job_of_a_fill_whose_simulation_is_stored_is_not_run_again(tmp_path):
+    """The DEM tab queued a run of fill 26 % although the store held the run of fill 25 %:
+    6 acrylic particles per cell either way, the same seed and settings, the same numbers."""
+    from pidcore.dem import DemConfig
+    from pidcore.dem.persist import run_key, run_or_load
+
+    store_file = tmp_path / "dem.h5"
+    config = DemConfig(cells=1, steady_cycles=4, block_cycles=2, max_transient_cycles=2)
+    (stored, same) = jobs.plan_dem_cases([1000.0], [5.0], [25.0, 26.0], material="acrylic",
+                                         direction="z")
+    run_or_load(store_file, None, stored, config)
+    runner = jobs.DemJobRunner(store_file)
+    (job,) = runner.submit([same], config)
+    assert job.state == "in store" and "same simulation" in job.message
+    assert job.run_key == run_key(stored, config)  # the run it is, as stored

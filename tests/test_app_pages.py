@@ -972,3 +972,32 @@ def test_an_invalid_specimen_file_turns_run_off_and_names_the_users_file(store_f
     # the old page fell back to acrylic on the paper's coupon and ran it
     assert at.button(key="dem_run").disabled
     assert "dem_material" not in {s.key for s in at.selectbox}
+
+
+def test_report_tab_names_other_specimens_runs_and_offers_their_specimen(store_file):
+    """A store holding one run of a user specimen: the Report tab showed its row with an empty
+    specimen column and no note; now it leaves it out as `pidcore report` does, names it, and
+    offers the specimen (the column then names it)."""
+    from pidcore.compare.specimens import specimen_label
+    from pidcore.dem.persist import run_or_load
+    from pidcore.dem.simulate import DemConfig, LoadCase
+    from pidcore.specimen import Specimen, paper_specimen
+
+    text = paper_specimen().with_values({"coupon.fixture_mass_kg": 0.05}).to_toml()
+    own = Specimen.from_text(text.replace('name = "paper_coupon"', 'name = "my_panel"'))
+    # bookkeeping only: one cell, few cycles
+    run = run_or_load(store_file, own, LoadCase(1000.0, 5.0, 25.0),
+                      DemConfig(cells=1, steady_cycles=4, block_cycles=2,
+                                max_transient_cycles=2))
+    label = specimen_label(own.name, own.hash)
+    at = _app()
+    said = " ".join(c.value for c in at.caption)
+    assert f"1 run(s) of other specimens: 1 of {label}" in said
+    box = at.selectbox(key="report_specimen")
+    assert box.options == ["paper_coupon (the default)", label]
+    box.set_value(label)
+    at.run()
+    assert not at.exception
+    table = _table(at, "DEM settings")
+    assert table["specimen"].tolist() == ["my_panel"]
+    assert table["SDC DEM (ours) [-]"].tolist() == [run.sdc]

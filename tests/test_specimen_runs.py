@@ -352,3 +352,51 @@ def test_run_stored_before_moving_mass_kg_reads_its_coupon_mass_kg_as_the_sum():
     old = load_dem_result(stored)
     assert old.moving_mass_kg == 0.0333 + 0.015 and old.coupon_mass_kg == 0.0333
     assert old.to_dict()["coupon_mass_kg"] == 0.0333
+
+
+@pytest.fixture(scope="module")
+def own_panel_store(tmp_path_factory):
+    """A store (as the app's) holding one run of a user specimen named my_panel only."""
+    where = tmp_path_factory.mktemp("own_panel")
+    text = paper_specimen().with_values({"coupon.fixture_mass_kg": 0.05}).to_toml()
+    own = Specimen.from_text(text.replace('name = "paper_coupon"', 'name = "my_panel"'),
+                             source=str(where / "my_panel.toml"))
+    (where / "my_panel.toml").write_text(own.to_toml())
+    run = run_or_load(where / "app.h5", own, CASE, TINY)
+    return SimpleNamespace(store=where / "app.h5", own=own, run=run,
+                           file=where / "my_panel.toml")
+
+
+@pytest.mark.usefixtures("undrawn_report_figures")
+def test_app_report_chooses_specimen_runs_as_the_cli_does(tmp_path, own_panel_store):
+    """The app's Report listed another specimen's DEM row with an empty specimen column and
+    nothing naming it; `pidcore report` left the run out with a note. Both go through
+    pidcore.report.pipeline.specimen_report_table now."""
+    from pidcore.compare.specimens import specimen_label
+    from pidcore.report import make_report
+    from pidcore.report.downloads import report_files, store_report_table
+
+    store, own = own_panel_store.store, own_panel_store.own
+    label = specimen_label(own.name, own.hash)
+    default = store_report_table(store)
+    assert default.empty  # the paper's coupon (the default) has no run here
+    left_out = f"1 run(s) of other specimens: 1 of {label}"
+    assert any(left_out in n for n in default.attrs["notes"])
+    cli = make_report([], out_dir=tmp_path / "cli", dem_store=store, formats="csv")
+    assert any(left_out in n for n in cli.notes)
+    # the app offers the store's specimens, rebuilt from the runs' stored text
+    from pidcore.compare.specimens import run_specimens
+
+    offered = run_specimens(Store(store).list_dem_runs())
+    assert list(offered) == [label] and offered[label].hash == own.hash
+    mine = store_report_table(store, specimen=offered[label])
+    assert mine["specimen"].tolist() == [own.name]
+    assert mine["SDC DEM (ours) [-]"].tolist() == [own_panel_store.run.sdc]
+    assert mine["SDC DEM (paper) [-]"].isna().all()  # not the paper's coupon
+    cli = make_report([], out_dir=tmp_path / "cli_own", dem_store=store, formats="csv",
+                      specimen=own)
+    pd_cols = ["specimen", "SDC DEM (ours) [-]", "DEM runs [-]", "load case", "note"]
+    assert mine[pd_cols].equals(cli.table[pd_cols])
+    # the downloads' provenance names the specimen and its hash, as the CLI's does
+    files = report_files(store, specimen=offered[label])
+    assert f"sha256 {own.hash}" in files["csv_provenance"][1].decode()

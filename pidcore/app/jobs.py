@@ -153,10 +153,13 @@ class DemJobRunner:
         """Queue ``cases`` with ``config`` on ``specimen`` (:class:`pidcore.specimen.Specimen`;
         None: the paper's coupon); returns the jobs created (duplicates are skipped: a run
         queued, running or already in the store is not submitted again)."""
-        from ..dem.persist import run_key
+        from ..dem.persist import run_identity, run_key, stored_identities
         from ..store import Store
 
         stored = Store(self.store_path) if self.store_path.is_file() else None
+        # runs of another fill with the same particle count (and seed, settings, specimen) are
+        # the same simulation (pidcore.dem.persist.stored_run_key): read once per submission
+        identities = stored_identities(stored) if stored is not None else {}
         created = []
         with self._lock:
             active = {j.run_key for j in self._jobs if j.state in ("queued", "running")}
@@ -169,6 +172,11 @@ class DemJobRunner:
                 if stored is not None and stored.has_dem_run(key):
                     job.state, job.message = "in store", "already in the store; not run again"
                     job.finished = time.time()
+                elif (same := identities.get(run_identity(case, config, specimen))) is not None:
+                    job.state, job.finished = "in store", time.time()
+                    job.message = (f"the same simulation (particles per cell, seed, settings) "
+                                   f"as stored run {same} of another fill; not run again")
+                    job.run_key = same  # the jobs table's store key names the run it is
                 self._jobs.append(job)
                 active.add(key)
                 created.append(job)

@@ -53,14 +53,16 @@ def store_listing(what: str, stamp: tuple, _stores):
 
 @st.cache_data(max_entries=16, show_spinner=False)
 def report_table(stamp: tuple, pool: bool, keys: tuple[str, ...] | None,
-                 calibration_digest: str, _stores, _calibration):
-    """The report table of the stores (only the analyses ``keys``, all when None), with the
-    calibrated DEM's columns of ``_calibration`` (identified by ``calibration_digest``)."""
+                 calibration_digest: str, specimen_label: str, _stores, _calibration,
+                 _specimen):
+    """The report table of the stores (only the analyses ``keys``, all when None) of the
+    DEM runs of ``_specimen`` (None: the paper's coupon; named by ``specimen_label``), with
+    the calibrated DEM's columns of ``_calibration`` (identified by ``calibration_digest``)."""
     from pidcore.report.downloads import store_report_table
 
     return store_report_table(_stores.path, _stores.dem_reference, pool=pool,
                               analysis_keys=None if keys is None else list(keys),
-                              calibration=_calibration)
+                              calibration=_calibration, specimen=_specimen)
 
 
 @st.cache_resource(max_entries=_CACHE_ENTRIES, show_spinner=False)

@@ -212,6 +212,12 @@ def sweep(args: argparse.Namespace) -> int:
     else:
         print(f"{len(summary.completed)} case(s) simulated, {len(summary.skipped)} already in "
               f"{args.store}; wall time {summary.wall_s:.1f} s")
+        for case in summary.cases:
+            if case["status"].startswith("same simulation"):
+                print(f"fill {case['fill_percent']:g} % ({case['frequency_hz']:g} Hz, "
+                      f"{case['acceleration_g']:g} g): {case['status']} ("
+                      f"{case.get('particles_per_cell', '?')} particles per cell, the same "
+                      f"seed and settings), not simulated again: {case['store_key']}")
     return 0
 
 
@@ -270,12 +276,13 @@ def run(args: argparse.Namespace) -> int:
     store = None
     try:
         if args.store is not None:
-            from ..dem.persist import run_key, run_or_load
+            from ..dem.persist import run_key, run_or_load, stored_run_key
             from ..store import Store
 
-            key = run_key(case, config, specimen)
             store = Store(args.store)
-            reused = args.store.exists() and store.has_dem_run(key)
+            found = stored_run_key(store, case, config, specimen)
+            reused = found is not None
+            key = found if found is not None else run_key(case, config, specimen)
             result = run_or_load(store, specimen, case, config, progress=progress)
         else:
             result = simulate_load_case(case, config, progress=progress, specimen=specimen)
@@ -284,19 +291,37 @@ def run(args: argparse.Namespace) -> int:
         saved = (store is not None and key is not None and not reused
                  and args.store.exists() and store.has_dem_run(key))
         return _interrupted("run", int(saved), args.store)
+    notes = list(result.notes)
+    same = _same_simulation_note(case, result) if reused else ""
+    if same:
+        notes.append(same)
     if args.json:
         out = {k: result.to_dict()[k] for k in JSON_KEYS}
         out.update(result.to_dict())
-        out["notes"] = list(result.notes)
+        out["notes"] = notes
         if key is not None:
             out["store_key"] = key
             out["reused_from_store"] = reused
         print(json.dumps(out))
         return 0
     print(format_summary(result))
+    if same:
+        print(f"note            {same}")
     if key is not None:
         print(f"{'reused from' if reused else 'saved to'} {args.store} as {key}")
     return 0
+
+
+def _same_simulation_note(asked, result) -> str:
+    """The note for a run reused from a stored run of another stated fill (the same particle
+    count: :func:`pidcore.dem.persist.stored_run_key`); "" where the fill is the one asked."""
+    stored = result.case.fill_percent
+    if stored == asked.fill_percent:
+        return ""
+    return (f"fill {asked.fill_percent:g} % asked; reused the stored run of fill {stored:g} %: "
+            f"the same simulation ({result.particles_per_cell} particles per cell, seed "
+            f"{result.config.seed}, the same settings and specimen), so the numbers are those "
+            "of that run and it is stated at its fill")
 
 
 def _tangential_stiffness_model(result) -> str:

@@ -18,6 +18,7 @@ from .align import (
     dem_cases,
     match_paper,
     pooled_mean,
+    simulation_identity,
 )
 from .loadcase import (
     DIRECTION_PATTERN,
@@ -38,5 +39,5 @@ __all__ = [
     "MEASURED_COLUMNS", "SIDECAR_COLUMNS", "SIDECAR_NAME", "AlignedCase", "Aligner",
     "AlignmentStatus", "DemCase", "LoadCase", "LoadCaseError", "StatedLoadCase", "Tolerances",
     "align_measured", "dem_cases", "match_paper", "parse_file_name", "pooled_mean",
-    "read_sidecar", "resolve_load_case",
+    "read_sidecar", "resolve_load_case", "simulation_identity",
 ]

@@ -128,6 +128,14 @@ class DemCase:
         detected (``steady_detected`` false: measured from the transient cap, as ``pidcore dem
         run`` prints "NOT converged, transient cap"); empty where every run converged or the
         runs do not record it.
+    duplicate_keys : tuple of str
+        Store keys of runs left out because they are the same simulation as a run counted
+        (:func:`simulation_identity`: e.g. fills 50 % and 50.2 % both give 11 particles per
+        cell, and the same seed gives the same numbers bit for bit). Counting such a run again
+        would shrink the standard error by sqrt(2) with no new information. Not in ``n_runs``
+        or ``run_keys``.
+    duplicate_fills : tuple of float
+        Fill percentages, %, the duplicates were stored with (for the note).
     """
 
     load_case: LoadCase
@@ -140,6 +148,22 @@ class DemCase:
     settings: str = ""
     cells_simulated: float = math.nan
     not_converged: tuple[tuple[int, int], ...] = ()
+    duplicate_keys: tuple[str, ...] = ()
+    duplicate_fills: tuple[float, ...] = ()
+
+
+def duplicates_note(dem: DemCase) -> str:
+    """The note for a DEM case with stored runs counted once (:attr:`DemCase.duplicate_keys`);
+    "" where there are none. The report table and the app's Compare tab say it alike."""
+    if not dem.duplicate_keys:
+        return ""
+    n = len(dem.duplicate_keys)
+    fills = ", ".join(f"{f:g} %" for f in dict.fromkeys(dem.duplicate_fills))
+    ppc = (f"{dem.particles_per_cell:g} particles per cell, "
+           if math.isfinite(dem.particles_per_cell) else "")
+    return (f"{n} stored DEM run(s) counted once: the same simulation ({ppc}seed, settings "
+            f"and specimen) as a run counted, stored under another key (fill {fills}); "
+            f"{dem.n_runs} distinct run(s) used")
 
 
 @dataclass(frozen=True)
@@ -285,6 +309,47 @@ def run_settings(parameters_json: object) -> dict | None:
     return {k: v for k, v in params.items() if not k.startswith("case_") and k != "config_seed"}
 
 
+def simulation_identity(parameters_json: object, particles_per_cell: object) -> str | None:
+    """What makes two stored DEM runs the same simulation (hex digest), or None where a run
+    does not record its inputs.
+
+    A run's key (:func:`pidcore.dem.persist.run_key`) hashes the fill percentage as stated,
+    but the simulation reads it only through the particle count it rounds to
+    (:func:`pidcore.dem.simulate.particles_per_cell`): fills 50 % and 50.2 % of a 22-particle
+    cell both run 11 particles, and with the same seed give the same numbers bit for bit. The
+    identity is therefore every stored input except ``case_fill_percent`` and
+    ``specimen_text`` (its hash ``specimen_sha256`` stands for it), plus the particles per
+    cell. ``parameters_json``: a JSON string (a store listing's column) or a dict
+    (:func:`pidcore.dem.persist.run_parameters`).
+    """
+    import hashlib
+    import json
+
+    if isinstance(parameters_json, dict):
+        params = dict(parameters_json)
+    else:
+        if not isinstance(parameters_json, str) or not parameters_json:
+            return None
+        try:
+            params = json.loads(parameters_json)
+        except ValueError:
+            return None
+        if not isinstance(params, dict):
+            return None
+    try:
+        count = float(particles_per_cell)
+    except (TypeError, ValueError):
+        return None
+    if not math.isfinite(count) or "config_seed" not in params:
+        return None
+    params.pop("case_fill_percent", None)
+    params.pop("specimen_text", None)
+    # runs stored before the version was recorded are version 1 (pidcore.dem.persist)
+    params.setdefault("dem_code_version", 1)
+    params["particles_per_cell"] = int(count)
+    return hashlib.sha256(json.dumps(params, sort_keys=True, default=str).encode()).hexdigest()
+
+
 def _settings_digest(settings: dict) -> str:
     import hashlib
     import json
@@ -357,7 +422,9 @@ def dem_cases(dem_runs: pd.DataFrame, *, tolerances: Tolerances | None = None,
             groups.append((case, settings, [pos]))
     out = []
     for case, settings, members in groups:
+        members, duplicates = _distinct(runs, members)
         sub = runs.iloc[members]
+        dup = runs.iloc[duplicates]
         sdc, stderr = pooled_mean(sub["sdc"].to_numpy(float), sub["sdc_stderr"].to_numpy(float))
         ppc = math.nan
         if "particles_per_cell" in sub:
@@ -369,9 +436,32 @@ def dem_cases(dem_runs: pd.DataFrame, *, tolerances: Tolerances | None = None,
         # "m_c_kg": the column's name in stores written by pidcore 0.1
         mass_column = next((c for c in ("vibrated_mass_kg", "m_c_kg") if c in sub), None)
         m_c = float(sub[mass_column].astype(float).mean()) if mass_column else math.nan
+        dup_keys = tuple(str(k) for k in dup[key_column]) if key_column in dup else ()
+        dup_fills = tuple(float(f) for f in dup["fill_percent"])
         out.append(DemCase(case, sdc, stderr, len(members), ppc, keys, m_c, settings,
-                           cells_of.get(settings, math.nan), _not_converged(sub)))
+                           cells_of.get(settings, math.nan), _not_converged(sub),
+                           dup_keys, dup_fills))
     return sorted(out, key=lambda c: (*_sort_key(c.load_case), c.settings))
+
+
+def _distinct(runs: pd.DataFrame, members: list[int]) -> tuple[list[int], list[int]]:
+    """(members counted, members left out) of one case: a run that is the same simulation as
+    an earlier member (:func:`simulation_identity`) is left out; a run without recorded
+    inputs is always counted (nothing shows it repeats another)."""
+    if "parameters_json" not in runs.columns or "particles_per_cell" not in runs.columns:
+        return members, []
+    seen: set[str] = set()
+    kept, left_out = [], []
+    for pos in members:
+        row = runs.iloc[pos]
+        identity = simulation_identity(row["parameters_json"], row["particles_per_cell"])
+        if identity is not None and identity in seen:
+            left_out.append(pos)
+            continue
+        if identity is not None:
+            seen.add(identity)
+        kept.append(pos)
+    return kept, left_out
 
 
 def steady_stated(detected) -> bool | None:
@@ -524,7 +614,9 @@ class Aligner:
             return AlignedCase(case, "grid", grid.sdc, grid.sdc_stderr, grid, **common,
                                message=f"DEM grid case {grid.load_case.key} "
                                        f"({grid.n_runs} run(s)"
-                                       + (f", {grid.settings})" if grid.settings else ")"))
+                                       + (f", {grid.settings})" if grid.settings else ")")
+                                       + (f"; {duplicates_note(grid)}"
+                                          if grid.duplicate_keys else ""))
         model = self.model if self.model is not None \
             else self._models.get((case.material, case.direction),
                                   f"no DEM runs of ours for {case.material}, direction "

@@ -16,7 +16,14 @@ import pandas as pd
 
 from .. import defaults
 from ..errors import ParameterError, PidcoreError
-from .align import Aligner, Tolerances, consistency_chi2, pooled_mean, pooled_sdc_eq10
+from .align import (
+    Aligner,
+    Tolerances,
+    consistency_chi2,
+    duplicates_note,
+    pooled_mean,
+    pooled_sdc_eq10,
+)
 from .loadcase import LoadCase, StatedLoadCase
 
 #: Fill (packing ratio, %) proposed for a file whose name states none; the user confirms or
@@ -416,6 +423,8 @@ def compare_case(records: Sequence[MeasuredEntry],
             if point[2]:
                 notes.append(point[2])
     grid = getattr(aligned, "grid_case", None)
+    if grid is not None and grid.duplicate_keys:
+        notes.append(f"our DEM at {grid.load_case.label()}: {duplicates_note(grid)}")
     m_c = float(grid.vibrated_mass_kg) if grid is not None else math.nan
     eq10, sdc10, stderr10 = pooled_sdc_eq10(
         np.array([r.energy_per_cycle_j for r in records]),

@@ -114,3 +114,29 @@ def runs_for_measurement(runs: pd.DataFrame | None, specimen: str, material: str
                                       "the settings table) to compare it with one of them",
                             refused=True)
     return SpecimenRuns(same.reset_index(drop=True), str(labels.iloc[0]))
+
+
+def run_specimens(runs: pd.DataFrame | None) -> dict[str, object]:
+    """The specimens other than the paper's coupon whose DEM runs ``runs`` holds, by
+    :func:`specimen_label` (``"my_steel [3e945a]"``), each rebuilt from the specimen file text
+    its first run stored (``parameters_json``): what a report of their runs compares
+    (``pidcore report --specimen FILE``; the app's Report tab offers them). Runs that do not
+    store their specimen's text are left out (they cannot name it)."""
+    import json
+
+    from ..specimen import PAPER_SPECIMEN_NAME, Specimen
+
+    out: dict[str, object] = {}
+    if runs is None or runs.empty or "parameters_json" not in runs.columns:
+        return out
+    for label, params, key in zip(run_specimen_labels(runs), runs["parameters_json"],
+                                  runs["case_key"], strict=True):
+        if label == PAPER_SPECIMEN_NAME or label in out:
+            continue
+        try:
+            text = json.loads(params).get("specimen_text") if isinstance(params, str) else None
+        except ValueError:
+            text = None
+        if text:
+            out[label] = Specimen.from_text(text, source=f"stored DEM run {key}")
+    return out

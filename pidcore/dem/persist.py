@@ -6,6 +6,12 @@ A run's key holds every input that changes its numbers: the load case, the confi
 pairs) and :data:`DEM_CODE_VERSION`. ``pidcore dem run --store``, sweeps, the app and the
 calibration all save through :func:`save_dem_entry` and find runs by :func:`run_key`, so a run
 stored by any of them is reused by the others (:func:`run_or_load`), never recomputed.
+
+The key hashes the fill as stated; the simulation reads it only through the particle count it
+rounds to. A run of another fill with the same count (and seed, settings, specimen) is the
+same simulation: the run cache and sweeps find it by the stored runs' inputs
+(:func:`stored_run_key`, :func:`run_identity`) without changing any key, and the report counts
+such runs once (:func:`pidcore.compare.align.simulation_identity`).
 """
 
 from __future__ import annotations
@@ -194,10 +200,80 @@ def load_dem_result(entry: StoredEntry) -> DemResult:
     return DemResult(**values)
 
 
+def same_simulation_key(store: Store | str | os.PathLike[str], case: LoadCase,
+                        config: DemConfig, specimen: Specimen | None = None) -> str | None:
+    """Key of a stored run that is the same simulation as ``case``/``config``/``specimen``
+    under another key, or None.
+
+    A key hashes the fill as stated, the simulation only the particle count it rounds to
+    (:func:`pidcore.compare.align.simulation_identity`): ``dem run --specimen`` stores the
+    specimen's fill 21.73913... %, ``dem sweep --fills 21.7391`` asks for another key with
+    the same 5 particles per cell and seed. Found by the stored runs' inputs, so no key
+    changes. Runs that do not record their inputs are never matched.
+    """
+    store = _open(store)
+    if not store.path.exists():
+        return None
+    return stored_identities(store).get(run_identity(case, config, specimen))
+
+
+def run_identity(case: LoadCase, config: DemConfig, specimen: Specimen | None = None) -> str:
+    """The simulation a run of these inputs is (:func:`pidcore.compare.align.
+    simulation_identity`): its inputs with the fill replaced by the particles per cell."""
+    from ..compare.align import simulation_identity
+    from .simulate import particles_per_cell
+
+    specimen = resolve_specimen(case, specimen)
+    count, _ = particles_per_cell(case.fill_percent, specimen=specimen,
+                                  fill_reference=config.fill_reference)
+    identity = simulation_identity(run_parameters(case, config, specimen), count)
+    assert identity is not None  # run_parameters states the seed; the count is a whole number
+    return identity
+
+
+def stored_identities(store: Store | str | os.PathLike[str]) -> dict[str, str]:
+    """Simulation identity -> key of the first stored run of it, for the runs of ``store``
+    that record their inputs (:func:`run_identity`)."""
+    from ..compare.align import simulation_identity
+
+    store = _open(store)
+    if not store.path.exists():
+        return {}
+    runs = store.list_dem_runs()
+    if runs.empty or "parameters_json" not in runs.columns:
+        return {}
+    out: dict[str, str] = {}
+    for key, params, count in zip(runs["case_key"], runs["parameters_json"],
+                                  runs.get("particles_per_cell", [None] * len(runs)),
+                                  strict=True):
+        identity = simulation_identity(params, count)
+        if identity is not None:
+            out.setdefault(identity, str(key))
+    return out
+
+
+def stored_run_key(store: Store | str | os.PathLike[str], case: LoadCase, config: DemConfig,
+                   specimen: Specimen | None = None) -> str | None:
+    """Key under which ``store`` holds this run: its own :func:`run_key`, else a run of the
+    same simulation under another key (:func:`same_simulation_key`); None if neither."""
+    store = _open(store)
+    if not store.path.exists():
+        return None
+    key = run_key(case, config, specimen)
+    if store.has_dem_run(key):
+        return key
+    return same_simulation_key(store, case, config, specimen)
+
+
 def run_or_load(store: Store | str | os.PathLike[str], specimen: Specimen | None,
                 case: LoadCase, config: DemConfig | None = None, *,
                 progress: bool = False) -> DemResult:
     """The run cache: the stored run of these inputs, or simulate, store and return it.
+
+    A stored run of the same simulation under another key (another fill stated that rounds to
+    the same particle count: :func:`stored_run_key`) is returned as stored: its ``case``
+    states the fill it was stored with, which callers should say
+    (``pidcore dem run`` does).
 
     Parameters
     ----------
@@ -215,11 +291,11 @@ def run_or_load(store: Store | str | os.PathLike[str], specimen: Specimen | None
     config = config or DemConfig()
     store = _open(store)
     specimen = resolve_specimen(case, specimen)
-    key = run_key(case, config, specimen)
-    if store.path.exists() and store.has_dem_run(key):
-        return load_dem_result(store.get_dem_run(key))
+    stored = stored_run_key(store, case, config, specimen)
+    if stored is not None:
+        return load_dem_result(store.get_dem_run(stored))
     result = simulate_load_case(case, config, specimen=specimen, progress=progress)
-    save_dem_entry(store, key, dem_run_entry(result))
+    save_dem_entry(store, run_key(case, config, specimen), dem_run_entry(result))
     return result
 
 
@@ -281,7 +357,7 @@ def rekey_dem_store(source: str | os.PathLike[str], target: str | os.PathLike[st
     return len(items)
 
 
-__all__ = ["DEM_CODE_VERSION", "dem_run_entry", "load_dem_result", "run_key", "run_or_load",
-           "run_parameters", "runs_of_specimen", "rekey_dem_store", "save_dem_entry",
-           "save_dem_result"]
-
+__all__ = ["DEM_CODE_VERSION", "dem_run_entry", "load_dem_result", "rekey_dem_store",
+           "run_identity", "run_key", "run_or_load", "run_parameters", "runs_of_specimen",
+           "same_simulation_key", "save_dem_entry", "save_dem_result", "stored_identities",
+           "stored_run_key"]

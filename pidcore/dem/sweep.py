@@ -1,5 +1,9 @@
 """Sweeps of DEM load cases: local process pool by default, dask.distributed on request.
 
+A case whose run the store holds under another key (another fill of the same particle count
+and seed: :func:`pidcore.dem.persist.same_simulation_key`), or that repeats another case of the
+sweep so, is not simulated again; :attr:`SweepSummary.cases` says so per case.
+
 Every finished case is written to the store at once, in its own transaction, by the parent
 process (the store's lock serialises writers, but one writer is simpler and faster). An
 interrupted sweep therefore keeps every finished case, and a re-run skips them: the case key
@@ -18,7 +22,14 @@ from pathlib import Path
 from ..constants import DriveDirection, ParticleMaterial
 from ..errors import ParameterError
 from ..specimen import Specimen
-from .persist import dem_run_entry, run_key, run_key_0_1, save_dem_entry
+from .persist import (
+    dem_run_entry,
+    run_identity,
+    run_key,
+    run_key_0_1,
+    save_dem_entry,
+    stored_identities,
+)
 from .simulate import DemConfig, LoadCase, resolve_specimen, simulate_load_case
 
 #: Named grids. ``table3`` is the paper's Table 3: 4 frequencies x 3 accelerations x 4 fills.
@@ -127,18 +138,71 @@ def init_dem_worker() -> None:
     interrupt.install()
 
 
+#: How a sweep got each case's run (:attr:`SweepSummary.cases`).
+SWEEP_CASE_STATUSES = ("simulated", "already stored",
+                       "same simulation as a stored run",
+                       "same simulation as another case of this sweep")
+#: Result fields of each case in :meth:`SweepSummary.to_dict`, named (units as suffixes) as
+#: ``pidcore dem run --json`` names them, read from the stored run.
+SWEEP_CASE_FIELDS = ("sdc", "sdc_stderr", "loss_factor", "particles_per_cell",
+                     "cells_simulated", "seed", "steady_detected")
+
+
 @dataclass
 class SweepSummary:
-    """What a sweep did: keys run now, keys skipped as already stored, wall time."""
+    """What a sweep did: keys run now, keys skipped as already stored, wall time, and per case
+    (in the order asked) its run's key, how it was got and its stored results.
+
+    ``cases``: one dict per case asked: ``frequency_hz``, ``acceleration_g``,
+    ``fill_percent`` (as asked), ``material``, ``direction``, ``store_key``, ``status`` (one of
+    :data:`SWEEP_CASE_STATUSES`) and, once the run is stored, ``stored_fill_percent`` (the
+    fill its run is stored with: another where the same simulation was found under another
+    fill) and :data:`SWEEP_CASE_FIELDS`.
+    """
 
     completed: list[str] = field(default_factory=list)
     skipped: list[str] = field(default_factory=list)
     wall_s: float = 0.0
     store_path: str = ""
+    cases: list[dict] = field(default_factory=list)
 
     def to_dict(self) -> dict:
         return {"completed": len(self.completed), "skipped": len(self.skipped),
-                "wall_s": self.wall_s, "store": self.store_path}
+                "wall_s": self.wall_s, "store": self.store_path,
+                "cases": [dict(c) for c in self.cases]}
+
+    def fill_results(self, store) -> None:
+        """Read each case's results from ``store`` (the runs as stored)."""
+        if not self.cases or not store.path.exists():
+            return
+        runs = store.list_dem_runs()
+        if runs.empty:
+            return
+        by_key = runs.set_index("case_key")
+        for case in self.cases:
+            if case["store_key"] not in by_key.index:
+                continue  # not finished (interrupted)
+            row = by_key.loc[case["store_key"]]
+            case["stored_fill_percent"] = float(row["fill_percent"])
+            for name in SWEEP_CASE_FIELDS:
+                case[name] = _plain(row.get(name))
+            if case.get("steady_detected") is not None:  # the store reads a bool back as 0/1
+                case["steady_detected"] = bool(case["steady_detected"])
+
+
+def _plain(value):
+    """A listing value as JSON takes it (numpy scalars to Python; NaN to None)."""
+    import math
+
+    import numpy as np
+
+    if isinstance(value, np.bool_ | bool):
+        return bool(value)
+    if isinstance(value, np.integer):
+        return int(value)
+    if isinstance(value, np.floating | float):
+        return None if not math.isfinite(float(value)) else float(value)
+    return value
 
 
 def run_sweep(cases: Sequence[LoadCase], config: DemConfig, *,
@@ -173,6 +237,8 @@ def run_sweep(cases: Sequence[LoadCase], config: DemConfig, *,
     store = Store(store_path)
     summary = SweepSummary(store_path=str(Path(store_path)))
     todo: list[tuple[LoadCase, str]] = []
+    identities = stored_identities(store)  # read once, not once per case
+    planned: dict[str, str] = {}  # simulation identity -> key of a case to simulate
     for case in cases:
         key = run_key(case, config, specimen)
         # a 0.1 key names only the paper's coupon (with its constant k_t): another specimen's
@@ -180,15 +246,33 @@ def run_sweep(cases: Sequence[LoadCase], config: DemConfig, *,
         keys = (key, run_key_0_1(case, config)) if resolve_specimen(case, specimen).is_paper() \
             else (key,)
         stored = [k for k in keys if store.path.exists() and store.has_dem_run(k)]
+        status = "already stored"
+        identity = None
+        if not stored:
+            # another fill of the same particle count and seed is the same simulation
+            identity = run_identity(case, config, specimen)
+            same = identities.get(identity)
+            stored, status = ([same], "same simulation as a stored run") if same else ([], "")
+        record = {"frequency_hz": case.frequency_hz, "acceleration_g": case.acceleration_g,
+                  "fill_percent": case.fill_percent, "material": case.material,
+                  "direction": case.direction}
         if stored:  # also under the key a 0.1 store holds it by
             summary.skipped.append(stored[0])
+            summary.cases.append({**record, "store_key": stored[0], "status": status})
+        elif identity is not None and identity in planned:
+            summary.cases.append({**record, "store_key": planned[identity],
+                                  "status": "same simulation as another case of this sweep"})
         else:
+            if identity is not None:
+                planned[identity] = key
             todo.append((case, key))
+            summary.cases.append({**record, "store_key": key, "status": "simulated"})
     bar = None
     if progress:
         from tqdm import tqdm
 
-        bar = tqdm(total=len(cases), initial=len(summary.skipped), unit="case", desc="DEM sweep")
+        bar = tqdm(total=len(cases), initial=len(cases) - len(todo), unit="case",
+                   desc="DEM sweep")
 
     def finish(outcome: CaseOutcome) -> None:
         outcome.save_to(store)
@@ -208,6 +292,7 @@ def run_sweep(cases: Sequence[LoadCase], config: DemConfig, *,
         if bar is not None:
             bar.close()
         summary.wall_s = time.perf_counter() - start
+    summary.fill_results(store)
     return summary
 
 

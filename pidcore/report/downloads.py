@@ -18,29 +18,36 @@ from ..errors import ParameterError
 
 if TYPE_CHECKING:  # pragma: no cover
     from ..calibrate.prediction import Calibration
+    from ..specimen import Specimen
 
 #: MIME type of each report format (:data:`pidcore.constants.REPORT_FORMATS`).
 REPORT_MIME_TYPES: dict[str, str] = {
     "csv": "text/csv", "md": "text/markdown", "html": "text/html",
     "tex": "application/x-tex", "pdf": "application/pdf",
 }
+#: How the app's notes say another specimen's runs are chosen (:func:`store_report_table`).
+CHOOSE_SPECIMEN_APP = "the Report tab's specimen choice for another"
 #: Name of the report files offered for download: ``pidcore_report.<format>``.
 DOWNLOAD_STEM = "pidcore_report"
 
 
 def store_report_table(path: str | os.PathLike, dem_store: str | os.PathLike | None = None, *,
                        analysis_keys: list[str] | None = None, pool: bool = False,
-                       calibration: Calibration | None = None) -> pd.DataFrame:
+                       calibration: Calibration | None = None,
+                       specimen: Specimen | None = None) -> pd.DataFrame:
     """The Table 3-style report table of what the stores hold (empty if they hold nothing).
 
     Measurements: the newest analysis per measurement and parameters of the store that states
     a fill (:func:`pidcore.store.listing.saved_analyses`), or only ``analysis_keys``. DEM: the
-    runs of both stores. ``calibration``: add the calibrated DEM's columns, as ``pidcore
-    report --calibration`` does (:func:`pidcore.report.table.add_calibration_columns`).
+    runs of both stores of ``specimen`` (default: the paper's coupon), chosen and noted as
+    ``pidcore report --specimen`` chooses them
+    (:func:`pidcore.report.pipeline.specimen_report_table`: other specimens' runs are left out
+    and named in ``attrs["notes"]``). ``calibration``: add the calibrated DEM's columns, as
+    ``pidcore report --calibration`` does (:func:`pidcore.report.table.add_calibration_columns`).
     """
-    from ..compare.case import paper_table
     from ..store.listing import list_dem_runs, saved_analyses
-    from .table import add_calibration_columns, build_report_table
+    from .pipeline import specimen_report_table
+    from .table import add_calibration_columns
 
     analyses = saved_analyses(path)
     if analysis_keys is not None and not analyses.empty:
@@ -48,15 +55,19 @@ def store_report_table(path: str | os.PathLike, dem_store: str | os.PathLike | N
     dem_runs = list_dem_runs(path, dem_store)
     if analyses.empty and dem_runs.empty:
         return pd.DataFrame()
-    table = build_report_table(dem_runs if not dem_runs.empty else None,
-                               analyses if not analyses.empty else None, paper_table(),
-                               pool=pool)
-    return table if calibration is None else add_calibration_columns(table, calibration)
+    where = " and ".join(str(p) for p in (path, dem_store)
+                         if p is not None and Path(p).is_file())
+    table = specimen_report_table(dem_runs if not dem_runs.empty else None,
+                                  analyses if not analyses.empty else None, specimen=specimen,
+                                  where=where or None, pool=pool,
+                                  choose_another=CHOOSE_SPECIMEN_APP).table
+    return table if calibration is None else add_calibration_columns(
+        table, calibration, specimen=specimen, paper=specimen is None)
 
 
 def report_files(path: str | os.PathLike, dem_store: str | os.PathLike | None = None, *,
                  analysis_keys: list[str] | None = None, pool: bool = False,
-                 calibration: Calibration | None = None,
+                 calibration: Calibration | None = None, specimen: Specimen | None = None,
                  ) -> dict[str, tuple[str, bytes, str]]:
     """The report of :func:`store_report_table` as downloads: format -> (file name, bytes,
     MIME type), plus ``"csv_provenance"`` (the CSV's notes sidecar).
@@ -67,7 +78,7 @@ def report_files(path: str | os.PathLike, dem_store: str | os.PathLike | None = 
     from ..compare import Tolerances
     from ..store.listing import list_dem_runs
     from .comparison_figures import plot_sdc_comparison
-    from .pipeline import open_verified_store
+    from .pipeline import open_verified_store, specimen_provenance
     from .provenance import collect_provenance
     from .render import write_report
 
@@ -75,18 +86,23 @@ def report_files(path: str | os.PathLike, dem_store: str | os.PathLike | None = 
     for p in stores:
         open_verified_store(p, must_exist=True)
     table = store_report_table(path, dem_store, analysis_keys=analysis_keys, pool=pool,
-                               calibration=calibration)
+                               calibration=calibration, specimen=specimen)
     if table.empty:
         raise ParameterError("nothing to report: the stores hold no saved analyses with a "
                              "load case and no DEM runs")
     tol = Tolerances()
     runs = list_dem_runs(path, dem_store)
+    if not runs.empty:
+        from ..dem.persist import runs_of_specimen
+
+        runs = runs_of_specimen(runs, specimen)  # the seeds of the runs compared
     seeds = sorted({int(s) for s in runs.get("seed", pd.Series(dtype=float)).dropna()})
     provenance = collect_provenance(
         parameters={"frequency_rtol": tol.frequency_rtol,
                     "acceleration_rtol": tol.acceleration_rtol,
                     "fill_atol_percent": tol.fill_atol_percent, "pool": pool},
-        seeds=seeds, stores=stores, notes=table.attrs.get("notes", []))
+        seeds=seeds, stores=stores, notes=table.attrs.get("notes", []),
+        specimens=specimen_provenance(specimen))
     figures = {"sdc_per_load_case": plot_sdc_comparison(table)}
     try:
         with tempfile.TemporaryDirectory(prefix="pidcore_report_") as folder:

@@ -250,7 +250,7 @@ def _measured_loops(results: list[MeasuredResult], analyses: pd.DataFrame, store
     return loops
 
 
-def _specimen_provenance(specimen) -> list[tuple[str, str]]:
+def specimen_provenance(specimen) -> list[tuple[str, str]]:
     """(label, SHA-256) of the specimen(s) whose DEM runs a report compares."""
     from ..constants import PARTICLE_MATERIALS
     from ..specimen import paper_specimen
@@ -275,6 +275,87 @@ def _other_specimens(stored: pd.DataFrame, kept: pd.DataFrame) -> str:
     counts = run_specimen_labels(left_out).value_counts(sort=False)
     return (f"{len(left_out)} run(s) of other specimens: "
             + ", ".join(f"{n} of {label}" for label, n in counts.items()))
+
+
+#: How ``pidcore report`` says another specimen is chosen (the app says its own way).
+CHOOSE_SPECIMEN_CLI = "--specimen FILE for another"
+
+
+def specimen_dem_runs(stored: pd.DataFrame | None, specimen=None, *,
+                      where: str | Path | None = None,
+                      choose_another: str = CHOOSE_SPECIMEN_CLI,
+                      ) -> tuple[pd.DataFrame | None, list[str]]:
+    """The DEM runs a report of ``specimen`` compares, and notes naming those left out.
+
+    ``specimen=None`` is the default: the paper's coupon with either table material
+    (:func:`pidcore.dem.persist.runs_of_specimen`). Runs of other specimens are left out and
+    named by label and count (``"1 run(s) of other specimens: 1 of my_steel [3e945a]; not
+    compared ..."``). ``where``: the store named in the notes; ``choose_another``: how the
+    default's note says another specimen is chosen. ``pidcore report`` and the app's Report
+    tab both choose their runs here.
+    """
+    notes: list[str] = []
+    where = where if where is not None else "the DEM store"
+    if stored is None:
+        return None, notes
+    if stored.empty:
+        notes.append(f"{where}: holds no DEM runs")
+        return None, notes
+    from ..compare.specimens import specimen_label
+    from ..dem.persist import runs_of_specimen
+    from ..specimen import paper_specimen
+
+    kept = runs_of_specimen(stored, specimen)
+    others = _other_specimens(stored, kept)
+    # the default takes the paper's coupon with either table material: no one hash
+    name = (specimen_label(specimen.name, specimen.hash) if specimen is not None else
+            f"{paper_specimen().name} (the default; {choose_another})")
+    if kept.empty:
+        notes.append(f"{where}: holds no DEM runs of specimen {name} ({others})")
+        return None, notes
+    if others:
+        notes.append(f"{where}: {others}; not compared (the report is of specimen {name})")
+    return kept, notes
+
+
+@dataclass(frozen=True)
+class SpecimenTable:
+    """What :func:`specimen_report_table` built: the table (notes in ``attrs["notes"]``), the
+    DEM runs compared (None: none) and the paper's Table 3 used (None where not compared)."""
+
+    table: pd.DataFrame
+    dem_runs: pd.DataFrame | None
+    paper: pd.DataFrame | None
+
+
+def specimen_report_table(stored_runs: pd.DataFrame | None, analyses: pd.DataFrame | None, *,
+                          specimen=None, where: str | Path | None = None,
+                          tolerances: Tolerances | None = None, pool: bool = False,
+                          choose_another: str = CHOOSE_SPECIMEN_CLI) -> SpecimenTable:
+    """The report table of one specimen's DEM runs (:func:`specimen_dem_runs`) beside the
+    analyses, as ``pidcore report`` and the app's Report tab show it.
+
+    The paper's Table 3 is compared only for the paper's coupon. With a ``specimen`` (and not
+    ``pool``) the ``specimen`` column names it on every row that does not name its own (its
+    DEM runs', and the files given as its tests); the default (the paper's coupon) leaves the
+    column empty, as the bundled report always had it.
+    """
+    from ..model import load_paper_table3
+
+    dem_runs, notes = specimen_dem_runs(stored_runs, specimen, where=where,
+                                        choose_another=choose_another)
+    paper = load_paper_table3()
+    if specimen is not None and not specimen.is_paper():
+        paper = None
+        notes.append(f"specimen {specimen.name} is not the paper's coupon: the paper's "
+                     "Table 3 is not compared")
+    table = build_report_table(dem_runs, analyses, paper, tolerances=tolerances, pool=pool)
+    if specimen is not None and not pool:
+        # every DEM row is this specimen's (runs_of_specimen) and the files are its tests; a
+        # measurement stored with a specimen of its own (the app's uploads) keeps that one
+        table["specimen"] = table["specimen"].mask(table["specimen"] == "", specimen.name)
+    table.attrs["notes"] = notes + list(table.attrs.get("notes", []))
+    return SpecimenTable(table, dem_runs, paper)
 
 
 def _figures(table: pd.DataFrame, dem_runs: pd.DataFrame | None, aligner: Aligner,
@@ -371,7 +452,6 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
     ReportResult
     """
     from ..measure import AnalysisOptions, save_analyses
-    from ..model import load_paper_table3
 
     formats = parse_formats(formats)
     calibrated = None
@@ -452,37 +532,9 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         analyses = measured_frame(results)
 
     dem_runs = dem.list_dem_runs() if dem is not None else None
-    if dem_runs is not None and not dem_runs.empty:
-        from ..dem.persist import runs_of_specimen
-
-        stored = dem_runs
-        dem_runs = runs_of_specimen(stored, specimen)
-        others = _other_specimens(stored, dem_runs)
-        from ..compare.specimens import specimen_label
-        from ..specimen import paper_specimen
-
-        # the default takes the paper's coupon with either table material: no one hash
-        name = (specimen_label(specimen.name, specimen.hash) if specimen is not None else
-                f"{paper_specimen().name} (the default; --specimen FILE for another)")
-        if dem_runs.empty:
-            notes.append(f"{dem_path}: holds no DEM runs of specimen {name} ({others})")
-            dem_runs = None
-        elif others:
-            notes.append(f"{dem_path}: {others}; not compared (the report is of specimen "
-                         f"{name})")
-    elif dem_runs is not None:
-        notes.append(f"{dem_path}: holds no DEM runs")
-        dem_runs = None
-    paper = load_paper_table3()
-    if specimen is not None and not specimen.is_paper():
-        paper = None
-        notes.append(f"specimen {specimen.name} is not the paper's coupon: the paper's "
-                     "Table 3 is not compared")
-    table = build_report_table(dem_runs, analyses, paper, tolerances=tolerances, pool=pool)
-    if specimen is not None and not pool:
-        # every DEM row is this specimen's (runs_of_specimen) and the files are its tests; a
-        # measurement stored with a specimen of its own (the app's uploads) keeps that one
-        table["specimen"] = table["specimen"].mask(table["specimen"] == "", specimen.name)
+    built = specimen_report_table(dem_runs, analyses, specimen=specimen, where=dem_path,
+                                  tolerances=tolerances, pool=pool)
+    table, dem_runs, paper = built.table, built.dem_runs, built.paper
     if calibrated is not None:
         table = add_calibration_columns(table, calibrated, tolerances=tolerances,
                                         specimen=specimen, paper=specimen is None)
@@ -506,7 +558,7 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
                         "fill_atol_percent": tolerances.fill_atol_percent},
             seeds=seeds, inputs=[r.path for r in results],
             input_hashes={str(r.path): getattr(r.measurement, "sha256", "") for r in results},
-            stores=stores, notes=notes, specimens=_specimen_provenance(specimen))
+            stores=stores, notes=notes, specimens=specimen_provenance(specimen))
         paths = write_report(table, figures, provenance, out_dir, formats)
     finally:
         for fig in figures.values():  # bare Figures: drop references to free Agg buffers

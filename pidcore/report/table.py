@@ -4,7 +4,9 @@ Rows are the union of our DEM grid cases and the measured cases. A measured case
 DEM grid case (:mod:`pidcore.compare.align`) shares its row; one that does not gets its own row
 with our DEM value interpolated by the pchip model (or none, out of range). Numbers are copied
 from the inputs unchanged; only runs of one case and settings (seeds) and measurements of one
-case and specimen are pooled (:func:`pidcore.compare.pooled_mean`). DEM runs of different
+case and specimen are pooled (:func:`pidcore.compare.pooled_mean`); stored runs that are the
+same simulation (:func:`pidcore.compare.align.simulation_identity`) count once, which the row's
+note says. DEM runs of different
 numerical settings and measurements of different specimens get rows of their own unless
 ``pool=True`` (``pidcore report --pool``), which the row's note then says.
 
@@ -27,6 +29,7 @@ from ..compare.align import (
     DemCase,
     Tolerances,
     consistency_chi2,
+    duplicates_note,
     match_paper,
     pooled_mean,
     pooled_sdc_eq10,
@@ -219,6 +222,7 @@ def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | N
 
     records = []
     unconverged_rows: list[str] = []
+    duplicate_rows: list[str] = []
     for row in (r for group in rows.values() for r in group):
         lc = row.case
         sdc_m = sdc_m_se = f_m = a_m = chi2_dof = math.nan
@@ -246,6 +250,9 @@ def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | N
                            if chi2_dof > 3 else ""))
         if row.dem is not None and row.dem.n_runs > 1:
             note.append(f"{row.dem.n_runs} DEM runs pooled")
+        if row.dem is not None and row.dem.duplicate_keys:
+            note.append(duplicates_note(row.dem))
+            duplicate_rows.append(f"{lc.label()} ({len(row.dem.duplicate_keys)} duplicate)")
         if row.dem is not None and row.dem.not_converged:
             note.append(not_converged_note(row.dem))
             unconverged_rows.append(lc.label())
@@ -290,6 +297,12 @@ def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | N
         notes.append(f"{len(unconverged_rows)} row(s) rest on DEM runs that did not converge "
                      "(no steady state before the transient cap): their DEM SDC may include "
                      f"the transient: {'; '.join(unconverged_rows)}")
+    if duplicate_rows:
+        # named here too: the console's short table has no note column
+        notes.append(f"{len(duplicate_rows)} row(s) have stored DEM runs counted once, "
+                     "being the same simulation as a run counted (same particles per cell, "
+                     "seed, settings and specimen under another stated fill): "
+                     f"{'; '.join(duplicate_rows)}")
     table.attrs["notes"] = notes
     return table
 

@@ -6,11 +6,16 @@ import streamlit as st
 
 from pidcore.app import state
 
+#: The Report tab's default specimen: the paper's coupon, as ``pidcore report`` without
+#: ``--specimen``.
+DEFAULT_SPECIMEN = "paper_coupon (the default)"
+
 
 def render(stores, calibrations: list) -> None:
     """The page. ``calibrations``: [(calibration or None, label)], as the Compare tab's; the
     calibrated columns show the one chosen (the first by default)."""
     from pidcore.app.calibration import calibration_digest
+    from pidcore.compare.specimens import run_specimens
     from pidcore.errors import PidcoreError
     from pidcore.report.downloads import report_files
 
@@ -41,14 +46,35 @@ def render(stores, calibrations: list) -> None:
         calibration, label = usable[labels.index(chosen_label)] \
             if chosen_label in labels else usable[0]
     digest = calibration_digest(calibration)
+    # the DEM runs of one specimen, as `pidcore report [--specimen FILE]` compares them; the
+    # others are left out and named in the notes
     try:
-        table = state.report_table(stamp, pool, keys, digest, stores, calibration)
+        others = run_specimens(state.store_listing("dem_runs", stamp, stores))
+    except PidcoreError as exc:
+        st.error(f"cannot read the store: {exc}")
+        return
+    specimen_label = DEFAULT_SPECIMEN
+    if others:
+        options = [DEFAULT_SPECIMEN, *others]
+        specimen_label = st.selectbox("specimen of the DEM runs compared", options,
+                                      key="report_specimen",
+                                      help="as `pidcore report --specimen FILE`: the runs of "
+                                           "other specimens are left out, the notes name them")
+        if specimen_label not in options:
+            specimen_label = DEFAULT_SPECIMEN
+    specimen = others.get(specimen_label)
+    try:
+        table = state.report_table(stamp, pool, keys, digest, specimen_label, stores,
+                                   calibration, specimen)
     except PidcoreError as exc:
         st.error(f"cannot read the store: {exc}")
         return
     if table.empty:
-        st.info(f"{stores.path} holds no saved analyses with a load case and no DEM runs yet: "
-                "save analysed files (tab Analyse) or run DEM cases (tab DEM).")
+        st.info(f"{stores.path} holds no saved analyses with a load case and no DEM runs "
+                f"of this specimen yet: save analysed files (tab Analyse) or run DEM cases "
+                "(tab DEM).")
+        for note in table.attrs.get("notes", []):  # e.g. other specimens' runs left out
+            st.caption(f"note: {note}")
         return
     st.caption(f"calibrated DEM columns: {label}" if calibration is not None else label)
     st.dataframe(table, hide_index=True, key="report_table", width="stretch")
@@ -57,14 +83,16 @@ def render(stores, calibrations: list) -> None:
     if st.button("Build report files (CSV, Markdown, HTML, LaTeX, PDF)", key="build_report"):
         try:
             with st.spinner("Writing the report ..."):
-                st.session_state["report_files"] = ((stamp, pool, keys, digest), report_files(
-                    stores.path, stores.dem_reference, pool=pool,
-                    analysis_keys=None if keys is None else list(keys),
-                    calibration=calibration))
+                st.session_state["report_files"] = (
+                    (stamp, pool, keys, digest, specimen_label), report_files(
+                        stores.path, stores.dem_reference, pool=pool,
+                        analysis_keys=None if keys is None else list(keys),
+                        calibration=calibration, specimen=specimen))
         except PidcoreError as exc:
             st.error(f"no report: {exc}")
     made, files = st.session_state.get("report_files") or (None, None)
-    if files and made == (stamp, pool, keys, digest):  # files of an older state are not offered
+    # files of an older state are not offered
+    if files and made == (stamp, pool, keys, digest, specimen_label):
         cols = st.columns(len(files))
         for col, (fmt, (name, data, mime)) in zip(cols, files.items(), strict=True):
             label = "CSV notes" if fmt == "csv_provenance" else fmt.upper()
