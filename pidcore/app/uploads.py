@@ -263,7 +263,11 @@ def is_settings_table(data: bytes) -> bool:
         return False
     names = {c.strip().strip('"').lower() for c in head[0].split(",")}
     known = set(FILE_TABLE_COLUMNS.values()) | {k.lower() for k in FILE_TABLE_COLUMNS}
-    return "file" in names and len(names & known) >= 2
+    # A column that is neither known nor free text (a misspelt ``velocity_delay_ms``) still
+    # makes a table: read as one, it is refused naming the column; read as a measurement it
+    # was refused as "no data rows" and its files were analysed without their settings.
+    other = names - {"file"} - set(FREE_TEXT_COLUMNS)
+    return "file" in names and (len(names & known) >= 2 or bool(other - known))
 
 
 def measurement_materials(extra: Iterable[object] = ()) -> tuple[str, ...]:
@@ -359,6 +363,72 @@ def read_settings_table(name: str, data: bytes,
         raise ParameterError(f"{name}: every row needs a file name")
     out.attrs["given"] = [c for c in FILE_TABLE_COLUMNS if c in raw.columns and c != "file"]
     return out
+
+
+def _names_file(table_file: str, name: str) -> bool:
+    """Whether a settings table's ``file`` cell names the upload ``name`` (as
+    :func:`merge_settings` matches: the name, else its base name)."""
+    return table_file == name or Path(table_file).name == Path(name).name
+
+
+@dataclass(frozen=True)
+class RefusedTable:
+    """An uploaded settings table that was refused: its ``error`` and the ``files`` its
+    ``file`` column names (``None``: the table cannot be read at all, so it may name any)."""
+
+    name: str
+    error: str
+    files: tuple[str, ...] | None
+
+    def refuses(self, name: str) -> bool:
+        """Whether this table holds back the upload ``name``: it names it, or cannot say."""
+        return self.files is None or any(_names_file(f, name) for f in self.files)
+
+
+def refused_table(name: str, data: bytes, error: str) -> RefusedTable:
+    """The refused settings table ``name`` with the file names it holds back: its ``file``
+    column read as plain text (whatever else in the table is wrong), or ``None`` where the
+    table is no readable UTF-8 CSV with a ``file`` column (a Latin-1 file name would not match
+    its upload, and the file would be analysed without the settings meant for it)."""
+    try:
+        raw = pd.read_csv(io.BytesIO(data), dtype=str, keep_default_na=False,
+                          skipinitialspace=True, encoding="utf-8-sig")
+    except (ValueError, UnicodeError):
+        return RefusedTable(name, error, None)
+    column = next((c for c in raw.columns if str(c).strip().lower() == "file"), None)
+    if column is None:
+        return RefusedTable(name, error, None)
+    files = tuple(f for f in (str(v).strip() for v in raw[column]) if f)
+    return RefusedTable(name, error, files)
+
+
+def refusal_of(name: str, refused: Sequence[RefusedTable]) -> str:
+    """Why the upload ``name`` is not analysed: the refused settings tables that hold it back
+    (:meth:`RefusedTable.refuses`), as one line; "" where none does. Analysing it without the
+    settings meant for it (e.g. its vibrometer delay) would show and save a wrong SDC."""
+    tables = [t.name for t in refused if t.refuses(name)]
+    if not tables:
+        return ""
+    return (f"{name}: not analysed: the settings table {', '.join(tables)} that gives its "
+            "settings was refused (see the error above); fix the table and upload it again, "
+            "or remove it")
+
+
+def table_match_note(name: str, table: pd.DataFrame, uploaded: Sequence[str]) -> tuple[str, str]:
+    """``(info, warning)`` on an accepted settings table ``name``: how many of its rows match
+    the ``uploaded`` measurement files (and the columns it gives), and the rows (by line of
+    the CSV) that match none, e.g. a misspelt file name; the warning is "" when every row
+    matches."""
+    given = ", ".join(table.attrs.get("given", []))
+    files = [str(f) for f in table["file"]]
+    matched = [any(_names_file(f, u) for u in uploaded) for f in files]
+    info = (f"{name}: {sum(matched)} of {len(files)} row(s) match uploaded files"
+            + (f" ({given})" if given else ""))
+    unmatched = [f"line {i} {f!r}" for i, (f, ok) in enumerate(zip(files, matched, strict=True),
+                                                                  start=2) if not ok]
+    warning = (f"{name}: row(s) matching no uploaded file: {', '.join(unmatched)}; their "
+               "settings apply to no file uploaded (check the file names)" if unmatched else "")
+    return info, warning
 
 
 def default_settings_row(name: str, stated) -> dict:

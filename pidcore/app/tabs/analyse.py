@@ -151,7 +151,8 @@ def render(stores) -> list:
                                step=1000.0, key="sample_rate",
                                help="only for CSV/TXT files without a time column; 0 = none")
     sample_rate_hz = rate if rate > 0 else None
-    measurements, tables = [], {}
+    measurements, tables, accepted = [], {}, []
+    refused: list[uploads.RefusedTable] = []
     try:
         runs = state.store_listing("dem_runs", stores.stamp(), stores)
     except PidcoreError as exc:  # the uploads work without it: only the table's materials
@@ -172,12 +173,19 @@ def render(stores) -> list:
                 table = uploads.read_settings_table(upload.name, data, materials)
             except PidcoreError as exc:
                 st.error(str(exc))
+                # the files it names wait for it: analysed without it, they showed and saved
+                # a result with settings the user did not give (e.g. no vibrometer delay)
+                refused.append(uploads.refused_table(upload.name, data, str(exc)))
                 continue
             tables[state.upload_sha256(upload)] = table
-            st.info(f"{upload.name}: settings of {len(table)} file(s) read "
-                    f"({', '.join(table.attrs.get('given', []))})")
+            accepted.append((upload.name, table))  # by name: two tables may be byte-equal
         else:
             measurements.append(upload)
+    for name, table in accepted:
+        info, unmatched = uploads.table_match_note(name, table, [u.name for u in measurements])
+        st.info(info)
+        if unmatched:
+            st.warning(unmatched)
     if not measurements:
         return []
     kept, notes = uploads.distinct_uploads([(u.name, state.upload_sha256(u))
@@ -195,6 +203,12 @@ def render(stores) -> list:
     settings = _settings_editor(measurements, tables, channel_names, materials)
     analysed = []
     for upload, (_, row) in zip(measurements, settings.iterrows(), strict=True):
+        held = uploads.refusal_of(upload.name, refused)
+        if held:  # no numbers, no "none given" notes: its settings were given, and refused
+            with st.container(border=True):
+                st.markdown(f"**{upload.name}** · {_size(upload.size)}")
+                st.error(held)
+            continue
         result = _card(upload, row, sample_rate_hz, materials,
                        uploads.columns_given(list(tables.values()), upload.name))
         if result is not None:
@@ -209,6 +223,9 @@ def render(stores) -> list:
         confirm = st.checkbox(f"Save the {len(flagged)} implausible record(s) anyway (their "
                               "warnings are saved with them)", key="confirm_implausible")
     conflict = uploads.load_case_conflict(analysed)
+    if refused:  # one save of what the user uploaded, not of the part its settings allow
+        conflict = (f"the settings table {', '.join(t.name for t in refused)} is refused: fix "
+                    "it and upload it again, or remove it")
     if conflict:  # said before Save, which would refuse it
         st.error(f"cannot save: {conflict}")
     if st.button(f"Save {uploads.saved_count(analysed)} record(s) to the store",
