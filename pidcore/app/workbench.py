@@ -138,3 +138,53 @@ def case_view(entries: Sequence[MeasuredEntry], dem_runs: pd.DataFrame | None,
             "dem_specimen": met.specimen, "dem_refused": met.note if met.refused else "",
             "dem_warning": (not_converged_note(grid) if grid is not None and grid.not_converged
                             else "")}
+
+
+
+#: Report columns whose missing number is a result without a value, shown with the reason.
+REPORT_STDERR_COLUMN = "SDC DEM stderr [-]"
+REPORT_CHI2_COLUMN = "measured chi2/dof [-]"
+
+
+def _one_cell(settings: object) -> bool:
+    """Whether a report row's "DEM settings" (:func:`pidcore.compare.align.dem_cases`: ``"cells
+    1, steady cycles ..."``) say its runs simulated one cell (pooled settings say nothing)."""
+    return str(settings).startswith("cells 1,") or str(settings) == "cells 1"
+
+
+def _with_reason(values: pd.Series, present: pd.Series, reasons: list[str],
+                 number: str) -> list[str]:
+    """``values`` as text (format ``number``); a missing one is "" where ``present`` is false
+    (nothing to have a value of), else its ``reasons`` entry."""
+    import math
+
+    values = pd.to_numeric(values, errors="coerce")
+    return [format(v, number) if math.isfinite(v) else reason if there else ""
+            for v, there, reason in zip(values, present, reasons, strict=True)]
+
+
+def report_display(table: pd.DataFrame) -> pd.DataFrame:
+    """The Report tab's view of :func:`pidcore.report.downloads.store_report_table`: the grid
+    shows a missing number as a literal "None", which read as a fault, so two results that can
+    lack a value are text saying why. The DEM standard error: ``"n/a (1 cell)"`` where the run
+    simulated one cell (one cell has no scatter to take a standard error from; the DEM tab says
+    the same), ``"n/a"`` where it is missing otherwise, empty where no DEM ran. The measured
+    chi2/dof: ``"n/a (1 measurement)"`` for one measurement (nothing to scatter), empty where
+    none. The downloads keep the table as ``pidcore report`` writes it (empty cells)."""
+    import numpy as np
+
+    if table.empty or not {REPORT_STDERR_COLUMN, REPORT_CHI2_COLUMN} <= set(table.columns):
+        return table
+    out = table.copy()
+    dem = np.isfinite(pd.to_numeric(table["SDC DEM (ours) [-]"], errors="coerce"))
+    settings = table.get("DEM settings", pd.Series("", index=table.index))
+    out[REPORT_STDERR_COLUMN] = _with_reason(  # 3 digits, as the DEM tab's runs table
+        table[REPORT_STDERR_COLUMN], dem,
+        ["n/a (1 cell)" if _one_cell(s) else "n/a" for s in settings], ".3g")
+    measured = np.isfinite(pd.to_numeric(table["SDC measured [-]"], errors="coerce"))
+    sources = table.get("source file(s)", pd.Series("", index=table.index))
+    out[REPORT_CHI2_COLUMN] = _with_reason(  # 2 digits, as the Compare tab says it
+        table[REPORT_CHI2_COLUMN], measured,
+        ["n/a (1 measurement)" if s and "; " not in str(s) else "n/a" for s in sources], ".2g")
+    out.attrs = dict(table.attrs)
+    return out

@@ -15,6 +15,7 @@ def render(stores, calibrations: list) -> None:
     """The page. ``calibrations``: [(calibration or None, label)], as the Compare tab's; the
     calibrated columns show the one chosen (the first by default)."""
     from pidcore.app.calibration import calibration_digest
+    from pidcore.app.workbench import report_display
     from pidcore.compare.specimens import run_specimens
     from pidcore.errors import PidcoreError
     from pidcore.report.downloads import report_files
@@ -77,7 +78,7 @@ def render(stores, calibrations: list) -> None:
             st.caption(f"note: {note}")
         return
     st.caption(f"calibrated DEM columns: {label}" if calibration is not None else label)
-    st.dataframe(table, hide_index=True, key="report_table", width="stretch")
+    st.dataframe(report_display(table), hide_index=True, key="report_table", width="stretch")
     for note in table.attrs.get("notes", []):
         st.caption(f"note: {note}")
     if st.button("Build report files (CSV, Markdown, HTML, LaTeX, PDF)", key="build_report"):
