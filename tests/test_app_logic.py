@@ -1292,3 +1292,63 @@ def test_dem_job_of_a_fill_whose_simulation_is_stored_is_not_run_again(tmp_path)
     (job,) = runner.submit([same], config)
     assert job.state == "in store" and "same simulation" in job.message
     assert job.run_key == run_key(stored, config)  # the run it is, as stored
+
+
+# --- refused and unmatched settings tables; the report's missing numbers ------------------------
+
+def test_a_refused_settings_table_holds_back_the_files_it_names():
+    # the app analysed and saved a file whose table it had refused (no delay: SDC 1.034 for
+    # 1.136); the files it names wait for it, and a table that cannot be read holds back all
+    table = b"file,velocity_delay_us\nrun_a.uff,50 us\nsub/run_b.uff,40\n"
+    with pytest.raises(ParameterError) as refused:
+        uploads.read_settings_table("settings.csv", table)
+    held = uploads.refused_table("settings.csv", table, str(refused.value))
+    assert held.files == ("run_a.uff", "sub/run_b.uff")
+    assert held.refuses("run_a.uff") and held.refuses("run_b.uff")  # by base name, as merged
+    assert not held.refuses("run_c.uff")
+    line = uploads.refusal_of("run_a.uff", [held])
+    assert line.startswith("run_a.uff: not analysed") and "settings.csv" in line
+    assert "\n" not in line and uploads.refusal_of("run_c.uff", [held]) == ""
+    # a Latin-1 table cannot say which files it names (a name with "ö" would not match)
+    latin = "file,velocity_delay_us,notes\nrun_a.uff,50,Verzögerung\n".encode("latin-1")
+    assert uploads.refused_table("settings.csv", latin, "bad").files is None
+    assert uploads.refusal_of("any.uff", [uploads.refused_table("s.csv", latin, "bad")])
+
+
+def test_a_table_with_an_unknown_column_is_read_as_a_table_and_refused():
+    # read as a measurement it was refused as "no data rows", and its file was analysed as if
+    # the table had never been uploaded
+    table = b"file,velocity_delay_ms\nrun_a.uff,0.05\n"
+    assert uploads.is_settings_table(table)
+    with pytest.raises(ParameterError, match=r"unknown column\(s\) \['velocity_delay_ms'\]"):
+        uploads.read_settings_table("settings.csv", table)
+    assert not uploads.is_settings_table(b"file,notes\nx,y\n")  # remarks only: no settings
+
+
+def test_a_settings_table_says_which_rows_match_no_uploaded_file():
+    # "settings of 1 file(s) read" was said of a table whose only row named no upload
+    table = uploads.read_settings_table(
+        "settings.csv", b"file,velocity_delay_us\nsynthetic_typo.uff,50\nrun_a.uff,40\n")
+    info, warning = uploads.table_match_note("settings.csv", table, ["run_a.uff", "b.uff"])
+    assert info == "settings.csv: 1 of 2 row(s) match uploaded files (vibrometer delay [µs])"
+    assert "line 2 'synthetic_typo.uff'" in warning and "run_a.uff" not in warning
+    assert uploads.table_match_note("settings.csv", table,
+                                    ["synthetic_typo.uff", "x/run_a.uff"])[1] == ""
+
+
+def test_the_report_tab_says_why_a_result_has_no_number():
+    # the grid showed a 1-cell run's missing standard error as a literal "None"
+    from pidcore.app.workbench import report_display
+
+    table = pd.DataFrame({
+        "SDC DEM (ours) [-]": [1.1, 0.5, math.nan, 0.7],
+        "SDC DEM stderr [-]": [math.nan, 0.0123456, math.nan, math.nan],
+        "SDC measured [-]": [1.13, math.nan, 0.9, 0.8],
+        "measured chi2/dof [-]": [math.nan, math.nan, 1.234, math.nan],
+        "DEM settings": ["cells 1, steady cycles auto, settings hash 44136f",
+                         "cells 4, steady cycles auto, settings hash 44136f", "", ""],
+        "source file(s)": ["a.uff", "", "a.uff; b.uff", "c.uff; d.uff"]})
+    shown = report_display(table)
+    assert shown["SDC DEM stderr [-]"].tolist() == ["n/a (1 cell)", "0.0123", "", "n/a"]
+    assert shown["measured chi2/dof [-]"].tolist() == ["n/a (1 measurement)", "", "1.2", "n/a"]
+    assert math.isnan(table["SDC DEM stderr [-]"].iloc[0])  # the table itself is unchanged

@@ -1001,3 +1001,55 @@ def test_report_tab_names_other_specimens_runs_and_offers_their_specimen(store_f
     table = _table(at, "DEM settings")
     assert table["specimen"].tolist() == ["my_panel"]
     assert table["SDC DEM (ours) [-]"].tolist() == [run.sdc]
+
+
+_SAMPLE = REPO / "data_samples" / "exports" / "synthetic_f50Hz_a5g_fill50_acrylic.uff"
+
+
+@pytest.mark.parametrize("table", [
+    b"file,velocity_delay_us\n" + _SAMPLE.name.encode() + b",50 us\n",   # not a number
+    b"file,velocity_delay_ms\n" + _SAMPLE.name.encode() + b",0.05\n",    # unknown column
+    ("file,velocity_delay_us,notes\n" + _SAMPLE.name + ",50,Verzögerung\n").encode("latin-1"),
+], ids=["not-a-number", "unknown-column", "latin-1"])
+def test_a_file_whose_settings_table_is_refused_is_not_analysed_or_saved(store_file, table):
+    # the app showed SDC 1.0343 (no delay) under the table's error, said "vibrometer delay:
+    # none given" and saved it; the sample's SDC at the table's 50 µs is 1.1360
+    at = _upload(_app(), [(_SAMPLE.name, _SAMPLE.read_bytes()), ("settings.csv", table)])
+    errors = [e.value for e in at.error]
+    assert errors[0].startswith("settings.csv")
+    assert any(e.startswith(f"{_SAMPLE.name}: not analysed") for e in errors), errors
+    assert not _metric(at, "SDC ± stderr [-]")
+    assert not any("none given" in i.value for i in at.info)
+    assert at.button(key="save").disabled
+    assert any("cannot save: the settings table settings.csv is refused" in e for e in errors)
+    # the file without the table (removed) is analysed again
+    at = _upload(at, [(_SAMPLE.name, _SAMPLE.read_bytes())])
+    assert len(_metric(at, "SDC ± stderr [-]")) == 1 and not at.button(key="save").disabled
+
+
+def test_a_settings_table_row_that_matches_no_upload_is_named(store_file):
+    # "settings.csv: settings of 1 file(s) read" although its one row named no upload
+    table = b"file,velocity_delay_us\nsynthetic_typo.uff,50\n"
+    at = _upload(_app(), [(_SAMPLE.name, _SAMPLE.read_bytes()), ("settings.csv", table)])
+    assert [i.value for i in at.info if i.value.startswith("settings.csv")] == [
+        "settings.csv: 0 of 1 row(s) match uploaded files (vibrometer delay [µs])"]
+    assert any("line 2 'synthetic_typo.uff'" in w.value for w in at.warning)
+
+
+def test_the_report_tab_says_a_one_cell_run_has_no_standard_error(store_file):
+    # the grid showed a literal "None"; the CSV download leaves the cell empty, as the CLI's
+    import io
+
+    import pandas as pd
+
+    from pidcore.report.downloads import report_files
+    from pidcore.store import Store
+
+    Store(store_file).add_dem_run("one_cell", {
+        "frequency_hz": 100.0, "acceleration_g": 5.0, "fill_percent": 50.0,
+        "material": "acrylic", "direction": "z", "sdc": 1.1, "sdc_stderr": float("nan"),
+        "m_c_kg": 0.3, "cells_simulated": 1})
+    at = _app()
+    assert _table(at, "SDC measured [-]")["SDC DEM stderr [-]"].tolist() == ["n/a (1 cell)"]
+    back = pd.read_csv(io.BytesIO(report_files(store_file)["csv"][1]))
+    assert back["SDC DEM stderr [-]"].isna().all()
