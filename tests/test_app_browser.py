@@ -412,7 +412,7 @@ def test_per_file_vibrometer_delays_and_a_negative_loss_factor_in_one_session(
     table.write_text(f"file,velocity_delay_us\n{a.name},0\n{b.name},200\n")
     page.locator("input[type=file]").first.set_input_files([str(a), str(b), str(odd),
                                                             str(table)])
-    page.get_by_text("settings of 2 file(s) read").wait_for(timeout=RESULT_TIMEOUT_MS)
+    page.get_by_text("2 of 2 row(s) match uploaded files").wait_for(timeout=RESULT_TIMEOUT_MS)
     want = [_analysis_of(a), _analysis_of(b, velocity_delay_s=200e-6)]
     page.get_by_text("vibrometer delay 200 µs").wait_for(timeout=RESULT_TIMEOUT_MS)
     deadline = time.monotonic() + RESULT_TIMEOUT_MS / 1000

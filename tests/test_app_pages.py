@@ -143,7 +143,7 @@ def test_each_file_is_analysed_with_its_own_corrections_and_mapping(store_file, 
     # files first, the settings table (any name) afterwards: it still applies
     at = _upload(_app(), [("a_fill50.csv", a), ("b_fill50.csv", b)])
     at = _upload(at, [("a_fill50.csv", a), ("b_fill50.csv", b), ("setup B.csv", settings)])
-    assert any("setup B.csv: settings of 1 file(s)" in i.value for i in at.info)
+    assert any("setup B.csv: 1 of 1 row(s) match uploaded files" in i.value for i in at.info)
     want = {}
     for name, data, options in (
             ("a_fill50.csv", a, _options()),
