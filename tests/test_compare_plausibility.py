@@ -106,6 +106,14 @@ def test_headline_compares_like_with_like_and_counts_sigmas():
     unknown = headline(compare_case([_entry(rec)], _dem(0.3, 0.01).drop(columns="m_c_kg"),
                                     paper))
     assert unknown.measured_kind == "Eq. 11" and math.isnan(unknown.sigmas)
+    # a DEM value without a standard error (a 1-cell run): the σ is the measurement's alone, so
+    # the count is only an upper bound, and the verdict says so ("differs by 314.1 σ" before)
+    one_cell = headline(compare_case([_entry(rec)], _dem(m + 1.0, float("nan")), paper))
+    assert one_cell.sigmas == pytest.approx(1.0 / se)
+    assert one_cell.verdict.startswith(f"differs by up to {1.0 / se:.1f} σ (the DEM value has "
+                                       "no standard error")
+    near = headline(compare_case([_entry(rec)], _dem(m + 0.5 * se, float("nan")), paper))
+    assert near.verdict == "agrees within 2 σ (≤ 0.5 σ; the DEM value has no standard error)"
 
 
 def test_model_curve_is_drawn_for_a_case_a_hair_below_the_grid_edge():

@@ -485,7 +485,16 @@ def headline(comparison: CaseComparison, *, k: float = AGREEMENT_SIGMAS) -> Head
     if not se > 0:
         return Headline(m, m_se, kind, dem, dem_se, math.nan, "no standard error to judge by")
     z = abs(m - dem) / se
-    verdict = (f"agrees within {k:g} σ ({z:.1f} σ)" if z <= k else f"differs by {z:.1f} σ")
+    if math.isfinite(m_se) and math.isfinite(dem_se):
+        verdict = (f"agrees within {k:g} σ ({z:.1f} σ)" if z <= k else f"differs by {z:.1f} σ")
+    else:
+        # one side's error is unknown (a 1-cell DEM run, a single record without one): the
+        # combined σ is at least the known side's, so z is an upper bound; "differs by" would
+        # overstate it ("differs by 314 σ" of a 1-cell run against the measurement's σ alone)
+        unknown = "DEM value" if not math.isfinite(dem_se) else "measured value"
+        verdict = (f"agrees within {k:g} σ (≤ {z:.1f} σ; the {unknown} has no standard error)"
+                   if z <= k else f"differs by up to {z:.1f} σ (the {unknown} has no standard "
+                   "error, e.g. a 1-cell run: σ is the other side's alone)")
     return Headline(m, m_se, kind, dem, dem_se, z, verdict)
 
 
