@@ -14,6 +14,10 @@ compared with our DEM in one of three ways, named by :data:`AlignmentStatus`:
 ``"out_of_range"``
     Outside the model's box, or no model can be built: no value, a message says why. The model is
     never extrapolated.
+``"no_dem_runs"``
+    No DEM run of ours at the case's material and direction at all (of the specimen compared):
+    nothing to interpolate, so "out of range" would mislead; a message says which runs the store
+    holds instead.
 
 The paper's DEM and experimental values are attached where the case is a Table 3 grid point
 within the same tolerances (the paper used acrylic particles driven along z); otherwise NaN.
@@ -34,7 +38,7 @@ from ..errors import ParameterError
 from .loadcase import LoadCase
 
 #: How a measured case was matched with our DEM.
-AlignmentStatus = Literal["grid", "interpolated", "out_of_range"]
+AlignmentStatus = Literal["grid", "interpolated", "out_of_range", "no_dem_runs"]
 ALIGNMENT_STATUSES: tuple[str, ...] = get_args(AlignmentStatus)
 
 #: Columns a table of measured cases must have (one row per analysed measurement).
@@ -618,9 +622,11 @@ class Aligner:
                                        + (f"; {duplicates_note(grid)}"
                                           if grid.duplicate_keys else ""))
         model = self.model if self.model is not None \
-            else self._models.get((case.material, case.direction),
-                                  f"no DEM runs of ours for {case.material}, direction "
-                                  f"{case.direction}")
+            else self._models.get((case.material, case.direction))
+        if model is None:  # nothing at this material and direction: not a range question
+            return AlignedCase(case, "no_dem_runs", **common,
+                               message=f"no DEM runs of ours for {case.material}, direction "
+                                       f"{case.direction}")
         if isinstance(model, str):
             return AlignedCase(case, "out_of_range", **common, message=model)
         point = (case.fill_percent, case.acceleration_g, case.frequency_hz)
