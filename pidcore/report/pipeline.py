@@ -551,7 +551,12 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         table = add_calibration_columns(table, calibrated, tolerances=tolerances,
                                         specimen=specimen, paper=specimen is None)
     notes.extend(table.attrs.get("notes", []))
-    aligner = Aligner(dem_cases(dem_runs, tolerances=tolerances, pool_settings=pool)
+    # the fills measured choose among duplicate runs as the table does (its loop overlays
+    # show the run the row counts)
+    fills = pd.to_numeric(analyses["fill_percent"], errors="coerce").tolist() \
+        if analyses is not None and "fill_percent" in analyses.columns else []
+    aligner = Aligner(dem_cases(dem_runs, tolerances=tolerances, pool_settings=pool,
+                                reference_fills=fills)
                       if dem_runs is not None else [],
                       paper, None, tolerances)
     loops = _measured_loops(results, analyses, main, notes)

@@ -208,8 +208,12 @@ def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | N
     """
     tolerances = tolerances or Tolerances()
     notes: list[str] = []
+    measured_rows = _measured_rows(analyses, notes)
+    # of stored runs that are one simulation, the one nearest the measured fill is counted
+    # and names the row (a 50.2 % duplicate beside 50 % runs must not label a 50 % row)
+    fills = [case.fill_percent for case, _ in measured_rows]
     aligner = Aligner.from_tables(dem_runs, paper, model=model, tolerances=tolerances,
-                                  pool_settings=pool)
+                                  pool_settings=pool, reference_fills=fills)
     rows: dict[str, list[_Row]] = {}
     for dem in aligner.cases:
         paper_dem, paper_exp, _ = match_paper(dem.load_case, paper, tolerances=tolerances)
@@ -218,7 +222,7 @@ def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | N
     # a measurement meets only the DEM runs of its specimen (pidcore.compare.specimens); one
     # aligner per (specimen, material, direction) over those runs
     aligners: dict[tuple[str, str, str], tuple[Aligner, str, bool]] = {}
-    for case, rec in _measured_rows(analyses, notes):
+    for case, rec in measured_rows:
         # a store's listing holds NaN where a record names no specimen and another does
         # (str(NaN) is "nan", a specimen of its own meeting no DEM run)
         named = rec.get("specimen", "")
@@ -231,7 +235,8 @@ def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | N
             if which not in aligners:
                 met = runs_for_measurement(dem_runs, *which)
                 aligners[which] = (Aligner.from_tables(met.runs, paper, model=model,
-                                                       tolerances=tolerances),
+                                                       tolerances=tolerances,
+                                                       reference_fills=fills),
                                    met.note if met.runs is None else "", met.refused)
             own, met_note, refused = aligners[which]
         aligned = own.align(case)
