@@ -110,3 +110,14 @@ def test_aligner_without_runs_of_the_material_says_no_dem_runs_not_out_of_range(
         "material": ["aluminium"], "direction": ["z"], "sdc": [1.0], "sdc_stderr": [0.1],
         "source": ["al.h5"]}), None)
     assert _measured(table, "al.h5")["note"] == "no DEM runs of ours for aluminium, direction z"
+
+
+def test_the_apps_report_tab_says_how_to_compare_the_other_runs_in_its_own_words(
+        steel, store_runs, analyses):
+    from pidcore.report.downloads import CHOOSE_SPECIMEN_APP
+
+    table = specimen_report_table(store_runs, analyses, specimen=steel,
+                                  choose_another=CHOOSE_SPECIMEN_APP).table
+    assert _measured(table, "acrylic.h5")["note"].endswith(
+        "another specimen's: choose theirs with the Report tab's specimen choice to compare "
+        "them)")

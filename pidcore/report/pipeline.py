@@ -358,7 +358,8 @@ def specimen_report_table(stored_runs: pd.DataFrame | None, analyses: pd.DataFra
         dem_runs, analyses, paper, tolerances=tolerances, pool=pool, store_runs=stored_runs,
         of_specimen=specimen.name if specimen is not None else PAPER_SPECIMEN_NAME,
         choose_another="" if choose_another == CHOOSE_SPECIMEN_CLI
-        else f"choose theirs ({choose_another}) to compare them")
+        else f"choose theirs with {choose_another.removesuffix(' for another')} to compare "
+             "them")
     if specimen is not None and not pool:
         # every DEM row is this specimen's (runs_of_specimen) and the files of its particle
         # material are its tests; a measurement of another material cannot be (its specimen
