@@ -176,6 +176,34 @@ def test_sweep_runs_the_values_given_in_place_of_the_grids(tmp_path, capsys):
                   for c in map(parse_key, runs["case_key"])) == [(500, 5, 25), (500, 5, 50)]
 
 
+def test_sweep_json_lists_cases_in_the_order_it_documents(tmp_path, capsys):
+    """Documented as "in the order asked", the cases came in Table 3's order (--fills 52,48
+    listed 48 first): the order is ascending, and the docs now say so and which of two fills
+    that round alike was simulated."""
+    from pathlib import Path
+
+    from pidcore.dem.sweep import SweepSummary
+
+    assert main(["dem", "sweep", "--frequencies", "1000,500", "--accelerations", "5",
+                 "--fills", "52,48", "--cells", "1", "--cycles", "2", "--workers", "1",
+                 "--store", str(tmp_path / "s.h5"), "--no-progress", "--json"]) == 0
+    cases = json.loads(capsys.readouterr().out)["cases"]
+    assert [(c["frequency_hz"], c["fill_percent"]) for c in cases] == [
+        (500.0, 48.0), (500.0, 52.0), (1000.0, 48.0), (1000.0, 52.0)]
+    # 48 % and 52 % of 22 acrylic particles both round to 11: the lower fill is simulated
+    assert [c["status"] for c in cases[:2]] == [
+        "simulated", "same simulation as another case of this sweep"]
+    assert cases[1]["store_key"] == cases[0]["store_key"]
+    assert cases[1]["stored_fill_percent"] == 48.0
+    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text(encoding="utf-8")
+    for text in (" ".join(readme.split()), " ".join(SweepSummary.__doc__.split())):
+        assert "in the order asked" not in text and "each ascending" in text
+        assert "the lower fill" in text or "the lower is simulated" in text
+    with pytest.raises(SystemExit):
+        main(["dem", "sweep", "--help"])
+    assert "whatever the order given" in " ".join(capsys.readouterr().out.split())
+
+
 @pytest.mark.parametrize("value", ["25,x", "25,-5", "nan", ""])
 def test_sweep_refuses_a_bad_value_list_in_one_line(tmp_path, capsys, value):
     assert main(["dem", "sweep", "--fills", value, "--store", str(tmp_path / "s.h5")]) == 2

@@ -84,6 +84,32 @@ def test_the_same_simulation_under_two_keys_is_counted_once():
     assert dem_cases(runs)[0].n_runs == 2
 
 
+def test_of_one_simulation_the_run_nearest_the_measured_fill_is_kept_and_names_the_row():
+    """The trial: runs at 50 % (seed 12345), 50.2 % (seed 12345, the same simulation) and
+    50 % (seed 7), listed 50.2 % first (its key sorts first): the 50 % run was dropped and
+    the row said packing ratio 50.2 %, load case ...fill50.2pct, as did Compare's message."""
+    runs = _runs(("b", 50.2, 12345, 11), ("a", 50.0, 12345, 11), ("c", 50.0, 7, 11))
+    measured = pd.DataFrame({"frequency_hz": [1000.0], "acceleration_g": [5.0],
+                             "fill_percent": [50.0], "sdc": [1.5], "sdc_stderr": [0.02],
+                             "source": ["m.csv"]})
+    table = build_report_table(runs, measured, None)
+    assert (table["packing ratio [%]"].tolist(), table["load case"].tolist()) == (
+        [50.0], ["f1000Hz_a5g_fill50pct_acrylic_z"])
+    assert table["DEM runs [-]"].tolist() == [2] and "fill 50.2 %" in table["note"].iloc[0]
+    aligned = Aligner.from_tables(runs, reference_fills=[50.0]).align(
+        LoadCase(1000.0, 5.0, 50.0))
+    assert aligned.grid_case.run_keys == ("a", "c") and aligned.grid_case.duplicate_keys == ("b",)
+    assert aligned.message.startswith("DEM grid case f1000Hz_a5g_fill50pct_acrylic_z (2 run(s)")
+    # with nothing measured the fill most runs state wins (two of three say 50 %)
+    (case,) = dem_cases(runs)
+    assert (case.load_case.fill_percent, case.run_keys) == (50.0, ("a", "c"))
+    # a measurement at 50.2 % keeps the 50.2 % run of the pair; the case is named by the fill
+    # its kept runs state most, of a tie the one nearest the measurement
+    pair = _runs(("a", 50.0, 12345, 11), ("b", 50.2, 12345, 11))
+    (case,) = dem_cases(pair, reference_fills=[50.2])
+    assert (case.load_case.fill_percent, case.run_keys) == (50.2, ("b",))
+    (case,) = dem_cases(runs, reference_fills=[50.2])
+    assert case.run_keys == ("b", "c") and case.load_case.fill_percent == 50.2
 
 
 @pytest.fixture(scope="module")

@@ -259,12 +259,17 @@ def test_to_dict_is_json_safe_and_has_cli_keys():
                                    snr_db=40)
     res = analyze_power(rec.force_n, rec.velocity_m_s, fs, source="run1.uff")
     d = json.loads(json.dumps(res.to_dict(), allow_nan=False))
-    for key in ("source", "frequency_hz", "acceleration_g", "complex_power", "loss_factor", "sdc",
-                "sdc_stderr", "damping_ratio", "energy_per_cycle_j"):
+    for key in ("source", "frequency_hz", "acceleration_g", "complex_power_real_w",
+                "complex_power_imag_w", "loss_factor", "sdc", "sdc_stderr", "damping_ratio",
+                "energy_per_cycle_j"):
         assert key in d
     assert d["source"] == "run1.uff"
-    assert d["complex_power"]["real"] == pytest.approx(res.complex_power_w.real)
-    assert d["complex_power"]["imag"] == pytest.approx(res.complex_power_w.imag)
+    # exact: the same float, copied
+    assert d["complex_power_real_w"] == res.complex_power_w.real
+    assert d["complex_power_imag_w"] == res.complex_power_w.imag
+    # every key names its unit: no unit-less {"real", "imag"} duplicate of P_c
+    assert "complex_power" not in d and not any(isinstance(v, dict) and "real" in v
+                                                for v in d.values())
 
 
 def test_plot_draws_harmonic_amplitudes():

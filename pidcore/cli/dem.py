@@ -130,7 +130,8 @@ def _register_sweep(sub: argparse._SubParsersAction) -> None:
                        ("--fills", "fills (packing ratios), %%")):
         p.add_argument(flag, metavar="X,X", default=None,
                        help=f"{what}, comma-separated, in place of the grid's (every "
-                            "combination is run)")
+                            "combination is run, each value once, in Table 3's order: "
+                            "ascending, whatever the order given)")
     _add_config_options(p)
     p.add_argument("--workers", metavar="N", type=positive_int, default=None,
                    help="local processes (default: all cores)")

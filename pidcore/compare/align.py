@@ -14,6 +14,10 @@ compared with our DEM in one of three ways, named by :data:`AlignmentStatus`:
 ``"out_of_range"``
     Outside the model's box, or no model can be built: no value, a message says why. The model is
     never extrapolated.
+``"no_dem_runs"``
+    No DEM run of ours at the case's material and direction at all (of the specimen compared):
+    nothing to interpolate, so "out of range" would mislead; a message says which runs the store
+    holds instead.
 
 The paper's DEM and experimental values are attached where the case is a Table 3 grid point
 within the same tolerances (the paper used acrylic particles driven along z); otherwise NaN.
@@ -23,7 +27,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Literal, get_args
 
 import numpy as np
@@ -34,7 +38,7 @@ from ..errors import ParameterError
 from .loadcase import LoadCase
 
 #: How a measured case was matched with our DEM.
-AlignmentStatus = Literal["grid", "interpolated", "out_of_range"]
+AlignmentStatus = Literal["grid", "interpolated", "out_of_range", "no_dem_runs"]
 ALIGNMENT_STATUSES: tuple[str, ...] = get_args(AlignmentStatus)
 
 #: Columns a table of measured cases must have (one row per analysed measurement).
@@ -384,7 +388,8 @@ def _settings_of(row: pd.Series) -> tuple[str, float]:
 
 
 def dem_cases(dem_runs: pd.DataFrame, *, tolerances: Tolerances | None = None,
-              pool_settings: bool = False) -> list[DemCase]:
+              pool_settings: bool = False,
+              reference_fills: Iterable[float] = ()) -> list[DemCase]:
     """Group DEM runs into load cases (runs within the tolerances pool into one case).
 
     Runs of different numerical settings (a 2-cell smoke run beside a 32-cell run) are separate
@@ -397,6 +402,13 @@ def dem_cases(dem_runs: pd.DataFrame, *, tolerances: Tolerances | None = None,
         ``particles_per_cell``); one row per
         run, as :meth:`pidcore.store.Store.list_dem_runs` returns. Runs with a non-finite SDC are
         skipped (an interrupted run has no result).
+    reference_fills : iterable of float
+        Fills, %, the cases are wanted at (the measured or asked ones). Of stored runs that are
+        the same simulation (:func:`simulation_identity`) the one whose stored fill is nearest
+        the case's reference is counted: the fill a reference within the fill tolerance states,
+        else the fill most runs of the case state. The case is labelled by the fill most of
+        its counted runs state (ties: the one nearest the reference), so a duplicate stored
+        under a near fill (50.2 % beside 50 %) never names the case.
 
     Returns
     -------
@@ -420,9 +432,15 @@ def dem_cases(dem_runs: pd.DataFrame, *, tolerances: Tolerances | None = None,
                 break
         else:
             groups.append((case, settings, [pos]))
+    wanted = [float(f) for f in reference_fills if math.isfinite(float(f))]
     out = []
     for case, settings, members in groups:
-        members, duplicates = _distinct(runs, members)
+        fills = runs["fill_percent"].astype(float).to_numpy()
+        reference = _reference_fill(fills[members], wanted, tolerances)
+        members, duplicates = _distinct(runs, members, reference)
+        label = _label_fill(fills[members], reference)
+        if label != case.fill_percent:
+            case = replace(case, fill_percent=label)
         sub = runs.iloc[members]
         dup = runs.iloc[duplicates]
         sdc, stderr = pooled_mean(sub["sdc"].to_numpy(float), sub["sdc_stderr"].to_numpy(float))
@@ -444,23 +462,63 @@ def dem_cases(dem_runs: pd.DataFrame, *, tolerances: Tolerances | None = None,
     return sorted(out, key=lambda c: (*_sort_key(c.load_case), c.settings))
 
 
-def _distinct(runs: pd.DataFrame, members: list[int]) -> tuple[list[int], list[int]]:
-    """(members counted, members left out) of one case: a run that is the same simulation as
-    an earlier member (:func:`simulation_identity`) is left out; a run without recorded
-    inputs is always counted (nothing shows it repeats another)."""
+def _most_common(fills: np.ndarray) -> list[float]:
+    """The fills stated by the most runs, in order of first appearance."""
+    values, counts = [], []
+    for f in fills:
+        if f in values:
+            counts[values.index(f)] += 1
+        else:
+            values.append(float(f))
+            counts.append(1)
+    return [v for v, n in zip(values, counts, strict=True) if n == max(counts)]
+
+
+def _reference_fill(fills: np.ndarray, wanted: list[float], tolerances: Tolerances) -> float:
+    """The fill a case's runs are wanted at: the wanted fill within the fill tolerance of its
+    runs' (nearest their median), else the fill most of its runs state (the first of a tie)."""
+    median = float(np.median(fills))
+    near = [f for f in wanted if np.any(np.abs(fills - f) <= tolerances.fill_atol_percent)]
+    if near:
+        return min(near, key=lambda f: abs(f - median))
+    return _most_common(fills)[0]
+
+
+def _label_fill(fills: np.ndarray, reference: float) -> float:
+    """The fill a case is labelled by: the one most of its counted runs state, of a tie the
+    one nearest ``reference`` (then the first)."""
+    common = _most_common(fills)
+    return min(common, key=lambda f: abs(f - reference))
+
+
+def _distinct(runs: pd.DataFrame, members: list[int],
+              reference: float = math.nan) -> tuple[list[int], list[int]]:
+    """(members counted, members left out) of one case: of runs that are the same simulation
+    (:func:`simulation_identity`) the one whose stored fill is nearest ``reference`` is
+    counted (of a tie, or without a reference, the first stored); a run without recorded
+    inputs is always counted (nothing shows it repeats another). Both lists keep the order of
+    ``members``."""
     if "parameters_json" not in runs.columns or "particles_per_cell" not in runs.columns:
         return members, []
-    seen: set[str] = set()
-    kept, left_out = [], []
+    chosen: dict[str, int] = {}  # identity -> the member counted
+    identities: list[str | None] = []
     for pos in members:
         row = runs.iloc[pos]
         identity = simulation_identity(row["parameters_json"], row["particles_per_cell"])
-        if identity is not None and identity in seen:
-            left_out.append(pos)
+        identities.append(identity)
+        if identity is None:
             continue
-        if identity is not None:
-            seen.add(identity)
-        kept.append(pos)
+        if identity not in chosen:
+            chosen[identity] = pos
+        elif math.isfinite(reference):
+            # the stored fill nearest the one asked or measured: its label is the row's
+            distance = abs(float(row["fill_percent"]) - reference)
+            best = abs(float(runs.iloc[chosen[identity]]["fill_percent"]) - reference)
+            if distance < best:
+                chosen[identity] = pos
+    kept, left_out = [], []
+    for pos, identity in zip(members, identities, strict=True):
+        (kept if identity is None or chosen[identity] == pos else left_out).append(pos)
     return kept, left_out
 
 
@@ -584,11 +642,14 @@ class Aligner:
     def from_tables(cls, dem_runs: pd.DataFrame | None, paper: pd.DataFrame | None = None, *,
                     model: object | None = None,
                     tolerances: Tolerances | None = None,
-                    pool_settings: bool = False) -> Aligner:
-        """Aligner over a table of DEM runs (see :func:`dem_cases`)."""
+                    pool_settings: bool = False,
+                    reference_fills: Iterable[float] = ()) -> Aligner:
+        """Aligner over a table of DEM runs (see :func:`dem_cases`; ``reference_fills``: the
+        measured fills, which choose among runs that are the same simulation)."""
         tolerances = tolerances or Tolerances()
         cases = dem_cases(dem_runs if dem_runs is not None else pd.DataFrame(),
-                          tolerances=tolerances, pool_settings=pool_settings)
+                          tolerances=tolerances, pool_settings=pool_settings,
+                          reference_fills=reference_fills)
         return cls(cases, paper, model, tolerances)
 
     def grid_case(self, case: LoadCase) -> DemCase | None:
@@ -618,9 +679,11 @@ class Aligner:
                                        + (f"; {duplicates_note(grid)}"
                                           if grid.duplicate_keys else ""))
         model = self.model if self.model is not None \
-            else self._models.get((case.material, case.direction),
-                                  f"no DEM runs of ours for {case.material}, direction "
-                                  f"{case.direction}")
+            else self._models.get((case.material, case.direction))
+        if model is None:  # nothing at this material and direction: not a range question
+            return AlignedCase(case, "no_dem_runs", **common,
+                               message=f"no DEM runs of ours for {case.material}, direction "
+                                       f"{case.direction}")
         if isinstance(model, str):
             return AlignedCase(case, "out_of_range", **common, message=model)
         point = (case.fill_percent, case.acceleration_g, case.frequency_hz)

@@ -384,7 +384,9 @@ def compare_case(records: Sequence[MeasuredEntry],
     chi2, dof = consistency_chi2(values, errors)
     tol = Tolerances()
     runs = dem_runs if dem_runs is not None and not dem_runs.empty else None
-    aligner = Aligner.from_tables(runs, paper, tolerances=tol)
+    # the measured fill chooses among stored runs that are one simulation (and names the case)
+    aligner = Aligner.from_tables(runs, paper, tolerances=tol,
+                                  reference_fills=[case.fill_percent])
     aligned = aligner.align(case)
     notes: list[str] = []
 

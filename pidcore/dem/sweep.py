@@ -151,9 +151,17 @@ SWEEP_CASE_FIELDS = ("sdc", "sdc_stderr", "loss_factor", "particles_per_cell",
 @dataclass
 class SweepSummary:
     """What a sweep did: keys run now, keys skipped as already stored, wall time, and per case
-    (in the order asked) its run's key, how it was got and its stored results.
+    its run's key, how it was got and its stored results.
 
-    ``cases``: one dict per case asked: ``frequency_hz``, ``acceleration_g``,
+    ``cases``: one dict per case, in the order of the ``cases`` given to :func:`run_sweep`;
+    ``pidcore dem sweep`` and the app build them with :func:`cross_cases`, so that order is
+    Table 3's (frequency, then acceleration, then fill, each ascending and each value once),
+    not the order the values were typed in. Of two fills that round to one particle count
+    (neither stored yet) the first in that order (the lower fill) is simulated (status
+    ``simulated``); the other says ``same simulation as another case of this sweep`` and
+    names the simulated case's ``store_key``, its ``stored_fill_percent`` that case's fill.
+    Each dict holds
+    ``frequency_hz``, ``acceleration_g``,
     ``fill_percent`` (as asked), ``material``, ``direction``, ``store_key``, ``status`` (one of
     :data:`SWEEP_CASE_STATUSES`) and, once the run is stored, ``stored_fill_percent`` (the
     fill its run is stored with: another where the same simulation was found under another

@@ -336,9 +336,12 @@ def specimen_report_table(stored_runs: pd.DataFrame | None, analyses: pd.DataFra
     analyses, as ``pidcore report`` and the app's Report tab show it.
 
     The paper's Table 3 is compared only for the paper's coupon. With a ``specimen`` (and not
-    ``pool``) the ``specimen`` column names it on every row that does not name its own (its
-    DEM runs', and the files given as its tests); the default (the paper's coupon) leaves the
-    column empty, as the bundled report always had it.
+    ``pool``) the ``specimen`` column names it on every row of its particle material that
+    does not name its own (its DEM runs', and the files given as its tests); a measurement of
+    another material names none (it is not this specimen's test). A measured row with no DEM
+    run of its specimen at its material and direction says so (alignment ``no_dem_runs``) and
+    names the runs of other specimens the store holds there. The default (the paper's coupon)
+    leaves the column empty, as the bundled report always had it.
     """
     from ..model import load_paper_table3
 
@@ -349,11 +352,21 @@ def specimen_report_table(stored_runs: pd.DataFrame | None, analyses: pd.DataFra
         paper = None
         notes.append(f"specimen {specimen.name} is not the paper's coupon: the paper's "
                      "Table 3 is not compared")
-    table = build_report_table(dem_runs, analyses, paper, tolerances=tolerances, pool=pool)
+    from ..specimen import PAPER_SPECIMEN_NAME
+
+    table = build_report_table(
+        dem_runs, analyses, paper, tolerances=tolerances, pool=pool, store_runs=stored_runs,
+        of_specimen=specimen.name if specimen is not None else PAPER_SPECIMEN_NAME,
+        choose_another="" if choose_another == CHOOSE_SPECIMEN_CLI
+        else f"choose theirs with {choose_another.removesuffix(' for another')} to compare "
+             "them")
     if specimen is not None and not pool:
-        # every DEM row is this specimen's (runs_of_specimen) and the files are its tests; a
-        # measurement stored with a specimen of its own (the app's uploads) keeps that one
-        table["specimen"] = table["specimen"].mask(table["specimen"] == "", specimen.name)
+        # every DEM row is this specimen's (runs_of_specimen) and the files of its particle
+        # material are its tests; a measurement of another material cannot be (its specimen
+        # is unknown: left empty), and one stored with a specimen of its own (the app's
+        # uploads, a sidecar's) keeps that one
+        mine = (table["specimen"] == "") & (table["material"] == specimen.particles.material)
+        table.loc[mine, "specimen"] = specimen.name
     table.attrs["notes"] = notes + list(table.attrs.get("notes", []))
     return SpecimenTable(table, dem_runs, paper)
 
@@ -539,7 +552,12 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         table = add_calibration_columns(table, calibrated, tolerances=tolerances,
                                         specimen=specimen, paper=specimen is None)
     notes.extend(table.attrs.get("notes", []))
-    aligner = Aligner(dem_cases(dem_runs, tolerances=tolerances, pool_settings=pool)
+    # the fills measured choose among duplicate runs as the table does (its loop overlays
+    # show the run the row counts)
+    fills = pd.to_numeric(analyses["fill_percent"], errors="coerce").tolist() \
+        if analyses is not None and "fill_percent" in analyses.columns else []
+    aligner = Aligner(dem_cases(dem_runs, tolerances=tolerances, pool_settings=pool,
+                                reference_fills=fills)
                       if dem_runs is not None else [],
                       paper, None, tolerances)
     loops = _measured_loops(results, analyses, main, notes)

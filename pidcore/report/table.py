@@ -17,7 +17,7 @@ case's E = m_c a^2 / (2 w^2) (Eq. 10), as our DEM SDC is defined, minus our DEM 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import NamedTuple
 
 import numpy as np
@@ -49,6 +49,9 @@ DIFFERENCE_COLUMN = "difference measured (E of Eq. 10) - ours [-]"
 #: within their errors; NaN for a single measurement).
 CONSISTENCY_COLUMN = "measured chi2/dof [-]"
 #: Column holding the alignment status.
+#: Its values are :data:`pidcore.compare.ALIGNMENT_STATUSES`; ``no_dem_runs`` (no DEM run of the
+#: row's specimen at its material and direction) is not in the header: the header is kept as
+#: reports written before it had it (a status is not a unit), and the row's note explains it.
 ALIGNMENT_COLUMN = "alignment [grid/interpolated/out_of_range]"
 #: Columns of :func:`build_report_table`, in order.
 REPORT_COLUMNS: tuple[str, ...] = (
@@ -118,10 +121,42 @@ def _measured_rows(analyses: pd.DataFrame | None, notes: list[str]) -> list[tupl
     return out
 
 
+def no_runs_note(of: str, material: str, direction: str, store_runs: pd.DataFrame | None,
+                 choose_another: str = "", *, named: bool = False) -> str:
+    """Why a measured row has no DEM value: no run of its specimen ``of`` at its material and
+    direction, and the runs of other specimens the store holds there (which are another
+    specimen's, so not compared), e.g. "no DEM runs of steel_6mm for acrylic, direction z
+    (the store has 48 of paper_coupon, another specimen's: report without --specimen to
+    compare them)". ``choose_another``: how the reader compares them (default: the CLI's
+    words); ``named``: the measurement names ``of`` itself (its record's specimen), so no
+    choice of the report's specimen compares it with the others' runs."""
+    from ..compare.specimens import run_specimen_labels
+    from ..specimen import PAPER_SPECIMEN_NAME
+
+    note = f"no DEM runs of {of or 'ours'} for {material}, direction {direction}"
+    if store_runs is None or store_runs.empty or not {"material", "direction"} <= set(
+            store_runs.columns):
+        return note
+    there = store_runs[(store_runs["material"] == material)
+                       & (store_runs["direction"] == direction)]
+    if there.empty:
+        return note
+    counts = run_specimen_labels(there).value_counts(sort=False)
+    if named:
+        choose_another = f"not compared with a test of {of}"
+    elif not choose_another:
+        choose_another = ("report without --specimen to compare them"
+                          if set(counts.index) == {PAPER_SPECIMEN_NAME}
+                          else "report with their --specimen FILE to compare them")
+    listed = ", ".join(f"{n} of {label}" for label, n in counts.items())
+    return f"{note} (the store has {listed}, another specimen's: {choose_another})"
+
+
 def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | None,
                        paper: pd.DataFrame | None, *, model: object | None = None,
                        tolerances: Tolerances | None = None,
-                       pool: bool = False) -> pd.DataFrame:
+                       pool: bool = False, store_runs: pd.DataFrame | None = None,
+                       of_specimen: str = "", choose_another: str = "") -> pd.DataFrame:
     """Table 3-style comparison of our DEM, our measurements and the paper.
 
     Parameters
@@ -144,6 +179,15 @@ def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | N
     pool : bool
         Pool DEM runs of different numerical settings and measurements of different specimens
         at one load case (default: separate rows).
+    store_runs : pandas.DataFrame, optional
+        Every DEM run of the store, ``dem_runs`` being one specimen's of them: a measured row
+        with no run of its specimen at its material and direction (alignment ``no_dem_runs``)
+        names the other specimens' runs there (:func:`no_runs_note`). Default: ``dem_runs``.
+    of_specimen : str
+        The specimen ``dem_runs`` are of, named in those notes for a measurement that names
+        none (default: "ours").
+    choose_another : str
+        How those notes say the other specimens' runs are compared (default: the CLI's words).
 
     Returns
     -------
@@ -164,8 +208,12 @@ def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | N
     """
     tolerances = tolerances or Tolerances()
     notes: list[str] = []
+    measured_rows = _measured_rows(analyses, notes)
+    # of stored runs that are one simulation, the one nearest the measured fill is counted
+    # and names the row (a 50.2 % duplicate beside 50 % runs must not label a 50 % row)
+    fills = [case.fill_percent for case, _ in measured_rows]
     aligner = Aligner.from_tables(dem_runs, paper, model=model, tolerances=tolerances,
-                                  pool_settings=pool)
+                                  pool_settings=pool, reference_fills=fills)
     rows: dict[str, list[_Row]] = {}
     for dem in aligner.cases:
         paper_dem, paper_exp, _ = match_paper(dem.load_case, paper, tolerances=tolerances)
@@ -173,13 +221,13 @@ def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | N
             _Row(dem.load_case, "grid", dem, dem.sdc, dem.sdc_stderr, paper_dem, paper_exp))
     # a measurement meets only the DEM runs of its specimen (pidcore.compare.specimens); one
     # aligner per (specimen, material, direction) over those runs
-    aligners: dict[tuple[str, str, str], tuple[Aligner, str]] = {}
-    for case, rec in _measured_rows(analyses, notes):
+    aligners: dict[tuple[str, str, str], tuple[Aligner, str, bool]] = {}
+    for case, rec in measured_rows:
         # a store's listing holds NaN where a record names no specimen and another does
         # (str(NaN) is "nan", a specimen of its own meeting no DEM run)
         named = rec.get("specimen", "")
         specimen = "" if pool or not isinstance(named, str) else named
-        met_note = ""
+        met_note, refused = "", False
         if pool or dem_runs is None or dem_runs.empty:
             own = aligner
         else:
@@ -187,10 +235,20 @@ def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | N
             if which not in aligners:
                 met = runs_for_measurement(dem_runs, *which)
                 aligners[which] = (Aligner.from_tables(met.runs, paper, model=model,
-                                                       tolerances=tolerances),
-                                   met.note if met.runs is None else "")
-            own, met_note = aligners[which]
+                                                       tolerances=tolerances,
+                                                       reference_fills=fills),
+                                   met.note if met.runs is None else "", met.refused)
+            own, met_note, refused = aligners[which]
         aligned = own.align(case)
+        if aligned.status == "no_dem_runs" and not refused:
+            # name whose runs are missing and whose the store holds there instead: another
+            # specimen's, never compared with this measurement ("of ours" alone misled when a
+            # row of those runs stood just above)
+            aligned = replace(aligned, message=no_runs_note(
+                specimen or of_specimen, case.material, case.direction,
+                dem_runs if store_runs is None else store_runs, choose_another,
+                named=bool(specimen)))
+            met_note = ""
         entry = _Measured(float(rec["sdc"]), float(rec["sdc_stderr"]), case.frequency_hz,
                           case.acceleration_g, str(rec.get("source", "")),
                           float(rec.get("energy_per_cycle_j", math.nan)), specimen)

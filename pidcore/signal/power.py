@@ -190,7 +190,8 @@ class PowerAnalysis:
         return frame
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON-safe scalars (NaN -> None); includes the CLI keys."""
+        """JSON-safe scalars (NaN -> None); includes the CLI keys, each naming its unit
+        (``complex_power_real_w``, ``complex_power_imag_w``: Re and Im of P_c, Eq. 11)."""
 
         def num(v: float | None) -> float | None:
             return None if v is None or not math.isfinite(v) else float(v)
@@ -200,7 +201,9 @@ class PowerAnalysis:
             "source": self.source,
             "frequency_hz": num(self.frequency_hz),
             "acceleration_g": num(self.acceleration_g),
-            "complex_power": {"real": num(p.real), "imag": num(p.imag)},
+            # P_c once, each part's unit in its key (a {"real", "imag"} pair named none)
+            "complex_power_real_w": num(p.real),
+            "complex_power_imag_w": num(p.imag),
             "loss_factor": num(self.loss_factor),
             "sdc": num(self.sdc),
             "sdc_stderr": num(self.sdc_stderr),
@@ -209,8 +212,6 @@ class PowerAnalysis:
             "omega_rad_s": num(self.omega_rad_s),
             "n_periods": num(self.n_periods),
             "sample_rate_hz": num(self.sample_rate_hz),
-            "complex_power_real_w": num(p.real),
-            "complex_power_imag_w": num(p.imag),
             "loss_factor_stderr": num(self.loss_factor_stderr),
             "loss_factor_raw": num(self.loss_factor_raw),
             "damping_ratio_note": self.damping_ratio_note,

@@ -1,0 +1,123 @@
+"""Measured rows of a report of one specimen (``pidcore report --specimen``): whose specimen a
+row is, and what a row with no DEM run of its specimen says (user trial defect 10)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+from pidcore.compare.align import Aligner
+from pidcore.compare.loadcase import LoadCase
+from pidcore.report.pipeline import specimen_report_table
+from pidcore.report.table import ALIGNMENT_COLUMN, build_report_table
+from pidcore.specimen import load_specimen, paper_specimen
+
+STEEL = Path(__file__).resolve().parents[1] / "data_samples" / "specimens" / "steel_6mm.toml"
+
+
+def _run(key: str, material: str, sdc: float, specimen) -> dict:
+    return {"case_key": key, "frequency_hz": 1000.0, "acceleration_g": 5.0,
+            "fill_percent": 50.0, "material": material, "direction": "z", "sdc": sdc,
+            "sdc_stderr": 0.01, "specimen_name": specimen.name,
+            "specimen_sha256": specimen.hash}
+
+
+@pytest.fixture(scope="module")
+def steel():
+    return load_specimen(STEEL)
+
+
+@pytest.fixture(scope="module")
+def store_runs(steel) -> pd.DataFrame:
+    """Two acrylic z runs of the paper's coupon and one steel z run of steel_6mm."""
+    paper = paper_specimen("acrylic")
+    return pd.DataFrame([_run("p1", "acrylic", 0.50, paper),
+                         {**_run("p2", "acrylic", 0.40, paper), "frequency_hz": 500.0},
+                         _run("s1", "steel", 1.75, steel)])
+
+
+@pytest.fixture(scope="module")
+def analyses() -> pd.DataFrame:
+    """An acrylic measurement naming no specimen and a steel one of another specimen."""
+    return pd.DataFrame({
+        "frequency_hz": [1000.0, 1000.0], "acceleration_g": [5.0, 5.0],
+        "fill_percent": [50.0, 50.0], "material": ["acrylic", "steel"],
+        "direction": ["z", "z"], "sdc": [3.5, 3.6], "sdc_stderr": [0.05, 0.05],
+        "source": ["acrylic.h5", "other.h5"], "specimen": ["", "other_coupon"]})
+
+
+def _measured(table: pd.DataFrame, source: str) -> pd.Series:
+    return table[table["source file(s)"] == source].iloc[0]
+
+
+def test_rows_without_runs_of_their_specimen_name_it_and_the_other_specimens_runs(
+        steel, store_runs, analyses):
+    """Was: status out_of_range, note "no DEM runs of ours for acrylic, direction z" though
+    the store holds the paper coupon's acrylic runs; the other_coupon row said "no DEM runs
+    of ours for steel" beside a steel row (steel_6mm's)."""
+    table = specimen_report_table(store_runs, analyses, specimen=steel).table
+    acrylic = _measured(table, "acrylic.h5")
+    assert acrylic[ALIGNMENT_COLUMN] == "no_dem_runs"
+    assert acrylic["note"] == ("no DEM runs of steel_6mm for acrylic, direction z (the store "
+                               "has 2 of paper_coupon, another specimen's: report without "
+                               "--specimen to compare them)")
+    other = _measured(table, "other.h5")
+    assert other[ALIGNMENT_COLUMN] == "no_dem_runs"
+    assert other["note"] == (f"no DEM runs of other_coupon for steel, direction z (the store "
+                             f"has 1 of steel_6mm [{steel.hash[:6]}], another specimen's: not "
+                             f"compared with a test of other_coupon)")
+    assert "of ours" not in " ".join(table["note"])
+
+
+def test_a_measured_row_names_its_own_specimen_not_the_reports(steel, store_runs, analyses):
+    """Was: the acrylic measurement's row had specimen steel_6mm (the --specimen's label on a
+    row of another material)."""
+    table = specimen_report_table(store_runs, analyses, specimen=steel).table
+    assert _measured(table, "acrylic.h5")["specimen"] == ""  # unknown: not steel_6mm's test
+    assert _measured(table, "other.h5")["specimen"] == "other_coupon"
+    dem_row = table[table["source file(s)"] == ""].iloc[0]
+    assert (dem_row["material"], dem_row["specimen"]) == ("steel", "steel_6mm")
+    # a measurement of the specimen's own material is its test and keeps its label
+    steel_test = analyses.assign(specimen=["", ""], source=["acrylic.h5", "steel.h5"])
+    table = specimen_report_table(store_runs, steel_test, specimen=steel).table
+    row = _measured(table, "steel.h5")
+    assert (row["specimen"], row[ALIGNMENT_COLUMN]) == ("steel_6mm", "grid")
+
+
+def test_default_report_names_other_specimens_runs_and_how_to_compare_them(
+        store_runs, analyses):
+    """Without --specimen a steel measurement of no named specimen meets no paper run; the
+    note names the steel_6mm run and the --specimen that compares it."""
+    steel_only = analyses.assign(specimen=["", ""])
+    table = specimen_report_table(store_runs, steel_only).table
+    row = _measured(table, "other.h5")
+    assert row[ALIGNMENT_COLUMN] == "no_dem_runs"
+    assert row["note"].startswith("no DEM runs of paper_coupon for steel, direction z (the "
+                                  "store has 1 of steel_6mm [")
+    assert row["note"].endswith("report with their --specimen FILE to compare them)")
+    assert _measured(table, "acrylic.h5")[ALIGNMENT_COLUMN] == "grid"
+
+
+def test_aligner_without_runs_of_the_material_says_no_dem_runs_not_out_of_range(store_runs):
+    aligner = Aligner.from_tables(store_runs)
+    out = aligner.align(LoadCase(1000.0, 5.0, 50.0, material="aluminium"))
+    assert out.status == "no_dem_runs" and "no DEM runs" in out.message
+    # a table built without a store listing names "ours" as before
+    table = build_report_table(store_runs.iloc[:1], pd.DataFrame({
+        "frequency_hz": [1000.0], "acceleration_g": [5.0], "fill_percent": [50.0],
+        "material": ["aluminium"], "direction": ["z"], "sdc": [1.0], "sdc_stderr": [0.1],
+        "source": ["al.h5"]}), None)
+    assert _measured(table, "al.h5")["note"] == "no DEM runs of ours for aluminium, direction z"
+
+
+def test_the_apps_report_tab_says_how_to_compare_the_other_runs_in_its_own_words(
+        steel, store_runs, analyses):
+    from pidcore.report.downloads import CHOOSE_SPECIMEN_APP
+
+    table = specimen_report_table(store_runs, analyses, specimen=steel,
+                                  choose_another=CHOOSE_SPECIMEN_APP).table
+    assert _measured(table, "acrylic.h5")["note"].endswith(
+        "another specimen's: choose theirs with the Report tab's specimen choice to compare "
+        "them)")
