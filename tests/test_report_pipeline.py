@@ -14,6 +14,7 @@ from pidcore.errors import StoreError
 from pidcore.io import write_measurement
 from pidcore.records import Channel, Measurement
 from pidcore.report import make_report, sha256_file
+from pidcore.report.table import ALIGNMENT_COLUMN
 from pidcore.signal import synthesize_shaker_record
 from pidcore.store import Store
 
@@ -92,7 +93,7 @@ def test_report_end_to_end(e2e, dem_store):
     row = result.table[result.table["source file(s)"] != ""].iloc[0]
     assert row["SDC measured [-]"] == stored["sdc"] == result.measured[0].analysis.sdc
     assert row["SDC measured stderr [-]"] == stored["sdc_stderr"]
-    assert row["alignment [grid/interpolated/out_of_range]"] == "grid"
+    assert row[ALIGNMENT_COLUMN] == "grid"
     dem_rec = Store(dem_store).get_dem_run("f500_a5_fill50_seed11").record
     assert row["SDC DEM (ours) [-]"] == dem_rec["sdc"]
     assert row["SDC DEM (paper) [-]"] == 0.5417  # Table 3, 500 Hz, 5 g, 50 %

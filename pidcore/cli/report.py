@@ -9,6 +9,7 @@ import argparse
 from pathlib import Path
 
 from ..report.render import format_cell
+from ..report.table import ALIGNMENT_COLUMN
 from ._options import (
     add_load_case_options,
     add_measurement_options,
@@ -25,7 +26,7 @@ _STDOUT_COLUMNS = (
     "SDC measured, E of Eq. 10 [-]", "SDC measured [-]", "SDC calibrated DEM (Eq. 11) [-]",
     "calibrated low 95 % [-]",
     "calibrated high 95 % [-]", "SDC DEM (paper) [-]", "SDC measured (paper) [-]",
-    "alignment [grid/interpolated/out_of_range]",
+    ALIGNMENT_COLUMN,
 )
 
 
@@ -90,7 +91,7 @@ def run(args: argparse.Namespace) -> int:
 def short_table(table) -> str:
     """A fixed-width text table of the main columns."""
     cols = [c for c in _STDOUT_COLUMNS if c in table.columns]
-    short = {"alignment [grid/interpolated/out_of_range]": "alignment",
+    short = {ALIGNMENT_COLUMN: "alignment",
              "SDC measured, E of Eq. 10 [-]": "SDC measured (Eq. 10) [-]",
              "SDC measured [-]": "SDC measured (Eq. 11) [-]"}
     heads = [short.get(c, c) for c in cols]

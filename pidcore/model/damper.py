@@ -35,7 +35,7 @@ from ..errors import ParameterError
 from .sdc_model import SdcModel
 
 #: The flag of :func:`equivalent_damper_table` marking points at a filled hole of the model grid.
-#: Like the report's category columns (``alignment [grid/interpolated/out_of_range]``) its
+#: Like the report's category columns (``alignment [grid/interpolated/...]``) its
 #: brackets list the values it takes, as pandas writes and reads them back (bool).
 SDC_FILLED_COLUMN = "sdc_filled [True/False]"
 #: Output columns of :func:`equivalent_damper_table` and their units, each named in the

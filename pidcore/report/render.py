@@ -29,6 +29,7 @@ from .. import defaults
 from ..constants import REPORT_FORMATS
 from ..errors import ParameterError
 from .provenance import Provenance
+from .table import ALIGNMENT_COLUMN
 
 #: File written into every report folder; only folders holding it are ever replaced.
 REPORT_MARKER = ".pidcore-report"
@@ -38,7 +39,7 @@ REPORT_STEM = "report"
 PDF_COLUMNS: tuple[str, ...] = (
     "frequency [Hz]", "acceleration [g]", "packing ratio [%]", "SDC DEM (ours) [-]",
     "SDC DEM stderr [-]", "SDC measured [-]", "SDC measured stderr [-]", "SDC DEM (paper) [-]",
-    "SDC measured (paper) [-]", "alignment [grid/interpolated/out_of_range]",
+    "SDC measured (paper) [-]", ALIGNMENT_COLUMN,
 )
 _TITLE = "Specific damping capacity: our DEM, our measurements and the paper (Table 3)"
 

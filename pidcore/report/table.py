@@ -25,6 +25,7 @@ import pandas as pd
 
 from .. import defaults
 from ..compare.align import (
+    ALIGNMENT_STATUSES,
     Aligner,
     DemCase,
     Tolerances,
@@ -48,11 +49,9 @@ DIFFERENCE_COLUMN = "difference measured (E of Eq. 10) - ours [-]"
 #: Chi-square per degree of freedom of the pooled measurements about their mean (~1: they agree
 #: within their errors; NaN for a single measurement).
 CONSISTENCY_COLUMN = "measured chi2/dof [-]"
-#: Column holding the alignment status.
-#: Its values are :data:`pidcore.compare.ALIGNMENT_STATUSES`; ``no_dem_runs`` (no DEM run of the
-#: row's specimen at its material and direction) is not in the header: the header is kept as
-#: reports written before it had it (a status is not a unit), and the row's note explains it.
-ALIGNMENT_COLUMN = "alignment [grid/interpolated/out_of_range]"
+#: Column holding the alignment status; the header lists its values,
+#: :data:`pidcore.compare.ALIGNMENT_STATUSES`.
+ALIGNMENT_COLUMN = f"alignment [{'/'.join(ALIGNMENT_STATUSES)}]"
 #: Columns of :func:`build_report_table`, in order.
 REPORT_COLUMNS: tuple[str, ...] = (
     "frequency [Hz]", "acceleration [g]", "packing ratio [%]", "material", "direction",
