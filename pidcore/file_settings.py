@@ -8,11 +8,11 @@ direction``: :mod:`pidcore.compare.loadcase`) a row states:
 =========================  ==================================================================
 column                     meaning (:class:`~pidcore.measure.AnalysisOptions` field)
 =========================  ==================================================================
-``velocity_delay_us``      vibrometer output delay, µs, >= 0 (``velocity_delay_s``)
-``mass_below_gauge_g``     mass between force gauge and coupon, g, >= 0 (``mass_below_gauge_kg``)
+``velocity_delay_us``      vibrometer output delay, µs, 0 or >= 0.01 (``velocity_delay_s``)
+``mass_below_gauge_g``     mass between gauge and coupon, g, 0 or >= 0.1 (``mass_below_gauge_kg``)
 ``baseline_loss_factor``   loss factor of the empty coupon, >= 0 (``baseline_loss_factor``)
-``force``, ``velocity``,   channel names (``force``, ``velocity``, ``acceleration``)
-``acceleration``
+``force``, ``velocity``,   channel names (``force``, ``velocity``, ``acceleration``);
+``acceleration``           ``(auto)`` and ``(none)`` (the app's template) name none: detected
 ``invert``                 channels whose sign is flipped, ``;``-separated (``invert``)
 ``specimen``               the specimen tested (a name, saved with the analysis record)
 ``note``, ``notes``,       free text for the user's own remarks: read and ignored
@@ -171,7 +171,7 @@ def analysis_overrides(values: Mapping[str, object], where: str, *,
         read from a CSV, or numbers / names as the app's editor holds them. ``None`` or blank
         text states nothing.
     where : str
-        The row, as errors name it, e.g. ``"loadcases.csv, row 2 (a.uff)"``.
+        The row, as errors name it, e.g. ``"loadcases.csv, line 2 (a.uff)"``.
     labels : mapping, optional
         Column -> the name errors use for it (the app's ``"vibrometer delay [µs]"``).
 
@@ -298,7 +298,7 @@ class FileSettings:
     def explain(self, message: str) -> str:
         """``message`` (an analysis error) saying which values came from the table: the
         options keyword of a number it set is its words and its cell (``velocity_delay_s``
-        becomes ``vibrometer delay (column velocity_delay_us '1e6' of loadcases.csv, row 2
+        becomes ``vibrometer delay (column velocity_delay_us '1e6' of loadcases.csv, line 2
         (a.uff))``), not the option the CLI would translate the keyword to; a channel name it
         set that the message quotes gets its cell appended."""
         appended = []

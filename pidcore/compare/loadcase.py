@@ -14,9 +14,11 @@ are what the user *states*, in one of three ways (later ones override earlier on
 
    Example: ``coupon3_fill50_acrylic_dirz_500Hz_5g.uff``.
 2. **Sidecar table** ``loadcases.csv`` beside the file (or given explicitly) with columns
-   ``file, fill_percent, material, direction``; rows are looked up by file name (no folder).
-   Empty cells state nothing. The same row may state how the file is analysed (vibrometer
-   delay, channels, specimen, ...: :mod:`pidcore.file_settings`); any other column is refused.
+   ``file, fill_percent, material, direction`` (only ``file`` required), read as spreadsheets
+   write it (:mod:`pidcore.tables`); rows are looked up by file name (a folder in the cell is
+   ignored, as in the app: :func:`find_row`). Empty cells state nothing. The same row may
+   state how the file is analysed (vibrometer delay, channels, specimen, ...:
+   :mod:`pidcore.file_settings`); any other column is refused.
 3. **Options** ``--fill``, ``--material``, ``--direction`` (keyword arguments here).
 
 Material and direction default to the paper's acrylic particles driven along z
