@@ -5,8 +5,8 @@ Such tables come out of spreadsheets as often as out of editors, so they are rea
 spreadsheet tools write them, with the detection of the measurement CSV reader
 (:mod:`pidcore.io.delimited`):
 
-* encodings UTF-8 (with or without BOM), UTF-16, else Latin-1 (cp1252's letters, e.g. ``µ``
-  and ``é``, are Latin-1's);
+* encodings UTF-8 (with or without BOM), UTF-16, else cp1252 (a spreadsheet's "ANSI"
+  export), else Latin-1;
 * the separator is found from the header line: tab, ``;`` or ``,`` (a one-column table has
   none); with ``;`` or tab, the ``numeric`` columns may use a **decimal comma** (``50,5``);
 * a line whose first non-blank character is ``#`` is a comment; a ``#`` anywhere else is data
@@ -46,11 +46,18 @@ def line_where(where: str, line: int) -> str:
 
 def decode_table(data: bytes) -> str:
     """Table bytes as text, in the encoding the measurement CSV reader detects (BOM, UTF-16
-    NUL pattern, UTF-8, else Latin-1: a byte string is always text in Latin-1, so a cp1252
-    spreadsheet export is read, its letters as Latin-1's)."""
+    NUL pattern, UTF-8), else cp1252, else Latin-1 (a byte string is always Latin-1 text)."""
     from .io.delimited import _encoding
 
-    return data.decode(_encoding(data), errors="replace")
+    encoding = _encoding(data)
+    if encoding == "latin-1":
+        # a spreadsheet's "ANSI" export is cp1252: Latin-1 but for 0x80-0x9F, where cp1252 has
+        # letters a file name may hold (en dash, €) and Latin-1 control characters
+        try:
+            return data.decode("cp1252")
+        except UnicodeDecodeError:
+            pass
+    return data.decode(encoding, errors="replace")
 
 
 def _is_comment(line: str) -> bool:

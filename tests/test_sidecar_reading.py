@@ -139,6 +139,16 @@ def test_spreadsheet_tables_are_read_in_the_cli_and_the_app(tmp_path, capsys, te
     assert table["vibrometer delay [µs]"].tolist() == [50.0]
 
 
+def test_a_cp1252_file_name_with_an_en_dash_is_matched(tmp_path, capsys):
+    # an "ANSI" spreadsheet export writes '–' as byte 0x96 (a control character in Latin-1)
+    name = "Messung–3_f50Hz_a5g_fill50_acrylic.uff"
+    path = copy_f(tmp_path, name)
+    (tmp_path / "loadcases.csv").write_bytes(
+        f"file;velocity_delay_us\n{name};50\n".encode("cp1252"))
+    (rec,) = analyze_json([str(path)], capsys)["records"]
+    assert rec["sdc"] == pytest.approx(SDC_50US, abs=TOL)
+
+
 def test_a_row_with_more_cells_than_the_header_names_its_line(tmp_path, capsys):
     path = copy_f(tmp_path)
     (tmp_path / "loadcases.csv").write_text(
