@@ -206,3 +206,15 @@ def test_the_reader_keeps_quoted_separators_and_skips_empty_spreadsheet_rows():
     table = read_text_table(b'file;invert\n"a;b.uff";"Force;Accel"\n;;\n\n# end\n', "t.csv")
     assert table.to_dict("list") == {"file": ["a;b.uff"], "invert": ["Force;Accel"]}
     assert table.index.tolist() == [2]
+
+
+def test_calibrates_measured_table_names_a_row_by_its_line_too(tmp_path):
+    # "row 2" (the data row's position + 1, comment lines not counted) became the line
+    from pidcore.calibrate import read_measured_table
+    from pidcore.errors import InputFileError
+
+    table = tmp_path / "m.csv"
+    table.write_text("# lab A, 2026-11-30\nfrequency_hz,acceleration_g,fill_percent,sdc\n"
+                     "500,5,50,0.6\n500,1,50,x\n", encoding="utf-8")
+    with pytest.raises(InputFileError, match=r"m\.csv, line 4: sdc 'x' is not a number"):
+        read_measured_table(table)
