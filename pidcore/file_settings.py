@@ -156,7 +156,7 @@ def _number(value: object, column: str, spec: SettingsColumn, where: str) -> flo
             f"{where}, column {column}: {shown!r} is implausibly small (below "
             f"{spec.smallest:g} {spec.unit}); it looks like a value in {spec.slip} "
             f"({number:g} {spec.slip} = {number * spec.slip_scale:g} {spec.unit}); expected "
-            f"{spec.expected}")
+            f"0 or at least {spec.smallest:g} {spec.unit}")
     return number / spec.scale
 
 
