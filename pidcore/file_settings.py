@@ -8,11 +8,11 @@ direction``: :mod:`pidcore.compare.loadcase`) a row states:
 =========================  ==================================================================
 column                     meaning (:class:`~pidcore.measure.AnalysisOptions` field)
 =========================  ==================================================================
-``velocity_delay_us``      vibrometer output delay, µs, >= 0 (``velocity_delay_s``)
-``mass_below_gauge_g``     mass between force gauge and coupon, g, >= 0 (``mass_below_gauge_kg``)
+``velocity_delay_us``      vibrometer output delay, µs, 0 or >= 0.01 (``velocity_delay_s``)
+``mass_below_gauge_g``     mass between gauge and coupon, g, 0 or >= 0.1 (``mass_below_gauge_kg``)
 ``baseline_loss_factor``   loss factor of the empty coupon, >= 0 (``baseline_loss_factor``)
-``force``, ``velocity``,   channel names (``force``, ``velocity``, ``acceleration``)
-``acceleration``
+``force``, ``velocity``,   channel names (``force``, ``velocity``, ``acceleration``);
+``acceleration``           ``(auto)`` and ``(none)`` (the app's template) name none: detected
 ``invert``                 channels whose sign is flipped, ``;``-separated (``invert``)
 ``specimen``               the specimen tested (a name, saved with the analysis record)
 ``note``, ``notes``,       free text for the user's own remarks: read and ignored
@@ -40,7 +40,9 @@ from typing import TYPE_CHECKING
 
 from .compare.loadcase import (
     ANALYSIS_SETTINGS_COLUMNS,
+    AUTO_CHANNEL,
     FREE_TEXT_COLUMNS,
+    NO_CHANNEL,
     SETTINGS_COLUMNS,
     SPECIMEN_COLUMN,
     check_columns,
@@ -55,7 +57,8 @@ if TYPE_CHECKING:
 
     from .measure import AnalysisOptions, AnalyzedRecord
 
-__all__ = ["ANALYSIS_COLUMNS", "ANALYSIS_SETTINGS_COLUMNS", "FREE_TEXT_COLUMNS",
+__all__ = ["ANALYSIS_COLUMNS", "ANALYSIS_SETTINGS_COLUMNS", "AUTO_CHANNEL", "FREE_TEXT_COLUMNS",
+           "NO_CHANNEL",
            "SETTINGS_COLUMNS", "SPECIMEN_COLUMN", "FileSettings", "SettingsColumn",
            "analysis_overrides", "analyze_with_settings", "check_columns",
            "resolve_file_settings"]
@@ -77,21 +80,38 @@ class SettingsColumn:
         ``--velocity-delay 5e-5`` is, so both give the same analysis to the last bit.
     expected : str
         What a valid value is, for the error message.
+    smallest : float
+        Smallest plausible positive value in the column's unit: a positive value below it is
+        refused as a unit slip (0 for no such check).
+    slip : str
+        The unit the value was probably typed in (``"s"``), and ``slip_scale`` its factor to
+        the column's unit (``unit``), for the message.
     """
 
     field: str
     kind: str
     scale: float = 1.0
     expected: str = ""
+    smallest: float = 0.0
+    slip: str = ""
+    slip_scale: float = 1.0
+    unit: str = ""
 
 
 #: How each column of :data:`~pidcore.compare.loadcase.ANALYSIS_SETTINGS_COLUMNS` sets its
 #: options field.
 ANALYSIS_COLUMNS: dict[str, SettingsColumn] = {
+    # A laser vibrometer's output delay is µs to ms (tens of µs typically, from its data
+    # sheet); 0.01 µs = 10 ns is a thousandth of a sample at 100 kHz and would correct
+    # nothing measurable, so a positive value below it is a delay typed in s (5e-5 for 50 µs).
     "velocity_delay_us": SettingsColumn("velocity_delay_s", "number", 1e6,
-                                        "a vibrometer output delay in µs >= 0"),
+                                        "a vibrometer output delay in µs >= 0",
+                                        0.01, "s", 1e6, "µs"),
+    # The mass between force gauge and coupon is the gauge's top half, a screw or an adapter:
+    # grams to hundreds of grams; a positive value below 0.1 g weighs less than an M1 screw
+    # and would change nothing measurable, so it is a mass typed in kg (0.012 for 12 g).
     "mass_below_gauge_g": SettingsColumn("mass_below_gauge_kg", "number", 1e3,
-                                         "a mass in g >= 0"),
+                                         "a mass in g >= 0", 0.1, "kg", 1e3, "g"),
     "baseline_loss_factor": SettingsColumn("baseline_loss_factor", "number", 1.0,
                                            "the empty coupon's loss factor >= 0"),
     "force": SettingsColumn("force", "channel"),
@@ -131,6 +151,12 @@ def _number(value: object, column: str, spec: SettingsColumn, where: str) -> flo
         # a negative mass or baseline would add what they are meant to remove
         raise SettingsTableError(f"{where}, column {column}: {shown!r} is negative; "
                              f"expected {spec.expected}")
+    if 0 < number < spec.smallest:
+        raise SettingsTableError(
+            f"{where}, column {column}: {shown!r} is implausibly small (below "
+            f"{spec.smallest:g} {spec.unit}); it looks like a value in {spec.slip} "
+            f"({number:g} {spec.slip} = {number * spec.slip_scale:g} {spec.unit}); expected "
+            f"0 or at least {spec.smallest:g} {spec.unit}")
     return number / spec.scale
 
 
@@ -145,7 +171,7 @@ def analysis_overrides(values: Mapping[str, object], where: str, *,
         read from a CSV, or numbers / names as the app's editor holds them. ``None`` or blank
         text states nothing.
     where : str
-        The row, as errors name it, e.g. ``"loadcases.csv, row 2 (a.uff)"``.
+        The row, as errors name it, e.g. ``"loadcases.csv, line 2 (a.uff)"``.
     labels : mapping, optional
         Column -> the name errors use for it (the app's ``"vibrometer delay [µs]"``).
 
@@ -178,7 +204,11 @@ def analysis_overrides(values: Mapping[str, object], where: str, *,
         if isinstance(value, float) and math.isnan(value):
             continue  # a text column's empty cell, as pandas holds it
         if spec.kind == "channel":
-            out[spec.field] = str(value).strip()
+            channel = str(value).strip()
+            # the app's words for "detect it" and "none named": the analysis names no channel
+            # (the app's template round-trips through the CLI to the same numbers)
+            if channel not in (AUTO_CHANNEL, NO_CHANNEL):
+                out[spec.field] = channel
         else:
             names = value.split(";") if isinstance(value, str) else (
                 list(value) if isinstance(value, (list, tuple)) else [value])
@@ -226,6 +256,10 @@ class FileSettings:
     cells : dict of str to tuple
         Options field -> (column, cell text, row) of each value the table set (errors of the
         analysis name the cell, not the option it became).
+    unmatched : str
+        A note when a table given explicitly (``--sidecar``) has no row for the file: not an
+        error (one table may cover several runs), but a misspelt row would otherwise leave the
+        file at the defaults without a word. "" otherwise.
     """
 
     options: AnalysisOptions
@@ -233,6 +267,7 @@ class FileSettings:
     sources: dict[str, str] = field(default_factory=dict)
     notes: tuple[str, ...] = ()
     cells: dict[str, tuple[str, str, str]] = field(default_factory=dict)
+    unmatched: str = ""
 
     def summary(self) -> str:
         """The settings the table set, in words with their table, e.g. ``'vibrometer delay
@@ -263,7 +298,7 @@ class FileSettings:
     def explain(self, message: str) -> str:
         """``message`` (an analysis error) saying which values came from the table: the
         options keyword of a number it set is its words and its cell (``velocity_delay_s``
-        becomes ``vibrometer delay (column velocity_delay_us '1e6' of loadcases.csv, row 2
+        becomes ``vibrometer delay (column velocity_delay_us '1e6' of loadcases.csv, line 2
         (a.uff))``), not the option the CLI would translate the keyword to; a channel name it
         set that the message quotes gets its cell appended."""
         appended = []
@@ -310,6 +345,8 @@ def resolve_file_settings(path: str | os.PathLike, options: AnalysisOptions | No
         A table with an unknown column (:func:`check_columns`) or a bad value in this file's
         row (:func:`analysis_overrides`).
     """
+    import pandas as pd
+
     from .measure import AnalysisOptions
 
     options = options if options is not None else AnalysisOptions()
@@ -319,7 +356,11 @@ def resolve_file_settings(path: str | os.PathLike, options: AnalysisOptions | No
                  if getattr(options, f.name) != getattr(default, f.name)}
     row = sidecar_row(path, sidecar)
     if row is None:
-        return FileSettings(options)
+        unmatched = ""
+        if sidecar is not None and not isinstance(sidecar, pd.DataFrame):
+            unmatched = (f"{Path(path).name}: no row in {sidecar} (rows are matched by file "
+                         "name); its load case and settings come from its name and the options")
+        return FileSettings(options, unmatched=unmatched)
     stated = analysis_overrides(row.values, row.where)
     changes: dict[str, object] = {}
     sources: dict[str, str] = {}

@@ -240,7 +240,7 @@ def test_repeated_rows_of_one_load_case_are_refused(tmp_path):
     table = tmp_path / "dup.csv"
     table.write_text("frequency_hz,acceleration_g,fill_percent,sdc\n"
                      "500,1,40,0.21\n500,5,40,0.3\n500,1,40,0.22\n")
-    with pytest.raises(InputFileError, match=r"rows 1 and 3 state the same load case "
+    with pytest.raises(InputFileError, match=r"lines 2 and 4 state the same load case "
                                              r"\(500 Hz, 1 g, 40 %, acrylic\)"):
         read_measured_table(table)
     # another material at the same load case is another point

@@ -156,7 +156,7 @@ def test_rows_of_another_specimen_are_refused(capsys, tmp_path):
                              "500,5,50,0.6,someone_elses_coupon\n1000,5,50,0.6,\n"
                              "500,1,50,0.2,someone_elses_coupon\n")
     _refused(capsys, tmp_path, ["--data", str(table)],
-             "m.csv rows 2, 4 name specimen 'someone_elses_coupon'", "not 'paper_coupon'")
+             "m.csv lines 2, 4 name specimen 'someone_elses_coupon'", "not 'paper_coupon'")
     # with --specimen: rows naming another one are refused, its own name is its (and its
     # calibrated file's name is the specimen it was calibrated from)
     mine = tmp_path / "my.toml"
@@ -166,7 +166,7 @@ def test_rows_of_another_specimen_are_refused(capsys, tmp_path):
                              "500,5,50,0.6,my_coupon\n1000,5,50,0.6,other_specimen\n"
                              "500,1,50,0.2,my_coupon_calibrated\n", name="n.csv")
     _refused(capsys, tmp_path, ["--data", str(table), "--specimen", str(mine)],
-             "n.csv row 3 name specimen 'other_specimen'", "not 'my_coupon'")
+             "n.csv line 3 name specimen 'other_specimen'", "not 'my_coupon'")
     from pidcore.specimen import load_specimen
 
     specimen = load_specimen(mine)

@@ -121,7 +121,7 @@ def test_an_explicit_option_overrides_the_sidecar_for_every_file_with_a_note(tmp
     (note,) = rec["overridden"]
     assert note == doc["notes"][0]
     assert note == (f"rec.csv: --velocity-delay (vibrometer delay 0 µs) overrides column "
-                    f"velocity_delay_us '200' of {table}, row 1 (rec.csv)")
+                    f"velocity_delay_us '200' of {table}, line 2 (rec.csv)")
     assert main(["analyze", str(path), "--no-store", "--velocity-delay", "0"]) == 0
     assert f"note: {note}" in capsys.readouterr().out
     # an option equal to the table's value overrides nothing: no note
@@ -166,7 +166,7 @@ def test_corrections_channels_and_inversion_of_a_row_are_applied(tmp_path, capsy
     # a channel the row names that the file lacks names the row's cell
     sidecar(tmp_path, "file,fill_percent,velocity\nflipped.csv,50,LDV\n")
     err = refused(["analyze", str(flipped), "--no-store"], capsys)
-    assert "'LDV'" in err and "column velocity 'LDV' of" in err and "row 1" in err
+    assert "'LDV'" in err and "column velocity 'LDV' of" in err and "line 2" in err
 
 
 def test_a_row_s_delay_too_long_for_the_record_names_the_cell_not_the_option(tmp_path, capsys):
@@ -233,8 +233,9 @@ def test_a_bad_value_names_the_table_row_file_and_column(tmp_path, capsys, colum
                               f"ok.csv,50,\nbad.csv,50,{value}\n")
     store = tmp_path / "s.h5"
     err = refused(["analyze", str(ok), str(bad), "--store", str(store)], capsys, store)
-    # the second data row (the comment line is not counted), its file and the column
-    assert f"{table}, row 2 (bad.csv), column {column}: '{value}' {said}; expected" in err
+    # the row's line in the file as an editor shows it (comment and header lines count), its
+    # file and the column
+    assert f"{table}, line 4 (bad.csv), column {column}: '{value}' {said}; expected" in err
     assert ">= 0" in err
     assert not store.exists()  # refused before anything was analysed or saved
 

@@ -12,7 +12,6 @@ settings table (under any name, uploaded at any time) and fills the rows of the 
 from __future__ import annotations
 
 import hashlib
-import io
 import json
 import math
 import os
@@ -26,7 +25,7 @@ from typing import TYPE_CHECKING
 import pandas as pd
 
 from .. import defaults
-from ..compare.loadcase import FREE_TEXT_COLUMNS
+from ..compare.loadcase import AUTO_CHANNEL, NO_CHANNEL
 from ..constants import PARTICLE_MATERIALS
 from ..errors import ParameterError, PidcoreError
 
@@ -35,10 +34,8 @@ if TYPE_CHECKING:
     from ..measure import AnalysisOptions, AnalyzedRecord
     from ..records import Measurement
 
-#: Label of "no channel" (acceleration is optional).
-NO_CHANNEL = "(none)"
-#: Label of "the channel the readers detect".
-AUTO_CHANNEL = "(auto)"
+# NO_CHANNEL ("(none)": acceleration is optional) and AUTO_CHANNEL ("(auto)": the channel the
+# readers detect) are the sidecar's words too (pidcore.compare.loadcase): one definition.
 
 #: Per-file settings: column shown in the app -> column of the CSV template / uploaded table
 #: (:data:`pidcore.compare.loadcase.SETTINGS_COLUMNS`, the sidecar's columns of the CLI).
@@ -257,11 +254,12 @@ def identical_uploads(uploads: Sequence[tuple[str, str]]) -> list[str]:
 
 def is_settings_table(data: bytes) -> bool:
     """Whether uploaded bytes are a per-file settings table (a load-case table is one): a CSV
-    whose header names ``file`` and at least one other column of :data:`FILE_TABLE_COLUMNS`."""
-    head = data[:4096].decode("utf-8-sig", errors="replace").splitlines()
-    if not head:
-        return False
-    names = {c.strip().strip('"').lower() for c in head[0].split(",")}
+    whose header names ``file`` and at least one other column of :data:`FILE_TABLE_COLUMNS`
+    (its header read as ``pidcore analyze`` reads a sidecar's: ``,``/``;``/tab, any
+    encoding the reader knows, ``#`` comment lines skipped)."""
+    from ..tables import header_cells
+
+    names = {c.lower() for c in header_cells(data)}
     known = set(FILE_TABLE_COLUMNS.values()) | {k.lower() for k in FILE_TABLE_COLUMNS}
     # A column that is neither known nor free text (a misspelt ``velocity_delay_ms``) still
     # makes a table: read as one, it is refused naming the column; read as a measurement it
@@ -325,32 +323,36 @@ def read_settings_table(name: str, data: bytes,
     Raises :class:`ParameterError` naming the table, row and column for a value that is not a
     number, material (one of ``materials``) or direction.
     """
-    from ..compare.loadcase import normalize_direction, normalize_material
+    from ..compare.loadcase import (
+        NUMERIC_COLUMNS,
+        normalize_direction,
+        normalize_material,
+        settings_table,
+    )
+    from ..tables import line_where, read_text_table
 
     try:
-        raw = pd.read_csv(io.BytesIO(data), dtype=str, keep_default_na=False,
-                          skipinitialspace=True)
-    except (ValueError, UnicodeError) as exc:
-        raise ParameterError(f"{name}: not a readable CSV table ({exc})") from None
-    by_name = {k.lower(): k for k in FILE_TABLE_COLUMNS} | {
-        v: k for k, v in FILE_TABLE_COLUMNS.items()}
-    raw.columns = [by_name.get(str(c).strip().lower(), str(c).strip()) for c in raw.columns]
-    # free-text remarks are accepted and ignored, as by `pidcore analyze` (one table for both)
-    raw = raw.loc[:, [c for c in raw.columns if c.lower() not in FREE_TEXT_COLUMNS]]
-    unknown = [c for c in raw.columns if c not in FILE_TABLE_COLUMNS]
-    if unknown:
-        raise ParameterError(f"{name}: unknown column(s) {unknown}; expected some of "
-                             f"{list(FILE_TABLE_COLUMNS.values())} (and free text: "
-                             f"{', '.join(FREE_TEXT_COLUMNS)})")
-    out = pd.DataFrame({c: raw[c].str.strip() if c in raw else "" for c in FILE_TABLE_COLUMNS})
+        raw = read_text_table(data, name, numeric=(
+            *NUMERIC_COLUMNS, *(k.lower() for k in _NUMERIC)))
+    except PidcoreError as exc:
+        raise ParameterError(str(exc)) from None
+    by_name = {k.lower(): v for k, v in FILE_TABLE_COLUMNS.items()}
+    given = {by_name.get(c, c) for c in raw.columns}
+    # the checks of `pidcore analyze` (one table for both): known columns, a file name per
+    # row, each file once; free-text remarks are accepted and ignored
+    raw = settings_table(raw.rename(columns=by_name), name)
+    labels = {v: k for k, v in FILE_TABLE_COLUMNS.items()}
+    raw = raw.rename(columns=labels).loc[:, list(FILE_TABLE_COLUMNS)]
+    out = raw.reset_index(drop=True)
     for column in _NUMERIC:
         values = []
-        for i, text in enumerate(out[column], start=2):
+        for line, text in zip(raw.index, raw[column], strict=True):
             try:
                 values.append(float(text) if text != "" else math.nan)
             except ValueError:
-                raise ParameterError(f"{name}, line {i}: {FILE_TABLE_COLUMNS[column]} "
-                                     f"{text!r} is not a number") from None
+                raise ParameterError(f"{line_where(name, int(line))}: "
+                                     f"{FILE_TABLE_COLUMNS[column]} {text!r} is not a "
+                                     "number") from None
         out[column] = values
     try:
         out["material"] = [normalize_material(v, f"{name}: material", materials) if v else ""
@@ -359,9 +361,8 @@ def read_settings_table(name: str, data: bytes,
         raise ParameterError(f"{exc} ({MATERIAL_HINT})") from None
     out["direction"] = [normalize_direction(v, f"{name}: direction") if v else ""
                         for v in out["direction"]]
-    if (out["file"] == "").any():
-        raise ParameterError(f"{name}: every row needs a file name")
-    out.attrs["given"] = [c for c in FILE_TABLE_COLUMNS if c in raw.columns and c != "file"]
+    out.attrs["given"] = [c for c in FILE_TABLE_COLUMNS
+                          if FILE_TABLE_COLUMNS[c] in given and c != "file"]
     return out
 
 

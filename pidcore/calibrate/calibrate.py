@@ -231,7 +231,8 @@ def check_point_specimens(points: Sequence[MeasuredPoint], specimen: Specimen) -
     for (source, name), rows in others.items():
         numbered = [str(r) for r in rows if r is not None]
         if numbered:  # a table's rows
-            where = f"{source} row{'s' if len(numbered) > 1 else ''} {', '.join(numbered)}"
+            # lines of the file, as every table's rows are named (pidcore.tables.line_where)
+            where = f"{source} line{'s' if len(numbered) > 1 else ''} {', '.join(numbered)}"
         else:  # a store's load cases (or points made in code)
             where = f"{len(rows)} measured load case(s)" + (f" of {source}" if source else "")
         said.append(f"{where} name specimen {name!r}")

@@ -41,7 +41,7 @@ class MeasuredPoint:
     sdc_stderr: float = 0.0
     material: str = DEFAULT_MATERIAL
     specimen: str = ""
-    # where the point was read (a table and its row, or a store), for messages naming it; not
+    # where the point was read (a table and its line, or a store), for messages naming it; not
     # part of the point's identity
     source: str = field(default="", compare=False)
     row: int | None = field(default=None, compare=False)
@@ -68,35 +68,29 @@ def read_measured_table(path: str | os.PathLike, *,
     A row without a ``material`` takes ``default_material`` (the calibrated specimen's when
     one is given, as a measurement compared with a specimen does; else the paper's acrylic).
     """
+    from ..tables import line_where, read_text_table_file
+
     path = Path(path)
     if not path.is_file():
         raise InputFileError(f"{path}: no such file")
-    try:
-        head = next((line for line in path.read_text(encoding="utf-8-sig").splitlines()
-                     if line.strip() and not line.lstrip().startswith("#")), "")
-        # European spreadsheets write ';' between columns and ',' as the decimal mark
-        semicolons = ";" in head and "," not in head
-        frame = pd.read_csv(path, comment="#", encoding="utf-8-sig",
-                            sep=";" if semicolons else ",", decimal="," if semicolons else ".")
-    except (pd.errors.ParserError, UnicodeDecodeError, pd.errors.EmptyDataError) as exc:
-        raise InputFileError(f"{path}: not a readable CSV table ({exc})") from None
-    frame.columns = [str(c).strip().lower() for c in frame.columns]  # Frequency_Hz too
+    # the reader of the sidecar tables: ',' / ';' / tab with a decimal comma, UTF-8 or
+    # Latin-1, '#' lines are comments, rows named by their line in the file
+    frame = read_text_table_file(path, numeric=(*REQUIRED_COLUMNS, *OPTIONAL_COLUMNS))
     missing = [c for c in REQUIRED_COLUMNS if c not in frame.columns]
     if missing:
         raise InputFileError(f"{path}: missing column(s) {', '.join(missing)}; expected "
                              f"{', '.join(REQUIRED_COLUMNS)} (optional: "
                              f"{', '.join(OPTIONAL_COLUMNS)})")
     points = []
-    for i, row in frame.iterrows():
-        where = f"{path}: row {i + 2}"
+    for line, row in frame.iterrows():
+        where = line_where(str(path), int(line))
         values = {}
         for column in REQUIRED_COLUMNS + ("sdc_stderr",):
-            raw = row.get(column, 0.0)
-            if column == "sdc_stderr" and (raw is None or (isinstance(raw, float)
-                                                           and math.isnan(raw))):
-                raw = 0.0
+            raw = row.get(column, "")
+            if column == "sdc_stderr" and raw == "":
+                raw = "0"
             try:
-                value = float(raw)
+                value = float(raw) if raw != "" else math.nan
             except (TypeError, ValueError):
                 raise InputFileError(f"{where}: {column} {raw!r} is not a number") from None
             if not math.isfinite(value):
@@ -110,19 +104,19 @@ def read_measured_table(path: str | os.PathLike, *,
             raise InputFileError(f"{where}: sdc and sdc_stderr must be >= 0")
         points.append(MeasuredPoint(material=_text_cell(row.get("material"), default_material),
                                     specimen=_text_cell(row.get("specimen"), ""),
-                                    source=str(path), row=int(i) + 2, **values))
+                                    source=str(path), row=int(line), **values))
     if not points:
         raise InputFileError(f"{path}: no rows")
-    seen: dict[tuple, int] = {}
-    for i, p in enumerate(points):
+    seen: dict[tuple, int | None] = {}
+    for p in points:
         key = (p.frequency_hz, p.acceleration_g, p.fill_percent, p.material, p.specimen)
         if key in seen:
             # rows counted as load cases of their own would pass the count of load cases a
             # fit needs, and weigh one case several times
-            raise InputFileError(f"{path}: rows {seen[key] + 1} and {i + 1} state the same load "
+            raise InputFileError(f"{path}: lines {seen[key]} and {p.row} state the same load "
                                  f"case ({p.label()}); give one row per load case (the mean "
                                  "SDC of repeated tests and its standard error)")
-        seen[key] = i
+        seen[key] = p.row
     return points
 
 

@@ -139,13 +139,14 @@ def _run(args: argparse.Namespace) -> int:
 def _print_results(args: argparse.Namespace, results: list, cases: list, stated: list,
                    settings: list, replaced: list[str]) -> None:
     """The results table (or JSON document), each file's load case and settings, notes."""
-    overrides = [note for fs in settings for note in fs.notes]
+    overrides = [note for fs in settings for note in (*fs.notes, fs.unmatched) if note]
     if args.json:
         json.dump({"records": [{**r.to_dict(), "load_case": c.key if c else None,
                                 "specimen": fs.specimen or None,
                                 "parameters": fs.options.parameters(),
                                 "settings_from": dict(fs.sources),
-                                "overridden": list(fs.notes)}
+                                "overridden": list(fs.notes),
+                                "sidecar_row_missing": fs.unmatched or None}
                                for r, c, fs in zip(results, cases, settings, strict=True)],
                    "notes": [*overrides, *replaced]}, sys.stdout)
         sys.stdout.write("\n")

@@ -14,9 +14,11 @@ are what the user *states*, in one of three ways (later ones override earlier on
 
    Example: ``coupon3_fill50_acrylic_dirz_500Hz_5g.uff``.
 2. **Sidecar table** ``loadcases.csv`` beside the file (or given explicitly) with columns
-   ``file, fill_percent, material, direction``; rows are looked up by file name (no folder).
-   Empty cells state nothing. The same row may state how the file is analysed (vibrometer
-   delay, channels, specimen, ...: :mod:`pidcore.file_settings`); any other column is refused.
+   ``file, fill_percent, material, direction`` (only ``file`` required), read as spreadsheets
+   write it (:mod:`pidcore.tables`); rows are looked up by file name (a folder in the cell is
+   ignored, as in the app: :func:`find_row`). Empty cells state nothing. The same row may
+   state how the file is analysed (vibrometer delay, channels, specimen, ...:
+   :mod:`pidcore.file_settings`); any other column is refused.
 3. **Options** ``--fill``, ``--material``, ``--direction`` (keyword arguments here).
 
 Material and direction default to the paper's acrylic particles driven along z
@@ -30,12 +32,11 @@ import re
 from dataclasses import dataclass
 from pathlib import Path
 
-import numpy as np
 import pandas as pd
 
 from .. import defaults
 from ..constants import PARTICLE_MATERIALS, UNTABULATED_PARTICLE_MATERIALS
-from ..errors import SettingsTableError
+from ..errors import InputFileError, SettingsTableError
 from ..loadcase import (
     LoadCase,
     LoadCaseError,
@@ -43,6 +44,7 @@ from ..loadcase import (
     normalize_material,
 )
 from ..loadcase import check_fill as _check_fill
+from ..tables import line_where, read_text_table_file
 
 
 class FillNotStated(LoadCaseError):
@@ -64,7 +66,8 @@ class UntabulatedMaterial(LoadCaseError):
 
 #: Name of the sidecar table looked for beside each measurement file.
 SIDECAR_NAME = "loadcases.csv"
-#: Load case columns of the sidecar table (``file`` and ``fill_percent`` required).
+#: Load case columns of the sidecar table (``file`` required: a table may state only settings,
+#: the fill then comes from the file name or ``--fill``).
 SIDECAR_COLUMNS: tuple[str, ...] = ("file", "fill_percent", "material", "direction")
 #: Column naming the specimen tested (a name, saved with the analysis record as ``specimen``).
 SPECIMEN_COLUMN = "specimen"
@@ -75,6 +78,15 @@ ANALYSIS_SETTINGS_COLUMNS: tuple[str, ...] = (
 #: Every column of a sidecar / the app's settings table (its template's columns, in its order).
 SETTINGS_COLUMNS: tuple[str, ...] = (*SIDECAR_COLUMNS, SPECIMEN_COLUMN,
                                      *ANALYSIS_SETTINGS_COLUMNS)
+#: Columns holding numbers (a ``;``-separated table may write them with a decimal comma).
+NUMERIC_COLUMNS: tuple[str, ...] = ("fill_percent", "velocity_delay_us", "mass_below_gauge_g",
+                                    "baseline_loss_factor")
+#: Channel cell meaning "the channel the readers detect" (the app's default, and its template's).
+AUTO_CHANNEL = "(auto)"
+#: Channel cell meaning "no channel named" (the app's choice for an unused acceleration): as
+#: for ``(auto)`` the analysis names none, so the readers use a channel only where one is
+#: needed and found.
+NO_CHANNEL = "(none)"
 #: Free-text columns accepted and ignored: a lab's table keeps its remarks beside the values,
 #: and refusing them would make users delete documentation to run an analysis.
 FREE_TEXT_COLUMNS: tuple[str, ...] = ("note", "notes", "comment", "comments")
@@ -220,45 +232,65 @@ def read_sidecar(path: str | Path) -> pd.DataFrame:
     Parameters
     ----------
     path : str or Path
-        CSV with a header row; columns ``file`` and ``fill_percent`` required, the other
-        columns of :data:`SETTINGS_COLUMNS` optional, free-text
-        ``note``/``comment`` columns ignored. ``#`` starts a comment line.
+        CSV with a header row (:func:`pidcore.tables.read_text_table`: ``,``/``;``/tab
+        separated, UTF-8 or Latin-1, a line starting with ``#`` is a comment, a ``#`` in a
+        cell is data); column ``file`` required, the other columns of :data:`SETTINGS_COLUMNS`
+        optional, free-text ``note``/``comment`` columns ignored.
 
     Returns
     -------
     pandas.DataFrame
-        One row per file, columns :data:`SETTINGS_COLUMNS` (missing
-        optional ones empty), text stripped.
+        One row per file, columns :data:`SETTINGS_COLUMNS` (missing optional ones empty), text
+        stripped; the index (``"line"``) is each row's line in the file.
 
     Raises
     ------
     LoadCaseError
-        Not found, not a CSV table, a required column missing, a file listed twice.
+        Not found, not a readable table, column ``file`` missing, a row without a file name,
+        a file listed twice.
     SettingsTableError
         A column neither the CLI nor the app knows (:func:`check_columns`).
     """
     path = Path(path)
+    if not path.is_file():
+        raise LoadCaseError(f"{path}: sidecar table not found")
     try:
-        table = pd.read_csv(path, comment="#", dtype=str, skipinitialspace=True,
-                            keep_default_na=False)
-    except FileNotFoundError:
-        raise LoadCaseError(f"{path}: sidecar table not found") from None
-    except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
-        raise LoadCaseError(f"{path}: not a readable CSV table ({exc})") from None
-    table.columns = [str(c).strip().lower() for c in table.columns]
-    for required in ("file", "fill_percent"):
-        if required not in table.columns:
-            raise LoadCaseError(f"{path}: sidecar table lacks column {required!r}; expected "
-                                f"columns {', '.join(SIDECAR_COLUMNS)}")
-    check_columns(table.columns, f"{path} (sidecar table)")
+        return settings_table(read_text_table_file(path, numeric=NUMERIC_COLUMNS), str(path))
+    except InputFileError as exc:
+        raise LoadCaseError(str(exc)) from None
+
+
+def settings_table(raw: pd.DataFrame, where: str) -> pd.DataFrame:
+    """A table read by :func:`pidcore.tables.read_text_table` as a settings table (the
+    sidecar's and the app's): the checks of :func:`read_sidecar`, columns
+    :data:`SETTINGS_COLUMNS` in order."""
+    if "file" not in raw.columns:
+        found = ", ".join(map(repr, raw.columns)) or "none"
+        raise LoadCaseError(f"{where}: settings table lacks column 'file' (found {found}); "
+                            f"expected columns {', '.join(SETTINGS_COLUMNS)} (file required)")
+    check_columns(raw.columns, f"{where} (settings table)")
+    table = raw.copy()
     for optional in SETTINGS_COLUMNS:
         if optional not in table.columns:
             table[optional] = ""
-    table = table.loc[:, list(SETTINGS_COLUMNS)].apply(lambda col: col.str.strip())
-    duplicated = table["file"][table["file"].duplicated()].tolist()
-    if duplicated:
-        raise LoadCaseError(f"{path}: sidecar table lists {duplicated[0]!r} more than once")
-    return table.reset_index(drop=True)
+    table = table.loc[:, list(SETTINGS_COLUMNS)]
+    for line, file in table["file"].items():
+        if not file:
+            raise LoadCaseError(f"{line_where(where, int(line))}: no file name; expected the "
+                                "name of the measurement file the row is for")
+    seen: dict[str, int] = {}
+    for line, file in table["file"].items():
+        if file in seen:
+            raise LoadCaseError(f"{where}: lists {file!r} more than once (lines {seen[file]} "
+                                f"and {line}); expected one row per file")
+        seen[file] = int(line)
+    return table
+
+
+def _base_name(cell: str) -> str:
+    """The file name of a ``file`` cell without its folder (``/`` or ``\\``): the app and the
+    CLI match rows by it, so a table written on another machine still finds its files."""
+    return re.split(r"[\\/]", cell)[-1]
 
 
 @dataclass(frozen=True)
@@ -273,8 +305,9 @@ class SidecarRow:
         The table as an origin is named: its file name (``"loadcases.csv"``), or
         ``"sidecar table"`` for a table given as a DataFrame.
     where : str
-        The row as errors name it: ``"data/loadcases.csv, row 2 (a.uff)"`` (rows counted from
-        1 below the header, comment lines not counted; the file name makes it unambiguous).
+        The row as errors name it: ``"data/loadcases.csv, line 3 (a.uff)"``
+        (:func:`pidcore.tables.line_where`; the row's position from 1 for a DataFrame read
+        otherwise).
     """
 
     values: dict[str, str]
@@ -282,13 +315,55 @@ class SidecarRow:
     where: str
 
 
+def _row_label(table: pd.DataFrame, position: int) -> str:
+    """``"line 3"`` for a table read from a file (its line there), else ``"row 1"``."""
+    if table.index.name == "line":
+        return line_where("", int(table.index[position]))[2:]
+    return f"row {position + 1}"
+
+
+def _row_where(table: pd.DataFrame, position: int, shown: str) -> str:
+    return f"{shown}, {_row_label(table, position)}"
+
+
+def _ends_with(parts: tuple[str, ...], cell: list[str]) -> bool:
+    cell = [c for c in cell if c not in ("", ".")]
+    return len(cell) <= len(parts) and list(parts[len(parts) - len(cell):]) == cell
+
+
+def find_row(table: pd.DataFrame, path: str | Path, shown: str) -> int | None:
+    """Position of the row of file ``path`` in a settings ``table`` (None: no row).
+
+    A row's ``file`` is matched by its base name (a folder in the cell is allowed, as in the
+    app); exporters and file systems disagree on case, so a case-folded match is accepted when
+    no exact one exists. Several rows matching equally (two cases of one name, or one name
+    under two folders none of which is the file's) are refused: taking the first would be a
+    silent guess.
+    """
+    path = Path(path)
+    files = [str(f) for f in table["file"]]
+    for same in (lambda a, b: a == b, lambda a, b: a.casefold() == b.casefold()):
+        found = [i for i, f in enumerate(files) if same(_base_name(f), path.name)]
+        if len(found) > 1:
+            # one name under several folders: the row whose folders end the file's path
+            parts = path.absolute().parts
+            tail = [i for i in found if _ends_with(parts, re.split(r"[\\/]", files[i]))]
+            found = tail if len(tail) == 1 else found
+        if len(found) > 1:
+            rows = " and ".join(f"{_row_label(table, i)} ({files[i]!r})" for i in found[:2])
+            raise LoadCaseError(f"{shown}: {rows} both match {path.name!r}; expected one "
+                                "row per file (fix the name or the case of one)")
+        if found:
+            return found[0]
+    return None
+
+
 def sidecar_row(path: str | Path,
                 sidecar: str | Path | pd.DataFrame | None = None) -> SidecarRow | None:
     """The row of ``path``'s file name in its sidecar table (None: no table, or no row).
 
     ``sidecar``: the table (a path, read with :func:`read_sidecar`, or a DataFrame), else
-    ``loadcases.csv`` beside the file if there is one. Rows are matched by file name; exporters
-    and file systems disagree on case, so a unique case-folded match is accepted too.
+    ``loadcases.csv`` beside the file if there is one. Rows are matched by :func:`find_row`.
     """
     path = Path(path)
     if isinstance(sidecar, pd.DataFrame):
@@ -298,15 +373,12 @@ def sidecar_row(path: str | Path,
         if sidecar is None and not sidecar_path.is_file():
             return None
         table, shown, name = read_sidecar(sidecar_path), str(sidecar_path), sidecar_path.name
-    files = table["file"].astype(str)
-    found = np.flatnonzero((files == path.name).to_numpy())
-    if not found.size:
-        found = np.flatnonzero((files.str.casefold() == path.name.casefold()).to_numpy())
-    if not found.size:
+    found = find_row(table, path, shown)
+    if found is None:
         return None
-    row = table.iloc[int(found[0])]
+    row = table.iloc[found]
     values = {str(c): ("" if v is None else str(v)) for c, v in row.items()}
-    return SidecarRow(values, name, f"{shown}, row {int(found[0]) + 1} ({path.name})")
+    return SidecarRow(values, name, f"{_row_where(table, found, shown)} ({path.name})")
 
 
 def _material(value: str, what: str, known: tuple[str, ...]) -> str:

@@ -510,6 +510,8 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
                      + (f"; {said}" if said else ""))
         if r.settings is not None:
             notes.extend(r.settings.notes)
+            if r.settings.unmatched:
+                notes.append(r.settings.unmatched)
             named = r.settings.specimen
             if specimen is not None and named and named != specimen.name:
                 # the sidecar's specimen is the file's (as an app upload's is kept): it meets

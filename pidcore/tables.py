@@ -1,0 +1,169 @@
+"""User-written tables (the sidecar / settings table, the measured-SDC table of ``calibrate``):
+one reader, one way of naming a row.
+
+Such tables come out of spreadsheets as often as out of editors, so they are read as
+spreadsheet tools write them, with the detection of the measurement CSV reader
+(:mod:`pidcore.io.delimited`):
+
+* encodings UTF-8 (with or without BOM), UTF-16, else cp1252 (a spreadsheet's "ANSI"
+  export), else Latin-1;
+* the separator is found from the header line: tab, ``;`` or ``,`` (a one-column table has
+  none); with ``;`` or tab, the ``numeric`` columns may use a **decimal comma** (``50,5``);
+* a line whose first non-blank character is ``#`` is a comment; a ``#`` anywhere else is data
+  (file names such as ``MPSTD#Set001_...uff`` hold one); blank lines and lines of empty cells
+  (a spreadsheet's ``;;;``) are skipped;
+* every cell is text, stripped; quoted cells may hold the separator.
+
+A row is named by its **line in the file**, as a spreadsheet or an editor shows it: the header
+is line 1 when it is the first line, and comment and blank lines count (:func:`line_where`).
+"""
+
+from __future__ import annotations
+
+import csv
+import os
+import re
+from collections.abc import Iterable
+
+import pandas as pd
+
+from .errors import InputFileError
+
+__all__ = ["decode_table", "header_cells", "line_where", "read_text_table",
+           "read_text_table_file"]
+
+_LINE_BREAK = re.compile(r"\r\n|\n|\r")
+#: A number written with a decimal comma (``50,5``, ``-1,2e-3``): only read as a number in a
+#: ``;``- or tab-separated table, where the comma cannot be the separator.
+_DECIMAL_COMMA = re.compile(r"^[+-]?(?:\d+,\d*|,\d+)(?:[eE][+-]?\d+)?$")
+
+
+def line_where(where: str, line: int) -> str:
+    """A table row as every message names it: ``"loadcases.csv, line 3"`` (the line in the
+    file, counting the header, comments and blank lines, as a spreadsheet numbers rows)."""
+    return f"{where}, line {line}"
+
+
+def decode_table(data: bytes) -> str:
+    """Table bytes as text, in the encoding the measurement CSV reader detects (BOM, UTF-16
+    NUL pattern, UTF-8), else cp1252, else Latin-1 (a byte string is always Latin-1 text)."""
+    from .io.delimited import _encoding
+
+    encoding = _encoding(data)
+    if encoding == "latin-1":
+        # a spreadsheet's "ANSI" export is cp1252: Latin-1 but for 0x80-0x9F, where cp1252 has
+        # letters a file name may hold (en dash, €) and Latin-1 control characters
+        try:
+            return data.decode("cp1252")
+        except UnicodeDecodeError:
+            pass
+    return data.decode(encoding, errors="replace")
+
+
+def _is_comment(line: str) -> bool:
+    return line.lstrip().startswith("#")
+
+
+def _separator(header: str) -> str:
+    """The separator of a table, from its header line (:func:`pidcore.io.delimited._delimiter`
+    picks tab, ``;``, ``,`` in that order); ``,`` for a one-column header."""
+    from .io.delimited import _delimiter
+
+    found = _delimiter([header])
+    return "," if found == r"\s+" else found
+
+
+def header_cells(data: bytes) -> list[str]:
+    """The header cells of a table (its first line that is neither blank nor a comment),
+    stripped of blanks and quotes; ``[]`` for none. For telling a table from a measurement
+    without reading it all."""
+    lines = [ln for ln in _LINE_BREAK.split(decode_table(data[:1 << 16]))
+             if ln.strip() and not _is_comment(ln)]
+    if not lines:
+        return []
+    cells = next(csv.reader([lines[0]], delimiter=_separator(lines[0]), skipinitialspace=True))
+    return [c.strip().strip('"').strip() for c in cells]
+
+
+def read_text_table(data: bytes, where: str, *, numeric: Iterable[str] = ()) -> pd.DataFrame:
+    """Read a user-written table (see the module's conventions) as text cells.
+
+    Parameters
+    ----------
+    data : bytes
+        The file's bytes.
+    where : str
+        The table as messages name it (its path or upload name).
+    numeric : iterable of str
+        Columns (lower-case header names) whose decimal commas are read as decimal points in a
+        ``;``- or tab-separated table.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns: the header cells, stripped and lower-cased; every cell a stripped string
+        (``""`` for empty or missing trailing cells). The index, named ``"line"``, holds each
+        row's line in the file (:func:`line_where`).
+
+    Raises
+    ------
+    InputFileError
+        No header line; a row with more cells than the header (naming its line and both
+        counts); a header naming a column twice.
+    """
+    text = decode_table(data)
+    lines = _LINE_BREAK.split(text)
+    kept = [(n, ln) for n, ln in enumerate(lines, start=1) if ln.strip() and not _is_comment(ln)]
+    if not kept:
+        raise InputFileError(f"{where}: empty table; expected a header line such as "
+                             "'file,fill_percent,velocity_delay_us' and one row per file")
+    separator = _separator(kept[0][1])
+    reader = csv.reader((ln for _, ln in kept), delimiter=separator, skipinitialspace=True)
+    rows: list[tuple[int, list[str]]] = []
+    try:
+        start = 0
+        for cells in reader:
+            rows.append((kept[start][0], [c.strip() for c in cells]))
+            start = reader.line_num  # a quoted cell may span lines
+    except csv.Error as exc:
+        line = kept[min(reader.line_num, len(kept)) - 1][0]
+        raise InputFileError(f"{line_where(where, line)}: not a readable table row ({exc}); "
+                             f"expected cells separated by {separator!r}") from None
+    (_, header), body = rows[0], rows[1:]
+    columns = [c.lower() for c in header]
+    doubled = sorted({c for c in columns if columns.count(c) > 1})
+    if doubled:
+        raise InputFileError(f"{line_where(where, rows[0][0])}: column {doubled[0]!r} given "
+                             "more than once; expected each column once")
+    records, numbers = [], []
+    for line, cells in body:
+        if not any(cells):
+            continue  # a spreadsheet's row of empty cells
+        if len(cells) > len(columns):
+            raise InputFileError(
+                f"{line_where(where, line)}: {len(cells)} cells, but the header (line "
+                f"{rows[0][0]}) names {len(columns)} columns separated by {separator!r}; "
+                "expected one cell per column (quote a cell that holds the separator)")
+        records.append(cells + [""] * (len(columns) - len(cells)))
+        numbers.append(line)
+    table = pd.DataFrame(records, columns=columns, index=pd.Index(numbers, name="line"),
+                         dtype=object)
+    if separator != ",":
+        for column in set(numeric) & set(columns):
+            table[column] = [c.replace(",", ".") if _DECIMAL_COMMA.match(c) else c
+                             for c in table[column]]
+    return table
+
+
+def read_text_table_file(path: str | os.PathLike[str], *,
+                         numeric: Iterable[str] = ()) -> pd.DataFrame:
+    """:func:`read_text_table` of a file, named by its path (``InputFileError`` if missing)."""
+    try:
+        with open(path, "rb") as fh:
+            data = fh.read()
+    except FileNotFoundError:
+        raise InputFileError(f"{path}: no such file") from None
+    except IsADirectoryError:
+        raise InputFileError(f"{path}: is a folder; expected a CSV table") from None
+    return read_text_table(data, str(path), numeric=numeric)
+
