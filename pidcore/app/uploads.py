@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING
 import pandas as pd
 
 from .. import defaults
-from ..compare.loadcase import AUTO_CHANNEL, NO_CHANNEL
+from ..compare.loadcase import AUTO_CHANNEL, FREE_TEXT_COLUMNS, NO_CHANNEL
 from ..constants import PARTICLE_MATERIALS
 from ..errors import ParameterError, PidcoreError
 
@@ -388,18 +388,19 @@ class RefusedTable:
 
 def refused_table(name: str, data: bytes, error: str) -> RefusedTable:
     """The refused settings table ``name`` with the file names it holds back: its ``file``
-    column read as plain text (whatever else in the table is wrong), or ``None`` where the
-    table is no readable UTF-8 CSV with a ``file`` column (a Latin-1 file name would not match
-    its upload, and the file would be analysed without the settings meant for it)."""
+    column read as text by the one table reader (whatever else in the table is wrong), or
+    ``None`` where the table cannot be read as one or has no ``file`` column (then it cannot
+    say which files it is for, and every file would be analysed without settings meant for
+    it)."""
+    from ..tables import read_text_table
+
     try:
-        raw = pd.read_csv(io.BytesIO(data), dtype=str, keep_default_na=False,
-                          skipinitialspace=True, encoding="utf-8-sig")
-    except (ValueError, UnicodeError):
+        raw = read_text_table(data, name)
+    except PidcoreError:
         return RefusedTable(name, error, None)
-    column = next((c for c in raw.columns if str(c).strip().lower() == "file"), None)
-    if column is None:
+    if "file" not in raw.columns:
         return RefusedTable(name, error, None)
-    files = tuple(f for f in (str(v).strip() for v in raw[column]) if f)
+    files = tuple(f for f in raw["file"] if f)
     return RefusedTable(name, error, files)
 
 
