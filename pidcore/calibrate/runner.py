@@ -116,21 +116,11 @@ def run_requests(requests: Sequence[RunRequest], *, store_path: str | os.PathLik
             for request in todo:
                 finish(*_run_entry(request))
         elif todo:
-            from concurrent.futures import ProcessPoolExecutor, as_completed
+            from ..dem.sweep import run_pooled
 
-            from ..dem.sweep import dem_process_context, init_dem_worker
-
-            pool = ProcessPoolExecutor(max_workers=min(workers, len(todo)),
-                                       mp_context=dem_process_context(),
-                                       initializer=init_dem_worker)
-            try:
-                futures = [pool.submit(_run_entry, request) for request in todo]
-                for future in as_completed(futures):
-                    finish(*future.result())
-            except BaseException:
-                pool.shutdown(wait=False, cancel_futures=True)
-                raise
-            pool.shutdown()
+            # on Ctrl-C the workers are stopped and waited for; finished runs are saved
+            run_pooled(_run_entry, [(request,) for request in todo], workers=workers,
+                       finish=lambda result: finish(*result))
     finally:
         if bar is not None:
             bar.close()
