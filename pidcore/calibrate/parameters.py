@@ -27,7 +27,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..errors import ParameterError
+from ..errors import ParameterError, as_given
 
 DISCREPANCY = "model_discrepancy"
 
@@ -49,15 +49,16 @@ class ParameterSpec:
 
     def check(self) -> None:
         if not (math.isfinite(self.low) and math.isfinite(self.high) and self.low < self.high):
-            raise ParameterError(f"{self.name}: bounds {self.low:g}:{self.high:g} are empty "
-                                 "(expected LOW < HIGH)")
+            raise ParameterError(f"{self.name}: bounds {as_given(self.low)}:"
+                                 f"{as_given(self.high)} are empty (expected LOW < HIGH)")
         if self.prior == "normal":
             if not self.prior_sd > 0:
-                raise ParameterError(f"{self.name}: prior sd must be > 0, got {self.prior_sd:g}")
+                raise ParameterError(f"{self.name}: prior sd must be > 0, got "
+                                     f"{as_given(self.prior_sd)}")
             if not self.low <= self.prior_mean <= self.high:
                 raise ParameterError(
-                    f"{self.name}: bounds {self.low:g}:{self.high:g} exclude the prior mean "
-                    f"{self.prior_mean:g}")
+                    f"{self.name}: bounds {as_given(self.low)}:{as_given(self.high)} exclude "
+                    f"the prior mean {as_given(self.prior_mean)}")
         if self.prior == "log-uniform" and self.low <= 0:
             raise ParameterError(f"{self.name}: a log-uniform prior needs bounds > 0")
 
@@ -309,8 +310,9 @@ def check_domains(specs: Sequence[ParameterSpec], specimen=None,
         return ""
 
     def outside(spec: ParameterSpec, bound: float, complaint: str) -> ParameterError:
-        return ParameterError(f"{_prior_words(spec, given)}: {spec.name}={bound:g} is outside "
-                              f"its physical domain ({complaint}); give a range inside it")
+        return ParameterError(f"{_prior_words(spec, given)}: {spec.name}={as_given(bound)} "
+                              f"is outside its physical domain ({complaint}); give a range "
+                              "inside it")
 
     for spec in specs:
         if spec.kind == "hyper" and spec.low < 0:  # a relative standard deviation
