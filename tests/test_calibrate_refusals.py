@@ -122,6 +122,28 @@ def test_a_static_friction_range_below_the_sliding_friction_is_refused():
     build_specs(["static_friction"])  # the default bounds (0.1..1.0) reach above both
 
 
+@pytest.mark.parametrize("name", ["static_friction_pw", "pairs.particle_wall.static_friction"])
+def test_a_static_friction_follows_one_rule_under_either_name(name):
+    # pairs.particle_wall.static_friction=0.1:0.3 was refused as outside its physical domain
+    # while static_friction_pw=0.1:0.3 was fitted, its points below 0.14 taken as 0.14 (the
+    # documented rule): one parameter, one rule, the documented one
+    from pidcore.calibrate.runner import specimen_with
+
+    spec = next(s for s in build_specs([name], [f"{name}=0.1:0.3"]) if s.name == name)
+    assert (spec.low, spec.high) == (0.1, 0.3)
+    paper = paper_specimen()
+    wall = [specimen_with(paper, {name: v}).pairs.particle_wall.static_friction
+            for v in (0.1, 0.3)]
+    assert wall == [0.14, 0.3]  # below the sliding friction 0.14: taken as it
+    # a range wholly below it changes no run: refused alike under both names
+    with pytest.raises(ParameterError, match=rf"^--prior {name}=0.05:0.12: static friction "
+                                             r"below the sliding friction \(at least 0.14"):
+        build_specs([name], [f"{name}=0.05:0.12"])
+    # a sliding friction set by dotted path in the same call is the floor
+    both = specimen_with(paper, {name: 0.1, "pairs.particle_wall.sliding_friction": 0.05})
+    assert both.pairs.particle_wall.static_friction == 0.1
+
+
 def test_a_design_point_outside_the_domain_names_it_not_the_specimen_file():
     # a constraint the corners cannot see would fail inside the design: the design point is
     # named, not the bundled specimen file

@@ -98,6 +98,29 @@ def dem_alias_paths(name: str) -> tuple[str, tuple[str, ...]] | None:
     return None
 
 
+def friction_paths(name: str) -> tuple[str, tuple[str, ...]] | None:
+    """(pair field, pair names) of a parameter that sets a pair's friction by a rule of its
+    own: a named alias (:func:`dem_alias_paths`), or a pair's static or sliding friction by
+    dotted path (``pairs.particle_wall.static_friction``).
+
+    One parameter, one rule: ``pairs.particle_wall.static_friction`` is
+    ``static_friction_pw`` and is taken as the sliding friction where below it, as the
+    documented alias is; the dotted path used to go to the specimen unchanged, so the same
+    prior was refused as outside the physical domain under one name and fitted under the
+    other. A dotted ``sliding_friction`` sets that field alone (unlike ``friction``, which
+    sets the static one too); it is named here so that a static friction set with it is
+    checked against it.
+    """
+    alias = dem_alias_paths(name)
+    if alias is not None:
+        return alias
+    parts = name.split(".")
+    if (len(parts) == 3 and parts[0] == "pairs" and parts[1] in _PAIR[""]
+            and parts[2] in ("static_friction", "sliding_friction")):
+        return parts[2], (parts[1],)
+    return None
+
+
 def dem_parameter_names() -> list[str]:
     """Named DEM parameters ``--fit`` accepts besides dotted specimen paths."""
     return [f"{n}{s}" for n in _DEM_ALIASES for s in ("", "_pp", "_pw")]
@@ -363,11 +386,11 @@ def _check_static_friction(dem: Sequence[ParameterSpec], specimen,
     lowest = {pair: getattr(specimen.pairs, pair).sliding_friction
               for pair in ("particle_particle", "particle_wall")}
     for spec in dem:
-        alias = dem_alias_paths(spec.name)
+        alias = friction_paths(spec.name)
         if alias is not None and alias[0] == "sliding_friction":
             lowest.update((pair, spec.low) for pair in alias[1])
     for spec in dem:
-        alias = dem_alias_paths(spec.name)
+        alias = friction_paths(spec.name)
         if alias is None or alias[0] != "static_friction":
             continue
         floor = {pair: lowest[pair] for pair in alias[1]}
