@@ -235,3 +235,22 @@ def test_teardown_errors_are_silent_after_an_interrupt_and_reported_before(capsy
     finally:
         interrupt.reset()
         restore()
+
+
+def test_the_generic_interrupt_line_names_only_what_the_command_has(tmp_path, capsys,
+                                                                    monkeypatch):
+    # `analyze --no-store` said "no store write was left half-done (an output folder may hold
+    # part of this run's files)": it has neither
+    import pidcore.cli.analyze as analyze_cli
+    from pidcore.cli import main
+
+    def interrupted(*args, **kwargs):  # before analyze's own accounting
+        interrupt._interrupted.set()
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(analyze_cli, "_stated", interrupted)
+    assert main(["analyze", str(tmp_path / "x.csv"), "--no-store"]) == 130
+    assert capsys.readouterr().err == "pidcore analyze: interrupted; nothing was saved\n"
+    assert main(["analyze", str(tmp_path / "x.csv"), "--store", str(tmp_path / "s.h5")]) == 130
+    assert capsys.readouterr().err == \
+        "pidcore analyze: interrupted; no store write was left half-done\n"
