@@ -37,3 +37,17 @@ class StoreError(PidcoreError):
 
 class SimulationError(PidcoreError):
     """A DEM run became unphysical (excess overlap, particle escaped) or was refused."""
+
+
+def as_given(value: float) -> str:
+    """A number in an error message, as the user gave it: ``:g`` where that reads back to the
+    same value (``5``, ``0.05``), else the shortest text that does (``1.0000001``).
+
+    ``:g`` alone keeps 6 digits: ``baseline_loss_factor = 1.0000001`` was refused as
+    ``1: expected a fraction``, a message about a value that is accepted.
+    """
+    short = f"{value:g}"
+    try:
+        return short if float(short) == value else repr(float(value))
+    except (TypeError, ValueError):  # not a number: as Python shows it
+        return repr(value)

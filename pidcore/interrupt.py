@@ -33,6 +33,13 @@ def _unraisable_hook(unraisable) -> None:
     # already set, so say nothing here (the CLI prints its one line) instead of a traceback.
     if unraisable.exc_type is not None and issubclass(unraisable.exc_type, KeyboardInterrupt):
         return
+    # Once SIGINT has arrived, the interrupted run's half-built objects are torn down: e.g.
+    # llvmlite's ObjectRef.__del__ on a PipelineTuningOptions whose __init__ the interrupt cut
+    # short ("AttributeError: ... no attribute '_as_parameter_'", after the CLI's one line).
+    # Errors of a run the user stopped are not the user's business. Before an interrupt, an
+    # unraisable error is a real one and is reported as usual.
+    if _interrupted.is_set():
+        return
     sys.__unraisablehook__(unraisable)
 
 

@@ -77,7 +77,7 @@ from .constants import (
     CellShape,
     TangentialStiffnessModel,
 )
-from .errors import ParameterError
+from .errors import ParameterError, as_given
 
 #: Version of the specimen schema written by :meth:`Specimen.to_toml`.
 SCHEMA_VERSION = 1
@@ -163,7 +163,7 @@ def _plausible(where: str, key: str, value: float) -> None:
     hint = r.below if value < r.low else r.above
     unit = {"m": "metres", "kg": "kilograms", "Pa": "pascals",
             "": "a fraction"}.get(r.unit, r.unit)
-    shown = f"{value:g} {r.unit}".rstrip()  # a ratio has no unit to show
+    shown = f"{as_given(value)} {r.unit}".rstrip()  # a ratio has no unit to show
     raise _fail(where, f"{shown}: expected {unit} ({r.what})" + (f"; {hint}" if hint else ""))
 
 
@@ -184,7 +184,7 @@ def particles_for_fill(fill_percent: float, full: int) -> int:
     if n < 1:
         # the smallest fill shown on a 0.01 % step strictly above half a particle: rounds to 1
         least = math.floor(5000.0 / full) / 100 + 0.01
-        raise ParameterError(f"fill {fill_percent:g} % of {full} particles rounds to none; "
+        raise ParameterError(f"fill {as_given(fill_percent)} % of {full} particles rounds to none; "
                              f"expected >= {least:.2f} %")
     return n
 
@@ -361,7 +361,7 @@ class Specimen:
         area = self.cell.count * self.geometry().volume_m3() / self.cell.height_m
         if self.coupon.mass_kg / area > MAX_COUPON_AREAL_MASS_KG_M2:
             raise _fail("[coupon] mass_kg",
-                        f"{self.coupon.mass_kg:g} kg on {self.cell.count} cells "
+                        f"{as_given(self.coupon.mass_kg)} kg on {self.cell.count} cells "
                         f"({area * 1e4:.4g} cm^2) is {self.coupon.mass_kg / area:.4g} kg/m^2; "
                         f"expected kilograms (a coupon is up to "
                         f"{MAX_COUPON_AREAL_MASS_KG_M2:g} kg/m^2); was it g, or is [cell] "

@@ -122,6 +122,28 @@ def test_a_static_friction_range_below_the_sliding_friction_is_refused():
     build_specs(["static_friction"])  # the default bounds (0.1..1.0) reach above both
 
 
+@pytest.mark.parametrize("name", ["static_friction_pw", "pairs.particle_wall.static_friction"])
+def test_a_static_friction_follows_one_rule_under_either_name(name):
+    # pairs.particle_wall.static_friction=0.1:0.3 was refused as outside its physical domain
+    # while static_friction_pw=0.1:0.3 was fitted, its points below 0.14 taken as 0.14 (the
+    # documented rule): one parameter, one rule, the documented one
+    from pidcore.calibrate.runner import specimen_with
+
+    spec = next(s for s in build_specs([name], [f"{name}=0.1:0.3"]) if s.name == name)
+    assert (spec.low, spec.high) == (0.1, 0.3)
+    paper = paper_specimen()
+    wall = [specimen_with(paper, {name: v}).pairs.particle_wall.static_friction
+            for v in (0.1, 0.3)]
+    assert wall == [0.14, 0.3]  # below the sliding friction 0.14: taken as it
+    # a range wholly below it changes no run: refused alike under both names
+    with pytest.raises(ParameterError, match=rf"^--prior {name}=0.05:0.12: static friction "
+                                             r"below the sliding friction \(at least 0.14"):
+        build_specs([name], [f"{name}=0.05:0.12"])
+    # a sliding friction set by dotted path in the same call is the floor
+    both = specimen_with(paper, {name: 0.1, "pairs.particle_wall.sliding_friction": 0.05})
+    assert both.pairs.particle_wall.static_friction == 0.1
+
+
 def test_a_design_point_outside_the_domain_names_it_not_the_specimen_file():
     # a constraint the corners cannot see would fail inside the design: the design point is
     # named, not the bundled specimen file
@@ -257,3 +279,36 @@ def test_outputs_that_cannot_be_made_leave_no_folder(tmp_path):
     with pytest.raises(ParameterError):
         write_outputs(Broken(), out)
     assert not out.exists()
+
+
+def test_a_ctrl_c_while_the_outputs_are_written_leaves_out_as_it_was_and_says_so(
+        capsys, tmp_path, monkeypatch):
+    # ~4 s into a tiny run (the figures) it said the generic "no store write was left
+    # half-done (an output folder may hold part of this run's files)", and --out held a
+    # calibration.json without figures: a folder that looked finished
+    import pidcore.calibrate.outputs as outputs
+
+    store, out = tmp_path / "dem.h5", tmp_path / "out"
+    argv = ["calibrate", "--data", str(_table(tmp_path)), "--fit", "fixture_mass_kg",
+            "--discrepancy", "0.2", "--dem-store", str(store), "--out", str(out), *TINY]
+    plot_pairs = outputs.plot_pairs
+
+    def interrupted(*args, **kwargs):  # the last figure: every other file made before it
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(outputs, "plot_pairs", interrupted)
+    assert main(argv) == 130
+    err = capsys.readouterr().err.strip()
+    assert err == (f"pidcore calibrate: interrupted; 3 DEM run(s) finished before the interrupt "
+                   f"are saved in {store} (3 of the calibration's 3 stored now); a re-run of "
+                   f"the same command computes no DEM run again; nothing written to {out} "
+                   "(left as it was)"), err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["dem.h5", "m.csv"]  # no temp folder
+    # a folder from an earlier run keeps its files, none of them half-replaced
+    monkeypatch.setattr(outputs, "plot_pairs", plot_pairs)
+    assert main(argv) == 0
+    (out / "calibration.json").write_text("earlier")
+    monkeypatch.setattr(outputs, "plot_pairs", interrupted)
+    assert main(argv) == 130
+    assert (out / "calibration.json").read_text() == "earlier"
+    assert len(list(out.iterdir())) == 6 and len(list(tmp_path.iterdir())) == 3

@@ -226,8 +226,9 @@ def test_a_fill_of_no_particle_names_its_option_and_writes_nothing(tmp_path, cap
     assert not store.exists()
 
 
-@pytest.mark.parametrize("fill", ["nan", "inf", "0", "150"])
+@pytest.mark.parametrize("fill", ["nan", "inf", "0", "150", "100.0000001"])
 def test_a_fill_outside_0_100_is_one_line_naming_the_option(capsys, fill):
+    # 100.0000001 was shown as "--fill 100", a fill that is accepted
     # "nan" and "inf" raised a traceback from the particle count's rounding
     code = main(["dem", "run", "--frequency", "500", "--acceleration", "5", "--fill", fill])
     err = capsys.readouterr().err

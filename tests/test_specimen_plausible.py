@@ -237,3 +237,25 @@ def test_a_file_not_in_utf8_is_one_line_and_a_byte_order_mark_is_accepted(tmp_pa
     bom = tmp_path / "bom.toml"
     bom.write_bytes(b"\xef\xbb\xbf" + TEXT.encode("utf-8"))
     assert load_specimen(bom) == load_specimen(STEEL)
+
+
+def test_a_refused_value_is_shown_as_given_not_rounded_to_look_valid():
+    # 1.0000001 was refused as "baseline_loss_factor: 1: expected a fraction", a message
+    # about 1, which is accepted: ":g" keeps 6 digits
+    with pytest.raises(ParameterError, match=r"\[coupon\] baseline_loss_factor: 1\.0000001: "
+                                             r"expected a fraction"):
+        Specimen.from_text(_edit("baseline_loss_factor = 0.0",
+                                 "baseline_loss_factor = 1.0000001"))
+    # the same in a calibration prior beyond the domain (1 is its bound too)
+    from pidcore.calibrate.parameters import build_specs
+
+    with pytest.raises(ParameterError, match=r"baseline_loss_factor=1\.0000001 is outside"):
+        build_specs(["baseline_loss_factor"], ["baseline_loss_factor=0:1.0000001"])
+
+
+def test_as_given_keeps_short_numbers_short_and_long_ones_whole():
+    from pidcore.errors import as_given
+
+    assert [as_given(v) for v in (5.0, 0.05, 3400.0, 1e-7)] == ["5", "0.05", "3400", "1e-07"]
+    assert as_given(1.0000001) == "1.0000001" and as_given(100.0000001) == "100.0000001"
+    assert float(as_given(0.1 + 0.2)) == 0.1 + 0.2  # reads back to the same float

@@ -16,12 +16,6 @@ from .calibrate import CalibrationResult
 SPECIMEN_FILE = "calibrated_specimen.toml"
 
 
-def _write_text(path: Path, text: str) -> None:
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(text, encoding="utf-8")
-    os.replace(tmp, path)
-
-
 def _json_safe(value):
     if isinstance(value, float) and not math.isfinite(value):
         return None
@@ -196,22 +190,47 @@ def plot_pairs(result: CalibrationResult, path: Path) -> None:
 
 
 def write_outputs(result: CalibrationResult, out_dir: str | os.PathLike) -> list[Path]:
-    """Write every output into ``out_dir`` (created); returns the paths written."""
+    """Write every output into ``out_dir`` (created); returns the paths written.
+
+    All or nothing, as the store commits: the files are made in a hidden folder beside
+    ``out_dir`` and moved into it in one step that Ctrl-C cannot cut in two
+    (:func:`pidcore.interrupt.deferred`). A Ctrl-C while they were written (the figures take
+    seconds) used to leave a folder with a calibration.json and no figures, which looked like
+    a finished calibration; now ``out_dir`` is as it was, or holds the whole new set (files
+    of other names in it are kept).
+    """
+    import secrets
+    import shutil
+
+    from .. import interrupt
+
     out = Path(out_dir)
     # every text first: one that cannot be made (a calibrated specimen outside the domain)
-    # refuses before the folder is created, not after, leaving it empty
+    # refuses before any folder is created, not after, leaving it empty
     texts = (("calibration.json", document_json(result.full_document())),
              (SPECIMEN_FILE, specimen_text(result)),
              ("summary.md", summary_markdown(result)),
              ("summary.html", summary_html(result)))
-    out.mkdir(parents=True, exist_ok=True)
-    written = []
-    for name, text in texts:
-        _write_text(out / name, text)
-        written.append(out / name)
-    for name, plot in (("predictions.png", plot_predictions), ("posterior_pairs.png", plot_pairs)):
-        tmp = out / f".{name}.tmp.png"
-        plot(result, tmp)
-        os.replace(tmp, out / name)
-        written.append(out / name)
-    return written
+    out.parent.mkdir(parents=True, exist_ok=True)
+    # beside out_dir: on its file system, so that the moves below are renames (made with
+    # mkdir, not mkdtemp, for the umask's permissions: it may become out_dir itself)
+    work = out.parent / f".{out.name}.{os.getpid()}.{secrets.token_hex(4)}.tmp"
+    work.mkdir()
+    try:
+        names = []
+        for name, text in texts:
+            (work / name).write_text(text, encoding="utf-8")
+            names.append(name)
+        for name, plot in (("predictions.png", plot_predictions),
+                           ("posterior_pairs.png", plot_pairs)):
+            plot(result, work / name)
+            names.append(name)
+        with interrupt.deferred():
+            if not out.exists():
+                os.replace(work, out)
+            else:  # a folder (check_out_folder): each file replaced, the set in one step
+                for name in names:
+                    os.replace(work / name, out / name)
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+    return [out / name for name in names]

@@ -27,7 +27,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..errors import ParameterError
+from ..errors import ParameterError, as_given
 
 DISCREPANCY = "model_discrepancy"
 
@@ -49,15 +49,16 @@ class ParameterSpec:
 
     def check(self) -> None:
         if not (math.isfinite(self.low) and math.isfinite(self.high) and self.low < self.high):
-            raise ParameterError(f"{self.name}: bounds {self.low:g}:{self.high:g} are empty "
-                                 "(expected LOW < HIGH)")
+            raise ParameterError(f"{self.name}: bounds {as_given(self.low)}:"
+                                 f"{as_given(self.high)} are empty (expected LOW < HIGH)")
         if self.prior == "normal":
             if not self.prior_sd > 0:
-                raise ParameterError(f"{self.name}: prior sd must be > 0, got {self.prior_sd:g}")
+                raise ParameterError(f"{self.name}: prior sd must be > 0, got "
+                                     f"{as_given(self.prior_sd)}")
             if not self.low <= self.prior_mean <= self.high:
                 raise ParameterError(
-                    f"{self.name}: bounds {self.low:g}:{self.high:g} exclude the prior mean "
-                    f"{self.prior_mean:g}")
+                    f"{self.name}: bounds {as_given(self.low)}:{as_given(self.high)} exclude "
+                    f"the prior mean {as_given(self.prior_mean)}")
         if self.prior == "log-uniform" and self.low <= 0:
             raise ParameterError(f"{self.name}: a log-uniform prior needs bounds > 0")
 
@@ -94,6 +95,29 @@ def dem_alias_paths(name: str) -> tuple[str, tuple[str, ...]] | None:
             return _DEM_ALIASES[name[:-3]][0], _PAIR[suffix]
     if name in _DEM_ALIASES:
         return _DEM_ALIASES[name][0], _PAIR[""]
+    return None
+
+
+def friction_paths(name: str) -> tuple[str, tuple[str, ...]] | None:
+    """(pair field, pair names) of a parameter that sets a pair's friction by a rule of its
+    own: a named alias (:func:`dem_alias_paths`), or a pair's static or sliding friction by
+    dotted path (``pairs.particle_wall.static_friction``).
+
+    One parameter, one rule: ``pairs.particle_wall.static_friction`` is
+    ``static_friction_pw`` and is taken as the sliding friction where below it, as the
+    documented alias is; the dotted path used to go to the specimen unchanged, so the same
+    prior was refused as outside the physical domain under one name and fitted under the
+    other. A dotted ``sliding_friction`` sets that field alone (unlike ``friction``, which
+    sets the static one too); it is named here so that a static friction set with it is
+    checked against it.
+    """
+    alias = dem_alias_paths(name)
+    if alias is not None:
+        return alias
+    parts = name.split(".")
+    if (len(parts) == 3 and parts[0] == "pairs" and parts[1] in _PAIR[""]
+            and parts[2] in ("static_friction", "sliding_friction")):
+        return parts[2], (parts[1],)
     return None
 
 
@@ -309,8 +333,9 @@ def check_domains(specs: Sequence[ParameterSpec], specimen=None,
         return ""
 
     def outside(spec: ParameterSpec, bound: float, complaint: str) -> ParameterError:
-        return ParameterError(f"{_prior_words(spec, given)}: {spec.name}={bound:g} is outside "
-                              f"its physical domain ({complaint}); give a range inside it")
+        return ParameterError(f"{_prior_words(spec, given)}: {spec.name}={as_given(bound)} "
+                              f"is outside its physical domain ({complaint}); give a range "
+                              "inside it")
 
     for spec in specs:
         if spec.kind == "hyper" and spec.low < 0:  # a relative standard deviation
@@ -361,11 +386,11 @@ def _check_static_friction(dem: Sequence[ParameterSpec], specimen,
     lowest = {pair: getattr(specimen.pairs, pair).sliding_friction
               for pair in ("particle_particle", "particle_wall")}
     for spec in dem:
-        alias = dem_alias_paths(spec.name)
+        alias = friction_paths(spec.name)
         if alias is not None and alias[0] == "sliding_friction":
             lowest.update((pair, spec.low) for pair in alias[1])
     for spec in dem:
-        alias = dem_alias_paths(spec.name)
+        alias = friction_paths(spec.name)
         if alias is None or alias[0] != "static_friction":
             continue
         floor = {pair: lowest[pair] for pair in alias[1]}

@@ -19,7 +19,7 @@ from pathlib import Path
 from ..dem.persist import dem_run_entry, run_key, save_dem_entry
 from ..dem.simulate import DemConfig, LoadCase, simulate_load_case
 from ..specimen import Specimen
-from .parameters import dem_alias_paths
+from .parameters import dem_alias_paths, friction_paths
 
 
 def specimen_with(specimen: Specimen, values: Mapping[str, float]) -> Specimen:
@@ -27,17 +27,20 @@ def specimen_with(specimen: Specimen, values: Mapping[str, float]) -> Specimen:
 
     ``friction`` sets the sliding friction and the static friction to the same value (one
     Coulomb coefficient, today's model); a ``static_friction`` given as well is then the stick
-    limit, taken as the sliding friction where below it (static >= sliding always).
+    limit, taken as the sliding friction where below it (static >= sliding always); so is a
+    static friction by dotted path (``pairs.particle_wall.static_friction``, the same
+    parameter as ``static_friction_pw``: :func:`pidcore.calibrate.parameters.friction_paths`).
     """
     changes: dict[str, float] = {}
     # sliding friction first: a static friction set in the same call is checked against it
-    order = sorted(values, key=lambda n: 0 if (dem_alias_paths(n) or ("",))[0]
+    order = sorted(values, key=lambda n: 0 if (friction_paths(n) or ("",))[0]
                    == "sliding_friction" else 1)
     for name in order:
         value = float(values[name])
-        alias = dem_alias_paths(name)
-        if alias is None:
-            changes[name] = value
+        # a static friction by dotted path follows the alias's rule (friction_paths)
+        alias = friction_paths(name)
+        if alias is None or (dem_alias_paths(name) is None and alias[0] == "sliding_friction"):
+            changes[name] = value  # a dotted sliding friction sets that field alone
             continue
         field, pairs = alias
         for pair in pairs:
@@ -116,21 +119,11 @@ def run_requests(requests: Sequence[RunRequest], *, store_path: str | os.PathLik
             for request in todo:
                 finish(*_run_entry(request))
         elif todo:
-            from concurrent.futures import ProcessPoolExecutor, as_completed
+            from ..dem.sweep import run_pooled
 
-            from ..dem.sweep import dem_process_context, init_dem_worker
-
-            pool = ProcessPoolExecutor(max_workers=min(workers, len(todo)),
-                                       mp_context=dem_process_context(),
-                                       initializer=init_dem_worker)
-            try:
-                futures = [pool.submit(_run_entry, request) for request in todo]
-                for future in as_completed(futures):
-                    finish(*future.result())
-            except BaseException:
-                pool.shutdown(wait=False, cancel_futures=True)
-                raise
-            pool.shutdown()
+            # on Ctrl-C the workers are stopped and waited for; finished runs are saved
+            run_pooled(_run_entry, [(request,) for request in todo], workers=workers,
+                       finish=lambda result: finish(*result))
     finally:
         if bar is not None:
             bar.close()

@@ -62,6 +62,7 @@ def _run(argv: list[str] | None) -> int:
     words = sys.argv[1:] if argv is None else argv
     command = next((w for w in words if not w.startswith("-")), "COMMAND")
     started = False
+    args: argparse.Namespace | None = None
     try:
         parser = build_parser(command)
         args, unknown = parser.parse_known_args(argv)
@@ -86,13 +87,31 @@ def _run(argv: list[str] | None) -> int:
         # an interrupt, or what one turned into inside C code (pidcore.interrupt)
         if not interrupt.is_interruption(exc):
             raise
-        # commands that count what they saved say so themselves (analyze, dem); here only
-        # what holds for every command: a store write is whole or absent, never half-done
-        said = ("no store write was left half-done (an output folder may hold part of this "
-                "run's files)" if started else "nothing was done")
+        # commands that count what they saved say so themselves (analyze, dem, calibrate);
+        # here only what holds for every command: a store write is whole or absent, never
+        # half-done, and an output folder may hold part of the files
+        said = _what_an_interrupt_left(args) if started and args is not None \
+            else "nothing was done"
         print(f"pidcore {command}: interrupted; {said}", file=sys.stderr)
         interrupt.mark_handled()
         return 130
+
+
+def _what_an_interrupt_left(args: argparse.Namespace) -> str:
+    """What an interrupted command may have left, from the options it was given: a store
+    (``--store``/``--dem-store``; none with ``--no-store``) whose writes are whole or absent,
+    an ``--out`` folder that may hold part of the files. Only what the command has: an
+    "output folder" said of ``analyze --no-store`` named something it does not have."""
+    stores = [] if getattr(args, "no_store", False) else \
+        [s for s in (getattr(args, "store", None), getattr(args, "dem_store", None)) if s]
+    out = getattr(args, "out", None)
+    if stores and out is not None:
+        return f"no store write was left half-done ({out} may hold part of this run's files)"
+    if stores:
+        return "no store write was left half-done"
+    if out is not None:
+        return f"{out} may hold part of this run's files"
+    return "nothing was saved"
 
 
 def _command_name(args: argparse.Namespace) -> str:

@@ -7,7 +7,7 @@ import re
 from pathlib import Path
 
 from .. import defaults
-from ..errors import ParameterError
+from ..errors import ParameterError, as_given
 from ..measure import AnalysisOptions
 
 #: Help of ``--store`` where it names the default store.
@@ -141,7 +141,7 @@ def analysis_options(args: argparse.Namespace) -> AnalysisOptions:
     delay = given(args.velocity_delay)
     if not delay >= 0:  # NaN too
         # the library takes a signed delay (a late force); a vibrometer only ever lags
-        raise ParameterError(f"--velocity-delay {delay:g}: expected a delay "
+        raise ParameterError(f"--velocity-delay {as_given(delay)}: expected a delay "
                              ">= 0 s (the vibrometer output lags the motion)")
     return AnalysisOptions(
         force=args.force, velocity=args.velocity, acceleration=args.acceleration,

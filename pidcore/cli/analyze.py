@@ -129,7 +129,8 @@ def _run(args: argparse.Namespace) -> int:
             raise
         said = (f"interrupted after saving {_saved(results)} to {args.store}"
                 if store is not None and store.commits else
-                "interrupted; nothing saved, the store is unchanged")
+                "interrupted; nothing saved, the store is unchanged" if store is not None else
+                "interrupted; nothing saved (--no-store)")
         print(f"pidcore analyze: {said}", file=sys.stderr)
         interrupt.mark_handled()
         return 130

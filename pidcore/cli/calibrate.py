@@ -89,6 +89,7 @@ def run(args: argparse.Namespace) -> int:
     points = read_measured_table(args.data, default_material=default_material) \
         if args.data is not None else measured_from_store(args.store)
     tally = RunTally(args.dem_store)
+    written = False
     try:
         result = calibrate(points, fit=fit, priors=args.prior, discrepancy=args.discrepancy,
                            discrepancy_floor=args.discrepancy_floor, store_path=args.dem_store,
@@ -97,15 +98,18 @@ def run(args: argparse.Namespace) -> int:
                            cross_validate=args.cross_validate, method=args.method,
                            progress=not args.no_progress, specimen=specimen,
                            on_design=tally.design)
+        if args.out is not None:
+            write_outputs(result, args.out)  # all or nothing
+            written = True
+        interrupt.raise_if_interrupted()  # one swallowed on the way, or held by the move
     except BaseException as exc:  # noqa: BLE001 - an interrupt, or what one became in C code
         if not interrupt.is_interruption(exc):
             raise
         # finished runs are each saved in their own transaction: counted from the store
-        print(f"pidcore calibrate: interrupted; {tally.interrupted()}", file=sys.stderr)
+        print(f"pidcore calibrate: interrupted; {tally.interrupted()}"
+              f"{_out_words(args.out, written)}", file=sys.stderr)
         interrupt.mark_handled()
         return 130
-    if args.out is not None:
-        write_outputs(result, args.out)
     for note in result.notes:
         print(f"pidcore calibrate: note: {note}", file=sys.stderr)
     if args.json:
@@ -120,3 +124,12 @@ def run(args: argparse.Namespace) -> int:
         if args.out is not None:
             print(f"wrote {args.out}")
     return 0
+
+
+def _out_words(out: Path | None, written: bool) -> str:
+    """What an interrupt left of ``--out`` (written all at once or not at all: write_outputs)."""
+    if out is None:
+        return ""
+    if written:
+        return f"; {out} was written in full"
+    return f"; nothing written to {out} (left as it was)"

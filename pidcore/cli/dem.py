@@ -19,7 +19,7 @@ from ..constants import (
     TANGENTIAL_STIFFNESS_MODELS,
     VIBRATED_MASS_CONVENTIONS,
 )
-from ..errors import ParameterError
+from ..errors import ParameterError, as_given
 from ._options import add_json_option, add_store_option, non_negative_int, positive_int
 
 #: Keys of ``pidcore dem run --json`` (more may follow them).
@@ -240,14 +240,14 @@ def _check_fill(fill: float, option: str, args: argparse.Namespace, specimen,
     from ..dem.simulate import particles_per_cell
 
     if not (math.isfinite(fill) and 0.0 < fill <= 100.0):
-        raise ParameterError(f"{option} {fill:g}: expected a fill in (0, 100] %")
+        raise ParameterError(f"{option} {as_given(fill)}: expected a fill in (0, 100] %")
     try:
         particles_per_cell(fill, material, specimen=specimen,
                            fill_reference=args.fill_reference)
     except ParameterError as exc:
         if not str(exc).startswith("fill "):  # not about this fill (e.g. --fill-reference)
             raise
-        raise ParameterError(f"{option} {fill:g}: {exc}") from None
+        raise ParameterError(f"{option} {as_given(fill)}: {exc}") from None
 
 
 def _fill(args: argparse.Namespace, specimen, material: str) -> float:

@@ -15,7 +15,7 @@ from pathlib import Path
 
 from .. import defaults
 from ..constants import PARTICLE_MATERIALS, VIBRATED_MASS_CONVENTIONS
-from ..errors import ParameterError
+from ..errors import ParameterError, as_given
 from ._options import add_store_option, check_out_folder
 
 
@@ -151,7 +151,7 @@ def run_damper(args: argparse.Namespace) -> int:
     model, runs = build_model(args)
     if runs is not None and args.vibrated_mass is not None:
         raise ParameterError(
-            f"--vibrated-mass {args.vibrated_mass:g}: the DEM runs in {args.store} divided "
+            f"--vibrated-mass {as_given(args.vibrated_mass)}: the DEM runs in {args.store} divided "
             "their SDC by their own m_c, which c_eq = SDC m_c w / (2 pi) must use; leave "
             "--vibrated-mass out")
     for option, axis, values in (("--fills", 0, args.fills), ("--accelerations", 1,
@@ -160,7 +160,7 @@ def run_damper(args: argparse.Namespace) -> int:
         lo, hi = model.axes[axis][0], model.axes[axis][-1]
         outside = [v for v in values or () if not lo <= v <= hi]
         if outside:
-            raise ParameterError(f"{option} {','.join(f'{v:g}' for v in outside)}: outside "
+            raise ParameterError(f"{option} {','.join(as_given(v) for v in outside)}: outside "
                                  f"the model's range {lo:g} .. {hi:g} (never extrapolated)")
     if runs is not None:
         for option, column, given in (("--mass-convention", "vibrated_mass_convention",

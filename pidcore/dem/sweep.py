@@ -119,23 +119,103 @@ def dem_process_context():
         return multiprocessing.get_context("spawn")
     context = multiprocessing.get_context("forkserver")
     context.set_forkserver_preload(_WORKER_MODULES)
+    _start_fork_server_deaf_to_ctrl_c()
     return context
+
+
+def _start_fork_server_deaf_to_ctrl_c() -> None:
+    """Start the fork server (if not yet running) with SIGINT blocked, so that it and every
+    process it forks never see Ctrl-C: the parent stops them (:func:`run_pooled`).
+
+    A terminal's Ctrl-C goes to the whole process group. A worker still starting up when it
+    lands printed ``KeyboardInterrupt`` from inside multiprocessing's bootstrap, before any
+    initializer could ignore it. A blocked signal stays blocked across the fork server's
+    fork/exec and its forks, so there is no such window. Blocking (not ignoring) in the
+    calling thread for these few milliseconds loses nothing: a Ctrl-C that comes meanwhile is
+    delivered when the mask is put back. A fork server started earlier by other code is left
+    as it is.
+    """
+    import signal
+    from multiprocessing import forkserver, resource_tracker
+
+    # the fork server starts the resource tracker first, which unblocks SIGINT when it has
+    # started it (resource_tracker.ensure_running): started before the block, it is left as is
+    resource_tracker.ensure_running()
+    previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        forkserver.ensure_running()
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
 
 
 def init_dem_worker() -> None:
     """Set up a pool process that runs DEM cases (sweeps, calibration design runs).
 
     One kernel thread: the parallelism is across cases, threads inside each would
-    oversubscribe the cores. Ctrl-C routed through :mod:`pidcore.interrupt`, so that a case
-    stops at its next block of cycles even when the interrupt was swallowed inside Numba
-    (a worker used to run its case to the end, up to a minute and more).
+    oversubscribe the cores. Ctrl-C ignored: the parent terminates its workers on an
+    interrupt (:func:`run_pooled`), which stops a case at once, even inside a Numba kernel;
+    a worker that handled Ctrl-C itself printed a traceback when the signal came while it
+    waited for work (``spawn`` start-up; with the fork server SIGINT is already blocked).
     """
+    import multiprocessing
+    import signal
+
     import numba
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    # Numba makes a named (file-backed) process lock when the start method contains "fork",
+    # "forkserver" included; a worker terminated on Ctrl-C leaves it behind, and the resource
+    # tracker warns of a "leaked semaphore" after the CLI's one line. Each worker makes its
+    # own, so it guards nothing between workers; a worker starts no process of its own, so
+    # its default start method is free to change.
+    multiprocessing.set_start_method("spawn", force=True)
+    numba.set_num_threads(1)
+
+
+def run_pooled(function: Callable, calls: Sequence[tuple], *, workers: int,
+               finish: Callable[[object], None]) -> None:
+    """``function(*call)`` for each of ``calls`` in up to ``workers`` DEM processes; ``finish``
+    (in this process) gets each result as it comes, in the order they finish.
+
+    On Ctrl-C or a failed call the workers are terminated and waited for before the exception
+    goes on: the results already given to ``finish`` are all that is kept. Leaving them
+    running (``shutdown(wait=False)``) let this process exit first; a worker still starting
+    then found the pool's semaphores removed and printed ``FileNotFoundError`` from
+    multiprocessing's ``forkserver.py`` after the CLI's one line.
+    """
+    from concurrent.futures import ProcessPoolExecutor, as_completed
 
     from .. import interrupt
 
-    numba.set_num_threads(1)
-    interrupt.install()
+    pool = ProcessPoolExecutor(max_workers=min(workers, len(calls)),
+                               mp_context=dem_process_context(),
+                               initializer=init_dem_worker)
+    try:
+        # submit() starts the workers: a Ctrl-C inside Process.start() could leave a worker
+        # forked but not yet in the pool's table, out of reach of _stop_pool; held back until
+        # every submit is done (milliseconds)
+        with interrupt.deferred():
+            futures = [pool.submit(function, *call) for call in calls]
+        interrupt.raise_if_interrupted()
+        for future in as_completed(futures):
+            finish(future.result())
+    except BaseException:
+        _stop_pool(pool)
+        raise
+    pool.shutdown()
+
+
+def _stop_pool(pool) -> None:
+    """Terminate a ProcessPoolExecutor's workers and wait until they are gone."""
+    # The executor has no public way to stop running work before Python 3.14
+    # (terminate_workers); its process table is read before shutdown() clears it.
+    processes = list((getattr(pool, "_processes", None) or {}).values())
+    for process in processes:
+        if process.is_alive():
+            process.terminate()
+    pool.shutdown(wait=True, cancel_futures=True)
+    for process in processes:
+        process.join()
 
 
 #: How a sweep got each case's run (:attr:`SweepSummary.cases`).
@@ -314,20 +394,9 @@ def _run_local(todo: Iterable[tuple[LoadCase, str]], config: DemConfig, workers:
         for case, _ in todo:
             finish(run_case(case, config, specimen))
         return
-    from concurrent.futures import ProcessPoolExecutor, as_completed
-
-    pool = ProcessPoolExecutor(max_workers=min(workers, len(todo)),
-                               mp_context=dem_process_context(),
-                               initializer=init_dem_worker)
-    try:
-        futures = [pool.submit(run_case, case, config, specimen) for case, _ in todo]
-        for future in as_completed(futures):
-            finish(future.result())
-    except BaseException:
-        # Ctrl-C or a failed case: drop queued work now; finished cases are already stored.
-        pool.shutdown(wait=False, cancel_futures=True)
-        raise
-    pool.shutdown()
+    # Ctrl-C or a failed case stops the workers; finished cases are already stored
+    run_pooled(run_case, [(case, config, specimen) for case, _ in todo], workers=workers,
+               finish=finish)
 
 
 def _run_dask(todo: Iterable[tuple[LoadCase, str]], config: DemConfig, scheduler: str,

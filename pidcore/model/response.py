@@ -36,7 +36,7 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
 from ..constants import STANDARD_GRAVITY
-from ..errors import ParameterError
+from ..errors import ParameterError, as_given
 from .damper import coupon_area_m2, equivalent_damping_coefficient
 from .sdc_model import SdcModel
 
@@ -161,8 +161,8 @@ def _sdc_section(model: SdcModel, mode: TreatedMode, frequency_hz: float,
     f_lo, f_hi = model.bounds["frequency_hz"]
     inside_f = f_lo * (1 - _RANGE_RTOL) <= frequency_hz <= f_hi * (1 + _RANGE_RTOL)
     if not inside_f and not clip_to_range:
-        raise ParameterError(f"harmonic_response: frequency {frequency_hz:g} Hz outside the "
-                             f"SDC model range [{f_lo:g}, {f_hi:g}] Hz; pass "
+        raise ParameterError(f"harmonic_response: frequency {as_given(frequency_hz)} Hz outside "
+                             f"the SDC model range [{f_lo:g}, {f_hi:g}] Hz; pass "
                              f"clip_to_range=True to hold the edge SDC")
     section = model.acceleration_section(mode.fill_percent,
                                          float(np.clip(frequency_hz, f_lo, f_hi)))

@@ -47,7 +47,7 @@ import numpy as np
 import pandas as pd
 from scipy.interpolate import PchipInterpolator
 
-from ..errors import ParameterError
+from ..errors import ParameterError, as_given
 
 #: Names of the model's axes, in the order of :attr:`SdcModel.axes` and of ``__call__``.
 AXIS_NAMES: tuple[str, str, str] = ("fill_percent", "acceleration_g", "frequency_hz")
@@ -288,8 +288,9 @@ class SdcModel:
         :class:`ParameterError` if fill or frequency lies outside the grid.
         """
         if not self.contains((fill_percent, self.axes[1][0], frequency_hz)):
-            raise ParameterError(f"SdcModel: fill_percent={fill_percent:g} %, frequency_hz="
-                                 f"{frequency_hz:g} Hz outside the model range {self.bounds}")
+            raise ParameterError(f"SdcModel: fill_percent={as_given(fill_percent)} %, "
+                                 f"frequency_hz={as_given(frequency_hz)} Hz outside the "
+                                 f"model range {self.bounds}")
         f = np.clip(float(fill_percent), self.axes[0][0], self.axes[0][-1])
         z = np.clip(float(frequency_hz), self.axes[2][0], self.axes[2][-1])
         zq = np.log10(z) if self.log_frequency else z

@@ -50,7 +50,7 @@ import pandas as pd
 
 from .. import defaults
 from ..constants import STANDARD_GRAVITY
-from ..errors import ChannelError, ParameterError, SignalError
+from ..errors import ChannelError, ParameterError, SignalError, as_given
 from ..loop import ForceDisplacementLoop
 from ..records import Channel
 from . import validate
@@ -279,7 +279,7 @@ def _check_parameters(sample_rate_hz: float, n_harmonics: int, n_blocks: int, mi
     if frequency_hz is not None and not (math.isfinite(frequency_hz) and frequency_hz > 0):
         raise ParameterError(f"frequency_hz: {frequency_hz!r}, expected a positive hint in Hz")
     if frequency_hz is not None and frequency_hz >= sample_rate_hz / 2:
-        raise ParameterError(f"frequency_hz: {frequency_hz:g} Hz is not below the Nyquist "
+        raise ParameterError(f"frequency_hz: {as_given(frequency_hz)} Hz is not below the Nyquist "
                              f"frequency {sample_rate_hz / 2:g} Hz")
     if not math.isfinite(velocity_delay_s):
         raise ParameterError(f"velocity_delay_s: {velocity_delay_s!r}, expected a finite time")

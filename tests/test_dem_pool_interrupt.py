@@ -1,0 +1,109 @@
+"""Ctrl-C during a pooled DEM run (``dem sweep``, ``calibrate``): the workers are stopped and
+waited for, and nothing but the CLI's one line reaches the terminal."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import threading
+import time
+from pathlib import Path
+
+import pytest
+from _pool_probe import wait_in_worker
+
+from pidcore.dem.sweep import run_pooled
+
+TESTS = Path(__file__).resolve().parent
+ROOT = TESTS.parent
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    return True
+
+
+def _when_started(folder: Path, count: int, then) -> threading.Thread:
+    """Call ``then()`` once ``count`` workers have said they are running (at most 60 s)."""
+    def watch() -> None:
+        deadline = time.monotonic() + 60
+        while len(list(folder.iterdir())) < count and time.monotonic() < deadline:
+            time.sleep(0.02)
+        then()
+
+    thread = threading.Thread(target=watch, daemon=True)
+    thread.start()
+    return thread
+
+
+@pytest.mark.slow
+def test_an_interrupted_pool_has_stopped_its_workers_when_the_interrupt_goes_on(tmp_path):
+    # Left running (shutdown(wait=False)), a worker outlived the CLI: one still starting found
+    # the pool's semaphores removed and printed multiprocessing's FileNotFoundError traceback
+    # after the one line. 60 s of waiting per case: only a terminated worker is gone at once.
+    main = threading.main_thread().ident  # a real signal: it wakes the waiting main thread
+    watcher = _when_started(tmp_path, 2, lambda: signal.pthread_kill(main, signal.SIGINT))
+    with pytest.raises(KeyboardInterrupt):
+        run_pooled(wait_in_worker, [(str(tmp_path), 60.0)] * 4, workers=2, finish=print)
+    watcher.join()
+    pids = [int(p.name) for p in tmp_path.iterdir()]
+    assert len(pids) == 2 and not any(_alive(pid) for pid in pids)
+
+
+@pytest.mark.slow
+def test_dem_workers_never_see_ctrl_c_the_parent_stops_them():
+    # A terminal's Ctrl-C reaches every process of the group; a worker that handled it printed
+    # a KeyboardInterrupt traceback when it came during the worker's start-up. SIGINT is
+    # blocked from the fork server's start (no window) and ignored once the worker is set up.
+    # In a fresh interpreter: the fork server of this one may have been started by other code.
+    code = textwrap.dedent("""
+        from _pool_probe import sigint_state
+        from pidcore.dem.sweep import run_pooled
+        if __name__ == "__main__":
+            states = []
+            run_pooled(sigint_state, [(0,), (1,)], workers=2, finish=states.append)
+            print(sorted(set(states)))
+    """)
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT), str(TESTS)])}
+    done = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
+                          text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == "[(True, True)]"  # ignored and blocked in every worker
+
+
+@pytest.mark.slow
+def test_ctrl_c_to_the_whole_group_prints_only_the_callers_line(tmp_path):
+    # As a terminal sends it: to the caller and its workers at once, the workers mid-case.
+    # Before: a worker's own KeyboardInterrupt; a terminated worker's Numba lock left for the
+    # resource tracker to report ("leaked semaphore objects") after the caller's line.
+    code = textwrap.dedent(f"""
+        import sys
+        from pidcore import interrupt
+        from pidcore.dem.sweep import run_pooled
+        from _pool_probe import wait_in_worker
+        if __name__ == "__main__":
+            interrupt.install()
+            try:
+                run_pooled(wait_in_worker, [({str(tmp_path)!r}, 60.0)] * 4, workers=2,
+                           finish=print)
+            except KeyboardInterrupt:
+                print("interrupted", file=sys.stderr)
+                sys.exit(130)
+    """)
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT), str(TESTS)])}
+    p = subprocess.Popen([sys.executable, "-c", code], env=env, stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, text=True, start_new_session=True)
+    deadline = time.monotonic() + 90
+    while len(list(tmp_path.iterdir())) < 2 and time.monotonic() < deadline:
+        time.sleep(0.02)
+    os.killpg(p.pid, signal.SIGINT)
+    out, err = p.communicate(timeout=60)  # waits for the resource tracker's stderr too
+    assert p.returncode == 130 and err == "interrupted\n", err
+    pids = [int(f.name) for f in tmp_path.iterdir()]
+    assert len(pids) == 2 and not any(_alive(pid) for pid in pids)
