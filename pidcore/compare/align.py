@@ -299,16 +299,27 @@ def consistency_chi2(values: np.ndarray, stderrs: np.ndarray) -> tuple[float, in
     return float(np.sum(w * (v[ok] - mean) ** 2)), int(ok.sum() - 1)
 
 
-def run_settings(parameters_json: object) -> dict | None:
-    """A DEM run's numerical settings: every stored input (its ``parameters_json``) except the
-    load case and the seed; None where they are not stored or not readable."""
+def _stored_parameters(parameters_json: object) -> dict | None:
+    """A DEM run's stored inputs as a dict (from a store listing's JSON string, or a dict
+    :func:`pidcore.dem.persist.run_parameters` gives); None where none are readable."""
     import json
 
+    if isinstance(parameters_json, dict):
+        return dict(parameters_json)
     if not isinstance(parameters_json, str) or not parameters_json:
         return None
     try:
         params = json.loads(parameters_json)
     except ValueError:
+        return None
+    return params if isinstance(params, dict) else None
+
+
+def run_settings(parameters_json: object) -> dict | None:
+    """A DEM run's numerical settings: every stored input (its ``parameters_json``) except the
+    load case and the seed; None where they are not stored or not readable."""
+    params = _stored_parameters(parameters_json)
+    if params is None:
         return None
     return {k: v for k, v in params.items() if not k.startswith("case_") and k != "config_seed"}
 
@@ -329,17 +340,9 @@ def simulation_identity(parameters_json: object, particles_per_cell: object) -> 
     import hashlib
     import json
 
-    if isinstance(parameters_json, dict):
-        params = dict(parameters_json)
-    else:
-        if not isinstance(parameters_json, str) or not parameters_json:
-            return None
-        try:
-            params = json.loads(parameters_json)
-        except ValueError:
-            return None
-        if not isinstance(params, dict):
-            return None
+    params = _stored_parameters(parameters_json)
+    if params is None:
+        return None
     try:
         count = float(particles_per_cell)
     except (TypeError, ValueError):
