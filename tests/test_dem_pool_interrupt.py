@@ -8,14 +8,10 @@ import signal
 import subprocess
 import sys
 import textwrap
-import threading
 import time
 from pathlib import Path
 
 import pytest
-from _pool_probe import wait_in_worker
-
-from pidcore.dem.sweep import run_pooled
 
 TESTS = Path(__file__).resolve().parent
 ROOT = TESTS.parent
@@ -36,17 +32,30 @@ def _alive(pid: int) -> bool:
     return state not in ("Z", "X")
 
 
-def _when_started(folder: Path, count: int, then) -> threading.Thread:
-    """Call ``then()`` once ``count`` workers have said they are running (at most 60 s)."""
-    def watch() -> None:
-        deadline = time.monotonic() + 60
-        while len(list(folder.iterdir())) < count and time.monotonic() < deadline:
-            time.sleep(0.02)
-        then()
-
-    thread = threading.Thread(target=watch, daemon=True)
-    thread.start()
-    return thread
+def _pooled_waits(tmp_path: Path) -> subprocess.Popen:
+    """A fresh interpreter running 4 cases of 60 s on 2 pool workers (a test process's own
+    signal state, e.g. a pytest-xdist worker's, is not the CLI's), exit 130 on Ctrl-C."""
+    code = textwrap.dedent(f"""
+        import sys
+        from pidcore import interrupt
+        from pidcore.dem.sweep import run_pooled
+        from _pool_probe import wait_in_worker
+        if __name__ == "__main__":
+            interrupt.install()
+            try:
+                run_pooled(wait_in_worker, [({str(tmp_path)!r}, 60.0)] * 4, workers=2,
+                           finish=print)
+            except KeyboardInterrupt:
+                print("interrupted", file=sys.stderr)
+                sys.exit(130)
+    """)
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT), str(TESTS)])}
+    p = subprocess.Popen([sys.executable, "-c", code], env=env, stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, text=True, start_new_session=True)
+    deadline = time.monotonic() + 90
+    while len(list(tmp_path.iterdir())) < 2 and time.monotonic() < deadline:
+        time.sleep(0.02)
+    return p
 
 
 @pytest.mark.slow
@@ -54,12 +63,12 @@ def test_an_interrupted_pool_has_stopped_its_workers_when_the_interrupt_goes_on(
     # Left running (shutdown(wait=False)), a worker outlived the CLI: one still starting found
     # the pool's semaphores removed and printed multiprocessing's FileNotFoundError traceback
     # after the one line. 60 s of waiting per case: only a terminated worker is gone at once.
-    main = threading.main_thread().ident  # a real signal: it wakes the waiting main thread
-    watcher = _when_started(tmp_path, 2, lambda: signal.pthread_kill(main, signal.SIGINT))
-    with pytest.raises(KeyboardInterrupt):
-        run_pooled(wait_in_worker, [(str(tmp_path), 60.0)] * 4, workers=2, finish=print)
-    watcher.join()
-    pids = [int(p.name) for p in tmp_path.iterdir()]
+    p = _pooled_waits(tmp_path)
+    os.kill(p.pid, signal.SIGINT)  # the caller alone (a kill, not a terminal's Ctrl-C)
+    out, err = p.communicate(timeout=60)
+    assert p.returncode == 130 and err == "interrupted\n", err
+    assert out == ""  # no case finished: the interrupt came mid-case
+    pids = [int(f.name) for f in tmp_path.iterdir()]
     assert len(pids) == 2 and not any(_alive(pid) for pid in pids)
 
 
@@ -89,26 +98,7 @@ def test_ctrl_c_to_the_whole_group_prints_only_the_callers_line(tmp_path):
     # As a terminal sends it: to the caller and its workers at once, the workers mid-case.
     # Before: a worker's own KeyboardInterrupt; a terminated worker's Numba lock left for the
     # resource tracker to report ("leaked semaphore objects") after the caller's line.
-    code = textwrap.dedent(f"""
-        import sys
-        from pidcore import interrupt
-        from pidcore.dem.sweep import run_pooled
-        from _pool_probe import wait_in_worker
-        if __name__ == "__main__":
-            interrupt.install()
-            try:
-                run_pooled(wait_in_worker, [({str(tmp_path)!r}, 60.0)] * 4, workers=2,
-                           finish=print)
-            except KeyboardInterrupt:
-                print("interrupted", file=sys.stderr)
-                sys.exit(130)
-    """)
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT), str(TESTS)])}
-    p = subprocess.Popen([sys.executable, "-c", code], env=env, stdout=subprocess.PIPE,
-                         stderr=subprocess.PIPE, text=True, start_new_session=True)
-    deadline = time.monotonic() + 90
-    while len(list(tmp_path.iterdir())) < 2 and time.monotonic() < deadline:
-        time.sleep(0.02)
+    p = _pooled_waits(tmp_path)
     os.killpg(p.pid, signal.SIGINT)
     out, err = p.communicate(timeout=60)  # waits for the resource tracker's stderr too
     assert p.returncode == 130 and err == "interrupted\n", err
