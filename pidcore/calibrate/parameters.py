@@ -337,24 +337,24 @@ def check_domains(specs: Sequence[ParameterSpec], specimen=None,
                               f"is outside its physical domain ({complaint}); give a range "
                               "inside it")
 
+    def check_each_bound(spec: ParameterSpec) -> None:
+        """Each bound of ``spec`` alone, the other parameters at their starting values."""
+        for bound in (spec.low, spec.high):
+            complaint = build({spec.name: bound})
+            if complaint:
+                raise outside(spec, bound, complaint)
+
     for spec in specs:
         if spec.kind == "hyper" and spec.low < 0:  # a relative standard deviation
             raise ParameterError(f"{_prior_words(spec, given)}: {spec.name} is a relative "
                                  "standard deviation; expected bounds >= 0")
         if spec.kind == "observation":  # enters no DEM run: its own bounds are its domain
-            for bound in (spec.low, spec.high):
-                complaint = build({spec.name: bound})
-                if complaint:
-                    raise outside(spec, bound, complaint)
+            check_each_bound(spec)
     dem = [s for s in specs if s.kind == "dem"]
     _check_static_friction(dem, specimen, given)
-    if len(dem) > _MAX_CORNER_PARAMETERS:
-        # too many corners: each bound with the other parameters at their starting values
+    if len(dem) > _MAX_CORNER_PARAMETERS:  # too many corners: each bound alone
         for spec in dem:
-            for bound in (spec.low, spec.high):
-                complaint = build({spec.name: bound})
-                if complaint:
-                    raise outside(spec, bound, complaint)
+            check_each_bound(spec)
         return
     corners = list(itertools.product(*((s.low, s.high) for s in dem)))
     complaints = [build(dict(zip((s.name for s in dem), c, strict=True))) for c in corners]
@@ -368,7 +368,7 @@ def check_domains(specs: Sequence[ParameterSpec], specimen=None,
             if all(at):
                 raise outside(spec, bound, at[0])
     corner, complaint = next((c, m) for c, m in zip(corners, complaints, strict=True) if m)
-    values = ", ".join(f"{s.name}={v:g}" for s, v in zip(dem, corner, strict=True))
+    values = ", ".join(f"{s.name}={as_given(v)}" for s, v in zip(dem, corner, strict=True))
     priors = "; ".join(_prior_words(s, given) for s in dem)
     raise ParameterError(f"{priors}: the prior corner {values} is outside the physical "
                          f"domain ({complaint}); narrow the ranges")

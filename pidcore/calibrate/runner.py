@@ -16,7 +16,7 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..dem.persist import dem_run_entry, run_key, save_dem_entry
+from ..dem.persist import dem_run_entry, run_key, save_dem_entry, stored_keys
 from ..dem.simulate import DemConfig, LoadCase, simulate_load_case
 from ..specimen import Specimen
 from .parameters import dem_alias_paths, friction_paths
@@ -128,17 +128,6 @@ def run_requests(requests: Sequence[RunRequest], *, store_path: str | os.PathLik
         if bar is not None:
             bar.close()
     return {"computed": len(todo), "cached": cached, "wall_s": time.perf_counter() - start}
-
-
-def stored_keys(store_path: str | os.PathLike, keys: Sequence[str]) -> set[str]:
-    """The run keys of ``keys`` that the store at ``store_path`` holds now (read from the
-    store itself: a hook called after each save could miss the one committed as Ctrl-C came)."""
-    from ..store import Store
-
-    if not Path(store_path).exists():
-        return set()
-    store = Store(store_path)
-    return {key for key in keys if store.has_dem_run(key)}
 
 
 @dataclass

@@ -184,6 +184,7 @@ def _interrupted(command: str, saved: int, store) -> int:
 
 
 def sweep(args: argparse.Namespace) -> int:
+    from ..dem.persist import run_key, stored_keys
     from ..dem.sweep import cross_cases, grid_axes, run_sweep
     from ..loadcase import parse_values
 
@@ -200,13 +201,14 @@ def sweep(args: argparse.Namespace) -> int:
     config = _config(args)
     # What a Ctrl-C leaves saved is read from the store itself: a count kept beside the saves
     # could miss one that committed as the interrupt came.
-    before = _stored_runs(args.store, cases, config, specimen)
+    keys = [run_key(case, config, specimen) for case in cases]
+    before = stored_keys(args.store, keys)
     try:
         summary = run_sweep(cases, config, store_path=args.store, workers=args.workers,
                             scheduler=args.scheduler, progress=not args.no_progress,
                             specimen=specimen)
     except KeyboardInterrupt:
-        saved = _stored_runs(args.store, cases, config, specimen) - before
+        saved = stored_keys(args.store, keys) - before
         return _interrupted("sweep", len(saved), args.store)
     if args.json:
         print(json.dumps(summary.to_dict()))
@@ -220,18 +222,6 @@ def sweep(args: argparse.Namespace) -> int:
                       f"{case.get('particles_per_cell', '?')} particles per cell, the same "
                       f"seed and settings), not simulated again: {case['store_key']}")
     return 0
-
-
-def _stored_runs(store_path: Path, cases, config, specimen) -> set[str]:
-    """The run keys of ``cases`` that the store at ``store_path`` holds now."""
-    from ..dem.persist import run_key
-    from ..store import Store
-
-    if not store_path.exists():
-        return set()
-    store = Store(store_path)
-    return {key for key in (run_key(case, config, specimen) for case in cases)
-            if store.has_dem_run(key)}
 
 
 def _check_fill(fill: float, option: str, args: argparse.Namespace, specimen,
@@ -319,7 +309,8 @@ def _same_simulation_note(asked, result) -> str:
     stored = result.case.fill_percent
     if stored == asked.fill_percent:
         return ""
-    return (f"fill {asked.fill_percent:g} % asked; reused the stored run of fill {stored:g} %: "
+    return (f"fill {as_given(asked.fill_percent)} % asked; reused the stored run of fill "
+            f"{as_given(stored)} %: "
             f"the same simulation ({result.particles_per_cell} particles per cell, seed "
             f"{result.config.seed}, the same settings and specimen), so the numbers are those "
             "of that run and it is stated at its fill")

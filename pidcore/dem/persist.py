@@ -21,7 +21,7 @@ import hashlib
 import json
 import math
 import os
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -103,6 +103,18 @@ def _open(store: Store | str | os.PathLike[str]) -> Store:
     from ..store import Store
 
     return store if isinstance(store, Store) else Store(store)
+
+
+def stored_keys(store_path: str | os.PathLike[str], keys: Iterable[str]) -> set[str]:
+    """The run keys of ``keys`` that the store at ``store_path`` holds now, read from the store
+    itself: after Ctrl-C, a count kept beside the saves could miss the one that committed as
+    the interrupt came."""
+    from ..store import Store
+
+    if not Path(store_path).exists():
+        return set()
+    store = Store(store_path)
+    return {key for key in keys if store.has_dem_run(key)}
 
 
 def save_dem_entry(store: Store | str | os.PathLike[str], key: str, entry: dict) -> bool:
