@@ -484,8 +484,7 @@ def columns_given(tables: Sequence[pd.DataFrame], name: str) -> set[str]:
     given: set[str] = set()
     for table in tables:
         for _, row in table.iterrows():
-            file = str(row["file"])
-            if file != name and Path(file).name != Path(name).name:
+            if not _names_file(str(row["file"]), name):
                 continue
             given |= {k for k in FILE_TABLE_COLUMNS if k != "file" and not _empty(row.get(k))}
     return given
@@ -525,7 +524,7 @@ def _apply_tables(rows: dict[str, dict], tables: Sequence[pd.DataFrame]) -> None
     for table in tables:
         for _, new in table.iterrows():
             target = new["file"] if new["file"] in rows else next(
-                (n for n in rows if Path(n).name == Path(str(new["file"])).name), None)
+                (n for n in rows if _names_file(str(new["file"]), n)), None)
             if target is None:
                 continue
             for k in FILE_TABLE_COLUMNS:

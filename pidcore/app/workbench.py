@@ -21,6 +21,7 @@ from ..compare.case import (
     sdc_points,
 )
 from ..loop import ForceDisplacementLoop
+from ..report.table import CONSISTENCY_COLUMN
 
 #: Columns of :func:`loop_frame`.
 LOOP_COLUMNS = ("series", "displacement [m]", "force [N]", "order")
@@ -140,10 +141,9 @@ def case_view(entries: Sequence[MeasuredEntry], dem_runs: pd.DataFrame | None,
                             else "")}
 
 
-
 #: Report columns whose missing number is a result without a value, shown with the reason.
 REPORT_STDERR_COLUMN = "SDC DEM stderr [-]"
-REPORT_CHI2_COLUMN = "measured chi2/dof [-]"
+REPORT_CHI2_COLUMN = CONSISTENCY_COLUMN
 
 
 def _one_cell(settings: object) -> bool:

@@ -467,14 +467,11 @@ def dem_cases(dem_runs: pd.DataFrame, *, tolerances: Tolerances | None = None,
 
 def _most_common(fills: np.ndarray) -> list[float]:
     """The fills stated by the most runs, in order of first appearance."""
-    values, counts = [], []
-    for f in fills:
-        if f in values:
-            counts[values.index(f)] += 1
-        else:
-            values.append(float(f))
-            counts.append(1)
-    return [v for v, n in zip(values, counts, strict=True) if n == max(counts)]
+    from collections import Counter
+
+    counts = Counter(float(f) for f in fills)  # keeps the order of first appearance
+    most = max(counts.values())
+    return [v for v, n in counts.items() if n == most]
 
 
 def _reference_fill(fills: np.ndarray, wanted: list[float], tolerances: Tolerances) -> float:

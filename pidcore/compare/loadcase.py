@@ -131,26 +131,29 @@ class StatedLoadCase:
                         self.material, self.direction)
 
 
+def _material_tokens(stem: str, names) -> set[str]:
+    """Tokens of ``stem`` that are one of ``names`` (lower case): a whole token only, so
+    ``steel`` is not found in ``steelcase``."""
+    names = list(names)
+    if not names:
+        return set()
+    pattern = re.compile(_SEP + "(?P<material>" + "|".join(map(re.escape, names)) + ")"
+                         + _END, re.IGNORECASE)
+    return {m.group("material").lower() for m in pattern.finditer(stem)}
+
+
 def _own_material_tokens(stem: str, materials: tuple[str, ...]) -> set[str]:
     """Tokens of ``stem`` that name one of ``materials`` beyond the table's (e.g. ``steel``
-    of a user's specimen): a whole token only, so ``steel`` is not found in ``steelcase``."""
-    own = [m for m in materials if m not in PARTICLE_MATERIALS]
-    if not own:
-        return set()
-    pattern = re.compile(_SEP + "(?P<material>" + "|".join(map(re.escape, own)) + ")" + _END,
-                         re.IGNORECASE)
-    return {m.group("material").lower() for m in pattern.finditer(stem)}
+    of a user's specimen)."""
+    return _material_tokens(stem, (m for m in materials if m not in PARTICLE_MATERIALS))
 
 
 def _refuse_untabulated_material(path: Path, known: tuple[str, ...]) -> None:
     """A file name naming a particle material that neither the table nor a specimen knows
     (``..._steel.csv``) would be read as the default or the specimen's material: refused."""
-    pattern = re.compile(_SEP + "(?P<material>" + "|".join(UNTABULATED_PARTICLE_MATERIALS)
-                         + ")" + _END, re.IGNORECASE)
     # a specimen's "steel_440c" is the file name's "steel"
     parts = {part for k in known for part in k.split("_")}
-    named = sorted({m.group("material").lower() for m in pattern.finditer(path.stem)}
-                   - parts)
+    named = sorted(_material_tokens(path.stem, UNTABULATED_PARTICLE_MATERIALS) - parts)
     if named:
         raise UntabulatedMaterial(
             f"{path.name}: file name states particle material {named[0]!r}, which the "

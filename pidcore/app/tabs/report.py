@@ -61,8 +61,6 @@ def render(stores, calibrations: list) -> None:
                                       key="report_specimen",
                                       help="as `pidcore report --specimen FILE`: the runs of "
                                            "other specimens are left out, the notes name them")
-        if specimen_label not in options:
-            specimen_label = DEFAULT_SPECIMEN
     specimen = others.get(specimen_label)
     try:
         table = state.report_table(stamp, pool, keys, digest, specimen_label, stores,
