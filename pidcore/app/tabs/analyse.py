@@ -222,10 +222,11 @@ def render(stores) -> list:
     if flagged:
         confirm = st.checkbox(f"Save the {len(flagged)} implausible record(s) anyway (their "
                               "warnings are saved with them)", key="confirm_implausible")
-    conflict = uploads.load_case_conflict(analysed)
     if refused:  # one save of what the user uploaded, not of the part its settings allow
         conflict = (f"the settings table {', '.join(t.name for t in refused)} is refused: fix "
                     "it and upload it again, or remove it")
+    else:
+        conflict = uploads.load_case_conflict(analysed)
     if conflict:  # said before Save, which would refuse it
         st.error(f"cannot save: {conflict}")
     if st.button(f"Save {uploads.saved_count(analysed)} record(s) to the store",
