@@ -317,7 +317,8 @@ class FileSettings:
 
 def resolve_file_settings(path: str | os.PathLike, options: AnalysisOptions | None = None, *,
                           given: Mapping[str, str] | None = None,
-                          sidecar: str | os.PathLike | pd.DataFrame | None = None) -> FileSettings:
+                          sidecar: str | os.PathLike | pd.DataFrame | None = None,
+                          tables: dict[Path, pd.DataFrame] | None = None) -> FileSettings:
     """The analysis settings of one measurement file: table row < explicit options.
 
     Parameters
@@ -334,6 +335,8 @@ def resolve_file_settings(path: str | os.PathLike, options: AnalysisOptions | No
     sidecar : path or DataFrame, optional
         The table to use instead of ``loadcases.csv`` beside the file
         (:func:`pidcore.compare.loadcase.sidecar_row`).
+    tables : dict, optional
+        Tables read so far by path (:func:`~pidcore.compare.loadcase.sidecar_row`).
 
     Returns
     -------
@@ -354,7 +357,7 @@ def resolve_file_settings(path: str | os.PathLike, options: AnalysisOptions | No
         default = AnalysisOptions()
         given = {f.name: f.name for f in fields(default)
                  if getattr(options, f.name) != getattr(default, f.name)}
-    row = sidecar_row(path, sidecar)
+    row = sidecar_row(path, sidecar, tables=tables)
     if row is None:
         unmatched = ""
         if sidecar is not None and not isinstance(sidecar, pd.DataFrame):

@@ -78,15 +78,18 @@ def _stated(args: argparse.Namespace) -> tuple[list, list]:
 
         specimen_material = load_specimen(args.specimen).particles.material
     stated, settings = [], []
+    tables: dict = {}  # each sidecar read once for all files
     for path in args.paths:  # (a missing file is named by its analysis)
         try:
             stated.append(resolve_load_case(path, fill_percent=args.fill,
                                             material=args.material, direction=args.direction,
                                             sidecar=args.sidecar,
-                                            specimen_material=specimen_material))
+                                            specimen_material=specimen_material,
+                                            tables=tables))
         except FillNotStated:
             stated.append(None)
-        settings.append(resolve_file_settings(path, options, given=given, sidecar=args.sidecar))
+        settings.append(resolve_file_settings(path, options, given=given, sidecar=args.sidecar,
+                                              tables=tables))
     return stated, settings
 
 

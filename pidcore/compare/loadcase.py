@@ -362,11 +362,14 @@ def find_row(table: pd.DataFrame, path: str | Path, shown: str) -> int | None:
 
 
 def sidecar_row(path: str | Path,
-                sidecar: str | Path | pd.DataFrame | None = None) -> SidecarRow | None:
+                sidecar: str | Path | pd.DataFrame | None = None, *,
+                tables: dict[Path, pd.DataFrame] | None = None) -> SidecarRow | None:
     """The row of ``path``'s file name in its sidecar table (None: no table, or no row).
 
     ``sidecar``: the table (a path, read with :func:`read_sidecar`, or a DataFrame), else
     ``loadcases.csv`` beside the file if there is one. Rows are matched by :func:`find_row`.
+    ``tables``: the tables read so far by path, filled here, so that the callers resolving
+    many files against one table (load case and settings of each) read it once.
     """
     path = Path(path)
     if isinstance(sidecar, pd.DataFrame):
@@ -375,7 +378,13 @@ def sidecar_row(path: str | Path,
         sidecar_path = Path(sidecar) if sidecar is not None else path.parent / SIDECAR_NAME
         if sidecar is None and not sidecar_path.is_file():
             return None
-        table, shown, name = read_sidecar(sidecar_path), str(sidecar_path), sidecar_path.name
+        if tables is None:
+            table = read_sidecar(sidecar_path)
+        else:
+            table = tables.get(sidecar_path)
+            if table is None:
+                table = tables[sidecar_path] = read_sidecar(sidecar_path)
+        shown, name = str(sidecar_path), sidecar_path.name
     found = find_row(table, path, shown)
     if found is None:
         return None
@@ -426,6 +435,7 @@ def resolve_load_case(
     sidecar: str | Path | pd.DataFrame | None = None,
     specimen_material: str | None = None,
     materials: tuple[str, ...] = (),
+    tables: dict[Path, pd.DataFrame] | None = None,
 ) -> StatedLoadCase:
     """What the user states about a measurement file: file name < sidecar < options.
 
@@ -481,7 +491,7 @@ def resolve_load_case(
         origin["material"] = "specimen"
         values["material"] = specimen_material
     take(parse_file_name(path, known), "file name")
-    row = sidecar_row(path, sidecar)
+    row = sidecar_row(path, sidecar, tables=tables)
     if row is not None:
         take(_sidecar_entry(row, known), row.name)
     stated_by_user = {"file name"} | ({row.name} if row is not None else set())

@@ -163,11 +163,13 @@ def analyze_files(paths: Sequence[str | Path], *, fill_percent: float | None = N
     options = options or AnalysisOptions()
     for path in paths:  # a missing or empty file is named as such, not as "no fill stated"
         detect_file_format(path)
+    tables: dict = {}  # each sidecar read once for all files
     stated = [resolve_load_case(p, fill_percent=fill_percent, material=material,
                                 direction=direction, sidecar=sidecar,
-                                specimen_material=specimen_material) for p in paths]
-    settings = [resolve_file_settings(p, options, given=options_given, sidecar=sidecar)
-                for p in paths]
+                                specimen_material=specimen_material, tables=tables)
+              for p in paths]
+    settings = [resolve_file_settings(p, options, given=options_given, sidecar=sidecar,
+                                      tables=tables) for p in paths]
     results = []
     for path, st, fs in zip(paths, stated, settings, strict=True):
         analyzed = analyze_with_settings(path, fs)
