@@ -20,7 +20,6 @@ from .align import (
     Aligner,
     Tolerances,
     consistency_chi2,
-    duplicates_note,
     pooled_mean,
     pooled_sdc_eq10,
 )
@@ -424,9 +423,9 @@ def compare_case(records: Sequence[MeasuredEntry],
             model_y = np.asarray(model(model_x, point[0], point[1]), dtype=float)
             if point[2]:
                 notes.append(point[2])
+    # (runs counted once as the same simulation are said by the alignment's message, shown
+    # beside these notes)
     grid = getattr(aligned, "grid_case", None)
-    if grid is not None and grid.duplicate_keys:
-        notes.append(f"our DEM at {grid.load_case.label()}: {duplicates_note(grid)}")
     m_c = float(grid.vibrated_mass_kg) if grid is not None else math.nan
     eq10, sdc10, stderr10 = pooled_sdc_eq10(
         np.array([r.energy_per_cycle_j for r in records]),
