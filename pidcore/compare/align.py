@@ -299,7 +299,7 @@ def consistency_chi2(values: np.ndarray, stderrs: np.ndarray) -> tuple[float, in
     return float(np.sum(w * (v[ok] - mean) ** 2)), int(ok.sum() - 1)
 
 
-def _stored_parameters(parameters_json: object) -> dict | None:
+def stored_parameters(parameters_json: object) -> dict | None:
     """A DEM run's stored inputs as a dict (from a store listing's JSON string, or a dict
     :func:`pidcore.dem.persist.run_parameters` gives); None where none are readable."""
     import json
@@ -318,7 +318,7 @@ def _stored_parameters(parameters_json: object) -> dict | None:
 def run_settings(parameters_json: object) -> dict | None:
     """A DEM run's numerical settings: every stored input (its ``parameters_json``) except the
     load case and the seed; None where they are not stored or not readable."""
-    params = _stored_parameters(parameters_json)
+    params = stored_parameters(parameters_json)
     if params is None:
         return None
     return {k: v for k, v in params.items() if not k.startswith("case_") and k != "config_seed"}
@@ -340,7 +340,7 @@ def simulation_identity(parameters_json: object, particles_per_cell: object) -> 
     import hashlib
     import json
 
-    params = _stored_parameters(parameters_json)
+    params = stored_parameters(parameters_json)
     if params is None:
         return None
     try:

@@ -122,9 +122,8 @@ def run_specimens(runs: pd.DataFrame | None) -> dict[str, object]:
     its first run stored (``parameters_json``): what a report of their runs compares
     (``pidcore report --specimen FILE``; the app's Report tab offers them). Runs that do not
     store their specimen's text are left out (they cannot name it)."""
-    import json
-
     from ..specimen import PAPER_SPECIMEN_NAME, Specimen
+    from .align import stored_parameters
 
     out: dict[str, object] = {}
     if runs is None or runs.empty or "parameters_json" not in runs.columns:
@@ -133,10 +132,7 @@ def run_specimens(runs: pd.DataFrame | None) -> dict[str, object]:
                                   runs["case_key"], strict=True):
         if label == PAPER_SPECIMEN_NAME or label in out:
             continue
-        try:
-            text = json.loads(params).get("specimen_text") if isinstance(params, str) else None
-        except ValueError:
-            text = None
+        text = (stored_parameters(params) or {}).get("specimen_text")
         if text:
             out[label] = Specimen.from_text(text, source=f"stored DEM run {key}")
     return out
