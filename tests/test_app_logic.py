@@ -1337,6 +1337,13 @@ def test_a_settings_table_says_which_rows_match_no_uploaded_file():
     assert "line 2 'synthetic_typo.uff'" in warning and "run_a.uff" not in warning
     assert uploads.table_match_note("settings.csv", table,
                                     ["synthetic_typo.uff", "x/run_a.uff"])[1] == ""
+    # lines as the file numbers them (comment and blank lines counted), as every other
+    # message names a row: it said line 3 of a row on line 6
+    commented = uploads.read_settings_table(
+        "settings.csv", b"# delays from the lab book\nfile,velocity_delay_us\n\nrun_a.uff,40\n"
+                        b"# next coupon\nsynthetic_typo.uff,50\n")
+    assert "line 6 'synthetic_typo.uff'" in uploads.table_match_note(
+        "settings.csv", commented, ["run_a.uff"])[1]
 
 
 def test_the_report_tab_says_why_a_result_has_no_number():

@@ -361,6 +361,7 @@ def read_settings_table(name: str, data: bytes,
         raise ParameterError(f"{exc} ({MATERIAL_HINT})") from None
     out["direction"] = [normalize_direction(v, f"{name}: direction") if v else ""
                         for v in out["direction"]]
+    out.attrs["lines"] = [int(line) for line in raw.index]  # each row's line in the file
     out.attrs["given"] = [c for c in FILE_TABLE_COLUMNS
                           if FILE_TABLE_COLUMNS[c] in given and c != "file"]
     return out
@@ -426,8 +427,11 @@ def table_match_note(name: str, table: pd.DataFrame, uploaded: Sequence[str]) ->
     matched = [any(_names_file(f, u) for u in uploaded) for f in files]
     info = (f"{name}: {sum(matched)} of {len(files)} row(s) match uploaded files"
             + (f" ({given})" if given else ""))
-    unmatched = [f"line {i} {f!r}" for i, (f, ok) in enumerate(zip(files, matched, strict=True),
-                                                                  start=2) if not ok]
+    # the line of each row in the file (read_settings_table keeps them); a table built
+    # otherwise counts from the line after its header
+    lines = table.attrs.get("lines") or range(2, 2 + len(files))
+    unmatched = [f"line {line} {f!r}" for line, f, ok in zip(lines, files, matched, strict=True)
+                 if not ok]
     warning = (f"{name}: row(s) matching no uploaded file: {', '.join(unmatched)}; their "
                "settings apply to no file uploaded (check the file names)" if unmatched else "")
     return info, warning
