@@ -150,6 +150,8 @@ def test_per_file_settings_convert_units_and_each_file_keeps_its_own():
                                                            pytest.approx(2.5e-3))
     assert o.baseline_loss_factor == 0.001 and o.sample_rate_hz == 1000.0
     assert o.force is None  # "(auto)": the readers' detection
+    # an empty channel cell as the editor holds it (NaN) names no channel, as "(auto)" does
+    assert uploads.options_of({**row, "velocity channel": float("nan")}).velocity is None
     with pytest.raises(ParameterError, match="a.csv"):
         uploads.options_of({**row, "mass below gauge [g]": -1.0})
 

@@ -25,7 +25,11 @@ from typing import TYPE_CHECKING
 import pandas as pd
 
 from .. import defaults
-from ..compare.loadcase import AUTO_CHANNEL, FREE_TEXT_COLUMNS, NO_CHANNEL
+from ..compare.loadcase import (
+    AUTO_CHANNEL,
+    FREE_TEXT_COLUMNS,
+    NO_CHANNEL,  # noqa: F401 - the pages read it from here
+)
 from ..constants import PARTICLE_MATERIALS
 from ..errors import ParameterError, PidcoreError
 
@@ -549,13 +553,10 @@ def options_of(row: Mapping, *, sample_rate_hz: float | None = None) -> Analysis
     from ..file_settings import analysis_overrides
     from ..measure import AnalysisOptions
 
-    def channel(value) -> str | None:
-        return None if value in (None, "", AUTO_CHANNEL, NO_CHANNEL) else str(value)
-
     labels = {v: k for k, v in FILE_TABLE_COLUMNS.items()}  # errors name the app's columns
+    # channel cells as the table holds them: the overrides read "(auto)", "(none)", blank and
+    # NaN cells as no channel named (a NaN cell was passed on as a channel named "nan")
     cells = {column: row.get(label) for column, label in labels.items()}
-    for role in ("force", "velocity", "acceleration"):
-        cells[role] = channel(cells[role])
     return AnalysisOptions(**analysis_overrides(cells, str(row["file"]), labels=labels),
                            sample_rate_hz=sample_rate_hz)
 
