@@ -614,17 +614,6 @@ class SavedRecords:
     notes: tuple[str, ...] = ()
 
 
-def replacement_notes(analyses: pd.DataFrame, files: Sequence[AnalysedFile]) -> list[str]:
-    """Which saved records saving ``files`` replaces (:func:`pidcore.measure.replacement_notes`);
-    ``analyses`` is :meth:`pidcore.store.Store.list_analyses` before the save."""
-    from ..measure import replacement_notes as notes_of
-    from ..records import measurement_key
-
-    return notes_of(analyses, [(Path(f.record.measurement.source).name,
-                                measurement_key(f.record.measurement),
-                                f.load_case.full_label()) for f in files])
-
-
 def check_one_load_case_per_content(files: Sequence[AnalysedFile]) -> None:
     """Refuse byte-identical files that state different load cases (or specimens): the store
     keeps one record of them, so one statement would silently replace the other (as
@@ -665,10 +654,10 @@ def save_records(path: str | os.PathLike, files: Sequence[AnalysedFile], *,
     Each file's own corrections are its analysis parameters (with its channel mapping); the
     load case fields and the specimen go into its record. A file with plausibility warnings is
     only saved with ``confirm_implausible`` (the user's explicit confirmation). The notes say
-    which saved record each byte-identical file replaces (:func:`replacement_notes`).
+    which saved record each byte-identical file replaces: :func:`pidcore.measure.save_analyses`,
+    the save of ``pidcore analyze`` and ``pidcore report``.
     """
-    from ..measure import store_analysis
-    from ..store import Store
+    from ..measure import save_analyses
 
     if not files:
         raise ParameterError("nothing to save: no file was analysed successfully")
@@ -677,18 +666,13 @@ def save_records(path: str | os.PathLike, files: Sequence[AnalysedFile], *,
         raise ParameterError(f"{', '.join(flagged)}: implausible result(s); confirm to save "
                              "them anyway")
     check_one_load_case_per_content(files)
-    store = Store(path)
-    with store.transaction():
-        notes = replacement_notes(store.list_analyses(), files)
-        keys = []
-        for f in files:
-            parameters = replace(f.options, force=None, velocity=None,
-                                 acceleration=None).parameters()
-            fields = f.load_case.as_record("stated in the app")
-            if f.specimen:
-                fields = {**fields, "specimen": f.specimen}
-            if f.warnings:
-                fields = {**fields, "plausibility_warnings": "; ".join(str(w)
-                                                                       for w in f.warnings)}
-            keys.append(store_analysis(store, f.record, parameters, fields=fields))
-        return SavedRecords(keys, tuple(notes))
+    saved = save_analyses(
+        path, [f.record for f in files],
+        # the channel mapping is the record's (channels used), not an analysis parameter
+        [replace(f.options, force=None, velocity=None, acceleration=None) for f in files],
+        [(Path(f.record.measurement.source).name, f.load_case, "stated in the app")
+         for f in files],
+        fields=[{**({"specimen": f.specimen} if f.specimen else {}),
+                 **({"plausibility_warnings": "; ".join(str(w) for w in f.warnings)}
+                    if f.warnings else {})} for f in files])
+    return SavedRecords(saved.keys, tuple(saved.notes))
