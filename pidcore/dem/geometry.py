@@ -140,15 +140,21 @@ def check_packing_size(geometry: CellGeometry, radius_m: float,
             "check the units of the sizes, or simulate larger particles")
 
 
+def _grid_points(geometry: CellGeometry, radius_m: float,
+                 axis_values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The xy grid of ``axis_values`` along x and y as 3-D points at z = 0, and whether each
+    leaves a sphere of ``radius_m`` clear of the six side walls."""
+    xx, yy = np.meshgrid(axis_values, axis_values)
+    pts = np.column_stack([xx.ravel(), yy.ravel(), np.zeros(xx.size)])
+    sd = pts @ geometry.wall_normals[:6].T + geometry.wall_offsets[:6]
+    return pts, np.all(sd >= radius_m * (1 + 1e-9), axis=1)
+
+
 def _candidate_grid(geometry: CellGeometry, radius_m: float, spacing_m: float) -> np.ndarray:
     """xy points where a sphere centre may sit (inside the hexagon shrunk by the radius)."""
     check_packing_size(geometry, radius_m, spacing_m / radius_m)
     rc = (geometry.apothem_m - radius_m) * 2.0 / np.sqrt(3.0)
-    g = np.arange(-rc, rc + spacing_m / 2, spacing_m)
-    xx, yy = np.meshgrid(g, g)
-    pts = np.column_stack([xx.ravel(), yy.ravel(), np.zeros(xx.size)])
-    sd = pts @ geometry.wall_normals[:6].T + geometry.wall_offsets[:6]
-    ok = np.all(sd >= radius_m * (1 + 1e-9), axis=1)
+    pts, ok = _grid_points(geometry, radius_m, np.arange(-rc, rc + spacing_m / 2, spacing_m))
     if ok.any():
         return pts[ok, :2]
     # A near fit (sphere diameter within about a grid step, ~2 %, of the cell's width): the region
@@ -159,10 +165,8 @@ def _candidate_grid(geometry: CellGeometry, radius_m: float, spacing_m: float) -
     # itself, with no rounding, and check_sphere_fits has made sure that exceeds r. (Cells
     # whose grid finds room keep the grid above, so their packings do not change.)
     k = np.arange(-np.floor(rc / spacing_m), np.floor(rc / spacing_m) + 1.0)
-    xx, yy = np.meshgrid(k * spacing_m, k * spacing_m)
-    pts = np.column_stack([xx.ravel(), yy.ravel(), np.zeros(xx.size)])
-    sd = pts @ geometry.wall_normals[:6].T + geometry.wall_offsets[:6]
-    ok = np.all(sd >= radius_m * (1 + 1e-9), axis=1) | ((xx.ravel() == 0) & (yy.ravel() == 0))
+    pts, ok = _grid_points(geometry, radius_m, k * spacing_m)
+    ok |= (pts[:, 0] == 0) & (pts[:, 1] == 0)
     return pts[ok, :2]
 
 
