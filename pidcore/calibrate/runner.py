@@ -19,7 +19,7 @@ from pathlib import Path
 from ..dem.persist import dem_run_entry, run_key, save_dem_entry, stored_keys
 from ..dem.simulate import DemConfig, LoadCase, simulate_load_case
 from ..specimen import Specimen
-from .parameters import dem_alias_paths, friction_paths
+from .parameters import friction_paths
 
 
 def specimen_with(specimen: Specimen, values: Mapping[str, float]) -> Specimen:
@@ -39,7 +39,7 @@ def specimen_with(specimen: Specimen, values: Mapping[str, float]) -> Specimen:
         value = float(values[name])
         # a static friction by dotted path follows the alias's rule (friction_paths)
         alias = friction_paths(name)
-        if alias is None or (dem_alias_paths(name) is None and alias[0] == "sliding_friction"):
+        if alias is None or name.endswith(".sliding_friction"):
             changes[name] = value  # a dotted sliding friction sets that field alone
             continue
         field, pairs = alias
