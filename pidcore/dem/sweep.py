@@ -315,7 +315,8 @@ def run_sweep(cases: Sequence[LoadCase], config: DemConfig, *,
     progress : bool
         tqdm bar on stderr.
     on_case : callable, optional
-        Called with each finished :class:`CaseOutcome` after it is stored (the app's progress).
+        Called with each finished :class:`CaseOutcome` after it is stored (a library caller's
+        own progress or bookkeeping; the CLI counts saved runs from the store itself).
     specimen : Specimen, optional
         What every case simulates (:mod:`pidcore.specimen`); the paper's coupon by default.
     """
