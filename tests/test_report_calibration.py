@@ -275,3 +275,17 @@ def test_a_calibration_speaks_for_its_own_specimen_or_an_unnamed_one(tmp_path):
     assert not paper.speaks_for("my_panel")
     app = calibration_from_json(BUNDLED.read_bytes(), "app", specimen_name="steel_6mm")
     assert app.speaks_for("steel_6mm") and not app.speaks_for("paper_coupon")
+
+
+def test_bundled_calibration_states_a_unit_for_everything_it_reports():
+    """The shipped calibration.json names the unit of each fitted parameter and of each number
+    of its predictions and energy check, as a freshly written one does (its units table used
+    to lack the first fitted parameter, rolling_friction)."""
+    doc = json.loads(BUNDLED.read_text(encoding="utf-8"))
+    units = doc["units"]
+    assert set(doc["parameters"]) <= set(units)
+    numbers = doc["predictions"] + (doc["loo"] or []) + doc["energy_check"]
+    reported = {k for row in numbers for k, v in row.items()
+                if isinstance(v, (int, float)) and not isinstance(v, bool)}
+    reported |= {"rms_in_sample", "loo_rms", "wall_s"}
+    assert reported <= set(units), sorted(reported - set(units))
