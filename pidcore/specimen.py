@@ -352,13 +352,14 @@ class Specimen:
         from .dem.geometry import check_packing_size, check_sphere_fits
 
         r = self.particles.radius_m
+        geometry = self.geometry()
         try:
             # the packing's own limit (a sphere strictly narrower than the cell, clearing
             # floor and ceiling by its gap): a looser one let a near fit through to fail there
-            check_sphere_fits(self.geometry(), r)
+            check_sphere_fits(geometry, r)
         except ParameterError as exc:
             raise _fail("[particles] radius_m", str(exc)) from None
-        area = self.cell.count * self.geometry().volume_m3() / self.cell.height_m
+        area = self.cell.count * geometry.volume_m3() / self.cell.height_m
         if self.coupon.mass_kg / area > MAX_COUPON_AREAL_MASS_KG_M2:
             raise _fail("[coupon] mass_kg",
                         f"{as_given(self.coupon.mass_kg)} kg on {self.cell.count} cells "
@@ -368,7 +369,7 @@ class Specimen:
                         "count wrong?")
         try:
             # before any packing is laid out: a size in the wrong unit would ask for GiBs
-            check_packing_size(self.geometry(), r)
+            check_packing_size(geometry, r)
         except ParameterError as exc:
             raise _fail("[particles] radius_m", str(exc)) from None
         if self.particles.fill_percent is not None:
