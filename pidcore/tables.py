@@ -73,15 +73,21 @@ def _separator(header: str) -> str:
     return "," if found == r"\s+" else found
 
 
+def _table_lines(text: str) -> list[tuple[int, str]]:
+    """(line number from 1, line) of the lines that are neither blank nor a comment."""
+    return [(n, ln) for n, ln in enumerate(_LINE_BREAK.split(text), start=1)
+            if ln.strip() and not _is_comment(ln)]
+
+
 def header_cells(data: bytes) -> list[str]:
     """The header cells of a table (its first line that is neither blank nor a comment),
     stripped of blanks and quotes; ``[]`` for none. For telling a table from a measurement
     without reading it all."""
-    lines = [ln for ln in _LINE_BREAK.split(decode_table(data[:1 << 16]))
-             if ln.strip() and not _is_comment(ln)]
+    lines = _table_lines(decode_table(data[:1 << 16]))
     if not lines:
         return []
-    cells = next(csv.reader([lines[0]], delimiter=_separator(lines[0]), skipinitialspace=True))
+    first = lines[0][1]
+    cells = next(csv.reader([first], delimiter=_separator(first), skipinitialspace=True))
     return [c.strip().strip('"').strip() for c in cells]
 
 
@@ -111,9 +117,7 @@ def read_text_table(data: bytes, where: str, *, numeric: Iterable[str] = ()) -> 
         No header line; a row with more cells than the header (naming its line and both
         counts); a header naming a column twice.
     """
-    text = decode_table(data)
-    lines = _LINE_BREAK.split(text)
-    kept = [(n, ln) for n, ln in enumerate(lines, start=1) if ln.strip() and not _is_comment(ln)]
+    kept = _table_lines(decode_table(data))
     if not kept:
         raise InputFileError(f"{where}: empty table; expected a header line such as "
                              "'file,fill_percent,velocity_delay_us' and one row per file")
