@@ -84,8 +84,12 @@ class SettingsColumn:
         Smallest plausible positive value in the column's unit: a positive value below it is
         refused as a unit slip (0 for no such check).
     slip : str
-        The unit the value was probably typed in (``"s"``), and ``slip_scale`` its factor to
-        the column's unit (``unit``), for the message.
+        The unit the value was probably typed in: the field's SI unit (``"s"``), whose value
+        times ``scale`` is the column's (``unit``), for the message.
+    unit : str
+        The column's unit (``"µs"``).
+    label : str
+        How messages name the setting (``"vibrometer delay"``); "" for a channel column.
     """
 
     field: str
@@ -94,8 +98,8 @@ class SettingsColumn:
     expected: str = ""
     smallest: float = 0.0
     slip: str = ""
-    slip_scale: float = 1.0
     unit: str = ""
+    label: str = ""
 
 
 #: How each column of :data:`~pidcore.compare.loadcase.ANALYSIS_SETTINGS_COLUMNS` sets its
@@ -106,14 +110,16 @@ ANALYSIS_COLUMNS: dict[str, SettingsColumn] = {
     # nothing measurable, so a positive value below it is a delay typed in s (5e-5 for 50 µs).
     "velocity_delay_us": SettingsColumn("velocity_delay_s", "number", 1e6,
                                         "a vibrometer output delay in µs >= 0",
-                                        0.01, "s", 1e6, "µs"),
+                                        0.01, "s", "µs", "vibrometer delay"),
     # The mass between force gauge and coupon is the gauge's top half, a screw or an adapter:
     # grams to hundreds of grams; a positive value below 0.1 g weighs less than an M1 screw
     # and would change nothing measurable, so it is a mass typed in kg (0.012 for 12 g).
     "mass_below_gauge_g": SettingsColumn("mass_below_gauge_kg", "number", 1e3,
-                                         "a mass in g >= 0", 0.1, "kg", 1e3, "g"),
+                                         "a mass in g >= 0", 0.1, "kg", "g",
+                                         "mass below gauge"),
     "baseline_loss_factor": SettingsColumn("baseline_loss_factor", "number", 1.0,
-                                           "the empty coupon's loss factor >= 0"),
+                                           "the empty coupon's loss factor >= 0",
+                                           label="baseline loss factor"),
     "force": SettingsColumn("force", "channel"),
     "velocity": SettingsColumn("velocity", "channel"),
     "acceleration": SettingsColumn("acceleration", "channel"),
@@ -121,10 +127,9 @@ ANALYSIS_COLUMNS: dict[str, SettingsColumn] = {
 }
 
 _COLUMN_OF_FIELD = {c.field: name for name, c in ANALYSIS_COLUMNS.items()}
-#: How each setting is said in words (units as the table's, not SI).
-_WORDS = {"velocity_delay_s": ("vibrometer delay", 1e6, " µs"),
-          "mass_below_gauge_kg": ("mass below gauge", 1e3, " g"),
-          "baseline_loss_factor": ("baseline loss factor", 1.0, "")}
+#: How each numeric setting is said in words: label, factor and unit as the table's, not SI.
+_WORDS = {c.field: (c.label, c.scale, f" {c.unit}" if c.unit else "")
+          for c in ANALYSIS_COLUMNS.values() if c.label}
 
 
 def _stated(value: object) -> bool:
@@ -155,7 +160,7 @@ def _number(value: object, column: str, spec: SettingsColumn, where: str) -> flo
         raise SettingsTableError(
             f"{where}, column {column}: {shown!r} is implausibly small (below "
             f"{spec.smallest:g} {spec.unit}); it looks like a value in {spec.slip} "
-            f"({number:g} {spec.slip} = {number * spec.slip_scale:g} {spec.unit}); expected "
+            f"({number:g} {spec.slip} = {number * spec.scale:g} {spec.unit}); expected "
             f"0 or at least {spec.smallest:g} {spec.unit}")
     return number / spec.scale
 
