@@ -372,13 +372,13 @@ def settings_hash(parameters_json: object) -> str:
     return "" if settings is None else _settings_digest(settings)
 
 
-def _settings_of(row: pd.Series) -> tuple[str, float]:
+def _settings_of(row: pd.Series, params: dict | None) -> tuple[str, float]:
     """(label, cells) of the numerical settings of one DEM run: every stored input except the
     load case and the seed (:func:`settings_hash`), with the cells and steady cycles spelled
-    out."""
+    out. ``params``: the run's stored inputs (:func:`stored_parameters`)."""
     cells = float(row.get("cells_simulated", math.nan) or math.nan) \
         if "cells_simulated" in row else math.nan
-    settings = run_settings(row.get("parameters_json"))
+    settings = run_settings(params)
     if settings is None:
         return (f"cells {cells:g}" if math.isfinite(cells) else ""), cells
     digest = _settings_digest(settings)
@@ -423,11 +423,14 @@ def dem_cases(dem_runs: pd.DataFrame, *, tolerances: Tolerances | None = None,
         return []
     _check_columns(dem_runs, DEM_COLUMNS, "DEM runs")
     runs = dem_runs[np.isfinite(dem_runs["sdc"].astype(float))]
+    # each run's stored inputs parsed once, for its settings and its simulation identity
+    params = [stored_parameters(v) for v in runs["parameters_json"]] \
+        if "parameters_json" in runs.columns else [None] * len(runs)
     groups: list[tuple[LoadCase, str, list[int]]] = []
     cells_of: dict[str, float] = {}
     for pos, (_, row) in enumerate(runs.iterrows()):
         case = _row_case(row)
-        settings, cells = ("", math.nan) if pool_settings else _settings_of(row)
+        settings, cells = ("", math.nan) if pool_settings else _settings_of(row, params[pos])
         cells_of[settings] = cells
         for grid, grid_settings, members in groups:
             if grid_settings == settings and tolerances.matches(case, grid):
@@ -440,7 +443,7 @@ def dem_cases(dem_runs: pd.DataFrame, *, tolerances: Tolerances | None = None,
     for case, settings, members in groups:
         fills = runs["fill_percent"].astype(float).to_numpy()
         reference = _reference_fill(fills[members], wanted, tolerances)
-        members, duplicates = _distinct(runs, members, reference)
+        members, duplicates = _distinct(runs, members, params, reference)
         label = _label_fill(fills[members], reference)
         if label != case.fill_percent:
             case = replace(case, fill_percent=label)
@@ -491,20 +494,20 @@ def _label_fill(fills: np.ndarray, reference: float) -> float:
     return min(common, key=lambda f: abs(f - reference))
 
 
-def _distinct(runs: pd.DataFrame, members: list[int],
+def _distinct(runs: pd.DataFrame, members: list[int], params: list[dict | None],
               reference: float = math.nan) -> tuple[list[int], list[int]]:
     """(members counted, members left out) of one case: of runs that are the same simulation
     (:func:`simulation_identity`) the one whose stored fill is nearest ``reference`` is
     counted (of a tie, or without a reference, the first stored); a run without recorded
     inputs is always counted (nothing shows it repeats another). Both lists keep the order of
-    ``members``."""
+    ``members``. ``params``: every run's stored inputs (:func:`stored_parameters`)."""
     if "parameters_json" not in runs.columns or "particles_per_cell" not in runs.columns:
         return members, []
     chosen: dict[str, int] = {}  # identity -> the member counted
     identities: list[str | None] = []
     for pos in members:
         row = runs.iloc[pos]
-        identity = simulation_identity(row["parameters_json"], row["particles_per_cell"])
+        identity = simulation_identity(params[pos], row["particles_per_cell"])
         identities.append(identity)
         if identity is None:
             continue
