@@ -23,14 +23,14 @@ from typing import TYPE_CHECKING
 import numpy as np
 import pandas as pd
 
-from ..compare.align import Aligner, Tolerances, dem_cases
+from ..compare.align import Aligner, Tolerances
 from ..compare.loadcase import LoadCase, StatedLoadCase, resolve_load_case
 from ..constants import REPORT_FORMATS
 from ..errors import ParameterError, StoreError
 from ..loadcase import refuse_identical_contents_stating_apart
 from .provenance import collect_provenance
 from .render import check_out_dir, parse_formats, write_report
-from .table import add_calibration_columns, build_report_table
+from .table import add_calibration_columns, report_table_and_aligner
 
 if TYPE_CHECKING:  # pragma: no cover
     from ..file_settings import FileSettings
@@ -323,11 +323,13 @@ def specimen_dem_runs(stored: pd.DataFrame | None, specimen=None, *,
 @dataclass(frozen=True)
 class SpecimenTable:
     """What :func:`specimen_report_table` built: the table (notes in ``attrs["notes"]``), the
-    DEM runs compared (None: none) and the paper's Table 3 used (None where not compared)."""
+    DEM runs compared (None: none), the paper's Table 3 used (None where not compared) and the
+    aligner of the table's DEM rows (the runs counted and their models, for its figures)."""
 
     table: pd.DataFrame
     dem_runs: pd.DataFrame | None
     paper: pd.DataFrame | None
+    aligner: Aligner
 
 
 def specimen_report_table(stored_runs: pd.DataFrame | None, analyses: pd.DataFrame | None, *,
@@ -356,7 +358,7 @@ def specimen_report_table(stored_runs: pd.DataFrame | None, analyses: pd.DataFra
                      "Table 3 is not compared")
     from ..specimen import PAPER_SPECIMEN_NAME
 
-    table = build_report_table(
+    table, aligner = report_table_and_aligner(
         dem_runs, analyses, paper, tolerances=tolerances, pool=pool, store_runs=stored_runs,
         of_specimen=specimen.name if specimen is not None else PAPER_SPECIMEN_NAME,
         choose_another="" if choose_another == CHOOSE_SPECIMEN_CLI
@@ -370,7 +372,7 @@ def specimen_report_table(stored_runs: pd.DataFrame | None, analyses: pd.DataFra
         mine = (table["specimen"] == "") & (table["material"] == specimen.particles.material)
         table.loc[mine, "specimen"] = specimen.name
     table.attrs["notes"] = notes + list(table.attrs.get("notes", []))
-    return SpecimenTable(table, dem_runs, paper)
+    return SpecimenTable(table, dem_runs, paper, aligner)
 
 
 def _figures(table: pd.DataFrame, dem_runs: pd.DataFrame | None, aligner: Aligner,
@@ -551,19 +553,11 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
     dem_runs = dem.list_dem_runs() if dem is not None else None
     built = specimen_report_table(dem_runs, analyses, specimen=specimen, where=dem_path,
                                   tolerances=tolerances, pool=pool)
-    table, dem_runs, paper = built.table, built.dem_runs, built.paper
+    table, dem_runs, aligner = built.table, built.dem_runs, built.aligner
     if calibrated is not None:
         table = add_calibration_columns(table, calibrated, tolerances=tolerances,
                                         specimen=specimen, paper=specimen is None)
     notes.extend(table.attrs.get("notes", []))
-    # the fills measured choose among duplicate runs as the table does (its loop overlays
-    # show the run the row counts)
-    fills = pd.to_numeric(analyses["fill_percent"], errors="coerce").tolist() \
-        if analyses is not None and "fill_percent" in analyses.columns else []
-    aligner = Aligner(dem_cases(dem_runs, tolerances=tolerances, pool_settings=pool,
-                                reference_fills=fills)
-                      if dem_runs is not None else [],
-                      paper, None, tolerances)
     loops = _measured_loops(results, analyses, main, notes)
     figures = _figures(table, dem_runs, aligner, loops, dem, notes)
     try:

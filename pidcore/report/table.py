@@ -205,6 +205,19 @@ def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | N
     >>> round(float(t.loc[0, "difference ours - paper DEM [-]"]), 6)  # 0.52 - 0.5417
     -0.0217
     """
+    return report_table_and_aligner(dem_runs, analyses, paper, model=model,
+                                    tolerances=tolerances, pool=pool, store_runs=store_runs,
+                                    of_specimen=of_specimen, choose_another=choose_another)[0]
+
+
+def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | None,
+                              paper: pd.DataFrame | None, *, model: object | None = None,
+                              tolerances: Tolerances | None = None,
+                              pool: bool = False, store_runs: pd.DataFrame | None = None,
+                              of_specimen: str = "", choose_another: str = "",
+                              ) -> tuple[pd.DataFrame, Aligner]:
+    """:func:`build_report_table` and the aligner of its DEM rows (the runs it counted, its
+    pchip models), for figures that must show what the table compared."""
     tolerances = tolerances or Tolerances()
     notes: list[str] = []
     measured_rows = _measured_rows(analyses, notes)
@@ -361,7 +374,7 @@ def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | N
                      "seed, settings and specimen under another stated fill): "
                      f"{'; '.join(duplicate_rows)}")
     table.attrs["notes"] = notes
-    return table
+    return table, aligner
 
 
 def not_converged_note(dem: DemCase) -> str:
