@@ -45,6 +45,15 @@ def store_report_table(path: str | os.PathLike, dem_store: str | os.PathLike | N
     and named in ``attrs["notes"]``). ``calibration``: add the calibrated DEM's columns, as
     ``pidcore report --calibration`` does (:func:`pidcore.report.table.add_calibration_columns`).
     """
+    return _store_report(path, dem_store, analysis_keys=analysis_keys, pool=pool,
+                         calibration=calibration, specimen=specimen)[0]
+
+
+def _store_report(path: str | os.PathLike, dem_store: str | os.PathLike | None, *,
+                  analysis_keys: list[str] | None, pool: bool, calibration: Calibration | None,
+                  specimen: Specimen | None) -> tuple[pd.DataFrame, pd.DataFrame | None]:
+    """(:func:`store_report_table`, the DEM runs of the specimen it chose from: None for
+    none)."""
     from ..store.listing import list_dem_runs, saved_analyses
     from .pipeline import specimen_report_table
     from .table import add_calibration_columns
@@ -54,15 +63,16 @@ def store_report_table(path: str | os.PathLike, dem_store: str | os.PathLike | N
         analyses = analyses[analyses["key"].isin(analysis_keys)]
     dem_runs = list_dem_runs(path, dem_store)
     if analyses.empty and dem_runs.empty:
-        return pd.DataFrame()
+        return pd.DataFrame(), None
     where = " and ".join(str(p) for p in (path, dem_store)
                          if p is not None and Path(p).is_file())
-    table = specimen_report_table(dem_runs if not dem_runs.empty else None,
+    built = specimen_report_table(dem_runs if not dem_runs.empty else None,
                                   analyses if not analyses.empty else None, specimen=specimen,
                                   where=where or None, pool=pool,
-                                  choose_another=CHOOSE_SPECIMEN_APP).table
-    return table if calibration is None else add_calibration_columns(
-        table, calibration, specimen=specimen, paper=specimen is None)
+                                  choose_another=CHOOSE_SPECIMEN_APP)
+    table = built.table if calibration is None else add_calibration_columns(
+        built.table, calibration, specimen=specimen, paper=specimen is None)
+    return table, built.dem_runs
 
 
 def report_files(path: str | os.PathLike, dem_store: str | os.PathLike | None = None, *,
@@ -76,7 +86,6 @@ def report_files(path: str | os.PathLike, dem_store: str | os.PathLike | None = 
     nothing is written.
     """
     from ..compare import Tolerances
-    from ..store.listing import list_dem_runs
     from .comparison_figures import plot_sdc_comparison
     from .pipeline import open_verified_store, specimen_provenance
     from .provenance import collect_provenance
@@ -85,18 +94,15 @@ def report_files(path: str | os.PathLike, dem_store: str | os.PathLike | None = 
     stores = [Path(p) for p in (path, dem_store) if p is not None and Path(p).is_file()]
     for p in stores:
         open_verified_store(p, must_exist=True)
-    table = store_report_table(path, dem_store, analysis_keys=analysis_keys, pool=pool,
-                               calibration=calibration, specimen=specimen)
+    table, runs = _store_report(path, dem_store, analysis_keys=analysis_keys, pool=pool,
+                                calibration=calibration, specimen=specimen)
     if table.empty:
         raise ParameterError("nothing to report: the stores hold no saved analyses with a "
                              "load case and no DEM runs")
     tol = Tolerances()
-    runs = list_dem_runs(path, dem_store)
-    if not runs.empty:
-        from ..dem.persist import runs_of_specimen
-
-        runs = runs_of_specimen(runs, specimen)  # the seeds of the runs compared
-    seeds = sorted({int(s) for s in runs.get("seed", pd.Series(dtype=float)).dropna()})
+    # the seeds of the specimen's runs, those the table compared from
+    seeds = sorted({int(s) for s in runs["seed"].dropna()}) \
+        if runs is not None and "seed" in runs.columns else []
     provenance = collect_provenance(
         parameters={"frequency_rtol": tol.frequency_rtol,
                     "acceleration_rtol": tol.acceleration_rtol,
