@@ -1364,3 +1364,18 @@ def test_the_report_tab_says_why_a_result_has_no_number():
     assert shown["SDC DEM stderr [-]"].tolist() == ["n/a (1 cell)", "0.0123", "", "n/a"]
     assert shown["measured chi2/dof [-]"].tolist() == ["n/a (1 measurement)", "", "1.2", "n/a"]
     assert math.isnan(table["SDC DEM stderr [-]"].iloc[0])  # the table itself is unchanged
+
+
+def test_report_download_names_the_seeds_of_the_specimens_runs_only(tmp_path):
+    """The provenance of the app's report lists the seeds of the runs of the specimen
+    reported (the paper's coupon by default), not another specimen's in the same store."""
+    from pidcore.store import Store
+
+    store_file = tmp_path / "app.h5"
+    Store(store_file).add_dem_run("paper", {**_dem_record(0.40), "seed": 11})
+    Store(store_file).add_dem_run("other", {**_dem_record(0.30, fill=75.0), "seed": 22,
+                                            "specimen_sha256": "f" * 64})
+    files = report_files(store_file)
+    provenance = files["csv_provenance"][1].decode()
+    assert "seeds: 11\n" in provenance or provenance.rstrip().endswith("seeds: 11")
+    assert "22" not in provenance.split("seeds:")[1].splitlines()[0]

@@ -400,3 +400,22 @@ def test_app_report_chooses_specimen_runs_as_the_cli_does(tmp_path, own_panel_st
     # the downloads' provenance names the specimen and its hash, as the CLI's does
     files = report_files(store, specimen=offered[label])
     assert f"sha256 {own.hash}" in files["csv_provenance"][1].decode()
+
+
+def test_runs_stored_before_specimens_stay_the_papers_beside_hashed_runs():
+    """A listing mixing runs stored before specimens (no hash: the paper's coupon) with runs
+    of another specimen: the default keeps the first, the other specimen only its own. (With
+    pandas' string dtype, a mapped None became NaN and the hashless runs were dropped, the
+    report saying the store held none of the paper's.)"""
+    import pandas as pd
+
+    steel = load_specimen(STEEL)
+    runs = pd.DataFrame({"case_key": ["old", "steel"],
+                         "specimen_sha256": pd.Series([None, steel.hash], dtype="str")})
+    assert persist.runs_of_specimen(runs)["case_key"].tolist() == ["old"]
+    assert persist.runs_of_specimen(runs, paper_specimen())["case_key"].tolist() == ["old"]
+    assert persist.runs_of_specimen(runs, steel)["case_key"].tolist() == ["steel"]
+    # no hash column at all: every run is the paper's
+    bare = runs[["case_key"]]
+    assert persist.runs_of_specimen(bare)["case_key"].tolist() == ["old", "steel"]
+    assert persist.runs_of_specimen(bare, steel).empty

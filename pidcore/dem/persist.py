@@ -320,16 +320,16 @@ def runs_of_specimen(runs, specimen: Specimen | None = None):
     if runs is None or runs.empty:
         return runs
     specimen = specimen or paper_specimen()
-    if "specimen_sha256" in runs.columns:
-        stated = runs["specimen_sha256"].map(lambda h: h if isinstance(h, str) and h else None)
-    else:
-        stated = runs["case_key"].map(lambda _: None)
+    # a plain list: pandas' string dtype turns a mapped None back into NaN, which would make
+    # a run stored before specimens (no hash) look like another specimen's beside hashed ones
+    stated = [h if isinstance(h, str) and h else None
+              for h in runs.get("specimen_sha256", [None] * len(runs))]
     if specimen.is_paper():
         paper = paper_hashes()
-        keep = stated.map(lambda h: h is None or h in paper)
+        keep = [h is None or h in paper for h in stated]
     else:
-        keep = stated == specimen.hash
-    return runs[keep.astype(bool)].reset_index(drop=True)
+        keep = [h == specimen.hash for h in stated]
+    return runs[np.array(keep, dtype=bool)].reset_index(drop=True)
 
 
 def rekey_dem_store(source: str | os.PathLike[str], target: str | os.PathLike[str]) -> int:
