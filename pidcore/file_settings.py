@@ -32,7 +32,7 @@ from __future__ import annotations
 import json
 import math
 import re
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, fields, replace
 from numbers import Real
 from pathlib import Path
@@ -45,7 +45,10 @@ from .compare.loadcase import (
     NO_CHANNEL,
     SETTINGS_COLUMNS,
     SPECIMEN_COLUMN,
+    FillNotStated,
+    StatedLoadCase,
     check_columns,
+    resolve_load_case,
     sidecar_row,
 )
 from .errors import PidcoreError, SettingsTableError
@@ -61,7 +64,7 @@ __all__ = ["ANALYSIS_COLUMNS", "ANALYSIS_SETTINGS_COLUMNS", "AUTO_CHANNEL", "FRE
            "NO_CHANNEL",
            "SETTINGS_COLUMNS", "SPECIMEN_COLUMN", "FileSettings", "SettingsColumn",
            "analysis_overrides", "analyze_with_settings", "check_columns",
-           "resolve_file_settings"]
+           "resolve_file_settings", "resolve_files"]
 
 
 @dataclass(frozen=True)
@@ -405,3 +408,34 @@ def analyze_with_settings(path: str | os.PathLike, settings: FileSettings, *,
         if explained == str(exc):
             raise
         raise type(exc)(explained) from None
+
+
+def resolve_files(paths: Sequence[str | os.PathLike], *, options: AnalysisOptions | None = None,
+                  given: Mapping[str, str] | None = None, fill_percent: float | None = None,
+                  material: str | None = None, direction: str | None = None,
+                  sidecar: str | os.PathLike | None = None,
+                  specimen_material: str | None = None, fill_required: bool = True,
+                  ) -> tuple[list[StatedLoadCase | None], list[FileSettings]]:
+    """What each file states about its load case (:func:`resolve_load_case`) and how it is
+    analysed (:func:`resolve_file_settings`), file by file, before any analysis, so that a bad
+    sidecar or option is refused at once; each sidecar is read once for all files.
+
+    ``fill_required=False`` gives None for a file that states no fill (``pidcore analyze``
+    saves it without a load case); otherwise :class:`FillNotStated` is raised.
+    """
+    tables: dict = {}
+    stated: list[StatedLoadCase | None] = []
+    settings: list[FileSettings] = []
+    for path in paths:
+        try:
+            stated.append(resolve_load_case(path, fill_percent=fill_percent, material=material,
+                                            direction=direction, sidecar=sidecar,
+                                            specimen_material=specimen_material,
+                                            tables=tables))
+        except FillNotStated:
+            if fill_required:
+                raise
+            stated.append(None)
+        settings.append(resolve_file_settings(path, options, given=given, sidecar=sidecar,
+                                              tables=tables))
+    return stated, settings

@@ -68,29 +68,18 @@ def _stated(args: argparse.Namespace) -> tuple[list, list]:
     """What each path states about its load case (None: no fill stated) and how it is analysed
     (:class:`~pidcore.file_settings.FileSettings`), resolved before any analysis so that a bad
     sidecar or option is refused at once."""
-    from ..compare.loadcase import FillNotStated, resolve_load_case
-    from ..file_settings import resolve_file_settings
+    from ..file_settings import resolve_files
 
-    options, given = analysis_options(args), given_options(args)
     specimen_material = None
     if args.specimen is not None:
         from ..specimen import load_specimen
 
         specimen_material = load_specimen(args.specimen).particles.material
-    stated, settings = [], []
-    tables: dict = {}  # each sidecar read once for all files
-    for path in args.paths:  # (a missing file is named by its analysis)
-        try:
-            stated.append(resolve_load_case(path, fill_percent=args.fill,
-                                            material=args.material, direction=args.direction,
-                                            sidecar=args.sidecar,
-                                            specimen_material=specimen_material,
-                                            tables=tables))
-        except FillNotStated:
-            stated.append(None)
-        settings.append(resolve_file_settings(path, options, given=given, sidecar=args.sidecar,
-                                              tables=tables))
-    return stated, settings
+    # (a missing file is named by its analysis)
+    return resolve_files(args.paths, options=analysis_options(args), given=given_options(args),
+                         fill_percent=args.fill, material=args.material,
+                         direction=args.direction, sidecar=args.sidecar,
+                         specimen_material=specimen_material, fill_required=False)
 
 
 def _run(args: argparse.Namespace) -> int:

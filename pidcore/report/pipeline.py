@@ -24,7 +24,7 @@ import numpy as np
 import pandas as pd
 
 from ..compare.align import Aligner, Tolerances
-from ..compare.loadcase import LoadCase, StatedLoadCase, resolve_load_case
+from ..compare.loadcase import LoadCase, StatedLoadCase
 from ..constants import REPORT_FORMATS
 from ..errors import ParameterError, StoreError
 from ..loadcase import refuse_identical_contents_stating_apart
@@ -156,20 +156,17 @@ def analyze_files(paths: Sequence[str | Path], *, fill_percent: float | None = N
     ``specimen_material``: the particle material of the specimen compared with (accepted
     besides the table's, and the default).
     """
-    from ..file_settings import analyze_with_settings, resolve_file_settings
+    from ..file_settings import analyze_with_settings, resolve_files
     from ..io import detect_file_format
     from ..measure import AnalysisOptions
 
     options = options or AnalysisOptions()
     for path in paths:  # a missing or empty file is named as such, not as "no fill stated"
         detect_file_format(path)
-    tables: dict = {}  # each sidecar read once for all files
-    stated = [resolve_load_case(p, fill_percent=fill_percent, material=material,
-                                direction=direction, sidecar=sidecar,
-                                specimen_material=specimen_material, tables=tables)
-              for p in paths]
-    settings = [resolve_file_settings(p, options, given=options_given, sidecar=sidecar,
-                                      tables=tables) for p in paths]
+    stated, settings = resolve_files(paths, options=options, given=options_given,
+                                     fill_percent=fill_percent, material=material,
+                                     direction=direction, sidecar=sidecar,
+                                     specimen_material=specimen_material)
     results = []
     for path, st, fs in zip(paths, stated, settings, strict=True):
         analyzed = analyze_with_settings(path, fs)
