@@ -157,6 +157,33 @@ def test_a_sweep_never_takes_a_01_paper_run_for_a_mindlin_one(tmp_path):
     assert mindlin.completed == [run_key(CASE, TINY, MINDLIN)] and not mindlin.skipped
 
 
+def test_the_run_cache_finds_a_01_paper_run_as_the_sweep_does(tmp_path, monkeypatch):
+    """``dem run --store`` (the run cache) reuses a run a 0.1 store holds under its old key,
+    as ``dem sweep`` does, instead of simulating it again; a Mindlin run is not taken from it."""
+    from pidcore.dem import persist
+
+    from pidcore.dem.simulate import config_parameters
+
+    store = tmp_path / "old.h5"
+    old = simulate_load_case(CASE, TINY)
+    # as 0.1 stored it: its inputs without specimen or code version
+    entry = {**dem_run_entry(old), "parameters": config_parameters(CASE, TINY)}
+    Store(store).add_dem_run(run_key_0_1(CASE, TINY), **entry)
+    assert persist.stored_run_key(store, CASE, TINY) == run_key_0_1(CASE, TINY)
+    assert persist.stored_run_key(store, CASE, TINY, MINDLIN) is None
+    simulate = persist.simulate_load_case
+
+    def no_paper_simulation(case, config, *, specimen=None, progress=False):
+        assert specimen is not None and not specimen.is_paper(), "simulated a stored run"
+        return simulate(case, config, specimen=specimen, progress=progress)
+
+    monkeypatch.setattr(persist, "simulate_load_case", no_paper_simulation)
+    again = run_or_load(store, None, CASE, TINY)
+    assert again.sdc == old.sdc and again.energy_per_cycle_j == old.energy_per_cycle_j
+    assert not Store(store).has_dem_run(run_key(CASE, TINY))  # nothing stored twice
+    assert run_or_load(store, MINDLIN, CASE, TINY).specimen == MINDLIN
+
+
 def test_dem_run_flag_overrides_the_specimen_both_ways(tmp_path, capsys):
     store = tmp_path / "s.h5"
     mindlin_file = tmp_path / "mindlin.toml"

@@ -212,23 +212,6 @@ def load_dem_result(entry: StoredEntry) -> DemResult:
     return DemResult(**values)
 
 
-def same_simulation_key(store: Store | str | os.PathLike[str], case: LoadCase,
-                        config: DemConfig, specimen: Specimen | None = None) -> str | None:
-    """Key of a stored run that is the same simulation as ``case``/``config``/``specimen``
-    under another key, or None.
-
-    A key hashes the fill as stated, the simulation only the particle count it rounds to
-    (:func:`pidcore.compare.align.simulation_identity`): ``dem run --specimen`` stores the
-    specimen's fill 21.73913... %, ``dem sweep --fills 21.7391`` asks for another key with
-    the same 5 particles per cell and seed. Found by the stored runs' inputs, so no key
-    changes. Runs that do not record their inputs are never matched.
-    """
-    store = _open(store)
-    if not store.path.exists():
-        return None
-    return stored_identities(store).get(run_identity(case, config, specimen))
-
-
 def run_identity(case: LoadCase, config: DemConfig, specimen: Specimen | None = None) -> str:
     """The simulation a run of these inputs is (:func:`pidcore.compare.align.
     simulation_identity`): its inputs with the fill replaced by the particles per cell."""
@@ -264,17 +247,43 @@ def stored_identities(store: Store | str | os.PathLike[str]) -> dict[str, str]:
     return out
 
 
+def own_run_keys(case: LoadCase, config: DemConfig,
+                 specimen: Specimen | None = None) -> tuple[str, ...]:
+    """The keys a run of these inputs is stored under: its :func:`run_key`, and for the
+    paper's coupon the key pidcore 0.1 stored it under (:func:`run_key_0_1`). A 0.1 key names
+    only the paper's coupon with its constant k_t: another specimen's run, a Mindlin one of
+    that coupon included, is never found under it."""
+    key = run_key(case, config, specimen)
+    if resolve_specimen(case, specimen).is_paper():
+        return key, run_key_0_1(case, config)
+    return (key,)
+
+
 def stored_run_key(store: Store | str | os.PathLike[str], case: LoadCase, config: DemConfig,
-                   specimen: Specimen | None = None) -> str | None:
-    """Key under which ``store`` holds this run: its own :func:`run_key`, else a run of the
-    same simulation under another key (:func:`same_simulation_key`); None if neither."""
+                   specimen: Specimen | None = None, *,
+                   identities: Mapping[str, str] | None = None) -> str | None:
+    """Key under which ``store`` holds this run: one of its :func:`own_run_keys`, else a run
+    of the same simulation under another key; None if neither.
+
+    A key hashes the fill as stated, the simulation only the particle count it rounds to
+    (:func:`pidcore.compare.align.simulation_identity`): ``dem run --specimen`` stores the
+    specimen's fill 21.73913... %, ``dem sweep --fills 21.7391`` asks for another key with
+    the same 5 particles per cell and seed. Such a run is found by the stored runs' inputs
+    (:func:`run_identity`), so no key changes; runs that do not record their inputs are never
+    matched.
+
+    ``identities``: :func:`stored_identities` of ``store``, read once by a caller that looks
+    up many runs (default: read here).
+    """
     store = _open(store)
     if not store.path.exists():
         return None
-    key = run_key(case, config, specimen)
-    if store.has_dem_run(key):
-        return key
-    return same_simulation_key(store, case, config, specimen)
+    for key in own_run_keys(case, config, specimen):
+        if store.has_dem_run(key):
+            return key
+    if identities is None:
+        identities = stored_identities(store)
+    return identities.get(run_identity(case, config, specimen))
 
 
 def run_or_load(store: Store | str | os.PathLike[str], specimen: Specimen | None,
@@ -371,5 +380,5 @@ def rekey_dem_store(source: str | os.PathLike[str], target: str | os.PathLike[st
 
 __all__ = ["DEM_CODE_VERSION", "dem_run_entry", "load_dem_result", "rekey_dem_store",
            "run_identity", "run_key", "run_or_load", "run_parameters", "runs_of_specimen",
-           "same_simulation_key", "save_dem_entry", "save_dem_result", "stored_identities",
+           "own_run_keys", "save_dem_entry", "save_dem_result", "stored_identities",
            "stored_run_key"]

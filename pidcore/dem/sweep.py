@@ -1,7 +1,7 @@
 """Sweeps of DEM load cases: local process pool by default, dask.distributed on request.
 
 A case whose run the store holds under another key (another fill of the same particle count
-and seed: :func:`pidcore.dem.persist.same_simulation_key`), or that repeats another case of the
+and seed: :func:`pidcore.dem.persist.stored_run_key`), or that repeats another case of the
 sweep so, is not simulated again; :attr:`SweepSummary.cases` says so per case.
 
 Every finished case is written to the store at once, in its own transaction, by the parent
@@ -24,13 +24,14 @@ from ..errors import ParameterError
 from ..specimen import Specimen
 from .persist import (
     dem_run_entry,
+    own_run_keys,
     run_identity,
     run_key,
-    run_key_0_1,
     save_dem_entry,
     stored_identities,
+    stored_run_key,
 )
-from .simulate import DemConfig, LoadCase, resolve_specimen, simulate_load_case
+from .simulate import DemConfig, LoadCase, simulate_load_case
 
 #: Named grids. ``table3`` is the paper's Table 3: 4 frequencies x 3 accelerations x 4 fills.
 GRIDS: dict[str, dict[str, tuple[float, ...]]] = {
@@ -330,30 +331,24 @@ def run_sweep(cases: Sequence[LoadCase], config: DemConfig, *,
     planned: dict[str, str] = {}  # simulation identity -> key of a case to simulate
     for case in cases:
         key = run_key(case, config, specimen)
-        # a 0.1 key names only the paper's coupon (with its constant k_t): another specimen's
-        # run, a Mindlin one of that coupon included, is never found under it
-        keys = (key, run_key_0_1(case, config)) if resolve_specimen(case, specimen).is_paper() \
-            else (key,)
-        stored = [k for k in keys if store.path.exists() and store.has_dem_run(k)]
-        status = "already stored"
-        identity = None
-        if not stored:
-            # another fill of the same particle count and seed is the same simulation
-            identity = run_identity(case, config, specimen)
-            same = identities.get(identity)
-            stored, status = ([same], "same simulation as a stored run") if same else ([], "")
+        # its own key, the key a 0.1 store holds it by, or a stored run of the same simulation
+        found = stored_run_key(store, case, config, specimen, identities=identities)
         record = {"frequency_hz": case.frequency_hz, "acceleration_g": case.acceleration_g,
                   "fill_percent": case.fill_percent, "material": case.material,
                   "direction": case.direction}
-        if stored:  # also under the key a 0.1 store holds it by
-            summary.skipped.append(stored[0])
-            summary.cases.append({**record, "store_key": stored[0], "status": status})
-        elif identity is not None and identity in planned:
+        if found is not None:
+            status = ("already stored" if found in own_run_keys(case, config, specimen)
+                      else "same simulation as a stored run")
+            summary.skipped.append(found)
+            summary.cases.append({**record, "store_key": found, "status": status})
+            continue
+        # another fill of the same particle count and seed is the same simulation
+        identity = run_identity(case, config, specimen)
+        if identity in planned:
             summary.cases.append({**record, "store_key": planned[identity],
                                   "status": "same simulation as another case of this sweep"})
         else:
-            if identity is not None:
-                planned[identity] = key
+            planned[identity] = key
             todo.append((case, key))
             summary.cases.append({**record, "store_key": key, "status": "simulated"})
     bar = None
