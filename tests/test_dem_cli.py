@@ -98,7 +98,7 @@ def test_ctrl_c_before_a_run_finishes_says_nothing_saved(tmp_path, monkeypatch, 
     assert main(ARGS) == 130
     err = capsys.readouterr().err
     assert "nothing saved" in err and "are saved" not in err
-    monkeypatch.setattr(pidcore.dem.persist, "run_or_load", _interrupt)
+    monkeypatch.setattr(pidcore.dem.persist, "cached_run", _interrupt)
     path = tmp_path / "s.h5"
     assert main(ARGS + ["--store", str(path)]) == 130
     err = capsys.readouterr().err
@@ -109,13 +109,13 @@ def test_ctrl_c_after_the_run_was_stored_says_it_was_saved(tmp_path, monkeypatch
     import pidcore.dem.persist
     from pidcore.store import Store
 
-    real = pidcore.dem.persist.run_or_load
+    real = pidcore.dem.persist.cached_run
 
     def run_then_interrupt(*args, **kwargs):
         real(*args, **kwargs)
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(pidcore.dem.persist, "run_or_load", run_then_interrupt)
+    monkeypatch.setattr(pidcore.dem.persist, "cached_run", run_then_interrupt)
     path = tmp_path / "s.h5"
     assert main(ARGS + ["--store", str(path)]) == 130
     err = capsys.readouterr().err

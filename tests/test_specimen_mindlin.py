@@ -161,7 +161,6 @@ def test_the_run_cache_finds_a_01_paper_run_as_the_sweep_does(tmp_path, monkeypa
     """``dem run --store`` (the run cache) reuses a run a 0.1 store holds under its old key,
     as ``dem sweep`` does, instead of simulating it again; a Mindlin run is not taken from it."""
     from pidcore.dem import persist
-
     from pidcore.dem.simulate import config_parameters
 
     store = tmp_path / "old.h5"

@@ -267,21 +267,17 @@ def run(args: argparse.Namespace) -> int:
     store = None
     try:
         if args.store is not None:
-            from ..dem.persist import run_key, run_or_load, stored_run_key
+            from ..dem import persist
             from ..store import Store
 
             store = Store(args.store)
-            found = stored_run_key(store, case, config, specimen)
-            reused = found is not None
-            key = found if found is not None else run_key(case, config, specimen)
-            result = run_or_load(store, specimen, case, config, progress=progress)
+            cached = persist.cached_run(store, specimen, case, config, progress=progress)
+            result, key, reused = cached.result, cached.key, cached.reused
         else:
             result = simulate_load_case(case, config, progress=progress, specimen=specimen)
     except KeyboardInterrupt:
-        # the run is saved in one transaction at its end: in the store now, or not at all
-        saved = (store is not None and key is not None and not reused
-                 and args.store.exists() and store.has_dem_run(key))
-        return _interrupted("run", int(saved), args.store)
+        # the run is saved in one transaction at its end: committed now, or not at all
+        return _interrupted("run", int(store is not None and store.commits > 0), args.store)
     notes = list(result.notes)
     same = _same_simulation_note(case, result) if reused else ""
     if same:

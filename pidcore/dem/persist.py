@@ -286,6 +286,33 @@ def stored_run_key(store: Store | str | os.PathLike[str], case: LoadCase, config
     return identities.get(run_identity(case, config, specimen))
 
 
+@dataclasses.dataclass(frozen=True)
+class CachedRun:
+    """What :func:`cached_run` gave: the run, the key it is stored under, and whether it was
+    found in the store (``reused``) rather than simulated and saved."""
+
+    result: DemResult
+    key: str
+    reused: bool
+
+
+def cached_run(store: Store | str | os.PathLike[str], specimen: Specimen | None,
+               case: LoadCase, config: DemConfig | None = None, *,
+               progress: bool = False) -> CachedRun:
+    """:func:`run_or_load`, saying under which key the run is stored and whether it was
+    found there (``pidcore dem run --store`` says both)."""
+    config = config or DemConfig()
+    store = _open(store)
+    specimen = resolve_specimen(case, specimen)
+    stored = stored_run_key(store, case, config, specimen)
+    if stored is not None:
+        return CachedRun(load_dem_result(store.get_dem_run(stored)), stored, True)
+    result = simulate_load_case(case, config, specimen=specimen, progress=progress)
+    key = run_key(case, config, specimen)
+    save_dem_entry(store, key, dem_run_entry(result))
+    return CachedRun(result, key, False)
+
+
 def run_or_load(store: Store | str | os.PathLike[str], specimen: Specimen | None,
                 case: LoadCase, config: DemConfig | None = None, *,
                 progress: bool = False) -> DemResult:
@@ -309,15 +336,7 @@ def run_or_load(store: Store | str | os.PathLike[str], specimen: Specimen | None
     --------
     >>> r = run_or_load("runs.h5", None, LoadCase(500, 5, 50))  # doctest: +SKIP
     """
-    config = config or DemConfig()
-    store = _open(store)
-    specimen = resolve_specimen(case, specimen)
-    stored = stored_run_key(store, case, config, specimen)
-    if stored is not None:
-        return load_dem_result(store.get_dem_run(stored))
-    result = simulate_load_case(case, config, specimen=specimen, progress=progress)
-    save_dem_entry(store, run_key(case, config, specimen), dem_run_entry(result))
-    return result
+    return cached_run(store, specimen, case, config, progress=progress).result
 
 
 def runs_of_specimen(runs, specimen: Specimen | None = None):
@@ -378,7 +397,7 @@ def rekey_dem_store(source: str | os.PathLike[str], target: str | os.PathLike[st
     return len(items)
 
 
-__all__ = ["DEM_CODE_VERSION", "dem_run_entry", "load_dem_result", "rekey_dem_store",
-           "run_identity", "run_key", "run_or_load", "run_parameters", "runs_of_specimen",
-           "own_run_keys", "save_dem_entry", "save_dem_result", "stored_identities",
-           "stored_run_key"]
+__all__ = ["DEM_CODE_VERSION", "cached_run", "CachedRun", "dem_run_entry", "load_dem_result",
+           "own_run_keys", "rekey_dem_store", "run_identity", "run_key", "run_or_load",
+           "run_parameters", "runs_of_specimen", "save_dem_entry", "save_dem_result",
+           "stored_identities", "stored_run_key"]
