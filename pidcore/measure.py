@@ -354,7 +354,7 @@ def replacement_notes(analyses: pd.DataFrame,
 #: Units of the scalar fields stored per analysis.
 ANALYSIS_UNITS = {
     "frequency_hz": "Hz", "acceleration_g": "g", "acceleration_m_s2": "m/s^2",
-    "complex_power_real_w": "W", "complex_power_imag_w": "var", "loss_factor": "1",
+    "complex_power_real_w": "W", "complex_power_imag_w": "W", "loss_factor": "1",
     "loss_factor_stderr": "1", "sdc": "1", "sdc_stderr": "1", "damping_ratio": "1",
     "energy_per_cycle_j": "J", "max_kinetic_energy_j": "J", "force_amplitude_n": "N",
     "velocity_amplitude_m_s": "m/s", "displacement_amplitude_m": "m", "n_periods": "1",

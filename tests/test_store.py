@@ -296,3 +296,27 @@ def test_newer_store_version_is_refused(store):
         h5.attrs["pidcore_store_version"] = np.int64(STORE_VERSION + 1)
     with pytest.raises(StoreError, match="newer"):
         store.list_dem_runs()
+
+
+# A field's name ends in the unit it holds (guide: every output column names its unit); the
+# suffixes and the unit each one promises.
+_SUFFIX_UNITS = {"_hz": "Hz", "_w": "W", "_j": "J", "_n": "N", "_m_s": "m/s", "_m_s2": "m/s^2",
+                 "_m": "m", "_kg": "kg", "_s": "s", "_g": "g", "_per_s": "1/s"}
+
+
+def _promised_unit(name: str) -> str | None:
+    for suffix in sorted(_SUFFIX_UNITS, key=len, reverse=True):  # "_m_s2" before "_m_s"
+        if name.endswith(suffix):
+            return _SUFFIX_UNITS[suffix]
+    return None
+
+
+def test_stored_units_are_those_the_field_names_promise():
+    from pidcore.dem.result import UNITS as DEM_UNITS
+    from pidcore.measure import ANALYSIS_UNITS
+
+    for table in (ANALYSIS_UNITS, DEM_UNITS):
+        for name, unit in table.items():
+            promised = _promised_unit(name)
+            if promised is not None:
+                assert unit == promised, f"{name}: stored unit {unit!r}, name says {promised!r}"

@@ -455,7 +455,7 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
                      "the mass between gauge and structure (its cancelled inertia exceeds the "
                      "structure's), or " + cause)
         raise SignalError(
-            f"{source or 'record'}: reactive power Im(P_c) = {p_c.imag:.4g} var <= 0 (no "
+            f"{source or 'record'}: reactive power Im(P_c) = {p_c.imag:.4g} W <= 0 (no "
             f"positive kinetic energy: a mass-like structure gives Im(P_c) > 0); {cause}")
 
     loss_raw = p_c.real / p_c.imag if p_c.imag != 0 else math.nan
