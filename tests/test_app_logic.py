@@ -1364,3 +1364,50 @@ def test_the_report_tab_says_why_a_result_has_no_number():
     assert shown["SDC DEM stderr [-]"].tolist() == ["n/a (1 cell)", "0.0123", "", "n/a"]
     assert shown["measured chi2/dof [-]"].tolist() == ["n/a (1 measurement)", "", "1.2", "n/a"]
     assert math.isnan(table["SDC DEM stderr [-]"].iloc[0])  # the table itself is unchanged
+
+
+@pytest.mark.parametrize("rows", [
+    ["RUN_A.uff", "Run_A.uff"],            # names differing only by case
+    ["lab1/run_a.uff", "lab2/run_a.uff"],  # one base name under two folders
+], ids=["case", "folders"])
+def test_an_ambiguous_settings_row_is_refused_as_the_cli_refuses_it(tmp_path, rows):
+    # the app applied the first base-name match (or none) where `pidcore analyze` refuses the
+    # table: the rows are matched by the CLI's find_row, with its message
+    from pidcore.compare.loadcase import sidecar_row
+
+    data = ("file,velocity_delay_us\n" + "".join(f"{r},{40 + i}\n" for i, r in
+                                                  enumerate(rows))).encode()
+    table = uploads.read_settings_table("settings.csv", data)
+    with pytest.raises(ParameterError) as app:
+        uploads.check_table_rows("settings.csv", table, ["other.uff", "run_a.uff"])
+    sidecar = tmp_path / "settings.csv"
+    sidecar.write_bytes(data)
+    with pytest.raises(ParameterError) as cli:
+        sidecar_row(tmp_path / "run_a.uff", sidecar)
+    assert str(app.value) == str(cli.value).replace(str(sidecar), "settings.csv")
+    assert str(app.value).startswith(f"settings.csv: line 2 ({rows[0]!r}) and line 3 "
+                                     f"({rows[1]!r}) both match 'run_a.uff'")
+    held = uploads.refused_table("settings.csv", data, str(app.value))
+    assert held.refuses("run_a.uff") and not held.refuses("other.uff")
+    uploads.check_table_rows("settings.csv", table, ["other.uff"])  # concerns no upload
+
+
+def test_a_settings_row_is_found_as_the_cli_finds_it():
+    # a case-folded match is the row (the CLI's); the app left such a file without settings
+    table = uploads.read_settings_table("s.csv", b"file,velocity_delay_us\nRUN_A.uff,50\n")
+    settings = uploads.merge_settings(["run_a.uff"], [stated_case("run_a.uff")], None, [table])
+    assert settings["vibrometer delay [µs]"].tolist() == [50.0]
+    assert uploads.columns_given([table], "run_a.uff") == {"vibrometer delay [µs]"}
+    assert uploads.table_match_note("s.csv", table, ["run_a.uff"])[1] == ""
+    # an exact name is preferred to a case-folded one, as the CLI prefers it
+    both = uploads.read_settings_table("s.csv", b"file,velocity_delay_us\nRUN_A.uff,50\n"
+                                                b"run_a.uff,40\n")
+    uploads.check_table_rows("s.csv", both, ["run_a.uff"])
+    assert uploads.merge_settings(["run_a.uff"], [stated_case("run_a.uff")], None, [both])[
+        "vibrometer delay [µs]"].tolist() == [40.0]
+    # a cell naming the app's working folder is not taken for the upload's folder
+    cwd = Path.cwd().name
+    folders = uploads.read_settings_table("s.csv", f"file,velocity_delay_us\n{cwd}/run_a.uff,"
+                                                   f"50\nother/run_a.uff,40\n".encode())
+    with pytest.raises(ParameterError, match="both match 'run_a.uff'"):
+        uploads.check_table_rows("s.csv", folders, ["run_a.uff"])

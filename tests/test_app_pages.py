@@ -1053,3 +1053,23 @@ def test_the_report_tab_says_a_one_cell_run_has_no_standard_error(store_file):
     assert _table(at, "SDC measured [-]")["SDC DEM stderr [-]"].tolist() == ["n/a (1 cell)"]
     back = pd.read_csv(io.BytesIO(report_files(store_file)["csv"][1]))
     assert back["SDC DEM stderr [-]"].isna().all()
+
+
+@pytest.mark.parametrize("rows", [
+    [_SAMPLE.name.upper(), _SAMPLE.name.capitalize()],     # names differing only by case
+    [f"lab1/{_SAMPLE.name}", f"lab2/{_SAMPLE.name}"],      # one name under two folders
+], ids=["case", "folders"])
+def test_a_settings_table_with_an_ambiguous_row_is_refused_as_the_cli_refuses_it(store_file,
+                                                                                 rows):
+    # the app analysed the file with the first matching row's delay (or none) and saved it;
+    # `pidcore analyze` refuses the table naming both rows
+    table = ("file,velocity_delay_us\n" + "".join(f"{r},{40 + i}\n" for i, r in
+                                                   enumerate(rows))).encode()
+    at = _upload(_app(), [(_SAMPLE.name, _SAMPLE.read_bytes()), ("settings.csv", table)])
+    errors = [e.value for e in at.error]
+    assert errors[0] == (f"settings.csv: line 2 ({rows[0]!r}) and line 3 ({rows[1]!r}) both "
+                         f"match {_SAMPLE.name!r}; expected one row per file (fix the name or "
+                         "the case of one)")
+    assert any(e.startswith(f"{_SAMPLE.name}: not analysed") for e in errors), errors
+    assert not _metric(at, "SDC ± stderr [-]")
+    assert at.button(key="save").disabled

@@ -177,10 +177,20 @@ def render(stores) -> list:
                 # a result with settings the user did not give (e.g. no vibrometer delay)
                 refused.append(uploads.refused_table(upload.name, data, str(exc)))
                 continue
-            tables[state.upload_sha256(upload)] = table
-            accepted.append((upload.name, table))  # by name: two tables may be byte-equal
+            accepted.append((upload, data, table))  # by name: two tables may be byte-equal
         else:
             measurements.append(upload)
+    kept_tables = []
+    for upload, data, table in accepted:
+        try:  # rows matched as `pidcore analyze` matches them: an ambiguous one is refused
+            uploads.check_table_rows(upload.name, table, [u.name for u in measurements])
+        except PidcoreError as exc:
+            st.error(str(exc))
+            refused.append(uploads.refused_table(upload.name, data, str(exc)))
+            continue
+        tables[state.upload_sha256(upload)] = table
+        kept_tables.append((upload.name, table))
+    accepted = kept_tables
     for name, table in accepted:
         info, unmatched = uploads.table_match_note(name, table, [u.name for u in measurements])
         st.info(info)
