@@ -8,6 +8,7 @@ import json
 import math
 import re
 import threading
+import time
 import tomllib
 from pathlib import Path
 
@@ -1411,3 +1412,34 @@ def test_a_settings_row_is_found_as_the_cli_finds_it():
                                                    f"50\nother/run_a.uff,40\n".encode())
     with pytest.raises(ParameterError, match="both match 'run_a.uff'"):
         uploads.check_table_rows("s.csv", folders, ["run_a.uff"])
+
+
+def test_two_fills_of_one_simulation_in_one_submission_are_run_once(tmp_path):
+    """The DEM tab ran and stored fills 25 and 26 % of one submission twice: 6 acrylic
+    particles per cell either way, the same seed and settings, the same numbers (the CLI's
+    `dem sweep` runs them once)."""
+    from pidcore.dem import DemConfig
+    from pidcore.dem.persist import run_key
+    from pidcore.store import Store
+
+    store_file = tmp_path / "dem.h5"
+    config = DemConfig(cells=1, steady_cycles=4, block_cycles=2, max_transient_cycles=2)
+    cases = jobs.plan_dem_cases([1000.0], [5.0], [25.0, 26.0], material="acrylic",
+                                direction="z")
+    runner = jobs.DemJobRunner(store_file)
+    first, second = runner.submit(cases, config)
+    assert first.state in ("queued", "running")
+    assert second.state == "same run" and second.run_key == run_key(cases[0], config)
+    assert f"as {first.job_id} (fill 25 %)" in second.message
+    assert jobs.submitted_text(2, [first, second]) == (
+        "1 job(s) submitted; 1 the same simulation as another job (same particle count and "
+        "seed), run once")
+    # submitted again while it runs: the same run is not queued a second time either
+    (again,) = runner.submit(cases[1:], config)
+    assert again.state == "same run"
+    deadline = time.monotonic() + 300
+    while runner.busy():
+        assert time.monotonic() < deadline
+        time.sleep(0.05)
+    assert [j.state for j in runner.jobs()] == ["saved", "same run", "same run"]
+    assert Store(store_file).list_dem_runs()["case_key"].tolist() == [first.run_key]
