@@ -1073,3 +1073,18 @@ def test_a_settings_table_with_an_ambiguous_row_is_refused_as_the_cli_refuses_it
     assert any(e.startswith(f"{_SAMPLE.name}: not analysed") for e in errors), errors
     assert not _metric(at, "SDC ± stderr [-]")
     assert at.button(key="save").disabled
+
+
+def test_the_report_grid_leaves_cells_empty_by_design_empty(store_file):
+    # a DEM-only row showed a greyed "None" in every measured column (and in the difference
+    # to the measurement): the grid now shows those cells empty
+    from pidcore.store import Store
+
+    Store(store_file).add_dem_run("dem_only", {
+        "frequency_hz": 100.0, "acceleration_g": 5.0, "fill_percent": 50.0,
+        "material": "acrylic", "direction": "z", "sdc": 1.1, "sdc_stderr": 0.01,
+        "m_c_kg": 0.3, "cells_simulated": 2})
+    at = _app()
+    (grid,) = [d for d in at.dataframe if "SDC measured [-]" in d.value.columns]
+    assert grid.value["SDC measured [-]"].isna().all()  # missing by design: no measurement
+    assert grid.proto.HasField("placeholder") and grid.proto.placeholder == ""

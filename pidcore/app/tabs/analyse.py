@@ -226,7 +226,7 @@ def render(stores) -> list:
     if analysed:
         st.markdown("**Results**")
         st.dataframe(uploads.results_table(analysed), hide_index=True, key="results_table",
-                     width="stretch")
+                     width="stretch", placeholder="")
     flagged = [f for f in analysed if f.warnings]
     confirm = False
     if flagged:
