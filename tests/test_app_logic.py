@@ -1441,5 +1441,24 @@ def test_two_fills_of_one_simulation_in_one_submission_are_run_once(tmp_path):
     while runner.busy():
         assert time.monotonic() < deadline
         time.sleep(0.05)
-    assert [j.state for j in runner.jobs()] == ["saved", "same run", "same run"]
+    # once saved, the jobs of its other fills are in the store (under its key), as the CLI's
+    assert [j.state for j in runner.jobs()] == ["saved", "in store", "in store"]
+    assert runner.jobs()[1].message.endswith(f"; saved by it as {first.run_key}")
+    assert runner.jobs()[1].fraction() == 1.0
     assert Store(store_file).list_dem_runs()["case_key"].tolist() == [first.run_key]
+
+
+def test_a_job_waiting_for_a_cancelled_same_simulation_says_it_was_not_run(tmp_path):
+    # its partner cancelled, the "same run" job would wait for a run that never comes
+    from pidcore.dem import DemConfig
+
+    config = DemConfig(cells=1, steady_cycles=4, block_cycles=2, max_transient_cycles=2)
+    cases = jobs.plan_dem_cases([1000.0], [5.0], [25.0, 26.0], material="acrylic",
+                                direction="z")
+    runner = jobs.DemJobRunner(tmp_path / "dem.h5")
+    first, second = runner.submit(cases, config)
+    assert runner.cancel() == 1  # the one queued or running; the other never runs
+    assert runner.wait_cancelled(30)
+    states = {j.job_id: j for j in runner.jobs()}
+    assert states[second.job_id].state == "cancelled"
+    assert states[second.job_id].message.startswith(f"not run: {first.job_id}")

@@ -54,6 +54,8 @@ class DemJob:
     cycles_done: int = 0
     cycles_expected: int = 0
     message: str = ""
+    #: The job that runs this one's simulation (state :data:`SAME_RUN_STATE`), else "".
+    same_as: str = ""
 
     def elapsed_s(self, now: float | None = None) -> float:
         """Seconds the case has run (0 while queued)."""
@@ -196,6 +198,7 @@ class DemJobRunner:
                                    f"as {running.job_id} (fill {running.case.fill_percent:g} %),"
                                    " which runs it; not run twice")
                     job.run_key = running.run_key  # the run it will be stored as
+                    job.same_as = running.job_id
                 else:
                     active[identity] = job
                 self._jobs.append(job)
@@ -217,6 +220,7 @@ class DemJobRunner:
                     if job.state == "queued":
                         job.state, job.finished = "cancelled", time.time()
                         job.message = "cancelled before it started"
+                        self._settle_same(job)
                     n += 1
             self._wake.notify_all()
         return n
@@ -267,10 +271,24 @@ class DemJobRunner:
             except Exception as exc:  # noqa: BLE001 - a failed save must not stop the queue
                 self._finish(job, "failed", f"{type(exc).__name__}: {exc}")
 
+    def _settle_same(self, job: DemJob) -> None:
+        """The jobs waiting for ``job``'s run (:data:`SAME_RUN_STATE`), once it ended (lock
+        held): in the store where it was saved, else not run."""
+        for same in self._jobs:
+            if same.state == SAME_RUN_STATE and same.same_as == job.job_id:
+                if job.state == "saved":
+                    same.state = "in store"
+                    same.message += f"; saved by it as {job.run_key}"
+                else:
+                    same.state = "cancelled"
+                    same.message = (f"not run: {job.job_id}, the same simulation, is "
+                                    f"{job.state}; run it again")
+
     def _finish(self, job: DemJob, state: str, message: str = "") -> None:
         with self._lock:
             job.state, job.message, job.finished = state, message, time.time()
             self._cancel.discard(job.job_id)
+            self._settle_same(job)
             self._wake.notify_all()  # wait_cancelled
 
     def _run(self, job: DemJob) -> None:
@@ -325,6 +343,7 @@ class DemJobRunner:
             if job.job_id in self._cancel:  # cancelled after the result came: not saved
                 job.state, job.finished = "cancelled", time.time()
                 job.message = "cancelled as it finished; nothing saved"
+                self._settle_same(job)
                 self._cancel.discard(job.job_id)
                 self._wake.notify_all()  # wait_cancelled
                 return
