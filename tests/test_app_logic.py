@@ -1462,3 +1462,16 @@ def test_a_job_waiting_for_a_cancelled_same_simulation_says_it_was_not_run(tmp_p
     states = {j.job_id: j for j in runner.jobs()}
     assert states[second.job_id].state == "cancelled"
     assert states[second.job_id].message.startswith(f"not run: {first.job_id}")
+
+
+def test_two_refused_settings_tables_are_named_in_the_plural():
+    # "the settings table unknown.csv, ambiguous.csv that gives its settings was refused"
+    one = uploads.RefusedTable("a.csv", "bad", None)
+    two = uploads.RefusedTable("b.csv", "bad", None)
+    assert "the settings table a.csv that gives its settings was refused" in \
+        uploads.refusal_of("x.uff", [one])
+    assert "the settings tables a.csv, b.csv that give its settings were refused" in \
+        uploads.refusal_of("x.uff", [one, two])
+    assert uploads.refused_tables_text([one]).startswith("the settings table a.csv is refused")
+    assert uploads.refused_tables_text([one, two]).startswith(
+        "the settings tables a.csv, b.csv are refused")

@@ -457,9 +457,22 @@ def refusal_of(name: str, refused: Sequence[RefusedTable]) -> str:
     tables = [t.name for t in refused if t.refuses(name)]
     if not tables:
         return ""
-    return (f"{name}: not analysed: the settings table {', '.join(tables)} that gives its "
-            "settings was refused (see the error above); fix the table and upload it again, "
-            "or remove it")
+    if len(tables) == 1:
+        return (f"{name}: not analysed: the settings table {tables[0]} that gives its "
+                "settings was refused (see the error above); fix the table and upload it "
+                "again, or remove it")
+    return (f"{name}: not analysed: the settings tables {', '.join(tables)} that give its "
+            "settings were refused (see the errors above); fix the tables and upload them "
+            "again, or remove them")
+
+
+def refused_tables_text(refused: Sequence[RefusedTable]) -> str:
+    """Why nothing is saved while settings tables are refused, as one line."""
+    names = ", ".join(t.name for t in refused)
+    if len(refused) == 1:
+        return f"the settings table {names} is refused: fix it and upload it again, or remove it"
+    return (f"the settings tables {names} are refused: fix them and upload them again, or "
+            "remove them")
 
 
 def table_match_note(name: str, table: pd.DataFrame, uploaded: Sequence[str]) -> tuple[str, str]:

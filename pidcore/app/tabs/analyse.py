@@ -233,8 +233,7 @@ def render(stores) -> list:
         confirm = st.checkbox(f"Save the {len(flagged)} implausible record(s) anyway (their "
                               "warnings are saved with them)", key="confirm_implausible")
     if refused:  # one save of what the user uploaded, not of the part its settings allow
-        conflict = (f"the settings table {', '.join(t.name for t in refused)} is refused: fix "
-                    "it and upload it again, or remove it")
+        conflict = uploads.refused_tables_text(refused)
     else:
         conflict = uploads.load_case_conflict(analysed)
     if conflict:  # said before Save, which would refuse it
