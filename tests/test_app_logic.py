@@ -1475,3 +1475,29 @@ def test_two_refused_settings_tables_are_named_in_the_plural():
     assert uploads.refused_tables_text([one]).startswith("the settings table a.csv is refused")
     assert uploads.refused_tables_text([one, two]).startswith(
         "the settings tables a.csv, b.csv are refused")
+
+
+@pytest.mark.parametrize("cell", ["150", "0", "fifty"])
+def test_a_settings_table_with_a_fill_out_of_range_is_refused_as_the_cli_refuses_it(
+        tmp_path, cell):
+    # the app accepted the table ("1 of 1 row(s) match") and each file's card said "no valid
+    # load case ... set it in the settings table"; `pidcore analyze` refuses the table, naming
+    # its line and file
+    from pidcore.compare.loadcase import resolve_load_case
+
+    data = f"file,fill_percent\nrun_a.uff,{cell}\n".encode()
+    with pytest.raises(ParameterError) as app:
+        uploads.read_settings_table("settings.csv", data)
+    sidecar = tmp_path / "settings.csv"
+    sidecar.write_bytes(data)
+    with pytest.raises(ParameterError) as cli:
+        resolve_load_case(tmp_path / "run_a.uff", sidecar=sidecar)
+    assert str(app.value) == str(cli.value).replace(str(sidecar), "settings.csv")
+    assert str(app.value).startswith("settings.csv, line 2 (run_a.uff): fill ")
+
+
+def test_the_sample_rate_hint_names_the_apps_option():
+    # "give the sample rate (--sample-rate)": the app has no such option, but a field
+    outcome = uploads.parse_upload("no_time.csv", b"Force [N],Velocity [m/s]\n1,2\n3,4\n")
+    assert "--sample-rate" not in outcome.error
+    assert "'sample rate if no time column' under 'Options for every file'" in outcome.error

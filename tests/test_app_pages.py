@@ -1088,3 +1088,26 @@ def test_the_report_grid_leaves_cells_empty_by_design_empty(store_file):
     (grid,) = [d for d in at.dataframe if "SDC measured [-]" in d.value.columns]
     assert grid.value["SDC measured [-]"].isna().all()  # missing by design: no measurement
     assert grid.proto.HasField("placeholder") and grid.proto.placeholder == ""
+
+
+def test_a_file_that_cannot_be_read_gets_its_error_without_assumed_load_case_notes(
+        store_file):
+    # "fill: not stated, 50 % proposed; material: not stated, acrylic assumed" was shown above
+    # the read error of a file that has no numbers, and the error named the CLI's option
+    at = _upload(_app(), [("plain.csv", b"Force [N],Velocity [m/s]\n1,2\n3,4\n")])
+    errors = [e.value for e in at.error]
+    assert len(errors) == 1 and errors[0].startswith("plain.csv: ")
+    assert "Options for every file" in errors[0] and "--sample-rate" not in errors[0]
+    assert not [i.value for i in at.info if "not stated" in i.value]
+
+
+def test_a_settings_table_with_a_fill_over_100_is_refused_naming_its_line(store_file):
+    # the table was accepted ("1 of 1 row(s) match uploaded files") and the file's card said
+    # "no valid load case"; `pidcore analyze` refuses the table naming the line
+    table = b"file,fill_percent\n" + _SAMPLE.name.encode() + b",150\n"
+    at = _upload(_app(), [(_SAMPLE.name, _SAMPLE.read_bytes()), ("settings.csv", table)])
+    errors = [e.value for e in at.error]
+    assert errors[0] == (f"settings.csv, line 2 ({_SAMPLE.name}): fill must be in (0, 100] % "
+                         "(packing ratio), got '150'")
+    assert any(e.startswith(f"{_SAMPLE.name}: not analysed") for e in errors), errors
+    assert at.button(key="save").disabled

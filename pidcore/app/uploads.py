@@ -169,6 +169,8 @@ def error_message(name: str, exc: BaseException) -> str:
     text = re.sub(r"--(force|velocity|acceleration) NAME", r"the '\1 channel' column", text)
     text = text.replace("pass --invert NAME for the inverted channel",
                         "name the inverted channel in the 'inverted channels' column")
+    text = text.replace("(--sample-rate)", "('sample rate if no time column' under 'Options "
+                                           "for every file')")
     if isinstance(exc, PidcoreError):
         return text if name in text else f"{name}: {text}"
     return f"{name}: could not be read ({type(exc).__name__}: {text})"
@@ -333,6 +335,7 @@ def read_settings_table(name: str, data: bytes,
         normalize_material,
         settings_table,
     )
+    from ..loadcase import check_fill
     from ..tables import line_where, read_text_table
 
     try:
@@ -350,7 +353,12 @@ def read_settings_table(name: str, data: bytes,
     out = raw.reset_index(drop=True)
     for column in _NUMERIC:
         values = []
-        for line, text in zip(raw.index, raw[column], strict=True):
+        for line, file, text in zip(raw.index, raw["file"], raw[column], strict=True):
+            if column == "fill [%]" and text != "":
+                # the CLI's check of a sidecar's fill, naming the line and file as it does: a
+                # fill of 150 % was accepted and each file's card said "no valid load case"
+                values.append(check_fill(text, f"{line_where(name, int(line))} ({file})"))
+                continue
             try:
                 values.append(float(text) if text != "" else math.nan)
             except ValueError:

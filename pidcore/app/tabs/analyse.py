@@ -78,14 +78,14 @@ def _card(upload, row, sample_rate_hz, materials, given=()):
     name = upload.name
     with st.container(border=True):
         st.markdown(f"**{name}** · {_size(upload.size)}")
+        sha = state.upload_sha256(upload)
+        found = state.parsed(sha, name, sample_rate_hz, upload)
+        if found.error is not None:  # no numbers: nothing assumed for them to say
+            st.error(found.error)
+            return None
         assumed = uploads.assumed_note(stated_case(name, materials=materials), row, given)
         if assumed:  # a default the user has not confirmed: say so next to the numbers
             st.info(f"{assumed} (set it in the settings table)")
-        sha = state.upload_sha256(upload)
-        found = state.parsed(sha, name, sample_rate_hz, upload)
-        if found.error is not None:
-            st.error(found.error)
-            return None
         try:
             options = uploads.options_of(row, sample_rate_hz=sample_rate_hz)
         except PidcoreError as exc:
