@@ -1111,3 +1111,10 @@ def test_a_settings_table_with_a_fill_over_100_is_refused_naming_its_line(store_
                          "(packing ratio), got '150'")
     assert any(e.startswith(f"{_SAMPLE.name}: not analysed") for e in errors), errors
     assert at.button(key="save").disabled
+
+
+def test_the_results_table_names_each_files_material_and_direction(store_file):
+    # "50 Hz, 5 g, 50 %" for every material: a file set to aluminium in the settings read as
+    # its acrylic twin; Compare lists "50 Hz, 5 g, 50 %, acrylic, z"
+    at = _upload(_app(), [(_SAMPLE.name, _SAMPLE.read_bytes())])
+    assert _table(at, "SDC [-]")["load case"].tolist() == ["50 Hz, 5 g, 50 %, acrylic, z"]

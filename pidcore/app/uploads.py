@@ -660,7 +660,10 @@ def results_table(files: Sequence[AnalysedFile]) -> pd.DataFrame:
     for f in files:
         a = f.record.analysis
         rows.append({
-            "file": Path(f.record.measurement.source).name, "load case": f.load_case.label(),
+            # with material and direction, as Compare lists it: a file set to aluminium
+            # read the same as its acrylic twin
+            "file": Path(f.record.measurement.source).name,
+            "load case": f.load_case.full_label(),
             "specimen": f.specimen, "frequency [Hz]": a.frequency_hz,
             "acceleration [g]": a.acceleration_g, "loss factor [-]": a.loss_factor,
             "SDC [-]": a.sdc, "SDC stderr [-]": a.sdc_stderr,
