@@ -8,6 +8,7 @@ import json
 import math
 import re
 import threading
+import time
 import tomllib
 from pathlib import Path
 
@@ -1379,3 +1380,139 @@ def test_report_download_names_the_seeds_of_the_specimens_runs_only(tmp_path):
     provenance = files["csv_provenance"][1].decode()
     assert "seeds: 11\n" in provenance or provenance.rstrip().endswith("seeds: 11")
     assert "22" not in provenance.split("seeds:")[1].splitlines()[0]
+
+
+@pytest.mark.parametrize("rows", [
+    ["RUN_A.uff", "Run_A.uff"],            # names differing only by case
+    ["lab1/run_a.uff", "lab2/run_a.uff"],  # one base name under two folders
+], ids=["case", "folders"])
+def test_an_ambiguous_settings_row_is_refused_as_the_cli_refuses_it(tmp_path, rows):
+    # the app applied the first base-name match (or none) where `pidcore analyze` refuses the
+    # table: the rows are matched by the CLI's find_row, with its message
+    from pidcore.compare.loadcase import sidecar_row
+
+    data = ("file,velocity_delay_us\n" + "".join(f"{r},{40 + i}\n" for i, r in
+                                                  enumerate(rows))).encode()
+    table = uploads.read_settings_table("settings.csv", data)
+    with pytest.raises(ParameterError) as app:
+        uploads.check_table_rows("settings.csv", table, ["other.uff", "run_a.uff"])
+    sidecar = tmp_path / "settings.csv"
+    sidecar.write_bytes(data)
+    with pytest.raises(ParameterError) as cli:
+        sidecar_row(tmp_path / "run_a.uff", sidecar)
+    assert str(app.value) == str(cli.value).replace(str(sidecar), "settings.csv")
+    assert str(app.value).startswith(f"settings.csv: line 2 ({rows[0]!r}) and line 3 "
+                                     f"({rows[1]!r}) both match 'run_a.uff'")
+    held = uploads.refused_table("settings.csv", data, str(app.value))
+    assert held.refuses("run_a.uff") and not held.refuses("other.uff")
+    uploads.check_table_rows("settings.csv", table, ["other.uff"])  # concerns no upload
+
+
+def test_a_settings_row_is_found_as_the_cli_finds_it():
+    # a case-folded match is the row (the CLI's); the app left such a file without settings
+    table = uploads.read_settings_table("s.csv", b"file,velocity_delay_us\nRUN_A.uff,50\n")
+    settings = uploads.merge_settings(["run_a.uff"], [stated_case("run_a.uff")], None, [table])
+    assert settings["vibrometer delay [µs]"].tolist() == [50.0]
+    assert uploads.columns_given([table], "run_a.uff") == {"vibrometer delay [µs]"}
+    assert uploads.table_match_note("s.csv", table, ["run_a.uff"])[1] == ""
+    # an exact name is preferred to a case-folded one, as the CLI prefers it
+    both = uploads.read_settings_table("s.csv", b"file,velocity_delay_us\nRUN_A.uff,50\n"
+                                                b"run_a.uff,40\n")
+    uploads.check_table_rows("s.csv", both, ["run_a.uff"])
+    assert uploads.merge_settings(["run_a.uff"], [stated_case("run_a.uff")], None, [both])[
+        "vibrometer delay [µs]"].tolist() == [40.0]
+    # a cell naming the app's working folder is not taken for the upload's folder
+    cwd = Path.cwd().name
+    folders = uploads.read_settings_table("s.csv", f"file,velocity_delay_us\n{cwd}/run_a.uff,"
+                                                   f"50\nother/run_a.uff,40\n".encode())
+    with pytest.raises(ParameterError, match="both match 'run_a.uff'"):
+        uploads.check_table_rows("s.csv", folders, ["run_a.uff"])
+
+
+def test_two_fills_of_one_simulation_in_one_submission_are_run_once(tmp_path):
+    """The DEM tab ran and stored fills 25 and 26 % of one submission twice: 6 acrylic
+    particles per cell either way, the same seed and settings, the same numbers (the CLI's
+    `dem sweep` runs them once)."""
+    from pidcore.dem import DemConfig
+    from pidcore.dem.persist import run_key
+    from pidcore.store import Store
+
+    store_file = tmp_path / "dem.h5"
+    config = DemConfig(cells=1, steady_cycles=4, block_cycles=2, max_transient_cycles=2)
+    cases = jobs.plan_dem_cases([1000.0], [5.0], [25.0, 26.0], material="acrylic",
+                                direction="z")
+    runner = jobs.DemJobRunner(store_file)
+    first, second = runner.submit(cases, config)
+    assert first.state in ("queued", "running")
+    assert second.state == "same run" and second.run_key == run_key(cases[0], config)
+    assert f"as {first.job_id} (fill 25 %)" in second.message
+    assert jobs.submitted_text(2, [first, second]) == (
+        "1 job(s) submitted; 1 the same simulation as another job (same particle count and "
+        "seed), run once")
+    # submitted again while it runs: the same run is not queued a second time either
+    (again,) = runner.submit(cases[1:], config)
+    assert again.state == "same run"
+    deadline = time.monotonic() + 300
+    while runner.busy():
+        assert time.monotonic() < deadline
+        time.sleep(0.05)
+    # once saved, the jobs of its other fills are in the store (under its key), as the CLI's
+    assert [j.state for j in runner.jobs()] == ["saved", "in store", "in store"]
+    assert runner.jobs()[1].message.endswith(f"; saved by it as {first.run_key}")
+    assert runner.jobs()[1].fraction() == 1.0
+    assert Store(store_file).list_dem_runs()["case_key"].tolist() == [first.run_key]
+
+
+def test_a_job_waiting_for_a_cancelled_same_simulation_says_it_was_not_run(tmp_path):
+    # its partner cancelled, the "same run" job would wait for a run that never comes
+    from pidcore.dem import DemConfig
+
+    config = DemConfig(cells=1, steady_cycles=4, block_cycles=2, max_transient_cycles=2)
+    cases = jobs.plan_dem_cases([1000.0], [5.0], [25.0, 26.0], material="acrylic",
+                                direction="z")
+    runner = jobs.DemJobRunner(tmp_path / "dem.h5")
+    first, second = runner.submit(cases, config)
+    assert runner.cancel() == 1  # the one queued or running; the other never runs
+    assert runner.wait_cancelled(30)
+    states = {j.job_id: j for j in runner.jobs()}
+    assert states[second.job_id].state == "cancelled"
+    assert states[second.job_id].message.startswith(f"not run: {first.job_id}")
+
+
+def test_two_refused_settings_tables_are_named_in_the_plural():
+    # "the settings table unknown.csv, ambiguous.csv that gives its settings was refused"
+    one = uploads.RefusedTable("a.csv", "bad", None)
+    two = uploads.RefusedTable("b.csv", "bad", None)
+    assert "the settings table a.csv that gives its settings was refused" in \
+        uploads.refusal_of("x.uff", [one])
+    assert "the settings tables a.csv, b.csv that give its settings were refused" in \
+        uploads.refusal_of("x.uff", [one, two])
+    assert uploads.refused_tables_text([one]).startswith("the settings table a.csv is refused")
+    assert uploads.refused_tables_text([one, two]).startswith(
+        "the settings tables a.csv, b.csv are refused")
+
+
+@pytest.mark.parametrize("cell", ["150", "0", "fifty"])
+def test_a_settings_table_with_a_fill_out_of_range_is_refused_as_the_cli_refuses_it(
+        tmp_path, cell):
+    # the app accepted the table ("1 of 1 row(s) match") and each file's card said "no valid
+    # load case ... set it in the settings table"; `pidcore analyze` refuses the table, naming
+    # its line and file
+    from pidcore.compare.loadcase import resolve_load_case
+
+    data = f"file,fill_percent\nrun_a.uff,{cell}\n".encode()
+    with pytest.raises(ParameterError) as app:
+        uploads.read_settings_table("settings.csv", data)
+    sidecar = tmp_path / "settings.csv"
+    sidecar.write_bytes(data)
+    with pytest.raises(ParameterError) as cli:
+        resolve_load_case(tmp_path / "run_a.uff", sidecar=sidecar)
+    assert str(app.value) == str(cli.value).replace(str(sidecar), "settings.csv")
+    assert str(app.value).startswith("settings.csv, line 2 (run_a.uff): fill ")
+
+
+def test_the_sample_rate_hint_names_the_apps_option():
+    # "give the sample rate (--sample-rate)": the app has no such option, but a field
+    outcome = uploads.parse_upload("no_time.csv", b"Force [N],Velocity [m/s]\n1,2\n3,4\n")
+    assert "--sample-rate" not in outcome.error
+    assert "'sample rate if no time column' under 'Options for every file'" in outcome.error

@@ -1053,3 +1053,68 @@ def test_the_report_tab_says_a_one_cell_run_has_no_standard_error(store_file):
     assert _table(at, "SDC measured [-]")["SDC DEM stderr [-]"].tolist() == ["n/a (1 cell)"]
     back = pd.read_csv(io.BytesIO(report_files(store_file)["csv"][1]))
     assert back["SDC DEM stderr [-]"].isna().all()
+
+
+@pytest.mark.parametrize("rows", [
+    [_SAMPLE.name.upper(), _SAMPLE.name.capitalize()],     # names differing only by case
+    [f"lab1/{_SAMPLE.name}", f"lab2/{_SAMPLE.name}"],      # one name under two folders
+], ids=["case", "folders"])
+def test_a_settings_table_with_an_ambiguous_row_is_refused_as_the_cli_refuses_it(store_file,
+                                                                                 rows):
+    # the app analysed the file with the first matching row's delay (or none) and saved it;
+    # `pidcore analyze` refuses the table naming both rows
+    table = ("file,velocity_delay_us\n" + "".join(f"{r},{40 + i}\n" for i, r in
+                                                   enumerate(rows))).encode()
+    at = _upload(_app(), [(_SAMPLE.name, _SAMPLE.read_bytes()), ("settings.csv", table)])
+    errors = [e.value for e in at.error]
+    assert errors[0] == (f"settings.csv: line 2 ({rows[0]!r}) and line 3 ({rows[1]!r}) both "
+                         f"match {_SAMPLE.name!r}; expected one row per file (fix the name or "
+                         "the case of one)")
+    assert any(e.startswith(f"{_SAMPLE.name}: not analysed") for e in errors), errors
+    assert not _metric(at, "SDC ± stderr [-]")
+    assert at.button(key="save").disabled
+
+
+def test_the_report_grid_leaves_cells_empty_by_design_empty(store_file):
+    # a DEM-only row showed a greyed "None" in every measured column (and in the difference
+    # to the measurement): the grid now shows those cells empty
+    from pidcore.store import Store
+
+    Store(store_file).add_dem_run("dem_only", {
+        "frequency_hz": 100.0, "acceleration_g": 5.0, "fill_percent": 50.0,
+        "material": "acrylic", "direction": "z", "sdc": 1.1, "sdc_stderr": 0.01,
+        "m_c_kg": 0.3, "cells_simulated": 2})
+    at = _app()
+    (grid,) = [d for d in at.dataframe if "SDC measured [-]" in d.value.columns]
+    assert grid.value["SDC measured [-]"].isna().all()  # missing by design: no measurement
+    assert grid.proto.HasField("placeholder") and grid.proto.placeholder == ""
+
+
+def test_a_file_that_cannot_be_read_gets_its_error_without_assumed_load_case_notes(
+        store_file):
+    # "fill: not stated, 50 % proposed; material: not stated, acrylic assumed" was shown above
+    # the read error of a file that has no numbers, and the error named the CLI's option
+    at = _upload(_app(), [("plain.csv", b"Force [N],Velocity [m/s]\n1,2\n3,4\n")])
+    errors = [e.value for e in at.error]
+    assert len(errors) == 1 and errors[0].startswith("plain.csv: ")
+    assert "Options for every file" in errors[0] and "--sample-rate" not in errors[0]
+    assert not [i.value for i in at.info if "not stated" in i.value]
+
+
+def test_a_settings_table_with_a_fill_over_100_is_refused_naming_its_line(store_file):
+    # the table was accepted ("1 of 1 row(s) match uploaded files") and the file's card said
+    # "no valid load case"; `pidcore analyze` refuses the table naming the line
+    table = b"file,fill_percent\n" + _SAMPLE.name.encode() + b",150\n"
+    at = _upload(_app(), [(_SAMPLE.name, _SAMPLE.read_bytes()), ("settings.csv", table)])
+    errors = [e.value for e in at.error]
+    assert errors[0] == (f"settings.csv, line 2 ({_SAMPLE.name}): fill must be in (0, 100] % "
+                         "(packing ratio), got '150'")
+    assert any(e.startswith(f"{_SAMPLE.name}: not analysed") for e in errors), errors
+    assert at.button(key="save").disabled
+
+
+def test_the_results_table_names_each_files_material_and_direction(store_file):
+    # "50 Hz, 5 g, 50 %" for every material: a file set to aluminium in the settings read as
+    # its acrylic twin; Compare lists "50 Hz, 5 g, 50 %, acrylic, z"
+    at = _upload(_app(), [(_SAMPLE.name, _SAMPLE.read_bytes())])
+    assert _table(at, "SDC [-]")["load case"].tolist() == ["50 Hz, 5 g, 50 %, acrylic, z"]

@@ -10,7 +10,9 @@ worker thread saves it to the store in its own transaction, so a killed case nev
 half-written store.
 
 A case is never started twice: a submission is dropped when the same run (same store key: load
-case and every numerical setting) is queued, running, or already in the store.
+case and every numerical setting) is queued, running, or already in the store, and a case that
+is the same simulation as another (a fill rounding to the same particle count:
+:func:`pidcore.dem.persist.run_identity`) is not run again.
 """
 
 from __future__ import annotations
@@ -26,7 +28,10 @@ from .. import defaults
 from ..errors import ParameterError
 
 #: Job states, in the order a job passes through them.
-JOB_STATES = ("queued", "running", "saved", "in store", "cancelled", "failed")
+JOB_STATES = ("queued", "running", "saved", "in store", "same run", "cancelled", "failed")
+#: State of a job that is the same simulation as another job queued or running (another fill
+#: rounding to the same particle count): not run, the other job's run is its run.
+SAME_RUN_STATE = "same run"
 #: Seconds between checks of the running case (progress, cancel).
 _POLL_S = 0.05
 #: Seconds a terminated process gets before it is killed.
@@ -49,6 +54,8 @@ class DemJob:
     cycles_done: int = 0
     cycles_expected: int = 0
     message: str = ""
+    #: The job that runs this one's simulation (state :data:`SAME_RUN_STATE`), else "".
+    same_as: str = ""
 
     def elapsed_s(self, now: float | None = None) -> float:
         """Seconds the case has run (0 while queued)."""
@@ -152,7 +159,9 @@ class DemJobRunner:
     def submit(self, cases: Sequence, config, specimen=None) -> list[DemJob]:
         """Queue ``cases`` with ``config`` on ``specimen`` (:class:`pidcore.specimen.Specimen`;
         None: the paper's coupon); returns the jobs created (duplicates are skipped: a run
-        queued, running or already in the store is not submitted again)."""
+        queued or running is not submitted again; a run already in the store, or the same
+        simulation as a job queued or running, this submission's included, gets a job that
+        says so and is not run: :data:`SAME_RUN_STATE`)."""
         from ..dem.persist import run_identity, run_key, stored_identities
         from ..store import Store
 
@@ -162,23 +171,37 @@ class DemJobRunner:
         identities = stored_identities(stored) if stored is not None else {}
         created = []
         with self._lock:
-            active = {j.run_key for j in self._jobs if j.state in ("queued", "running")}
+            # the simulations queued or running, this submission's included, by identity
+            # (pidcore.compare.align.simulation_identity), as `pidcore dem sweep` plans them:
+            # fills 50 and 50.2 % of one particle count are run once
+            active = {run_identity(j.case, j.config, j.specimen): j for j in self._jobs
+                      if j.state in ("queued", "running")}
             for case in cases:
                 key = run_key(case, config, specimen)
-                if key in active:
-                    continue
+                identity = run_identity(case, config, specimen)
+                running = active.get(identity)
+                if running is not None and running.run_key == key:
+                    continue  # this very run is queued or running
                 self._counter += 1
                 job = DemJob(f"job{self._counter:04d}", case, config, key, specimen)
                 if stored is not None and stored.has_dem_run(key):
                     job.state, job.message = "in store", "already in the store; not run again"
                     job.finished = time.time()
-                elif (same := identities.get(run_identity(case, config, specimen))) is not None:
+                elif (same := identities.get(identity)) is not None:
                     job.state, job.finished = "in store", time.time()
                     job.message = (f"the same simulation (particles per cell, seed, settings) "
                                    f"as stored run {same} of another fill; not run again")
                     job.run_key = same  # the jobs table's store key names the run it is
+                elif running is not None:
+                    job.state, job.finished = SAME_RUN_STATE, time.time()
+                    job.message = (f"the same simulation (particles per cell, seed, settings) "
+                                   f"as {running.job_id} (fill {running.case.fill_percent:g} %),"
+                                   " which runs it; not run twice")
+                    job.run_key = running.run_key  # the run it will be stored as
+                    job.same_as = running.job_id
+                else:
+                    active[identity] = job
                 self._jobs.append(job)
-                active.add(key)
                 created.append(job)
             self._wake.notify_all()
         return created
@@ -197,6 +220,7 @@ class DemJobRunner:
                     if job.state == "queued":
                         job.state, job.finished = "cancelled", time.time()
                         job.message = "cancelled before it started"
+                        self._settle_same(job)
                     n += 1
             self._wake.notify_all()
         return n
@@ -247,10 +271,24 @@ class DemJobRunner:
             except Exception as exc:  # noqa: BLE001 - a failed save must not stop the queue
                 self._finish(job, "failed", f"{type(exc).__name__}: {exc}")
 
+    def _settle_same(self, job: DemJob) -> None:
+        """The jobs waiting for ``job``'s run (:data:`SAME_RUN_STATE`), once it ended (lock
+        held): in the store where it was saved, else not run."""
+        for same in self._jobs:
+            if same.state == SAME_RUN_STATE and same.same_as == job.job_id:
+                if job.state == "saved":
+                    same.state = "in store"
+                    same.message += f"; saved by it as {job.run_key}"
+                else:
+                    same.state = "cancelled"
+                    same.message = (f"not run: {job.job_id}, the same simulation, is "
+                                    f"{job.state}; run it again")
+
     def _finish(self, job: DemJob, state: str, message: str = "") -> None:
         with self._lock:
             job.state, job.message, job.finished = state, message, time.time()
             self._cancel.discard(job.job_id)
+            self._settle_same(job)
             self._wake.notify_all()  # wait_cancelled
 
     def _run(self, job: DemJob) -> None:
@@ -305,6 +343,7 @@ class DemJobRunner:
             if job.job_id in self._cancel:  # cancelled after the result came: not saved
                 job.state, job.finished = "cancelled", time.time()
                 job.message = "cancelled as it finished; nothing saved"
+                self._settle_same(job)
                 self._cancel.discard(job.job_id)
                 self._wake.notify_all()  # wait_cancelled
                 return
@@ -381,11 +420,16 @@ DEM_RUN_COLUMNS = {"specimen": "specimen", "frequency_hz": "frequency [Hz]",
 
 def submitted_text(n_cases: int, created: Sequence[DemJob]) -> str:
     """What a click on Run did: jobs that will run, runs already in the store (not run
-    again), and cases already queued or running (not submitted again)."""
+    again), cases that are the same simulation as another job (run once), and cases already
+    queued or running (not submitted again)."""
     stored = sum(j.state == "in store" for j in created)
-    parts = [f"{len(created) - stored} job(s) submitted"]
+    same = sum(j.state == SAME_RUN_STATE for j in created)
+    parts = [f"{len(created) - stored - same} job(s) submitted"]
     if stored:
         parts.append(f"{stored} already in the store, not run again")
+    if same:
+        parts.append(f"{same} the same simulation as another job (same particle count and "
+                     "seed), run once")
     skipped = n_cases - len(created)
     if skipped:
         parts.append(f"{skipped} already queued or running, not submitted again")

@@ -19,7 +19,7 @@ import re
 import tempfile
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import asdict, dataclass, replace
-from pathlib import Path
+from pathlib import Path, PurePosixPath
 from typing import TYPE_CHECKING
 
 import pandas as pd
@@ -169,6 +169,8 @@ def error_message(name: str, exc: BaseException) -> str:
     text = re.sub(r"--(force|velocity|acceleration) NAME", r"the '\1 channel' column", text)
     text = text.replace("pass --invert NAME for the inverted channel",
                         "name the inverted channel in the 'inverted channels' column")
+    text = text.replace("(--sample-rate)", "('sample rate if no time column' under 'Options "
+                                           "for every file')")
     if isinstance(exc, PidcoreError):
         return text if name in text else f"{name}: {text}"
     return f"{name}: could not be read ({type(exc).__name__}: {text})"
@@ -333,6 +335,7 @@ def read_settings_table(name: str, data: bytes,
         normalize_material,
         settings_table,
     )
+    from ..loadcase import check_fill
     from ..tables import line_where, read_text_table
 
     try:
@@ -350,7 +353,12 @@ def read_settings_table(name: str, data: bytes,
     out = raw.reset_index(drop=True)
     for column in _NUMERIC:
         values = []
-        for line, text in zip(raw.index, raw[column], strict=True):
+        for line, file, text in zip(raw.index, raw["file"], raw[column], strict=True):
+            if column == "fill [%]" and text != "":
+                # the CLI's check of a sidecar's fill, naming the line and file as it does: a
+                # fill of 150 % was accepted and each file's card said "no valid load case"
+                values.append(check_fill(text, f"{line_where(name, int(line))} ({file})"))
+                continue
             try:
                 values.append(float(text) if text != "" else math.nan)
             except ValueError:
@@ -371,10 +379,44 @@ def read_settings_table(name: str, data: bytes,
     return out
 
 
-def _names_file(table_file: str, name: str) -> bool:
-    """Whether a settings table's ``file`` cell names the upload ``name`` (as
-    :func:`merge_settings` matches: the name, else its base name)."""
-    return table_file == name or Path(table_file).name == Path(name).name
+def _file_column(files: Sequence[str], lines: Sequence[int] | None = None) -> pd.DataFrame:
+    """A settings table's ``file`` cells as :func:`pidcore.compare.loadcase.find_row` reads a
+    sidecar: indexed by each row's line in the file (a table built otherwise counts from the
+    line after its header)."""
+    files = [str(f) for f in files]
+    lines = list(lines) if lines else list(range(2, 2 + len(files)))
+    return pd.DataFrame({"file": files}, index=pd.Index(lines, name="line"))
+
+
+def _upload_path(name: str) -> PurePosixPath:
+    """An upload as a path for :func:`~pidcore.compare.loadcase.find_row`: it has no folder,
+    so it is anchored at the root (a relative name would take the app's working folder for
+    its folders, and match a cell naming that folder)."""
+    return PurePosixPath("/", *[p for p in re.split(r"[\\/]", name) if p not in ("", ".", "..")])
+
+
+def table_row(table: pd.DataFrame, name: str, shown: str) -> int | None:
+    """Position of the row of the upload ``name`` in an app settings ``table`` (None: no
+    row), matched as ``pidcore analyze`` matches a sidecar's rows: one function,
+    :func:`pidcore.compare.loadcase.find_row` (base name, else a case-folded match).
+
+    Raises
+    ------
+    LoadCaseError
+        Several rows match ``name`` equally (names differing only by case, or one name under
+        two folders), naming the table ``shown`` and the rows' lines, as the CLI does.
+    """
+    from ..compare.loadcase import find_row
+
+    return find_row(_file_column(table["file"], table.attrs.get("lines")), _upload_path(name),
+                    shown)
+
+
+def check_table_rows(name: str, table: pd.DataFrame, uploaded: Sequence[str]) -> None:
+    """Refuse the settings table ``name`` if a row of one of the ``uploaded`` files is
+    ambiguous (:func:`table_row`): the CLI refuses it, and the app took the first match."""
+    for upload in uploaded:
+        table_row(table, upload, name)
 
 
 @dataclass(frozen=True)
@@ -388,7 +430,14 @@ class RefusedTable:
 
     def refuses(self, name: str) -> bool:
         """Whether this table holds back the upload ``name``: it names it, or cannot say."""
-        return self.files is None or any(_names_file(f, name) for f in self.files)
+        from ..loadcase import LoadCaseError
+
+        if self.files is None:
+            return True
+        try:
+            return table_row(pd.DataFrame({"file": list(self.files)}), name, self.name) is not None
+        except LoadCaseError:
+            return True  # several of its rows name it
 
 
 def refused_table(name: str, data: bytes, error: str) -> RefusedTable:
@@ -416,9 +465,22 @@ def refusal_of(name: str, refused: Sequence[RefusedTable]) -> str:
     tables = [t.name for t in refused if t.refuses(name)]
     if not tables:
         return ""
-    return (f"{name}: not analysed: the settings table {', '.join(tables)} that gives its "
-            "settings was refused (see the error above); fix the table and upload it again, "
-            "or remove it")
+    if len(tables) == 1:
+        return (f"{name}: not analysed: the settings table {tables[0]} that gives its "
+                "settings was refused (see the error above); fix the table and upload it "
+                "again, or remove it")
+    return (f"{name}: not analysed: the settings tables {', '.join(tables)} that give its "
+            "settings were refused (see the errors above); fix the tables and upload them "
+            "again, or remove them")
+
+
+def refused_tables_text(refused: Sequence[RefusedTable]) -> str:
+    """Why nothing is saved while settings tables are refused, as one line."""
+    names = ", ".join(t.name for t in refused)
+    if len(refused) == 1:
+        return f"the settings table {names} is refused: fix it and upload it again, or remove it"
+    return (f"the settings tables {names} are refused: fix them and upload them again, or "
+            "remove them")
 
 
 def table_match_note(name: str, table: pd.DataFrame, uploaded: Sequence[str]) -> tuple[str, str]:
@@ -428,7 +490,8 @@ def table_match_note(name: str, table: pd.DataFrame, uploaded: Sequence[str]) ->
     matches."""
     given = ", ".join(table.attrs.get("given", []))
     files = [str(f) for f in table["file"]]
-    matched = [any(_names_file(f, u) for u in uploaded) for f in files]
+    found = {_row_or_none(table, u, name) for u in uploaded}
+    matched = [i in found for i in range(len(files))]
     info = (f"{name}: {sum(matched)} of {len(files)} row(s) match uploaded files"
             + (f" ({given})" if given else ""))
     # the line of each row in the file (read_settings_table keeps them); a table built
@@ -488,14 +551,25 @@ def delay_note(row: Mapping, given: Iterable[str] = (), *, velocity_used: bool) 
 
 def columns_given(tables: Sequence[pd.DataFrame], name: str) -> set[str]:
     """The settings columns that uploaded ``tables`` give a value for file ``name`` (matched
-    as :func:`merge_settings` matches it: the name, else its base name)."""
+    as :func:`table_row` matches it, as ``pidcore analyze`` does)."""
     given: set[str] = set()
     for table in tables:
-        for _, row in table.iterrows():
-            if not _names_file(str(row["file"]), name):
-                continue
+        found = _row_or_none(table, name, "settings table")
+        if found is not None:
+            row = table.iloc[found]
             given |= {k for k in FILE_TABLE_COLUMNS if k != "file" and not _empty(row.get(k))}
     return given
+
+
+def _row_or_none(table: pd.DataFrame, name: str, shown: str) -> int | None:
+    """:func:`table_row`, None where it is ambiguous (such a table is refused before its
+    rows are used: :func:`check_table_rows`)."""
+    from ..loadcase import LoadCaseError
+
+    try:
+        return table_row(table, name, shown)
+    except LoadCaseError:
+        return None
 
 
 def _empty(value) -> bool:
@@ -530,11 +604,11 @@ def merge_settings(names: Sequence[str], stated: Sequence, previous: pd.DataFram
 
 def _apply_tables(rows: dict[str, dict], tables: Sequence[pd.DataFrame]) -> None:
     for table in tables:
-        for _, new in table.iterrows():
-            target = new["file"] if new["file"] in rows else next(
-                (n for n in rows if _names_file(str(new["file"]), n)), None)
-            if target is None:
+        for target in rows:
+            found = _row_or_none(table, target, "settings table")
+            if found is None:
                 continue
+            new = table.iloc[found]
             for k in FILE_TABLE_COLUMNS:
                 value = new.get(k, "")
                 if k != "file" and not _empty(value):
@@ -586,7 +660,10 @@ def results_table(files: Sequence[AnalysedFile]) -> pd.DataFrame:
     for f in files:
         a = f.record.analysis
         rows.append({
-            "file": Path(f.record.measurement.source).name, "load case": f.load_case.label(),
+            # with material and direction, as Compare lists it: a file set to aluminium
+            # read the same as its acrylic twin
+            "file": Path(f.record.measurement.source).name,
+            "load case": f.load_case.full_label(),
             "specimen": f.specimen, "frequency [Hz]": a.frequency_hz,
             "acceleration [g]": a.acceleration_g, "loss factor [-]": a.loss_factor,
             "SDC [-]": a.sdc, "SDC stderr [-]": a.sdc_stderr,

@@ -165,8 +165,9 @@ def _with_reason(values: pd.Series, present: pd.Series, reasons: list[str],
 
 def report_display(table: pd.DataFrame) -> pd.DataFrame:
     """The Report tab's view of :func:`pidcore.report.downloads.store_report_table`: the grid
-    shows a missing number as a literal "None", which read as a fault, so two results that can
-    lack a value are text saying why. The DEM standard error: ``"n/a (1 cell)"`` where the run
+    shows a cell empty by design (a measured column of a DEM-only row) empty (its
+    ``placeholder``), and two results that can lack a value as text saying why. The DEM
+    standard error: ``"n/a (1 cell)"`` where the run
     simulated one cell (one cell has no scatter to take a standard error from; the DEM tab says
     the same), ``"n/a"`` where it is missing otherwise, empty where no DEM ran. The measured
     chi2/dof: ``"n/a (1 measurement)"`` for one measurement (nothing to scatter), empty where

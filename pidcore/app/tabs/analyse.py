@@ -78,14 +78,14 @@ def _card(upload, row, sample_rate_hz, materials, given=()):
     name = upload.name
     with st.container(border=True):
         st.markdown(f"**{name}** · {_size(upload.size)}")
+        sha = state.upload_sha256(upload)
+        found = state.parsed(sha, name, sample_rate_hz, upload)
+        if found.error is not None:  # no numbers: nothing assumed for them to say
+            st.error(found.error)
+            return None
         assumed = uploads.assumed_note(stated_case(name, materials=materials), row, given)
         if assumed:  # a default the user has not confirmed: say so next to the numbers
             st.info(f"{assumed} (set it in the settings table)")
-        sha = state.upload_sha256(upload)
-        found = state.parsed(sha, name, sample_rate_hz, upload)
-        if found.error is not None:
-            st.error(found.error)
-            return None
         try:
             options = uploads.options_of(row, sample_rate_hz=sample_rate_hz)
         except PidcoreError as exc:
@@ -177,10 +177,20 @@ def render(stores) -> list:
                 # a result with settings the user did not give (e.g. no vibrometer delay)
                 refused.append(uploads.refused_table(upload.name, data, str(exc)))
                 continue
-            tables[state.upload_sha256(upload)] = table
-            accepted.append((upload.name, table))  # by name: two tables may be byte-equal
+            accepted.append((upload, data, table))  # by name: two tables may be byte-equal
         else:
             measurements.append(upload)
+    kept_tables = []
+    for upload, data, table in accepted:
+        try:  # rows matched as `pidcore analyze` matches them: an ambiguous one is refused
+            uploads.check_table_rows(upload.name, table, [u.name for u in measurements])
+        except PidcoreError as exc:
+            st.error(str(exc))
+            refused.append(uploads.refused_table(upload.name, data, str(exc)))
+            continue
+        tables[state.upload_sha256(upload)] = table
+        kept_tables.append((upload.name, table))
+    accepted = kept_tables
     for name, table in accepted:
         info, unmatched = uploads.table_match_note(name, table, [u.name for u in measurements])
         st.info(info)
@@ -216,15 +226,14 @@ def render(stores) -> list:
     if analysed:
         st.markdown("**Results**")
         st.dataframe(uploads.results_table(analysed), hide_index=True, key="results_table",
-                     width="stretch")
+                     width="stretch", placeholder="")
     flagged = [f for f in analysed if f.warnings]
     confirm = False
     if flagged:
         confirm = st.checkbox(f"Save the {len(flagged)} implausible record(s) anyway (their "
                               "warnings are saved with them)", key="confirm_implausible")
     if refused:  # one save of what the user uploaded, not of the part its settings allow
-        conflict = (f"the settings table {', '.join(t.name for t in refused)} is refused: fix "
-                    "it and upload it again, or remove it")
+        conflict = uploads.refused_tables_text(refused)
     else:
         conflict = uploads.load_case_conflict(analysed)
     if conflict:  # said before Save, which would refuse it

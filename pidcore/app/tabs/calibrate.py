@@ -154,7 +154,7 @@ def _form(stores, api, points: list) -> str:
         "frequency_hz": "frequency [Hz]", "acceleration_g": "acceleration [g]",
         "fill_percent": "fill [%]", "sdc": "SDC measured, Eq. 11 [-]",
         "sdc_stderr": "SDC stderr [-]"}), hide_index=True, width="stretch",
-        key="calibration_points")
+        key="calibration_points", placeholder="")
     c1, c2, c3 = st.columns(3)
     fittable = fittable_names(api)
     chosen = c1.multiselect("parameters to fit", fittable,

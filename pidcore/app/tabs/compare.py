@@ -177,7 +177,8 @@ def render(stores, session_files: list, calibrations: list) -> None:
     st.dataframe(spectrum.drop(columns="velocity amplitude [m/s]").assign(
         **{"velocity amplitude [mm/s]": spectrum["velocity amplitude [m/s]"] * 1e3}),
         hide_index=True, width="stretch")
-    st.dataframe(comp.measured, hide_index=True, width="stretch", key="compare_measured")
+    st.dataframe(comp.measured, hide_index=True, width="stretch", key="compare_measured",
+                 placeholder="")
     if st.button("PDF of this load case (plots and corrections)", key="case_pdf"):
         from pidcore.report.case_sheet import case_pdf
 

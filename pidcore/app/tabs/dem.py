@@ -138,7 +138,8 @@ def render(stores) -> None:
     if not runs.empty:
         st.markdown(f"**DEM runs in the stores** ({len(runs)})")
         table = jobs.dem_runs_table(runs)
-        st.dataframe(table, hide_index=True, width="stretch", key="dem_runs_table")
+        st.dataframe(table, hide_index=True, width="stretch", key="dem_runs_table",
+                     placeholder="")
         unconverged = int(table["steady state"].str.startswith("NOT").sum())
         if unconverged:
             st.warning(f"{unconverged} run(s) did not converge (steady state NOT detected "

@@ -76,7 +76,11 @@ def render(stores, calibrations: list) -> None:
             st.caption(f"note: {note}")
         return
     st.caption(f"calibrated DEM columns: {label}" if calibration is not None else label)
-    st.dataframe(report_display(table), hide_index=True, key="report_table", width="stretch")
+    # cells empty by design (measured columns of a DEM-only row, DEM columns of a measured-only
+    # one) are empty, not the grid's greyed "None"; the two results that can lack a value say
+    # why (report_display)
+    st.dataframe(report_display(table), hide_index=True, key="report_table", width="stretch",
+                 placeholder="")
     for note in table.attrs.get("notes", []):
         st.caption(f"note: {note}")
     if st.button("Build report files (CSV, Markdown, HTML, LaTeX, PDF)", key="build_report"):
