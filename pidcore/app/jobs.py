@@ -162,7 +162,13 @@ class DemJobRunner:
         queued or running is not submitted again; a run already in the store, or the same
         simulation as a job queued or running, this submission's included, gets a job that
         says so and is not run: :data:`SAME_RUN_STATE`)."""
-        from ..dem.persist import run_identity, run_key, stored_identities
+        from ..dem.persist import (
+            own_run_keys,
+            run_identity,
+            run_key,
+            stored_identities,
+            stored_run_key,
+        )
         from ..store import Store
 
         stored = Store(self.store_path) if self.store_path.is_file() else None
@@ -184,10 +190,13 @@ class DemJobRunner:
                     continue  # this very run is queued or running
                 self._counter += 1
                 job = DemJob(f"job{self._counter:04d}", case, config, key, specimen)
-                if stored is not None and stored.has_dem_run(key):
+                found = stored_run_key(stored, case, config, specimen, identities=identities) \
+                    if stored is not None else None
+                if found is not None and found in own_run_keys(case, config, specimen):
                     job.state, job.message = "in store", "already in the store; not run again"
                     job.finished = time.time()
-                elif (same := identities.get(identity)) is not None:
+                    job.run_key = found  # its own key, or the paper's 0.1 key it is held by
+                elif (same := found) is not None:
                     job.state, job.finished = "in store", time.time()
                     job.message = (f"the same simulation (particles per cell, seed, settings) "
                                    f"as stored run {same} of another fill; not run again")
