@@ -218,3 +218,24 @@ def test_calibrates_measured_table_names_a_row_by_its_line_too(tmp_path):
                      "500,5,50,0.6\n500,1,50,x\n", encoding="utf-8")
     with pytest.raises(InputFileError, match=r"m\.csv, line 4: sdc 'x' is not a number"):
         read_measured_table(table)
+
+
+def test_a_spreadsheets_trailing_empty_columns_are_left_out(tmp_path, capsys):
+    # Excel saved the table with a trailing ';;' for columns that once held a cell: the CLI
+    # refused it with "column '' given more than once" (two such columns) or "unknown
+    # column(s) ''" (one). A column with neither name nor value states nothing.
+    path = copy_f(tmp_path)
+    (tmp_path / "loadcases.csv").write_bytes(
+        f"\ufefffile;velocity_delay_us;;\r\n{F.name};50,0;;\r\n;;;\r\n".encode())
+    (rec,) = analyze_json([str(path)], capsys)["records"]
+    assert rec["parameters"]["velocity_delay_s"] == 5e-5
+    assert rec["sdc"] == pytest.approx(SDC_50US, abs=TOL)
+    (tmp_path / "loadcases.csv").write_text(f"file,velocity_delay_us,\n{F.name},50,\n",
+                                            encoding="utf-8")
+    (rec,) = analyze_json([str(path)], capsys)["records"]
+    assert rec["sdc"] == pytest.approx(SDC_50US, abs=TOL)
+    # a value under no name is refused, naming its line and column, not silently dropped
+    (tmp_path / "loadcases.csv").write_text(f"file,velocity_delay_us,\n{F.name},50,20\n",
+                                            encoding="utf-8")
+    err = refused([str(path)], capsys)
+    assert "loadcases.csv, line 2: '20' in column 3" in err and "without a name" in err
