@@ -239,3 +239,19 @@ def test_a_spreadsheets_trailing_empty_columns_are_left_out(tmp_path, capsys):
                                             encoding="utf-8")
     err = refused([str(path)], capsys)
     assert "loadcases.csv, line 2: '20' in column 3" in err and "without a name" in err
+
+
+def test_the_sidecar_among_the_files_is_named_as_the_sidecar(tmp_path, capsys):
+    # `pidcore analyze folder/*` with loadcases.csv beside the exports (as the README places
+    # it) said "loadcases.csv: header but no data rows; expected a header row such as
+    # 'Time [s],Force [N],Velocity [m/s]'" of a table that has data rows
+    path = copy_f(tmp_path)
+    table = tmp_path / "loadcases.csv"
+    table.write_text(f"file,velocity_delay_us\n{F.name},50\n", encoding="utf-8")
+    for extra in ([], ["--sidecar", str(table)]):
+        err = refused([str(path), str(table), *extra], capsys)
+        assert f"{table}: is the sidecar table" in err and "not a measurement" in err
+        assert "header but no data rows" not in err
+    # without it among the files, the table is read as before
+    (rec,) = analyze_json([str(path)], capsys)["records"]
+    assert rec["sdc"] == pytest.approx(SDC_50US, abs=TOL)
