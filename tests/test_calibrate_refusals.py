@@ -312,3 +312,12 @@ def test_a_ctrl_c_while_the_outputs_are_written_leaves_out_as_it_was_and_says_so
     assert main(argv) == 130
     assert (out / "calibration.json").read_text() == "earlier"
     assert len(list(out.iterdir())) == 6 and len(list(tmp_path.iterdir())) == 3
+
+
+def test_a_fill_the_dem_cannot_run_is_refused_naming_its_line(capsys, tmp_path):
+    # a fraction typed for a percentage (0.5 for 50 %): "fill 0.5 % of 22 particles rounds to
+    # none", naming neither the table nor the row, after the DEM store was opened
+    table = _table(tmp_path, HEADER + "500,5,50,0.6\n1000,5,0.5,0.6\n500,1,50,0.2\n")
+    _refused(capsys, tmp_path, ["--data", str(table)],
+             "m.csv, line 3 (1000 Hz, 5 g, 0.5 %, acrylic): fill_percent: fill 0.5 % of 22 "
+             "particles rounds to none")
