@@ -36,6 +36,7 @@ from ._common import (
     file_sha256,
     interpret_unit,
     make_channel,
+    overridden_rate,
     rate_from_times,
     unique_names,
 )
@@ -217,7 +218,8 @@ def read_csv(path: str | os.PathLike[str], *, sample_rate_hz: float | None = Non
             _, factor = interpret_unit(unit) if unit else ("time", 1.0)
             start_time = float(values[0, time_index]) * factor
             notes.append(f"{where}: time column {name!r} ignored: the sample rate "
-                         f"{rate:g} Hz was given (--sample-rate)")
+                         f"{rate:g} Hz was given (--sample-rate)"
+                         + overridden_rate(values[:, time_index] * factor, rate))
     elif time_index is not None:
         name, unit = cells[time_index]
         _, factor = interpret_unit(unit) if unit else ("time", 1.0)
