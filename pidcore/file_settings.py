@@ -393,10 +393,22 @@ def analyze_with_settings(path: str | os.PathLike, settings: FileSettings, *,
     option the table set names the table's cell instead (:meth:`FileSettings.explain`)."""
     from .measure import analyze_file
 
+    invert_cell = settings.cells.get("invert")
     try:
-        return analyze_file(path, settings.options, key=key)
+        record = analyze_file(path, settings.options, key=key)
     except PidcoreError as exc:
-        explained = settings.explain(str(exc))
+        message = str(exc)
+        if invert_cell is not None:  # the table's cell, appended below, not the option
+            message = message.replace("--invert '", "invert '")
+        explained = settings.explain(message)
         if explained == str(exc):
             raise
         raise type(exc)(explained) from None
+    if invert_cell is None:
+        return record
+    # "channel 'V' inverted (--invert)" of a channel the table's invert column named: the
+    # note names the cell, as the settings line and the errors do
+    column, _, where = invert_cell
+    return replace(record, notes=tuple(
+        n.replace(" inverted (--invert)", f" inverted (column {column} of {where})")
+        for n in record.notes))
