@@ -255,3 +255,19 @@ def test_the_sidecar_among_the_files_is_named_as_the_sidecar(tmp_path, capsys):
     # without it among the files, the table is read as before
     (rec,) = analyze_json([str(path)], capsys)["records"]
     assert rec["sdc"] == pytest.approx(SDC_50US, abs=TOL)
+
+
+def test_a_row_naming_the_file_without_its_extension_is_pointed_out(tmp_path, capsys):
+    # loadcases.csv beside the file named it as a spreadsheet user types it, without '.uff':
+    # no row matched, and the file was analysed without its 50 µs delay (SDC 1.03 instead of
+    # 1.14) with no word but "no fill stated" (the name states the fill here: not even that)
+    path = copy_f(tmp_path)
+    (tmp_path / "loadcases.csv").write_text(f"file,velocity_delay_us\n{Path(F.name).stem},50\n",
+                                            encoding="utf-8")
+    doc = analyze_json([str(path)], capsys)
+    (rec,) = doc["records"]
+    assert rec["sdc"] == pytest.approx(SDC_0US, abs=TOL)  # still not matched, but said:
+    said = (f"{F.name}: no row in {tmp_path / 'loadcases.csv'} (rows are matched by file name; "
+            f"line 2 names {Path(F.name).stem!r}, without the extension: write {F.name!r})")
+    assert rec["sidecar_row_missing"].startswith(said)
+    assert any(n.startswith(said) for n in doc["notes"])
