@@ -119,7 +119,11 @@ def _layout(lines: list[str], where: str) -> tuple[int, str, list[str], list[str
         first = next((i for i in candidates if _is_numeric_row(lines[i], _delimiter([lines[i]]))),
                      None)
     if first is None:
-        what = "header but no data rows" if candidates else "no rows of numbers"
+        # "header but no data rows" was said of any text without a row of numbers: a report
+        # CSV, a TOML file, a load-case table of 40 rows
+        what = "header but no data rows" if len(candidates) == 1 else \
+            f"no rows of numbers in its {len(candidates)} lines (the first: " \
+            f"{lines[candidates[0]].strip()[:60]!r})" if candidates else "no rows of numbers"
         raise InputFileError(f"{where}: {what}; expected a header row such as "
                              "'Time [s],Force [N],Velocity [m/s]' and data rows")
     data = [lines[j] for j in candidates if j >= first][:200]
