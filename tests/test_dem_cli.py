@@ -1,6 +1,7 @@
 """``pidcore dem run`` command line."""
 
 import json
+from pathlib import Path
 
 import pytest
 
@@ -291,3 +292,32 @@ def test_the_flag_wording_leaves_other_words_alone():
     assert with_dem_flags(said, "run") == \
         "over 2 cells: my_time_step.toml: --acceleration must be > 0"
     assert with_dem_flags("frequency_hz must be > 0", "sweep") == "--frequencies must be > 0"
+
+
+def test_a_sweep_over_the_grids_fills_says_it_is_not_the_specimens_fill(tmp_path, capsys,
+                                                                        monkeypatch):
+    # a specimen stating its fill (steel_6mm: fill_percent = 50 of 46 -> 23 per cell; a file
+    # stating count_per_cell 20) swept without --fills ran Table 3's 25, 50, 75, 90 % and no
+    # word said the specimen's own fill was not among them
+    import pidcore.dem.sweep as sweep_module
+    from pidcore.specimen import load_specimen
+
+    def stop(*args, **kwargs):
+        raise KeyboardInterrupt  # the cases are not the point: what was said before them
+
+    monkeypatch.setattr(sweep_module, "run_sweep", stop)
+    spec = Path(__file__).resolve().parents[1] / "data_samples" / "specimens" / "steel_6mm.toml"
+    mine = tmp_path / "mine.toml"
+    mine.write_text(spec.read_text().replace("fill_percent = 50.0", "count_per_cell = 20"))
+    capacity = load_specimen(mine).capacity_per_cell()
+    argv = ["dem", "sweep", "--specimen", str(mine), "--frequencies", "500",
+            "--accelerations", "5", "--store", str(tmp_path / "s.h5"), "--no-progress"]
+    assert main(argv) == 130
+    err = capsys.readouterr().err
+    assert (f"pidcore dem sweep: note: fills 25, 50, 75, 90 % are grid table3's, not the "
+            f"{100 * 20 / capacity:.6g} % specimen steel_6mm states ([particles] count_per_cell "
+            f"20 of capacity {capacity}); give --fills to choose\n") in err
+    # fills given, or a specimen whose fill is on the grid (steel_6mm's 50 %): nothing to say
+    for more, path in ((["--fills", "30"], mine), ([], spec)):
+        assert main([*argv[:3], str(path), *argv[4:], *more]) == 130
+        assert "note" not in capsys.readouterr().err

@@ -228,7 +228,7 @@ def _interrupted(command: str, saved: int, store) -> int:
 
 def sweep(args: argparse.Namespace) -> int:
     from ..dem.persist import run_key, stored_keys
-    from ..dem.sweep import cross_cases, grid_axes, run_sweep
+    from ..dem.sweep import cross_cases, grid_axes, grid_fill_note, run_sweep
     from ..loadcase import parse_values
 
     axes = grid_axes(args.grid)
@@ -240,6 +240,9 @@ def sweep(args: argparse.Namespace) -> int:
     specimen, material = _specimen(args)
     for fill in values[2]:
         _check_fill(fill, "--fills", args, specimen, material)
+    note = grid_fill_note(specimen, args.grid, values[2]) if args.fills is None else ""
+    if note:  # on stderr: --json prints one document
+        print(f"pidcore dem sweep: note: {note}", file=sys.stderr)
     cases = cross_cases(*values, material=material, direction=args.direction)
     config = _config(args)
     # What a Ctrl-C leaves saved is read from the store itself: a count kept beside the saves
