@@ -44,6 +44,7 @@ from .compare.loadcase import (
     FREE_TEXT_COLUMNS,
     NO_CHANNEL,
     SETTINGS_COLUMNS,
+    SIDECAR_NAME,
     SPECIMEN_COLUMN,
     FillNotStated,
     StatedLoadCase,
@@ -323,6 +324,23 @@ class FileSettings:
         return message + "".join(f"; {cell}" for cell in appended)
 
 
+def _stem_hint(path: str | os.PathLike, table_path: Path,
+               tables: dict[Path, pd.DataFrame] | None) -> str:
+    """``"; line 3 names 'run 13', without the extension"`` where a row names the file's name
+    without its extension (as a spreadsheet user types it), else ``""``."""
+    from .compare.loadcase import read_sidecar
+
+    table = tables.get(table_path) if tables is not None else None
+    if table is None:
+        table = read_sidecar(table_path)
+    stem = Path(path).stem.casefold()
+    for line, cell in table["file"].items():
+        if re.split(r"[\\/]", str(cell))[-1].casefold() == stem:
+            return (f"; line {line} names {cell!r}, without the extension: write "
+                    f"{Path(path).name!r}")
+    return ""
+
+
 def resolve_file_settings(path: str | os.PathLike, options: AnalysisOptions | None = None, *,
                           given: Mapping[str, str] | None = None,
                           sidecar: str | os.PathLike | pd.DataFrame | None = None,
@@ -367,10 +385,20 @@ def resolve_file_settings(path: str | os.PathLike, options: AnalysisOptions | No
                  if getattr(options, f.name) != getattr(default, f.name)}
     row = sidecar_row(path, sidecar, tables=tables)
     if row is None:
-        unmatched = ""
+        # A table given: a file without a row there is said to have none. The loadcases.csv
+        # found beside the file may state only some files, so only a row that names this
+        # one without its extension is said (it left the file's 50 µs delay out silently).
+        unmatched, hint, shown = "", "", None
         if sidecar is not None and not isinstance(sidecar, pd.DataFrame):
-            unmatched = (f"{Path(path).name}: no row in {sidecar} (rows are matched by file "
-                         "name); its load case and settings come from its name and the options")
+            hint = _stem_hint(path, Path(sidecar), tables)
+            shown = sidecar
+        elif sidecar is None and (Path(path).parent / SIDECAR_NAME).is_file():
+            shown = Path(path).parent / SIDECAR_NAME
+            hint = _stem_hint(path, shown, tables)
+        if hint or (sidecar is not None and not isinstance(sidecar, pd.DataFrame)):
+            unmatched = (f"{Path(path).name}: no row in {shown} (rows are matched by file "
+                         f"name{hint}); its load case and settings come from its name and the "
+                         "options")
         return FileSettings(options, unmatched=unmatched)
     stated = analysis_overrides(row.values, row.where)
     changes: dict[str, object] = {}
@@ -401,13 +429,25 @@ def analyze_with_settings(path: str | os.PathLike, settings: FileSettings, *,
     option the table set names the table's cell instead (:meth:`FileSettings.explain`)."""
     from .measure import analyze_file
 
+    invert_cell = settings.cells.get("invert")
     try:
-        return analyze_file(path, settings.options, key=key)
+        record = analyze_file(path, settings.options, key=key)
     except PidcoreError as exc:
-        explained = settings.explain(str(exc))
+        message = str(exc)
+        if invert_cell is not None:  # the table's cell, appended below, not the option
+            message = message.replace("--invert '", "invert '")
+        explained = settings.explain(message)
         if explained == str(exc):
             raise
         raise type(exc)(explained) from None
+    if invert_cell is None:
+        return record
+    # "channel 'V' inverted (--invert)" of a channel the table's invert column named: the
+    # note names the cell, as the settings line and the errors do
+    column, _, where = invert_cell
+    return replace(record, notes=tuple(
+        n.replace(" inverted (--invert)", f" inverted (column {column} of {where})")
+        for n in record.notes))
 
 
 def resolve_files(paths: Sequence[str | os.PathLike], *, options: AnalysisOptions | None = None,

@@ -28,6 +28,11 @@ if TYPE_CHECKING:
 #: Largest fractional-sample offset between the start times of the force channel and an
 #: acceleration channel that is ignored (the velocity's is corrected as a delay instead).
 MAX_IGNORED_OFFSET_SAMPLES = 0.02
+#: An acceleration channel whose drive-line amplitude differs from omega |V| of the velocity
+#: channel by more than this factor (either way) is noted as a likely unit slip: a rigid coupon
+#: and the shaker head beside it move alike (a fixture resonance may give a factor of 2 or
+#: so), while a unit written wrongly gives 9.81 (g as m/s^2), 25.4 (in) or 1000 (mm as m).
+UNIT_SLIP_FACTOR = 5.0
 
 
 @dataclass(frozen=True)
@@ -189,6 +194,55 @@ def _invert(measurement: Measurement, names: Sequence[str], notes: list[str]) ->
     return replace(measurement, channels=channels)
 
 
+def _drive_amplitude(channel: Channel, omega_rad_s: float) -> float:
+    """Amplitude of ``channel`` at the drive line: least-squares cosine, sine and offset."""
+    data = np.asarray(channel.data, dtype=np.float64)
+    # normal equations accumulated in blocks: no N x 3 basis for a 5 M-sample record
+    normal, rhs = np.zeros((3, 3)), np.zeros(3)
+    for start in range(0, data.size, 1 << 16):
+        t = np.arange(start, min(start + (1 << 16), data.size)) / channel.sample_rate_hz
+        basis = np.stack([np.cos(omega_rad_s * t), np.sin(omega_rad_s * t), np.ones_like(t)])
+        normal += basis @ basis.T
+        rhs += basis @ data[start:start + t.size]
+    coef = np.linalg.lstsq(normal, rhs, rcond=None)[0]
+    return float(np.hypot(coef[0], coef[1]))
+
+
+def _unit_slip_notes(measurement: Measurement, chosen: Mapping[str, Channel],
+                     omega_rad_s: float) -> list[str]:
+    """A note per acceleration channel (used or ignored) whose drive-line amplitude is more
+    than :data:`UNIT_SLIP_FACTOR` times off omega |V| of the velocity channel used: one of the
+    two units is likely wrong. A velocity exported in mm/s but labelled m/s changes neither the
+    loss factor nor the SDC (force and velocity scale Re and Im of P_c alike), so nothing else
+    shows it; the acceleration amplitude and the energy per cycle come out 1000 times off."""
+    velocity = chosen.get("velocity")
+    if velocity is None or velocity.data.size < 8:
+        return []
+    accelerations = [c for c in measurement.channels if c.quantity == "acceleration"
+                     and c.name not in (velocity.name, chosen["force"].name)
+                     and c.data.size >= 8]
+    if "acceleration" in chosen:
+        accelerations = [chosen["acceleration"]] + [c for c in accelerations
+                                                     if c.name != chosen["acceleration"].name]
+    expected = omega_rad_s * _drive_amplitude(velocity, omega_rad_s)
+    notes = []
+    for acc in accelerations:
+        amplitude = _drive_amplitude(acc, omega_rad_s)
+        if not (expected > 0 and amplitude > 0):
+            continue
+        ratio = amplitude / expected
+        if 1.0 / UNIT_SLIP_FACTOR <= ratio <= UNIT_SLIP_FACTOR:
+            continue
+        notes.append(
+            f"channel {acc.name!r} ({acc.source_unit or 'no unit'}) has {ratio:.4g} x the "
+            f"acceleration of channel {velocity.name!r} ({velocity.source_unit or 'no unit'}) "
+            f"at the drive line ({amplitude:.4g} against omega |V| = {expected:.4g} m/s^2): "
+            "a unit slip in one of them (mm/s written as m/s, g as m/s^2)? The velocity is "
+            "used as its unit says; check both units (--velocity-unit, "
+            "--acceleration-unit)")
+    return notes
+
+
 def analyze_measurement(measurement: Measurement, options: AnalysisOptions) -> AnalyzedRecord:
     """Map channels to roles, prepare them and run the Eq. 11 analysis on one measurement.
 
@@ -231,6 +285,7 @@ def analyze_measurement(measurement: Measurement, options: AnalysisOptions) -> A
         n_harmonics=options.n_harmonics,
         allow_clipped=options.allow_clipped,
     )
+    notes.extend(_unit_slip_notes(measurement, chosen, analysis.omega_rad_s))
     used = {role: ch.name for role, ch in chosen.items()}
     detail = tuple({"role": role, "name": ch.name, "unit": ch.unit,
                     "source_unit": ch.source_unit} for role, ch in chosen.items())

@@ -12,7 +12,9 @@ spreadsheet tools write them, with the detection of the measurement CSV reader
 * a line whose first non-blank character is ``#`` is a comment; a ``#`` anywhere else is data
   (file names such as ``MPSTD#Set001_...uff`` hold one); blank lines and lines of empty cells
   (a spreadsheet's ``;;;``) are skipped;
-* every cell is text, stripped; quoted cells may hold the separator.
+* every cell is text, stripped; quoted cells may hold the separator;
+* a column with neither a name nor a value (the trailing ``;;`` a spreadsheet writes for a
+  column that once held a cell) is left out; a value under no name is refused.
 
 A row is named by its **line in the file**, as a spreadsheet or an editor shows it: the header
 is line 1 when it is the first line, and comment and blank lines count (:func:`line_where`).
@@ -115,7 +117,8 @@ def read_text_table(data: bytes, where: str, *, numeric: Iterable[str] = ()) -> 
     ------
     InputFileError
         No header line; a row with more cells than the header (naming its line and both
-        counts); a header naming a column twice.
+        counts); a header naming a column twice; a value in a column without a name (an
+        unnamed column without values, a spreadsheet's trailing ``;;``, is left out).
     """
     kept = _table_lines(decode_table(data))
     if not kept:
@@ -135,10 +138,6 @@ def read_text_table(data: bytes, where: str, *, numeric: Iterable[str] = ()) -> 
                              f"expected cells separated by {separator!r}") from None
     (_, header), body = rows[0], rows[1:]
     columns = [c.lower() for c in header]
-    doubled = sorted({c for c in columns if columns.count(c) > 1})
-    if doubled:
-        raise InputFileError(f"{line_where(where, rows[0][0])}: column {doubled[0]!r} given "
-                             "more than once; expected each column once")
     records, numbers = [], []
     for line, cells in body:
         if not any(cells):
@@ -150,6 +149,25 @@ def read_text_table(data: bytes, where: str, *, numeric: Iterable[str] = ()) -> 
                 "expected one cell per column (quote a cell that holds the separator)")
         records.append(cells + [""] * (len(columns) - len(cells)))
         numbers.append(line)
+    # A spreadsheet writes a separator for every column that once held a cell (``a;b;;``): a
+    # column with neither a name nor a value states nothing and is left out. One with a value
+    # but no name is refused: what it states cannot be told.
+    unnamed = [i for i, c in enumerate(columns) if not c]
+    for i in unnamed:
+        for line, cells in zip(numbers, records, strict=True):
+            if cells[i]:
+                raise InputFileError(
+                    f"{line_where(where, line)}: {cells[i]!r} in column {i + 1}, which the "
+                    f"header (line {rows[0][0]}) leaves without a name; expected a column "
+                    "name for every column that holds values")
+    if unnamed:
+        kept_columns = [i for i in range(len(columns)) if i not in unnamed]
+        columns = [columns[i] for i in kept_columns]
+        records = [[cells[i] for i in kept_columns] for cells in records]
+    doubled = sorted({c for c in columns if columns.count(c) > 1})
+    if doubled:
+        raise InputFileError(f"{line_where(where, rows[0][0])}: column {doubled[0]!r} given "
+                             "more than once; expected each column once")
     table = pd.DataFrame(records, columns=columns, index=pd.Index(numbers, name="line"),
                          dtype=object)
     if separator != ",":

@@ -312,3 +312,27 @@ def test_a_ctrl_c_while_the_outputs_are_written_leaves_out_as_it_was_and_says_so
     assert main(argv) == 130
     assert (out / "calibration.json").read_text() == "earlier"
     assert len(list(out.iterdir())) == 6 and len(list(tmp_path.iterdir())) == 3
+
+
+def test_a_fill_the_dem_cannot_run_is_refused_naming_its_line(capsys, tmp_path):
+    # a fraction typed for a percentage (0.5 for 50 %): "fill 0.5 % of 22 particles rounds to
+    # none", naming neither the table nor the row, after the DEM store was opened
+    table = _table(tmp_path, HEADER + "500,5,50,0.6\n1000,5,0.5,0.6\n500,1,50,0.2\n")
+    _refused(capsys, tmp_path, ["--data", str(table)],
+             "m.csv, line 3 (1000 Hz, 5 g, 0.5 %, acrylic): fill_percent: fill 0.5 % of 22 "
+             "particles rounds to none")
+
+
+@pytest.mark.parametrize("option, value", [
+    ("--workers", "0"), ("--workers", "-2"), ("--steady-cycles", "0"), ("--design-size", "-3")])
+def test_a_count_below_one_is_refused_as_dem_sweep_refuses_it(capsys, tmp_path, option, value):
+    # `calibrate --workers 0` (or -2) ran without a word, where `dem sweep --workers 0` is
+    # refused; `--steady-cycles 0` named the library's field ("steady_cycles: expected >= 1")
+    store = tmp_path / "dem.h5"
+    with pytest.raises(SystemExit) as stop:  # argparse's refusal, as from the shell
+        main(["calibrate", "--data", str(_table(tmp_path)), "--dem-store", str(store),
+              *TINY[:-3], option, value])
+    err = capsys.readouterr().err
+    assert stop.value.code == 2 and f"argument {option}: expected a whole number >= 1, got " \
+        f"'{value}'" in err and len(err.strip().splitlines()) == 1
+    assert not store.exists()

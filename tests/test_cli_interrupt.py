@@ -254,3 +254,42 @@ def test_the_generic_interrupt_line_names_only_what_the_command_has(tmp_path, ca
     assert main(["analyze", str(tmp_path / "x.csv"), "--store", str(tmp_path / "s.h5")]) == 130
     assert capsys.readouterr().err == \
         "pidcore analyze: interrupted; no store write was left half-done\n"
+
+
+def test_an_interrupt_swallowed_by_a_reader_is_not_reported_as_a_bad_file(tmp_path, capsys,
+                                                                          monkeypatch):
+    # `timeout -s INT 1.3 pidcore analyze ..._58b.uff` printed "error: ...: no force channel
+    # among 'Velocity', 'Acceleration'" and exit 2: pyuff's bare `except:` swallowed the
+    # KeyboardInterrupt mid-file and the half-read file was refused as if it were bad. After
+    # SIGINT the refusal is the interruption (exit 130, one line), in analyze's own handler and
+    # in the generic one of every other command.
+    import pidcore.cli.analyze as analyze_cli
+    from pidcore.cli import main
+    from pidcore.errors import ChannelError
+
+    def half_read(*args, **kwargs):
+        interrupt._interrupted.set()  # what the handler does before pyuff swallows the raise
+        raise ChannelError("x.uff: no force channel among 'Velocity'; name one with --force")
+
+    monkeypatch.setattr(analyze_cli, "analyze_with_settings", half_read)
+    store = tmp_path / "s.h5"
+    assert main(["analyze", str(tmp_path / "x.uff"), "--store", str(store)]) == 130
+    assert capsys.readouterr().err == \
+        "pidcore analyze: interrupted; nothing saved, the store is unchanged\n"
+    assert not store.exists()
+
+    def refused_early(*args, **kwargs):  # before analyze's own accounting: the generic line
+        interrupt._interrupted.set()
+        raise ChannelError("x.uff: no force channel")
+
+    monkeypatch.setattr(analyze_cli, "_stated", refused_early)
+    assert main(["analyze", str(tmp_path / "x.uff"), "--no-store"]) == 130
+    assert capsys.readouterr().err == "pidcore analyze: interrupted; nothing was saved\n"
+
+    # without SIGINT the same refusal is the user's: exit 2 and the message
+    def really_bad(*args, **kwargs):
+        raise ChannelError("x.uff: no force channel")
+
+    monkeypatch.setattr(analyze_cli, "_stated", really_bad)
+    assert main(["analyze", str(tmp_path / "x.uff"), "--no-store"]) == 2
+    assert "error: x.uff: no force channel" in capsys.readouterr().err

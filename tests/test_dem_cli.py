@@ -1,6 +1,7 @@
 """``pidcore dem run`` command line."""
 
 import json
+from pathlib import Path
 
 import pytest
 
@@ -50,7 +51,7 @@ def test_unsafe_time_step_is_one_line_error_exit_2(capsys):
     code = main(["dem", "run", "--frequency", "50", "--acceleration", "10", "--fill", "50",
                  "--time-step", "2e-6", "--no-progress"])
     err = capsys.readouterr().err
-    assert code == 2 and err.count("\n") == 1 and "time_step <=" in err
+    assert code == 2 and err.count("\n") == 1 and "use --time-step <=" in err
 
 
 def test_paper_fill_reference_refused(capsys):
@@ -262,3 +263,61 @@ def test_no_fill_and_no_specimen_says_what_to_give(capsys):
     code = main(["dem", "run", "--frequency", "500", "--acceleration", "5"])
     err = capsys.readouterr().err
     assert code == 2 and "--fill: required (or a --specimen file stating count_per_cell" in err
+
+
+@pytest.mark.parametrize("command", [
+    ["dem", "run", "--frequency", "500", "--acceleration", "5", "--fill", "50"],
+    ["dem", "sweep", "--frequencies", "500", "--accelerations", "5", "--fills", "50"]])
+@pytest.mark.parametrize("option, said", [
+    # "use fill_reference='capacity'": the Python keyword, not the flag the user types
+    (["--fill-reference", "paper"],
+     "error: --fill-reference paper: 36 acrylic particles (r = 1.25 mm) do not fit a 4.76 x "
+     "25.4 mm cell (capacity 22); use --fill-reference capacity\n"),
+    (["--cells", "0"], "error: --cells: expected >= 1, got 0\n"),  # was "cells: ..."
+    (["--time-step", "0"], "error: --time-step: expected > 0 s, got 0.0\n"),
+])
+def test_dem_refusals_name_the_flags_not_the_library_keywords(tmp_path, capsys, command,
+                                                              option, said):
+    store = tmp_path / "s.h5"
+    assert main([*command, *option, "--store", str(store), "--no-progress"]) == 2
+    assert capsys.readouterr().err == f"pidcore {' '.join(command[:2])}: {said}"
+    assert not store.exists()
+
+
+def test_the_flag_wording_leaves_other_words_alone():
+    from pidcore.cli.dem import with_dem_flags
+
+    # "cells" names the option only as a message's first word; paths keep their names
+    said = "over 2 cells: my_time_step.toml: acceleration_g must be > 0"
+    assert with_dem_flags(said, "run") == \
+        "over 2 cells: my_time_step.toml: --acceleration must be > 0"
+    assert with_dem_flags("frequency_hz must be > 0", "sweep") == "--frequencies must be > 0"
+
+
+def test_a_sweep_over_the_grids_fills_says_it_is_not_the_specimens_fill(tmp_path, capsys,
+                                                                        monkeypatch):
+    # a specimen stating its fill (steel_6mm: fill_percent = 50 of 46 -> 23 per cell; a file
+    # stating count_per_cell 20) swept without --fills ran Table 3's 25, 50, 75, 90 % and no
+    # word said the specimen's own fill was not among them
+    import pidcore.dem.sweep as sweep_module
+    from pidcore.specimen import load_specimen
+
+    def stop(*args, **kwargs):
+        raise KeyboardInterrupt  # the cases are not the point: what was said before them
+
+    monkeypatch.setattr(sweep_module, "run_sweep", stop)
+    spec = Path(__file__).resolve().parents[1] / "data_samples" / "specimens" / "steel_6mm.toml"
+    mine = tmp_path / "mine.toml"
+    mine.write_text(spec.read_text().replace("fill_percent = 50.0", "count_per_cell = 20"))
+    capacity = load_specimen(mine).capacity_per_cell()
+    argv = ["dem", "sweep", "--specimen", str(mine), "--frequencies", "500",
+            "--accelerations", "5", "--store", str(tmp_path / "s.h5"), "--no-progress"]
+    assert main(argv) == 130
+    err = capsys.readouterr().err
+    assert (f"pidcore dem sweep: note: fills 25, 50, 75, 90 % are grid table3's, not the "
+            f"{100 * 20 / capacity:.6g} % specimen steel_6mm states ([particles] count_per_cell "
+            f"20 of capacity {capacity}); give --fills to choose\n") in err
+    # fills given, or a specimen whose fill is on the grid (steel_6mm's 50 %): nothing to say
+    for more, path in ((["--fills", "30"], mine), ([], spec)):
+        assert main([*argv[:3], str(path), *argv[4:], *more]) == 130
+        assert "note" not in capsys.readouterr().err

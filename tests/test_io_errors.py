@@ -104,3 +104,14 @@ def test_uff_time_record_with_fewer_samples_than_declared(tmp_path):
 def test_bad_parameters():
     with pytest.raises(ParameterError, match="file_format"):
         read_measurement("x.csv", file_format="xls")
+
+
+def test_text_without_numbers_is_not_called_a_header_without_data(tmp_path):
+    # `pidcore analyze rp/report.csv` (a report's table, 48 data rows of text and numbers) said
+    # "header but no data rows", as it did of a TOML file: wrong of both
+    table = tmp_path / "report.csv"
+    table.write_text('"frequency [Hz]","material","note"\n50.0,"acrylic","a"\n'
+                     '100.0,"acrylic","b"\n')
+    with pytest.raises(InputFileError, match=r"report\.csv: no rows of numbers in its 3 lines "
+                                             r"\(the first: '\"frequency \[Hz\]\","):
+        read_measurement(table)

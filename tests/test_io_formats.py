@@ -311,3 +311,35 @@ def test_csv_writer_header_names_si_units(tmp_path):
     header = path.read_text().splitlines()[0]
     assert header == "Time [s],Drive point force [N],LDV [m/s],Acc 1 [m/s^2],Bridge [V^2]"
     assert len(read_measurements(path)) == 1
+
+
+@pytest.mark.parametrize(("suffix", "file_format"), [
+    (".uff", "uff"), (".mat", "mat"), (".h5", "hdf5")])
+def test_a_sample_rate_a_file_keeps_is_noted_not_ignored_silently(tmp_path, suffix,
+                                                                  file_format):
+    # `pidcore analyze run.uff --sample-rate 25.6` (kHz typed) printed the same result as
+    # without the option and said nothing: UFF, HDF5 and pidcore/Testlab MAT files state each
+    # channel's rate and keep it. Now a note says the value given was not applied.
+    written = _measurement()
+    path = tmp_path / f"record{suffix}"
+    write_measurement(written, path, file_format)
+    read = read_measurement(path, sample_rate_hz=25.6)
+    assert [c.sample_rate_hz for c in read.channels] == [FS] * 4  # kept, as documented
+    (note,) = read.metadata["reader_notes"]
+    assert "the sample rate 25.6 Hz given (--sample-rate) is not applied" in note
+    assert "(2560 Hz), which is kept" in note
+    # the file's own rate given: nothing to say
+    assert "reader_notes" not in read_measurement(path, sample_rate_hz=FS).metadata
+
+
+def test_an_overridden_time_column_says_what_rate_it_gave(tmp_path):
+    # "time column 'Time' ignored: the sample rate 25.6 Hz was given": the column's 25600 Hz
+    # (a rate typed in kHz) was not shown, so the 1000-fold slip went unseen
+    t = np.arange(200) / 500.0
+    path = tmp_path / "with_time.csv"
+    path.write_text("Time [s],F [N],V [m/s]\n" + "".join(
+        f"{a:.17g},{np.sin(a):.17g},{np.cos(a):.17g}\n" for a in t))
+    (note,) = read_measurement(path, sample_rate_hz=0.5).metadata["reader_notes"]
+    assert note.endswith("(--sample-rate); the column gives 500 Hz, 1000 x the rate given")
+    (note,) = read_measurement(path, sample_rate_hz=500.0 * 1.001).metadata["reader_notes"]
+    assert note.endswith("(--sample-rate)")  # within 0.5 %: a correction, nothing to add

@@ -638,3 +638,34 @@ def test_json_carries_channels_notes_and_corrections(tmp_path, capsys):
     assert any("ignored channels" in n and "'Mic'" in n for n in record["notes"])
     assert record["corrections"]["ignored_channels"] == ["Mic"]
     assert abs(record["loss_factor"] - LF) <= max(0.03 * LF, 1.5e-4)
+
+
+@pytest.mark.parametrize("v_unit, a_unit, factor", [
+    ("mm/s", "m/s^2", 1000.0),  # m/s values written under "mm/s"
+    ("m/s", "g", 9.80665),  # m/s^2 values written under "g"
+])
+def test_an_acceleration_channel_that_disagrees_with_the_velocity_is_noted(
+        tmp_path, v_unit, a_unit, factor):
+    # A velocity exported in m/s but labelled mm/s changes neither the loss factor nor the SDC
+    # (force x velocity scales Re and Im of P_c alike): the record read 0.001 g and an energy
+    # per cycle 1000 x too small, and nothing said so, although an acceleration channel of
+    # the same motion sat beside it (ignored). Now its drive-line amplitude is compared with
+    # omega |V|.
+    rec = _record(with_acceleration=True)
+
+    def write(v_label: str, a_label: str) -> Path:
+        path = tmp_path / "slip.csv"
+        path.write_text(f"Time [s],Force [N],LDV [{v_label}],Acc [{a_label}]\n" + "".join(
+            f"{i / FS:.17g},{f:.17g},{v:.17g},{a:.17g}\n" for i, (f, v, a) in enumerate(
+                zip(rec.force_n, rec.velocity_m_s, rec.acceleration_m_s2, strict=True))))
+        return path
+
+    result = analyze_file(write(v_unit, a_unit), AnalysisOptions())
+    (note,) = [n for n in result.notes if "unit slip" in n]
+    ratio = float(note.split(" x the acceleration")[0].rsplit(" ", 1)[1])
+    # 60 dB noise over 40 periods: the drive-line amplitudes agree to far better than 1 %
+    assert ratio == pytest.approx(factor, rel=0.01)
+    assert note.startswith(f"channel 'Acc' ({a_unit}) has ") and f"'LDV' ({v_unit})" in note
+    # the same record with its true labels: nothing to say
+    result = analyze_file(write("m/s", "m/s^2"), AnalysisOptions())
+    assert not [n for n in result.notes if "unit slip" in n]

@@ -291,3 +291,39 @@ def test_figures_of_stored_runs_name_their_specimen(tmp_path, monkeypatch):
     titles = {fig._suptitle.get_text() for fig in built if fig._suptitle is not None}
     assert titles == {f"DEM runs of steel_6mm [aaaaaa] in {tmp_path / 's.h5'}"}
     assert len(built) == 2 * (4 + 3)  # every figure titled, each saved as PNG and SVG
+
+
+@pytest.mark.parametrize("area, said", [
+    ("100", "--area 100 m^2 is 1.16e+04 x the cross-section of specimen paper_coupon's 441 "
+            "cells (0.008653 m^2); expected the coupon's face area in m^2; was it cm^2 or mm^2?"),
+    ("1e-7", "--area 1e-07 m^2 is 1.16e-05 x the cross-section"),
+])
+def test_an_area_in_another_unit_is_refused(tmp_path, area, said):
+    # `--area 100` (the 100 cm^2 coupon typed in cm^2) wrote c_eq per area 1e4 times too small
+    # without a word. The paper's 441 cells of 4.76 mm: 441 x (sqrt(3)/2) x 4.76e-3^2 m^2.
+    with pytest.raises(ParameterError) as refused:
+        _run(["model", "damper", "--out", str(tmp_path / "o"), "--area", area])
+    assert said in str(refused.value)
+    assert not (tmp_path / "o").exists()
+    # the coupon's face (0.01 m^2, 1.16 x its cells) and a panel 50 x larger are taken
+    for ok in ("0.01", "0.5"):
+        _run(["model", "damper", "--out", str(tmp_path / ok), "--area", ok, "--format", "csv"])
+        table = pd.read_csv(tmp_path / ok / "equivalent_damper.csv")
+        np.testing.assert_allclose(table["c_eq_per_area [N s/m^3]"],
+                                   table["c_eq [N s/m]"] / float(ok), rtol=1e-12)
+
+
+def test_an_area_is_checked_against_the_stored_runs_specimen(tmp_path):
+    from pidcore.model.damper import check_area, runs_specimen
+    from pidcore.specimen import load_specimen
+
+    steel = load_specimen(Path(__file__).resolve().parents[1] / "data_samples" / "specimens"
+                          / "steel_6mm.toml")
+    runs = pd.DataFrame({"parameters_json": [json.dumps({"specimen_text": steel.text})] * 2})
+    assert runs_specimen(runs).hash == steel.hash
+    check_area(0.01, runs_specimen(runs))  # its 286 cells of 6.35 mm: 0.00999 m^2
+    with pytest.raises(ParameterError, match=r"area_m2 100 m\^2 is 1e\+04 x .* steel_6mm's "
+                                             r"286 cells"):
+        check_area(100.0, runs_specimen(runs))
+    # runs of an older store (no specimen text) or of several specimens: nothing to check by
+    assert runs_specimen(pd.DataFrame({"parameters_json": ["{}"]})) is None

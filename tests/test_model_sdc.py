@@ -194,6 +194,17 @@ def test_line_without_any_value_is_refused():
         SdcModel.from_table(t, value="sdc")
 
 
+def test_a_line_without_any_value_is_named_by_its_acceleration_and_frequency():
+    # a report row's note said "no value at any fill for acceleration index 1, frequency
+    # index 0": the model's array indices, which the user cannot map to a load case
+    t = pd.DataFrame({"fill_percent": [20.0, 40.0, 20.0, 40.0, 43.5],
+                      "acceleration_g": [5.0, 5.0, 10.0, 10.0, 5.0],
+                      "frequency_hz": [500.0, 500.0, 500.0, 500.0, 200.0],
+                      "sdc": [0.7, 1.1, 0.4, 0.5, 1.3]})
+    with pytest.raises(ParameterError, match=r"no value at any fill for 10 g, 200 Hz \("):
+        SdcModel.from_table(t, value="sdc")
+
+
 # --------------------------------------------------------------------------- range handling
 @pytest.mark.parametrize("point", [(24.9, 5, 100), (95, 5, 100), (50, 0.5, 100), (50, 11, 100),
                                    (50, 5, 40), (50, 5, 1001)])

@@ -183,3 +183,47 @@ def test_parse_formats():
     assert parse_formats("pdf,csv,pdf") == ("pdf", "csv")
     with pytest.raises(ParameterError, match="docx"):
         parse_formats("docx")
+
+
+@pytest.mark.parametrize("moment", ["before the write", "during the swap"])
+def test_ctrl_c_says_whether_the_report_was_written(tmp_path, table, provenance, monkeypatch,
+                                                    capsys, moment):
+    # `timeout -s INT 4 pidcore report ... --out rp` said "rp may hold part of this run's
+    # files" (and "no store write was left half-done" with no FILES and no write): rp is
+    # replaced whole or not at all, and was as it was. A Ctrl-C during the swap is delivered
+    # once the swap and the old report's removal are done (no '.rp.*.old' folder left).
+    import os
+    import signal
+
+    import pidcore.report.pipeline as pipeline
+    import pidcore.report.render as render
+    from pidcore.cli import main
+
+    out = tmp_path / "rp"
+    write_report(table, {}, provenance, out, "csv")
+    old_csv = (out / "report.csv").read_bytes()
+    move = render._move_into_place
+
+    def sigint_during_the_swap(tmp, out_dir):
+        move(tmp, out_dir)
+        os.kill(os.getpid(), signal.SIGINT)  # lands in the handler main() installed
+
+    def make_report(files, *, out_dir, **kwargs):
+        if moment == "before the write":
+            raise KeyboardInterrupt
+        monkeypatch.setattr(render, "_move_into_place", sigint_during_the_swap)
+        write_report(table.iloc[:1], {}, provenance, out_dir, "csv")
+        raise AssertionError("the interrupt was not delivered after the swap")
+
+    monkeypatch.setattr(pipeline, "make_report", make_report)
+    assert main(["report", "--store", str(tmp_path / "s.h5"), "--out", str(out)]) == 130
+    err = capsys.readouterr().err
+    if moment == "before the write":
+        assert err == f"pidcore report: interrupted; {out} is as it was (a report is written " \
+                      "whole or not at all)\n"
+        assert (out / "report.csv").read_bytes() == old_csv
+    else:
+        assert err == f"pidcore report: interrupted; the report was written to {out} before " \
+                      "it\n"
+        assert (out / "report.csv").read_bytes() != old_csv
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["rp"]  # no temporary or .old left

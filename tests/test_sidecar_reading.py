@@ -218,3 +218,56 @@ def test_calibrates_measured_table_names_a_row_by_its_line_too(tmp_path):
                      "500,5,50,0.6\n500,1,50,x\n", encoding="utf-8")
     with pytest.raises(InputFileError, match=r"m\.csv, line 4: sdc 'x' is not a number"):
         read_measured_table(table)
+
+
+def test_a_spreadsheets_trailing_empty_columns_are_left_out(tmp_path, capsys):
+    # Excel saved the table with a trailing ';;' for columns that once held a cell: the CLI
+    # refused it with "column '' given more than once" (two such columns) or "unknown
+    # column(s) ''" (one). A column with neither name nor value states nothing.
+    path = copy_f(tmp_path)
+    (tmp_path / "loadcases.csv").write_bytes(
+        f"\ufefffile;velocity_delay_us;;\r\n{F.name};50,0;;\r\n;;;\r\n".encode())
+    (rec,) = analyze_json([str(path)], capsys)["records"]
+    assert rec["parameters"]["velocity_delay_s"] == 5e-5
+    assert rec["sdc"] == pytest.approx(SDC_50US, abs=TOL)
+    (tmp_path / "loadcases.csv").write_text(f"file,velocity_delay_us,\n{F.name},50,\n",
+                                            encoding="utf-8")
+    (rec,) = analyze_json([str(path)], capsys)["records"]
+    assert rec["sdc"] == pytest.approx(SDC_50US, abs=TOL)
+    # a value under no name is refused, naming its line and column, not silently dropped
+    (tmp_path / "loadcases.csv").write_text(f"file,velocity_delay_us,\n{F.name},50,20\n",
+                                            encoding="utf-8")
+    err = refused([str(path)], capsys)
+    assert "loadcases.csv, line 2: '20' in column 3" in err and "without a name" in err
+
+
+def test_the_sidecar_among_the_files_is_named_as_the_sidecar(tmp_path, capsys):
+    # `pidcore analyze folder/*` with loadcases.csv beside the exports (as the README places
+    # it) said "loadcases.csv: header but no data rows; expected a header row such as
+    # 'Time [s],Force [N],Velocity [m/s]'" of a table that has data rows
+    path = copy_f(tmp_path)
+    table = tmp_path / "loadcases.csv"
+    table.write_text(f"file,velocity_delay_us\n{F.name},50\n", encoding="utf-8")
+    for extra in ([], ["--sidecar", str(table)]):
+        err = refused([str(path), str(table), *extra], capsys)
+        assert f"{table}: is the sidecar table" in err and "not a measurement" in err
+        assert "header but no data rows" not in err
+    # without it among the files, the table is read as before
+    (rec,) = analyze_json([str(path)], capsys)["records"]
+    assert rec["sdc"] == pytest.approx(SDC_50US, abs=TOL)
+
+
+def test_a_row_naming_the_file_without_its_extension_is_pointed_out(tmp_path, capsys):
+    # loadcases.csv beside the file named it as a spreadsheet user types it, without '.uff':
+    # no row matched, and the file was analysed without its 50 µs delay (SDC 1.03 instead of
+    # 1.14) with no word but "no fill stated" (the name states the fill here: not even that)
+    path = copy_f(tmp_path)
+    (tmp_path / "loadcases.csv").write_text(f"file,velocity_delay_us\n{Path(F.name).stem},50\n",
+                                            encoding="utf-8")
+    doc = analyze_json([str(path)], capsys)
+    (rec,) = doc["records"]
+    assert rec["sdc"] == pytest.approx(SDC_0US, abs=TOL)  # still not matched, but said:
+    said = (f"{F.name}: no row in {tmp_path / 'loadcases.csv'} (rows are matched by file name; "
+            f"line 2 names {Path(F.name).stem!r}, without the extension: write {F.name!r})")
+    assert rec["sidecar_row_missing"].startswith(said)
+    assert any(n.startswith(said) for n in doc["notes"])

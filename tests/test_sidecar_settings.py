@@ -351,3 +351,22 @@ def test_regenerated_samples_sidecar_is_the_bundled_one_with_the_delay(tmp_path)
     shutil.copyfile(SAMPLES / "dem_table3.h5", tmp_path / "dem_table3.h5")
     written = make_samples(tmp_path, run_sweep=False, progress=False)
     assert written["loadcases"].read_bytes() == (SAMPLES / "loadcases.csv").read_bytes()
+
+
+def test_an_inversion_from_the_table_is_not_credited_to_the_option(tmp_path, capsys):
+    # the row's invert gave the note "channel 'Force' inverted (--invert)" beside the settings
+    # line "inverted 'Force' (loadcases.csv)", and a misspelt cell the error "--invert 'Forc':
+    # no such channel": an option the user never typed
+    flipped = export(tmp_path / "flipped.csv", invert_force=True)
+    table = sidecar(tmp_path, "file,fill_percent,invert\nflipped.csv,50,Force\n")
+    (rec,) = run_json([str(flipped), "--no-store"], capsys)["records"]
+    assert f"channel 'Force' inverted (column invert of {table}, line 2 (flipped.csv))" \
+        in rec["notes"]
+    assert not any("--invert" in n for n in rec["notes"])
+    # the option given: the note names the option, as before
+    (rec,) = run_json([str(flipped), "--no-store", "--invert", "Force"], capsys)["records"]
+    assert "channel 'Force' inverted (--invert)" in rec["notes"]
+    sidecar(tmp_path, "file,fill_percent,invert\nflipped.csv,50,Forc\n")
+    err = refused(["analyze", str(flipped), "--no-store"], capsys)
+    assert "flipped.csv: invert 'Forc': no such channel" in err and "--invert" not in err
+    assert f"column invert 'Forc' of {table}, line 2 (flipped.csv)" in err

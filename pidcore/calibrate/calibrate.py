@@ -212,6 +212,23 @@ def base_specimen(points: Sequence[MeasuredPoint], specimen: Specimen | None) ->
     return chosen
 
 
+def check_point_fills(points: Sequence[MeasuredPoint], specimen: Specimen,
+                      config: DemConfig) -> None:
+    """Refuse a point whose fill the DEM cannot run (it rounds to no particle, or to more than
+    the cell holds) before any DEM run, naming its table line: the DEM's own refusal named
+    neither the table nor the row ("fill 0.4 % of 46 particles rounds to none")."""
+    from ..dem.simulate import particles_per_cell
+
+    for p in points:
+        try:
+            particles_per_cell(p.fill_percent, specimen=specimen,
+                               fill_reference=config.fill_reference)
+        except ParameterError as exc:
+            where = f"{p.source}, line {p.row}" if p.row is not None else \
+                (p.source or "measured point")
+            raise ParameterError(f"{where} ({p.label()}): fill_percent: {exc}") from None
+
+
 def check_point_specimens(points: Sequence[MeasuredPoint], specimen: Specimen) -> None:
     """Refuse points measured on another specimen than ``specimen``, the one calibrated.
 
@@ -290,6 +307,7 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: Sequence[str],
     design = design_points(dem_specs, n_design, seed=seed)
     config = dataclasses.replace(dem_config or DemConfig(), cells=cells, seed=seed,
                                  steady_cycles=steady_cycles)
+    check_point_fills(points, specimen, config)
     requests = _requests(points, dem_specs, design, config, specimen)
     if on_design is not None:
         on_design([r.key() for row in requests for r in row])

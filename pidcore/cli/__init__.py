@@ -76,6 +76,13 @@ def _run(argv: list[str] | None) -> int:
             raise KeyboardInterrupt
         return rc
     except PidcoreError as exc:
+        if interrupt.interrupted():  # an interrupt swallowed by a library (pyuff's bare
+            # ``except:``) left data out and surfaced as a refusal: it is the interruption
+            said = _what_an_interrupt_left(args) if started and args is not None \
+                else "nothing was done"
+            print(f"pidcore {command}: interrupted; {said}", file=sys.stderr)
+            interrupt.mark_handled()
+            return 130
         print(f"pidcore {command}: error: {exc}", file=sys.stderr)
         return 2
     except BrokenPipeError:  # the reader of stdout (| head) stopped: end quietly

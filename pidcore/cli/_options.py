@@ -101,8 +101,9 @@ def add_measurement_options(p: argparse.ArgumentParser) -> None:
     g.add_argument("--harmonics", metavar="N", type=int, default=defaults.N_HARMONICS,
                    help=f"drive harmonics fitted (default {defaults.N_HARMONICS})")
     g.add_argument("--sample-rate", metavar="HZ", type=float, default=None,
-                   help="sample rate, Hz, for CSV/TXT/MAT files; overrides a time column "
-                        "(noted in the output)")
+                   help="sample rate, Hz, for CSV/TXT files and MAT files of plain "
+                        "vectors; overrides their time column (noted in the output); UFF, "
+                        "HDF5 and Testlab/pidcore MAT files keep their own rate (noted)")
     g.add_argument("--allow-clipped", action="store_true",
                    help="analyse clipped channels anyway (reported in the output)")
     g.add_argument("--force-unit", metavar="UNIT", default=None,

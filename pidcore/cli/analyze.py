@@ -116,7 +116,9 @@ def _run(args: argparse.Namespace) -> int:
         interrupt.raise_if_interrupted()  # an interrupt swallowed on the way still counts
         # inside: a Ctrl-C while the results are written out still says what was saved
         _print_results(args, results, cases, stated, settings, replaced)
-    except (KeyboardInterrupt, SystemError) as exc:
+    except (KeyboardInterrupt, Exception) as exc:
+        # after SIGINT any error is the interruption: pyuff's bare ``except:`` swallows the
+        # KeyboardInterrupt and its half-read file then comes back as "no force channel"
         if not interrupt.is_interruption(exc):
             raise
         said = (f"interrupted after saving {_saved(results)} to {args.store}"

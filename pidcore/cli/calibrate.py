@@ -7,7 +7,7 @@ import sys
 from pathlib import Path
 
 from .. import defaults, interrupt
-from ._options import check_out_folder, non_negative_int
+from ._options import check_out_folder, non_negative_int, positive_int
 
 DEFAULT_STORE = Path("calibration_store.h5")
 
@@ -43,15 +43,16 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help="fix the relative model discrepancy instead of fitting it")
     p.add_argument("--discrepancy-floor", metavar="SDC", type=float, default=DISCREPANCY_FLOOR,
                    help="absolute model-error floor on the SDC (default %(default)s)")
-    p.add_argument("--cells", metavar="K", type=int, default=None,
+    p.add_argument("--cells", metavar="K", type=positive_int, default=None,
                    help="cells per DEM run (default 4)")
-    p.add_argument("--steady-cycles", metavar="N", type=int, default=None,
+    p.add_argument("--steady-cycles", metavar="N", type=positive_int, default=None,
                    help="steady cycles measured per DEM run (default: the DEM's)")
-    p.add_argument("--design-size", metavar="N", type=int, default=None,
+    p.add_argument("--design-size", metavar="N", type=positive_int, default=None,
                    help="DEM design points (default: enough for a quadratic surrogate)")
     p.add_argument("--seed", type=non_negative_int, default=defaults.DEM_SEED,
                    help="DEM seed")
-    p.add_argument("--workers", type=int, default=2, help="DEM processes (default 2)")
+    p.add_argument("--workers", metavar="N", type=positive_int, default=2,
+                   help="DEM processes (default 2)")
     p.add_argument("--method", choices=("auto", "grid", "emcee"), default="auto",
                    help="posterior: exact grid (<= 3 quantities) or emcee; auto picks")
     p.add_argument("--dem-store", metavar="FILE", type=Path, default=DEFAULT_STORE,

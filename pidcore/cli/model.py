@@ -96,7 +96,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     d.add_argument("--area", metavar="M2", type=_positive_float, default=None,
                    help="coupon area for c_eq per area, m^2 (default: the paper's 0.1 m x "
                         "0.1 m; required for runs of another specimen, whose file has no "
-                        "coupon area)")
+                        "coupon area; more than 100 x off its cells' cross-section is refused "
+                        "as a unit slip)")
     d.set_defaults(func=run_damper)
 
     f = sub.add_parser("figures", help="SDC figures (paper Figs. 8-14), PNG and SVG")
@@ -188,6 +189,12 @@ def run_damper(args: argparse.Namespace) -> int:
         mass = paper_vibrated_mass(convention, material)
         mass_text = f"{convention} ({material}, paper count per cell)"
     if args.area is not None:
+        from ..model.damper import check_area, runs_specimen
+        from ..specimen import paper_specimen
+
+        specimen = paper_specimen() if runs is None else runs_specimen(runs)
+        if specimen is not None:  # runs of an older store name no specimen text
+            check_area(args.area, specimen, "--area")
         area, area_text = args.area, f"{args.area} m^2 (given)"
     elif runs is not None and "specimen_is_paper" in runs.columns \
             and not runs["specimen_is_paper"].fillna(True).astype(bool).all():

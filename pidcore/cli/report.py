@@ -6,9 +6,11 @@ All logic is in :func:`pidcore.report.pipeline.make_report`.
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 
-from ..report.render import format_cell
+from .. import interrupt
+from ..report.render import folder_identity, format_cell
 from ..report.table import ALIGNMENT_COLUMN
 from ._options import (
     add_load_case_options,
@@ -74,17 +76,31 @@ def run(args: argparse.Namespace) -> int:
     from ..specimen import load_specimen
 
     specimen = load_specimen(args.specimen) if args.specimen is not None else None
-    result = make_report(
-        args.files, out_dir=args.out, store=args.store, dem_store=args.dem_store,
-        formats=args.format, fill_percent=args.fill, material=args.material,
-        direction=args.direction, sidecar=args.sidecar, options=analysis_options(args),
-        options_given=given_options(args),
-        specimen=specimen, pool=args.pool, calibration=args.calibration)
-    print(short_table(result.table))
-    for note in result.notes:
-        print(f"note: {note}")
-    for name, path in result.paths.items():
-        print(f"wrote {name}: {path}")
+    before = folder_identity(args.out)
+    try:
+        result = make_report(
+            args.files, out_dir=args.out, store=args.store, dem_store=args.dem_store,
+            formats=args.format, fill_percent=args.fill, material=args.material,
+            direction=args.direction, sidecar=args.sidecar, options=analysis_options(args),
+            options_given=given_options(args),
+            specimen=specimen, pool=args.pool, calibration=args.calibration)
+        print(short_table(result.table))
+        for note in result.notes:
+            print(f"note: {note}")
+        for name, path in result.paths.items():
+            print(f"wrote {name}: {path}")
+    except (KeyboardInterrupt, Exception) as exc:
+        if not interrupt.is_interruption(exc):
+            raise
+        # the report folder is replaced whole or not at all: say which, not "may hold part"
+        after = folder_identity(args.out)
+        said = (f"the report was written to {args.out} before it" if after != before else
+                f"{args.out} is as it was (a report is written whole or not at all)")
+        if args.files:  # their analyses are saved to the store in one transaction
+            said += "; no store write was left half-done"
+        print(f"pidcore report: interrupted; {said}", file=sys.stderr)
+        interrupt.mark_handled()
+        return 130
     return 0
 
 

@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from ._options import positive_int
+
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     p = subparsers.add_parser("samples", help="regenerate the bundled sample data")
@@ -13,10 +15,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                        description="Regenerate data_samples/: the paper's Table 3 as CSV, a DEM "
                                    "store of the whole Table 3 grid (sweep, resumable) and "
                                    "synthetic virtual shaker-test exports in every format.")
-    m.add_argument("--out", type=Path, default=Path("data_samples"), help="output folder")
+    m.add_argument("--out", type=Path, default=Path("data_samples"),
+                   help="output folder (default: ./data_samples)")
     m.add_argument("--skip-sweep", action="store_true",
                    help="reuse the DEM runs already in OUT/dem_table3.h5")
-    m.add_argument("--workers", type=int, default=None, help="processes for the DEM sweep")
+    m.add_argument("--workers", metavar="N", type=positive_int, default=None,
+                   help="processes for the DEM sweep")
     m.set_defaults(func=_make)
 
 

@@ -378,6 +378,13 @@ def sidecar_row(path: str | Path,
         sidecar_path = Path(sidecar) if sidecar is not None else path.parent / SIDECAR_NAME
         if sidecar is None and not sidecar_path.is_file():
             return None
+        if path.is_file() and sidecar_path.is_file() and path.samefile(sidecar_path):
+            # `pidcore analyze folder/*` with the table beside the files: refused as what it
+            # is, not read as a measurement ("header but no data rows")
+            raise LoadCaseError(
+                f"{path}: is the sidecar table (the load case and settings of each file), "
+                "not a measurement; leave it out of the files given (a "
+                f"{SIDECAR_NAME} beside the files is read by itself; another with --sidecar)")
         if tables is None:
             table = read_sidecar(sidecar_path)
         else:

@@ -120,6 +120,26 @@ def _displayed(measurement: Measurement, path: str | os.PathLike[str]) -> Measur
                    metadata={**measurement.metadata, "reader_notes": notes})
 
 
+def _rate_kept(measurement: Measurement, sample_rate_hz: float | None,
+               path: str | os.PathLike[str]) -> Measurement:
+    """``measurement`` with a reader note where ``sample_rate_hz`` was given but not applied:
+    UFF, HDF5 and the structured MATLAB layouts (Testlab ``Signal``, pidcore's) state each
+    channel's rate and keep it. Without the note the option was ignored without a word, and
+    a rate typed to correct the file's changed nothing that the output showed."""
+    if sample_rate_hz is None or not measurement.channels or any(
+            abs(c.sample_rate_hz - sample_rate_hz) <= 1e-9 * sample_rate_hz
+            for c in measurement.channels):
+        return measurement
+    rates = ", ".join(f"{r:.9g}" for r in sorted({c.sample_rate_hz
+                                                  for c in measurement.channels}))
+    notes = [*measurement.metadata.get("reader_notes", ()),
+             f"{display_path(path)}: the sample rate {sample_rate_hz:g} Hz given "
+             f"(--sample-rate) is not applied: the file states its channels' rate ({rates} Hz), "
+             "which is kept; the option sets the rate of CSV/TXT files and of MATLAB files of "
+             "plain vectors"]
+    return replace(measurement, metadata={**measurement.metadata, "reader_notes": notes})
+
+
 def _check_format(file_format: str | None) -> None:
     if file_format is not None and file_format not in _FORMATS:
         raise ParameterError(f"file_format must be one of {', '.join(_FORMATS)}; "
@@ -149,9 +169,10 @@ def read_measurement(path: str | os.PathLike[str], *, sample_rate_hz: float | No
     path : str or path-like
         UFF (58/58b), CSV/TXT, MATLAB or pidcore HDF5 file.
     sample_rate_hz : float, optional
-        Sample rate, Hz, for CSV or MATLAB files without a time vector. Where the file has a
-        time base, a different value raises :class:`ParameterError`; UFF and HDF5 files carry
-        their own rate and ignore it.
+        Sample rate, Hz, for CSV or MATLAB files of plain vectors without a time vector; where
+        they have one (or a rate variable), it overrides it, with a reader note. UFF, HDF5 and
+        the structured MATLAB layouts state each channel's rate and keep it, with a reader
+        note saying the value given was not applied.
     file_format : {"uff", "csv", "mat", "hdf5"}, optional
         Skip detection.
     key : str, optional
@@ -177,16 +198,17 @@ def read_measurement(path: str | os.PathLike[str], *, sample_rate_hz: float | No
         raise ParameterError(f"{display_path(path)}: key={key!r} picks a measurement of a "
                              f"pidcore HDF5 store; this is a {fmt} file")
     if fmt == "uff":
-        return _displayed(read_uff(path), path)
+        return _rate_kept(_displayed(read_uff(path), path), sample_rate_hz, path)
     if fmt == "csv":
         return _displayed(read_csv(path, sample_rate_hz=sample_rate_hz), path)
     if fmt == "mat":
-        return _displayed(read_mat(path, sample_rate_hz=sample_rate_hz), path)
+        return _rate_kept(_displayed(read_mat(path, sample_rate_hz=sample_rate_hz), path),
+                          sample_rate_hz, path)
     keys = hdf5_keys(path)
     if key is None and len(keys) > 1:
         raise InputFileError(f"{display_path(path)}: holds {len(keys)} measurements "
                              f"({', '.join(keys)}); choose one with key=")
-    return _displayed(read_hdf5(path, key=key)[0], path)
+    return _rate_kept(_displayed(read_hdf5(path, key=key)[0], path), sample_rate_hz, path)
 
 
 def write_measurement(measurement: Measurement, path: str | os.PathLike[str],

@@ -89,6 +89,25 @@ def snap_rate(rate_hz: float, relative_resolution: float) -> float:
 PRINTED_TIME_DIGITS = 5
 
 
+def overridden_rate(times: np.ndarray, rate_hz: float) -> str:
+    """What a time column overridden by a given sample rate said, for the note that announces
+    the override: ``"; the column gives 25600 Hz, 1000 x the rate given"`` where its mean
+    interval is more than 0.5 % off ``rate_hz`` (a rate typed in kHz, or a column in ms
+    labelled s), else ``""``. The column may be the reason for the override (uneven, not
+    increasing): then its mean interval is not a rate and nothing is said."""
+    t = np.asarray(times, dtype=np.float64).ravel()
+    if t.size < 2 or not (np.isfinite(t[0]) and np.isfinite(t[-1])):
+        return ""
+    dt = (float(t[-1]) - float(t[0])) / (t.size - 1)
+    if not dt > 0:
+        return ""
+    column_rate = 1.0 / dt
+    ratio = column_rate / rate_hz
+    if abs(ratio - 1.0) <= 0.005:
+        return ""
+    return f"; the column gives {column_rate:.6g} Hz, {ratio:.4g} x the rate given"
+
+
 def rate_from_times(times: np.ndarray, *, what: str, with_note: bool = False):
     """Sample rate (Hz) and start time (s) of an evenly spaced time vector.
 

@@ -36,6 +36,7 @@ from ._common import (
     file_sha256,
     interpret_unit,
     make_channel,
+    overridden_rate,
     rate_from_times,
     unique_names,
 )
@@ -118,7 +119,11 @@ def _layout(lines: list[str], where: str) -> tuple[int, str, list[str], list[str
         first = next((i for i in candidates if _is_numeric_row(lines[i], _delimiter([lines[i]]))),
                      None)
     if first is None:
-        what = "header but no data rows" if candidates else "no rows of numbers"
+        # "header but no data rows" was said of any text without a row of numbers: a report
+        # CSV, a TOML file, a load-case table of 40 rows
+        what = "header but no data rows" if len(candidates) == 1 else \
+            f"no rows of numbers in its {len(candidates)} lines (the first: " \
+            f"{lines[candidates[0]].strip()[:60]!r})" if candidates else "no rows of numbers"
         raise InputFileError(f"{where}: {what}; expected a header row such as "
                              "'Time [s],Force [N],Velocity [m/s]' and data rows")
     data = [lines[j] for j in candidates if j >= first][:200]
@@ -217,7 +222,8 @@ def read_csv(path: str | os.PathLike[str], *, sample_rate_hz: float | None = Non
             _, factor = interpret_unit(unit) if unit else ("time", 1.0)
             start_time = float(values[0, time_index]) * factor
             notes.append(f"{where}: time column {name!r} ignored: the sample rate "
-                         f"{rate:g} Hz was given (--sample-rate)")
+                         f"{rate:g} Hz was given (--sample-rate)"
+                         + overridden_rate(values[:, time_index] * factor, rate))
     elif time_index is not None:
         name, unit = cells[time_index]
         _, factor = interpret_unit(unit) if unit else ("time", 1.0)

@@ -39,6 +39,7 @@ from ._common import (
     atomic_path,
     file_sha256,
     make_channel,
+    overridden_rate,
     rate_from_times,
     reraise_interrupt,
     unique_names,
@@ -274,7 +275,8 @@ def _simple_layout(variables: Mapping, where: str,
         rate, start = float(sample_rate_hz), float(_numeric_vector(public[time_key])[0])
         n = _numeric_vector(public[time_key]).size
         notes.append(f"{where}: time vector {time_key!r} ignored: the sample rate "
-                     f"{rate:g} Hz was given (--sample-rate)")
+                     f"{rate:g} Hz was given (--sample-rate)"
+                     + overridden_rate(_numeric_vector(public[time_key]), rate))
     elif time_key is not None:
         rate, start, note = rate_from_times(_numeric_vector(public[time_key]),
                                             what=f"{where}: variable {time_key!r}",

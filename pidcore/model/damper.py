@@ -148,6 +148,47 @@ def coupon_area_m2(side_m: float = D.COUPON_SIDE_M) -> float:
     return float(_positive("side_m", side_m)) ** 2
 
 
+#: Most a coupon area may differ from its cells' cross-section (count x hexagon) before it is
+#: refused as a unit slip: cm^2 or mm^2 typed for m^2 is 1e4 or 1e6 times off, while a panel
+#: whose filled cells are a patch of it, or the paper's 0.01 m^2 over its 441 cells (1.16 x),
+#: stay well within it.
+AREA_TO_CELLS_LIMIT = 100.0
+
+
+def cells_area_m2(specimen) -> float:
+    """Cross-section [m^2] of a specimen's ``[cell] count`` cells (count x hexagon across the
+    flats), as ``pidcore specimen check`` takes the coupon area in its mass check."""
+    return specimen.cell.count * specimen.geometry().volume_m3() / specimen.cell.height_m
+
+
+def runs_specimen(runs: pd.DataFrame):
+    """The specimen of DEM runs (its canonical text, stored with each run), None where the
+    runs hold none (an older store) or several."""
+    from ..specimen import Specimen
+
+    if "parameters_json" not in runs.columns or runs.empty:
+        return None
+    texts = {json.loads(p).get("specimen_text") for p in runs["parameters_json"].dropna()}
+    if len(texts) != 1 or None in texts:
+        return None
+    return Specimen.from_text(texts.pop(), source="stored DEM runs")
+
+
+def check_area(area_m2: float, specimen, what: str = "area_m2") -> None:
+    """Refuse a coupon area more than :data:`AREA_TO_CELLS_LIMIT` times off the cross-section
+    of ``specimen``'s cells as a unit slip (``what``: the option as messages name it)."""
+    cells = cells_area_m2(specimen)
+    ratio = float(area_m2) / cells
+    if 1.0 / AREA_TO_CELLS_LIMIT <= ratio <= AREA_TO_CELLS_LIMIT:
+        return
+    hint = "was it cm^2 or mm^2?" if ratio > 1 else \
+        "was it one cell's area, or is the specimen's [cell] count wrong?"
+    raise ParameterError(
+        f"{what} {float(area_m2):g} m^2 is {ratio:.3g} x the cross-section of specimen "
+        f"{specimen.name}'s {specimen.cell.count} cells ({cells:.4g} m^2); expected the "
+        f"coupon's face area in m^2; {hint}")
+
+
 def coupon_vibrated_mass_kg(*, particles_mass_kg: float = 0.0,
                             side_m: float = D.COUPON_SIDE_M,
                             face_sheet_thickness_m: float = D.FACE_SHEET_THICKNESS_M,

@@ -82,8 +82,11 @@ def _pchip_select(x: np.ndarray, y: np.ndarray, xq: np.ndarray, *,
     return out
 
 
-def _fill_holes_along_fill(values: np.ndarray, fills: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Fill NaNs along the fill axis (axis 0); see the module docstring for the rule."""
+def _fill_holes_along_fill(values: np.ndarray, axes: tuple[np.ndarray, ...]
+                           ) -> tuple[np.ndarray, np.ndarray]:
+    """Fill NaNs along the fill axis (axis 0); see the module docstring for the rule.
+    ``axes``: fill [%], acceleration [g], frequency [Hz], to name a line without a value."""
+    fills = axes[0]
     values = values.copy()
     filled = np.isnan(values)
     for ia in range(values.shape[1]):
@@ -94,9 +97,10 @@ def _fill_holes_along_fill(values: np.ndarray, fills: np.ndarray) -> tuple[np.nd
                 continue
             if not known.any():
                 raise ParameterError(
-                    f"SDC table: no value at any fill for acceleration index {ia}, frequency "
-                    f"index {iz}; cannot fill the grid (every frequency/acceleration pair needs "
-                    f"at least one fill value)")
+                    f"SDC table: no value at any fill for {axes[1][ia]:g} g, {axes[2][iz]:g} Hz "
+                    "(the grid is every combination of the frequencies, accelerations and "
+                    "fills given); cannot fill the grid (every frequency/acceleration pair "
+                    "needs at least one fill value)")
             xk, yk = fills[known], line[known]
             inner = (~known) & (fills > xk[0]) & (fills < xk[-1])
             if inner.any():
@@ -204,7 +208,7 @@ class SdcModel:
                                      f"the model needs at least 2 per axis")
         full = pd.MultiIndex.from_product(axes, names=list(AXIS_NAMES))
         grid = mean.reindex(full).to_numpy().reshape(tuple(a.size for a in axes))
-        values, filled = _fill_holes_along_fill(grid, axes[0])
+        values, filled = _fill_holes_along_fill(grid, axes)
         return cls(axes=axes, values=values, filled=filled, value_name=value,
                    log_frequency=log_frequency, source=source)
 

@@ -25,7 +25,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from .. import defaults
+from .. import defaults, interrupt
 from ..constants import REPORT_FORMATS
 from ..errors import ParameterError
 from .provenance import Provenance
@@ -332,8 +332,23 @@ def write_report(table: pd.DataFrame, figures: Mapping[str, object], provenance:
                 written["csv_provenance"] = tmp / f"{REPORT_STEM}{CSV_NOTES_SUFFIX}"
         (tmp / REPORT_MARKER).write_text("written by pidcore report\n", encoding="utf-8")
         os.chmod(tmp, 0o755)  # mkdtemp makes 0700; a report folder is meant to be shared
-        _move_into_place(tmp, out_dir)
+        # the swap and the earlier report's removal are one step for Ctrl-C: cut between them,
+        # a '.<name>.*.old' folder was left beside the report (interrupt.deferred)
+        with interrupt.deferred():
+            _move_into_place(tmp, out_dir)
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
         raise
+    interrupt.raise_if_interrupted()
     return {k: out_dir / p.relative_to(tmp) for k, p in written.items()}
+
+
+def folder_identity(folder: str | Path) -> tuple[int, int] | None:
+    """``(device, inode)`` of a folder, None if there is none: :func:`write_report` puts a
+    new folder in place, so a caller that took this before can tell after a Ctrl-C whether the
+    report was written (identity changed) or the folder is as it was."""
+    try:
+        st = os.stat(folder)
+    except OSError:
+        return None
+    return st.st_dev, st.st_ino
