@@ -111,6 +111,7 @@ class PlausibleRange:
     what: str
     below: str = ""  # likely slip of a value below ``low``
     above: str = ""  # likely slip of a value above ``high``
+    kind: str = ""  # what a value is, in messages (default: from ``unit``)
 
 
 #: Generous physical bounds of specimen values. A value outside is almost surely in the wrong
@@ -146,6 +147,16 @@ PLAUSIBLE_RANGES: dict[str, PlausibleRange] = {
     "baseline_loss_factor": PlausibleRange(0.0, 1.0, "", "the empty coupon's loss factor is "
                                            "0-1, metal sandwiches ~0.001-0.01",
                                            above="was it %?"),
+    # Coulomb coefficients of dry solids: ~0.05 (PTFE) to ~1.5 (clean metals in vacuum,
+    # rubber); 2 leaves room. A larger number is a percentage or an angle in degrees
+    "friction": PlausibleRange(0.0, 2.0, "", "a friction coefficient is 0-2, dry solids "
+                               "~0.05-1.5", above="was it % or an angle?",
+                               kind="a coefficient"),
+    # rolling resistance coefficients (torque / (R* F_n)): ~0.001 (steel balls) to ~0.3
+    # (rough or angular grains); 1 would resist rolling as a sphere's own lever arm does
+    "rolling_friction": PlausibleRange(0.0, 1.0, "", "a rolling friction coefficient is 0-1, "
+                                       "real spheres ~0.001-0.3", above="was it %?",
+                                       kind="a coefficient"),
 }
 #: Most coupon mass per coupon area (``[cell] count`` cells' cross-section), kg/m^2: a 127 mm
 #: steel plate. Sandwich panels weigh 1-20 kg/m^2 (the paper's 2.6); more is a mass in grams
@@ -161,8 +172,8 @@ def _plausible(where: str, key: str, value: float) -> None:
     if r.low <= value <= r.high:
         return
     hint = r.below if value < r.low else r.above
-    unit = {"m": "metres", "kg": "kilograms", "Pa": "pascals",
-            "": "a fraction"}.get(r.unit, r.unit)
+    unit = r.kind or {"m": "metres", "kg": "kilograms", "Pa": "pascals",
+                      "": "a fraction"}.get(r.unit, r.unit)
     shown = f"{as_given(value)} {r.unit}".rstrip()  # a ratio has no unit to show
     raise _fail(where, f"{shown}: expected {unit} ({r.what})" + (f"; {hint}" if hint else ""))
 
@@ -298,8 +309,11 @@ class PairSpec:
             raise _fail(f"{where} restitution",
                         f"expected 0 < e <= 1, got {self.restitution!r}")
         _non_negative(f"{where} sliding_friction", self.sliding_friction, "[-]")
+        _plausible(f"{where} sliding_friction", "friction", self.sliding_friction)
         _non_negative(f"{where} static_friction", self.static_friction, "[-]")
+        _plausible(f"{where} static_friction", "friction", self.static_friction)
         _non_negative(f"{where} rolling_friction", self.rolling_friction, "[-]")
+        _plausible(f"{where} rolling_friction", "rolling_friction", self.rolling_friction)
         _non_negative(f"{where} rolling_damping_ratio", self.rolling_damping_ratio, "[-]")
         if self.static_friction < self.sliding_friction:
             raise _fail(f"{where} static_friction",

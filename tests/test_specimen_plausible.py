@@ -60,6 +60,14 @@ def _edit(old: str, new: str, text: str = TEXT) -> str:
     ("baseline_loss_factor = 0.0", "baseline_loss_factor = 5.0",  # 5 % typed as 5
      r"\[coupon\] baseline_loss_factor: 5: expected a fraction \(the empty coupon's loss "
      r"factor is 0-1, .*\); was it %\?$"),
+    # 30 % or a friction angle of 30 degrees typed for the coefficient 0.3
+    ("sliding_friction = 0.3\n", "sliding_friction = 30.0\n",
+     r"\[pairs.particle_particle\] sliding_friction: 30: expected a coefficient .*was it % or "
+     r"an angle\?$"),
+    ("static_friction = 0.45", "static_friction = 45.0",
+     r"\[pairs.particle_wall\] static_friction: 45: expected a coefficient"),
+    ("rolling_friction = 0.01           #", "rolling_friction = 10.0           #",
+     r"\[pairs.particle_particle\] rolling_friction: 10: expected a coefficient .*was it %\?$"),
 ])
 def test_a_value_in_the_wrong_unit_is_refused_naming_key_value_unit_and_slip(old, new,
                                                                              message):
