@@ -336,3 +336,12 @@ def test_a_count_below_one_is_refused_as_dem_sweep_refuses_it(capsys, tmp_path, 
     assert stop.value.code == 2 and f"argument {option}: expected a whole number >= 1, got " \
         f"'{value}'" in err and len(err.strip().splitlines()) == 1
     assert not store.exists()
+
+
+def test_an_sdc_in_percent_is_refused_naming_its_line(capsys, tmp_path):
+    # 42 typed for 0.42 (an SDC in %) ran the whole calibration, exit 0, and only said the
+    # posterior piled against a prior bound. Above 2 pi (a loss factor of 1) is the bound the
+    # analysis' plausibility check uses (pidcore.compare.plausibility.SDC_UPPER_BOUND)
+    table = _table(tmp_path, HEADER + "500,5,50,0.6\n1000,5,50,42\n500,1,50,0.2\n")
+    _refused(capsys, tmp_path, ["--data", str(table)],
+             "m.csv, line 3: sdc 42 is above 6.283 (2 pi, a loss factor of 1")

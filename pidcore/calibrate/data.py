@@ -21,7 +21,8 @@ import numpy as np
 import pandas as pd
 
 from .. import defaults
-from ..errors import InputFileError, ParameterError
+from ..compare.plausibility import SDC_UPPER_BOUND
+from ..errors import InputFileError, ParameterError, as_given
 
 REQUIRED_COLUMNS = ("frequency_hz", "acceleration_g", "fill_percent", "sdc")
 OPTIONAL_COLUMNS = ("sdc_stderr", "energy_per_cycle_j", "material", "specimen")
@@ -102,6 +103,12 @@ def read_measured_table(path: str | os.PathLike, *,
             raise InputFileError(f"{where}: fill_percent must be in (0, 100]")
         if values["sdc"] < 0 or values["sdc_stderr"] < 0:
             raise InputFileError(f"{where}: sdc and sdc_stderr must be >= 0")
+        if values["sdc"] > SDC_UPPER_BOUND:
+            # a fit to it runs to the end and only says its posterior piles at a bound
+            raise InputFileError(
+                f"{where}: sdc {as_given(values['sdc'])} is above {SDC_UPPER_BOUND:.4g} (2 pi, "
+                "a loss factor of 1: more dissipated per radian than the coupon stores; "
+                "Table 3's largest is 0.88); expected the SDC as a ratio; was it %?")
         points.append(MeasuredPoint(material=_text_cell(row.get("material"), default_material),
                                     specimen=_text_cell(row.get("specimen"), ""),
                                     source=str(path), row=int(line), **values))
