@@ -351,3 +351,15 @@ def test_energy_check_calls_a_start_outside_only_beyond_its_own_uncertainty():
     # outside the 0.1 % resolution; 0.06 % above it: inside
     assert not within(0.2)
     assert within(0.05)
+
+
+def test_method_help_states_the_grid_limit_the_posterior_applies(capsys):
+    """`pidcore calibrate --help` said "exact grid (<= 3 quantities)" while auto picks the grid
+    for up to GRID_MAX_DIMENSIONS (4: three parameters plus the discrepancy)."""
+    from pidcore.calibrate.posterior import GRID_MAX_DIMENSIONS
+    from pidcore.cli import build_parser
+
+    with pytest.raises(SystemExit):
+        build_parser("calibrate").parse_args(["calibrate", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert f"exact grid (<= {GRID_MAX_DIMENSIONS} fitted quantities" in text, text
