@@ -363,3 +363,18 @@ def test_method_help_states_the_grid_limit_the_posterior_applies(capsys):
         build_parser("calibrate").parse_args(["calibrate", "--help"])
     text = " ".join(capsys.readouterr().out.split())
     assert f"exact grid (<= {GRID_MAX_DIMENSIONS} fitted quantities" in text, text
+
+
+def test_design_size_0_and_workers_0_are_refused_not_taken_as_defaults(capsys, tmp_path):
+    """`--design-size 0 --fit friction` silently ran the default 5-point design (60 DEM runs)
+    while 1 and -1 were refused; `--workers 0` was accepted where every other command's
+    --workers refuses it."""
+    table = _table(tmp_path)
+    _refused(capsys, tmp_path, ["--data", str(table), "--fit", "friction",
+                                "--design-size", "0"], "--design-size", "got 0")
+    with pytest.raises(SystemExit) as exited:
+        main(["calibrate", "--data", str(table), "--workers", "0",
+              "--dem-store", str(tmp_path / "dem.h5")])
+    assert exited.value.code == 2
+    assert "--workers" in capsys.readouterr().err
+    assert not (tmp_path / "dem.h5").exists()

@@ -7,7 +7,7 @@ import sys
 from pathlib import Path
 
 from .. import defaults, interrupt
-from ._options import check_out_folder, non_negative_int
+from ._options import check_out_folder, non_negative_int, positive_int
 
 DEFAULT_STORE = Path("calibration_store.h5")
 
@@ -51,7 +51,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help="DEM design points (default: enough for a quadratic surrogate)")
     p.add_argument("--seed", type=non_negative_int, default=defaults.DEM_SEED,
                    help="DEM seed")
-    p.add_argument("--workers", type=int, default=2, help="DEM processes (default 2)")
+    p.add_argument("--workers", type=positive_int, default=2, help="DEM processes (default 2)")
     p.add_argument("--method", choices=("auto", "grid", "emcee"), default="auto",
                    help="posterior: exact grid (<= 4 fitted quantities: 3 parameters plus "
                         "the discrepancy) or emcee; auto picks")
