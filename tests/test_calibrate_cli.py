@@ -378,3 +378,11 @@ def test_design_size_0_and_workers_0_are_refused_not_taken_as_defaults(capsys, t
     assert exited.value.code == 2
     assert "--workers" in capsys.readouterr().err
     assert not (tmp_path / "dem.h5").exists()
+
+
+def test_an_empty_data_table_suggests_the_measured_sdc_header(capsys, tmp_path):
+    """`pidcore calibrate --data empty.csv` suggested the sidecar's header
+    'file,fill_percent,velocity_delay_us' and "one row per file"."""
+    table = _table(tmp_path, text="# nothing yet\n")
+    _refused(capsys, tmp_path, ["--data", str(table)], "empty table",
+             "'frequency_hz,acceleration_g,fill_percent,sdc'", "one row per load case")
