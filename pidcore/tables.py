@@ -93,7 +93,9 @@ def header_cells(data: bytes) -> list[str]:
     return [c.strip().strip('"').strip() for c in cells]
 
 
-def read_text_table(data: bytes, where: str, *, numeric: Iterable[str] = ()) -> pd.DataFrame:
+def read_text_table(data: bytes, where: str, *, numeric: Iterable[str] = (),
+                    example: str = "file,fill_percent,velocity_delay_us",
+                    row: str = "file") -> pd.DataFrame:
     """Read a user-written table (see the module's conventions) as text cells.
 
     Parameters
@@ -105,6 +107,9 @@ def read_text_table(data: bytes, where: str, *, numeric: Iterable[str] = ()) -> 
     numeric : iterable of str
         Columns (lower-case header names) whose decimal commas are read as decimal points in a
         ``;``- or tab-separated table.
+    example, row : str
+        The header line an empty table's message suggests, and what one row stands for
+        (default: a sidecar / settings table's).
 
     Returns
     -------
@@ -123,7 +128,7 @@ def read_text_table(data: bytes, where: str, *, numeric: Iterable[str] = ()) -> 
     kept = _table_lines(decode_table(data))
     if not kept:
         raise InputFileError(f"{where}: empty table; expected a header line such as "
-                             "'file,fill_percent,velocity_delay_us' and one row per file")
+                             f"'{example}' and one row per {row}")
     separator = _separator(kept[0][1])
     reader = csv.reader((ln for _, ln in kept), delimiter=separator, skipinitialspace=True)
     rows: list[tuple[int, list[str]]] = []
@@ -177,8 +182,9 @@ def read_text_table(data: bytes, where: str, *, numeric: Iterable[str] = ()) -> 
     return table
 
 
-def read_text_table_file(path: str | os.PathLike[str], *,
-                         numeric: Iterable[str] = ()) -> pd.DataFrame:
+def read_text_table_file(path: str | os.PathLike[str], *, numeric: Iterable[str] = (),
+                         example: str = "file,fill_percent,velocity_delay_us",
+                         row: str = "file") -> pd.DataFrame:
     """:func:`read_text_table` of a file, named by its path (``InputFileError`` if missing)."""
     try:
         with open(path, "rb") as fh:
@@ -187,5 +193,5 @@ def read_text_table_file(path: str | os.PathLike[str], *,
         raise InputFileError(f"{path}: no such file") from None
     except IsADirectoryError:
         raise InputFileError(f"{path}: is a folder; expected a CSV table") from None
-    return read_text_table(data, str(path), numeric=numeric)
+    return read_text_table(data, str(path), numeric=numeric, example=example, row=row)
 

@@ -351,3 +351,38 @@ def test_energy_check_calls_a_start_outside_only_beyond_its_own_uncertainty():
     # outside the 0.1 % resolution; 0.06 % above it: inside
     assert not within(0.2)
     assert within(0.05)
+
+
+def test_method_help_states_the_grid_limit_the_posterior_applies(capsys):
+    """`pidcore calibrate --help` said "exact grid (<= 3 quantities)" while auto picks the grid
+    for up to GRID_MAX_DIMENSIONS (4: three parameters plus the discrepancy)."""
+    from pidcore.calibrate.posterior import GRID_MAX_DIMENSIONS
+    from pidcore.cli import build_parser
+
+    with pytest.raises(SystemExit):
+        build_parser("calibrate").parse_args(["calibrate", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert f"exact grid (<= {GRID_MAX_DIMENSIONS} fitted quantities" in text, text
+
+
+def test_design_size_0_and_workers_0_are_refused_not_taken_as_defaults(capsys, tmp_path):
+    """`--design-size 0 --fit friction` silently ran the default 5-point design (60 DEM runs)
+    while 1 and -1 were refused; `--workers 0` was accepted where every other command's
+    --workers refuses it."""
+    table = _table(tmp_path)
+    _refused(capsys, tmp_path, ["--data", str(table), "--fit", "friction",
+                                "--design-size", "0"], "--design-size", "got 0")
+    with pytest.raises(SystemExit) as exited:
+        main(["calibrate", "--data", str(table), "--workers", "0",
+              "--dem-store", str(tmp_path / "dem.h5")])
+    assert exited.value.code == 2
+    assert "--workers" in capsys.readouterr().err
+    assert not (tmp_path / "dem.h5").exists()
+
+
+def test_an_empty_data_table_suggests_the_measured_sdc_header(capsys, tmp_path):
+    """`pidcore calibrate --data empty.csv` suggested the sidecar's header
+    'file,fill_percent,velocity_delay_us' and "one row per file"."""
+    table = _table(tmp_path, text="# nothing yet\n")
+    _refused(capsys, tmp_path, ["--data", str(table)], "empty table",
+             "'frequency_hz,acceleration_g,fill_percent,sdc'", "one row per load case")

@@ -59,3 +59,18 @@ def test_errors_name_the_sub_command_and_its_action(capsys):
     with pytest.raises(SystemExit):
         console_main(["analyze", "--bogus", "x.csv"])
     assert capsys.readouterr().err.startswith("pidcore analyze: error: unrecognized")
+
+
+def test_bench_signal_with_too_few_samples_is_one_line_exit_2(capsys):
+    """`pidcore bench signal --samples 5` ended in a ValueError traceback (exit 1)."""
+    assert console_main(["bench", "signal", "--samples", "5"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--samples 5" in err[0] and "10000" in err[0], err
+
+
+def test_report_calibration_help_says_a_folder_is_taken_too(capsys):
+    """README: `--calibration DIR/calibration.json (of pidcore calibrate; or DIR)`; the help
+    named only the file, though `--calibration data_samples/paper_calibration` works."""
+    with pytest.raises(SystemExit):
+        console_main(["report", "--help"])
+    assert "(or the --out folder holding it)" in " ".join(capsys.readouterr().out.split())

@@ -151,3 +151,22 @@ def test_sweep_of_a_specimen_stores_its_runs_with_provenance_and_resumes(tmp_pat
     # the paper's coupon is another run: not skipped
     paper = run_sweep(CASES[:1], CONFIG, store_path=store_path, workers=1, progress=False)
     assert paper.completed == [run_key(CASES[0], CONFIG)]
+
+
+def test_an_unreachable_scheduler_is_one_line_exit_2_and_nothing_stored(tmp_path, capsys):
+    """`pidcore dem sweep --scheduler tcp://host:8786` with no scheduler there printed a
+    30-line dask traceback and exited 1 (the README: one line, exit code 2)."""
+    pytest.importorskip("distributed")
+    import dask
+
+    from pidcore.cli import main
+
+    store = tmp_path / "s.h5"
+    with dask.config.set({"distributed.comm.timeouts.connect": "2s"}):
+        code = main(["dem", "sweep", "--frequencies", "1000", "--accelerations", "5",
+                     "--fills", "25", "--cells", "1", "--cycles", "2", "--no-progress",
+                     "--scheduler", "tcp://127.0.0.1:1", "--store", str(store)])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2
+    assert len(err) == 1 and "--scheduler tcp://127.0.0.1:1" in err[0], err
+    assert not store.exists() or not Store(store).list_dem_runs().shape[0]

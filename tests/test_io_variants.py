@@ -563,6 +563,12 @@ def test_non_utf8_file_name_is_stored_escaped(tmp_path, capsys):
     assert record["source"].endswith("run_\\xff\\xfe.csv")
     assert any("not valid UTF-8" in n for n in record["notes"])
     assert store.exists()
+    # the text output names the file escaped on every line; its load-case line printed the
+    # raw bytes (surrogates) while the table and notes showed run_\xff\xfe.csv
+    code, out, _ = _cli([str(path), "--no-store"], capsys)
+    assert code == 0
+    assert "\\udc" not in ascii(out)
+    assert "run_\\xff\\xfe.csv: no fill stated" in out, out
 
 
 # --- 6. interruption and output -----------------------------------------------------------
@@ -669,3 +675,21 @@ def test_an_acceleration_channel_that_disagrees_with_the_velocity_is_noted(
     # the same record with its true labels: nothing to say
     result = analyze_file(write("m/s", "m/s^2"), AnalysisOptions())
     assert not [n for n in result.notes if "unit slip" in n]
+
+
+def test_report_of_a_non_utf8_file_name_writes_it_escaped(tmp_path, capsys):
+    """`pidcore report` of a file whose name is not UTF-8 ended in a matplotlib traceback
+    (exit 1): the loop figure's title held the name's raw bytes (surrogates)."""
+    rec = _record(n_periods=12)
+    path = Path(tmp_path, os.fsdecode(b"run_\xe9_fill50_acrylic.csv"))
+    write_measurement(Measurement("x", (Channel("Force", "force", rec.force_n, FS, "N"),
+                                        Channel("Velocity", "velocity", rec.velocity_m_s, FS,
+                                                "m/s"))), path, "csv")
+    out = tmp_path / "rep"
+    assert main(["report", str(path), "--store", str(tmp_path / "s.h5"), "--out", str(out),
+                 "--format", "csv"]) == 0
+    printed = capsys.readouterr().out
+    assert "run_\\xe9_fill50_acrylic.csv: load case" in printed
+    provenance = (out / "report.provenance.txt").read_text(encoding="utf-8")
+    assert "input: run_\\xe9_fill50_acrylic.csv sha256" in provenance
+    assert "\\udc" not in ascii(printed + provenance)

@@ -267,3 +267,20 @@ def test_as_given_keeps_short_numbers_short_and_long_ones_whole():
     assert [as_given(v) for v in (5.0, 0.05, 3400.0, 1e-7)] == ["5", "0.05", "3400", "1e-07"]
     assert as_given(1.0000001) == "1.0000001" and as_given(100.0000001) == "100.0000001"
     assert float(as_given(0.1 + 0.2)) == 0.1 + 0.2  # reads back to the same float
+
+
+def test_check_help_says_inline_properties_override_a_table_material(tmp_path, capsys):
+    """`pidcore specimen check --help` listed "one whose inline properties differ from the
+    table's" among the refusals, while such a file is accepted (exit 0) with a note per
+    overriding value, as the README says."""
+    with pytest.raises(SystemExit):
+        main(["specimen", "check", "--help"])
+    helptext = " ".join(capsys.readouterr().out.split())
+    path = tmp_path / "alu.toml"
+    text = STEEL.read_text(encoding="utf-8")
+    path.write_text(text.replace('material = "steel"', 'material = "aluminium"'),
+                    encoding="utf-8")
+    assert main(["specimen", "check", str(path)]) == 0
+    assert "overrides 2850 of table material 'aluminium'" in capsys.readouterr().out
+    assert "one whose inline properties differ from the table's)" not in helptext
+    assert "keeps them" in helptext

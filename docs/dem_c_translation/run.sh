@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# The C translation of the DEM kernel against Numba on the four bench beds (docs/README.md
-# beside this file). Run from anywhere; takes ~2 minutes on 2 cores. Needs gcc (clang-14 too,
+# The C translation of the DEM kernel against Numba on the four bench beds (README.md
+# beside this file). Run from anywhere; takes ~40 s on 2 cores. Needs gcc (clang-14 too,
 # if installed) and the project installed or on PYTHONPATH.
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"

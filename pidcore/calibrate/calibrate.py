@@ -301,7 +301,7 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: Sequence[str],
         notes.append(f"--design-size {design_size} ignored: no DEM parameter is fitted, so "
                      "each load case needs one DEM run")
         design_size = None
-    n_design = design_size or default_design_size(len(dem_specs))
+    n_design = default_design_size(len(dem_specs)) if design_size is None else design_size
     if dem_specs and n_design < 2:
         raise ParameterError(f"--design-size: expected >= 2 with DEM parameters, got {n_design}")
     design = design_points(dem_specs, n_design, seed=seed)

@@ -76,7 +76,8 @@ def read_measured_table(path: str | os.PathLike, *,
         raise InputFileError(f"{path}: no such file")
     # the reader of the sidecar tables: ',' / ';' / tab with a decimal comma, UTF-8 or
     # Latin-1, '#' lines are comments, rows named by their line in the file
-    frame = read_text_table_file(path, numeric=(*REQUIRED_COLUMNS, *OPTIONAL_COLUMNS))
+    frame = read_text_table_file(path, numeric=(*REQUIRED_COLUMNS, *OPTIONAL_COLUMNS),
+                                 example=",".join(REQUIRED_COLUMNS), row="load case")
     missing = [c for c in REQUIRED_COLUMNS if c not in frame.columns]
     if missing:
         raise InputFileError(f"{path}: missing column(s) {', '.join(missing)}; expected "

@@ -10,6 +10,7 @@ from pathlib import Path
 from .. import interrupt
 from ..errors import PidcoreError
 from ..file_settings import analyze_with_settings
+from ..io import display_path
 from ..measure import NO_LOAD_CASE
 from ._options import (
     add_json_option,
@@ -149,7 +150,7 @@ def _print_results(args: argparse.Namespace, results: list, cases: list, stated:
     print(format_table(results))
     for path, c, st, fs in zip(args.paths, cases, stated, settings, strict=True):
         said = fs.summary()
-        print(f"{Path(path).name}: " + (f"load case {c.key} ({st.origin})" if c else
+        print(f"{display_path(Path(path).name)}: " + (f"load case {c.key} ({st.origin})" if c else
               "no fill stated: saved without a load case (state it in the file name, "
               "a sidecar or --fill for `pidcore report --store` to place it)"
               if not args.no_store else "no fill stated") + (f"; {said}" if said else ""))

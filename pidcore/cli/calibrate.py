@@ -54,7 +54,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--workers", metavar="N", type=positive_int, default=2,
                    help="DEM processes (default 2)")
     p.add_argument("--method", choices=("auto", "grid", "emcee"), default="auto",
-                   help="posterior: exact grid (<= 3 quantities) or emcee; auto picks")
+                   help="posterior: exact grid (<= 4 fitted quantities: 3 parameters plus "
+                        "the discrepancy) or emcee; auto picks")
     p.add_argument("--dem-store", metavar="FILE", type=Path, default=DEFAULT_STORE,
                    help="HDF5 store caching the DEM runs (default %(default)s)")
     p.add_argument("--cross-validate", choices=("loo",), default=None,

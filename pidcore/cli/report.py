@@ -65,8 +65,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         "different specimens at one load case into one row (default: a row "
                         "each)")
     p.add_argument("--calibration", metavar="FILE", type=Path, default=None,
-                   help="calibration.json of pidcore calibrate: add the calibrated DEM's Eq. 11 "
-                        "SDC with its 95 %% band beside the raw DEM and the measurement")
+                   help="calibration.json of pidcore calibrate (or the --out folder holding "
+                        "it): add the calibrated DEM's Eq. 11 SDC with its 95 %% band beside the "
+                        "raw DEM and the measurement")
     add_measurement_options(p)
     p.set_defaults(func=run)
 

@@ -21,8 +21,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         description="Validate FILE (one-line error, exit 2, on a missing or unknown key, a "
                     "negative mass, a value outside its plausible range (a unit slip), "
                     "particles that do not fit, a fill of no particle, static below sliding "
-                    "friction, an unknown material or one whose inline properties differ "
-                    "from the table's) and print what follows from it.")
+                    "friction or an unknown material) and print what follows from it; a "
+                    "table material with inline properties that differ from the table's keeps "
+                    "them, and a note names each value that overrides the table's.")
     check.add_argument("file", metavar="FILE", type=Path, help="specimen TOML file")
     add_json_option(check)
     check.set_defaults(func=run_check)

@@ -416,7 +416,12 @@ def _run_dask(todo: Iterable[tuple[LoadCase, str]], config: DemConfig, scheduler
     except ImportError:
         raise ParameterError("--scheduler needs dask.distributed: "
                              "pip install 'pidcore[distributed]'") from None
-    client = Client(scheduler)
+    try:
+        client = Client(scheduler)
+    except (OSError, ValueError) as exc:  # refused, timed out (OSError), or a bad address
+        raise ParameterError(f"--scheduler {scheduler}: cannot connect to a dask.distributed "
+                             f"scheduler there ({' '.join(str(exc).split())}); expected the "
+                             f"address of a running scheduler, e.g. tcp://host:8786") from None
     try:
         futures = [client.submit(run_case, case, config, specimen, key=f"pidcore-{key}",
                                  pure=False)

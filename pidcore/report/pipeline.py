@@ -27,6 +27,7 @@ from ..compare.align import Aligner, Tolerances
 from ..compare.loadcase import LoadCase, StatedLoadCase
 from ..constants import REPORT_FORMATS
 from ..errors import ParameterError, StoreError
+from ..io import display_path
 from ..loadcase import refuse_identical_contents_stating_apart
 from .provenance import collect_provenance
 from .render import check_out_dir, parse_formats, write_report
@@ -230,7 +231,7 @@ def _measured_loops(results: list[MeasuredResult], analyses: pd.DataFrame, store
     from .comparison_figures import loop_from_phasors
 
     if results:
-        return [(r.path.name, r.load_case, r.analysis.loop())
+        return [(display_path(r.path.name), r.load_case, r.analysis.loop())
                 for r in results]
     loops = []
     if store is None or analyses.empty or "key" not in analyses.columns:
@@ -507,7 +508,7 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
     notes: list[str] = []
     for r in results:
         said = r.settings.summary() if r.settings is not None else ""
-        notes.append(f"{r.path.name}: load case {r.load_case.key} ({r.stated.origin})"
+        notes.append(f"{display_path(r.path.name)}: load case {r.load_case.key} ({r.stated.origin})"
                      + (f"; {said}" if said else ""))
         if r.settings is not None:
             notes.extend(r.settings.notes)
@@ -517,11 +518,12 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
             if specimen is not None and named and named != specimen.name:
                 # the sidecar's specimen is the file's (as an app upload's is kept): it meets
                 # only DEM runs of that name, not the --specimen's
-                notes.append(f"{r.path.name}: its sidecar row names specimen {named!r}, not "
-                             f"{specimen.name!r} of --specimen; compared as {named!r}")
+                notes.append(f"{display_path(r.path.name)}: its sidecar row names specimen "
+                             f"{named!r}, not {specimen.name!r} of --specimen; compared as "
+                             f"{named!r}")
     if len(results) < len(files):
         kept = {r.path for r in results}
-        notes += [f"{f.name}: identical contents to another file given; counted once"
+        notes += [f"{display_path(f.name)}: identical contents to another file given; counted once"
                   for f in files if f not in kept]
     if main is not None and results:
         # Same entry as `pidcore analyze` for the same file and options (replaced, not

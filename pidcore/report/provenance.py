@@ -10,6 +10,8 @@ from datetime import UTC, datetime
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
 
+from ..io import display_path
+
 #: Packages whose versions every report lists.
 PROVENANCE_PACKAGES: tuple[str, ...] = ("numpy", "scipy", "numba", "pandas", "matplotlib", "h5py")
 
@@ -121,7 +123,7 @@ def collect_provenance(*, parameters: Mapping[str, object] | None = None,
     hashed_inputs = []
     for path in inputs:
         digest = input_hashes.get(str(path)) or sha256_file(path)
-        hashed_inputs.append((Path(path).name, digest))
+        hashed_inputs.append((display_path(Path(path).name), digest))
     hashed_stores = tuple((str(p), sha256_file(p)) for p in dict.fromkeys(map(str, stores)))
     stamp = (created_utc or datetime.now(UTC)).astimezone(UTC)
     return Provenance(versions=versions, parameters=dict(parameters or {}),
