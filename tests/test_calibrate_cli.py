@@ -370,13 +370,22 @@ def test_design_size_0_and_workers_0_are_refused_not_taken_as_defaults(capsys, t
     while 1 and -1 were refused; `--workers 0` was accepted where every other command's
     --workers refuses it."""
     table = _table(tmp_path)
-    _refused(capsys, tmp_path, ["--data", str(table), "--fit", "friction",
-                                "--design-size", "0"], "--design-size", "got 0")
-    with pytest.raises(SystemExit) as exited:
-        main(["calibrate", "--data", str(table), "--workers", "0",
-              "--dem-store", str(tmp_path / "dem.h5")])
-    assert exited.value.code == 2
-    assert "--workers" in capsys.readouterr().err
+    for option in (["--fit", "friction", "--design-size", "0"], ["--workers", "0"]):
+        with pytest.raises(SystemExit) as exited:  # argparse's one line, as from the shell
+            main(["calibrate", "--data", str(table), *option,
+                  "--dem-store", str(tmp_path / "dem.h5")])
+        assert exited.value.code == 2
+        assert f"argument {option[-2]}: expected a whole number >= 1, got '0'" in \
+            capsys.readouterr().err
+        assert not (tmp_path / "dem.h5").exists()
+    # the library too: 0 is not "the default design"
+    from pidcore.calibrate.data import read_measured_table
+    from pidcore.errors import ParameterError
+
+    with pytest.raises(ParameterError, match="--design-size: expected >= 2 with DEM "
+                                             "parameters, got 0"):
+        calibrate(read_measured_table(table), fit=["friction"], design_size=0,
+                  store_path=tmp_path / "dem.h5")
     assert not (tmp_path / "dem.h5").exists()
 
 
