@@ -373,7 +373,7 @@ class Specimen:
             check_sphere_fits(geometry, r)
         except ParameterError as exc:
             raise _fail("[particles] radius_m", str(exc)) from None
-        area = self.cell.count * geometry.volume_m3() / self.cell.height_m
+        area = self.cells_area_m2(geometry)
         if self.coupon.mass_kg / area > MAX_COUPON_AREAL_MASS_KG_M2:
             raise _fail("[coupon] mass_kg",
                         f"{as_given(self.coupon.mass_kg)} kg on {self.cell.count} cells "
@@ -498,6 +498,13 @@ class Specimen:
         return self.hash in paper_hashes()
 
     # --- what follows from it ------------------------------------------------------------
+
+    def cells_area_m2(self, geometry=None) -> float:
+        """Cross-section of the coupon's ``[cell] count`` cells, m^2 (count x one cell's
+        hexagon across the flats): the coupon's face area as far as its cells go.
+        ``geometry``: :meth:`geometry`, where the caller has it."""
+        geometry = geometry or self.geometry()
+        return self.cell.count * geometry.volume_m3() / self.cell.height_m
 
     def capacity_per_cell(self) -> int:
         """Spheres one cell holds (dense drop packing, :func:`pidcore.dem.cell_capacity`)."""

@@ -155,20 +155,15 @@ def coupon_area_m2(side_m: float = D.COUPON_SIDE_M) -> float:
 AREA_TO_CELLS_LIMIT = 100.0
 
 
-def cells_area_m2(specimen) -> float:
-    """Cross-section [m^2] of a specimen's ``[cell] count`` cells (count x hexagon across the
-    flats), as ``pidcore specimen check`` takes the coupon area in its mass check."""
-    return specimen.cell.count * specimen.geometry().volume_m3() / specimen.cell.height_m
-
-
 def runs_specimen(runs: pd.DataFrame):
     """The specimen of DEM runs (its canonical text, stored with each run), None where the
     runs hold none (an older store) or several."""
+    from ..compare.align import stored_parameters
     from ..specimen import Specimen
 
     if "parameters_json" not in runs.columns or runs.empty:
         return None
-    texts = {json.loads(p).get("specimen_text") for p in runs["parameters_json"].dropna()}
+    texts = {(stored_parameters(p) or {}).get("specimen_text") for p in runs["parameters_json"]}
     if len(texts) != 1 or None in texts:
         return None
     return Specimen.from_text(texts.pop(), source="stored DEM runs")
@@ -177,7 +172,7 @@ def runs_specimen(runs: pd.DataFrame):
 def check_area(area_m2: float, specimen, what: str = "area_m2") -> None:
     """Refuse a coupon area more than :data:`AREA_TO_CELLS_LIMIT` times off the cross-section
     of ``specimen``'s cells as a unit slip (``what``: the option as messages name it)."""
-    cells = cells_area_m2(specimen)
+    cells = specimen.cells_area_m2()
     ratio = float(area_m2) / cells
     if 1.0 / AREA_TO_CELLS_LIMIT <= ratio <= AREA_TO_CELLS_LIMIT:
         return
