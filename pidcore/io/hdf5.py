@@ -21,7 +21,9 @@ from .hdf5_layout import LAYOUT_TAG, read_measurement_group, write_measurement_g
 MEASUREMENTS_GROUP = "measurements"
 
 
-def _is_measurement(group: h5py.Group) -> bool:
+def _is_measurement(group: h5py.Group | None) -> bool:
+    if not isinstance(group, h5py.Group):  # a dataset, or None for a soft link to nothing
+        return False
     tag = group.attrs.get("pidcore_layout", "")
     return (tag.decode() if isinstance(tag, bytes) else str(tag)) == LAYOUT_TAG
 
@@ -48,7 +50,7 @@ def hdf5_keys(path: str | os.PathLike[str]) -> list[str]:
                 return [""]
             group = h5.get(MEASUREMENTS_GROUP)
             if isinstance(group, h5py.Group):
-                keys = sorted(k for k in group if _is_measurement(group[k]))
+                keys = sorted(k for k in group if _is_measurement(group.get(k)))
                 if keys:
                     return keys
             holds = _contents(h5)
@@ -62,7 +64,7 @@ def hdf5_keys(path: str | os.PathLike[str]) -> list[str]:
 def _contents(h5: h5py.File) -> str:
     """What a file without measurements holds, for the message: ``48 dem_runs, ...``."""
     parts = [f"{len(item)} {name}" if isinstance(item, h5py.Group) else name
-             for name, item in h5.items()]
+             for name, item in ((name, h5.get(name)) for name in h5)]
     nonempty = [p for p in parts if not p.startswith("0 ")]
     return ", ".join(nonempty) if nonempty else "nothing"
 

@@ -1,0 +1,97 @@
+"""Hostile and broken measurement files: every one is refused with one line naming the file and
+what was expected (an InputFileError, exit code 2 in the CLI), never a traceback and never a
+number computed from samples the file does not hold (complex parts dropped, a matrix flattened).
+"""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+
+from pidcore.cli import main
+from pidcore.errors import InputFileError
+from pidcore.io import read_measurement
+
+SAMPLE_H5 = (Path(__file__).resolve().parents[1] / "data_samples" / "exports"
+             / "synthetic_f1000Hz_a5g_fill50_acrylic.h5")
+
+
+def _replace_channel(h5: h5py.File, make) -> None:
+    """Replace the velocity channel ``/channels/001`` by ``make(channels, samples)``, keeping
+    its attributes."""
+    channels = h5["channels"]
+    attrs, samples = dict(channels["001"].attrs), channels["001"][()]
+    del channels["001"]
+    new = make(channels, samples)
+    for name, value in attrs.items():
+        new.attrs[name] = value
+
+
+def _enum(ch, v):
+    return ch.create_dataset("001", data=np.zeros(v.size, "i1"),
+                             dtype=h5py.enum_dtype({"A": 0, "B": 1}, basetype="i1"))
+
+
+def _refs(ch, v):
+    ds = ch.create_dataset("001", (10,), dtype=h5py.ref_dtype)
+    for i in range(10):
+        ds[i] = ch["000"].ref
+    return ds
+
+
+def _set_attr(name, value):
+    def edit(h5):
+        h5["channels"]["001"].attrs[name] = value
+    return edit
+
+
+HOSTILE_HDF5 = {
+    "complex": (lambda h5: _replace_channel(
+        h5, lambda ch, v: ch.create_dataset("001", data=v * (1 + 1j))), "complex numbers"),
+    "matrix": (lambda h5: _replace_channel(
+        h5, lambda ch, v: ch.create_dataset("001", data=np.stack([v, v]))), "shape (2, "),
+    "text": (lambda h5: _replace_channel(
+        h5, lambda ch, v: ch.create_dataset("001", data=np.array([b"abc"] * 99))), "text"),
+    "compound": (lambda h5: _replace_channel(
+        h5, lambda ch, v: ch.create_dataset("001", data=np.zeros(
+            v.size, [("re", "f8"), ("im", "f8")]))), "compound"),
+    "enum": (lambda h5: _replace_channel(h5, _enum), "enumerated"),
+    "references": (lambda h5: _replace_channel(h5, _refs), "references"),
+    "vlen": (lambda h5: _replace_channel(h5, lambda ch, v: ch.create_dataset(
+        "001", (3,), dtype=h5py.vlen_dtype("f8"))), "variable-length"),
+    "no samples": (lambda h5: _replace_channel(
+        h5, lambda ch, v: ch.create_dataset("001", (0,), "f8")), "holds no samples"),
+    "rate text": (_set_attr("sample_rate_hz", "fast"), "sample_rate_hz is 'fast'"),
+    "rate nan": (_set_attr("sample_rate_hz", np.nan), "sample_rate_hz is"),
+    "rate array": (_set_attr("sample_rate_hz", np.array([1.0, 2.0])), "sample_rate_hz is"),
+    "start inf": (_set_attr("start_time_s", np.inf), "start_time_s is"),
+    "dangling soft link": (lambda h5: h5["channels"].__setitem__(
+        "003", h5py.SoftLink("/nowhere")), "a link to nothing"),
+    "group as channel": (lambda h5: h5["channels"].create_group("003"), "is a group"),
+    "channels a dataset": (lambda h5: (h5.__delitem__("channels"),
+                                       h5.create_dataset("channels", data=np.arange(5))),
+                           "not a pidcore measurement group"),
+    "metadata a list": (lambda h5: h5.attrs.__setitem__("metadata_json", "[1, 2]"),
+                        "expected a JSON object"),
+    "reader notes a number": (lambda h5: h5.attrs.__setitem__(
+        "metadata_json", '{"reader_notes": 5}'), "reader_notes"),
+}
+
+
+@pytest.mark.parametrize("case", list(HOSTILE_HDF5))
+def test_hostile_hdf5_channel_is_one_line_error(tmp_path, capsys, case):
+    edit, expected = HOSTILE_HDF5[case]
+    path = tmp_path / "upload.h5"
+    shutil.copy(SAMPLE_H5, path)
+    with h5py.File(path, "r+") as h5:
+        edit(h5)
+    with pytest.raises(InputFileError, match="upload.h5") as info:
+        read_measurement(path)
+    assert expected in str(info.value)
+    assert main(["analyze", str(path), "--no-store"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and expected in err and "--sample-rate" not in err
