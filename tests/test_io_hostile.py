@@ -95,3 +95,90 @@ def test_hostile_hdf5_channel_is_one_line_error(tmp_path, capsys, case):
     assert main(["analyze", str(path), "--no-store"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and expected in err and "--sample-rate" not in err
+
+
+# --- MATLAB ------------------------------------------------------------------------------------
+
+_FS = 25600.0
+_T = np.arange(2560) / _FS
+_F = np.sin(2 * np.pi * 100 * _T)
+_V = 0.01 * np.cos(2 * np.pi * 100 * _T)
+
+
+def _pidcore_mat(force_data=_F, rate=_FS):
+    scipy_io = pytest.importorskip("scipy.io")
+    cells = np.array([{"name": "Force", "quantity": "force", "data": force_data,
+                       "sample_rate_hz": rate},
+                      {"name": "Velocity", "quantity": "velocity", "data": _V,
+                       "sample_rate_hz": _FS}], dtype=object)
+    return lambda path: scipy_io.savemat(path, {"pidcore_layout": "measurement",
+                                                "pidcore_channels": cells})
+
+
+def _lms_mat(values, **x_values):
+    scipy_io = pytest.importorskip("scipy.io")
+    signal = {"x_values": {"start_value": 0.0, "increment": 1 / _FS, **x_values},
+              "y_values": {"values": values, "quantity": {"unit": "N"}}}
+    return lambda path: scipy_io.savemat(path, {"Signal": signal})
+
+
+def _simple_mat(**variables):
+    scipy_io = pytest.importorskip("scipy.io")
+    return lambda path: scipy_io.savemat(path, {"Force": _F, "Velocity": _V, **variables})
+
+
+def _v73(edit):
+    def write(path):
+        with h5py.File(path, "w", userblock_size=512) as h5:
+            for name, data in (("time", _T), ("Force", _F), ("Velocity", _V)):
+                h5[name] = data
+                h5[name].attrs["MATLAB_class"] = np.bytes_("double")
+            edit(h5)
+        with open(path, "r+b") as fh:
+            fh.write(b"MATLAB 7.3 MAT-file".ljust(128))
+    return write
+
+
+def _self_reference(h5):
+    ds = h5.create_dataset("c", (1,), dtype=h5py.ref_dtype)
+    ds[0] = ds.ref
+
+
+def _bad_char(h5):
+    h5["name"] = np.array([0x110000, 65], dtype="u4")
+    h5["name"].attrs["MATLAB_class"] = np.bytes_("char")
+
+
+HOSTILE_MAT = {
+    # complex samples: the imaginary part was dropped and an SDC printed (exit 0)
+    "pidcore layout complex": (_pidcore_mat(_F * (1 + 1j)), "complex numbers"),
+    # a matrix in one channel was flattened into one record and analysed (exit 0)
+    "pidcore layout matrix": (_pidcore_mat(np.c_[_F, _F]), "expected one vector"),
+    "pidcore layout text": (_pidcore_mat("abc"), "samples are text"),
+    "pidcore layout rate nan": (_pidcore_mat(rate=np.nan), "field sample_rate_hz is nan"),
+    "Test.Lab complex": (_lms_mat(np.c_[_F, _V] * (1 + 1j)), "complex numbers"),
+    "Test.Lab negative count": (_lms_mat(np.c_[_F, _V], number_of_values=-3),
+                                "number_of_values is -3"),
+    "Test.Lab start inf": (_lms_mat(np.c_[_F, _V], start_value=np.inf), "start_value is inf"),
+    "rate text": (_simple_mat(fs="fast"), "variable fs is 'fast'"),
+    "rate nan": (_simple_mat(fs=np.nan), "variable fs is nan"),
+    "v7.3 reference to itself": (_v73(_self_reference), "deeper than"),
+    "v7.3 null reference": (_v73(lambda h5: h5.create_dataset("c", (1,), dtype=h5py.ref_dtype)),
+                            "invalid reference"),
+    "v7.3 char out of range": (_v73(_bad_char), "no characters"),
+    "v7.3 dangling soft link": (_v73(lambda h5: h5.__setitem__("s", h5py.SoftLink("/nowhere"))),
+                                "link to nothing"),
+}
+
+
+@pytest.mark.parametrize("case", list(HOSTILE_MAT))
+def test_hostile_mat_is_one_line_error(tmp_path, capsys, case):
+    write, expected = HOSTILE_MAT[case]
+    path = tmp_path / "upload.mat"
+    write(path)
+    with pytest.raises(InputFileError, match="upload.mat") as info:
+        read_measurement(path)
+    assert expected in str(info.value)
+    assert main(["analyze", str(path), "--no-store"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and expected in err and "--sample-rate" not in err
