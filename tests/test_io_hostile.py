@@ -182,3 +182,44 @@ def test_hostile_mat_is_one_line_error(tmp_path, capsys, case):
     assert main(["analyze", str(path), "--no-store"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and expected in err and "--sample-rate" not in err
+
+
+# --- whatever a reader lets out ----------------------------------------------------------------
+
+
+@pytest.mark.parametrize("error", [ValueError("could not convert"), KeyError("component"),
+                                   RecursionError("maximum recursion depth"),
+                                   TypeError("float() argument")])
+def test_an_exception_a_reader_lets_out_is_one_line_naming_the_file(tmp_path, capsys,
+                                                                     monkeypatch, error):
+    """Readers check what they know of; a case they miss must still be a one-line error (exit
+    2) naming the file, not a traceback (exit 1)."""
+    import pidcore.io as io
+
+    def broken_reader(path, **kwargs):
+        raise error
+
+    path = tmp_path / "run.csv"
+    path.write_text("Time [s],Force [N]\n0,1\n")
+    monkeypatch.setattr(io, "read_csv", broken_reader)
+    with pytest.raises(InputFileError, match=r"run\.csv: not a readable csv measurement file"):
+        read_measurement(path)
+    assert main(["analyze", str(path), "--no-store"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "run.csv" in err and type(error).__name__ in err
+
+
+def test_ctrl_c_inside_a_reader_stays_an_interruption(tmp_path, monkeypatch):
+    import pidcore.io as io
+
+    def interrupted(path, **kwargs):
+        try:
+            raise KeyboardInterrupt
+        except KeyboardInterrupt:
+            raise Exception("pyuff wraps it") from None  # noqa: TRY002 (as pyuff does)
+
+    path = tmp_path / "run.csv"
+    path.write_text("Time [s],Force [N]\n0,1\n")
+    monkeypatch.setattr(io, "read_csv", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        read_measurement(path)
