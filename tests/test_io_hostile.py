@@ -102,7 +102,7 @@ def test_hostile_hdf5_channel_is_one_line_error(tmp_path, capsys, case):
 _FS = 25600.0
 _T = np.arange(2560) / _FS
 _F = np.sin(2 * np.pi * 100 * _T)
-_V = 0.01 * np.cos(2 * np.pi * 100 * _T)
+_V = 0.01 * np.sin(2 * np.pi * 100 * _T - 1.2)
 
 
 def _pidcore_mat(force_data=_F, rate=_FS):
@@ -223,3 +223,23 @@ def test_ctrl_c_inside_a_reader_stays_an_interruption(tmp_path, monkeypatch):
     monkeypatch.setattr(io, "read_csv", interrupted)
     with pytest.raises(KeyboardInterrupt):
         read_measurement(path)
+
+
+# --- numbers the analysis cannot square ----------------------------------------------------------
+
+
+@pytest.mark.parametrize("velocity_scale", [1.0, 1e306])
+def test_samples_beyond_any_physical_value_are_refused_not_overflowed(tmp_path, capsys,
+                                                                      velocity_scale):
+    """A CSV of finite but absurd values (1e306 N) overflowed the products of the analysis:
+    it was refused as an inverted channel (Im(P_c) <= 0), or, with both columns that large,
+    the spectrum's squares became NaN and it ended in a traceback ('cannot convert float NaN
+    to integer')."""
+    rows = "\n".join(f"{t:.17g},{f * 1e306:.17g},{v * velocity_scale:.17g}"
+                     for t, f, v in zip(_T, _F, _V, strict=True))
+    path = tmp_path / "huge.csv"
+    path.write_text("Time [s],Force [N],Velocity [m/s]\n" + rows + "\n")
+    assert main(["analyze", str(path), "--no-store"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1
+    assert "huge.csv: channel 'Force'" in err and "above 1e+100" in err
