@@ -5,7 +5,10 @@ number computed from samples the file does not hold (complex parts dropped, a ma
 
 from __future__ import annotations
 
+import os
 import shutil
+import subprocess
+import sys
 from pathlib import Path
 
 import h5py
@@ -243,3 +246,51 @@ def test_samples_beyond_any_physical_value_are_refused_not_overflowed(tmp_path, 
     err = capsys.readouterr().err
     assert err.count("\n") == 1
     assert "huge.csv: channel 'Force'" in err and "above 1e+100" in err
+
+
+# --- a CSV of one enormous line ------------------------------------------------------------------
+
+
+def test_a_line_longer_than_any_row_is_refused_before_pandas_buffers_it(tmp_path):
+    """A CSV with one 40 MiB line (500 MB in the report) was tokenised whole by pandas,
+    holding ~3.3x the file in memory (1.6 GB for 500 MB) before its 'Expected 3 fields'
+    error; the line is now found by a streaming scan and refused naming it."""
+    path = tmp_path / "one_line.csv"
+    with open(path, "w", encoding="ascii") as fh:
+        fh.write("Time [s],Force [N],Velocity [m/s]\n")
+        fh.writelines(f"{i / 1000!r},{i % 7},{i % 5}\n" for i in range(200))
+        chunk = "0.1,0.2,0.3," * 10_000
+        fh.writelines(chunk for _ in range(40 * 2**20 // len(chunk)))
+        fh.write("\n")
+    script = (
+        "import sys\n"
+        "import numpy, pandas, pidcore.io\n"
+        "def hwm():\n"
+        "    for line in open('/proc/self/status'):\n"
+        "        if line.startswith('VmHWM:'):\n"
+        "            return int(line.split()[1]) * 1024\n"
+        "base = hwm()\n"
+        "try:\n"
+        "    pidcore.io.read_measurement(sys.argv[1])\n"
+        "except pidcore.errors.InputFileError as exc:\n"
+        "    print(hwm() - base, exc)\n")
+    env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[1])}
+    out = subprocess.run([sys.executable, "-c", script, str(path)], capture_output=True,
+                         text=True, env=env, check=True).stdout
+    grown, message = out.split(" ", 1)
+    assert int(grown) < path.stat().st_size / 4, (grown, path.stat().st_size, message)
+    assert "one_line.csv: line 202 is longer than 16 MiB" in message
+
+
+def test_long_files_of_ordinary_lines_pass_the_line_scan(tmp_path):
+    """The scan runs only on files above the limit; LF, CRLF and CR files of short lines pass,
+    and the line named is counted in the file's own line breaks."""
+    from pidcore.io import delimited
+
+    for newline in ("\n", "\r\n", "\r"):
+        path = tmp_path / "rows.csv"
+        path.write_bytes(("1,2,3" + newline).encode() * (4 * 2**20))  # 24-28 MiB
+        delimited._check_line_lengths(path, "rows.csv")
+        path.write_bytes(("1,2,3" + newline).encode() * 10 + b"9" * (17 * 2**20))
+        with pytest.raises(InputFileError, match="rows.csv: line 11 is longer than 16 MiB"):
+            delimited._check_line_lengths(path, "rows.csv")
