@@ -46,6 +46,15 @@ def _refs(ch, v):
     return ds
 
 
+def _plugin_filter(ch, v):
+    """The samples in chunks that declare filter 32099 (no such filter is built in): reading
+    them makes HDF5 search its plugin directories for a library to load."""
+    ds = ch.create_dataset("001", v.shape, "f8", chunks=v.shape, compression=32099,
+                           allow_unknown_filter=True)
+    ds.id.write_direct_chunk((0,), np.ascontiguousarray(v, "<f8").tobytes(), filter_mask=0)
+    return ds
+
+
 def _set_attr(name, value):
     def edit(h5):
         h5["channels"]["001"].attrs[name] = value
@@ -63,6 +72,8 @@ HOSTILE_HDF5 = {
         h5, lambda ch, v: ch.create_dataset("001", data=np.zeros(
             v.size, [("re", "f8"), ("im", "f8")]))), "compound"),
     "enum": (lambda h5: _replace_channel(h5, _enum), "enumerated"),
+    "plugin filter": (lambda h5: _replace_channel(h5, _plugin_filter),
+                      "HDF5 filter 32099, which is not built in"),
     "references": (lambda h5: _replace_channel(h5, _refs), "references"),
     "vlen": (lambda h5: _replace_channel(h5, lambda ch, v: ch.create_dataset(
         "001", (3,), dtype=h5py.vlen_dtype("f8"))), "variable-length"),
