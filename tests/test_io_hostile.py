@@ -305,3 +305,26 @@ def test_long_files_of_ordinary_lines_pass_the_line_scan(tmp_path):
         path.write_bytes(("1,2,3" + newline).encode() * 10 + b"9" * (17 * 2**20))
         with pytest.raises(InputFileError, match="rows.csv: line 11 is longer than 16 MiB"):
             delimited._check_line_lengths(path, "rows.csv")
+
+
+# --- UFF ---------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("count", ["-5120", "    0"])
+def test_uff_record_declaring_no_samples_names_the_field(tmp_path, capsys, count):
+    """A UFF58 record 7 declaring -5120 samples kept all samples but 5120 (here none) and was
+    refused as 'the channels do not overlap in time (start times 0 s, 0 s)'."""
+    from pidcore.io import write_measurement
+    from pidcore.records import Channel, Measurement
+
+    path = tmp_path / "run.uff"
+    write_measurement(Measurement("run.uff", (Channel("Force", "force", _F, _FS, "N"),
+                                              Channel("Velocity", "velocity", _V, _FS, "m/s"))),
+                      path)
+    text = path.read_text()
+    assert text.count("      2560         1") == 2
+    path.write_text(text.replace("      2560         1", f"     {count}         1", 1))
+    with pytest.raises(InputFileError, match=f"run.uff: record 1 declares {int(count)} samples"):
+        read_measurement(path)
+    assert main(["analyze", str(path), "--no-store"]) == 2
+    assert "declares" in capsys.readouterr().err
