@@ -62,3 +62,25 @@ def test_foreign_layout_is_refused_and_the_file_never_changes(tmp_path, capsys, 
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and expected in err
     assert _digest(path) == before
+
+
+def test_analysing_the_store_into_itself_is_refused_and_adds_no_copy(tmp_path, capsys):
+    """'pidcore analyze S.h5 --store S.h5' read the store's measurement, whose hash is the
+    store file's, and saved it again under that new key: a copy of a stored measurement, one
+    more on every run (the store's hash changes with each save)."""
+    fs = 25600.0
+    t = np.arange(2560) / fs
+    rows = (f"{a:.17g},{np.sin(2 * np.pi * 100 * a):.17g},"
+            f"{0.01 * np.sin(2 * np.pi * 100 * a - 1.2):.17g}" for a in t)
+    export = tmp_path / "run.csv"
+    export.write_text("Time [s],Force [N],Velocity [m/s]\n" + "\n".join(rows) + "\n")
+    store = tmp_path / "pid_store.h5"
+    assert main(["analyze", str(export), "--store", str(store)]) == 0
+    before = _digest(store)
+    capsys.readouterr()
+    assert main(["analyze", str(store), "--store", str(store)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "is the store being saved to" in err
+    assert _digest(store) == before
+    assert len(Store(store).list_measurements()) == 1
+    assert main(["analyze", str(store), "--no-store"]) == 0  # reading it is fine
