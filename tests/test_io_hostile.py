@@ -5,6 +5,7 @@ number computed from samples the file does not hold (complex parts dropped, a ma
 
 from __future__ import annotations
 
+import json
 import os
 import shutil
 import subprocess
@@ -328,3 +329,23 @@ def test_uff_record_declaring_no_samples_names_the_field(tmp_path, capsys, count
         read_measurement(path)
     assert main(["analyze", str(path), "--no-store"]) == 2
     assert "declares" in capsys.readouterr().err
+
+
+def test_hdf5_channels_of_one_name_are_told_apart_as_every_reader_does(tmp_path, capsys):
+    """Two HDF5 channels both named 'Force' were listed as ('Force', 'Force'): '--force Force'
+    took the first without a word and the second could not be chosen at all."""
+    path = tmp_path / "two_forces.h5"
+    shutil.copy(SAMPLE_H5, path)
+    with h5py.File(path, "r+") as h5:
+        first = h5["channels"]["000"]
+        second = h5["channels"].create_dataset("003", data=first[()] * 2)
+        for name, value in first.attrs.items():
+            second.attrs[name] = value
+    assert [c.name for c in read_measurement(path).channels][::3] == ["Force", "Force (2)"]
+    assert main(["analyze", str(path), "--no-store"]) == 2
+    assert "('Force', 'Force (2)')" in capsys.readouterr().err
+    energies = []
+    for force in ("Force", "Force (2)"):
+        assert main(["analyze", str(path), "--no-store", "--json", "--force", force]) == 0
+        energies.append(json.loads(capsys.readouterr().out)["records"][0]["energy_per_cycle_j"])
+    assert energies[1] == pytest.approx(2 * energies[0])

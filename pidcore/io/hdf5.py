@@ -9,12 +9,13 @@ provenance stored in the group (the original file's name, hash and format) is ke
 from __future__ import annotations
 
 import os
+from dataclasses import replace
 
 import h5py
 
 from ..errors import InputFileError, ParameterError
 from ..records import Measurement
-from ._common import atomic_path, file_sha256
+from ._common import atomic_path, file_sha256, unique_names
 from ._hdf5_safety import check_hdf5_input
 from .hdf5_layout import LAYOUT_TAG, read_measurement_group, write_measurement_group
 
@@ -32,7 +33,12 @@ def _as_read(measurement: Measurement, where: str, sha256: str) -> Measurement:
     metadata = dict(measurement.metadata)
     metadata.update(original_source=measurement.source, original_sha256=measurement.sha256,
                     original_file_format=measurement.file_format)
-    return Measurement(source=where, channels=measurement.channels, sha256=sha256,
+    # two datasets may carry one name; as every reader does, the second becomes 'Force (2)',
+    # so that a channel can be chosen by name (a name given chose the first without a word)
+    names = unique_names([c.name for c in measurement.channels])
+    channels = tuple(c if c.name == n else replace(c, name=n)
+                     for c, n in zip(measurement.channels, names, strict=True))
+    return Measurement(source=where, channels=channels, sha256=sha256,
                        file_format="hdf5", metadata=metadata)
 
 
