@@ -349,3 +349,46 @@ def test_hdf5_channels_of_one_name_are_told_apart_as_every_reader_does(tmp_path,
         assert main(["analyze", str(path), "--no-store", "--json", "--force", force]) == 0
         energies.append(json.loads(capsys.readouterr().out)["records"][0]["energy_per_cycle_j"])
     assert energies[1] == pytest.approx(2 * energies[0])
+
+
+def _v5_zeros_bomb(path, n_samples):
+    """A MATLAB v5 file of one compressed variable 'Force' of ``n_samples`` zeros, written
+    streaming (the zeros are never held)."""
+    import struct
+    import zlib
+
+    def tag(data_type, nbytes):
+        return struct.pack("<II", data_type, nbytes)
+
+    name = tag(1, 5) + b"Force" + b"\0" * 3
+    head = tag(6, 8) + struct.pack("<II", 6, 0) + tag(5, 8) + struct.pack("<ii", n_samples, 1)
+    body = head + name + tag(9, 8 * n_samples)
+    deflate = zlib.compressobj(1)
+    parts = [deflate.compress(tag(14, len(body) + 8 * n_samples) + body)]
+    zeros = bytes(1 << 22)
+    for start in range(0, 8 * n_samples, len(zeros)):
+        parts.append(deflate.compress(zeros[:min(len(zeros), 8 * n_samples - start)]))
+    payload = b"".join([*parts, deflate.flush()])
+    header = b"MATLAB 5.0 MAT-file".ljust(116) + bytes(8) + struct.pack("<H", 0x0100) + b"IM"
+    path.write_bytes(header + tag(15, len(payload)) + payload)
+
+
+def test_mat_v5_compressed_bomb_is_refused_before_scipy_inflates_it(tmp_path, capsys):
+    """A 1.9 MB v5 file declaring 2 GB of compressed zeros made 'pidcore analyze' reach a
+    2.4 GB resident set (scipy inflates every variable) before any message; HDF5 and v7.3
+    uploads had this guard, v5 had not."""
+    path = tmp_path / "bomb.mat"
+    _v5_zeros_bomb(path, 20_000_000)  # 160 MB of float64 in a ~0.5 MB file
+    assert path.stat().st_size < 2**20
+    with pytest.raises(InputFileError, match=r"bomb\.mat: its variables inflate to more than"):
+        read_measurement(path)
+    assert main(["analyze", str(path), "--no-store"]) == 2
+    assert "refused before reading" in capsys.readouterr().err
+
+
+def test_mat_v5_within_the_expansion_limit_reads_as_before(tmp_path):
+    path = tmp_path / "small.mat"
+    _v5_zeros_bomb(path, 1000)
+    pytest.importorskip("scipy.io")
+    with pytest.raises(InputFileError, match="no time vector"):  # read, then judged
+        read_measurement(path)

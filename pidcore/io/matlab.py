@@ -26,6 +26,8 @@ MATLAB objects (``MCOS``) are ignored.
 from __future__ import annotations
 
 import os
+import struct
+import zlib
 from collections.abc import Mapping
 
 import h5py
@@ -46,7 +48,12 @@ from ._common import (
     reraise_interrupt,
     unique_names,
 )
-from ._hdf5_safety import check_hdf5_input
+from ._hdf5_safety import (
+    EXPANSION_ALLOWANCE_BYTES,
+    MAX_DECLARED_BYTES,
+    MAX_EXPANSION_FACTOR,
+    check_hdf5_input,
+)
 
 _TIME_VARIABLES = ("time", "t", "Time", "T")
 _RATE_VARIABLES = ("sample_rate_hz", "fs", "Fs", "sample_rate")
@@ -179,6 +186,42 @@ def _load_v73(path: str) -> dict:
         return {k: _h5_value(_member(h5, k), h5) for k in h5 if not k.startswith("#")}
 
 
+_V5_COMPRESSED, _V5_CHUNK = 15, 1 << 20
+
+
+def _check_v5_expansion(path: str) -> None:
+    """Refuse a v5 file whose compressed variables inflate to far more than the file holds
+    (a 2 MB file of zeros declaring 2 GB made scipy allocate them all), with the limits of
+    HDF5 uploads (:mod:`pidcore.io._hdf5_safety`), streaming: nothing inflated is kept."""
+    size = os.path.getsize(path)
+    limit = min(MAX_DECLARED_BYTES, max(MAX_EXPANSION_FACTOR * size, EXPANSION_ALLOWANCE_BYTES))
+    total = 0
+    with open(path, "rb") as fh:
+        header = fh.read(128)
+        order = ">" if header[126:128] == b"MI" else "<"
+        while len(tag := fh.read(8)) == 8:
+            data_type, nbytes = struct.unpack(f"{order}II", tag)
+            if data_type >> 16:  # small data element: its bytes are in the tag
+                continue
+            if data_type != _V5_COMPRESSED:
+                total += nbytes
+                fh.seek(nbytes + (-nbytes) % 8, os.SEEK_CUR)
+            else:
+                inflate, left = zlib.decompressobj(), nbytes
+                while left > 0 and total <= limit and (chunk := fh.read(min(left, _V5_CHUNK))):
+                    left -= len(chunk)
+                    try:
+                        total += len(inflate.decompress(chunk, _V5_CHUNK))
+                        while inflate.unconsumed_tail and total <= limit:
+                            total += len(inflate.decompress(inflate.unconsumed_tail, _V5_CHUNK))
+                    except zlib.error:
+                        return  # corrupt: scipy says so in its own words
+            if total > limit:
+                raise InputFileError(f"{path}: its variables inflate to more than "
+                                     f"{limit / 2**20:.0f} MiB in a {size / 2**20:.2f} MiB "
+                                     "file; refused before reading (a compressed 'bomb'?)")
+
+
 def _load(path: str) -> dict:
     with open(path, "rb") as fh:
         head = fh.read(520)
@@ -189,6 +232,7 @@ def _load(path: str) -> dict:
             return _load_v73(path)
         except OSError as exc:
             raise InputFileError(f"{path}: corrupt MATLAB v7.3 (HDF5) file ({exc})") from None
+    _check_v5_expansion(path)
     try:
         return scipy.io.loadmat(path, simplify_cells=True)
     except NotImplementedError:
