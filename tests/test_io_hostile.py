@@ -392,3 +392,15 @@ def test_mat_v5_within_the_expansion_limit_reads_as_before(tmp_path):
     pytest.importorskip("scipy.io")
     with pytest.raises(InputFileError, match="no time vector"):  # read, then judged
         read_measurement(path)
+
+
+def test_a_file_variable_named_like_an_option_is_not_shown_as_the_flag(tmp_path, capsys):
+    """A MAT file without a time base was told "no sample rate ('fs' or '--sample-rate')":
+    the CLI rewrote the variable name sample_rate_hz into the flag, naming a variable that no
+    file can hold."""
+    scipy_io = pytest.importorskip("scipy.io")
+    path = tmp_path / "no_rate.mat"
+    scipy_io.savemat(path, {"Force": _F, "Velocity": _V})
+    assert main(["analyze", str(path), "--no-store"]) == 2
+    err = capsys.readouterr().err
+    assert "('fs' or 'sample_rate_hz')" in err and "give the sample rate (--sample-rate)" in err
