@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 import os
 from collections.abc import Mapping, Sequence
+from contextlib import suppress
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -16,7 +17,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from . import defaults
-from .errors import ChannelError, ParameterError
+from .errors import ChannelError, ParameterError, StoreError
 from .io import assign_roles, read_measurement
 from .records import Channel, Measurement
 from .signal import PowerAnalysis, analyze_channels
@@ -357,6 +358,7 @@ def save_analyses(store, results: Sequence[AnalyzedRecord],
             raise ParameterError(f"{name}: expected one per result ({len(results)}), got "
                                  f"{len(given)}")
     store = store if isinstance(store, Store) else Store(store)
+    _refuse_the_store_itself(store, results)
     with store.transaction():
         notes = replacement_notes(store.list_analyses(), [
             (name, measurement_key(r.measurement),
@@ -367,6 +369,20 @@ def save_analyses(store, results: Sequence[AnalyzedRecord],
                 for r, o, (_, case, origin), more in zip(results, per_result, stated, extra,
                                                          strict=True)]
     return SavedAnalyses(keys, notes)
+
+
+def _refuse_the_store_itself(store, results: Sequence[AnalyzedRecord]) -> None:
+    """A measurement read from the store file itself holds that file's hash, not its original
+    file's: saved, it would be a copy of a stored measurement under a new key, and one more
+    each time (the store's hash changes with every save)."""
+    for r in results:
+        source = Path(r.measurement.source)
+        with suppress(OSError):
+            if store.path.exists() and source.is_file() and os.path.samefile(source,
+                                                                              store.path):
+                raise StoreError(f"{r.measurement.source}: is the store being saved to; its "
+                                 "measurements are stored in it already: analyse it without "
+                                 "saving, or save to another store")
 
 
 def _stored_case_label(row) -> str:

@@ -170,9 +170,13 @@ _FLAG_OF_KEYWORD = (
     ("sample_rate_hz", "--sample-rate"),
 )
 # whole words only: "my_frequency_hz_col" (a file's column) stays as it is, and so does a
-# sidecar's column of the same name ("column baseline_loss_factor '-1' of loadcases.csv")
+# sidecar's column of the same name ("column baseline_loss_factor '-1' of loadcases.csv"), and
+# so do a file's own attributes, fields and variables ("attribute sample_rate_hz is nan",
+# "field sample_rate_hz", "variable sample_rate_hz", "('fs' or 'sample_rate_hz')"), which
+# are not the option
+_NOT_THE_OPTION = r"(?<![\w'-])(?<!column )(?<!attribute )(?<!field )(?<!variable )"
 _KEYWORD_PATTERN = re.compile("|".join(
-    rf"(?<![\w-])(?<!column ){re.escape(k)}" + (r"(?!\w)" if k[-1].isalnum() else "")
+    _NOT_THE_OPTION + re.escape(k) + (r"(?!\w)" if k[-1].isalnum() else "")
     for k, _ in _FLAG_OF_KEYWORD))
 
 

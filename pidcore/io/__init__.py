@@ -28,12 +28,15 @@ from __future__ import annotations
 
 import os
 import re
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import replace
 from pathlib import Path
 
 from ..constants import FileFormat
-from ..errors import InputFileError, ParameterError
+from ..errors import InputFileError, ParameterError, PidcoreError
 from ..records import Measurement
+from ._common import reraise_interrupt
 from .delimited import read_csv, write_csv
 from .hdf5 import hdf5_keys, read_hdf5, write_hdf5
 from .matlab import read_mat, write_mat
@@ -155,7 +158,8 @@ def read_measurements(path: str | os.PathLike[str], *, sample_rate_hz: float | N
     _check_format(file_format)
     fmt = file_format or detect_file_format(path)
     if fmt == "hdf5":
-        return [_displayed(m, path) for m in read_hdf5(path)]
+        with _one_line_errors(path, fmt):
+            return [_displayed(m, path) for m in read_hdf5(path)]
     return [read_measurement(path, sample_rate_hz=sample_rate_hz, file_format=fmt)]
 
 
@@ -197,6 +201,26 @@ def read_measurement(path: str | os.PathLike[str], *, sample_rate_hz: float | No
     if key is not None and fmt != "hdf5":
         raise ParameterError(f"{display_path(path)}: key={key!r} picks a measurement of a "
                              f"pidcore HDF5 store; this is a {fmt} file")
+    with _one_line_errors(path, fmt):
+        return _read(path, fmt, sample_rate_hz, key)
+
+
+@contextmanager
+def _one_line_errors(path: str | os.PathLike[str], fmt: str) -> Iterator[None]:
+    """Any other exception a reader lets out (a blind spot of its checks) becomes an
+    :class:`InputFileError` naming the file: one line and exit code 2, not a traceback."""
+    try:
+        yield
+    except (PidcoreError, MemoryError):
+        raise
+    except Exception as exc:
+        reraise_interrupt(exc)
+        raise InputFileError(f"{display_path(path)}: not a readable {fmt} measurement file "
+                             f"({type(exc).__name__}: {exc})") from None
+
+
+def _read(path: str | os.PathLike[str], fmt: str, sample_rate_hz: float | None,
+          key: str | None) -> Measurement:
     if fmt == "uff":
         return _rate_kept(_displayed(read_uff(path), path), sample_rate_hz, path)
     if fmt == "csv":

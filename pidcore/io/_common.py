@@ -208,3 +208,43 @@ def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
     finally:
         if tmp.exists():
             tmp.unlink()
+
+
+_KIND_WORDS = {"c": "complex numbers", "S": "text", "U": "text", "O": "objects (references, "
+               "variable-length data or cells)", "V": "records (a compound type)",
+               "M": "dates", "m": "time spans"}
+
+
+def real_samples(values: object, *, where: str) -> np.ndarray:
+    """``values`` as a 1-D float64 vector of real samples, or an :class:`InputFileError`.
+
+    A channel's samples must be real numbers (integers, floats, booleans) in one vector; a
+    MATLAB row or column (``1 x N``) counts as one. Complex samples are refused (casting them
+    drops the imaginary part without a word), as are text, records, references and matrices
+    (flattening a matrix interleaves its columns into one record).
+    """
+    arr = np.asarray(values)
+    kind = arr.dtype.kind
+    if kind not in "biuf":
+        raise InputFileError(f"{where}: samples are {_KIND_WORDS.get(kind, str(arr.dtype))}; "
+                             "expected real numbers")
+    if sum(n > 1 for n in arr.shape) > 1:
+        raise InputFileError(f"{where}: samples have shape {arr.shape}; expected one vector "
+                             "per channel")
+    if arr.size == 0:
+        raise InputFileError(f"{where}: holds no samples")
+    return arr.astype(np.float64).reshape(-1)
+
+
+def real_scalar(value: object, *, where: str, positive: bool = False) -> float:
+    """``value`` as one finite float (``positive``: also > 0), or an :class:`InputFileError`
+    saying what it is and what was expected."""
+    try:
+        arr = np.asarray(value, dtype=np.float64).reshape(-1)
+    except (TypeError, ValueError):
+        arr = None
+    if arr is None or arr.size != 1 or not np.isfinite(arr[0]) or (positive and arr[0] <= 0):
+        shown = value.decode("utf-8", "replace") if isinstance(value, bytes) else value
+        raise InputFileError(f"{where} is {shown!r}; expected a finite "
+                             f"{'positive ' if positive else ''}number")
+    return float(arr[0])

@@ -24,6 +24,10 @@ EXPANSION_ALLOWANCE_BYTES = 64 * 2**20
 #: Declared dataset bytes never read, whatever the file size (the upload limit of the app is
 #: far below it).
 MAX_DECLARED_BYTES = 4 * 2**30
+#: Filters HDF5 and h5py build in (deflate, shuffle, fletcher32, szip, n-bit, scale-offset,
+#: LZF). Reading a dataset with any other filter makes HDF5 search its plugin directory and
+#: load shared libraries from the machine, so such a dataset is refused before it is read.
+BUILT_IN_FILTERS = frozenset({1, 2, 3, 4, 5, 6, 32000})
 #: Deepest group nesting and most objects walked (a file can hard-link a group into itself).
 MAX_DEPTH = 32
 MAX_OBJECTS = 100_000
@@ -54,16 +58,26 @@ def _walk(group: h5py.Group, where: str, depth: int, counter: list[int]) -> int:
             if obj.is_virtual:
                 raise InputFileError(f"{where}: dataset {path!r} is a virtual dataset (data "
                                      "mapped from other files); refused")
-            if obj.id.get_create_plist().get_external_count() > 0:
+            plist = obj.id.get_create_plist()
+            if plist.get_external_count() > 0:
                 raise InputFileError(f"{where}: dataset {path!r} keeps its data in external "
                                      "file(s); refused: a measurement file must not make "
                                      "pidcore read other files")
+            for index in range(plist.get_nfilters()):
+                filter_id = plist.get_filter(index)[0]
+                if filter_id not in BUILT_IN_FILTERS:
+                    raise InputFileError(
+                        f"{where}: dataset {path!r} is compressed with HDF5 filter "
+                        f"{filter_id}, which is not built in; refused: reading it would load "
+                        "a plugin library from this machine (export without that filter, "
+                        "or with gzip)")
             total += int(obj.size) * int(obj.dtype.itemsize)
     return total
 
 
 def check_hdf5_input(path: str | os.PathLike[str], *, what: str = "HDF5") -> None:
-    """Refuse external storage, external links, virtual datasets and oversized declarations.
+    """Refuse external storage, external links, virtual datasets, filters that are not built
+    in (HDF5 would load a plugin library for them) and oversized declarations.
 
     Raises
     ------

@@ -49,6 +49,11 @@ _HEAD_BYTES = 1 << 16
 _NUMBER = re.compile(r"^[+-]?(?:\d+(?:[.,]\d*)?|[.,]\d+)(?:[eE][+-]?\d+)?$|^[+-]?(?:nan|inf)$",
                      re.IGNORECASE)
 _LINE_BREAK = re.compile(r"\r\n|\n|\r")
+#: Longest line (bytes) of a table read. A row of numbers is tens of bytes per column, so
+#: this allows some 400 000 columns; pandas' tokenizer holds a whole line in memory several
+#: times over, and a 500 MB file of one line took 1.6 GB before it was refused.
+MAX_LINE_BYTES = 16 * 2**20
+_SCAN_CHUNK_BYTES = 1 << 20
 
 
 def _split_header(cell: str) -> tuple[str, str]:
@@ -147,6 +152,32 @@ def _layout(lines: list[str], where: str) -> tuple[int, str, list[str], list[str
     return first, delimiter, names, units, decimal
 
 
+def _check_line_lengths(path: str | os.PathLike[str], where: str) -> None:
+    """Refuse a line longer than :data:`MAX_LINE_BYTES`, streaming (1 MiB at a time), before
+    pandas reads the file. Files no longer than the limit need no scan, and a chunk with a
+    line break in it ends any line, so only the first and last break of a chunk are sought."""
+    if os.path.getsize(path) <= MAX_LINE_BYTES:
+        return
+    run, line = 0, 1  # bytes since the last line break; number of the current line
+    line_break = b""  # LF (also ends CRLF lines), else CR (classic Mac)
+    with open(path, "rb") as fh:
+        while chunk := fh.read(_SCAN_CHUNK_BYTES):
+            if not line_break:
+                line_break = b"\n" if b"\n" in chunk or b"\r" not in chunk else b"\r"
+            first = chunk.find(line_break)
+            if first < 0:
+                run += len(chunk)
+            elif run + first + 1 > MAX_LINE_BYTES:
+                run += first + 1
+            else:
+                line += chunk.count(line_break)
+                run = len(chunk) - chunk.rfind(line_break) - 1
+            if run > MAX_LINE_BYTES:
+                raise InputFileError(f"{where}: line {line} is longer than "
+                                     f"{MAX_LINE_BYTES >> 20} MiB; expected rows of numbers "
+                                     "(is the file one line, or binary?)")
+
+
 def read_csv(path: str | os.PathLike[str], *, sample_rate_hz: float | None = None) -> Measurement:
     """Read a delimited text file of channels into a SI :class:`Measurement`.
 
@@ -177,6 +208,7 @@ def read_csv(path: str | os.PathLike[str], *, sample_rate_hz: float | None = Non
     if not complete:
         lines = lines[:-1]  # possibly cut
     first, delimiter, header_cells, unit_cells, decimal = _layout(lines, where)
+    _check_line_lengths(path, where)
     notes: list[str] = []
     try:
         # skiprows skips raw lines (blank ones included), as counted by _LINE_BREAK

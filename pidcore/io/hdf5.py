@@ -9,19 +9,22 @@ provenance stored in the group (the original file's name, hash and format) is ke
 from __future__ import annotations
 
 import os
+from dataclasses import replace
 
 import h5py
 
 from ..errors import InputFileError, ParameterError
 from ..records import Measurement
-from ._common import atomic_path, file_sha256
+from ._common import atomic_path, file_sha256, unique_names
 from ._hdf5_safety import check_hdf5_input
 from .hdf5_layout import LAYOUT_TAG, read_measurement_group, write_measurement_group
 
 MEASUREMENTS_GROUP = "measurements"
 
 
-def _is_measurement(group: h5py.Group) -> bool:
+def _is_measurement(group: h5py.Group | None) -> bool:
+    if not isinstance(group, h5py.Group):  # a dataset, or None for a soft link to nothing
+        return False
     tag = group.attrs.get("pidcore_layout", "")
     return (tag.decode() if isinstance(tag, bytes) else str(tag)) == LAYOUT_TAG
 
@@ -30,7 +33,12 @@ def _as_read(measurement: Measurement, where: str, sha256: str) -> Measurement:
     metadata = dict(measurement.metadata)
     metadata.update(original_source=measurement.source, original_sha256=measurement.sha256,
                     original_file_format=measurement.file_format)
-    return Measurement(source=where, channels=measurement.channels, sha256=sha256,
+    # two datasets may carry one name; as every reader does, the second becomes 'Force (2)',
+    # so that a channel can be chosen by name (a name given chose the first without a word)
+    names = unique_names([c.name for c in measurement.channels])
+    channels = tuple(c if c.name == n else replace(c, name=n)
+                     for c, n in zip(measurement.channels, names, strict=True))
+    return Measurement(source=where, channels=channels, sha256=sha256,
                        file_format="hdf5", metadata=metadata)
 
 
@@ -48,7 +56,7 @@ def hdf5_keys(path: str | os.PathLike[str]) -> list[str]:
                 return [""]
             group = h5.get(MEASUREMENTS_GROUP)
             if isinstance(group, h5py.Group):
-                keys = sorted(k for k in group if _is_measurement(group[k]))
+                keys = sorted(k for k in group if _is_measurement(group.get(k)))
                 if keys:
                     return keys
             holds = _contents(h5)
@@ -62,7 +70,7 @@ def hdf5_keys(path: str | os.PathLike[str]) -> list[str]:
 def _contents(h5: h5py.File) -> str:
     """What a file without measurements holds, for the message: ``48 dem_runs, ...``."""
     parts = [f"{len(item)} {name}" if isinstance(item, h5py.Group) else name
-             for name, item in h5.items()]
+             for name, item in ((name, h5.get(name)) for name in h5)]
     nonempty = [p for p in parts if not p.startswith("0 ")]
     return ", ".join(nonempty) if nonempty else "nothing"
 

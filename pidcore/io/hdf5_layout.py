@@ -21,6 +21,7 @@ import numpy as np
 
 from ..errors import InputFileError
 from ..records import Channel, Measurement
+from ._common import real_samples, real_scalar
 
 LAYOUT_TAG = "measurement"
 
@@ -49,30 +50,61 @@ def _text(value: object) -> str:
     return value.decode("utf-8", "replace") if isinstance(value, bytes) else str(value)
 
 
+def _channel_dataset(channels: h5py.Group, key: str, where: str) -> h5py.Dataset:
+    item = channels.get(key)  # None for a soft link to nothing
+    if not isinstance(item, h5py.Dataset):
+        what = "a link to nothing" if item is None else "a group"
+        raise InputFileError(f"{where}/channels/{key}: is {what}; expected a dataset of samples")
+    if h5py.check_enum_dtype(item.dtype) is not None:
+        raise InputFileError(f"{where}/channels/{key}: samples are enumerated labels; "
+                             "expected real numbers")
+    return item
+
+
 def read_measurement_group(group: h5py.Group, *, where: str = "") -> Measurement:
-    """Read a measurement group written by :func:`write_measurement_group`."""
+    """Read a measurement group written by :func:`write_measurement_group`.
+
+    Raises
+    ------
+    InputFileError
+        Not a measurement group, or a channel that is not a vector of real numbers (complex,
+        text, compound, enumerated, references, a matrix, no samples), a link to nothing, or a
+        sample rate or start time that is not a finite number (the rate also > 0).
+    """
     where = where or f"{group.file.filename}:{group.name}"
-    if _text(group.attrs.get("pidcore_layout", "")) != LAYOUT_TAG or "channels" not in group:
+    channels_group = group.get("channels")
+    if _text(group.attrs.get("pidcore_layout", "")) != LAYOUT_TAG \
+            or not isinstance(channels_group, h5py.Group):
         raise InputFileError(f"{where}: not a pidcore measurement group "
                              "(expected attribute pidcore_layout='measurement' and 'channels/')")
     channels = []
-    for key in sorted(group["channels"]):
-        ds = group["channels"][key]
+    for key in sorted(channels_group):
+        ds = _channel_dataset(channels_group, key, where)
+        at = f"{where}/channels/{key}"
         try:
             channels.append(Channel(
                 name=_text(ds.attrs["name"]),
                 quantity=_text(ds.attrs["quantity"]),
-                data=np.asarray(ds[()], dtype=np.float64),
-                sample_rate_hz=float(ds.attrs["sample_rate_hz"]),
+                data=real_samples(ds[()], where=at),
+                sample_rate_hz=real_scalar(ds.attrs["sample_rate_hz"],
+                                           where=f"{at}: attribute sample_rate_hz",
+                                           positive=True),
                 source_unit=_text(ds.attrs.get("source_unit", "")),
-                start_time_s=float(ds.attrs.get("start_time_s", 0.0)),
+                start_time_s=real_scalar(ds.attrs.get("start_time_s", 0.0),
+                                         where=f"{at}: attribute start_time_s"),
             ))
         except KeyError as exc:
-            raise InputFileError(f"{where}/channels/{key}: missing attribute {exc}") from None
+            raise InputFileError(f"{at}: missing attribute {exc}") from None
     try:
         metadata = json.loads(_text(group.attrs.get("metadata_json", "{}")))
     except json.JSONDecodeError:
         raise InputFileError(f"{where}: attribute metadata_json is not valid JSON") from None
+    if not isinstance(metadata, dict):
+        raise InputFileError(f"{where}: attribute metadata_json holds a "
+                             f"{type(metadata).__name__}; expected a JSON object")
+    notes = metadata.get("reader_notes", [])
+    if not isinstance(notes, list) or not all(isinstance(n, str) for n in notes):
+        raise InputFileError(f"{where}: metadata_json's reader_notes is not a list of text")
     return Measurement(
         source=_text(group.attrs.get("source", where)),
         channels=tuple(channels),

@@ -26,6 +26,8 @@ MATLAB objects (``MCOS``) are ignored.
 from __future__ import annotations
 
 import os
+import struct
+import zlib
 from collections.abc import Mapping
 
 import h5py
@@ -41,10 +43,17 @@ from ._common import (
     make_channel,
     overridden_rate,
     rate_from_times,
+    real_samples,
+    real_scalar,
     reraise_interrupt,
     unique_names,
 )
-from ._hdf5_safety import check_hdf5_input
+from ._hdf5_safety import (
+    EXPANSION_ALLOWANCE_BYTES,
+    MAX_DECLARED_BYTES,
+    MAX_EXPANSION_FACTOR,
+    check_hdf5_input,
+)
 
 _TIME_VARIABLES = ("time", "t", "Time", "T")
 _RATE_VARIABLES = ("sample_rate_hz", "fs", "Fs", "sample_rate")
@@ -113,22 +122,58 @@ def _attr_text(obj: h5py.Group | h5py.Dataset, name: str) -> str:
     return value.decode() if isinstance(value, bytes) else str(value)
 
 
-def _h5_value(obj: h5py.Group | h5py.Dataset, file: h5py.File) -> object:
+#: Deepest nesting of structs, cells and references read from a v7.3 file (a reference can
+#: point back at the cell that holds it).
+MAX_V73_DEPTH = 32
+
+
+def _member(group: h5py.Group, name: str) -> h5py.Group | h5py.Dataset:
+    item = group.get(name)  # None for a soft link to nothing
+    if item is None:
+        raise InputFileError(f"{group.file.filename}: {group.name.rstrip('/')}/{name} is a link "
+                             "to nothing; expected a MATLAB variable or field")
+    return item
+
+
+def _dereference(file: h5py.File, ref: object, where: str) -> h5py.Group | h5py.Dataset:
+    try:
+        return file[ref]
+    except (ValueError, KeyError, TypeError) as exc:
+        raise InputFileError(f"{file.filename}: {where} holds an invalid reference ({exc}); "
+                             "expected a MATLAB cell or struct array") from None
+
+
+def _chars(data: object, where: str) -> str:
+    codes = np.asarray(data).T.ravel()
+    if codes.dtype.kind not in "iu" or (codes.size and (codes.min() < 0
+                                                        or codes.max() > 0x10FFFF)):
+        raise InputFileError(f"{where} is a char array of values that are no characters")
+    return "".join(chr(c) for c in codes)
+
+
+def _h5_value(obj: h5py.Group | h5py.Dataset, file: h5py.File, depth: int = 0) -> object:
+    if depth > MAX_V73_DEPTH:
+        raise InputFileError(f"{file.filename}: {obj.name} nests cells, structs or references "
+                             f"deeper than {MAX_V73_DEPTH} levels (a reference to itself?); "
+                             "refused")
     if isinstance(obj, h5py.Group):
         fields = _struct_array_fields(obj)
         if fields is not None:  # struct array -> list of dicts, as loadmat gives
-            columns = {k: [_h5_value(file[ref], file) for ref in np.asarray(obj[k][()]).T.ravel()]
+            columns = {k: [_h5_value(_dereference(file, ref, obj[k].name), file, depth + 1)
+                           for ref in np.asarray(obj[k][()]).T.ravel()]
                        for k in fields}
             n = len(next(iter(columns.values())))
             return [{k: columns[k][i] for k in fields} for i in range(n)]
-        return {k: _h5_value(obj[k], file) for k in obj if not k.startswith("#")}
+        return {k: _h5_value(_member(obj, k), file, depth + 1)
+                for k in obj if not k.startswith("#")}
     matlab_class = obj.attrs.get("MATLAB_class", b"")
     matlab_class = matlab_class.decode() if isinstance(matlab_class, bytes) else matlab_class
     data = obj[()]
     if matlab_class == "char":
-        return "".join(chr(c) for c in np.asarray(data).T.ravel())
+        return _chars(data, f"{file.filename}: {obj.name}")
     if obj.dtype == h5py.ref_dtype:
-        return [_h5_value(file[ref], file) for ref in np.asarray(data).T.ravel()]
+        return [_h5_value(_dereference(file, ref, obj.name), file, depth + 1)
+                for ref in np.asarray(data).T.ravel()]
     if obj.attrs.get("MATLAB_empty", 0):
         return np.zeros(0)
     arr = np.asarray(data)
@@ -138,7 +183,43 @@ def _h5_value(obj: h5py.Group | h5py.Dataset, file: h5py.File) -> object:
 def _load_v73(path: str) -> dict:
     check_hdf5_input(path, what="MATLAB v7.3 (HDF5)")
     with h5py.File(path, "r") as h5:
-        return {k: _h5_value(h5[k], h5) for k in h5 if not k.startswith("#")}
+        return {k: _h5_value(_member(h5, k), h5) for k in h5 if not k.startswith("#")}
+
+
+_V5_COMPRESSED, _V5_CHUNK = 15, 1 << 20
+
+
+def _check_v5_expansion(path: str) -> None:
+    """Refuse a v5 file whose compressed variables inflate to far more than the file holds
+    (a 2 MB file of zeros declaring 2 GB made scipy allocate them all), with the limits of
+    HDF5 uploads (:mod:`pidcore.io._hdf5_safety`), streaming: nothing inflated is kept."""
+    size = os.path.getsize(path)
+    limit = min(MAX_DECLARED_BYTES, max(MAX_EXPANSION_FACTOR * size, EXPANSION_ALLOWANCE_BYTES))
+    total = 0
+    with open(path, "rb") as fh:
+        header = fh.read(128)
+        order = ">" if header[126:128] == b"MI" else "<"
+        while len(tag := fh.read(8)) == 8:
+            data_type, nbytes = struct.unpack(f"{order}II", tag)
+            if data_type >> 16:  # small data element: its bytes are in the tag
+                continue
+            if data_type != _V5_COMPRESSED:
+                total += nbytes
+                fh.seek(nbytes + (-nbytes) % 8, os.SEEK_CUR)
+            else:
+                inflate, left = zlib.decompressobj(), nbytes
+                while left > 0 and total <= limit and (chunk := fh.read(min(left, _V5_CHUNK))):
+                    left -= len(chunk)
+                    try:
+                        total += len(inflate.decompress(chunk, _V5_CHUNK))
+                        while inflate.unconsumed_tail and total <= limit:
+                            total += len(inflate.decompress(inflate.unconsumed_tail, _V5_CHUNK))
+                    except zlib.error:
+                        return  # corrupt: scipy says so in its own words
+            if total > limit:
+                raise InputFileError(f"{path}: its variables inflate to more than "
+                                     f"{limit / 2**20:.0f} MiB in a {size / 2**20:.2f} MiB "
+                                     "file; refused before reading (a compressed 'bomb'?)")
 
 
 def _load(path: str) -> dict:
@@ -151,6 +232,7 @@ def _load(path: str) -> dict:
             return _load_v73(path)
         except OSError as exc:
             raise InputFileError(f"{path}: corrupt MATLAB v7.3 (HDF5) file ({exc})") from None
+    _check_v5_expansion(path)
     try:
         return scipy.io.loadmat(path, simplify_cells=True)
     except NotImplementedError:
@@ -166,15 +248,18 @@ def _load(path: str) -> dict:
 def _pidcore_layout(variables: Mapping, where: str) -> list[Channel]:
     channels = []
     for i, item in enumerate(_as_list(variables.get("pidcore_channels"))):
+        what = f"{where}: pidcore_channels{{{i + 1}}}"
         if not isinstance(item, Mapping):
-            raise InputFileError(f"{where}: pidcore_channels{{{i + 1}}} is not a struct")
+            raise InputFileError(f"{what} is not a struct")
         try:
             channels.append(Channel(
                 name=_text(item["name"]), quantity=_text(item["quantity"]),
-                data=np.atleast_1d(np.asarray(item["data"], dtype=np.float64)).ravel(),
-                sample_rate_hz=_scalar(item["sample_rate_hz"], where),
+                data=real_samples(item["data"], where=f"{what}: field data"),
+                sample_rate_hz=real_scalar(item["sample_rate_hz"], positive=True,
+                                           where=f"{what}: field sample_rate_hz"),
                 source_unit=_text(item.get("source_unit", "")),
-                start_time_s=_scalar(item.get("start_time_s", 0.0), where)))
+                start_time_s=real_scalar(item.get("start_time_s", 0.0),
+                                         where=f"{what}: field start_time_s")))
         except KeyError as exc:
             raise InputFileError(f"{where}: pidcore_channels{{{i + 1}}} lacks field "
                                  f"{exc}") from None
@@ -236,17 +321,26 @@ def _lms_layout(signal: object, where: str) -> list[Channel]:
                                  "(LMS Test.Lab export)")
         x, y = sig["x_values"], sig["y_values"]
         try:
-            start = _scalar(x.get("start_value", 0.0), what)
+            start = real_scalar(x.get("start_value", 0.0), where=f"{what}: x_values.start_value")
             increment = _scalar(x["increment"], what)
-            values = np.asarray(y["values"], dtype=np.float64)
+            values = np.asarray(y["values"])
         except (KeyError, AttributeError, TypeError, ValueError) as exc:
             raise InputFileError(f"{what}: incomplete x_values/y_values ({exc})") from None
+        if values.dtype.kind not in "biuf":
+            real_samples(values, where=f"{what}: y_values.values")  # raises, naming the kind
+        values = values.astype(np.float64)
         if not increment > 0:
             raise InputFileError(f"{what}: x_values.increment is {increment!r}; expected a "
                                  "positive sample interval in s")
         values = values.reshape(values.shape[0], -1) if values.ndim > 1 else values[:, None]
         if "number_of_values" in x:
-            n = int(_scalar(x["number_of_values"], what))
+            n_given = real_scalar(x["number_of_values"], where=f"{what}: x_values.number_of_values",
+                                  positive=True)
+            if n_given != int(n_given) or n_given > values.size:
+                raise InputFileError(f"{what}: x_values.number_of_values is {n_given:.6g}; "
+                                     f"expected a whole number of samples the file holds "
+                                     f"(y_values holds {values.size} values)")
+            n = int(n_given)
             if values.shape[0] != n and values.shape[1] == n:
                 values = values.T  # channels stored as rows
             if values.shape[0] < n:
@@ -284,7 +378,8 @@ def _simple_layout(variables: Mapping, where: str,
         n = _numeric_vector(public[time_key]).size
         notes += [note] if note else []
     elif rate_key is not None or sample_rate_hz is not None:
-        rate = (_scalar(public[rate_key], f"{where}: {rate_key}") if rate_key is not None
+        rate = (real_scalar(public[rate_key], where=f"{where}: variable {rate_key}",
+                            positive=True) if rate_key is not None
                 else float(sample_rate_hz))
         start, n = 0.0, None
     else:

@@ -156,6 +156,9 @@ def _describe(set_types: list[int], func_types: list[int]) -> str:
 def _record_channel(dset: dict, index: int, where: str,
                     unit_factors: tuple[float, float]) -> Channel:
     num_pts = int(dset["num_pts"])
+    if num_pts < 1:  # values[:num_pts] would keep all but |num_pts| samples, or none
+        raise InputFileError(f"{where}: record {index + 1} declares {num_pts} samples (record "
+                             "7, field 2); expected a positive number of samples")
     values = np.asarray(dset["data"])
     if np.iscomplexobj(values):
         raise InputFileError(f"{where}: record {index + 1} is a time record with complex "

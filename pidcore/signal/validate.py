@@ -106,8 +106,16 @@ def _label(source: str, channel: str) -> str:
     return f"{source}: channel {channel!r}" if source else f"channel {channel!r}"
 
 
+#: Largest sample magnitude analysed, in SI units. Far beyond any force (N), velocity (m/s)
+#: or acceleration (m/s^2) a shaker makes, and far enough below the float64 range (1.8e308)
+#: that the squares and sums of the spectrum and the least-squares fit stay finite; a sample
+#: of 1e306 overflowed them into NaN and a traceback.
+MAX_SAMPLE_MAGNITUDE = 1e100
+
+
 def check_finite(data: np.ndarray, *, source: str, channel: str) -> None:
-    """Reject NaN/inf samples, saying how many and where the first one is.
+    """Reject NaN/inf samples, saying how many and where the first one is, and samples beyond
+    :data:`MAX_SAMPLE_MAGNITUDE` (a corrupt file: the analysis would overflow).
 
     Examples
     --------
@@ -116,16 +124,20 @@ def check_finite(data: np.ndarray, *, source: str, channel: str) -> None:
     ...
     pidcore.errors.ChannelError: a.uff: channel 'F': 1 non-finite sample (NaN/inf), first at index 1
     """
-    if np.isfinite(np.sum(data)):  # fast path: one pass, no temporary
-        return
-    bad = ~np.isfinite(data)
-    count = int(bad.sum())
-    if count == 0:  # the sum overflowed although every sample is finite
-        return
-    first = int(np.argmax(bad))
-    plural = "s" if count > 1 else ""
-    raise ChannelError(f"{_label(source, channel)}: {count} non-finite sample{plural} (NaN/inf), "
-                       f"first at index {first}")
+    if not np.isfinite(np.sum(data)):  # fast path: one pass, no temporary
+        bad = ~np.isfinite(data)
+        count = int(bad.sum())
+        if count:  # else the sum overflowed although every sample is finite
+            first = int(np.argmax(bad))
+            plural = "s" if count > 1 else ""
+            raise ChannelError(f"{_label(source, channel)}: {count} non-finite "
+                               f"sample{plural} (NaN/inf), first at index {first}")
+    if data.size and max(float(np.max(data)), -float(np.min(data))) > MAX_SAMPLE_MAGNITUDE:
+        big = np.abs(data) > MAX_SAMPLE_MAGNITUDE
+        first = int(np.argmax(big))
+        raise ChannelError(f"{_label(source, channel)}: {int(big.sum())} sample(s) of magnitude "
+                           f"above {MAX_SAMPLE_MAGNITUDE:g} (SI units), first at index {first} "
+                           f"({data[first]:g}); expected physical values: a corrupt file")
 
 
 def check_length(data: np.ndarray, *, source: str, channel: str, min_samples: int) -> None:

@@ -300,6 +300,35 @@ class Store:
             raise StoreError(f"{self.path}: store version {version} is newer than this pidcore "
                              f"({__version__}) understands (version {STORE_VERSION}); "
                              "upgrade pidcore")
+        self._check_sections(h5)
+
+    def _check_sections(self, h5: h5py.File) -> None:
+        """Refuse a foreign layout before anything reads or copies it: each section a group of
+        the file itself, each entry a group of the file itself (an external link would make
+        every listing open another file on the machine; a soft link to nothing, a dataset
+        where a group belongs, crashed every listing and every write)."""
+        for section in (_MEASUREMENTS, _ANALYSES, _DEM_RUNS):
+            link = h5.get(section, getlink=True)
+            if link is None:
+                continue
+            parent = h5.get(section) if isinstance(link, h5py.HardLink) else None
+            if not isinstance(parent, h5py.Group):
+                raise self._unreadable(f"/{section} is {self._what(link, parent)}; expected "
+                                       "a group of entries")
+            for name in parent:
+                link = parent.get(name, getlink=True)
+                item = parent.get(name) if isinstance(link, h5py.HardLink) else None
+                if not isinstance(item, h5py.Group):
+                    raise self._unreadable(f"/{section}/{name} is {self._what(link, item)}; "
+                                           "expected an entry group in the store's own file")
+
+    @staticmethod
+    def _what(link: object, item: object) -> str:
+        if isinstance(link, h5py.ExternalLink):
+            return f"an external link to {link.filename!r}"
+        if isinstance(link, h5py.SoftLink):
+            return f"a soft link to {link.path!r}"
+        return "a dataset" if isinstance(item, h5py.Dataset) else "not a group"
 
     @contextmanager
     def _reading(self) -> Iterator[h5py.File | None]:

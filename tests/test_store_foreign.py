@@ -1,0 +1,86 @@
+"""A store file with a foreign layout (a section that is a dataset, an entry that is a link
+out of the file or to nothing) is refused in one line, read by nothing and never changed."""
+
+from __future__ import annotations
+
+import hashlib
+
+import h5py
+import numpy as np
+import pytest
+
+from pidcore.cli import main
+from pidcore.errors import StoreError
+from pidcore.records import Channel, Measurement
+from pidcore.store import Store
+
+
+def _digest(path):
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def _section_dataset(section):
+    def edit(h5):
+        del h5[section]
+        h5.create_dataset(section, data=np.arange(3))
+    return edit
+
+
+FOREIGN = {
+    "measurements a dataset": (_section_dataset("measurements"),
+                               "/measurements is a dataset"),
+    "analyses a dataset": (_section_dataset("analyses"), "/analyses is a dataset"),
+    "entry an external link": (lambda h5: h5["measurements"].__setitem__(
+        "evil", h5py.ExternalLink("/etc/passwd", "/")), "external link to '/etc/passwd'"),
+    "entry a soft link to nothing": (lambda h5: h5["analyses"].__setitem__(
+        "zz", h5py.SoftLink("/nowhere")), "soft link to '/nowhere'"),
+    "entry a dataset": (lambda h5: h5["dem_runs"].create_dataset("run", data=[1.0]),
+                        "/dem_runs/run is a dataset"),
+}
+
+
+@pytest.mark.parametrize("case", list(FOREIGN))
+def test_foreign_layout_is_refused_and_the_file_never_changes(tmp_path, capsys, case):
+    edit, expected = FOREIGN[case]
+    path = tmp_path / "pid_store.h5"
+    fs = 25600.0
+    t = np.arange(2560) / fs
+    Store(path).add_measurement(Measurement("a.csv", (
+        Channel("Force", "force", np.sin(2 * np.pi * 100 * t), fs, "N"),
+        Channel("Velocity", "velocity", 0.01 * np.sin(2 * np.pi * 100 * t - 1.2), fs, "m/s")),
+        sha256="ab" * 32, file_format="csv"))
+    with h5py.File(path, "r+") as h5:
+        edit(h5)
+    before = _digest(path)
+    with pytest.raises(StoreError, match=expected):
+        Store(path)
+    export = tmp_path / "run.csv"
+    rows = (f"{a:.17g},{np.sin(2 * np.pi * 100 * a):.17g},"
+            f"{0.01 * np.sin(2 * np.pi * 100 * a - 1.2):.17g}" for a in t)
+    export.write_text("Time [s],Force [N],Velocity [m/s]\n" + "\n".join(rows) + "\n")
+    assert main(["analyze", str(export), "--store", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and expected in err
+    assert _digest(path) == before
+
+
+def test_analysing_the_store_into_itself_is_refused_and_adds_no_copy(tmp_path, capsys):
+    """'pidcore analyze S.h5 --store S.h5' read the store's measurement, whose hash is the
+    store file's, and saved it again under that new key: a copy of a stored measurement, one
+    more on every run (the store's hash changes with each save)."""
+    fs = 25600.0
+    t = np.arange(2560) / fs
+    rows = (f"{a:.17g},{np.sin(2 * np.pi * 100 * a):.17g},"
+            f"{0.01 * np.sin(2 * np.pi * 100 * a - 1.2):.17g}" for a in t)
+    export = tmp_path / "run.csv"
+    export.write_text("Time [s],Force [N],Velocity [m/s]\n" + "\n".join(rows) + "\n")
+    store = tmp_path / "pid_store.h5"
+    assert main(["analyze", str(export), "--store", str(store)]) == 0
+    before = _digest(store)
+    capsys.readouterr()
+    assert main(["analyze", str(store), "--store", str(store)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "is the store being saved to" in err
+    assert _digest(store) == before
+    assert len(Store(store).list_measurements()) == 1
+    assert main(["analyze", str(store), "--no-store"]) == 0  # reading it is fine
