@@ -436,7 +436,15 @@ ANALYSIS_UNITS = {
 def analysis_record(r: AnalyzedRecord) -> dict:
     """Flat scalar record of one analysis, as stored."""
     a = r.analysis
-    return {
+    # an undefined damping ratio (SDC >= 1, or no positive loss factor) is stored as the
+    # store's null (None), with the note saying why, not as NaN. A standard error that cannot
+    # be had stays NaN, the "unknown" every reader of sdc_stderr pools by, with its note.
+    notes = {}
+    if a.damping_ratio is None:
+        notes["damping_ratio_note"] = a.damping_ratio_note
+    if not (math.isfinite(a.sdc_stderr) and math.isfinite(a.loss_factor_stderr)):
+        notes["uncertainty_note"] = a.uncertainty_note
+    record = {
         "frequency_hz": a.frequency_hz,
         "acceleration_g": a.acceleration_g,
         "acceleration_m_s2": a.acceleration_amplitude_m_s2,
@@ -446,7 +454,7 @@ def analysis_record(r: AnalyzedRecord) -> dict:
         "loss_factor_stderr": a.loss_factor_stderr,
         "sdc": a.sdc,
         "sdc_stderr": a.sdc_stderr,
-        "damping_ratio": float("nan") if a.damping_ratio is None else a.damping_ratio,
+        "damping_ratio": a.damping_ratio,
         "energy_per_cycle_j": a.energy_per_cycle_j,
         "max_kinetic_energy_j": a.max_kinetic_energy_j,
         "force_amplitude_n": a.force_amplitude_n,
@@ -457,6 +465,7 @@ def analysis_record(r: AnalyzedRecord) -> dict:
         "velocity_channel": r.channels_used.get("velocity", ""),
         "acceleration_channel": r.channels_used.get("acceleration", ""),
     }
+    return record | notes
 
 
 def analysis_arrays(a: PowerAnalysis) -> dict:

@@ -320,3 +320,31 @@ def test_stored_units_are_those_the_field_names_promise():
             promised = _promised_unit(name)
             if promised is not None:
                 assert unit == promised, f"{name}: stored unit {unit!r}, name says {promised!r}"
+
+
+def test_an_undefined_damping_ratio_is_stored_as_null_with_its_reason_not_as_nan(tmp_path):
+    """SDC >= 1 has no equivalent damping ratio (zeta = -ln(1 - SDC)/(4 pi)): the store held
+    NaN for it (the guide: never a NaN saved as a result). It is now the store's null (None),
+    the note saying why stored beside the numbers."""
+    import json
+    from pathlib import Path
+
+    from pidcore.cli import main
+
+    repo = Path(__file__).resolve().parents[1]
+    export = repo / "data_samples" / "exports" / "synthetic_f500Hz_a1g_fill50_acrylic.csv"
+    store = tmp_path / "s.h5"
+    assert main(["analyze", str(export), "--store", str(store),
+                 "--sidecar", str(repo / "data_samples" / "loadcases.csv")]) == 0
+    with h5py.File(store, "r") as h5:
+        (group,) = h5["analyses"].values()
+        values = dict(group["record"].attrs)
+        nulls = set(json.loads(group.attrs["null_fields_json"]))
+    assert values["sdc"] >= 1  # the bundled export at 500 Hz, 1 g: SDC ~2.2
+    (entry,) = [Store(store).get_analysis(k) for k in Store(store).list_analyses()["key"]]
+    assert entry.record["damping_ratio"] is None
+    assert "SDC" in entry.record["damping_ratio_note"]
+    assert nulls == {"damping_ratio"}  # the one value without a number, marked as such
+    floats = {k: v for k, v in values.items()
+              if isinstance(v, (float, np.floating)) and k not in nulls}
+    assert floats and all(math.isfinite(v) for v in floats.values()), floats
