@@ -6,15 +6,13 @@ number computed from samples the file does not hold (complex parts dropped, a ma
 from __future__ import annotations
 
 import json
-import os
 import shutil
-import subprocess
-import sys
 from pathlib import Path
 
 import h5py
 import numpy as np
 import pytest
+from _peak_memory import read_peak_memory
 
 from pidcore.cli import main
 from pidcore.errors import InputFileError
@@ -274,23 +272,8 @@ def test_a_line_longer_than_any_row_is_refused_before_pandas_buffers_it(tmp_path
         chunk = "0.1,0.2,0.3," * 10_000
         fh.writelines(chunk for _ in range(40 * 2**20 // len(chunk)))
         fh.write("\n")
-    script = (
-        "import sys\n"
-        "import numpy, pandas, pidcore.io\n"
-        "def hwm():\n"
-        "    for line in open('/proc/self/status'):\n"
-        "        if line.startswith('VmHWM:'):\n"
-        "            return int(line.split()[1]) * 1024\n"
-        "base = hwm()\n"
-        "try:\n"
-        "    pidcore.io.read_measurement(sys.argv[1])\n"
-        "except pidcore.errors.InputFileError as exc:\n"
-        "    print(hwm() - base, exc)\n")
-    env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[1])}
-    out = subprocess.run([sys.executable, "-c", script, str(path)], capture_output=True,
-                         text=True, env=env, check=True).stdout
-    grown, message = out.split(" ", 1)
-    assert int(grown) < path.stat().st_size / 4, (grown, path.stat().st_size, message)
+    grown, message = read_peak_memory(path)
+    assert grown < path.stat().st_size / 4, (grown, path.stat().st_size, message)
     assert "one_line.csv: line 202 is longer than 16 MiB" in message
 
 

@@ -23,6 +23,7 @@ import numpy as np
 import pytest
 import pyuff
 import scipy.io
+from _peak_memory import read_peak_memory
 from _shaker_files import file_sha256
 
 from pidcore.cli import main
@@ -457,22 +458,8 @@ def test_csv_reading_memory_within_three_times_the_file(tmp_path):
     path.write_text("Time [s],Force [N],Velocity [m/s]\n"
                     + ("%.10g,%.10g,%.10g\n" * n) % tuple(data.ravel().tolist()),
                     encoding="ascii")
-    # VmHWM (peak resident set) belongs to the new process image; ru_maxrss would carry the
-    # parent's peak over the exec
-    script = (
-        "import sys\n"
-        "import numpy, pandas, pidcore.io\n"
-        "def hwm():\n"
-        "    for line in open('/proc/self/status'):\n"
-        "        if line.startswith('VmHWM:'):\n"
-        "            return int(line.split()[1]) * 1024\n"
-        "base = hwm()\n"
-        "m = pidcore.io.read_measurement(sys.argv[1])\n"
-        "print(hwm() - base, m.channels[0].n_samples)\n")
-    env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[1])}
-    out = subprocess.run([sys.executable, "-c", script, str(path)], capture_output=True,
-                         text=True, env=env, check=True).stdout.split()
-    grown, samples = int(out[0]), int(out[1])
+    grown, said = read_peak_memory(path)
+    samples = int(said.removeprefix("samples "))
     assert samples == n
     assert grown <= 3 * path.stat().st_size, (grown, path.stat().st_size)
 
