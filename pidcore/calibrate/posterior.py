@@ -133,10 +133,17 @@ def sample_grid(model: Model, indices: Sequence[int], *, rng: np.random.Generato
     lo = np.clip(mesh[keep].min(axis=0) - step, 0.0, 1.0)
     hi = np.clip(mesh[keep].max(axis=0) + step, 0.0, 1.0)
     mesh, _, logp, cell = _grid_pass(model, indices, lo, hi, fine)
-    weights = np.exp(logp - logp.max())
+    # each node stands for its cell [u - cell/2, u + cell/2] cut to [lo, hi]: a node on an
+    # edge (a prior bound) holds half a cell per dimension, and its samples are drawn inside
+    # that half only (a full weight clipped to the bound put a point mass there: in 4
+    # dimensions 10-20 % of the samples of a posterior against a bound sat on the bound)
+    cell_lo = np.maximum(mesh - 0.5 * cell, lo)
+    cell_hi = np.minimum(mesh + 0.5 * cell, hi)
+    volume = np.prod((cell_hi - cell_lo) / cell, axis=1)
+    weights = np.exp(logp - logp.max()) * volume
     weights /= weights.sum()
     pick = rng.choice(len(weights), size=n_samples, p=weights)
-    u = np.clip(mesh[pick] + (rng.random((n_samples, k)) - 0.5) * cell, lo, hi)
+    u = cell_lo[pick] + rng.random((n_samples, k)) * (cell_hi[pick] - cell_lo[pick])
     out = np.empty_like(u)
     for j, spec in enumerate(model.specs):
         out[:, j] = _from_unit(spec, u[:, j])[0]
