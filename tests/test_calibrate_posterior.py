@@ -96,3 +96,54 @@ def test_a_posterior_against_a_prior_bound_puts_no_point_mass_on_it(method):
         assert median == pytest.approx(exact[1, j], rel=0.07)
         assert high == pytest.approx(exact[2, j], rel=0.07)
         assert low < 2 * exact[0, j]  # 0.1 and 0.05 of the median: near the bound
+
+
+def _coverage_trial(rng: np.random.Generator, n_dem: int, n_points: int = 8):
+    """One synthetic calibration with the truth drawn from the prior and data from the
+    observation model itself (measurement error, relative discrepancy tau): (which 95 %
+    parameter intervals hold the truth, whether the 95 % band of a held-out point holds its
+    measurement)."""
+    from dataclasses import replace
+
+    from pidcore.calibrate.parameters import parameter_spec
+    from pidcore.calibrate.posterior import predictive
+
+    sigma = 0.01
+    surrogates = [LinearSurrogate(1e-3 * (1 + i), 4e-3 * rng.uniform(0.3, 1.5, n_dem))
+                  for i in range(n_points + 1)]
+    specs = [ParameterSpec(f"p{j}", "dem", 0.5, 0.0, 1.0, "x") for j in range(n_dem)]
+    specs.append(ParameterSpec("baseline_loss_factor", "observation", 0.0, 0.0, 0.05, "eta"))
+    # log-uniform as the default, narrower: no synthetic SDC below 0 (the band is cut there)
+    specs.append(replace(parameter_spec("model_discrepancy"), high=0.3))
+    truth = np.array([math.exp(rng.uniform(math.log(s.low), math.log(s.high)))
+                      if s.prior == "log-uniform" else rng.uniform(s.low, s.high)
+                      for s in specs])
+    fixed = {"fixture_mass_kg": 0.0}
+    blank = tuple(MeasuredPoint(100.0, 1.0, 50.0, 0.0, sigma) for _ in surrogates)
+    model = Model(tuple(specs), tuple(surrogates), blank, fixed, 0.01)
+    points = []
+    for i in range(n_points + 1):
+        sdc, variance = model.predict(truth[None, :], i)
+        points.append(MeasuredPoint(100.0, 1.0, 50.0,
+                                    float(sdc[0] + math.sqrt(variance[0]) * rng.standard_normal()),
+                                    sigma))
+    model = Model(tuple(specs), tuple(surrogates), tuple(points), fixed, 0.01)
+    fitted = range(n_points)  # the last point is held out, as in a leave-one-out fold
+    samples = sample_posterior(model, fitted, seed=int(rng.integers(2**31)), method="grid",
+                               n_samples=2000)
+    low, high = np.percentile(samples, [2.5, 97.5], axis=0)
+    band = predictive(model, samples, n_points, rng=rng)
+    return (low <= truth) & (truth <= high), band["low95"] <= points[-1].sdc <= band["high95"]
+
+
+@pytest.mark.parametrize("n_dem, trials", [(0, 300), (1, 150)])
+def test_95_percent_intervals_cover_the_truth_95_percent_of_the_time(n_dem, trials):
+    # truth drawn from the prior: a Bayesian 95 % interval then holds it with probability
+    # 0.95 exactly, near a bound too; the band of a held-out measurement likewise
+    rng = np.random.default_rng(2026 + n_dem)
+    results = [_coverage_trial(rng, n_dem) for _ in range(trials)]
+    covered = np.array([r[0] for r in results]).mean(axis=0)
+    band = np.mean([r[1] for r in results])
+    tolerance = 3.3 * math.sqrt(0.95 * 0.05 / trials)  # binomial, 3.3 sd
+    assert np.all(np.abs(covered - 0.95) < tolerance), covered
+    assert abs(band - 0.95) < tolerance, band
