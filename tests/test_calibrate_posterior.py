@@ -147,3 +147,27 @@ def test_95_percent_intervals_cover_the_truth_95_percent_of_the_time(n_dem, tria
     tolerance = 3.3 * math.sqrt(0.95 * 0.05 / trials)  # binomial, 3.3 sd
     assert np.all(np.abs(covered - 0.95) < tolerance), covered
     assert abs(band - 0.95) < tolerance, band
+
+
+@pytest.mark.parametrize("truth, sigma", [([0.5, 0.5, 0.02], 0.001),
+                                          ([0.5, 0.5, 0.5, 0.02], 0.0003)])
+def test_a_posterior_narrower_than_the_grid_steps_is_resolved(truth, sigma):
+    # precise data: a correlated posterior far narrower than the coarse grid's step (the
+    # marginal sd 0.2-0.5 % of the prior range). One fine pass on the box the coarse pass
+    # found put it on a handful of nodes, or cut it off: sd 0.7x-5.7x, the mean 0.3-0.6 sd off
+    model, mean, cov, _ = linear_problem(truth, sigma, seed=5)
+    sd = np.sqrt(np.diag(cov))
+    samples = sample_posterior(model, range(8), seed=3, method="grid")
+    assert samples.std(axis=0) == pytest.approx(sd, rel=0.08)
+    assert np.all(np.abs(samples.mean(axis=0) - mean) < 0.15 * sd)
+
+
+def test_a_grid_that_cannot_box_the_posterior_is_refused_or_left_to_emcee(monkeypatch):
+    from pidcore.calibrate import posterior
+
+    model, mean, cov, _ = linear_problem([0.5, 0.5, 0.02], 0.001, seed=5)
+    monkeypatch.setattr(posterior, "GRID_MAX_PASSES", 1)  # no room to zoom in
+    with pytest.raises(posterior.GridUnresolved, match="use --method emcee"):
+        sample_posterior(model, range(8), seed=3, method="grid")
+    samples = sample_posterior(model, range(8), seed=3, method="auto")
+    assert samples.std(axis=0) == pytest.approx(np.sqrt(np.diag(cov)), rel=0.1)
