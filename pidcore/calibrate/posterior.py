@@ -245,7 +245,12 @@ def sample_posterior(model: Model, indices: Sequence[int], *, seed: int = 0,
 
 def predictive(model: Model, samples: np.ndarray, index: int, *,
                rng: np.random.Generator) -> dict:
-    """Posterior-predictive median and 95 % band of a measurement of load case ``index``."""
+    """Prediction of load case ``index``: ``predicted``, the posterior median of the model's
+    SDC (its mean: no measurement error or discrepancy; RMS errors are of it), and ``low95``
+    / ``high95``, the posterior-predictive 95 % band of a measurement there (parameters,
+    surrogate variance, discrepancy, floor and the point's own ``sdc_stderr``: what a
+    measured value is checked against); ``predicted_low95`` / ``predicted_high95``: the 95 %
+    band of the model's SDC alone."""
     sdc, variance = model.predict(samples, index)
     draws = sdc + rng.standard_normal(sdc.shape) * np.sqrt(variance)
     # an SDC is >= 0 (dissipation): the normal error model's tail below 0 is cut there
