@@ -136,7 +136,8 @@ def _coverage_trial(rng: np.random.Generator, n_dem: int, n_points: int = 8):
     return (low <= truth) & (truth <= high), band["low95"] <= points[-1].sdc <= band["high95"]
 
 
-@pytest.mark.parametrize("n_dem, trials", [(0, 300), (1, 150)])
+@pytest.mark.parametrize("n_dem, trials", [(0, 300),
+                                            pytest.param(1, 150, marks=pytest.mark.slow)])
 def test_95_percent_intervals_cover_the_truth_95_percent_of_the_time(n_dem, trials):
     # truth drawn from the prior: a Bayesian 95 % interval then holds it with probability
     # 0.95 exactly, near a bound too; the band of a held-out measurement likewise
