@@ -30,7 +30,8 @@ class CalibratedPrediction:
     load_case : LoadCase
         Load case the calibration predicted (its measured point).
     sdc : float
-        Posterior-predictive median of the Eq. 11 SDC [-].
+        Posterior median of the calibrated model's Eq. 11 SDC [-] (the model's mean; the
+        band is that of a measurement).
     low95, high95 : float
         Bounds of the 95 % posterior-predictive band [-].
     measured : float
