@@ -92,8 +92,12 @@ def test_json_document(capsys, tmp_path, tiny_store):
                  "--dem-store", str(tiny_store), "--out", str(tmp_path / "out"), *TINY])
     assert code == 0
     doc = json.loads(capsys.readouterr().out)
-    assert set(doc) == {"parameters", "predictions", "loo", "loo_rms"}
+    assert set(doc) == {"parameters", "predictions", "loo", "loo_rms", "units"}
     assert set(doc["parameters"]) == {"fixture_mass_kg"}
+    # every number of the document names its unit, as calibration.json's table does
+    assert doc["units"] == {"fixture_mass_kg": "kg", "loo_rms": "-",
+                            "frequency_hz": "Hz", "acceleration_g": "g", "fill_percent": "%",
+                            "measured": "-", "predicted": "-", "low95": "-", "high95": "-"}
     p = doc["parameters"]["fixture_mass_kg"]
     assert set(p) == {"median", "low95", "high95"} and p["low95"] <= p["median"] <= p["high95"]
     keys = {"frequency_hz", "acceleration_g", "fill_percent", "material", "measured",

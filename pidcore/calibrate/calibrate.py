@@ -103,13 +103,17 @@ class CalibrationResult:
                         f"{fitted} (these replace any value stated above)".strip(" -"))
 
     def document(self) -> dict:
-        """The ``--json`` document: parameters, predictions, loo, loo_rms."""
+        """The ``--json`` document: parameters, predictions, loo, loo_rms, and the units of
+        each of their numbers (``units``: the parameters' and the predictions' fields)."""
         keep = ("median", "low95", "high95")
+        predictions = [_public(r) for r in self.predictions]
+        named = {*self.parameters, "loo_rms", *(k for r in predictions for k in r)}
         return {
             "parameters": {n: {k: p[k] for k in keep} for n, p in self.parameters.items()},
-            "predictions": [_public(r) for r in self.predictions],
+            "predictions": predictions,
             "loo": [_public(r) for r in self.loo] if self.loo is not None else None,
             "loo_rms": self.loo_rms,
+            "units": {k: u for k, u in self.units().items() if k in named},
         }
 
     def full_document(self) -> dict:
