@@ -466,7 +466,7 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
     -------
     ReportResult
     """
-    from ..measure import AnalysisOptions, save_analyses
+    from ..measure import AnalysisOptions, refuse_store_among_inputs, save_analyses
 
     formats = parse_formats(formats)
     calibrated = None
@@ -498,6 +498,8 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         dem = main if (main is not None and dem_path == Path(store)) else \
             open_verified_store(dem_path, must_exist=True)
 
+    if main is not None:
+        refuse_store_among_inputs(main, files)  # before reading (it may hold many measurements)
     options = options or AnalysisOptions()
     results = analyze_files(
         files, fill_percent=fill_percent, material=material, direction=direction,
