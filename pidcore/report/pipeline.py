@@ -211,7 +211,9 @@ def _parameters(results: Sequence[MeasuredResult], options: AnalysisOptions) -> 
 
 def measured_frame(results: Iterable[MeasuredResult]) -> pd.DataFrame:
     """The analyses table (as the store lists it) for results that were not stored."""
-    rows = [{"source": str(r.path), **r.record()} for r in results]
+    # the path as stored (\xNN escapes): a file name that is not UTF-8 held surrogates that
+    # pandas' string columns cannot encode (a traceback without --store)
+    rows = [{"source": display_path(r.path), **r.record()} for r in results]
     return pd.DataFrame(rows)
 
 
