@@ -53,6 +53,7 @@ from .compare.loadcase import (
     sidecar_row,
 )
 from .errors import PidcoreError, SettingsTableError
+from .io import display_path
 
 if TYPE_CHECKING:
     import os
@@ -337,7 +338,7 @@ def _stem_hint(path: str | os.PathLike, table_path: Path,
     for line, cell in table["file"].items():
         if re.split(r"[\\/]", str(cell))[-1].casefold() == stem:
             return (f"; line {line} names {cell!r}, without the extension: write "
-                    f"{Path(path).name!r}")
+                    f"{display_path(Path(path).name)!r}")
     return ""
 
 
@@ -396,7 +397,8 @@ def resolve_file_settings(path: str | os.PathLike, options: AnalysisOptions | No
             shown = Path(path).parent / SIDECAR_NAME
             hint = _stem_hint(path, shown, tables)
         if hint or (sidecar is not None and not isinstance(sidecar, pd.DataFrame)):
-            unmatched = (f"{Path(path).name}: no row in {shown} (rows are matched by file "
+            unmatched = (f"{display_path(Path(path).name)}: no row in {display_path(shown)} "
+                         "(rows are matched by file "
                          f"name{hint}); its load case and settings come from its name and the "
                          "options")
         return FileSettings(options, unmatched=unmatched)
@@ -411,7 +413,8 @@ def resolve_file_settings(path: str | os.PathLike, options: AnalysisOptions | No
         if name in given:
             mine = getattr(options, name)
             if not _same(value, mine):
-                notes.append(f"{Path(path).name}: {given[name]} ({_words(name, mine)}) "
+                notes.append(f"{display_path(Path(path).name)}: {given[name]} "
+                             f"({_words(name, mine)}) "
                              f"overrides column {column} {text!r} of {row.where}")
             continue
         changes[name] = value

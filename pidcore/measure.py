@@ -371,18 +371,32 @@ def save_analyses(store, results: Sequence[AnalyzedRecord],
     return SavedAnalyses(keys, notes)
 
 
-def _refuse_the_store_itself(store, results: Sequence[AnalyzedRecord]) -> None:
-    """A measurement read from the store file itself holds that file's hash, not its original
+def refuse_store_among_inputs(store, paths: Sequence[str | os.PathLike]) -> None:
+    """Refuse ``paths`` that are the file of ``store`` (a :class:`~pidcore.store.Store` or
+    path), which the analyses are to be saved to, before anything is read.
+
+    A measurement read from the store file itself holds that file's hash, not its original
     file's: saved, it would be a copy of a stored measurement under a new key, and one more
-    each time (the store's hash changes with every save)."""
-    for r in results:
-        source = Path(r.measurement.source)
+    each time (the store's hash changes with every save). Checked before reading, so that
+    ``pidcore analyze *`` in a folder holding its ``pid_store.h5`` is told so, not asked to
+    choose one of the store's measurements with ``--key`` (which this refusal then met)."""
+    from .store import Store
+
+    store_path = store.path if isinstance(store, Store) else Path(store)
+    for path in paths:
+        source = Path(path)
         with suppress(OSError):
-            if store.path.exists() and source.is_file() and os.path.samefile(source,
-                                                                              store.path):
-                raise StoreError(f"{r.measurement.source}: is the store being saved to; its "
+            if store_path.exists() and source.is_file() and os.path.samefile(source,
+                                                                              store_path):
+                raise StoreError(f"{path}: is the store being saved to; its "
                                  "measurements are stored in it already: analyse it without "
                                  "saving, or save to another store")
+
+
+def _refuse_the_store_itself(store, results: Sequence[AnalyzedRecord]) -> None:
+    """:func:`refuse_store_among_inputs` of the results' sources (a library caller that
+    analysed the store file itself)."""
+    refuse_store_among_inputs(store, [r.measurement.source for r in results])
 
 
 def _stored_case_label(row) -> str:

@@ -75,10 +75,17 @@ def _separator(header: str) -> str:
     return "," if found == r"\s+" else found
 
 
+#: A line of empty cells only (a spreadsheet's ``;;;;`` for an empty row; tab is blank).
+_EMPTY_CELLS = re.compile(r"^[\s;,]*$")
+
+
 def _table_lines(text: str) -> list[tuple[int, str]]:
-    """(line number from 1, line) of the lines that are neither blank nor a comment."""
+    """(line number from 1, line) of the lines that are neither blank, a comment nor a row of
+    empty cells. An empty spreadsheet row above the header (``;;;;``) was taken for the
+    header: the table was refused ('file' in a column without a name) and the app read it as
+    a measurement, analysing every file without its settings."""
     return [(n, ln) for n, ln in enumerate(_LINE_BREAK.split(text), start=1)
-            if ln.strip() and not _is_comment(ln)]
+            if not _EMPTY_CELLS.match(ln) and not _is_comment(ln)]
 
 
 def header_cells(data: bytes) -> list[str]:

@@ -1479,6 +1479,48 @@ def test_a_job_waiting_for_a_cancelled_same_simulation_says_it_was_not_run(tmp_p
     assert states[second.job_id].message.startswith(f"not run: {first.job_id}")
 
 
+def test_a_fill_rounding_to_no_particle_is_a_job_that_says_so_not_a_traceback(tmp_path):
+    # Run with fills "1, 25" on the DEM page: submit computed each case's simulation identity
+    # (particles per cell) and raised "fill 1 % of 22 particles rounds to none" out of the
+    # page's script, a Streamlit traceback, and the valid case was not queued either
+    from pidcore.dem import DemConfig
+
+    config = DemConfig(cells=1, steady_cycles=4, block_cycles=2, max_transient_cycles=2)
+    cases = jobs.plan_dem_cases([1000.0], [5.0], [1.0, 25.0], material="acrylic",
+                                direction="z")
+    runner = jobs.DemJobRunner(tmp_path / "dem.h5")
+    refused, queued = runner.submit(cases, config)
+    assert refused.state == "failed" and "rounds to none" in refused.message
+    assert queued.state in ("queued", "running")
+    assert jobs.submitted_text(2, [refused, queued]).startswith(
+        "1 job(s) submitted; 1 not run (fill 1 % of 22 particles rounds to none")
+    assert runner.cancel() == 1 and runner.wait_cancelled(30)
+
+
+def test_a_unit_slip_note_in_the_app_does_not_point_at_options_the_page_lacks():
+    # a velocity in m/s under 'Velocity [mm/s]' beside an acceleration channel: the note
+    # (added for `pidcore analyze`) told the app user to "check both units (--velocity-unit,
+    # --acceleration-unit)", options the app does not have
+    from pidcore.measure import AnalysisOptions
+
+    fs, f0 = 10_000.0, 100.0
+    t = np.arange(10_000) / fs
+    w = 2 * math.pi * f0
+    v = 0.05 * np.sin(w * t)
+    rows = "\n".join(f"{a:.9e},{0.2 * np.cos(w * a):.9e},{b:.9e},{w * 0.05 * np.cos(w * a):.9e}"
+                     for a, b in zip(t, v, strict=True))
+    data = ("Time [s],Force [N],Velocity [mm/s],Acceleration [m/s^2]\n" + rows + "\n").encode()
+    outcome = uploads.analyze_upload("slip.csv", data, AnalysisOptions())
+    (note,) = [n for n in outcome.record.notes if "unit slip" in n]
+    assert "1000 x" in note and "--velocity-unit," not in note
+    assert "the app takes each channel's unit from its file" in note
+    # a unit the file does not give: the error says where the unit comes from in the app
+    bare = data.replace(b"Force [N]", b"Force")
+    error = uploads.analyze_upload("bare.csv", bare, AnalysisOptions()).error
+    assert error is not None and "give it with --force-unit" not in error
+    assert "the app takes units from the file" in error
+
+
 def test_two_refused_settings_tables_are_named_in_the_plural():
     # "the settings table unknown.csv, ambiguous.csv that gives its settings was refused"
     one = uploads.RefusedTable("a.csv", "bad", None)

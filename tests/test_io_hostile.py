@@ -387,3 +387,22 @@ def test_a_file_variable_named_like_an_option_is_not_shown_as_the_flag(tmp_path,
     assert main(["analyze", str(path), "--no-store"]) == 2
     err = capsys.readouterr().err
     assert "('fs' or 'sample_rate_hz')" in err and "give the sample rate (--sample-rate)" in err
+
+
+@pytest.mark.parametrize("fs", [0.0, np.nan, "fast"])
+def test_a_bad_file_rate_gives_way_to_the_sample_rate_given(tmp_path, capsys, fs):
+    """--sample-rate overrides a plain MAT file's rate (as it overrides its time vector), but
+    a file rate that is no rate (fs = 0, NaN, text) was refused even with --sample-rate given:
+    'variable fs is 0.0; expected a finite positive number', with no way round it. Now the
+    given rate is used and the file's value noted; without it the file is still refused."""
+    path = tmp_path / "plain.mat"
+    _simple_mat(fs=fs)(path)
+    with pytest.raises(InputFileError, match="variable fs is"):
+        read_measurement(path)
+    m = read_measurement(path, sample_rate_hz=_FS)
+    assert {c.sample_rate_hz for c in m.channels} == {_FS}
+    assert main(["analyze", str(path), "--sample-rate", str(_FS), "--force-unit", "N",
+                 "--velocity-unit", "m/s", "--fill", "50", "--no-store", "--json"]) == 0
+    (rec,) = json.loads(capsys.readouterr().out)["records"]
+    assert rec["frequency_hz"] == pytest.approx(100.0, rel=1e-6)
+    assert any("variable fs is" in n and "(--sample-rate)" in n for n in rec["notes"])

@@ -680,3 +680,27 @@ def test_report_of_a_non_utf8_file_name_writes_it_escaped(tmp_path, capsys):
     provenance = (out / "report.provenance.txt").read_text(encoding="utf-8")
     assert "input: run_\\xe9_fill50_acrylic.csv sha256" in provenance
     assert "\\udc" not in ascii(printed + provenance)
+
+
+def test_report_without_a_store_of_a_non_utf8_file_name_writes_it_escaped(tmp_path, capsys):
+    """`pidcore report FILE --out DIR` (no --store, the default) of a file whose name is not
+    UTF-8 ended in a pandas/pyarrow UnicodeEncodeError traceback (exit 1): the measured rows
+    held the raw path; with a --sidecar lacking its row the note did too, and without a fill
+    the refusal printed the name as '\\udce9'."""
+    rec = _record(n_periods=12)
+    path = Path(tmp_path, os.fsdecode(b"run_\xe9_acrylic.csv"))
+    write_measurement(Measurement("x", (Channel("Force", "force", rec.force_n, FS, "N"),
+                                        Channel("Velocity", "velocity", rec.velocity_m_s, FS,
+                                                "m/s"))), path, "csv")
+    sidecar = tmp_path / "other.csv"
+    sidecar.write_text("file,fill_percent\nother.csv,50\n", encoding="utf-8")
+    out = tmp_path / "rep"
+    assert main(["report", str(path), "--fill", "50", "--sidecar", str(sidecar),
+                 "--out", str(out), "--format", "csv"]) == 0
+    printed = capsys.readouterr().out
+    assert "run_\\xe9_acrylic.csv: no row in" in printed
+    provenance = (out / "report.provenance.txt").read_text(encoding="utf-8")
+    assert "\\udc" not in ascii(printed + provenance)
+    assert main(["report", str(path), "--out", str(tmp_path / "rep2")]) == 2
+    err = capsys.readouterr().err
+    assert "run_\\xe9_acrylic.csv: no fill" in err and "\\udc" not in ascii(err)

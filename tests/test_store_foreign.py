@@ -84,3 +84,32 @@ def test_analysing_the_store_into_itself_is_refused_and_adds_no_copy(tmp_path, c
     assert _digest(store) == before
     assert len(Store(store).list_measurements()) == 1
     assert main(["analyze", str(store), "--no-store"]) == 0  # reading it is fine
+
+
+def test_the_store_among_the_files_is_refused_before_it_is_read(tmp_path, capsys):
+    """'pidcore analyze *' run twice in a folder holding its pid_store.h5: the store (of two
+    measurements) was read as an input and refused with 'holds 2 measurements ...; choose one
+    with --key NAME', advice that only led to 'is the store being saved to'. report FILES
+    --store did the same. Both now name the store at once and leave it unchanged."""
+    fs = 25600.0
+    t = np.arange(2560) / fs
+    exports = []
+    for i, f in enumerate((100.0, 200.0)):
+        rows = (f"{a:.17g},{np.sin(2 * np.pi * f * a):.17g},"
+                f"{0.01 * np.sin(2 * np.pi * f * a - 1.2):.17g}" for a in t)
+        export = tmp_path / f"run{i}_fill50.csv"
+        export.write_text("Time [s],Force [N],Velocity [m/s]\n" + "\n".join(rows) + "\n")
+        exports.append(str(export))
+    store = tmp_path / "pid_store.h5"
+    assert main(["analyze", *exports, "--store", str(store)]) == 0
+    before = _digest(store)
+    capsys.readouterr()
+    for args in (["analyze", *exports, str(store), "--store", str(store)],
+                 ["report", *exports, str(store), "--store", str(store),
+                  "--out", str(tmp_path / "out")]):
+        assert main(args) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and "is the store being saved to" in err, err
+        assert "--key" not in err
+        assert _digest(store) == before
+    assert len(Store(store).list_measurements()) == 2

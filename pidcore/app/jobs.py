@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from .. import defaults
-from ..errors import ParameterError
+from ..errors import ParameterError, PidcoreError
 
 #: Job states, in the order a job passes through them.
 JOB_STATES = ("queued", "running", "saved", "in store", "same run", "cancelled", "failed")
@@ -184,7 +184,18 @@ class DemJobRunner:
                       if j.state in ("queued", "running")}
             for case in cases:
                 key = run_key(case, config, specimen)
-                identity = run_identity(case, config, specimen)
+                try:
+                    identity = run_identity(case, config, specimen)
+                except PidcoreError as exc:
+                    # a case the DEM cannot run (a fill rounding to no particle): its job
+                    # says why, as `pidcore dem run` refuses it; the other cases run
+                    self._counter += 1
+                    job = DemJob(f"job{self._counter:04d}", case, config, key, specimen,
+                                 state="failed", message=f"not run: {exc}")
+                    job.finished = time.time()
+                    self._jobs.append(job)
+                    created.append(job)
+                    continue
                 running = active.get(identity)
                 if running is not None and running.run_key == key:
                     continue  # this very run is queued or running
@@ -429,11 +440,15 @@ DEM_RUN_COLUMNS = {"specimen": "specimen", "frequency_hz": "frequency [Hz]",
 
 def submitted_text(n_cases: int, created: Sequence[DemJob]) -> str:
     """What a click on Run did: jobs that will run, runs already in the store (not run
-    again), cases that are the same simulation as another job (run once), and cases already
-    queued or running (not submitted again)."""
+    again), cases that are the same simulation as another job (run once), cases the DEM
+    cannot run (a fill rounding to no particle: not run, the first one's reason said), and
+    cases already queued or running (not submitted again)."""
     stored = sum(j.state == "in store" for j in created)
     same = sum(j.state == SAME_RUN_STATE for j in created)
-    parts = [f"{len(created) - stored - same} job(s) submitted"]
+    refused = [j for j in created if j.state == "failed"]  # cases the DEM cannot run
+    parts = [f"{len(created) - stored - same - len(refused)} job(s) submitted"]
+    if refused:
+        parts.append(f"{len(refused)} not run ({refused[0].message.removeprefix('not run: ')})")
     if stored:
         parts.append(f"{stored} already in the store, not run again")
     if same:

@@ -161,9 +161,23 @@ class UploadOutcome:
         return self.record is not None
 
 
+def app_words(text: str) -> str:
+    """A library message or note as the app says it: the app has no unit setting (it takes
+    each channel's unit from its file), so the unit options of ``pidcore analyze`` a message
+    suggests are named as that command's, not as choices of the page."""
+    text = text.replace(
+        "check both units (--velocity-unit, --acceleration-unit)",
+        "check both units in the export (the app takes each channel's unit from its file; "
+        "`pidcore analyze --velocity-unit/--acceleration-unit` override them)")
+    return re.sub(r"give it with --(force|velocity|acceleration)-unit UNIT",
+                  r"state it in the export (the app takes units from the file; "
+                  r"`pidcore analyze --\1-unit UNIT` gives it)", text)
+
+
 def error_message(name: str, exc: BaseException) -> str:
     """One-line message for a failed upload; library errors already name the file."""
     text = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+    text = app_words(text)
     text = re.sub(r"\S*pidcore_upload_[^/\\\s]*[/\\][^:\s]*", name, text)
     # The library's hints name CLI options; in the app the same choice is a table column.
     text = re.sub(r"--(force|velocity|acceleration) NAME", r"the '\1 channel' column", text)
@@ -202,6 +216,8 @@ def analyze_parsed(parsed: ParsedUpload, options: AnalysisOptions) -> UploadOutc
         record = analyze_measurement(parsed.measurement, options)
     except _BAD_INPUT_ERRORS as exc:
         return UploadOutcome(parsed.name, parsed.sha256, error=error_message(parsed.name, exc))
+    # the unit-slip note suggested `analyze` options the page does not have
+    record = replace(record, notes=tuple(app_words(n) for n in record.notes))
     return UploadOutcome(parsed.name, parsed.sha256, record=record)
 
 

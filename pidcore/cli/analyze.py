@@ -91,6 +91,10 @@ def _run(args: argparse.Namespace) -> int:
     # refused before any analysis (a folder, a foreign file); its commit count says after a
     # Ctrl-C whether the records were saved, even if it came as the commit returned
     store = None if args.no_store else Store(args.store)
+    if store is not None:
+        from ..measure import refuse_store_among_inputs
+
+        refuse_store_among_inputs(store, args.paths)
     results: list = []
     try:
         # Analyse everything before writing anything: one bad file leaves the store untouched.

@@ -427,7 +427,10 @@ def _sidecar_entry(row: SidecarRow,
 
 def missing_fill_message(path: str | Path) -> str:
     """The error text for a measurement without a stated fill (names the three ways)."""
-    return (f"{Path(path).name}: no fill (packing ratio, %) stated; state it (1) in the file name, "
+    from ..io import display_path
+
+    return (f"{display_path(Path(path).name)}: no fill (packing ratio, %) stated; state it "
+            "(1) in the file name, "
             f"e.g. '..._fill50_...' or '..._50pct_...', (2) in a sidecar table {SIDECAR_NAME} "
             f"beside the file or given with --sidecar (columns {', '.join(SIDECAR_COLUMNS)}), "
             "or (3) with --fill")

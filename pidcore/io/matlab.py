@@ -378,9 +378,17 @@ def _simple_layout(variables: Mapping, where: str,
         n = _numeric_vector(public[time_key]).size
         notes += [note] if note else []
     elif rate_key is not None or sample_rate_hz is not None:
-        rate = (real_scalar(public[rate_key], where=f"{where}: variable {rate_key}",
-                            positive=True) if rate_key is not None
-                else float(sample_rate_hz))
+        try:
+            rate = (real_scalar(public[rate_key], where=f"{where}: variable {rate_key}",
+                                positive=True) if rate_key is not None
+                    else float(sample_rate_hz))
+        except InputFileError as exc:
+            if sample_rate_hz is None:
+                raise
+            # --sample-rate overrides the file's rate, as it overrides a time vector: a file
+            # rate that is no rate at all (0, NaN) is noted, not refused
+            rate = float(sample_rate_hz)
+            notes.append(f"{exc}; the sample rate {rate:g} Hz given is used (--sample-rate)")
         start, n = 0.0, None
     else:
         raise InputFileError(f"{where}: no time vector ('time' or 't') and no sample rate "

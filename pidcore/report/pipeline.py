@@ -211,7 +211,9 @@ def _parameters(results: Sequence[MeasuredResult], options: AnalysisOptions) -> 
 
 def measured_frame(results: Iterable[MeasuredResult]) -> pd.DataFrame:
     """The analyses table (as the store lists it) for results that were not stored."""
-    rows = [{"source": str(r.path), **r.record()} for r in results]
+    # the path as stored (\xNN escapes): a file name that is not UTF-8 held surrogates that
+    # pandas' string columns cannot encode (a traceback without --store)
+    rows = [{"source": display_path(r.path), **r.record()} for r in results]
     return pd.DataFrame(rows)
 
 
@@ -466,7 +468,7 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
     -------
     ReportResult
     """
-    from ..measure import AnalysisOptions, save_analyses
+    from ..measure import AnalysisOptions, refuse_store_among_inputs, save_analyses
 
     formats = parse_formats(formats)
     calibrated = None
@@ -498,6 +500,8 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         dem = main if (main is not None and dem_path == Path(store)) else \
             open_verified_store(dem_path, must_exist=True)
 
+    if main is not None:
+        refuse_store_among_inputs(main, files)  # before reading (it may hold many measurements)
     options = options or AnalysisOptions()
     results = analyze_files(
         files, fill_percent=fill_percent, material=material, direction=direction,
