@@ -79,6 +79,19 @@ def _separator(header: str) -> str:
 _EMPTY_CELLS = re.compile(r"^[\s;,]*$")
 
 
+#: Excel's separator hint, a first line ``sep=;`` that tells it how to split the file.
+_SEPARATOR_HINT = re.compile(r'^\s*"?sep=(.)"?\s*$', re.IGNORECASE)
+
+
+def _table_start(text: str) -> tuple[list[tuple[int, str]], str]:
+    """The table's lines (:func:`_table_lines`) after any separator hint of Excel's
+    (``sep=;`` as the first line), and the separator: the hint's, else the header's."""
+    lines = _table_lines(text)
+    if lines and (hint := _SEPARATOR_HINT.match(lines[0][1])):
+        return lines[1:], hint.group(1)
+    return lines, _separator(lines[0][1]) if lines else ","
+
+
 def _table_lines(text: str) -> list[tuple[int, str]]:
     """(line number from 1, line) of the lines that are neither blank, a comment nor a row of
     empty cells. An empty spreadsheet row above the header (``;;;;``) was taken for the
@@ -92,11 +105,10 @@ def header_cells(data: bytes) -> list[str]:
     """The header cells of a table (its first line that is neither blank nor a comment),
     stripped of blanks and quotes; ``[]`` for none. For telling a table from a measurement
     without reading it all."""
-    lines = _table_lines(decode_table(data[:1 << 16]))
+    lines, separator = _table_start(decode_table(data[:1 << 16]))
     if not lines:
         return []
-    first = lines[0][1]
-    cells = next(csv.reader([first], delimiter=_separator(first), skipinitialspace=True))
+    cells = next(csv.reader([lines[0][1]], delimiter=separator, skipinitialspace=True))
     return [c.strip().strip('"').strip() for c in cells]
 
 
@@ -132,11 +144,10 @@ def read_text_table(data: bytes, where: str, *, numeric: Iterable[str] = (),
         counts); a header naming a column twice; a value in a column without a name (an
         unnamed column without values, a spreadsheet's trailing ``;;``, is left out).
     """
-    kept = _table_lines(decode_table(data))
+    kept, separator = _table_start(decode_table(data))
     if not kept:
         raise InputFileError(f"{where}: empty table; expected a header line such as "
                              f"'{example}' and one row per {row}")
-    separator = _separator(kept[0][1])
     reader = csv.reader((ln for _, ln in kept), delimiter=separator, skipinitialspace=True)
     rows: list[tuple[int, list[str]]] = []
     try:

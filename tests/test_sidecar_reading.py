@@ -288,3 +288,19 @@ def test_an_empty_spreadsheet_row_above_the_header_is_skipped_in_the_cli_and_the
     table = uploads.read_settings_table("loadcases.csv", data)
     assert table["vibrometer delay [µs]"].tolist() == [50.0]
     assert table.attrs["lines"] == [3]  # rows still named by their line in the file
+
+
+@pytest.mark.parametrize("hint", ["sep=;", '"sep=;"', "SEP=;"])
+def test_excels_separator_hint_line_is_read_in_the_cli_and_the_app(tmp_path, capsys, hint):
+    # a CSV that starts with Excel's separator hint ('sep=;', which Excel writes for files it
+    # should split at ';') was refused: the hint was taken for a one-column header ("line 2: 5
+    # cells, but the header (line 1) names 2 columns"), and the app saw no settings table
+    path = copy_f(tmp_path)
+    data = f"{hint}\r\nfile;velocity_delay_us\r\n{F.name};50,0\r\n".encode()
+    (tmp_path / "loadcases.csv").write_bytes(data)
+    (rec,) = analyze_json([str(path)], capsys)["records"]
+    assert rec["sdc"] == pytest.approx(SDC_50US, abs=TOL)
+    assert uploads.is_settings_table(data)
+    table = uploads.read_settings_table("loadcases.csv", data)
+    assert table["vibrometer delay [µs]"].tolist() == [50.0]
+    assert table.attrs["lines"] == [3]  # rows still named by their line in the file
