@@ -214,3 +214,24 @@ def test_sweep_json_gives_each_cases_key_and_results(stored, tmp_path, capsys):
             assert case[name] == row[name], name
         assert isinstance(case["steady_detected"], bool)
     assert doc["cases"][0]["particles_per_cell"] == 6
+
+
+def test_runs_of_two_particle_counts_within_the_fill_tolerance_are_two_cases():
+    """The trial: runs at 40 % (18 particles per cell) and 40.5 % (19) of one specimen, within
+    the 0.5-point fill tolerance, were pooled into one row with 2 runs (a standard error as of
+    two replicates, of two different beds), its label moving with the measurements present.
+    They are two cases now; a measurement at 40 % meets the 18-particle one, at 40.5 % the
+    other. Pooling (``pool``) still pools them, as asked."""
+    runs = _runs(("a", 40.0, 12345, 18), ("b", 40.5, 12345, 19))
+    cases = dem_cases(runs)
+    assert [(c.load_case.fill_percent, c.particles_per_cell, c.n_runs) for c in cases] == [
+        (40.0, 18.0, 1), (40.5, 19.0, 1)]
+    aligner = Aligner.from_tables(runs)
+    assert aligner.align(LoadCase(1000.0, 5.0, 40.0)).grid_case.run_keys == ("a",)
+    assert aligner.align(LoadCase(1000.0, 5.0, 40.5)).grid_case.run_keys == ("b",)
+    (pooled,) = dem_cases(runs, pool_settings=True)
+    assert pooled.n_runs == 2
+    # a run that does not state its count joins either (nothing shows it is another bed)
+    unknown = _runs(("a", 40.0, 12345, 18), ("c", 40.2, 777, 18))
+    unknown["particles_per_cell"] = [18.0, math.nan]
+    assert [c.n_runs for c in dem_cases(unknown)] == [2]

@@ -395,8 +395,10 @@ def dem_cases(dem_runs: pd.DataFrame, *, tolerances: Tolerances | None = None,
               reference_fills: Iterable[float] = ()) -> list[DemCase]:
     """Group DEM runs into load cases (runs within the tolerances pool into one case).
 
-    Runs of different numerical settings (a 2-cell smoke run beside a 32-cell run) are separate
-    cases unless ``pool_settings`` is true; only seeds are pooled.
+    Runs of different numerical settings (a 2-cell smoke run beside a 32-cell run), or of
+    different particle counts within the fill tolerance (40 and 40.5 % of a 46-sphere cell: 18
+    and 19 particles), are separate cases unless ``pool_settings`` is true; only seeds are
+    pooled.
 
     Parameters
     ----------
@@ -426,6 +428,12 @@ def dem_cases(dem_runs: pd.DataFrame, *, tolerances: Tolerances | None = None,
     # each run's stored inputs parsed once, for its settings and its simulation identity
     params = [stored_parameters(v) for v in runs["parameters_json"]] \
         if "parameters_json" in runs.columns else [None] * len(runs)
+    # runs of another particle count are another bed, not a replicate, even within the fill
+    # tolerance (40 and 40.5 % of a 46-sphere cell: 18 and 19): not pooled unless pooling is
+    # asked for (NaN: unknown, joins any)
+    counts = pd.to_numeric(runs["particles_per_cell"], errors="coerce").to_numpy(float) \
+        if "particles_per_cell" in runs.columns and not pool_settings \
+        else np.full(len(runs), np.nan)
     groups: list[tuple[LoadCase, str, list[int]]] = []
     cells_of: dict[str, float] = {}
     for pos, (_, row) in enumerate(runs.iterrows()):
@@ -433,7 +441,8 @@ def dem_cases(dem_runs: pd.DataFrame, *, tolerances: Tolerances | None = None,
         settings, cells = ("", math.nan) if pool_settings else _settings_of(row, params[pos])
         cells_of[settings] = cells
         for grid, grid_settings, members in groups:
-            if grid_settings == settings and tolerances.matches(case, grid):
+            if grid_settings == settings and tolerances.matches(case, grid) and (
+                    _same_count(counts[pos], counts[members])):
                 members.append(pos)
                 break
         else:
@@ -466,6 +475,15 @@ def dem_cases(dem_runs: pd.DataFrame, *, tolerances: Tolerances | None = None,
                            cells_of.get(settings, math.nan), _not_converged(sub),
                            dup_keys, dup_fills))
     return sorted(out, key=lambda c: (*_sort_key(c.load_case), c.settings))
+
+
+def _same_count(count: float, group: np.ndarray) -> bool:
+    """Whether a run of ``count`` particles per cell may join a group of runs of ``group``
+    counts: the same count as every member that states one (an unknown count joins any)."""
+    if not math.isfinite(count):
+        return True
+    known = group[np.isfinite(group)]
+    return bool(np.all(known == count))
 
 
 def _most_common(fills: np.ndarray) -> list[float]:
