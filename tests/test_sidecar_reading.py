@@ -273,30 +273,18 @@ def test_a_row_naming_the_file_without_its_extension_is_pointed_out(tmp_path, ca
     assert any(n.startswith(said) for n in doc["notes"])
 
 
-def test_an_empty_spreadsheet_row_above_the_header_is_skipped_in_the_cli_and_the_app(
-        tmp_path, capsys):
-    # Excel saved a sheet whose first row was left empty: ';;;;' above the header. It was
-    # taken for the header: the CLI refused the table ("'file' in column 1, which the header
-    # (line 1) leaves without a name") and the app did not see a settings table in it (it was
-    # read as a measurement, and every export analysed without its 50 us delay).
+# A line above the header that is no header, as Excel writes them: an empty first row
+# (';;;;') was taken for the header, so the CLI refused the table ("'file' in column 1, which
+# the header (line 1) leaves without a name") and the app did not see a settings table (it read
+# it as a measurement and analysed every export without its 50 us delay); the separator hint
+# 'sep=;' was taken for a one-column header ("line 2: 5 cells, but the header (line 1) names 2
+# columns").
+@pytest.mark.parametrize("first, trail", [(";;;;", ";;;"), ("sep=;", ""), ('"sep=;"', ""),
+                                          ("SEP=;", "")])
+def test_a_spreadsheets_line_above_the_header_is_read_in_the_cli_and_the_app(tmp_path, capsys,
+                                                                              first, trail):
     path = copy_f(tmp_path)
-    data = f";;;;\r\nfile;velocity_delay_us;;;\r\n{F.name};50,0;;;\r\n".encode()
-    (tmp_path / "loadcases.csv").write_bytes(data)
-    (rec,) = analyze_json([str(path)], capsys)["records"]
-    assert rec["sdc"] == pytest.approx(SDC_50US, abs=TOL)
-    assert uploads.is_settings_table(data)
-    table = uploads.read_settings_table("loadcases.csv", data)
-    assert table["vibrometer delay [µs]"].tolist() == [50.0]
-    assert table.attrs["lines"] == [3]  # rows still named by their line in the file
-
-
-@pytest.mark.parametrize("hint", ["sep=;", '"sep=;"', "SEP=;"])
-def test_excels_separator_hint_line_is_read_in_the_cli_and_the_app(tmp_path, capsys, hint):
-    # a CSV that starts with Excel's separator hint ('sep=;', which Excel writes for files it
-    # should split at ';') was refused: the hint was taken for a one-column header ("line 2: 5
-    # cells, but the header (line 1) names 2 columns"), and the app saw no settings table
-    path = copy_f(tmp_path)
-    data = f"{hint}\r\nfile;velocity_delay_us\r\n{F.name};50,0\r\n".encode()
+    data = f"{first}\r\nfile;velocity_delay_us{trail}\r\n{F.name};50,0{trail}\r\n".encode()
     (tmp_path / "loadcases.csv").write_bytes(data)
     (rec,) = analyze_json([str(path)], capsys)["records"]
     assert rec["sdc"] == pytest.approx(SDC_50US, abs=TOL)
