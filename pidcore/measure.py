@@ -210,12 +210,13 @@ def _drive_amplitude(channel: Channel, omega_rad_s: float) -> float:
 
 
 def _unit_slip_notes(measurement: Measurement, chosen: Mapping[str, Channel],
-                     omega_rad_s: float) -> list[str]:
+                     analysis: PowerAnalysis) -> list[str]:
     """A note per acceleration channel (used or ignored) whose drive-line amplitude is more
     than :data:`UNIT_SLIP_FACTOR` times off omega |V| of the velocity channel used: one of the
     two units is likely wrong. A velocity exported in mm/s but labelled m/s changes neither the
     loss factor nor the SDC (force and velocity scale Re and Im of P_c alike), so nothing else
-    shows it; the acceleration amplitude and the energy per cycle come out 1000 times off."""
+    shows it; the acceleration amplitude and the energy per cycle come out 1000 times off.
+    omega |V| is the analysis' own (its fundamental velocity phasor), not fitted again."""
     velocity = chosen.get("velocity")
     if velocity is None or velocity.data.size < 8:
         return []
@@ -225,10 +226,10 @@ def _unit_slip_notes(measurement: Measurement, chosen: Mapping[str, Channel],
     if "acceleration" in chosen:
         accelerations = [chosen["acceleration"]] + [c for c in accelerations
                                                      if c.name != chosen["acceleration"].name]
-    expected = omega_rad_s * _drive_amplitude(velocity, omega_rad_s)
+    expected = analysis.acceleration_amplitude_m_s2
     notes = []
     for acc in accelerations:
-        amplitude = _drive_amplitude(acc, omega_rad_s)
+        amplitude = _drive_amplitude(acc, analysis.omega_rad_s)
         if not (expected > 0 and amplitude > 0):
             continue
         ratio = amplitude / expected
@@ -286,7 +287,7 @@ def analyze_measurement(measurement: Measurement, options: AnalysisOptions) -> A
         n_harmonics=options.n_harmonics,
         allow_clipped=options.allow_clipped,
     )
-    notes.extend(_unit_slip_notes(measurement, chosen, analysis.omega_rad_s))
+    notes.extend(_unit_slip_notes(measurement, chosen, analysis))
     used = {role: ch.name for role, ch in chosen.items()}
     detail = tuple({"role": role, "name": ch.name, "unit": ch.unit,
                     "source_unit": ch.source_unit} for role, ch in chosen.items())
