@@ -215,6 +215,17 @@ _KIND_WORDS = {"c": "complex numbers", "S": "text", "U": "text", "O": "objects (
                "M": "dates", "m": "time spans"}
 
 
+def real_numbers(values: object, *, where: str) -> np.ndarray:
+    """``values`` as an array of real numbers (integers, floats, booleans) of any shape, or an
+    :class:`InputFileError` naming what they are instead (complex, text, records, ...)."""
+    arr = np.asarray(values)
+    kind = arr.dtype.kind
+    if kind not in "biuf":
+        raise InputFileError(f"{where}: samples are {_KIND_WORDS.get(kind, str(arr.dtype))}; "
+                             "expected real numbers")
+    return arr
+
+
 def real_samples(values: object, *, where: str) -> np.ndarray:
     """``values`` as a 1-D float64 vector of real samples, or an :class:`InputFileError`.
 
@@ -223,11 +234,7 @@ def real_samples(values: object, *, where: str) -> np.ndarray:
     drops the imaginary part without a word), as are text, records, references and matrices
     (flattening a matrix interleaves its columns into one record).
     """
-    arr = np.asarray(values)
-    kind = arr.dtype.kind
-    if kind not in "biuf":
-        raise InputFileError(f"{where}: samples are {_KIND_WORDS.get(kind, str(arr.dtype))}; "
-                             "expected real numbers")
+    arr = real_numbers(values, where=where)
     if sum(n > 1 for n in arr.shape) > 1:
         raise InputFileError(f"{where}: samples have shape {arr.shape}; expected one vector "
                              "per channel")

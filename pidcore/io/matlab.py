@@ -43,6 +43,7 @@ from ._common import (
     make_channel,
     overridden_rate,
     rate_from_times,
+    real_numbers,
     real_samples,
     real_scalar,
     reraise_interrupt,
@@ -326,9 +327,8 @@ def _lms_layout(signal: object, where: str) -> list[Channel]:
             values = np.asarray(y["values"])
         except (KeyError, AttributeError, TypeError, ValueError) as exc:
             raise InputFileError(f"{what}: incomplete x_values/y_values ({exc})") from None
-        if values.dtype.kind not in "biuf":
-            real_samples(values, where=f"{what}: y_values.values")  # raises, naming the kind
-        values = values.astype(np.float64)
+        # real numbers in any shape: a matrix holds one channel per column or row
+        values = real_numbers(values, where=f"{what}: y_values.values").astype(np.float64)
         if not increment > 0:
             raise InputFileError(f"{what}: x_values.increment is {increment!r}; expected a "
                                  "positive sample interval in s")
