@@ -145,22 +145,23 @@ def _stated(value: object) -> bool:
 
 def _number(value: object, column: str, spec: SettingsColumn, where: str) -> float:
     shown = value.strip() if isinstance(value, str) else value
+
+    def refused(what: str) -> SettingsTableError:
+        return SettingsTableError(f"{where}, column {column}: {shown!r} {what}; "
+                                  f"expected {spec.expected}")
+
     if isinstance(value, bool) or not isinstance(value, (str, Real)):
-        raise SettingsTableError(f"{where}, column {column}: {shown!r} is not a number; "
-                             f"expected {spec.expected}")
+        raise refused("is not a number")
     try:
         number = float(value)
     except ValueError:
-        raise SettingsTableError(f"{where}, column {column}: {shown!r} is not a number; "
-                             f"expected {spec.expected}") from None
+        raise refused("is not a number") from None
     if not math.isfinite(number):
-        raise SettingsTableError(f"{where}, column {column}: {shown!r} is not a finite number; "
-                             f"expected {spec.expected}")
+        raise refused("is not a finite number")
     if number < 0:
         # the library takes a signed delay (a late force); a vibrometer only ever lags, and
         # a negative mass or baseline would add what they are meant to remove
-        raise SettingsTableError(f"{where}, column {column}: {shown!r} is negative; "
-                             f"expected {spec.expected}")
+        raise refused("is negative")
     if 0 < number < spec.smallest:
         raise SettingsTableError(
             f"{where}, column {column}: {shown!r} is implausibly small (below "
