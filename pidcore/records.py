@@ -7,6 +7,7 @@ downstream of a reader knows about file formats.
 from __future__ import annotations
 
 import hashlib
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
@@ -15,6 +16,19 @@ import numpy as np
 from .constants import SI_UNITS
 from .errors import ChannelError, StoreError
 
+
+def json_safe(value: object) -> object:
+    """``value`` as JSON takes it: numpy scalars as Python numbers and booleans, non-finite
+    numbers as ``None`` (JSON has no NaN), through dicts, lists and tuples."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    if isinstance(value, dict):
+        return {k: json_safe(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [json_safe(v) for v in value]
+    if isinstance(value, np.generic):
+        return json_safe(value.item())
+    return value
 
 @dataclass(frozen=True)
 class Channel:

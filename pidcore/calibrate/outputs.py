@@ -5,32 +5,20 @@ from __future__ import annotations
 
 import html
 import json
-import math
 import os
 from pathlib import Path
 
 import numpy as np
 
+from ..records import json_safe
 from .calibrate import CalibrationResult
 
 SPECIMEN_FILE = "calibrated_specimen.toml"
 
 
-def _json_safe(value):
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    if isinstance(value, dict):
-        return {k: _json_safe(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_json_safe(v) for v in value]
-    if isinstance(value, np.generic):
-        return _json_safe(value.item())
-    return value
-
-
 def document_json(document: dict) -> str:
     """JSON text of a calibration document (non-finite numbers as null)."""
-    return json.dumps(_json_safe(document), indent=2)
+    return json.dumps(json_safe(document), indent=2)
 
 
 def specimen_text(result: CalibrationResult) -> str:

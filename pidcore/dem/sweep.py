@@ -21,6 +21,7 @@ from pathlib import Path
 
 from ..constants import DriveDirection, ParticleMaterial
 from ..errors import ParameterError
+from ..records import json_safe
 from ..specimen import Specimen
 from .persist import (
     dem_run_entry,
@@ -288,24 +289,9 @@ class SweepSummary:
             row = by_key.loc[case["store_key"]]
             case["stored_fill_percent"] = float(row["fill_percent"])
             for name in SWEEP_CASE_FIELDS:
-                case[name] = _plain(row.get(name))
+                case[name] = json_safe(row.get(name))
             if case.get("steady_detected") is not None:  # the store reads a bool back as 0/1
                 case["steady_detected"] = bool(case["steady_detected"])
-
-
-def _plain(value):
-    """A listing value as JSON takes it (numpy scalars to Python; NaN to None)."""
-    import math
-
-    import numpy as np
-
-    if isinstance(value, np.bool_ | bool):
-        return bool(value)
-    if isinstance(value, np.integer):
-        return int(value)
-    if isinstance(value, np.floating | float):
-        return None if not math.isfinite(float(value)) else float(value)
-    return value
 
 
 def run_sweep(cases: Sequence[LoadCase], config: DemConfig, *,
