@@ -330,14 +330,14 @@ def _stem_hint(path: str | os.PathLike, table_path: Path,
                tables: dict[Path, pd.DataFrame] | None) -> str:
     """``"; line 3 names 'run 13', without the extension"`` where a row names the file's name
     without its extension (as a spreadsheet user types it), else ``""``."""
-    from .compare.loadcase import read_sidecar
+    from .compare.loadcase import base_name, read_sidecar
 
     table = tables.get(table_path) if tables is not None else None
     if table is None:
         table = read_sidecar(table_path)
     stem = Path(path).stem.casefold()
     for line, cell in table["file"].items():
-        if re.split(r"[\\/]", str(cell))[-1].casefold() == stem:
+        if base_name(str(cell)).casefold() == stem:
             return (f"; line {line} names {cell!r}, without the extension: write "
                     f"{display_path(Path(path).name)!r}")
     return ""

@@ -290,7 +290,7 @@ def settings_table(raw: pd.DataFrame, where: str) -> pd.DataFrame:
     return table
 
 
-def _base_name(cell: str) -> str:
+def base_name(cell: str) -> str:
     """The file name of a ``file`` cell without its folder (``/`` or ``\\``): the app and the
     CLI match rows by it, so a table written on another machine still finds its files."""
     return re.split(r"[\\/]", cell)[-1]
@@ -346,7 +346,7 @@ def find_row(table: pd.DataFrame, path: str | Path, shown: str) -> int | None:
     path = Path(path)
     files = [str(f) for f in table["file"]]
     for same in (lambda a, b: a == b, lambda a, b: a.casefold() == b.casefold()):
-        found = [i for i, f in enumerate(files) if same(_base_name(f), path.name)]
+        found = [i for i, f in enumerate(files) if same(base_name(f), path.name)]
         if len(found) > 1:
             # one name under several folders: the row whose folders end the file's path
             parts = path.absolute().parts
