@@ -34,7 +34,6 @@ from .errors import InputFileError
 __all__ = ["decode_table", "header_cells", "line_where", "read_text_table",
            "read_text_table_file"]
 
-_LINE_BREAK = re.compile(r"\r\n|\n|\r")
 #: A number written with a decimal comma (``50,5``, ``-1,2e-3``): only read as a number in a
 #: ``;``- or tab-separated table, where the comma cannot be the separator.
 _DECIMAL_COMMA = re.compile(r"^[+-]?(?:\d+,\d*|,\d+)(?:[eE][+-]?\d+)?$")
@@ -97,6 +96,9 @@ def _table_lines(text: str) -> list[tuple[int, str]]:
     empty cells. An empty spreadsheet row above the header (``;;;;``) was taken for the
     header: the table was refused ('file' in a column without a name) and the app read it as
     a measurement, analysing every file without its settings."""
+    # line breaks as the measurement CSV reader counts them: a row's line is the same number
+    from .io.delimited import _LINE_BREAK
+
     return [(n, ln) for n, ln in enumerate(_LINE_BREAK.split(text), start=1)
             if not _EMPTY_CELLS.match(ln) and not _is_comment(ln)]
 
