@@ -399,3 +399,29 @@ def test_an_empty_data_table_suggests_the_measured_sdc_header(capsys, tmp_path):
     table = _table(tmp_path, text="# nothing yet\n")
     _refused(capsys, tmp_path, ["--data", str(table)], "empty table",
              "'frequency_hz,acceleration_g,fill_percent,sdc'", "one row per load case")
+
+
+def test_auto_falling_back_from_the_grid_to_emcee_is_said(tiny_store, tmp_path, monkeypatch):
+    # --method auto sampled with emcee where the grid could not box the posterior, and the
+    # summary, notes and settings still read as if the grid had been used
+    from pidcore.calibrate import posterior
+    from pidcore.calibrate.data import read_measured_table
+    from pidcore.calibrate.outputs import summary_markdown
+
+    points = read_measured_table(_table(tmp_path))
+    settings = {"fit": ["fixture_mass_kg"], "discrepancy": 0.2, "store_path": tiny_store,
+                "cells": 2, "steady_cycles": 10, "workers": 1, "progress": False,
+                "cross_validate": "loo"}
+    on_grid = calibrate(points, **settings)
+    assert on_grid.settings["method_used"] == "grid"
+    assert not any("emcee" in note for note in on_grid.notes)
+    assert "posterior by grid" in summary_markdown(on_grid)
+    # a box the posterior never spans enough of: the grid cannot settle in its one pass
+    monkeypatch.setattr(posterior, "GRID_MAX_PASSES", 1)
+    monkeypatch.setattr(posterior, "GRID_ZOOM_SHARE", 2.0)
+    fallen = calibrate(points, **settings)
+    assert fallen.settings["method"] == "auto" and fallen.settings["method_used"] == "emcee"
+    notes = " ".join(fallen.notes)
+    assert "--method auto: the grid posterior did not settle" in notes
+    assert "3 of 3 leave-one-out fold(s)" in notes
+    assert "posterior by emcee" in summary_markdown(fallen)

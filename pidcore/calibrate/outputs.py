@@ -60,6 +60,7 @@ def summary_markdown(result: CalibrationResult) -> str:
                  f"{len(result.predictions)} measured load cases; "
                  f"{result.settings['cells']} cells per DEM run, design of "
                  f"{result.settings['design_size']} point(s); "
+                 f"posterior by {result.settings['method_used']}; "
                  f"runs computed {result.runs['computed']}, cached {result.runs['cached']}; "
                  f"{result.wall_s:.1f} s.")
     lines += ["", "| parameter | median | 95 % interval | prior bounds |", "|---|---|---|---|"]
