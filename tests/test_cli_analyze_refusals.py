@@ -182,3 +182,40 @@ def test_usage_errors_are_one_line_naming_the_sub_command(capsys, args, words):
     assert len(err.strip().splitlines()) == 1, err  # no usage block
     for word in words:
         assert word in err
+
+
+@pytest.mark.parametrize("how", ["option", "file name", "sidecar"])
+def test_a_fill_that_puts_no_particle_in_a_cell_is_refused(tmp_path, capsys, how):
+    # `analyze --fill 0.5` (50 % typed as a fraction) was saved as a 0.5 % load case, which
+    # no DEM run can be made at (0.11 of the paper cell's 22 particles) and no report places
+    from pidcore.specimen import paper_specimen
+
+    capacity = paper_specimen().capacity_per_cell()
+    fill = 0.5
+    assert round(fill / 100 * capacity) == 0  # the premise: half a percent is no particle
+    name = "rec_fill0.5pct.csv" if how == "file name" else "rec.csv"
+    path = export(tmp_path / name)
+    args = ["analyze", str(path), "--store", str(tmp_path / "s.h5")]
+    if how == "option":
+        args += ["--fill", str(fill)]
+    if how == "sidecar":
+        (tmp_path / "loadcases.csv").write_text(f"file,fill_percent\n{name},{fill}\n")
+    assert main(args) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1
+    source = {"option": "--fill", "file name": "file name", "sidecar": "loadcases.csv"}[how]
+    assert f"{name} ({source}" in err and "rounds to none" in err
+    assert "was 0.5 meant as 50 %?" in err
+    assert not (tmp_path / "s.h5").exists()  # nothing written
+
+
+def test_the_smallest_fill_holding_a_particle_is_saved(tmp_path, capsys):
+    # the refusal's own bound: the least fill it names rounds to one particle and is kept
+    import re
+
+    path = export(tmp_path / "rec.csv")
+    store = tmp_path / "s.h5"
+    assert main(["analyze", str(path), "--store", str(store), "--fill", "1"]) == 2
+    least = re.search(r"expected >= ([0-9.]+) %", capsys.readouterr().err).group(1)
+    assert main(["analyze", str(path), "--store", str(store), "--fill", least]) == 0
+    assert f"fill{least}pct" in capsys.readouterr().out

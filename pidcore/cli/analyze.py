@@ -69,18 +69,25 @@ def _stated(args: argparse.Namespace) -> tuple[list, list]:
     """What each path states about its load case (None: no fill stated) and how it is analysed
     (:class:`~pidcore.file_settings.FileSettings`), resolved before any analysis so that a bad
     sidecar or option is refused at once."""
+    from ..compare.loadcase import refuse_fill_of_no_particle
     from ..file_settings import resolve_files
 
-    specimen_material = None
+    specimen = specimen_material = None
     if args.specimen is not None:
         from ..specimen import load_specimen
 
-        specimen_material = load_specimen(args.specimen).particles.material
+        specimen = load_specimen(args.specimen)
+        specimen_material = specimen.particles.material
     # (a missing file is named by its analysis)
-    return resolve_files(args.paths, options=analysis_options(args), given=given_options(args),
-                         fill_percent=args.fill, material=args.material,
-                         direction=args.direction, sidecar=args.sidecar,
-                         specimen_material=specimen_material, fill_required=False)
+    stated, settings = resolve_files(
+        args.paths, options=analysis_options(args), given=given_options(args),
+        fill_percent=args.fill, material=args.material, direction=args.direction,
+        sidecar=args.sidecar, specimen_material=specimen_material, fill_required=False)
+    for path, st, fs in zip(args.paths, stated, settings, strict=True):
+        # a sidecar's specimen is only a name: its cell is not known
+        if st is not None and (specimen is not None or not fs.specimen):
+            refuse_fill_of_no_particle(st, display_path(Path(path).name), specimen)
+    return stated, settings
 
 
 def _run(args: argparse.Namespace) -> int:

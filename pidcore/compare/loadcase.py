@@ -131,6 +131,35 @@ class StatedLoadCase:
                         self.material, self.direction)
 
 
+def refuse_fill_of_no_particle(stated: StatedLoadCase, what: str, specimen=None) -> None:
+    """Refuse a stated fill that puts no particle in a cell of the specimen tested.
+
+    ``specimen``: the :class:`~pidcore.specimen.Specimen` (default: the paper's coupon with
+    the stated particles; nothing is checked for a material without a table row, whose cell
+    is not known). The rounding is the DEM's (:func:`pidcore.specimen.particles_for_fill`,
+    100 % = the cell's capacity), so a fill saved here is one the model can be run at: a
+    packing ratio typed as a fraction (0.5 for 50 %) is refused, not stored as a load case
+    no comparison can ever place.
+    """
+    from ..errors import ParameterError
+    from ..specimen import paper_specimen, particles_for_fill
+
+    if specimen is None:
+        if stated.material not in PARTICLE_MATERIALS:
+            return
+        specimen = paper_specimen(stated.material)
+    capacity = specimen.capacity_per_cell()
+    try:
+        particles_for_fill(stated.fill_percent, capacity)
+    except ParameterError as exc:
+        source = next((part.split(": ", 1)[1] for part in stated.origin.split("; ")
+                       if part.startswith("fill: ")), "stated")
+        hint = (f"; was {stated.fill_percent:g} meant as {stated.fill_percent * 100:g} %?"
+                if stated.fill_percent <= 1.0 else "")
+        raise ParameterError(f"{what} ({'--fill' if source == 'option' else source}): {exc} "
+                             f"({specimen.name}'s cell capacity{hint})") from None
+
+
 def _material_tokens(stem: str, names) -> set[str]:
     """Tokens of ``stem`` that are one of ``names`` (lower case): a whole token only, so
     ``steel`` is not found in ``steelcase``."""
