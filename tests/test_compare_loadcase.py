@@ -168,3 +168,27 @@ def test_an_own_material_in_the_file_name_is_recognised_when_known():
     plain = stated_case("coupon_500Hz.csv")
     assert unstated_note(plain) == "fill: not stated, 50 % proposed; material: not stated, " \
                                    "acrylic assumed"
+
+
+def test_the_apps_column_labels_read_as_the_sidecars_columns(tmp_path):
+    # a table typed after the app's settings grid ("fill [%]", "vibrometer delay [µs]") was
+    # refused by `pidcore analyze` ("unknown column") while the app took it
+    from pidcore.compare.loadcase import SETTINGS_COLUMN_LABELS, read_sidecar
+
+    labelled = tmp_path / "labelled.csv"
+    labelled.write_text("File;Fill [%];vibrometer delay [µs];Force channel\n"
+                        "a.uff;62,5;50;Kraft\n", encoding="utf-8")
+    plain = tmp_path / "plain.csv"
+    plain.write_text("file;fill_percent;velocity_delay_us;force\na.uff;62,5;50;Kraft\n",
+                     encoding="utf-8")
+    assert read_sidecar(labelled).equals(read_sidecar(plain))
+    assert read_sidecar(labelled).loc[2, "fill_percent"] == "62.5"  # decimal comma read
+    # every label names a settings column (one vocabulary)
+    from pidcore.compare.loadcase import SETTINGS_COLUMNS
+
+    assert set(SETTINGS_COLUMN_LABELS.values()) == set(SETTINGS_COLUMNS)
+    both = tmp_path / "both.csv"
+    both.write_text("file,fill [%],fill_percent\na.uff,50,50\n")
+    with pytest.raises(PidcoreError, match=r"column 'fill_percent' given more than once "
+                                           r"\(as 'fill \[%\]' and 'fill_percent'\)"):
+        read_sidecar(both)

@@ -29,6 +29,7 @@ from ..compare.loadcase import (
     AUTO_CHANNEL,
     FREE_TEXT_COLUMNS,
     NO_CHANNEL,  # noqa: F401 - the pages read it from here
+    SETTINGS_COLUMN_LABELS,
 )
 from ..constants import PARTICLE_MATERIALS
 from ..errors import ParameterError, PidcoreError
@@ -42,21 +43,9 @@ if TYPE_CHECKING:
 # readers detect) are the sidecar's words too (pidcore.compare.loadcase): one definition.
 
 #: Per-file settings: column shown in the app -> column of the CSV template / uploaded table
-#: (:data:`pidcore.compare.loadcase.SETTINGS_COLUMNS`, the sidecar's columns of the CLI).
-FILE_TABLE_COLUMNS: dict[str, str] = {
-    "file": "file",
-    "fill [%]": "fill_percent",
-    "material": "material",
-    "direction": "direction",
-    "specimen": "specimen",
-    "vibrometer delay [µs]": "velocity_delay_us",
-    "mass below gauge [g]": "mass_below_gauge_g",
-    "baseline loss factor [-]": "baseline_loss_factor",
-    "force channel": "force",
-    "velocity channel": "velocity",
-    "acceleration channel": "acceleration",
-    "inverted channels": "invert",
-}
+#: (:data:`pidcore.compare.loadcase.SETTINGS_COLUMNS`, the sidecar's columns of the CLI, which
+#: reads these labels too: one table for both).
+FILE_TABLE_COLUMNS: dict[str, str] = SETTINGS_COLUMN_LABELS
 _NUMERIC = ("fill [%]", "vibrometer delay [µs]", "mass below gauge [g]",
             "baseline loss factor [-]")
 
@@ -346,7 +335,7 @@ def read_settings_table(name: str, data: bytes,
     number, material (one of ``materials``) or direction.
     """
     from ..compare.loadcase import (
-        NUMERIC_COLUMNS,
+        NUMERIC_HEADERS,
         normalize_direction,
         normalize_material,
         settings_table,
@@ -355,8 +344,7 @@ def read_settings_table(name: str, data: bytes,
     from ..tables import line_where, read_text_table
 
     try:
-        raw = read_text_table(data, name, numeric=(
-            *NUMERIC_COLUMNS, *(k.lower() for k in _NUMERIC)))
+        raw = read_text_table(data, name, numeric=NUMERIC_HEADERS)
     except PidcoreError as exc:
         raise ParameterError(str(exc)) from None
     by_name = {k.lower(): v for k, v in FILE_TABLE_COLUMNS.items()}

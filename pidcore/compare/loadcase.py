@@ -81,6 +81,28 @@ SETTINGS_COLUMNS: tuple[str, ...] = (*SIDECAR_COLUMNS, SPECIMEN_COLUMN,
 #: Columns holding numbers (a ``;``-separated table may write them with a decimal comma).
 NUMERIC_COLUMNS: tuple[str, ...] = ("fill_percent", "velocity_delay_us", "mass_below_gauge_g",
                                     "baseline_loss_factor")
+#: The app's labels of the settings columns (its settings grid shows them, and an uploaded
+#: table may use them) -> the settings table's columns. The CLI's sidecar reads them too, so
+#: one table reads the same in both (a table typed after the app's grid was refused by the CLI).
+SETTINGS_COLUMN_LABELS: dict[str, str] = {
+    "file": "file",
+    "fill [%]": "fill_percent",
+    "material": "material",
+    "direction": "direction",
+    "specimen": "specimen",
+    "vibrometer delay [µs]": "velocity_delay_us",
+    "mass below gauge [g]": "mass_below_gauge_g",
+    "baseline loss factor [-]": "baseline_loss_factor",
+    "force channel": "force",
+    "velocity channel": "velocity",
+    "acceleration channel": "acceleration",
+    "inverted channels": "invert",
+}
+#: Numeric columns by either name, as :func:`pidcore.tables.read_text_table` takes them.
+NUMERIC_HEADERS: tuple[str, ...] = (
+    *NUMERIC_COLUMNS,
+    *(label.lower() for label, column in SETTINGS_COLUMN_LABELS.items()
+      if column in NUMERIC_COLUMNS))
 #: Channel cell meaning "the channel the readers detect" (the app's default, and its template's).
 AUTO_CHANNEL = "(auto)"
 #: Channel cell meaning "no channel named" (the app's choice for an unused acceleration): as
@@ -287,7 +309,7 @@ def read_sidecar(path: str | Path) -> pd.DataFrame:
     if not path.is_file():
         raise LoadCaseError(f"{path}: sidecar table not found")
     try:
-        return settings_table(read_text_table_file(path, numeric=NUMERIC_COLUMNS), str(path))
+        return settings_table(read_text_table_file(path, numeric=NUMERIC_HEADERS), str(path))
     except InputFileError as exc:
         raise LoadCaseError(str(exc)) from None
 
@@ -295,7 +317,16 @@ def read_sidecar(path: str | Path) -> pd.DataFrame:
 def settings_table(raw: pd.DataFrame, where: str) -> pd.DataFrame:
     """A table read by :func:`pidcore.tables.read_text_table` as a settings table (the
     sidecar's and the app's): the checks of :func:`read_sidecar`, columns
-    :data:`SETTINGS_COLUMNS` in order."""
+    :data:`SETTINGS_COLUMNS` in order. A column may be named by its app label
+    (:data:`SETTINGS_COLUMN_LABELS`, any case); one column under both names is refused."""
+    by_label = {label.lower(): column for label, column in SETTINGS_COLUMN_LABELS.items()}
+    named = [by_label.get(str(c).lower(), c) for c in raw.columns]
+    for column in set(named):
+        spelt = [str(c) for c, n in zip(raw.columns, named, strict=True) if n == column]
+        if len(spelt) > 1:
+            raise LoadCaseError(f"{where}: column {column!r} given more than once (as "
+                                f"{' and '.join(map(repr, spelt))}); expected it once")
+    raw = raw.set_axis(named, axis=1)
     if "file" not in raw.columns:
         found = ", ".join(map(repr, raw.columns)) or "none"
         raise LoadCaseError(f"{where}: settings table lacks column 'file' (found {found}); "
