@@ -192,3 +192,25 @@ def test_the_apps_column_labels_read_as_the_sidecars_columns(tmp_path):
     with pytest.raises(PidcoreError, match=r"column 'fill_percent' given more than once "
                                            r"\(as 'fill \[%\]' and 'fill_percent'\)"):
         read_sidecar(both)
+
+
+def test_a_file_named_in_cp1252_finds_its_row_of_a_cp1252_table(tmp_path):
+    # a file named on Windows (Prüfung: byte 0xFC) copied to Linux never matched the row of
+    # the cp1252 table saved beside it, and its fill was silently taken from elsewhere
+    import os
+
+    from pidcore.compare import resolve_load_case
+    from pidcore.compare.loadcase import name_spellings
+
+    try:
+        path = tmp_path / os.fsdecode(b"Pr\xfcfung_fill50.uff")
+        path.write_bytes(b"")
+    except (OSError, UnicodeError):
+        pytest.skip("the file system refuses names that are not UTF-8")
+    (tmp_path / "loadcases.csv").write_bytes("file,fill_percent\nPrüfung_fill50.uff,75\n"
+                                             .encode("cp1252"))
+    assert "Prüfung_fill50.uff" in name_spellings(path.name)
+    stated = resolve_load_case(path, sidecar=None)
+    assert stated.fill_percent == 75.0 and "fill: loadcases.csv" in stated.origin
+    # a UTF-8 name is only itself
+    assert name_spellings("Prüfung.uff") == ("Prüfung.uff",)

@@ -394,6 +394,27 @@ def _ends_with(parts: tuple[str, ...], cell: list[str]) -> bool:
     return len(cell) <= len(parts) and list(parts[len(parts) - len(cell):]) == cell
 
 
+def name_spellings(name: str) -> tuple[str, ...]:
+    """``name`` as the file system gives it, and, where its bytes are not UTF-8 (a file named
+    on Windows, ``Prüfung.uff`` in cp1252, copied to Linux: Python holds the byte 0xFC as a
+    lone surrogate), as cp1252 reads them: the spelling a settings table saved by a Windows
+    spreadsheet (read as cp1252, :mod:`pidcore.tables`) has in its ``file`` cell."""
+    import os
+
+    spellings = [name]
+    raw = os.fsencode(name)
+    try:
+        raw.decode("utf-8")
+    except UnicodeDecodeError:
+        for encoding in ("cp1252", "latin-1"):
+            try:
+                spellings.append(raw.decode(encoding))
+                break
+            except UnicodeDecodeError:  # cp1252 leaves 5 bytes undefined; latin-1 none
+                continue
+    return tuple(spellings)
+
+
 def find_row(table: pd.DataFrame, path: str | Path, shown: str) -> int | None:
     """Position of the row of file ``path`` in a settings ``table`` (None: no row).
 
@@ -405,8 +426,10 @@ def find_row(table: pd.DataFrame, path: str | Path, shown: str) -> int | None:
     """
     path = Path(path)
     files = [str(f) for f in table["file"]]
+    names = name_spellings(path.name)
     for same in (lambda a, b: a == b, lambda a, b: a.casefold() == b.casefold()):
-        found = [i for i, f in enumerate(files) if same(base_name(f), path.name)]
+        found = [i for i, f in enumerate(files)
+                 if any(same(base_name(f), name) for name in names)]
         if len(found) > 1:
             # one name under several folders: the row whose folders end the file's path
             parts = path.absolute().parts
