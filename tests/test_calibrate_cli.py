@@ -97,11 +97,14 @@ def test_json_document(capsys, tmp_path, tiny_store):
     # every number of the document names its unit, as calibration.json's table does
     assert doc["units"] == {"fixture_mass_kg": "kg", "loo_rms": "-",
                             "frequency_hz": "Hz", "acceleration_g": "g", "fill_percent": "%",
-                            "measured": "-", "predicted": "-", "low95": "-", "high95": "-"}
+                            "measured": "-", "measured_stderr": "-", "predicted": "-",
+                            "low95": "-", "high95": "-", "low95_without_stderr": "-",
+                            "high95_without_stderr": "-"}
     p = doc["parameters"]["fixture_mass_kg"]
     assert set(p) == {"median", "low95", "high95"} and p["low95"] <= p["median"] <= p["high95"]
     keys = {"frequency_hz", "acceleration_g", "fill_percent", "material", "measured",
-            "predicted", "low95", "high95"}
+            "measured_stderr", "predicted", "low95", "high95", "low95_without_stderr",
+            "high95_without_stderr"}
     assert len(doc["predictions"]) == len(doc["loo"]) == 3
     assert all(set(r) == keys for r in doc["predictions"] + doc["loo"])
     rms = math.sqrt(sum((r["predicted"] - r["measured"]) ** 2 for r in doc["loo"]) / 3)

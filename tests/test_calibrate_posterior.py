@@ -179,3 +179,39 @@ def test_a_grid_that_cannot_box_the_posterior_is_refused_or_left_to_emcee(monkey
     monkeypatch.setattr(posterior, "GRID_MAX_PASSES", passes)
     resolved = sample_posterior(model, range(8), seed=3, method="auto")
     assert resolved.method == "grid" and resolved.fallback is None
+
+
+def test_a_band_for_another_measurements_stderr_is_that_measurements_band():
+    # a report compared a new measurement with the band of the fitted point's measurement
+    # error: a precise measurement was judged by a noisy point's wide band. The band without
+    # measurement error widened by another stderr must be the band the posterior gives a
+    # point of that stderr (independent normal errors add in quadrature)
+    from dataclasses import replace
+
+    from pidcore.calibrate.posterior import predictive
+    from pidcore.calibrate.prediction import CalibratedPrediction
+    from pidcore.loadcase import LoadCase
+
+    sigma, other = 0.01, 0.05
+    model, _, _, _ = linear_problem([0.4, 0.02], sigma, seed=1)
+    samples = sample_posterior(model, range(8), seed=3, method="grid").samples
+    fitted = predictive(model, samples, 0, rng=np.random.default_rng(7))
+    hit = CalibratedPrediction(LoadCase(100.0, 1.0, 50.0), fitted["predicted"],
+                               fitted["low95"], fitted["high95"], 0.0, sigma,
+                               fitted["low95_without_stderr"], fitted["high95_without_stderr"])
+    # its own point's stderr (or none known): the band calibration.json states, exactly
+    assert hit.band(sigma) == hit.band() == (fitted["low95"], fitted["high95"])
+    # without the measurement error the band is narrower, and no stderr gives exactly it
+    assert fitted["low95"] < fitted["low95_without_stderr"] < fitted["predicted"]
+    assert fitted["predicted"] < fitted["high95_without_stderr"] < fitted["high95"]
+    assert hit.band(0.0) == pytest.approx((fitted["low95_without_stderr"],
+                                           fitted["high95_without_stderr"]), rel=1e-12)
+    # the same posterior asked for a point of stderr 0.05 at that load case
+    points = (replace(model.points[0], sdc_stderr=other), *model.points[1:])
+    noisy = predictive(replace(model, points=points), samples, 0, rng=np.random.default_rng(7))
+    low, high = hit.band(other)
+    width = noisy["high95"] - noisy["low95"]
+    # Monte-Carlo percentiles of the 2.5 % tails of N_SAMPLES draws: ~2 % of the width
+    assert low == pytest.approx(noisy["low95"], abs=0.03 * width)
+    assert high == pytest.approx(noisy["high95"], abs=0.03 * width)
+    assert high - low > 2 * (fitted["high95"] - fitted["low95"])  # 5 x the stderr: far wider

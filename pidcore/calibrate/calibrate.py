@@ -140,7 +140,8 @@ class CalibrationResult:
         exactly the fitted parameters and the fixed ones (from their definitions,
         :attr:`ParameterSpec.unit`)."""
         out = {"frequency_hz": "Hz", "acceleration_g": "g", "fill_percent": "%",
-               "measured": "-", "predicted": "-", "low95": "-", "high95": "-",
+               "measured": "-", "measured_stderr": "-", "predicted": "-", "low95": "-",
+               "high95": "-", "low95_without_stderr": "-", "high95_without_stderr": "-",
                "rms_in_sample": "-", "loo_rms": "-", "energy_per_cycle_per_cell_start_j": "J",
                "energy_per_cycle_per_cell_calibrated_j": "J", "low95_j": "J", "high95_j": "J",
                "wall_s": "s"}
@@ -152,7 +153,8 @@ class CalibrationResult:
 
 def _public(row: dict) -> dict:
     keys = ("frequency_hz", "acceleration_g", "fill_percent", "material", "measured",
-            "predicted", "low95", "high95")
+            "measured_stderr", "predicted", "low95", "high95", "low95_without_stderr",
+            "high95_without_stderr")
     return {k: row[k] for k in keys}
 
 

@@ -275,14 +275,24 @@ def predictive(model: Model, samples: np.ndarray, index: int, *,
     / ``high95``, the posterior-predictive 95 % band of a measurement there (parameters,
     surrogate variance, discrepancy, floor and the point's own ``sdc_stderr``: what a
     measured value is checked against); ``predicted_low95`` / ``predicted_high95``: the 95 %
-    band of the model's SDC alone."""
+    band of the model's SDC alone; ``low95_without_stderr`` / ``high95_without_stderr``: the
+    band of a measurement without measurement error (all of the above but ``sdc_stderr``),
+    which :meth:`pidcore.calibrate.prediction.CalibratedPrediction.band` widens by another
+    measurement's own stderr."""
     sdc, variance = model.predict(samples, index)
-    draws = sdc + rng.standard_normal(sdc.shape) * np.sqrt(variance)
+    normal = rng.standard_normal(sdc.shape)
+    draws = sdc + normal * np.sqrt(variance)
     # an SDC is >= 0 (dissipation): the normal error model's tail below 0 is cut there
     low, high = np.percentile(np.maximum(draws, 0.0), [2.5, 97.5])
+    # the same band without the point's own measurement error (the same normal draws): what
+    # a report widens by another measurement's stderr at this load case
+    stderr = model.points[index].sdc_stderr
+    error_free = sdc + normal * np.sqrt(np.maximum(variance - stderr**2, 0.0))
+    low0, high0 = np.percentile(np.maximum(error_free, 0.0), [2.5, 97.5])
     return {"predicted": float(np.median(sdc)), "low95": float(low), "high95": float(high),
             "predicted_low95": float(np.percentile(sdc, 2.5)),
-            "predicted_high95": float(np.percentile(sdc, 97.5))}
+            "predicted_high95": float(np.percentile(sdc, 97.5)),
+            "low95_without_stderr": float(low0), "high95_without_stderr": float(high0)}
 
 
 def summarise(specs: Sequence[ParameterSpec], samples: np.ndarray) -> tuple[dict, list]:

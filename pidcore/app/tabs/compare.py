@@ -75,12 +75,17 @@ def _calibrated(calibrations, comp, head, specimen: str) -> None:
     c1.metric("SDC measured, Eq. 11 [-]",
               uploads.format_sdc(comp.measured_sdc, comp.measured_stderr))
     c2.metric("SDC DEM, raw [-]", f"{head.dem:.4f}" if math.isfinite(head.dem) else "none")
+    # the band of a measurement with this one's standard error (the report's)
+    low, high = hit.band(comp.measured_stderr if math.isfinite(comp.measured_sdc)
+                         else math.nan)
     c3.metric("SDC calibrated DEM, Eq. 11 [-]", f"{hit.sdc:.4f}",
-              help=f"95 % band {hit.low95:.4f} .. {hit.high95:.4f}")
-    verdict = ("inside" if hit.contains(comp.measured_sdc) else "outside") \
+              help=f"95 % band {low:.4f} .. {high:.4f}")
+    verdict = ("inside" if low <= comp.measured_sdc <= high else "outside") \
         if math.isfinite(comp.measured_sdc) else "not compared (no Eq. 11 SDC)"
-    st.caption(f"calibrated 95 % band {hit.low95:.4f} .. {hit.high95:.4f} [-]; the measured "
-               f"Eq. 11 SDC is {verdict}.")
+    st.caption(f"calibrated 95 % band {low:.4f} .. {high:.4f} [-]"
+               + (f" (for this measurement's SDC stderr {comp.measured_stderr:.3g})"
+                  if (low, high) != (hit.low95, hit.high95) else "")
+               + f"; the measured Eq. 11 SDC is {verdict}.")
 
 
 def render(stores, session_files: list, calibrations: list) -> None:
