@@ -313,10 +313,11 @@ def store_analysis(store, result: AnalyzedRecord, parameters: Mapping, *,
     """
     measurement_key, _ = store.add_measurement(result.measurement)
     record = {**analysis_record(result), **(fields or {})}
+    arrays = analysis_arrays(result.analysis)
     return store.add_analysis(
-        measurement_key, record, arrays=analysis_arrays(result.analysis),
+        measurement_key, record, arrays=arrays,
         parameters={**parameters, "channels": result.channels_used},
-        units={k: v for k, v in ANALYSIS_UNITS.items() if k in record})
+        units={k: v for k, v in ANALYSIS_UNITS.items() if k in record or k in arrays})
 
 
 #: How a saved analysis without a load case is named in notes.
@@ -445,6 +446,8 @@ ANALYSIS_UNITS = {
     "energy_per_cycle_j": "J", "max_kinetic_energy_j": "J", "force_amplitude_n": "N",
     "velocity_amplitude_m_s": "m/s", "displacement_amplitude_m": "m", "n_periods": "1",
     "fill_percent": "%",
+    # arrays (analysis_arrays): harmonic numbers and the phasors x(t) = Re(X e^{j n w t})
+    "harmonics": "1", "force_phasors_n": "N", "velocity_phasors_m_s": "m/s",
 }
 
 

@@ -348,3 +348,32 @@ def test_an_undefined_damping_ratio_is_stored_as_null_with_its_reason_not_as_nan
     floats = {k: v for k, v in values.items()
               if isinstance(v, (float, np.floating)) and k not in nulls}
     assert floats and all(math.isfinite(v) for v in floats.values()), floats
+
+
+def test_stored_analysis_arrays_carry_their_units(tmp_path):
+    """The harmonic phasors of a saved analysis were written with ``unit`` '' (only the record
+    fields' units were passed to the store): a reader of /analyses/<key>/arrays could not tell
+    N from kN. Each array's unit must be the one its name promises, and the phasors must be
+    in it: 1/2 sum F V* of the stored arrays gives back the stored complex power in W."""
+    from pathlib import Path
+
+    from pidcore.cli import main
+
+    repo = Path(__file__).resolve().parents[1]
+    export = repo / "data_samples" / "exports" / "synthetic_f500Hz_a1g_fill50_acrylic.csv"
+    store = tmp_path / "s.h5"
+    assert main(["analyze", str(export), "--store", str(store), "--velocity-delay", "5e-5"]) == 0
+    with h5py.File(store, "r") as h5:
+        (group,) = h5["analyses"].values()
+        arrays = group["arrays"]
+        units = {name: arrays[name].attrs["unit"] for name in arrays}
+        listed = dict(group["units"].attrs)
+        force = arrays["force_phasors_n"][()]
+        velocity = arrays["velocity_phasors_m_s"][()]
+        record = dict(group["record"].attrs)
+    assert units == {"harmonics": "1", "force_phasors_n": "N", "velocity_phasors_m_s": "m/s"}
+    assert {k: listed[k] for k in units} == units  # the units group names them too
+    power = 0.5 * np.sum(force * np.conj(velocity))
+    # same numbers, summed in another order: round-off only
+    assert power.real == pytest.approx(record["complex_power_real_w"], rel=1e-12)
+    assert power.imag == pytest.approx(record["complex_power_imag_w"], rel=1e-12)
