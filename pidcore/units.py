@@ -10,6 +10,7 @@ never taken as SI (the analysis asks for ``--force-unit`` etc.).
 
 from __future__ import annotations
 
+import math
 import re
 from dataclasses import dataclass
 
@@ -171,3 +172,19 @@ def g_to_si(value_g: float) -> float:
 def si_to_g(value_m_s2: float) -> float:
     """Acceleration in m/s^2 to g (standard gravity)."""
     return value_m_s2 / STANDARD_GRAVITY
+
+
+#: Below this magnitude :func:`display_number` switches from four decimals to significant
+#: digits: four decimals would show two digits or fewer of it, or 0.0000.
+DISPLAY_FIXED_MIN = 1e-3
+
+
+def display_number(value: float, *, missing: str = "—") -> str:
+    """A number as shown on a page: four decimals (``0.1856``, ``0.0010``), three significant
+    digits below 0.001 (``0.000157``, ``4.4e-05``) so that no nonzero value reads 0.0000,
+    ``missing`` for NaN, inf or None."""
+    if value is None or not math.isfinite(value):
+        return missing
+    if value == 0 or abs(value) >= DISPLAY_FIXED_MIN:
+        return f"{value:.4f}"
+    return f"{value:.3g}"
