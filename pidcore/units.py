@@ -174,17 +174,13 @@ def si_to_g(value_m_s2: float) -> float:
     return value_m_s2 / STANDARD_GRAVITY
 
 
-#: Below this magnitude :func:`display_number` switches from four decimals to significant
-#: digits: four decimals would show two digits or fewer of it, or 0.0000.
-DISPLAY_FIXED_MIN = 1e-3
-
-
-def display_number(value: float, *, missing: str = "—") -> str:
-    """A number as shown on a page: four decimals (``0.1856``, ``0.0010``), three significant
-    digits below 0.001 (``0.000157``, ``4.4e-05``) so that no nonzero value reads 0.0000,
-    ``missing`` for NaN, inf or None."""
+def display_number(value: float | None, *, decimals: int = 4, missing: str = "—") -> str:
+    """A number as shown on a page: ``decimals`` fixed decimals (``0.1856``, ``0.0010``) down
+    to 10**(1 - decimals), where they would show a single digit; three significant digits
+    below (``0.000157``, ``4.4e-05``), so that no nonzero value reads 0.0000; ``missing`` for
+    NaN, inf or None."""
     if value is None or not math.isfinite(value):
         return missing
-    if value == 0 or abs(value) >= DISPLAY_FIXED_MIN:
-        return f"{value:.4f}"
+    if value == 0 or abs(round(value, decimals)) >= 10.0 ** (1 - decimals):  # as printed
+        return f"{value:.{decimals}f}"
     return f"{value:.3g}"
