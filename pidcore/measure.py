@@ -69,7 +69,9 @@ class AnalysisOptions:
 
 @dataclass(frozen=True)
 class AnalyzedRecord:
-    """A measurement with its analysis and the channels used."""
+    """A measurement with its analysis and the channels used. ``measurement`` is the one
+    read (what the store keeps under the file's SHA-256); channels inverted by ``invert``
+    are inverted for the analysis only, and the inversion is in ``corrections``."""
 
     measurement: Measurement
     analysis: PowerAnalysis
@@ -256,6 +258,7 @@ def analyze_measurement(measurement: Measurement, options: AnalysisOptions) -> A
     """
     notes: list[str] = list(measurement.metadata.get("reader_notes", ()) or ())
     corrections: dict = {}
+    as_read = measurement  # what is stored: the file's channels, the inversion a parameter
     measurement = _invert(measurement, options.invert, notes)
     if options.invert:
         corrections["inverted_channels"] = list(options.invert)
@@ -291,7 +294,7 @@ def analyze_measurement(measurement: Measurement, options: AnalysisOptions) -> A
     used = {role: ch.name for role, ch in chosen.items()}
     detail = tuple({"role": role, "name": ch.name, "unit": ch.unit,
                     "source_unit": ch.source_unit} for role, ch in chosen.items())
-    return AnalyzedRecord(measurement, analysis, used, tuple(notes) + analysis.notes,
+    return AnalyzedRecord(as_read, analysis, used, tuple(notes) + analysis.notes,
                           detail, corrections)
 
 

@@ -377,3 +377,39 @@ def test_stored_analysis_arrays_carry_their_units(tmp_path):
     # same numbers, summed in another order: round-off only
     assert power.real == pytest.approx(record["complex_power_real_w"], rel=1e-12)
     assert power.imag == pytest.approx(record["complex_power_imag_w"], rel=1e-12)
+
+
+def test_a_stored_measurement_holds_the_file_as_read_whatever_the_invert_option(tmp_path):
+    """--invert NAME negated the channel in the measurement that was then stored under the
+    file's SHA-256, unmarked: the store's "raw channels" were not the file's, a re-analysis of
+    the stored measurement with the saved parameters (invert again) flipped it twice, and
+    which sign the store kept depended on which analysis of the file came first. The stored
+    channels are the file's; the inversion is in the analysis' parameters."""
+    from pidcore.cli import main
+
+    t = np.arange(25_600) / 25_600.0
+    w = 2 * np.pi * 200.0
+    v = 0.04 * np.sin(w * t)
+    force = 0.1 * 0.04 * w * np.cos(w * t) + 5.0 * v  # mass 0.1 kg and a 5 N s/m damper
+    path = tmp_path / "inverted_velocity.csv"
+    np.savetxt(path, np.column_stack([t, force, -v]), delimiter=",", comments="",
+               header="Time [s],Force [N],Velocity [m/s]", fmt="%.17g")
+    in_file = np.loadtxt(path, delimiter=",", skiprows=1)[:, 2]
+    store = tmp_path / "s.h5"
+    assert main(["analyze", str(path), "--invert", "Velocity", "--store", str(store)]) == 0
+    with h5py.File(store, "r") as h5:
+        (group,) = h5["measurements"].values()
+        velocity = {ch.attrs["name"]: ch[()] for ch in group["channels"].values()}["Velocity"]
+        (analysis,) = h5["analyses"].values()
+        sdc = analysis["record"].attrs["sdc"]
+    np.testing.assert_array_equal(velocity, in_file)  # the file's samples, bit for bit
+    # the stored measurement analysed with the saved parameters gives the saved result
+    # (noise-free: the same numbers, round-off only)
+    entry = Store(store).get_analysis(Store(store).list_analyses()["key"][0])
+    from pidcore.measure import AnalysisOptions, analyze_measurement
+
+    (key,) = Store(store).list_measurements()["key"]
+    again = analyze_measurement(Store(store).get_measurement(key),
+                                AnalysisOptions(invert=tuple(entry.parameters["invert"])))
+    assert again.analysis.sdc == pytest.approx(sdc, rel=1e-12)
+    assert sdc == pytest.approx(2 * np.pi * 5.0 / (0.1 * w), rel=1e-9)
