@@ -177,6 +177,18 @@ def test_csv_time_column_without_unit_is_taken_as_seconds_and_says_so(tmp_path, 
     assert not any("no unit" in n for n in m.metadata.get("reader_notes", ()))
 
 
+def test_mat_time_vector_is_taken_as_seconds_and_says_so(tmp_path):
+    """The MAT reader's plain layout (a 't' vector beside channel vectors) took the time as
+    seconds without a word; a vector in ms gave a 1000 x low frequency. It is said."""
+    t_ms = np.arange(200) / 25.6
+    path = tmp_path / "plain.mat"
+    scipy.io.savemat(path, {"t": t_ms, "F": np.ones(200), "units": np.array(["N"], dtype=object)})
+    m = read_measurement(path)
+    assert m.channels[0].sample_rate_hz == pytest.approx(25.6)
+    assert any("time vector 't' states no unit: taken as seconds (sample rate 25.6 Hz)" in n
+               for n in m.metadata["reader_notes"])
+
+
 def test_csv_uneven_time_column_rejected(tmp_path):
     t = np.arange(100) / 1000.0
     t[50:] += 1e-3  # one dropped sample
