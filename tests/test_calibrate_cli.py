@@ -428,3 +428,19 @@ def test_auto_falling_back_from_the_grid_to_emcee_is_said(tiny_store, tmp_path, 
     assert "--method auto: the grid posterior did not settle" in notes
     assert "3 of 3 leave-one-out fold(s)" in notes
     assert "posterior by emcee" in summary_markdown(fallen)
+
+
+def test_summary_table_shows_small_sdc_with_its_digits():
+    """The summary's prediction table printed SDCs with three fixed decimals: a load case of
+    SDC 2.97e-4 (the paper's 100 Hz, 1 g, 25 %) read 0.000 measured, predicted and in its
+    band, as if there were no damping. Small values keep three significant digits; the
+    usual look (0.230, 0.052 .. 0.436, +0.010) is kept."""
+    from pidcore.calibrate.outputs import _table_rows
+
+    rows = [{"frequency_hz": 100.0, "acceleration_g": 1.0, "fill_percent": 25.0,
+             "measured": 2.9705e-4, "predicted": 4.1e-4, "low95": 1.2e-4, "high95": 8.8e-4},
+            {"frequency_hz": 50.0, "acceleration_g": 5.0, "fill_percent": 50.0,
+             "measured": 0.23, "predicted": 0.24, "low95": 0.052, "high95": 0.436}]
+    small, usual = _table_rows(rows)
+    assert small[3:7] == ["0.000297", "0.00041", "0.00012 .. 0.00088", "+0.000113"]
+    assert usual[3:7] == ["0.230", "0.240", "0.052 .. 0.436", "+0.010"]

@@ -33,6 +33,7 @@ from ..compare.loadcase import (
 )
 from ..constants import PARTICLE_MATERIALS
 from ..errors import ParameterError, PidcoreError
+from ..units import display_number
 
 if TYPE_CHECKING:
     from ..compare import LoadCase
@@ -680,10 +681,12 @@ def results_table(files: Sequence[AnalysedFile]) -> pd.DataFrame:
 
 
 def format_sdc(sdc: float, stderr: float) -> str:
-    """SDC with its standard error as shown, e.g. ``'0.1856 ± 0.0042'``; ``'—'`` for none."""
+    """SDC with its standard error as shown, e.g. ``'0.1856 ± 0.0042'``, ``'5.09e-05 ±
+    4.4e-05'`` (:func:`pidcore.units.display_number`); ``'—'`` for none."""
     if not math.isfinite(sdc):
         return "—"
-    return f"{sdc:.4f} ± {stderr:.4f}" if math.isfinite(stderr) else f"{sdc:.4f}"
+    shown = display_number(sdc)
+    return f"{shown} ± {display_number(stderr)}" if math.isfinite(stderr) else shown
 
 
 @dataclass(frozen=True)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 from pathlib import Path
 
@@ -181,20 +182,30 @@ def _saved(results: list) -> str:
                                "given: one record)" if same > 0 else "")
 
 
+def _significant(value: float | None, digits: int, *, keep_zeros: bool = True) -> str:
+    """``digits`` significant digits (trailing zeros kept: "5.0000" is five), "n/a" for none
+    or NaN: fixed decimals showed a damping ratio of 4e-6 as 0.00000, a loss factor of 8.1e-6
+    as 0.000008 (one digit) and a missing standard error as nan."""
+    if value is None or not math.isfinite(value):
+        return "n/a"
+    return f"{value:#.{digits}g}" if keep_zeros else f"{value:.{digits}g}"
+
+
 def format_table(results: list) -> str:
     # the whole file name: a cut one may no longer say which load case a row is
     names = [Path(r.analysis.source).name for r in results]
     width = max([40, *map(len, names)])
     header = (f"{'source':<{width}} {'frequency [Hz]':>14} {'accel. [g]':>10} "
-              f"{'loss factor [-]':>15} {'SDC [-]':>9} {'± SE [-]':>9} {'zeta [-]':>9} "
+              f"{'loss factor [-]':>15} {'SDC [-]':>12} {'± SE [-]':>9} {'zeta [-]':>10} "
               f"{'dE/cycle [J]':>12}")
     lines = [header, "-" * len(header)]
     for r, name in zip(results, names, strict=True):
         a = r.analysis
-        zeta = "n/a" if a.damping_ratio is None else f"{a.damping_ratio:9.5f}"
-        lines.append(f"{name:<{width}} {a.frequency_hz:14.4f} {a.acceleration_g:10.4f} "
-                     f"{a.loss_factor:15.6f} {a.sdc:9.5f} {a.sdc_stderr:9.5f} {zeta:>9} "
-                     f"{a.energy_per_cycle_j:12.4e}")
+        lines.append(f"{name:<{width}} {a.frequency_hz:14.4f} "
+                     f"{_significant(a.acceleration_g, 5):>10} "
+                     f"{_significant(a.loss_factor, 6):>15} {_significant(a.sdc, 6):>12} "
+                     f"{_significant(a.sdc_stderr, 2, keep_zeros=False):>9} "
+                     f"{_significant(a.damping_ratio, 4):>10} {a.energy_per_cycle_j:12.4e}")
         for note in r.notes:
             lines.append(f"    note: {note}")
     return "\n".join(lines)

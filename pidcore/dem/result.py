@@ -339,5 +339,9 @@ def virtual_shaker_loop(force_n: np.ndarray, velocity_m_s: np.ndarray, *,
                              frequency_hz=float(frequency_hz), n_harmonics=n_harmonics,
                              min_periods=min(defaults.MIN_PERIODS, cycles),
                              n_blocks=max(2, min(defaults.N_UNCERTAINTY_BLOCKS, cycles)),
-                             source=label)
+                             source=label,
+                             # the loop is force against displacement: it divides by no
+                             # reactive power, so a record that stores no kinetic energy
+                             # (a pure damper) still has one
+                             require_mass_like=False)
     return analysis.loop(n_points)

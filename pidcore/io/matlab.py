@@ -370,6 +370,10 @@ def _simple_layout(variables: Mapping, where: str,
                                             with_note=True)
         n = _numeric_vector(public[time_key]).size
         notes += [note] if note else []
+        # a vector states no unit: as for a CSV time column without one, the assumption is said
+        notes.append(f"{where}: time vector {time_key!r} states no unit: taken as seconds "
+                     f"(sample rate {rate:.6g} Hz); if it is not, give the sample rate "
+                     "(--sample-rate)")
     elif rate_key is not None or sample_rate_hz is not None:
         try:
             rate = (real_scalar(public[rate_key], where=f"{where}: variable {rate_key}",

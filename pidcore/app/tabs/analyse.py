@@ -12,6 +12,7 @@ import streamlit as st
 from pidcore import defaults
 from pidcore.app import state, uploads
 from pidcore.constants import DRIVE_DIRECTIONS
+from pidcore.units import display_number
 
 
 def _size(n: int) -> str:
@@ -119,8 +120,8 @@ def _card(upload, row, sample_rate_hz, materials, given=()):
         a = record.analysis
         m1, m2, m3, m4 = st.columns([1, 1, 1, 1.6])  # the SDC ± stderr needs the room
         m1.metric("frequency [Hz]", f"{a.frequency_hz:.3f}")
-        m2.metric("acceleration [g]", f"{a.acceleration_g:.3f}")
-        m3.metric("loss factor [-]", f"{a.loss_factor:.5f}")
+        m2.metric("acceleration [g]", display_number(a.acceleration_g))
+        m3.metric("loss factor [-]", display_number(a.loss_factor))
         m4.metric("SDC ± stderr [-]", uploads.format_sdc(a.sdc, a.sdc_stderr))
         warnings = check_analysis(a)
         for w in warnings:
