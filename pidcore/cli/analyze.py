@@ -92,6 +92,7 @@ def _stated(args: argparse.Namespace) -> tuple[list, list]:
 
 
 def _run(args: argparse.Namespace) -> int:
+    from ..compare.plausibility import refuse_implausible
     from ..loadcase import refuse_identical_contents_stating_apart
     from ..store import Store
 
@@ -106,8 +107,11 @@ def _run(args: argparse.Namespace) -> int:
     results: list = []
     try:
         # Analyse everything before writing anything: one bad file leaves the store untouched.
-        results = [analyze_with_settings(path, fs, key=args.key)
-                   for path, fs in zip(args.paths, settings, strict=True)]
+        results = refuse_implausible(
+            [analyze_with_settings(path, fs, key=args.key)
+             for path, fs in zip(args.paths, settings, strict=True)],
+            [display_path(Path(path).name) for path in args.paths],
+            accept=args.accept_implausible)
         cases = [st.load_case(r.analysis.frequency_hz, r.analysis.acceleration_g)
                  if st is not None else None for r, st in zip(results, stated, strict=True)]
         # one content is one measurement: two statements (load case, specimen, settings) about
