@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from . import defaults
+from .constants import COUNT_UNIT, RATIO_UNIT
 from .errors import ChannelError, ParameterError, StoreError
 from .io import assign_roles, read_measurement
 from .records import Channel, Measurement
@@ -444,13 +445,13 @@ def replacement_notes(analyses: pd.DataFrame,
 #: Units of the scalar fields stored per analysis.
 ANALYSIS_UNITS = {
     "frequency_hz": "Hz", "acceleration_g": "g", "acceleration_m_s2": "m/s^2",
-    "complex_power_real_w": "W", "complex_power_imag_w": "W", "loss_factor": "1",
-    "loss_factor_stderr": "1", "sdc": "1", "sdc_stderr": "1", "damping_ratio": "1",
-    "energy_per_cycle_j": "J", "max_kinetic_energy_j": "J", "force_amplitude_n": "N",
-    "velocity_amplitude_m_s": "m/s", "displacement_amplitude_m": "m", "n_periods": "1",
-    "fill_percent": "%",
+    "complex_power_real_w": "W", "complex_power_imag_w": "W", "loss_factor": RATIO_UNIT,
+    "loss_factor_stderr": RATIO_UNIT, "sdc": RATIO_UNIT, "sdc_stderr": RATIO_UNIT,
+    "damping_ratio": RATIO_UNIT, "energy_per_cycle_j": "J", "max_kinetic_energy_j": "J",
+    "force_amplitude_n": "N", "velocity_amplitude_m_s": "m/s", "displacement_amplitude_m": "m",
+    "n_periods": COUNT_UNIT, "fill_percent": "%",
     # arrays (analysis_arrays): harmonic numbers and the phasors x(t) = Re(X e^{j n w t})
-    "harmonics": "1", "force_phasors_n": "N", "velocity_phasors_m_s": "m/s",
+    "harmonics": COUNT_UNIT, "force_phasors_n": "N", "velocity_phasors_m_s": "m/s",
 }
 
 

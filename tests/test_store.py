@@ -320,6 +320,14 @@ def test_stored_units_are_those_the_field_names_promise():
             promised = _promised_unit(name)
             if promised is not None:
                 assert unit == promised, f"{name}: stored unit {unit!r}, name says {promised!r}"
+    # a quantity stored by both (loss factor, SDC, ...) has one unit: analyses wrote "1" for
+    # the ratios DEM runs write as "-"
+    for name in set(ANALYSIS_UNITS) & set(DEM_UNITS):
+        assert ANALYSIS_UNITS[name] == DEM_UNITS[name], name
+    from pidcore.constants import RATIO_UNIT
+
+    for name in ("loss_factor", "sdc", "sdc_stderr", "loss_factor_stderr", "damping_ratio"):
+        assert ANALYSIS_UNITS[name] == RATIO_UNIT
 
 
 def test_an_undefined_damping_ratio_is_stored_as_null_with_its_reason_not_as_nan(tmp_path):
