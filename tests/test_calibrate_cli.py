@@ -399,3 +399,51 @@ def test_an_empty_data_table_suggests_the_measured_sdc_header(capsys, tmp_path):
     table = _table(tmp_path, text="# nothing yet\n")
     _refused(capsys, tmp_path, ["--data", str(table)], "empty table",
              "'frequency_hz,acceleration_g,fill_percent,sdc'", "one row per load case")
+
+
+def _mixed_store(monkeypatch):
+    """A store's analyses: acrylic of the paper's coupon, steel of steel_6mm (unnamed) and of
+    another steel specimen."""
+    import pandas as pd
+
+    frame = pd.DataFrame({"frequency_hz": [500.0, 1000.0, 500.0, 1000.0, 500.0],
+                          "acceleration_g": [1.0, 5.0, 1.0, 5.0, 5.0],
+                          "fill_percent": [50.0] * 5, "sdc": [0.2, 0.5, 0.4, 0.6, 0.5],
+                          "sdc_stderr": [0.01] * 5,
+                          "material": ["acrylic", "acrylic", "steel", "steel", "steel"],
+                          "specimen": ["", "", "", "", "steel_other"]})
+    monkeypatch.setattr(Store, "list_analyses", lambda self: frame)
+
+
+def test_store_of_two_materials_calibrates_the_specimens_points(capsys, monkeypatch, tmp_path):
+    # `calibrate --store` on a store holding acrylic and steel measurements was refused as a
+    # whole ("choose the points of one material") with no option to choose them; with
+    # --specimen it takes that specimen's points, as the app's Calibrate page does, and says
+    # what it leaves out
+    import importlib
+
+    from pidcore.errors import ParameterError
+
+    # the module, not the function pidcore.calibrate exports under the same name
+    library = importlib.import_module("pidcore.calibrate.calibrate")
+
+    _mixed_store(monkeypatch)
+    seen = {}
+
+    def fake_calibrate(points, **kwargs):
+        seen["points"] = points
+        raise ParameterError("stopped before any DEM run")
+
+    monkeypatch.setattr(library, "calibrate", fake_calibrate)
+    steel = REPO / "data_samples" / "specimens" / "steel_6mm.toml"
+    code = main(["calibrate", "--store", str(tmp_path / "s.h5"), "--specimen", str(steel),
+                 "--dem-store", str(tmp_path / "dem.h5"), *TINY])
+    err = capsys.readouterr().err
+    assert code == 2 and "stopped before any DEM run" in err
+    assert sorted((p.frequency_hz, p.material, p.specimen) for p in seen["points"]) == [
+        (500.0, "steel", ""), (1000.0, "steel", "")]
+    assert ("note: Not used for steel_6mm (steel particles): 1 measured load case(s) of "
+            "specimen steel_other; 2 measured load case(s) of acrylic particles.") in err
+    # without --specimen (the paper's coupon) the two materials are refused with the way out
+    _refused(capsys, tmp_path, ["--store", str(tmp_path / "s.h5")],
+             "measurements of acrylic, steel particles", "--specimen FILE")
