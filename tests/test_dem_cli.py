@@ -321,3 +321,66 @@ def test_a_sweep_over_the_grids_fills_says_it_is_not_the_specimens_fill(tmp_path
     for more, path in ((["--fills", "30"], mine), ([], spec)):
         assert main([*argv[:3], str(path), *argv[4:], *more]) == 130
         assert "note" not in capsys.readouterr().err
+
+
+def _read_only(path: Path, monkeypatch) -> None:
+    """Make ``path`` read-only; as root (who may write it anyway) the store's permission check
+    is answered from the mode bits, as the kernel answers every other user."""
+    import os
+    import stat
+
+    import pidcore.store.store as store_module
+
+    path.chmod(0o444)
+    if os.geteuid() == 0:
+        real = os.access
+
+        def access(target, mode, **kw):
+            if Path(target) == path and mode & os.W_OK:
+                return bool(path.stat().st_mode & stat.S_IWUSR)
+            return real(target, mode, **kw)
+
+        monkeypatch.setattr(store_module.os, "access", access)
+
+
+def test_a_read_only_store_is_refused_before_any_simulation(tmp_path, monkeypatch, capsys):
+    # dem run / dem sweep / calibrate simulated first and then lost the work at the commit
+    # ("cannot commit the changes ([Errno 1] Operation not permitted ...)"); a stored run is
+    # still read from a read-only store
+    import pidcore.calibrate.runner  # noqa: F401 - the module patched below
+    import pidcore.dem.persist
+    import pidcore.dem.sweep
+    from pidcore.store import Store
+
+    store = tmp_path / "runs.h5"
+    assert main(ARGS + ["--store", str(store)]) == 0
+    capsys.readouterr()
+    before = store.read_bytes()
+    _read_only(store, monkeypatch)
+
+    def never(*args, **kwargs):
+        raise AssertionError("simulated for a store it cannot save to")
+
+    monkeypatch.setattr(pidcore.dem.persist, "simulate_load_case", never)
+    monkeypatch.setattr(pidcore.dem.sweep, "_run_local", never)
+    other = [a if a != "500" else "400" for a in ARGS]
+    for argv in (other + ["--store", str(store)],
+                 ["dem", "sweep", "--frequencies", "400", "--accelerations", "5", "--fills",
+                  "50", "--cells", "2", "--cycles", "5", "--no-progress", "--store",
+                  str(store)]):
+        assert main(argv) == 2
+        err = capsys.readouterr().err.strip()
+        assert len(err.splitlines()) == 1 and "runs.h5: the store file is read-only" in err
+    # calibrate's DEM runs: refused before the first
+    from pidcore.calibrate.runner import RunRequest, run_requests
+    from pidcore.dem import DemConfig, LoadCase
+    from pidcore.errors import StoreError
+    from pidcore.specimen import paper_specimen
+
+    request = RunRequest(LoadCase(400, 5, 50), paper_specimen(), DemConfig(cells=2))
+    with pytest.raises(StoreError, match="the store file is read-only"):
+        run_requests([request], store_path=store, workers=1, progress=False)
+    # the cached run is read as before, and the store is untouched
+    assert main(ARGS + ["--store", str(store)]) == 0
+    assert "reused from" in capsys.readouterr().out
+    assert store.read_bytes() == before and len(Store(store).list_dem_runs()) == 1
