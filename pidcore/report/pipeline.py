@@ -320,6 +320,37 @@ def specimen_dem_runs(stored: pd.DataFrame | None, specimen=None, *,
     return kept, notes
 
 
+def unsubtracted_baseline_note(specimen, analyses: pd.DataFrame | None) -> str:
+    """The note for measurements of ``specimen``'s particles analysed without the empty
+    coupon's loss factor its file states (``[coupon] baseline_loss_factor``); "" where it
+    states none or every such record subtracted one.
+
+    The DEM's SDC is the particles' alone and the measured one includes the structure's
+    damping unless the analysis subtracted it; the specimen's value was used only by
+    ``pidcore calibrate``, and a report of the specimen compared the two without a word.
+    """
+    from ..compare.align import stored_parameters
+
+    eta = float(specimen.coupon.baseline_loss_factor) if specimen is not None else 0.0
+    if eta <= 0 or analyses is None or analyses.empty or "material" not in analyses.columns:
+        return ""
+    material = specimen.particles.material
+    named = analyses.get("specimen", pd.Series([""] * len(analyses), index=analyses.index))
+    mine = analyses[(analyses["material"] == material)
+                    & named.fillna("").isin(["", specimen.name])]
+    subtracted = [float((stored_parameters(p) or {}).get("baseline_loss_factor") or 0.0)
+                  for p in mine.get("parameters_json", pd.Series([None] * len(mine)))]
+    without = sum(1 for value in subtracted if value == 0.0)
+    if not without:
+        return ""
+    return (f"specimen {specimen.name} states [coupon] baseline_loss_factor {eta:g} (the empty "
+            f"coupon's damping), which {without} measured record(s) of its {material} particles "
+            f"were analysed without: their SDC includes it (2 pi x {eta:g} = "
+            f"{2 * math.pi * eta:.3g}) and the DEM's, of the particles alone, does not; analyse "
+            f"them with --baseline-loss-factor {eta:g} (or a sidecar's baseline_loss_factor) to "
+            "subtract it")
+
+
 @dataclass(frozen=True)
 class SpecimenTable:
     """What :func:`specimen_report_table` built: the table (notes in ``attrs["notes"]``), the
@@ -364,6 +395,9 @@ def specimen_report_table(stored_runs: pd.DataFrame | None, analyses: pd.DataFra
         choose_another="" if choose_another == CHOOSE_SPECIMEN_CLI
         else f"choose theirs with {choose_another.removesuffix(' for another')} to compare "
              "them")
+    baseline = unsubtracted_baseline_note(specimen, analyses)
+    if baseline:
+        notes.append(baseline)
     if specimen is not None and not pool:
         # every DEM row is this specimen's (runs_of_specimen) and the files of its particle
         # material are its tests; a measurement of another material cannot be (its specimen
