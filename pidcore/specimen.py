@@ -949,6 +949,7 @@ def describe(specimen: Specimen) -> dict[str, Any]:
         "cell_shape": specimen.cell.shape, "cells_per_coupon": specimen.cell.count,
         "capacity_per_cell": capacity, "particles_per_cell": count,
         "particles_per_cell_basis": basis,
+        "particle_radius_m": p.radius_m,
         "particle_mass_kg": p.mass_kg,
         "particles_mass_kg": specimen.cell.count * count * p.mass_kg,
         "coupon_mass_kg": specimen.coupon.mass_kg,

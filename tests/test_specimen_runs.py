@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -419,3 +420,33 @@ def test_runs_stored_before_specimens_stay_the_papers_beside_hashed_runs():
     bare = runs[["case_key"]]
     assert persist.runs_of_specimen(bare)["case_key"].tolist() == ["old", "steel"]
     assert persist.runs_of_specimen(bare, steel).empty
+
+
+def test_specimen_check_states_the_particle_radius_it_simulates(capsys, tmp_path):
+    # the check printed masses and gaps but not the radius: a 2 mm diameter typed as
+    # radius_m = 2e-3 (or a table material's default radius) could not be seen; the sphere
+    # mass it printed is 4/3 pi r^3 rho of that radius
+    import math
+
+    typed_diameter = tmp_path / "diameter.toml"
+    typed_diameter.write_text(STEEL.read_text().replace("radius_m = 1.0e-3", "radius_m = 2.0e-3"))
+    assert main(["specimen", "check", str(typed_diameter)]) == 0
+    assert "radius 2 mm (diameter 4 mm)" in capsys.readouterr().out
+    assert main(["specimen", "check", str(typed_diameter), "--json"]) == 0
+    facts = json.loads(capsys.readouterr().out)
+    assert facts["particle_radius_m"] == 2.0e-3
+    assert facts["particle_mass_kg"] == pytest.approx(4 / 3 * math.pi * 2.0e-3 ** 3 * 7850.0)
+
+
+def test_readme_specimen_table_names_every_key_the_reader_takes():
+    # the README's key table is the documented schema; schema_version, which every bundled
+    # file starts with and the reader checks, was missing from it
+    from pidcore.specimen import SCHEMA
+
+    readme = (REPO / "README.md").read_text(encoding="utf-8")
+    table = readme[readme.index("| key | unit | meaning |"):]
+    table = table[:table.index("\n\n")]
+    # a key is written `key` or within a cell's code span (`[cell] shape`, `wall_poisson_ratio`)
+    missing = [key for section in SCHEMA.values() for key in section
+               if not re.search(rf"[`\s]{key}`", table)]
+    assert missing == []
