@@ -384,3 +384,31 @@ def test_a_read_only_store_is_refused_before_any_simulation(tmp_path, monkeypatc
     assert main(ARGS + ["--store", str(store)]) == 0
     assert "reused from" in capsys.readouterr().out
     assert store.read_bytes() == before and len(Store(store).list_dem_runs()) == 1
+
+
+def test_a_drive_no_shaker_makes_is_refused_before_any_simulation(tmp_path, capsys):
+    # 0.2 typed for 200 Hz: 5 g at 0.2 Hz is a displacement amplitude a/w^2 of 31 m; the DEM
+    # simulated its cycles (~100 s of simulated time) for many minutes without a word
+    import math
+
+    from pidcore.dem import LoadCase, simulate_load_case
+    from pidcore.errors import ParameterError
+
+    stroke = 5 * 9.80665 / (2 * math.pi * 0.2) ** 2
+    assert stroke == pytest.approx(31.05, rel=1e-3)
+    slow = [a if a != "500" else "0.2" for a in ARGS]
+    assert main(slow) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1
+    assert "--frequency/--acceleration 0.2 Hz, 5 g: a displacement amplitude of 31.1 m" in err
+    assert "kHz" in err
+    store = tmp_path / "runs.h5"
+    assert main(["dem", "sweep", "--frequencies", "200,0.2", "--accelerations", "5", "--fills",
+                 "50", "--cells", "2", "--cycles", "5", "--no-progress", "--store",
+                 str(store)]) == 2
+    assert "--frequencies/--accelerations 0.2 Hz" in capsys.readouterr().err
+    assert not store.exists()  # the 200 Hz case was not run either
+    with pytest.raises(ParameterError, match="displacement amplitude"):
+        simulate_load_case(LoadCase(0.2, 5, 50))
+    # Table 3's largest stroke (50 Hz, 10 g: 1 mm) is far inside the 50 mm limit
+    assert 10 * 9.80665 / (2 * math.pi * 50) ** 2 < 1.0e-3
