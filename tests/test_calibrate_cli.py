@@ -116,6 +116,14 @@ def test_json_document(capsys, tmp_path, tiny_store):
     for name in ("calibrated_specimen.toml", "summary.md", "summary.html", "predictions.png",
                  "posterior_pairs.png"):
         assert (out / name).stat().st_size > 0
+    # every column of the summary's prediction tables names its unit (it said "measured SDC",
+    # "error", "inside"); parameters carry theirs in their names (fixture_mass_kg)
+    summary = (out / "summary.md").read_text()
+    heads = [line for line in summary.splitlines() if line.startswith("| f [Hz]")]
+    assert len(heads) == 2  # in-sample and leave-one-out
+    for head in heads:
+        cells = [c.strip() for c in head.strip("|").split("|")]
+        assert all(c.endswith("]") for c in cells), cells
     # the calibrated specimen is a valid specimen file holding the fitted value, all else
     # as the paper's coupon
     spec = load_specimen(out / "calibrated_specimen.toml")
