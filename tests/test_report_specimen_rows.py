@@ -146,3 +146,21 @@ def test_a_specimen_baseline_the_measurements_did_not_subtract_is_said(steel, st
                             (dataclasses.replace(damped), analyses)):
         notes = specimen_report_table(store_runs, frame, specimen=specimen).table.attrs["notes"]
         assert not [n for n in notes if "baseline_loss_factor" in n]
+
+
+def test_a_test_of_a_specimen_whose_runs_the_store_holds_says_how_to_compare_them(
+        steel, store_runs, analyses):
+    # a report of the paper's coupon with a steel measurement named steel_6mm, whose run the
+    # store holds: the note said the steel_6mm run was "another specimen's: not compared with
+    # a test of steel_6mm", of the test's own specimen
+    named = analyses.assign(specimen=["", "steel_6mm"])
+    row = _measured(specimen_report_table(store_runs, named).table, "other.h5")
+    assert row[ALIGNMENT_COLUMN] == "no_dem_runs"
+    assert row["note"] == (f"no DEM runs of steel_6mm for steel, direction z among this "
+                           f"report's runs (the store has 1 of steel_6mm [{steel.hash[:6]}]; "
+                           "steel_6mm's are left out of a report of another specimen: report "
+                           "with their --specimen FILE to compare them)")
+    assert "another specimen's: not compared" not in row["note"]
+    # with its --specimen the same test meets that run
+    row = _measured(specimen_report_table(store_runs, named, specimen=steel).table, "other.h5")
+    assert row[ALIGNMENT_COLUMN] == "grid"
