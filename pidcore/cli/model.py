@@ -134,7 +134,8 @@ def build_model(args: argparse.Namespace):
 
     # the specimen named: steel and paper-coupon figures looked alike
     specimen = run_specimen_labels(runs).iloc[0]
-    text = f"DEM runs of {specimen} in {args.store}" + (f" where {where}" if where else "")
+    text = f"DEM runs of {specimen} in {args.store}" + (
+        " where " + ", ".join(f"{k}={v}" for k, v in where.items()) if where else "")
     return SdcModel.from_table(runs, value="sdc", log_frequency=args.log_frequency,
                                source=text), runs
 
