@@ -288,7 +288,8 @@ def test_figures_of_stored_runs_name_their_specimen(tmp_path, monkeypatch):
     _fake_store(monkeypatch, lambda: mine)
     assert _run(["model", "figures", "--out", str(tmp_path), "--table", "store", "--store",
                  str(tmp_path / "s.h5")]) == 0
-    titles = {fig._suptitle.get_text() for fig in built if fig._suptitle is not None}
+    titles = {fig._suptitle.get_text().replace("\n", " ")  # wrapped to the figure width
+              for fig in built if fig._suptitle is not None}
     assert titles == {f"DEM runs of steel_6mm [aaaaaa] in {tmp_path / 's.h5'}"}
     assert len(built) == 2 * (4 + 3)  # every figure titled, each saved as PNG and SVG
 

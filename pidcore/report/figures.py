@@ -109,7 +109,8 @@ def _draw_family(model: SdcModel, *, panels: Sequence[float], panel_column: str,
     if ax is None and model.source:  # a figure of its own says what it draws
         # wrapped: a store's source (runs of a specimen in a store, where ...) ran past both
         # edges of the 6.4 in figure and was cut off at each end
-        fig.suptitle(textwrap.fill(model.source, _SUPTITLE_CHARS), fontsize="small")
+        fig.suptitle(textwrap.fill(model.source, _SUPTITLE_CHARS, break_on_hyphens=False,
+                                   break_long_words=False), fontsize="small")
     return fig
 
 
