@@ -459,6 +459,7 @@ def resolve_files(paths: Sequence[str | os.PathLike], *, options: AnalysisOption
                   material: str | None = None, direction: str | None = None,
                   sidecar: str | os.PathLike | None = None,
                   specimen_material: str | None = None, fill_required: bool = True,
+                  specimen_name: str | None = None,
                   ) -> tuple[list[StatedLoadCase | None], list[FileSettings]]:
     """What each file states about its load case (:func:`resolve_load_case`) and how it is
     analysed (:func:`resolve_file_settings`), file by file, before any analysis, so that a bad
@@ -466,6 +467,10 @@ def resolve_files(paths: Sequence[str | os.PathLike], *, options: AnalysisOption
 
     ``fill_required=False`` gives None for a file that states no fill (``pidcore analyze``
     saves it without a load case); otherwise :class:`FillNotStated` is raised.
+    ``specimen_name`` (of ``--specimen``): the specimen of every file of its particles
+    (``specimen_material``) whose sidecar row names none, with source ``--specimen``. Such
+    files were saved unnamed, and a later report of another specimen of those particles took
+    them for its own tests.
     """
     tables: dict = {}
     stated: list[StatedLoadCase | None] = []
@@ -480,6 +485,10 @@ def resolve_files(paths: Sequence[str | os.PathLike], *, options: AnalysisOption
             if fill_required:
                 raise
             stated.append(None)
-        settings.append(resolve_file_settings(path, options, given=given, sidecar=sidecar,
-                                              tables=tables))
+        fs = resolve_file_settings(path, options, given=given, sidecar=sidecar, tables=tables)
+        if (specimen_name and not fs.specimen and stated[-1] is not None
+                and stated[-1].material == specimen_material):
+            fs = replace(fs, specimen=specimen_name,
+                         sources={**fs.sources, SPECIMEN_COLUMN: "--specimen"})
+        settings.append(fs)
     return stated, settings

@@ -270,3 +270,33 @@ sliding_friction = 0.3
 restitution = 0.8
 sliding_friction = 0.35
 """
+
+
+def test_files_of_a_specimens_particles_are_saved_as_its_tests(tmp_path, capsys):
+    # `analyze --specimen A` saved its steel records unnamed: a later `report --specimen B` (B
+    # another steel specimen) took them for B's tests and compared them with B's DEM runs
+    spec_a = tmp_path / "a.toml"
+    spec_a.write_text(STEEL_SPECIMEN.replace('name = "my_steel"', 'name = "panel_a"'))
+    spec_b = tmp_path / "b.toml"
+    spec_b.write_text(STEEL_SPECIMEN.replace('name = "my_steel"', 'name = "panel_b"'))
+    store = tmp_path / "s.h5"
+    steel_a = export(tmp_path / "a_fill20_steel.csv", fmt="csv")
+    acrylic = export(tmp_path / "c_fill20_acrylic.uff", fmt="uff")
+    doc = run_json([str(steel_a), str(acrylic), "--specimen", str(spec_a), "--store",
+                    str(store)], capsys)
+    assert [r["specimen"] for r in doc["records"]] == ["panel_a", None]  # acrylic: not its
+    steel_b = export(tmp_path / "b_fill30_steel.mat", fmt="mat")  # other bytes: another record
+    assert main(["analyze", str(steel_b), "--specimen", str(spec_b), "--store",
+                 str(store)]) == 0
+    assert "specimen 'panel_b' (--specimen)" in capsys.readouterr().out
+    saved = Store(store).list_analyses()
+    named = {Path(src).name: (spec if isinstance(spec, str) else "")
+             for src, spec in zip(saved["source"], saved.get("specimen", [""] * len(saved)),
+                                  strict=True)}
+    assert {k: named.get(k) for k in ("a_fill20_steel.csv", "b_fill30_steel.mat")} == {
+        "a_fill20_steel.csv": "panel_a", "b_fill30_steel.mat": "panel_b"}
+    assert named.get("c_fill20_acrylic.uff", "") == ""
+    # a sidecar's specimen is the file's own, as before
+    (tmp_path / "loadcases.csv").write_text("file,specimen\nb_fill30_steel.mat,rig_c\n")
+    doc = run_json([str(steel_b), "--specimen", str(spec_a), "--no-store"], capsys)
+    assert doc["records"][0]["specimen"] == "rig_c"

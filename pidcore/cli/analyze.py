@@ -46,7 +46,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     g.add_argument("--specimen", metavar="FILE", type=Path, default=None,
                    help="specimen file whose particle material the files may state (e.g. "
                         "steel, which the material table lacks) and which is the default "
-                        "material")
+                        "material; its name is saved with the files of its particles whose "
+                        "sidecar names no specimen")
     p.add_argument("--key", metavar="NAME", default=None,
                    help="which measurement of a pidcore HDF5 store to analyse, when it holds "
                         "several (the error lists them)")
@@ -71,16 +72,18 @@ def _stated(args: argparse.Namespace) -> tuple[list, list]:
     sidecar or option is refused at once."""
     from ..file_settings import resolve_files
 
-    specimen_material = None
+    specimen = None
     if args.specimen is not None:
         from ..specimen import load_specimen
 
-        specimen_material = load_specimen(args.specimen).particles.material
+        specimen = load_specimen(args.specimen)
     # (a missing file is named by its analysis)
     return resolve_files(args.paths, options=analysis_options(args), given=given_options(args),
                          fill_percent=args.fill, material=args.material,
                          direction=args.direction, sidecar=args.sidecar,
-                         specimen_material=specimen_material, fill_required=False)
+                         specimen_material=specimen.particles.material if specimen else None,
+                         fill_required=False,
+                         specimen_name=specimen.name if specimen else None)
 
 
 def _run(args: argparse.Namespace) -> int:
