@@ -300,3 +300,16 @@ def test_files_of_a_specimens_particles_are_saved_as_its_tests(tmp_path, capsys)
     (tmp_path / "loadcases.csv").write_text("file,specimen\nb_fill30_steel.mat,rig_c\n")
     doc = run_json([str(steel_b), "--specimen", str(spec_a), "--no-store"], capsys)
     assert doc["records"][0]["specimen"] == "rig_c"
+
+
+def test_a_file_of_other_particles_than_the_specimens_names_the_specimens(tmp_path, capsys):
+    # `analyze coupon_fill20_steel.csv --specimen wc.toml` (tungsten carbide) said the table
+    # lacks steel and to "give --specimen FILE whose particles are steel", as if none was given
+    steel = export(tmp_path / "coupon_fill20_steel.csv", fmt="csv")
+    spec = tmp_path / "wc.toml"
+    spec.write_text(STEEL_SPECIMEN.replace('material = "steel"', 'material = "tungsten_carbide"'))
+    assert main(["analyze", str(steel), "--specimen", str(spec), "--no-store"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1
+    assert ("which the material table (acrylic, aluminium) and the --specimen's "
+            "tungsten_carbide particles lack") in err

@@ -148,18 +148,24 @@ def _own_material_tokens(stem: str, materials: tuple[str, ...]) -> set[str]:
     return _material_tokens(stem, (m for m in materials if m not in PARTICLE_MATERIALS))
 
 
-def _refuse_untabulated_material(path: Path, known: tuple[str, ...]) -> None:
+def _refuse_untabulated_material(path: Path, known: tuple[str, ...],
+                                 specimen_material: str | None = None) -> None:
     """A file name naming a particle material that neither the table nor a specimen knows
-    (``..._steel.csv``) would be read as the default or the specimen's material: refused."""
+    (``..._steel.csv``) would be read as the default or the specimen's material: refused.
+    With a specimen given, the message names its particles (it asked for "--specimen FILE
+    whose particles are steel" of a user who had given one of tungsten carbide)."""
     # a specimen's "steel_440c" is the file name's "steel"
     parts = {part for k in known for part in k.split("_")}
     named = sorted(_material_tokens(path.stem, UNTABULATED_PARTICLE_MATERIALS) - parts)
     if named:
+        lacks = f"material table ({', '.join(PARTICLE_MATERIALS)}) lacks"
+        if specimen_material is not None and specimen_material not in PARTICLE_MATERIALS:
+            lacks = (f"material table ({', '.join(PARTICLE_MATERIALS)}) and the --specimen's "
+                     f"{specimen_material} particles lack")
         raise UntabulatedMaterial(
             f"{path.name}: file name states particle material {named[0]!r}, which the "
-            f"material table ({', '.join(PARTICLE_MATERIALS)}) lacks; give --specimen FILE "
-            f"whose particles are {named[0]}, or state the material with --material or a "
-            "sidecar", named[0])
+            f"{lacks}; give --specimen FILE whose particles are {named[0]}, or state the "
+            "material with --material or a sidecar", named[0])
 
 
 def parse_file_name(name: str | Path,
@@ -506,7 +512,7 @@ def resolve_load_case(
         take(_sidecar_entry(row, known), row.name)
     stated_by_user = {"file name"} | ({row.name} if row is not None else set())
     if origin.get("material") not in stated_by_user and material is None:
-        _refuse_untabulated_material(path, known)
+        _refuse_untabulated_material(path, known, specimen_material)
     options: dict[str, float | str] = {}
     if fill_percent is not None:
         options["fill_percent"] = _check_fill(fill_percent, "--fill")
