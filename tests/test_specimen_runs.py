@@ -450,3 +450,24 @@ def test_readme_specimen_table_names_every_key_the_reader_takes():
     missing = [key for section in SCHEMA.values() for key in section
                if not re.search(rf"[`\s]{key}`", table)]
     assert missing == []
+
+
+def test_dem_run_says_the_specimens_baseline_is_not_in_its_sdc(capsys, tmp_path, monkeypatch):
+    # a specimen stating [coupon] baseline_loss_factor 0.002 printed the particles' SDC with no
+    # word of whether the empty coupon's damping was in it (it is not: SDC = dissipation / E)
+    import math
+
+    damped = tmp_path / "damped.toml"
+    damped.write_text(STEEL.read_text().replace("baseline_loss_factor = 0.0",
+                                                "baseline_loss_factor = 0.002"))
+    args = ["dem", "run", "--specimen", str(damped), "--frequency", "1000", "--acceleration",
+            "5", "--cells", "1", "--cycles", "2", "--no-progress", "--json"]
+    assert main(args) == 0
+    doc = json.loads(capsys.readouterr().out)
+    (note,) = [n for n in doc["notes"] if "baseline_loss_factor" in n]
+    assert "baseline_loss_factor 0.002" in note and f"{2 * math.pi * 0.002:.3g}" in note
+    # the SDC is the dissipation over E alone, with no baseline added
+    assert doc["sdc"] == pytest.approx(doc["energy_per_cycle_j"] / doc["max_kinetic_energy_j"],
+                                       rel=1e-12)
+    assert main(args[:-1]) == 0
+    assert "note            SDC of the particles alone" in capsys.readouterr().out
