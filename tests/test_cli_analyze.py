@@ -313,3 +313,26 @@ def test_a_file_of_other_particles_than_the_specimens_names_the_specimens(tmp_pa
     assert err.count("\n") == 1
     assert ("which the material table (acrylic, aluminium) and the --specimen's "
             "tungsten_carbide particles lack") in err
+
+
+def test_a_fill_of_no_particle_is_refused_naming_the_file(tmp_path, capsys):
+    # `--fill 0.5` (a fraction typed for 50 %) was analysed and saved as a load case of 0.5 %,
+    # a coupon without a particle in its cells (22 acrylic spheres fill the paper's cell:
+    # 0.5 % of 22 is 0.11, rounded to none), which no DEM run can ever match
+    path = export(tmp_path / "rec_fill50_acrylic.csv", fmt="csv")
+    store = tmp_path / "s.h5"
+    assert main(["analyze", str(path), "--fill", "0.5", "--store", str(store)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "rec_fill50_acrylic.csv: fill 0.5 % of 22 particles " \
+        "rounds to none" in err and "fill: option" in err
+    assert not store.exists()
+    # against a specimen's cell: 46 steel spheres of 1 mm radius fill the 6.35 mm cell
+    spec = tmp_path / "steel.toml"
+    spec.write_text(STEEL_SPECIMEN)
+    steel = export(tmp_path / "rec_fill1_steel.csv", fmt="csv")
+    assert main(["analyze", str(steel), "--specimen", str(spec), "--no-store"]) == 2
+    assert "fill 1 % of 46 particles rounds to none" in capsys.readouterr().err
+    assert main(["report", str(steel), "--specimen", str(spec), "--out",
+                 str(tmp_path / "rep")]) == 2
+    assert "fill 1 % of 46 particles rounds to none" in capsys.readouterr().err
+    assert not (tmp_path / "rep").exists()

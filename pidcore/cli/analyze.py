@@ -83,7 +83,7 @@ def _stated(args: argparse.Namespace) -> tuple[list, list]:
                          direction=args.direction, sidecar=args.sidecar,
                          specimen_material=specimen.particles.material if specimen else None,
                          fill_required=False,
-                         specimen_name=specimen.name if specimen else None)
+                         specimen_name=specimen.name if specimen else None, specimen=specimen)
 
 
 def _run(args: argparse.Namespace) -> int:

@@ -146,7 +146,8 @@ def analyze_files(paths: Sequence[str | Path], *, fill_percent: float | None = N
                   options: AnalysisOptions | None = None,
                   options_given: Mapping[str, str] | None = None,
                   specimen_material: str | None = None,
-                  specimen_name: str | None = None) -> list[MeasuredResult]:
+                  specimen_name: str | None = None,
+                  specimen=None) -> list[MeasuredResult]:
     """Read, assign roles, analyze (Eq. 11) and attach the load case of every file.
 
     The load case and the analysis settings are resolved first for every file, so a missing
@@ -157,7 +158,9 @@ def analyze_files(paths: Sequence[str | Path], *, fill_percent: float | None = N
     kept once, and refused if they state different load cases, specimens or settings.
     ``specimen_material``: the particle material of the specimen compared with (accepted
     besides the table's, and the default); ``specimen_name``: its name, saved with the files
-    of its particles whose sidecar names no specimen (:func:`pidcore.file_settings.resolve_files`).
+    of its particles whose sidecar names no specimen; ``specimen``: its cell, against which a
+    stated fill of its particles must round to a particle at least
+    (:func:`pidcore.file_settings.resolve_files`).
     """
     from ..file_settings import analyze_with_settings, resolve_files
     from ..io import detect_file_format
@@ -170,7 +173,7 @@ def analyze_files(paths: Sequence[str | Path], *, fill_percent: float | None = N
                                      fill_percent=fill_percent, material=material,
                                      direction=direction, sidecar=sidecar,
                                      specimen_material=specimen_material,
-                                     specimen_name=specimen_name)
+                                     specimen_name=specimen_name, specimen=specimen)
     results = []
     for path, st, fs in zip(paths, stated, settings, strict=True):
         analyzed = analyze_with_settings(path, fs)
@@ -544,7 +547,7 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         files, fill_percent=fill_percent, material=material, direction=direction,
         sidecar=sidecar, options=options, options_given=options_given,
         specimen_material=specimen.particles.material if specimen is not None else None,
-        specimen_name=specimen.name if specimen is not None else None,
+        specimen_name=specimen.name if specimen is not None else None, specimen=specimen,
     ) if files else []
     parameters = _parameters(results, options)
     notes: list[str] = []
