@@ -455,3 +455,31 @@ def test_store_of_two_materials_calibrates_the_specimens_points(capsys, monkeypa
     # without --specimen (the paper's coupon) the two materials are refused with the way out
     _refused(capsys, tmp_path, ["--store", str(tmp_path / "s.h5")],
              "measurements of acrylic, steel particles", "--specimen FILE")
+
+
+def test_a_file_analysed_twice_is_one_measured_point_of_its_newest_analysis(tmp_path):
+    # one file analysed again with a baseline loss factor was taken for two repeated tests:
+    # the mean of both analyses, with a standard error from their difference (0.006 instead
+    # of the analysis's own 0.03), and the same raw data counted twice
+    from _shaker_files import write_force_velocity
+
+    from pidcore.calibrate import measured_from_store
+    from pidcore.constants import STANDARD_GRAVITY
+    from pidcore.signal.synthetic import synthesize_shaker_record
+
+    rec = synthesize_shaker_record(mass_kg=0.25, acceleration_amplitude_m_s2=5 * STANDARD_GRAVITY,
+                                   frequency_hz=500.0, sample_rate_hz=25_600.0, n_periods=40.3,
+                                   viscous_damping_n_s_m=2.0, coulomb_friction_n=0.3,
+                                   snr_db=50, seed=3)
+    path = tmp_path / "run_fill50_acrylic.csv"
+    write_force_velocity(path, rec.force_n, rec.velocity_m_s, 25_600.0, "csv")
+    store = tmp_path / "s.h5"
+    assert main(["analyze", str(path), "--store", str(store)]) == 0
+    assert main(["analyze", str(path), "--store", str(store), "--baseline-loss-factor",
+                 "0.002"]) == 0
+    analyses = Store(store).list_analyses()
+    assert len(analyses) == 2  # the store keeps both analyses of the one measurement
+    newest = analyses.sort_values("created_utc").iloc[-1]
+    (point,) = measured_from_store(store)
+    assert point.sdc == newest["sdc"]  # the baseline-corrected one, not the mean of both
+    assert point.sdc_stderr == newest["sdc_stderr"]

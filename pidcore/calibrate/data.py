@@ -130,7 +130,7 @@ def read_measured_table(path: str | os.PathLike, *,
 
 def measured_from_store(store_path: str | os.PathLike) -> list[MeasuredPoint]:
     """Analysed measurements of a store, grouped per load case, particle material and specimen
-    label (mean SDC, standard error).
+    label (mean SDC, standard error), of the newest analysis of each measurement.
 
     Records of other materials or specimens at one load case are kept apart (averaging acrylic
     and steel particles would fit neither); a record without a material is the paper's acrylic,
@@ -141,6 +141,7 @@ def measured_from_store(store_path: str | os.PathLike) -> list[MeasuredPoint]:
     analyses must carry ``fill_percent`` (from a sidecar).
     """
     from ..store import Store
+    from ..store.listing import latest_per_measurement
 
     frame = Store(store_path).list_analyses()
     need = {"frequency_hz", "sdc"}
@@ -151,6 +152,9 @@ def measured_from_store(store_path: str | os.PathLike) -> list[MeasuredPoint]:
             raise InputFileError(f"{store_path}: analyses carry no {column}; calibrate from a "
                                  "table (--data) instead")
     frame = frame.dropna(subset=["frequency_hz", "acceleration_g", "fill_percent", "sdc"])
+    # a file analysed again (other settings) is one measurement, not a repeated test: its two
+    # analyses were averaged, with a standard error from their difference
+    frame = latest_per_measurement(frame)
     # measured frequency and acceleration scatter about the nominal ones: a load case is the
     # frequency to 3 significant digits, the acceleration to 2 (e.g. 50.02 Hz, 4.97 g -> 50, 5)
     frame = frame.assign(

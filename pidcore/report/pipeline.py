@@ -227,9 +227,10 @@ def latest_per_measurement(analyses: pd.DataFrame) -> pd.DataFrame:
     """The newest analysis of each measurement that states a fill (store-only reports)."""
     if analyses.empty or "fill_percent" not in analyses.columns:
         return analyses.iloc[0:0]
+    from ..store.listing import latest_per_measurement as newest
+
     with_fill = analyses[np.isfinite(pd.to_numeric(analyses["fill_percent"], errors="coerce"))]
-    return (with_fill.sort_values("created_utc", kind="stable")
-            .groupby("measurement_key", sort=False).tail(1).reset_index(drop=True))
+    return newest(with_fill).reset_index(drop=True)
 
 
 def _measured_loops(results: list[MeasuredResult], analyses: pd.DataFrame, store,
