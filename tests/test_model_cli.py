@@ -328,3 +328,17 @@ def test_an_area_is_checked_against_the_stored_runs_specimen(tmp_path):
         check_area(100.0, runs_specimen(runs))
     # runs of an older store (no specimen text) or of several specimens: nothing to check by
     assert runs_specimen(pd.DataFrame({"parameters_json": ["{}"]})) is None
+
+
+def test_a_missing_store_is_named_as_missing(tmp_path, capsys):
+    # `model damper --table store --store runs.h6` (a typo) said "no DEM runs stored; run
+    # `pidcore dem` first", sending the user to simulate again
+    from pidcore.cli import main
+
+    missing = tmp_path / "runs.h6"
+    for command in ("damper", "figures"):
+        assert main(["model", command, "--table", "store", "--store", str(missing), "--out",
+                     str(tmp_path / command)]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and f"{missing}: store not found" in err
+        assert not missing.exists() and not (tmp_path / command).exists()

@@ -126,6 +126,11 @@ def build_model(args: argparse.Namespace):
             raise ParameterError(f"--where {item!r}: expected COLUMN=VALUE")
         where[column.strip()] = value.strip()
     runs = Store(args.store).list_dem_runs()
+    if runs.empty and not Path(args.store).is_file():  # a mistyped path: "no DEM runs stored"
+        from ..errors import StoreError
+
+        raise StoreError(f"{args.store}: store not found; expected the store holding the DEM "
+                         "runs (--store FILE)")
     if runs.empty:
         raise ParameterError(f"{args.store}: no DEM runs stored; run `pidcore dem` first or use "
                              f"--table paper")
