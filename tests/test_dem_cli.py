@@ -412,3 +412,12 @@ def test_a_drive_no_shaker_makes_is_refused_before_any_simulation(tmp_path, caps
         simulate_load_case(LoadCase(0.2, 5, 50))
     # Table 3's largest stroke (50 Hz, 10 g: 1 mm) is far inside the 50 mm limit
     assert 10 * 9.80665 / (2 * math.pi * 50) ** 2 < 1.0e-3
+
+
+def test_a_far_too_long_time_step_states_its_steps_per_contact(capsys):
+    # --time-step 1e-3 s said "gives 0.0 steps per acrylic contact": 1.74e-5 s / 1e-3 s is
+    # 0.0174 steps, which one decimal rounded to nothing
+    assert main(["dem", "run", "--frequency", "100", "--acceleration", "5", "--fill", "50",
+                 "--time-step", "1e-3", "--no-progress"]) == 2
+    err = capsys.readouterr().err
+    assert "gives 0.0 steps" not in err and "gives 0.017 steps per acrylic contact" in err

@@ -205,7 +205,7 @@ def choose_time_step(case: LoadCase, law: ContactLaw, geometry: CellGeometry,
         return min(defaults.DEM_TIME_STEP_S, safe)
     if requested > safe:
         raise ParameterError(
-            f"time_step {requested:.3g} s gives {t_contact / requested:.1f} steps per "
+            f"time_step {requested:.3g} s gives {t_contact / requested:.2g} steps per "
             f"{what}; need >= {defaults.DEM_MIN_STEPS_PER_CONTACT}: "
             f"use time_step <= {safe:.3g} s or 'auto'")
     return float(requested)
