@@ -336,3 +336,25 @@ def test_a_fill_of_no_particle_is_refused_naming_the_file(tmp_path, capsys):
                  str(tmp_path / "rep")]) == 2
     assert "fill 1 % of 46 particles rounds to none" in capsys.readouterr().err
     assert not (tmp_path / "rep").exists()
+
+
+def test_a_read_only_store_is_named_as_such_before_any_analysis(tmp_path, capsys, read_only):
+    # a read-only store ended the analysis in "cannot make the working copy .s.h5.<hex>.tmp
+    # ([Errno 13] Unable to synchronously open file (unable to open file: name = ...))"
+    path = export(tmp_path / "rec_fill50_acrylic.csv", fmt="csv")
+    store = tmp_path / "s.h5"
+    assert main(["analyze", str(path), "--store", str(store)]) == 0
+    capsys.readouterr()
+    before = store.read_bytes()
+    read_only(store)
+    other = export(tmp_path / "rec_fill25_acrylic.uff", fmt="uff")
+    assert main(["analyze", str(other), "--store", str(store)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "s.h5: the store file is read-only" in err
+    assert main(["report", str(other), "--store", str(store), "--out",
+                 str(tmp_path / "rep")]) == 2
+    assert "s.h5: the store file is read-only" in capsys.readouterr().err
+    assert store.read_bytes() == before and not (tmp_path / "rep").exists()
+    # only read: a report of what it holds is made as before
+    assert main(["report", "--store", str(store), "--out", str(tmp_path / "rep"),
+                 "--format", "csv"]) == 0

@@ -323,27 +323,8 @@ def test_a_sweep_over_the_grids_fills_says_it_is_not_the_specimens_fill(tmp_path
         assert "note" not in capsys.readouterr().err
 
 
-def _read_only(path: Path, monkeypatch) -> None:
-    """Make ``path`` read-only; as root (who may write it anyway) the store's permission check
-    is answered from the mode bits, as the kernel answers every other user."""
-    import os
-    import stat
-
-    import pidcore.store.store as store_module
-
-    path.chmod(0o444)
-    if os.geteuid() == 0:
-        real = os.access
-
-        def access(target, mode, **kw):
-            if Path(target) == path and mode & os.W_OK:
-                return bool(path.stat().st_mode & stat.S_IWUSR)
-            return real(target, mode, **kw)
-
-        monkeypatch.setattr(store_module.os, "access", access)
-
-
-def test_a_read_only_store_is_refused_before_any_simulation(tmp_path, monkeypatch, capsys):
+def test_a_read_only_store_is_refused_before_any_simulation(tmp_path, monkeypatch, capsys,
+                                                              read_only):
     # dem run / dem sweep / calibrate simulated first and then lost the work at the commit
     # ("cannot commit the changes ([Errno 1] Operation not permitted ...)"); a stored run is
     # still read from a read-only store
@@ -356,7 +337,7 @@ def test_a_read_only_store_is_refused_before_any_simulation(tmp_path, monkeypatc
     assert main(ARGS + ["--store", str(store)]) == 0
     capsys.readouterr()
     before = store.read_bytes()
-    _read_only(store, monkeypatch)
+    read_only(store)
 
     def never(*args, **kwargs):
         raise AssertionError("simulated for a store it cannot save to")

@@ -98,6 +98,7 @@ def _run(args: argparse.Namespace) -> int:
         from ..measure import refuse_store_among_inputs
 
         refuse_store_among_inputs(store, args.paths)
+        store.check_writable()  # before the analyses, in one line naming the store
     results: list = []
     try:
         # Analyse everything before writing anything: one bad file leaves the store untouched.

@@ -543,6 +543,8 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
 
     if main is not None:
         refuse_store_among_inputs(main, files)  # before reading (it may hold many measurements)
+        if files:  # their analyses are added to it
+            main.check_writable()
     options = options or AnalysisOptions()
     results = analyze_files(
         files, fill_percent=fill_percent, material=material, direction=direction,
