@@ -471,3 +471,20 @@ def test_dem_run_says_the_specimens_baseline_is_not_in_its_sdc(capsys, tmp_path,
                                        rel=1e-12)
     assert main(args[:-1]) == 0
     assert "note            SDC of the particles alone" in capsys.readouterr().out
+
+
+def test_specimen_check_names_a_fixture_far_heavier_than_the_coupon(capsys, tmp_path):
+    # a 35 g fixture typed as 35 (kg) passed in silence: inside the 0-1000 kg range, but 140 x
+    # the steel_6mm coupon and its particles (33 g + 216 g), so E of Eq. 10 is nearly all
+    # fixture
+    heavy = tmp_path / "heavy.toml"
+    heavy.write_text(STEEL.read_text().replace("fixture_mass_kg = 0.015", "fixture_mass_kg = 35"))
+    spec = load_specimen(heavy)
+    facts = describe(spec)
+    carried = spec.coupon.mass_kg + spec.cell.count * facts["particles_per_cell"] * \
+        spec.particles.mass_kg
+    (note,) = [n for n in facts["notes"] if "fixture_mass_kg" in n]
+    assert f"{35 / carried:.0f} x the coupon and its particles" in note and "was it g?" in note
+    assert main(["specimen", "check", str(heavy)]) == 0  # a note, not a refusal
+    assert "note: [coupon] fixture_mass_kg 35 kg" in capsys.readouterr().out
+    assert not [n for n in describe(load_specimen(STEEL))["notes"] if "fixture_mass_kg" in n]
