@@ -53,7 +53,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     add_store_option(p, flag="--dem-store", default=None,
                      help="HDF5 store holding the DEM runs (default: --store); only read")
     p.add_argument("--format", metavar="FMT", default="all",
-                   help="all or a comma-separated list of csv, md, html, tex, pdf (default all)")
+                   help="all or a comma-separated list of csv, md, html, tex, pdf (default "
+                        "all); the figures (PNG and SVG, figures/) are written with any")
     add_load_case_options(p, what="FILE", material_help=" or the --specimen's (default: "
                                                          "stated, else the specimen's, else "
                                                          "acrylic)")
