@@ -98,6 +98,10 @@ DEM_MAX_TRANSIENT_TIME_S = 1.0
 #: aliases onto the fundamental and moved Eq. 11 by 1.5 % (50 Hz, 5 g, 25 %); 128 keeps the
 #: shaker within 0.4 % of the walls' work there.
 DEM_SAMPLES_PER_CYCLE = 128
+#: Largest drive displacement amplitude a/w^2 the DEM takes, m: electrodynamic shakers stroke
+#: at most about +-25-50 mm, and a larger one is a unit slip (0.2 typed for 200 Hz: 5 g at
+#: 0.2 Hz is 31 m) whose simulated time (cycles / f) ran for many minutes without a word.
+DEM_MAX_DISPLACEMENT_AMPLITUDE_M = 0.05
 #: Settling ends when every cell's kinetic energy is below this fraction of N m g r.
 DEM_SETTLE_KINETIC_FRACTION = 1e-5
 #: Longest settling time before the run is refused, s.

@@ -47,6 +47,7 @@ from .compare.loadcase import (
     SIDECAR_NAME,
     SPECIMEN_COLUMN,
     FillNotStated,
+    LoadCaseError,
     StatedLoadCase,
     check_columns,
     resolve_load_case,
@@ -61,6 +62,7 @@ if TYPE_CHECKING:
     import pandas as pd
 
     from .measure import AnalysisOptions, AnalyzedRecord
+    from .specimen import Specimen
 
 __all__ = ["ANALYSIS_COLUMNS", "ANALYSIS_SETTINGS_COLUMNS", "AUTO_CHANNEL", "FREE_TEXT_COLUMNS",
            "NO_CHANNEL",
@@ -454,11 +456,42 @@ def analyze_with_settings(path: str | os.PathLike, settings: FileSettings, *,
         for n in record.notes))
 
 
+def _refuse_fill_of_no_particle(path: str | os.PathLike, stated: StatedLoadCase | None,
+                                specimen: Specimen | None) -> None:
+    """Refuse a stated fill that rounds to no particle of its cell (the rule `dem run`
+    applies), naming the file and where the fill came from."""
+    from .constants import PARTICLE_MATERIALS
+    from .dem.simulate import particles_per_cell
+
+    if stated is None:
+        return
+    if specimen is not None and stated.material == specimen.particles.material:
+        cell = specimen
+    elif stated.material in PARTICLE_MATERIALS:
+        cell = None  # the paper's coupon with these particles
+    else:
+        return
+    try:
+        particles_per_cell(stated.fill_percent, stated.material, specimen=cell)
+    except PidcoreError as exc:
+        if not str(exc).startswith("fill "):  # not about the fill
+            raise
+        origin = next((part.strip() for part in stated.origin.split(";")
+                       if part.strip().startswith("fill")), "")
+        origin = origin.replace("fill: option", "fill: --fill")
+        fill = stated.fill_percent
+        hint = (f"was {fill:g} meant as {fill * 100:g} %?" if fill <= 1.0 else
+                "a fill is a percentage of the cell's capacity")
+        raise LoadCaseError(f"{display_path(Path(path).name)}: {exc} ({origin}; "
+                            f"{hint})") from None
+
+
 def resolve_files(paths: Sequence[str | os.PathLike], *, options: AnalysisOptions | None = None,
                   given: Mapping[str, str] | None = None, fill_percent: float | None = None,
                   material: str | None = None, direction: str | None = None,
                   sidecar: str | os.PathLike | None = None,
                   specimen_material: str | None = None, fill_required: bool = True,
+                  specimen_name: str | None = None, specimen: Specimen | None = None,
                   ) -> tuple[list[StatedLoadCase | None], list[FileSettings]]:
     """What each file states about its load case (:func:`resolve_load_case`) and how it is
     analysed (:func:`resolve_file_settings`), file by file, before any analysis, so that a bad
@@ -466,6 +499,12 @@ def resolve_files(paths: Sequence[str | os.PathLike], *, options: AnalysisOption
 
     ``fill_required=False`` gives None for a file that states no fill (``pidcore analyze``
     saves it without a load case); otherwise :class:`FillNotStated` is raised.
+    ``specimen_name`` (of ``--specimen``): the specimen of every file of its particles
+    (``specimen_material``) whose sidecar row names none, with source ``--specimen``. Such
+    files were saved unnamed, and a later report of another specimen of those particles took
+    them for its own tests. A stated fill that rounds to no particle of the cell of its
+    material (``specimen``'s for its particles, the paper's coupon for the table's) is refused
+    naming the file: 0.5 typed for 50 % was analysed and saved as a coupon without particles.
     """
     tables: dict = {}
     stated: list[StatedLoadCase | None] = []
@@ -480,6 +519,11 @@ def resolve_files(paths: Sequence[str | os.PathLike], *, options: AnalysisOption
             if fill_required:
                 raise
             stated.append(None)
-        settings.append(resolve_file_settings(path, options, given=given, sidecar=sidecar,
-                                              tables=tables))
+        _refuse_fill_of_no_particle(path, stated[-1], specimen)
+        fs = resolve_file_settings(path, options, given=given, sidecar=sidecar, tables=tables)
+        if (specimen_name and not fs.specimen and stated[-1] is not None
+                and stated[-1].material == specimen_material):
+            fs = replace(fs, specimen=specimen_name,
+                         sources={**fs.sources, SPECIMEN_COLUMN: "--specimen"})
+        settings.append(fs)
     return stated, settings

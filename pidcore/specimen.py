@@ -945,10 +945,11 @@ def describe(specimen: Specimen) -> dict[str, Any]:
                    for name, pair in (("pp", law.pair_particle), ("pw", law.pair_wall))}
     return {
         "name": specimen.name, "sha256": specimen.hash, "is_paper": specimen.is_paper(),
-        "notes": list(table_overrides(specimen)),
+        "notes": [*table_overrides(specimen), *_heavy_fixture_note(specimen, count)],
         "cell_shape": specimen.cell.shape, "cells_per_coupon": specimen.cell.count,
         "capacity_per_cell": capacity, "particles_per_cell": count,
         "particles_per_cell_basis": basis,
+        "particle_radius_m": p.radius_m,
         "particle_mass_kg": p.mass_kg,
         "particles_mass_kg": specimen.cell.count * count * p.mass_kg,
         "coupon_mass_kg": specimen.coupon.mass_kg,
@@ -972,6 +973,25 @@ def describe(specimen: Specimen) -> dict[str, Any]:
         "time_step_s": choose_time_step(case, law, geometry, "auto",
                                         defaults.DEM_TANGENTIAL_MODEL),
     }
+
+
+#: A fixture this many times the coupon and its particles is named in `specimen check`'s
+#: notes: m_c, and so E of Eq. 10, is then almost all fixture (a 35 g fixture typed as 35 kg
+#: on a 16 g coupon with 91 g of particles is 330 x; the paper's calibrated 0.256 kg fixture is
+#: 3.7 x its 69 g).
+HEAVY_FIXTURE_RATIO = 100.0
+
+
+def _heavy_fixture_note(specimen: Specimen, count: int) -> tuple[str, ...]:
+    """A note for a fixture far heavier than what it carries (a likely g typed as kg); a note,
+    not a refusal: a heavy head expander is possible, but the SDC then measures little."""
+    carried = specimen.coupon.mass_kg + specimen.cell.count * count * specimen.particles.mass_kg
+    fixture = specimen.coupon.fixture_mass_kg
+    if carried <= 0 or fixture <= HEAVY_FIXTURE_RATIO * carried:
+        return ()
+    return (f"[coupon] fixture_mass_kg {fixture:g} kg is {fixture / carried:.0f} x the coupon "
+            f"and its particles ({carried * 1e3:.4g} g): E of Eq. 10 (m_c a^2 / (2 w^2)) is "
+            "then almost all the fixture's and the SDC small; was it g?",)
 
 
 # --- geometry -------------------------------------------------------------------------------

@@ -233,3 +233,29 @@ def undrawn_report_figures(monkeypatch):
         return png, svg
 
     monkeypatch.setattr(render, "save_figure_files", save_figure_files)
+
+
+@pytest.fixture
+def read_only(monkeypatch):
+    """``read_only(path)``: make a store file read-only. As root (who may write it anyway) the
+    store's permission check is answered from the mode bits, as the kernel answers every other
+    user."""
+    import stat
+
+    import pidcore.store.store as store_module
+
+    made: list[Path] = []
+    real = os.access
+
+    def access(target, mode, **kw):
+        if Path(target) in made and mode & os.W_OK:
+            return bool(Path(target).stat().st_mode & stat.S_IWUSR)
+        return real(target, mode, **kw)
+
+    def make(path: Path) -> None:
+        path.chmod(0o444)
+        made.append(Path(path))
+        if os.geteuid() == 0:
+            monkeypatch.setattr(store_module.os, "access", access)
+
+    return make

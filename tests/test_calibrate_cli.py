@@ -119,6 +119,14 @@ def test_json_document(capsys, tmp_path, tiny_store):
     for name in ("calibrated_specimen.toml", "summary.md", "summary.html", "predictions.png",
                  "posterior_pairs.png"):
         assert (out / name).stat().st_size > 0
+    # every column of the summary's prediction tables names its unit (it said "measured SDC",
+    # "error", "inside"); parameters carry theirs in their names (fixture_mass_kg)
+    summary = (out / "summary.md").read_text()
+    heads = [line for line in summary.splitlines() if line.startswith("| f [Hz]")]
+    assert len(heads) == 2  # in-sample and leave-one-out
+    for head in heads:
+        cells = [c.strip() for c in head.strip("|").split("|")]
+        assert all(c.endswith("]") for c in cells), cells
     # the calibrated specimen is a valid specimen file holding the fitted value, all else
     # as the paper's coupon
     spec = load_specimen(out / "calibrated_specimen.toml")
@@ -444,3 +452,79 @@ def test_summary_table_shows_small_sdc_with_its_digits():
     small, usual = _table_rows(rows)
     assert small[3:7] == ["0.000297", "0.00041", "0.00012 .. 0.00088", "+0.000113"]
     assert usual[3:7] == ["0.230", "0.240", "0.052 .. 0.436", "+0.010"]
+
+
+def _mixed_store(monkeypatch):
+    """A store's analyses: acrylic of the paper's coupon, steel of steel_6mm (unnamed) and of
+    another steel specimen."""
+    import pandas as pd
+
+    frame = pd.DataFrame({"frequency_hz": [500.0, 1000.0, 500.0, 1000.0, 500.0],
+                          "acceleration_g": [1.0, 5.0, 1.0, 5.0, 5.0],
+                          "fill_percent": [50.0] * 5, "sdc": [0.2, 0.5, 0.4, 0.6, 0.5],
+                          "sdc_stderr": [0.01] * 5,
+                          "material": ["acrylic", "acrylic", "steel", "steel", "steel"],
+                          "specimen": ["", "", "", "", "steel_other"]})
+    monkeypatch.setattr(Store, "list_analyses", lambda self: frame)
+
+
+def test_store_of_two_materials_calibrates_the_specimens_points(capsys, monkeypatch, tmp_path):
+    # `calibrate --store` on a store holding acrylic and steel measurements was refused as a
+    # whole ("choose the points of one material") with no option to choose them; with
+    # --specimen it takes that specimen's points, as the app's Calibrate page does, and says
+    # what it leaves out
+    import importlib
+
+    from pidcore.errors import ParameterError
+
+    # the module, not the function pidcore.calibrate exports under the same name
+    library = importlib.import_module("pidcore.calibrate.calibrate")
+
+    _mixed_store(monkeypatch)
+    seen = {}
+
+    def fake_calibrate(points, **kwargs):
+        seen["points"] = points
+        raise ParameterError("stopped before any DEM run")
+
+    monkeypatch.setattr(library, "calibrate", fake_calibrate)
+    steel = REPO / "data_samples" / "specimens" / "steel_6mm.toml"
+    code = main(["calibrate", "--store", str(tmp_path / "s.h5"), "--specimen", str(steel),
+                 "--dem-store", str(tmp_path / "dem.h5"), *TINY])
+    err = capsys.readouterr().err
+    assert code == 2 and "stopped before any DEM run" in err
+    assert sorted((p.frequency_hz, p.material, p.specimen) for p in seen["points"]) == [
+        (500.0, "steel", ""), (1000.0, "steel", "")]
+    assert ("note: Not used for steel_6mm (steel particles): 1 measured load case(s) of "
+            "specimen steel_other; 2 measured load case(s) of acrylic particles.") in err
+    # without --specimen (the paper's coupon) the two materials are refused with the way out
+    _refused(capsys, tmp_path, ["--store", str(tmp_path / "s.h5")],
+             "measurements of acrylic, steel particles", "--specimen FILE")
+
+
+def test_a_file_analysed_twice_is_one_measured_point_of_its_newest_analysis(tmp_path):
+    # one file analysed again with a baseline loss factor was taken for two repeated tests:
+    # the mean of both analyses, with a standard error from their difference (0.006 instead
+    # of the analysis's own 0.03), and the same raw data counted twice
+    from _shaker_files import write_force_velocity
+
+    from pidcore.calibrate import measured_from_store
+    from pidcore.constants import STANDARD_GRAVITY
+    from pidcore.signal.synthetic import synthesize_shaker_record
+
+    rec = synthesize_shaker_record(mass_kg=0.25, acceleration_amplitude_m_s2=5 * STANDARD_GRAVITY,
+                                   frequency_hz=500.0, sample_rate_hz=25_600.0, n_periods=40.3,
+                                   viscous_damping_n_s_m=2.0, coulomb_friction_n=0.3,
+                                   snr_db=50, seed=3)
+    path = tmp_path / "run_fill50_acrylic.csv"
+    write_force_velocity(path, rec.force_n, rec.velocity_m_s, 25_600.0, "csv")
+    store = tmp_path / "s.h5"
+    assert main(["analyze", str(path), "--store", str(store)]) == 0
+    assert main(["analyze", str(path), "--store", str(store), "--baseline-loss-factor",
+                 "0.002"]) == 0
+    analyses = Store(store).list_analyses()
+    assert len(analyses) == 2  # the store keeps both analyses of the one measurement
+    newest = analyses.sort_values("created_utc").iloc[-1]
+    (point,) = measured_from_store(store)
+    assert point.sdc == newest["sdc"]  # the baseline-corrected one, not the mean of both
+    assert point.sdc_stderr == newest["sdc_stderr"]

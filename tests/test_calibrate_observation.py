@@ -141,3 +141,22 @@ def test_bound_notes_flag_a_posterior_piled_against_a_prior_bound():
     assert bound_notes([tau], good) == []
     low = np.exp(rng.uniform(math.log(0.02), math.log(0.025), (4000, 1)))  # lowest 5 % in log
     assert "lower bound 0.02" in bound_notes([tau], low)[0]
+
+
+def test_bound_notes_spare_a_narrow_posterior_inside_the_prior_edge():
+    # a 35 g fixture under the 0-1 kg prior: the data pin it to 20-54 g (95 %), all of it in
+    # the prior's lowest 5 %, and the note said the median was "set by the prior, not the
+    # data". Piling means the density is highest at the bound (half-normal against it: still
+    # noted); a posterior 4 standard deviations clear of the bound is not piled.
+    from pidcore.calibrate.parameters import parameter_spec
+    from pidcore.calibrate.posterior import bound_notes
+
+    spec = parameter_spec("fixture_mass_kg")
+    assert (spec.low, spec.high) == (0.0, 1.0)
+    rng = np.random.default_rng(1)
+    narrow = rng.normal(0.037, 0.0087, (4000, 1))  # 95 % 0.020 .. 0.054 kg
+    assert np.mean(narrow < 0.05) > 0.9  # the old rule's 20 % of the prior's edge, exceeded
+    assert bound_notes([spec], narrow) == []
+    half_normal = np.abs(rng.normal(0.0, 0.02, (4000, 1)))  # the data ask for <= 0 kg
+    (note,) = bound_notes([spec], half_normal)
+    assert "lower bound 0" in note

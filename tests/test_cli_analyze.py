@@ -320,3 +320,91 @@ sliding_friction = 0.3
 restitution = 0.8
 sliding_friction = 0.35
 """
+
+
+def test_files_of_a_specimens_particles_are_saved_as_its_tests(tmp_path, capsys):
+    # `analyze --specimen A` saved its steel records unnamed: a later `report --specimen B` (B
+    # another steel specimen) took them for B's tests and compared them with B's DEM runs
+    spec_a = tmp_path / "a.toml"
+    spec_a.write_text(STEEL_SPECIMEN.replace('name = "my_steel"', 'name = "panel_a"'))
+    spec_b = tmp_path / "b.toml"
+    spec_b.write_text(STEEL_SPECIMEN.replace('name = "my_steel"', 'name = "panel_b"'))
+    store = tmp_path / "s.h5"
+    steel_a = export(tmp_path / "a_fill20_steel.csv", fmt="csv")
+    acrylic = export(tmp_path / "c_fill20_acrylic.uff", fmt="uff")
+    doc = run_json([str(steel_a), str(acrylic), "--specimen", str(spec_a), "--store",
+                    str(store)], capsys)
+    assert [r["specimen"] for r in doc["records"]] == ["panel_a", None]  # acrylic: not its
+    steel_b = export(tmp_path / "b_fill30_steel.mat", fmt="mat")  # other bytes: another record
+    assert main(["analyze", str(steel_b), "--specimen", str(spec_b), "--store",
+                 str(store)]) == 0
+    assert "specimen 'panel_b' (--specimen)" in capsys.readouterr().out
+    saved = Store(store).list_analyses()
+    named = {Path(src).name: (spec if isinstance(spec, str) else "")
+             for src, spec in zip(saved["source"], saved.get("specimen", [""] * len(saved)),
+                                  strict=True)}
+    assert {k: named.get(k) for k in ("a_fill20_steel.csv", "b_fill30_steel.mat")} == {
+        "a_fill20_steel.csv": "panel_a", "b_fill30_steel.mat": "panel_b"}
+    assert named.get("c_fill20_acrylic.uff", "") == ""
+    # a sidecar's specimen is the file's own, as before
+    (tmp_path / "loadcases.csv").write_text("file,specimen\nb_fill30_steel.mat,rig_c\n")
+    doc = run_json([str(steel_b), "--specimen", str(spec_a), "--no-store"], capsys)
+    assert doc["records"][0]["specimen"] == "rig_c"
+
+
+def test_a_file_of_other_particles_than_the_specimens_names_the_specimens(tmp_path, capsys):
+    # `analyze coupon_fill20_steel.csv --specimen wc.toml` (tungsten carbide) said the table
+    # lacks steel and to "give --specimen FILE whose particles are steel", as if none was given
+    steel = export(tmp_path / "coupon_fill20_steel.csv", fmt="csv")
+    spec = tmp_path / "wc.toml"
+    spec.write_text(STEEL_SPECIMEN.replace('material = "steel"', 'material = "tungsten_carbide"'))
+    assert main(["analyze", str(steel), "--specimen", str(spec), "--no-store"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1
+    assert ("which the material table (acrylic, aluminium) and the --specimen's "
+            "tungsten_carbide particles lack") in err
+
+
+def test_a_fill_of_no_particle_is_refused_naming_the_file(tmp_path, capsys):
+    # `--fill 0.5` (a fraction typed for 50 %) was analysed and saved as a load case of 0.5 %,
+    # a coupon without a particle in its cells (22 acrylic spheres fill the paper's cell:
+    # 0.5 % of 22 is 0.11, rounded to none), which no DEM run can ever match
+    path = export(tmp_path / "rec_fill50_acrylic.csv", fmt="csv")
+    store = tmp_path / "s.h5"
+    assert main(["analyze", str(path), "--fill", "0.5", "--store", str(store)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "rec_fill50_acrylic.csv: fill 0.5 % of 22 particles " \
+        "rounds to none" in err and "fill: --fill" in err
+    assert not store.exists()
+    # against a specimen's cell: 46 steel spheres of 1 mm radius fill the 6.35 mm cell
+    spec = tmp_path / "steel.toml"
+    spec.write_text(STEEL_SPECIMEN)
+    steel = export(tmp_path / "rec_fill1_steel.csv", fmt="csv")
+    assert main(["analyze", str(steel), "--specimen", str(spec), "--no-store"]) == 2
+    assert "fill 1 % of 46 particles rounds to none" in capsys.readouterr().err
+    assert main(["report", str(steel), "--specimen", str(spec), "--out",
+                 str(tmp_path / "rep")]) == 2
+    assert "fill 1 % of 46 particles rounds to none" in capsys.readouterr().err
+    assert not (tmp_path / "rep").exists()
+
+
+def test_a_read_only_store_is_named_as_such_before_any_analysis(tmp_path, capsys, read_only):
+    # a read-only store ended the analysis in "cannot make the working copy .s.h5.<hex>.tmp
+    # ([Errno 13] Unable to synchronously open file (unable to open file: name = ...))"
+    path = export(tmp_path / "rec_fill50_acrylic.csv", fmt="csv")
+    store = tmp_path / "s.h5"
+    assert main(["analyze", str(path), "--store", str(store)]) == 0
+    capsys.readouterr()
+    before = store.read_bytes()
+    read_only(store)
+    other = export(tmp_path / "rec_fill25_acrylic.uff", fmt="uff")
+    assert main(["analyze", str(other), "--store", str(store)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "s.h5: the store file is read-only" in err
+    assert main(["report", str(other), "--store", str(store), "--out",
+                 str(tmp_path / "rep")]) == 2
+    assert "s.h5: the store file is read-only" in capsys.readouterr().err
+    assert store.read_bytes() == before and not (tmp_path / "rep").exists()
+    # only read: a report of what it holds is made as before
+    assert main(["report", "--store", str(store), "--out", str(tmp_path / "rep"),
+                 "--format", "csv"]) == 0

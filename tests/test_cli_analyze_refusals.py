@@ -204,8 +204,8 @@ def test_a_fill_that_puts_no_particle_in_a_cell_is_refused(tmp_path, capsys, how
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1
     source = {"option": "--fill", "file name": "file name", "sidecar": "loadcases.csv"}[how]
-    assert f"{name} ({source}" in err and "rounds to none" in err
-    assert "was 0.5 meant as 50 %?" in err
+    assert f"{name}: fill 0.5 % of {capacity} particles rounds to none" in err
+    assert f"(fill: {source}" in err and "was 0.5 meant as 50 %?" in err
     assert not (tmp_path / "s.h5").exists()  # nothing written
 
 

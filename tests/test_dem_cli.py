@@ -321,3 +321,84 @@ def test_a_sweep_over_the_grids_fills_says_it_is_not_the_specimens_fill(tmp_path
     for more, path in ((["--fills", "30"], mine), ([], spec)):
         assert main([*argv[:3], str(path), *argv[4:], *more]) == 130
         assert "note" not in capsys.readouterr().err
+
+
+def test_a_read_only_store_is_refused_before_any_simulation(tmp_path, monkeypatch, capsys,
+                                                              read_only):
+    # dem run / dem sweep / calibrate simulated first and then lost the work at the commit
+    # ("cannot commit the changes ([Errno 1] Operation not permitted ...)"); a stored run is
+    # still read from a read-only store
+    import pidcore.calibrate.runner  # noqa: F401 - the module patched below
+    import pidcore.dem.persist
+    import pidcore.dem.sweep
+    from pidcore.store import Store
+
+    store = tmp_path / "runs.h5"
+    assert main(ARGS + ["--store", str(store)]) == 0
+    capsys.readouterr()
+    before = store.read_bytes()
+    read_only(store)
+
+    def never(*args, **kwargs):
+        raise AssertionError("simulated for a store it cannot save to")
+
+    monkeypatch.setattr(pidcore.dem.persist, "simulate_load_case", never)
+    monkeypatch.setattr(pidcore.dem.sweep, "_run_local", never)
+    other = [a if a != "500" else "400" for a in ARGS]
+    for argv in (other + ["--store", str(store)],
+                 ["dem", "sweep", "--frequencies", "400", "--accelerations", "5", "--fills",
+                  "50", "--cells", "2", "--cycles", "5", "--no-progress", "--store",
+                  str(store)]):
+        assert main(argv) == 2
+        err = capsys.readouterr().err.strip()
+        assert len(err.splitlines()) == 1 and "runs.h5: the store file is read-only" in err
+    # calibrate's DEM runs: refused before the first
+    from pidcore.calibrate.runner import RunRequest, run_requests
+    from pidcore.dem import DemConfig, LoadCase
+    from pidcore.errors import StoreError
+    from pidcore.specimen import paper_specimen
+
+    request = RunRequest(LoadCase(400, 5, 50), paper_specimen(), DemConfig(cells=2))
+    with pytest.raises(StoreError, match="the store file is read-only"):
+        run_requests([request], store_path=store, workers=1, progress=False)
+    # the cached run is read as before, and the store is untouched
+    assert main(ARGS + ["--store", str(store)]) == 0
+    assert "reused from" in capsys.readouterr().out
+    assert store.read_bytes() == before and len(Store(store).list_dem_runs()) == 1
+
+
+def test_a_drive_no_shaker_makes_is_refused_before_any_simulation(tmp_path, capsys):
+    # 0.2 typed for 200 Hz: 5 g at 0.2 Hz is a displacement amplitude a/w^2 of 31 m; the DEM
+    # simulated its cycles (~100 s of simulated time) for many minutes without a word
+    import math
+
+    from pidcore.dem import LoadCase, simulate_load_case
+    from pidcore.errors import ParameterError
+
+    stroke = 5 * 9.80665 / (2 * math.pi * 0.2) ** 2
+    assert stroke == pytest.approx(31.05, rel=1e-3)
+    slow = [a if a != "500" else "0.2" for a in ARGS]
+    assert main(slow) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1
+    assert "--frequency/--acceleration 0.2 Hz, 5 g: a displacement amplitude of 31.1 m" in err
+    assert "kHz" in err
+    store = tmp_path / "runs.h5"
+    assert main(["dem", "sweep", "--frequencies", "200,0.2", "--accelerations", "5", "--fills",
+                 "50", "--cells", "2", "--cycles", "5", "--no-progress", "--store",
+                 str(store)]) == 2
+    assert "--frequencies/--accelerations 0.2 Hz" in capsys.readouterr().err
+    assert not store.exists()  # the 200 Hz case was not run either
+    with pytest.raises(ParameterError, match="displacement amplitude"):
+        simulate_load_case(LoadCase(0.2, 5, 50))
+    # Table 3's largest stroke (50 Hz, 10 g: 1 mm) is far inside the 50 mm limit
+    assert 10 * 9.80665 / (2 * math.pi * 50) ** 2 < 1.0e-3
+
+
+def test_a_far_too_long_time_step_states_its_steps_per_contact(capsys):
+    # --time-step 1e-3 s said "gives 0.0 steps per acrylic contact": 1.74e-5 s / 1e-3 s is
+    # 0.0174 steps, which one decimal rounded to nothing
+    assert main(["dem", "run", "--frequency", "100", "--acceleration", "5", "--fill", "50",
+                 "--time-step", "1e-3", "--no-progress"]) == 2
+    err = capsys.readouterr().err
+    assert "gives 0.0 steps" not in err and "gives 0.017 steps per acrylic contact" in err

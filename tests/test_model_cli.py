@@ -288,7 +288,8 @@ def test_figures_of_stored_runs_name_their_specimen(tmp_path, monkeypatch):
     _fake_store(monkeypatch, lambda: mine)
     assert _run(["model", "figures", "--out", str(tmp_path), "--table", "store", "--store",
                  str(tmp_path / "s.h5")]) == 0
-    titles = {fig._suptitle.get_text() for fig in built if fig._suptitle is not None}
+    titles = {fig._suptitle.get_text().replace("\n", " ")  # wrapped to the figure width
+              for fig in built if fig._suptitle is not None}
     assert titles == {f"DEM runs of steel_6mm [aaaaaa] in {tmp_path / 's.h5'}"}
     assert len(built) == 2 * (4 + 3)  # every figure titled, each saved as PNG and SVG
 
@@ -349,3 +350,17 @@ def test_a_vibrated_mass_in_grams_is_refused(tmp_path):
         tables[mass] = pd.read_csv(out / "equivalent_damper.csv")["c_eq [N s/m]"].to_numpy()
     small, large = tables.values()
     np.testing.assert_allclose(large, 10 * small, rtol=1e-9)
+
+
+def test_a_missing_store_is_named_as_missing(tmp_path, capsys):
+    # `model damper --table store --store runs.h6` (a typo) said "no DEM runs stored; run
+    # `pidcore dem` first", sending the user to simulate again
+    from pidcore.cli import main
+
+    missing = tmp_path / "runs.h6"
+    for command in ("damper", "figures"):
+        assert main(["model", command, "--table", "store", "--store", str(missing), "--out",
+                     str(tmp_path / command)]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and f"{missing}: store not found" in err
+        assert not missing.exists() and not (tmp_path / command).exists()

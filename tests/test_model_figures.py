@@ -91,3 +91,21 @@ def test_save_figure_writes_png_and_svg(paper_model, tmp_path):
     assert b"<svg" in paths[1].read_bytes()[:2000]
     with pytest.raises(ParameterError):
         save_figure(fig, tmp_path, "../escape")
+
+
+def test_a_long_source_title_stays_inside_the_figure(paper_model):
+    # `model figures --table store --where ...` titled the figure "DEM runs of X [hash] in
+    # runs.h5 where {...}" on one line, cut off at both edges of the saved PNG
+    import dataclasses
+
+    source = ("DEM runs of my_panel_steel [30fbec] in /tmp/some/folder/runs.h5 where "
+              "specimen_name=my_panel_steel, settings_hash=00039b")
+    fig = plot_sdc_vs_frequency(dataclasses.replace(paper_model, source=source),
+                                accelerations=[5.0], fills=[50.0])
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    canvas = FigureCanvasAgg(fig)  # as save_figure renders the PNG
+    canvas.draw()
+    box = fig._suptitle.get_window_extent(canvas.get_renderer())
+    assert box.x0 >= fig.bbox.x0 and box.x1 <= fig.bbox.x1, (box, fig.bbox)
+    assert fig._suptitle.get_text().replace("\n", " ") == source

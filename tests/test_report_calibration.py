@@ -317,3 +317,20 @@ def test_a_measurement_is_checked_against_the_band_of_its_own_stderr(tmp_path):
     old = load_calibration(_write(tmp_path / "old.json", [_prediction(50, 5, 50, 0.5, 0.2,
                                                                         0.8)]))
     assert add_calibration_columns(table, old)[CALIBRATED_LOW_COLUMN].tolist() == [0.2] * 3
+
+
+@pytest.mark.usefixtures("undrawn_report_figures")
+def test_format_help_says_the_figures_come_with_any_format(tmp_path, capsys):
+    # `report --format csv` wrote figures/ as well, which its help ("all or a comma-separated
+    # list of csv, md, html, tex, pdf") did not say
+    from pidcore.cli import main
+
+    out = tmp_path / "rep"
+    assert main(["report", "--dem-store", str(ROOT / "data_samples" / "dem_table3.h5"),
+                 "--format", "csv", "--out", str(out)]) == 0
+    assert (out / "report.csv").is_file() and not (out / "report.md").exists()
+    assert any((out / "figures").glob("*.png")) and any((out / "figures").glob("*.svg"))
+    with pytest.raises(SystemExit):
+        main(["report", "--help"])
+    help_text = " ".join(capsys.readouterr().out.split())
+    assert "the figures (PNG and SVG, figures/) are written with any" in help_text

@@ -121,3 +121,46 @@ def test_the_apps_report_tab_says_how_to_compare_the_other_runs_in_its_own_words
     assert _measured(table, "acrylic.h5")["note"].endswith(
         "another specimen's: choose theirs with the Report tab's specimen choice to compare "
         "them)")
+
+
+def test_a_specimen_baseline_the_measurements_did_not_subtract_is_said(steel, store_runs,
+                                                                        analyses):
+    # the specimen file's [coupon] baseline_loss_factor (the empty coupon's damping) was used
+    # only by calibrate: a report of the specimen compared measured SDCs that include it with
+    # the DEM's (particles alone), and its provenance said baseline_loss_factor=0.0
+    import dataclasses
+    import json
+    import math
+
+    damped = steel.with_values({"coupon.baseline_loss_factor": 0.002})
+    mine = analyses.assign(material="steel", specimen=["", "other_coupon"],
+                           parameters_json=[json.dumps({"baseline_loss_factor": 0.0})] * 2)
+    notes = specimen_report_table(store_runs, mine, specimen=damped).table.attrs["notes"]
+    (note,) = [n for n in notes if "baseline_loss_factor" in n]
+    # one record: the other_coupon one is not this specimen's test
+    assert "states [coupon] baseline_loss_factor 0.002" in note and "1 measured record(s)" in note
+    assert f"{2 * math.pi * 0.002:.3g}" in note and "--baseline-loss-factor 0.002" in note
+    # subtracted at analysis, or no baseline stated: nothing to say
+    done = mine.assign(parameters_json=[json.dumps({"baseline_loss_factor": 0.002})] * 2)
+    for specimen, frame in ((damped, done), (steel, mine),
+                            (dataclasses.replace(damped), analyses)):
+        notes = specimen_report_table(store_runs, frame, specimen=specimen).table.attrs["notes"]
+        assert not [n for n in notes if "baseline_loss_factor" in n]
+
+
+def test_a_test_of_a_specimen_whose_runs_the_store_holds_says_how_to_compare_them(
+        steel, store_runs, analyses):
+    # a report of the paper's coupon with a steel measurement named steel_6mm, whose run the
+    # store holds: the note said the steel_6mm run was "another specimen's: not compared with
+    # a test of steel_6mm", of the test's own specimen
+    named = analyses.assign(specimen=["", "steel_6mm"])
+    row = _measured(specimen_report_table(store_runs, named).table, "other.h5")
+    assert row[ALIGNMENT_COLUMN] == "no_dem_runs"
+    assert row["note"] == (f"no DEM runs of steel_6mm for steel, direction z among this "
+                           f"report's runs (the store has 1 of steel_6mm [{steel.hash[:6]}]; "
+                           "steel_6mm's are left out of a report of another specimen: report "
+                           "with their --specimen FILE to compare them)")
+    assert "another specimen's: not compared" not in row["note"]
+    # with its --specimen the same test meets that run
+    row = _measured(specimen_report_table(store_runs, named, specimen=steel).table, "other.h5")
+    assert row[ALIGNMENT_COLUMN] == "grid"

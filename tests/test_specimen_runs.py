@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -419,3 +420,71 @@ def test_runs_stored_before_specimens_stay_the_papers_beside_hashed_runs():
     bare = runs[["case_key"]]
     assert persist.runs_of_specimen(bare)["case_key"].tolist() == ["old", "steel"]
     assert persist.runs_of_specimen(bare, steel).empty
+
+
+def test_specimen_check_states_the_particle_radius_it_simulates(capsys, tmp_path):
+    # the check printed masses and gaps but not the radius: a 2 mm diameter typed as
+    # radius_m = 2e-3 (or a table material's default radius) could not be seen; the sphere
+    # mass it printed is 4/3 pi r^3 rho of that radius
+    import math
+
+    typed_diameter = tmp_path / "diameter.toml"
+    typed_diameter.write_text(STEEL.read_text().replace("radius_m = 1.0e-3", "radius_m = 2.0e-3"))
+    assert main(["specimen", "check", str(typed_diameter)]) == 0
+    assert "radius 2 mm (diameter 4 mm)" in capsys.readouterr().out
+    assert main(["specimen", "check", str(typed_diameter), "--json"]) == 0
+    facts = json.loads(capsys.readouterr().out)
+    assert facts["particle_radius_m"] == 2.0e-3
+    assert facts["particle_mass_kg"] == pytest.approx(4 / 3 * math.pi * 2.0e-3 ** 3 * 7850.0)
+
+
+def test_readme_specimen_table_names_every_key_the_reader_takes():
+    # the README's key table is the documented schema; schema_version, which every bundled
+    # file starts with and the reader checks, was missing from it
+    from pidcore.specimen import SCHEMA
+
+    readme = (REPO / "README.md").read_text(encoding="utf-8")
+    table = readme[readme.index("| key | unit | meaning |"):]
+    table = table[:table.index("\n\n")]
+    # a key is written `key` or within a cell's code span (`[cell] shape`, `wall_poisson_ratio`)
+    missing = [key for section in SCHEMA.values() for key in section
+               if not re.search(rf"[`\s]{key}`", table)]
+    assert missing == []
+
+
+def test_dem_run_says_the_specimens_baseline_is_not_in_its_sdc(capsys, tmp_path, monkeypatch):
+    # a specimen stating [coupon] baseline_loss_factor 0.002 printed the particles' SDC with no
+    # word of whether the empty coupon's damping was in it (it is not: SDC = dissipation / E)
+    import math
+
+    damped = tmp_path / "damped.toml"
+    damped.write_text(STEEL.read_text().replace("baseline_loss_factor = 0.0",
+                                                "baseline_loss_factor = 0.002"))
+    args = ["dem", "run", "--specimen", str(damped), "--frequency", "1000", "--acceleration",
+            "5", "--cells", "1", "--cycles", "2", "--no-progress", "--json"]
+    assert main(args) == 0
+    doc = json.loads(capsys.readouterr().out)
+    (note,) = [n for n in doc["notes"] if "baseline_loss_factor" in n]
+    assert "baseline_loss_factor 0.002" in note and f"{2 * math.pi * 0.002:.3g}" in note
+    # the SDC is the dissipation over E alone, with no baseline added
+    assert doc["sdc"] == pytest.approx(doc["energy_per_cycle_j"] / doc["max_kinetic_energy_j"],
+                                       rel=1e-12)
+    assert main(args[:-1]) == 0
+    assert "note            SDC of the particles alone" in capsys.readouterr().out
+
+
+def test_specimen_check_names_a_fixture_far_heavier_than_the_coupon(capsys, tmp_path):
+    # a 35 g fixture typed as 35 (kg) passed in silence: inside the 0-1000 kg range, but 140 x
+    # the steel_6mm coupon and its particles (33 g + 216 g), so E of Eq. 10 is nearly all
+    # fixture
+    heavy = tmp_path / "heavy.toml"
+    heavy.write_text(STEEL.read_text().replace("fixture_mass_kg = 0.015", "fixture_mass_kg = 35"))
+    spec = load_specimen(heavy)
+    facts = describe(spec)
+    carried = spec.coupon.mass_kg + spec.cell.count * facts["particles_per_cell"] * \
+        spec.particles.mass_kg
+    (note,) = [n for n in facts["notes"] if "fixture_mass_kg" in n]
+    assert f"{35 / carried:.0f} x the coupon and its particles" in note and "was it g?" in note
+    assert main(["specimen", "check", str(heavy)]) == 0  # a note, not a refusal
+    assert "note: [coupon] fixture_mass_kg 35 kg" in capsys.readouterr().out
+    assert not [n for n in describe(load_specimen(STEEL))["notes"] if "fixture_mass_kg" in n]

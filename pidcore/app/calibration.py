@@ -61,51 +61,18 @@ def points_by_material(points: Sequence) -> dict[str, list]:
 
 
 def points_for_specimen(points: Sequence, specimen) -> tuple[list, str]:
-    """(points, note): the measured points a specimen file is calibrated against, those of its
-    particle material measured on it (their specimen label is its name, or the name it was
-    calibrated from) or on no named specimen; ``note`` says what is left out and why ("" if
-    nothing)."""
-    from ..specimen import uncalibrated_name
+    """:func:`pidcore.calibrate.data.points_for_specimen` (imported when called, as the rest
+    of the library: :func:`calibration_api`)."""
+    from ..calibrate.data import points_for_specimen as library_points_for_specimen
 
-    material = specimen.particles.material
-    # a calibrated file (as pidcore calibrate names it) is the specimen its measurements
-    # were made on
-    names = {"", specimen.name, uncalibrated_name(specimen.name)}
-    kept, other_material, other_specimen = [], {}, {}
-    for p in points:
-        if str(p.material) != material:
-            other_material[str(p.material)] = other_material.get(str(p.material), 0) + 1
-        elif str(p.specimen) not in names:
-            other_specimen[str(p.specimen)] = other_specimen.get(str(p.specimen), 0) + 1
-        else:
-            kept.append(p)
-    reasons = [f"{n} measured load case(s) of specimen {name}"
-               for name, n in other_specimen.items()]
-    reasons += [f"{n} measured load case(s) of {name} particles"
-                for name, n in other_material.items()]
-    note = (f"Not used for {specimen.name} ({material} particles): " + "; ".join(reasons)
-            + ".") if reasons else ""
-    return kept, note
+    return library_points_for_specimen(points, specimen)
 
 
 def points_for_paper(points: Sequence) -> tuple[list, str]:
-    """(points, note): the measured points the paper's coupon is calibrated against, those
-    naming no specimen or the paper's coupon (the library refuses others:
-    :func:`pidcore.calibrate.calibrate.check_point_specimens`); ``note`` says what is left out
-    ("" if nothing)."""
-    from ..specimen import PAPER_SPECIMEN_NAME, uncalibrated_name
+    """:func:`pidcore.calibrate.data.points_for_paper` with the page's way out in its note."""
+    from ..calibrate.data import points_for_paper as library_points_for_paper
 
-    kept, others = [], {}
-    for p in points:
-        name = str(p.specimen)
-        if name and uncalibrated_name(name) != PAPER_SPECIMEN_NAME:
-            others[name] = others.get(name, 0) + 1
-        else:
-            kept.append(p)
-    note = ("Not used for the paper's coupon: " + "; ".join(
-        f"{n} measured load case(s) of specimen {name}" for name, n in others.items())
-        + " (choose their specimen file above).") if others else ""
-    return kept, note
+    return library_points_for_paper(points, hint="choose their specimen file above")
 
 
 def specimen_label(specimen) -> str:

@@ -130,7 +130,7 @@ def read_measured_table(path: str | os.PathLike, *,
 
 def measured_from_store(store_path: str | os.PathLike) -> list[MeasuredPoint]:
     """Analysed measurements of a store, grouped per load case, particle material and specimen
-    label (mean SDC, standard error).
+    label (mean SDC, standard error), of the newest analysis of each measurement.
 
     Records of other materials or specimens at one load case are kept apart (averaging acrylic
     and steel particles would fit neither); a record without a material is the paper's acrylic,
@@ -141,6 +141,7 @@ def measured_from_store(store_path: str | os.PathLike) -> list[MeasuredPoint]:
     analyses must carry ``fill_percent`` (from a sidecar).
     """
     from ..store import Store
+    from ..store.listing import latest_per_measurement
 
     frame = Store(store_path).list_analyses()
     need = {"frequency_hz", "sdc"}
@@ -151,6 +152,9 @@ def measured_from_store(store_path: str | os.PathLike) -> list[MeasuredPoint]:
             raise InputFileError(f"{store_path}: analyses carry no {column}; calibrate from a "
                                  "table (--data) instead")
     frame = frame.dropna(subset=["frequency_hz", "acceleration_g", "fill_percent", "sdc"])
+    # a file analysed again (other settings) is one measurement, not a repeated test: its two
+    # analyses were averaged, with a standard error from their difference
+    frame = latest_per_measurement(frame)
     # measured frequency and acceleration scatter about the nominal ones: a load case is the
     # frequency to 3 significant digits, the acceleration to 2 (e.g. 50.02 Hz, 4.97 g -> 50, 5)
     frame = frame.assign(
@@ -173,6 +177,54 @@ def measured_from_store(store_path: str | os.PathLike) -> list[MeasuredPoint]:
     if not points:
         raise InputFileError(f"{store_path}: no analysed measurement has a complete load case")
     return points
+
+
+def points_for_specimen(points: Sequence[MeasuredPoint], specimen) -> tuple[list, str]:
+    """(points, note): the measured points a specimen file is calibrated against, those of its
+    particle material measured on it (their specimen label is its name, or the name it was
+    calibrated from) or on no named specimen; ``note`` says what is left out and why ("" if
+    nothing)."""
+    from ..specimen import uncalibrated_name
+
+    material = specimen.particles.material
+    # a calibrated file (as pidcore calibrate names it) is the specimen its measurements
+    # were made on
+    names = {"", specimen.name, uncalibrated_name(specimen.name)}
+    kept, other_material, other_specimen = [], {}, {}
+    for p in points:
+        if str(p.material) != material:
+            other_material[str(p.material)] = other_material.get(str(p.material), 0) + 1
+        elif str(p.specimen) not in names:
+            other_specimen[str(p.specimen)] = other_specimen.get(str(p.specimen), 0) + 1
+        else:
+            kept.append(p)
+    reasons = [f"{n} measured load case(s) of specimen {name}"
+               for name, n in other_specimen.items()]
+    reasons += [f"{n} measured load case(s) of {name} particles"
+                for name, n in other_material.items()]
+    note = (f"Not used for {specimen.name} ({material} particles): " + "; ".join(reasons)
+            + ".") if reasons else ""
+    return kept, note
+
+
+def points_for_paper(points: Sequence[MeasuredPoint], *, hint: str = "") -> tuple[list, str]:
+    """(points, note): the measured points the paper's coupon is calibrated against, those
+    naming no specimen or the paper's coupon (the library refuses others:
+    :func:`pidcore.calibrate.calibrate.check_point_specimens`); ``note`` says what is left out
+    ("" if nothing), with ``hint``, the caller's way to calibrate them, in brackets."""
+    from ..specimen import PAPER_SPECIMEN_NAME, uncalibrated_name
+
+    kept, others = [], {}
+    for p in points:
+        name = str(p.specimen)
+        if name and uncalibrated_name(name) != PAPER_SPECIMEN_NAME:
+            others[name] = others.get(name, 0) + 1
+        else:
+            kept.append(p)
+    note = ("Not used for the paper's coupon: " + "; ".join(
+        f"{n} measured load case(s) of specimen {name}" for name, n in others.items())
+        + (f" ({hint})" if hint else "") + ".") if others else ""
+    return kept, note
 
 
 def check_enough_points(points: list[MeasuredPoint], names: Sequence[str], *,

@@ -54,8 +54,9 @@ def _table_rows(rows: list[dict]) -> list[list[str]]:
     return out
 
 
-_HEAD = ["f [Hz]", "a [g]", "fill [%]", "measured SDC", "predicted SDC", "95 % band",
-         "error", "inside"]
+#: Every column names its unit, as the report's (SDC and its error are dimensionless).
+_HEAD = ["f [Hz]", "a [g]", "fill [%]", "measured SDC [-]", "predicted SDC [-]",
+         "95 % band [-]", "error [-]", "inside [yes/no]"]
 
 
 def summary_markdown(result: CalibrationResult) -> str:
@@ -89,7 +90,7 @@ def summary_markdown(result: CalibrationResult) -> str:
     if any(s.kind == "dem" for s in result.specs):
         lines += ["", "## Energy per cycle per cell: starting specimen vs calibrated DEM", "",
                   "| f [Hz] | a [g] | start [J] | calibrated median [J] | 95 % band [J] | "
-                  "start inside |", "|---|---|---|---|---|---|"]
+                  "start inside [yes/no] |", "|---|---|---|---|---|---|"]
         for r in result.energy_check:
             lines.append(f"| {r['frequency_hz']:g} | {r['acceleration_g']:g} | "
                          f"{r['energy_per_cycle_per_cell_start_j']:.3g} | "

@@ -101,6 +101,8 @@ def run_requests(requests: Sequence[RunRequest], *, store_path: str | os.PathLik
             todo.append(request)
         seen.add(key)
     cached = len(seen) - len(todo)
+    if todo:
+        store.check_writable()  # before the DEM runs, not at the first commit
     bar = None
     if progress and todo:
         from tqdm import tqdm

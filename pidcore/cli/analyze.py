@@ -47,7 +47,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     g.add_argument("--specimen", metavar="FILE", type=Path, default=None,
                    help="specimen file whose particle material the files may state (e.g. "
                         "steel, which the material table lacks) and which is the default "
-                        "material")
+                        "material; its name is saved with the files of its particles whose "
+                        "sidecar names no specimen")
     p.add_argument("--key", metavar="NAME", default=None,
                    help="which measurement of a pidcore HDF5 store to analyse, when it holds "
                         "several (the error lists them)")
@@ -70,25 +71,20 @@ def _stated(args: argparse.Namespace) -> tuple[list, list]:
     """What each path states about its load case (None: no fill stated) and how it is analysed
     (:class:`~pidcore.file_settings.FileSettings`), resolved before any analysis so that a bad
     sidecar or option is refused at once."""
-    from ..compare.loadcase import refuse_fill_of_no_particle
     from ..file_settings import resolve_files
 
-    specimen = specimen_material = None
+    specimen = None
     if args.specimen is not None:
         from ..specimen import load_specimen
 
         specimen = load_specimen(args.specimen)
-        specimen_material = specimen.particles.material
     # (a missing file is named by its analysis)
-    stated, settings = resolve_files(
-        args.paths, options=analysis_options(args), given=given_options(args),
-        fill_percent=args.fill, material=args.material, direction=args.direction,
-        sidecar=args.sidecar, specimen_material=specimen_material, fill_required=False)
-    for path, st, fs in zip(args.paths, stated, settings, strict=True):
-        # a sidecar's specimen is only a name: its cell is not known
-        if st is not None and (specimen is not None or not fs.specimen):
-            refuse_fill_of_no_particle(st, display_path(Path(path).name), specimen)
-    return stated, settings
+    return resolve_files(args.paths, options=analysis_options(args), given=given_options(args),
+                         fill_percent=args.fill, material=args.material,
+                         direction=args.direction, sidecar=args.sidecar,
+                         specimen_material=specimen.particles.material if specimen else None,
+                         fill_required=False,
+                         specimen_name=specimen.name if specimen else None, specimen=specimen)
 
 
 def _run(args: argparse.Namespace) -> int:
@@ -104,6 +100,7 @@ def _run(args: argparse.Namespace) -> int:
         from ..measure import refuse_store_among_inputs
 
         refuse_store_among_inputs(store, args.paths)
+        store.check_writable()  # before the analyses, in one line naming the store
     results: list = []
     try:
         # Analyse everything before writing anything: one bad file leaves the store untouched.

@@ -31,7 +31,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                              "without a material is of --specimen's particles (else acrylic); "
                              "one of another material than the specimen's is refused")
     source.add_argument("--store", metavar="FILE", type=Path,
-                        help="use the analysed measurements of this store, per load case")
+                        help="use the analysed measurements of this store, per load case: "
+                             "those of --specimen's particles measured on it or on no named "
+                             "specimen (the paper's coupon: those naming no other specimen); "
+                             "a note names the ones left out")
     p.add_argument("--specimen", metavar="FILE", type=Path, default=None,
                    help="specimen file to start from (default: the paper's coupon)")
     p.add_argument("--fit", metavar="NAME,...", default=",".join(DEFAULT_FIT),
@@ -88,8 +91,10 @@ def run(args: argparse.Namespace) -> int:
     # --specimen`); a stated material other than the specimen's is refused by calibrate()
     default_material = specimen.particles.material if specimen is not None \
         else DEFAULT_MATERIAL
-    points = read_measured_table(args.data, default_material=default_material) \
-        if args.data is not None else measured_from_store(args.store)
+    if args.data is not None:
+        points = read_measured_table(args.data, default_material=default_material)
+    else:
+        points = _store_points(measured_from_store(args.store), specimen, args.store)
     tally = RunTally(args.dem_store)
     written = False
     try:
@@ -126,6 +131,34 @@ def run(args: argparse.Namespace) -> int:
         if args.out is not None:
             print(f"wrote {args.out}")
     return 0
+
+
+def _store_points(points: list, specimen, store: Path) -> list:
+    """The store's measured points the specimen is calibrated against, as the app's Calibrate
+    page chooses them (its particles, measured on it or on no named specimen; the paper's
+    coupon: those naming no other specimen); what is left out is said on stderr. A store of
+    acrylic and steel measurements was refused as a whole ("choose the points of one
+    material"), with no option to choose them."""
+    from ..calibrate.data import points_for_paper, points_for_specimen
+    from ..errors import ParameterError
+
+    if specimen is None:
+        kept, note = points_for_paper(points, hint="--specimen FILE of theirs")
+        materials = sorted({str(p.material) for p in kept})
+        if len(materials) > 1:
+            raise ParameterError(
+                f"--store {store}: measurements of {', '.join(materials)} particles; give "
+                "--specimen FILE to calibrate those of its particles")
+    else:
+        kept, note = points_for_specimen(points, specimen)
+        if not kept:
+            raise ParameterError(
+                f"--store {store}: no measurement of specimen {specimen.name} "
+                f"({specimen.particles.material} particles) or of an unnamed specimen of them"
+                f"{'; ' + note if note else ''}")
+    if note and kept:
+        print(f"pidcore calibrate: note: {note}", file=sys.stderr)
+    return kept
 
 
 def _out_words(out: Path | None, written: bool) -> str:

@@ -228,6 +228,7 @@ def _interrupted(command: str, saved: int, store) -> int:
 
 def sweep(args: argparse.Namespace) -> int:
     from ..dem.persist import run_key, stored_keys
+    from ..dem.simulate import check_drive_stroke
     from ..dem.sweep import cross_cases, grid_axes, grid_fill_note, run_sweep
     from ..loadcase import parse_values
 
@@ -244,6 +245,8 @@ def sweep(args: argparse.Namespace) -> int:
     if note:  # on stderr: --json prints one document
         print(f"pidcore dem sweep: note: {note}", file=sys.stderr)
     cases = cross_cases(*values, material=material, direction=args.direction)
+    for case in cases:  # before any case runs, not in a worker after the others
+        check_drive_stroke(case, what="--frequencies/--accelerations")
     config = _config(args)
     # What a Ctrl-C leaves saved is read from the store itself: a count kept beside the saves
     # could miss one that committed as the interrupt came.
@@ -306,6 +309,9 @@ def run(args: argparse.Namespace) -> int:
     specimen, material = _specimen(args)
     case = LoadCase(args.frequency, args.acceleration, _fill(args, specimen, material),
                     material=material, direction=args.direction)
+    from ..dem.simulate import check_drive_stroke
+
+    check_drive_stroke(case, what="--frequency/--acceleration")
     config = _config(args)
     progress = not args.no_progress and sys.stderr.isatty()
     key = None
@@ -325,9 +331,9 @@ def run(args: argparse.Namespace) -> int:
         # the run is saved in one transaction at its end: committed now, or not at all
         return _interrupted("run", int(store is not None and store.commits > 0), args.store)
     notes = list(result.notes)
-    same = _same_simulation_note(case, result) if reused else ""
-    if same:
-        notes.append(same)
+    said = [note for note in (_same_simulation_note(case, result) if reused else "",
+                              _baseline_note(specimen)) if note]
+    notes += said
     if args.json:
         out = {k: result.to_dict()[k] for k in JSON_KEYS}
         out.update(result.to_dict())
@@ -338,11 +344,23 @@ def run(args: argparse.Namespace) -> int:
         print(json.dumps(out))
         return 0
     print(format_summary(result))
-    if same:
-        print(f"note            {same}")
+    for note in said:
+        print(f"note            {note}")
     if key is not None:
         print(f"{'reused from' if reused else 'saved to'} {args.store} as {key}")
     return 0
+
+
+def _baseline_note(specimen) -> str:
+    """What the SDC leaves out of a specimen stating the empty coupon's loss factor: the run
+    printed the particles' SDC beside a file stating ``baseline_loss_factor`` without a word
+    of whether it was in it; "" where the specimen states none."""
+    eta = float(specimen.coupon.baseline_loss_factor) if specimen is not None else 0.0
+    if eta <= 0:
+        return ""
+    return (f"SDC of the particles alone: the specimen's [coupon] baseline_loss_factor {eta:g} "
+            f"(the empty coupon's damping, 2 pi x {eta:g} = {2 * math.pi * eta:.3g} in SDC) is "
+            "not in it; pidcore calibrate's prediction adds it")
 
 
 def _same_simulation_note(asked, result) -> str:

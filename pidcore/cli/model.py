@@ -127,6 +127,11 @@ def build_model(args: argparse.Namespace):
             raise ParameterError(f"--where {item!r}: expected COLUMN=VALUE")
         where[column.strip()] = value.strip()
     runs = Store(args.store).list_dem_runs()
+    if runs.empty and not Path(args.store).is_file():  # a mistyped path: "no DEM runs stored"
+        from ..errors import StoreError
+
+        raise StoreError(f"{args.store}: store not found; expected the store holding the DEM "
+                         "runs (--store FILE)")
     if runs.empty:
         raise ParameterError(f"{args.store}: no DEM runs stored; run `pidcore dem` first or use "
                              f"--table paper")
@@ -135,7 +140,8 @@ def build_model(args: argparse.Namespace):
 
     # the specimen named: steel and paper-coupon figures looked alike
     specimen = run_specimen_labels(runs).iloc[0]
-    text = f"DEM runs of {specimen} in {args.store}" + (f" where {where}" if where else "")
+    text = f"DEM runs of {specimen} in {args.store}" + (
+        " where " + ", ".join(f"{k}={v}" for k, v in where.items()) if where else "")
     return SdcModel.from_table(runs, value="sdc", log_frequency=args.log_frequency,
                                source=text), runs
 

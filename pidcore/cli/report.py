@@ -55,13 +55,15 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     add_store_option(p, flag="--dem-store", default=None,
                      help="HDF5 store holding the DEM runs (default: --store); only read")
     p.add_argument("--format", metavar="FMT", default="all",
-                   help="all or a comma-separated list of csv, md, html, tex, pdf (default all)")
+                   help="all or a comma-separated list of csv, md, html, tex, pdf (default "
+                        "all); the figures (PNG and SVG, figures/) are written with any")
     add_load_case_options(p, what="FILE", material_help=" or the --specimen's (default: "
                                                          "stated, else the specimen's, else "
                                                          "acrylic)")
     p.add_argument("--specimen", metavar="FILE", type=Path, default=None,
                    help="compare only DEM runs of this specimen file (default: the paper's "
-                        "coupon); the paper's Table 3 only for the paper's coupon")
+                        "coupon); the paper's Table 3 only for the paper's coupon; FILES of "
+                        "its particles whose sidecar names no specimen are saved as its tests")
     p.add_argument("--pool", action="store_true",
                    help="pool DEM runs of different numerical settings and measurements of "
                         "different specimens at one load case into one row (default: a row "

@@ -51,8 +51,9 @@ def format_facts(f: dict, source: str) -> str:
         f"gaps            wall to wall {f['wall_to_wall_gap_m'] * 1e3:.4g} mm, floor to "
         f"ceiling {f['floor_to_ceiling_gap_m'] * 1e3:.4g} mm beside one particle",
         f"particles       {f['particles_per_cell']} per cell ({f['particles_per_cell_basis']}), "
-        f"{f['particle_mass_kg'] * 1e3:.4g} g each, {f['particles_mass_kg'] * 1e3:.4g} g "
-        f"in the coupon",
+        f"radius {f['particle_radius_m'] * 1e3:.4g} mm (diameter "
+        f"{2 * f['particle_radius_m'] * 1e3:.4g} mm), {f['particle_mass_kg'] * 1e3:.4g} g "
+        f"each, {f['particles_mass_kg'] * 1e3:.4g} g in the coupon",
         f"masses          coupon {f['coupon_mass_kg'] * 1e3:.4g} g + fixture "
         f"{f['fixture_mass_kg'] * 1e3:.4g} g + particles = vibrated "
         f"{f['vibrated_mass_kg'] * 1e3:.4g} g",

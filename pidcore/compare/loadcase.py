@@ -153,35 +153,6 @@ class StatedLoadCase:
                         self.material, self.direction)
 
 
-def refuse_fill_of_no_particle(stated: StatedLoadCase, what: str, specimen=None) -> None:
-    """Refuse a stated fill that puts no particle in a cell of the specimen tested.
-
-    ``specimen``: the :class:`~pidcore.specimen.Specimen` (default: the paper's coupon with
-    the stated particles; nothing is checked for a material without a table row, whose cell
-    is not known). The rounding is the DEM's (:func:`pidcore.specimen.particles_for_fill`,
-    100 % = the cell's capacity), so a fill saved here is one the model can be run at: a
-    packing ratio typed as a fraction (0.5 for 50 %) is refused, not stored as a load case
-    no comparison can ever place.
-    """
-    from ..errors import ParameterError
-    from ..specimen import paper_specimen, particles_for_fill
-
-    if specimen is None:
-        if stated.material not in PARTICLE_MATERIALS:
-            return
-        specimen = paper_specimen(stated.material)
-    capacity = specimen.capacity_per_cell()
-    try:
-        particles_for_fill(stated.fill_percent, capacity)
-    except ParameterError as exc:
-        source = next((part.split(": ", 1)[1] for part in stated.origin.split("; ")
-                       if part.startswith("fill: ")), "stated")
-        hint = (f"; was {stated.fill_percent:g} meant as {stated.fill_percent * 100:g} %?"
-                if stated.fill_percent <= 1.0 else "")
-        raise ParameterError(f"{what} ({'--fill' if source == 'option' else source}): {exc} "
-                             f"({specimen.name}'s cell capacity{hint})") from None
-
-
 def _material_tokens(stem: str, names) -> set[str]:
     """Tokens of ``stem`` that are one of ``names`` (lower case): a whole token only, so
     ``steel`` is not found in ``steelcase``."""
@@ -199,18 +170,24 @@ def _own_material_tokens(stem: str, materials: tuple[str, ...]) -> set[str]:
     return _material_tokens(stem, (m for m in materials if m not in PARTICLE_MATERIALS))
 
 
-def _refuse_untabulated_material(path: Path, known: tuple[str, ...]) -> None:
+def _refuse_untabulated_material(path: Path, known: tuple[str, ...],
+                                 specimen_material: str | None = None) -> None:
     """A file name naming a particle material that neither the table nor a specimen knows
-    (``..._steel.csv``) would be read as the default or the specimen's material: refused."""
+    (``..._steel.csv``) would be read as the default or the specimen's material: refused.
+    With a specimen given, the message names its particles (it asked for "--specimen FILE
+    whose particles are steel" of a user who had given one of tungsten carbide)."""
     # a specimen's "steel_440c" is the file name's "steel"
     parts = {part for k in known for part in k.split("_")}
     named = sorted(_material_tokens(path.stem, UNTABULATED_PARTICLE_MATERIALS) - parts)
     if named:
+        lacks = f"material table ({', '.join(PARTICLE_MATERIALS)}) lacks"
+        if specimen_material is not None and specimen_material not in PARTICLE_MATERIALS:
+            lacks = (f"material table ({', '.join(PARTICLE_MATERIALS)}) and the --specimen's "
+                     f"{specimen_material} particles lack")
         raise UntabulatedMaterial(
             f"{path.name}: file name states particle material {named[0]!r}, which the "
-            f"material table ({', '.join(PARTICLE_MATERIALS)}) lacks; give --specimen FILE "
-            f"whose particles are {named[0]}, or state the material with --material or a "
-            "sidecar", named[0])
+            f"{lacks}; give --specimen FILE whose particles are {named[0]}, or state the "
+            "material with --material or a sidecar", named[0])
 
 
 def parse_file_name(name: str | Path,
@@ -589,7 +566,7 @@ def resolve_load_case(
         take(_sidecar_entry(row, known), row.name)
     stated_by_user = {"file name"} | ({row.name} if row is not None else set())
     if origin.get("material") not in stated_by_user and material is None:
-        _refuse_untabulated_material(path, known)
+        _refuse_untabulated_material(path, known, specimen_material)
     options: dict[str, float | str] = {}
     if fill_percent is not None:
         options["fill_percent"] = _check_fill(fill_percent, "--fill")

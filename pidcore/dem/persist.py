@@ -307,6 +307,7 @@ def cached_run(store: Store | str | os.PathLike[str], specimen: Specimen | None,
     stored = stored_run_key(store, case, config, specimen)
     if stored is not None:
         return CachedRun(load_dem_result(store.get_dem_run(stored)), stored, True)
+    store.check_writable()  # before the simulation, not at its commit
     result = simulate_load_case(case, config, specimen=specimen, progress=progress)
     key = run_key(case, config, specimen)
     save_dem_entry(store, key, dem_run_entry(result))

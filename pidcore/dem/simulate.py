@@ -205,7 +205,7 @@ def choose_time_step(case: LoadCase, law: ContactLaw, geometry: CellGeometry,
         return min(defaults.DEM_TIME_STEP_S, safe)
     if requested > safe:
         raise ParameterError(
-            f"time_step {requested:.3g} s gives {t_contact / requested:.1f} steps per "
+            f"time_step {requested:.3g} s gives {t_contact / requested:.2g} steps per "
             f"{what}; need >= {defaults.DEM_MIN_STEPS_PER_CONTACT}: "
             f"use time_step <= {safe:.3g} s or 'auto'")
     return float(requested)
@@ -449,6 +449,19 @@ def resolve_specimen(case: LoadCase, specimen: Specimen | None) -> Specimen:
     return specimen
 
 
+def check_drive_stroke(case: LoadCase, *, what: str = "load case") -> None:
+    """Refuse a drive whose displacement amplitude a/w^2 no shaker makes
+    (:data:`pidcore.defaults.DEM_MAX_DISPLACEMENT_AMPLITUDE_M`): a frequency typed in kHz or an
+    acceleration in m/s^2 where g is expected; one line naming ``what`` and the likely slip."""
+    stroke = case.acceleration_m_s2 / case.omega_rad_s ** 2
+    if stroke > defaults.DEM_MAX_DISPLACEMENT_AMPLITUDE_M:
+        raise ParameterError(
+            f"{what} {case.frequency_hz:g} Hz, {case.acceleration_g:g} g: a displacement "
+            f"amplitude of {stroke:.3g} m (a / (2 pi f)^2); expected at most "
+            f"{defaults.DEM_MAX_DISPLACEMENT_AMPLITUDE_M * 1e3:g} mm, a shaker's stroke; was "
+            "the frequency typed in kHz, or the acceleration in m/s^2?")
+
+
 def simulate_load_case(case: LoadCase, config: DemConfig | None = None, *,
                        progress: bool = False,
                        specimen: Specimen | None = None,
@@ -487,6 +500,7 @@ def simulate_load_case(case: LoadCase, config: DemConfig | None = None, *,
     ... # doctest: +SKIP
     """
     config = config or DemConfig()
+    check_drive_stroke(case)
     specimen = resolve_specimen(case, specimen)
     geometry = specimen.geometry()
     wall_clock = time.perf_counter()

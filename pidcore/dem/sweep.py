@@ -352,6 +352,8 @@ def run_sweep(cases: Sequence[LoadCase], config: DemConfig, *,
             todo.append((case, key))
             summary.cases.append({**record, "store_key": key, "status": "simulated"})
     bar = None
+    if todo:
+        store.check_writable()  # before the simulations, not at the first commit
     if progress:
         from tqdm import tqdm
 

@@ -14,6 +14,7 @@ drawn as open markers labelled ``"... filled"``.
 
 from __future__ import annotations
 
+import textwrap
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
@@ -25,6 +26,10 @@ from ..model.sdc_model import SdcModel
 
 #: Points per curve.
 _CURVE_POINTS = 200
+
+
+#: Characters per line of a figure's title: "small" text is ~80 characters across 6.4 in.
+_SUPTITLE_CHARS = 80
 
 
 def _figure_and_axes(n_panels: int, ax):
@@ -102,7 +107,10 @@ def _draw_family(model: SdcModel, *, panels: Sequence[float], panel_column: str,
         panel.set_ylabel("SDC [-]")
         panel.legend(fontsize="small", ncols=2)
     if ax is None and model.source:  # a figure of its own says what it draws
-        fig.suptitle(model.source, fontsize="small")
+        # wrapped: a store's source (runs of a specimen in a store, where ...) ran past both
+        # edges of the 6.4 in figure and was cut off at each end
+        fig.suptitle(textwrap.fill(model.source, _SUPTITLE_CHARS, break_on_hyphens=False,
+                                   break_long_words=False), fontsize="small")
     return fig
 
 

@@ -146,6 +146,8 @@ def analyze_files(paths: Sequence[str | Path], *, fill_percent: float | None = N
                   options: AnalysisOptions | None = None,
                   options_given: Mapping[str, str] | None = None,
                   specimen_material: str | None = None,
+                  specimen_name: str | None = None,
+                  specimen=None,
                   accept_implausible: bool = False) -> list[MeasuredResult]:
     """Read, assign roles, analyze (Eq. 11) and attach the load case of every file.
 
@@ -156,7 +158,10 @@ def analyze_files(paths: Sequence[str | Path], *, fill_percent: float | None = N
     those that differ from the defaults). Files with identical contents are one measurement:
     kept once, and refused if they state different load cases, specimens or settings.
     ``specimen_material``: the particle material of the specimen compared with (accepted
-    besides the table's, and the default). A result the plausibility checks refuse (a
+    besides the table's, and the default); ``specimen_name``: its name, saved with the files
+    of its particles whose sidecar names no specimen; ``specimen``: its cell, against which a
+    stated fill of its particles must round to a particle at least
+    (:func:`pidcore.file_settings.resolve_files`). A result the plausibility checks refuse (a
     negative loss factor beyond its noise, an SDC above 2 pi) is refused unless
     ``accept_implausible`` (:func:`pidcore.compare.plausibility.refuse_implausible`).
     """
@@ -171,7 +176,8 @@ def analyze_files(paths: Sequence[str | Path], *, fill_percent: float | None = N
     stated, settings = resolve_files(paths, options=options, given=options_given,
                                      fill_percent=fill_percent, material=material,
                                      direction=direction, sidecar=sidecar,
-                                     specimen_material=specimen_material)
+                                     specimen_material=specimen_material,
+                                     specimen_name=specimen_name, specimen=specimen)
     try:
         analyzed_files = refuse_implausible(
             [analyze_with_settings(path, fs) for path, fs in zip(paths, settings, strict=True)],
@@ -234,9 +240,10 @@ def latest_per_measurement(analyses: pd.DataFrame) -> pd.DataFrame:
     """The newest analysis of each measurement that states a fill (store-only reports)."""
     if analyses.empty or "fill_percent" not in analyses.columns:
         return analyses.iloc[0:0]
+    from ..store.listing import latest_per_measurement as newest
+
     with_fill = analyses[np.isfinite(pd.to_numeric(analyses["fill_percent"], errors="coerce"))]
-    return (with_fill.sort_values("created_utc", kind="stable")
-            .groupby("measurement_key", sort=False).tail(1).reset_index(drop=True))
+    return newest(with_fill).reset_index(drop=True)
 
 
 def _measured_loops(results: list[MeasuredResult], analyses: pd.DataFrame, store,
@@ -333,6 +340,37 @@ def specimen_dem_runs(stored: pd.DataFrame | None, specimen=None, *,
     return kept, notes
 
 
+def unsubtracted_baseline_note(specimen, analyses: pd.DataFrame | None) -> str:
+    """The note for measurements of ``specimen``'s particles analysed without the empty
+    coupon's loss factor its file states (``[coupon] baseline_loss_factor``); "" where it
+    states none or every such record subtracted one.
+
+    The DEM's SDC is the particles' alone and the measured one includes the structure's
+    damping unless the analysis subtracted it; the specimen's value was used only by
+    ``pidcore calibrate``, and a report of the specimen compared the two without a word.
+    """
+    from ..compare.align import stored_parameters
+
+    eta = float(specimen.coupon.baseline_loss_factor) if specimen is not None else 0.0
+    if eta <= 0 or analyses is None or analyses.empty or "material" not in analyses.columns:
+        return ""
+    material = specimen.particles.material
+    named = analyses.get("specimen", pd.Series([""] * len(analyses), index=analyses.index))
+    mine = analyses[(analyses["material"] == material)
+                    & named.fillna("").isin(["", specimen.name])]
+    subtracted = [float((stored_parameters(p) or {}).get("baseline_loss_factor") or 0.0)
+                  for p in mine.get("parameters_json", pd.Series([None] * len(mine)))]
+    without = sum(1 for value in subtracted if value == 0.0)
+    if not without:
+        return ""
+    return (f"specimen {specimen.name} states [coupon] baseline_loss_factor {eta:g} (the empty "
+            f"coupon's damping), which {without} measured record(s) of its {material} particles "
+            f"were analysed without: their SDC includes it (2 pi x {eta:g} = "
+            f"{2 * math.pi * eta:.3g}) and the DEM's, of the particles alone, does not; analyse "
+            f"them with --baseline-loss-factor {eta:g} (or a sidecar's baseline_loss_factor) to "
+            "subtract it")
+
+
 @dataclass(frozen=True)
 class SpecimenTable:
     """What :func:`specimen_report_table` built: the table (notes in ``attrs["notes"]``), the
@@ -377,6 +415,9 @@ def specimen_report_table(stored_runs: pd.DataFrame | None, analyses: pd.DataFra
         choose_another="" if choose_another == CHOOSE_SPECIMEN_CLI
         else f"choose theirs with {choose_another.removesuffix(' for another')} to compare "
              "them")
+    baseline = unsubtracted_baseline_note(specimen, analyses)
+    if baseline:
+        notes.append(baseline)
     if specimen is not None and not pool:
         # every DEM row is this specimen's (runs_of_specimen) and the files of its particle
         # material are its tests; a measurement of another material cannot be (its specimen
@@ -518,6 +559,8 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
 
     if main is not None:
         refuse_store_among_inputs(main, files)  # before reading (it may hold many measurements)
+        if files:  # their analyses are added to it
+            main.check_writable()
     from ..compare.plausibility import plausibility_notes
 
     options = options or AnalysisOptions()
@@ -525,6 +568,7 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         files, fill_percent=fill_percent, material=material, direction=direction,
         sidecar=sidecar, options=options, options_given=options_given,
         specimen_material=specimen.particles.material if specimen is not None else None,
+        specimen_name=specimen.name if specimen is not None else None, specimen=specimen,
         accept_implausible=accept_implausible,
     ) if files else []
     parameters = _parameters(results, options)

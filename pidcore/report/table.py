@@ -140,14 +140,23 @@ def no_runs_note(of: str, material: str, direction: str, store_runs: pd.DataFram
                        & (store_runs["direction"] == direction)]
     if there.empty:
         return note
-    counts = run_specimen_labels(there).value_counts(sort=False)
-    if named:
+    labels = run_specimen_labels(there)
+    counts = labels.value_counts(sort=False)
+    # runs of the specimen the measurement names are in the store, left out only because the
+    # report is of another specimen: "another specimen's: not compared with a test of X" was
+    # said of X's own runs
+    own = named and bool(((labels == of) if of == PAPER_SPECIMEN_NAME
+                          else there.get("specimen_name", pd.Series(dtype=object)) == of).any())
+    if named and not own:
         choose_another = f"not compared with a test of {of}"
     elif not choose_another:
         choose_another = ("report without --specimen to compare them"
                           if set(counts.index) == {PAPER_SPECIMEN_NAME}
                           else "report with their --specimen FILE to compare them")
     listed = ", ".join(f"{n} of {label}" for label, n in counts.items())
+    if own:
+        return (f"{note} among this report's runs (the store has {listed}; {of}'s are left "
+                f"out of a report of another specimen: {choose_another})")
     return f"{note} (the store has {listed}, another specimen's: {choose_another})"
 
 

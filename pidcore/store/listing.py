@@ -34,6 +34,16 @@ def list_dem_runs(*paths: str | os.PathLike | None) -> pd.DataFrame:
     return runs.drop_duplicates("case_key", keep="first").reset_index(drop=True)
 
 
+def latest_per_measurement(analyses: pd.DataFrame) -> pd.DataFrame:
+    """The newest analysis of each measurement (a file re-analysed with other corrections is
+    one measurement, not a repeat of it); unchanged where the listing has no
+    ``measurement_key`` and ``created_utc``."""
+    if not {"measurement_key", "created_utc"} <= set(analyses.columns):
+        return analyses
+    return (analyses.sort_values("created_utc", kind="stable")
+            .groupby("measurement_key", sort=False).tail(1))
+
+
 def saved_analyses(path: str | os.PathLike, *, latest_only: bool = True) -> pd.DataFrame:
     """Analyses of a store that state a load case (a fill), newest first.
 
@@ -50,8 +60,7 @@ def saved_analyses(path: str | os.PathLike, *, latest_only: bool = True) -> pd.D
     fill = pd.to_numeric(analyses["fill_percent"], errors="coerce")
     out = analyses[np.isfinite(fill.to_numpy(float))].copy()
     if latest_only:
-        out = (out.sort_values("created_utc", kind="stable")
-               .groupby("measurement_key", sort=False).tail(1))
+        out = latest_per_measurement(out)
     out["file"] = [Path(str(s)).name for s in out["source"]]
     out["date"] = out["created_utc"].astype(str).str[:10]
     if "specimen" not in out.columns:

@@ -280,6 +280,27 @@ class Store:
         """Sidecar file whose ``flock`` serialises writers."""
         return lock_path_for(self.path)
 
+    def check_writable(self) -> None:
+        """Refuse, before any work is done for it, a store this process may not write: a
+        read-only (or immutable) file, or a folder it may not create the working copy and
+        lock file in. A DEM run, sweep or calibration finished its simulations first and then
+        lost them at the commit ("cannot commit the changes ([Errno 1] Operation not
+        permitted ...)").
+
+        Raises
+        ------
+        StoreError
+            One line naming the store, what is read-only and the way out.
+        """
+        directory = self.path.parent
+        if self.path.exists() and not os.access(self.path, os.W_OK):
+            raise StoreError(f"{self.path}: the store file is read-only; expected a store "
+                             "pidcore may write (make it writable, or give another store file)")
+        if directory.is_dir() and not os.access(directory, os.W_OK | os.X_OK):
+            raise StoreError(f"{self.path}: its folder {directory} is read-only (the store is "
+                             "written as a copy beside it, then renamed); expected a writable "
+                             "folder (give a store file in another one)")
+
     # --- transactions and file access ----------------------------------------------------------
 
     def _in_transaction(self) -> bool:
