@@ -79,7 +79,10 @@ def check_upload_size(name: str, n_bytes: int, *, limit_mb: float | None = None)
         raise ParameterError(f"{name}: {n_bytes / 1024 / 1024:.1f} MB is larger than the upload "
                              f"limit of {limit_mb:g} MB")
     if n_bytes == 0:
-        raise ParameterError(f"{name}: the file is empty")
+        from ..io import EMPTY_MEASUREMENT_FILE
+
+        # in the words of `pidcore analyze` on the same file (the app said "the file is empty")
+        raise ParameterError(f"{name}: {EMPTY_MEASUREMENT_FILE}")
 
 
 def safe_file_name(name: str) -> str:
@@ -351,6 +354,7 @@ def read_settings_table(name: str, data: bytes,
         normalize_material,
         settings_table,
     )
+    from ..file_settings import analysis_overrides
     from ..loadcase import check_fill
     from ..tables import line_where, read_text_table
 
@@ -370,17 +374,19 @@ def read_settings_table(name: str, data: bytes,
     for column in _NUMERIC:
         values = []
         for line, file, text in zip(raw.index, raw["file"], raw[column], strict=True):
-            if column == "fill [%]" and text != "":
+            where = f"{line_where(name, int(line))} ({file})"
+            if text == "":
+                values.append(math.nan)
+            elif column == "fill [%]":
                 # the CLI's check of a sidecar's fill, naming the line and file as it does: a
                 # fill of 150 % was accepted and each file's card said "no valid load case"
-                values.append(check_fill(text, f"{line_where(name, int(line))} ({file})"))
-                continue
-            try:
-                values.append(float(text) if text != "" else math.nan)
-            except ValueError:
-                raise ParameterError(f"{line_where(name, int(line))}: "
-                                     f"{FILE_TABLE_COLUMNS[column]} {text!r} is not a "
-                                     "number") from None
+                values.append(check_fill(text, where))
+            else:
+                # the CLI's check of a sidecar's setting (file_settings.analysis_overrides),
+                # so a table is refused with the words `pidcore analyze --sidecar` uses; a
+                # delay typed in s (5e-5) was accepted here and refused only on the file's card
+                analysis_overrides({FILE_TABLE_COLUMNS[column]: text}, where)
+                values.append(float(text))
         out[column] = values
     try:
         out["material"] = [normalize_material(v, f"{name}: material", materials) if v else ""

@@ -1,0 +1,65 @@
+"""The app refuses what the CLI refuses, in the CLI's words (findings of a browser trial of the
+app against ``pidcore analyze`` on the same files and tables)."""
+
+from __future__ import annotations
+
+import pytest
+from _app_samples import mass_damper_csv
+
+from pidcore.app import uploads
+from pidcore.cli import main
+from pidcore.errors import ParameterError
+
+
+def cli_error(args: list[str], capsys) -> str:
+    """The one-line message of a refused CLI command (exit 2), without its program prefix."""
+    assert main(args) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1, err
+    return err.split("error: ", 1)[1]
+
+
+@pytest.mark.parametrize("column,value", [
+    ("velocity_delay_us", "fifty"),     # not a number
+    ("velocity_delay_us", "nan"),       # not finite
+    ("velocity_delay_us", "-50"),       # negative
+    ("velocity_delay_us", "5e-05"),     # a delay typed in s
+    ("mass_below_gauge_g", "0.012"),    # a mass typed in kg
+    ("baseline_loss_factor", "-0.001"),  # negative
+])
+def test_a_settings_table_with_a_bad_value_is_refused_in_the_words_of_the_cli(
+        tmp_path, capsys, column, value):
+    # the app said "t.csv, line 2: velocity_delay_us 'fifty' is not a number" (no file, no
+    # expected value), and took a delay typed in s or a mass in kg into the table, to be
+    # refused on the file's card only; `pidcore analyze --sidecar` refuses the table itself
+    text = f"# set-up A\nfile,fill_percent,{column}\nok.csv,50,\nbad.csv,50,{value}\n"
+    table = tmp_path / "loadcases.csv"
+    table.write_text(text)
+    for name, seed in (("ok.csv", 1), ("bad.csv", 2)):
+        (tmp_path / name).write_bytes(mass_damper_csv(seed=seed))
+    expected = cli_error(["analyze", str(tmp_path / "ok.csv"), str(tmp_path / "bad.csv"),
+                          "--sidecar", str(table), "--no-store"], capsys)
+    with pytest.raises(ParameterError) as refused:
+        uploads.read_settings_table("loadcases.csv", text.encode())
+    assert str(refused.value) == expected.replace(str(table), "loadcases.csv")
+
+
+def test_a_settings_table_with_good_values_is_read_in_the_apps_units():
+    table = uploads.read_settings_table(
+        "t.csv", b"file,velocity_delay_us,mass_below_gauge_g,baseline_loss_factor\n"
+                 b"a.csv,50,12,0.001\nb.csv,,0,\n")
+    assert table["vibrometer delay [\u00b5s]"].tolist()[0] == 50.0
+    assert table["mass below gauge [g]"].tolist() == [12.0, 0.0]
+    assert table["baseline loss factor [-]"].tolist()[0] == 0.001
+
+
+def test_an_empty_upload_is_refused_in_the_words_of_the_cli(tmp_path, capsys):
+    # the app said "empty.csv: the file is empty"; the CLI names what it expected
+    empty = tmp_path / "empty.csv"
+    empty.write_bytes(b"")
+    expected = cli_error(["analyze", str(empty), "--no-store"], capsys)
+    for refuse in (lambda: uploads.check_upload_size("empty.csv", 0),
+                   lambda: uploads.read_upload("empty.csv", b"")):
+        with pytest.raises(ParameterError) as refused:
+            refuse()
+        assert str(refused.value) == expected.replace(str(empty), "empty.csv")
