@@ -63,3 +63,26 @@ def test_an_empty_upload_is_refused_in_the_words_of_the_cli(tmp_path, capsys):
         with pytest.raises(ParameterError) as refused:
             refuse()
         assert str(refused.value) == expected.replace(str(empty), "empty.csv")
+
+
+def test_the_compare_pages_loop_energy_is_the_energy_pidcore_analyze_prints(tmp_path, capsys):
+    # Compare showed "energy per cycle (loop area): 3.0366e-06 J" for the bundled 1000 Hz
+    # export, `pidcore analyze --json` 3.0369e-06 J: the 256-gon's area is 1e-4 short of the
+    # loop's; the page prints 5 digits (.4e), so they must agree to rounding
+    import json
+    from pathlib import Path
+
+    from pidcore.compare.case import MeasuredEntry, load_case_of
+    from pidcore.measure import AnalysisOptions
+
+    sample = Path(__file__).parents[1] / "data_samples" / "exports" / \
+        "synthetic_f1000Hz_a5g_fill50_acrylic.h5"
+    assert main(["analyze", str(sample), "--velocity-delay", "5e-5", "--fill", "50",
+                 "--no-store", "--json"]) == 0
+    (cli,) = json.loads(capsys.readouterr().out)["records"]
+    record = uploads.analyze_upload(sample.name, sample.read_bytes(),
+                                    AnalysisOptions(velocity_delay_s=5e-5)).record
+    case = load_case_of(record, fill_percent=50, material="acrylic")
+    loop = MeasuredEntry.from_record(record, case).loop()
+    assert f"{loop.energy_per_cycle_j:.4e}" == f"{cli['energy_per_cycle_j']:.4e}"
+    assert loop.energy_per_cycle_j == pytest.approx(cli["energy_per_cycle_j"], rel=1e-12)
