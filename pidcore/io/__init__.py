@@ -44,8 +44,8 @@ from .roles import RoleAssignment, assign_roles, name_suggests
 from .uff import read_uff, write_uff
 
 __all__ = [
-    "EMPTY_MEASUREMENT_FILE", "FILE_FORMAT_EXTENSIONS", "RoleAssignment", "assign_roles", "detect_file_format",
-    "display_path",
+    "EMPTY_MEASUREMENT_FILE", "FILE_FORMAT_EXTENSIONS", "RoleAssignment", "assign_roles",
+    "detect_file_format", "display_path",
     "hdf5_keys", "name_suggests", "read_csv", "read_hdf5", "read_mat", "read_measurement",
     "read_measurements", "read_uff", "write_csv", "write_hdf5", "write_mat",
     "write_measurement", "write_uff",
