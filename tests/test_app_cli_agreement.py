@@ -3,6 +3,8 @@ app against ``pidcore analyze`` on the same files and tables)."""
 
 from __future__ import annotations
 
+import math
+
 import pytest
 from _app_samples import mass_damper_csv
 
@@ -86,3 +88,45 @@ def test_the_compare_pages_loop_energy_is_the_energy_pidcore_analyze_prints(tmp_
     loop = MeasuredEntry.from_record(record, case).loop()
     assert f"{loop.energy_per_cycle_j:.4e}" == f"{cli['energy_per_cycle_j']:.4e}"
     assert loop.energy_per_cycle_j == pytest.approx(cli["energy_per_cycle_j"], rel=1e-12)
+
+
+def test_the_compare_pages_equivalent_damper_is_pidcore_model_dampers(tmp_path, capsys):
+    # the app had no equivalent damper; Compare now gives c_eq at a DEM grid case, which must
+    # be the c_eq [N s/m] `pidcore model damper --table store` writes for the same runs
+    from pathlib import Path
+
+    import pandas as pd
+
+    from pidcore.compare.case import (
+        MeasuredEntry,
+        compare_case,
+        equivalent_dampers,
+        load_case_of,
+        paper_table,
+    )
+    from pidcore.measure import AnalysisOptions
+    from pidcore.store.listing import list_dem_runs
+
+    root = Path(__file__).parents[1] / "data_samples"
+    sample = root / "exports" / "synthetic_f1000Hz_a5g_fill50_acrylic.h5"
+    record = uploads.analyze_upload(sample.name, sample.read_bytes(),
+                                    AnalysisOptions(velocity_delay_s=5e-5)).record
+    entry = MeasuredEntry.from_record(record, load_case_of(record, fill_percent=50,
+                                                           material="acrylic"))
+    comparison = compare_case([entry], list_dem_runs(root / "dem_table3.h5"), paper_table())
+    dampers = equivalent_dampers(comparison)
+    assert main(["model", "damper", "--table", "store", "--store", str(root / "dem_table3.h5"),
+                 "--fills", "50", "--accelerations", "5", "--frequencies", "1000",
+                 "--format", "csv", "--out", str(tmp_path)]) == 0
+    capsys.readouterr()
+    (cli,) = pd.read_csv(tmp_path / "equivalent_damper.csv")["c_eq [N s/m]"]
+    # the same SDC and m_c (rebuilt from the runs' specimen columns, equal to rounding)
+    assert dampers["our DEM"] == pytest.approx(cli, rel=1e-12)
+    # the measured damper dissipates the measured energy per cycle: dE / (pi w X^2), X = a/w^2
+    w = 2 * math.pi * record.analysis.frequency_hz
+    x = record.analysis.acceleration_amplitude_m_s2 / w**2
+    assert dampers["measured"] == pytest.approx(
+        record.analysis.energy_per_cycle_j / (math.pi * w * x**2), rel=1e-12)
+    # a DEM value without m_c (no grid case) gives no damper rather than a guessed one
+    assert equivalent_dampers(compare_case([entry], None, paper_table())) == {}
+
