@@ -130,3 +130,39 @@ def test_the_compare_pages_equivalent_damper_is_pidcore_model_dampers(tmp_path, 
     # a DEM value without m_c (no grid case) gives no damper rather than a guessed one
     assert equivalent_dampers(compare_case([entry], None, paper_table())) == {}
 
+
+def _dem_record(sdc: float, fill: float) -> dict:
+    return {"frequency_hz": 100.0, "acceleration_g": 5.0, "fill_percent": fill,
+            "material": "acrylic", "direction": "z", "sdc": sdc, "sdc_stderr": 0.01}
+
+
+def test_the_apps_report_of_two_stores_is_the_clis_with_both_dem_stores(tmp_path, capsys):
+    # the app's Report joins the DEM runs of its store (DEM tab, calibration) with the
+    # reference runs; `pidcore report --dem-store` took one store, so the app's CSV (57 rows
+    # in the trial: 9 of the app store's runs) could not be had from the CLI at all
+    import pandas as pd
+
+    from pidcore.compare.case import load_case_of
+    from pidcore.measure import AnalysisOptions
+    from pidcore.report.downloads import report_files
+    from pidcore.store import Store
+
+    app, ref = tmp_path / "app.h5", tmp_path / "ref.h5"
+    Store(ref).add_dem_run("shared", _dem_record(0.40, 50.0))
+    Store(ref).add_dem_run("ref_only", _dem_record(0.30, 75.0))
+    Store(app).add_dem_run("shared", _dem_record(0.20, 50.0))   # the app store's wins
+    Store(app).add_dem_run("app_only", _dem_record(0.25, 25.0))
+    options = AnalysisOptions()
+    record = uploads.analyze_upload("m_fill50.csv", mass_damper_csv(), options).record
+    uploads.save_records(app, [uploads.AnalysedFile(
+        record, load_case_of(record, fill_percent=50, material="acrylic"), options, "")])
+    _, data, _ = report_files(app, ref)["csv"]
+    (tmp_path / "app.csv").write_bytes(data)
+    shown = pd.read_csv(tmp_path / "app.csv")
+    assert shown["SDC DEM (ours) [-]"].tolist() == [0.25, 0.20, 0.30]
+    assert main(["report", "--store", str(app), "--dem-store", str(app), "--dem-store", str(ref),
+                 "--format", "csv", "--out", str(tmp_path / "cli")]) == 0
+    capsys.readouterr()
+    pd.testing.assert_frame_equal(pd.read_csv(tmp_path / "cli" / "report.csv"), shown)
+    provenance = (tmp_path / "cli" / "report.provenance.txt").read_text()
+    assert f"store: {app}" in provenance and f"store: {ref}" in provenance
