@@ -166,3 +166,17 @@ def test_the_apps_report_of_two_stores_is_the_clis_with_both_dem_stores(tmp_path
     pd.testing.assert_frame_equal(pd.read_csv(tmp_path / "cli" / "report.csv"), shown)
     provenance = (tmp_path / "cli" / "report.provenance.txt").read_text()
     assert f"store: {app}" in provenance and f"store: {ref}" in provenance
+
+
+@pytest.mark.parametrize("fill", ["150", "100.5"])
+def test_a_dem_fill_over_100_percent_is_refused_naming_the_field_as_the_cli_does(fill, capsys):
+    # the DEM tab said "load case: fill must be in (0, 100] % (packing ratio), got 150.0",
+    # not naming its field; `pidcore dem sweep --fills 150` names its option
+    from pidcore.app import jobs
+
+    expected = cli_error(["dem", "sweep", "--frequencies", "100", "--accelerations", "5",
+                          "--fills", fill, "--store", "unused.h5"], capsys)
+    with pytest.raises(ParameterError) as refused:
+        jobs.dem_fills(f"50, {fill}")
+    assert str(refused.value) == expected.replace("--fills", "fills [%]")
+    assert jobs.dem_fills("25, 100") == ([25.0, 100.0], None)  # the bounds' inside
