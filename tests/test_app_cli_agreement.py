@@ -180,3 +180,20 @@ def test_a_dem_fill_over_100_percent_is_refused_naming_the_field_as_the_cli_does
         jobs.dem_fills(f"50, {fill}")
     assert str(refused.value) == expected.replace("--fills", "fills [%]")
     assert jobs.dem_fills("25, 100") == ([25.0, 100.0], None)  # the bounds' inside
+
+
+def test_every_number_column_of_the_dem_runs_table_names_its_unit():
+    # "cells simulated" and "seed" were the DEM tab's only number columns without a unit,
+    # where the report writes counts as "particles per cell [-]", "DEM runs [-]"
+    import pandas as pd
+
+    from pidcore.app import jobs
+
+    runs = pd.DataFrame({"frequency_hz": [100.0], "acceleration_g": [5.0], "fill_percent": [50.0],
+                         "material": ["acrylic"], "direction": ["z"], "sdc": [1.1],
+                         "sdc_stderr": [0.01], "steady_detected": [True], "cells_simulated": [8],
+                         "seed": [12345], "wall_s": [1.5], "case_key": ["k"]})
+    table = jobs.dem_runs_table(runs)
+    numbers = [c for c in table.columns if pd.api.types.is_numeric_dtype(table[c])]
+    assert {"cells simulated [-]", "seed [-]"} <= set(numbers)
+    assert all(c.endswith("]") for c in numbers), numbers

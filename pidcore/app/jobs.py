@@ -437,7 +437,7 @@ DEM_RUN_COLUMNS = {"specimen": "specimen", "frequency_hz": "frequency [Hz]",
                    "acceleration_g": "acceleration [g]", "fill_percent": "fill [%]",
                    "material": "material", "sdc": "SDC [-]", "sdc_stderr": "SDC stderr [-]",
                    "steady state": "steady state", "direction": "direction",
-                   "cells_simulated": "cells simulated", "seed": "seed",
+                   "cells_simulated": "cells simulated [-]", "seed": "seed [-]",
                    "wall_s": "wall time [s]", "case_key": "run", "store": "store"}
 
 
