@@ -197,3 +197,31 @@ def test_every_number_column_of_the_dem_runs_table_names_its_unit():
     numbers = [c for c in table.columns if pd.api.types.is_numeric_dtype(table[c])]
     assert {"cells simulated [-]", "seed [-]"} <= set(numbers)
     assert all(c.endswith("]") for c in numbers), numbers
+
+
+def test_a_store_reports_provenance_names_the_settings_its_records_were_analysed_with(
+        tmp_path, capsys):
+    # `pidcore report --store S` wrote "parameters: velocity_delay_s=0.0, ..." (the unused
+    # options' defaults) for records analysed with 50 µs; the app's notes file named none
+    from pidcore.compare.case import load_case_of
+    from pidcore.measure import AnalysisOptions
+    from pidcore.report.downloads import report_files
+
+    store = tmp_path / "s.h5"
+    files = []
+    for name, delay in (("b_fill50.csv", 5e-5), ("a_fill75.csv", 0.0)):
+        options = AnalysisOptions(velocity_delay_s=delay)
+        record = uploads.analyze_upload(name, mass_damper_csv(seed=len(name) + int(delay > 0)),
+                                        options).record
+        fill = 50 if name.startswith("b") else 75
+        files.append(uploads.AnalysedFile(
+            record, load_case_of(record, fill_percent=fill, material="acrylic"), options, ""))
+    uploads.save_records(store, files)
+    assert main(["report", "--store", str(store), "--format", "csv",
+                 "--out", str(tmp_path / "cli")]) == 0
+    capsys.readouterr()
+    cli = (tmp_path / "cli" / "report.provenance.txt").read_text().splitlines()
+    app = report_files(store)["csv_provenance"][1].decode().splitlines()
+    line = next(x for x in cli if x.startswith("parameters: "))
+    assert "velocity_delay_s=a_fill75.csv: 0.0; b_fill50.csv: 5e-05" in line
+    assert line == next(x for x in app if x.startswith("parameters: "))

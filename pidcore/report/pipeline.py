@@ -14,6 +14,7 @@ Order matters for the guarantees of the command:
 
 from __future__ import annotations
 
+import json
 import math
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -197,8 +198,33 @@ def _parameters(results: Sequence[MeasuredResult], options: AnalysisOptions) -> 
     that differs between them as ``"a.uff: 5e-05; b.uff: 0"`` (per-file sidecar settings)."""
     if not results:
         return options.parameters()
-    per_file = [(r.path.name, (r.settings.options if r.settings is not None else options)
-                 .parameters()) for r in results]
+    return _shared_parameters([(r.path.name, (r.settings.options if r.settings is not None
+                                              else options).parameters()) for r in results])
+
+
+def stored_parameters(analyses: pd.DataFrame | None) -> dict:
+    """The analysis parameters the reported stored analyses were saved with (their
+    ``parameters_json``), for the provenance, as :func:`_parameters` gives those of files
+    analysed now. A report of a store without files listed the options' defaults
+    (``velocity_delay_s=0.0``) for records analysed with 50 µs."""
+    if analyses is None or analyses.empty or "parameters_json" not in analyses.columns:
+        return {}
+    names = analyses["file"] if "file" in analyses.columns else analyses["source"].map(
+        lambda s: Path(str(s)).name)
+    per_file = []
+    for name, text in zip(names, analyses["parameters_json"], strict=True):
+        try:
+            stated = json.loads(text) if isinstance(text, str) and text else {}
+        except ValueError:
+            stated = {}
+        per_file.append((str(name), stated if isinstance(stated, dict) else {}))
+    # by file name: the CLI and the app list a store's analyses in different orders
+    return _shared_parameters(sorted(per_file, key=lambda item: item[0]))
+
+
+def _shared_parameters(per_file: list[tuple[str, dict]]) -> dict:
+    """Each parameter as the files share it, one that differs between them as
+    ``"a.uff: 5e-05; b.uff: 0"``."""
     names = list(dict.fromkeys(k for _, p in per_file for k in p))
     out: dict[str, object] = {}
     for name in names:
@@ -581,6 +607,8 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         analyses = measured_frame(results)
 
     dem_runs = _joined_dem_runs(dems)
+    if not results:  # the stored records' own settings, not the unused options' defaults
+        parameters = stored_parameters(analyses)
     built = specimen_report_table(dem_runs, analyses, specimen=specimen, where=dem_path,
                                   tolerances=tolerances, pool=pool)
     table, dem_runs, aligner = built.table, built.dem_runs, built.aligner
@@ -601,7 +629,7 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
             parameters={**parameters,
                         "frequency_rtol": tolerances.frequency_rtol,
                         "acceleration_rtol": tolerances.acceleration_rtol,
-                        "fill_atol_percent": tolerances.fill_atol_percent},
+                        "fill_atol_percent": tolerances.fill_atol_percent, "pool": pool},
             seeds=seeds, inputs=[r.path for r in results],
             input_hashes={str(r.path): getattr(r.measurement, "sha256", "") for r in results},
             stores=stores, notes=notes, specimens=specimen_provenance(specimen))
