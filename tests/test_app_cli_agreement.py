@@ -225,3 +225,24 @@ def test_a_store_reports_provenance_names_the_settings_its_records_were_analysed
     line = next(x for x in cli if x.startswith("parameters: "))
     assert "velocity_delay_s=a_fill75.csv: 0.0; b_fill50.csv: 5e-05" in line
     assert line == next(x for x in app if x.startswith("parameters: "))
+
+
+def test_an_uploaded_file_of_several_measurements_says_what_to_do_in_the_app(tmp_path):
+    # a pidcore store of 2 measurements uploaded: "choose one with key=", a keyword of the
+    # library the page does not have
+    from pidcore.compare.case import load_case_of
+    from pidcore.measure import AnalysisOptions
+
+    store = tmp_path / "s.h5"
+    files = []
+    for seed, fill in ((1, 50), (2, 75)):
+        options = AnalysisOptions()
+        record = uploads.analyze_upload(f"m{seed}.csv", mass_damper_csv(seed=seed),
+                                        options).record
+        files.append(uploads.AnalysedFile(
+            record, load_case_of(record, fill_percent=fill, material="acrylic"), options, ""))
+    uploads.save_records(store, files)
+    parsed = uploads.parse_upload("lab.h5", store.read_bytes())
+    assert parsed.measurement is None
+    assert parsed.error.startswith("lab.h5: holds 2 measurements (")
+    assert "key=" not in parsed.error and "`pidcore analyze FILE --key NAME`" in parsed.error

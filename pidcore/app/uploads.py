@@ -188,6 +188,10 @@ def error_message(name: str, exc: BaseException) -> str:
                         "name the inverted channel in the 'inverted channels' column")
     text = text.replace("(--sample-rate)", "('sample rate if no time column' under 'Options "
                                            "for every file')")
+    # the reader's hint is a keyword of read_measurement; the page has no choice of record
+    # (it said "choose one with key=", pointing at nothing)
+    text = text.replace("choose one with key=", "upload one measurement per file, or analyse "
+                                                "one with `pidcore analyze FILE --key NAME`")
     if isinstance(exc, PidcoreError):
         return text if name in text else f"{name}: {text}"
     return f"{name}: could not be read ({type(exc).__name__}: {text})"
