@@ -246,3 +246,36 @@ def test_an_uploaded_file_of_several_measurements_says_what_to_do_in_the_app(tmp
     assert parsed.measurement is None
     assert parsed.error.startswith("lab.h5: holds 2 measurements (")
     assert "key=" not in parsed.error and "`pidcore analyze FILE --key NAME`" in parsed.error
+
+
+def _shaker_csv(header: str, columns) -> bytes:
+    import numpy as np
+
+    rows = "\n".join(",".join(f"{v:.9g}" for v in row) for row in np.column_stack(columns))
+    return f"{header}\n{rows}\n".encode()
+
+
+def test_channel_refusals_name_the_pages_columns_not_cli_options():
+    # the page said "confirm it with --acceleration 'Shaker reference'", "--mass-below-gauge
+    # needs the acceleration at the drive point", "--invert 'Nope': no such channel"
+    import numpy as np
+
+    from pidcore.measure import AnalysisOptions
+
+    fs, f, amp = 10_000, 100.0, 5 * 9.80665
+    t = np.arange(fs) / fs
+    w = 2 * np.pi * f
+    acc = amp * np.sin(w * t)
+    force = 0.3 * acc + 0.5 * np.cos(w * t)
+    reference = _shaker_csv("Time [s],Force [N],Shaker reference [m/s^2]", (t, force, acc))
+    two = _shaker_csv("Time [s],Force [N],Velocity [m/s],Drive acc [m/s^2],Other acc [m/s^2]",
+                      (t, force, -amp / w * np.cos(w * t), acc, 1.01 * acc))
+    said = [uploads.analyze_upload("ref_fill50.csv", reference, AnalysisOptions()).error,
+            uploads.analyze_upload("two_fill50.csv", two,
+                                   AnalysisOptions(mass_below_gauge_kg=0.01)).error,
+            uploads.analyze_upload("two_fill50.csv", two,
+                                   AnalysisOptions(invert=("Nope",))).error]
+    assert all(s is not None and " --" not in s for s in said), said
+    assert "confirm it in the 'acceleration channel' column ('Shaker reference')" in said[0]
+    assert "the mass below gauge needs the acceleration at the drive point" in said[1]
+    assert "'inverted channels' 'Nope': no such channel" in said[2]

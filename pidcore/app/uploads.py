@@ -188,6 +188,15 @@ def error_message(name: str, exc: BaseException) -> str:
                         "name the inverted channel in the 'inverted channels' column")
     text = text.replace("(--sample-rate)", "('sample rate if no time column' under 'Options "
                                            "for every file')")
+    # the channel hints that name a channel or an option the page sets in a column (they
+    # said "confirm it with --acceleration 'Ref'", "--mass-below-gauge needs ...", "--invert
+    # 'X': no such channel": options the page does not have)
+    text = re.sub(r"confirm it with --(force|velocity|acceleration) ('[^']*')",
+                  r"confirm it in the '\1 channel' column (\2)", text)
+    text = text.replace("--mass-below-gauge needs", "the mass below gauge needs")
+    text = text.replace("or remove the option", "or set 'mass below gauge [g]' to 0")
+    text = re.sub(r"--invert ('[^']*'): no such channel",
+                  r"'inverted channels' \1: no such channel", text)
     # the reader's hint is a keyword of read_measurement; the page has no choice of record
     # (it said "choose one with key=", pointing at nothing)
     text = text.replace("choose one with key=", "upload one measurement per file, or analyse "
