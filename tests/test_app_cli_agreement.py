@@ -279,3 +279,18 @@ def test_channel_refusals_name_the_pages_columns_not_cli_options():
     assert "confirm it in the 'acceleration channel' column ('Shaker reference')" in said[0]
     assert "the mass below gauge needs the acceleration at the drive point" in said[1]
     assert "'inverted channels' 'Nope': no such channel" in said[2]
+
+
+def test_an_analysis_note_names_the_pages_column_not_a_cli_option():
+    # a file analysed with a channel inverted on the page noted "channel 'Force' inverted
+    # (--invert)"; notes pass through the same words as errors
+    from pidcore.measure import AnalysisOptions
+
+    flipped = mass_damper_csv().decode().splitlines()
+    rows = [flipped[0]] + [",".join([t, str(-float(f)), v]) for t, f, v in
+                           (line.split(",")[:3] for line in flipped[1:] if line)]
+    outcome = uploads.analyze_upload("flipped_fill50.csv", "\n".join(rows).encode(),
+                                     AnalysisOptions(invert=("Force",)))
+    assert outcome.ok, outcome.error
+    assert "channel 'Force' inverted ('inverted channels' column)" in outcome.record.notes
+    assert not any("--" in n for n in outcome.record.notes), outcome.record.notes

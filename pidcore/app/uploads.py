@@ -167,22 +167,18 @@ class UploadOutcome:
 def app_words(text: str) -> str:
     """A library message or note as the app says it: the app has no unit setting (it takes
     each channel's unit from its file), so the unit options of ``pidcore analyze`` a message
-    suggests are named as that command's, not as choices of the page."""
+    suggests are named as that command's, not as choices of the page; the options the page
+    sets in a column or field (channels, inverted channels, mass below gauge, sample rate)
+    are named by that column."""
     text = text.replace(
         "check both units (--velocity-unit, --acceleration-unit)",
         "check both units in the export (the app takes each channel's unit from its file; "
         "`pidcore analyze --velocity-unit/--acceleration-unit` override them)")
-    return re.sub(r"give it with --(force|velocity|acceleration)-unit UNIT",
+    text = re.sub(r"give it with --(force|velocity|acceleration)-unit UNIT",
                   r"state it in the export (the app takes units from the file; "
                   r"`pidcore analyze --\1-unit UNIT` gives it)", text)
-
-
-def error_message(name: str, exc: BaseException) -> str:
-    """One-line message for a failed upload; library errors already name the file."""
-    text = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
-    text = app_words(text)
-    text = re.sub(r"\S*pidcore_upload_[^/\\\s]*[/\\][^:\s]*", name, text)
-    # The library's hints name CLI options; in the app the same choice is a table column.
+    # The library's hints (errors and notes: a note said "channel 'Force' inverted
+    # (--invert)") name CLI options; in the app the same choice is a table column.
     text = re.sub(r"--(force|velocity|acceleration) NAME", r"the '\1 channel' column", text)
     text = text.replace("pass --invert NAME for the inverted channel",
                         "name the inverted channel in the 'inverted channels' column")
@@ -201,6 +197,15 @@ def error_message(name: str, exc: BaseException) -> str:
     # (it said "choose one with key=", pointing at nothing)
     text = text.replace("choose one with key=", "upload one measurement per file, or analyse "
                                                 "one with `pidcore analyze FILE --key NAME`")
+    text = text.replace(" inverted (--invert)", " inverted ('inverted channels' column)")
+    return text
+
+
+def error_message(name: str, exc: BaseException) -> str:
+    """One-line message for a failed upload; library errors already name the file."""
+    text = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+    text = app_words(text)
+    text = re.sub(r"\S*pidcore_upload_[^/\\\s]*[/\\][^:\s]*", name, text)
     if isinstance(exc, PidcoreError):
         return text if name in text else f"{name}: {text}"
     return f"{name}: could not be read ({type(exc).__name__}: {text})"
