@@ -68,6 +68,11 @@ CELL_SHAPES: tuple[str, ...] = get_args(CellShape)
 #: Standard gravity, m/s^2 (ISO 80000-3); used for g <-> m/s^2 and for gravity on particles.
 STANDARD_GRAVITY = 9.80665
 
+#: Unit of a dimensionless ratio (loss factor, SDC, a relative error) and of a count (steps,
+#: periods, harmonic numbers, particles) in the store and every output: one spelling each.
+RATIO_UNIT = "-"
+COUNT_UNIT = "1"
+
 #: SI unit of each quantity, as written in every output.
 SI_UNITS: dict[str, str] = {
     "force": "N",

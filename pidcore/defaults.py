@@ -31,6 +31,13 @@ FREQUENCY_SEARCH_RELATIVE_WIDTH = 0.05
 #: The drive peak's power must exceed the median spectral power by this factor (20 dB); the
 #: largest of ~1e6 white-noise bins exceeds the median by ~20 (13 dB), a drive tone by >> 1e3.
 DOMINANT_PEAK_MIN_POWER_RATIO = 100.0
+#: A measured reactive power Im(P_c) must exceed this many of its own standard errors (from
+#: the blocks of whole periods) to be taken as a stored kinetic energy E = Im(P_c)/w: below
+#: it E is not resolved (a resistive load, noise), and Re/Im would be a number of noise.
+REACTIVE_POWER_MIN_STDERRS = 3.0
+#: ... and this fraction of |P_c| (a record without blocks, or noise-free): a purely resistive
+#: record gives Im(P_c) ~ 1e-16 |P_c| of round-off, a loss factor of 1e15 otherwise.
+REACTIVE_POWER_MIN_FRACTION = 1e-8
 #: Harmonics above this fraction of the Nyquist frequency are dropped from the fit.
 HARMONIC_MAX_FRACTION_OF_NYQUIST = 0.9
 #: Longest FFT used for the coarse drive-frequency estimate (memory bound on long records).

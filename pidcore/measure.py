@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from . import defaults
+from .constants import COUNT_UNIT, RATIO_UNIT
 from .errors import ChannelError, ParameterError, StoreError
 from .io import assign_roles, read_measurement
 from .records import Channel, Measurement
@@ -69,7 +70,9 @@ class AnalysisOptions:
 
 @dataclass(frozen=True)
 class AnalyzedRecord:
-    """A measurement with its analysis and the channels used."""
+    """A measurement with its analysis and the channels used. ``measurement`` is the one
+    read (what the store keeps under the file's SHA-256); channels inverted by ``invert``
+    are inverted for the analysis only, and the inversion is in ``corrections``."""
 
     measurement: Measurement
     analysis: PowerAnalysis
@@ -256,6 +259,7 @@ def analyze_measurement(measurement: Measurement, options: AnalysisOptions) -> A
     """
     notes: list[str] = list(measurement.metadata.get("reader_notes", ()) or ())
     corrections: dict = {}
+    as_read = measurement  # what is stored: the file's channels, the inversion a parameter
     measurement = _invert(measurement, options.invert, notes)
     if options.invert:
         corrections["inverted_channels"] = list(options.invert)
@@ -291,7 +295,7 @@ def analyze_measurement(measurement: Measurement, options: AnalysisOptions) -> A
     used = {role: ch.name for role, ch in chosen.items()}
     detail = tuple({"role": role, "name": ch.name, "unit": ch.unit,
                     "source_unit": ch.source_unit} for role, ch in chosen.items())
-    return AnalyzedRecord(measurement, analysis, used, tuple(notes) + analysis.notes,
+    return AnalyzedRecord(as_read, analysis, used, tuple(notes) + analysis.notes,
                           detail, corrections)
 
 
@@ -313,10 +317,11 @@ def store_analysis(store, result: AnalyzedRecord, parameters: Mapping, *,
     """
     measurement_key, _ = store.add_measurement(result.measurement)
     record = {**analysis_record(result), **(fields or {})}
+    arrays = analysis_arrays(result.analysis)
     return store.add_analysis(
-        measurement_key, record, arrays=analysis_arrays(result.analysis),
+        measurement_key, record, arrays=arrays,
         parameters={**parameters, "channels": result.channels_used},
-        units={k: v for k, v in ANALYSIS_UNITS.items() if k in record})
+        units={k: v for k, v in ANALYSIS_UNITS.items() if k in record or k in arrays})
 
 
 #: How a saved analysis without a load case is named in notes.
@@ -440,11 +445,13 @@ def replacement_notes(analyses: pd.DataFrame,
 #: Units of the scalar fields stored per analysis.
 ANALYSIS_UNITS = {
     "frequency_hz": "Hz", "acceleration_g": "g", "acceleration_m_s2": "m/s^2",
-    "complex_power_real_w": "W", "complex_power_imag_w": "W", "loss_factor": "1",
-    "loss_factor_stderr": "1", "sdc": "1", "sdc_stderr": "1", "damping_ratio": "1",
-    "energy_per_cycle_j": "J", "max_kinetic_energy_j": "J", "force_amplitude_n": "N",
-    "velocity_amplitude_m_s": "m/s", "displacement_amplitude_m": "m", "n_periods": "1",
-    "fill_percent": "%",
+    "complex_power_real_w": "W", "complex_power_imag_w": "W", "loss_factor": RATIO_UNIT,
+    "loss_factor_stderr": RATIO_UNIT, "sdc": RATIO_UNIT, "sdc_stderr": RATIO_UNIT,
+    "damping_ratio": RATIO_UNIT, "energy_per_cycle_j": "J", "max_kinetic_energy_j": "J",
+    "force_amplitude_n": "N", "velocity_amplitude_m_s": "m/s", "displacement_amplitude_m": "m",
+    "n_periods": COUNT_UNIT, "fill_percent": "%",
+    # arrays (analysis_arrays): harmonic numbers and the phasors x(t) = Re(X e^{j n w t})
+    "harmonics": COUNT_UNIT, "force_phasors_n": "N", "velocity_phasors_m_s": "m/s",
 }
 
 

@@ -10,6 +10,7 @@ never taken as SI (the analysis asks for ``--force-unit`` etc.).
 
 from __future__ import annotations
 
+import math
 import re
 from dataclasses import dataclass
 
@@ -171,3 +172,15 @@ def g_to_si(value_g: float) -> float:
 def si_to_g(value_m_s2: float) -> float:
     """Acceleration in m/s^2 to g (standard gravity)."""
     return value_m_s2 / STANDARD_GRAVITY
+
+
+def display_number(value: float | None, *, decimals: int = 4, missing: str = "—") -> str:
+    """A number as shown on a page: ``decimals`` fixed decimals (``0.1856``, ``0.0010``) down
+    to 10**(1 - decimals), where they would show a single digit; three significant digits
+    below (``0.000157``, ``4.4e-05``), so that no nonzero value reads 0.0000; ``missing`` for
+    NaN, inf or None."""
+    if value is None or not math.isfinite(value):
+        return missing
+    if value == 0 or abs(round(value, decimals)) >= 10.0 ** (1 - decimals):  # as printed
+        return f"{value:.{decimals}f}"
+    return f"{value:.3g}"

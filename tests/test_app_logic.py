@@ -1559,3 +1559,22 @@ def test_the_sample_rate_hint_names_the_apps_option():
     outcome = uploads.parse_upload("no_time.csv", b"Force [N],Velocity [m/s]\n1,2\n3,4\n")
     assert "--sample-rate" not in outcome.error
     assert "'sample rate if no time column' under 'Options for every file'" in outcome.error
+
+
+@pytest.mark.parametrize(("sdc", "stderr", "shown"), [
+    (0.1856, 0.0042, "0.1856 ± 0.0042"),  # the usual look is kept
+    (0.0231, 0.0010, "0.0231 ± 0.0010"),
+    (1.5702e-4, float("nan"), "0.000157"),  # the paper's 50 Hz, 1 g, 25 % DEM value
+    (5.09e-5, 4.4e-5, "5.09e-05 ± 4.4e-05"),  # a mass without damping, within noise
+    (0.25, 1.1e-14, "0.2500 ± 1.1e-14"),  # a noise-free record's round-off error
+])
+def test_sdc_shown_on_the_pages_keeps_its_digits(sdc, stderr, shown):
+    """Four fixed decimals showed the paper's SDC 1.5702e-4 as 0.0002 and an undamped
+    mass's 5.1e-5 ± 4.4e-5 as 0.0001 ± 0.0000 (a nonzero error shown as zero) on the
+    Analyse and Compare pages and the case sheet."""
+    from pidcore.app.uploads import format_sdc
+
+    assert format_sdc(sdc, stderr) == shown
+    for text in shown.split(" ± "):  # each number shown reads back within its last digit
+        assert "0.0000" != text
+    assert float(shown.split(" ± ")[0]) == pytest.approx(sdc, rel=5e-3)

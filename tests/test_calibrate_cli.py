@@ -97,11 +97,14 @@ def test_json_document(capsys, tmp_path, tiny_store):
     # every number of the document names its unit, as calibration.json's table does
     assert doc["units"] == {"fixture_mass_kg": "kg", "loo_rms": "-",
                             "frequency_hz": "Hz", "acceleration_g": "g", "fill_percent": "%",
-                            "measured": "-", "predicted": "-", "low95": "-", "high95": "-"}
+                            "measured": "-", "measured_stderr": "-", "predicted": "-",
+                            "low95": "-", "high95": "-", "low95_without_stderr": "-",
+                            "high95_without_stderr": "-"}
     p = doc["parameters"]["fixture_mass_kg"]
     assert set(p) == {"median", "low95", "high95"} and p["low95"] <= p["median"] <= p["high95"]
     keys = {"frequency_hz", "acceleration_g", "fill_percent", "material", "measured",
-            "predicted", "low95", "high95"}
+            "measured_stderr", "predicted", "low95", "high95", "low95_without_stderr",
+            "high95_without_stderr"}
     assert len(doc["predictions"]) == len(doc["loo"]) == 3
     assert all(set(r) == keys for r in doc["predictions"] + doc["loo"])
     rms = math.sqrt(sum((r["predicted"] - r["measured"]) ** 2 for r in doc["loo"]) / 3)
@@ -399,3 +402,45 @@ def test_an_empty_data_table_suggests_the_measured_sdc_header(capsys, tmp_path):
     table = _table(tmp_path, text="# nothing yet\n")
     _refused(capsys, tmp_path, ["--data", str(table)], "empty table",
              "'frequency_hz,acceleration_g,fill_percent,sdc'", "one row per load case")
+
+
+def test_auto_falling_back_from_the_grid_to_emcee_is_said(tiny_store, tmp_path, monkeypatch):
+    # --method auto sampled with emcee where the grid could not box the posterior, and the
+    # summary, notes and settings still read as if the grid had been used
+    from pidcore.calibrate import posterior
+    from pidcore.calibrate.data import read_measured_table
+    from pidcore.calibrate.outputs import summary_markdown
+
+    points = read_measured_table(_table(tmp_path))
+    settings = {"fit": ["fixture_mass_kg"], "discrepancy": 0.2, "store_path": tiny_store,
+                "cells": 2, "steady_cycles": 10, "workers": 1, "progress": False,
+                "cross_validate": "loo"}
+    on_grid = calibrate(points, **settings)
+    assert on_grid.settings["method_used"] == "grid"
+    assert not any("emcee" in note for note in on_grid.notes)
+    assert "posterior by grid" in summary_markdown(on_grid)
+    # a box the posterior never spans enough of: the grid cannot settle in its one pass
+    monkeypatch.setattr(posterior, "GRID_MAX_PASSES", 1)
+    monkeypatch.setattr(posterior, "GRID_ZOOM_SHARE", 2.0)
+    fallen = calibrate(points, **settings)
+    assert fallen.settings["method"] == "auto" and fallen.settings["method_used"] == "emcee"
+    notes = " ".join(fallen.notes)
+    assert "--method auto: the grid posterior did not settle" in notes
+    assert "3 of 3 leave-one-out fold(s)" in notes
+    assert "posterior by emcee" in summary_markdown(fallen)
+
+
+def test_summary_table_shows_small_sdc_with_its_digits():
+    """The summary's prediction table printed SDCs with three fixed decimals: a load case of
+    SDC 2.97e-4 (the paper's 100 Hz, 1 g, 25 %) read 0.000 measured, predicted and in its
+    band, as if there were no damping. Small values keep three significant digits; the
+    usual look (0.230, 0.052 .. 0.436, +0.010) is kept."""
+    from pidcore.calibrate.outputs import _table_rows
+
+    rows = [{"frequency_hz": 100.0, "acceleration_g": 1.0, "fill_percent": 25.0,
+             "measured": 2.9705e-4, "predicted": 4.1e-4, "low95": 1.2e-4, "high95": 8.8e-4},
+            {"frequency_hz": 50.0, "acceleration_g": 5.0, "fill_percent": 50.0,
+             "measured": 0.23, "predicted": 0.24, "low95": 0.052, "high95": 0.436}]
+    small, usual = _table_rows(rows)
+    assert small[3:7] == ["0.000297", "0.00041", "0.00012 .. 0.00088", "+0.000113"]
+    assert usual[3:7] == ["0.230", "0.240", "0.052 .. 0.436", "+0.010"]

@@ -71,7 +71,7 @@ def test_a_linear_gaussian_posterior_is_the_analytic_one(method):
     # well inside the bounds: the posterior is the untruncated normal
     model, mean, cov, _ = linear_problem([0.4, 0.02], 0.01, seed=1)
     sd = np.sqrt(np.diag(cov))
-    samples = sample_posterior(model, range(8), seed=3, method=method)
+    samples = sample_posterior(model, range(8), seed=3, method=method).samples
     n = len(samples)
     # the mean within 4 Monte-Carlo standard errors (emcee's draws are correlated: x3)
     assert np.all(np.abs(samples.mean(axis=0) - mean) < 4 * 3 * sd / math.sqrt(n))
@@ -88,7 +88,7 @@ def test_a_posterior_against_a_prior_bound_puts_no_point_mass_on_it(method):
     # bound: 13 % and 17 % of the samples sat exactly on it, and the medians were 9 % and 17 %
     # low (of a truncated normal known exactly)
     model, mean, cov, bounds = linear_problem([0.5, 0.5, 0.02, 0.002], 0.01, seed=5)
-    samples = sample_posterior(model, range(8), seed=3, method=method)
+    samples = sample_posterior(model, range(8), seed=3, method=method).samples
     exact = truncated_quantiles(mean, cov, bounds, [2.5, 50, 97.5])
     for j in (2, 3):
         assert np.mean(samples[:, j] == bounds[j][0]) < 0.001
@@ -130,7 +130,7 @@ def _coverage_trial(rng: np.random.Generator, n_dem: int, n_points: int = 8):
     model = Model(tuple(specs), tuple(surrogates), tuple(points), fixed, 0.01)
     fitted = range(n_points)  # the last point is held out, as in a leave-one-out fold
     samples = sample_posterior(model, fitted, seed=int(rng.integers(2**31)), method="grid",
-                               n_samples=2000)
+                               n_samples=2000).samples
     low, high = np.percentile(samples, [2.5, 97.5], axis=0)
     band = predictive(model, samples, n_points, rng=rng)
     return (low <= truth) & (truth <= high), band["low95"] <= points[-1].sdc <= band["high95"]
@@ -158,7 +158,7 @@ def test_a_posterior_narrower_than_the_grid_steps_is_resolved(truth, sigma):
     # found put it on a handful of nodes, or cut it off: sd 0.7x-5.7x, the mean 0.3-0.6 sd off
     model, mean, cov, _ = linear_problem(truth, sigma, seed=5)
     sd = np.sqrt(np.diag(cov))
-    samples = sample_posterior(model, range(8), seed=3, method="grid")
+    samples = sample_posterior(model, range(8), seed=3, method="grid").samples
     assert samples.std(axis=0) == pytest.approx(sd, rel=0.08)
     assert np.all(np.abs(samples.mean(axis=0) - mean) < 0.15 * sd)
 
@@ -167,8 +167,51 @@ def test_a_grid_that_cannot_box_the_posterior_is_refused_or_left_to_emcee(monkey
     from pidcore.calibrate import posterior
 
     model, mean, cov, _ = linear_problem([0.5, 0.5, 0.02], 0.001, seed=5)
+    passes = posterior.GRID_MAX_PASSES
     monkeypatch.setattr(posterior, "GRID_MAX_PASSES", 1)  # no room to zoom in
     with pytest.raises(posterior.GridUnresolved, match="use --method emcee"):
         sample_posterior(model, range(8), seed=3, method="grid")
-    samples = sample_posterior(model, range(8), seed=3, method="auto")
-    assert samples.std(axis=0) == pytest.approx(np.sqrt(np.diag(cov)), rel=0.1)
+    drawn = sample_posterior(model, range(8), seed=3, method="auto")
+    assert drawn.samples.std(axis=0) == pytest.approx(np.sqrt(np.diag(cov)), rel=0.1)
+    # the fallback is said (the calibration shows it as a note), not silent
+    assert drawn.method == "emcee" and "did not settle" in drawn.fallback
+    # where the grid resolves it, auto uses the grid and says nothing
+    monkeypatch.setattr(posterior, "GRID_MAX_PASSES", passes)
+    resolved = sample_posterior(model, range(8), seed=3, method="auto")
+    assert resolved.method == "grid" and resolved.fallback is None
+
+
+def test_a_band_for_another_measurements_stderr_is_that_measurements_band():
+    # a report compared a new measurement with the band of the fitted point's measurement
+    # error: a precise measurement was judged by a noisy point's wide band. The band without
+    # measurement error widened by another stderr must be the band the posterior gives a
+    # point of that stderr (independent normal errors add in quadrature)
+    from dataclasses import replace
+
+    from pidcore.calibrate.posterior import predictive
+    from pidcore.calibrate.prediction import CalibratedPrediction
+    from pidcore.loadcase import LoadCase
+
+    sigma, other = 0.01, 0.05
+    model, _, _, _ = linear_problem([0.4, 0.02], sigma, seed=1)
+    samples = sample_posterior(model, range(8), seed=3, method="grid").samples
+    fitted = predictive(model, samples, 0, rng=np.random.default_rng(7))
+    hit = CalibratedPrediction(LoadCase(100.0, 1.0, 50.0), fitted["predicted"],
+                               fitted["low95"], fitted["high95"], 0.0, sigma,
+                               fitted["low95_without_stderr"], fitted["high95_without_stderr"])
+    # its own point's stderr (or none known): the band calibration.json states, exactly
+    assert hit.band(sigma) == hit.band() == (fitted["low95"], fitted["high95"])
+    # without the measurement error the band is narrower, and no stderr gives exactly it
+    assert fitted["low95"] < fitted["low95_without_stderr"] < fitted["predicted"]
+    assert fitted["predicted"] < fitted["high95_without_stderr"] < fitted["high95"]
+    assert hit.band(0.0) == pytest.approx((fitted["low95_without_stderr"],
+                                           fitted["high95_without_stderr"]), rel=1e-12)
+    # the same posterior asked for a point of stderr 0.05 at that load case
+    points = (replace(model.points[0], sdc_stderr=other), *model.points[1:])
+    noisy = predictive(replace(model, points=points), samples, 0, rng=np.random.default_rng(7))
+    low, high = hit.band(other)
+    width = noisy["high95"] - noisy["low95"]
+    # Monte-Carlo percentiles of the 2.5 % tails of N_SAMPLES draws: ~2 % of the width
+    assert low == pytest.approx(noisy["low95"], abs=0.03 * width)
+    assert high == pytest.approx(noisy["high95"], abs=0.03 * width)
+    assert high - low > 2 * (fitted["high95"] - fitted["low95"])  # 5 x the stderr: far wider

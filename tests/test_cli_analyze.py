@@ -198,6 +198,56 @@ def test_table_output_names_units_and_whole_file_names(tmp_path, capsys):
     assert end == header.index("frequency [Hz]") + len("frequency [Hz]")
 
 
+def _table_cells(out: str, heads: tuple[str, ...]) -> dict[str, str]:
+    """The first row's cell under each head (right-aligned under it)."""
+    header, _, row = out.splitlines()[:3]
+    return {head: row[:header.index(head) + len(head)].split()[-1] for head in heads}
+
+
+def test_table_shows_small_values_with_their_digits(tmp_path, capsys):
+    """A lightly damped mass (loss factor 1.6e-5, zeta 8.0e-6): the table printed the loss
+    factor 0.000016 and zeta 0.00001 (fixed decimals: two digits and one; a damping ratio
+    below 5e-6 as 0.00000). Every number is now shown to at least four significant digits,
+    right-aligned under its head."""
+    eta = 1.6e-5
+    c = eta * 2 * math.pi * FREQ * MASS  # loss factor c/(m w)
+    rec = synthesize_shaker_record(mass_kg=MASS, acceleration_amplitude_m_s2=ACCEL,
+                                   frequency_hz=FREQ, sample_rate_hz=FS, n_periods=20.3,
+                                   viscous_damping_n_s_m=c)
+    path = tmp_path / "light.csv"
+    write_force_velocity(path, rec.force_n, rec.velocity_m_s, FS, "csv")
+    assert main(["analyze", str(path), "--no-store"]) == 0
+    cells = _table_cells(capsys.readouterr().out, ("loss factor [-]", "SDC [-]", "zeta [-]"))
+    sdc = 2 * math.pi * eta
+    zeta = -math.log1p(-sdc) / (4 * math.pi)  # 8.0e-6: printed 0.00001 by 9.5f
+    # noise-free: the printed digits are the truth's
+    for head, truth in (("loss factor [-]", eta), ("SDC [-]", sdc), ("zeta [-]", zeta)):
+        shown = cells[head]
+        digits = len(shown.split("e")[0].replace(".", "").replace("-", "").lstrip("0"))
+        assert digits >= 4, (head, shown)
+        assert float(shown) == pytest.approx(truth, rel=10 ** (1 - digits)), (head, shown)
+
+
+def test_table_shows_a_missing_standard_error_as_na_not_nan(tmp_path, capsys):
+    """A record whose first of 8 blocks is not mass-like has no standard error (NaN, with its
+    note): the table printed 'nan' in the ± SE column."""
+    w = 2 * math.pi * FREQ
+    t = np.arange(int(40 * FS / FREQ)) / FS
+    v = 0.01 * np.sin(w * t)
+    x = -0.01 / w * np.cos(w * t)
+    # first 5 periods a spring (Im < 0; k = 0.2 m w^2 keeps the whole record's Im resolved),
+    # then a mass with a damper
+    force = np.where(t < 5 / FREQ, 0.2 * MASS * w**2 * x,
+                     MASS * 0.01 * w * np.cos(w * t) + C_VISCOUS * v)
+    path = tmp_path / "spring_block.csv"
+    write_force_velocity(path, force, v, FS, "csv")
+    assert main(["analyze", str(path), "--no-store"]) == 0
+    out = capsys.readouterr().out
+    assert "no standard error" in out
+    assert "nan" not in out.lower()
+    assert _table_cells(out, ("± SE [-]",))["± SE [-]"] == "n/a"
+
+
 def test_allow_clipped_analyses_and_reports_the_clipping(tmp_path, capsys):
     rec = synthesize_shaker_record(mass_kg=MASS, acceleration_amplitude_m_s2=ACCEL,
                                    frequency_hz=FREQ, sample_rate_hz=FS, n_periods=20)

@@ -182,3 +182,100 @@ def test_usage_errors_are_one_line_naming_the_sub_command(capsys, args, words):
     assert len(err.strip().splitlines()) == 1, err  # no usage block
     for word in words:
         assert word in err
+
+
+@pytest.mark.parametrize("how", ["option", "file name", "sidecar"])
+def test_a_fill_that_puts_no_particle_in_a_cell_is_refused(tmp_path, capsys, how):
+    # `analyze --fill 0.5` (50 % typed as a fraction) was saved as a 0.5 % load case, which
+    # no DEM run can be made at (0.11 of the paper cell's 22 particles) and no report places
+    from pidcore.specimen import paper_specimen
+
+    capacity = paper_specimen().capacity_per_cell()
+    fill = 0.5
+    assert round(fill / 100 * capacity) == 0  # the premise: half a percent is no particle
+    name = "rec_fill0.5pct.csv" if how == "file name" else "rec.csv"
+    path = export(tmp_path / name)
+    args = ["analyze", str(path), "--store", str(tmp_path / "s.h5")]
+    if how == "option":
+        args += ["--fill", str(fill)]
+    if how == "sidecar":
+        (tmp_path / "loadcases.csv").write_text(f"file,fill_percent\n{name},{fill}\n")
+    assert main(args) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1
+    source = {"option": "--fill", "file name": "file name", "sidecar": "loadcases.csv"}[how]
+    assert f"{name} ({source}" in err and "rounds to none" in err
+    assert "was 0.5 meant as 50 %?" in err
+    assert not (tmp_path / "s.h5").exists()  # nothing written
+
+
+def test_the_smallest_fill_holding_a_particle_is_saved(tmp_path, capsys):
+    # the refusal's own bound: the least fill it names rounds to one particle and is kept
+    import re
+
+    path = export(tmp_path / "rec.csv")
+    store = tmp_path / "s.h5"
+    assert main(["analyze", str(path), "--store", str(store), "--fill", "1"]) == 2
+    least = re.search(r"expected >= ([0-9.]+) %", capsys.readouterr().err).group(1)
+    assert main(["analyze", str(path), "--store", str(store), "--fill", least]) == 0
+    assert f"fill{least}pct" in capsys.readouterr().out
+
+
+def _damped_export(path: Path, damping: float, *, snr_db: float = 60) -> Path:
+    rec = synthesize_shaker_record(mass_kg=MASS, acceleration_amplitude_m_s2=ACCEL,
+                                   frequency_hz=FREQ, sample_rate_hz=FS, n_periods=15,
+                                   viscous_damping_n_s_m=damping, snr_db=snr_db, seed=5)
+    return write_force_velocity(path, rec.force_n, rec.velocity_m_s, FS)
+
+
+def test_a_negative_loss_factor_beyond_its_noise_is_refused_unless_accepted(tmp_path, capsys):
+    # the CLI saved SDC -0.08 (energy created per cycle, 10^4 standard errors below zero)
+    # with only a note, where the app warns and asks for confirmation before it saves
+    from pidcore.store import Store
+
+    path = _damped_export(tmp_path / "rec_fill50.csv", -C_VISCOUS)
+    store = tmp_path / "s.h5"
+    for command in (["analyze", str(path), "--store", str(store)],
+                    ["report", str(path), "--store", str(store), "--out", str(tmp_path / "r"),
+                     "--format", "csv"]):
+        assert main(command) == 2
+        err = capsys.readouterr().err.strip()
+        assert len(err.splitlines()) == 1
+        assert "rec_fill50.csv: implausible: negative loss factor" in err
+        assert "Likely cause:" in err and "pass --accept-implausible" in err
+        assert not store.exists() and not (tmp_path / "r").exists()  # nothing written
+    assert main(["analyze", str(path), "--store", str(store), "--accept-implausible"]) == 0
+    assert "note: implausible, kept as asked: negative loss factor" in capsys.readouterr().out
+    (key,) = Store(store).list_analyses()["key"]
+    assert -truth_loss_factor() == pytest.approx(
+        Store(store).get_analysis(key).record["loss_factor"], rel=0.03)
+
+
+def test_a_negative_loss_factor_within_its_noise_is_zero_damping_not_refused(tmp_path, capsys):
+    # an undamped coupon at 20 dB: its loss factor scatters about 0 and may come out
+    # slightly negative; that is no damping resolved, not a set-up error
+    import json
+
+    negative = 0
+    for damping in (0.0, -1e-4, 1e-4):
+        path = _damped_export(tmp_path / f"rec{damping}.csv", damping, snr_db=20)
+        assert main(["analyze", str(path), "--no-store", "--json"]) == 0
+        (rec,) = json.loads(capsys.readouterr().out)["records"]
+        # within 3 standard errors of zero, whatever its sign
+        assert abs(rec["sdc"]) <= 3 * rec["sdc_stderr"]
+        if rec["sdc"] < 0:
+            negative += 1
+            assert any("zero within its uncertainty" in n for n in rec["notes"])
+    assert negative  # the premise: this noise (seed 5) makes the SDC come out negative
+
+
+def test_an_sdc_above_2_pi_is_refused_unless_accepted(tmp_path, capsys):
+    # loss factor c / (m w) = 200 / (0.25 x 2 pi x 100) = 1.27: SDC 8.0 > 2 pi, more
+    # dissipated per radian than the coupon stores; no particle damper comes near
+    damping = 200.0
+    assert damping / (MASS * 2 * math.pi * FREQ) * 2 * math.pi > 2 * math.pi
+    path = _damped_export(tmp_path / "rec_fill50.csv", damping)
+    assert main(["analyze", str(path), "--no-store"]) == 2
+    err = capsys.readouterr().err
+    assert "implausible: SDC 7.99" in err and "above the physical bound 6.28" in err
+    assert main(["analyze", str(path), "--no-store", "--accept-implausible"]) == 0

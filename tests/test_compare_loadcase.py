@@ -168,3 +168,49 @@ def test_an_own_material_in_the_file_name_is_recognised_when_known():
     plain = stated_case("coupon_500Hz.csv")
     assert unstated_note(plain) == "fill: not stated, 50 % proposed; material: not stated, " \
                                    "acrylic assumed"
+
+
+def test_the_apps_column_labels_read_as_the_sidecars_columns(tmp_path):
+    # a table typed after the app's settings grid ("fill [%]", "vibrometer delay [µs]") was
+    # refused by `pidcore analyze` ("unknown column") while the app took it
+    from pidcore.compare.loadcase import SETTINGS_COLUMN_LABELS, read_sidecar
+
+    labelled = tmp_path / "labelled.csv"
+    labelled.write_text("File;Fill [%];vibrometer delay [µs];Force channel\n"
+                        "a.uff;62,5;50;Kraft\n", encoding="utf-8")
+    plain = tmp_path / "plain.csv"
+    plain.write_text("file;fill_percent;velocity_delay_us;force\na.uff;62,5;50;Kraft\n",
+                     encoding="utf-8")
+    assert read_sidecar(labelled).equals(read_sidecar(plain))
+    assert read_sidecar(labelled).loc[2, "fill_percent"] == "62.5"  # decimal comma read
+    # every label names a settings column (one vocabulary)
+    from pidcore.compare.loadcase import SETTINGS_COLUMNS
+
+    assert set(SETTINGS_COLUMN_LABELS.values()) == set(SETTINGS_COLUMNS)
+    both = tmp_path / "both.csv"
+    both.write_text("file,fill [%],fill_percent\na.uff,50,50\n")
+    with pytest.raises(PidcoreError, match=r"column 'fill_percent' given more than once "
+                                           r"\(as 'fill \[%\]' and 'fill_percent'\)"):
+        read_sidecar(both)
+
+
+def test_a_file_named_in_cp1252_finds_its_row_of_a_cp1252_table(tmp_path):
+    # a file named on Windows (Prüfung: byte 0xFC) copied to Linux never matched the row of
+    # the cp1252 table saved beside it, and its fill was silently taken from elsewhere
+    import os
+
+    from pidcore.compare import resolve_load_case
+    from pidcore.compare.loadcase import name_spellings
+
+    try:
+        path = tmp_path / os.fsdecode(b"Pr\xfcfung_fill50.uff")
+        path.write_bytes(b"")
+    except (OSError, UnicodeError):
+        pytest.skip("the file system refuses names that are not UTF-8")
+    (tmp_path / "loadcases.csv").write_bytes("file,fill_percent\nPrüfung_fill50.uff,75\n"
+                                             .encode("cp1252"))
+    assert "Prüfung_fill50.uff" in name_spellings(path.name)
+    stated = resolve_load_case(path, sidecar=None)
+    assert stated.fill_percent == 75.0 and "fill: loadcases.csv" in stated.origin
+    # a UTF-8 name is only itself
+    assert name_spellings("Prüfung.uff") == ("Prüfung.uff",)

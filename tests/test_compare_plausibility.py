@@ -129,3 +129,24 @@ def test_model_curve_is_drawn_for_a_case_a_hair_below_the_grid_edge():
     # pchip through the paper's DEM values at 50 Hz, 5 g
     at = np.interp(comp.paper_points["fill [%]"], comp.model_fill_percent, comp.model_sdc)
     np.testing.assert_allclose(at, comp.paper_points["SDC DEM (paper) [-]"], rtol=2e-2)
+
+
+def test_a_negative_loss_factor_within_its_noise_is_a_note_not_a_warning():
+    # the app asked to confirm an undamped record whose noise made its SDC -0.04 +- 0.05,
+    # as if it were a wrong delay; beyond 3 standard errors it is still a warning
+    from types import SimpleNamespace
+
+    from pidcore.compare.plausibility import NEGATIVE_WITHIN_STDERRS, implausible_findings
+
+    def analysis(sdc, stderr):
+        return SimpleNamespace(complex_power_w=complex(sdc, 2 * math.pi), loss_factor=sdc / (
+            2 * math.pi), sdc=sdc, sdc_stderr=stderr, omega_rad_s=2 * math.pi * 100)
+
+    edge = -NEGATIVE_WITHIN_STDERRS * 0.01
+    warnings, notes = implausible_findings(analysis(edge, 0.01))
+    assert warnings == () and "zero within its uncertainty" in notes[0]
+    warnings, notes = implausible_findings(analysis(edge * 1.01, 0.01))
+    assert [w.check for w in warnings] == ["negative_loss_factor"] and notes == ()
+    # no standard error known: no noise to read it as, a warning
+    warnings, _ = implausible_findings(analysis(-1e-6, math.nan))
+    assert [w.check for w in warnings] == ["negative_loss_factor"]

@@ -158,6 +158,37 @@ def test_csv_sample_rate_given_equals_time_column(tmp_path):
         read_measurement(without)
 
 
+@pytest.mark.parametrize("header", ["Time", "t"])
+def test_csv_time_column_without_unit_is_taken_as_seconds_and_says_so(tmp_path, header):
+    """A time column without a unit was read as seconds without a word: a column written in
+    ms made the drive frequency 0.2 Hz for 200 Hz, the acceleration 0.005 g for 5 g and the
+    energy per cycle 1000 x (loss factor and SDC unchanged, so nothing else showed it)."""
+    t_ms = np.arange(200) / 25.6  # 25.6 kHz sampling, written in ms
+    path = tmp_path / "ms.csv"
+    path.write_text(f"{header},F [N]\n" + "".join(f"{x:.17g},1.0\n" for x in t_ms))
+    m = read_measurement(path)
+    assert m.channels[0].sample_rate_hz == pytest.approx(25.6)  # seconds, as before ...
+    (note,) = [n for n in m.metadata["reader_notes"] if "no unit" in n]
+    assert f"time column {header!r} has no unit: taken as seconds" in note  # ... and said
+    assert "25.6 Hz" in note and "Time [ms]" in note
+    path.write_text(f"{header} [ms],F [N]\n" + "".join(f"{x:.17g},1.0\n" for x in t_ms))
+    m = read_measurement(path)
+    assert m.channels[0].sample_rate_hz == pytest.approx(25600.0)
+    assert not any("no unit" in n for n in m.metadata.get("reader_notes", ()))
+
+
+def test_mat_time_vector_is_taken_as_seconds_and_says_so(tmp_path):
+    """The MAT reader's plain layout (a 't' vector beside channel vectors) took the time as
+    seconds without a word; a vector in ms gave a 1000 x low frequency. It is said."""
+    t_ms = np.arange(200) / 25.6
+    path = tmp_path / "plain.mat"
+    scipy.io.savemat(path, {"t": t_ms, "F": np.ones(200), "units": np.array(["N"], dtype=object)})
+    m = read_measurement(path)
+    assert m.channels[0].sample_rate_hz == pytest.approx(25.6)
+    assert any("time vector 't' states no unit: taken as seconds (sample rate 25.6 Hz)" in n
+               for n in m.metadata["reader_notes"])
+
+
 def test_csv_uneven_time_column_rejected(tmp_path):
     t = np.arange(100) / 1000.0
     t[50:] += 1e-3  # one dropped sample

@@ -173,6 +173,11 @@ HOSTILE_MAT = {
     "Test.Lab negative count": (_lms_mat(np.c_[_F, _V], number_of_values=-3),
                                 "number_of_values is -3"),
     "Test.Lab start inf": (_lms_mat(np.c_[_F, _V], start_value=np.inf), "start_value is inf"),
+    # an infinite sample interval passed "> 0" and made a 0 Hz sample rate
+    "Test.Lab increment inf": (_lms_mat(np.c_[_F, _V], increment=np.inf),
+                               "x_values.increment is inf"),
+    "Test.Lab increment text": (_lms_mat(np.c_[_F, _V], increment="abc"),
+                                "x_values.increment is 'abc'"),
     "rate text": (_simple_mat(fs="fast"), "variable fs is 'fast'"),
     "rate nan": (_simple_mat(fs=np.nan), "variable fs is nan"),
     "v7.3 reference to itself": (_v73(_self_reference), "deeper than"),

@@ -327,3 +327,25 @@ def test_an_area_is_checked_against_the_stored_runs_specimen(tmp_path):
         check_area(100.0, runs_specimen(runs))
     # runs of an older store (no specimen text) or of several specimens: nothing to check by
     assert runs_specimen(pd.DataFrame({"parameters_json": ["{}"]})) is None
+
+
+def test_a_vibrated_mass_in_grams_is_refused(tmp_path):
+    # `--vibrated-mass 115.8` (the 115.8 g of coupon and particles typed in g) wrote a c_eq
+    # 1000 x too large without a word
+    from pidcore.model.damper import paper_vibrated_mass
+
+    grams = 1000 * paper_vibrated_mass("coupon_plus_particles", "acrylic")(50.0)
+    with pytest.raises(ParameterError, match=r"--vibrated-mass .* kg is .* x the paper "
+                                             r"coupon's vibrated masses .*was it grams\?"):
+        _run(["model", "damper", "--out", str(tmp_path / "g"), "--vibrated-mass", f"{grams}"])
+    assert not (tmp_path / "g").exists()
+    # the same mass in kg, and one with a fixture 10 x the coupon's m_c, are taken; c_eq is
+    # proportional to the m_c given (c_eq = SDC m_c w / (2 pi))
+    tables = {}
+    for mass in (grams / 1000, 10 * grams / 1000):
+        out = tmp_path / f"{mass:g}"
+        _run(["model", "damper", "--out", str(out), "--vibrated-mass", f"{mass}",
+              "--format", "csv"])
+        tables[mass] = pd.read_csv(out / "equivalent_damper.csv")["c_eq [N s/m]"].to_numpy()
+    small, large = tables.values()
+    np.testing.assert_allclose(large, 10 * small, rtol=1e-9)

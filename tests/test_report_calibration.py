@@ -289,3 +289,31 @@ def test_bundled_calibration_states_a_unit_for_everything_it_reports():
                 if isinstance(v, (int, float)) and not isinstance(v, bool)}
     reported |= {"rms_in_sample", "loo_rms", "wall_s"}
     assert reported <= set(units), sorted(reported - set(units))
+
+
+def test_a_measurement_is_checked_against_the_band_of_its_own_stderr(tmp_path):
+    # the report compared every measurement with the band of the fitted point's measurement
+    # error (0.1 here): a precise new measurement (stderr 0.001) 0.3 off the prediction read
+    # "inside". Its band is the error-free one widened by its own stderr.
+    fitted = {**_prediction(50, 5, 50, 0.50, 0.20, 0.80), "measured_stderr": 0.1,
+              "low95_without_stderr": 0.40, "high95_without_stderr": 0.62}
+    cal = load_calibration(_write(tmp_path / "calibration.json", [fitted]))
+    table = pd.DataFrame({
+        "frequency [Hz]": [50.0, 50.0, 50.0], "acceleration [g]": [5.0] * 3,
+        "packing ratio [%]": [50.0] * 3, "material": ["acrylic"] * 3,
+        "SDC measured [-]": [0.25, 0.25, 0.25],
+        "SDC measured stderr [-]": [0.1, 0.001, math.nan], "note": [""] * 3})
+    out = add_calibration_columns(table, cal)
+    low, high = out[CALIBRATED_LOW_COLUMN], out[CALIBRATED_HIGH_COLUMN]
+    # the fitted point's own stderr, or none known: the band calibration.json states
+    assert (low[0], high[0]) == (low[2], high[2]) == (0.20, 0.80)
+    assert out[CALIBRATED_INSIDE_COLUMN].tolist() == ["yes", "no", "yes"]
+    # stderr 0.001: 0.5 - hypot(0.1, 1.96 x 0.001), 0.5 + hypot(0.12, 1.96 x 0.001)
+    assert low[1] == pytest.approx(0.5 - math.hypot(0.10, 1.959964 * 0.001), rel=1e-6)
+    assert high[1] == pytest.approx(0.5 + math.hypot(0.12, 1.959964 * 0.001), rel=1e-6)
+    assert "calibrated band for this measurement's SDC stderr 0.001" in out["note"][1]
+    assert out["note"][0] == out["note"][2] == ""
+    # a calibration.json written before the error-free band was kept: the stated band
+    old = load_calibration(_write(tmp_path / "old.json", [_prediction(50, 5, 50, 0.5, 0.2,
+                                                                        0.8)]))
+    assert add_calibration_columns(table, old)[CALIBRATED_LOW_COLUMN].tolist() == [0.2] * 3

@@ -79,7 +79,12 @@ def test_a_sidecar_delay_recovers_the_analytic_loss_factor_as_the_option_does(tm
     path = export(tmp_path / "rec.csv", delay_s=DELAY_S)
     by_option = run_json([str(path), "--no-store", "--velocity-delay", "2e-4"],
                          capsys)["records"][0]
-    bare = run_json([str(path), "--no-store"], capsys)["records"][0]  # no table: 0 µs
+    # no table: 0 µs. The loss factor then comes out negative, far beyond its noise: refused
+    # with the delay that would zero it (about the 200 µs the record has), kept if asked
+    said = refused(["analyze", str(path), "--no-store"], capsys)
+    assert "implausible: negative loss factor" in said and "--accept-implausible" in said
+    assert "a vibrometer delay of about" in said
+    bare = run_json([str(path), "--no-store", "--accept-implausible"], capsys)["records"][0]
     sidecar(tmp_path, "file,fill_percent,velocity_delay_us\nrec.csv,50,200\n")
     by_table = run_json([str(path), "--no-store"], capsys)["records"][0]
     eta = truth_loss_factor()
@@ -114,15 +119,17 @@ def test_an_explicit_option_overrides_the_sidecar_for_every_file_with_a_note(tmp
     path = export(tmp_path / "rec.csv", delay_s=DELAY_S)
     table = sidecar(tmp_path, "file,fill_percent,velocity_delay_us,mass_below_gauge_g\n"
                               "rec.csv,50,200,0\n")
-    doc = run_json([str(path), "--no-store", "--velocity-delay", "0"], capsys)
+    # 250 µs, not 0: under-correcting the record's 200 µs makes its loss factor negative,
+    # which is refused as implausible (tests/test_cli_analyze_refusals.py)
+    doc = run_json([str(path), "--no-store", "--velocity-delay", "2.5e-4"], capsys)
     (rec,) = doc["records"]
-    assert rec["parameters"]["velocity_delay_s"] == 0.0  # the option won
+    assert rec["parameters"]["velocity_delay_s"] == 2.5e-4  # the option won
     assert rec["settings_from"] == {"mass_below_gauge_kg": "loadcases.csv"}
     (note,) = rec["overridden"]
     assert note == doc["notes"][0]
-    assert note == (f"rec.csv: --velocity-delay (vibrometer delay 0 µs) overrides column "
+    assert note == (f"rec.csv: --velocity-delay (vibrometer delay 250 µs) overrides column "
                     f"velocity_delay_us '200' of {table}, line 2 (rec.csv)")
-    assert main(["analyze", str(path), "--no-store", "--velocity-delay", "0"]) == 0
+    assert main(["analyze", str(path), "--no-store", "--velocity-delay", "2.5e-4"]) == 0
     assert f"note: {note}" in capsys.readouterr().out
     # an option equal to the table's value overrides nothing: no note
     doc = run_json([str(path), "--no-store", "--velocity-delay", "2e-4",
@@ -285,12 +292,13 @@ def test_report_cli_option_overrides_the_sidecar_with_a_note(tmp_path, capsys):
     a = export(tmp_path / "a_fill50.csv", delay_s=DELAY_S)
     sidecar(tmp_path, "file,fill_percent,velocity_delay_us\na_fill50.csv,50,200\n")
     out = tmp_path / "rep"
-    assert main(["report", str(a), "--velocity-delay", "1e-4", "--format", "csv",
+    # 300 µs: an under-corrected delay (100 µs) gives a negative loss factor, refused
+    assert main(["report", str(a), "--velocity-delay", "3e-4", "--format", "csv",
                  "--out", str(out)]) == 0
     said = capsys.readouterr().out
-    assert ("note: a_fill50.csv: --velocity-delay (vibrometer delay 100 µs) overrides column "
+    assert ("note: a_fill50.csv: --velocity-delay (vibrometer delay 300 µs) overrides column "
             "velocity_delay_us '200'") in said
-    assert "velocity_delay_s=0.0001" in (out / "report.provenance.txt").read_text()
+    assert "velocity_delay_s=0.0003" in (out / "report.provenance.txt").read_text()
 
 
 def test_report_keeps_a_sidecar_specimen_beside_specimen_and_says_so(tmp_path):

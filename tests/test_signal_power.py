@@ -96,10 +96,41 @@ def test_conjugate_convention_pure_mass_and_pure_damper():
     damper = synthesize_shaker_record(mass_kg=0.0, acceleration_amplitude_m_s2=a, frequency_hz=f,
                                       sample_rate_hz=fs, n_periods=40.3,
                                       viscous_damping_n_s_m=c)
-    res = analyze_power(damper.force_n, damper.velocity_m_s, fs)
+    # a pure damper stores no kinetic energy: its loss factor is undefined and refused by
+    # default (test_purely_resistive_load_is_refused_not_reported); the power itself is read
+    # without the mass-like check
+    res = analyze_power(damper.force_n, damper.velocity_m_s, fs, require_mass_like=False)
     assert res.complex_power_w.real == pytest.approx(0.5 * c * v**2, rel=1e-9)
     assert abs(res.complex_power_w.imag) < 1e-9 * res.complex_power_w.real
     assert res.energy_per_cycle_j == pytest.approx(np.pi * c * v**2 / w, rel=1e-9)
+
+
+# seeds whose noise leaves Im(P_c) > 0 (others give Im < 0: refused as an inverted channel)
+@pytest.mark.parametrize(("snr_db", "seed"), [(None, 0), (40.0, 0), (40.0, 2), (40.0, 5)])
+def test_purely_resistive_load_is_refused_not_reported(snr_db, seed):
+    """Force in phase with velocity (F = c v) has Im(P_c) = 0: no stored kinetic energy, so
+    loss factor Re/Im and SDC are undefined. The round-off (~1e-19 W) or noise left in Im was
+    taken as E: loss factor 2.3e15, SDC 1.5e16 (noise-free), 1e4-3e5 at 40 dB, reported with
+    exit 0. Noise-free it is below 1e-8 |P_c|; with noise, within 3 block standard errors."""
+    fs, f, c = 10240.0, 80.0, 4.0
+    rec = synthesize_shaker_record(mass_kg=0.0, acceleration_amplitude_m_s2=3 * G,
+                                   frequency_hz=f, sample_rate_hz=fs, n_periods=40.3,
+                                   viscous_damping_n_s_m=c)
+    force, velocity = rec.force_n, rec.velocity_m_s
+    if snr_db is not None:
+        rng = np.random.default_rng(seed)
+        noise = 10 ** (-snr_db / 20)
+        force = force + noise * np.std(force) * rng.standard_normal(force.size)
+        velocity = velocity + noise * np.std(velocity) * rng.standard_normal(velocity.size)
+    with pytest.raises(SignalError, match=r"no stored kinetic energy E = Im\(P_c\)/w is resolved"):
+        analyze_power(force, velocity, fs)
+    # the same damper on a mass is resolved: eta = c/(m w) exactly (noise-free)
+    m = 0.2
+    rec = synthesize_shaker_record(mass_kg=m, acceleration_amplitude_m_s2=3 * G,
+                                   frequency_hz=f, sample_rate_hz=fs, n_periods=40.3,
+                                   viscous_damping_n_s_m=c)
+    res = analyze_power(rec.force_n, rec.velocity_m_s, fs)
+    assert res.loss_factor == pytest.approx(c / (m * 2 * np.pi * f), rel=1e-9)
 
 
 def test_spring_like_or_inverted_record_is_refused():
@@ -200,7 +231,11 @@ def test_block_that_is_not_mass_like_gives_nan_with_note():
     # 40 periods in 8 blocks; the first 5 periods are a stiff spring (Im(P) < 0), the rest a
     # mass with a damper, so the record as a whole is mass-like. The first block's loss
     # factor is meaningless: the standard error must be refused, not computed over it.
-    fs, f, m, c, k = 10240.0, 100.0, 0.5, 3.0, 5e5
+    # Block 1 has Im = -k v^2/(2 w) < 0 for any k; with k = 1e5 < m w^2 = 2e5 its reactive
+    # power is smaller than a mass block's, and the whole record's Im(P_c) is 4.3 block
+    # standard errors above zero. (k = 5e5 left it 2.2 standard errors above zero, since
+    # refused as not resolved: test_purely_resistive_load_is_refused_not_reported.)
+    fs, f, m, c, k = 10240.0, 100.0, 0.5, 3.0, 1e5
     w = 2 * np.pi * f
     t = np.arange(int(40 * fs / f)) / fs
     v = 0.01 * np.sin(w * t)

@@ -320,6 +320,14 @@ def test_stored_units_are_those_the_field_names_promise():
             promised = _promised_unit(name)
             if promised is not None:
                 assert unit == promised, f"{name}: stored unit {unit!r}, name says {promised!r}"
+    # a quantity stored by both (loss factor, SDC, ...) has one unit: analyses wrote "1" for
+    # the ratios DEM runs write as "-"
+    for name in set(ANALYSIS_UNITS) & set(DEM_UNITS):
+        assert ANALYSIS_UNITS[name] == DEM_UNITS[name], name
+    from pidcore.constants import RATIO_UNIT
+
+    for name in ("loss_factor", "sdc", "sdc_stderr", "loss_factor_stderr", "damping_ratio"):
+        assert ANALYSIS_UNITS[name] == RATIO_UNIT
 
 
 def test_an_undefined_damping_ratio_is_stored_as_null_with_its_reason_not_as_nan(tmp_path):
@@ -348,3 +356,68 @@ def test_an_undefined_damping_ratio_is_stored_as_null_with_its_reason_not_as_nan
     floats = {k: v for k, v in values.items()
               if isinstance(v, (float, np.floating)) and k not in nulls}
     assert floats and all(math.isfinite(v) for v in floats.values()), floats
+
+
+def test_stored_analysis_arrays_carry_their_units(tmp_path):
+    """The harmonic phasors of a saved analysis were written with ``unit`` '' (only the record
+    fields' units were passed to the store): a reader of /analyses/<key>/arrays could not tell
+    N from kN. Each array's unit must be the one its name promises, and the phasors must be
+    in it: 1/2 sum F V* of the stored arrays gives back the stored complex power in W."""
+    from pathlib import Path
+
+    from pidcore.cli import main
+
+    repo = Path(__file__).resolve().parents[1]
+    export = repo / "data_samples" / "exports" / "synthetic_f500Hz_a1g_fill50_acrylic.csv"
+    store = tmp_path / "s.h5"
+    assert main(["analyze", str(export), "--store", str(store), "--velocity-delay", "5e-5"]) == 0
+    with h5py.File(store, "r") as h5:
+        (group,) = h5["analyses"].values()
+        arrays = group["arrays"]
+        units = {name: arrays[name].attrs["unit"] for name in arrays}
+        listed = dict(group["units"].attrs)
+        force = arrays["force_phasors_n"][()]
+        velocity = arrays["velocity_phasors_m_s"][()]
+        record = dict(group["record"].attrs)
+    assert units == {"harmonics": "1", "force_phasors_n": "N", "velocity_phasors_m_s": "m/s"}
+    assert {k: listed[k] for k in units} == units  # the units group names them too
+    power = 0.5 * np.sum(force * np.conj(velocity))
+    # same numbers, summed in another order: round-off only
+    assert power.real == pytest.approx(record["complex_power_real_w"], rel=1e-12)
+    assert power.imag == pytest.approx(record["complex_power_imag_w"], rel=1e-12)
+
+
+def test_a_stored_measurement_holds_the_file_as_read_whatever_the_invert_option(tmp_path):
+    """--invert NAME negated the channel in the measurement that was then stored under the
+    file's SHA-256, unmarked: the store's "raw channels" were not the file's, a re-analysis of
+    the stored measurement with the saved parameters (invert again) flipped it twice, and
+    which sign the store kept depended on which analysis of the file came first. The stored
+    channels are the file's; the inversion is in the analysis' parameters."""
+    from pidcore.cli import main
+
+    t = np.arange(25_600) / 25_600.0
+    w = 2 * np.pi * 200.0
+    v = 0.04 * np.sin(w * t)
+    force = 0.1 * 0.04 * w * np.cos(w * t) + 5.0 * v  # mass 0.1 kg and a 5 N s/m damper
+    path = tmp_path / "inverted_velocity.csv"
+    np.savetxt(path, np.column_stack([t, force, -v]), delimiter=",", comments="",
+               header="Time [s],Force [N],Velocity [m/s]", fmt="%.17g")
+    in_file = np.loadtxt(path, delimiter=",", skiprows=1)[:, 2]
+    store = tmp_path / "s.h5"
+    assert main(["analyze", str(path), "--invert", "Velocity", "--store", str(store)]) == 0
+    with h5py.File(store, "r") as h5:
+        (group,) = h5["measurements"].values()
+        velocity = {ch.attrs["name"]: ch[()] for ch in group["channels"].values()}["Velocity"]
+        (analysis,) = h5["analyses"].values()
+        sdc = analysis["record"].attrs["sdc"]
+    np.testing.assert_array_equal(velocity, in_file)  # the file's samples, bit for bit
+    # the stored measurement analysed with the saved parameters gives the saved result
+    # (noise-free: the same numbers, round-off only)
+    entry = Store(store).get_analysis(Store(store).list_analyses()["key"][0])
+    from pidcore.measure import AnalysisOptions, analyze_measurement
+
+    (key,) = Store(store).list_measurements()["key"]
+    again = analyze_measurement(Store(store).get_measurement(key),
+                                AnalysisOptions(invert=tuple(entry.parameters["invert"])))
+    assert again.analysis.sdc == pytest.approx(sdc, rel=1e-12)
+    assert sdc == pytest.approx(2 * np.pi * 5.0 / (0.1 * w), rel=1e-9)

@@ -29,9 +29,11 @@ from ..compare.loadcase import (
     AUTO_CHANNEL,
     FREE_TEXT_COLUMNS,
     NO_CHANNEL,  # noqa: F401 - the pages read it from here
+    SETTINGS_COLUMN_LABELS,
 )
 from ..constants import PARTICLE_MATERIALS
 from ..errors import ParameterError, PidcoreError
+from ..units import display_number
 
 if TYPE_CHECKING:
     from ..compare import LoadCase
@@ -42,21 +44,9 @@ if TYPE_CHECKING:
 # readers detect) are the sidecar's words too (pidcore.compare.loadcase): one definition.
 
 #: Per-file settings: column shown in the app -> column of the CSV template / uploaded table
-#: (:data:`pidcore.compare.loadcase.SETTINGS_COLUMNS`, the sidecar's columns of the CLI).
-FILE_TABLE_COLUMNS: dict[str, str] = {
-    "file": "file",
-    "fill [%]": "fill_percent",
-    "material": "material",
-    "direction": "direction",
-    "specimen": "specimen",
-    "vibrometer delay [µs]": "velocity_delay_us",
-    "mass below gauge [g]": "mass_below_gauge_g",
-    "baseline loss factor [-]": "baseline_loss_factor",
-    "force channel": "force",
-    "velocity channel": "velocity",
-    "acceleration channel": "acceleration",
-    "inverted channels": "invert",
-}
+#: (:data:`pidcore.compare.loadcase.SETTINGS_COLUMNS`, the sidecar's columns of the CLI, which
+#: reads these labels too: one table for both).
+FILE_TABLE_COLUMNS: dict[str, str] = SETTINGS_COLUMN_LABELS
 _NUMERIC = ("fill [%]", "vibrometer delay [µs]", "mass below gauge [g]",
             "baseline loss factor [-]")
 
@@ -367,7 +357,7 @@ def read_settings_table(name: str, data: bytes,
     number, material (one of ``materials``) or direction.
     """
     from ..compare.loadcase import (
-        NUMERIC_COLUMNS,
+        NUMERIC_HEADERS,
         normalize_direction,
         normalize_material,
         settings_table,
@@ -377,8 +367,7 @@ def read_settings_table(name: str, data: bytes,
     from ..tables import line_where, read_text_table
 
     try:
-        raw = read_text_table(data, name, numeric=(
-            *NUMERIC_COLUMNS, *(k.lower() for k in _NUMERIC)))
+        raw = read_text_table(data, name, numeric=NUMERIC_HEADERS)
     except PidcoreError as exc:
         raise ParameterError(str(exc)) from None
     by_name = {k.lower(): v for k, v in FILE_TABLE_COLUMNS.items()}
@@ -716,10 +705,12 @@ def results_table(files: Sequence[AnalysedFile]) -> pd.DataFrame:
 
 
 def format_sdc(sdc: float, stderr: float) -> str:
-    """SDC with its standard error as shown, e.g. ``'0.1856 ± 0.0042'``; ``'—'`` for none."""
+    """SDC with its standard error as shown, e.g. ``'0.1856 ± 0.0042'``, ``'5.09e-05 ±
+    4.4e-05'`` (:func:`pidcore.units.display_number`); ``'—'`` for none."""
     if not math.isfinite(sdc):
         return "—"
-    return f"{sdc:.4f} ± {stderr:.4f}" if math.isfinite(stderr) else f"{sdc:.4f}"
+    shown = display_number(sdc)
+    return f"{shown} ± {display_number(stderr)}" if math.isfinite(stderr) else shown
 
 
 @dataclass(frozen=True)

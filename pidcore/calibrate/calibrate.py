@@ -140,7 +140,8 @@ class CalibrationResult:
         exactly the fitted parameters and the fixed ones (from their definitions,
         :attr:`ParameterSpec.unit`)."""
         out = {"frequency_hz": "Hz", "acceleration_g": "g", "fill_percent": "%",
-               "measured": "-", "predicted": "-", "low95": "-", "high95": "-",
+               "measured": "-", "measured_stderr": "-", "predicted": "-", "low95": "-",
+               "high95": "-", "low95_without_stderr": "-", "high95_without_stderr": "-",
                "rms_in_sample": "-", "loo_rms": "-", "energy_per_cycle_per_cell_start_j": "J",
                "energy_per_cycle_per_cell_calibrated_j": "J", "low95_j": "J", "high95_j": "J",
                "wall_s": "s"}
@@ -152,7 +153,8 @@ class CalibrationResult:
 
 def _public(row: dict) -> dict:
     keys = ("frequency_hz", "acceleration_g", "fill_percent", "material", "measured",
-            "predicted", "low95", "high95")
+            "measured_stderr", "predicted", "low95", "high95", "low95_without_stderr",
+            "high95_without_stderr")
     return {k: row[k] for k in keys}
 
 
@@ -344,7 +346,12 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: Sequence[str],
         fixed[DISCREPANCY] = float(discrepancy)
     model = Model(tuple(specs), surrogates, tuple(points), fixed, discrepancy_floor)
     everything = list(range(len(points)))
-    samples = sample_posterior(model, everything, seed=posterior_seed, method=method)
+    posterior = sample_posterior(model, everything, seed=posterior_seed, method=method)
+    samples = posterior.samples
+    if posterior.fallback:
+        notes.append(f"--method {method}: {posterior.fallback}; the posterior was sampled "
+                     "with emcee instead of the grid")
+    fold_fallbacks = []
     parameters, correlations = summarise(specs, samples)
     notes += bound_notes(specs, samples)
     rng = np.random.default_rng(posterior_seed + 1)
@@ -364,14 +371,21 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: Sequence[str],
                 others = [j for j in everything if j != i]
                 fold = sample_posterior(model, others, seed=posterior_seed + 1 + i,
                                         method=method)
-                loo.append(_row(points[i], predictive(model, fold, i, rng=rng)))
+                if fold.fallback:
+                    fold_fallbacks.append(points[i].label())
+                loo.append(_row(points[i], predictive(model, fold.samples, i, rng=rng)))
                 if bar is not None:
                     bar.update(1)
         finally:
             if bar is not None:
                 bar.close()
+    if fold_fallbacks:
+        notes.append(f"--method {method}: the grid could not box the posterior of "
+                     f"{len(fold_fallbacks)} of {len(everything)} leave-one-out fold(s) "
+                     f"(without {', '.join(fold_fallbacks)}); those were sampled with emcee")
     settings = {"fit": list(fit), "priors": list(priors), "cells": cells, "seed": seed,
                 "steady_cycles": steady_cycles, "design_size": n_design, "method": method,
+                "method_used": posterior.method,
                 "discrepancy_fixed": discrepancy, "discrepancy_floor": discrepancy_floor,
                 "cross_validate": cross_validate, "store": str(store_path)}
     return CalibrationResult(specimen=specimen, specs=specs, samples=samples, parameters=parameters,

@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from ..records import json_safe
+from ..units import display_number
 from .calibrate import CalibrationResult
 
 SPECIMEN_FILE = "calibrated_specimen.toml"
@@ -39,12 +40,16 @@ def specimen_text(result: CalibrationResult) -> str:
 
 
 def _table_rows(rows: list[dict]) -> list[list[str]]:
+    def sdc(value: float) -> str:  # three decimals; a small SDC keeps its digits, not 0.000
+        return display_number(value, decimals=3)
+
     out = []
     for r in rows:
+        error = r["predicted"] - r["measured"]
         out.append([f"{r['frequency_hz']:g}", f"{r['acceleration_g']:g}",
-                    f"{r['fill_percent']:g}", f"{r['measured']:.3f}", f"{r['predicted']:.3f}",
-                    f"{r['low95']:.3f} .. {r['high95']:.3f}",
-                    f"{r['predicted'] - r['measured']:+.3f}",
+                    f"{r['fill_percent']:g}", sdc(r["measured"]), sdc(r["predicted"]),
+                    f"{sdc(r['low95'])} .. {sdc(r['high95'])}",
+                    ("+" if error >= 0 else "") + sdc(error),
                     "yes" if r["low95"] <= r["measured"] <= r["high95"] else "**no**"])
     return out
 
@@ -60,6 +65,7 @@ def summary_markdown(result: CalibrationResult) -> str:
                  f"{len(result.predictions)} measured load cases; "
                  f"{result.settings['cells']} cells per DEM run, design of "
                  f"{result.settings['design_size']} point(s); "
+                 f"posterior by {result.settings['method_used']}; "
                  f"runs computed {result.runs['computed']}, cached {result.runs['cached']}; "
                  f"{result.wall_s:.1f} s.")
     lines += ["", "| parameter | median | 95 % interval | prior bounds |", "|---|---|---|---|"]

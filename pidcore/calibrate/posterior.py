@@ -18,6 +18,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -104,7 +105,12 @@ class Model:
 
 
 class GridUnresolved(ParameterError):
-    """The grid posterior could not find a box that resolves the posterior."""
+    """The grid posterior could not find a box that resolves the posterior; ``reason`` says
+    why (the message adds what to do)."""
+
+    def __init__(self, reason: str):
+        self.reason = reason
+        super().__init__(f"calibration: {reason}; use --method emcee")
 
 
 def _to_unit(spec: ParameterSpec, x: np.ndarray) -> np.ndarray:
@@ -169,9 +175,8 @@ def sample_grid(model: Model, indices: Sequence[int], *, rng: np.random.Generato
             break
         if attempt == GRID_MAX_PASSES - 1:
             raise GridUnresolved(
-                f"calibration: the grid posterior did not settle in {GRID_MAX_PASSES} passes "
-                "(a posterior much narrower than the prior, or several modes); use "
-                "--method emcee")
+                f"the grid posterior did not settle in {GRID_MAX_PASSES} passes (a posterior "
+                "much narrower than the prior, or several modes)")
         lo, hi = new_lo, new_hi
     # each node stands for its cell [u - cell/2, u + cell/2] cut to [lo, hi]: a node on an
     # edge (a prior bound) holds half a cell per dimension, and its samples are drawn inside
@@ -222,24 +227,44 @@ def sample_emcee(model: Model, indices: Sequence[int], *, rng: np.random.Generat
     return out
 
 
+class PosteriorSamples(NamedTuple):
+    """Result of :func:`sample_posterior`: equally weighted ``samples`` (n_samples, n_specs),
+    the ``method`` that drew them (``"grid"`` or ``"emcee"``) and, where ``auto`` fell back
+    from the grid to emcee, ``fallback``: why (else None)."""
+
+    samples: np.ndarray
+    method: str
+    fallback: str | None = None
+
+
 def sample_posterior(model: Model, indices: Sequence[int], *, seed: int = 0,
-                     method: str = "auto", n_samples: int = N_SAMPLES) -> np.ndarray:
-    """Posterior samples (n_samples, n_specs) given the measured points ``indices``."""
+                     method: str = "auto", n_samples: int = N_SAMPLES) -> PosteriorSamples:
+    """Posterior samples given the measured points ``indices``.
+
+    ``method``: ``"grid"`` (at most GRID_MAX_DIMENSIONS fitted quantities), ``"emcee"``, or
+    ``"auto"``: the grid where it applies, emcee where there are more quantities or where the
+    grid cannot box the posterior (the result's ``fallback`` says why, so that it is shown).
+    """
     rng = np.random.default_rng(seed)
+    fallback = None
     if method == "auto":
         if len(model.specs) <= GRID_MAX_DIMENSIONS:
             try:
-                return sample_grid(model, indices, rng=rng, n_samples=n_samples)
-            except GridUnresolved:  # a posterior the grid cannot box: the sampler can
+                return PosteriorSamples(sample_grid(model, indices, rng=rng,
+                                                    n_samples=n_samples), "grid")
+            except GridUnresolved as exc:  # a posterior the grid cannot box: the sampler can
                 rng = np.random.default_rng(seed)
+                fallback = exc.reason
         method = "emcee"
     if method == "grid":
         if len(model.specs) > GRID_MAX_DIMENSIONS:
             raise ParameterError(f"--method grid: at most {GRID_MAX_DIMENSIONS} fitted "
                                  f"quantities, got {len(model.specs)}")
-        return sample_grid(model, indices, rng=rng, n_samples=n_samples)
+        return PosteriorSamples(sample_grid(model, indices, rng=rng, n_samples=n_samples),
+                                "grid")
     if method == "emcee":
-        return sample_emcee(model, indices, rng=rng, n_samples=n_samples)
+        return PosteriorSamples(sample_emcee(model, indices, rng=rng, n_samples=n_samples),
+                                "emcee", fallback)
     raise ParameterError(f"--method: expected auto, grid or emcee, got {method!r}")
 
 
@@ -250,14 +275,24 @@ def predictive(model: Model, samples: np.ndarray, index: int, *,
     / ``high95``, the posterior-predictive 95 % band of a measurement there (parameters,
     surrogate variance, discrepancy, floor and the point's own ``sdc_stderr``: what a
     measured value is checked against); ``predicted_low95`` / ``predicted_high95``: the 95 %
-    band of the model's SDC alone."""
+    band of the model's SDC alone; ``low95_without_stderr`` / ``high95_without_stderr``: the
+    band of a measurement without measurement error (all of the above but ``sdc_stderr``),
+    which :meth:`pidcore.calibrate.prediction.CalibratedPrediction.band` widens by another
+    measurement's own stderr."""
     sdc, variance = model.predict(samples, index)
-    draws = sdc + rng.standard_normal(sdc.shape) * np.sqrt(variance)
+    normal = rng.standard_normal(sdc.shape)
+    draws = sdc + normal * np.sqrt(variance)
     # an SDC is >= 0 (dissipation): the normal error model's tail below 0 is cut there
     low, high = np.percentile(np.maximum(draws, 0.0), [2.5, 97.5])
+    # the same band without the point's own measurement error (the same normal draws): what
+    # a report widens by another measurement's stderr at this load case
+    stderr = model.points[index].sdc_stderr
+    error_free = sdc + normal * np.sqrt(np.maximum(variance - stderr**2, 0.0))
+    low0, high0 = np.percentile(np.maximum(error_free, 0.0), [2.5, 97.5])
     return {"predicted": float(np.median(sdc)), "low95": float(low), "high95": float(high),
             "predicted_low95": float(np.percentile(sdc, 2.5)),
-            "predicted_high95": float(np.percentile(sdc, 97.5))}
+            "predicted_high95": float(np.percentile(sdc, 97.5)),
+            "low95_without_stderr": float(low0), "high95_without_stderr": float(high0)}
 
 
 def summarise(specs: Sequence[ParameterSpec], samples: np.ndarray) -> tuple[dict, list]:

@@ -21,6 +21,10 @@ from ..loadcase import LoadCase
 _REQUIRED = ("frequency_hz", "acceleration_g", "fill_percent", "predicted", "low95", "high95")
 
 
+#: Two-sided 95 % quantile of the normal distribution (a measurement's stderr -> half-width).
+Z95 = 1.959963984540054
+
+
 @dataclass(frozen=True)
 class CalibratedPrediction:
     """The calibrated DEM's prediction at one load case.
@@ -33,9 +37,15 @@ class CalibratedPrediction:
         Posterior median of the calibrated model's Eq. 11 SDC [-] (the model's mean; the
         band is that of a measurement).
     low95, high95 : float
-        Bounds of the 95 % posterior-predictive band [-].
+        Bounds of the 95 % posterior-predictive band [-] of a measurement with the fitted
+        point's standard error (:attr:`measured_stderr`).
     measured : float
         SDC the calibration was fitted to at this load case [-] (NaN if not stated).
+    measured_stderr : float
+        Standard error of that SDC [-] (0: none stated; NaN: a calibration.json written
+        before it was kept).
+    low95_without_stderr, high95_without_stderr : float
+        The band without measurement error [-] (NaN in an older calibration.json).
     """
 
     load_case: LoadCase
@@ -43,10 +53,37 @@ class CalibratedPrediction:
     low95: float
     high95: float
     measured: float = math.nan
+    measured_stderr: float = math.nan
+    low95_without_stderr: float = math.nan
+    high95_without_stderr: float = math.nan
 
-    def contains(self, sdc: float) -> bool:
-        """True if ``sdc`` lies inside the 95 % band (bounds included); False for NaN."""
-        return bool(self.low95 <= sdc <= self.high95)
+    def band(self, stderr: float = math.nan) -> tuple[float, float]:
+        """The 95 % band [-] a measurement with standard error ``stderr`` is checked against.
+
+        The fitted point's band (:attr:`low95`, :attr:`high95`) where ``stderr`` is that
+        point's, unknown (NaN) or cannot be told apart (an older calibration.json); else the
+        band without measurement error widened by ``stderr`` (each side's distance from
+        :attr:`sdc` and 1.96 ``stderr`` added in quadrature, as independent normal errors
+        add; cut at 0): a precise new measurement is not judged by the wider band of a noisy
+        fitted one, nor a noisy one by a narrow band.
+        """
+        same = (not math.isfinite(stderr) or not math.isfinite(self.measured_stderr)
+                or not math.isfinite(self.low95_without_stderr)
+                or math.isclose(stderr, self.measured_stderr, rel_tol=1e-9, abs_tol=1e-12))
+        if same:
+            return self.low95, self.high95
+        if stderr < 0:
+            raise ParameterError(f"stderr {stderr!r}: expected a standard error >= 0")
+        width = Z95 * stderr
+        low = self.sdc - math.hypot(self.sdc - self.low95_without_stderr, width)
+        high = self.sdc + math.hypot(self.high95_without_stderr - self.sdc, width)
+        return max(low, 0.0), high
+
+    def contains(self, sdc: float, stderr: float = math.nan) -> bool:
+        """True if ``sdc`` lies inside the 95 % band of a measurement with standard error
+        ``stderr`` (:meth:`band`; bounds included); False for NaN."""
+        low, high = self.band(stderr)
+        return bool(low <= sdc <= high)
 
 
 @dataclass(frozen=True)
@@ -191,6 +228,12 @@ def _number(value, what: str, path: Path) -> float:
     return float(value)
 
 
+def _optional(value, what: str, path: Path) -> float:
+    """An optional number of a prediction row: NaN where absent or null (an older file, or
+    no value), else checked as :func:`_number` checks a required one."""
+    return math.nan if value is None else _number(value, what, path)
+
+
 def load_calibration(path: str | os.PathLike) -> Calibration:
     """Read and check a ``calibration.json`` of ``pidcore calibrate`` (or the ``--out`` folder
     holding it).
@@ -244,9 +287,15 @@ def calibration_from_json(text: str | bytes, source: str | os.PathLike, *,
             raise ParameterError(f"{path}: predictions[{i}]: expected low95 <= predicted <= "
                                  f"high95, got {low} / {sdc} / {high}")
         material = row.get("material") or defaults.COMPARE_DEFAULT_MATERIAL
-        measured = row.get("measured")
-        measured = float(measured) if isinstance(measured, (int, float)) else math.nan
+        measured, measured_stderr, low0, high0 = (
+            _optional(row.get(k), f"predictions[{i}].{k}", path)
+            for k in ("measured", "measured_stderr", "low95_without_stderr",
+                      "high95_without_stderr"))
+        if math.isfinite(low0) != math.isfinite(high0) or (
+                math.isfinite(low0) and not low0 <= high0):
+            raise ParameterError(f"{path}: predictions[{i}]: expected low95_without_stderr <= "
+                                 f"high95_without_stderr, got {low0} / {high0}")
         predictions.append(CalibratedPrediction(LoadCase(f, a, fill, str(material)), sdc, low,
-                                                high, measured))
+                                                high, measured, measured_stderr, low0, high0))
     return Calibration(path=path, parameters=doc["parameters"], predictions=tuple(predictions),
                        specimen_name=specimen_name)

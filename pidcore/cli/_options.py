@@ -106,6 +106,10 @@ def add_measurement_options(p: argparse.ArgumentParser) -> None:
                         "HDF5 and Testlab/pidcore MAT files keep their own rate (noted)")
     g.add_argument("--allow-clipped", action="store_true",
                    help="analyse clipped channels anyway (reported in the output)")
+    g.add_argument("--accept-implausible", action="store_true",
+                   help="keep a result the plausibility checks refuse (a negative loss factor "
+                        "beyond its noise, an SDC above 2 pi: usually a wrong delay, sign or "
+                        "correction), noted with the record")
     g.add_argument("--force-unit", metavar="UNIT", default=None,
                    help="unit of the force channel's values (N, kN, lbf, ...) when the file "
                         "gives none or a wrong one")
@@ -161,6 +165,8 @@ _FLAG_OF_KEYWORD = (
     ("choose one with key=", "choose one with --key NAME"),
     ("pass allow_clipped=True", "pass --allow-clipped"),
     ("allow_clipped", "--allow-clipped"),
+    ("pass accept_implausible=True", "pass --accept-implausible"),
+    ("accept_implausible", "--accept-implausible"),
     ("key=", "--key "),
     ("velocity_delay_s", "--velocity-delay"),
     ("mass_below_gauge_kg", "--mass-below-gauge"),

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 from pathlib import Path
 
@@ -69,21 +70,29 @@ def _stated(args: argparse.Namespace) -> tuple[list, list]:
     """What each path states about its load case (None: no fill stated) and how it is analysed
     (:class:`~pidcore.file_settings.FileSettings`), resolved before any analysis so that a bad
     sidecar or option is refused at once."""
+    from ..compare.loadcase import refuse_fill_of_no_particle
     from ..file_settings import resolve_files
 
-    specimen_material = None
+    specimen = specimen_material = None
     if args.specimen is not None:
         from ..specimen import load_specimen
 
-        specimen_material = load_specimen(args.specimen).particles.material
+        specimen = load_specimen(args.specimen)
+        specimen_material = specimen.particles.material
     # (a missing file is named by its analysis)
-    return resolve_files(args.paths, options=analysis_options(args), given=given_options(args),
-                         fill_percent=args.fill, material=args.material,
-                         direction=args.direction, sidecar=args.sidecar,
-                         specimen_material=specimen_material, fill_required=False)
+    stated, settings = resolve_files(
+        args.paths, options=analysis_options(args), given=given_options(args),
+        fill_percent=args.fill, material=args.material, direction=args.direction,
+        sidecar=args.sidecar, specimen_material=specimen_material, fill_required=False)
+    for path, st, fs in zip(args.paths, stated, settings, strict=True):
+        # a sidecar's specimen is only a name: its cell is not known
+        if st is not None and (specimen is not None or not fs.specimen):
+            refuse_fill_of_no_particle(st, display_path(Path(path).name), specimen)
+    return stated, settings
 
 
 def _run(args: argparse.Namespace) -> int:
+    from ..compare.plausibility import refuse_implausible
     from ..loadcase import refuse_identical_contents_stating_apart
     from ..store import Store
 
@@ -98,8 +107,11 @@ def _run(args: argparse.Namespace) -> int:
     results: list = []
     try:
         # Analyse everything before writing anything: one bad file leaves the store untouched.
-        results = [analyze_with_settings(path, fs, key=args.key)
-                   for path, fs in zip(args.paths, settings, strict=True)]
+        results = refuse_implausible(
+            [analyze_with_settings(path, fs, key=args.key)
+             for path, fs in zip(args.paths, settings, strict=True)],
+            [display_path(Path(path).name) for path in args.paths],
+            accept=args.accept_implausible)
         cases = [st.load_case(r.analysis.frequency_hz, r.analysis.acceleration_g)
                  if st is not None else None for r, st in zip(results, stated, strict=True)]
         # one content is one measurement: two statements (load case, specimen, settings) about
@@ -174,20 +186,30 @@ def _saved(results: list) -> str:
                                "given: one record)" if same > 0 else "")
 
 
+def _significant(value: float | None, digits: int, *, keep_zeros: bool = True) -> str:
+    """``digits`` significant digits (trailing zeros kept: "5.0000" is five), "n/a" for none
+    or NaN: fixed decimals showed a damping ratio of 4e-6 as 0.00000, a loss factor of 8.1e-6
+    as 0.000008 (one digit) and a missing standard error as nan."""
+    if value is None or not math.isfinite(value):
+        return "n/a"
+    return f"{value:#.{digits}g}" if keep_zeros else f"{value:.{digits}g}"
+
+
 def format_table(results: list) -> str:
     # the whole file name: a cut one may no longer say which load case a row is
     names = [Path(r.analysis.source).name for r in results]
     width = max([40, *map(len, names)])
     header = (f"{'source':<{width}} {'frequency [Hz]':>14} {'accel. [g]':>10} "
-              f"{'loss factor [-]':>15} {'SDC [-]':>9} {'± SE [-]':>9} {'zeta [-]':>9} "
+              f"{'loss factor [-]':>15} {'SDC [-]':>12} {'± SE [-]':>9} {'zeta [-]':>10} "
               f"{'dE/cycle [J]':>12}")
     lines = [header, "-" * len(header)]
     for r, name in zip(results, names, strict=True):
         a = r.analysis
-        zeta = "n/a" if a.damping_ratio is None else f"{a.damping_ratio:9.5f}"
-        lines.append(f"{name:<{width}} {a.frequency_hz:14.4f} {a.acceleration_g:10.4f} "
-                     f"{a.loss_factor:15.6f} {a.sdc:9.5f} {a.sdc_stderr:9.5f} {zeta:>9} "
-                     f"{a.energy_per_cycle_j:12.4e}")
+        lines.append(f"{name:<{width}} {a.frequency_hz:14.4f} "
+                     f"{_significant(a.acceleration_g, 5):>10} "
+                     f"{_significant(a.loss_factor, 6):>15} {_significant(a.sdc, 6):>12} "
+                     f"{_significant(a.sdc_stderr, 2, keep_zeros=False):>9} "
+                     f"{_significant(a.damping_ratio, 4):>10} {a.energy_per_cycle_j:12.4e}")
         for note in r.notes:
             lines.append(f"    note: {note}")
     return "\n".join(lines)

@@ -92,7 +92,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         f"{defaults.MODEL_PARTICLE_MATERIAL}); --table store: the runs' own")
     d.add_argument("--vibrated-mass", metavar="KG", type=_positive_float, default=None,
                    help="explicit m_c, kg (overrides --mass-convention; --table paper only: "
-                        "stored runs divided their SDC by their own m_c)")
+                        "stored runs divided their SDC by their own m_c; more than 100 x "
+                        "outside the paper coupon's m_c is refused as a unit slip)")
     d.add_argument("--area", metavar="M2", type=_positive_float, default=None,
                    help="coupon area for c_eq per area, m^2 (default: the paper's 0.1 m x "
                         "0.1 m; required for runs of another specimen, whose file has no "
@@ -176,6 +177,10 @@ def run_damper(args: argparse.Namespace) -> int:
                     f"{option} {given}: the DEM runs in {args.store} are {', '.join(stated)}"
                     f"{why}; leave {option} out or select runs with --where")
     if args.vibrated_mass is not None:
+        from ..model.damper import check_vibrated_mass
+
+        check_vibrated_mass(args.vibrated_mass, model.axes[0],
+                            args.material or defaults.MODEL_PARTICLE_MATERIAL, "--vibrated-mass")
         mass = args.vibrated_mass
         mass_text = f"{mass} kg (given)"
     elif runs is not None:

@@ -10,6 +10,7 @@ import sys
 from pathlib import Path
 
 from .. import interrupt
+from ..errors import PidcoreError
 from ..report.render import folder_identity, format_cell
 from ..report.table import ALIGNMENT_COLUMN
 from ._options import (
@@ -18,6 +19,7 @@ from ._options import (
     add_store_option,
     analysis_options,
     given_options,
+    with_cli_flags,
 )
 
 #: Columns of the short table printed on stdout.
@@ -76,6 +78,16 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    try:
+        return _run(args)
+    except PidcoreError as exc:
+        # the analysis' errors name options by library keyword (n_harmonics): the flags
+        if not getattr(exc, "names_analysis_options", False):
+            raise
+        raise type(exc)(with_cli_flags(str(exc))) from None
+
+
+def _run(args: argparse.Namespace) -> int:
     from ..report.pipeline import make_report
     from ..specimen import load_specimen
 
@@ -87,7 +99,8 @@ def run(args: argparse.Namespace) -> int:
             formats=args.format, fill_percent=args.fill, material=args.material,
             direction=args.direction, sidecar=args.sidecar, options=analysis_options(args),
             options_given=given_options(args),
-            specimen=specimen, pool=args.pool, calibration=args.calibration)
+            specimen=specimen, pool=args.pool, calibration=args.calibration,
+            accept_implausible=args.accept_implausible)
         print(short_table(result.table))
         for note in result.notes:
             print(f"note: {note}")

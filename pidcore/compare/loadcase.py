@@ -81,6 +81,28 @@ SETTINGS_COLUMNS: tuple[str, ...] = (*SIDECAR_COLUMNS, SPECIMEN_COLUMN,
 #: Columns holding numbers (a ``;``-separated table may write them with a decimal comma).
 NUMERIC_COLUMNS: tuple[str, ...] = ("fill_percent", "velocity_delay_us", "mass_below_gauge_g",
                                     "baseline_loss_factor")
+#: The app's labels of the settings columns (its settings grid shows them, and an uploaded
+#: table may use them) -> the settings table's columns. The CLI's sidecar reads them too, so
+#: one table reads the same in both (a table typed after the app's grid was refused by the CLI).
+SETTINGS_COLUMN_LABELS: dict[str, str] = {
+    "file": "file",
+    "fill [%]": "fill_percent",
+    "material": "material",
+    "direction": "direction",
+    "specimen": "specimen",
+    "vibrometer delay [µs]": "velocity_delay_us",
+    "mass below gauge [g]": "mass_below_gauge_g",
+    "baseline loss factor [-]": "baseline_loss_factor",
+    "force channel": "force",
+    "velocity channel": "velocity",
+    "acceleration channel": "acceleration",
+    "inverted channels": "invert",
+}
+#: Numeric columns by either name, as :func:`pidcore.tables.read_text_table` takes them.
+NUMERIC_HEADERS: tuple[str, ...] = (
+    *NUMERIC_COLUMNS,
+    *(label.lower() for label, column in SETTINGS_COLUMN_LABELS.items()
+      if column in NUMERIC_COLUMNS))
 #: Channel cell meaning "the channel the readers detect" (the app's default, and its template's).
 AUTO_CHANNEL = "(auto)"
 #: Channel cell meaning "no channel named" (the app's choice for an unused acceleration): as
@@ -129,6 +151,35 @@ class StatedLoadCase:
         """The full load case with the measured frequency (Hz) and acceleration (g)."""
         return LoadCase(float(frequency_hz), float(acceleration_g), self.fill_percent,
                         self.material, self.direction)
+
+
+def refuse_fill_of_no_particle(stated: StatedLoadCase, what: str, specimen=None) -> None:
+    """Refuse a stated fill that puts no particle in a cell of the specimen tested.
+
+    ``specimen``: the :class:`~pidcore.specimen.Specimen` (default: the paper's coupon with
+    the stated particles; nothing is checked for a material without a table row, whose cell
+    is not known). The rounding is the DEM's (:func:`pidcore.specimen.particles_for_fill`,
+    100 % = the cell's capacity), so a fill saved here is one the model can be run at: a
+    packing ratio typed as a fraction (0.5 for 50 %) is refused, not stored as a load case
+    no comparison can ever place.
+    """
+    from ..errors import ParameterError
+    from ..specimen import paper_specimen, particles_for_fill
+
+    if specimen is None:
+        if stated.material not in PARTICLE_MATERIALS:
+            return
+        specimen = paper_specimen(stated.material)
+    capacity = specimen.capacity_per_cell()
+    try:
+        particles_for_fill(stated.fill_percent, capacity)
+    except ParameterError as exc:
+        source = next((part.split(": ", 1)[1] for part in stated.origin.split("; ")
+                       if part.startswith("fill: ")), "stated")
+        hint = (f"; was {stated.fill_percent:g} meant as {stated.fill_percent * 100:g} %?"
+                if stated.fill_percent <= 1.0 else "")
+        raise ParameterError(f"{what} ({'--fill' if source == 'option' else source}): {exc} "
+                             f"({specimen.name}'s cell capacity{hint})") from None
 
 
 def _material_tokens(stem: str, names) -> set[str]:
@@ -258,7 +309,7 @@ def read_sidecar(path: str | Path) -> pd.DataFrame:
     if not path.is_file():
         raise LoadCaseError(f"{path}: sidecar table not found")
     try:
-        return settings_table(read_text_table_file(path, numeric=NUMERIC_COLUMNS), str(path))
+        return settings_table(read_text_table_file(path, numeric=NUMERIC_HEADERS), str(path))
     except InputFileError as exc:
         raise LoadCaseError(str(exc)) from None
 
@@ -266,7 +317,16 @@ def read_sidecar(path: str | Path) -> pd.DataFrame:
 def settings_table(raw: pd.DataFrame, where: str) -> pd.DataFrame:
     """A table read by :func:`pidcore.tables.read_text_table` as a settings table (the
     sidecar's and the app's): the checks of :func:`read_sidecar`, columns
-    :data:`SETTINGS_COLUMNS` in order."""
+    :data:`SETTINGS_COLUMNS` in order. A column may be named by its app label
+    (:data:`SETTINGS_COLUMN_LABELS`, any case); one column under both names is refused."""
+    by_label = {label.lower(): column for label, column in SETTINGS_COLUMN_LABELS.items()}
+    named = [by_label.get(str(c).lower(), c) for c in raw.columns]
+    for column in set(named):
+        spelt = [str(c) for c, n in zip(raw.columns, named, strict=True) if n == column]
+        if len(spelt) > 1:
+            raise LoadCaseError(f"{where}: column {column!r} given more than once (as "
+                                f"{' and '.join(map(repr, spelt))}); expected it once")
+    raw = raw.set_axis(named, axis=1)
     if "file" not in raw.columns:
         found = ", ".join(map(repr, raw.columns)) or "none"
         raise LoadCaseError(f"{where}: settings table lacks column 'file' (found {found}); "
@@ -334,6 +394,27 @@ def _ends_with(parts: tuple[str, ...], cell: list[str]) -> bool:
     return len(cell) <= len(parts) and list(parts[len(parts) - len(cell):]) == cell
 
 
+def name_spellings(name: str) -> tuple[str, ...]:
+    """``name`` as the file system gives it, and, where its bytes are not UTF-8 (a file named
+    on Windows, ``Prüfung.uff`` in cp1252, copied to Linux: Python holds the byte 0xFC as a
+    lone surrogate), as cp1252 reads them: the spelling a settings table saved by a Windows
+    spreadsheet (read as cp1252, :mod:`pidcore.tables`) has in its ``file`` cell."""
+    import os
+
+    spellings = [name]
+    raw = os.fsencode(name)
+    try:
+        raw.decode("utf-8")
+    except UnicodeDecodeError:
+        for encoding in ("cp1252", "latin-1"):
+            try:
+                spellings.append(raw.decode(encoding))
+                break
+            except UnicodeDecodeError:  # cp1252 leaves 5 bytes undefined; latin-1 none
+                continue
+    return tuple(spellings)
+
+
 def find_row(table: pd.DataFrame, path: str | Path, shown: str) -> int | None:
     """Position of the row of file ``path`` in a settings ``table`` (None: no row).
 
@@ -345,8 +426,10 @@ def find_row(table: pd.DataFrame, path: str | Path, shown: str) -> int | None:
     """
     path = Path(path)
     files = [str(f) for f in table["file"]]
+    names = name_spellings(path.name)
     for same in (lambda a, b: a == b, lambda a, b: a.casefold() == b.casefold()):
-        found = [i for i, f in enumerate(files) if same(base_name(f), path.name)]
+        found = [i for i, f in enumerate(files)
+                 if any(same(base_name(f), name) for name in names)]
         if len(found) > 1:
             # one name under several folders: the row whose folders end the file's path
             parts = path.absolute().parts

@@ -91,3 +91,56 @@ def check_analysis(analysis) -> tuple[PlausibilityWarning, ...]:
             "a wrong vibrometer delay (a delay too large turns the force-velocity phase and "
             "inflates Re P), or a mass-below-gauge correction close to the whole moving mass"))
     return tuple(out)
+
+
+#: Standard errors within which a negative loss factor is read as zero damping (an empty
+#: coupon's loss factor of 1e-4 measured as -2e-5 +- 1e-5), not as a set-up error.
+NEGATIVE_WITHIN_STDERRS = 3.0
+
+
+def implausible_findings(analysis) -> tuple[tuple[PlausibilityWarning, ...], tuple[str, ...]]:
+    """(warnings beyond noise, notes) of one analysis: :func:`check_analysis`'s warnings,
+    except a negative loss factor within :data:`NEGATIVE_WITHIN_STDERRS` standard errors of
+    zero, which becomes a note (zero damping, measured with noise)."""
+    warnings, notes = [], []
+    for w in check_analysis(analysis):
+        stderr = float(getattr(analysis, "sdc_stderr", math.nan))
+        if (w.check == "negative_loss_factor" and math.isfinite(stderr)
+                and analysis.sdc + NEGATIVE_WITHIN_STDERRS * stderr >= 0):
+            notes.append(f"SDC {analysis.sdc:.3g} is zero within its uncertainty "
+                         f"({NEGATIVE_WITHIN_STDERRS:g} x its standard error {stderr:.2g}): "
+                         "no damping resolved")
+            continue
+        warnings.append(w)
+    return tuple(warnings), tuple(notes)
+
+
+def plausibility_notes(analysis) -> tuple[str, ...]:
+    """The notes a kept result carries: a negative SDC read as zero within its noise, and
+    each warning beyond noise kept as asked (:func:`refuse_implausible` with ``accept``)."""
+    warnings, notes = implausible_findings(analysis)
+    return notes + tuple(f"implausible, kept as asked: {w}" for w in warnings)
+
+
+def refuse_implausible(records, names, *, accept: bool) -> list:
+    """``records`` (:class:`pidcore.measure.AnalyzedRecord`) checked for plausibility before
+    anything is saved or reported, as the app asks for confirmation before it saves.
+
+    A warning beyond noise (:func:`implausible_findings`: a negative loss factor, an SDC
+    above :data:`SDC_UPPER_BOUND`) refuses the file (``names``: how messages name each), with
+    the likely cause, unless ``accept``: then the record is kept and its notes say what was
+    accepted (:func:`plausibility_notes`). Returns the records with those notes added.
+    """
+    from dataclasses import replace
+
+    from ..errors import SignalError
+
+    out = []
+    for record, name in zip(records, names, strict=True):
+        warnings, _ = implausible_findings(record.analysis)
+        if warnings and not accept:
+            raise SignalError(f"{name}: implausible: {warnings[0]}; refused, nothing saved "
+                              "(pass accept_implausible=True to keep it as it is)")
+        notes = plausibility_notes(record.analysis)
+        out.append(replace(record, notes=record.notes + notes) if notes else record)
+    return out

@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .. import defaults
+from ..constants import COUNT_UNIT, RATIO_UNIT
 from ..loop import ForceDisplacementLoop
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -18,22 +19,23 @@ if TYPE_CHECKING:  # pragma: no cover
 
 #: Unit of every scalar and array of :class:`DemResult`.
 UNITS: dict[str, str] = {
-    "sdc": "-", "sdc_stderr": "-", "loss_factor": "-",
+    "sdc": RATIO_UNIT, "sdc_stderr": RATIO_UNIT, "loss_factor": RATIO_UNIT,
     "energy_per_cycle_j": "J", "energy_dissipated_normal_j": "J",
     "energy_dissipated_friction_j": "J", "energy_dissipated_rolling_j": "J",
     "max_kinetic_energy_j": "J", "work_per_cycle_j": "J",
     "stored_energy_change_per_cycle_j": "J",
-    "particles_per_cell": "1", "particles_full_cell": "1", "cells_simulated": "1",
+    "particles_per_cell": COUNT_UNIT, "particles_full_cell": COUNT_UNIT,
+    "cells_simulated": COUNT_UNIT,
     "vibrated_mass_kg": "kg", "coupon_mass_kg": "kg", "moving_mass_kg": "kg",
-    "energy_balance_error": "-", "steps": "1",
+    "energy_balance_error": RATIO_UNIT, "steps": COUNT_UNIT,
     "wall_s": "s", "particle_steps_per_s": "1/s", "time_step_s": "s",
-    "steady_start_cycle": "1", "steady_cycles": "1", "cycles_simulated": "1",
+    "steady_start_cycle": COUNT_UNIT, "steady_cycles": COUNT_UNIT, "cycles_simulated": COUNT_UNIT,
     "settle_time_s": "s", "frequency_hz": "Hz", "acceleration_g": "g", "fill_percent": "%",
-    "sdc_per_cell": "-", "dissipation_per_cycle_j": "J", "sample_time_s": "s",
+    "sdc_per_cell": RATIO_UNIT, "dissipation_per_cycle_j": "J", "sample_time_s": "s",
     "wall_force_n": "N", "shaker_force_n": "N", "velocity_m_s": "m/s",
     "sample_rate_hz": "Hz", "work_walls_j": "J", "dissipated_total_j": "J",
     "mechanical_energy_change_j": "J", "dissipation_per_cell_cycle_j": "J",
-    "coupon_cells": "1", "samples_per_cycle": "1", "fixture_mass_kg": "kg",
+    "coupon_cells": COUNT_UNIT, "samples_per_cycle": COUNT_UNIT, "fixture_mass_kg": "kg",
     "particle_mass_kg": "kg",
 }
 
@@ -339,5 +341,9 @@ def virtual_shaker_loop(force_n: np.ndarray, velocity_m_s: np.ndarray, *,
                              frequency_hz=float(frequency_hz), n_harmonics=n_harmonics,
                              min_periods=min(defaults.MIN_PERIODS, cycles),
                              n_blocks=max(2, min(defaults.N_UNCERTAINTY_BLOCKS, cycles)),
-                             source=label)
+                             source=label,
+                             # the loop is force against displacement: it divides by no
+                             # reactive power, so a record that stores no kinetic energy
+                             # (a pure damper) still has one
+                             require_mass_like=False)
     return analysis.loop(n_points)

@@ -264,6 +264,12 @@ def read_csv(path: str | os.PathLike[str], *, sample_rate_hz: float | None = Non
                                                  with_note=True)
         if note:
             notes.append(note)
+        if not unit:
+            # a time in ms read as s makes the frequency, acceleration and energy per cycle
+            # 1000 x off (the loss factor and SDC unchanged): the assumption is said
+            notes.append(f"{where}: time column {name!r} has no unit: taken as seconds "
+                         f"(sample rate {rate:.6g} Hz); if it is not, write its unit in the "
+                         "header ('Time [ms]') or give the sample rate (--sample-rate)")
     else:
         raise InputFileError(f"{where}: no time column (e.g. 'Time [s]') and no sample rate; "
                              "add a time column or give the sample rate (--sample-rate)")

@@ -70,13 +70,6 @@ def _as_list(value: object) -> list:
     return [value]
 
 
-def _scalar(value: object, what: str) -> float:
-    arr = np.asarray(value, dtype=np.float64).ravel()
-    if arr.size != 1:
-        raise InputFileError(f"{what}: expected a scalar, found {arr.size} values")
-    return float(arr[0])
-
-
 def _text(value: object) -> str:
     if isinstance(value, bytes):
         return value.decode("utf-8", "replace")
@@ -290,7 +283,7 @@ def _terms_unit(terms: object) -> str:
             continue
         exponent = term.get("unit_exponent", term.get("exponent"))
         try:
-            power = 1.0 if exponent is None else _scalar(exponent, "exponent")
+            power = 1.0 if exponent is None else real_scalar(exponent, where="exponent")
         except InputFileError:
             power = 1.0
         parts.append(text if power == 1 else f"{text}^{power:g}")
@@ -323,7 +316,7 @@ def _lms_layout(signal: object, where: str) -> list[Channel]:
         x, y = sig["x_values"], sig["y_values"]
         try:
             start = real_scalar(x.get("start_value", 0.0), where=f"{what}: x_values.start_value")
-            increment = _scalar(x["increment"], what)
+            increment = real_scalar(x["increment"], where=f"{what}: x_values.increment")
             values = np.asarray(y["values"])
         except (KeyError, AttributeError, TypeError, ValueError) as exc:
             raise InputFileError(f"{what}: incomplete x_values/y_values ({exc})") from None
@@ -377,6 +370,10 @@ def _simple_layout(variables: Mapping, where: str,
                                             with_note=True)
         n = _numeric_vector(public[time_key]).size
         notes += [note] if note else []
+        # a vector states no unit: as for a CSV time column without one, the assumption is said
+        notes.append(f"{where}: time vector {time_key!r} states no unit: taken as seconds "
+                     f"(sample rate {rate:.6g} Hz); if it is not, give the sample rate "
+                     "(--sample-rate)")
     elif rate_key is not None or sample_rate_hz is not None:
         try:
             rate = (real_scalar(public[rate_key], where=f"{where}: variable {rate_key}",

@@ -184,6 +184,31 @@ def check_area(area_m2: float, specimen, what: str = "area_m2") -> None:
         f"coupon's face area in m^2; {hint}")
 
 
+#: Most an explicit m_c may lie outside the range of the paper coupon's own m_c (every
+#: convention, every fill of the model) before it is refused as a unit slip: grams typed for
+#: kilograms are 1000 x off, while a heavy fixture (the paper calibration's 0.26 kg beside the
+#: 0.02-0.2 kg of coupon and particles) stays well within it.
+VIBRATED_MASS_LIMIT = 100.0
+
+
+def check_vibrated_mass(mass_kg: float, fills: Sequence[float], material: str,
+                        what: str = "vibrated_mass_kg") -> None:
+    """Refuse an explicit m_c more than :data:`VIBRATED_MASS_LIMIT` times outside the range of
+    the paper coupon's m_c over ``fills`` [%] (every convention, ``material`` particles) as a
+    unit slip (``what``: the option as messages name it)."""
+    masses = [paper_vibrated_mass(convention, material)(float(fill))
+              for convention in VIBRATED_MASS_CONVENTIONS for fill in fills]
+    low, high = min(m for m in masses if m > 0), max(masses)
+    mass = float(mass_kg)
+    if low / VIBRATED_MASS_LIMIT <= mass <= high * VIBRATED_MASS_LIMIT:
+        return
+    hint = "was it grams?" if mass > high else "was it in another unit?"
+    raise ParameterError(
+        f"{what} {mass:g} kg is {mass / (high if mass > high else low):.3g} x the paper "
+        f"coupon's vibrated masses ({low:.3g} .. {high:.3g} kg over every convention and "
+        f"fill, {material} particles); expected m_c in kg; {hint}")
+
+
 def coupon_vibrated_mass_kg(*, particles_mass_kg: float = 0.0,
                             side_m: float = D.COUPON_SIDE_M,
                             face_sheet_thickness_m: float = D.FACE_SHEET_THICKNESS_M,

@@ -12,6 +12,8 @@ import math
 
 import pandas as pd
 
+from ..units import display_number
+
 #: Page size of the sheet, inches (A4 landscape).
 PAGE_IN = (11.69, 8.27)
 
@@ -54,11 +56,11 @@ def case_pdf(view: dict, *, title: str) -> bytes:
     with PdfPages(buffer) as pdf:
         fig = Figure(figsize=PAGE_IN, layout="constrained")
         top, bottom = fig.subfigures(2, 1, height_ratios=[1, 3])
-        dem = (f"{head.dem:.4f} ± {head.dem_stderr:.4f}" if math.isfinite(head.dem)
-               else "none")
+        dem = (f"{display_number(head.dem)} ± {display_number(head.dem_stderr)}"
+               if math.isfinite(head.dem) else "none")
         lines = [title,
-                 f"measured SDC ({head.measured_kind}) {head.measured:.4f} ± "
-                 f"{head.measured_stderr:.4f}  vs  our DEM {dem}: {head.verdict}",
+                 f"measured SDC ({head.measured_kind}) {display_number(head.measured)} ± "
+                 f"{display_number(head.measured_stderr)}  vs  our DEM {dem}: {head.verdict}",
                  f"DEM alignment: {comp.aligned.status}. {comp.aligned.message}"]
         lines += [f"note: {n}" for n in view["notes"]]
         top.text(0.01, 0.95, "\n".join(lines), va="top", fontsize=9, family="monospace",

@@ -27,7 +27,7 @@ import pandas as pd
 from ..compare.align import Aligner, Tolerances
 from ..compare.loadcase import LoadCase, StatedLoadCase
 from ..constants import REPORT_FORMATS
-from ..errors import ParameterError, StoreError
+from ..errors import ParameterError, PidcoreError, StoreError
 from ..io import display_path
 from ..loadcase import refuse_identical_contents_stating_apart
 from .provenance import collect_provenance
@@ -146,7 +146,8 @@ def analyze_files(paths: Sequence[str | Path], *, fill_percent: float | None = N
                   sidecar: str | Path | None = None,
                   options: AnalysisOptions | None = None,
                   options_given: Mapping[str, str] | None = None,
-                  specimen_material: str | None = None) -> list[MeasuredResult]:
+                  specimen_material: str | None = None,
+                  accept_implausible: bool = False) -> list[MeasuredResult]:
     """Read, assign roles, analyze (Eq. 11) and attach the load case of every file.
 
     The load case and the analysis settings are resolved first for every file, so a missing
@@ -156,8 +157,11 @@ def analyze_files(paths: Sequence[str | Path], *, fill_percent: float | None = N
     those that differ from the defaults). Files with identical contents are one measurement:
     kept once, and refused if they state different load cases, specimens or settings.
     ``specimen_material``: the particle material of the specimen compared with (accepted
-    besides the table's, and the default).
+    besides the table's, and the default). A result the plausibility checks refuse (a
+    negative loss factor beyond its noise, an SDC above 2 pi) is refused unless
+    ``accept_implausible`` (:func:`pidcore.compare.plausibility.refuse_implausible`).
     """
+    from ..compare.plausibility import refuse_implausible
     from ..file_settings import analyze_with_settings, resolve_files
     from ..io import detect_file_format
     from ..measure import AnalysisOptions
@@ -169,9 +173,18 @@ def analyze_files(paths: Sequence[str | Path], *, fill_percent: float | None = N
                                      fill_percent=fill_percent, material=material,
                                      direction=direction, sidecar=sidecar,
                                      specimen_material=specimen_material)
+    try:
+        analyzed_files = refuse_implausible(
+            [analyze_with_settings(path, fs) for path, fs in zip(paths, settings, strict=True)],
+            [display_path(Path(path).name) for path in paths], accept=accept_implausible)
+    except PidcoreError as exc:
+        # an error of the analysis names the options by their library keywords; the CLI
+        # renames them to its flags (and only these: a calibration file's own fields keep
+        # their names)
+        exc.names_analysis_options = True
+        raise
     results = []
-    for path, st, fs in zip(paths, stated, settings, strict=True):
-        analyzed = analyze_with_settings(path, fs)
+    for path, st, fs, analyzed in zip(paths, stated, settings, analyzed_files, strict=True):
         a = analyzed.analysis
         results.append(MeasuredResult(Path(path), analyzed, st,
                                       st.load_case(a.frequency_hz, a.acceleration_g), fs))
@@ -475,7 +488,8 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
                 options_given: Mapping[str, str] | None = None,
                 tolerances: Tolerances | None = None, specimen=None,
                 pool: bool = False,
-                calibration: str | Path | None = None) -> ReportResult:
+                calibration: str | Path | None = None,
+                accept_implausible: bool = False) -> ReportResult:
     """Analyse files, store them, align with DEM and the paper, and write the report.
 
     Parameters
@@ -517,6 +531,8 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         A ``calibration.json`` of ``pidcore calibrate``: each row it predicts gets the
         calibrated DEM's Eq. 11 SDC with its 95 % band and whether the measured Eq. 11 SDC
         lies inside (:func:`pidcore.report.table.add_calibration_columns`).
+    accept_implausible : bool
+        Keep (noted) a file's result the plausibility checks refuse (:func:`analyze_files`).
 
     Returns
     -------
@@ -555,11 +571,14 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
 
     if main is not None:
         refuse_store_among_inputs(main, files)  # before reading (it may hold many measurements)
+    from ..compare.plausibility import plausibility_notes
+
     options = options or AnalysisOptions()
     results = analyze_files(
         files, fill_percent=fill_percent, material=material, direction=direction,
         sidecar=sidecar, options=options, options_given=options_given,
         specimen_material=specimen.particles.material if specimen is not None else None,
+        accept_implausible=accept_implausible,
     ) if files else []
     parameters = _parameters(results, options)
     notes: list[str] = []
@@ -567,6 +586,9 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         said = r.settings.summary() if r.settings is not None else ""
         notes.append(f"{display_path(r.path.name)}: load case {r.load_case.key} ({r.stated.origin})"
                      + (f"; {said}" if said else ""))
+        # what the plausibility checks found (a result kept as asked, or zero within noise)
+        notes.extend(f"{display_path(r.path.name)}: {n}"
+                     for n in plausibility_notes(r.analyzed.analysis))
         if r.settings is not None:
             notes.extend(r.settings.notes)
             if r.settings.unmatched:

@@ -440,6 +440,15 @@ CALIBRATION_COLUMNS: tuple[str, ...] = (CALIBRATED_COLUMN, CALIBRATED_LOW_COLUMN
                                         CALIBRATED_HIGH_COLUMN, CALIBRATED_INSIDE_COLUMN)
 
 
+def _finite_or_nan(value) -> float:
+    """A table cell as a float; NaN for an empty, None or non-finite one."""
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        return math.nan
+    return number if math.isfinite(number) else math.nan
+
+
 def add_calibration_columns(table: pd.DataFrame, calibration, *,
                             tolerances=None, specimen=None, paper: bool = False) -> pd.DataFrame:
     """A copy of a report table with the calibrated DEM's prediction beside each row.
@@ -496,16 +505,24 @@ def add_calibration_columns(table: pd.DataFrame, calibration, *,
             why = other or calibration.why_not_predicted(case, tolerances=tolerances)
             extra = f"not predicted by the calibration {calibration.path.name}: {why}"
         else:
+            measured = _finite_or_nan(row.get("SDC measured [-]"))
+            stderr = _finite_or_nan(row.get("SDC measured stderr [-]"))
+            # the band of a measurement with this row's own standard error (not the fitted
+            # point's, unless it is that measurement)
+            band = hit.band(stderr if math.isfinite(measured) else math.nan)
             sdc.append(hit.sdc)
-            low.append(hit.low95)
-            high.append(hit.high95)
-            measured = row.get("SDC measured [-]", math.nan)
-            if measured is None or not math.isfinite(float(measured)):
+            low.append(band[0])
+            high.append(band[1])
+            extra = ""
+            if band != (hit.low95, hit.high95):
+                extra = (f"calibrated band for this measurement's SDC stderr {stderr:.3g} "
+                         f"(the calibration's point at this load case: "
+                         f"{hit.measured_stderr:.3g})")
+            if not math.isfinite(measured):
                 inside.append(NOT_COMPARED)
                 extra = "no Eq. 11 measurement to compare with the calibrated band"
             else:
-                inside.append("yes" if hit.contains(float(measured)) else "no")
-                extra = ""
+                inside.append("yes" if band[0] <= measured <= band[1] else "no")
         notes.append("; ".join(n for n in (note, extra) if n))
     at = list(out.columns).index("SDC measured [-]") + 1 if "SDC measured [-]" in out.columns \
         else len(out.columns)

@@ -246,6 +246,33 @@ def _damping_ratio(sdc: float, loss_factor: float) -> tuple[float | None, str]:
     return -math.log1p(-sdc) / (4 * math.pi), ""
 
 
+def _check_reactive_power_resolved(p_c: complex, p_blocks: np.ndarray | None, *,
+                                   source: str) -> None:
+    """Refuse a positive reactive power that is zero within its uncertainty.
+
+    E = Im(P_c)/w is the denominator of the loss factor and the SDC: a purely resistive load
+    (force in phase with velocity) has no stored kinetic energy, and its Im(P_c) is round-off
+    or noise of either sign. A negative one is refused as an inverted channel (the caller);
+    a positive one gave a loss factor of 1e15 and an SDC reported as a result.
+    """
+    if not p_c.imag > 0:
+        return  # the caller's inverted-channel refusal
+    floor = defaults.REACTIVE_POWER_MIN_FRACTION * abs(p_c)
+    why = f"below {defaults.REACTIVE_POWER_MIN_FRACTION:g} x |P_c| (round-off)"
+    if p_blocks is not None and p_blocks.size >= 2:
+        stderr = float(np.std(p_blocks.imag, ddof=1) / math.sqrt(p_blocks.size))
+        if defaults.REACTIVE_POWER_MIN_STDERRS * stderr > floor:
+            floor = defaults.REACTIVE_POWER_MIN_STDERRS * stderr
+            why = (f"within {defaults.REACTIVE_POWER_MIN_STDERRS:g} standard errors "
+                   f"({stderr:.3g} W, from {p_blocks.size} blocks) of zero")
+    if p_c.imag <= floor:
+        raise SignalError(
+            f"{source or 'record'}: reactive power Im(P_c) = {p_c.imag:.4g} W is {why}, with "
+            f"Re(P_c) = {p_c.real:.4g} W: no stored kinetic energy E = Im(P_c)/w is resolved, "
+            "so the loss factor Re/Im and the SDC are undefined (force in phase with velocity: "
+            "a purely resistive load, or a velocity channel that is not the structure's)")
+
+
 def _complex_power(f_ph: np.ndarray, m_ph: np.ndarray, a_ph: np.ndarray | None,
                    n: np.ndarray, omega: float, *, motion_is_velocity: bool, delay_s: float,
                    mass_kg: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -442,6 +469,13 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
                                      None if a_fit is None else a_fit.total[0],
                                      harmonics, omega, **kw)
     p_c = complex(p_c)
+    p_blocks = None
+    if k_blocks:
+        _, _, p_blocks = _complex_power(fit.phasors[0, :k_blocks], fit.phasors[1, :k_blocks],
+                                        None if a_fit is None else a_fit.phasors[0, :k_blocks],
+                                        harmonics, omega, **kw)
+    if require_mass_like:
+        _check_reactive_power_resolved(p_c, p_blocks, source=source)
     if require_mass_like and not p_c.imag > 0:
         # There is no negative mass: a driven structure above its suspension resonance is
         # mass-like, Im(P_c) > 0. A negative reactive power is almost always one channel with
@@ -468,10 +502,7 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
     loss = loss_raw - baseline_loss_factor
     sdc = 2 * np.pi * loss
     lf_stderr = float("nan")
-    if k_blocks:
-        _, _, p_blocks = _complex_power(fit.phasors[0, :k_blocks], fit.phasors[1, :k_blocks],
-                                        None if a_fit is None else a_fit.phasors[0, :k_blocks],
-                                        harmonics, omega, **kw)
+    if p_blocks is not None:
         if np.all(p_blocks.imag > 0):
             lf_blocks = p_blocks.real / p_blocks.imag
             lf_stderr = float(np.std(lf_blocks, ddof=1) / np.sqrt(k_blocks))

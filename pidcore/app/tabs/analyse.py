@@ -12,6 +12,7 @@ import streamlit as st
 from pidcore import defaults
 from pidcore.app import state, uploads
 from pidcore.constants import DRIVE_DIRECTIONS
+from pidcore.units import display_number
 
 
 def _size(n: int) -> str:
@@ -72,7 +73,7 @@ def _settings_editor(measurements, tables: dict[str, pd.DataFrame], channel_name
 def _card(upload, row, sample_rate_hz, materials, given=()):
     """Results of one file; returns an AnalysedFile or None."""
     from pidcore.compare.case import load_case_of, stated_case
-    from pidcore.compare.plausibility import check_analysis
+    from pidcore.compare.plausibility import implausible_findings
     from pidcore.errors import PidcoreError
 
     name = upload.name
@@ -119,14 +120,16 @@ def _card(upload, row, sample_rate_hz, materials, given=()):
         a = record.analysis
         m1, m2, m3, m4 = st.columns([1, 1, 1, 1.6])  # the SDC ± stderr needs the room
         m1.metric("frequency [Hz]", f"{a.frequency_hz:.3f}")
-        m2.metric("acceleration [g]", f"{a.acceleration_g:.3f}")
-        m3.metric("loss factor [-]", f"{a.loss_factor:.5f}")
+        m2.metric("acceleration [g]", display_number(a.acceleration_g))
+        m3.metric("loss factor [-]", display_number(a.loss_factor))
         m4.metric("SDC ± stderr [-]", uploads.format_sdc(a.sdc, a.sdc_stderr))
-        warnings = check_analysis(a)
+        # as the CLI: a negative SDC within its noise is zero damping (a note), not a
+        # warning to confirm
+        warnings, zero_notes = implausible_findings(a)
         for w in warnings:
             st.warning(f"**Implausible:** {w.message}. *Likely cause:* {w.likely_cause}.",
                        icon="⚠️")
-        for note in record.notes:
+        for note in (*record.notes, *zero_notes):
             st.caption(f"note: {note}")
         return uploads.AnalysedFile(record, case, options, str(row.get("specimen", "") or ""),
                                     warnings)

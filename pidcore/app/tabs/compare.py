@@ -10,6 +10,7 @@ import streamlit as st
 
 from pidcore.app import state, uploads, workbench
 from pidcore.compare.case import equivalent_dampers
+from pidcore.units import display_number
 
 
 def _entries(stores, session_files):
@@ -75,13 +76,18 @@ def _calibrated(calibrations, comp, head, specimen: str) -> None:
     c1, c2, c3 = st.columns(3)
     c1.metric("SDC measured, Eq. 11 [-]",
               uploads.format_sdc(comp.measured_sdc, comp.measured_stderr))
-    c2.metric("SDC DEM, raw [-]", f"{head.dem:.4f}" if math.isfinite(head.dem) else "none")
-    c3.metric("SDC calibrated DEM, Eq. 11 [-]", f"{hit.sdc:.4f}",
-              help=f"95 % band {hit.low95:.4f} .. {hit.high95:.4f}")
-    verdict = ("inside" if hit.contains(comp.measured_sdc) else "outside") \
+    c2.metric("SDC DEM, raw [-]", display_number(head.dem, missing="none"))
+    # the band of a measurement with this one's standard error (the report's)
+    low, high = hit.band(comp.measured_stderr if math.isfinite(comp.measured_sdc)
+                         else math.nan)
+    c3.metric("SDC calibrated DEM, Eq. 11 [-]", display_number(hit.sdc),
+              help=f"95 % band {display_number(low)} .. {display_number(high)}")
+    verdict = ("inside" if low <= comp.measured_sdc <= high else "outside") \
         if math.isfinite(comp.measured_sdc) else "not compared (no Eq. 11 SDC)"
-    st.caption(f"calibrated 95 % band {hit.low95:.4f} .. {hit.high95:.4f} [-]; the measured "
-               f"Eq. 11 SDC is {verdict}.")
+    st.caption(f"calibrated 95 % band {display_number(low)} .. {display_number(high)} [-]"
+               + (f" (for this measurement's SDC stderr {comp.measured_stderr:.3g})"
+                  if (low, high) != (hit.low95, hit.high95) else "")
+               + f"; the measured Eq. 11 SDC is {verdict}.")
 
 
 def render(stores, session_files: list, calibrations: list) -> None:
@@ -161,10 +167,9 @@ def render(stores, session_files: list, calibrations: list) -> None:
                   uploads.format_sdc(comp.measured_sdc, comp.measured_stderr),
                   help="energy per cycle over the reactive energy Im(P)/w")
         # "none" fits the metric's width ("not a Table 3 case" was cut); the caption says why
-        c2.metric("SDC paper DEM [-]", f"{aligned.sdc_paper_dem:.4f}"
-                  if math.isfinite(aligned.sdc_paper_dem) else "none")
-        c3.metric("SDC paper measured [-]", f"{aligned.sdc_paper_experimental:.4f}"
-                  if math.isfinite(aligned.sdc_paper_experimental) else "none")
+        c2.metric("SDC paper DEM [-]", display_number(aligned.sdc_paper_dem, missing="none"))
+        c3.metric("SDC paper measured [-]",
+                  display_number(aligned.sdc_paper_experimental, missing="none"))
         if not (math.isfinite(aligned.sdc_paper_dem)
                 and math.isfinite(aligned.sdc_paper_experimental)):
             st.caption("paper: none where Table 3 has no value at this case (it tabulates "
