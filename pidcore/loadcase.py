@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 from . import defaults
 from .constants import DRIVE_DIRECTIONS, PARTICLE_MATERIALS, STANDARD_GRAVITY
-from .errors import ParameterError
+from .errors import ParameterError, as_given
 
 _MATERIAL_ALIASES = {"pmma": "acrylic", "aluminum": "aluminium"}
 
@@ -184,6 +184,13 @@ def key_0_1(case: LoadCase) -> str:
             f"_a{case.acceleration_g:g}_fill{case.fill_percent:g}")
 
 
+def check_fill_range(fill: float, where: str) -> None:
+    """Refuse a fill outside (0, 100] % in one wording for ``pidcore dem`` and the app's DEM
+    tab, naming where it was given (``--fill``, ``fills [%]``)."""
+    if not (math.isfinite(fill) and 0.0 < fill <= 100.0):
+        raise ParameterError(f"{where} {as_given(fill)}: expected a fill in (0, 100] %")
+
+
 def parse_values(text: str, *, name: str) -> list[float]:
     """Numbers typed as ``"50, 100 500"``: positive floats, or a one-line error naming
     ``name``."""
@@ -202,6 +209,7 @@ def parse_values(text: str, *, name: str) -> list[float]:
 
 
 __all__ = ["KEY_PATTERN", "KEY_PATTERN_0_1", "LoadCase", "LoadCaseError", "check_fill",
+           "check_fill_range",
            "key_0_1", "normalize_material", "normalize_direction", "parse_key",
            "parse_values"]
 

@@ -181,7 +181,8 @@ def test_a_settings_table_is_detected_by_its_columns_under_any_name():
     # the template round-trips through the reader
     back = uploads.read_settings_table("t.csv", uploads.settings_template(again))
     assert back["vibrometer delay [µs]"].tolist() == [50.0, 200.0]
-    with pytest.raises(ParameterError, match=r"t\.csv, line 2: velocity_delay_us 'x'"):
+    with pytest.raises(ParameterError,
+                       match=r"t\.csv, line 2 \(a\.csv\), column velocity_delay_us: 'x'"):
         uploads.read_settings_table("t.csv", b"file,velocity_delay_us\na.csv,x\n")
 
 

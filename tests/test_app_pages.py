@@ -1118,3 +1118,15 @@ def test_the_results_table_names_each_files_material_and_direction(store_file):
     # its acrylic twin; Compare lists "50 Hz, 5 g, 50 %, acrylic, z"
     at = _upload(_app(), [(_SAMPLE.name, _SAMPLE.read_bytes())])
     assert _table(at, "SDC [-]")["load case"].tolist() == ["50 Hz, 5 g, 50 %, acrylic, z"]
+
+
+def test_compare_gives_the_equivalent_damper_of_the_dem_case_and_the_measurement(store_file):
+    # the app had no equivalent damper; at a DEM grid case Compare gives c_eq = SDC m_c w/(2 pi)
+    # of the DEM (pooled 0.21 of two runs, m_c 0.3 kg, 100 Hz: 6.3 N s/m, analytic) and of
+    # the measurement (its Eq. 10 SDC with the same m_c)
+    _dem_store_with_runs(store_file)
+    at = _upload(_app(), [("a_fill50.csv", mass_damper_csv(frequency_hz=100.0,
+                                                           acceleration_g=5.0))])
+    caption = next(c.value for c in at.caption if c.value.startswith("equivalent viscous"))
+    assert "our DEM **6.3 N s/m**" in caption and "m_c = 0.3 kg" in caption
+    assert "measured **" in caption

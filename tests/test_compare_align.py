@@ -154,3 +154,23 @@ def test_align_measured_returns_unit_suffixed_rows():
 def test_tolerances_are_validated():
     with pytest.raises(ValueError, match="frequency_rtol"):
         Tolerances(frequency_rtol=-0.1)
+
+
+def test_a_run_off_the_grid_leaves_the_rest_of_the_grid_modelled():
+    # the app's DEM tab runs any case: one run at 70 Hz, 5 g (no 70 Hz run at 1 g) left the
+    # pair (70 Hz, 1 g) without a value, and the model of every off-grid measurement was
+    # refused ("no value at any fill for 1 g, 70 Hz"); the complete 2 x 2 grid still models
+    # the linear field exactly (trilinear pchip, analytic truth) and the message says what
+    # was left out of it
+    runs = dem_grid()
+    extra = runs[(runs.frequency_hz == 50) & (runs.acceleration_g == 5)].assign(
+        frequency_hz=70.0, sdc=lambda r: r.sdc + 1.0,
+        case_key=lambda r: r.case_key + "_70Hz")
+    case = LoadCase(80.0, 3.0, 40.0)
+    out = Aligner.from_tables(pd.concat([runs, extra], ignore_index=True)).align(case)
+    assert out.status == "interpolated", out.message
+    assert out.sdc_dem == pytest.approx(linear_sdc(40.0, 3.0, 80.0), rel=1e-12)
+    assert "left out: 70 Hz (not run at every acceleration)" in out.message
+    # a grid that is complete is modelled over all its runs, with no such words
+    plain = Aligner.from_tables(runs).align(case)
+    assert plain.sdc_dem == out.sdc_dem and "left out" not in plain.message

@@ -25,16 +25,17 @@ def analysis():
 
 
 def test_viscous_loop_area_is_pi_c_omega_x_squared():
-    # f = c v with x = X sin(wt): oint f dx = pi c w X^2 (exact); the N-gon of the ellipse
-    # encloses N/(2 pi) sin(2 pi/N) of it, which is 1 - 1e-4 at N = 256
+    # f = c v with x = X sin(wt): oint f dx = pi c w X^2 (exact). The N-gon of the ellipse
+    # encloses only N/(2 pi) sin(2 pi/N) of it (1 - 1e-4 at N = 256), which the app showed
+    # as the energy per cycle; the area is exact to rounding (1e-12), at any N >= 3
     c, freq, amp = 2.5, 80.0, 1e-4
     w = 2 * np.pi * freq
-    loop = ForceDisplacementLoop.from_phasors([1], [c * w * amp], [w * amp], freq)
-    n = defaults.LOOP_POINTS
     exact = np.pi * c * w * amp**2
-    assert loop.energy_per_cycle_j == pytest.approx(exact * n / (2 * np.pi)
-                                                    * np.sin(2 * np.pi / n), rel=1e-12)
-    assert loop.n_points == n
+    for n in (3, 16, defaults.LOOP_POINTS):
+        loop = ForceDisplacementLoop.from_phasors([1], [c * w * amp], [w * amp], freq,
+                                                  n_points=n)
+        assert loop.energy_per_cycle_j == pytest.approx(exact, rel=1e-12)
+        assert loop.n_points == n
     # a pure spring (force in phase with displacement) encloses nothing
     spring = ForceDisplacementLoop.from_phasors([1], [1e3 * amp / 1j], [w * amp], freq)
     assert abs(spring.energy_per_cycle_j) < 1e-15
@@ -42,10 +43,12 @@ def test_viscous_loop_area_is_pi_c_omega_x_squared():
 
 def test_power_analysis_loop_area_is_the_measured_energy_per_cycle(analysis):
     loop = analysis.loop(512)
-    # trapezoid error on a trig polynomial of degree 5 with 512 points < (2 pi 5/512)^2/6
-    # = 2.5e-4 relative on the highest harmonic's share; 1e-3 overall is generous
+    # the loop of 5 harmonics encloses Re(P_c) T, the energy `pidcore analyze` prints, to
+    # rounding (1e-12; the polygon's area was off by 1e-4 and the app showed that digit)
     assert loop.energy_per_cycle_j == pytest.approx(
-        analysis.complex_power_w.real * analysis.period_s, rel=1e-3)
+        analysis.complex_power_w.real * analysis.period_s, rel=1e-12)
+    assert analysis.loop().energy_per_cycle_j == pytest.approx(analysis.energy_per_cycle_j,
+                                                               rel=1e-12)
     assert loop.label == "run.uff" and loop.frequency_hz == analysis.frequency_hz
     x, f = analysis.force_displacement_loop(512)  # 0.1 spelling: the same arrays
     np.testing.assert_array_equal(x, loop.displacement_m)
@@ -87,8 +90,9 @@ def test_virtual_shaker_loop_skips_the_transient():
     loop = virtual_shaker_loop(f, v, sample_rate_hz=rate, frequency_hz=freq,
                                steady_start_cycle=5, n_harmonics=1)
     exact = 0.5 * c * amp_v**2 / freq  # Re(P_c) T
-    # polygon of 256 points: 1 - 1e-4 of the ellipse's area
-    assert loop.energy_per_cycle_j == pytest.approx(exact, rel=2e-4)
+    # one harmonic fitted to a noise-free sine over whole periods: exact to rounding
+    # (the polygon of 256 points had 1 - 1e-4 of the ellipse's area)
+    assert loop.energy_per_cycle_j == pytest.approx(exact, rel=1e-9)
     with pytest.raises(ParameterError, match="steady cycles"):
         virtual_shaker_loop(f, v, sample_rate_hz=rate, frequency_hz=freq,
                             steady_start_cycle=16)

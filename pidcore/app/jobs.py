@@ -393,12 +393,15 @@ def dem_fills(text: str, specimen=None) -> tuple[list[float], str | None]:
     so. Otherwise the typed values (:func:`pidcore.loadcase.parse_values`), or a one-line
     error naming the field.
     """
-    from ..loadcase import parse_values
+    from ..loadcase import check_fill_range, parse_values
 
     stated = specimen.stated_fill() if specimen is not None and not text.strip() else None
     if stated is None:
         try:
-            return parse_values(text, name="fills [%]"), None
+            fills = parse_values(text, name="fills [%]")
+            for fill in fills:  # as `pidcore dem` refuses --fills 150 (the page said "load
+                check_fill_range(fill, "fills [%]")  # case: fill must be ...", no field)
+            return fills, None
         except ParameterError as exc:
             if text.strip():
                 raise
@@ -434,7 +437,7 @@ DEM_RUN_COLUMNS = {"specimen": "specimen", "frequency_hz": "frequency [Hz]",
                    "acceleration_g": "acceleration [g]", "fill_percent": "fill [%]",
                    "material": "material", "sdc": "SDC [-]", "sdc_stderr": "SDC stderr [-]",
                    "steady state": "steady state", "direction": "direction",
-                   "cells_simulated": "cells simulated", "seed": "seed",
+                   "cells_simulated": "cells simulated [-]", "seed": "seed [-]",
                    "wall_s": "wall time [s]", "case_key": "run", "store": "store"}
 
 

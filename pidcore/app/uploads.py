@@ -69,7 +69,10 @@ def check_upload_size(name: str, n_bytes: int, *, limit_mb: float | None = None)
         raise ParameterError(f"{name}: {n_bytes / 1024 / 1024:.1f} MB is larger than the upload "
                              f"limit of {limit_mb:g} MB")
     if n_bytes == 0:
-        raise ParameterError(f"{name}: the file is empty")
+        from ..io import EMPTY_MEASUREMENT_FILE
+
+        # in the words of `pidcore analyze` on the same file (the app said "the file is empty")
+        raise ParameterError(f"{name}: {EMPTY_MEASUREMENT_FILE}")
 
 
 def safe_file_name(name: str) -> str:
@@ -154,14 +157,38 @@ class UploadOutcome:
 def app_words(text: str) -> str:
     """A library message or note as the app says it: the app has no unit setting (it takes
     each channel's unit from its file), so the unit options of ``pidcore analyze`` a message
-    suggests are named as that command's, not as choices of the page."""
+    suggests are named as that command's, not as choices of the page; the options the page
+    sets in a column or field (channels, inverted channels, mass below gauge, sample rate)
+    are named by that column."""
     text = text.replace(
         "check both units (--velocity-unit, --acceleration-unit)",
         "check both units in the export (the app takes each channel's unit from its file; "
         "`pidcore analyze --velocity-unit/--acceleration-unit` override them)")
-    return re.sub(r"give it with --(force|velocity|acceleration)-unit UNIT",
+    text = re.sub(r"give it with --(force|velocity|acceleration)-unit UNIT",
                   r"state it in the export (the app takes units from the file; "
                   r"`pidcore analyze --\1-unit UNIT` gives it)", text)
+    # The library's hints (errors and notes: a note said "channel 'Force' inverted
+    # (--invert)") name CLI options; in the app the same choice is a table column.
+    text = re.sub(r"--(force|velocity|acceleration) NAME", r"the '\1 channel' column", text)
+    text = text.replace("pass --invert NAME for the inverted channel",
+                        "name the inverted channel in the 'inverted channels' column")
+    text = text.replace("(--sample-rate)", "('sample rate if no time column' under 'Options "
+                                           "for every file')")
+    # the channel hints that name a channel or an option the page sets in a column (they
+    # said "confirm it with --acceleration 'Ref'", "--mass-below-gauge needs ...", "--invert
+    # 'X': no such channel": options the page does not have)
+    text = re.sub(r"confirm it with --(force|velocity|acceleration) ('[^']*')",
+                  r"confirm it in the '\1 channel' column (\2)", text)
+    text = text.replace("--mass-below-gauge needs", "the mass below gauge needs")
+    text = text.replace("or remove the option", "or set 'mass below gauge [g]' to 0")
+    text = re.sub(r"--invert ('[^']*'): no such channel",
+                  r"'inverted channels' \1: no such channel", text)
+    # the reader's hint is a keyword of read_measurement; the page has no choice of record
+    # (it said "choose one with key=", pointing at nothing)
+    text = text.replace("choose one with key=", "upload one measurement per file, or analyse "
+                                                "one with `pidcore analyze FILE --key NAME`")
+    text = text.replace(" inverted (--invert)", " inverted ('inverted channels' column)")
+    return text
 
 
 def error_message(name: str, exc: BaseException) -> str:
@@ -169,12 +196,6 @@ def error_message(name: str, exc: BaseException) -> str:
     text = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
     text = app_words(text)
     text = re.sub(r"\S*pidcore_upload_[^/\\\s]*[/\\][^:\s]*", name, text)
-    # The library's hints name CLI options; in the app the same choice is a table column.
-    text = re.sub(r"--(force|velocity|acceleration) NAME", r"the '\1 channel' column", text)
-    text = text.replace("pass --invert NAME for the inverted channel",
-                        "name the inverted channel in the 'inverted channels' column")
-    text = text.replace("(--sample-rate)", "('sample rate if no time column' under 'Options "
-                                           "for every file')")
     if isinstance(exc, PidcoreError):
         return text if name in text else f"{name}: {text}"
     return f"{name}: could not be read ({type(exc).__name__}: {text})"
@@ -341,6 +362,7 @@ def read_settings_table(name: str, data: bytes,
         normalize_material,
         settings_table,
     )
+    from ..file_settings import analysis_overrides
     from ..loadcase import check_fill
     from ..tables import line_where, read_text_table
 
@@ -359,17 +381,19 @@ def read_settings_table(name: str, data: bytes,
     for column in _NUMERIC:
         values = []
         for line, file, text in zip(raw.index, raw["file"], raw[column], strict=True):
-            if column == "fill [%]" and text != "":
+            where = f"{line_where(name, int(line))} ({file})"
+            if text == "":
+                values.append(math.nan)
+            elif column == "fill [%]":
                 # the CLI's check of a sidecar's fill, naming the line and file as it does: a
                 # fill of 150 % was accepted and each file's card said "no valid load case"
-                values.append(check_fill(text, f"{line_where(name, int(line))} ({file})"))
-                continue
-            try:
-                values.append(float(text) if text != "" else math.nan)
-            except ValueError:
-                raise ParameterError(f"{line_where(name, int(line))}: "
-                                     f"{FILE_TABLE_COLUMNS[column]} {text!r} is not a "
-                                     "number") from None
+                values.append(check_fill(text, where))
+            else:
+                # the CLI's check of a sidecar's setting (file_settings.analysis_overrides),
+                # so a table is refused with the words `pidcore analyze --sidecar` uses; a
+                # delay typed in s (5e-5) was accepted here and refused only on the file's card
+                analysis_overrides({FILE_TABLE_COLUMNS[column]: text}, where)
+                values.append(float(text))
         out[column] = values
     try:
         out["material"] = [normalize_material(v, f"{name}: material", materials) if v else ""

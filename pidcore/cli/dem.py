@@ -277,9 +277,9 @@ def _check_fill(fill: float, option: str, args: argparse.Namespace, specimen,
                 material: str) -> None:
     """A fill that rounds to no particle (or more than fit) is refused naming the option."""
     from ..dem.simulate import particles_per_cell
+    from ..loadcase import check_fill_range
 
-    if not (math.isfinite(fill) and 0.0 < fill <= 100.0):
-        raise ParameterError(f"{option} {as_given(fill)}: expected a fill in (0, 100] %")
+    check_fill_range(fill, option)
     try:
         particles_per_cell(fill, material, specimen=specimen,
                            fill_reference=args.fill_reference)

@@ -52,8 +52,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     add_store_option(p, default=None,
                      help="HDF5 store: analyses of FILES are added to it; without FILES its "
                           "analyses are reported")
-    add_store_option(p, flag="--dem-store", default=None,
-                     help="HDF5 store holding the DEM runs (default: --store); only read")
+    p.add_argument("--dem-store", metavar="FILE", type=Path, action="append", default=None,
+                   help="HDF5 store holding the DEM runs (default: --store); only read; "
+                        "repeat it to join the runs of several stores (the first holding a "
+                        "run gives it), as the app joins its store's runs with the reference "
+                        "runs: --dem-store APP.h5 --dem-store REFERENCE.h5")
     p.add_argument("--format", metavar="FMT", default="all",
                    help="all or a comma-separated list of csv, md, html, tex, pdf (default "
                         "all); the figures (PNG and SVG, figures/) are written with any")

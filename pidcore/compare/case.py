@@ -439,6 +439,26 @@ def compare_case(records: Sequence[MeasuredEntry],
                           tuple(notes))
 
 
+def equivalent_dampers(comparison: CaseComparison) -> dict[str, float]:
+    """The equivalent viscous damper ``c_eq = SDC m_c w / (2 pi)`` [N s/m] of a compared case,
+    the ``c_eq [N s/m]`` of ``pidcore model damper``: ``"our DEM"`` (its grid case's SDC and
+    m_c) and ``"measured"`` (the pooled Eq. 10 SDC with the same m_c, at the measured
+    frequency: ``dE / (pi w X^2)`` of the measured energy per cycle). Empty where no DEM grid
+    case states m_c (an interpolated DEM value has none); a value is left out where its SDC
+    is not finite."""
+    from ..model.damper import equivalent_damping_coefficient
+
+    grid = getattr(comparison.aligned, "grid_case", None)
+    m_c = float(getattr(grid, "vibrated_mass_kg", math.nan))
+    if not (math.isfinite(m_c) and m_c > 0):
+        return {}
+    found = {"our DEM": (grid.sdc, grid.load_case.frequency_hz),
+             "measured": (comparison.measured_sdc_eq10, comparison.load_case.frequency_hz)}
+    return {name: float(equivalent_damping_coefficient(sdc, vibrated_mass_kg=m_c,
+                                                       frequency_hz=freq))
+            for name, (sdc, freq) in found.items() if math.isfinite(sdc)}
+
+
 @dataclass(frozen=True)
 class Headline:
     """The one line per load case: like-for-like measured SDC beside our DEM.

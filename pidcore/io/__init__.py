@@ -44,8 +44,8 @@ from .roles import RoleAssignment, assign_roles, name_suggests
 from .uff import read_uff, write_uff
 
 __all__ = [
-    "FILE_FORMAT_EXTENSIONS", "RoleAssignment", "assign_roles", "detect_file_format",
-    "display_path",
+    "EMPTY_MEASUREMENT_FILE", "FILE_FORMAT_EXTENSIONS", "RoleAssignment", "assign_roles",
+    "detect_file_format", "display_path",
     "hdf5_keys", "name_suggests", "read_csv", "read_hdf5", "read_mat", "read_measurement",
     "read_measurements", "read_uff", "write_csv", "write_hdf5", "write_mat",
     "write_measurement", "write_uff",
@@ -59,6 +59,8 @@ FILE_FORMAT_EXTENSIONS: dict[str, tuple[str, ...]] = {
     "hdf5": (".h5", ".hdf5", ".hdf"),
 }
 _FORMATS = tuple(FILE_FORMAT_EXTENSIONS)
+#: Why an empty file is refused, after its name (one wording for the CLI and the app's uploads).
+EMPTY_MEASUREMENT_FILE = "empty file; expected a UFF, CSV, MAT or HDF5 measurement file"
 _HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 _UFF_START = re.compile(rb"\A\s*-1[ \t]*\r?\n\s*\d+")
 
@@ -80,8 +82,7 @@ def detect_file_format(path: str | os.PathLike[str]) -> str:
     except OSError as exc:
         raise InputFileError(f"{where}: cannot open ({exc.strerror})") from None
     if not head:
-        raise InputFileError(f"{where}: empty file; expected a UFF, CSV, MAT or HDF5 "
-                             "measurement file")
+        raise InputFileError(f"{where}: {EMPTY_MEASUREMENT_FILE}")
     if head.startswith(b"MATLAB"):
         return "mat"  # v5 header text; v7.3 is HDF5 behind the same 128-byte text header
     if head.startswith(_HDF5_SIGNATURE) or head[512:520] == _HDF5_SIGNATURE:

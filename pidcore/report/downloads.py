@@ -51,9 +51,10 @@ def store_report_table(path: str | os.PathLike, dem_store: str | os.PathLike | N
 
 def _store_report(path: str | os.PathLike, dem_store: str | os.PathLike | None, *,
                   analysis_keys: list[str] | None, pool: bool, calibration: Calibration | None,
-                  specimen: Specimen | None) -> tuple[pd.DataFrame, pd.DataFrame | None]:
+                  specimen: Specimen | None
+                  ) -> tuple[pd.DataFrame, pd.DataFrame | None, pd.DataFrame]:
     """(:func:`store_report_table`, the DEM runs of the specimen it chose from: None for
-    none)."""
+    none, the saved analyses it reports)."""
     from ..store.listing import list_dem_runs, saved_analyses
     from .pipeline import specimen_report_table
     from .table import add_calibration_columns
@@ -63,7 +64,7 @@ def _store_report(path: str | os.PathLike, dem_store: str | os.PathLike | None, 
         analyses = analyses[analyses["key"].isin(analysis_keys)]
     dem_runs = list_dem_runs(path, dem_store)
     if analyses.empty and dem_runs.empty:
-        return pd.DataFrame(), None
+        return pd.DataFrame(), None, analyses
     where = " and ".join(str(p) for p in (path, dem_store)
                          if p is not None and Path(p).is_file())
     built = specimen_report_table(dem_runs if not dem_runs.empty else None,
@@ -72,7 +73,7 @@ def _store_report(path: str | os.PathLike, dem_store: str | os.PathLike | None, 
                                   choose_another=CHOOSE_SPECIMEN_APP)
     table = built.table if calibration is None else add_calibration_columns(
         built.table, calibration, specimen=specimen, paper=specimen is None)
-    return table, built.dem_runs
+    return table, built.dem_runs, analyses
 
 
 def report_files(path: str | os.PathLike, dem_store: str | os.PathLike | None = None, *,
@@ -87,15 +88,16 @@ def report_files(path: str | os.PathLike, dem_store: str | os.PathLike | None = 
     """
     from ..compare import Tolerances
     from .comparison_figures import plot_sdc_comparison
-    from .pipeline import open_verified_store, specimen_provenance
+    from .pipeline import open_verified_store, specimen_provenance, stored_parameters
     from .provenance import collect_provenance
     from .render import write_report
 
     stores = [Path(p) for p in (path, dem_store) if p is not None and Path(p).is_file()]
     for p in stores:
         open_verified_store(p, must_exist=True)
-    table, runs = _store_report(path, dem_store, analysis_keys=analysis_keys, pool=pool,
-                                calibration=calibration, specimen=specimen)
+    table, runs, analyses = _store_report(path, dem_store, analysis_keys=analysis_keys,
+                                          pool=pool, calibration=calibration,
+                                          specimen=specimen)
     if table.empty:
         raise ParameterError("nothing to report: the stores hold no saved analyses with a "
                              "load case and no DEM runs")
@@ -104,7 +106,8 @@ def report_files(path: str | os.PathLike, dem_store: str | os.PathLike | None = 
     seeds = sorted({int(s) for s in runs["seed"].dropna()}) \
         if runs is not None and "seed" in runs.columns else []
     provenance = collect_provenance(
-        parameters={"frequency_rtol": tol.frequency_rtol,
+        # the saved analyses' own settings first, as `pidcore report --store` lists them
+        parameters={**stored_parameters(analyses), "frequency_rtol": tol.frequency_rtol,
                     "acceleration_rtol": tol.acceleration_rtol,
                     "fill_atol_percent": tol.fill_atol_percent, "pool": pool},
         seeds=seeds, stores=stores, notes=table.attrs.get("notes", []),

@@ -14,6 +14,7 @@ Order matters for the guarantees of the command:
 
 from __future__ import annotations
 
+import json
 import math
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -216,8 +217,33 @@ def _parameters(results: Sequence[MeasuredResult], options: AnalysisOptions) -> 
     that differs between them as ``"a.uff: 5e-05; b.uff: 0"`` (per-file sidecar settings)."""
     if not results:
         return options.parameters()
-    per_file = [(r.path.name, (r.settings.options if r.settings is not None else options)
-                 .parameters()) for r in results]
+    return _shared_parameters([(r.path.name, (r.settings.options if r.settings is not None
+                                              else options).parameters()) for r in results])
+
+
+def stored_parameters(analyses: pd.DataFrame | None) -> dict:
+    """The analysis parameters the reported stored analyses were saved with (their
+    ``parameters_json``), for the provenance, as :func:`_parameters` gives those of files
+    analysed now. A report of a store without files listed the options' defaults
+    (``velocity_delay_s=0.0``) for records analysed with 50 µs."""
+    if analyses is None or analyses.empty or "parameters_json" not in analyses.columns:
+        return {}
+    names = analyses["file"] if "file" in analyses.columns else analyses["source"].map(
+        lambda s: Path(str(s)).name)
+    per_file = []
+    for name, text in zip(names, analyses["parameters_json"], strict=True):
+        try:
+            stated = json.loads(text) if isinstance(text, str) and text else {}
+        except ValueError:
+            stated = {}
+        per_file.append((str(name), stated if isinstance(stated, dict) else {}))
+    # by file name: the CLI and the app list a store's analyses in different orders
+    return _shared_parameters(sorted(per_file, key=lambda item: item[0]))
+
+
+def _shared_parameters(per_file: list[tuple[str, dict]]) -> dict:
+    """Each parameter as the files share it, one that differs between them as
+    ``"a.uff: 5e-05; b.uff: 0"``."""
     names = list(dict.fromkeys(k for _, p in per_file for k in p))
     out: dict[str, object] = {}
     for name in names:
@@ -430,7 +456,7 @@ def specimen_report_table(stored_runs: pd.DataFrame | None, analyses: pd.DataFra
 
 
 def _figures(table: pd.DataFrame, dem_runs: pd.DataFrame | None, aligner: Aligner,
-             loops: list[tuple[str, LoadCase, ForceDisplacementLoop]], dem_store,
+             loops: list[tuple[str, LoadCase, ForceDisplacementLoop]], dem_stores: list,
              notes: list[str]) -> dict[str, object]:
     from .comparison_figures import dem_loop_from_arrays, plot_loop_overlay, plot_sdc_comparison
 
@@ -452,10 +478,12 @@ def _figures(table: pd.DataFrame, dem_runs: pd.DataFrame | None, aligner: Aligne
     for i, (name, case, loop) in enumerate(loops[:MAX_LOOP_FIGURES]):
         dem_loop = None
         grid = aligner.grid_case(case)
-        if grid is None or not grid.run_keys or dem_store is None:
+        holder = next((s for s in dem_stores if s.has_dem_run(grid.run_keys[0])), None) \
+            if grid is not None and grid.run_keys else None
+        if holder is None:
             notes.append(f"{name}: no DEM run at {case.label()}; loop drawn without DEM overlay")
         else:
-            entry = dem_store.get_dem_run(grid.run_keys[0])
+            entry = holder.get_dem_run(grid.run_keys[0])
             found = dem_loop_from_arrays(entry.arrays, entry.record)
             if isinstance(found, str):
                 notes.append(f"{name}: {found}; loop drawn without DEM overlay")
@@ -468,8 +496,32 @@ def _figures(table: pd.DataFrame, dem_runs: pd.DataFrame | None, aligner: Aligne
     return figures
 
 
+def _dem_paths(store: str | Path | None,
+               dem_store: str | Path | Sequence[str | Path] | None) -> list[Path]:
+    """The stores whose DEM runs a report compares: ``dem_store`` (one path or several, in
+    order), else ``store``; each once."""
+    if dem_store is None:
+        return [Path(store)] if store else []
+    given = [dem_store] if isinstance(dem_store, str | Path) else list(dem_store)
+    return list(dict.fromkeys(Path(p) for p in given))
+
+
+def _joined_dem_runs(stores: list) -> pd.DataFrame | None:
+    """The DEM runs of ``stores`` joined as the app joins its stores
+    (:func:`pidcore.store.listing.list_dem_runs`: a run key held by several comes from the
+    first); None without a store."""
+    if not stores:
+        return None
+    if len(stores) == 1:
+        return stores[0].list_dem_runs()
+    from ..store.listing import list_dem_runs
+
+    return list_dem_runs(*(s.path for s in stores))
+
+
 def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
-                store: str | Path | None = None, dem_store: str | Path | None = None,
+                store: str | Path | None = None,
+                dem_store: str | Path | Sequence[str | Path] | None = None,
                 formats: str | Iterable[str] = REPORT_FORMATS,
                 fill_percent: float | None = None, material: str | None = None,
                 direction: str | None = None, sidecar: str | Path | None = None,
@@ -490,8 +542,10 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
     store : path, optional
         Store the analyses are added to; without files its analyses are reported (the newest
         per measurement that states a fill).
-    dem_store : path, optional
-        Store whose DEM runs are compared (default: ``store``). Only read.
+    dem_store : path or sequence of path, optional
+        Store(s) whose DEM runs are compared (default: ``store``); several are joined as the
+        app joins its store with the reference runs (a run key in several: the first's).
+        Only read.
     formats : str or iterable of str
         ``csv, md, html, tex, pdf`` or ``"all"``.
     fill_percent, material, direction, sidecar
@@ -551,11 +605,10 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
                                  "analyses keep the load case and corrections they were "
                                  "saved with)")
     main = open_verified_store(store, must_exist=not files) if store is not None else None
-    dem_path = Path(dem_store) if dem_store is not None else (Path(store) if store else None)
-    dem = None
-    if dem_path is not None:
-        dem = main if (main is not None and dem_path == Path(store)) else \
-            open_verified_store(dem_path, must_exist=True)
+    dem_paths = _dem_paths(store, dem_store)
+    dems = [main if (main is not None and p == Path(store)) else
+            open_verified_store(p, must_exist=True) for p in dem_paths]
+    dem_path = " and ".join(map(str, dem_paths)) or None  # as the notes name the runs' stores
 
     if main is not None:
         refuse_store_among_inputs(main, files)  # before reading (it may hold many measurements)
@@ -619,7 +672,9 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
     else:
         analyses = measured_frame(results)
 
-    dem_runs = dem.list_dem_runs() if dem is not None else None
+    dem_runs = _joined_dem_runs(dems)
+    if not results:  # the stored records' own settings, not the unused options' defaults
+        parameters = stored_parameters(analyses)
     built = specimen_report_table(dem_runs, analyses, specimen=specimen, where=dem_path,
                                   tolerances=tolerances, pool=pool)
     table, dem_runs, aligner = built.table, built.dem_runs, built.aligner
@@ -628,19 +683,19 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
                                         specimen=specimen, paper=specimen is None)
     notes.extend(table.attrs.get("notes", []))
     loops = _measured_loops(results, analyses, main, notes)
-    figures = _figures(table, dem_runs, aligner, loops, dem, notes)
+    figures = _figures(table, dem_runs, aligner, loops, dems, notes)
     try:
         seeds = []
         if dem_runs is not None and "seed" in dem_runs.columns:
             seeds = [int(s) for s in dem_runs["seed"] if s is not None and not (
                 isinstance(s, float) and math.isnan(s))]
-        stores = [p for p in (Path(store) if store else None, dem_path)
-                  if p is not None and p.exists()]
+        stores = [p for p in dict.fromkeys((*([Path(store)] if store else []), *dem_paths))
+                  if p.exists()]
         provenance = collect_provenance(
             parameters={**parameters,
                         "frequency_rtol": tolerances.frequency_rtol,
                         "acceleration_rtol": tolerances.acceleration_rtol,
-                        "fill_atol_percent": tolerances.fill_atol_percent},
+                        "fill_atol_percent": tolerances.fill_atol_percent, "pool": pool},
             seeds=seeds, inputs=[r.path for r in results],
             input_hashes={str(r.path): getattr(r.measurement, "sha256", "") for r in results},
             stores=stores, notes=notes, specimens=specimen_provenance(specimen))

@@ -9,6 +9,7 @@ import math
 import streamlit as st
 
 from pidcore.app import state, uploads, workbench
+from pidcore.compare.case import equivalent_dampers
 from pidcore.units import display_number
 
 
@@ -145,6 +146,13 @@ def render(stores, session_files: list, calibrations: list) -> None:
                + (" (energy per cycle over the DEM case's m_c a²/(2ω²), as our DEM SDC is "
                   "defined)" if head.measured_kind.startswith("Eq. 10") else "")
                + f". DEM alignment: {aligned.status}. {aligned.message}")
+    dampers = equivalent_dampers(comp)
+    if dampers:  # the FEM number of `pidcore model damper` at this case
+        st.caption("equivalent viscous damper c_eq = SDC m_c ω/(2π) (as `pidcore model "
+                   "damper`): " + " · ".join(f"{name} **{c:.4g} N s/m**"
+                                             for name, c in dampers.items())
+                   + f" (m_c = {comp.aligned.grid_case.vibrated_mass_kg:.4g} kg of the DEM "
+                     "case)")
     if len(members) > 1:
         if math.isfinite(comp.chi2_dof) and comp.chi2_dof > 3:
             st.warning(f"The {len(members)} pooled files scatter more than their errors allow "
