@@ -19,6 +19,13 @@ def test_json_is_one_document_with_the_agreed_keys(capsys):
     assert set(JSON_KEYS) <= set(doc)
     assert doc["particles_per_cell"] == 11 and doc["cells_simulated"] == 2
     assert doc["sdc"] == pytest.approx(doc["energy_per_cycle_j"] / doc["max_kinetic_energy_j"])
+    # every number of the document names its unit (as calibrate --json does): a run total
+    # in J beside per-cycle values was readable only from the docstring
+    numbers = {k for k, v in doc.items() if isinstance(v, (int, float))
+               and not isinstance(v, bool) and k != "seed"}
+    assert numbers <= set(doc["units"]), numbers - set(doc["units"])
+    assert doc["units"]["sdc"] == "-" and doc["units"]["work_walls_j"] == "J"
+    assert doc["units"]["particles_per_cell"] == "1" and doc["units"]["wall_s"] == "s"
 
 
 def test_readable_summary_names_units_and_particle_count(capsys):

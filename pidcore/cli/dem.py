@@ -338,6 +338,11 @@ def run(args: argparse.Namespace) -> int:
         out = {k: result.to_dict()[k] for k in JSON_KEYS}
         out.update(result.to_dict())
         out["notes"] = notes
+        # every number names its unit, as calibrate --json does (work_walls_j and the other
+        # run totals are of the simulated cells over the whole run: DemResult)
+        from ..dem.result import UNITS as DEM_UNITS
+
+        out["units"] = {k: unit for k, unit in DEM_UNITS.items() if k in out}
         if key is not None:
             out["store_key"] = key
             out["reused_from_store"] = reused

@@ -55,7 +55,9 @@ class DemResult:
     ``stored_energy_change_per_cycle_j`` (the change of the particles' mechanical energy over
     the steady window divided by its cycles, e.g. a bed compacting).
     ``energy_balance_error`` is (W_walls - dE_mech - D) / W_walls over the whole driven run
-    (all cells), with dE_mech = kinetic (incl. rotation) + gravity + elastic (Hertz and
+    (all cells): ``work_walls_j``, ``mechanical_energy_change_j`` and ``dissipated_total_j``
+    are these totals (the simulated cells, every driven cycle; not per cycle, not the
+    coupon), with dE_mech = kinetic (incl. rotation) + gravity + elastic (Hertz and
     contact springs) energy change. ``particle_steps_per_s`` counts settling and driven steps
     over the time spent in the kernel (all threads), leaving out kernel calls that compiled
     Numba code (NaN when every call did, see :attr:`notes`); ``wall_s`` is the whole call,
