@@ -174,3 +174,28 @@ def test_a_run_off_the_grid_leaves_the_rest_of_the_grid_modelled():
     # a grid that is complete is modelled over all its runs, with no such words
     plain = Aligner.from_tables(runs).align(case)
     assert plain.sdc_dem == out.sdc_dem and "left out" not in plain.message
+
+
+def test_the_model_takes_one_settings_case_per_load_case_as_a_grid_case_does():
+    # the app's calibration stores 4-cell runs at grid load cases beside the 8-cell grid: the
+    # pchip model averaged both at those points (an interpolated 250 Hz row moved 1.238 ->
+    # 1.254), while the grid case itself is the 8-cell one. The model now keeps, at each
+    # load case, the case a grid match would take (the most cells).
+    runs = dem_grid().assign(cells_simulated=8.0)
+    other = runs[(runs.frequency_hz == 50) & (runs.acceleration_g == 5)].assign(
+        cells_simulated=4.0, sdc=lambda r: r.sdc + 1.0, seed=2,
+        case_key=lambda r: r.case_key + "_4cells")
+    both = pd.concat([runs, other], ignore_index=True)
+    case = LoadCase(80.0, 3.0, 40.0)
+    aligner = Aligner.from_tables(both)
+    out = aligner.align(case)
+    assert out.status == "interpolated", out.message
+    # the linear field of the 8-cell runs, exactly (trilinear pchip): no 4-cell value in it
+    assert out.sdc_dem == pytest.approx(linear_sdc(40.0, 3.0, 80.0), rel=1e-12)
+    assert "the runs of other settings left out" in out.message
+    # the grid case at that point is the 8-cell one too: model and grid agree
+    grid = aligner.align(LoadCase(50.0, 5.0, 50.0))
+    assert grid.status == "grid" and grid.sdc_dem == linear_sdc(50.0, 5.0, 50.0)
+    # pooled explicitly (--pool), the settings are one case and the model averages them
+    pooled = Aligner.from_tables(both, pool_settings=True).align(case)
+    assert pooled.sdc_dem != pytest.approx(out.sdc_dem, rel=1e-6)

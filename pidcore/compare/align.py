@@ -597,6 +597,29 @@ def match_paper(case: LoadCase, paper: pd.DataFrame | None, *,
     return float(row["sdc_dem"]), float(row["sdc_experimental"]), best[2]
 
 
+def _preference(case: DemCase) -> tuple[float, int]:
+    """Sort key of the DEM cases of several settings at one load case, best first: the most
+    cells simulated, then the most runs (the least noisy estimate)."""
+    return (-float(np.nan_to_num(case.cells_simulated, nan=0.0)), -case.n_runs)
+
+
+def _one_case_per_point(cases: list[DemCase]) -> tuple[list[DemCase], int]:
+    """The preferred case (:func:`_preference`) at each load case, and how many load cases
+    had cases of other settings: a model averaging them mixed, e.g., a calibration's 4-cell
+    runs into the 8-cell grid, which :meth:`Aligner.grid_case` never does."""
+    best: dict[tuple[float, float, float], DemCase] = {}
+    crowded = set()
+    for c in cases:
+        point = (c.load_case.fill_percent, c.load_case.acceleration_g, c.load_case.frequency_hz)
+        if point in best:
+            crowded.add(point)
+            if _preference(c) < _preference(best[point]):
+                best[point] = c
+        else:
+            best[point] = c
+    return list(best.values()), len(crowded)
+
+
 def build_dem_models(cases: list[DemCase]) -> dict[tuple[str, str], object]:
     """pchip models over our DEM cases, one per (material, direction); failures map to a message.
 
@@ -613,6 +636,7 @@ def build_dem_models(cases: list[DemCase]) -> dict[tuple[str, str], object]:
     for c in cases:
         by_kind.setdefault((c.load_case.material, c.load_case.direction), []).append(c)
     for kind, members in by_kind.items():
+        members, other_settings = _one_case_per_point(members)
         table = pd.DataFrame({
             "fill_percent": [c.load_case.fill_percent for c in members],
             "acceleration_g": [c.load_case.acceleration_g for c in members],
@@ -620,6 +644,9 @@ def build_dem_models(cases: list[DemCase]) -> dict[tuple[str, str], object]:
             "sdc": [c.sdc for c in members],
         })
         source = f"our DEM runs ({kind[0]}, {kind[1]})"
+        if other_settings:
+            source += (f"; at {other_settings} load case(s) the runs of other settings left "
+                       "out (those with the most cells kept, as for a grid case)")
         try:
             models[kind] = SdcModel.from_table(table, value="sdc", source=source)
         except ParameterError as exc:
@@ -732,7 +759,7 @@ class Aligner:
         if not hits:
             return None
         return min(hits, key=lambda c: (self.tolerances.distance(case, c.load_case),
-                                        -np.nan_to_num(c.cells_simulated, nan=0.0), -c.n_runs))
+                                        *_preference(c)))
 
     def align(self, case: LoadCase) -> AlignedCase:
         """Align one measured case; never extrapolates the model."""
