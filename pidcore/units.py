@@ -184,3 +184,26 @@ def display_number(value: float | None, *, decimals: int = 4, missing: str = "â€
     if value == 0 or abs(round(value, decimals)) >= 10.0 ** (1 - decimals):  # as printed
         return f"{value:.{decimals}f}"
     return f"{value:.3g}"
+
+
+def display_with_uncertainty(value: float, stderr: float, *, digits: int = 4,
+                             missing: str = "â€”") -> str:
+    """``value`` rounded at the first significant digit of its standard error ``stderr`` (the
+    last digit shown is the uncertain one), with at least two significant digits; ``digits``
+    significant digits where the error is unknown or zero; ``missing`` for NaN or inf.
+
+    >>> display_with_uncertainty(0.46662, 0.0081), display_with_uncertainty(0.2563, 0.0009)
+    ('0.467', '0.2563')
+    >>> display_with_uncertainty(1234.5, 60.0), display_with_uncertainty(0.01518, float("nan"))
+    ('1230', '0.01518')
+    """
+    if value is None or not math.isfinite(value):
+        return missing
+    if stderr is None or not (math.isfinite(stderr) and stderr > 0):
+        return f"{value:.{digits}g}"
+    place = math.floor(math.log10(stderr))
+    if value != 0:
+        place = min(place, math.floor(math.log10(abs(value))) - 1)
+    if place < 0:
+        return f"{value:.{-place}f}"
+    return f"{round(value, -place):.0f}"

@@ -215,3 +215,28 @@ def test_a_band_for_another_measurements_stderr_is_that_measurements_band():
     assert low == pytest.approx(noisy["low95"], abs=0.03 * width)
     assert high == pytest.approx(noisy["high95"], abs=0.03 * width)
     assert high - low > 2 * (fitted["high95"] - fitted["low95"])  # 5 x the stderr: far wider
+
+
+def test_a_reported_bound_is_shown_to_the_digits_its_sampling_leaves():
+    # the fixture mass's upper bound read 0.4734 while it moved 0.467-0.484 from one set of
+    # posterior samples to the next: digits beyond its Monte-Carlo error were noise. The
+    # batch-means error must predict the seed-to-seed scatter, and the shown digits end there
+    from pidcore.calibrate.posterior import summarise, summary_texts
+
+    model, _, _, _ = linear_problem([0.4, 0.02], 0.01, seed=1)
+    summaries = [summarise(model.specs, sample_posterior(model, range(8), seed=seed,
+                                                          method="grid").samples)[0]["p0"]
+                 for seed in range(30)]
+    for key in ("median", "low95", "high95"):
+        scatter = np.std([s[key] for s in summaries], ddof=1)
+        predicted = np.mean([s[f"{key}_mc_se"] for s in summaries])
+        # 30 seeds: the scatter's own estimate is good to ~13 %, each batch-means error to
+        # ~24 % (10 batches); their ratio well inside a factor 1.6 either way
+        assert predicted == pytest.approx(scatter, rel=0.6), key
+    s = summaries[0]
+    median, low, high = summary_texts(s)
+    for text, key in ((median, "median"), (low, "low95"), (high, "high95")):
+        decimals = len(text.split(".")[1]) if "." in text else 0
+        # the last digit shown is the one the standard error reaches, not further
+        assert 10.0 ** -decimals >= s[f"{key}_mc_se"] / 10
+        assert float(text) == pytest.approx(s[key], abs=10.0 ** -decimals)

@@ -32,6 +32,7 @@ from .posterior import (
     predictive,
     sample_posterior,
     summarise,
+    summary_texts,
 )
 from .runner import RunRequest, run_requests, specimen_with
 from .surrogate import build_surrogate, default_design_size, design_points
@@ -94,9 +95,8 @@ class CalibrationResult:
         # the values themselves: a description written for the start ("15 g fixture") would
         # otherwise contradict the fitted numbers below it
         fitted = "; ".join(
-            f"{s.name} {p['median']:.4g} (95 % {p['low95']:.4g} .. {p['high95']:.4g})"
-            for s in self.specs if s.kind != "hyper"
-            for p in (self.parameters[s.name],))
+            "{} {} (95 % {} .. {})".format(s.name, *summary_texts(self.parameters[s.name]))
+            for s in self.specs if s.kind != "hyper")
         return dataclasses.replace(
             out, name=f"{self.specimen.name}{CALIBRATED_SUFFIX}",
             description=f"{self.specimen.description} -- calibrated by pidcore calibrate: "

@@ -13,6 +13,7 @@ import numpy as np
 from ..records import json_safe
 from ..units import display_number
 from .calibrate import CalibrationResult
+from .posterior import summary_texts
 
 SPECIMEN_FILE = "calibrated_specimen.toml"
 
@@ -30,8 +31,9 @@ def specimen_text(result: CalibrationResult) -> str:
              f"# started from {result.specimen.name} ({result.specimen.source}); "
              f"fitted: {', '.join(result.settings['fit'])}"]
     for name, p in result.parameters.items():
-        lines.append(f"#   {name} = {p['median']:.6g}  (95 %: {p['low95']:.4g} .. "
-                     f"{p['high95']:.4g})")
+        # the value the file sets, in full; the interval to the digits its sampling leaves
+        _, low, high = summary_texts(p)
+        lines.append(f"#   {name} = {p['median']:.6g}  (95 %: {low} .. {high})")
     if result.loo_rms is not None:
         lines.append(f"# leave-one-out RMS of the SDC: {result.loo_rms:.4g}")
     lines.append(f"# in-sample RMS of the SDC: {result.rms:.4g}")
@@ -71,7 +73,8 @@ def summary_markdown(result: CalibrationResult) -> str:
                  f"{result.wall_s:.1f} s.")
     lines += ["", "| parameter | median | 95 % interval | prior bounds |", "|---|---|---|---|"]
     for name, p in result.parameters.items():
-        lines.append(f"| {name} | {p['median']:.4g} | {p['low95']:.4g} .. {p['high95']:.4g} | "
+        median, low, high = summary_texts(p)
+        lines.append(f"| {name} | {median} | {low} .. {high} | "
                      f"{p['prior_low']:g} .. {p['prior_high']:g} |")
     names = [s.name for s in result.specs]
     lines += ["", "Posterior correlations:", "", "| | " + " | ".join(names) + " |",
@@ -109,8 +112,9 @@ def summary_html(result: CalibrationResult) -> str:
              "table{border-collapse:collapse}</style></head><body><h1>Calibration summary</h1>"]
     parts.append("<table><tr><th>parameter</th><th>median</th><th>95 % interval</th></tr>")
     for name, p in result.parameters.items():
-        parts.append(f"<tr><td>{html.escape(name)}</td><td>{p['median']:.4g}</td>"
-                     f"<td>{p['low95']:.4g} .. {p['high95']:.4g}</td></tr>")
+        median, low, high = summary_texts(p)
+        parts.append(f"<tr><td>{html.escape(name)}</td><td>{median}</td>"
+                     f"<td>{low} .. {high}</td></tr>")
     parts.append("</table>")
     for title, rows in (("In-sample predictions", result.predictions),
                         ("Leave-one-out predictions", result.loo)):

@@ -295,20 +295,52 @@ def predictive(model: Model, samples: np.ndarray, index: int, *,
             "low95_without_stderr": float(low0), "high95_without_stderr": float(high0)}
 
 
+#: Batches of the posterior samples whose quantiles' scatter gives the Monte-Carlo standard
+#: error of a reported quantile (:func:`summarise`).
+MC_BATCHES = 10
+
+
+def quantile_mc_stderr(x: np.ndarray, q: Sequence[float],
+                       batches: int = MC_BATCHES) -> np.ndarray:
+    """Monte-Carlo standard error of the percentiles ``q`` of the samples ``x``: the scatter
+    of each percentile over ``batches`` equal batches, / sqrt(batches) (the batch-means
+    estimate; the samples are in random order). What a reported bound would move by with
+    another set of samples: its digits beyond that are noise."""
+    n = len(x) // batches
+    if n < 2:
+        return np.full(len(q), np.nan)
+    per_batch = np.percentile(np.reshape(x[:n * batches], (batches, n)), q, axis=1)
+    return np.std(per_batch, axis=1, ddof=1) / math.sqrt(batches)
+
+
 def summarise(specs: Sequence[ParameterSpec], samples: np.ndarray) -> tuple[dict, list]:
-    """({name: median, low95, high95, mean, sd}, correlation matrix as nested lists)."""
+    """({name: median, low95, high95, mean, sd, and the Monte-Carlo standard errors
+    median_mc_se, low95_mc_se, high95_mc_se}, correlation matrix as nested lists)."""
     out = {}
     for j, spec in enumerate(specs):
         x = samples[:, j]
         low, median, high = np.percentile(x, [2.5, 50, 97.5])
+        se_low, se_median, se_high = quantile_mc_stderr(x, [2.5, 50, 97.5])
         out[spec.name] = {"median": float(median), "low95": float(low), "high95": float(high),
                           "mean": float(np.mean(x)), "sd": float(np.std(x)),
+                          "median_mc_se": float(se_median), "low95_mc_se": float(se_low),
+                          "high95_mc_se": float(se_high),
                           "kind": spec.kind, "prior_low": spec.low, "prior_high": spec.high}
     if samples.shape[1] > 1:
         corr = np.corrcoef(samples.T)
     else:
         corr = np.ones((1, 1))
     return out, np.round(corr, 4).tolist()
+
+
+def summary_texts(summary: dict) -> tuple[str, str, str]:
+    """(median, low95, high95) of one parameter of :func:`summarise` as shown: each to the
+    digit its Monte-Carlo standard error leaves (``*_mc_se``; 4 significant digits where the
+    summary has none, e.g. a calibration.json written before them)."""
+    from ..units import display_with_uncertainty
+
+    return tuple(display_with_uncertainty(summary[k], summary.get(f"{k}_mc_se", math.nan))
+                 for k in ("median", "low95", "high95"))
 
 
 #: Share of the prior range, at each finite bound, that :func:`bound_notes` inspects, and the

@@ -122,8 +122,11 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         print(document_json(result.document()))
     else:
+        from ..calibrate.posterior import summary_texts
+
         for name, p in result.parameters.items():
-            print(f"{name}: {p['median']:.4g} (95 % {p['low95']:.4g} .. {p['high95']:.4g})")
+            median, low, high = summary_texts(p)
+            print(f"{name}: {median} (95 % {low} .. {high})")
         print(f"in-sample RMS {result.rms:.4f}")
         if result.loo is not None:
             print(f"leave-one-out RMS {result.loo_rms:.4f}, {result.loo_coverage}/"
