@@ -102,6 +102,10 @@ DEM_SAMPLES_PER_CYCLE = 128
 #: at most about +-25-50 mm, and a larger one is a unit slip (0.2 typed for 200 Hz: 5 g at
 #: 0.2 Hz is 31 m) whose simulated time (cycles / f) ran for many minutes without a word.
 DEM_MAX_DISPLACEMENT_AMPLITUDE_M = 0.05
+#: Drive acceleration, g, above which a DEM run notes that it may be m/s^2 typed for g: Table
+#: 3 spans 1-10 g, and 5 or 10 g typed in m/s^2 read 49 or 98 "g" (a stroke a shaker makes at
+#: 50 Hz and above, so check_drive_stroke cannot tell). A note, not a refusal: a shaker can.
+DEM_NOTE_ACCELERATION_G = 20.0
 #: Settling ends when every cell's kinetic energy is below this fraction of N m g r.
 DEM_SETTLE_KINETIC_FRACTION = 1e-5
 #: Longest settling time before the run is refused, s.

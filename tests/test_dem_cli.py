@@ -409,3 +409,21 @@ def test_a_far_too_long_time_step_states_its_steps_per_contact(capsys):
                  "--time-step", "1e-3", "--no-progress"]) == 2
     err = capsys.readouterr().err
     assert "gives 0.0 steps" not in err and "gives 0.017 steps per acrylic contact" in err
+
+
+def test_a_drive_far_above_the_papers_accelerations_asks_whether_it_was_m_s2(capsys):
+    # `--acceleration 49` (5 g typed in m/s^2) strokes 50 µm at 500 Hz, which a shaker makes:
+    # the stroke check cannot tell; the run says what it would be in g
+    from pidcore import defaults
+    from pidcore.constants import STANDARD_GRAVITY
+
+    high = ["dem", "run", "--frequency", "500", "--acceleration", "49", "--fill", "50",
+            "--cells", "1", "--cycles", "2", "--no-progress", "--json"]
+    assert 49 > defaults.DEM_NOTE_ACCELERATION_G
+    assert main(high) == 0
+    notes = json.loads(capsys.readouterr().out)["notes"]
+    (note,) = [n for n in notes if "m/s^2" in n]
+    assert f"it is {49 / STANDARD_GRAVITY:.3g} g" in note
+    # the paper's 10 g says nothing of the kind
+    assert main([a if a != "49" else "10" for a in high]) == 0
+    assert not any("m/s^2" in n for n in json.loads(capsys.readouterr().out)["notes"])

@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .. import defaults
-from ..constants import COUNT_UNIT, RATIO_UNIT
+from ..constants import COUNT_UNIT, RATIO_UNIT, STANDARD_GRAVITY
 from ..loop import ForceDisplacementLoop
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -189,7 +189,9 @@ class DemResult:
           cycles, and the two blocks that detect the steady state both belong to the window;
         * ``particle_steps_per_s`` was not measured (NaN): every kernel call compiled code;
         * a property of the specimen overrides its table material's
-          (:func:`pidcore.specimen.table_overrides`).
+          (:func:`pidcore.specimen.table_overrides`);
+        * the drive is above :data:`pidcore.defaults.DEM_NOTE_ACCELERATION_G` (m/s^2 typed
+          for g?).
         """
         from ..specimen import table_overrides
         from .simulate import required_steady_cycles
@@ -208,6 +210,10 @@ class DemResult:
                          "included Numba compilation (run again for the compiled speed)")
         if self.specimen is not None:
             notes += table_overrides(self.specimen)
+        g = self.case.acceleration_g
+        if g > defaults.DEM_NOTE_ACCELERATION_G:
+            notes.append(f"a {g:g} g drive, above the paper's 1-10 g: if it was typed in "
+                         f"m/s^2, it is {g / STANDARD_GRAVITY:.3g} g")
         return tuple(notes)
 
     @property
