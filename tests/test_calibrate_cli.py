@@ -528,3 +528,19 @@ def test_a_file_analysed_twice_is_one_measured_point_of_its_newest_analysis(tmp_
     (point,) = measured_from_store(store)
     assert point.sdc == newest["sdc"]  # the baseline-corrected one, not the mean of both
     assert point.sdc_stderr == newest["sdc_stderr"]
+
+
+def test_help_states_the_design_size_and_seed_defaults(capsys):
+    """--design-size said 'enough for a quadratic surrogate' (the surrogate is a Gaussian
+    process; the default is default_design_size's 5 + 4 per further DEM parameter) and --seed
+    gave no default."""
+    from pidcore import defaults
+    from pidcore.calibrate.surrogate import default_design_size
+
+    with pytest.raises(SystemExit):
+        main(["calibrate", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert "quadratic" not in text
+    assert f"default {default_design_size(1)} for one DEM parameter" in text
+    assert f"{default_design_size(2) - default_design_size(1)} more per further one" in text
+    assert f"DEM seed (default {defaults.DEM_SEED})" in text

@@ -15,6 +15,7 @@ DEFAULT_STORE = Path("calibration_store.h5")
 def register(subparsers: argparse._SubParsersAction) -> None:
     from ..calibrate.parameters import DEFAULT_FIT, dem_parameter_names
     from ..calibrate.posterior import DISCREPANCY_FLOOR
+    from ..calibrate.surrogate import default_design_size
 
     names = ", ".join(["fixture_mass_kg", "baseline_loss_factor", *dem_parameter_names(),
                        "any numeric specimen field by dotted path"])
@@ -51,9 +52,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--steady-cycles", metavar="N", type=positive_int, default=None,
                    help="steady cycles measured per DEM run (default: the DEM's)")
     p.add_argument("--design-size", metavar="N", type=positive_int, default=None,
-                   help="DEM design points (default: enough for a quadratic surrogate)")
+                   help=f"DEM design points (default {default_design_size(1)} for one DEM "
+                        f"parameter, {default_design_size(2) - default_design_size(1)} more per "
+                        "further one; none fitted: one run per load case)")
     p.add_argument("--seed", type=non_negative_int, default=defaults.DEM_SEED,
-                   help="DEM seed")
+                   help=f"DEM seed (default {defaults.DEM_SEED})")
     p.add_argument("--workers", metavar="N", type=positive_int, default=2,
                    help="DEM processes (default 2)")
     p.add_argument("--method", choices=("auto", "grid", "emcee"), default="auto",
