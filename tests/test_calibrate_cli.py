@@ -544,3 +544,20 @@ def test_help_states_the_design_size_and_seed_defaults(capsys):
     assert f"default {default_design_size(1)} for one DEM parameter" in text
     assert f"{default_design_size(2) - default_design_size(1)} more per further one" in text
     assert f"DEM seed (default {defaults.DEM_SEED})" in text
+
+
+def test_store_of_only_another_specimens_tests_says_why_none_is_used(capsys, monkeypatch,
+                                                                     tmp_path):
+    # calibrate --store (the paper's coupon) on a store of steel_6mm's tests said only 'no
+    # measured points to calibrate against': the note naming what was left out, and how to
+    # calibrate it, was dropped when nothing was kept
+    import pandas as pd
+
+    frame = pd.DataFrame({"frequency_hz": [500.0, 1000.0], "acceleration_g": [1.0, 5.0],
+                          "fill_percent": [50.0] * 2, "sdc": [0.4, 0.6],
+                          "sdc_stderr": [0.01] * 2, "material": ["steel"] * 2,
+                          "specimen": ["steel_6mm"] * 2})
+    monkeypatch.setattr(Store, "list_analyses", lambda self: frame)
+    _refused(capsys, tmp_path, ["--store", str(tmp_path / "s.h5")],
+             "no measurement of the paper's coupon",
+             "2 measured load case(s) of specimen steel_6mm", "--specimen FILE of theirs")

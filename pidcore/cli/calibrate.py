@@ -147,6 +147,10 @@ def _store_points(points: list, specimen, store: Path) -> list:
 
     if specimen is None:
         kept, note = points_for_paper(points, hint="--specimen FILE of theirs")
+        if not kept:  # the library's 'no measured points' would not say why
+            raise ParameterError(
+                f"--store {store}: no measurement of the paper's coupon or of an unnamed "
+                f"specimen{'; ' + note if note else ''}")
         materials = sorted({str(p.material) for p in kept})
         if len(materials) > 1:
             raise ParameterError(
