@@ -410,21 +410,3 @@ def test_a_far_too_long_time_step_states_its_steps_per_contact(capsys):
     err = capsys.readouterr().err
     assert "gives 0.0 steps" not in err and "gives 0.017 steps per acrylic contact" in err
 
-
-@pytest.mark.parametrize("action_name", ["run", "sweep"])
-def test_every_choice_option_names_its_default_in_the_help(action_name):
-    # dem run --help gave no default for --direction, --damping-coefficient,
-    # --mass-convention, --start and --fill-reference (with_cell, say, is not the first
-    # choice a reader would guess); every option with choices now names the one it takes
-    import argparse
-
-    from pidcore.cli import build_parser
-
-    dem = next(a for a in build_parser("dem")._actions
-               if isinstance(a, argparse._SubParsersAction)).choices["dem"]
-    sub = next(a for a in dem._actions
-               if isinstance(a, argparse._SubParsersAction)).choices[action_name]
-    missing = [a.option_strings[0] for a in sub._actions
-               if a.choices is not None and a.default is not None
-               and f"default {a.default}" not in " ".join((a.help or "").split())]
-    assert not missing, missing

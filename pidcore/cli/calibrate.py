@@ -61,7 +61,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help="DEM processes (default 2)")
     p.add_argument("--method", choices=("auto", "grid", "emcee"), default="auto",
                    help="posterior: exact grid (<= 4 fitted quantities: 3 parameters plus "
-                        "the discrepancy) or emcee; auto picks")
+                        "the discrepancy) or emcee; auto picks (default auto)")
     p.add_argument("--dem-store", metavar="FILE", type=Path, default=DEFAULT_STORE,
                    help="HDF5 store caching the DEM runs (default %(default)s)")
     p.add_argument("--cross-validate", choices=("loo",), default=None,
