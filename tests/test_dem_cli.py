@@ -409,4 +409,3 @@ def test_a_far_too_long_time_step_states_its_steps_per_contact(capsys):
                  "--time-step", "1e-3", "--no-progress"]) == 2
     err = capsys.readouterr().err
     assert "gives 0.0 steps" not in err and "gives 0.017 steps per acrylic contact" in err
-
