@@ -151,6 +151,20 @@ def test_identical_files_stating_different_load_cases_are_refused_before_saving(
     assert not store_path.exists()
 
 
+def test_identical_files_of_one_load_case_stating_different_settings_say_so(tmp_path, capsys):
+    # the refusal said "state different load cases" beside two identical load cases (50 Hz,
+    # 5 g, 50 %, ... vs the same with a vibrometer delay): what differs is the setting
+    a = export(tmp_path / "a_fill50.csv", fmt="csv")
+    b = tmp_path / "b_fill50.csv"
+    b.write_bytes(a.read_bytes())
+    (tmp_path / "loadcases.csv").write_text(
+        "file,velocity_delay_us\na_fill50.csv,50\nb_fill50.csv,0\n", encoding="utf-8")
+    assert main(["analyze", str(a), str(b), "--no-store"]) == 2
+    err = capsys.readouterr().err
+    assert "identical contents but state different load cases, specimens or settings" in err
+    assert "vibrometer delay 50 µs" in err and err.count("\n") == 1
+
+
 def test_bad_file_leaves_store_untouched_and_exits_nonzero(tmp_path, capsys):
     store_path = tmp_path / "s.h5"
     good = export(tmp_path / "good.csv", fmt="csv")
