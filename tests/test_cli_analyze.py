@@ -422,3 +422,19 @@ def test_a_read_only_store_is_named_as_such_before_any_analysis(tmp_path, capsys
     # only read: a report of what it holds is made as before
     assert main(["report", "--store", str(store), "--out", str(tmp_path / "rep"),
                  "--format", "csv"]) == 0
+
+
+def test_a_file_of_other_particles_than_a_table_material_specimens_names_them(tmp_path, capsys):
+    # with a --specimen of acrylic particles (a table material) the refusal of a ..._steel
+    # file still read as if no specimen was given ("give --specimen FILE whose particles are
+    # steel"), not saying that the one given holds acrylic
+    from pidcore.specimen import paper_specimen
+
+    steel = export(tmp_path / "coupon_fill20_steel.csv", fmt="csv")
+    spec = tmp_path / "acrylic_coupon.toml"
+    spec.write_text(paper_specimen().to_toml(), encoding="utf-8")
+    assert main(["analyze", str(steel), "--specimen", str(spec), "--no-store"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1
+    assert "lacks (the --specimen's particles are acrylic); give --specimen FILE whose " \
+           "particles are steel" in err
