@@ -216,7 +216,8 @@ __all__ = ["KEY_PATTERN", "KEY_PATTERN_0_1", "LoadCase", "LoadCaseError", "check
 
 def refuse_identical_contents_stating_apart(files: Iterable[tuple[str, str, Hashable, str]],
                                             *, remedy: str = "") -> None:
-    """Refuse byte-identical files that state different load cases, as :class:`LoadCaseError`.
+    """Refuse byte-identical files that state different load cases (or specimens or analysis
+    settings), as :class:`LoadCaseError`.
 
     ``files``: per file (name, content key, what it states, that statement in words); the
     content key is the file's SHA-256 or the store's key of it ("" when unknown: not
@@ -230,7 +231,9 @@ def refuse_identical_contents_stating_apart(files: Iterable[tuple[str, str, Hash
             continue
         other = first.setdefault(key, (name, stated, words))
         if other[1] != stated:
+            # "different load cases" alone misled where only the settings or specimen differ
             clashes.append(f"{name} and {other[0]} have identical contents but state "
-                           f"different load cases ({words} vs {other[2]})")
+                           f"different load cases, specimens or settings ({words} vs "
+                           f"{other[2]})")
     if clashes:  # every one named: fixing one should not reveal the next
         raise LoadCaseError("; ".join(clashes) + (f"; {remedy}" if remedy else ""))

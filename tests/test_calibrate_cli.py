@@ -534,3 +534,36 @@ def test_a_file_analysed_twice_is_one_measured_point_of_its_newest_analysis(tmp_
     (point,) = measured_from_store(store)
     assert point.sdc == newest["sdc"]  # the baseline-corrected one, not the mean of both
     assert point.sdc_stderr == newest["sdc_stderr"]
+
+
+def test_help_states_the_design_size_and_seed_defaults(capsys):
+    """--design-size said 'enough for a quadratic surrogate' (the surrogate is a Gaussian
+    process; the default is default_design_size's 5 + 4 per further DEM parameter) and --seed
+    gave no default."""
+    from pidcore import defaults
+    from pidcore.calibrate.surrogate import default_design_size
+
+    with pytest.raises(SystemExit):
+        main(["calibrate", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert "quadratic" not in text
+    assert f"default {default_design_size(1)} for one DEM parameter" in text
+    assert f"{default_design_size(2) - default_design_size(1)} more per further one" in text
+    assert f"DEM seed (default {defaults.DEM_SEED})" in text
+
+
+def test_store_of_only_another_specimens_tests_says_why_none_is_used(capsys, monkeypatch,
+                                                                     tmp_path):
+    # calibrate --store (the paper's coupon) on a store of steel_6mm's tests said only 'no
+    # measured points to calibrate against': the note naming what was left out, and how to
+    # calibrate it, was dropped when nothing was kept
+    import pandas as pd
+
+    frame = pd.DataFrame({"frequency_hz": [500.0, 1000.0], "acceleration_g": [1.0, 5.0],
+                          "fill_percent": [50.0] * 2, "sdc": [0.4, 0.6],
+                          "sdc_stderr": [0.01] * 2, "material": ["steel"] * 2,
+                          "specimen": ["steel_6mm"] * 2})
+    monkeypatch.setattr(Store, "list_analyses", lambda self: frame)
+    _refused(capsys, tmp_path, ["--store", str(tmp_path / "s.h5")],
+             "no measurement of the paper's coupon",
+             "2 measured load case(s) of specimen steel_6mm", "--specimen FILE of theirs")

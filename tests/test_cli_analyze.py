@@ -151,6 +151,20 @@ def test_identical_files_stating_different_load_cases_are_refused_before_saving(
     assert not store_path.exists()
 
 
+def test_identical_files_of_one_load_case_stating_different_settings_say_so(tmp_path, capsys):
+    # the refusal said "state different load cases" beside two identical load cases (50 Hz,
+    # 5 g, 50 %, ... vs the same with a vibrometer delay): what differs is the setting
+    a = export(tmp_path / "a_fill50.csv", fmt="csv")
+    b = tmp_path / "b_fill50.csv"
+    b.write_bytes(a.read_bytes())
+    (tmp_path / "loadcases.csv").write_text(
+        "file,velocity_delay_us\na_fill50.csv,50\nb_fill50.csv,0\n", encoding="utf-8")
+    assert main(["analyze", str(a), str(b), "--no-store"]) == 2
+    err = capsys.readouterr().err
+    assert "identical contents but state different load cases, specimens or settings" in err
+    assert "vibrometer delay 50 µs" in err and err.count("\n") == 1
+
+
 def test_bad_file_leaves_store_untouched_and_exits_nonzero(tmp_path, capsys):
     store_path = tmp_path / "s.h5"
     good = export(tmp_path / "good.csv", fmt="csv")
@@ -408,3 +422,19 @@ def test_a_read_only_store_is_named_as_such_before_any_analysis(tmp_path, capsys
     # only read: a report of what it holds is made as before
     assert main(["report", "--store", str(store), "--out", str(tmp_path / "rep"),
                  "--format", "csv"]) == 0
+
+
+def test_a_file_of_other_particles_than_a_table_material_specimens_names_them(tmp_path, capsys):
+    # with a --specimen of acrylic particles (a table material) the refusal of a ..._steel
+    # file still read as if no specimen was given ("give --specimen FILE whose particles are
+    # steel"), not saying that the one given holds acrylic
+    from pidcore.specimen import paper_specimen
+
+    steel = export(tmp_path / "coupon_fill20_steel.csv", fmt="csv")
+    spec = tmp_path / "acrylic_coupon.toml"
+    spec.write_text(paper_specimen().to_toml(), encoding="utf-8")
+    assert main(["analyze", str(steel), "--specimen", str(spec), "--no-store"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1
+    assert "lacks (the --specimen's particles are acrylic); give --specimen FILE whose " \
+           "particles are steel" in err

@@ -279,3 +279,20 @@ def test_an_sdc_above_2_pi_is_refused_unless_accepted(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "implausible: SDC 7.99" in err and "above the physical bound 6.28" in err
     assert main(["analyze", str(path), "--no-store", "--accept-implausible"]) == 0
+
+
+def test_a_report_of_the_store_says_again_that_a_stored_result_was_kept_implausible(tmp_path,
+                                                                                   capsys):
+    # a result saved with --accept-implausible (SDC 8.0 > 2 pi) was reported from the store
+    # later as an ordinary measured SDC: report FILES noted it, report --store said nothing
+    damping = 200.0
+    path = _damped_export(tmp_path / "rec_fill50.csv", damping)
+    store = tmp_path / "s.h5"
+    assert main(["analyze", str(path), "--store", str(store), "--accept-implausible"]) == 0
+    capsys.readouterr()
+    out = tmp_path / "r"
+    assert main(["report", "--store", str(store), "--out", str(out), "--format", "csv"]) == 0
+    said = capsys.readouterr().out
+    provenance = (out / "report.provenance.txt").read_text(encoding="utf-8")
+    for text in (said, provenance):
+        assert "rec_fill50.csv: implausible, kept as asked: SDC 7.99" in text, text

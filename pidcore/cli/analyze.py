@@ -29,7 +29,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "analyze",
         help="loss factor and SDC from force/velocity exports (Eq. 11)",
         description="Analyse shaker-test exports (UFF58/58b, CSV/TXT, MAT, HDF5): complex power "
-                    "(Eq. 11), loss factor, specific damping capacity, one record per load case. "
+                    "(Eq. 11), loss factor, specific damping capacity, one record per file, "
+                    "saved with its load case. "
                     "Each file is analysed with its sidecar row's settings (vibrometer delay, "
                     "channels, ...) unless an option overrides them. Results are saved to the "
                     "store unless --no-store.",

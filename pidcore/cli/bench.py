@@ -15,7 +15,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     s.add_argument("--samples", type=positive_int, default=10_000_000,
                    help="samples per channel (default 10 000 000)")
     s.add_argument("--repeat", type=positive_int, default=3,
-                   help="timed repetitions (best is kept)")
+                   help="timed repetitions (best is kept; default 3)")
     s.add_argument("--json", action="store_true", help="one JSON document on stdout")
     s.set_defaults(func=_bench_signal)
     d = sub.add_parser("dem", help="DEM particle-steps/s on one core and the Table 3 grid time",

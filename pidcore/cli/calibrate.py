@@ -15,6 +15,7 @@ DEFAULT_STORE = Path("calibration_store.h5")
 def register(subparsers: argparse._SubParsersAction) -> None:
     from ..calibrate.parameters import DEFAULT_FIT, dem_parameter_names
     from ..calibrate.posterior import DISCREPANCY_FLOOR
+    from ..calibrate.surrogate import default_design_size
 
     names = ", ".join(["fixture_mass_kg", "baseline_loss_factor", *dem_parameter_names(),
                        "any numeric specimen field by dotted path"])
@@ -51,14 +52,16 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--steady-cycles", metavar="N", type=positive_int, default=None,
                    help="steady cycles measured per DEM run (default: the DEM's)")
     p.add_argument("--design-size", metavar="N", type=positive_int, default=None,
-                   help="DEM design points (default: enough for a quadratic surrogate)")
+                   help=f"DEM design points (default {default_design_size(1)} for one DEM "
+                        f"parameter, {default_design_size(2) - default_design_size(1)} more per "
+                        "further one; none fitted: one run per load case)")
     p.add_argument("--seed", type=non_negative_int, default=defaults.DEM_SEED,
-                   help="DEM seed")
+                   help=f"DEM seed (default {defaults.DEM_SEED})")
     p.add_argument("--workers", metavar="N", type=positive_int, default=2,
                    help="DEM processes (default 2)")
     p.add_argument("--method", choices=("auto", "grid", "emcee"), default="auto",
                    help="posterior: exact grid (<= 4 fitted quantities: 3 parameters plus "
-                        "the discrepancy) or emcee; auto picks")
+                        "the discrepancy) or emcee; auto picks (default auto)")
     p.add_argument("--dem-store", metavar="FILE", type=Path, default=DEFAULT_STORE,
                    help="HDF5 store caching the DEM runs (default %(default)s)")
     p.add_argument("--cross-validate", choices=("loo",), default=None,
@@ -147,6 +150,10 @@ def _store_points(points: list, specimen, store: Path) -> list:
 
     if specimen is None:
         kept, note = points_for_paper(points, hint="--specimen FILE of theirs")
+        if not kept:  # the library's 'no measured points' would not say why
+            raise ParameterError(
+                f"--store {store}: no measurement of the paper's coupon or of an unnamed "
+                f"specimen{'; ' + note if note else ''}")
         materials = sorted({str(p.material) for p in kept})
         if len(materials) > 1:
             raise ParameterError(

@@ -123,7 +123,8 @@ def _add_config_options(p: argparse.ArgumentParser) -> None:
                    help="particles of the paper's coupon (default acrylic; with --specimen: "
                         "the specimen's)")
     p.add_argument("--direction", choices=DRIVE_DIRECTIONS, default="z",
-                   help="drive direction in the cell frame (z normal to the face sheets)")
+                   help="drive direction in the cell frame (z normal to the face sheets; "
+                        "default z)")
     p.add_argument("--cycles", metavar="N", type=int, default=None,
                    help=f"steady-state cycles measured (default "
                         f"{defaults.DEM_MIN_STEADY_CYCLES})")
@@ -137,12 +138,15 @@ def _add_config_options(p: argparse.ArgumentParser) -> None:
                         f"{defaults.DEM_NORMAL_DAMPING_MODE})")
     p.add_argument("--damping-coefficient", choices=("eq3", "calibrated"),
                    default=defaults.DEM_DAMPING_COEFFICIENT,
-                   help="alpha by Eq. 3, or calibrated to the table's restitution")
+                   help="alpha by Eq. 3, or calibrated to the table's restitution (default "
+                        f"{defaults.DEM_DAMPING_COEFFICIENT})")
     p.add_argument("--mass-convention", choices=VIBRATED_MASS_CONVENTIONS,
                    default=defaults.DEM_VIBRATED_MASS_CONVENTION,
-                   help="mass m_c in E = m_c a^2 / (2 w^2)")
+                   help="mass m_c in E = m_c a^2 / (2 w^2) (default "
+                        f"{defaults.DEM_VIBRATED_MASS_CONVENTION})")
     p.add_argument("--start", choices=START_PROTOCOLS, default=defaults.DEM_START_PROTOCOL,
-                   help="particles at rest or moving with the cell when the drive starts")
+                   help="particles at rest or moving with the cell when the drive starts "
+                        f"(default {defaults.DEM_START_PROTOCOL})")
     p.add_argument("--packing", choices=START_PACKINGS, default=defaults.DEM_START_PACKING,
                    help="start packing: settled first without friction (dense) or with "
                         f"friction only (loose) (default {defaults.DEM_START_PACKING})")
@@ -158,7 +162,8 @@ def _add_config_options(p: argparse.ArgumentParser) -> None:
                         "the specimen's, constant for the paper's coupon)")
     p.add_argument("--fill-reference", choices=("capacity", "paper"),
                    default=defaults.DEM_FILL_REFERENCE,
-                   help="100 %% = cell capacity (dense packing) or the paper's 36 particles")
+                   help="100 %% = cell capacity (dense packing) or the paper's 36 particles "
+                        f"(default {defaults.DEM_FILL_REFERENCE})")
 
 
 def _register_sweep(sub: argparse._SubParsersAction) -> None:

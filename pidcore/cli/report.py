@@ -66,7 +66,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--specimen", metavar="FILE", type=Path, default=None,
                    help="compare only DEM runs of this specimen file (default: the paper's "
                         "coupon); the paper's Table 3 only for the paper's coupon; FILES of "
-                        "its particles whose sidecar names no specimen are saved as its tests")
+                        "its particles whose sidecar names no specimen are its tests (saved "
+                        "as such to --store)")
     p.add_argument("--pool", action="store_true",
                    help="pool DEM runs of different numerical settings and measurements of "
                         "different specimens at one load case into one row (default: a row "

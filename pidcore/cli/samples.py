@@ -20,7 +20,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     m.add_argument("--skip-sweep", action="store_true",
                    help="reuse the DEM runs already in OUT/dem_table3.h5")
     m.add_argument("--workers", metavar="N", type=positive_int, default=None,
-                   help="processes for the DEM sweep")
+                   help="processes for the DEM sweep (default: all cores)")
     m.set_defaults(func=_make)
 
 

@@ -184,6 +184,8 @@ def _refuse_untabulated_material(path: Path, known: tuple[str, ...],
         if specimen_material is not None and specimen_material not in PARTICLE_MATERIALS:
             lacks = (f"material table ({', '.join(PARTICLE_MATERIALS)}) and the --specimen's "
                      f"{specimen_material} particles lack")
+        elif specimen_material is not None:  # a specimen of a table material was given too
+            lacks += f" (the --specimen's particles are {specimen_material})"
         raise UntabulatedMaterial(
             f"{path.name}: file name states particle material {named[0]!r}, which the "
             f"{lacks}; give --specimen FILE whose particles are {named[0]}, or state the "

@@ -144,3 +144,25 @@ def refuse_implausible(records, names, *, accept: bool) -> list:
         notes = plausibility_notes(record.analysis)
         out.append(replace(record, notes=record.notes + notes) if notes else record)
     return out
+
+
+def stored_plausibility_notes(analyses) -> list[str]:
+    """:func:`plausibility_notes` of stored analyses (a store listing's rows, as
+    :meth:`pidcore.store.Store.list_analyses` gives them), each prefixed with its source: a
+    record kept with ``--accept-implausible`` (or confirmed in the app) says so again in a
+    report of the store, not only when it was saved."""
+    from types import SimpleNamespace
+
+    out = []
+    for row in analyses.to_dict("records"):
+        try:
+            analysis = SimpleNamespace(
+                complex_power_w=complex(float(row["complex_power_real_w"]),
+                                        float(row["complex_power_imag_w"])),
+                loss_factor=float(row["loss_factor"]), sdc=float(row["sdc"]),
+                sdc_stderr=float(row.get("sdc_stderr", math.nan)),
+                omega_rad_s=2 * math.pi * float(row["frequency_hz"]))
+        except (KeyError, TypeError, ValueError):  # a record lacking a value: nothing to judge
+            continue
+        out.extend(f"{row.get('source', '')}: {n}" for n in plausibility_notes(analysis))
+    return out

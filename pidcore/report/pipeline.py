@@ -614,7 +614,7 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         refuse_store_among_inputs(main, files)  # before reading (it may hold many measurements)
         if files:  # their analyses are added to it
             main.check_writable()
-    from ..compare.plausibility import plausibility_notes
+    from ..compare.plausibility import plausibility_notes, stored_plausibility_notes
 
     options = options or AnalysisOptions()
     results = analyze_files(
@@ -664,6 +664,8 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
     elif main is not None:
         listed = main.list_analyses()
         analyses = latest_per_measurement(listed)
+        # a stored result kept as implausible is said again here, as when it was saved
+        notes.extend(stored_plausibility_notes(analyses))
         if not listed.empty:
             left_out = listed["measurement_key"].nunique() - analyses["measurement_key"].nunique()
             if left_out:
