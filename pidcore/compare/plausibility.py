@@ -102,6 +102,8 @@ def implausible_findings(analysis) -> tuple[tuple[PlausibilityWarning, ...], tup
     """(warnings beyond noise, notes) of one analysis: :func:`check_analysis`'s warnings,
     except a negative loss factor within :data:`NEGATIVE_WITHIN_STDERRS` standard errors of
     zero, which becomes a note (zero damping, measured with noise)."""
+    from ..defaults import REACTIVE_POWER_MIN_FRACTION
+
     warnings, notes = [], []
     for w in check_analysis(analysis):
         stderr = float(getattr(analysis, "sdc_stderr", math.nan))
@@ -110,6 +112,15 @@ def implausible_findings(analysis) -> tuple[tuple[PlausibilityWarning, ...], tup
             notes.append(f"SDC {analysis.sdc:.3g} is zero within its uncertainty "
                          f"({NEGATIVE_WITHIN_STDERRS:g} x its standard error {stderr:.2g}): "
                          "no damping resolved")
+            continue
+        power = complex(analysis.complex_power_w)
+        if (w.check == "negative_loss_factor"
+                and -power.real <= REACTIVE_POWER_MIN_FRACTION * abs(power)):
+            # a noise-free undamped record gives Re P of round-off (-1e-16 |P|), whose block
+            # standard error is round-off too: it was refused as energy created, with "a
+            # vibrometer delay of about 0 µs" as its cause
+            notes.append(f"SDC {analysis.sdc:.3g} is zero within round-off (Re P_c below "
+                         f"{REACTIVE_POWER_MIN_FRACTION:g} x |P_c|): no damping resolved")
             continue
         warnings.append(w)
     return tuple(warnings), tuple(notes)
