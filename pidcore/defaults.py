@@ -102,6 +102,11 @@ DEM_SAMPLES_PER_CYCLE = 128
 #: at most about +-25-50 mm, and a larger one is a unit slip (0.2 typed for 200 Hz: 5 g at
 #: 0.2 Hz is 31 m) whose simulated time (cycles / f) ran for many minutes without a word.
 DEM_MAX_DISPLACEMENT_AMPLITUDE_M = 0.05
+#: Largest factor by which DEM_SAMPLES_PER_CYCLE samples per drive period may shorten the
+#: contacts' time step: above ~40 kHz (1 MHz typed for 1 kHz) the step shrank 100-fold and the
+#: settling alone (up to DEM_MAX_SETTLE_TIME_S of simulated time) ran for hours without a word;
+#: 1e300 Hz ended in an OverflowError traceback.
+DEM_MAX_STEP_SHORTENING = 10.0
 #: Settling ends when every cell's kinetic energy is below this fraction of N m g r.
 DEM_SETTLE_KINETIC_FRACTION = 1e-5
 #: Longest settling time before the run is refused, s.
