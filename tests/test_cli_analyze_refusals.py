@@ -279,3 +279,23 @@ def test_an_sdc_above_2_pi_is_refused_unless_accepted(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "implausible: SDC 7.99" in err and "above the physical bound 6.28" in err
     assert main(["analyze", str(path), "--no-store", "--accept-implausible"]) == 0
+
+
+def test_a_record_saved_as_implausible_is_named_so_by_a_report_of_the_store(tmp_path, capsys):
+    # analyze --accept-implausible noted it, but the store keeps numbers, not notes: a later
+    # report --store pooled its SDC (-0.16, energy created) into the row without a word
+    path = _damped_export(tmp_path / "rec_fill50.csv", -C_VISCOUS)
+    good = _damped_export(tmp_path / "ok_fill50.csv", C_VISCOUS)
+    store = tmp_path / "s.h5"
+    assert main(["analyze", str(path), str(good), "--store", str(store),
+                 "--accept-implausible"]) == 0
+    capsys.readouterr()
+    assert main(["report", "--store", str(store), "--out", str(tmp_path / "r"),
+                 "--format", "csv"]) == 0
+    out = capsys.readouterr().out
+    flagged = [ln for ln in out.splitlines() if "implausible, saved as accepted" in ln]
+    assert len(flagged) == 1 and flagged[0].startswith("note: rec_fill50.csv: ")
+    assert "negative loss factor" in flagged[0]
+    provenance = (tmp_path / "r" / "report.provenance.txt").read_text(encoding="utf-8")
+    assert "rec_fill50.csv: implausible, saved as accepted" in provenance
+    assert "ok_fill50.csv: implausible" not in provenance

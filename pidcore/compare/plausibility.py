@@ -155,3 +155,26 @@ def refuse_implausible(records, names, *, accept: bool) -> list:
         notes = plausibility_notes(record.analysis)
         out.append(replace(record, notes=record.notes + notes) if notes else record)
     return out
+
+
+def stored_plausibility_notes(record) -> tuple[str, ...]:
+    """The notes a stored analysis (a row of :meth:`pidcore.store.Store.list_analyses`: its
+    complex power, loss factor, SDC, standard error and frequency) carries, as
+    :func:`plausibility_notes` gives them for an analysis in memory. A store keeps the numbers,
+    not the notes: a record saved with ``--accept-implausible`` was reported from the store
+    as any other (its SDC -1.26 pooled into a row without a word)."""
+    from types import SimpleNamespace
+
+    try:
+        analysis = SimpleNamespace(
+            complex_power_w=complex(float(record["complex_power_real_w"]),
+                                    float(record["complex_power_imag_w"])),
+            loss_factor=float(record["loss_factor"]), sdc=float(record["sdc"]),
+            sdc_stderr=float(record.get("sdc_stderr", math.nan)),
+            omega_rad_s=2 * math.pi * float(record["frequency_hz"]))
+    except (KeyError, TypeError, ValueError):  # a listing without the numbers: nothing to say
+        return ()
+    warnings, notes = implausible_findings(analysis)
+    return notes + tuple(f"implausible, saved as accepted (--accept-implausible): {w}"
+                         for w in warnings)
+

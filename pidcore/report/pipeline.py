@@ -664,6 +664,11 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
     elif main is not None:
         listed = main.list_analyses()
         analyses = latest_per_measurement(listed)
+        from ..compare.plausibility import stored_plausibility_notes
+
+        for _, record in analyses.iterrows():
+            notes.extend(f"{display_path(str(record.get('source', '') or record['key']))}: "
+                         f"{n}" for n in stored_plausibility_notes(record))
         if not listed.empty:
             left_out = listed["measurement_key"].nunique() - analyses["measurement_key"].nunique()
             if left_out:
