@@ -667,7 +667,8 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         from ..compare.plausibility import stored_plausibility_notes
 
         for _, record in analyses.iterrows():
-            notes.extend(f"{display_path(str(record.get('source', '') or record['key']))}: "
+            name = Path(str(record.get("source", "") or record["key"])).name
+            notes.extend(f"{display_path(name)}: "
                          f"{n}" for n in stored_plausibility_notes(record))
         if not listed.empty:
             left_out = listed["measurement_key"].nunique() - analyses["measurement_key"].nunique()
