@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -408,3 +409,24 @@ def test_a_read_only_store_is_named_as_such_before_any_analysis(tmp_path, capsys
     # only read: a report of what it holds is made as before
     assert main(["report", "--store", str(store), "--out", str(tmp_path / "rep"),
                  "--format", "csv"]) == 0
+
+
+def test_a_store_named_in_latin1_bytes_is_printed_with_escapes(tmp_path, capsys):
+    # in a UTF-8 terminal (stdout errors 'strict') analyze printed 'saved 1 record(s) to
+    # s\udce9.h5' as a UnicodeEncodeError traceback, after the record was saved
+    import os
+
+    from _shaker_files import write_force_velocity
+
+    from pidcore.signal.synthetic import synthesize_shaker_record
+
+    rec = synthesize_shaker_record(mass_kg=0.25, acceleration_amplitude_m_s2=49.0,
+                                   frequency_hz=100.0, sample_rate_hz=25_600.0, n_periods=15,
+                                   viscous_damping_n_s_m=2.0, snr_db=60, seed=5)
+    path = write_force_velocity(tmp_path / "rec_fill50.csv", rec.force_n, rec.velocity_m_s,
+                                25_600.0)
+    store = tmp_path / os.fsdecode(b"s\xe9.h5")
+    assert sys.stdout.errors == "strict"  # the premise: capsys encodes as a UTF-8 terminal
+    assert main(["analyze", str(path), "--store", str(store)]) == 0
+    assert "saved 1 record(s) to " + str(tmp_path) + "/s\\xe9.h5" in capsys.readouterr().out
+    assert sys.stdout.errors == "strict"  # put back for the caller

@@ -270,3 +270,22 @@ def test_missing_or_empty_file_is_named_before_its_load_case(tmp_path, capsys, c
     assert rc == 2 and err.count("\n") == 1 and str(path) in err
     assert ("file not found" if content is None else "empty file") in err
     assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.usefixtures("undrawn_report_figures")
+def test_a_store_whose_name_is_not_utf8_is_reported_with_escapes(tmp_path, dem_store, capsys):
+    # a store named s\xe9.h5 (Latin-1 bytes) failed the report after its analyses were saved:
+    # "UnicodeEncodeError: 'utf-8' codec can't encode character '\udce9' ... surrogates not
+    # allowed" (a traceback) where its provenance was written
+    import os
+
+    file = _write_measurement(tmp_path / "coupon1_fill50_acrylic.csv")
+    store = tmp_path / os.fsdecode(b"s\xe9.h5")
+    assert main(["report", str(file), "--store", str(store), "--dem-store", str(dem_store),
+                 "--out", str(tmp_path / "r"), "--format", "csv,md,html"]) == 0
+    capsys.readouterr()
+    assert main(["report", "--store", str(store), "--out", str(tmp_path / "r2"),
+                 "--format", "csv,md"]) == 0
+    for folder in ("r", "r2"):
+        text = (tmp_path / folder / "report.provenance.txt").read_text(encoding="utf-8")
+        assert f"store: {tmp_path}/s\\xe9.h5 sha256 {sha256_file(store)}" in text
