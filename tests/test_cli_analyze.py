@@ -430,3 +430,22 @@ def test_a_store_named_in_latin1_bytes_is_printed_with_escapes(tmp_path, capsys)
     assert main(["analyze", str(path), "--store", str(store)]) == 0
     assert "saved 1 record(s) to " + str(tmp_path) + "/s\\xe9.h5" in capsys.readouterr().out
     assert sys.stdout.errors == "strict"  # put back for the caller
+
+
+def test_a_store_chmod_444_is_read_only_for_root_too(tmp_path, capsys):
+    # as root (containers) os.access lets anything be written: analyze, report FILES, dem run
+    # and calibrate replaced a store its owner had made read-only (chmod 444) by their copy
+    path = export(tmp_path / "rec_fill50_acrylic.csv", fmt="csv")
+    store = tmp_path / "s.h5"
+    assert main(["analyze", str(path), "--store", str(store)]) == 0
+    capsys.readouterr()
+    store.chmod(0o444)
+    before = store.read_bytes()
+    other = export(tmp_path / "rec_fill25_acrylic.uff", fmt="uff")
+    assert main(["analyze", str(other), "--store", str(store)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "s.h5: the store file is read-only" in err
+    assert store.read_bytes() == before
+    assert sorted(p.name for p in tmp_path.iterdir() if p.name.startswith(".")) == []
+    store.chmod(0o644)  # made writable again: written as before
+    assert main(["analyze", str(other), "--store", str(store)]) == 0
