@@ -299,3 +299,18 @@ def test_a_record_saved_as_implausible_is_named_so_by_a_report_of_the_store(tmp_
     provenance = (tmp_path / "r" / "report.provenance.txt").read_text(encoding="utf-8")
     assert "rec_fill50.csv: implausible, saved as accepted" in provenance
     assert "ok_fill50.csv: implausible" not in provenance
+
+
+def test_a_fraction_hint_offers_only_a_fill_that_holds_a_particle(tmp_path, capsys):
+    # --fill 1e-9 was asked "was 1e-09 meant as 1e-07 %?": a fill that rounds to none too
+    from pidcore.specimen import paper_specimen
+
+    capacity = paper_specimen().capacity_per_cell()
+    path = export(tmp_path / "rec.csv")
+    for fill in ("1e-9", "0.01"):
+        assert round(float(fill) * 100 / 100 * capacity) == 0  # x100 holds none either
+        assert main(["analyze", str(path), "--no-store", "--fill", fill]) == 2
+        err = capsys.readouterr().err
+        assert "meant as" not in err and "a fill is a percentage of the cell's capacity" in err
+    assert main(["analyze", str(path), "--no-store", "--fill", "0.5"]) == 2
+    assert "was 0.5 meant as 50 %?" in capsys.readouterr().err
