@@ -289,3 +289,23 @@ def test_a_store_whose_name_is_not_utf8_is_reported_with_escapes(tmp_path, dem_s
     for folder in ("r", "r2"):
         text = (tmp_path / folder / "report.provenance.txt").read_text(encoding="utf-8")
         assert f"store: {tmp_path}/s\\xe9.h5 sha256 {sha256_file(store)}" in text
+
+
+@pytest.mark.usefixtures("undrawn_report_figures")
+def test_one_dem_store_given_under_several_spellings_is_read_and_listed_once(tmp_path,
+                                                                              dem_store):
+    # --dem-store d.h5 --dem-store /abs/d.h5 --dem-store link.h5 listed the one file three
+    # times in the provenance (each "store: ... sha256" the same digest)
+    import os
+
+    link = tmp_path / "link.h5"
+    link.symlink_to(dem_store)
+    rel = os.path.relpath(dem_store)
+    result = make_report([], out_dir=tmp_path / "r", dem_store=[dem_store, rel, link],
+                         formats="csv")
+    text = (tmp_path / "r" / "report.provenance.txt").read_text(encoding="utf-8")
+    digest = sha256_file(dem_store)
+    assert text.count(f"sha256 {digest}") == 1
+    assert f"store: {dem_store} sha256 {digest}" in text  # the first spelling given
+    alone = make_report([], out_dir=tmp_path / "r1", dem_store=dem_store, formats="csv")
+    pd.testing.assert_frame_equal(result.table, alone.table)

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -503,7 +504,12 @@ def _dem_paths(store: str | Path | None,
     if dem_store is None:
         return [Path(store)] if store else []
     given = [dem_store] if isinstance(dem_store, str | Path) else list(dem_store)
-    return list(dict.fromkeys(Path(p) for p in given))
+    # one file once, however spelt (d.h5, /abs/d.h5, a link to it): it was listed in the
+    # provenance once per spelling
+    first: dict[str, Path] = {}
+    for p in map(Path, given):
+        first.setdefault(os.path.realpath(p), p)
+    return list(first.values())
 
 
 def _joined_dem_runs(stores: list) -> pd.DataFrame | None:
