@@ -314,3 +314,30 @@ def test_a_fraction_hint_offers_only_a_fill_that_holds_a_particle(tmp_path, caps
         assert "meant as" not in err and "a fill is a percentage of the cell's capacity" in err
     assert main(["analyze", str(path), "--no-store", "--fill", "0.5"]) == 2
     assert "was 0.5 meant as 50 %?" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("store_existed", [False, True])
+def test_ctrl_c_after_the_analyses_were_saved_says_so(tmp_path, capsys, monkeypatch,
+                                                      store_existed):
+    # report FILES --store saves the analyses, then writes the report; a Ctrl-C in the write
+    # said "no store write was left half-done" alone, as if nothing had been saved
+    import pidcore.report.pipeline as pipeline
+    from pidcore.store import Store
+
+    path = export(tmp_path / "rec_fill50.csv")
+    store = tmp_path / "s.h5"
+    if store_existed:
+        assert main(["analyze", str(export(tmp_path / "other_fill25.csv", n_periods=20)),
+                     "--store", str(store)]) == 0
+        capsys.readouterr()
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(pipeline, "write_report", interrupted)
+    assert main(["report", str(path), "--store", str(store), "--out", str(tmp_path / "r"),
+                 "--format", "csv"]) == 130
+    err = capsys.readouterr().err
+    assert len(Store(store).list_analyses()) == 1 + store_existed  # saved, whole
+    assert f"the analyses of the 1 file(s) were saved to {store} before it (whole)" in err
+    assert "unchanged" not in err
