@@ -309,3 +309,30 @@ def test_one_dem_store_given_under_several_spellings_is_read_and_listed_once(tmp
     assert f"store: {dem_store} sha256 {digest}" in text  # the first spelling given
     alone = make_report([], out_dir=tmp_path / "r1", dem_store=dem_store, formats="csv")
     pd.testing.assert_frame_equal(result.table, alone.table)
+
+
+def test_a_store_kept_in_an_earlier_report_folder_is_never_replaced_with_it(tmp_path,
+                                                                           dem_store, capsys):
+    # report FILES --store rp/s.h5 --out rp (rp an earlier report): the analyses were saved
+    # to rp/s.h5, then rp was replaced whole by the new report, the store with it
+    out = tmp_path / "rp"
+    assert main(["report", "--dem-store", str(dem_store), "--out", str(out),
+                 "--format", "csv"]) == 0
+    store = out / "s.h5"
+    file = _write_measurement(tmp_path / "coupon1_fill50_acrylic.csv")
+    assert main(["analyze", str(file), "--store", str(store)]) == 0
+    before = store.read_bytes()
+    report_csv = (out / "report.csv").read_bytes()
+    capsys.readouterr()
+    assert main(["report", str(file), "--store", str(store), "--dem-store", str(dem_store),
+                 "--out", str(out), "--format", "csv"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "also holds 's.h5', which a report does not write" in err
+    assert store.read_bytes() == before and (out / "report.csv").read_bytes() == report_csv
+    # an earlier report holding only what a report writes is replaced as before
+    store.unlink()
+    assert main(["report", "--dem-store", str(dem_store), "--out", str(out),
+                 "--format", "all"]) == 0
+    assert main(["report", "--dem-store", str(dem_store), "--out", str(out),
+                 "--format", "csv"]) == 0
+    assert not (out / "report.md").exists()
