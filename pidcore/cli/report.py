@@ -48,7 +48,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("files", nargs="*", metavar="FILE", type=Path,
                    help="measurement exports to analyse (UFF58, CSV/TXT, MAT, HDF5)")
     p.add_argument("--out", metavar="DIR", type=Path, required=True,
-                   help="report folder (new, empty or an earlier report, replaced atomically)")
+                   help="report folder (new, empty or an earlier report holding only what a "
+                        "report writes, replaced atomically)")
     add_store_option(p, default=None,
                      help="HDF5 store: analyses of FILES are added to it; without FILES its "
                           "analyses are reported")
