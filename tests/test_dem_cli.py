@@ -424,7 +424,25 @@ def test_a_tiny_or_huge_frequency_is_one_line_not_a_traceback(capsys, frequency)
     if frequency == "1e-300":
         assert "displacement amplitude of more than 1e308 m" in err
     else:
-        assert f"frequency {float(frequency):g} Hz: 128 samples per drive period" in err
+        assert f"--frequency {float(frequency):g} Hz: 128 samples per drive period" in err
+
+
+def test_a_sweep_refuses_a_frequency_it_cannot_sample_before_any_case_runs(tmp_path, capsys,
+                                                                           monkeypatch):
+    # --frequencies 200,1e6 ran the 200 Hz case before the 1 MHz one was refused in its worker
+    import pidcore.dem.sweep as sweep
+
+    def no_run(*args, **kwargs):
+        raise AssertionError("a case ran")
+
+    monkeypatch.setattr(sweep, "run_sweep", no_run)
+    store = tmp_path / "runs.h5"
+    assert main(["dem", "sweep", "--frequencies", "200,1e6", "--accelerations", "5", "--fills",
+                 "50", "--cells", "2", "--cycles", "5", "--no-progress", "--store",
+                 str(store)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--frequencies 1e+06 Hz: 128 samples per drive period" in err
+    assert not store.exists()
 
 
 def test_the_highest_frequency_the_dem_takes_follows_from_its_time_step():

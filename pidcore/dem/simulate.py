@@ -469,8 +469,28 @@ def check_drive_stroke(case: LoadCase, *, what: str = "load case") -> None:
             "the frequency typed in kHz, or the acceleration in m/s^2?")
 
 
+def check_drive(case: LoadCase, config: DemConfig | None = None,
+                specimen: Specimen | None = None, *, what: str = "load case") -> None:
+    """Refuse, before any simulation, a drive :func:`simulate_load_case` refuses: a stroke no
+    shaker makes (:func:`check_drive_stroke`) or a frequency its sampling cannot afford
+    (:func:`check_drive_sampling`); a sweep refused the second only in the case's worker,
+    after the cases before it had run. ``what`` names the options in the message."""
+    config = config or DemConfig()
+    check_drive_stroke(case, what=what)
+    specimen = resolve_specimen(case, specimen)
+    law = contact_law(specimen, alpha_pp=config.alpha_pp, alpha_pw=config.alpha_pw)
+    dt_req = choose_time_step(case, law, specimen.geometry(), config.time_step,
+                              config.tangential_model)
+    period = 1.0 / case.frequency_hz
+    steps_per_cycle = math.ceil(period / (config.samples_per_cycle * dt_req)) \
+        * config.samples_per_cycle
+    check_drive_sampling(case, dt_s=period / steps_per_cycle, contact_step_s=dt_req,
+                         samples_per_cycle=config.samples_per_cycle,
+                         what=what.split("/")[0])  # the frequency's option
+
+
 def check_drive_sampling(case: LoadCase, *, dt_s: float, contact_step_s: float,
-                         samples_per_cycle: int) -> None:
+                         samples_per_cycle: int, what: str = "frequency") -> None:
     """Refuse a drive frequency whose samples per period shorten the contacts' time step
     ``contact_step_s`` to ``dt_s`` by more than :data:`pidcore.defaults.DEM_MAX_STEP_SHORTENING`
     (a frequency typed in mHz, or a megahertz drive no shaker makes): one line naming it."""
@@ -478,7 +498,7 @@ def check_drive_sampling(case: LoadCase, *, dt_s: float, contact_step_s: float,
         return
     highest = defaults.DEM_MAX_STEP_SHORTENING / (samples_per_cycle * contact_step_s)
     raise ParameterError(
-        f"frequency {case.frequency_hz:g} Hz: {samples_per_cycle} samples per drive period need "
+        f"{what} {case.frequency_hz:g} Hz: {samples_per_cycle} samples per drive period need "
         f"a time step {contact_step_s / dt_s:.3g} x shorter than the contacts' "
         f"({contact_step_s:.3g} s), and the run as much longer; expected at most "
         f"{highest:.3g} Hz (was it typed in mHz?)")
