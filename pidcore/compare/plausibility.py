@@ -157,12 +157,10 @@ def refuse_implausible(records, names, *, accept: bool) -> list:
     return out
 
 
-def stored_plausibility_notes(record) -> tuple[str, ...]:
-    """The notes a stored analysis (a row of :meth:`pidcore.store.Store.list_analyses`: its
-    complex power, loss factor, SDC, standard error and frequency) carries, as
-    :func:`plausibility_notes` gives them for an analysis in memory. A store keeps the numbers,
-    not the notes: a record saved with ``--accept-implausible`` was reported from the store
-    as any other (its SDC -1.26 pooled into a row without a word)."""
+def stored_findings(record) -> tuple[tuple[PlausibilityWarning, ...], tuple[str, ...]]:
+    """:func:`implausible_findings` of a stored analysis (a row of
+    :meth:`pidcore.store.Store.list_analyses`: its complex power, loss factor, SDC, standard
+    error and frequency); nothing where the row lacks those numbers."""
     from types import SimpleNamespace
 
     try:
@@ -173,8 +171,15 @@ def stored_plausibility_notes(record) -> tuple[str, ...]:
             sdc_stderr=float(record.get("sdc_stderr", math.nan)),
             omega_rad_s=2 * math.pi * float(record["frequency_hz"]))
     except (KeyError, TypeError, ValueError):  # a listing without the numbers: nothing to say
-        return ()
-    warnings, notes = implausible_findings(analysis)
+        return (), ()
+    return implausible_findings(analysis)
+
+
+def stored_plausibility_notes(record) -> tuple[str, ...]:
+    """The notes a stored analysis carries (:func:`stored_findings`), as
+    :func:`plausibility_notes` gives them for an analysis in memory. A store keeps the numbers,
+    not the notes: a record saved with ``--accept-implausible`` was reported from the store
+    as any other (its SDC -1.26 pooled into a row without a word)."""
+    warnings, notes = stored_findings(record)
     return notes + tuple(f"implausible, saved as accepted (--accept-implausible): {w}"
                          for w in warnings)
-
