@@ -106,6 +106,11 @@ DEM_MAX_DISPLACEMENT_AMPLITUDE_M = 0.05
 #: 3 spans 1-10 g, and 5 or 10 g typed in m/s^2 read 49 or 98 "g" (a stroke a shaker makes at
 #: 50 Hz and above, so check_drive_stroke cannot tell). A note, not a refusal: a shaker can.
 DEM_NOTE_ACCELERATION_G = 20.0
+#: Largest factor by which DEM_SAMPLES_PER_CYCLE samples per drive period may shorten the
+#: contacts' time step: above ~40 kHz (1 MHz typed for 1 kHz) the step shrank 100-fold and the
+#: settling alone (up to DEM_MAX_SETTLE_TIME_S of simulated time) ran for hours without a word;
+#: 1e300 Hz ended in an OverflowError traceback.
+DEM_MAX_STEP_SHORTENING = 10.0
 #: Settling ends when every cell's kinetic energy is below this fraction of N m g r.
 DEM_SETTLE_KINETIC_FRACTION = 1e-5
 #: Longest settling time before the run is refused, s.

@@ -61,6 +61,13 @@ class AnalysisOptions:
             raise ParameterError(f"invert: expected a sequence of channel names, got "
                                  f"{self.invert!r}")
         object.__setattr__(self, "invert", tuple(self.invert))  # JSON gives back a list
+        for name in ("velocity_delay_s", "mass_below_gauge_kg", "baseline_loss_factor"):
+            # -0 (a sidecar's '-0', --velocity-delay -0) is no correction: saved as -0.0 it
+            # made a second record of the same analysis (parameters_json differed) and was
+            # shown as 'vibrometer delay -0 µs'
+            value = getattr(self, name)
+            if isinstance(value, float) and value == 0.0:
+                object.__setattr__(self, name, 0.0)
 
     def parameters(self) -> dict:
         """JSON-safe parameters stored as provenance."""

@@ -114,6 +114,16 @@ def header_cells(data: bytes) -> list[str]:
     return [c.strip().strip('"').strip() for c in cells]
 
 
+def header_key(name: str) -> str:
+    """A column name as headers are matched: Unicode compatibility form (NFKC: the micro sign
+    µ is the Greek mu μ a Greek keyboard or autocorrect types, a no-break space a space), runs
+    of white space as one space, lower case. Both look alike in a spreadsheet; one was refused
+    as an unknown column."""
+    import unicodedata
+
+    return " ".join(unicodedata.normalize("NFKC", str(name)).split()).lower()
+
+
 def read_text_table(data: bytes, where: str, *, numeric: Iterable[str] = (),
                     example: str = "file,fill_percent,velocity_delay_us",
                     row: str = "file") -> pd.DataFrame:
@@ -196,7 +206,8 @@ def read_text_table(data: bytes, where: str, *, numeric: Iterable[str] = (),
     table = pd.DataFrame(records, columns=columns, index=pd.Index(numbers, name="line"),
                          dtype=object)
     if separator != ",":
-        for column in set(numeric) & set(columns):
+        numeric_keys = {header_key(n) for n in numeric}
+        for column in (c for c in columns if header_key(c) in numeric_keys):
             table[column] = [c.replace(",", ".") if _DECIMAL_COMMA.match(c) else c
                              for c in table[column]]
     return table

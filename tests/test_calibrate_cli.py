@@ -567,3 +567,34 @@ def test_store_of_only_another_specimens_tests_says_why_none_is_used(capsys, mon
     _refused(capsys, tmp_path, ["--store", str(tmp_path / "s.h5")],
              "no measurement of the paper's coupon",
              "2 measured load case(s) of specimen steel_6mm", "--specimen FILE of theirs")
+
+
+def test_a_record_saved_as_implausible_is_left_out_of_a_store_calibration(tmp_path, capsys):
+    # calibrate --store fitted an SDC of -1.26 (energy created, kept with
+    # --accept-implausible) averaged with the load case's real tests, without a word
+    from _shaker_files import write_force_velocity
+
+    from pidcore.calibrate import measured_from_store
+    from pidcore.constants import STANDARD_GRAVITY
+    from pidcore.signal.synthetic import synthesize_shaker_record
+
+    store = tmp_path / "s.h5"
+    paths = []
+    for name, damping in (("good_fill50_acrylic.csv", 2.0), ("neg_fill50_acrylic.csv", -2.0)):
+        rec = synthesize_shaker_record(mass_kg=0.25,
+                                       acceleration_amplitude_m_s2=5 * STANDARD_GRAVITY,
+                                       frequency_hz=500.0, sample_rate_hz=25_600.0,
+                                       n_periods=40, viscous_damping_n_s_m=damping,
+                                       snr_db=60, seed=3)
+        paths.append(write_force_velocity(tmp_path / name, rec.force_n, rec.velocity_m_s,
+                                          25_600.0, "csv"))
+    assert main(["analyze", *map(str, paths), "--store", str(store),
+                 "--accept-implausible"]) == 0
+    capsys.readouterr()
+    good = Store(store).list_analyses().set_index("source")
+    good_sdc = next(v for k, v in good["sdc"].items() if k.endswith("good_fill50_acrylic.csv"))
+    left_out: list[str] = []
+    (point,) = measured_from_store(store, left_out=left_out)
+    assert point.sdc == good_sdc > 0  # the good test alone, not the mean with -SDC
+    assert len(left_out) == 1 and left_out[0].startswith("neg_fill50_acrylic.csv: left out, "
+                                                         "implausible")

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -438,3 +439,43 @@ def test_a_file_of_other_particles_than_a_table_material_specimens_names_them(tm
     assert err.count("\n") == 1
     assert "lacks (the --specimen's particles are acrylic); give --specimen FILE whose " \
            "particles are steel" in err
+
+
+def test_a_store_named_in_latin1_bytes_is_printed_with_escapes(tmp_path, capsys):
+    # in a UTF-8 terminal (stdout errors 'strict') analyze printed 'saved 1 record(s) to
+    # s\udce9.h5' as a UnicodeEncodeError traceback, after the record was saved
+    import os
+
+    from _shaker_files import write_force_velocity
+
+    from pidcore.signal.synthetic import synthesize_shaker_record
+
+    rec = synthesize_shaker_record(mass_kg=0.25, acceleration_amplitude_m_s2=49.0,
+                                   frequency_hz=100.0, sample_rate_hz=25_600.0, n_periods=15,
+                                   viscous_damping_n_s_m=2.0, snr_db=60, seed=5)
+    path = write_force_velocity(tmp_path / "rec_fill50.csv", rec.force_n, rec.velocity_m_s,
+                                25_600.0)
+    store = tmp_path / os.fsdecode(b"s\xe9.h5")
+    assert sys.stdout.errors == "strict"  # the premise: capsys encodes as a UTF-8 terminal
+    assert main(["analyze", str(path), "--store", str(store)]) == 0
+    assert "saved 1 record(s) to " + str(tmp_path) + "/s\\xe9.h5" in capsys.readouterr().out
+    assert sys.stdout.errors == "strict"  # put back for the caller
+
+
+def test_a_store_chmod_444_is_read_only_for_root_too(tmp_path, capsys):
+    # as root (containers) os.access lets anything be written: analyze, report FILES, dem run
+    # and calibrate replaced a store its owner had made read-only (chmod 444) by their copy
+    path = export(tmp_path / "rec_fill50_acrylic.csv", fmt="csv")
+    store = tmp_path / "s.h5"
+    assert main(["analyze", str(path), "--store", str(store)]) == 0
+    capsys.readouterr()
+    store.chmod(0o444)
+    before = store.read_bytes()
+    other = export(tmp_path / "rec_fill25_acrylic.uff", fmt="uff")
+    assert main(["analyze", str(other), "--store", str(store)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "s.h5: the store file is read-only" in err
+    assert store.read_bytes() == before
+    assert sorted(p.name for p in tmp_path.iterdir() if p.name.startswith(".")) == []
+    store.chmod(0o644)  # made writable again: written as before
+    assert main(["analyze", str(other), "--store", str(store)]) == 0

@@ -295,4 +295,67 @@ def test_a_report_of_the_store_says_again_that_a_stored_result_was_kept_implausi
     said = capsys.readouterr().out
     provenance = (out / "report.provenance.txt").read_text(encoding="utf-8")
     for text in (said, provenance):
-        assert "rec_fill50.csv: implausible, kept as asked: SDC 7.99" in text, text
+        assert "rec_fill50.csv: implausible, saved as accepted (--accept-implausible): " \
+            "SDC 7.99" in text, text
+
+
+def test_a_record_saved_as_implausible_is_named_so_by_a_report_of_the_store(tmp_path, capsys):
+    # analyze --accept-implausible noted it, but the store keeps numbers, not notes: a later
+    # report --store pooled its SDC (-0.16, energy created) into the row without a word
+    path = _damped_export(tmp_path / "rec_fill50.csv", -C_VISCOUS)
+    good = _damped_export(tmp_path / "ok_fill50.csv", C_VISCOUS)
+    store = tmp_path / "s.h5"
+    assert main(["analyze", str(path), str(good), "--store", str(store),
+                 "--accept-implausible"]) == 0
+    capsys.readouterr()
+    assert main(["report", "--store", str(store), "--out", str(tmp_path / "r"),
+                 "--format", "csv"]) == 0
+    out = capsys.readouterr().out
+    flagged = [ln for ln in out.splitlines() if "implausible, saved as accepted" in ln]
+    assert len(flagged) == 1 and flagged[0].startswith("note: rec_fill50.csv: ")
+    assert "negative loss factor" in flagged[0]
+    provenance = (tmp_path / "r" / "report.provenance.txt").read_text(encoding="utf-8")
+    assert "rec_fill50.csv: implausible, saved as accepted" in provenance
+    assert "ok_fill50.csv: implausible" not in provenance
+
+
+def test_a_fraction_hint_offers_only_a_fill_that_holds_a_particle(tmp_path, capsys):
+    # --fill 1e-9 was asked "was 1e-09 meant as 1e-07 %?": a fill that rounds to none too
+    from pidcore.specimen import paper_specimen
+
+    capacity = paper_specimen().capacity_per_cell()
+    path = export(tmp_path / "rec.csv")
+    for fill in ("1e-9", "0.01"):
+        assert round(float(fill) * 100 / 100 * capacity) == 0  # x100 holds none either
+        assert main(["analyze", str(path), "--no-store", "--fill", fill]) == 2
+        err = capsys.readouterr().err
+        assert "meant as" not in err and "a fill is a percentage of the cell's capacity" in err
+    assert main(["analyze", str(path), "--no-store", "--fill", "0.5"]) == 2
+    assert "was 0.5 meant as 50 %?" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("store_existed", [False, True])
+def test_ctrl_c_after_the_analyses_were_saved_says_so(tmp_path, capsys, monkeypatch,
+                                                      store_existed):
+    # report FILES --store saves the analyses, then writes the report; a Ctrl-C in the write
+    # said "no store write was left half-done" alone, as if nothing had been saved
+    import pidcore.report.pipeline as pipeline
+    from pidcore.store import Store
+
+    path = export(tmp_path / "rec_fill50.csv")
+    store = tmp_path / "s.h5"
+    if store_existed:
+        assert main(["analyze", str(export(tmp_path / "other_fill25.csv", n_periods=20)),
+                     "--store", str(store)]) == 0
+        capsys.readouterr()
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(pipeline, "write_report", interrupted)
+    assert main(["report", str(path), "--store", str(store), "--out", str(tmp_path / "r"),
+                 "--format", "csv"]) == 130
+    err = capsys.readouterr().err
+    assert len(Store(store).list_analyses()) == 1 + store_existed  # saved, whole
+    assert f"the analyses of the 1 file(s) were saved to {store} before it (whole)" in err
+    assert "unchanged" not in err

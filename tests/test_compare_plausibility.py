@@ -150,3 +150,27 @@ def test_a_negative_loss_factor_within_its_noise_is_a_note_not_a_warning():
     # no standard error known: no noise to read it as, a warning
     warnings, _ = implausible_findings(analysis(-1e-6, math.nan))
     assert [w.check for w in warnings] == ["negative_loss_factor"]
+
+
+def _bare_analysis(real_w: float, imag_w: float, sdc_stderr: float):
+    """The fields the plausibility checks read, of a record with complex power P."""
+    from types import SimpleNamespace
+
+    eta = real_w / imag_w
+    return SimpleNamespace(complex_power_w=complex(real_w, imag_w), loss_factor=eta,
+                           sdc=2 * math.pi * eta, omega_rad_s=2 * math.pi * 100.0,
+                           sdc_stderr=sdc_stderr)
+
+
+def test_a_loss_factor_of_round_off_is_zero_damping_not_a_set_up_error():
+    # a noise-free undamped record (pidcore analyze of F = m a exactly) gave Re P = -1.25e-16 W
+    # of Im P 0.574 W and a block standard error of round-off (3.5e-16): it was refused as
+    # "negative loss factor -2.18e-16 ... a vibrometer delay of about 0 µs"
+    from pidcore.compare.plausibility import implausible_findings
+
+    warnings, notes = implausible_findings(_bare_analysis(-1.25e-16, 0.574, 3.5e-16))
+    assert warnings == ()
+    assert len(notes) == 1 and "zero within round-off" in notes[0]
+    # beyond round-off (1e-6 |P|) and beyond its standard error it is still refused
+    warnings, _ = implausible_findings(_bare_analysis(-0.574e-6, 0.574, 3.5e-16))
+    assert [w.check for w in warnings] == ["negative_loss_factor"]

@@ -427,3 +427,62 @@ def test_a_drive_far_above_the_papers_accelerations_asks_whether_it_was_m_s2(cap
     # the paper's 10 g says nothing of the kind
     assert main([a if a != "49" else "10" for a in high]) == 0
     assert not any("m/s^2" in n for n in json.loads(capsys.readouterr().out)["notes"])
+
+
+@pytest.mark.parametrize("frequency", ["1e-300", "1e300", "1e6"])
+def test_a_tiny_or_huge_frequency_is_one_line_not_a_traceback(capsys, frequency):
+    # --frequency 1e-300 raised ZeroDivisionError ((2 pi f)^2 underflows to 0), 1e300 an
+    # OverflowError (the settling's step count), and 1e6 ran for hours: 128 samples per
+    # 1 µs period need a time step ~230 x shorter than the contacts' ~1.8 µs
+    args = [a if a != "500" else frequency for a in ARGS]
+    assert main(args) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "Traceback" not in err
+    assert "inf" not in err and "nan" not in err
+    if frequency == "1e-300":
+        assert "displacement amplitude of more than 1e308 m" in err
+    else:
+        assert f"--frequency {float(frequency):g} Hz: 128 samples per drive period" in err
+
+
+def test_a_sweep_refuses_a_frequency_it_cannot_sample_before_any_case_runs(tmp_path, capsys,
+                                                                           monkeypatch):
+    # --frequencies 200,1e6 ran the 200 Hz case before the 1 MHz one was refused in its worker
+    import pidcore.dem.sweep as sweep
+
+    def no_run(*args, **kwargs):
+        raise AssertionError("a case ran")
+
+    monkeypatch.setattr(sweep, "run_sweep", no_run)
+    store = tmp_path / "runs.h5"
+    assert main(["dem", "sweep", "--frequencies", "200,1e6", "--accelerations", "5", "--fills",
+                 "50", "--cells", "2", "--cycles", "5", "--no-progress", "--store",
+                 str(store)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--frequencies 1e+06 Hz: 128 samples per drive period" in err
+    assert not store.exists()
+
+
+def test_the_highest_frequency_the_dem_takes_follows_from_its_time_step():
+    # at the frequency the refusal names, a period's 128 samples shorten the contacts' step
+    # by exactly DEM_MAX_STEP_SHORTENING: 1 % below it runs, 1 % above it is refused
+    import re
+
+    from pidcore import defaults
+    from pidcore.dem import LoadCase
+    from pidcore.dem.simulate import check_drive_sampling
+    from pidcore.errors import ParameterError
+
+    step = 1.81e-6
+    highest = defaults.DEM_MAX_STEP_SHORTENING / (defaults.DEM_SAMPLES_PER_CYCLE * step)
+    for f, refused in ((highest * 0.99, False), (highest * 1.01, True)):
+        dt = 1 / f / defaults.DEM_SAMPLES_PER_CYCLE
+        try:
+            check_drive_sampling(LoadCase(f, 5, 50), dt_s=dt, contact_step_s=step,
+                                 samples_per_cycle=defaults.DEM_SAMPLES_PER_CYCLE)
+        except ParameterError as exc:
+            assert refused
+            named = float(re.search(r"at most (\S+) Hz", str(exc)).group(1))
+            assert named == pytest.approx(highest, rel=1e-2)  # 3 significant digits
+        else:
+            assert not refused

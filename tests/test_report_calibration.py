@@ -10,6 +10,7 @@ import json
 import math
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 import pytest
 
@@ -334,3 +335,44 @@ def test_format_help_says_the_figures_come_with_any_format(tmp_path, capsys):
         main(["report", "--help"])
     help_text = " ".join(capsys.readouterr().out.split())
     assert "the figures (PNG and SVG, figures/) are written with any" in help_text
+
+
+@pytest.mark.parametrize("fields, words", [
+    # a band without measurement error that misses its own median was folded about it by
+    # the quadrature (low 0.6 > predicted 0.5 read as a band from 0.4)
+    ({"low95_without_stderr": 0.6, "high95_without_stderr": 0.7},
+     "low95_without_stderr <= predicted <= high95_without_stderr"),
+    ({"low95_without_stderr": 0.3, "high95_without_stderr": 0.45},
+     "low95_without_stderr <= predicted <= high95_without_stderr"),
+    ({"low95_without_stderr": 1e308, "high95_without_stderr": 1e308},
+     "low95_without_stderr <= predicted <= high95_without_stderr"),
+    # a negative standard error was loaded, matched a row's -0.01 and printed in its note
+    ({"measured_stderr": -0.01}, "measured_stderr must be a standard error >= 0"),
+])
+def test_a_calibration_whose_error_free_band_or_stderr_cannot_be_is_refused(tmp_path, fields,
+                                                                          words):
+    path = _write(tmp_path / "calibration.json",
+                  [{**_prediction(50, 5, 50, 0.50, 0.20, 0.80), "measured_stderr": 0.1,
+                    "low95_without_stderr": 0.40, "high95_without_stderr": 0.62, **fields}])
+    with pytest.raises(ParameterError, match=words) as err:
+        load_calibration(path)
+    assert str(path) in str(err.value) and "\n" not in str(err.value)
+
+
+def test_a_row_whose_stderr_gives_no_band_is_not_compared_and_says_why(tmp_path):
+    # a stderr of 1e308 gave a band up to inf (shown and saved), a negative one a
+    # ParameterError naming neither the row nor the file
+    fitted = {**_prediction(50, 5, 50, 0.50, 0.20, 0.80), "measured_stderr": 0.1,
+              "low95_without_stderr": 0.40, "high95_without_stderr": 0.62}
+    cal = load_calibration(_write(tmp_path / "calibration.json", [fitted]))
+    table = pd.DataFrame({
+        "frequency [Hz]": [50.0] * 3, "acceleration [g]": [5.0] * 3,
+        "packing ratio [%]": [50.0] * 3, "material": ["acrylic"] * 3,
+        "SDC measured [-]": [0.25] * 3, "SDC measured stderr [-]": [1e308, -0.01, 0.001],
+        "note": [""] * 3})
+    out = add_calibration_columns(table, cal)
+    bounds = out[[CALIBRATED_LOW_COLUMN, CALIBRATED_HIGH_COLUMN]].to_numpy()
+    assert not np.isinf(bounds).any()
+    assert out[CALIBRATED_INSIDE_COLUMN].tolist() == ["not compared", "not compared", "no"]
+    assert all("no calibrated band for this measurement's SDC stderr" in n
+               for n in out["note"][:2])

@@ -270,3 +270,69 @@ def test_missing_or_empty_file_is_named_before_its_load_case(tmp_path, capsys, c
     assert rc == 2 and err.count("\n") == 1 and str(path) in err
     assert ("file not found" if content is None else "empty file") in err
     assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.usefixtures("undrawn_report_figures")
+def test_a_store_whose_name_is_not_utf8_is_reported_with_escapes(tmp_path, dem_store, capsys):
+    # a store named s\xe9.h5 (Latin-1 bytes) failed the report after its analyses were saved:
+    # "UnicodeEncodeError: 'utf-8' codec can't encode character '\udce9' ... surrogates not
+    # allowed" (a traceback) where its provenance was written
+    import os
+
+    file = _write_measurement(tmp_path / "coupon1_fill50_acrylic.csv")
+    store = tmp_path / os.fsdecode(b"s\xe9.h5")
+    assert main(["report", str(file), "--store", str(store), "--dem-store", str(dem_store),
+                 "--out", str(tmp_path / "r"), "--format", "csv,md,html"]) == 0
+    capsys.readouterr()
+    assert main(["report", "--store", str(store), "--out", str(tmp_path / "r2"),
+                 "--format", "csv,md"]) == 0
+    for folder in ("r", "r2"):
+        text = (tmp_path / folder / "report.provenance.txt").read_text(encoding="utf-8")
+        assert f"store: {tmp_path}/s\\xe9.h5 sha256 {sha256_file(store)}" in text
+
+
+@pytest.mark.usefixtures("undrawn_report_figures")
+def test_one_dem_store_given_under_several_spellings_is_read_and_listed_once(tmp_path,
+                                                                              dem_store):
+    # --dem-store d.h5 --dem-store /abs/d.h5 --dem-store link.h5 listed the one file three
+    # times in the provenance (each "store: ... sha256" the same digest)
+    import os
+
+    link = tmp_path / "link.h5"
+    link.symlink_to(dem_store)
+    rel = os.path.relpath(dem_store)
+    result = make_report([], out_dir=tmp_path / "r", dem_store=[dem_store, rel, link],
+                         formats="csv")
+    text = (tmp_path / "r" / "report.provenance.txt").read_text(encoding="utf-8")
+    digest = sha256_file(dem_store)
+    assert text.count(f"sha256 {digest}") == 1
+    assert f"store: {dem_store} sha256 {digest}" in text  # the first spelling given
+    alone = make_report([], out_dir=tmp_path / "r1", dem_store=dem_store, formats="csv")
+    pd.testing.assert_frame_equal(result.table, alone.table)
+
+
+def test_a_store_kept_in_an_earlier_report_folder_is_never_replaced_with_it(tmp_path,
+                                                                           dem_store, capsys):
+    # report FILES --store rp/s.h5 --out rp (rp an earlier report): the analyses were saved
+    # to rp/s.h5, then rp was replaced whole by the new report, the store with it
+    out = tmp_path / "rp"
+    assert main(["report", "--dem-store", str(dem_store), "--out", str(out),
+                 "--format", "csv"]) == 0
+    store = out / "s.h5"
+    file = _write_measurement(tmp_path / "coupon1_fill50_acrylic.csv")
+    assert main(["analyze", str(file), "--store", str(store)]) == 0
+    before = store.read_bytes()
+    report_csv = (out / "report.csv").read_bytes()
+    capsys.readouterr()
+    assert main(["report", str(file), "--store", str(store), "--dem-store", str(dem_store),
+                 "--out", str(out), "--format", "csv"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "also holds 's.h5', which a report does not write" in err
+    assert store.read_bytes() == before and (out / "report.csv").read_bytes() == report_csv
+    # an earlier report holding only what a report writes is replaced as before
+    store.unlink()
+    assert main(["report", "--dem-store", str(dem_store), "--out", str(out),
+                 "--format", "all"]) == 0
+    assert main(["report", "--dem-store", str(dem_store), "--out", str(out),
+                 "--format", "csv"]) == 0
+    assert not (out / "report.md").exists()

@@ -294,3 +294,27 @@ def test_a_spreadsheets_line_above_the_header_is_read_in_the_cli_and_the_app(tmp
     table = uploads.read_settings_table("loadcases.csv", data)
     assert table["vibrometer delay [µs]"].tolist() == [50.0]
     assert table.attrs["lines"] == [3]  # rows still named by their line in the file
+
+
+@pytest.mark.parametrize("header", [
+    "file,fill [%],vibrometer delay [\u03bcs]",  # Greek mu (Greek keyboard, autocorrect)
+    "file,fill\u00a0[%],vibrometer delay [\u00b5s]",  # a spreadsheet's no-break space
+    "\ufeffFILE ,  Fill   [%] ,VIBROMETER DELAY [\u00b5S]",  # BOM, case, spaces
+])
+def test_a_column_label_spelt_with_lookalike_characters_is_read(header):
+    # "vibrometer delay [μs]" (Greek mu, U+03BC) was refused as an unknown column while
+    # "[µs]" (micro sign, U+00B5) was read: the error showed two names that look the same
+    from pidcore.compare.loadcase import settings_table
+    from pidcore.tables import read_text_table
+
+    for sep, numbers in ((",", "50,10"), (";", "50,5;10,5")):
+        text = header.replace(",", sep) + "\na.csv" + sep + numbers + "\n"
+        from pidcore.compare.loadcase import NUMERIC_HEADERS
+
+        table = settings_table(read_text_table(text.encode("utf-8"), "lc.csv",
+                                               numeric=NUMERIC_HEADERS), "lc.csv")
+        row = table.iloc[0]
+        # ';' tables write a decimal comma, read as a point in the numeric columns
+        expected = ("50", "10") if sep == "," else ("50.5", "10.5")
+        assert (row["file"], row["fill_percent"], row["velocity_delay_us"]) == ("a.csv",
+                                                                                 *expected)

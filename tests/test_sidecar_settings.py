@@ -378,3 +378,27 @@ def test_an_inversion_from_the_table_is_not_credited_to_the_option(tmp_path, cap
     err = refused(["analyze", str(flipped), "--no-store"], capsys)
     assert "flipped.csv: invert 'Forc': no such channel" in err and "--invert" not in err
     assert f"column invert 'Forc' of {table}, line 2 (flipped.csv)" in err
+
+
+def test_a_correction_of_minus_zero_is_the_same_analysis_as_none(tmp_path, capsys):
+    # a sidecar's '-0' (or --velocity-delay -0) was saved as velocity_delay_s -0.0: a second
+    # record of the same file and settings beside the one without it, shown as '-0 µs'
+    from pidcore.measure import AnalysisOptions
+    from pidcore.store import Store
+
+    minus = AnalysisOptions(velocity_delay_s=-0.0, mass_below_gauge_kg=-0.0,
+                            baseline_loss_factor=-0.0)
+    assert json.dumps(minus.parameters()) == json.dumps(AnalysisOptions().parameters())
+    from _app_samples import mass_damper_csv
+
+    src = tmp_path / "a_fill50.csv"
+    src.write_bytes(mass_damper_csv())
+    store = tmp_path / "s.h5"
+    (tmp_path / "lc.csv").write_text("file,velocity_delay_us,mass_below_gauge_g\n"
+                                     "a_fill50.csv,-0,-0\n", encoding="utf-8")
+    assert main(["analyze", str(src), "--sidecar", str(tmp_path / "lc.csv"),
+                 "--store", str(store)]) == 0
+    assert "vibrometer delay 0 µs, mass below gauge 0 g" in capsys.readouterr().out
+    assert main(["analyze", str(src), "--store", str(store)]) == 0
+    assert main(["analyze", str(src), "--velocity-delay", "-0", "--store", str(store)]) == 0
+    assert len(Store(store).list_analyses()) == 1

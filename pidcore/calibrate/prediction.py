@@ -77,6 +77,9 @@ class CalibratedPrediction:
         width = Z95 * stderr
         low = self.sdc - math.hypot(self.sdc - self.low95_without_stderr, width)
         high = self.sdc + math.hypot(self.high95_without_stderr - self.sdc, width)
+        if not math.isfinite(high):  # a stderr near 1e308: its band has no finite bound
+            raise ParameterError(f"stderr {stderr!r}: no finite 95 % band; expected a "
+                                 "standard error of an SDC")
         return max(low, 0.0), high
 
     def contains(self, sdc: float, stderr: float = math.nan) -> bool:
@@ -292,9 +295,15 @@ def calibration_from_json(text: str | bytes, source: str | os.PathLike, *,
             for k in ("measured", "measured_stderr", "low95_without_stderr",
                       "high95_without_stderr"))
         if math.isfinite(low0) != math.isfinite(high0) or (
-                math.isfinite(low0) and not low0 <= high0):
+                math.isfinite(low0) and not low0 <= sdc <= high0):
+            # a band without measurement error that misses its own median (low > predicted)
+            # was folded about it by band()'s quadrature: a made-up band, not the file's
             raise ParameterError(f"{path}: predictions[{i}]: expected low95_without_stderr <= "
-                                 f"high95_without_stderr, got {low0} / {high0}")
+                                 f"predicted <= high95_without_stderr, got {low0} / {sdc} / "
+                                 f"{high0}")
+        if measured_stderr < 0:  # NaN (not stated) passes
+            raise ParameterError(f"{path}: predictions[{i}].measured_stderr must be a standard "
+                                 f"error >= 0, got {measured_stderr!r}")
         predictions.append(CalibratedPrediction(LoadCase(f, a, fill, str(material)), sdc, low,
                                                 high, measured, measured_stderr, low0, high0))
     return Calibration(path=path, parameters=doc["parameters"], predictions=tuple(predictions),

@@ -8,8 +8,10 @@ exit code 2; Ctrl-C exits 130 after finished work has been saved.
 from __future__ import annotations
 
 import argparse
+import codecs
 import importlib
 import sys
+from collections.abc import Callable
 
 from .. import interrupt
 from ..errors import PidcoreError
@@ -45,15 +47,56 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
     return parser
 
 
+def _escape_unencodable(exc: UnicodeError) -> tuple[str, int]:
+    """Codec error handler ``pidcore.display``: a file name byte that is not UTF-8 (a
+    surrogate of ``os.fsdecode``) as ``\\xNN``, as :func:`pidcore.io.display_path` shows it;
+    any other character the stream cannot encode as a backslash escape."""
+    if not isinstance(exc, UnicodeEncodeError):
+        raise exc
+    bad = exc.object[exc.start:exc.end]
+    return "".join(f"\\x{ord(c) - 0xDC00:02x}" if 0xDC80 <= ord(c) <= 0xDCFF else
+                   c.encode("ascii", "backslashreplace").decode("ascii")
+                   for c in bad), exc.end
+
+
+codecs.register_error("pidcore.display", _escape_unencodable)
+
+
+def _displayable_streams() -> Callable[[], None]:
+    """stdout and stderr made to show what they cannot encode (a store or folder named in
+    Latin-1 bytes, printed in a UTF-8 terminal: a UnicodeEncodeError traceback after the
+    analyses were saved); returns what puts them back."""
+    undo = []
+    for stream in (sys.stdout, sys.stderr):
+        errors = getattr(stream, "errors", None)
+        if errors in (None, "pidcore.display") or not hasattr(stream, "reconfigure"):
+            continue
+        try:
+            stream.reconfigure(errors="pidcore.display")
+        except (ValueError, OSError):  # a stream that cannot change its handler: as it is
+            continue
+        undo.append((stream, errors))
+
+    def restore() -> None:
+        for stream, errors in undo:
+            try:
+                stream.reconfigure(errors=errors)
+            except (ValueError, OSError):
+                pass
+    return restore
+
+
 def main(argv: list[str] | None = None) -> int:
     # First thing: Ctrl-C during the imports below (every sub-command) or inside Numba must
     # end as one line and exit 130, and an interrupt swallowed somewhere must still stop the
     # store from committing (pidcore.interrupt).
     restore = interrupt.install()
     interrupt.reset()
+    streams = _displayable_streams()
     try:
         return _run(argv)
     finally:
+        streams()
         restore()
         interrupt.reset()  # an in-process caller (app, tests) may commit again afterwards
 

@@ -97,7 +97,11 @@ def run(args: argparse.Namespace) -> int:
     if args.data is not None:
         points = read_measured_table(args.data, default_material=default_material)
     else:
-        points = _store_points(measured_from_store(args.store), specimen, args.store)
+        left_out: list[str] = []
+        points = _store_points(measured_from_store(args.store, left_out=left_out), specimen,
+                               args.store)
+        for note in left_out:
+            print(f"pidcore calibrate: note: {note}", file=sys.stderr)
     tally = RunTally(args.dem_store)
     written = False
     try:

@@ -233,7 +233,7 @@ def _interrupted(command: str, saved: int, store) -> int:
 
 def sweep(args: argparse.Namespace) -> int:
     from ..dem.persist import run_key, stored_keys
-    from ..dem.simulate import check_drive_stroke
+    from ..dem.simulate import check_drive
     from ..dem.sweep import cross_cases, grid_axes, grid_fill_note, run_sweep
     from ..loadcase import parse_values
 
@@ -250,9 +250,9 @@ def sweep(args: argparse.Namespace) -> int:
     if note:  # on stderr: --json prints one document
         print(f"pidcore dem sweep: note: {note}", file=sys.stderr)
     cases = cross_cases(*values, material=material, direction=args.direction)
-    for case in cases:  # before any case runs, not in a worker after the others
-        check_drive_stroke(case, what="--frequencies/--accelerations")
     config = _config(args)
+    for case in cases:  # before any case runs, not in a worker after the others
+        check_drive(case, config, specimen, what="--frequencies/--accelerations")
     # What a Ctrl-C leaves saved is read from the store itself: a count kept beside the saves
     # could miss one that committed as the interrupt came.
     keys = [run_key(case, config, specimen) for case in cases]
@@ -314,10 +314,10 @@ def run(args: argparse.Namespace) -> int:
     specimen, material = _specimen(args)
     case = LoadCase(args.frequency, args.acceleration, _fill(args, specimen, material),
                     material=material, direction=args.direction)
-    from ..dem.simulate import check_drive_stroke
+    from ..dem.simulate import check_drive
 
-    check_drive_stroke(case, what="--frequency/--acceleration")
     config = _config(args)
+    check_drive(case, config, specimen, what="--frequency/--acceleration")
     progress = not args.no_progress and sys.stderr.isatty()
     key = None
     reused = False

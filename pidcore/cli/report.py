@@ -48,7 +48,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("files", nargs="*", metavar="FILE", type=Path,
                    help="measurement exports to analyse (UFF58, CSV/TXT, MAT, HDF5)")
     p.add_argument("--out", metavar="DIR", type=Path, required=True,
-                   help="report folder (new, empty or an earlier report, replaced atomically)")
+                   help="report folder (new, empty or an earlier report holding only what a "
+                        "report writes, replaced atomically)")
     add_store_option(p, default=None,
                      help="HDF5 store: analyses of FILES are added to it; without FILES its "
                           "analyses are reported")
@@ -96,6 +97,9 @@ def _run(args: argparse.Namespace) -> int:
 
     specimen = load_specimen(args.specimen) if args.specimen is not None else None
     before = folder_identity(args.out)
+    # a commit puts a new store file in place (copy, then rename): its identity says after a
+    # Ctrl-C whether the analyses of FILES were saved
+    store_before = folder_identity(args.store) if args.store is not None else None
     try:
         result = make_report(
             args.files, out_dir=args.out, store=args.store, dem_store=args.dem_store,
@@ -116,8 +120,13 @@ def _run(args: argparse.Namespace) -> int:
         after = folder_identity(args.out)
         said = (f"the report was written to {args.out} before it" if after != before else
                 f"{args.out} is as it was (a report is written whole or not at all)")
-        if args.files:  # their analyses are saved to the store in one transaction
-            said += "; no store write was left half-done"
+        if args.files and args.store is not None and \
+                folder_identity(args.store) != store_before:
+            # saved in one transaction before the report: said, not "nothing half-done" alone
+            said += (f"; the analyses of the {len(args.files)} file(s) were saved to "
+                     f"{args.store} before it (whole)")
+        elif args.files and args.store is not None:  # saved in one transaction, or not
+            said += "; no store write was left half-done, the store is unchanged"
         print(f"pidcore report: interrupted; {said}", file=sys.stderr)
         interrupt.mark_handled()
         return 130

@@ -44,7 +44,7 @@ from ..loadcase import (
     normalize_material,
 )
 from ..loadcase import check_fill as _check_fill
-from ..tables import line_where, read_text_table_file
+from ..tables import header_key, line_where, read_text_table_file
 
 
 class FillNotStated(LoadCaseError):
@@ -298,8 +298,9 @@ def settings_table(raw: pd.DataFrame, where: str) -> pd.DataFrame:
     sidecar's and the app's): the checks of :func:`read_sidecar`, columns
     :data:`SETTINGS_COLUMNS` in order. A column may be named by its app label
     (:data:`SETTINGS_COLUMN_LABELS`, any case); one column under both names is refused."""
-    by_label = {label.lower(): column for label, column in SETTINGS_COLUMN_LABELS.items()}
-    named = [by_label.get(str(c).lower(), c) for c in raw.columns]
+    by_label = {header_key(label): column for label, column in SETTINGS_COLUMN_LABELS.items()}
+    by_label.update({header_key(c): c for c in (*SETTINGS_COLUMNS, *FREE_TEXT_COLUMNS)})
+    named = [by_label.get(header_key(c), c) for c in raw.columns]
     for column in set(named):
         spelt = [str(c) for c, n in zip(raw.columns, named, strict=True) if n == column]
         if len(spelt) > 1:

@@ -102,6 +102,8 @@ def implausible_findings(analysis) -> tuple[tuple[PlausibilityWarning, ...], tup
     """(warnings beyond noise, notes) of one analysis: :func:`check_analysis`'s warnings,
     except a negative loss factor within :data:`NEGATIVE_WITHIN_STDERRS` standard errors of
     zero, which becomes a note (zero damping, measured with noise)."""
+    from ..defaults import REACTIVE_POWER_MIN_FRACTION
+
     warnings, notes = [], []
     for w in check_analysis(analysis):
         stderr = float(getattr(analysis, "sdc_stderr", math.nan))
@@ -110,6 +112,15 @@ def implausible_findings(analysis) -> tuple[tuple[PlausibilityWarning, ...], tup
             notes.append(f"SDC {analysis.sdc:.3g} is zero within its uncertainty "
                          f"({NEGATIVE_WITHIN_STDERRS:g} x its standard error {stderr:.2g}): "
                          "no damping resolved")
+            continue
+        power = complex(analysis.complex_power_w)
+        if (w.check == "negative_loss_factor"
+                and -power.real <= REACTIVE_POWER_MIN_FRACTION * abs(power)):
+            # a noise-free undamped record gives Re P of round-off (-1e-16 |P|), whose block
+            # standard error is round-off too: it was refused as energy created, with "a
+            # vibrometer delay of about 0 µs" as its cause
+            notes.append(f"SDC {analysis.sdc:.3g} is zero within round-off (Re P_c below "
+                         f"{REACTIVE_POWER_MIN_FRACTION:g} x |P_c|): no damping resolved")
             continue
         warnings.append(w)
     return tuple(warnings), tuple(notes)
@@ -146,23 +157,29 @@ def refuse_implausible(records, names, *, accept: bool) -> list:
     return out
 
 
-def stored_plausibility_notes(analyses) -> list[str]:
-    """:func:`plausibility_notes` of stored analyses (a store listing's rows, as
-    :meth:`pidcore.store.Store.list_analyses` gives them), each prefixed with its source: a
-    record kept with ``--accept-implausible`` (or confirmed in the app) says so again in a
-    report of the store, not only when it was saved."""
+def stored_findings(record) -> tuple[tuple[PlausibilityWarning, ...], tuple[str, ...]]:
+    """:func:`implausible_findings` of a stored analysis (a row of
+    :meth:`pidcore.store.Store.list_analyses`: its complex power, loss factor, SDC, standard
+    error and frequency); nothing where the row lacks those numbers."""
     from types import SimpleNamespace
 
-    out = []
-    for row in analyses.to_dict("records"):
-        try:
-            analysis = SimpleNamespace(
-                complex_power_w=complex(float(row["complex_power_real_w"]),
-                                        float(row["complex_power_imag_w"])),
-                loss_factor=float(row["loss_factor"]), sdc=float(row["sdc"]),
-                sdc_stderr=float(row.get("sdc_stderr", math.nan)),
-                omega_rad_s=2 * math.pi * float(row["frequency_hz"]))
-        except (KeyError, TypeError, ValueError):  # a record lacking a value: nothing to judge
-            continue
-        out.extend(f"{row.get('source', '')}: {n}" for n in plausibility_notes(analysis))
-    return out
+    try:
+        analysis = SimpleNamespace(
+            complex_power_w=complex(float(record["complex_power_real_w"]),
+                                    float(record["complex_power_imag_w"])),
+            loss_factor=float(record["loss_factor"]), sdc=float(record["sdc"]),
+            sdc_stderr=float(record.get("sdc_stderr", math.nan)),
+            omega_rad_s=2 * math.pi * float(record["frequency_hz"]))
+    except (KeyError, TypeError, ValueError):  # a listing without the numbers: nothing to say
+        return (), ()
+    return implausible_findings(analysis)
+
+
+def stored_plausibility_notes(record) -> tuple[str, ...]:
+    """The notes a stored analysis carries (:func:`stored_findings`), as
+    :func:`plausibility_notes` gives them for an analysis in memory. A store keeps the numbers,
+    not the notes: a record saved with ``--accept-implausible`` was reported from the store
+    as any other (its SDC -1.26 pooled into a row without a word)."""
+    warnings, notes = stored_findings(record)
+    return notes + tuple(f"implausible, saved as accepted (--accept-implausible): {w}"
+                         for w in warnings)

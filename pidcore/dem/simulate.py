@@ -449,17 +449,59 @@ def resolve_specimen(case: LoadCase, specimen: Specimen | None) -> Specimen:
     return specimen
 
 
+def _amount(value: float) -> str:
+    """A number as a message shows it: 3 significant digits, never 'inf'."""
+    return f"{value:.3g}" if math.isfinite(value) else "more than 1e308"
+
+
 def check_drive_stroke(case: LoadCase, *, what: str = "load case") -> None:
     """Refuse a drive whose displacement amplitude a/w^2 no shaker makes
     (:data:`pidcore.defaults.DEM_MAX_DISPLACEMENT_AMPLITUDE_M`): a frequency typed in kHz or an
     acceleration in m/s^2 where g is expected; one line naming ``what`` and the likely slip."""
-    stroke = case.acceleration_m_s2 / case.omega_rad_s ** 2
-    if stroke > defaults.DEM_MAX_DISPLACEMENT_AMPLITUDE_M:
+    # a / w / w, not a / w**2: w**2 overflows (1e300 Hz) or underflows to 0 (1e-300 Hz), which
+    # raised OverflowError / ZeroDivisionError; divided twice it is 0 or inf, judged as any
+    stroke = case.acceleration_m_s2 / case.omega_rad_s / case.omega_rad_s
+    if not stroke <= defaults.DEM_MAX_DISPLACEMENT_AMPLITUDE_M:
         raise ParameterError(
             f"{what} {case.frequency_hz:g} Hz, {case.acceleration_g:g} g: a displacement "
-            f"amplitude of {stroke:.3g} m (a / (2 pi f)^2); expected at most "
+            f"amplitude of {_amount(stroke)} m (a / (2 pi f)^2); expected at most "
             f"{defaults.DEM_MAX_DISPLACEMENT_AMPLITUDE_M * 1e3:g} mm, a shaker's stroke; was "
             "the frequency typed in kHz, or the acceleration in m/s^2?")
+
+
+def check_drive(case: LoadCase, config: DemConfig | None = None,
+                specimen: Specimen | None = None, *, what: str = "load case") -> None:
+    """Refuse, before any simulation, a drive :func:`simulate_load_case` refuses: a stroke no
+    shaker makes (:func:`check_drive_stroke`) or a frequency its sampling cannot afford
+    (:func:`check_drive_sampling`); a sweep refused the second only in the case's worker,
+    after the cases before it had run. ``what`` names the options in the message."""
+    config = config or DemConfig()
+    check_drive_stroke(case, what=what)
+    specimen = resolve_specimen(case, specimen)
+    law = contact_law(specimen, alpha_pp=config.alpha_pp, alpha_pw=config.alpha_pw)
+    dt_req = choose_time_step(case, law, specimen.geometry(), config.time_step,
+                              config.tangential_model)
+    period = 1.0 / case.frequency_hz
+    steps_per_cycle = math.ceil(period / (config.samples_per_cycle * dt_req)) \
+        * config.samples_per_cycle
+    check_drive_sampling(case, dt_s=period / steps_per_cycle, contact_step_s=dt_req,
+                         samples_per_cycle=config.samples_per_cycle,
+                         what=what.split("/")[0])  # the frequency's option
+
+
+def check_drive_sampling(case: LoadCase, *, dt_s: float, contact_step_s: float,
+                         samples_per_cycle: int, what: str = "frequency") -> None:
+    """Refuse a drive frequency whose samples per period shorten the contacts' time step
+    ``contact_step_s`` to ``dt_s`` by more than :data:`pidcore.defaults.DEM_MAX_STEP_SHORTENING`
+    (a frequency typed in mHz, or a megahertz drive no shaker makes): one line naming it."""
+    if dt_s * defaults.DEM_MAX_STEP_SHORTENING >= contact_step_s:
+        return
+    highest = defaults.DEM_MAX_STEP_SHORTENING / (samples_per_cycle * contact_step_s)
+    raise ParameterError(
+        f"{what} {case.frequency_hz:g} Hz: {samples_per_cycle} samples per drive period need "
+        f"a time step {contact_step_s / dt_s:.3g} x shorter than the contacts' "
+        f"({contact_step_s:.3g} s), and the run as much longer; expected at most "
+        f"{highest:.3g} Hz (was it typed in mHz?)")
 
 
 def simulate_load_case(case: LoadCase, config: DemConfig | None = None, *,
@@ -513,6 +555,7 @@ def simulate_load_case(case: LoadCase, config: DemConfig | None = None, *,
     sample_every = math.ceil(period / (spc_samples * dt_req))
     steps_per_cycle = sample_every * spc_samples
     dt = period / steps_per_cycle
+    check_drive_sampling(case, dt_s=dt, contact_step_s=dt_req, samples_per_cycle=spc_samples)
     if config.damping_coefficient == "calibrated":
         from .impact import calibrate_damping_coefficient
 

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -503,7 +504,12 @@ def _dem_paths(store: str | Path | None,
     if dem_store is None:
         return [Path(store)] if store else []
     given = [dem_store] if isinstance(dem_store, str | Path) else list(dem_store)
-    return list(dict.fromkeys(Path(p) for p in given))
+    # one file once, however spelt (d.h5, /abs/d.h5, a link to it): it was listed in the
+    # provenance once per spelling
+    first: dict[str, Path] = {}
+    for p in map(Path, given):
+        first.setdefault(os.path.realpath(p), p)
+    return list(first.values())
 
 
 def _joined_dem_runs(stores: list) -> pd.DataFrame | None:
@@ -665,7 +671,10 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         listed = main.list_analyses()
         analyses = latest_per_measurement(listed)
         # a stored result kept as implausible is said again here, as when it was saved
-        notes.extend(stored_plausibility_notes(analyses))
+        for _, record in analyses.iterrows():
+            name = Path(str(record.get("source", "") or record["key"])).name
+            notes.extend(f"{display_path(name)}: "
+                         f"{n}" for n in stored_plausibility_notes(record))
         if not listed.empty:
             left_out = listed["measurement_key"].nunique() - analyses["measurement_key"].nunique()
             if left_out:

@@ -124,9 +124,13 @@ def collect_provenance(*, parameters: Mapping[str, object] | None = None,
     for path in inputs:
         digest = input_hashes.get(str(path)) or sha256_file(path)
         hashed_inputs.append((display_path(Path(path).name), digest))
-    hashed_stores = tuple((str(p), sha256_file(p)) for p in dict.fromkeys(map(str, stores)))
+    # display_path: a store or note naming a file that is not UTF-8 failed the report's
+    # write (UnicodeEncodeError: surrogates not allowed) after its analyses were saved
+    hashed_stores = tuple((display_path(p), sha256_file(p))
+                          for p in dict.fromkeys(map(str, stores)))
     stamp = (created_utc or datetime.now(UTC)).astimezone(UTC)
     return Provenance(versions=versions, parameters=dict(parameters or {}),
                       seeds=tuple(sorted({int(s) for s in seeds})), inputs=tuple(hashed_inputs),
                       stores=hashed_stores, created_utc=stamp.isoformat(timespec="seconds"),
-                      notes=tuple(notes), specimens=tuple(specimens))
+                      notes=tuple(map(display_path, notes)),
+                      specimens=tuple((display_path(n), h) for n, h in specimens))

@@ -28,6 +28,7 @@ import pandas as pd
 from .. import defaults, interrupt
 from ..constants import REPORT_FORMATS
 from ..errors import ParameterError
+from ..io import display_path
 from .provenance import Provenance
 from .table import ALIGNMENT_COLUMN
 
@@ -261,6 +262,32 @@ def check_out_dir(out_dir: Path) -> None:
         if any(out_dir.iterdir()) and not (out_dir / REPORT_MARKER).exists():
             raise ParameterError(f"{out_dir}: folder exists, is not empty and holds no earlier "
                                  "pidcore report; choose a new or empty folder for --out")
+        foreign = _not_written_by_a_report(out_dir)
+        if foreign:
+            # the folder is replaced whole: a store kept in an earlier report's folder
+            # (report FILES --store rp/s.h5 --out rp) was deleted with the analyses just saved
+            raise ParameterError(
+                f"{out_dir}: an earlier pidcore report, but it also holds {foreign!r}, which a "
+                "report does not write and replacing the report would delete; move it out or "
+                "choose another folder for --out")
+
+
+def _not_written_by_a_report(out_dir: Path) -> str:
+    """The first entry of an earlier report folder that a report does not write ("" if
+    none): its files, the CSV's notes, the marker, and PNG/SVG files in ``figures``."""
+    ours = {REPORT_MARKER, "figures", f"{REPORT_STEM}{CSV_NOTES_SUFFIX}",
+            *(f"{REPORT_STEM}.{ext}" for ext in REPORT_FORMATS)}
+    for entry in sorted(out_dir.iterdir()):
+        if entry.name not in ours or (entry.name == "figures") != entry.is_dir() \
+                or entry.is_symlink():
+            return display_path(entry.name)
+    figures = out_dir / "figures"
+    if figures.is_dir():
+        for entry in sorted(figures.iterdir()):
+            if entry.suffix not in (".png", ".svg") or not entry.is_file() \
+                    or entry.is_symlink():
+                return display_path(f"figures/{entry.name}")
+    return ""
 
 
 def _move_into_place(tmp: Path, out_dir: Path) -> None:

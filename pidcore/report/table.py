@@ -37,6 +37,7 @@ from ..compare.align import (
 )
 from ..compare.loadcase import LoadCase, LoadCaseError
 from ..compare.specimens import runs_for_measurement
+from ..errors import ParameterError
 from ..units import g_to_si
 
 #: Measured energy per cycle over the DEM case's E = m_c a^2 / (2 w^2) (Eq. 10): the like-for-like
@@ -518,19 +519,27 @@ def add_calibration_columns(table: pd.DataFrame, calibration, *,
             stderr = _finite_or_nan(row.get("SDC measured stderr [-]"))
             # the band of a measurement with this row's own standard error (not the fitted
             # point's, unless it is that measurement)
-            band = hit.band(stderr if math.isfinite(measured) else math.nan)
+            extra = ""
+            try:
+                band = hit.band(stderr if math.isfinite(measured) else math.nan)
+            except ParameterError as exc:
+                # a negative or near-1e308 stderr (a hand-edited store): no band, not a
+                # traceback nor an infinite bound
+                band = (math.nan, math.nan)
+                extra = f"no calibrated band for this measurement's SDC stderr: {exc}"
             sdc.append(hit.sdc)
             low.append(band[0])
             high.append(band[1])
-            extra = ""
-            if band != (hit.low95, hit.high95):
-                extra = (f"calibrated band for this measurement's SDC stderr {stderr:.3g} "
-                         f"(the calibration's point at this load case: "
-                         f"{hit.measured_stderr:.3g})")
-            if not math.isfinite(measured):
+            if extra:
+                inside.append(NOT_COMPARED)
+            elif not math.isfinite(measured):
                 inside.append(NOT_COMPARED)
                 extra = "no Eq. 11 measurement to compare with the calibrated band"
             else:
+                if band != (hit.low95, hit.high95):
+                    extra = (f"calibrated band for this measurement's SDC stderr {stderr:.3g} "
+                             f"(the calibration's point at this load case: "
+                             f"{hit.measured_stderr:.3g})")
                 inside.append("yes" if band[0] <= measured <= band[1] else "no")
         notes.append("; ".join(n for n in (note, extra) if n))
     at = list(out.columns).index("SDC measured [-]") + 1 if "SDC measured [-]" in out.columns \

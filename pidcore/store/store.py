@@ -293,7 +293,10 @@ class Store:
             One line naming the store, what is read-only and the way out.
         """
         directory = self.path.parent
-        if self.path.exists() and not os.access(self.path, os.W_OK):
+        # no write bit for anyone (chmod 444) is read-only for root too, whom os.access lets
+        # write anything: the store marked read-only was replaced by the commit's copy
+        if self.path.exists() and (not os.access(self.path, os.W_OK)
+                                   or not self.path.stat().st_mode & 0o222):
             raise StoreError(f"{self.path}: the store file is read-only; expected a store "
                              "pidcore may write (make it writable, or give another store file)")
         if directory.is_dir() and not os.access(directory, os.W_OK | os.X_OK):

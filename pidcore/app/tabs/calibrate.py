@@ -85,11 +85,15 @@ def render(stores) -> None:
     if api is None:
         st.info(f"Calibration is not available: {reason}.")
         return
+    left_out: list[str] = []  # records saved as implausible: named, as the CLI names them
     try:
-        points = api.measured_from_store(stores.path) if stores.path.is_file() else []
+        points = api.measured_from_store(stores.path, left_out=left_out) \
+            if stores.path.is_file() else []
     except PidcoreError as exc:
         st.info(f"Nothing to calibrate against: {exc}")
         return
+    for note in left_out:
+        st.caption(f"Note: {note}")
     if not points:
         st.info(f"{stores.path} holds no saved measurements with a load case yet: analyse "
                 "files on the Analyse tab and Save them.")
