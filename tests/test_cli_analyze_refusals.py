@@ -359,3 +359,18 @@ def test_ctrl_c_after_the_analyses_were_saved_says_so(tmp_path, capsys, monkeypa
     assert len(Store(store).list_analyses()) == 1 + store_existed  # saved, whole
     assert f"the analyses of the 1 file(s) were saved to {store} before it (whole)" in err
     assert "unchanged" not in err
+
+
+def test_every_implausible_file_of_a_batch_is_named_in_one_refusal(tmp_path, capsys):
+    # with two implausible files among three only the first was named: the user fixed it,
+    # ran again, and only then learnt of the second
+    bad_a = _damped_export(tmp_path / "a_fill50.csv", -C_VISCOUS)
+    good = _damped_export(tmp_path / "b_fill50.csv", C_VISCOUS)
+    bad_c = _damped_export(tmp_path / "c_fill50.csv", 200.0)  # SDC 8 > 2 pi
+    store = tmp_path / "s.h5"
+    assert main(["analyze", str(bad_a), str(good), str(bad_c), "--store", str(store)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1  # (and "--accept-implausible" at its end)
+    assert "a_fill50.csv: implausible: negative loss factor" in err
+    assert "also implausible: c_fill50.csv" in err and "b_fill50.csv" not in err
+    assert not store.exists()

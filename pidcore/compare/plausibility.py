@@ -146,12 +146,17 @@ def refuse_implausible(records, names, *, accept: bool) -> list:
 
     from ..errors import SignalError
 
+    records, names = list(records), list(names)
+    flagged = [(name, warnings[0]) for record, name in zip(records, names, strict=True)
+               for warnings in (implausible_findings(record.analysis)[0],) if warnings]
+    if flagged and not accept:
+        # the first in full; the others named, so that one run shows every file to fix
+        (name, warning), others = flagged[0], [n for n, _ in flagged[1:]]
+        also = (f"; also implausible: {', '.join(others)}" if others else "")
+        raise SignalError(f"{name}: implausible: {warning}{also}; refused, nothing saved "
+                          "(pass accept_implausible=True to keep it as it is)")
     out = []
-    for record, name in zip(records, names, strict=True):
-        warnings, _ = implausible_findings(record.analysis)
-        if warnings and not accept:
-            raise SignalError(f"{name}: implausible: {warnings[0]}; refused, nothing saved "
-                              "(pass accept_implausible=True to keep it as it is)")
+    for record in records:
         notes = plausibility_notes(record.analysis)
         out.append(replace(record, notes=record.notes + notes) if notes else record)
     return out
