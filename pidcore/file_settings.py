@@ -479,24 +479,10 @@ def _refuse_fill_of_no_particle(path: str | os.PathLike, stated: StatedLoadCase 
         origin = next((part.strip() for part in stated.origin.split(";")
                        if part.strip().startswith("fill")), "")
         origin = origin.replace("fill: option", "fill: --fill")
-        fill = stated.fill_percent
-        hint = (f"was {fill:g} meant as {fill * 100:g} %?"
-                if fill <= 1.0 and _holds_a_particle(fill * 100, stated.material, cell) else
-                "a fill is a percentage of the cell's capacity")
-        raise LoadCaseError(f"{display_path(Path(path).name)}: {exc} ({origin}; "
-                            f"{hint})") from None
-
-
-def _holds_a_particle(fill_percent: float, material: str, specimen: Specimen | None) -> bool:
-    """Whether ``fill_percent`` puts a particle in the cell (a fraction's hint offers only a
-    fill that does: --fill 1e-9 was asked 'was 1e-09 meant as 1e-07 %?', also none)."""
-    from .dem.simulate import particles_per_cell
-
-    try:
-        particles_per_cell(fill_percent, material, specimen=specimen)
-    except PidcoreError:
-        return False
-    return True
+        # (particles_for_fill asks whether a fraction was typed where that holds a particle)
+        hint = "" if "meant as" in str(exc) else "; a fill is a percentage of the cell's capacity"
+        raise LoadCaseError(f"{display_path(Path(path).name)}: {exc} ({origin}{hint})") \
+            from None
 
 
 def resolve_files(paths: Sequence[str | os.PathLike], *, options: AnalysisOptions | None = None,

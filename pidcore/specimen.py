@@ -195,8 +195,12 @@ def particles_for_fill(fill_percent: float, full: int) -> int:
     if n < 1:
         # the smallest fill shown on a 0.01 % step strictly above half a particle: rounds to 1
         least = math.floor(5000.0 / full) / 100 + 0.01
+        # a fraction typed for a percentage (0.5 for 50 %), offered only where x100 is a fill
+        # that holds a particle (1e-9 as 1e-7 % holds none either)
+        hint = (f"; was {as_given(fill_percent)} meant as {fill_percent * 100:g} %?"
+                if 0 < fill_percent <= 1.0 and round(fill_percent * full) >= 1 else "")
         raise ParameterError(f"fill {as_given(fill_percent)} % of {full} particles rounds to none; "
-                             f"expected >= {least:.2f} %")
+                             f"expected >= {least:.2f} %{hint}")
     return n
 
 

@@ -486,3 +486,13 @@ def test_the_highest_frequency_the_dem_takes_follows_from_its_time_step():
             assert named == pytest.approx(highest, rel=1e-2)  # 3 significant digits
         else:
             assert not refused
+
+
+def test_a_fill_typed_as_a_fraction_gets_the_hint_analyze_gives(capsys):
+    # `dem run --fill 0.5` said only "rounds to none" where analyze asked "was 0.5 meant as
+    # 50 %?": one rule (particles_for_fill) words both
+    assert main(["dem", "run", "--frequency", "100", "--acceleration", "5", "--fill", "0.5",
+                 "--cells", "1", "--cycles", "2", "--no-progress"]) == 2
+    err = capsys.readouterr().err
+    assert "--fill 0.5: fill 0.5 % of 22 particles rounds to none" in err
+    assert "was 0.5 meant as 50 %?" in err

@@ -171,8 +171,11 @@ def test_a_fill_of_no_particle_is_refused_by_check_as_by_dem_run():
     with pytest.raises(ParameterError, match=f"fill 1 % of {capacity} particles rounds to none"):
         particles_per_cell(1.0, specimen=steel, fill_reference="capacity")
     # the least fill the message names does give one particle
-    least = float(str(pytest.raises(ParameterError, particles_per_cell, 1.0, specimen=steel,
-                                    fill_reference="capacity").value).split(">= ")[1][:-2])
+    import re
+
+    said = str(pytest.raises(ParameterError, particles_per_cell, 1.0, specimen=steel,
+                             fill_reference="capacity").value)
+    least = float(re.search(r">= ([0-9.]+) %", said).group(1))
     assert particles_per_cell(least, specimen=steel, fill_reference="capacity")[0] == 1
     ok = Specimen.from_text(_edit("fill_percent = 50.0", f"fill_percent = {least}"))
     assert describe(ok)["particles_per_cell"] == 1
