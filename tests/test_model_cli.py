@@ -364,3 +364,25 @@ def test_a_missing_store_is_named_as_missing(tmp_path, capsys):
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and f"{missing}: store not found" in err
         assert not missing.exists() and not (tmp_path / command).exists()
+
+
+def test_a_selection_refusal_names_the_where_option_not_a_python_dict(tmp_path, monkeypatch):
+    # the CLI said "select one, e.g. where={'specimen_name': 'steel_6mm'} (CLI: --where
+    # specimen_name=steel_6mm)" and "none match {'material': 'steel'}": a Python dict to a
+    # user who types --where; and "(1 runs)"
+    mine = _specimen_runs("steel_6mm", "a" * 64, coupon_kg=0.05, fixture_kg=0.12,
+                          sdc_scale=0.5)
+    one = _specimen_runs("thick_core", "b" * 64, coupon_kg=0.07, fixture_kg=0.0,
+                         sdc_scale=2.0).iloc[:1]
+    _fake_store(monkeypatch, lambda: pd.concat([mine, one]))
+    argv = ["model", "damper", "--out", str(tmp_path / "o"), "--table", "store", "--store",
+            str(tmp_path / "s.h5")]
+    with pytest.raises(ParameterError) as refused:
+        _run(argv)
+    said = str(refused.value)
+    assert "thick_core [bbbbbb] (1 run)" in said and "{" not in said and "CLI:" not in said
+    assert "select one, e.g. --where specimen_name=" in said
+    with pytest.raises(ParameterError) as refused:
+        _run([*argv, "--where", "material=steel"])
+    assert str(refused.value) == "DEM runs: none match --where material=steel"
+    assert not (tmp_path / "o").exists()

@@ -135,7 +135,10 @@ def build_model(args: argparse.Namespace):
     if runs.empty:
         raise ParameterError(f"{args.store}: no DEM runs stored; run `pidcore dem` first or use "
                              f"--table paper")
-    runs = select_runs(runs, where=where)
+    try:
+        runs = select_runs(runs, where=where)
+    except ParameterError as exc:
+        raise ParameterError(_cli_where(str(exc), where)) from None
     from ..compare.specimens import run_specimen_labels
 
     # the specimen named: steel and paper-coupon figures looked alike
@@ -144,6 +147,19 @@ def build_model(args: argparse.Namespace):
         " where " + ", ".join(f"{k}={v}" for k, v in where.items()) if where else "")
     return SdcModel.from_table(runs, value="sdc", log_frequency=args.log_frequency,
                                source=text), runs
+
+
+def _cli_where(message: str, where: dict) -> str:
+    """A :func:`pidcore.model.select_runs` message in the CLI's words: its library selection
+    (``where={'material': 'steel'} (CLI: --where material=steel)``) as the ``--where`` option
+    alone, and the selection that matched nothing as the options typed."""
+    import re
+
+    message = re.sub(r"where=\{[^{}]*\} \(CLI: (--where [^)]*)\)", r"\1", message)
+    if message.startswith("DEM runs: none match "):
+        message = "DEM runs: none match " + " ".join(f"--where {k}={v}"
+                                                    for k, v in where.items())
+    return message
 
 
 def run_damper(args: argparse.Namespace) -> int:

@@ -410,7 +410,8 @@ def _check_one_specimen(runs: pd.DataFrame) -> None:
     counts = labels.value_counts(sort=False)
     if len(counts) < 2:
         return
-    listed = ", ".join(f"{label} ({n} runs)" for label, n in counts.items())
+    listed = ", ".join(f"{label} ({n} run{'s' if n != 1 else ''})"
+                       for label, n in counts.items())
     # a specimen of the user's (the paper's coupon has no hash in its label), by name unless
     # two files share it
     k = next(k for k, label in enumerate(labels) if label.endswith("]"))
