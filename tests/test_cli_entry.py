@@ -74,3 +74,23 @@ def test_report_calibration_help_says_a_folder_is_taken_too(capsys):
     with pytest.raises(SystemExit):
         console_main(["report", "--help"])
     assert "(or the --out folder holding it)" in " ".join(capsys.readouterr().out.split())
+
+
+@pytest.mark.parametrize("argv", [
+    ["report", "--out", "r", "--dem-store", ""],
+    ["analyze", ""],
+    ["calibrate", "--data", " ", "--fit", "fixture_mass_kg"],
+    ["specimen", "check", ""],
+])
+def test_an_empty_path_is_refused_naming_its_option_not_taken_as_the_current_folder(
+        argv, capsys, tmp_path, monkeypatch):
+    # `--dem-store "$UNSET"` was read as "." and refused as ".: is a folder"
+    from pidcore.cli import main
+
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SystemExit) as done:  # argparse's usage error
+        main(argv)
+    assert done.value.code == 2
+    err = capsys.readouterr().err
+    assert "expected a path, got" in err
+    assert list(tmp_path.iterdir()) == []  # nothing written

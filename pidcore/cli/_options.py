@@ -24,6 +24,14 @@ def _whole_number(text: str, minimum: int) -> int:
     return value
 
 
+def path_argument(text: str) -> Path:
+    """argparse type: a file or folder path, refused when empty (``--dem-store ""`` from an
+    unset shell variable was taken as the current folder: ".: is a folder")."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError(f"expected a path, got {text!r}")
+    return Path(text)
+
+
 def positive_int(text: str) -> int:
     """argparse type: a whole number >= 1 (a count of repetitions, samples or processes)."""
     return _whole_number(text, 1)
@@ -48,7 +56,7 @@ def add_load_case_options(p: argparse._ActionsContainer, *, what: str,
                         f"{material_help}")
     p.add_argument("--direction", choices=DRIVE_DIRECTIONS, default=None,
                    help=f"drive direction of every {what} (default: stated or z)")
-    p.add_argument("--sidecar", metavar="CSV", type=Path, default=None,
+    p.add_argument("--sidecar", metavar="CSV", type=path_argument, default=None,
                    help="per-file table: load case (file, fill_percent, material, direction) "
                         "and analysis settings (velocity_delay_us, mass_below_gauge_g, "
                         "baseline_loss_factor, force, velocity, acceleration, invert, "
@@ -67,7 +75,7 @@ def add_store_option(p: argparse.ArgumentParser, *, flag: str = "--store",
                      default: Path | None = defaults.STORE_PATH,
                      help: str = STORE_HELP) -> None:
     """An HDF5 store file option (``--store``, ``--dem-store``) read as a :class:`Path`."""
-    p.add_argument(flag, metavar="FILE", type=Path, default=default, help=help)
+    p.add_argument(flag, metavar="FILE", type=path_argument, default=default, help=help)
 
 
 def add_json_option(p: argparse.ArgumentParser, *, progress: bool = False) -> None:

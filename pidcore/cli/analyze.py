@@ -20,6 +20,7 @@ from ._options import (
     add_store_option,
     analysis_options,
     given_options,
+    path_argument,
     with_cli_flags,
 )
 
@@ -35,7 +36,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                     "channels, ...) unless an option overrides them. Results are saved to the "
                     "store unless --no-store.",
     )
-    p.add_argument("paths", nargs="+", metavar="PATH", type=Path, help="export files")
+    p.add_argument("paths", nargs="+", metavar="PATH", type=path_argument, help="export files")
     add_measurement_options(p)
     add_store_option(p)
     p.add_argument("--no-store", action="store_true", help="do not save to the store")
@@ -45,7 +46,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     add_load_case_options(g, what="PATH", material_help=" or the --specimen's (default: "
                                                          "stated, else the specimen's, else "
                                                          "acrylic)")
-    g.add_argument("--specimen", metavar="FILE", type=Path, default=None,
+    g.add_argument("--specimen", metavar="FILE", type=path_argument, default=None,
                    help="specimen file whose particle material the files may state (e.g. "
                         "steel, which the material table lacks) and which is the default "
                         "material; its name is saved with the files of its particles whose "

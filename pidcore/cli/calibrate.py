@@ -7,7 +7,7 @@ import sys
 from pathlib import Path
 
 from .. import defaults, interrupt
-from ._options import check_out_folder, non_negative_int, positive_int
+from ._options import check_out_folder, non_negative_int, path_argument, positive_int
 
 DEFAULT_STORE = Path("calibration_store.h5")
 
@@ -26,17 +26,17 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                     "95 % intervals and optional leave-one-out cross-validation. DEM runs "
                     "over a space-filling design are cached in --dem-store.")
     source = p.add_mutually_exclusive_group(required=True)
-    source.add_argument("--data", metavar="TABLE.csv", type=Path,
+    source.add_argument("--data", metavar="TABLE.csv", type=path_argument,
                         help="measured SDCs: frequency_hz, acceleration_g, fill_percent, sdc "
                              "[, sdc_stderr, energy_per_cycle_j, material, specimen]; a row "
                              "without a material is of --specimen's particles (else acrylic); "
                              "one of another material than the specimen's is refused")
-    source.add_argument("--store", metavar="FILE", type=Path,
+    source.add_argument("--store", metavar="FILE", type=path_argument,
                         help="use the analysed measurements of this store, per load case: "
                              "those of --specimen's particles measured on it or on no named "
                              "specimen (the paper's coupon: those naming no other specimen); "
                              "a note names the ones left out")
-    p.add_argument("--specimen", metavar="FILE", type=Path, default=None,
+    p.add_argument("--specimen", metavar="FILE", type=path_argument, default=None,
                    help="specimen file to start from (default: the paper's coupon)")
     p.add_argument("--fit", metavar="NAME,...", default=",".join(DEFAULT_FIT),
                    help=f"parameters to fit (default %(default)s); from: {names}")
@@ -62,11 +62,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--method", choices=("auto", "grid", "emcee"), default="auto",
                    help="posterior: exact grid (<= 4 fitted quantities: 3 parameters plus "
                         "the discrepancy) or emcee; auto picks (default auto)")
-    p.add_argument("--dem-store", metavar="FILE", type=Path, default=DEFAULT_STORE,
+    p.add_argument("--dem-store", metavar="FILE", type=path_argument, default=DEFAULT_STORE,
                    help="HDF5 store caching the DEM runs (default %(default)s)")
     p.add_argument("--cross-validate", choices=("loo",), default=None,
                    help="leave-one-out: predict each load case from a fit without it")
-    p.add_argument("--out", metavar="DIR", type=Path, default=None,
+    p.add_argument("--out", metavar="DIR", type=path_argument, default=None,
                    help="write calibration.json, the calibrated specimen, figures, summary")
     p.add_argument("--json", action="store_true", help="print the result document on stdout")
     p.add_argument("--no-progress", action="store_true", help="no progress bars")

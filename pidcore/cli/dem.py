@@ -8,7 +8,6 @@ import math
 import re
 import sys
 from collections.abc import Callable
-from pathlib import Path
 
 from .. import defaults
 from ..constants import (
@@ -22,7 +21,13 @@ from ..constants import (
     VIBRATED_MASS_CONVENTIONS,
 )
 from ..errors import ParameterError, PidcoreError, as_given
-from ._options import add_json_option, add_store_option, non_negative_int, positive_int
+from ._options import (
+    add_json_option,
+    add_store_option,
+    non_negative_int,
+    path_argument,
+    positive_int,
+)
 
 #: Keys of ``pidcore dem run --json`` (more may follow them).
 JSON_KEYS = ("sdc", "sdc_stderr", "energy_per_cycle_j", "energy_dissipated_normal_j",
@@ -116,7 +121,7 @@ def _add_config_options(p: argparse.ArgumentParser) -> None:
                    help=f"independent cells simulated (default {defaults.DEM_CELLS})")
     p.add_argument("--seed", metavar="S", type=non_negative_int, default=defaults.DEM_SEED,
                    help=f"random seed of the packings (default {defaults.DEM_SEED})")
-    p.add_argument("--specimen", metavar="FILE", type=Path, default=None,
+    p.add_argument("--specimen", metavar="FILE", type=path_argument, default=None,
                    help="specimen file (cell, coupon and fixture masses, particles, contact "
                         "pairs; see 'pidcore specimen check'); default: the paper's coupon")
     p.add_argument("--material", choices=PARTICLE_MATERIALS, default=None,

@@ -16,7 +16,7 @@ from pathlib import Path
 from .. import defaults
 from ..constants import PARTICLE_MATERIALS, VIBRATED_MASS_CONVENTIONS
 from ..errors import ParameterError, as_given
-from ._options import add_store_option, check_out_folder
+from ._options import add_store_option, check_out_folder, path_argument
 
 
 def _float_list(text: str) -> list[float]:
@@ -51,7 +51,7 @@ def _formats(text: str) -> list[str]:
 
 
 def _add_model_source(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--out", metavar="DIR", type=Path, required=True, help="output folder")
+    p.add_argument("--out", metavar="DIR", type=path_argument, required=True, help="output folder")
     p.add_argument("--table", choices=("paper", "store"), default="paper",
                    help="SDC data: the paper's Table 3 DEM column or the store's DEM runs "
                         "(default paper)")

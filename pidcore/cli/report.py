@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import argparse
 import sys
-from pathlib import Path
 
 from .. import interrupt
 from ..errors import PidcoreError
@@ -19,6 +18,7 @@ from ._options import (
     add_store_option,
     analysis_options,
     given_options,
+    path_argument,
     with_cli_flags,
 )
 
@@ -45,15 +45,15 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                     "a sidecar loadcases.csv, or with --fill; the sidecar may also state each "
                     "file's analysis settings (velocity_delay_us, ...), which options given "
                     "override.")
-    p.add_argument("files", nargs="*", metavar="FILE", type=Path,
+    p.add_argument("files", nargs="*", metavar="FILE", type=path_argument,
                    help="measurement exports to analyse (UFF58, CSV/TXT, MAT, HDF5)")
-    p.add_argument("--out", metavar="DIR", type=Path, required=True,
+    p.add_argument("--out", metavar="DIR", type=path_argument, required=True,
                    help="report folder (new, empty or an earlier report holding only what a "
                         "report writes, replaced atomically)")
     add_store_option(p, default=None,
                      help="HDF5 store: analyses of FILES are added to it; without FILES its "
                           "analyses are reported")
-    p.add_argument("--dem-store", metavar="FILE", type=Path, action="append", default=None,
+    p.add_argument("--dem-store", metavar="FILE", type=path_argument, action="append", default=None,
                    help="HDF5 store holding the DEM runs (default: --store); only read; "
                         "repeat it to join the runs of several stores (the first holding a "
                         "run gives it), as the app joins its store's runs with the reference "
@@ -64,7 +64,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     add_load_case_options(p, what="FILE", material_help=" or the --specimen's (default: "
                                                          "stated, else the specimen's, else "
                                                          "acrylic)")
-    p.add_argument("--specimen", metavar="FILE", type=Path, default=None,
+    p.add_argument("--specimen", metavar="FILE", type=path_argument, default=None,
                    help="compare only DEM runs of this specimen file (default: the paper's "
                         "coupon); the paper's Table 3 only for the paper's coupon; FILES of "
                         "its particles whose sidecar names no specimen are its tests (saved "
@@ -73,7 +73,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help="pool DEM runs of different numerical settings and measurements of "
                         "different specimens at one load case into one row (default: a row "
                         "each)")
-    p.add_argument("--calibration", metavar="FILE", type=Path, default=None,
+    p.add_argument("--calibration", metavar="FILE", type=path_argument, default=None,
                    help="calibration.json of pidcore calibrate (or the --out folder holding "
                         "it): add the calibrated DEM's Eq. 11 SDC with its 95 %% band beside the "
                         "raw DEM and the measurement")

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ._options import positive_int
+from ._options import path_argument, positive_int
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -15,7 +15,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                        description="Regenerate data_samples/: the paper's Table 3 as CSV, a DEM "
                                    "store of the whole Table 3 grid (sweep, resumable) and "
                                    "synthetic virtual shaker-test exports in every format.")
-    m.add_argument("--out", type=Path, default=Path("data_samples"),
+    m.add_argument("--out", type=path_argument, default=Path("data_samples"),
                    help="output folder (default: ./data_samples)")
     m.add_argument("--skip-sweep", action="store_true",
                    help="reuse the DEM runs already in OUT/dem_table3.h5")

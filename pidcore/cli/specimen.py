@@ -4,10 +4,9 @@ from __future__ import annotations
 
 import argparse
 import json
-from pathlib import Path
 
 from .. import defaults
-from ._options import add_json_option
+from ._options import add_json_option, path_argument
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -24,7 +23,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                     "friction or an unknown material) and print what follows from it; a "
                     "table material with inline properties that differ from the table's keeps "
                     "them, and a note names each value that overrides the table's.")
-    check.add_argument("file", metavar="FILE", type=Path, help="specimen TOML file")
+    check.add_argument("file", metavar="FILE", type=path_argument, help="specimen TOML file")
     add_json_option(check)
     check.set_defaults(func=run_check)
 
