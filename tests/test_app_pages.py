@@ -1130,3 +1130,31 @@ def test_compare_gives_the_equivalent_damper_of_the_dem_case_and_the_measurement
     caption = next(c.value for c in at.caption if c.value.startswith("equivalent viscous"))
     assert "our DEM **6.3 N s/m**" in caption and "m_c = 0.3 kg" in caption
     assert "measured **" in caption
+
+
+def test_compare_names_a_saved_implausible_result_and_judges_no_band_of_its_pool(
+        store_file, tmp_path, monkeypatch):
+    # Compare pooled a record saved as implausible (loss factor 1.5: SDC 9.4 > 2 pi) with a
+    # good one of its load case, without a word, and judged the mean (4.9, its stderr the
+    # scatter of the two) 'inside' the calibrated band widened by that stderr; report --store
+    # names such a record and calibrate --store leaves it out
+    from pidcore.app.calibration import CALIBRATION_ENV_VAR
+    from pidcore.cli import main
+
+    for name, eta, seed in (("bad_fill50.csv", 1.5, 1), ("ok_fill50.csv", 0.05, 2)):
+        (tmp_path / name).write_bytes(mass_damper_csv(loss_factor=eta, seed=seed))
+    assert main(["analyze", str(tmp_path / "bad_fill50.csv"), str(tmp_path / "ok_fill50.csv"),
+                 "--store", str(store_file), "--accept-implausible"]) == 0
+    doc = {"parameters": {"fixture_mass_kg": {"median": 0.2, "low95": 0.1, "high95": 0.3}},
+           "predictions": [{"frequency_hz": 100, "acceleration_g": 5, "fill_percent": 50,
+                            "material": "acrylic", "measured": 0.35, "measured_stderr": 0.01,
+                            "predicted": 0.35, "low95": 0.1, "high95": 0.6,
+                            "low95_without_stderr": 0.11, "high95_without_stderr": 0.59}]}
+    (tmp_path / "calibration.json").write_text(json.dumps(doc), encoding="utf-8")
+    monkeypatch.setenv(CALIBRATION_ENV_VAR, str(tmp_path / "calibration.json"))
+    at = _app()
+    assert not at.exception
+    captions = " ".join(c.value for c in at.caption)
+    assert "the measured Eq. 11 SDC is not compared (it pools an implausible result" in captions
+    assert "bad_fill50.csv: implausible, saved as accepted: SDC 9.4" in captions
+    assert "ok_fill50.csv: implausible" not in captions
