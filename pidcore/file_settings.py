@@ -479,24 +479,28 @@ def _refuse_fill_of_no_particle(path: str | os.PathLike, stated: StatedLoadCase 
         origin = next((part.strip() for part in stated.origin.split(";")
                        if part.strip().startswith("fill")), "")
         origin = origin.replace("fill: option", "fill: --fill")
-        fill = stated.fill_percent
-        hint = (f"was {fill:g} meant as {fill * 100:g} %?"
-                if fill <= 1.0 and _holds_a_particle(fill * 100, stated.material, cell) else
-                "a fill is a percentage of the cell's capacity")
+        hint = fill_fraction_hint(stated.fill_percent, stated.material, cell)
         raise LoadCaseError(f"{display_path(Path(path).name)}: {exc} ({origin}; "
                             f"{hint})") from None
 
 
-def _holds_a_particle(fill_percent: float, material: str, specimen: Specimen | None) -> bool:
-    """Whether ``fill_percent`` puts a particle in the cell (a fraction's hint offers only a
-    fill that does: --fill 1e-9 was asked 'was 1e-09 meant as 1e-07 %?', also none)."""
+def fill_fraction_hint(fill_percent: float, material: str, specimen: Specimen | None, *,
+                       fill_reference: str | None = None) -> str:
+    """What to say of a fill that rounds to no particle: ``was 0.5 meant as 50 %?`` where it
+    is at most 1 and x100 puts a particle in the cell (--fill 1e-9 was asked 'was 1e-09
+    meant as 1e-07 %?', a fill of none too), else that a fill is a percentage. One wording
+    for ``analyze``/``report`` (file name, sidecar, --fill) and ``dem run``/``dem sweep``."""
     from .dem.simulate import particles_per_cell
 
-    try:
-        particles_per_cell(fill_percent, material, specimen=specimen)
-    except PidcoreError:
-        return False
-    return True
+    reference = {} if fill_reference is None else {"fill_reference": fill_reference}
+    if fill_percent <= 1.0:
+        try:
+            particles_per_cell(fill_percent * 100, material, specimen=specimen, **reference)
+        except PidcoreError:
+            pass
+        else:
+            return f"was {fill_percent:g} meant as {fill_percent * 100:g} %?"
+    return "a fill is a percentage of the cell's capacity"
 
 
 def resolve_files(paths: Sequence[str | os.PathLike], *, options: AnalysisOptions | None = None,

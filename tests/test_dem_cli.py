@@ -234,6 +234,28 @@ def test_a_fill_of_no_particle_names_its_option_and_writes_nothing(tmp_path, cap
     assert not store.exists()
 
 
+@pytest.mark.parametrize("command", [
+    ["dem", "run", "--frequency", "500", "--acceleration", "5", "--fill"],
+    ["dem", "sweep", "--frequencies", "500", "--accelerations", "5", "--fills"]])
+def test_a_fill_typed_as_a_fraction_gets_the_hint_analyze_gives(tmp_path, capsys, command):
+    # analyze --fill 0.5 asks 'was 0.5 meant as 50 %?'; dem run/sweep refused it without
+    # the hint. 0.01 x 100 = 1 % holds none of 22 either: no such offer, as in analyze
+    from pidcore.file_settings import fill_fraction_hint
+
+    for fill, hint in (("0.5", "(was 0.5 meant as 50 %?)"),
+                       ("0.01", "(a fill is a percentage of the cell's capacity)")):
+        store = tmp_path / "s.h5"
+        assert main([*command, fill, "--store", str(store), "--no-progress"]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and err.rstrip().endswith(hint), err
+        assert hint == f"({fill_fraction_hint(float(fill), 'acrylic', None)})"
+        assert not store.exists()
+        export = (Path(__file__).resolve().parents[1] / "data_samples" / "exports"
+                  / "synthetic_f50Hz_a5g_fill50_acrylic.uff")
+        assert main(["analyze", str(export), "--no-store", "--fill", fill]) == 2
+        assert hint[1:-1] in capsys.readouterr().err  # the same words
+
+
 @pytest.mark.parametrize("fill", ["nan", "inf", "0", "150", "100.0000001"])
 def test_a_fill_outside_0_100_is_one_line_naming_the_option(capsys, fill):
     # 100.0000001 was shown as "--fill 100", a fill that is accepted

@@ -291,7 +291,13 @@ def _check_fill(fill: float, option: str, args: argparse.Namespace, specimen,
     except ParameterError as exc:
         if not str(exc).startswith("fill "):  # not about this fill (e.g. --fill-reference)
             raise
-        raise ParameterError(f"{option} {as_given(fill)}: {exc}") from None
+        if "rounds to none" not in str(exc):  # more than fit: no fraction was typed
+            raise ParameterError(f"{option} {as_given(fill)}: {exc}") from None
+        from ..file_settings import fill_fraction_hint
+
+        # as analyze says it: --fill 0.5 typed for 50 % was refused here with no hint
+        hint = fill_fraction_hint(fill, material, specimen, fill_reference=args.fill_reference)
+        raise ParameterError(f"{option} {as_given(fill)}: {exc} ({hint})") from None
 
 
 def _fill(args: argparse.Namespace, specimen, material: str) -> float:
