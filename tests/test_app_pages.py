@@ -169,6 +169,9 @@ def test_negative_loss_factor_is_flagged_and_saving_needs_confirmation(store_fil
     at = _upload(_app(), [("odd_fill50.csv", mass_damper_csv(loss_factor=-0.04))])
     warnings = [w.value for w in at.warning]
     assert any("negative loss factor" in w and "Likely cause" in w for w in warnings)
+    # Compare names it too, as unsaved (not 'saved as accepted', the words for a stored one)
+    assert any(c.value.startswith("note: odd_fill50.csv: implausible, this session (unsaved): "
+                                  "negative loss factor") for c in at.caption)
     at.button(key="save").click()
     at.run()
     assert any("confirm" in e.value for e in at.error)
