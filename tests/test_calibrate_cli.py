@@ -643,3 +643,18 @@ def test_a_record_left_out_of_a_store_calibration_is_named_in_its_outputs(tmp_pa
     # said once each on stderr, as before
     assert err.count("neg_fill50_acrylic.csv: left out") == 1
     assert err.count("the fit's own note") == 1
+
+
+def test_the_html_summary_carries_the_notes_of_the_markdown_one():
+    # summary.md listed its notes (a median set by the prior, a record left out as
+    # implausible); summary.html, 'the Markdown summary's content', dropped them
+    import html
+    from types import SimpleNamespace
+
+    from pidcore.calibrate.outputs import summary_html
+
+    notes = ["neg_fill50.csv: left out, implausible (saved as accepted): SDC -1.26 < 0",
+             "fixture_mass_kg: the posterior piles against its prior's lower bound 0 & <more>"]
+    page = summary_html(SimpleNamespace(parameters={}, predictions=[], loo=None, notes=notes))
+    for note in notes:
+        assert f"<li>{html.escape(note)}</li>" in page
