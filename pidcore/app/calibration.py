@@ -197,7 +197,8 @@ class CalibrationRunner:
         try:
             result = api.calibrate(points, fit=fit, store_path=self.store_path, cells=cells,
                                    design_size=design_size, progress=False, **given)
-            result.notes = [*notes, *result.notes]
+            if notes:
+                result.notes = [*notes, *result.notes]
             with tempfile.TemporaryDirectory(prefix="pidcore_calibration_") as folder:
                 paths = api.write_outputs(result, folder)
                 outputs = {Path(p).name: Path(p).read_bytes() for p in paths}
