@@ -595,10 +595,11 @@ def _fake_calibrate_module(calls: list):
         calls.append((len(points), tuple(fit), cells)
                      + ((specimen.name, tuple(p.material for p in points))
                         if specimen is not None else ()))
-        return {"fit": fit}
+        return types.SimpleNamespace(fit=fit, notes=[])  # the library's result has notes
 
     def write_outputs(result, out_dir):
         out = Path(out_dir)
+        module.written_notes = list(result.notes)  # what the downloaded summary says
         (out / "summary.md").write_text("# Calibration summary\n\nfixture_mass_kg: 0.01\n")
         (out / "calibrated_specimen.toml").write_text("[coupon]\nmass_kg = 0.3\n")
         return [out / "summary.md", out / "calibrated_specimen.toml"]
@@ -664,7 +665,8 @@ def test_calibrate_page_calibrates_a_chosen_specimen_file_on_its_own_measurement
     folder.mkdir(parents=True)
     shutil.copy(REPO / "data_samples" / "specimens" / "steel_6mm.toml", folder)
     calls: list = []
-    monkeypatch.setitem(sys.modules, "pidcore.calibrate", _fake_calibrate_module(calls))
+    fake = _fake_calibrate_module(calls)
+    monkeypatch.setitem(sys.modules, "pidcore.calibrate", fake)
     steel = [(f"m{f:g}_fill50.csv", mass_damper_csv(frequency_hz=f, acceleration_g=5.0,
                                                       seed=int(f))) for f in (100.0, 200.0)]
     acrylic = mass_damper_csv(frequency_hz=500.0, acceleration_g=5.0, seed=3)
@@ -689,6 +691,9 @@ def test_calibrate_page_calibrates_a_chosen_specimen_file_on_its_own_measurement
     _run_calibration(at, store_file)
     assert calls == [(2, ("fixture_mass_kg",), 4, "steel_6mm", ("steel", "steel"))]
     assert "calibrated steel_6mm in" in " ".join(m.value for m in at.success)
+    # what the page left out is in the calibration's own notes (its summary, its json)
+    assert any(n.startswith("Not used for steel_6mm (steel particles): ")
+               for n in fake.written_notes)
     toml = next(b for b in at.get("download_button") if b.label == "calibrated specimen (TOML)")
     assert toml.proto.help == "steel_6mm_calibrated.toml"
     # back to the paper's coupon: the result stays, and says whose it is; the steel cases
