@@ -1578,3 +1578,28 @@ def test_sdc_shown_on_the_pages_keeps_its_digits(sdc, stderr, shown):
     for text in shown.split(" ± "):  # each number shown reads back within its last digit
         assert "0.0000" != text
     assert float(shown.split(" ± ")[0]) == pytest.approx(sdc, rel=5e-3)
+
+
+def test_the_pages_calibration_keeps_what_it_left_out_in_its_outputs(tmp_path):
+    # the Calibrate page named records left out as implausible in a caption, but its
+    # downloadable summary and calibration.json (what Compare and Report then read) did not,
+    # unlike `pidcore calibrate --store`'s
+    import types
+
+    from pidcore.app.calibration import CalibrationRunner, CalibrationTask
+
+    written = {}
+
+    def write_outputs(result, folder):
+        written["notes"] = list(result.notes)
+        return []
+
+    api = types.SimpleNamespace(
+        calibrate=lambda points, **kw: types.SimpleNamespace(notes=["the fit's own note"]),
+        write_outputs=write_outputs)
+    task = CalibrationTask(("fixture_mass_kg",), 3)
+    left = "bad.csv: left out, implausible (saved as accepted): SDC 9.4 above 6.28"
+    CalibrationRunner(tmp_path / "s.h5")._run(api, task, [], ["fixture_mass_kg"], 2, None,
+                                              None, [left])
+    assert task.state == "done"
+    assert written["notes"] == [left, "the fit's own note"]

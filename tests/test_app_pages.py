@@ -169,6 +169,9 @@ def test_negative_loss_factor_is_flagged_and_saving_needs_confirmation(store_fil
     at = _upload(_app(), [("odd_fill50.csv", mass_damper_csv(loss_factor=-0.04))])
     warnings = [w.value for w in at.warning]
     assert any("negative loss factor" in w and "Likely cause" in w for w in warnings)
+    # Compare names it too, as unsaved (not 'saved as accepted', the words for a stored one)
+    assert any(c.value.startswith("note: odd_fill50.csv: implausible, this session (unsaved): "
+                                  "negative loss factor") for c in at.caption)
     at.button(key="save").click()
     at.run()
     assert any("confirm" in e.value for e in at.error)
@@ -592,10 +595,11 @@ def _fake_calibrate_module(calls: list):
         calls.append((len(points), tuple(fit), cells)
                      + ((specimen.name, tuple(p.material for p in points))
                         if specimen is not None else ()))
-        return {"fit": fit}
+        return types.SimpleNamespace(fit=fit, notes=[])  # the library's result has notes
 
     def write_outputs(result, out_dir):
         out = Path(out_dir)
+        module.written_notes = list(result.notes)  # what the downloaded summary says
         (out / "summary.md").write_text("# Calibration summary\n\nfixture_mass_kg: 0.01\n")
         (out / "calibrated_specimen.toml").write_text("[coupon]\nmass_kg = 0.3\n")
         return [out / "summary.md", out / "calibrated_specimen.toml"]
@@ -661,7 +665,8 @@ def test_calibrate_page_calibrates_a_chosen_specimen_file_on_its_own_measurement
     folder.mkdir(parents=True)
     shutil.copy(REPO / "data_samples" / "specimens" / "steel_6mm.toml", folder)
     calls: list = []
-    monkeypatch.setitem(sys.modules, "pidcore.calibrate", _fake_calibrate_module(calls))
+    fake = _fake_calibrate_module(calls)
+    monkeypatch.setitem(sys.modules, "pidcore.calibrate", fake)
     steel = [(f"m{f:g}_fill50.csv", mass_damper_csv(frequency_hz=f, acceleration_g=5.0,
                                                       seed=int(f))) for f in (100.0, 200.0)]
     acrylic = mass_damper_csv(frequency_hz=500.0, acceleration_g=5.0, seed=3)
@@ -686,6 +691,9 @@ def test_calibrate_page_calibrates_a_chosen_specimen_file_on_its_own_measurement
     _run_calibration(at, store_file)
     assert calls == [(2, ("fixture_mass_kg",), 4, "steel_6mm", ("steel", "steel"))]
     assert "calibrated steel_6mm in" in " ".join(m.value for m in at.success)
+    # what the page left out is in the calibration's own notes (its summary, its json)
+    assert any(n.startswith("Not used for steel_6mm (steel particles): ")
+               for n in fake.written_notes)
     toml = next(b for b in at.get("download_button") if b.label == "calibrated specimen (TOML)")
     assert toml.proto.help == "steel_6mm_calibrated.toml"
     # back to the paper's coupon: the result stays, and says whose it is; the steel cases
@@ -1130,3 +1138,31 @@ def test_compare_gives_the_equivalent_damper_of_the_dem_case_and_the_measurement
     caption = next(c.value for c in at.caption if c.value.startswith("equivalent viscous"))
     assert "our DEM **6.3 N s/m**" in caption and "m_c = 0.3 kg" in caption
     assert "measured **" in caption
+
+
+def test_compare_names_a_saved_implausible_result_and_judges_no_band_of_its_pool(
+        store_file, tmp_path, monkeypatch):
+    # Compare pooled a record saved as implausible (loss factor 1.5: SDC 9.4 > 2 pi) with a
+    # good one of its load case, without a word, and judged the mean (4.9, its stderr the
+    # scatter of the two) 'inside' the calibrated band widened by that stderr; report --store
+    # names such a record and calibrate --store leaves it out
+    from pidcore.app.calibration import CALIBRATION_ENV_VAR
+    from pidcore.cli import main
+
+    for name, eta, seed in (("bad_fill50.csv", 1.5, 1), ("ok_fill50.csv", 0.05, 2)):
+        (tmp_path / name).write_bytes(mass_damper_csv(loss_factor=eta, seed=seed))
+    assert main(["analyze", str(tmp_path / "bad_fill50.csv"), str(tmp_path / "ok_fill50.csv"),
+                 "--store", str(store_file), "--accept-implausible"]) == 0
+    doc = {"parameters": {"fixture_mass_kg": {"median": 0.2, "low95": 0.1, "high95": 0.3}},
+           "predictions": [{"frequency_hz": 100, "acceleration_g": 5, "fill_percent": 50,
+                            "material": "acrylic", "measured": 0.35, "measured_stderr": 0.01,
+                            "predicted": 0.35, "low95": 0.1, "high95": 0.6,
+                            "low95_without_stderr": 0.11, "high95_without_stderr": 0.59}]}
+    (tmp_path / "calibration.json").write_text(json.dumps(doc), encoding="utf-8")
+    monkeypatch.setenv(CALIBRATION_ENV_VAR, str(tmp_path / "calibration.json"))
+    at = _app()
+    assert not at.exception
+    captions = " ".join(c.value for c in at.caption)
+    assert "the measured Eq. 11 SDC is not compared (it pools an implausible result" in captions
+    assert "bad_fill50.csv: implausible, saved as accepted: SDC 9.4" in captions
+    assert "ok_fill50.csv: implausible" not in captions

@@ -598,3 +598,63 @@ def test_a_record_saved_as_implausible_is_left_out_of_a_store_calibration(tmp_pa
     assert point.sdc == good_sdc > 0  # the good test alone, not the mean with -SDC
     assert len(left_out) == 1 and left_out[0].startswith("neg_fill50_acrylic.csv: left out, "
                                                          "implausible")
+
+
+def test_a_record_left_out_of_a_store_calibration_is_named_in_its_outputs(tmp_path, capsys,
+                                                                        monkeypatch):
+    # calibrate --store said on stderr that a record saved as implausible was left out, but
+    # summary.md and calibration.json (what a later report --calibration reads) counted their
+    # measured load cases with no word of it
+    import importlib
+    from types import SimpleNamespace
+
+    from _shaker_files import write_force_velocity
+
+    from pidcore.constants import STANDARD_GRAVITY
+    from pidcore.signal.synthetic import synthesize_shaker_record
+
+    library = importlib.import_module("pidcore.calibrate.calibrate")
+    outputs = importlib.import_module("pidcore.calibrate.outputs")
+    store = tmp_path / "s.h5"
+    paths = []
+    for name, damping in (("good_fill50_acrylic.csv", 2.0), ("neg_fill50_acrylic.csv", -2.0)):
+        rec = synthesize_shaker_record(mass_kg=0.25,
+                                       acceleration_amplitude_m_s2=5 * STANDARD_GRAVITY,
+                                       frequency_hz=500.0, sample_rate_hz=25_600.0,
+                                       n_periods=40, viscous_damping_n_s_m=damping,
+                                       snr_db=60, seed=3)
+        paths.append(write_force_velocity(tmp_path / name, rec.force_n, rec.velocity_m_s,
+                                          25_600.0, "csv"))
+    assert main(["analyze", *map(str, paths), "--store", str(store),
+                 "--accept-implausible"]) == 0
+    capsys.readouterr()
+    written = {}
+    monkeypatch.setattr(outputs, "write_outputs",
+                        lambda result, out: written.setdefault("notes", list(result.notes)))
+    monkeypatch.setattr(outputs, "document_json", lambda document: "{}")
+    fake = SimpleNamespace(notes=["the fit's own note"], document=dict)
+    monkeypatch.setattr(library, "calibrate", lambda points, **kwargs: fake)
+    assert main(["calibrate", "--store", str(store), "--dem-store", str(tmp_path / "d.h5"),
+                 "--out", str(tmp_path / "cal"), "--json", *TINY]) == 0
+    err = capsys.readouterr().err
+    (left,) = [n for n in written["notes"] if "left out" in n]
+    assert left.startswith("neg_fill50_acrylic.csv: left out, implausible")
+    assert written["notes"][-1] == "the fit's own note"
+    # said once each on stderr, as before
+    assert err.count("neg_fill50_acrylic.csv: left out") == 1
+    assert err.count("the fit's own note") == 1
+
+
+def test_the_html_summary_carries_the_notes_of_the_markdown_one():
+    # summary.md listed its notes (a median set by the prior, a record left out as
+    # implausible); summary.html, 'the Markdown summary's content', dropped them
+    import html
+    from types import SimpleNamespace
+
+    from pidcore.calibrate.outputs import summary_html
+
+    notes = ["neg_fill50.csv: left out, implausible (saved as accepted): SDC -1.26 < 0",
+             "fixture_mass_kg: the posterior piles against its prior's lower bound 0 & <more>"]
+    page = summary_html(SimpleNamespace(parameters={}, predictions=[], loo=None, notes=notes))
+    for note in notes:
+        assert f"<li>{html.escape(note)}</li>" in page

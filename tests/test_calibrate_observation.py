@@ -160,3 +160,19 @@ def test_bound_notes_spare_a_narrow_posterior_inside_the_prior_edge():
     half_normal = np.abs(rng.normal(0.0, 0.02, (4000, 1)))  # the data ask for <= 0 kg
     (note,) = bound_notes([spec], half_normal)
     assert "lower bound 0" in note
+
+
+def test_a_bound_note_gives_the_median_as_the_summary_shows_it():
+    # the note said 'its median 0.001285' under a summary row of 0.00128: the summary shows
+    # each number to the digit its Monte-Carlo standard error leaves, the note to 4 digits
+    from pidcore.calibrate.parameters import parameter_spec
+    from pidcore.calibrate.posterior import bound_notes, summarise, summary_texts
+
+    spec = parameter_spec("fixture_mass_kg")
+    rng = np.random.default_rng(2)
+    piled = np.abs(rng.normal(0.0, 0.002, (4000, 1)))  # against 0 kg, median ~1.35 g
+    (note,) = bound_notes([spec], piled)
+    median, _, _ = summary_texts(summarise([spec], piled)[0][spec.name])
+    assert f"its median {median} is set by the prior" in note
+    # the premise: the Monte-Carlo error leaves fewer digits than the 4 the note printed
+    assert median != f"{float(np.median(piled)):.4g}"

@@ -374,3 +374,45 @@ def test_every_implausible_file_of_a_batch_is_named_in_one_refusal(tmp_path, cap
     assert "a_fill50.csv: implausible: negative loss factor" in err
     assert "also implausible: c_fill50.csv" in err and "b_fill50.csv" not in err
     assert not store.exists()
+
+
+def test_a_row_pooling_a_stored_implausible_result_says_so_and_judges_no_band(tmp_path,
+                                                                             capsys):
+    # report --store pooled an SDC of 8.0 (> 2 pi, kept with --accept-implausible) with a
+    # good one of the same case: the CSV row showed their mean with no word of it (the note
+    # was apart from the rows), and its standard error, the scatter of the impossible SDC
+    # about the good one, made the calibrated band wide enough to read 'inside', where
+    # calibrate --store leaves that record out
+    import json
+
+    import pandas as pd
+
+    from pidcore.report.table import CALIBRATED_INSIDE_COLUMN, NOT_COMPARED
+
+    bad = _damped_export(tmp_path / "rec_fill50.csv", 200.0)
+    good = _damped_export(tmp_path / "ok_fill50.csv", C_VISCOUS)
+    store = tmp_path / "s.h5"
+    assert main(["analyze", str(bad), str(good), "--store", str(store),
+                 "--accept-implausible"]) == 0
+    calibration = tmp_path / "calibration.json"
+    calibration.write_text(json.dumps({
+        "parameters": {"baseline_loss_factor": {"median": 0.01, "low95": 0.0, "high95": 0.02}},
+        "predictions": [{"frequency_hz": FREQ, "acceleration_g": 5.0, "fill_percent": 50.0,
+                         "material": "acrylic", "measured": 0.5, "predicted": 0.5,
+                         "measured_stderr": 0.01, "low95": 0.4, "high95": 0.6,
+                         "low95_without_stderr": 0.41, "high95_without_stderr": 0.59}]}),
+        encoding="utf-8")
+    capsys.readouterr()
+    out = tmp_path / "r"
+    assert main(["report", "--store", str(store), "--calibration", str(calibration),
+                 "--out", str(out), "--format", "csv"]) == 0
+    table = pd.read_csv(out / "report.csv")
+    (pooled,) = (r for _, r in table[table["SDC measured [-]"].notna()].iterrows())
+    # the premise: both records pooled, the mean's standard error wide enough for the band
+    # of its own stderr to hold the mean (the old verdict 'yes')
+    assert "2 measurements pooled" in pooled["note"]
+    assert pooled["SDC measured [-]"] > 2 * math.pi / 2
+    assert pooled["calibrated high 95 % [-]"] >= pooled["SDC measured [-]"]
+    assert pooled[CALIBRATED_INSIDE_COLUMN] == NOT_COMPARED
+    assert "kept as accepted: rec_fill50.csv (SDC 7.99" in pooled["note"]
+    assert "ok_fill50.csv (" not in pooled["note"]

@@ -234,6 +234,26 @@ def test_a_fill_of_no_particle_names_its_option_and_writes_nothing(tmp_path, cap
     assert not store.exists()
 
 
+@pytest.mark.parametrize("command", [
+    ["dem", "run", "--frequency", "500", "--acceleration", "5", "--fill"],
+    ["dem", "sweep", "--frequencies", "500", "--accelerations", "5", "--fills"]])
+def test_a_fill_typed_as_a_fraction_gets_the_hint_analyze_gives(tmp_path, capsys, command):
+    # analyze --fill 0.5 asks 'was 0.5 meant as 50 %?'; dem run/sweep refused it without
+    # the hint. 0.01 x 100 = 1 % holds none of 22 either: no such offer, as in analyze
+    for fill, hint in (("0.5", "was 0.5 meant as 50 %?"), ("0.01", None)):
+        store = tmp_path / "s.h5"
+        assert main([*command, fill, "--store", str(store), "--no-progress"]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and "rounds to none" in err, err
+        assert (hint in err) if hint else ("meant as" not in err)
+        assert not store.exists()
+        export = (Path(__file__).resolve().parents[1] / "data_samples" / "exports"
+                  / "synthetic_f50Hz_a5g_fill50_acrylic.uff")
+        assert main(["analyze", str(export), "--no-store", "--fill", fill]) == 2
+        said = capsys.readouterr().err
+        assert (hint in said) if hint else ("meant as" not in said)  # the same words
+
+
 @pytest.mark.parametrize("fill", ["nan", "inf", "0", "150", "100.0000001"])
 def test_a_fill_outside_0_100_is_one_line_naming_the_option(capsys, fill):
     # 100.0000001 was shown as "--fill 100", a fill that is accepted
@@ -486,13 +506,3 @@ def test_the_highest_frequency_the_dem_takes_follows_from_its_time_step():
             assert named == pytest.approx(highest, rel=1e-2)  # 3 significant digits
         else:
             assert not refused
-
-
-def test_a_fill_typed_as_a_fraction_gets_the_hint_analyze_gives(capsys):
-    # `dem run --fill 0.5` said only "rounds to none" where analyze asked "was 0.5 meant as
-    # 50 %?": one rule (particles_for_fill) words both
-    assert main(["dem", "run", "--frequency", "100", "--acceleration", "5", "--fill", "0.5",
-                 "--cells", "1", "--cycles", "2", "--no-progress"]) == 2
-    err = capsys.readouterr().err
-    assert "--fill 0.5: fill 0.5 % of 22 particles rounds to none" in err
-    assert "was 0.5 meant as 50 %?" in err

@@ -170,10 +170,13 @@ class CalibrationRunner:
         self.task: CalibrationTask | None = None
 
     def start(self, api, points: Sequence, *, fit: Sequence[str], cells: int,
-              design_size: int | None, specimen=None) -> CalibrationTask | None:
+              design_size: int | None, specimen=None,
+              notes: Sequence[str] = ()) -> CalibrationTask | None:
         """Start a calibration of ``specimen`` (None: the paper's coupon); None (nothing
         started) while one is running. Points the library refuses raise its error here
-        (:func:`check_points`), not in the background."""
+        (:func:`check_points`), not in the background. ``notes``: what the store held but
+        the page left out (records saved as implausible, other specimens' tests), kept with
+        the outputs' notes as ``pidcore calibrate --store`` keeps them."""
         check_points(api, points, specimen, fit)
         with self._lock:
             if self.task is not None and self.task.state == "running":
@@ -181,12 +184,12 @@ class CalibrationRunner:
             task = self.task = CalibrationTask(tuple(fit), len(points),
                                                specimen_label(specimen))
         threading.Thread(target=self._run, args=(api, task, list(points), list(fit), cells,
-                                                 design_size, specimen),
+                                                 design_size, specimen, list(notes)),
                          name="pidcore-calibration", daemon=True).start()
         return task
 
     def _run(self, api, task: CalibrationTask, points, fit, cells, design_size,
-             specimen) -> None:
+             specimen, notes: Sequence[str] = ()) -> None:
         from ..errors import PidcoreError
 
         # the paper's coupon is the library's default: no specimen argument for it
@@ -194,6 +197,8 @@ class CalibrationRunner:
         try:
             result = api.calibrate(points, fit=fit, store_path=self.store_path, cells=cells,
                                    design_size=design_size, progress=False, **given)
+            if notes:
+                result.notes = [*notes, *result.notes]
             with tempfile.TemporaryDirectory(prefix="pidcore_calibration_") as folder:
                 paths = api.write_outputs(result, folder)
                 outputs = {Path(p).name: Path(p).read_bytes() for p in paths}

@@ -119,6 +119,12 @@ def case_view(entries: Sequence[MeasuredEntry], dem_runs: pd.DataFrame | None,
     notes = list(comparison.notes)
     if met.note and not met.refused:
         notes.append(met.note)
+    # a record the plausibility checks refuse, saved as confirmed, was pooled here without a
+    # word (report --store names it, calibrate --store leaves it out)
+    notes.extend(f"{e.file}: implausible, "
+                 + ("saved as accepted" if e.origin == "store" else f"{e.origin}")
+                 + f": {e.implausible}; pooled here, so the calibrated band is not judged"
+                 for e in entries if e.implausible)
     grid = getattr(comparison.aligned, "grid_case", None)
     loops = []
     for e in entries:

@@ -126,6 +126,9 @@ def summary_html(result: CalibrationResult) -> str:
             parts.append("<tr>" + "".join(f"<td>{html.escape(c.strip('*'))}</td>"
                                           for c in cells) + "</tr>")
         parts.append("</table>")
+    if result.notes:  # summary.md's notes (a value set by its prior, records left out)
+        parts.append("<h2>Notes</h2><ul>"
+                     + "".join(f"<li>{html.escape(n)}</li>" for n in result.notes) + "</ul>")
     parts.append("<p><img src='predictions.png' alt='measured vs predicted'></p>"
                  "<p><img src='posterior_pairs.png' alt='posterior pairs'></p></body></html>")
     return "\n".join(parts)

@@ -365,12 +365,18 @@ def bound_notes(specs: Sequence[ParameterSpec], samples: np.ndarray) -> list[str
     the prior allows): a stated value that is off (a fixture mass, a baseline) or a prior
     that is too narrow. The median is still reported; the note says not to trust it.
     """
+    from ..units import display_with_uncertainty
+
     notes = []
     for j, spec in enumerate(specs):
         low, high = float(spec.low), float(spec.high)
         if not (math.isfinite(low) and math.isfinite(high) and high > low):
             continue
         x = samples[:, j]
+        # the median as the summary shows it (summary_texts): the note said 0.001285 beside
+        # the table's 0.00128, digits the Monte-Carlo error does not hold
+        median = display_with_uncertainty(float(np.median(x)),
+                                          float(quantile_mc_stderr(x, [50])[0]))
         u = _to_unit(spec, x)  # the prior's own scale: log for a log-uniform prior
         q_low, q_high = np.quantile(u, [0.025, 0.975])
         near = OWN_WIDTH_SHARE * float(q_high - q_low)
@@ -383,7 +389,7 @@ def bound_notes(specs: Sequence[ParameterSpec], samples: np.ndarray) -> list[str
                     f"{spec.name}: the posterior piles against its prior's {side} bound "
                     f"{bound:g} ({share:.0%} of the samples in the {EDGE_SHARE:.0%} of the prior's "
                     f"range next to it): the data ask for a value at or beyond it, so its median "
-                    f"{float(np.median(x)):.4g} is set by the prior, not the data; check the "
+                    f"{median} is set by the prior, not the data; check the "
                     f"stated values, and widen the prior (--prior {spec.name}=LOW:HIGH) unless "
                     "the bound is physical")
     return notes

@@ -94,12 +94,15 @@ def run(args: argparse.Namespace) -> int:
     # --specimen`); a stated material other than the specimen's is refused by calibrate()
     default_material = specimen.particles.material if specimen is not None \
         else DEFAULT_MATERIAL
+    # what the store held but the fit leaves out, said now (before the DEM runs) and kept with
+    # the outputs: summary.md and calibration.json said '5 measured load cases' with no word
+    # of the record left out as implausible
+    left_out: list[str] = []
     if args.data is not None:
         points = read_measured_table(args.data, default_material=default_material)
     else:
-        left_out: list[str] = []
-        points = _store_points(measured_from_store(args.store, left_out=left_out), specimen,
-                               args.store)
+        measured = measured_from_store(args.store, left_out=left_out)
+        points = _store_points(measured, specimen, args.store, left_out)
         for note in left_out:
             print(f"pidcore calibrate: note: {note}", file=sys.stderr)
     tally = RunTally(args.dem_store)
@@ -112,6 +115,8 @@ def run(args: argparse.Namespace) -> int:
                            cross_validate=args.cross_validate, method=args.method,
                            progress=not args.no_progress, specimen=specimen,
                            on_design=tally.design)
+        own_notes = list(result.notes)
+        result.notes = [*left_out, *own_notes]
         if args.out is not None:
             write_outputs(result, args.out)  # all or nothing
             written = True
@@ -124,7 +129,7 @@ def run(args: argparse.Namespace) -> int:
               f"{_out_words(args.out, written)}", file=sys.stderr)
         interrupt.mark_handled()
         return 130
-    for note in result.notes:
+    for note in own_notes:
         print(f"pidcore calibrate: note: {note}", file=sys.stderr)
     if args.json:
         print(document_json(result.document()))
@@ -143,12 +148,12 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _store_points(points: list, specimen, store: Path) -> list:
+def _store_points(points: list, specimen, store: Path, left_out: list[str]) -> list:
     """The store's measured points the specimen is calibrated against, as the app's Calibrate
     page chooses them (its particles, measured on it or on no named specimen; the paper's
-    coupon: those naming no other specimen); what is left out is said on stderr. A store of
-    acrylic and steel measurements was refused as a whole ("choose the points of one
-    material"), with no option to choose them."""
+    coupon: those naming no other specimen); what is left out is added to ``left_out`` (said
+    on stderr and kept with the outputs). A store of acrylic and steel measurements was
+    refused as a whole ("choose the points of one material"), with no option to choose them."""
     from ..calibrate.data import points_for_paper, points_for_specimen
     from ..errors import ParameterError
 
@@ -171,7 +176,7 @@ def _store_points(points: list, specimen, store: Path) -> list:
                 f"({specimen.particles.material} particles) or of an unnamed specimen of them"
                 f"{'; ' + note if note else ''}")
     if note and kept:
-        print(f"pidcore calibrate: note: {note}", file=sys.stderr)
+        left_out.append(note)  # said with the others by the caller
     return kept
 
 

@@ -296,6 +296,8 @@ def _check_fill(fill: float, option: str, args: argparse.Namespace, specimen,
     except ParameterError as exc:
         if not str(exc).startswith("fill "):  # not about this fill (e.g. --fill-reference)
             raise
+        # (a fraction typed for a percentage is asked about by particles_for_fill, as for
+        # analyze)
         raise ParameterError(f"{option} {as_given(fill)}: {exc}") from None
 
 

@@ -197,6 +197,9 @@ class MeasuredEntry:
         Fitted harmonics (for the loop and the spectrum).
     specimen, created_utc : str
         Specimen named with the record (may be empty) and when it was saved.
+    implausible : str
+        What the plausibility checks refuse in it (:mod:`pidcore.compare.plausibility`; saved
+        with ``--accept-implausible`` or the app's confirmation), or empty.
     corrections : str
         The corrections the analysis ran with, e.g. ``"vibrometer delay 50 µs, mass below
         gauge 0 g, baseline loss factor 0"`` (empty where unknown).
@@ -223,6 +226,8 @@ class MeasuredEntry:
     created_utc: str = ""
     corrections: str = ""
     measurement_key: str = ""
+    #: the first plausibility warning beyond noise (a result kept or saved as accepted), or ""
+    implausible: str = ""
 
     @classmethod
     def from_record(cls, record, load_case: LoadCase, *,
@@ -230,8 +235,10 @@ class MeasuredEntry:
         """Entry of a fresh (unsaved) analysis (:class:`pidcore.measure.AnalyzedRecord`);
         ``options`` (:class:`pidcore.measure.AnalysisOptions`) names the corrections."""
         from ..records import measurement_key
+        from .plausibility import implausible_findings
 
         a = record.analysis
+        found, _ = implausible_findings(a)
         try:
             content = measurement_key(record.measurement)
         except PidcoreError:  # a malformed digest: the entry is never taken for a copy
@@ -243,15 +250,17 @@ class MeasuredEntry:
                    np.asarray(a.harmonics), np.asarray(a.force_phasors_n),
                    np.asarray(a.velocity_phasors_m_s), specimen,
                    corrections=describe_corrections(vars(options)) if options else "",
-                   measurement_key=content)
+                   measurement_key=content, implausible=found[0].message if found else "")
 
     @classmethod
     def from_store(cls, row: pd.Series, arrays: dict) -> MeasuredEntry:
         """Entry of a saved analysis: a row of :func:`pidcore.store.listing.saved_analyses`
         and the entry's arrays (:meth:`pidcore.store.Store.get_analysis`)."""
         from .align import _row_case
+        from .plausibility import stored_findings
 
         empty = np.empty(0)
+        found, _ = stored_findings(row)
         return cls(str(row["key"]), Path(str(row.get("source", ""))).name, "store",
                    _row_case(row), float(row["frequency_hz"]),
                    float(row.get("acceleration_m_s2", math.nan)),
@@ -262,7 +271,8 @@ class MeasuredEntry:
                    np.asarray(arrays.get("velocity_phasors_m_s", empty)),
                    _specimen_of(row), str(row.get("created_utc", "")),
                    describe_corrections(_json_dict(row.get("parameters_json"))),
-                   str(row.get("measurement_key", "") or ""))
+                   str(row.get("measurement_key", "") or ""),
+                   found[0].message if found else "")
 
     def loop(self):
         """The measured loop (:class:`pidcore.loop.ForceDisplacementLoop`, labelled

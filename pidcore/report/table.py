@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
+from pathlib import Path
 from typing import NamedTuple
 
 import numpy as np
@@ -36,6 +37,7 @@ from ..compare.align import (
     pooled_sdc_eq10,
 )
 from ..compare.loadcase import LoadCase, LoadCaseError
+from ..compare.plausibility import stored_findings
 from ..compare.specimens import runs_for_measurement
 from ..errors import ParameterError
 from ..units import g_to_si
@@ -79,6 +81,8 @@ class _Measured(NamedTuple):
     source: str
     energy_per_cycle_j: float
     specimen: str
+    #: the first plausibility warning beyond noise of the record (kept as accepted), or ""
+    implausible: str = ""
 
 
 @dataclass
@@ -271,9 +275,11 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
                 dem_runs if store_runs is None else store_runs, choose_another,
                 named=bool(specimen)))
             met_note = ""
+        found, _ = stored_findings(rec)
         entry = _Measured(float(rec["sdc"]), float(rec["sdc_stderr"]), case.frequency_hz,
                           case.acceleration_g, str(rec.get("source", "")),
-                          float(rec.get("energy_per_cycle_j", math.nan)), specimen)
+                          float(rec.get("energy_per_cycle_j", math.nan)), specimen,
+                          found[0].message if found else "")
         base = None
         if aligned.status == "grid" and aligned.grid_case is not None:
             dem = aligned.grid_case
@@ -328,6 +334,12 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
             note.append(f"{len(row.measured)} measurements pooled"
                         + (f" (chi2/dof {chi2_dof:.2g}: they scatter more than their errors)"
                            if chi2_dof > 3 else ""))
+        implausible = [m for m in row.measured if m.implausible]
+        if implausible:
+            # the report's notes named them apart from the rows: the CSV row of a case pooling
+            # an SDC of 46.1 with one of 2.19 showed 24.1 with no word of it
+            note.append(IMPLAUSIBLE_ROW_NOTE + "; ".join(
+                f"{Path(m.source).name} ({m.implausible})" for m in implausible))
         if row.dem is not None and row.dem.n_runs > 1:
             note.append(f"{row.dem.n_runs} DEM runs pooled")
         if row.dem is not None and row.dem.duplicate_keys:
@@ -439,6 +451,11 @@ def _sort_like_table3(table: pd.DataFrame, aligner: Aligner, paper: pd.DataFrame
     return table.loc[order].reset_index(drop=True)
 
 
+#: Opens the note of a row whose measured SDC includes a record the plausibility checks refuse
+#: (saved or kept with --accept-implausible); :func:`add_calibration_columns` judges no band
+#: for such a row.
+IMPLAUSIBLE_ROW_NOTE = "includes a result no passive coupon gives, kept as accepted: "
+
 #: Columns added by :func:`add_calibration_columns` (after "SDC measured [-]").
 CALIBRATED_COLUMN = "SDC calibrated DEM (Eq. 11) [-]"
 CALIBRATED_LOW_COLUMN = "calibrated low 95 % [-]"
@@ -535,6 +552,12 @@ def add_calibration_columns(table: pd.DataFrame, calibration, *,
             elif not math.isfinite(measured):
                 inside.append(NOT_COMPARED)
                 extra = "no Eq. 11 measurement to compare with the calibrated band"
+            elif IMPLAUSIBLE_ROW_NOTE in note:
+                # its standard error is the scatter of an impossible SDC about the others
+                # (22 for 46.1 pooled with 2.19): the band it gives holds anything, and the
+                # row read 'inside' where calibrate --store leaves that record out
+                inside.append(NOT_COMPARED)
+                extra = "so not compared with the calibrated band"
             else:
                 if band != (hit.low95, hit.high95):
                     extra = (f"calibrated band for this measurement's SDC stderr {stderr:.3g} "

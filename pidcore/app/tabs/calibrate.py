@@ -98,14 +98,16 @@ def render(stores) -> None:
         st.info(f"{stores.path} holds no saved measurements with a load case yet: analyse "
                 "files on the Analyse tab and Save them.")
         return
-    chosen_label = _form(stores, api, points)
+    chosen_label = _form(stores, api, points, left_out)
     # the running or finished calibration, whichever specimen is chosen now
     draw_polling(_task, stores, chosen_label, polling=_running(stores), every_s=REFRESH_S)
 
 
-def _form(stores, api, points: list) -> str:
+def _form(stores, api, points: list, left_out: list[str]) -> str:
     """The specimen, cases and parameters to calibrate, and Run; returns the chosen
-    specimen's name as the result below is compared with it."""
+    specimen's name as the result below is compared with it. ``left_out``: the store's
+    records left out as implausible; kept with the outputs' notes, with what the specimen
+    leaves out."""
     from pidcore.errors import PidcoreError
 
     specimen, refused = specimen_choice("calibration")
@@ -118,6 +120,7 @@ def _form(stores, api, points: list) -> str:
         points, note = points_for_specimen(points, specimen)
         if note:
             st.caption(note)
+            left_out = [*left_out, note]
         if not points:
             st.info(f"No saved measurement is of specimen {specimen.name} "
                     f"({specimen.particles.material} particles) or of an unnamed specimen of "
@@ -128,6 +131,7 @@ def _form(stores, api, points: list) -> str:
         points, note = points_for_paper(points)
         if note:
             st.caption(note)
+            left_out = [*left_out, note]
         if not points:
             return chosen_label
     by_material = points_by_material(points)
@@ -181,7 +185,7 @@ def _form(stores, api, points: list) -> str:
             fit = api.parse_fit(wanted, specimen)
             started = runner_for(stores.path).start(api, points, fit=fit, cells=int(cells),
                                                     design_size=int(design) or None,
-                                                    specimen=specimen)
+                                                    specimen=specimen, notes=left_out)
         except PidcoreError as exc:
             st.error(page_words(str(exc)))
         else:

@@ -47,7 +47,7 @@ def _group_key(members) -> str:
     return "|".join(f"{e.key}:{e.load_case.key}:{e.specimen}:{e.sdc!r}" for e in members)
 
 
-def _calibrated(calibrations, comp, head, specimen: str) -> None:
+def _calibrated(calibrations, comp, head, specimen: str, *, implausible: bool = False) -> None:
     """The calibrated DEM's Eq. 11 SDC with its 95 % band beside the raw DEM and the measured
     Eq. 11 SDC (like for like: the calibration predicts what a shaker test of the DEM would
     measure with Eq. 11). ``calibrations``: [(calibration or None, label)], see :func:`render`;
@@ -82,8 +82,12 @@ def _calibrated(calibrations, comp, head, specimen: str) -> None:
                          else math.nan)
     c3.metric("SDC calibrated DEM, Eq. 11 [-]", display_number(hit.sdc),
               help=f"95 % band {display_number(low)} .. {display_number(high)}")
-    verdict = ("inside" if low <= comp.measured_sdc <= high else "outside") \
-        if math.isfinite(comp.measured_sdc) else "not compared (no Eq. 11 SDC)"
+    if not math.isfinite(comp.measured_sdc):
+        verdict = "not compared (no Eq. 11 SDC)"
+    elif implausible:  # as the report judges such a row: its stderr is an impossible scatter
+        verdict = "not compared (it pools an implausible result, named below)"
+    else:
+        verdict = "inside" if low <= comp.measured_sdc <= high else "outside"
     st.caption(f"calibrated 95 % band {display_number(low)} .. {display_number(high)} [-]"
                + (f" (for this measurement's SDC stderr {comp.measured_stderr:.3g})"
                   if (low, high) != (hit.low95, hit.high95) else "")
@@ -174,7 +178,8 @@ def render(stores, session_files: list, calibrations: list) -> None:
                 and math.isfinite(aligned.sdc_paper_experimental)):
             st.caption("paper: none where Table 3 has no value at this case (it tabulates "
                        "acrylic spheres driven along z at its grid of load cases)")
-    _calibrated(calibrations, comp, head, members[0].specimen)
+    _calibrated(calibrations, comp, head, members[0].specimen,
+                implausible=any(e.implausible for e in members))
     for note in view["notes"]:
         st.caption(f"note: {note}")
     left, right = st.columns(2)
