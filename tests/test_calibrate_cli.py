@@ -569,12 +569,11 @@ def test_store_of_only_another_specimens_tests_says_why_none_is_used(capsys, mon
              "2 measured load case(s) of specimen steel_6mm", "--specimen FILE of theirs")
 
 
-def test_a_record_saved_as_implausible_is_left_out_of_a_store_calibration(tmp_path, capsys):
-    # calibrate --store fitted an SDC of -1.26 (energy created, kept with
-    # --accept-implausible) averaged with the load case's real tests, without a word
+def _store_with_an_implausible_record(tmp_path, capsys) -> Path:
+    """A store of two 500 Hz, 5 g, 50 % tests: a damped one and one of negative damping (SDC
+    < 0, energy created) saved with --accept-implausible."""
     from _shaker_files import write_force_velocity
 
-    from pidcore.calibrate import measured_from_store
     from pidcore.constants import STANDARD_GRAVITY
     from pidcore.signal.synthetic import synthesize_shaker_record
 
@@ -591,6 +590,15 @@ def test_a_record_saved_as_implausible_is_left_out_of_a_store_calibration(tmp_pa
     assert main(["analyze", *map(str, paths), "--store", str(store),
                  "--accept-implausible"]) == 0
     capsys.readouterr()
+    return store
+
+
+def test_a_record_saved_as_implausible_is_left_out_of_a_store_calibration(tmp_path, capsys):
+    # calibrate --store fitted an SDC of -1.26 (energy created, kept with
+    # --accept-implausible) averaged with the load case's real tests, without a word
+    from pidcore.calibrate import measured_from_store
+
+    store = _store_with_an_implausible_record(tmp_path, capsys)
     good = Store(store).list_analyses().set_index("source")
     good_sdc = next(v for k, v in good["sdc"].items() if k.endswith("good_fill50_acrylic.csv"))
     left_out: list[str] = []
@@ -608,26 +616,9 @@ def test_a_record_left_out_of_a_store_calibration_is_named_in_its_outputs(tmp_pa
     import importlib
     from types import SimpleNamespace
 
-    from _shaker_files import write_force_velocity
-
-    from pidcore.constants import STANDARD_GRAVITY
-    from pidcore.signal.synthetic import synthesize_shaker_record
-
     library = importlib.import_module("pidcore.calibrate.calibrate")
     outputs = importlib.import_module("pidcore.calibrate.outputs")
-    store = tmp_path / "s.h5"
-    paths = []
-    for name, damping in (("good_fill50_acrylic.csv", 2.0), ("neg_fill50_acrylic.csv", -2.0)):
-        rec = synthesize_shaker_record(mass_kg=0.25,
-                                       acceleration_amplitude_m_s2=5 * STANDARD_GRAVITY,
-                                       frequency_hz=500.0, sample_rate_hz=25_600.0,
-                                       n_periods=40, viscous_damping_n_s_m=damping,
-                                       snr_db=60, seed=3)
-        paths.append(write_force_velocity(tmp_path / name, rec.force_n, rec.velocity_m_s,
-                                          25_600.0, "csv"))
-    assert main(["analyze", *map(str, paths), "--store", str(store),
-                 "--accept-implausible"]) == 0
-    capsys.readouterr()
+    store = _store_with_an_implausible_record(tmp_path, capsys)
     written = {}
     monkeypatch.setattr(outputs, "write_outputs",
                         lambda result, out: written.setdefault("notes", list(result.notes)))
