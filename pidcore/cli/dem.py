@@ -131,8 +131,10 @@ def _add_config_options(p: argparse.ArgumentParser) -> None:
                    help="drive direction in the cell frame (z normal to the face sheets; "
                         "default z)")
     p.add_argument("--cycles", metavar="N", type=int, default=None,
-                   help=f"steady-state cycles measured (default "
-                        f"{defaults.DEM_MIN_STEADY_CYCLES})")
+                   help=f"steady-state cycles measured, at least (default "
+                        f"{defaults.DEM_MIN_STEADY_CYCLES}); the DEM runs whole blocks of "
+                        f"{defaults.DEM_STEADY_BLOCK_CYCLES} cycles and measures the two that "
+                        "detect the steady state, so more may be measured (noted)")
     p.add_argument("--time-step", metavar="S", type=_time_step,
                    default=defaults.DEM_TIME_STEP_MODE,
                    help=f"time step, s, or 'auto' (default: min(2e-6 s, contact time / "
