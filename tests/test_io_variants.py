@@ -24,7 +24,7 @@ import pytest
 import pyuff
 import scipy.io
 from _peak_memory import read_peak_memory
-from _shaker_files import file_sha256
+from _shaker_files import file_sha256, write_force_velocity
 
 from pidcore.cli import main
 from pidcore.errors import ChannelError, InputFileError, SignalError
@@ -540,9 +540,7 @@ def test_non_utf8_file_name_is_stored_escaped(tmp_path, capsys):
     rec = _record(n_periods=12)
     name = os.fsdecode(b"run_\xff\xfe.csv")
     path = Path(tmp_path, name)
-    write_measurement(Measurement("x", (Channel("Force", "force", rec.force_n, FS, "N"),
-                                        Channel("Velocity", "velocity", rec.velocity_m_s, FS,
-                                                "m/s"))), path, "csv")
+    write_force_velocity(path, rec.force_n, rec.velocity_m_s, FS)
     store = tmp_path / "s.h5"
     code, out, _ = _cli([str(path), "--store", str(store), "--json"], capsys)
     assert code == 0
@@ -564,9 +562,7 @@ def test_non_utf8_file_name_is_stored_escaped(tmp_path, capsys):
 def test_ctrl_c_while_reading_or_writing_leaves_the_store(tmp_path, capsys, monkeypatch):
     rec = _record(n_periods=12)
     path = tmp_path / "r.csv"
-    write_measurement(Measurement("x", (Channel("Force", "force", rec.force_n, FS, "N"),
-                                        Channel("Velocity", "velocity", rec.velocity_m_s, FS,
-                                                "m/s"))), path)
+    write_force_velocity(path, rec.force_n, rec.velocity_m_s, FS)
     store = tmp_path / "s.h5"
     assert _cli([str(path), "--store", str(store)], capsys)[0] == 0
     before = file_sha256(store)
@@ -669,9 +665,7 @@ def test_report_of_a_non_utf8_file_name_writes_it_escaped(tmp_path, capsys):
     (exit 1): the loop figure's title held the name's raw bytes (surrogates)."""
     rec = _record(n_periods=12)
     path = Path(tmp_path, os.fsdecode(b"run_\xe9_fill50_acrylic.csv"))
-    write_measurement(Measurement("x", (Channel("Force", "force", rec.force_n, FS, "N"),
-                                        Channel("Velocity", "velocity", rec.velocity_m_s, FS,
-                                                "m/s"))), path, "csv")
+    write_force_velocity(path, rec.force_n, rec.velocity_m_s, FS)
     out = tmp_path / "rep"
     assert main(["report", str(path), "--store", str(tmp_path / "s.h5"), "--out", str(out),
                  "--format", "csv"]) == 0
@@ -689,9 +683,7 @@ def test_report_without_a_store_of_a_non_utf8_file_name_writes_it_escaped(tmp_pa
     the refusal printed the name as '\\udce9'."""
     rec = _record(n_periods=12)
     path = Path(tmp_path, os.fsdecode(b"run_\xe9_acrylic.csv"))
-    write_measurement(Measurement("x", (Channel("Force", "force", rec.force_n, FS, "N"),
-                                        Channel("Velocity", "velocity", rec.velocity_m_s, FS,
-                                                "m/s"))), path, "csv")
+    write_force_velocity(path, rec.force_n, rec.velocity_m_s, FS)
     sidecar = tmp_path / "other.csv"
     sidecar.write_text("file,fill_percent\nother.csv,50\n", encoding="utf-8")
     out = tmp_path / "rep"
