@@ -104,16 +104,16 @@ def implausible_findings(analysis) -> tuple[tuple[PlausibilityWarning, ...], tup
     zero, which becomes a note (zero damping, measured with noise)."""
     from ..defaults import REACTIVE_POWER_MIN_FRACTION
 
+    stderr = float(getattr(analysis, "sdc_stderr", math.nan))
+    power = complex(analysis.complex_power_w)
     warnings, notes = [], []
     for w in check_analysis(analysis):
-        stderr = float(getattr(analysis, "sdc_stderr", math.nan))
         if (w.check == "negative_loss_factor" and math.isfinite(stderr)
                 and analysis.sdc + NEGATIVE_WITHIN_STDERRS * stderr >= 0):
             notes.append(f"SDC {analysis.sdc:.3g} is zero within its uncertainty "
                          f"({NEGATIVE_WITHIN_STDERRS:g} x its standard error {stderr:.2g}): "
                          "no damping resolved")
             continue
-        power = complex(analysis.complex_power_w)
         if (w.check == "negative_loss_factor"
                 and -power.real <= REACTIVE_POWER_MIN_FRACTION * abs(power)):
             # a noise-free undamped record gives Re P of round-off (-1e-16 |P|), whose block
@@ -126,11 +126,17 @@ def implausible_findings(analysis) -> tuple[tuple[PlausibilityWarning, ...], tup
     return tuple(warnings), tuple(notes)
 
 
+def _findings_notes(findings, kept: str) -> tuple[str, ...]:
+    """The notes of :func:`implausible_findings`' (warnings, notes): the notes, then each
+    warning as an implausible result ``kept`` (how it came to be kept)."""
+    warnings, notes = findings
+    return notes + tuple(f"implausible, {kept}: {w}" for w in warnings)
+
+
 def plausibility_notes(analysis) -> tuple[str, ...]:
     """The notes a kept result carries: a negative SDC read as zero within its noise, and
     each warning beyond noise kept as asked (:func:`refuse_implausible` with ``accept``)."""
-    warnings, notes = implausible_findings(analysis)
-    return notes + tuple(f"implausible, kept as asked: {w}" for w in warnings)
+    return _findings_notes(implausible_findings(analysis), "kept as asked")
 
 
 def refuse_implausible(records, names, *, accept: bool) -> list:
@@ -146,9 +152,10 @@ def refuse_implausible(records, names, *, accept: bool) -> list:
 
     from ..errors import SignalError
 
-    records, names = list(records), list(names)
-    flagged = [(name, warnings[0]) for record, name in zip(records, names, strict=True)
-               for warnings in (implausible_findings(record.analysis)[0],) if warnings]
+    records = list(records)
+    findings = [implausible_findings(record.analysis) for record in records]
+    flagged = [(name, warnings[0])
+               for (warnings, _), name in zip(findings, names, strict=True) if warnings]
     if flagged and not accept:
         # the first in full; the others named, so that one run shows every file to fix
         (name, warning), others = flagged[0], [n for n, _ in flagged[1:]]
@@ -156,8 +163,8 @@ def refuse_implausible(records, names, *, accept: bool) -> list:
         raise SignalError(f"{name}: implausible: {warning}{also}; refused, nothing saved "
                           "(pass accept_implausible=True to keep it as it is)")
     out = []
-    for record in records:
-        notes = plausibility_notes(record.analysis)
+    for record, found in zip(records, findings, strict=True):
+        notes = _findings_notes(found, "kept as asked")
         out.append(replace(record, notes=record.notes + notes) if notes else record)
     return out
 
@@ -185,6 +192,5 @@ def stored_plausibility_notes(record) -> tuple[str, ...]:
     :func:`plausibility_notes` gives them for an analysis in memory. A store keeps the numbers,
     not the notes: a record saved with ``--accept-implausible`` was reported from the store
     as any other (its SDC -1.26 pooled into a row without a word)."""
-    warnings, notes = stored_findings(record)
-    return notes + tuple(f"implausible, saved as accepted (--accept-implausible): {w}"
-                         for w in warnings)
+    return _findings_notes(stored_findings(record),
+                           "saved as accepted (--accept-implausible)")
