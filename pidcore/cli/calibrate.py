@@ -78,6 +78,7 @@ def run(args: argparse.Namespace) -> int:
     from ..calibrate.data import DEFAULT_MATERIAL, measured_from_store, read_measured_table
     from ..calibrate.outputs import document_json, write_outputs
     from ..calibrate.parameters import parse_fit
+    from ..calibrate.persist import save_calibration
     from ..calibrate.runner import RunTally
     from ..errors import ParameterError
     from ..specimen import load_specimen
@@ -106,7 +107,7 @@ def run(args: argparse.Namespace) -> int:
         for note in left_out:
             print(f"pidcore calibrate: note: {note}", file=sys.stderr)
     tally = RunTally(args.dem_store)
-    written = False
+    written, saved = False, None
     try:
         result = calibrate(points, fit=fit, priors=args.prior, discrepancy=args.discrepancy,
                            discrepancy_floor=args.discrepancy_floor, store_path=args.dem_store,
@@ -117,6 +118,9 @@ def run(args: argparse.Namespace) -> int:
                            on_design=tally.design)
         own_notes = list(result.notes)
         result.notes = [*left_out, *own_notes]
+        # beside the DEM runs it was made from (one transaction): reports and the app read
+        # it from there (report --calibration STORE), and it outlives the --out folder
+        saved = save_calibration(result, args.dem_store)
         if args.out is not None:
             write_outputs(result, args.out)  # all or nothing
             written = True
@@ -126,13 +130,16 @@ def run(args: argparse.Namespace) -> int:
             raise
         # finished runs are each saved in their own transaction: counted from the store
         print(f"pidcore calibrate: interrupted; {tally.interrupted()}"
-              f"{_out_words(args.out, written)}", file=sys.stderr)
+              f"{_saved_words(saved, args.dem_store)}{_out_words(args.out, written)}",
+              file=sys.stderr)
         interrupt.mark_handled()
         return 130
     for note in own_notes:
         print(f"pidcore calibrate: note: {note}", file=sys.stderr)
+    said = _saved_words(saved, args.dem_store).removeprefix("; ")
     if args.json:
         print(document_json(result.document()))
+        print(f"pidcore calibrate: {said}", file=sys.stderr)
     else:
         from ..calibrate.posterior import summary_texts
 
@@ -143,9 +150,21 @@ def run(args: argparse.Namespace) -> int:
         if result.loo is not None:
             print(f"leave-one-out RMS {result.loo_rms:.4f}, {result.loo_coverage}/"
                   f"{len(result.loo)} inside the 95 % band")
+        print(said)
         if args.out is not None:
             print(f"wrote {args.out}")
     return 0
+
+
+def _saved_words(saved: tuple[str, bool] | None, store: Path) -> str:
+    """What became of the calibration in the store (:func:`pidcore.calibrate.persist.
+    save_calibration`'s ``(key, added)``; None: not saved)."""
+    if saved is None:
+        return "; the calibration was not saved"
+    key, added = saved
+    if added:
+        return f"; saved calibration {key} in {store} (report --calibration {store})"
+    return f"; calibration {key} is stored in {store} already (the same result)"
 
 
 def _store_points(points: list, specimen, store: Path, left_out: list[str]) -> list:

@@ -536,6 +536,7 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
                 tolerances: Tolerances | None = None, specimen=None,
                 pool: bool = False,
                 calibration: str | Path | None = None,
+                calibration_key: str | None = None,
                 accept_implausible: bool = False) -> ReportResult:
     """Analyse files, store them, align with DEM and the paper, and write the report.
 
@@ -575,9 +576,12 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         Pool DEM runs of different settings and measurements of different specimens at one
         load case (default: separate rows; see :func:`pidcore.report.build_report_table`).
     calibration : path, optional
-        A ``calibration.json`` of ``pidcore calibrate``: each row it predicts gets the
-        calibrated DEM's Eq. 11 SDC with its 95 % band and whether the measured Eq. 11 SDC
-        lies inside (:func:`pidcore.report.table.add_calibration_columns`).
+        A ``calibration.json`` of ``pidcore calibrate``, or a store holding calibrations
+        (:mod:`pidcore.calibrate.persist`): each row it predicts gets the calibrated DEM's
+        Eq. 11 SDC with its 95 % band and whether the measured Eq. 11 SDC lies inside
+        (:func:`pidcore.report.table.add_calibration_columns`).
+    calibration_key : str, optional
+        Which of the store's calibrations (a store holding one needs none).
     accept_implausible : bool
         Keep (noted) a file's result the plausibility checks refuse (:func:`analyze_files`).
 
@@ -592,7 +596,10 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
     if calibration is not None:  # checked before anything is analysed or written
         from ..calibrate.prediction import load_calibration
 
-        calibrated = load_calibration(calibration)
+        calibrated = load_calibration(calibration, key=calibration_key)
+    elif calibration_key is not None:
+        raise ParameterError(f"--calibration-key {calibration_key}: give the store holding it "
+                             "as --calibration")
     out_dir = Path(out_dir)
     check_out_dir(out_dir)
     tolerances = tolerances or Tolerances()
