@@ -76,7 +76,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     from ..calibrate.calibrate import CALIBRATION_CELLS, calibrate
     from ..calibrate.data import DEFAULT_MATERIAL, measured_from_store, read_measured_table
-    from ..calibrate.outputs import document_json, write_outputs
+    from ..calibrate.outputs import document_json, rms_text, write_outputs
     from ..calibrate.parameters import parse_fit
     from ..calibrate.persist import save_calibration
     from ..calibrate.runner import RunTally
@@ -146,9 +146,9 @@ def run(args: argparse.Namespace) -> int:
         for name, p in result.parameters.items():
             median, low, high = summary_texts(p)
             print(f"{name}: {median} (95 % {low} .. {high})")
-        print(f"in-sample RMS {result.rms:.4f}")
+        print(f"in-sample RMS {rms_text(result.rms)}")
         if result.loo is not None:
-            print(f"leave-one-out RMS {result.loo_rms:.4f}, {result.loo_coverage}/"
+            print(f"leave-one-out RMS {rms_text(result.loo_rms)}, {result.loo_coverage}/"
                   f"{len(result.loo)} inside the 95 % band")
         print(said)
         if args.out is not None:
