@@ -834,6 +834,28 @@ def test_a_calibration_saved_in_the_store_is_listed_and_used_after_a_restart(sto
     assert downloads, "the stored calibration.json is offered for download"
 
 
+def test_dem_jobs_interrupted_by_a_stop_are_shown_and_resubmitted(store_file):
+    from pidcore.dem import DemConfig
+
+    (case,) = jobs.plan_dem_cases([50.0], [5.0], [50.0], material="acrylic", direction="z")
+    queued = jobs.DemJob("job0003", case, DemConfig(cells=1, steady_cycles=5000), "k")
+    jobs.write_journal(jobs.journal_path(store_file), [queued])
+    at = _app()
+    assert any("1 job(s) were queued or running when the app stopped" in w.value
+               for w in at.warning), [w.value for w in at.warning]
+    at.button(key="dem_resubmit").click()
+    at.run()
+    runner = jobs.runner_for(store_file)
+    try:
+        assert not at.exception, at.exception
+        states = {j.job_id: j.state for j in runner.jobs()}
+        assert states["job0003"] == "cancelled" and states["job0004"] in ("queued", "running")
+        assert not any("when the app stopped" in w.value for w in at.warning)
+    finally:
+        runner.cancel()
+        runner.wait_cancelled(5.0)
+
+
 def test_compare_says_when_the_calibration_does_not_predict_the_case(store_file, tmp_path,
                                                                       monkeypatch):
     from pidcore.app.calibration import CALIBRATION_ENV_VAR
