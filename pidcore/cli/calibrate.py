@@ -24,7 +24,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         description="Fit chosen parameters to measured SDCs (Eq. 11 of the DEM's virtual "
                     "shaker, with fixture mass and baseline loss factor), with a posterior, "
                     "95 % intervals and optional leave-one-out cross-validation. DEM runs "
-                    "over a space-filling design are cached in --dem-store.")
+                    "over a space-filling design are cached in --dem-store, and the result is "
+                    "saved there.")
     source = p.add_mutually_exclusive_group(required=True)
     source.add_argument("--data", metavar="TABLE.csv", type=path_argument,
                         help="measured SDCs: frequency_hz, acceleration_g, fill_percent, sdc "
@@ -63,7 +64,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help="posterior: exact grid (<= 4 fitted quantities: 3 parameters plus "
                         "the discrepancy) or emcee; auto picks (default auto)")
     p.add_argument("--dem-store", metavar="FILE", type=path_argument, default=DEFAULT_STORE,
-                   help="HDF5 store caching the DEM runs (default %(default)s)")
+                   help="HDF5 store caching the DEM runs; the calibration is saved in it "
+                        "too (report --calibration FILE reads it) (default %(default)s)")
     p.add_argument("--cross-validate", choices=("loo",), default=None,
                    help="leave-one-out: predict each load case from a fit without it")
     p.add_argument("--out", metavar="DIR", type=path_argument, default=None,
