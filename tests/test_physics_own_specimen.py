@@ -354,3 +354,18 @@ def test_real_solids_pass_the_wave_speed_check(density, modulus):
 def test_a_critically_damped_rolling_dashpot_is_accepted():
     spec = Specimen.from_text(_edit("rolling_damping_ratio = 0.0", "rolling_damping_ratio = 1.0"))
     assert spec.pairs.particle_particle.rolling_damping_ratio == 1.0
+
+
+def test_cells_that_ran_one_motion_give_no_standard_error():
+    # one sphere per cell driven along z never touches a side wall, so the cells' random start
+    # xy changes nothing: both cells are one simulation. Their scatter is exactly 0, which
+    # `dem run` printed as "SDC 0.2635 +- 0" for a bouncer that had not even settled
+    lone = Specimen.from_text(_edit("fill_percent = 50.0", "count_per_cell = 1"))
+    result = simulate_load_case(
+        LoadCase(200.0, 5.0, 100.0 / describe(lone)["capacity_per_cell"], "tungsten_carbide"),
+        DemConfig(cells=2, steady_cycles=4, block_cycles=2, max_transient_cycles=2),
+        specimen=lone)
+    assert result.particles_per_cell == 1
+    assert result.sdc_per_cell[0] == result.sdc_per_cell[1] > 0  # the same motion
+    assert math.isnan(result.sdc_stderr)
+    assert any("no standard error: the 2 cells ran the same motion" in n for n in result.notes)

@@ -436,8 +436,9 @@ def format_summary(result) -> str:
          f"{result.loss_factor:.4g} [-]) over {result.cells_simulated} cells"
          if math.isfinite(result.sdc_stderr) else
          f"SDC             {result.sdc:.4g} [-] (loss factor {result.loss_factor:.4g} [-]) over "
-         f"{result.cells_simulated} cell(s): no standard error (the cells' scatter; simulate "
-         "--cells 2 or more)"),
+         f"{result.cells_simulated} cell(s): no standard error"
+         + (" (see the note)" if result.cells_simulated > 1 else
+            " (the cells' scatter; simulate --cells 2 or more)")),
         f"dissipated      {result.energy_per_cycle_j:.4g} J/cycle (coupon, "
         f"{result.coupon_cells} cells): normal "
         f"damping {result.energy_dissipated_normal_j:.4g} J, friction "
