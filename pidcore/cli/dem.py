@@ -346,7 +346,7 @@ def run(args: argparse.Namespace) -> int:
         return _interrupted("run", int(store is not None and store.commits > 0), args.store)
     notes = list(result.notes)
     said = [note for note in (_same_simulation_note(case, result) if reused else "",
-                              _baseline_note(specimen)) if note]
+                              _baseline_note(specimen, result)) if note]
     notes += said
     if args.json:
         out = {k: result.to_dict()[k] for k in JSON_KEYS}
@@ -370,16 +370,26 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _baseline_note(specimen) -> str:
+def _baseline_note(specimen, result) -> str:
     """What the SDC leaves out of a specimen stating the empty coupon's loss factor: the run
     printed the particles' SDC beside a file stating ``baseline_loss_factor`` without a word
-    of whether it was in it; "" where the specimen states none."""
+    of whether it was in it; "" where the specimen states none.
+
+    The empty structure (coupon and fixture, the rigid mass the shaker moves) dissipates
+    2 pi eta_0 of *its own* peak kinetic energy per cycle, so it adds
+    2 pi eta_0 m_structure / m_c to an SDC taken over E = m_c a^2 / (2 w^2) -- the observation
+    model of ``pidcore calibrate`` (:func:`pidcore.calibrate.surrogate.predicted_sdc`). The note
+    said 2 pi eta_0, 9 x too much for a bed of tungsten carbide nine times the structure's mass.
+    """
     eta = float(specimen.coupon.baseline_loss_factor) if specimen is not None else 0.0
     if eta <= 0:
         return ""
+    share = result.moving_mass_kg / result.vibrated_mass_kg
     return (f"SDC of the particles alone: the specimen's [coupon] baseline_loss_factor {eta:g} "
-            f"(the empty coupon's damping, 2 pi x {eta:g} = {2 * math.pi * eta:.3g} in SDC) is "
-            "not in it; pidcore calibrate's prediction adds it")
+            f"(the empty coupon's damping: 2 pi x {eta:g} of the coupon and fixture's own "
+            f"kinetic energy, {result.moving_mass_kg:.4g} kg of m_c = "
+            f"{result.vibrated_mass_kg:.4g} kg, i.e. {2 * math.pi * eta * share:.3g} in this "
+            "SDC) is not in it; pidcore calibrate's prediction adds it")
 
 
 def _same_simulation_note(asked, result) -> str:
@@ -426,8 +436,9 @@ def format_summary(result) -> str:
          f"{result.loss_factor:.4g} [-]) over {result.cells_simulated} cells"
          if math.isfinite(result.sdc_stderr) else
          f"SDC             {result.sdc:.4g} [-] (loss factor {result.loss_factor:.4g} [-]) over "
-         f"{result.cells_simulated} cell(s): no standard error (the cells' scatter; simulate "
-         "--cells 2 or more)"),
+         f"{result.cells_simulated} cell(s): no standard error"
+         + (" (see the note)" if result.cells_simulated > 1 else
+            " (the cells' scatter; simulate --cells 2 or more)")),
         f"dissipated      {result.energy_per_cycle_j:.4g} J/cycle (coupon, "
         f"{result.coupon_cells} cells): normal "
         f"damping {result.energy_dissipated_normal_j:.4g} J, friction "
