@@ -47,6 +47,7 @@ class AnalysisOptions:
     velocity_delay_s: float = 0.0
     mass_below_gauge_kg: float = 0.0
     baseline_loss_factor: float = 0.0
+    structure_mass_kg: float | None = None
     frequency_hz: float | None = None
     n_harmonics: int = defaults.N_HARMONICS
     sample_rate_hz: float | None = None
@@ -68,6 +69,11 @@ class AnalysisOptions:
             value = getattr(self, name)
             if isinstance(value, float) and value == 0.0:
                 object.__setattr__(self, name, 0.0)
+        if isinstance(self.structure_mass_kg, (int, float)) and self.structure_mass_kg == 0:
+            # 0 states no mass, as 0 states no correction in the other columns (the app's
+            # settings grid starts every row at 0): the baseline then goes off the whole
+            # vibrated mass, noted by the analysis
+            object.__setattr__(self, "structure_mass_kg", None)
 
     def parameters(self) -> dict:
         """JSON-safe parameters stored as provenance."""
@@ -294,6 +300,7 @@ def analyze_measurement(measurement: Measurement, options: AnalysisOptions) -> A
         velocity_delay_s=options.velocity_delay_s + start_delay,
         mass_below_gauge_kg=options.mass_below_gauge_kg,
         baseline_loss_factor=options.baseline_loss_factor,
+        structure_mass_kg=options.structure_mass_kg,
         frequency_hz=options.frequency_hz,
         n_harmonics=options.n_harmonics,
         allow_clipped=options.allow_clipped,

@@ -59,9 +59,9 @@ def add_load_case_options(p: argparse._ActionsContainer, *, what: str,
     p.add_argument("--sidecar", metavar="CSV", type=path_argument, default=None,
                    help="per-file table: load case (file, fill_percent, material, direction) "
                         "and analysis settings (velocity_delay_us, mass_below_gauge_g, "
-                        "baseline_loss_factor, force, velocity, acceleration, invert, "
-                        "specimen); options given override it; default: loadcases.csv beside "
-                        "each file")
+                        "baseline_loss_factor, structure_mass_g, force, velocity, acceleration, "
+                        "invert, specimen); options given override it; default: "
+                        "loadcases.csv beside each file")
 
 
 def check_out_folder(out: Path) -> None:
@@ -104,6 +104,11 @@ def add_measurement_options(p: argparse.ArgumentParser) -> None:
     g.add_argument("--baseline-loss-factor", metavar="ETA", type=float, default=None,
                    help="loss factor of the empty coupon to subtract (default: the sidecar's, "
                         "else 0)")
+    g.add_argument("--structure-mass", metavar="KG", type=float, default=None,
+                   help="mass of that empty structure (coupon and fixture above the gauge), "
+                        "kg: its own dissipation is subtracted (default: the sidecar's "
+                        "structure_mass_g; none: the baseline is taken off the whole vibrated "
+                        "mass, which takes too much, noted)")
     g.add_argument("--frequency", metavar="HZ", type=float, default=None,
                    help="drive frequency hint, Hz (estimated from the data anyway)")
     g.add_argument("--harmonics", metavar="N", type=int, default=defaults.N_HARMONICS,
@@ -134,7 +139,8 @@ def add_measurement_options(p: argparse.ArgumentParser) -> None:
 SIDECAR_OPTION_FLAGS: dict[str, str] = {
     "force": "--force", "velocity": "--velocity", "acceleration": "--acceleration",
     "velocity_delay_s": "--velocity-delay", "mass_below_gauge_kg": "--mass-below-gauge",
-    "baseline_loss_factor": "--baseline-loss-factor", "invert": "--invert",
+    "baseline_loss_factor": "--baseline-loss-factor", "structure_mass_kg": "--structure-mass",
+    "invert": "--invert",
 }
 
 
@@ -159,7 +165,8 @@ def analysis_options(args: argparse.Namespace) -> AnalysisOptions:
     return AnalysisOptions(
         force=args.force, velocity=args.velocity, acceleration=args.acceleration,
         velocity_delay_s=delay, mass_below_gauge_kg=given(args.mass_below_gauge),
-        baseline_loss_factor=given(args.baseline_loss_factor), frequency_hz=args.frequency,
+        baseline_loss_factor=given(args.baseline_loss_factor),
+        structure_mass_kg=args.structure_mass, frequency_hz=args.frequency,
         n_harmonics=args.harmonics, sample_rate_hz=args.sample_rate,
         allow_clipped=args.allow_clipped, force_unit=args.force_unit,
         velocity_unit=args.velocity_unit, acceleration_unit=args.acceleration_unit,
@@ -179,6 +186,7 @@ _FLAG_OF_KEYWORD = (
     ("velocity_delay_s", "--velocity-delay"),
     ("mass_below_gauge_kg", "--mass-below-gauge"),
     ("baseline_loss_factor", "--baseline-loss-factor"),
+    ("structure_mass_kg", "--structure-mass"),
     ("frequency_hz", "--frequency"),
     ("n_harmonics", "--harmonics"),
     ("sample_rate_hz", "--sample-rate"),

@@ -390,12 +390,14 @@ def unsubtracted_baseline_note(specimen, analyses: pd.DataFrame | None) -> str:
     without = sum(1 for value in subtracted if value == 0.0)
     if not without:
         return ""
+    structure_kg = float(specimen.coupon.mass_kg) + float(specimen.coupon.fixture_mass_kg)
     return (f"specimen {specimen.name} states [coupon] baseline_loss_factor {eta:g} (the empty "
             f"coupon's damping), which {without} measured record(s) of its {material} particles "
-            f"were analysed without: their SDC includes it (2 pi x {eta:g} = "
-            f"{2 * math.pi * eta:.3g}) and the DEM's, of the particles alone, does not; analyse "
-            f"them with --baseline-loss-factor {eta:g} (or a sidecar's baseline_loss_factor) to "
-            "subtract it")
+            f"were analysed without: their SDC includes the structure's share of it (2 pi x "
+            f"{eta:g} x its share of the vibrated mass, at most {2 * math.pi * eta:.3g}) and the "
+            f"DEM's, of the particles alone, does not; analyse them with --baseline-loss-factor "
+            f"{eta:g} --structure-mass {structure_kg:.4g} (coupon and fixture; or a sidecar's "
+            "baseline_loss_factor and structure_mass_g) to subtract it")
 
 
 @dataclass(frozen=True)
