@@ -109,7 +109,7 @@ def run(args: argparse.Namespace) -> int:
         for note in left_out:
             print(f"pidcore calibrate: note: {note}", file=sys.stderr)
     tally = RunTally(args.dem_store)
-    written, saved = False, None
+    written, fitted, saved = False, False, None
     try:
         result = calibrate(points, fit=fit, priors=args.prior, discrepancy=args.discrepancy,
                            discrepancy_floor=args.discrepancy_floor, store_path=args.dem_store,
@@ -120,19 +120,22 @@ def run(args: argparse.Namespace) -> int:
                            on_design=tally.design)
         own_notes = list(result.notes)
         result.notes = [*left_out, *own_notes]
-        # beside the DEM runs it was made from (one transaction): reports and the app read
-        # it from there (report --calibration STORE), and it outlives the --out folder
-        saved = save_calibration(result, args.dem_store)
+        fitted = True
         if args.out is not None:
             write_outputs(result, args.out)  # all or nothing
             written = True
+        # beside the DEM runs it was made from (one transaction, after --out so that a Ctrl-C
+        # while the figures are drawn commits nothing): reports and the app read it from there
+        # (report --calibration STORE), and it outlives the --out folder
+        saved = save_calibration(result, args.dem_store)
         interrupt.raise_if_interrupted()  # one swallowed on the way, or held by the move
     except BaseException as exc:  # noqa: BLE001 - an interrupt, or what one became in C code
         if not interrupt.is_interruption(exc):
             raise
         # finished runs are each saved in their own transaction: counted from the store
         print(f"pidcore calibrate: interrupted; {tally.interrupted()}"
-              f"{_saved_words(saved, args.dem_store)}{_out_words(args.out, written)}",
+              f"{_saved_words(saved, args.dem_store) if fitted else ''}"
+              f"{_out_words(args.out, written)}",
               file=sys.stderr)
         interrupt.mark_handled()
         return 130
@@ -162,7 +165,7 @@ def _saved_words(saved: tuple[str, bool] | None, store: Path) -> str:
     """What became of the calibration in the store (:func:`pidcore.calibrate.persist.
     save_calibration`'s ``(key, added)``; None: not saved)."""
     if saved is None:
-        return "; the calibration was not saved"
+        return f"; the calibration was not saved in {store}"
     key, added = saved
     if added:
         return f"; saved calibration {key} in {store} (report --calibration {store})"
