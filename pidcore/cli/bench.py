@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import json
 
-from ._options import positive_int
+from ._options import positive_int, progress_wanted
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -39,6 +39,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     d.add_argument("--workers", type=positive_int, default=None,
                    help="processes for the grid (default: all cores)")
     d.add_argument("--json", action="store_true", help="one JSON document on stdout")
+    d.add_argument("--no-progress", action="store_true",
+                   help="no progress bar for --grid (drawn only on a terminal)")
     d.set_defaults(func=_bench_dem)
 
 
@@ -89,6 +91,7 @@ def _bench_dem(args: argparse.Namespace) -> int:
     result["threads"] = 1
     result["repeat"] = args.repeat
     if args.grid:
-        result.update(run_grid_bench(workers=args.workers), target_grid_wall_s=60.0)
+        result.update(run_grid_bench(workers=args.workers,
+                                     progress=progress_wanted(args)), target_grid_wall_s=60.0)
     _emit(result, args.json)
     return 0

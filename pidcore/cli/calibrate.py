@@ -7,7 +7,13 @@ import sys
 from pathlib import Path
 
 from .. import defaults, interrupt
-from ._options import check_out_folder, non_negative_int, path_argument, positive_int
+from ._options import (
+    check_out_folder,
+    non_negative_int,
+    path_argument,
+    positive_int,
+    progress_wanted,
+)
 
 DEFAULT_STORE = Path("calibration_store.h5")
 
@@ -113,7 +119,7 @@ def run(args: argparse.Namespace) -> int:
                            cells=cells, seed=args.seed, steady_cycles=args.steady_cycles,
                            design_size=args.design_size, workers=args.workers,
                            cross_validate=args.cross_validate, method=args.method,
-                           progress=not args.no_progress, specimen=specimen,
+                           progress=progress_wanted(args), specimen=specimen,
                            on_design=tally.design)
         own_notes = list(result.notes)
         result.notes = [*left_out, *own_notes]
@@ -140,6 +146,9 @@ def run(args: argparse.Namespace) -> int:
             median, low, high = summary_texts(p)
             print(f"{name}: {median} (95 % {low} .. {high})")
         print(f"in-sample RMS {result.rms:.4f}")
+        # a re-run (after Ctrl-C, or with other priors) says that it reused its stored runs
+        print(f"DEM runs: {result.runs['computed']} computed, {result.runs['cached']} reused "
+              f"from {args.dem_store}")
         if result.loo is not None:
             print(f"leave-one-out RMS {result.loo_rms:.4f}, {result.loo_coverage}/"
                   f"{len(result.loo)} inside the 95 % band")

@@ -27,6 +27,8 @@ from ._options import (
     non_negative_int,
     path_argument,
     positive_int,
+    progress_wanted,
+    scheduler_address,
 )
 
 #: Keys of ``pidcore dem run --json`` (more may follow them).
@@ -190,7 +192,7 @@ def _register_sweep(sub: argparse._SubParsersAction) -> None:
     _add_config_options(p)
     p.add_argument("--workers", metavar="N", type=positive_int, default=None,
                    help="local processes (default: all cores)")
-    p.add_argument("--scheduler", metavar="ADDR", default=None,
+    p.add_argument("--scheduler", metavar="ADDR", type=scheduler_address, default=None,
                    help="dask.distributed scheduler address (needs the 'distributed' extra)")
     add_store_option(p)
     add_json_option(p, progress=True)
@@ -266,7 +268,7 @@ def sweep(args: argparse.Namespace) -> int:
     before = stored_keys(args.store, keys)
     try:
         summary = run_sweep(cases, config, store_path=args.store, workers=args.workers,
-                            scheduler=args.scheduler, progress=not args.no_progress,
+                            scheduler=args.scheduler, progress=progress_wanted(args),
                             specimen=specimen)
     except KeyboardInterrupt:
         saved = stored_keys(args.store, keys) - before
@@ -327,7 +329,7 @@ def run(args: argparse.Namespace) -> int:
 
     config = _config(args)
     check_drive(case, config, specimen, what="--frequency/--acceleration")
-    progress = not args.no_progress and sys.stderr.isatty()
+    progress = progress_wanted(args)
     key = None
     reused = False
     store = None

@@ -406,7 +406,10 @@ def _run_dask(todo: Iterable[tuple[LoadCase, str]], config: DemConfig, scheduler
                              "pip install 'pidcore[distributed]'") from None
     try:
         client = Client(scheduler)
-    except (OSError, ValueError) as exc:  # refused, timed out (OSError), or a bad address
+    # refused or timed out (OSError), a bad address (ValueError), and whatever else the
+    # connection raises: tls:// without a TLS configuration is a TypeError, which came out
+    # as a traceback
+    except Exception as exc:  # noqa: BLE001 - every failure to connect is one line
         raise ParameterError(f"--scheduler {scheduler}: cannot connect to a dask.distributed "
                              f"scheduler there ({' '.join(str(exc).split())}); expected the "
                              f"address of a running scheduler, e.g. tcp://host:8786") from None

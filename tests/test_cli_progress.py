@@ -1,0 +1,117 @@
+"""Long commands on a terminal and off it: a progress bar only where one can be drawn, a re-run
+that says what it reused, and a dask scheduler address refused in one line."""
+
+from __future__ import annotations
+
+import sys
+
+import pytest
+
+from pidcore.cli import main
+from pidcore.store import Store
+
+# one tiny case: the bar's drawing is under test, not the physics
+SWEEP = ["dem", "sweep", "--frequencies", "1000", "--accelerations", "5", "--fills", "25",
+         "--cells", "1", "--cycles", "2", "--workers", "1"]
+# a calibration that needs one DEM run per load case (no DEM parameter fitted)
+CALIBRATION_ROWS = "frequency_hz,acceleration_g,fill_percent,sdc\n" \
+                   "500,5,50,0.6\n1000,5,50,0.6\n1000,10,50,0.3\n"
+CALIBRATE = ["calibrate", "--fit", "fixture_mass_kg", "--cells", "2", "--steady-cycles", "10",
+             "--workers", "1"]
+
+
+def _on_a_terminal(monkeypatch, yes: bool) -> None:
+    """stderr (pytest's capture) as a terminal or, as captured, not one."""
+    monkeypatch.setattr(sys.stderr, "isatty", lambda: yes, raising=False)
+
+
+def _bar_drawn(err: str) -> bool:
+    # tqdm redraws with carriage returns; its rate and ETA field is "[00:00<..."
+    return "\r" in err or "<?" in err or "it/s" in err
+
+
+@pytest.mark.parametrize("terminal", [False, True])
+def test_sweep_draws_its_bar_only_on_a_terminal(tmp_path, capsys, monkeypatch, terminal):
+    """`pidcore dem sweep ... 2> log` wrote every redraw of the bar into the log as one line
+    of carriage returns (dem run drew none there; sweep and calibrate did)."""
+    _on_a_terminal(monkeypatch, terminal)
+    assert main([*SWEEP, "--store", str(tmp_path / "s.h5")]) == 0
+    err = capsys.readouterr().err
+    assert _bar_drawn(err) == terminal, repr(err)
+    if terminal:
+        assert "DEM sweep" in err
+    _on_a_terminal(monkeypatch, True)  # --no-progress: none on a terminal either
+    assert main([*SWEEP, "--store", str(tmp_path / "t.h5"), "--no-progress"]) == 0
+    assert not _bar_drawn(capsys.readouterr().err)
+
+
+def test_calibrate_draws_no_bar_off_a_terminal_and_says_a_rerun_reused_its_runs(
+        tmp_path, capsys, monkeypatch):
+    table = tmp_path / "m.csv"
+    table.write_text(CALIBRATION_ROWS)
+    store = tmp_path / "dem.h5"
+    argv = [*CALIBRATE, "--data", str(table), "--dem-store", str(store)]
+    _on_a_terminal(monkeypatch, False)
+    assert main(argv) == 0
+    first = capsys.readouterr()
+    assert not _bar_drawn(first.err), repr(first.err)
+    assert f"DEM runs: 3 computed, 0 reused from {store}" in first.out
+    runs = set(Store(store).list_dem_runs()["case_key"])
+    _on_a_terminal(monkeypatch, True)
+    assert main(argv) == 0
+    again = capsys.readouterr()
+    # the re-run computed nothing (the store holds the same runs) and says so
+    assert f"DEM runs: 0 computed, 3 reused from {store}" in again.out
+    assert set(Store(store).list_dem_runs()["case_key"]) == runs
+    # everything else it printed is the first run's, number for number
+    assert [line for line in again.out.splitlines() if not line.startswith("DEM runs:")] == \
+        [line for line in first.out.splitlines() if not line.startswith("DEM runs:")]
+
+
+@pytest.mark.parametrize("address", ["", "  "])
+def test_an_empty_scheduler_address_is_refused_not_run_locally(tmp_path, capsys, address):
+    """`--scheduler "$SCHEDULER"` with the variable unset ran every case on local processes
+    without a word."""
+    store = tmp_path / "s.h5"
+    with pytest.raises(SystemExit) as refused:  # a usage error: argparse exits
+        main([*SWEEP, "--no-progress", "--scheduler", address, "--store", str(store)])
+    assert refused.value.code == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--scheduler" in err[0] and "tcp://host:8786" in err[0], err
+    assert not store.exists()
+
+
+def test_a_scheduler_address_dask_cannot_use_is_one_line_exit_2(tmp_path, capsys):
+    """tls:// without a TLS configuration raised a TypeError inside distributed: a 40-line
+    traceback and exit 1."""
+    pytest.importorskip("distributed")
+    store = tmp_path / "s.h5"
+    code = main([*SWEEP, "--no-progress", "--scheduler", "tls://127.0.0.1:1",
+                 "--store", str(store)])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2
+    assert len(err) == 1 and "--scheduler tls://127.0.0.1:1" in err[0], err
+    assert not store.exists()
+
+
+@pytest.mark.parametrize("terminal", [False, True])
+def test_bench_dem_grid_draws_its_sweep_bar_only_on_a_terminal(monkeypatch, capsys, terminal):
+    """`pidcore bench dem --grid > log 2>&1` filled the log with the grid sweep's redraws."""
+    import pidcore.dem.bench
+    import pidcore.dem.sweep
+    from pidcore.dem.sweep import SweepSummary
+
+    asked: list[bool] = []
+
+    def sweep(cases, config, *, progress, **kwargs):
+        asked.append(progress)
+        return SweepSummary(wall_s=1.0)
+
+    bed = {"particle_steps_per_s": 1.0, "particle_steps_per_s_cpu": 1.0,
+           "reference_particle_steps_per_s": 1.0}
+    monkeypatch.setattr(pidcore.dem.bench, "run_dem_bench", lambda **kwargs: bed)
+    monkeypatch.setattr(pidcore.dem.sweep, "run_sweep", sweep)
+    _on_a_terminal(monkeypatch, terminal)
+    assert main(["bench", "dem", "--repeat", "1", "--grid", "--json"]) == 0
+    assert main(["bench", "dem", "--repeat", "1", "--grid", "--json", "--no-progress"]) == 0
+    assert asked == [terminal, False]
