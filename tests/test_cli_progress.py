@@ -63,6 +63,9 @@ def test_calibrate_draws_no_bar_off_a_terminal_and_says_a_rerun_reused_its_runs(
     # the re-run computed nothing (the store holds the same runs) and says so
     assert f"DEM runs: 0 computed, 3 reused from {store}" in again.out
     assert set(Store(store).list_dem_runs()["case_key"]) == runs
+    # with --json, said on stderr (stdout holds the one document)
+    assert main([*argv, "--json", "--no-progress"]) == 0
+    assert f"note: DEM runs: 0 computed, 3 reused from {store}" in capsys.readouterr().err
     # everything else it printed is the first run's, number for number
     assert [line for line in again.out.splitlines() if not line.startswith("DEM runs:")] == \
         [line for line in first.out.splitlines() if not line.startswith("DEM runs:")]

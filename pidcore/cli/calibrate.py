@@ -137,7 +137,12 @@ def run(args: argparse.Namespace) -> int:
         return 130
     for note in own_notes:
         print(f"pidcore calibrate: note: {note}", file=sys.stderr)
+    # a re-run (after Ctrl-C, or with other priors) says that it reused its stored runs; on
+    # stderr beside --json's one document
+    runs = (f"DEM runs: {result.runs['computed']} computed, {result.runs['cached']} reused "
+            f"from {args.dem_store}")
     if args.json:
+        print(f"pidcore calibrate: note: {runs}", file=sys.stderr)
         print(document_json(result.document()))
     else:
         from ..calibrate.posterior import summary_texts
@@ -146,9 +151,7 @@ def run(args: argparse.Namespace) -> int:
             median, low, high = summary_texts(p)
             print(f"{name}: {median} (95 % {low} .. {high})")
         print(f"in-sample RMS {result.rms:.4f}")
-        # a re-run (after Ctrl-C, or with other priors) says that it reused its stored runs
-        print(f"DEM runs: {result.runs['computed']} computed, {result.runs['cached']} reused "
-              f"from {args.dem_store}")
+        print(runs)
         if result.loo is not None:
             print(f"leave-one-out RMS {result.loo_rms:.4f}, {result.loo_coverage}/"
                   f"{len(result.loo)} inside the 95 % band")
