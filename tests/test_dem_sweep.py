@@ -170,3 +170,43 @@ def test_an_unreachable_scheduler_is_one_line_exit_2_and_nothing_stored(tmp_path
     assert code == 2
     assert len(err) == 1 and "--scheduler tcp://127.0.0.1:1" in err[0], err
     assert not store.exists() or not Store(store).list_dem_runs().shape[0]
+
+
+def test_a_killed_pool_worker_is_one_error_not_a_traceback():
+    """A DEM worker killed from outside (OOM killer, kill -9) ended `pidcore dem sweep` and
+    `calibrate` with concurrent.futures' BrokenProcessPool traceback, exit 1."""
+    import os
+
+    from pidcore.dem.sweep import run_pooled
+    from pidcore.errors import SimulationError
+
+    finished: list = []
+    # os._exit ends the worker process at once, as SIGKILL would (picklable by reference)
+    with pytest.raises(SimulationError, match="worker process ended abruptly"):
+        run_pooled(os._exit, [(9,), (9,)], workers=2, finish=finished.append)
+    assert finished == []
+
+
+def test_a_sweep_that_fails_after_some_cases_says_they_are_saved(tmp_path, monkeypatch, capsys):
+    import pidcore.dem.sweep
+    from pidcore.cli import main
+    from pidcore.errors import SimulationError
+
+    store = tmp_path / "s.h5"
+
+    def first_then_fail(cases, config, *, store_path, **kwargs):
+        Store(store_path).add_dem_run(run_key(cases[0], config), {"sdc": 0.1})
+        raise SimulationError("a DEM worker process ended abruptly")
+
+    monkeypatch.setattr(pidcore.dem.sweep, "run_sweep", first_then_fail)
+    argv = ["dem", "sweep", "--frequencies", "1000", "--accelerations", "5,10", "--fills", "25",
+            "--cells", "1", "--cycles", "10", "--no-progress", "--store", str(store)]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].endswith(
+        f"ended abruptly; 1 finished run(s) saved to {store}; re-run to resume"), err
+    # nothing stored: the error as it was, with no word of saved runs
+    monkeypatch.setattr(pidcore.dem.sweep, "run_sweep", lambda *a, **k: (_ for _ in ()).throw(
+        SimulationError("refused")))
+    assert main([*argv[:-1], str(tmp_path / "t.h5")]) == 2
+    assert capsys.readouterr().err.strip() == "pidcore dem sweep: error: refused"

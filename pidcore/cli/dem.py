@@ -273,6 +273,12 @@ def sweep(args: argparse.Namespace) -> int:
     except KeyboardInterrupt:
         saved = stored_keys(args.store, keys) - before
         return _interrupted("sweep", len(saved), args.store)
+    except PidcoreError as exc:  # a case refused or failed, a worker killed: what is kept
+        saved = stored_keys(args.store, keys) - before
+        if not saved:
+            raise
+        raise type(exc)(f"{exc}; {len(saved)} finished run(s) saved to {args.store}; re-run "
+                        "to resume") from None
     if args.json:
         print(json.dumps(summary.to_dict()))
     else:

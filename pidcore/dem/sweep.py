@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..constants import DriveDirection, ParticleMaterial
-from ..errors import ParameterError
+from ..errors import ParameterError, SimulationError
 from ..records import json_safe
 from ..specimen import Specimen
 from .persist import (
@@ -200,6 +200,7 @@ def run_pooled(function: Callable, calls: Sequence[tuple], *, workers: int,
     multiprocessing's ``forkserver.py`` after the CLI's one line.
     """
     from concurrent.futures import ProcessPoolExecutor, as_completed
+    from concurrent.futures.process import BrokenProcessPool
 
     from .. import interrupt
 
@@ -215,6 +216,13 @@ def run_pooled(function: Callable, calls: Sequence[tuple], *, workers: int,
         interrupt.raise_if_interrupted()
         for future in as_completed(futures):
             finish(future.result())
+    except BrokenProcessPool:
+        # a worker killed from outside (the kernel's OOM killer, kill -9): a traceback of
+        # concurrent.futures and exit 1 said neither what happened nor what was kept
+        _stop_pool(pool)
+        raise SimulationError(
+            "a DEM worker process ended abruptly (killed, or out of memory?) while running "
+            "a case; the cases finished before it are kept") from None
     except BaseException:
         _stop_pool(pool)
         raise
