@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 from pidcore.dem.simulate import DemConfig, LoadCase
@@ -116,6 +117,16 @@ def test_dask_scheduler_path(tmp_path):
                             scheduler=cluster.scheduler_address, progress=False)
     assert summary.completed == [run_key(CASES[0], CONFIG)]
     assert Store(tmp_path / "d.h5").has_dem_run(summary.completed[0])
+    # the same run, bit for bit, as the local processes store it (the key promises it)
+    run_sweep(CASES[:1], CONFIG, store_path=tmp_path / "l.h5", workers=1, progress=False)
+    remote = Store(tmp_path / "d.h5").get_dem_run(summary.completed[0])
+    local = Store(tmp_path / "l.h5").get_dem_run(summary.completed[0])
+    assert remote.arrays.keys() == local.arrays.keys()
+    for name, values in local.arrays.items():
+        np.testing.assert_array_equal(remote.arrays[name], values, err_msg=name)
+    timing = {"wall_s", "kernel_s", "particle_steps_per_s"}  # how long it took, not what
+    assert {k: v for k, v in remote.record.items() if k not in timing} == \
+        {k: v for k, v in local.record.items() if k not in timing}
 
 
 def test_a_run_saved_by_dem_run_is_skipped_by_a_sweep(tmp_path):
