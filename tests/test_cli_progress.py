@@ -3,6 +3,7 @@ that says what it reused, and a dask scheduler address refused in one line."""
 
 from __future__ import annotations
 
+import re
 import sys
 
 import pytest
@@ -118,3 +119,71 @@ def test_bench_dem_grid_draws_its_sweep_bar_only_on_a_terminal(monkeypatch, caps
     assert main(["bench", "dem", "--repeat", "1", "--grid", "--json"]) == 0
     assert main(["bench", "dem", "--repeat", "1", "--grid", "--json", "--no-progress"]) == 0
     assert asked == [terminal, False]
+
+
+@pytest.mark.parametrize("terminal", [False, True])
+def test_analyze_shows_a_bar_over_many_files_only_on_a_terminal(capsys, monkeypatch,
+                                                                 terminal):
+    """Forty exports took 7-12 s (a 5 M-sample export alone 2.6 s to read) with nothing on
+    the screen until the table."""
+    from pathlib import Path
+
+    exports = sorted(str(p) for p in (Path(__file__).resolve().parents[1] / "data_samples"
+                                      / "exports").iterdir() if p.suffix in (".csv", ".uff"))
+    assert len(exports) >= 2
+    _on_a_terminal(monkeypatch, terminal)
+    assert main(["analyze", *exports, "--no-store"]) == 0
+    err = capsys.readouterr().err
+    assert _bar_drawn(err) == terminal, repr(err)
+    if terminal:
+        # the files to do, then files done (tqdm skips redraws closer than 0.1 s: which)
+        assert f"0/{len(exports)}" in err and "analysing" in err, repr(err)
+        assert re.search(rf"\b[1-9]\d*/{len(exports)}\b", err), repr(err)
+    assert main(["analyze", *exports, "--no-store", "--no-progress"]) == 0
+    assert not _bar_drawn(capsys.readouterr().err)
+
+
+@pytest.mark.parametrize("terminal", [False, True])
+def test_report_asks_for_bars_only_on_a_terminal(tmp_path, monkeypatch, terminal):
+    import pidcore.report.pipeline
+
+    asked: list[bool] = []
+
+    def report(files, *, progress, **kwargs):
+        asked.append(progress)
+        raise KeyboardInterrupt  # enough: what it was asked is recorded
+
+    monkeypatch.setattr(pidcore.report.pipeline, "make_report", report)
+    _on_a_terminal(monkeypatch, terminal)
+    argv = ["report", "--dem-store", str(tmp_path / "none.h5"), "--out", str(tmp_path / "r")]
+    assert main(argv) == 130
+    assert main([*argv, "--no-progress"]) == 130
+    assert asked == [terminal, False]
+
+
+def test_ctrl_c_during_analyze_clears_the_bar_before_its_one_line(capsys, monkeypatch):
+    """The interrupted line was printed after the half-drawn bar on the same line, and the
+    bar was cleared only afterwards (when collected), wiping it from the terminal."""
+    from pathlib import Path
+
+    import pidcore.file_settings
+
+    exports = sorted(str(p) for p in (Path(__file__).resolve().parents[1] / "data_samples"
+                                      / "exports").iterdir() if p.suffix in (".csv", ".uff"))
+    real = pidcore.file_settings.analyze_with_settings
+    seen: list[str] = []
+
+    def second_interrupted(path, settings, **kwargs):
+        seen.append(path)
+        if len(seen) == 2:
+            raise KeyboardInterrupt
+        return real(path, settings, **kwargs)
+
+    monkeypatch.setattr(pidcore.file_settings, "analyze_with_settings", second_interrupted)
+    _on_a_terminal(monkeypatch, True)
+    assert main(["analyze", *exports, "--no-store"]) == 130
+    err = capsys.readouterr().err
+    # what the terminal shows last: the bar's line cleared, then the one line
+    last = err.split("\r")[-1]
+    assert last.strip() == "pidcore analyze: interrupted; nothing saved (--no-store)", repr(err)
+    assert "analysing" in err

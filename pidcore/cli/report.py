@@ -19,6 +19,7 @@ from ._options import (
     analysis_options,
     given_options,
     path_argument,
+    progress_wanted,
     with_cli_flags,
 )
 
@@ -77,6 +78,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help="calibration.json of pidcore calibrate (or the --out folder holding "
                         "it): add the calibrated DEM's Eq. 11 SDC with its 95 %% band beside the "
                         "raw DEM and the measurement")
+    p.add_argument("--no-progress", action="store_true",
+                   help="no progress bars (drawn only on a terminal)")
     add_measurement_options(p)
     p.set_defaults(func=run)
 
@@ -107,7 +110,7 @@ def _run(args: argparse.Namespace) -> int:
             direction=args.direction, sidecar=args.sidecar, options=analysis_options(args),
             options_given=given_options(args),
             specimen=specimen, pool=args.pool, calibration=args.calibration,
-            accept_implausible=args.accept_implausible)
+            accept_implausible=args.accept_implausible, progress=progress_wanted(args))
         print(short_table(result.table))
         for note in result.notes:
             print(f"note: {note}")
