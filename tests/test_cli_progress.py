@@ -187,3 +187,18 @@ def test_ctrl_c_during_analyze_clears_the_bar_before_its_one_line(capsys, monkey
     last = err.split("\r")[-1]
     assert last.strip() == "pidcore analyze: interrupted; nothing saved (--no-store)", repr(err)
     assert "analysing" in err
+
+
+@pytest.mark.parametrize("terminal", [False, True])
+def test_bench_dem_shows_its_beds_only_on_a_terminal(monkeypatch, capsys, terminal):
+    """`pidcore bench dem --repeat 1` measured its five beds for ~40 s with nothing shown."""
+    import pidcore.dem.bench
+
+    bed = {"particle_steps_per_s": 1.0, "particle_steps_per_s_cpu": 1.0,
+           "reference_particle_steps_per_s": 1.0}
+    monkeypatch.setattr(pidcore.dem.bench, "run_dem_bench", lambda **kwargs: bed)
+    _on_a_terminal(monkeypatch, terminal)
+    assert main(["bench", "dem", "--repeat", "1", "--json"]) == 0
+    err = capsys.readouterr().err
+    assert ("DEM beds" in err and "0/5" in err) == terminal, repr(err)
+    assert _bar_drawn(err) == terminal
