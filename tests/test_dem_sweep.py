@@ -221,3 +221,25 @@ def test_a_sweep_that_fails_after_some_cases_says_they_are_saved(tmp_path, monke
         SimulationError("refused")))
     assert main([*argv[:-1], str(tmp_path / "t.h5")]) == 2
     assert capsys.readouterr().err.strip() == "pidcore dem sweep: error: refused"
+
+
+def test_a_run_keyed_otherwise_by_a_worker_is_refused_not_stored(tmp_path, monkeypatch):
+    """A dask worker with another pidcore (another DEM code version) returns its run under
+    another key: it was stored, the sweep listed the case as unfinished, and every re-run
+    simulated it again."""
+    import dataclasses
+
+    import pidcore.dem.sweep
+    from pidcore.errors import SimulationError
+
+    real = pidcore.dem.sweep.run_case
+
+    def other_code(case, config, specimen=None):
+        outcome = real(case, config, specimen)
+        return dataclasses.replace(outcome, key=outcome.key[:-10] + "0123456789")
+
+    monkeypatch.setattr(pidcore.dem.sweep, "run_case", other_code)
+    store = tmp_path / "s.h5"
+    with pytest.raises(SimulationError, match="another pidcore than this one"):
+        run_sweep(CASES[:1], CONFIG, store_path=store, workers=1, progress=False)
+    assert not store.exists() or Store(store).list_dem_runs().empty

@@ -368,7 +368,19 @@ def run_sweep(cases: Sequence[LoadCase], config: DemConfig, *,
         bar = tqdm(total=len(cases), initial=len(cases) - len(todo), unit="case",
                    desc="DEM sweep")
 
+    asked = {key for _, key in todo}
+
     def finish(outcome: CaseOutcome) -> None:
+        if outcome.key not in asked:
+            from .. import __version__
+
+            # a dask worker with another pidcore (DEM code version, key rules) keys its run
+            # otherwise: stored, the sweep listed its case as unfinished and every re-run
+            # simulated it again
+            raise SimulationError(
+                f"a worker returned run {outcome.key}, which this sweep did not ask for (it "
+                f"asked for {len(asked)} run(s) such as {min(asked)}): the workers run "
+                f"another pidcore than this one ({__version__}); install the same on them")
         outcome.save_to(store)
         summary.completed.append(outcome.key)
         if bar is not None:
