@@ -202,3 +202,26 @@ def test_bench_dem_shows_its_beds_only_on_a_terminal(monkeypatch, capsys, termin
     err = capsys.readouterr().err
     assert ("DEM beds" in err and "0/5" in err) == terminal, repr(err)
     assert _bar_drawn(err) == terminal
+
+
+def test_ctrl_c_as_calibrate_prints_says_what_it_saved_and_wrote(tmp_path, capsys,
+                                                                 monkeypatch):
+    """A Ctrl-C after the DEM runs and --out were written, as the result printed, got the
+    generic line: --out "may hold part of this run's files" (it was written whole) and no
+    word of the runs saved."""
+    import pidcore.cli.calibrate as calibrate_cli
+
+    table = tmp_path / "m.csv"
+    table.write_text(CALIBRATION_ROWS)
+    store, out = tmp_path / "dem.h5", tmp_path / "cal"
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(calibrate_cli, "_print_result", interrupted)
+    assert main([*CALIBRATE, "--data", str(table), "--dem-store", str(store), "--out", str(out),
+                 "--no-progress"]) == 130
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1, err
+    assert f"3 DEM run(s) finished before the interrupt are saved in {store}" in err[0]
+    assert err[0].endswith(f"; {out} was written in full"), err

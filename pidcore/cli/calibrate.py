@@ -82,7 +82,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     from ..calibrate.calibrate import CALIBRATION_CELLS, calibrate
     from ..calibrate.data import DEFAULT_MATERIAL, measured_from_store, read_measured_table
-    from ..calibrate.outputs import document_json, write_outputs
+    from ..calibrate.outputs import write_outputs
     from ..calibrate.parameters import parse_fit
     from ..calibrate.runner import RunTally
     from ..errors import ParameterError
@@ -126,6 +126,9 @@ def run(args: argparse.Namespace) -> int:
         if args.out is not None:
             write_outputs(result, args.out)  # all or nothing
             written = True
+        # inside: a Ctrl-C as the result printed was answered by the generic line, which
+        # said the complete --out "may hold part of this run's files"
+        _print_result(args, result, own_notes)
         interrupt.raise_if_interrupted()  # one swallowed on the way, or held by the move
     except BaseException as exc:  # noqa: BLE001 - an interrupt, or what one became in C code
         if not interrupt.is_interruption(exc):
@@ -135,6 +138,14 @@ def run(args: argparse.Namespace) -> int:
               f"{_out_words(args.out, written)}", file=sys.stderr)
         interrupt.mark_handled()
         return 130
+    return 0
+
+
+def _print_result(args: argparse.Namespace, result, own_notes: list[str]) -> None:
+    """The calibration's notes (stderr), its parameters and scores or its JSON document, and
+    how many DEM runs it computed and reused."""
+    from ..calibrate.outputs import document_json
+
     for note in own_notes:
         print(f"pidcore calibrate: note: {note}", file=sys.stderr)
     # a re-run (after Ctrl-C, or with other priors) says that it reused its stored runs; on
@@ -157,7 +168,6 @@ def run(args: argparse.Namespace) -> int:
                   f"{len(result.loo)} inside the 95 % band")
         if args.out is not None:
             print(f"wrote {args.out}")
-    return 0
 
 
 def _store_points(points: list, specimen, store: Path, left_out: list[str]) -> list:
