@@ -623,7 +623,8 @@ def test_a_record_left_out_of_a_store_calibration_is_named_in_its_outputs(tmp_pa
     monkeypatch.setattr(outputs, "write_outputs",
                         lambda result, out: written.setdefault("notes", list(result.notes)))
     monkeypatch.setattr(outputs, "document_json", lambda document: "{}")
-    fake = SimpleNamespace(notes=["the fit's own note"], document=dict)
+    fake = SimpleNamespace(notes=["the fit's own note"], document=dict,
+                           runs={"computed": 0, "cached": 0})
     monkeypatch.setattr(library, "calibrate", lambda points, **kwargs: fake)
     # the store keeps what full_document() gives, with the same notes (checked for a real
     # result in tests/test_calibration_store.py); the fake has no document to keep

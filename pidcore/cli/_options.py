@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import re
+import sys
 from pathlib import Path
 
 from .. import defaults
@@ -76,6 +77,25 @@ def add_store_option(p: argparse.ArgumentParser, *, flag: str = "--store",
                      help: str = STORE_HELP) -> None:
     """An HDF5 store file option (``--store``, ``--dem-store``) read as a :class:`Path`."""
     p.add_argument(flag, metavar="FILE", type=path_argument, default=default, help=help)
+
+
+def progress_wanted(args: argparse.Namespace) -> bool:
+    """Whether a command draws progress bars: not with ``--no-progress``, and only on a
+    terminal. tqdm redraws its bar with carriage returns, which a log file or a pipe keeps
+    as one long line of every redraw (``pidcore dem sweep ... 2> log``)."""
+    if getattr(args, "no_progress", False):
+        return False
+    isatty = getattr(sys.stderr, "isatty", None)
+    return bool(isatty and isatty())
+
+
+def scheduler_address(text: str) -> str:
+    """argparse type: a dask.distributed scheduler address, refused when empty (``--scheduler
+    "$SCHEDULER"`` with the variable unset ran the sweep on local processes without a word)."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError(f"expected a scheduler address such as "
+                                         f"tcp://host:8786, got {text!r}")
+    return text.strip()
 
 
 def add_json_option(p: argparse.ArgumentParser, *, progress: bool = False) -> None:

@@ -7,7 +7,13 @@ import sys
 from pathlib import Path
 
 from .. import defaults, interrupt
-from ._options import check_out_folder, non_negative_int, path_argument, positive_int
+from ._options import (
+    check_out_folder,
+    non_negative_int,
+    path_argument,
+    positive_int,
+    progress_wanted,
+)
 
 DEFAULT_STORE = Path("calibration_store.h5")
 
@@ -78,7 +84,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     from ..calibrate.calibrate import CALIBRATION_CELLS, calibrate
     from ..calibrate.data import DEFAULT_MATERIAL, measured_from_store, read_measured_table
-    from ..calibrate.outputs import document_json, rms_text, write_outputs
+    from ..calibrate.outputs import write_outputs
     from ..calibrate.parameters import parse_fit
     from ..calibrate.persist import save_calibration
     from ..calibrate.runner import RunTally
@@ -116,7 +122,7 @@ def run(args: argparse.Namespace) -> int:
                            cells=cells, seed=args.seed, steady_cycles=args.steady_cycles,
                            design_size=args.design_size, workers=args.workers,
                            cross_validate=args.cross_validate, method=args.method,
-                           progress=not args.no_progress, specimen=specimen,
+                           progress=progress_wanted(args), specimen=specimen,
                            on_design=tally.design)
         own_notes = list(result.notes)
         result.notes = [*left_out, *own_notes]
@@ -128,6 +134,9 @@ def run(args: argparse.Namespace) -> int:
         # while the figures are drawn commits nothing): reports and the app read it from there
         # (report --calibration STORE), and it outlives the --out folder
         saved = save_calibration(result, args.dem_store)
+        # inside: a Ctrl-C as the result printed was answered by the generic line, which
+        # said the complete --out "may hold part of this run's files"
+        _print_result(args, result, own_notes, _saved_words(saved, args.dem_store))
         interrupt.raise_if_interrupted()  # one swallowed on the way, or held by the move
     except BaseException as exc:  # noqa: BLE001 - an interrupt, or what one became in C code
         if not interrupt.is_interruption(exc):
@@ -139,10 +148,24 @@ def run(args: argparse.Namespace) -> int:
               file=sys.stderr)
         interrupt.mark_handled()
         return 130
+    return 0
+
+
+def _print_result(args: argparse.Namespace, result, own_notes: list[str], saved: str) -> None:
+    """The calibration's notes (stderr), its parameters and scores or its JSON document, how
+    many DEM runs it computed and reused, and ``saved`` (:func:`_saved_words`: where the store
+    keeps it)."""
+    from ..calibrate.outputs import document_json, rms_text
+
     for note in own_notes:
         print(f"pidcore calibrate: note: {note}", file=sys.stderr)
-    said = _saved_words(saved, args.dem_store).removeprefix("; ")
+    said = saved.removeprefix("; ")
+    # a re-run (after Ctrl-C, or with other priors) says that it reused its stored runs; on
+    # stderr beside --json's one document
+    runs = (f"DEM runs: {result.runs['computed']} computed, {result.runs['cached']} reused "
+            f"from {args.dem_store}")
     if args.json:
+        print(f"pidcore calibrate: note: {runs}", file=sys.stderr)
         print(document_json(result.document()))
         print(f"pidcore calibrate: {said}", file=sys.stderr)
     else:
@@ -152,13 +175,13 @@ def run(args: argparse.Namespace) -> int:
             median, low, high = summary_texts(p)
             print(f"{name}: {median} (95 % {low} .. {high})")
         print(f"in-sample RMS {rms_text(result.rms)}")
+        print(runs)
         if result.loo is not None:
             print(f"leave-one-out RMS {rms_text(result.loo_rms)}, {result.loo_coverage}/"
                   f"{len(result.loo)} inside the 95 % band")
         print(said)
         if args.out is not None:
             print(f"wrote {args.out}")
-    return 0
 
 
 def _saved_words(saved: tuple[str, bool] | None, store: Path) -> str:

@@ -9,7 +9,7 @@ import re
 import sys
 from collections.abc import Callable
 
-from .. import defaults
+from .. import defaults, interrupt
 from ..constants import (
     DRIVE_DIRECTIONS,
     NORMAL_DAMPING_MODES,
@@ -27,6 +27,8 @@ from ._options import (
     non_negative_int,
     path_argument,
     positive_int,
+    progress_wanted,
+    scheduler_address,
 )
 
 #: Keys of ``pidcore dem run --json`` (more may follow them).
@@ -190,7 +192,7 @@ def _register_sweep(sub: argparse._SubParsersAction) -> None:
     _add_config_options(p)
     p.add_argument("--workers", metavar="N", type=positive_int, default=None,
                    help="local processes (default: all cores)")
-    p.add_argument("--scheduler", metavar="ADDR", default=None,
+    p.add_argument("--scheduler", metavar="ADDR", type=scheduler_address, default=None,
                    help="dask.distributed scheduler address (needs the 'distributed' extra)")
     add_store_option(p)
     add_json_option(p, progress=True)
@@ -266,11 +268,27 @@ def sweep(args: argparse.Namespace) -> int:
     before = stored_keys(args.store, keys)
     try:
         summary = run_sweep(cases, config, store_path=args.store, workers=args.workers,
-                            scheduler=args.scheduler, progress=not args.no_progress,
+                            scheduler=args.scheduler, progress=progress_wanted(args),
                             specimen=specimen)
+        # inside: a Ctrl-C as the summary is printed (every case done) said "no store write
+        # was left half-done" instead of what the sweep saved
+        _print_sweep(args, summary)
+        interrupt.raise_if_interrupted()
     except KeyboardInterrupt:
         saved = stored_keys(args.store, keys) - before
         return _interrupted("sweep", len(saved), args.store)
+    except PidcoreError as exc:  # a case refused or failed, a worker killed: what is kept
+        saved = stored_keys(args.store, keys) - before
+        if not saved:
+            raise
+        raise type(exc)(f"{exc}; {len(saved)} finished run(s) saved to {args.store}; re-run "
+                        "to resume") from None
+    return 0
+
+
+def _print_sweep(args: argparse.Namespace, summary) -> None:
+    """What a finished sweep did: its JSON document, or the counts and the cases it found
+    to be the same simulation as another."""
     if args.json:
         print(json.dumps(summary.to_dict()))
     else:
@@ -282,7 +300,6 @@ def sweep(args: argparse.Namespace) -> int:
                       f"{case['acceleration_g']:g} g): {case['status']} ("
                       f"{case.get('particles_per_cell', '?')} particles per cell, the same "
                       f"seed and settings), not simulated again: {case['store_key']}")
-    return 0
 
 
 def _check_fill(fill: float, option: str, args: argparse.Namespace, specimen,
@@ -327,7 +344,7 @@ def run(args: argparse.Namespace) -> int:
 
     config = _config(args)
     check_drive(case, config, specimen, what="--frequency/--acceleration")
-    progress = not args.no_progress and sys.stderr.isatty()
+    progress = progress_wanted(args)
     key = None
     reused = False
     store = None
@@ -341,9 +358,19 @@ def run(args: argparse.Namespace) -> int:
             result, key, reused = cached.result, cached.key, cached.reused
         else:
             result = simulate_load_case(case, config, progress=progress, specimen=specimen)
+        # inside: a Ctrl-C as the result is printed said "no store write was left
+        # half-done" instead of whether the run was saved
+        _print_run(args, result, case, specimen, key=key, reused=reused)
+        interrupt.raise_if_interrupted()
     except KeyboardInterrupt:
         # the run is saved in one transaction at its end: committed now, or not at all
         return _interrupted("run", int(store is not None and store.commits > 0), args.store)
+    return 0
+
+
+def _print_run(args: argparse.Namespace, result, case, specimen, *, key: str | None,
+               reused: bool) -> None:
+    """One run's summary and notes, or its JSON document, and where it is stored."""
     notes = list(result.notes)
     said = [note for note in (_same_simulation_note(case, result) if reused else "",
                               _baseline_note(specimen, result)) if note]
@@ -361,13 +388,12 @@ def run(args: argparse.Namespace) -> int:
             out["store_key"] = key
             out["reused_from_store"] = reused
         print(json.dumps(out))
-        return 0
+        return
     print(format_summary(result))
     for note in said:
         print(f"note            {note}")
     if key is not None:
         print(f"{'reused from' if reused else 'saved to'} {args.store} as {key}")
-    return 0
 
 
 def _baseline_note(specimen, result) -> str:

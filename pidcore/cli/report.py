@@ -19,6 +19,7 @@ from ._options import (
     analysis_options,
     given_options,
     path_argument,
+    progress_wanted,
     with_cli_flags,
 )
 
@@ -81,6 +82,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--calibration-key", metavar="KEY", default=None,
                    help="which calibration of the --calibration store (cal_...; a store "
                         "holding one needs none)")
+    p.add_argument("--no-progress", action="store_true",
+                   help="no progress bars (drawn only on a terminal)")
     add_measurement_options(p)
     p.set_defaults(func=run)
 
@@ -112,7 +115,7 @@ def _run(args: argparse.Namespace) -> int:
             options_given=given_options(args),
             specimen=specimen, pool=args.pool, calibration=args.calibration,
             calibration_key=args.calibration_key,
-            accept_implausible=args.accept_implausible)
+            accept_implausible=args.accept_implausible, progress=progress_wanted(args))
         print(short_table(result.table))
         for note in result.notes:
             print(f"note: {note}")
