@@ -13,9 +13,13 @@ Layout (every group explains itself through its attributes)::
     /dem_runs/<case_key>       as an analysis, with case_key instead of measurement_key
 
 Writes are transactions: under an exclusive lock on ``<store>.lock`` the store is copied to a
-temporary file beside it, changed there, flushed, fsync'ed and moved over the original with
+temporary file beside it, read into memory (HDF5's core driver) and changed there; at the commit
+its image is written to the temporary file, fsync'ed and moved over the original with
 :func:`os.replace`; any exception (KeyboardInterrupt included) discards the copy. The file at
-the store's path therefore only ever holds a complete, committed state.
+the store's path therefore only ever holds a complete, committed state. HDF5 itself never writes
+to disk: a write it fails (file size limit, full disk) surfaced as errors inside h5py's object
+destructors, a two-line message and a segmentation fault at exit; a failed write of the image
+is one ``OSError`` of Python's own.
 
 Readers take no lock. Because the path is only ever swapped atomically and an open HDF5 handle
 keeps reading the file it opened, a reader sees the last committed state even while a writer
@@ -115,6 +119,21 @@ def _utc_now() -> str:
 
 def _text(value: Any) -> str:
     return value.decode("utf-8", "replace") if isinstance(value, bytes) else str(value)
+
+
+def _one_line(reason: object) -> str:
+    # HDF5's messages hold newlines ("file write failed: time = ...\n, filename = ..."); an
+    # error of pidcore is one line
+    return " ".join(str(reason).split())
+
+
+def _write_image(path: Path, image: bytes) -> None:
+    """Write ``image`` over the file at ``path`` and fsync it (an ``OSError`` on failure)."""
+    with open(path, "r+b") as file:
+        file.truncate(0)
+        file.write(image)
+        file.flush()
+        os.fsync(file.fileno())
 
 
 def _fsync_path(path: Path, *, directory: bool = False) -> None:
@@ -310,7 +329,7 @@ class Store:
         return self._active is not None and self._active_thread == threading.get_ident()
 
     def _unreadable(self, reason: object) -> StoreError:
-        return StoreError(f"{self.path}: not a readable pidcore store ({reason})")
+        return StoreError(f"{self.path}: not a readable pidcore store ({_one_line(reason)})")
 
     def _check_root(self, h5: h5py.File) -> None:
         version = h5.attrs.get("pidcore_store_version")
@@ -424,8 +443,12 @@ class Store:
                 finally:
                     self._active, self._active_thread = None, None
                 try:
-                    h5.close()
-                    _fsync_path(tmp)
+                    try:
+                        h5.flush()  # the image holds only what was flushed
+                        image = h5.id.get_file_image()
+                    finally:
+                        h5.close()
+                    _write_image(tmp, image)
                     # The rename and its count are one step for Ctrl-C (a caller reads
                     # `commits` to say whether its work was saved); a Ctrl-C swallowed on the
                     # way (weakref callback, Numba) never commits.
@@ -434,8 +457,8 @@ class Store:
                         os.replace(tmp, self.path)
                         self.commits += 1
                 except OSError as exc:
-                    raise StoreError(f"{self.path}: cannot commit the changes ({exc}); "
-                                     "the store is unchanged") from None
+                    raise StoreError(f"{self.path}: cannot commit the changes "
+                                     f"({_one_line(exc)}); the store is unchanged") from None
                 # Makes the rename itself durable; the commit has happened either way, and some
                 # file systems cannot fsync a directory, so a failure here is not an error.
                 with suppress(OSError):
@@ -446,7 +469,8 @@ class Store:
                 raise
 
     def _working_copy(self, tmp: Path, *, exists: bool) -> h5py.File:
-        """Copy of the committed store (or a new store) at ``tmp``, opened for writing."""
+        """Copy of the committed store (or a new store) at ``tmp``, opened for writing in
+        memory (the core driver without backing store: the commit writes its image)."""
         try:
             os.close(os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600))
             if exists:
@@ -454,10 +478,10 @@ class Store:
                 shutil.copymode(self.path, tmp)
             else:
                 os.chmod(tmp, _new_file_mode())
-            h5 = h5py.File(tmp, "r+" if exists else "w")
+            h5 = h5py.File(tmp, "r+" if exists else "w", driver="core", backing_store=False)
         except OSError as exc:
-            raise StoreError(f"{self.path}: cannot make the working copy {tmp.name} ({exc}); "
-                             "the store is unchanged") from None
+            raise StoreError(f"{self.path}: cannot make the working copy {tmp.name} "
+                             f"({_one_line(exc)}); the store is unchanged") from None
         try:
             if not exists:
                 h5.attrs["pidcore_store_version"] = np.int64(STORE_VERSION)
