@@ -3,11 +3,14 @@ same writes with ENOSPC), a writer killed or terminated mid-run, the workers of 
 
 from __future__ import annotations
 
+import contextlib
 import os
 import resource
+import signal
 import subprocess
 import sys
 import textwrap
+import time
 from pathlib import Path
 
 import numpy as np
@@ -67,3 +70,47 @@ def test_a_write_past_the_file_size_limit_is_one_line_and_leaves_the_store(tmp_p
     # the next write, with room, works without any repair
     store.add_dem_run("next", {"sdc": 0.5}, arrays={"noise": np.ones(250_000)})
     assert store.verify() == [] and store.get_dem_run("kept").units == {"sdc": "1"}
+
+
+def _alive(pid: int) -> bool:
+    """Whether ``pid`` runs code (a zombie awaiting its reaper does not)."""
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except (OSError, IndexError):
+        return False
+    return state not in ("Z", "X")
+
+
+@pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="reads /proc (Linux)")
+def test_the_workers_of_a_killed_sweep_end_with_it(tmp_path):
+    # `kill -9` of a sweep (or calibrate) left its pool workers waiting for work forever,
+    # with the fork server and the killed command's stdout and stderr: a caller reading those
+    # to their end (`$(pidcore dem sweep ...)`, a harness) never returned. 4 calls of 60 s on
+    # 2 workers: only a worker that ends with its parent is gone within the 20 s given.
+    tests = Path(__file__).resolve().parent
+    code = textwrap.dedent(f"""
+        from _pool_probe import wait_in_worker
+        from pidcore.dem.sweep import run_pooled
+        if __name__ == "__main__":
+            run_pooled(wait_in_worker, [({str(tmp_path)!r}, 60.0)] * 4, workers=2,
+                       finish=print)
+    """)
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT), str(tests)])}
+    p = subprocess.Popen([sys.executable, "-c", code], env=env, stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, text=True, start_new_session=True)
+    try:
+        deadline = time.monotonic() + 60
+        while len(os.listdir(tmp_path)) < 2 and time.monotonic() < deadline:
+            time.sleep(0.02)
+        workers = [int(name) for name in os.listdir(tmp_path)]
+        assert len(workers) == 2
+        p.kill()
+        out, _ = p.communicate(timeout=20)  # EOF: no worker holds the pipes any more
+        assert p.returncode == -signal.SIGKILL and out == ""
+        deadline = time.monotonic() + 5
+        while any(map(_alive, workers)) and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert not any(map(_alive, workers))
+    finally:
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(p.pid, signal.SIGKILL)  # whatever is left of this test's processes
