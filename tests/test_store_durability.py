@@ -15,8 +15,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from _shaker_files import file_sha256
+from _shaker_files import file_sha256, write_force_velocity
 
+from pidcore.signal.synthetic import synthesize_shaker_record
 from pidcore.store import Store
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -82,18 +83,28 @@ def _alive(pid: int) -> bool:
 
 
 @pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="reads /proc (Linux)")
-def test_the_workers_of_a_killed_sweep_end_with_it(tmp_path):
+@pytest.mark.parametrize("signum", [signal.SIGKILL, signal.SIGTERM], ids=["kill-9", "sigterm"])
+def test_the_workers_of_a_killed_sweep_end_with_it(tmp_path, signum):
     # `kill -9` of a sweep (or calibrate) left its pool workers waiting for work forever,
     # with the fork server and the killed command's stdout and stderr: a caller reading those
-    # to their end (`$(pidcore dem sweep ...)`, a harness) never returned. 4 calls of 60 s on
-    # 2 workers: only a worker that ends with its parent is gone within the 20 s given.
+    # to their end (`$(pidcore dem sweep ...)`, a harness) never returned. SIGTERM did the
+    # same (the parent ended on the spot, status -15); now it is the CLI's interruption, which
+    # stops the workers and says so. 4 calls of 60 s on 2 workers: only workers that end with
+    # their parent are gone within the 20 s given.
     tests = Path(__file__).resolve().parent
     code = textwrap.dedent(f"""
+        import sys
         from _pool_probe import wait_in_worker
+        from pidcore import interrupt
         from pidcore.dem.sweep import run_pooled
         if __name__ == "__main__":
-            run_pooled(wait_in_worker, [({str(tmp_path)!r}, 60.0)] * 4, workers=2,
-                       finish=print)
+            interrupt.install()  # as pidcore.cli.main does
+            try:
+                run_pooled(wait_in_worker, [({str(tmp_path)!r}, 60.0)] * 4, workers=2,
+                           finish=print)
+            except KeyboardInterrupt:
+                print("interrupted", file=sys.stderr)
+                sys.exit(interrupt.exit_status())
     """)
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT), str(tests)])}
     p = subprocess.Popen([sys.executable, "-c", code], env=env, stdout=subprocess.PIPE,
@@ -104,9 +115,13 @@ def test_the_workers_of_a_killed_sweep_end_with_it(tmp_path):
             time.sleep(0.02)
         workers = [int(name) for name in os.listdir(tmp_path)]
         assert len(workers) == 2
-        p.kill()
-        out, _ = p.communicate(timeout=20)  # EOF: no worker holds the pipes any more
-        assert p.returncode == -signal.SIGKILL and out == ""
+        p.send_signal(signum)
+        out, err = p.communicate(timeout=20)  # EOF: no worker holds the pipes any more
+        assert out == ""
+        if signum == signal.SIGKILL:
+            assert p.returncode == -signal.SIGKILL
+        else:
+            assert (p.returncode, err) == (128 + signal.SIGTERM, "interrupted\n")
         deadline = time.monotonic() + 5
         while any(map(_alive, workers)) and time.monotonic() < deadline:
             time.sleep(0.05)
@@ -114,3 +129,38 @@ def test_the_workers_of_a_killed_sweep_end_with_it(tmp_path):
     finally:
         with contextlib.suppress(ProcessLookupError):
             os.killpg(p.pid, signal.SIGKILL)  # whatever is left of this test's processes
+
+
+def test_sigterm_mid_commit_is_an_interruption_exit_143_store_unchanged(tmp_path):
+    # `kill PID`, `timeout`, a batch scheduler: SIGTERM ended the process on the spot (status
+    # -15, no word on stderr), the store's working copy left beside it. Now it is Ctrl-C's
+    # interruption with the shell's status for SIGTERM, 128 + 15. The signal is sent from
+    # inside the store's transaction (the analysis saved, before the rename) so that it lands
+    # there every time, not at a moment a loaded machine chooses.
+    rec = synthesize_shaker_record(mass_kg=0.25, acceleration_amplitude_m_s2=49.0,
+                                   frequency_hz=100.0, sample_rate_hz=25_600.0, n_periods=40,
+                                   viscous_damping_n_s_m=2.0, snr_db=50, seed=3)
+    small = write_force_velocity(tmp_path / "run_fill50.csv", rec.force_n, rec.velocity_m_s,
+                                 25_600.0)
+    store = Store(tmp_path / "s.h5")
+    store.add_dem_run("kept", {"sdc": 0.25})
+    digest = file_sha256(store.path)
+    code = textwrap.dedent(f"""
+        import os, signal, sys
+        import pidcore.measure as measure
+        from pidcore.cli import console_main
+        saved = measure.store_analysis
+        def store_then_sigterm(*args, **kwargs):
+            key = saved(*args, **kwargs)
+            os.kill(os.getpid(), signal.SIGTERM)
+            return key
+        measure.store_analysis = store_then_sigterm
+        sys.exit(console_main(["analyze", {str(small)!r}, "--store", {str(store.path)!r}]))
+    """)
+    p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                       timeout=120, env={**os.environ, "PYTHONPATH": str(ROOT)})
+    assert p.returncode == 128 + signal.SIGTERM, (p.returncode, p.stderr[-2000:])
+    assert p.stderr == ("pidcore analyze: interrupted; nothing saved, the store is "
+                        "unchanged\n") and p.stdout == ""
+    assert file_sha256(store.path) == digest
+    assert sorted(os.listdir(tmp_path)) == ["run_fill50.csv", "s.h5"]  # no working copy

@@ -128,7 +128,7 @@ def run(args: argparse.Namespace) -> int:
         print(f"pidcore calibrate: interrupted; {tally.interrupted()}"
               f"{_out_words(args.out, written)}", file=sys.stderr)
         interrupt.mark_handled()
-        return 130
+        return interrupt.exit_status()
     for note in own_notes:
         print(f"pidcore calibrate: note: {note}", file=sys.stderr)
     if args.json:
