@@ -17,7 +17,9 @@ import numpy as np
 import pytest
 from _shaker_files import file_sha256, write_force_velocity
 
+from pidcore.errors import ParameterError, StoreError
 from pidcore.signal.synthetic import synthesize_shaker_record
+from pidcore.specimen import load_specimen
 from pidcore.store import Store
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -164,3 +166,27 @@ def test_sigterm_mid_commit_is_an_interruption_exit_143_store_unchanged(tmp_path
                         "unchanged\n") and p.stdout == ""
     assert file_sha256(store.path) == digest
     assert sorted(os.listdir(tmp_path)) == ["run_fill50.csv", "s.h5"]  # no working copy
+
+
+@pytest.mark.parametrize("text", ["st\x00eel", "caf\udce9"], ids=["nul", "lone-surrogate"])
+def test_a_record_string_hdf5_cannot_hold_is_one_line_and_leaves_the_store(tmp_path, text):
+    # h5py raised ValueError ("VLEN strings do not support embedded NULLs") or
+    # UnicodeEncodeError from inside the transaction: a traceback from the CLI, not one line
+    store = Store(tmp_path / "s.h5")
+    store.add_dem_run("kept", {"specimen_name": "steel"})
+    digest = file_sha256(store.path)
+    with pytest.raises(StoreError, match=r"s\.h5: DEM run 'new': record field 'specimen_name'"):
+        store.add_dem_run("new", {"specimen_name": text})
+    assert file_sha256(store.path) == digest and sorted(os.listdir(tmp_path)) == ["s.h5"]
+
+
+def test_a_specimen_named_with_a_nul_is_refused_before_any_simulation(tmp_path):
+    # TOML allows "\u0000" in a string; the name goes into every stored run's record, where
+    # HDF5 cannot hold it: `dem run --specimen F --store S` simulated, then lost the run to
+    # that traceback at the commit (exit 1)
+    text = (ROOT / "data_samples" / "specimens" / "steel_6mm.toml").read_text()
+    assert 'name = "steel_6mm"' in text
+    path = tmp_path / "nul.toml"
+    path.write_text(text.replace('name = "steel_6mm"', 'name = "steel\\u0000_6mm"'))
+    with pytest.raises(ParameterError, match=r"nul\.toml: name: expected a name of printable"):
+        load_specimen(path)
