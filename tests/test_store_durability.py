@@ -190,3 +190,17 @@ def test_a_specimen_named_with_a_nul_is_refused_before_any_simulation(tmp_path):
     path.write_text(text.replace('name = "steel_6mm"', 'name = "steel\\u0000_6mm"'))
     with pytest.raises(ParameterError, match=r"nul\.toml: name: expected a name of printable"):
         load_specimen(path)
+
+
+def test_a_writer_leaves_the_working_copy_of_a_store_named_like_it_alone(tmp_path):
+    # Stale working copies were found by prefix, ".s.h5." ... ".tmp": that took the live
+    # working copy of "s.h5.old.h5" (another store, another lock, a writer running), whose
+    # commit then failed with FileNotFoundError and lost its batch.
+    store, other = Store(tmp_path / "s.h5"), Store(tmp_path / "s.h5.old.h5")
+    other.add_dem_run("kept", {"sdc": 0.1})
+    with other.transaction():
+        other.add_dem_run("pending", {"sdc": 0.2})
+        store.add_dem_run("meanwhile", {"sdc": 0.3})  # removes stale copies of s.h5 only
+    assert list(other.list_dem_runs()["case_key"]) == ["kept", "pending"]
+    assert store.has_dem_run("meanwhile")
+    assert sorted(os.listdir(tmp_path)) == ["s.h5", "s.h5.old.h5"]

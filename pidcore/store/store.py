@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import secrets
 import shutil
 import threading
@@ -398,9 +399,12 @@ class Store:
     def _remove_stale_temporaries(self) -> None:
         # Called under the write lock: no other writer is running, so any temporary copy left
         # beside the store was abandoned by a writer that was killed before it could clean up.
-        prefix = f".{self.path.name}."
+        # Exactly this store's names (see transaction()): a prefix match took the working copy
+        # of a store named like this one plus a suffix ("s.h5" and "s.h5.old.h5"), whose
+        # writer, not excluded by this store's lock, then failed its commit.
+        pattern = re.compile(re.escape(f".{self.path.name}.") + r"[0-9a-f]{16}\.tmp")
         for stale in self.path.parent.iterdir():
-            if stale.name.startswith(prefix) and stale.name.endswith(".tmp"):
+            if pattern.fullmatch(stale.name):
                 stale.unlink(missing_ok=True)
 
     @contextmanager
