@@ -204,3 +204,22 @@ def test_a_writer_leaves_the_working_copy_of_a_store_named_like_it_alone(tmp_pat
     assert list(other.list_dem_runs()["case_key"]) == ["kept", "pending"]
     assert store.has_dem_run("meanwhile")
     assert sorted(os.listdir(tmp_path)) == ["s.h5", "s.h5.old.h5"]
+
+
+@pytest.mark.parametrize("version", [0, -1])
+def test_a_store_version_pidcore_never_wrote_is_refused_and_left_untouched(tmp_path, version):
+    # Only versions above this pidcore's were refused: a file claiming version 0 (no pidcore
+    # wrote one) was read and written to as a store of version 1, its claim left as it was.
+    import h5py
+
+    store = Store(tmp_path / "s.h5")
+    store.add_dem_run("kept", {"sdc": 0.1})
+    with h5py.File(store.path, "r+") as h5:
+        h5.attrs["pidcore_store_version"] = np.int64(version)
+    digest = file_sha256(store.path)
+    with pytest.raises(StoreError, match=rf"s\.h5: not a readable pidcore store "
+                                         rf"\(pidcore_store_version {version} is not one"):
+        Store(store.path)
+    with pytest.raises(StoreError, match="not one pidcore writes"):
+        store.add_dem_run("new", {"sdc": 0.2})
+    assert file_sha256(store.path) == digest

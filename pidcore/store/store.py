@@ -340,6 +340,9 @@ class Store:
             version = int(from_attribute(version))
         except (TypeError, ValueError):
             raise self._unreadable(f"pidcore_store_version {version!r} is not an integer") from None
+        if version < 1:  # no pidcore wrote it: another program's file (or a damaged one)
+            raise self._unreadable(f"pidcore_store_version {version} is not one pidcore "
+                                   f"writes (1 to {STORE_VERSION})")
         if version > STORE_VERSION:
             raise StoreError(f"{self.path}: store version {version} is newer than this pidcore "
                              f"({__version__}) understands (version {STORE_VERSION}); "
