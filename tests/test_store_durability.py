@@ -223,3 +223,36 @@ def test_a_store_version_pidcore_never_wrote_is_refused_and_left_untouched(tmp_p
     with pytest.raises(StoreError, match="not one pidcore writes"):
         store.add_dem_run("new", {"sdc": 0.2})
     assert file_sha256(store.path) == digest
+
+
+@pytest.mark.parametrize("where", ["arrays/evil", "record"], ids=["array", "record-group"])
+def test_an_external_link_deep_in_an_entry_is_refused_before_it_is_followed(tmp_path, where):
+    # Only sections and entries were checked for links: an external link inside an entry
+    # (a store handed over by someone) made get_dem_run, report --store and the app's
+    # listing read the file it named, and verify() found nothing wrong.
+    import h5py
+
+    secret = tmp_path / "secret.h5"
+    with h5py.File(secret, "w") as h5:
+        h5["data"] = np.arange(5.0)
+        h5.create_group("group").attrs["sdc"] = 99.0
+    store = Store(tmp_path / "s.h5")
+    store.add_dem_run("run", {"sdc": 0.1}, arrays={"trace": np.ones(3)})
+    with h5py.File(store.path, "r+") as h5:
+        entry = h5["dem_runs/run"]
+        if where == "record":
+            del entry["record"]
+            entry["record"] = h5py.ExternalLink(str(secret), "/group")
+        else:
+            entry["arrays"]["evil"] = h5py.ExternalLink(str(secret), "/data")
+    digest = file_sha256(store.path)
+    reopened = Store(store.path)
+    refused = rf"s\.h5: not a readable pidcore store .*{where}.* external link to '.*secret\.h5'"
+    with pytest.raises(StoreError, match=refused):
+        reopened.get_dem_run("run")
+    if where == "record":
+        with pytest.raises(StoreError, match=refused):
+            reopened.list_dem_runs()
+    problems = reopened.verify()
+    assert len(problems) == 1 and "external link to" in problems[0], problems
+    assert file_sha256(store.path) == digest

@@ -47,6 +47,7 @@ import pandas as pd
 
 from .. import __version__, defaults, interrupt
 from ..errors import InputFileError, ParameterError, StoreError
+from ..io._hdf5_safety import check_self_contained
 from ..io.hdf5_layout import read_measurement_group, write_measurement_group
 from ..records import Measurement
 from ..records import measurement_key_and_basis as _measurement_key
@@ -575,8 +576,9 @@ class Store:
         rows = []
         with self._reading() as h5:
             for key, group in ({} if h5 is None else h5.get(_MEASUREMENTS, {})).items():
-                channels = group.get("channels", {})
-                names = tuple(_text(channels[c].attrs.get("name", c)) for c in sorted(channels))
+                channels = self._own_child(group, "channels") or {}
+                names = tuple(_text(self._own_child(channels, c).attrs.get("name", c))
+                              for c in sorted(channels))
                 rows.append({
                     "key": key,
                     "source": _text(group.attrs.get("source", "")),
@@ -754,7 +756,31 @@ class Store:
         parent = h5.get(section, {})
         if key not in parent:
             raise StoreError(f"{self.path}: no {what} {key!r} ({len(parent)} stored)")
-        return parent[key]
+        group = parent[key]
+        self._check_self_contained(group)
+        return group
+
+    def _check_self_contained(self, group: h5py.Group) -> None:
+        """Refuse an entry holding, at any depth, what makes HDF5 read another file (an
+        external link, external storage, a virtual dataset) or load a plugin, before any of
+        it is read: a store handed over with an external link at /dem_runs/K/arrays/X made
+        get_dem_run (and report --store) read whichever file it named, and verify() saw
+        nothing (only sections and entries themselves were checked)."""
+        try:
+            check_self_contained(group, where=f"{self.path}:{group.name}")
+        except InputFileError as exc:
+            raise self._unreadable(exc) from None
+
+    def _own_child(self, group: h5py.Group, name: str) -> h5py.Group | h5py.Dataset | None:
+        """``group[name]`` where it is an object of this file (None where absent); what a
+        listing reads of each entry, without a walk of the whole entry."""
+        link = group.get(name, getlink=True)
+        if link is None:
+            return None
+        if not isinstance(link, h5py.HardLink):
+            raise self._unreadable(f"{group.name}/{name} is {self._what(link, None)}; "
+                                   "expected an object of the store's own file")
+        return group[name]
 
     def _listing(self, h5: h5py.File | None, section: str, leading: list[str],
                  link: Any) -> pd.DataFrame:
@@ -763,7 +789,7 @@ class Store:
         for key, group in ({} if h5 is None else h5.get(section, {})).items():
             row: dict[str, Any] = {"key": key, **link(group),
                                    "created_utc": _text(group.attrs.get("created_utc", ""))}
-            record = group.get("record")
+            record = self._own_child(group, "record")
             for name, value in ({} if record is None else record.attrs).items():
                 row[name] = from_attribute(value)
                 fields[name] = None
@@ -814,6 +840,10 @@ class Store:
 
     def _verify_entry(self, h5: h5py.File, section: str, key: str, where: str) -> list[str]:
         group = h5[section][key]
+        try:
+            check_self_contained(group, where=where)
+        except InputFileError as exc:
+            return [str(exc)]
         if section == _MEASUREMENTS:
             problems = [f"{where}: attribute {name} missing"
                         for name in _MEASUREMENT_ATTRS if name not in group.attrs]
