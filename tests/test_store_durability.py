@@ -256,3 +256,37 @@ def test_an_external_link_deep_in_an_entry_is_refused_before_it_is_followed(tmp_
     problems = reopened.verify()
     assert len(problems) == 1 and "external link to" in problems[0], problems
     assert file_sha256(store.path) == digest
+
+
+def test_a_disk_without_room_for_the_copy_is_refused_before_the_work(tmp_path, monkeypatch):
+    # Every save writes a whole copy of the store beside it: with less room than that, a
+    # `dem run`/sweep/calibrate simulated first and lost the run at the commit ("cannot make
+    # the working copy ... No space left on device").
+    import shutil
+
+    store = Store(tmp_path / "s.h5")
+    store.add_dem_run("kept", {"sdc": 0.1}, arrays={"trace": np.ones(200_000)})
+    size = store.path.stat().st_size
+    usage = shutil.disk_usage(tmp_path)
+    monkeypatch.setattr(shutil, "disk_usage", lambda path: usage._replace(free=size))
+    with pytest.raises(StoreError, match=r"s\.h5: 0\.\d MiB free in .*copy of the store "
+                                         r"\(0\.\d MiB\).*at least [12]\.\d MiB free"):
+        store.check_writable()
+
+
+def test_a_file_size_limit_below_the_store_is_refused_before_the_simulation(tmp_path):
+    # as above for `ulimit -f` below the store's size: the run was simulated, then lost
+    # ("cannot make the working copy ... File too large"); the limit is known before any work
+    store = Store(tmp_path / "s.h5")
+    store.add_dem_run("kept", {"sdc": 0.1}, arrays={"trace": np.ones(200_000)})
+    digest, size = file_sha256(store.path), store.path.stat().st_size
+    p = subprocess.run([sys.executable, "-m", "pidcore", "dem", "run", "--frequency", "1000",
+                        "--acceleration", "5", "--fill", "50", "--cells", "1", "--cycles", "10",
+                        "--no-progress", "--store", str(store.path)],
+                       capture_output=True, text=True, timeout=120,
+                       env={**os.environ, "PYTHONPATH": str(ROOT)},
+                       preexec_fn=_with_file_size_limit(size - 1))
+    assert p.returncode == 2 and p.stdout == "", (p.returncode, p.stdout, p.stderr)
+    lines = p.stderr.splitlines()
+    assert len(lines) == 1 and "s.h5: the file size limit of this process (ulimit -f)" in lines[0]
+    assert file_sha256(store.path) == digest

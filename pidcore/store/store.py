@@ -31,6 +31,7 @@ from __future__ import annotations
 import json
 import os
 import re
+import resource
 import secrets
 import shutil
 import threading
@@ -65,6 +66,10 @@ from .values import (
 
 #: Layout version written to the root attribute ``pidcore_store_version``.
 STORE_VERSION = 1
+#: Room a commit needs beyond the store's size before work is started for it, bytes: a DEM
+#: run's entry is ~10-300 kB (an analysis with its measurement may be more; it is quick to
+#: redo, and its commit fails in one line). More would refuse saves that fit.
+_COMMIT_HEADROOM_BYTES = 2**20
 
 _MEASUREMENTS, _ANALYSES, _DEM_RUNS = "measurements", "analyses", "dem_runs"
 _LAYOUT_ANALYSIS, _LAYOUT_DEM_RUN = "analysis", "dem_run"
@@ -324,6 +329,33 @@ class Store:
             raise StoreError(f"{self.path}: its folder {directory} is read-only (the store is "
                              "written as a copy beside it, then renamed); expected a writable "
                              "folder (give a store file in another one)")
+        self._check_room(directory)
+
+    def _check_room(self, directory: Path) -> None:
+        """Refuse a commit that cannot fit: every commit writes a whole copy of the store
+        beside it, so a disk with less free space than the store (or a file size limit,
+        ``ulimit -f``, below its size) fails it. Found at the commit, that lost a DEM run or
+        sweep case just simulated. The new entries' size is not known yet: the headroom is a
+        guess, so a commit may still fail, in one line, store unchanged."""
+        if not directory.is_dir():
+            return
+        size = self.path.stat().st_size if self.path.exists() else 0
+        needed = size + _COMMIT_HEADROOM_BYTES
+        with suppress(OSError):  # a file system that cannot say: the commit will tell
+            free = shutil.disk_usage(directory).free
+            if free < needed:
+                raise StoreError(
+                    f"{self.path}: {free / 2**20:.1f} MiB free in {directory}, and every save "
+                    f"writes a copy of the store ({size / 2**20:.1f} MiB) beside it; expected "
+                    f"at least {needed / 2**20:.1f} MiB free (free some space, or give a "
+                    "store file on another disk)")
+        limit = resource.getrlimit(resource.RLIMIT_FSIZE)[0]
+        if limit != resource.RLIM_INFINITY and limit < needed:
+            raise StoreError(
+                f"{self.path}: the file size limit of this process (ulimit -f) is "
+                f"{limit / 2**20:.1f} MiB, and every save writes a copy of the store "
+                f"({size / 2**20:.1f} MiB); expected a limit of at least "
+                f"{needed / 2**20:.1f} MiB (raise it, or give a smaller store file)")
 
     # --- transactions and file access ----------------------------------------------------------
 
