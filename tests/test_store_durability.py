@@ -290,3 +290,24 @@ def test_a_file_size_limit_below_the_store_is_refused_before_the_simulation(tmp_
     lines = p.stderr.splitlines()
     assert len(lines) == 1 and "s.h5: the file size limit of this process (ulimit -f)" in lines[0]
     assert file_sha256(store.path) == digest
+
+
+def test_a_store_reached_through_a_symbolic_link_is_written_where_it_lives(tmp_path):
+    # The commit's rename replaced the link with a file of its own: the shared store never got
+    # the record, and writers through the link and to the store itself locked beside different
+    # names, so neither waited for the other.
+    (tmp_path / "shared").mkdir()
+    (tmp_path / "project").mkdir()
+    shared = Store(tmp_path / "shared" / "store.h5")
+    shared.add_dem_run("kept", {"sdc": 0.1})
+    link = tmp_path / "project" / "pid_store.h5"
+    link.symlink_to(Path("..") / "shared" / "store.h5")
+    linked = Store(link)
+    linked.add_dem_run("through_the_link", {"sdc": 0.2})
+    assert link.is_symlink()
+    assert sorted(shared.list_dem_runs()["case_key"]) == ["kept", "through_the_link"]
+    with linked.transaction():  # one lock for both names
+        with pytest.raises(StoreError, match="could not take the write lock"):
+            Store(shared.path, lock_timeout_s=0.2).add_dem_run("blocked", {"sdc": 0.3})
+    assert sorted(os.listdir(tmp_path / "project")) == ["pid_store.h5"]
+    assert sorted(os.listdir(tmp_path / "shared")) == ["store.h5"] and shared.verify() == []

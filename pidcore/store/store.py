@@ -304,7 +304,15 @@ class Store:
     @property
     def lock_path(self) -> Path:
         """Sidecar file whose ``flock`` serialises writers."""
-        return lock_path_for(self.path)
+        return lock_path_for(self._file)
+
+    @property
+    def _file(self) -> Path:
+        """The file a commit replaces: the target of a store path that is a symbolic link
+        (a shared store linked into a project folder). The rename replaced the link itself
+        with a file of its own, so that the shared store never got the record (and writers
+        through two links, each locking beside its link, did not exclude each other)."""
+        return Path(os.path.realpath(self.path)) if self.path.is_symlink() else self.path
 
     def check_writable(self) -> None:
         """Refuse, before any work is done for it, a store this process may not write: a
@@ -318,7 +326,7 @@ class Store:
         StoreError
             One line naming the store, what is read-only and the way out.
         """
-        directory = self.path.parent
+        directory = self._file.parent
         # no write bit for anyone (chmod 444) is read-only for root too, whom os.access lets
         # write anything: the store marked read-only was replaced by the commit's copy
         if self.path.exists() and (not os.access(self.path, os.W_OK)
@@ -438,8 +446,8 @@ class Store:
         # Exactly this store's names (see transaction()): a prefix match took the working copy
         # of a store named like this one plus a suffix ("s.h5" and "s.h5.old.h5"), whose
         # writer, not excluded by this store's lock, then failed its commit.
-        pattern = re.compile(re.escape(f".{self.path.name}.") + r"[0-9a-f]{16}\.tmp")
-        for stale in self.path.parent.iterdir():
+        pattern = re.compile(re.escape(f".{self._file.name}.") + r"[0-9a-f]{16}\.tmp")
+        for stale in self._file.parent.iterdir():
             if pattern.fullmatch(stale.name):
                 stale.unlink(missing_ok=True)
 
@@ -461,16 +469,17 @@ class Store:
         if self._in_transaction():
             yield self._active
             return
-        directory = self.path.parent
+        target = self._file
+        directory = target.parent
         if not directory.is_dir():
             raise StoreError(f"{self.path}: directory {directory} does not exist")
-        with exclusive_lock(self.path, timeout_s=self.lock_timeout_s):
+        with exclusive_lock(target, timeout_s=self.lock_timeout_s):
             self._remove_stale_temporaries()
-            exists = self.path.exists()
+            exists = target.exists()
             if exists:
                 with self._reading():
                     pass  # validates: a foreign or corrupt file must never be replaced
-            tmp = directory / f".{self.path.name}.{secrets.token_hex(8)}.tmp"
+            tmp = directory / f".{target.name}.{secrets.token_hex(8)}.tmp"
             try:
                 h5 = self._working_copy(tmp, exists=exists)
                 try:
@@ -494,7 +503,7 @@ class Store:
                     # way (weakref callback, Numba) never commits.
                     with interrupt.deferred():
                         interrupt.raise_if_interrupted()
-                        os.replace(tmp, self.path)
+                        os.replace(tmp, target)
                         self.commits += 1
                 except OSError as exc:
                     raise StoreError(f"{self.path}: cannot commit the changes "
@@ -514,8 +523,8 @@ class Store:
         try:
             os.close(os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600))
             if exists:
-                shutil.copyfile(self.path, tmp)
-                shutil.copymode(self.path, tmp)
+                shutil.copyfile(self._file, tmp)
+                shutil.copymode(self._file, tmp)
             else:
                 os.chmod(tmp, _new_file_mode())
             h5 = h5py.File(tmp, "r+" if exists else "w", driver="core", backing_store=False)
