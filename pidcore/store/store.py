@@ -12,9 +12,9 @@ Layout (every group explains itself through its attributes)::
     /analyses/<key>/arrays/<name>   dataset (complex allowed), attr unit
     /dem_runs/<case_key>       as an analysis, with case_key instead of measurement_key
 
-Writes are transactions: under an exclusive lock on ``<store>.lock`` the store is copied to a
-temporary file beside it, read into memory (HDF5's core driver) and changed there; at the commit
-its image is written to the temporary file, fsync'ed and moved over the original with
+Writes are transactions: under an exclusive lock on ``<store>.lock`` the store is read into
+memory (h5py on a :class:`io.BytesIO`) and changed there; at the commit the buffer is written to
+a temporary file beside the store, fsync'ed and moved over the original with
 :func:`os.replace`; any exception (KeyboardInterrupt included) discards the copy. The file at
 the store's path therefore only ever holds a complete, committed state. HDF5 itself never writes
 to disk: a write it fails (file size limit, full disk) surfaced as errors inside h5py's object
@@ -28,6 +28,7 @@ works, instead of waiting for it.
 
 from __future__ import annotations
 
+import io
 import json
 import os
 import re
@@ -134,7 +135,7 @@ def _one_line(reason: object) -> str:
     return " ".join(str(reason).split())
 
 
-def _write_image(path: Path, image: bytes) -> None:
+def _write_image(path: Path, image: memoryview) -> None:
     """Write ``image`` over the file at ``path`` and fsync it (an ``OSError`` on failure)."""
     with open(path, "r+b") as file:
         file.truncate(0)
@@ -481,7 +482,7 @@ class Store:
                     pass  # validates: a foreign or corrupt file must never be replaced
             tmp = directory / f".{target.name}.{secrets.token_hex(8)}.tmp"
             try:
-                h5 = self._working_copy(tmp, exists=exists)
+                h5, buffer = self._working_copy(tmp, exists=exists)
                 try:
                     self._active, self._active_thread = h5, threading.get_ident()
                     yield h5
@@ -492,12 +493,8 @@ class Store:
                 finally:
                     self._active, self._active_thread = None, None
                 try:
-                    try:
-                        h5.flush()  # the image holds only what was flushed
-                        image = h5.id.get_file_image()
-                    finally:
-                        h5.close()
-                    _write_image(tmp, image)
+                    h5.close()  # flushes every change into the buffer
+                    _write_image(tmp, buffer.getbuffer())
                     # The rename and its count are one step for Ctrl-C (a caller reads
                     # `commits` to say whether its work was saved); a Ctrl-C swallowed on the
                     # way (weakref callback, Numba) never commits.
@@ -517,17 +514,19 @@ class Store:
                 tmp.unlink(missing_ok=True)
                 raise
 
-    def _working_copy(self, tmp: Path, *, exists: bool) -> h5py.File:
-        """Copy of the committed store (or a new store) at ``tmp``, opened for writing in
-        memory (the core driver without backing store: the commit writes its image)."""
+    def _working_copy(self, tmp: Path, *, exists: bool) -> tuple[h5py.File, io.BytesIO]:
+        """The committed store (or a new store) in memory, opened for writing, and its
+        buffer; ``tmp`` created beside the store, empty, with the store's permissions, for
+        the commit to write the buffer to."""
         try:
             os.close(os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600))
             if exists:
-                shutil.copyfile(self._file, tmp)
                 shutil.copymode(self._file, tmp)
             else:
                 os.chmod(tmp, _new_file_mode())
-            h5 = h5py.File(tmp, "r+" if exists else "w", driver="core", backing_store=False)
+            # the only reference to the bytes read: the buffer grows them in place
+            buffer = io.BytesIO(self._file.read_bytes() if exists else b"")
+            h5 = h5py.File(buffer, "r+" if exists else "w")
         except OSError as exc:
             raise StoreError(f"{self.path}: cannot make the working copy {tmp.name} "
                              f"({_one_line(exc)}); the store is unchanged") from None
@@ -541,7 +540,7 @@ class Store:
         except BaseException:
             h5.close()
             raise
-        return h5
+        return h5, buffer
 
     # --- measurements --------------------------------------------------------------------------
 
