@@ -308,3 +308,21 @@ def test_a_store_reached_through_a_symbolic_link_is_written_where_it_lives(tmp_p
             Store(shared.path, lock_timeout_s=0.2).add_dem_run("blocked", {"sdc": 0.3})
     assert sorted(os.listdir(tmp_path / "project")) == ["pid_store.h5"]
     assert sorted(os.listdir(tmp_path / "shared")) == ["store.h5"] and shared.verify() == []
+
+
+def test_a_numba_cache_that_cannot_be_written_costs_a_compile_not_the_run(tmp_path):
+    # A cold cache on a full disk (or under a quota, or `ulimit -f`): Numba's save of the
+    # compiled code raised OSError ("[Errno 27] File too large" from numba/core/caching.py)
+    # out of the first call, so `pidcore analyze --no-store` ended in that traceback (exit 1).
+    # An empty NUMBA_CACHE_DIR makes the cache cold; the limit makes every file write fail.
+    code = textwrap.dedent("""
+        import numpy as np
+        from pidcore.signal.validate import _scan
+        min_step, crossings, starts, lengths = _scan(np.sin(np.arange(1000.0)), 5, 10)
+        print(crossings > 0)
+    """)
+    p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                       timeout=120, preexec_fn=_with_file_size_limit(1),
+                       env={**os.environ, "PYTHONPATH": str(ROOT),
+                            "NUMBA_CACHE_DIR": str(tmp_path / "cache")})
+    assert (p.returncode, p.stdout, p.stderr) == (0, "True\n", "")
