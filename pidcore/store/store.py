@@ -317,8 +317,9 @@ class Store:
 
     def check_writable(self) -> None:
         """Refuse, before any work is done for it, a store this process may not write: a
-        read-only (or immutable) file, or a folder it may not create the working copy and
-        lock file in. A DEM run, sweep or calibration finished its simulations first and then
+        read-only (or immutable) file, a folder it may not create the working copy and
+        lock file in, or no room for the copy every save writes (free disk space, the file
+        size limit). A DEM run, sweep or calibration finished its simulations first and then
         lost them at the commit ("cannot commit the changes ([Errno 1] Operation not
         permitted ...)").
 
