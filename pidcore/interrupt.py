@@ -64,7 +64,11 @@ def install() -> Callable[[], None]:
     """
     if threading.current_thread() is not threading.main_thread():
         return lambda: None
-    previous_handlers = {signum: signal.signal(signum, _handler) for signum in _SIGNALS}
+    # a SIGTERM ignored by whoever started the process stays ignored (as Python leaves a
+    # SIGINT ignored at start-up alone)
+    previous_handlers = {signum: signal.signal(signum, _handler) for signum in _SIGNALS
+                         if signum == signal.SIGINT
+                         or signal.getsignal(signum) is not signal.SIG_IGN}
     previous_hook = sys.unraisablehook
     sys.unraisablehook = _unraisable_hook
 

@@ -326,3 +326,20 @@ def test_a_numba_cache_that_cannot_be_written_costs_a_compile_not_the_run(tmp_pa
                        env={**os.environ, "PYTHONPATH": str(ROOT),
                             "NUMBA_CACHE_DIR": str(tmp_path / "cache")})
     assert (p.returncode, p.stdout, p.stderr) == (0, "True\n", "")
+
+
+def test_a_sigterm_ignored_by_whoever_started_pidcore_stays_ignored():
+    # nohup-like launchers that ignore SIGTERM: routing it through the interrupt flag would
+    # let a signal the caller chose to ignore stop the run
+    from pidcore import interrupt
+
+    previous = signal.signal(signal.SIGTERM, signal.SIG_IGN)
+    try:
+        restore = interrupt.install()
+        try:
+            assert signal.getsignal(signal.SIGTERM) is signal.SIG_IGN
+        finally:
+            restore()
+        assert signal.getsignal(signal.SIGTERM) is signal.SIG_IGN
+    finally:
+        signal.signal(signal.SIGTERM, previous)
