@@ -1,5 +1,11 @@
 """Ctrl-C that never half-commits: a SIGINT flag shared by the CLI and the store.
 
+SIGTERM (``kill PID``, ``timeout``, a service manager, a batch scheduler ending a job) is the
+same interruption: the same flag, the same one line and nothing half-written, and exit status
+143 (128 + 15) where Ctrl-C's is 130 (128 + 2). With Python's default handling it ended the
+process on the spot (status -15): no word of what was saved, the store's working copy left
+beside it, a sweep's workers left running.
+
 Python's default SIGINT handler raises :class:`KeyboardInterrupt` at whatever bytecode runs
 next. Raised inside a weakref callback it is printed as "Exception ignored" and swallowed (the
 run carries on and commits); raised inside Numba's dispatcher it comes back as a
@@ -17,11 +23,18 @@ from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 
 _interrupted = threading.Event()
+#: The signal that interrupted (SIGINT where the flag was set by other means).
+_signal_number = signal.SIGINT
+#: Signals handled as an interruption.
+_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 #: Depth of :func:`deferred` blocks the main thread is in (the handler runs in that thread).
 _deferring = 0
 
 
 def _handler(signum, frame) -> None:  # noqa: ARG001 - signal handler signature
+    global _signal_number
+    if not _interrupted.is_set():  # the first signal is the one the exit status says
+        _signal_number = signum
     _interrupted.set()
     if _deferring:
         return  # raised by the deferred block's owner once its step is whole
@@ -44,19 +57,24 @@ def _unraisable_hook(unraisable) -> None:
 
 
 def install() -> Callable[[], None]:
-    """Route SIGINT through the flag (main thread only; a no-op elsewhere).
+    """Route SIGINT and SIGTERM through the flag (main thread only; a no-op elsewhere).
 
     Returns a function that puts back the previous handler and unraisable hook (for callers
     such as tests that run the CLI in-process).
     """
     if threading.current_thread() is not threading.main_thread():
         return lambda: None
-    previous_handler = signal.signal(signal.SIGINT, _handler)
+    # a SIGTERM ignored by whoever started the process stays ignored (as Python leaves a
+    # SIGINT ignored at start-up alone)
+    previous_handlers = {signum: signal.signal(signum, _handler) for signum in _SIGNALS
+                         if signum == signal.SIGINT
+                         or signal.getsignal(signum) is not signal.SIG_IGN}
     previous_hook = sys.unraisablehook
     sys.unraisablehook = _unraisable_hook
 
     def restore() -> None:
-        signal.signal(signal.SIGINT, previous_handler)
+        for signum, previous in previous_handlers.items():
+            signal.signal(signum, previous)
         sys.unraisablehook = previous_hook
 
     return restore
@@ -69,7 +87,23 @@ def interrupted() -> bool:
 
 def reset() -> None:
     """Forget an earlier interruption (a new CLI run in the same process)."""
+    global _signal_number
     _interrupted.clear()
+    _signal_number = signal.SIGINT
+
+
+def exit_status() -> int:
+    """Exit status of an interrupted command: 128 + the signal's number, the shell's
+    convention (130 for Ctrl-C, 143 for SIGTERM)."""
+    return 128 + int(_signal_number)
+
+
+def ignore() -> None:
+    """Ignore further interruptions for the rest of the process (a command that is over:
+    one landing while the interpreter shuts down would end it by the signal, status -2 or
+    -15, instead of the command's own status)."""
+    for signum in _SIGNALS:
+        signal.signal(signum, signal.SIG_IGN)
 
 
 def raise_if_interrupted() -> None:

@@ -91,6 +91,18 @@ def _fail(where: str, message: str) -> ParameterError:
     return ParameterError(f"{where}: {message}")
 
 
+def _printable(where: str, text: str) -> None:
+    """Refuse a name holding a control character or a lone surrogate (TOML allows both as
+    escapes): the name goes into every stored run's record, where HDF5 can hold neither
+    ("VLEN strings do not support embedded NULLs": `dem run --store` lost its finished
+    simulation to that traceback at the commit), and into reports."""
+    bad = next((c for c in text if ord(c) < 32 or ord(c) == 127 or 0xD800 <= ord(c) <= 0xDFFF),
+               None)
+    if bad is not None:
+        raise _fail(where, f"expected a name of printable characters, got {text!r} "
+                           f"(it holds {bad!r})")
+
+
 def _positive(where: str, value: float, unit: str) -> None:
     if not (math.isfinite(value) and value > 0):
         raise _fail(where, f"expected > 0 {unit}, got {value!r}")
@@ -303,6 +315,7 @@ class ParticleSpec:
     def __post_init__(self):
         if not self.material or not isinstance(self.material, str):
             raise _fail("[particles] material", f"expected a name, got {self.material!r}")
+        _printable("[particles] material", self.material)
         _positive("[particles] radius_m", self.radius_m, "m")
         _plausible("[particles] radius_m", "radius_m", self.radius_m)
         _positive("[particles] density_kg_m3", self.density_kg_m3, "kg/m^3")
@@ -401,6 +414,7 @@ class Specimen:
     def __post_init__(self):
         if not isinstance(self.name, str) or not self.name:
             raise _fail("name", f"expected a non-empty name, got {self.name!r}")
+        _printable("name", self.name)
         from .dem.geometry import check_packing_size, check_sphere_fits
 
         r = self.particles.radius_m

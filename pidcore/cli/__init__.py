@@ -2,7 +2,7 @@
 
 Each sub-command lives in its own module with ``register(subparsers)``; all logic is in the
 library. Errors derived from :class:`pidcore.errors.PidcoreError` become one line on stderr and
-exit code 2; Ctrl-C exits 130 after finished work has been saved.
+exit code 2; Ctrl-C exits 130 (SIGTERM 143) after finished work has been saved.
 """
 
 from __future__ import annotations
@@ -115,8 +115,8 @@ def _run(argv: list[str] | None) -> int:
                            f"{' '.join(unknown)} (see pidcore {command} --help)\n")
         started = True
         rc = int(args.func(args) or 0)
-        if rc != 130 and interrupt.interrupted():  # swallowed on the way: still 130
-            raise KeyboardInterrupt
+        if rc != interrupt.exit_status() and interrupt.interrupted():
+            raise KeyboardInterrupt  # swallowed on the way: still the interruption
         return rc
     except PidcoreError as exc:
         if interrupt.interrupted():  # an interrupt swallowed by a library (pyuff's bare
@@ -125,7 +125,7 @@ def _run(argv: list[str] | None) -> int:
                 else "nothing was done"
             print(f"pidcore {command}: interrupted; {said}", file=sys.stderr)
             interrupt.mark_handled()
-            return 130
+            return interrupt.exit_status()
         print(f"pidcore {command}: error: {exc}", file=sys.stderr)
         return 2
     except BrokenPipeError:  # the reader of stdout (| head) stopped: end quietly
@@ -144,7 +144,7 @@ def _run(argv: list[str] | None) -> int:
             else "nothing was done"
         print(f"pidcore {command}: interrupted; {said}", file=sys.stderr)
         interrupt.mark_handled()
-        return 130
+        return interrupt.exit_status()
 
 
 def _what_an_interrupt_left(args: argparse.Namespace) -> str:
@@ -173,16 +173,14 @@ def _command_name(args: argparse.Namespace) -> str:
 
 def console_main(argv: list[str] | None = None) -> int:
     """Entry point of the ``pidcore`` command and of ``python -m pidcore``: :func:`main`, then
-    Ctrl-C ignored for the rest of the process.
+    Ctrl-C and SIGTERM ignored for the rest of the process.
 
     The command is over by then (whatever it saved is committed and reported); a Ctrl-C that
     lands while the interpreter shuts down would otherwise end the process by the signal
     (exit status -2) instead of the command's own status.
     """
-    import signal
-
     rc = main(argv)
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    interrupt.ignore()
     return rc
 
 

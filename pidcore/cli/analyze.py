@@ -143,7 +143,7 @@ def _run(args: argparse.Namespace) -> int:
                 "interrupted; nothing saved (--no-store)")
         print(f"pidcore analyze: {said}", file=sys.stderr)
         interrupt.mark_handled()
-        return 130
+        return interrupt.exit_status()
     return 0
 
 

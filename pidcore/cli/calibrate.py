@@ -147,7 +147,7 @@ def run(args: argparse.Namespace) -> int:
               f"{_out_words(args.out, written)}",
               file=sys.stderr)
         interrupt.mark_handled()
-        return 130
+        return interrupt.exit_status()
     return 0
 
 

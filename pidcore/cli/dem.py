@@ -231,13 +231,16 @@ def _specimen(args: argparse.Namespace):
 
 
 def _interrupted(command: str, saved: int, store) -> int:
-    """Ctrl-C: say what was saved (finished runs are, each in its own transaction), exit 130."""
+    """Ctrl-C (or SIGTERM): say what was saved (finished runs are, each in its own
+    transaction), exit 130 (143)."""
+    from .. import interrupt
+
     if saved:
         what = f"{saved} finished run(s) saved to {store}; re-run to resume"
     else:
         what = "nothing saved" + (f", {store} unchanged" if store is not None else "")
     print(f"pidcore dem {command}: interrupted; {what}", file=sys.stderr)
-    return 130
+    return interrupt.exit_status()
 
 
 def sweep(args: argparse.Namespace) -> int:

@@ -137,7 +137,7 @@ def _run(args: argparse.Namespace) -> int:
             said += "; no store write was left half-done, the store is unchanged"
         print(f"pidcore report: interrupted; {said}", file=sys.stderr)
         interrupt.mark_handled()
-        return 130
+        return interrupt.exit_status()
     return 0
 
 

@@ -15,12 +15,16 @@ Benchmarks (kernel throughput, a grid sweep into a temporary store) are in
 :mod:`pidcore.dem.bench`.
 """
 
+from .._numba_cache import tolerate_unwritable_cache
 from .contact import ContactLaw, PairLaw
 from .geometry import CellGeometry, cell_capacity
 from .impact import calibrate_damping_coefficient, measure_restitution, simulate_impact
 from .materials import MaterialProperties, PairParameters
 from .result import DemResult
 from .simulate import DemConfig, LoadCase, particles_per_cell, simulate_load_case
+
+# before the first call of any cache=True function of this package (compiled, then saved)
+tolerate_unwritable_cache()
 
 __all__ = ["CellGeometry", "ContactLaw", "DemConfig", "DemResult", "LoadCase",
            "MaterialProperties", "PairLaw", "PairParameters",

@@ -164,7 +164,33 @@ def _start_fork_server_deaf_to_ctrl_c() -> None:
         signal.pthread_sigmask(signal.SIG_SETMASK, previous)
 
 
-def init_dem_worker() -> None:
+def _exit_with(pid: int) -> None:
+    """End this process as soon as process ``pid`` has ended (a daemon thread's loop).
+
+    ``os.pidfd_open`` (Linux): the descriptor turns readable when the process exits, a zombie
+    not yet reaped included, which a probe of the pid by ``os.kill(pid, 0)`` takes for alive.
+    Elsewhere that probe, once a second.
+    """
+    import select
+
+    try:
+        fd = os.pidfd_open(pid)
+    except ProcessLookupError:
+        os._exit(1)
+    except (AttributeError, OSError):  # no pidfd: another OS, or a kernel before 5.3
+        while True:
+            time.sleep(1.0)
+            try:
+                os.kill(pid, 0)
+            except ProcessLookupError:
+                os._exit(1)
+            except OSError:
+                pass  # alive, only not ours to signal
+    select.select([fd], [], [])
+    os._exit(1)
+
+
+def init_dem_worker(parent_pid: int | None = None) -> None:
     """Set up a pool process that runs DEM cases (sweeps, calibration design runs).
 
     One kernel thread: the parallelism is across cases, threads inside each would
@@ -172,13 +198,23 @@ def init_dem_worker() -> None:
     interrupt (:func:`run_pooled`), which stops a case at once, even inside a Numba kernel;
     a worker that handled Ctrl-C itself printed a traceback when the signal came while it
     waited for work (``spawn`` start-up; with the fork server SIGINT is already blocked).
+
+    ``parent_pid``: the process that owns the pool; the worker ends when it ends. A parent
+    killed outright (``kill -9``, the out-of-memory killer) stops no worker: each waited for
+    work forever (it holds both ends of the pool's call queue, so it never reads its end),
+    and kept the fork server and the killed command's stdout and stderr open, so that a
+    caller reading them to their end (``$(pidcore dem sweep ...)``, a test harness) hung.
     """
     import multiprocessing
     import signal
+    import threading
 
     import numba
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    if parent_pid is not None:
+        threading.Thread(target=_exit_with, args=(parent_pid,), daemon=True,
+                         name="pidcore-exit-with-parent").start()
     # Numba makes a named (file-backed) process lock when the start method contains "fork",
     # "forkserver" included; a worker terminated on Ctrl-C leaves it behind, and the resource
     # tracker warns of a "leaked semaphore" after the CLI's one line. Each worker makes its
@@ -206,7 +242,7 @@ def run_pooled(function: Callable, calls: Sequence[tuple], *, workers: int,
 
     pool = ProcessPoolExecutor(max_workers=min(workers, len(calls)),
                                mp_context=dem_process_context(),
-                               initializer=init_dem_worker)
+                               initializer=init_dem_worker, initargs=(os.getpid(),))
     try:
         # submit() starts the workers: a Ctrl-C inside Process.start() could leave a worker
         # forked but not yet in the pool's table, out of reach of _stop_pool; held back until

@@ -47,7 +47,7 @@ def _walk(group: h5py.Group, where: str, depth: int, counter: list[int]) -> int:
         link = group.get(name, getlink=True)
         if isinstance(link, h5py.ExternalLink):
             raise InputFileError(f"{where}: {path!r} is an external link to "
-                                 f"{link.filename!r}; refused: a measurement file must not make "
+                                 f"{link.filename!r}; refused: a file from elsewhere must not make "
                                  "pidcore read other files")
         if isinstance(link, h5py.SoftLink):
             continue  # a path inside this file; its target is walked where it lives
@@ -61,7 +61,7 @@ def _walk(group: h5py.Group, where: str, depth: int, counter: list[int]) -> int:
             plist = obj.id.get_create_plist()
             if plist.get_external_count() > 0:
                 raise InputFileError(f"{where}: dataset {path!r} keeps its data in external "
-                                     "file(s); refused: a measurement file must not make "
+                                     "file(s); refused: a file from elsewhere must not make "
                                      "pidcore read other files")
             for index in range(plist.get_nfilters()):
                 filter_id = plist.get_filter(index)[0]
@@ -73,6 +73,20 @@ def _walk(group: h5py.Group, where: str, depth: int, counter: list[int]) -> int:
                         "or with gzip)")
             total += int(obj.size) * int(obj.dtype.itemsize)
     return total
+
+
+def check_self_contained(group: h5py.Group, *, where: str) -> None:
+    """Refuse what below ``group`` would make HDF5 read other files or load a plugin library
+    (external links, external storage, virtual datasets, filters not built in), before any
+    dataset below it is read: :func:`check_hdf5_input` for one part of an open file (an entry
+    of a store, whose whole walk on every open would cost more than the reads it guards).
+
+    Raises
+    ------
+    InputFileError
+        Naming ``where`` and the offending object.
+    """
+    _walk(group, where, 0, [0])
 
 
 def check_hdf5_input(path: str | os.PathLike[str], *, what: str = "HDF5") -> None:

@@ -14,9 +14,13 @@ synthesize_shaker_record
     Synthetic records with an analytic answer.
 """
 
+from .._numba_cache import tolerate_unwritable_cache
 from .frequency import estimate_drive_frequency
 from .power import PowerAnalysis, analyze_channels, analyze_power
 from .synthetic import SyntheticRecord, synthesize_shaker_record
+
+# before the first call of any cache=True function of this package (compiled, then saved)
+tolerate_unwritable_cache()
 
 __all__ = ["PowerAnalysis", "SyntheticRecord", "analyze_channels", "analyze_power",
            "estimate_drive_frequency", "synthesize_shaker_record"]

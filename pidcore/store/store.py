@@ -16,10 +16,14 @@ Layout (every group explains itself through its attributes)::
                                calibration.json and the calibrated specimen file as UTF-8 byte
                                arrays (arrays/calibration_json, arrays/calibrated_specimen_toml)
 
-Writes are transactions: under an exclusive lock on ``<store>.lock`` the store is copied to a
-temporary file beside it, changed there, flushed, fsync'ed and moved over the original with
+Writes are transactions: under an exclusive lock on ``<store>.lock`` the store is read into
+memory (h5py on a :class:`io.BytesIO`) and changed there; at the commit the buffer is written to
+a temporary file beside the store, fsync'ed and moved over the original with
 :func:`os.replace`; any exception (KeyboardInterrupt included) discards the copy. The file at
-the store's path therefore only ever holds a complete, committed state.
+the store's path therefore only ever holds a complete, committed state. HDF5 itself never writes
+to disk: a write it fails (file size limit, full disk) surfaced as errors inside h5py's object
+destructors, a two-line message and a segmentation fault at exit; a failed write of the image
+is one ``OSError`` of Python's own.
 
 Readers take no lock. Because the path is only ever swapped atomically and an open HDF5 handle
 keeps reading the file it opened, a reader sees the last committed state even while a writer
@@ -28,8 +32,11 @@ works, instead of waiting for it.
 
 from __future__ import annotations
 
+import io
 import json
 import os
+import re
+import resource
 import secrets
 import shutil
 import threading
@@ -46,6 +53,7 @@ import pandas as pd
 
 from .. import __version__, defaults, interrupt
 from ..errors import InputFileError, ParameterError, StoreError
+from ..io._hdf5_safety import check_self_contained
 from ..io.hdf5_layout import read_measurement_group, write_measurement_group
 from ..records import Measurement
 from ..records import measurement_key_and_basis as _measurement_key
@@ -63,6 +71,10 @@ from .values import (
 
 #: Layout version written to the root attribute ``pidcore_store_version``.
 STORE_VERSION = 1
+#: Room a commit needs beyond the store's size before work is started for it, bytes: a DEM
+#: run's entry is ~10-300 kB (an analysis with its measurement may be more; it is quick to
+#: redo, and its commit fails in one line). More would refuse saves that fit.
+_COMMIT_HEADROOM_BYTES = 2**20
 
 _MEASUREMENTS, _ANALYSES, _DEM_RUNS = "measurements", "analyses", "dem_runs"
 _CALIBRATIONS = "calibrations"
@@ -125,6 +137,21 @@ def _utc_now() -> str:
 
 def _text(value: Any) -> str:
     return value.decode("utf-8", "replace") if isinstance(value, bytes) else str(value)
+
+
+def _one_line(reason: object) -> str:
+    # HDF5's messages hold newlines ("file write failed: time = ...\n, filename = ..."); an
+    # error of pidcore is one line
+    return " ".join(str(reason).split())
+
+
+def _write_image(path: Path, image: memoryview) -> None:
+    """Write ``image`` over the file at ``path`` and fsync it (an ``OSError`` on failure)."""
+    with open(path, "r+b") as file:
+        file.truncate(0)
+        file.write(image)
+        file.flush()
+        os.fsync(file.fileno())
 
 
 def _fsync_path(path: Path, *, directory: bool = False) -> None:
@@ -314,12 +341,21 @@ class Store:
     @property
     def lock_path(self) -> Path:
         """Sidecar file whose ``flock`` serialises writers."""
-        return lock_path_for(self.path)
+        return lock_path_for(self._file)
+
+    @property
+    def _file(self) -> Path:
+        """The file a commit replaces: the target of a store path that is a symbolic link
+        (a shared store linked into a project folder). The rename replaced the link itself
+        with a file of its own, so that the shared store never got the record (and writers
+        through two links, each locking beside its link, did not exclude each other)."""
+        return Path(os.path.realpath(self.path)) if self.path.is_symlink() else self.path
 
     def check_writable(self) -> None:
         """Refuse, before any work is done for it, a store this process may not write: a
-        read-only (or immutable) file, or a folder it may not create the working copy and
-        lock file in. A DEM run, sweep or calibration finished its simulations first and then
+        read-only (or immutable) file, a folder it may not create the working copy and
+        lock file in, or no room for the copy every save writes (free disk space, the file
+        size limit). A DEM run, sweep or calibration finished its simulations first and then
         lost them at the commit ("cannot commit the changes ([Errno 1] Operation not
         permitted ...)").
 
@@ -328,7 +364,7 @@ class Store:
         StoreError
             One line naming the store, what is read-only and the way out.
         """
-        directory = self.path.parent
+        directory = self._file.parent
         # no write bit for anyone (chmod 444) is read-only for root too, whom os.access lets
         # write anything: the store marked read-only was replaced by the commit's copy
         if self.path.exists() and (not os.access(self.path, os.W_OK)
@@ -339,6 +375,33 @@ class Store:
             raise StoreError(f"{self.path}: its folder {directory} is read-only (the store is "
                              "written as a copy beside it, then renamed); expected a writable "
                              "folder (give a store file in another one)")
+        self._check_room(directory)
+
+    def _check_room(self, directory: Path) -> None:
+        """Refuse a commit that cannot fit: every commit writes a whole copy of the store
+        beside it, so a disk with less free space than the store (or a file size limit,
+        ``ulimit -f``, below its size) fails it. Found at the commit, that lost a DEM run or
+        sweep case just simulated. The new entries' size is not known yet: the headroom is a
+        guess, so a commit may still fail, in one line, store unchanged."""
+        if not directory.is_dir():
+            return
+        size = self.path.stat().st_size if self.path.exists() else 0
+        needed = size + _COMMIT_HEADROOM_BYTES
+        with suppress(OSError):  # a file system that cannot say: the commit will tell
+            free = shutil.disk_usage(directory).free
+            if free < needed:
+                raise StoreError(
+                    f"{self.path}: {free / 2**20:.1f} MiB free in {directory}, and every save "
+                    f"writes a copy of the store ({size / 2**20:.1f} MiB) beside it; expected "
+                    f"at least {needed / 2**20:.1f} MiB free (free some space, or give a "
+                    "store file on another disk)")
+        limit = resource.getrlimit(resource.RLIMIT_FSIZE)[0]
+        if limit != resource.RLIM_INFINITY and limit < needed:
+            raise StoreError(
+                f"{self.path}: the file size limit of this process (ulimit -f) is "
+                f"{limit / 2**20:.1f} MiB, and every save writes a copy of the store "
+                f"({size / 2**20:.1f} MiB); expected a limit of at least "
+                f"{needed / 2**20:.1f} MiB (raise it, or give a smaller store file)")
 
     # --- transactions and file access ----------------------------------------------------------
 
@@ -346,7 +409,7 @@ class Store:
         return self._active is not None and self._active_thread == threading.get_ident()
 
     def _unreadable(self, reason: object) -> StoreError:
-        return StoreError(f"{self.path}: not a readable pidcore store ({reason})")
+        return StoreError(f"{self.path}: not a readable pidcore store ({_one_line(reason)})")
 
     def _check_root(self, h5: h5py.File) -> None:
         version = h5.attrs.get("pidcore_store_version")
@@ -356,6 +419,9 @@ class Store:
             version = int(from_attribute(version))
         except (TypeError, ValueError):
             raise self._unreadable(f"pidcore_store_version {version!r} is not an integer") from None
+        if version < 1:  # no pidcore wrote it: another program's file (or a damaged one)
+            raise self._unreadable(f"pidcore_store_version {version} is not one pidcore "
+                                   f"writes (1 to {STORE_VERSION})")
         if version > STORE_VERSION:
             raise StoreError(f"{self.path}: store version {version} is newer than this pidcore "
                              f"({__version__}) understands (version {STORE_VERSION}); "
@@ -415,9 +481,12 @@ class Store:
     def _remove_stale_temporaries(self) -> None:
         # Called under the write lock: no other writer is running, so any temporary copy left
         # beside the store was abandoned by a writer that was killed before it could clean up.
-        prefix = f".{self.path.name}."
-        for stale in self.path.parent.iterdir():
-            if stale.name.startswith(prefix) and stale.name.endswith(".tmp"):
+        # Exactly this store's names (see transaction()): a prefix match took the working copy
+        # of a store named like this one plus a suffix ("s.h5" and "s.h5.old.h5"), whose
+        # writer, not excluded by this store's lock, then failed its commit.
+        pattern = re.compile(re.escape(f".{self._file.name}.") + r"[0-9a-f]{16}\.tmp")
+        for stale in self._file.parent.iterdir():
+            if pattern.fullmatch(stale.name):
                 stale.unlink(missing_ok=True)
 
     @contextmanager
@@ -438,18 +507,19 @@ class Store:
         if self._in_transaction():
             yield self._active
             return
-        directory = self.path.parent
+        target = self._file
+        directory = target.parent
         if not directory.is_dir():
             raise StoreError(f"{self.path}: directory {directory} does not exist")
-        with exclusive_lock(self.path, timeout_s=self.lock_timeout_s):
+        with exclusive_lock(target, timeout_s=self.lock_timeout_s):
             self._remove_stale_temporaries()
-            exists = self.path.exists()
+            exists = target.exists()
             if exists:
                 with self._reading():
                     pass  # validates: a foreign or corrupt file must never be replaced
-            tmp = directory / f".{self.path.name}.{secrets.token_hex(8)}.tmp"
+            tmp = directory / f".{target.name}.{secrets.token_hex(8)}.tmp"
             try:
-                h5 = self._working_copy(tmp, exists=exists)
+                h5, buffer = self._working_copy(tmp, exists=exists)
                 try:
                     self._active, self._active_thread = h5, threading.get_ident()
                     yield h5
@@ -460,18 +530,18 @@ class Store:
                 finally:
                     self._active, self._active_thread = None, None
                 try:
-                    h5.close()
-                    _fsync_path(tmp)
+                    h5.close()  # flushes every change into the buffer
+                    _write_image(tmp, buffer.getbuffer())
                     # The rename and its count are one step for Ctrl-C (a caller reads
                     # `commits` to say whether its work was saved); a Ctrl-C swallowed on the
                     # way (weakref callback, Numba) never commits.
                     with interrupt.deferred():
                         interrupt.raise_if_interrupted()
-                        os.replace(tmp, self.path)
+                        os.replace(tmp, target)
                         self.commits += 1
                 except OSError as exc:
-                    raise StoreError(f"{self.path}: cannot commit the changes ({exc}); "
-                                     "the store is unchanged") from None
+                    raise StoreError(f"{self.path}: cannot commit the changes "
+                                     f"({_one_line(exc)}); the store is unchanged") from None
                 # Makes the rename itself durable; the commit has happened either way, and some
                 # file systems cannot fsync a directory, so a failure here is not an error.
                 with suppress(OSError):
@@ -481,19 +551,22 @@ class Store:
                 tmp.unlink(missing_ok=True)
                 raise
 
-    def _working_copy(self, tmp: Path, *, exists: bool) -> h5py.File:
-        """Copy of the committed store (or a new store) at ``tmp``, opened for writing."""
+    def _working_copy(self, tmp: Path, *, exists: bool) -> tuple[h5py.File, io.BytesIO]:
+        """The committed store (or a new store) in memory, opened for writing, and its
+        buffer; ``tmp`` created beside the store, empty, with the store's permissions, for
+        the commit to write the buffer to."""
         try:
             os.close(os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600))
             if exists:
-                shutil.copyfile(self.path, tmp)
-                shutil.copymode(self.path, tmp)
+                shutil.copymode(self._file, tmp)
             else:
                 os.chmod(tmp, _new_file_mode())
-            h5 = h5py.File(tmp, "r+" if exists else "w")
+            # the only reference to the bytes read: the buffer grows them in place
+            buffer = io.BytesIO(self._file.read_bytes() if exists else b"")
+            h5 = h5py.File(buffer, "r+" if exists else "w")
         except OSError as exc:
-            raise StoreError(f"{self.path}: cannot make the working copy {tmp.name} ({exc}); "
-                             "the store is unchanged") from None
+            raise StoreError(f"{self.path}: cannot make the working copy {tmp.name} "
+                             f"({_one_line(exc)}); the store is unchanged") from None
         try:
             if not exists:
                 h5.attrs["pidcore_store_version"] = np.int64(STORE_VERSION)
@@ -504,7 +577,7 @@ class Store:
         except BaseException:
             h5.close()
             raise
-        return h5
+        return h5, buffer
 
     # --- measurements --------------------------------------------------------------------------
 
@@ -580,8 +653,9 @@ class Store:
         rows = []
         with self._reading() as h5:
             for key, group in ({} if h5 is None else h5.get(_MEASUREMENTS, {})).items():
-                channels = group.get("channels", {})
-                names = tuple(_text(channels[c].attrs.get("name", c)) for c in sorted(channels))
+                channels = self._own_child(group, "channels") or {}
+                names = tuple(_text(self._own_child(channels, c).attrs.get("name", c))
+                              for c in sorted(channels))
                 rows.append({
                     "key": key,
                     "source": _text(group.attrs.get("source", "")),
@@ -826,7 +900,31 @@ class Store:
         parent = h5.get(section, {})
         if key not in parent:
             raise StoreError(f"{self.path}: no {what} {key!r} ({len(parent)} stored)")
-        return parent[key]
+        group = parent[key]
+        self._check_self_contained(group)
+        return group
+
+    def _check_self_contained(self, group: h5py.Group) -> None:
+        """Refuse an entry holding, at any depth, what makes HDF5 read another file (an
+        external link, external storage, a virtual dataset) or load a plugin, before any of
+        it is read: a store handed over with an external link at /dem_runs/K/arrays/X made
+        get_dem_run (and report --store) read whichever file it named, and verify() saw
+        nothing (only sections and entries themselves were checked)."""
+        try:
+            check_self_contained(group, where=f"{self.path}:{group.name}")
+        except InputFileError as exc:
+            raise self._unreadable(exc) from None
+
+    def _own_child(self, group: h5py.Group, name: str) -> h5py.Group | h5py.Dataset | None:
+        """``group[name]`` where it is an object of this file (None where absent); what a
+        listing reads of each entry, without a walk of the whole entry."""
+        link = group.get(name, getlink=True)
+        if link is None:
+            return None
+        if not isinstance(link, h5py.HardLink):
+            raise self._unreadable(f"{group.name}/{name} is {self._what(link, None)}; "
+                                   "expected an object of the store's own file")
+        return group[name]
 
     def _listing(self, h5: h5py.File | None, section: str, leading: list[str],
                  link: Any) -> pd.DataFrame:
@@ -835,7 +933,7 @@ class Store:
         for key, group in ({} if h5 is None else h5.get(section, {})).items():
             row: dict[str, Any] = {"key": key, **link(group),
                                    "created_utc": _text(group.attrs.get("created_utc", ""))}
-            record = group.get("record")
+            record = self._own_child(group, "record")
             for name, value in ({} if record is None else record.attrs).items():
                 row[name] = from_attribute(value)
                 fields[name] = None
@@ -888,6 +986,10 @@ class Store:
 
     def _verify_entry(self, h5: h5py.File, section: str, key: str, where: str) -> list[str]:
         group = h5[section][key]
+        try:
+            check_self_contained(group, where=where)
+        except InputFileError as exc:
+            return [str(exc)]
         if section == _MEASUREMENTS:
             problems = [f"{where}: attribute {name} missing"
                         for name in _MEASUREMENT_ATTRS if name not in group.attrs]

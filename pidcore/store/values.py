@@ -59,6 +59,16 @@ def to_attribute(value: object, *, field: str, where: str) -> tuple[Any, bool]:
     if isinstance(value, complex | np.complexfloating):
         return np.complex128(value), False
     if isinstance(value, str):
+        # HDF5's variable-length strings are UTF-8 and end at a NUL: h5py raised ValueError
+        # or UnicodeEncodeError from inside the transaction, a traceback, not one line
+        if "\x00" in value:
+            raise StoreError(f"{where}: record field {field!r} = {value!r} holds a NUL "
+                             "character, which an HDF5 string cannot hold")
+        try:
+            value.encode("utf-8")
+        except UnicodeEncodeError:
+            raise StoreError(f"{where}: record field {field!r} = {value!r} is not valid "
+                             "Unicode (a lone surrogate); expected text UTF-8 can hold") from None
         return value, False
     raise StoreError(f"{where}: record field {field!r} has type {type(value).__name__}; expected a "
                      "scalar (str, int, float, bool, complex or None); put arrays in arrays=")
