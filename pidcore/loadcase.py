@@ -4,6 +4,17 @@ One type for the DEM (what to simulate), measurements (what was stated about the
 store, the CLI, reports and the app, with one text key (:attr:`LoadCase.key`,
 ``f50Hz_a5g_fill50pct_acrylic_z``). Stores written by pidcore 0.1 named DEM runs with the
 older key ``acrylic_z_f50_a5_fill50``; :func:`parse_key` reads both.
+
+Public API
+----------
+LoadCase, LoadCaseError
+    The load case (frequency [Hz], acceleration [g], fill [%], material, direction).
+parse_key, KEY_PATTERN, KEY_PATTERN_0_1, key_0_1
+    Keys of load cases and DEM runs, today's and pidcore 0.1's.
+check_fill, check_fill_range, parse_values
+    Fills in (0, 100] %; numbers typed as ``"50, 100 500"``.
+normalize_material, normalize_direction
+    Canonical material and direction names.
 """
 
 from __future__ import annotations

@@ -5,6 +5,11 @@ phasors of a measurement or of a DEM run's virtual shaker record (the same way f
 their areas are comparable energies per cycle). Matplotlib figures
 (:mod:`pidcore.report.figures_results`) and the app's charts read the same
 :meth:`ForceDisplacementLoop.to_pandas` frame.
+
+Public API
+----------
+ForceDisplacementLoop
+    One period of force against displacement (``to_pandas()``, ``energy_per_cycle_j``).
 """
 
 from __future__ import annotations

@@ -1,7 +1,26 @@
 """Measurement workflow: file -> channels -> Eq. 11 analysis -> store.
 
 The glue shared by the CLI (``pidcore analyze``), the report and the app, so that each of them
-stays thin.
+stays thin; a script analyses files the same way.
+
+Public API
+----------
+analyze_file, analyze_measurement
+    One export file (or a measurement read already) -> :class:`AnalyzedRecord`: channels
+    mapped to roles, units checked, the Eq. 11 analysis (``record.analysis``, a
+    :class:`~pidcore.signal.PowerAnalysis` with ``to_pandas()`` and ``plot()``) and notes.
+AnalysisOptions
+    The options of ``pidcore analyze`` (channels, delay, mass below the gauge, baseline, ...).
+AnalyzedRecord
+    A measurement with its analysis, channels used, notes and corrections.
+save_analyses, SavedAnalyses, store_analysis
+    Analyses saved to a :class:`~pidcore.store.Store` in one transaction.
+
+Examples
+--------
+>>> from pidcore.measure import AnalysisOptions, analyze_file          # doctest: +SKIP
+>>> record = analyze_file("run_012.uff", AnalysisOptions(velocity_delay_s=50e-6))  # doctest: +SKIP
+>>> record.analysis.sdc, record.analysis.sdc_stderr                   # doctest: +SKIP
 """
 
 from __future__ import annotations
@@ -26,6 +45,11 @@ from .units import lookup_unit
 
 if TYPE_CHECKING:
     import pandas as pd
+
+    from .store import Store
+
+__all__ = ["AnalysisOptions", "AnalyzedRecord", "SavedAnalyses", "analyze_file",
+           "analyze_measurement", "save_analyses", "store_analysis"]
 
 #: Largest fractional-sample offset between the start times of the force channel and an
 #: acceleration channel that is ignored (the velocity's is corrected as a delay instead).
@@ -314,7 +338,7 @@ def analyze_file(path: str | os.PathLike, options: AnalysisOptions, *,
     return analyze_measurement(measurement, options)
 
 
-def store_analysis(store, result: AnalyzedRecord, parameters: Mapping, *,
+def store_analysis(store: Store, result: AnalyzedRecord, parameters: Mapping, *,
                    fields: Mapping | None = None) -> str:
     """Add one analysed record and its measurement to an open :class:`~pidcore.store.Store`.
 
@@ -344,7 +368,7 @@ class SavedAnalyses:
     notes: list[str]
 
 
-def save_analyses(store, results: Sequence[AnalyzedRecord],
+def save_analyses(store: Store | str | os.PathLike, results: Sequence[AnalyzedRecord],
                   options: AnalysisOptions | Sequence[AnalysisOptions],
                   stated: Sequence[tuple[str, object, str]], *,
                   fields: Sequence[Mapping | None] | None = None) -> SavedAnalyses:

@@ -17,6 +17,23 @@ mat       MATLAB v5 / v7.3                                       :mod:`pidcore.i
 hdf5      pidcore measurement group or store                     :mod:`pidcore.io.hdf5`
 ========  =====================================================  ==========================
 
+Public API
+----------
+read_measurement, read_measurements
+    Read a file of any format (detected) into :class:`~pidcore.records.Measurement`.
+write_measurement
+    Write one, the format from the extension.
+read_uff, read_csv, read_mat, read_hdf5, hdf5_keys
+    The readers of one format; the measurements a pidcore HDF5 file holds.
+write_uff, write_csv, write_mat, write_hdf5
+    The writers of one format (atomic).
+detect_file_format, FILE_FORMAT_EXTENSIONS, EMPTY_MEASUREMENT_FILE
+    Format detection: from the content, else the extension; why an empty file is refused.
+assign_roles, RoleAssignment, name_suggests
+    Which channels are force, velocity and acceleration (units, then names).
+display_path
+    A path as printable text (undecodable bytes escaped).
+
 Examples
 --------
 >>> from pidcore.io import read_measurement, assign_roles  # doctest: +SKIP

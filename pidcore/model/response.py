@@ -30,8 +30,10 @@ the SDC at the nearest edge of the grid and flags the point.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
+import pandas as pd
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
@@ -137,22 +139,34 @@ class HarmonicResponse:
     multiple_solutions: np.ndarray
     force_amplitude_n: float
 
-    def plot(self, ax=None):
-        """Plot amplitude (and the untreated amplitude) against frequency; return the Axes."""
-        import matplotlib.pyplot as plt
+    def to_pandas(self) -> pd.DataFrame:
+        """One row per drive frequency, each column naming its unit.
 
-        if ax is None:
-            _, ax = plt.subplots()
-        ax.plot(self.frequency_hz, self.amplitude_untreated_m, "--", label="untreated")
-        ax.plot(self.frequency_hz, self.amplitude_m, "-", label="with particle damper")
-        if np.any(self.clipped):
-            ax.plot(self.frequency_hz[self.clipped], self.amplitude_m[self.clipped], "x",
-                    label="SDC held at model edge")
-        ax.set_yscale("log")
-        ax.set_xlabel("frequency [Hz]")
-        ax.set_ylabel("displacement amplitude [m]")
-        ax.legend()
-        return ax
+        Columns ``frequency [Hz]``, ``amplitude [m]``, ``phase [rad]``, ``acceleration [g]``,
+        ``sdc [-]``, ``particle damping [N s/m]``, ``amplitude untreated [m]``,
+        ``clipped [True/False]``, ``multiple solutions [True/False]``; ``attrs`` hold
+        ``force_amplitude_n``.
+        """
+        frame = pd.DataFrame({
+            "frequency [Hz]": np.asarray(self.frequency_hz, dtype=float),
+            "amplitude [m]": np.asarray(self.amplitude_m, dtype=float),
+            "phase [rad]": np.asarray(self.phase_rad, dtype=float),
+            "acceleration [g]": np.asarray(self.acceleration_g, dtype=float),
+            "sdc [-]": np.asarray(self.sdc, dtype=float),
+            "particle damping [N s/m]": np.asarray(self.particle_damping_n_s_m, dtype=float),
+            "amplitude untreated [m]": np.asarray(self.amplitude_untreated_m, dtype=float),
+            "clipped [True/False]": np.asarray(self.clipped, dtype=bool),
+            "multiple solutions [True/False]": np.asarray(self.multiple_solutions, dtype=bool),
+        })
+        frame.attrs["force_amplitude_n"] = float(self.force_amplitude_n)
+        return frame
+
+    def plot(self, ax: Any = None) -> Any:
+        """Amplitude (and the untreated amplitude) against frequency
+        (:func:`pidcore.report.figures_results.plot_harmonic_response`); returns ``ax``."""
+        from ..report.figures_results import plot_harmonic_response  # lazy: drawing is optional
+
+        return plot_harmonic_response(self.to_pandas(), ax=ax)
 
 
 def _sdc_section(model: SdcModel, mode: TreatedMode, frequency_hz: float,

@@ -1,14 +1,19 @@
 """Matplotlib figures of single results; drawing only, the data come from the results.
 
 * :func:`plot_spectrum` - harmonic amplitudes of a measurement
-  (:meth:`pidcore.signal.PowerAnalysis.spectrum_frame`).
+  (:meth:`pidcore.signal.PowerAnalysis.to_pandas`).
 * :func:`plot_loop` - a force-displacement loop (:class:`pidcore.loop.ForceDisplacementLoop`).
 * :func:`plot_dem_run` - per-cycle dissipation and forces of a DEM run
   (:class:`pidcore.dem.DemResult`).
+* :func:`plot_harmonic_response` - a treated mode's amplitude against frequency
+  (:meth:`pidcore.model.HarmonicResponse.to_pandas`).
+* :func:`plot_calibration` - a calibration's predictions with their 95 % bands beside the
+  SDCs it was fitted to (:meth:`pidcore.calibrate.Calibration.to_pandas`).
 
-``PowerAnalysis.plot`` and ``DemResult.plot`` forward here (python-control style), so the
-physics modules import no matplotlib. With ``ax=None`` a new pyplot figure is made, as an
-interactive ``.plot()`` is expected to do.
+``PowerAnalysis.plot``, ``DemResult.plot``, ``HarmonicResponse.plot`` and
+``Calibration.plot`` forward here (python-control style), so the physics modules import no
+matplotlib. With ``ax=None`` a new pyplot figure is made, as an interactive ``.plot()`` is
+expected to do.
 """
 
 from __future__ import annotations
@@ -28,7 +33,7 @@ if TYPE_CHECKING:  # pragma: no cover
 def plot_spectrum(frame: pd.DataFrame, *, ax: Any = None) -> Any:
     """Harmonic spectrum: |F_n| (N, left axis) and |V_n| (m/s, right axis). Returns ``ax``.
 
-    ``frame`` is :meth:`pidcore.signal.PowerAnalysis.spectrum_frame` (its ``attrs`` give the
+    ``frame`` is :meth:`pidcore.signal.PowerAnalysis.to_pandas` (its ``attrs`` give the
     title).
     """
     import matplotlib.pyplot as plt
@@ -95,4 +100,54 @@ def plot_dem_run(result: DemResult, *, ax: Any = None) -> Any:
     a1.legend()
     a0.set_title(f"{result.case.key}: SDC {result.sdc:.4g} +- {result.sdc_stderr:.2g}, "
                  f"{result.particles_per_cell} particles/cell")
+    return ax
+
+
+def plot_calibration(frame: pd.DataFrame, *, ax: Any = None) -> Any:
+    """Calibrated predictions (points, 95 % band as error bars) and the measured SDCs they
+    were fitted to (crosses), one position per load case. Returns ``ax``.
+
+    ``frame`` is :meth:`pidcore.calibrate.Calibration.to_pandas`.
+    """
+    import matplotlib.pyplot as plt
+
+    if ax is None:
+        _, ax = plt.subplots(figsize=(max(6.0, 0.5 * len(frame)), 4.0), constrained_layout=True)
+    x = np.arange(len(frame))
+    sdc = frame["sdc predicted [-]"].to_numpy(float)
+    below = sdc - frame["low95 [-]"].to_numpy(float)
+    above = frame["high95 [-]"].to_numpy(float) - sdc
+    ax.errorbar(x, sdc, yerr=[below, above], fmt="o", capsize=3,
+                label="calibrated DEM (95 % band)")
+    ax.plot(x, frame["sdc measured [-]"].to_numpy(float), "x", color="k", label="measured")
+    ax.set_xticks(x)
+    ax.set_xticklabels([f"{f:g} Hz, {a:g} g, {p:g} %" for f, a, p in zip(
+        frame["frequency [Hz]"], frame["acceleration [g]"], frame["fill [%]"], strict=True)],
+        rotation=60, ha="right", fontsize="small")
+    ax.set_ylabel("SDC [-]")
+    ax.legend()
+    return ax
+
+
+def plot_harmonic_response(frame: pd.DataFrame, *, ax: Any = None) -> Any:
+    """Displacement amplitude against frequency, with and without the particle damper; points
+    where the SDC was held at the model's edge marked. Returns ``ax``.
+
+    ``frame`` is :meth:`pidcore.model.HarmonicResponse.to_pandas`.
+    """
+    import matplotlib.pyplot as plt
+
+    if ax is None:
+        _, ax = plt.subplots()
+    f = frame["frequency [Hz]"].to_numpy(float)
+    x = frame["amplitude [m]"].to_numpy(float)
+    clipped = frame["clipped [True/False]"].to_numpy(bool)
+    ax.plot(f, frame["amplitude untreated [m]"].to_numpy(float), "--", label="untreated")
+    ax.plot(f, x, "-", label="with particle damper")
+    if clipped.any():
+        ax.plot(f[clipped], x[clipped], "x", label="SDC held at model edge")
+    ax.set_yscale("log")
+    ax.set_xlabel("frequency [Hz]")
+    ax.set_ylabel("displacement amplitude [m]")
+    ax.legend()
     return ax

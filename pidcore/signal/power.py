@@ -168,12 +168,14 @@ class PowerAnalysis:
         loop = self.loop(n_points)
         return loop.displacement_m, loop.force_n
 
-    def spectrum_frame(self) -> pd.DataFrame:
+    def to_pandas(self) -> pd.DataFrame:
         """Fitted harmonics, one row each: order, frequency, amplitudes and phases (SI units).
 
         Columns ``harmonic [-]``, ``frequency [Hz]``, ``force amplitude [N]``,
         ``velocity amplitude [m/s]``, ``force phase [rad]``, ``velocity phase [rad]``
-        (``|F_n|`` and ``arg F_n`` of the one-sided phasors, after corrections).
+        (``|F_n|`` and ``arg F_n`` of the one-sided phasors, after corrections). The frame's
+        ``attrs`` hold ``source``, ``frequency_hz`` and ``sdc``; the scalar results are
+        :meth:`to_dict`'s.
         """
         n = np.asarray(self.harmonics, dtype=int)
         f = np.asarray(self.force_phasors_n, dtype=complex)
@@ -188,6 +190,10 @@ class PowerAnalysis:
         })
         frame.attrs.update(source=self.source, frequency_hz=self.frequency_hz, sdc=self.sdc)
         return frame
+
+    def spectrum_frame(self) -> pd.DataFrame:
+        """:meth:`to_pandas` (the name of pidcore 0.2; the same frame)."""
+        return self.to_pandas()
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-safe scalars (NaN -> None); includes the CLI keys, each naming its unit
@@ -232,7 +238,7 @@ class PowerAnalysis:
         """
         from ..report.figures_results import plot_spectrum  # lazy: drawing is optional
 
-        return plot_spectrum(self.spectrum_frame(), ax=ax)
+        return plot_spectrum(self.to_pandas(), ax=ax)
 
 
 def _damping_ratio(sdc: float, loss_factor: float) -> tuple[float | None, str]:

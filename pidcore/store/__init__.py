@@ -1,6 +1,23 @@
 """pidcore.store: the HDF5 store of measurements, analyses and DEM runs.
 
 See :mod:`pidcore.store.store` for the file layout and the transaction protocol.
+
+Public API
+----------
+Store
+    The store: ``add_measurement``/``add_analysis``/``add_dem_run``, their ``get_`` and
+    ``list_`` (pandas frames), ``transaction()``, ``verify()``, ``summary()``.
+StoredEntry
+    One analysis or DEM run read back: its record, arrays, parameters and units.
+measurement_key
+    The key a measurement is stored under (its content).
+STORE_VERSION
+    The layout version this pidcore writes.
+
+Examples
+--------
+>>> from pidcore.store import Store                     # doctest: +SKIP
+>>> Store("pid_store.h5").list_analyses()[["source", "sdc"]]  # doctest: +SKIP
 """
 
 from ..records import measurement_key
