@@ -37,10 +37,11 @@ import numpy as np
 
 from . import defaults
 from .constants import COUNT_UNIT, RATIO_UNIT
-from .errors import ChannelError, ParameterError, StoreError
+from .errors import ChannelError, ParameterError, StoreError, instance_of
 from .io import assign_roles, read_measurement
 from .records import Channel, Measurement
 from .signal import PowerAnalysis, analyze_channels
+from .signal.power import check_analysis_settings
 from .units import lookup_unit
 
 if TYPE_CHECKING:
@@ -85,6 +86,18 @@ class AnalysisOptions:
             raise ParameterError(f"invert: expected a sequence of channel names, got "
                                  f"{self.invert!r}")
         object.__setattr__(self, "invert", tuple(self.invert))  # JSON gives back a list
+        # refused when made, naming the keyword, not when the first file is analysed (or, for
+        # a string, as a TypeError from inside the analysis)
+        for name in ("force", "velocity", "acceleration", "force_unit", "velocity_unit",
+                     "acceleration_unit"):
+            instance_of(name, getattr(self, name), (str, type(None)))
+        for name in self.invert:
+            instance_of("invert", name, str)
+        instance_of("allow_clipped", self.allow_clipped, bool)
+        check_analysis_settings(
+            n_harmonics=self.n_harmonics, mass_below_gauge_kg=self.mass_below_gauge_kg,
+            frequency_hz=self.frequency_hz, velocity_delay_s=self.velocity_delay_s,
+            baseline_loss_factor=self.baseline_loss_factor, sample_rate_hz=self.sample_rate_hz)
         for name in ("velocity_delay_s", "mass_below_gauge_kg", "baseline_loss_factor"):
             # -0 (a sidecar's '-0', --velocity-delay -0) is no correction: saved as -0.0 it
             # made a second record of the same analysis (parameters_json differed) and was

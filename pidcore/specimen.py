@@ -93,7 +93,7 @@ from .constants import (
     CellShape,
     TangentialStiffnessModel,
 )
-from .errors import ParameterError, as_given
+from .errors import ParameterError, as_given, real_number
 
 if TYPE_CHECKING:  # pragma: no cover
     from .dem.contact import ContactLaw
@@ -209,8 +209,12 @@ def particles_for_fill(fill_percent: float, full: int) -> int:
     The one rounding rule of a fill, for ``specimen check`` and ``dem run`` alike: a fill that
     rounds to no particle is refused (an empty cell damps nothing, and its SDC is 0/0).
     """
+    fill_percent = real_number("fill_percent", fill_percent)
     if not math.isfinite(fill_percent):
         raise ParameterError(f"fill {fill_percent} %: expected a finite percentage")
+    if fill_percent > 100.0:  # 150 % gave 1.5 full cells of particles, more than fit
+        raise ParameterError(f"fill {as_given(fill_percent)} %: more than a full cell; "
+                             "expected a packing ratio in (0, 100] %")
     n = int(round(fill_percent / 100.0 * full))
     if n < 1:
         # the smallest fill shown on a 0.01 % step strictly above half a particle: rounds to 1

@@ -42,6 +42,7 @@ Corrections (applied to the phasors in this order):
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -50,7 +51,7 @@ import pandas as pd
 
 from .. import defaults
 from ..constants import STANDARD_GRAVITY
-from ..errors import ChannelError, ParameterError, SignalError, as_given
+from ..errors import ChannelError, ParameterError, SignalError, as_given, real_number
 from ..loop import ForceDisplacementLoop
 from ..records import Channel
 from . import validate
@@ -296,30 +297,53 @@ def _complex_power(f_ph: np.ndarray, m_ph: np.ndarray, a_ph: np.ndarray | None,
     return f, v, 0.5 * np.sum(f * np.conj(v), axis=-1)
 
 
-def _check_parameters(sample_rate_hz: float, n_harmonics: int, n_blocks: int, min_periods: int,
-                      mass_below_gauge_kg: float, frequency_hz: float | None,
-                      velocity_delay_s: float, baseline_loss_factor: float) -> None:
-    if not (math.isfinite(sample_rate_hz) and sample_rate_hz > 0):
+def check_analysis_settings(*, n_harmonics: int = defaults.N_HARMONICS,
+                            mass_below_gauge_kg: float = 0.0, frequency_hz: float | None = None,
+                            velocity_delay_s: float = 0.0, baseline_loss_factor: float = 0.0,
+                            sample_rate_hz: float | None = None) -> None:
+    """Refuse the settings of an analysis that no record can make right (a string, a bool, a
+    fraction of a harmonic, a negative mass or baseline, a non-positive frequency hint or
+    rate), each naming its keyword: :func:`analyze_power` checks them, and
+    :class:`pidcore.measure.AnalysisOptions` when it is made, before any file is read."""
+    for name, value in (("mass_below_gauge_kg", mass_below_gauge_kg),
+                        ("velocity_delay_s", velocity_delay_s),
+                        ("baseline_loss_factor", baseline_loss_factor),
+                        *((("frequency_hz", frequency_hz),) if frequency_hz is not None else ()),
+                        *((("sample_rate_hz", sample_rate_hz),) if sample_rate_hz is not None
+                          else ())):
+        real_number(name, value)
+    if sample_rate_hz is not None and not (math.isfinite(sample_rate_hz) and sample_rate_hz > 0):
         raise ParameterError(f"sample_rate_hz: {sample_rate_hz!r}, expected a positive number")
-    if int(n_harmonics) != n_harmonics or n_harmonics < 1:
+    if (isinstance(n_harmonics, bool) or not isinstance(n_harmonics, numbers.Real)
+            or not math.isfinite(n_harmonics) or int(n_harmonics) != n_harmonics
+            or n_harmonics < 1):
         raise ParameterError(f"n_harmonics: {n_harmonics!r}, expected an integer >= 1")
-    if int(n_blocks) != n_blocks or n_blocks < 0:
-        raise ParameterError(f"n_blocks: {n_blocks!r}, expected an integer >= 0 (0: no stderr)")
-    if int(min_periods) != min_periods or min_periods < 1:
-        raise ParameterError(f"min_periods: {min_periods!r}, expected an integer >= 1")
     if not (math.isfinite(mass_below_gauge_kg) and mass_below_gauge_kg >= 0):
         raise ParameterError(f"mass_below_gauge_kg: {mass_below_gauge_kg!r}, expected >= 0 kg")
     if frequency_hz is not None and not (math.isfinite(frequency_hz) and frequency_hz > 0):
         raise ParameterError(f"frequency_hz: {frequency_hz!r}, expected a positive hint in Hz")
-    if frequency_hz is not None and frequency_hz >= sample_rate_hz / 2:
-        raise ParameterError(f"frequency_hz: {as_given(frequency_hz)} Hz is not below the Nyquist "
-                             f"frequency {sample_rate_hz / 2:g} Hz")
     if not math.isfinite(velocity_delay_s):
         raise ParameterError(f"velocity_delay_s: {velocity_delay_s!r}, expected a finite time")
     if not (math.isfinite(baseline_loss_factor) and baseline_loss_factor >= 0):
         # the empty coupon dissipates energy: a negative baseline would add damping
         raise ParameterError(f"baseline_loss_factor: {baseline_loss_factor!r}, expected a "
                              "loss factor >= 0 (that of the empty coupon)")
+
+
+def _check_parameters(sample_rate_hz: float, n_harmonics: int, n_blocks: int, min_periods: int,
+                      mass_below_gauge_kg: float, frequency_hz: float | None,
+                      velocity_delay_s: float, baseline_loss_factor: float) -> None:
+    check_analysis_settings(n_harmonics=n_harmonics, mass_below_gauge_kg=mass_below_gauge_kg,
+                            frequency_hz=frequency_hz, velocity_delay_s=velocity_delay_s,
+                            baseline_loss_factor=baseline_loss_factor,
+                            sample_rate_hz=sample_rate_hz)
+    if int(n_blocks) != n_blocks or n_blocks < 0:
+        raise ParameterError(f"n_blocks: {n_blocks!r}, expected an integer >= 0 (0: no stderr)")
+    if int(min_periods) != min_periods or min_periods < 1:
+        raise ParameterError(f"min_periods: {min_periods!r}, expected an integer >= 1")
+    if frequency_hz is not None and frequency_hz >= sample_rate_hz / 2:
+        raise ParameterError(f"frequency_hz: {as_given(frequency_hz)} Hz is not below the Nyquist "
+                             f"frequency {sample_rate_hz / 2:g} Hz")
 
 
 def _check_delay(velocity_delay_s: float, frequency_hz: float, duration_s: float) -> None:

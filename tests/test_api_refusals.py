@@ -1,0 +1,85 @@
+"""Wrong types and out-of-range values given to the library are refused where they are given,
+with a one-line :class:`~pidcore.errors.ParameterError` naming the keyword (as the CLI's
+options are), not as a TypeError or AttributeError from deep inside, nor run as something
+else (``cells=2.5`` ran; a fill of 150 % gave one and a half cells of particles)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from pidcore.dem import DemConfig, LoadCase, particles_per_cell, simulate_load_case
+from pidcore.errors import ParameterError
+from pidcore.measure import AnalysisOptions
+from pidcore.signal import analyze_power
+
+
+@pytest.mark.parametrize(("keywords", "named"), [
+    ({"cells": 2.5}, "cells: expected a whole number, got 2.5"),
+    ({"cells": "4"}, "cells: expected a whole number, got '4'"),
+    ({"seed": 1.5}, "seed: expected a whole number"),
+    ({"steady_cycles": 10.5}, "steady_cycles: expected a whole number"),
+    ({"samples_per_cycle": True}, "samples_per_cycle: expected a whole number"),
+    ({"time_step": True}, "time_step: expected a number, got True"),
+    ({"max_transient_s": "1"}, "max_transient_s: expected a number"),
+    ({"alpha_pp": "0.1"}, "alpha_pp: expected a number"),
+])
+def test_dem_config_refuses_wrong_types_naming_the_field(keywords, named):
+    with pytest.raises(ParameterError, match=f"^{named}"):
+        DemConfig(**keywords)
+
+
+def test_dem_config_takes_whole_floats_as_counts():
+    # a JSON or HDF5 reader may give 4.0 back for a count: the same run, kept an int
+    config = DemConfig(cells=4.0, seed=np.int64(7), steady_cycles=20.0)
+    assert (config.cells, config.seed, config.steady_cycles) == (4, 7, 20)
+    assert all(type(v) is int for v in (config.cells, config.seed, config.steady_cycles))
+    assert config == DemConfig(cells=4, seed=7, steady_cycles=20)
+
+
+@pytest.mark.parametrize(("arguments", "named"), [
+    (((100.0, 5.0, 50.0),), r"^case: expected a LoadCase, got tuple"),
+    ((LoadCase(100.0, 5.0, 50.0), {"cells": 1}),
+     r"^config: expected a DemConfig or None, got dict"),
+])
+def test_simulate_load_case_refuses_what_is_not_a_record(arguments, named):
+    with pytest.raises(ParameterError, match=named):
+        simulate_load_case(*arguments)
+
+
+def test_simulate_load_case_refuses_a_specimen_path_saying_how_to_read_it():
+    with pytest.raises(ParameterError, match=r"^specimen: expected a Specimen or None, got str "
+                                             r".*load_specimen\(path\)"):
+        simulate_load_case(LoadCase(100.0, 5.0, 50.0), DemConfig(cells=1),
+                           specimen="steel_6mm.toml")
+
+
+def test_a_fill_above_a_full_cell_is_refused():
+    n_full, full = particles_per_cell(100.0)
+    assert n_full == full  # the limit itself: a full cell
+    with pytest.raises(ParameterError, match=r"^fill 150 %: more than a full cell"):
+        particles_per_cell(150.0)  # was (1.5 x capacity, capacity): more than fit
+
+
+@pytest.mark.parametrize(("keywords", "named"), [
+    ({"velocity_delay_s": "50e-6"}, r"^velocity_delay_s: expected a number, got '50e-6'"),
+    ({"mass_below_gauge_kg": -0.01}, r"^mass_below_gauge_kg: -0.01, expected >= 0 kg"),
+    ({"baseline_loss_factor": -0.1}, r"^baseline_loss_factor: -0.1, expected a loss factor"),
+    ({"n_harmonics": 0}, r"^n_harmonics: 0, expected an integer >= 1"),
+    ({"n_harmonics": 2.5}, r"^n_harmonics: 2.5, expected an integer >= 1"),
+    ({"frequency_hz": -100.0}, r"^frequency_hz: -100.0, expected a positive hint"),
+    ({"sample_rate_hz": 0.0}, r"^sample_rate_hz: 0.0, expected a positive number"),
+    ({"force": 3}, r"^force: expected a str or None, got int"),
+    ({"allow_clipped": "yes"}, r"^allow_clipped: expected a bool, got str"),
+])
+def test_analysis_options_are_refused_when_made(keywords, named):
+    # before: made without a word, and refused (or a TypeError) only once a file was read
+    with pytest.raises(ParameterError, match=named):
+        AnalysisOptions(**keywords)
+
+
+def test_analyze_power_names_a_sample_rate_that_is_not_a_number():
+    t = np.arange(4000) / 4000.0
+    force, velocity = np.sin(2 * np.pi * 50 * t), np.cos(2 * np.pi * 50 * t)
+    with pytest.raises(ParameterError, match=r"^sample_rate_hz: expected a number, got '4000'"):
+        analyze_power(force, velocity, "4000")  # was TypeError: must be real number, not str
