@@ -89,6 +89,9 @@ def instance_of(name: str, value: object, kind: type | tuple[type, ...], *,
     if isinstance(value, kind):
         return
     kinds = kind if isinstance(kind, tuple) else (kind,)
-    expected = " or ".join("None" if k is type(None) else k.__name__ for k in kinds)
-    raise ParameterError(f"{name}: expected a {expected}, got {type(value).__name__} "
+    # numpy's bool_ is named "bool" too: each name once
+    expected = " or ".join(dict.fromkeys("None" if k is type(None) else k.__name__
+                                         for k in kinds))
+    article = "an" if expected[0].lower() in "aeiou" else "a"
+    raise ParameterError(f"{name}: expected {article} {expected}, got {type(value).__name__} "
                          f"{value!r:.60}" + (f" ({hint})" if hint else ""))

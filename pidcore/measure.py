@@ -93,7 +93,7 @@ class AnalysisOptions:
             instance_of(name, getattr(self, name), (str, type(None)))
         for name in self.invert:
             instance_of("invert", name, str)
-        instance_of("allow_clipped", self.allow_clipped, bool)
+        instance_of("allow_clipped", self.allow_clipped, (bool, np.bool_))
         check_analysis_settings(
             n_harmonics=self.n_harmonics, mass_below_gauge_kg=self.mass_below_gauge_kg,
             frequency_hz=self.frequency_hz, velocity_delay_s=self.velocity_delay_s,
@@ -292,8 +292,12 @@ def _unit_slip_notes(measurement: Measurement, chosen: Mapping[str, Channel],
     return notes
 
 
-def analyze_measurement(measurement: Measurement, options: AnalysisOptions) -> AnalyzedRecord:
+def analyze_measurement(measurement: Measurement, options: AnalysisOptions | None = None
+                        ) -> AnalyzedRecord:
     """Map channels to roles, prepare them and run the Eq. 11 analysis on one measurement.
+
+    ``options``: channels, corrections and analysis settings; ``AnalysisOptions()`` (the
+    CLI's defaults) when not given.
 
     Preparation, each step announced in the notes: channels inverted on request
     (``invert``), units given by option for channels without one (a channel of unknown unit is
@@ -301,6 +305,9 @@ def analyze_measurement(measurement: Measurement, options: AnalysisOptions) -> A
     lengths differ (a fractional-sample start offset of the velocity is corrected as a delay),
     channels no role needs named as ignored.
     """
+    options = AnalysisOptions() if options is None else options
+    instance_of("options", options, AnalysisOptions,
+                hint="e.g. AnalysisOptions(velocity_delay_s=5e-5)")
     notes: list[str] = list(measurement.metadata.get("reader_notes", ()) or ())
     corrections: dict = {}
     as_read = measurement  # what is stored: the file's channels, the inversion a parameter
@@ -343,10 +350,14 @@ def analyze_measurement(measurement: Measurement, options: AnalysisOptions) -> A
                           detail, corrections)
 
 
-def analyze_file(path: str | os.PathLike, options: AnalysisOptions, *,
+def analyze_file(path: str | os.PathLike, options: AnalysisOptions | None = None, *,
                  key: str | None = None) -> AnalyzedRecord:
-    """Read one export file and analyse it; ``key`` picks a measurement of a pidcore store
+    """Read one export file and analyse it (:func:`analyze_measurement`; ``options`` default
+    ``AnalysisOptions()``); ``key`` picks a measurement of a pidcore store
     (:func:`pidcore.io.read_measurement`)."""
+    options = AnalysisOptions() if options is None else options
+    instance_of("options", options, AnalysisOptions,
+                hint="e.g. AnalysisOptions(velocity_delay_s=5e-5)")
     measurement = read_measurement(Path(path), sample_rate_hz=options.sample_rate_hz, key=key)
     return analyze_measurement(measurement, options)
 

@@ -5,12 +5,14 @@ else (``cells=2.5`` ran; a fill of 150 % gave one and a half cells of particles)
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
 from pidcore.dem import DemConfig, LoadCase, particles_per_cell, simulate_load_case
 from pidcore.errors import ParameterError
-from pidcore.measure import AnalysisOptions
+from pidcore.measure import AnalysisOptions, analyze_file
 from pidcore.signal import analyze_power
 
 
@@ -83,3 +85,18 @@ def test_analyze_power_names_a_sample_rate_that_is_not_a_number():
     force, velocity = np.sin(2 * np.pi * 50 * t), np.cos(2 * np.pi * 50 * t)
     with pytest.raises(ParameterError, match=r"^sample_rate_hz: expected a number, got '4000'"):
         analyze_power(force, velocity, "4000")  # was TypeError: must be real number, not str
+
+
+_SAMPLE = (Path(__file__).resolve().parents[1] / "data_samples" / "exports"
+           / "synthetic_f500Hz_a1g_fill50_acrylic.csv")
+
+
+def test_analyze_file_takes_the_default_options_when_given_none():
+    # a script's first call, analyze_file(path), was a TypeError (options was required)
+    default = analyze_file(_SAMPLE, AnalysisOptions())
+    assert analyze_file(_SAMPLE).analysis.sdc == default.analysis.sdc
+
+
+def test_analyze_file_refuses_options_that_are_not_analysis_options():
+    with pytest.raises(ParameterError, match=r"^options: expected an AnalysisOptions, got dict"):
+        analyze_file(_SAMPLE, {"velocity_delay_s": 5e-5})  # was AttributeError: 'dict' ...
