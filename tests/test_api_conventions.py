@@ -69,7 +69,8 @@ def test_unknown_keyword_arguments_are_rejected():
 
 _BUNDLED = Path(__file__).resolve().parents[1] / "data_samples"
 #: Columns of a result frame that are labels, not quantities (no unit to name).
-_LABEL_COLUMNS = {"material", "direction"}
+_LABEL_COLUMNS = {"material", "direction", "DEM settings", "specimen", "source file(s)",
+                  "load case", "note"}
 _UNIT_COLUMN = re.compile(r"^.+ \[[^\[\]]+\]$")
 
 
@@ -114,8 +115,18 @@ def _calibration():
     return load_calibration(_BUNDLED / "paper_calibration")
 
 
+def _report_result():
+    from pidcore.model import load_paper_table3
+    from pidcore.report import ReportResult, build_report_table
+    from pidcore.store import Store
+
+    runs = Store(_BUNDLED / "dem_table3.h5").list_dem_runs()
+    return ReportResult(paths={}, table=build_report_table(runs, None, load_paper_table3()))
+
+
 _RESULTS = {"PowerAnalysis": _power_analysis, "DemResult": _dem_result,
-            "HarmonicResponse": _harmonic_response, "Calibration": _calibration}
+            "HarmonicResponse": _harmonic_response, "Calibration": _calibration,
+            "ReportResult": _report_result}
 
 
 @pytest.mark.parametrize("name", sorted(_RESULTS))
@@ -147,6 +158,8 @@ def test_result_frames_hold_the_results_arrays():
     frame = calibration.to_pandas()
     assert len(frame) == len(calibration.predictions)
     np.testing.assert_array_equal(frame["high95 [-]"], [p.high95 for p in calibration.predictions])
+    report = _report_result()
+    assert report.to_pandas() is report.table
 
 
 @pytest.mark.parametrize("name", sorted(_RESULTS))
@@ -166,7 +179,8 @@ def test_result_plot_draws_into_the_axes_given_and_returns_them(name, monkeypatc
         got = result.plot(ax=axes)
     finally:
         plt.close("all") if plt.get_fignums() != before_figures else None
-    assert got is axes
+    # the axes given, or (a report's figure of panels) the figure holding them
+    assert got is axes or (name == "ReportResult" and got is fig)
     assert plt.get_fignums() == before_figures, f"{name}.plot(ax=...) opened a figure"
     assert dict(matplotlib.rcParams) == before_rc, f"{name}.plot() changed rcParams"
     assert all(a.has_data() for a in np.atleast_1d(axes))

@@ -20,7 +20,7 @@ import os
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pandas as pd
@@ -115,6 +115,18 @@ class ReportResult:
     table: pd.DataFrame
     measured: list[MeasuredResult] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
+
+    def to_pandas(self) -> pd.DataFrame:
+        """The report table (:attr:`table`; columns :data:`REPORT_COLUMNS`, each naming its
+        unit, and the calibration's where one was given)."""
+        return self.table
+
+    def plot(self, ax: Any = None) -> Any:
+        """SDC per load case, measured beside our DEM and the paper's
+        (:func:`pidcore.report.comparison_figures.plot_sdc_comparison`); returns the figure."""
+        from .comparison_figures import plot_sdc_comparison
+
+        return plot_sdc_comparison(self.table, ax=ax)
 
 
 def open_verified_store(path: str | Path, *, must_exist: bool) -> Store:
