@@ -142,6 +142,17 @@ def test_damper_table_refuses_out_of_range(model):
                                 vibrated_mass_kg=0.0)
 
 
+def test_damper_table_refuses_a_vibrated_mass_in_grams(model):
+    # the paper coupon's m_c with particles is 0.02-0.2 kg: 98.8 is grams typed for kg, which
+    # gave c_eq and energies 1000 x too large (pidcore model damper --vibrated-mass refused it)
+    with pytest.raises(ParameterError, match=r"^vibrated_mass_kg 98.8 kg is .*was it grams\?"):
+        equivalent_damper_table(model, fills=[50], accelerations=[5], frequencies=[100],
+                                vibrated_mass_kg=98.8)
+    kept = equivalent_damper_table(model, fills=[50], accelerations=[5], frequencies=[100],
+                                   vibrated_mass_kg=0.0988)
+    assert kept["vibrated_mass [kg]"].tolist() == [0.0988]
+
+
 def test_written_files_round_trip(tmp_path):
     grid = pd.MultiIndex.from_product([[25.0, 90.0], [1.0, 10.0], [50.0, 1000.0]],
                                       names=["fill_percent", "acceleration_g", "frequency_hz"])

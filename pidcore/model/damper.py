@@ -352,7 +352,9 @@ def equivalent_damper_table(model: SdcModel, *, fills: Sequence[float],
         Values in %, g and Hz; the table is their Cartesian product.
     vibrated_mass_kg : float or callable
         m_c [kg] of Eq. 10, or a function of fill [%] returning it (the particle mass grows
-        with fill).
+        with fill). A number more than :data:`VIBRATED_MASS_LIMIT` times outside the paper
+        coupon's m_c is refused as a unit slip (grams typed for kg), as ``pidcore model
+        damper --vibrated-mass`` refuses it.
     area_m2 : float, optional
         Coupon area for the per-area damper; default :func:`coupon_area_m2`.
     clip_to_range : bool
@@ -374,6 +376,9 @@ def equivalent_damper_table(model: SdcModel, *, fills: Sequence[float],
     if callable(vibrated_mass_kg):
         mass = np.array([float(vibrated_mass_kg(x)) for x in p])
     else:
+        # 69 (g) for 0.069 kg gave a c_eq 1000 x too large without a word; the CLI refused it
+        check_vibrated_mass(float(_positive("vibrated_mass_kg", vibrated_mass_kg)),
+                            model.axes[0], D.MODEL_PARTICLE_MATERIAL)
         mass = np.full(p.shape, float(vibrated_mass_kg))
     mass = _positive("vibrated_mass_kg", mass)
     area = coupon_area_m2() if area_m2 is None else float(_positive("area_m2", area_m2))
