@@ -93,5 +93,7 @@ def instance_of(name: str, value: object, kind: type | tuple[type, ...], *,
     expected = " or ".join(dict.fromkeys("None" if k is type(None) else k.__name__
                                          for k in kinds))
     article = "an" if expected[0].lower() in "aeiou" else "a"
+    shown = " ".join(repr(value).split())  # one line, whatever the object's repr
+    shown = shown if len(shown) <= 60 else shown[:57] + "..."
     raise ParameterError(f"{name}: expected {article} {expected}, got {type(value).__name__} "
-                         f"{value!r:.60}" + (f" ({hint})" if hint else ""))
+                         f"{shown}" + (f" ({hint})" if hint else ""))

@@ -80,6 +80,8 @@ def normalize_direction(value: str, what: str) -> str:
 def check_fill(value: float, what: str) -> float:
     """``value`` as a fill in (0, 100] % (packing ratio), or :class:`LoadCaseError`."""
     try:
+        if isinstance(value, bool):  # True was a fill of 1 %
+            raise TypeError
         fill = float(value)
     except (TypeError, ValueError):
         raise LoadCaseError(f"{what}: fill {value!r} is not a number (packing ratio in %)") \
@@ -122,8 +124,8 @@ class LoadCase:
     def __post_init__(self) -> None:
         for name in ("frequency_hz", "acceleration_g"):
             value = getattr(self, name)
-            try:
-                number = float(value)
+            try:  # text as a table holds it is read; True is not 1 Hz
+                number = math.nan if isinstance(value, bool) else float(value)
             except (TypeError, ValueError):
                 number = math.nan
             if not (math.isfinite(number) and number > 0):

@@ -94,6 +94,7 @@ from .constants import (
     TangentialStiffnessModel,
 )
 from .errors import ParameterError, as_given, real_number
+from .loadcase import normalize_material
 
 if TYPE_CHECKING:  # pragma: no cover
     from .dem.contact import ContactLaw
@@ -854,6 +855,8 @@ def paper_specimen(material: str = "acrylic") -> Specimen:
     (``materials.csv``, ``material_pairs.csv``), which reproduces ``--material aluminium``
     runs of earlier versions.
     """
+    # "aluminum" and "pmma", which LoadCase and the CLI take, were unknown here
+    material = normalize_material(material, "material", known=None)
     base = Specimen.from_text(_paper_text(), source=f"pidcore:{PAPER_SPECIMEN_NAME}.toml")
     if material == base.particles.material:
         return base

@@ -10,10 +10,20 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from pidcore.calibrate import load_calibration
 from pidcore.dem import DemConfig, LoadCase, particles_per_cell, simulate_load_case
 from pidcore.errors import ParameterError
+from pidcore.io import read_measurement, read_measurements
 from pidcore.measure import AnalysisOptions, analyze_file
+from pidcore.model import (
+    SdcModel,
+    TreatedMode,
+    harmonic_response,
+    load_paper_table3,
+    time_domain_response,
+)
 from pidcore.signal import analyze_power
+from pidcore.specimen import paper_specimen
 
 
 @pytest.mark.parametrize(("keywords", "named"), [
@@ -100,3 +110,50 @@ def test_analyze_file_takes_the_default_options_when_given_none():
 def test_analyze_file_refuses_options_that_are_not_analysis_options():
     with pytest.raises(ParameterError, match=r"^options: expected an AnalysisOptions, got dict"):
         analyze_file(_SAMPLE, {"velocity_delay_s": 5e-5})  # was AttributeError: 'dict' ...
+
+
+def test_a_load_case_refuses_booleans():
+    # True was taken as 1 Hz (or a fill of 1 %)
+    with pytest.raises(ParameterError, match=r"^load case: frequency_hz must be .* got True"):
+        LoadCase(True, 5.0, 50.0)
+    with pytest.raises(ParameterError, match=r"^load case: fill True is not a number"):
+        LoadCase(100.0, 5.0, True)
+    assert LoadCase("100", "5", "50") == LoadCase(100.0, 5.0, 50.0)  # text as tables hold it
+
+
+def test_the_paper_specimen_takes_the_material_aliases_a_load_case_takes():
+    # LoadCase and the CLI read "aluminum" as "aluminium"; paper_specimen refused it
+    assert LoadCase(100.0, 5.0, 50.0, material="aluminum").material == "aluminium"
+    assert paper_specimen("aluminum") == paper_specimen("aluminium")
+    assert paper_specimen("PMMA") == paper_specimen("acrylic")
+
+
+def test_a_file_descriptor_is_not_a_path():
+    # read_measurement(0) opened file descriptor 0 (stdin) and read from it
+    for read in (read_measurement, read_measurements):
+        with pytest.raises(ParameterError, match=r"^path: expected a str or PathLike, got int"):
+            read(0)
+
+
+def test_response_functions_refuse_what_is_not_their_record():
+    table = load_paper_table3()
+    mode = TreatedMode(300.0, 2.0, 0.01, 0.2, 50.0, 0.1)
+    with pytest.raises(ParameterError, match=r"^model: expected an? SdcModel, got DataFrame") \
+            as refused:  # was AttributeError: 'DataFrame' object has no attribute 'bounds'
+        harmonic_response(table, mode, frequencies_hz=[300.0], force_amplitude_n=10.0)
+    assert "\n" not in str(refused.value)  # one line, though a frame's repr has many
+    model = SdcModel.from_table(table)
+    with pytest.raises(ParameterError, match=r"^measure_cycles: expected a whole number"):
+        time_domain_response(model, mode, frequency_hz=300.0, force_amplitude_n=10.0,
+                             measure_cycles=2.5)  # was a TypeError of numpy
+    with pytest.raises(ParameterError, match=r"^TreatedMode: natural_frequency_hz: expected a "
+                                             r"number, got '300'"):
+        TreatedMode("300", 2.0, 0.01, 0.2, 50.0, 0.1)  # was a TypeError of np.isfinite
+
+
+def test_a_calibration_refuses_what_is_not_a_load_case_or_a_stderr():
+    calibration = load_calibration(_SAMPLE.parents[1] / "paper_calibration")
+    with pytest.raises(ParameterError, match=r"^case: expected a LoadCase, got tuple"):
+        calibration.lookup((50.0, 1.0, 50.0))  # was AttributeError: no attribute 'material'
+    with pytest.raises(ParameterError, match=r"^stderr: expected a number, got '0.1'"):
+        calibration.predictions[0].band("0.1")

@@ -18,7 +18,7 @@ import pandas as pd
 
 from .. import defaults
 from ..compare.align import Tolerances
-from ..errors import ParameterError
+from ..errors import ParameterError, instance_of, real_number
 from ..loadcase import LoadCase
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -73,6 +73,7 @@ class CalibratedPrediction:
         add; cut at 0): a precise new measurement is not judged by the wider band of a noisy
         fitted one, nor a noisy one by a narrow band.
         """
+        stderr = real_number("stderr", stderr)
         same = (not math.isfinite(stderr) or not math.isfinite(self.measured_stderr)
                 or not math.isfinite(self.low95_without_stderr)
                 or math.isclose(stderr, self.measured_stderr, rel_tol=1e-9, abs_tol=1e-12))
@@ -155,6 +156,7 @@ class Calibration:
                tolerances: Tolerances | None = None) -> CalibratedPrediction | None:
         """The prediction at ``case`` (same material; frequency, acceleration and fill within
         ``tolerances``, default the report's ``COMPARE_*``), or None if it predicts none."""
+        instance_of("case", case, LoadCase, hint="e.g. LoadCase(500.0, 5.0, 50.0)")
         tolerances = tolerances or Tolerances()
         hits = [p for p in self.predictions
                 if p.load_case.material == case.material and tolerances.matches(case,

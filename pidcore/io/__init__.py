@@ -51,7 +51,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from ..constants import FileFormat
-from ..errors import InputFileError, ParameterError, PidcoreError
+from ..errors import InputFileError, ParameterError, PidcoreError, instance_of
 from ..records import Measurement
 from ._common import reraise_interrupt
 from .delimited import read_csv, write_csv
@@ -90,6 +90,8 @@ def detect_file_format(path: str | os.PathLike[str]) -> str:
     InputFileError
         Missing, unreadable or empty file, or neither content nor extension decides.
     """
+    # an int is a file descriptor to open(): read_measurement(0) read stdin
+    instance_of("path", path, (str, os.PathLike), hint="a file name")
     where = str(path)
     try:
         with open(path, "rb") as fh:
@@ -173,6 +175,7 @@ def read_measurements(path: str | os.PathLike[str], *, sample_rate_hz: float | N
 
     See :func:`read_measurement` for the parameters.
     """
+    instance_of("path", path, (str, os.PathLike), hint="a file name")
     _check_format(file_format)
     fmt = file_format or detect_file_format(path)
     if fmt == "hdf5":
@@ -210,6 +213,7 @@ def read_measurement(path: str | os.PathLike[str], *, sample_rate_hz: float | No
         The file is missing, empty, truncated, corrupt or holds no time record; a store holds
         several measurements and no ``key`` was given (the message lists the keys).
     """
+    instance_of("path", path, (str, os.PathLike), hint="a file name")
     _check_format(file_format)
     fmt = file_format or detect_file_format(path)
     if not Path(path).is_file():

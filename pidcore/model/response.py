@@ -38,7 +38,7 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
 from ..constants import STANDARD_GRAVITY
-from ..errors import ParameterError, as_given
+from ..errors import ParameterError, as_given, instance_of, real_number, whole_number
 from .damper import coupon_area_m2, equivalent_damping_coefficient
 from .sdc_model import SdcModel
 
@@ -81,6 +81,10 @@ class TreatedMode:
     coupon_area_m2: float = coupon_area_m2()
 
     def __post_init__(self) -> None:
+        for name in ("natural_frequency_hz", "modal_mass_kg", "structural_damping_ratio",
+                     "treated_area_m2", "fill_percent", "coupon_vibrated_mass_kg",
+                     "coupon_area_m2"):
+            real_number(f"TreatedMode: {name}", getattr(self, name))  # "300" was a TypeError
         for name in ("natural_frequency_hz", "modal_mass_kg", "treated_area_m2",
                      "coupon_vibrated_mass_kg", "coupon_area_m2"):
             v = getattr(self, name)
@@ -219,6 +223,8 @@ def harmonic_response(model: SdcModel, mode: TreatedMode, *, frequencies_hz: np.
     -------
     HarmonicResponse
     """
+    instance_of("model", model, SdcModel, hint="e.g. SdcModel.from_table(load_paper_table3())")
+    instance_of("mode", mode, TreatedMode)
     if not np.isfinite(force_amplitude_n) or force_amplitude_n <= 0:
         raise ParameterError(f"force_amplitude_n must be finite and > 0, got "
                              f"{force_amplitude_n!r}")
@@ -313,6 +319,11 @@ def time_domain_response(model: SdcModel, mode: TreatedMode, *, frequency_hz: fl
     ``settle_cycles`` defaults to 8 decay time constants of the lightest possible damping
     (structural only), in drive cycles.
     """
+    instance_of("model", model, SdcModel, hint="e.g. SdcModel.from_table(load_paper_table3())")
+    instance_of("mode", mode, TreatedMode)
+    measure_cycles = whole_number("measure_cycles", measure_cycles)
+    if settle_cycles is not None:
+        settle_cycles = whole_number("settle_cycles", settle_cycles)
     w = 2.0 * np.pi * frequency_hz
     k, m, c_s = mode.stiffness_n_m, mode.modal_mass_kg, mode.structural_damping_n_s_m
     sdc_of, _ = _sdc_section(model, mode, frequency_hz, True)
