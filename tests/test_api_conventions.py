@@ -74,6 +74,12 @@ _LABEL_COLUMNS = {"material", "direction", "DEM settings", "specimen", "source f
 _UNIT_COLUMN = re.compile(r"^.+ \[[^\[\]]+\]$")
 
 
+def _measurement():
+    from pidcore.io import read_measurement
+
+    return read_measurement(_BUNDLED / "exports" / "synthetic_f500Hz_a1g_fill50_acrylic.csv")
+
+
 def _power_analysis():
     from pidcore.signal import analyze_power, synthesize_shaker_record
 
@@ -124,7 +130,7 @@ def _report_result():
     return ReportResult(paths={}, table=build_report_table(runs, None, load_paper_table3()))
 
 
-_RESULTS = {"PowerAnalysis": _power_analysis, "DemResult": _dem_result,
+_RESULTS = {"Measurement": _measurement, "PowerAnalysis": _power_analysis, "DemResult": _dem_result,
             "HarmonicResponse": _harmonic_response, "Calibration": _calibration,
             "ReportResult": _report_result}
 
@@ -142,6 +148,12 @@ def test_results_give_a_frame_whose_columns_name_their_units(name):
 
 def test_result_frames_hold_the_results_arrays():
     # each frame is the result's own arrays, not a copy that could drift from them
+    measurement = _measurement()
+    frame = measurement.to_pandas()
+    for ch in measurement.channels:
+        np.testing.assert_array_equal(frame[f"{ch.name} [{ch.unit}]"], ch.data)
+    rate = measurement.channels[0].sample_rate_hz
+    np.testing.assert_allclose(np.diff(frame["time [s]"]), 1 / rate, rtol=1e-9)  # t0 + i / fs
     analysis = _power_analysis()
     frame = analysis.to_pandas()
     np.testing.assert_array_equal(frame["force amplitude [N]"], np.abs(analysis.force_phasors_n))
@@ -171,7 +183,8 @@ def test_result_plot_draws_into_the_axes_given_and_returns_them(name, monkeypatc
 
     monkeypatch.setattr(plt, "show", lambda *a, **k: pytest.fail(f"{name}.plot() called show"))
     result = _RESULTS[name]()
-    n_axes = 2 if name == "DemResult" else 1  # a DEM run draws dissipation over forces
+    # a DEM run draws dissipation over forces, a measurement each channel apart
+    n_axes = {"DemResult": 2, "Measurement": len(getattr(result, "channels", ()))}.get(name, 1)
     fig = matplotlib.figure.Figure()  # not a pyplot figure: no global state involved
     axes = fig.subplots(n_axes, 1)
     before_figures, before_rc = plt.get_fignums(), dict(matplotlib.rcParams)

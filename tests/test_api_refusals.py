@@ -12,7 +12,7 @@ import pytest
 
 from pidcore.calibrate import load_calibration
 from pidcore.dem import DemConfig, LoadCase, particles_per_cell, simulate_load_case
-from pidcore.errors import ParameterError
+from pidcore.errors import ChannelError, ParameterError
 from pidcore.io import read_measurement, read_measurements
 from pidcore.measure import AnalysisOptions, analyze_file
 from pidcore.model import (
@@ -22,6 +22,7 @@ from pidcore.model import (
     load_paper_table3,
     time_domain_response,
 )
+from pidcore.records import Channel, Measurement
 from pidcore.signal import analyze_power
 from pidcore.specimen import paper_specimen
 
@@ -157,3 +158,14 @@ def test_a_calibration_refuses_what_is_not_a_load_case_or_a_stderr():
         calibration.lookup((50.0, 1.0, 50.0))  # was AttributeError: no attribute 'material'
     with pytest.raises(ParameterError, match=r"^stderr: expected a number, got '0.1'"):
         calibration.predictions[0].band("0.1")
+
+
+def test_a_measurement_without_a_common_time_axis_is_not_tabulated():
+    force = Channel("F", "force", np.zeros(100), 1000.0, "N")
+    velocity = Channel("V", "velocity", np.zeros(50), 500.0, "m/s")
+    with pytest.raises(ChannelError, match=r"^m.csv: channel 'V' \(500 Hz from 0 s\) and 'F' "
+                                           r"\(1000 Hz from 0 s\) share no time axis"):
+        Measurement("m.csv", (force, velocity)).to_pandas()
+    shorter = Channel("V", "velocity", np.ones(60), 1000.0, "m/s")
+    frame = Measurement("m.csv", (force, shorter)).to_pandas()
+    assert len(frame) == 100 and frame["V [m/s]"].isna().sum() == 40  # padded, not cut

@@ -1,5 +1,7 @@
 """Matplotlib figures of single results; drawing only, the data come from the results.
 
+* :func:`plot_measurement` - the channels of a measurement against time
+  (:meth:`pidcore.records.Measurement.to_pandas`).
 * :func:`plot_spectrum` - harmonic amplitudes of a measurement
   (:meth:`pidcore.signal.PowerAnalysis.to_pandas`).
 * :func:`plot_loop` - a force-displacement loop (:class:`pidcore.loop.ForceDisplacementLoop`).
@@ -10,8 +12,8 @@
 * :func:`plot_calibration` - a calibration's predictions with their 95 % bands beside the
   SDCs it was fitted to (:meth:`pidcore.calibrate.Calibration.to_pandas`).
 
-``PowerAnalysis.plot``, ``DemResult.plot``, ``HarmonicResponse.plot`` and
-``Calibration.plot`` forward here (python-control style), so the physics modules import no
+``Measurement.plot``, ``PowerAnalysis.plot``, ``DemResult.plot``, ``HarmonicResponse.plot``
+and ``Calibration.plot`` forward here (python-control style), so the physics modules import no
 matplotlib. With ``ax=None`` a new pyplot figure is made, as an interactive ``.plot()`` is
 expected to do.
 """
@@ -24,6 +26,7 @@ import numpy as np
 import pandas as pd
 
 from .. import defaults
+from ..errors import ParameterError
 
 if TYPE_CHECKING:  # pragma: no cover
     from ..dem.result import DemResult
@@ -150,4 +153,31 @@ def plot_harmonic_response(frame: pd.DataFrame, *, ax: Any = None) -> Any:
     ax.set_xlabel("frequency [Hz]")
     ax.set_ylabel("displacement amplitude [m]")
     ax.legend()
+    return ax
+
+
+def plot_measurement(frame: pd.DataFrame, *, ax: Any = None) -> Any:
+    """Each channel of a measurement against time, one axes per channel, stacked with a shared
+    time axis. Returns the axes (one, or an array of them).
+
+    ``frame`` is :meth:`pidcore.records.Measurement.to_pandas`; ``ax``: as many axes as it has
+    channels, or None for a new figure.
+    """
+    import matplotlib.pyplot as plt
+
+    names = [c for c in frame.columns if c != "time [s]"]
+    if ax is None:
+        _, ax = plt.subplots(len(names), 1, sharex=True, squeeze=False,
+                             figsize=(7.0, 1.8 + 1.6 * len(names)), constrained_layout=True)
+        ax = ax[:, 0] if len(names) > 1 else ax[0, 0]
+    axes = np.atleast_1d(ax)
+    if len(axes) != len(names):
+        raise ParameterError(f"ax: {len(names)} channels need as many axes, got {len(axes)}")
+    t = frame["time [s]"].to_numpy(float)
+    for a, name in zip(axes, names, strict=True):
+        a.plot(t, frame[name].to_numpy(float), lw=0.8)
+        a.set_ylabel(name)
+    axes[-1].set_xlabel("time [s]")
+    if "source" in frame.attrs:
+        axes[0].set_title(str(frame.attrs["source"]))
     return ax
