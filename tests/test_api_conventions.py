@@ -287,3 +287,23 @@ def test_public_callables_are_typed_and_documented(qualname):
     assert not untyped, f"{qualname}: parameters without a type hint: {untyped}"
     assert signature.return_annotation is not inspect.Signature.empty, \
         f"{qualname}: no return type hint"
+
+
+def test_closed_vocabularies_live_in_constants():
+    # one place for every closed vocabulary (scikit-rf style): a Literal alias defined in
+    # another module is a second place a word list can drift (AlignmentStatus, ImpactPair were)
+    import pkgutil
+    import typing
+
+    import pidcore
+    import pidcore.constants as constants
+
+    known = {id(v) for v in vars(constants).values()}
+    elsewhere = []
+    for info in pkgutil.walk_packages(pidcore.__path__, "pidcore."):
+        if info.name.startswith(("pidcore.app", "pidcore.__main__")):
+            continue  # the Streamlit app imports streamlit; its words are its pages'
+        module = importlib.import_module(info.name)
+        elsewhere += [f"{info.name}.{name}" for name, value in vars(module).items()
+                      if typing.get_origin(value) is typing.Literal and id(value) not in known]
+    assert not elsewhere, f"Literal vocabularies outside pidcore.constants: {elsewhere}"

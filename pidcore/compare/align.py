@@ -28,18 +28,14 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable
 from dataclasses import dataclass, field, replace
-from typing import Literal, get_args
 
 import numpy as np
 import pandas as pd
 
 from .. import defaults
+from ..constants import ALIGNMENT_STATUSES, AlignmentStatus  # noqa: F401 (kept: defined here before)
 from ..errors import ParameterError
 from .loadcase import LoadCase
-
-#: How a measured case was matched with our DEM.
-AlignmentStatus = Literal["grid", "interpolated", "out_of_range", "no_dem_runs"]
-ALIGNMENT_STATUSES: tuple[str, ...] = get_args(AlignmentStatus)
 
 #: Columns a table of measured cases must have (one row per analysed measurement).
 MEASURED_COLUMNS: tuple[str, ...] = ("frequency_hz", "acceleration_g", "fill_percent", "material",
