@@ -62,7 +62,7 @@ MAX_IGNORED_OFFSET_SAMPLES = 0.02
 UNIT_SLIP_FACTOR = 5.0
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class AnalysisOptions:
     """User choices for one analysis run (channel mapping and corrections)."""
 

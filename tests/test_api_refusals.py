@@ -138,7 +138,9 @@ def test_a_file_descriptor_is_not_a_path():
 
 def test_response_functions_refuse_what_is_not_their_record():
     table = load_paper_table3()
-    mode = TreatedMode(300.0, 2.0, 0.01, 0.2, 50.0, 0.1)
+    mode = TreatedMode(natural_frequency_hz=300.0, modal_mass_kg=2.0,
+                       structural_damping_ratio=0.01, treated_area_m2=0.2, fill_percent=50.0,
+                       coupon_vibrated_mass_kg=0.1)
     with pytest.raises(ParameterError, match=r"^model: expected an? SdcModel, got DataFrame") \
             as refused:  # was AttributeError: 'DataFrame' object has no attribute 'bounds'
         harmonic_response(table, mode, frequencies_hz=[300.0], force_amplitude_n=10.0)
@@ -149,7 +151,9 @@ def test_response_functions_refuse_what_is_not_their_record():
                              measure_cycles=2.5)  # was a TypeError of numpy
     with pytest.raises(ParameterError, match=r"^TreatedMode: natural_frequency_hz: expected a "
                                              r"number, got '300'"):
-        TreatedMode("300", 2.0, 0.01, 0.2, 50.0, 0.1)  # was a TypeError of np.isfinite
+        TreatedMode(natural_frequency_hz="300", modal_mass_kg=2.0,  # was a TypeError of numpy
+                    structural_damping_ratio=0.01, treated_area_m2=0.2, fill_percent=50.0,
+                    coupon_vibrated_mass_kg=0.1)
 
 
 def test_a_calibration_refuses_what_is_not_a_load_case_or_a_stderr():
@@ -169,3 +173,13 @@ def test_a_measurement_without_a_common_time_axis_is_not_tabulated():
     shorter = Channel("V", "velocity", np.ones(60), 1000.0, "m/s")
     frame = Measurement("m.csv", (force, shorter)).to_pandas()
     assert len(frame) == 100 and frame["V [m/s]"].isna().sum() == 40  # padded, not cut
+
+
+@pytest.mark.parametrize("make", [lambda: DemConfig(4), lambda: AnalysisOptions("Force"),
+                                  lambda: TreatedMode(300.0, 2.0, 0.01, 0.2, 50.0, 0.1)],
+                         ids=["DemConfig", "AnalysisOptions", "TreatedMode"])
+def test_settings_records_take_keywords_only(make):
+    # 15-20 fields of one type each: DemConfig(4) was cells=4, TreatedMode(...) took six
+    # numbers in an order nothing at the call showed (mass and frequency swap silently)
+    with pytest.raises(TypeError, match="positional argument"):
+        make()

@@ -96,7 +96,7 @@ from .state import (
 )
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class DemConfig:
     """Numerical settings of a DEM run (defaults in :mod:`pidcore.defaults`).
 

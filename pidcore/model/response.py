@@ -50,7 +50,7 @@ _ZERO_RESIDUAL = 1e-12
 _RANGE_RTOL = 1e-9
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class TreatedMode:
     """One mode of a structure treated with particle dampers (SI units).
 
