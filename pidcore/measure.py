@@ -29,7 +29,7 @@ import math
 import os
 from collections.abc import Mapping, Sequence
 from contextlib import suppress
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import asdict, dataclass, field, fields, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -124,6 +124,8 @@ class AnalyzedRecord:
     notes: tuple[str, ...] = field(default_factory=tuple)
     channels: tuple[dict, ...] = field(default_factory=tuple)
     corrections: dict = field(default_factory=dict)
+    #: The options it was analysed with (what :func:`save_analyses` saves as its parameters).
+    options: AnalysisOptions | None = None
 
     def to_dict(self) -> dict:
         """JSON-safe record: the analysis, the channels used (role, name, SI unit, unit in the
@@ -347,7 +349,7 @@ def analyze_measurement(measurement: Measurement, options: AnalysisOptions | Non
     detail = tuple({"role": role, "name": ch.name, "unit": ch.unit,
                     "source_unit": ch.source_unit} for role, ch in chosen.items())
     return AnalyzedRecord(as_read, analysis, used, tuple(notes) + analysis.notes,
-                          detail, corrections)
+                          detail, corrections, options)
 
 
 def analyze_file(path: str | os.PathLike, options: AnalysisOptions | None = None, *,
@@ -393,17 +395,22 @@ class SavedAnalyses:
 
 
 def save_analyses(store: Store | str | os.PathLike, results: Sequence[AnalyzedRecord],
-                  options: AnalysisOptions | Sequence[AnalysisOptions],
-                  stated: Sequence[tuple[str, object, str]], *,
+                  options: AnalysisOptions | Sequence[AnalysisOptions] | None = None,
+                  stated: Sequence[tuple[str, object, str]] | None = None, *,
                   fields: Sequence[Mapping | None] | None = None) -> SavedAnalyses:
     """Save measurements and their analyses in one transaction of ``store`` (a
     :class:`~pidcore.store.Store` or its path).
 
     ``options``: per result, the options it was analysed with (their parameters are its
     record's, so that each record says how it was made: files of one call may have different
-    settings, :mod:`pidcore.file_settings`); one :class:`AnalysisOptions` stands for all.
+    settings, :mod:`pidcore.file_settings`); one :class:`AnalysisOptions` stands for all;
+    None (default): each result's own (:attr:`AnalyzedRecord.options`). Options whose
+    analysis settings differ from those a result was analysed with are refused: the record
+    would say it was made otherwise than it was (the channel names may differ: the record
+    keeps the channels used).
     ``stated``: per result, (file name, its :class:`~pidcore.loadcase.LoadCase` or None, who
-    stated it); the load case goes into the record (:meth:`~pidcore.loadcase.LoadCase.as_record`).
+    stated it); the load case goes into the record (:meth:`~pidcore.loadcase.LoadCase.as_record`);
+    default: each file's name and no load case.
     ``fields``: per result, further record fields or None (the ``specimen`` a sidecar names).
     A saved record of the same bytes under another name or load case is replaced, and the
     notes say so (:func:`replacement_notes`).
@@ -411,13 +418,24 @@ def save_analyses(store: Store | str | os.PathLike, results: Sequence[AnalyzedRe
     from .records import measurement_key
     from .store import Store
 
-    per_result = ([options] * len(results) if isinstance(options, AnalysisOptions)
-                  else list(options))
+    if options is None:
+        missing = [r.measurement.source for r in results if r.options is None]
+        if missing:
+            raise ParameterError(f"options: {', '.join(missing)} carry no analysis options; "
+                                 "give the options they were analysed with")
+        per_result = [r.options for r in results]
+    else:
+        per_result = ([options] * len(results) if isinstance(options, AnalysisOptions)
+                      else list(options))
+    if stated is None:
+        stated = [(Path(r.measurement.source).name, None, "") for r in results]
     extra = list(fields) if fields is not None else [None] * len(results)
     for name, given in (("options", per_result), ("stated", stated), ("fields", extra)):
         if len(given) != len(results):
             raise ParameterError(f"{name}: expected one per result ({len(results)}), got "
                                  f"{len(given)}")
+    for r, given in zip(results, per_result, strict=True):
+        _refuse_other_settings(r, given)
     store = store if isinstance(store, Store) else Store(store)
     _refuse_the_store_itself(store, results)
     with store.transaction():
@@ -430,6 +448,28 @@ def save_analyses(store: Store | str | os.PathLike, results: Sequence[AnalyzedRe
                 for r, o, (_, case, origin), more in zip(results, per_result, stated, extra,
                                                          strict=True)]
     return SavedAnalyses(keys, notes)
+
+
+#: Fields of :class:`AnalysisOptions` that name channels: a record keeps the channels it used
+#: (the app saves its options without them), so these may differ from the analysis's.
+_CHANNEL_FIELDS = ("force", "velocity", "acceleration")
+
+
+def _refuse_other_settings(result: AnalyzedRecord, given: AnalysisOptions) -> None:
+    """Refuse to save ``result`` with options whose analysis settings differ from those it
+    was analysed with: its record would say a delay, mass or baseline it was not made with
+    (a script passing ``AnalysisOptions()`` for files analysed with a 50 µs delay)."""
+    instance_of("options", given, AnalysisOptions)
+    used = result.options
+    if used is None:
+        return  # a record made by hand: its options are the caller's word
+    differ = [f"{name} {getattr(given, name)!r} (analysed with {getattr(used, name)!r})"
+              for name in (f.name for f in fields(AnalysisOptions))
+              if name not in _CHANNEL_FIELDS and getattr(given, name) != getattr(used, name)]
+    if differ:
+        raise ParameterError(f"options: {result.measurement.source} would be saved with "
+                             f"{'; '.join(differ)}; give the options it was analysed with, or "
+                             "none (its own)")
 
 
 def refuse_store_among_inputs(store, paths: Sequence[str | os.PathLike]) -> None:

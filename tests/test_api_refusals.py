@@ -5,6 +5,7 @@ else (``cells=2.5`` ran; a fill of 150 % gave one and a half cells of particles)
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import numpy as np
@@ -183,3 +184,23 @@ def test_settings_records_take_keywords_only(make):
     # numbers in an order nothing at the call showed (mass and frequency swap silently)
     with pytest.raises(TypeError, match="positional argument"):
         make()
+
+
+def test_saved_analyses_carry_the_options_they_were_analysed_with(tmp_path):
+    from pidcore.measure import save_analyses
+    from pidcore.store import Store
+
+    options = AnalysisOptions(velocity_delay_s=5e-5)
+    record = analyze_file(_SAMPLE, options)
+    assert record.options == options
+    store = Store(tmp_path / "s.h5")
+    # AnalysisOptions() given for a record analysed with a 50 µs delay: the store said delay 0
+    with pytest.raises(ParameterError, match=r"^options: .*synthetic_f500Hz_a1g_fill50_acrylic"
+                                             r"\.csv would be saved with velocity_delay_s 0\.0 "
+                                             r"\(analysed with 5e-05\)"):
+        save_analyses(store, [record], AnalysisOptions(), [(_SAMPLE.name, None, "")])
+    assert not store.path.exists()  # nothing half-written
+    saved = save_analyses(store, [record])  # options and names: the record's own
+    stored = json.loads(store.list_analyses().set_index("key").loc[saved.keys[0],
+                                                                   "parameters_json"])
+    assert stored["velocity_delay_s"] == 5e-5
