@@ -130,7 +130,12 @@ def _report_result():
     return ReportResult(paths={}, table=build_report_table(runs, None, load_paper_table3()))
 
 
-_RESULTS = {"Measurement": _measurement, "PowerAnalysis": _power_analysis, "DemResult": _dem_result,
+def _loop():
+    return _power_analysis().loop()
+
+
+_RESULTS = {"Measurement": _measurement, "PowerAnalysis": _power_analysis,
+            "ForceDisplacementLoop": _loop, "DemResult": _dem_result,
             "HarmonicResponse": _harmonic_response, "Calibration": _calibration,
             "ReportResult": _report_result}
 

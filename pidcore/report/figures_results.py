@@ -12,10 +12,10 @@
 * :func:`plot_calibration` - a calibration's predictions with their 95 % bands beside the
   SDCs it was fitted to (:meth:`pidcore.calibrate.Calibration.to_pandas`).
 
-``Measurement.plot``, ``PowerAnalysis.plot``, ``DemResult.plot``, ``HarmonicResponse.plot``
-and ``Calibration.plot`` forward here (python-control style), so the physics modules import no
-matplotlib. With ``ax=None`` a new pyplot figure is made, as an interactive ``.plot()`` is
-expected to do.
+``Measurement.plot``, ``PowerAnalysis.plot``, ``ForceDisplacementLoop.plot``,
+``DemResult.plot``, ``HarmonicResponse.plot`` and ``Calibration.plot`` forward here
+(python-control style), so the physics modules import no matplotlib. With ``ax=None`` a new
+pyplot figure is made, as an interactive ``.plot()`` is expected to do.
 """
 
 from __future__ import annotations
