@@ -312,3 +312,18 @@ def test_closed_vocabularies_live_in_constants():
         elsewhere += [f"{info.name}.{name}" for name, value in vars(module).items()
                       if typing.get_origin(value) is typing.Literal and id(value) not in known]
     assert not elsewhere, f"Literal vocabularies outside pidcore.constants: {elsewhere}"
+
+
+def test_results_with_a_table_have_a_plot_and_the_other_way_round():
+    # python-control style: data and picture come together; every such class is in _RESULTS
+    one_sided, classes = [], set()
+    for name in PUBLIC_MODULES:
+        module = importlib.import_module(name)
+        for attr in getattr(module, "__all__", ()):
+            obj = getattr(module, attr)
+            if inspect.isclass(obj) and (hasattr(obj, "to_pandas") or hasattr(obj, "plot")):
+                classes.add(obj.__name__)
+                if hasattr(obj, "to_pandas") != hasattr(obj, "plot"):
+                    one_sided.append(f"{name}.{attr}")
+    assert not one_sided, f"to_pandas() without plot() or the other way round: {one_sided}"
+    assert classes <= set(_RESULTS), classes - set(_RESULTS)
