@@ -204,3 +204,20 @@ def test_saved_analyses_carry_the_options_they_were_analysed_with(tmp_path):
     stored = json.loads(store.list_analyses().set_index("key").loc[saved.keys[0],
                                                                    "parameters_json"])
     assert stored["velocity_delay_s"] == 5e-5
+
+
+def test_calibrate_reads_fit_as_the_cli_does_before_any_run(tmp_path):
+    from pidcore.calibrate import calibrate, read_measured_table
+
+    points = read_measured_table(_SAMPLE.parents[1] / "paper_measured_sdc.csv")
+    # a string was taken letter by letter: "unknown parameter 'r'"
+    with pytest.raises(ParameterError, match=r"unknown parameter 'foo'"):
+        calibrate(points, fit="rolling_friction,foo", store_path=tmp_path / "c.h5")
+    assert not (tmp_path / "c.h5").exists()  # refused before any DEM run
+
+
+def test_tolerances_name_a_value_that_is_not_a_number():
+    from pidcore.compare import Tolerances
+
+    with pytest.raises(ParameterError, match=r"^Tolerances: frequency_rtol: expected a number"):
+        Tolerances(frequency_rtol="0.1")  # was TypeError: must be real number, not str

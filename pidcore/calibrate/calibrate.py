@@ -24,7 +24,14 @@ from ..errors import ParameterError
 from ..specimen import CALIBRATED_SUFFIX, Specimen, paper_specimen, uncalibrated_name
 from .data import MeasuredPoint, check_enough_points
 from .observation import Observation, observation_from_run
-from .parameters import CATALOGUE, DISCREPANCY, ParameterSpec, build_specs, parameter_spec
+from .parameters import (
+    CATALOGUE,
+    DISCREPANCY,
+    ParameterSpec,
+    build_specs,
+    parameter_spec,
+    parse_fit,
+)
 from .posterior import (
     DISCREPANCY_FLOOR,
     Model,
@@ -264,8 +271,8 @@ def check_point_specimens(points: Sequence[MeasuredPoint], specimen: Specimen) -
                          "leave those rows out")
 
 
-def calibrate(points: Sequence[MeasuredPoint], *, fit: Sequence[str],
-              store_path: str | os.PathLike, priors: Sequence[str] = (),
+def calibrate(points: Sequence[MeasuredPoint], *, fit: str | Sequence[str],
+              store_path: str | os.PathLike, priors: str | Sequence[str] = (),
               discrepancy: float | None = None,
               discrepancy_floor: float = DISCREPANCY_FLOOR,
               cells: int = CALIBRATION_CELLS, seed: int = defaults.DEM_SEED,
@@ -276,6 +283,9 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: Sequence[str],
               specimen: Specimen | None = None,
               on_design: Callable[[list[str]], None] | None = None) -> CalibrationResult:
     """Fit ``fit`` parameters to measured SDCs (see the package docstring for the model).
+
+    ``fit``: parameter names, a sequence or ``"a,b"`` as ``--fit`` takes them; ``priors``:
+    ``--prior`` texts (``"NAME=LOW:HIGH"``), one string or a sequence.
 
     DEM runs go to (and are reused from) the store at ``store_path``. ``discrepancy``: fix the
     relative model discrepancy instead of fitting it. ``cross_validate="loo"``: also predict
@@ -288,6 +298,10 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: Sequence[str],
     start = time.perf_counter()
     points = list(points)
     specimen = base_specimen(points, specimen)
+    # as the CLI reads them: "a,b" is two names (a string was taken letter by letter:
+    # "unknown parameter 'r'"), one prior string is one prior
+    fit = parse_fit(fit, specimen)
+    priors = [priors] if isinstance(priors, str) else list(priors)
     specs = build_specs(fit, priors, discrepancy=discrepancy, specimen=specimen)
     check_enough_points(points, [spec.name for spec in specs])
     if cross_validate is not None and cross_validate not in CROSS_VALIDATIONS:

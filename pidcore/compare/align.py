@@ -34,7 +34,7 @@ import pandas as pd
 
 from .. import defaults
 from ..constants import ALIGNMENT_STATUSES, AlignmentStatus  # noqa: F401 (kept: defined here before)
-from ..errors import ParameterError
+from ..errors import ParameterError, real_number
 from .loadcase import LoadCase
 
 #: Columns a table of measured cases must have (one row per analysed measurement).
@@ -69,6 +69,7 @@ class Tolerances:
     def __post_init__(self) -> None:
         for name in ("frequency_rtol", "acceleration_rtol", "fill_atol_percent"):
             value = getattr(self, name)
+            real_number(f"Tolerances: {name}", value)  # "0.1" was a TypeError of math
             if not (math.isfinite(value) and value >= 0):
                 raise ParameterError(f"Tolerances: {name} must be a finite number >= 0, "
                                      f"got {value!r}")
