@@ -4,6 +4,17 @@ Every error a user can cause derives from :class:`PidcoreError`; the CLI prints 
 one line and exits non-zero. Messages name the file, channel or parameter and what was expected.
 :func:`whole_number`, :func:`real_number` and :func:`instance_of` refuse a value of the wrong
 type (a string, a bool, a fraction where a count is meant) in those words, before any use of it.
+
+Public API
+----------
+PidcoreError
+    Base of every error a user can cause (catch it to catch them all).
+InputFileError, ChannelError, SignalError, ParameterError
+    What was wrong: the file, a channel, the record, a parameter.
+SettingsTableError, StoreError, SimulationError
+    A settings table (sidecar), the store, a DEM run.
+whole_number, real_number, instance_of, as_given
+    The checks of a value's type, and a number shown as the user gave it.
 """
 
 import math
@@ -97,3 +108,8 @@ def instance_of(name: str, value: object, kind: type | tuple[type, ...], *,
     shown = shown if len(shown) <= 60 else shown[:57] + "..."
     raise ParameterError(f"{name}: expected {article} {expected}, got {type(value).__name__} "
                          f"{shown}" + (f" ({hint})" if hint else ""))
+
+
+__all__ = ["ChannelError", "InputFileError", "ParameterError", "PidcoreError",
+           "SettingsTableError", "SignalError", "SimulationError", "StoreError", "as_given",
+           "instance_of", "real_number", "whole_number"]

@@ -2,6 +2,16 @@
 
 Readers produce :class:`Measurement` objects whose channels are already in SI units. Nothing
 downstream of a reader knows about file formats.
+
+Public API
+----------
+Measurement, Channel
+    A file's channels (SI samples, rate, start, unit as written); ``Measurement.to_pandas()``
+    and ``plot()``.
+measurement_key, measurement_key_and_basis
+    The key a store keeps a measurement under (its file's bytes, or its contents).
+json_safe
+    A value as JSON takes it (numpy scalars, NaN as null).
 """
 
 from __future__ import annotations
@@ -179,3 +189,6 @@ def measurement_key(measurement: Measurement) -> str:
     byte-identical files (under any name) share it, so it is also what says two records hold
     the same data (here, below the store, so that the comparison layer can ask it too)."""
     return measurement_key_and_basis(measurement)[0]
+
+
+__all__ = ["Channel", "Measurement", "json_safe", "measurement_key", "measurement_key_and_basis"]

@@ -13,7 +13,8 @@ import pytest
 
 PUBLIC_MODULES = ("pidcore.io", "pidcore.signal", "pidcore.store", "pidcore.dem",
                   "pidcore.model", "pidcore.compare", "pidcore.report", "pidcore.loadcase",
-                  "pidcore.loop", "pidcore.calibrate", "pidcore.measure", "pidcore.specimen")
+                  "pidcore.loop", "pidcore.calibrate", "pidcore.measure", "pidcore.specimen",
+                  "pidcore.records", "pidcore.errors")
 
 
 def _public_names() -> list[str]:
