@@ -13,6 +13,7 @@ import os
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -43,6 +44,11 @@ from .posterior import (
 )
 from .runner import RunRequest, run_requests, specimen_with
 from .surrogate import build_surrogate, default_design_size, design_points
+
+if TYPE_CHECKING:  # pragma: no cover
+    import pandas as pd
+
+    from .prediction import Calibration
 
 #: Cells per DEM run of a calibration: the ensemble scatter enters the likelihood, and 4
 #: cells keep a 12-case design within minutes on two cores.
@@ -108,6 +114,26 @@ class CalibrationResult:
             out, name=f"{self.specimen.name}{CALIBRATED_SUFFIX}",
             description=f"{self.specimen.description} -- calibrated by pidcore calibrate: "
                         f"{fitted} (these replace any value stated above)".strip(" -"))
+
+    def calibration(self) -> Calibration:
+        """This result as :func:`~pidcore.calibrate.load_calibration` reads it back from its
+        ``calibration.json``: ``lookup(case).band(stderr)``, ``to_pandas()``, ``plot()``."""
+        from .outputs import document_json
+        from .prediction import calibration_from_json
+
+        return calibration_from_json(document_json(self.document()),
+                                     "<calibration in memory>",
+                                     specimen_name=self.calibrated_specimen().name)
+
+    def to_pandas(self) -> pd.DataFrame:
+        """The in-sample predictions with their 95 % bands, one row per measured load case,
+        columns naming their units (:meth:`Calibration.to_pandas` of :meth:`calibration`)."""
+        return self.calibration().to_pandas()
+
+    def plot(self, ax: Any = None) -> Any:
+        """Predictions and bands beside the measured SDCs (:meth:`Calibration.plot` of
+        :meth:`calibration`); returns ``ax``."""
+        return self.calibration().plot(ax=ax)
 
     def document(self) -> dict:
         """The ``--json`` document: parameters, predictions, loo, loo_rms, and the units of
