@@ -205,6 +205,15 @@ def test_result_plot_draws_into_the_axes_given_and_returns_them(name, monkeypatc
     assert all(a.has_data() for a in np.atleast_1d(axes))
 
 
+def test_a_dem_run_plot_given_one_axes_says_it_draws_two():
+    import matplotlib
+
+    from pidcore.errors import ParameterError
+
+    with pytest.raises(ParameterError, match=r"^ax: a DEM run draws two panels"):
+        _dem_result().plot(ax=matplotlib.figure.Figure().subplots())
+
+
 # ---------------------------------------------------------------- discoverability
 def _api_section(doc: str) -> list[str]:
     """Names the numpydoc ``Public API`` section of a module docstring lists: its unindented

@@ -18,7 +18,8 @@ Modules, one concern each:
 Public API
 ----------
 calibrate, CalibrationResult, base_specimen
-    Fit specimen parameters to measured SDCs (posterior, 95 % bands, leave-one-out).
+    Fit specimen parameters to measured SDCs (posterior, 95 % bands, leave-one-out);
+    the result's ``calibration()``, ``to_pandas()`` and ``plot()``.
 read_measured_table, measured_from_store, MeasuredPoint
     The measured SDCs to fit: a table, or the analyses of a store.
 CATALOGUE, ParameterSpec, build_specs, parse_fit, dem_parameter_names

@@ -88,6 +88,9 @@ def plot_dem_run(result: DemResult, *, ax: Any = None) -> Any:
 
     if ax is None:
         _, ax = plt.subplots(2, 1, figsize=(7, 6), constrained_layout=True)
+    if len(np.atleast_1d(ax)) != 2:  # one axes was "cannot unpack non-iterable Axes"
+        raise ParameterError("ax: a DEM run draws two panels (dissipation per cycle, forces); "
+                             "expected a pair of axes, e.g. fig.subplots(2, 1)")
     a0, a1 = ax
     cycles = np.arange(len(result.dissipation_per_cycle_j))
     a0.plot(cycles, result.dissipation_per_cycle_j, ".-", label="coupon")
