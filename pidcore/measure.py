@@ -72,6 +72,7 @@ class AnalysisOptions:
     velocity_delay_s: float = 0.0
     mass_below_gauge_kg: float = 0.0
     baseline_loss_factor: float = 0.0
+    structure_mass_kg: float | None = None
     frequency_hz: float | None = None
     n_harmonics: int = defaults.N_HARMONICS
     sample_rate_hz: float | None = None
@@ -94,10 +95,6 @@ class AnalysisOptions:
         for name in self.invert:
             instance_of("invert", name, str)
         instance_of("allow_clipped", self.allow_clipped, (bool, np.bool_))
-        check_analysis_settings(
-            n_harmonics=self.n_harmonics, mass_below_gauge_kg=self.mass_below_gauge_kg,
-            frequency_hz=self.frequency_hz, velocity_delay_s=self.velocity_delay_s,
-            baseline_loss_factor=self.baseline_loss_factor, sample_rate_hz=self.sample_rate_hz)
         for name in ("velocity_delay_s", "mass_below_gauge_kg", "baseline_loss_factor"):
             # -0 (a sidecar's '-0', --velocity-delay -0) is no correction: saved as -0.0 it
             # made a second record of the same analysis (parameters_json differed) and was
@@ -105,6 +102,16 @@ class AnalysisOptions:
             value = getattr(self, name)
             if isinstance(value, float) and value == 0.0:
                 object.__setattr__(self, name, 0.0)
+        if isinstance(self.structure_mass_kg, (int, float)) and self.structure_mass_kg == 0:
+            # 0 states no mass, as 0 states no correction in the other columns (the app's
+            # settings grid starts every row at 0): the baseline then goes off the whole
+            # vibrated mass, noted by the analysis
+            object.__setattr__(self, "structure_mass_kg", None)
+        check_analysis_settings(
+            n_harmonics=self.n_harmonics, mass_below_gauge_kg=self.mass_below_gauge_kg,
+            frequency_hz=self.frequency_hz, velocity_delay_s=self.velocity_delay_s,
+            baseline_loss_factor=self.baseline_loss_factor, sample_rate_hz=self.sample_rate_hz,
+            structure_mass_kg=self.structure_mass_kg)
 
     def parameters(self) -> dict:
         """JSON-safe parameters stored as provenance."""
@@ -340,6 +347,7 @@ def analyze_measurement(measurement: Measurement, options: AnalysisOptions | Non
         velocity_delay_s=options.velocity_delay_s + start_delay,
         mass_below_gauge_kg=options.mass_below_gauge_kg,
         baseline_loss_factor=options.baseline_loss_factor,
+        structure_mass_kg=options.structure_mass_kg,
         frequency_hz=options.frequency_hz,
         n_harmonics=options.n_harmonics,
         allow_clipped=options.allow_clipped,

@@ -178,6 +178,12 @@ PLAUSIBLE_RANGES: dict[str, PlausibleRange] = {
     "rolling_friction": PlausibleRange(0.0, 1.0, "", "a rolling friction coefficient is 0-1, "
                                        "real spheres ~0.001-0.3", above="was it %?",
                                        kind="a coefficient"),
+    # the rolling dashpot as a fraction of its critical value: 0-1 (LIGGGHTS epsd2 ~0.3). An
+    # overdamped one is also beyond the explicit integration: 30 (a percentage) left a 23-particle
+    # bed of 2 mm spheres still moving after 1 s of settling, and the run failed
+    "rolling_damping_ratio": PlausibleRange(0.0, 1.0, "", "a rolling damping ratio is 0-1, "
+                                            "typically ~0.3", above="was it %?",
+                                            kind="a fraction of critical"),
 }
 #: Most coupon mass per coupon area (``[cell] count`` cells' cross-section), kg/m^2: a 127 mm
 #: steel plate. Sandwich panels weigh 1-20 kg/m^2 (the paper's 2.6); more is a mass in grams
@@ -197,6 +203,30 @@ def _plausible(where: str, key: str, value: float) -> None:
                       "": "a fraction"}.get(r.unit, r.unit)
     shown = f"{as_given(value)} {r.unit}".rstrip()  # a ratio has no unit to show
     raise _fail(where, f"{shown}: expected {unit} ({r.what})" + (f"; {hint}" if hint else ""))
+
+
+#: Fastest bar wave speed sqrt(E / rho) of any solid, m/s: diamond's is 18.5 km/s (E 1.2e12 Pa,
+#: 3515 kg/m^3), beryllium's 12.5 km/s, steel's 5 km/s. Each of E and rho alone may lie within
+#: its range with the other in the wrong unit: tungsten carbide's 15.6 g/cm^3 typed as 15.6
+#: kg/m^3 beside its 600 GPa is 196 km/s (a 1000 x lighter particle, silently simulated).
+#: Checked for the particles only: the walls are rigid and their density is unused, and a
+#: honeycomb's bulk core density (32.1 kg/m^3 in the paper's Table 2) beside its foil's
+#: modulus is a reasonable thing to write there.
+MAX_BAR_WAVE_SPEED_M_S = 2.0e4
+
+
+def _wave_speed(where: str, *, density_key: str, density_kg_m3: float,
+                modulus_key: str, youngs_modulus_pa: float) -> None:
+    """Refuse a density and Young's modulus no solid combines (one is in the wrong unit)."""
+    speed = math.sqrt(youngs_modulus_pa / density_kg_m3)
+    if speed <= MAX_BAR_WAVE_SPEED_M_S:
+        return
+    raise _fail(f"{where} {density_key}",
+                f"{as_given(density_kg_m3)} kg/m^3 with {modulus_key} "
+                f"{as_given(youngs_modulus_pa)} Pa gives a bar wave speed sqrt(E/rho) of "
+                f"{speed / 1e3:.3g} km/s; expected a solid's, at most "
+                f"{MAX_BAR_WAVE_SPEED_M_S / 1e3:g} km/s (diamond 18.5 km/s); was the density "
+                "in g/cm^3, or the modulus in the wrong unit?")
 
 
 def _poisson(where: str, value: float) -> None:
@@ -304,6 +334,8 @@ class ParticleSpec:
         _plausible("[particles] density_kg_m3", "density_kg_m3", self.density_kg_m3)
         _positive("[particles] youngs_modulus_pa", self.youngs_modulus_pa, "Pa")
         _plausible("[particles] youngs_modulus_pa", "youngs_modulus_pa", self.youngs_modulus_pa)
+        _wave_speed("[particles]", density_key="density_kg_m3", density_kg_m3=self.density_kg_m3,
+                    modulus_key="youngs_modulus_pa", youngs_modulus_pa=self.youngs_modulus_pa)
         _poisson("[particles] poisson_ratio", self.poisson_ratio)
         if self.count_per_cell is not None and self.fill_percent is not None:
             raise _fail("[particles]", "give count_per_cell or fill_percent, not both")
@@ -344,6 +376,8 @@ class PairSpec:
         _non_negative(f"{where} rolling_friction", self.rolling_friction, "[-]")
         _plausible(f"{where} rolling_friction", "rolling_friction", self.rolling_friction)
         _non_negative(f"{where} rolling_damping_ratio", self.rolling_damping_ratio, "[-]")
+        _plausible(f"{where} rolling_damping_ratio", "rolling_damping_ratio",
+                   self.rolling_damping_ratio)
         if self.static_friction < self.sliding_friction:
             raise _fail(f"{where} static_friction",
                         f"{self.static_friction!r} is below sliding_friction "

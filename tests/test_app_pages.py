@@ -805,6 +805,57 @@ def test_compare_shows_the_calibrated_band_beside_raw_dem_and_measurement(
     assert row[CALIBRATED_INSIDE_COLUMN].tolist() == [{"inside": "yes", "outside": "no"}[verdict]]
 
 
+def test_a_calibration_saved_in_the_store_is_listed_and_used_after_a_restart(store_file,
+                                                                            tmp_path):
+    # the app kept its calibrations in memory: a restart lost them. One saved in the store
+    # (as the Calibrate page and `pidcore calibrate` save them) is listed on the Calibrate tab
+    # and gives Compare its band, with no calibration file anywhere
+    from pidcore.calibrate.persist import calibration_key
+    from pidcore.specimen import paper_specimen
+    from pidcore.store import Store
+
+    doc = json.loads(_calibration_json(tmp_path / "c.json", 100, 5, 50, 0.3456, 0.1, 0.6)
+                     .read_text())
+    key = calibration_key(doc)
+    Store(store_file).add_calibration(key, {"specimen": "paper_coupon",
+                                            "fit": "fixture_mass_kg"},
+                                      document=json.dumps(doc),
+                                      specimen_toml=paper_specimen().text)
+    (tmp_path / "c.json").unlink()
+    at = _upload(_app(), [("c_fill50.csv", mass_damper_csv())])
+    metrics = {m.label: m.value for m in at.metric}
+    assert metrics["SDC calibrated DEM, Eq. 11 [-]"] == "0.3456"
+    # Compare names where the band comes from
+    assert any(f"this store's calibration {key}" in m.value for m in at.markdown), \
+        [m.value for m in at.markdown]
+    assert list(_table(at, "fitted")["calibration"]) == [key]
+    downloads = [b for b in at.get("download_button")
+                 if b.proto.id and "calibration_saved_json" in b.proto.id]
+    assert downloads, "the stored calibration.json is offered for download"
+
+
+def test_dem_jobs_interrupted_by_a_stop_are_shown_and_resubmitted(store_file):
+    from pidcore.dem import DemConfig
+
+    (case,) = jobs.plan_dem_cases([50.0], [5.0], [50.0], material="acrylic", direction="z")
+    queued = jobs.DemJob("job0003", case, DemConfig(cells=1, steady_cycles=5000), "k")
+    jobs.write_journal(jobs.journal_path(store_file), [queued])
+    at = _app()
+    assert any("1 job(s) were queued or running when the app stopped" in w.value
+               for w in at.warning), [w.value for w in at.warning]
+    at.button(key="dem_resubmit").click()
+    at.run()
+    runner = jobs.runner_for(store_file)
+    try:
+        assert not at.exception, at.exception
+        states = {j.job_id: j.state for j in runner.jobs()}
+        assert states["job0003"] == "cancelled" and states["job0004"] in ("queued", "running")
+        assert not any("when the app stopped" in w.value for w in at.warning)
+    finally:
+        runner.cancel()
+        runner.wait_cancelled(5.0)
+
+
 def test_compare_says_when_the_calibration_does_not_predict_the_case(store_file, tmp_path,
                                                                       monkeypatch):
     from pidcore.app.calibration import CALIBRATION_ENV_VAR

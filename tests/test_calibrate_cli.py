@@ -646,8 +646,13 @@ def test_a_record_left_out_of_a_store_calibration_is_named_in_its_outputs(tmp_pa
     monkeypatch.setattr(outputs, "write_outputs",
                         lambda result, out: written.setdefault("notes", list(result.notes)))
     monkeypatch.setattr(outputs, "document_json", lambda document: "{}")
-    fake = SimpleNamespace(notes=["the fit's own note"], document=dict)
+    fake = SimpleNamespace(notes=["the fit's own note"], document=dict,
+                           runs={"computed": 0, "cached": 0})
     monkeypatch.setattr(library, "calibrate", lambda points, **kwargs: fake)
+    # the store keeps what full_document() gives, with the same notes (checked for a real
+    # result in tests/test_calibration_store.py); the fake has no document to keep
+    monkeypatch.setattr(importlib.import_module("pidcore.calibrate.persist"),
+                        "save_calibration", lambda result, store: ("cal_0", True))
     assert main(["calibrate", "--store", str(store), "--dem-store", str(tmp_path / "d.h5"),
                  "--out", str(tmp_path / "cal"), "--json", *TINY]) == 0
     err = capsys.readouterr().err

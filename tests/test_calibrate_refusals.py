@@ -301,9 +301,10 @@ def test_a_ctrl_c_while_the_outputs_are_written_leaves_out_as_it_was_and_says_so
     err = capsys.readouterr().err.strip()
     assert err == (f"pidcore calibrate: interrupted; 3 DEM run(s) finished before the interrupt "
                    f"are saved in {store} (3 of the calibration's 3 stored now); a re-run of "
-                   f"the same command computes no DEM run again; nothing written to {out} "
-                   "(left as it was)"), err
+                   f"the same command computes no DEM run again; the calibration was not saved "
+                   f"in {store}; nothing written to {out} (left as it was)"), err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["dem.h5", "m.csv"]  # no temp folder
+    assert Store(store).list_calibrations().empty  # Ctrl-C commits nothing of the result
     # a folder from an earlier run keeps its files, none of them half-replaced
     monkeypatch.setattr(outputs, "plot_pairs", plot_pairs)
     assert main(argv) == 0

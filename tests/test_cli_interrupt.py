@@ -115,14 +115,14 @@ def test_an_import_broken_by_the_interrupt_still_exits_130(tmp_path, capsys, mon
     # numba._devicearray failed to import" and a traceback with exit 1 (once in ~20 runs of
     # the test above). After the handler has seen SIGINT, any error is the interruption;
     # without SIGINT the same error is a real one and is not hidden.
-    import pidcore.cli.analyze as analyze_cli
+    import pidcore.file_settings as file_settings
     from pidcore.cli import main
 
     def broken_import(*args, **kwargs):
         interrupt._interrupted.set()  # what the handler does before raising inside the import
         raise ImportError("numba._devicearray failed to import")
 
-    monkeypatch.setattr(analyze_cli, "analyze_with_settings", broken_import)
+    monkeypatch.setattr(file_settings, "analyze_with_settings", broken_import)
     assert main(["analyze", str(tmp_path / "x.csv"), "--no-store"]) == 130
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "interrupted" in err[0]
@@ -130,7 +130,7 @@ def test_an_import_broken_by_the_interrupt_still_exits_130(tmp_path, capsys, mon
     def really_missing(*args, **kwargs):
         raise ImportError("no module named numba")
 
-    monkeypatch.setattr(analyze_cli, "analyze_with_settings", really_missing)
+    monkeypatch.setattr(file_settings, "analyze_with_settings", really_missing)
     with pytest.raises(ImportError, match="no module named numba"):
         main(["analyze", str(tmp_path / "x.csv"), "--no-store"])
     assert not interrupt.is_interruption(ImportError("unrelated"))
@@ -139,14 +139,14 @@ def test_an_import_broken_by_the_interrupt_still_exits_130(tmp_path, capsys, mon
 def test_an_interrupted_in_process_run_leaves_no_flag_behind(tmp_path, capsys, monkeypatch):
     # main() run in-process (tests, the app) must not leave the SIGINT flag set: later
     # commits in the same process would all be refused.
-    import pidcore.cli.analyze as analyze_cli
+    import pidcore.file_settings as file_settings
     from pidcore.cli import main
 
     def interrupted(*args, **kwargs):
         interrupt._interrupted.set()  # what the handler does
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(analyze_cli, "analyze_with_settings", interrupted)
+    monkeypatch.setattr(file_settings, "analyze_with_settings", interrupted)
     assert main(["analyze", str(tmp_path / "x.csv"), "--no-store"]) == 130
     assert len(capsys.readouterr().err.strip().splitlines()) == 1
     assert not interrupt.interrupted()
@@ -264,6 +264,7 @@ def test_an_interrupt_swallowed_by_a_reader_is_not_reported_as_a_bad_file(tmp_pa
     # SIGINT the refusal is the interruption (exit 130, one line), in analyze's own handler and
     # in the generic one of every other command.
     import pidcore.cli.analyze as analyze_cli
+    import pidcore.file_settings as file_settings
     from pidcore.cli import main
     from pidcore.errors import ChannelError
 
@@ -271,7 +272,7 @@ def test_an_interrupt_swallowed_by_a_reader_is_not_reported_as_a_bad_file(tmp_pa
         interrupt._interrupted.set()  # what the handler does before pyuff swallows the raise
         raise ChannelError("x.uff: no force channel among 'Velocity'; name one with --force")
 
-    monkeypatch.setattr(analyze_cli, "analyze_with_settings", half_read)
+    monkeypatch.setattr(file_settings, "analyze_with_settings", half_read)
     store = tmp_path / "s.h5"
     assert main(["analyze", str(tmp_path / "x.uff"), "--store", str(store)]) == 130
     assert capsys.readouterr().err == \

@@ -506,3 +506,25 @@ def test_the_highest_frequency_the_dem_takes_follows_from_its_time_step():
             assert named == pytest.approx(highest, rel=1e-2)  # 3 significant digits
         else:
             assert not refused
+
+
+@pytest.mark.parametrize("command", ["sweep", "run"])
+def test_ctrl_c_as_the_result_prints_still_says_what_was_saved(tmp_path, monkeypatch, capsys,
+                                                               command):
+    """A Ctrl-C after the last case was stored, while the summary printed, was answered by
+    the generic "no store write was left half-done", not by what was saved."""
+    import pidcore.cli.dem as dem_cli
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(dem_cli, f"_print_{command}", interrupted)
+    store = tmp_path / "s.h5"
+    argv = (["dem", "sweep", "--frequencies", "1000", "--accelerations", "5", "--fills", "25",
+             "--workers", "1"] if command == "sweep" else
+            ["dem", "run", "--frequency", "1000", "--acceleration", "5", "--fill", "25"])
+    assert main([*argv, "--cells", "1", "--cycles", "2", "--no-progress",
+                 "--store", str(store)]) == 130
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == [f"pidcore dem {command}: interrupted; 1 finished run(s) saved to {store}; "
+                   "re-run to resume"], err

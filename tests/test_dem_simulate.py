@@ -187,6 +187,67 @@ def test_a_swallowed_ctrl_c_stops_a_run_at_its_next_kernel_call():
         interrupt.reset()
 
 
+def _drive_calls(monkeypatch) -> list[int]:
+    """Records the steps of every kernel call a run makes after this (settle and drive)."""
+    from pidcore.dem import simulate as sim
+
+    calls: list[int] = []
+    advance = sim._KernelClock.advance
+
+    def counted(self, state, settings, n_steps, **kwargs):
+        if settings.omega_rad_s > 0:  # the drive's calls, not the settle's
+            calls.append(n_steps * state.n_particles * state.n_cells)
+        return advance(self, state, settings, n_steps, **kwargs)
+
+    monkeypatch.setattr(sim._KernelClock, "advance", counted)
+    return calls
+
+
+def test_ctrl_c_waits_for_at_most_one_bounded_kernel_call_of_the_drive(monkeypatch):
+    """Ctrl-C is answered between kernel calls; a 10-cycle block was one call (a 50 Hz, 1 g
+    case of 8 cells made the user wait up to 4 s). Calls now hold whole cycles within
+    DEM_PARTICLE_STEPS_PER_CALL particle-steps (one cycle where a cycle is more)."""
+    from pidcore.dem.simulate import cycles_per_call
+
+    case, config = LoadCase(100, 5, 50), DemConfig(**FAST)
+    one_cycle_steps = None
+    for budget in (1, 3 * 10**5):
+        monkeypatch.setattr(defaults, "DEM_PARTICLE_STEPS_PER_CALL", budget, raising=False)
+        calls = _drive_calls(monkeypatch)
+        run = simulate_load_case(case, config)
+        cycles = len(run.dissipation_per_cycle_j)
+        steps_per_cycle = run.steps // cycles
+        one_cycle_steps = steps_per_cycle * run.particles_per_cell * config.cells
+        assert max(calls) <= max(budget, one_cycle_steps), (budget, calls)
+        # every cycle of the run simulated, in as many calls as the budget asks
+        assert sum(calls) == cycles * one_cycle_steps
+        per_call = cycles_per_call(steps_per_cycle=steps_per_cycle,
+                                   particles=run.particles_per_cell * config.cells,
+                                   cycles=config.block_cycles)
+        assert len(calls) == cycles // config.block_cycles * -(-config.block_cycles // per_call)
+    assert one_cycle_steps < 3 * 10**5 < config.block_cycles * one_cycle_steps  # it did split
+
+
+# one cycle of this run is 25 344 particle-steps: calls of 1 cycle, and of 2, 2 and 1
+@pytest.mark.parametrize("budget", [1, 60_000])
+def test_a_drive_in_shorter_kernel_calls_gives_the_same_run_bit_for_bit(run_500hz, budget,
+                                                                        monkeypatch):
+    # the kernel starts each call's cycle tallies and sample intervals from zero and takes
+    # the wall's position from the step count: calls that end on cycle boundaries are
+    # numerically invisible (every array and number, not only the SDC)
+    monkeypatch.setattr(defaults, "DEM_PARTICLE_STEPS_PER_CALL", budget, raising=False)
+    calls = _drive_calls(monkeypatch)
+    split = simulate_load_case(LoadCase(500, 5, 50), DemConfig(**FAST))
+    blocks = len(split.dissipation_per_cycle_j) // FAST["block_cycles"]
+    assert len(calls) > blocks  # the blocks were split
+    for name, value in vars(run_500hz).items():
+        if isinstance(value, np.ndarray):
+            np.testing.assert_array_equal(getattr(split, name), value, err_msg=name)
+        elif isinstance(value, float) and name not in ("wall_s", "particle_steps_per_s"):
+            assert getattr(split, name) == value or (math.isnan(value) and math.isnan(
+                getattr(split, name))), name
+
+
 def test_one_g_dissipates_far_less_than_five_g_at_50hz():
     # At <= 1 g the bed never leaves the floor along z (gravity holds it): no impacts, only
     # slight rocking and sliding of loose particles (measured with 8 cells: SDC 0.005 at 1 g

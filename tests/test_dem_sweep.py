@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 from pidcore.dem.simulate import DemConfig, LoadCase
@@ -116,6 +117,16 @@ def test_dask_scheduler_path(tmp_path):
                             scheduler=cluster.scheduler_address, progress=False)
     assert summary.completed == [run_key(CASES[0], CONFIG)]
     assert Store(tmp_path / "d.h5").has_dem_run(summary.completed[0])
+    # the same run, bit for bit, as the local processes store it (the key promises it)
+    run_sweep(CASES[:1], CONFIG, store_path=tmp_path / "l.h5", workers=1, progress=False)
+    remote = Store(tmp_path / "d.h5").get_dem_run(summary.completed[0])
+    local = Store(tmp_path / "l.h5").get_dem_run(summary.completed[0])
+    assert remote.arrays.keys() == local.arrays.keys()
+    for name, values in local.arrays.items():
+        np.testing.assert_array_equal(remote.arrays[name], values, err_msg=name)
+    timing = {"wall_s", "kernel_s", "particle_steps_per_s"}  # how long it took, not what
+    assert {k: v for k, v in remote.record.items() if k not in timing} == \
+        {k: v for k, v in local.record.items() if k not in timing}
 
 
 def test_a_run_saved_by_dem_run_is_skipped_by_a_sweep(tmp_path):
@@ -170,3 +181,65 @@ def test_an_unreachable_scheduler_is_one_line_exit_2_and_nothing_stored(tmp_path
     assert code == 2
     assert len(err) == 1 and "--scheduler tcp://127.0.0.1:1" in err[0], err
     assert not store.exists() or not Store(store).list_dem_runs().shape[0]
+
+
+def test_a_killed_pool_worker_is_one_error_not_a_traceback():
+    """A DEM worker killed from outside (OOM killer, kill -9) ended `pidcore dem sweep` and
+    `calibrate` with concurrent.futures' BrokenProcessPool traceback, exit 1."""
+    import os
+
+    from pidcore.dem.sweep import run_pooled
+    from pidcore.errors import SimulationError
+
+    finished: list = []
+    # os._exit ends the worker process at once, as SIGKILL would (picklable by reference)
+    with pytest.raises(SimulationError, match="worker process ended abruptly"):
+        run_pooled(os._exit, [(9,), (9,)], workers=2, finish=finished.append)
+    assert finished == []
+
+
+def test_a_sweep_that_fails_after_some_cases_says_they_are_saved(tmp_path, monkeypatch, capsys):
+    import pidcore.dem.sweep
+    from pidcore.cli import main
+    from pidcore.errors import SimulationError
+
+    store = tmp_path / "s.h5"
+
+    def first_then_fail(cases, config, *, store_path, **kwargs):
+        Store(store_path).add_dem_run(run_key(cases[0], config), {"sdc": 0.1})
+        raise SimulationError("a DEM worker process ended abruptly")
+
+    monkeypatch.setattr(pidcore.dem.sweep, "run_sweep", first_then_fail)
+    argv = ["dem", "sweep", "--frequencies", "1000", "--accelerations", "5,10", "--fills", "25",
+            "--cells", "1", "--cycles", "10", "--no-progress", "--store", str(store)]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].endswith(
+        f"ended abruptly; 1 finished run(s) saved to {store}; re-run to resume"), err
+    # nothing stored: the error as it was, with no word of saved runs
+    monkeypatch.setattr(pidcore.dem.sweep, "run_sweep", lambda *a, **k: (_ for _ in ()).throw(
+        SimulationError("refused")))
+    assert main([*argv[:-1], str(tmp_path / "t.h5")]) == 2
+    assert capsys.readouterr().err.strip() == "pidcore dem sweep: error: refused"
+
+
+def test_a_run_keyed_otherwise_by_a_worker_is_refused_not_stored(tmp_path, monkeypatch):
+    """A dask worker with another pidcore (another DEM code version) returns its run under
+    another key: it was stored, the sweep listed the case as unfinished, and every re-run
+    simulated it again."""
+    import dataclasses
+
+    import pidcore.dem.sweep
+    from pidcore.errors import SimulationError
+
+    real = pidcore.dem.sweep.run_case
+
+    def other_code(case, config, specimen=None):
+        outcome = real(case, config, specimen)
+        return dataclasses.replace(outcome, key=outcome.key[:-10] + "0123456789")
+
+    monkeypatch.setattr(pidcore.dem.sweep, "run_case", other_code)
+    store = tmp_path / "s.h5"
+    with pytest.raises(SimulationError, match="another pidcore than this one"):
+        run_sweep(CASES[:1], CONFIG, store_path=store, workers=1, progress=False)
+    assert not store.exists() or Store(store).list_dem_runs().empty

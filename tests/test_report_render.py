@@ -227,3 +227,16 @@ def test_ctrl_c_says_whether_the_report_was_written(tmp_path, table, provenance,
                       "it\n"
         assert (out / "report.csv").read_bytes() != old_csv
     assert sorted(p.name for p in tmp_path.iterdir()) == ["rp"]  # no temporary or .old left
+
+
+def test_writing_shows_a_bar_over_figures_and_formats_only_when_asked(tmp_path, table,
+                                                                      provenance, capsys):
+    """A report of forty files spent 35 s on its figures and PDF with no sign of life."""
+    write_report(table, _figures(), provenance, tmp_path / "quiet", ("csv", "md"))
+    assert capsys.readouterr().err == ""
+    write_report(table, _figures(), provenance, tmp_path / "shown", ("csv", "md"),
+                 progress=True)
+    err = capsys.readouterr().err
+    # one figure and two formats: three files (tqdm skips redraws closer than 0.1 s: which)
+    assert "writing report" in err and "0/3" in err, repr(err)
+    assert re.search(r"\b[123]/3\b", err), repr(err)

@@ -225,6 +225,38 @@ def test_an_unknown_column_is_refused_and_nothing_is_written(tmp_path, capsys, c
     assert not out.exists()
 
 
+def test_the_structure_mass_of_a_row_is_the_options_and_a_kg_value_is_refused(tmp_path,
+                                                                                capsys):
+    # the baseline is the empty structure's loss factor of its own kinetic energy: with its
+    # mass (0.2 of the record's 0.25 kg) only 0.2/0.25 of it is taken off
+    path = export(tmp_path / "rec.csv")
+    eta0 = 0.01
+    by_option = run_json([str(path), "--no-store", "--baseline-loss-factor", "0.01",
+                          "--structure-mass", "0.2"], capsys)["records"][0]
+    sidecar(tmp_path, "file,fill_percent,baseline_loss_factor,structure_mass_g\n"
+                      "rec.csv,50,0.01,200\n")
+    by_table = run_json([str(path), "--no-store"], capsys)["records"][0]
+    assert by_table["loss_factor"] == by_option["loss_factor"]  # 200 g is 0.2 kg to the bit
+    share = by_option["corrections"]["baseline_structure_share"]
+    # 60 dB SNR: the measured reactive power is the 0.25 kg mass's within ~0.1 %
+    assert share == pytest.approx(0.2 / MASS, rel=3e-3)
+    assert by_option["loss_factor"] == pytest.approx(
+        by_option["loss_factor_raw"] - eta0 * share, rel=1e-12)
+    assert any("the empty structure (0.2 kg) holds" in n for n in by_option["notes"])
+    # without the mass the whole baseline goes, and the output says it is too much
+    rough = run_json([str(path), "--no-store", "--baseline-loss-factor", "0.01",
+                      "--sidecar", str(sidecar(tmp_path, "file\n", "none.csv"))],
+                     capsys)["records"][0]
+    assert rough["loss_factor"] == pytest.approx(rough["loss_factor_raw"] - eta0, rel=1e-12)
+    assert any("give the structure's mass" in n and "--structure-mass" in n
+               for n in rough["notes"]), rough["notes"]
+    # 0.2 typed in the grams column is a mass in kg
+    sidecar(tmp_path, "file,fill_percent,baseline_loss_factor,structure_mass_g\n"
+                      "rec.csv,50,0.01,0.2\n")
+    err = refused(["analyze", str(path), "--no-store"], capsys)
+    assert "column structure_mass_g: '0.2' is implausibly small" in err and "in kg" in err
+
+
 @pytest.mark.parametrize("column,value,said", [
     ("velocity_delay_us", "fifty", "is not a number"),
     ("velocity_delay_us", "nan", "is not a finite number"),

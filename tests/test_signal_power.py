@@ -196,6 +196,71 @@ def test_baseline_subtraction():
         2 * np.pi * (lf - baseline) * res.max_kinetic_energy_j, rel=1e-9)
 
 
+def _structure_and_particles(structure_kg, particles_kg, baseline, particle_c):
+    """A record of an empty structure of loss factor ``baseline`` (a damper c_s = baseline x
+    omega m_s) carrying particles (mass m_p, damper c_p), and the particles' true loss factor
+    normalised by the whole kinetic energy, as Eq. 11 normalises it."""
+    fs, f = 10240.0, 100.0
+    omega = 2 * np.pi * f
+    c_s = baseline * omega * structure_kg
+    rec = synthesize_shaker_record(mass_kg=structure_kg + particles_kg,
+                                   acceleration_amplitude_m_s2=G, frequency_hz=f,
+                                   sample_rate_hz=fs, n_periods=30,
+                                   viscous_damping_n_s_m=c_s + particle_c)
+    return rec, fs, particle_c / (omega * (structure_kg + particles_kg))
+
+
+def test_the_baseline_takes_off_the_empty_structures_own_dissipation():
+    # the paper's coupon (22.2 g) with a 0.256 kg fixture and 12 g of particles: the empty
+    # structure's eta_0 0.0152 is of its own kinetic energy; the whole vibrated mass's stood
+    # for it and took off 0.0152 instead of 0.0152 x 0.278 / 0.290
+    m_s, m_p, eta0 = 0.0222 + 0.256, 0.012, 0.0152
+    rec, fs, particles = _structure_and_particles(m_s, m_p, eta0, particle_c=0.9)
+    exact = analyze_power(rec.force_n, rec.velocity_m_s, fs, baseline_loss_factor=eta0,
+                          structure_mass_kg=m_s)
+    # noise-free synthetic record: the fit is exact to round-off, hence 1e-9
+    assert exact.loss_factor == pytest.approx(particles, rel=1e-9)
+    assert exact.sdc == pytest.approx(2 * np.pi * particles, rel=1e-9)
+    assert exact.energy_per_cycle_j == pytest.approx(
+        2 * np.pi * particles * exact.max_kinetic_energy_j, rel=1e-9)
+    assert exact.corrections["baseline_structure_share"] == pytest.approx(m_s / (m_s + m_p),
+                                                                          rel=1e-9)
+    assert any("holds 0.959 of the reactive power" in n for n in exact.notes), exact.notes
+    # without the mass: the documented approximation, too low by eta_0 m_p / (m_s + m_p),
+    # and said
+    rough = analyze_power(rec.force_n, rec.velocity_m_s, fs, baseline_loss_factor=eta0)
+    assert rough.loss_factor == pytest.approx(particles - eta0 * m_p / (m_s + m_p), rel=1e-9)
+    assert any("give the structure's mass" in n for n in rough.notes)
+    # no baseline: no note, and the mass changes nothing
+    plain = analyze_power(rec.force_n, rec.velocity_m_s, fs, structure_mass_kg=m_s)
+    assert plain.loss_factor == plain.loss_factor_raw and not any("baseline" in n
+                                                                  for n in plain.notes)
+
+
+def test_heavy_particles_below_the_empty_structures_loss_factor_are_not_refused():
+    # tungsten-carbide beads weighing 9x the structure, damping little: the filled coupon's
+    # loss factor is below the empty one's, as physics allows (the structure is a tenth of
+    # the kinetic energy); the exact subtraction keeps it, the whole-mass one must refuse
+    m_s, m_p, eta0 = 0.05, 0.45, 0.004
+    rec, fs, particles = _structure_and_particles(m_s, m_p, eta0, particle_c=0.3)
+    assert analyze_power(rec.force_n, rec.velocity_m_s, fs).loss_factor < eta0
+    res = analyze_power(rec.force_n, rec.velocity_m_s, fs, baseline_loss_factor=eta0,
+                        structure_mass_kg=m_s)
+    assert res.loss_factor == pytest.approx(particles, rel=1e-9)
+    with pytest.raises(ParameterError, match="is not below the measured loss factor"):
+        analyze_power(rec.force_n, rec.velocity_m_s, fs, baseline_loss_factor=eta0)
+
+
+@pytest.mark.parametrize("mass, words", [(278.2, "was it in g"), (0.0, "expected the empty"),
+                                         (-1.0, "expected the empty"),
+                                         (float("nan"), "expected the empty")])
+def test_a_structure_mass_in_grams_or_not_a_mass_is_refused(mass, words):
+    rec, fs, _ = _structure_and_particles(0.2782, 0.012, 0.0152, particle_c=0.9)
+    with pytest.raises(ParameterError, match=words):
+        analyze_power(rec.force_n, rec.velocity_m_s, fs, baseline_loss_factor=0.0152,
+                      structure_mass_kg=mass)
+
+
 def test_block_stderr_consistent_with_scatter_over_noise():
     """std of 20 seeds' loss factors vs the mean reported stderr: within a factor 2.
 

@@ -3,9 +3,11 @@
 The page calls only what is here. :func:`calibration_api` says whether the calibration library
 is installed (it is written on its own branch); :class:`CalibrationRunner` runs
 ``pidcore.calibrate.calibrate`` on the store's measurements in a thread outside the script
-runs (it starts DEM runs, minutes) and keeps the outputs of ``write_outputs`` in memory for
-the page to show and offer for download. The DEM runs it needs are cached in the store, so a
-calibration started again reuses them.
+runs (it starts DEM runs, minutes), saves the calibration in the store
+(:func:`pidcore.calibrate.persist.save_calibration`, so that it outlives a restart of the app
+and :func:`available_calibrations` offers it from there) and keeps the outputs of
+``write_outputs`` in memory for the page to show and offer for download. The DEM runs it needs
+are cached in the store, so a calibration started again reuses them.
 """
 
 from __future__ import annotations
@@ -155,6 +157,8 @@ class CalibrationTask:
     finished: float | None = None
     message: str = ""
     outputs: dict[str, bytes] = field(default_factory=dict)
+    #: Its key in the store once saved there ("" : not saved).
+    store_key: str = ""
 
     def elapsed_s(self) -> float:
         """Seconds since the start (to the end once finished)."""
@@ -203,15 +207,35 @@ class CalibrationRunner:
                 paths = api.write_outputs(result, folder)
                 outputs = {Path(p).name: Path(p).read_bytes() for p in paths}
             state, message = "done", f"{len(points)} load case(s), fitted {', '.join(fit)}"
+            key, saved = _save(api, result, self.store_path)
+            message += saved
         except Exception as exc:  # noqa: BLE001 - shown on the page as the task's error
             # a library refusal is its one line (the class name is no news to a user); an
             # unexpected error keeps its name, without which "KeyError: 'x'" says nothing
-            outputs, state = {}, "failed"
+            outputs, state, key = {}, "failed", ""
             message = page_words(str(exc)) if isinstance(exc, PidcoreError) \
                 else f"{type(exc).__name__}: {exc}"
         with self._lock:
             task.outputs, task.state, task.message = outputs, state, message
-            task.finished = time.time()
+            task.store_key, task.finished = key, time.time()
+
+
+def _save(api, result, store_path: Path) -> tuple[str, str]:
+    """Save a finished calibration in the store (``api.save_calibration``:
+    :func:`pidcore.calibrate.persist.save_calibration`); ``(key, words for the task's
+    message)`` (``key`` "" where it was not saved: the outputs are still offered, and the
+    message says so)."""
+    from ..errors import PidcoreError
+
+    save = getattr(api, "save_calibration", None)
+    if save is None:
+        return "", "; not saved in the store (this pidcore cannot): download calibration.json below"
+    try:
+        key, added = save(result, store_path)
+    except PidcoreError as exc:
+        return "", f"; NOT saved in the store ({exc}): download calibration.json below"
+    return key, (f"; saved in the store as {key}" if added
+                 else f"; the same result is in the store already as {key}")
 
 
 _RUNNERS: dict[str, CalibrationRunner] = {}
@@ -251,21 +275,65 @@ def calibration_digest(calibration) -> str:
     return hashlib.sha256(repr(calibration).encode()).hexdigest()[:16]
 
 
+def stored_calibration_label(calibration) -> str:
+    """How the pages name a calibration saved in the app's store."""
+    fitted = ", ".join(calibration.parameters)
+    return (f"this store's calibration {calibration.store_key} of "
+            f"{calibration.specimen_name or 'the paper coupon'} ({fitted}; saved "
+            f"{calibration.created_utc[:16].replace('T', ' ')} UTC)")
+
+
+#: Columns of :func:`saved_calibrations_table`: listing column -> name shown (units named).
+SAVED_CALIBRATION_COLUMNS = {"key": "calibration", "specimen": "specimen", "fit": "fitted",
+                             "n_points": "load cases [-]", "rms_in_sample": "in-sample RMS [-]",
+                             "loo_rms": "leave-one-out RMS [-]",
+                             "loo_coverage95": "inside 95 % band (LOO) [-]",
+                             "created_utc": "saved [UTC]"}
+
+
+def saved_calibrations_table(store_path: str | Path):
+    """The Calibrate tab's table of the calibrations saved in the store, newest first
+    (:meth:`pidcore.store.Store.list_calibrations`; columns :data:`SAVED_CALIBRATION_COLUMNS`,
+    a blank where a calibration has no leave-one-out)."""
+    from ..store import Store
+
+    listing = Store(store_path).list_calibrations().iloc[::-1]
+    shown = {c: n for c, n in SAVED_CALIBRATION_COLUMNS.items() if c in listing.columns}
+    table = listing[list(shown)].rename(columns=shown).reset_index(drop=True)
+    table["saved [UTC]"] = table["saved [UTC]"].str[:19].str.replace("T", " ")
+    table = table.astype(object).where(table.notna(), "")
+    for column in ("load cases [-]", "inside 95 % band (LOO) [-]"):  # counts, not 10.0
+        if column in table.columns:
+            table[column] = [v if v == "" else int(v) for v in table[column]]
+    return table
+
+
 def available_calibrations(task: CalibrationTask | None,
                            environ: Mapping[str, str] | None = None, *,
-                           cwd: Path | None = None) -> list[tuple[object | None, str]]:
-    """The calibrations the Compare and Report pages offer, as ``(calibration, label)``: the
-    Calibrate page's finished calibration of this store first, then :func:`calibration_path`'s
-    file (the bundled paper calibration by default). A calibration of one specimen does not
-    hide the other's bands: Compare takes the first that predicts a case. One that cannot be
-    read comes last as ``(None, reason)``; ``[(None, reason)]`` when there is none or none can
-    be read (the reason is shown)."""
+                           cwd: Path | None = None,
+                           store_path: str | Path | None = None,
+                           ) -> list[tuple[object | None, str]]:
+    """The calibrations the Compare and Report pages offer, as ``(calibration, label)``: those
+    saved in the app's store (``store_path``), newest first, then the Calibrate page's finished
+    calibration where the store did not take it, then :func:`calibration_path`'s file (the
+    bundled paper calibration by default). A calibration of one specimen does not hide the
+    other's bands: Compare takes the first that predicts a case. One that cannot be read comes
+    last as ``(None, reason)``; ``[(None, reason)]`` when there is none or none can be read
+    (the reason is shown)."""
+    from ..calibrate.persist import stored_calibrations
     from ..calibrate.prediction import calibration_from_json, load_calibration
     from ..errors import PidcoreError
 
     found: list[tuple[object | None, str]] = []
     problems: list[str] = []
-    if task is not None and task.state == "done" and "calibration.json" in task.outputs:
+    if store_path is not None:
+        try:
+            found += [(c, stored_calibration_label(c)) for c in stored_calibrations(store_path)]
+        except PidcoreError as exc:
+            problems.append(f"calibrations of the store not shown: {exc}")
+    saved = {c.store_key for c, _ in found}
+    if task is not None and task.state == "done" and "calibration.json" in task.outputs \
+            and task.store_key not in saved:
         try:
             found.append((calibration_from_json(task.outputs["calibration.json"],
                                                 "calibration.json (Calibrate page)",

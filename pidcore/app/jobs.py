@@ -13,11 +13,21 @@ A case is never started twice: a submission is dropped when the same run (same s
 case and every numerical setting) is queued, running, or already in the store, and a case that
 is the same simulation as another (a fill rounding to the same particle count:
 :func:`pidcore.dem.persist.run_identity`) is not run again.
+
+The job table outlives the server process: the runner keeps it in a JSON journal beside the
+store (``<store>.jobs.json``, replaced atomically on every change of state). A runner started
+on a store whose journal lists jobs still queued or running (the app stopped or crashed) shows
+them as :data:`INTERRUPTED_STATE`, nothing saved, ready to run again
+(:meth:`DemJobRunner.resubmit_interrupted`); its finished jobs are listed as they were.
 """
 
 from __future__ import annotations
 
+import dataclasses
+import json
 import math
+import os
+import secrets
 import threading
 import time
 from collections.abc import Sequence
@@ -28,7 +38,15 @@ from .. import defaults
 from ..errors import ParameterError, PidcoreError
 
 #: Job states, in the order a job passes through them.
-JOB_STATES = ("queued", "running", "saved", "in store", "same run", "cancelled", "failed")
+JOB_STATES = ("queued", "running", "saved", "in store", "same run", "cancelled", "failed",
+              "interrupted")
+#: State of a job that was queued or running when the app stopped (read from the journal):
+#: nothing of it was saved; :meth:`DemJobRunner.resubmit_interrupted` runs it again.
+INTERRUPTED_STATE = "interrupted"
+#: The journal of a store's jobs: ``<store>`` + this suffix, beside the store.
+JOURNAL_SUFFIX = ".jobs.json"
+#: Layout version written into the journal.
+_JOURNAL_VERSION = 1
 #: State of a job that is the same simulation as another job queued or running (another fill
 #: rounding to the same particle count): not run, the other job's run is its run.
 SAME_RUN_STATE = "same run"
@@ -148,9 +166,14 @@ class DemJobRunner:
         self.store_path = Path(store_path)
         self._lock = threading.Lock()
         self._wake = threading.Condition(self._lock)
-        self._jobs: list[DemJob] = []
         self._cancel: set[str] = set()
-        self._counter = 0
+        #: Why the journal could not be read or written ("" : all well).
+        self.journal_problem: str
+        self._jobs, self.journal_problem = read_journal(journal_path(self.store_path))
+        self._counter = max((_job_number(j.job_id) for j in self._jobs), default=0)
+        if self._jobs:
+            with self._lock:
+                self._write_journal()  # the interrupted ones as such
         self._thread = threading.Thread(target=self._work, name="pidcore-dem-jobs", daemon=True)
         self._thread.start()
 
@@ -223,8 +246,39 @@ class DemJobRunner:
                     active[identity] = job
                 self._jobs.append(job)
                 created.append(job)
+            if created:
+                self._write_journal()
             self._wake.notify_all()
         return created
+
+    def resubmit_interrupted(self) -> list[DemJob]:
+        """Submit again every job the app's last stop interrupted (:data:`INTERRUPTED_STATE`);
+        returns the jobs created. Each interrupted job then says which job runs it."""
+        with self._lock:
+            interrupted = [j for j in self._jobs if j.state == INTERRUPTED_STATE]
+        created = []
+        for old in interrupted:
+            new = self.submit([old.case], old.config, old.specimen)
+            created += new
+            with self._lock:
+                old.state = "cancelled"
+                old.message = (f"interrupted by a stop of the app; submitted again as "
+                               f"{new[0].job_id}" if new else
+                               "interrupted by a stop of the app; already queued or running")
+        with self._lock:
+            self._write_journal()
+        return created
+
+    def _write_journal(self) -> None:
+        """Replace the journal with the jobs as they are now (lock held). A journal that
+        cannot be written costs the table after a restart, never a run: said, not raised."""
+        try:
+            write_journal(journal_path(self.store_path), self._jobs)
+            self.journal_problem = ""
+        except (OSError, TypeError, ValueError) as exc:
+            self.journal_problem = (f"the job table cannot be kept in "
+                                    f"{journal_path(self.store_path)} ({exc}); it is lost "
+                                    "when the app stops")
 
     def cancel(self, job_ids: Sequence[str] | None = None) -> int:
         """Cancel queued and running jobs (all of them, or ``job_ids``); returns how many.
@@ -242,6 +296,8 @@ class DemJobRunner:
                         job.message = "cancelled before it started"
                         self._settle_same(job)
                     n += 1
+            if n:
+                self._write_journal()
             self._wake.notify_all()
         return n
 
@@ -271,6 +327,7 @@ class DemJobRunner:
         """Forget finished jobs (the store keeps their runs)."""
         with self._lock:
             self._jobs = [j for j in self._jobs if j.state in ("queued", "running")]
+            self._write_journal()
 
     # --- worker thread ------------------------------------------------------------------------
 
@@ -280,6 +337,7 @@ class DemJobRunner:
                 for job in self._jobs:
                     if job.state == "queued":
                         job.state, job.started = "running", time.time()
+                        self._write_journal()
                         return job
                 self._wake.wait()
 
@@ -309,6 +367,7 @@ class DemJobRunner:
             job.state, job.message, job.finished = state, message, time.time()
             self._cancel.discard(job.job_id)
             self._settle_same(job)
+            self._write_journal()
             self._wake.notify_all()  # wait_cancelled
 
     def _run(self, job: DemJob) -> None:
@@ -365,10 +424,89 @@ class DemJobRunner:
                 job.message = "cancelled as it finished; nothing saved"
                 self._settle_same(job)
                 self._cancel.discard(job.job_id)
+                self._write_journal()
                 self._wake.notify_all()  # wait_cancelled
                 return
         CaseOutcome(job.run_key, **outcome).save_to(Store(self.store_path))
         self._finish(job, "saved", f"saved as {job.run_key}")
+
+
+def journal_path(store_path: str | Path) -> Path:
+    """The journal of a store's jobs: ``<store>.jobs.json`` beside it."""
+    path = Path(store_path)
+    return path.with_name(path.name + JOURNAL_SUFFIX)
+
+
+def _job_number(job_id: str) -> int:
+    digits = job_id.removeprefix("job")
+    return int(digits) if digits.isdigit() else 0
+
+
+def _job_document(job: DemJob) -> dict:
+    specimen = job.specimen
+    return {"job_id": job.job_id, "state": job.state, "run_key": job.run_key,
+            "submitted": job.submitted, "started": job.started, "finished": job.finished,
+            "cycles_done": job.cycles_done, "cycles_expected": job.cycles_expected,
+            "message": job.message, "same_as": job.same_as,
+            "case": dataclasses.asdict(job.case), "config": dataclasses.asdict(job.config),
+            "specimen": None if specimen is None else {"text": specimen.text,
+                                                       "source": str(specimen.source)}}
+
+
+def write_journal(path: Path, jobs: Sequence[DemJob]) -> None:
+    """Write the jobs' journal at ``path`` in one step (a temporary file renamed over it): a
+    stop while it is written leaves the previous journal, never half of one."""
+    text = json.dumps({"pidcore_jobs_version": _JOURNAL_VERSION,
+                       "jobs": [_job_document(j) for j in jobs]}, indent=1)
+    tmp = path.with_name(f".{path.name}.{secrets.token_hex(4)}.tmp")
+    try:
+        tmp.write_text(text, encoding="utf-8")
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)
+
+
+def _job_from_document(doc: dict) -> DemJob:
+    from ..dem.simulate import DemConfig
+    from ..loadcase import LoadCase
+    from ..specimen import Specimen
+
+    spec = doc["specimen"]
+    specimen = None if spec is None else Specimen.from_text(spec["text"],
+                                                            source=str(spec["source"]))
+    job = DemJob(str(doc["job_id"]), LoadCase(**doc["case"]), DemConfig(**doc["config"]),
+                 str(doc["run_key"]), specimen, state=str(doc["state"]),
+                 submitted=float(doc["submitted"]), started=doc["started"],
+                 finished=doc["finished"], cycles_done=int(doc["cycles_done"]),
+                 cycles_expected=int(doc["cycles_expected"]), message=str(doc["message"]),
+                 same_as=str(doc["same_as"]))
+    if job.state not in JOB_STATES:
+        raise ValueError(f"unknown job state {job.state!r}")
+    if job.state in ("queued", "running", SAME_RUN_STATE):
+        # the app stopped before it ran (or before the job running it finished): nothing saved
+        job.state, job.finished = INTERRUPTED_STATE, job.finished or time.time()
+        job.message = ("the app stopped before this case finished; nothing of it was saved: "
+                       "run it again with Resubmit interrupted")
+        job.cycles_done = 0
+    return job
+
+
+def read_journal(path: Path) -> tuple[list[DemJob], str]:
+    """The jobs of a journal (:func:`write_journal`) and "" ; no journal: ``([], "")``. One that
+    cannot be read gives no job and says why (it is JSON, parsed, never executed; it is
+    replaced by the next change)."""
+    if not path.is_file():
+        return [], ""
+    try:
+        doc = json.loads(path.read_text(encoding="utf-8"))
+        if not isinstance(doc, dict) or doc.get("pidcore_jobs_version") != _JOURNAL_VERSION \
+                or not isinstance(doc.get("jobs"), list):
+            raise ValueError("not a pidcore job journal of version "
+                             f"{_JOURNAL_VERSION}")
+        return [_job_from_document(d) for d in doc["jobs"]], ""
+    except (OSError, ValueError, TypeError, KeyError, PidcoreError) as exc:
+        return [], (f"the job table of the last run of the app ({path}) cannot be read "
+                    f"({type(exc).__name__}: {exc}); its saved runs are in the store")
 
 
 _RUNNERS: dict[str, DemJobRunner] = {}

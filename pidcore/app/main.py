@@ -27,7 +27,7 @@ def main() -> None:
         st.markdown(f"**upload limit**: {defaults.APP_MAX_UPLOAD_MB} MB per file")
         st.caption(f"pidcore {__version__}")
     # read once per run: the Compare and Report tabs offer the same calibrations
-    calibrations = available_calibrations(runner_for(stores.path).task)
+    calibrations = available_calibrations(runner_for(stores.path).task, store_path=stores.path)
     t_analyse, t_compare, t_dem, t_cal, t_report = st.tabs(
         ["Analyse", "Compare", "DEM", "Calibrate", "Report"])
     with t_analyse:

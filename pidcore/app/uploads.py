@@ -48,7 +48,7 @@ if TYPE_CHECKING:
 #: reads these labels too: one table for both).
 FILE_TABLE_COLUMNS: dict[str, str] = SETTINGS_COLUMN_LABELS
 _NUMERIC = ("fill [%]", "vibrometer delay [µs]", "mass below gauge [g]",
-            "baseline loss factor [-]")
+            "baseline loss factor [-]", "structure mass [g]")
 
 
 # --- reading ----------------------------------------------------------------------------------
@@ -538,8 +538,9 @@ def default_settings_row(name: str, stated) -> dict:
     return {"file": name, "fill [%]": float(stated.fill_percent), "material": stated.material,
             "direction": stated.direction, "specimen": "", "vibrometer delay [µs]": 0.0,
             "mass below gauge [g]": 0.0, "baseline loss factor [-]": 0.0,
-            "force channel": AUTO_CHANNEL, "velocity channel": AUTO_CHANNEL,
-            "acceleration channel": AUTO_CHANNEL, "inverted channels": ""}
+            "structure mass [g]": 0.0, "force channel": AUTO_CHANNEL,
+            "velocity channel": AUTO_CHANNEL, "acceleration channel": AUTO_CHANNEL,
+            "inverted channels": ""}
 
 
 def assumed_note(stated, row: Mapping, given: Iterable[str] = ()) -> str:

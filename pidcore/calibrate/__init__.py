@@ -13,7 +13,8 @@ Modules, one concern each:
 * :mod:`~pidcore.calibrate.calibrate`: the pipeline and leave-one-out;
 * :mod:`~pidcore.calibrate.outputs`: calibration.json, specimen file, figures, summary;
 * :mod:`~pidcore.calibrate.prediction`: reading a calibration.json back and looking up the
-  calibrated prediction of a load case (reports, app).
+  calibrated prediction of a load case (reports, app);
+* :mod:`~pidcore.calibrate.persist`: calibrations saved in and read from the HDF5 store.
 
 Public API
 ----------
@@ -28,6 +29,8 @@ Observation, observation_from_run
     The SDC a shaker test of a DEM run would measure.
 write_outputs
     calibration.json, the calibrated specimen, figures and summary.
+save_calibration, stored_calibration, stored_calibrations
+    Calibrations saved in and read from the HDF5 store.
 load_calibration, calibration_from_json, Calibration, CalibratedPrediction
     A calibration read back (``to_pandas()``, ``plot()``); its prediction and 95 % band at
     a calibrated load case (``Calibration.lookup(case).band(stderr)``).
@@ -38,10 +41,12 @@ from .data import MeasuredPoint, measured_from_store, read_measured_table
 from .observation import Observation, observation_from_run
 from .outputs import write_outputs
 from .parameters import CATALOGUE, ParameterSpec, build_specs, dem_parameter_names, parse_fit
+from .persist import save_calibration, stored_calibration, stored_calibrations
 from .prediction import CalibratedPrediction, Calibration, calibration_from_json, load_calibration
 
 __all__ = ["calibrate", "base_specimen", "CalibrationResult", "MeasuredPoint",
            "read_measured_table", "measured_from_store", "Observation", "observation_from_run",
            "write_outputs",
            "CATALOGUE", "ParameterSpec", "build_specs", "parse_fit", "dem_parameter_names",
-           "Calibration", "CalibratedPrediction", "load_calibration", "calibration_from_json"]
+           "Calibration", "CalibratedPrediction", "load_calibration", "calibration_from_json",
+           "save_calibration", "stored_calibration", "stored_calibrations"]

@@ -23,6 +23,12 @@ def document_json(document: dict) -> str:
     return json.dumps(json_safe(document), indent=2)
 
 
+def rms_text(value: float) -> str:
+    """An RMS error of the SDC as every output shows it (the CLI, summary.md, the calibrated
+    specimen's header: they showed 0.0822, 0.082 and 0.08218 for one number)."""
+    return display_number(value, decimals=4)
+
+
 def specimen_text(result: CalibrationResult) -> str:
     """TOML text of the calibrated specimen (every fitted specimen field at its posterior
     median), headed by comments with the 95 % intervals; any command takes it as --specimen.
@@ -35,8 +41,8 @@ def specimen_text(result: CalibrationResult) -> str:
         _, low, high = summary_texts(p)
         lines.append(f"#   {name} = {p['median']:.6g}  (95 %: {low} .. {high})")
     if result.loo_rms is not None:
-        lines.append(f"# leave-one-out RMS of the SDC: {result.loo_rms:.4g}")
-    lines.append(f"# in-sample RMS of the SDC: {result.rms:.4g}")
+        lines.append(f"# leave-one-out RMS of the SDC: {rms_text(result.loo_rms)}")
+    lines.append(f"# in-sample RMS of the SDC: {rms_text(result.rms)}")
     lines += [f"# note: {note}" for note in result.notes]  # e.g. a value set by its prior
     return "\n".join(lines) + "\n" + result.calibrated_specimen().to_toml()
 
@@ -87,7 +93,8 @@ def summary_markdown(result: CalibrationResult) -> str:
             continue
         rms = float(np.sqrt(np.mean([(r["predicted"] - r["measured"]) ** 2 for r in rows])))
         inside = sum(r["low95"] <= r["measured"] <= r["high95"] for r in rows)
-        lines += ["", f"## {title}: RMS {rms:.3f}, {inside}/{len(rows)} inside the 95 % band",
+        lines += ["", f"## {title}: RMS {rms_text(rms)}, {inside}/{len(rows)} inside the 95 % "
+                  "band",
                   "", "| " + " | ".join(_HEAD) + " |", "|---" * len(_HEAD) + "|"]
         lines += ["| " + " | ".join(cells) + " |" for cells in _table_rows(rows)]
     if any(s.kind == "dem" for s in result.specs):

@@ -112,7 +112,16 @@ class Calibration:
         The calibrated specimen file beside it, if present.
     specimen_name : str
         The name of the specimen it calibrates where known without a file (a calibration
-        held in memory by the app); "" otherwise.
+        held in memory by the app, or read from a store); "" otherwise.
+    specimen_text : str
+        The calibrated specimen file's text where it was read with the calibration (from a
+        store: :mod:`pidcore.calibrate.persist`); "" otherwise.
+    document_text : str
+        The whole calibration.json where it was read from a store; "" otherwise.
+    store_key : str
+        Its key in the store it was read from; "" for a calibration.json.
+    created_utc : str
+        When the store saved it; "" for a calibration.json.
     """
 
     path: Path
@@ -120,6 +129,10 @@ class Calibration:
     predictions: tuple[CalibratedPrediction, ...]
     specimen_path: Path | None = None
     specimen_name: str = ""
+    specimen_text: str = ""
+    document_text: str = ""
+    store_key: str = ""
+    created_utc: str = ""
 
     def to_pandas(self) -> pd.DataFrame:
         """The predictions, one row per calibrated load case, each column naming its unit.
@@ -169,14 +182,17 @@ class Calibration:
                                         abs(p.load_case.fill_percent - case.fill_percent)))
 
     def calibrated_specimen(self) -> Specimen | None:
-        """The specimen file beside the calibration (:attr:`specimen_path`), or None where
-        there is none or it cannot be read (then which specimen it calibrates is unknown)."""
+        """The calibrated specimen: read with it from a store (:attr:`specimen_text`), else
+        the file beside the calibration (:attr:`specimen_path`); None where there is none or
+        it cannot be read (then which specimen it calibrates is unknown)."""
         from ..errors import PidcoreError
-        from ..specimen import load_specimen
+        from ..specimen import Specimen, load_specimen
 
-        if self.specimen_path is None:
-            return None
         try:
+            if self.specimen_text:
+                return Specimen.from_text(self.specimen_text, source=f"{self.path} (specimen)")
+            if self.specimen_path is None:
+                return None
             return load_specimen(self.specimen_path)
         except (PidcoreError, OSError):
             return None
@@ -276,18 +292,26 @@ def _optional(value, what: str, path: Path) -> float:
     return math.nan if value is None else _number(value, what, path)
 
 
-def load_calibration(path: str | os.PathLike) -> Calibration:
+def load_calibration(path: str | os.PathLike, *, key: str | None = None) -> Calibration:
     """Read and check a ``calibration.json`` of ``pidcore calibrate`` (or the ``--out`` folder
-    holding it).
+    holding it), or a calibration saved in an HDF5 store (``key``: which one; a store holding
+    one needs none: :func:`pidcore.calibrate.persist.stored_calibration`).
 
     Raises
     ------
     ParameterError
         One line naming the file and what was expected: missing, not JSON, not a
-        calibration (no ``parameters``/``predictions``), or a prediction with a missing or
-        non-finite field or ``low95 > high95``.
+        calibration (no ``parameters``/``predictions``), a store without it, or a prediction
+        with a missing or non-finite field or ``low95 > high95``.
     """
+    from .persist import is_store_file, stored_calibration
+
     path = Path(path)
+    if is_store_file(path):
+        return stored_calibration(path, key)
+    if key is not None:
+        raise ParameterError(f"{path}: a calibration key ({key}) chooses among the "
+                             "calibrations of an HDF5 store; this is not one")
     if path.is_dir() and (path / "calibration.json").is_file():
         path = path / "calibration.json"  # the folder `pidcore calibrate --out` wrote
     if path.is_dir():

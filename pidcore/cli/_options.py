@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import re
+import sys
 from pathlib import Path
 
 from .. import defaults
@@ -59,9 +60,9 @@ def add_load_case_options(p: argparse._ActionsContainer, *, what: str,
     p.add_argument("--sidecar", metavar="CSV", type=path_argument, default=None,
                    help="per-file table: load case (file, fill_percent, material, direction) "
                         "and analysis settings (velocity_delay_us, mass_below_gauge_g, "
-                        "baseline_loss_factor, force, velocity, acceleration, invert, "
-                        "specimen); options given override it; default: loadcases.csv beside "
-                        "each file")
+                        "baseline_loss_factor, structure_mass_g, force, velocity, acceleration, "
+                        "invert, specimen); options given override it; default: "
+                        "loadcases.csv beside each file")
 
 
 def check_out_folder(out: Path) -> None:
@@ -76,6 +77,25 @@ def add_store_option(p: argparse.ArgumentParser, *, flag: str = "--store",
                      help: str = STORE_HELP) -> None:
     """An HDF5 store file option (``--store``, ``--dem-store``) read as a :class:`Path`."""
     p.add_argument(flag, metavar="FILE", type=path_argument, default=default, help=help)
+
+
+def progress_wanted(args: argparse.Namespace) -> bool:
+    """Whether a command draws progress bars: not with ``--no-progress``, and only on a
+    terminal. tqdm redraws its bar with carriage returns, which a log file or a pipe keeps
+    as one long line of every redraw (``pidcore dem sweep ... 2> log``)."""
+    if getattr(args, "no_progress", False):
+        return False
+    isatty = getattr(sys.stderr, "isatty", None)
+    return bool(isatty and isatty())
+
+
+def scheduler_address(text: str) -> str:
+    """argparse type: a dask.distributed scheduler address, refused when empty (``--scheduler
+    "$SCHEDULER"`` with the variable unset ran the sweep on local processes without a word)."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError(f"expected a scheduler address such as "
+                                         f"tcp://host:8786, got {text!r}")
+    return text.strip()
 
 
 def add_json_option(p: argparse.ArgumentParser, *, progress: bool = False) -> None:
@@ -104,6 +124,11 @@ def add_measurement_options(p: argparse.ArgumentParser) -> None:
     g.add_argument("--baseline-loss-factor", metavar="ETA", type=float, default=None,
                    help="loss factor of the empty coupon to subtract (default: the sidecar's, "
                         "else 0)")
+    g.add_argument("--structure-mass", metavar="KG", type=float, default=None,
+                   help="mass of that empty structure (coupon and fixture above the gauge), "
+                        "kg: its own dissipation is subtracted (default: the sidecar's "
+                        "structure_mass_g; none: the baseline is taken off the whole vibrated "
+                        "mass, which takes too much, noted)")
     g.add_argument("--frequency", metavar="HZ", type=float, default=None,
                    help="drive frequency hint, Hz (estimated from the data anyway)")
     g.add_argument("--harmonics", metavar="N", type=int, default=defaults.N_HARMONICS,
@@ -134,7 +159,8 @@ def add_measurement_options(p: argparse.ArgumentParser) -> None:
 SIDECAR_OPTION_FLAGS: dict[str, str] = {
     "force": "--force", "velocity": "--velocity", "acceleration": "--acceleration",
     "velocity_delay_s": "--velocity-delay", "mass_below_gauge_kg": "--mass-below-gauge",
-    "baseline_loss_factor": "--baseline-loss-factor", "invert": "--invert",
+    "baseline_loss_factor": "--baseline-loss-factor", "structure_mass_kg": "--structure-mass",
+    "invert": "--invert",
 }
 
 
@@ -159,7 +185,8 @@ def analysis_options(args: argparse.Namespace) -> AnalysisOptions:
     return AnalysisOptions(
         force=args.force, velocity=args.velocity, acceleration=args.acceleration,
         velocity_delay_s=delay, mass_below_gauge_kg=given(args.mass_below_gauge),
-        baseline_loss_factor=given(args.baseline_loss_factor), frequency_hz=args.frequency,
+        baseline_loss_factor=given(args.baseline_loss_factor),
+        structure_mass_kg=args.structure_mass, frequency_hz=args.frequency,
         n_harmonics=args.harmonics, sample_rate_hz=args.sample_rate,
         allow_clipped=args.allow_clipped, force_unit=args.force_unit,
         velocity_unit=args.velocity_unit, acceleration_unit=args.acceleration_unit,
@@ -179,6 +206,7 @@ _FLAG_OF_KEYWORD = (
     ("velocity_delay_s", "--velocity-delay"),
     ("mass_below_gauge_kg", "--mass-below-gauge"),
     ("baseline_loss_factor", "--baseline-loss-factor"),
+    ("structure_mass_kg", "--structure-mass"),
     ("frequency_hz", "--frequency"),
     ("n_harmonics", "--harmonics"),
     ("sample_rate_hz", "--sample-rate"),

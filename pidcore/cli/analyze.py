@@ -10,7 +10,7 @@ from pathlib import Path
 
 from .. import interrupt
 from ..errors import PidcoreError
-from ..file_settings import analyze_with_settings
+from ..file_settings import analyze_each
 from ..io import display_path
 from ..measure import NO_LOAD_CASE
 from ._options import (
@@ -21,6 +21,7 @@ from ._options import (
     analysis_options,
     given_options,
     path_argument,
+    progress_wanted,
     with_cli_flags,
 )
 
@@ -54,7 +55,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--key", metavar="NAME", default=None,
                    help="which measurement of a pidcore HDF5 store to analyse, when it holds "
                         "several (the error lists them)")
-    add_json_option(p)
+    add_json_option(p, progress=True)
     p.set_defaults(func=run)
 
 
@@ -107,8 +108,7 @@ def _run(args: argparse.Namespace) -> int:
     try:
         # Analyse everything before writing anything: one bad file leaves the store untouched.
         results = refuse_implausible(
-            [analyze_with_settings(path, fs, key=args.key)
-             for path, fs in zip(args.paths, settings, strict=True)],
+            analyze_each(args.paths, settings, key=args.key, progress=progress_wanted(args)),
             [display_path(Path(path).name) for path in args.paths],
             accept=args.accept_implausible)
         cases = [st.load_case(r.analysis.frequency_hz, r.analysis.acceleration_g)

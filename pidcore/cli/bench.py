@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import json
 
-from ._options import positive_int
+from ._options import positive_int, progress_wanted
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -39,6 +39,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     d.add_argument("--workers", type=positive_int, default=None,
                    help="processes for the grid (default: all cores)")
     d.add_argument("--json", action="store_true", help="one JSON document on stdout")
+    d.add_argument("--no-progress", action="store_true",
+                   help="no progress bars (drawn only on a terminal)")
     d.set_defaults(func=_bench_dem)
 
 
@@ -71,24 +73,32 @@ DEM_BENCH_BEDS = (
 
 
 def _bench_dem(args: argparse.Namespace) -> int:
+    from tqdm import tqdm
+
     from ..dem.bench import run_dem_bench, run_grid_bench
 
     result: dict = {}
-    for label, material, n, accel, mu_s, mu_r, target in DEM_BENCH_BEDS:
-        r = run_dem_bench(particles_per_cell=n, material=material, acceleration_g=accel,
-                          static_friction=mu_s, rolling_friction=mu_r, repeat=args.repeat,
-                          reference=True)
-        result[f"{label}_particle_steps_per_s"] = r["particle_steps_per_s"]
-        result[f"{label}_particle_steps_per_s_cpu"] = r["particle_steps_per_s_cpu"]
-        result[f"{label}_target_particle_steps_per_s"] = target
-        result[f"{label}_reference_particle_steps_per_s_cpu"] = \
-            r["reference_particle_steps_per_s"]
-        # both CPU times: the kernel's own speed on a shared machine
-        result[f"{label}_ratio_to_reference"] = \
-            r["particle_steps_per_s_cpu"] / r["reference_particle_steps_per_s"]
+    # the beds of --repeat 1 took ~40 s with no sign of life; the bar is closed (its line
+    # cleared) as the block ends, Ctrl-C included, before the CLI's one line
+    with tqdm(total=len(DEM_BENCH_BEDS), desc="DEM beds", unit="bed", leave=False,
+              dynamic_ncols=True, disable=not progress_wanted(args)) as bar:
+        for label, material, n, accel, mu_s, mu_r, target in DEM_BENCH_BEDS:
+            r = run_dem_bench(particles_per_cell=n, material=material, acceleration_g=accel,
+                              static_friction=mu_s, rolling_friction=mu_r,
+                              repeat=args.repeat, reference=True)
+            result[f"{label}_particle_steps_per_s"] = r["particle_steps_per_s"]
+            result[f"{label}_particle_steps_per_s_cpu"] = r["particle_steps_per_s_cpu"]
+            result[f"{label}_target_particle_steps_per_s"] = target
+            result[f"{label}_reference_particle_steps_per_s_cpu"] = \
+                r["reference_particle_steps_per_s"]
+            # both CPU times: the kernel's own speed on a shared machine
+            result[f"{label}_ratio_to_reference"] = \
+                r["particle_steps_per_s_cpu"] / r["reference_particle_steps_per_s"]
+            bar.update(1)
     result["threads"] = 1
     result["repeat"] = args.repeat
     if args.grid:
-        result.update(run_grid_bench(workers=args.workers), target_grid_wall_s=60.0)
+        result.update(run_grid_bench(workers=args.workers,
+                                     progress=progress_wanted(args)), target_grid_wall_s=60.0)
     _emit(result, args.json)
     return 0

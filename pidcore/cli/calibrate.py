@@ -7,7 +7,13 @@ import sys
 from pathlib import Path
 
 from .. import defaults, interrupt
-from ._options import check_out_folder, non_negative_int, path_argument, positive_int
+from ._options import (
+    check_out_folder,
+    non_negative_int,
+    path_argument,
+    positive_int,
+    progress_wanted,
+)
 
 DEFAULT_STORE = Path("calibration_store.h5")
 
@@ -24,7 +30,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         description="Fit chosen parameters to measured SDCs (Eq. 11 of the DEM's virtual "
                     "shaker, with fixture mass and baseline loss factor), with a posterior, "
                     "95 % intervals and optional leave-one-out cross-validation. DEM runs "
-                    "over a space-filling design are cached in --dem-store.")
+                    "over a space-filling design are cached in --dem-store, and the result is "
+                    "saved there.")
     source = p.add_mutually_exclusive_group(required=True)
     source.add_argument("--data", metavar="TABLE.csv", type=path_argument,
                         help="measured SDCs: frequency_hz, acceleration_g, fill_percent, sdc "
@@ -63,7 +70,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help="posterior: exact grid (<= 4 fitted quantities: 3 parameters plus "
                         "the discrepancy) or emcee; auto picks (default auto)")
     p.add_argument("--dem-store", metavar="FILE", type=path_argument, default=DEFAULT_STORE,
-                   help="HDF5 store caching the DEM runs (default %(default)s)")
+                   help="HDF5 store caching the DEM runs; the calibration is saved in it "
+                        "too (report --calibration FILE reads it) (default %(default)s)")
     p.add_argument("--cross-validate", choices=("loo",), default=None,
                    help="leave-one-out: predict each load case from a fit without it")
     p.add_argument("--out", metavar="DIR", type=path_argument, default=None,
@@ -76,8 +84,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     from ..calibrate.calibrate import CALIBRATION_CELLS, calibrate
     from ..calibrate.data import DEFAULT_MATERIAL, measured_from_store, read_measured_table
-    from ..calibrate.outputs import document_json, write_outputs
+    from ..calibrate.outputs import write_outputs
     from ..calibrate.parameters import parse_fit
+    from ..calibrate.persist import save_calibration
     from ..calibrate.runner import RunTally
     from ..errors import ParameterError
     from ..specimen import load_specimen
@@ -106,46 +115,84 @@ def run(args: argparse.Namespace) -> int:
         for note in left_out:
             print(f"pidcore calibrate: note: {note}", file=sys.stderr)
     tally = RunTally(args.dem_store)
-    written = False
+    written, fitted, saved = False, False, None
     try:
         result = calibrate(points, fit=fit, priors=args.prior, discrepancy=args.discrepancy,
                            discrepancy_floor=args.discrepancy_floor, store_path=args.dem_store,
                            cells=cells, seed=args.seed, steady_cycles=args.steady_cycles,
                            design_size=args.design_size, workers=args.workers,
                            cross_validate=args.cross_validate, method=args.method,
-                           progress=not args.no_progress, specimen=specimen,
+                           progress=progress_wanted(args), specimen=specimen,
                            on_design=tally.design)
         own_notes = list(result.notes)
         result.notes = [*left_out, *own_notes]
+        fitted = True
         if args.out is not None:
             write_outputs(result, args.out)  # all or nothing
             written = True
+        # beside the DEM runs it was made from (one transaction, after --out so that a Ctrl-C
+        # while the figures are drawn commits nothing): reports and the app read it from there
+        # (report --calibration STORE), and it outlives the --out folder
+        saved = save_calibration(result, args.dem_store)
+        # inside: a Ctrl-C as the result printed was answered by the generic line, which
+        # said the complete --out "may hold part of this run's files"
+        _print_result(args, result, own_notes, _saved_words(saved, args.dem_store))
         interrupt.raise_if_interrupted()  # one swallowed on the way, or held by the move
     except BaseException as exc:  # noqa: BLE001 - an interrupt, or what one became in C code
         if not interrupt.is_interruption(exc):
             raise
         # finished runs are each saved in their own transaction: counted from the store
         print(f"pidcore calibrate: interrupted; {tally.interrupted()}"
-              f"{_out_words(args.out, written)}", file=sys.stderr)
+              f"{_saved_words(saved, args.dem_store) if fitted else ''}"
+              f"{_out_words(args.out, written)}",
+              file=sys.stderr)
         interrupt.mark_handled()
         return 130
+    return 0
+
+
+def _print_result(args: argparse.Namespace, result, own_notes: list[str], saved: str) -> None:
+    """The calibration's notes (stderr), its parameters and scores or its JSON document, how
+    many DEM runs it computed and reused, and ``saved`` (:func:`_saved_words`: where the store
+    keeps it)."""
+    from ..calibrate.outputs import document_json, rms_text
+
     for note in own_notes:
         print(f"pidcore calibrate: note: {note}", file=sys.stderr)
+    said = saved.removeprefix("; ")
+    # a re-run (after Ctrl-C, or with other priors) says that it reused its stored runs; on
+    # stderr beside --json's one document
+    runs = (f"DEM runs: {result.runs['computed']} computed, {result.runs['cached']} reused "
+            f"from {args.dem_store}")
     if args.json:
+        print(f"pidcore calibrate: note: {runs}", file=sys.stderr)
         print(document_json(result.document()))
+        print(f"pidcore calibrate: {said}", file=sys.stderr)
     else:
         from ..calibrate.posterior import summary_texts
 
         for name, p in result.parameters.items():
             median, low, high = summary_texts(p)
             print(f"{name}: {median} (95 % {low} .. {high})")
-        print(f"in-sample RMS {result.rms:.4f}")
+        print(f"in-sample RMS {rms_text(result.rms)}")
+        print(runs)
         if result.loo is not None:
-            print(f"leave-one-out RMS {result.loo_rms:.4f}, {result.loo_coverage}/"
+            print(f"leave-one-out RMS {rms_text(result.loo_rms)}, {result.loo_coverage}/"
                   f"{len(result.loo)} inside the 95 % band")
+        print(said)
         if args.out is not None:
             print(f"wrote {args.out}")
-    return 0
+
+
+def _saved_words(saved: tuple[str, bool] | None, store: Path) -> str:
+    """What became of the calibration in the store (:func:`pidcore.calibrate.persist.
+    save_calibration`'s ``(key, added)``; None: not saved)."""
+    if saved is None:
+        return f"; the calibration was not saved in {store}"
+    key, added = saved
+    if added:
+        return f"; saved calibration {key} in {store} (report --calibration {store})"
+    return f"; calibration {key} is stored in {store} already (the same result)"
 
 
 def _store_points(points: list, specimen, store: Path, left_out: list[str]) -> list:

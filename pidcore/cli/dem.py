@@ -9,7 +9,7 @@ import re
 import sys
 from collections.abc import Callable
 
-from .. import defaults
+from .. import defaults, interrupt
 from ..constants import (
     DRIVE_DIRECTIONS,
     NORMAL_DAMPING_MODES,
@@ -27,6 +27,8 @@ from ._options import (
     non_negative_int,
     path_argument,
     positive_int,
+    progress_wanted,
+    scheduler_address,
 )
 
 #: Keys of ``pidcore dem run --json`` (more may follow them).
@@ -190,7 +192,7 @@ def _register_sweep(sub: argparse._SubParsersAction) -> None:
     _add_config_options(p)
     p.add_argument("--workers", metavar="N", type=positive_int, default=None,
                    help="local processes (default: all cores)")
-    p.add_argument("--scheduler", metavar="ADDR", default=None,
+    p.add_argument("--scheduler", metavar="ADDR", type=scheduler_address, default=None,
                    help="dask.distributed scheduler address (needs the 'distributed' extra)")
     add_store_option(p)
     add_json_option(p, progress=True)
@@ -266,11 +268,27 @@ def sweep(args: argparse.Namespace) -> int:
     before = stored_keys(args.store, keys)
     try:
         summary = run_sweep(cases, config, store_path=args.store, workers=args.workers,
-                            scheduler=args.scheduler, progress=not args.no_progress,
+                            scheduler=args.scheduler, progress=progress_wanted(args),
                             specimen=specimen)
+        # inside: a Ctrl-C as the summary is printed (every case done) said "no store write
+        # was left half-done" instead of what the sweep saved
+        _print_sweep(args, summary)
+        interrupt.raise_if_interrupted()
     except KeyboardInterrupt:
         saved = stored_keys(args.store, keys) - before
         return _interrupted("sweep", len(saved), args.store)
+    except PidcoreError as exc:  # a case refused or failed, a worker killed: what is kept
+        saved = stored_keys(args.store, keys) - before
+        if not saved:
+            raise
+        raise type(exc)(f"{exc}; {len(saved)} finished run(s) saved to {args.store}; re-run "
+                        "to resume") from None
+    return 0
+
+
+def _print_sweep(args: argparse.Namespace, summary) -> None:
+    """What a finished sweep did: its JSON document, or the counts and the cases it found
+    to be the same simulation as another."""
     if args.json:
         print(json.dumps(summary.to_dict()))
     else:
@@ -282,7 +300,6 @@ def sweep(args: argparse.Namespace) -> int:
                       f"{case['acceleration_g']:g} g): {case['status']} ("
                       f"{case.get('particles_per_cell', '?')} particles per cell, the same "
                       f"seed and settings), not simulated again: {case['store_key']}")
-    return 0
 
 
 def _check_fill(fill: float, option: str, args: argparse.Namespace, specimen,
@@ -327,7 +344,7 @@ def run(args: argparse.Namespace) -> int:
 
     config = _config(args)
     check_drive(case, config, specimen, what="--frequency/--acceleration")
-    progress = not args.no_progress and sys.stderr.isatty()
+    progress = progress_wanted(args)
     key = None
     reused = False
     store = None
@@ -341,12 +358,22 @@ def run(args: argparse.Namespace) -> int:
             result, key, reused = cached.result, cached.key, cached.reused
         else:
             result = simulate_load_case(case, config, progress=progress, specimen=specimen)
+        # inside: a Ctrl-C as the result is printed said "no store write was left
+        # half-done" instead of whether the run was saved
+        _print_run(args, result, case, specimen, key=key, reused=reused)
+        interrupt.raise_if_interrupted()
     except KeyboardInterrupt:
         # the run is saved in one transaction at its end: committed now, or not at all
         return _interrupted("run", int(store is not None and store.commits > 0), args.store)
+    return 0
+
+
+def _print_run(args: argparse.Namespace, result, case, specimen, *, key: str | None,
+               reused: bool) -> None:
+    """One run's summary and notes, or its JSON document, and where it is stored."""
     notes = list(result.notes)
     said = [note for note in (_same_simulation_note(case, result) if reused else "",
-                              _baseline_note(specimen)) if note]
+                              _baseline_note(specimen, result)) if note]
     notes += said
     if args.json:
         out = {k: result.to_dict()[k] for k in JSON_KEYS}
@@ -361,25 +388,34 @@ def run(args: argparse.Namespace) -> int:
             out["store_key"] = key
             out["reused_from_store"] = reused
         print(json.dumps(out))
-        return 0
+        return
     print(format_summary(result))
     for note in said:
         print(f"note            {note}")
     if key is not None:
         print(f"{'reused from' if reused else 'saved to'} {args.store} as {key}")
-    return 0
 
 
-def _baseline_note(specimen) -> str:
+def _baseline_note(specimen, result) -> str:
     """What the SDC leaves out of a specimen stating the empty coupon's loss factor: the run
     printed the particles' SDC beside a file stating ``baseline_loss_factor`` without a word
-    of whether it was in it; "" where the specimen states none."""
+    of whether it was in it; "" where the specimen states none.
+
+    The empty structure (coupon and fixture, the rigid mass the shaker moves) dissipates
+    2 pi eta_0 of *its own* peak kinetic energy per cycle, so it adds
+    2 pi eta_0 m_structure / m_c to an SDC taken over E = m_c a^2 / (2 w^2) -- the observation
+    model of ``pidcore calibrate`` (:func:`pidcore.calibrate.surrogate.predicted_sdc`). The note
+    said 2 pi eta_0, 9 x too much for a bed of tungsten carbide nine times the structure's mass.
+    """
     eta = float(specimen.coupon.baseline_loss_factor) if specimen is not None else 0.0
     if eta <= 0:
         return ""
+    share = result.moving_mass_kg / result.vibrated_mass_kg
     return (f"SDC of the particles alone: the specimen's [coupon] baseline_loss_factor {eta:g} "
-            f"(the empty coupon's damping, 2 pi x {eta:g} = {2 * math.pi * eta:.3g} in SDC) is "
-            "not in it; pidcore calibrate's prediction adds it")
+            f"(the empty coupon's damping: 2 pi x {eta:g} of the coupon and fixture's own "
+            f"kinetic energy, {result.moving_mass_kg:.4g} kg of m_c = "
+            f"{result.vibrated_mass_kg:.4g} kg, i.e. {2 * math.pi * eta * share:.3g} in this "
+            "SDC) is not in it; pidcore calibrate's prediction adds it")
 
 
 def _same_simulation_note(asked, result) -> str:
@@ -426,8 +462,9 @@ def format_summary(result) -> str:
          f"{result.loss_factor:.4g} [-]) over {result.cells_simulated} cells"
          if math.isfinite(result.sdc_stderr) else
          f"SDC             {result.sdc:.4g} [-] (loss factor {result.loss_factor:.4g} [-]) over "
-         f"{result.cells_simulated} cell(s): no standard error (the cells' scatter; simulate "
-         "--cells 2 or more)"),
+         f"{result.cells_simulated} cell(s): no standard error"
+         + (" (see the note)" if result.cells_simulated > 1 else
+            " (the cells' scatter; simulate --cells 2 or more)")),
         f"dissipated      {result.energy_per_cycle_j:.4g} J/cycle (coupon, "
         f"{result.coupon_cells} cells): normal "
         f"damping {result.energy_dissipated_normal_j:.4g} J, friction "

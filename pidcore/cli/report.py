@@ -19,6 +19,7 @@ from ._options import (
     analysis_options,
     given_options,
     path_argument,
+    progress_wanted,
     with_cli_flags,
 )
 
@@ -75,8 +76,14 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         "each)")
     p.add_argument("--calibration", metavar="FILE", type=path_argument, default=None,
                    help="calibration.json of pidcore calibrate (or the --out folder holding "
-                        "it): add the calibrated DEM's Eq. 11 SDC with its 95 %% band beside the "
-                        "raw DEM and the measurement")
+                        "it), or an HDF5 store it saved calibrations in (its --dem-store): add "
+                        "the calibrated DEM's Eq. 11 SDC with its 95 %% band beside the raw DEM "
+                        "and the measurement")
+    p.add_argument("--calibration-key", metavar="KEY", default=None,
+                   help="which calibration of the --calibration store (cal_...; a store "
+                        "holding one needs none)")
+    p.add_argument("--no-progress", action="store_true",
+                   help="no progress bars (drawn only on a terminal)")
     add_measurement_options(p)
     p.set_defaults(func=run)
 
@@ -107,7 +114,8 @@ def _run(args: argparse.Namespace) -> int:
             direction=args.direction, sidecar=args.sidecar, options=analysis_options(args),
             options_given=given_options(args),
             specimen=specimen, pool=args.pool, calibration=args.calibration,
-            accept_implausible=args.accept_implausible)
+            calibration_key=args.calibration_key,
+            accept_implausible=args.accept_implausible, progress=progress_wanted(args))
         print(short_table(result.table))
         for note in result.notes:
             print(f"note: {note}")

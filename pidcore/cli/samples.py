@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ._options import path_argument, positive_int
+from ._options import path_argument, positive_int, progress_wanted
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -28,6 +28,7 @@ def _make(args: argparse.Namespace) -> int:
     from ..samples import make_samples
 
     for name, path in make_samples(args.out, run_sweep=not args.skip_sweep,
-                                   workers=args.workers).items():
+                                   workers=args.workers,
+                                   progress=progress_wanted(args)).items():
         print(f"{name:<50} {path}")
     return 0

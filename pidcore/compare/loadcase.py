@@ -73,14 +73,14 @@ SIDECAR_COLUMNS: tuple[str, ...] = ("file", "fill_percent", "material", "directi
 SPECIMEN_COLUMN = "specimen"
 #: Columns stating how a file is analysed (read by :mod:`pidcore.file_settings`).
 ANALYSIS_SETTINGS_COLUMNS: tuple[str, ...] = (
-    "velocity_delay_us", "mass_below_gauge_g", "baseline_loss_factor", "force", "velocity",
-    "acceleration", "invert")
+    "velocity_delay_us", "mass_below_gauge_g", "baseline_loss_factor", "structure_mass_g",
+    "force", "velocity", "acceleration", "invert")
 #: Every column of a sidecar / the app's settings table (its template's columns, in its order).
 SETTINGS_COLUMNS: tuple[str, ...] = (*SIDECAR_COLUMNS, SPECIMEN_COLUMN,
                                      *ANALYSIS_SETTINGS_COLUMNS)
 #: Columns holding numbers (a ``;``-separated table may write them with a decimal comma).
 NUMERIC_COLUMNS: tuple[str, ...] = ("fill_percent", "velocity_delay_us", "mass_below_gauge_g",
-                                    "baseline_loss_factor")
+                                    "baseline_loss_factor", "structure_mass_g")
 #: The app's labels of the settings columns (its settings grid shows them, and an uploaded
 #: table may use them) -> the settings table's columns. The CLI's sidecar reads them too, so
 #: one table reads the same in both (a table typed after the app's grid was refused by the CLI).
@@ -93,6 +93,7 @@ SETTINGS_COLUMN_LABELS: dict[str, str] = {
     "vibrometer delay [µs]": "velocity_delay_us",
     "mass below gauge [g]": "mass_below_gauge_g",
     "baseline loss factor [-]": "baseline_loss_factor",
+    "structure mass [g]": "structure_mass_g",
     "force channel": "force",
     "velocity channel": "velocity",
     "acceleration channel": "acceleration",

@@ -117,11 +117,11 @@ def _time_reference(state: CellsState, settings: KernelSettings, steps: int,
 
 
 def run_grid_bench(*, material: str = "acrylic", seed: int = defaults.DEM_SEED,
-                   workers: int | None = None) -> dict:
+                   workers: int | None = None, progress: bool = True) -> dict:
     """Wall time of the paper's Table 3 grid with default settings, into a temporary store.
 
     Returns ``grid_cases`` and ``grid_wall_s`` [s] of :func:`pidcore.dem.sweep.run_sweep` with
-    ``workers`` processes.
+    ``workers`` processes; ``progress``: the sweep's bar on stderr.
     """
     import tempfile
     from pathlib import Path
@@ -132,5 +132,5 @@ def run_grid_bench(*, material: str = "acrylic", seed: int = defaults.DEM_SEED,
     cases = grid_cases("table3", material=material)
     with tempfile.TemporaryDirectory() as tmp:
         summary = run_sweep(cases, DemConfig(seed=seed), store_path=Path(tmp) / "b.h5",
-                            workers=workers, progress=True)
+                            workers=workers, progress=progress)
     return {"grid_cases": len(cases), "grid_wall_s": summary.wall_s}

@@ -132,7 +132,11 @@ class DemResult:
         e_max = vibrated_mass_kg * case.acceleration_m_s2**2 / (2 * case.omega_rad_s**2)
         per_cell = n_coupon * steady[:, :, 1:].sum(axis=2).mean(axis=1)  # coupon J / cycle
         sdc_cells = per_cell / e_max if e_max > 0 else np.full(k, np.nan)
-        stderr = float(np.std(sdc_cells, ddof=1) / math.sqrt(k)) if k > 1 else float("nan")
+        # cells that ran one motion (a lone particle bouncing along the drive axis touches no
+        # side wall, so its random start xy does not matter) are one sample, not K: their
+        # scatter of exactly 0 is no standard error (it printed "+- 0" for an unsettled bouncer)
+        stderr = (float(np.std(sdc_cells, ddof=1) / math.sqrt(k))
+                  if k > 1 and not cells_ran_one_motion(sdc_cells) else float("nan"))
         work = float(tally[:, :, 0].sum())
         # friction and normal summed as before rolling existed (same rounding), rolling added
         dissipated = float(tally[:, :, 1:3].sum()) + float(tally[:, :, 3:].sum())
@@ -215,6 +219,11 @@ class DemResult:
                          "included Numba compilation (run again for the compiled speed)")
         if self.specimen is not None:
             notes += table_overrides(self.specimen)
+        if cells_ran_one_motion(self.sdc_per_cell):
+            notes.append(f"no standard error: the {self.cells_simulated} cells ran the same "
+                         "motion (the same SDC to the last bit, as a lone particle bouncing along "
+                         "the drive axis does), so they are one sample and their scatter says "
+                         "nothing of the SDC's uncertainty")
         g = self.case.acceleration_g
         if g > defaults.DEM_NOTE_ACCELERATION_G:
             notes.append(f"a {g:g} g drive, above the paper's 1-10 g: if it was typed in "
@@ -340,6 +349,12 @@ class DemResult:
         from ..report.figures_results import plot_dem_run  # lazy: drawing is optional
 
         return plot_dem_run(self, ax=ax)
+
+
+def cells_ran_one_motion(sdc_per_cell: np.ndarray) -> bool:
+    """Whether two or more cells gave the same SDC to the last bit: the same simulation."""
+    sdc = np.asarray(sdc_per_cell, dtype=float)
+    return sdc.size > 1 and bool(np.all(np.isfinite(sdc))) and float(np.ptp(sdc)) == 0.0
 
 
 def virtual_shaker_loop(force_n: np.ndarray, velocity_m_s: np.ndarray, *,

@@ -300,6 +300,48 @@ class _KernelClock:
         return out
 
 
+def cycles_per_call(*, steps_per_cycle: int, particles: int, cycles: int,
+                    budget: int | None = None) -> int:
+    """Whole drive cycles per kernel call of a block of ``cycles``: as many as fit in
+    ``budget`` particle-steps (``particles``: of all cells; default
+    :data:`pidcore.defaults.DEM_PARTICLE_STEPS_PER_CALL`), at least one, at most the block."""
+    if budget is None:
+        budget = defaults.DEM_PARTICLE_STEPS_PER_CALL
+    per_cycle = max(steps_per_cycle * particles, 1)
+    return max(1, min(cycles, budget // per_cycle))
+
+
+def _drive_block(clock: _KernelClock, state: CellsState, drive: KernelSettings, cycles: int,
+                 *, steps_per_cycle: int, sample_every: int,
+                 on_cycles: Callable[[int], None] | None = None
+                 ) -> tuple[np.ndarray, np.ndarray]:
+    """``cycles`` drive cycles in kernel calls of whole cycles (:func:`cycles_per_call`):
+    the tally and samples of one call over the whole block, bit for bit.
+
+    The kernel keeps nothing between calls that a call boundary on a cycle boundary changes:
+    each cycle's tally and each sample interval start from zero within one call (a sample
+    interval divides the cycle), the wall's position is recomputed from the step count, and
+    the Verlet lists, rebuilt at each call, keep the brute-force order of contacts. Shorter
+    calls only let Ctrl-C in sooner (:meth:`_KernelClock.advance` checks it after each);
+    ``on_cycles(n)`` is told of each call's cycles (a progress bar)."""
+    per_call = cycles_per_call(steps_per_cycle=steps_per_cycle,
+                               particles=state.n_particles * state.n_cells, cycles=cycles)
+    tallies, samples = [], []
+    done = 0
+    while done < cycles:
+        n = min(per_call, cycles - done)
+        t, s = clock.advance(state, drive, n * steps_per_cycle,
+                             steps_per_cycle=steps_per_cycle, sample_every=sample_every)
+        tallies.append(t)
+        samples.append(s)
+        done += n
+        if on_cycles is not None:
+            on_cycles(n)
+    if len(tallies) == 1:
+        return tallies[0], samples[0]
+    return np.concatenate(tallies, axis=1), np.concatenate(samples, axis=1)
+
+
 def settle(state: CellsState, settings: KernelSettings, *,
            max_time_s: float = defaults.DEM_MAX_SETTLE_TIME_S,
            kinetic_fraction: float = defaults.DEM_SETTLE_KINETIC_FRACTION,
@@ -636,8 +678,9 @@ def simulate_load_case(case: LoadCase, config: DemConfig | None = None, *,
         bar = tqdm(total=need + 2 * b, unit="cycle", desc=f"DEM {case.key}", leave=False)
     try:
         while True:
-            t, s = clock.advance(state, drive, b * steps_per_cycle,
-                                 steps_per_cycle=steps_per_cycle, sample_every=sample_every)
+            t, s = _drive_block(clock, state, drive, b, steps_per_cycle=steps_per_cycle,
+                                sample_every=sample_every,
+                                on_cycles=bar.update if bar is not None else None)
             tallies.append(t)
             samples.append(s)
             u_now = wall_displacement(state.step * dt, accel_m_s2=case.acceleration_m_s2,
@@ -645,8 +688,6 @@ def simulate_load_case(case: LoadCase, config: DemConfig | None = None, *,
             block_energy.append(energies(state, law, geometry, wall_offset_m=unit * u_now,
                                          gravity_m_s2=STANDARD_GRAVITY)[:, 3])
             done = len(tallies) * b
-            if bar is not None:
-                bar.update(b)
             if steady_start is None:
                 all_t = np.concatenate(tallies, axis=1).mean(axis=0)  # (cycles, 3)
                 steady_start = _steady_start(all_t[:, 1] + all_t[:, 2] + all_t[:, 3],

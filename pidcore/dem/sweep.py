@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..constants import DriveDirection, ParticleMaterial
-from ..errors import ParameterError
+from ..errors import ParameterError, SimulationError
 from ..records import json_safe
 from ..specimen import Specimen
 from .persist import (
@@ -200,6 +200,7 @@ def run_pooled(function: Callable, calls: Sequence[tuple], *, workers: int,
     multiprocessing's ``forkserver.py`` after the CLI's one line.
     """
     from concurrent.futures import ProcessPoolExecutor, as_completed
+    from concurrent.futures.process import BrokenProcessPool
 
     from .. import interrupt
 
@@ -215,6 +216,13 @@ def run_pooled(function: Callable, calls: Sequence[tuple], *, workers: int,
         interrupt.raise_if_interrupted()
         for future in as_completed(futures):
             finish(future.result())
+    except BrokenProcessPool:
+        # a worker killed from outside (the kernel's OOM killer, kill -9): a traceback of
+        # concurrent.futures and exit 1 said neither what happened nor what was kept
+        _stop_pool(pool)
+        raise SimulationError(
+            "a DEM worker process ended abruptly (killed, or out of memory?) while running "
+            "a case; the cases finished before it are kept") from None
     except BaseException:
         _stop_pool(pool)
         raise
@@ -360,7 +368,19 @@ def run_sweep(cases: Sequence[LoadCase], config: DemConfig, *,
         bar = tqdm(total=len(cases), initial=len(cases) - len(todo), unit="case",
                    desc="DEM sweep")
 
+    asked = {key for _, key in todo}
+
     def finish(outcome: CaseOutcome) -> None:
+        if outcome.key not in asked:
+            from .. import __version__
+
+            # a dask worker with another pidcore (DEM code version, key rules) keys its run
+            # otherwise: stored, the sweep listed its case as unfinished and every re-run
+            # simulated it again
+            raise SimulationError(
+                f"a worker returned run {outcome.key}, which this sweep did not ask for (it "
+                f"asked for {len(asked)} run(s) such as {min(asked)}): the workers run "
+                f"another pidcore than this one ({__version__}); install the same on them")
         outcome.save_to(store)
         summary.completed.append(outcome.key)
         if bar is not None:
@@ -406,7 +426,10 @@ def _run_dask(todo: Iterable[tuple[LoadCase, str]], config: DemConfig, scheduler
                              "pip install 'pidcore[distributed]'") from None
     try:
         client = Client(scheduler)
-    except (OSError, ValueError) as exc:  # refused, timed out (OSError), or a bad address
+    # refused or timed out (OSError), a bad address (ValueError), and whatever else the
+    # connection raises: tls:// without a TLS configuration is a TypeError, which came out
+    # as a traceback
+    except Exception as exc:  # noqa: BLE001 - every failure to connect is one line
         raise ParameterError(f"--scheduler {scheduler}: cannot connect to a dask.distributed "
                              f"scheduler there ({' '.join(str(exc).split())}); expected the "
                              f"address of a running scheduler, e.g. tcp://host:8786") from None

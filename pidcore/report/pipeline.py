@@ -164,7 +164,8 @@ def analyze_files(paths: Sequence[str | Path], *, fill_percent: float | None = N
                   specimen_material: str | None = None,
                   specimen_name: str | None = None,
                   specimen: Specimen | None = None,
-                  accept_implausible: bool = False) -> list[MeasuredResult]:
+                  accept_implausible: bool = False,
+                  progress: bool = False) -> list[MeasuredResult]:
     """Read, assign roles, analyze (Eq. 11) and attach the load case of every file.
 
     The load case and the analysis settings are resolved first for every file, so a missing
@@ -180,9 +181,10 @@ def analyze_files(paths: Sequence[str | Path], *, fill_percent: float | None = N
     (:func:`pidcore.file_settings.resolve_files`). A result the plausibility checks refuse (a
     negative loss factor beyond its noise, an SDC above 2 pi) is refused unless
     ``accept_implausible`` (:func:`pidcore.compare.plausibility.refuse_implausible`).
+    ``progress``: a bar over the files on stderr (:func:`pidcore.file_settings.analyze_each`).
     """
     from ..compare.plausibility import refuse_implausible
-    from ..file_settings import analyze_with_settings, resolve_files
+    from ..file_settings import analyze_each, resolve_files
     from ..io import detect_file_format
     from ..measure import AnalysisOptions
 
@@ -196,7 +198,7 @@ def analyze_files(paths: Sequence[str | Path], *, fill_percent: float | None = N
                                      specimen_name=specimen_name, specimen=specimen)
     try:
         analyzed_files = refuse_implausible(
-            [analyze_with_settings(path, fs) for path, fs in zip(paths, settings, strict=True)],
+            analyze_each(paths, settings, progress=progress),
             [display_path(Path(path).name) for path in paths], accept=accept_implausible)
     except PidcoreError as exc:
         # an error of the analysis names the options by their library keywords; the CLI
@@ -404,12 +406,14 @@ def unsubtracted_baseline_note(specimen, analyses: pd.DataFrame | None) -> str:
     without = sum(1 for value in subtracted if value == 0.0)
     if not without:
         return ""
+    structure_kg = float(specimen.coupon.mass_kg) + float(specimen.coupon.fixture_mass_kg)
     return (f"specimen {specimen.name} states [coupon] baseline_loss_factor {eta:g} (the empty "
             f"coupon's damping), which {without} measured record(s) of its {material} particles "
-            f"were analysed without: their SDC includes it (2 pi x {eta:g} = "
-            f"{2 * math.pi * eta:.3g}) and the DEM's, of the particles alone, does not; analyse "
-            f"them with --baseline-loss-factor {eta:g} (or a sidecar's baseline_loss_factor) to "
-            "subtract it")
+            f"were analysed without: their SDC includes the structure's share of it (2 pi x "
+            f"{eta:g} x its share of the vibrated mass, at most {2 * math.pi * eta:.3g}) and the "
+            f"DEM's, of the particles alone, does not; analyse them with --baseline-loss-factor "
+            f"{eta:g} --structure-mass {structure_kg:.4g} (coupon and fixture; or a sidecar's "
+            "baseline_loss_factor and structure_mass_g) to subtract it")
 
 
 @dataclass(frozen=True)
@@ -550,7 +554,8 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
                 tolerances: Tolerances | None = None, specimen: Specimen | None = None,
                 pool: bool = False,
                 calibration: str | Path | None = None,
-                accept_implausible: bool = False) -> ReportResult:
+                calibration_key: str | None = None,
+                accept_implausible: bool = False, progress: bool = False) -> ReportResult:
     """Analyse files, store them, align with DEM and the paper, and write the report.
 
     Parameters
@@ -589,11 +594,17 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         Pool DEM runs of different settings and measurements of different specimens at one
         load case (default: separate rows; see :func:`pidcore.report.build_report_table`).
     calibration : path, optional
-        A ``calibration.json`` of ``pidcore calibrate``: each row it predicts gets the
-        calibrated DEM's Eq. 11 SDC with its 95 % band and whether the measured Eq. 11 SDC
-        lies inside (:func:`pidcore.report.table.add_calibration_columns`).
+        A ``calibration.json`` of ``pidcore calibrate``, or a store holding calibrations
+        (:mod:`pidcore.calibrate.persist`): each row it predicts gets the calibrated DEM's
+        Eq. 11 SDC with its 95 % band and whether the measured Eq. 11 SDC lies inside
+        (:func:`pidcore.report.table.add_calibration_columns`).
+    calibration_key : str, optional
+        Which of the store's calibrations (a store holding one needs none).
     accept_implausible : bool
         Keep (noted) a file's result the plausibility checks refuse (:func:`analyze_files`).
+    progress : bool
+        Bars on stderr over the files analysed and the figures and formats written (forty
+        files: 40-50 s, most of it figures and PDF, with no sign of life).
 
     Returns
     -------
@@ -606,7 +617,10 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
     if calibration is not None:  # checked before anything is analysed or written
         from ..calibrate.prediction import load_calibration
 
-        calibrated = load_calibration(calibration)
+        calibrated = load_calibration(calibration, key=calibration_key)
+    elif calibration_key is not None:
+        raise ParameterError(f"--calibration-key {calibration_key}: give the store holding it "
+                             "as --calibration")
     out_dir = Path(out_dir)
     check_out_dir(out_dir)
     tolerances = tolerances or Tolerances()
@@ -642,7 +656,7 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         sidecar=sidecar, options=options, options_given=options_given,
         specimen_material=specimen.particles.material if specimen is not None else None,
         specimen_name=specimen.name if specimen is not None else None, specimen=specimen,
-        accept_implausible=accept_implausible,
+        accept_implausible=accept_implausible, progress=progress,
     ) if files else []
     parameters = _parameters(results, options)
     notes: list[str] = []
@@ -724,7 +738,7 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
             seeds=seeds, inputs=[r.path for r in results],
             input_hashes={str(r.path): getattr(r.measurement, "sha256", "") for r in results},
             stores=stores, notes=notes, specimens=specimen_provenance(specimen))
-        paths = write_report(table, figures, provenance, out_dir, formats)
+        paths = write_report(table, figures, provenance, out_dir, formats, progress=progress)
     finally:
         for fig in figures.values():  # bare Figures: drop references to free Agg buffers
             fig.clear()

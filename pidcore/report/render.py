@@ -307,7 +307,7 @@ def _move_into_place(tmp: Path, out_dir: Path) -> None:
 
 def write_report(table: pd.DataFrame, figures: Mapping[str, object], provenance: Provenance,
                  out_dir: str | Path, formats: str | Iterable[str] = REPORT_FORMATS,
-                 ) -> dict[str, Path]:
+                 *, progress: bool = False) -> dict[str, Path]:
     """Write the report into ``out_dir``, atomically.
 
     Parameters
@@ -323,6 +323,9 @@ def write_report(table: pd.DataFrame, figures: Mapping[str, object], provenance:
         Output folder. It must be new, empty or an earlier pidcore report (which is replaced).
     formats : str or iterable of str
         Any of ``csv, md, html, tex, pdf`` or ``"all"``.
+    progress : bool
+        A bar over the figures and formats written, on stderr (the figures and the PDF are
+        most of a report's time).
 
     Returns
     -------
@@ -342,6 +345,12 @@ def write_report(table: pd.DataFrame, figures: Mapping[str, object], provenance:
     tmp = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.", suffix=".partial",
                                 dir=out_dir.parent))
     written: dict[str, Path] = {}
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        bar = tqdm(total=len(figures) + len(formats), unit="file", desc="writing report",
+                   leave=False, dynamic_ncols=True)
     try:
         pngs: dict[str, Path] = {}
         for stem, fig in figures.items():
@@ -349,7 +358,11 @@ def write_report(table: pd.DataFrame, figures: Mapping[str, object], provenance:
             pngs[stem] = png
             written[f"figure:{png.name}"] = png
             written[f"figure:{svg.name}"] = svg
+            if bar is not None:
+                bar.update(1)
         for name in formats:
+            if bar is not None:
+                bar.set_postfix_str(name)
             if name == "pdf":
                 written[name] = RENDERERS[name](table, pngs, provenance, tmp,
                                                 figure_objects=figures)
@@ -357,6 +370,10 @@ def write_report(table: pd.DataFrame, figures: Mapping[str, object], provenance:
                 written[name] = RENDERERS[name](table, pngs, provenance, tmp)
             if name == "csv":
                 written["csv_provenance"] = tmp / f"{REPORT_STEM}{CSV_NOTES_SUFFIX}"
+            if bar is not None:
+                bar.update(1)
+        if bar is not None:
+            bar.close()  # before the "wrote ..." lines
         (tmp / REPORT_MARKER).write_text("written by pidcore report\n", encoding="utf-8")
         os.chmod(tmp, 0o755)  # mkdtemp makes 0700; a report folder is meant to be shared
         # the swap and the earlier report's removal are one step for Ctrl-C: cut between them,
@@ -364,6 +381,8 @@ def write_report(table: pd.DataFrame, figures: Mapping[str, object], provenance:
         with interrupt.deferred():
             _move_into_place(tmp, out_dir)
     except BaseException:
+        if bar is not None:
+            bar.close()
         shutil.rmtree(tmp, ignore_errors=True)
         raise
     interrupt.raise_if_interrupted()

@@ -32,11 +32,14 @@ Corrections (applied to the phasors in this order):
 3. Mass cancellation: the gauge also feels the inertia of the mass between it and the coupon
    (impedance-head seismic mass, fixture): ``F_n -= m_below A_n`` with ``A_n`` from the
    acceleration channel when there is one, else ``j n w V_n``.
-4. Baseline subtraction: the loss factor of the empty coupon (measured the same way) is
-   subtracted, ``eta_l - eta_baseline``, and so are its SDC and energy per cycle. Loss factors
-   add only when normalised by the same kinetic energy, so this assumes the baseline run had the
-   same vibrated mass and amplitude (or that the particles' mass is small against the coupon's).
-   ``complex_power_w`` stays the measured (corrections 1-3) value.
+4. Baseline subtraction: the empty structure (coupon and fixture, measured the same way)
+   dissipates ``eta_baseline`` of its *own* reactive power, ``Q_s = sum_n 1/2 n w m_s |V_n|^2``
+   for its mass ``m_s`` (``structure_mass_kg``), so ``eta_baseline Q_s`` is taken off
+   ``Re(P_c)``: ``eta_l = (Re P_c - eta_baseline Q_s) / Im P_c``, and so are the SDC and the
+   energy per cycle. Without ``m_s`` the whole reactive power stands for ``Q_s``
+   (``eta_l - eta_baseline``), which takes off too much by ``eta_baseline`` times the particles'
+   share of the vibrated mass; the result says so in a note. ``complex_power_w`` stays the
+   measured (corrections 1-3) value.
 """
 
 from __future__ import annotations
@@ -297,13 +300,21 @@ def _complex_power(f_ph: np.ndarray, m_ph: np.ndarray, a_ph: np.ndarray | None,
     return f, v, 0.5 * np.sum(f * np.conj(v), axis=-1)
 
 
+#: Largest share of the measured reactive power the empty structure's mass may claim before
+#: it is taken for a unit slip: particles moving against the coupon (a bed above its own
+#: resonance) lower the reactive power below the structure's, by tens of per cent, not by the
+#: factor 1000 of grams typed as kilograms.
+UNIT_SLIP_SHARE = 2.0
+
+
 def check_analysis_settings(*, n_harmonics: int = defaults.N_HARMONICS,
                             mass_below_gauge_kg: float = 0.0, frequency_hz: float | None = None,
                             velocity_delay_s: float = 0.0, baseline_loss_factor: float = 0.0,
-                            sample_rate_hz: float | None = None) -> None:
+                            sample_rate_hz: float | None = None,
+                            structure_mass_kg: float | None = None) -> None:
     """Refuse the settings of an analysis that no record can make right (a string, a bool, a
-    fraction of a harmonic, a negative mass or baseline, a non-positive frequency hint or
-    rate), each naming its keyword: :func:`analyze_power` checks them, and
+    fraction of a harmonic, a negative mass or baseline, a non-positive frequency hint, rate
+    or structure mass), each naming its keyword: :func:`analyze_power` checks them, and
     :class:`pidcore.measure.AnalysisOptions` when it is made, before any file is read."""
     for name, value in (("mass_below_gauge_kg", mass_below_gauge_kg),
                         ("velocity_delay_s", velocity_delay_s),
@@ -328,15 +339,21 @@ def check_analysis_settings(*, n_harmonics: int = defaults.N_HARMONICS,
         # the empty coupon dissipates energy: a negative baseline would add damping
         raise ParameterError(f"baseline_loss_factor: {baseline_loss_factor!r}, expected a "
                              "loss factor >= 0 (that of the empty coupon)")
+    if structure_mass_kg is not None and not (
+            isinstance(structure_mass_kg, (int, float)) and not isinstance(structure_mass_kg, bool)
+            and math.isfinite(structure_mass_kg) and structure_mass_kg > 0):
+        raise ParameterError(f"structure_mass_kg: {structure_mass_kg!r}, expected the empty "
+                             "structure's mass in kg > 0 (coupon and fixture above the gauge)")
 
 
 def _check_parameters(sample_rate_hz: float, n_harmonics: int, n_blocks: int, min_periods: int,
                       mass_below_gauge_kg: float, frequency_hz: float | None,
-                      velocity_delay_s: float, baseline_loss_factor: float) -> None:
+                      velocity_delay_s: float, baseline_loss_factor: float,
+                      structure_mass_kg: float | None = None) -> None:
     check_analysis_settings(n_harmonics=n_harmonics, mass_below_gauge_kg=mass_below_gauge_kg,
                             frequency_hz=frequency_hz, velocity_delay_s=velocity_delay_s,
                             baseline_loss_factor=baseline_loss_factor,
-                            sample_rate_hz=sample_rate_hz)
+                            sample_rate_hz=sample_rate_hz, structure_mass_kg=structure_mass_kg)
     if int(n_blocks) != n_blocks or n_blocks < 0:
         raise ParameterError(f"n_blocks: {n_blocks!r}, expected an integer >= 0 (0: no stderr)")
     if int(min_periods) != min_periods or min_periods < 1:
@@ -366,6 +383,7 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
                   velocity_delay_s: float = 0.0,
                   mass_below_gauge_kg: float = 0.0,
                   baseline_loss_factor: float = 0.0,
+                  structure_mass_kg: float | None = None,
                   n_blocks: int = defaults.N_UNCERTAINTY_BLOCKS,
                   min_periods: int = defaults.MIN_PERIODS,
                   source: str = "",
@@ -395,7 +413,12 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
     mass_below_gauge_kg : float
         Mass between force gauge and structure whose inertia force is cancelled, kg.
     baseline_loss_factor : float
-        Loss factor of the empty structure, subtracted from the result.
+        Loss factor of the empty structure, subtracted from the result (correction 4 of the
+        module docstring).
+    structure_mass_kg : float, optional
+        Mass of that empty structure as the gauge sees it (coupon and fixture above the gauge,
+        less what ``mass_below_gauge_kg`` cancels), kg: its dissipation ``baseline_loss_factor
+        x Q_s`` is subtracted. None: the whole reactive power stands for ``Q_s`` (noted).
     n_blocks : int
         Blocks of whole periods for the standard errors (0 or 1: none).
     min_periods : int
@@ -431,7 +454,7 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
     (0.0064, 0.0064)
     """
     _check_parameters(sample_rate_hz, n_harmonics, n_blocks, min_periods, mass_below_gauge_kg,
-                      frequency_hz, velocity_delay_s, baseline_loss_factor)
+                      frequency_hz, velocity_delay_s, baseline_loss_factor, structure_mass_kg)
     if velocity is None and acceleration is None:
         raise ParameterError(f"{source or 'record'}: neither a velocity nor an acceleration "
                              "channel given; expected at least one")
@@ -523,13 +546,21 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
             f"positive kinetic energy: a mass-like structure gives Im(P_c) > 0); {cause}")
 
     loss_raw = p_c.real / p_c.imag if p_c.imag != 0 else math.nan
-    if baseline_loss_factor > 0 and not loss_raw > baseline_loss_factor:
+    # the empty structure's share of the reactive power, whose baseline_loss_factor it
+    # dissipates (1: the whole of it stands for the structure's, noted below)
+    structure_share, baseline_note = _structure_share(
+        structure_mass_kg, baseline_loss_factor, v_ph, harmonics, omega, p_c, source)
+    baseline = baseline_loss_factor * structure_share
+    if baseline_loss_factor > 0 and not loss_raw > baseline:
         # subtracting it would give zero or negative damping: energy created per cycle
         raise ParameterError(
-            f"{source or 'record'}: baseline_loss_factor {baseline_loss_factor:g} is not below "
-            f"the measured loss factor {loss_raw:.6g}; expected the empty coupon's loss factor, "
+            f"{source or 'record'}: baseline_loss_factor {baseline_loss_factor:g} "
+            + ("is not below " if structure_share == 1.0 else
+               f"x the structure's share {structure_share:.4g} of the reactive power is not "
+               "below ")
+            + f"the measured loss factor {loss_raw:.6g}; expected the empty coupon's loss factor, "
             "smaller than that of the filled one")
-    loss = loss_raw - baseline_loss_factor
+    loss = loss_raw - baseline
     sdc = 2 * np.pi * loss
     lf_stderr = float("nan")
     if p_blocks is not None:
@@ -554,6 +585,10 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
                                    "acceleration channel" if acc_data is not None
                                    else "velocity (j n w V_n)"),
     }
+    if baseline_loss_factor > 0:
+        corrections["baseline_structure_share"] = float(structure_share)
+        if structure_mass_kg is not None:
+            corrections["structure_mass_kg"] = float(structure_mass_kg)
     return PowerAnalysis(
         source=source,
         frequency_hz=float(freq),
@@ -571,7 +606,7 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
         sdc_stderr=float(2 * np.pi * lf_stderr),
         damping_ratio=zeta,
         damping_ratio_note=zeta_note,
-        energy_per_cycle_j=float((p_c.real - baseline_loss_factor * p_c.imag) * period),
+        energy_per_cycle_j=float((p_c.real - baseline * p_c.imag) * period),
         max_kinetic_energy_j=float(p_c.imag / omega),
         force_amplitude_n=float(abs(f_ph[0])),
         velocity_amplitude_m_s=float(v1),
@@ -580,8 +615,36 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
         n_blocks=k_blocks,
         uncertainty_note=uncertainty_note,
         corrections=corrections,
-        notes=tuple(n for n in (zeta_note, uncertainty_note) if n),
+        notes=tuple(n for n in (zeta_note, uncertainty_note, baseline_note) if n),
     )
+
+
+def _structure_share(structure_mass_kg: float | None, baseline_loss_factor: float,
+                     v_ph: np.ndarray, harmonics: np.ndarray, omega: float, p_c: complex,
+                     source: str) -> tuple[float, str]:
+    """The empty structure's share ``Q_s / Im(P_c)`` of the reactive power (correction 4),
+    and a note; ``(1.0, note)`` without its mass. A mass whose reactive power would be many
+    times the measured one is a unit slip (g typed as kg) and is refused."""
+    if baseline_loss_factor <= 0:
+        return 1.0, ""
+    if structure_mass_kg is None:
+        return 1.0, (f"baseline loss factor {baseline_loss_factor:g} subtracted as if the whole "
+                     "vibrated mass were the empty structure's (too much by the particles' "
+                     "share of it); give the structure's mass (coupon and fixture above the "
+                     "gauge: --structure-mass KG, a structure_mass_g column, the app's structure "
+                     "mass [g]) for the exact subtraction")
+    q_s = float(np.sum(0.5 * harmonics * omega * structure_mass_kg * np.abs(v_ph) ** 2))
+    share = q_s / p_c.imag
+    vibrated_kg = structure_mass_kg / share  # the mass-like reactive power's mass
+    if share > UNIT_SLIP_SHARE:
+        raise ParameterError(
+            f"{source or 'record'}: structure_mass_kg {structure_mass_kg:g} kg is {share:.3g} "
+            f"times the vibrated mass the measurement shows ({vibrated_kg:.4g} kg from Im(P_c)); "
+            "expected the empty coupon and fixture above the gauge in kg (was it in g?)")
+    note = (f"baseline: the empty structure ({structure_mass_kg:.4g} kg) holds {share:.3g} of "
+            f"the reactive power (vibrated mass {vibrated_kg:.4g} kg); baseline loss factor "
+            f"{baseline_loss_factor:g} x {share:.3g} subtracted")
+    return share, note
 
 
 def analyze_channels(force: Channel, velocity: Channel | None, *,
@@ -592,6 +655,7 @@ def analyze_channels(force: Channel, velocity: Channel | None, *,
                      velocity_delay_s: float = 0.0,
                      mass_below_gauge_kg: float = 0.0,
                      baseline_loss_factor: float = 0.0,
+                     structure_mass_kg: float | None = None,
                      n_blocks: int = defaults.N_UNCERTAINTY_BLOCKS,
                      min_periods: int = defaults.MIN_PERIODS,
                      allow_clipped: bool = False) -> PowerAnalysis:
@@ -640,8 +704,8 @@ def analyze_channels(force: Channel, velocity: Channel | None, *,
             frequency_hz=frequency_hz, n_harmonics=n_harmonics,
             velocity_delay_s=velocity_delay_s,
             mass_below_gauge_kg=mass_below_gauge_kg, baseline_loss_factor=baseline_loss_factor,
-            n_blocks=n_blocks, min_periods=min_periods, source=source, force_name=force.name,
-            velocity_name=motion.name)
+            structure_mass_kg=structure_mass_kg, n_blocks=n_blocks, min_periods=min_periods,
+            source=source, force_name=force.name, velocity_name=motion.name)
     except SignalError as exc:
         if dropout_notes:
             raise SignalError(f"{exc} (after cutting out dropouts: {dropout_notes[0]})") from None

@@ -11,6 +11,10 @@ Layout (every group explains itself through its attributes)::
     /analyses/<key>/units      one attribute per field or array: its unit
     /analyses/<key>/arrays/<name>   dataset (complex allowed), attr unit
     /dem_runs/<case_key>       as an analysis, with case_key instead of measurement_key
+    /calibrations/<key>        as an analysis (pidcore_layout="calibration"; record: specimen,
+                               fit, posterior medians and intervals, RMS), with the whole
+                               calibration.json and the calibrated specimen file as UTF-8 byte
+                               arrays (arrays/calibration_json, arrays/calibrated_specimen_toml)
 
 Writes are transactions: under an exclusive lock on ``<store>.lock`` the store is copied to a
 temporary file beside it, changed there, flushed, fsync'ed and moved over the original with
@@ -61,7 +65,13 @@ from .values import (
 STORE_VERSION = 1
 
 _MEASUREMENTS, _ANALYSES, _DEM_RUNS = "measurements", "analyses", "dem_runs"
-_LAYOUT_ANALYSIS, _LAYOUT_DEM_RUN = "analysis", "dem_run"
+_CALIBRATIONS = "calibrations"
+#: Every section; a store written before calibrations were stored has no /calibrations (it is
+#: made by the next write), so verify() does not count its absence as damage.
+_SECTIONS = (_MEASUREMENTS, _ANALYSES, _DEM_RUNS, _CALIBRATIONS)
+_LAYOUT_ANALYSIS, _LAYOUT_DEM_RUN, _LAYOUT_CALIBRATION = "analysis", "dem_run", "calibration"
+#: Arrays of a stored calibration holding text (UTF-8 bytes, checksummed like every array).
+CALIBRATION_DOCUMENT, CALIBRATION_SPECIMEN = "calibration_json", "calibrated_specimen_toml"
 _ROOT_ATTRS = ("pidcore_store_version", "created_utc", "pidcore_version")
 _MEASUREMENT_ATTRS = ("pidcore_layout", "source", "sha256", "file_format", "metadata_json",
                       "imported_utc", "pidcore_version")
@@ -210,6 +220,32 @@ def _read_entry(group: h5py.Group, key: str) -> StoredEntry:
                        units=units)
 
 
+def calibration_texts(entry: StoredEntry) -> tuple[str, str]:
+    """``(calibration.json, calibrated specimen file)`` of a stored calibration."""
+    where = f"calibration {entry.key!r}"
+    out = []
+    for name in (CALIBRATION_DOCUMENT, CALIBRATION_SPECIMEN):
+        array = entry.arrays.get(name)
+        if array is None or array.dtype != np.uint8 or array.ndim != 1:
+            raise StoreError(f"{where}: array {name} missing or not UTF-8 bytes")
+        try:
+            out.append(array.tobytes().decode("utf-8"))
+        except UnicodeDecodeError as exc:
+            raise StoreError(f"{where}: array {name} is not UTF-8 text ({exc})") from None
+    return out[0], out[1]
+
+
+def _calibration_text_problems(entry: StoredEntry, where: str) -> list[str]:
+    try:
+        document, _ = calibration_texts(entry)
+        parsed = json.loads(document)
+    except (StoreError, json.JSONDecodeError) as exc:
+        return [f"{where}: {exc}"]
+    if not isinstance(parsed, dict) or "predictions" not in parsed:
+        return [f"{where}: {CALIBRATION_DOCUMENT} is not a calibration.json (no predictions)"]
+    return []
+
+
 def _check_measurement(measurement: Measurement) -> None:
     if not isinstance(measurement, Measurement):
         raise StoreError("expected a pidcore.records.Measurement, "
@@ -331,7 +367,7 @@ class Store:
         the file itself, each entry a group of the file itself (an external link would make
         every listing open another file on the machine; a soft link to nothing, a dataset
         where a group belongs, crashed every listing and every write)."""
-        for section in (_MEASUREMENTS, _ANALYSES, _DEM_RUNS):
+        for section in _SECTIONS:
             link = h5.get(section, getlink=True)
             if link is None:
                 continue
@@ -463,7 +499,7 @@ class Store:
                 h5.attrs["pidcore_store_version"] = np.int64(STORE_VERSION)
                 h5.attrs["created_utc"] = _utc_now()
                 h5.attrs["pidcore_version"] = __version__
-            for name in (_MEASUREMENTS, _ANALYSES, _DEM_RUNS):
+            for name in _SECTIONS:
                 h5.require_group(name)
         except BaseException:
             h5.close()
@@ -715,6 +751,73 @@ class Store:
         return frame.rename(columns={"key": "case_key"}).sort_values("case_key",
                                                                      ignore_index=True)
 
+    # --- calibrations --------------------------------------------------------------------------
+
+    def add_calibration(self, key: str, record: Mapping[str, Scalar], *, document: str,
+                        specimen_toml: str, units: Mapping[str, str] | None = None,
+                        parameters: Mapping[str, Any] | None = None) -> tuple[str, bool]:
+        """Store a calibration (the text of its ``calibration.json`` and of its calibrated
+        specimen file) unless one is stored under ``key`` already.
+
+        Parameters
+        ----------
+        key : str
+            Chosen by the caller from what the calibration is (:func:`pidcore.calibrate.
+            persist.calibration_key`): the same calibration made again is not stored twice.
+        record : mapping
+            Scalars listed by :meth:`list_calibrations` (specimen, fit, medians, RMS).
+        document : str
+            The whole ``calibration.json``.
+        specimen_toml : str
+            The calibrated specimen file.
+        units, parameters
+            As for :meth:`add_analysis` (``units`` names the record's units).
+
+        Returns
+        -------
+        key : str
+        added : bool
+            False when a calibration was stored under ``key`` before (it is kept as it was).
+        """
+        check_name(key, what="calibration key", where=str(self.path))
+        where = f"{self.path}: calibration {key!r}"
+        texts = {}
+        for name, text in ((CALIBRATION_DOCUMENT, document),
+                           (CALIBRATION_SPECIMEN, specimen_toml)):
+            if not isinstance(text, str):
+                raise StoreError(f"{where}: {name} must be text, got {type(text).__name__}")
+            texts[name] = np.frombuffer(text.encode("utf-8"), dtype=np.uint8)
+        units = {**({} if units is None else units),
+                 **{name: "UTF-8 bytes" for name in texts}}
+        entry = _prepare_entry(record, texts, parameters, units, where=where)
+        if self.has_calibration(key):
+            return key, False
+        with self.transaction() as h5:
+            parent = h5[_CALIBRATIONS]
+            if key in parent:  # stored by another process since the check above
+                return key, False
+            _write_entry(parent, key, entry, layout=_LAYOUT_CALIBRATION,
+                         link_attrs={"calibration_key": key})
+        return key, True
+
+    def has_calibration(self, key: str) -> bool:
+        """Whether a calibration is stored under ``key``."""
+        check_name(key, what="calibration key", where=str(self.path))
+        with self._reading() as h5:
+            return h5 is not None and key in h5.get(_CALIBRATIONS, {})
+
+    def get_calibration(self, key: str) -> StoredEntry:
+        """The calibration stored under ``key`` (its texts: :func:`calibration_texts`)."""
+        check_name(key, what="calibration key", where=str(self.path))
+        with self._reading() as h5:
+            return _read_entry(self._entry_group(h5, _CALIBRATIONS, key, "calibration"), key)
+
+    def list_calibrations(self) -> pd.DataFrame:
+        """One row per calibration: key, created_utc, every scalar field, parameters_json,
+        pidcore_version (oldest first)."""
+        with self._reading() as h5:
+            return self._listing(h5, _CALIBRATIONS, [], lambda group: {})
+
     # --- shared reading helpers ----------------------------------------------------------------
 
     def _entry_group(self, h5: h5py.File | None, section: str, key: str, what: str) -> h5py.Group:
@@ -767,8 +870,10 @@ class Store:
                 return [str(exc)]
             problems += [f"{self.path}: root attribute {name} missing"
                          for name in _ROOT_ATTRS if name not in h5.attrs]
-            for section in (_MEASUREMENTS, _ANALYSES, _DEM_RUNS):
+            for section in _SECTIONS:
                 if section not in h5:
+                    if section == _CALIBRATIONS:
+                        continue  # written before calibrations were stored: not damage
                     problems.append(f"{self.path}: group /{section} missing")
                     continue
                 for key in h5[section]:
@@ -814,18 +919,20 @@ class Store:
             canonical = parameters_to_json(entry.parameters, where=where)
             if analysis_key(measurement_key, canonical) != key:
                 problems.append(f"{where}: key does not match measurement_key and parameters")
+        elif section == _CALIBRATIONS:
+            problems += _calibration_text_problems(entry, where)
         elif _text(group.attrs.get("case_key", "")) != key:
             problems.append(f"{where}: attribute case_key does not match the group name")
         return problems
 
     def summary(self) -> dict[str, Any]:
         """Counts and identity of the store: path, exists, store_version, created_utc,
-        n_measurements, n_analyses, n_dem_runs, size_bytes."""
+        n_measurements, n_analyses, n_dem_runs, n_calibrations, size_bytes."""
         with self._reading() as h5:
             if h5 is None:
                 return {"path": str(self.path), "exists": False, "store_version": None,
                         "created_utc": None, "n_measurements": 0, "n_analyses": 0,
-                        "n_dem_runs": 0, "size_bytes": 0}
+                        "n_dem_runs": 0, "n_calibrations": 0, "size_bytes": 0}
             return {
                 "path": str(self.path),
                 "exists": True,
@@ -834,5 +941,6 @@ class Store:
                 "n_measurements": len(h5.get(_MEASUREMENTS, {})),
                 "n_analyses": len(h5.get(_ANALYSES, {})),
                 "n_dem_runs": len(h5.get(_DEM_RUNS, {})),
+                "n_calibrations": len(h5.get(_CALIBRATIONS, {})),
                 "size_bytes": self.path.stat().st_size,
             }

@@ -25,6 +25,7 @@ from pidcore.app.calibration import (
 )
 from pidcore.app.tabs import draw_polling, specimen_choice
 from pidcore.specimen import CALIBRATED_SUFFIX
+from pidcore.specimen import uncalibrated_name as uncalibrated
 
 #: Seconds between refreshes of the calibration's state while it runs.
 REFRESH_S = 2.0
@@ -78,13 +79,21 @@ def _task(stores, chosen: str, polling: bool) -> None:
 
 def render(stores) -> None:
     """The page (a clear "not available" state while the calibration library is missing)."""
-    from pidcore.errors import PidcoreError
 
     st.subheader("Calibrate the DEM against measurements")
     api, reason = calibration_api()
     if api is None:
         st.info(f"Calibration is not available: {reason}.")
         return
+    _calibrate(stores, api)
+    _saved(stores)  # also where nothing can be calibrated now (no measurement saved yet)
+
+
+def _calibrate(stores, api) -> None:
+    """The form and the running or finished calibration (a word where nothing can be
+    calibrated)."""
+    from pidcore.errors import PidcoreError
+
     left_out: list[str] = []  # records saved as implausible: named, as the CLI names them
     try:
         points = api.measured_from_store(stores.path, left_out=left_out) \
@@ -101,6 +110,34 @@ def render(stores) -> None:
     chosen_label = _form(stores, api, points, left_out)
     # the running or finished calibration, whichever specimen is chosen now
     draw_polling(_task, stores, chosen_label, polling=_running(stores), every_s=REFRESH_S)
+
+
+def _saved(stores) -> None:
+    """The calibrations saved in the store (they outlive a restart of the app; the Compare
+    and Report tabs use them, newest first), each file offered for download."""
+    from pidcore.app.calibration import saved_calibrations_table
+    from pidcore.calibrate.persist import stored_calibrations
+    from pidcore.errors import PidcoreError
+
+    try:
+        saved = stored_calibrations(stores.path)
+    except PidcoreError as exc:
+        st.caption(f"Calibrations of the store not shown: {exc}")
+        return
+    if not saved:
+        return
+    st.markdown("**Calibrations saved in this store** (newest first; Compare and Report use "
+                "them)")
+    st.dataframe(saved_calibrations_table(stores.path), hide_index=True)
+    keys = [c.store_key for c in saved]
+    key = st.selectbox("download the files of", keys, key="calibration_saved_key")
+    chosen = saved[keys.index(key)]
+    c1, c2 = st.columns(2)
+    c1.download_button("calibration.json", chosen.document_text, file_name="calibration.json",
+                       mime="application/json", key="calibration_saved_json")
+    name = f"{uncalibrated(chosen.specimen_name)}{CALIBRATED_SUFFIX}.toml"
+    c2.download_button("calibrated specimen (TOML)", chosen.specimen_text, file_name=name,
+                       mime="application/toml", key="calibration_saved_toml", help=name)
 
 
 def _form(stores, api, points: list, left_out: list[str]) -> str:

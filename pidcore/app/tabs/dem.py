@@ -125,6 +125,18 @@ def render(stores) -> None:
             text = jobs.submitted_text(len(cases), created)
             st.session_state["dem_message"] = (
                 "info", text if fill_note is None else f"{fill_note}; {text}")
+    runner = jobs.runner_for(stores.path)
+    interrupted = sum(j.state == jobs.INTERRUPTED_STATE for j in runner.jobs())
+    if interrupted:
+        st.warning(f"{interrupted} job(s) were queued or running when the app stopped; nothing "
+                   "of them was saved.")
+        if st.button(f"Resubmit interrupted ({interrupted})", key="dem_resubmit"):
+            created = runner.resubmit_interrupted()
+            st.session_state["dem_message"] = ("info", jobs.submitted_text(interrupted,
+                                                                            created))
+            st.rerun()
+    if runner.journal_problem:
+        st.caption(f"Note: {runner.journal_problem}")
     message = st.session_state.get("dem_message")
     if message:
         getattr(st, message[0])(message[1])

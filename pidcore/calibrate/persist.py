@@ -1,0 +1,149 @@
+"""Calibrations in the HDF5 store: saved by ``pidcore calibrate`` and the app, read back by
+reports and the app (which then survive a restart and travel with the store's DEM runs).
+
+* :func:`calibration_key`: what a calibration is called in the store (the same calibration made
+  again gets the same key and is not stored twice);
+* :func:`save_calibration`: a :class:`~pidcore.calibrate.calibrate.CalibrationResult` into a
+  store: its whole ``calibration.json`` and calibrated specimen file, and a listing record;
+* :func:`stored_calibrations`: every calibration of a store, newest first, as
+  :class:`~pidcore.calibrate.prediction.Calibration`;
+* :func:`stored_calibration`: one of them, by key (a store holding one needs none);
+* :func:`is_store_file`: whether a ``--calibration`` path names a store rather than a JSON file.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from ..errors import ParameterError
+from .outputs import document_json, specimen_text
+from .prediction import Calibration, calibration_from_json
+
+if TYPE_CHECKING:  # pragma: no cover
+    from .calibrate import CalibrationResult
+
+#: Fields of calibration.json that describe how a calibration was made, not what it is: the
+#: wall time, how many runs came from the cache, the path of the store that cached them.
+_BOOKKEEPING = ("wall_s", "runs")
+_KEY_PREFIX = "cal_"
+#: HDF5's format signature (the first 8 bytes of a file written by h5py).
+_HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
+
+
+def calibration_key(document: dict) -> str:
+    """``"cal_"`` and 16 hex digits of SHA-256 of ``document`` (a calibration.json) without
+    its bookkeeping (wall time, cached-run counts, the caching store's path)."""
+    what = {k: v for k, v in document.items() if k not in _BOOKKEEPING}
+    settings = dict(what.get("settings") or {})
+    settings.pop("store", None)
+    what["settings"] = settings
+    text = json.dumps(json.loads(document_json(what)), sort_keys=True, separators=(",", ":"))
+    return _KEY_PREFIX + hashlib.sha256(text.encode("utf-8")).hexdigest()[:16]
+
+
+def _record(result) -> tuple[dict, dict]:
+    """The listing record of a calibration and its units."""
+    units = result.units()
+    record: dict = {"specimen": result.specimen.name, "specimen_hash": result.specimen.hash,
+                    "fit": ",".join(result.settings["fit"]),
+                    "method_used": str(result.settings.get("method_used", "")),
+                    "n_points": len(result.predictions), "rms_in_sample": result.rms,
+                    "loo_rms": result.loo_rms, "loo_coverage95": result.loo_coverage}
+    out_units = {"n_points": "count", "rms_in_sample": "-", "loo_rms": "-",
+                 "loo_coverage95": "count"}
+    for name, p in result.parameters.items():
+        for stat in ("median", "low95", "high95"):
+            record[f"{name}_{stat}"] = p[stat]
+            out_units[f"{name}_{stat}"] = units.get(name, "-")
+    return record, out_units
+
+
+def save_calibration(result: CalibrationResult, store_path: str | os.PathLike
+                     ) -> tuple[str, bool]:
+    """Save ``result`` (:class:`~pidcore.calibrate.calibrate.CalibrationResult`) into the store
+    at ``store_path`` in one transaction; returns ``(key, added)`` (``added`` False: the same
+    calibration was stored before and is kept as it was)."""
+    from ..store import Store
+
+    document = result.full_document()
+    record, units = _record(result)
+    return Store(store_path).add_calibration(
+        calibration_key(document), record, document=document_json(document),
+        specimen_toml=specimen_text(result), units=units,
+        parameters={"settings": result.settings})
+
+
+def is_store_file(path: str | os.PathLike) -> bool:
+    """Whether ``path`` is a file that starts with HDF5's signature (a store), not JSON."""
+    path = Path(path)
+    if not path.is_file():
+        return False
+    with open(path, "rb") as handle:
+        return handle.read(len(_HDF5_SIGNATURE)) == _HDF5_SIGNATURE
+
+
+def _calibration(store, key: str) -> Calibration:
+    from ..errors import PidcoreError
+    from ..store import calibration_texts
+
+    entry = store.get_calibration(key)
+    try:
+        document, specimen = calibration_texts(entry)
+    except PidcoreError as exc:
+        raise ParameterError(f"{store.path}: {exc}") from None
+    calibration = calibration_from_json(document, f"{store.path}:{key}")
+    return Calibration(path=calibration.path, parameters=calibration.parameters,
+                       predictions=calibration.predictions,
+                       specimen_name=str(entry.record.get("specimen") or ""),
+                       specimen_text=specimen, document_text=document, store_key=key,
+                       created_utc=str(entry.attrs.get("created_utc", "")))
+
+
+def stored_calibrations(store_path: str | os.PathLike) -> list[Calibration]:
+    """Every calibration stored in ``store_path``, newest first (none: an empty list; no
+    store yet: an empty list)."""
+    from ..store import Store
+
+    path = Path(store_path)
+    if not path.is_file():
+        return []
+    store = Store(path)
+    listing = store.list_calibrations()
+    return [_calibration(store, key) for key in reversed(list(listing["key"]))]
+
+
+def stored_calibration(store_path: str | os.PathLike, key: str | None = None) -> Calibration:
+    """The calibration ``key`` of the store at ``store_path``; without a key, the store's only
+    one. Raises :class:`ParameterError` (one line naming the store) where there is none, the
+    key is not stored, or several are stored and no key says which."""
+    from ..store import Store
+
+    path = Path(store_path)
+    store = Store(path)
+    listing = store.list_calibrations()
+    keys = list(listing["key"])
+    if key is not None:
+        if key not in keys:
+            raise ParameterError(f"{path}: no calibration {key!r} in this store (it holds "
+                                 f"{_keys_text(listing)})")
+        return _calibration(store, key)
+    if not keys:
+        raise ParameterError(f"{path}: this store holds no calibration (save one with "
+                             f"pidcore calibrate --dem-store {path}, or give a calibration.json)")
+    if len(keys) > 1:
+        raise ParameterError(f"{path}: this store holds {len(keys)} calibrations; choose one "
+                             f"with --calibration-key: {_keys_text(listing)}")
+    return _calibration(store, keys[0])
+
+
+def _keys_text(listing) -> str:
+    """``"cal_... (specimen, fitted a,b; 2026-11-30T17:02)"`` per calibration, newest first."""
+    if listing.empty:
+        return "none"
+    rows = listing.iloc[::-1]
+    return "; ".join(f"{r['key']} ({r.get('specimen', '')}, fitted {r.get('fit', '')}; "
+                     f"{str(r['created_utc'])[:16]})" for _, r in rows.iterrows())

@@ -1,0 +1,99 @@
+"""The app's DEM job table outlives the server (:mod:`pidcore.app.jobs` journal): a runner
+started after a stop lists the finished jobs as they were, the queued and running ones as
+interrupted (nothing saved) and can run them again; a journal that cannot be read costs the
+table, never the store or a traceback."""
+
+from __future__ import annotations
+
+import json
+import time
+from pathlib import Path
+
+from pidcore.app import jobs
+from pidcore.dem import DemConfig
+from pidcore.specimen import load_specimen
+
+REPO = Path(__file__).resolve().parents[1]
+#: A case that runs for minutes (thousands of steady cycles) so that it is surely still
+#: running when the test looks; cancelled at the end.
+LONG = DemConfig(cells=1, steady_cycles=5000)
+
+
+def _wait_running(runner, timeout_s: float = 120.0):
+    deadline = time.monotonic() + timeout_s
+    while not any(j.state == "running" for j in runner.jobs()):
+        assert time.monotonic() < deadline, [j.row() for j in runner.jobs()]
+        time.sleep(0.05)
+
+
+def _steel():
+    return load_specimen(REPO / "data_samples" / "specimens" / "steel_6mm.toml")
+
+
+def test_jobs_running_or_queued_at_a_stop_come_back_interrupted(tmp_path):
+    store = tmp_path / "app.h5"
+    specimen = _steel()
+    cases = jobs.plan_dem_cases([50.0, 60.0], [5.0], [50.0], material=specimen.particles.material,
+                                direction="z")
+    first = jobs.DemJobRunner(store)
+    try:
+        submitted = first.submit(cases, LONG, specimen)
+        _wait_running(first)
+        # the server stops here: a new process starts a runner on the same store and reads
+        # the journal the first one keeps
+        second = jobs.DemJobRunner(store)
+        restored = second.jobs()
+    finally:
+        first.cancel()
+        first.wait_cancelled(5.0)
+    assert [j.job_id for j in restored] == [j.job_id for j in submitted]
+    assert [j.state for j in restored] == [jobs.INTERRUPTED_STATE] * 2
+    assert all("nothing of it was saved" in j.message for j in restored)
+    for old, new in zip(submitted, restored, strict=True):
+        # everything needed to run it again, read back equal (the specimen by its text)
+        assert (new.case, new.config, new.run_key) == (old.case, old.config, old.run_key)
+        assert new.specimen.hash == specimen.hash
+    assert not second.busy()  # an interrupted job is not run without being asked
+    # asked: each is submitted again under a new number, and the old one says by which
+    created = second.resubmit_interrupted()
+    try:
+        assert [j.case for j in created] == [j.case for j in submitted]
+        assert all(j.specimen.hash == specimen.hash for j in created)
+        assert min(jobs._job_number(j.job_id) for j in created) > max(
+            jobs._job_number(j.job_id) for j in submitted)
+        by_id = {j.job_id: j for j in second.jobs()}
+        for old, new in zip(submitted, created, strict=True):
+            assert by_id[old.job_id].message.endswith(f"submitted again as {new.job_id}")
+    finally:
+        second.cancel()
+        second.wait_cancelled(5.0)
+    # the journal says what the runner says, and no temporary file is left beside the store
+    listed = json.loads(jobs.journal_path(store).read_text())["jobs"]
+    assert [d["state"] for d in listed] == [j.state for j in second.jobs()]
+    assert sorted(p.name for p in tmp_path.iterdir() if p.name.endswith(".tmp")) == []
+
+
+def test_finished_jobs_are_listed_as_they_were(tmp_path):
+    store = tmp_path / "app.h5"
+    (case,) = jobs.plan_dem_cases([100.0], [5.0], [50.0], material="acrylic", direction="z")
+    done = jobs.DemJob("job0007", case, DemConfig(cells=2), "k", state="saved",
+                       started=1.0, finished=3.5, cycles_done=20, cycles_expected=20,
+                       message="saved as k")
+    jobs.write_journal(jobs.journal_path(store), [done])
+    (back,) = jobs.DemJobRunner(store).jobs()
+    assert back.row() == done.row()  # every column of the table, elapsed time included
+    assert back.specimen is None
+
+
+def test_a_journal_that_cannot_be_read_gives_an_empty_table_and_says_why(tmp_path):
+    store = tmp_path / "app.h5"
+    journal = jobs.journal_path(store)
+    for text in ("{not json", json.dumps({"pidcore_jobs_version": 99, "jobs": []}),
+                 json.dumps({"pidcore_jobs_version": 1, "jobs": [{"job_id": "job0001"}]})):
+        journal.write_text(text)
+        runner = jobs.DemJobRunner(store)
+        assert runner.jobs() == []
+        assert str(journal) in runner.journal_problem and "cannot be read" in \
+            runner.journal_problem
+        assert journal.read_text() == text  # kept until the next change replaces it
+        assert not store.exists()  # the store is not touched

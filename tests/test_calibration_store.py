@@ -1,0 +1,214 @@
+"""Calibrations in the HDF5 store (:mod:`pidcore.calibrate.persist`): ``pidcore calibrate``
+saves its result beside the DEM runs it was made from; reports and the app read it back as
+they read calibration.json, with the same numbers; the same calibration is stored once; a
+store of several needs a key; a damaged one is found by ``verify``."""
+
+from __future__ import annotations
+
+import json
+import types
+
+import h5py
+import numpy as np
+import pandas as pd
+import pytest
+
+from pidcore.calibrate import load_calibration, stored_calibration, stored_calibrations
+from pidcore.calibrate.persist import calibration_key
+from pidcore.cli import main
+from pidcore.errors import ParameterError
+from pidcore.store import Store
+
+ROWS = "frequency_hz,acceleration_g,fill_percent,sdc\n500,5,50,0.6\n1000,5,50,0.6\n500,1,50,0.2\n"
+TINY = ["--cells", "2", "--steady-cycles", "10", "--workers", "1", "--no-progress"]
+
+
+def _calibrate(folder, store, discrepancy: str, capsys) -> str:
+    table = folder / "m.csv"
+    table.write_text(ROWS)
+    out = folder / f"out_{discrepancy}"
+    code = main(["calibrate", "--data", str(table), "--fit", "fixture_mass_kg", "--discrepancy",
+                 discrepancy, "--dem-store", str(store), "--out", str(out), *TINY])
+    assert code == 0
+    return capsys.readouterr().out
+
+
+@pytest.fixture(scope="module")
+def calibrated(tmp_path_factory):
+    """A store holding the calibration of the tiny table, and its --out folder."""
+    folder = tmp_path_factory.mktemp("calstore")
+    store = folder / "dem.h5"
+    table = folder / "m.csv"
+    table.write_text(ROWS)
+    assert main(["calibrate", "--data", str(table), "--fit", "fixture_mass_kg",
+                 "--discrepancy", "0.2", "--dem-store", str(store), "--out",
+                 str(folder / "out"), *TINY]) == 0
+    return folder, store
+
+
+def test_the_stored_calibration_is_the_json_written_beside_it(calibrated):
+    folder, store = calibrated
+    stored = stored_calibration(store)
+    written = load_calibration(folder / "out")
+    # the store keeps the very texts the --out folder got, so every number read back is the
+    # same double (no tolerance: a round trip of text)
+    assert stored.document_text == (folder / "out" / "calibration.json").read_text()
+    assert stored.specimen_text == (folder / "out" / "calibrated_specimen.toml").read_text()
+    assert stored.parameters == written.parameters
+    assert stored.predictions == written.predictions
+    assert stored.calibrated_specimen().hash == written.calibrated_specimen().hash
+    assert stored.specimen_name == "paper_coupon"
+    assert stored.store_key == calibration_key(json.loads(stored.document_text))
+    # listed with its medians, each named with its unit, and a sound store
+    listing = Store(store).list_calibrations()
+    assert list(listing["key"]) == [stored.store_key]
+    row = listing.iloc[0]
+    p = written.parameters["fixture_mass_kg"]
+    assert row["fixture_mass_kg_median"] == p["median"]
+    assert row["fit"] == "fixture_mass_kg" and row["n_points"] == 3
+    units = Store(store).get_calibration(stored.store_key).units
+    assert units["fixture_mass_kg_median"] == "kg" and units["rms_in_sample"] == "-"
+    assert Store(store).verify() == []
+    assert Store(store).summary()["n_calibrations"] == 1
+
+
+def test_the_same_calibration_again_is_not_stored_twice(calibrated, capsys):
+    folder, store = calibrated
+    before = Store(store).list_calibrations()
+    out = _calibrate(folder, store, "0.2", capsys)  # every DEM run cached: same posterior
+    key = before["key"].iloc[0]
+    assert f"calibration {key} is stored in" in out and "already" in out
+    after = Store(store).list_calibrations()
+    assert list(after["key"]) == [key]
+    assert list(after["created_utc"]) == list(before["created_utc"])  # kept as it was
+    # one number, one text: the CLI, summary.md and the specimen's header showed the in-sample
+    # RMS to 4 decimals, 3 decimals and 4 significant digits
+    (rms,) = [line.split()[-1] for line in out.splitlines() if line.startswith("in-sample RMS")]
+    summary = (folder / "out_0.2" / "summary.md").read_text()
+    assert f"## In-sample posterior predictions: RMS {rms}," in summary
+    header = (folder / "out_0.2" / "calibrated_specimen.toml").read_text()
+    assert f"# in-sample RMS of the SDC: {rms}\n" in header
+
+
+def test_the_key_ignores_bookkeeping_but_not_results(calibrated):
+    folder, _ = calibrated
+    doc = json.loads((folder / "out" / "calibration.json").read_text())
+    key = calibration_key(doc)
+    # how it was made (wall time, cached-run counts, the caching store's path) is not what
+    # it is
+    same = {**doc, "wall_s": doc["wall_s"] + 99, "runs": {"computed": 0, "cached": 99},
+            "settings": {**doc["settings"], "store": "elsewhere.h5"}}
+    assert calibration_key(same) == key
+    moved = json.loads(json.dumps(doc))
+    moved["predictions"][0]["predicted"] *= 1.0 + 1e-12
+    assert calibration_key(moved) != key
+
+
+def test_a_store_of_several_calibrations_needs_a_key(calibrated, capsys, tmp_path):
+    folder, store = calibrated
+    copy = tmp_path / "two.h5"
+    copy.write_bytes(store.read_bytes())
+    _calibrate(folder, copy, "0.3", capsys)
+    keys = list(Store(copy).list_calibrations()["key"])
+    assert len(keys) == 2
+    with pytest.raises(ParameterError, match="holds 2 calibrations; choose one with "
+                                             "--calibration-key") as refused:
+        stored_calibration(copy)
+    assert all(k in str(refused.value) for k in keys)
+    assert stored_calibration(copy, keys[0]).store_key == keys[0]
+    assert [c.store_key for c in stored_calibrations(copy)] == keys[::-1]  # newest first
+    with pytest.raises(ParameterError, match="no calibration 'cal_0000000000000000'"):
+        stored_calibration(copy, "cal_0000000000000000")
+    with pytest.raises(ParameterError, match="not one"):  # a key for a calibration.json
+        load_calibration(folder / "out", key=keys[0])
+    # the CLI: refused in one line, exit 2, nothing written
+    out = tmp_path / "report"
+    assert main(["report", "--dem-store", str(copy), "--calibration", str(copy), "--out",
+                 str(out), "--format", "csv"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "--calibration-key" in err, err
+    assert not out.exists()
+
+
+def _calibration_columns(folder) -> pd.DataFrame:
+    table = pd.read_csv(folder / "report.csv")
+    columns = [c for c in table.columns if "calibrated" in c and "note" not in c]
+    assert columns, table.columns
+    return table[columns]
+
+
+def test_a_report_from_the_store_has_the_numbers_of_its_json(calibrated, capsys, tmp_path):
+    folder, store = calibrated
+    key = stored_calibration(store).store_key
+    for name, source in (("from_store", [str(store), "--calibration-key", key]),
+                         ("from_json", [str(folder / "out" / "calibration.json")])):
+        assert main(["report", "--dem-store", str(store), "--calibration", *source,
+                     "--out", str(tmp_path / name), "--format", "csv"]) == 0
+    capsys.readouterr()
+    from_store = _calibration_columns(tmp_path / "from_store")
+    # the same doubles read from the same text: equal, and the rows it predicts are there
+    pd.testing.assert_frame_equal(from_store, _calibration_columns(tmp_path / "from_json"))
+    assert from_store.notna().any().any()
+
+
+def test_verify_finds_a_damaged_calibration_and_accepts_a_store_from_before(calibrated,
+                                                                            tmp_path):
+    _, store = calibrated
+    damaged = tmp_path / "damaged.h5"
+    damaged.write_bytes(store.read_bytes())
+    key = stored_calibration(damaged).store_key
+    with h5py.File(damaged, "r+") as h5:
+        arrays = h5[f"calibrations/{key}/arrays"]
+        del arrays["calibration_json"]
+        arrays.create_dataset("calibration_json", data=np.frombuffer(b"{not json", np.uint8))
+    problems = Store(damaged).verify()
+    assert len(problems) == 1 and key in problems[0], problems
+    # a store written before calibrations were stored has no /calibrations: sound, none listed
+    old = tmp_path / "old.h5"
+    old.write_bytes(store.read_bytes())
+    with h5py.File(old, "r+") as h5:
+        del h5["calibrations"]
+    assert Store(old).verify() == []
+    assert stored_calibrations(old) == []
+    assert Store(old).list_calibrations().empty
+
+
+def test_the_app_offers_the_stores_calibrations_after_a_restart(calibrated, tmp_path):
+    from pidcore.app.calibration import (
+        CalibrationRunner,
+        CalibrationTask,
+        available_calibrations,
+        saved_calibrations_table,
+    )
+    from pidcore.calibrate import calibrate, save_calibration, write_outputs
+    from pidcore.calibrate.data import read_measured_table
+    from pidcore.dem.simulate import DemConfig
+
+    folder, store = calibrated
+    app_store = tmp_path / "app.h5"
+    app_store.write_bytes(store.read_bytes())
+    # the Calibrate page's runner saves what it calibrated (the library's own functions;
+    # calibrate() returns a result computed from the cached runs)
+    points = read_measured_table(folder / "m.csv")
+    config = DemConfig(cells=2, steady_cycles=10)
+    result = calibrate(points, fit=["fixture_mass_kg"], discrepancy=0.4, store_path=app_store,
+                       cells=2, steady_cycles=10, dem_config=config, workers=1, progress=False)
+    api = types.SimpleNamespace(calibrate=lambda points, **kw: result,
+                                write_outputs=write_outputs, save_calibration=save_calibration)
+    task = CalibrationTask(("fixture_mass_kg",), 3)
+    CalibrationRunner(app_store)._run(api, task, points, ["fixture_mass_kg"], 2, None, None)
+    assert task.state == "done" and task.store_key.startswith("cal_"), task.message
+    assert f"saved in the store as {task.store_key}" in task.message
+    # a restarted app has no task: the store still offers both, newest (the page's) first,
+    # and the task's, once saved, is not offered twice
+    for running_task in (None, task):
+        found = available_calibrations(running_task, {}, cwd=tmp_path, store_path=app_store)
+        keys = [c.store_key for c, _ in found]
+        assert keys == [task.store_key, stored_calibration(store).store_key], found
+        assert all("this store's calibration cal_" in label for _, label in found)
+    table = saved_calibrations_table(app_store)
+    assert list(table["calibration"]) == keys
+    assert list(table["load cases [-]"]) == [3, 3]
+    assert list(table["inside 95 % band (LOO) [-]"]) == ["", ""]  # no leave-one-out asked
+    assert all(c.endswith("]") for c in table.columns if c not in ("calibration", "specimen",
+                                                                   "fitted"))
