@@ -38,6 +38,11 @@ CellShape = Literal["hexagonal"]
 ReportFormat = Literal["csv", "md", "html", "tex", "pdf"]
 #: What 100 % fill is: the cell's capacity (dense drop packing) or the paper's 36 particles.
 FillReference = Literal["capacity", "paper"]
+#: How a measured case was matched with our DEM (:mod:`pidcore.compare.align`): at a grid
+#: point of the runs, interpolated by the pchip model, outside its range, or no runs at all.
+AlignmentStatus = Literal["grid", "interpolated", "out_of_range", "no_dem_runs"]
+#: What a single-impact run hits (:mod:`pidcore.dem.impact`): a wall or another particle.
+ImpactPair = Literal["wall", "particle"]
 #: Normal damping constant: "eq3" = alpha from the table's e_n by Eq. 3; "calibrated" = alpha
 #: root-found so that a simulated head-on impact gives the table's e_n exactly.
 DampingCoefficient = Literal["eq3", "calibrated"]
@@ -50,6 +55,8 @@ UNTABULATED_PARTICLE_MATERIALS: tuple[str, ...] = (
     "titanium", "nylon", "ptfe", "teflon", "delrin", "polyurethane", "rubber", "ceramic",
     "zirconia", "alumina")
 
+ALIGNMENT_STATUSES: tuple[str, ...] = get_args(AlignmentStatus)
+IMPACT_PAIRS: tuple[str, ...] = get_args(ImpactPair)
 QUANTITIES: tuple[str, ...] = get_args(Quantity)
 CHANNEL_ROLES: tuple[str, ...] = get_args(ChannelRole)
 DRIVE_DIRECTIONS: tuple[str, ...] = get_args(DriveDirection)

@@ -2,7 +2,23 @@
 
 Every error a user can cause derives from :class:`PidcoreError`; the CLI prints its message as
 one line and exits non-zero. Messages name the file, channel or parameter and what was expected.
+:func:`whole_number`, :func:`real_number` and :func:`instance_of` refuse a value of the wrong
+type (a string, a bool, a fraction where a count is meant) in those words, before any use of it.
+
+Public API
+----------
+PidcoreError
+    Base of every error a user can cause (catch it to catch them all).
+InputFileError, ChannelError, SignalError, ParameterError
+    What was wrong: the file, a channel, the record, a parameter.
+SettingsTableError, StoreError, SimulationError
+    A settings table (sidecar), the store, a DEM run.
+whole_number, real_number, instance_of, as_given
+    The checks of a value's type, and a number shown as the user gave it.
 """
+
+import math
+import numbers
 
 
 class PidcoreError(Exception):
@@ -51,3 +67,49 @@ def as_given(value: float) -> str:
         return short if float(short) == value else repr(float(value))
     except (TypeError, ValueError):  # not a number: as Python shows it
         return repr(value)
+
+
+def whole_number(name: str, value: object) -> int:
+    """``value`` as an ``int``, or a :class:`ParameterError` naming ``name``.
+
+    Python and numpy integers and whole floats (``4.0``, as a JSON or HDF5 reader may give
+    back) are taken; a bool, a string or a fraction is refused rather than truncated or
+    compared (``cells=2.5`` ran, ``cells="4"`` failed with a TypeError naming nothing).
+    """
+    if isinstance(value, numbers.Integral) and not isinstance(value, bool):
+        return int(value)
+    if (isinstance(value, numbers.Real) and not isinstance(value, bool)
+            and math.isfinite(value) and float(value).is_integer()):
+        return int(value)
+    raise ParameterError(f"{name}: expected a whole number, got {value!r}")
+
+
+def real_number(name: str, value: object) -> float:
+    """``value`` as a ``float`` (NaN and inf pass: the caller checks the range), or a
+    :class:`ParameterError` naming ``name`` for a bool, a string or anything not a number."""
+    if isinstance(value, numbers.Real) and not isinstance(value, bool):
+        return float(value)
+    raise ParameterError(f"{name}: expected a number, got {value!r}")
+
+
+def instance_of(name: str, value: object, kind: type | tuple[type, ...], *,
+                hint: str = "") -> None:
+    """Refuse ``value`` unless it is a ``kind``: a :class:`ParameterError` naming ``name``, the
+    type expected and the type given (and ``hint``: how to make one), instead of an
+    AttributeError from deep inside the first use of it."""
+    if isinstance(value, kind):
+        return
+    kinds = kind if isinstance(kind, tuple) else (kind,)
+    # numpy's bool_ is named "bool" too: each name once
+    expected = " or ".join(dict.fromkeys("None" if k is type(None) else k.__name__
+                                         for k in kinds))
+    article = "an" if expected[0].lower() in "aeiou" else "a"
+    shown = " ".join(repr(value).split())  # one line, whatever the object's repr
+    shown = shown if len(shown) <= 60 else shown[:57] + "..."
+    raise ParameterError(f"{name}: expected {article} {expected}, got {type(value).__name__} "
+                         f"{shown}" + (f" ({hint})" if hint else ""))
+
+
+__all__ = ["ChannelError", "InputFileError", "ParameterError", "PidcoreError",
+           "SettingsTableError", "SignalError", "SimulationError", "StoreError", "as_given",
+           "instance_of", "real_number", "whole_number"]

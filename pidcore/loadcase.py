@@ -4,6 +4,17 @@ One type for the DEM (what to simulate), measurements (what was stated about the
 store, the CLI, reports and the app, with one text key (:attr:`LoadCase.key`,
 ``f50Hz_a5g_fill50pct_acrylic_z``). Stores written by pidcore 0.1 named DEM runs with the
 older key ``acrylic_z_f50_a5_fill50``; :func:`parse_key` reads both.
+
+Public API
+----------
+LoadCase, LoadCaseError
+    The load case (frequency [Hz], acceleration [g], fill [%], material, direction).
+parse_key, KEY_PATTERN, KEY_PATTERN_0_1, key_0_1
+    Keys of load cases and DEM runs, today's and pidcore 0.1's.
+check_fill, check_fill_range, parse_values
+    Fills in (0, 100] %; numbers typed as ``"50, 100 500"``.
+normalize_material, normalize_direction
+    Canonical material and direction names.
 """
 
 from __future__ import annotations
@@ -69,6 +80,8 @@ def normalize_direction(value: str, what: str) -> str:
 def check_fill(value: float, what: str) -> float:
     """``value`` as a fill in (0, 100] % (packing ratio), or :class:`LoadCaseError`."""
     try:
+        if isinstance(value, bool):  # True was a fill of 1 %
+            raise TypeError
         fill = float(value)
     except (TypeError, ValueError):
         raise LoadCaseError(f"{what}: fill {value!r} is not a number (packing ratio in %)") \
@@ -111,8 +124,8 @@ class LoadCase:
     def __post_init__(self) -> None:
         for name in ("frequency_hz", "acceleration_g"):
             value = getattr(self, name)
-            try:
-                number = float(value)
+            try:  # text as a table holds it is read; True is not 1 Hz
+                number = math.nan if isinstance(value, bool) else float(value)
             except (TypeError, ValueError):
                 number = math.nan
             if not (math.isfinite(number) and number > 0):

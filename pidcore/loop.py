@@ -5,6 +5,12 @@ phasors of a measurement or of a DEM run's virtual shaker record (the same way f
 their areas are comparable energies per cycle). Matplotlib figures
 (:mod:`pidcore.report.figures_results`) and the app's charts read the same
 :meth:`ForceDisplacementLoop.to_pandas` frame.
+
+Public API
+----------
+ForceDisplacementLoop
+    One period of force against displacement (``to_pandas()``, ``plot()``,
+    ``energy_per_cycle_j``).
 """
 
 from __future__ import annotations
@@ -12,7 +18,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass
 from types import MappingProxyType
-from typing import ClassVar
+from typing import Any, ClassVar
 
 import numpy as np
 import pandas as pd
@@ -124,6 +130,13 @@ class ForceDisplacementLoop:
         frame.attrs.update(label=self.label, frequency_hz=self.frequency_hz,
                            energy_per_cycle_j=self.energy_per_cycle_j)
         return frame
+
+    def plot(self, ax: Any = None) -> Any:
+        """The closed loop, displacement in µm, its energy per cycle in the legend text
+        (:func:`pidcore.report.figures_results.plot_loop`); returns ``ax``."""
+        from .report.figures_results import plot_loop  # lazy: drawing is optional
+
+        return plot_loop(self, ax=ax)
 
 
 __all__ = ["ForceDisplacementLoop"]

@@ -1,7 +1,26 @@
 """Measurement workflow: file -> channels -> Eq. 11 analysis -> store.
 
 The glue shared by the CLI (``pidcore analyze``), the report and the app, so that each of them
-stays thin.
+stays thin; a script analyses files the same way.
+
+Public API
+----------
+analyze_file, analyze_measurement
+    One export file (or a measurement read already) -> :class:`AnalyzedRecord`: channels
+    mapped to roles, units checked, the Eq. 11 analysis (``record.analysis``, a
+    :class:`~pidcore.signal.PowerAnalysis` with ``to_pandas()`` and ``plot()``) and notes.
+AnalysisOptions
+    The options of ``pidcore analyze`` (channels, delay, mass below the gauge, baseline, ...).
+AnalyzedRecord
+    A measurement with its analysis, channels used, notes and corrections.
+save_analyses, SavedAnalyses, store_analysis
+    Analyses saved to a :class:`~pidcore.store.Store` in one transaction.
+
+Examples
+--------
+>>> from pidcore.measure import AnalysisOptions, analyze_file          # doctest: +SKIP
+>>> record = analyze_file("run_012.uff", AnalysisOptions(velocity_delay_s=50e-6))  # doctest: +SKIP
+>>> record.analysis.sdc, record.analysis.sdc_stderr                   # doctest: +SKIP
 """
 
 from __future__ import annotations
@@ -10,7 +29,7 @@ import math
 import os
 from collections.abc import Mapping, Sequence
 from contextlib import suppress
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import asdict, dataclass, field, fields, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -18,14 +37,20 @@ import numpy as np
 
 from . import defaults
 from .constants import COUNT_UNIT, RATIO_UNIT
-from .errors import ChannelError, ParameterError, StoreError
+from .errors import ChannelError, ParameterError, StoreError, instance_of
 from .io import assign_roles, read_measurement
 from .records import Channel, Measurement
 from .signal import PowerAnalysis, analyze_channels
+from .signal.power import check_analysis_settings
 from .units import lookup_unit
 
 if TYPE_CHECKING:
     import pandas as pd
+
+    from .store import Store
+
+__all__ = ["AnalysisOptions", "AnalyzedRecord", "SavedAnalyses", "analyze_file",
+           "analyze_measurement", "save_analyses", "store_analysis"]
 
 #: Largest fractional-sample offset between the start times of the force channel and an
 #: acceleration channel that is ignored (the velocity's is corrected as a delay instead).
@@ -37,7 +62,7 @@ MAX_IGNORED_OFFSET_SAMPLES = 0.02
 UNIT_SLIP_FACTOR = 5.0
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class AnalysisOptions:
     """User choices for one analysis run (channel mapping and corrections)."""
 
@@ -62,6 +87,14 @@ class AnalysisOptions:
             raise ParameterError(f"invert: expected a sequence of channel names, got "
                                  f"{self.invert!r}")
         object.__setattr__(self, "invert", tuple(self.invert))  # JSON gives back a list
+        # refused when made, naming the keyword, not when the first file is analysed (or, for
+        # a string, as a TypeError from inside the analysis)
+        for name in ("force", "velocity", "acceleration", "force_unit", "velocity_unit",
+                     "acceleration_unit"):
+            instance_of(name, getattr(self, name), (str, type(None)))
+        for name in self.invert:
+            instance_of("invert", name, str)
+        instance_of("allow_clipped", self.allow_clipped, (bool, np.bool_))
         for name in ("velocity_delay_s", "mass_below_gauge_kg", "baseline_loss_factor"):
             # -0 (a sidecar's '-0', --velocity-delay -0) is no correction: saved as -0.0 it
             # made a second record of the same analysis (parameters_json differed) and was
@@ -74,6 +107,11 @@ class AnalysisOptions:
             # settings grid starts every row at 0): the baseline then goes off the whole
             # vibrated mass, noted by the analysis
             object.__setattr__(self, "structure_mass_kg", None)
+        check_analysis_settings(
+            n_harmonics=self.n_harmonics, mass_below_gauge_kg=self.mass_below_gauge_kg,
+            frequency_hz=self.frequency_hz, velocity_delay_s=self.velocity_delay_s,
+            baseline_loss_factor=self.baseline_loss_factor, sample_rate_hz=self.sample_rate_hz,
+            structure_mass_kg=self.structure_mass_kg)
 
     def parameters(self) -> dict:
         """JSON-safe parameters stored as provenance."""
@@ -93,6 +131,8 @@ class AnalyzedRecord:
     notes: tuple[str, ...] = field(default_factory=tuple)
     channels: tuple[dict, ...] = field(default_factory=tuple)
     corrections: dict = field(default_factory=dict)
+    #: The options it was analysed with (what :func:`save_analyses` saves as its parameters).
+    options: AnalysisOptions | None = None
 
     def to_dict(self) -> dict:
         """JSON-safe record: the analysis, the channels used (role, name, SI unit, unit in the
@@ -261,8 +301,12 @@ def _unit_slip_notes(measurement: Measurement, chosen: Mapping[str, Channel],
     return notes
 
 
-def analyze_measurement(measurement: Measurement, options: AnalysisOptions) -> AnalyzedRecord:
+def analyze_measurement(measurement: Measurement, options: AnalysisOptions | None = None
+                        ) -> AnalyzedRecord:
     """Map channels to roles, prepare them and run the Eq. 11 analysis on one measurement.
+
+    ``options``: channels, corrections and analysis settings; ``AnalysisOptions()`` (the
+    CLI's defaults) when not given.
 
     Preparation, each step announced in the notes: channels inverted on request
     (``invert``), units given by option for channels without one (a channel of unknown unit is
@@ -270,6 +314,9 @@ def analyze_measurement(measurement: Measurement, options: AnalysisOptions) -> A
     lengths differ (a fractional-sample start offset of the velocity is corrected as a delay),
     channels no role needs named as ignored.
     """
+    options = AnalysisOptions() if options is None else options
+    instance_of("options", options, AnalysisOptions,
+                hint="e.g. AnalysisOptions(velocity_delay_s=5e-5)")
     notes: list[str] = list(measurement.metadata.get("reader_notes", ()) or ())
     corrections: dict = {}
     as_read = measurement  # what is stored: the file's channels, the inversion a parameter
@@ -310,18 +357,22 @@ def analyze_measurement(measurement: Measurement, options: AnalysisOptions) -> A
     detail = tuple({"role": role, "name": ch.name, "unit": ch.unit,
                     "source_unit": ch.source_unit} for role, ch in chosen.items())
     return AnalyzedRecord(as_read, analysis, used, tuple(notes) + analysis.notes,
-                          detail, corrections)
+                          detail, corrections, options)
 
 
-def analyze_file(path: str | os.PathLike, options: AnalysisOptions, *,
+def analyze_file(path: str | os.PathLike, options: AnalysisOptions | None = None, *,
                  key: str | None = None) -> AnalyzedRecord:
-    """Read one export file and analyse it; ``key`` picks a measurement of a pidcore store
+    """Read one export file and analyse it (:func:`analyze_measurement`; ``options`` default
+    ``AnalysisOptions()``); ``key`` picks a measurement of a pidcore store
     (:func:`pidcore.io.read_measurement`)."""
+    options = AnalysisOptions() if options is None else options
+    instance_of("options", options, AnalysisOptions,
+                hint="e.g. AnalysisOptions(velocity_delay_s=5e-5)")
     measurement = read_measurement(Path(path), sample_rate_hz=options.sample_rate_hz, key=key)
     return analyze_measurement(measurement, options)
 
 
-def store_analysis(store, result: AnalyzedRecord, parameters: Mapping, *,
+def store_analysis(store: Store, result: AnalyzedRecord, parameters: Mapping, *,
                    fields: Mapping | None = None) -> str:
     """Add one analysed record and its measurement to an open :class:`~pidcore.store.Store`.
 
@@ -351,18 +402,23 @@ class SavedAnalyses:
     notes: list[str]
 
 
-def save_analyses(store, results: Sequence[AnalyzedRecord],
-                  options: AnalysisOptions | Sequence[AnalysisOptions],
-                  stated: Sequence[tuple[str, object, str]], *,
+def save_analyses(store: Store | str | os.PathLike, results: Sequence[AnalyzedRecord],
+                  options: AnalysisOptions | Sequence[AnalysisOptions] | None = None,
+                  stated: Sequence[tuple[str, object, str]] | None = None, *,
                   fields: Sequence[Mapping | None] | None = None) -> SavedAnalyses:
     """Save measurements and their analyses in one transaction of ``store`` (a
     :class:`~pidcore.store.Store` or its path).
 
     ``options``: per result, the options it was analysed with (their parameters are its
     record's, so that each record says how it was made: files of one call may have different
-    settings, :mod:`pidcore.file_settings`); one :class:`AnalysisOptions` stands for all.
+    settings, :mod:`pidcore.file_settings`); one :class:`AnalysisOptions` stands for all;
+    None (default): each result's own (:attr:`AnalyzedRecord.options`). Options whose
+    analysis settings differ from those a result was analysed with are refused: the record
+    would say it was made otherwise than it was (the channel names may differ: the record
+    keeps the channels used).
     ``stated``: per result, (file name, its :class:`~pidcore.loadcase.LoadCase` or None, who
-    stated it); the load case goes into the record (:meth:`~pidcore.loadcase.LoadCase.as_record`).
+    stated it); the load case goes into the record (:meth:`~pidcore.loadcase.LoadCase.as_record`);
+    default: each file's name and no load case.
     ``fields``: per result, further record fields or None (the ``specimen`` a sidecar names).
     A saved record of the same bytes under another name or load case is replaced, and the
     notes say so (:func:`replacement_notes`).
@@ -370,13 +426,24 @@ def save_analyses(store, results: Sequence[AnalyzedRecord],
     from .records import measurement_key
     from .store import Store
 
-    per_result = ([options] * len(results) if isinstance(options, AnalysisOptions)
-                  else list(options))
+    if options is None:
+        missing = [r.measurement.source for r in results if r.options is None]
+        if missing:
+            raise ParameterError(f"options: {', '.join(missing)} carry no analysis options; "
+                                 "give the options they were analysed with")
+        per_result = [r.options for r in results]
+    else:
+        per_result = ([options] * len(results) if isinstance(options, AnalysisOptions)
+                      else list(options))
+    if stated is None:
+        stated = [(Path(r.measurement.source).name, None, "") for r in results]
     extra = list(fields) if fields is not None else [None] * len(results)
     for name, given in (("options", per_result), ("stated", stated), ("fields", extra)):
         if len(given) != len(results):
             raise ParameterError(f"{name}: expected one per result ({len(results)}), got "
                                  f"{len(given)}")
+    for r, given in zip(results, per_result, strict=True):
+        _refuse_other_settings(r, given)
     store = store if isinstance(store, Store) else Store(store)
     _refuse_the_store_itself(store, results)
     with store.transaction():
@@ -389,6 +456,28 @@ def save_analyses(store, results: Sequence[AnalyzedRecord],
                 for r, o, (_, case, origin), more in zip(results, per_result, stated, extra,
                                                          strict=True)]
     return SavedAnalyses(keys, notes)
+
+
+#: Fields of :class:`AnalysisOptions` that name channels: a record keeps the channels it used
+#: (the app saves its options without them), so these may differ from the analysis's.
+_CHANNEL_FIELDS = ("force", "velocity", "acceleration")
+
+
+def _refuse_other_settings(result: AnalyzedRecord, given: AnalysisOptions) -> None:
+    """Refuse to save ``result`` with options whose analysis settings differ from those it
+    was analysed with: its record would say a delay, mass or baseline it was not made with
+    (a script passing ``AnalysisOptions()`` for files analysed with a 50 µs delay)."""
+    instance_of("options", given, AnalysisOptions)
+    used = result.options
+    if used is None:
+        return  # a record made by hand: its options are the caller's word
+    differ = [f"{name} {getattr(given, name)!r} (analysed with {getattr(used, name)!r})"
+              for name in (f.name for f in fields(AnalysisOptions))
+              if name not in _CHANNEL_FIELDS and getattr(given, name) != getattr(used, name)]
+    if differ:
+        raise ParameterError(f"options: {result.measurement.source} would be saved with "
+                             f"{'; '.join(differ)}; give the options it was analysed with, or "
+                             "none (its own)")
 
 
 def refuse_store_among_inputs(store, paths: Sequence[str | os.PathLike]) -> None:

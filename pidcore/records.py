@@ -2,6 +2,16 @@
 
 Readers produce :class:`Measurement` objects whose channels are already in SI units. Nothing
 downstream of a reader knows about file formats.
+
+Public API
+----------
+Measurement, Channel
+    A file's channels (SI samples, rate, start, unit as written); ``Measurement.to_pandas()``
+    and ``plot()``.
+measurement_key, measurement_key_and_basis
+    The key a store keeps a measurement under (its file's bytes, or its contents).
+json_safe
+    A value as JSON takes it (numpy scalars, NaN as null).
 """
 
 from __future__ import annotations
@@ -10,11 +20,15 @@ import hashlib
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from .constants import SI_UNITS
 from .errors import ChannelError, StoreError
+
+if TYPE_CHECKING:  # pragma: no cover
+    import pandas as pd
 
 
 def json_safe(value: object) -> object:
@@ -104,7 +118,51 @@ class Measurement:
 
     @property
     def channel_names(self) -> list[str]:
+        """Names of the channels, in file order."""
         return [c.name for c in self.channels]
+
+    def to_pandas(self) -> pd.DataFrame:
+        """The channels side by side, one row per sample (SI units, each column naming its
+        unit): ``time [s]`` (from the first channel's start) and ``<name> [<unit>]`` per
+        channel; a shorter channel ends in NaN. ``attrs`` hold ``source`` and
+        ``sample_rate_hz``.
+
+        Raises
+        ------
+        ChannelError
+            The channels have different sample rates or start times (no common time axis;
+            :func:`pidcore.measure.analyze_measurement` aligns them for an analysis).
+        """
+        import pandas as pd  # here: records is imported by every reader, pandas is slow
+
+        if not self.channels:
+            raise ChannelError(f"{self.source}: no channels to tabulate")
+        first = self.channels[0]
+        for ch in self.channels[1:]:
+            if not (math.isclose(ch.sample_rate_hz, first.sample_rate_hz, rel_tol=1e-9)
+                    and math.isclose(ch.start_time_s, first.start_time_s, rel_tol=0.0,
+                                     abs_tol=1e-3 / first.sample_rate_hz)):
+                raise ChannelError(
+                    f"{self.source}: channel {ch.name!r} ({ch.sample_rate_hz:g} Hz from "
+                    f"{ch.start_time_s:g} s) and {first.name!r} ({first.sample_rate_hz:g} Hz "
+                    f"from {first.start_time_s:g} s) share no time axis; tabulate them apart")
+        n = max(ch.n_samples for ch in self.channels)
+        columns: dict[str, np.ndarray] = {
+            "time [s]": first.start_time_s + np.arange(n) / first.sample_rate_hz}
+        for ch in self.channels:
+            values = np.full(n, np.nan)
+            values[:ch.n_samples] = ch.data
+            columns[f"{ch.name} [{ch.unit}]"] = values
+        frame = pd.DataFrame(columns)
+        frame.attrs.update(source=self.source, sample_rate_hz=first.sample_rate_hz)
+        return frame
+
+    def plot(self, ax: Any = None) -> Any:
+        """Each channel against time, one axes per channel
+        (:func:`pidcore.report.figures_results.plot_measurement`); returns the axes."""
+        from .report.figures_results import plot_measurement  # lazy: drawing is optional
+
+        return plot_measurement(self.to_pandas(), ax=ax)
 
 
 def measurement_key_and_basis(measurement: Measurement) -> tuple[str, str]:
@@ -131,3 +189,6 @@ def measurement_key(measurement: Measurement) -> str:
     byte-identical files (under any name) share it, so it is also what says two records hold
     the same data (here, below the store, so that the comparison layer can ask it too)."""
     return measurement_key_and_basis(measurement)[0]
+
+
+__all__ = ["Channel", "Measurement", "json_safe", "measurement_key", "measurement_key_and_basis"]

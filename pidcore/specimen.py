@@ -55,6 +55,22 @@ tables say later. ``[pairs] tangential_stiffness_model`` (``"constant"``, the de
 set it keep the hash they had before the key existed. Every numeric field (and that key) is
 addressable by a dotted path (``"pairs.particle_wall.static_friction"``, ``"particles.radius_m"``,
 ``"pairs.tangential_stiffness_model"``) for :meth:`Specimen.with_values`.
+
+Public API
+----------
+load_specimen, paper_specimen, Specimen
+    A specimen from a TOML file, the bundled paper coupon; ``Specimen.from_text``,
+    ``with_values``, ``to_toml``, ``capacity_per_cell``.
+CellSpec, CouponSpec, ParticleSpec, PairSpec, PairsSpec
+    Its sections (SI units in the field names).
+describe
+    What follows from it: capacity, masses, contact numbers, time step.
+particles_for_fill
+    Particles per cell of a fill percentage (the one rounding rule).
+cell_geometry, contact_law
+    The DEM's cell geometry and contact law of a specimen.
+numeric_fields
+    Dotted paths of its numeric fields (what calibration can fit).
 """
 
 from __future__ import annotations
@@ -69,7 +85,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from .constants import (
     CELL_SHAPES,
@@ -77,7 +93,12 @@ from .constants import (
     CellShape,
     TangentialStiffnessModel,
 )
-from .errors import ParameterError, as_given
+from .errors import ParameterError, as_given, real_number
+from .loadcase import normalize_material
+
+if TYPE_CHECKING:  # pragma: no cover
+    from .dem.contact import ContactLaw
+    from .dem.geometry import CellGeometry
 
 #: Version of the specimen schema written by :meth:`Specimen.to_toml`.
 SCHEMA_VERSION = 1
@@ -231,8 +252,12 @@ def particles_for_fill(fill_percent: float, full: int) -> int:
     The one rounding rule of a fill, for ``specimen check`` and ``dem run`` alike: a fill that
     rounds to no particle is refused (an empty cell damps nothing, and its SDC is 0/0).
     """
+    fill_percent = real_number("fill_percent", fill_percent)
     if not math.isfinite(fill_percent):
         raise ParameterError(f"fill {fill_percent} %: expected a finite percentage")
+    if fill_percent > 100.0:  # 150 % gave 1.5 full cells of particles, more than fit
+        raise ParameterError(f"fill {as_given(fill_percent)} %: more than a full cell; "
+                             "expected a packing ratio in (0, 100] %")
     n = int(round(fill_percent / 100.0 * full))
     if n < 1:
         # the smallest fill shown on a 0.01 % step strictly above half a particle: rounds to 1
@@ -551,7 +576,7 @@ class Specimen:
 
     # --- what follows from it ------------------------------------------------------------
 
-    def cells_area_m2(self, geometry=None) -> float:
+    def cells_area_m2(self, geometry: CellGeometry | None = None) -> float:
         """Cross-section of the coupon's ``[cell] count`` cells, m^2 (count x one cell's
         hexagon across the flats): the coupon's face area as far as its cells go.
         ``geometry``: :meth:`geometry`, where the caller has it."""
@@ -580,7 +605,7 @@ class Specimen:
                     f"[particles] count_per_cell {p.count_per_cell} of capacity {capacity}")
         return None
 
-    def geometry(self):
+    def geometry(self) -> CellGeometry:
         """The cell as a DEM geometry record (dispatch on ``cell.shape``)."""
         return cell_geometry(self.cell)
 
@@ -878,6 +903,8 @@ def paper_specimen(material: str = "acrylic") -> Specimen:
     (``materials.csv``, ``material_pairs.csv``), which reproduces ``--material aluminium``
     runs of earlier versions.
     """
+    # "aluminum" and "pmma", which LoadCase and the CLI take, were unknown here
+    material = normalize_material(material, "material", known=None)
     base = Specimen.from_text(_paper_text(), source=f"pidcore:{PAPER_SPECIMEN_NAME}.toml")
     if material == base.particles.material:
         return base
@@ -906,7 +933,7 @@ def paper_specimen(material: str = "acrylic") -> Specimen:
 # --- contact law ----------------------------------------------------------------------------
 
 def contact_law(specimen: Specimen, *, alpha_pp: float | None = None,
-                alpha_pw: float | None = None):
+                alpha_pw: float | None = None) -> ContactLaw:
     """The DEM contact law of a specimen's particles in its cell (paper Eq. 2-5).
 
     :meth:`pidcore.dem.contact.ContactLaw.from_properties` fed from the specimen's resolved
@@ -1048,7 +1075,7 @@ def _heavy_fixture_note(specimen: Specimen, count: int) -> tuple[str, ...]:
 
 # --- geometry -------------------------------------------------------------------------------
 
-def cell_geometry(cell: CellSpec):
+def cell_geometry(cell: CellSpec) -> CellGeometry:
     """DEM geometry of a cell, by shape (only ``"hexagonal"`` so far)."""
     from .dem.geometry import CellGeometry
 

@@ -46,7 +46,7 @@ import pytest  # noqa: E402
 
 #: Test modules that call the DEM kernel (directly, through the CLI, sweeps or the app): run
 #: after the others, whose tests need no wait.
-DEM_KERNEL_TESTS = re.compile(r"^test_(dem_|app_|samples|specimen|calibrat)")
+DEM_KERNEL_TESTS = re.compile(r"^test_(dem_|app_|samples|specimen|calibrat|readme)")
 #: Environment variable naming the file the background warm-up writes when it is done.
 WARMUP_DONE_ENV = "PIDCORE_NUMBA_WARMUP_DONE"
 #: Longest wait for the warm-up before a worker compiles on its own, s.

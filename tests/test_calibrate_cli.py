@@ -146,6 +146,29 @@ def test_json_document(capsys, tmp_path, tiny_store):
             f"(95 % {low} .. {high})") in spec.description
 
 
+def test_a_calibration_result_reads_as_its_calibration_json(tmp_path, tiny_store):
+    # a script's calibrate() result had neither to_pandas() nor plot() nor lookup(): only
+    # lists of dicts, while the same numbers read back from calibration.json had them all
+    import matplotlib
+    import pandas as pd
+
+    from pidcore.calibrate import load_calibration, write_outputs
+
+    points = [MeasuredPoint(500, 5, 50, 0.6), MeasuredPoint(1000, 5, 50, 0.6),
+              MeasuredPoint(500, 1, 50, 0.2)]
+    result = calibrate(points, fit=["fixture_mass_kg"], store_path=tiny_store,
+                       discrepancy=0.2, cells=2, steady_cycles=10,
+                       dem_config=DemConfig(steady_cycles=10), workers=1, progress=False)
+    write_outputs(result, tmp_path / "out")
+    read_back = load_calibration(tmp_path / "out")
+    pd.testing.assert_frame_equal(result.to_pandas(), read_back.to_pandas())
+    case = LoadCase(500.0, 1.0, 50.0)
+    assert result.calibration().lookup(case) == read_back.lookup(case)
+    assert result.calibration().lookup(case).sdc == result.predictions[2]["predicted"]
+    ax = matplotlib.figure.Figure().subplots()
+    assert result.plot(ax=ax) is ax and ax.has_data()
+
+
 def test_loo_prediction_never_sees_the_held_out_value(tiny_store):
     # a fold's prediction must not move when the held-out measurement changes
     config = DemConfig(steady_cycles=10)

@@ -24,6 +24,12 @@ README = ROOT / "README.md"
 UPWARD_ALLOWED: dict[tuple[str, str], str] = {
     ("pidcore.signal.power", "pidcore.report.figures_results"): "PowerAnalysis.plot forwards",
     ("pidcore.dem.result", "pidcore.report.figures_results"): "DemResult.plot forwards",
+    ("pidcore.records", "pidcore.report.figures_results"): "Measurement.plot forwards",
+    ("pidcore.loop", "pidcore.report.figures_results"): "ForceDisplacementLoop.plot forwards",
+    ("pidcore.model.response", "pidcore.report.figures_results"):
+        "HarmonicResponse.plot forwards",
+    ("pidcore.calibrate.prediction", "pidcore.report.figures_results"):
+        "Calibration.plot forwards",
 }
 
 

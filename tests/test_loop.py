@@ -68,7 +68,7 @@ def test_loop_frame_round_trips_the_arrays_with_units(analysis):
 
 
 def test_spectrum_frame_gives_back_the_phasors(analysis):
-    frame = analysis.spectrum_frame()
+    frame = analysis.to_pandas()
     assert isinstance(frame, pd.DataFrame)
     n = frame["harmonic [-]"].to_numpy()
     np.testing.assert_array_equal(n, analysis.harmonics)

@@ -104,8 +104,8 @@ def test_damper_table_content(model):
     def mass(fill):
         return 0.02 + fill / 1000
 
-    t = equivalent_damper_table(model, fills=[25, 90], accelerations=[1, 5],
-                                frequencies=[100, 1000], vibrated_mass_kg=mass)
+    t = equivalent_damper_table(model, fills_percent=[25, 90], accelerations_g=[1, 5],
+                                frequencies_hz=[100, 1000], vibrated_mass_kg=mass)
     assert list(t.columns) == list(DAMPER_COLUMNS)
     assert len(t) == 8
     # every column names its unit; the flag's brackets name its values, as the report's
@@ -135,11 +135,22 @@ def test_damper_table_content(model):
 
 def test_damper_table_refuses_out_of_range(model):
     with pytest.raises(ParameterError, match="outside the model range"):
-        equivalent_damper_table(model, fills=[50], accelerations=[20], frequencies=[100],
-                                vibrated_mass_kg=0.1)
+        equivalent_damper_table(model, fills_percent=[50], accelerations_g=[20],
+                                frequencies_hz=[100], vibrated_mass_kg=0.1)
     with pytest.raises(ParameterError, match="vibrated_mass_kg"):
-        equivalent_damper_table(model, fills=[50], accelerations=[5], frequencies=[100],
-                                vibrated_mass_kg=0.0)
+        equivalent_damper_table(model, fills_percent=[50], accelerations_g=[5],
+                                frequencies_hz=[100], vibrated_mass_kg=0.0)
+
+
+def test_damper_table_refuses_a_vibrated_mass_in_grams(model):
+    # the paper coupon's m_c with particles is 0.02-0.2 kg: 98.8 is grams typed for kg, which
+    # gave c_eq and energies 1000 x too large (pidcore model damper --vibrated-mass refused it)
+    with pytest.raises(ParameterError, match=r"^vibrated_mass_kg 98.8 kg is .*was it grams\?"):
+        equivalent_damper_table(model, fills_percent=[50], accelerations_g=[5],
+                                frequencies_hz=[100], vibrated_mass_kg=98.8)
+    kept = equivalent_damper_table(model, fills_percent=[50], accelerations_g=[5],
+                                   frequencies_hz=[100], vibrated_mass_kg=0.0988)
+    assert kept["vibrated_mass [kg]"].tolist() == [0.0988]
 
 
 def test_written_files_round_trip(tmp_path):
@@ -148,8 +159,8 @@ def test_written_files_round_trip(tmp_path):
     t = grid.to_frame(index=False)
     t["sdc"] = np.linspace(1e-7, 1.0, len(t))  # includes SDC = 1: damping ratio undefined
     m = SdcModel.from_table(t, value="sdc", source="synthetic")
-    table = equivalent_damper_table(m, fills=[25, 90], accelerations=[1, 10],
-                                    frequencies=[50, 1000], vibrated_mass_kg=0.1)
+    table = equivalent_damper_table(m, fills_percent=[25, 90], accelerations_g=[1, 10],
+                                    frequencies_hz=[50, 1000], vibrated_mass_kg=0.1)
     paths = write_damper_table(table, tmp_path, provenance={"sdc_source": m.source})
     assert [p.name for p in paths] == ["equivalent_damper.csv", "equivalent_damper.json"]
     back = pd.read_csv(paths[0])
@@ -178,3 +189,22 @@ def test_sdc_from_energy_per_cycle_inverts_energy_per_cycle():
     # no reference energy (unknown m_c): NaN, not an exception or a number
     assert math.isnan(sdc_from_energy_per_cycle(1e-3, vibrated_mass_kg=float("nan"),
                                                 acceleration_m_s2=9.8, frequency_hz=100.0))
+
+
+def test_damper_table_axes_name_their_units_and_the_old_names_still_work(model):
+    # fills=, accelerations=, frequencies= named no unit (g here, m/s^2 in energy_per_cycle;
+    # harmonic_response says frequencies_hz=): the names with units, the old ones warned
+    new = equivalent_damper_table(model, fills_percent=[50], accelerations_g=[5],
+                                  frequencies_hz=[100], vibrated_mass_kg=0.1)
+    with pytest.warns(DeprecationWarning) as caught:
+        old = equivalent_damper_table(model, fills=[50], accelerations=[5], frequencies=[100],
+                                      vibrated_mass_kg=0.1)
+    assert sorted(str(w.message).split(": ")[1] for w in caught) == [
+        "accelerations= is now accelerations_g= (the unit in the name)",
+        "fills= is now fills_percent= (the unit in the name)",
+        "frequencies= is now frequencies_hz= (the unit in the name)"]
+    assert {w.filename for w in caught} == {__file__}  # pointed at the caller's line
+    pd.testing.assert_frame_equal(new, old)
+    with pytest.raises(ParameterError, match="^fills_percent and fills name the same axis"):
+        equivalent_damper_table(model, fills_percent=[50], fills=[50], accelerations_g=[5],
+                                frequencies_hz=[100], vibrated_mass_kg=0.1)

@@ -15,6 +15,25 @@ Modules, one concern each:
 * :mod:`~pidcore.calibrate.prediction`: reading a calibration.json back and looking up the
   calibrated prediction of a load case (reports, app);
 * :mod:`~pidcore.calibrate.persist`: calibrations saved in and read from the HDF5 store.
+
+Public API
+----------
+calibrate, CalibrationResult, base_specimen
+    Fit specimen parameters to measured SDCs (posterior, 95 % bands, leave-one-out);
+    the result's ``calibration()``, ``to_pandas()`` and ``plot()``.
+read_measured_table, measured_from_store, MeasuredPoint
+    The measured SDCs to fit: a table, or the analyses of a store.
+CATALOGUE, ParameterSpec, build_specs, parse_fit, dem_parameter_names
+    What can be fitted, its bounds and priors.
+Observation, observation_from_run
+    The SDC a shaker test of a DEM run would measure.
+write_outputs
+    calibration.json, the calibrated specimen, figures and summary.
+save_calibration, stored_calibration, stored_calibrations
+    Calibrations saved in and read from the HDF5 store.
+load_calibration, calibration_from_json, Calibration, CalibratedPrediction
+    A calibration read back (``to_pandas()``, ``plot()``); its prediction and 95 % band at
+    a calibrated load case (``Calibration.lookup(case).band(stderr)``).
 """
 
 from .calibrate import CalibrationResult, base_specimen, calibrate

@@ -13,6 +13,7 @@ import os
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -24,7 +25,14 @@ from ..errors import ParameterError
 from ..specimen import CALIBRATED_SUFFIX, Specimen, paper_specimen, uncalibrated_name
 from .data import MeasuredPoint, check_enough_points
 from .observation import Observation, observation_from_run
-from .parameters import CATALOGUE, DISCREPANCY, ParameterSpec, build_specs, parameter_spec
+from .parameters import (
+    CATALOGUE,
+    DISCREPANCY,
+    ParameterSpec,
+    build_specs,
+    parameter_spec,
+    parse_fit,
+)
 from .posterior import (
     DISCREPANCY_FLOOR,
     Model,
@@ -36,6 +44,11 @@ from .posterior import (
 )
 from .runner import RunRequest, run_requests, specimen_with
 from .surrogate import build_surrogate, default_design_size, design_points
+
+if TYPE_CHECKING:  # pragma: no cover
+    import pandas as pd
+
+    from .prediction import Calibration
 
 #: Cells per DEM run of a calibration: the ensemble scatter enters the likelihood, and 4
 #: cells keep a 12-case design within minutes on two cores.
@@ -101,6 +114,26 @@ class CalibrationResult:
             out, name=f"{self.specimen.name}{CALIBRATED_SUFFIX}",
             description=f"{self.specimen.description} -- calibrated by pidcore calibrate: "
                         f"{fitted} (these replace any value stated above)".strip(" -"))
+
+    def calibration(self) -> Calibration:
+        """This result as :func:`~pidcore.calibrate.load_calibration` reads it back from its
+        ``calibration.json``: ``lookup(case).band(stderr)``, ``to_pandas()``, ``plot()``."""
+        from .outputs import document_json
+        from .prediction import calibration_from_json
+
+        return calibration_from_json(document_json(self.document()),
+                                     "<calibration in memory>",
+                                     specimen_name=self.calibrated_specimen().name)
+
+    def to_pandas(self) -> pd.DataFrame:
+        """The in-sample predictions with their 95 % bands, one row per measured load case,
+        columns naming their units (:meth:`Calibration.to_pandas` of :meth:`calibration`)."""
+        return self.calibration().to_pandas()
+
+    def plot(self, ax: Any = None) -> Any:
+        """Predictions and bands beside the measured SDCs (:meth:`Calibration.plot` of
+        :meth:`calibration`); returns ``ax``."""
+        return self.calibration().plot(ax=ax)
 
     def document(self) -> dict:
         """The ``--json`` document: parameters, predictions, loo, loo_rms, and the units of
@@ -264,8 +297,8 @@ def check_point_specimens(points: Sequence[MeasuredPoint], specimen: Specimen) -
                          "leave those rows out")
 
 
-def calibrate(points: Sequence[MeasuredPoint], *, fit: Sequence[str],
-              store_path: str | os.PathLike, priors: Sequence[str] = (),
+def calibrate(points: Sequence[MeasuredPoint], *, fit: str | Sequence[str],
+              store_path: str | os.PathLike, priors: str | Sequence[str] = (),
               discrepancy: float | None = None,
               discrepancy_floor: float = DISCREPANCY_FLOOR,
               cells: int = CALIBRATION_CELLS, seed: int = defaults.DEM_SEED,
@@ -276,6 +309,9 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: Sequence[str],
               specimen: Specimen | None = None,
               on_design: Callable[[list[str]], None] | None = None) -> CalibrationResult:
     """Fit ``fit`` parameters to measured SDCs (see the package docstring for the model).
+
+    ``fit``: parameter names, a sequence or ``"a,b"`` as ``--fit`` takes them; ``priors``:
+    ``--prior`` texts (``"NAME=LOW:HIGH"``), one string or a sequence.
 
     DEM runs go to (and are reused from) the store at ``store_path``. ``discrepancy``: fix the
     relative model discrepancy instead of fitting it. ``cross_validate="loo"``: also predict
@@ -288,6 +324,10 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: Sequence[str],
     start = time.perf_counter()
     points = list(points)
     specimen = base_specimen(points, specimen)
+    # as the CLI reads them: "a,b" is two names (a string was taken letter by letter:
+    # "unknown parameter 'r'"), one prior string is one prior
+    fit = parse_fit(fit, specimen)
+    priors = [priors] if isinstance(priors, str) else list(priors)
     specs = build_specs(fit, priors, discrepancy=discrepancy, specimen=specimen)
     check_enough_points(points, [spec.name for spec in specs])
     if cross_validate is not None and cross_validate not in CROSS_VALIDATIONS:

@@ -50,7 +50,8 @@ class Observation:
     coupon_mass_kg: float
     energy_per_cycle_j: float
 
-    def sdc(self, fixture_mass_kg=0.0, baseline_loss_factor=0.0):
+    def sdc(self, fixture_mass_kg: float | np.ndarray = 0.0,
+            baseline_loss_factor: float | np.ndarray = 0.0) -> np.ndarray:
         """Predicted measured SDC (Eq. 11) for a fixture mass (kg) and a baseline loss factor."""
         structure = self.coupon_mass_kg + np.asarray(fixture_mass_kg, dtype=float)
         return 2 * math.pi * (self.dissipative_mass_kg + np.asarray(baseline_loss_factor)

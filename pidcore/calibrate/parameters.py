@@ -24,10 +24,14 @@ import itertools
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..errors import ParameterError, as_given
+
+if TYPE_CHECKING:  # pragma: no cover
+    from ..specimen import Specimen
 
 DISCREPANCY = "model_discrepancy"
 
@@ -48,6 +52,8 @@ class ParameterSpec:
     unit: str = "-"  # of the value, as calibration.json's "units" states it
 
     def check(self) -> None:
+        """Refuse empty bounds and a prior that does not fit them (one-line
+        :class:`~pidcore.errors.ParameterError` naming the parameter)."""
         if not (math.isfinite(self.low) and math.isfinite(self.high) and self.low < self.high):
             raise ParameterError(f"{self.name}: bounds {as_given(self.low)}:"
                                  f"{as_given(self.high)} are empty (expected LOW < HIGH)")
@@ -217,7 +223,8 @@ def _field_value(specimen, path: str):
     return node
 
 
-def parse_fit(text: str | Sequence[str] | None, specimen=None) -> list[str]:
+def parse_fit(text: str | Sequence[str] | None, specimen: Specimen | None = None
+              ) -> list[str]:
     """Names from ``--fit a,b``; unknown names are a one-line error."""
     if text is None:
         return list(DEFAULT_FIT)
@@ -264,7 +271,8 @@ def parse_prior(text: str) -> tuple[str, dict]:
 
 
 def build_specs(fit: Sequence[str], priors: Sequence[str] = (), *,
-                discrepancy: float | None = None, specimen=None) -> list[ParameterSpec]:
+                discrepancy: float | None = None, specimen: Specimen | None = None
+                ) -> list[ParameterSpec]:
     """Specs of the fitted parameters (order of ``fit``, then ``model_discrepancy`` unless
     fixed by ``discrepancy``), with ``--prior`` changes applied and checked."""
     changes: dict[str, dict] = {}

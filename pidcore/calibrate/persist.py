@@ -17,10 +17,14 @@ import hashlib
 import json
 import os
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ..errors import ParameterError
 from .outputs import document_json, specimen_text
 from .prediction import Calibration, calibration_from_json
+
+if TYPE_CHECKING:  # pragma: no cover
+    from .calibrate import CalibrationResult
 
 #: Fields of calibration.json that describe how a calibration was made, not what it is: the
 #: wall time, how many runs came from the cache, the path of the store that cached them.
@@ -58,7 +62,8 @@ def _record(result) -> tuple[dict, dict]:
     return record, out_units
 
 
-def save_calibration(result, store_path: str | os.PathLike) -> tuple[str, bool]:
+def save_calibration(result: CalibrationResult, store_path: str | os.PathLike
+                     ) -> tuple[str, bool]:
     """Save ``result`` (:class:`~pidcore.calibrate.calibrate.CalibrationResult`) into the store
     at ``store_path`` in one transaction; returns ``(key, added)`` (``added`` False: the same
     calibration was stored before and is kept as it was)."""

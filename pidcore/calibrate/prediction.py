@@ -12,11 +12,17 @@ import math
 import os
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import pandas as pd
 
 from .. import defaults
 from ..compare.align import Tolerances
-from ..errors import ParameterError
+from ..errors import ParameterError, instance_of, real_number
 from ..loadcase import LoadCase
+
+if TYPE_CHECKING:  # pragma: no cover
+    from ..specimen import Specimen
 
 _REQUIRED = ("frequency_hz", "acceleration_g", "fill_percent", "predicted", "low95", "high95")
 
@@ -67,6 +73,7 @@ class CalibratedPrediction:
         add; cut at 0): a precise new measurement is not judged by the wider band of a noisy
         fitted one, nor a noisy one by a narrow band.
         """
+        stderr = real_number("stderr", stderr)
         same = (not math.isfinite(stderr) or not math.isfinite(self.measured_stderr)
                 or not math.isfinite(self.low95_without_stderr)
                 or math.isclose(stderr, self.measured_stderr, rel_tol=1e-9, abs_tol=1e-12))
@@ -127,10 +134,42 @@ class Calibration:
     store_key: str = ""
     created_utc: str = ""
 
+    def to_pandas(self) -> pd.DataFrame:
+        """The predictions, one row per calibrated load case, each column naming its unit.
+
+        Columns ``frequency [Hz]``, ``acceleration [g]``, ``fill [%]``, ``material``,
+        ``direction``, ``sdc predicted [-]``, ``low95 [-]``, ``high95 [-]`` (the band of a
+        measurement with the fitted point's standard error), ``sdc measured [-]``,
+        ``sdc measured stderr [-]``, ``low95 without stderr [-]``,
+        ``high95 without stderr [-]`` (NaN where the file does not state them).
+        """
+        return pd.DataFrame([{
+            "frequency [Hz]": p.load_case.frequency_hz,
+            "acceleration [g]": p.load_case.acceleration_g,
+            "fill [%]": p.load_case.fill_percent,
+            "material": p.load_case.material,
+            "direction": p.load_case.direction,
+            "sdc predicted [-]": p.sdc,
+            "low95 [-]": p.low95,
+            "high95 [-]": p.high95,
+            "sdc measured [-]": p.measured,
+            "sdc measured stderr [-]": p.measured_stderr,
+            "low95 without stderr [-]": p.low95_without_stderr,
+            "high95 without stderr [-]": p.high95_without_stderr,
+        } for p in self.predictions])
+
+    def plot(self, ax: Any = None) -> Any:
+        """Predictions with their 95 % bands beside the measured SDCs
+        (:func:`pidcore.report.figures_results.plot_calibration`); returns ``ax``."""
+        from ..report.figures_results import plot_calibration  # lazy: drawing is optional
+
+        return plot_calibration(self.to_pandas(), ax=ax)
+
     def lookup(self, case: LoadCase, *,
                tolerances: Tolerances | None = None) -> CalibratedPrediction | None:
         """The prediction at ``case`` (same material; frequency, acceleration and fill within
         ``tolerances``, default the report's ``COMPARE_*``), or None if it predicts none."""
+        instance_of("case", case, LoadCase, hint="e.g. LoadCase(500.0, 5.0, 50.0)")
         tolerances = tolerances or Tolerances()
         hits = [p for p in self.predictions
                 if p.load_case.material == case.material and tolerances.matches(case,
@@ -142,7 +181,7 @@ class Calibration:
                                         abs(p.load_case.acceleration_g - case.acceleration_g),
                                         abs(p.load_case.fill_percent - case.fill_percent)))
 
-    def calibrated_specimen(self):
+    def calibrated_specimen(self) -> Specimen | None:
         """The calibrated specimen: read with it from a store (:attr:`specimen_text`), else
         the file beside the calibration (:attr:`specimen_path`); None where there is none or
         it cannot be read (then which specimen it calibrates is unknown)."""
@@ -172,7 +211,7 @@ class Calibration:
             return True
         return uncalibrated_name(calibrated) == uncalibrated_name(specimen_name)
 
-    def other_specimen_reason(self, specimen) -> str:
+    def other_specimen_reason(self, specimen: Specimen | None) -> str:
         """Why this calibration does not speak for ``specimen`` (another specimen, or one of
         the same name with another cell or particles); "" where it does, or where either is
         unknown (``specimen`` None, or no readable :meth:`calibrated_specimen`). A report

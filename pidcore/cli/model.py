@@ -232,9 +232,9 @@ def run_damper(args: argparse.Namespace) -> int:
     else:
         area, area_text = None, f"{coupon_area_m2()} m^2 (the paper's 0.1 m x 0.1 m coupon)"
     table = equivalent_damper_table(
-        model, fills=args.fills if args.fills else model.axes[0],
-        accelerations=args.accelerations if args.accelerations else model.axes[1],
-        frequencies=args.frequencies if args.frequencies else model.axes[2],
+        model, fills_percent=args.fills if args.fills else model.axes[0],
+        accelerations_g=args.accelerations if args.accelerations else model.axes[1],
+        frequencies_hz=args.frequencies if args.frequencies else model.axes[2],
         vibrated_mass_kg=mass, area_m2=area)
     provenance = {
         "sdc_source": model.source, "sdc_value": model.value_name,

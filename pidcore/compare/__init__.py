@@ -3,6 +3,25 @@
 :mod:`.loadcase` says which load case a measurement belongs to (measured frequency and
 acceleration, stated fill/material/direction); :mod:`.align` pairs measured cases with our DEM
 grid, the pchip model over it (never extrapolated) and the paper's Table 3.
+
+Public API
+----------
+LoadCase, LoadCaseError
+    The load case (:mod:`pidcore.loadcase`, the same class).
+StatedLoadCase, resolve_load_case, parse_file_name, read_sidecar
+    What a file's name, a sidecar table and options state about its load case.
+SIDECAR_NAME, SIDECAR_COLUMNS, FILL_PATTERN, MATERIAL_PATTERN, DIRECTION_PATTERN
+    The sidecar table's name and load-case columns; what a file name may state.
+Aligner, align_measured, AlignedCase, AlignmentStatus, ALIGNMENT_STATUSES
+    Measured cases beside our DEM (grid point, interpolated, out of range, no runs).
+Tolerances
+    When two load cases are the same grid point.
+dem_cases, DemCase, pooled_mean, simulation_identity
+    Stored DEM runs pooled into load cases (mean and standard error over seeds).
+match_paper
+    The paper's Table 3 SDCs at a grid point.
+DEM_COLUMNS, MEASURED_COLUMNS
+    Columns the aligner reads.
 """
 
 from .align import (

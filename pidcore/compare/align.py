@@ -28,18 +28,14 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable
 from dataclasses import dataclass, field, replace
-from typing import Literal, get_args
 
 import numpy as np
 import pandas as pd
 
 from .. import defaults
-from ..errors import ParameterError
+from ..constants import ALIGNMENT_STATUSES, AlignmentStatus  # noqa: F401 (kept: defined here before)
+from ..errors import ParameterError, real_number
 from .loadcase import LoadCase
-
-#: How a measured case was matched with our DEM.
-AlignmentStatus = Literal["grid", "interpolated", "out_of_range", "no_dem_runs"]
-ALIGNMENT_STATUSES: tuple[str, ...] = get_args(AlignmentStatus)
 
 #: Columns a table of measured cases must have (one row per analysed measurement).
 MEASURED_COLUMNS: tuple[str, ...] = ("frequency_hz", "acceleration_g", "fill_percent", "material",
@@ -73,6 +69,7 @@ class Tolerances:
     def __post_init__(self) -> None:
         for name in ("frequency_rtol", "acceleration_rtol", "fill_atol_percent"):
             value = getattr(self, name)
+            real_number(f"Tolerances: {name}", value)  # "0.1" was a TypeError of math
             if not (math.isfinite(value) and value >= 0):
                 raise ParameterError(f"Tolerances: {name} must be a finite number >= 0, "
                                      f"got {value!r}")

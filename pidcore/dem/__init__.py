@@ -2,8 +2,9 @@
 
 Public API
 ----------
-LoadCase, DemConfig, simulate_load_case
-    One load case -> :class:`DemResult` (SDC, energy tallies, virtual shaker record).
+LoadCase, DemConfig, simulate_load_case, DemResult
+    One load case -> :class:`DemResult` (SDC, energy tallies, virtual shaker record;
+    ``to_pandas()``, ``plot()``).
 ContactLaw, PairLaw, PairParameters, MaterialProperties, CellGeometry
     Contact parameters (from the CSV tables or explicit properties); the hexagonal cell.
 cell_capacity, particles_per_cell

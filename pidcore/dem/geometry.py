@@ -60,6 +60,7 @@ class CellGeometry:
         return np.asarray(points) @ self.wall_normals.T + self.wall_offsets
 
     def volume_m3(self) -> float:
+        """Volume of the hexagonal prism (area 2 sqrt(3) apothem^2 times height), m^3."""
         return 2.0 * np.sqrt(3.0) * self.apothem_m**2 * self.height_m
 
 

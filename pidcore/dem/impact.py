@@ -10,19 +10,16 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from typing import Literal
 
 import numpy as np
 from scipy.optimize import brentq
 
 from .. import defaults
-from ..constants import NormalDampingMode, TangentialModel
+from ..constants import ImpactPair, NormalDampingMode, TangentialModel
 from ..errors import ParameterError
 from .contact import ContactLaw, check_damping_mode
 from .geometry import CellGeometry
 from .state import CellsState, KernelSettings, advance, energies
-
-ImpactPair = Literal["wall", "particle"]
 
 
 @dataclasses.dataclass(frozen=True)

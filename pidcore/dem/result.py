@@ -7,12 +7,14 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+import pandas as pd
 
 from .. import defaults
 from ..constants import COUNT_UNIT, RATIO_UNIT, STANDARD_GRAVITY
 from ..loop import ForceDisplacementLoop
 
 if TYPE_CHECKING:  # pragma: no cover
+    from ..signal import PowerAnalysis
     from ..specimen import Specimen
     from .contact import ContactLaw
     from .simulate import DemConfig, LoadCase
@@ -119,6 +121,9 @@ class DemResult:
                  stored_energy_change_steady: np.ndarray,
                  settle_time_s: float, steps: int, wall_s: float, kernel_s: float,
                  particle_steps: int, specimen: Specimen | None = None) -> DemResult:
+        """The result of one run's kernel tallies and wall forces (:func:`simulate_load_case`
+        calls it): SDC per cell and its mean, energy split, energy balance and the virtual
+        shaker record, scaled to the coupon's cells."""
         n_coupon = specimen.cell.count if specimen is not None else defaults.COUPON_CELLS
         k = tally.shape[0]
         steady = tally[:, steady_start_cycle:, :]
@@ -234,7 +239,7 @@ class DemResult:
         """Slice of the sample arrays covering the steady-state cycles."""
         return slice(self.steady_start_cycle * self.samples_per_cycle, None)
 
-    def power_analysis(self, *, n_harmonics: int = defaults.N_HARMONICS):
+    def power_analysis(self, *, n_harmonics: int = defaults.N_HARMONICS) -> PowerAnalysis:
         """Virtual shaker test: :func:`pidcore.signal.analyze_power` of the steady record."""
         from ..signal import analyze_power
 
@@ -292,10 +297,12 @@ class DemResult:
 
     @staticmethod
     def array_names() -> tuple[str, ...]:
+        """Names of the array fields (stored beside the scalars)."""
         return ("sdc_per_cell", "dissipation_per_cycle_j", "dissipation_per_cell_cycle_j",
                 "sample_time_s", "wall_force_n", "shaker_force_n", "velocity_m_s")
 
     def arrays(self) -> dict[str, np.ndarray]:
+        """The array fields by name (:meth:`array_names`)."""
         return {name: np.asarray(getattr(self, name)) for name in self.array_names()}
 
     def loop(self, n_points: int = defaults.LOOP_POINTS, *,
@@ -309,6 +316,30 @@ class DemResult:
             self.shaker_force_n, self.velocity_m_s, sample_rate_hz=self.sample_rate_hz,
             frequency_hz=self.case.frequency_hz, steady_start_cycle=self.steady_start_cycle,
             n_points=n_points, n_harmonics=n_harmonics, label=f"DEM {self.case.key}")
+
+    def to_pandas(self) -> pd.DataFrame:
+        """The virtual shaker record, one row per sample (SI units, each column names its unit).
+
+        Columns ``time [s]`` (from the drive start), ``cycle [-]`` (the drive cycle the sample
+        belongs to), ``steady [True/False]`` (in the steady window the SDC is measured over),
+        ``shaker force [N]``, ``wall force [N]`` and ``velocity [m/s]`` (the coupon's). The
+        frame's ``attrs`` hold the load case key, ``sdc``, ``sdc_stderr`` and
+        ``sample_rate_hz``; the scalar results are :meth:`to_dict`'s, the per-cycle ones
+        :attr:`dissipation_per_cycle_j`.
+        """
+        t = np.asarray(self.sample_time_s, dtype=float)
+        cycle = np.arange(t.size) // max(self.samples_per_cycle, 1)
+        frame = pd.DataFrame({
+            "time [s]": t,
+            "cycle [-]": cycle,
+            "steady [True/False]": cycle >= self.steady_start_cycle,
+            "shaker force [N]": np.asarray(self.shaker_force_n, dtype=float),
+            "wall force [N]": np.asarray(self.wall_force_n, dtype=float),
+            "velocity [m/s]": np.asarray(self.velocity_m_s, dtype=float),
+        })
+        frame.attrs.update(case_key=self.case.key, sdc=self.sdc, sdc_stderr=self.sdc_stderr,
+                           sample_rate_hz=self.sample_rate_hz)
+        return frame
 
     def plot(self, ax: Any = None) -> Any:
         """Per-cycle dissipation and forces (:func:`pidcore.report.figures_results.plot_dem_run`).

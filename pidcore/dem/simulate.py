@@ -66,7 +66,13 @@ from ..constants import (
     TangentialModel,
     VibratedMassConvention,
 )
-from ..errors import ParameterError, SimulationError
+from ..errors import (
+    ParameterError,
+    SimulationError,
+    instance_of,
+    real_number,
+    whole_number,
+)
 from ..loadcase import LoadCase
 from ..specimen import (
     Specimen,
@@ -90,7 +96,7 @@ from .state import (
 )
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class DemConfig:
     """Numerical settings of a DEM run (defaults in :mod:`pidcore.defaults`).
 
@@ -121,7 +127,17 @@ class DemConfig:
     alpha_pw: float | None = None
     damping_coefficient: str = defaults.DEM_DAMPING_COEFFICIENT
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
+        # types first, each named: cells=2.5 ran and cells="4" failed in a comparison
+        for name in ("cells", "seed", "block_cycles", "max_transient_cycles",
+                     "samples_per_cycle", *(("steady_cycles",) if self.steady_cycles is not None
+                                             else ())):
+            object.__setattr__(self, name, whole_number(name, getattr(self, name)))
+        for name in ("steady_relative_tolerance", "max_transient_s",
+                     "friction_regularisation_m_s",
+                     *(n for n in ("alpha_pp", "alpha_pw") if getattr(self, n) is not None),
+                     *(("time_step",) if not isinstance(self.time_step, str) else ())):
+            object.__setattr__(self, name, real_number(name, getattr(self, name)))
         if self.cells < 1:
             raise ParameterError(f"cells: expected >= 1, got {self.cells}")
         if not 0 <= self.seed < 2**63:  # numpy's generators take no negative seed
@@ -583,6 +599,10 @@ def simulate_load_case(case: LoadCase, config: DemConfig | None = None, *,
     >>> r = simulate_load_case(LoadCase(500, 5, 50), DemConfig(cells=2, steady_cycles=10))
     ... # doctest: +SKIP
     """
+    instance_of("case", case, LoadCase, hint="e.g. LoadCase(500.0, 5.0, 50.0)")
+    instance_of("config", config, (DemConfig, type(None)), hint="e.g. DemConfig(cells=2)")
+    instance_of("specimen", specimen, (Specimen, type(None)),
+                hint="read a file with pidcore.specimen.load_specimen(path)")
     config = config or DemConfig()
     check_drive_stroke(case)
     specimen = resolve_specimen(case, specimen)

@@ -17,6 +17,23 @@ mat       MATLAB v5 / v7.3                                       :mod:`pidcore.i
 hdf5      pidcore measurement group or store                     :mod:`pidcore.io.hdf5`
 ========  =====================================================  ==========================
 
+Public API
+----------
+read_measurement, read_measurements
+    Read a file of any format (detected) into :class:`~pidcore.records.Measurement`.
+write_measurement
+    Write one, the format from the extension.
+read_uff, read_csv, read_mat, read_hdf5, hdf5_keys
+    The readers of one format; the measurements a pidcore HDF5 file holds.
+write_uff, write_csv, write_mat, write_hdf5
+    The writers of one format (atomic).
+detect_file_format, FILE_FORMAT_EXTENSIONS, EMPTY_MEASUREMENT_FILE
+    Format detection: from the content, else the extension; why an empty file is refused.
+assign_roles, RoleAssignment, name_suggests
+    Which channels are force, velocity and acceleration (units, then names).
+display_path
+    A path as printable text (undecodable bytes escaped).
+
 Examples
 --------
 >>> from pidcore.io import read_measurement, assign_roles  # doctest: +SKIP
@@ -34,7 +51,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from ..constants import FileFormat
-from ..errors import InputFileError, ParameterError, PidcoreError
+from ..errors import InputFileError, ParameterError, PidcoreError, instance_of
 from ..records import Measurement
 from ._common import reraise_interrupt
 from .delimited import read_csv, write_csv
@@ -73,6 +90,8 @@ def detect_file_format(path: str | os.PathLike[str]) -> str:
     InputFileError
         Missing, unreadable or empty file, or neither content nor extension decides.
     """
+    # an int is a file descriptor to open(): read_measurement(0) read stdin
+    instance_of("path", path, (str, os.PathLike), hint="a file name")
     where = str(path)
     try:
         with open(path, "rb") as fh:
@@ -156,6 +175,7 @@ def read_measurements(path: str | os.PathLike[str], *, sample_rate_hz: float | N
 
     See :func:`read_measurement` for the parameters.
     """
+    instance_of("path", path, (str, os.PathLike), hint="a file name")
     _check_format(file_format)
     fmt = file_format or detect_file_format(path)
     if fmt == "hdf5":
@@ -193,6 +213,7 @@ def read_measurement(path: str | os.PathLike[str], *, sample_rate_hz: float | No
         The file is missing, empty, truncated, corrupt or holds no time record; a store holds
         several measurements and no ``key`` was given (the message lists the keys).
     """
+    instance_of("path", path, (str, os.PathLike), hint="a file name")
     _check_format(file_format)
     fmt = file_format or detect_file_format(path)
     if not Path(path).is_file():

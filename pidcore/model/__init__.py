@@ -3,6 +3,32 @@
 Paper Sect. 3, 4 and 8: Table 3 (:func:`load_paper_table3`), the multivariate pchip SDC model
 (:class:`SdcModel`), the equivalent viscous damper derived from SDC (:mod:`.damper`) and the
 response of a structure treated with it (:mod:`.response`).
+
+Public API
+----------
+load_paper_table3, TABLE3_COLUMNS
+    The paper's Table 3 (DEM and measured SDC over fill, acceleration, frequency).
+SdcModel, AXIS_NAMES
+    The pchip SDC model: ``SdcModel.from_table(table)(fill_percent, acceleration_g,
+    frequency_hz)``; refuses points outside its grid.
+select_runs, DEM_CONDITION_COLUMNS
+    The stored DEM runs of one set of conditions, to build a model from.
+equivalent_damper_table, write_damper_table, DAMPER_COLUMNS, SDC_FILLED_COLUMN
+    The equivalent viscous damper over a grid (a pandas frame whose columns name their
+    units), and its CSV/JSON files.
+loss_factor, damping_ratio, energy_per_cycle, sdc_from_energy_per_cycle, displacement_amplitude
+    SDC to loss factor, damping ratio, energy per cycle (Eq. 8-10) and back.
+equivalent_damping_coefficient, sdc_from_damping_coefficient
+    SDC to c_eq [N s/m] and back.
+coupon_area_m2, coupon_vibrated_mass_kg, paper_particles_mass_kg
+    The paper coupon's area and masses.
+paper_vibrated_mass, runs_vibrated_mass
+    m_c of Eq. 10 against fill: the paper's coupon, or as stored DEM runs normalised it.
+TreatedMode, harmonic_response, HarmonicResponse, particle_damping_n_s_m
+    A mode treated with particles, its steady response by harmonic balance (``to_pandas()``,
+    ``plot()``) and the particle damper c_pd.
+time_domain_response, TimeDomainSteadyState
+    The same oscillator integrated in time (a check of the harmonic balance).
 """
 
 from .damper import (

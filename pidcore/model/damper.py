@@ -20,6 +20,7 @@ the same fill, acceleration and frequency.
 from __future__ import annotations
 
 import json
+import warnings
 from collections.abc import Callable, Sequence
 from datetime import UTC, datetime
 from importlib import resources
@@ -337,26 +338,35 @@ def runs_vibrated_mass(runs: pd.DataFrame) -> Callable[[float], float]:
     return mass
 
 
-def equivalent_damper_table(model: SdcModel, *, fills: Sequence[float],
-                            accelerations: Sequence[float], frequencies: Sequence[float],
+def equivalent_damper_table(model: SdcModel, *, fills_percent: Sequence[float] | None = None,
+                            accelerations_g: Sequence[float] | None = None,
+                            frequencies_hz: Sequence[float] | None = None,
                             vibrated_mass_kg: float | Callable[[float], float],
                             area_m2: float | None = None,
-                            clip_to_range: bool = False) -> pd.DataFrame:
+                            clip_to_range: bool = False,
+                            fills: Sequence[float] | None = None,
+                            accelerations: Sequence[float] | None = None,
+                            frequencies: Sequence[float] | None = None) -> pd.DataFrame:
     """Equivalent damper over a grid of fill [%], acceleration [g] and frequency [Hz].
 
     Parameters
     ----------
     model : SdcModel
         SDC model.
-    fills, accelerations, frequencies : sequence of float
+    fills_percent, accelerations_g, frequencies_hz : sequence of float
         Values in %, g and Hz; the table is their Cartesian product.
     vibrated_mass_kg : float or callable
         m_c [kg] of Eq. 10, or a function of fill [%] returning it (the particle mass grows
-        with fill).
+        with fill). A number more than :data:`VIBRATED_MASS_LIMIT` times outside the paper
+        coupon's m_c is refused as a unit slip (grams typed for kg), as ``pidcore model
+        damper --vibrated-mass`` refuses it.
     area_m2 : float, optional
         Coupon area for the per-area damper; default :func:`coupon_area_m2`.
     clip_to_range : bool
         Passed to :meth:`SdcModel.evaluate` (default: refuse points outside the model).
+    fills, accelerations, frequencies : sequence of float, optional
+        The names of pidcore 0.2, without their units (a ``DeprecationWarning``); giving
+        both names of one axis is refused.
 
     Returns
     -------
@@ -364,6 +374,11 @@ def equivalent_damper_table(model: SdcModel, *, fills: Sequence[float],
         Columns :data:`DAMPER_COLUMNS` (each names its unit); :data:`SDC_FILLED_COLUMN` (a
         bool flag) is True where the point coincides with a filled hole of the model grid.
     """
+    # one call each, not a loop: the warning points at the caller's line (stacklevel)
+    fills = _one_name("fills_percent", fills_percent, "fills", fills)
+    accelerations = _one_name("accelerations_g", accelerations_g, "accelerations",
+                              accelerations)
+    frequencies = _one_name("frequencies_hz", frequencies_hz, "frequencies", frequencies)
     grid = pd.MultiIndex.from_product(
         [np.asarray(frequencies, float), np.asarray(accelerations, float),
          np.asarray(fills, float)], names=["f", "a", "p"]).to_frame(index=False)
@@ -374,6 +389,9 @@ def equivalent_damper_table(model: SdcModel, *, fills: Sequence[float],
     if callable(vibrated_mass_kg):
         mass = np.array([float(vibrated_mass_kg(x)) for x in p])
     else:
+        # 69 (g) for 0.069 kg gave a c_eq 1000 x too large without a word; the CLI refused it
+        check_vibrated_mass(float(_positive("vibrated_mass_kg", vibrated_mass_kg)),
+                            model.axes[0], D.MODEL_PARTICLE_MATERIAL)
         mass = np.full(p.shape, float(vibrated_mass_kg))
     mass = _positive("vibrated_mass_kg", mass)
     area = coupon_area_m2() if area_m2 is None else float(_positive("area_m2", area_m2))
@@ -401,6 +419,21 @@ def equivalent_damper_table(model: SdcModel, *, fills: Sequence[float],
         "c_eq_per_area [N s/m^3]": c_eq / area,
     })
     return out
+
+
+def _one_name(new: str, new_value: Sequence[float] | None, old: str,
+              old_value: Sequence[float] | None) -> Sequence[float]:
+    """The grid axis given under its name with the unit (``new``) or, warned, under the name
+    pidcore 0.2 gave it (``old``); one of them, not both."""
+    if new_value is not None and old_value is not None:
+        raise ParameterError(f"{new} and {old} name the same axis; give {new} only")
+    if old_value is not None:
+        warnings.warn(f"equivalent_damper_table: {old}= is now {new}= (the unit in the name)",
+                      DeprecationWarning, stacklevel=3)
+        return old_value
+    if new_value is None:
+        raise TypeError(f"equivalent_damper_table() missing keyword argument: {new!r}")
+    return new_value
 
 
 def _json_value(value):

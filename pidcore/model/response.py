@@ -30,13 +30,15 @@ the SDC at the nearest edge of the grid and flags the point.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
+import pandas as pd
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
 from ..constants import STANDARD_GRAVITY
-from ..errors import ParameterError, as_given
+from ..errors import ParameterError, as_given, instance_of, real_number, whole_number
 from .damper import coupon_area_m2, equivalent_damping_coefficient
 from .sdc_model import SdcModel
 
@@ -48,7 +50,7 @@ _ZERO_RESIDUAL = 1e-12
 _RANGE_RTOL = 1e-9
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class TreatedMode:
     """One mode of a structure treated with particle dampers (SI units).
 
@@ -79,6 +81,10 @@ class TreatedMode:
     coupon_area_m2: float = coupon_area_m2()
 
     def __post_init__(self) -> None:
+        for name in ("natural_frequency_hz", "modal_mass_kg", "structural_damping_ratio",
+                     "treated_area_m2", "fill_percent", "coupon_vibrated_mass_kg",
+                     "coupon_area_m2"):
+            real_number(f"TreatedMode: {name}", getattr(self, name))  # "300" was a TypeError
         for name in ("natural_frequency_hz", "modal_mass_kg", "treated_area_m2",
                      "coupon_vibrated_mass_kg", "coupon_area_m2"):
             v = getattr(self, name)
@@ -137,22 +143,34 @@ class HarmonicResponse:
     multiple_solutions: np.ndarray
     force_amplitude_n: float
 
-    def plot(self, ax=None):
-        """Plot amplitude (and the untreated amplitude) against frequency; return the Axes."""
-        import matplotlib.pyplot as plt
+    def to_pandas(self) -> pd.DataFrame:
+        """One row per drive frequency, each column naming its unit.
 
-        if ax is None:
-            _, ax = plt.subplots()
-        ax.plot(self.frequency_hz, self.amplitude_untreated_m, "--", label="untreated")
-        ax.plot(self.frequency_hz, self.amplitude_m, "-", label="with particle damper")
-        if np.any(self.clipped):
-            ax.plot(self.frequency_hz[self.clipped], self.amplitude_m[self.clipped], "x",
-                    label="SDC held at model edge")
-        ax.set_yscale("log")
-        ax.set_xlabel("frequency [Hz]")
-        ax.set_ylabel("displacement amplitude [m]")
-        ax.legend()
-        return ax
+        Columns ``frequency [Hz]``, ``amplitude [m]``, ``phase [rad]``, ``acceleration [g]``,
+        ``sdc [-]``, ``particle damping [N s/m]``, ``amplitude untreated [m]``,
+        ``clipped [True/False]``, ``multiple solutions [True/False]``; ``attrs`` hold
+        ``force_amplitude_n``.
+        """
+        frame = pd.DataFrame({
+            "frequency [Hz]": np.asarray(self.frequency_hz, dtype=float),
+            "amplitude [m]": np.asarray(self.amplitude_m, dtype=float),
+            "phase [rad]": np.asarray(self.phase_rad, dtype=float),
+            "acceleration [g]": np.asarray(self.acceleration_g, dtype=float),
+            "sdc [-]": np.asarray(self.sdc, dtype=float),
+            "particle damping [N s/m]": np.asarray(self.particle_damping_n_s_m, dtype=float),
+            "amplitude untreated [m]": np.asarray(self.amplitude_untreated_m, dtype=float),
+            "clipped [True/False]": np.asarray(self.clipped, dtype=bool),
+            "multiple solutions [True/False]": np.asarray(self.multiple_solutions, dtype=bool),
+        })
+        frame.attrs["force_amplitude_n"] = float(self.force_amplitude_n)
+        return frame
+
+    def plot(self, ax: Any = None) -> Any:
+        """Amplitude (and the untreated amplitude) against frequency
+        (:func:`pidcore.report.figures_results.plot_harmonic_response`); returns ``ax``."""
+        from ..report.figures_results import plot_harmonic_response  # lazy: drawing is optional
+
+        return plot_harmonic_response(self.to_pandas(), ax=ax)
 
 
 def _sdc_section(model: SdcModel, mode: TreatedMode, frequency_hz: float,
@@ -205,6 +223,8 @@ def harmonic_response(model: SdcModel, mode: TreatedMode, *, frequencies_hz: np.
     -------
     HarmonicResponse
     """
+    instance_of("model", model, SdcModel, hint="e.g. SdcModel.from_table(load_paper_table3())")
+    instance_of("mode", mode, TreatedMode)
     if not np.isfinite(force_amplitude_n) or force_amplitude_n <= 0:
         raise ParameterError(f"force_amplitude_n must be finite and > 0, got "
                              f"{force_amplitude_n!r}")
@@ -299,6 +319,11 @@ def time_domain_response(model: SdcModel, mode: TreatedMode, *, frequency_hz: fl
     ``settle_cycles`` defaults to 8 decay time constants of the lightest possible damping
     (structural only), in drive cycles.
     """
+    instance_of("model", model, SdcModel, hint="e.g. SdcModel.from_table(load_paper_table3())")
+    instance_of("mode", mode, TreatedMode)
+    measure_cycles = whole_number("measure_cycles", measure_cycles)
+    if settle_cycles is not None:
+        settle_cycles = whole_number("settle_cycles", settle_cycles)
     w = 2.0 * np.pi * frequency_hz
     k, m, c_s = mode.stiffness_n_m, mode.modal_mass_kg, mode.structural_damping_n_s_m
     sdc_of, _ = _sdc_section(model, mode, frequency_hz, True)

@@ -7,6 +7,21 @@
 * :func:`collect_provenance` (:mod:`.provenance`) - versions, parameters, seeds, hashes.
 * :func:`make_report` (:mod:`.pipeline`) - everything ``pidcore report`` does.
 * Figures: :mod:`.figures` (model families, paper Figs. 8-14) and :mod:`.comparison_figures`.
+
+Public API
+----------
+make_report, ReportResult
+    Everything ``pidcore report`` does, as a function; what it wrote.
+analyze_files, MeasuredResult
+    Files analysed with their load cases (the first step of a report).
+build_report_table, REPORT_COLUMNS, ALIGNMENT_COLUMN
+    The Table 3-style comparison (a pandas frame whose columns name their units).
+write_report, parse_formats, RENDERERS, REPORT_MARKER
+    The report files (CSV, Markdown, HTML, LaTeX, PDF).
+collect_provenance, Provenance, sha256_file
+    Versions, parameters, seeds and hashes behind a report.
+open_verified_store
+    A store opened and verified (one-line error if corrupt).
 """
 
 from .pipeline import MeasuredResult, ReportResult, analyze_files, make_report, open_verified_store

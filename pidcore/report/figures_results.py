@@ -1,14 +1,21 @@
 """Matplotlib figures of single results; drawing only, the data come from the results.
 
+* :func:`plot_measurement` - the channels of a measurement against time
+  (:meth:`pidcore.records.Measurement.to_pandas`).
 * :func:`plot_spectrum` - harmonic amplitudes of a measurement
-  (:meth:`pidcore.signal.PowerAnalysis.spectrum_frame`).
+  (:meth:`pidcore.signal.PowerAnalysis.to_pandas`).
 * :func:`plot_loop` - a force-displacement loop (:class:`pidcore.loop.ForceDisplacementLoop`).
 * :func:`plot_dem_run` - per-cycle dissipation and forces of a DEM run
   (:class:`pidcore.dem.DemResult`).
+* :func:`plot_harmonic_response` - a treated mode's amplitude against frequency
+  (:meth:`pidcore.model.HarmonicResponse.to_pandas`).
+* :func:`plot_calibration` - a calibration's predictions with their 95 % bands beside the
+  SDCs it was fitted to (:meth:`pidcore.calibrate.Calibration.to_pandas`).
 
-``PowerAnalysis.plot`` and ``DemResult.plot`` forward here (python-control style), so the
-physics modules import no matplotlib. With ``ax=None`` a new pyplot figure is made, as an
-interactive ``.plot()`` is expected to do.
+``Measurement.plot``, ``PowerAnalysis.plot``, ``ForceDisplacementLoop.plot``,
+``DemResult.plot``, ``HarmonicResponse.plot`` and ``Calibration.plot`` forward here
+(python-control style), so the physics modules import no matplotlib. With ``ax=None`` a new
+pyplot figure is made, as an interactive ``.plot()`` is expected to do.
 """
 
 from __future__ import annotations
@@ -19,6 +26,7 @@ import numpy as np
 import pandas as pd
 
 from .. import defaults
+from ..errors import ParameterError
 
 if TYPE_CHECKING:  # pragma: no cover
     from ..dem.result import DemResult
@@ -28,7 +36,7 @@ if TYPE_CHECKING:  # pragma: no cover
 def plot_spectrum(frame: pd.DataFrame, *, ax: Any = None) -> Any:
     """Harmonic spectrum: |F_n| (N, left axis) and |V_n| (m/s, right axis). Returns ``ax``.
 
-    ``frame`` is :meth:`pidcore.signal.PowerAnalysis.spectrum_frame` (its ``attrs`` give the
+    ``frame`` is :meth:`pidcore.signal.PowerAnalysis.to_pandas` (its ``attrs`` give the
     title).
     """
     import matplotlib.pyplot as plt
@@ -80,6 +88,9 @@ def plot_dem_run(result: DemResult, *, ax: Any = None) -> Any:
 
     if ax is None:
         _, ax = plt.subplots(2, 1, figsize=(7, 6), constrained_layout=True)
+    if len(np.atleast_1d(ax)) != 2:  # one axes was "cannot unpack non-iterable Axes"
+        raise ParameterError("ax: a DEM run draws two panels (dissipation per cycle, forces); "
+                             "expected a pair of axes, e.g. fig.subplots(2, 1)")
     a0, a1 = ax
     cycles = np.arange(len(result.dissipation_per_cycle_j))
     a0.plot(cycles, result.dissipation_per_cycle_j, ".-", label="coupon")
@@ -95,4 +106,81 @@ def plot_dem_run(result: DemResult, *, ax: Any = None) -> Any:
     a1.legend()
     a0.set_title(f"{result.case.key}: SDC {result.sdc:.4g} +- {result.sdc_stderr:.2g}, "
                  f"{result.particles_per_cell} particles/cell")
+    return ax
+
+
+def plot_calibration(frame: pd.DataFrame, *, ax: Any = None) -> Any:
+    """Calibrated predictions (points, 95 % band as error bars) and the measured SDCs they
+    were fitted to (crosses), one position per load case. Returns ``ax``.
+
+    ``frame`` is :meth:`pidcore.calibrate.Calibration.to_pandas`.
+    """
+    import matplotlib.pyplot as plt
+
+    if ax is None:
+        _, ax = plt.subplots(figsize=(max(6.0, 0.5 * len(frame)), 4.0), constrained_layout=True)
+    x = np.arange(len(frame))
+    sdc = frame["sdc predicted [-]"].to_numpy(float)
+    below = sdc - frame["low95 [-]"].to_numpy(float)
+    above = frame["high95 [-]"].to_numpy(float) - sdc
+    ax.errorbar(x, sdc, yerr=[below, above], fmt="o", capsize=3,
+                label="calibrated DEM (95 % band)")
+    ax.plot(x, frame["sdc measured [-]"].to_numpy(float), "x", color="k", label="measured")
+    ax.set_xticks(x)
+    ax.set_xticklabels([f"{f:g} Hz, {a:g} g, {p:g} %" for f, a, p in zip(
+        frame["frequency [Hz]"], frame["acceleration [g]"], frame["fill [%]"], strict=True)],
+        rotation=60, ha="right", fontsize="small")
+    ax.set_ylabel("SDC [-]")
+    ax.legend()
+    return ax
+
+
+def plot_harmonic_response(frame: pd.DataFrame, *, ax: Any = None) -> Any:
+    """Displacement amplitude against frequency, with and without the particle damper; points
+    where the SDC was held at the model's edge marked. Returns ``ax``.
+
+    ``frame`` is :meth:`pidcore.model.HarmonicResponse.to_pandas`.
+    """
+    import matplotlib.pyplot as plt
+
+    if ax is None:
+        _, ax = plt.subplots()
+    f = frame["frequency [Hz]"].to_numpy(float)
+    x = frame["amplitude [m]"].to_numpy(float)
+    clipped = frame["clipped [True/False]"].to_numpy(bool)
+    ax.plot(f, frame["amplitude untreated [m]"].to_numpy(float), "--", label="untreated")
+    ax.plot(f, x, "-", label="with particle damper")
+    if clipped.any():
+        ax.plot(f[clipped], x[clipped], "x", label="SDC held at model edge")
+    ax.set_yscale("log")
+    ax.set_xlabel("frequency [Hz]")
+    ax.set_ylabel("displacement amplitude [m]")
+    ax.legend()
+    return ax
+
+
+def plot_measurement(frame: pd.DataFrame, *, ax: Any = None) -> Any:
+    """Each channel of a measurement against time, one axes per channel, stacked with a shared
+    time axis. Returns the axes (one, or an array of them).
+
+    ``frame`` is :meth:`pidcore.records.Measurement.to_pandas`; ``ax``: as many axes as it has
+    channels, or None for a new figure.
+    """
+    import matplotlib.pyplot as plt
+
+    names = [c for c in frame.columns if c != "time [s]"]
+    if ax is None:
+        _, ax = plt.subplots(len(names), 1, sharex=True, squeeze=False,
+                             figsize=(7.0, 1.8 + 1.6 * len(names)), constrained_layout=True)
+        ax = ax[:, 0] if len(names) > 1 else ax[0, 0]
+    axes = np.atleast_1d(ax)
+    if len(axes) != len(names):
+        raise ParameterError(f"ax: {len(names)} channels need as many axes, got {len(axes)}")
+    t = frame["time [s]"].to_numpy(float)
+    for a, name in zip(axes, names, strict=True):
+        a.plot(t, frame[name].to_numpy(float), lw=0.8)
+        a.set_ylabel(name)
+    axes[-1].set_xlabel("time [s]")
+    if "source" in frame.attrs:
+        axes[0].set_title(str(frame.attrs["source"]))
     return ax

@@ -20,7 +20,7 @@ import os
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pandas as pd
@@ -39,6 +39,8 @@ if TYPE_CHECKING:  # pragma: no cover
     from ..file_settings import FileSettings
     from ..loop import ForceDisplacementLoop
     from ..measure import AnalysisOptions, AnalyzedRecord
+    from ..specimen import Specimen
+    from ..store import Store
 
 # pidcore.measure (readers, signal analysis) is imported where used: `import pidcore.report`
 # stays light for the app, which only renders stored results.
@@ -114,8 +116,20 @@ class ReportResult:
     measured: list[MeasuredResult] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
 
+    def to_pandas(self) -> pd.DataFrame:
+        """The report table (:attr:`table`; columns :data:`REPORT_COLUMNS`, each naming its
+        unit, and the calibration's where one was given)."""
+        return self.table
 
-def open_verified_store(path: str | Path, *, must_exist: bool):
+    def plot(self, ax: Any = None) -> Any:
+        """SDC per load case, measured beside our DEM and the paper's
+        (:func:`pidcore.report.comparison_figures.plot_sdc_comparison`); returns the figure."""
+        from .comparison_figures import plot_sdc_comparison
+
+        return plot_sdc_comparison(self.table, ax=ax)
+
+
+def open_verified_store(path: str | Path, *, must_exist: bool) -> Store:
     """Open a store and verify it; a corrupt or partial store raises one-line StoreError.
 
     Parameters
@@ -149,7 +163,7 @@ def analyze_files(paths: Sequence[str | Path], *, fill_percent: float | None = N
                   options_given: Mapping[str, str] | None = None,
                   specimen_material: str | None = None,
                   specimen_name: str | None = None,
-                  specimen=None,
+                  specimen: Specimen | None = None,
                   accept_implausible: bool = False,
                   progress: bool = False) -> list[MeasuredResult]:
     """Read, assign roles, analyze (Eq. 11) and attach the load case of every file.
@@ -415,7 +429,7 @@ class SpecimenTable:
 
 
 def specimen_report_table(stored_runs: pd.DataFrame | None, analyses: pd.DataFrame | None, *,
-                          specimen=None, where: str | Path | None = None,
+                          specimen: Specimen | None = None, where: str | Path | None = None,
                           tolerances: Tolerances | None = None, pool: bool = False,
                           choose_another: str = CHOOSE_SPECIMEN_CLI) -> SpecimenTable:
     """The report table of one specimen's DEM runs (:func:`specimen_dem_runs`) beside the
@@ -537,7 +551,7 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
                 direction: str | None = None, sidecar: str | Path | None = None,
                 options: AnalysisOptions | None = None,
                 options_given: Mapping[str, str] | None = None,
-                tolerances: Tolerances | None = None, specimen=None,
+                tolerances: Tolerances | None = None, specimen: Specimen | None = None,
                 pool: bool = False,
                 calibration: str | Path | None = None,
                 calibration_key: str | None = None,

@@ -83,6 +83,7 @@ class Provenance:
         return out
 
     def to_dict(self) -> dict[str, object]:
+        """JSON-safe dict of every field (tuples as lists)."""
         return {"versions": dict(self.versions), "parameters": dict(self.parameters),
                 "seeds": list(self.seeds), "inputs": [list(i) for i in self.inputs],
                 "stores": [list(s) for s in self.stores], "created_utc": self.created_utc,

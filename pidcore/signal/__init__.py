@@ -10,8 +10,8 @@ PowerAnalysis
     Frozen result (phasors, complex power, loss factor, SDC, damping ratio, uncertainty).
 estimate_drive_frequency
     Drive frequency of the motion channel (FFT peak + Gauss-Newton phase refinement).
-synthesize_shaker_record
-    Synthetic records with an analytic answer.
+synthesize_shaker_record, SyntheticRecord
+    Synthetic records with an analytic answer, and the record they return.
 """
 
 from .._numba_cache import tolerate_unwritable_cache

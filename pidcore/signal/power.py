@@ -45,6 +45,7 @@ Corrections (applied to the phasors in this order):
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -53,7 +54,7 @@ import pandas as pd
 
 from .. import defaults
 from ..constants import STANDARD_GRAVITY
-from ..errors import ChannelError, ParameterError, SignalError, as_given
+from ..errors import ChannelError, ParameterError, SignalError, as_given, real_number
 from ..loop import ForceDisplacementLoop
 from ..records import Channel
 from . import validate
@@ -171,12 +172,14 @@ class PowerAnalysis:
         loop = self.loop(n_points)
         return loop.displacement_m, loop.force_n
 
-    def spectrum_frame(self) -> pd.DataFrame:
+    def to_pandas(self) -> pd.DataFrame:
         """Fitted harmonics, one row each: order, frequency, amplitudes and phases (SI units).
 
         Columns ``harmonic [-]``, ``frequency [Hz]``, ``force amplitude [N]``,
         ``velocity amplitude [m/s]``, ``force phase [rad]``, ``velocity phase [rad]``
-        (``|F_n|`` and ``arg F_n`` of the one-sided phasors, after corrections).
+        (``|F_n|`` and ``arg F_n`` of the one-sided phasors, after corrections). The frame's
+        ``attrs`` hold ``source``, ``frequency_hz`` and ``sdc``; the scalar results are
+        :meth:`to_dict`'s.
         """
         n = np.asarray(self.harmonics, dtype=int)
         f = np.asarray(self.force_phasors_n, dtype=complex)
@@ -191,6 +194,10 @@ class PowerAnalysis:
         })
         frame.attrs.update(source=self.source, frequency_hz=self.frequency_hz, sdc=self.sdc)
         return frame
+
+    def spectrum_frame(self) -> pd.DataFrame:
+        """:meth:`to_pandas` (the name of pidcore 0.2; the same frame)."""
+        return self.to_pandas()
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-safe scalars (NaN -> None); includes the CLI keys, each naming its unit
@@ -235,7 +242,7 @@ class PowerAnalysis:
         """
         from ..report.figures_results import plot_spectrum  # lazy: drawing is optional
 
-        return plot_spectrum(self.spectrum_frame(), ax=ax)
+        return plot_spectrum(self.to_pandas(), ax=ax)
 
 
 def _damping_ratio(sdc: float, loss_factor: float) -> tuple[float | None, str]:
@@ -300,25 +307,32 @@ def _complex_power(f_ph: np.ndarray, m_ph: np.ndarray, a_ph: np.ndarray | None,
 UNIT_SLIP_SHARE = 2.0
 
 
-def _check_parameters(sample_rate_hz: float, n_harmonics: int, n_blocks: int, min_periods: int,
-                      mass_below_gauge_kg: float, frequency_hz: float | None,
-                      velocity_delay_s: float, baseline_loss_factor: float,
-                      structure_mass_kg: float | None = None) -> None:
-    if not (math.isfinite(sample_rate_hz) and sample_rate_hz > 0):
+def check_analysis_settings(*, n_harmonics: int = defaults.N_HARMONICS,
+                            mass_below_gauge_kg: float = 0.0, frequency_hz: float | None = None,
+                            velocity_delay_s: float = 0.0, baseline_loss_factor: float = 0.0,
+                            sample_rate_hz: float | None = None,
+                            structure_mass_kg: float | None = None) -> None:
+    """Refuse the settings of an analysis that no record can make right (a string, a bool, a
+    fraction of a harmonic, a negative mass or baseline, a non-positive frequency hint, rate
+    or structure mass), each naming its keyword: :func:`analyze_power` checks them, and
+    :class:`pidcore.measure.AnalysisOptions` when it is made, before any file is read."""
+    for name, value in (("mass_below_gauge_kg", mass_below_gauge_kg),
+                        ("velocity_delay_s", velocity_delay_s),
+                        ("baseline_loss_factor", baseline_loss_factor),
+                        *((("frequency_hz", frequency_hz),) if frequency_hz is not None else ()),
+                        *((("sample_rate_hz", sample_rate_hz),) if sample_rate_hz is not None
+                          else ())):
+        real_number(name, value)
+    if sample_rate_hz is not None and not (math.isfinite(sample_rate_hz) and sample_rate_hz > 0):
         raise ParameterError(f"sample_rate_hz: {sample_rate_hz!r}, expected a positive number")
-    if int(n_harmonics) != n_harmonics or n_harmonics < 1:
+    if (isinstance(n_harmonics, bool) or not isinstance(n_harmonics, numbers.Real)
+            or not math.isfinite(n_harmonics) or int(n_harmonics) != n_harmonics
+            or n_harmonics < 1):
         raise ParameterError(f"n_harmonics: {n_harmonics!r}, expected an integer >= 1")
-    if int(n_blocks) != n_blocks or n_blocks < 0:
-        raise ParameterError(f"n_blocks: {n_blocks!r}, expected an integer >= 0 (0: no stderr)")
-    if int(min_periods) != min_periods or min_periods < 1:
-        raise ParameterError(f"min_periods: {min_periods!r}, expected an integer >= 1")
     if not (math.isfinite(mass_below_gauge_kg) and mass_below_gauge_kg >= 0):
         raise ParameterError(f"mass_below_gauge_kg: {mass_below_gauge_kg!r}, expected >= 0 kg")
     if frequency_hz is not None and not (math.isfinite(frequency_hz) and frequency_hz > 0):
         raise ParameterError(f"frequency_hz: {frequency_hz!r}, expected a positive hint in Hz")
-    if frequency_hz is not None and frequency_hz >= sample_rate_hz / 2:
-        raise ParameterError(f"frequency_hz: {as_given(frequency_hz)} Hz is not below the Nyquist "
-                             f"frequency {sample_rate_hz / 2:g} Hz")
     if not math.isfinite(velocity_delay_s):
         raise ParameterError(f"velocity_delay_s: {velocity_delay_s!r}, expected a finite time")
     if not (math.isfinite(baseline_loss_factor) and baseline_loss_factor >= 0):
@@ -330,6 +344,23 @@ def _check_parameters(sample_rate_hz: float, n_harmonics: int, n_blocks: int, mi
             and math.isfinite(structure_mass_kg) and structure_mass_kg > 0):
         raise ParameterError(f"structure_mass_kg: {structure_mass_kg!r}, expected the empty "
                              "structure's mass in kg > 0 (coupon and fixture above the gauge)")
+
+
+def _check_parameters(sample_rate_hz: float, n_harmonics: int, n_blocks: int, min_periods: int,
+                      mass_below_gauge_kg: float, frequency_hz: float | None,
+                      velocity_delay_s: float, baseline_loss_factor: float,
+                      structure_mass_kg: float | None = None) -> None:
+    check_analysis_settings(n_harmonics=n_harmonics, mass_below_gauge_kg=mass_below_gauge_kg,
+                            frequency_hz=frequency_hz, velocity_delay_s=velocity_delay_s,
+                            baseline_loss_factor=baseline_loss_factor,
+                            sample_rate_hz=sample_rate_hz, structure_mass_kg=structure_mass_kg)
+    if int(n_blocks) != n_blocks or n_blocks < 0:
+        raise ParameterError(f"n_blocks: {n_blocks!r}, expected an integer >= 0 (0: no stderr)")
+    if int(min_periods) != min_periods or min_periods < 1:
+        raise ParameterError(f"min_periods: {min_periods!r}, expected an integer >= 1")
+    if frequency_hz is not None and frequency_hz >= sample_rate_hz / 2:
+        raise ParameterError(f"frequency_hz: {as_given(frequency_hz)} Hz is not below the Nyquist "
+                             f"frequency {sample_rate_hz / 2:g} Hz")
 
 
 def _check_delay(velocity_delay_s: float, frequency_hz: float, duration_s: float) -> None:

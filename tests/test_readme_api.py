@@ -1,0 +1,44 @@
+"""The README's ``Python API`` block runs as written: the whole job through the library, on the
+bundled samples (a script user's first copy must not fail), and its numbers are the CLI's."""
+
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _python_api_block() -> str:
+    section = (ROOT / "README.md").read_text(encoding="utf-8").split("\n## Python API\n", 1)[1]
+    match = re.search(r"```python\n(.*?)```", section.split("\n## ", 1)[0], re.S)
+    assert match, "README: no python block under '## Python API'"
+    return match.group(1)
+
+
+@pytest.mark.slow  # one small DEM run (1 cell, 10 steady cycles)
+def test_the_readme_python_api_block_runs(tmp_path, monkeypatch, capsys):
+    (tmp_path / "data_samples").symlink_to(ROOT / "data_samples")
+    monkeypatch.chdir(tmp_path)
+    namespace: dict = {}
+    exec(compile(_python_api_block(), "README.md (Python API)", "exec"), namespace)  # noqa: S102
+    printed = capsys.readouterr().out.split()
+    assert float(printed[0]) == namespace["records"][0].analysis.sdc
+    # the same files through `pidcore analyze --json`: the same numbers, bit for bit
+    from pidcore.cli import main
+
+    files = [str(f) for f in namespace["files"]]
+    assert main(["analyze", *files, "--velocity-delay", "5e-5", "--no-store", "--json"]) == 0
+    cli = json.loads(capsys.readouterr().out)["records"]
+    for record, printed_by_cli in zip(namespace["records"], cli, strict=True):
+        for key in ("sdc", "sdc_stderr", "loss_factor", "energy_per_cycle_j", "frequency_hz"):
+            assert record.analysis.to_dict()[key] == printed_by_cli[key], key
+    low, high = namespace["prediction"].band(stderr=0.01)
+    assert low <= namespace["prediction"].sdc <= high
+    assert (tmp_path / "my_store.h5").is_file()
+    assert len(namespace["table"]) > 0
+    assert namespace["run"].sdc > 0
+    assert list(namespace["damper"]["c_eq [N s/m]"] > 0) == [True, True]
