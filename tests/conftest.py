@@ -259,3 +259,18 @@ def read_only(monkeypatch):
             monkeypatch.setattr(store_module.os, "access", access)
 
     return make
+
+
+@pytest.fixture(autouse=True)
+def _signal_handlers_restored():
+    """Each test leaves SIGINT and SIGTERM as it found them: ``console_main`` ignores both once
+    its command is over (as the ``pidcore`` process then ends), and run in-process by a test it
+    left the worker ignoring them, so a later test's subprocess inherited SIGTERM ignored and
+    (rightly) kept it so, and an interrupt of pytest itself went unheard."""
+    import signal
+
+    saved = {signum: signal.getsignal(signum) for signum in (signal.SIGINT, signal.SIGTERM)}
+    yield
+    for signum, handler in saved.items():
+        if signal.getsignal(signum) is not handler and handler is not None:
+            signal.signal(signum, handler)
