@@ -1603,3 +1603,27 @@ def test_the_pages_calibration_keeps_what_it_left_out_in_its_outputs(tmp_path):
                                               None, [left])
     assert task.state == "done"
     assert written["notes"] == [left, "the fit's own note"]
+
+
+def test_the_report_tab_defaults_to_the_newest_calibration_of_the_specimen_reported(tmp_path):
+    # a steel calibration saved after the paper's was the Report tab's default for the paper
+    # coupon's report: every calibrated cell empty while Compare showed the paper's band
+    from pidcore.app.calibration import default_calibration_index
+    from pidcore.calibrate.prediction import calibration_from_json
+
+    doc = {"parameters": {"fixture_mass_kg": {"median": 0.2, "low95": 0.1, "high95": 0.3}},
+           "predictions": [{"frequency_hz": 100.0, "acceleration_g": 5.0, "fill_percent": 50.0,
+                            "material": "acrylic", "measured": 0.3, "predicted": 0.3,
+                            "low95": 0.1, "high95": 0.6}]}
+
+    def of(name):
+        return calibration_from_json(json.dumps(doc).encode(), f"{name}.json",
+                                     specimen_name=name)
+
+    newest_first = [(of("steel_6mm"), "steel"), (of("paper_coupon"), "paper"),
+                    (of("steel_6mm"), "older steel")]
+    assert default_calibration_index(newest_first, "paper_coupon") == 1
+    assert default_calibration_index(newest_first, "steel_6mm") == 0
+    # a calibration naming no specimen speaks for any; none speaking for it: the first
+    assert default_calibration_index([(of(""), "file")], "my_panel") == 0
+    assert default_calibration_index(newest_first[:1], "my_panel") == 0

@@ -283,6 +283,15 @@ def stored_calibration_label(calibration) -> str:
             f"{calibration.created_utc[:16].replace('T', ' ')} UTC)")
 
 
+def default_calibration_index(usable: Sequence[tuple[object, str]], specimen_name: str) -> int:
+    """Which of ``usable`` ([(calibration, label)], newest first) the Report tab shows by
+    default for a report of specimen ``specimen_name``: the first that speaks for it, as the
+    Compare tab takes the first (a steel calibration saved last left the paper coupon's
+    report without a calibrated column); 0 where none does (the report then says why)."""
+    return next((i for i, (calibration, _) in enumerate(usable)
+                 if calibration.speaks_for(specimen_name)), 0)
+
+
 #: Columns of :func:`saved_calibrations_table`: listing column -> name shown (units named).
 SAVED_CALIBRATION_COLUMNS = {"key": "calibration", "specimen": "specimen", "fit": "fitted",
                              "n_points": "load cases [-]", "rms_in_sample": "in-sample RMS [-]",
