@@ -1627,3 +1627,29 @@ def test_the_report_tab_defaults_to_the_newest_calibration_of_the_specimen_repor
     # a calibration naming no specimen speaks for any; none speaking for it: the first
     assert default_calibration_index([(of(""), "file")], "my_panel") == 0
     assert default_calibration_index(newest_first[:1], "my_panel") == 0
+
+
+def test_a_damaged_calibration_in_the_store_does_not_hide_the_others(tmp_path):
+    # one calibration of the store whose calibration.json was cut short hid every one of
+    # them on Compare, Report and the Calibrate page ("calibrations of the store not shown")
+    from pidcore.app.calibration import available_calibrations
+    from pidcore.calibrate.persist import readable_calibrations
+    from pidcore.store import Store
+
+    doc = {"parameters": {"fixture_mass_kg": {"median": 0.2, "low95": 0.1, "high95": 0.3}},
+           "predictions": [{"frequency_hz": 100.0, "acceleration_g": 5.0, "fill_percent": 50.0,
+                            "material": "acrylic", "measured": 0.3, "predicted": 0.3,
+                            "low95": 0.1, "high95": 0.6}]}
+    store = tmp_path / "s.h5"
+    text = json.dumps(doc)
+    Store(store).add_calibration("cal_good", {"specimen": "paper_coupon"}, document=text,
+                                 specimen_toml="")
+    Store(store).add_calibration("cal_cut", {"specimen": "steel_6mm"},
+                                 document=text[:len(text) // 2], specimen_toml="")
+    readable, damaged = readable_calibrations(store)
+    assert [c.store_key for c in readable] == ["cal_good"]
+    assert len(damaged) == 1 and "cal_cut" in damaged[0] and "\n" not in damaged[0]
+    found = available_calibrations(None, {}, cwd=tmp_path, store_path=store)
+    assert found[0][0] is not None and found[0][0].store_key == "cal_good"
+    assert found[-1][0] is None and "cal_cut" in found[-1][1]
+    assert readable_calibrations(tmp_path / "none.h5") == ([], [])

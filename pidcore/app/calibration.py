@@ -329,7 +329,7 @@ def available_calibrations(task: CalibrationTask | None,
     other's bands: Compare takes the first that predicts a case. One that cannot be read comes
     last as ``(None, reason)``; ``[(None, reason)]`` when there is none or none can be read
     (the reason is shown)."""
-    from ..calibrate.persist import stored_calibrations
+    from ..calibrate.persist import readable_calibrations
     from ..calibrate.prediction import calibration_from_json, load_calibration
     from ..errors import PidcoreError
 
@@ -337,9 +337,11 @@ def available_calibrations(task: CalibrationTask | None,
     problems: list[str] = []
     if store_path is not None:
         try:
-            found += [(c, stored_calibration_label(c)) for c in stored_calibrations(store_path)]
-        except PidcoreError as exc:
-            problems.append(f"calibrations of the store not shown: {exc}")
+            readable, damaged = readable_calibrations(store_path)
+        except PidcoreError as exc:  # the store's listing itself cannot be read
+            readable, damaged = [], [str(exc)]
+        found += [(c, stored_calibration_label(c)) for c in readable]
+        problems += [f"calibration of the store not shown: {problem}" for problem in damaged]
     saved = {c.store_key for c, _ in found}
     if task is not None and task.state == "done" and "calibration.json" in task.outputs \
             and task.store_key not in saved:
