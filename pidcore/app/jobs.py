@@ -170,6 +170,7 @@ class DemJobRunner:
         #: Why the journal could not be read or written ("" : all well).
         self.journal_problem: str
         self._jobs, self.journal_problem = read_journal(journal_path(self.store_path))
+        _settle_saved_before_stop(self._jobs, self.store_path)
         self._counter = max((_job_number(j.job_id) for j in self._jobs), default=0)
         if self._jobs:
             with self._lock:
@@ -429,6 +430,27 @@ class DemJobRunner:
                 return
         CaseOutcome(job.run_key, **outcome).save_to(Store(self.store_path))
         self._finish(job, "saved", f"saved as {job.run_key}")
+
+
+def _settle_saved_before_stop(jobs: Sequence[DemJob], store_path: Path) -> None:
+    """Interrupted jobs whose run the store holds: the stop came after the run was saved
+    and before the journal said so (or the job was waiting for that run), so the table
+    says "in store", not "nothing of it was saved"; a store that cannot be read leaves
+    them interrupted (Resubmit then finds the run and does not run it again)."""
+    from ..store import Store
+
+    interrupted = [j for j in jobs if j.state == INTERRUPTED_STATE]
+    if not interrupted or not store_path.is_file():
+        return
+    try:
+        store = Store(store_path)
+        held = [j for j in interrupted if store.has_dem_run(j.run_key)]
+    except PidcoreError:
+        return
+    for job in held:
+        job.state = "in store"
+        job.message = (f"the app stopped after its run was saved as {job.run_key}: in the "
+                       "store, not run again")
 
 
 def journal_path(store_path: str | Path) -> Path:
