@@ -1653,3 +1653,17 @@ def test_a_damaged_calibration_in_the_store_does_not_hide_the_others(tmp_path):
     assert found[0][0] is not None and found[0][0].store_key == "cal_good"
     assert found[-1][0] is None and "cal_cut" in found[-1][1]
     assert readable_calibrations(tmp_path / "none.h5") == ([], [])
+
+
+def test_a_structure_mass_typed_in_mg_is_refused_in_the_pages_unit():
+    # 280000 typed in 'structure mass [g]' was refused as "structure_mass_kg 280 kg ...
+    # expected ... in kg (was it in g?)": the field's name and a unit the column does not
+    # take; typing kg there (0.28) is refused as a unit slip in turn
+    from pidcore.measure import AnalysisOptions
+
+    parsed = uploads.parse_upload("c_fill50.csv", mass_damper_csv())
+    outcome = uploads.analyze_parsed(parsed, AnalysisOptions(baseline_loss_factor=0.01,
+                                                             structure_mass_kg=280.0))
+    assert outcome.error.startswith("c_fill50.csv: structure mass [g] 280000 g is ")
+    assert "structure_mass_kg" not in outcome.error
+    assert "in g in a structure_mass_g column and the app's structure mass [g]" in outcome.error
