@@ -64,6 +64,8 @@ def test_jobs_running_or_queued_at_a_stop_come_back_interrupted(tmp_path):
         by_id = {j.job_id: j for j in second.jobs()}
         for old, new in zip(submitted, created, strict=True):
             assert by_id[old.job_id].message.endswith(f"submitted again as {new.job_id}")
+            # not "cancelled" (the page counted "1 cancelled" where no one had cancelled)
+            assert by_id[old.job_id].state == jobs.RESUBMITTED_STATE
     finally:
         second.cancel()
         second.wait_cancelled(5.0)

@@ -849,7 +849,8 @@ def test_dem_jobs_interrupted_by_a_stop_are_shown_and_resubmitted(store_file):
     try:
         assert not at.exception, at.exception
         states = {j.job_id: j.state for j in runner.jobs()}
-        assert states["job0003"] == "cancelled" and states["job0004"] in ("queued", "running")
+        assert states["job0003"] == jobs.RESUBMITTED_STATE and states["job0004"] in ("queued",
+                                                                            "running")
         assert not any("when the app stopped" in w.value for w in at.warning)
     finally:
         runner.cancel()

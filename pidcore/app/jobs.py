@@ -39,10 +39,13 @@ from ..errors import ParameterError, PidcoreError
 
 #: Job states, in the order a job passes through them.
 JOB_STATES = ("queued", "running", "saved", "in store", "same run", "cancelled", "failed",
-              "interrupted")
+              "interrupted", "resubmitted")
 #: State of a job that was queued or running when the app stopped (read from the journal):
 #: nothing of it was saved; :meth:`DemJobRunner.resubmit_interrupted` runs it again.
 INTERRUPTED_STATE = "interrupted"
+#: State of an interrupted job once *Resubmit interrupted* submitted it again (its message
+#: names the new job): not "cancelled", which no one asked for.
+RESUBMITTED_STATE = "resubmitted"
 #: The journal of a store's jobs: ``<store>`` + this suffix, beside the store.
 JOURNAL_SUFFIX = ".jobs.json"
 #: Layout version written into the journal.
@@ -262,7 +265,7 @@ class DemJobRunner:
             new = self.submit([old.case], old.config, old.specimen)
             created += new
             with self._lock:
-                old.state = "cancelled"
+                old.state = RESUBMITTED_STATE
                 old.message = (f"interrupted by a stop of the app; submitted again as "
                                f"{new[0].job_id}" if new else
                                "interrupted by a stop of the app; already queued or running")
