@@ -1667,3 +1667,17 @@ def test_a_structure_mass_typed_in_mg_is_refused_in_the_pages_unit():
     assert outcome.error.startswith("c_fill50.csv: structure mass [g] 280000 g is ")
     assert "structure_mass_kg" not in outcome.error
     assert "in g in a structure_mass_g column and the app's structure mass [g]" in outcome.error
+
+
+def test_the_corrections_say_how_the_baseline_went_off():
+    # Compare's corrections column read "baseline loss factor 0.0152" for a record with the
+    # exact subtraction (structure mass given) and one off the whole vibrated mass, whose
+    # SDCs differ by the baseline x the particles' share
+    from pidcore.compare.case import describe_corrections
+
+    exact = describe_corrections({"baseline_loss_factor": 0.0152, "structure_mass_kg": 0.28})
+    whole = describe_corrections({"baseline_loss_factor": 0.0152, "structure_mass_kg": None})
+    assert exact.endswith("baseline loss factor 0.0152 (of a structure mass 280 g)")
+    assert whole.endswith("baseline loss factor 0.0152 (off the whole vibrated mass)")
+    # no baseline: the structure mass changes nothing and is not named
+    assert describe_corrections({"structure_mass_kg": 0.28}).endswith("baseline loss factor 0")
