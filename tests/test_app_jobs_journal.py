@@ -126,3 +126,22 @@ def test_a_job_whose_run_was_saved_just_before_the_stop_is_not_said_unsaved(tmp_
     listed = json.loads(jobs.journal_path(store).read_text())["jobs"]
     assert [d["state"] for d in listed] == ["in store", jobs.INTERRUPTED_STATE]
     runner.cancel()
+
+
+def test_one_job_that_cannot_be_read_costs_its_row_not_the_table(tmp_path):
+    # a journal holding one job this version cannot rebuild (its specimen file is refused
+    # now, or the entry is damaged) lost every job of the table
+    store = tmp_path / "app.h5"
+    (case,) = jobs.plan_dem_cases([100.0], [5.0], [50.0], material="acrylic", direction="z")
+    done = jobs.DemJob("job0001", case, DemConfig(cells=2), "k", state="saved",
+                       started=1.0, finished=3.5, message="saved as k")
+    jobs.write_journal(jobs.journal_path(store), [done])
+    doc = json.loads(jobs.journal_path(store).read_text())
+    bad = dict(doc["jobs"][0], job_id="job0002",
+               specimen={"text": "schema_version = 1\nname = 'x'\n", "source": "x.toml"})
+    doc["jobs"].append(bad)
+    jobs.journal_path(store).write_text(json.dumps(doc))
+    runner = jobs.DemJobRunner(store)
+    assert [j.row() for j in runner.jobs()] == [done.row()]
+    assert runner.journal_problem.startswith("1 job(s) of the job table")
+    assert "job0002" in runner.journal_problem and "\n" not in runner.journal_problem

@@ -176,8 +176,11 @@ class DemJobRunner:
         _settle_saved_before_stop(self._jobs, self.store_path)
         self._counter = max((_job_number(j.job_id) for j in self._jobs), default=0)
         if self._jobs:
+            read_problem = self.journal_problem
             with self._lock:
                 self._write_journal()  # the interrupted ones as such
+            # a job that could not be read is still said after the journal is rewritten
+            self.journal_problem = self.journal_problem or read_problem
         self._thread = threading.Thread(target=self._work, name="pidcore-dem-jobs", daemon=True)
         self._thread.start()
 
@@ -522,16 +525,29 @@ def read_journal(path: Path) -> tuple[list[DemJob], str]:
     replaced by the next change)."""
     if not path.is_file():
         return [], ""
+    unreadable = (OSError, ValueError, TypeError, KeyError, AttributeError, PidcoreError)
     try:
         doc = json.loads(path.read_text(encoding="utf-8"))
         if not isinstance(doc, dict) or doc.get("pidcore_jobs_version") != _JOURNAL_VERSION \
                 or not isinstance(doc.get("jobs"), list):
             raise ValueError("not a pidcore job journal of version "
                              f"{_JOURNAL_VERSION}")
-        return [_job_from_document(d) for d in doc["jobs"]], ""
-    except (OSError, ValueError, TypeError, KeyError, PidcoreError) as exc:
+    except unreadable as exc:
         return [], (f"the job table of the last run of the app ({path}) cannot be read "
                     f"({type(exc).__name__}: {exc}); its saved runs are in the store")
+    # job by job: one that cannot be rebuilt (a specimen file this version refuses) costs
+    # its own row, not the table
+    found, lost = [], []
+    for number, entry in enumerate(doc["jobs"], start=1):
+        try:
+            found.append(_job_from_document(entry))
+        except unreadable as exc:
+            name = entry.get("job_id") if isinstance(entry, dict) else None
+            lost.append(f"{name or f'entry {number}'} ({type(exc).__name__}: {exc})")
+    if not lost:
+        return found, ""
+    return found, (f"{len(lost)} job(s) of the job table of the last run of the app ({path}) "
+                   f"cannot be read: {'; '.join(lost)}; their saved runs are in the store")
 
 
 _RUNNERS: dict[str, DemJobRunner] = {}
