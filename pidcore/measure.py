@@ -353,6 +353,14 @@ def analyze_measurement(measurement: Measurement, options: AnalysisOptions | Non
         allow_clipped=options.allow_clipped,
     )
     notes.extend(_unit_slip_notes(measurement, chosen, analysis))
+    if options.structure_mass_kg is not None and not options.baseline_loss_factor > 0:
+        # the mass only says how much of the reactive power the baseline applies to: given
+        # alone it changes nothing, which a user who set it believing the structure's damping
+        # taken off must be told
+        notes.append(f"structure mass {options.structure_mass_kg:.4g} kg given without a "
+                     "baseline loss factor: nothing subtracted (give the empty structure's "
+                     "loss factor too: --baseline-loss-factor, a baseline_loss_factor column, "
+                     "the app's baseline loss factor [-])")
     used = {role: ch.name for role, ch in chosen.items()}
     detail = tuple({"role": role, "name": ch.name, "unit": ch.unit,
                     "source_unit": ch.source_unit} for role, ch in chosen.items())

@@ -64,6 +64,8 @@ def test_jobs_running_or_queued_at_a_stop_come_back_interrupted(tmp_path):
         by_id = {j.job_id: j for j in second.jobs()}
         for old, new in zip(submitted, created, strict=True):
             assert by_id[old.job_id].message.endswith(f"submitted again as {new.job_id}")
+            # not "cancelled" (the page counted "1 cancelled" where no one had cancelled)
+            assert by_id[old.job_id].state == jobs.RESUBMITTED_STATE
     finally:
         second.cancel()
         second.wait_cancelled(5.0)
@@ -97,3 +99,49 @@ def test_a_journal_that_cannot_be_read_gives_an_empty_table_and_says_why(tmp_pat
             runner.journal_problem
         assert journal.read_text() == text  # kept until the next change replaces it
         assert not store.exists()  # the store is not touched
+
+
+def test_a_job_whose_run_was_saved_just_before_the_stop_is_not_said_unsaved(tmp_path):
+    # a stop between the run's save and the journal's "saved" showed the job as
+    # "interrupted: nothing of it was saved" while the store held its run
+    from pidcore.store import Store
+
+    store = tmp_path / "app.h5"
+    saved_case, lost_case = jobs.plan_dem_cases([100.0, 200.0], [5.0], [50.0],
+                                                material="acrylic", direction="z")
+    config = DemConfig(cells=2)
+    running = [jobs.DemJob("job0001", saved_case, config, "k_saved", state="running",
+                           started=1.0),
+               jobs.DemJob("job0002", lost_case, config, "k_lost", state="queued")]
+    record = {"frequency_hz": 100.0, "acceleration_g": 5.0, "fill_percent": 50.0,
+              "material": "acrylic", "direction": "z", "sdc": 0.5, "sdc_stderr": 0.01}
+    Store(store).add_dem_runs([{"case_key": "k_saved", "record": record, "arrays": None}])
+    jobs.write_journal(jobs.journal_path(store), running)
+    runner = jobs.DemJobRunner(store)
+    states = {j.job_id: (j.state, j.message) for j in runner.jobs()}
+    assert states["job0001"][0] == "in store" and "k_saved" in states["job0001"][1]
+    assert states["job0002"][0] == jobs.INTERRUPTED_STATE
+    assert "nothing of it was saved" in states["job0002"][1]
+    # the journal says so too (Resubmit then offers only the one that was lost)
+    listed = json.loads(jobs.journal_path(store).read_text())["jobs"]
+    assert [d["state"] for d in listed] == ["in store", jobs.INTERRUPTED_STATE]
+    runner.cancel()
+
+
+def test_one_job_that_cannot_be_read_costs_its_row_not_the_table(tmp_path):
+    # a journal holding one job this version cannot rebuild (its specimen file is refused
+    # now, or the entry is damaged) lost every job of the table
+    store = tmp_path / "app.h5"
+    (case,) = jobs.plan_dem_cases([100.0], [5.0], [50.0], material="acrylic", direction="z")
+    done = jobs.DemJob("job0001", case, DemConfig(cells=2), "k", state="saved",
+                       started=1.0, finished=3.5, message="saved as k")
+    jobs.write_journal(jobs.journal_path(store), [done])
+    doc = json.loads(jobs.journal_path(store).read_text())
+    bad = dict(doc["jobs"][0], job_id="job0002",
+               specimen={"text": "schema_version = 1\nname = 'x'\n", "source": "x.toml"})
+    doc["jobs"].append(bad)
+    jobs.journal_path(store).write_text(json.dumps(doc))
+    runner = jobs.DemJobRunner(store)
+    assert [j.row() for j in runner.jobs()] == [done.row()]
+    assert runner.journal_problem.startswith("1 job(s) of the job table")
+    assert "job0002" in runner.journal_problem and "\n" not in runner.journal_problem

@@ -1603,3 +1603,81 @@ def test_the_pages_calibration_keeps_what_it_left_out_in_its_outputs(tmp_path):
                                               None, [left])
     assert task.state == "done"
     assert written["notes"] == [left, "the fit's own note"]
+
+
+def test_the_report_tab_defaults_to_the_newest_calibration_of_the_specimen_reported(tmp_path):
+    # a steel calibration saved after the paper's was the Report tab's default for the paper
+    # coupon's report: every calibrated cell empty while Compare showed the paper's band
+    from pidcore.app.calibration import default_calibration_index
+    from pidcore.calibrate.prediction import calibration_from_json
+
+    doc = {"parameters": {"fixture_mass_kg": {"median": 0.2, "low95": 0.1, "high95": 0.3}},
+           "predictions": [{"frequency_hz": 100.0, "acceleration_g": 5.0, "fill_percent": 50.0,
+                            "material": "acrylic", "measured": 0.3, "predicted": 0.3,
+                            "low95": 0.1, "high95": 0.6}]}
+
+    def of(name):
+        return calibration_from_json(json.dumps(doc).encode(), f"{name}.json",
+                                     specimen_name=name)
+
+    newest_first = [(of("steel_6mm"), "steel"), (of("paper_coupon"), "paper"),
+                    (of("steel_6mm"), "older steel")]
+    assert default_calibration_index(newest_first, "paper_coupon") == 1
+    assert default_calibration_index(newest_first, "steel_6mm") == 0
+    # a calibration naming no specimen speaks for any; none speaking for it: the first
+    assert default_calibration_index([(of(""), "file")], "my_panel") == 0
+    assert default_calibration_index(newest_first[:1], "my_panel") == 0
+
+
+def test_a_damaged_calibration_in_the_store_does_not_hide_the_others(tmp_path):
+    # one calibration of the store whose calibration.json was cut short hid every one of
+    # them on Compare, Report and the Calibrate page ("calibrations of the store not shown")
+    from pidcore.app.calibration import available_calibrations
+    from pidcore.calibrate.persist import readable_calibrations
+    from pidcore.store import Store
+
+    doc = {"parameters": {"fixture_mass_kg": {"median": 0.2, "low95": 0.1, "high95": 0.3}},
+           "predictions": [{"frequency_hz": 100.0, "acceleration_g": 5.0, "fill_percent": 50.0,
+                            "material": "acrylic", "measured": 0.3, "predicted": 0.3,
+                            "low95": 0.1, "high95": 0.6}]}
+    store = tmp_path / "s.h5"
+    text = json.dumps(doc)
+    Store(store).add_calibration("cal_good", {"specimen": "paper_coupon"}, document=text,
+                                 specimen_toml="")
+    Store(store).add_calibration("cal_cut", {"specimen": "steel_6mm"},
+                                 document=text[:len(text) // 2], specimen_toml="")
+    readable, damaged = readable_calibrations(store)
+    assert [c.store_key for c in readable] == ["cal_good"]
+    assert len(damaged) == 1 and "cal_cut" in damaged[0] and "\n" not in damaged[0]
+    found = available_calibrations(None, {}, cwd=tmp_path, store_path=store)
+    assert found[0][0] is not None and found[0][0].store_key == "cal_good"
+    assert found[-1][0] is None and "cal_cut" in found[-1][1]
+    assert readable_calibrations(tmp_path / "none.h5") == ([], [])
+
+
+def test_a_structure_mass_typed_in_mg_is_refused_in_the_pages_unit():
+    # 280000 typed in 'structure mass [g]' was refused as "structure_mass_kg 280 kg ...
+    # expected ... in kg (was it in g?)": the field's name and a unit the column does not
+    # take; typing kg there (0.28) is refused as a unit slip in turn
+    from pidcore.measure import AnalysisOptions
+
+    parsed = uploads.parse_upload("c_fill50.csv", mass_damper_csv())
+    outcome = uploads.analyze_parsed(parsed, AnalysisOptions(baseline_loss_factor=0.01,
+                                                             structure_mass_kg=280.0))
+    assert outcome.error.startswith("c_fill50.csv: structure mass [g] 280000 g is ")
+    assert "structure_mass_kg" not in outcome.error
+    assert "in g in a structure_mass_g column and the app's structure mass [g]" in outcome.error
+
+
+def test_the_corrections_say_how_the_baseline_went_off():
+    # Compare's corrections column read "baseline loss factor 0.0152" for a record with the
+    # exact subtraction (structure mass given) and one off the whole vibrated mass, whose
+    # SDCs differ by the baseline x the particles' share
+    from pidcore.compare.case import describe_corrections
+
+    exact = describe_corrections({"baseline_loss_factor": 0.0152, "structure_mass_kg": 0.28})
+    whole = describe_corrections({"baseline_loss_factor": 0.0152, "structure_mass_kg": None})
+    assert exact.endswith("baseline loss factor 0.0152 (of a structure mass 280 g)")
+    assert whole.endswith("baseline loss factor 0.0152 (off the whole vibrated mass)")
+    # no baseline: the structure mass changes nothing and is not named
+    assert describe_corrections({"structure_mass_kg": 0.28}).endswith("baseline loss factor 0")

@@ -849,7 +849,8 @@ def test_dem_jobs_interrupted_by_a_stop_are_shown_and_resubmitted(store_file):
     try:
         assert not at.exception, at.exception
         states = {j.job_id: j.state for j in runner.jobs()}
-        assert states["job0003"] == "cancelled" and states["job0004"] in ("queued", "running")
+        assert states["job0003"] == jobs.RESUBMITTED_STATE and states["job0004"] in ("queued",
+                                                                            "running")
         assert not any("when the app stopped" in w.value for w in at.warning)
     finally:
         runner.cancel()
@@ -893,18 +894,21 @@ def test_a_calibration_of_another_specimen_does_not_hide_the_papers_band(store_f
     assert metrics["SDC calibrated DEM, Eq. 11 [-]"] == "0.3456"  # the paper's, not none
     assert any("the bundled calibration" in m.value or str(paper) in m.value
                for m in at.markdown if "calibrated DEM" in m.value)
-    # the Report tab offers both, this store's first; the paper's gives the acrylic row
+    # the Report tab offers both, this store's first, and shows by default the first that
+    # speaks for the specimen reported (the paper's coupon): the paper's, as Compare does (it
+    # showed the newer steel one, its calibrated column empty on every row)
     at.button(key="save").click()
     at.run()
-    box = at.selectbox(key="report_calibration")
+    box = at.selectbox(key="report_calibration_paper_coupon (the default)")
     assert box.options[0].startswith("this store's calibration of steel_6mm")
-    assert _table(at, "SDC calibrated DEM (Eq. 11) [-]")["SDC calibrated DEM (Eq. 11) [-]"] \
-        .isna().all()
-    box.set_value(box.options[1])
-    at.run()
+    assert box.value == box.options[1]
     table = _table(at, "SDC calibrated DEM (Eq. 11) [-]")
     assert table.loc[table["SDC measured [-]"].notna(), "SDC calibrated DEM (Eq. 11) [-]"] \
         .tolist() == [0.3456]
+    box.set_value(box.options[0])  # the steel one, chosen: no acrylic row predicted
+    at.run()
+    assert _table(at, "SDC calibrated DEM (Eq. 11) [-]")["SDC calibrated DEM (Eq. 11) [-]"] \
+        .isna().all()
 
 
 def test_compare_shows_no_band_of_another_specimens_calibration(store_file, tmp_path,

@@ -108,9 +108,12 @@ def test_a_store_of_several_calibrations_needs_a_key(calibrated, capsys, tmp_pat
     folder, store = calibrated
     copy = tmp_path / "two.h5"
     copy.write_bytes(store.read_bytes())
-    _calibrate(folder, copy, "0.3", capsys)
+    said = _calibrate(folder, copy, "0.3", capsys)
     keys = list(Store(copy).list_calibrations()["key"])
     assert len(keys) == 2
+    # the command it advises reads the new one (without the key it was refused: two stored)
+    new_key = (set(keys) - {Store(store).list_calibrations()["key"].iloc[0]}).pop()
+    assert f"report --calibration {copy} --calibration-key {new_key})" in said
     with pytest.raises(ParameterError, match="holds 2 calibrations; choose one with "
                                              "--calibration-key") as refused:
         stored_calibration(copy)

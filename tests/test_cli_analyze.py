@@ -479,3 +479,23 @@ def test_a_store_chmod_444_is_read_only_for_root_too(tmp_path, capsys):
     assert sorted(p.name for p in tmp_path.iterdir() if p.name.startswith(".")) == []
     store.chmod(0o644)  # made writable again: written as before
     assert main(["analyze", str(other), "--store", str(store)]) == 0
+
+
+def test_a_structure_mass_without_a_baseline_is_said_to_change_nothing(tmp_path, capsys):
+    # --structure-mass alone (or a structure_mass_g column with no baseline) was taken in
+    # silence: the user believed the structure's damping taken off, and nothing was
+    rec = synthesize_shaker_record(mass_kg=0.3, acceleration_amplitude_m_s2=5 * STANDARD_GRAVITY,
+                                   frequency_hz=100.0, sample_rate_hz=10000.0, n_periods=30,
+                                   viscous_damping_n_s_m=2.0)
+    path = write_force_velocity(tmp_path / "a.csv", rec.force_n, rec.velocity_m_s, 10000.0)
+
+    def notes(*options):
+        assert main(["analyze", str(path), "--no-store", "--json", *options]) == 0
+        (record,) = json.loads(capsys.readouterr().out)["records"]
+        return record, [n for n in record["notes"] if "given without a baseline" in n]
+
+    alone, said = notes("--structure-mass", "0.28")
+    assert len(said) == 1 and "nothing subtracted" in said[0]
+    plain, _ = notes()
+    assert alone["loss_factor"] == plain["loss_factor"]  # indeed nothing subtracted
+    assert notes("--structure-mass", "0.28", "--baseline-loss-factor", "0.001")[1] == []

@@ -336,3 +336,26 @@ def test_a_store_kept_in_an_earlier_report_folder_is_never_replaced_with_it(tmp_
     assert main(["report", "--dem-store", str(dem_store), "--out", str(out),
                  "--format", "csv"]) == 0
     assert not (out / "report.md").exists()
+
+
+@pytest.mark.slow
+def test_a_baseline_taken_off_the_whole_vibrated_mass_is_said_in_the_report(tmp_path,
+                                                                            dem_store):
+    # `pidcore analyze --baseline-loss-factor` without --structure-mass notes that the
+    # subtraction is too large; the report compared that SDC with the DEM without a word,
+    # whether from the files, from the files saved in a store, or from the store alone
+    file = _write_measurement(tmp_path / "coupon1_fill50_acrylic.csv")
+    said = "subtracted as if the whole vibrated mass were the empty structure's"
+
+    def notes(*args, out):
+        assert main(["report", *args, "--dem-store", str(dem_store), "--format", "md",
+                     "--out", str(tmp_path / out)]) == 0
+        return (tmp_path / out / "report.md").read_text(encoding="utf-8")
+
+    baseline = ["--baseline-loss-factor", "0.001"]  # below the record's 0.0048
+    assert said in notes(str(file), *baseline, out="files")
+    assert said in notes(str(file), *baseline, "--store", str(tmp_path / "s.h5"), out="saved")
+    assert said in notes("--store", str(tmp_path / "s.h5"), out="stored")
+    # the exact subtraction (half the 0.2 kg rigid mass the structure) and none: no note
+    assert said not in notes(str(file), *baseline, "--structure-mass", "0.1", out="exact")
+    assert said not in notes(str(file), out="none")

@@ -283,6 +283,15 @@ def stored_calibration_label(calibration) -> str:
             f"{calibration.created_utc[:16].replace('T', ' ')} UTC)")
 
 
+def default_calibration_index(usable: Sequence[tuple[object, str]], specimen_name: str) -> int:
+    """Which of ``usable`` ([(calibration, label)], newest first) the Report tab shows by
+    default for a report of specimen ``specimen_name``: the first that speaks for it, as the
+    Compare tab takes the first (a steel calibration saved last left the paper coupon's
+    report without a calibrated column); 0 where none does (the report then says why)."""
+    return next((i for i, (calibration, _) in enumerate(usable)
+                 if calibration.speaks_for(specimen_name)), 0)
+
+
 #: Columns of :func:`saved_calibrations_table`: listing column -> name shown (units named).
 SAVED_CALIBRATION_COLUMNS = {"key": "calibration", "specimen": "specimen", "fit": "fitted",
                              "n_points": "load cases [-]", "rms_in_sample": "in-sample RMS [-]",
@@ -320,7 +329,7 @@ def available_calibrations(task: CalibrationTask | None,
     other's bands: Compare takes the first that predicts a case. One that cannot be read comes
     last as ``(None, reason)``; ``[(None, reason)]`` when there is none or none can be read
     (the reason is shown)."""
-    from ..calibrate.persist import stored_calibrations
+    from ..calibrate.persist import readable_calibrations
     from ..calibrate.prediction import calibration_from_json, load_calibration
     from ..errors import PidcoreError
 
@@ -328,9 +337,11 @@ def available_calibrations(task: CalibrationTask | None,
     problems: list[str] = []
     if store_path is not None:
         try:
-            found += [(c, stored_calibration_label(c)) for c in stored_calibrations(store_path)]
-        except PidcoreError as exc:
-            problems.append(f"calibrations of the store not shown: {exc}")
+            readable, damaged = readable_calibrations(store_path)
+        except PidcoreError as exc:  # the store's listing itself cannot be read
+            readable, damaged = [], [str(exc)]
+        found += [(c, stored_calibration_label(c)) for c in readable]
+        problems += [f"calibration of the store not shown: {problem}" for problem in damaged]
     saved = {c.store_key for c, _ in found}
     if task is not None and task.state == "done" and "calibration.json" in task.outputs \
             and task.store_key not in saved:

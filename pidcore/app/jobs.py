@@ -39,10 +39,13 @@ from ..errors import ParameterError, PidcoreError
 
 #: Job states, in the order a job passes through them.
 JOB_STATES = ("queued", "running", "saved", "in store", "same run", "cancelled", "failed",
-              "interrupted")
+              "interrupted", "resubmitted")
 #: State of a job that was queued or running when the app stopped (read from the journal):
 #: nothing of it was saved; :meth:`DemJobRunner.resubmit_interrupted` runs it again.
 INTERRUPTED_STATE = "interrupted"
+#: State of an interrupted job once *Resubmit interrupted* submitted it again (its message
+#: names the new job): not "cancelled", which no one asked for.
+RESUBMITTED_STATE = "resubmitted"
 #: The journal of a store's jobs: ``<store>`` + this suffix, beside the store.
 JOURNAL_SUFFIX = ".jobs.json"
 #: Layout version written into the journal.
@@ -170,10 +173,14 @@ class DemJobRunner:
         #: Why the journal could not be read or written ("" : all well).
         self.journal_problem: str
         self._jobs, self.journal_problem = read_journal(journal_path(self.store_path))
+        _settle_saved_before_stop(self._jobs, self.store_path)
         self._counter = max((_job_number(j.job_id) for j in self._jobs), default=0)
         if self._jobs:
+            read_problem = self.journal_problem
             with self._lock:
                 self._write_journal()  # the interrupted ones as such
+            # a job that could not be read is still said after the journal is rewritten
+            self.journal_problem = self.journal_problem or read_problem
         self._thread = threading.Thread(target=self._work, name="pidcore-dem-jobs", daemon=True)
         self._thread.start()
 
@@ -261,7 +268,7 @@ class DemJobRunner:
             new = self.submit([old.case], old.config, old.specimen)
             created += new
             with self._lock:
-                old.state = "cancelled"
+                old.state = RESUBMITTED_STATE
                 old.message = (f"interrupted by a stop of the app; submitted again as "
                                f"{new[0].job_id}" if new else
                                "interrupted by a stop of the app; already queued or running")
@@ -431,6 +438,27 @@ class DemJobRunner:
         self._finish(job, "saved", f"saved as {job.run_key}")
 
 
+def _settle_saved_before_stop(jobs: Sequence[DemJob], store_path: Path) -> None:
+    """Interrupted jobs whose run the store holds: the stop came after the run was saved
+    and before the journal said so (or the job was waiting for that run), so the table
+    says "in store", not "nothing of it was saved"; a store that cannot be read leaves
+    them interrupted (Resubmit then finds the run and does not run it again)."""
+    from ..store import Store
+
+    interrupted = [j for j in jobs if j.state == INTERRUPTED_STATE]
+    if not interrupted or not store_path.is_file():
+        return
+    try:
+        store = Store(store_path)
+        held = [j for j in interrupted if store.has_dem_run(j.run_key)]
+    except PidcoreError:
+        return
+    for job in held:
+        job.state = "in store"
+        job.message = (f"the app stopped after its run was saved as {job.run_key}: in the "
+                       "store, not run again")
+
+
 def journal_path(store_path: str | Path) -> Path:
     """The journal of a store's jobs: ``<store>.jobs.json`` beside it."""
     path = Path(store_path)
@@ -497,16 +525,29 @@ def read_journal(path: Path) -> tuple[list[DemJob], str]:
     replaced by the next change)."""
     if not path.is_file():
         return [], ""
+    unreadable = (OSError, ValueError, TypeError, KeyError, AttributeError, PidcoreError)
     try:
         doc = json.loads(path.read_text(encoding="utf-8"))
         if not isinstance(doc, dict) or doc.get("pidcore_jobs_version") != _JOURNAL_VERSION \
                 or not isinstance(doc.get("jobs"), list):
             raise ValueError("not a pidcore job journal of version "
                              f"{_JOURNAL_VERSION}")
-        return [_job_from_document(d) for d in doc["jobs"]], ""
-    except (OSError, ValueError, TypeError, KeyError, PidcoreError) as exc:
+    except unreadable as exc:
         return [], (f"the job table of the last run of the app ({path}) cannot be read "
                     f"({type(exc).__name__}: {exc}); its saved runs are in the store")
+    # job by job: one that cannot be rebuilt (a specimen file this version refuses) costs
+    # its own row, not the table
+    found, lost = [], []
+    for number, entry in enumerate(doc["jobs"], start=1):
+        try:
+            found.append(_job_from_document(entry))
+        except unreadable as exc:
+            name = entry.get("job_id") if isinstance(entry, dict) else None
+            lost.append(f"{name or f'entry {number}'} ({type(exc).__name__}: {exc})")
+    if not lost:
+        return found, ""
+    return found, (f"{len(lost)} job(s) of the job table of the last run of the app ({path}) "
+                   f"cannot be read: {'; '.join(lost)}; their saved runs are in the store")
 
 
 _RUNNERS: dict[str, DemJobRunner] = {}

@@ -188,6 +188,10 @@ def app_words(text: str) -> str:
     text = text.replace("choose one with key=", "upload one measurement per file, or analyse "
                                                 "one with `pidcore analyze FILE --key NAME`")
     text = text.replace(" inverted (--invert)", " inverted ('inverted channels' column)")
+    # the structure mass is typed in g here: the refusal named the options field in kg
+    # ("structure_mass_kg 280 kg") for 280000 typed in 'structure mass [g]'
+    text = re.sub(r"structure_mass_kg (\S+) kg",
+                  lambda m: f"structure mass [g] {float(m[1]) * 1e3:g} g", text)
     return text
 
 

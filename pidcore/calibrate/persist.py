@@ -7,6 +7,7 @@ reports and the app (which then survive a restart and travel with the store's DE
   store: its whole ``calibration.json`` and calibrated specimen file, and a listing record;
 * :func:`stored_calibrations`: every calibration of a store, newest first, as
   :class:`~pidcore.calibrate.prediction.Calibration`;
+* :func:`readable_calibrations`: those that can be read, and what is wrong with the others;
 * :func:`stored_calibration`: one of them, by key (a store holding one needs none);
 * :func:`is_store_file`: whether a ``--calibration`` path names a store rather than a JSON file.
 """
@@ -114,6 +115,27 @@ def stored_calibrations(store_path: str | os.PathLike) -> list[Calibration]:
     store = Store(path)
     listing = store.list_calibrations()
     return [_calibration(store, key) for key in reversed(list(listing["key"]))]
+
+
+def readable_calibrations(store_path: str | os.PathLike) -> tuple[list[Calibration], list[str]]:
+    """Every calibration of ``store_path`` that can be read, newest first, and a one-line
+    problem per one that cannot (a damaged entry): one damaged calibration does not hide the
+    store's others, as :func:`stored_calibrations` (which raises on the first) would."""
+    from ..errors import PidcoreError
+    from ..store import Store
+
+    path = Path(store_path)
+    if not path.is_file():
+        return [], []
+    store = Store(path)
+    found: list[Calibration] = []
+    problems: list[str] = []
+    for key in reversed(list(store.list_calibrations()["key"])):
+        try:
+            found.append(_calibration(store, key))
+        except PidcoreError as exc:
+            problems.append(str(exc))
+    return found, problems
 
 
 def stored_calibration(store_path: str | os.PathLike, key: str | None = None) -> Calibration:

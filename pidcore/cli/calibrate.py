@@ -190,8 +190,9 @@ def _saved_words(saved: tuple[str, bool] | None, store: Path) -> str:
     if saved is None:
         return f"; the calibration was not saved in {store}"
     key, added = saved
-    if added:
-        return f"; saved calibration {key} in {store} (report --calibration {store})"
+    if added:  # the key in the command: it still reads this one once the store holds more
+        return (f"; saved calibration {key} in {store} (report --calibration {store} "
+                f"--calibration-key {key})")
     return f"; calibration {key} is stored in {store} already (the same result)"
 
 

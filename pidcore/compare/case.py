@@ -349,8 +349,14 @@ def describe_corrections(parameters: dict) -> str:
     delay = float(parameters.get("velocity_delay_s", 0.0) or 0.0) * 1e6
     mass = float(parameters.get("mass_below_gauge_kg", 0.0) or 0.0) * 1e3
     baseline = float(parameters.get("baseline_loss_factor", 0.0) or 0.0)
+    # how the baseline went off: of the structure's own reactive power, or of the whole
+    # (too much); two records of one baseline differ by that, and read the same without it
+    structure_kg = float(parameters.get("structure_mass_kg") or 0.0)
+    how = ("" if baseline <= 0 else
+           f" (of a structure mass {structure_kg * 1e3:g} g)" if structure_kg > 0
+           else " (off the whole vibrated mass)")
     return (f"vibrometer delay {delay:g} µs, mass below gauge {mass:g} g, "
-            f"baseline loss factor {baseline:g}")
+            f"baseline loss factor {baseline:g}{how}")
 
 
 def compare_case(records: Sequence[MeasuredEntry],

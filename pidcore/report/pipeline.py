@@ -416,6 +416,25 @@ def unsubtracted_baseline_note(specimen, analyses: pd.DataFrame | None) -> str:
             "baseline_loss_factor and structure_mass_g) to subtract it")
 
 
+def whole_mass_baseline_note(settings: Iterable[Mapping | None]) -> str:
+    """The note for measured records whose baseline loss factor was subtracted off the whole
+    vibrated mass (no structure mass given): ``settings`` are each record's analysis
+    parameters (stored ``parameters_json``, or an analysis's ``corrections``); "" where none
+    was. ``pidcore analyze`` says it per file; the report compared such an SDC, too low by
+    the baseline x the particles' share of the vibrated mass, with the DEM without a word."""
+    count = sum(1 for s in settings
+                if s and float(s.get("baseline_loss_factor") or 0.0) > 0
+                and not s.get("structure_mass_kg"))
+    if not count:
+        return ""
+    return (f"{count} measured record(s) had the baseline loss factor subtracted as if the "
+            "whole vibrated mass were the empty structure's (no structure mass given): too "
+            "much by the baseline x the particles' share of that mass, so their SDC is low by "
+            "2 pi x that; give the structure's mass (coupon and fixture above the gauge: "
+            "--structure-mass KG, a structure_mass_g column, the app's structure mass [g]) "
+            "for the exact subtraction")
+
+
 @dataclass(frozen=True)
 class SpecimenTable:
     """What :func:`specimen_report_table` built: the table (notes in ``attrs["notes"]``), the
@@ -463,6 +482,12 @@ def specimen_report_table(stored_runs: pd.DataFrame | None, analyses: pd.DataFra
     baseline = unsubtracted_baseline_note(specimen, analyses)
     if baseline:
         notes.append(baseline)
+    if analyses is not None and "parameters_json" in analyses.columns:
+        from ..compare.align import stored_parameters as parsed
+
+        whole = whole_mass_baseline_note(parsed(p) for p in analyses["parameters_json"])
+        if whole:
+            notes.append(whole)
     if specimen is not None and not pool:
         # every DEM row is this specimen's (runs_of_specimen) and the files of its particle
         # material are its tests; a measurement of another material cannot be (its specimen
@@ -710,6 +735,10 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
                              "not in the table (re-run with the files and --fill)")
     else:
         analyses = measured_frame(results)
+        # not stored: the analyses' own corrections say how the baseline went off
+        whole = whole_mass_baseline_note(r.analyzed.analysis.corrections for r in results)
+        if whole:
+            notes.append(whole)
 
     dem_runs = _joined_dem_runs(dems)
     if not results:  # the stored records' own settings, not the unused options' defaults

@@ -640,7 +640,9 @@ def _structure_share(structure_mass_kg: float | None, baseline_loss_factor: floa
         raise ParameterError(
             f"{source or 'record'}: structure_mass_kg {structure_mass_kg:g} kg is {share:.3g} "
             f"times the vibrated mass the measurement shows ({vibrated_kg:.4g} kg from Im(P_c)); "
-            "expected the empty coupon and fixture above the gauge in kg (was it in g?)")
+            "expected the empty coupon and fixture above the gauge: in kg as --structure-mass "
+            "(was it in g?), in g in a structure_mass_g column and the app's structure mass [g] "
+            "(was it in mg?)")
     note = (f"baseline: the empty structure ({structure_mass_kg:.4g} kg) holds {share:.3g} of "
             f"the reactive power (vibrated mass {vibrated_kg:.4g} kg); baseline loss factor "
             f"{baseline_loss_factor:g} x {share:.3g} subtracted")

@@ -116,14 +116,16 @@ def _saved(stores) -> None:
     """The calibrations saved in the store (they outlive a restart of the app; the Compare
     and Report tabs use them, newest first), each file offered for download."""
     from pidcore.app.calibration import saved_calibrations_table
-    from pidcore.calibrate.persist import stored_calibrations
+    from pidcore.calibrate.persist import readable_calibrations
     from pidcore.errors import PidcoreError
 
-    try:
-        saved = stored_calibrations(stores.path)
+    try:  # a damaged calibration is said, and does not hide the others
+        saved, damaged = readable_calibrations(stores.path)
     except PidcoreError as exc:
         st.caption(f"Calibrations of the store not shown: {exc}")
         return
+    for problem in damaged:
+        st.caption(f"Calibration of the store not shown: {problem}")
     if not saved:
         return
     st.markdown("**Calibrations saved in this store** (newest first; Compare and Report use "

@@ -14,11 +14,12 @@ DEFAULT_SPECIMEN = "paper_coupon (the default)"
 def render(stores, calibrations: list) -> None:
     """The page. ``calibrations``: [(calibration or None, label)], as the Compare tab's; the
     calibrated columns show the one chosen (the first by default)."""
-    from pidcore.app.calibration import calibration_digest
+    from pidcore.app.calibration import calibration_digest, default_calibration_index
     from pidcore.app.workbench import report_display
     from pidcore.compare.specimens import run_specimens
     from pidcore.errors import PidcoreError
     from pidcore.report.downloads import report_files
+    from pidcore.specimen import PAPER_SPECIMEN_NAME
 
     st.subheader("Report (Table 3 style)")
     stamp = stores.stamp()
@@ -36,17 +37,6 @@ def render(stores, calibrations: list) -> None:
                             "specimen)")
     keys = (tuple(saved[saved["file"].isin(chosen)]["key"]) if chosen and not saved.empty
             else None)
-    # the calibration the Compare tab shows, in the same columns as `pidcore report
-    # --calibration`
-    usable = [(c, text) for c, text in calibrations if c is not None]
-    calibration, label = usable[0] if usable else calibrations[0]
-    if len(usable) > 1:  # e.g. this store's steel calibration and the paper's bundled one
-        labels = [text for _, text in usable]
-        chosen_label = st.selectbox("calibration for the calibrated DEM columns", labels,
-                                    key="report_calibration")
-        calibration, label = usable[labels.index(chosen_label)] \
-            if chosen_label in labels else usable[0]
-    digest = calibration_digest(calibration)
     # the DEM runs of one specimen, as `pidcore report [--specimen FILE]` compares them; the
     # others are left out and named in the notes
     try:
@@ -62,6 +52,21 @@ def render(stores, calibrations: list) -> None:
                                       help="as `pidcore report --specimen FILE`: the runs of "
                                            "other specimens are left out, the notes name them")
     specimen = others.get(specimen_label)
+    # the calibration the Compare tab shows, in the same columns as `pidcore report
+    # --calibration`: by default the newest that speaks for the specimen reported
+    usable = [(c, text) for c, text in calibrations if c is not None]
+    calibration, label = usable[0] if usable else calibrations[0]
+    if len(usable) > 1:  # e.g. this store's steel calibration and the paper's bundled one
+        labels = [text for _, text in usable]
+        default = default_calibration_index(
+            usable, PAPER_SPECIMEN_NAME if specimen is None else specimen.name)
+        # a choice per specimen reported: another specimen starts at its own default
+        chosen_label = st.selectbox("calibration for the calibrated DEM columns", labels,
+                                    index=default,
+                                    key=f"report_calibration_{specimen_label}")
+        calibration, label = usable[labels.index(chosen_label)] \
+            if chosen_label in labels else usable[default]
+    digest = calibration_digest(calibration)
     try:
         table = state.report_table(stamp, pool, keys, digest, specimen_label, stores,
                                    calibration, specimen)
