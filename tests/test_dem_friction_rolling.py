@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 import pytest
+from _incline import Incline
 
 from pidcore.constants import STANDARD_GRAVITY as G
 from pidcore.dem.contact import ContactLaw, capped_spring
@@ -16,25 +17,6 @@ from pidcore.dem.simulate import settle_bed
 from pidcore.dem.state import CellsState, KernelSettings, advance, energies
 
 DT = 1.0e-6  # > 15 steps per contact for acrylic at <= 1 m/s
-
-
-class _Incline:
-    """A plane through the origin tilted by ``theta`` about y (the other walls 1 m away).
-
-    Down-slope direction t = (cos th, 0, -sin th); inward normal n = (sin th, 0, cos th).
-    """
-
-    def __init__(self, theta: float):
-        base = CellGeometry()
-        normals = base.wall_normals.copy()
-        normals[6] = [math.sin(theta), 0.0, math.cos(theta)]
-        self.wall_normals = np.ascontiguousarray(normals)
-        self.wall_offsets = np.array([1.0] * 6 + [0.0, 1.0])
-        self.normal = normals[6]
-        self.down = np.array([math.cos(theta), 0.0, -math.sin(theta)])
-
-    def signed_distances(self, points):
-        return np.asarray(points) @ self.wall_normals.T + self.wall_offsets
 
 
 def _law(sliding, static, rolling=0.0, *, frozen=False, model="constant", damping_ratio=0.0):
@@ -54,7 +36,7 @@ def _on_incline(law, theta, v0=0.0, spin=0.0, preload=False):
     put down gently; without it gravity is a step load and the undamped spring overshoots to
     twice the static force).
     """
-    plane = _Incline(theta)
+    plane = Incline(theta)
     delta = (law.mass_kg * G * math.cos(theta) / law.pair_wall.stiffness) ** (2 / 3)
     state = CellsState.from_positions(((law.radius_m - delta) * plane.normal)[None, None, :],
                                       mass_kg=law.mass_kg)

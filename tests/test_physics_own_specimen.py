@@ -17,6 +17,7 @@ import math
 
 import numpy as np
 import pytest
+from _incline import Incline
 from scipy.integrate import solve_ivp
 
 from pidcore.cli import main
@@ -203,25 +204,10 @@ def test_free_flight_is_a_parabola():
     np.testing.assert_array_equal(state.omg[:, 0, 0], [100.0, 0.0, 0.0])
 
 
-class _Incline:
-    """The floor tilted by ``theta`` about y (the other walls 1 m away); down-slope ``down``."""
-
-    def __init__(self, theta: float):
-        normals = CellGeometry().wall_normals.copy()
-        normals[6] = [math.sin(theta), 0.0, math.cos(theta)]
-        self.wall_normals = np.ascontiguousarray(normals)
-        self.wall_offsets = np.array([1.0] * 6 + [0.0, 1.0])
-        self.normal = normals[6]
-        self.down = np.array([math.cos(theta), 0.0, -math.sin(theta)])
-
-    def signed_distances(self, points):
-        return np.asarray(points) @ self.wall_normals.T + self.wall_offsets
-
-
 def _resting(law, theta: float, *, v0: float = 0.0, rolling: bool = False):
     """One sphere at its static Hertz overlap on the incline, its tangential spring holding the
     weight's down-slope part (a sphere put down gently), moving down-slope at ``v0``."""
-    plane = _Incline(theta)
+    plane = Incline(theta)
     k_n = law.pair_wall.stiffness
     overlap = (law.mass_kg * G0 * math.cos(theta) / k_n) ** (2 / 3)
     state = CellsState.from_positions(((law.radius_m - overlap) * plane.normal)[None, None, :],
