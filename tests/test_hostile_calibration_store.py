@@ -126,3 +126,16 @@ def test_the_calibrate_tab_lists_a_count_that_is_not_one_as_stored(sound_store, 
     cell = saved_calibrations_table(store)["load cases [-]"].iloc[0]
     assert cell == f"{value!r} (not a count)"
     assert saved_calibrations_table(sound_store)["load cases [-]"].iloc[0] == 12
+
+
+def test_verify_names_a_key_the_store_would_refuse(sound_store, tmp_path):
+    """A second entry under a key with a tab (copied by hand): readers refuse that key, and
+    verify called the store sound."""
+    store = tmp_path / "odd_key.h5"
+    store.write_bytes(sound_store.read_bytes())
+    with h5py.File(store, "r+") as h5:
+        h5["calibrations"].copy(KEY, "odd key\t")
+    problems = Store(store).verify()
+    assert len(problems) == 1 and "'odd key\\t' is not valid" in problems[0], problems
+    readable, damaged = readable_calibrations(store)
+    assert [c.store_key for c in readable] == [KEY] and len(damaged) == 1

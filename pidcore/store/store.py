@@ -1000,6 +1000,13 @@ class Store:
                 for key in h5[section]:
                     where = f"{self.path}:/{section}/{key}"
                     try:
+                        # a key no add_* accepts (a tab, surrounding spaces) is one get_*
+                        # refuses: verify called such a store sound
+                        check_name(key, what="key", where=f"{self.path}:/{section}")
+                    except StoreError as exc:
+                        problems.append(str(exc))
+                        continue
+                    try:
                         problems += self._verify_entry(h5, section, key, where)
                     except Exception as exc:  # report any damage; verify must never crash
                         problems.append(f"{where}: unreadable ({type(exc).__name__}: {exc})")
