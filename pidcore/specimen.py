@@ -485,6 +485,9 @@ class Specimen:
             data = tomllib.loads(text)
         except tomllib.TOMLDecodeError as exc:
             raise ParameterError(f"{source}: not valid TOML ({exc})") from None
+        except RecursionError:  # tomllib parses nested arrays/tables recursively
+            raise ParameterError(f"{source}: not a specimen file (arrays or tables nested "
+                                 "too deeply for TOML to be read)") from None
         try:
             return _from_mapping(data, source=source)
         except ParameterError as exc:

@@ -109,3 +109,16 @@ def test_vibrated_mass_counts_fixture_coupon_and_particles():
                                                   rel=1e-15)
     assert s.vibrated_mass_kg(n, "coupon") == pytest.approx(PAPER.coupon.mass_kg + 0.5)
     assert s.vibrated_mass_kg(n, "particles") == pytest.approx(particles)
+
+
+def test_a_specimen_file_nested_past_the_stack_is_one_line(tmp_path, capsys):
+    """tomllib parses nested arrays recursively: a file of 100 000 '[' was a RecursionError
+    traceback (dem run --specimen, the app's upload, a job journal's specimen)."""
+    from pidcore.cli import main
+
+    deep = tmp_path / "deep.toml"
+    deep.write_text("a = " + "[" * 100_000)
+    code = main(["dem", "run", "--specimen", str(deep), "--freq", "500", "--accel", "5"])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and len(err.splitlines()) == 1 and str(deep) in err, err
+    assert "nested too deeply" in err

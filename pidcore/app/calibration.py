@@ -13,6 +13,7 @@ are cached in the store, so a calibration started again reuses them.
 from __future__ import annotations
 
 import importlib
+import math
 import tempfile
 import threading
 import time
@@ -313,8 +314,20 @@ def saved_calibrations_table(store_path: str | Path):
     table = table.astype(object).where(table.notna(), "")
     for column in ("load cases [-]", "inside 95 % band (LOO) [-]"):  # counts, not 10.0
         if column in table.columns:
-            table[column] = [v if v == "" else int(v) for v in table[column]]
+            table[column] = [_count_cell(v) for v in table[column]]
     return table
+
+
+def _count_cell(value: object) -> object:
+    """A stored count as a whole number; blank stays blank; anything else (a damaged record:
+    text, inf, an array) is shown as stored, said, not raised: int() of it ended the page in a
+    traceback."""
+    if isinstance(value, str) and value == "":
+        return ""
+    if isinstance(value, int | float) and not isinstance(value, bool) \
+            and math.isfinite(value) and value == int(value):
+        return int(value)
+    return f"{value!r} (not a count)"
 
 
 def available_calibrations(task: CalibrationTask | None,

@@ -27,6 +27,7 @@ import dataclasses
 import json
 import math
 import os
+import re
 import secrets
 import threading
 import time
@@ -465,9 +466,31 @@ def journal_path(store_path: str | Path) -> Path:
     return path.with_name(path.name + JOURNAL_SUFFIX)
 
 
+#: A job id as the runner makes them (``job0001``): ASCII digits only (``str.isdigit`` also
+#: takes "job²", which int() refuses, and 5000 digits are past int()'s limit).
+_JOB_ID = re.compile(r"job[0-9]{4,18}")
+
+
 def _job_number(job_id: str) -> int:
-    digits = job_id.removeprefix("job")
-    return int(digits) if digits.isdigit() else 0
+    return int(job_id[3:]) if _JOB_ID.fullmatch(job_id) else 0
+
+
+def _time_s(value: object, name: str) -> float | None:
+    """A journal's time stamp: None (not yet) or a finite number of seconds since the epoch
+    (a text there made every row of the job table a TypeError)."""
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, int | float) \
+            or not math.isfinite(value):
+        raise ValueError(f"{name} must be a time in s or null, got {value!r}")
+    return float(value)
+
+
+def _count(value: object, name: str) -> int:
+    """A journal's cycle count: a whole number >= 0 (inf was an OverflowError traceback)."""
+    if isinstance(value, bool) or not isinstance(value, int) or value < 0:
+        raise ValueError(f"{name} must be a whole number >= 0, got {value!r}")
+    return value
 
 
 def _job_document(job: DemJob) -> dict:
@@ -499,15 +522,23 @@ def _job_from_document(doc: dict) -> DemJob:
     from ..loadcase import LoadCase
     from ..specimen import Specimen
 
+    job_id = doc["job_id"]
+    if not isinstance(job_id, str) or not _JOB_ID.fullmatch(job_id):
+        raise ValueError(f"job id {job_id!r} is not one the app writes (job0001)")
     spec = doc["specimen"]
     specimen = None if spec is None else Specimen.from_text(spec["text"],
                                                             source=str(spec["source"]))
-    job = DemJob(str(doc["job_id"]), LoadCase(**doc["case"]), DemConfig(**doc["config"]),
+    submitted = _time_s(doc["submitted"], "submitted")
+    if submitted is None:
+        raise ValueError("submitted must be a time in s, got null")
+    job = DemJob(job_id, LoadCase(**doc["case"]), DemConfig(**doc["config"]),
                  str(doc["run_key"]), specimen, state=str(doc["state"]),
-                 submitted=float(doc["submitted"]), started=doc["started"],
-                 finished=doc["finished"], cycles_done=int(doc["cycles_done"]),
-                 cycles_expected=int(doc["cycles_expected"]), message=str(doc["message"]),
-                 same_as=str(doc["same_as"]))
+                 submitted=submitted,
+                 started=_time_s(doc["started"], "started"),
+                 finished=_time_s(doc["finished"], "finished"),
+                 cycles_done=_count(doc["cycles_done"], "cycles_done"),
+                 cycles_expected=_count(doc["cycles_expected"], "cycles_expected"),
+                 message=str(doc["message"]), same_as=str(doc["same_as"]))
     if job.state not in JOB_STATES:
         raise ValueError(f"unknown job state {job.state!r}")
     if job.state in ("queued", "running", SAME_RUN_STATE):
@@ -525,7 +556,9 @@ def read_journal(path: Path) -> tuple[list[DemJob], str]:
     replaced by the next change)."""
     if not path.is_file():
         return [], ""
-    unreadable = (OSError, ValueError, TypeError, KeyError, AttributeError, PidcoreError)
+    # RecursionError: JSON nested deeper than Python's stack (json.loads is recursive)
+    unreadable = (OSError, ValueError, TypeError, KeyError, AttributeError, RecursionError,
+                  PidcoreError)
     try:
         doc = json.loads(path.read_text(encoding="utf-8"))
         if not isinstance(doc, dict) or doc.get("pidcore_jobs_version") != _JOURNAL_VERSION \
@@ -537,13 +570,19 @@ def read_journal(path: Path) -> tuple[list[DemJob], str]:
                     f"({type(exc).__name__}: {exc}); its saved runs are in the store")
     # job by job: one that cannot be rebuilt (a specimen file this version refuses) costs
     # its own row, not the table
-    found, lost = [], []
+    found: list[DemJob] = []
+    lost = []
     for number, entry in enumerate(doc["jobs"], start=1):
         try:
-            found.append(_job_from_document(entry))
+            job = _job_from_document(entry)
+            if any(j.job_id == job.job_id for j in found):
+                # Cancel and the jobs waiting for a run name a job by its id
+                raise ValueError(f"job id {job.job_id} listed twice")
+            found.append(job)
         except unreadable as exc:
             name = entry.get("job_id") if isinstance(entry, dict) else None
-            lost.append(f"{name or f'entry {number}'} ({type(exc).__name__}: {exc})")
+            lost.append(f"{str(name)[:40] if name else f'entry {number}'} "
+                        f"({type(exc).__name__}: {str(exc)[:200]})")
     if not lost:
         return found, ""
     return found, (f"{len(lost)} job(s) of the job table of the last run of the app ({path}) "

@@ -339,6 +339,9 @@ def calibration_from_json(text: str | bytes, source: str | os.PathLike, *,
     except (UnicodeDecodeError, json.JSONDecodeError) as exc:
         raise ParameterError(f"{path}: not a calibration.json of pidcore calibrate "
                              f"(not JSON: {exc})") from None
+    except RecursionError:  # json.loads is recursive: "[[[[..." a traceback before
+        raise ParameterError(f"{path}: not a calibration.json of pidcore calibrate (JSON "
+                             "nested too deeply to be read)") from None
     if not isinstance(doc, dict) or not isinstance(doc.get("predictions"), list) \
             or not isinstance(doc.get("parameters"), dict) or not doc["predictions"]:
         raise ParameterError(f"{path}: not a calibration.json of pidcore calibrate (expected "
@@ -367,7 +370,11 @@ def calibration_from_json(text: str | bytes, source: str | os.PathLike, *,
         if measured_stderr < 0:  # NaN (not stated) passes
             raise ParameterError(f"{path}: predictions[{i}].measured_stderr must be a standard "
                                  f"error >= 0, got {measured_stderr!r}")
-        predictions.append(CalibratedPrediction(LoadCase(f, a, fill, str(material)), sdc, low,
-                                                high, measured, measured_stderr, low0, high0))
+        try:
+            case = LoadCase(f, a, fill, str(material))
+        except ParameterError as exc:  # said without the file and row before
+            raise ParameterError(f"{path}: predictions[{i}]: {exc}") from None
+        predictions.append(CalibratedPrediction(case, sdc, low, high, measured,
+                                                measured_stderr, low0, high0))
     return Calibration(path=path, parameters=doc["parameters"], predictions=tuple(predictions),
                        specimen_name=specimen_name)

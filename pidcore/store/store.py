@@ -235,14 +235,28 @@ def _write_entry(parent: h5py.Group, key: str, entry: _PreparedEntry, *, layout:
         dataset.attrs["unit"] = entry.units.get(name, "")
 
 
-def _read_entry(group: h5py.Group, key: str) -> StoredEntry:
-    attrs = {name: from_attribute(value) for name, value in group.attrs.items()}
-    nulls = set(json.loads(_text(group.attrs.get("null_fields_json", "[]"))))
-    record = {name: (None if name in nulls else from_attribute(value))
-              for name, value in group["record"].attrs.items()}
-    units = {name: _text(value) for name, value in group["units"].attrs.items()}
-    arrays = {name: dataset[()] for name, dataset in group["arrays"].items()}
-    parameters = json.loads(_text(group.attrs.get("parameters_json", "{}")))
+def _read_entry(group: h5py.Group, key: str, *, where: str) -> StoredEntry:
+    """The entry ``group`` as written by :func:`_write_entry`; one damaged in its layout (a
+    subgroup missing, a JSON attribute that is not JSON, a record field that is not a scalar,
+    a dangling soft link) is a one-line :class:`StoreError` naming ``where``: a KeyError or
+    JSONDecodeError traceback before (report --calibration, the app's Compare page)."""
+    try:
+        attrs = {name: from_attribute(value) for name, value in group.attrs.items()}
+        nulls = set(json.loads(_text(group.attrs.get("null_fields_json", "[]"))))
+        record = {name: (None if name in nulls else from_attribute(value))
+                  for name, value in group["record"].attrs.items()}
+        units = {name: _text(value) for name, value in group["units"].attrs.items()}
+        arrays = {name: dataset[()] for name, dataset in group["arrays"].items()}
+        parameters = json.loads(_text(group.attrs.get("parameters_json", "{}")))
+    except (KeyError, TypeError, ValueError, AttributeError, RecursionError) as exc:
+        raise StoreError(f"{where}: damaged entry ({type(exc).__name__}: "
+                         f"{_one_line(exc)[:200]})") from None
+    odd = [name for name, value in record.items()
+           if value is not None and not isinstance(value, str | int | float | complex)]
+    if odd or not isinstance(parameters, dict):
+        what = f"record field {odd[0]!r} is not a scalar" if odd else \
+            "parameters_json is not a JSON object"
+        raise StoreError(f"{where}: damaged entry ({what})")
     return StoredEntry(key=key, record=record, arrays=arrays, parameters=parameters, attrs=attrs,
                        units=units)
 
@@ -253,7 +267,8 @@ def calibration_texts(entry: StoredEntry) -> tuple[str, str]:
     out = []
     for name in (CALIBRATION_DOCUMENT, CALIBRATION_SPECIMEN):
         array = entry.arrays.get(name)
-        if array is None or array.dtype != np.uint8 or array.ndim != 1:
+        # an HDF5 string dataset reads back as bytes, not an array
+        if not isinstance(array, np.ndarray) or array.dtype != np.uint8 or array.ndim != 1:
             raise StoreError(f"{where}: array {name} missing or not UTF-8 bytes")
         try:
             out.append(array.tobytes().decode("utf-8"))
@@ -263,13 +278,18 @@ def calibration_texts(entry: StoredEntry) -> tuple[str, str]:
 
 
 def _calibration_text_problems(entry: StoredEntry, where: str) -> list[str]:
+    """What makes the calibration unreadable, checked as reports read it (a NaN prediction
+    or a negative frequency passed verify, then report --calibration refused it)."""
+    from ..calibrate.prediction import calibration_from_json
+
     try:
         document, _ = calibration_texts(entry)
-        parsed = json.loads(document)
-    except (StoreError, json.JSONDecodeError) as exc:
+    except StoreError as exc:
         return [f"{where}: {exc}"]
-    if not isinstance(parsed, dict) or "predictions" not in parsed:
-        return [f"{where}: {CALIBRATION_DOCUMENT} is not a calibration.json (no predictions)"]
+    try:
+        calibration_from_json(document, where)
+    except ParameterError as exc:
+        return [str(exc)]
     return []
 
 
@@ -715,7 +735,8 @@ class Store:
         """The analysis stored under ``key``."""
         check_name(key, what="analysis key", where=str(self.path))
         with self._reading() as h5:
-            return _read_entry(self._entry_group(h5, _ANALYSES, key, "analysis"), key)
+            group = self._entry_group(h5, _ANALYSES, key, "analysis")
+            return _read_entry(group, key, where=f"{self.path}:{group.name}")
 
     def list_analyses(self) -> pd.DataFrame:
         """One row per analysis: key, measurement_key, source, created_utc, every scalar field,
@@ -815,7 +836,8 @@ class Store:
         """The DEM run stored under ``case_key``."""
         check_name(case_key, what="DEM case key", where=str(self.path))
         with self._reading() as h5:
-            return _read_entry(self._entry_group(h5, _DEM_RUNS, case_key, "DEM run"), case_key)
+            group = self._entry_group(h5, _DEM_RUNS, case_key, "DEM run")
+            return _read_entry(group, case_key, where=f"{self.path}:{group.name}")
 
     def list_dem_runs(self) -> pd.DataFrame:
         """One row per DEM run: case_key, created_utc, every scalar field, parameters_json,
@@ -884,7 +906,8 @@ class Store:
         """The calibration stored under ``key`` (its texts: :func:`calibration_texts`)."""
         check_name(key, what="calibration key", where=str(self.path))
         with self._reading() as h5:
-            return _read_entry(self._entry_group(h5, _CALIBRATIONS, key, "calibration"), key)
+            group = self._entry_group(h5, _CALIBRATIONS, key, "calibration")
+            return _read_entry(group, key, where=f"{self.path}:{group.name}")
 
     def list_calibrations(self) -> pd.DataFrame:
         """One row per calibration: key, created_utc, every scalar field, parameters_json,
@@ -977,6 +1000,13 @@ class Store:
                 for key in h5[section]:
                     where = f"{self.path}:/{section}/{key}"
                     try:
+                        # a key no add_* accepts (a tab, surrounding spaces) is one get_*
+                        # refuses: verify called such a store sound
+                        check_name(key, what="key", where=f"{self.path}:/{section}")
+                    except StoreError as exc:
+                        problems.append(str(exc))
+                        continue
+                    try:
                         problems += self._verify_entry(h5, section, key, where)
                     except Exception as exc:  # report any damage; verify must never crash
                         problems.append(f"{where}: unreadable ({type(exc).__name__}: {exc})")
@@ -1012,7 +1042,10 @@ class Store:
                      for name in ("record", "units", "arrays") if name not in group]
         if problems:
             return problems
-        entry = _read_entry(group, key)  # reads every array, so checksums are checked
+        try:  # reads every array, so checksums are checked
+            entry = _read_entry(group, key, where=where)
+        except StoreError as exc:
+            return [*problems, str(exc)]
         if section == _ANALYSES:
             measurement_key = _text(group.attrs.get("measurement_key", ""))
             if measurement_key not in h5.get(_MEASUREMENTS, {}):

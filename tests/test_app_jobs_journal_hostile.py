@@ -1,0 +1,83 @@
+"""A crafted ``<store>.jobs.json`` (:mod:`pidcore.app.jobs`): every entry the runner cannot
+trust costs its own row, said in the runner's note, never a traceback, and nothing runs
+without Resubmit. Before: JSON or a specimen's TOML nested past Python's stack, a job id
+``job²`` or of 5000 digits and a cycle count of Infinity ended the runner's start (the app's
+DEM tab) in a traceback; a started/finished time that was text did so on the first row drawn;
+two jobs of one id were both listed (Cancel names a job by its id)."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+
+import pytest
+
+from pidcore.app import jobs
+from pidcore.dem import DemConfig
+from pidcore.loadcase import LoadCase
+
+CASE = LoadCase(500.0, 5.0, 50.0, "acrylic", "z")
+CONFIG = DemConfig(cells=1, steady_cycles=10)
+
+
+def _entry(**changes) -> dict:
+    """A journal entry as the runner writes it (a finished job), with ``changes``."""
+    entry = {"job_id": "job0001", "state": "saved", "run_key": "k", "submitted": 1.0,
+             "started": 2.0, "finished": 3.0, "cycles_done": 10, "cycles_expected": 10,
+             "message": "", "same_as": "", "case": dataclasses.asdict(CASE),
+             "config": dataclasses.asdict(CONFIG), "specimen": None}
+    return {**entry, **changes}
+
+
+def _journal(tmp_path, text: str):
+    store = tmp_path / "app.h5"
+    jobs.journal_path(store).write_text(text)
+    return store
+
+
+def _runner_rows(store):
+    """The runner's jobs and note, and the table's rows drawn (as the DEM tab does)."""
+    runner = jobs.DemJobRunner(store)
+    listed = runner.jobs()
+    rows = [j.row() for j in listed]
+    assert not runner.busy()  # nothing runs without Resubmit
+    return listed, rows, runner.journal_problem
+
+
+DAMAGED = {
+    "job id with a superscript digit": {"job_id": "job\u00b2"},
+    "job id of 5000 digits": {"job_id": "job" + "9" * 5000},
+    "job id not a string": {"job_id": 7},
+    "cycles Infinity": {"cycles_done": float("inf")},
+    "negative cycles": {"cycles_done": -5},
+    "started is text": {"started": "yesterday"},
+    "finished is a list": {"finished": [1]},
+    "started NaN": {"started": float("nan")},
+    "specimen TOML nested too deeply": {"specimen": {"text": "a = " + "[" * 100_000,
+                                                     "source": "deep.toml"}},
+}
+
+
+@pytest.mark.parametrize("name", list(DAMAGED))
+def test_a_damaged_entry_costs_its_row_with_a_note(tmp_path, name):
+    good = _entry(job_id="job0002")
+    store = _journal(tmp_path, json.dumps({"pidcore_jobs_version": 1, "jobs": [
+        _entry(**DAMAGED[name]), good]}))
+    listed, rows, note = _runner_rows(store)
+    assert [j.job_id for j in listed] == ["job0002"] and len(rows) == 1
+    assert "1 job(s)" in note and "cannot be read" in note
+
+
+def test_json_nested_past_the_stack_is_an_empty_table_with_a_note(tmp_path):
+    store = _journal(tmp_path, '{"pidcore_jobs_version": 1, "jobs": ['
+                     + "[" * 100_000 + "]" * 100_000 + "]}")
+    listed, _, note = _runner_rows(store)
+    assert listed == [] and "cannot be read" in note and "RecursionError" in note
+
+
+def test_a_job_id_listed_twice_keeps_the_first(tmp_path):
+    store = _journal(tmp_path, json.dumps({"pidcore_jobs_version": 1, "jobs": [
+        _entry(state="saved"), _entry(state="queued")]}))
+    listed, _, note = _runner_rows(store)
+    assert [(j.job_id, j.state) for j in listed] == [("job0001", "saved")]
+    assert "job0001" in note and "listed twice" in note
