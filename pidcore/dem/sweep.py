@@ -98,12 +98,12 @@ class CaseOutcome:
     parameters: dict
     units: dict
 
-    def save_to(self, store) -> str:
+    def save_to(self, store) -> bool:
         """Add this run to ``store`` unless stored already (:func:`~.persist.save_dem_entry`);
-        returns its key."""
-        save_dem_entry(store, self.key, {"record": self.record, "arrays": self.arrays,
-                                         "parameters": self.parameters, "units": self.units})
-        return self.key
+        True if this call added it (False: another process stored it meanwhile)."""
+        return save_dem_entry(store, self.key, {"record": self.record, "arrays": self.arrays,
+                                                "parameters": self.parameters,
+                                                "units": self.units})
 
 
 def run_case(case: LoadCase, config: DemConfig,
@@ -278,10 +278,14 @@ def _stop_pool(pool) -> None:
         process.join()
 
 
+#: Status of a case another process (a second sweep on the same store) stored while this
+#: sweep ran: this sweep's run of it, if it made one, was not saved.
+STORED_MEANWHILE = "stored meanwhile by another process"
 #: How a sweep got each case's run (:attr:`SweepSummary.cases`).
 SWEEP_CASE_STATUSES = ("simulated", "already stored",
                        "same simulation as a stored run",
-                       "same simulation as another case of this sweep")
+                       "same simulation as another case of this sweep",
+                       STORED_MEANWHILE)
 #: Result fields of each case in :meth:`SweepSummary.to_dict`, named (units as suffixes) as
 #: ``pidcore dem run --json`` names them, read from the stored run.
 SWEEP_CASE_FIELDS = ("sdc", "sdc_stderr", "loss_factor", "particles_per_cell",
@@ -417,19 +421,31 @@ def run_sweep(cases: Sequence[LoadCase], config: DemConfig, *,
                 f"a worker returned run {outcome.key}, which this sweep did not ask for (it "
                 f"asked for {len(asked)} run(s) such as {min(asked)}): the workers run "
                 f"another pidcore than this one ({__version__}); install the same on them")
-        outcome.save_to(store)
-        summary.completed.append(outcome.key)
+        if outcome.save_to(store):
+            summary.completed.append(outcome.key)
+        else:
+            _stored_meanwhile(summary, outcome.key)
         if bar is not None:
             bar.update(1)
             bar.set_postfix_str(outcome.key.split("_seed")[0])
         if on_case is not None:
             on_case(outcome)
 
+    def stored_now(key: str) -> bool:
+        """Whether another process stored ``key`` since the sweep began: its case is then
+        not simulated again (checked before each serial case)."""
+        if store.has_dem_run(key):
+            _stored_meanwhile(summary, key)
+            if bar is not None:
+                bar.update(1)
+            return True
+        return False
+
     try:
         if todo and scheduler:
             _run_dask(todo, config, scheduler, finish, specimen)
         elif todo:
-            _run_local(todo, config, workers, finish, specimen)
+            _run_local(todo, config, workers, finish, specimen, stored_now)
     finally:
         if bar is not None:
             bar.close()
@@ -438,15 +454,26 @@ def run_sweep(cases: Sequence[LoadCase], config: DemConfig, *,
     return summary
 
 
+def _stored_meanwhile(summary: SweepSummary, key: str) -> None:
+    """Count ``key`` as found stored (by another process while this sweep ran), not as
+    simulated and saved by this sweep."""
+    summary.skipped.append(key)
+    for case in summary.cases:
+        if case["store_key"] == key and case["status"] == "simulated":
+            case["status"] = STORED_MEANWHILE
+
+
 def _run_local(todo: Iterable[tuple[LoadCase, str]], config: DemConfig, workers: int | None,
-               finish: Callable[[CaseOutcome], None], specimen: Specimen | None) -> None:
+               finish: Callable[[CaseOutcome], None], specimen: Specimen | None,
+               stored_now: Callable[[str], bool] = lambda key: False) -> None:
     todo = list(todo)
     workers = workers or os.cpu_count() or 1
     if workers < 1:
         raise ParameterError(f"--workers: expected a positive number of processes, got {workers}")
     if workers == 1 or len(todo) == 1:
-        for case, _ in todo:
-            finish(run_case(case, config, specimen))
+        for case, key in todo:
+            if not stored_now(key):
+                finish(run_case(case, config, specimen))
         return
     # Ctrl-C or a failed case stops the workers; finished cases are already stored
     run_pooled(run_case, [(case, config, specimen) for case, _ in todo], workers=workers,
