@@ -1681,3 +1681,32 @@ def test_the_corrections_say_how_the_baseline_went_off():
     assert whole.endswith("baseline loss factor 0.0152 (off the whole vibrated mass)")
     # no baseline: the structure mass changes nothing and is not named
     assert describe_corrections({"structure_mass_kg": 0.28}).endswith("baseline loss factor 0")
+
+
+def test_compare_notes_a_saved_baseline_off_the_whole_vibrated_mass(tmp_path, good_csv,
+                                                                   options):
+    # the Report tab and `pidcore report` note a record whose baseline loss factor went off
+    # the whole vibrated mass (its SDC low); Compare showed the saved record without it
+    from dataclasses import replace
+
+    from pidcore.app.workbench import case_view, saved_entries
+    from pidcore.report.pipeline import whole_mass_baseline_note
+    from pidcore.store.listing import saved_analyses
+
+    whole = replace(options, baseline_loss_factor=0.01, structure_mass_kg=None)
+    exact = replace(options, baseline_loss_factor=0.01, structure_mass_kg=0.28)
+    for name, opts in (("whole.h5", whole), ("exact.h5", exact)):
+        store_file = tmp_path / name
+        rec = _record(good_csv, opts, name="a.csv")
+        uploads.save_records(store_file, [_file(rec, opts)])
+        (saved,) = saved_entries(store_file, saved_analyses(store_file))
+        notes = case_view([saved], None, paper_table(), ())["notes"]
+        # the same note, word for word, as the report's for the same stored settings
+        expected = whole_mass_baseline_note([vars(opts)])
+        assert bool(expected) == (opts is whole)
+        assert (expected in notes) if expected else not any(
+            "whole vibrated mass" in n for n in notes), notes
+        # the session's unsaved analysis says the same
+        unsaved = case_view([_entry(rec, options=opts)], None, paper_table(), ())["notes"]
+        assert ((expected in unsaved) if expected
+                else not any("whole vibrated mass" in n for n in unsaved))
