@@ -895,6 +895,34 @@ def test_unnamed_acrylic_measurements_still_meet_the_papers_coupon(good_csv, opt
     assert view["dem_specimen"] == "paper_coupon" and view["dem_refused"] == ""
 
 
+def test_a_calibrations_design_runs_do_not_hide_the_papers_coupon(good_csv, options):
+    # a calibration's store as the app's: beside the coupon's own runs, its design runs (the
+    # coupon's file with another rolling friction ..., named paper_coupon, another hash).
+    # Compare refused every case ("the DEM runs ... are of 2 specimens"; named paper_coupon:
+    # "2 different specimen files named paper_coupon"); `pidcore report` on the same store
+    # compares the paper's coupon and names the others left out: so does Compare now
+    from pidcore.app.workbench import case_view
+    from pidcore.specimen import paper_specimen
+
+    rec = _record(good_csv, options)
+    runs = pd.DataFrame({
+        "case_key": ["coupon", "design"], "frequency_hz": [100.0, 100.0],
+        "acceleration_g": [5.0, 5.0], "fill_percent": [50.0, 50.0],
+        "material": ["acrylic"] * 2, "direction": ["z"] * 2, "sdc": [0.20, 0.50],
+        "sdc_stderr": [0.01, 0.01], "specimen_name": ["paper_coupon"] * 2,
+        "specimen_sha256": [paper_specimen().hash, "c" * 64]})
+    for named in ("", "paper_coupon"):
+        view = case_view([_entry(rec, specimen=named)], runs, paper_table(), ())
+        assert view["headline"].dem == 0.20  # the coupon's run alone, not pooled
+        assert view["dem_specimen"] == "paper_coupon" and view["dem_refused"] == ""
+        (note,) = [n for n in view["notes"] if "other specimens" in n]
+        assert "paper_coupon [cccccc] (1 run(s))" in note and "design point" in note
+        assert "`specimen` column" in note  # how to choose another
+    # without the coupon's own runs the design run is still not taken for it silently
+    view = case_view([_entry(rec, specimen="paper_coupon")], runs.iloc[1:], paper_table(), ())
+    assert view["headline"].dem == 0.50 and view["dem_specimen"] == "paper_coupon [cccccc]"
+
+
 def test_compare_and_report_say_a_dem_run_did_not_converge_alike(good_csv, options):
     from pidcore.app.workbench import case_view
     from pidcore.measure import analysis_record
