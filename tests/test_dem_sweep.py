@@ -271,3 +271,38 @@ def test_a_run_another_sweep_stored_meanwhile_is_not_counted_or_simulated_again(
     assert sorted(summary.skipped) == sorted(run_key(c, CONFIG) for c in CASES[:2])
     assert [c["status"] for c in summary.cases] == [sweep_module.STORED_MEANWHILE] * 2
     assert len(Store(store_path).list_dem_runs()) == 2
+
+
+def test_pooled_workers_skip_a_run_stored_after_the_sweep_listed_its_cases(tmp_path,
+                                                                          monkeypatch):
+    """With several workers (the default) a second sweep simulated every case the first had
+    saved since it listed the store; each worker now reads the store as its case starts."""
+    import pidcore.dem.sweep as sweep_module
+
+    store_path = tmp_path / "s.h5"
+    run_sweep(CASES[:1], CONFIG, store_path=store_path, workers=1, progress=False)
+    stamp = Store(store_path).list_dem_runs()["created_utc"].iloc[0]
+    # the listing as it was before the other sweep saved CASES[0] (the workers, forked from
+    # a clean server, read the real store)
+    monkeypatch.setattr(sweep_module, "stored_run_key", lambda *args, **kwargs: None)
+    returned = []  # what each worker sent back: a run it simulated, or the key it found
+    real_pooled = sweep_module.run_pooled
+
+    def spy(function, calls, *, workers, finish):
+        def kept(outcome):
+            returned.append(outcome)
+            finish(outcome)
+        real_pooled(function, calls, workers=workers, finish=kept)
+
+    monkeypatch.setattr(sweep_module, "run_pooled", spy)
+    summary = run_sweep(CASES[:2], CONFIG, store_path=store_path, workers=2, progress=False)
+    # CASES[0] was not simulated again: its worker sent back the key it found stored
+    assert sorted(o if isinstance(o, str) else o.key for o in returned) == sorted(
+        run_key(c, CONFIG) for c in CASES[:2])
+    assert run_key(CASES[0], CONFIG) in returned
+    assert summary.completed == [run_key(CASES[1], CONFIG)]
+    assert summary.skipped == [run_key(CASES[0], CONFIG)]
+    assert [c["status"] for c in summary.cases] == [sweep_module.STORED_MEANWHILE,
+                                                    "simulated"]
+    runs = Store(store_path).list_dem_runs().set_index("case_key")
+    assert runs.loc[run_key(CASES[0], CONFIG), "created_utc"] == stamp  # the first kept

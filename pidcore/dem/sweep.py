@@ -30,6 +30,7 @@ from .persist import (
     run_key,
     save_dem_entry,
     stored_identities,
+    stored_keys,
     stored_run_key,
 )
 from .simulate import DemConfig, LoadCase, simulate_load_case
@@ -431,21 +432,19 @@ def run_sweep(cases: Sequence[LoadCase], config: DemConfig, *,
         if on_case is not None:
             on_case(outcome)
 
-    def stored_now(key: str) -> bool:
-        """Whether another process stored ``key`` since the sweep began: its case is then
-        not simulated again (checked before each serial case)."""
-        if store.has_dem_run(key):
-            _stored_meanwhile(summary, key)
+    def finish_or_skip(outcome: CaseOutcome | str) -> None:
+        if isinstance(outcome, str):  # stored by another process before it was simulated
+            _stored_meanwhile(summary, outcome)
             if bar is not None:
                 bar.update(1)
-            return True
-        return False
+        else:
+            finish(outcome)
 
     try:
         if todo and scheduler:
             _run_dask(todo, config, scheduler, finish, specimen)
         elif todo:
-            _run_local(todo, config, workers, finish, specimen, stored_now)
+            _run_local(todo, config, workers, finish_or_skip, specimen, store_path)
     finally:
         if bar is not None:
             bar.close()
@@ -463,21 +462,30 @@ def _stored_meanwhile(summary: SweepSummary, key: str) -> None:
             case["status"] = STORED_MEANWHILE
 
 
+def run_case_unless_stored(case: LoadCase, config: DemConfig, specimen: Specimen | None,
+                           store_path: str | os.PathLike, key: str) -> CaseOutcome | str:
+    """:func:`run_case`, or ``key`` where the store holds that run already: another process
+    (a second sweep on the same store) saved it since this sweep listed what to run, and it
+    is not simulated twice. Read as the case starts (in its worker)."""
+    if stored_keys(store_path, [key]):
+        return key
+    return run_case(case, config, specimen)
+
+
 def _run_local(todo: Iterable[tuple[LoadCase, str]], config: DemConfig, workers: int | None,
-               finish: Callable[[CaseOutcome], None], specimen: Specimen | None,
-               stored_now: Callable[[str], bool] = lambda key: False) -> None:
+               finish: Callable[[CaseOutcome | str], None], specimen: Specimen | None,
+               store_path: str | os.PathLike) -> None:
     todo = list(todo)
     workers = workers or os.cpu_count() or 1
     if workers < 1:
         raise ParameterError(f"--workers: expected a positive number of processes, got {workers}")
+    calls = [(case, config, specimen, store_path, key) for case, key in todo]
     if workers == 1 or len(todo) == 1:
-        for case, key in todo:
-            if not stored_now(key):
-                finish(run_case(case, config, specimen))
+        for call in calls:
+            finish(run_case_unless_stored(*call))
         return
     # Ctrl-C or a failed case stops the workers; finished cases are already stored
-    run_pooled(run_case, [(case, config, specimen) for case, _ in todo], workers=workers,
-               finish=finish)
+    run_pooled(run_case_unless_stored, calls, workers=workers, finish=finish)
 
 
 def _run_dask(todo: Iterable[tuple[LoadCase, str]], config: DemConfig, scheduler: str,
