@@ -304,8 +304,8 @@ def _print_sweep(args: argparse.Namespace, summary) -> None:
         # what this sweep saved: a run another process stored first is not counted as ours
         print(f"{len(summary.completed)} case(s) simulated and saved, {len(summary.skipped)} "
               f"already in {args.store}"
-              + (f" ({meanwhile} of them saved meanwhile by another process; its run kept)"
-                 if meanwhile else "")
+              + (f" ({meanwhile} of them saved meanwhile by another process, whose runs "
+                 "are kept)" if meanwhile else "")
               + f"; wall time {summary.wall_s:.1f} s")
         for case in summary.cases:
             if case["status"].startswith("same simulation"):
