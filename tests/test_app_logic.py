@@ -895,6 +895,34 @@ def test_unnamed_acrylic_measurements_still_meet_the_papers_coupon(good_csv, opt
     assert view["dem_specimen"] == "paper_coupon" and view["dem_refused"] == ""
 
 
+def test_a_calibrations_design_runs_do_not_hide_the_papers_coupon(good_csv, options):
+    # a calibration's store as the app's: beside the coupon's own runs, its design runs (the
+    # coupon's file with another rolling friction ..., named paper_coupon, another hash).
+    # Compare refused every case ("the DEM runs ... are of 2 specimens"; named paper_coupon:
+    # "2 different specimen files named paper_coupon"); `pidcore report` on the same store
+    # compares the paper's coupon and names the others left out: so does Compare now
+    from pidcore.app.workbench import case_view
+    from pidcore.specimen import paper_specimen
+
+    rec = _record(good_csv, options)
+    runs = pd.DataFrame({
+        "case_key": ["coupon", "design"], "frequency_hz": [100.0, 100.0],
+        "acceleration_g": [5.0, 5.0], "fill_percent": [50.0, 50.0],
+        "material": ["acrylic"] * 2, "direction": ["z"] * 2, "sdc": [0.20, 0.50],
+        "sdc_stderr": [0.01, 0.01], "specimen_name": ["paper_coupon"] * 2,
+        "specimen_sha256": [paper_specimen().hash, "c" * 64]})
+    for named in ("", "paper_coupon"):
+        view = case_view([_entry(rec, specimen=named)], runs, paper_table(), ())
+        assert view["headline"].dem == 0.20  # the coupon's run alone, not pooled
+        assert view["dem_specimen"] == "paper_coupon" and view["dem_refused"] == ""
+        (note,) = [n for n in view["notes"] if "other specimens" in n]
+        assert "paper_coupon [cccccc] (1 run(s))" in note and "design point" in note
+        assert "`specimen` column" in note  # how to choose another
+    # without the coupon's own runs the design run is still not taken for it silently
+    view = case_view([_entry(rec, specimen="paper_coupon")], runs.iloc[1:], paper_table(), ())
+    assert view["headline"].dem == 0.50 and view["dem_specimen"] == "paper_coupon [cccccc]"
+
+
 def test_compare_and_report_say_a_dem_run_did_not_converge_alike(good_csv, options):
     from pidcore.app.workbench import case_view
     from pidcore.measure import analysis_record
@@ -1681,3 +1709,32 @@ def test_the_corrections_say_how_the_baseline_went_off():
     assert whole.endswith("baseline loss factor 0.0152 (off the whole vibrated mass)")
     # no baseline: the structure mass changes nothing and is not named
     assert describe_corrections({"structure_mass_kg": 0.28}).endswith("baseline loss factor 0")
+
+
+def test_compare_notes_a_saved_baseline_off_the_whole_vibrated_mass(tmp_path, good_csv,
+                                                                   options):
+    # the Report tab and `pidcore report` note a record whose baseline loss factor went off
+    # the whole vibrated mass (its SDC low); Compare showed the saved record without it
+    from dataclasses import replace
+
+    from pidcore.app.workbench import case_view, saved_entries
+    from pidcore.report.pipeline import whole_mass_baseline_note
+    from pidcore.store.listing import saved_analyses
+
+    whole = replace(options, baseline_loss_factor=0.01, structure_mass_kg=None)
+    exact = replace(options, baseline_loss_factor=0.01, structure_mass_kg=0.28)
+    for name, opts in (("whole.h5", whole), ("exact.h5", exact)):
+        store_file = tmp_path / name
+        rec = _record(good_csv, opts, name="a.csv")
+        uploads.save_records(store_file, [_file(rec, opts)])
+        (saved,) = saved_entries(store_file, saved_analyses(store_file))
+        notes = case_view([saved], None, paper_table(), ())["notes"]
+        # the same note, word for word, as the report's for the same stored settings
+        expected = whole_mass_baseline_note([vars(opts)])
+        assert bool(expected) == (opts is whole)
+        assert (expected in notes) if expected else not any(
+            "whole vibrated mass" in n for n in notes), notes
+        # the session's unsaved analysis says the same
+        unsaved = case_view([_entry(rec, options=opts)], None, paper_table(), ())["notes"]
+        assert ((expected in unsaved) if expected
+                else not any("whole vibrated mass" in n for n in unsaved))

@@ -157,7 +157,8 @@ def test_ctrl_c_in_a_sweep_counts_the_cases_stored(tmp_path, monkeypatch, capsys
 
     monkeypatch.setattr(pidcore.dem.sweep, "run_sweep", first_only)
     assert main(sweep) == 130
-    assert "interrupted; 1 finished run(s) saved to" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "interrupted; 1 finished run(s) saved to" in err and "re-run to resume" in err
     monkeypatch.setattr(pidcore.dem.sweep, "run_sweep", three_then_interrupt)
     assert main(sweep) == 130
     assert "interrupted; 2 finished run(s) saved to" in capsys.readouterr().err
@@ -526,5 +527,25 @@ def test_ctrl_c_as_the_result_prints_still_says_what_was_saved(tmp_path, monkeyp
     assert main([*argv, "--cells", "1", "--cycles", "2", "--no-progress",
                  "--store", str(store)]) == 130
     err = capsys.readouterr().err.strip().splitlines()
+    # every case had finished: "re-run to resume" sent the user to re-run for nothing
     assert err == [f"pidcore dem {command}: interrupted; 1 finished run(s) saved to {store}; "
-                   "re-run to resume"], err
+                   "every case is stored, nothing left to run"], err
+
+
+def test_sweep_says_what_it_saved_not_what_another_sweep_saved(tmp_path, monkeypatch, capsys):
+    """A second sweep on one store whose runs the first saved meanwhile printed
+    "1 case(s) simulated" although it saved none."""
+    import pidcore.dem.sweep
+    from pidcore.dem.sweep import STORED_MEANWHILE, SweepSummary
+
+    def stored_by_another(cases, config, *, store_path, specimen, **kwargs):
+        return SweepSummary(skipped=["k"], store_path=str(store_path),
+                            cases=[{"store_key": "k", "status": STORED_MEANWHILE}])
+
+    monkeypatch.setattr(pidcore.dem.sweep, "run_sweep", stored_by_another)
+    store = tmp_path / "s.h5"
+    assert main(["dem", "sweep", "--frequencies", "1000", "--accelerations", "5", "--fills",
+                 "25", "--no-progress", "--store", str(store)]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith(f"0 case(s) simulated and saved, 1 already in {store} (1 of them "
+                          "saved meanwhile by another process"), out

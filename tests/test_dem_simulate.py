@@ -3,6 +3,7 @@
 import dataclasses
 import json
 import math
+import re
 
 import numba
 import numpy as np
@@ -430,3 +431,20 @@ def test_throughput_of_a_run_that_only_compiled_is_refused(monkeypatch):
     assert math.isnan(r.particle_steps_per_s)
     assert r.to_dict()["particle_steps_per_s"] is None
     assert any("particle_steps_per_s not measured" in n for n in r.notes)
+
+
+def test_progress_shows_the_settle_before_the_cycle_bar(capsys):
+    """With progress on, nothing was drawn during the bed's settle (3-7 s at the paper's
+    sizes) before the cycle bar started: the run looked hung."""
+    result = simulate_load_case(LoadCase(1000.0, 5.0, 25.0),
+                                DemConfig(cells=1, steady_cycles=4, max_transient_cycles=4),
+                                progress=True)
+    err = capsys.readouterr().err
+    assert "settling the bed" in err
+    # the line counts the simulated settle, ms: growing, never past the run's settle time
+    # (tqdm redraws at most every 0.1 s wall, so the last figure drawn may be short of it;
+    # 1 ms: the figure is rounded to whole ms)
+    shown = [float(m) for m in re.findall(r"settling the bed: (\d+) ms simulated", err)]
+    assert shown == sorted(shown) and shown[-1] <= result.settle_time_s * 1e3 + 1.0
+    # settling comes before the first cycle is drawn
+    assert err.index("settling the bed") < err.index("cycle")

@@ -243,3 +243,66 @@ def test_a_run_keyed_otherwise_by_a_worker_is_refused_not_stored(tmp_path, monke
     with pytest.raises(SimulationError, match="another pidcore than this one"):
         run_sweep(CASES[:1], CONFIG, store_path=store, workers=1, progress=False)
     assert not store.exists() or Store(store).list_dem_runs().empty
+
+
+def test_a_run_another_sweep_stored_meanwhile_is_not_counted_or_simulated_again(tmp_path,
+                                                                              monkeypatch):
+    """Two sweeps on one store: the second said "N case(s) simulated" for runs the first had
+    saved (its own save was skipped), and simulated cases the first had stored meanwhile."""
+    import pidcore.dem.sweep as sweep_module
+
+    store_path = tmp_path / "s.h5"
+    real_run_case = sweep_module.run_case
+    simulated = []
+
+    def other_process_saves_first(case, config, specimen=None):
+        # the "other sweep" finishes this case and the next one before this sweep saves
+        simulated.append(case)
+        outcome = real_run_case(case, config, specimen)
+        for other in CASES[:2]:
+            theirs = real_run_case(other, config, specimen)
+            assert theirs.save_to(Store(store_path))
+        return outcome
+
+    monkeypatch.setattr(sweep_module, "run_case", other_process_saves_first)
+    summary = run_sweep(CASES[:2], CONFIG, store_path=store_path, workers=1, progress=False)
+    assert simulated == [CASES[0]]  # the second case was found stored before it was run
+    assert not summary.completed  # this sweep saved nothing
+    assert sorted(summary.skipped) == sorted(run_key(c, CONFIG) for c in CASES[:2])
+    assert [c["status"] for c in summary.cases] == [sweep_module.STORED_MEANWHILE] * 2
+    assert len(Store(store_path).list_dem_runs()) == 2
+
+
+def test_pooled_workers_skip_a_run_stored_after_the_sweep_listed_its_cases(tmp_path,
+                                                                          monkeypatch):
+    """With several workers (the default) a second sweep simulated every case the first had
+    saved since it listed the store; each worker now reads the store as its case starts."""
+    import pidcore.dem.sweep as sweep_module
+
+    store_path = tmp_path / "s.h5"
+    run_sweep(CASES[:1], CONFIG, store_path=store_path, workers=1, progress=False)
+    stamp = Store(store_path).list_dem_runs()["created_utc"].iloc[0]
+    # the listing as it was before the other sweep saved CASES[0] (the workers, forked from
+    # a clean server, read the real store)
+    monkeypatch.setattr(sweep_module, "stored_run_key", lambda *args, **kwargs: None)
+    returned = []  # what each worker sent back: a run it simulated, or the key it found
+    real_pooled = sweep_module.run_pooled
+
+    def spy(function, calls, *, workers, finish):
+        def kept(outcome):
+            returned.append(outcome)
+            finish(outcome)
+        real_pooled(function, calls, workers=workers, finish=kept)
+
+    monkeypatch.setattr(sweep_module, "run_pooled", spy)
+    summary = run_sweep(CASES[:2], CONFIG, store_path=store_path, workers=2, progress=False)
+    # CASES[0] was not simulated again: its worker sent back the key it found stored
+    assert sorted(o if isinstance(o, str) else o.key for o in returned) == sorted(
+        run_key(c, CONFIG) for c in CASES[:2])
+    assert run_key(CASES[0], CONFIG) in returned
+    assert summary.completed == [run_key(CASES[1], CONFIG)]
+    assert summary.skipped == [run_key(CASES[0], CONFIG)]
+    assert [c["status"] for c in summary.cases] == [sweep_module.STORED_MEANWHILE,
+                                                    "simulated"]
+    runs = Store(store_path).list_dem_runs().set_index("case_key")
+    assert runs.loc[run_key(CASES[0], CONFIG), "created_utc"] == stamp  # the first kept

@@ -109,6 +109,7 @@ def case_view(entries: Sequence[MeasuredEntry], dem_runs: pd.DataFrame | None,
     for a DEM case with unconverged runs; empty otherwise).
     """
     from ..compare.specimens import runs_for_measurement
+    from ..report.pipeline import whole_mass_baseline_note
     from ..report.table import not_converged_note
 
     # group_entries never pools specimens: the first entry names the group's
@@ -119,6 +120,11 @@ def case_view(entries: Sequence[MeasuredEntry], dem_runs: pd.DataFrame | None,
     notes = list(comparison.notes)
     if met.note and not met.refused:
         notes.append(met.note)
+    # the Report tab and `pidcore report` say it; the Compare page showed such a low SDC
+    # against the DEM without a word
+    whole = whole_mass_baseline_note(e.settings for e in entries)
+    if whole:
+        notes.append(whole)
     # a record the plausibility checks refuse, saved as confirmed, was pooled here without a
     # word (report --store names it, calibrate --store leaves it out)
     notes.extend(f"{e.file}: implausible, "

@@ -230,13 +230,15 @@ def _specimen(args: argparse.Namespace):
     return specimen, material
 
 
-def _interrupted(command: str, saved: int, store) -> int:
+def _interrupted(command: str, saved: int, store, *, left: int = 1) -> int:
     """Ctrl-C (or SIGTERM): say what was saved (finished runs are, each in its own
-    transaction), exit 130 (143)."""
+    transaction), exit 130 (143). ``left``: runs still missing from the store (none: nothing
+    to resume)."""
     from .. import interrupt
 
     if saved:
-        what = f"{saved} finished run(s) saved to {store}; re-run to resume"
+        what = f"{saved} finished run(s) saved to {store}; " + (
+            "re-run to resume" if left else "every case is stored, nothing left to run")
     else:
         what = "nothing saved" + (f", {store} unchanged" if store is not None else "")
     print(f"pidcore dem {command}: interrupted; {what}", file=sys.stderr)
@@ -278,8 +280,9 @@ def sweep(args: argparse.Namespace) -> int:
         _print_sweep(args, summary)
         interrupt.raise_if_interrupted()
     except KeyboardInterrupt:
-        saved = stored_keys(args.store, keys) - before
-        return _interrupted("sweep", len(saved), args.store)
+        stored = stored_keys(args.store, keys)
+        return _interrupted("sweep", len(stored - before), args.store,
+                            left=len(set(keys) - stored))
     except PidcoreError as exc:  # a case refused or failed, a worker killed: what is kept
         saved = stored_keys(args.store, keys) - before
         if not saved:
@@ -295,8 +298,15 @@ def _print_sweep(args: argparse.Namespace, summary) -> None:
     if args.json:
         print(json.dumps(summary.to_dict()))
     else:
-        print(f"{len(summary.completed)} case(s) simulated, {len(summary.skipped)} already in "
-              f"{args.store}; wall time {summary.wall_s:.1f} s")
+        from ..dem.sweep import STORED_MEANWHILE
+
+        meanwhile = sum(case["status"] == STORED_MEANWHILE for case in summary.cases)
+        # what this sweep saved: a run another process stored first is not counted as ours
+        print(f"{len(summary.completed)} case(s) simulated and saved, {len(summary.skipped)} "
+              f"already in {args.store}"
+              + (f" ({meanwhile} of them saved meanwhile by another process, whose runs "
+                 "are kept)" if meanwhile else "")
+              + f"; wall time {summary.wall_s:.1f} s")
         for case in summary.cases:
             if case["status"].startswith("same simulation"):
                 print(f"fill {case['fill_percent']:g} % ({case['frequency_hz']:g} Hz, "
@@ -367,7 +377,9 @@ def run(args: argparse.Namespace) -> int:
         interrupt.raise_if_interrupted()
     except KeyboardInterrupt:
         # the run is saved in one transaction at its end: committed now, or not at all
-        return _interrupted("run", int(store is not None and store.commits > 0), args.store)
+        # one run: saved, it is finished (nothing to resume)
+        return _interrupted("run", int(store is not None and store.commits > 0), args.store,
+                            left=0)
     return 0
 
 

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -203,6 +203,10 @@ class MeasuredEntry:
     corrections : str
         The corrections the analysis ran with, e.g. ``"vibrometer delay 50 µs, mass below
         gauge 0 g, baseline loss factor 0"`` (empty where unknown).
+    settings : dict
+        The analysis's parameters (stored ``parameters_json``, or the options of an unsaved
+        analysis): how its corrections went, e.g. the baseline off the whole vibrated mass
+        (:func:`pidcore.report.pipeline.whole_mass_baseline_note`); empty where unknown.
     measurement_key : str
         The store's key of the measured data (:func:`pidcore.store.measurement_key`): equal
         for byte-identical files under any name, so :func:`unique_entries` counts them once
@@ -228,6 +232,7 @@ class MeasuredEntry:
     measurement_key: str = ""
     #: the first plausibility warning beyond noise (a result kept or saved as accepted), or ""
     implausible: str = ""
+    settings: dict = field(default_factory=dict, repr=False, compare=False)
 
     @classmethod
     def from_record(cls, record, load_case: LoadCase, *,
@@ -250,7 +255,8 @@ class MeasuredEntry:
                    np.asarray(a.harmonics), np.asarray(a.force_phasors_n),
                    np.asarray(a.velocity_phasors_m_s), specimen,
                    corrections=describe_corrections(vars(options)) if options else "",
-                   measurement_key=content, implausible=found[0].message if found else "")
+                   measurement_key=content, implausible=found[0].message if found else "",
+                   settings=dict(vars(options)) if options else {})
 
     @classmethod
     def from_store(cls, row: pd.Series, arrays: dict) -> MeasuredEntry:
@@ -261,6 +267,7 @@ class MeasuredEntry:
 
         empty = np.empty(0)
         found, _ = stored_findings(row)
+        settings = _json_dict(row.get("parameters_json"))
         return cls(str(row["key"]), Path(str(row.get("source", ""))).name, "store",
                    _row_case(row), float(row["frequency_hz"]),
                    float(row.get("acceleration_m_s2", math.nan)),
@@ -270,9 +277,9 @@ class MeasuredEntry:
                    np.asarray(arrays.get("force_phasors_n", empty)),
                    np.asarray(arrays.get("velocity_phasors_m_s", empty)),
                    _specimen_of(row), str(row.get("created_utc", "")),
-                   describe_corrections(_json_dict(row.get("parameters_json"))),
+                   describe_corrections(settings),
                    str(row.get("measurement_key", "") or ""),
-                   found[0].message if found else "")
+                   found[0].message if found else "", settings)
 
     def loop(self):
         """The measured loop (:class:`pidcore.loop.ForceDisplacementLoop`, labelled

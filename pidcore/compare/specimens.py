@@ -3,8 +3,12 @@
 A measurement may name its specimen (the ``specimen`` of a saved analysis: a specimen file's
 ``name``); a stored DEM run states ``specimen_name`` and ``specimen_sha256``. A named
 measurement meets only the runs of that name; an unnamed one meets the runs of its material and
-direction when they all come from one specimen, and none when they come from several (they are
-not pooled: which specimen was tested is the user's to say). Runs stored before specimens
+direction when they all come from one specimen, the paper's coupon's among several (the
+default of ``pidcore report``: a calibration's store holds its design runs, files named
+``paper_coupon`` with other values, beside the coupon's own), and none when they come from
+several others (they are not pooled: which specimen was tested is the user's to say). A
+measurement named ``paper_coupon`` meets the paper's coupon's runs, not another file of that
+name. Runs stored before specimens
 existed (no hash) and runs of the paper's coupon with either table material are the paper's
 coupon, as in :func:`pidcore.dem.persist.runs_of_specimen`.
 
@@ -91,8 +95,16 @@ def runs_for_measurement(runs: pd.DataFrame | None, specimen: str, material: str
         same = runs[(runs["material"] == material) & (runs["direction"] == direction)]
     if same.empty:
         return SpecimenRuns(None)
+    from ..specimen import PAPER_SPECIMEN_NAME
+
     labels = run_specimen_labels(same)
     specimen = (specimen or "").strip()
+    paper = (labels == PAPER_SPECIMEN_NAME).to_numpy(bool)
+    if specimen == PAPER_SPECIMEN_NAME and paper.any():
+        # the paper's coupon is the paper's file (its hash), not every file that kept its
+        # name: a calibration's design runs (the coupon with another rolling friction ...)
+        # are named paper_coupon too, and were pooled with it or refused it
+        return _paper_runs(same, labels, paper)
     if specimen:
         mine = (_names(same, labels) == specimen).to_numpy(bool)
         kept, others = labels[mine], labels[~mine]
@@ -107,6 +119,9 @@ def runs_for_measurement(runs: pd.DataFrame | None, specimen: str, material: str
                                           "(keep one version's runs, or rename the other)",
                                 refused=True)
         return SpecimenRuns(same[mine].reset_index(drop=True), str(kept.iloc[0]), left_out)
+    if labels.nunique() > 1 and paper.any():
+        # as `pidcore report` and the Report tab: the paper's coupon unless another is named
+        return _paper_runs(same, labels, paper)
     if labels.nunique() > 1:
         return SpecimenRuns(None, "", f"the DEM runs at {material}, {direction} are of "
                                       f"{labels.nunique()} specimens: {_listed(labels)}; not "
@@ -114,6 +129,24 @@ def runs_for_measurement(runs: pd.DataFrame | None, specimen: str, material: str
                                       "the settings table) to compare it with one of them",
                             refused=True)
     return SpecimenRuns(same.reset_index(drop=True), str(labels.iloc[0]))
+
+
+def _paper_runs(runs: pd.DataFrame, labels: pd.Series, paper) -> SpecimenRuns:
+    """The paper's coupon's runs of ``runs`` (``paper``: which), with a note naming the
+    other specimens' runs left out and how to compare one of them."""
+    from ..specimen import PAPER_SPECIMEN_NAME
+
+    others = labels[~paper]
+    note = ""
+    if len(others):
+        same_name = (_names(runs, labels)[~paper] == PAPER_SPECIMEN_NAME).any()
+        note = (f"DEM runs of other specimens not compared: {_listed(others)} (the paper's "
+                f"coupon is compared, as in pidcore report"
+                + ("; a run named paper_coupon with a hash is another file of that name, "
+                   "e.g. a calibration's design point" if same_name else "")
+                + "); to compare another, name its specimen in the file's `specimen` column "
+                  "(the settings table) or keep its runs in a store of their own")
+    return SpecimenRuns(runs[paper].reset_index(drop=True), PAPER_SPECIMEN_NAME, note)
 
 
 def run_specimens(runs: pd.DataFrame | None) -> dict[str, object]:

@@ -281,6 +281,8 @@ class _KernelClock:
     seconds: float = 0.0
     particle_steps: int = 0
     compiling_calls: int = 0
+    #: told the simulated seconds of each call (the settle's progress line), when set
+    on_simulated: Callable[[float], None] | None = None
 
     def advance(self, state: CellsState, settings: KernelSettings, n_steps: int,
                 **kwargs) -> tuple[np.ndarray, np.ndarray]:
@@ -293,6 +295,8 @@ class _KernelClock:
         else:
             self.seconds += elapsed
             self.particle_steps += n_steps * state.n_particles * state.n_cells
+        if self.on_simulated is not None:
+            self.on_simulated(n_steps * settings.dt_s)
         # A Ctrl-C that arrived during the call may have been swallowed on its way out of
         # Numba; where pidcore.interrupt routes SIGINT (the CLI, DEM worker processes), stop
         # here instead of running the case to its end (a sweep's worker kept going ~80 s)
@@ -653,7 +657,19 @@ def simulate_load_case(case: LoadCase, config: DemConfig | None = None, *,
                   tangential_model=config.tangential_model,
                   max_overlap_fraction=defaults.DEM_MAX_OVERLAP_FRACTION)
     clock = _KernelClock()
-    settle_time = settle_bed(state, KernelSettings(**common), config.start_packing, clock=clock)
+    settling = None
+    if progress:  # the settle takes seconds before the cycle bar starts: say it is running
+        from tqdm import tqdm
+        settling = tqdm(desc=f"DEM {case.key}: settling the bed", unit="ms", leave=False,
+                        bar_format="{desc}: {n:.0f} ms simulated [{elapsed}]")
+        clock.on_simulated = lambda seconds: settling.update(seconds * 1e3)
+    try:
+        settle_time = settle_bed(state, KernelSettings(**common), config.start_packing,
+                                 clock=clock)
+    finally:
+        if settling is not None:
+            settling.close()
+            clock.on_simulated = None
 
     axis = AXIS_INDEX[case.direction]
     unit = np.zeros(3)

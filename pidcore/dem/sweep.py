@@ -30,6 +30,7 @@ from .persist import (
     run_key,
     save_dem_entry,
     stored_identities,
+    stored_keys,
     stored_run_key,
 )
 from .simulate import DemConfig, LoadCase, simulate_load_case
@@ -98,12 +99,12 @@ class CaseOutcome:
     parameters: dict
     units: dict
 
-    def save_to(self, store) -> str:
+    def save_to(self, store) -> bool:
         """Add this run to ``store`` unless stored already (:func:`~.persist.save_dem_entry`);
-        returns its key."""
-        save_dem_entry(store, self.key, {"record": self.record, "arrays": self.arrays,
-                                         "parameters": self.parameters, "units": self.units})
-        return self.key
+        True if this call added it (False: another process stored it meanwhile)."""
+        return save_dem_entry(store, self.key, {"record": self.record, "arrays": self.arrays,
+                                                "parameters": self.parameters,
+                                                "units": self.units})
 
 
 def run_case(case: LoadCase, config: DemConfig,
@@ -278,10 +279,14 @@ def _stop_pool(pool) -> None:
         process.join()
 
 
+#: Status of a case another process (a second sweep on the same store) stored while this
+#: sweep ran: this sweep's run of it, if it made one, was not saved.
+STORED_MEANWHILE = "stored meanwhile by another process"
 #: How a sweep got each case's run (:attr:`SweepSummary.cases`).
 SWEEP_CASE_STATUSES = ("simulated", "already stored",
                        "same simulation as a stored run",
-                       "same simulation as another case of this sweep")
+                       "same simulation as another case of this sweep",
+                       STORED_MEANWHILE)
 #: Result fields of each case in :meth:`SweepSummary.to_dict`, named (units as suffixes) as
 #: ``pidcore dem run --json`` names them, read from the stored run.
 SWEEP_CASE_FIELDS = ("sdc", "sdc_stderr", "loss_factor", "particles_per_cell",
@@ -417,19 +422,29 @@ def run_sweep(cases: Sequence[LoadCase], config: DemConfig, *,
                 f"a worker returned run {outcome.key}, which this sweep did not ask for (it "
                 f"asked for {len(asked)} run(s) such as {min(asked)}): the workers run "
                 f"another pidcore than this one ({__version__}); install the same on them")
-        outcome.save_to(store)
-        summary.completed.append(outcome.key)
+        if outcome.save_to(store):
+            summary.completed.append(outcome.key)
+        else:
+            _stored_meanwhile(summary, outcome.key)
         if bar is not None:
             bar.update(1)
             bar.set_postfix_str(outcome.key.split("_seed")[0])
         if on_case is not None:
             on_case(outcome)
 
+    def finish_or_skip(outcome: CaseOutcome | str) -> None:
+        if isinstance(outcome, str):  # stored by another process before it was simulated
+            _stored_meanwhile(summary, outcome)
+            if bar is not None:
+                bar.update(1)
+        else:
+            finish(outcome)
+
     try:
         if todo and scheduler:
             _run_dask(todo, config, scheduler, finish, specimen)
         elif todo:
-            _run_local(todo, config, workers, finish, specimen)
+            _run_local(todo, config, workers, finish_or_skip, specimen, store_path)
     finally:
         if bar is not None:
             bar.close()
@@ -438,19 +453,39 @@ def run_sweep(cases: Sequence[LoadCase], config: DemConfig, *,
     return summary
 
 
+def _stored_meanwhile(summary: SweepSummary, key: str) -> None:
+    """Count ``key`` as found stored (by another process while this sweep ran), not as
+    simulated and saved by this sweep."""
+    summary.skipped.append(key)
+    for case in summary.cases:
+        if case["store_key"] == key and case["status"] == "simulated":
+            case["status"] = STORED_MEANWHILE
+
+
+def run_case_unless_stored(case: LoadCase, config: DemConfig, specimen: Specimen | None,
+                           store_path: str | os.PathLike, key: str) -> CaseOutcome | str:
+    """:func:`run_case`, or ``key`` where the store holds that run already: another process
+    (a second sweep on the same store) saved it since this sweep listed what to run, and it
+    is not simulated twice. Read as the case starts (in its worker)."""
+    if stored_keys(store_path, [key]):
+        return key
+    return run_case(case, config, specimen)
+
+
 def _run_local(todo: Iterable[tuple[LoadCase, str]], config: DemConfig, workers: int | None,
-               finish: Callable[[CaseOutcome], None], specimen: Specimen | None) -> None:
+               finish: Callable[[CaseOutcome | str], None], specimen: Specimen | None,
+               store_path: str | os.PathLike) -> None:
     todo = list(todo)
     workers = workers or os.cpu_count() or 1
     if workers < 1:
         raise ParameterError(f"--workers: expected a positive number of processes, got {workers}")
+    calls = [(case, config, specimen, store_path, key) for case, key in todo]
     if workers == 1 or len(todo) == 1:
-        for case, _ in todo:
-            finish(run_case(case, config, specimen))
+        for call in calls:
+            finish(run_case_unless_stored(*call))
         return
     # Ctrl-C or a failed case stops the workers; finished cases are already stored
-    run_pooled(run_case, [(case, config, specimen) for case, _ in todo], workers=workers,
-               finish=finish)
+    run_pooled(run_case_unless_stored, calls, workers=workers, finish=finish)
 
 
 def _run_dask(todo: Iterable[tuple[LoadCase, str]], config: DemConfig, scheduler: str,
