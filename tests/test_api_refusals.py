@@ -243,3 +243,24 @@ def test_save_analyses_refuses_what_is_not_a_list_of_analysed_records(tmp_path):
         save_analyses(store, [record], [{}])
     assert not store.path.exists()  # nothing half-written
     assert len(save_analyses(store, (record,)).keys) == 1  # a tuple is a sequence too
+
+
+def test_listing_functions_refuse_a_store_given_for_its_listing(tmp_path):
+    # select_runs(Store(...)) and build_report_table(runs, Store(...), None), the listing call
+    # forgotten, failed with AttributeError ('Store' object has no attribute 'columns')
+    from pidcore.model import select_runs
+    from pidcore.report import build_report_table
+    from pidcore.store import Store
+
+    store = Store(_SAMPLE.parents[1] / "dem_table3.h5")
+    with pytest.raises(ParameterError, match=r"^runs: expected a DataFrame, got Store .*"
+                                             r"\(e\.g\. Store\(path\)\.list_dem_runs\(\)\)$"):
+        select_runs(store)
+    runs = select_runs(store.list_dem_runs())
+    with pytest.raises(ParameterError, match=r"^analyses: expected a DataFrame or None, got "
+                                             r"Store .*list_analyses\(\)\)$"):
+        build_report_table(runs, store, None)
+    with pytest.raises(ParameterError, match=r"^dem_runs: expected a DataFrame or None, got str"):
+        build_report_table("runs.h5", None, None)
+    assert len(build_report_table(runs, None, None)) == len(runs.groupby(
+        ["frequency_hz", "acceleration_g", "fill_percent"]))  # one row per DEM load case
