@@ -434,6 +434,7 @@ def save_analyses(store: Store | str | os.PathLike, results: Sequence[AnalyzedRe
     from .records import measurement_key
     from .store import Store
 
+    results = _analyzed_records(results)
     if options is None:
         missing = [r.measurement.source for r in results if r.options is None]
         if missing:
@@ -443,6 +444,8 @@ def save_analyses(store: Store | str | os.PathLike, results: Sequence[AnalyzedRe
     else:
         per_result = ([options] * len(results) if isinstance(options, AnalysisOptions)
                       else list(options))
+        for i, given in enumerate(per_result):
+            instance_of(f"options[{i}]", given, AnalysisOptions)
     if stated is None:
         stated = [(Path(r.measurement.source).name, None, "") for r in results]
     extra = list(fields) if fields is not None else [None] * len(results)
@@ -464,6 +467,19 @@ def save_analyses(store: Store | str | os.PathLike, results: Sequence[AnalyzedRe
                 for r, o, (_, case, origin), more in zip(results, per_result, stated, extra,
                                                          strict=True)]
     return SavedAnalyses(keys, notes)
+
+
+def _analyzed_records(results: object) -> list[AnalyzedRecord]:
+    """``results`` as a list of :class:`AnalyzedRecord`, else a ParameterError naming it: one
+    record given alone, the arguments swapped or a measurement failed inside with
+    AttributeError/TypeError."""
+    hint = "e.g. [analyze_file(path)]"
+    if isinstance(results, (AnalyzedRecord, str, bytes, os.PathLike)) or not isinstance(
+            results, Sequence):
+        instance_of("results", results, list, hint=hint)
+    for i, r in enumerate(results):
+        instance_of(f"results[{i}]", r, AnalyzedRecord, hint=hint)
+    return list(results)
 
 
 #: Fields of :class:`AnalysisOptions` that name channels: a record keeps the channels it used

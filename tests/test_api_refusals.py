@@ -221,3 +221,46 @@ def test_tolerances_name_a_value_that_is_not_a_number():
 
     with pytest.raises(ParameterError, match=r"^Tolerances: frequency_rtol: expected a number"):
         Tolerances(frequency_rtol="0.1")  # was TypeError: must be real number, not str
+
+
+def test_save_analyses_refuses_what_is_not_a_list_of_analysed_records(tmp_path):
+    # a record given alone, the arguments swapped or a list of paths failed with
+    # AttributeError/TypeError from inside (`'int' object has no attribute 'options'`)
+    from pidcore.measure import save_analyses
+    from pidcore.store import Store
+
+    record = analyze_file(_SAMPLE, AnalysisOptions(velocity_delay_s=5e-5))
+    store = Store(tmp_path / "s.h5")
+    with pytest.raises(ParameterError, match=r"^results: expected a list, got AnalyzedRecord"):
+        save_analyses(store, record)
+    with pytest.raises(ParameterError, match=r"^results: expected a list, got Store"):
+        save_analyses([record], store)
+    with pytest.raises(ParameterError, match=r"^results\[1\]: expected an AnalyzedRecord, "
+                                             r"got PosixPath"):
+        save_analyses(store, [record, _SAMPLE])
+    with pytest.raises(ParameterError, match=r"^options\[0\]: expected an AnalysisOptions, "
+                                             r"got dict"):
+        save_analyses(store, [record], [{}])
+    assert not store.path.exists()  # nothing half-written
+    assert len(save_analyses(store, (record,)).keys) == 1  # a tuple is a sequence too
+
+
+def test_listing_functions_refuse_a_store_given_for_its_listing(tmp_path):
+    # select_runs(Store(...)) and build_report_table(runs, Store(...), None), the listing call
+    # forgotten, failed with AttributeError ('Store' object has no attribute 'columns')
+    from pidcore.model import select_runs
+    from pidcore.report import build_report_table
+    from pidcore.store import Store
+
+    store = Store(_SAMPLE.parents[1] / "dem_table3.h5")
+    with pytest.raises(ParameterError, match=r"^runs: expected a DataFrame, got Store .*"
+                                             r"\(e\.g\. Store\(path\)\.list_dem_runs\(\)\)$"):
+        select_runs(store)
+    runs = select_runs(store.list_dem_runs())
+    with pytest.raises(ParameterError, match=r"^analyses: expected a DataFrame or None, got "
+                                             r"Store .*list_analyses\(\)\)$"):
+        build_report_table(runs, store, None)
+    with pytest.raises(ParameterError, match=r"^dem_runs: expected a DataFrame or None, got str"):
+        build_report_table("runs.h5", None, None)
+    assert len(build_report_table(runs, None, None)) == len(runs.groupby(
+        ["frequency_hz", "acceleration_g", "fill_percent"]))  # one row per DEM load case

@@ -39,6 +39,13 @@ def test_the_readme_python_api_block_runs(tmp_path, monkeypatch, capsys):
     low, high = namespace["prediction"].band(stderr=0.01)
     assert low <= namespace["prediction"].sdc <= high
     assert (tmp_path / "my_store.h5").is_file()
-    assert len(namespace["table"]) > 0
+    table = namespace["table"]
+    # every saved measurement is in the table, at its file name's load case (saved without
+    # `stated` they had no fill: 'have no fill stated; not in the table', 0 measured rows)
+    measured = table[table["SDC measured [-]"].notna()]
+    assert sorted(measured["SDC measured [-]"]) == sorted(r.analysis.sdc
+                                                          for r in namespace["records"])
+    assert set(measured["packing ratio [%]"]) == {50.0}
+    assert not any("no fill" in note for note in table.attrs.get("notes", []))
     assert namespace["run"].sdc > 0
     assert list(namespace["damper"]["c_eq [N s/m]"] > 0) == [True, True]

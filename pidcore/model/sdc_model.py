@@ -47,7 +47,7 @@ import numpy as np
 import pandas as pd
 from scipy.interpolate import PchipInterpolator
 
-from ..errors import ParameterError, as_given
+from ..errors import ParameterError, as_given, instance_of
 
 #: Names of the model's axes, in the order of :attr:`SdcModel.axes` and of ``__call__``.
 AXIS_NAMES: tuple[str, str, str] = ("fill_percent", "acceleration_g", "frequency_hz")
@@ -343,6 +343,8 @@ def select_runs(runs: pd.DataFrame, *, where: Mapping[str, str] | None = None) -
     """
     from ..compare.align import settings_hash
 
+    # a Store given for its listing failed with AttributeError from inside
+    instance_of("runs", runs, pd.DataFrame, hint="e.g. Store(path).list_dem_runs()")
     selected = runs
     if "parameters_json" in runs.columns:
         selected = runs = runs.assign(settings_hash=runs["parameters_json"].map(settings_hash))

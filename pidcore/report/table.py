@@ -39,7 +39,7 @@ from ..compare.align import (
 from ..compare.loadcase import LoadCase, LoadCaseError
 from ..compare.plausibility import stored_findings
 from ..compare.specimens import runs_for_measurement
-from ..errors import ParameterError
+from ..errors import ParameterError, instance_of
 from ..units import g_to_si
 
 #: Measured energy per cycle over the DEM case's E = m_c a^2 / (2 w^2) (Eq. 10): the like-for-like
@@ -219,6 +219,11 @@ def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | N
     >>> round(float(t.loc[0, "difference ours - paper DEM [-]"]), 6)  # 0.52 - 0.5417
     -0.0217
     """
+    # a Store given for its listing failed with AttributeError from inside
+    for name, table, listing in (("dem_runs", dem_runs, "Store.list_dem_runs()"),
+                                 ("analyses", analyses, "Store.list_analyses()"),
+                                 ("paper", paper, "pidcore.model.load_paper_table3()")):
+        instance_of(name, table, (pd.DataFrame, type(None)), hint=f"e.g. {listing}")
     return report_table_and_aligner(dem_runs, analyses, paper, model=model,
                                     tolerances=tolerances, pool=pool, store_runs=store_runs,
                                     of_specimen=of_specimen, choose_another=choose_another)[0]

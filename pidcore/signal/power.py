@@ -559,7 +559,12 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
                f"x the structure's share {structure_share:.4g} of the reactive power is not "
                "below ")
             + f"the measured loss factor {loss_raw:.6g}; expected the empty coupon's loss factor, "
-            "smaller than that of the filled one")
+            "smaller than that of the filled one"
+            # heavy beads may damp less than the empty coupon: only the exact subtraction
+            # (the structure's own share) tells that from a wrong baseline
+            + ("" if structure_share != 1.0 else
+               " (heavy particles can take it below: give structure_mass_kg, the coupon and "
+               "fixture above the gauge, for the exact subtraction)"))
     loss = loss_raw - baseline
     sdc = 2 * np.pi * loss
     lf_stderr = float("nan")
