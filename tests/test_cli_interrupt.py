@@ -275,8 +275,9 @@ def test_an_interrupt_swallowed_by_a_reader_is_not_reported_as_a_bad_file(tmp_pa
     monkeypatch.setattr(file_settings, "analyze_with_settings", half_read)
     store = tmp_path / "s.h5"
     assert main(["analyze", str(tmp_path / "x.uff"), "--store", str(store)]) == 130
+    # a store that never existed is not "unchanged"
     assert capsys.readouterr().err == \
-        "pidcore analyze: interrupted; nothing saved, the store is unchanged\n"
+        f"pidcore analyze: interrupted; nothing saved, {store} not created\n"
     assert not store.exists()
 
     def refused_early(*args, **kwargs):  # before analyze's own accounting: the generic line

@@ -106,11 +106,17 @@ def test_ctrl_c_before_a_run_finishes_says_nothing_saved(tmp_path, monkeypatch, 
     assert main(ARGS) == 130
     err = capsys.readouterr().err
     assert "nothing saved" in err and "are saved" not in err
+    from pidcore.store import Store
+
     monkeypatch.setattr(pidcore.dem.persist, "cached_run", _interrupt)
     path = tmp_path / "s.h5"
     assert main(ARGS + ["--store", str(path)]) == 130
     err = capsys.readouterr().err
-    assert f"nothing saved, {path} unchanged" in err and not path.exists()
+    # a store that never existed was said to be "unchanged"
+    assert f"nothing saved, {path} not created" in err and not path.exists()
+    Store(path).add_dem_run("kept", {"sdc": 0.5})  # one that exists is left unchanged
+    assert main(ARGS + ["--store", str(path)]) == 130
+    assert f"nothing saved, {path} unchanged" in capsys.readouterr().err
 
 
 def test_ctrl_c_after_the_run_was_stored_says_it_was_saved(tmp_path, monkeypatch, capsys):

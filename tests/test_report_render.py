@@ -222,6 +222,12 @@ def test_ctrl_c_says_whether_the_report_was_written(tmp_path, table, provenance,
         assert err == f"pidcore report: interrupted; {out} is as it was (a report is written " \
                       "whole or not at all)\n"
         assert (out / "report.csv").read_bytes() == old_csv
+        # a folder that never existed is "not created", not "as it was"
+        new = tmp_path / "new_rp"
+        assert main(["report", "--store", str(tmp_path / "s.h5"), "--out", str(new)]) == 130
+        assert capsys.readouterr().err == (f"pidcore report: interrupted; {new} not created (a "
+                                           "report is written whole or not at all)\n")
+        assert not new.exists()
     else:
         assert err == f"pidcore report: interrupted; the report was written to {out} before " \
                       "it\n"

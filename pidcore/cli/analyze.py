@@ -22,6 +22,7 @@ from ._options import (
     given_options,
     path_argument,
     progress_wanted,
+    untouched,
     with_cli_flags,
 )
 
@@ -139,7 +140,9 @@ def _run(args: argparse.Namespace) -> int:
             raise
         said = (f"interrupted after saving {_saved(results)} to {args.store}"
                 if store is not None and store.commits else
-                "interrupted; nothing saved, the store is unchanged" if store is not None else
+                ("interrupted; nothing saved, the store is unchanged" if store.path.exists()
+                 else f"interrupted; nothing saved, {untouched(store.path)}")
+                if store is not None else
                 "interrupted; nothing saved (--no-store)")
         print(f"pidcore analyze: {said}", file=sys.stderr)
         interrupt.mark_handled()

@@ -235,12 +235,13 @@ def _interrupted(command: str, saved: int, store, *, left: int = 1) -> int:
     transaction), exit 130 (143). ``left``: runs still missing from the store (none: nothing
     to resume)."""
     from .. import interrupt
+    from ._options import untouched
 
     if saved:
         what = f"{saved} finished run(s) saved to {store}; " + (
             "re-run to resume" if left else "every case is stored, nothing left to run")
     else:
-        what = "nothing saved" + (f", {store} unchanged" if store is not None else "")
+        what = "nothing saved" + (f", {untouched(store)}" if store is not None else "")
     print(f"pidcore dem {command}: interrupted; {what}", file=sys.stderr)
     return interrupt.exit_status()
 

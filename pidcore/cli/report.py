@@ -20,6 +20,7 @@ from ._options import (
     given_options,
     path_argument,
     progress_wanted,
+    untouched,
     with_cli_flags,
 )
 
@@ -127,14 +128,17 @@ def _run(args: argparse.Namespace) -> int:
         # the report folder is replaced whole or not at all: say which, not "may hold part"
         after = folder_identity(args.out)
         said = (f"the report was written to {args.out} before it" if after != before else
-                f"{args.out} is as it was (a report is written whole or not at all)")
+                f"{args.out} is as it was (a report is written whole or not at all)"
+                if args.out.exists() else f"{untouched(args.out)} (a report is written whole "
+                "or not at all)")
         if args.files and args.store is not None and \
                 folder_identity(args.store) != store_before:
             # saved in one transaction before the report: said, not "nothing half-done" alone
             said += (f"; the analyses of the {len(args.files)} file(s) were saved to "
                      f"{args.store} before it (whole)")
         elif args.files and args.store is not None:  # saved in one transaction, or not
-            said += "; no store write was left half-done, the store is unchanged"
+            said += ("; no store write was left half-done, the store is unchanged"
+                     if args.store.exists() else f"; {untouched(args.store)}")
         print(f"pidcore report: interrupted; {said}", file=sys.stderr)
         interrupt.mark_handled()
         return interrupt.exit_status()
