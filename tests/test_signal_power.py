@@ -253,13 +253,19 @@ def test_heavy_particles_below_the_empty_structures_loss_factor_are_not_refused(
         analyze_power(rec.force_n, rec.velocity_m_s, fs, baseline_loss_factor=eta0)
 
 
-@pytest.mark.parametrize("mass, words", [(278.2, "was it in g"), (0.0, "expected the empty"),
+# the record's vibrated mass is 0.29 kg: 278.2 is grams typed as kg (959 times it), 2e-4 kg
+# is 0.07 % of it (no coupon is a thousandth of the beads it holds)
+@pytest.mark.parametrize("mass, words", [(278.2, "was it in g"), (2e-4, "is only 0.000"),
+                                         (0.0, "expected the empty"),
                                          (-1.0, "expected the empty"),
                                          (float("nan"), "expected the empty")])
-def test_a_structure_mass_in_grams_or_not_a_mass_is_refused(mass, words):
+@pytest.mark.parametrize("baseline", [0.0152, 0.0])
+def test_a_structure_mass_in_grams_or_not_a_mass_is_refused(mass, words, baseline):
+    # with a baseline or without one: the mass is saved with the record either way (a slip
+    # refused with a baseline was kept without a word without one)
     rec, fs, _ = _structure_and_particles(0.2782, 0.012, 0.0152, particle_c=0.9)
     with pytest.raises(ParameterError, match=words):
-        analyze_power(rec.force_n, rec.velocity_m_s, fs, baseline_loss_factor=0.0152,
+        analyze_power(rec.force_n, rec.velocity_m_s, fs, baseline_loss_factor=baseline,
                       structure_mass_kg=mass)
 
 

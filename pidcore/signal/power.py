@@ -305,6 +305,10 @@ def _complex_power(f_ph: np.ndarray, m_ph: np.ndarray, a_ph: np.ndarray | None,
 #: resonance) lower the reactive power below the structure's, by tens of per cent, not by the
 #: factor 1000 of grams typed as kilograms.
 UNIT_SLIP_SHARE = 2.0
+#: Smallest share the empty structure may hold: particles a hundred times heavier than the
+#: coupon and fixture they fill are no sandwich panel (tungsten-carbide beads filling a light
+#: coupon reach about 9 times, a share of 0.1); below it the mass was typed in another unit.
+MIN_STRUCTURE_SHARE = 0.01
 
 
 def check_analysis_settings(*, n_harmonics: int = defaults.N_HARMONICS,
@@ -629,8 +633,11 @@ def _structure_share(structure_mass_kg: float | None, baseline_loss_factor: floa
                      source: str) -> tuple[float, str]:
     """The empty structure's share ``Q_s / Im(P_c)`` of the reactive power (correction 4),
     and a note; ``(1.0, note)`` without its mass. A mass whose reactive power would be many
-    times the measured one is a unit slip (g typed as kg) and is refused."""
+    times the measured one, or a vanishing part of it, is a unit slip and is refused, with a
+    baseline or without one (the mass is saved with the record either way)."""
     if baseline_loss_factor <= 0:
+        if structure_mass_kg is not None:
+            _structure_share_checked(structure_mass_kg, v_ph, harmonics, omega, p_c, source)
         return 1.0, ""
     if structure_mass_kg is None:
         return 1.0, (f"baseline loss factor {baseline_loss_factor:g} subtracted as if the whole "
@@ -638,20 +645,35 @@ def _structure_share(structure_mass_kg: float | None, baseline_loss_factor: floa
                      "share of it); give the structure's mass (coupon and fixture above the "
                      "gauge: --structure-mass KG, a structure_mass_g column, the app's structure "
                      "mass [g]) for the exact subtraction")
-    q_s = float(np.sum(0.5 * harmonics * omega * structure_mass_kg * np.abs(v_ph) ** 2))
-    share = q_s / p_c.imag
-    vibrated_kg = structure_mass_kg / share  # the mass-like reactive power's mass
-    if share > UNIT_SLIP_SHARE:
-        raise ParameterError(
-            f"{source or 'record'}: structure_mass_kg {structure_mass_kg:g} kg is {share:.3g} "
-            f"times the vibrated mass the measurement shows ({vibrated_kg:.4g} kg from Im(P_c)); "
-            "expected the empty coupon and fixture above the gauge: in kg as --structure-mass "
-            "(was it in g?), in g in a structure_mass_g column and the app's structure mass [g] "
-            "(was it in mg?)")
+    share, vibrated_kg = _structure_share_checked(structure_mass_kg, v_ph, harmonics, omega,
+                                                  p_c, source)
     note = (f"baseline: the empty structure ({structure_mass_kg:.4g} kg) holds {share:.3g} of "
             f"the reactive power (vibrated mass {vibrated_kg:.4g} kg); baseline loss factor "
             f"{baseline_loss_factor:g} x {share:.3g} subtracted")
     return share, note
+
+
+def _structure_share_checked(structure_mass_kg: float, v_ph: np.ndarray, harmonics: np.ndarray,
+                             omega: float, p_c: complex, source: str) -> tuple[float, float]:
+    """``(share of the reactive power, vibrated mass kg)`` of the empty structure's mass, or a
+    one-line refusal where it cannot be that structure's (a unit slip)."""
+    q_s = float(np.sum(0.5 * harmonics * omega * structure_mass_kg * np.abs(v_ph) ** 2))
+    share = q_s / p_c.imag
+    vibrated_kg = structure_mass_kg / share  # the mass-like reactive power's mass
+    expected = ("expected the empty coupon and fixture above the gauge: in kg as "
+                "--structure-mass, in g in a structure_mass_g column and the app's structure "
+                "mass [g]")
+    if share > UNIT_SLIP_SHARE:
+        raise ParameterError(
+            f"{source or 'record'}: structure_mass_kg {structure_mass_kg:g} kg is {share:.3g} "
+            f"times the vibrated mass the measurement shows ({vibrated_kg:.4g} kg from Im(P_c)); "
+            f"{expected} (was it in g, or in mg in a g column?)")
+    if share < MIN_STRUCTURE_SHARE:
+        raise ParameterError(
+            f"{source or 'record'}: structure_mass_kg {structure_mass_kg:g} kg is only "
+            f"{share:.3g} of the vibrated mass the measurement shows ({vibrated_kg:.4g} kg from "
+            f"Im(P_c)); {expected} (was it in t, or in kg in a g column?)")
+    return share, vibrated_kg
 
 
 def analyze_channels(force: Channel, velocity: Channel | None, *,
