@@ -733,10 +733,7 @@ class Store:
 
     def get_analysis(self, key: str) -> StoredEntry:
         """The analysis stored under ``key``."""
-        check_name(key, what="analysis key", where=str(self.path))
-        with self._reading() as h5:
-            group = self._entry_group(h5, _ANALYSES, key, "analysis")
-            return _read_entry(group, key, where=f"{self.path}:{group.name}")
+        return self._get_entry(_ANALYSES, key, "analysis")
 
     def list_analyses(self) -> pd.DataFrame:
         """One row per analysis: key, measurement_key, source, created_utc, every scalar field,
@@ -834,10 +831,7 @@ class Store:
 
     def get_dem_run(self, case_key: str) -> StoredEntry:
         """The DEM run stored under ``case_key``."""
-        check_name(case_key, what="DEM case key", where=str(self.path))
-        with self._reading() as h5:
-            group = self._entry_group(h5, _DEM_RUNS, case_key, "DEM run")
-            return _read_entry(group, case_key, where=f"{self.path}:{group.name}")
+        return self._get_entry(_DEM_RUNS, case_key, "DEM run", key_name="DEM case key")
 
     def list_dem_runs(self) -> pd.DataFrame:
         """One row per DEM run: case_key, created_utc, every scalar field, parameters_json,
@@ -904,10 +898,7 @@ class Store:
 
     def get_calibration(self, key: str) -> StoredEntry:
         """The calibration stored under ``key`` (its texts: :func:`calibration_texts`)."""
-        check_name(key, what="calibration key", where=str(self.path))
-        with self._reading() as h5:
-            group = self._entry_group(h5, _CALIBRATIONS, key, "calibration")
-            return _read_entry(group, key, where=f"{self.path}:{group.name}")
+        return self._get_entry(_CALIBRATIONS, key, "calibration")
 
     def list_calibrations(self) -> pd.DataFrame:
         """One row per calibration: key, created_utc, every scalar field, parameters_json,
@@ -916,6 +907,15 @@ class Store:
             return self._listing(h5, _CALIBRATIONS, [], lambda group: {})
 
     # --- shared reading helpers ----------------------------------------------------------------
+
+    def _get_entry(self, section: str, key: str, what: str, *,
+                   key_name: str | None = None) -> StoredEntry:
+        """The entry ``key`` of ``section`` read whole (``what`` names it in errors, and
+        ``key_name``, default "<what> key", names its key)."""
+        check_name(key, what=key_name or f"{what} key", where=str(self.path))
+        with self._reading() as h5:
+            group = self._entry_group(h5, section, key, what)
+            return _read_entry(group, key, where=f"{self.path}:{group.name}")
 
     def _entry_group(self, h5: h5py.File | None, section: str, key: str, what: str) -> h5py.Group:
         if h5 is None:
