@@ -104,38 +104,40 @@ def _calibration(store, key: str) -> Calibration:
                        created_utc=str(entry.attrs.get("created_utc", "")))
 
 
-def stored_calibrations(store_path: str | os.PathLike) -> list[Calibration]:
-    """Every calibration stored in ``store_path``, newest first (none: an empty list; no
-    store yet: an empty list)."""
+def _calibrations(store_path: str | os.PathLike,
+                  problems: list[str] | None) -> list[Calibration]:
+    """Every calibration of ``store_path``, newest first (no store yet: none). A damaged one
+    raises, or, given ``problems``, is left out with its one line appended there."""
+    from ..errors import PidcoreError
     from ..store import Store
 
     path = Path(store_path)
     if not path.is_file():
         return []
     store = Store(path)
-    listing = store.list_calibrations()
-    return [_calibration(store, key) for key in reversed(list(listing["key"]))]
+    found: list[Calibration] = []
+    for key in reversed(list(store.list_calibrations()["key"])):
+        try:
+            found.append(_calibration(store, key))
+        except PidcoreError as exc:
+            if problems is None:
+                raise
+            problems.append(str(exc))
+    return found
+
+
+def stored_calibrations(store_path: str | os.PathLike) -> list[Calibration]:
+    """Every calibration stored in ``store_path``, newest first (none: an empty list; no
+    store yet: an empty list); a damaged one raises."""
+    return _calibrations(store_path, None)
 
 
 def readable_calibrations(store_path: str | os.PathLike) -> tuple[list[Calibration], list[str]]:
     """Every calibration of ``store_path`` that can be read, newest first, and a one-line
     problem per one that cannot (a damaged entry): one damaged calibration does not hide the
     store's others, as :func:`stored_calibrations` (which raises on the first) would."""
-    from ..errors import PidcoreError
-    from ..store import Store
-
-    path = Path(store_path)
-    if not path.is_file():
-        return [], []
-    store = Store(path)
-    found: list[Calibration] = []
     problems: list[str] = []
-    for key in reversed(list(store.list_calibrations()["key"])):
-        try:
-            found.append(_calibration(store, key))
-        except PidcoreError as exc:
-            problems.append(str(exc))
-    return found, problems
+    return _calibrations(store_path, problems), problems
 
 
 def stored_calibration(store_path: str | os.PathLike, key: str | None = None) -> Calibration:
