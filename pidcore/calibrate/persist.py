@@ -31,8 +31,6 @@ if TYPE_CHECKING:  # pragma: no cover
 #: wall time, how many runs came from the cache, the path of the store that cached them.
 _BOOKKEEPING = ("wall_s", "runs")
 _KEY_PREFIX = "cal_"
-#: HDF5's format signature (the first 8 bytes of a file written by h5py).
-_HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 
 
 def calibration_key(document: dict) -> str:
@@ -83,8 +81,10 @@ def is_store_file(path: str | os.PathLike) -> bool:
     path = Path(path)
     if not path.is_file():
         return False
+    from ..io import HDF5_SIGNATURE
+
     with open(path, "rb") as handle:
-        return handle.read(len(_HDF5_SIGNATURE)) == _HDF5_SIGNATURE
+        return handle.read(len(HDF5_SIGNATURE)) == HDF5_SIGNATURE
 
 
 def _calibration(store, key: str) -> Calibration:

@@ -53,7 +53,7 @@ from pathlib import Path
 from ..constants import FileFormat
 from ..errors import InputFileError, ParameterError, PidcoreError, instance_of
 from ..records import Measurement
-from ._common import reraise_interrupt
+from ._common import HDF5_SIGNATURE, reraise_interrupt
 from .delimited import read_csv, write_csv
 from .hdf5 import hdf5_keys, read_hdf5, write_hdf5
 from .matlab import read_mat, write_mat
@@ -78,7 +78,6 @@ FILE_FORMAT_EXTENSIONS: dict[str, tuple[str, ...]] = {
 _FORMATS = tuple(FILE_FORMAT_EXTENSIONS)
 #: Why an empty file is refused, after its name (one wording for the CLI and the app's uploads).
 EMPTY_MEASUREMENT_FILE = "empty file; expected a UFF, CSV, MAT or HDF5 measurement file"
-_HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 _UFF_START = re.compile(rb"\A\s*-1[ \t]*\r?\n\s*\d+")
 
 
@@ -104,7 +103,7 @@ def detect_file_format(path: str | os.PathLike[str]) -> str:
         raise InputFileError(f"{where}: {EMPTY_MEASUREMENT_FILE}")
     if head.startswith(b"MATLAB"):
         return "mat"  # v5 header text; v7.3 is HDF5 behind the same 128-byte text header
-    if head.startswith(_HDF5_SIGNATURE) or head[512:520] == _HDF5_SIGNATURE:
+    if head.startswith(HDF5_SIGNATURE) or head[512:520] == HDF5_SIGNATURE:
         return "hdf5"
     if _UFF_START.match(head):
         return "uff"

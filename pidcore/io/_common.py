@@ -255,3 +255,7 @@ def real_scalar(value: object, *, where: str, positive: bool = False) -> float:
         raise InputFileError(f"{where} is {shown!r}; expected a finite "
                              f"{'positive ' if positive else ''}number")
     return float(arr[0])
+
+
+#: The first 8 bytes of every HDF5 file (at 0, or at 512 behind a MATLAB v7.3 header).
+HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"

@@ -38,6 +38,7 @@ from ..constants import SI_UNITS
 from ..errors import InputFileError, ParameterError
 from ..records import Channel, Measurement
 from ._common import (
+    HDF5_SIGNATURE,
     atomic_path,
     file_sha256,
     make_channel,
@@ -221,7 +222,7 @@ def _load(path: str) -> dict:
         head = fh.read(520)
     if not head:
         raise InputFileError(f"{path}: empty file; expected a MATLAB .mat file")
-    if head.startswith(b"MATLAB 7.3") or head[512:520] == b"\x89HDF\r\n\x1a\n":
+    if head.startswith(b"MATLAB 7.3") or head[512:520] == HDF5_SIGNATURE:
         try:
             return _load_v73(path)
         except OSError as exc:
