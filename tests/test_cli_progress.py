@@ -137,6 +137,19 @@ def test_analyze_shows_a_bar_over_many_files_only_on_a_terminal(capsys, monkeypa
                                       / "exports").iterdir() if p.suffix in (".csv", ".uff"))
     assert len(exports) >= 2
     _on_a_terminal(monkeypatch, terminal)
+    # each file made to take longer than tqdm's 0.1 s between redraws: on a fast machine the
+    # three samples finished inside one interval and no "n/3" was ever drawn (a flaky test)
+    import time
+
+    import pidcore.file_settings
+
+    analyze_one = pidcore.file_settings.analyze_with_settings
+
+    def slow(*args, **kwargs):
+        time.sleep(0.15)
+        return analyze_one(*args, **kwargs)
+
+    monkeypatch.setattr(pidcore.file_settings, "analyze_with_settings", slow)
     assert main(["analyze", *exports, "--no-store"]) == 0
     err = capsys.readouterr().err
     assert _bar_drawn(err) == terminal, repr(err)
