@@ -4,7 +4,8 @@ SIGTERM (``kill PID``, ``timeout``, a service manager, a batch scheduler ending 
 same interruption: the same flag, the same one line and nothing half-written, and exit status
 143 (128 + 15) where Ctrl-C's is 130 (128 + 2). With Python's default handling it ended the
 process on the spot (status -15): no word of what was saved, the store's working copy left
-beside it, a sweep's workers left running.
+beside it, a sweep's workers left running. So does SIGHUP (the terminal or ssh session of a
+running sweep closed), exit status 129, where it is not ignored (``nohup`` keeps it ignored).
 
 Python's default SIGINT handler raises :class:`KeyboardInterrupt` at whatever bytecode runs
 next. Raised inside a weakref callback it is printed as "Exception ignored" and swallowed (the
@@ -25,8 +26,9 @@ from contextlib import contextmanager
 _interrupted = threading.Event()
 #: The signal that interrupted (SIGINT where the flag was set by other means).
 _signal_number = signal.SIGINT
-#: Signals handled as an interruption.
-_SIGNALS = (signal.SIGINT, signal.SIGTERM)
+#: Signals handled as an interruption (SIGHUP where the platform has it).
+_SIGNALS = (signal.SIGINT, signal.SIGTERM) + tuple(
+    getattr(signal, name) for name in ("SIGHUP",) if hasattr(signal, name))
 #: Depth of :func:`deferred` blocks the main thread is in (the handler runs in that thread).
 _deferring = 0
 
@@ -57,14 +59,14 @@ def _unraisable_hook(unraisable) -> None:
 
 
 def install() -> Callable[[], None]:
-    """Route SIGINT and SIGTERM through the flag (main thread only; a no-op elsewhere).
+    """Route SIGINT, SIGTERM and SIGHUP through the flag (main thread only; a no-op elsewhere).
 
     Returns a function that puts back the previous handler and unraisable hook (for callers
     such as tests that run the CLI in-process).
     """
     if threading.current_thread() is not threading.main_thread():
         return lambda: None
-    # a SIGTERM ignored by whoever started the process stays ignored (as Python leaves a
+    # a SIGTERM or SIGHUP ignored by whoever started the process stays ignored (as Python leaves a
     # SIGINT ignored at start-up alone)
     previous_handlers = {signum: signal.signal(signum, _handler) for signum in _SIGNALS
                          if signum == signal.SIGINT
@@ -94,7 +96,7 @@ def reset() -> None:
 
 def exit_status() -> int:
     """Exit status of an interrupted command: 128 + the signal's number, the shell's
-    convention (130 for Ctrl-C, 143 for SIGTERM)."""
+    convention (130 for Ctrl-C, 143 for SIGTERM, 129 for SIGHUP)."""
     return 128 + int(_signal_number)
 
 

@@ -263,13 +263,15 @@ def read_only(monkeypatch):
 
 @pytest.fixture(autouse=True)
 def _signal_handlers_restored():
-    """Each test leaves SIGINT and SIGTERM as it found them: ``console_main`` ignores both once
-    its command is over (as the ``pidcore`` process then ends), and run in-process by a test it
-    left the worker ignoring them, so a later test's subprocess inherited SIGTERM ignored and
-    (rightly) kept it so, and an interrupt of pytest itself went unheard."""
+    """Each test leaves SIGINT, SIGTERM and SIGHUP as it found them: ``console_main`` ignores
+    them once its command is over (as the ``pidcore`` process then ends), and run in-process
+    by a test it left the worker ignoring them, so a later test's subprocess inherited
+    SIGTERM ignored and (rightly) kept it so, and an interrupt of pytest itself went
+    unheard."""
     import signal
 
-    saved = {signum: signal.getsignal(signum) for signum in (signal.SIGINT, signal.SIGTERM)}
+    saved = {signum: signal.getsignal(signum)
+             for signum in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)}
     yield
     for signum, handler in saved.items():
         if signal.getsignal(signum) is not handler and handler is not None:

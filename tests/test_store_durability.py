@@ -82,7 +82,8 @@ def _alive(pid: int) -> bool:
 
 
 @pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="reads /proc (Linux)")
-@pytest.mark.parametrize("signum", [signal.SIGKILL, signal.SIGTERM], ids=["kill-9", "sigterm"])
+@pytest.mark.parametrize("signum", [signal.SIGKILL, signal.SIGTERM, signal.SIGHUP],
+                         ids=["kill-9", "sigterm", "sighup"])
 def test_the_workers_of_a_killed_sweep_end_with_it(tmp_path, signum):
     # `kill -9` of a sweep (or calibrate) left its pool workers waiting for work forever,
     # with the fork server and the killed command's stdout and stderr: a caller reading those
@@ -120,7 +121,7 @@ def test_the_workers_of_a_killed_sweep_end_with_it(tmp_path, signum):
         if signum == signal.SIGKILL:
             assert p.returncode == -signal.SIGKILL
         else:
-            assert (p.returncode, err) == (128 + signal.SIGTERM, "interrupted\n")
+            assert (p.returncode, err) == (128 + signum, "interrupted\n")
         deadline = time.monotonic() + 5
         while any(map(_alive, workers)) and time.monotonic() < deadline:
             time.sleep(0.05)
@@ -130,12 +131,14 @@ def test_the_workers_of_a_killed_sweep_end_with_it(tmp_path, signum):
             os.killpg(p.pid, signal.SIGKILL)  # whatever is left of this test's processes
 
 
-def test_sigterm_mid_commit_is_an_interruption_exit_143_store_unchanged(tmp_path):
+@pytest.mark.parametrize("signum", [signal.SIGTERM, signal.SIGHUP], ids=["sigterm", "sighup"])
+def test_sigterm_mid_commit_is_an_interruption_exit_143_store_unchanged(tmp_path, signum):
     # `kill PID`, `timeout`, a batch scheduler: SIGTERM ended the process on the spot (status
     # -15, no word on stderr), the store's working copy left beside it. Now it is Ctrl-C's
     # interruption with the shell's status for SIGTERM, 128 + 15. The signal is sent from
     # inside the store's transaction (the analysis saved, before the rename) so that it lands
-    # there every time, not at a moment a loaded machine chooses.
+    # there every time, not at a moment a loaded machine chooses. SIGHUP (the terminal of a
+    # sweep closed) ended the process on the spot too; now the same, with status 128 + 1.
     rec = synthesize_shaker_record(mass_kg=0.25, acceleration_amplitude_m_s2=49.0,
                                    frequency_hz=100.0, sample_rate_hz=25_600.0, n_periods=40,
                                    viscous_damping_n_s_m=2.0, snr_db=50, seed=3)
@@ -151,14 +154,14 @@ def test_sigterm_mid_commit_is_an_interruption_exit_143_store_unchanged(tmp_path
         saved = measure.store_analysis
         def store_then_sigterm(*args, **kwargs):
             key = saved(*args, **kwargs)
-            os.kill(os.getpid(), signal.SIGTERM)
+            os.kill(os.getpid(), {int(signum)})
             return key
         measure.store_analysis = store_then_sigterm
         sys.exit(console_main(["analyze", {str(small)!r}, "--store", {str(store.path)!r}]))
     """)
     p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                        timeout=120, env={**os.environ, "PYTHONPATH": str(ROOT)})
-    assert p.returncode == 128 + signal.SIGTERM, (p.returncode, p.stderr[-2000:])
+    assert p.returncode == 128 + signum, (p.returncode, p.stderr[-2000:])
     assert p.stderr == ("pidcore analyze: interrupted; nothing saved, the store is "
                         "unchanged\n") and p.stdout == ""
     assert file_sha256(store.path) == digest
@@ -308,6 +311,28 @@ def test_a_store_reached_through_a_symbolic_link_is_written_where_it_lives(tmp_p
             Store(shared.path, lock_timeout_s=0.2).add_dem_run("blocked", {"sdc": 0.3})
     assert sorted(os.listdir(tmp_path / "project")) == ["pid_store.h5"]
     assert sorted(os.listdir(tmp_path / "shared")) == ["store.h5"] and shared.verify() == []
+
+
+def test_a_store_file_with_two_names_is_refused_before_any_write(tmp_path):
+    # A hard link: the commit's rename gave one name a new file and left the other with the
+    # old content, so a record saved through one name was missing under the other, without a
+    # word. Refused at the write-ability check (before a DEM run is simulated for it) and by
+    # the transaction itself (library callers), both names unchanged.
+    store = Store(tmp_path / "s.h5")
+    store.add_dem_run("kept", {"sdc": 0.1})
+    other = tmp_path / "other_name.h5"
+    os.link(store.path, other)
+    digest = file_sha256(store.path)
+    with pytest.raises(StoreError, match=r"s\.h5: the store file has 2 names \(hard links\)"):
+        store.check_writable()
+    with pytest.raises(StoreError, match="hard links"):
+        Store(other).add_dem_run("new", {"sdc": 0.2})
+    assert file_sha256(store.path) == file_sha256(other) == digest
+    assert os.stat(store.path).st_ino == os.stat(other).st_ino  # still one file
+    assert sorted(os.listdir(tmp_path)) == ["other_name.h5", "s.h5"]  # no working copy
+    os.unlink(other)  # one name again: saving works
+    store.add_dem_run("new", {"sdc": 0.2})
+    assert list(store.list_dem_runs()["case_key"]) == ["kept", "new"]
 
 
 def test_a_numba_cache_that_cannot_be_written_costs_a_compile_not_the_run(tmp_path):

@@ -2,7 +2,7 @@
 
 Each sub-command lives in its own module with ``register(subparsers)``; all logic is in the
 library. Errors derived from :class:`pidcore.errors.PidcoreError` become one line on stderr and
-exit code 2; Ctrl-C exits 130 (SIGTERM 143) after finished work has been saved.
+exit code 2; Ctrl-C exits 130 (SIGTERM 143, SIGHUP 129) after finished work has been saved.
 """
 
 from __future__ import annotations
@@ -173,7 +173,7 @@ def _command_name(args: argparse.Namespace) -> str:
 
 def console_main(argv: list[str] | None = None) -> int:
     """Entry point of the ``pidcore`` command and of ``python -m pidcore``: :func:`main`, then
-    Ctrl-C and SIGTERM ignored for the rest of the process.
+    Ctrl-C, SIGTERM and SIGHUP ignored for the rest of the process.
 
     The command is over by then (whatever it saved is committed and reported); a Ctrl-C that
     lands while the interpreter shuts down would otherwise end the process by the signal

@@ -395,7 +395,21 @@ class Store:
             raise StoreError(f"{self.path}: its folder {directory} is read-only (the store is "
                              "written as a copy beside it, then renamed); expected a writable "
                              "folder (give a store file in another one)")
+        self._check_single_link()
         self._check_room(directory)
+
+    def _check_single_link(self) -> None:
+        """Refuse a store file with more than one name (a hard link): a save replaces the
+        file, so every other name kept the old content without a word, and records saved
+        through one name were missing under the other."""
+        with suppress(OSError):  # gone or unreadable: the transaction says what is wrong
+            links = self._file.stat().st_nlink
+            if links > 1:
+                raise StoreError(
+                    f"{self.path}: the store file has {links} names (hard links), and a save "
+                    "replaces the file, so the other names would keep the old content; "
+                    "expected a store file with one name (give a copy of it, or a symbolic link "
+                    "in place of the hard link)")
 
     def _check_room(self, directory: Path) -> None:
         """Refuse a commit that cannot fit: every commit writes a whole copy of the store
@@ -535,6 +549,7 @@ class Store:
             self._remove_stale_temporaries()
             exists = target.exists()
             if exists:
+                self._check_single_link()
                 with self._reading():
                     pass  # validates: a foreign or corrupt file must never be replaced
             tmp = directory / f".{target.name}.{secrets.token_hex(8)}.tmp"
