@@ -133,6 +133,24 @@ def test_purely_resistive_load_is_refused_not_reported(snr_db, seed):
     assert res.loss_factor == pytest.approx(c / (m * 2 * np.pi * f), rel=1e-9)
 
 
+@pytest.mark.parametrize("sign", [1.0, -1.0], ids=["positive", "negative"])
+def test_a_reactive_power_within_its_uncertainty_is_unresolved_whatever_its_sign(sign):
+    """A purely resistive load's Im(P_c) is round-off or noise of either sign. Noise-free, one
+    machine's round-off gave -6.36e-35 W, and the record was refused as an inverted channel
+    ("pass --invert"), sending the user to flip a sensor that was right. Both signs are now
+    "not resolved"; a negative Im(P_c) beyond its uncertainty is still an inverted channel."""
+    from pidcore.signal.power import _check_reactive_power_resolved
+
+    with pytest.raises(SignalError, match=r"below 1e-08 x \|P_c\| \(round-off\)"):
+        _check_reactive_power_resolved(complex(2.0, sign * 1e-19), None, source="r")
+    blocks = np.array([1 + 0.01j, 1 - 0.012j, 1 + 0.009j, 1 - 0.008j])  # noise about zero
+    with pytest.raises(SignalError, match=r"within 3 standard errors .* of zero"):
+        _check_reactive_power_resolved(complex(1.0, sign * 0.001), blocks, source="r")
+    # resolved: 0.5 W is 100+ standard errors (~0.005 W) from zero, either sign; the negative
+    # one is left to analyze_power's inverted-channel refusal
+    _check_reactive_power_resolved(complex(1.0, sign * 0.5), blocks, source="r")
+
+
 def test_spring_like_or_inverted_record_is_refused():
     """Force in phase with displacement (Im(P_c) < 0), or a mass record with the velocity
     inverted: never a NaN loss factor or a negative energy, an error naming both channels."""
