@@ -23,4 +23,5 @@ rm -rf r14_rep r14_damp && $PY -m pidcore report --store r14_store.h5 --out r14_
 $PY -m pidcore model damper --table store --store r14_store.h5 --out r14_damp >/dev/null
 $PY measure_ref.py r14_an.json r14_rep/report.csv r14_store.h5
 $PY damper_store_ref.py r14_damp r14_store.h5
+$PY app_cli_ref.py r14_store.h5 r14_damp r14_rep/report.csv
 $PY pchip_ref2.py
