@@ -258,15 +258,14 @@ def _damping_ratio(sdc: float, loss_factor: float) -> tuple[float | None, str]:
 
 def _check_reactive_power_resolved(p_c: complex, p_blocks: np.ndarray | None, *,
                                    source: str) -> None:
-    """Refuse a positive reactive power that is zero within its uncertainty.
+    """Refuse a reactive power that is zero within its uncertainty, of either sign.
 
     E = Im(P_c)/w is the denominator of the loss factor and the SDC: a purely resistive load
     (force in phase with velocity) has no stored kinetic energy, and its Im(P_c) is round-off
     or noise of either sign. A negative one is refused as an inverted channel (the caller);
-    a positive one gave a loss factor of 1e15 and an SDC reported as a result.
+    a positive one gave a loss factor of 1e15 and an SDC reported as a result. A negative one
+    within that floor is round-off too: it was called an inverted channel by its sign alone.
     """
-    if not p_c.imag > 0:
-        return  # the caller's inverted-channel refusal
     floor = defaults.REACTIVE_POWER_MIN_FRACTION * abs(p_c)
     why = f"below {defaults.REACTIVE_POWER_MIN_FRACTION:g} x |P_c| (round-off)"
     if p_blocks is not None and p_blocks.size >= 2:
@@ -275,6 +274,8 @@ def _check_reactive_power_resolved(p_c: complex, p_blocks: np.ndarray | None, *,
             floor = defaults.REACTIVE_POWER_MIN_STDERRS * stderr
             why = (f"within {defaults.REACTIVE_POWER_MIN_STDERRS:g} standard errors "
                    f"({stderr:.3g} W, from {p_blocks.size} blocks) of zero")
+    if p_c.imag < -floor:
+        return  # resolved and negative: the caller's inverted-channel refusal
     if p_c.imag <= floor:
         raise SignalError(
             f"{source or 'record'}: reactive power Im(P_c) = {p_c.imag:.4g} W is {why}, with "
