@@ -154,7 +154,7 @@ def main(analysis_json: str, report_csv: str, store_h5: str) -> None:
               f"{row['difference measured (E of Eq. 10) - ours [-]']:.5f} vs {diff:.5f} here")
 
 
-def paper_columns(report_csv: str) -> None:
+def paper_columns(report_csv: str, store_h5: str) -> None:
     """Every grid row's paper columns equal the shared Table 3 transcription (not pidcore's
     copy), and the difference column is ours minus the paper's."""
     shared = pd.read_csv("/work/shared/reference/table3.csv")
@@ -168,6 +168,15 @@ def paper_columns(report_csv: str) -> None:
             and np.array_equal(merged["SDC measured (paper) [-]"], merged["sdc_experimental"],
                                equal_nan=True))
     diff = merged["SDC DEM (ours) [-]"] - merged["sdc_dem"]
+    from pidcore.store import Store  # the listing only: the values are those stored
+
+    runs = Store(store_h5).list_dem_runs()
+    ours = merged.merge(runs, on=["frequency_hz", "acceleration_g", "fill_percent"])
+    dem_same = (np.array_equal(ours["SDC DEM (ours) [-]"], ours["sdc"])
+                and np.array_equal(ours["SDC DEM stderr [-]"], ours["sdc_stderr"])
+                and np.array_equal(ours["particles per cell [-]"], ours["particles_per_cell"]))
+    print(f"report DEM columns (SDC, stderr, particles per cell) equal the {len(ours)} stored "
+          f"runs: {dem_same}")
     print(f"report paper columns equal the shared Table 3 on 48 rows: {same}; difference "
           f"column max |error| "
           f"{np.nanmax(np.abs(merged['difference ours - paper DEM [-]'] - diff)):.1e}")
@@ -175,4 +184,4 @@ def paper_columns(report_csv: str) -> None:
 
 if __name__ == "__main__":
     main(*sys.argv[1:4])
-    paper_columns(sys.argv[2])
+    paper_columns(sys.argv[2], sys.argv[3])
