@@ -287,6 +287,28 @@ def test_compare_case_on_the_paper_grid(good_csv, options):
     np.testing.assert_allclose(at_grid, comp.paper_points["SDC DEM (paper) [-]"], rtol=2e-2)
 
 
+def test_compare_case_of_another_specimen_shows_no_paper_table3(good_csv, options):
+    """Was: the Compare page drew the paper's Table 3 points, its pchip curve and its DEM
+    0.1891 / measured 0.21 beside a test of another acrylic specimen (my_acrylic), a coupon
+    the paper never tested; `pidcore report` left them out of such a row only for the report
+    of that specimen. The paper's coupon (unnamed, or named paper_coupon) keeps them."""
+    from pidcore.model import load_paper_table3
+
+    paper = load_paper_table3()
+    rec = _record(good_csv, options)
+    mine = compare_case([_entry(rec, specimen="my_acrylic")], None, paper)
+    assert mine.paper_points.empty and mine.model_sdc.size == 0
+    assert math.isnan(mine.aligned.sdc_paper_dem)
+    assert math.isnan(mine.aligned.sdc_paper_experimental)
+    assert ("specimen my_acrylic is not the paper's coupon: the paper's Table 3 is not "
+            "compared") in mine.notes
+    for name in ("", "paper_coupon"):
+        theirs = compare_case([_entry(rec, specimen=name)], None, paper)
+        assert theirs.aligned.sdc_paper_dem == 0.1891  # Table 3: 100 Hz, 5 g, 50 %
+        assert theirs.paper_points.set_index("fill [%]").loc[50.0,
+                                                             "SDC measured (paper) [-]"] == 0.21
+
+
 def test_chart_data_hold_every_series_with_their_errors(good_csv, options):
     from pidcore.model import load_paper_table3
 
@@ -333,7 +355,9 @@ def test_save_writes_the_load_case_and_the_report_reads_it(tmp_path, good_csv, o
     assert row["specimen"] == "S1"
     table = store_report_table(store_file)
     assert table["SDC measured [-]"].tolist() == [rec.analysis.sdc]
-    assert table["SDC DEM (paper) [-]"].tolist() == [0.1891]
+    # S1 is not the paper's coupon: Table 3 (DEM 0.1891 here) is not set beside its test
+    assert table["SDC DEM (paper) [-]"].isna().all()
+    assert "specimen S1 is not the paper's coupon" in table["note"].iloc[0]
 
 
 def test_two_sessions_saving_at_once_keep_the_store_whole(tmp_path, options):

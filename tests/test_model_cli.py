@@ -386,3 +386,27 @@ def test_a_selection_refusal_names_the_where_option_not_a_python_dict(tmp_path, 
         _run([*argv, "--where", "material=steel"])
     assert str(refused.value) == "DEM runs: none match --where material=steel"
     assert not (tmp_path / "o").exists()
+
+
+def test_table3_sdc_is_not_put_over_another_materials_mass(tmp_path):
+    """Was: `--material aluminium` wrote c_eq = SDC m_c w / (2 pi) with Table 3's acrylic SDC
+    over the m_c of aluminium spheres (1.18 x the acrylic m_c at 50 %): a damper dissipating
+    energy no DEM run found, written as the paper's. The acrylic table (the default, or named)
+    gives back each SDC's energy: c_eq = dE / (pi w X^2) with dE = SDC m_c a^2 / (2 w^2)."""
+    out = tmp_path / "al"
+    with pytest.raises(ParameterError, match=r"--material aluminium: the paper's Table 3 "
+                                             r"holds the SDC of acrylic particles only"):
+        _run(["model", "damper", "--out", str(out), "--material", "aluminium"])
+    assert not out.exists()
+    _run(["model", "damper", "--out", str(tmp_path / "ac"), "--material", "acrylic",
+          "--format", "csv"])
+    table = pd.read_csv(tmp_path / "ac" / "equivalent_damper.csv")
+    w = 2 * np.pi * table["frequency [Hz]"]
+    a = 9.80665 * table["acceleration [g]"]
+    energy = table["sdc [-]"] * table["vibrated_mass [kg]"] * a**2 / (2 * w**2)
+    # the same products in another order: equal to round-off
+    np.testing.assert_allclose(table["c_eq [N s/m]"], energy / (np.pi * w * (a / w**2) ** 2),
+                               rtol=1e-12)
+    # an explicit m_c is the user's: the material then only sets its unit-slip range
+    assert _run(["model", "damper", "--out", str(tmp_path / "m"), "--material", "aluminium",
+                 "--vibrated-mass", "0.1", "--format", "csv"]) == 0

@@ -167,3 +167,21 @@ def test_a_test_of_a_specimen_whose_runs_the_store_holds_says_how_to_compare_the
     # with its --specimen the same test meets that run
     row = _measured(specimen_report_table(store_runs, named, specimen=steel).table, "other.h5")
     assert row[ALIGNMENT_COLUMN] == "grid"
+
+
+def test_a_test_of_another_acrylic_specimen_gets_no_paper_table3_columns(store_runs):
+    """Was: the default report put the paper's Table 3 (DEM 0.5612, measured 0.63 at 1000 Hz,
+    5 g, 50 %) beside a measurement naming another acrylic specimen, a coupon the paper never
+    tested. The unnamed measurement at the same case is the paper's coupon's and keeps them."""
+    analyses = pd.DataFrame({
+        "frequency_hz": [1000.0, 1000.0], "acceleration_g": [5.0, 5.0],
+        "fill_percent": [50.0, 50.0], "material": ["acrylic", "acrylic"],
+        "direction": ["z", "z"], "sdc": [3.5, 3.6], "sdc_stderr": [0.05, 0.05],
+        "source": ["paper.h5", "mine.h5"], "specimen": ["", "my_acrylic"]})
+    table = specimen_report_table(store_runs, analyses).table
+    mine = _measured(table, "mine.h5")
+    assert mine["specimen"] == "my_acrylic"
+    assert pd.isna(mine["SDC DEM (paper) [-]"]) and pd.isna(mine["SDC measured (paper) [-]"])
+    assert "not the paper's coupon" in mine["note"]
+    paper = _measured(table, "paper.h5")  # Table 3 values, transcribed in paper_table3.csv
+    assert (paper["SDC DEM (paper) [-]"], paper["SDC measured (paper) [-]"]) == (0.5612, 0.63)

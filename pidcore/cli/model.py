@@ -88,8 +88,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         "their SDC by (their specimen's masses and count; another convention "
                         "is refused)")
     d.add_argument("--material", choices=PARTICLE_MATERIALS, default=None,
-                   help="particle material of --table paper's masses (default "
-                        f"{defaults.MODEL_PARTICLE_MATERIAL}); --table store: the runs' own")
+                   help="particle material of the masses: --table paper: "
+                        f"{defaults.MODEL_PARTICLE_MATERIAL}, Table 3's (another is refused "
+                        "unless --vibrated-mass gives m_c, whose unit-slip check it sets); "
+                        "--table store: the runs' own")
     d.add_argument("--vibrated-mass", metavar="KG", type=_positive_float, default=None,
                    help="explicit m_c, kg (overrides --mass-convention; --table paper only: "
                         "stored runs divided their SDC by their own m_c; more than 100 x "
@@ -186,6 +188,16 @@ def run_damper(args: argparse.Namespace) -> int:
         if outside:
             raise ParameterError(f"{option} {','.join(as_given(v) for v in outside)}: outside "
                                  f"the model's range {lo:g} .. {hi:g} (never extrapolated)")
+    table3 = defaults.MODEL_PARTICLE_MATERIAL  # Table 3's particles (paper Sect. 4)
+    if runs is None and args.vibrated_mass is None and args.material not in (None, table3):
+        # Table 3's SDC is the acrylic coupon's dissipation over its own m_c: times the m_c
+        # of other particles it gave a damper no DEM run found (c_eq 1.18 x at 50 %
+        # aluminium), written as the paper's
+        raise ParameterError(
+            f"--material {args.material}: the paper's Table 3 holds the SDC of {table3} "
+            f"particles only, taken over an m_c holding {table3} spheres, which c_eq = SDC "
+            f"m_c w / (2 pi) must use; leave --material out, or run the DEM with --material "
+            f"{args.material} (pidcore dem sweep) and use --table store")
     if runs is not None:
         for option, column, given in (("--mass-convention", "vibrated_mass_convention",
                                        args.mass_convention),

@@ -384,6 +384,7 @@ def compare_case(records: Sequence[MeasuredEntry],
     """
     from ..model import SdcModel
     from .align import PAPER_DIRECTION, PAPER_MATERIAL
+    from .specimens import NOT_PAPER_SPECIMEN_NOTE, is_paper_specimen_name
 
     if not records:
         raise ParameterError("compare_case: no records given")
@@ -406,11 +407,18 @@ def compare_case(records: Sequence[MeasuredEntry],
     chi2, dof = consistency_chi2(values, errors)
     tol = Tolerances()
     runs = dem_runs if dem_runs is not None and not dem_runs.empty else None
+    notes: list[str] = []
+    # Table 3 describes the paper's coupon: beside a test of another specimen its points, its
+    # pchip curve and its values were read as that coupon's (the report's rule too)
+    specimen = records[0].specimen
+    if not is_paper_specimen_name(specimen):
+        if case.material == PAPER_MATERIAL and case.direction == PAPER_DIRECTION:
+            notes.append(NOT_PAPER_SPECIMEN_NOTE.format(name=specimen.strip()))
+        paper = paper.iloc[0:0]
     # the measured fill chooses among stored runs that are one simulation (and names the case)
     aligner = Aligner.from_tables(runs, paper, tolerances=tol,
                                   reference_fills=[case.fill_percent])
     aligned = aligner.align(case)
-    notes: list[str] = []
 
     dem_rows = []
     for c in aligner.cases:
@@ -425,7 +433,7 @@ def compare_case(records: Sequence[MeasuredEntry],
     paper_cols = ["fill [%]", "SDC DEM (paper) [-]", "SDC measured (paper) [-]"]
     paper_points = pd.DataFrame(columns=paper_cols)
     model_x = model_y = np.empty(0)
-    if case.material == PAPER_MATERIAL and case.direction == PAPER_DIRECTION:
+    if case.material == PAPER_MATERIAL and case.direction == PAPER_DIRECTION and not paper.empty:
         f = paper["frequency_hz"].to_numpy(float)
         a = paper["acceleration_g"].to_numpy(float)
         at_case = ((np.abs(f - case.frequency_hz) <= tol.frequency_rtol * f)

@@ -55,6 +55,20 @@ def specimen_label(name: str, sha256: str) -> str:
     return f"{name or 'unnamed'} [{sha256[:6]}]"
 
 
+def is_paper_specimen_name(name: object) -> bool:
+    """True where a measurement's specimen (its name; empty: not named, the paper's coupon by
+    default) is the paper's coupon, the only specimen the paper's Table 3 describes."""
+    from ..constants import PARTICLE_MATERIALS
+    from ..specimen import paper_specimen
+
+    named = name.strip() if isinstance(name, str) else ""
+    return not named or named in {paper_specimen(m).name for m in PARTICLE_MATERIALS}
+
+
+NOT_PAPER_SPECIMEN_NOTE = ("specimen {name} is not the paper's coupon: the paper's Table 3 is "
+                           "not compared")
+
+
 def run_specimen_labels(runs: pd.DataFrame) -> pd.Series:
     """One :func:`specimen_label` per run (the paper's coupon is one specimen)."""
 

@@ -38,7 +38,11 @@ from ..compare.align import (
 )
 from ..compare.loadcase import LoadCase, LoadCaseError
 from ..compare.plausibility import stored_findings
-from ..compare.specimens import runs_for_measurement
+from ..compare.specimens import (
+    NOT_PAPER_SPECIMEN_NOTE,
+    is_paper_specimen_name,
+    runs_for_measurement,
+)
 from ..errors import ParameterError, instance_of
 from ..units import g_to_si
 
@@ -298,9 +302,16 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
                             *match_paper(dem.load_case, paper, tolerances=tolerances)[:2])
         if base is None:
             group = rows.setdefault(case.key, [])
+            # Table 3 describes the paper's coupon: a test of another specimen showed its
+            # values (and the paper's measurement) as if they were that coupon's
+            paper_values = (aligned.sdc_paper_dem, aligned.sdc_paper_experimental)
+            not_paper = []
+            if not is_paper_specimen_name(specimen) and np.isfinite(paper_values).any():
+                paper_values = (math.nan, math.nan)
+                not_paper = [NOT_PAPER_SPECIMEN_NOTE.format(name=specimen)]
             base = _Row(case, aligned.status, None, aligned.sdc_dem, aligned.sdc_dem_stderr,
-                        aligned.sdc_paper_dem, aligned.sdc_paper_experimental,
-                        notes=[aligned.message] + ([met_note] if met_note else []))
+                        *paper_values,
+                        notes=[aligned.message] + ([met_note] if met_note else []) + not_paper)
         row = next((r for r in group if r.dem is base.dem and r.specimen == specimen), None)
         if row is None:
             row = next((r for r in group if r.dem is base.dem and r.specimen is None), None)

@@ -177,7 +177,8 @@ def render(stores, session_files: list, calibrations: list) -> None:
         if not (math.isfinite(aligned.sdc_paper_dem)
                 and math.isfinite(aligned.sdc_paper_experimental)):
             st.caption("paper: none where Table 3 has no value at this case (it tabulates "
-                       "acrylic spheres driven along z at its grid of load cases)")
+                       "the paper's coupon, acrylic spheres driven along z, at its grid of "
+                       "load cases)")
     _calibrated(calibrations, comp, head, members[0].specimen,
                 implausible=any(e.implausible for e in members))
     for note in view["notes"]:
