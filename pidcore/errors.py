@@ -5,6 +5,12 @@ one line and exits non-zero. Messages name the file, channel or parameter and wh
 :func:`whole_number`, :func:`real_number` and :func:`instance_of` refuse a value of the wrong
 type (a string, a bool, a fraction where a count is meant) in those words, before any use of it.
 
+A message names a parameter as a Python caller writes it: its keyword (``structure_mass_kg``),
+with a value or a placeholder where it says what to give (``key=NAME``, ``force='Fz'``,
+``allow_clipped=True``), never a front-end's flag or label. The CLI says it as its flag
+(``--structure-mass``: one table, :mod:`pidcore.cli._vocabulary`), the app as its field
+(``'structure mass [g]'``: :mod:`pidcore.app.vocabulary`).
+
 Public API
 ----------
 PidcoreError

@@ -472,18 +472,18 @@ def analyze_with_settings(path: str | os.PathLike, settings: FileSettings, *,
     except PidcoreError as exc:
         message = str(exc)
         if invert_cell is not None:  # the table's cell, appended below, not the option
-            message = message.replace("--invert '", "invert '")
+            message = message.replace("invert='", "invert '")
         explained = settings.explain(message)
         if explained == str(exc):
             raise
         raise type(exc)(explained) from None
     if invert_cell is None:
         return record
-    # "channel 'V' inverted (--invert)" of a channel the table's invert column named: the
+    # "channel 'V' inverted (invert='V')" of a channel the table's invert column named: the
     # note names the cell, as the settings line and the errors do
     column, _, where = invert_cell
     return replace(record, notes=tuple(
-        n.replace(" inverted (--invert)", f" inverted (column {column} of {where})")
+        re.sub(r" inverted \(invert='[^']*'\)", f" inverted (column {column} of {where})", n)
         for n in record.notes))
 
 
@@ -509,7 +509,7 @@ def _refuse_fill_of_no_particle(path: str | os.PathLike, stated: StatedLoadCase 
             raise
         origin = next((part.strip() for part in stated.origin.split(";")
                        if part.strip().startswith("fill")), "")
-        origin = origin.replace("fill: option", "fill: --fill")
+        origin = origin.replace("fill: option", "fill: fill_percent")
         # (particles_for_fill asks whether a fraction was typed where that holds a particle)
         hint = "" if "meant as" in str(exc) else "; a fill is a percentage of the cell's capacity"
         raise LoadCaseError(f"{display_path(Path(path).name)}: {exc} ({origin}{hint})") \

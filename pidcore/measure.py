@@ -145,8 +145,8 @@ class AnalyzedRecord:
         return out
 
 
-_UNIT_OPTIONS = {"force": "--force-unit", "velocity": "--velocity-unit",
-                 "acceleration": "--acceleration-unit"}
+_UNIT_OPTIONS = {"force": "force_unit", "velocity": "velocity_unit",
+                 "acceleration": "acceleration_unit"}
 _UNIT_EXAMPLES = {"force": "N, kN, lbf", "velocity": "m/s, mm/s, in/s",
                   "acceleration": "m/s^2, g"}
 
@@ -159,11 +159,11 @@ def _with_unit(ch: Channel, role: str, unit: str | None, source: str,
             said = f"the file gives {ch.source_unit!r}" if ch.source_unit else "the file gives none"
             raise ChannelError(
                 f"{source}: channel {ch.name!r} ({role}) has no recognised unit ({said}); give "
-                f"it with {_UNIT_OPTIONS[role]} UNIT (e.g. {_UNIT_EXAMPLES[role]})")
+                f"it with {_UNIT_OPTIONS[role]}=UNIT (e.g. {_UNIT_EXAMPLES[role]})")
         return ch
     info = lookup_unit(unit)
     if info is None or info.quantity != role:
-        raise ParameterError(f"{_UNIT_OPTIONS[role]} {unit!r}: not a {role} unit")
+        raise ParameterError(f"{_UNIT_OPTIONS[role]}={unit!r}: not a {role} unit")
     if ch.quantity != "unknown":
         # the reader scaled the file's numbers to SI by the file's unit, of whatever quantity
         # (a force exported as "m/s"): undo that, then apply the unit the user gives
@@ -243,11 +243,11 @@ def _invert(measurement: Measurement, names: Sequence[str], notes: list[str]) ->
     known = {c.name for c in measurement.channels}
     for name in names:
         if name not in known:
-            raise ChannelError(f"{measurement.source}: --invert {name!r}: no such channel; "
+            raise ChannelError(f"{measurement.source}: invert={name!r}: no such channel; "
                                f"channels are {', '.join(repr(n) for n in known)}")
     channels = tuple(replace(c, data=-np.asarray(c.data)) if c.name in names else c
                      for c in measurement.channels)
-    notes.extend(f"channel {n!r} inverted (--invert)" for n in names)
+    notes.extend(f"channel {n!r} inverted (invert={n!r})" for n in names)
     return replace(measurement, channels=channels)
 
 
@@ -296,8 +296,8 @@ def _unit_slip_notes(measurement: Measurement, chosen: Mapping[str, Channel],
             f"acceleration of channel {velocity.name!r} ({velocity.source_unit or 'no unit'}) "
             f"at the drive line ({amplitude:.4g} against omega |V| = {expected:.4g} m/s^2): "
             "a unit slip in one of them (mm/s written as m/s, g as m/s^2)? The velocity is "
-            "used as its unit says; check both units (--velocity-unit, "
-            "--acceleration-unit)")
+            "used as its unit says; check both units (velocity_unit, "
+            "acceleration_unit)")
     return notes
 
 
@@ -334,7 +334,7 @@ def analyze_measurement(measurement: Measurement, options: AnalysisOptions | Non
                                ("acceleration", roles.acceleration)) if ch is not None}
     for role, unit in units.items():
         if unit is not None and role not in chosen:
-            raise ParameterError(f"{_UNIT_OPTIONS[role]} {unit!r}: {measurement.source} has no "
+            raise ParameterError(f"{_UNIT_OPTIONS[role]}={unit!r}: {measurement.source} has no "
                                  f"{role} channel in use")
     chosen, start_delay = _align(chosen, measurement.source, notes, corrections)
     if roles.ignored:
@@ -359,8 +359,8 @@ def analyze_measurement(measurement: Measurement, options: AnalysisOptions | Non
         # taken off must be told
         notes.append(f"structure mass {options.structure_mass_kg:.4g} kg given without a "
                      "baseline loss factor: nothing subtracted (give the empty structure's "
-                     "loss factor too: --baseline-loss-factor, a baseline_loss_factor column, "
-                     "the app's baseline loss factor [-])")
+                     "loss factor too: baseline_loss_factor, or a baseline_loss_factor column of "
+                     "the settings table)")
     used = {role: ch.name for role, ch in chosen.items()}
     detail = tuple({"role": role, "name": ch.name, "unit": ch.unit,
                     "source_unit": ch.source_unit} for role, ch in chosen.items())

@@ -1298,7 +1298,7 @@ def test_a_failed_calibration_says_the_librarys_line_in_the_pages_terms(tmp_path
 
     runner = CalibrationRunner(tmp_path / "s.h5")
     for error, said in (
-            (ParameterError("--fit: unknown parameter 'frction'; expected ... "
+            (ParameterError("fit: unknown parameter 'frction'; expected ... "
                             "(pidcore specimen check)"),
              "parameters to fit: unknown parameter 'frction'; expected ... (as `pidcore "
              "specimen check` lists them)"),
@@ -1312,10 +1312,10 @@ def test_a_failed_calibration_says_the_librarys_line_in_the_pages_terms(tmp_path
 
     (spec,) = build_specs(["fixture_mass_kg"], discrepancy=0.2)
     (note,) = bound_notes([spec], np.zeros((100, 1)))  # piled on the lower bound 0
-    assert "(--prior fixture_mass_kg=LOW:HIGH)" in note
+    assert "(priors=fixture_mass_kg=LOW:HIGH)" in note
     assert "(the page fits the default prior; `pidcore calibrate --prior fixture_mass_kg=LOW:" \
            "HIGH` widens it)" in page_words(note)
-    assert page_words("--design-size 5 ignored: no DEM parameter") == \
+    assert page_words("design_size 5 ignored: no DEM parameter") == \
         "design points 5 ignored: no DEM parameter"
 
 
@@ -1718,7 +1718,8 @@ def test_a_structure_mass_typed_in_mg_is_refused_in_the_pages_unit():
                                                              structure_mass_kg=280.0))
     assert outcome.error.startswith("c_fill50.csv: structure mass [g] 280000 g is ")
     assert "structure_mass_kg" not in outcome.error
-    assert "in g in a structure_mass_g column and the app's structure mass [g]" in outcome.error
+    assert "('structure mass [g]' in g; a structure_mass_g column of the settings table in g)" \
+        in outcome.error
 
 
 def test_the_corrections_say_how_the_baseline_went_off():

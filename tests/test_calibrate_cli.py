@@ -303,7 +303,7 @@ def test_too_few_load_cases_name_the_fitted_parameters():
     with pytest.raises(ParameterError, match=r"2 measured load case\(s\) cannot determine 3 "
                                              r"fitted parameter\(s\): fixture_mass_kg, "
                                              r"baseline_loss_factor, model_discrepancy; .*"
-                                             r"--discrepancy TAU"):
+                                             r"discrepancy=TAU"):
         check_enough_points(points, ["fixture_mass_kg", "baseline_loss_factor",
                                      "model_discrepancy"])
     check_enough_points(points, ["fixture_mass_kg", "baseline_loss_factor"])
@@ -426,7 +426,7 @@ def test_design_size_0_and_workers_0_are_refused_not_taken_as_defaults(capsys, t
     from pidcore.calibrate.data import read_measured_table
     from pidcore.errors import ParameterError
 
-    with pytest.raises(ParameterError, match="--design-size: expected >= 2 with DEM "
+    with pytest.raises(ParameterError, match="design_size: expected >= 2 with DEM "
                                              "parameters, got 0"):
         calibrate(read_measured_table(table), fit=["friction"], design_size=0,
                   store_path=tmp_path / "dem.h5")
@@ -462,7 +462,7 @@ def test_auto_falling_back_from_the_grid_to_emcee_is_said(tiny_store, tmp_path, 
     fallen = calibrate(points, **settings)
     assert fallen.settings["method"] == "auto" and fallen.settings["method_used"] == "emcee"
     notes = " ".join(fallen.notes)
-    assert "--method auto: the grid posterior did not settle" in notes
+    assert "method=auto: the grid posterior did not settle" in notes
     assert "3 of 3 leave-one-out fold(s)" in notes
     assert "posterior by emcee" in summary_markdown(fallen)
 

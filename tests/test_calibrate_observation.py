@@ -128,7 +128,7 @@ def test_bound_notes_flag_a_posterior_piled_against_a_prior_bound():
     assert bound_notes([spec], flat) == [] and bound_notes([spec], inside) == []
     high = spec.high - (spec.high - spec.low) * rng.beta(1, 8, (4000, 1))  # 34 % in the top 5 %
     (note,) = bound_notes([spec], high)
-    assert "upper bound 1" in note and "--prior fixture_mass_kg=LOW:HIGH" in note
+    assert "upper bound 1" in note and "priors=fixture_mass_kg=LOW:HIGH" in note
     (note,) = bound_notes([spec], spec.high - high)
     assert "lower bound 0" in note
     # a log-uniform prior's edges are measured in log: a model error of ~8 % lies in the

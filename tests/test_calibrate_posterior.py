@@ -169,7 +169,7 @@ def test_a_grid_that_cannot_box_the_posterior_is_refused_or_left_to_emcee(monkey
     model, mean, cov, _ = linear_problem([0.5, 0.5, 0.02], 0.001, seed=5)
     passes = posterior.GRID_MAX_PASSES
     monkeypatch.setattr(posterior, "GRID_MAX_PASSES", 1)  # no room to zoom in
-    with pytest.raises(posterior.GridUnresolved, match="use --method emcee"):
+    with pytest.raises(posterior.GridUnresolved, match="use method=emcee"):
         sample_posterior(model, range(8), seed=3, method="grid")
     drawn = sample_posterior(model, range(8), seed=3, method="auto")
     assert drawn.samples.std(axis=0) == pytest.approx(np.sqrt(np.diag(cov)), rel=0.1)

@@ -72,7 +72,7 @@ def test_fixture_mass_and_baseline_are_recovered(tmp_path):
                        progress=False, design_size=3)
     # no DEM parameter fitted: a design size is ignored, and said (the summary claimed a
     # design of 3 points while one run per load case was made)
-    assert "--design-size 3 ignored: no DEM parameter is fitted" in " ".join(capped.notes)
+    assert "design_size 3 ignored: no DEM parameter is fitted" in " ".join(capped.notes)
     assert capped.settings["design_size"] == 1
     piled = [n for n in capped.notes if "piles against" in n]
     assert any(n.startswith("fixture_mass_kg:") and "upper bound 0.03" in n for n in piled)

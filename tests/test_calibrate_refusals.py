@@ -87,7 +87,7 @@ def test_default_bounds_outside_the_domain_name_them_and_the_way_out():
         build_specs(["cell.inscribed_diameter_m"])
     text = str(refused.value)
     assert "the default prior bounds cell.inscribed_diameter_m=" in text
-    assert "--prior cell.inscribed_diameter_m=LOW:HIGH" in text and "does not fit" in text
+    assert "priors=cell.inscribed_diameter_m=LOW:HIGH" in text and "does not fit" in text
 
 
 def test_a_prior_box_is_checked_at_its_corners():
@@ -97,7 +97,7 @@ def test_a_prior_box_is_checked_at_its_corners():
     fit = ["particles.radius_m", "cell.inscribed_diameter_m"]
     build_specs(fit, priors)  # every corner valid
     wider = ["particles.radius_m=1e-3:1.2e-3", priors[1]]
-    with pytest.raises(ParameterError, match=r"--prior particles.radius_m=1e-3:1.2e-3; --prior "
+    with pytest.raises(ParameterError, match=r"priors=particles.radius_m=1e-3:1.2e-3; priors="
                                              r"cell.inscribed_diameter_m=2.3e-3:3e-3: the prior "
                                              r"corner particles.radius_m=0.0012, "
                                              r"cell.inscribed_diameter_m=0.0023 is outside"):
@@ -110,7 +110,7 @@ def test_a_static_friction_range_below_the_sliding_friction_is_refused():
     paper = paper_specimen().pairs  # sliding friction 0.096 particle-particle, 0.14 wall
     assert (paper.particle_particle.sliding_friction, paper.particle_wall.sliding_friction) \
         == (0.096, 0.14)
-    with pytest.raises(ParameterError, match=r"^--prior static_friction_pw=0.01:0.12: static "
+    with pytest.raises(ParameterError, match=r"^priors=static_friction_pw=0.01:0.12: static "
                                              r"friction below the sliding friction \(at least "
                                              r"0.14 particle-wall\)"):
         build_specs(["static_friction_pw"], ["static_friction_pw=0.01:0.12"])
@@ -136,7 +136,7 @@ def test_a_static_friction_follows_one_rule_under_either_name(name):
             for v in (0.1, 0.3)]
     assert wall == [0.14, 0.3]  # below the sliding friction 0.14: taken as it
     # a range wholly below it changes no run: refused alike under both names
-    with pytest.raises(ParameterError, match=rf"^--prior {name}=0.05:0.12: static friction "
+    with pytest.raises(ParameterError, match=rf"^priors={name}=0.05:0.12: static friction "
                                              r"below the sliding friction \(at least 0.14"):
         build_specs([name], [f"{name}=0.05:0.12"])
     # a sliding friction set by dotted path in the same call is the floor
@@ -156,7 +156,7 @@ def test_a_design_point_outside_the_domain_names_it_not_the_specimen_file():
     with pytest.raises(ParameterError) as refused:
         calibrate_module._requests([point], [spec], np.array([[2.1e-3]]), DemConfig(), specimen)
     text = str(refused.value)
-    assert text.startswith("--fit/--prior: the design point cell.inscribed_diameter_m=0.0021 ")
+    assert text.startswith("fit/priors: the design point cell.inscribed_diameter_m=0.0021 ")
     assert "does not fit" in text and specimen.source not in text
 
 

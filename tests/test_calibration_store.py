@@ -115,7 +115,7 @@ def test_a_store_of_several_calibrations_needs_a_key(calibrated, capsys, tmp_pat
     new_key = (set(keys) - {Store(store).list_calibrations()["key"].iloc[0]}).pop()
     assert f"report --calibration {copy} --calibration-key {new_key})" in said
     with pytest.raises(ParameterError, match="holds 2 calibrations; choose one with "
-                                             "--calibration-key") as refused:
+                                             "key=KEY") as refused:
         stored_calibration(copy)
     assert all(k in str(refused.value) for k in keys)
     assert stored_calibration(copy, keys[0]).store_key == keys[0]

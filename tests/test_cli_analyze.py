@@ -376,7 +376,7 @@ def test_a_file_of_other_particles_than_the_specimens_names_the_specimens(tmp_pa
     assert main(["analyze", str(steel), "--specimen", str(spec), "--no-store"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1
-    assert ("which the material table (acrylic, aluminium) and the --specimen's "
+    assert ("which the material table (acrylic, aluminium) and the specimen's "
             "tungsten_carbide particles lack") in err
 
 
@@ -437,7 +437,7 @@ def test_a_file_of_other_particles_than_a_table_material_specimens_names_them(tm
     assert main(["analyze", str(steel), "--specimen", str(spec), "--no-store"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1
-    assert "lacks (the --specimen's particles are acrylic); give --specimen FILE whose " \
+    assert "lacks (the specimen's particles are acrylic); give --specimen FILE whose " \
            "particles are steel" in err
 
 

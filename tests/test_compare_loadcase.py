@@ -110,7 +110,7 @@ def test_a_specimens_own_material_is_accepted_and_the_default_with_its_specimen(
     # accepted in the sidecar and by --material only with the specimen, and is the default
     _write_sidecar(tmp_path, "file,fill_percent,material\nsteel.uff,40,steel_440c\n"
                              "plain.uff,40,\n")
-    with pytest.raises(LoadCaseError, match=r"'steel_440c'.*needs --specimen FILE"):
+    with pytest.raises(LoadCaseError, match=r"'steel_440c'.*needs specimen=FILE"):
         resolve_load_case(tmp_path / "steel.uff")
     stated = resolve_load_case(tmp_path / "steel.uff", specimen_material="steel_440c")
     assert stated.material == "steel_440c" and "material: loadcases.csv" in stated.origin
@@ -118,7 +118,7 @@ def test_a_specimens_own_material_is_accepted_and_the_default_with_its_specimen(
     assert stated.material == "steel_440c" and "material: specimen" in stated.origin
     assert stated.load_case(500.0, 1.0).key.endswith("_steel_440c_z")
     assert resolve_load_case(tmp_path / "plain.uff").material == "acrylic"  # no specimen
-    with pytest.raises(LoadCaseError, match="--specimen FILE"):
+    with pytest.raises(LoadCaseError, match="specimen=FILE"):
         resolve_load_case(tmp_path / "plain.uff", material="steel_440c")
     # the specimen's material in the file name is read too (it was the sidecar and option
     # only, and the name's "_steel" was passed over)
@@ -140,7 +140,7 @@ def test_missing_fill_names_file_and_the_three_ways(tmp_path):
     message = str(info.value)
     assert isinstance(info.value, PidcoreError) and "\n" not in message
     assert message.startswith("run_500Hz_acrylic.uff:")
-    for way in ("_fill50_", "_50pct_", "loadcases.csv", "--fill"):
+    for way in ("_fill50_", "_50pct_", "loadcases.csv", "with fill_percent"):
         assert way in message
 
 

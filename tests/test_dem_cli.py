@@ -319,13 +319,13 @@ def test_dem_refusals_name_the_flags_not_the_library_keywords(tmp_path, capsys, 
 
 
 def test_the_flag_wording_leaves_other_words_alone():
-    from pidcore.cli.dem import with_dem_flags
+    from pidcore.cli._vocabulary import cli_words
 
     # "cells" names the option only as a message's first word; paths keep their names
     said = "over 2 cells: my_time_step.toml: acceleration_g must be > 0"
-    assert with_dem_flags(said, "run") == \
+    assert cli_words(said, "dem run") == \
         "over 2 cells: my_time_step.toml: --acceleration must be > 0"
-    assert with_dem_flags("frequency_hz must be > 0", "sweep") == "--frequencies must be > 0"
+    assert cli_words("frequency_hz must be > 0", "dem sweep") == "--frequencies must be > 0"
 
 
 def test_a_sweep_over_the_grids_fills_says_it_is_not_the_specimens_fill(tmp_path, capsys,

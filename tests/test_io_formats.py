@@ -154,7 +154,7 @@ def test_csv_sample_rate_given_equals_time_column(tmp_path):
     c = read_measurement(with_time, sample_rate_hz=400.0)
     assert c.channels[0].sample_rate_hz == 400.0
     assert "time column 'Time' ignored" in c.metadata["reader_notes"][0]
-    with pytest.raises(InputFileError, match=r"without\.csv.*--sample-rate"):
+    with pytest.raises(InputFileError, match=r"without\.csv.*\(sample_rate_hz\)"):
         read_measurement(without)
 
 
@@ -357,7 +357,7 @@ def test_a_sample_rate_a_file_keeps_is_noted_not_ignored_silently(tmp_path, suff
     read = read_measurement(path, sample_rate_hz=25.6)
     assert [c.sample_rate_hz for c in read.channels] == [FS] * 4  # kept, as documented
     (note,) = read.metadata["reader_notes"]
-    assert "the sample rate 25.6 Hz given (--sample-rate) is not applied" in note
+    assert "the sample rate 25.6 Hz given (sample_rate_hz) is not applied" in note
     assert "(2560 Hz), which is kept" in note
     # the file's own rate given: nothing to say
     assert "reader_notes" not in read_measurement(path, sample_rate_hz=FS).metadata
@@ -371,6 +371,6 @@ def test_an_overridden_time_column_says_what_rate_it_gave(tmp_path):
     path.write_text("Time [s],F [N],V [m/s]\n" + "".join(
         f"{a:.17g},{np.sin(a):.17g},{np.cos(a):.17g}\n" for a in t))
     (note,) = read_measurement(path, sample_rate_hz=0.5).metadata["reader_notes"]
-    assert note.endswith("(--sample-rate); the column gives 500 Hz, 1000 x the rate given")
+    assert note.endswith("(sample_rate_hz); the column gives 500 Hz, 1000 x the rate given")
     (note,) = read_measurement(path, sample_rate_hz=500.0 * 1.001).metadata["reader_notes"]
-    assert note.endswith("(--sample-rate)")  # within 0.5 %: a correction, nothing to add
+    assert note.endswith("(sample_rate_hz)")  # within 0.5 %: a correction, nothing to add

@@ -44,7 +44,7 @@ def test_mass_cancellation_needs_the_drive_point_acceleration():
     two = _m(_ch("Force", "force", "N"), _ch("LDV", "velocity", "m/s"),
              _ch("Ref acc", "acceleration", "g"), _ch("Acc 2", "acceleration", "g"))
     with pytest.raises(ChannelError, match=r"2 acceleration channels.*drive point.*"
-                                           r"--acceleration NAME"):
+                                           r"acceleration=NAME"):
         assign_roles(two, mass_cancellation=True)
     assert assign_roles(two, mass_cancellation=True, acceleration="Acc 2").acceleration.name \
         == "Acc 2"
@@ -70,7 +70,7 @@ def test_two_force_channels_unnamed_is_ambiguous():
     with pytest.raises(ChannelError) as info:
         assign_roles(m)
     message = str(info.value)
-    assert "'F1'" in message and "'F2'" in message and "--force NAME" in message
+    assert "'F1'" in message and "'F2'" in message and "force=NAME" in message
     assert assign_roles(m, force="F2").force.name == "F2"
 
 
@@ -89,7 +89,7 @@ def test_override_unknown_name_lists_channels():
 
 def test_override_of_other_quantity_refused_unknown_accepted():
     m = _m(_ch("F", "force", "N"), _ch("acc", "acceleration", "g"), _ch("raw", "unknown", "V^2"))
-    with pytest.raises(ChannelError, match=r"--force 'acc' is an acceleration channel"):
+    with pytest.raises(ChannelError, match=r"force='acc' is an acceleration channel"):
         assign_roles(m, force="acc")
     # with the role's unit given (--force-unit) the file's unit is taken as wrong
     wrong = _m(_ch("Force", "velocity", "m/s"), _ch("LDV", "velocity", "m/s"))
@@ -106,7 +106,7 @@ def test_same_channel_for_two_roles_refused():
 
 
 def test_missing_force_and_missing_motion():
-    with pytest.raises(ChannelError, match=r"no force channel.*--force NAME"):
+    with pytest.raises(ChannelError, match=r"no force channel.*force=NAME"):
         assign_roles(_m(_ch("v", "velocity", "m/s")))
     with pytest.raises(ChannelError, match=r"no velocity or acceleration channel"):
         assign_roles(_m(_ch("F", "force", "N"), _ch("mic", "pressure", "Pa")))

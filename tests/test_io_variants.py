@@ -129,7 +129,7 @@ def test_inverted_channel_is_an_error_with_the_fix(tmp_path, capsys):
     assert "'Force' / 'Velocity' is probably inverted" in err and "--invert NAME" in err
     result = analyze_file(path, AnalysisOptions(invert=("Velocity",)))
     _assert_truth(result.analysis)
-    assert "channel 'Velocity' inverted (--invert)" in result.notes
+    assert "channel 'Velocity' inverted (invert='Velocity')" in result.notes
 
 
 @pytest.mark.parametrize("offset_samples", [1, 3, 0.5])
@@ -185,7 +185,7 @@ def test_unknown_units_never_taken_as_si(tmp_path, capsys):
     assert code == 2 and "--velocity-unit UNIT" in err
     result = analyze_file(path, AnalysisOptions(force_unit="N", velocity_unit="mm/s"))
     _assert_truth(result.analysis)
-    assert any("taken as 'mm/s' (--velocity-unit)" in n for n in result.notes)
+    assert any("taken as 'mm/s' (velocity_unit)" in n for n in result.notes)
 
 
 def test_unit_option_overrides_a_unit_of_another_kind(tmp_path, capsys):
@@ -200,7 +200,7 @@ def test_unit_option_overrides_a_unit_of_another_kind(tmp_path, capsys):
     assert code == 2 and "is an acceleration channel" in err
     result = analyze_file(path, AnalysisOptions(force="Force", force_unit="N"))
     _assert_truth(result.analysis)
-    assert any("says 'm/s', a velocity unit; taken as 'N' (--force-unit)" in n
+    assert any("says 'm/s', a velocity unit; taken as 'N' (force_unit)" in n
                for n in result.notes)
     # the output's "source_unit" is the file's, as documented (it showed the option's)
     (force,) = [c for c in result.channels if c["role"] == "force"]
@@ -249,7 +249,7 @@ def test_wrong_frequency_hint_never_moves_the_estimate(tmp_path, hint):
     write_measurement(Measurement("x", (Channel("Force", "force", rec.force_n, FS, "N"),
                                         Channel("Velocity", "velocity", rec.velocity_m_s, FS,
                                                 "m/s"))), path)
-    with pytest.raises(SignalError, match=r"drive line is at 100(\.\d+)? Hz.*--frequency"):
+    with pytest.raises(SignalError, match=r"drive line is at 100(\.\d+)? Hz.*\(frequency_hz\)"):
         analyze_file(path, AnalysisOptions(frequency_hz=hint))
     _assert_truth(analyze_file(path, AnalysisOptions(frequency_hz=102.0)).analysis)
 

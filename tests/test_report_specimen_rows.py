@@ -62,7 +62,7 @@ def test_rows_without_runs_of_their_specimen_name_it_and_the_other_specimens_run
     assert acrylic[ALIGNMENT_COLUMN] == "no_dem_runs"
     assert acrylic["note"] == ("no DEM runs of steel_6mm for acrylic, direction z (the store "
                                "has 2 of paper_coupon, another specimen's: report without "
-                               "--specimen to compare them)")
+                               "specimen= to compare them)")
     other = _measured(table, "other.h5")
     assert other[ALIGNMENT_COLUMN] == "no_dem_runs"
     assert other["note"] == (f"no DEM runs of other_coupon for steel, direction z (the store "
@@ -96,7 +96,7 @@ def test_default_report_names_other_specimens_runs_and_how_to_compare_them(
     assert row[ALIGNMENT_COLUMN] == "no_dem_runs"
     assert row["note"].startswith("no DEM runs of paper_coupon for steel, direction z (the "
                                   "store has 1 of steel_6mm [")
-    assert row["note"].endswith("report with their --specimen FILE to compare them)")
+    assert row["note"].endswith("report with their specimen=FILE to compare them)")
     assert _measured(table, "acrylic.h5")[ALIGNMENT_COLUMN] == "grid"
 
 
@@ -139,10 +139,10 @@ def test_a_specimen_baseline_the_measurements_did_not_subtract_is_said(steel, st
     (note,) = [n for n in notes if "baseline_loss_factor" in n]
     # one record: the other_coupon one is not this specimen's test
     assert "states [coupon] baseline_loss_factor 0.002" in note and "1 measured record(s)" in note
-    assert f"at most {2 * math.pi * 0.002:.3g}" in note and "--baseline-loss-factor 0.002" in note
+    assert f"at most {2 * math.pi * 0.002:.3g}" in note and "baseline_loss_factor=0.002" in note
     # the exact subtraction needs the structure's mass: the specimen's coupon and fixture
     structure = damped.coupon.mass_kg + damped.coupon.fixture_mass_kg
-    assert f"--structure-mass {structure:.4g}" in note
+    assert f"structure_mass_kg={structure:.4g}" in note
     # subtracted at analysis, or no baseline stated: nothing to say
     done = mine.assign(parameters_json=[json.dumps({"baseline_loss_factor": 0.002})] * 2)
     for specimen, frame in ((damped, done), (steel, mine),
@@ -162,7 +162,7 @@ def test_a_test_of_a_specimen_whose_runs_the_store_holds_says_how_to_compare_the
     assert row["note"] == (f"no DEM runs of steel_6mm for steel, direction z among this "
                            f"report's runs (the store has 1 of steel_6mm [{steel.hash[:6]}]; "
                            "steel_6mm's are left out of a report of another specimen: report "
-                           "with their --specimen FILE to compare them)")
+                           "with their specimen=FILE to compare them)")
     assert "another specimen's: not compared" not in row["note"]
     # with its --specimen the same test meets that run
     row = _measured(specimen_report_table(store_runs, named, specimen=steel).table, "other.h5")

@@ -244,7 +244,7 @@ def test_dem_runs_of_different_settings_are_separate_rows_unless_pooled():
     assert "[" not in settings
     pooled = build_report_table(dem, None, None, pool=True)
     assert len(pooled) == 1 and pooled.iloc[0]["DEM runs [-]"] == 3
-    assert "--pool" in pooled.iloc[0]["note"]
+    assert "(pool=True)" in pooled.iloc[0]["note"]
 
 
 def test_a_measurement_is_compared_with_the_largest_dem_run():

@@ -345,8 +345,8 @@ def test_report_keeps_a_sidecar_specimen_beside_specimen_and_says_so(tmp_path):
                       "b_fill50.csv,50,\n")
     steel = load_specimen(SAMPLES / "specimens" / "steel_6mm.toml")
     result = make_report([a, b], out_dir=tmp_path / "rep", formats="csv", specimen=steel)
-    assert ("a_fill50.csv: its sidecar row names specimen 'coupon_B', not 'steel_6mm' of "
-            "--specimen; compared as 'coupon_B'") in result.notes
+    assert ("a_fill50.csv: its sidecar row names specimen 'coupon_B', not 'steel_6mm' "
+            "(specimen=); compared as 'coupon_B'") in result.notes
     assert not any(n.startswith("b_fill50.csv: its sidecar row") for n in result.notes)
     by_file = result.table.set_index("source file(s)")["specimen"]
     assert by_file[str(a)] == "coupon_B" and by_file[str(b)] == "steel_6mm"
@@ -405,7 +405,7 @@ def test_an_inversion_from_the_table_is_not_credited_to_the_option(tmp_path, cap
     assert not any("--invert" in n for n in rec["notes"])
     # the option given: the note names the option, as before
     (rec,) = run_json([str(flipped), "--no-store", "--invert", "Force"], capsys)["records"]
-    assert "channel 'Force' inverted (--invert)" in rec["notes"]
+    assert "channel 'Force' inverted (--invert 'Force')" in rec["notes"]
     sidecar(tmp_path, "file,fill_percent,invert\nflipped.csv,50,Forc\n")
     err = refused(["analyze", str(flipped), "--no-store"], capsys)
     assert "flipped.csv: invert 'Forc': no such channel" in err and "--invert" not in err

@@ -164,7 +164,7 @@ def test_spring_like_or_inverted_record_is_refused():
                                    frequency_hz=f, sample_rate_hz=fs, n_periods=40,
                                    viscous_damping_n_s_m=1.0)
     assert analyze_power(rec.force_n, rec.velocity_m_s, fs).loss_factor > 0
-    with pytest.raises(SignalError, match="--invert NAME"):
+    with pytest.raises(SignalError, match="pass invert=NAME"):
         analyze_power(rec.force_n, -rec.velocity_m_s, fs)
 
 

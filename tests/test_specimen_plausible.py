@@ -122,7 +122,7 @@ def test_a_baseline_loss_factor_up_to_1_is_kept_and_a_calibration_prior_beyond_r
         assert spec.coupon.baseline_loss_factor == value
     # a calibration writes its fit to the calibrated specimen, which would refuse it: the
     # prior is refused before any DEM run
-    with pytest.raises(ParameterError, match=r"^--prior baseline_loss_factor=0:2: "
+    with pytest.raises(ParameterError, match=r"^priors=baseline_loss_factor=0:2: "
                                              r"baseline_loss_factor=2 is outside .*was it %\?"):
         build_specs(["baseline_loss_factor"], ["baseline_loss_factor=0:2"])
     assert build_specs(["baseline_loss_factor"], ["baseline_loss_factor=0:1"])[0].high == 1.0

@@ -118,32 +118,36 @@ def points_needed_text(n_points: int, fit: Sequence[str]) -> str:
             "load cases or fit fewer parameters")
 
 
-#: The library's words for command-line options, and the page's for the same thing (as
-#: :func:`pidcore.app.uploads.error_message` rewords the analysis's hints). The page fits the
-#: default priors and the parameters chosen in its form; it has no --prior input.
+#: The library's words for the calibration's parameters (its keywords), and the page's for
+#: the same thing; the rest as every page says it (:func:`pidcore.app.vocabulary.page_terms`).
+#: The page fits the default priors and the parameters chosen in its form; it has no prior
+#: input.
 _PAGE_WORDS: tuple[tuple[str, str], ...] = (
-    (r"\(give --prior (\S+)=LOW:HIGH\)",
+    (r"\(give priors=(\S+)=LOW:HIGH\)",
      r"(the page fits the default prior; `pidcore calibrate --prior \1=LOW:HIGH` changes it)"),
-    (r"\(--prior (\S+)=LOW:HIGH\)",
+    (r"\(priors=(\S+)=LOW:HIGH\)",
      r"(the page fits the default prior; `pidcore calibrate --prior \1=LOW:HIGH` widens it)"),
-    (r"--fit/--prior: ", ""),
-    (r"--fit (\S+): ", r"parameter to fit \1: "),
-    (r"--fit: ", "parameters to fit: "),
-    (r"--design-size (\d+)", r"design points \1"),
-    (r"--design-size", "design points"),
-    (r"\(--specimen FILE\)", "(choose their specimen file above)"),
-    (r"\(pidcore calibrate --specimen FILE\)", "(choose their specimen file above)"),
+    (r"narrow the ranges of priors=", "narrow the prior ranges (`pidcore calibrate --prior`)"),
+    (r"(?<![\w-])fit/priors: ", ""),
+    (r"(?<![\w-])fit (\S+): ", r"parameter to fit \1: "),
+    (r"(?<![\w-])fit: ", "parameters to fit: "),
+    (r"design_size (\d+)", r"design points \1"),
+    (r"design_size", "design points"),
+    (r"\(specimen=FILE\)", "(choose their specimen file above)"),
     (r"\(pidcore specimen check\)", "(as `pidcore specimen check` lists them)"),
 )
 
 
 def page_words(text: str) -> str:
-    """A library message or note in the page's terms: its options, not the command line's."""
+    """A library message or note in the page's terms: its fields, not the library's keywords
+    nor the command line's flags."""
     import re
+
+    from .vocabulary import page_terms
 
     for pattern, replacement in _PAGE_WORDS:
         text = re.sub(pattern, replacement, text)
-    return text
+    return page_terms(text)
 
 
 @dataclass

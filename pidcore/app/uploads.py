@@ -34,6 +34,7 @@ from ..compare.loadcase import (
 from ..constants import PARTICLE_MATERIALS
 from ..errors import ParameterError, PidcoreError
 from ..units import display_number
+from .vocabulary import page_terms
 
 if TYPE_CHECKING:
     from ..compare import LoadCase
@@ -155,44 +156,41 @@ class UploadOutcome:
 
 
 def app_words(text: str) -> str:
-    """A library message or note as the app says it: the app has no unit setting (it takes
-    each channel's unit from its file), so the unit options of ``pidcore analyze`` a message
-    suggests are named as that command's, not as choices of the page; the options the page
-    sets in a column or field (channels, inverted channels, mass below gauge, sample rate)
-    are named by that column."""
+    """A library message or note as the app says it: the parameters it names by their
+    keywords (:func:`pidcore.app.vocabulary.page_terms`) as the page's fields and columns,
+    and the hints whose advice differs on the page said as the page's: the app has no unit
+    setting (it takes each channel's unit from its file), no choice of a store's record, and
+    sets the inverted channels and the mass below gauge in the table."""
     text = text.replace(
-        "check both units (--velocity-unit, --acceleration-unit)",
+        "check both units (velocity_unit, acceleration_unit)",
         "check both units in the export (the app takes each channel's unit from its file; "
         "`pidcore analyze --velocity-unit/--acceleration-unit` override them)")
-    text = re.sub(r"give it with --(force|velocity|acceleration)-unit UNIT",
+    text = re.sub(r"give it with (force|velocity|acceleration)_unit=UNIT",
                   r"state it in the export (the app takes units from the file; "
                   r"`pidcore analyze --\1-unit UNIT` gives it)", text)
-    # The library's hints (errors and notes: a note said "channel 'Force' inverted
-    # (--invert)") name CLI options; in the app the same choice is a table column.
-    text = re.sub(r"--(force|velocity|acceleration) NAME", r"the '\1 channel' column", text)
-    text = text.replace("pass --invert NAME for the inverted channel",
+    text = text.replace("pass invert=NAME for the inverted channel",
                         "name the inverted channel in the 'inverted channels' column")
-    text = text.replace("(--sample-rate)", "('sample rate if no time column' under 'Options "
-                                           "for every file')")
     # the channel hints that name a channel or an option the page sets in a column (they
-    # said "confirm it with --acceleration 'Ref'", "--mass-below-gauge needs ...", "--invert
-    # 'X': no such channel": options the page does not have)
-    text = re.sub(r"confirm it with --(force|velocity|acceleration) ('[^']*')",
+    # said "confirm it with acceleration='Ref'", "mass_below_gauge_kg needs ...",
+    # "invert='X': no such channel")
+    text = re.sub(r"confirm it with (force|velocity|acceleration)=('[^']*')",
                   r"confirm it in the '\1 channel' column (\2)", text)
-    text = text.replace("--mass-below-gauge needs", "the mass below gauge needs")
+    text = text.replace("mass_below_gauge_kg needs", "the mass below gauge needs")
     text = text.replace("or remove the option", "or set 'mass below gauge [g]' to 0")
-    text = re.sub(r"--invert ('[^']*'): no such channel",
+    text = re.sub(r"invert=('[^']*'): no such channel",
                   r"'inverted channels' \1: no such channel", text)
+    text = re.sub(r" inverted \(invert='[^']*'\)", " inverted ('inverted channels' column)",
+                  text)
     # the reader's hint is a keyword of read_measurement; the page has no choice of record
-    # (it said "choose one with key=", pointing at nothing)
-    text = text.replace("choose one with key=", "upload one measurement per file, or analyse "
-                                                "one with `pidcore analyze FILE --key NAME`")
-    text = text.replace(" inverted (--invert)", " inverted ('inverted channels' column)")
+    text = text.replace("choose one with key=NAME", "upload one measurement per file, or "
+                                                    "analyse one with `pidcore analyze FILE "
+                                                    "--key NAME`")
     # the structure mass is typed in g here: the refusal named the options field in kg
     # ("structure_mass_kg 280 kg") for 280000 typed in 'structure mass [g]'
-    text = re.sub(r"structure_mass_kg (\S+) kg",
+    text = re.sub(r"structure_mass_kg ([-+]?[0-9.]+(?:e[-+]?[0-9]+)?) kg",
                   lambda m: f"structure mass [g] {float(m[1]) * 1e3:g} g", text)
-    return text
+    text = text.replace("structure_mass_kg in kg", "'structure mass [g]' in g")
+    return page_terms(text)
 
 
 def error_message(name: str, exc: BaseException) -> str:

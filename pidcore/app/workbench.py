@@ -22,6 +22,7 @@ from ..compare.case import (
 )
 from ..loop import ForceDisplacementLoop
 from ..report.table import CONSISTENCY_COLUMN
+from .vocabulary import page_terms
 
 #: Columns of :func:`loop_frame`.
 LOOP_COLUMNS = ("series", "displacement [m]", "force [N]", "order")
@@ -199,5 +200,10 @@ def report_display(table: pd.DataFrame) -> pd.DataFrame:
     out[REPORT_CHI2_COLUMN] = _with_reason(  # 2 digits, as the Compare tab says it
         table[REPORT_CHI2_COLUMN], measured,
         ["n/a (1 measurement)" if s and "; " not in str(s) else "n/a" for s in sources], ".2g")
+    # the notes name parameters by the library's keywords: here by the page's fields
+    if "note" in out.columns:
+        out["note"] = [page_terms(n) if isinstance(n, str) else n for n in out["note"]]
     out.attrs = dict(table.attrs)
+    if "notes" in table.attrs:
+        out.attrs["notes"] = [page_terms(n) for n in table.attrs["notes"]]
     return out

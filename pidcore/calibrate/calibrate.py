@@ -204,9 +204,9 @@ def _requests(points: Sequence[MeasuredPoint], dem_specs: Sequence[ParameterSpec
             # prior's corners; a constraint that is not monotone could still fail inside)
             at = ", ".join(f"{n}={v:g}" for n, v in values.items())
             raise ParameterError(
-                f"--fit/--prior: the design point {at} is outside the physical domain "
-                f"({str(exc).removeprefix(f'{specimen.source}: ')}); narrow the --prior "
-                "ranges") from None
+                f"fit/priors: the design point {at} is outside the physical domain "
+                f"({str(exc).removeprefix(f'{specimen.source}: ')}); narrow the ranges of "
+                "priors=") from None
     out = []
     for point in points:
         case = LoadCase(point.frequency_hz, point.acceleration_g, point.fill_percent,
@@ -238,7 +238,7 @@ def base_specimen(points: Sequence[MeasuredPoint], specimen: Specimen | None) ->
         except ParameterError:
             raise ParameterError(f"the measured points are of {material} particles, which are "
                                  "not in the materials table: give the specimen file of these "
-                                 "particles (pidcore calibrate --specimen FILE)") from None
+                                 "particles (specimen=FILE)") from None
     else:
         chosen = specimen
         own = specimen.particles.material
@@ -293,7 +293,7 @@ def check_point_specimens(points: Sequence[MeasuredPoint], specimen: Specimen) -
             where = f"{len(rows)} measured load case(s)" + (f" of {source}" if source else "")
         said.append(f"{where} name specimen {name!r}")
     raise ParameterError(f"{'; '.join(said)}, not {specimen.name!r}, the specimen calibrated; "
-                         "calibrate them with their own specimen file (--specimen FILE), or "
+                         "calibrate them with their own specimen file (specimen=FILE), or "
                          "leave those rows out")
 
 
@@ -331,12 +331,12 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: str | Sequence[str],
     specs = build_specs(fit, priors, discrepancy=discrepancy, specimen=specimen)
     check_enough_points(points, [spec.name for spec in specs])
     if cross_validate is not None and cross_validate not in CROSS_VALIDATIONS:
-        raise ParameterError(f"--cross-validate: expected one of {CROSS_VALIDATIONS}, "
+        raise ParameterError(f"cross_validate: expected one of {CROSS_VALIDATIONS}, "
                              f"got {cross_validate!r}")
     if cross_validate == "loo":
         check_enough_points(points, [spec.name for spec in specs], leave_one_out=True)
     if not discrepancy_floor >= 0:
-        raise ParameterError(f"--discrepancy-floor: expected >= 0, got {discrepancy_floor}")
+        raise ParameterError(f"discrepancy_floor: expected >= 0, got {discrepancy_floor}")
     notes = []
     if all(p.sdc_stderr == 0 for p in points):
         notes.append("no sdc_stderr in the data: measurement error is carried by the "
@@ -344,12 +344,12 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: str | Sequence[str],
     dem_specs = [s for s in specs if s.kind == "dem"]
     if not dem_specs and design_size not in (None, 1):
         # nothing varies between DEM runs: one run per load case, whatever the design asks
-        notes.append(f"--design-size {design_size} ignored: no DEM parameter is fitted, so "
+        notes.append(f"design_size {design_size} ignored: no DEM parameter is fitted, so "
                      "each load case needs one DEM run")
         design_size = None
     n_design = default_design_size(len(dem_specs)) if design_size is None else design_size
     if dem_specs and n_design < 2:
-        raise ParameterError(f"--design-size: expected >= 2 with DEM parameters, got {n_design}")
+        raise ParameterError(f"design_size: expected >= 2 with DEM parameters, got {n_design}")
     design = design_points(dem_specs, n_design, seed=seed)
     config = dataclasses.replace(dem_config or DemConfig(), cells=cells, seed=seed,
                                  steady_cycles=steady_cycles)
@@ -389,7 +389,7 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: str | Sequence[str],
     posterior = sample_posterior(model, everything, seed=posterior_seed, method=method)
     samples = posterior.samples
     if posterior.fallback:
-        notes.append(f"--method {method}: {posterior.fallback}; the posterior was sampled "
+        notes.append(f"method={method}: {posterior.fallback}; the posterior was sampled "
                      "with emcee instead of the grid")
     fold_fallbacks = []
     parameters, correlations = summarise(specs, samples)
@@ -420,7 +420,7 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: str | Sequence[str],
             if bar is not None:
                 bar.close()
     if fold_fallbacks:
-        notes.append(f"--method {method}: the grid could not box the posterior of "
+        notes.append(f"method={method}: the grid could not box the posterior of "
                      f"{len(fold_fallbacks)} of {len(everything)} leave-one-out fold(s) "
                      f"(without {', '.join(fold_fallbacks)}); those were sampled with emcee")
     settings = {"fit": list(fit), "priors": list(priors), "cells": cells, "seed": seed,

@@ -153,7 +153,7 @@ def measured_from_store(store_path: str | os.PathLike, *,
     for column in ("acceleration_g", "fill_percent"):
         if column not in frame.columns:
             raise InputFileError(f"{store_path}: analyses carry no {column}; calibrate from a "
-                                 "table (--data) instead")
+                                 "table (read_measured_table) instead")
     frame = frame.dropna(subset=["frequency_hz", "acceleration_g", "fill_percent", "sdc"])
     # a file analysed again (other settings) is one measurement, not a repeated test: its two
     # analyses were averaged, with a standard error from their difference
@@ -249,14 +249,14 @@ def check_enough_points(points: list[MeasuredPoint], names: Sequence[str], *,
     need = n_parameters + (1 if leave_one_out else 0)
     if len(points) < need:
         listed = f": {', '.join(names)}"
-        fixed = " (fix model_discrepancy with --discrepancy TAU)" \
+        fixed = " (fix model_discrepancy with discrepancy=TAU)" \
             if "model_discrepancy" in names else ""
         if leave_one_out:
             raise ParameterError(
-                f"--cross-validate loo: leave-one-out fits each fold on {len(points) - 1} of the "
+                f"cross_validate=loo: leave-one-out fits each fold on {len(points) - 1} of the "
                 f"{len(points)} measured load case(s), which cannot determine {n_parameters} "
                 f"fitted parameter(s){listed}; it needs at least {need} load cases (parameters "
-                f"+ 1): give more, fit fewer parameters{fixed}, or leave out --cross-validate")
+                f"+ 1): give more, fit fewer parameters{fixed}, or leave out cross_validate")
         raise ParameterError(f"{len(points)} measured load case(s) cannot determine "
                              f"{n_parameters} fitted parameter(s){listed}; give at least "
                              f"{n_parameters} load cases or fit fewer parameters{fixed}")

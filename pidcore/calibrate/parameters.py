@@ -196,9 +196,9 @@ def parameter_spec(name: str, specimen=None) -> ParameterSpec:
             return ParameterSpec(name, "dem", value, 0.5 * value, 1.5 * value,
                                  f"specimen field {name}", unit=unit)
         return ParameterSpec(name, "dem", value, float("nan"), float("nan"),
-                             f"specimen field {name} (give --prior {name}=LOW:HIGH)",
+                             f"specimen field {name} (give priors={name}=LOW:HIGH)",
                              unit=unit)
-    raise ParameterError(f"--fit: unknown parameter {name!r}; expected fixture_mass_kg, "
+    raise ParameterError(f"fit: unknown parameter {name!r}; expected fixture_mass_kg, "
                          f"baseline_loss_factor, one of {', '.join(dem_parameter_names())}, or a "
                          "numeric specimen field by dotted path (pidcore specimen check)")
 
@@ -211,7 +211,7 @@ def _refuse_whole_number(name: str, specimen) -> None:
 
     specimen = _specimen(specimen)
     if name in numeric_fields(specimen) and isinstance(_field_value(specimen, name), int):
-        raise ParameterError(f"--fit {name}: a whole-number field cannot be fitted (the fit "
+        raise ParameterError(f"fit {name}: a whole-number field cannot be fitted (the fit "
                              "varies parameters continuously); set it in the specimen file and "
                              "calibrate once per value instead")
 
@@ -231,22 +231,22 @@ def parse_fit(text: str | Sequence[str] | None, specimen: Specimen | None = None
     names = [n.strip() for n in (text.split(",") if isinstance(text, str) else text)]
     names = [OBSERVATION_PATHS.get(n, n) for n in names if n]
     if not names:
-        raise ParameterError("--fit: no parameter named")
+        raise ParameterError("fit: no parameter named")
     for name in names:
         if name == DISCREPANCY:
-            raise ParameterError(f"--fit: {DISCREPANCY} is always fitted (fix it with "
-                                 "--discrepancy)")
+            raise ParameterError(f"fit: {DISCREPANCY} is always fitted (fix it with "
+                                 "discrepancy=TAU)")
         parameter_spec(name, specimen)
         _refuse_whole_number(name, specimen)
     if len(set(names)) != len(names):
-        raise ParameterError(f"--fit: a parameter is named twice in {','.join(names)}")
+        raise ParameterError(f"fit: a parameter is named twice in {','.join(names)}")
     return names
 
 
 def parse_prior(text: str) -> tuple[str, dict]:
     """``NAME=LOW:HIGH`` or ``NAME=normal:MU:SD[:LOW:HIGH]`` -> (name, ParameterSpec fields)."""
     if "=" not in text:
-        raise ParameterError(f"--prior {text!r}: expected NAME=LOW:HIGH or "
+        raise ParameterError(f"priors {text!r}: expected NAME=LOW:HIGH or "
                              "NAME=normal:MU:SD[:LOW:HIGH]")
     name, rhs = (s.strip() for s in text.split("=", 1))
     name = OBSERVATION_PATHS.get(name, name)
@@ -265,7 +265,7 @@ def parse_prior(text: str) -> tuple[str, dict]:
                 raise ValueError
             fields = {"low": numbers[0], "high": numbers[1]}
     except ValueError:
-        raise ParameterError(f"--prior {text!r}: expected NAME=LOW:HIGH or "
+        raise ParameterError(f"priors {text!r}: expected NAME=LOW:HIGH or "
                              "NAME=normal:MU:SD[:LOW:HIGH] with numbers") from None
     return name, fields
 
@@ -284,14 +284,14 @@ def build_specs(fit: Sequence[str], priors: Sequence[str] = (), *,
     names = list(fit) + ([] if discrepancy is not None else [DISCREPANCY])
     for name in changes:
         if name not in names:
-            raise ParameterError(f"--prior {name}: not a fitted parameter (add it to --fit)")
+            raise ParameterError(f"priors {name}: not a fitted parameter (add it to fit=)")
     specs = []
     for name in names:
         spec = replace(parameter_spec(name, specimen), **changes.get(name, {}))
         spec.check()
         specs.append(spec)
     if discrepancy is not None and not discrepancy >= 0:
-        raise ParameterError(f"--discrepancy: expected >= 0, got {discrepancy}")
+        raise ParameterError(f"discrepancy: expected >= 0, got {discrepancy}")
     check_domains(specs, specimen, given)
     return specs
 
@@ -304,9 +304,9 @@ _MAX_CORNER_PARAMETERS = 6
 def _prior_words(spec: ParameterSpec, given: Mapping[str, str]) -> str:
     """How the message names a prior: the ``--prior`` given, or the default bounds."""
     if spec.name in given:
-        return f"--prior {given[spec.name]}"
-    return (f"the default prior bounds {spec.name}={spec.low:g}:{spec.high:g} (give --prior "
-            f"{spec.name}=LOW:HIGH)")
+        return f"priors={given[spec.name]}"
+    return (f"the default prior bounds {spec.name}={spec.low:g}:{spec.high:g} (give "
+            f"priors={spec.name}=LOW:HIGH)")
 
 
 def check_domains(specs: Sequence[ParameterSpec], specimen=None,

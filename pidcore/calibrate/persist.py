@@ -156,11 +156,12 @@ def stored_calibration(store_path: str | os.PathLike, key: str | None = None) ->
                                  f"{_keys_text(listing)})")
         return _calibration(store, key)
     if not keys:
-        raise ParameterError(f"{path}: this store holds no calibration (save one with "
-                             f"pidcore calibrate --dem-store {path}, or give a calibration.json)")
+        raise ParameterError(f"{path}: this store holds no calibration (calibrate "
+                             f"with store_path={path} to save one there, or give a "
+                             "calibration.json)")
     if len(keys) > 1:
         raise ParameterError(f"{path}: this store holds {len(keys)} calibrations; choose one "
-                             f"with --calibration-key: {_keys_text(listing)}")
+                             f"with key=KEY: {_keys_text(listing)}")
     return _calibration(store, keys[0])
 
 

@@ -110,7 +110,7 @@ class GridUnresolved(ParameterError):
 
     def __init__(self, reason: str):
         self.reason = reason
-        super().__init__(f"calibration: {reason}; use --method emcee")
+        super().__init__(f"calibration: {reason}; use method=emcee")
 
 
 def _to_unit(spec: ParameterSpec, x: np.ndarray) -> np.ndarray:
@@ -258,14 +258,14 @@ def sample_posterior(model: Model, indices: Sequence[int], *, seed: int = 0,
         method = "emcee"
     if method == "grid":
         if len(model.specs) > GRID_MAX_DIMENSIONS:
-            raise ParameterError(f"--method grid: at most {GRID_MAX_DIMENSIONS} fitted "
+            raise ParameterError(f"method=grid: at most {GRID_MAX_DIMENSIONS} fitted "
                                  f"quantities, got {len(model.specs)}")
         return PosteriorSamples(sample_grid(model, indices, rng=rng, n_samples=n_samples),
                                 "grid")
     if method == "emcee":
         return PosteriorSamples(sample_emcee(model, indices, rng=rng, n_samples=n_samples),
                                 "emcee", fallback)
-    raise ParameterError(f"--method: expected auto, grid or emcee, got {method!r}")
+    raise ParameterError(f"method: expected auto, grid or emcee, got {method!r}")
 
 
 def predictive(model: Model, samples: np.ndarray, index: int, *,
@@ -390,6 +390,6 @@ def bound_notes(specs: Sequence[ParameterSpec], samples: np.ndarray) -> list[str
                     f"{bound:g} ({share:.0%} of the samples in the {EDGE_SHARE:.0%} of the prior's "
                     f"range next to it): the data ask for a value at or beyond it, so its median "
                     f"{median} is set by the prior, not the data; check the "
-                    f"stated values, and widen the prior (--prior {spec.name}=LOW:HIGH) unless "
+                    f"stated values, and widen the prior (priors={spec.name}=LOW:HIGH) unless "
                     "the bound is physical")
     return notes

@@ -316,11 +316,11 @@ def load_calibration(path: str | os.PathLike, *, key: str | None = None) -> Cali
         path = path / "calibration.json"  # the folder `pidcore calibrate --out` wrote
     if path.is_dir():
         raise ParameterError(f"{path}: a folder without calibration.json (expected the "
-                             "calibration.json written by pidcore calibrate --out, or its "
+                             "calibration.json written by write_outputs(result, out_dir), or its "
                              "folder)")
     if not path.is_file():
         raise ParameterError(f"{path}: no such calibration file (expected the calibration.json "
-                             "written by pidcore calibrate --out)")
+                             "written by write_outputs(result, out_dir))")
     calibration = calibration_from_json(path.read_bytes(), path)
     specimen = path.parent / "calibrated_specimen.toml"
     return Calibration(path=path, parameters=calibration.parameters,

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import re
 import sys
 from pathlib import Path
 
@@ -198,37 +197,3 @@ def analysis_options(args: argparse.Namespace) -> AnalysisOptions:
         velocity_unit=args.velocity_unit, acceleration_unit=args.acceleration_unit,
         invert=tuple(args.invert or ()),
     )
-
-
-#: Library keywords in error messages and the flags of :func:`add_measurement_options` that set
-#: them: the library keeps its names, the CLI user reads the flag to type.
-_FLAG_OF_KEYWORD = (
-    ("choose one with key=", "choose one with --key NAME"),
-    ("pass allow_clipped=True", "pass --allow-clipped"),
-    ("allow_clipped", "--allow-clipped"),
-    ("pass accept_implausible=True", "pass --accept-implausible"),
-    ("accept_implausible", "--accept-implausible"),
-    ("key=", "--key "),
-    ("velocity_delay_s", "--velocity-delay"),
-    ("mass_below_gauge_kg", "--mass-below-gauge"),
-    ("baseline_loss_factor", "--baseline-loss-factor"),
-    ("structure_mass_kg", "--structure-mass"),
-    ("frequency_hz", "--frequency"),
-    ("n_harmonics", "--harmonics"),
-    ("sample_rate_hz", "--sample-rate"),
-)
-# whole words only: "my_frequency_hz_col" (a file's column) stays as it is, and so does a
-# sidecar's column of the same name ("column baseline_loss_factor '-1' of loadcases.csv"), and
-# so do a file's own attributes, fields and variables ("attribute sample_rate_hz is nan",
-# "field sample_rate_hz", "variable sample_rate_hz", "('fs' or 'sample_rate_hz')"), which
-# are not the option
-_NOT_THE_OPTION = r"(?<![\w'-])(?<!column )(?<!attribute )(?<!field )(?<!variable )"
-_KEYWORD_PATTERN = re.compile("|".join(
-    _NOT_THE_OPTION + re.escape(k) + (r"(?!\w)" if k[-1].isalnum() else "")
-    for k, _ in _FLAG_OF_KEYWORD))
-
-
-def with_cli_flags(message: str) -> str:
-    """``message`` with the library keywords of the measurement options named as CLI flags."""
-    flags = dict(_FLAG_OF_KEYWORD)
-    return _KEYWORD_PATTERN.sub(lambda m: flags[m.group(0)], message)

@@ -9,7 +9,6 @@ import sys
 from pathlib import Path
 
 from .. import interrupt
-from ..errors import PidcoreError
 from ..file_settings import analyze_each
 from ..io import display_path
 from ..measure import NO_LOAD_CASE
@@ -23,8 +22,8 @@ from ._options import (
     path_argument,
     progress_wanted,
     untouched,
-    with_cli_flags,
 )
+from ._vocabulary import cli_words
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -60,17 +59,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run)
 
 
-def run(args: argparse.Namespace) -> int:
-    from ..errors import SettingsTableError
-
-    try:
-        return _run(args)
-    except SettingsTableError:  # names the sidecar's columns, which are not flags
-        raise
-    except PidcoreError as exc:  # library keywords -> the flags the user types
-        raise type(exc)(with_cli_flags(str(exc))) from None
-
-
 def _stated(args: argparse.Namespace) -> tuple[list, list]:
     """What each path states about its load case (None: no fill stated) and how it is analysed
     (:class:`~pidcore.file_settings.FileSettings`), resolved before any analysis so that a bad
@@ -91,7 +79,7 @@ def _stated(args: argparse.Namespace) -> tuple[list, list]:
                          specimen_name=specimen.name if specimen else None, specimen=specimen)
 
 
-def _run(args: argparse.Namespace) -> int:
+def run(args: argparse.Namespace) -> int:
     from ..compare.plausibility import refuse_implausible
     from ..loadcase import refuse_identical_contents_stating_apart
     from ..store import Store
@@ -155,7 +143,8 @@ def _print_results(args: argparse.Namespace, results: list, cases: list, stated:
     """The results table (or JSON document), each file's load case and settings, notes."""
     overrides = [note for fs in settings for note in (*fs.notes, fs.unmatched) if note]
     if args.json:
-        json.dump({"records": [{**r.to_dict(), "load_case": c.key if c else None,
+        json.dump({"records": [{**r.to_dict(), "notes": [cli_words(n) for n in r.notes],
+                                "load_case": c.key if c else None,
                                 "specimen": fs.specimen or None,
                                 "parameters": fs.options.parameters(),
                                 "settings_from": dict(fs.sources),
@@ -212,6 +201,5 @@ def format_table(results: list) -> str:
                      f"{_significant(a.loss_factor, 6):>15} {_significant(a.sdc, 6):>12} "
                      f"{_significant(a.sdc_stderr, 2, keep_zeros=False):>9} "
                      f"{_significant(a.damping_ratio, 4):>10} {a.energy_per_cycle_j:12.4e}")
-        for note in r.notes:
-            lines.append(f"    note: {note}")
+        lines += [f"    note: {cli_words(note)}" for note in r.notes]
     return "\n".join(lines)

@@ -14,6 +14,7 @@ from ._options import (
     positive_int,
     progress_wanted,
 )
+from ._vocabulary import cli_words
 
 DEFAULT_STORE = Path("calibration_store.h5")
 
@@ -113,7 +114,7 @@ def run(args: argparse.Namespace) -> int:
         measured = measured_from_store(args.store, left_out=left_out)
         points = _store_points(measured, specimen, args.store, left_out)
         for note in left_out:
-            print(f"pidcore calibrate: note: {note}", file=sys.stderr)
+            print(f"pidcore calibrate: note: {cli_words(note, 'calibrate')}", file=sys.stderr)
     tally = RunTally(args.dem_store)
     written, fitted, saved = False, False, None
     try:
@@ -157,8 +158,8 @@ def _print_result(args: argparse.Namespace, result, own_notes: list[str], saved:
     keeps it)."""
     from ..calibrate.outputs import document_json, rms_text
 
-    for note in own_notes:
-        print(f"pidcore calibrate: note: {note}", file=sys.stderr)
+    for note in own_notes:  # the library's words, kept so with the outputs and the store
+        print(f"pidcore calibrate: note: {cli_words(note, 'calibrate')}", file=sys.stderr)
     said = saved.removeprefix("; ")
     # a re-run (after Ctrl-C, or with other priors) says that it reused its stored runs; on
     # stderr beside --json's one document

@@ -5,9 +5,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import re
 import sys
-from collections.abc import Callable
 
 from .. import defaults, interrupt
 from ..constants import (
@@ -30,52 +28,12 @@ from ._options import (
     progress_wanted,
     scheduler_address,
 )
+from ._vocabulary import cli_words
 
 #: Keys of ``pidcore dem run --json`` (more may follow them).
 JSON_KEYS = ("sdc", "sdc_stderr", "energy_per_cycle_j", "energy_dissipated_normal_j",
              "energy_dissipated_friction_j", "particles_per_cell", "cells_simulated",
              "vibrated_mass_kg", "energy_balance_error", "steps", "wall_s", "particle_steps_per_s")
-
-
-#: Library keywords in the DEM's messages and the flags that set them (``pidcore dem run``;
-#: ``sweep`` takes lists): the library keeps its names, the CLI user reads the flag to type.
-_FLAG_OF_KEYWORD = {
-    "run": (("fill_reference='capacity'", "--fill-reference capacity"),
-            ("fill_reference='paper'", "--fill-reference paper"),
-            ("fill_reference", "--fill-reference"), ("time_step", "--time-step"),
-            ("cells", "--cells"), ("frequency_hz", "--frequency"),
-            ("acceleration_g", "--acceleration")),
-}
-_FLAG_OF_KEYWORD["sweep"] = tuple(
-    (k, {"--frequency": "--frequencies", "--acceleration": "--accelerations"}.get(f, f))
-    for k, f in _FLAG_OF_KEYWORD["run"])
-
-
-def with_dem_flags(message: str, command: str) -> str:
-    """``message`` with the DEM configuration's keywords named as ``pidcore dem COMMAND``'s
-    flags: "use fill_reference='capacity'" is "use --fill-reference capacity", "cells:
-    expected >= 1" is "--cells: expected >= 1". Whole words only, and ``cells`` only where it
-    names the option (a message's first word, before a colon), not in "over 2 cells: ..."."""
-    flags = dict(_FLAG_OF_KEYWORD[command])
-    pattern = re.compile("|".join(
-        r"^cells(?=:)" if k == "cells" else
-        rf"(?<![\w-]){re.escape(k)}" + (r"(?!\w)" if k[-1].isalnum() else "")
-        for k, _ in _FLAG_OF_KEYWORD[command]))
-    return pattern.sub(lambda m: flags[m.group(0)], message)
-
-
-def _with_flags(command: str, func: Callable[[argparse.Namespace], int]
-                ) -> Callable[[argparse.Namespace], int]:
-    """``func`` (the command), its refusals in the words of its flags."""
-    def run_command(args: argparse.Namespace) -> int:
-        try:
-            return func(args)
-        except PidcoreError as exc:
-            said = with_dem_flags(str(exc), command)
-            if said == str(exc):
-                raise
-            raise type(exc)(said) from None
-    return run_command
 
 
 def _time_step(text: str) -> float | str:
@@ -114,7 +72,7 @@ def _register_run(sub: argparse._SubParsersAction) -> None:
                      help="run cache: reuse the run stored there with the same inputs, else "
                           "simulate and save it")
     add_json_option(p, progress=True)
-    p.set_defaults(func=_with_flags("run", run))
+    p.set_defaults(func=run)
 
 
 def _add_config_options(p: argparse.ArgumentParser) -> None:
@@ -196,7 +154,7 @@ def _register_sweep(sub: argparse._SubParsersAction) -> None:
                    help="dask.distributed scheduler address (needs the 'distributed' extra)")
     add_store_option(p)
     add_json_option(p, progress=True)
-    p.set_defaults(func=_with_flags("sweep", sweep))
+    p.set_defaults(func=sweep)
 
 
 def _config(args: argparse.Namespace):
@@ -263,7 +221,7 @@ def sweep(args: argparse.Namespace) -> int:
         _check_fill(fill, "--fills", args, specimen, material)
     note = grid_fill_note(specimen, args.grid, values[2]) if args.fills is None else ""
     if note:  # on stderr: --json prints one document
-        print(f"pidcore dem sweep: note: {note}", file=sys.stderr)
+        print(f"pidcore dem sweep: note: {cli_words(note, 'dem sweep')}", file=sys.stderr)
     cases = cross_cases(*values, material=material, direction=args.direction)
     config = _config(args)
     for case in cases:  # before any case runs, not in a worker after the others

@@ -9,7 +9,6 @@ import argparse
 import sys
 
 from .. import interrupt
-from ..errors import PidcoreError
 from ..report.render import folder_identity, format_cell
 from ..report.table import ALIGNMENT_COLUMN
 from ._options import (
@@ -21,8 +20,8 @@ from ._options import (
     path_argument,
     progress_wanted,
     untouched,
-    with_cli_flags,
 )
+from ._vocabulary import cli_words
 
 #: Columns of the short table printed on stdout.
 #: The like-for-like measured SDC (Eq. 10's E, as our DEM's) stands beside our DEM's; the
@@ -90,16 +89,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    try:
-        return _run(args)
-    except PidcoreError as exc:
-        # the analysis' errors name options by library keyword (n_harmonics): the flags
-        if not getattr(exc, "names_analysis_options", False):
-            raise
-        raise type(exc)(with_cli_flags(str(exc))) from None
-
-
-def _run(args: argparse.Namespace) -> int:
     from ..report.pipeline import make_report
     from ..specimen import load_specimen
 
@@ -116,9 +105,10 @@ def _run(args: argparse.Namespace) -> int:
             options_given=given_options(args),
             specimen=specimen, pool=args.pool, calibration=args.calibration,
             calibration_key=args.calibration_key,
-            accept_implausible=args.accept_implausible, progress=progress_wanted(args))
+            accept_implausible=args.accept_implausible, progress=progress_wanted(args),
+            wording=lambda text: cli_words(text, "report"))
         print(short_table(result.table))
-        for note in result.notes:
+        for note in result.notes:  # in the command's words (wording=)
             print(f"note: {note}")
         for name, path in result.paths.items():
             print(f"wrote {name}: {path}")

@@ -183,14 +183,14 @@ def _refuse_untabulated_material(path: Path, known: tuple[str, ...],
     if named:
         lacks = f"material table ({', '.join(PARTICLE_MATERIALS)}) lacks"
         if specimen_material is not None and specimen_material not in PARTICLE_MATERIALS:
-            lacks = (f"material table ({', '.join(PARTICLE_MATERIALS)}) and the --specimen's "
+            lacks = (f"material table ({', '.join(PARTICLE_MATERIALS)}) and the specimen's "
                      f"{specimen_material} particles lack")
         elif specimen_material is not None:  # a specimen of a table material was given too
-            lacks += f" (the --specimen's particles are {specimen_material})"
+            lacks += f" (the specimen's particles are {specimen_material})"
         raise UntabulatedMaterial(
             f"{path.name}: file name states particle material {named[0]!r}, which the "
-            f"{lacks}; give --specimen FILE whose particles are {named[0]}, or state the "
-            "material with --material or a sidecar", named[0])
+            f"{lacks}; give specimen=FILE whose particles are {named[0]}, or state the "
+            "material with material=NAME or a sidecar", named[0])
 
 
 def parse_file_name(name: str | Path,
@@ -223,7 +223,7 @@ def parse_file_name(name: str | Path,
     fills = {float(m.group("fill") or m.group("pct")) for m in FILL_PATTERN.finditer(stem)}
     if len(fills) > 1:
         raise LoadCaseError(f"{path.name}: file name states several fills "
-                            f"{sorted(fills)}; state one (or use --fill)")
+                            f"{sorted(fills)}; state one (or use fill_percent)")
     if fills:
         found["fill_percent"] = _check_fill(fills.pop(), path.name)
     stated = {normalize_material(m.group("material"), path.name)
@@ -448,7 +448,7 @@ def sidecar_row(path: str | Path,
             raise LoadCaseError(
                 f"{path}: is the sidecar table (the load case and settings of each file), "
                 "not a measurement; leave it out of the files given (a "
-                f"{SIDECAR_NAME} beside the files is read by itself; another with --sidecar)")
+                f"{SIDECAR_NAME} beside the files is read by itself; another with sidecar=PATH)")
         if tables is None:
             table = read_sidecar(sidecar_path)
         else:
@@ -473,7 +473,7 @@ def _material(value: str, what: str, known: tuple[str, ...]) -> str:
         if known != PARTICLE_MATERIALS:
             raise
         raise LoadCaseError(f"{exc} (a specimen's own material, e.g. steel, needs "
-                            "--specimen FILE)") from None
+                            "specimen=FILE)") from None
 
 
 def _sidecar_entry(row: SidecarRow,
@@ -496,8 +496,8 @@ def missing_fill_message(path: str | Path) -> str:
     return (f"{display_path(Path(path).name)}: no fill (packing ratio, %) stated; state it "
             "(1) in the file name, "
             f"e.g. '..._fill50_...' or '..._50pct_...', (2) in a sidecar table {SIDECAR_NAME} "
-            f"beside the file or given with --sidecar (columns {', '.join(SIDECAR_COLUMNS)}), "
-            "or (3) with --fill")
+            f"beside the file or given with sidecar=PATH (columns {', '.join(SIDECAR_COLUMNS)}), "
+            "or (3) with fill_percent")
 
 
 def resolve_load_case(
@@ -573,11 +573,11 @@ def resolve_load_case(
         _refuse_untabulated_material(path, known, specimen_material)
     options: dict[str, float | str] = {}
     if fill_percent is not None:
-        options["fill_percent"] = _check_fill(fill_percent, "--fill")
+        options["fill_percent"] = _check_fill(fill_percent, "fill_percent")
     if material is not None:
-        options["material"] = _material(material, "--material", known)
+        options["material"] = _material(material, "material", known)
     if direction is not None:
-        options["direction"] = normalize_direction(direction, "--direction")
+        options["direction"] = normalize_direction(direction, "direction")
     take(options, "option")
 
     if "fill_percent" not in values:

@@ -193,4 +193,4 @@ def stored_plausibility_notes(record) -> tuple[str, ...]:
     not the notes: a record saved with ``--accept-implausible`` was reported from the store
     as any other (its SDC -1.26 pooled into a row without a word)."""
     return _findings_notes(stored_findings(record),
-                           "saved as accepted (--accept-implausible)")
+                           "saved as accepted (accept_implausible=True)")

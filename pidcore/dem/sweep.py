@@ -48,7 +48,7 @@ GRIDS: dict[str, dict[str, tuple[float, ...]]] = {
 def grid_axes(grid: str = "table3") -> dict[str, tuple[float, ...]]:
     """The values of a named grid: ``frequency_hz``, ``acceleration_g``, ``fill_percent``."""
     if grid not in GRIDS:
-        raise ParameterError(f"--grid: unknown grid {grid!r}; expected one of {sorted(GRIDS)}")
+        raise ParameterError(f"grid: unknown grid {grid!r}; expected one of {sorted(GRIDS)}")
     return GRIDS[grid]
 
 
@@ -62,8 +62,8 @@ def grid_fill_note(specimen: Specimen | None, grid: str, fills_percent: Iterable
     if stated is None or any(abs(f - stated[0]) < 1e-9 for f in fills):
         return ""
     return (f"fills {', '.join(f'{f:g}' for f in fills)} % are grid {grid}'s, not the "
-            f"{stated[0]:.6g} % specimen {specimen.name} states ({stated[1]}); give --fills to "
-            "choose")
+            f"{stated[0]:.6g} % specimen {specimen.name} states ({stated[1]}); give "
+            "fills_percent to choose")
 
 
 def cross_cases(frequencies_hz: Iterable[float], accelerations_g: Iterable[float],
@@ -478,7 +478,7 @@ def _run_local(todo: Iterable[tuple[LoadCase, str]], config: DemConfig, workers:
     todo = list(todo)
     workers = workers or os.cpu_count() or 1
     if workers < 1:
-        raise ParameterError(f"--workers: expected a positive number of processes, got {workers}")
+        raise ParameterError(f"workers: expected a positive number of processes, got {workers}")
     calls = [(case, config, specimen, store_path, key) for case, key in todo]
     if workers == 1 or len(todo) == 1:
         for call in calls:
@@ -493,7 +493,7 @@ def _run_dask(todo: Iterable[tuple[LoadCase, str]], config: DemConfig, scheduler
     try:
         from distributed import Client, as_completed
     except ImportError:
-        raise ParameterError("--scheduler needs dask.distributed: "
+        raise ParameterError("scheduler: needs dask.distributed: "
                              "pip install 'pidcore[distributed]'") from None
     try:
         client = Client(scheduler)
@@ -501,7 +501,7 @@ def _run_dask(todo: Iterable[tuple[LoadCase, str]], config: DemConfig, scheduler
     # connection raises: tls:// without a TLS configuration is a TypeError, which came out
     # as a traceback
     except Exception as exc:  # noqa: BLE001 - every failure to connect is one line
-        raise ParameterError(f"--scheduler {scheduler}: cannot connect to a dask.distributed "
+        raise ParameterError(f"scheduler {scheduler}: cannot connect to a dask.distributed "
                              f"scheduler there ({' '.join(str(exc).split())}); expected the "
                              f"address of a running scheduler, e.g. tcp://host:8786") from None
     try:

@@ -156,7 +156,7 @@ def _rate_kept(measurement: Measurement, sample_rate_hz: float | None,
                                                   for c in measurement.channels}))
     notes = [*measurement.metadata.get("reader_notes", ()),
              f"{display_path(path)}: the sample rate {sample_rate_hz:g} Hz given "
-             f"(--sample-rate) is not applied: the file states its channels' rate ({rates} Hz), "
+             f"(sample_rate_hz) is not applied: the file states its channels' rate ({rates} Hz), "
              "which is kept; the option sets the rate of CSV/TXT files and of MATLAB files of "
              "plain vectors"]
     return replace(measurement, metadata={**measurement.metadata, "reader_notes": notes})
@@ -252,7 +252,7 @@ def _read(path: str | os.PathLike[str], fmt: str, sample_rate_hz: float | None,
     keys = hdf5_keys(path)
     if key is None and len(keys) > 1:
         raise InputFileError(f"{display_path(path)}: holds {len(keys)} measurements "
-                             f"({', '.join(keys)}); choose one with key=")
+                             f"({', '.join(keys)}); choose one with key=NAME")
     return _rate_kept(_displayed(read_hdf5(path, key=key)[0], path), sample_rate_hz, path)
 
 

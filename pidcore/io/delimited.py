@@ -254,7 +254,7 @@ def read_csv(path: str | os.PathLike[str], *, sample_rate_hz: float | None = Non
             _, factor = interpret_unit(unit) if unit else ("time", 1.0)
             start_time = float(values[0, time_index]) * factor
             notes.append(f"{where}: time column {name!r} ignored: the sample rate "
-                         f"{rate:g} Hz was given (--sample-rate)"
+                         f"{rate:g} Hz was given (sample_rate_hz)"
                          + overridden_rate(values[:, time_index] * factor, rate))
     elif time_index is not None:
         name, unit = cells[time_index]
@@ -269,10 +269,10 @@ def read_csv(path: str | os.PathLike[str], *, sample_rate_hz: float | None = Non
             # 1000 x off (the loss factor and SDC unchanged): the assumption is said
             notes.append(f"{where}: time column {name!r} has no unit: taken as seconds "
                          f"(sample rate {rate:.6g} Hz); if it is not, write its unit in the "
-                         "header ('Time [ms]') or give the sample rate (--sample-rate)")
+                         "header ('Time [ms]') or give the sample rate (sample_rate_hz)")
     else:
         raise InputFileError(f"{where}: no time column (e.g. 'Time [s]') and no sample rate; "
-                             "add a time column or give the sample rate (--sample-rate)")
+                             "add a time column or give the sample rate (sample_rate_hz)")
 
     keep = [i for i in range(len(cells)) if i != time_index]
     if not keep:

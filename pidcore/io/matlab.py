@@ -363,7 +363,7 @@ def _simple_layout(variables: Mapping, where: str,
         rate, start = float(sample_rate_hz), float(_numeric_vector(public[time_key])[0])
         n = _numeric_vector(public[time_key]).size
         notes.append(f"{where}: time vector {time_key!r} ignored: the sample rate "
-                     f"{rate:g} Hz was given (--sample-rate)"
+                     f"{rate:g} Hz was given (sample_rate_hz)"
                      + overridden_rate(_numeric_vector(public[time_key]), rate))
     elif time_key is not None:
         rate, start, note = rate_from_times(_numeric_vector(public[time_key]),
@@ -374,7 +374,7 @@ def _simple_layout(variables: Mapping, where: str,
         # a vector states no unit: as for a CSV time column without one, the assumption is said
         notes.append(f"{where}: time vector {time_key!r} states no unit: taken as seconds "
                      f"(sample rate {rate:.6g} Hz); if it is not, give the sample rate "
-                     "(--sample-rate)")
+                     "(sample_rate_hz)")
     elif rate_key is not None or sample_rate_hz is not None:
         try:
             rate = (real_scalar(public[rate_key], where=f"{where}: variable {rate_key}",
@@ -383,17 +383,17 @@ def _simple_layout(variables: Mapping, where: str,
         except InputFileError as exc:
             if sample_rate_hz is None:
                 raise
-            # --sample-rate overrides the file's rate, as it overrides a time vector: a file
+            # the given sample rate overrides the file's rate, as it overrides a time vector: a file
             # rate that is no rate at all (0, NaN) is noted, not refused
             rate = float(sample_rate_hz)
-            notes.append(f"{exc}; the sample rate {rate:g} Hz given is used (--sample-rate)")
+            notes.append(f"{exc}; the sample rate {rate:g} Hz given is used (sample_rate_hz)")
         start, n = 0.0, None
     else:
         raise InputFileError(f"{where}: no time vector ('time' or 't') and no sample rate "
-                             "('fs' or 'sample_rate_hz'); give the sample rate (--sample-rate)")
+                             "('fs' or 'sample_rate_hz'); give the sample rate (sample_rate_hz)")
     if sample_rate_hz is not None and abs(rate - sample_rate_hz) > 1e-6 * rate:
         notes.append(f"{where}: the file's sample rate {rate:.9g} Hz overridden by "
-                     f"{sample_rate_hz:.9g} Hz (--sample-rate)")
+                     f"{sample_rate_hz:.9g} Hz (sample_rate_hz)")
         rate = float(sample_rate_hz)
     skip = {time_key, rate_key, "units"}
     vectors = {k: _numeric_vector(v) for k, v in public.items() if k not in skip}

@@ -45,7 +45,8 @@ _NAME_PREFIXES = {
     "velocity": ("veloc", "vibrom", "ldv"),
     "acceleration": ("accel", "acc", "beschl"),
 }
-_OPTIONS = {"force": "--force", "velocity": "--velocity", "acceleration": "--acceleration"}
+#: The keyword of AnalysisOptions naming each role's channel, as a message says it.
+_OPTIONS = {"force": "force=", "velocity": "velocity=", "acceleration": "acceleration="}
 #: Name tokens of accelerometers that are not at the drive point.
 _REFERENCE_TOKENS = {"ref", "reference", "shaker", "table", "armature", "base", "control",
                      "ctrl", "fixture", "slip", "head", "kopf", "referenz"}
@@ -113,12 +114,12 @@ def _drive_point_acceleration(measurement: Measurement, taken: set[str],
     if len(found) > 1:
         raise ChannelError(f"{measurement.source}: {len(found)} acceleration channels "
                            f"({_names(found)}); {why} needs the acceleration at the drive point:"
-                           " choose it with --acceleration NAME")
+                           " choose it with acceleration=NAME")
     if found and is_reference_name(found[0].name):
         raise ChannelError(f"{measurement.source}: the only acceleration channel "
                            f"{found[0].name!r} is named like a reference/shaker accelerometer; "
                            f"{why} needs the acceleration at the drive point: confirm it with "
-                           f"--acceleration {found[0].name!r} or remove the option")
+                           f"acceleration={found[0].name!r} or remove the option")
     return found[0] if found else None
 
 
@@ -132,13 +133,13 @@ def _detect(measurement: Measurement, role: str, taken: set[str]) -> Channel | N
         if len(named) == 1:
             return named[0]
         raise ChannelError(f"{measurement.source}: {len(by_quantity)} {role} channels "
-                           f"({_names(by_quantity)}); choose one with {_OPTIONS[role]} NAME")
+                           f"({_names(by_quantity)}); choose one with {_OPTIONS[role]}NAME")
     by_name = [c for c in free if c.quantity == "unknown" and name_suggests(c.name, role)]
     if len(by_name) == 1:
         return by_name[0]
     if len(by_name) > 1:
         raise ChannelError(f"{measurement.source}: {len(by_name)} channels look like {role} "
-                           f"({_names(by_name)}); choose one with {_OPTIONS[role]} NAME")
+                           f"({_names(by_name)}); choose one with {_OPTIONS[role]}NAME")
     return None
 
 
@@ -146,10 +147,10 @@ def _named(measurement: Measurement, role: str, name: str, retyped: bool) -> Cha
     channel = measurement.channel(name)  # ChannelError listing the channels there are
     if channel.quantity not in (role, "unknown") and not retyped:
         article = "an" if channel.quantity[0] in "aeiou" else "a"
-        raise ChannelError(f"{measurement.source}: {_OPTIONS[role]} {name!r} is {article} "
+        raise ChannelError(f"{measurement.source}: {_OPTIONS[role]}{name!r} is {article} "
                            f"{channel.quantity} channel ({channel.source_unit or channel.unit});"
                            f" expected a {role} channel or one without a unit, or give its "
-                           f"unit with {_OPTIONS[role]}-unit UNIT if the file's is wrong")
+                           f"unit with {role}_unit=UNIT if the file's is wrong")
     return channel
 
 
@@ -206,7 +207,7 @@ def assign_roles(measurement: Measurement, *, force: str | None = None,
             if role == "acceleration" and chosen["velocity"] is not None:
                 # not needed as the motion: only for mass cancellation, at the drive point
                 chosen[role] = (_drive_point_acceleration(measurement, taken,
-                                                          "--mass-below-gauge")
+                                                          "mass_below_gauge_kg")
                                 if mass_cancellation else None)
             else:
                 chosen[role] = _detect(measurement, role, taken)
@@ -215,18 +216,18 @@ def assign_roles(measurement: Measurement, *, force: str | None = None,
                     raise ChannelError(
                         f"{measurement.source}: no velocity channel and the acceleration "
                         f"channel {chosen[role].name!r} is named like a reference/shaker "
-                        f"accelerometer; confirm it with --acceleration {chosen[role].name!r}")
+                        f"accelerometer; confirm it with acceleration={chosen[role].name!r}")
             if chosen[role] is not None:
                 taken.add(chosen[role].name)
         if role == "force" and chosen["force"] is None:
             # Checked before the other roles: a missing force is the more basic problem.
             raise ChannelError(f"{measurement.source}: no force channel among "
                                f"{_names(list(measurement.channels))}; name one with "
-                               "--force NAME")
+                               "force=NAME")
     if chosen["velocity"] is None and chosen["acceleration"] is None:
         raise ChannelError(f"{measurement.source}: no velocity or acceleration channel among "
-                           f"{_names(list(measurement.channels))}; name one with --velocity NAME "
-                           "or --acceleration NAME")
+                           f"{_names(list(measurement.channels))}; name one with velocity=NAME "
+                           "or acceleration=NAME")
     used = {c.name for c in chosen.values() if c is not None}
     return RoleAssignment(force=chosen["force"], velocity=chosen["velocity"],
                           acceleration=chosen["acceleration"],

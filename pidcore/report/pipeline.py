@@ -17,7 +17,7 @@ from __future__ import annotations
 import json
 import math
 import os
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -28,7 +28,7 @@ import pandas as pd
 from ..compare.align import Aligner, Tolerances
 from ..compare.loadcase import LoadCase, StatedLoadCase
 from ..constants import REPORT_FORMATS
-from ..errors import ParameterError, PidcoreError, StoreError
+from ..errors import ParameterError, StoreError
 from ..io import display_path
 from ..loadcase import refuse_identical_contents_stating_apart
 from .provenance import collect_provenance
@@ -196,16 +196,9 @@ def analyze_files(paths: Sequence[str | Path], *, fill_percent: float | None = N
                                      direction=direction, sidecar=sidecar,
                                      specimen_material=specimen_material,
                                      specimen_name=specimen_name, specimen=specimen)
-    try:
-        analyzed_files = refuse_implausible(
-            analyze_each(paths, settings, progress=progress),
-            [display_path(Path(path).name) for path in paths], accept=accept_implausible)
-    except PidcoreError as exc:
-        # an error of the analysis names the options by their library keywords; the CLI
-        # renames them to its flags (and only these: a calibration file's own fields keep
-        # their names)
-        exc.names_analysis_options = True
-        raise
+    analyzed_files = refuse_implausible(
+        analyze_each(paths, settings, progress=progress),
+        [display_path(Path(path).name) for path in paths], accept=accept_implausible)
     results = []
     for path, st, fs, analyzed in zip(paths, stated, settings, analyzed_files, strict=True):
         a = analyzed.analysis
@@ -343,7 +336,7 @@ def _other_specimens(stored: pd.DataFrame, kept: pd.DataFrame) -> str:
 
 
 #: How ``pidcore report`` says another specimen is chosen (the app says its own way).
-CHOOSE_SPECIMEN_CLI = "--specimen FILE for another"
+CHOOSE_SPECIMEN_CLI = "specimen=FILE for another"
 
 
 def specimen_dem_runs(stored: pd.DataFrame | None, specimen=None, *,
@@ -411,8 +404,8 @@ def unsubtracted_baseline_note(specimen, analyses: pd.DataFrame | None) -> str:
             f"coupon's damping), which {without} measured record(s) of its {material} particles "
             f"were analysed without: their SDC includes the structure's share of it (2 pi x "
             f"{eta:g} x its share of the vibrated mass, at most {2 * math.pi * eta:.3g}) and the "
-            f"DEM's, of the particles alone, does not; analyse them with --baseline-loss-factor "
-            f"{eta:g} --structure-mass {structure_kg:.4g} (coupon and fixture; or a sidecar's "
+            f"DEM's, of the particles alone, does not; analyse them with baseline_loss_factor="
+            f"{eta:g} structure_mass_kg={structure_kg:.4g} (coupon and fixture; or a sidecar's "
             "baseline_loss_factor and structure_mass_g) to subtract it")
 
 
@@ -431,8 +424,8 @@ def whole_mass_baseline_note(settings: Iterable[Mapping | None]) -> str:
             "whole vibrated mass were the empty structure's (no structure mass given): too "
             "much by the baseline x the particles' share of that mass, so their SDC is low by "
             "2 pi x that; give the structure's mass (coupon and fixture above the gauge: "
-            "--structure-mass KG, a structure_mass_g column, the app's structure mass [g]) "
-            "for the exact subtraction")
+            "structure_mass_kg, or a structure_mass_g column of the settings table) for the "
+            "exact subtraction")
 
 
 @dataclass(frozen=True)
@@ -580,7 +573,8 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
                 pool: bool = False,
                 calibration: str | Path | None = None,
                 calibration_key: str | None = None,
-                accept_implausible: bool = False, progress: bool = False) -> ReportResult:
+                accept_implausible: bool = False, progress: bool = False,
+                wording: Callable[[str], str] | None = None) -> ReportResult:
     """Analyse files, store them, align with DEM and the paper, and write the report.
 
     Parameters
@@ -630,6 +624,11 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
     progress : bool
         Bars on stderr over the files analysed and the figures and formats written (forty
         files: 40-50 s, most of it figures and PDF, with no sign of life).
+    wording : callable, optional
+        The notes (the table's, its rows' and the report's) in a front-end's words: it names
+        the parameters the library names by keyword (``structure_mass_kg``) as its own
+        (``--structure-mass``: :func:`pidcore.cli._vocabulary.cli_words`). Default: the
+        keywords of this function and :class:`AnalysisOptions`.
 
     Returns
     -------
@@ -642,23 +641,29 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
     if calibration is not None:  # checked before anything is analysed or written
         from ..calibrate.prediction import load_calibration
 
-        calibrated = load_calibration(calibration, key=calibration_key)
+        try:
+            calibrated = load_calibration(calibration, key=calibration_key)
+        except ParameterError as exc:  # load_calibration's key is this one's calibration_key
+            raise type(exc)(str(exc).replace("with key=KEY", "with calibration_key=KEY")) \
+                from None
     elif calibration_key is not None:
-        raise ParameterError(f"--calibration-key {calibration_key}: give the store holding it "
-                             "as --calibration")
+        raise ParameterError(f"calibration_key={calibration_key}: give the store holding it "
+                             "as calibration=PATH")
     out_dir = Path(out_dir)
     check_out_dir(out_dir)
     tolerances = tolerances or Tolerances()
     files = [Path(f) for f in files]
     if not files and store is None and dem_store is None:
-        raise StoreError("nothing to report: give measurement files, --store or --dem-store")
+        raise StoreError("nothing to report: give measurement files, store=PATH or dem_store=PATH")
     if not files:
         # they would be ignored: stored analyses keep the load case and corrections they had
-        stated = [flag for flag, value in (("--fill", fill_percent), ("--material", material),
-                                           ("--direction", direction), ("--sidecar", sidecar))
+        stated = [keyword for keyword, value in (("fill_percent", fill_percent),
+                                                 ("material=", material),
+                                                 ("direction=", direction),
+                                                 ("sidecar=", sidecar))
                   if value is not None]
         if options is not None and options != AnalysisOptions():
-            stated.append("analysis options (--velocity-delay, --force, ...)")
+            stated.append("analysis options (velocity_delay_s, force=NAME, ...)")
         if stated:
             raise ParameterError(f"{', '.join(stated)}: only with measurement FILES (stored "
                                  "analyses keep the load case and corrections they were "
@@ -701,7 +706,7 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
                 # the sidecar's specimen is the file's (as an app upload's is kept): it meets
                 # only DEM runs of that name, not the --specimen's
                 notes.append(f"{display_path(r.path.name)}: its sidecar row names specimen "
-                             f"{named!r}, not {specimen.name!r} of --specimen; compared as "
+                             f"{named!r}, not {specimen.name!r} (specimen=); compared as "
                              f"{named!r}")
     if len(results) < len(files):
         kept = {r.path for r in results}
@@ -732,7 +737,7 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
             left_out = listed["measurement_key"].nunique() - analyses["measurement_key"].nunique()
             if left_out:
                 notes.append(f"{left_out} stored measurement(s) have no analysis stating a fill; "
-                             "not in the table (re-run with the files and --fill)")
+                             "not in the table (re-run with the files and fill_percent)")
     else:
         analyses = measured_frame(results)
         # not stored: the analyses' own corrections say how the baseline went off
@@ -752,6 +757,13 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
     notes.extend(table.attrs.get("notes", []))
     loops = _measured_loops(results, analyses, main, notes)
     figures = _figures(table, dem_runs, aligner, loops, dems, notes)
+    if wording is not None:
+        notes = [wording(n) for n in notes]
+        attrs = {**table.attrs, "notes": [wording(n) for n in table.attrs.get("notes", [])]}
+        if "note" in table.columns:
+            table = table.assign(note=[wording(n) if isinstance(n, str) else n
+                                       for n in table["note"]])
+        table.attrs = attrs
     try:
         seeds = []
         if dem_runs is not None and "seed" in dem_runs.columns:

@@ -261,7 +261,7 @@ def check_out_dir(out_dir: Path) -> None:
             raise ParameterError(f"{out_dir}: report output exists and is not a folder")
         if any(out_dir.iterdir()) and not (out_dir / REPORT_MARKER).exists():
             raise ParameterError(f"{out_dir}: folder exists, is not empty and holds no earlier "
-                                 "pidcore report; choose a new or empty folder for --out")
+                                 "pidcore report; choose a new or empty folder for out_dir")
         foreign = _not_written_by_a_report(out_dir)
         if foreign:
             # the folder is replaced whole: a store kept in an earlier report's folder
@@ -269,7 +269,7 @@ def check_out_dir(out_dir: Path) -> None:
             raise ParameterError(
                 f"{out_dir}: an earlier pidcore report, but it also holds {foreign!r}, which a "
                 "report does not write and replacing the report would delete; move it out or "
-                "choose another folder for --out")
+                "choose another folder for out_dir")
 
 
 def _not_written_by_a_report(out_dir: Path) -> str:

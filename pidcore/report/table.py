@@ -159,9 +159,9 @@ def no_runs_note(of: str, material: str, direction: str, store_runs: pd.DataFram
     if named and not own:
         choose_another = f"not compared with a test of {of}"
     elif not choose_another:
-        choose_another = ("report without --specimen to compare them"
+        choose_another = ("report without specimen= to compare them"
                           if set(counts.index) == {PAPER_SPECIMEN_NAME}
-                          else "report with their --specimen FILE to compare them")
+                          else "report with their specimen=FILE to compare them")
     listed = ", ".join(f"{n} of {label}" for label, n in counts.items())
     if own:
         return (f"{note} among this report's runs (the store has {listed}; {of}'s are left "
@@ -365,7 +365,7 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
             note.append(not_converged_note(row.dem))
             unconverged_rows.append(lc.label())
         if pool:
-            note.append("pooled across specimens and DEM settings (--pool)")
+            note.append("pooled across specimens and DEM settings (pool=True)")
         if row.measured and math.isfinite(row.sdc_dem) and not math.isfinite(sdc_m10):
             note.append("no DEM m_c: no like-for-like difference")
         records.append({

@@ -34,7 +34,7 @@ def run_signal_bench(n_samples: int = 10_000_000, *, repeat: int = 3) -> dict:
         whether they are met.
     """
     if n_samples < 10_000:
-        raise ParameterError(f"--samples {n_samples}: expected >= 10000 samples per channel")
+        raise ParameterError(f"n_samples {n_samples}: expected >= 10000 samples per channel")
     fs = 51_200.0
     f = 500.0 * 1.0007  # a drive slightly off its nominal value, as a controller leaves it
     rec = synthesize_shaker_record(mass_kg=0.25, acceleration_amplitude_m_s2=49.0,

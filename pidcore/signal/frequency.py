@@ -119,7 +119,7 @@ def estimate_drive_frequency(x: np.ndarray, sample_rate_hz: float, *,
                 raise SignalError(
                     f"{what}: the drive line is at {f_all:.6g} Hz, outside +-{100 * rel:g} % of "
                     f"the frequency hint {frequency_hint_hz:g} Hz; correct the hint "
-                    "(--frequency) or leave it out")
+                    "(frequency_hz) or leave it out")
     if not np.isfinite(f0) or ratio < defaults.DOMINANT_PEAK_MIN_POWER_RATIO:
         near = f" near the hint {frequency_hint_hz:g} Hz" if frequency_hint_hz else ""
         raise SignalError(
@@ -131,7 +131,7 @@ def estimate_drive_frequency(x: np.ndarray, sample_rate_hz: float, *,
             abs(f - frequency_hint_hz) > rel * frequency_hint_hz + 3 * bin_hz:
         raise SignalError(f"{what}: the drive frequency {f:.6g} Hz lies outside "
                           f"+-{100 * rel:g} % of the frequency hint {frequency_hint_hz:g} Hz; "
-                          "correct the hint (--frequency) or leave it out")
+                          "correct the hint (frequency_hz) or leave it out")
     return f
 
 

@@ -542,7 +542,7 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
         # mass cancellation, a mass below the gauge larger than the mass actually there: its
         # subtracted inertia force then exceeds the structure's.
         cause = (f"one of the channels {force_name!r} / {motion_name!r} is probably inverted: "
-                 "check the sensor directions, or pass --invert NAME for the inverted channel")
+                 "check the sensor directions, or pass invert=NAME for the inverted channel")
         if mass_below_gauge_kg > 0:
             cause = (f"mass_below_gauge_kg {mass_below_gauge_kg:g} kg is probably larger than "
                      "the mass between gauge and structure (its cancelled inertia exceeds the "
@@ -645,8 +645,8 @@ def _structure_share(structure_mass_kg: float | None, baseline_loss_factor: floa
         return 1.0, (f"baseline loss factor {baseline_loss_factor:g} subtracted as if the whole "
                      "vibrated mass were the empty structure's (too much by the particles' "
                      "share of it); give the structure's mass (coupon and fixture above the "
-                     "gauge: --structure-mass KG, a structure_mass_g column, the app's structure "
-                     "mass [g]) for the exact subtraction")
+                     "gauge: structure_mass_kg, or a structure_mass_g column of the settings "
+                     "table) for the exact subtraction")
     share, vibrated_kg = _structure_share_checked(structure_mass_kg, v_ph, harmonics, omega,
                                                   p_c, source)
     note = (f"baseline: the empty structure ({structure_mass_kg:.4g} kg) holds {share:.3g} of "
@@ -662,9 +662,8 @@ def _structure_share_checked(structure_mass_kg: float, v_ph: np.ndarray, harmoni
     q_s = float(np.sum(0.5 * harmonics * omega * structure_mass_kg * np.abs(v_ph) ** 2))
     share = q_s / p_c.imag
     vibrated_kg = structure_mass_kg / share  # the mass-like reactive power's mass
-    expected = ("expected the empty coupon and fixture above the gauge: in kg as "
-                "--structure-mass, in g in a structure_mass_g column and the app's structure "
-                "mass [g]")
+    expected = ("expected the empty coupon and fixture above the gauge (structure_mass_kg in "
+                "kg; a structure_mass_g column of the settings table in g)")
     if share > UNIT_SLIP_SHARE:
         raise ParameterError(
             f"{source or 'record'}: structure_mass_kg {structure_mass_kg:g} kg is {share:.3g} "

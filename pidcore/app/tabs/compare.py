@@ -9,6 +9,7 @@ import math
 import streamlit as st
 
 from pidcore.app import state, uploads, workbench
+from pidcore.app.vocabulary import page_terms
 from pidcore.compare.case import equivalent_dampers
 from pidcore.units import display_number
 
@@ -130,7 +131,7 @@ def render(stores, session_files: list, calibrations: list) -> None:
     try:
         view = state.case_view(_group_key(members), stamp, members, stores)
     except PidcoreError as exc:
-        st.error(f"cannot compare: {exc}")
+        st.error(f"cannot compare: {page_terms(str(exc))}")
         return
     comp, head = view["comparison"], view["headline"]
     aligned = comp.aligned

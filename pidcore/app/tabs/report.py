@@ -5,6 +5,7 @@ from __future__ import annotations
 import streamlit as st
 
 from pidcore.app import state
+from pidcore.app.vocabulary import page_terms
 
 #: The Report tab's default specimen: the paper's coupon, as ``pidcore report`` without
 #: ``--specimen``.
@@ -97,7 +98,7 @@ def render(stores, calibrations: list) -> None:
                         analysis_keys=None if keys is None else list(keys),
                         calibration=calibration, specimen=specimen))
         except PidcoreError as exc:
-            st.error(f"no report: {exc}")
+            st.error(f"no report: {page_terms(str(exc))}")
     made, files = st.session_state.get("report_files") or (None, None)
     # files of an older state are not offered
     if files and made == (stamp, pool, keys, digest, specimen_label):

@@ -1,0 +1,83 @@
+"""The library's parameter names in the app's words: one table, keyword -> the page's label.
+
+The library names a parameter as a Python caller writes it (``structure_mass_kg``,
+``force=NAME``; :mod:`pidcore.errors`), the CLI as its flag (:mod:`pidcore.cli._vocabulary`);
+the app names the field or column the user sets it in ("'structure mass [g]'"), and what it
+has no field for as the command that sets it. :func:`page_terms` does it; the pages show
+every library refusal and note through it (:func:`pidcore.app.uploads.app_words`).
+"""
+
+from __future__ import annotations
+
+import re
+
+#: Library keyword (as the message writes it) -> the app's label of it. A single word
+#: (``force``) is a keyword only with its ``=``, and a ``=VALUE`` after a keyword stays as the
+#: value (``force='Fz'`` is "the 'force channel' column ('Fz')").
+LABEL_OF_KEYWORD: dict[str, str] = {
+    "structure_mass_kg": "'structure mass [g]'",
+    "baseline_loss_factor": "'baseline loss factor [-]'",
+    "mass_below_gauge_kg": "'mass below gauge [g]'",
+    "velocity_delay_s": "'vibrometer delay [µs]'",
+    "sample_rate_hz": "'sample rate if no time column' under 'Options for every file'",
+    "force=": "the 'force channel' column",
+    "velocity=": "the 'velocity channel' column",
+    "acceleration=": "the 'acceleration channel' column",
+    "invert=": "the 'inverted channels' column",
+    "fill_percent": "'fill [%]'",
+    "material=": "the 'material' column",
+    "direction=": "the 'direction' column",
+    "specimen=": "the 'specimen' choice",
+    "calibration_key": "'calibration for the calibrated DEM columns'",
+    "accept_implausible=True": "the 'Save ... anyway' confirmation",
+    "accept_implausible": "the 'Save ... anyway' confirmation",
+    # no field on the pages: the command that sets it
+    "frequency_hz": "`pidcore analyze --frequency`",
+    "n_harmonics": "`pidcore analyze --harmonics`",
+    "allow_clipped=True": "`pidcore analyze --allow-clipped`",
+    "allow_clipped": "`pidcore analyze --allow-clipped`",
+    "force_unit": "`pidcore analyze --force-unit`",
+    "velocity_unit": "`pidcore analyze --velocity-unit`",
+    "acceleration_unit": "`pidcore analyze --acceleration-unit`",
+    "key=": "`pidcore analyze --key`",
+    "dem_store": "the DEM store",
+    "pool=True": "'pool DEM settings and specimens'",
+    "calibration_key=": "`pidcore report --calibration-key`",
+}
+
+#: The page's unit of a field where it is not the keyword's SI unit: a value given with the
+#: keyword (``structure_mass_kg=0.0483``) is shown in it ("'structure mass [g]' (48.3)").
+_PAGE_SCALE: dict[str, float] = {"structure_mass_kg": 1e3, "mass_below_gauge_kg": 1e3,
+                                 "velocity_delay_s": 1e6}
+
+# as in pidcore.cli._vocabulary: the parameter, not a file's column, attribute or field of
+# that name, nor part of a longer name
+_NOT_BEFORE = r"(?<![\w'=-])(?<!\] )(?<!column )(?<!attribute )(?<!field )(?<!variable )"
+_NOT_AFTER_WORD = r"(?![\w'])(?! column)"
+_VALUE = r"(?P<value>'[^']*'|[\w.+-]+)"
+_PATTERNS = tuple(
+    (re.compile(_NOT_BEFORE + re.escape(k.removesuffix("="))
+                + (f"={_VALUE}?" if k.endswith("=") else
+                   _NOT_AFTER_WORD if k[-1].isalnum() else "")
+                + ("" if k.endswith("=") or not k[-1].isalnum() else f"(?:={_VALUE})?")),
+     label, _PAGE_SCALE.get(k, 1.0))
+    for k, label in sorted(LABEL_OF_KEYWORD.items(), key=lambda kv: -len(kv[0])))
+
+
+def page_terms(message: str) -> str:
+    """``message`` (a library refusal or note) with its parameter keywords named as the app's
+    fields and columns; a value given with one follows in parentheses (a placeholder such as
+    ``NAME`` is left out)."""
+    def labelled(named: str, scale: float, m: re.Match) -> str:
+        value = m.group("value")
+        if value is None or (value.isupper() and not value.startswith("'")):
+            return named
+        try:
+            value = f"{float(value) * scale:g}" if scale != 1.0 else value
+        except ValueError:  # not a number: as given
+            pass
+        return f"{named} ({value})"
+
+    for pattern, named, scale in _PATTERNS:
+        message = pattern.sub(lambda m, n=named, s=scale: labelled(n, s, m), message)
+    return message

@@ -1,0 +1,130 @@
+"""The library's parameter names in the command line's words: one table, keyword -> flag.
+
+The library names a parameter as a Python caller writes it (``structure_mass_kg``,
+``key=NAME``, ``allow_clipped=True``; :mod:`pidcore.errors`); the CLI prints every refusal and
+note through :func:`cli_words`, which names the flag the user types instead
+(``--structure-mass``, ``--key NAME``, ``--allow-clipped``), from the table of that
+sub-command in :data:`COMMAND_FLAGS` (``dem sweep`` takes ``--frequencies``).
+"""
+
+from __future__ import annotations
+
+import functools
+import re
+
+#: Library keyword (as the message writes it) -> the flag of ``pidcore analyze`` and
+#: ``pidcore report`` that sets it: the analysis options and the load case. A single word
+#: (``key``, ``force``) is only a keyword with its ``=`` ("the force channel" stays as it is)
+#: or, marked ``^``, as the message's first word before its value or colon ("material: ...",
+#: "cells: expected >= 1", not "over 2 cells").
+FLAG_OF_KEYWORD: dict[str, str] = {
+    # analysis options (pidcore.measure.AnalysisOptions, analyze_power)
+    "allow_clipped=True": "--allow-clipped",
+    "allow_clipped": "--allow-clipped",
+    "accept_implausible=True": "--accept-implausible",
+    "accept_implausible": "--accept-implausible",
+    "velocity_delay_s": "--velocity-delay",
+    "mass_below_gauge_kg": "--mass-below-gauge",
+    "baseline_loss_factor": "--baseline-loss-factor",
+    "structure_mass_kg": "--structure-mass",
+    "frequency_hz": "--frequency",
+    "n_harmonics": "--harmonics",
+    "sample_rate_hz": "--sample-rate",
+    "force_unit": "--force-unit",
+    "velocity_unit": "--velocity-unit",
+    "acceleration_unit": "--acceleration-unit",
+    "force=": "--force ",
+    "velocity=": "--velocity ",
+    "acceleration=": "--acceleration ",
+    "invert=": "--invert ",
+    "key=": "--key ",
+    # load case and specimen (pidcore.compare.loadcase)
+    "fill_percent=": "--fill ",
+    "fill_percent": "--fill",
+    "material=": "--material ",
+    "^material": "--material",
+    "direction=": "--direction ",
+    "^direction": "--direction",
+    "specimen=": "--specimen ",
+    "sidecar=": "--sidecar ",
+}
+
+#: Each sub-command's keywords and flags (a command not named here has no parameter a
+#: library message names: its messages stay as they are). Only the command's own: a
+#: calibration's fitted ``baseline_loss_factor`` is no ``--baseline-loss-factor``, and a
+#: calibration table's ``frequency_hz`` column no ``--frequency``.
+COMMAND_FLAGS: dict[str, dict[str, str]] = {
+    "analyze": FLAG_OF_KEYWORD,
+    "report": {
+        **FLAG_OF_KEYWORD,
+        "store=": "--store ", "dem_store=": "--dem-store ", "dem_store": "--dem-store",
+        "calibration=": "--calibration ", "calibration_key=": "--calibration-key ",
+        "calibration_key": "--calibration-key", "pool=True": "--pool", "out_dir": "--out",
+        # the calibration a report reads from a DEM store is saved there by `pidcore calibrate`
+        "calibrate with store_path=": "pidcore calibrate --dem-store ",
+    },
+    "dem run": {
+        "fill_reference='capacity'": "--fill-reference capacity",
+        "fill_reference='paper'": "--fill-reference paper",
+        "fill_reference": "--fill-reference", "time_step": "--time-step",
+        "^cells": "--cells", "frequency_hz": "--frequency", "acceleration_g": "--acceleration",
+        "^material": "--material", "^direction": "--direction",
+    },
+    "calibrate": {
+        "^fit/priors": "--fit/--prior", "^fit": "--fit", "fit=": "--fit ",
+        "^priors": "--prior", "priors=": "--prior ",
+        "^discrepancy": "--discrepancy", "discrepancy=": "--discrepancy ",
+        "discrepancy_floor": "--discrepancy-floor", "design_size": "--design-size",
+        "cross_validate": "--cross-validate", "^method": "--method", "method=": "--method ",
+        "specimen=": "--specimen ", "read_measured_table": "--data",
+        "write_outputs(result, out_dir)": "pidcore calibrate --out",
+    },
+    "bench signal": {"n_samples": "--samples"},
+}
+COMMAND_FLAGS["dem sweep"] = {
+    **COMMAND_FLAGS["dem run"],
+    "frequency_hz": "--frequencies", "acceleration_g": "--accelerations",
+    "fills_percent": "--fills", "^grid": "--grid", "^workers": "--workers",
+    "^scheduler": "--scheduler",
+}
+
+# A keyword names the parameter, not a file's own column, attribute, field or variable of the
+# same name ("column baseline_loss_factor '-1' of loadcases.csv", "a baseline_loss_factor
+# column", "field sample_rate_hz", "('fs' or 'sample_rate_hz')"), nor part of a longer name
+# ("my_frequency_hz_col", "--structure-mass"), nor a specimen file's key ("[coupon]
+# baseline_loss_factor 0.01"). A keyword written with its value
+# ("structure_mass_kg=0.2") is the flag with that value ("--structure-mass 0.2").
+_NOT_BEFORE = r"(?<![\w'=-])(?<!\] )(?<!column )(?<!attribute )(?<!field )(?<!variable )"
+_NOT_AFTER_WORD = r"(?![\w'])(?! column)"
+
+
+@functools.cache
+def _table(command: str) -> tuple[dict[str, str], re.Pattern]:
+    flags = COMMAND_FLAGS.get(command, {})
+    if not flags:
+        return {}, re.compile(r"(?!)")  # matches nothing
+    alternatives = []
+    for keyword in sorted(flags, key=len, reverse=True):  # "allow_clipped=True" first
+        anchored = keyword.startswith("^")
+        word = keyword.removeprefix("^")
+        alternatives.append((r"^" if anchored else _NOT_BEFORE) + re.escape(word)
+                            + (r"(?=[:\s])" if anchored else
+                               _NOT_AFTER_WORD + "=?" if word[-1].isalnum() else ""))
+    return ({k.removeprefix("^"): v for k, v in flags.items()},
+            re.compile("|".join(alternatives)))
+
+
+def _flag(flags: dict[str, str], m: re.Match) -> str:
+    said = m.group(0)
+    flag = flags[said] if said in flags else flags[said.removesuffix("=")] + " "
+    # "force_unit='N'" is "--force-unit 'N'": a flag takes its value after a space, and
+    # without one ("material=, direction=: only with FILES") it is the flag alone
+    valued = m.end() < len(m.string) and m.string[m.end()] not in " ,:;)"
+    return flag if valued else flag.rstrip()
+
+
+def cli_words(message: str, command: str = "analyze") -> str:
+    """``message`` (a library refusal or note) with its parameter keywords named as the flags
+    of ``pidcore COMMAND`` (``"dem sweep"``; the default: those of ``analyze``)."""
+    flags, pattern = _table(command)
+    return pattern.sub(lambda m: _flag(flags, m), message)
