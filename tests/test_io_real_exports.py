@@ -178,7 +178,7 @@ def test_roles_on_real_exports():
     from pidcore.io import assign_roles
 
     four_acc = _read("pyuff_MPSTD_Set001_2024_10_08_10_27_07.uff")
-    with pytest.raises(ChannelError, match=r"no force channel among 'MPS set1 Dof1'.*--force NAME"):
+    with pytest.raises(ChannelError, match=r"no force channel among 'MPS set1 Dof1'.*force=NAME"):
         assign_roles(four_acc)
     force_only = _read("UFFFilesjl_dataset58_time.unv")
     with pytest.raises(ChannelError, match="no velocity or acceleration channel"):
