@@ -1231,3 +1231,40 @@ def test_compare_names_a_saved_implausible_result_and_judges_no_band_of_its_pool
     assert "the measured Eq. 11 SDC is not compared (it pools an implausible result" in captions
     assert "bad_fill50.csv: implausible, saved as accepted: SDC 9.4" in captions
     assert "ok_fill50.csv: implausible" not in captions
+
+
+def test_stored_calibrations_are_read_once_per_store_state_and_a_new_one_is_seen(
+        store_file, monkeypatch):
+    # Before, every draw read each stored calibration twice (the Compare/Report list in the
+    # page's main, then the Calibrate tab's table), and again on every click.
+    import pidcore.calibrate.persist as persist
+    from pidcore.store import Store
+
+    bundled = (REPO / "data_samples" / "paper_calibration" / "calibration.json").read_text()
+
+    def add(key: str) -> None:
+        Store(store_file).add_calibration(key, {"specimen": "paper_coupon", "n_points": 12},
+                                          document=bundled, specimen_toml="",
+                                          units={"n_points": "count"})
+
+    add("cal_00000000000000a1")
+    reads: list[str] = []
+    real = persist._calibration
+
+    def counted(store, key):
+        reads.append(key)
+        return real(store, key)
+
+    monkeypatch.setattr(persist, "_calibration", counted)
+    at = _app()
+    assert reads == ["cal_00000000000000a1"]  # one read for all three tabs
+    at.run()  # a click that changes nothing in the store: nothing read again
+    assert not at.exception, at.exception
+    assert reads == ["cal_00000000000000a1"]
+    add("cal_00000000000000b2")  # saved meanwhile (e.g. by the Calibrate page or the CLI)
+    at.run()
+    assert not at.exception, at.exception
+    # both read once more, and the new one is offered at once, not a stale list
+    assert sorted(reads[1:]) == ["cal_00000000000000a1", "cal_00000000000000b2"]
+    assert at.selectbox(key="calibration_saved_key").options == [
+        "cal_00000000000000b2", "cal_00000000000000a1"]
