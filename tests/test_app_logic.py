@@ -541,6 +541,51 @@ def test_cancel_stops_a_running_dem_case_within_two_seconds_and_saves_nothing(tm
     assert not store_file.exists() or Store(store_file).list_dem_runs().empty
 
 
+@pytest.mark.dem_subprocess
+def test_a_queued_dem_job_whose_run_is_stored_meanwhile_is_not_run(tmp_path):
+    # Before, a job looked for its run only when submitted: a run that `pidcore dem`, a
+    # calibration or another app server stored while the job waited was simulated again.
+    from pidcore.dem import DemConfig
+    from pidcore.dem.persist import dem_run_entry, load_dem_result, run_key, save_dem_entry
+    from pidcore.store import Store
+
+    store_file = tmp_path / "dem.h5"
+    reference = Store(REPO / "data_samples" / "dem_table3.h5")
+    runner = jobs.DemJobRunner(store_file)
+    try:
+        (first,) = runner.submit(
+            jobs.plan_dem_cases([50.0], [5.0], [50.0], material="acrylic", direction="z"),
+            DemConfig(cells=1, steady_cycles=5000))  # long: still running below
+        (case,) = jobs.plan_dem_cases([100.0], [5.0], [50.0], material="acrylic",
+                                      direction="z")
+        (queued,) = runner.submit([case], DemConfig())
+        assert queued.state == "queued"
+        deadline = time.monotonic() + 120
+        while not any(j.state == "running" for j in runner.jobs()):
+            assert time.monotonic() < deadline
+            time.sleep(0.05)
+        # stored meanwhile by someone else (the bundled reference run of this very key)
+        key = run_key(case, DemConfig())
+        save_dem_entry(store_file, key, dem_run_entry(load_dem_result(reference.get_dem_run(
+            key))))
+        runner.cancel([first.job_id])
+        deadline = time.monotonic() + 30  # a 8-cell run would take minutes, the check none
+        while runner.busy():
+            assert time.monotonic() < deadline, [j.row() for j in runner.jobs()]
+            time.sleep(0.05)
+        by_id = {j.job_id: j for j in runner.jobs()}
+    finally:
+        runner.cancel()
+        runner.wait_cancelled(5.0)
+    done = by_id[queued.job_id]
+    assert done.state == "in store" and done.run_key == key
+    assert done.message == (f"stored in the store as {key} after it was queued; not run "
+                            "again")
+    runs = Store(store_file).list_dem_runs()
+    assert list(runs["case_key"]) == [key]  # the run saved above, nothing else
+    assert runs["sdc"].iloc[0] == reference.get_dem_run(key).record["sdc"]
+
+
 def test_dem_values_are_any_positive_numbers():
     from pidcore.loadcase import parse_values
 

@@ -1268,3 +1268,38 @@ def test_stored_calibrations_are_read_once_per_store_state_and_a_new_one_is_seen
     assert sorted(reads[1:]) == ["cal_00000000000000a1", "cal_00000000000000b2"]
     assert at.selectbox(key="calibration_saved_key").options == [
         "cal_00000000000000b2", "cal_00000000000000a1"]
+
+
+def test_a_run_the_reference_store_holds_is_shown_stored_and_never_run(store_file, tmp_path,
+                                                                      monkeypatch):
+    # Before, Run with the page's defaults (100 Hz, 5 g, 50 %, 8 cells, seed 12345) queued
+    # and simulated the very run the bundled reference store holds: `pidcore dem sweep`
+    # reuses it. The run key (specimen hash, load case, settings, seed, code version) must
+    # find it there.
+    import shutil
+
+    from pidcore.dem import DemConfig, LoadCase
+    from pidcore.dem.persist import run_key
+
+    ref = tmp_path / "reference.h5"
+    shutil.copyfile(REPO / "data_samples" / "dem_table3.h5", ref)
+    ref_bytes = ref.read_bytes()
+    monkeypatch.setenv(stores.DEM_STORE_ENV_VAR, str(ref))
+    at = _app()
+    at.button(key="dem_run").click()  # the page's defaults
+    at.run()
+    runner = jobs.runner_for(store_file)
+    try:
+        assert not at.exception, at.exception
+        said = [i.value for i in at.info]
+        assert any(v.startswith("0 job(s) submitted; 1 already in the store, not run again")
+                   for v in said), said
+        (job,) = runner.jobs()
+        assert job.state == "in store" and not runner.busy()
+        assert job.run_key == run_key(LoadCase(100.0, 5.0, 50.0), DemConfig())
+        assert job.message == f"already in the reference store {ref}; not run again"
+    finally:
+        runner.cancel()
+        runner.wait_cancelled(5.0)
+    assert not store_file.exists()  # nothing simulated, nothing saved
+    assert ref.read_bytes() == ref_bytes

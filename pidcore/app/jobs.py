@@ -166,8 +166,12 @@ class DemJobRunner:
         Store every finished case is saved to.
     """
 
-    def __init__(self, store_path: str | Path) -> None:
+    def __init__(self, store_path: str | Path, reference_store: str | Path | None = None,
+                 ) -> None:
         self.store_path = Path(store_path)
+        #: Read-only store of reference DEM runs (the app's ``$PIDCORE_DEM_STORE``): a run
+        #: it holds is never run again, as ``pidcore dem sweep`` reuses stored runs.
+        self.reference_store = None if reference_store is None else Path(reference_store)
         self._lock = threading.Lock()
         self._wake = threading.Condition(self._lock)
         self._cancel: set[str] = set()
@@ -193,19 +197,9 @@ class DemJobRunner:
         queued or running is not submitted again; a run already in the store, or the same
         simulation as a job queued or running, this submission's included, gets a job that
         says so and is not run: :data:`SAME_RUN_STATE`)."""
-        from ..dem.persist import (
-            own_run_keys,
-            run_identity,
-            run_key,
-            stored_identities,
-            stored_run_key,
-        )
-        from ..store import Store
+        from ..dem.persist import own_run_keys, run_identity, run_key
 
-        stored = Store(self.store_path) if self.store_path.is_file() else None
-        # runs of another fill with the same particle count (and seed, settings, specimen) are
-        # the same simulation (pidcore.dem.persist.stored_run_key): read once per submission
-        identities = stored_identities(stored) if stored is not None else {}
+        lookup = self._stored_runs()  # the stores' runs, read once per submission
         created = []
         with self._lock:
             # the simulations queued or running, this submission's included, by identity
@@ -232,16 +226,16 @@ class DemJobRunner:
                     continue  # this very run is queued or running
                 self._counter += 1
                 job = DemJob(f"job{self._counter:04d}", case, config, key, specimen)
-                found = stored_run_key(stored, case, config, specimen, identities=identities) \
-                    if stored is not None else None
+                found, where = lookup(case, config, specimen)
                 if found is not None and found in own_run_keys(case, config, specimen):
-                    job.state, job.message = "in store", "already in the store; not run again"
+                    job.state, job.message = "in store", f"already in {where}; not run again"
                     job.finished = time.time()
                     job.run_key = found  # its own key, or the paper's 0.1 key it is held by
                 elif (same := found) is not None:
                     job.state, job.finished = "in store", time.time()
                     job.message = (f"the same simulation (particles per cell, seed, settings) "
-                                   f"as stored run {same} of another fill; not run again")
+                                   f"as stored run {same} of another fill in {where}; not run "
+                                   "again")
                     job.run_key = same  # the jobs table's store key names the run it is
                 elif running is not None:
                     job.state, job.finished = SAME_RUN_STATE, time.time()
@@ -258,6 +252,42 @@ class DemJobRunner:
                 self._write_journal()
             self._wake.notify_all()
         return created
+
+    def _stored_runs(self):
+        """A lookup ``(case, config, specimen) -> (key, where)`` of the runs the app store and
+        the reference store hold (:func:`pidcore.dem.persist.stored_run_key`: the run's own
+        key, or a stored run of the same simulation under another fill), ``(None, "")`` where
+        neither does; each store's runs are read once, here. A reference store that cannot
+        be read holds nothing for this lookup (the DEM page says why it cannot be read)."""
+        from ..dem.persist import stored_identities, stored_run_key
+        from ..store import Store
+
+        stores = []
+        reference = self.reference_store
+        if reference is not None and reference.resolve() == self.store_path.resolve():
+            reference = None  # the app store itself, looked up already
+        for path, where in ((self.store_path, "the store"),
+                            (reference, f"the reference store {reference}")):
+            if path is None or not path.is_file():
+                continue
+            try:
+                store = Store(path)
+                # runs of another fill with the same particle count (and seed, settings,
+                # specimen) are the same simulation: found by the stored runs' inputs
+                stores.append((store, stored_identities(store), where))
+            except PidcoreError:
+                if path == self.store_path:
+                    raise  # the app store must be readable to save anything in it
+                continue
+
+        def lookup(case, config, specimen) -> tuple[str | None, str]:
+            for store, identities, where in stores:
+                found = stored_run_key(store, case, config, specimen, identities=identities)
+                if found is not None:
+                    return found, where
+            return None, ""
+
+        return lookup
 
     def resubmit_interrupted(self) -> list[DemJob]:
         """Submit again every job the app's last stop interrupted (:data:`INTERRUPTED_STATE`);
@@ -365,6 +395,9 @@ class DemJobRunner:
                 if job.state == "saved":
                     same.state = "in store"
                     same.message += f"; saved by it as {job.run_key}"
+                elif job.state == "in store":  # found stored as it was about to run
+                    same.state = "in store"
+                    same.message += f"; stored as {job.run_key}"
                 else:
                     same.state = "cancelled"
                     same.message = (f"not run: {job.job_id}, the same simulation, is "
@@ -382,6 +415,15 @@ class DemJobRunner:
         from ..dem.sweep import CaseOutcome, dem_process_context
         from ..store import Store
 
+        # stored since it was queued (by `pidcore dem`, another app server, a calibration):
+        # not run again
+        found, where = self._stored_runs()(job.case, job.config, job.specimen)
+        if found is not None:
+            with self._lock:
+                job.run_key = found
+            self._finish(job, "in store", f"stored in {where} as {found} after it was queued; "
+                                          "not run again")
+            return
         ctx = dem_process_context()
         parent, child = ctx.Pipe(duplex=False)
         proc = ctx.Process(target=_child, args=(job.case, job.config, job.specimen, child),
@@ -593,13 +635,18 @@ _RUNNERS: dict[str, DemJobRunner] = {}
 _RUNNERS_LOCK = threading.Lock()
 
 
-def runner_for(store_path: str | Path) -> DemJobRunner:
+def runner_for(store_path: str | Path,
+               reference_store: str | Path | None = None) -> DemJobRunner:
     """The process-wide job runner of a store (created on first use; outlives script runs and
-    browser sessions, so a reload shows the jobs still running)."""
+    browser sessions, so a reload shows the jobs still running). ``reference_store``: the
+    read-only store of reference DEM runs whose runs are not run again (kept from the first
+    call that names one)."""
     key = str(Path(store_path).resolve())
     with _RUNNERS_LOCK:
         if key not in _RUNNERS:
-            _RUNNERS[key] = DemJobRunner(key)
+            _RUNNERS[key] = DemJobRunner(key, reference_store)
+        elif reference_store is not None:
+            _RUNNERS[key].reference_store = Path(reference_store)
         return _RUNNERS[key]
 
 
