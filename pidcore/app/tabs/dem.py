@@ -53,7 +53,8 @@ def _job_table(stores, polling: bool) -> None:
     listed = runner.jobs()  # one locked copy for the table and the progress bar
     rows = [j.row() for j in listed]
     busy = runner.busy()
-    running = [j for j in listed if j.state == "running"]
+    # this server's: another server's progress is not in the journal (it writes states only)
+    running = [j for j in listed if j.state == "running" and not j.server]
     if running:
         st.progress(running[0].fraction(), text=running[0].progress_text())
     if rows:
