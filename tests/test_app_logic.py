@@ -1783,3 +1783,39 @@ def test_compare_notes_a_saved_baseline_off_the_whole_vibrated_mass(tmp_path, go
         unsaved = case_view([_entry(rec, options=opts)], None, paper_table(), ())["notes"]
         assert ((expected in unsaved) if expected
                 else not any("whole vibrated mass" in n for n in unsaved))
+
+
+def test_a_report_build_runs_in_the_background_and_says_why_it_failed():
+    from pidcore.app.report_builds import start_report_build
+
+    release = threading.Event()
+
+    def slow():
+        release.wait(30.0)
+        return {"csv": ("r.csv", b"x", "text/csv")}
+
+    build = start_report_build(("stamp", 1), slow)
+    assert build.state == "running" and build.files == {}  # returned before the build ended
+    # the same report asked again while it runs: the running build, not a second one
+    assert start_report_build(("stamp", 1), slow, build) is build
+    release.set()
+    deadline = time.monotonic() + 30
+    while build.state == "running":
+        assert time.monotonic() < deadline
+        time.sleep(0.01)
+    assert build.state == "done" and build.files["csv"][1] == b"x" and build.message == ""
+
+    def refused():
+        raise ParameterError("store.h5: no DEM runs of specimen steel")
+
+    def broken():
+        raise KeyError("x")
+
+    for fn, said in ((refused, "store.h5: no DEM runs of specimen steel"),
+                     (broken, "KeyError: 'x'")):
+        failed = start_report_build(("stamp", 2), fn, build)
+        assert failed is not build  # another state of the store: a new build
+        while failed.state == "running":
+            assert time.monotonic() < deadline
+            time.sleep(0.01)
+        assert (failed.state, failed.message, failed.files) == ("failed", said, {})

@@ -344,6 +344,7 @@ def test_report_tab_shows_the_table_and_offers_clean_downloads(store_file):
     assert table["SDC DEM (paper) [-]"].tolist() == [0.1891]
     at.button(key="build_report").click()
     at.run(timeout=RUN_TIMEOUT_S)
+    _wait_report(at)
     assert not at.exception
     labels = sorted(b.label for b in at.get("download_button")
                     if not b.proto.label.startswith("Download these"))
@@ -353,6 +354,52 @@ def test_report_tab_shows_the_table_and_offers_clean_downloads(store_file):
     files = report_files(store_file)
     back = pd.read_csv(io.BytesIO(files["csv"][1]))
     assert len(back) == 1 and back["SDC measured [-]"].iloc[0] == shown_sdc
+
+
+def _wait_report(at: AppTest, timeout_s: float = 120.0) -> None:
+    """Wait for the Report page's background build to end, then draw the page again."""
+    deadline = time.monotonic() + timeout_s
+    while at.session_state["report_build"].state == "running":
+        assert time.monotonic() < deadline, "the report build did not end"
+        time.sleep(0.05)
+    at.run()
+
+
+def test_building_the_report_files_does_not_block_the_page(store_file, monkeypatch):
+    # Before, the report files (figures, HTML, LaTeX, PDF: seconds of CPU) were written inside
+    # the script run: the page was blocked meanwhile and a click elsewhere stopped the build.
+    import threading
+
+    import pidcore.report.downloads as downloads
+
+    release, calls = threading.Event(), []
+
+    def slow_report_files(*args, **kwargs):
+        calls.append(kwargs)
+        release.wait(30.0)  # a long build, until the test lets it finish
+        return {"csv": ("pidcore_report.csv", b"a,b\n1,2\n", "text/csv")}
+
+    monkeypatch.setattr(downloads, "report_files", slow_report_files)
+    at = _upload(_app(), [("coupon_fill50.csv", mass_damper_csv())])
+    at.button(key="save").click()
+    at.run()
+    at.run()
+    at.button(key="build_report").click()
+    start = time.perf_counter()
+    at.run()
+    try:
+        assert time.perf_counter() - start < 10.0  # returned while the build still runs
+        assert not at.exception, at.exception
+        assert any(i.value.startswith("Writing the report ...") for i in at.info)
+        at.button(key="build_report").click()  # a second click meanwhile builds nothing twice
+        at.run()
+        assert len(calls) == 1
+    finally:
+        release.set()
+    _wait_report(at)
+    csv = [b for b in at.get("download_button") if b.label == "CSV"]
+    assert len(csv) == 1 and not any(i.value.startswith("Writing") for i in at.info)
+    assert len(calls) == 1
 
 
 def _fill_dem(at, *, freqs: str, accs: str, fills: str, cells: int, steady: int) -> None:
