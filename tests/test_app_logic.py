@@ -1819,3 +1819,18 @@ def test_a_report_build_runs_in_the_background_and_says_why_it_failed():
             assert time.monotonic() < deadline
             time.sleep(0.01)
         assert (failed.state, failed.message, failed.files) == ("failed", said, {})
+
+
+def test_cancel_says_when_there_is_nothing_to_cancel_and_what_it_cannot_cancel():
+    # Before, Cancel with no job running warned "cancel requested for 0 job(s)", and a job of
+    # another app server of the store went unmentioned though it kept running.
+    mine = jobs.DemJob("job0001", None, None, "k1", None, state="saved")
+    theirs = jobs.DemJob("job0002", None, None, "k2", None, state="running",
+                         server="pid 812 on host lab3")
+    assert jobs.cancelled_text(0, [mine]) == (
+        "info", "nothing to cancel: no job of this app server is queued or running")
+    level, said = jobs.cancelled_text(2, [mine, theirs])
+    assert level == "warning" and said == (
+        "cancel requested for 2 job(s); finished cases stay saved; 1 job(s) queued or running "
+        "on another app server of this store cannot be cancelled here (cancel them on that "
+        "server's page)")

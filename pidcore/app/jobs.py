@@ -932,6 +932,20 @@ DEM_RUN_COLUMNS = {"specimen": "specimen", "frequency_hz": "frequency [Hz]",
                    "wall_s": "wall time [s]", "case_key": "run", "store": "store"}
 
 
+def cancelled_text(n_cancelled: int, listed: Sequence[DemJob]) -> tuple[str, str]:
+    """(level, words) of what a click on Cancel did: ``n_cancelled`` jobs of this server
+    (:meth:`DemJobRunner.cancel`), and ``listed`` (:meth:`DemJobRunner.jobs`) to name the
+    jobs of another app server that cannot be cancelled from here. Nothing to cancel is
+    said as such ("cancel requested for 0 job(s)" read as a failed cancel)."""
+    theirs = sum(j.state in ("queued", "running") and bool(j.server) for j in listed)
+    other = (f"; {theirs} job(s) queued or running on another app server of this store "
+             "cannot be cancelled here (cancel them on that server's page)" if theirs else "")
+    if n_cancelled == 0:
+        return "info", f"nothing to cancel: no job of this app server is queued or running{other}"
+    return "warning", (f"cancel requested for {n_cancelled} job(s); finished cases stay saved"
+                       f"{other}")
+
+
 def submitted_text(n_cases: int, created: Sequence[DemJob]) -> str:
     """What a click on Run did: jobs that will run, runs already in the store (not run
     again), cases that are the same simulation as another job (run once), cases the DEM

@@ -43,8 +43,7 @@ def _cancel(stores) -> None:
     runner = _runner(stores)
     n = runner.cancel()
     runner.wait_cancelled(CANCEL_WAIT_S)
-    st.session_state["dem_message"] = ("warning", f"cancel requested for {n} job(s); finished "
-                                                  "cases stay saved")
+    st.session_state["dem_message"] = jobs.cancelled_text(n, runner.jobs())
 
 
 def _job_table(stores, polling: bool) -> None:
