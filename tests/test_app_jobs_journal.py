@@ -30,22 +30,63 @@ def _steel():
     return load_specimen(REPO / "data_samples" / "specimens" / "steel_6mm.toml")
 
 
+#: An app server of its own (another process): a runner on ``argv[1]`` that submits two long
+#: cases of the steel specimen, says "running" once the first runs, and waits to be killed.
+_SERVER = """
+import sys, time
+from pidcore.app import jobs
+from pidcore.dem import DemConfig
+from pidcore.specimen import load_specimen
+specimen = load_specimen(sys.argv[2])
+cases = jobs.plan_dem_cases([50.0, 60.0], [5.0], [50.0], material=specimen.particles.material,
+                            direction="z")
+runner = jobs.DemJobRunner(sys.argv[1])
+runner.submit(cases, DemConfig(cells=1, steady_cycles=5000), specimen)
+while not any(j.state == "running" for j in runner.jobs()):
+    time.sleep(0.05)
+print(" ".join(j.job_id for j in runner.jobs()), flush=True)
+time.sleep(600)
+"""
+
+
+class _Server:
+    """Another app server on ``store`` (:data:`_SERVER`), its jobs running once started."""
+
+    def __init__(self, store: Path) -> None:
+        import subprocess
+        import sys
+
+        self.process = subprocess.Popen(
+            [sys.executable, "-c", _SERVER, str(store),
+             str(REPO / "data_samples" / "specimens" / "steel_6mm.toml")],
+            stdout=subprocess.PIPE, text=True, start_new_session=True)
+        #: The ids of its jobs, once the first runs (read from its output).
+        self.job_ids = (self.process.stdout.readline() or "").split()
+        assert self.job_ids, f"the other server ended (exit code {self.process.poll()})"
+
+    def crash(self) -> None:
+        """Kill it and its DEM processes at once, as a crash or SIGKILL does."""
+        import os
+        import signal
+
+        import psutil
+
+        for child in psutil.Process(self.process.pid).children(recursive=True):
+            child.kill()
+        os.killpg(self.process.pid, signal.SIGKILL)
+        self.process.wait(10)
+
+
 def test_jobs_running_or_queued_at_a_stop_come_back_interrupted(tmp_path):
     store = tmp_path / "app.h5"
     specimen = _steel()
-    cases = jobs.plan_dem_cases([50.0, 60.0], [5.0], [50.0], material=specimen.particles.material,
-                                direction="z")
-    first = jobs.DemJobRunner(store)
+    first = _Server(store)  # the first app server: its jobs are running and queued
     try:
-        submitted = first.submit(cases, LONG, specimen)
-        _wait_running(first)
-        # the server stops here: a new process starts a runner on the same store and reads
-        # the journal the first one keeps
-        second = jobs.DemJobRunner(store)
-        restored = second.jobs()
+        submitted = jobs.DemJobRunner(store).jobs()
     finally:
-        first.cancel()
-        first.wait_cancelled(5.0)
+        first.crash()  # the server stops; a new server starts a runner on the same store
+    second = jobs.DemJobRunner(store)
+    restored = second.jobs()
     assert [j.job_id for j in restored] == [j.job_id for j in submitted]
     assert [j.state for j in restored] == [jobs.INTERRUPTED_STATE] * 2
     assert all("nothing of it was saved" in j.message for j in restored)
@@ -73,6 +114,77 @@ def test_jobs_running_or_queued_at_a_stop_come_back_interrupted(tmp_path):
     listed = json.loads(jobs.journal_path(store).read_text())["jobs"]
     assert [d["state"] for d in listed] == [j.state for j in second.jobs()]
     assert sorted(p.name for p in tmp_path.iterdir() if p.name.endswith(".tmp")) == []
+
+
+def test_a_second_server_on_the_store_leaves_the_first_ones_running_jobs_running(tmp_path):
+    # Before, a second app server on the store read the first's running and queued jobs as
+    # left by a stop: it listed them "interrupted, nothing saved", offered to run them again
+    # (twice the same simulation) and rewrote the journal without them.
+    import os
+    import socket
+
+    store = tmp_path / "app.h5"
+    first = _Server(store)
+    try:
+        second = jobs.DemJobRunner(store)  # this process: the second server
+        listed = second.jobs()
+        assert [j.job_id for j in listed] == first.job_ids
+        assert [j.state for j in listed] == ["running", "queued"]
+        theirs = f"pid {first.process.pid} on host {socket.gethostname()}"
+        assert all(j.server == theirs for j in listed)
+        assert listed[0].row()["message"].startswith(f"on another app server ({theirs})")
+        assert second.busy()  # the page keeps refreshing while the first server runs them
+        # the same cases are not queued a second time here (and never run twice) ...
+        cases, config, specimen = listed[0].case, listed[0].config, listed[0].specimen
+        assert second.submit([cases, listed[1].case], config, specimen) == []
+        # ... nor cancelled from here, and a rewrite by this server keeps the first's entries
+        assert second.cancel() == 0
+        second.clear_finished()
+        entries = json.loads(jobs.journal_path(store).read_text())["jobs"]
+        assert [(e["job_id"], e["state"], e["owner"]["pid"]) for e in entries] == [
+            (first.job_ids[0], "running", first.process.pid),
+            (first.job_ids[1], "queued", first.process.pid)]
+        # a third runner (another server of this host) sees them the same way
+        assert [j.state for j in jobs.DemJobRunner(store).jobs()] == ["running", "queued"]
+    finally:
+        first.crash()
+    # once the first server is gone its jobs are interrupted, taken over by one server only
+    after = second.jobs()
+    assert [j.state for j in after] == [jobs.INTERRUPTED_STATE] * 2
+    assert all(j.server == "" and "nothing of it was saved" in j.message for j in after)
+    entries = json.loads(jobs.journal_path(store).read_text())["jobs"]
+    assert {e["owner"]["pid"] for e in entries} == {os.getpid()}
+    third = jobs.DemJobRunner(store).jobs()
+    assert [(j.state, j.server) for j in third] == [
+        (jobs.INTERRUPTED_STATE, f"pid {os.getpid()} on host {socket.gethostname()}")] * 2
+    assert not second.busy()
+
+
+def test_an_owner_is_alive_while_its_process_runs_and_not_under_a_reused_id(tmp_path):
+    import subprocess
+    import sys
+
+    import psutil
+
+    me = jobs.JournalOwner.of_this_process()
+    assert me.alive() is False  # a runner token this process never made
+    runner = jobs.DemJobRunner(tmp_path / "app.h5")
+    assert runner.owner.alive()
+    sleeper = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"])
+    try:
+        started = psutil.Process(sleeper.pid).create_time()
+        other = jobs.JournalOwner(me.host, sleeper.pid, started, "r")
+        assert other.alive()
+        # the same process id with another start time is another process (a reused id)
+        assert not jobs.JournalOwner(me.host, sleeper.pid, started - 3600.0, "r").alive()
+    finally:
+        sleeper.kill()
+        sleeper.wait()
+    assert not other.alive()  # ended
+    # an owner written by an older pidcore (none), or one that cannot be trusted
+    assert jobs.JournalOwner.from_document(None) is None
+    assert jobs.JournalOwner.from_document({**other.document(), "pid": True}) is None
+    assert jobs.JournalOwner.from_document(other.document()) == other
 
 
 def test_finished_jobs_are_listed_as_they_were(tmp_path):

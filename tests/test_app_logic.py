@@ -565,6 +565,51 @@ def test_cancel_stops_a_running_dem_case_within_two_seconds_and_saves_nothing(tm
     assert not store_file.exists() or Store(store_file).list_dem_runs().empty
 
 
+@pytest.mark.dem_subprocess
+def test_a_queued_dem_job_whose_run_is_stored_meanwhile_is_not_run(tmp_path):
+    # Before, a job looked for its run only when submitted: a run that `pidcore dem`, a
+    # calibration or another app server stored while the job waited was simulated again.
+    from pidcore.dem import DemConfig
+    from pidcore.dem.persist import dem_run_entry, load_dem_result, run_key, save_dem_entry
+    from pidcore.store import Store
+
+    store_file = tmp_path / "dem.h5"
+    reference = Store(REPO / "data_samples" / "dem_table3.h5")
+    runner = jobs.DemJobRunner(store_file)
+    try:
+        (first,) = runner.submit(
+            jobs.plan_dem_cases([50.0], [5.0], [50.0], material="acrylic", direction="z"),
+            DemConfig(cells=1, steady_cycles=5000))  # long: still running below
+        (case,) = jobs.plan_dem_cases([100.0], [5.0], [50.0], material="acrylic",
+                                      direction="z")
+        (queued,) = runner.submit([case], DemConfig())
+        assert queued.state == "queued"
+        deadline = time.monotonic() + 120
+        while not any(j.state == "running" for j in runner.jobs()):
+            assert time.monotonic() < deadline
+            time.sleep(0.05)
+        # stored meanwhile by someone else (the bundled reference run of this very key)
+        key = run_key(case, DemConfig())
+        save_dem_entry(store_file, key, dem_run_entry(load_dem_result(reference.get_dem_run(
+            key))))
+        runner.cancel([first.job_id])
+        deadline = time.monotonic() + 30  # a 8-cell run would take minutes, the check none
+        while runner.busy():
+            assert time.monotonic() < deadline, [j.row() for j in runner.jobs()]
+            time.sleep(0.05)
+        by_id = {j.job_id: j for j in runner.jobs()}
+    finally:
+        runner.cancel()
+        runner.wait_cancelled(5.0)
+    done = by_id[queued.job_id]
+    assert done.state == "in store" and done.run_key == key
+    assert done.message == (f"stored in the store as {key} after it was queued; not run "
+                            "again")
+    runs = Store(store_file).list_dem_runs()
+    assert list(runs["case_key"]) == [key]  # the run saved above, nothing else
+    assert runs["sdc"].iloc[0] == reference.get_dem_run(key).record["sdc"]
+
+
 def test_dem_values_are_any_positive_numbers():
     from pidcore.loadcase import parse_values
 
@@ -1763,3 +1808,54 @@ def test_compare_notes_a_saved_baseline_off_the_whole_vibrated_mass(tmp_path, go
         unsaved = case_view([_entry(rec, options=opts)], None, paper_table(), ())["notes"]
         assert ((expected in unsaved) if expected
                 else not any("whole vibrated mass" in n for n in unsaved))
+
+
+def test_a_report_build_runs_in_the_background_and_says_why_it_failed():
+    from pidcore.app.report_builds import start_report_build
+
+    release = threading.Event()
+
+    def slow():
+        release.wait(30.0)
+        return {"csv": ("r.csv", b"x", "text/csv")}
+
+    build = start_report_build(("stamp", 1), slow)
+    assert build.state == "running" and build.files == {}  # returned before the build ended
+    # the same report asked again while it runs: the running build, not a second one
+    assert start_report_build(("stamp", 1), slow, build) is build
+    release.set()
+    deadline = time.monotonic() + 30
+    while build.state == "running":
+        assert time.monotonic() < deadline
+        time.sleep(0.01)
+    assert build.state == "done" and build.files["csv"][1] == b"x" and build.message == ""
+
+    def refused():
+        raise ParameterError("store.h5: no DEM runs of specimen steel")
+
+    def broken():
+        raise KeyError("x")
+
+    for fn, said in ((refused, "store.h5: no DEM runs of specimen steel"),
+                     (broken, "KeyError: 'x'")):
+        failed = start_report_build(("stamp", 2), fn, build)
+        assert failed is not build  # another state of the store: a new build
+        while failed.state == "running":
+            assert time.monotonic() < deadline
+            time.sleep(0.01)
+        assert (failed.state, failed.message, failed.files) == ("failed", said, {})
+
+
+def test_cancel_says_when_there_is_nothing_to_cancel_and_what_it_cannot_cancel():
+    # Before, Cancel with no job running warned "cancel requested for 0 job(s)", and a job of
+    # another app server of the store went unmentioned though it kept running.
+    mine = jobs.DemJob("job0001", None, None, "k1", None, state="saved")
+    theirs = jobs.DemJob("job0002", None, None, "k2", None, state="running",
+                         server="pid 812 on host lab3")
+    assert jobs.cancelled_text(0, [mine]) == (
+        "info", "nothing to cancel: no job of this app server is queued or running")
+    level, said = jobs.cancelled_text(2, [mine, theirs])
+    assert level == "warning" and said == (
+        "cancel requested for 2 job(s); finished cases stay saved; 1 job(s) queued or running "
+        "on another app server of this store cannot be cancelled here (cancel them on that "
+        "server's page)")

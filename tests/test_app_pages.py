@@ -344,6 +344,7 @@ def test_report_tab_shows_the_table_and_offers_clean_downloads(store_file):
     assert table["SDC DEM (paper) [-]"].tolist() == [0.1891]
     at.button(key="build_report").click()
     at.run(timeout=RUN_TIMEOUT_S)
+    _wait_report(at)
     assert not at.exception
     labels = sorted(b.label for b in at.get("download_button")
                     if not b.proto.label.startswith("Download these"))
@@ -353,6 +354,52 @@ def test_report_tab_shows_the_table_and_offers_clean_downloads(store_file):
     files = report_files(store_file)
     back = pd.read_csv(io.BytesIO(files["csv"][1]))
     assert len(back) == 1 and back["SDC measured [-]"].iloc[0] == shown_sdc
+
+
+def _wait_report(at: AppTest, timeout_s: float = 120.0) -> None:
+    """Wait for the Report page's background build to end, then draw the page again."""
+    deadline = time.monotonic() + timeout_s
+    while at.session_state["report_build"].state == "running":
+        assert time.monotonic() < deadline, "the report build did not end"
+        time.sleep(0.05)
+    at.run()
+
+
+def test_building_the_report_files_does_not_block_the_page(store_file, monkeypatch):
+    # Before, the report files (figures, HTML, LaTeX, PDF: seconds of CPU) were written inside
+    # the script run: the page was blocked meanwhile and a click elsewhere stopped the build.
+    import threading
+
+    import pidcore.report.downloads as downloads
+
+    release, calls = threading.Event(), []
+
+    def slow_report_files(*args, **kwargs):
+        calls.append(kwargs)
+        release.wait(30.0)  # a long build, until the test lets it finish
+        return {"csv": ("pidcore_report.csv", b"a,b\n1,2\n", "text/csv")}
+
+    monkeypatch.setattr(downloads, "report_files", slow_report_files)
+    at = _upload(_app(), [("coupon_fill50.csv", mass_damper_csv())])
+    at.button(key="save").click()
+    at.run()
+    at.run()
+    at.button(key="build_report").click()
+    start = time.perf_counter()
+    at.run()
+    try:
+        assert time.perf_counter() - start < 10.0  # returned while the build still runs
+        assert not at.exception, at.exception
+        assert any(i.value.startswith("Writing the report ...") for i in at.info)
+        at.button(key="build_report").click()  # a second click meanwhile builds nothing twice
+        at.run()
+        assert len(calls) == 1
+    finally:
+        release.set()
+    _wait_report(at)
+    csv = [b for b in at.get("download_button") if b.label == "CSV"]
+    assert len(csv) == 1 and not any(i.value.startswith("Writing") for i in at.info)
+    assert len(calls) == 1
 
 
 def _fill_dem(at, *, freqs: str, accs: str, fills: str, cells: int, steady: int) -> None:
@@ -1231,3 +1278,75 @@ def test_compare_names_a_saved_implausible_result_and_judges_no_band_of_its_pool
     assert "the measured Eq. 11 SDC is not compared (it pools an implausible result" in captions
     assert "bad_fill50.csv: implausible, saved as accepted: SDC 9.4" in captions
     assert "ok_fill50.csv: implausible" not in captions
+
+
+def test_stored_calibrations_are_read_once_per_store_state_and_a_new_one_is_seen(
+        store_file, monkeypatch):
+    # Before, every draw read each stored calibration twice (the Compare/Report list in the
+    # page's main, then the Calibrate tab's table), and again on every click.
+    import pidcore.calibrate.persist as persist
+    from pidcore.store import Store
+
+    bundled = (REPO / "data_samples" / "paper_calibration" / "calibration.json").read_text()
+
+    def add(key: str) -> None:
+        Store(store_file).add_calibration(key, {"specimen": "paper_coupon", "n_points": 12},
+                                          document=bundled, specimen_toml="",
+                                          units={"n_points": "count"})
+
+    add("cal_00000000000000a1")
+    reads: list[str] = []
+    real = persist._calibration
+
+    def counted(store, key):
+        reads.append(key)
+        return real(store, key)
+
+    monkeypatch.setattr(persist, "_calibration", counted)
+    at = _app()
+    assert reads == ["cal_00000000000000a1"]  # one read for all three tabs
+    at.run()  # a click that changes nothing in the store: nothing read again
+    assert not at.exception, at.exception
+    assert reads == ["cal_00000000000000a1"]
+    add("cal_00000000000000b2")  # saved meanwhile (e.g. by the Calibrate page or the CLI)
+    at.run()
+    assert not at.exception, at.exception
+    # both read once more, and the new one is offered at once, not a stale list
+    assert sorted(reads[1:]) == ["cal_00000000000000a1", "cal_00000000000000b2"]
+    assert at.selectbox(key="calibration_saved_key").options == [
+        "cal_00000000000000b2", "cal_00000000000000a1"]
+
+
+def test_a_run_the_reference_store_holds_is_shown_stored_and_never_run(store_file, tmp_path,
+                                                                      monkeypatch):
+    # Before, Run with the page's defaults (100 Hz, 5 g, 50 %, 8 cells, seed 12345) queued
+    # and simulated the very run the bundled reference store holds: `pidcore dem sweep`
+    # reuses it. The run key (specimen hash, load case, settings, seed, code version) must
+    # find it there.
+    import shutil
+
+    from pidcore.dem import DemConfig, LoadCase
+    from pidcore.dem.persist import run_key
+
+    ref = tmp_path / "reference.h5"
+    shutil.copyfile(REPO / "data_samples" / "dem_table3.h5", ref)
+    ref_bytes = ref.read_bytes()
+    monkeypatch.setenv(stores.DEM_STORE_ENV_VAR, str(ref))
+    at = _app()
+    at.button(key="dem_run").click()  # the page's defaults
+    at.run()
+    runner = jobs.runner_for(store_file)
+    try:
+        assert not at.exception, at.exception
+        said = [i.value for i in at.info]
+        assert any(v.startswith("0 job(s) submitted; 1 already in the store, not run again")
+                   for v in said), said
+        (job,) = runner.jobs()
+        assert job.state == "in store" and not runner.busy()
+        assert job.run_key == run_key(LoadCase(100.0, 5.0, 50.0), DemConfig())
+        assert job.message == f"already in the reference store {ref}; not run again"
+    finally:
+        runner.cancel()
+        runner.wait_cancelled(5.0)
+    assert not store_file.exists()  # nothing simulated, nothing saved
+    assert ref.read_bytes() == ref_bytes

@@ -305,13 +305,56 @@ SAVED_CALIBRATION_COLUMNS = {"key": "calibration", "specimen": "specimen", "fit"
                              "created_utc": "saved [UTC]"}
 
 
-def saved_calibrations_table(store_path: str | Path):
-    """The Calibrate tab's table of the calibrations saved in the store, newest first
-    (:meth:`pidcore.store.Store.list_calibrations`; columns :data:`SAVED_CALIBRATION_COLUMNS`,
-    a blank where a calibration has no leave-one-out)."""
+@dataclass(frozen=True)
+class StoreCalibrations:
+    """The calibrations of the app's store as one page draw shows them (read once by
+    :func:`read_store_calibrations`; the Compare, Report and Calibrate tabs all use it).
+
+    Attributes
+    ----------
+    readable : list
+        The calibrations that can be read, newest first.
+    damaged : list of str
+        One line per calibration that cannot be read (or the listing's own problem).
+    listing : pandas.DataFrame or None
+        :meth:`pidcore.store.Store.list_calibrations` as read (None: no store, or unreadable).
+    """
+
+    readable: list
+    damaged: list[str]
+    listing: object = None
+
+
+def read_store_calibrations(store_path: str | Path) -> StoreCalibrations:
+    """Every calibration of the store at ``store_path`` and its listing, each read once (no
+    store yet: none). A store whose listing cannot be read gives none and says why in
+    ``damaged``; one damaged calibration does not hide the others."""
+    from ..calibrate.persist import readable_calibrations
+    from ..errors import PidcoreError
     from ..store import Store
 
-    listing = Store(store_path).list_calibrations().iloc[::-1]
+    path = Path(store_path)
+    if not path.is_file():
+        return StoreCalibrations([], [])
+    try:
+        listing = Store(path).list_calibrations()
+        readable, damaged = readable_calibrations(path, listing=listing)
+    except PidcoreError as exc:  # the store's listing itself cannot be read
+        return StoreCalibrations([], [str(exc)])
+    return StoreCalibrations(readable, damaged, listing)
+
+
+def saved_calibrations_table(store_path: str | Path | None = None, *,
+                             listing=None):
+    """The Calibrate tab's table of the calibrations saved in the store, newest first
+    (:meth:`pidcore.store.Store.list_calibrations` of ``store_path``, or that ``listing`` as
+    already read; columns :data:`SAVED_CALIBRATION_COLUMNS`, a blank where a calibration has
+    no leave-one-out)."""
+    from ..store import Store
+
+    if listing is None:
+        listing = Store(store_path).list_calibrations()
+    listing = listing.iloc[::-1]
     shown = {c: n for c, n in SAVED_CALIBRATION_COLUMNS.items() if c in listing.columns}
     table = listing[list(shown)].rename(columns=shown).reset_index(drop=True)
     table["saved [UTC]"] = table["saved [UTC]"].str[:19].str.replace("T", " ")
@@ -338,6 +381,7 @@ def available_calibrations(task: CalibrationTask | None,
                            environ: Mapping[str, str] | None = None, *,
                            cwd: Path | None = None,
                            store_path: str | Path | None = None,
+                           stored: StoreCalibrations | None = None,
                            ) -> list[tuple[object | None, str]]:
     """The calibrations the Compare and Report pages offer, as ``(calibration, label)``: those
     saved in the app's store (``store_path``), newest first, then the Calibrate page's finished
@@ -345,20 +389,19 @@ def available_calibrations(task: CalibrationTask | None,
     bundled paper calibration by default). A calibration of one specimen does not hide the
     other's bands: Compare takes the first that predicts a case. One that cannot be read comes
     last as ``(None, reason)``; ``[(None, reason)]`` when there is none or none can be read
-    (the reason is shown)."""
-    from ..calibrate.persist import readable_calibrations
+    (the reason is shown). ``stored``: :func:`read_store_calibrations` of ``store_path`` as
+    the caller read it already (read here otherwise)."""
     from ..calibrate.prediction import calibration_from_json, load_calibration
     from ..errors import PidcoreError
 
     found: list[tuple[object | None, str]] = []
     problems: list[str] = []
-    if store_path is not None:
-        try:
-            readable, damaged = readable_calibrations(store_path)
-        except PidcoreError as exc:  # the store's listing itself cannot be read
-            readable, damaged = [], [str(exc)]
-        found += [(c, stored_calibration_label(c)) for c in readable]
-        problems += [f"calibration of the store not shown: {problem}" for problem in damaged]
+    if stored is None and store_path is not None:
+        stored = read_store_calibrations(store_path)
+    if stored is not None:
+        found += [(c, stored_calibration_label(c)) for c in stored.readable]
+        problems += [f"calibration of the store not shown: {problem}"
+                     for problem in stored.damaged]
     saved = {c.store_key for c, _ in found}
     if task is not None and task.state == "done" and "calibration.json" in task.outputs \
             and task.store_key not in saved:

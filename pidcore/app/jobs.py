@@ -15,20 +15,27 @@ is the same simulation as another (a fill rounding to the same particle count:
 :func:`pidcore.dem.persist.run_identity`) is not run again.
 
 The job table outlives the server process: the runner keeps it in a JSON journal beside the
-store (``<store>.jobs.json``, replaced atomically on every change of state). A runner started
-on a store whose journal lists jobs still queued or running (the app stopped or crashed) shows
-them as :data:`INTERRUPTED_STATE`, nothing saved, ready to run again
-(:meth:`DemJobRunner.resubmit_interrupted`); its finished jobs are listed as they were.
+store (``<store>.jobs.json``, replaced atomically on every change of state). Each job there
+names its owner (:class:`JournalOwner`: host, process id and start time of the app server, and
+its runner), and every change re-reads the journal under a lock file
+(``<store>.jobs.json.lock``) and keeps the entries of the other owners, so two app servers on
+one store share the journal. A job whose owner still runs is shown as that server wrote it;
+one whose owner stopped or crashed (no such process, or another process under a reused id) is
+taken over: a job still queued or running comes back as :data:`INTERRUPTED_STATE`, nothing
+saved, ready to run again (:meth:`DemJobRunner.resubmit_interrupted`); finished jobs are listed
+as they were.
 """
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import json
 import math
 import os
 import re
 import secrets
+import socket
 import threading
 import time
 from collections.abc import Sequence
@@ -37,6 +44,11 @@ from pathlib import Path
 
 from .. import defaults
 from ..errors import ParameterError, PidcoreError
+
+try:  # POSIX: the journal's read-modify-write is exclusive between app servers
+    import fcntl
+except ImportError:  # pragma: no cover - Windows: no exclusion (one server per store there)
+    fcntl = None
 
 #: Job states, in the order a job passes through them.
 JOB_STATES = ("queued", "running", "saved", "in store", "same run", "cancelled", "failed",
@@ -54,6 +66,12 @@ _JOURNAL_VERSION = 1
 #: State of a job that is the same simulation as another job queued or running (another fill
 #: rounding to the same particle count): not run, the other job's run is its run.
 SAME_RUN_STATE = "same run"
+#: A journal owner's recorded process start time and the running process's may differ by
+#: this much and still be the same process, s (both are boot time + start ticks; a process
+#: that reused the id starts later than that).
+_START_TOLERANCE_S = 1.0
+#: Runners of this process (:attr:`JournalOwner.runner`): runners live as long as the process.
+_LIVE_RUNNERS: set[str] = set()
 #: Seconds between checks of the running case (progress, cancel).
 _POLL_S = 0.05
 #: Seconds a terminated process gets before it is killed.
@@ -78,6 +96,8 @@ class DemJob:
     message: str = ""
     #: The job that runs this one's simulation (state :data:`SAME_RUN_STATE`), else "".
     same_as: str = ""
+    #: The other app server running this job (``"pid 812 on host lab3"``); "": this one.
+    server: str = ""
 
     def elapsed_s(self, now: float | None = None) -> float:
         """Seconds the case has run (0 while queued)."""
@@ -135,7 +155,9 @@ class DemJob:
                 "elapsed [s]": round(self.elapsed_s(now), 1),
                 # text: a blank beside numbers would make the column "None" or mixed
                 "ETA [s]": "" if eta is None else f"{eta:.0f}",
-                "message": self.message, "store key": self.run_key}
+                "message": (f"on another app server ({self.server}); {self.message}"
+                            if self.server else self.message),
+                "store key": self.run_key}
 
 
 def _child(case, config, specimen, conn) -> None:
@@ -157,6 +179,80 @@ def _child(case, config, specimen, conn) -> None:
         conn.close()
 
 
+@dataclass(frozen=True)
+class JournalOwner:
+    """The app server (and its runner) a journal entry belongs to: whether it still runs
+    decides whether its queued and running jobs are live or interrupted.
+
+    Attributes
+    ----------
+    host : str
+        Host name of the server's machine.
+    pid : int
+        Its process id.
+    started : float
+        Its process's start time, s since the epoch (a process id is reused; this is not).
+    runner : str
+        Token of its :class:`DemJobRunner` (several runners of one process are told apart).
+    """
+
+    host: str
+    pid: int
+    started: float
+    runner: str
+
+    @classmethod
+    def of_this_process(cls) -> JournalOwner:
+        """A new owner: this process, with a new runner token."""
+        import psutil
+
+        return cls(socket.gethostname(), os.getpid(), psutil.Process().create_time(),
+                   secrets.token_hex(8))
+
+    def document(self) -> dict:
+        """The owner as the journal stores it."""
+        return dataclasses.asdict(self)
+
+    @classmethod
+    def from_document(cls, doc: object) -> JournalOwner | None:
+        """The owner a journal entry names; None where it names none (a journal of an older
+        pidcore) or none that can be trusted (then its jobs are taken over as a stopped
+        server's)."""
+        if not isinstance(doc, dict):
+            return None
+        host, pid, started, runner = (doc.get(k) for k in ("host", "pid", "started", "runner"))
+        if not (isinstance(host, str) and isinstance(runner, str)
+                and isinstance(pid, int) and not isinstance(pid, bool) and pid > 0
+                and isinstance(started, int | float) and not isinstance(started, bool)
+                and math.isfinite(started)):
+            return None
+        return cls(host, pid, float(started), runner)
+
+    def describe(self) -> str:
+        """``"pid 812 on host lab3"``."""
+        return f"pid {self.pid} on host {self.host}"
+
+    def alive(self) -> bool:
+        """Whether the owner still runs: its process lives (same id and start time) and, in
+        this process, its runner was made here. A server on another host cannot be seen from
+        here: it is taken to run (its jobs are shown as it last wrote them)."""
+        import psutil
+
+        if self.host != socket.gethostname():
+            return True
+        if self.pid == os.getpid():
+            return self.runner in _LIVE_RUNNERS
+        try:
+            process = psutil.Process(self.pid)
+            started = process.create_time()
+            zombie = process.status() == psutil.STATUS_ZOMBIE
+        except psutil.NoSuchProcess:
+            return False
+        except psutil.AccessDenied:  # another user's process of that id lives: assume it
+            return True
+        return not zombie and abs(started - self.started) <= _START_TOLERANCE_S
+
+
 class DemJobRunner:
     """Queue of DEM cases for one store, run one at a time by a background thread.
 
@@ -166,22 +262,29 @@ class DemJobRunner:
         Store every finished case is saved to.
     """
 
-    def __init__(self, store_path: str | Path) -> None:
+    def __init__(self, store_path: str | Path, reference_store: str | Path | None = None,
+                 ) -> None:
         self.store_path = Path(store_path)
+        #: Read-only store of reference DEM runs (the app's ``$PIDCORE_DEM_STORE``): a run
+        #: it holds is never run again, as ``pidcore dem sweep`` reuses stored runs.
+        self.reference_store = None if reference_store is None else Path(reference_store)
         self._lock = threading.Lock()
         self._wake = threading.Condition(self._lock)
         self._cancel: set[str] = set()
+        #: This runner in the journal (:class:`JournalOwner`).
+        self.owner = JournalOwner.of_this_process()
+        _LIVE_RUNNERS.add(self.owner.runner)
         #: Why the journal could not be read or written ("" : all well).
-        self.journal_problem: str
-        self._jobs, self.journal_problem = read_journal(journal_path(self.store_path))
-        _settle_saved_before_stop(self._jobs, self.store_path)
-        self._counter = max((_job_number(j.job_id) for j in self._jobs), default=0)
-        if self._jobs:
-            read_problem = self.journal_problem
-            with self._lock:
-                self._write_journal()  # the interrupted ones as such
-            # a job that could not be read is still said after the journal is rewritten
-            self.journal_problem = self.journal_problem or read_problem
+        self.journal_problem = ""
+        self._jobs: list[DemJob] = []
+        #: Jobs of other app servers on this store that still run (read from the journal).
+        self._foreign: list[DemJob] = []
+        #: Their journal entries, written back as they are.
+        self._foreign_entries: list[dict] = []
+        self._counter = 0
+        self._journal_lock_depth = 0
+        with self._lock:
+            self._refresh()  # a stopped server's jobs are taken over, interrupted ones as such
         self._thread = threading.Thread(target=self._work, name="pidcore-dem-jobs", daemon=True)
         self._thread.start()
 
@@ -193,25 +296,19 @@ class DemJobRunner:
         queued or running is not submitted again; a run already in the store, or the same
         simulation as a job queued or running, this submission's included, gets a job that
         says so and is not run: :data:`SAME_RUN_STATE`)."""
-        from ..dem.persist import (
-            own_run_keys,
-            run_identity,
-            run_key,
-            stored_identities,
-            stored_run_key,
-        )
-        from ..store import Store
+        from ..dem.persist import own_run_keys, run_identity, run_key
 
-        stored = Store(self.store_path) if self.store_path.is_file() else None
-        # runs of another fill with the same particle count (and seed, settings, specimen) are
-        # the same simulation (pidcore.dem.persist.stored_run_key): read once per submission
-        identities = stored_identities(stored) if stored is not None else {}
+        lookup = self._stored_runs()  # the stores' runs, read once per submission
         created = []
-        with self._lock:
+        # the journal locked from reading it to writing it: job numbers are unique across
+        # every app server of the store, and another server's queued runs are seen
+        with self._lock, self._journal_locked():
+            self._merge_journal()
             # the simulations queued or running, this submission's included, by identity
             # (pidcore.compare.align.simulation_identity), as `pidcore dem sweep` plans them:
-            # fills 50 and 50.2 % of one particle count are run once
-            active = {run_identity(j.case, j.config, j.specimen): j for j in self._jobs
+            # fills 50 and 50.2 % of one particle count are run once; on any server
+            active = {run_identity(j.case, j.config, j.specimen): j
+                      for j in [*self._foreign, *self._jobs]
                       if j.state in ("queued", "running")}
             for case in cases:
                 key = run_key(case, config, specimen)
@@ -232,16 +329,16 @@ class DemJobRunner:
                     continue  # this very run is queued or running
                 self._counter += 1
                 job = DemJob(f"job{self._counter:04d}", case, config, key, specimen)
-                found = stored_run_key(stored, case, config, specimen, identities=identities) \
-                    if stored is not None else None
+                found, where = lookup(case, config, specimen)
                 if found is not None and found in own_run_keys(case, config, specimen):
-                    job.state, job.message = "in store", "already in the store; not run again"
+                    job.state, job.message = "in store", f"already in {where}; not run again"
                     job.finished = time.time()
                     job.run_key = found  # its own key, or the paper's 0.1 key it is held by
                 elif (same := found) is not None:
                     job.state, job.finished = "in store", time.time()
                     job.message = (f"the same simulation (particles per cell, seed, settings) "
-                                   f"as stored run {same} of another fill; not run again")
+                                   f"as stored run {same} of another fill in {where}; not run "
+                                   "again")
                     job.run_key = same  # the jobs table's store key names the run it is
                 elif running is not None:
                     job.state, job.finished = SAME_RUN_STATE, time.time()
@@ -258,6 +355,42 @@ class DemJobRunner:
                 self._write_journal()
             self._wake.notify_all()
         return created
+
+    def _stored_runs(self):
+        """A lookup ``(case, config, specimen) -> (key, where)`` of the runs the app store and
+        the reference store hold (:func:`pidcore.dem.persist.stored_run_key`: the run's own
+        key, or a stored run of the same simulation under another fill), ``(None, "")`` where
+        neither does; each store's runs are read once, here. A reference store that cannot
+        be read holds nothing for this lookup (the DEM page says why it cannot be read)."""
+        from ..dem.persist import stored_identities, stored_run_key
+        from ..store import Store
+
+        stores = []
+        reference = self.reference_store
+        if reference is not None and reference.resolve() == self.store_path.resolve():
+            reference = None  # the app store itself, looked up already
+        for path, where in ((self.store_path, "the store"),
+                            (reference, f"the reference store {reference}")):
+            if path is None or not path.is_file():
+                continue
+            try:
+                store = Store(path)
+                # runs of another fill with the same particle count (and seed, settings,
+                # specimen) are the same simulation: found by the stored runs' inputs
+                stores.append((store, stored_identities(store), where))
+            except PidcoreError:
+                if path == self.store_path:
+                    raise  # the app store must be readable to save anything in it
+                continue
+
+        def lookup(case, config, specimen) -> tuple[str | None, str]:
+            for store, identities, where in stores:
+                found = stored_run_key(store, case, config, specimen, identities=identities)
+                if found is not None:
+                    return found, where
+            return None, ""
+
+        return lookup
 
     def resubmit_interrupted(self) -> list[DemJob]:
         """Submit again every job the app's last stop interrupted (:data:`INTERRUPTED_STATE`);
@@ -277,16 +410,115 @@ class DemJobRunner:
             self._write_journal()
         return created
 
-    def _write_journal(self) -> None:
-        """Replace the journal with the jobs as they are now (lock held). A journal that
-        cannot be written costs the table after a restart, never a run: said, not raised."""
+    @contextlib.contextmanager
+    def _journal_locked(self):
+        """The journal's lock file held (lock held; re-entrant): no other runner, of this
+        process or another, reads and rewrites the journal meanwhile. Where the lock file
+        cannot be made (a read-only folder) the journal cannot be written either, which
+        :meth:`_write_journal` says."""
+        if self._journal_lock_depth:
+            self._journal_lock_depth += 1
+            try:
+                yield
+            finally:
+                self._journal_lock_depth -= 1
+            return
+        path = journal_path(self.store_path)
         try:
-            write_journal(journal_path(self.store_path), self._jobs)
-            self.journal_problem = ""
-        except (OSError, TypeError, ValueError) as exc:
-            self.journal_problem = (f"the job table cannot be kept in "
-                                    f"{journal_path(self.store_path)} ({exc}); it is lost "
-                                    "when the app stops")
+            fd = os.open(path.with_name(path.name + ".lock"), os.O_RDWR | os.O_CREAT, 0o644)
+        except OSError:
+            fd = None
+        try:
+            if fd is not None and fcntl is not None:
+                fcntl.flock(fd, fcntl.LOCK_EX)  # released when fd is closed, or the process dies
+            self._journal_lock_depth = 1
+            yield
+        finally:
+            self._journal_lock_depth = 0
+            if fd is not None:
+                os.close(fd)
+
+    def _merge_journal(self) -> tuple[str, int]:
+        """Read the journal (lock and journal lock held): the jobs of other servers that still
+        run are kept apart as theirs (:attr:`_foreign`); those of servers that stopped (or of
+        a journal that names no owner) become this runner's, interrupted where they were
+        queued or running. Returns why entries could not be read ("" : none) and how many
+        jobs were taken over."""
+        entries, problem = _journal_entries(journal_path(self.store_path))
+        own_ids = {j.job_id for j in self._jobs}
+        foreign, foreign_entries, taken, lost = [], [], [], []
+        for number, (entry, owner) in enumerate(entries, start=1):
+            if owner == self.owner:
+                continue  # this runner's own: its memory is newer
+            live = owner is not None and owner.alive()
+            if not live and isinstance(entry, dict) and entry.get("job_id") in own_ids:
+                continue  # taken over already, the journal not rewritten since
+            try:
+                job = _job_from_document(entry, live=live)
+                if job.job_id in own_ids or any(j.job_id == job.job_id
+                                                for j in [*foreign, *taken]):
+                    # Cancel and the jobs waiting for a run name a job by its id
+                    raise ValueError(f"job id {job.job_id} listed twice")
+            except _UNREADABLE as exc:
+                if live:  # another running server's: written back as it is
+                    foreign_entries.append(entry)
+                    continue
+                name = entry.get("job_id") if isinstance(entry, dict) else None
+                lost.append(f"{str(name)[:40] if name else f'entry {number}'} "
+                            f"({type(exc).__name__}: {str(exc)[:200]})")
+                continue
+            if live:
+                job.server = owner.describe()
+                foreign.append(job)
+                foreign_entries.append(entry)
+            else:
+                taken.append(job)
+        _settle_saved_before_stop(taken, self.store_path)
+        self._jobs = sorted([*self._jobs, *taken], key=lambda j: _job_number(j.job_id))
+        self._foreign, self._foreign_entries = foreign, foreign_entries
+        self._counter = max([self._counter, *(_job_number(j.job_id)
+                                               for j in [*self._jobs, *foreign])])
+        if lost:
+            path = journal_path(self.store_path)
+            problem = (f"{len(lost)} job(s) of the job table of the last run of the app ({path}) "
+                       f"cannot be read: {'; '.join(lost)}; their saved runs are in the store")
+        return problem, len(taken)
+
+    def _refresh(self) -> None:
+        """Bring the other servers' jobs up to date from the journal (lock held); where a
+        server stopped, take its jobs over and rewrite the journal (under its lock, so that
+        two servers never both take them)."""
+        entries, problem = _journal_entries(journal_path(self.store_path))
+        if problem:  # said; the file is left for a look until the next change replaces it
+            self.journal_problem = problem
+            self._foreign, self._foreign_entries = [], []
+            return
+        if not any(owner != self.owner and (owner is None or not owner.alive())
+                   for _, owner in entries):
+            self._merge_journal()
+            return
+        with self._journal_locked():  # taken over by one server only
+            read_problem, taken = self._merge_journal()
+            if taken:
+                self._write_journal()  # the interrupted ones as such, and as this server's
+            # a job that could not be read is said, and still after the journal is rewritten
+            self.journal_problem = self.journal_problem or read_problem
+
+    def _write_journal(self) -> None:
+        """Replace the journal with this runner's jobs as they are now and the other running
+        servers' as they wrote them (lock held). A journal that cannot be written costs the
+        table after a restart, never a run: said, not raised."""
+        with self._journal_locked():
+            read_problem, _ = self._merge_journal()
+            try:
+                write_journal(journal_path(self.store_path), self._jobs, owner=self.owner,
+                              foreign=self._foreign_entries)
+                # a job that could not be read is said after the journal is rewritten
+                self.journal_problem = read_problem
+            except (OSError, TypeError, ValueError) as exc:
+                self.journal_problem = (f"the job table cannot be kept in "
+                                        f"{journal_path(self.store_path)} ({exc}); it is lost "
+                                        "when the app stops")
 
     def cancel(self, job_ids: Sequence[str] | None = None) -> int:
         """Cancel queued and running jobs (all of them, or ``job_ids``); returns how many.
@@ -322,14 +554,18 @@ class DemJobRunner:
             return True
 
     def jobs(self) -> list[DemJob]:
-        """Copies of every job, oldest first (safe to read while the worker runs)."""
+        """Copies of every job of the store, this server's and the other running servers'
+        (:attr:`DemJob.server`), oldest first (safe to read while the worker runs)."""
         with self._lock:
-            return [DemJob(**vars(j)) for j in self._jobs]
+            self._refresh()
+            listed = sorted([*self._jobs, *self._foreign], key=lambda j: _job_number(j.job_id))
+            return [DemJob(**vars(j)) for j in listed]
 
     def busy(self) -> bool:
-        """Whether a job is queued or running."""
+        """Whether a job is queued or running, here or on another running app server of the
+        store (as it last wrote the journal)."""
         with self._lock:
-            return any(j.state in ("queued", "running") for j in self._jobs)
+            return any(j.state in ("queued", "running") for j in [*self._jobs, *self._foreign])
 
     def clear_finished(self) -> None:
         """Forget finished jobs (the store keeps their runs)."""
@@ -365,6 +601,9 @@ class DemJobRunner:
                 if job.state == "saved":
                     same.state = "in store"
                     same.message += f"; saved by it as {job.run_key}"
+                elif job.state == "in store":  # found stored as it was about to run
+                    same.state = "in store"
+                    same.message += f"; stored as {job.run_key}"
                 else:
                     same.state = "cancelled"
                     same.message = (f"not run: {job.job_id}, the same simulation, is "
@@ -382,6 +621,15 @@ class DemJobRunner:
         from ..dem.sweep import CaseOutcome, dem_process_context
         from ..store import Store
 
+        # stored since it was queued (by `pidcore dem`, another app server, a calibration):
+        # not run again
+        found, where = self._stored_runs()(job.case, job.config, job.specimen)
+        if found is not None:
+            with self._lock:
+                job.run_key = found
+            self._finish(job, "in store", f"stored in {where} as {found} after it was queued; "
+                                          "not run again")
+            return
         ctx = dem_process_context()
         parent, child = ctx.Pipe(duplex=False)
         proc = ctx.Process(target=_child, args=(job.case, job.config, job.specimen, child),
@@ -493,9 +741,10 @@ def _count(value: object, name: str) -> int:
     return value
 
 
-def _job_document(job: DemJob) -> dict:
+def _job_document(job: DemJob, owner: JournalOwner | None = None) -> dict:
     specimen = job.specimen
-    return {"job_id": job.job_id, "state": job.state, "run_key": job.run_key,
+    return {"owner": None if owner is None else owner.document(), "job_id": job.job_id,
+            "state": job.state, "run_key": job.run_key,
             "submitted": job.submitted, "started": job.started, "finished": job.finished,
             "cycles_done": job.cycles_done, "cycles_expected": job.cycles_expected,
             "message": job.message, "same_as": job.same_as,
@@ -504,11 +753,15 @@ def _job_document(job: DemJob) -> dict:
                                                        "source": str(specimen.source)}}
 
 
-def write_journal(path: Path, jobs: Sequence[DemJob]) -> None:
+def write_journal(path: Path, jobs: Sequence[DemJob], *, owner: JournalOwner | None = None,
+                  foreign: Sequence[dict] = ()) -> None:
     """Write the jobs' journal at ``path`` in one step (a temporary file renamed over it): a
-    stop while it is written leaves the previous journal, never half of one."""
+    stop while it is written leaves the previous journal, never half of one. ``owner``: the
+    runner the jobs belong to (None: no one's, taken over by the next runner);
+    ``foreign``: the other servers' entries, written as they are."""
     text = json.dumps({"pidcore_jobs_version": _JOURNAL_VERSION,
-                       "jobs": [_job_document(j) for j in jobs]}, indent=1)
+                       "jobs": [*foreign, *(_job_document(j, owner) for j in jobs)]},
+                      indent=1)
     tmp = path.with_name(f".{path.name}.{secrets.token_hex(4)}.tmp")
     try:
         tmp.write_text(text, encoding="utf-8")
@@ -517,7 +770,9 @@ def write_journal(path: Path, jobs: Sequence[DemJob]) -> None:
         tmp.unlink(missing_ok=True)
 
 
-def _job_from_document(doc: dict) -> DemJob:
+def _job_from_document(doc: dict, *, live: bool = False) -> DemJob:
+    """The job of a journal entry; ``live``: its server still runs (shown as written),
+    else one queued or running is :data:`INTERRUPTED_STATE`."""
     from ..dem.simulate import DemConfig
     from ..loadcase import LoadCase
     from ..specimen import Specimen
@@ -541,7 +796,7 @@ def _job_from_document(doc: dict) -> DemJob:
                  message=str(doc["message"]), same_as=str(doc["same_as"]))
     if job.state not in JOB_STATES:
         raise ValueError(f"unknown job state {job.state!r}")
-    if job.state in ("queued", "running", SAME_RUN_STATE):
+    if not live and job.state in ("queued", "running", SAME_RUN_STATE):
         # the app stopped before it ran (or before the job running it finished): nothing saved
         job.state, job.finished = INTERRUPTED_STATE, job.finished or time.time()
         job.message = ("the app stopped before this case finished; nothing of it was saved: "
@@ -550,36 +805,49 @@ def _job_from_document(doc: dict) -> DemJob:
     return job
 
 
-def read_journal(path: Path) -> tuple[list[DemJob], str]:
-    """The jobs of a journal (:func:`write_journal`) and "" ; no journal: ``([], "")``. One that
-    cannot be read gives no job and says why (it is JSON, parsed, never executed; it is
-    replaced by the next change)."""
+#: What a journal that cannot be trusted raises while it is read (RecursionError: JSON nested
+#: deeper than Python's stack, json.loads is recursive).
+_UNREADABLE = (OSError, ValueError, TypeError, KeyError, AttributeError, RecursionError,
+               PidcoreError)
+
+
+def _journal_entries(path: Path) -> tuple[list[tuple[object, JournalOwner | None]], str]:
+    """The entries of a journal with the owner each names (None: none), and "" ; no journal:
+    ``([], "")``. One that cannot be read gives no entry and says why (it is JSON, parsed,
+    never executed; it is replaced by the next change)."""
     if not path.is_file():
         return [], ""
-    # RecursionError: JSON nested deeper than Python's stack (json.loads is recursive)
-    unreadable = (OSError, ValueError, TypeError, KeyError, AttributeError, RecursionError,
-                  PidcoreError)
     try:
         doc = json.loads(path.read_text(encoding="utf-8"))
         if not isinstance(doc, dict) or doc.get("pidcore_jobs_version") != _JOURNAL_VERSION \
                 or not isinstance(doc.get("jobs"), list):
             raise ValueError("not a pidcore job journal of version "
                              f"{_JOURNAL_VERSION}")
-    except unreadable as exc:
+    except _UNREADABLE as exc:
         return [], (f"the job table of the last run of the app ({path}) cannot be read "
                     f"({type(exc).__name__}: {exc}); its saved runs are in the store")
-    # job by job: one that cannot be rebuilt (a specimen file this version refuses) costs
-    # its own row, not the table
+    return [(entry, JournalOwner.from_document(entry.get("owner"))
+             if isinstance(entry, dict) else None) for entry in doc["jobs"]], ""
+
+
+def read_journal(path: Path) -> tuple[list[DemJob], str]:
+    """The jobs of a journal (:func:`write_journal`) and "" , each job queued or running
+    there as :data:`INTERRUPTED_STATE` (whoever owns it); no journal: ``([], "")``. One that
+    cannot be read gives no job and says why; one job that cannot be read costs its own row,
+    said, not the table."""
+    entries, problem = _journal_entries(path)
+    if problem:
+        return [], problem
     found: list[DemJob] = []
     lost = []
-    for number, entry in enumerate(doc["jobs"], start=1):
+    for number, (entry, _) in enumerate(entries, start=1):
         try:
             job = _job_from_document(entry)
             if any(j.job_id == job.job_id for j in found):
                 # Cancel and the jobs waiting for a run name a job by its id
                 raise ValueError(f"job id {job.job_id} listed twice")
             found.append(job)
-        except unreadable as exc:
+        except _UNREADABLE as exc:
             name = entry.get("job_id") if isinstance(entry, dict) else None
             lost.append(f"{str(name)[:40] if name else f'entry {number}'} "
                         f"({type(exc).__name__}: {str(exc)[:200]})")
@@ -593,13 +861,18 @@ _RUNNERS: dict[str, DemJobRunner] = {}
 _RUNNERS_LOCK = threading.Lock()
 
 
-def runner_for(store_path: str | Path) -> DemJobRunner:
+def runner_for(store_path: str | Path,
+               reference_store: str | Path | None = None) -> DemJobRunner:
     """The process-wide job runner of a store (created on first use; outlives script runs and
-    browser sessions, so a reload shows the jobs still running)."""
+    browser sessions, so a reload shows the jobs still running). ``reference_store``: the
+    read-only store of reference DEM runs whose runs are not run again (kept from the first
+    call that names one)."""
     key = str(Path(store_path).resolve())
     with _RUNNERS_LOCK:
         if key not in _RUNNERS:
-            _RUNNERS[key] = DemJobRunner(key)
+            _RUNNERS[key] = DemJobRunner(key, reference_store)
+        elif reference_store is not None:
+            _RUNNERS[key].reference_store = Path(reference_store)
         return _RUNNERS[key]
 
 
@@ -657,6 +930,20 @@ DEM_RUN_COLUMNS = {"specimen": "specimen", "frequency_hz": "frequency [Hz]",
                    "steady state": "steady state", "direction": "direction",
                    "cells_simulated": "cells simulated [-]", "seed": "seed [-]",
                    "wall_s": "wall time [s]", "case_key": "run", "store": "store"}
+
+
+def cancelled_text(n_cancelled: int, listed: Sequence[DemJob]) -> tuple[str, str]:
+    """(level, words) of what a click on Cancel did: ``n_cancelled`` jobs of this server
+    (:meth:`DemJobRunner.cancel`), and ``listed`` (:meth:`DemJobRunner.jobs`) to name the
+    jobs of another app server that cannot be cancelled from here. Nothing to cancel is
+    said as such ("cancel requested for 0 job(s)" read as a failed cancel)."""
+    theirs = sum(j.state in ("queued", "running") and bool(j.server) for j in listed)
+    other = (f"; {theirs} job(s) queued or running on another app server of this store "
+             "cannot be cancelled here (cancel them on that server's page)" if theirs else "")
+    if n_cancelled == 0:
+        return "info", f"nothing to cancel: no job of this app server is queued or running{other}"
+    return "warning", (f"cancel requested for {n_cancelled} job(s); finished cases stay saved"
+                       f"{other}")
 
 
 def submitted_text(n_cases: int, created: Sequence[DemJob]) -> str:

@@ -10,6 +10,7 @@ from __future__ import annotations
 import streamlit as st
 
 from pidcore import __version__, defaults
+from pidcore.app import state
 from pidcore.app.calibration import available_calibrations, runner_for
 from pidcore.app.stores import AppStores
 from pidcore.app.tabs import analyse, calibrate, compare, dem, report
@@ -26,8 +27,11 @@ def main() -> None:
             st.markdown(f"**reference DEM runs** (read-only): `{stores.dem_reference}`")
         st.markdown(f"**upload limit**: {defaults.APP_MAX_UPLOAD_MB} MB per file")
         st.caption(f"pidcore {__version__}")
-    # read once per run: the Compare and Report tabs offer the same calibrations
-    calibrations = available_calibrations(runner_for(stores.path).task, store_path=stores.path)
+    # read once per store state: the Compare and Report tabs offer the same calibrations and
+    # the Calibrate tab lists them
+    stored = state.store_calibrations(stores.stamp(), stores)
+    calibrations = available_calibrations(runner_for(stores.path).task, store_path=stores.path,
+                                          stored=stored)
     t_analyse, t_compare, t_dem, t_cal, t_report = st.tabs(
         ["Analyse", "Compare", "DEM", "Calibrate", "Report"])
     with t_analyse:
@@ -37,6 +41,6 @@ def main() -> None:
     with t_dem:
         dem.render(stores)
     with t_cal:
-        calibrate.render(stores)
+        calibrate.render(stores, stored)
     with t_report:
         report.render(stores, calibrations)

@@ -51,6 +51,18 @@ def store_listing(what: str, stamp: tuple, _stores):
     raise ValueError(what)
 
 
+# cache_resource: the calibrations are frozen records, read once per store state (stamp) and
+# shared by the Compare, Report and Calibrate tabs; a saved calibration rewrites the store, so
+# the next draw has another stamp and reads it
+@st.cache_resource(max_entries=4, show_spinner=False)
+def store_calibrations(stamp: tuple, _stores):
+    """The app store's calibrations (:func:`pidcore.app.calibration.read_store_calibrations`),
+    re-read only when a store file changed (``AppStores.stamp``)."""
+    from pidcore.app.calibration import read_store_calibrations
+
+    return read_store_calibrations(_stores.path)
+
+
 @st.cache_data(max_entries=16, show_spinner=False)
 def report_table(stamp: tuple, pool: bool, keys: tuple[str, ...] | None,
                  calibration_digest: str, specimen_label: str, _stores, _calibration,

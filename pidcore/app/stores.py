@@ -69,13 +69,15 @@ class AppStores:
         return cls(store_path(environ), dem_store_path(environ, cwd=cwd))
 
     def stamp(self) -> tuple:
-        """(path, mtime, size) of each store: changes whenever a store is rewritten (the
-        store replaces its file atomically on every commit), so it keys cached listings."""
+        """(path, mtime, size, inode) of each store: changes whenever a store is rewritten
+        (the store replaces its file atomically on every commit, a new inode even within the
+        file system's mtime resolution), so it keys cached listings."""
         out = []
         for p in (self.path, self.dem_reference):
             try:
                 stat = Path(p).stat() if p is not None else None
             except OSError:
                 stat = None
-            out.append((str(p), stat.st_mtime_ns, stat.st_size) if stat else (str(p), 0, 0))
+            out.append((str(p), stat.st_mtime_ns, stat.st_size, stat.st_ino) if stat
+                       else (str(p), 0, 0, 0))
         return tuple(out)

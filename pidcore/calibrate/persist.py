@@ -105,9 +105,11 @@ def _calibration(store, key: str) -> Calibration:
 
 
 def _calibrations(store_path: str | os.PathLike,
-                  problems: list[str] | None) -> list[Calibration]:
+                  problems: list[str] | None, listing=None) -> list[Calibration]:
     """Every calibration of ``store_path``, newest first (no store yet: none). A damaged one
-    raises, or, given ``problems``, is left out with its one line appended there."""
+    raises, or, given ``problems``, is left out with its one line appended there.
+    ``listing``: the store's :meth:`~pidcore.store.Store.list_calibrations` as the caller
+    read it already (read here otherwise)."""
     from ..errors import PidcoreError
     from ..store import Store
 
@@ -116,7 +118,9 @@ def _calibrations(store_path: str | os.PathLike,
         return []
     store = Store(path)
     found: list[Calibration] = []
-    for key in reversed(list(store.list_calibrations()["key"])):
+    if listing is None:
+        listing = store.list_calibrations()
+    for key in reversed(list(listing["key"])):
         try:
             found.append(_calibration(store, key))
         except PidcoreError as exc:
@@ -132,12 +136,14 @@ def stored_calibrations(store_path: str | os.PathLike) -> list[Calibration]:
     return _calibrations(store_path, None)
 
 
-def readable_calibrations(store_path: str | os.PathLike) -> tuple[list[Calibration], list[str]]:
+def readable_calibrations(store_path: str | os.PathLike, *, listing=None,
+                          ) -> tuple[list[Calibration], list[str]]:
     """Every calibration of ``store_path`` that can be read, newest first, and a one-line
     problem per one that cannot (a damaged entry): one damaged calibration does not hide the
-    store's others, as :func:`stored_calibrations` (which raises on the first) would."""
+    store's others, as :func:`stored_calibrations` (which raises on the first) would.
+    ``listing``: the store's calibration listing as the caller read it already."""
     problems: list[str] = []
-    return _calibrations(store_path, problems), problems
+    return _calibrations(store_path, problems, listing), problems
 
 
 def stored_calibration(store_path: str | os.PathLike, key: str | None = None) -> Calibration:

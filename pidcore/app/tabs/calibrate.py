@@ -77,8 +77,10 @@ def _task(stores, chosen: str, polling: bool) -> None:
                             help=file_name)
 
 
-def render(stores) -> None:
-    """The page (a clear "not available" state while the calibration library is missing)."""
+def render(stores, stored) -> None:
+    """The page (a clear "not available" state while the calibration library is missing).
+    ``stored``: the store's calibrations as this draw read them
+    (:func:`pidcore.app.calibration.read_store_calibrations`)."""
 
     st.subheader("Calibrate the DEM against measurements")
     api, reason = calibration_api()
@@ -86,7 +88,7 @@ def render(stores) -> None:
         st.info(f"Calibration is not available: {reason}.")
         return
     _calibrate(stores, api)
-    _saved(stores)  # also where nothing can be calibrated now (no measurement saved yet)
+    _saved(stored)  # also where nothing can be calibrated now (no measurement saved yet)
 
 
 def _calibrate(stores, api) -> None:
@@ -112,25 +114,24 @@ def _calibrate(stores, api) -> None:
     draw_polling(_task, stores, chosen_label, polling=_running(stores), every_s=REFRESH_S)
 
 
-def _saved(stores) -> None:
+def _saved(stored) -> None:
     """The calibrations saved in the store (they outlive a restart of the app; the Compare
-    and Report tabs use them, newest first), each file offered for download."""
+    and Report tabs use them, newest first), each file offered for download. ``stored``: as
+    :func:`pidcore.app.calibration.read_store_calibrations` read them for this draw."""
     from pidcore.app.calibration import saved_calibrations_table
-    from pidcore.calibrate.persist import readable_calibrations
-    from pidcore.errors import PidcoreError
 
-    try:  # a damaged calibration is said, and does not hide the others
-        saved, damaged = readable_calibrations(stores.path)
-    except PidcoreError as exc:
-        st.caption(f"Calibrations of the store not shown: {exc}")
+    # a damaged calibration is said, and does not hide the others
+    if stored.listing is None and stored.damaged:
+        st.caption(f"Calibrations of the store not shown: {stored.damaged[0]}")
         return
-    for problem in damaged:
+    for problem in stored.damaged:
         st.caption(f"Calibration of the store not shown: {problem}")
+    saved = stored.readable
     if not saved:
         return
     st.markdown("**Calibrations saved in this store** (newest first; Compare and Report use "
                 "them)")
-    st.dataframe(saved_calibrations_table(stores.path), hide_index=True)
+    st.dataframe(saved_calibrations_table(listing=stored.listing), hide_index=True)
     keys = [c.store_key for c in saved]
     key = st.selectbox("download the files of", keys, key="calibration_saved_key")
     chosen = saved[keys.index(key)]

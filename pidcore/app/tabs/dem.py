@@ -31,24 +31,29 @@ def _config(cells: int, seed: int, steady_cycles: int):
                      steady_cycles=int(steady_cycles) if steady_cycles > 0 else None)
 
 
+def _runner(stores) -> jobs.DemJobRunner:
+    # the reference store's runs are not run again, as `pidcore dem sweep` reuses stored runs
+    return jobs.runner_for(stores.path, stores.dem_reference)
+
+
 def _cancel(stores) -> None:
     # Button callback: runs before the script, so the cancel reaches the runner at once; it
     # waits (briefly) for the running case's process to end, so that this very script run
     # shows the jobs cancelled instead of the next table refresh a second later
-    runner = jobs.runner_for(stores.path)
+    runner = _runner(stores)
     n = runner.cancel()
     runner.wait_cancelled(CANCEL_WAIT_S)
-    st.session_state["dem_message"] = ("warning", f"cancel requested for {n} job(s); finished "
-                                                  "cases stay saved")
+    st.session_state["dem_message"] = jobs.cancelled_text(n, runner.jobs())
 
 
 def _job_table(stores, polling: bool) -> None:
     # a fragment (see draw_polling): rerun every REFRESH_S while jobs are queued or running
-    runner = jobs.runner_for(stores.path)
+    runner = _runner(stores)
     listed = runner.jobs()  # one locked copy for the table and the progress bar
     rows = [j.row() for j in listed]
     busy = runner.busy()
-    running = [j for j in listed if j.state == "running"]
+    # this server's: another server's progress is not in the journal (it writes states only)
+    running = [j for j in listed if j.state == "running" and not j.server]
     if running:
         st.progress(running[0].fraction(), text=running[0].progress_text())
     if rows:
@@ -121,11 +126,11 @@ def render(stores) -> None:
         except PidcoreError as exc:
             st.session_state["dem_message"] = ("error", str(exc))
         else:
-            created = jobs.runner_for(stores.path).submit(cases, config, specimen)
+            created = _runner(stores).submit(cases, config, specimen)
             text = jobs.submitted_text(len(cases), created)
             st.session_state["dem_message"] = (
                 "info", text if fill_note is None else f"{fill_note}; {text}")
-    runner = jobs.runner_for(stores.path)
+    runner = _runner(stores)
     interrupted = sum(j.state == jobs.INTERRUPTED_STATE for j in runner.jobs())
     if interrupted:
         st.warning(f"{interrupted} job(s) were queued or running when the app stopped; nothing "
@@ -140,7 +145,7 @@ def render(stores) -> None:
     message = st.session_state.get("dem_message")
     if message:
         getattr(st, message[0])(message[1])
-    draw_polling(_job_table, stores, polling=jobs.runner_for(stores.path).busy(),
+    draw_polling(_job_table, stores, polling=_runner(stores).busy(),
                  every_s=REFRESH_S)
     try:
         runs = state.store_listing("dem_runs", stores.stamp(), stores)

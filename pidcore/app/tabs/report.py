@@ -5,7 +5,12 @@ from __future__ import annotations
 import streamlit as st
 
 from pidcore.app import state
+from pidcore.app.report_builds import start_report_build
+from pidcore.app.tabs import draw_polling
 from pidcore.app.vocabulary import page_terms
+
+#: Seconds between refreshes of the report build's state while it runs.
+REFRESH_S = 1.0
 
 #: The Report tab's default specimen: the paper's coupon, as ``pidcore report`` without
 #: ``--specimen``.
@@ -89,22 +94,33 @@ def render(stores, calibrations: list) -> None:
                  placeholder="")
     for note in table.attrs.get("notes", []):
         st.caption(f"note: {note}")
+    made = (stamp, pool, keys, digest, specimen_label)
     if st.button("Build report files (CSV, Markdown, HTML, LaTeX, PDF)", key="build_report"):
-        try:
-            with st.spinner("Writing the report ..."):
-                st.session_state["report_files"] = (
-                    (stamp, pool, keys, digest, specimen_label), report_files(
-                        stores.path, stores.dem_reference, pool=pool,
-                        analysis_keys=None if keys is None else list(keys),
-                        calibration=calibration, specimen=specimen))
-        except PidcoreError as exc:
-            st.error(f"no report: {page_terms(str(exc))}")
-    made, files = st.session_state.get("report_files") or (None, None)
-    # files of an older state are not offered
-    if files and made == (stamp, pool, keys, digest, specimen_label):
-        cols = st.columns(len(files))
-        for col, (fmt, (name, data, mime)) in zip(cols, files.items(), strict=True):
-            label = "CSV notes" if fmt == "csv_provenance" else fmt.upper()
-            col.download_button(label, data, file_name=name, mime=mime, key=f"download_{fmt}")
-        st.caption("report.csv holds only the table (pandas.read_csv reads it as is); "
-                   "provenance and notes are in the CSV notes file and in the other formats.")
+        # built in the background: the page stays usable, and a click elsewhere meanwhile
+        # does not stop the build
+        st.session_state["report_build"] = start_report_build(
+            made, lambda: report_files(stores.path, stores.dem_reference, pool=pool,
+                                       analysis_keys=None if keys is None else list(keys),
+                                       calibration=calibration, specimen=specimen),
+            st.session_state.get("report_build"))
+    build = st.session_state.get("report_build")
+    if build is not None and build.of == made:  # files of an older state are not offered
+        draw_polling(_build_state, build, polling=build.state == "running", every_s=REFRESH_S)
+
+
+def _build_state(build, polling: bool) -> None:
+    # a fragment (see draw_polling): rerun every REFRESH_S while the report is being built
+    if build.state == "running":
+        st.info(f"Writing the report ... {build.elapsed_s():.0f} s")
+        return
+    if polling:  # it ended: draw the page again, without the timer
+        st.rerun(scope="app")
+    if build.state == "failed":
+        st.error(f"no report: {page_terms(build.message)}")
+        return
+    cols = st.columns(len(build.files))
+    for col, (fmt, (name, data, mime)) in zip(cols, build.files.items(), strict=True):
+        label = "CSV notes" if fmt == "csv_provenance" else fmt.upper()
+        col.download_button(label, data, file_name=name, mime=mime, key=f"download_{fmt}")
+    st.caption("report.csv holds only the table (pandas.read_csv reads it as is); "
+               "provenance and notes are in the CSV notes file and in the other formats.")
