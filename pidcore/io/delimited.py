@@ -23,6 +23,7 @@ needs about the size of the resulting float64 arrays (well under 3x the file siz
 from __future__ import annotations
 
 import codecs
+import math
 import os
 import re
 
@@ -63,6 +64,27 @@ def _split_header(cell: str) -> tuple[str, str]:
     if match is None or not match.group("name"):
         return cell, ""
     return match.group("name"), (match.group("unit") or "").strip()
+
+
+def _name_and_unit(cell: str, row_unit: str) -> tuple[str, str]:
+    """Channel name and unit text of a header cell and its unit-row cell (``""``: none).
+
+    Beside a unit row, text in brackets that is no unit belongs to the name (Testlab's
+    ``Force (Drive point)``): taken as the unit, it hid the row's unit and cut the name. A
+    name stating a unit the row contradicts (``Force (N)`` over ``kN``) gives a unit no table
+    knows, which the analysis refuses (``--force-unit`` decides): either reading is a
+    silent x1000 when it is the wrong one.
+    """
+    name, own = _split_header(cell)
+    if not row_unit or not own:
+        return name, own or row_unit
+    own_reading, row_reading = interpret_unit(own), interpret_unit(row_unit)
+    if own_reading[0] == "unknown":
+        return cell.strip().strip('"').strip(), row_unit
+    if row_reading[0] == "unknown" or (own_reading[0] == row_reading[0] and math.isclose(
+            own_reading[1], row_reading[1], rel_tol=1e-9)):
+        return name, own  # a row of '-' (no unit) does not contradict the name
+    return name, f"{own} in the name, {row_unit} in the unit row"
 
 
 def _encoding(head: bytes) -> str:
@@ -232,10 +254,8 @@ def read_csv(path: str | os.PathLike[str], *, sample_rate_hz: float | None = Non
     if values.shape[1] != len(header_cells):
         raise InputFileError(f"{where}: the header has {len(header_cells)} columns but the data "
                              f"rows have {values.shape[1]}")
-    cells = []
-    for cell, unit in zip(header_cells, unit_cells, strict=True):
-        name, own = _split_header(cell)
-        cells.append((name, own or unit))
+    cells = [_name_and_unit(cell, unit) for cell, unit in zip(header_cells, unit_cells,
+                                                               strict=True)]
     if len(cells) < 1 or values.shape[0] < 2:
         raise InputFileError(f"{where}: expected at least one channel and two data rows")
 
