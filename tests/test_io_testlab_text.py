@@ -88,3 +88,30 @@ def test_a_unit_in_the_name_agreeing_with_the_unit_row_is_read_as_before(tmp_pat
     assert names == {"Point1:+Z": "mm/s", "Force": "N"}
     record = analyze_json(path, capsys)
     assert record["complex_power_real_w"] == pytest.approx(TRUE_REAL_POWER_W, rel=1e-6)
+
+
+@pytest.mark.parametrize("options", [(), ("--allow-clipped",)])
+def test_an_overflow_marker_is_named_not_called_clipping(tmp_path, capsys, options):
+    # a float32-max overload marker in one sample: the clipping test's tolerance grew with the
+    # range, so 'clipped: 10239 samples at -0.05 m/s' was said of a clean channel, and
+    # --allow-clipped then fitted a 3.4e38 sample
+    columns = shaker_columns("Force", "N", 1.0, "Point1:+Z", "m/s", 1.0)
+    columns[1][2][100] = 3.402823e38
+    path = write_testlab_text(tmp_path / "run10.txt", columns)
+    assert main(["analyze", str(path), "--no-store", "--no-progress", *options]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1
+    assert "run10.txt" in err and "'Point1:+Z'" in err and "index 100" in err
+    assert "3.40282e+38 m/s" in err and "overload" in err and "clipped" not in err
+
+
+def test_the_array_api_refuses_an_overflow_marker_too():
+    from pidcore.errors import ChannelError
+    from pidcore.signal.power import analyze_power
+
+    t = np.arange(int(2 * FS)) / FS
+    force = F0 * np.sin(2 * math.pi * FREQ * t)
+    velocity = V0 * np.sin(2 * math.pi * FREQ * t - PHI)
+    force[777] = -9.9e37
+    with pytest.raises(ChannelError, match=r"channel 'force'.*index 777 \(-9\.9e\+37"):
+        analyze_power(force, velocity, FS, force_name="force", velocity_name="velocity")
