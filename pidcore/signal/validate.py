@@ -254,12 +254,17 @@ def check_clipping(data: np.ndarray, *, source: str, channel: str, unit: str = "
         raise ChannelError(f"{message}; pass allow_clipped=True to analyse anyway")
 
 
+#: Relative difference within which two channels' sample rates are one rate (one clock whose
+#: rate two files or columns state with different round-off).
+SAME_RATE_RELATIVE_TOLERANCE = 1e-9
+
+
 def check_same_sampling(names: list[str], sample_rates_hz: list[float], lengths: list[int], *,
                         source: str) -> None:
     """Reject channels of different sample rate or length (they must be simultaneous)."""
     ref_rate, ref_len = sample_rates_hz[0], lengths[0]
     for name, rate, length in zip(names[1:], sample_rates_hz[1:], lengths[1:], strict=True):
-        if abs(rate - ref_rate) > 1e-9 * ref_rate:
+        if abs(rate - ref_rate) > SAME_RATE_RELATIVE_TOLERANCE * ref_rate:
             raise ChannelError(f"{_label(source, name)}: sample rate {rate:g} Hz differs from "
                                f"{ref_rate:g} Hz of channel {names[0]!r}; expected simultaneous "
                                "channels")
