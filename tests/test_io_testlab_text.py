@@ -115,3 +115,41 @@ def test_the_array_api_refuses_an_overflow_marker_too():
     force[777] = -9.9e37
     with pytest.raises(ChannelError, match=r"channel 'force'.*index 777 \(-9\.9e\+37"):
         analyze_power(force, velocity, FS, force_name="force", velocity_name="velocity")
+
+
+@pytest.mark.parametrize("force_later_s", [1e-4, -1e-4])
+def test_each_x_y_pair_keeps_its_own_time_column(tmp_path, capsys, force_later_s):
+    # Testlab writes signals of their own time axis as x/y pairs ('Time, Point1:+Z, Time,
+    # Force'). The second time column was an ignored channel and the force took the first
+    # column's times: sampled 0.1 ms off (half a sample here), a 3.6 degree phase error: 0.1 ms
+    # earlier gave a loss factor of 0.113 for 0.05, saved without a word (0.1 ms later: -0.013,
+    # refused as an uncorrected vibrometer delay)
+    t = np.arange(int(2 * FS)) / FS
+    w = 2 * math.pi * FREQ
+    shifted = t + force_later_s
+    path = write_testlab_text(tmp_path / "run11.txt", [
+        ("Time", "s", t), ("Point1:+Z", "m/s", V0 * np.sin(w * t - PHI)),
+        ("Time", "s", shifted), ("Force", "N", F0 * np.sin(w * shifted))])
+    channels = read_measurement(path).channels
+    assert [c.name for c in channels] == ["Point1:+Z", "Force"]
+    # 8 printed digits of 1e-4 s
+    assert channels[1].start_time_s == pytest.approx(force_later_s, abs=1e-9)
+    record = analyze_json(path, capsys)
+    # the half-sample offset is removed as a velocity delay: exact up to the 8 printed digits
+    assert record["loss_factor"] == pytest.approx(ETA, rel=1e-6)
+    assert record["complex_power_imag_w"] == pytest.approx(TRUE_REACTIVE_POWER_W, rel=1e-6)
+
+
+def test_an_x_y_pair_at_another_rate_is_refused_naming_both_rates(tmp_path, capsys):
+    # the force pair holds every second sample; its shorter columns end in empty cells
+    t = np.arange(int(2 * FS)) / FS
+    w = 2 * math.pi * FREQ
+    half = np.full(t.size // 2, np.nan)
+    path = write_testlab_text(tmp_path / "run12.txt", [
+        ("Time", "s", t), ("Point1:+Z", "m/s", V0 * np.sin(w * t - PHI)),
+        ("Time", "s", np.r_[t[::2], half]), ("Force", "N", np.r_[F0 * np.sin(w * t[::2]), half])])
+    path.write_bytes(path.read_bytes().replace(b"\tnan\tnan", b"\t\t"))
+    assert main(["analyze", str(path), "--no-store", "--no-progress"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "run12.txt" in err
+    assert "5120 Hz" in err and "2560 Hz" in err
