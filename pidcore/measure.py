@@ -42,6 +42,7 @@ from .io import assign_roles, read_measurement
 from .records import Channel, Measurement
 from .signal import PowerAnalysis, analyze_channels
 from .signal.power import check_analysis_settings
+from .signal.validate import SAME_RATE_RELATIVE_TOLERANCE
 from .units import lookup_unit
 
 if TYPE_CHECKING:
@@ -188,10 +189,12 @@ def _align(channels: dict[str, Channel], source: str, notes: list[str],
            corrections: dict) -> tuple[dict[str, Channel], float]:
     """Cut the channels to their common time span; returns them and the velocity delay (s)
     that corrects a fractional-sample start offset of the velocity against the force."""
-    rates = {ch.sample_rate_hz for ch in channels.values()}
-    if len(rates) > 1:
+    rate = channels["force"].sample_rate_hz
+    # equal within the analysis's tolerance, not bit for bit: two time columns printed with 8
+    # digits give rates 1e-12 apart, and the start offset between them was then ignored
+    if any(abs(ch.sample_rate_hz - rate) > SAME_RATE_RELATIVE_TOLERANCE * rate
+           for ch in channels.values()):
         return channels, 0.0  # refused by the analysis with both rates named
-    rate = rates.pop()
     starts = {r: ch.start_time_s for r, ch in channels.items()}
     lengths = {r: ch.n_samples for r, ch in channels.items()}
     if len(set(starts.values())) == 1 and len(set(lengths.values())) == 1:

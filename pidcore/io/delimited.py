@@ -11,7 +11,8 @@ Understood as spreadsheet tools, MATLAB and acquisition software write them:
   not a comma, recognised from any of the first data rows (the first may hold integers only);
 * encodings UTF-8 (with or without BOM), **UTF-16** (BOM or NUL pattern), else Latin-1.
 
-The time base is the first column whose unit is a time unit or whose name is ``time``/``t``.
+The time base is the first column whose unit is a time unit or whose name is ``time``/``t``;
+later time columns (x/y pairs) are the time base of the columns up to the next one.
 It must be evenly spaced within the precision it was printed with (a column printed with 5-6
 significant digits is fitted, see :func:`pidcore.io._common.rate_from_times`). Without one,
 ``sample_rate_hz`` must be given; with one, ``sample_rate_hz`` overrides it (noted).
@@ -23,6 +24,7 @@ needs about the size of the resulting float64 arrays (well under 3x the file siz
 from __future__ import annotations
 
 import codecs
+import math
 import os
 import re
 
@@ -63,6 +65,27 @@ def _split_header(cell: str) -> tuple[str, str]:
     if match is None or not match.group("name"):
         return cell, ""
     return match.group("name"), (match.group("unit") or "").strip()
+
+
+def _name_and_unit(cell: str, row_unit: str) -> tuple[str, str]:
+    """Channel name and unit text of a header cell and its unit-row cell (``""``: none).
+
+    Beside a unit row, text in brackets that is no unit belongs to the name (Testlab's
+    ``Force (Drive point)``): taken as the unit, it hid the row's unit and cut the name. A
+    name stating a unit the row contradicts (``Force (N)`` over ``kN``) gives a unit no table
+    knows, which the analysis refuses (``--force-unit`` decides): either reading is a
+    silent x1000 when it is the wrong one.
+    """
+    name, own = _split_header(cell)
+    if not row_unit or not own:
+        return name, own or row_unit
+    own_reading, row_reading = interpret_unit(own), interpret_unit(row_unit)
+    if own_reading[0] == "unknown":
+        return cell.strip().strip('"').strip(), row_unit
+    if row_reading[0] == "unknown" or (own_reading[0] == row_reading[0] and math.isclose(
+            own_reading[1], row_reading[1], rel_tol=1e-9)):
+        return name, own  # a row of '-' (no unit) does not contradict the name
+    return name, f"{own} in the name, {row_unit} in the unit row"
 
 
 def _encoding(head: bytes) -> str:
@@ -232,10 +255,8 @@ def read_csv(path: str | os.PathLike[str], *, sample_rate_hz: float | None = Non
     if values.shape[1] != len(header_cells):
         raise InputFileError(f"{where}: the header has {len(header_cells)} columns but the data "
                              f"rows have {values.shape[1]}")
-    cells = []
-    for cell, unit in zip(header_cells, unit_cells, strict=True):
-        name, own = _split_header(cell)
-        cells.append((name, own or unit))
+    cells = [_name_and_unit(cell, unit) for cell, unit in zip(header_cells, unit_cells,
+                                                               strict=True)]
     if len(cells) < 1 or values.shape[0] < 2:
         raise InputFileError(f"{where}: expected at least one channel and two data rows")
 
@@ -274,18 +295,74 @@ def read_csv(path: str | os.PathLike[str], *, sample_rate_hz: float | None = Non
         raise InputFileError(f"{where}: no time column (e.g. 'Time [s]') and no sample rate; "
                              "add a time column or give the sample rate (sample_rate_hz)")
 
-    keep = [i for i in range(len(cells)) if i != time_index]
+    pair_times = _pair_time_columns(cells, time_index)
+    keep = [i for i in range(len(cells)) if i != time_index and i not in pair_times]
     if not keep:
         raise InputFileError(f"{where}: only a time column; expected channel columns beside it")
     names = unique_names([cells[i][0] or f"column {i + 1}" for i in keep])
-    channels = tuple(make_channel(n, values[:, i], sample_rate_hz=rate, unit=cells[i][1],
-                                  start_time_s=start_time)
+    bases = _pair_time_bases(values, cells, pair_times, keep, names, where=where,
+                             main=(rate, start_time, values.shape[0]),
+                             given_rate=sample_rate_hz, notes=notes)
+    channels = tuple(make_channel(n, values[:bases[i][2], i], sample_rate_hz=bases[i][0],
+                                  unit=cells[i][1], start_time_s=bases[i][1])
                      for n, i in zip(names, keep, strict=True))
     metadata: dict = {"csv_encoding": encoding}
     if notes:
         metadata["reader_notes"] = notes
     return Measurement(source=where, channels=channels, sha256=file_sha256(path),
                        file_format="csv", metadata=metadata)
+
+
+def _pair_time_columns(cells: list[tuple[str, str]], time_index: int | None) -> list[int]:
+    """Time columns after the first one: the x of x/y pairs (``Time;Force;Time;Point1:+Z``,
+    as Testlab exports signals of their own time axis). Such a column has a time unit or the
+    first time column's name; each is the time base of the columns up to the next one."""
+    if time_index is None:
+        return []
+    first_name = cells[time_index][0].strip().lower()
+    return [i for i, (name, unit) in enumerate(cells) if i > time_index and (
+        interpret_unit(unit)[0] == "time" or (not unit and name.strip().lower() == first_name))]
+
+
+def _pair_time_bases(values: np.ndarray, cells: list[tuple[str, str]], pair_times: list[int],
+                     keep: list[int], names: list[str], *, where: str,
+                     main: tuple[float, float, int], given_rate: float | None,
+                     notes: list[str]) -> dict[int, tuple[float, float, int]]:
+    """Rate, start and length of each channel column from the time column left of it.
+
+    A later time column was read as a channel and ignored, so its channels took the first
+    column's times: a force sampled 1 ms later than the velocity read as a 36 degree phase
+    error (a wrong loss factor without a word). A pair's column that ends early (empty
+    cells) gives its channels that length; the analysis cuts all to their common span."""
+    bases = {i: main for i in keep}
+    for k, t_index in enumerate(pair_times):
+        end = pair_times[k + 1] if k + 1 < len(pair_times) else len(cells)
+        owned = [i for i in keep if t_index < i < end]
+        if not owned:
+            continue
+        times = values[:, t_index]
+        length = int(np.argmax(np.isnan(times))) if np.isnan(times).any() else times.size
+        name, unit = cells[t_index]
+        factor = interpret_unit(unit)[1] if unit else 1.0
+        what = f"{where}: column {name!r} (time of column {owned[0] + 1})"
+        if length < 2:
+            raise InputFileError(f"{what}: holds {length} times; expected the time of each "
+                                 "sample of its channels")
+        if given_rate is not None:
+            base = (float(given_rate), float(times[0]) * factor, length)
+        else:
+            rate, start = rate_from_times(times[:length] * factor, what=what)
+            base = (rate, start, length)
+        if base == main:
+            continue
+        for i in owned:
+            bases[i] = base
+        channels = ", ".join(repr(names[keep.index(i)]) for i in owned)
+        notes.append(f"{where}: column {name!r} is the time of {channels}: "
+                     f"{base[2]} samples from {base[1]:.9g} s at {base[0]:.9g} Hz "
+                     f"(the first time column: {main[2]} from {main[1]:.9g} s at "
+                     f"{main[0]:.9g} Hz)")
+    return bases
 
 
 def write_csv(measurement: Measurement, path: str | os.PathLike[str]) -> None:

@@ -476,6 +476,7 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
     for name, data in channels:
         validate.check_length(data, source=source, channel=name, min_samples=8)
         validate.check_finite(data, source=source, channel=name)
+        validate.check_outliers(data, source=source, channel=name)
     validate.check_same_sampling([c[0] for c in channels], [sample_rate_hz] * len(channels),
                                  [c[1].shape[0] for c in channels], source=source)
     f_data = channels[0][1]
@@ -712,6 +713,7 @@ def analyze_channels(force: Channel, velocity: Channel | None, *,
         validate.check_length(data, source=source, channel=ch.name, min_samples=8)
         validate.check_finite(data, source=source, channel=ch.name)
         validate.check_not_constant(data, source=source, channel=ch.name, unit=ch.unit)
+        validate.check_outliers(data, source=source, channel=ch.name, unit=ch.unit)
         datas.append(data)
     validate.check_same_sampling([ch.name for _, ch in present],
                                  [ch.sample_rate_hz for _, ch in present],

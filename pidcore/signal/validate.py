@@ -140,6 +140,39 @@ def check_finite(data: np.ndarray, *, source: str, channel: str) -> None:
                            f"({data[first]:g}); expected physical values: a corrupt file")
 
 
+#: How far beyond the range of 99 % of its samples a sample may lie, as a multiple of that
+#: range's half width. A channel's input range is set within a few decades of the signal it
+#: resolves (a 24-bit ADC spans 1.7e7 of its step), and an analysable record is dominated by
+#: its drive line, so no measured sample lies a million times its amplitude out; an overload
+#: or "no value" marker does (float32 max 3.4e38, 9.9e37), and a single one makes the range,
+#: the clipping test and the fit meaningless.
+MAX_OUTLIER_FACTOR = 1e6
+
+
+def check_outliers(data: np.ndarray, *, source: str, channel: str, unit: str = "") -> None:
+    """Reject samples more than :data:`MAX_OUTLIER_FACTOR` half-ranges of the channel's central
+    99 % outside it: overflow markers and corrupt values. Without this, one 3.4e38 made every
+    other sample count as clipped at the channel's minimum."""
+    if data.size < 2:
+        return
+    low, high = (float(v) for v in np.percentile(data, [0.5, 99.5]))
+    half_range, middle = 0.5 * (high - low), 0.5 * (high + low)
+    if not half_range > 0:
+        return  # over 99 % equal: the constant and dropout checks say what it is
+    limit = MAX_OUTLIER_FACTOR * half_range
+    if float(np.max(data)) - middle <= limit and middle - float(np.min(data)) <= limit:
+        return
+    far = np.abs(data - middle) > limit
+    first = int(np.argmax(far))
+    count = int(far.sum())
+    in_unit = f" {unit}" if unit else ""
+    raise ChannelError(
+        f"{_label(source, channel)}: {count} sample{'s' if count > 1 else ''} far outside the "
+        f"signal, first at index {first} ({data[first]:.6g}{in_unit}; 99 % of the samples lie "
+        f"within {low:.6g} .. {high:.6g}{in_unit}); expected measured values, not an overload "
+        "or 'no value' marker: cut them out of the export")
+
+
 def check_length(data: np.ndarray, *, source: str, channel: str, min_samples: int) -> None:
     """Reject a channel that is not 1-D or holds fewer than ``min_samples`` samples."""
     if data.ndim != 1:
@@ -221,12 +254,17 @@ def check_clipping(data: np.ndarray, *, source: str, channel: str, unit: str = "
         raise ChannelError(f"{message}; pass allow_clipped=True to analyse anyway")
 
 
+#: Relative difference within which two channels' sample rates are one rate (one clock whose
+#: rate two files or columns state with different round-off).
+SAME_RATE_RELATIVE_TOLERANCE = 1e-9
+
+
 def check_same_sampling(names: list[str], sample_rates_hz: list[float], lengths: list[int], *,
                         source: str) -> None:
     """Reject channels of different sample rate or length (they must be simultaneous)."""
     ref_rate, ref_len = sample_rates_hz[0], lengths[0]
     for name, rate, length in zip(names[1:], sample_rates_hz[1:], lengths[1:], strict=True):
-        if abs(rate - ref_rate) > 1e-9 * ref_rate:
+        if abs(rate - ref_rate) > SAME_RATE_RELATIVE_TOLERANCE * ref_rate:
             raise ChannelError(f"{_label(source, name)}: sample rate {rate:g} Hz differs from "
                                f"{ref_rate:g} Hz of channel {names[0]!r}; expected simultaneous "
                                "channels")
