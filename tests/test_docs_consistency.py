@@ -231,3 +231,27 @@ def test_docs_scripts_import_what_exists(script):
                 except ImportError:
                     missing.append(f"{target}.{name}")
     assert missing == []
+
+
+AUDIT = ROOT / "docs" / "physics_audit"
+
+
+@pytest.mark.parametrize("name", ["paper", "steel", "wc", "pom", "wc_tiny", "wc_full"])
+def test_physics_audit_reference_agrees_with_specimen_check(name):
+    # docs/physics_audit/README.md: ref.py's first-principles numbers differ from `specimen
+    # check` by at most 3e-16; its overlap was of a 0.3 m/s impact under the name of specimen
+    # check's hardest-impact overlap and read +229 %. 1e-12 leaves round-off of a few
+    # operations (the README's 3e-16) and catches any change of a formula or its inputs.
+    import importlib.util
+
+    from pidcore.specimen import describe, load_specimen
+
+    spec = importlib.util.spec_from_file_location("physics_audit_ref", AUDIT / "ref.py")
+    ref = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(ref)
+    mine, _ = ref.ref(str(AUDIT / f"{name}.toml"))
+    described = describe(load_specimen(AUDIT / f"{name}.toml"))
+    compared = {k: (described[k], v) for k, v in mine.items() if k in described}
+    assert len(compared) >= 12  # masses, stiffnesses, overlaps, speeds, times, gaps
+    off = {k: (p, r) for k, (p, r) in compared.items() if p != pytest.approx(r, rel=1e-12)}
+    assert off == {}

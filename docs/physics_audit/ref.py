@@ -46,16 +46,17 @@ def ref(path):
     out['tangential_period_s'] = min(ttp, ttw)
     out['time_step_s'] = min(2e-6, min(out['contact_time_s'], out['tangential_period_s'])/10)
     return out, s
-for f in sys.argv[1:]:
-    mine, s = ref(f + '.toml')
-    pc = json.load(open(f + '.json'))
-    n = pc['particles_per_cell']
-    mine['particles_mass_kg'] = s['cell']['count']*n*mine['particle_mass_kg']
-    mine['vibrated_mass_kg'] = s['coupon']['mass_kg'] + s['coupon'].get('fixture_mass_kg', 0) + mine['particles_mass_kg']
-    print(f"## {f}: capacity {pc['capacity_per_cell']}, per cell {n}; hex area {mine['hex_area_m2']*1e6:.4f} mm2, "
-          f"circumdiameter {mine['hex_circumdiameter_m']*1e3:.4f} mm, volume {mine['hex_volume_m3']*1e9:.3f} mm3, "
-          f"cells/100mm square {mine['cells_in_100mm_square']:.1f} (file {s['cell']['count']}); packing fraction "
-          f"{pc['capacity_per_cell']*4/3*math.pi*s['particles']['radius_m']**3/mine['hex_volume_m3']:.3f}")
-    for k, v in mine.items():
-        if k in pc:
-            print(f"| {f} | {k} | {pc[k]:.6g} | {v:.6g} | {(pc[k]-v)/v:+.2e} |")
+if __name__ == "__main__":  # importable: tests/test_docs_consistency.py
+    for f in sys.argv[1:]:
+        mine, s = ref(f + '.toml')
+        pc = json.load(open(f + '.json'))
+        n = pc['particles_per_cell']
+        mine['particles_mass_kg'] = s['cell']['count']*n*mine['particle_mass_kg']
+        mine['vibrated_mass_kg'] = s['coupon']['mass_kg'] + s['coupon'].get('fixture_mass_kg', 0) + mine['particles_mass_kg']
+        print(f"## {f}: capacity {pc['capacity_per_cell']}, per cell {n}; hex area {mine['hex_area_m2']*1e6:.4f} mm2, "
+              f"circumdiameter {mine['hex_circumdiameter_m']*1e3:.4f} mm, volume {mine['hex_volume_m3']*1e9:.3f} mm3, "
+              f"cells/100mm square {mine['cells_in_100mm_square']:.1f} (file {s['cell']['count']}); packing fraction "
+              f"{pc['capacity_per_cell']*4/3*math.pi*s['particles']['radius_m']**3/mine['hex_volume_m3']:.3f}")
+        for k, v in mine.items():
+            if k in pc:
+                print(f"| {f} | {k} | {pc[k]:.6g} | {v:.6g} | {(pc[k]-v)/v:+.2e} |")
