@@ -1,6 +1,6 @@
 import math, dataclasses, sys, numpy as np
 sys.path.insert(0, "../../tests")
-from test_dem_friction_rolling import _Incline
+from _incline import Incline as _Incline  # the tests keep it in tests/_incline.py
 from pidcore.specimen import load_specimen, contact_law
 from pidcore.dem.geometry import CellGeometry, random_packing
 from pidcore.dem.state import CellsState, KernelSettings, advance, energies

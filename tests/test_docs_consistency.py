@@ -1,0 +1,257 @@
+"""The README and docs/ stay true to the code in what can be checked without running anything:
+every command they show parses with today's CLI, every option they name exists, every link and
+anchor resolves, and the tables of sidecar columns and specimen keys name exactly what the
+readers take (drift that a reader only finds when a copied command fails)."""
+
+from __future__ import annotations
+
+import argparse
+import re
+import shlex
+from pathlib import Path
+
+import pytest
+
+from pidcore.cli import build_parser
+from pidcore.compare.loadcase import (
+    ANALYSIS_SETTINGS_COLUMNS,
+    FREE_TEXT_COLUMNS,
+    SPECIMEN_COLUMN,
+)
+from pidcore.specimen import PAIR_NAMES, SCHEMA
+
+ROOT = Path(__file__).resolve().parents[1]
+README = ROOT / "README.md"
+DOCS = sorted((ROOT / "docs").rglob("*.md"))
+SAMPLE_NOTES = sorted((ROOT / "data_samples").rglob("README.md"))
+PAGES = [README, *DOCS, *SAMPLE_NOTES]
+
+
+def _ids(pages: list[Path]) -> list[str]:
+    return [str(p.relative_to(ROOT)) for p in pages]
+
+
+def _subparsers(parser: argparse.ArgumentParser) -> dict[str, argparse.ArgumentParser]:
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            return dict(action.choices)
+    return {}
+
+
+def _all_parsers(parser: argparse.ArgumentParser) -> list[argparse.ArgumentParser]:
+    out = [parser]
+    for sub in _subparsers(parser).values():
+        out.extend(_all_parsers(sub))
+    return out
+
+
+def _options(parser: argparse.ArgumentParser) -> set[str]:
+    return {o for action in parser._actions for o in action.option_strings}
+
+
+@pytest.fixture(scope="module")
+def parser() -> argparse.ArgumentParser:
+    return build_parser()
+
+
+def _shown_commands(text: str) -> list[str]:
+    """``pidcore ...`` command lines of the page's code blocks (continuations joined, comments
+    and ``&&`` chains split off); usage synopses (``[--x]``, ``(a | b)``) are not commands."""
+    commands = []
+    for block in re.findall(r"```[a-z]*\n(.*?)```", text, re.S):
+        for line in block.replace("\\\n", " ").splitlines():
+            line = re.split(r"\s#", line)[0].strip()
+            for part in line.split("&&"):
+                part = part.strip()
+                if part.startswith("pidcore ") and not re.search(r"[\[\]|]|\(--", part):
+                    commands.append(part)
+    return commands
+
+
+@pytest.mark.parametrize("page", PAGES, ids=_ids(PAGES))
+def test_every_command_shown_parses_with_the_cli(page, parser):
+    # a renamed or removed option, or a value a choice no longer takes, fails here rather
+    # than in the hands of a user who copied the command
+    refused = []
+    for command in _shown_commands(page.read_text(encoding="utf-8")):
+        try:
+            parser.parse_args(shlex.split(command)[1:])
+        except SystemExit:
+            refused.append(command)
+    assert refused == []
+
+
+def test_readme_shows_commands_of_every_subcommand():
+    # the parse test above is only as good as what it finds: the README's blocks hold
+    # analyze, dem run/sweep, specimen check, report and calibrate commands
+    shown = {" ".join(c.split()[:2]) for c in _shown_commands(README.read_text("utf-8"))}
+    assert {"pidcore analyze", "pidcore dem", "pidcore specimen", "pidcore report",
+            "pidcore calibrate", "pidcore app"} <= shown
+
+
+def _script_options(folder: Path) -> set[str]:
+    """Options of the docs' own scripts (``docs/physics_study.py --plot-only``)."""
+    return {m for script in folder.rglob("*.py")
+            for m in re.findall(r"add_argument\(\s*[\"'](--[a-z][a-z0-9-]*)", script.read_text(
+                encoding="utf-8", errors="replace"))}
+
+
+@pytest.mark.parametrize("page", PAGES, ids=_ids(PAGES))
+def test_every_option_named_exists(page, parser):
+    known = set().union(*(_options(p) for p in _all_parsers(parser)))
+    known |= _script_options(ROOT / "docs")
+    text = page.read_text(encoding="utf-8")
+    named = set(re.findall(r"(?<![\w-])(--[a-z][a-z0-9-]*)", text))
+    assert sorted(named - known) == []
+
+
+@pytest.mark.parametrize("page", PAGES, ids=_ids(PAGES))
+def test_inline_commands_name_options_of_their_own_subcommand(page, parser):
+    # `pidcore report --calibration-key` must be an option of report, not of some other command
+    wrong = []
+    for span in re.findall(r"`(pidcore [^`]+)`", page.read_text(encoding="utf-8")):
+        words = span.split()[1:]
+        subs = [parser]
+        # `dem run/sweep --x`: the option of each
+        while words and all(w in _subparsers(subs[0]) for w in words[0].split("/")):
+            subs = [_subparsers(subs[0])[w] for w in words.pop(0).split("/")]
+        if subs == [parser]:
+            continue
+        options = {w.split("=")[0] for w in words if w.startswith("--")}
+        wrong += [f"{span}: {o}" for sub in subs for o in sorted(options - _options(sub))]
+    assert wrong == []
+
+
+def _anchors(page: Path) -> set[str]:
+    """GitHub's heading anchors of a Markdown page."""
+    out, seen = set(), {}
+    for line in page.read_text(encoding="utf-8").splitlines():
+        m = re.match(r"#+\s+(.*)", line)
+        if not m:
+            continue
+        slug = re.sub(r"[^\w\- ]", "", m.group(1).strip().lower()).replace(" ", "-")
+        n = seen.get(slug, 0)
+        seen[slug] = n + 1
+        out.add(slug if n == 0 else f"{slug}-{n}")
+    return out
+
+
+@pytest.mark.parametrize("page", PAGES, ids=_ids(PAGES))
+def test_every_link_and_anchor_resolves(page):
+    broken = []
+    text = re.sub(r"```.*?```", "", page.read_text(encoding="utf-8"), flags=re.S)
+    for target in re.findall(r"\]\(([^)\s]+)\)", text):
+        if re.match(r"[a-z]+:", target):
+            continue  # a web address: not checked offline
+        path, _, anchor = target.partition("#")
+        resolved = (page.parent / path) if path else page
+        if not resolved.exists():
+            broken.append(target)
+        elif anchor and anchor not in _anchors(resolved):
+            broken.append(target)
+    assert broken == []
+
+
+@pytest.mark.parametrize("page", PAGES, ids=_ids(PAGES))
+def test_every_repository_path_named_exists(page):
+    # `tests/test_x.py`, `pidcore/dem/bench_reference.py`, `data_samples/...` in prose
+    text = page.read_text(encoding="utf-8")
+    missing = []
+    for path in re.findall(
+            r"`((?:docs|tests|pidcore|data_samples|app|\.ci|\.streamlit)/[^`\s]*)`", text):
+        if any(c in path for c in "*…<") or "..." in path:
+            continue
+        if not (ROOT / path.rstrip("/")).exists():
+            missing.append(path)
+    assert missing == []
+
+
+def _table(text: str, header: str) -> list[str]:
+    """First cells of the Markdown table starting with ``header``."""
+    start = text.index(header)
+    rows = text[start:text.index("\n\n", start)].splitlines()[2:]
+    return [row.split("|")[1] for row in rows]
+
+
+def test_readme_sidecar_table_names_exactly_the_columns_read():
+    # one more column in the reader, or one the reader no longer takes, shows here
+    cells = _table(README.read_text(encoding="utf-8"),
+                   "| column | meaning (option it stands for) |")
+    documented = {name for cell in cells for name in re.findall(r"`([^`]+)`", cell)}
+    assert documented == {*ANALYSIS_SETTINGS_COLUMNS, SPECIMEN_COLUMN, *FREE_TEXT_COLUMNS}
+
+
+def test_readme_specimen_table_names_no_key_the_reader_refuses():
+    # the other direction (every key documented) is test_specimen_runs'
+    cells = _table(README.read_text(encoding="utf-8"), "| key | unit | meaning |")
+    sections = {"cell", "coupon", "particles", "pairs", *(f"pairs.{p}" for p in PAIR_NAMES)}
+    keys = {k for section in SCHEMA.values() for k in section}
+    stale = []
+    for cell in cells:
+        for span in re.findall(r"`([^`]+)`", cell):
+            for word in re.sub(r"\[([^\]]+)\]", r" \1 ", span).split():
+                if word not in keys | sections:
+                    stale.append(word)
+    assert stale == []
+
+
+DOC_SCRIPTS = sorted((ROOT / "docs").rglob("*.py"))
+
+
+@pytest.mark.parametrize("script", DOC_SCRIPTS, ids=_ids(DOC_SCRIPTS))
+def test_docs_scripts_import_what_exists(script):
+    # docs/physics_audit/dem2.py imported _Incline from a test module that had moved it to
+    # tests/_incline.py: run_all.sh, which the audit's README says repeats everything, stopped
+    # there. Only pidcore's and the tests' modules are checked (the docs' own are scripts).
+    import ast
+    import importlib
+
+    tests_dir = Path(__file__).resolve().parent
+    missing = []
+    for node in ast.walk(ast.parse(script.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+            module, names = node.module, [a.name for a in node.names]
+        elif isinstance(node, ast.Import):
+            module, names = None, [a.name for a in node.names]
+        else:
+            continue
+        for target, name in ([(module, n) for n in names] if module else
+                             [(n, None) for n in names]):
+            top = target.split(".")[0]
+            if top != "pidcore" and not (tests_dir / f"{top}.py").exists():
+                continue
+            try:
+                found = importlib.import_module(target)
+            except ImportError:
+                missing.append(target)
+                continue
+            if name is not None and not hasattr(found, name):
+                try:
+                    importlib.import_module(f"{target}.{name}")
+                except ImportError:
+                    missing.append(f"{target}.{name}")
+    assert missing == []
+
+
+AUDIT = ROOT / "docs" / "physics_audit"
+
+
+@pytest.mark.parametrize("name", ["paper", "steel", "wc", "pom", "wc_tiny", "wc_full"])
+def test_physics_audit_reference_agrees_with_specimen_check(name):
+    # docs/physics_audit/README.md: ref.py's first-principles numbers differ from `specimen
+    # check` by at most 3e-16; its overlap was of a 0.3 m/s impact under the name of specimen
+    # check's hardest-impact overlap and read +229 %. 1e-12 leaves round-off of a few
+    # operations (the README's 3e-16) and catches any change of a formula or its inputs.
+    import importlib.util
+
+    from pidcore.specimen import describe, load_specimen
+
+    spec = importlib.util.spec_from_file_location("physics_audit_ref", AUDIT / "ref.py")
+    ref = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(ref)
+    mine, _ = ref.ref(str(AUDIT / f"{name}.toml"))
+    described = describe(load_specimen(AUDIT / f"{name}.toml"))
+    compared = {k: (described[k], v) for k, v in mine.items() if k in described}
+    assert len(compared) >= 12  # masses, stiffnesses, overlaps, speeds, times, gaps
+    off = {k: (p, r) for k, (p, r) in compared.items() if p != pytest.approx(r, rel=1e-12)}
+    assert off == {}
