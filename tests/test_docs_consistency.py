@@ -56,13 +56,14 @@ def parser() -> argparse.ArgumentParser:
 
 def _shown_commands(text: str) -> list[str]:
     """``pidcore ...`` command lines of the page's code blocks (continuations joined, comments
-    and ``&&`` chains split off); usage synopses (``[--x]``, ``(a | b)``) are not commands."""
+    ``&&``/``;`` chains and output redirections split off); usage synopses (``[--x]``, ``(a | b)``) are not commands."""
     commands = []
     for block in re.findall(r"```[a-z]*\n(.*?)```", text, re.S):
         for line in block.replace("\\\n", " ").splitlines():
             line = re.split(r"\s#", line)[0].strip()
-            for part in line.split("&&"):
-                part = part.strip()
+            for part in re.split(r"&&|;", line):
+                # an output redirection is the shell's, not the command's
+                part = re.split(r"\s\d?>>?\s", part)[0].strip()
                 if part.startswith("pidcore ") and not re.search(r"[\[\]|]|\(--", part):
                     commands.append(part)
     return commands
