@@ -268,6 +268,20 @@ def test_units_are_those_of_the_fitted_and_fixed_parameters():
         == ["Pa", "kg/m^3", "kg", "m", "-", "%"]
 
 
+def test_an_interrupt_names_a_store_that_never_existed_not_created(tmp_path):
+    # "no DEM run was started; dem.h5 unchanged" of a store the calibration would have made
+    from pidcore.calibrate.runner import RunTally
+
+    store = tmp_path / "dem.h5"
+    tally = RunTally(store)
+    assert tally.interrupted() == f"no DEM run was started; {store} not created"
+    tally.design(["a", "b"])
+    assert tally.interrupted() == f"no DEM run finished in this call; {store} not created"
+    Store(store).add_dem_run("other", {"sdc": 0.1})
+    assert tally.interrupted().startswith(f"no DEM run finished in this call; {store} holds 0 ")
+    assert RunTally(store).interrupted() == f"no DEM run was started; {store} unchanged"
+
+
 def test_outputs_that_cannot_be_made_leave_no_folder(tmp_path):
     from pidcore.calibrate.outputs import write_outputs
 
@@ -302,7 +316,7 @@ def test_a_ctrl_c_while_the_outputs_are_written_leaves_out_as_it_was_and_says_so
     assert err == (f"pidcore calibrate: interrupted; 3 DEM run(s) finished before the interrupt "
                    f"are saved in {store} (3 of the calibration's 3 stored now); a re-run of "
                    f"the same command computes no DEM run again; the calibration was not saved "
-                   f"in {store}; nothing written to {out} (left as it was)"), err
+                   f"in {store}; {out} not created"), err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["dem.h5", "m.csv"]  # no temp folder
     assert Store(store).list_calibrations().empty  # Ctrl-C commits nothing of the result
     # a folder from an earlier run keeps its files, none of them half-replaced

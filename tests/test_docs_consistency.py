@@ -55,8 +55,9 @@ def parser() -> argparse.ArgumentParser:
 
 
 def _shown_commands(text: str) -> list[str]:
-    """``pidcore ...`` command lines of the page's code blocks (continuations joined, comments
-    ``&&``/``;`` chains and output redirections split off); usage synopses (``[--x]``, ``(a | b)``) are not commands."""
+    """``pidcore ...`` command lines of the page's code blocks (continuations joined;
+    comments, ``&&``/``;`` chains and output redirections split off); usage synopses
+    (``[--x]``, ``(a | b)``) are not commands."""
     commands = []
     for block in re.findall(r"```[a-z]*\n(.*?)```", text, re.S):
         for line in block.replace("\\\n", " ").splitlines():

@@ -155,9 +155,13 @@ class RunTally:
         """What an interrupted calibration kept, e.g. ``"3 DEM run(s) finished before the
         interrupt are saved in dem.h5 (10 of the calibration's 24 stored now); re-run the same
         command to resume: stored runs are reused"``."""
+        # a store that never existed is "not created" (it was said to be "unchanged")
+        left = "unchanged" if Path(self.store_path).exists() else "not created"
         if not self.known:
-            return f"no DEM run was started; {self.store_path} unchanged"
+            return f"no DEM run was started; {self.store_path} {left}"
         now = stored_keys(self.store_path, self.keys)
+        if not now and left == "not created":
+            return f"no DEM run finished in this call; {self.store_path} {left}"
         saved = len(now - self.before)
         held = f"{len(now)} of the calibration's {len(self.keys)} stored now"
         if saved:

@@ -235,4 +235,6 @@ def _out_words(out: Path | None, written: bool) -> str:
         return ""
     if written:
         return f"; {out} was written in full"
+    if not out.exists():  # it was said to be "left as it was"
+        return f"; {out} not created"
     return f"; nothing written to {out} (left as it was)"
