@@ -41,6 +41,7 @@ from .posterior import (
     sample_posterior,
     summarise,
     summary_texts,
+    unconstrained_notes,
 )
 from .runner import RunRequest, run_requests, specimen_with
 from .surrogate import build_surrogate, default_design_size, design_points
@@ -394,6 +395,7 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: str | Sequence[str],
     fold_fallbacks = []
     parameters, correlations = summarise(specs, samples)
     notes += bound_notes(specs, samples)
+    notes += unconstrained_notes(specs, samples)
     rng = np.random.default_rng(posterior_seed + 1)
     predictions = [_row(points[i], predictive(model, samples, i, rng=rng)) for i in everything]
     energy = energy_check(model, samples, specimen)
