@@ -112,7 +112,8 @@ class CalibrationResult:
             "{} {} (95 % {} .. {})".format(s.name, *summary_texts(self.parameters[s.name]))
             for s in self.specs if s.kind != "hyper")
         return dataclasses.replace(
-            out, name=f"{self.specimen.name}{CALIBRATED_SUFFIX}",
+            # a calibrated file calibrated again is still x_calibrated, not x_calibrated_calibrated
+            out, name=f"{uncalibrated_name(self.specimen.name)}{CALIBRATED_SUFFIX}",
             description=f"{self.specimen.description} -- calibrated by pidcore calibrate: "
                         f"{fitted} (these replace any value stated above)".strip(" -"))
 
