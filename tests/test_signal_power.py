@@ -459,3 +459,18 @@ def test_the_numba_warm_up_record_is_accepted():
     from _numba_warmup import warm_signal_kernels
 
     warm_signal_kernels()
+
+
+def test_a_reactive_power_of_round_off_is_unresolved_whichever_its_sign():
+    # a noise-free damper gave Im(P_c) = -6.36e-35 W beside Re(P_c) = 1.8 W on one machine
+    # (+1e-19 W on another): refused as "one of the channels is probably inverted" there, and
+    # test_purely_resistive_load_is_refused_not_reported failed. Both signs of round-off are
+    # the same zero; a negative Im beyond round-off is still the caller's inverted channel.
+    from pidcore.signal.power import _check_reactive_power_resolved
+
+    for imag in (-6.36e-35, 0.0, 1e-19):
+        with pytest.raises(SignalError, match=r"within 1e-08 x \|P_c\| of zero \(round-off\)"
+                                              r".*no stored kinetic energy"):
+            _check_reactive_power_resolved(complex(1.8, imag), None, source="damper.csv")
+    assert _check_reactive_power_resolved(complex(1.8, -0.5), None, source="x") is None
+    assert _check_reactive_power_resolved(complex(0.02, 0.98), None, source="x") is None
