@@ -639,9 +639,14 @@ CALIBRATED_SUFFIX = "_calibrated"
 
 
 def uncalibrated_name(name: str) -> str:
-    """The name of the specimen a calibrated one was made from ("x_calibrated" -> "x"); other
-    names unchanged."""
-    return name.removesuffix(CALIBRATED_SUFFIX)
+    """The name of the specimen a calibrated one was made from ("x_calibrated" -> "x", and
+    "x_calibrated_calibrated", a calibrated file calibrated again, -> "x"); other names
+    unchanged."""
+    # one suffix removed made a recalibrated file "x_calibrated"'s, and the tests of x were
+    # refused as another specimen's
+    while name.endswith(CALIBRATED_SUFFIX):
+        name = name.removesuffix(CALIBRATED_SUFFIX)
+    return name
 
 
 # --- schema ---------------------------------------------------------------------------------

@@ -143,6 +143,41 @@ def test_bound_notes_flag_a_posterior_piled_against_a_prior_bound():
     assert "lower bound 0.02" in bound_notes([tau], low)[0]
 
 
+def test_unconstrained_notes_flag_a_parameter_the_data_leave_at_its_prior():
+    # a trial calibration (own alumina specimen, flying beds at 2-10 g) returned rolling
+    # friction 0.0495 (95 % 0.0024 .. 0.0974) under its 0 .. 0.1 prior, which is the prior
+    # itself, and wrote 0.0495 into the calibrated specimen without a word
+    from pidcore.calibrate.parameters import DISCREPANCY, parameter_spec
+    from pidcore.calibrate.posterior import bound_notes, unconstrained_notes
+
+    rng = np.random.default_rng(3)
+    mu_r = parameter_spec("rolling_friction")
+    assert (mu_r.low, mu_r.high) == (0.0, 0.1)
+    prior_like = rng.uniform(0.0, 0.1, (4000, 1))
+    (note,) = unconstrained_notes([mu_r], prior_like)
+    assert note.startswith("rolling_friction: the data hardly constrain it")
+    assert "0 .. 0.1" in note and "calibrated specimen" in note
+    assert bound_notes([mu_r], prior_like) == []  # the bound notes said nothing of it
+    # constrained to half its prior's width: data, not prior (the trial's baseline: 0.59)
+    assert unconstrained_notes([mu_r], rng.uniform(0.02, 0.07, (4000, 1))) == []
+    # a log-uniform prior is judged in log: flat in log over 0.02 .. 2 is the prior, while
+    # 0.02 .. 0.2 taken linearly is only 9 % of the range but half of it in log
+    tau = parameter_spec(DISCREPANCY)
+    flat_log = np.exp(rng.uniform(math.log(0.02), math.log(2.0), (4000, 1)))
+    assert len(unconstrained_notes([tau], flat_log)) == 1
+    half_log = np.exp(rng.uniform(math.log(0.02), math.log(0.2), (4000, 1)))
+    assert unconstrained_notes([tau], half_log) == []
+    # a truncated normal prior is compared with its own 95 % interval, not its bounds: the
+    # prior N(0.1, 0.02) on 0 .. 1 kg drawn back is unconstrained though it spans 8 % of them
+    from dataclasses import replace
+
+    fixture = replace(parameter_spec("fixture_mass_kg"), prior="normal", prior_mean=0.1,
+                      prior_sd=0.02)
+    drawn = rng.normal(0.1, 0.02, (4000, 1))
+    assert len(unconstrained_notes([fixture], drawn)) == 1
+    assert unconstrained_notes([fixture], rng.normal(0.1, 0.005, (4000, 1))) == []
+
+
 def test_bound_notes_spare_a_narrow_posterior_inside_the_prior_edge():
     # a 35 g fixture under the 0-1 kg prior: the data pin it to 20-54 g (95 %), all of it in
     # the prior's lowest 5 %, and the note said the median was "set by the prior, not the

@@ -207,6 +207,36 @@ def test_rows_of_another_specimen_are_refused(capsys, tmp_path):
         base_specimen(stored, specimen)
 
 
+def test_a_calibrated_file_calibrated_again_is_still_of_the_specimen_tested(tmp_path):
+    # trial 14h: calibrating alumina_6mm_trial_calibrated.toml again wrote
+    # alumina_6mm_trial_calibrated_calibrated, and calibrating that one refused the tests of
+    # alumina_6mm_trial ("--data rows name specimen 'alumina_6mm_trial', not '..._calibrated_
+    # calibrated'"; --store: "no measurement of specimen ..."): one suffix was taken off
+    from pidcore.calibrate.data import points_for_specimen
+    from pidcore.calibrate.parameters import parameter_spec
+    from pidcore.specimen import uncalibrated_name
+
+    assert uncalibrated_name("my_coupon_calibrated_calibrated") == "my_coupon"
+    assert uncalibrated_name("my_coupon") == "my_coupon"
+    mine = dataclasses.replace(paper_specimen(), name="my_coupon")
+    tested = [MeasuredPoint(500, 5, 50, 0.6, specimen="my_coupon"),
+              MeasuredPoint(1000, 5, 50, 0.6, specimen="my_coupon_calibrated")]
+    twice = dataclasses.replace(mine, name="my_coupon_calibrated_calibrated")  # an old file's
+    assert base_specimen(tested, twice) is twice
+    assert points_for_specimen(tested, twice) == (tested, "")
+    # calibrating a calibrated file names the result after the specimen tested, once
+    once = dataclasses.replace(mine, name="my_coupon_calibrated")
+    specs = [parameter_spec("fixture_mass_kg", once)]
+    result = CalibrationResult(
+        specimen=once, specs=specs, samples=np.zeros((1, 1)),
+        parameters={"fixture_mass_kg": {"median": 0.05, "low95": 0.04, "high95": 0.06}},
+        correlations=[], predictions=[], loo=None, fixed={"baseline_loss_factor": 0.0},
+        design=np.zeros((1, 0)), observations=[], runs={}, settings={})
+    calibrated = result.calibrated_specimen()
+    assert calibrated.name == "my_coupon_calibrated"
+    assert calibrated.coupon.fixture_mass_kg == 0.05
+
+
 def test_loo_says_it_needs_one_case_more_than_parameters(capsys, tmp_path):
     # 3 cases given, 3 fitted quantities: it said "2 measured load case(s) ... give at least
     # 3 load cases" although 3 were given

@@ -185,3 +185,39 @@ def test_a_test_of_another_acrylic_specimen_gets_no_paper_table3_columns(store_r
     assert "not the paper's coupon" in mine["note"]
     paper = _measured(table, "paper.h5")  # Table 3 values, transcribed in paper_table3.csv
     assert (paper["SDC DEM (paper) [-]"], paper["SDC measured (paper) [-]"]) == (0.5612, 0.63)
+
+
+def test_a_test_of_a_specimen_meets_the_runs_of_its_calibrated_file(steel):
+    """Trial 14h: measurements named alumina_6mm_trial, a calibration from them, and DEM runs
+    of the calibrated file (alumina_6mm_trial_calibrated) at the tested load cases: `report
+    --specimen alumina_6mm_trial_calibrated.toml` put every test on a no_dem_runs row of its
+    own ("another specimen's: not compared with a test of alumina_6mm_trial") beside the DEM
+    row of its own load case, while the calibration's band was compared with it."""
+    import dataclasses
+
+    calibrated = dataclasses.replace(
+        steel.with_values({"coupon.fixture_mass_kg": 0.05}), name="steel_6mm_calibrated")
+    runs = pd.DataFrame([_run("c1", "steel", 1.75, calibrated)])
+    tests = pd.DataFrame({
+        "frequency_hz": [1000.0], "acceleration_g": [5.0], "fill_percent": [50.0],
+        "material": ["steel"], "direction": ["z"], "sdc": [1.7], "sdc_stderr": [0.05],
+        "source": ["steel.h5"], "specimen": ["steel_6mm"]})
+    table = specimen_report_table(runs, tests, specimen=calibrated).table
+    assert len(table) == 1  # the test's row is the DEM row of its load case
+    row = _measured(table, "steel.h5")
+    assert row[ALIGNMENT_COLUMN] == "grid"
+    assert row["SDC DEM (ours) [-]"] == pytest.approx(1.75)  # the calibrated file's run
+    assert row["specimen"] == "steel_6mm"  # the specimen tested, and the note names the runs'
+    assert (f"a test of steel_6mm compared with the DEM runs of steel_6mm_calibrated "
+            f"[{calibrated.hash[:6]}], the file pidcore calibrate made from it") in row["note"]
+    # the file's own runs, where the store holds them, are still the ones a test of it meets
+    both = pd.concat([runs, pd.DataFrame([_run("s1", "steel", 1.60, steel)])])
+    table = specimen_report_table(both, tests, specimen=steel).table
+    row = _measured(table, "steel.h5")
+    assert row["SDC DEM (ours) [-]"] == pytest.approx(1.60)
+    assert "calibrate made from it" not in str(row["note"])
+    # another specimen's calibrated file is not this one's
+    other = tests.assign(specimen=["steel_6mm_b"])
+    row = _measured(specimen_report_table(runs, other, specimen=calibrated).table, "steel.h5")
+    assert row[ALIGNMENT_COLUMN] == "no_dem_runs"
+

@@ -41,6 +41,7 @@ from .posterior import (
     sample_posterior,
     summarise,
     summary_texts,
+    unconstrained_notes,
 )
 from .runner import RunRequest, run_requests, specimen_with
 from .surrogate import build_surrogate, default_design_size, design_points
@@ -111,7 +112,8 @@ class CalibrationResult:
             "{} {} (95 % {} .. {})".format(s.name, *summary_texts(self.parameters[s.name]))
             for s in self.specs if s.kind != "hyper")
         return dataclasses.replace(
-            out, name=f"{self.specimen.name}{CALIBRATED_SUFFIX}",
+            # a calibrated file calibrated again is still x_calibrated, not x_calibrated_calibrated
+            out, name=f"{uncalibrated_name(self.specimen.name)}{CALIBRATED_SUFFIX}",
             description=f"{self.specimen.description} -- calibrated by pidcore calibrate: "
                         f"{fitted} (these replace any value stated above)".strip(" -"))
 
@@ -394,6 +396,7 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: str | Sequence[str],
     fold_fallbacks = []
     parameters, correlations = summarise(specs, samples)
     notes += bound_notes(specs, samples)
+    notes += unconstrained_notes(specs, samples)
     rng = np.random.default_rng(posterior_seed + 1)
     predictions = [_row(points[i], predictive(model, samples, i, rng=rng)) for i in everything]
     energy = energy_check(model, samples, specimen)

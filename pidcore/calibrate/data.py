@@ -200,13 +200,14 @@ def points_for_specimen(points: Sequence[MeasuredPoint], specimen) -> tuple[list
 
     material = specimen.particles.material
     # a calibrated file (as pidcore calibrate names it) is the specimen its measurements
-    # were made on
-    names = {"", specimen.name, uncalibrated_name(specimen.name)}
+    # were made on, as base_specimen reads a point's name: "x", "x_calibrated" and an older
+    # "x_calibrated_calibrated" are all x
+    tested = uncalibrated_name(specimen.name)
     kept, other_material, other_specimen = [], {}, {}
     for p in points:
         if str(p.material) != material:
             other_material[str(p.material)] = other_material.get(str(p.material), 0) + 1
-        elif str(p.specimen) not in names:
+        elif str(p.specimen) and uncalibrated_name(str(p.specimen)) != tested:
             other_specimen[str(p.specimen)] = other_specimen.get(str(p.specimen), 0) + 1
         else:
             kept.append(p)

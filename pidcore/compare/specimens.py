@@ -7,6 +7,8 @@ direction when they all come from one specimen, the paper's coupon's among sever
 default of ``pidcore report``: a calibration's store holds its design runs, files named
 ``paper_coupon`` with other values, beside the coupon's own), and none when they come from
 several others (they are not pooled: which specimen was tested is the user's to say). A
+measurement named ``x`` with no run of that name meets the runs of ``x_calibrated``, the
+file ``pidcore calibrate`` wrote from it (a model of the specimen tested). A
 measurement named ``paper_coupon`` meets the paper's coupon's runs, not another file of that
 name. Runs stored before specimens
 existed (no hash) and runs of the paper's coupon with either table material are the paper's
@@ -37,12 +39,16 @@ class SpecimenRuns:
         the user to name the specimen.
     refused : bool
         True where the runs of several specimens would have been pooled: none is met.
+    calibrated_from : str
+        The measurement's specimen ``x`` where the runs met are those of ``x_calibrated`` (no
+        run of ``x`` itself); "" otherwise.
     """
 
     runs: pd.DataFrame | None
     specimen: str = ""
     note: str = ""
     refused: bool = False
+    calibrated_from: str = ""
 
 
 def specimen_label(name: str, sha256: str) -> str:
@@ -120,7 +126,18 @@ def runs_for_measurement(runs: pd.DataFrame | None, specimen: str, material: str
         # are named paper_coupon too, and were pooled with it or refused it
         return _paper_runs(same, labels, paper)
     if specimen:
-        mine = (_names(same, labels) == specimen).to_numpy(bool)
+        names = _names(same, labels)
+        mine = (names == specimen).to_numpy(bool)
+        calibrated_from = ""
+        if not mine.any():
+            # a file `pidcore calibrate` wrote from this specimen ("x_calibrated") models the
+            # specimen tested, as its calibration's bands speak for the tests of "x": a test of
+            # x met no run of `report --specimen x_calibrated.toml` (no_dem_runs on every row)
+            from ..specimen import CALIBRATED_SUFFIX, uncalibrated_name
+
+            mine = names.map(lambda n: n.endswith(CALIBRATED_SUFFIX)
+                             and uncalibrated_name(n) == specimen).to_numpy(bool)
+            calibrated_from = specimen if mine.any() else ""
         kept, others = labels[mine], labels[~mine]
         left_out = (f"DEM runs of other specimens not compared: {_listed(others)}"
                     if len(others) else "")
@@ -132,7 +149,8 @@ def runs_for_measurement(runs: pd.DataFrame | None, specimen: str, material: str
                                           f"files named {specimen}: {_listed(kept)}; not pooled "
                                           "(keep one version's runs, or rename the other)",
                                 refused=True)
-        return SpecimenRuns(same[mine].reset_index(drop=True), str(kept.iloc[0]), left_out)
+        return SpecimenRuns(same[mine].reset_index(drop=True), str(kept.iloc[0]), left_out,
+                            calibrated_from=calibrated_from)
     if labels.nunique() > 1 and paper.any():
         # as `pidcore report` and the Report tab: the paper's coupon unless another is named
         return _paper_runs(same, labels, paper)

@@ -256,24 +256,29 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
             _Row(dem.load_case, "grid", dem, dem.sdc, dem.sdc_stderr, paper_dem, paper_exp))
     # a measurement meets only the DEM runs of its specimen (pidcore.compare.specimens); one
     # aligner per (specimen, material, direction) over those runs
-    aligners: dict[tuple[str, str, str], tuple[Aligner, str, bool]] = {}
+    aligners: dict[tuple[str, str, str], tuple[Aligner, str, bool, str]] = {}
     for case, rec in measured_rows:
         # a store's listing holds NaN where a record names no specimen and another does
         # (str(NaN) is "nan", a specimen of its own meeting no DEM run)
         named = rec.get("specimen", "")
         specimen = "" if pool or not isinstance(named, str) else named
-        met_note, refused = "", False
+        met_note, refused, met_calibrated = "", False, ""
         if pool or dem_runs is None or dem_runs.empty:
             own = aligner
         else:
             which = (specimen, case.material, case.direction)
             if which not in aligners:
                 met = runs_for_measurement(dem_runs, *which)
+                # the row's specimen column names the test's specimen: say whose runs it met
+                calibrated = (f"a test of {met.calibrated_from} compared with the DEM runs of "
+                              f"{met.specimen}, the file pidcore calibrate made from it"
+                              if met.calibrated_from else "")
                 aligners[which] = (Aligner.from_tables(met.runs, paper, model=model,
                                                        tolerances=tolerances,
                                                        reference_fills=fills),
-                                   met.note if met.runs is None else "", met.refused)
-            own, met_note, refused = aligners[which]
+                                   met.note if met.runs is None else "", met.refused,
+                                   calibrated)
+            own, met_note, refused, met_calibrated = aligners[which]
         aligned = own.align(case)
         if aligned.status == "no_dem_runs" and not refused:
             # name whose runs are missing and whose the store holds there instead: another
@@ -321,6 +326,9 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
             group.append(row)
         row.specimen = specimen
         row.measured.append(entry)
+        if met_calibrated and aligned.status in ("grid", "interpolated") \
+                and met_calibrated not in row.notes:
+            row.notes.append(met_calibrated)
 
     records = []
     unconverged_rows: list[str] = []
