@@ -677,3 +677,31 @@ def test_the_html_summary_carries_the_notes_of_the_markdown_one():
     page = summary_html(SimpleNamespace(parameters={}, predictions=[], loo=None, notes=notes))
     for note in notes:
         assert f"<li>{html.escape(note)}</li>" in page
+
+
+def test_an_emcee_posterior_that_did_not_converge_is_flagged(tiny_store, tmp_path, monkeypatch):
+    # emcee's chains were never checked: a posterior, and leave-one-out folds, from chains
+    # too short for their autocorrelation were reported as results. Now the notes, the
+    # settings and the summary say so (a rule no chain can meet forces the case)
+    from pidcore.calibrate import posterior
+    from pidcore.calibrate.data import read_measured_table
+    from pidcore.calibrate.outputs import summary_markdown
+
+    points = read_measured_table(_table(tmp_path))
+    settings = {"fit": ["fixture_mass_kg"], "discrepancy": 0.2, "store_path": tiny_store,
+                "cells": 2, "steady_cycles": 10, "workers": 1, "progress": False,
+                "cross_validate": "loo", "method": "emcee"}
+    converged = calibrate(points, **settings)
+    assert converged.settings["sampler"]["converged"] is True
+    assert not any("NOT CONVERGED" in note for note in converged.notes)
+    assert ", converged)" in summary_markdown(converged)
+    monkeypatch.setattr(posterior, "EMCEE_TAU_LENGTHS", 10**9)
+    monkeypatch.setattr(posterior, "EMCEE_MAX_STEPS", 2000)
+    flagged = calibrate(points, **settings)
+    notes = " ".join(flagged.notes)
+    assert "NOT CONVERGED: the emcee posterior did not converge within 2000 steps" in notes
+    assert "the medians, intervals and bands are not reliable" in notes
+    assert "NOT CONVERGED: the emcee chains of 3 of 3 leave-one-out fold(s)" in notes
+    sampler = flagged.settings["sampler"]
+    assert sampler["converged"] is False and sampler["steps"] == 2000
+    assert "NOT converged)" in summary_markdown(flagged)

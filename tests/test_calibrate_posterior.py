@@ -240,3 +240,56 @@ def test_a_reported_bound_is_shown_to_the_digits_its_sampling_leaves():
         # the last digit shown is the one the standard error reaches, not further
         assert 10.0 ** -decimals >= s[f"{key}_mc_se"] / 10
         assert float(text) == pytest.approx(s[key], abs=10.0 ** -decimals)
+
+
+def test_an_emcee_chain_shorter_than_emcee_asks_is_flagged_not_passed():
+    # emcee ran a fixed 2000 steps whatever the posterior and said nothing: with 4 fitted
+    # quantities that was 18 autocorrelation times, an effective sample of 580 draws behind
+    # the 4000 samples. A chain under emcee's rule must say so; the default run extends its
+    # chain until the rule holds
+    from pidcore.calibrate.posterior import EMCEE_TAU_LENGTHS, sample_emcee
+
+    model, mean, cov, _ = linear_problem([0.4, 0.02], 0.01, seed=1)
+    _, short = sample_emcee(model, range(8), rng=np.random.default_rng(3), n_steps=150,
+                            burn=50, max_steps=150)
+    assert not short.converged and "autocorrelation times" in short.reason
+    assert short.steps - short.discarded < EMCEE_TAU_LENGTHS * max(short.autocorrelation_steps)
+    drawn = sample_posterior(model, range(8), seed=3, method="emcee")
+    d = drawn.diagnostics
+    assert drawn.converged and d.reason is None
+    kept = d.steps - d.discarded
+    assert kept >= EMCEE_TAU_LENGTHS * max(d.autocorrelation_steps)
+    assert d.effective_size == pytest.approx(d.walkers * kept / max(d.autocorrelation_steps))
+    # the stretch move on a 2-d Gaussian accepts about half its proposals: far from stuck
+    assert 0.2 < d.acceptance < 0.8
+    # the grid is an exact quadrature: no chain to judge
+    assert sample_posterior(model, range(8), seed=3, method="grid").diagnostics is None
+
+
+def test_the_monte_carlo_error_of_chain_samples_counts_the_chains_effective_draws():
+    # emcee's samples are 4000 picked from a correlated chain; the batch-means error saw them
+    # as 4000 independent draws and shrank the error (and the digits shown) by
+    # sqrt(1 + n / effective size). An AR(1) chain has a known autocorrelation time
+    # (1 + rho) / (1 - rho): the error given its effective size must match the scatter of the
+    # median over many chains
+    from scipy.signal import lfilter
+
+    from pidcore.calibrate.posterior import quantile_mc_stderr
+
+    rng = np.random.default_rng(11)
+    rho, length, n = 0.9, 40_000, 4000
+    tau = (1 + rho) / (1 - rho)
+    medians, errors, iid = [], [], []
+    for _ in range(200):
+        # started from the stationary law (unit variance): no burn-in
+        chain = lfilter([math.sqrt(1 - rho**2)], [1, -rho], rng.standard_normal(length),
+                        zi=[rho * rng.standard_normal()])[0]
+        picked = rng.choice(chain, size=n, replace=False)
+        medians.append(np.median(picked))
+        errors.append(quantile_mc_stderr(picked, [50], effective_size=length / tau)[0])
+        iid.append(quantile_mc_stderr(picked, [50])[0])
+    scatter = np.std(medians, ddof=1)
+    # 200 chains: the scatter is known to 5 %, the mean batch-means error to ~2 %; the
+    # formula leaves out the picking's finite-population term (-n/length: 3 % of the variance)
+    assert np.mean(errors) == pytest.approx(scatter, rel=0.15)
+    assert np.mean(iid) < 0.7 * scatter  # the old error: 1.7x too small here

@@ -36,6 +36,7 @@ from .parameters import (
 from .posterior import (
     DISCREPANCY_FLOOR,
     Model,
+    SamplerDiagnostics,
     bound_notes,
     predictive,
     sample_posterior,
@@ -393,9 +394,13 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: str | Sequence[str],
     if posterior.fallback:
         notes.append(f"method={method}: {posterior.fallback}; the posterior was sampled "
                      "with emcee instead of the grid")
+    if not posterior.converged:
+        notes.append(_not_converged_note(posterior.diagnostics))
     fold_fallbacks = []
-    parameters, correlations = summarise(specs, samples)
-    notes += bound_notes(specs, samples)
+    fold_unconverged: list[str] = []
+    parameters, correlations = summarise(specs, samples,
+                                         effective_size=posterior.effective_size)
+    notes += bound_notes(specs, samples, effective_size=posterior.effective_size)
     notes += unconstrained_notes(specs, samples)
     rng = np.random.default_rng(posterior_seed + 1)
     predictions = [_row(points[i], predictive(model, samples, i, rng=rng)) for i in everything]
@@ -416,6 +421,8 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: str | Sequence[str],
                                         method=method)
                 if fold.fallback:
                     fold_fallbacks.append(points[i].label())
+                if not fold.converged:
+                    fold_unconverged.append(points[i].label())
                 loo.append(_row(points[i], predictive(model, fold.samples, i, rng=rng)))
                 if bar is not None:
                     bar.update(1)
@@ -426,16 +433,31 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: str | Sequence[str],
         notes.append(f"method={method}: the grid could not box the posterior of "
                      f"{len(fold_fallbacks)} of {len(everything)} leave-one-out fold(s) "
                      f"(without {', '.join(fold_fallbacks)}); those were sampled with emcee")
+    if fold_unconverged:
+        notes.append(f"NOT CONVERGED: the emcee chains of {len(fold_unconverged)} of "
+                     f"{len(everything)} leave-one-out fold(s) (without "
+                     f"{', '.join(fold_unconverged)}) did not converge (emcee's rule: a chain "
+                     "of 50 autocorrelation times): their predictions, and the leave-one-out "
+                     "RMS and coverage, are not reliable")
     settings = {"fit": list(fit), "priors": list(priors), "cells": cells, "seed": seed,
                 "steady_cycles": steady_cycles, "design_size": n_design, "method": method,
                 "method_used": posterior.method,
                 "discrepancy_fixed": discrepancy, "discrepancy_floor": discrepancy_floor,
                 "cross_validate": cross_validate, "store": str(store_path)}
+    if posterior.diagnostics is not None:  # emcee's: acceptance, autocorrelation, sample size
+        settings["sampler"] = posterior.diagnostics.to_dict()
     return CalibrationResult(specimen=specimen, specs=specs, samples=samples, parameters=parameters,
                              correlations=correlations, predictions=predictions, loo=loo,
                              fixed=fixed, design=design, observations=observations, runs=runs,
                              settings=settings, notes=notes, energy_check=energy,
                              wall_s=time.perf_counter() - start)
+
+
+def _not_converged_note(diagnostics: SamplerDiagnostics) -> str:
+    return (f"NOT CONVERGED: the emcee posterior did not converge within {diagnostics.steps} "
+            f"steps ({diagnostics.reason}; effective sample {diagnostics.effective_size:.0f}): "
+            "the medians, intervals and bands are not reliable; fit fewer parameters, narrow "
+            "the priors, or use method=grid (at most 4 fitted quantities)")
 
 
 #: Relative change of the energy per cycle below the DEM's resolution (:func:`energy_check`).

@@ -67,6 +67,18 @@ _HEAD = ["f [Hz]", "a [g]", "fill [%]", "measured SDC [-]", "predicted SDC [-]",
          "95 % band [-]", "error [-]", "inside [yes/no]"]
 
 
+def _sampler_words(result: CalibrationResult) -> str:
+    """emcee's convergence figures, as the summary states them (nothing for the grid)."""
+    sampler = result.settings.get("sampler")
+    if not sampler:
+        return ""
+    return (f" ({sampler['steps']} steps x {sampler['walkers']} walkers, acceptance "
+            f"{sampler['acceptance']:.2f}, autocorrelation time "
+            f"{max(sampler['autocorrelation_steps']):.0f} steps, effective sample "
+            f"{sampler['effective_size']:.0f}, "
+            f"{'converged' if sampler['converged'] else 'NOT converged'})")
+
+
 def summary_markdown(result: CalibrationResult) -> str:
     """Markdown summary: parameters, correlations, predictions, LOO table."""
     lines = ["# Calibration summary", ""]
@@ -74,7 +86,7 @@ def summary_markdown(result: CalibrationResult) -> str:
                  f"{len(result.predictions)} measured load cases; "
                  f"{result.settings['cells']} cells per DEM run, design of "
                  f"{result.settings['design_size']} point(s); "
-                 f"posterior by {result.settings['method_used']}; "
+                 f"posterior by {result.settings['method_used']}{_sampler_words(result)}; "
                  f"runs computed {result.runs['computed']}, cached {result.runs['cached']}; "
                  f"{result.wall_s:.1f} s.")
     lines += ["", "| parameter | median | 95 % interval | prior bounds |", "|---|---|---|---|"]

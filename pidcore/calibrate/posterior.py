@@ -15,6 +15,7 @@ with emcee. Either way the result is a set of equally weighted samples.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -195,14 +196,82 @@ def sample_grid(model: Model, indices: Sequence[int], *, rng: np.random.Generato
     return out
 
 
+#: emcee's own convergence rule (its documentation, "Autocorrelation analysis"): the chain
+#: after burn-in at least EMCEE_TAU_LENGTHS integrated autocorrelation times long, else the
+#: estimate of the autocorrelation time itself, and the effective sample size from it, cannot
+#: be trusted. The burn-in is at least EMCEE_BURN_TAUS of them. The chain is extended in
+#: blocks of the first run's length up to EMCEE_MAX_STEPS; a mean acceptance below
+#: EMCEE_MIN_ACCEPTANCE means stuck walkers whatever the chain length.
+EMCEE_TAU_LENGTHS = 50
+EMCEE_BURN_TAUS = 5
+EMCEE_MAX_STEPS = 20000
+EMCEE_MIN_ACCEPTANCE = 0.1
+
+
+@dataclass(frozen=True)
+class SamplerDiagnostics:
+    """How far to trust a set of emcee samples: mean ``acceptance`` fraction of the walkers,
+    integrated autocorrelation time ``autocorrelation_steps`` per parameter (steps), the
+    ``steps`` run and ``discarded`` as burn-in, ``walkers``, the ``effective_size`` of the
+    kept chain (walkers x kept steps / the longest autocorrelation time), ``converged``
+    (emcee's rule, see EMCEE_TAU_LENGTHS) and, where not, ``reason``."""
+
+    acceptance: float
+    autocorrelation_steps: tuple[float, ...]
+    steps: int
+    discarded: int
+    walkers: int
+    effective_size: float
+    converged: bool
+    reason: str | None = None
+
+    def to_dict(self) -> dict:
+        return dataclasses.asdict(self) | {
+            "autocorrelation_steps": list(self.autocorrelation_steps)}
+
+
+def _emcee_diagnostics(sampler, burn: int, names: Sequence[str]) -> SamplerDiagnostics:
+    steps = sampler.iteration
+    # tol=0: an estimate even where the chain is too short for it (then judged below)
+    tau = np.asarray(sampler.get_autocorr_time(discard=burn, quiet=True, tol=0), dtype=float)
+    tau_max = float(np.max(tau)) if np.all(np.isfinite(tau)) else math.inf
+    discarded = max(burn, int(math.ceil(EMCEE_BURN_TAUS * tau_max))) \
+        if math.isfinite(tau_max) else burn
+    discarded = min(discarded, steps - 1)
+    kept = steps - discarded
+    walkers = sampler.nwalkers
+    acceptance = float(np.mean(sampler.acceptance_fraction))
+    effective = walkers * kept / tau_max if tau_max > 0 else 0.0
+    reason = None
+    if acceptance < EMCEE_MIN_ACCEPTANCE:
+        reason = (f"mean acceptance {acceptance:.3f} of the walkers (below "
+                  f"{EMCEE_MIN_ACCEPTANCE}: walkers stuck)")
+    elif not kept >= EMCEE_TAU_LENGTHS * tau_max:
+        slowest = names[int(np.nanargmax(tau))] if np.any(np.isfinite(tau)) else "?"
+        reason = (f"chain of {kept} steps after burn-in is {kept / tau_max:.0f} "
+                  f"autocorrelation times ({tau_max:.0f} steps, {slowest}), under the "
+                  f"{EMCEE_TAU_LENGTHS} emcee requires")
+    return SamplerDiagnostics(acceptance, tuple(float(t) for t in tau), steps, discarded,
+                              walkers, float(effective), reason is None, reason)
+
+
 def sample_emcee(model: Model, indices: Sequence[int], *, rng: np.random.Generator,
-                 n_samples: int = N_SAMPLES, n_steps: int = 2000,
-                 burn: int = 500) -> np.ndarray:
-    """Equally weighted posterior samples by emcee (affine-invariant ensemble, vectorised)."""
+                 n_samples: int = N_SAMPLES, n_steps: int = 2000, burn: int = 500,
+                 max_steps: int | None = None) -> tuple[np.ndarray, SamplerDiagnostics]:
+    """Equally weighted posterior samples by emcee (affine-invariant ensemble, vectorised),
+    and their :class:`SamplerDiagnostics`.
+
+    The chain runs ``n_steps``, then further blocks of ``n_steps`` while it is shorter than
+    emcee's convergence rule asks, up to ``max_steps`` (default EMCEE_MAX_STEPS); a chain that
+    still fails it is returned with ``converged=False`` for the caller to flag: 2000 steps
+    were taken as enough whatever the posterior (4 fitted quantities: 18 autocorrelation
+    times, the effective sample 580 draws behind 4000 samples, and nothing said).
+    """
     import emcee
 
     k = len(model.specs)
     walkers = max(32, 4 * k)
+    max_steps = EMCEE_MAX_STEPS if max_steps is None else max_steps
 
     def log_prob(u: np.ndarray) -> np.ndarray:
         values = np.empty_like(u)
@@ -217,24 +286,42 @@ def sample_emcee(model: Model, indices: Sequence[int], *, rng: np.random.Generat
     start = rng.random((walkers, k))
     sampler = emcee.EnsembleSampler(walkers, k, log_prob, vectorize=True)
     sampler.random_state = np.random.RandomState(int(rng.integers(2**31))).get_state()
+    names = [s.name for s in model.specs]
     sampler.run_mcmc(start, n_steps, progress=False)
-    chain = sampler.get_chain(discard=burn, flat=True)
+    diagnostics = _emcee_diagnostics(sampler, burn, names)
+    while not diagnostics.converged and sampler.iteration + n_steps <= max_steps \
+            and diagnostics.acceptance >= EMCEE_MIN_ACCEPTANCE:
+        sampler.run_mcmc(None, n_steps, progress=False)
+        diagnostics = _emcee_diagnostics(sampler, burn, names)
+    chain = sampler.get_chain(discard=diagnostics.discarded, flat=True)
     pick = rng.choice(len(chain), size=n_samples, replace=len(chain) < n_samples)
     u = chain[pick]
     out = np.empty_like(u)
     for j, spec in enumerate(model.specs):
         out[:, j] = _from_unit(spec, u[:, j])[0]
-    return out
+    return out, diagnostics
 
 
 class PosteriorSamples(NamedTuple):
     """Result of :func:`sample_posterior`: equally weighted ``samples`` (n_samples, n_specs),
-    the ``method`` that drew them (``"grid"`` or ``"emcee"``) and, where ``auto`` fell back
-    from the grid to emcee, ``fallback``: why (else None)."""
+    the ``method`` that drew them (``"grid"`` or ``"emcee"``), where ``auto`` fell back
+    from the grid to emcee, ``fallback``: why (else None), and for emcee the sampler's
+    ``diagnostics`` (None for the grid: an exact quadrature, whose settling is checked by
+    :func:`sample_grid` itself)."""
 
     samples: np.ndarray
     method: str
     fallback: str | None = None
+    diagnostics: SamplerDiagnostics | None = None
+
+    @property
+    def converged(self) -> bool:
+        return self.diagnostics is None or self.diagnostics.converged
+
+    @property
+    def effective_size(self) -> float | None:
+        """Effective number of independent draws behind the samples (None: they are)."""
+        return None if self.diagnostics is None else self.diagnostics.effective_size
 
 
 def sample_posterior(model: Model, indices: Sequence[int], *, seed: int = 0,
@@ -263,8 +350,8 @@ def sample_posterior(model: Model, indices: Sequence[int], *, seed: int = 0,
         return PosteriorSamples(sample_grid(model, indices, rng=rng, n_samples=n_samples),
                                 "grid")
     if method == "emcee":
-        return PosteriorSamples(sample_emcee(model, indices, rng=rng, n_samples=n_samples),
-                                "emcee", fallback)
+        samples, diagnostics = sample_emcee(model, indices, rng=rng, n_samples=n_samples)
+        return PosteriorSamples(samples, "emcee", fallback, diagnostics)
     raise ParameterError(f"method: expected auto, grid or emcee, got {method!r}")
 
 
@@ -300,27 +387,38 @@ def predictive(model: Model, samples: np.ndarray, index: int, *,
 MC_BATCHES = 10
 
 
-def quantile_mc_stderr(x: np.ndarray, q: Sequence[float],
-                       batches: int = MC_BATCHES) -> np.ndarray:
+def quantile_mc_stderr(x: np.ndarray, q: Sequence[float], batches: int = MC_BATCHES, *,
+                       effective_size: float | None = None) -> np.ndarray:
     """Monte-Carlo standard error of the percentiles ``q`` of the samples ``x``: the scatter
     of each percentile over ``batches`` equal batches, / sqrt(batches) (the batch-means
     estimate; the samples are in random order). What a reported bound would move by with
-    another set of samples: its digits beyond that are noise."""
+    another set of samples: its digits beyond that are noise.
+
+    ``effective_size``: the independent draws behind samples picked from a Markov chain
+    (:attr:`PosteriorSamples.effective_size`). The batches see the picked samples as
+    independent, but they repeat the chain's ``effective_size`` draws: the error is then
+    sqrt(1 + n / effective_size) times larger (the chain's error plus the picking's)."""
     n = len(x) // batches
     if n < 2:
         return np.full(len(q), np.nan)
     per_batch = np.percentile(np.reshape(x[:n * batches], (batches, n)), q, axis=1)
-    return np.std(per_batch, axis=1, ddof=1) / math.sqrt(batches)
+    error = np.std(per_batch, axis=1, ddof=1) / math.sqrt(batches)
+    if effective_size is not None:
+        error = error * math.sqrt(1.0 + len(x) / max(effective_size, 1.0))
+    return error
 
 
-def summarise(specs: Sequence[ParameterSpec], samples: np.ndarray) -> tuple[dict, list]:
+def summarise(specs: Sequence[ParameterSpec], samples: np.ndarray, *,
+              effective_size: float | None = None) -> tuple[dict, list]:
     """({name: median, low95, high95, mean, sd, and the Monte-Carlo standard errors
-    median_mc_se, low95_mc_se, high95_mc_se}, correlation matrix as nested lists)."""
+    median_mc_se, low95_mc_se, high95_mc_se}, correlation matrix as nested lists).
+    ``effective_size``: of a Markov chain's samples (:func:`quantile_mc_stderr`)."""
     out = {}
     for j, spec in enumerate(specs):
         x = samples[:, j]
         low, median, high = np.percentile(x, [2.5, 50, 97.5])
-        se_low, se_median, se_high = quantile_mc_stderr(x, [2.5, 50, 97.5])
+        se_low, se_median, se_high = quantile_mc_stderr(x, [2.5, 50, 97.5],
+                                                        effective_size=effective_size)
         out[spec.name] = {"median": float(median), "low95": float(low), "high95": float(high),
                           "mean": float(np.mean(x)), "sd": float(np.std(x)),
                           "median_mc_se": float(se_median), "low95_mc_se": float(se_low),
@@ -358,7 +456,8 @@ PILED_SHARE = 0.2
 OWN_WIDTH_SHARE = 0.25
 
 
-def bound_notes(specs: Sequence[ParameterSpec], samples: np.ndarray) -> list[str]:
+def bound_notes(specs: Sequence[ParameterSpec], samples: np.ndarray, *,
+                effective_size: float | None = None) -> list[str]:
     """A note for each parameter whose posterior piles against a finite prior bound.
 
     Its value is then set by the prior, not the data (the data ask for more, or less, than
@@ -376,7 +475,8 @@ def bound_notes(specs: Sequence[ParameterSpec], samples: np.ndarray) -> list[str
         # the median as the summary shows it (summary_texts): the note said 0.001285 beside
         # the table's 0.00128, digits the Monte-Carlo error does not hold
         median = display_with_uncertainty(float(np.median(x)),
-                                          float(quantile_mc_stderr(x, [50])[0]))
+                                          float(quantile_mc_stderr(
+                                              x, [50], effective_size=effective_size)[0]))
         u = _to_unit(spec, x)  # the prior's own scale: log for a log-uniform prior
         q_low, q_high = np.quantile(u, [0.025, 0.975])
         near = OWN_WIDTH_SHARE * float(q_high - q_low)
