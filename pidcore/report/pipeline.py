@@ -301,9 +301,10 @@ def _measured_loops(results: list[MeasuredResult], analyses: pd.DataFrame, store
     loops = []
     if store is None or analyses.empty or "key" not in analyses.columns:
         return loops
-    for _, row in analyses.iterrows():
+    # one opening of the store for all of them, not one per analysis
+    entries = store.get_analyses(str(key) for key in analyses["key"])
+    for (_, row), entry in zip(analyses.iterrows(), entries, strict=True):
         name = Path(str(row.get("source", "") or row["key"])).name
-        entry = store.get_analysis(str(row["key"]))
         found = loop_from_phasors(entry.arrays, row.get("frequency_hz"))
         if isinstance(found, str):
             notes.append(f"{name}: {found}; loop not drawn")
