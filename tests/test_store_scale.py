@@ -127,3 +127,14 @@ def test_verify_reports_its_progress_over_every_entry_and_finds_the_same(tmp_pat
     # the bar is drawn (tqdm throttles its redraws, so which counts show depends on timing;
     # the counts are the callback's, checked above)
     assert "verifying s.h5" in capsys.readouterr().err
+
+
+def test_the_store_benchmark_times_a_sound_store_of_the_size_asked(tmp_path):
+    """`pidcore bench store`: its figures are per entry of the store it built, so that store
+    must hold what was asked (colliding keys would silently make it smaller) and be sound."""
+    from pidcore.store.bench import run_store_bench
+
+    result = run_store_bench(30, n_measurements=7, n_dem_runs=4, directory=str(tmp_path))
+    assert (result["n_measurements"], result["n_analyses"], result["n_dem_runs"]) == (7, 30, 4)
+    assert result["verify_problems"] == 0
+    assert result["list_analyses_s_per_entry"] == pytest.approx(result["list_analyses_s"] / 30)
