@@ -457,19 +457,9 @@ class Store:
         every listing open another file on the machine; a soft link to nothing, a dataset
         where a group belongs, crashed every listing and every write)."""
         for section in _SECTIONS:
-            link = h5.get(section, getlink=True)
-            if link is None:
-                continue
-            parent = h5.get(section) if isinstance(link, h5py.HardLink) else None
-            if not isinstance(parent, h5py.Group):
-                raise self._unreadable(f"/{section} is {self._what(link, parent)}; expected "
-                                       "a group of entries")
-            for name in parent:
-                link = parent.get(name, getlink=True)
-                item = parent.get(name) if isinstance(link, h5py.HardLink) else None
-                if not isinstance(item, h5py.Group):
-                    raise self._unreadable(f"/{section}/{name} is {self._what(link, item)}; "
-                                           "expected an entry group in the store's own file")
+            parent = self._section(h5, section)
+            for name in () if parent is None else parent:
+                self._entry_of(parent, section, name)
 
     @staticmethod
     def _what(link: object, item: object) -> str:
@@ -496,8 +486,11 @@ class Store:
         """The entry group ``section/key`` (None where not stored), its link checked before
         it is followed, as :meth:`_check_sections` checks every entry."""
         parent = None if h5 is None else self._section(h5, section)
-        if parent is None:
-            return None
+        return None if parent is None else self._entry_of(parent, section, key)
+
+    def _entry_of(self, parent: h5py.Group, section: str, key: str) -> h5py.Group | None:
+        """The entry ``key`` of the section group ``parent`` (None where not stored), refused
+        where it is not a group of the store's own file."""
         link = parent.get(key, getlink=True)
         if link is None:
             return None
