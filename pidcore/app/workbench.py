@@ -47,9 +47,10 @@ def saved_entries(path: str | os.PathLike, rows: pd.DataFrame) -> list[MeasuredE
 
     if rows.empty:
         return []
-    store = Store(path)
-    return [MeasuredEntry.from_store(row, store.get_analysis(str(row["key"])).arrays)
-            for _, row in rows.iterrows()]
+    # one opening of the store for all of them, not one per row
+    stored = Store(path).get_analyses(str(key) for key in rows["key"])
+    return [MeasuredEntry.from_store(row, entry.arrays)
+            for (_, row), entry in zip(rows.iterrows(), stored, strict=True)]
 
 
 def group_entries(entries: Sequence[MeasuredEntry]) -> list[list[int]]:

@@ -18,6 +18,21 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help="timed repetitions (best is kept; default 3)")
     s.add_argument("--json", action="store_true", help="one JSON document on stdout")
     s.set_defaults(func=_bench_signal)
+    t = sub.add_parser("store", help="store listing, reads by key, batch reads and verify "
+                                     "on a store of years of tests",
+                       description="Builds a temporary store of many small entries (default "
+                                   "400 measurements, 2000 analyses, 300 DEM runs) and times "
+                                   "a listing, one read by key (whose cost must not grow with "
+                                   "the store), every analysis read through one opening, and "
+                                   "verify; per entry, against targets.")
+    t.add_argument("--analyses", type=positive_int, default=2000,
+                   help="analyses stored (default 2000)")
+    t.add_argument("--measurements", type=positive_int, default=400,
+                   help="measurements stored (default 400)")
+    t.add_argument("--dem-runs", type=positive_int, default=300,
+                   help="DEM runs stored (default 300)")
+    t.add_argument("--json", action="store_true", help="one JSON document on stdout")
+    t.set_defaults(func=_bench_store)
     d = sub.add_parser("dem", help="DEM particle-steps/s on one core and the Table 3 grid time",
                        description="Particle-steps per second on one core for standard beds: "
                                    "acrylic at capacity (22/cell) and 24 aluminium per cell, "
@@ -58,6 +73,14 @@ def _bench_signal(args: argparse.Namespace) -> int:
     from ..signal.bench import run_signal_bench
 
     _emit(run_signal_bench(args.samples, repeat=args.repeat), args.json)
+    return 0
+
+
+def _bench_store(args: argparse.Namespace) -> int:
+    from ..store.bench import run_store_bench
+
+    _emit(run_store_bench(args.analyses, n_measurements=args.measurements,
+                          n_dem_runs=args.dem_runs), args.json)
     return 0
 
 

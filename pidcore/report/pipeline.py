@@ -129,7 +129,8 @@ class ReportResult:
         return plot_sdc_comparison(self.table, ax=ax)
 
 
-def open_verified_store(path: str | Path, *, must_exist: bool) -> Store:
+def open_verified_store(path: str | Path, *, must_exist: bool,
+                        progress: bool = False) -> Store:
     """Open a store and verify it; a corrupt or partial store raises one-line StoreError.
 
     Parameters
@@ -139,6 +140,8 @@ def open_verified_store(path: str | Path, *, must_exist: bool) -> Store:
     must_exist : bool
         True for stores that are only read (a missing file is an error); False for a store that
         analyses will be added to (created on first write).
+    progress : bool
+        A bar over the store's entries on stderr while they are verified.
     """
     from ..store import Store
 
@@ -148,7 +151,18 @@ def open_verified_store(path: str | Path, *, must_exist: bool) -> Store:
             raise StoreError(f"{path}: store not found")
         return Store(path)
     store = Store(path)
-    problems = store.verify()
+    if progress:  # every array of the store is read: a minute or more for years of tests
+        from tqdm import tqdm
+
+        with tqdm(unit="entry", desc=f"verifying {path.name}", leave=False,
+                  dynamic_ncols=True) as bar:
+            def advance(done: int, total: int) -> None:
+                bar.total = total
+                bar.update(done - bar.n)
+
+            problems = store.verify(progress=advance)
+    else:
+        problems = store.verify()
     if problems:
         more = f" (and {len(problems) - 1} more problem(s))" if len(problems) > 1 else ""
         raise StoreError(f"{path}: corrupt or partial store, no report written: "
@@ -294,9 +308,10 @@ def _measured_loops(results: list[MeasuredResult], analyses: pd.DataFrame, store
     loops = []
     if store is None or analyses.empty or "key" not in analyses.columns:
         return loops
-    for _, row in analyses.iterrows():
+    # one opening of the store for all of them, not one per analysis
+    entries = store.get_analyses(str(key) for key in analyses["key"])
+    for (_, row), entry in zip(analyses.iterrows(), entries, strict=True):
         name = Path(str(row.get("source", "") or row["key"])).name
-        entry = store.get_analysis(str(row["key"]))
         found = loop_from_phasors(entry.arrays, row.get("frequency_hz"))
         if isinstance(found, str):
             notes.append(f"{name}: {found}; loop not drawn")
@@ -668,10 +683,11 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
             raise ParameterError(f"{', '.join(stated)}: only with measurement FILES (stored "
                                  "analyses keep the load case and corrections they were "
                                  "saved with)")
-    main = open_verified_store(store, must_exist=not files) if store is not None else None
+    main = (open_verified_store(store, must_exist=not files, progress=progress)
+            if store is not None else None)
     dem_paths = _dem_paths(store, dem_store)
     dems = [main if (main is not None and p == Path(store)) else
-            open_verified_store(p, must_exist=True) for p in dem_paths]
+            open_verified_store(p, must_exist=True, progress=progress) for p in dem_paths]
     dem_path = " and ".join(map(str, dem_paths)) or None  # as the notes name the runs' stores
 
     if main is not None:

@@ -40,7 +40,7 @@ import resource
 import secrets
 import shutil
 import threading
-from collections.abc import Iterable, Iterator, Mapping
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from contextlib import contextmanager, suppress
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
@@ -445,7 +445,9 @@ class Store:
     def _unreadable(self, reason: object) -> StoreError:
         return StoreError(f"{self.path}: not a readable pidcore store ({_one_line(reason)})")
 
-    def _check_root(self, h5: h5py.File) -> None:
+    def _check_root(self, h5: h5py.File, *, every_entry: bool = True) -> None:
+        """Refuse a file that is not a store of a version this pidcore reads, and, with
+        ``every_entry``, a foreign layout anywhere in its sections (:meth:`_check_sections`)."""
         version = h5.attrs.get("pidcore_store_version")
         if version is None:
             raise self._unreadable("HDF5 file without the root attribute pidcore_store_version")
@@ -460,7 +462,8 @@ class Store:
             raise StoreError(f"{self.path}: store version {version} is newer than this pidcore "
                              f"({__version__}) understands (version {STORE_VERSION}); "
                              "upgrade pidcore")
-        self._check_sections(h5)
+        if every_entry:
+            self._check_sections(h5)
 
     def _check_sections(self, h5: h5py.File) -> None:
         """Refuse a foreign layout before anything reads or copies it: each section a group of
@@ -468,19 +471,9 @@ class Store:
         every listing open another file on the machine; a soft link to nothing, a dataset
         where a group belongs, crashed every listing and every write)."""
         for section in _SECTIONS:
-            link = h5.get(section, getlink=True)
-            if link is None:
-                continue
-            parent = h5.get(section) if isinstance(link, h5py.HardLink) else None
-            if not isinstance(parent, h5py.Group):
-                raise self._unreadable(f"/{section} is {self._what(link, parent)}; expected "
-                                       "a group of entries")
-            for name in parent:
-                link = parent.get(name, getlink=True)
-                item = parent.get(name) if isinstance(link, h5py.HardLink) else None
-                if not isinstance(item, h5py.Group):
-                    raise self._unreadable(f"/{section}/{name} is {self._what(link, item)}; "
-                                           "expected an entry group in the store's own file")
+            parent = self._section(h5, section)
+            for name in () if parent is None else parent:
+                self._entry_of(parent, section, name)
 
     @staticmethod
     def _what(link: object, item: object) -> str:
@@ -490,9 +483,46 @@ class Store:
             return f"a soft link to {link.path!r}"
         return "a dataset" if isinstance(item, h5py.Dataset) else "not a group"
 
+    def _section(self, h5: h5py.File, section: str) -> h5py.Group | None:
+        """The section group (None where absent), refused as :meth:`_check_sections` refuses
+        it where it is not a group of the store's own file."""
+        link = h5.get(section, getlink=True)
+        if link is None:
+            return None
+        parent = h5.get(section) if isinstance(link, h5py.HardLink) else None
+        if not isinstance(parent, h5py.Group):
+            raise self._unreadable(f"/{section} is {self._what(link, parent)}; expected "
+                                   "a group of entries")
+        return parent
+
+    def _stored_entry(self, h5: h5py.File | None, section: str,
+                      key: str) -> h5py.Group | None:
+        """The entry group ``section/key`` (None where not stored), its link checked before
+        it is followed, as :meth:`_check_sections` checks every entry."""
+        parent = None if h5 is None else self._section(h5, section)
+        return None if parent is None else self._entry_of(parent, section, key)
+
+    def _entry_of(self, parent: h5py.Group, section: str, key: str) -> h5py.Group | None:
+        """The entry ``key`` of the section group ``parent`` (None where not stored), refused
+        where it is not a group of the store's own file."""
+        link = parent.get(key, getlink=True)
+        if link is None:
+            return None
+        item = parent.get(key) if isinstance(link, h5py.HardLink) else None
+        if not isinstance(item, h5py.Group):
+            raise self._unreadable(f"/{section}/{key} is {self._what(link, item)}; "
+                                   "expected an entry group in the store's own file")
+        return item
+
     @contextmanager
-    def _reading(self) -> Iterator[h5py.File | None]:
-        """Open the committed store read-only (``None`` when it does not exist yet)."""
+    def _reading(self, *, every_entry: bool = True) -> Iterator[h5py.File | None]:
+        """Open the committed store read-only (``None`` when it does not exist yet).
+
+        ``every_entry=False`` is for reading a few entries by key: their links are checked
+        where they are read (:meth:`_stored_entry`). The check of every entry of every
+        section made each ``get_analysis`` cost as much as a listing, and a report drawing
+        the loops of 2000 stored analyses (one ``get_analysis`` each) take over 40 minutes.
+        """
         if self._in_transaction():
             yield self._active
             return
@@ -504,7 +534,7 @@ class Store:
         except OSError as exc:
             raise self._unreadable(exc) from None
         try:
-            self._check_root(h5)
+            self._check_root(h5, every_entry=every_entry)
             yield h5
         except (OSError, RuntimeError) as exc:
             # h5py reports damaged objects inside an openable file as OSError/RuntimeError.
@@ -635,9 +665,9 @@ class Store:
         """
         _check_measurement(measurement)
         key, basis = _measurement_key(measurement)
-        with self._reading() as h5:
-            if h5 is not None and key in h5.get(_MEASUREMENTS, {}):
-                group = h5[_MEASUREMENTS][key]
+        with self._reading(every_entry=False) as h5:
+            group = self._stored_entry(h5, _MEASUREMENTS, key)
+            if group is not None:
                 self._check_same_measurement(group, measurement, key)
                 if _text(group.attrs.get("source", "")) == measurement.source:
                     return key, False
@@ -667,7 +697,7 @@ class Store:
     def get_measurement(self, key: str) -> Measurement:
         """The measurement stored under ``key``."""
         check_name(key, what="measurement key", where=str(self.path))
-        with self._reading() as h5:
+        with self._reading(every_entry=False) as h5:
             group = self._entry_group(h5, _MEASUREMENTS, key, "measurement")
             try:
                 return read_measurement_group(group, where=f"{self.path}:{group.name}")
@@ -677,8 +707,8 @@ class Store:
     def has_measurement(self, key: str) -> bool:
         """Whether a measurement is stored under ``key``."""
         check_name(key, what="measurement key", where=str(self.path))
-        with self._reading() as h5:
-            return h5 is not None and key in h5.get(_MEASUREMENTS, {})
+        with self._reading(every_entry=False) as h5:
+            return self._stored_entry(h5, _MEASUREMENTS, key) is not None
 
     def list_measurements(self) -> pd.DataFrame:
         """One row per measurement: key, source, file_format, n_channels, channel_names,
@@ -749,6 +779,11 @@ class Store:
     def get_analysis(self, key: str) -> StoredEntry:
         """The analysis stored under ``key``."""
         return self._get_entry(_ANALYSES, key, "analysis")
+
+    def get_analyses(self, keys: Iterable[str]) -> list[StoredEntry]:
+        """The analyses stored under ``keys``, in their order, read through one opening of
+        the store (a report of many stored analyses opened it once per analysis)."""
+        return self._get_entries(_ANALYSES, list(keys), "analysis")
 
     def list_analyses(self) -> pd.DataFrame:
         """One row per analysis: key, measurement_key, source, created_utc, every scalar field,
@@ -841,8 +876,8 @@ class Store:
     def has_dem_run(self, case_key: str) -> bool:
         """Whether a DEM run is stored under ``case_key``."""
         check_name(case_key, what="DEM case key", where=str(self.path))
-        with self._reading() as h5:
-            return h5 is not None and case_key in h5.get(_DEM_RUNS, {})
+        with self._reading(every_entry=False) as h5:
+            return self._stored_entry(h5, _DEM_RUNS, case_key) is not None
 
     def get_dem_run(self, case_key: str) -> StoredEntry:
         """The DEM run stored under ``case_key``."""
@@ -908,8 +943,8 @@ class Store:
     def has_calibration(self, key: str) -> bool:
         """Whether a calibration is stored under ``key``."""
         check_name(key, what="calibration key", where=str(self.path))
-        with self._reading() as h5:
-            return h5 is not None and key in h5.get(_CALIBRATIONS, {})
+        with self._reading(every_entry=False) as h5:
+            return self._stored_entry(h5, _CALIBRATIONS, key) is not None
 
     def get_calibration(self, key: str) -> StoredEntry:
         """The calibration stored under ``key`` (its texts: :func:`calibration_texts`)."""
@@ -927,18 +962,28 @@ class Store:
                    key_name: str | None = None) -> StoredEntry:
         """The entry ``key`` of ``section`` read whole (``what`` names it in errors, and
         ``key_name``, default "<what> key", names its key)."""
-        check_name(key, what=key_name or f"{what} key", where=str(self.path))
-        with self._reading() as h5:
-            group = self._entry_group(h5, section, key, what)
-            return _read_entry(group, key, where=f"{self.path}:{group.name}")
+        return self._get_entries(section, [key], what, key_name=key_name)[0]
+
+    def _get_entries(self, section: str, keys: list[str], what: str, *,
+                     key_name: str | None = None) -> list[StoredEntry]:
+        """The entries ``keys`` of ``section``, each read whole, through one opening."""
+        for key in keys:
+            check_name(key, what=key_name or f"{what} key", where=str(self.path))
+        entries = []
+        with self._reading(every_entry=False) as h5:
+            for key in keys:
+                group = self._entry_group(h5, section, key, what)
+                entries.append(_read_entry(group, key, where=f"{self.path}:{group.name}"))
+        return entries
 
     def _entry_group(self, h5: h5py.File | None, section: str, key: str, what: str) -> h5py.Group:
         if h5 is None:
             raise StoreError(f"{self.path}: no {what} {key!r}; the store does not exist yet")
-        parent = h5.get(section, {})
-        if key not in parent:
-            raise StoreError(f"{self.path}: no {what} {key!r} ({len(parent)} stored)")
-        group = parent[key]
+        group = self._stored_entry(h5, section, key)
+        if group is None:
+            parent = self._section(h5, section)
+            raise StoreError(f"{self.path}: no {what} {key!r} "
+                             f"({0 if parent is None else len(parent)} stored)")
         self._check_self_contained(group)
         return group
 
@@ -985,12 +1030,16 @@ class Store:
 
     # --- integrity -----------------------------------------------------------------------------
 
-    def verify(self) -> list[str]:
+    def verify(self, *, progress: Callable[[int, int], None] | None = None) -> list[str]:
         """Integrity check: one line per problem found (empty list: the store is sound).
 
         Checks the root attributes, that every measurement, analysis and DEM run has its
         provenance attributes and readable datasets (checksummed arrays are read in full), that
         keys match their contents and that every analysis refers to a stored measurement.
+
+        ``progress``, where given, is called with (entries checked, entries in all) after
+        each entry: every array is read, a minute for some 3000 entries, more with long
+        records stored, which ``pidcore report --store`` spent without a sign of life.
         """
         if not self.path.exists():
             return [f"{self.path}: store does not exist"]
@@ -1006,6 +1055,8 @@ class Store:
                 return [str(exc)]
             problems += [f"{self.path}: root attribute {name} missing"
                          for name in _ROOT_ATTRS if name not in h5.attrs]
+            total = sum(len(h5[section]) for section in _SECTIONS if section in h5)
+            done = 0
             for section in _SECTIONS:
                 if section not in h5:
                     if section == _CALIBRATIONS:
@@ -1013,6 +1064,9 @@ class Store:
                     problems.append(f"{self.path}: group /{section} missing")
                     continue
                 for key in h5[section]:
+                    done += 1
+                    if progress is not None:
+                        progress(done, total)
                     where = f"{self.path}:/{section}/{key}"
                     try:
                         # a key no add_* accepts (a tab, surrounding spaces) is one get_*
