@@ -29,8 +29,12 @@ from .parameters import DISCREPANCY, ParameterSpec
 from .surrogate import CaseSurrogate, predicted_sdc, unique_points
 
 GRID_MAX_DIMENSIONS = 4
-#: Grid points per dimension (coarse pass, fine pass) by number of dimensions.
-GRID_SIZES = {1: (201, 401), 2: (61, 101), 3: (25, 41), 4: (13, 21)}
+#: Grid points per dimension (coarse pass, fine pass) by number of dimensions. Four
+#: quantities had 21 in the fine pass: each cell is sampled uniformly, and the steep lower
+#: tails of a posterior spanning most of the box came out up to half a cell too low (the
+#: calibration audit's quadrature; tests/test_calibrate_grid_tails.py). 31 costs ~2 x the
+#: paper calibration's time (5 s to 10 s from cached runs) and ~0.7 GB.
+GRID_SIZES = {1: (201, 401), 2: (61, 101), 3: (25, 41), 4: (13, 31)}
 #: Absolute model-error floor on the SDC [-]: below it the measurement itself (a 1 g SDC of
 #: 0.01 next to one of 0.10 at 50 Hz) is not reproducible by any smooth model.
 DISCREPANCY_FLOOR = 0.01
@@ -532,8 +536,8 @@ def unconstrained_notes(specs: Sequence[ParameterSpec], samples: np.ndarray) -> 
         if share >= UNCONSTRAINED_SHARE:
             notes.append(
                 f"{spec.name}: the data hardly constrain it (its 95 % interval spans "
-                f"{min(share, 1.0):.0%} of its prior's, {low:g} .. {high:g}): its median is "
-                "the prior's more than the data's, no measured value, and so is the value "
-                "written to the calibrated specimen; measure load cases where it changes the "
-                "SDC, or do not fit it")
+                f"{100 * min(share, 1.0):.0f} % of its prior's, {low:g} .. {high:g}): its "
+                "median is the prior's more than the data's, no measured value, and so is the "
+                "value written to the calibrated specimen; measure load cases where it changes "
+                "the SDC, or do not fit it")
     return notes
