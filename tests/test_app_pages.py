@@ -980,15 +980,18 @@ def test_compare_shows_no_band_of_another_specimens_calibration(store_file, tmp_
         assert said == (not shown)
 
 
-#: DEM runs of the bundled calibration (`pidcore calibrate ... --dem-store calibration_store.h5`,
-#: ~10 min from empty, gitignored): with it the real library calibrates in seconds.
+#: DEM runs of the README's two `pidcore calibrate` commands (section Calibrate; default
+#: `--dem-store calibration_store.h5`, gitignored, ~1.5 min from empty on an idle machine): the
+#: first holds the paper coupon's own runs, which Compare needs, the second the bundled
+#: calibration's 60 design runs. With it the real library calibrates in seconds.
 CALIBRATION_CACHE = REPO / "calibration_store.h5"
 
 
 @pytest.mark.dem_subprocess
 @pytest.mark.slow
 @pytest.mark.skipif(not CALIBRATION_CACHE.is_file(),
-                    reason="needs the cached DEM runs of calibration_store.h5 (see README)")
+                    reason="needs calibration_store.h5, the DEM runs of the README's two "
+                           "calibrate commands")
 def test_calibrate_page_runs_the_real_library_and_compare_shows_its_band(store_file,
                                                                          monkeypatch):
     import shutil
@@ -1029,7 +1032,7 @@ def test_calibrate_page_runs_the_real_library_and_compare_shows_its_band(store_f
     # the calibration's design runs (files named paper_coupon with other values) made Compare
     # refuse every case ("the DEM runs ... are of 6 specimens"); the coupon's own runs are
     # compared, as `pidcore report` on this store does, and the others named in a note
-    assert not any("No DEM value" in w.value for w in at.warning)
+    assert not any("No DEM value" in w.value for w in at.warning), [w.value for w in at.warning]
     assert any("vs our DEM" in m.value and "vs our DEM none" not in m.value
                for m in at.markdown)
     assert any("DEM runs of other specimens not compared" in c.value for c in at.caption)
