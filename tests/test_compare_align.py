@@ -199,3 +199,17 @@ def test_the_model_takes_one_settings_case_per_load_case_as_a_grid_case_does():
     # pooled explicitly (--pool), the settings are one case and the model averages them
     pooled = Aligner.from_tables(both, pool_settings=True).align(case)
     assert pooled.sdc_dem != pytest.approx(out.sdc_dem, rel=1e-6)
+
+
+@pytest.mark.parametrize("field", ["frequency_hz", "acceleration_g", "fill_percent"])
+def test_a_dem_run_without_its_load_case_is_refused_naming_the_run(field):
+    # A run stored through the library without its load case (Store.add_dem_run("handmade",
+    # {"sdc": 0.3})): `pidcore report` said "load case: --frequency must be a positive finite
+    # number, got nan", naming neither the run nor the stored field
+    from pidcore.errors import ParameterError
+
+    runs = dem_grid()
+    runs.loc[3, field] = math.nan
+    with pytest.raises(ParameterError, match=rf"DEM run '{runs.loc[3, 'case_key']}': record "
+                                             rf"field {field} is nan; expected a positive"):
+        dem_cases(runs)

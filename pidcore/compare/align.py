@@ -229,6 +229,15 @@ def _check_columns(table: pd.DataFrame, columns: Iterable[str], what: str) -> No
 
 
 def _row_case(row: pd.Series) -> LoadCase:
+    for name in ("frequency_hz", "acceleration_g", "fill_percent"):
+        value = pd.to_numeric(pd.Series([row.get(name)]), errors="coerce").iloc[0]
+        if not (np.isfinite(value) and value > 0):
+            # a run stored without its load case (by hand, through the library): the report
+            # said "load case: --frequency must be ..." and named no run
+            key = row.get("case_key", row.name)
+            raise ParameterError(
+                f"DEM run {key!r}: record field {name} is {row.get(name)!r}; expected a "
+                "positive number (a run stored without its load case cannot be compared)")
     material = row.get("material", defaults.COMPARE_DEFAULT_MATERIAL)
     direction = row.get("direction", defaults.COMPARE_DEFAULT_DIRECTION)
     return LoadCase(float(row["frequency_hz"]), float(row["acceleration_g"]),
