@@ -251,6 +251,44 @@ def test_the_cli_table_renames_keywords_only_where_they_name_the_parameter():
     assert cli_words("frequency_hz must be > 0", "model damper") == "frequency_hz must be > 0"
 
 
+#: Messages whose only keyword-like words are the user's own names: a file, a folder, a
+#: quoted channel, a specimen and a store key the library writes unquoted.
+USERS_NAMES = ("/data/structure_mass_kg.csv: no force channel",
+               "/data/key=1/a.csv: no force channel", "runs/fill_percent/a.csv: empty",
+               "C:\\runs\\frequency_hz\\a.csv: empty", "/tmp/allow_clipped: no such file",
+               "a.csv: channel 'force=' is constant", 'a.csv: channel "velocity=" is constant',
+               "specimen fill_percent is not the paper's coupon",
+               "store.h5: measurement key key=abc already holds rec.csv")
+
+
+def test_the_users_names_that_hold_a_keyword_stay_as_written(tmp_path, capsys):
+    from pidcore.app import uploads
+    from pidcore.app.vocabulary import page_terms
+    from pidcore.cli._vocabulary import cli_words
+    from pidcore.measure import AnalysisOptions
+
+    for said in USERS_NAMES:
+        assert cli_words(said, "report") == said
+        assert page_terms(said) == said
+    # beside a name, the message's own keyword is still the flag or field
+    assert cli_words("/d/key=1/x.csv: choose one with key=NAME") == \
+        "/d/key=1/x.csv: choose one with --key NAME"
+    assert page_terms("structure_mass_kg.csv: give structure_mass_kg") == \
+        "structure_mass_kg.csv: give 'structure mass [g]'"
+    # end to end: the folder and file the user named come back as they are (they read
+    # "/.../--key 1/--structure-mass.csv")
+    (tmp_path / "key=1").mkdir()
+    path = export(tmp_path / "key=1" / "structure_mass_kg.csv")
+    err = cli_refusal(["analyze", str(path), "--no-store", "--force", "Velocity"], capsys)
+    assert err.startswith(f"pidcore analyze: error: {path}: ")
+    assert "--force 'Velocity' is a velocity channel" in err
+    outcome = uploads.analyze_parsed(uploads.parse_upload("structure_mass_kg.csv",
+                                                          path.read_bytes()),
+                                     AnalysisOptions(force="Velocity"))
+    assert outcome.error.startswith("structure_mass_kg.csv: ")
+    assert "the 'force channel' column ('Velocity') is a velocity channel" in outcome.error
+
+
 def test_the_app_names_its_fields_where_it_shows_a_library_refusal(tmp_path):
     from pidcore.app import uploads
     from pidcore.app.calibration import page_words
