@@ -153,3 +153,32 @@ def test_an_x_y_pair_at_another_rate_is_refused_naming_both_rates(tmp_path, caps
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and "run12.txt" in err
     assert "5120 Hz" in err and "2560 Hz" in err
+
+
+@pytest.mark.parametrize(("name", "unit", "value"), [("Delay", "ms", 0.5),
+                                                      ("Time offset", "s", 1e-3)])
+def test_a_constant_column_in_seconds_is_a_channel_not_a_time_base(tmp_path, capsys, name,
+                                                                    unit, value):
+    # a vibrometer delay or a trigger offset written as a column of its unit beside the
+    # signals: read as the x of an x/y pair, it refused the whole file ('time does not
+    # increase'); it is a quantity in seconds, as it was read before x/y pairs
+    t = np.arange(int(2 * FS)) / FS
+    w = 2 * math.pi * FREQ
+    path = write_testlab_text(tmp_path / "run13.txt", [
+        ("Time", "s", t), ("Point1:+Z", "m/s", V0 * np.sin(w * t - PHI)),
+        (name, unit, np.full(t.size, value)), ("Force", "N", F0 * np.sin(w * t))])
+    channels = read_measurement(path).channels
+    assert [c.name for c in channels] == ["Point1:+Z", name, "Force"]
+    # the force is timed by the first time column, as the velocity
+    assert (channels[2].start_time_s, channels[2].sample_rate_hz) == \
+        (channels[0].start_time_s, channels[0].sample_rate_hz)
+    record = analyze_json(path, capsys)
+    # same grid for both channels: exact up to the 8 printed digits
+    assert record["loss_factor"] == pytest.approx(ETA, rel=1e-6)
+    # a column named as the time column is the pair's time base, even broken: refused
+    path = write_testlab_text(tmp_path / "run14.txt", [
+        ("Time", "s", t), ("Point1:+Z", "m/s", V0 * np.sin(w * t - PHI)),
+        ("Time", "s", np.zeros(t.size)), ("Force", "N", F0 * np.sin(w * t))])
+    assert main(["analyze", str(path), "--no-store", "--no-progress"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "run14.txt: column 'Time' (time of column 4)" in err
