@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import os
+import socket
 
 import pytest
 
@@ -55,6 +57,10 @@ DAMAGED = {
     "started NaN": {"started": float("nan")},
     "specimen TOML nested too deeply": {"specimen": {"text": "a = " + "[" * 100_000,
                                                      "source": "deep.toml"}},
+    # JSON integers have no size limit; as a float they overflowed (a traceback at start)
+    "submitted an integer of 400 digits": {"submitted": 10**400},
+    "a load case's frequency of 400 digits": {"case": {**dataclasses.asdict(CASE),
+                                                       "frequency_hz": 10**400}},
 }
 
 
@@ -81,3 +87,22 @@ def test_a_job_id_listed_twice_keeps_the_first(tmp_path):
     listed, _, note = _runner_rows(store)
     assert [(j.job_id, j.state) for j in listed] == [("job0001", "saved")]
     assert "job0001" in note and "listed twice" in note
+
+
+@pytest.mark.parametrize("owner", [
+    {"host": socket.gethostname(), "pid": 1, "started": 10**400, "runner": "r"},
+    {"host": socket.gethostname(), "pid": 10**30, "started": 1.0, "runner": "r"},
+    {"host": socket.gethostname(), "pid": os.getpid(), "started": 4e9, "runner": "r"},
+    {"host": ["lab3"], "pid": "812", "started": "now", "runner": None}, "me"])
+def test_an_owner_that_cannot_be_trusted_is_a_stopped_server(tmp_path, owner):
+    # a start time of 400 digits was an OverflowError traceback at the runner's start; any
+    # owner this host cannot confirm running (pid 1 started at another time, no such pid,
+    # this process under a runner it never made, fields of the wrong type) has stopped:
+    # its running job is taken over as interrupted, its finished job listed as it was
+    store = _journal(tmp_path, json.dumps({"pidcore_jobs_version": 1, "jobs": [
+        _entry(owner=owner, state="running", finished=None),
+        _entry(owner=owner, job_id="job0002")]}))
+    listed, rows, note = _runner_rows(store)
+    assert [(j.job_id, j.state) for j in listed] == [("job0001", jobs.INTERRUPTED_STATE),
+                                                     ("job0002", "saved")]
+    assert len(rows) == 2 and note == ""

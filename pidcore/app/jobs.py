@@ -223,8 +223,7 @@ class JournalOwner:
         host, pid, started, runner = (doc.get(k) for k in ("host", "pid", "started", "runner"))
         if not (isinstance(host, str) and isinstance(runner, str)
                 and isinstance(pid, int) and not isinstance(pid, bool) and pid > 0
-                and isinstance(started, int | float) and not isinstance(started, bool)
-                and math.isfinite(started)):
+                and _finite_number(started)):
             return None
         return cls(host, pid, float(started), runner)
 
@@ -728,10 +727,20 @@ def _time_s(value: object, name: str) -> float | None:
     (a text there made every row of the job table a TypeError)."""
     if value is None:
         return None
-    if isinstance(value, bool) or not isinstance(value, int | float) \
-            or not math.isfinite(value):
-        raise ValueError(f"{name} must be a time in s or null, got {value!r}")
+    if not _finite_number(value):
+        raise ValueError(f"{name} must be a time in s or null, got {repr(value)[:40]}")
     return float(value)
+
+
+def _finite_number(value: object) -> bool:
+    """Whether a journal's value is a finite int or float: an integer of 400 digits is no
+    float (math.isfinite raised OverflowError, a traceback at the app's start)."""
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        return False
+    try:
+        return math.isfinite(value)
+    except OverflowError:
+        return False
 
 
 def _count(value: object, name: str) -> int:
@@ -806,9 +815,10 @@ def _job_from_document(doc: dict, *, live: bool = False) -> DemJob:
 
 
 #: What a journal that cannot be trusted raises while it is read (RecursionError: JSON nested
-#: deeper than Python's stack, json.loads is recursive).
+#: deeper than Python's stack, json.loads is recursive; OverflowError: an integer of
+#: hundreds of digits where the load case holds a float).
 _UNREADABLE = (OSError, ValueError, TypeError, KeyError, AttributeError, RecursionError,
-               PidcoreError)
+               OverflowError, PidcoreError)
 
 
 def _journal_entries(path: Path) -> tuple[list[tuple[object, JournalOwner | None]], str]:
