@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from pidcore.cli import main
+from pidcore.errors import InputFileError
 from pidcore.io import read_measurement
 
 F0, V0, FREQ, ETA, FS = 10.0, 0.05, 100.0, 0.05, 5120.0
@@ -182,3 +183,14 @@ def test_a_constant_column_in_seconds_is_a_channel_not_a_time_base(tmp_path, cap
     assert main(["analyze", str(path), "--no-store", "--no-progress"]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and "run14.txt: column 'Time' (time of column 4)" in err
+
+
+def test_a_time_column_that_does_not_advance_names_its_times_as_numbers(tmp_path):
+    # numpy 2's repr leaked into the message: "(first np.float64(0.0005), last ...)"
+    t = np.arange(64) / FS
+    path = write_testlab_text(tmp_path / "run15.txt", [
+        ("Time", "s", np.full(t.size, 0.0005)), ("Force", "N", np.sin(t))])
+    with pytest.raises(InputFileError) as info:
+        read_measurement(path)
+    assert str(info.value).endswith("run15.txt: column 'Time': time does not increase "
+                                    "(first 0.0005, last 0.0005)")
