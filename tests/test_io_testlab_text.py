@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -194,3 +195,26 @@ def test_a_time_column_that_does_not_advance_names_its_times_as_numbers(tmp_path
         read_measurement(path)
     assert str(info.value).endswith("run15.txt: column 'Time': time does not increase "
                                     "(first 0.0005, last 0.0005)")
+
+
+@pytest.mark.parametrize("options", [(), ("--allow-clipped",)])
+def test_overflow_markers_on_over_half_a_percent_of_samples_are_named(tmp_path, capsys,
+                                                                      options):
+    # an overload of 2 % of the record: the markers were inside the central 99 % the outlier
+    # test measures from, so 'clipped: 3911 samples' was said (and with --allow-clipped, an
+    # 'unresolved' reactive power of -2.75e+33 W)
+    columns = shaker_columns("Force", "N", 1.0, "Point1:+Z", "m/s", 1.0)
+    marked = np.arange(50, columns[2][2].size, 50)  # every 50th sample: 2 %
+    columns[2][2][marked] = 3.402823e38
+    path = write_testlab_text(tmp_path / "run16.txt", columns)
+    assert main(["analyze", str(path), "--no-store", "--no-progress", *options]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "run16.txt: channel 'Force': " in err
+    assert f"{marked.size} samples far outside the signal, first at index 50 " in err
+    # the rest of the channel is the drive line of amplitude F0: its central 99 % reach
+    # within 0.1 % of +-F0 (a sine's 0.5 % quantile is F0 cos(0.005 pi), 0.012 % short of it,
+    # sampled 51 times a period); the markers no longer stretch it to 3.4e38
+    low, high = map(float, re.search(r"99 % of the other samples lie within (\S+) \.\. (\S+) N",
+                                      err).groups())
+    assert (low, high) == (pytest.approx(-F0, rel=1e-3), pytest.approx(F0, rel=1e-3))
+    assert "clipped" not in err
