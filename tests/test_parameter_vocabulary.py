@@ -343,3 +343,78 @@ def test_no_library_message_names_a_cli_flag():
     for name in NOT_CONVERTED:
         tree = ast.parse((root / name).read_text(encoding="utf-8"))
         assert any(FLAG.search(n.value) for n in _strings_outside_docstrings(tree)), name
+
+
+# --- every keyword a library message names is a parameter ------------------------------------
+
+#: Files whose strings are HTML (attributes alt=, src=, width=), not messages.
+HTML_WRITERS = {"pidcore/report/render.py", "pidcore/calibrate/outputs.py"}
+#: Words written with '=' in messages that name no parameter, and why: an HDF5 attribute
+#: ("pidcore_layout=2") and a settings table's column in a --where value.
+NOT_PARAMETERS = {"pidcore_layout", "settings_hash"}
+#: A keyword as a message gives it: a lower-case name right before '=' and its value or
+#: placeholder (key=NAME, force='Fz', allow_clipped=True, store=PATH), not inside a longer
+#: name, a quoted name or a comparison ('==').
+_KEYWORD_IN_MESSAGE = re.compile(r"(?<![\w.'\"=-])([a-z][a-z0-9_]*)=(?=[A-Z'{\"0-9]|$|[ ,;)])")
+
+
+def _public_parameters() -> set[str]:
+    """Every parameter of every public function, method and data class field of the library
+    (the front-ends, pidcore.cli and pidcore.app, left out: their words are their own)."""
+    import dataclasses
+    import importlib
+    import inspect
+    import pkgutil
+
+    import pidcore
+
+    names: set[str] = set()
+    for info in pkgutil.walk_packages(pidcore.__path__, "pidcore."):
+        if info.name.startswith(("pidcore.cli", "pidcore.app")) or info.name.endswith("__main__"):
+            continue
+        module = importlib.import_module(info.name)
+        for name, obj in vars(module).items():
+            if name.startswith("_") or getattr(obj, "__module__", None) != module.__name__:
+                continue
+            callables = [obj]
+            if inspect.isclass(obj):
+                callables += [v for k, v in vars(obj).items()
+                              if not k.startswith("_") and callable(v)]
+                if dataclasses.is_dataclass(obj):
+                    names |= {f.name for f in dataclasses.fields(obj)}
+            for c in callables:
+                try:
+                    names |= set(inspect.signature(c).parameters)
+                except (TypeError, ValueError):  # a builtin without a signature
+                    pass
+    return names
+
+
+def test_every_keyword_a_library_message_names_is_a_public_parameter():
+    # a message that tells a caller to pass a keyword the API does not have (a typo, a
+    # renamed parameter: "give structure_mass=...") sends a Python user to a TypeError and
+    # has no flag or field in the front-ends' tables
+    from pidcore.app.vocabulary import LABEL_OF_KEYWORD
+    from pidcore.cli._vocabulary import COMMAND_FLAGS
+
+    parameters = _public_parameters()
+    named: dict[str, str] = {}
+    root = Path(__file__).resolve().parents[1]
+    for path in sorted((root / "pidcore").rglob("*.py")):
+        relative = path.relative_to(root).as_posix()
+        if relative.startswith(("pidcore/cli/", "pidcore/app/")) or relative in HTML_WRITERS:
+            continue
+        tree = ast.parse(path.read_text(encoding="utf-8"))
+        for node in _strings_outside_docstrings(tree):
+            for keyword in _KEYWORD_IN_MESSAGE.findall(node.value):
+                named.setdefault(keyword, f"{relative}:{node.lineno}")
+    assert len(named) > 20  # the pattern still finds the messages' keywords
+    unknown = {k: where for k, where in named.items()
+               if k not in parameters and k not in NOT_PARAMETERS}
+    assert not unknown, f"keywords that no public function takes: {unknown}"
+    # the front-ends' tables translate only parameters that exist
+    tabled = {re.match(r"\^?([a-z_]+)", k).group(1) for table in
+              [*COMMAND_FLAGS.values(), LABEL_OF_KEYWORD] for k in table if k[0] != "^" or
+              k[1:].isidentifier()}
+    assert tabled - parameters <= {"calibrate", "write_outputs", "read_measured_table"}, \
+        tabled - parameters
