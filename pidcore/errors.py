@@ -9,7 +9,10 @@ A message names a parameter as a Python caller writes it: its keyword (``structu
 with a value or a placeholder where it says what to give (``key=NAME``, ``force='Fz'``,
 ``allow_clipped=True``), never a front-end's flag or label. The CLI says it as its flag
 (``--structure-mass``: one table, :mod:`pidcore.cli._vocabulary`), the app as its field
-(``'structure mass [g]'``: :mod:`pidcore.app.vocabulary`).
+(``'structure mass [g]'``: :mod:`pidcore.app.vocabulary`); both through
+:func:`outside_user_names`, so a keyword inside the user's own names (a file
+``structure_mass_kg.csv``, a folder ``key=1/``, a channel ``'force='``, a specimen
+``fill_percent``) is left as the user wrote it.
 
 Public API
 ----------
@@ -21,10 +24,14 @@ SettingsTableError, StoreError, SimulationError
     A settings table (sidecar), the store, a DEM run.
 whole_number, real_number, instance_of, as_given
     The checks of a value's type, and a number shown as the user gave it.
+outside_user_names
+    A message rewritten everywhere but in the names the user gave.
 """
 
 import math
 import numbers
+import re
+from collections.abc import Callable, Iterable
 
 
 class PidcoreError(Exception):
@@ -116,6 +123,59 @@ def instance_of(name: str, value: object, kind: type | tuple[type, ...], *,
                          f"{shown}" + (f" ({hint})" if hint else ""))
 
 
+# What a message quotes or names as the user's: a quoted name ('force=', "x"; an apostrophe
+# inside a word is no quote, and a keyword's quoted value is the keyword's table's:
+# fill_reference='paper'), a path (/data/key=1/a.csv, runs/x=1/, C:\\runs\\x.csv), a file
+# name with its extension (structure_mass_kg.csv; a path or file after "=" is a keyword's
+# value: store_path=/data/s.h5), and the word after "specimen", "key",
+# "channel", "store", "file" or "folder", which the library writes unquoted (store keys,
+# specimen names).
+_USER_NAME = re.compile(
+    r"(?<![\w=])'[^'\n]*'(?!\w)"
+    r'|(?<![\w=])"[^"\n]*"(?!\w)'
+    r"|(?P<path>[^\s'\"(),;=]*[/\\][^\s'\"(),;]*)"
+    r"|(?<![\w.-])[\w.+-]*\w\.[A-Za-z][A-Za-z0-9]{0,4}(?![\w.])"
+    r"|(?:(?<=specimen )|(?<=key )|(?<=channel )|(?<=store )|(?<=file )|(?<=folder ))"
+    r"[^\s,;()']+")
+# a private-use code point: never written by the library, nor in a name typed by a user
+_HELD = "\ue000{}\ue001"
+_HELD_BACK = re.compile("\ue000(\\d+)\ue001")
+
+
+def _is_path(token: str) -> bool:
+    # "fit/priors" (two keywords) and "m/s" are no paths: one slash between plain words
+    return ("\\" in token or token.startswith(("/", "~", ".")) or token.endswith("/")
+            or token.count("/") > 1 or any(c in token for c in ".=\ue000"))
+
+
+def outside_user_names(message: str, rewrite: Callable[[str], str], *,
+                       names: Iterable[str] = ()) -> str:
+    """``rewrite(message)`` applied to all but the user's names in it (quoted, a path, a file
+    name, a store key or specimen, and each of ``names`` standing alone): a front-end says a
+    parameter keyword in its own words without renaming a file ``structure_mass_kg.csv``.
+
+    A held name reaches ``rewrite`` as a placeholder of non-word characters, so a keyword
+    before it keeps its value (``force='Fz'`` -> ``--force 'Fz'``)."""
+    held: list[str] = []
+
+    def hold(m: re.Match) -> str:
+        if m.groupdict().get("path") and not _is_path(m.group(0)):
+            return m.group(0)
+        held.append(m.group(0))
+        return _HELD.format(len(held) - 1)
+
+    def restore(text: str) -> str:  # a held path may hold a name given in ``names``
+        return _HELD_BACK.sub(lambda m: restore(held[int(m.group(1))]), text)
+
+    given = sorted({n for n in names if len(n) >= 2}, key=len, reverse=True)
+    if given:
+        # standing alone: within quotes it is a quoted name or a keyword's value
+        # (fill_reference='paper' for a typed "paper"), which the table says
+        message = re.sub(r"(?<![\w'=])(?:" + "|".join(map(re.escape, given)) + r")(?![\w'])",
+                         hold, message)
+    return restore(rewrite(_USER_NAME.sub(hold, message)))
+
+
 __all__ = ["ChannelError", "InputFileError", "ParameterError", "PidcoreError",
            "SettingsTableError", "SignalError", "SimulationError", "StoreError", "as_given",
-           "instance_of", "real_number", "whole_number"]
+           "instance_of", "outside_user_names", "real_number", "whole_number"]

@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import os
+import socket
 
 import pytest
 
@@ -55,6 +57,10 @@ DAMAGED = {
     "started NaN": {"started": float("nan")},
     "specimen TOML nested too deeply": {"specimen": {"text": "a = " + "[" * 100_000,
                                                      "source": "deep.toml"}},
+    # JSON integers have no size limit; as a float they overflowed (a traceback at start)
+    "submitted an integer of 400 digits": {"submitted": 10**400},
+    "a load case's frequency of 400 digits": {"case": {**dataclasses.asdict(CASE),
+                                                       "frequency_hz": 10**400}},
 }
 
 
@@ -81,3 +87,75 @@ def test_a_job_id_listed_twice_keeps_the_first(tmp_path):
     listed, _, note = _runner_rows(store)
     assert [(j.job_id, j.state) for j in listed] == [("job0001", "saved")]
     assert "job0001" in note and "listed twice" in note
+
+
+@pytest.mark.parametrize("owner", [
+    {"host": socket.gethostname(), "pid": 1, "started": 10**400, "runner": "r"},
+    {"host": socket.gethostname(), "pid": 10**30, "started": 1.0, "runner": "r"},
+    {"host": socket.gethostname(), "pid": os.getpid(), "started": 4e9, "runner": "r"},
+    {"host": ["lab3"], "pid": "812", "started": "now", "runner": None}, "me"])
+def test_an_owner_that_cannot_be_trusted_is_a_stopped_server(tmp_path, owner):
+    # a start time of 400 digits was an OverflowError traceback at the runner's start; any
+    # owner this host cannot confirm running (pid 1 started at another time, no such pid,
+    # this process under a runner it never made, fields of the wrong type) has stopped:
+    # its running job is taken over as interrupted, its finished job listed as it was
+    store = _journal(tmp_path, json.dumps({"pidcore_jobs_version": 1, "jobs": [
+        _entry(owner=owner, state="running", finished=None),
+        _entry(owner=owner, job_id="job0002")]}))
+    listed, rows, note = _runner_rows(store)
+    assert [(j.job_id, j.state) for j in listed] == [("job0001", jobs.INTERRUPTED_STATE),
+                                                     ("job0002", "saved")]
+    assert len(rows) == 2 and note == ""
+
+
+def _ownerless_running_journal(tmp_path):
+    # a job of a server that stopped: the runner takes it over under the journal's lock
+    return _journal(tmp_path, json.dumps({"pidcore_jobs_version": 1, "jobs": [
+        _entry(owner=None, state="running", finished=None)]}))
+
+
+def test_a_folder_in_the_lock_files_place_is_said_and_the_journal_still_kept(tmp_path):
+    store = _ownerless_running_journal(tmp_path)
+    lock = jobs.journal_path(store).with_name(jobs.journal_path(store).name + ".lock")
+    lock.mkdir()
+    listed, _, note = _runner_rows(store)
+    assert [(j.job_id, j.state) for j in listed] == [("job0001", jobs.INTERRUPTED_STATE)]
+    # the take-over was written (unlocked), and that it was is said, naming the lock file
+    written = json.loads(jobs.journal_path(store).read_text())["jobs"]
+    assert [e["state"] for e in written] == [jobs.INTERRUPTED_STATE]
+    assert note.startswith(f"{lock} cannot be opened (IsADirectoryError); the job table was "
+                           "read and written without it")
+
+
+@pytest.mark.skipif(jobs.fcntl is None, reason="no journal lock without fcntl")
+def test_a_lock_held_by_a_hung_server_delays_the_runner_not_forever(tmp_path, monkeypatch):
+    import subprocess
+    import sys
+    import threading
+
+    store = _ownerless_running_journal(tmp_path)
+    lock = jobs.journal_path(store).with_name(jobs.journal_path(store).name + ".lock")
+    holder = subprocess.Popen(
+        [sys.executable, "-c", "import fcntl, os, sys, time; "
+         f"fd = os.open({str(lock)!r}, os.O_RDWR | os.O_CREAT); fcntl.flock(fd, "
+         "fcntl.LOCK_EX); print('held', flush=True); time.sleep(600)"],
+        stdout=subprocess.PIPE, text=True)
+    try:
+        assert holder.stdout.readline().strip() == "held"
+        monkeypatch.setattr(jobs, "JOURNAL_LOCK_WAIT_S", 0.2, raising=False)
+        made = []
+        start = threading.Thread(target=lambda: made.append(jobs.DemJobRunner(store)),
+                                 daemon=True)
+        start.start()
+        # the runner waited on the lock for as long as the holder held it (the app's page
+        # hung); 60 s is far beyond the 0.2 s wait and a runner's start
+        start.join(timeout=60)
+        assert made, "the runner still waits for the journal's lock"
+        (runner,) = made
+        assert [(j.job_id, j.state) for j in runner.jobs()] == \
+            [("job0001", jobs.INTERRUPTED_STATE)]
+        assert runner.journal_problem.startswith(
+            f"{lock} was held by another process for over 0.2 s")
+    finally:
+        holder.kill()
+        holder.wait()

@@ -5,12 +5,14 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from pidcore.cli import main
+from pidcore.errors import InputFileError
 from pidcore.io import read_measurement
 
 F0, V0, FREQ, ETA, FS = 10.0, 0.05, 100.0, 0.05, 5120.0
@@ -153,3 +155,66 @@ def test_an_x_y_pair_at_another_rate_is_refused_naming_both_rates(tmp_path, caps
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and "run12.txt" in err
     assert "5120 Hz" in err and "2560 Hz" in err
+
+
+@pytest.mark.parametrize(("name", "unit", "value"), [("Delay", "ms", 0.5),
+                                                      ("Time offset", "s", 1e-3)])
+def test_a_constant_column_in_seconds_is_a_channel_not_a_time_base(tmp_path, capsys, name,
+                                                                    unit, value):
+    # a vibrometer delay or a trigger offset written as a column of its unit beside the
+    # signals: read as the x of an x/y pair, it refused the whole file ('time does not
+    # increase'); it is a quantity in seconds, as it was read before x/y pairs
+    t = np.arange(int(2 * FS)) / FS
+    w = 2 * math.pi * FREQ
+    path = write_testlab_text(tmp_path / "run13.txt", [
+        ("Time", "s", t), ("Point1:+Z", "m/s", V0 * np.sin(w * t - PHI)),
+        (name, unit, np.full(t.size, value)), ("Force", "N", F0 * np.sin(w * t))])
+    channels = read_measurement(path).channels
+    assert [c.name for c in channels] == ["Point1:+Z", name, "Force"]
+    # the force is timed by the first time column, as the velocity
+    assert (channels[2].start_time_s, channels[2].sample_rate_hz) == \
+        (channels[0].start_time_s, channels[0].sample_rate_hz)
+    record = analyze_json(path, capsys)
+    # same grid for both channels: exact up to the 8 printed digits
+    assert record["loss_factor"] == pytest.approx(ETA, rel=1e-6)
+    # a column named as the time column is the pair's time base, even broken: refused
+    path = write_testlab_text(tmp_path / "run14.txt", [
+        ("Time", "s", t), ("Point1:+Z", "m/s", V0 * np.sin(w * t - PHI)),
+        ("Time", "s", np.zeros(t.size)), ("Force", "N", F0 * np.sin(w * t))])
+    assert main(["analyze", str(path), "--no-store", "--no-progress"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "run14.txt: column 'Time' (time of column 4)" in err
+
+
+def test_a_time_column_that_does_not_advance_names_its_times_as_numbers(tmp_path):
+    # numpy 2's repr leaked into the message: "(first np.float64(0.0005), last ...)"
+    t = np.arange(64) / FS
+    path = write_testlab_text(tmp_path / "run15.txt", [
+        ("Time", "s", np.full(t.size, 0.0005)), ("Force", "N", np.sin(t))])
+    with pytest.raises(InputFileError) as info:
+        read_measurement(path)
+    assert str(info.value).endswith("run15.txt: column 'Time': time does not increase "
+                                    "(first 0.0005, last 0.0005)")
+
+
+@pytest.mark.parametrize("options", [(), ("--allow-clipped",)])
+def test_overflow_markers_on_over_half_a_percent_of_samples_are_named(tmp_path, capsys,
+                                                                      options):
+    # an overload of 2 % of the record: the markers were inside the central 99 % the outlier
+    # test measures from, so 'clipped: 3911 samples' was said (and with --allow-clipped, an
+    # 'unresolved' reactive power of -2.75e+33 W)
+    columns = shaker_columns("Force", "N", 1.0, "Point1:+Z", "m/s", 1.0)
+    marked = np.arange(50, columns[2][2].size, 50)  # every 50th sample: 2 %
+    columns[2][2][marked] = 3.402823e38
+    path = write_testlab_text(tmp_path / "run16.txt", columns)
+    assert main(["analyze", str(path), "--no-store", "--no-progress", *options]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "run16.txt: channel 'Force': " in err
+    assert f"{marked.size} samples far outside the signal, first at index 50 " in err
+    # the rest of the channel is the drive line of amplitude F0: its central 99 % reach
+    # within 0.1 % of +-F0 (a sine's 0.5 % quantile is F0 cos(0.005 pi), 0.012 % short of it,
+    # sampled 51 times a period); the markers no longer stretch it to 3.4e38
+    low, high = map(float, re.search(r"99 % of the other samples lie within (\S+) \.\. (\S+) N",
+                                      err).groups())
+    assert (low, high) == (pytest.approx(-F0, rel=1e-3), pytest.approx(F0, rel=1e-3))
+    assert "clipped" not in err

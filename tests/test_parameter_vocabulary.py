@@ -251,6 +251,44 @@ def test_the_cli_table_renames_keywords_only_where_they_name_the_parameter():
     assert cli_words("frequency_hz must be > 0", "model damper") == "frequency_hz must be > 0"
 
 
+#: Messages whose only keyword-like words are the user's own names: a file, a folder, a
+#: quoted channel, a specimen and a store key the library writes unquoted.
+USERS_NAMES = ("/data/structure_mass_kg.csv: no force channel",
+               "/data/key=1/a.csv: no force channel", "runs/fill_percent/a.csv: empty",
+               "C:\\runs\\frequency_hz\\a.csv: empty", "/tmp/allow_clipped: no such file",
+               "a.csv: channel 'force=' is constant", 'a.csv: channel "velocity=" is constant',
+               "specimen fill_percent is not the paper's coupon",
+               "store.h5: measurement key key=abc already holds rec.csv")
+
+
+def test_the_users_names_that_hold_a_keyword_stay_as_written(tmp_path, capsys):
+    from pidcore.app import uploads
+    from pidcore.app.vocabulary import page_terms
+    from pidcore.cli._vocabulary import cli_words
+    from pidcore.measure import AnalysisOptions
+
+    for said in USERS_NAMES:
+        assert cli_words(said, "report") == said
+        assert page_terms(said) == said
+    # beside a name, the message's own keyword is still the flag or field
+    assert cli_words("/d/key=1/x.csv: choose one with key=NAME") == \
+        "/d/key=1/x.csv: choose one with --key NAME"
+    assert page_terms("structure_mass_kg.csv: give structure_mass_kg") == \
+        "structure_mass_kg.csv: give 'structure mass [g]'"
+    # end to end: the folder and file the user named come back as they are (they read
+    # "/.../--key 1/--structure-mass.csv")
+    (tmp_path / "key=1").mkdir()
+    path = export(tmp_path / "key=1" / "structure_mass_kg.csv")
+    err = cli_refusal(["analyze", str(path), "--no-store", "--force", "Velocity"], capsys)
+    assert err.startswith(f"pidcore analyze: error: {path}: ")
+    assert "--force 'Velocity' is a velocity channel" in err
+    outcome = uploads.analyze_parsed(uploads.parse_upload("structure_mass_kg.csv",
+                                                          path.read_bytes()),
+                                     AnalysisOptions(force="Velocity"))
+    assert outcome.error.startswith("structure_mass_kg.csv: ")
+    assert "the 'force channel' column ('Velocity') is a velocity channel" in outcome.error
+
+
 def test_the_app_names_its_fields_where_it_shows_a_library_refusal(tmp_path):
     from pidcore.app import uploads
     from pidcore.app.calibration import page_words
@@ -305,3 +343,78 @@ def test_no_library_message_names_a_cli_flag():
     for name in NOT_CONVERTED:
         tree = ast.parse((root / name).read_text(encoding="utf-8"))
         assert any(FLAG.search(n.value) for n in _strings_outside_docstrings(tree)), name
+
+
+# --- every keyword a library message names is a parameter ------------------------------------
+
+#: Files whose strings are HTML (attributes alt=, src=, width=), not messages.
+HTML_WRITERS = {"pidcore/report/render.py", "pidcore/calibrate/outputs.py"}
+#: Words written with '=' in messages that name no parameter, and why: an HDF5 attribute
+#: ("pidcore_layout=2") and a settings table's column in a --where value.
+NOT_PARAMETERS = {"pidcore_layout", "settings_hash"}
+#: A keyword as a message gives it: a lower-case name right before '=' and its value or
+#: placeholder (key=NAME, force='Fz', allow_clipped=True, store=PATH), not inside a longer
+#: name, a quoted name or a comparison ('==').
+_KEYWORD_IN_MESSAGE = re.compile(r"(?<![\w.'\"=-])([a-z][a-z0-9_]*)=(?=[A-Z'{\"0-9]|$|[ ,;)])")
+
+
+def _public_parameters() -> set[str]:
+    """Every parameter of every public function, method and data class field of the library
+    (the front-ends, pidcore.cli and pidcore.app, left out: their words are their own)."""
+    import dataclasses
+    import importlib
+    import inspect
+    import pkgutil
+
+    import pidcore
+
+    names: set[str] = set()
+    for info in pkgutil.walk_packages(pidcore.__path__, "pidcore."):
+        if info.name.startswith(("pidcore.cli", "pidcore.app")) or info.name.endswith("__main__"):
+            continue
+        module = importlib.import_module(info.name)
+        for name, obj in vars(module).items():
+            if name.startswith("_") or getattr(obj, "__module__", None) != module.__name__:
+                continue
+            callables = [obj]
+            if inspect.isclass(obj):
+                callables += [v for k, v in vars(obj).items()
+                              if not k.startswith("_") and callable(v)]
+                if dataclasses.is_dataclass(obj):
+                    names |= {f.name for f in dataclasses.fields(obj)}
+            for c in callables:
+                try:
+                    names |= set(inspect.signature(c).parameters)
+                except (TypeError, ValueError):  # a builtin without a signature
+                    pass
+    return names
+
+
+def test_every_keyword_a_library_message_names_is_a_public_parameter():
+    # a message that tells a caller to pass a keyword the API does not have (a typo, a
+    # renamed parameter: "give structure_mass=...") sends a Python user to a TypeError and
+    # has no flag or field in the front-ends' tables
+    from pidcore.app.vocabulary import LABEL_OF_KEYWORD
+    from pidcore.cli._vocabulary import COMMAND_FLAGS
+
+    parameters = _public_parameters()
+    named: dict[str, str] = {}
+    root = Path(__file__).resolve().parents[1]
+    for path in sorted((root / "pidcore").rglob("*.py")):
+        relative = path.relative_to(root).as_posix()
+        if relative.startswith(("pidcore/cli/", "pidcore/app/")) or relative in HTML_WRITERS:
+            continue
+        tree = ast.parse(path.read_text(encoding="utf-8"))
+        for node in _strings_outside_docstrings(tree):
+            for keyword in _KEYWORD_IN_MESSAGE.findall(node.value):
+                named.setdefault(keyword, f"{relative}:{node.lineno}")
+    assert len(named) > 20  # the pattern still finds the messages' keywords
+    unknown = {k: where for k, where in named.items()
+               if k not in parameters and k not in NOT_PARAMETERS}
+    assert not unknown, f"keywords that no public function takes: {unknown}"
+    # the front-ends' tables translate only parameters that exist
+    tabled = {re.match(r"\^?([a-z_]+)", k).group(1) for table in
+              [*COMMAND_FLAGS.values(), LABEL_OF_KEYWORD] for k in table if k[0] != "^" or
+              k[1:].isidentifier()}
+    assert tabled - parameters <= {"calibrate", "write_outputs", "read_measured_table"}, \
+        tabled - parameters

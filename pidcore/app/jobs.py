@@ -72,6 +72,9 @@ SAME_RUN_STATE = "same run"
 _START_TOLERANCE_S = 1.0
 #: Runners of this process (:attr:`JournalOwner.runner`): runners live as long as the process.
 _LIVE_RUNNERS: set[str] = set()
+#: Seconds a runner waits for the journal's lock file before it goes on without it (a
+#: journal change takes milliseconds; a holder this long hangs).
+JOURNAL_LOCK_WAIT_S = 10.0
 #: Seconds between checks of the running case (progress, cancel).
 _POLL_S = 0.05
 #: Seconds a terminated process gets before it is killed.
@@ -223,8 +226,7 @@ class JournalOwner:
         host, pid, started, runner = (doc.get(k) for k in ("host", "pid", "started", "runner"))
         if not (isinstance(host, str) and isinstance(runner, str)
                 and isinstance(pid, int) and not isinstance(pid, bool) and pid > 0
-                and isinstance(started, int | float) and not isinstance(started, bool)
-                and math.isfinite(started)):
+                and _finite_number(started)):
             return None
         return cls(host, pid, float(started), runner)
 
@@ -424,19 +426,32 @@ class DemJobRunner:
                 self._journal_lock_depth -= 1
             return
         path = journal_path(self.store_path)
+        lock_path = path.with_name(path.name + ".lock")
+        unlocked = ""  # why the journal is changed without the lock
         try:
-            fd = os.open(path.with_name(path.name + ".lock"), os.O_RDWR | os.O_CREAT, 0o644)
-        except OSError:
+            fd = os.open(lock_path, os.O_RDWR | os.O_CREAT, 0o644)
+        except OSError as exc:
             fd = None
+            # a read-only folder: the journal cannot be written either, which
+            # _write_journal says; a folder or an unreadable file in the lock's place is said
+            if lock_path.exists():
+                unlocked = f"{lock_path} cannot be opened ({type(exc).__name__})"
         try:
-            if fd is not None and fcntl is not None:
-                fcntl.flock(fd, fcntl.LOCK_EX)  # released when fd is closed, or the process dies
+            if fd is not None and fcntl is not None \
+                    and not _lock_within(fd, JOURNAL_LOCK_WAIT_S):
+                unlocked = (f"{lock_path} was held by another process for over "
+                            f"{JOURNAL_LOCK_WAIT_S:g} s (an app server that hangs?)")
             self._journal_lock_depth = 1
             yield
         finally:
             self._journal_lock_depth = 0
             if fd is not None:
                 os.close(fd)
+            if unlocked:  # said after the body, whose journal note it would replace
+                self.journal_problem = (
+                    f"{unlocked}; the job table was read and written without it: a change "
+                    "another app server made meanwhile may be lost"
+                    + (f"; {self.journal_problem}" if self.journal_problem else ""))
 
     def _merge_journal(self) -> tuple[str, int]:
         """Read the journal (lock and journal lock held): the jobs of other servers that still
@@ -719,6 +734,24 @@ def journal_path(store_path: str | Path) -> Path:
 _JOB_ID = re.compile(r"job[0-9]{4,18}")
 
 
+def _lock_within(fd: int, wait_s: float) -> bool:
+    """Take the exclusive lock of ``fd`` (released when it is closed, or the process dies)
+    within ``wait_s``; False when another process held it all that time (True where the file
+    system has no locks). Waiting without end
+    hung the app's page on a server that holds it and hangs (stopped, a dead NFS mount)."""
+    deadline = time.monotonic() + wait_s
+    while True:
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            return True
+        except BlockingIOError:
+            if time.monotonic() >= deadline:
+                return False
+            time.sleep(_POLL_S)
+        except OSError:  # a file system without locks: as where no lock file can be made
+            return True
+
+
 def _job_number(job_id: str) -> int:
     return int(job_id[3:]) if _JOB_ID.fullmatch(job_id) else 0
 
@@ -728,10 +761,20 @@ def _time_s(value: object, name: str) -> float | None:
     (a text there made every row of the job table a TypeError)."""
     if value is None:
         return None
-    if isinstance(value, bool) or not isinstance(value, int | float) \
-            or not math.isfinite(value):
-        raise ValueError(f"{name} must be a time in s or null, got {value!r}")
+    if not _finite_number(value):
+        raise ValueError(f"{name} must be a time in s or null, got {repr(value)[:40]}")
     return float(value)
+
+
+def _finite_number(value: object) -> bool:
+    """Whether a journal's value is a finite int or float: an integer of 400 digits is no
+    float (math.isfinite raised OverflowError, a traceback at the app's start)."""
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        return False
+    try:
+        return math.isfinite(value)
+    except OverflowError:
+        return False
 
 
 def _count(value: object, name: str) -> int:
@@ -806,9 +849,10 @@ def _job_from_document(doc: dict, *, live: bool = False) -> DemJob:
 
 
 #: What a journal that cannot be trusted raises while it is read (RecursionError: JSON nested
-#: deeper than Python's stack, json.loads is recursive).
+#: deeper than Python's stack, json.loads is recursive; OverflowError: an integer of
+#: hundreds of digits where the load case holds a float).
 _UNREADABLE = (OSError, ValueError, TypeError, KeyError, AttributeError, RecursionError,
-               PidcoreError)
+               OverflowError, PidcoreError)
 
 
 def _journal_entries(path: Path) -> tuple[list[tuple[object, JournalOwner | None]], str]:

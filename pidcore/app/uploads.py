@@ -155,12 +155,13 @@ class UploadOutcome:
         return self.record is not None
 
 
-def app_words(text: str) -> str:
+def app_words(text: str, *, names: Iterable[str] = ()) -> str:
     """A library message or note as the app says it: the parameters it names by their
     keywords (:func:`pidcore.app.vocabulary.page_terms`) as the page's fields and columns,
     and the hints whose advice differs on the page said as the page's: the app has no unit
     setting (it takes each channel's unit from its file), no choice of a store's record, and
-    sets the inverted channels and the mass below gauge in the table."""
+    sets the inverted channels and the mass below gauge in the table; ``names`` (the
+    upload's) stay as written."""
     text = text.replace(
         "check both units (velocity_unit, acceleration_unit)",
         "check both units in the export (the app takes each channel's unit from its file; "
@@ -190,13 +191,13 @@ def app_words(text: str) -> str:
     text = re.sub(r"structure_mass_kg ([-+]?[0-9.]+(?:e[-+]?[0-9]+)?) kg",
                   lambda m: f"structure mass [g] {float(m[1]) * 1e3:g} g", text)
     text = text.replace("structure_mass_kg in kg", "'structure mass [g]' in g")
-    return page_terms(text)
+    return page_terms(text, names=names)
 
 
 def error_message(name: str, exc: BaseException) -> str:
     """One-line message for a failed upload; library errors already name the file."""
     text = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
-    text = app_words(text)
+    text = app_words(text, names=[name])
     text = re.sub(r"\S*pidcore_upload_[^/\\\s]*[/\\][^:\s]*", name, text)
     if isinstance(exc, PidcoreError):
         return text if name in text else f"{name}: {text}"
@@ -230,7 +231,8 @@ def analyze_parsed(parsed: ParsedUpload, options: AnalysisOptions) -> UploadOutc
     except _BAD_INPUT_ERRORS as exc:
         return UploadOutcome(parsed.name, parsed.sha256, error=error_message(parsed.name, exc))
     # the unit-slip note suggested `analyze` options the page does not have
-    record = replace(record, notes=tuple(app_words(n) for n in record.notes))
+    record = replace(record, notes=tuple(app_words(n, names=[parsed.name])
+                                               for n in record.notes))
     return UploadOutcome(parsed.name, parsed.sha256, record=record)
 
 

@@ -10,6 +10,9 @@ every library refusal and note through it (:func:`pidcore.app.uploads.app_words`
 from __future__ import annotations
 
 import re
+from collections.abc import Iterable
+
+from ..errors import outside_user_names
 
 #: Library keyword (as the message writes it) -> the app's label of it. A single word
 #: (``force``) is a keyword only with its ``=``, and a ``=VALUE`` after a keyword stays as the
@@ -54,7 +57,8 @@ _PAGE_SCALE: dict[str, float] = {"structure_mass_kg": 1e3, "mass_below_gauge_kg"
 # that name, nor part of a longer name
 _NOT_BEFORE = r"(?<![\w'=-])(?<!\] )(?<!column )(?<!attribute )(?<!field )(?<!variable )"
 _NOT_AFTER_WORD = r"(?![\w'])(?! column)"
-_VALUE = r"(?P<value>'[^']*'|[\w.+-]+)"
+# a value the user's name held (pidcore.errors.outside_user_names) is a placeholder
+_VALUE = r"(?P<value>'[^']*'|\ue000\d+\ue001|[\w.+-]+)"
 _PATTERNS = tuple(
     (re.compile(_NOT_BEFORE + re.escape(k.removesuffix("="))
                 + (f"={_VALUE}?" if k.endswith("=") else
@@ -64,10 +68,15 @@ _PATTERNS = tuple(
     for k, label in sorted(LABEL_OF_KEYWORD.items(), key=lambda kv: -len(kv[0])))
 
 
-def page_terms(message: str) -> str:
+def page_terms(message: str, *, names: Iterable[str] = ()) -> str:
     """``message`` (a library refusal or note) with its parameter keywords named as the app's
     fields and columns; a value given with one follows in parentheses (a placeholder such as
-    ``NAME`` is left out)."""
+    ``NAME`` is left out). The user's names in it (files, channels, specimens, and ``names``:
+    the upload's) stay as written."""
+    return outside_user_names(message, _in_page_terms, names=names)
+
+
+def _in_page_terms(message: str) -> str:
     def labelled(named: str, scale: float, m: re.Match) -> str:
         value = m.group("value")
         if value is None or (value.isupper() and not value.startswith("'")):

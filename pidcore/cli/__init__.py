@@ -126,7 +126,7 @@ def _run(argv: list[str] | None) -> int:
             print(f"pidcore {command}: interrupted; {said}", file=sys.stderr)
             interrupt.mark_handled()
             return interrupt.exit_status()
-        print(f"pidcore {command}: error: {_in_flags(exc, command)}", file=sys.stderr)
+        print(f"pidcore {command}: error: {_in_flags(exc, command, words)}", file=sys.stderr)
         return 2
     except BrokenPipeError:  # the reader of stdout (| head) stopped: end quietly
         import os
@@ -147,7 +147,7 @@ def _run(argv: list[str] | None) -> int:
         return interrupt.exit_status()
 
 
-def _in_flags(exc: PidcoreError, command: str) -> str:
+def _in_flags(exc: PidcoreError, command: str, words: list[str]) -> str:
     """A library refusal in the words of ``pidcore COMMAND``: the parameters it names by their
     keyword (``structure_mass_kg``) as the flags the user types (``--structure-mass``). A
     settings table's refusal names the table's columns, which are no flags, and stays as it
@@ -155,7 +155,10 @@ def _in_flags(exc: PidcoreError, command: str) -> str:
     from ..errors import SettingsTableError
     from ._vocabulary import cli_words
 
-    return str(exc) if isinstance(exc, SettingsTableError) else cli_words(str(exc), command)
+    # what the command line gave (a file, a folder, a key) is the user's, whatever it holds
+    given = [w.split("=", 1)[1] if w.startswith("--") and "=" in w else w for w in words]
+    return str(exc) if isinstance(exc, SettingsTableError) else \
+        cli_words(str(exc), command, names=[w for w in given if not w.startswith("-")])
 
 
 def _what_an_interrupt_left(args: argparse.Namespace) -> str:

@@ -11,6 +11,9 @@ from __future__ import annotations
 
 import functools
 import re
+from collections.abc import Iterable
+
+from ..errors import outside_user_names
 
 #: Library keyword (as the message writes it) -> the flag of ``pidcore analyze`` and
 #: ``pidcore report`` that sets it: the analysis options and the load case. A single word
@@ -123,8 +126,11 @@ def _flag(flags: dict[str, str], m: re.Match) -> str:
     return flag if valued else flag.rstrip()
 
 
-def cli_words(message: str, command: str = "analyze") -> str:
+def cli_words(message: str, command: str = "analyze", *, names: Iterable[str] = ()) -> str:
     """``message`` (a library refusal or note) with its parameter keywords named as the flags
-    of ``pidcore COMMAND`` (``"dem sweep"``; the default: those of ``analyze``)."""
+    of ``pidcore COMMAND`` (``"dem sweep"``; the default: those of ``analyze``); the user's
+    names in it (files, folders, channels, specimens, store keys, and ``names``: what the
+    command line gave) stay as written."""
     flags, pattern = _table(command)
-    return pattern.sub(lambda m: _flag(flags, m), message)
+    return outside_user_names(message, lambda text: pattern.sub(lambda m: _flag(flags, m), text),
+                              names=names)

@@ -128,7 +128,9 @@ def rate_from_times(times: np.ndarray, *, what: str, with_note: bool = False):
         raise InputFileError(f"{what}: the time column holds non-finite values")
     dt = (t[-1] - t[0]) / (t.size - 1)
     if not dt > 0:
-        raise InputFileError(f"{what}: time does not increase (first {t[0]!r}, last {t[-1]!r})")
+        # as numbers: numpy 2's repr says "np.float64(0.0005)"
+        raise InputFileError(f"{what}: time does not increase (first {float(t[0])!r}, "
+                             f"last {float(t[-1])!r})")
     index = np.arange(t.size, dtype=np.float64)
     residual = np.max(np.abs(t - (t[0] + dt * index)))
     note = ""

@@ -295,7 +295,7 @@ def read_csv(path: str | os.PathLike[str], *, sample_rate_hz: float | None = Non
         raise InputFileError(f"{where}: no time column (e.g. 'Time [s]') and no sample rate; "
                              "add a time column or give the sample rate (sample_rate_hz)")
 
-    pair_times = _pair_time_columns(cells, time_index)
+    pair_times = _pair_time_columns(cells, time_index, values)
     keep = [i for i in range(len(cells)) if i != time_index and i not in pair_times]
     if not keep:
         raise InputFileError(f"{where}: only a time column; expected channel columns beside it")
@@ -313,15 +313,32 @@ def read_csv(path: str | os.PathLike[str], *, sample_rate_hz: float | None = Non
                        file_format="csv", metadata=metadata)
 
 
-def _pair_time_columns(cells: list[tuple[str, str]], time_index: int | None) -> list[int]:
+def _pair_time_columns(cells: list[tuple[str, str]], time_index: int | None,
+                       values: np.ndarray) -> list[int]:
     """Time columns after the first one: the x of x/y pairs (``Time;Force;Time;Point1:+Z``,
-    as Testlab exports signals of their own time axis). Such a column has a time unit or the
-    first time column's name; each is the time base of the columns up to the next one."""
+    as Testlab exports signals of their own time axis). Such a column has a time's name (the
+    first time column's, or ``time``), or a time unit and times that advance; each is the time
+    base of the columns up to the next one. A column in seconds that does not advance is a
+    quantity of that unit (``Delay [ms]``, ``Time offset [s]``), kept as a channel as before:
+    read as a time base, it refused the whole file."""
     if time_index is None:
         return []
-    first_name = cells[time_index][0].strip().lower()
-    return [i for i, (name, unit) in enumerate(cells) if i > time_index and (
-        interpret_unit(unit)[0] == "time" or (not unit and name.strip().lower() == first_name))]
+    time_names = {cells[time_index][0].strip().lower(), "time"}
+    pairs = []
+    for i, (name, unit) in enumerate(cells):
+        if i <= time_index:
+            continue
+        if name.strip().lower() in time_names and (not unit or _is_time_unit(unit)):
+            pairs.append(i)
+        elif _is_time_unit(unit):
+            given = values[:, i][np.isfinite(values[:, i])]
+            if given.size >= 2 and given[-1] > given[0]:
+                pairs.append(i)
+    return pairs
+
+
+def _is_time_unit(unit: str) -> bool:
+    return interpret_unit(unit)[0] == "time"
 
 
 def _pair_time_bases(values: np.ndarray, cells: list[tuple[str, str]], pair_times: list[int],

@@ -149,28 +149,44 @@ def check_finite(data: np.ndarray, *, source: str, channel: str) -> None:
 MAX_OUTLIER_FACTOR = 1e6
 
 
+#: A sample this large in magnitude is an overflow or "no value" marker whatever the rest of
+#: the channel holds (float32 max 3.4e38, Testlab's 9.9e37): no force, velocity or
+#: acceleration in any unit comes near it. Markers on over 0.5 % of the samples moved the
+#: central range itself, and the channel was called clipped (or its power unresolved).
+MARKER_MAGNITUDE = 1e30
+
+
 def check_outliers(data: np.ndarray, *, source: str, channel: str, unit: str = "") -> None:
-    """Reject samples more than :data:`MAX_OUTLIER_FACTOR` half-ranges of the channel's central
-    99 % outside it: overflow markers and corrupt values. Without this, one 3.4e38 made every
-    other sample count as clipped at the channel's minimum."""
+    """Reject samples of :data:`MARKER_MAGNITUDE` or more, and samples more than
+    :data:`MAX_OUTLIER_FACTOR` half-ranges of the channel's central 99 % (without those) outside
+    it: overflow markers and corrupt values. Without this, one 3.4e38 made every other sample
+    count as clipped at the channel's minimum."""
     if data.size < 2:
         return
-    low, high = (float(v) for v in np.percentile(data, [0.5, 99.5]))
+    marker = np.abs(data) >= MARKER_MAGNITUDE
+    clean = data[~marker]
+    if clean.size:
+        low, high = (float(v) for v in np.percentile(clean, [0.5, 99.5]))
+    else:
+        low = high = float("nan")
     half_range, middle = 0.5 * (high - low), 0.5 * (high + low)
-    if not half_range > 0:
-        return  # over 99 % equal: the constant and dropout checks say what it is
-    limit = MAX_OUTLIER_FACTOR * half_range
-    if float(np.max(data)) - middle <= limit and middle - float(np.min(data)) <= limit:
-        return
-    far = np.abs(data - middle) > limit
+    if not marker.any():
+        if not half_range > 0:
+            return  # over 99 % equal: the constant and dropout checks say what it is
+        limit = MAX_OUTLIER_FACTOR * half_range
+        if float(np.max(data)) - middle <= limit and middle - float(np.min(data)) <= limit:
+            return
+    far = marker | (np.abs(data - middle) > MAX_OUTLIER_FACTOR * half_range
+                    if half_range > 0 else marker)
     first = int(np.argmax(far))
     count = int(far.sum())
     in_unit = f" {unit}" if unit else ""
+    rest = (f"99 % of the other samples lie within {low:.6g} .. {high:.6g}{in_unit}"
+            if clean.size else "no other samples")
     raise ChannelError(
         f"{_label(source, channel)}: {count} sample{'s' if count > 1 else ''} far outside the "
-        f"signal, first at index {first} ({data[first]:.6g}{in_unit}; 99 % of the samples lie "
-        f"within {low:.6g} .. {high:.6g}{in_unit}); expected measured values, not an overload "
-        "or 'no value' marker: cut them out of the export")
+        f"signal, first at index {first} ({data[first]:.6g}{in_unit}; {rest}); expected "
+        "measured values, not an overload or 'no value' marker: cut them out of the export")
 
 
 def check_length(data: np.ndarray, *, source: str, channel: str, min_samples: int) -> None:
