@@ -11,6 +11,11 @@ from . import constants
 STORE_PATH = Path("pid_store.h5")
 #: Seconds a writer waits for the store's write lock before giving up with a StoreError.
 STORE_LOCK_TIMEOUT_S = 60.0
+#: Largest store, bytes, whose working copy is changed in memory (HDF5 never writes to disk, so
+#: a full disk is one line of Python's); a larger one is copied to disk and changed there, as
+#: holding it in memory made every commit of a store of long records need its size in RAM
+#: (10 GB for ~25 ten-minute records).
+STORE_IN_MEMORY_MAX_BYTES = 256 * 2**20
 
 # --- Measurement (Eq. 11) -------------------------------------------------------------------
 #: Number of drive harmonics fitted (1 = fundamental only). Harmonics above Nyquist are dropped.

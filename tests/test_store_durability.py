@@ -33,6 +33,33 @@ def _with_file_size_limit(limit_bytes: int):
     return limit
 
 
+def test_a_store_changed_on_disk_is_refused_in_one_line_where_its_copy_cannot_fit(tmp_path):
+    # A store above STORE_IN_MEMORY_MAX_BYTES is copied to disk and HDF5 writes that copy
+    # itself, so a write it fails would end in h5py's destructor errors and a segfault (as the
+    # test above found for every store before the in-memory copy): the room is checked before
+    # the copy is made, in one line, store unchanged.
+    store = Store(tmp_path / "s.h5")
+    store.add_dem_run("kept", {"sdc": 0.25}, arrays={"trace": np.arange(1000.0)})
+    digest, size = file_sha256(store.path), store.path.stat().st_size
+    code = textwrap.dedent(f"""
+        from pidcore import defaults
+        from pidcore.errors import StoreError
+        from pidcore.store import Store
+        defaults.STORE_IN_MEMORY_MAX_BYTES = 0  # every store is "large"
+        try:
+            Store({str(store.path)!r}).add_dem_run("new", {{"sdc": 0.5}})
+        except StoreError as exc:
+            print(exc)
+    """)
+    p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                       timeout=60, env={**os.environ, "PYTHONPATH": str(ROOT)},
+                       preexec_fn=_with_file_size_limit(size - 4000))
+    assert p.returncode == 0 and p.stderr == "", (p.returncode, p.stderr[-2000:])
+    lines = p.stdout.splitlines()
+    assert len(lines) == 1 and "s.h5: the file size limit of this process" in lines[0]
+    assert file_sha256(store.path) == digest and sorted(os.listdir(tmp_path)) == ["s.h5"]
+
+
 @pytest.mark.parametrize("room", [-4000, 1_000_000], ids=["below-the-store", "above-it"])
 def test_a_write_past_the_file_size_limit_is_one_line_and_leaves_the_store(tmp_path, room):
     # The limit is just below the store's size or 1 MB above it (a copy of the store fits,

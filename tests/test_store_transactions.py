@@ -32,6 +32,17 @@ def leftovers(directory) -> list[str]:
                   if p.name not in {"pid_store.h5", "pid_store.h5.lock"})
 
 
+@pytest.fixture(autouse=True, params=["in memory", "on disk"])
+def working_copy(request, monkeypatch):
+    """Every test here in both ways a commit changes its copy: in memory (stores up to
+    STORE_IN_MEMORY_MAX_BYTES) and copied to disk (larger ones; here every store)."""
+    from pidcore import defaults
+
+    if request.param == "on disk":
+        monkeypatch.setattr(defaults, "STORE_IN_MEMORY_MAX_BYTES", 0)
+    return request.param
+
+
 @pytest.fixture
 def store(tmp_path):
     store = Store(tmp_path / "pid_store.h5")
@@ -192,3 +203,35 @@ def test_writer_killed_mid_transaction_loses_only_its_own_batch(store, tmp_path)
     Store(store.path, lock_timeout_s=5).add_dem_run("next", {"sdc": 0.5})
     assert leftovers(tmp_path) == []
     assert list(store.list_dem_runs()["case_key"]) == ["existing", "next"]
+
+
+def test_a_store_above_the_in_memory_limit_is_changed_on_disk_not_read_into_memory(
+        tmp_path, monkeypatch, working_copy):
+    # A store of long records (G's scale trial: ~380 MB per ten-minute record) needed its whole
+    # size in memory at every commit: 10 GB of RAM for ~25 records, per DEM case of a sweep.
+    # Above the limit the copy is made on disk: Python's own allocations during a commit stay
+    # far below the store's size (tracemalloc sees the in-memory copy, not HDF5's C buffers).
+    import tracemalloc
+
+    from pidcore import defaults
+
+    store = Store(tmp_path / "pid_store.h5")
+    samples = np.random.default_rng(0).standard_normal(2_000_000)  # 16 MB, incompressible
+    store.add_dem_run("big", {"sdc": 0.1}, arrays={"samples": samples})
+    size = store.path.stat().st_size
+    assert size > 10e6  # compression takes a few %
+    monkeypatch.setattr(defaults, "STORE_IN_MEMORY_MAX_BYTES",
+                        size - 1 if working_copy == "on disk" else size)
+    tracemalloc.start()
+    try:
+        store.add_dem_run("small", {"sdc": 0.2})
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    if working_copy == "on disk":
+        assert peak < 0.1 * size, peak  # a few hundred kB of Python objects, not the 16 MB
+    else:
+        assert peak > size, peak  # the image itself
+    assert sorted(store.list_dem_runs()["case_key"]) == ["big", "small"]
+    np.testing.assert_array_equal(store.get_dem_run("big").arrays["samples"], samples)
+    assert store.verify() == [] and leftovers(tmp_path) == []

@@ -23,7 +23,10 @@ a temporary file beside the store, fsync'ed and moved over the original with
 the store's path therefore only ever holds a complete, committed state. HDF5 itself never writes
 to disk: a write it fails (file size limit, full disk) surfaced as errors inside h5py's object
 destructors, a two-line message and a segmentation fault at exit; a failed write of the image
-is one ``OSError`` of Python's own.
+is one ``OSError`` of Python's own. A store larger than
+:data:`pidcore.defaults.STORE_IN_MEMORY_MAX_BYTES` is copied to the temporary file instead and
+changed there (its size in memory per commit was the price otherwise); the room for the copy
+is checked before (:meth:`Store.check_writable`), and the rename is the same.
 
 Readers take no lock. Because the path is only ever swapped atomically and an open HDF5 handle
 keeps reading the file it opened, a reader sees the last committed state even while a writer
@@ -595,8 +598,11 @@ class Store:
                 finally:
                     self._active, self._active_thread = None, None
                 try:
-                    h5.close()  # flushes every change into the buffer
-                    _write_image(tmp, buffer.getbuffer())
+                    h5.close()  # flushes every change into the buffer (or the copy on disk)
+                    if buffer is None:
+                        _fsync_path(tmp)
+                    else:
+                        _write_image(tmp, buffer.getbuffer())
                     # The rename and its count are one step for Ctrl-C (a caller reads
                     # `commits` to say whether its work was saved); a Ctrl-C swallowed on the
                     # way (weakref callback, Numba) never commits.
@@ -616,19 +622,30 @@ class Store:
                 tmp.unlink(missing_ok=True)
                 raise
 
-    def _working_copy(self, tmp: Path, *, exists: bool) -> tuple[h5py.File, io.BytesIO]:
-        """The committed store (or a new store) in memory, opened for writing, and its
-        buffer; ``tmp`` created beside the store, empty, with the store's permissions, for
-        the commit to write the buffer to."""
+    def _working_copy(self, tmp: Path, *,
+                      exists: bool) -> tuple[h5py.File, io.BytesIO | None]:
+        """The committed store (or a new store) opened for writing, and its buffer: in memory,
+        ``tmp`` created beside the store, empty, with the store's permissions, for the commit
+        to write the buffer to; a store above :data:`pidcore.defaults.
+        STORE_IN_MEMORY_MAX_BYTES` copied to ``tmp`` and opened there (buffer ``None``)."""
         try:
             os.close(os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600))
             if exists:
                 shutil.copymode(self._file, tmp)
             else:
                 os.chmod(tmp, _new_file_mode())
-            # the only reference to the bytes read: the buffer grows them in place
-            buffer = io.BytesIO(self._file.read_bytes() if exists else b"")
-            h5 = h5py.File(buffer, "r+" if exists else "w")
+            if exists and self._file.stat().st_size > defaults.STORE_IN_MEMORY_MAX_BYTES:
+                # HDF5 writes this copy itself: a write it fails (no room, a file size limit)
+                # ends in errors from h5py's destructors, not one line, so the room is checked
+                # first (the store stays intact either way: it is never written in place)
+                self._check_room(self._file.parent)
+                shutil.copyfile(self._file, tmp)
+                buffer = None
+                h5 = h5py.File(tmp, "r+")
+            else:
+                # the only reference to the bytes read: the buffer grows them in place
+                buffer = io.BytesIO(self._file.read_bytes() if exists else b"")
+                h5 = h5py.File(buffer, "r+" if exists else "w")
         except OSError as exc:
             raise StoreError(f"{self.path}: cannot make the working copy {tmp.name} "
                              f"({_one_line(exc)}); the store is unchanged") from None
