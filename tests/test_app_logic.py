@@ -1859,3 +1859,30 @@ def test_cancel_says_when_there_is_nothing_to_cancel_and_what_it_cannot_cancel()
         "cancel requested for 2 job(s); finished cases stay saved; 1 job(s) queued or running "
         "on another app server of this store cannot be cancelled here (cancel them on that "
         "server's page)")
+
+
+def test_the_calibrate_page_names_its_fitted_parameters_as_its_fit_field_offers_them():
+    # the Calibrate page's summary read "Fitted: rolling_friction, fixture_mass_kg,
+    # 'baseline loss factor [-]'" (the Analyse tab's per-file column, another quantity) and an
+    # unknown parameter's error offered "'baseline loss factor [-]'", a name the 'parameters
+    # to fit' field does not hold and 'more parameters' refuses
+    import pidcore.calibrate as api
+    from pidcore.app.calibration import fittable_names, page_words
+
+    summary = (REPO / "data_samples" / "paper_calibration" / "summary.md").read_text()
+    shown = page_words(summary)
+    assert "'baseline loss factor [-]'" not in shown
+    assert shown.splitlines()[2] == summary.splitlines()[2]  # the "Fitted: ..." line as is
+    assert "| baseline_loss_factor | 0.01518 |" in shown
+    with pytest.raises(ParameterError) as refused:
+        api.parse_fit(["bogus_field"])
+    said = page_words(str(refused.value))
+    assert said.startswith("parameters to fit: unknown parameter 'bogus_field'")
+    offered = fittable_names(api)
+    assert "baseline_loss_factor" in offered
+    # every parameter the error lists is one the page's fit field offers, by that name
+    for name in ("fixture_mass_kg", "baseline_loss_factor", "rolling_friction"):
+        assert re.search(rf"(?<![\w']){name}(?![\w'])", said), name
+    # the keywords the page does have fields for are still said as those fields
+    assert page_words("structure_mass_kg=0.28 refused; baseline_loss_factor fitted") == \
+        "'structure mass [g]' (280) refused; baseline_loss_factor fitted"
