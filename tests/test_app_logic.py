@@ -113,6 +113,25 @@ def test_bad_upload_becomes_a_message_naming_the_file(data, options):
     assert "\n" not in outcome.error
 
 
+def test_reader_notes_of_an_upload_name_the_upload_not_its_temporary_copy(options):
+    # an x/y pair export (Time;Force;Time;Velocity, the velocity's own time 0.1 ms later)
+    # showed "note: /tmp/pidcore_upload_c_4macox/xy.txt: column 'Time' is the time of
+    # 'Velocity' ..." on its card, and the record saved that folder, gone once read
+    w, rate, delay = 2 * math.pi * 100.0, 10_000.0, 1e-4
+    t = np.arange(10_000) / rate
+    v_amp = 5 * 9.80665 / w
+    rows = "".join(f"{a:.9g};{0.1 * v_amp * w * math.cos(w * a):.9g};{a + delay:.9g};"
+                   f"{v_amp * math.sin(w * (a + delay)):.9g}\n" for a in t)
+    data = ("Time;Force;Time;Velocity\ns;N;s;m/s\n" + rows).encode()
+    outcome = uploads.analyze_upload("xy_pairs.txt", data, options)
+    assert outcome.ok, outcome.error
+    reader = outcome.record.measurement.metadata["reader_notes"]
+    pair = [n for n in reader if "is the time of 'Velocity'" in n]
+    assert pair and pair[0].startswith("xy_pairs.txt: column 'Time'")
+    for note in (*reader, *outcome.record.notes):
+        assert "pidcore_upload_" not in note, note
+
+
 def test_missing_channel_message_points_to_the_selectboxes(options):
     data = b"Time [s],Pressure [Pa]\n" + b"".join(
         f"{i / 1000:.4f},{np.sin(i / 10):.6f}\n".encode() for i in range(2000))

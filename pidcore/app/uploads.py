@@ -97,6 +97,14 @@ def read_upload(name: str, data: bytes, *, sample_rate_hz: float | None = None) 
         path = Path(folder) / safe_file_name(name)
         path.write_bytes(data)
         measurement = read_measurement(path, sample_rate_hz=sample_rate_hz)
+    # the readers' notes name the file they read: the private copy, whose folder is gone
+    # once read ("/tmp/pidcore_upload_x1/a.txt: column 'Time' is the time of 'Velocity'",
+    # shown on the card and saved with the record)
+    notes = measurement.metadata.get("reader_notes")
+    if notes:
+        measurement = replace(measurement, metadata={
+            **measurement.metadata,
+            "reader_notes": [str(n).replace(str(path), name) for n in notes]})
     return replace(measurement, source=name, sha256=measurement.sha256 or content_sha256(data))
 
 
