@@ -132,6 +132,33 @@ def test_reader_notes_of_an_upload_name_the_upload_not_its_temporary_copy(option
         assert "pidcore_upload_" not in note, note
 
 
+@pytest.mark.parametrize("typed, said, not_said", [
+    # 500 typed in 'mass below gauge [g]': "'mass below gauge [g]' 0.5 kg is probably larger"
+    ({"mass below gauge [g]": 500.0}, "'mass below gauge [g]' 500 g is probably larger", " kg "),
+    # 500000 typed in the µs field: "0.5 s ...; expected a vibrometer delay in s (e.g.
+    # 2e-4)", advice the field then refuses (2e-4 µs is "implausibly small")
+    ({"vibrometer delay [µs]": 5e5}, "'vibrometer delay [µs]': 500000 µs is longer than 4 "
+     "drive periods", "in s (e.g. 2e-4)"),
+    # 5 typed in 'structure mass [g]': "structure mass 0.005 kg given without a baseline"
+    ({"structure mass [g]": 5.0}, "'structure mass [g]' 5 g given without a baseline "
+     "loss factor", "0.005 kg"),
+])
+def test_messages_give_a_typed_mass_or_delay_in_the_fields_unit(typed, said, not_said):
+    name = "synthetic_f500Hz_a1g_fill50_acrylic.csv"
+    data = (REPO / "data_samples" / "exports" / name).read_bytes()
+    row = {**uploads.default_settings_row(name, stated_case(name)),
+           "vibrometer delay [µs]": 50.0, **typed}
+    outcome = uploads.analyze_upload(name, data, uploads.options_of(row))
+    text = outcome.error or " ".join(outcome.record.notes)
+    assert said in text
+    assert not_said not in text
+    if "vibrometer delay" in said:
+        assert "expected a vibrometer delay in µs (e.g. 200)" in text
+        # the advice is a value the field takes
+        assert uploads.options_of({**row, "vibrometer delay [µs]": 200.0}).velocity_delay_s \
+            == pytest.approx(2e-4, rel=1e-12)
+
+
 def test_missing_channel_message_points_to_the_selectboxes(options):
     data = b"Time [s],Pressure [Pa]\n" + b"".join(
         f"{i / 1000:.4f},{np.sin(i / 10):.6f}\n".encode() for i in range(2000))

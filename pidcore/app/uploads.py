@@ -198,6 +198,13 @@ def app_words(text: str) -> str:
     text = re.sub(r"structure_mass_kg ([-+]?[0-9.]+(?:e[-+]?[0-9]+)?) kg",
                   lambda m: f"structure mass [g] {float(m[1]) * 1e3:g} g", text)
     text = text.replace("structure_mass_kg in kg", "'structure mass [g]' in g")
+    # the fields are in g and µs: the hints gave kg and s ("structure mass 0.005 kg given"
+    # for 5 typed in g; "expected a vibrometer delay in s (e.g. 2e-4)", which the µs field
+    # then refuses as implausibly small)
+    text = re.sub(r"(?<![\w'])structure mass ([-+]?[0-9.]+(?:e[-+]?[0-9]+)?) kg given",
+                  lambda m: f"'structure mass [g]' {float(m[1]) * 1e3:g} g given", text)
+    text = text.replace("expected a vibrometer delay in s (e.g. 2e-4)",
+                        "expected a vibrometer delay in µs (e.g. 200)")
     return page_terms(text)
 
 
