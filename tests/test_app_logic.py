@@ -159,6 +159,21 @@ def test_messages_give_a_typed_mass_or_delay_in_the_fields_unit(typed, said, not
             == pytest.approx(2e-4, rel=1e-12)
 
 
+def test_a_refused_sign_names_the_channel_the_user_already_inverted():
+    # a correct export with 'Force' typed in 'inverted channels' was refused with "one of the
+    # channels is probably inverted: ... name the inverted channel in the 'inverted channels'
+    # column", as if none was: the user's own inversion is the slip to undo
+    name = "synthetic_f500Hz_a1g_fill50_acrylic.csv"
+    data = (REPO / "data_samples" / "exports" / name).read_bytes()
+    row = {**uploads.default_settings_row(name, stated_case(name)), "vibrometer delay [µs]": 50.0}
+    refused = uploads.analyze_upload(
+        name, data, uploads.options_of({**row, "inverted channels": "Force"})).error
+    assert refused.endswith("(inverted on request already: the 'inverted channels' column "
+                            "('Force'); is that one right?)")
+    # as exported, it is analysed (the sign refusal was the inversion's)
+    assert uploads.analyze_upload(name, data, uploads.options_of(row)).ok
+
+
 def test_missing_channel_message_points_to_the_selectboxes(options):
     data = b"Time [s],Pressure [Pa]\n" + b"".join(
         f"{i / 1000:.4f},{np.sin(i / 10):.6f}\n".encode() for i in range(2000))
