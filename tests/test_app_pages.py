@@ -1350,3 +1350,24 @@ def test_a_run_the_reference_store_holds_is_shown_stored_and_never_run(store_fil
         runner.wait_cancelled(5.0)
     assert not store_file.exists()  # nothing simulated, nothing saved
     assert ref.read_bytes() == ref_bytes
+
+
+def test_compare_of_another_specimen_says_why_neither_paper_nor_dem_is_shown(store_file):
+    # a file of specimen my_coupon at 100 Hz, 5 g, 50 % (a Table 3 case) beside a store of
+    # the paper's coupon's acrylic runs: the page said "no DEM runs of ours for acrylic,
+    # direction z" (there are two) and "paper: none where Table 3 has no value at this case"
+    # (it has one: 0.1891), both false; the reason is the specimen
+    _dem_store_with_runs(store_file)
+    settings = b"file,fill_percent,material,specimen\nm_fill50.csv,50,acrylic,my_coupon\n"
+    at = _upload(_app(), [("m_fill50.csv", mass_damper_csv(frequency_hz=100.0,
+                                                           acceleration_g=5.0)),
+                          ("settings.csv", settings)])
+    assert "vs our DEM none" in _headline(at)
+    captions = [c.value for c in at.caption]
+    assert not any("no DEM runs of ours" in c for c in captions), captions
+    assert any("DEM alignment: no_dem_runs. no DEM runs of specimen my_coupon for acrylic, "
+               "direction z" in c for c in captions), captions
+    assert not any("Table 3 has no value at this case" in c for c in captions), captions
+    assert "paper: none: specimen my_coupon is not the paper's coupon: the paper's Table 3 " \
+           "is not compared (it tabulates the paper's coupon)" in captions
+    assert _metric(at, "SDC paper DEM [-]") == ["none"]
