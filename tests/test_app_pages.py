@@ -1371,3 +1371,23 @@ def test_compare_of_another_specimen_says_why_neither_paper_nor_dem_is_shown(sto
     assert "paper: none: specimen my_coupon is not the paper's coupon: the paper's Table 3 " \
            "is not compared (it tabulates the paper's coupon)" in captions
     assert _metric(at, "SDC paper DEM [-]") == ["none"]
+
+
+def test_report_files_of_an_older_store_state_are_said_to_be_stale(store_file):
+    # a DEM job or a save that changed the store after a build took the downloads away
+    # without a word: the page looked as if the build had been lost
+    from pidcore.app.tabs.report import STALE_BUILD_TEXT
+
+    at = _upload(_app(), [("coupon_fill50.csv", mass_damper_csv())])
+    at.button(key="save").click()
+    at.run()
+    at.run()
+    at.button(key="build_report").click()
+    at.run()
+    _wait_report(at)
+    assert [b.label for b in at.get("download_button") if b.label == "CSV"] == ["CSV"]
+    assert STALE_BUILD_TEXT not in [c.value for c in at.caption]
+    _dem_store_with_runs(store_file)  # the store changes (as a finished DEM job saves)
+    at.run()
+    assert not [b for b in at.get("download_button") if b.label == "CSV"]
+    assert STALE_BUILD_TEXT in [c.value for c in at.caption]
