@@ -1391,3 +1391,17 @@ def test_report_files_of_an_older_store_state_are_said_to_be_stale(store_file):
     at.run()
     assert not [b for b in at.get("download_button") if b.label == "CSV"]
     assert STALE_BUILD_TEXT in [c.value for c in at.caption]
+
+
+def test_a_refused_files_card_names_no_placeholder_channels(store_file):
+    # a file whose analysis is refused (its force inverted in the settings table) read
+    # "channels: Time, Force, Velocity · used: force ?, velocity ?" above the refusal
+    data = mass_damper_csv(frequency_hz=100.0, acceleration_g=5.0)
+    settings = b"file,fill_percent,invert\nbad_fill50.csv,50,Force\ngood_fill50.csv,50,\n"
+    at = _upload(_app(), [("bad_fill50.csv", data), ("good_fill50.csv", data + b"\n"),
+                          ("settings.csv", settings)])
+    lines = [c.value for c in at.caption if c.value.startswith("channels: ")]
+    assert lines == ["channels: Force, Velocity · vibrometer delay 0 µs",
+                     "channels: Force, Velocity · used: force Force, velocity Velocity · "
+                     "vibrometer delay 0 µs"]
+    assert any(e.value.startswith("bad_fill50.csv: reactive power") for e in at.error)

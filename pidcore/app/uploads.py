@@ -255,6 +255,19 @@ def analyze_upload(name: str, data: bytes, options: AnalysisOptions) -> UploadOu
                           options)
 
 
+def channels_caption(names: Sequence[str], outcome: UploadOutcome,
+                     options: AnalysisOptions) -> str:
+    """The line above a file's result: its channels, those the analysis used and the delay
+    removed. A refused analysis used none: it read "used: force ?, velocity ?"."""
+    used = ""
+    if outcome.ok:
+        roles = outcome.record.channels_used
+        used = " · used: " + ", ".join(f"{role} {roles[role]}" for role in
+                                       ("force", "velocity", "acceleration") if role in roles)
+    return (f"channels: {', '.join(names)}{used} · vibrometer delay "
+            f"{options.velocity_delay_s * 1e6:g} µs")
+
+
 def options_to_json(options: AnalysisOptions) -> str:
     """Canonical JSON of analysis options (a stable, hashable cache key)."""
     return json.dumps(asdict(options), sort_keys=True)
