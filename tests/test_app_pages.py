@@ -1405,3 +1405,19 @@ def test_a_refused_files_card_names_no_placeholder_channels(store_file):
                      "channels: Force, Velocity · used: force Force, velocity Velocity · "
                      "vibrometer delay 0 µs"]
     assert any(e.value.startswith("bad_fill50.csv: reactive power") for e in at.error)
+
+
+def test_a_drive_the_dem_refuses_is_refused_on_the_dem_page_not_as_a_failed_job(store_file):
+    # 1e9 Hz was submitted and failed in its worker as "ParameterError: frequency 1e+09 Hz:
+    # ..." in the job table (the exception's class, the library's word); now it is refused
+    # at Run with the page's field, and nothing is queued
+    at = _app()
+    _fill_dem(at, freqs="100, 1e9", accs="5", fills="50", cells=1, steady=0)
+    at.button(key="dem_run").click()
+    at.run()
+    assert not at.exception
+    (error,) = [e.value for e in at.error]
+    assert error.startswith("frequencies [Hz] 1e+09 Hz: 128 samples per drive period need a "
+                            "time step")
+    assert "Error" not in error
+    assert jobs.runner_for(store_file).jobs() == []

@@ -921,6 +921,18 @@ def plan_dem_cases(frequencies_hz: Sequence[float], accelerations_g: Sequence[fl
     return cases
 
 
+def check_dem_cases(cases: Sequence, config, specimen=None) -> None:
+    """Refuse, before any is submitted, a case the DEM refuses (a stroke no shaker makes, a
+    frequency its sampling cannot afford: :func:`pidcore.dem.simulate.check_drive`), naming
+    the page's fields as `pidcore dem sweep` names its options. The job failed instead, its
+    message the exception's class and the library's words ("ParameterError: frequency 1e+09
+    Hz: ..."), after the cases before it had run."""
+    from ..dem.simulate import check_drive
+
+    for case in cases:
+        check_drive(case, config, specimen, what="frequencies [Hz]/accelerations [g]")
+
+
 #: Columns of :func:`dem_runs_table`: store listing column -> name shown (units in the names).
 #: The specimen, the load case and the result come first: at 1280 px the table shows about
 #: eight columns before it scrolls, and the SDC was cut off behind the run key.
