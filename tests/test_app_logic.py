@@ -1947,3 +1947,18 @@ def test_the_calibrate_page_names_its_fitted_parameters_as_its_fit_field_offers_
     # the keywords the page does have fields for are still said as those fields
     assert page_words("structure_mass_kg=0.28 refused; baseline_loss_factor fitted") == \
         "'structure mass [g]' (280) refused; baseline_loss_factor fitted"
+
+
+def test_a_dem_worker_reports_a_refusal_as_its_line_not_its_exception_class():
+    # the job table read "ParameterError: frequency 1e+09 Hz: ..." for a case the DEM refuses
+    import multiprocessing
+
+    from pidcore.dem import DemConfig
+    from pidcore.dem import LoadCase as DemLoadCase
+
+    parent, child = multiprocessing.Pipe()
+    jobs._child(DemLoadCase(1e9, 5.0, 50.0), DemConfig(cells=1), None, child)
+    kind, message = parent.recv()
+    assert kind == "error"
+    assert message.startswith("frequency 1e+09 Hz: 128 samples per drive period need")
+    assert "Error" not in message

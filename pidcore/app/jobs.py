@@ -44,6 +44,7 @@ from pathlib import Path
 
 from .. import defaults
 from ..errors import ParameterError, PidcoreError
+from .vocabulary import page_terms
 
 try:  # POSIX: the journal's read-modify-write is exclusive between app servers
     import fcntl
@@ -173,6 +174,8 @@ def _child(case, config, specimen, conn) -> None:
             case, config, specimen=specimen,
             on_block=lambda done, expected: conn.send(("progress", done, expected)))
         conn.send(("done", dem_run_entry(result)))
+    except PidcoreError as exc:  # a refusal is its one line, as the report build says it
+        conn.send(("error", page_terms(str(exc))))
     except BaseException as exc:  # noqa: BLE001 - reported to the parent as the job's error
         conn.send(("error", f"{type(exc).__name__}: {exc}"))
     finally:
