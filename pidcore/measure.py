@@ -37,11 +37,11 @@ import numpy as np
 
 from . import defaults
 from .constants import COUNT_UNIT, RATIO_UNIT
-from .errors import ChannelError, ParameterError, StoreError, instance_of
+from .errors import ChannelError, ParameterError, SignalError, StoreError, instance_of
 from .io import assign_roles, read_measurement
 from .records import Channel, Measurement
 from .signal import PowerAnalysis, analyze_channels
-from .signal.power import check_analysis_settings
+from .signal.power import PROBABLY_INVERTED, check_analysis_settings
 from .signal.validate import SAME_RATE_RELATIVE_TOLERANCE
 from .units import lookup_unit
 
@@ -344,17 +344,26 @@ def analyze_measurement(measurement: Measurement, options: AnalysisOptions | Non
         notes.append("ignored channels (not needed): "
                      + ", ".join(repr(n) for n in roles.ignored))
         corrections["ignored_channels"] = list(roles.ignored)
-    analysis = analyze_channels(
-        chosen["force"], chosen.get("velocity"), acceleration=chosen.get("acceleration"),
-        source=measurement.source,
-        velocity_delay_s=options.velocity_delay_s + start_delay,
-        mass_below_gauge_kg=options.mass_below_gauge_kg,
-        baseline_loss_factor=options.baseline_loss_factor,
-        structure_mass_kg=options.structure_mass_kg,
-        frequency_hz=options.frequency_hz,
-        n_harmonics=options.n_harmonics,
-        allow_clipped=options.allow_clipped,
-    )
+    try:
+        analysis = analyze_channels(
+            chosen["force"], chosen.get("velocity"), acceleration=chosen.get("acceleration"),
+            source=measurement.source,
+            velocity_delay_s=options.velocity_delay_s + start_delay,
+            mass_below_gauge_kg=options.mass_below_gauge_kg,
+            baseline_loss_factor=options.baseline_loss_factor,
+            structure_mass_kg=options.structure_mass_kg,
+            frequency_hz=options.frequency_hz,
+            n_harmonics=options.n_harmonics,
+            allow_clipped=options.allow_clipped,
+        )
+    except SignalError as exc:
+        # "one of the channels is probably inverted: ... pass invert=NAME" read as if none
+        # was, where the inversion asked for is the likely slip (a channel inverted twice)
+        if options.invert and PROBABLY_INVERTED in str(exc):
+            raise SignalError(f"{exc} (inverted on request already: "
+                              + ", ".join(f"invert={n!r}" for n in options.invert)
+                              + "; is that one right?)") from None
+        raise
     notes.extend(_unit_slip_notes(measurement, chosen, analysis))
     if options.structure_mass_kg is not None and not options.baseline_loss_factor > 0:
         # the mass only says how much of the reactive power the baseline applies to: given

@@ -113,6 +113,67 @@ def test_bad_upload_becomes_a_message_naming_the_file(data, options):
     assert "\n" not in outcome.error
 
 
+def test_reader_notes_of_an_upload_name_the_upload_not_its_temporary_copy(options):
+    # an x/y pair export (Time;Force;Time;Velocity, the velocity's own time 0.1 ms later)
+    # showed "note: /tmp/pidcore_upload_c_4macox/xy.txt: column 'Time' is the time of
+    # 'Velocity' ..." on its card, and the record saved that folder, gone once read
+    w, rate, delay = 2 * math.pi * 100.0, 10_000.0, 1e-4
+    t = np.arange(10_000) / rate
+    v_amp = 5 * 9.80665 / w
+    rows = "".join(f"{a:.9g};{0.1 * v_amp * w * math.cos(w * a):.9g};{a + delay:.9g};"
+                   f"{v_amp * math.sin(w * (a + delay)):.9g}\n" for a in t)
+    data = ("Time;Force;Time;Velocity\ns;N;s;m/s\n" + rows).encode()
+    outcome = uploads.analyze_upload("xy_pairs.txt", data, options)
+    assert outcome.ok, outcome.error
+    reader = outcome.record.measurement.metadata["reader_notes"]
+    pair = [n for n in reader if "is the time of 'Velocity'" in n]
+    assert pair and pair[0].startswith("xy_pairs.txt: column 'Time'")
+    for note in (*reader, *outcome.record.notes):
+        assert "pidcore_upload_" not in note, note
+
+
+@pytest.mark.parametrize("typed, said, not_said", [
+    # 500 typed in 'mass below gauge [g]': "'mass below gauge [g]' 0.5 kg is probably larger"
+    ({"mass below gauge [g]": 500.0}, "'mass below gauge [g]' 500 g is probably larger", " kg "),
+    # 500000 typed in the µs field: "0.5 s ...; expected a vibrometer delay in s (e.g.
+    # 2e-4)", advice the field then refuses (2e-4 µs is "implausibly small")
+    ({"vibrometer delay [µs]": 5e5}, "'vibrometer delay [µs]': 500000 µs is longer than 4 "
+     "drive periods", "in s (e.g. 2e-4)"),
+    # 5 typed in 'structure mass [g]': "structure mass 0.005 kg given without a baseline"
+    ({"structure mass [g]": 5.0}, "'structure mass [g]' 5 g given without a baseline "
+     "loss factor", "0.005 kg"),
+])
+def test_messages_give_a_typed_mass_or_delay_in_the_fields_unit(typed, said, not_said):
+    name = "synthetic_f500Hz_a1g_fill50_acrylic.csv"
+    data = (REPO / "data_samples" / "exports" / name).read_bytes()
+    row = {**uploads.default_settings_row(name, stated_case(name)),
+           "vibrometer delay [µs]": 50.0, **typed}
+    outcome = uploads.analyze_upload(name, data, uploads.options_of(row))
+    text = outcome.error or " ".join(outcome.record.notes)
+    assert said in text
+    assert not_said not in text
+    if "vibrometer delay" in said:
+        assert "expected a vibrometer delay in µs (e.g. 200)" in text
+        # the advice is a value the field takes
+        assert uploads.options_of({**row, "vibrometer delay [µs]": 200.0}).velocity_delay_s \
+            == pytest.approx(2e-4, rel=1e-12)
+
+
+def test_a_refused_sign_names_the_channel_the_user_already_inverted():
+    # a correct export with 'Force' typed in 'inverted channels' was refused with "one of the
+    # channels is probably inverted: ... name the inverted channel in the 'inverted channels'
+    # column", as if none was: the user's own inversion is the slip to undo
+    name = "synthetic_f500Hz_a1g_fill50_acrylic.csv"
+    data = (REPO / "data_samples" / "exports" / name).read_bytes()
+    row = {**uploads.default_settings_row(name, stated_case(name)), "vibrometer delay [µs]": 50.0}
+    refused = uploads.analyze_upload(
+        name, data, uploads.options_of({**row, "inverted channels": "Force"})).error
+    assert refused.endswith("(inverted on request already: the 'inverted channels' column "
+                            "('Force'); is that one right?)")
+    # as exported, it is analysed (the sign refusal was the inversion's)
+    assert uploads.analyze_upload(name, data, uploads.options_of(row)).ok
+
+
 def test_missing_channel_message_points_to_the_selectboxes(options):
     data = b"Time [s],Pressure [Pa]\n" + b"".join(
         f"{i / 1000:.4f},{np.sin(i / 10):.6f}\n".encode() for i in range(2000))
@@ -1859,3 +1920,45 @@ def test_cancel_says_when_there_is_nothing_to_cancel_and_what_it_cannot_cancel()
         "cancel requested for 2 job(s); finished cases stay saved; 1 job(s) queued or running "
         "on another app server of this store cannot be cancelled here (cancel them on that "
         "server's page)")
+
+
+def test_the_calibrate_page_names_its_fitted_parameters_as_its_fit_field_offers_them():
+    # the Calibrate page's summary read "Fitted: rolling_friction, fixture_mass_kg,
+    # 'baseline loss factor [-]'" (the Analyse tab's per-file column, another quantity) and an
+    # unknown parameter's error offered "'baseline loss factor [-]'", a name the 'parameters
+    # to fit' field does not hold and 'more parameters' refuses
+    import pidcore.calibrate as api
+    from pidcore.app.calibration import fittable_names, page_words
+
+    summary = (REPO / "data_samples" / "paper_calibration" / "summary.md").read_text()
+    shown = page_words(summary)
+    assert "'baseline loss factor [-]'" not in shown
+    assert shown.splitlines()[2] == summary.splitlines()[2]  # the "Fitted: ..." line as is
+    assert "| baseline_loss_factor | 0.01518 |" in shown
+    with pytest.raises(ParameterError) as refused:
+        api.parse_fit(["bogus_field"])
+    said = page_words(str(refused.value))
+    assert said.startswith("parameters to fit: unknown parameter 'bogus_field'")
+    offered = fittable_names(api)
+    assert "baseline_loss_factor" in offered
+    # every parameter the error lists is one the page's fit field offers, by that name
+    for name in ("fixture_mass_kg", "baseline_loss_factor", "rolling_friction"):
+        assert re.search(rf"(?<![\w']){name}(?![\w'])", said), name
+    # the keywords the page does have fields for are still said as those fields
+    assert page_words("structure_mass_kg=0.28 refused; baseline_loss_factor fitted") == \
+        "'structure mass [g]' (280) refused; baseline_loss_factor fitted"
+
+
+def test_a_dem_worker_reports_a_refusal_as_its_line_not_its_exception_class():
+    # the job table read "ParameterError: frequency 1e+09 Hz: ..." for a case the DEM refuses
+    import multiprocessing
+
+    from pidcore.dem import DemConfig
+    from pidcore.dem import LoadCase as DemLoadCase
+
+    parent, child = multiprocessing.Pipe()
+    jobs._child(DemLoadCase(1e9, 5.0, 50.0), DemConfig(cells=1), None, child)
+    kind, message = parent.recv()
+    assert kind == "error"
+    assert message.startswith("frequency 1e+09 Hz: 128 samples per drive period need")
+    assert "Error" not in message

@@ -1353,3 +1353,74 @@ def test_a_run_the_reference_store_holds_is_shown_stored_and_never_run(store_fil
         runner.wait_cancelled(5.0)
     assert not store_file.exists()  # nothing simulated, nothing saved
     assert ref.read_bytes() == ref_bytes
+
+
+def test_compare_of_another_specimen_says_why_neither_paper_nor_dem_is_shown(store_file):
+    # a file of specimen my_coupon at 100 Hz, 5 g, 50 % (a Table 3 case) beside a store of
+    # the paper's coupon's acrylic runs: the page said "no DEM runs of ours for acrylic,
+    # direction z" (there are two) and "paper: none where Table 3 has no value at this case"
+    # (it has one: 0.1891), both false; the reason is the specimen
+    _dem_store_with_runs(store_file)
+    settings = b"file,fill_percent,material,specimen\nm_fill50.csv,50,acrylic,my_coupon\n"
+    at = _upload(_app(), [("m_fill50.csv", mass_damper_csv(frequency_hz=100.0,
+                                                           acceleration_g=5.0)),
+                          ("settings.csv", settings)])
+    assert "vs our DEM none" in _headline(at)
+    captions = [c.value for c in at.caption]
+    assert not any("no DEM runs of ours" in c for c in captions), captions
+    assert any("DEM alignment: no_dem_runs. no DEM runs of specimen my_coupon for acrylic, "
+               "direction z" in c for c in captions), captions
+    assert not any("Table 3 has no value at this case" in c for c in captions), captions
+    assert "paper: none: specimen my_coupon is not the paper's coupon: the paper's Table 3 " \
+           "is not compared (it tabulates the paper's coupon)" in captions
+    assert _metric(at, "SDC paper DEM [-]") == ["none"]
+
+
+def test_report_files_of_an_older_store_state_are_said_to_be_stale(store_file):
+    # a DEM job or a save that changed the store after a build took the downloads away
+    # without a word: the page looked as if the build had been lost
+    from pidcore.app.tabs.report import STALE_BUILD_TEXT
+
+    at = _upload(_app(), [("coupon_fill50.csv", mass_damper_csv())])
+    at.button(key="save").click()
+    at.run()
+    at.run()
+    at.button(key="build_report").click()
+    at.run()
+    _wait_report(at)
+    assert [b.label for b in at.get("download_button") if b.label == "CSV"] == ["CSV"]
+    assert STALE_BUILD_TEXT not in [c.value for c in at.caption]
+    _dem_store_with_runs(store_file)  # the store changes (as a finished DEM job saves)
+    at.run()
+    assert not [b for b in at.get("download_button") if b.label == "CSV"]
+    assert STALE_BUILD_TEXT in [c.value for c in at.caption]
+
+
+def test_a_refused_files_card_names_no_placeholder_channels(store_file):
+    # a file whose analysis is refused (its force inverted in the settings table) read
+    # "channels: Time, Force, Velocity · used: force ?, velocity ?" above the refusal
+    data = mass_damper_csv(frequency_hz=100.0, acceleration_g=5.0)
+    settings = b"file,fill_percent,invert\nbad_fill50.csv,50,Force\ngood_fill50.csv,50,\n"
+    at = _upload(_app(), [("bad_fill50.csv", data), ("good_fill50.csv", data + b"\n"),
+                          ("settings.csv", settings)])
+    lines = [c.value for c in at.caption if c.value.startswith("channels: ")]
+    assert lines == ["channels: Force, Velocity · vibrometer delay 0 µs",
+                     "channels: Force, Velocity · used: force Force, velocity Velocity · "
+                     "vibrometer delay 0 µs"]
+    assert any(e.value.startswith("bad_fill50.csv: reactive power") for e in at.error)
+
+
+def test_a_drive_the_dem_refuses_is_refused_on_the_dem_page_not_as_a_failed_job(store_file):
+    # 1e9 Hz was submitted and failed in its worker as "ParameterError: frequency 1e+09 Hz:
+    # ..." in the job table (the exception's class, the library's word); now it is refused
+    # at Run with the page's field, and nothing is queued
+    at = _app()
+    _fill_dem(at, freqs="100, 1e9", accs="5", fills="50", cells=1, steady=0)
+    at.button(key="dem_run").click()
+    at.run()
+    assert not at.exception
+    (error,) = [e.value for e in at.error]
+    assert error.startswith("frequencies [Hz] 1e+09 Hz: 128 samples per drive period need a "
+                            "time step")
+    assert "Error" not in error
+    assert jobs.runner_for(store_file).jobs() == []

@@ -87,6 +87,17 @@ def test_override_unknown_name_lists_channels():
         assign_roles(m, force="Force")
 
 
+def test_override_refusal_says_the_expected_role_with_its_article():
+    # the acceleration role's refusal read "expected a acceleration channel"
+    m = _m(_ch("F", "force", "N"), _ch("acc", "acceleration", "g"))
+    with pytest.raises(ChannelError) as refused:
+        assign_roles(m, acceleration="F")
+    assert "acceleration='F' is a force channel (N); expected an acceleration channel or " \
+        "one without a unit" in str(refused.value)
+    with pytest.raises(ChannelError, match=r"; expected a force channel or one without"):
+        assign_roles(m, force="acc")
+
+
 def test_override_of_other_quantity_refused_unknown_accepted():
     m = _m(_ch("F", "force", "N"), _ch("acc", "acceleration", "g"), _ch("raw", "unknown", "V^2"))
     with pytest.raises(ChannelError, match=r"force='acc' is an acceleration channel"):

@@ -312,7 +312,9 @@ def test_a_measurement_is_checked_against_the_band_of_its_own_stderr(tmp_path):
     # stderr 0.001: 0.5 - hypot(0.1, 1.96 x 0.001), 0.5 + hypot(0.12, 1.96 x 0.001)
     assert low[1] == pytest.approx(0.5 - math.hypot(0.10, 1.959964 * 0.001), rel=1e-6)
     assert high[1] == pytest.approx(0.5 + math.hypot(0.12, 1.959964 * 0.001), rel=1e-6)
-    assert "calibrated band for this measurement's SDC stderr 0.001" in out["note"][1]
+    assert out["note"][1] == ("calibrated band for this measurement's SDC stderr 0.001 (the "
+                              "calibration's own measurement at this load case had SDC "
+                              "stderr 0.1)")
     assert out["note"][0] == out["note"][2] == ""
     # a calibration.json written before the error-free band was kept: the stated band
     old = load_calibration(_write(tmp_path / "old.json", [_prediction(50, 5, 50, 0.5, 0.2,

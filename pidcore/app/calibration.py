@@ -140,14 +140,35 @@ _PAGE_WORDS: tuple[tuple[str, str], ...] = (
 
 def page_words(text: str) -> str:
     """A library message or note in the page's terms: its fields, not the library's keywords
-    nor the command line's flags."""
+    nor the command line's flags.
+
+    The calibration's parameters keep their names (:func:`fittable_names`): the page's
+    'parameters to fit' offers them so, and ``baseline_loss_factor`` here is the specimen's
+    fitted coupon loss factor, not the Analyse tab's per-file 'baseline loss factor [-]'
+    column that :func:`pidcore.app.vocabulary.page_terms` names it as (the summary's
+    table read "'baseline loss factor [-]'" beside "fixture_mass_kg", and an unknown
+    parameter's error offered a name the field refuses).
+    """
     import re
 
     from .vocabulary import page_terms
 
     for pattern, replacement in _PAGE_WORDS:
         text = re.sub(pattern, replacement, text)
-    return page_terms(text)
+    api, _ = calibration_api()
+    names = sorted(fittable_names(api), key=len, reverse=True) if api is not None else []
+    if not names:
+        return page_terms(text)
+    # each name held out of page_terms as a placeholder no keyword pattern matches
+    own = re.compile(r"(?<![\w'])(" + "|".join(map(re.escape, names)) + r")(?![\w'])")
+    kept: list[str] = []
+
+    def hold(m: re.Match) -> str:
+        kept.append(m[1])
+        return f"\x00{len(kept) - 1}\x00"
+
+    return re.sub("\x00(\\d+)\x00", lambda m: kept[int(m[1])],
+                  page_terms(own.sub(hold, text)))
 
 
 @dataclass

@@ -44,6 +44,7 @@ from pathlib import Path
 
 from .. import defaults
 from ..errors import ParameterError, PidcoreError
+from .vocabulary import page_terms
 
 try:  # POSIX: the journal's read-modify-write is exclusive between app servers
     import fcntl
@@ -176,6 +177,8 @@ def _child(case, config, specimen, conn) -> None:
             case, config, specimen=specimen,
             on_block=lambda done, expected: conn.send(("progress", done, expected)))
         conn.send(("done", dem_run_entry(result)))
+    except PidcoreError as exc:  # a refusal is its one line, as the report build says it
+        conn.send(("error", page_terms(str(exc))))
     except BaseException as exc:  # noqa: BLE001 - reported to the parent as the job's error
         conn.send(("error", f"{type(exc).__name__}: {exc}"))
     finally:
@@ -963,6 +966,18 @@ def plan_dem_cases(frequencies_hz: Sequence[float], accelerations_g: Sequence[fl
         raise ParameterError(f"{len(cases)} load cases chosen; the app runs at most "
                              f"{max_cases} at a time (use `pidcore dem` for larger sweeps)")
     return cases
+
+
+def check_dem_cases(cases: Sequence, config, specimen=None) -> None:
+    """Refuse, before any is submitted, a case the DEM refuses (a stroke no shaker makes, a
+    frequency its sampling cannot afford: :func:`pidcore.dem.simulate.check_drive`), naming
+    the page's fields as `pidcore dem sweep` names its options. The job failed instead, its
+    message the exception's class and the library's words ("ParameterError: frequency 1e+09
+    Hz: ..."), after the cases before it had run."""
+    from ..dem.simulate import check_drive
+
+    for case in cases:
+        check_drive(case, config, specimen, what="frequencies [Hz]/accelerations [g]")
 
 
 #: Columns of :func:`dem_runs_table`: store listing column -> name shown (units in the names).

@@ -97,6 +97,14 @@ def read_upload(name: str, data: bytes, *, sample_rate_hz: float | None = None) 
         path = Path(folder) / safe_file_name(name)
         path.write_bytes(data)
         measurement = read_measurement(path, sample_rate_hz=sample_rate_hz)
+    # the readers' notes name the file they read: the private copy, whose folder is gone
+    # once read ("/tmp/pidcore_upload_x1/a.txt: column 'Time' is the time of 'Velocity'",
+    # shown on the card and saved with the record)
+    notes = measurement.metadata.get("reader_notes")
+    if notes:
+        measurement = replace(measurement, metadata={
+            **measurement.metadata,
+            "reader_notes": [str(n).replace(str(path), name) for n in notes]})
     return replace(measurement, source=name, sha256=measurement.sha256 or content_sha256(data))
 
 
@@ -191,6 +199,13 @@ def app_words(text: str, *, names: Iterable[str] = ()) -> str:
     text = re.sub(r"structure_mass_kg ([-+]?[0-9.]+(?:e[-+]?[0-9]+)?) kg",
                   lambda m: f"structure mass [g] {float(m[1]) * 1e3:g} g", text)
     text = text.replace("structure_mass_kg in kg", "'structure mass [g]' in g")
+    # the fields are in g and µs: the hints gave kg and s ("structure mass 0.005 kg given"
+    # for 5 typed in g; "expected a vibrometer delay in s (e.g. 2e-4)", which the µs field
+    # then refuses as implausibly small)
+    text = re.sub(r"(?<![\w'])structure mass ([-+]?[0-9.]+(?:e[-+]?[0-9]+)?) kg given",
+                  lambda m: f"'structure mass [g]' {float(m[1]) * 1e3:g} g given", text)
+    text = text.replace("expected a vibrometer delay in s (e.g. 2e-4)",
+                        "expected a vibrometer delay in µs (e.g. 200)")
     return page_terms(text, names=names)
 
 
@@ -240,6 +255,19 @@ def analyze_upload(name: str, data: bytes, options: AnalysisOptions) -> UploadOu
     """Read and analyse one upload; never raises for bad user data."""
     return analyze_parsed(parse_upload(name, data, sample_rate_hz=options.sample_rate_hz),
                           options)
+
+
+def channels_caption(names: Sequence[str], outcome: UploadOutcome,
+                     options: AnalysisOptions) -> str:
+    """The line above a file's result: its channels, those the analysis used and the delay
+    removed. A refused analysis used none: it read "used: force ?, velocity ?"."""
+    used = ""
+    if outcome.ok:
+        roles = outcome.record.channels_used
+        used = " · used: " + ", ".join(f"{role} {roles[role]}" for role in
+                                       ("force", "velocity", "acceleration") if role in roles)
+    return (f"channels: {', '.join(names)}{used} · vibrometer delay "
+            f"{options.velocity_delay_s * 1e6:g} µs")
 
 
 def options_to_json(options: AnalysisOptions) -> str:

@@ -53,6 +53,13 @@ LABEL_OF_KEYWORD: dict[str, str] = {
 _PAGE_SCALE: dict[str, float] = {"structure_mass_kg": 1e3, "mass_below_gauge_kg": 1e3,
                                  "velocity_delay_s": 1e6}
 
+#: The SI unit a message gives after a keyword (``mass_below_gauge_kg 0.5 kg``) and the
+#: page's unit of its field: the number is said in the field's unit ("'mass below gauge [g]'
+#: 500 g"), not in kg beside a label in g.
+_PAGE_UNIT: dict[str, tuple[str, str]] = {"structure_mass_kg": ("kg", "g"),
+                                          "mass_below_gauge_kg": ("kg", "g"),
+                                          "velocity_delay_s": ("s", "µs")}
+
 # as in pidcore.cli._vocabulary: the parameter, not a file's column, attribute or field of
 # that name, nor part of a longer name
 _NOT_BEFORE = r"(?<![\w'=-])(?<!\] )(?<!column )(?<!attribute )(?<!field )(?<!variable )"
@@ -66,6 +73,14 @@ _PATTERNS = tuple(
                 + ("" if k.endswith("=") or not k[-1].isalnum() else f"(?:={_VALUE})?")),
      label, _PAGE_SCALE.get(k, 1.0))
     for k, label in sorted(LABEL_OF_KEYWORD.items(), key=lambda kv: -len(kv[0])))
+
+
+_NUMBER = r"(?P<number>[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)"
+_WITH_UNIT = tuple(
+    (re.compile(_NOT_BEFORE + re.escape(k) + r"(?P<colon>:?) " + _NUMBER + " "
+                + re.escape(si) + r"(?![\w/])"),
+     LABEL_OF_KEYWORD[k], _PAGE_SCALE[k], page_unit)
+    for k, (si, page_unit) in _PAGE_UNIT.items())
 
 
 def page_terms(message: str, *, names: Iterable[str] = ()) -> str:
@@ -87,6 +102,10 @@ def _in_page_terms(message: str) -> str:
             pass
         return f"{named} ({value})"
 
+    for pattern, named, scale, unit in _WITH_UNIT:
+        message = pattern.sub(
+            lambda m, n=named, s=scale, u=unit:
+            f"{n}{m['colon']} {float(m['number']) * s:g} {u}", message)
     for pattern, named, scale in _PATTERNS:
         message = pattern.sub(lambda m, n=named, s=scale: labelled(n, s, m), message)
     return message

@@ -147,9 +147,10 @@ def _named(measurement: Measurement, role: str, name: str, retyped: bool) -> Cha
     channel = measurement.channel(name)  # ChannelError listing the channels there are
     if channel.quantity not in (role, "unknown") and not retyped:
         article = "an" if channel.quantity[0] in "aeiou" else "a"
+        wanted = "an" if role[0] in "aeiou" else "a"  # "expected a acceleration channel"
         raise ChannelError(f"{measurement.source}: {_OPTIONS[role]}{name!r} is {article} "
                            f"{channel.quantity} channel ({channel.source_unit or channel.unit});"
-                           f" expected a {role} channel or one without a unit, or give its "
+                           f" expected {wanted} {role} channel or one without a unit, or give its "
                            f"unit with {role}_unit=UNIT if the file's is wrong")
     return channel
 

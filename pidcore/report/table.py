@@ -584,9 +584,11 @@ def add_calibration_columns(table: pd.DataFrame, calibration, *,
                 extra = "so not compared with the calibrated band"
             else:
                 if band != (hit.low95, hit.high95):
+                    # "(the calibration's point at this load case: 0)" read as a point
+                    # numbered 0, or an SDC of 0: it is the stderr of the fitted point
                     extra = (f"calibrated band for this measurement's SDC stderr {stderr:.3g} "
-                             f"(the calibration's point at this load case: "
-                             f"{hit.measured_stderr:.3g})")
+                             f"(the calibration's own measurement at this load case had SDC "
+                             f"stderr {hit.measured_stderr:.3g})")
                 inside.append("yes" if band[0] <= measured <= band[1] else "no")
         notes.append("; ".join(n for n in (note, extra) if n))
     at = list(out.columns).index("SDC measured [-]") + 1 if "SDC measured [-]" in out.columns \

@@ -369,6 +369,10 @@ def _check_parameters(sample_rate_hz: float, n_harmonics: int, n_blocks: int, mi
                              f"frequency {sample_rate_hz / 2:g} Hz")
 
 
+#: The refusal of a negative reactive power says a channel "is probably inverted".
+PROBABLY_INVERTED = "is probably inverted"
+
+
 def _check_delay(velocity_delay_s: float, frequency_hz: float, duration_s: float) -> None:
     # A vibrometer's output delay is tens of µs to a few ms; a value of several drive periods
     # (or longer than the record) is a unit slip (ms typed as s): the phase correction wraps
@@ -542,7 +546,7 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
         # the wrong sign (sensor mounted the other way, a -Z direction not applied), or, with
         # mass cancellation, a mass below the gauge larger than the mass actually there: its
         # subtracted inertia force then exceeds the structure's.
-        cause = (f"one of the channels {force_name!r} / {motion_name!r} is probably inverted: "
+        cause = (f"one of the channels {force_name!r} / {motion_name!r} {PROBABLY_INVERTED}: "
                  "check the sensor directions, or pass invert=NAME for the inverted channel")
         if mass_below_gauge_kg > 0:
             cause = (f"mass_below_gauge_kg {mass_below_gauge_kg:g} kg is probably larger than "

@@ -94,12 +94,7 @@ def _card(upload, row, sample_rate_hz, materials, given=()):
             return None
         outcome = state.analysed(sha, name, sample_rate_hz, uploads.options_to_json(options),
                                  upload)
-        ch = found.channels
-        st.caption(f"channels: {', '.join(ch.names)} · used: force "
-                   f"{outcome.record.channels_used.get('force', '?') if outcome.ok else '?'}, "
-                   f"velocity "
-                   f"{outcome.record.channels_used.get('velocity', '?') if outcome.ok else '?'}"
-                   f" · vibrometer delay {options.velocity_delay_s * 1e6:g} µs")
+        st.caption(uploads.channels_caption(found.channels.names, outcome, options))
         if outcome.error is not None:
             st.error(outcome.error)
             return None

@@ -123,6 +123,7 @@ def render(stores) -> None:
                 parse_values(freqs, name="frequencies [Hz]"),
                 parse_values(accs, name="accelerations [g]"),
                 fill_values, material=material, direction=direction)
+            jobs.check_dem_cases(cases, config, specimen)
         except PidcoreError as exc:
             st.session_state["dem_message"] = ("error", str(exc))
         else:

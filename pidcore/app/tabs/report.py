@@ -12,6 +12,11 @@ from pidcore.app.vocabulary import page_terms
 #: Seconds between refreshes of the report build's state while it runs.
 REFRESH_S = 1.0
 
+#: Said where the report files built in this session are of another state of the store or
+#: other choices than the table shown.
+STALE_BUILD_TEXT = ("The report files built before are not offered: the store or the choices "
+                    "above changed since; build them again for this table.")
+
 #: The Report tab's default specimen: the paper's coupon, as ``pidcore report`` without
 #: ``--specimen``.
 DEFAULT_SPECIMEN = "paper_coupon (the default)"
@@ -106,6 +111,9 @@ def render(stores, calibrations: list) -> None:
     build = st.session_state.get("report_build")
     if build is not None and build.of == made:  # files of an older state are not offered
         draw_polling(_build_state, build, polling=build.state == "running", every_s=REFRESH_S)
+    elif build is not None and build.state == "done":
+        # the downloads vanished without a word when a DEM job or a save changed the store
+        st.caption(STALE_BUILD_TEXT)
 
 
 def _build_state(build, polling: bool) -> None:
