@@ -1934,7 +1934,9 @@ def test_the_calibrate_page_names_its_fitted_parameters_as_its_fit_field_offers_
     shown = page_words(summary)
     assert "'baseline loss factor [-]'" not in shown
     assert shown.splitlines()[2] == summary.splitlines()[2]  # the "Fitted: ..." line as is
-    assert "| baseline_loss_factor | 0.01518 |" in shown
+    row = next(line for line in summary.splitlines()
+               if line.startswith("| baseline_loss_factor | "))
+    assert row in shown.splitlines()  # the parameter table's row as the file has it
     with pytest.raises(ParameterError) as refused:
         api.parse_fit(["bogus_field"])
     said = page_words(str(refused.value))
