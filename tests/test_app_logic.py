@@ -1934,7 +1934,11 @@ def test_the_calibrate_page_names_its_fitted_parameters_as_its_fit_field_offers_
     shown = page_words(summary)
     assert "'baseline loss factor [-]'" not in shown
     assert shown.splitlines()[2] == summary.splitlines()[2]  # the "Fitted: ..." line as is
-    assert "| baseline_loss_factor | 0.01518 |" in shown
+    # the fitted table's row keeps its parameter's name (read from the file: the bundled
+    # calibration's numbers change when it is regenerated; 0.01518 was hard-coded here)
+    row = next(line for line in summary.splitlines()
+               if line.startswith("| baseline_loss_factor | "))
+    assert row in shown.splitlines()
     with pytest.raises(ParameterError) as refused:
         api.parse_fit(["bogus_field"])
     said = page_words(str(refused.value))
