@@ -468,7 +468,7 @@ class DemJobRunner:
         for number, (entry, owner) in enumerate(entries, start=1):
             if owner == self.owner:
                 continue  # this runner's own: its memory is newer
-            live = owner is not None and owner.alive()
+            live = _still_runs(owner)
             if not live and isinstance(entry, dict) and entry.get("job_id") in own_ids:
                 continue  # taken over already, the journal not rewritten since
             try:
@@ -511,8 +511,7 @@ class DemJobRunner:
             self.journal_problem = problem
             self._foreign, self._foreign_entries = [], []
             return
-        if not any(owner != self.owner and (owner is None or not owner.alive())
-                   for _, owner in entries):
+        if not any(owner != self.owner and not _still_runs(owner) for _, owner in entries):
             self._merge_journal()
             return
         with self._journal_locked():  # taken over by one server only
@@ -797,6 +796,12 @@ def _job_document(job: DemJob, owner: JournalOwner | None = None) -> dict:
             "case": dataclasses.asdict(job.case), "config": dataclasses.asdict(job.config),
             "specimen": None if specimen is None else {"text": specimen.text,
                                                        "source": str(specimen.source)}}
+
+
+def _still_runs(owner: JournalOwner | None) -> bool:
+    """Whether a journal entry's server still runs: its jobs stay its own. An entry naming no
+    owner (an older journal's, or written as no one's) is taken over like a stopped one's."""
+    return owner is not None and owner.alive()
 
 
 def write_journal(path: Path, jobs: Sequence[DemJob], *, owner: JournalOwner | None = None,
