@@ -21,6 +21,8 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from ..constants import BackgroundState
+
 #: Module the page wraps.
 CALIBRATE_MODULE = "pidcore.calibrate"
 #: Functions and tables the page needs from it.
@@ -173,12 +175,13 @@ def page_words(text: str) -> str:
 
 @dataclass
 class CalibrationTask:
-    """One calibration: its state (``running``, ``done``, ``failed``) and outputs."""
+    """One calibration: its state (:data:`pidcore.constants.BACKGROUND_STATES`) and
+    outputs."""
 
     fit: tuple[str, ...]
     n_points: int
     specimen: str = ""  # :func:`specimen_label` of the specimen calibrated
-    state: str = "running"
+    state: BackgroundState = "running"
     started: float = field(default_factory=time.time)
     finished: float | None = None
     message: str = ""
