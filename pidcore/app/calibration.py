@@ -20,8 +20,12 @@ import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ..constants import BackgroundState
+
+if TYPE_CHECKING:  # pragma: no cover
+    import pandas as pd
 
 #: Module the page wraps.
 CALIBRATE_MODULE = "pidcore.calibrate"
@@ -369,7 +373,7 @@ def read_store_calibrations(store_path: str | Path) -> StoreCalibrations:
 
 
 def saved_calibrations_table(store_path: str | Path | None = None, *,
-                             listing=None):
+                             listing: pd.DataFrame | None = None) -> pd.DataFrame:
     """The Calibrate tab's table of the calibrations saved in the store, newest first
     (:meth:`pidcore.store.Store.list_calibrations` of ``store_path``, or that ``listing`` as
     already read; columns :data:`SAVED_CALIBRATION_COLUMNS`, a blank where a calibration has

@@ -41,10 +41,16 @@ import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from .. import defaults
 from ..errors import ParameterError, PidcoreError
 from .vocabulary import page_terms
+
+if TYPE_CHECKING:  # pragma: no cover - for the hints; the functions import them where used
+    from ..dem.simulate import DemConfig
+    from ..loadcase import LoadCase
+    from ..specimen import Specimen
 
 try:  # POSIX: the journal's read-modify-write is exclusive between app servers
     import fcntl
@@ -973,7 +979,8 @@ def plan_dem_cases(frequencies_hz: Sequence[float], accelerations_g: Sequence[fl
     return cases
 
 
-def check_dem_cases(cases: Sequence, config, specimen=None) -> None:
+def check_dem_cases(cases: Sequence[LoadCase], config: DemConfig,
+                    specimen: Specimen | None = None) -> None:
     """Refuse, before any is submitted, a case the DEM refuses (a stroke no shaker makes, a
     frequency its sampling cannot afford: :func:`pidcore.dem.simulate.check_drive`), naming
     the page's fields as `pidcore dem sweep` names its options. The job failed instead, its
