@@ -1822,7 +1822,9 @@ def test_a_structure_mass_typed_in_mg_is_refused_in_the_pages_unit():
     parsed = uploads.parse_upload("c_fill50.csv", mass_damper_csv())
     outcome = uploads.analyze_parsed(parsed, AnalysisOptions(baseline_loss_factor=0.01,
                                                              structure_mass_kg=280.0))
-    assert outcome.error.startswith("c_fill50.csv: structure mass [g] 280000 g is ")
+    # the field named as everywhere on the page, quoted (it was unquoted here alone, beside
+    # "('structure mass [g]' in g" in the same sentence)
+    assert outcome.error.startswith("c_fill50.csv: 'structure mass [g]' 280000 g is ")
     assert "structure_mass_kg" not in outcome.error
     assert "('structure mass [g]' in g; a structure_mass_g column of the settings table in g)" \
         in outcome.error
