@@ -162,19 +162,8 @@ def page_words(text: str) -> str:
     for pattern, replacement in _PAGE_WORDS:
         text = re.sub(pattern, replacement, text)
     api, _ = calibration_api()
-    names = sorted(fittable_names(api), key=len, reverse=True) if api is not None else []
-    if not names:
-        return page_terms(text)
-    # each name held out of page_terms as a placeholder no keyword pattern matches
-    own = re.compile(r"(?<![\w'])(" + "|".join(map(re.escape, names)) + r")(?![\w'])")
-    kept: list[str] = []
-
-    def hold(m: re.Match) -> str:
-        kept.append(m[1])
-        return f"\x00{len(kept) - 1}\x00"
-
-    return re.sub("\x00(\\d+)\x00", lambda m: kept[int(m[1])],
-                  page_terms(own.sub(hold, text)))
+    # kept as written, as the user's own names are (pidcore.errors.outside_user_names)
+    return page_terms(text, names=fittable_names(api) if api is not None else ())
 
 
 @dataclass
