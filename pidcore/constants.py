@@ -46,6 +46,9 @@ ImpactPair = Literal["wall", "particle"]
 #: Normal damping constant: "eq3" = alpha from the table's e_n by Eq. 3; "calibrated" = alpha
 #: root-found so that a simulated head-on impact gives the table's e_n exactly.
 DampingCoefficient = Literal["eq3", "calibrated"]
+#: State of work an app page runs outside Streamlit's script run (a report build, a
+#: calibration), in the order it passes through them: running, then done or failed.
+BackgroundState = Literal["running", "done", "failed"]
 
 #: Particle materials in use for particle dampers that the material table does not hold: a
 #: file name stating one (``..._fill50_steel.csv``) is refused unless a specimen file gives
@@ -71,6 +74,7 @@ REPORT_FORMATS: tuple[str, ...] = get_args(ReportFormat)
 FILL_REFERENCES: tuple[str, ...] = get_args(FillReference)
 DAMPING_COEFFICIENTS: tuple[str, ...] = get_args(DampingCoefficient)
 CELL_SHAPES: tuple[str, ...] = get_args(CellShape)
+BACKGROUND_STATES: tuple[str, ...] = get_args(BackgroundState)
 
 #: Standard gravity, m/s^2 (ISO 80000-3); used for g <-> m/s^2 and for gravity on particles.
 STANDARD_GRAVITY = 9.80665

@@ -26,6 +26,8 @@ whole_number, real_number, instance_of, as_given
     The checks of a value's type, and a number shown as the user gave it.
 outside_user_names
     A message rewritten everywhere but in the names the user gave.
+KEYWORD_NOT_BEFORE, KEYWORD_NOT_AFTER_WORD
+    Where a keyword in a message is the parameter, as both front-ends' tables find it.
 """
 
 import math
@@ -176,6 +178,19 @@ def outside_user_names(message: str, rewrite: Callable[[str], str], *,
     return restore(rewrite(_USER_NAME.sub(hold, message)))
 
 
-__all__ = ["ChannelError", "InputFileError", "ParameterError", "PidcoreError",
+# A keyword names the parameter, not a file's own column, attribute, field or variable of the
+# same name ("column baseline_loss_factor '-1' of loadcases.csv", "a baseline_loss_factor
+# column", "field sample_rate_hz", "('fs' or 'sample_rate_hz')"), nor part of a longer name
+# ("my_frequency_hz_col", "--structure-mass"), nor a specimen file's key ("[coupon]
+# baseline_loss_factor 0.01"): the CLI's flags and the app's labels must agree on which.
+#: Regex look-behinds before a keyword that is the parameter (:mod:`pidcore.cli._vocabulary`,
+#: :mod:`pidcore.app.vocabulary`).
+KEYWORD_NOT_BEFORE = r"(?<![\w'=-])(?<!\] )(?<!column )(?<!attribute )(?<!field )(?<!variable )"
+#: Regex look-aheads after a keyword ending in a word character that is the parameter.
+KEYWORD_NOT_AFTER_WORD = r"(?![\w'])(?! column)"
+
+
+__all__ = ["ChannelError", "InputFileError", "KEYWORD_NOT_AFTER_WORD", "KEYWORD_NOT_BEFORE",
+           "ParameterError", "PidcoreError",
            "SettingsTableError", "SignalError", "SimulationError", "StoreError", "as_given",
            "instance_of", "outside_user_names", "real_number", "whole_number"]

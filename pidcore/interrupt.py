@@ -17,11 +17,13 @@ interruption and then raises, so that a swallowed interrupt is still seen by
 
 from __future__ import annotations
 
+import os
 import signal
 import sys
 import threading
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
+from pathlib import Path
 
 _interrupted = threading.Event()
 #: The signal that interrupted (SIGINT where the flag was set by other means).
@@ -169,3 +171,10 @@ def mark_handled() -> None:
         ctypes.c_int.in_dll(ctypes.pythonapi, "_Py_UnhandledKeyboardInterrupt").value = 0
     except (ImportError, AttributeError, ValueError, OSError):
         pass
+
+
+def untouched(path: str | os.PathLike) -> str:
+    """What an interrupt left of ``path`` it did not write: ``"X unchanged"``, or ``"X not
+    created"`` where it never existed (a first run into a new store or folder was told it was
+    'unchanged'). One wording for every command and the calibration runner."""
+    return f"{path} unchanged" if Path(path).exists() else f"{path} not created"

@@ -649,6 +649,12 @@ def uncalibrated_name(name: str) -> str:
     return name
 
 
+def calibrated_name(name: str) -> str:
+    """The name ``pidcore calibrate`` gives the specimen it calibrates from ``name``
+    ("x" -> "x_calibrated"; "x_calibrated", calibrated again, stays "x_calibrated")."""
+    return uncalibrated_name(name) + CALIBRATED_SUFFIX
+
+
 # --- schema ---------------------------------------------------------------------------------
 
 #: Keys of each section: name -> (required, kind). kind: "float", "int", "str".

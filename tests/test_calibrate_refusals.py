@@ -214,10 +214,13 @@ def test_a_calibrated_file_calibrated_again_is_still_of_the_specimen_tested(tmp_
     # calibrated'"; --store: "no measurement of specimen ..."): one suffix was taken off
     from pidcore.calibrate.data import points_for_specimen
     from pidcore.calibrate.parameters import parameter_spec
-    from pidcore.specimen import uncalibrated_name
+    from pidcore.specimen import calibrated_name, uncalibrated_name
 
     assert uncalibrated_name("my_coupon_calibrated_calibrated") == "my_coupon"
     assert uncalibrated_name("my_coupon") == "my_coupon"
+    # the library's name and the app's download name of the calibrated file come from here
+    assert calibrated_name("my_coupon") == "my_coupon_calibrated"
+    assert calibrated_name("my_coupon_calibrated_calibrated") == "my_coupon_calibrated"
     mine = dataclasses.replace(paper_specimen(), name="my_coupon")
     tested = [MeasuredPoint(500, 5, 50, 0.6, specimen="my_coupon"),
               MeasuredPoint(1000, 5, 50, 0.6, specimen="my_coupon_calibrated")]

@@ -20,6 +20,12 @@ import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
+
+from ..constants import BackgroundState
+
+if TYPE_CHECKING:  # pragma: no cover
+    import pandas as pd
 
 #: Module the page wraps.
 CALIBRATE_MODULE = "pidcore.calibrate"
@@ -156,29 +162,19 @@ def page_words(text: str) -> str:
     for pattern, replacement in _PAGE_WORDS:
         text = re.sub(pattern, replacement, text)
     api, _ = calibration_api()
-    names = sorted(fittable_names(api), key=len, reverse=True) if api is not None else []
-    if not names:
-        return page_terms(text)
-    # each name held out of page_terms as a placeholder no keyword pattern matches
-    own = re.compile(r"(?<![\w'])(" + "|".join(map(re.escape, names)) + r")(?![\w'])")
-    kept: list[str] = []
-
-    def hold(m: re.Match) -> str:
-        kept.append(m[1])
-        return f"\x00{len(kept) - 1}\x00"
-
-    return re.sub("\x00(\\d+)\x00", lambda m: kept[int(m[1])],
-                  page_terms(own.sub(hold, text)))
+    # kept as written, as the user's own names are (pidcore.errors.outside_user_names)
+    return page_terms(text, names=fittable_names(api) if api is not None else ())
 
 
 @dataclass
 class CalibrationTask:
-    """One calibration: its state (``running``, ``done``, ``failed``) and outputs."""
+    """One calibration: its state (:data:`pidcore.constants.BACKGROUND_STATES`) and
+    outputs."""
 
     fit: tuple[str, ...]
     n_points: int
     specimen: str = ""  # :func:`specimen_label` of the specimen calibrated
-    state: str = "running"
+    state: BackgroundState = "running"
     started: float = field(default_factory=time.time)
     finished: float | None = None
     message: str = ""
@@ -366,7 +362,7 @@ def read_store_calibrations(store_path: str | Path) -> StoreCalibrations:
 
 
 def saved_calibrations_table(store_path: str | Path | None = None, *,
-                             listing=None):
+                             listing: pd.DataFrame | None = None) -> pd.DataFrame:
     """The Calibrate tab's table of the calibrations saved in the store, newest first
     (:meth:`pidcore.store.Store.list_calibrations` of ``store_path``, or that ``listing`` as
     already read; columns :data:`SAVED_CALIBRATION_COLUMNS`, a blank where a calibration has

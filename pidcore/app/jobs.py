@@ -41,10 +41,16 @@ import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from .. import defaults
 from ..errors import ParameterError, PidcoreError
 from .vocabulary import page_terms
+
+if TYPE_CHECKING:  # pragma: no cover - for the hints; the functions import them where used
+    from ..dem.simulate import DemConfig
+    from ..loadcase import LoadCase
+    from ..specimen import Specimen
 
 try:  # POSIX: the journal's read-modify-write is exclusive between app servers
     import fcntl
@@ -468,7 +474,7 @@ class DemJobRunner:
         for number, (entry, owner) in enumerate(entries, start=1):
             if owner == self.owner:
                 continue  # this runner's own: its memory is newer
-            live = owner is not None and owner.alive()
+            live = _still_runs(owner)
             if not live and isinstance(entry, dict) and entry.get("job_id") in own_ids:
                 continue  # taken over already, the journal not rewritten since
             try:
@@ -511,8 +517,7 @@ class DemJobRunner:
             self.journal_problem = problem
             self._foreign, self._foreign_entries = [], []
             return
-        if not any(owner != self.owner and (owner is None or not owner.alive())
-                   for _, owner in entries):
+        if not any(owner != self.owner and not _still_runs(owner) for _, owner in entries):
             self._merge_journal()
             return
         with self._journal_locked():  # taken over by one server only
@@ -799,6 +804,12 @@ def _job_document(job: DemJob, owner: JournalOwner | None = None) -> dict:
                                                        "source": str(specimen.source)}}
 
 
+def _still_runs(owner: JournalOwner | None) -> bool:
+    """Whether a journal entry's server still runs: its jobs stay its own. An entry naming no
+    owner (an older journal's, or written as no one's) is taken over like a stopped one's."""
+    return owner is not None and owner.alive()
+
+
 def write_journal(path: Path, jobs: Sequence[DemJob], *, owner: JournalOwner | None = None,
                   foreign: Sequence[dict] = ()) -> None:
     """Write the jobs' journal at ``path`` in one step (a temporary file renamed over it): a
@@ -968,7 +979,8 @@ def plan_dem_cases(frequencies_hz: Sequence[float], accelerations_g: Sequence[fl
     return cases
 
 
-def check_dem_cases(cases: Sequence, config, specimen=None) -> None:
+def check_dem_cases(cases: Sequence[LoadCase], config: DemConfig,
+                    specimen: Specimen | None = None) -> None:
     """Refuse, before any is submitted, a case the DEM refuses (a stroke no shaker makes, a
     frequency its sampling cannot afford: :func:`pidcore.dem.simulate.check_drive`), naming
     the page's fields as `pidcore dem sweep` names its options. The job failed instead, its

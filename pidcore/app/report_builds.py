@@ -14,8 +14,7 @@ import time
 from collections.abc import Callable, Hashable
 from dataclasses import dataclass, field
 
-#: States of a build, in the order it passes through them.
-BUILD_STATES = ("running", "done", "failed")
+from ..constants import BackgroundState
 
 
 @dataclass
@@ -28,7 +27,7 @@ class ReportBuild:
         What the files are of (the store's state and the page's choices): files of another
         state are not offered.
     state : str
-        One of :data:`BUILD_STATES`.
+        One of :data:`pidcore.constants.BACKGROUND_STATES`.
     files : dict
         The built files by format, ``{format: (file name, bytes, MIME type)}`` once done.
     message : str
@@ -36,7 +35,7 @@ class ReportBuild:
     """
 
     of: Hashable
-    state: str = "running"
+    state: BackgroundState = "running"
     started: float = field(default_factory=time.time)
     finished: float | None = None
     files: dict = field(default_factory=dict)

@@ -194,10 +194,7 @@ def app_words(text: str, *, names: Iterable[str] = ()) -> str:
     text = text.replace("choose one with key=NAME", "upload one measurement per file, or "
                                                     "analyse one with `pidcore analyze FILE "
                                                     "--key NAME`")
-    # the structure mass is typed in g here: the refusal named the options field in kg
-    # ("structure_mass_kg 280 kg") for 280000 typed in 'structure mass [g]'
-    text = re.sub(r"structure_mass_kg ([-+]?[0-9.]+(?:e[-+]?[0-9]+)?) kg",
-                  lambda m: f"structure mass [g] {float(m[1]) * 1e3:g} g", text)
+    # "structure_mass_kg 280 kg" is said in the field's g by page_terms
     text = text.replace("structure_mass_kg in kg", "'structure mass [g]' in g")
     # the fields are in g and µs: the hints gave kg and s ("structure mass 0.005 kg given"
     # for 5 typed in g; "expected a vibrometer delay in s (e.g. 2e-4)", which the µs field

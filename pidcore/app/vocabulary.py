@@ -12,7 +12,7 @@ from __future__ import annotations
 import re
 from collections.abc import Iterable
 
-from ..errors import outside_user_names
+from ..errors import KEYWORD_NOT_AFTER_WORD, KEYWORD_NOT_BEFORE, outside_user_names
 
 #: Library keyword (as the message writes it) -> the app's label of it. A single word
 #: (``force``) is a keyword only with its ``=``, and a ``=VALUE`` after a keyword stays as the
@@ -48,39 +48,32 @@ LABEL_OF_KEYWORD: dict[str, str] = {
     "calibration_key=": "`pidcore report --calibration-key`",
 }
 
-#: The page's unit of a field where it is not the keyword's SI unit: a value given with the
-#: keyword (``structure_mass_kg=0.0483``) is shown in it ("'structure mass [g]' (48.3)").
-_PAGE_SCALE: dict[str, float] = {"structure_mass_kg": 1e3, "mass_below_gauge_kg": 1e3,
-                                 "velocity_delay_s": 1e6}
+#: The SI unit a message gives after a keyword, the page's unit of its field where it is not
+#: the keyword's SI unit, and the page's units per SI unit. A value given with the keyword
+#: (``structure_mass_kg=0.0483``) is shown in it ("'structure mass [g]' (48.3)"), and so is a
+#: number after it (``mass_below_gauge_kg 0.5 kg`` is "'mass below gauge [g]' 500 g"), not
+#: in kg beside a label in g.
+_PAGE_UNIT: dict[str, tuple[str, str, float]] = {"structure_mass_kg": ("kg", "g", 1e3),
+                                                 "mass_below_gauge_kg": ("kg", "g", 1e3),
+                                                 "velocity_delay_s": ("s", "µs", 1e6)}
 
-#: The SI unit a message gives after a keyword (``mass_below_gauge_kg 0.5 kg``) and the
-#: page's unit of its field: the number is said in the field's unit ("'mass below gauge [g]'
-#: 500 g"), not in kg beside a label in g.
-_PAGE_UNIT: dict[str, tuple[str, str]] = {"structure_mass_kg": ("kg", "g"),
-                                          "mass_below_gauge_kg": ("kg", "g"),
-                                          "velocity_delay_s": ("s", "µs")}
-
-# as in pidcore.cli._vocabulary: the parameter, not a file's column, attribute or field of
-# that name, nor part of a longer name
-_NOT_BEFORE = r"(?<![\w'=-])(?<!\] )(?<!column )(?<!attribute )(?<!field )(?<!variable )"
-_NOT_AFTER_WORD = r"(?![\w'])(?! column)"
 # a value the user's name held (pidcore.errors.outside_user_names) is a placeholder
 _VALUE = r"(?P<value>'[^']*'|\ue000\d+\ue001|[\w.+-]+)"
 _PATTERNS = tuple(
-    (re.compile(_NOT_BEFORE + re.escape(k.removesuffix("="))
+    (re.compile(KEYWORD_NOT_BEFORE + re.escape(k.removesuffix("="))
                 + (f"={_VALUE}?" if k.endswith("=") else
-                   _NOT_AFTER_WORD if k[-1].isalnum() else "")
+                   KEYWORD_NOT_AFTER_WORD if k[-1].isalnum() else "")
                 + ("" if k.endswith("=") or not k[-1].isalnum() else f"(?:={_VALUE})?")),
-     label, _PAGE_SCALE.get(k, 1.0))
+     label, _PAGE_UNIT[k][2] if k in _PAGE_UNIT else 1.0)
     for k, label in sorted(LABEL_OF_KEYWORD.items(), key=lambda kv: -len(kv[0])))
 
 
 _NUMBER = r"(?P<number>[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)"
 _WITH_UNIT = tuple(
-    (re.compile(_NOT_BEFORE + re.escape(k) + r"(?P<colon>:?) " + _NUMBER + " "
+    (re.compile(KEYWORD_NOT_BEFORE + re.escape(k) + r"(?P<colon>:?) " + _NUMBER + " "
                 + re.escape(si) + r"(?![\w/])"),
-     LABEL_OF_KEYWORD[k], _PAGE_SCALE[k], page_unit)
-    for k, (si, page_unit) in _PAGE_UNIT.items())
+     LABEL_OF_KEYWORD[k], scale, page_unit)
+    for k, (si, page_unit, scale) in _PAGE_UNIT.items())
 
 
 def page_terms(message: str, *, names: Iterable[str] = ()) -> str:

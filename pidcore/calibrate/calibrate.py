@@ -22,7 +22,7 @@ from ..compare.align import steady_stated
 from ..constants import STANDARD_GRAVITY
 from ..dem.simulate import DemConfig, LoadCase
 from ..errors import ParameterError
-from ..specimen import CALIBRATED_SUFFIX, Specimen, paper_specimen, uncalibrated_name
+from ..specimen import Specimen, calibrated_name, paper_specimen, uncalibrated_name
 from .data import MeasuredPoint, check_enough_points
 from .observation import Observation, observation_from_run
 from .parameters import (
@@ -113,8 +113,7 @@ class CalibrationResult:
             "{} {} (95 % {} .. {})".format(s.name, *summary_texts(self.parameters[s.name]))
             for s in self.specs if s.kind != "hyper")
         return dataclasses.replace(
-            # a calibrated file calibrated again is still x_calibrated, not x_calibrated_calibrated
-            out, name=f"{uncalibrated_name(self.specimen.name)}{CALIBRATED_SUFFIX}",
+            out, name=calibrated_name(self.specimen.name),
             description=f"{self.specimen.description} -- calibrated by pidcore calibrate: "
                         f"{fitted} (these replace any value stated above)".strip(" -"))
 

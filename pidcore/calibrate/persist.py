@@ -25,6 +25,8 @@ from .outputs import document_json, specimen_text
 from .prediction import Calibration, calibration_from_json
 
 if TYPE_CHECKING:  # pragma: no cover
+    import pandas as pd
+
     from .calibrate import CalibrationResult
 
 #: Fields of calibration.json that describe how a calibration was made, not what it is: the
@@ -136,7 +138,7 @@ def stored_calibrations(store_path: str | os.PathLike) -> list[Calibration]:
     return _calibrations(store_path, None)
 
 
-def readable_calibrations(store_path: str | os.PathLike, *, listing=None,
+def readable_calibrations(store_path: str | os.PathLike, *, listing: pd.DataFrame | None = None,
                           ) -> tuple[list[Calibration], list[str]]:
     """Every calibration of ``store_path`` that can be read, newest first, and a one-line
     problem per one that cannot (a damaged entry): one damaged calibration does not hide the

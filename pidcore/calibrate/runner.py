@@ -18,6 +18,7 @@ from pathlib import Path
 
 from ..dem.persist import dem_run_entry, run_key, save_dem_entry, stored_keys
 from ..dem.simulate import DemConfig, LoadCase, simulate_load_case
+from ..interrupt import untouched
 from ..specimen import Specimen
 from .parameters import friction_paths
 
@@ -155,13 +156,11 @@ class RunTally:
         """What an interrupted calibration kept, e.g. ``"3 DEM run(s) finished before the
         interrupt are saved in dem.h5 (10 of the calibration's 24 stored now); re-run the same
         command to resume: stored runs are reused"``."""
-        # a store that never existed is "not created" (it was said to be "unchanged")
-        left = "unchanged" if Path(self.store_path).exists() else "not created"
         if not self.known:
-            return f"no DEM run was started; {self.store_path} {left}"
+            return f"no DEM run was started; {untouched(self.store_path)}"
         now = stored_keys(self.store_path, self.keys)
-        if not now and left == "not created":
-            return f"no DEM run finished in this call; {self.store_path} {left}"
+        if not now and not Path(self.store_path).exists():
+            return f"no DEM run finished in this call; {untouched(self.store_path)}"
         saved = len(now - self.before)
         held = f"{len(now)} of the calibration's {len(self.keys)} stored now"
         if saved:

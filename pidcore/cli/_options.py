@@ -64,12 +64,6 @@ def add_load_case_options(p: argparse._ActionsContainer, *, what: str,
                         "loadcases.csv beside each file")
 
 
-def untouched(path: Path) -> str:
-    """What an interrupt left of ``path``: ``"X unchanged"``, or ``"X not created"`` where it
-    never existed (a first run into a new store or folder was told it was 'unchanged')."""
-    return f"{path} unchanged" if Path(path).exists() else f"{path} not created"
-
-
 def check_out_folder(out: Path) -> None:
     """``--out`` must be a folder or not exist yet (a file there would be half-overwritten);
     checked before any work, so a long run is not thrown away at the end."""

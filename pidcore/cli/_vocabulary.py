@@ -13,7 +13,7 @@ import functools
 import re
 from collections.abc import Iterable
 
-from ..errors import outside_user_names
+from ..errors import KEYWORD_NOT_AFTER_WORD, KEYWORD_NOT_BEFORE, outside_user_names
 
 #: Library keyword (as the message writes it) -> the flag of ``pidcore analyze`` and
 #: ``pidcore report`` that sets it: the analysis options and the load case. A single word
@@ -91,15 +91,6 @@ COMMAND_FLAGS["dem sweep"] = {
     "^scheduler": "--scheduler",
 }
 
-# A keyword names the parameter, not a file's own column, attribute, field or variable of the
-# same name ("column baseline_loss_factor '-1' of loadcases.csv", "a baseline_loss_factor
-# column", "field sample_rate_hz", "('fs' or 'sample_rate_hz')"), nor part of a longer name
-# ("my_frequency_hz_col", "--structure-mass"), nor a specimen file's key ("[coupon]
-# baseline_loss_factor 0.01"). A keyword written with its value
-# ("structure_mass_kg=0.2") is the flag with that value ("--structure-mass 0.2").
-_NOT_BEFORE = r"(?<![\w'=-])(?<!\] )(?<!column )(?<!attribute )(?<!field )(?<!variable )"
-_NOT_AFTER_WORD = r"(?![\w'])(?! column)"
-
 
 @functools.cache
 def _table(command: str) -> tuple[dict[str, str], re.Pattern]:
@@ -110,9 +101,9 @@ def _table(command: str) -> tuple[dict[str, str], re.Pattern]:
     for keyword in sorted(flags, key=len, reverse=True):  # "allow_clipped=True" first
         anchored = keyword.startswith("^")
         word = keyword.removeprefix("^")
-        alternatives.append((r"^" if anchored else _NOT_BEFORE) + re.escape(word)
+        alternatives.append((r"^" if anchored else KEYWORD_NOT_BEFORE) + re.escape(word)
                             + (r"(?=[:\s])" if anchored else
-                               _NOT_AFTER_WORD + "=?" if word[-1].isalnum() else ""))
+                               KEYWORD_NOT_AFTER_WORD + "=?" if word[-1].isalnum() else ""))
     return ({k.removeprefix("^"): v for k, v in flags.items()},
             re.compile("|".join(alternatives)))
 

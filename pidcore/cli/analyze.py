@@ -10,6 +10,7 @@ from pathlib import Path
 
 from .. import interrupt
 from ..file_settings import analyze_each
+from ..interrupt import untouched
 from ..io import display_path
 from ..measure import NO_LOAD_CASE
 from ._options import (
@@ -21,7 +22,6 @@ from ._options import (
     given_options,
     path_argument,
     progress_wanted,
-    untouched,
 )
 from ._vocabulary import cli_words
 

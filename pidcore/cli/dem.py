@@ -193,7 +193,7 @@ def _interrupted(command: str, saved: int, store, *, left: int = 1) -> int:
     transaction), exit 130 (143). ``left``: runs still missing from the store (none: nothing
     to resume)."""
     from .. import interrupt
-    from ._options import untouched
+    from ..interrupt import untouched
 
     if saved:
         what = f"{saved} finished run(s) saved to {store}; " + (

@@ -9,6 +9,7 @@ import argparse
 import sys
 
 from .. import interrupt
+from ..interrupt import untouched
 from ..report.render import folder_identity, format_cell
 from ..report.table import ALIGNMENT_COLUMN
 from ._options import (
@@ -19,7 +20,6 @@ from ._options import (
     given_options,
     path_argument,
     progress_wanted,
-    untouched,
 )
 from ._vocabulary import cli_words
 

@@ -262,8 +262,7 @@ def read_csv(path: str | os.PathLike[str], *, sample_rate_hz: float | None = Non
 
     time_index = None
     for i, (name, unit) in enumerate(cells):
-        quantity, _ = interpret_unit(unit)
-        if quantity == "time" or (not unit and name.strip().lower() in _TIME_NAMES):
+        if _is_time_unit(unit) or (not unit and name.strip().lower() in _TIME_NAMES):
             time_index = i
             break
     if sample_rate_hz is not None:
@@ -272,14 +271,14 @@ def read_csv(path: str | os.PathLike[str], *, sample_rate_hz: float | None = Non
         rate, start_time = float(sample_rate_hz), 0.0
         if time_index is not None:
             name, unit = cells[time_index]
-            _, factor = interpret_unit(unit) if unit else ("time", 1.0)
+            factor = _seconds_per(unit)
             start_time = float(values[0, time_index]) * factor
             notes.append(f"{where}: time column {name!r} ignored: the sample rate "
                          f"{rate:g} Hz was given (sample_rate_hz)"
                          + overridden_rate(values[:, time_index] * factor, rate))
     elif time_index is not None:
         name, unit = cells[time_index]
-        _, factor = interpret_unit(unit) if unit else ("time", 1.0)
+        factor = _seconds_per(unit)
         rate, start_time, note = rate_from_times(values[:, time_index] * factor,
                                                  what=f"{where}: column {name!r}",
                                                  with_note=True)
@@ -341,6 +340,12 @@ def _is_time_unit(unit: str) -> bool:
     return interpret_unit(unit)[0] == "time"
 
 
+def _seconds_per(unit: str) -> float:
+    """Seconds per unit of a time column (a column without a unit is taken as seconds, which
+    the caller notes)."""
+    return interpret_unit(unit)[1] if unit else 1.0
+
+
 def _pair_time_bases(values: np.ndarray, cells: list[tuple[str, str]], pair_times: list[int],
                      keep: list[int], names: list[str], *, where: str,
                      main: tuple[float, float, int], given_rate: float | None,
@@ -360,7 +365,7 @@ def _pair_time_bases(values: np.ndarray, cells: list[tuple[str, str]], pair_time
         times = values[:, t_index]
         length = int(np.argmax(np.isnan(times))) if np.isnan(times).any() else times.size
         name, unit = cells[t_index]
-        factor = interpret_unit(unit)[1] if unit else 1.0
+        factor = _seconds_per(unit)
         what = f"{where}: column {name!r} (time of column {owned[0] + 1})"
         if length < 2:
             raise InputFileError(f"{what}: holds {length} times; expected the time of each "

@@ -27,6 +27,7 @@ import pandas as pd
 
 from ..compare.align import Aligner, Tolerances
 from ..compare.loadcase import LoadCase, StatedLoadCase
+from ..compare.specimens import NOT_PAPER_SPECIMEN_NOTE
 from ..constants import REPORT_FORMATS
 from ..errors import ParameterError, StoreError
 from ..io import display_path
@@ -477,8 +478,7 @@ def specimen_report_table(stored_runs: pd.DataFrame | None, analyses: pd.DataFra
     paper = load_paper_table3()
     if specimen is not None and not specimen.is_paper():
         paper = None
-        notes.append(f"specimen {specimen.name} is not the paper's coupon: the paper's "
-                     "Table 3 is not compared")
+        notes.append(NOT_PAPER_SPECIMEN_NOTE.format(name=specimen.name))
     from ..specimen import PAPER_SPECIMEN_NAME
 
     table, aligner = report_table_and_aligner(

@@ -489,14 +489,7 @@ class Store:
     def _section(self, h5: h5py.File, section: str) -> h5py.Group | None:
         """The section group (None where absent), refused as :meth:`_check_sections` refuses
         it where it is not a group of the store's own file."""
-        link = h5.get(section, getlink=True)
-        if link is None:
-            return None
-        parent = h5.get(section) if isinstance(link, h5py.HardLink) else None
-        if not isinstance(parent, h5py.Group):
-            raise self._unreadable(f"/{section} is {self._what(link, parent)}; expected "
-                                   "a group of entries")
-        return parent
+        return self._own_group(h5, section, f"/{section}", "a group of entries")
 
     def _stored_entry(self, h5: h5py.File | None, section: str,
                       key: str) -> h5py.Group | None:
@@ -508,13 +501,20 @@ class Store:
     def _entry_of(self, parent: h5py.Group, section: str, key: str) -> h5py.Group | None:
         """The entry ``key`` of the section group ``parent`` (None where not stored), refused
         where it is not a group of the store's own file."""
-        link = parent.get(key, getlink=True)
+        return self._own_group(parent, key, f"/{section}/{key}",
+                               "an entry group in the store's own file")
+
+    def _own_group(self, parent: h5py.Group, name: str, where: str,
+                   expected: str) -> h5py.Group | None:
+        """The group ``name`` of ``parent`` (None where absent), its link checked before it is
+        followed: refused, saying ``where`` it is and what was ``expected``, where it is not a
+        hard-linked group of the store's own file (an external or soft link, a dataset)."""
+        link = parent.get(name, getlink=True)
         if link is None:
             return None
-        item = parent.get(key) if isinstance(link, h5py.HardLink) else None
+        item = parent.get(name) if isinstance(link, h5py.HardLink) else None
         if not isinstance(item, h5py.Group):
-            raise self._unreadable(f"/{section}/{key} is {self._what(link, item)}; "
-                                   "expected an entry group in the store's own file")
+            raise self._unreadable(f"{where} is {self._what(link, item)}; expected {expected}")
         return item
 
     @contextmanager

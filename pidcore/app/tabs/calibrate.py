@@ -24,8 +24,7 @@ from pidcore.app.calibration import (
     specimen_label,
 )
 from pidcore.app.tabs import draw_polling, specimen_choice
-from pidcore.specimen import CALIBRATED_SUFFIX
-from pidcore.specimen import uncalibrated_name as uncalibrated
+from pidcore.specimen import calibrated_name
 
 #: Seconds between refreshes of the calibration's state while it runs.
 REFRESH_S = 2.0
@@ -69,7 +68,7 @@ def _task(stores, chosen: str, polling: bool) -> None:
     files = [n for n in sorted(out) if Path(n).suffix in mimes]
     for col, name in zip(st.columns(max(len(files), 1)), files, strict=False):
         # the calibrated specimen file saves under its specimen's name
-        file_name = f"{task.specimen}{CALIBRATED_SUFFIX}.toml" \
+        file_name = f"{calibrated_name(task.specimen)}.toml" \
             if name.endswith(".toml") and task.specimen else name
         label = "calibrated specimen (TOML)" if name.endswith(".toml") else name
         col.download_button(label, out[name], file_name=file_name,
@@ -138,7 +137,7 @@ def _saved(stored) -> None:
     c1, c2 = st.columns(2)
     c1.download_button("calibration.json", chosen.document_text, file_name="calibration.json",
                        mime="application/json", key="calibration_saved_json")
-    name = f"{uncalibrated(chosen.specimen_name)}{CALIBRATED_SUFFIX}.toml"
+    name = f"{calibrated_name(chosen.specimen_name)}.toml"
     c2.download_button("calibrated specimen (TOML)", chosen.specimen_text, file_name=name,
                        mime="application/toml", key="calibration_saved_toml", help=name)
 
