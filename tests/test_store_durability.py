@@ -21,6 +21,7 @@ from pidcore.errors import ParameterError, StoreError
 from pidcore.signal.synthetic import synthesize_shaker_record
 from pidcore.specimen import load_specimen
 from pidcore.store import Store
+from pidcore.store.lock import exclusive_lock
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -465,3 +466,32 @@ def test_a_sigterm_ignored_by_whoever_started_pidcore_stays_ignored():
         assert signal.getsignal(signal.SIGTERM) is signal.SIG_IGN
     finally:
         signal.signal(signal.SIGTERM, previous)
+
+
+def test_the_copy_of_a_writer_killed_outright_does_not_refuse_the_next_run(
+        tmp_path, monkeypatch):
+    # A writer killed by `kill -9` (or the OOM killer) mid-commit leaves its working copy, a
+    # hidden file as large as the store, until the next commit removes it. check_writable()
+    # counted its space as used and refused the next `dem run`/sweep for want of room ("0.5
+    # MiB free ... expected at least 1.4 MiB free") that removing the copy gave.
+    import shutil
+
+    store = Store(tmp_path / "s.h5")
+    store.add_dem_run("kept", {"sdc": 0.1}, arrays={"trace": np.ones(50_000)})
+    digest = file_sha256(store.path)
+    stale = tmp_path / ".s.h5.0123456789abcdef.tmp"
+    shutil.copyfile(store.path, stale)  # what the killed writer of a large store left
+    capacity = 2 * store.path.stat().st_size + 2**20 + 4096  # a disk with room for one copy
+    usage = shutil.disk_usage(tmp_path)
+
+    def disk_of_fixed_capacity(path):
+        used = sum(p.stat().st_size for p in Path(path).iterdir() if p.is_file())
+        return usage._replace(free=capacity - used)
+
+    monkeypatch.setattr(shutil, "disk_usage", disk_of_fixed_capacity)
+    with exclusive_lock(store.path, timeout_s=1):  # a writer at work: its copy is not stale
+        with pytest.raises(StoreError, match=r"s\.h5: 1\.0 MiB free in "):
+            store.check_writable()
+        assert stale.exists()
+    store.check_writable()  # the lock is free: the copy is stale, and removed
+    assert sorted(os.listdir(tmp_path)) == ["s.h5"] and file_sha256(store.path) == digest

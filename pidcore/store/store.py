@@ -408,7 +408,17 @@ class Store:
                              "written as a copy beside it, then renamed); expected a writable "
                              "folder (give a store file in another one)")
         self._check_single_link()
+        self._remove_stale_temporaries_if_idle()
         self._check_room(directory)
+
+    def _remove_stale_temporaries_if_idle(self) -> None:
+        """Remove the working copies of writers killed outright (``kill -9``, the OOM killer)
+        when no writer holds the lock now: such a copy (hidden, as large as the store) stayed
+        until the next commit, and its space counted as used refused that commit's run for
+        want of the room removing it gives. A live writer's copy is not stale: nothing is
+        removed while the lock is taken."""
+        with suppress(StoreError, OSError), exclusive_lock(self._file, timeout_s=0):
+            self._remove_stale_temporaries()
 
     def _check_single_link(self) -> None:
         """Refuse a store file with more than one name (a hard link): a save replaces the
