@@ -582,7 +582,10 @@ class Store:
         Every ``add_*`` call made inside the block (same thread) joins it, so a batch copies the
         store once. Leaving the block normally commits; any exception, KeyboardInterrupt
         included, discards every change of the batch and leaves the store file untouched.
-        Nested ``transaction()`` blocks join the outermost one.
+        Nested ``transaction()`` blocks join the outermost one. The room on disk for each
+        ``add_*`` call is checked before it is written; data written straight into the
+        yielded file of a store above :data:`pidcore.defaults.STORE_IN_MEMORY_MAX_BYTES`
+        is not, and a write HDF5 fails there ends in h5py's destructor errors (store intact).
 
         Raises
         ------
