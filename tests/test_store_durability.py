@@ -21,6 +21,7 @@ from pidcore.errors import ParameterError, StoreError
 from pidcore.signal.synthetic import synthesize_shaker_record
 from pidcore.specimen import load_specimen
 from pidcore.store import Store
+from pidcore.store.lock import exclusive_lock
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -58,6 +59,76 @@ def test_a_store_changed_on_disk_is_refused_in_one_line_where_its_copy_cannot_fi
     lines = p.stdout.splitlines()
     assert len(lines) == 1 and "s.h5: the file size limit of this process" in lines[0]
     assert file_sha256(store.path) == digest and sorted(os.listdir(tmp_path)) == ["s.h5"]
+
+
+def test_new_data_that_does_not_fit_a_store_changed_on_disk_is_one_line_store_unchanged(
+        tmp_path):
+    # The room checked before the copy is the store plus 1 MiB of headroom: an 8 MB array
+    # saved under a file size limit 3 MiB above the store passed that check, HDF5 failed its
+    # own write of the copy, and the process printed h5py's destructor tracebacks and died of
+    # a segmentation fault (status -11). Now the entry's size is checked before HDF5 writes it.
+    store = Store(tmp_path / "s.h5")
+    store.add_dem_run("kept", {"sdc": 0.25}, arrays={"trace": np.arange(1000.0)})
+    digest, size = file_sha256(store.path), store.path.stat().st_size
+    code = textwrap.dedent(f"""
+        import numpy as np
+        from pidcore import defaults
+        from pidcore.errors import StoreError
+        from pidcore.store import Store
+        defaults.STORE_IN_MEMORY_MAX_BYTES = 0  # every store is "large"
+        samples = np.random.default_rng(0).standard_normal(1_000_000)  # 8 MB, incompressible
+        try:
+            Store({str(store.path)!r}).add_dem_run("new", {{"sdc": 0.5}},
+                                                    arrays={{"samples": samples}})
+        except StoreError as exc:
+            print(exc)
+    """)
+    p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                       timeout=60, env={**os.environ, "PYTHONPATH": str(ROOT)},
+                       preexec_fn=_with_file_size_limit(size + 3 * 2**20))
+    assert p.returncode == 0 and p.stderr == "", (p.returncode, p.stderr[-2000:])
+    lines = p.stdout.splitlines()
+    assert len(lines) == 1, lines
+    assert ("s.h5: DEM run 'new' needs up to 8.7 MiB more, and the file size limit of this "
+            "process (ulimit -f) is 3.0 MiB") in lines[0]
+    assert lines[0].endswith("the store is unchanged")
+    assert file_sha256(store.path) == digest and sorted(os.listdir(tmp_path)) == ["s.h5"]
+
+
+def test_new_data_that_does_not_fit_the_disk_of_a_store_changed_on_disk_is_refused(
+        tmp_path, monkeypatch):
+    # As above for a full disk (HDF5's write fails with ENOSPC the same way): room for the
+    # copy of the store, not for the measurement's channels that come into it.
+    import shutil
+
+    from pidcore import defaults
+
+    store = Store(tmp_path / "s.h5")
+    store.add_dem_run("kept", {"sdc": 0.25})
+    digest = file_sha256(store.path)
+    rec = synthesize_shaker_record(mass_kg=0.25, acceleration_amplitude_m_s2=49.0,
+                                   frequency_hz=100.0, sample_rate_hz=25_600.0, n_periods=400,
+                                   viscous_damping_n_s_m=2.0, snr_db=50, seed=3)
+    csv = write_force_velocity(tmp_path / "run.csv", rec.force_n, rec.velocity_m_s, 25_600.0)
+    from pidcore.io import read_measurement
+
+    measurement = read_measurement(csv)
+    channel_bytes = sum(np.asarray(ch.data).size * 8 for ch in measurement.channels)
+    usage = shutil.disk_usage(tmp_path)
+    # 1.5 MiB: the copy of the store and its 1 MiB headroom fit, the channels (~1.6 MB +
+    # 1 MiB of headroom for HDF5's own structures) do not
+    assert channel_bytes + 2**20 > 1.5 * 2**20
+    monkeypatch.setattr(shutil, "disk_usage", lambda path: usage._replace(free=3 * 2**19))
+    monkeypatch.setattr(defaults, "STORE_IN_MEMORY_MAX_BYTES", 0)
+    with pytest.raises(StoreError, match=r"s\.h5: measurement .*run\.csv needs up to "
+                                         r"[\d.]+ MiB more, and 1\.5 MiB free in .*the store "
+                                         r"is unchanged$"):
+        store.add_measurement(measurement)
+    assert file_sha256(store.path) == digest
+    assert sorted(os.listdir(tmp_path)) == ["run.csv", "s.h5"]
+    monkeypatch.setattr(defaults, "STORE_IN_MEMORY_MAX_BYTES", 2**30)
+    store.add_measurement(measurement)  # in memory: the image is written by Python, no check
+    assert store.verify() == [] and len(store.list_measurements()) == 1
 
 
 @pytest.mark.parametrize("room", [-4000, 1_000_000], ids=["below-the-store", "above-it"])
@@ -395,3 +466,32 @@ def test_a_sigterm_ignored_by_whoever_started_pidcore_stays_ignored():
         assert signal.getsignal(signal.SIGTERM) is signal.SIG_IGN
     finally:
         signal.signal(signal.SIGTERM, previous)
+
+
+def test_the_copy_of_a_writer_killed_outright_does_not_refuse_the_next_run(
+        tmp_path, monkeypatch):
+    # A writer killed by `kill -9` (or the OOM killer) mid-commit leaves its working copy, a
+    # hidden file as large as the store, until the next commit removes it. check_writable()
+    # counted its space as used and refused the next `dem run`/sweep for want of room ("0.5
+    # MiB free ... expected at least 1.4 MiB free") that removing the copy gave.
+    import shutil
+
+    store = Store(tmp_path / "s.h5")
+    store.add_dem_run("kept", {"sdc": 0.1}, arrays={"trace": np.ones(50_000)})
+    digest = file_sha256(store.path)
+    stale = tmp_path / ".s.h5.0123456789abcdef.tmp"
+    shutil.copyfile(store.path, stale)  # what the killed writer of a large store left
+    capacity = 2 * store.path.stat().st_size + 2**20 + 4096  # a disk with room for one copy
+    usage = shutil.disk_usage(tmp_path)
+
+    def disk_of_fixed_capacity(path):
+        used = sum(p.stat().st_size for p in Path(path).iterdir() if p.is_file())
+        return usage._replace(free=capacity - used)
+
+    monkeypatch.setattr(shutil, "disk_usage", disk_of_fixed_capacity)
+    with exclusive_lock(store.path, timeout_s=1):  # a writer at work: its copy is not stale
+        with pytest.raises(StoreError, match=r"s\.h5: 1\.0 MiB free in "):
+            store.check_writable()
+        assert stale.exists()
+    store.check_writable()  # the lock is free: the copy is stale, and removed
+    assert sorted(os.listdir(tmp_path)) == ["s.h5"] and file_sha256(store.path) == digest

@@ -26,7 +26,9 @@ destructors, a two-line message and a segmentation fault at exit; a failed write
 is one ``OSError`` of Python's own. A store larger than
 :data:`pidcore.defaults.STORE_IN_MEMORY_MAX_BYTES` is copied to the temporary file instead and
 changed there (its size in memory per commit was the price otherwise); the room for the copy
-is checked before (:meth:`Store.check_writable`), and the rename is the same.
+is checked before (:meth:`Store.check_writable`), the room for each entry before HDF5 writes it
+(:meth:`Store._check_room_to_write`; a disk filled by another process in between still ends in
+h5py's errors, store intact), and the rename is the same.
 
 Readers take no lock. Because the path is only ever swapped atomically and an open HDF5 handle
 keeps reading the file it opened, a reader sees the last committed state even while a writer
@@ -132,6 +134,11 @@ class _PreparedEntry:
     arrays: dict[str, np.ndarray]
     units: dict[str, str]
     parameters_json: str
+
+    @property
+    def nbytes(self) -> int:
+        """Bytes of its arrays, uncompressed (its attributes are within the headroom)."""
+        return sum(array.nbytes for array in self.arrays.values())
 
 
 def _utc_now() -> str:
@@ -349,6 +356,8 @@ class Store:
         self.lock_timeout_s = timeout
         self._active: h5py.File | None = None
         self._active_thread: int | None = None
+        #: The working copy HDF5 writes itself (a store above STORE_IN_MEMORY_MAX_BYTES)
+        self._active_on_disk: Path | None = None
         #: Transactions this object has committed (read after a Ctrl-C: was anything saved?)
         self.commits = 0
         if self.path.is_dir():  # HDF5's own message is two lines of C-library internals
@@ -399,7 +408,17 @@ class Store:
                              "written as a copy beside it, then renamed); expected a writable "
                              "folder (give a store file in another one)")
         self._check_single_link()
+        self._remove_stale_temporaries_if_idle()
         self._check_room(directory)
+
+    def _remove_stale_temporaries_if_idle(self) -> None:
+        """Remove the working copies of writers killed outright (``kill -9``, the OOM killer)
+        when no writer holds the lock now: such a copy (hidden, as large as the store) stayed
+        until the next commit, and its space counted as used refused that commit's run for
+        want of the room removing it gives. A live writer's copy is not stale: nothing is
+        removed while the lock is taken."""
+        with suppress(StoreError, OSError), exclusive_lock(self._file, timeout_s=0):
+            self._remove_stale_temporaries()
 
     def _check_single_link(self) -> None:
         """Refuse a store file with more than one name (a hard link): a save replaces the
@@ -563,7 +582,10 @@ class Store:
         Every ``add_*`` call made inside the block (same thread) joins it, so a batch copies the
         store once. Leaving the block normally commits; any exception, KeyboardInterrupt
         included, discards every change of the batch and leaves the store file untouched.
-        Nested ``transaction()`` blocks join the outermost one.
+        Nested ``transaction()`` blocks join the outermost one. The room on disk for each
+        ``add_*`` call is checked before it is written; data written straight into the
+        yielded file of a store above :data:`pidcore.defaults.STORE_IN_MEMORY_MAX_BYTES`
+        is not, and a write HDF5 fails there ends in h5py's destructor errors (store intact).
 
         Raises
         ------
@@ -590,6 +612,7 @@ class Store:
                 h5, buffer = self._working_copy(tmp, exists=exists)
                 try:
                     self._active, self._active_thread = h5, threading.get_ident()
+                    self._active_on_disk = tmp if buffer is None else None
                     yield h5
                 except BaseException:
                     with suppress(Exception):  # the copy is discarded anyway
@@ -597,6 +620,7 @@ class Store:
                     raise
                 finally:
                     self._active, self._active_thread = None, None
+                    self._active_on_disk = None
                 try:
                     h5.close()  # flushes every change into the buffer (or the copy on disk)
                     if buffer is None:
@@ -621,6 +645,36 @@ class Store:
             except BaseException:
                 tmp.unlink(missing_ok=True)
                 raise
+
+    def _check_room_to_write(self, h5: h5py.File, nbytes: int, *, what: str) -> None:
+        """Refuse, before HDF5 writes them, ``nbytes`` of new data that do not fit in the
+        working copy on disk (free space, the file size limit): HDF5 writes that copy itself,
+        and a write it fails ended in h5py's destructor errors and a segmentation fault (the
+        room checked before the copy only covers the copy and a guess of a few entries; a
+        long record or a big array did not fit in that guess). No check for a copy in
+        memory: its image is written by Python, whose failure is one line."""
+        if self._active_on_disk is None:
+            return
+        tmp = self._active_on_disk
+        size = h5.id.get_filesize()
+        # uncompressed, as gzip may save nothing, plus 1 % for what grows with them (zlib's
+        # worst case is +0.03 %, fletcher32 4 bytes and the chunk index ~32 bytes per chunk)
+        needed = nbytes + nbytes // 100 + _COMMIT_HEADROOM_BYTES
+        problem = ""
+        with suppress(OSError):  # a file system that cannot say: HDF5 will tell
+            free = shutil.disk_usage(tmp.parent).free
+            if free < needed:
+                problem = f"{free / 2**20:.1f} MiB free in {tmp.parent}"
+        limit = resource.getrlimit(resource.RLIMIT_FSIZE)[0]
+        if not problem and limit != resource.RLIM_INFINITY and limit < size + needed:
+            problem = (f"the file size limit of this process (ulimit -f) is "
+                       f"{limit / 2**20:.1f} MiB and its working copy is "
+                       f"{size / 2**20:.1f} MiB already")
+        if problem:
+            raise StoreError(
+                f"{self.path}: {what} needs up to {needed / 2**20:.1f} MiB more, and "
+                f"{problem}; expected room for it (free some space, raise the limit, or give "
+                "a store file on another disk); the store is unchanged")
 
     def _working_copy(self, tmp: Path, *,
                       exists: bool) -> tuple[h5py.File, io.BytesIO | None]:
@@ -694,6 +748,9 @@ class Store:
                 self._check_same_measurement(parent[key], measurement, key)
                 parent[key].attrs["source"] = measurement.source
                 return key, False
+            self._check_room_to_write(
+                h5, sum(np.asarray(ch.data).size * 8 for ch in measurement.channels),
+                what=f"measurement {measurement.source}")  # stored as float64
             group = parent.create_group(key)
             try:
                 write_measurement_group(group, measurement)
@@ -789,6 +846,7 @@ class Store:
             parent = h5[_ANALYSES]
             if key in parent:
                 del parent[key]
+            self._check_room_to_write(h5, entry.nbytes, what=f"analysis {key!r}")
             _write_entry(parent, key, entry, layout=_LAYOUT_ANALYSIS,
                          link_attrs={"measurement_key": measurement_key})
         return key
@@ -886,6 +944,7 @@ class Store:
                         raise StoreError(f"{self.path}: DEM run {case_key!r} is stored already; "
                                          "pass replace=True to overwrite it")
                     del parent[case_key]
+                self._check_room_to_write(h5, entry.nbytes, what=f"DEM run {case_key!r}")
                 _write_entry(parent, case_key, entry, layout=_LAYOUT_DEM_RUN,
                              link_attrs={"case_key": case_key})
         return list(prepared)
@@ -953,6 +1012,7 @@ class Store:
             parent = h5[_CALIBRATIONS]
             if key in parent:  # stored by another process since the check above
                 return key, False
+            self._check_room_to_write(h5, entry.nbytes, what=f"calibration {key!r}")
             _write_entry(parent, key, entry, layout=_LAYOUT_CALIBRATION,
                          link_attrs={"calibration_key": key})
         return key, True
