@@ -393,3 +393,18 @@ def test_an_sdc_in_percent_is_refused_naming_its_line(capsys, tmp_path):
     table = _table(tmp_path, HEADER + "500,5,50,0.6\n1000,5,50,42\n500,1,50,0.2\n")
     _refused(capsys, tmp_path, ["--data", str(table)],
              "m.csv, line 3: sdc 42 is above 6.283 (2 pi, a loss factor of 1")
+
+
+def test_a_field_of_value_zero_asks_for_its_prior_by_name(capsys, tmp_path):
+    # the paper's particle-wall rolling friction is 0: no 0.5x..1.5x default range, and the
+    # refusal said "bounds nan:nan are empty (expected LOW < HIGH)", naming no way out
+    field = "pairs.particle_wall.rolling_friction"
+    assert paper_specimen().pairs.particle_wall.rolling_friction == 0
+    err = _refused(capsys, tmp_path, ["--data", str(_table(tmp_path)), "--fit", field],
+                   f"give --prior {field}=LOW:HIGH", "no default prior bounds")
+    assert "nan" not in err
+    with pytest.raises(ParameterError, match=rf"give priors={field}=LOW:HIGH$"):
+        build_specs([field], [])
+    # the way out it names works: with a prior, the specs build
+    (spec,) = [s for s in build_specs([field], [f"{field}=0:0.1"]) if s.name == field]
+    assert (spec.low, spec.high) == (0.0, 0.1)

@@ -215,3 +215,25 @@ def test_the_app_offers_the_stores_calibrations_after_a_restart(calibrated, tmp_
     assert list(table["inside 95 % band (LOO) [-]"]) == ["", ""]  # no leave-one-out asked
     assert all(c.endswith("]") for c in table.columns if c not in ("calibration", "specimen",
                                                                    "fitted"))
+
+
+def test_the_listing_of_a_refused_report_keeps_the_fitted_names(calibrated, capsys, tmp_path):
+    # "fitted fixture_mass_kg,--baseline-loss-factor": the report CLI read the calibration's
+    # fitted baseline_loss_factor as its own option of that name
+    folder, store = calibrated
+    copy = tmp_path / "two.h5"
+    copy.write_bytes(store.read_bytes())
+    table = folder / "m.csv"
+    assert main(["calibrate", "--data", str(table), "--fit",
+                 "fixture_mass_kg,baseline_loss_factor", "--discrepancy", "0.2",
+                 "--dem-store", str(copy), "--out", str(tmp_path / "out"), *TINY]) == 0
+    capsys.readouterr()
+    assert main(["report", "--dem-store", str(copy), "--calibration", str(copy), "--out",
+                 str(tmp_path / "report"), "--format", "csv"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1, err
+    assert "fitted 'fixture_mass_kg,baseline_loss_factor';" in err, err
+    assert "fitted 'fixture_mass_kg';" in err and "--baseline-loss-factor" not in err, err
+    # the library says the same names to a Python caller
+    with pytest.raises(ParameterError, match="fitted 'fixture_mass_kg,baseline_loss_factor';"):
+        stored_calibration(copy)

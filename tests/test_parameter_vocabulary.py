@@ -418,3 +418,29 @@ def test_every_keyword_a_library_message_names_is_a_public_parameter():
               k[1:].isidentifier()}
     assert tabled - parameters <= {"calibrate", "write_outputs", "read_measured_table"}, \
         tabled - parameters
+
+
+def test_every_flag_a_command_names_for_a_keyword_is_one_of_its_own():
+    # `report` translated key=NAME to "--key NAME", a flag only `analyze` had: a user told
+    # to type it met argparse's "unrecognized arguments"
+    import argparse
+
+    from pidcore.cli import build_parser
+    from pidcore.cli._vocabulary import COMMAND_FLAGS
+
+    own: dict[tuple[str, ...], set[str]] = {}
+
+    def walk(parser: argparse.ArgumentParser, path: tuple[str, ...]) -> None:
+        for action in parser._actions:
+            own.setdefault(path, set()).update(action.option_strings)
+            if isinstance(action, argparse._SubParsersAction):
+                for name, sub in action.choices.items():
+                    walk(sub, (*path, name))
+
+    walk(build_parser(), ())
+    assert "--key" in own[("analyze",)]  # the walk sees the commands' flags
+    wrong = [(command, keyword, said) for command, table in COMMAND_FLAGS.items()
+             for keyword, said in table.items() if not said.startswith("pidcore ")
+             for flag in re.findall(r"--[a-z][a-z0-9-]*", said)
+             if flag not in own[tuple(command.split())]]
+    assert not wrong, wrong

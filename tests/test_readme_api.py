@@ -49,3 +49,26 @@ def test_the_readme_python_api_block_runs(tmp_path, monkeypatch, capsys):
     assert not any("no fill" in note for note in table.attrs.get("notes", []))
     assert namespace["run"].sdc > 0
     assert list(namespace["damper"]["c_eq [N s/m]"] > 0) == [True, True]
+
+
+def test_the_refusals_the_python_api_section_promises():
+    # the section said "wrong keywords ... are refused with a ParameterError": a misspelt
+    # keyword is Python's own TypeError; a wrong value or type is a ParameterError naming
+    # the keyword a script writes, not the CLI's flag
+    from pidcore.dem import DemConfig
+    from pidcore.errors import ParameterError
+    from pidcore.measure import AnalysisOptions, analyze_file
+
+    section = (ROOT / "README.md").read_text(encoding="utf-8").split("\n## Python API\n", 1)[1]
+    assert "misspelt keyword with Python's own `TypeError`" in " ".join(section.split())
+    with pytest.raises(TypeError, match="'velocity_delay'"):
+        AnalysisOptions(velocity_delay=1e-4)
+    with pytest.raises(ParameterError, match=r"^velocity_delay_s: expected a number, got 'abc'$"):
+        AnalysisOptions(velocity_delay_s="abc")
+    with pytest.raises(ParameterError, match=r"^cells: expected >= 1, got 0$"):
+        DemConfig(cells=0)
+    export = ROOT / "data_samples" / "exports" / "synthetic_f500Hz_a1g_fill50_acrylic.csv"
+    with pytest.raises(ParameterError) as refused:
+        analyze_file(export, AnalysisOptions(structure_mass_kg=5.0, baseline_loss_factor=0.01))
+    assert "structure_mass_kg 5 kg" in str(refused.value)
+    assert "--" not in str(refused.value)

@@ -378,3 +378,22 @@ def test_a_row_whose_stderr_gives_no_band_is_not_compared_and_says_why(tmp_path)
     assert out[CALIBRATED_INSIDE_COLUMN].tolist() == ["not compared", "not compared", "no"]
     assert all("no calibrated band for this measurement's SDC stderr" in n
                for n in out["note"][:2])
+
+
+@pytest.mark.parametrize("missing", ["nope.json", "folder"])
+def test_a_missing_calibration_names_the_command_that_writes_one(tmp_path, capsys, missing):
+    # the CLI said "... written by write_outputs(result, --out)": a Python call, half
+    # translated, where the user needs the command that writes calibration.json
+    path = tmp_path / missing
+    if missing == "folder":
+        path.mkdir()
+    out = tmp_path / "report"
+    rc = main(["report", "--dem-store", str(ROOT / "data_samples" / "dem_table3.h5"),
+               "--calibration", str(path), "--out", str(out)])
+    err = capsys.readouterr().err.strip()
+    assert rc == 2 and not out.exists() and len(err.splitlines()) == 1
+    assert "written by pidcore calibrate --out" in err, err
+    assert "write_outputs" not in err and "result" not in err
+    # the library, for a Python caller, names its own function
+    with pytest.raises(ParameterError, match=r"write_outputs\(result, out_dir\)"):
+        load_calibration(path)

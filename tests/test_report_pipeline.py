@@ -359,3 +359,33 @@ def test_a_baseline_taken_off_the_whole_vibrated_mass_is_said_in_the_report(tmp_
     # the exact subtraction (half the 0.2 kg rigid mass the structure) and none: no note
     assert said not in notes(str(file), *baseline, "--structure-mass", "0.1", out="exact")
     assert said not in notes(str(file), out="none")
+
+
+def test_a_store_of_several_measurements_is_reported_with_the_key_its_refusal_names(
+        tmp_path, capsys):
+    # `report STORE.h5` said "choose one with --key NAME", a flag report did not have
+    import json
+    from pathlib import Path
+
+    samples = Path(__file__).resolve().parents[1] / "data_samples" / "exports"
+    files = [str(samples / "synthetic_f500Hz_a1g_fill50_acrylic.csv"),
+             str(samples / "synthetic_f500Hz_a5g_fill50_acrylic.mat")]
+    held = tmp_path / "held.h5"
+    assert main(["analyze", *files, "--store", str(held), "--fill", "50", "--no-progress"]) == 0
+    capsys.readouterr()
+    out = tmp_path / "report"
+    assert main(["report", str(held), "--fill", "50", "--out", str(out), "--format", "csv",
+                 "--dem-store", str(samples.parent / "dem_table3.h5")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "choose one with --key NAME" in err, err
+    assert not out.exists()
+    key = Store(held).list_measurements()["key"].iloc[0]
+    assert main(["report", str(held), "--key", key, "--fill", "50", "--out", str(out),
+                 "--format", "csv", "--dem-store", str(samples.parent / "dem_table3.h5")]) == 0
+    capsys.readouterr()
+    assert main(["analyze", str(held), "--key", key, "--fill", "50", "--no-store",
+                 "--json"]) == 0
+    (analyzed,) = json.loads(capsys.readouterr().out)["records"]
+    table = pd.read_csv(out / "report.csv")
+    # the measurement the key names, analysed as `analyze --key` analyses it, bit for bit
+    assert list(table["SDC measured [-]"].dropna()) == [analyzed["sdc"]]

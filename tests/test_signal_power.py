@@ -477,3 +477,19 @@ def test_the_numba_warm_up_record_is_accepted():
     from _numba_warmup import warm_signal_kernels
 
     warm_signal_kernels()
+
+
+@pytest.mark.parametrize("delay, said", [
+    (0.1, "velocity_delay_s: 0.1 s is longer than 4 drive periods of 500 Hz"),
+    # a negative delay (a lead) was said to be "-0.1 s ... longer than 4 drive periods"
+    (-0.1, "velocity_delay_s: -0.1 s shifts the velocity by more than 4 drive periods of "
+           "500 Hz")])
+def test_a_delay_of_several_periods_is_refused_as_the_shift_it_is(delay, said):
+    rec = synthesize_shaker_record(mass_kg=0.4, acceleration_amplitude_m_s2=5 * G,
+                                   frequency_hz=500.0, sample_rate_hz=51200.0, n_periods=100,
+                                   viscous_damping_n_s_m=5.0)
+    with pytest.raises(ParameterError) as refused:
+        analyze_power(rec.force_n, rec.velocity_m_s, 51200.0, velocity_delay_s=delay)
+    assert str(refused.value).startswith(said), refused.value
+    # 4 periods of 500 Hz (0.008 s) is the limit, below the 0.2 s record, whichever the sign
+    assert "(0.008 s, record 0.2 s)" in str(refused.value)

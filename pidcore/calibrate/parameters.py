@@ -54,6 +54,12 @@ class ParameterSpec:
     def check(self) -> None:
         """Refuse empty bounds and a prior that does not fit them (one-line
         :class:`~pidcore.errors.ParameterError` naming the parameter)."""
+        if math.isnan(self.low) and math.isnan(self.high):
+            # a field of value 0 has no default range (0.5x..1.5x its value): "bounds nan:nan
+            # are empty" left the caller guessing what to give
+            raise ParameterError(f"{self.name}: no default prior bounds (they are 0.5 .. 1.5 "
+                                 f"x a positive value; this one is {as_given(self.default)}); "
+                                 f"give priors={self.name}=LOW:HIGH")
         if not (math.isfinite(self.low) and math.isfinite(self.high) and self.low < self.high):
             raise ParameterError(f"{self.name}: bounds {as_given(self.low)}:"
                                  f"{as_given(self.high)} are empty (expected LOW < HIGH)")

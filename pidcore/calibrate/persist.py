@@ -174,9 +174,11 @@ def stored_calibration(store_path: str | os.PathLike, key: str | None = None) ->
 
 
 def _keys_text(listing) -> str:
-    """``"cal_... (specimen, fitted a,b; 2026-11-30T17:02)"`` per calibration, newest first."""
+    """``"cal_... (specimen, fitted 'a,b'; 2026-11-30T17:02)"`` per calibration, newest
+    first. The fitted names are quoted: they are the calibration's, and a front-end must not
+    read a fitted ``baseline_loss_factor`` as its own option of that name."""
     if listing.empty:
         return "none"
     rows = listing.iloc[::-1]
-    return "; ".join(f"{r['key']} ({r.get('specimen', '')}, fitted {r.get('fit', '')}; "
+    return "; ".join(f"{r['key']} ({r.get('specimen', '')}, fitted '{r.get('fit', '')}'; "
                      f"{str(r['created_utc'])[:16]})" for _, r in rows.iterrows())

@@ -63,6 +63,9 @@ COMMAND_FLAGS: dict[str, dict[str, str]] = {
         "store=": "--store ", "dem_store=": "--dem-store ", "dem_store": "--dem-store",
         "calibration=": "--calibration ", "calibration_key=": "--calibration-key ",
         "calibration_key": "--calibration-key", "pool=True": "--pool", "out_dir": "--out",
+        # --calibration names the file `pidcore calibrate --out` writes, not the Python call
+        # (longer, so matched before its "out_dir")
+        "write_outputs(result, out_dir)": "pidcore calibrate --out",
         # the calibration a report reads from a DEM store is saved there by `pidcore calibrate`
         "calibrate with store_path=": "pidcore calibrate --dem-store ",
     },

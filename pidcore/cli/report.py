@@ -84,6 +84,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         "holding one needs none)")
     p.add_argument("--no-progress", action="store_true",
                    help="no progress bars (drawn only on a terminal)")
+    # a FILE may be a pidcore HDF5 store of several measurements, whose refusal says
+    # "choose one with --key NAME", as for `pidcore analyze`
+    p.add_argument("--key", metavar="NAME", default=None,
+                   help="which measurement of a pidcore HDF5 store FILE to report, when it "
+                        "holds several (the error lists them)")
     add_measurement_options(p)
     p.set_defaults(func=run)
 
@@ -106,7 +111,7 @@ def run(args: argparse.Namespace) -> int:
             specimen=specimen, pool=args.pool, calibration=args.calibration,
             calibration_key=args.calibration_key,
             accept_implausible=args.accept_implausible, progress=progress_wanted(args),
-            wording=lambda text: cli_words(text, "report"))
+            wording=lambda text: cli_words(text, "report"), key=args.key)
         print(short_table(result.table))
         for note in result.notes:  # in the command's words (wording=)
             print(f"note: {note}")

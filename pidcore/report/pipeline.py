@@ -180,7 +180,7 @@ def analyze_files(paths: Sequence[str | Path], *, fill_percent: float | None = N
                   specimen_name: str | None = None,
                   specimen: Specimen | None = None,
                   accept_implausible: bool = False,
-                  progress: bool = False) -> list[MeasuredResult]:
+                  progress: bool = False, key: str | None = None) -> list[MeasuredResult]:
     """Read, assign roles, analyze (Eq. 11) and attach the load case of every file.
 
     The load case and the analysis settings are resolved first for every file, so a missing
@@ -197,6 +197,8 @@ def analyze_files(paths: Sequence[str | Path], *, fill_percent: float | None = N
     negative loss factor beyond its noise, an SDC above 2 pi) is refused unless
     ``accept_implausible`` (:func:`pidcore.compare.plausibility.refuse_implausible`).
     ``progress``: a bar over the files on stderr (:func:`pidcore.file_settings.analyze_each`).
+    ``key``: which measurement of a pidcore HDF5 store among ``paths`` to read, where it holds
+    several (as :func:`pidcore.measure.analyze_file` takes it).
     """
     from ..compare.plausibility import refuse_implausible
     from ..file_settings import analyze_each, resolve_files
@@ -212,7 +214,7 @@ def analyze_files(paths: Sequence[str | Path], *, fill_percent: float | None = N
                                      specimen_material=specimen_material,
                                      specimen_name=specimen_name, specimen=specimen)
     analyzed_files = refuse_implausible(
-        analyze_each(paths, settings, progress=progress),
+        analyze_each(paths, settings, key=key, progress=progress),
         [display_path(Path(path).name) for path in paths], accept=accept_implausible)
     results = []
     for path, st, fs, analyzed in zip(paths, stated, settings, analyzed_files, strict=True):
@@ -589,7 +591,8 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
                 calibration: str | Path | None = None,
                 calibration_key: str | None = None,
                 accept_implausible: bool = False, progress: bool = False,
-                wording: Callable[[str], str] | None = None) -> ReportResult:
+                wording: Callable[[str], str] | None = None,
+                key: str | None = None) -> ReportResult:
     """Analyse files, store them, align with DEM and the paper, and write the report.
 
     Parameters
@@ -639,6 +642,9 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
     progress : bool
         Bars on stderr over the files analysed and the figures and formats written (forty
         files: 40-50 s, most of it figures and PDF, with no sign of life).
+    key : str, optional
+        Which measurement of a pidcore HDF5 store among ``files`` to read, where it holds
+        several (its refusal lists them; :func:`analyze_files`).
     wording : callable, optional
         The notes (the table's, its rows' and the report's) in a front-end's words: it names
         the parameters the library names by keyword (``structure_mass_kg``) as its own
@@ -702,7 +708,7 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         sidecar=sidecar, options=options, options_given=options_given,
         specimen_material=specimen.particles.material if specimen is not None else None,
         specimen_name=specimen.name if specimen is not None else None, specimen=specimen,
-        accept_implausible=accept_implausible, progress=progress,
+        accept_implausible=accept_implausible, progress=progress, key=key,
     ) if files else []
     parameters = _parameters(results, options)
     notes: list[str] = []

@@ -379,8 +379,11 @@ def _check_delay(velocity_delay_s: float, frequency_hz: float, duration_s: float
     # every period, so such a value cannot be told from a small one and must not pass.
     limit = min(defaults.MAX_VELOCITY_DELAY_PERIODS / frequency_hz, duration_s)
     if abs(velocity_delay_s) > limit:
+        # a negative value (a lead, as a test of the correction's sign may pass) is no
+        # "longer" delay: it is said as the shift it is
+        said = "is longer than" if velocity_delay_s > 0 else "shifts the velocity by more than"
         raise ParameterError(
-            f"velocity_delay_s: {velocity_delay_s:g} s is longer than "
+            f"velocity_delay_s: {velocity_delay_s:g} s {said} "
             f"{defaults.MAX_VELOCITY_DELAY_PERIODS} drive periods of {frequency_hz:.6g} Hz "
             f"({limit:.6g} s, record {duration_s:.6g} s); expected a vibrometer delay in s "
             "(e.g. 2e-4)")
