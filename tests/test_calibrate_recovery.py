@@ -7,6 +7,7 @@ Small, fast configuration: 4 cells, 10 steady cycles, three load cases where run
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -76,6 +77,9 @@ def test_fixture_mass_and_baseline_are_recovered(tmp_path):
     assert capped.settings["design_size"] == 1
     piled = [n for n in capped.notes if "piles against" in n]
     assert any(n.startswith("fixture_mass_kg:") and "upper bound 0.03" in n for n in piled)
+    # percentages written as everywhere else ("95 %"; it read "(87% of the samples in the 5%")
+    assert all(re.search(r"\(\d+ % of the samples in the 5 % of the prior's range", n)
+               for n in piled), piled
     # the calibrated specimen file carries the warning, and still reads
     from pidcore.calibrate.outputs import specimen_text
     from pidcore.specimen import Specimen

@@ -491,8 +491,9 @@ def bound_notes(specs: Sequence[ParameterSpec], samples: np.ndarray, *,
             if share > PILED_SHARE and own > PILED_SHARE:
                 notes.append(
                     f"{spec.name}: the posterior piles against its prior's {side} bound "
-                    f"{bound:g} ({share:.0%} of the samples in the {EDGE_SHARE:.0%} of the prior's "
-                    f"range next to it): the data ask for a value at or beyond it, so its median "
+                    f"{bound:g} ({100 * share:.0f} % of the samples in the "
+                    f"{100 * EDGE_SHARE:.0f} % of the prior's range next to it): the data ask for "
+                    f"a value at or beyond it, so its median "
                     f"{median} is set by the prior, not the data; check the "
                     f"stated values, and widen the prior (priors={spec.name}=LOW:HIGH) unless "
                     "the bound is physical")
