@@ -155,6 +155,17 @@ def _one_line(reason: object) -> str:
     return " ".join(str(reason).split())
 
 
+def _room_in(directory: Path) -> tuple[int | None, int | None]:
+    """(free bytes on the disk of ``directory``, this process's file size limit in bytes),
+    each None where unknown (a file system that cannot say: the write will tell) or
+    unlimited."""
+    free = None
+    with suppress(OSError):
+        free = shutil.disk_usage(directory).free
+    limit = resource.getrlimit(resource.RLIMIT_FSIZE)[0]
+    return free, None if limit == resource.RLIM_INFINITY else limit
+
+
 def _write_image(path: Path, image: memoryview) -> None:
     """Write ``image`` over the file at ``path`` and fsync it (an ``OSError`` on failure)."""
     with open(path, "r+b") as file:
@@ -356,8 +367,6 @@ class Store:
         self.lock_timeout_s = timeout
         self._active: h5py.File | None = None
         self._active_thread: int | None = None
-        #: The working copy HDF5 writes itself (a store above STORE_IN_MEMORY_MAX_BYTES)
-        self._active_on_disk: Path | None = None
         #: Transactions this object has committed (read after a Ctrl-C: was anything saved?)
         self.commits = 0
         if self.path.is_dir():  # HDF5's own message is two lines of C-library internals
@@ -443,16 +452,14 @@ class Store:
             return
         size = self.path.stat().st_size if self.path.exists() else 0
         needed = size + _COMMIT_HEADROOM_BYTES
-        with suppress(OSError):  # a file system that cannot say: the commit will tell
-            free = shutil.disk_usage(directory).free
-            if free < needed:
-                raise StoreError(
-                    f"{self.path}: {free / 2**20:.1f} MiB free in {directory}, and every save "
-                    f"writes a copy of the store ({size / 2**20:.1f} MiB) beside it; expected "
-                    f"at least {needed / 2**20:.1f} MiB free (free some space, or give a "
-                    "store file on another disk)")
-        limit = resource.getrlimit(resource.RLIMIT_FSIZE)[0]
-        if limit != resource.RLIM_INFINITY and limit < needed:
+        free, limit = _room_in(directory)
+        if free is not None and free < needed:
+            raise StoreError(
+                f"{self.path}: {free / 2**20:.1f} MiB free in {directory}, and every save "
+                f"writes a copy of the store ({size / 2**20:.1f} MiB) beside it; expected "
+                f"at least {needed / 2**20:.1f} MiB free (free some space, or give a "
+                "store file on another disk)")
+        if limit is not None and limit < needed:
             raise StoreError(
                 f"{self.path}: the file size limit of this process (ulimit -f) is "
                 f"{limit / 2**20:.1f} MiB, and every save writes a copy of the store "
@@ -612,7 +619,6 @@ class Store:
                 h5, buffer = self._working_copy(tmp, exists=exists)
                 try:
                     self._active, self._active_thread = h5, threading.get_ident()
-                    self._active_on_disk = tmp if buffer is None else None
                     yield h5
                 except BaseException:
                     with suppress(Exception):  # the copy is discarded anyway
@@ -620,7 +626,6 @@ class Store:
                     raise
                 finally:
                     self._active, self._active_thread = None, None
-                    self._active_on_disk = None
                 try:
                     h5.close()  # flushes every change into the buffer (or the copy on disk)
                     if buffer is None:
@@ -653,20 +658,18 @@ class Store:
         room checked before the copy only covers the copy and a guess of a few entries; a
         long record or a big array did not fit in that guess). No check for a copy in
         memory: its image is written by Python, whose failure is one line."""
-        if self._active_on_disk is None:
+        if h5.driver == "fileobj":  # the copy in memory (an io.BytesIO)
             return
-        tmp = self._active_on_disk
+        directory = Path(h5.filename).parent
         size = h5.id.get_filesize()
         # uncompressed, as gzip may save nothing, plus 1 % for what grows with them (zlib's
         # worst case is +0.03 %, fletcher32 4 bytes and the chunk index ~32 bytes per chunk)
         needed = nbytes + nbytes // 100 + _COMMIT_HEADROOM_BYTES
+        free, limit = _room_in(directory)
         problem = ""
-        with suppress(OSError):  # a file system that cannot say: HDF5 will tell
-            free = shutil.disk_usage(tmp.parent).free
-            if free < needed:
-                problem = f"{free / 2**20:.1f} MiB free in {tmp.parent}"
-        limit = resource.getrlimit(resource.RLIMIT_FSIZE)[0]
-        if not problem and limit != resource.RLIM_INFINITY and limit < size + needed:
+        if free is not None and free < needed:
+            problem = f"{free / 2**20:.1f} MiB free in {directory}"
+        elif limit is not None and limit < size + needed:
             problem = (f"the file size limit of this process (ulimit -f) is "
                        f"{limit / 2**20:.1f} MiB and its working copy is "
                        f"{size / 2**20:.1f} MiB already")
