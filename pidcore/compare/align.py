@@ -230,8 +230,11 @@ def _check_columns(table: pd.DataFrame, columns: Iterable[str], what: str) -> No
 
 def _row_case(row: pd.Series) -> LoadCase:
     for name in ("frequency_hz", "acceleration_g", "fill_percent"):
-        value = pd.to_numeric(pd.Series([row.get(name)]), errors="coerce").iloc[0]
-        if not (np.isfinite(value) and value > 0):
+        try:  # a number per field, not a pandas Series per field: called once per run
+            value = float(row.get(name))
+        except (TypeError, ValueError):
+            value = math.nan
+        if not (math.isfinite(value) and value > 0):
             # a run stored without its load case (by hand, through the library): the report
             # said "load case: --frequency must be ..." and named no run
             key = row.get("case_key", row.name)
