@@ -964,18 +964,22 @@ def test_calibration_digest_follows_the_content():
 
 # --- which DEM runs a measurement meets ----------------------------------------------------------
 
+def _runs_at_100hz_5g_50(material: str, **columns: list) -> pd.DataFrame:
+    """DEM runs at one load case (100 Hz, 5 g, 50 %, z) of ``material``, one per entry of the
+    per-run ``columns`` (case_key, sdc, sdc_stderr, specimen_name, ...)."""
+    n = len(columns["case_key"])
+    return pd.DataFrame({"frequency_hz": [100.0] * n, "acceleration_g": [5.0] * n,
+                         "fill_percent": [50.0] * n, "material": [material] * n,
+                         "direction": ["z"] * n, **columns})
+
+
 def _two_specimens_runs() -> pd.DataFrame:
     """One DEM run each of two specimens at one load case (as the new-user trial stored them:
     steel_6mm and its copy steel_6mm_b, both steel); b's never converged."""
-    return pd.DataFrame({
-        "case_key": ["run_a", "run_b"], "frequency_hz": [100.0, 100.0],
-        "acceleration_g": [5.0, 5.0], "fill_percent": [50.0, 50.0],
-        "material": ["steel", "steel"], "direction": ["z", "z"],
-        "sdc": [0.0197, 0.02308], "sdc_stderr": [0.001, 0.001],
-        "steady_detected": [True, False], "steady_start_cycle": [40, 200],
-        "steady_cycles": [30, 12],
-        "specimen_name": ["steel_6mm", "steel_6mm_b"],
-        "specimen_sha256": ["a" * 64, "b" * 64]})
+    return _runs_at_100hz_5g_50(
+        "steel", case_key=["run_a", "run_b"], sdc=[0.0197, 0.02308], sdc_stderr=[0.001, 0.001],
+        steady_detected=[True, False], steady_start_cycle=[40, 200], steady_cycles=[30, 12],
+        specimen_name=["steel_6mm", "steel_6mm_b"], specimen_sha256=["a" * 64, "b" * 64])
 
 
 def _steel_entry(rec, specimen=""):
@@ -1014,12 +1018,9 @@ def test_unnamed_acrylic_measurements_still_meet_the_papers_coupon(good_csv, opt
 
     rec = _record(good_csv, options)
     # a run stored before specimens (no hash) and one of the bundled paper coupon: one specimen
-    runs = pd.DataFrame({
-        "case_key": ["old", "new"], "frequency_hz": [100.0, 100.0],
-        "acceleration_g": [5.0, 5.0], "fill_percent": [50.0, 50.0],
-        "material": ["acrylic"] * 2, "direction": ["z"] * 2, "sdc": [0.20, 0.22],
-        "sdc_stderr": [0.01, 0.01], "specimen_name": [None, "paper_coupon"],
-        "specimen_sha256": [None, paper_specimen().hash]})
+    runs = _runs_at_100hz_5g_50(
+        "acrylic", case_key=["old", "new"], sdc=[0.20, 0.22], sdc_stderr=[0.01, 0.01],
+        specimen_name=[None, "paper_coupon"], specimen_sha256=[None, paper_specimen().hash])
     view = case_view([_entry(rec)], runs, paper_table(), ())
     assert view["headline"].dem == pytest.approx(0.21)  # both pooled, as before
     assert view["dem_specimen"] == "paper_coupon" and view["dem_refused"] == ""
@@ -1035,12 +1036,9 @@ def test_a_calibrations_design_runs_do_not_hide_the_papers_coupon(good_csv, opti
     from pidcore.specimen import paper_specimen
 
     rec = _record(good_csv, options)
-    runs = pd.DataFrame({
-        "case_key": ["coupon", "design"], "frequency_hz": [100.0, 100.0],
-        "acceleration_g": [5.0, 5.0], "fill_percent": [50.0, 50.0],
-        "material": ["acrylic"] * 2, "direction": ["z"] * 2, "sdc": [0.20, 0.50],
-        "sdc_stderr": [0.01, 0.01], "specimen_name": ["paper_coupon"] * 2,
-        "specimen_sha256": [paper_specimen().hash, "c" * 64]})
+    runs = _runs_at_100hz_5g_50(
+        "acrylic", case_key=["coupon", "design"], sdc=[0.20, 0.50], sdc_stderr=[0.01, 0.01],
+        specimen_name=["paper_coupon"] * 2, specimen_sha256=[paper_specimen().hash, "c" * 64])
     for named in ("", "paper_coupon"):
         view = case_view([_entry(rec, specimen=named)], runs, paper_table(), ())
         assert view["headline"].dem == 0.20  # the coupon's run alone, not pooled
