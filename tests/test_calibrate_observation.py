@@ -207,7 +207,12 @@ def test_a_bound_note_gives_the_median_as_the_summary_shows_it():
     rng = np.random.default_rng(2)
     piled = np.abs(rng.normal(0.0, 0.002, (4000, 1)))  # against 0 kg, median ~1.35 g
     (note,) = bound_notes([spec], piled)
-    median, _, _ = summary_texts(summarise([spec], piled)[0][spec.name])
-    assert f"its median {median} is set by the prior" in note
+    median, low95, high95 = summary_texts(summarise([spec], piled)[0][spec.name])
+    assert f"median {median} is set by where the prior ends" in note
+    # the interval beside it, as the summary shows it: a truth inside a broad interval next to
+    # the bound (trial H: baseline 0.006 inside 0.00027 .. 0.0283, piled against 0) read as
+    # rejected by "the data ask for a value at or beyond it"
+    assert f"95 % {low95} .. {high95})" in note
+    assert "a value inside the 95 % interval still fits them" in note
     # the premise: the Monte-Carlo error leaves fewer digits than the 4 the note printed
     assert median != f"{float(np.median(piled)):.4g}"

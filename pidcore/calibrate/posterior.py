@@ -464,9 +464,10 @@ def bound_notes(specs: Sequence[ParameterSpec], samples: np.ndarray, *,
                 effective_size: float | None = None) -> list[str]:
     """A note for each parameter whose posterior piles against a finite prior bound.
 
-    Its value is then set by the prior, not the data (the data ask for more, or less, than
-    the prior allows): a stated value that is off (a fixture mass, a baseline) or a prior
-    that is too narrow. The median is still reported; the note says not to trust it.
+    Its median is then set by where the prior ends more than by the data (the data favour
+    more, or less, than the prior allows; values inside the 95 % interval still fit them):
+    a stated value that is off (a fixture mass, a baseline) or a prior that is too narrow.
+    The median is still reported; the note says not to trust it.
     """
     from ..units import display_with_uncertainty
 
@@ -478,9 +479,11 @@ def bound_notes(specs: Sequence[ParameterSpec], samples: np.ndarray, *,
         x = samples[:, j]
         # the median as the summary shows it (summary_texts): the note said 0.001285 beside
         # the table's 0.00128, digits the Monte-Carlo error does not hold
-        median = display_with_uncertainty(float(np.median(x)),
-                                          float(quantile_mc_stderr(
-                                              x, [50], effective_size=effective_size)[0]))
+        errors = quantile_mc_stderr(x, [2.5, 50, 97.5], effective_size=effective_size)
+        low95, median, high95 = (
+            display_with_uncertainty(float(v), float(e))
+            # the table's numbers (summarise)
+            for v, e in zip(np.percentile(x, [2.5, 50, 97.5]), errors, strict=True))
         u = _to_unit(spec, x)  # the prior's own scale: log for a log-uniform prior
         q_low, q_high = np.quantile(u, [0.025, 0.975])
         near = OWN_WIDTH_SHARE * float(q_high - q_low)
@@ -492,9 +495,10 @@ def bound_notes(specs: Sequence[ParameterSpec], samples: np.ndarray, *,
                 notes.append(
                     f"{spec.name}: the posterior piles against its prior's {side} bound "
                     f"{bound:g} ({100 * share:.0f} % of the samples in the "
-                    f"{100 * EDGE_SHARE:.0f} % of the prior's range next to it): the data ask for "
-                    f"a value at or beyond it, so its median "
-                    f"{median} is set by the prior, not the data; check the "
+                    f"{100 * EDGE_SHARE:.0f} % of the prior's range next to it; 95 % "
+                    f"{low95} .. {high95}): the data favour values at or beyond it, so its "
+                    f"median {median} is set by where the prior ends more than by the data "
+                    "(a value inside the 95 % interval still fits them); check the "
                     f"stated values, and widen the prior (priors={spec.name}=LOW:HIGH) unless "
                     "the bound is physical")
     return notes
