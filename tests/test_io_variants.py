@@ -418,7 +418,8 @@ def _csv_rows(rec, sep=",", decimal=".", digits=10):
 
 
 @pytest.mark.parametrize("variant", ["decimal_comma_integer_first_row", "free_text_header",
-                                     "unit_row", "utf16", "tab_unit_row_latin1"])
+                                     "unit_row", "utf16", "tab_unit_row_latin1",
+                                     "comma_separated_quoted_decimal_comma"])
 def test_csv_variants(tmp_path, variant):
     rec = _record()
     path = tmp_path / f"{variant}.csv"
@@ -438,6 +439,12 @@ def test_csv_variants(tmp_path, variant):
         text = ("Zeit [s]\tKraft [N]\tGeschwindigkeit [mm/s]\n"
                 + "\n".join(_csv_rows(rec, sep="\t", decimal=",")) + "\n")
         path.write_bytes(text.encode("utf-16"))
+    elif variant == "comma_separated_quoted_decimal_comma":
+        # a spreadsheet in a German locale saving CSV with a comma separator quotes every
+        # number ("0,0002","-0,005"): refused as "no header row before the numbers"
+        rows = ['"' + row + '"' for row in _csv_rows(rec, sep='","', decimal=",")]
+        text = '"Time [s]","Force [N]","Velocity [mm/s]"\n' + "\n".join(rows) + "\n"
+        path.write_text(text)
     else:
         text = ("Messung \xfcber Nacht\nTime\tForce\tVelocity\n[s]\t[N]\t[mm/s]\n"
                 + "\n".join(_csv_rows(rec, sep="\t")) + "\n")
