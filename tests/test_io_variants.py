@@ -132,6 +132,31 @@ def test_inverted_channel_is_an_error_with_the_fix(tmp_path, capsys):
     assert "channel 'Velocity' inverted (invert='Velocity')" in result.notes
 
 
+def test_an_inverted_drive_point_accelerometer_is_refused_not_added_to_the_force(tmp_path,
+                                                                                capsys):
+    """Mass cancellation with the drive-point accelerometer mounted the other way: m a was
+    added to the force instead of taken off, and the loss factor came out 0.25/0.45 of the
+    truth (44 % low) without a word, the reactive power staying positive."""
+    m_below = 0.1
+    rec = _record(mass=M + m_below, with_acceleration=True)
+    path = tmp_path / "acc_inverted.csv"
+    write_measurement(Measurement("x", (
+        Channel("Force", "force", rec.force_n, FS, "N"),
+        Channel("LDV", "velocity", rec.velocity_m_s, FS, "m/s"),
+        Channel("Acc drive point", "acceleration", -rec.acceleration_m_s2, FS, "m/s^2"))),
+        path)
+    store = tmp_path / "s.h5"
+    code, out, err = _cli([str(path), "--mass-below-gauge", "0.1", "--store", str(store)],
+                          capsys)
+    assert code == 2 and not store.exists() and out == ""
+    assert len(err.strip().splitlines()) == 1 and "acc_inverted.csv" in err
+    assert "'Acc drive point' / 'LDV' is probably inverted" in err and "--invert NAME" in err
+    assert "180°" in err  # 60 dB noise turns the phase by ~1e-3 rad: printed as 180
+    result = analyze_file(path, AnalysisOptions(mass_below_gauge_kg=m_below,
+                                                invert=("Acc drive point",)))
+    _assert_truth(result.analysis)
+
+
 @pytest.mark.parametrize("offset_samples", [1, 3, 0.5])
 def test_channels_starting_at_different_times_are_aligned(tmp_path, offset_samples):
     """UFF records with their own abscissa minimum: the velocity starts later (one sample of
