@@ -174,3 +174,64 @@ def test_a_loss_factor_of_round_off_is_zero_damping_not_a_set_up_error():
     # beyond round-off (1e-6 |P|) and beyond its standard error it is still refused
     warnings, _ = implausible_findings(_bare_analysis(-0.574e-6, 0.574, 3.5e-16))
     assert [w.check for w in warnings] == ["negative_loss_factor"]
+
+
+def _force_acceleration_csv(path, *, lag_s: float, loss_factor: float = 0.02) -> None:
+    """``Time [s],Force [N],Acceleration [g]`` of a 0.3 kg mass-damper at 100 Hz, 5 g, the
+    acceleration recorded ``lag_s`` after the force (no velocity channel)."""
+    fs, freq, mass = 5120.0, 100.0, 0.3
+    w = 2 * math.pi * freq
+    t = np.arange(int(2 * fs)) / fs
+    v_amp = 5 * 9.80665 / w
+    force = mass * v_amp * w * np.cos(w * t) + loss_factor * w * mass * v_amp * np.sin(w * t)
+    acc_g = v_amp * w * np.cos(w * (t - lag_s)) / 9.80665
+    rows = "\n".join(f"{a:.9g},{b:.9g},{c:.9g}" for a, b, c in zip(t, force, acc_g, strict=True))
+    path.write_text("Time [s],Force [N],Acceleration [g]\n" + rows + "\n")
+
+
+def test_a_record_without_a_vibrometer_is_not_told_to_correct_a_vibrometer_delay(tmp_path,
+                                                                               capsys):
+    # force and acceleration only (an impedance head), the acceleration 100 µs behind the
+    # force: the negative loss factor was refused naming "an uncorrected vibrometer output
+    # delay" and "a vibrometer delay of about 68 µs more", and --velocity-delay is then
+    # refused for this very record ("a vibrometer delay needs a velocity channel")
+    from pidcore.cli import main
+
+    path = tmp_path / "impedance_head.csv"
+    _force_acceleration_csv(path, lag_s=100e-6)
+    assert main(["analyze", str(path), "--no-store", "--no-progress"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "impedance_head.csv" in err
+    assert "negative loss factor" in err and "vibrometer delay" not in err
+    assert "lag of the acceleration channel behind the force" in err
+    # the lag that zeroes the loss factor: 100 µs less the 0.02 damping's own
+    # atan(0.02)/w = 31.8 µs at 100 Hz; noise-free, so only the printed rounding (0.5 µs)
+    tau_us = float(err.split("a lag of about ")[1].split(" µs")[0])
+    assert tau_us == pytest.approx(100.0 - math.atan(0.02) / (2 * math.pi * 100) * 1e6, abs=0.6)
+    assert main(["analyze", str(path), "--no-store", "--no-progress",
+                 "--velocity-delay", f"{tau_us * 1e-6:g}"]) == 2
+    assert "needs a velocity channel" in capsys.readouterr().err
+    # a stored record of such a file (no velocity channel, an acceleration one) says the same
+    from pidcore.compare.plausibility import stored_findings
+
+    row = {"complex_power_real_w": -0.0246, "complex_power_imag_w": 0.574, "loss_factor": -0.0429,
+           "sdc": -0.269, "sdc_stderr": 1e-9, "frequency_hz": 100.0, "velocity_channel": "",
+           "acceleration_channel": "Acceleration"}
+    (warning,), _ = stored_findings(row)
+    assert "vibrometer delay" not in warning.likely_cause
+    assert "lag of the acceleration channel" in warning.likely_cause
+    (warning,), _ = stored_findings({**row, "velocity_channel": "LDV"})
+    assert "vibrometer delay of about" in warning.likely_cause
+
+
+def test_an_sdc_above_the_bound_without_a_vibrometer_names_the_channels_lead(tmp_path, capsys):
+    # the acceleration 300 µs ahead of the force inflates a loss factor of 0.95 to 1.39: the
+    # cause named "a wrong vibrometer delay" for a record that has no vibrometer
+    from pidcore.cli import main
+
+    path = tmp_path / "impedance_head.csv"
+    _force_acceleration_csv(path, lag_s=-300e-6, loss_factor=0.95)
+    assert main(["analyze", str(path), "--no-store", "--no-progress"]) == 2
+    err = capsys.readouterr().err
+    assert "above the physical bound" in err and "vibrometer" not in err
+    assert "lead of the acceleration channel over the force" in err

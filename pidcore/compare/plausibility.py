@@ -71,15 +71,27 @@ def check_analysis(analysis) -> tuple[PlausibilityWarning, ...]:
             "+90°)",
             "a force or velocity channel of inverted sign (check the channel mapping and the "
             "sensor sign), or the wrong channel chosen as force"))
+    # Without a velocity channel the velocity is the acceleration's integral: there is no
+    # vibrometer, and a delay correction is refused for such a record, so a cause naming one
+    # sent the user to an option that is then refused; the lag that turns the phase here is
+    # the acceleration's behind the force (their conditioning or anti-aliasing filters).
+    from_acceleration = bool(getattr(analysis, "corrections", {}).get(
+        "velocity_from_acceleration", False))
     if math.isfinite(eta) and eta < 0:
-        cause = ("more energy out than in is impossible for a passive damper: an uncorrected "
-                 "vibrometer output delay, or a mass-below-gauge or baseline correction that "
-                 "is too large")
+        delay_cause = ("a lag of the acceleration channel behind the force (their signal "
+                       "conditioning or anti-aliasing filters differ; a delay is corrected only "
+                       "for a vibrometer velocity channel, which this record has not)"
+                       if from_acceleration else "an uncorrected vibrometer output delay")
+        cause = (f"more energy out than in is impossible for a passive damper: {delay_cause}, "
+                 "or a mass-below-gauge or baseline correction that is too large")
         if p.imag > 0 and omega > 0:
             # a velocity delayed by tau turns P by +w tau; this tau brings Re P to zero
             tau = -math.atan2(p.real, p.imag) / omega
             if tau > 0:
-                cause += (f"; a vibrometer delay of about {tau * 1e6:.0f} µs more would bring "
+                cause += (f"; a lag of about {tau * 1e6:.0f} µs of the acceleration behind "
+                          "the force turns zero damping into this loss factor"
+                          if from_acceleration else
+                          f"; a vibrometer delay of about {tau * 1e6:.0f} µs more would bring "
                           "the loss factor to zero")
         out.append(PlausibilityWarning("negative_loss_factor",
                                        f"negative loss factor {eta:.4g} (SDC {sdc:.4g})", cause))
@@ -88,8 +100,12 @@ def check_analysis(analysis) -> tuple[PlausibilityWarning, ...]:
             "sdc_above_bound",
             f"SDC {sdc:.4g} is above the physical bound {SDC_UPPER_BOUND:.3g} (loss factor "
             f"{eta:.3g} > 1)",
-            "a wrong vibrometer delay (a delay too large turns the force-velocity phase and "
-            "inflates Re P), or a mass-below-gauge correction close to the whole moving mass"))
+            ("a lead of the acceleration channel over the force (their signal conditioning "
+             "or anti-aliasing filters differ: it turns the force-velocity phase and inflates "
+             "Re P)" if from_acceleration else
+             "a wrong vibrometer delay (a delay too large turns the force-velocity phase and "
+             "inflates Re P)")
+            + ", or a mass-below-gauge correction close to the whole moving mass"))
     return tuple(out)
 
 
@@ -181,7 +197,11 @@ def stored_findings(record) -> tuple[tuple[PlausibilityWarning, ...], tuple[str,
                                     float(record["complex_power_imag_w"])),
             loss_factor=float(record["loss_factor"]), sdc=float(record["sdc"]),
             sdc_stderr=float(record.get("sdc_stderr", math.nan)),
-            omega_rad_s=2 * math.pi * float(record["frequency_hz"]))
+            omega_rad_s=2 * math.pi * float(record["frequency_hz"]),
+            # a stored record names the channels it used: no velocity channel, an
+            # acceleration one, is a velocity integrated from the acceleration
+            corrections={"velocity_from_acceleration": not record.get("velocity_channel", "x")
+                         and bool(record.get("acceleration_channel", ""))})
     except (KeyError, TypeError, ValueError):  # a listing without the numbers: nothing to say
         return (), ()
     return implausible_findings(analysis)

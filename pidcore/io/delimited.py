@@ -24,6 +24,7 @@ needs about the size of the resulting float64 arrays (well under 3x the file siz
 from __future__ import annotations
 
 import codecs
+import csv
 import math
 import os
 import re
@@ -113,6 +114,12 @@ def _encoding(head: bytes) -> str:
 def _cells(line: str, delimiter: str) -> list[str]:
     if delimiter == r"\s+":
         return line.split()
+    if '"' in line:
+        # a quoted cell may hold the delimiter: a decimal comma in a comma-separated export
+        # ("0,0002","-0,005"), which split into twice the columns made the header row look
+        # too short, and the file was refused as having "no header row"
+        return [c.strip() for c in next(csv.reader([line], delimiter=delimiter,
+                                                   skipinitialspace=True))]
     return [c.strip().strip('"').strip() for c in line.split(delimiter)]
 
 
@@ -171,7 +178,8 @@ def _layout(lines: list[str], where: str) -> tuple[int, str, list[str], list[str
         units = [c.strip().strip("[]()").strip() for c in names]  # a unit row under the names
         names = _cells(text_rows[-2], delimiter)
         units = (units + [""] * len(names))[:len(names)]
-    decimal = "," if delimiter != "," and any("," in ln for ln in data) else "."
+    decimal = "," if (any("," in ln for ln in data) if delimiter != "," else
+                      any("," in c for ln in data for c in _cells(ln, delimiter))) else "."
     return first, delimiter, names, units, decimal
 
 

@@ -389,6 +389,30 @@ def _check_delay(velocity_delay_s: float, frequency_hz: float, duration_s: float
             "(e.g. 2e-4)")
 
 
+def _check_acceleration_sign(acceleration_phasor: complex, velocity_phasor: complex,
+                             omega: float, velocity_delay_s: float, *, source: str,
+                             acceleration_name: str, velocity_name: str) -> None:
+    """Refuse an acceleration channel that moves against the velocity at the drive line.
+
+    Mass cancellation takes ``m a`` off the force; an accelerometer mounted the other way
+    (or a -Z record not applied) made it add ``m a`` instead, and the loss factor came out
+    too small by the share of that mass in the reactive power (0.015 for 0.02 with 50 g on
+    a 0.3 kg coupon) without a word: the reactive power stays positive, so nothing else
+    catches it. The same point moves alike in both channels (a fixture resonance turns the
+    phase by tens of degrees, not past 90)."""
+    expected = 1j * omega * velocity_phasor * np.exp(1j * omega * velocity_delay_s)
+    if not (acceleration_phasor * np.conj(expected)).real < 0:
+        return
+    phase = math.degrees(abs(np.angle(acceleration_phasor * np.conj(expected))))
+    raise SignalError(
+        f"{source or 'record'}: channel {acceleration_name!r} moves against the velocity "
+        f"{velocity_name!r} at the drive line ({phase:.0f}° from j omega V, expected about 0°): "
+        f"mass cancellation would add its inertia force to the force instead of taking "
+        f"it off; one of the channels {acceleration_name!r} / {velocity_name!r} "
+        f"{PROBABLY_INVERTED}: check the sensor directions, or pass invert=NAME for the "
+        "inverted channel (or the vibrometer delay is far from corrected)")
+
+
 def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz: float, *,
                   acceleration: np.ndarray | None = None,
                   frequency_hz: float | None = None,
@@ -402,6 +426,7 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
                   source: str = "",
                   force_name: str = "force",
                   velocity_name: str = "velocity",
+                  acceleration_name: str = "acceleration",
                   require_mass_like: bool = True) -> PowerAnalysis:
     """Complex power, loss factor and SDC of a sine-driven force/velocity record (Eq. 8-11).
 
@@ -436,7 +461,7 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
         Blocks of whole periods for the standard errors (0 or 1: none).
     min_periods : int
         Fewest drive periods accepted.
-    source, force_name, velocity_name : str
+    source, force_name, velocity_name, acceleration_name : str
         Names used in messages and in the result.
     require_mass_like : bool
         Refuse a reactive power Im(P_c) <= 0 (default; a measured structure is mass-like, so
@@ -474,7 +499,7 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
     if velocity is None and velocity_delay_s:
         raise ParameterError("velocity_delay_s: a vibrometer delay needs a velocity channel; "
                              "the velocity here comes from the acceleration")
-    acc_name = "acceleration" if velocity is not None else velocity_name
+    acc_name = acceleration_name if velocity is not None else velocity_name
     channels: list[tuple[str, np.ndarray]] = [(force_name, np.asarray(force, dtype=np.float64))]
     if velocity is not None:
         channels.append((velocity_name, np.asarray(velocity, dtype=np.float64)))
@@ -530,6 +555,10 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
     a_fit = None
     if acc_data is not None and velocity is not None:
         a_fit = fit_harmonics(acc_data, None, theta, n_harm, edges)
+    if a_fit is not None and mass_below_gauge_kg > 0:
+        _check_acceleration_sign(a_fit.total[0, 0], fit.total[1, 0], omega, velocity_delay_s,
+                                 source=source, acceleration_name=acc_name,
+                                 velocity_name=velocity_name)
     kw = dict(motion_is_velocity=velocity is not None, delay_s=float(velocity_delay_s),
               mass_kg=float(mass_below_gauge_kg))
     f_ph, v_ph, p_c = _complex_power(fit.total[0], fit.total[1],
@@ -744,7 +773,8 @@ def analyze_channels(force: Channel, velocity: Channel | None, *,
             velocity_delay_s=velocity_delay_s,
             mass_below_gauge_kg=mass_below_gauge_kg, baseline_loss_factor=baseline_loss_factor,
             structure_mass_kg=structure_mass_kg, n_blocks=n_blocks, min_periods=min_periods,
-            source=source, force_name=force.name, velocity_name=motion.name)
+            source=source, force_name=force.name, velocity_name=motion.name,
+            acceleration_name=acceleration.name if acceleration is not None else "acceleration")
     except SignalError as exc:
         if dropout_notes:
             raise SignalError(f"{exc} (after cutting out dropouts: {dropout_notes[0]})") from None
