@@ -22,7 +22,13 @@ from ..compare.align import steady_stated
 from ..constants import STANDARD_GRAVITY
 from ..dem.simulate import DemConfig, LoadCase
 from ..errors import ParameterError
-from ..specimen import Specimen, calibrated_name, paper_specimen, uncalibrated_name
+from ..specimen import (
+    Specimen,
+    calibrated_name,
+    is_paper_coupon,
+    paper_specimen,
+    uncalibrated_name,
+)
 from .data import MeasuredPoint, check_enough_points
 from .observation import Observation, observation_from_run
 from .parameters import (
@@ -279,9 +285,18 @@ def check_point_specimens(points: Sequence[MeasuredPoint], specimen: Specimen) -
     speaks_for`). Any other was fitted silently against this specimen's DEM runs.
     """
     own = uncalibrated_name(specimen.name)
+
+    def of_another(name: str) -> bool:
+        if specimen.is_paper():
+            # the paper's coupon with either table material is one coupon: a test naming
+            # paper_coupon was refused for the aluminium coupon (and paper_coupon_aluminium
+            # left out of it by points_for_paper)
+            return not is_paper_coupon(name)
+        return bool(name) and uncalibrated_name(name) != own
+
     others: dict[tuple[str, str], list[int | None]] = {}
     for p in points:
-        if p.specimen and uncalibrated_name(p.specimen) != own:
+        if of_another(p.specimen):
             others.setdefault((p.source, p.specimen), []).append(p.row)
     if not others:
         return

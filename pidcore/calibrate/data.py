@@ -224,13 +224,16 @@ def points_for_paper(points: Sequence[MeasuredPoint], *, hint: str = "") -> tupl
     """(points, note): the measured points the paper's coupon is calibrated against, those
     naming no specimen or the paper's coupon (the library refuses others:
     :func:`pidcore.calibrate.calibrate.check_point_specimens`); ``note`` says what is left out
-    ("" if nothing), with ``hint``, the caller's way to calibrate them, in brackets."""
-    from ..specimen import PAPER_SPECIMEN_NAME, uncalibrated_name
+    ("" if nothing), with ``hint``, the caller's way to calibrate them, in brackets.
+    Which names are the paper's coupon is :func:`pidcore.specimen.is_paper_coupon`'s to say
+    (``paper_coupon_aluminium`` is; its tests were left out here and accepted by the
+    library)."""
+    from ..specimen import is_paper_coupon
 
     kept, others = [], {}
     for p in points:
         name = str(p.specimen)
-        if name and uncalibrated_name(name) != PAPER_SPECIMEN_NAME:
+        if not is_paper_coupon(name):
             others[name] = others.get(name, 0) + 1
         else:
             kept.append(p)

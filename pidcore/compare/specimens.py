@@ -54,21 +54,12 @@ class SpecimenRuns:
 def specimen_label(name: str, sha256: str) -> str:
     """A specimen as the pages name it: ``"name [hash6]"``; the paper's coupon (either table
     material, or no hash: a run stored before specimens existed) is ``"paper_coupon"``."""
-    from ..specimen import PAPER_SPECIMEN_NAME, paper_hashes
+    from ..specimen import PAPER_SPECIMEN_NAME, is_paper_coupon
 
-    if not sha256 or sha256 in paper_hashes():
+    # a run without a hash predates specimens: it was the paper's coupon, whatever it names
+    if not sha256 or is_paper_coupon(name, sha256):
         return PAPER_SPECIMEN_NAME
     return f"{name or 'unnamed'} [{sha256[:6]}]"
-
-
-def is_paper_specimen_name(name: object) -> bool:
-    """True where a measurement's specimen (its name; empty: not named, the paper's coupon by
-    default) is the paper's coupon, the only specimen the paper's Table 3 describes."""
-    from ..constants import PARTICLE_MATERIALS
-    from ..specimen import paper_specimen
-
-    named = name.strip() if isinstance(name, str) else ""
-    return not named or named in {paper_specimen(m).name for m in PARTICLE_MATERIALS}
 
 
 NOT_PAPER_SPECIMEN_NOTE = ("specimen {name} is not the paper's coupon: the paper's Table 3 is "
@@ -115,12 +106,15 @@ def runs_for_measurement(runs: pd.DataFrame | None, specimen: str, material: str
         same = runs[(runs["material"] == material) & (runs["direction"] == direction)]
     if same.empty:
         return SpecimenRuns(None)
-    from ..specimen import PAPER_SPECIMEN_NAME
+    from ..specimen import CALIBRATED_SUFFIX, PAPER_SPECIMEN_NAME, is_paper_coupon
 
     labels = run_specimen_labels(same)
     specimen = (specimen or "").strip()
     paper = (labels == PAPER_SPECIMEN_NAME).to_numpy(bool)
-    if specimen == PAPER_SPECIMEN_NAME and paper.any():
+    # a test naming paper_coupon_aluminium is of the paper's coupon too (is_paper_coupon); one
+    # naming paper_coupon_calibrated meets its calibrated file's runs first, as any x_calibrated
+    if specimen and is_paper_coupon(specimen) and not specimen.endswith(CALIBRATED_SUFFIX) \
+            and paper.any():
         # the paper's coupon is the paper's file (its hash), not every file that kept its
         # name: a calibration's design runs (the coupon with another rolling friction ...)
         # are named paper_coupon too, and were pooled with it or refused it
@@ -133,7 +127,7 @@ def runs_for_measurement(runs: pd.DataFrame | None, specimen: str, material: str
             # a file `pidcore calibrate` wrote from this specimen ("x_calibrated") models the
             # specimen tested, as its calibration's bands speak for the tests of "x": a test of
             # x met no run of `report --specimen x_calibrated.toml` (no_dem_runs on every row)
-            from ..specimen import CALIBRATED_SUFFIX, uncalibrated_name
+            from ..specimen import uncalibrated_name
 
             mine = names.map(lambda n: n.endswith(CALIBRATED_SUFFIX)
                              and uncalibrated_name(n) == specimen).to_numpy(bool)
