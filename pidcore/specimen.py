@@ -61,8 +61,9 @@ Public API
 load_specimen, paper_specimen, Specimen
     A specimen from a TOML file, the bundled paper coupon; ``Specimen.from_text``,
     ``with_values``, ``to_toml``, ``capacity_per_cell``.
-is_paper_coupon
-    Whether a specimen (by hash, else by name) is the paper's coupon: the one rule.
+is_paper_coupon, measured_specimen_name
+    Whether a specimen (by hash, else by name) is the paper's coupon: the one rule; the name
+    a measurement of a specimen file is saved under.
 CellSpec, CouponSpec, ParticleSpec, PairSpec, PairsSpec
     Its sections (SI units in the field names).
 describe
@@ -1013,7 +1014,9 @@ def is_paper_coupon(name: object = "", sha256: object = "") -> bool:
       design point, is not compared with Table 3 nor pooled with the coupon's runs.
     - Where only a name is known (a measurement, a run stored before specimens had a hash),
       the name decides: none (``""``: the paper's coupon by default) or the paper's coupon's
-      with a table particle material.
+      with a table particle material. A measurement analysed with a file of that name but
+      other content is saved under :func:`measured_specimen_name`'s ``"paper_coupon
+      [45d792]"``, which is not the paper's.
     - ``paper_coupon_aluminium`` (:func:`paper_specimen` ``("aluminium")``) is the paper's
       coupon: one coupon, filled with the table's aluminium spheres (both hashes are in
       :func:`paper_hashes`). (a) Table 3: it counts; the table holds acrylic rows only, so an
@@ -1033,6 +1036,36 @@ def is_paper_coupon(name: object = "", sha256: object = "") -> bool:
     named = name.strip() if isinstance(name, str) else ""
     return not named or uncalibrated_name(named) in _paper_names()
 
+
+def measured_specimen_name(specimen: Specimen) -> str:
+    """The specimen name a measurement analysed with ``specimen`` is saved and compared under
+    (``pidcore analyze --specimen FILE``, ``pidcore report FILES --specimen FILE``): its
+    ``name``, except for a file that takes the paper's coupon's name (:func:`is_paper_coupon`
+    by name) with other content, which is ``"paper_coupon [45d792]"`` (name and hash, as its
+    DEM runs are labelled on every page: :func:`pidcore.compare.specimens.specimen_label`).
+
+    A measurement records only this name: under the bare name ``paper_coupon``, a test of a
+    coupon with another cell size was compared with the paper's Table 3 and calibrated with
+    the paper coupon's tests. A calibrated file of the paper's coupon
+    (``paper_coupon_calibrated``: fitted contact, mass or damping values, the paper's cell and
+    spheres) keeps its name: its tests are the paper's coupon's.
+    """
+    if specimen.is_paper() or not is_paper_coupon(specimen.name):
+        return specimen.name
+    if specimen.name != uncalibrated_name(specimen.name) and _papers_cell_and_spheres(specimen):
+        return specimen.name
+    return f"{specimen.name} [{specimen.hash[:6]}]"
+
+
+def _papers_cell_and_spheres(specimen: Specimen) -> bool:
+    """Whether ``specimen`` holds the paper coupon's cells and spheres (of its particle
+    material): what a calibration of that coupon leaves as it was."""
+    try:
+        paper = paper_specimen(specimen.particles.material)
+    except ParameterError:  # a material the tables lack: not the paper's spheres
+        return False
+    return (specimen.cell == paper.cell
+            and specimen.particles.radius_m == paper.particles.radius_m)
 
 
 # --- what follows from a specimen ------------------------------------------------------------
@@ -1157,5 +1190,6 @@ def _capacity(shape: str, inscribed_diameter_m: float, height_m: float, radius_m
 
 __all__ = ["CellSpec", "CouponSpec", "PairSpec", "PairsSpec", "ParticleSpec", "Specimen",
            "cell_geometry", "contact_law", "describe", "is_paper_coupon", "load_specimen",
-           "numeric_fields", "paper_specimen", "particles_for_fill"]
+           "numeric_fields", "paper_specimen", "particles_for_fill",
+           "measured_specimen_name"]
 

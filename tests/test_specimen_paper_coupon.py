@@ -3,15 +3,27 @@ DEM runs, measurements and specimen files, by hash where the content is known, e
 
 from __future__ import annotations
 
+import dataclasses
+import re
+from pathlib import Path
+from types import SimpleNamespace
+
 import pandas as pd
 import pytest
 
 from pidcore.calibrate import MeasuredPoint
 from pidcore.calibrate.calibrate import base_specimen
 from pidcore.calibrate.data import points_for_paper
+from pidcore.cli import main
 from pidcore.compare.specimens import runs_for_measurement
 from pidcore.report.pipeline import specimen_report_table
-from pidcore.specimen import is_paper_coupon, paper_specimen
+from pidcore.specimen import (
+    is_paper_coupon,
+    load_specimen,
+    measured_specimen_name,
+    paper_specimen,
+)
+from pidcore.store import Store
 
 PAPER = paper_specimen("acrylic")
 ALUMINIUM = paper_specimen("aluminium")
@@ -92,3 +104,133 @@ def test_a_test_naming_the_aluminium_coupon_meets_the_papers_runs():
     met = runs_for_measurement(runs, "paper_coupon_aluminium", "aluminium", "z")
     assert met.runs is not None and met.runs["case_key"].tolist() == ["a1"]
     assert met.specimen == "paper_coupon"
+
+
+# --- a file named paper_coupon with other content -------------------------------------------
+
+REPO = Path(__file__).resolve().parents[1]
+CALIBRATED_PAPER = REPO / "data_samples" / "paper_calibrated_specimen.toml"
+OTHER_LABEL = f"paper_coupon [{OTHER_CELL.hash[:6]}]"
+
+
+@pytest.fixture(scope="module")
+def other_cell_tests(tmp_path_factory):
+    """A test at 1000 Hz, 5 g, 50 % analysed with a user's ``paper_coupon.toml`` of 1/4 in
+    cells (`pidcore analyze --specimen`), saved in a store, and that file."""
+    from pidcore.constants import STANDARD_GRAVITY
+    from pidcore.io import write_measurement
+    from pidcore.records import Channel, Measurement
+    from pidcore.signal import synthesize_shaker_record
+
+    where = tmp_path_factory.mktemp("other_cell")
+    (where / "mine").mkdir()
+    specimen_file = where / "mine" / "paper_coupon.toml"
+    specimen_file.write_text(OTHER_CELL.to_toml())
+    rate = 51200.0
+    rec = synthesize_shaker_record(mass_kg=0.05,
+                                   acceleration_amplitude_m_s2=5 * STANDARD_GRAVITY,
+                                   frequency_hz=1000.0, sample_rate_hz=rate, n_periods=40,
+                                   viscous_damping_n_s_m=5.0)
+    test = where / "test_fill50.csv"
+    write_measurement(Measurement("m", (Channel("Force", "force", rec.force_n, rate, "N"),
+                                        Channel("LDV", "velocity", rec.velocity_m_s, rate,
+                                                "m/s"))), test)
+    return SimpleNamespace(dir=where, specimen_file=specimen_file, test=test,
+                           store=where / "tests.h5")
+
+
+def _analyze(capsys, tests, specimen_file: Path, store: Path) -> str:
+    assert main(["analyze", str(tests.test), "--specimen", str(specimen_file), "--store",
+                 str(store)]) == 0
+    out = capsys.readouterr().out
+    return out
+
+
+def test_analyze_saves_a_test_of_another_file_named_paper_coupon_under_its_label(
+        capsys, other_cell_tests):
+    """Was: saved as specimen 'paper_coupon', the paper's coupon by name everywhere after."""
+    out = _analyze(capsys, other_cell_tests, other_cell_tests.specimen_file,
+                   other_cell_tests.store)
+    assert f"specimen '{OTHER_LABEL}' (--specimen)" in out
+    assert Store(other_cell_tests.store).list_analyses()["specimen"].tolist() == [OTHER_LABEL]
+    assert not is_paper_coupon(OTHER_LABEL)
+    # the paper's own file, and the coupon's calibrated file (fitted values, the paper's cell
+    # and spheres), keep their names: their tests are the paper's coupon's
+    assert measured_specimen_name(PAPER) == "paper_coupon"
+    assert measured_specimen_name(load_specimen(CALIBRATED_PAPER)) == "paper_coupon_calibrated"
+    # another file calibrated from the other-cell coupon is not the paper's either
+    calibrated_other = dataclasses.replace(OTHER_CELL, name="paper_coupon_calibrated")
+    assert measured_specimen_name(calibrated_other) == \
+        f"paper_coupon_calibrated [{calibrated_other.hash[:6]}]"
+
+
+@pytest.mark.usefixtures("undrawn_report_figures")
+def test_report_of_that_test_sets_no_table3_beside_it(tmp_path, capsys, other_cell_tests):
+    """Was: `pidcore report --store` put the paper's Table 3 (DEM 0.5612, measured 0.63 at
+    1000 Hz, 5 g, 50 %) beside the test of the other coupon, and `report --specimen FILE`
+    said "specimen paper_coupon is not the paper's coupon"."""
+    store = tmp_path / "tests.h5"
+    _analyze(capsys, other_cell_tests, other_cell_tests.specimen_file, store)
+    out = tmp_path / "default"
+    assert main(["report", "--store", str(store), "--out", str(out), "--format", "csv"]) == 0
+    capsys.readouterr()
+    row = pd.read_csv(out / "report.csv", comment="#").iloc[0]
+    assert row["specimen"] == OTHER_LABEL
+    assert pd.isna(row["SDC DEM (paper) [-]"]) and pd.isna(row["SDC measured (paper) [-]"])
+    assert f"specimen {OTHER_LABEL} is not the paper's coupon" in row["note"]
+    mine = tmp_path / "mine"
+    assert main(["report", "--store", str(store), "--specimen",
+                 str(other_cell_tests.specimen_file), "--out", str(mine),
+                 "--format", "csv"]) == 0
+    said = capsys.readouterr().out
+    assert f"note: specimen {OTHER_LABEL} is not the paper's coupon: the paper's Table 3 is " \
+           "not compared" in said
+    row = pd.read_csv(mine / "report.csv", comment="#").iloc[0]
+    assert row["specimen"] == OTHER_LABEL and pd.isna(row["SDC DEM (paper) [-]"])
+
+
+def test_calibrating_the_papers_coupon_refuses_the_test_of_the_other_file(
+        tmp_path, capsys, other_cell_tests):
+    """Was: the test was pooled with the paper coupon's (`calibrate --store` without
+    --specimen kept every test naming paper_coupon). Two parameters are asked for so that the
+    old code stops, before any DEM run, at "1 measured load case(s) cannot determine 3"
+    (the two and the model discrepancy)."""
+    store = tmp_path / "tests.h5"
+    _analyze(capsys, other_cell_tests, other_cell_tests.specimen_file, store)
+    before = Store(store).list_analyses()
+    code = main(["calibrate", "--store", str(store), "--fit",
+                 "fixture_mass_kg,baseline_loss_factor", "--out", str(tmp_path / "cal")])
+    err = capsys.readouterr().err
+    assert code == 2
+    assert err.strip().splitlines() == [
+        f"pidcore calibrate: error: --store {store}: no measurement of the paper's coupon or of "
+        f"an unnamed specimen; Not used for the paper's coupon: 1 measured load case(s) of "
+        f"specimen {OTHER_LABEL} (--specimen FILE of theirs)."]
+    assert not (tmp_path / "cal").exists()
+    pd.testing.assert_frame_equal(Store(store).list_analyses(), before)
+
+
+def test_the_other_files_tests_and_runs_are_its_own_not_the_papers():
+    """Its calibration takes its tests, not the paper coupon's that name paper_coupon; its
+    tests meet its runs, not the paper's (both labelled as the pages label them)."""
+    from pidcore.calibrate.data import points_for_specimen
+
+    own = MeasuredPoint(100, 1, 50, 0.2, specimen=OTHER_LABEL)
+    papers = MeasuredPoint(200, 1, 50, 0.3, specimen="paper_coupon")
+    unnamed = MeasuredPoint(300, 1, 50, 0.3)
+    assert points_for_specimen([own, papers, unnamed], OTHER_CELL) == (
+        [own, unnamed], f"Not used for {OTHER_LABEL} (acrylic particles): 1 measured load "
+                        "case(s) of specimen paper_coupon.")
+    assert points_for_paper([own, papers, unnamed])[0] == [papers, unnamed]
+    from pidcore.errors import ParameterError
+
+    with pytest.raises(ParameterError, match=r"name specimen 'paper_coupon', not "
+                                             + re.escape(repr(OTHER_LABEL))):
+        base_specimen([own, papers], OTHER_CELL)
+    runs = pd.DataFrame([{"case_key": key, "material": "acrylic", "direction": "z",
+                          "specimen_name": s.name, "specimen_sha256": s.hash}
+                         for key, s in (("p1", PAPER), ("o1", OTHER_CELL))])
+    met = runs_for_measurement(runs, OTHER_LABEL, "acrylic", "z")
+    assert met.runs["case_key"].tolist() == ["o1"] and met.specimen == OTHER_LABEL
+    met = runs_for_measurement(runs, "paper_coupon", "acrylic", "z")
+    assert met.runs["case_key"].tolist() == ["p1"] and met.specimen == "paper_coupon"

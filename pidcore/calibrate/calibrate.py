@@ -26,6 +26,7 @@ from ..specimen import (
     Specimen,
     calibrated_name,
     is_paper_coupon,
+    measured_specimen_name,
     paper_specimen,
     uncalibrated_name,
 )
@@ -284,7 +285,7 @@ def check_point_specimens(points: Sequence[MeasuredPoint], specimen: Specimen) -
     measurement in the report and the app (:meth:`pidcore.calibrate.prediction.Calibration.
     speaks_for`). Any other was fitted silently against this specimen's DEM runs.
     """
-    own = uncalibrated_name(specimen.name)
+    own = uncalibrated_name(measured_specimen_name(specimen))
 
     def of_another(name: str) -> bool:
         if specimen.is_paper():
@@ -309,7 +310,8 @@ def check_point_specimens(points: Sequence[MeasuredPoint], specimen: Specimen) -
         else:  # a store's load cases (or points made in code)
             where = f"{len(rows)} measured load case(s)" + (f" of {source}" if source else "")
         said.append(f"{where} name specimen {name!r}")
-    raise ParameterError(f"{'; '.join(said)}, not {specimen.name!r}, the specimen calibrated; "
+    raise ParameterError(f"{'; '.join(said)}, not {measured_specimen_name(specimen)!r}, the "
+                         "specimen calibrated; "
                          "calibrate them with their own specimen file (specimen=FILE), or "
                          "leave those rows out")
 

@@ -196,13 +196,14 @@ def points_for_specimen(points: Sequence[MeasuredPoint], specimen) -> tuple[list
     particle material measured on it (their specimen label is its name, or the name it was
     calibrated from) or on no named specimen; ``note`` says what is left out and why ("" if
     nothing)."""
-    from ..specimen import uncalibrated_name
+    from ..specimen import measured_specimen_name, uncalibrated_name
 
     material = specimen.particles.material
     # a calibrated file (as pidcore calibrate names it) is the specimen its measurements
     # were made on, as base_specimen reads a point's name: "x", "x_calibrated" and an older
-    # "x_calibrated_calibrated" are all x
-    tested = uncalibrated_name(specimen.name)
+    # "x_calibrated_calibrated" are all x. A file named paper_coupon with another cell is
+    # "paper_coupon [45d792]", as its tests are saved: the paper coupon's tests are not its
+    tested = uncalibrated_name(measured_specimen_name(specimen))
     kept, other_material, other_specimen = [], {}, {}
     for p in points:
         if str(p.material) != material:
@@ -215,7 +216,8 @@ def points_for_specimen(points: Sequence[MeasuredPoint], specimen) -> tuple[list
                for name, n in other_specimen.items()]
     reasons += [f"{n} measured load case(s) of {name} particles"
                 for name, n in other_material.items()]
-    note = (f"Not used for {specimen.name} ({material} particles): " + "; ".join(reasons)
+    note = (f"Not used for {measured_specimen_name(specimen)} ({material} particles): "
+            + "; ".join(reasons)
             + ".") if reasons else ""
     return kept, note
 

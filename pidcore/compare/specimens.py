@@ -121,7 +121,9 @@ def runs_for_measurement(runs: pd.DataFrame | None, specimen: str, material: str
         return _paper_runs(same, labels, paper)
     if specimen:
         names = _names(same, labels)
-        mine = (names == specimen).to_numpy(bool)
+        # a test of a file named like the paper's coupon with other content names it by its
+        # label, "paper_coupon [45d792]" (pidcore.specimen.measured_specimen_name), as its runs
+        mine = ((names == specimen) | (labels == specimen)).to_numpy(bool)
         calibrated_from = ""
         if not mine.any():
             # a file `pidcore calibrate` wrote from this specimen ("x_calibrated") models the

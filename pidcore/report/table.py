@@ -155,7 +155,8 @@ def no_runs_note(of: str, material: str, direction: str, store_runs: pd.DataFram
     # report is of another specimen: "another specimen's: not compared with a test of X" was
     # said of X's own runs
     own = named and bool(((labels == of) if of == PAPER_SPECIMEN_NAME
-                          else there.get("specimen_name", pd.Series(dtype=object)) == of).any())
+                          else (labels == of)
+                          | (there.get("specimen_name", pd.Series(dtype=object)) == of)).any())
     if named and not own:
         choose_another = f"not compared with a test of {of}"
     elif not choose_another:
