@@ -61,9 +61,9 @@ Public API
 load_specimen, paper_specimen, Specimen
     A specimen from a TOML file, the bundled paper coupon; ``Specimen.from_text``,
     ``with_values``, ``to_toml``, ``capacity_per_cell``.
-is_paper_coupon, measured_specimen_name
+is_paper_coupon, measured_specimen_name, models_paper_coupon
     Whether a specimen (by hash, else by name) is the paper's coupon: the one rule; the name
-    a measurement of a specimen file is saved under.
+    a measurement of a specimen file is saved under; whether a file models the coupon.
 CellSpec, CouponSpec, ParticleSpec, PairSpec, PairsSpec
     Its sections (SI units in the field names).
 describe
@@ -1052,14 +1052,16 @@ def measured_specimen_name(specimen: Specimen) -> str:
     """
     if specimen.is_paper() or not is_paper_coupon(specimen.name):
         return specimen.name
-    if specimen.name != uncalibrated_name(specimen.name) and _papers_cell_and_spheres(specimen):
+    if specimen.name != uncalibrated_name(specimen.name) and models_paper_coupon(specimen):
         return specimen.name
     return f"{specimen.name} [{specimen.hash[:6]}]"
 
 
-def _papers_cell_and_spheres(specimen: Specimen) -> bool:
+def models_paper_coupon(specimen: Specimen) -> bool:
     """Whether ``specimen`` holds the paper coupon's cells and spheres (of its particle
-    material): what a calibration of that coupon leaves as it was."""
+    material), whatever its contact, mass and damping values: a calibration's design point or
+    calibrated file of the coupon, a model of the coupon its tests were made on. A file with
+    another cell or other spheres models another coupon, whatever its name."""
     try:
         paper = paper_specimen(specimen.particles.material)
     except ParameterError:  # a material the tables lack: not the paper's spheres
@@ -1190,6 +1192,6 @@ def _capacity(shape: str, inscribed_diameter_m: float, height_m: float, radius_m
 
 __all__ = ["CellSpec", "CouponSpec", "PairSpec", "PairsSpec", "ParticleSpec", "Specimen",
            "cell_geometry", "contact_law", "describe", "is_paper_coupon", "load_specimen",
-           "numeric_fields", "paper_specimen", "particles_for_fill",
-           "measured_specimen_name"]
+           "measured_specimen_name", "models_paper_coupon", "numeric_fields",
+           "paper_specimen", "particles_for_fill"]
 

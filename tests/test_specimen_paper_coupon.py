@@ -234,3 +234,57 @@ def test_the_other_files_tests_and_runs_are_its_own_not_the_papers():
     assert met.runs["case_key"].tolist() == ["o1"] and met.specimen == OTHER_LABEL
     met = runs_for_measurement(runs, "paper_coupon", "acrylic", "z")
     assert met.runs["case_key"].tolist() == ["p1"] and met.specimen == "paper_coupon"
+
+
+def _stored_run(key: str, specimen) -> dict:
+    """A store listing's row of a DEM run of ``specimen`` (its file's text stored with it, as
+    pidcore.dem.persist stores it)."""
+    import json
+
+    return {"case_key": key, "material": "acrylic", "direction": "z",
+            "specimen_name": specimen.name, "specimen_sha256": specimen.hash,
+            "parameters_json": json.dumps({"specimen_text": specimen.text})}
+
+
+def test_a_test_of_the_papers_coupon_meets_no_runs_of_another_coupons_calibrated_file():
+    """Was: `pidcore calibrate --specimen mine/paper_coupon.toml` (1/4 in cells) writes
+    paper_coupon_calibrated.toml, and a test of the paper's coupon met that file's DEM runs
+    ("the file pidcore calibrate made from it") in a store without runs of the coupon itself.
+    The bundled calibration of the paper's coupon (its cell and spheres) is still met."""
+    other = dataclasses.replace(OTHER_CELL.with_values({"coupon.fixture_mass_kg": 0.25}),
+                                name="paper_coupon_calibrated")
+    papers = load_specimen(CALIBRATED_PAPER)
+    label = f"paper_coupon_calibrated [{other.hash[:6]}]"
+    met = runs_for_measurement(pd.DataFrame([_stored_run("o1", other)]), "paper_coupon",
+                               "acrylic", "z")
+    assert met.runs is None and met.calibrated_from == ""
+    assert met.note == ("no DEM runs of specimen paper_coupon at acrylic, z; DEM runs of other "
+                        f"specimens not compared: {label} (1 run(s))")
+    both = pd.DataFrame([_stored_run("o1", other), _stored_run("c1", papers)])
+    met = runs_for_measurement(both, "paper_coupon", "acrylic", "z")
+    assert met.runs["case_key"].tolist() == ["c1"] and met.calibrated_from == "paper_coupon"
+    # a run that stored no specimen text is taken as its name says (as before)
+    bare = pd.DataFrame([{k: v for k, v in _stored_run("o1", other).items()
+                          if k != "parameters_json"}])
+    assert runs_for_measurement(bare, "paper_coupon", "acrylic", "z").runs is not None
+
+
+def test_a_test_of_the_papers_coupon_meets_no_runs_of_another_file_of_its_name():
+    """Was: with no run of the paper's coupon at its material and direction (`report
+    --specimen mine/paper_coupon.toml`, the app's Compare on a store of such runs), a test
+    naming paper_coupon met the runs of the other file named paper_coupon (1/4 in cells)."""
+    runs = pd.DataFrame([_stored_run("o1", OTHER_CELL)])
+    for named in ("paper_coupon", "paper_coupon_aluminium"):
+        met = runs_for_measurement(runs, named, "acrylic", "z")
+        assert met.runs is None, named
+        assert met.note == (f"no DEM runs of specimen {named} at acrylic, z; DEM runs of other "
+                            f"specimens not compared: {OTHER_LABEL} (1 run(s))")
+    # its own test meets it
+    assert runs_for_measurement(runs, OTHER_LABEL, "acrylic", "z").runs is not None
+    # a calibration's design point (the coupon with another rolling friction) still models
+    # the coupon: met, under its hash (test_app_logic pins it for runs without stored text)
+    design = PAPER.with_values({"pairs.particle_wall.rolling_friction": 0.05})
+    met = runs_for_measurement(pd.DataFrame([_stored_run("d1", design)]), "paper_coupon",
+                               "acrylic", "z")
+    assert met.runs["case_key"].tolist() == ["d1"]
+    assert met.specimen == f"paper_coupon [{design.hash[:6]}]"
