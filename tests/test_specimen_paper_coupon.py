@@ -288,3 +288,26 @@ def test_a_test_of_the_papers_coupon_meets_no_runs_of_another_file_of_its_name()
                                "acrylic", "z")
     assert met.runs["case_key"].tolist() == ["d1"]
     assert met.specimen == f"paper_coupon [{design.hash[:6]}]"
+
+
+def test_a_calibration_of_another_file_named_paper_coupon_speaks_not_for_the_coupons_tests(
+        tmp_path):
+    """Was: the app's Compare showed the band of a calibration of mine/paper_coupon.toml (1/4
+    in cells; its calibrated file is paper_coupon_calibrated too) beside a test of the
+    paper's coupon, by name. The coupon's own calibration speaks for a test naming either
+    table material's coupon (is_paper_coupon; the material is lookup's)."""
+    import shutil
+
+    from pidcore.calibrate.prediction import load_calibration
+
+    bundled = REPO / "data_samples" / "paper_calibration" / "calibration.json"
+    shutil.copy(bundled, tmp_path / "calibration.json")
+    other = dataclasses.replace(OTHER_CELL, name="paper_coupon_calibrated")
+    (tmp_path / "calibrated_specimen.toml").write_text(other.to_toml())
+    cal = load_calibration(tmp_path / "calibration.json")
+    assert not cal.speaks_for("paper_coupon") and not cal.speaks_for("paper_coupon_aluminium")
+    assert cal.speaks_for("")  # an unnamed test: unknown, as before
+    shutil.copy(CALIBRATED_PAPER, tmp_path / "calibrated_specimen.toml")
+    cal = load_calibration(tmp_path / "calibration.json")
+    assert cal.speaks_for("paper_coupon") and cal.speaks_for("paper_coupon_aluminium")
+    assert not cal.speaks_for(OTHER_LABEL) and not cal.speaks_for("steel_6mm")
