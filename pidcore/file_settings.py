@@ -535,7 +535,17 @@ def resolve_files(paths: Sequence[str | os.PathLike], *, options: AnalysisOption
     them for its own tests. A stated fill that rounds to no particle of the cell of its
     material (``specimen``'s for its particles, the paper's coupon for the table's) is refused
     naming the file: 0.5 typed for 50 % was analysed and saved as a coupon without particles.
+    A file named like the paper's coupon with other content (``specimen``, named
+    ``specimen_name``) is saved under :func:`pidcore.specimen.measured_specimen_name`
+    (``"paper_coupon [45d792]"``), and so is a file whose sidecar names that name.
     """
+    renamed = ""
+    if specimen is not None:
+        from .specimen import measured_specimen_name
+
+        renamed = measured_specimen_name(specimen)
+        if specimen_name == specimen.name:
+            specimen_name = renamed
     tables: dict = {}
     stated: list[StatedLoadCase | None] = []
     settings: list[FileSettings] = []
@@ -551,6 +561,9 @@ def resolve_files(paths: Sequence[str | os.PathLike], *, options: AnalysisOption
             stated.append(None)
         _refuse_fill_of_no_particle(path, stated[-1], specimen)
         fs = resolve_file_settings(path, options, given=given, sidecar=sidecar, tables=tables)
+        if specimen is not None and fs.specimen == specimen.name != renamed:
+            # the sidecar names the file given: its name alone would claim the paper's coupon
+            fs = replace(fs, specimen=renamed)
         if (specimen_name and not fs.specimen and stated[-1] is not None
                 and stated[-1].material == specimen_material):
             fs = replace(fs, specimen=specimen_name,

@@ -61,6 +61,9 @@ Public API
 load_specimen, paper_specimen, Specimen
     A specimen from a TOML file, the bundled paper coupon; ``Specimen.from_text``,
     ``with_values``, ``to_toml``, ``capacity_per_cell``.
+is_paper_coupon, measured_specimen_name, models_paper_coupon
+    Whether a specimen (by hash, else by name) is the paper's coupon: the one rule; the name
+    a measurement of a specimen file is saved under; whether a file models the coupon.
 CellSpec, CouponSpec, ParticleSpec, PairSpec, PairsSpec
     Its sections (SI units in the field names).
 describe
@@ -574,8 +577,9 @@ class Specimen:
 
     def is_paper(self) -> bool:
         """True for the paper's coupon (acrylic, or another table particle material): the
-        specimen of the paper's Table 3, so only its runs are compared with that table."""
-        return self.hash in paper_hashes()
+        specimen of the paper's Table 3, so only its runs are compared with that table
+        (:func:`is_paper_coupon` by its hash)."""
+        return is_paper_coupon(self.name, self.hash)
 
     # --- what follows from it ------------------------------------------------------------
 
@@ -990,6 +994,82 @@ def paper_hashes() -> frozenset[str]:
     return frozenset(paper_specimen(m).hash for m in PARTICLE_MATERIALS)
 
 
+@functools.cache
+def _paper_names() -> frozenset[str]:
+    from .constants import PARTICLE_MATERIALS
+
+    return frozenset(paper_specimen(m).name for m in PARTICLE_MATERIALS)
+
+
+def is_paper_coupon(name: object = "", sha256: object = "") -> bool:
+    """Whether a specimen is the paper's coupon: the one the paper's Table 3 describes, and the
+    one ``pidcore calibrate`` calibrates when no specimen file is given. The one rule for DEM
+    runs (``specimen_name``, ``specimen_sha256``), measurements (the ``specimen`` they name)
+    and specimen files (:meth:`Specimen.is_paper`).
+
+    - Where the content is known (``sha256``, the hash of the specimen's canonical text: a DEM
+      run, a specimen file), it alone decides: the paper's coupon is the bundled
+      ``paper_coupon.toml`` (:func:`paper_hashes`). Another file is another specimen whatever
+      its name: a copy named ``paper_coupon`` with another cell size, or a calibration's
+      design point, is not compared with Table 3 nor pooled with the coupon's runs.
+    - Where only a name is known (a measurement, a run stored before specimens had a hash),
+      the name decides: none (``""``: the paper's coupon by default) or the paper's coupon's
+      with a table particle material. A measurement analysed with a file of that name but
+      other content is saved under :func:`measured_specimen_name`'s ``"paper_coupon
+      [45d792]"``, which is not the paper's.
+    - ``paper_coupon_aluminium`` (:func:`paper_specimen` ``("aluminium")``) is the paper's
+      coupon: one coupon, filled with the table's aluminium spheres (both hashes are in
+      :func:`paper_hashes`). (a) Table 3: it counts; the table holds acrylic rows only, so an
+      aluminium row gets no Table 3 value by its material (``compare.align.match_paper``),
+      not by its specimen. (b) Calibration: it counts; ``pidcore calibrate`` without a
+      specimen file calibrates ``paper_specimen(material)`` of the points' particles, and a
+      test naming ``paper_coupon`` or ``paper_coupon_aluminium`` is a test of it (the material
+      is checked apart: points of two materials are refused).
+    - A calibrated name (``x_calibrated``, the file ``pidcore calibrate`` wrote from ``x``'s
+      tests) names the specimen ``x`` that was tested (:func:`uncalibrated_name`): a
+      measurement naming ``paper_coupon_calibrated`` is a test of the paper's coupon, for
+      Table 3 and for calibration alike. A calibrated file's content (its hash) is not the
+      paper's: its DEM runs model the coupon with fitted values, not the paper's DEM.
+    """
+    if isinstance(sha256, str) and sha256:
+        return sha256 in paper_hashes()
+    named = name.strip() if isinstance(name, str) else ""
+    return not named or uncalibrated_name(named) in _paper_names()
+
+
+def measured_specimen_name(specimen: Specimen) -> str:
+    """The specimen name a measurement analysed with ``specimen`` is saved and compared under
+    (``pidcore analyze --specimen FILE``, ``pidcore report FILES --specimen FILE``): its
+    ``name``, except for a file that takes the paper's coupon's name (:func:`is_paper_coupon`
+    by name) with other content, which is ``"paper_coupon [45d792]"`` (name and hash, as its
+    DEM runs are labelled on every page: :func:`pidcore.compare.specimens.specimen_label`).
+
+    A measurement records only this name: under the bare name ``paper_coupon``, a test of a
+    coupon with another cell size was compared with the paper's Table 3 and calibrated with
+    the paper coupon's tests. A calibrated file of the paper's coupon
+    (``paper_coupon_calibrated``: fitted contact, mass or damping values, the paper's cell and
+    spheres) keeps its name: its tests are the paper's coupon's.
+    """
+    if specimen.is_paper() or not is_paper_coupon(specimen.name):
+        return specimen.name
+    if specimen.name != uncalibrated_name(specimen.name) and models_paper_coupon(specimen):
+        return specimen.name
+    return f"{specimen.name} [{specimen.hash[:6]}]"
+
+
+def models_paper_coupon(specimen: Specimen) -> bool:
+    """Whether ``specimen`` holds the paper coupon's cells and spheres (of its particle
+    material), whatever its contact, mass and damping values: a calibration's design point or
+    calibrated file of the coupon, a model of the coupon its tests were made on. A file with
+    another cell or other spheres models another coupon, whatever its name."""
+    try:
+        paper = paper_specimen(specimen.particles.material)
+    except ParameterError:  # a material the tables lack: not the paper's spheres
+        return False
+    return (specimen.cell == paper.cell
+            and specimen.particles.radius_m == paper.particles.radius_m)
+
+
 # --- what follows from a specimen ------------------------------------------------------------
 
 #: Load case whose impacts are the hardest of the paper's Table 3 grid (largest 2 a/w): the
@@ -1111,6 +1191,7 @@ def _capacity(shape: str, inscribed_diameter_m: float, height_m: float, radius_m
 
 
 __all__ = ["CellSpec", "CouponSpec", "PairSpec", "PairsSpec", "ParticleSpec", "Specimen",
-           "cell_geometry", "contact_law", "describe", "load_specimen", "numeric_fields",
+           "cell_geometry", "contact_law", "describe", "is_paper_coupon", "load_specimen",
+           "measured_specimen_name", "models_paper_coupon", "numeric_fields",
            "paper_specimen", "particles_for_fill"]
 

@@ -22,7 +22,14 @@ from ..compare.align import steady_stated
 from ..constants import STANDARD_GRAVITY
 from ..dem.simulate import DemConfig, LoadCase
 from ..errors import ParameterError
-from ..specimen import Specimen, calibrated_name, paper_specimen, uncalibrated_name
+from ..specimen import (
+    Specimen,
+    calibrated_name,
+    is_paper_coupon,
+    measured_specimen_name,
+    paper_specimen,
+    uncalibrated_name,
+)
 from .data import MeasuredPoint, check_enough_points
 from .observation import Observation, observation_from_run
 from .parameters import (
@@ -278,10 +285,19 @@ def check_point_specimens(points: Sequence[MeasuredPoint], specimen: Specimen) -
     measurement in the report and the app (:meth:`pidcore.calibrate.prediction.Calibration.
     speaks_for`). Any other was fitted silently against this specimen's DEM runs.
     """
-    own = uncalibrated_name(specimen.name)
+    own = uncalibrated_name(measured_specimen_name(specimen))
+
+    def of_another(name: str) -> bool:
+        if specimen.is_paper():
+            # the paper's coupon with either table material is one coupon: a test naming
+            # paper_coupon was refused for the aluminium coupon (and paper_coupon_aluminium
+            # left out of it by points_for_paper)
+            return not is_paper_coupon(name)
+        return bool(name) and uncalibrated_name(name) != own
+
     others: dict[tuple[str, str], list[int | None]] = {}
     for p in points:
-        if p.specimen and uncalibrated_name(p.specimen) != own:
+        if of_another(p.specimen):
             others.setdefault((p.source, p.specimen), []).append(p.row)
     if not others:
         return
@@ -294,7 +310,8 @@ def check_point_specimens(points: Sequence[MeasuredPoint], specimen: Specimen) -
         else:  # a store's load cases (or points made in code)
             where = f"{len(rows)} measured load case(s)" + (f" of {source}" if source else "")
         said.append(f"{where} name specimen {name!r}")
-    raise ParameterError(f"{'; '.join(said)}, not {specimen.name!r}, the specimen calibrated; "
+    raise ParameterError(f"{'; '.join(said)}, not {measured_specimen_name(specimen)!r}, the "
+                         "specimen calibrated; "
                          "calibrate them with their own specimen file (specimen=FILE), or "
                          "leave those rows out")
 

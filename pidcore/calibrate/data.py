@@ -196,13 +196,14 @@ def points_for_specimen(points: Sequence[MeasuredPoint], specimen) -> tuple[list
     particle material measured on it (their specimen label is its name, or the name it was
     calibrated from) or on no named specimen; ``note`` says what is left out and why ("" if
     nothing)."""
-    from ..specimen import uncalibrated_name
+    from ..specimen import measured_specimen_name, uncalibrated_name
 
     material = specimen.particles.material
     # a calibrated file (as pidcore calibrate names it) is the specimen its measurements
     # were made on, as base_specimen reads a point's name: "x", "x_calibrated" and an older
-    # "x_calibrated_calibrated" are all x
-    tested = uncalibrated_name(specimen.name)
+    # "x_calibrated_calibrated" are all x. A file named paper_coupon with another cell is
+    # "paper_coupon [45d792]", as its tests are saved: the paper coupon's tests are not its
+    tested = uncalibrated_name(measured_specimen_name(specimen))
     kept, other_material, other_specimen = [], {}, {}
     for p in points:
         if str(p.material) != material:
@@ -215,7 +216,8 @@ def points_for_specimen(points: Sequence[MeasuredPoint], specimen) -> tuple[list
                for name, n in other_specimen.items()]
     reasons += [f"{n} measured load case(s) of {name} particles"
                 for name, n in other_material.items()]
-    note = (f"Not used for {specimen.name} ({material} particles): " + "; ".join(reasons)
+    note = (f"Not used for {measured_specimen_name(specimen)} ({material} particles): "
+            + "; ".join(reasons)
             + ".") if reasons else ""
     return kept, note
 
@@ -224,13 +226,16 @@ def points_for_paper(points: Sequence[MeasuredPoint], *, hint: str = "") -> tupl
     """(points, note): the measured points the paper's coupon is calibrated against, those
     naming no specimen or the paper's coupon (the library refuses others:
     :func:`pidcore.calibrate.calibrate.check_point_specimens`); ``note`` says what is left out
-    ("" if nothing), with ``hint``, the caller's way to calibrate them, in brackets."""
-    from ..specimen import PAPER_SPECIMEN_NAME, uncalibrated_name
+    ("" if nothing), with ``hint``, the caller's way to calibrate them, in brackets.
+    Which names are the paper's coupon is :func:`pidcore.specimen.is_paper_coupon`'s to say
+    (``paper_coupon_aluminium`` is; its tests were left out here and accepted by the
+    library)."""
+    from ..specimen import is_paper_coupon
 
     kept, others = [], {}
     for p in points:
         name = str(p.specimen)
-        if name and uncalibrated_name(name) != PAPER_SPECIMEN_NAME:
+        if not is_paper_coupon(name):
             others[name] = others.get(name, 0) + 1
         else:
             kept.append(p)

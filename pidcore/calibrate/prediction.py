@@ -200,14 +200,22 @@ class Calibration:
     def speaks_for(self, specimen_name: str) -> bool:
         """Whether this calibration may predict a measurement of the specimen named
         ``specimen_name`` ("" : not named): the same name as the specimen it calibrates (its
-        calibrated file is "<name>_calibrated"), or either unknown."""
-        from ..specimen import uncalibrated_name
+        calibrated file is "<name>_calibrated"), or either unknown. The paper's coupon is
+        :func:`pidcore.specimen.is_paper_coupon`'s: its calibration speaks for a test naming
+        ``paper_coupon`` or ``paper_coupon_aluminium`` (the material is :meth:`lookup`'s), and
+        a calibrated file named ``paper_coupon_calibrated`` with another cell is named as its
+        tests are (:func:`pidcore.specimen.measured_specimen_name`), not as the coupon's."""
+        from ..specimen import is_paper_coupon, measured_specimen_name, uncalibrated_name
 
         calibrated = self.specimen_name
-        if not calibrated and specimen_name:
+        if specimen_name and (not calibrated or is_paper_coupon(calibrated)):
+            # another file named paper_coupon (another cell) calibrates to
+            # paper_coupon_calibrated too: its band was shown beside the coupon's tests
             spec = self.calibrated_specimen()
-            calibrated = spec.name if spec is not None else ""
+            calibrated = measured_specimen_name(spec) if spec is not None else calibrated
         if not specimen_name or not calibrated:
+            return True
+        if is_paper_coupon(calibrated) and is_paper_coupon(specimen_name):
             return True
         return uncalibrated_name(calibrated) == uncalibrated_name(specimen_name)
 

@@ -218,10 +218,12 @@ def _store_points(points: list, specimen, store: Path, left_out: list[str]) -> l
                 f"--store {store}: measurements of {', '.join(materials)} particles; give "
                 "--specimen FILE to calibrate those of its particles")
     else:
+        from ..specimen import measured_specimen_name
+
         kept, note = points_for_specimen(points, specimen)
         if not kept:
             raise ParameterError(
-                f"--store {store}: no measurement of specimen {specimen.name} "
+                f"--store {store}: no measurement of specimen {measured_specimen_name(specimen)} "
                 f"({specimen.particles.material} particles) or of an unnamed specimen of them"
                 f"{'; ' + note if note else ''}")
     if note and kept:

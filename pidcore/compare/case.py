@@ -383,8 +383,9 @@ def compare_case(records: Sequence[MeasuredEntry],
         Points on the model curve.
     """
     from ..model import SdcModel
+    from ..specimen import is_paper_coupon
     from .align import PAPER_DIRECTION, PAPER_MATERIAL
-    from .specimens import NOT_PAPER_SPECIMEN_NOTE, is_paper_specimen_name
+    from .specimens import NOT_PAPER_SPECIMEN_NOTE
 
     if not records:
         raise ParameterError("compare_case: no records given")
@@ -411,7 +412,7 @@ def compare_case(records: Sequence[MeasuredEntry],
     # Table 3 describes the paper's coupon: beside a test of another specimen its points, its
     # pchip curve and its values were read as that coupon's (the report's rule too)
     specimen = records[0].specimen
-    if not is_paper_specimen_name(specimen):
+    if not is_paper_coupon(specimen):
         if case.material == PAPER_MATERIAL and case.direction == PAPER_DIRECTION:
             notes.append(NOT_PAPER_SPECIMEN_NOTE.format(name=specimen.strip()))
         paper = paper.iloc[0:0]
@@ -419,7 +420,7 @@ def compare_case(records: Sequence[MeasuredEntry],
     aligner = Aligner.from_tables(runs, paper, tolerances=tol,
                                   reference_fills=[case.fill_percent])
     aligned = aligner.align(case)
-    if aligned.status == "no_dem_runs" and not is_paper_specimen_name(specimen):
+    if aligned.status == "no_dem_runs" and not is_paper_coupon(specimen):
         # the runs were those of this specimen: "no DEM runs of ours for acrylic" read false
         # beside a store of the paper's coupon's acrylic runs
         aligned = replace(aligned, message=f"no DEM runs of specimen {specimen.strip()} for "

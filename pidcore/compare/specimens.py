@@ -8,9 +8,13 @@ default of ``pidcore report``: a calibration's store holds its design runs, file
 ``paper_coupon`` with other values, beside the coupon's own), and none when they come from
 several others (they are not pooled: which specimen was tested is the user's to say). A
 measurement named ``x`` with no run of that name meets the runs of ``x_calibrated``, the
-file ``pidcore calibrate`` wrote from it (a model of the specimen tested). A
-measurement named ``paper_coupon`` meets the paper's coupon's runs, not another file of that
-name. Runs stored before specimens
+file ``pidcore calibrate`` wrote from it (a model of the specimen tested); for the paper's
+coupon only such a file of its cell and spheres (another file named ``paper_coupon``
+calibrates to the same name). A measurement named ``paper_coupon`` meets the paper's coupon's
+runs, not another file of that name; a test of such a file is named ``"paper_coupon
+[45d792]"``, as its runs are (:func:`pidcore.specimen.measured_specimen_name`). Which
+specimen is the paper's coupon is :func:`pidcore.specimen.is_paper_coupon`'s to say. Runs
+stored before specimens
 existed (no hash) and runs of the paper's coupon with either table material are the paper's
 coupon, as in :func:`pidcore.dem.persist.runs_of_specimen`.
 
@@ -21,7 +25,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numpy as np
 import pandas as pd
+
+from ..errors import PidcoreError
 
 
 @dataclass(frozen=True)
@@ -54,21 +61,12 @@ class SpecimenRuns:
 def specimen_label(name: str, sha256: str) -> str:
     """A specimen as the pages name it: ``"name [hash6]"``; the paper's coupon (either table
     material, or no hash: a run stored before specimens existed) is ``"paper_coupon"``."""
-    from ..specimen import PAPER_SPECIMEN_NAME, paper_hashes
+    from ..specimen import PAPER_SPECIMEN_NAME, is_paper_coupon
 
-    if not sha256 or sha256 in paper_hashes():
+    # a run without a hash predates specimens: it was the paper's coupon, whatever it names
+    if not sha256 or is_paper_coupon(name, sha256):
         return PAPER_SPECIMEN_NAME
     return f"{name or 'unnamed'} [{sha256[:6]}]"
-
-
-def is_paper_specimen_name(name: object) -> bool:
-    """True where a measurement's specimen (its name; empty: not named, the paper's coupon by
-    default) is the paper's coupon, the only specimen the paper's Table 3 describes."""
-    from ..constants import PARTICLE_MATERIALS
-    from ..specimen import paper_specimen
-
-    named = name.strip() if isinstance(name, str) else ""
-    return not named or named in {paper_specimen(m).name for m in PARTICLE_MATERIALS}
 
 
 NOT_PAPER_SPECIMEN_NOTE = ("specimen {name} is not the paper's coupon: the paper's Table 3 is "
@@ -99,6 +97,30 @@ def _names(runs: pd.DataFrame, labels: pd.Series) -> pd.Series:
                      index=runs.index, dtype=object)
 
 
+def _model_the_papers_coupon(runs: pd.DataFrame) -> np.ndarray:
+    """Per run: whether the specimen file it stored (``parameters_json``'s ``specimen_text``)
+    models the paper's coupon (:func:`pidcore.specimen.models_paper_coupon`: its cell and
+    spheres). A run that stored no text (runs of the paper's coupon's name before specimen
+    files were stored) is taken as its name says, as before; one whose text no longer reads
+    is not."""
+    from ..specimen import Specimen, models_paper_coupon
+    from .align import stored_parameters
+
+    if "parameters_json" not in runs.columns:
+        return np.ones(len(runs), dtype=bool)
+    keep = []
+    for params in runs["parameters_json"]:
+        text = (stored_parameters(params) or {}).get("specimen_text")
+        if not isinstance(text, str) or not text:
+            keep.append(True)
+            continue
+        try:
+            keep.append(models_paper_coupon(Specimen.from_text(text, source="stored DEM run")))
+        except PidcoreError:
+            keep.append(False)
+    return np.array(keep, dtype=bool)
+
+
 def _listed(labels: pd.Series) -> str:
     counts = labels.value_counts(sort=False)
     return ", ".join(f"{label} ({n} run(s))" for label, n in counts.items())
@@ -115,28 +137,45 @@ def runs_for_measurement(runs: pd.DataFrame | None, specimen: str, material: str
         same = runs[(runs["material"] == material) & (runs["direction"] == direction)]
     if same.empty:
         return SpecimenRuns(None)
-    from ..specimen import PAPER_SPECIMEN_NAME
+    from ..specimen import CALIBRATED_SUFFIX, PAPER_SPECIMEN_NAME, is_paper_coupon
 
     labels = run_specimen_labels(same)
     specimen = (specimen or "").strip()
     paper = (labels == PAPER_SPECIMEN_NAME).to_numpy(bool)
-    if specimen == PAPER_SPECIMEN_NAME and paper.any():
+    # a test naming paper_coupon_aluminium is of the paper's coupon too (is_paper_coupon); one
+    # naming paper_coupon_calibrated meets its calibrated file's runs first, as any x_calibrated
+    if specimen and is_paper_coupon(specimen) and not specimen.endswith(CALIBRATED_SUFFIX) \
+            and paper.any():
         # the paper's coupon is the paper's file (its hash), not every file that kept its
         # name: a calibration's design runs (the coupon with another rolling friction ...)
         # are named paper_coupon too, and were pooled with it or refused it
         return _paper_runs(same, labels, paper)
     if specimen:
         names = _names(same, labels)
-        mine = (names == specimen).to_numpy(bool)
+        # a test of a file named like the paper's coupon with other content names it by its
+        # label, "paper_coupon [45d792]" (pidcore.specimen.measured_specimen_name), as its runs
+        mine = ((names == specimen) | (labels == specimen)).to_numpy(bool)
+        of_paper = is_paper_coupon(specimen)
+        if of_paper and not specimen.endswith(CALIBRATED_SUFFIX):
+            # no run of the paper's coupon: the runs of another file of its name are met (with
+            # their hash) only where they model the coupon (a calibration's design point); a
+            # file of another cell was compared with the coupon's test
+            mine = mine & _model_the_papers_coupon(same)
         calibrated_from = ""
         if not mine.any():
             # a file `pidcore calibrate` wrote from this specimen ("x_calibrated") models the
             # specimen tested, as its calibration's bands speak for the tests of "x": a test of
             # x met no run of `report --specimen x_calibrated.toml` (no_dem_runs on every row)
-            from ..specimen import CALIBRATED_SUFFIX, uncalibrated_name
+            from ..specimen import uncalibrated_name
 
             mine = names.map(lambda n: n.endswith(CALIBRATED_SUFFIX)
                              and uncalibrated_name(n) == specimen).to_numpy(bool)
+            if of_paper:
+                # a file calibrated from another file named paper_coupon (another cell) is
+                # paper_coupon_calibrated too: its runs were compared with the paper
+                # coupon's tests. Only a calibrated file of the paper's cell and spheres
+                # models them
+                mine = mine & _model_the_papers_coupon(same)
             calibrated_from = specimen if mine.any() else ""
         kept, others = labels[mine], labels[~mine]
         left_out = (f"DEM runs of other specimens not compared: {_listed(others)}"

@@ -29,7 +29,7 @@ import numpy as np
 
 from ..errors import StoreError
 from ..loadcase import key_0_1
-from ..specimen import Specimen, paper_hashes, paper_specimen
+from ..specimen import Specimen, is_paper_coupon, paper_specimen
 from .result import UNITS, DemResult
 from .simulate import (
     DemConfig,
@@ -354,8 +354,8 @@ def runs_of_specimen(runs, specimen: Specimen | None = None):
     stated = [h if isinstance(h, str) and h else None
               for h in runs.get("specimen_sha256", [None] * len(runs))]
     if specimen.is_paper():
-        paper = paper_hashes()
-        keep = [h is None or h in paper for h in stated]
+        # no hash: a run stored before specimens, the paper's (is_paper_coupon of no name)
+        keep = [is_paper_coupon("", h or "") for h in stated]
     else:
         keep = [h == specimen.hash for h in stated]
     return runs[np.array(keep, dtype=bool)].reset_index(drop=True)

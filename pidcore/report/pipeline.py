@@ -410,8 +410,10 @@ def unsubtracted_baseline_note(specimen, analyses: pd.DataFrame | None) -> str:
         return ""
     material = specimen.particles.material
     named = analyses.get("specimen", pd.Series([""] * len(analyses), index=analyses.index))
+    from ..specimen import measured_specimen_name
+
     mine = analyses[(analyses["material"] == material)
-                    & named.fillna("").isin(["", specimen.name])]
+                    & named.fillna("").isin(["", measured_specimen_name(specimen)])]
     subtracted = [float((stored_parameters(p) or {}).get("baseline_loss_factor") or 0.0)
                   for p in mine.get("parameters_json", pd.Series([None] * len(mine)))]
     without = sum(1 for value in subtracted if value == 0.0)
@@ -478,14 +480,19 @@ def specimen_report_table(stored_runs: pd.DataFrame | None, analyses: pd.DataFra
     dem_runs, notes = specimen_dem_runs(stored_runs, specimen, where=where,
                                         choose_another=choose_another)
     paper = load_paper_table3()
+    from ..specimen import PAPER_SPECIMEN_NAME, measured_specimen_name
+
+    # a file named paper_coupon with another cell is "paper_coupon [45d792]" here, as its
+    # tests and DEM runs are: "specimen paper_coupon is not the paper's coupon" contradicted
+    # itself, and its rows were named as the paper's coupon's
+    name = measured_specimen_name(specimen) if specimen is not None else PAPER_SPECIMEN_NAME
     if specimen is not None and not specimen.is_paper():
         paper = None
-        notes.append(NOT_PAPER_SPECIMEN_NOTE.format(name=specimen.name))
-    from ..specimen import PAPER_SPECIMEN_NAME
+        notes.append(NOT_PAPER_SPECIMEN_NOTE.format(name=name))
 
     table, aligner = report_table_and_aligner(
         dem_runs, analyses, paper, tolerances=tolerances, pool=pool, store_runs=stored_runs,
-        of_specimen=specimen.name if specimen is not None else PAPER_SPECIMEN_NAME,
+        of_specimen=name,
         choose_another="" if choose_another == CHOOSE_SPECIMEN_CLI
         else f"choose theirs with {choose_another.removesuffix(' for another')} to compare "
              "them")
@@ -504,7 +511,7 @@ def specimen_report_table(stored_runs: pd.DataFrame | None, analyses: pd.DataFra
         # is unknown: left empty), and one stored with a specimen of its own (the app's
         # uploads, a sidecar's) keeps that one
         mine = (table["specimen"] == "") & (table["material"] == specimen.particles.material)
-        table.loc[mine, "specimen"] = specimen.name
+        table.loc[mine, "specimen"] = name
     table.attrs["notes"] = notes + list(table.attrs.get("notes", []))
     return SpecimenTable(table, dem_runs, paper, aligner)
 

@@ -40,10 +40,10 @@ from ..compare.loadcase import LoadCase, LoadCaseError
 from ..compare.plausibility import stored_findings
 from ..compare.specimens import (
     NOT_PAPER_SPECIMEN_NOTE,
-    is_paper_specimen_name,
     runs_for_measurement,
 )
 from ..errors import ParameterError, instance_of
+from ..specimen import is_paper_coupon
 from ..units import g_to_si
 
 #: Measured energy per cycle over the DEM case's E = m_c a^2 / (2 w^2) (Eq. 10): the like-for-like
@@ -155,7 +155,8 @@ def no_runs_note(of: str, material: str, direction: str, store_runs: pd.DataFram
     # report is of another specimen: "another specimen's: not compared with a test of X" was
     # said of X's own runs
     own = named and bool(((labels == of) if of == PAPER_SPECIMEN_NAME
-                          else there.get("specimen_name", pd.Series(dtype=object)) == of).any())
+                          else (labels == of)
+                          | (there.get("specimen_name", pd.Series(dtype=object)) == of)).any())
     if named and not own:
         choose_another = f"not compared with a test of {of}"
     elif not choose_another:
@@ -311,7 +312,7 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
             # values (and the paper's measurement) as if they were that coupon's
             paper_values = (aligned.sdc_paper_dem, aligned.sdc_paper_experimental)
             not_paper = []
-            if not is_paper_specimen_name(specimen) and np.isfinite(paper_values).any():
+            if not is_paper_coupon(specimen) and np.isfinite(paper_values).any():
                 paper_values = (math.nan, math.nan)
                 not_paper = [NOT_PAPER_SPECIMEN_NOTE.format(name=specimen)]
             base = _Row(case, aligned.status, None, aligned.sdc_dem, aligned.sdc_dem_stderr,

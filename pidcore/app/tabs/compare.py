@@ -11,7 +11,8 @@ import streamlit as st
 from pidcore.app import state, uploads, workbench
 from pidcore.app.vocabulary import page_terms
 from pidcore.compare.case import equivalent_dampers
-from pidcore.compare.specimens import NOT_PAPER_SPECIMEN_NOTE, is_paper_specimen_name
+from pidcore.compare.specimens import NOT_PAPER_SPECIMEN_NOTE
+from pidcore.specimen import is_paper_coupon
 from pidcore.units import display_number
 
 
@@ -176,7 +177,7 @@ def render(stores, session_files: list, calibrations: list) -> None:
         c2.metric("SDC paper DEM [-]", display_number(aligned.sdc_paper_dem, missing="none"))
         c3.metric("SDC paper measured [-]",
                   display_number(aligned.sdc_paper_experimental, missing="none"))
-        if not is_paper_specimen_name(members[0].specimen):
+        if not is_paper_coupon(members[0].specimen):
             # Table 3 may well have this case: its values are of another coupon
             st.caption("paper: none: " + NOT_PAPER_SPECIMEN_NOTE.format(
                 name=members[0].specimen.strip()) + " (it tabulates the paper's coupon)")
