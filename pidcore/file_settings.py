@@ -169,8 +169,8 @@ def _number(value: object, column: str, spec: SettingsColumn, where: str) -> flo
     if not math.isfinite(number):
         raise refused("is not a finite number")
     if number < 0:
-        # the library takes a signed delay (a late force); a vibrometer only ever lags, and
-        # a negative mass or baseline would add what they are meant to remove
+        # a vibrometer only ever lags (AnalysisOptions refuses a negative delay too, without
+        # the cell), and a negative mass or baseline would add what they are meant to remove
         raise refused("is negative")
     if 0 < number < spec.smallest:
         raise SettingsTableError(

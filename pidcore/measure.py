@@ -37,7 +37,7 @@ import numpy as np
 
 from . import defaults
 from .constants import COUNT_UNIT, RATIO_UNIT
-from .errors import ChannelError, ParameterError, SignalError, StoreError, instance_of
+from .errors import ChannelError, ParameterError, SignalError, StoreError, as_given, instance_of
 from .io import assign_roles, read_measurement
 from .records import Channel, Measurement
 from .signal import PowerAnalysis, analyze_channels
@@ -103,6 +103,14 @@ class AnalysisOptions:
             value = getattr(self, name)
             if isinstance(value, float) and value == 0.0:
                 object.__setattr__(self, name, 0.0)
+        delay = self.velocity_delay_s
+        if isinstance(delay, (int, float)) and not isinstance(delay, bool) and delay < 0:
+            # the one rule for a delay a user states (CLI, sidecar, app, script): analyze_power
+            # takes a signed delay, as a start offset between the channels corrects either
+            # way, but a vibrometer's output only ever lags the motion; -50 µs gave a loss
+            # factor shifted by -w tau and saved it
+            raise ParameterError(f"velocity_delay_s: {as_given(delay)} s, expected a delay "
+                                 ">= 0 s (the vibrometer output lags the motion)")
         if isinstance(self.structure_mass_kg, (int, float)) and self.structure_mass_kg == 0:
             # 0 states no mass, as 0 states no correction in the other columns (the app's
             # settings grid starts every row at 0): the baseline then goes off the whole

@@ -5,6 +5,7 @@ else (``cells=2.5`` ran; a fill of 150 % gave one and a half cells of particles)
 
 from __future__ import annotations
 
+import dataclasses
 import json
 from pathlib import Path
 
@@ -15,7 +16,7 @@ from pidcore.calibrate import load_calibration
 from pidcore.dem import DemConfig, LoadCase, particles_per_cell, simulate_load_case
 from pidcore.errors import ChannelError, ParameterError
 from pidcore.io import read_measurement, read_measurements
-from pidcore.measure import AnalysisOptions, analyze_file
+from pidcore.measure import AnalysisOptions, analyze_file, save_analyses
 from pidcore.model import (
     SdcModel,
     TreatedMode,
@@ -90,6 +91,24 @@ def test_analysis_options_are_refused_when_made(keywords, named):
     # before: made without a word, and refused (or a TypeError) only once a file was read
     with pytest.raises(ParameterError, match=named):
         AnalysisOptions(**keywords)
+
+
+def test_a_negative_vibrometer_delay_is_refused_by_the_library_as_by_the_cli(tmp_path):
+    # `pidcore analyze --velocity-delay=-5e-5` was refused, AnalysisOptions(velocity_delay_s=
+    # -5e-5) analysed and saved a loss factor shifted by -w tau; the rule is now the options'
+    # own, which the CLI, the sidecar table, the app and a script all make
+    said = (r"^velocity_delay_s: -5e-05 s, expected a delay >= 0 s \(the vibrometer output "
+            r"lags the motion\)$")
+    with pytest.raises(ParameterError, match=said):
+        AnalysisOptions(velocity_delay_s=-5e-5)
+    with pytest.raises(ParameterError, match=said):  # the app's way to a changed setting
+        dataclasses.replace(AnalysisOptions(), velocity_delay_s=-5e-5)
+    assert AnalysisOptions(velocity_delay_s=-0.0).velocity_delay_s == 0.0  # no correction
+    store = tmp_path / "s.h5"
+    with pytest.raises(ParameterError, match=said):  # a script's analyse-and-save
+        options = AnalysisOptions(velocity_delay_s=-5e-5)
+        save_analyses(store, [analyze_file(_SAMPLE, options)], options)
+    assert not store.exists()
 
 
 def test_analyze_power_names_a_sample_rate_that_is_not_a_number():
