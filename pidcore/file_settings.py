@@ -503,7 +503,8 @@ def _refuse_fill_of_no_particle(path: str | os.PathLike, stated: StatedLoadCase 
     else:
         return
     try:
-        particles_per_cell(stated.fill_percent, stated.material, specimen=cell)
+        # "fill", not the keyword: the fill may come from the file name or a sidecar
+        particles_per_cell(stated.fill_percent, stated.material, specimen=cell, what="fill")
     except PidcoreError as exc:
         if not str(exc).startswith("fill "):  # not about the fill
             raise

@@ -14,6 +14,7 @@ import pytest
 
 from pidcore.calibrate import load_calibration
 from pidcore.dem import DemConfig, LoadCase, particles_per_cell, simulate_load_case
+from pidcore.dem.sweep import run_sweep
 from pidcore.errors import ChannelError, ParameterError
 from pidcore.io import read_measurement, read_measurements
 from pidcore.measure import AnalysisOptions, analyze_file, save_analyses
@@ -72,8 +73,24 @@ def test_simulate_load_case_refuses_a_specimen_path_saying_how_to_read_it():
 def test_a_fill_above_a_full_cell_is_refused():
     n_full, full = particles_per_cell(100.0)
     assert n_full == full  # the limit itself: a full cell
-    with pytest.raises(ParameterError, match=r"^fill 150 %: more than a full cell"):
+    with pytest.raises(ParameterError, match=r"^fill_percent 150 %: more than a full cell"):
         particles_per_cell(150.0)  # was (1.5 x capacity, capacity): more than fit
+
+
+def test_a_fill_of_no_particle_is_refused_naming_the_keyword_before_any_work(tmp_path):
+    # `pidcore dem run --fill 1` names its option; the library said "fill 1 % of 22 ...",
+    # naming no parameter a script has. 1 % of the 22 acrylic spheres of the paper's cell is
+    # 0.22 of a sphere, rounded to none; 2.28 % is the least fill that rounds to one
+    said = r"^fill_percent 1 % of 22 particles rounds to none; expected >= 2\.28 %"
+    with pytest.raises(ParameterError, match=said):
+        particles_per_cell(1.0)
+    with pytest.raises(ParameterError, match=said):
+        simulate_load_case(LoadCase(500.0, 5.0, 1.0), DemConfig(cells=1))
+    store = tmp_path / "dem.h5"
+    with pytest.raises(ParameterError, match=said):  # the valid case is not run either
+        run_sweep([LoadCase(500.0, 5.0, 50.0), LoadCase(500.0, 5.0, 1.0)], DemConfig(cells=1),
+                  store_path=store, workers=1, progress=False)
+    assert not store.exists()
 
 
 @pytest.mark.parametrize(("keywords", "named"), [

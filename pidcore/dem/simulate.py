@@ -230,13 +230,15 @@ def choose_time_step(case: LoadCase, law: ContactLaw, geometry: CellGeometry,
 def particles_per_cell(fill_percent: float, material_name: str | None = None, *,
                        specimen: Specimen | None = None,
                        geometry: CellGeometry | None = None,
-                       fill_reference: str = defaults.DEM_FILL_REFERENCE) -> tuple[int, int]:
+                       fill_reference: str = defaults.DEM_FILL_REFERENCE,
+                       what: str = "fill_percent") -> tuple[int, int]:
     """(particles per cell, count taken as 100 %) for a fill percentage.
 
     The particles and cell are the ``specimen``'s (default: the paper's coupon with
     ``material_name`` particles); ``geometry`` overrides its cell.
     ``fill_reference="capacity"``: 100 % is :func:`~pidcore.dem.geometry.cell_capacity`;
-    ``"paper"``: 36 particles, refused when 36 do not fit the cell.
+    ``"paper"``: 36 particles, refused when 36 do not fit the cell. ``what``: how a refused
+    fill is named (:func:`pidcore.specimen.particles_for_fill`).
     """
     specimen = specimen or paper_specimen(material_name or "acrylic")
     material_name = specimen.particles.material
@@ -259,7 +261,7 @@ def particles_per_cell(fill_percent: float, material_name: str | None = None, *,
     else:
         raise ParameterError(f"fill_reference: expected one of {FILL_REFERENCES}, "
                              f"got {fill_reference!r}")
-    return particles_for_fill(fill_percent, full), full
+    return particles_for_fill(fill_percent, full, what=what), full
 
 
 def _kernel_specializations() -> int:
