@@ -164,12 +164,21 @@ def _layout(lines: list[str], where: str) -> tuple[int, str, list[str], list[str
     if not text_rows:
         raise InputFileError(f"{where}: no header row before the numbers; expected names such "
                              "as 'Time [s],Force [N],Velocity [m/s]'")
-    names = _cells(text_rows[-1], delimiter)
+    def header(row: str) -> list[str]:
+        # one column has no delimiter: its header is the whole line ('Time [s]' split at its
+        # space was two columns over data rows of one, refused for that, not for holding no
+        # channel)
+        if n_cols > 1:
+            return _cells(row, delimiter)
+        own = _delimiter([row])  # a header of more columns than the data says so
+        return [row.strip().strip('"').strip()] if own == r"\s+" else _cells(row, own)
+
+    names = header(text_rows[-1])
     units = [""] * len(names)
     if len(text_rows) >= 2 and all(_looks_like_unit(c) for c in names) \
             and any(c.strip() for c in names):
         units = [c.strip().strip("[]()").strip() for c in names]  # a unit row under the names
-        names = _cells(text_rows[-2], delimiter)
+        names = header(text_rows[-2])
         units = (units + [""] * len(names))[:len(names)]
     decimal = "," if delimiter != "," and any("," in ln for ln in data) else "."
     return first, delimiter, names, units, decimal
@@ -297,7 +306,9 @@ def read_csv(path: str | os.PathLike[str], *, sample_rate_hz: float | None = Non
     pair_times = _pair_time_columns(cells, time_index, values)
     keep = [i for i in range(len(cells)) if i != time_index and i not in pair_times]
     if not keep:
-        raise InputFileError(f"{where}: only a time column; expected channel columns beside it")
+        raise InputFileError(f"{where}: only a time column ({cells[time_index][0]!r}), no force "
+                             "or velocity channel; expected channel columns beside it, e.g. "
+                             "'Time [s],Force [N],Velocity [m/s]'")
     names = unique_names([cells[i][0] or f"column {i + 1}" for i in keep])
     bases = _pair_time_bases(values, cells, pair_times, keep, names, where=where,
                              main=(rate, start_time, values.shape[0]),
