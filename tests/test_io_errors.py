@@ -149,3 +149,29 @@ def test_a_one_column_csv_is_that_column_and_a_wider_header_still_says_so(tmp_pa
     with pytest.raises(InputFileError, match=r"the header has 2 columns but the data rows "
                                              r"have 1$"):
         read_measurement(wider)
+
+
+def test_a_csv_channel_shorter_than_its_time_column_says_where_it_ends(tmp_path, capsys):
+    # 'Velocity' ends at row 4 of 6 (trailing empty cells): was "channel 'Velocity': 2
+    # non-finite samples (NaN/inf), first at index 4", which did not say the column is short
+    rows = [f"{k / 1000},{k},{'' if k >= 4 else k}" for k in range(6)]
+    path = tmp_path / "short_fill50.csv"
+    path.write_text("Time [s],Force [N],Velocity [m/s]\n" + "\n".join(rows) + "\n")
+    # the 4th row's time: 3 ms, from the 1 kHz time column
+    said = (f"{path}: channel 'Velocity' ends early, at data row 4 of 6 (t = 0.003 s): the 2 "
+            "rows after it hold no value; expected a value in every row its time column has")
+    with pytest.raises(InputFileError) as refused:
+        read_measurement(path)
+    assert str(refused.value) == said
+    from pidcore.cli import main
+
+    store = tmp_path / "s.h5"
+    assert main(["analyze", str(path), "--store", str(store)]) == 2
+    assert capsys.readouterr().err == f"pidcore analyze: error: {said}\n"
+    assert not store.exists()
+    empty = tmp_path / "empty_column.csv"
+    empty.write_text("Time [s],Force [N],Velocity [m/s]\n"
+                     + "\n".join(f"{k / 1000},{k}," for k in range(6)) + "\n")
+    with pytest.raises(InputFileError, match=r"channel 'Velocity' holds no value in any of "
+                                             r"its 6 rows; expected a value in every row$"):
+        read_measurement(empty)

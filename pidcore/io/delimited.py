@@ -313,6 +313,8 @@ def read_csv(path: str | os.PathLike[str], *, sample_rate_hz: float | None = Non
     bases = _pair_time_bases(values, cells, pair_times, keep, names, where=where,
                              main=(rate, start_time, values.shape[0]),
                              given_rate=sample_rate_hz, notes=notes)
+    for name, i in zip(names, keep, strict=True):
+        _refuse_a_channel_ending_early(values[:bases[i][2], i], name, bases[i], where)
     channels = tuple(make_channel(n, values[:bases[i][2], i], sample_rate_hz=bases[i][0],
                                   unit=cells[i][1], start_time_s=bases[i][1])
                      for n, i in zip(names, keep, strict=True))
@@ -321,6 +323,25 @@ def read_csv(path: str | os.PathLike[str], *, sample_rate_hz: float | None = Non
         metadata["reader_notes"] = notes
     return Measurement(source=where, channels=channels, sha256=file_sha256(path),
                        file_format="csv", metadata=metadata)
+
+
+def _refuse_a_channel_ending_early(column: np.ndarray, name: str,
+                                   base: tuple[float, float, int], where: str) -> None:
+    """Refuse a channel whose last cells are empty while its time column goes on, saying
+    where it ends: it was refused as "892 non-finite samples (NaN/inf), first at index 3000",
+    which does not say that the column is short."""
+    if column.size == 0 or not np.isnan(column[-1]):
+        return
+    given = np.flatnonzero(~np.isnan(column))
+    last = int(given[-1]) if given.size else -1
+    if last < 0:
+        raise InputFileError(f"{where}: channel {name!r} holds no value in any of its "
+                             f"{column.size} rows; expected a value in every row")
+    rate, start, rows = base
+    raise InputFileError(
+        f"{where}: channel {name!r} ends early, at data row {last + 1} of {rows} (t = "
+        f"{start + last / rate:.9g} s): the {rows - last - 1} rows after it hold no value; "
+        "expected a value in every row its time column has")
 
 
 def _pair_time_columns(cells: list[tuple[str, str]], time_index: int | None,
