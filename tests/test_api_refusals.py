@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import math
 from pathlib import Path
 
 import numpy as np
@@ -75,6 +76,33 @@ def test_a_fill_above_a_full_cell_is_refused():
     assert n_full == full  # the limit itself: a full cell
     with pytest.raises(ParameterError, match=r"^fill_percent 150 %: more than a full cell"):
         particles_per_cell(150.0)  # was (1.5 x capacity, capacity): more than fit
+
+
+@pytest.mark.parametrize(("keywords", "said"), [
+    # inf found a steady state at once: the transient's SDC stored as steady
+    ({"steady_relative_tolerance": math.inf},
+     "steady_relative_tolerance: expected a finite fraction >= 0, got inf"),
+    ({"steady_relative_tolerance": math.nan},  # never steady: always the cap
+     "steady_relative_tolerance: expected a finite fraction >= 0, got nan"),
+    ({"steady_relative_tolerance": -0.1},
+     "steady_relative_tolerance: expected a finite fraction >= 0, got -0.1"),
+    ({"friction_regularisation_m_s": math.nan},  # simulated and stored in the run's record
+     "friction_regularisation_m_s: expected a speed > 0 m/s, got nan"),
+    ({"friction_regularisation_m_s": -1e-6},
+     "friction_regularisation_m_s: expected a speed > 0 m/s, got -1e-06"),
+    # refused as "non-finite positions; try a smaller time step", "overlap above 5 %"
+    ({"alpha_pp": math.nan}, "alpha_pp: expected an Eq. 3 damping constant >= 0 (0: elastic), "
+                             "got nan"),
+    ({"alpha_pw": -1.0}, "alpha_pw: expected an Eq. 3 damping constant >= 0 (0: elastic), "
+                         "got -1.0"),
+    ({"max_transient_s": math.inf},  # an OverflowError of the cap's ceil()
+     "max_transient_s: expected a finite time >= 0 s, got inf"),
+])
+def test_dem_settings_no_run_can_honour_are_refused_when_made(keywords, said):
+    with pytest.raises(ParameterError) as refused:
+        DemConfig(**keywords)
+    assert str(refused.value) == said
+    assert DemConfig(steady_relative_tolerance=0.0, alpha_pp=0.0).alpha_pp == 0.0  # the limits
 
 
 def test_a_fill_of_no_particle_is_refused_naming_the_keyword_before_any_work(tmp_path):

@@ -164,8 +164,27 @@ class DemConfig:
             raise ParameterError(f"steady_cycles: expected >= 1, got {self.steady_cycles}")
         if self.block_cycles < 1 or self.max_transient_cycles < 0:
             raise ParameterError("block_cycles >= 1 and max_transient_cycles >= 0 expected")
-        if not self.max_transient_s >= 0:
-            raise ParameterError(f"max_transient_s: expected >= 0 s, got {self.max_transient_s}")
+        if not (math.isfinite(self.max_transient_s) and self.max_transient_s >= 0):
+            # inf was an OverflowError of the transient cap's ceil()
+            raise ParameterError(f"max_transient_s: expected a finite time >= 0 s, got "
+                                 f"{self.max_transient_s}")
+        # NaN or a negative tolerance never found a steady state, inf found one at once (an SDC
+        # of the transient stored as steady); a NaN, zero or negative regularisation speed and
+        # a negative or NaN Eq. 3 constant were simulated, stored in the run's record, or
+        # refused as "try a smaller time step"
+        if not (math.isfinite(self.steady_relative_tolerance)
+                and self.steady_relative_tolerance >= 0):
+            raise ParameterError(f"steady_relative_tolerance: expected a finite fraction >= 0, "
+                                 f"got {self.steady_relative_tolerance}")
+        if not (math.isfinite(self.friction_regularisation_m_s)
+                and self.friction_regularisation_m_s > 0):
+            raise ParameterError(f"friction_regularisation_m_s: expected a speed > 0 m/s, got "
+                                 f"{self.friction_regularisation_m_s}")
+        for name in ("alpha_pp", "alpha_pw"):
+            alpha = getattr(self, name)
+            if alpha is not None and not (math.isfinite(alpha) and alpha >= 0):
+                raise ParameterError(f"{name}: expected an Eq. 3 damping constant >= 0 (0: "
+                                     f"elastic), got {alpha}")
         if self.samples_per_cycle < 8:
             raise ParameterError(f"samples_per_cycle: expected >= 8, "
                                  f"got {self.samples_per_cycle}")
