@@ -453,3 +453,32 @@ def test_a_negative_measured_sdc_is_refused_in_a_table_and_kept_for_a_synthetic_
     table = _table(tmp_path, HEADER + "500,5,50,-0.01\n1000,5,50,0.6\n500,1,50,0.2\n")
     with pytest.raises(InputFileError, match=r"m\.csv, line 2: sdc -0\.01: expected >= 0$"):
         read_measured_table(table)
+
+
+@pytest.mark.parametrize(("keywords", "said"), [
+    # ran every DEM run, then "calibration: the posterior is zero everywhere within the bounds"
+    ({"discrepancy": float("inf")}, "discrepancy: expected a finite fraction >= 0, got inf"),
+    ({"discrepancy_floor": float("inf")},
+     "discrepancy_floor: expected a finite SDC >= 0, got inf"),
+    ({"seed": -1}, "seed: expected a whole number >= 0, got -1"),  # numpy's, naming nothing
+    # numpy's "expected non-negative integer", after every DEM run
+    ({"posterior_seed": -1}, "posterior_seed: expected a whole number >= 0, got -1"),
+    ({"workers": 0}, "workers: expected a whole number >= 1, got 0"),  # ran; --workers 0 not
+    ({"workers": 1.5}, "workers: expected a whole number, got 1.5"),
+    ({"priors": "rolling_friction=0:inf"},  # was "are empty"
+     "rolling_friction: bounds 0:inf are not finite (expected finite LOW < HIGH)"),
+])
+def test_calibrate_refuses_what_its_options_refuse_before_any_dem_run(tmp_path, monkeypatch,
+                                                                      keywords, said):
+    def no_dem_run(*args, **kwargs):
+        raise AssertionError("a DEM run was asked for")
+
+    monkeypatch.setattr(calibrate_module, "run_requests", no_dem_run)
+    points = [MeasuredPoint(f, a, 50.0, sdc, 0.01)
+              for f, a, sdc in ((500, 5, 0.6), (1000, 5, 0.6), (500, 1, 0.2), (100, 5, 0.3))]
+    store = tmp_path / "dem.h5"
+    with pytest.raises(ParameterError) as refused:
+        calibrate(points, fit="rolling_friction", store_path=store, progress=False,
+                  **{"workers": 1, **keywords})
+    assert str(refused.value) == said
+    assert not store.exists()
