@@ -29,6 +29,7 @@ from pidcore.model import (
 from pidcore.records import Channel, Measurement
 from pidcore.signal import analyze_power
 from pidcore.specimen import paper_specimen
+from pidcore.store import Store
 
 
 @pytest.mark.parametrize(("keywords", "named"), [
@@ -328,3 +329,22 @@ def test_listing_functions_refuse_a_store_given_for_its_listing(tmp_path):
         build_report_table("runs.h5", None, None)
     assert len(build_report_table(runs, None, None)) == len(runs.groupby(
         ["frequency_hz", "acceleration_g", "fill_percent"]))  # one row per DEM load case
+
+
+def test_saving_a_fill_of_no_particle_is_refused_as_analyze_refuses_it(tmp_path):
+    # `pidcore analyze --fill 0.5` is refused (0.5 % of the paper cell's 22 acrylic spheres
+    # rounds to none); save_analyses stored a script's LoadCase(500, 1, 0.5), a load case no
+    # DEM run can be made at
+    record = analyze_file(_SAMPLE)
+    store = tmp_path / "s.h5"
+    with pytest.raises(ParameterError) as refused:
+        save_analyses(store, [record], stated=[("run.csv", LoadCase(500.0, 1.0, 0.5), "script")])
+    assert str(refused.value) == ("run.csv: fill_percent 0.5 % of 22 particles rounds to none; "
+                                  "expected >= 2.28 %; was 0.5 meant as 50 %?")
+    assert not store.exists()
+    # the least fill holding a particle is saved; a record naming its specimen is of its cell
+    save_analyses(store, [record], stated=[("run.csv", LoadCase(500.0, 1.0, 2.28), "script")])
+    other = tmp_path / "other.h5"
+    save_analyses(other, [record], stated=[("run.csv", LoadCase(500.0, 1.0, 0.5), "script")],
+                  fields=[{"specimen": "big_cells"}])
+    assert Store(other).list_analyses()["fill_percent"].tolist() == [0.5]
