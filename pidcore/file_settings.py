@@ -71,7 +71,7 @@ __all__ = ["ANALYSIS_COLUMNS", "ANALYSIS_SETTINGS_COLUMNS", "AUTO_CHANNEL", "FRE
            "NO_CHANNEL",
            "SETTINGS_COLUMNS", "SPECIMEN_COLUMN", "FileSettings", "SettingsColumn",
            "analysis_overrides", "analyze_with_settings", "check_columns",
-           "resolve_file_settings", "resolve_files"]
+           "resolve_file_settings", "resolve_files", "setting_in_words"]
 
 
 @dataclass(frozen=True)
@@ -169,8 +169,8 @@ def _number(value: object, column: str, spec: SettingsColumn, where: str) -> flo
     if not math.isfinite(number):
         raise refused("is not a finite number")
     if number < 0:
-        # the library takes a signed delay (a late force); a vibrometer only ever lags, and
-        # a negative mass or baseline would add what they are meant to remove
+        # a vibrometer only ever lags (AnalysisOptions refuses a negative delay too, without
+        # the cell), and a negative mass or baseline would add what they are meant to remove
         raise refused("is negative")
     if 0 < number < spec.smallest:
         raise SettingsTableError(
@@ -248,15 +248,45 @@ def _same(a: object, b: object) -> bool:
     return a == b
 
 
-def _words(name: str, value: object) -> str:
-    if name in _WORDS:
-        label, factor, unit = _WORDS[name]
-        return f"{label} {float(value) * factor:g}{unit}"
+#: The analysis settings no settings column states, in words with their unit (those of the
+#: columns: :data:`ANALYSIS_COLUMNS`' labels and units).
+_OTHER_WORDS = {"frequency_hz": ("drive frequency hint", 1.0, " Hz"),
+                "sample_rate_hz": ("sample rate", 1.0, " Hz"),
+                "n_harmonics": ("harmonics analysed", 1.0, "")}
+
+
+def setting_in_words(name: str, value: object) -> tuple[str, str]:
+    """An analysis setting (a :class:`~pidcore.measure.AnalysisOptions` field, or the
+    specimen) as the notes and reports say it: its name in words and its value with the unit
+    of its settings column, e.g. ``("vibrometer delay", "50 µs")`` for ``velocity_delay_s``
+    5e-5, ``("structure mass", "22.2 g")``, ``("force channel", "'Fz'")``. ``None`` is
+    ``"none"``."""
+    if name in _WORDS or name in _OTHER_WORDS:
+        label, factor, unit = _WORDS.get(name) or _OTHER_WORDS[name]
+        return label, "none" if value is None else f"{float(value) * factor:g}{unit}"
+    if value is None:
+        shown = "none"
+    elif isinstance(value, (tuple, list)):
+        shown = ", ".join(map(repr, value))
+    elif isinstance(value, str):
+        shown = repr(value)
+    else:
+        shown = str(value)
     if name == "invert":
-        return "inverted " + ", ".join(map(repr, value))  # type: ignore[arg-type]
+        return "inverted", shown
     if name == SPECIMEN_COLUMN:
-        return f"specimen {value!r}"
-    return f"{name} channel {value!r}"
+        return "specimen", shown
+    if name == "allow_clipped":
+        return "clipped samples", "kept" if value else "refused"
+    if name.endswith("_unit"):
+        return f"{name.removesuffix('_unit')} unit", shown
+    if name in ("force", "velocity", "acceleration"):
+        return f"{name} channel", shown
+    return name, shown
+
+
+def _words(name: str, value: object) -> str:
+    return " ".join(setting_in_words(name, value))
 
 
 @dataclass(frozen=True)
@@ -503,7 +533,8 @@ def _refuse_fill_of_no_particle(path: str | os.PathLike, stated: StatedLoadCase 
     else:
         return
     try:
-        particles_per_cell(stated.fill_percent, stated.material, specimen=cell)
+        # "fill", not the keyword: the fill may come from the file name or a sidecar
+        particles_per_cell(stated.fill_percent, stated.material, specimen=cell, what="fill")
     except PidcoreError as exc:
         if not str(exc).startswith("fill "):  # not about the fill
             raise

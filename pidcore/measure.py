@@ -37,7 +37,7 @@ import numpy as np
 
 from . import defaults
 from .constants import COUNT_UNIT, RATIO_UNIT
-from .errors import ChannelError, ParameterError, SignalError, StoreError, instance_of
+from .errors import ChannelError, ParameterError, SignalError, StoreError, as_given, instance_of
 from .io import assign_roles, read_measurement
 from .records import Channel, Measurement
 from .signal import PowerAnalysis, analyze_channels
@@ -103,6 +103,14 @@ class AnalysisOptions:
             value = getattr(self, name)
             if isinstance(value, float) and value == 0.0:
                 object.__setattr__(self, name, 0.0)
+        delay = self.velocity_delay_s
+        if isinstance(delay, (int, float)) and not isinstance(delay, bool) and delay < 0:
+            # the one rule for a delay a user states (CLI, sidecar, app, script): analyze_power
+            # takes a signed delay, as a start offset between the channels corrects either
+            # way, but a vibrometer's output only ever lags the motion; -50 µs gave a loss
+            # factor shifted by -w tau and saved it
+            raise ParameterError(f"velocity_delay_s: {as_given(delay)} s, expected a delay "
+                                 ">= 0 s (the vibrometer output lags the motion)")
         if isinstance(self.structure_mass_kg, (int, float)) and self.structure_mass_kg == 0:
             # 0 states no mass, as 0 states no correction in the other columns (the app's
             # settings grid starts every row at 0): the baseline then goes off the whole
@@ -482,6 +490,8 @@ def save_analyses(store: Store | str | os.PathLike, results: Sequence[AnalyzedRe
                                  f"{len(given)}")
     for r, given in zip(results, per_result, strict=True):
         _refuse_other_settings(r, given)
+    for (name, case, _), more in zip(stated, extra, strict=True):
+        _refuse_fill_of_no_particle(name, case, (more or {}).get("specimen"))
     store = store if isinstance(store, Store) else Store(store)
     _refuse_the_store_itself(store, results)
     with store.transaction():
@@ -494,6 +504,19 @@ def save_analyses(store: Store | str | os.PathLike, results: Sequence[AnalyzedRe
                 for r, o, (_, case, origin), more in zip(results, per_result, stated, extra,
                                                          strict=True)]
     return SavedAnalyses(keys, notes)
+
+
+def _refuse_fill_of_no_particle(name: str, case: object, specimen: object) -> None:
+    """Refuse a stated fill that rounds to no particle of the paper coupon's cell, as
+    ``pidcore analyze`` refuses it (:mod:`pidcore.file_settings`): a script saved a 0.5 %
+    load case (50 % typed as a fraction) that no DEM run can match. A record naming its
+    specimen is of another cell, which only the caller knows."""
+    from .constants import PARTICLE_MATERIALS
+    from .dem.simulate import particles_per_cell
+    from .loadcase import LoadCase
+
+    if isinstance(case, LoadCase) and not specimen and case.material in PARTICLE_MATERIALS:
+        particles_per_cell(case.fill_percent, case.material, what=f"{name}: fill_percent")
 
 
 def _analyzed_records(results: object) -> list[AnalyzedRecord]:

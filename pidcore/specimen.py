@@ -249,17 +249,20 @@ def _poisson(where: str, value: float) -> None:
         raise _fail(where, f"expected -1 < nu < 0.5, got {value!r}")
 
 
-def particles_for_fill(fill_percent: float, full: int) -> int:
+def particles_for_fill(fill_percent: float, full: int, *, what: str = "fill_percent") -> int:
     """Particles per cell of a fill percentage of ``full`` (the count taken as 100 %).
 
     The one rounding rule of a fill, for ``specimen check`` and ``dem run`` alike: a fill that
     rounds to no particle is refused (an empty cell damps nothing, and its SDC is 0/0).
+    ``what``: how the refusal names the fill, by default the keyword a Python caller gave it
+    by (a front end passes its own: ``--fill``, or ``fill`` where its message says where the
+    fill came from).
     """
-    fill_percent = real_number("fill_percent", fill_percent)
+    fill_percent = real_number(what, fill_percent)
     if not math.isfinite(fill_percent):
-        raise ParameterError(f"fill {fill_percent} %: expected a finite percentage")
+        raise ParameterError(f"{what} {fill_percent} %: expected a finite percentage")
     if fill_percent > 100.0:  # 150 % gave 1.5 full cells of particles, more than fit
-        raise ParameterError(f"fill {as_given(fill_percent)} %: more than a full cell; "
+        raise ParameterError(f"{what} {as_given(fill_percent)} %: more than a full cell; "
                              "expected a packing ratio in (0, 100] %")
     n = int(round(fill_percent / 100.0 * full))
     if n < 1:
@@ -269,8 +272,8 @@ def particles_for_fill(fill_percent: float, full: int) -> int:
         # that holds a particle (1e-9 as 1e-7 % holds none either)
         hint = (f"; was {as_given(fill_percent)} meant as {fill_percent * 100:g} %?"
                 if 0 < fill_percent <= 1.0 and round(fill_percent * full) >= 1 else "")
-        raise ParameterError(f"fill {as_given(fill_percent)} % of {full} particles rounds to none; "
-                             f"expected >= {least:.2f} %{hint}")
+        raise ParameterError(f"{what} {as_given(fill_percent)} % of {full} particles rounds to "
+                             f"none; expected >= {least:.2f} %{hint}")
     return n
 
 
@@ -468,7 +471,8 @@ class Specimen:
             raise _fail("[particles] radius_m", str(exc)) from None
         if self.particles.fill_percent is not None:
             try:
-                particles_for_fill(self.particles.fill_percent, self.capacity_per_cell())
+                particles_for_fill(self.particles.fill_percent, self.capacity_per_cell(),
+                                   what="fill")  # the key is named before it
             except ParameterError as exc:
                 raise _fail("[particles] fill_percent", f"{exc} (the cell's capacity)") \
                     from None

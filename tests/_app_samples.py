@@ -25,8 +25,12 @@ def damper_for(loss_factor: float, frequency_hz: float, mass_kg: float = MASS_KG
 def mass_damper_csv(*, frequency_hz: float = 100.0, acceleration_g: float = 5.0,
                     loss_factor: float = 0.05, sample_rate_hz: float = 10_000.0,
                     duration_s: float = 1.0, noise: float = 1e-3, seed: int = 1,
-                    extra_velocity_phase_rad: float | None = None) -> bytes:
+                    extra_velocity_phase_rad: float | None = None,
+                    velocity_late_s: float = 0.0) -> bytes:
     """CSV bytes ``Time [s],Force [N],Velocity [m/s]`` of a driven mass-damper.
+
+    ``velocity_late_s``: the velocity column recorded that much after the motion (a
+    vibrometer's output delay nobody corrected).
 
     ``extra_velocity_phase_rad`` adds a second velocity column ``Velocity 2 [m/s]`` shifted by
     that phase (a mis-mapped channel for the mapping tests).
@@ -37,6 +41,7 @@ def mass_damper_csv(*, frequency_hz: float = 100.0, acceleration_g: float = 5.0,
     t = np.arange(int(round(duration_s * sample_rate_hz))) / sample_rate_hz
     v = v_amp * np.sin(w * t)
     f = MASS_KG * v_amp * w * np.cos(w * t) + c * v
+    v = v_amp * np.sin(w * (t - velocity_late_s))
     rng = np.random.default_rng(seed)
     f = f + noise * np.max(np.abs(f)) * rng.standard_normal(t.size)
     v = v + noise * v_amp * rng.standard_normal(t.size)

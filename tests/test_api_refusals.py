@@ -5,7 +5,9 @@ else (``cells=2.5`` ran; a fill of 150 % gave one and a half cells of particles)
 
 from __future__ import annotations
 
+import dataclasses
 import json
+import math
 from pathlib import Path
 
 import numpy as np
@@ -13,9 +15,10 @@ import pytest
 
 from pidcore.calibrate import load_calibration
 from pidcore.dem import DemConfig, LoadCase, particles_per_cell, simulate_load_case
+from pidcore.dem.sweep import run_sweep
 from pidcore.errors import ChannelError, ParameterError
 from pidcore.io import read_measurement, read_measurements
-from pidcore.measure import AnalysisOptions, analyze_file
+from pidcore.measure import AnalysisOptions, analyze_file, save_analyses
 from pidcore.model import (
     SdcModel,
     TreatedMode,
@@ -26,6 +29,7 @@ from pidcore.model import (
 from pidcore.records import Channel, Measurement
 from pidcore.signal import analyze_power
 from pidcore.specimen import paper_specimen
+from pidcore.store import Store
 
 
 @pytest.mark.parametrize(("keywords", "named"), [
@@ -71,8 +75,51 @@ def test_simulate_load_case_refuses_a_specimen_path_saying_how_to_read_it():
 def test_a_fill_above_a_full_cell_is_refused():
     n_full, full = particles_per_cell(100.0)
     assert n_full == full  # the limit itself: a full cell
-    with pytest.raises(ParameterError, match=r"^fill 150 %: more than a full cell"):
+    with pytest.raises(ParameterError, match=r"^fill_percent 150 %: more than a full cell"):
         particles_per_cell(150.0)  # was (1.5 x capacity, capacity): more than fit
+
+
+@pytest.mark.parametrize(("keywords", "said"), [
+    # inf found a steady state at once: the transient's SDC stored as steady
+    ({"steady_relative_tolerance": math.inf},
+     "steady_relative_tolerance: expected a finite fraction >= 0, got inf"),
+    ({"steady_relative_tolerance": math.nan},  # never steady: always the cap
+     "steady_relative_tolerance: expected a finite fraction >= 0, got nan"),
+    ({"steady_relative_tolerance": -0.1},
+     "steady_relative_tolerance: expected a finite fraction >= 0, got -0.1"),
+    ({"friction_regularisation_m_s": math.nan},  # simulated and stored in the run's record
+     "friction_regularisation_m_s: expected a speed > 0 m/s, got nan"),
+    ({"friction_regularisation_m_s": -1e-6},
+     "friction_regularisation_m_s: expected a speed > 0 m/s, got -1e-06"),
+    # refused as "non-finite positions; try a smaller time step", "overlap above 5 %"
+    ({"alpha_pp": math.nan}, "alpha_pp: expected an Eq. 3 damping constant >= 0 (0: elastic), "
+                             "got nan"),
+    ({"alpha_pw": -1.0}, "alpha_pw: expected an Eq. 3 damping constant >= 0 (0: elastic), "
+                         "got -1.0"),
+    ({"max_transient_s": math.inf},  # an OverflowError of the cap's ceil()
+     "max_transient_s: expected a finite time >= 0 s, got inf"),
+])
+def test_dem_settings_no_run_can_honour_are_refused_when_made(keywords, said):
+    with pytest.raises(ParameterError) as refused:
+        DemConfig(**keywords)
+    assert str(refused.value) == said
+    assert DemConfig(steady_relative_tolerance=0.0, alpha_pp=0.0).alpha_pp == 0.0  # the limits
+
+
+def test_a_fill_of_no_particle_is_refused_naming_the_keyword_before_any_work(tmp_path):
+    # `pidcore dem run --fill 1` names its option; the library said "fill 1 % of 22 ...",
+    # naming no parameter a script has. 1 % of the 22 acrylic spheres of the paper's cell is
+    # 0.22 of a sphere, rounded to none; 2.28 % is the least fill that rounds to one
+    said = r"^fill_percent 1 % of 22 particles rounds to none; expected >= 2\.28 %"
+    with pytest.raises(ParameterError, match=said):
+        particles_per_cell(1.0)
+    with pytest.raises(ParameterError, match=said):
+        simulate_load_case(LoadCase(500.0, 5.0, 1.0), DemConfig(cells=1))
+    store = tmp_path / "dem.h5"
+    with pytest.raises(ParameterError, match=said):  # the valid case is not run either
+        run_sweep([LoadCase(500.0, 5.0, 50.0), LoadCase(500.0, 5.0, 1.0)], DemConfig(cells=1),
+                  store_path=store, workers=1, progress=False)
+    assert not store.exists()
 
 
 @pytest.mark.parametrize(("keywords", "named"), [
@@ -90,6 +137,24 @@ def test_analysis_options_are_refused_when_made(keywords, named):
     # before: made without a word, and refused (or a TypeError) only once a file was read
     with pytest.raises(ParameterError, match=named):
         AnalysisOptions(**keywords)
+
+
+def test_a_negative_vibrometer_delay_is_refused_by_the_library_as_by_the_cli(tmp_path):
+    # `pidcore analyze --velocity-delay=-5e-5` was refused, AnalysisOptions(velocity_delay_s=
+    # -5e-5) analysed and saved a loss factor shifted by -w tau; the rule is now the options'
+    # own, which the CLI, the sidecar table, the app and a script all make
+    said = (r"^velocity_delay_s: -5e-05 s, expected a delay >= 0 s \(the vibrometer output "
+            r"lags the motion\)$")
+    with pytest.raises(ParameterError, match=said):
+        AnalysisOptions(velocity_delay_s=-5e-5)
+    with pytest.raises(ParameterError, match=said):  # the app's way to a changed setting
+        dataclasses.replace(AnalysisOptions(), velocity_delay_s=-5e-5)
+    assert AnalysisOptions(velocity_delay_s=-0.0).velocity_delay_s == 0.0  # no correction
+    store = tmp_path / "s.h5"
+    with pytest.raises(ParameterError, match=said):  # a script's analyse-and-save
+        options = AnalysisOptions(velocity_delay_s=-5e-5)
+        save_analyses(store, [analyze_file(_SAMPLE, options)], options)
+    assert not store.exists()
 
 
 def test_analyze_power_names_a_sample_rate_that_is_not_a_number():
@@ -264,3 +329,22 @@ def test_listing_functions_refuse_a_store_given_for_its_listing(tmp_path):
         build_report_table("runs.h5", None, None)
     assert len(build_report_table(runs, None, None)) == len(runs.groupby(
         ["frequency_hz", "acceleration_g", "fill_percent"]))  # one row per DEM load case
+
+
+def test_saving_a_fill_of_no_particle_is_refused_as_analyze_refuses_it(tmp_path):
+    # `pidcore analyze --fill 0.5` is refused (0.5 % of the paper cell's 22 acrylic spheres
+    # rounds to none); save_analyses stored a script's LoadCase(500, 1, 0.5), a load case no
+    # DEM run can be made at
+    record = analyze_file(_SAMPLE)
+    store = tmp_path / "s.h5"
+    with pytest.raises(ParameterError) as refused:
+        save_analyses(store, [record], stated=[("run.csv", LoadCase(500.0, 1.0, 0.5), "script")])
+    assert str(refused.value) == ("run.csv: fill_percent 0.5 % of 22 particles rounds to none; "
+                                  "expected >= 2.28 %; was 0.5 meant as 50 %?")
+    assert not store.exists()
+    # the least fill holding a particle is saved; a record naming its specimen is of its cell
+    save_analyses(store, [record], stated=[("run.csv", LoadCase(500.0, 1.0, 2.28), "script")])
+    other = tmp_path / "other.h5"
+    save_analyses(other, [record], stated=[("run.csv", LoadCase(500.0, 1.0, 0.5), "script")],
+                  fields=[{"specimen": "big_cells"}])
+    assert Store(other).list_analyses()["fill_percent"].tolist() == [0.5]

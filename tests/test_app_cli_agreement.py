@@ -223,7 +223,7 @@ def test_a_store_reports_provenance_names_the_settings_its_records_were_analysed
     cli = (tmp_path / "cli" / "report.provenance.txt").read_text().splitlines()
     app = report_files(store)["csv_provenance"][1].decode().splitlines()
     line = next(x for x in cli if x.startswith("parameters: "))
-    assert "velocity_delay_s=a_fill75.csv: 0.0; b_fill50.csv: 5e-05" in line
+    assert "vibrometer delay 0 µs (a_fill75.csv), 50 µs (b_fill50.csv)" in line
     assert line == next(x for x in app if x.startswith("parameters: "))
 
 

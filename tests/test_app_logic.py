@@ -1650,7 +1650,7 @@ def test_a_fill_rounding_to_no_particle_is_a_job_that_says_so_not_a_traceback(tm
     assert refused.state == "failed" and "rounds to none" in refused.message
     assert queued.state in ("queued", "running")
     assert jobs.submitted_text(2, [refused, queued]).startswith(
-        "1 job(s) submitted; 1 not run (fill 1 % of 22 particles rounds to none")
+        "1 job(s) submitted; 1 not run ('fill [%]' 1 % of 22 particles rounds to none")
     assert runner.cancel() == 1 and runner.wait_cancelled(30)
 
 

@@ -408,3 +408,77 @@ def test_a_field_of_value_zero_asks_for_its_prior_by_name(capsys, tmp_path):
     # the way out it names works: with a prior, the specs build
     (spec,) = [s for s in build_specs([field], [f"{field}=0:0.1"]) if s.name == field]
     assert (spec.low, spec.high) == (0.0, 0.1)
+
+
+@pytest.mark.parametrize(("keywords", "said"), [
+    ({"sdc": float("nan")}, "sdc nan: expected a finite number"),
+    ({"sdc_stderr": -0.01}, "sdc_stderr -0.01: expected >= 0"),
+    ({"fill_percent": 0.0}, "fill_percent 0: expected a fill in (0, 100] %"),
+    ({"frequency_hz": float("inf")}, "frequency_hz inf: expected a finite number"),
+    ({"acceleration_g": -5.0}, "acceleration_g -5: expected > 0"),
+    ({"sdc": 42.0}, "sdc 42 is above 6.283 (2 pi, a loss factor of 1: more dissipated per "
+                    "radian than the coupon stores; Table 3's largest is 0.88); expected the "
+                    "SDC as a ratio; was it %?"),
+    ({"sdc": "0.6"}, "sdc: expected a number, got '0.6'"),
+])
+def test_a_scripts_measured_point_is_held_to_the_tables_rules(tmp_path, keywords, said):
+    # `pidcore calibrate --data` refused these rows; MeasuredPoint(..., sdc=nan) was fitted
+    # (a NaN likelihood) and sdc_stderr=-0.01 weighed the point as if measured exactly
+    point = {"frequency_hz": 500.0, "acceleration_g": 5.0, "fill_percent": 50.0, "sdc": 0.6,
+             "sdc_stderr": 0.01}
+    with pytest.raises(ParameterError) as refused:
+        MeasuredPoint(**{**point, **keywords})
+    assert str(refused.value) == said
+    # the table names the row, with the same rule
+    column, value = next(iter(keywords.items()))
+    table = _table(tmp_path, "frequency_hz,acceleration_g,fill_percent,sdc,sdc_stderr\n"
+                   + ",".join(str({**point, column: value}[c]) for c in point) + "\n"
+                   "1000,5,50,0.6,0.01\n500,1,50,0.2,0.01\n")
+    if column != "sdc" or value != "0.6":  # text is what a table holds
+        from pidcore.calibrate import read_measured_table
+        from pidcore.errors import InputFileError
+
+        with pytest.raises(InputFileError) as in_table:
+            read_measured_table(table)
+        assert str(in_table.value) == f"{table}, line 2: {said}"
+
+
+def test_a_negative_measured_sdc_is_refused_in_a_table_and_kept_for_a_synthetic_study(tmp_path):
+    # the docs' calibration audit fits noise draws below 0 as they are; a measured table
+    # (what `pidcore calibrate --data` reads) holds no negative SDC
+    from pidcore.calibrate import read_measured_table
+    from pidcore.errors import InputFileError
+
+    assert MeasuredPoint(500.0, 5.0, 50.0, -0.01, 0.02).sdc == -0.01
+    table = _table(tmp_path, HEADER + "500,5,50,-0.01\n1000,5,50,0.6\n500,1,50,0.2\n")
+    with pytest.raises(InputFileError, match=r"m\.csv, line 2: sdc -0\.01: expected >= 0$"):
+        read_measured_table(table)
+
+
+@pytest.mark.parametrize(("keywords", "said"), [
+    # ran every DEM run, then "calibration: the posterior is zero everywhere within the bounds"
+    ({"discrepancy": float("inf")}, "discrepancy: expected a finite fraction >= 0, got inf"),
+    ({"discrepancy_floor": float("inf")},
+     "discrepancy_floor: expected a finite SDC >= 0, got inf"),
+    ({"seed": -1}, "seed: expected a whole number >= 0, got -1"),  # numpy's, naming nothing
+    # numpy's "expected non-negative integer", after every DEM run
+    ({"posterior_seed": -1}, "posterior_seed: expected a whole number >= 0, got -1"),
+    ({"workers": 0}, "workers: expected a whole number >= 1, got 0"),  # ran; --workers 0 not
+    ({"workers": 1.5}, "workers: expected a whole number, got 1.5"),
+    ({"priors": "rolling_friction=0:inf"},  # was "are empty"
+     "rolling_friction: bounds 0:inf are not finite (expected finite LOW < HIGH)"),
+])
+def test_calibrate_refuses_what_its_options_refuse_before_any_dem_run(tmp_path, monkeypatch,
+                                                                      keywords, said):
+    def no_dem_run(*args, **kwargs):
+        raise AssertionError("a DEM run was asked for")
+
+    monkeypatch.setattr(calibrate_module, "run_requests", no_dem_run)
+    points = [MeasuredPoint(f, a, 50.0, sdc, 0.01)
+              for f, a, sdc in ((500, 5, 0.6), (1000, 5, 0.6), (500, 1, 0.2), (100, 5, 0.3))]
+    store = tmp_path / "dem.h5"
+    with pytest.raises(ParameterError) as refused:
+        calibrate(points, fit="rolling_friction", store_path=store, progress=False,
+                  **{"workers": 1, **keywords})
+    assert str(refused.value) == said
+    assert not store.exists()

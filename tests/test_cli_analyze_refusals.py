@@ -55,6 +55,8 @@ def test_velocity_delay_negative_or_beyond_a_few_periods_is_refused(record_and_s
     path, store = record_and_store
     err = _refused([str(path), f"--velocity-delay={delay}"], store, capsys)
     assert "--velocity-delay" in err and "velocity_delay_s" not in err
+    if delay.startswith("-"):
+        assert f"--velocity-delay: {float(delay):g} s, expected a delay >= 0 s" in err
 
 
 def test_a_real_vibrometer_delay_is_accepted(record_and_store, capsys):

@@ -28,7 +28,7 @@ def test_a_physical_record_raises_no_warning():
 def test_uncorrected_delay_gives_a_negative_loss_factor_and_the_delay_that_explains_it():
     # A velocity recorded 200 µs late turns P by +w tau = 7.2° at 100 Hz: a loss factor of
     # 0.05 (2.9°) becomes about tan(2.9° - 7.2°) = -0.075.
-    rec = _analysis(mass_damper_csv(loss_factor=0.05), velocity_delay_s=-200e-6)
+    rec = _analysis(mass_damper_csv(loss_factor=0.05, velocity_late_s=200e-6))
     (w,) = check_analysis(rec.analysis)
     assert w.check == "negative_loss_factor" and rec.analysis.loss_factor < 0
     # the delay that brings the loss factor to zero: 200 µs minus the 0.05 damping's own

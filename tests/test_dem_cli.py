@@ -237,7 +237,7 @@ def test_a_fill_of_no_particle_names_its_option_and_writes_nothing(tmp_path, cap
     err = capsys.readouterr().err
     option = command[-2]
     assert code == 2 and err.count("\n") == 1
-    assert f"{option} 1: fill 1 % of 22 particles rounds to none; expected >= 2.28 %" in err
+    assert f"error: {option} 1 % of 22 particles rounds to none; expected >= 2.28 %" in err
     assert not store.exists()
 
 

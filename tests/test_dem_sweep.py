@@ -306,3 +306,26 @@ def test_pooled_workers_skip_a_run_stored_after_the_sweep_listed_its_cases(tmp_p
                                                     "simulated"]
     runs = Store(store_path).list_dem_runs().set_index("case_key")
     assert runs.loc[run_key(CASES[0], CONFIG), "created_utc"] == stamp  # the first kept
+
+
+@pytest.mark.parametrize(("arguments", "said"), [
+    ({"workers": 0},  # ran on every core; `dem sweep --workers 0` is refused
+     "workers: expected a positive number of processes, got 0"),
+    ({"workers": 1.5}, "workers: expected a whole number, got 1.5"),  # a TypeError of range()
+    ({"config": None},  # a TypeError of asdict() naming nothing
+     "config: expected a DemConfig, got NoneType None (e.g. DemConfig(cells=2))"),
+    ({"cases": LoadCase(500.0, 5.0, 50.0)},  # "'LoadCase' object is not iterable"
+     "cases: expected a sequence of LoadCase, got one LoadCase; give [case]"),
+    ({"cases": [(500.0, 5.0, 50.0)]},
+     "cases: expected a LoadCase, got tuple (500.0, 5.0, 50.0) (e.g. [LoadCase(500.0, 5.0, "
+     "50.0)])"),
+])
+def test_run_sweep_refuses_what_dem_sweep_refuses_before_the_store_is_touched(tmp_path,
+                                                                             arguments, said):
+    store = tmp_path / "dem.h5"
+    call = {"cases": [LoadCase(500.0, 5.0, 50.0)], "config": DemConfig(cells=1),
+            "store_path": store, "workers": 1, "progress": False, **arguments}
+    with pytest.raises(ParameterError) as refused:
+        run_sweep(**call)
+    assert str(refused.value) == said
+    assert not store.exists()

@@ -115,3 +115,63 @@ def test_text_without_numbers_is_not_called_a_header_without_data(tmp_path):
     with pytest.raises(InputFileError, match=r"report\.csv: no rows of numbers in its 3 lines "
                                              r"\(the first: '\"frequency \[Hz\]\","):
         read_measurement(table)
+
+
+@pytest.mark.parametrize("text", ["Time [s]\n0\n0.001\n0.002\n", "Time\n[s]\n0\n0.001\n0.002\n",
+                                  '"Time [s]",\n0,\n0.001,\n0.002,\n'])
+def test_a_csv_of_only_a_time_column_says_it_has_no_channel(tmp_path, capsys, text):
+    # was "the header has 2 columns but the data rows have 1": 'Time [s]' split at its space
+    path = tmp_path / "times_fill50.csv"
+    path.write_text(text)
+    said = (f"{path}: only a time column ('Time'), no force or velocity channel; expected "
+            "channel columns beside it, e.g. 'Time [s],Force [N],Velocity [m/s]'")
+    with pytest.raises(InputFileError) as refused:
+        read_measurement(path)
+    assert str(refused.value) == said
+    from pidcore.cli import main
+
+    store = tmp_path / "s.h5"
+    assert main(["analyze", str(path), "--store", str(store)]) == 2
+    assert capsys.readouterr().err == f"pidcore analyze: error: {said}\n"
+    assert not store.exists()
+
+
+def test_a_one_column_csv_is_that_column_and_a_wider_header_still_says_so(tmp_path):
+    # a lone channel is read as one (named without its unit) and asks for the sample rate;
+    # a header of two columns over data rows of one is still refused as such
+    lone = tmp_path / "force.csv"
+    lone.write_text("Force [kN]\n1\n2\n3\n")
+    (channel,) = read_measurement(lone, sample_rate_hz=1000.0).channels
+    assert (channel.name, channel.quantity) == ("Force", "force")
+    np.testing.assert_array_equal(channel.data, [1e3, 2e3, 3e3])  # kN -> N, exact
+    wider = tmp_path / "wider.csv"
+    wider.write_text("Time [s]\tForce [N]\n0\n0.001\n0.002\n")
+    with pytest.raises(InputFileError, match=r"the header has 2 columns but the data rows "
+                                             r"have 1$"):
+        read_measurement(wider)
+
+
+def test_a_csv_channel_shorter_than_its_time_column_says_where_it_ends(tmp_path, capsys):
+    # 'Velocity' ends at row 4 of 6 (trailing empty cells): was "channel 'Velocity': 2
+    # non-finite samples (NaN/inf), first at index 4", which did not say the column is short
+    rows = [f"{k / 1000},{k},{'' if k >= 4 else k}" for k in range(6)]
+    path = tmp_path / "short_fill50.csv"
+    path.write_text("Time [s],Force [N],Velocity [m/s]\n" + "\n".join(rows) + "\n")
+    # the 4th row's time: 3 ms, from the 1 kHz time column
+    said = (f"{path}: channel 'Velocity' ends early, at data row 4 of 6 (t = 0.003 s): the 2 "
+            "rows after it hold no value; expected a value in every row its time column has")
+    with pytest.raises(InputFileError) as refused:
+        read_measurement(path)
+    assert str(refused.value) == said
+    from pidcore.cli import main
+
+    store = tmp_path / "s.h5"
+    assert main(["analyze", str(path), "--store", str(store)]) == 2
+    assert capsys.readouterr().err == f"pidcore analyze: error: {said}\n"
+    assert not store.exists()
+    empty = tmp_path / "empty_column.csv"
+    empty.write_text("Time [s],Force [N],Velocity [m/s]\n"
+                     + "\n".join(f"{k / 1000},{k}," for k in range(6)) + "\n")
+    with pytest.raises(InputFileError, match=r"channel 'Velocity' holds no value in any of "
+                                             r"its 6 rows; expected a value in every row$"):
+        read_measurement(empty)

@@ -16,6 +16,7 @@ from pidcore.model import (
     coupon_vibrated_mass_kg,
     equivalent_damping_coefficient,
     harmonic_response,
+    load_paper_table3,
     paper_particles_mass_kg,
     time_domain_response,
 )
@@ -148,3 +149,26 @@ def test_multiple_solutions_flagged_and_largest_returned():
     above = residual(np.geomspace(r.amplitude_m[0] * (1 + 1e-6), x_hi, 20000))
     assert np.any(np.diff(np.sign(below)) != 0)  # a smaller root exists
     assert np.all(above > 0)  # none larger than the one returned
+
+
+@pytest.mark.parametrize(("keywords", "said"), [
+    # measured the transient from rest as the steady state
+    ({"settle_cycles": -1}, "settle_cycles: expected >= 0 (or None), got -1"),
+    ({"measure_cycles": 0}, "measure_cycles: expected >= 1, got 0"),  # numpy's ValueError
+    ({"rtol": float("nan")},  # integrated for ever
+     "rtol: expected a finite relative tolerance > 0, got nan"),
+    ({"force_amplitude_n": "2"}, "force_amplitude_n: expected a number, got '2'"),
+])
+def test_time_domain_response_refuses_settings_it_cannot_honour(keywords, said):
+    model = SdcModel.from_table(load_paper_table3())
+    mode = TreatedMode(natural_frequency_hz=300.0, modal_mass_kg=0.5,
+                       structural_damping_ratio=0.005, treated_area_m2=0.01, fill_percent=50.0,
+                       coupon_vibrated_mass_kg=0.07)
+    call = {"frequency_hz": 300.0, "force_amplitude_n": 2.0, "measure_cycles": 3,
+            "settle_cycles": 20, **keywords}
+    with pytest.raises(ParameterError) as refused:
+        time_domain_response(model, mode, **call)
+    assert str(refused.value) == said
+    if "force_amplitude_n" in keywords:  # harmonic balance takes it by the same rule
+        with pytest.raises(ParameterError, match="^force_amplitude_n: expected a number"):
+            harmonic_response(model, mode, frequencies_hz=[300.0], force_amplitude_n="2")

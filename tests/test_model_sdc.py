@@ -219,6 +219,38 @@ def test_clip_to_range_holds_edge_value(model):
     assert model.evaluate(10, 0.2, 10, clip_to_range=True) == model(25, 1, 50)
 
 
+@pytest.mark.parametrize(("point", "shown"), [
+    ((0.0, 5.0, 500.0), "fill_percent=0 %, acceleration_g=5 g, frequency_hz=500 Hz"),
+    ((150.0, 5.0, 500.0), "fill_percent=150 %, acceleration_g=5 g, frequency_hz=500 Hz"),
+    ((50.0, -5.0, 500.0), "fill_percent=50 %, acceleration_g=-5 g, frequency_hz=500 Hz"),
+    ((50.0, 5.0, 0.0), "fill_percent=50 %, acceleration_g=5 g, frequency_hz=0 Hz"),
+])
+def test_clip_to_range_holds_no_edge_for_what_is_no_load_case(model, point, shown):
+    # a fill of 0 % (no particle) or 150 % got the 25 or 90 % SDC, and equivalent_damper_table
+    # (clip_to_range=True) a c_eq for it; `pidcore model damper --fills 0` is refused
+    from pidcore.model import equivalent_damper_table
+
+    said = (f"SdcModel: point ({shown}) is no load case (expected fill_percent in (0, 100] %, "
+            "acceleration_g and frequency_hz > 0); clip_to_range=True holds the edge value of "
+            "load cases beyond the grid only")
+    with pytest.raises(ParameterError) as refused:
+        model.evaluate(*point, clip_to_range=True)
+    assert str(refused.value) == said
+    fill, acceleration, frequency = point
+    with pytest.raises(ParameterError) as in_table:
+        equivalent_damper_table(model, fills_percent=[fill], accelerations_g=[acceleration],
+                                frequencies_hz=[frequency], vibrated_mass_kg=0.07,
+                                clip_to_range=True)
+    assert str(in_table.value) == said
+
+
+def test_clip_to_range_is_a_bool(model):
+    # "no" is truthy: it clipped
+    with pytest.raises(ParameterError, match=r"^clip_to_range: expected True or False, "
+                                             r"got 'no'$"):
+        model.evaluate(50, 12, 2000, clip_to_range="no")
+
+
 def test_contains_edges(model):
     assert model.contains((25, 1, 50)) and model.contains((90, 10, 1000))
     assert model.contains((50, 10 * (1 + 1e-12), 1000))  # float noise from unit conversions

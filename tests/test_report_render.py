@@ -246,3 +246,41 @@ def test_writing_shows_a_bar_over_figures_and_formats_only_when_asked(tmp_path, 
     # one figure and two formats: three files (tqdm skips redraws closer than 0.1 s: which)
     assert "writing report" in err and "0/3" in err, repr(err)
     assert re.search(r"\b[123]/3\b", err), repr(err)
+
+
+def test_provenance_says_its_parameters_as_quantities_with_units_not_keywords():
+    # the footer read "parameters: velocity_delay_s=5e-05, structure_mass_kg=0.0222, ...", the
+    # Python keywords, where a reader of the report expects the quantity and its unit (the
+    # words and units of the notes and the settings table, the app's fields)
+    from dataclasses import fields
+
+    from pidcore.compare import Tolerances
+    from pidcore.measure import AnalysisOptions
+
+    options = AnalysisOptions(
+        force="Fz", velocity="V", acceleration="A", velocity_delay_s=5e-5,
+        mass_below_gauge_kg=0.012, baseline_loss_factor=0.002, structure_mass_kg=0.0222,
+        frequency_hz=500.0, n_harmonics=3, sample_rate_hz=25600.0, allow_clipped=True,
+        force_unit="kN", velocity_unit="mm/s", acceleration_unit="g", invert=("Fz", "V"))
+    tolerances = Tolerances()
+    parameters = {**options.parameters(),
+                  **{f.name: getattr(tolerances, f.name) for f in fields(tolerances)},
+                  "pool": True}
+    line = collect_provenance(parameters=parameters).lines()[2]
+    assert line == (
+        "parameters: force channel 'Fz'; velocity channel 'V'; acceleration channel 'A'; "
+        "vibrometer delay 50 µs; mass below gauge 12 g; baseline loss factor 0.002; "
+        "structure mass 22.2 g; drive frequency hint 500 Hz; harmonics analysed 3; "
+        "sample rate 25600 Hz; clipped samples kept; force unit 'kN'; velocity unit 'mm/s'; "
+        "acceleration unit 'g'; inverted 'Fz', 'V'; frequency tolerance 1 %; acceleration "
+        "tolerance 5 %; fill tolerance 0.5 percentage points; DEM settings and specimens "
+        "pooled yes")
+    # every option a report can list has words: a keyword in the line is one without
+    assert not re.search(r"\w_\w|=", line)
+    # one that differs between files: per file, in the same words
+    per_file = collect_provenance(parameters={
+        "velocity_delay_s": {"a_fill50.csv": 0.0, "b_fill50.csv": 2e-4},
+        "structure_mass_kg": {"a_fill50.csv": None, "b_fill50.csv": 0.0483}}).lines()[2]
+    assert per_file == ("parameters: vibrometer delay 0 µs (a_fill50.csv), 200 µs "
+                        "(b_fill50.csv); structure mass none (a_fill50.csv), 48.3 g "
+                        "(b_fill50.csv)")

@@ -316,7 +316,8 @@ def test_report_analyses_each_file_with_its_row_and_lists_differing_parameters(t
                                                                "b_fill50.csv": 3e-4}
     assert stored["specimen"].fillna("").tolist() == ["", "coupon_B"]
     provenance = (tmp_path / "rep" / "report.provenance.txt").read_text(encoding="utf-8")
-    assert "velocity_delay_s=a_fill50.csv: 0.0001; b_fill50.csv: 0.0003" in provenance
+    assert "parameters: vibrometer delay 100 µs (a_fill50.csv), 300 µs (b_fill50.csv);" \
+        in provenance
     assert table.name in provenance
 
 
@@ -330,7 +331,7 @@ def test_report_cli_option_overrides_the_sidecar_with_a_note(tmp_path, capsys):
     said = capsys.readouterr().out
     assert ("note: a_fill50.csv: --velocity-delay (vibrometer delay 300 µs) overrides column "
             "velocity_delay_us '200'") in said
-    assert "velocity_delay_s=0.0003" in (out / "report.provenance.txt").read_text()
+    assert "parameters: vibrometer delay 300 µs;" in (out / "report.provenance.txt").read_text()
 
 
 def test_report_keeps_a_sidecar_specimen_beside_specimen_and_says_so(tmp_path):

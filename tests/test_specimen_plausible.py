@@ -168,7 +168,8 @@ def test_a_fill_of_no_particle_is_refused_by_check_as_by_dem_run():
         Specimen.from_text(text, source="s.toml")
     steel = load_specimen(STEEL)
     capacity = steel.capacity_per_cell()
-    with pytest.raises(ParameterError, match=f"fill 1 % of {capacity} particles rounds to none"):
+    with pytest.raises(ParameterError,
+                       match=f"^fill_percent 1 % of {capacity} particles rounds to none"):
         particles_per_cell(1.0, specimen=steel, fill_reference="capacity")
     # the least fill the message names does give one particle
     import re

@@ -330,7 +330,7 @@ class DemJobRunner:
                     # says why, as `pidcore dem run` refuses it; the other cases run
                     self._counter += 1
                     job = DemJob(f"job{self._counter:04d}", case, config, key, specimen,
-                                 state="failed", message=f"not run: {exc}")
+                                 state="failed", message=f"not run: {page_terms(str(exc))}")
                     job.finished = time.time()
                     self._jobs.append(job)
                     created.append(job)

@@ -21,7 +21,7 @@ from .. import defaults
 from ..compare.align import steady_stated
 from ..constants import STANDARD_GRAVITY
 from ..dem.simulate import DemConfig, LoadCase
-from ..errors import ParameterError
+from ..errors import ParameterError, real_number, whole_number
 from ..specimen import (
     Specimen,
     calibrated_name,
@@ -270,7 +270,7 @@ def check_point_fills(points: Sequence[MeasuredPoint], specimen: Specimen,
     for p in points:
         try:
             particles_per_cell(p.fill_percent, specimen=specimen,
-                               fill_reference=config.fill_reference)
+                               fill_reference=config.fill_reference, what="fill")
         except ParameterError as exc:
             where = f"{p.source}, line {p.row}" if p.row is not None else \
                 (p.source or "measured point")
@@ -354,8 +354,17 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: str | Sequence[str],
                              f"got {cross_validate!r}")
     if cross_validate == "loo":
         check_enough_points(points, [spec.name for spec in specs], leave_one_out=True)
-    if not discrepancy_floor >= 0:
-        raise ParameterError(f"discrepancy_floor: expected >= 0, got {discrepancy_floor}")
+    if not (math.isfinite(real_number("discrepancy_floor", discrepancy_floor))
+            and discrepancy_floor >= 0):
+        raise ParameterError(f"discrepancy_floor: expected a finite SDC >= 0, got "
+                             f"{discrepancy_floor}")
+    # before any DEM run, as the CLI's --seed and --workers are: seed=-1 was numpy's
+    # "expected non-negative integer" naming nothing, posterior_seed=-1 that after every DEM
+    # run, and workers=0 or -1 ran without a word
+    for name, value, least in (("seed", seed, 0), ("posterior_seed", posterior_seed, 0),
+                               ("workers", workers, 1)):
+        if whole_number(name, value) < least:
+            raise ParameterError(f"{name}: expected a whole number >= {least}, got {value}")
     notes = []
     if all(p.sdc_stderr == 0 for p in points):
         notes.append("no sdc_stderr in the data: measurement error is carried by the "

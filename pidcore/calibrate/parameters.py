@@ -28,7 +28,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..errors import ParameterError, as_given
+from ..errors import ParameterError, as_given, real_number
 
 if TYPE_CHECKING:  # pragma: no cover
     from ..specimen import Specimen
@@ -60,9 +60,12 @@ class ParameterSpec:
             raise ParameterError(f"{self.name}: no default prior bounds (they are 0.5 .. 1.5 "
                                  f"x a positive value; this one is {as_given(self.default)}); "
                                  f"give priors={self.name}=LOW:HIGH")
-        if not (math.isfinite(self.low) and math.isfinite(self.high) and self.low < self.high):
-            raise ParameterError(f"{self.name}: bounds {as_given(self.low)}:"
-                                 f"{as_given(self.high)} are empty (expected LOW < HIGH)")
+        bounds = f"{self.name}: bounds {as_given(self.low)}:{as_given(self.high)}"
+        if not (math.isfinite(self.low) and math.isfinite(self.high)):
+            # 0:inf was said to be "empty"
+            raise ParameterError(f"{bounds} are not finite (expected finite LOW < HIGH)")
+        if not self.low < self.high:
+            raise ParameterError(f"{bounds} are empty (expected LOW < HIGH)")
         if self.prior == "normal":
             if not self.prior_sd > 0:
                 raise ParameterError(f"{self.name}: prior sd must be > 0, got "
@@ -296,8 +299,10 @@ def build_specs(fit: Sequence[str], priors: Sequence[str] = (), *,
         spec = replace(parameter_spec(name, specimen), **changes.get(name, {}))
         spec.check()
         specs.append(spec)
-    if discrepancy is not None and not discrepancy >= 0:
-        raise ParameterError(f"discrepancy: expected >= 0, got {discrepancy}")
+    if discrepancy is not None and not (math.isfinite(real_number("discrepancy", discrepancy))
+                                        and discrepancy >= 0):
+        # inf ran every DEM run, then said "the posterior is zero everywhere"
+        raise ParameterError(f"discrepancy: expected a finite fraction >= 0, got {discrepancy}")
     check_domains(specs, specimen, given)
     return specs
 

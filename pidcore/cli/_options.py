@@ -7,7 +7,7 @@ import sys
 from pathlib import Path
 
 from .. import defaults
-from ..errors import ParameterError, as_given
+from ..errors import ParameterError
 from ..measure import AnalysisOptions
 
 #: Help of ``--store`` where it names the default store.
@@ -176,14 +176,10 @@ def analysis_options(args: argparse.Namespace) -> AnalysisOptions:
     def given(value: float | None) -> float:
         return 0.0 if value is None else value
 
-    delay = given(args.velocity_delay)
-    if not delay >= 0:  # NaN too
-        # the library takes a signed delay (a late force); a vibrometer only ever lags
-        raise ParameterError(f"--velocity-delay {as_given(delay)}: expected a delay "
-                             ">= 0 s (the vibrometer output lags the motion)")
     return AnalysisOptions(
         force=args.force, velocity=args.velocity, acceleration=args.acceleration,
-        velocity_delay_s=delay, mass_below_gauge_kg=given(args.mass_below_gauge),
+        velocity_delay_s=given(args.velocity_delay),
+        mass_below_gauge_kg=given(args.mass_below_gauge),
         baseline_loss_factor=given(args.baseline_loss_factor),
         structure_mass_kg=args.structure_mass, frequency_hz=args.frequency,
         n_harmonics=args.harmonics, sample_rate_hz=args.sample_rate,

@@ -281,15 +281,9 @@ def _check_fill(fill: float, option: str, args: argparse.Namespace, specimen,
     from ..loadcase import check_fill_range
 
     check_fill_range(fill, option)
-    try:
-        particles_per_cell(fill, material, specimen=specimen,
-                           fill_reference=args.fill_reference)
-    except ParameterError as exc:
-        if not str(exc).startswith("fill "):  # not about this fill (e.g. --fill-reference)
-            raise
-        # (a fraction typed for a percentage is asked about by particles_for_fill, as for
-        # analyze)
-        raise ParameterError(f"{option} {as_given(fill)}: {exc}") from None
+    # (a fraction typed for a percentage is asked about by particles_for_fill, as for analyze)
+    particles_per_cell(fill, material, specimen=specimen, fill_reference=args.fill_reference,
+                       what=option)
 
 
 def _fill(args: argparse.Namespace, specimen, material: str) -> float:

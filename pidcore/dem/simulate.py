@@ -164,8 +164,27 @@ class DemConfig:
             raise ParameterError(f"steady_cycles: expected >= 1, got {self.steady_cycles}")
         if self.block_cycles < 1 or self.max_transient_cycles < 0:
             raise ParameterError("block_cycles >= 1 and max_transient_cycles >= 0 expected")
-        if not self.max_transient_s >= 0:
-            raise ParameterError(f"max_transient_s: expected >= 0 s, got {self.max_transient_s}")
+        if not (math.isfinite(self.max_transient_s) and self.max_transient_s >= 0):
+            # inf was an OverflowError of the transient cap's ceil()
+            raise ParameterError(f"max_transient_s: expected a finite time >= 0 s, got "
+                                 f"{self.max_transient_s}")
+        # NaN or a negative tolerance never found a steady state, inf found one at once (an SDC
+        # of the transient stored as steady); a NaN, zero or negative regularisation speed and
+        # a negative or NaN Eq. 3 constant were simulated, stored in the run's record, or
+        # refused as "try a smaller time step"
+        if not (math.isfinite(self.steady_relative_tolerance)
+                and self.steady_relative_tolerance >= 0):
+            raise ParameterError(f"steady_relative_tolerance: expected a finite fraction >= 0, "
+                                 f"got {self.steady_relative_tolerance}")
+        if not (math.isfinite(self.friction_regularisation_m_s)
+                and self.friction_regularisation_m_s > 0):
+            raise ParameterError(f"friction_regularisation_m_s: expected a speed > 0 m/s, got "
+                                 f"{self.friction_regularisation_m_s}")
+        for name in ("alpha_pp", "alpha_pw"):
+            alpha = getattr(self, name)
+            if alpha is not None and not (math.isfinite(alpha) and alpha >= 0):
+                raise ParameterError(f"{name}: expected an Eq. 3 damping constant >= 0 (0: "
+                                     f"elastic), got {alpha}")
         if self.samples_per_cycle < 8:
             raise ParameterError(f"samples_per_cycle: expected >= 8, "
                                  f"got {self.samples_per_cycle}")
@@ -230,13 +249,15 @@ def choose_time_step(case: LoadCase, law: ContactLaw, geometry: CellGeometry,
 def particles_per_cell(fill_percent: float, material_name: str | None = None, *,
                        specimen: Specimen | None = None,
                        geometry: CellGeometry | None = None,
-                       fill_reference: str = defaults.DEM_FILL_REFERENCE) -> tuple[int, int]:
+                       fill_reference: str = defaults.DEM_FILL_REFERENCE,
+                       what: str = "fill_percent") -> tuple[int, int]:
     """(particles per cell, count taken as 100 %) for a fill percentage.
 
     The particles and cell are the ``specimen``'s (default: the paper's coupon with
     ``material_name`` particles); ``geometry`` overrides its cell.
     ``fill_reference="capacity"``: 100 % is :func:`~pidcore.dem.geometry.cell_capacity`;
-    ``"paper"``: 36 particles, refused when 36 do not fit the cell.
+    ``"paper"``: 36 particles, refused when 36 do not fit the cell. ``what``: how a refused
+    fill is named (:func:`pidcore.specimen.particles_for_fill`).
     """
     specimen = specimen or paper_specimen(material_name or "acrylic")
     material_name = specimen.particles.material
@@ -259,7 +280,7 @@ def particles_per_cell(fill_percent: float, material_name: str | None = None, *,
     else:
         raise ParameterError(f"fill_reference: expected one of {FILL_REFERENCES}, "
                              f"got {fill_reference!r}")
-    return particles_for_fill(fill_percent, full), full
+    return particles_for_fill(fill_percent, full, what=what), full
 
 
 def _kernel_specializations() -> int:

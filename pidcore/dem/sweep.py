@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..constants import DriveDirection, ParticleMaterial
-from ..errors import ParameterError, SimulationError
+from ..errors import ParameterError, SimulationError, instance_of, whole_number
 from ..records import json_safe
 from ..specimen import Specimen
 from .persist import (
@@ -372,6 +372,20 @@ def run_sweep(cases: Sequence[LoadCase], config: DemConfig, *,
     """
     from ..store import Store
 
+    # before the store is read, as simulate_load_case and `dem sweep` refuse them: a config of
+    # None or a fraction of a worker were TypeErrors naming nothing, workers=0 ran on every
+    # core where `dem sweep --workers 0` is refused
+    if isinstance(cases, LoadCase):
+        raise ParameterError("cases: expected a sequence of LoadCase, got one LoadCase; give "
+                             "[case]")
+    cases = list(cases)
+    for case in cases:
+        instance_of("cases", case, LoadCase, hint="e.g. [LoadCase(500.0, 5.0, 50.0)]")
+    instance_of("config", config, DemConfig, hint="e.g. DemConfig(cells=2)")
+    instance_of("specimen", specimen, (Specimen, type(None)),
+                hint="read a file with pidcore.specimen.load_specimen(path)")
+    if workers is not None and whole_number("workers", workers) < 1:
+        raise ParameterError(f"workers: expected a positive number of processes, got {workers}")
     start = time.perf_counter()
     store = Store(store_path)
     summary = SweepSummary(store_path=str(Path(store_path)))
@@ -476,9 +490,7 @@ def _run_local(todo: Iterable[tuple[LoadCase, str]], config: DemConfig, workers:
                finish: Callable[[CaseOutcome | str], None], specimen: Specimen | None,
                store_path: str | os.PathLike) -> None:
     todo = list(todo)
-    workers = workers or os.cpu_count() or 1
-    if workers < 1:
-        raise ParameterError(f"workers: expected a positive number of processes, got {workers}")
+    workers = workers or os.cpu_count() or 1  # a given number is checked by run_sweep
     calls = [(case, config, specimen, store_path, key) for case, key in todo]
     if workers == 1 or len(todo) == 1:
         for call in calls:

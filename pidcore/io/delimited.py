@@ -171,12 +171,21 @@ def _layout(lines: list[str], where: str) -> tuple[int, str, list[str], list[str
     if not text_rows:
         raise InputFileError(f"{where}: no header row before the numbers; expected names such "
                              "as 'Time [s],Force [N],Velocity [m/s]'")
-    names = _cells(text_rows[-1], delimiter)
+    def header(row: str) -> list[str]:
+        # one column has no delimiter: its header is the whole line ('Time [s]' split at its
+        # space was two columns over data rows of one, refused for that, not for holding no
+        # channel)
+        if n_cols > 1:
+            return _cells(row, delimiter)
+        own = _delimiter([row])  # a header of more columns than the data says so
+        return [row.strip().strip('"').strip()] if own == r"\s+" else _cells(row, own)
+
+    names = header(text_rows[-1])
     units = [""] * len(names)
     if len(text_rows) >= 2 and all(_looks_like_unit(c) for c in names) \
             and any(c.strip() for c in names):
         units = [c.strip().strip("[]()").strip() for c in names]  # a unit row under the names
-        names = _cells(text_rows[-2], delimiter)
+        names = header(text_rows[-2])
         units = (units + [""] * len(names))[:len(names)]
     decimal = "," if (any("," in ln for ln in data) if delimiter != "," else
                       any("," in c for ln in data for c in _cells(ln, delimiter))) else "."
@@ -305,11 +314,15 @@ def read_csv(path: str | os.PathLike[str], *, sample_rate_hz: float | None = Non
     pair_times = _pair_time_columns(cells, time_index, values)
     keep = [i for i in range(len(cells)) if i != time_index and i not in pair_times]
     if not keep:
-        raise InputFileError(f"{where}: only a time column; expected channel columns beside it")
+        raise InputFileError(f"{where}: only a time column ({cells[time_index][0]!r}), no force "
+                             "or velocity channel; expected channel columns beside it, e.g. "
+                             "'Time [s],Force [N],Velocity [m/s]'")
     names = unique_names([cells[i][0] or f"column {i + 1}" for i in keep])
     bases = _pair_time_bases(values, cells, pair_times, keep, names, where=where,
                              main=(rate, start_time, values.shape[0]),
                              given_rate=sample_rate_hz, notes=notes)
+    for name, i in zip(names, keep, strict=True):
+        _refuse_a_channel_ending_early(values[:bases[i][2], i], name, bases[i], where)
     channels = tuple(make_channel(n, values[:bases[i][2], i], sample_rate_hz=bases[i][0],
                                   unit=cells[i][1], start_time_s=bases[i][1])
                      for n, i in zip(names, keep, strict=True))
@@ -318,6 +331,25 @@ def read_csv(path: str | os.PathLike[str], *, sample_rate_hz: float | None = Non
         metadata["reader_notes"] = notes
     return Measurement(source=where, channels=channels, sha256=file_sha256(path),
                        file_format="csv", metadata=metadata)
+
+
+def _refuse_a_channel_ending_early(column: np.ndarray, name: str,
+                                   base: tuple[float, float, int], where: str) -> None:
+    """Refuse a channel whose last cells are empty while its time column goes on, saying
+    where it ends: it was refused as "892 non-finite samples (NaN/inf), first at index 3000",
+    which does not say that the column is short."""
+    if column.size == 0 or not np.isnan(column[-1]):
+        return
+    given = np.flatnonzero(~np.isnan(column))
+    last = int(given[-1]) if given.size else -1
+    if last < 0:
+        raise InputFileError(f"{where}: channel {name!r} holds no value in any of its "
+                             f"{column.size} rows; expected a value in every row")
+    rate, start, rows = base
+    raise InputFileError(
+        f"{where}: channel {name!r} ends early, at data row {last + 1} of {rows} (t = "
+        f"{start + last / rate:.9g} s): the {rows - last - 1} rows after it hold no value; "
+        "expected a value in every row its time column has")
 
 
 def _pair_time_columns(cells: list[tuple[str, str]], time_index: int | None,

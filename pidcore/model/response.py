@@ -29,6 +29,7 @@ the SDC at the nearest edge of the grid and flags the point.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -173,6 +174,14 @@ class HarmonicResponse:
         return plot_harmonic_response(self.to_pandas(), ax=ax)
 
 
+def _check_force(force_amplitude_n: float) -> None:
+    # "2" was a TypeError of numpy's isfinite, naming nothing
+    if not (math.isfinite(real_number("force_amplitude_n", force_amplitude_n))
+            and force_amplitude_n > 0):
+        raise ParameterError(f"force_amplitude_n must be finite and > 0, got "
+                             f"{force_amplitude_n!r}")
+
+
 def _sdc_section(model: SdcModel, mode: TreatedMode, frequency_hz: float,
                  clip_to_range: bool):
     """SDC as a function of acceleration [g] (clamped to the grid) at this fill and frequency."""
@@ -225,9 +234,7 @@ def harmonic_response(model: SdcModel, mode: TreatedMode, *, frequencies_hz: np.
     """
     instance_of("model", model, SdcModel, hint="e.g. SdcModel.from_table(load_paper_table3())")
     instance_of("mode", mode, TreatedMode)
-    if not np.isfinite(force_amplitude_n) or force_amplitude_n <= 0:
-        raise ParameterError(f"force_amplitude_n must be finite and > 0, got "
-                             f"{force_amplitude_n!r}")
+    _check_force(force_amplitude_n)
     freqs = np.atleast_1d(np.asarray(frequencies_hz, dtype=float))
     if not np.all(np.isfinite(freqs)) or np.any(freqs <= 0):
         raise ParameterError("frequencies_hz must be finite and > 0")
@@ -321,9 +328,18 @@ def time_domain_response(model: SdcModel, mode: TreatedMode, *, frequency_hz: fl
     """
     instance_of("model", model, SdcModel, hint="e.g. SdcModel.from_table(load_paper_table3())")
     instance_of("mode", mode, TreatedMode)
+    _check_force(force_amplitude_n)
+    # settle_cycles=-1 measured the transient from rest as the steady state; measure_cycles=0
+    # was numpy's "need at least one array"; rtol=nan integrated for ever
     measure_cycles = whole_number("measure_cycles", measure_cycles)
+    if measure_cycles < 1:
+        raise ParameterError(f"measure_cycles: expected >= 1, got {measure_cycles}")
     if settle_cycles is not None:
         settle_cycles = whole_number("settle_cycles", settle_cycles)
+        if settle_cycles < 0:
+            raise ParameterError(f"settle_cycles: expected >= 0 (or None), got {settle_cycles}")
+    if not (math.isfinite(real_number("rtol", rtol)) and rtol > 0):
+        raise ParameterError(f"rtol: expected a finite relative tolerance > 0, got {rtol!r}")
     w = 2.0 * np.pi * frequency_hz
     k, m, c_s = mode.stiffness_n_m, mode.modal_mass_kg, mode.structural_damping_n_s_m
     sdc_of, _ = _sdc_section(model, mode, frequency_hz, True)

@@ -261,7 +261,20 @@ class SdcModel:
         if not all(np.all(np.isfinite(c)) for c in coords):
             raise ParameterError("SdcModel: fill_percent, acceleration_g and frequency_hz must "
                                  "be finite")
+        if not isinstance(clip_to_range, (bool, np.bool_)):  # "no" clipped, being truthy
+            raise ParameterError(f"clip_to_range: expected True or False, got {clip_to_range!r}")
         if clip_to_range:
+            # the edge holds for a load case beyond the grid, not for none: a fill of 0 or
+            # 150 % was given the 25 or 90 % SDC, and a damper table made of it
+            possible = (coords[0] > 0) & (coords[0] <= 100) & (coords[1] > 0) & (coords[2] > 0)
+            if not np.all(possible):
+                i = int(np.argmin(possible))
+                bad = ", ".join(f"{n}={c[i]:g} {_AXIS_UNITS[n]}"
+                                for n, c in zip(AXIS_NAMES, coords, strict=True))
+                raise ParameterError(f"SdcModel: point ({bad}) is no load case (expected "
+                                     "fill_percent in (0, 100] %, acceleration_g and "
+                                     "frequency_hz > 0); clip_to_range=True holds the edge "
+                                     "value of load cases beyond the grid only")
             coords = [np.clip(c, ax[0], ax[-1]) for c, ax in zip(coords, self.axes, strict=True)]
         else:
             inside = self._inside(*coords)

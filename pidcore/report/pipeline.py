@@ -270,14 +270,13 @@ def stored_parameters(analyses: pd.DataFrame | None) -> dict:
 
 def _shared_parameters(per_file: list[tuple[str, dict]]) -> dict:
     """Each parameter as the files share it, one that differs between them as
-    ``"a.uff: 5e-05; b.uff: 0"``."""
+    ``{"a.uff": 5e-05, "b.uff": 0.0}`` (None where a file has none)."""
     names = list(dict.fromkeys(k for _, p in per_file for k in p))
     out: dict[str, object] = {}
     for name in names:
         values = [p.get(name) for _, p in per_file]
-        out[name] = values[0] if all(v == values[0] for v in values) else "; ".join(
-            f"{file}: {'-' if v is None else v}" for (file, _), v in zip(per_file, values,
-                                                                      strict=True))
+        out[name] = values[0] if all(v == values[0] for v in values) else {
+            file: v for (file, _), v in zip(per_file, values, strict=True)}
     return out
 
 

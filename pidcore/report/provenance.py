@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import hashlib
 import platform
-from collections.abc import Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
 from importlib.metadata import PackageNotFoundError, version
@@ -32,6 +32,35 @@ def _package_version(name: str) -> str:
         return "not installed"
 
 
+#: The comparison's parameters in words: keyword -> (words, value in words).
+_COMPARISON_WORDS: dict[str, tuple[str, Callable[[object], str]]] = {
+    "frequency_rtol": ("frequency tolerance", lambda v: f"{float(v) * 100:g} %"),
+    "acceleration_rtol": ("acceleration tolerance", lambda v: f"{float(v) * 100:g} %"),
+    "fill_atol_percent": ("fill tolerance", lambda v: f"{float(v):g} percentage points"),
+    "pool": ("DEM settings and specimens pooled", lambda v: "yes" if v else "no"),
+}
+
+
+def parameter_in_words(name: str, value: object) -> str:
+    """A report parameter as a reader of the report says it: ``"structure mass 22.2 g"``,
+    not the keyword ``structure_mass_kg=0.0222`` (the analysis settings in the words and
+    units of the notes and the settings table: :func:`pidcore.file_settings.setting_in_words`);
+    one that differs between files as ``"vibrometer delay 0 µs (a.csv), 50 µs (b.csv)"``."""
+    from ..file_settings import setting_in_words
+
+    def said(v: object) -> tuple[str, str]:
+        if name in _COMPARISON_WORDS:
+            label, shown = _COMPARISON_WORDS[name]
+            return label, shown(v)
+        return setting_in_words(name, v)
+
+    if isinstance(value, Mapping):
+        values = [(display_path(str(file)), said(v)) for file, v in value.items()]
+        label = values[0][1][0] if values else said(None)[0]
+        return f"{label} " + ", ".join(f"{words[1]} ({file})" for file, words in values)
+    return " ".join(said(value))
+
+
 @dataclass(frozen=True)
 class Provenance:
     """Everything needed to reproduce a report.
@@ -41,7 +70,9 @@ class Provenance:
     versions : mapping
         ``{"pidcore": ..., "python": ..., "numpy": ..., ...}``.
     parameters : mapping
-        Analysis and comparison parameters (name -> value, units in the name).
+        Analysis and comparison parameters (keyword -> value, SI, units in the name; a
+        mapping file -> value for one that differs between the files); :meth:`lines` says
+        them in words (:func:`parameter_in_words`).
     seeds : tuple of int
         Random seeds of the DEM runs in the report.
     inputs : tuple of (str, str)
@@ -71,7 +102,8 @@ class Provenance:
         out = [f"created (UTC): {self.created_utc}",
                "software: " + ", ".join(f"{k} {v}" for k, v in self.versions.items())]
         if self.parameters:
-            out.append("parameters: " + ", ".join(f"{k}={v}" for k, v in self.parameters.items()))
+            out.append("parameters: " + "; ".join(parameter_in_words(k, v)
+                                                  for k, v in self.parameters.items()))
         out.append("seeds: " + (", ".join(str(s) for s in self.seeds) or "none"))
         for name, digest in self.specimens:
             out.append(f"specimen: {name} sha256 {digest}")
