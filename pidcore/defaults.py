@@ -120,7 +120,8 @@ DEM_NOTE_ACCELERATION_G = 20.0
 #: Largest factor by which DEM_SAMPLES_PER_CYCLE samples per drive period may shorten the
 #: contacts' time step: above ~40 kHz (1 MHz typed for 1 kHz) the step shrank 100-fold and the
 #: settling alone (up to DEM_MAX_SETTLE_TIME_S of simulated time) ran for hours without a word;
-#: 1e300 Hz ended in an OverflowError traceback.
+#: 1e300 Hz ended in an OverflowError traceback. Also the most an explicit ``time_step`` may
+#: be shorter than the automatic one (1e-15 s ran for ever).
 DEM_MAX_STEP_SHORTENING = 10.0
 #: Settling ends when every cell's kinetic energy is below this fraction of N m g r.
 DEM_SETTLE_KINETIC_FRACTION = 1e-5

@@ -555,3 +555,32 @@ def test_sweep_says_what_it_saved_not_what_another_sweep_saved(tmp_path, monkeyp
     out = capsys.readouterr().out
     assert out.startswith(f"0 case(s) simulated and saved, 1 already in {store} (1 of them "
                           "saved meanwhile by another process"), out
+
+
+def test_a_far_too_short_time_step_is_refused_before_any_work(capsys, tmp_path):
+    # --time-step 1e-15 (a unit typed twice) had no lower limit: ~1e9 x the automatic step's
+    # steps, a run of years with nothing said; the automatic step of this case is
+    # min(2e-6 s, t_contact / 10) with the paper's acrylic contacts
+    from pidcore import defaults
+    from pidcore.dem import LoadCase
+    from pidcore.dem.contact import ContactLaw
+    from pidcore.dem.simulate import choose_time_step, resolve_specimen
+    from pidcore.errors import ParameterError
+
+    case = LoadCase(100, 5, 50)
+    specimen = resolve_specimen(case, None)
+    law = ContactLaw.for_material(case.material)
+    automatic = choose_time_step(case, law, specimen.geometry(), "auto")
+    store = tmp_path / "s.h5"
+    assert main(["dem", "run", "--frequency", "100", "--acceleration", "5", "--fill", "50",
+                 "--time-step", "1e-15", "--store", str(store), "--no-progress"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--time-step 1e-15 s is" in err
+    assert f"expected >= {automatic / defaults.DEM_MAX_STEP_SHORTENING:.3g} s" in err
+    assert not store.exists()
+    # just above the limit is accepted: a convergence check at up to 10 x the steps
+    shortest = automatic / defaults.DEM_MAX_STEP_SHORTENING
+    assert choose_time_step(case, law, specimen.geometry(), shortest * 1.0000001) \
+        == shortest * 1.0000001
+    with pytest.raises(ParameterError, match=r"time_step .* x shorter than the automatic"):
+        choose_time_step(case, law, specimen.geometry(), shortest * 0.999)

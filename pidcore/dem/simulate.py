@@ -236,13 +236,22 @@ def choose_time_step(case: LoadCase, law: ContactLaw, geometry: CellGeometry,
         t_contact = law.tangential_period()
         what = f"period of a stuck {case.material} tangential spring ({t_contact:.3g} s)"
     safe = t_contact / defaults.DEM_MIN_STEPS_PER_CONTACT
+    automatic = min(defaults.DEM_TIME_STEP_S, safe)
     if requested == "auto":
-        return min(defaults.DEM_TIME_STEP_S, safe)
+        return automatic
     if requested > safe:
         raise ParameterError(
             f"time_step {requested:.3g} s gives {t_contact / requested:.2g} steps per "
             f"{what}; need >= {defaults.DEM_MIN_STEPS_PER_CONTACT}: "
             f"use time_step <= {safe:.3g} s or 'auto'")
+    shortest = automatic / defaults.DEM_MAX_STEP_SHORTENING
+    if requested < shortest:
+        # no step-count limit: 1e-15 s (a unit typed twice) ran for ever without a word
+        raise ParameterError(
+            f"time_step {requested:.3g} s is {automatic / requested:.3g} x shorter than the "
+            f"automatic {automatic:.3g} s, and the run as much longer; expected >= "
+            f"{shortest:.3g} s (at most {defaults.DEM_MAX_STEP_SHORTENING:g} x shorter), "
+            "or 'auto'")
     return float(requested)
 
 
