@@ -80,6 +80,7 @@ import functools
 import hashlib
 import math
 import os
+import sys
 import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -485,6 +486,12 @@ class Specimen:
             data = tomllib.loads(text)
         except tomllib.TOMLDecodeError as exc:
             raise ParameterError(f"{source}: not valid TOML ({exc})") from None
+        except ValueError:
+            # tomllib turns a decimal integer into a Python int, which refuses more than
+            # sys.get_int_max_str_digits() (4300) digits with a bare ValueError
+            raise ParameterError(f"{source}: not a specimen file (an integer of more than "
+                                 f"{sys.get_int_max_str_digits()} digits, which no specimen "
+                                 "value has)") from None
         except RecursionError:  # tomllib parses nested arrays/tables recursively
             raise ParameterError(f"{source}: not a specimen file (arrays or tables nested "
                                  "too deeply for TOML to be read)") from None
