@@ -125,6 +125,16 @@ def _printable(where: str, text: str) -> None:
                            f"(it holds {bad!r})")
 
 
+def _large_count(count: int) -> str:
+    """A whole number of any size for a message (``:g`` overflows past 1e308)."""
+    if count < 10**15:
+        return str(count)
+    if count < 10**300:
+        return f"{count:.3g}"
+    # str() of an int refuses more than 4300 digits; the bit length gives the exponent
+    return f"about 10^{int((count.bit_length() - 1) * math.log10(2))}"
+
+
 def _positive(where: str, value: float, unit: str) -> None:
     if not (math.isfinite(value) and value > 0):
         raise _fail(where, f"expected > 0 {unit}, got {value!r}")
@@ -202,6 +212,11 @@ PLAUSIBLE_RANGES: dict[str, PlausibleRange] = {
 #: steel plate. Sandwich panels weigh 1-20 kg/m^2 (the paper's 2.6); more is a mass in grams
 #: or a cell count that does not describe the coupon.
 MAX_COUPON_AREAL_MASS_KG_M2 = 1000.0
+#: Most coupon area (``[cell] count`` cells' cross-section), m^2: the largest shaker slip
+#: tables and head expanders are about 2 x 2 m, so 100 m^2 leaves room for any coupon. More is
+#: a cell count that does not describe a coupon (10^20 cells of 6.35 mm passed, and a run of
+#: them simulated to the end before the store refused to save its count).
+MAX_COUPON_AREA_M2 = 100.0
 PLAUSIBLE_RANGES["wall_density_kg_m3"] = PLAUSIBLE_RANGES["density_kg_m3"]
 PLAUSIBLE_RANGES["wall_youngs_modulus_pa"] = PLAUSIBLE_RANGES["youngs_modulus_pa"]
 
@@ -451,6 +466,15 @@ class Specimen:
             check_sphere_fits(geometry, r)
         except ParameterError as exc:
             raise _fail("[particles] radius_m", str(exc)) from None
+        cell_area = float(geometry.volume_m3() / self.cell.height_m)
+        # an int compares with a float exactly: a count of thousands of digits is refused here
+        # rather than overflowing the float product below (a traceback)
+        if self.cell.count > MAX_COUPON_AREA_M2 / cell_area:
+            raise _fail("[cell] count",
+                        f"{_large_count(self.cell.count)} cells of {cell_area * 1e6:.4g} mm^2 "
+                        f"are more than {MAX_COUPON_AREA_M2:g} m^2 of coupon; expected the "
+                        "number of cells in the coupon (a shaker-test coupon is at most a few "
+                        "m^2)")
         area = self.cells_area_m2(geometry)
         if self.coupon.mass_kg / area > MAX_COUPON_AREAL_MASS_KG_M2:
             raise _fail("[coupon] mass_kg",

@@ -3,17 +3,20 @@ one line naming the file and key, exit 2, before anything is simulated or stored
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import pytest
 
 from pidcore.cli import main
 from pidcore.errors import ParameterError
-from pidcore.specimen import Specimen
+from pidcore.specimen import MAX_COUPON_AREA_M2, Specimen
 
 REPO = Path(__file__).resolve().parents[1]
 STEEL = REPO / "data_samples" / "specimens" / "steel_6mm.toml"
 TEXT = STEEL.read_text(encoding="utf-8")
+#: One 6.35 mm hexagonal cell's cross-section, m^2: (sqrt(3)/2) d^2.
+STEEL_CELL_AREA_M2 = 3**0.5 / 2 * 6.35e-3**2
 
 
 def _edit(old: str, new: str, text: str = TEXT) -> str:
@@ -38,3 +41,34 @@ def test_an_integer_past_pythons_digit_limit_is_one_line_naming_the_file(tmp_pat
         Specimen.from_text(path.read_text(), source=str(path))
     err = _one_line_exit_2(["specimen", "check", str(path)], capsys)
     assert str(path) in err and "integer of more than" in err
+
+
+@pytest.mark.parametrize("count, shown", [
+    (10**20, "1e+20"),  # fits a float, but not the store's int64: the run was lost at saving
+    ("9" * 4000, "about 10^3999"),  # the float area overflowed: a traceback
+])
+def test_a_cell_count_of_no_coupon_is_refused_naming_the_key(count, shown):
+    message = (rf"s.toml: \[cell\] count: {re.escape(shown)} cells of 34.92 mm\^2 are more than "
+               r"100 m\^2 of coupon")
+    with pytest.raises(ParameterError, match=message):
+        Specimen.from_text(_edit("count = 286", f"count = {count}"), source="s.toml")
+
+
+def test_the_largest_coupon_area_is_kept_and_one_more_cell_refused():
+    # the bound is on the cells' area: the last whole count inside it passes
+    largest = int(MAX_COUPON_AREA_M2 / STEEL_CELL_AREA_M2)
+    kept = Specimen.from_text(_edit("count = 286", f"count = {largest}"))
+    assert kept.cells_area_m2() == pytest.approx(largest * STEEL_CELL_AREA_M2, rel=1e-12)
+    with pytest.raises(ParameterError, match=r"\[cell\] count"):
+        Specimen.from_text(_edit("count = 286", f"count = {largest + 1}"))
+
+
+def test_dem_run_refuses_a_cell_count_of_no_coupon_before_simulating(tmp_path, capsys):
+    path = tmp_path / "many_cells.toml"
+    path.write_text(_edit("count = 286", "count = 100000000000000000000"))
+    store = tmp_path / "runs.h5"
+    err = _one_line_exit_2(["dem", "run", "--specimen", str(path), "--frequency", "400",
+                            "--acceleration", "5", "--cells", "1", "--cycles", "10",
+                            "--store", str(store), "--no-progress"], capsys)
+    assert str(path) in err and "[cell] count" in err
+    assert not store.exists()
