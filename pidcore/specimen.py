@@ -107,6 +107,11 @@ SCHEMA_VERSION = 1
 DEFAULT_TANGENTIAL_STIFFNESS_MODEL: TangentialStiffnessModel = "constant"
 #: The paper's coupon, bundled with the package.
 PAPER_SPECIMEN_NAME = "paper_coupon"
+#: Largest specimen file read, bytes. A specimen is ~1 kB (the bundled files 1-2 kB with their
+#: comments); 256 KiB is a 3000-line file. Beyond it the file is not a specimen: a 4 MB file of
+#: one array took 12 s to parse before its key was refused, and /dev/zero was read until
+#: memory ran out (a MemoryError traceback).
+MAX_SPECIMEN_FILE_BYTES = 256 * 1024
 
 
 def _fail(where: str, message: str) -> ParameterError:
@@ -528,6 +533,10 @@ class Specimen:
     def from_bytes(cls, data: bytes, *, source: str = "<specimen>") -> Specimen:
         """Decode (UTF-8, a byte-order mark allowed) and parse a specimen file's bytes; a file
         that is not UTF-8 is one line naming ``source`` and the line of the bad byte."""
+        if len(data) > MAX_SPECIMEN_FILE_BYTES:
+            raise ParameterError(f"{source}: not a specimen file (more than "
+                                 f"{MAX_SPECIMEN_FILE_BYTES // 1024} KiB; a specimen file is "
+                                 "a few kB of TOML)")
         try:
             # utf-8-sig: Windows editors write a byte-order mark, which TOML does not allow
             text = data.decode("utf-8-sig")
@@ -928,7 +937,10 @@ def load_specimen(path: str | os.PathLike[str]) -> Specimen:
     """Read and check a specimen file; a bad file is one ParameterError line naming it."""
     path = Path(path)
     try:
-        data = path.read_bytes()
+        with path.open("rb") as file:
+            # one byte past the limit tells a file at the limit from a larger one, and a
+            # device or pipe that never ends is not read to the end
+            data = file.read(MAX_SPECIMEN_FILE_BYTES + 1)
     except OSError as exc:
         raise ParameterError(f"{path}: cannot read specimen file ({exc.strerror})") from None
     return Specimen.from_bytes(data, source=str(path))

@@ -10,7 +10,12 @@ import pytest
 
 from pidcore.cli import main
 from pidcore.errors import ParameterError
-from pidcore.specimen import MAX_COUPON_AREA_M2, Specimen
+from pidcore.specimen import (
+    MAX_COUPON_AREA_M2,
+    MAX_SPECIMEN_FILE_BYTES,
+    Specimen,
+    load_specimen,
+)
 
 REPO = Path(__file__).resolve().parents[1]
 STEEL = REPO / "data_samples" / "specimens" / "steel_6mm.toml"
@@ -72,3 +77,28 @@ def test_dem_run_refuses_a_cell_count_of_no_coupon_before_simulating(tmp_path, c
                             "--store", str(store), "--no-progress"], capsys)
     assert str(path) in err and "[cell] count" in err
     assert not store.exists()
+
+
+def _padded(size: int) -> bytes:
+    """The steel specimen padded with a comment to exactly ``size`` bytes."""
+    head = TEXT.encode() + b"# "
+    return head + b"x" * (size - len(head) - 1) + b"\n"
+
+
+def test_a_file_past_the_size_limit_is_refused_unparsed_and_one_at_it_is_read(tmp_path,
+                                                                               capsys):
+    """A 4 MB file of one array took 12 s to parse before its key was refused (the app
+    parses an upload in its script run), and /dev/zero was read until a MemoryError."""
+    at_limit = tmp_path / "at_limit.toml"
+    at_limit.write_bytes(_padded(MAX_SPECIMEN_FILE_BYTES))
+    assert load_specimen(at_limit).hash == Specimen.from_text(TEXT).hash
+    over = tmp_path / "over.toml"
+    over.write_bytes(_padded(MAX_SPECIMEN_FILE_BYTES + 1))
+    message = rf"over.toml: not a specimen file \(more than {MAX_SPECIMEN_FILE_BYTES // 1024} KiB"
+    with pytest.raises(ParameterError, match=message):
+        load_specimen(over)
+    # an upload's bytes (the app's DEM and Calibrate pages) meet the same limit
+    with pytest.raises(ParameterError, match=r"upload.toml: not a specimen file"):
+        Specimen.from_bytes(over.read_bytes(), source="upload.toml")
+    err = _one_line_exit_2(["specimen", "check", str(over)], capsys)
+    assert str(over) in err
