@@ -765,7 +765,11 @@ def _take(table: Mapping[str, Any], section: str, where: str) -> dict[str, Any]:
         if kind == "float":
             if isinstance(value, bool) or not isinstance(value, int | float):
                 raise ParameterError(f"{where} {key}: expected a number, got {value!r}")
-            value = float(value)
+            try:
+                value = float(value)
+            except OverflowError:  # an integer literal past 1.8e308 (a float's would be inf)
+                raise ParameterError(f"{where} {key}: expected a number, got "
+                                     f"{_large_count(value)}, beyond any float") from None
         elif kind == "int":
             if isinstance(value, float) and value.is_integer():
                 value = int(value)

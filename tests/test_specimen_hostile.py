@@ -102,3 +102,18 @@ def test_a_file_past_the_size_limit_is_refused_unparsed_and_one_at_it_is_read(tm
         Specimen.from_bytes(over.read_bytes(), source="upload.toml")
     err = _one_line_exit_2(["specimen", "check", str(over)], capsys)
     assert str(over) in err
+
+
+@pytest.mark.parametrize("old, key", [
+    ("mass_kg = 0.0333", r"\[coupon\] mass_kg"),
+    ("fill_percent = 50.0", r"\[particles\] fill_percent"),
+    ("restitution = 0.9", r"\[pairs.particle_particle\] restitution"),
+])
+def test_an_integer_past_the_float_range_is_one_line_naming_the_key(old, key):
+    """An integer literal past 1.8e308 for a number key was an OverflowError traceback (a
+    float literal there reads as inf and was refused by the range checks)."""
+    text = _edit(old, old.split("=")[0] + "= " + "9" * 400)
+    with pytest.raises(ParameterError,
+                       match=rf"^s.toml: {key}: expected a number, got about 10\^399, beyond "
+                             r"any float$"):
+        Specimen.from_text(text, source="s.toml")
