@@ -126,8 +126,30 @@ def _printable(where: str, text: str) -> None:
     bad = next((c for c in text if ord(c) < 32 or ord(c) == 127 or 0xD800 <= ord(c) <= 0xDFFF),
                None)
     if bad is not None:
-        raise _fail(where, f"expected a name of printable characters, got {text!r} "
+        raise _fail(where, f"expected a name of printable characters, got {_shown(text)} "
                            f"(it holds {bad!r})")
+
+
+#: Longest value or key quoted whole in a message, characters: a specimen's values are a
+#: number or a name; a longer one (a 2-million-item array was quoted whole, a 6 MB error
+#: "line") is shown by its start and its size.
+MAX_SHOWN_CHARS = 80
+
+
+def _clip(text: str) -> str:
+    """``text`` (a repr or a key) for a message: whole where short, else its start and size."""
+    if len(text) <= MAX_SHOWN_CHARS:
+        return text
+    return f"{text[:MAX_SHOWN_CHARS - 20]}... ({len(text)} characters)"
+
+
+def _shown(value: object) -> str:
+    """A refused value for a message, as Python writes it (clipped: :func:`_clip`)."""
+    if isinstance(value, int) and not isinstance(value, bool):
+        return _large_count(value)  # repr refuses more than 4300 digits
+    if isinstance(value, list | tuple) and len(repr(value)) > MAX_SHOWN_CHARS:
+        return f"an array of {len(value)} items ({_clip(repr(value))})"
+    return _clip(repr(value))
 
 
 def _large_count(count: int) -> str:
@@ -307,7 +329,8 @@ class CellSpec:
 
     def __post_init__(self):
         if self.shape not in CELL_SHAPES:
-            raise _fail("[cell] shape", f"expected one of {CELL_SHAPES}, got {self.shape!r}")
+            raise _fail("[cell] shape",
+                        f"expected one of {CELL_SHAPES}, got {_shown(self.shape)}")
         _positive("[cell] inscribed_diameter_m", self.inscribed_diameter_m, "m")
         _plausible("[cell] inscribed_diameter_m", "inscribed_diameter_m",
                    self.inscribed_diameter_m)
@@ -360,7 +383,8 @@ class ParticleSpec:
 
     def __post_init__(self):
         if not self.material or not isinstance(self.material, str):
-            raise _fail("[particles] material", f"expected a name, got {self.material!r}")
+            raise _fail("[particles] material",
+                        f"expected a name, got {_shown(self.material)}")
         _printable("[particles] material", self.material)
         _positive("[particles] radius_m", self.radius_m, "m")
         _plausible("[particles] radius_m", "radius_m", self.radius_m)
@@ -377,7 +401,7 @@ class ParticleSpec:
                 isinstance(self.count_per_cell, bool) or not isinstance(self.count_per_cell, int)
                 or self.count_per_cell < 1):
             raise _fail("[particles] count_per_cell",
-                        f"expected a whole number >= 1, got {self.count_per_cell!r}")
+                        f"expected a whole number >= 1, got {_shown(self.count_per_cell)}")
         if self.fill_percent is not None and not (0 < self.fill_percent <= 100):
             raise _fail("[particles] fill_percent",
                         f"expected 0 < fill <= 100 %, got {self.fill_percent!r}")
@@ -437,7 +461,7 @@ class PairsSpec:
         if self.tangential_stiffness_model not in TANGENTIAL_STIFFNESS_MODELS:
             raise _fail("[pairs] tangential_stiffness_model",
                         f"expected one of {TANGENTIAL_STIFFNESS_MODELS}, "
-                        f"got {self.tangential_stiffness_model!r}")
+                        f"got {_shown(self.tangential_stiffness_model)}")
 
 
 @dataclass(frozen=True)
@@ -459,7 +483,7 @@ class Specimen:
 
     def __post_init__(self):
         if not isinstance(self.name, str) or not self.name:
-            raise _fail("name", f"expected a non-empty name, got {self.name!r}")
+            raise _fail("name", f"expected a non-empty name, got {_shown(self.name)}")
         _printable("name", self.name)
         from .dem.geometry import check_packing_size, check_sphere_fits
 
@@ -503,8 +527,8 @@ class Specimen:
             capacity = self.capacity_per_cell()
             if self.particles.count_per_cell > capacity:
                 raise _fail("[particles] count_per_cell",
-                            f"{self.particles.count_per_cell} particles do not fit the cell "
-                            f"(capacity {capacity})")
+                            f"{_large_count(self.particles.count_per_cell)} particles do not "
+                            f"fit the cell (capacity {capacity})")
 
     # --- construction --------------------------------------------------------------------
 
@@ -754,7 +778,8 @@ def _take(table: Mapping[str, Any], section: str, where: str) -> dict[str, Any]:
         raise ParameterError(f"{where}: expected a table")
     for key in table:
         if key not in schema:
-            raise ParameterError(f"{where} {key}: unknown key; expected one of {list(schema)}")
+            raise ParameterError(f"{where} {_clip(key)}: unknown key; expected one of "
+                                 f"{list(schema)}")
     out: dict[str, Any] = {}
     for key, (required, kind) in schema.items():
         if key not in table:
@@ -764,7 +789,7 @@ def _take(table: Mapping[str, Any], section: str, where: str) -> dict[str, Any]:
         value = table[key]
         if kind == "float":
             if isinstance(value, bool) or not isinstance(value, int | float):
-                raise ParameterError(f"{where} {key}: expected a number, got {value!r}")
+                raise ParameterError(f"{where} {key}: expected a number, got {_shown(value)}")
             try:
                 value = float(value)
             except OverflowError:  # an integer literal past 1.8e308 (a float's would be inf)
@@ -774,9 +799,10 @@ def _take(table: Mapping[str, Any], section: str, where: str) -> dict[str, Any]:
             if isinstance(value, float) and value.is_integer():
                 value = int(value)
             if isinstance(value, bool) or not isinstance(value, int):
-                raise ParameterError(f"{where} {key}: expected a whole number, got {value!r}")
+                raise ParameterError(f"{where} {key}: expected a whole number, got "
+                                     f"{_shown(value)}")
         elif not isinstance(value, str):
-            raise ParameterError(f"{where} {key}: expected text, got {value!r}")
+            raise ParameterError(f"{where} {key}: expected text, got {_shown(value)}")
         out[key] = value
     return out
 
@@ -790,7 +816,7 @@ def _table_material(name: str, where: str, role: str | None):
     if role is not None and row.role != role:
         table = material_table()
         names = ", ".join(table.index[table["role"] == role])
-        raise ParameterError(f"{where}: material {name!r} is a {row.role} material in "
+        raise ParameterError(f"{where}: material {_shown(name)} is a {row.role} material in "
                              f"materials.csv, expected a {role} material ({names}), or "
                              "another name with inline properties")
     return row
@@ -846,7 +872,7 @@ def _complete_from_material(table: dict[str, Any], where: str, name: str, role: 
         if key not in table:
             if row is None:
                 raise ParameterError(
-                    f"{where}: unknown material {name!r} (not in materials.csv) and no "
+                    f"{where}: unknown material {_shown(name)} (not in materials.csv) and no "
                     f"inline {key}")
             table[key] = getattr(row, column)
 
@@ -855,13 +881,13 @@ def _from_mapping(data: Mapping[str, Any], *, source: str) -> Specimen:
     top = _take({k: v for k, v in data.items() if not isinstance(v, Mapping)}, "", "top level")
     for key, value in data.items():
         if isinstance(value, Mapping) and key not in ("cell", "coupon", "particles", "pairs"):
-            raise ParameterError(f"[{key}]: unknown table; expected [cell], [coupon], "
+            raise ParameterError(f"[{_clip(key)}]: unknown table; expected [cell], [coupon], "
                                  "[particles], [pairs], [pairs.particle_particle], "
                                  "[pairs.particle_wall]")
     version = top.get("schema_version", SCHEMA_VERSION)
     if version != SCHEMA_VERSION:
         raise ParameterError(f"schema_version: this pidcore reads version {SCHEMA_VERSION}, "
-                             f"got {version}")
+                             f"got {_shown(version)}")
     for section in ("cell", "coupon", "particles", "pairs"):
         if section not in data:
             raise ParameterError(f"[{section}]: missing table")
@@ -886,7 +912,8 @@ def _from_mapping(data: Mapping[str, Any], *, source: str) -> Specimen:
                    "pairs", "[pairs]")
     for key, value in pairs_table.items():
         if isinstance(value, Mapping) and key not in PAIR_NAMES:
-            raise ParameterError(f"[pairs.{key}]: unknown pair; expected one of {PAIR_NAMES}")
+            raise ParameterError(f"[pairs.{_clip(key)}]: unknown pair; expected one of "
+                                 f"{PAIR_NAMES}")
     pairs = {}
     for name in PAIR_NAMES:
         if name not in pairs_table:

@@ -117,3 +117,29 @@ def test_an_integer_past_the_float_range_is_one_line_naming_the_key(old, key):
                        match=rf"^s.toml: {key}: expected a number, got about 10\^399, beyond "
                              r"any float$"):
         Specimen.from_text(text, source="s.toml")
+
+
+@pytest.mark.parametrize("old, new, start", [
+    # a 100 000-item array for a count: its 300 000 characters were the error line
+    ("fill_percent = 50.0", "count_per_cell = [" + "8, " * 100_000 + "]",
+     r"\[particles\] count_per_cell: expected a whole number, got an array of 100000 items "
+     r"\(\[8, 8, "),
+    ("count = 286", "count = 286\n" + "k" * 100_000 + " = 1", r"\[cell\] kkkk"),
+    ("[cell]", "[" + "t" * 100_000 + "]\n[cell]", r"\[tttt"),
+    ('material = "steel"', 'material = "' + "m" * 100_000 + '"',
+     r"\[particles\] material: unknown material 'mmmm"),
+    ('shape = "hexagonal"', 'shape = "' + "h" * 100_000 + '"',
+     r"\[cell\] shape: expected one of \('hexagonal',\), got 'hhhh"),
+    ('name = "steel_6mm"', 'name = "' + "x" * 100_000 + '\\n"',
+     r"name: expected a name of printable characters, got 'xxxx"),
+])
+def test_a_long_value_or_key_is_quoted_by_its_start_and_size(old, new, start):
+    text = _edit(old, new)
+    if "material = " in new:  # an unknown material: its inline density left out
+        text = _edit("density_kg_m3 = 7850.0\n", "", text)
+    with pytest.raises(ParameterError) as info:
+        Specimen.from_text(text, source="s.toml")
+    message = str(info.value)
+    assert re.match(rf"s.toml: {start}", message), message[:300]
+    # the value's start and its size, not its whole text: a message stays a line to read
+    assert len(message) < 400 and "characters)" in message, message[:300]
