@@ -877,7 +877,25 @@ def _complete_from_material(table: dict[str, Any], where: str, name: str, role: 
             table[key] = getattr(row, column)
 
 
+def _tables_are_tables(node: Mapping[str, Any], names: tuple[str, ...], prefix: str) -> None:
+    """Refuse a table of the schema written as an array of tables or as a value: either was
+    reported as an unknown key of the level above (``[pairs] particle_wall: unknown key;
+    expected one of ['tangential_stiffness_model']`` for ``[[pairs.particle_wall]]``)."""
+    for name in names:
+        if name in node and not isinstance(node[name], Mapping):
+            value = node[name]
+            got = (f"an array of tables [[{prefix}{name}]]"
+                   if isinstance(value, list) and value and all(isinstance(v, Mapping)
+                                                                 for v in value)
+                   else f"{prefix}{name} = {_shown(value)}")
+            raise ParameterError(f"[{prefix}{name}]: expected one table [{prefix}{name}], "
+                                 f"got {got}")
+
+
 def _from_mapping(data: Mapping[str, Any], *, source: str) -> Specimen:
+    _tables_are_tables(data, ("cell", "coupon", "particles", "pairs"), "")
+    if isinstance(data.get("pairs"), Mapping):
+        _tables_are_tables(data["pairs"], PAIR_NAMES, "pairs.")
     top = _take({k: v for k, v in data.items() if not isinstance(v, Mapping)}, "", "top level")
     for key, value in data.items():
         if isinstance(value, Mapping) and key not in ("cell", "coupon", "particles", "pairs"):

@@ -143,3 +143,20 @@ def test_a_long_value_or_key_is_quoted_by_its_start_and_size(old, new, start):
     assert re.match(rf"s.toml: {start}", message), message[:300]
     # the value's start and its size, not its whole text: a message stays a line to read
     assert len(message) < 400 and "characters)" in message, message[:300]
+
+
+@pytest.mark.parametrize("old, new, message", [
+    ("[pairs.particle_wall]", "[[pairs.particle_wall]]",
+     r"\[pairs.particle_wall\]: expected one table \[pairs.particle_wall\], got an array of "
+     r"tables \[\[pairs.particle_wall\]\]$"),
+    ("[cell]", "[[cell]]",
+     r"\[cell\]: expected one table \[cell\], got an array of tables \[\[cell\]\]$"),
+    ("[pairs.particle_particle]", "[pairs]\nparticle_particle = 3\n[pairs.unused]",
+     r"\[pairs.particle_particle\]: expected one table \[pairs.particle_particle\], got "
+     r"pairs.particle_particle = 3$"),
+])
+def test_a_known_table_written_as_an_array_or_a_value_is_named_as_such(old, new, message):
+    """`[[pairs.particle_wall]]` was "[pairs] particle_wall: unknown key; expected one of
+    ['tangential_stiffness_model']": a known table called unknown."""
+    with pytest.raises(ParameterError, match="^s.toml: " + message):
+        Specimen.from_text(_edit(old, new), source="s.toml")
