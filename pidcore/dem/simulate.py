@@ -56,6 +56,7 @@ from .. import defaults, interrupt
 from ..constants import (
     DAMPING_COEFFICIENTS,
     FILL_REFERENCES,
+    PARTICLE_MATERIALS,
     STANDARD_GRAVITY,
     START_PACKINGS,
     START_PROTOCOLS,
@@ -627,8 +628,11 @@ def simulate_load_case(case: LoadCase, config: DemConfig | None = None, *,
 
         # the impact calibration builds its law from the tables by material name: refuse a
         # specimen whose law differs from that (it would calibrate another contact); the k_t
-        # model may differ, the calibrating impact is head-on (no tangential spring)
+        # model may differ, the calibrating impact is head-on (no tangential spring). A
+        # material the tables do not hold is refused before the tables are asked for it (that
+        # refusal named --material, which an own specimen's user never gave)
         if (case.material != specimen.particles.material
+                or case.material not in PARTICLE_MATERIALS
                 or law != ContactLaw.for_material(
                     case.material, alpha_pp=config.alpha_pp, alpha_pw=config.alpha_pw,
                     tangential_stiffness_model=law.tangential_stiffness_model)):
