@@ -495,7 +495,7 @@ def _steady_start(dissipated: np.ndarray, work: np.ndarray, config: DemConfig) -
 def required_steady_cycles(case: LoadCase, config: DemConfig) -> int:
     if config.steady_cycles is not None:
         return config.steady_cycles
-    return max(defaults.DEM_MIN_STEADY_CYCLES, config.block_cycles)
+    return defaults.dem_automatic_steady_cycles(config.block_cycles)
 
 
 def resolve_specimen(case: LoadCase, specimen: Specimen | None) -> Specimen:
@@ -756,6 +756,11 @@ def config_parameters(case: LoadCase, config: DemConfig) -> dict:
     """Flat dict of every input (JSON-safe) for records and stores."""
     out = {f"case_{k}": v for k, v in asdict(case).items()}
     out.update({f"config_{k}": v for k, v in asdict(config).items()})
+    if config.steady_cycles == defaults.dem_automatic_steady_cycles(config.block_cycles):
+        # the same run as steady_cycles=None, so the same key: `--cycles 80`, the documented
+        # default, simulated again beside the default's stored run and made a report row of
+        # its own ("steady cycles 80" beside "auto")
+        out["config_steady_cycles"] = None
     return {k: ("" if v is None else v) for k, v in out.items()}
 
 
