@@ -87,6 +87,14 @@ DEM_TANGENTIAL_MODEL = "stick_slip"
 DEM_TANGENTIAL_REFERENCE_SPEED_M_S = 0.3
 #: Cycles per block for steady-state detection (block means compared).
 DEM_STEADY_BLOCK_CYCLES = 10
+
+
+def dem_automatic_steady_cycles(block_cycles: int = DEM_STEADY_BLOCK_CYCLES) -> int:
+    """Steady-state cycles a DEM run measures where none are asked (``steady_cycles=None``):
+    DEM_MIN_STEADY_CYCLES, at least one block. The one rule for the run and for telling an
+    explicit count that equals it (``--cycles 80``) from another."""
+    return max(DEM_MIN_STEADY_CYCLES, block_cycles)
+
 #: Most particle-steps (steps x particles x cells) of one DEM kernel call while driving; a
 #: block runs in calls of whole cycles, at least one. Ctrl-C is answered between calls (the
 #: kernel runs without the GIL): a 10-cycle block of a resting bed at 50 Hz, 1 g, 8 cells of

@@ -83,6 +83,7 @@ import functools
 import hashlib
 import math
 import os
+import sys
 import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -109,6 +110,11 @@ SCHEMA_VERSION = 1
 DEFAULT_TANGENTIAL_STIFFNESS_MODEL: TangentialStiffnessModel = "constant"
 #: The paper's coupon, bundled with the package.
 PAPER_SPECIMEN_NAME = "paper_coupon"
+#: Largest specimen file read, bytes. A specimen is ~1 kB (the bundled files 1-2 kB with their
+#: comments); 256 KiB is a 3000-line file. Beyond it the file is not a specimen: a 4 MB file of
+#: one array took 12 s to parse before its key was refused, and /dev/zero was read until
+#: memory ran out (a MemoryError traceback).
+MAX_SPECIMEN_FILE_BYTES = 256 * 1024
 
 
 def _fail(where: str, message: str) -> ParameterError:
@@ -123,8 +129,40 @@ def _printable(where: str, text: str) -> None:
     bad = next((c for c in text if ord(c) < 32 or ord(c) == 127 or 0xD800 <= ord(c) <= 0xDFFF),
                None)
     if bad is not None:
-        raise _fail(where, f"expected a name of printable characters, got {text!r} "
+        raise _fail(where, f"expected a name of printable characters, got {_shown(text)} "
                            f"(it holds {bad!r})")
+
+
+#: Longest value or key quoted whole in a message, characters: a specimen's values are a
+#: number or a name; a longer one (a 2-million-item array was quoted whole, a 6 MB error
+#: "line") is shown by its start and its size.
+MAX_SHOWN_CHARS = 80
+
+
+def _clip(text: str) -> str:
+    """``text`` (a repr or a key) for a message: whole where short, else its start and size."""
+    if len(text) <= MAX_SHOWN_CHARS:
+        return text
+    return f"{text[:MAX_SHOWN_CHARS - 20]}... ({len(text)} characters)"
+
+
+def _shown(value: object) -> str:
+    """A refused value for a message, as Python writes it (clipped: :func:`_clip`)."""
+    if isinstance(value, int) and not isinstance(value, bool):
+        return _large_count(value)  # repr refuses more than 4300 digits
+    if isinstance(value, list | tuple) and len(repr(value)) > MAX_SHOWN_CHARS:
+        return f"an array of {len(value)} items ({_clip(repr(value))})"
+    return _clip(repr(value))
+
+
+def _large_count(count: int) -> str:
+    """A whole number of any size for a message (``:g`` overflows past 1e308)."""
+    if count < 10**15:
+        return str(count)
+    if count < 10**300:
+        return f"{count:.3g}"
+    # str() of an int refuses more than 4300 digits; the bit length gives the exponent
+    return f"about 10^{int((count.bit_length() - 1) * math.log10(2))}"
 
 
 def _positive(where: str, value: float, unit: str) -> None:
@@ -204,6 +242,11 @@ PLAUSIBLE_RANGES: dict[str, PlausibleRange] = {
 #: steel plate. Sandwich panels weigh 1-20 kg/m^2 (the paper's 2.6); more is a mass in grams
 #: or a cell count that does not describe the coupon.
 MAX_COUPON_AREAL_MASS_KG_M2 = 1000.0
+#: Most coupon area (``[cell] count`` cells' cross-section), m^2: the largest shaker slip
+#: tables and head expanders are about 2 x 2 m, so 100 m^2 leaves room for any coupon. More is
+#: a cell count that does not describe a coupon (10^20 cells of 6.35 mm passed, and a run of
+#: them simulated to the end before the store refused to save its count).
+MAX_COUPON_AREA_M2 = 100.0
 PLAUSIBLE_RANGES["wall_density_kg_m3"] = PLAUSIBLE_RANGES["density_kg_m3"]
 PLAUSIBLE_RANGES["wall_youngs_modulus_pa"] = PLAUSIBLE_RANGES["youngs_modulus_pa"]
 
@@ -292,7 +335,8 @@ class CellSpec:
 
     def __post_init__(self):
         if self.shape not in CELL_SHAPES:
-            raise _fail("[cell] shape", f"expected one of {CELL_SHAPES}, got {self.shape!r}")
+            raise _fail("[cell] shape",
+                        f"expected one of {CELL_SHAPES}, got {_shown(self.shape)}")
         _positive("[cell] inscribed_diameter_m", self.inscribed_diameter_m, "m")
         _plausible("[cell] inscribed_diameter_m", "inscribed_diameter_m",
                    self.inscribed_diameter_m)
@@ -345,7 +389,8 @@ class ParticleSpec:
 
     def __post_init__(self):
         if not self.material or not isinstance(self.material, str):
-            raise _fail("[particles] material", f"expected a name, got {self.material!r}")
+            raise _fail("[particles] material",
+                        f"expected a name, got {_shown(self.material)}")
         _printable("[particles] material", self.material)
         _positive("[particles] radius_m", self.radius_m, "m")
         _plausible("[particles] radius_m", "radius_m", self.radius_m)
@@ -362,7 +407,7 @@ class ParticleSpec:
                 isinstance(self.count_per_cell, bool) or not isinstance(self.count_per_cell, int)
                 or self.count_per_cell < 1):
             raise _fail("[particles] count_per_cell",
-                        f"expected a whole number >= 1, got {self.count_per_cell!r}")
+                        f"expected a whole number >= 1, got {_shown(self.count_per_cell)}")
         if self.fill_percent is not None and not (0 < self.fill_percent <= 100):
             raise _fail("[particles] fill_percent",
                         f"expected 0 < fill <= 100 %, got {self.fill_percent!r}")
@@ -422,7 +467,7 @@ class PairsSpec:
         if self.tangential_stiffness_model not in TANGENTIAL_STIFFNESS_MODELS:
             raise _fail("[pairs] tangential_stiffness_model",
                         f"expected one of {TANGENTIAL_STIFFNESS_MODELS}, "
-                        f"got {self.tangential_stiffness_model!r}")
+                        f"got {_shown(self.tangential_stiffness_model)}")
 
 
 @dataclass(frozen=True)
@@ -444,7 +489,7 @@ class Specimen:
 
     def __post_init__(self):
         if not isinstance(self.name, str) or not self.name:
-            raise _fail("name", f"expected a non-empty name, got {self.name!r}")
+            raise _fail("name", f"expected a non-empty name, got {_shown(self.name)}")
         _printable("name", self.name)
         from .dem.geometry import check_packing_size, check_sphere_fits
 
@@ -456,6 +501,15 @@ class Specimen:
             check_sphere_fits(geometry, r)
         except ParameterError as exc:
             raise _fail("[particles] radius_m", str(exc)) from None
+        cell_area = float(geometry.volume_m3() / self.cell.height_m)
+        # an int compares with a float exactly: a count of thousands of digits is refused here
+        # rather than overflowing the float product below (a traceback)
+        if self.cell.count > MAX_COUPON_AREA_M2 / cell_area:
+            raise _fail("[cell] count",
+                        f"{_large_count(self.cell.count)} cells of {cell_area * 1e6:.4g} mm^2 "
+                        f"are more than {MAX_COUPON_AREA_M2:g} m^2 of coupon; expected the "
+                        "number of cells in the coupon (a shaker-test coupon is at most a few "
+                        "m^2)")
         area = self.cells_area_m2(geometry)
         if self.coupon.mass_kg / area > MAX_COUPON_AREAL_MASS_KG_M2:
             raise _fail("[coupon] mass_kg",
@@ -480,8 +534,8 @@ class Specimen:
             capacity = self.capacity_per_cell()
             if self.particles.count_per_cell > capacity:
                 raise _fail("[particles] count_per_cell",
-                            f"{self.particles.count_per_cell} particles do not fit the cell "
-                            f"(capacity {capacity})")
+                            f"{_large_count(self.particles.count_per_cell)} particles do not "
+                            f"fit the cell (capacity {capacity})")
 
     # --- construction --------------------------------------------------------------------
 
@@ -492,6 +546,12 @@ class Specimen:
             data = tomllib.loads(text)
         except tomllib.TOMLDecodeError as exc:
             raise ParameterError(f"{source}: not valid TOML ({exc})") from None
+        except ValueError:
+            # tomllib turns a decimal integer into a Python int, which refuses more than
+            # sys.get_int_max_str_digits() (4300) digits with a bare ValueError
+            raise ParameterError(f"{source}: not a specimen file (an integer of more than "
+                                 f"{sys.get_int_max_str_digits()} digits, which no specimen "
+                                 "value has)") from None
         except RecursionError:  # tomllib parses nested arrays/tables recursively
             raise ParameterError(f"{source}: not a specimen file (arrays or tables nested "
                                  "too deeply for TOML to be read)") from None
@@ -504,6 +564,10 @@ class Specimen:
     def from_bytes(cls, data: bytes, *, source: str = "<specimen>") -> Specimen:
         """Decode (UTF-8, a byte-order mark allowed) and parse a specimen file's bytes; a file
         that is not UTF-8 is one line naming ``source`` and the line of the bad byte."""
+        if len(data) > MAX_SPECIMEN_FILE_BYTES:
+            raise ParameterError(f"{source}: not a specimen file (more than "
+                                 f"{MAX_SPECIMEN_FILE_BYTES // 1024} KiB; a specimen file is "
+                                 "a few kB of TOML)")
         try:
             # utf-8-sig: Windows editors write a byte-order mark, which TOML does not allow
             text = data.decode("utf-8-sig")
@@ -722,7 +786,8 @@ def _take(table: Mapping[str, Any], section: str, where: str) -> dict[str, Any]:
         raise ParameterError(f"{where}: expected a table")
     for key in table:
         if key not in schema:
-            raise ParameterError(f"{where} {key}: unknown key; expected one of {list(schema)}")
+            raise ParameterError(f"{where} {_clip(key)}: unknown key; expected one of "
+                                 f"{list(schema)}")
     out: dict[str, Any] = {}
     for key, (required, kind) in schema.items():
         if key not in table:
@@ -732,15 +797,20 @@ def _take(table: Mapping[str, Any], section: str, where: str) -> dict[str, Any]:
         value = table[key]
         if kind == "float":
             if isinstance(value, bool) or not isinstance(value, int | float):
-                raise ParameterError(f"{where} {key}: expected a number, got {value!r}")
-            value = float(value)
+                raise ParameterError(f"{where} {key}: expected a number, got {_shown(value)}")
+            try:
+                value = float(value)
+            except OverflowError:  # an integer literal past 1.8e308 (a float's would be inf)
+                raise ParameterError(f"{where} {key}: expected a number, got "
+                                     f"{_large_count(value)}, beyond any float") from None
         elif kind == "int":
             if isinstance(value, float) and value.is_integer():
                 value = int(value)
             if isinstance(value, bool) or not isinstance(value, int):
-                raise ParameterError(f"{where} {key}: expected a whole number, got {value!r}")
+                raise ParameterError(f"{where} {key}: expected a whole number, got "
+                                     f"{_shown(value)}")
         elif not isinstance(value, str):
-            raise ParameterError(f"{where} {key}: expected text, got {value!r}")
+            raise ParameterError(f"{where} {key}: expected text, got {_shown(value)}")
         out[key] = value
     return out
 
@@ -754,7 +824,7 @@ def _table_material(name: str, where: str, role: str | None):
     if role is not None and row.role != role:
         table = material_table()
         names = ", ".join(table.index[table["role"] == role])
-        raise ParameterError(f"{where}: material {name!r} is a {row.role} material in "
+        raise ParameterError(f"{where}: material {_shown(name)} is a {row.role} material in "
                              f"materials.csv, expected a {role} material ({names}), or "
                              "another name with inline properties")
     return row
@@ -810,22 +880,40 @@ def _complete_from_material(table: dict[str, Any], where: str, name: str, role: 
         if key not in table:
             if row is None:
                 raise ParameterError(
-                    f"{where}: unknown material {name!r} (not in materials.csv) and no "
+                    f"{where}: unknown material {_shown(name)} (not in materials.csv) and no "
                     f"inline {key}")
             table[key] = getattr(row, column)
 
 
+def _tables_are_tables(node: Mapping[str, Any], names: tuple[str, ...], prefix: str) -> None:
+    """Refuse a table of the schema written as an array of tables or as a value: either was
+    reported as an unknown key of the level above (``[pairs] particle_wall: unknown key;
+    expected one of ['tangential_stiffness_model']`` for ``[[pairs.particle_wall]]``)."""
+    for name in names:
+        if name in node and not isinstance(node[name], Mapping):
+            value = node[name]
+            got = (f"an array of tables [[{prefix}{name}]]"
+                   if isinstance(value, list) and value and all(isinstance(v, Mapping)
+                                                                 for v in value)
+                   else f"{prefix}{name} = {_shown(value)}")
+            raise ParameterError(f"[{prefix}{name}]: expected one table [{prefix}{name}], "
+                                 f"got {got}")
+
+
 def _from_mapping(data: Mapping[str, Any], *, source: str) -> Specimen:
+    _tables_are_tables(data, ("cell", "coupon", "particles", "pairs"), "")
+    if isinstance(data.get("pairs"), Mapping):
+        _tables_are_tables(data["pairs"], PAIR_NAMES, "pairs.")
     top = _take({k: v for k, v in data.items() if not isinstance(v, Mapping)}, "", "top level")
     for key, value in data.items():
         if isinstance(value, Mapping) and key not in ("cell", "coupon", "particles", "pairs"):
-            raise ParameterError(f"[{key}]: unknown table; expected [cell], [coupon], "
+            raise ParameterError(f"[{_clip(key)}]: unknown table; expected [cell], [coupon], "
                                  "[particles], [pairs], [pairs.particle_particle], "
                                  "[pairs.particle_wall]")
     version = top.get("schema_version", SCHEMA_VERSION)
     if version != SCHEMA_VERSION:
         raise ParameterError(f"schema_version: this pidcore reads version {SCHEMA_VERSION}, "
-                             f"got {version}")
+                             f"got {_shown(version)}")
     for section in ("cell", "coupon", "particles", "pairs"):
         if section not in data:
             raise ParameterError(f"[{section}]: missing table")
@@ -850,7 +938,8 @@ def _from_mapping(data: Mapping[str, Any], *, source: str) -> Specimen:
                    "pairs", "[pairs]")
     for key, value in pairs_table.items():
         if isinstance(value, Mapping) and key not in PAIR_NAMES:
-            raise ParameterError(f"[pairs.{key}]: unknown pair; expected one of {PAIR_NAMES}")
+            raise ParameterError(f"[pairs.{_clip(key)}]: unknown pair; expected one of "
+                                 f"{PAIR_NAMES}")
     pairs = {}
     for name in PAIR_NAMES:
         if name not in pairs_table:
@@ -905,7 +994,10 @@ def load_specimen(path: str | os.PathLike[str]) -> Specimen:
     """Read and check a specimen file; a bad file is one ParameterError line naming it."""
     path = Path(path)
     try:
-        data = path.read_bytes()
+        with path.open("rb") as file:
+            # one byte past the limit tells a file at the limit from a larger one, and a
+            # device or pipe that never ends is not read to the end
+            data = file.read(MAX_SPECIMEN_FILE_BYTES + 1)
     except OSError as exc:
         raise ParameterError(f"{path}: cannot read specimen file ({exc.strerror})") from None
     return Specimen.from_bytes(data, source=str(path))

@@ -76,6 +76,21 @@ def test_store_round_trip(tmp_path, capsys):
     assert store.has_dem_run(doc["store_key"])
 
 
+def test_a_reused_run_says_its_wall_time_is_the_stored_runs(tmp_path, capsys):
+    """A reused run printed the stored run's "25.4 s wall" as if this command had spent it
+    (the reuse was said only on the last line)."""
+    path = tmp_path / "s.h5"
+    assert main(ARGS + ["--store", str(path)]) == 0
+    (simulated,) = [line for line in capsys.readouterr().out.splitlines()
+                    if line.startswith("numerics")]
+    assert main(ARGS + ["--store", str(path)]) == 0
+    (reused,) = [line for line in capsys.readouterr().out.splitlines()
+                 if line.startswith("numerics")]
+    assert "stored run" not in simulated
+    # the same stored numbers, said to be the stored run's
+    assert reused == simulated + " (the stored run's; nothing simulated now)"
+
+
 def test_steady_window_longer_than_asked_is_announced(capsys):
     # --cycles 5 with blocks of 10 cycles: the window measured is whole blocks, never 5
     assert main(ARGS + ["--json"]) == 0

@@ -235,3 +235,52 @@ def test_runs_of_two_particle_counts_within_the_fill_tolerance_are_two_cases():
     unknown = _runs(("a", 40.0, 12345, 18), ("c", 40.2, 777, 18))
     unknown["particles_per_cell"] = [18.0, math.nan]
     assert [c.n_runs for c in dem_cases(unknown)] == [2]
+
+
+def _stated_cycles(cycles: object, block: int = 10) -> str:
+    params = json.loads(_params(50.0))
+    params.update({"config_steady_cycles": cycles, "config_block_cycles": block})
+    return json.dumps(params)
+
+
+def test_the_automatic_steady_cycles_stated_are_the_defaults_key_identity_and_settings():
+    """`--cycles 80` is the documented default (80 cycles, blocks of 10), the same simulation
+    to the bit, but it was keyed apart from the default's run: simulated again, and a report
+    row of its own ("steady cycles 80" beside "auto")."""
+    from pidcore.compare.align import settings_hash
+
+    assert run_key(CASE, DemConfig(cells=1, steady_cycles=80)) == run_key(CASE,
+                                                                           DemConfig(cells=1))
+    assert run_key(CASE, DemConfig(cells=1, steady_cycles=90)) != run_key(CASE,
+                                                                           DemConfig(cells=1))
+    # with blocks of 100 cycles the automatic count is 100: 80 asks for another run
+    assert run_key(CASE, DemConfig(cells=1, steady_cycles=80, block_cycles=100)) \
+        != run_key(CASE, DemConfig(cells=1, block_cycles=100))
+    # runs stored with 80 stated before: the same simulation and settings as the default's
+    automatic = simulation_identity(_stated_cycles(""), 11)
+    assert simulation_identity(_stated_cycles(80), 11) == automatic
+    assert simulation_identity(_stated_cycles(90), 11) != automatic
+    assert simulation_identity(_stated_cycles(80, block=100), 11) \
+        != simulation_identity(_stated_cycles("", block=100), 11)
+    assert settings_hash(_stated_cycles(80)) == settings_hash(_stated_cycles(""))
+    assert settings_hash(_stated_cycles(90)) != settings_hash(_stated_cycles(""))
+    # one report row of one run, not two rows of "steady cycles 80" and "auto"
+    runs = _runs(("auto", 50.0, 12345, 11), ("stated", 50.0, 12345, 11))
+    runs["parameters_json"] = [_stated_cycles(""), _stated_cycles(80)]
+    table = build_report_table(runs, None, None)
+    assert table["DEM runs [-]"].tolist() == [1]
+    assert table["DEM settings"].str.contains("steady cycles auto").all()
+    assert any("counted once" in n and "the automatic count of steady cycles stated" in n
+               for n in table.attrs["notes"])
+
+
+def test_dem_run_with_the_default_cycles_stated_reuses_the_defaults_run(tmp_path, capsys):
+    store = tmp_path / "runs.h5"
+    case = ["--frequency", "1000", "--acceleration", "5", "--fill", "25", "--cells", "1",
+            "--no-progress", "--store", str(store)]
+    assert main(["dem", "run", *case]) == 0
+    assert "saved to" in capsys.readouterr().out
+    before = store.read_bytes()
+    assert main(["dem", "run", *case, "--cycles", "80"]) == 0
+    assert "reused from" in capsys.readouterr().out
+    assert store.read_bytes() == before  # nothing simulated, nothing written

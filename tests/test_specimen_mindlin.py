@@ -264,3 +264,31 @@ def test_the_sdc_model_does_not_average_mindlin_with_constant_runs():
         select_runs(runs)
     assert select_runs(runs, where={"tangential_stiffness_model": "mindlin"})["sdc"].tolist() \
         == [0.2]
+
+
+def test_specimen_check_says_what_sets_the_time_step(tmp_path, capsys):
+    """The step line said "(auto, for that impact)", the contact time's, also where Mindlin's
+    spring at the largest overlap the DEM takes, a shorter period, set it (2.5 x shorter than
+    the contact for 2 mm tungsten carbide spheres)."""
+    lines = {}
+    for name, specimen in (("constant", PAPER), ("mindlin", MINDLIN)):
+        path = tmp_path / f"{name}.toml"
+        path.write_text(specimen.to_toml())
+        facts = describe(specimen)
+        assert main(["specimen", "check", str(path)]) == 0
+        lines[name] = {line[:16].strip(): line[16:] for line in
+                       capsys.readouterr().out.splitlines()}
+        step = f"{facts['time_step_s']:.4g} s (auto: 1/10 of "
+        if name == "constant":  # the contact is the shorter: its tenth is the step
+            assert facts["contact_time_s"] < facts["tangential_period_s"]
+            assert facts["time_step_s"] == pytest.approx(facts["contact_time_s"] / 10,
+                                                         rel=1e-15)
+            assert lines[name]["time step"] == step + "that contact time)"
+        else:
+            assert facts["tangential_period_s"] < facts["contact_time_s"]
+            assert facts["time_step_s"] == pytest.approx(facts["tangential_period_s"] / 10,
+                                                         rel=1e-15)
+            assert lines[name]["time step"] == step + "the stuck tangential period)"
+            assert lines[name]["contact time"].endswith(
+                "(at the largest overlap the DEM takes, 5 % of the radius)")
+    assert "largest overlap" not in lines["constant"]["contact time"]

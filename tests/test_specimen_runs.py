@@ -494,3 +494,23 @@ def test_specimen_check_names_a_fixture_far_heavier_than_the_coupon(capsys, tmp_
     assert main(["specimen", "check", str(heavy)]) == 0  # a note, not a refusal
     assert "note: [coupon] fixture_mass_kg 35 kg" in capsys.readouterr().out
     assert not [n for n in describe(load_specimen(STEEL))["notes"] if "fixture_mass_kg" in n]
+
+
+def test_a_calibrated_damping_coefficient_is_refused_for_an_own_material_naming_the_option(
+        capsys, tmp_path):
+    """`--damping-coefficient calibrated` with the steel specimen was refused as "--material:
+    unknown material 'steel'", an option the user never gave (the tables were asked for the
+    specimen's material before the specimen was checked against them)."""
+    store = tmp_path / "runs.h5"
+    for command in ("run", "sweep"):
+        load_case = (["--frequency", "500", "--acceleration", "5"] if command == "run" else
+                     ["--frequencies", "500", "--accelerations", "5", "--fills", "50"])
+        code = main(["dem", command, "--specimen", str(STEEL), *load_case, "--cells", "1",
+                     "--cycles", "10", "--damping-coefficient", "calibrated",
+                     "--store", str(store), "--no-progress"])
+        err = capsys.readouterr().err.strip()
+        assert code == 2 and len(err.splitlines()) == 1, err
+        assert "--material" not in err
+        assert "damping_coefficient='calibrated': only for table particles" in err
+        assert "not specimen 'steel_6mm'; use 'eq3'" in err
+        assert not store.exists()

@@ -357,7 +357,7 @@ def _print_run(args: argparse.Namespace, result, case, specimen, *, key: str | N
             out["reused_from_store"] = reused
         print(json.dumps(out))
         return
-    print(format_summary(result))
+    print(format_summary(result, reused=reused))
     for note in said:
         print(f"note            {note}")
     if key is not None:
@@ -404,7 +404,7 @@ def _tangential_stiffness_model(result) -> str:
     return s.pairs.tangential_stiffness_model if s is not None else "constant"
 
 
-def format_summary(result) -> str:
+def format_summary(result, *, reused: bool = False) -> str:
     """Readable multi-line summary with units."""
     c = result.case
     s = result.specimen
@@ -449,7 +449,9 @@ def format_summary(result) -> str:
         f"{result.config.start_protocol.replace('_', ' ')}, k_t "
         f"{_tangential_stiffness_model(result)}",
         f"numerics        dt {result.time_step_s:.4g} s, {result.steps} steps, "
-        f"{result.wall_s:.1f} s wall, {result.particle_steps_per_s:.3g} particle-steps/s",
+        f"{result.wall_s:.1f} s wall, {result.particle_steps_per_s:.3g} particle-steps/s"
+        # a reused run's wall time is the stored run's: this command simulated nothing
+        + (" (the stored run's; nothing simulated now)" if reused else ""),
     ]
     lines += [f"note            {note}" for note in result.notes]
     return "\n".join(lines)

@@ -62,10 +62,25 @@ def format_facts(f: dict, source: str) -> str:
         f"{f['tangential_stiffness_pp_n_m']:.4g}, {f['tangential_stiffness_pw_n_m']:.4g} N/m",
         _tangential_line(f),
         f"contact time    {f['contact_time_s']:.4g} s at {f['reference_impact_speed_m_s']:.3g} "
-        f"m/s (50 Hz, 10 g); stuck tangential period {f['tangential_period_s']:.4g} s",
-        f"time step       {f['time_step_s']:.4g} s (auto, for that impact)",
+        f"m/s (50 Hz, 10 g); stuck tangential period {f['tangential_period_s']:.4g} s"
+        + (f" (at the largest overlap the DEM takes, "
+           f"{defaults.DEM_MAX_OVERLAP_FRACTION * 100:g} % of the radius)"
+           if f["tangential_stiffness_model"] == "mindlin" else ""),
+        f"time step       {f['time_step_s']:.4g} s (auto: {_step_limit(f)})",
         *(f"note: {note}" for note in f["notes"]),
     ])
+
+
+def _step_limit(f: dict) -> str:
+    """What sets the automatic time step (:func:`pidcore.dem.simulate.choose_time_step`): it
+    said "for that impact", read as the contact time, where a Mindlin spring's period (2.5 x
+    shorter than the contact for 2 mm tungsten carbide spheres) set it."""
+    shortest = min(f["contact_time_s"], f["tangential_period_s"])
+    if shortest / defaults.DEM_MIN_STEPS_PER_CONTACT > defaults.DEM_TIME_STEP_S:
+        return f"the {defaults.DEM_TIME_STEP_S:g} s cap"
+    what = ("that contact time" if f["contact_time_s"] <= f["tangential_period_s"]
+            else "the stuck tangential period")
+    return f"1/{defaults.DEM_MIN_STEPS_PER_CONTACT} of {what}"
 
 
 def _tangential_line(f: dict) -> str:

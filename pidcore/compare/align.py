@@ -314,14 +314,27 @@ def stored_parameters(parameters_json: object) -> dict | None:
     import json
 
     if isinstance(parameters_json, dict):
-        return dict(parameters_json)
+        return _automatic_cycles_unstated(dict(parameters_json))
     if not isinstance(parameters_json, str) or not parameters_json:
         return None
     try:
         params = json.loads(parameters_json)
     except ValueError:
         return None
-    return params if isinstance(params, dict) else None
+    return _automatic_cycles_unstated(params) if isinstance(params, dict) else None
+
+
+def _automatic_cycles_unstated(params: dict) -> dict:
+    """``params`` with a stated ``config_steady_cycles`` that equals the automatic count
+    written as unstated (""), as :func:`pidcore.dem.simulate.config_parameters` now writes it:
+    runs stored before with `--cycles 80` are the same simulation and settings as the
+    default's."""
+    block = params.get("config_block_cycles", defaults.DEM_STEADY_BLOCK_CYCLES)
+    steady = params.get("config_steady_cycles")
+    if (isinstance(steady, int) and not isinstance(steady, bool) and isinstance(block, int)
+            and steady == defaults.dem_automatic_steady_cycles(block)):
+        params["config_steady_cycles"] = ""
+    return params
 
 
 def run_settings(parameters_json: object) -> dict | None:

@@ -56,6 +56,7 @@ from .. import defaults, interrupt
 from ..constants import (
     DAMPING_COEFFICIENTS,
     FILL_REFERENCES,
+    PARTICLE_MATERIALS,
     STANDARD_GRAVITY,
     START_PACKINGS,
     START_PROTOCOLS,
@@ -524,7 +525,7 @@ def _steady_start(dissipated: np.ndarray, work: np.ndarray, config: DemConfig) -
 def required_steady_cycles(case: LoadCase, config: DemConfig) -> int:
     if config.steady_cycles is not None:
         return config.steady_cycles
-    return max(defaults.DEM_MIN_STEADY_CYCLES, config.block_cycles)
+    return defaults.dem_automatic_steady_cycles(config.block_cycles)
 
 
 def resolve_specimen(case: LoadCase, specimen: Specimen | None) -> Specimen:
@@ -657,8 +658,11 @@ def simulate_load_case(case: LoadCase, config: DemConfig | None = None, *,
 
         # the impact calibration builds its law from the tables by material name: refuse a
         # specimen whose law differs from that (it would calibrate another contact); the k_t
-        # model may differ, the calibrating impact is head-on (no tangential spring)
+        # model may differ, the calibrating impact is head-on (no tangential spring). A
+        # material the tables do not hold is refused before the tables are asked for it (that
+        # refusal named --material, which an own specimen's user never gave)
         if (case.material != specimen.particles.material
+                or case.material not in PARTICLE_MATERIALS
                 or law != ContactLaw.for_material(
                     case.material, alpha_pp=config.alpha_pp, alpha_pw=config.alpha_pw,
                     tangential_stiffness_model=law.tangential_stiffness_model)):
@@ -782,6 +786,11 @@ def config_parameters(case: LoadCase, config: DemConfig) -> dict:
     """Flat dict of every input (JSON-safe) for records and stores."""
     out = {f"case_{k}": v for k, v in asdict(case).items()}
     out.update({f"config_{k}": v for k, v in asdict(config).items()})
+    if config.steady_cycles == defaults.dem_automatic_steady_cycles(config.block_cycles):
+        # the same run as steady_cycles=None, so the same key: `--cycles 80`, the documented
+        # default, simulated again beside the default's stored run and made a report row of
+        # its own ("steady cycles 80" beside "auto")
+        out["config_steady_cycles"] = None
     return {k: ("" if v is None else v) for k, v in out.items()}
 
 

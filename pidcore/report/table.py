@@ -418,7 +418,8 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
         # named here too: the console's short table has no note column
         notes.append(f"{len(duplicate_rows)} row(s) have stored DEM runs counted once, "
                      "being the same simulation as a run counted (same particles per cell, "
-                     "seed, settings and specimen under another stated fill): "
+                     "seed, settings and specimen under another key: another stated fill, or "
+                     "the automatic count of steady cycles stated): "
                      f"{'; '.join(duplicate_rows)}")
     table.attrs["notes"] = notes
     return table, aligner
