@@ -599,3 +599,36 @@ def test_a_far_too_short_time_step_is_refused_before_any_work(capsys, tmp_path):
         == shortest * 1.0000001
     with pytest.raises(ParameterError, match=r"time_step .* x shorter than the automatic"):
         choose_time_step(case, law, specimen.geometry(), shortest * 0.999)
+
+
+def test_more_cells_than_memory_holds_are_refused_before_any_work(capsys, tmp_path):
+    # --cells 1000000000 packed cells for hours before running out of memory
+    import numpy as np
+
+    from pidcore.dem.simulate import (
+        _physical_memory_bytes,
+        check_cells_fit_memory,
+        particles_per_cell,
+        state_bytes_per_cell,
+    )
+    from pidcore.dem.state import CellsState
+
+    n, _ = particles_per_cell(50, "acrylic")
+    # the estimate is the state's real size: the arrays CellsState allocates
+    state = CellsState.from_positions(np.zeros((3, n, 3)), mass_kg=1e-5)
+    arrays = [state.pos, state.vel, state.omg, state.frc, state.trq, state.spring_pp,
+              state.spring_pw]
+    assert sum(a.nbytes for a in arrays) == 3 * state_bytes_per_cell(n)
+    total = _physical_memory_bytes()
+    most = total // state_bytes_per_cell(n)
+    check_cells_fit_memory(most, n)  # the largest that fits is accepted
+    store = tmp_path / "s.h5"
+    for command in (["dem", "run", "--fill", "50", "--frequency", "100", "--acceleration", "5"],
+                    ["dem", "sweep", "--fills", "50", "--frequencies", "100,200",
+                     "--accelerations", "5"]):
+        assert main([*command, "--cells", str(most + 1), "--store", str(store),
+                     "--no-progress"]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and f"--cells {most + 1}: the state of" in err
+        assert f"expected at most {most} cells" in err
+        assert not store.exists()

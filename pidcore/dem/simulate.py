@@ -562,6 +562,38 @@ def check_drive_stroke(case: LoadCase, *, what: str = "load case") -> None:
             "the frequency typed in kHz, or the acceleration in m/s^2?")
 
 
+def state_bytes_per_cell(particles: int) -> int:
+    """Bytes of a cell's DEM state (:class:`~pidcore.dem.state.CellsState`: five 3-vectors
+    per particle and the contact histories of every pair and particle-wall slot)."""
+    from .geometry import WALL_NAMES
+    from .kernel import N_HISTORY
+
+    return 8 * (15 * particles + N_HISTORY * particles * (particles + len(WALL_NAMES)))
+
+
+def _physical_memory_bytes() -> int | None:
+    """This machine's physical memory, bytes (None where the OS does not say)."""
+    import os
+
+    try:
+        return int(os.sysconf("SC_PHYS_PAGES")) * int(os.sysconf("SC_PAGE_SIZE"))
+    except (AttributeError, OSError, ValueError):
+        return None
+
+
+def check_cells_fit_memory(cells: int, particles: int, *, what: str = "cells") -> None:
+    """Refuse, before any work, more cells than this machine's memory holds the state of:
+    ``--cells 1000000000`` packed cells for hours before running out of memory."""
+    per_cell = state_bytes_per_cell(particles)
+    total = _physical_memory_bytes()
+    if total is None or cells * per_cell <= total:
+        return
+    raise ParameterError(
+        f"{what} {cells}: the state of {cells} cells of {particles} particles needs "
+        f"{cells * per_cell / 1e9:.3g} GB, more than this machine's {total / 1e9:.3g} GB of "
+        f"memory; expected at most {total // per_cell} cells")
+
+
 def check_drive(case: LoadCase, config: DemConfig | None = None,
                 specimen: Specimen | None = None, *, what: str = "load case") -> None:
     """Refuse, before any simulation, a drive :func:`simulate_load_case` refuses: a stroke no
@@ -580,6 +612,9 @@ def check_drive(case: LoadCase, config: DemConfig | None = None,
     check_drive_sampling(case, dt_s=period / steps_per_cycle, contact_step_s=dt_req,
                          samples_per_cycle=config.samples_per_cycle,
                          what=what.split("/")[0])  # the frequency's option
+    n, _ = particles_per_cell(case.fill_percent, specimen=specimen,
+                              fill_reference=config.fill_reference)
+    check_cells_fit_memory(config.cells, n)
 
 
 def check_drive_sampling(case: LoadCase, *, dt_s: float, contact_step_s: float,
@@ -646,6 +681,7 @@ def simulate_load_case(case: LoadCase, config: DemConfig | None = None, *,
     law = contact_law(specimen, alpha_pp=config.alpha_pp, alpha_pw=config.alpha_pw)
     n, full = particles_per_cell(case.fill_percent, specimen=specimen,
                                  fill_reference=config.fill_reference)
+    check_cells_fit_memory(config.cells, n)
     dt_req = choose_time_step(case, law, geometry, config.time_step, config.tangential_model)
     spc_samples = config.samples_per_cycle
     period = 1.0 / case.frequency_hz
