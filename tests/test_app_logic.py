@@ -460,7 +460,7 @@ def test_report_downloads_hold_the_saved_numbers(tmp_path, good_csv, options):
     store_file = tmp_path / "store.h5"
     uploads.save_records(store_file, [_file(rec, options)])
     files = report_files(store_file)
-    assert set(files) == {"csv", "md", "html", "tex", "pdf", "csv_provenance"}
+    assert set(files) == {"csv", "md", "html", "tex", "pdf", "csv_provenance", "zip"}
     name, data, mime = files["pdf"]
     assert name.endswith(".pdf") and data.startswith(b"%PDF") and mime == "application/pdf"
     import io
@@ -1522,6 +1522,32 @@ def test_the_report_tab_says_why_a_result_has_no_number():
     assert shown["SDC DEM stderr [-]"].tolist() == ["n/a (1 cell)", "0.0123", "", "n/a"]
     assert shown["measured chi2/dof [-]"].tolist() == ["n/a (1 measurement)", "", "1.2", "n/a"]
     assert math.isnan(table["SDC DEM stderr [-]"].iloc[0])  # the table itself is unchanged
+
+
+def test_report_zip_holds_the_figures_that_the_markdown_and_latex_files_link(
+        tmp_path, good_csv, options):
+    """The downloaded pidcore_report.md showed a broken image and the .tex did not compile:
+    both link figures/<stem>.png, which no download held."""
+    import io
+    import re
+    import zipfile
+
+    rec = _record(good_csv, options, name="coupon.csv")
+    store_file = tmp_path / "store.h5"
+    uploads.save_records(store_file, [_file(rec, options)])
+    files = report_files(store_file)
+    name, data, mime = files["zip"]
+    assert name == "pidcore_report.zip" and mime == "application/zip"
+    archive = zipfile.ZipFile(io.BytesIO(data))
+    # every other download, byte for byte, under its own download name
+    for fmt in ("csv", "md", "html", "tex", "pdf", "csv_provenance"):
+        assert archive.read(files[fmt][0]) == files[fmt][1]
+    md_links = re.findall(r"!\[[^]]*\]\(([^)]+)\)", files["md"][1].decode())
+    tex_links = re.findall(r"\\includegraphics(?:\[[^]]*\])?\{([^}]+)\}",
+                           files["tex"][1].decode())
+    assert md_links and tex_links
+    for link in md_links + tex_links:
+        assert archive.read(link).startswith(b"\x89PNG"), link
 
 
 def test_report_download_names_the_seeds_of_the_specimens_runs_only(tmp_path):

@@ -348,7 +348,7 @@ def test_report_tab_shows_the_table_and_offers_clean_downloads(store_file):
     assert not at.exception
     labels = sorted(b.label for b in at.get("download_button")
                     if not b.proto.label.startswith("Download these"))
-    assert labels == ["CSV", "CSV notes", "HTML", "MD", "PDF", "TEX"]
+    assert labels == ["CSV", "CSV notes", "HTML", "MD", "PDF", "TEX", "ZIP (all, with figures)"]
     from pidcore.report.downloads import report_files
 
     files = report_files(store_file)
