@@ -247,6 +247,42 @@ def test_a_settings_table_is_detected_by_its_columns_under_any_name():
         uploads.read_settings_table("t.csv", b"file,velocity_delay_us\na.csv,x\n")
 
 
+def test_the_settings_grid_edits_numbers_as_text_and_pidcore_reads_them_as_typed(tmp_path):
+    """The grid's number editor turned a typed "1,5" into 15 µs and "1e-3" into -13 µs: the
+    numbers are edited as text and read by the checks a settings table gets."""
+    from pidcore.errors import SettingsTableError
+    from pidcore.loadcase import LoadCaseError
+
+    names = ["a_fill50.csv"]
+    settings = uploads.merge_settings(names, [stated_case(n) for n in names], None)
+    settings.loc[0, "vibrometer delay [µs]"] = 1 / 3  # a value with all 17 digits
+    settings.loc[0, "structure mass [g]"] = math.nan  # an empty cell
+    shown = uploads.editor_settings(settings)
+    row = shown.iloc[0]
+    for column in uploads.TEXT_EDITED_NUMBERS:
+        assert isinstance(row[column], str), column
+    assert (row["fill [%]"], row["mass below gauge [g]"], row["structure mass [g]"]) == (
+        "50", "0", "")
+    # shown as text, read back to the same number (no digit lost to the display)
+    assert uploads.options_of(row).velocity_delay_s == (1 / 3) / 1e6
+    assert uploads.editor_settings(shown).equals(shown)  # text typed is kept as typed
+    assert uploads.fill_of({**row, "fill [%]": " 2e1 "}) == 20.0
+    typed = {**row, "vibrometer delay [µs]": "1,5"}
+    with pytest.raises(SettingsTableError, match=re.escape(
+            "a_fill50.csv, column vibrometer delay [µs]: '1,5' is not a number; expected a "
+            "vibrometer output delay in µs >= 0")):
+        uploads.options_of(typed)
+    with pytest.raises(SettingsTableError, match=r"column vibrometer delay \[µs\]: '1e-3' is "
+                                                 r"implausibly small"):
+        uploads.options_of({**row, "vibrometer delay [µs]": "1e-3"})
+    with pytest.raises(SettingsTableError, match=r"column mass below gauge \[g\]: '-2' is "
+                                                 r"negative"):
+        uploads.options_of({**row, "mass below gauge [g]": "-2"})
+    for fill in ("12,5", "-30", ""):
+        with pytest.raises(LoadCaseError, match=re.escape("a_fill50.csv, column fill [%]: ")):
+            uploads.fill_of({**row, "fill [%]": fill})
+
+
 def test_an_own_specimens_material_is_offered_once_its_dem_runs_are_stored():
     # a steel-sphere measurement must be labelled steel to meet its steel DEM runs; the
     # store's runs make the name known (the table's materials come first)
