@@ -1140,6 +1140,10 @@ def test_a_job_before_its_first_block_shows_starting_and_no_eta(tmp_path):
     row = job.row(now=103.0)
     assert row["cycles [-]"] == "starting" and row["ETA [s]"] == ""
     assert job.progress_text(now=103.0) == f"job0001 {case.key}: starting, 3 s elapsed"
+    job.settled_s = 0.0404  # the worker told the settle's simulated time (s)
+    assert job.row(now=103.0)["cycles [-]"] == "settling the bed (40 ms simulated)"
+    assert job.progress_text(now=103.0) == (f"job0001 {case.key}: settling the bed (40 ms "
+                                             "simulated), 3 s elapsed")
     job.cycles_done, job.cycles_expected = 10, 40
     # 10 of 40 cycles in 3 s: 9 s left
     assert job.progress_text(now=103.0) == (f"job0001 {case.key}: 10/40 cycles, 3 s elapsed, "
@@ -2028,3 +2032,31 @@ def test_a_dem_worker_reports_a_refusal_as_its_line_not_its_exception_class():
     assert kind == "error"
     assert message.startswith("frequency 1e+09 Hz: 128 samples per drive period need")
     assert "Error" not in message
+
+
+def test_a_dem_worker_reports_the_settle_before_its_first_block_of_cycles():
+    # the job said "starting" through the whole settle of the bed (20 s at 50 Hz, 8 cells)
+    import contextlib
+    import multiprocessing
+
+    from pidcore.dem import DemConfig
+    from pidcore.dem import LoadCase as DemLoadCase
+    from pidcore.dem.simulate import clear_settled_beds
+
+    clear_settled_beds()  # a kept bed is copied, not settled: make this one settle
+    parent, child = multiprocessing.Pipe()
+    jobs._child(DemLoadCase(1000.0, 5.0, 25.0, "acrylic", "z"),
+                DemConfig(cells=1, steady_cycles=4, max_transient_cycles=4), None, child)
+    messages = []
+    with contextlib.suppress(EOFError):  # the worker closed its end after "done"
+        while parent.poll():
+            messages.append(parent.recv())
+    kinds = [m[0] for m in messages]
+    assert kinds[0] == "settling" and kinds[-1] == "done"
+    first_block = kinds.index("progress")
+    assert set(kinds[:first_block]) == {"settling"} and "settling" not in kinds[first_block:]
+    settled = [m[1] for m in messages[:first_block]]
+    # simulated seconds, growing; never past the run's own settle time (the last report may
+    # be short of it: reports are at most one per 0.5 s of wall time)
+    settle_time_s = messages[-1][1]["record"]["settle_time_s"]
+    assert settled == sorted(settled) and 0 < settled[-1] <= settle_time_s
