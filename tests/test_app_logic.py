@@ -2060,3 +2060,14 @@ def test_a_dem_worker_reports_the_settle_before_its_first_block_of_cycles():
     # be short of it: reports are at most one per 0.5 s of wall time)
     settle_time_s = messages[-1][1]["record"]["settle_time_s"]
     assert settled == sorted(settled) and 0 < settled[-1] <= settle_time_s
+
+
+def test_a_specimen_file_uploaded_as_a_measurement_is_told_where_it_belongs():
+    # the Analyse uploader read a specimen TOML as a CSV: "no rows of numbers in its 38 lines"
+    toml = (Path(__file__).resolve().parents[1] / "data_samples" / "specimens" /
+            "steel_6mm.toml").read_bytes()
+    parsed = uploads.parse_upload("my coupon.TOML", toml)
+    assert parsed.measurement is None
+    assert parsed.error == ("my coupon.TOML: a specimen file (TOML), not a shaker-test export; "
+                            "upload it on the DEM or Calibrate tab, as 'or a specimen file "
+                            "(TOML)'")

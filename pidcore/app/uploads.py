@@ -50,6 +50,8 @@ if TYPE_CHECKING:
 FILE_TABLE_COLUMNS: dict[str, str] = SETTINGS_COLUMN_LABELS
 _NUMERIC = ("fill [%]", "vibrometer delay [µs]", "mass below gauge [g]",
             "baseline loss factor [-]", "structure mass [g]")
+#: Suffix of the specimen files that the DEM and Calibrate tabs read.
+SPECIMEN_SUFFIX = ".toml"
 #: The settings columns that the page edits as text (:func:`editor_settings`): the grid's
 #: number editor drops what it does not read as a digit without a word ("1,5" -> 15,
 #: "1e-3" -> -13, "2e1" -> 21); as text, the cell reaches the checks of a settings table
@@ -98,6 +100,12 @@ def read_upload(name: str, data: bytes, *, sample_rate_hz: float | None = None) 
     from ..io import read_measurement
 
     check_upload_size(name, len(data))
+    if PurePosixPath(safe_file_name(name)).suffix.lower() == SPECIMEN_SUFFIX:
+        # the DEM and Calibrate tabs take these; here it was read as a CSV and refused as
+        # "no rows of numbers in its 38 lines", which did not say where it belongs
+        raise ParameterError(f"{name}: a specimen file (TOML), not a shaker-test export; "
+                             f"upload it on the DEM or Calibrate tab, as 'or a specimen file "
+                             f"(TOML)'")
     with tempfile.TemporaryDirectory(prefix="pidcore_upload_") as folder:
         path = Path(folder) / safe_file_name(name)
         path.write_bytes(data)
