@@ -337,10 +337,10 @@ def _fill_dem(page, *, freqs: str, accs: str, fills: str, cells: int, steady: in
             box.fill(value)
             box.press("Enter")
     settings = page.get_by_text("numerical settings")
-    if not page.get_by_role("spinbutton", name="cells simulated").is_visible():
+    if not page.get_by_role("textbox", name="cells simulated").is_visible():
         settings.click()
     for label, value in (("cells simulated", cells), ("steady cycles (0 = automatic)", steady)):
-        box = page.get_by_role("spinbutton", name=label, exact=True)
+        box = page.get_by_role("textbox", name=label, exact=True)
         if box.input_value() != str(value):
             box.fill(str(value))
             box.press("Enter")

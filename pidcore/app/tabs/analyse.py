@@ -11,6 +11,7 @@ import streamlit as st
 from pidcore import defaults
 from pidcore.app import state, uploads
 from pidcore.constants import DRIVE_DIRECTIONS
+from pidcore.loadcase import parse_optional_rate
 from pidcore.units import display_number
 
 
@@ -148,10 +149,15 @@ def render(stores) -> list:
                              accept_multiple_files=True, key="uploads",
                              max_upload_size=defaults.APP_MAX_UPLOAD_MB)
     with st.expander("Options for every file", expanded=False):
-        rate = st.number_input("sample rate if no time column [Hz]", value=0.0, min_value=0.0,
-                               step=1000.0, key="sample_rate",
-                               help="only for CSV/TXT files without a time column; 0 = none")
-    sample_rate_hz = rate if rate > 0 else None
+        # text read by pidcore: the browser's number box made a typed "25,6" 256 Hz
+        rate = st.text_input("sample rate if no time column [Hz]", "0", key="sample_rate",
+                             help="only for CSV/TXT files without a time column; 0 = none")
+        try:
+            sample_rate_hz = parse_optional_rate(rate, name="sample rate if no time column "
+                                                            "[Hz]")
+        except PidcoreError as exc:
+            st.error(f"{exc}; files are read without a sample rate")
+            sample_rate_hz = None
     measurements, tables, accepted = [], {}, []
     refused: list[uploads.RefusedTable] = []
     try:
