@@ -2071,3 +2071,27 @@ def test_a_specimen_file_uploaded_as_a_measurement_is_told_where_it_belongs():
     assert parsed.error == ("my coupon.TOML: a specimen file (TOML), not a shaker-test export; "
                             "upload it on the DEM or Calibrate tab, as 'or a specimen file "
                             "(TOML)'")
+
+
+def test_a_running_calibration_counts_its_design_runs_done(tmp_path):
+    # the page said "calibrating ...: 340 s elapsed" and nothing else for many minutes
+    from pidcore.app.calibration import CalibrationTask
+    from pidcore.store import Store
+
+    store = tmp_path / "s.h5"
+    Store(store).add_dem_run("held", {"frequency_hz": 100.0, "acceleration_g": 5.0,
+                                      "fill_percent": 50.0, "material": "acrylic",
+                                      "direction": "z", "sdc": 0.25, "sdc_stderr": 0.02})
+    task = CalibrationTask(("friction",), 3)
+    task.started, task.finished = 1000.0, 1040.0  # 40 s elapsed, whatever the clock says
+    assert task.progress_text() == "40 s elapsed"  # before the design is made
+    task.design(["held", "a", "b", "a", "c"], store)  # a key asked twice is one run
+    assert (task.runs_total, task.runs_stored_before) == (4, 1)
+    assert task.progress_text() == "1 of 4 DEM runs (1 from the store), 40 s elapsed"
+    task.run_done("a")
+    # one run computed in 40 s, two left: 80 s
+    assert task.progress_text() == ("2 of 4 DEM runs (1 from the store), 40 s elapsed, "
+                                    "ETA 80 s")
+    task.run_done("b")
+    task.run_done("c")
+    assert task.progress_text() == "4 of 4 DEM runs (1 from the store), 40 s elapsed"

@@ -635,10 +635,15 @@ def _fake_calibrate_module(calls: list):
         ["fixture_mass_kg", "baseline_loss_factor"] if text is None
         else [n.strip() for n in text if n.strip()])
 
-    def calibrate(points, *, fit, store_path, cells, design_size, progress, **given):
+    def calibrate(points, *, fit, store_path, cells, design_size, progress, on_design,
+                  on_run_done, **given):
         # the paper's coupon is the library's default: the page names only another specimen
         specimen = given.pop("specimen", None)
         assert not given  # nothing but the specimen beyond the page's own arguments
+        keys = [f"run{i}" for i in range(len(points))]  # the progress hooks, as the library
+        on_design(keys)
+        for key in keys:
+            on_run_done(key)
         calls.append((len(points), tuple(fit), cells)
                      + ((specimen.name, tuple(p.material for p in points))
                         if specimen is not None else ()))

@@ -181,10 +181,41 @@ class CalibrationTask:
     outputs: dict[str, bytes] = field(default_factory=dict)
     #: Its key in the store once saved there ("" : not saved).
     store_key: str = ""
+    #: The DEM runs of its design (0 until the design is made), those the store held at the
+    #: start, and those saved since: the page said only "N s elapsed" for many minutes.
+    runs_total: int = 0
+    runs_stored_before: int = 0
+    runs_done: int = 0
 
     def elapsed_s(self) -> float:
         """Seconds since the start (to the end once finished)."""
         return (self.finished or time.time()) - self.started
+
+    def design(self, keys: Sequence[str], store_path: str | Path) -> None:
+        """Told the design's DEM run keys before any run starts (``calibrate(on_design=)``)."""
+        from ..dem.persist import stored_keys
+
+        unique = list(dict.fromkeys(keys))
+        self.runs_stored_before = len(stored_keys(store_path, unique))
+        self.runs_total = len(unique)
+
+    def run_done(self, key: str) -> None:
+        """Told a DEM run's key as it is saved (``calibrate(on_run_done=)``)."""
+        self.runs_done += 1
+
+    def progress_text(self) -> str:
+        """``"3 of 12 DEM runs (2 from the store), 40 s elapsed, ETA 60 s"``; before the
+        design is made ``"40 s elapsed"``. The ETA extrapolates the runs computed so far."""
+        elapsed = self.elapsed_s()
+        if self.runs_total <= 0:
+            return f"{elapsed:.0f} s elapsed"
+        done = self.runs_stored_before + self.runs_done
+        stored = f" ({self.runs_stored_before} from the store)" if self.runs_stored_before \
+            else ""
+        left = self.runs_total - done
+        eta = (f", ETA {elapsed * left / self.runs_done:.0f} s"
+               if self.runs_done > 0 and left > 0 else "")
+        return f"{done} of {self.runs_total} DEM runs{stored}, {elapsed:.0f} s elapsed{eta}"
 
 
 class CalibrationRunner:
@@ -221,8 +252,11 @@ class CalibrationRunner:
         # the paper's coupon is the library's default: no specimen argument for it
         given = {} if specimen is None else {"specimen": specimen}
         try:
-            result = api.calibrate(points, fit=fit, store_path=self.store_path, cells=cells,
-                                   design_size=design_size, progress=False, **given)
+            result = api.calibrate(
+                points, fit=fit, store_path=self.store_path, cells=cells,
+                design_size=design_size, progress=False,
+                on_design=lambda keys: task.design(keys, self.store_path),
+                on_run_done=task.run_done, **given)
             if notes:
                 result.notes = [*notes, *result.notes]
             with tempfile.TemporaryDirectory(prefix="pidcore_calibration_") as folder:

@@ -47,8 +47,10 @@ def _task(stores, chosen: str, polling: bool) -> None:
         st.caption(f"The calibration below is of {task.specimen}; {chosen} is chosen now.")
     if task.state == "running":
         st.info(f"calibrating {task.specimen} ({', '.join(task.fit)}, {task.n_points} load "
-                f"case(s)): {task.elapsed_s():.0f} s elapsed; DEM runs are saved in the store "
-                "as they finish")
+                f"case(s)): {task.progress_text()}; DEM runs are saved in the store as they "
+                "finish")
+        if task.runs_total:
+            st.progress((task.runs_stored_before + task.runs_done) / task.runs_total)
         return
     if task.state == "failed":
         st.error(f"calibration of {task.specimen} failed: {task.message}")
