@@ -2095,3 +2095,33 @@ def test_a_running_calibration_counts_its_design_runs_done(tmp_path):
     task.run_done("b")
     task.run_done("c")
     assert task.progress_text() == "4 of 4 DEM runs (1 from the store), 40 s elapsed"
+
+
+def test_a_cancelled_calibration_stops_at_its_next_run_and_keeps_the_saved_ones(tmp_path):
+    # a calibration of the page could not be stopped (minutes to hours of DEM runs)
+    import pidcore.calibrate as api
+    from pidcore.app.calibration import CalibrationRunner, CalibrationTask
+    from pidcore.calibrate import MeasuredPoint
+    from pidcore.store import Store
+
+    store = tmp_path / "s.h5"
+    points = [MeasuredPoint(500, 5, 50, 0.6), MeasuredPoint(1000, 5, 50, 0.6),
+              MeasuredPoint(500, 1, 50, 0.2)]
+    runner = CalibrationRunner(store)
+    task = runner.task = CalibrationTask(("restitution",), len(points))
+    counted = task.run_done
+
+    def first_run_then_cancel(key: str) -> None:  # the user's click as the first run ends
+        assert runner.cancel()
+        counted(key)
+
+    task.run_done = first_run_then_cancel
+    runner._run(api, task, points, ["restitution"], 2, 3, None)  # 3 design points: 9 runs
+    assert (task.state, task.runs_total, task.runs_done) == ("cancelled", 9, 1)
+    assert task.message == ("1 DEM run(s) computed before the cancel are kept in s.h5; run "
+                            "the same calibration again to resume (stored runs are reused)")
+    saved = Store(store)
+    # the run saved before the cancel, and nothing after it (the other worker was stopped)
+    assert len(saved.list_dem_runs()) == 1
+    assert saved.list_calibrations().empty  # no calibration of a cancelled run
+    assert not runner.cancel()  # nothing runs any more

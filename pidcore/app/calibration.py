@@ -166,6 +166,11 @@ def page_words(text: str) -> str:
     return page_terms(text, names=fittable_names(api) if api is not None else ())
 
 
+class CalibrationCancelled(Exception):  # noqa: N818 - a request, not an error
+    """Raised in the calibration's thread at its next DEM run saved after a cancel: the
+    library stops its DEM workers and keeps the runs saved (as on Ctrl-C)."""
+
+
 @dataclass
 class CalibrationTask:
     """One calibration: its state (:data:`pidcore.constants.BACKGROUND_STATES`) and
@@ -186,6 +191,8 @@ class CalibrationTask:
     runs_total: int = 0
     runs_stored_before: int = 0
     runs_done: int = 0
+    #: Set by :meth:`CalibrationRunner.cancel`; the run stops at its next DEM run saved.
+    cancel_requested: bool = False
 
     def elapsed_s(self) -> float:
         """Seconds since the start (to the end once finished)."""
@@ -198,10 +205,15 @@ class CalibrationTask:
         unique = list(dict.fromkeys(keys))
         self.runs_stored_before = len(stored_keys(store_path, unique))
         self.runs_total = len(unique)
+        if self.cancel_requested:
+            raise CalibrationCancelled
 
     def run_done(self, key: str) -> None:
-        """Told a DEM run's key as it is saved (``calibrate(on_run_done=)``)."""
+        """Told a DEM run's key as it is saved (``calibrate(on_run_done=)``); raises
+        :class:`CalibrationCancelled` once a cancel is requested (the run stays saved)."""
         self.runs_done += 1
+        if self.cancel_requested:
+            raise CalibrationCancelled
 
     def progress_text(self) -> str:
         """``"3 of 12 DEM runs (2 from the store), 40 s elapsed, ETA 60 s"``; before the
@@ -245,6 +257,15 @@ class CalibrationRunner:
                          name="pidcore-calibration", daemon=True).start()
         return task
 
+    def cancel(self) -> bool:
+        """Ask the running calibration to stop (True if one runs): it stops when its next DEM
+        run is saved, keeping every saved run for a later calibration to reuse."""
+        with self._lock:
+            if self.task is None or self.task.state != "running":
+                return False
+            self.task.cancel_requested = True
+            return True
+
     def _run(self, api, task: CalibrationTask, points, fit, cells, design_size,
              specimen, notes: Sequence[str] = ()) -> None:
         from ..errors import PidcoreError
@@ -265,6 +286,11 @@ class CalibrationRunner:
             state, message = "done", f"{len(points)} load case(s), fitted {', '.join(fit)}"
             key, saved = _save(api, result, self.store_path)
             message += saved
+        except CalibrationCancelled:
+            outputs, state, key = {}, "cancelled", ""
+            message = (f"{task.runs_done} DEM run(s) computed before the cancel are kept in "
+                       f"{self.store_path.name}; run the same calibration again to resume "
+                       "(stored runs are reused)")
         except Exception as exc:  # noqa: BLE001 - shown on the page as the task's error
             # a library refusal is its one line (the class name is no news to a user); an
             # unexpected error keeps its name, without which "KeyError: 'x'" says nothing

@@ -51,9 +51,18 @@ def _task(stores, chosen: str, polling: bool) -> None:
                 "finish")
         if task.runs_total:
             st.progress((task.runs_stored_before + task.runs_done) / task.runs_total)
+        if task.cancel_requested:
+            st.caption("cancelling: it stops when the running DEM run(s) end")
+        else:
+            st.button("Cancel calibration", key="calibration_cancel",
+                      on_click=runner_for(stores.path).cancel,
+                      help="stops at the next DEM run saved; saved runs are kept and reused")
         return
     if task.state == "failed":
         st.error(f"calibration of {task.specimen} failed: {task.message}")
+        return
+    if task.state == "cancelled":
+        st.warning(f"calibration of {task.specimen} cancelled: {task.message}")
         return
     st.success(f"calibrated {task.specimen} in {task.elapsed_s():.0f} s: {task.message}")
     out = task.outputs
