@@ -361,8 +361,10 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: str | Sequence[str],
     requests = _requests(points, dem_specs, design, config, specimen)
     if on_design is not None:
         on_design([r.key() for row in requests for r in row])
+    # on_done only where asked for: the call is otherwise the CLI's as before
+    told = {} if on_run_done is None else {"on_done": on_run_done}
     runs = run_requests([r for row in requests for r in row], store_path=store_path,
-                        workers=workers, progress=progress, on_done=on_run_done)
+                        workers=workers, progress=progress, **told)
     from ..store import Store
 
     store = Store(store_path)
