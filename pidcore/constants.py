@@ -48,7 +48,7 @@ ImpactPair = Literal["wall", "particle"]
 DampingCoefficient = Literal["eq3", "calibrated"]
 #: State of work an app page runs outside Streamlit's script run (a report build, a
 #: calibration), in the order it passes through them: running, then done or failed.
-BackgroundState = Literal["running", "done", "failed"]
+BackgroundState = Literal["running", "done", "failed", "cancelled"]
 
 #: Particle materials in use for particle dampers that the material table does not hold: a
 #: file name stating one (``..._fill50_steel.csv``) is refused unless a specimen file gives

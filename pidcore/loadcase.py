@@ -11,8 +11,8 @@ LoadCase, LoadCaseError
     The load case (frequency [Hz], acceleration [g], fill [%], material, direction).
 parse_key, KEY_PATTERN, KEY_PATTERN_0_1, key_0_1
     Keys of load cases and DEM runs, today's and pidcore 0.1's.
-check_fill, check_fill_range, parse_values
-    Fills in (0, 100] %; numbers typed as ``"50, 100 500"``.
+check_fill, check_fill_range, parse_values, parse_count, parse_optional_rate
+    Fills in (0, 100] %; numbers typed as ``"50, 100 500"``, a whole number, a rate or none.
 normalize_material, normalize_direction
     Canonical material and direction names.
 """
@@ -221,10 +221,46 @@ def parse_values(text: str, *, name: str) -> list[float]:
     return values
 
 
+def parse_count(text: str, *, name: str, minimum: int = 0, maximum: int | None = None) -> int:
+    """A whole number typed in a field (``"8"``, ``"1e3"``), or a one-line error naming
+    ``name``: a browser's number box read ``"2,5"`` as 25 and ``"1e3"`` as 1 without a word,
+    so such fields are text read here."""
+    token = text.strip()
+    try:
+        value = float(token)
+    except ValueError:
+        value = math.nan
+    if not math.isfinite(value) or value != int(value):
+        raise ParameterError(f"{name}: {token!r} is not a whole number")
+    count = int(value)
+    if count < minimum or (maximum is not None and count > maximum):
+        expected = (f"{minimum} to {maximum}" if maximum is not None
+                    else f"at least {minimum}")
+        raise ParameterError(f"{name}: {token!r}, expected {expected}")
+    return count
+
+
+def parse_optional_rate(text: str, *, name: str) -> float | None:
+    """A positive rate typed in a field, None where it is blank or 0 (none given), or a
+    one-line error naming ``name`` (``"25,6"`` is refused, not read as 256)."""
+    token = text.strip()
+    if token in ("", "0"):
+        return None
+    try:
+        value = float(token)
+    except ValueError:
+        raise ParameterError(f"{name}: {token!r} is not a number") from None
+    if value == 0:
+        return None
+    if not (math.isfinite(value) and value > 0):
+        raise ParameterError(f"{name}: {token!r}, expected a positive number (0 or blank: none)")
+    return value
+
+
 __all__ = ["KEY_PATTERN", "KEY_PATTERN_0_1", "LoadCase", "LoadCaseError", "check_fill",
            "check_fill_range",
-           "key_0_1", "normalize_material", "normalize_direction", "parse_key",
-           "parse_values"]
+           "key_0_1", "normalize_material", "normalize_direction", "parse_count", "parse_key",
+           "parse_optional_rate", "parse_values"]
 
 
 def refuse_identical_contents_stating_apart(files: Iterable[tuple[str, str, Hashable, str]],

@@ -337,10 +337,10 @@ def _fill_dem(page, *, freqs: str, accs: str, fills: str, cells: int, steady: in
             box.fill(value)
             box.press("Enter")
     settings = page.get_by_text("numerical settings")
-    if not page.get_by_role("spinbutton", name="cells simulated").is_visible():
+    if not page.get_by_role("textbox", name="cells simulated").is_visible():
         settings.click()
     for label, value in (("cells simulated", cells), ("steady cycles (0 = automatic)", steady)):
-        box = page.get_by_role("spinbutton", name=label, exact=True)
+        box = page.get_by_role("textbox", name=label, exact=True)
         if box.input_value() != str(value):
             box.fill(str(value))
             box.press("Enter")
@@ -431,3 +431,55 @@ def test_per_file_vibrometer_delays_and_a_negative_loss_factor_in_one_session(
     page.get_by_text("Save the 1 implausible record(s) anyway").wait_for(
         timeout=RESULT_TIMEOUT_MS)
     page.screenshot(path=str(ARTIFACTS / "app_e2e_two_delays.png"), full_page=True)
+
+
+def _cell_x(page, grid, column: int, y: float) -> float:
+    """The x of a column of a Streamlit data editor at height ``y``: glide-data-grid draws on
+    a canvas, so a click's cell is told by its accessible table's selected cell (which
+    follows the canvas a frame or more later: hence the waits)."""
+    box = grid.bounding_box()
+    selected = grid.locator(f'td[aria-selected="true"][data-testid^="glide-cell-{column}-"]')
+    for x in range(int(box["x"]) + 10, int(box["x"] + box["width"]), 15):
+        page.mouse.click(x, y)
+        page.wait_for_timeout(250)
+        if selected.count():
+            inside = x + 15  # off the column's left border; columns are wider than 40 px
+            page.mouse.click(inside, y)
+            page.wait_for_timeout(500)
+            assert selected.count()
+            return inside
+    pytest.fail(f"no column {column} found in the grid")
+
+
+def _type_in_cell(page, x: float, y: float, text: str) -> None:
+    """Open the cell's editor and commit ``text`` as a user types it (the editor is an input
+    laid over the canvas)."""
+    page.mouse.dblclick(x, y)
+    editor = page.locator("textarea.gdg-input, input.gdg-input").first
+    editor.wait_for(state="visible", timeout=RESULT_TIMEOUT_MS)
+    editor.fill(text)
+    editor.press("Enter")
+
+
+def test_a_number_typed_in_the_settings_grid_reaches_the_checks_as_typed(
+        app_url, browser_page, sample):
+    # the grid's number editor dropped what it did not read as a digit: a decimal comma "1,5"
+    # became a 15 µs vibrometer delay and "1e-3" a delay of -13 µs, without a word
+    page = browser_page
+    _open(page, app_url)
+    page.locator("input[type=file]").first.set_input_files([str(sample)])
+    _metric_texts(page, "SDC ± stderr")
+    grid = page.locator('[data-testid="stDataFrame"]').first  # the settings grid
+    header = grid.locator('th[role="columnheader"]')
+    header.filter(has_text="vibrometer delay [µs]").wait_for(state="attached",
+                                                             timeout=RESULT_TIMEOUT_MS)
+    headers = header.all_text_contents()
+    y = grid.bounding_box()["y"] + 35 * 1.5  # the first file's row, under the header (35 px)
+    x = _cell_x(page, grid, headers.index("vibrometer delay [µs]"), y)
+    for typed, refusal in (("1,5", "'1,5' is not a number"),
+                           ("1e-3", "'1e-3' is implausibly small")):
+        _type_in_cell(page, x, y, typed)
+        error = page.locator('[data-testid="stAlertContentError"]').filter(has_text=refusal)
+        error.first.wait_for(timeout=RESULT_TIMEOUT_MS)
+        assert f"{sample.name}, column vibrometer delay [µs]: " in error.first.inner_text()
+    page.screenshot(path=str(ARTIFACTS / "app_e2e_typed_number_refused.png"), full_page=True)

@@ -247,6 +247,42 @@ def test_a_settings_table_is_detected_by_its_columns_under_any_name():
         uploads.read_settings_table("t.csv", b"file,velocity_delay_us\na.csv,x\n")
 
 
+def test_the_settings_grid_edits_numbers_as_text_and_pidcore_reads_them_as_typed(tmp_path):
+    """The grid's number editor turned a typed "1,5" into 15 µs and "1e-3" into -13 µs: the
+    numbers are edited as text and read by the checks a settings table gets."""
+    from pidcore.errors import SettingsTableError
+    from pidcore.loadcase import LoadCaseError
+
+    names = ["a_fill50.csv"]
+    settings = uploads.merge_settings(names, [stated_case(n) for n in names], None)
+    settings.loc[0, "vibrometer delay [µs]"] = 1 / 3  # a value with all 17 digits
+    settings.loc[0, "structure mass [g]"] = math.nan  # an empty cell
+    shown = uploads.editor_settings(settings)
+    row = shown.iloc[0]
+    for column in uploads.TEXT_EDITED_NUMBERS:
+        assert isinstance(row[column], str), column
+    assert (row["fill [%]"], row["mass below gauge [g]"], row["structure mass [g]"]) == (
+        "50", "0", "")
+    # shown as text, read back to the same number (no digit lost to the display)
+    assert uploads.options_of(row).velocity_delay_s == (1 / 3) / 1e6
+    assert uploads.editor_settings(shown).equals(shown)  # text typed is kept as typed
+    assert uploads.fill_of({**row, "fill [%]": " 2e1 "}) == 20.0
+    typed = {**row, "vibrometer delay [µs]": "1,5"}
+    with pytest.raises(SettingsTableError, match=re.escape(
+            "a_fill50.csv, column vibrometer delay [µs]: '1,5' is not a number; expected a "
+            "vibrometer output delay in µs >= 0")):
+        uploads.options_of(typed)
+    with pytest.raises(SettingsTableError, match=r"column vibrometer delay \[µs\]: '1e-3' is "
+                                                 r"implausibly small"):
+        uploads.options_of({**row, "vibrometer delay [µs]": "1e-3"})
+    with pytest.raises(SettingsTableError, match=r"column mass below gauge \[g\]: '-2' is "
+                                                 r"negative"):
+        uploads.options_of({**row, "mass below gauge [g]": "-2"})
+    for fill in ("12,5", "-30", ""):
+        with pytest.raises(LoadCaseError, match=re.escape("a_fill50.csv, column fill [%]: ")):
+            uploads.fill_of({**row, "fill [%]": fill})
+
+
 def test_an_own_specimens_material_is_offered_once_its_dem_runs_are_stored():
     # a steel-sphere measurement must be labelled steel to meet its steel DEM runs; the
     # store's runs make the name known (the table's materials come first)
@@ -460,7 +496,7 @@ def test_report_downloads_hold_the_saved_numbers(tmp_path, good_csv, options):
     store_file = tmp_path / "store.h5"
     uploads.save_records(store_file, [_file(rec, options)])
     files = report_files(store_file)
-    assert set(files) == {"csv", "md", "html", "tex", "pdf", "csv_provenance"}
+    assert set(files) == {"csv", "md", "html", "tex", "pdf", "csv_provenance", "zip"}
     name, data, mime = files["pdf"]
     assert name.endswith(".pdf") and data.startswith(b"%PDF") and mime == "application/pdf"
     import io
@@ -1104,6 +1140,10 @@ def test_a_job_before_its_first_block_shows_starting_and_no_eta(tmp_path):
     row = job.row(now=103.0)
     assert row["cycles [-]"] == "starting" and row["ETA [s]"] == ""
     assert job.progress_text(now=103.0) == f"job0001 {case.key}: starting, 3 s elapsed"
+    job.settled_s = 0.0404  # the worker told the settle's simulated time (s)
+    assert job.row(now=103.0)["cycles [-]"] == "settling the bed (40 ms simulated)"
+    assert job.progress_text(now=103.0) == (f"job0001 {case.key}: settling the bed (40 ms "
+                                             "simulated), 3 s elapsed")
     job.cycles_done, job.cycles_expected = 10, 40
     # 10 of 40 cycles in 3 s: 9 s left
     assert job.progress_text(now=103.0) == (f"job0001 {case.key}: 10/40 cycles, 3 s elapsed, "
@@ -1522,6 +1562,32 @@ def test_the_report_tab_says_why_a_result_has_no_number():
     assert shown["SDC DEM stderr [-]"].tolist() == ["n/a (1 cell)", "0.0123", "", "n/a"]
     assert shown["measured chi2/dof [-]"].tolist() == ["n/a (1 measurement)", "", "1.2", "n/a"]
     assert math.isnan(table["SDC DEM stderr [-]"].iloc[0])  # the table itself is unchanged
+
+
+def test_report_zip_holds_the_figures_that_the_markdown_and_latex_files_link(
+        tmp_path, good_csv, options):
+    """The downloaded pidcore_report.md showed a broken image and the .tex did not compile:
+    both link figures/<stem>.png, which no download held."""
+    import io
+    import re
+    import zipfile
+
+    rec = _record(good_csv, options, name="coupon.csv")
+    store_file = tmp_path / "store.h5"
+    uploads.save_records(store_file, [_file(rec, options)])
+    files = report_files(store_file)
+    name, data, mime = files["zip"]
+    assert name == "pidcore_report.zip" and mime == "application/zip"
+    archive = zipfile.ZipFile(io.BytesIO(data))
+    # every other download, byte for byte, under its own download name
+    for fmt in ("csv", "md", "html", "tex", "pdf", "csv_provenance"):
+        assert archive.read(files[fmt][0]) == files[fmt][1]
+    md_links = re.findall(r"!\[[^]]*\]\(([^)]+)\)", files["md"][1].decode())
+    tex_links = re.findall(r"\\includegraphics(?:\[[^]]*\])?\{([^}]+)\}",
+                           files["tex"][1].decode())
+    assert md_links and tex_links
+    for link in md_links + tex_links:
+        assert archive.read(link).startswith(b"\x89PNG"), link
 
 
 def test_report_download_names_the_seeds_of_the_specimens_runs_only(tmp_path):
@@ -1966,3 +2032,96 @@ def test_a_dem_worker_reports_a_refusal_as_its_line_not_its_exception_class():
     assert kind == "error"
     assert message.startswith("frequency 1e+09 Hz: 128 samples per drive period need")
     assert "Error" not in message
+
+
+def test_a_dem_worker_reports_the_settle_before_its_first_block_of_cycles():
+    # the job said "starting" through the whole settle of the bed (20 s at 50 Hz, 8 cells)
+    import contextlib
+    import multiprocessing
+
+    from pidcore.dem import DemConfig
+    from pidcore.dem import LoadCase as DemLoadCase
+    from pidcore.dem.simulate import clear_settled_beds
+
+    clear_settled_beds()  # a kept bed is copied, not settled: make this one settle
+    parent, child = multiprocessing.Pipe()
+    jobs._child(DemLoadCase(1000.0, 5.0, 25.0, "acrylic", "z"),
+                DemConfig(cells=1, steady_cycles=4, max_transient_cycles=4), None, child)
+    messages = []
+    with contextlib.suppress(EOFError):  # the worker closed its end after "done"
+        while parent.poll():
+            messages.append(parent.recv())
+    kinds = [m[0] for m in messages]
+    assert kinds[0] == "settling" and kinds[-1] == "done"
+    first_block = kinds.index("progress")
+    assert set(kinds[:first_block]) == {"settling"} and "settling" not in kinds[first_block:]
+    settled = [m[1] for m in messages[:first_block]]
+    # simulated seconds, growing; never past the run's own settle time (the last report may
+    # be short of it: reports are at most one per 0.5 s of wall time)
+    settle_time_s = messages[-1][1]["record"]["settle_time_s"]
+    assert settled == sorted(settled) and 0 < settled[-1] <= settle_time_s
+
+
+def test_a_specimen_file_uploaded_as_a_measurement_is_told_where_it_belongs():
+    # the Analyse uploader read a specimen TOML as a CSV: "no rows of numbers in its 38 lines"
+    toml = (Path(__file__).resolve().parents[1] / "data_samples" / "specimens" /
+            "steel_6mm.toml").read_bytes()
+    parsed = uploads.parse_upload("my coupon.TOML", toml)
+    assert parsed.measurement is None
+    assert parsed.error == ("my coupon.TOML: a specimen file (TOML), not a shaker-test export; "
+                            "upload it on the DEM or Calibrate tab, as 'or a specimen file "
+                            "(TOML)'")
+
+
+def test_a_running_calibration_counts_its_design_runs_done(tmp_path):
+    # the page said "calibrating ...: 340 s elapsed" and nothing else for many minutes
+    from pidcore.app.calibration import CalibrationTask
+    from pidcore.store import Store
+
+    store = tmp_path / "s.h5"
+    Store(store).add_dem_run("held", {"frequency_hz": 100.0, "acceleration_g": 5.0,
+                                      "fill_percent": 50.0, "material": "acrylic",
+                                      "direction": "z", "sdc": 0.25, "sdc_stderr": 0.02})
+    task = CalibrationTask(("friction",), 3)
+    task.started, task.finished = 1000.0, 1040.0  # 40 s elapsed, whatever the clock says
+    assert task.progress_text() == "40 s elapsed"  # before the design is made
+    task.design(["held", "a", "b", "a", "c"], store)  # a key asked twice is one run
+    assert (task.runs_total, task.runs_stored_before) == (4, 1)
+    assert task.progress_text() == "1 of 4 DEM runs (1 from the store), 40 s elapsed"
+    task.run_done("a")
+    # one run computed in 40 s, two left: 80 s
+    assert task.progress_text() == ("2 of 4 DEM runs (1 from the store), 40 s elapsed, "
+                                    "ETA 80 s")
+    task.run_done("b")
+    task.run_done("c")
+    assert task.progress_text() == "4 of 4 DEM runs (1 from the store), 40 s elapsed"
+
+
+def test_a_cancelled_calibration_stops_at_its_next_run_and_keeps_the_saved_ones(tmp_path):
+    # a calibration of the page could not be stopped (minutes to hours of DEM runs)
+    import pidcore.calibrate as api
+    from pidcore.app.calibration import CalibrationRunner, CalibrationTask
+    from pidcore.calibrate import MeasuredPoint
+    from pidcore.store import Store
+
+    store = tmp_path / "s.h5"
+    points = [MeasuredPoint(500, 5, 50, 0.6), MeasuredPoint(1000, 5, 50, 0.6),
+              MeasuredPoint(500, 1, 50, 0.2)]
+    runner = CalibrationRunner(store)
+    task = runner.task = CalibrationTask(("restitution",), len(points))
+    counted = task.run_done
+
+    def first_run_then_cancel(key: str) -> None:  # the user's click as the first run ends
+        assert runner.cancel()
+        counted(key)
+
+    task.run_done = first_run_then_cancel
+    runner._run(api, task, points, ["restitution"], 2, 3, None)  # 3 design points: 9 runs
+    assert (task.state, task.runs_total, task.runs_done) == ("cancelled", 9, 1)
+    assert task.message == ("1 DEM run(s) computed before the cancel are kept in s.h5; run "
+                            "the same calibration again to resume (stored runs are reused)")
+    saved = Store(store)
+    # the run saved before the cancel, and nothing after it (the other worker was stopped)
+    assert len(saved.list_dem_runs()) == 1
+    assert saved.list_calibrations().empty  # no calibration of a cancelled run
+    assert not runner.cancel()  # nothing runs any more

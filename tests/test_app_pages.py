@@ -348,7 +348,7 @@ def test_report_tab_shows_the_table_and_offers_clean_downloads(store_file):
     assert not at.exception
     labels = sorted(b.label for b in at.get("download_button")
                     if not b.proto.label.startswith("Download these"))
-    assert labels == ["CSV", "CSV notes", "HTML", "MD", "PDF", "TEX"]
+    assert labels == ["CSV", "CSV notes", "HTML", "MD", "PDF", "TEX", "ZIP (all, with figures)"]
     from pidcore.report.downloads import report_files
 
     files = report_files(store_file)
@@ -407,8 +407,8 @@ def _fill_dem(at, *, freqs: str, accs: str, fills: str, cells: int, steady: int)
     at.text_input(key="dem_freqs").set_value(freqs)
     at.text_input(key="dem_accs").set_value(accs)
     at.text_input(key="dem_fills").set_value(fills)
-    at.number_input(key="dem_cells").set_value(cells)
-    at.number_input(key="dem_steady").set_value(steady)
+    at.text_input(key="dem_cells").set_value(str(cells))
+    at.text_input(key="dem_steady").set_value(str(steady))
 
 
 @pytest.mark.dem_subprocess
@@ -635,10 +635,15 @@ def _fake_calibrate_module(calls: list):
         ["fixture_mass_kg", "baseline_loss_factor"] if text is None
         else [n.strip() for n in text if n.strip()])
 
-    def calibrate(points, *, fit, store_path, cells, design_size, progress, **given):
+    def calibrate(points, *, fit, store_path, cells, design_size, progress, on_design,
+                  on_run_done, **given):
         # the paper's coupon is the library's default: the page names only another specimen
         specimen = given.pop("specimen", None)
         assert not given  # nothing but the specimen beyond the page's own arguments
+        keys = [f"run{i}" for i in range(len(points))]  # the progress hooks, as the library
+        on_design(keys)
+        for key in keys:
+            on_run_done(key)
         calls.append((len(points), tuple(fit), cells)
                      + ((specimen.name, tuple(p.material for p in points))
                         if specimen is not None else ()))
@@ -1424,3 +1429,21 @@ def test_a_drive_the_dem_refuses_is_refused_on_the_dem_page_not_as_a_failed_job(
                             "time step")
     assert "Error" not in error
     assert jobs.runner_for(store_file).jobs() == []
+
+
+def test_whole_numbers_and_the_sample_rate_are_read_as_typed_or_refused(store_file):
+    """The browser's number boxes read a typed "2,5" as 25 and "1e3" as 1 without a word (25
+    cells, 1 steady cycle, a 256 Hz sample rate for "25,6"): the fields are text that pidcore
+    reads, and what it cannot read is refused, naming the field."""
+    at = _app()
+    at.text_input(key="dem_steady").set_value("2,5")
+    at.button(key="dem_run").click()
+    at.run()
+    assert not at.exception
+    assert [e.value for e in at.error] == [
+        "steady cycles (0 = automatic): '2,5' is not a whole number"]
+    assert jobs.runner_for(store_file).jobs() == []  # nothing submitted
+    at.text_input(key="sample_rate").set_value("25,6")
+    at.run()
+    assert any(e.value == "sample rate if no time column [Hz]: '25,6' is not a number; files "
+                          "are read without a sample rate" for e in at.error)

@@ -705,3 +705,23 @@ def test_an_emcee_posterior_that_did_not_converge_is_flagged(tiny_store, tmp_pat
     sampler = flagged.settings["sampler"]
     assert sampler["converged"] is False and sampler["steps"] == 2000
     assert "NOT converged)" in summary_markdown(flagged)
+
+
+def test_on_run_done_tells_each_computed_run_of_the_design_once(tmp_path):
+    # the app's calibration said only "N s elapsed" for minutes: it now counts the design's
+    # runs done through these hooks, which must name each computed run once, cached ones never
+    from pidcore.store import Store
+
+    store = tmp_path / "dem.h5"
+    points = [MeasuredPoint(500, 5, 50, 0.6), MeasuredPoint(1000, 5, 50, 0.6),
+              MeasuredPoint(500, 1, 50, 0.2)]
+    kw = dict(fit=["fixture_mass_kg"], store_path=store, discrepancy=0.2, cells=2,
+              steady_cycles=10, dem_config=DemConfig(steady_cycles=10), workers=1,
+              progress=False)
+    design, done = [], []
+    calibrate(points, on_design=design.extend, on_run_done=done.append, **kw)
+    assert len(design) == 3 and sorted(done) == sorted(set(design))
+    assert all(Store(store).has_dem_run(key) for key in done)
+    again: list[str] = []
+    calibrate(points, on_run_done=again.append, **kw)
+    assert again == []  # every run reused from the store

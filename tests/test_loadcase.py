@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -135,3 +136,34 @@ def test_store_written_by_0_1_opens_and_reports_the_same_numbers(tmp_path):
     masses = {c.load_case.key: c.vibrated_mass_kg for c in dem_cases(runs)}
     np.testing.assert_array_equal(
         [masses[parse_key(k).key] for k in runs["case_key"]], runs["m_c_kg"].to_numpy(float))
+
+
+def test_a_whole_number_typed_in_a_field_is_read_as_typed_or_refused():
+    # the app's number boxes read "2,5" as 25 and "1e3" as 1 without a word
+    from pidcore.loadcase import parse_count
+
+    assert parse_count(" 8 ", name="cells") == 8
+    assert parse_count("1e3", name="steady cycles") == 1000  # exactly a whole number
+    for typed in ("2,5", "2.5", "", "nan", "inf", "eight"):
+        with pytest.raises(ParameterError) as info:
+            parse_count(typed, name="cells")
+        assert str(info.value) == f"cells: {typed!r} is not a whole number"
+    with pytest.raises(ParameterError, match=r"^cells simulated: '65', expected 1 to 64$"):
+        parse_count("65", name="cells simulated", minimum=1, maximum=64)
+    with pytest.raises(ParameterError, match=r"^seed: '-1', expected at least 0$"):
+        parse_count("-1", name="seed")
+
+
+def test_a_rate_typed_in_a_field_is_a_positive_number_or_none():
+    # the sample rate box read "25,6" as 256 Hz without a word
+    from pidcore.loadcase import parse_optional_rate
+
+    assert parse_optional_rate(" 25600 ", name="rate [Hz]") == 25600.0
+    assert parse_optional_rate("2.56e4", name="rate [Hz]") == 25600.0
+    assert [parse_optional_rate(t, name="rate [Hz]") for t in ("", " ", "0", "0.0")] == [None] * 4
+    with pytest.raises(ParameterError, match=r"^rate \[Hz\]: '25,6' is not a number$"):
+        parse_optional_rate("25,6", name="rate [Hz]")
+    for typed in ("-5", "inf", "nan"):
+        with pytest.raises(ParameterError, match=re.escape(
+                f"rate [Hz]: {typed!r}, expected a positive number (0 or blank: none)")):
+            parse_optional_rate(typed, name="rate [Hz]")

@@ -166,6 +166,11 @@ def page_words(text: str) -> str:
     return page_terms(text, names=fittable_names(api) if api is not None else ())
 
 
+class CalibrationCancelled(Exception):  # noqa: N818 - a request, not an error
+    """Raised in the calibration's thread at its next DEM run saved after a cancel: the
+    library stops its DEM workers and keeps the runs saved (as on Ctrl-C)."""
+
+
 @dataclass
 class CalibrationTask:
     """One calibration: its state (:data:`pidcore.constants.BACKGROUND_STATES`) and
@@ -181,10 +186,48 @@ class CalibrationTask:
     outputs: dict[str, bytes] = field(default_factory=dict)
     #: Its key in the store once saved there ("" : not saved).
     store_key: str = ""
+    #: The DEM runs of its design (0 until the design is made), those the store held at the
+    #: start, and those saved since: the page said only "N s elapsed" for many minutes.
+    runs_total: int = 0
+    runs_stored_before: int = 0
+    runs_done: int = 0
+    #: Set by :meth:`CalibrationRunner.cancel`; the run stops at its next DEM run saved.
+    cancel_requested: bool = False
 
     def elapsed_s(self) -> float:
         """Seconds since the start (to the end once finished)."""
         return (self.finished or time.time()) - self.started
+
+    def design(self, keys: Sequence[str], store_path: str | Path) -> None:
+        """Told the design's DEM run keys before any run starts (``calibrate(on_design=)``)."""
+        from ..dem.persist import stored_keys
+
+        unique = list(dict.fromkeys(keys))
+        self.runs_stored_before = len(stored_keys(store_path, unique))
+        self.runs_total = len(unique)
+        if self.cancel_requested:
+            raise CalibrationCancelled
+
+    def run_done(self, key: str) -> None:
+        """Told a DEM run's key as it is saved (``calibrate(on_run_done=)``); raises
+        :class:`CalibrationCancelled` once a cancel is requested (the run stays saved)."""
+        self.runs_done += 1
+        if self.cancel_requested:
+            raise CalibrationCancelled
+
+    def progress_text(self) -> str:
+        """``"3 of 12 DEM runs (2 from the store), 40 s elapsed, ETA 60 s"``; before the
+        design is made ``"40 s elapsed"``. The ETA extrapolates the runs computed so far."""
+        elapsed = self.elapsed_s()
+        if self.runs_total <= 0:
+            return f"{elapsed:.0f} s elapsed"
+        done = self.runs_stored_before + self.runs_done
+        stored = f" ({self.runs_stored_before} from the store)" if self.runs_stored_before \
+            else ""
+        left = self.runs_total - done
+        eta = (f", ETA {elapsed * left / self.runs_done:.0f} s"
+               if self.runs_done > 0 and left > 0 else "")
+        return f"{done} of {self.runs_total} DEM runs{stored}, {elapsed:.0f} s elapsed{eta}"
 
 
 class CalibrationRunner:
@@ -214,6 +257,15 @@ class CalibrationRunner:
                          name="pidcore-calibration", daemon=True).start()
         return task
 
+    def cancel(self) -> bool:
+        """Ask the running calibration to stop (True if one runs): it stops when its next DEM
+        run is saved, keeping every saved run for a later calibration to reuse."""
+        with self._lock:
+            if self.task is None or self.task.state != "running":
+                return False
+            self.task.cancel_requested = True
+            return True
+
     def _run(self, api, task: CalibrationTask, points, fit, cells, design_size,
              specimen, notes: Sequence[str] = ()) -> None:
         from ..errors import PidcoreError
@@ -221,8 +273,11 @@ class CalibrationRunner:
         # the paper's coupon is the library's default: no specimen argument for it
         given = {} if specimen is None else {"specimen": specimen}
         try:
-            result = api.calibrate(points, fit=fit, store_path=self.store_path, cells=cells,
-                                   design_size=design_size, progress=False, **given)
+            result = api.calibrate(
+                points, fit=fit, store_path=self.store_path, cells=cells,
+                design_size=design_size, progress=False,
+                on_design=lambda keys: task.design(keys, self.store_path),
+                on_run_done=task.run_done, **given)
             if notes:
                 result.notes = [*notes, *result.notes]
             with tempfile.TemporaryDirectory(prefix="pidcore_calibration_") as folder:
@@ -231,6 +286,11 @@ class CalibrationRunner:
             state, message = "done", f"{len(points)} load case(s), fitted {', '.join(fit)}"
             key, saved = _save(api, result, self.store_path)
             message += saved
+        except CalibrationCancelled:
+            outputs, state, key = {}, "cancelled", ""
+            message = (f"{task.runs_done} DEM run(s) computed before the cancel are kept in "
+                       f"{self.store_path.name}; run the same calibration again to resume "
+                       "(stored runs are reused)")
         except Exception as exc:  # noqa: BLE001 - shown on the page as the task's error
             # a library refusal is its one line (the class name is no news to a user); an
             # unexpected error keeps its name, without which "KeyError: 'x'" says nothing

@@ -86,6 +86,9 @@ JOURNAL_LOCK_WAIT_S = 10.0
 _POLL_S = 0.05
 #: Seconds a terminated process gets before it is killed.
 _TERMINATE_GRACE_S = 1.0
+#: Least wall seconds between two reports of the settle's progress by a worker (a report per
+#: kernel call would be thousands a second).
+_SETTLE_REPORT_S = 0.5
 
 
 @dataclass
@@ -103,6 +106,9 @@ class DemJob:
     finished: float | None = None
     cycles_done: int = 0
     cycles_expected: int = 0
+    #: Simulated seconds of the bed's settle so far, told before the first block of cycles
+    #: (that phase takes seconds to tens of seconds: "starting" said nothing meanwhile).
+    settled_s: float = 0.0
     message: str = ""
     #: The job that runs this one's simulation (state :data:`SAME_RUN_STATE`), else "".
     same_as: str = ""
@@ -139,11 +145,16 @@ class DemJob:
         return specimen_label("", "") if s is None else specimen_label(s.name, s.hash)
 
     def cycles_text(self) -> str:
-        """``"120/300"`` cycles done of expected; ``"starting"`` while running before the
-        first block reports (the expected count is not known yet); empty otherwise."""
+        """``"120/300"`` cycles done of expected; while running before the first block
+        reports (the expected count is not known yet) ``"settling the bed (40 ms
+        simulated)"`` once the settle reports, ``"starting"`` before; empty otherwise."""
         if self.cycles_expected > 0:
             return f"{self.cycles_done}/{self.cycles_expected}"
-        return "starting" if self.state == "running" else ""
+        if self.state != "running":
+            return ""
+        if self.settled_s > 0:
+            return f"settling the bed ({self.settled_s * 1e3:.0f} ms simulated)"
+        return "starting"
 
     def progress_text(self, now: float | None = None) -> str:
         """The progress bar's line, e.g. ``"job0001 f100Hz_...: 120/300 cycles, 12 s elapsed,
@@ -179,9 +190,18 @@ def _child(case, config, specimen, conn) -> None:
         from ..dem.persist import dem_run_entry
         from ..dem.simulate import simulate_load_case
 
+        last = [0.0]
+
+        def settling(simulated_s: float) -> None:
+            now = time.monotonic()
+            if now - last[0] >= _SETTLE_REPORT_S:
+                last[0] = now
+                conn.send(("settling", simulated_s))
+
         result = simulate_load_case(
             case, config, specimen=specimen,
-            on_block=lambda done, expected: conn.send(("progress", done, expected)))
+            on_block=lambda done, expected: conn.send(("progress", done, expected)),
+            on_settle=settling)
         conn.send(("done", dem_run_entry(result)))
     except PidcoreError as exc:  # a refusal is its one line, as the report build says it
         conn.send(("error", page_terms(str(exc))))
@@ -685,6 +705,9 @@ class DemJobRunner:
                         with self._lock:
                             job.cycles_done = message[1]
                             job.cycles_expected = max(message[1], message[2])
+                    elif message[0] == "settling":
+                        with self._lock:
+                            job.settled_s = message[1]
                     elif message[0] == "error":
                         self._finish(job, "failed", message[1])
                         return

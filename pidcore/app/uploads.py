@@ -50,6 +50,13 @@ if TYPE_CHECKING:
 FILE_TABLE_COLUMNS: dict[str, str] = SETTINGS_COLUMN_LABELS
 _NUMERIC = ("fill [%]", "vibrometer delay [µs]", "mass below gauge [g]",
             "baseline loss factor [-]", "structure mass [g]")
+#: Suffix of the specimen files that the DEM and Calibrate tabs read.
+SPECIMEN_SUFFIX = ".toml"
+#: The settings columns that the page edits as text (:func:`editor_settings`): the grid's
+#: number editor drops what it does not read as a digit without a word ("1,5" -> 15,
+#: "1e-3" -> -13, "2e1" -> 21); as text, the cell reaches the checks of a settings table
+#: (:func:`fill_of`, :func:`options_of`) as typed, and a value they cannot read is refused.
+TEXT_EDITED_NUMBERS = _NUMERIC
 
 
 # --- reading ----------------------------------------------------------------------------------
@@ -93,6 +100,12 @@ def read_upload(name: str, data: bytes, *, sample_rate_hz: float | None = None) 
     from ..io import read_measurement
 
     check_upload_size(name, len(data))
+    if PurePosixPath(safe_file_name(name)).suffix.lower() == SPECIMEN_SUFFIX:
+        # the DEM and Calibrate tabs take these; here it was read as a CSV and refused as
+        # "no rows of numbers in its 38 lines", which did not say where it belongs
+        raise ParameterError(f"{name}: a specimen file (TOML), not a shaker-test export; "
+                             f"upload it on the DEM or Calibrate tab, as 'or a specimen file "
+                             f"(TOML)'")
     with tempfile.TemporaryDirectory(prefix="pidcore_upload_") as folder:
         path = Path(folder) / safe_file_name(name)
         path.write_bytes(data)
@@ -672,6 +685,37 @@ def _apply_tables(rows: dict[str, dict], tables: Sequence[pd.DataFrame]) -> None
                 value = new.get(k, "")
                 if k != "file" and not _empty(value):
                     rows[target][k] = value
+
+
+def editor_settings(settings: pd.DataFrame) -> pd.DataFrame:
+    """``settings`` as the page's editor shows them: the :data:`TEXT_EDITED_NUMBERS` columns
+    as text (``50.0`` -> ``"50"``, ``5e-05`` -> ``"5e-05"``, an empty cell -> ``""``), the
+    others as they are. Text given (a cell typed before) is kept as typed."""
+    out = settings.copy()
+    for column in TEXT_EDITED_NUMBERS:
+        if column in out.columns:
+            out[column] = [_cell_text(v) for v in out[column]]
+    return out
+
+
+def _cell_text(value) -> str:
+    if _empty(value):
+        return ""
+    if isinstance(value, str):
+        return value
+    text = repr(float(value))  # the shortest text that reads back as the same number
+    return text[:-2] if text.endswith(".0") else text
+
+
+def fill_of(row: Mapping) -> float:
+    """The fill [%] of one file's settings row as typed in the page's editor (text) or given
+    by a settings table (a number): a :class:`pidcore.loadcase.LoadCaseError` naming the
+    file and the column for anything but a number in (0, 100]."""
+    from ..loadcase import check_fill
+
+    value = row.get("fill [%]")
+    return check_fill(value.strip() if isinstance(value, str) else value,
+                      f"{row['file']}, column fill [%]")
 
 
 def settings_template(settings: pd.DataFrame) -> bytes:

@@ -326,7 +326,8 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: str | Sequence[str],
               progress: bool = True, posterior_seed: int = 0,
               dem_config: DemConfig | None = None,
               specimen: Specimen | None = None,
-              on_design: Callable[[list[str]], None] | None = None) -> CalibrationResult:
+              on_design: Callable[[list[str]], None] | None = None,
+              on_run_done: Callable[[str], None] | None = None) -> CalibrationResult:
     """Fit ``fit`` parameters to measured SDCs (see the package docstring for the model).
 
     ``fit``: parameter names, a sequence or ``"a,b"`` as ``--fit`` takes them; ``priors``:
@@ -338,7 +339,8 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: str | Sequence[str],
     (cells, seed and steady cycles are then set from the arguments). ``specimen``: the
     specimen to start from (default: the paper's coupon). ``on_design``: called with the DEM
     run keys of the design before any run starts (:class:`pidcore.calibrate.runner.RunTally`
-    counts from them what a Ctrl-C kept).
+    counts from them what a Ctrl-C kept). ``on_run_done``: called with each DEM run's key as
+    it is saved (the app's progress: runs done of the design's).
     """
     start = time.perf_counter()
     points = list(points)
@@ -385,8 +387,10 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: str | Sequence[str],
     requests = _requests(points, dem_specs, design, config, specimen)
     if on_design is not None:
         on_design([r.key() for row in requests for r in row])
+    # on_done only where asked for: the call is otherwise the CLI's as before
+    told = {} if on_run_done is None else {"on_done": on_run_done}
     runs = run_requests([r for row in requests for r in row], store_path=store_path,
-                        workers=workers, progress=progress)
+                        workers=workers, progress=progress, **told)
     from ..store import Store
 
     store = Store(store_path)

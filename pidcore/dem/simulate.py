@@ -635,7 +635,8 @@ def check_drive_sampling(case: LoadCase, *, dt_s: float, contact_step_s: float,
 def simulate_load_case(case: LoadCase, config: DemConfig | None = None, *,
                        progress: bool = False,
                        specimen: Specimen | None = None,
-                       on_block: Callable[[int, int], None] | None = None) -> DemResult:
+                       on_block: Callable[[int, int], None] | None = None,
+                       on_settle: Callable[[float], None] | None = None) -> DemResult:
     """Simulate K independent cells under one load case and return the SDC (Eq. 8-10).
 
     Parameters
@@ -652,6 +653,10 @@ def simulate_load_case(case: LoadCase, config: DemConfig | None = None, *,
     on_block : callable, optional
         Called after every block as ``on_block(cycles_done, cycles_expected)`` (the
         expectation grows until the steady state is found); a job runner's progress hook.
+    on_settle : callable, optional
+        Called while the bed settles, before the first block (seconds to tens of seconds), as
+        ``on_settle(simulated_s)`` with the settle's simulated seconds so far; a job runner's
+        progress hook for that phase.
 
     Returns
     -------
@@ -732,14 +737,24 @@ def simulate_load_case(case: LoadCase, config: DemConfig | None = None, *,
         from tqdm import tqdm
         settling = tqdm(desc=f"DEM {case.key}: settling the bed", unit="ms", leave=False,
                         bar_format="{desc}: {n:.0f} ms simulated [{elapsed}]")
-        clock.on_simulated = lambda seconds: settling.update(seconds * 1e3)
+    if settling is not None or on_settle is not None:
+        settled = [0.0]
+
+        def simulated(seconds: float) -> None:
+            settled[0] += seconds
+            if settling is not None:
+                settling.update(seconds * 1e3)
+            if on_settle is not None:
+                on_settle(settled[0])
+
+        clock.on_simulated = simulated
     try:
         settle_time = settle_bed(state, KernelSettings(**common), config.start_packing,
                                  clock=clock)
     finally:
         if settling is not None:
             settling.close()
-            clock.on_simulated = None
+        clock.on_simulated = None
 
     axis = AXIS_INDEX[case.direction]
     unit = np.zeros(3)

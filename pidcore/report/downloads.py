@@ -6,8 +6,10 @@ downloads are exactly the files ``pidcore report`` writes.
 
 from __future__ import annotations
 
+import io
 import os
 import tempfile
+import zipfile
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -29,6 +31,9 @@ REPORT_MIME_TYPES: dict[str, str] = {
 CHOOSE_SPECIMEN_APP = "the Report tab's specimen choice for another"
 #: Name of the report files offered for download: ``pidcore_report.<format>``.
 DOWNLOAD_STEM = "pidcore_report"
+#: Folder of the figures that the Markdown and LaTeX files link (``figures/<stem>.png``), as
+#: :func:`pidcore.report.write_report` writes it beside them.
+FIGURES_FOLDER = "figures"
 
 
 def store_report_table(path: str | os.PathLike, dem_store: str | os.PathLike | None = None, *,
@@ -81,7 +86,8 @@ def report_files(path: str | os.PathLike, dem_store: str | os.PathLike | None = 
                  calibration: Calibration | None = None, specimen: Specimen | None = None,
                  ) -> dict[str, tuple[str, bytes, str]]:
     """The report of :func:`store_report_table` as downloads: format -> (file name, bytes,
-    MIME type), plus ``"csv_provenance"`` (the CSV's notes sidecar).
+    MIME type), plus ``"csv_provenance"`` (the CSV's notes sidecar) and ``"zip"``: all of
+    them with the ``figures/`` folder that the Markdown and LaTeX files link.
 
     Stores are verified first: a corrupt store raises :class:`pidcore.errors.StoreError` and
     nothing is written.
@@ -122,7 +128,23 @@ def report_files(path: str | os.PathLike, dem_store: str | os.PathLike | None = 
             sidecar = paths["csv_provenance"]
             out["csv_provenance"] = (f"{DOWNLOAD_STEM}{sidecar.name[len('report'):]}",
                                      sidecar.read_bytes(), "text/plain")
+            # the Markdown and LaTeX files link figures/<stem>.png: downloaded alone they
+            # showed a broken image and did not compile, so one archive holds them together
+            figure_files = {f"{FIGURES_FOLDER}/{p.name}": p.read_bytes()
+                            for key, p in paths.items() if key.startswith("figure:")}
+            out["zip"] = (f"{DOWNLOAD_STEM}.zip", _zip_bytes(
+                {name: data for name, data, _ in out.values()} | figure_files),
+                "application/zip")
             return out
     finally:
         for fig in figures.values():
             fig.clear()
+
+
+def _zip_bytes(files: dict[str, bytes]) -> bytes:
+    """A ZIP archive of ``{name inside the archive: content}``, names in the order given."""
+    buffer = io.BytesIO()
+    with zipfile.ZipFile(buffer, "w", compression=zipfile.ZIP_DEFLATED) as archive:
+        for name, data in files.items():
+            archive.writestr(name, data)
+    return buffer.getvalue()

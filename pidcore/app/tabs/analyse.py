@@ -4,7 +4,6 @@ results with plausibility warnings, Save."""
 from __future__ import annotations
 
 import hashlib
-import math
 
 import pandas as pd
 import streamlit as st
@@ -12,6 +11,7 @@ import streamlit as st
 from pidcore import defaults
 from pidcore.app import state, uploads
 from pidcore.constants import DRIVE_DIRECTIONS
+from pidcore.loadcase import parse_optional_rate
 from pidcore.units import display_number
 
 
@@ -40,24 +40,27 @@ def _settings_editor(measurements, tables: dict[str, pd.DataFrame], channel_name
         ss["settings_sig"] = sig
     channels = [uploads.AUTO_CHANNEL, uploads.NO_CHANNEL, *channel_names]
     key = "settings_" + hashlib.sha256(repr(sig).encode()).hexdigest()[:12]
+    # the numbers are edited as text, checked by pidcore (uploads.TEXT_EDITED_NUMBERS): the
+    # grid's number editor turned "1,5" into 15 and "1e-3" into -13 without a word
     edited = st.data_editor(
-        ss["settings_base"], key=key, hide_index=True, num_rows="fixed",
-        width="stretch", disabled=["file"],
+        uploads.editor_settings(ss["settings_base"]), key=key, hide_index=True,
+        num_rows="fixed", width="stretch", disabled=["file"],
         column_config={
-            "fill [%]": st.column_config.NumberColumn(min_value=0.1, max_value=100.0, step=1.0),
+            "fill [%]": st.column_config.TextColumn(help="packing ratio, 0 < fill <= 100"),
             "material": st.column_config.SelectboxColumn(
                 options=list(materials), required=True,
                 help="the table's materials, those of the specimen files and of the store's "
                      "DEM runs (own specimens)"),
             "direction": st.column_config.SelectboxColumn(options=list(DRIVE_DIRECTIONS),
                                                           required=True),
-            "vibrometer delay [µs]": st.column_config.NumberColumn(
-                step=1.0, help="output delay of the laser vibrometer, removed from velocity"),
-            "mass below gauge [g]": st.column_config.NumberColumn(
-                min_value=0.0, step=0.1, help="mass between force gauge and coupon"),
-            "baseline loss factor [-]": st.column_config.NumberColumn(
-                min_value=0.0, step=0.0001, format="%.5f",
+            "vibrometer delay [µs]": st.column_config.TextColumn(
+                help="output delay of the laser vibrometer, removed from velocity"),
+            "mass below gauge [g]": st.column_config.TextColumn(
+                help="mass between force gauge and coupon"),
+            "baseline loss factor [-]": st.column_config.TextColumn(
                 help="loss factor of the empty coupon, subtracted"),
+            "structure mass [g]": st.column_config.TextColumn(
+                help="mass of the empty structure above the gauge (coupon and fixture)"),
             **{f"{role} channel": st.column_config.SelectboxColumn(options=channels)
                for role in ("force", "velocity", "acceleration")},
             "inverted channels": st.column_config.TextColumn(
@@ -103,14 +106,15 @@ def _card(upload, row, sample_rate_hz, materials, given=()):
         if delay:
             st.info(f"{delay} (set it in the settings table)")
         try:
-            fill = float(row["fill [%]"])
-            if not math.isfinite(fill):
-                raise ValueError
+            fill = uploads.fill_of(row)
+        except PidcoreError as exc:  # names the file and the column itself
+            st.error(f"{exc}; set it in the settings table")
+            return None
+        try:
             case = load_case_of(record, fill_percent=fill, material=str(row["material"]),
                                 direction=str(row["direction"]))
         except (PidcoreError, ValueError, TypeError) as exc:
-            st.error(f"{name}: no valid load case ({exc or 'fill [%] missing'}); set it in "
-                     "the settings table")
+            st.error(f"{name}: no valid load case ({exc}); set it in the settings table")
             return None
         a = record.analysis
         m1, m2, m3, m4 = st.columns([1, 1, 1, 1.6])  # the SDC ± stderr needs the room
@@ -145,10 +149,15 @@ def render(stores) -> list:
                              accept_multiple_files=True, key="uploads",
                              max_upload_size=defaults.APP_MAX_UPLOAD_MB)
     with st.expander("Options for every file", expanded=False):
-        rate = st.number_input("sample rate if no time column [Hz]", value=0.0, min_value=0.0,
-                               step=1000.0, key="sample_rate",
-                               help="only for CSV/TXT files without a time column; 0 = none")
-    sample_rate_hz = rate if rate > 0 else None
+        # text read by pidcore: the browser's number box made a typed "25,6" 256 Hz
+        rate = st.text_input("sample rate if no time column [Hz]", "0", key="sample_rate",
+                             help="only for CSV/TXT files without a time column; 0 = none")
+        try:
+            sample_rate_hz = parse_optional_rate(rate, name="sample rate if no time column "
+                                                            "[Hz]")
+        except PidcoreError as exc:
+            st.error(f"{exc}; files are read without a sample rate")
+            sample_rate_hz = None
     measurements, tables, accepted = [], {}, []
     refused: list[uploads.RefusedTable] = []
     try:

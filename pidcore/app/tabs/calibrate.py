@@ -24,6 +24,7 @@ from pidcore.app.calibration import (
     specimen_label,
 )
 from pidcore.app.tabs import draw_polling, specimen_choice
+from pidcore.loadcase import parse_count
 from pidcore.specimen import calibrated_name
 
 #: Seconds between refreshes of the calibration's state while it runs.
@@ -46,11 +47,22 @@ def _task(stores, chosen: str, polling: bool) -> None:
         st.caption(f"The calibration below is of {task.specimen}; {chosen} is chosen now.")
     if task.state == "running":
         st.info(f"calibrating {task.specimen} ({', '.join(task.fit)}, {task.n_points} load "
-                f"case(s)): {task.elapsed_s():.0f} s elapsed; DEM runs are saved in the store "
-                "as they finish")
+                f"case(s)): {task.progress_text()}; DEM runs are saved in the store as they "
+                "finish")
+        if task.runs_total:
+            st.progress((task.runs_stored_before + task.runs_done) / task.runs_total)
+        if task.cancel_requested:
+            st.caption("cancelling: it stops when the running DEM run(s) end")
+        else:
+            st.button("Cancel calibration", key="calibration_cancel",
+                      on_click=runner_for(stores.path).cancel,
+                      help="stops at the next DEM run saved; saved runs are kept and reused")
         return
     if task.state == "failed":
         st.error(f"calibration of {task.specimen} failed: {task.message}")
+        return
+    if task.state == "cancelled":
+        st.warning(f"calibration of {task.specimen} cancelled: {task.message}")
         return
     st.success(f"calibrated {task.specimen} in {task.elapsed_s():.0f} s: {task.message}")
     out = task.outputs
@@ -210,10 +222,9 @@ def _form(stores, api, points: list, left_out: list[str]) -> str:
     extra = c1.text_input("more parameters (specimen fields, comma-separated)", "",
                           key="calibration_fit_extra",
                           help="e.g. friction, restitution (as `pidcore calibrate --fit`)")
-    cells = c2.number_input("cells per DEM run", min_value=2, max_value=64, value=4,
-                            key="calibration_cells")
-    design = c3.number_input("design points (0 = default)", min_value=0, value=0,
-                             key="calibration_design")
+    # text read by pidcore (parse_count): the browser's number box made "2,5" 25 cells
+    cells = c2.text_input("cells per DEM run", "4", key="calibration_cells", help="2 to 64")
+    design = c3.text_input("design points (0 = default)", "0", key="calibration_design")
     wanted = [*chosen, *(n.strip() for n in extra.split(",") if n.strip())]
     too_few = bool(wanted) and len(points) < points_needed(wanted)
     if too_few:
@@ -222,8 +233,10 @@ def _form(stores, api, points: list, left_out: list[str]) -> str:
                  disabled=not points or not wanted or too_few):
         try:
             fit = api.parse_fit(wanted, specimen)
-            started = runner_for(stores.path).start(api, points, fit=fit, cells=int(cells),
-                                                    design_size=int(design) or None,
+            n_cells = parse_count(cells, name="cells per DEM run", minimum=2, maximum=64)
+            n_design = parse_count(design, name="design points (0 = default)")
+            started = runner_for(stores.path).start(api, points, fit=fit, cells=n_cells,
+                                                    design_size=n_design or None,
                                                     specimen=specimen, notes=left_out)
         except PidcoreError as exc:
             st.error(page_words(str(exc)))

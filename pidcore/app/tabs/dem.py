@@ -15,7 +15,10 @@ from pidcore import defaults
 from pidcore.app import jobs, state
 from pidcore.app.tabs import draw_polling, specimen_choice
 from pidcore.constants import DRIVE_DIRECTIONS, PARTICLE_MATERIALS
-from pidcore.loadcase import parse_values
+from pidcore.loadcase import parse_count, parse_values
+
+#: Most cells a DEM job of the page simulates (the box's former bound).
+MAX_CELLS = 64
 
 #: Seconds between refreshes of the job table while jobs run.
 REFRESH_S = 1.0
@@ -24,11 +27,14 @@ REFRESH_S = 1.0
 CANCEL_WAIT_S = 1.5
 
 
-def _config(cells: int, seed: int, steady_cycles: int):
+def _config(cells: str, seed: str, steady_cycles: str):
     from pidcore.dem import DemConfig
 
-    return DemConfig(cells=int(cells), seed=int(seed),
-                     steady_cycles=int(steady_cycles) if steady_cycles > 0 else None)
+    steady = parse_count(steady_cycles, name="steady cycles (0 = automatic)")
+    return DemConfig(cells=parse_count(cells, name="cells simulated", minimum=1,
+                                       maximum=MAX_CELLS),
+                     seed=parse_count(seed, name="seed"),
+                     steady_cycles=steady if steady > 0 else None)
 
 
 def _runner(stores) -> jobs.DemJobRunner:
@@ -101,12 +107,12 @@ def render(stores) -> None:
     direction = c5.selectbox("drive direction", DRIVE_DIRECTIONS, key="dem_direction")
     with st.expander("numerical settings", expanded=False):
         d1, d2, d3 = st.columns(3)
-        cells = d1.number_input("cells simulated", min_value=1, max_value=64,
-                                value=defaults.DEM_CELLS, step=1, key="dem_cells")
-        seed = d2.number_input("seed", min_value=0, value=defaults.DEM_SEED, step=1,
-                               key="dem_seed")
-        steady = d3.number_input("steady cycles (0 = automatic)", min_value=0, value=0, step=1,
-                                 key="dem_steady")
+        # text read by pidcore (parse_count): the browser's number box made "1e3" steady
+        # cycles 1 and "2,5" cells 25 without a word
+        cells = d1.text_input("cells simulated", str(defaults.DEM_CELLS), key="dem_cells",
+                              help=f"1 to {MAX_CELLS}")
+        seed = d2.text_input("seed", str(defaults.DEM_SEED), key="dem_seed")
+        steady = d3.text_input("steady cycles (0 = automatic)", "0", key="dem_steady")
     b1, b2 = st.columns(2)
     start = b1.button("Run", type="primary", key="dem_run", disabled=refused is not None,
                       help="off while the chosen specimen file is refused"

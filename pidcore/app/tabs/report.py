@@ -17,6 +17,9 @@ REFRESH_S = 1.0
 STALE_BUILD_TEXT = ("The report files built before are not offered: the store or the choices "
                     "above changed since; build them again for this table.")
 
+#: Download buttons' labels of the report files that are not their format's name in capitals.
+DOWNLOAD_LABELS = {"csv_provenance": "CSV notes", "zip": "ZIP (all, with figures)"}
+
 #: The Report tab's default specimen: the paper's coupon, as ``pidcore report`` without
 #: ``--specimen``.
 DEFAULT_SPECIMEN = "paper_coupon (the default)"
@@ -128,7 +131,8 @@ def _build_state(build, polling: bool) -> None:
         return
     cols = st.columns(len(build.files))
     for col, (fmt, (name, data, mime)) in zip(cols, build.files.items(), strict=True):
-        label = "CSV notes" if fmt == "csv_provenance" else fmt.upper()
+        label = DOWNLOAD_LABELS.get(fmt, fmt.upper())
         col.download_button(label, data, file_name=name, mime=mime, key=f"download_{fmt}")
     st.caption("report.csv holds only the table (pandas.read_csv reads it as is); "
-               "provenance and notes are in the CSV notes file and in the other formats.")
+               "provenance and notes are in the CSV notes file and in the other formats. "
+               "MD and TEX link their figure in figures/: the ZIP holds them together.")
