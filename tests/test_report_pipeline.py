@@ -389,3 +389,17 @@ def test_a_store_of_several_measurements_is_reported_with_the_key_its_refusal_na
     table = pd.read_csv(out / "report.csv")
     # the measurement the key names, analysed as `analyze --key` analyses it, bit for bit
     assert list(table["SDC measured [-]"].dropna()) == [analyzed["sdc"]]
+
+
+@pytest.mark.usefixtures("undrawn_report_figures")
+def test_markup_in_a_file_name_reads_as_typed_in_the_markdown_report(tmp_path, dem_store):
+    # report.md passed a file name's raw HTML and link syntax to the viewer: "<b>" turned the
+    # row bold and "[x](javascript:...)" became a link (the HTML and LaTeX were escaped)
+    name = "<b>c<img src=x onerror=alert(1)>[x](javascript:alert(1))`k`_fill50_acrylic.csv"
+    file = _write_measurement(tmp_path / name)
+    result = make_report([file], out_dir=tmp_path / "r", dem_store=dem_store, formats="md")
+    text = result.paths["md"].read_text(encoding="utf-8")
+    assert (r"\<b\>c\<img src=x onerror=alert(1)\>\[x\](javascript:alert(1))\`k\`"
+            "_fill50_acrylic.csv") in text
+    assert "<b>" not in text.replace(r"\<b\>", "") and "<img" not in text.replace(r"\<img", "")
+    assert "[x](" not in text.replace(r"\[x\](", "")

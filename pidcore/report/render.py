@@ -94,8 +94,14 @@ def _write_csv(table: pd.DataFrame, figures: Mapping[str, Path], prov: Provenanc
     return path
 
 
+#: Characters a Markdown viewer would read as markup in a file or specimen name: raw HTML
+#: (``<b>``, ``<img onerror=...>``), links and images (``[x](javascript:...)``), code spans.
+#: Escaped with a backslash (CommonMark), so the name reads as typed, in a viewer and as text.
+_MD_MARKUP = str.maketrans({c: "\\" + c for c in "\\|<>[]`"})
+
+
 def _md_escape(text: str) -> str:
-    return text.replace("\\", "\\\\").replace("|", "\\|").replace("\n", " ")
+    return text.translate(_MD_MARKUP).replace("\n", " ")
 
 
 def _write_md(table: pd.DataFrame, figures: Mapping[str, Path], prov: Provenance,
