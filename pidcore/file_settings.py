@@ -521,20 +521,14 @@ def _refuse_fill_of_no_particle(path: str | os.PathLike, stated: StatedLoadCase 
                                 specimen: Specimen | None) -> None:
     """Refuse a stated fill that rounds to no particle of its cell (the rule `dem run`
     applies), naming the file and where the fill came from."""
-    from .constants import PARTICLE_MATERIALS
-    from .dem.simulate import particles_per_cell
+    from .dem.simulate import particles_of_stated_fill
 
     if stated is None:
         return
-    if specimen is not None and stated.material == specimen.particles.material:
-        cell = specimen
-    elif stated.material in PARTICLE_MATERIALS:
-        cell = None  # the paper's coupon with these particles
-    else:
-        return
     try:
         # "fill", not the keyword: the fill may come from the file name or a sidecar
-        particles_per_cell(stated.fill_percent, stated.material, specimen=cell, what="fill")
+        particles_of_stated_fill(stated.fill_percent, stated.material, specimen=specimen,
+                                 what="fill")
     except PidcoreError as exc:
         if not str(exc).startswith("fill "):  # not about the fill
             raise

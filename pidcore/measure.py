@@ -490,8 +490,16 @@ def save_analyses(store: Store | str | os.PathLike, results: Sequence[AnalyzedRe
                                  f"{len(given)}")
     for r, given in zip(results, per_result, strict=True):
         _refuse_other_settings(r, given)
+    from .dem.simulate import particles_of_stated_fill
+    from .loadcase import LoadCase
+
     for (name, case, _), more in zip(stated, extra, strict=True):
-        _refuse_fill_of_no_particle(name, case, (more or {}).get("specimen"))
+        # as `pidcore analyze` refuses it: a script saved a 0.5 % load case (50 % typed as a
+        # fraction) that no DEM run can match. A record naming its specimen is of another
+        # cell, which only the caller knows
+        if isinstance(case, LoadCase) and not (more or {}).get("specimen"):
+            particles_of_stated_fill(case.fill_percent, case.material,
+                                     what=f"{name}: fill_percent")
     store = store if isinstance(store, Store) else Store(store)
     _refuse_the_store_itself(store, results)
     with store.transaction():
@@ -504,19 +512,6 @@ def save_analyses(store: Store | str | os.PathLike, results: Sequence[AnalyzedRe
                 for r, o, (_, case, origin), more in zip(results, per_result, stated, extra,
                                                          strict=True)]
     return SavedAnalyses(keys, notes)
-
-
-def _refuse_fill_of_no_particle(name: str, case: object, specimen: object) -> None:
-    """Refuse a stated fill that rounds to no particle of the paper coupon's cell, as
-    ``pidcore analyze`` refuses it (:mod:`pidcore.file_settings`): a script saved a 0.5 %
-    load case (50 % typed as a fraction) that no DEM run can match. A record naming its
-    specimen is of another cell, which only the caller knows."""
-    from .constants import PARTICLE_MATERIALS
-    from .dem.simulate import particles_per_cell
-    from .loadcase import LoadCase
-
-    if isinstance(case, LoadCase) and not specimen and case.material in PARTICLE_MATERIALS:
-        particles_per_cell(case.fill_percent, case.material, what=f"{name}: fill_percent")
 
 
 def _analyzed_records(results: object) -> list[AnalyzedRecord]:

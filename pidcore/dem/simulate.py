@@ -293,6 +293,25 @@ def particles_per_cell(fill_percent: float, material_name: str | None = None, *,
     return particles_for_fill(fill_percent, full, what=what), full
 
 
+def particles_of_stated_fill(fill_percent: float, material: str, *,
+                             specimen: Specimen | None = None,
+                             what: str = "fill_percent") -> int | None:
+    """Particles per cell of a measurement's stated fill, in the cell it was tested in: the
+    ``specimen``'s where its particles are ``material``, else the paper's coupon's for a table
+    material (:data:`~pidcore.constants.PARTICLE_MATERIALS`); None where neither says which
+    cell (an own material without its specimen file). A fill that rounds to no particle is
+    refused (:func:`~pidcore.specimen.particles_for_fill`, naming it ``what``): the one rule of
+    ``pidcore analyze`` and :func:`pidcore.measure.save_analyses`, so that no stored load case
+    is one that no DEM run can match."""
+    if specimen is not None and material == specimen.particles.material:
+        cell = specimen
+    elif material in PARTICLE_MATERIALS:
+        cell = None  # the paper's coupon with these particles
+    else:
+        return None
+    return particles_per_cell(fill_percent, material, specimen=cell, what=what)[0]
+
+
 def _kernel_specializations() -> int:
     """Specialisations of the DEM kernel compiled (or loaded from Numba's cache) so far."""
     from .kernel import advance_cells
@@ -846,5 +865,6 @@ def config_parameters(case: LoadCase, config: DemConfig) -> dict:
 
 
 __all__ = ["LoadCase", "DemConfig", "simulate_load_case", "resolve_specimen", "choose_time_step",
-           "particles_per_cell", "vibrated_mass_kg", "coupon_mass_kg", "max_impact_speed",
+           "particles_of_stated_fill", "particles_per_cell", "vibrated_mass_kg",
+           "coupon_mass_kg", "max_impact_speed",
            "settle", "settle_bed", "clear_settled_beds", "config_parameters"]
