@@ -26,7 +26,7 @@ from dataclasses import dataclass
 
 from . import defaults
 from .constants import DRIVE_DIRECTIONS, PARTICLE_MATERIALS, STANDARD_GRAVITY
-from .errors import ParameterError, as_given
+from .errors import ParameterError, as_given, whole_number
 
 _MATERIAL_ALIASES = {"pmma": "acrylic", "aluminum": "aluminium"}
 
@@ -204,15 +204,20 @@ def check_fill_range(fill: float, where: str) -> None:
         raise ParameterError(f"{where} {as_given(fill)}: expected a fill in (0, 100] %")
 
 
+def _typed_number(token: str, *, name: str) -> float:
+    """One number as typed in a field, or a one-line error naming ``name`` and the text."""
+    try:
+        return float(token)
+    except ValueError:
+        raise ParameterError(f"{name}: {token!r} is not a number") from None
+
+
 def parse_values(text: str, *, name: str) -> list[float]:
     """Numbers typed as ``"50, 100 500"``: positive floats, or a one-line error naming
     ``name``."""
     values = []
     for token in text.replace(",", " ").replace(";", " ").split():
-        try:
-            value = float(token)
-        except ValueError:
-            raise ParameterError(f"{name}: {token!r} is not a number") from None
+        value = _typed_number(token, name=name)
         if not (math.isfinite(value) and value > 0):
             raise ParameterError(f"{name}: {token!r}, expected a positive number")
         values.append(value)
@@ -227,12 +232,10 @@ def parse_count(text: str, *, name: str, minimum: int = 0, maximum: int | None =
     so such fields are text read here."""
     token = text.strip()
     try:
-        value = float(token)
-    except ValueError:
-        value = math.nan
-    if not math.isfinite(value) or value != int(value):
-        raise ParameterError(f"{name}: {token!r} is not a whole number")
-    count = int(value)
+        # the rule of a count given in code (a fraction, inf or NaN is none), on the typed text
+        count = whole_number(name, float(token))
+    except ValueError:  # ParameterError is one: the typed text, not its float, is shown
+        raise ParameterError(f"{name}: {token!r} is not a whole number") from None
     if count < minimum or (maximum is not None and count > maximum):
         expected = (f"{minimum} to {maximum}" if maximum is not None
                     else f"at least {minimum}")
@@ -244,12 +247,9 @@ def parse_optional_rate(text: str, *, name: str) -> float | None:
     """A positive rate typed in a field, None where it is blank or 0 (none given), or a
     one-line error naming ``name`` (``"25,6"`` is refused, not read as 256)."""
     token = text.strip()
-    if token in ("", "0"):
+    if not token:
         return None
-    try:
-        value = float(token)
-    except ValueError:
-        raise ParameterError(f"{name}: {token!r} is not a number") from None
+    value = _typed_number(token, name=name)
     if value == 0:
         return None
     if not (math.isfinite(value) and value > 0):
