@@ -61,9 +61,10 @@ Public API
 load_specimen, paper_specimen, Specimen
     A specimen from a TOML file, the bundled paper coupon; ``Specimen.from_text``,
     ``with_values``, ``to_toml``, ``capacity_per_cell``.
-is_paper_coupon, measured_specimen_name, models_paper_coupon
+is_paper_coupon, measured_specimen_name, models_paper_coupon, hashed_name
     Whether a specimen (by hash, else by name) is the paper's coupon: the one rule; the name
-    a measurement of a specimen file is saved under; whether a file models the coupon.
+    a measurement of a specimen file is saved under; whether a file models the coupon; a
+    file's name with its hash, ``"name [45d792]"``.
 CellSpec, CouponSpec, ParticleSpec, PairSpec, PairsSpec
     Its sections (SI units in the field names).
 describe
@@ -1150,7 +1151,15 @@ def measured_specimen_name(specimen: Specimen) -> str:
         return specimen.name
     if specimen.name != uncalibrated_name(specimen.name) and models_paper_coupon(specimen):
         return specimen.name
-    return f"{specimen.name} [{specimen.hash[:6]}]"
+    return hashed_name(specimen.name, specimen.hash)
+
+
+def hashed_name(name: str, sha256: str) -> str:
+    """A specimen file by its name and the start of its hash, ``"name [45d792]"``: how the
+    pages label its DEM runs (:func:`pidcore.compare.specimens.specimen_label`) and the name
+    its tests are saved under (:func:`measured_specimen_name`), one spelling so that the two
+    meet."""
+    return f"{name or 'unnamed'} [{sha256[:6]}]"
 
 
 def models_paper_coupon(specimen: Specimen) -> bool:
@@ -1287,7 +1296,8 @@ def _capacity(shape: str, inscribed_diameter_m: float, height_m: float, radius_m
 
 
 __all__ = ["CellSpec", "CouponSpec", "PairSpec", "PairsSpec", "ParticleSpec", "Specimen",
-           "cell_geometry", "contact_law", "describe", "is_paper_coupon", "load_specimen",
+           "cell_geometry", "contact_law", "describe", "hashed_name", "is_paper_coupon",
+           "load_specimen",
            "measured_specimen_name", "models_paper_coupon", "numeric_fields",
            "paper_specimen", "particles_for_fill"]
 

@@ -61,12 +61,12 @@ class SpecimenRuns:
 def specimen_label(name: str, sha256: str) -> str:
     """A specimen as the pages name it: ``"name [hash6]"``; the paper's coupon (either table
     material, or no hash: a run stored before specimens existed) is ``"paper_coupon"``."""
-    from ..specimen import PAPER_SPECIMEN_NAME, is_paper_coupon
+    from ..specimen import PAPER_SPECIMEN_NAME, hashed_name, is_paper_coupon
 
     # a run without a hash predates specimens: it was the paper's coupon, whatever it names
     if not sha256 or is_paper_coupon(name, sha256):
         return PAPER_SPECIMEN_NAME
-    return f"{name or 'unnamed'} [{sha256[:6]}]"
+    return hashed_name(name, sha256)
 
 
 NOT_PAPER_SPECIMEN_NOTE = ("specimen {name} is not the paper's coupon: the paper's Table 3 is "
