@@ -47,6 +47,15 @@ def test_dem_config_refuses_wrong_types_naming_the_field(keywords, named):
         DemConfig(**keywords)
 
 
+def test_a_seed_beyond_the_largest_says_the_bound_it_breaks():
+    # 10^19 (an app seed typed 1e19) was refused as "expected a whole number >= 0"
+    assert DemConfig(seed=2**63 - 1).seed == 2**63 - 1
+    with pytest.raises(ParameterError) as refused:
+        DemConfig(seed=10**19)
+    assert str(refused.value) == ("seed: expected a whole number below 2^63 "
+                                  "(9223372036854775808), got 10000000000000000000")
+
+
 def test_dem_config_takes_whole_floats_as_counts():
     # a JSON or HDF5 reader may give 4.0 back for a count: the same run, kept an int
     config = DemConfig(cells=4.0, seed=np.int64(7), steady_cycles=20.0)

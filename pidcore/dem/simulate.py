@@ -141,8 +141,13 @@ class DemConfig:
             object.__setattr__(self, name, real_number(name, getattr(self, name)))
         if self.cells < 1:
             raise ParameterError(f"cells: expected >= 1, got {self.cells}")
-        if not 0 <= self.seed < 2**63:  # numpy's generators take no negative seed
+        if self.seed < 0:  # numpy's generators take no negative seed
             raise ParameterError(f"seed: expected a whole number >= 0, got {self.seed}")
+        if self.seed >= 2**63:
+            # the same bound, said: "expected a whole number >= 0" of 10^19 (typed in the
+            # app's seed field as 1e19) named a rule the value keeps
+            raise ParameterError(f"seed: expected a whole number below 2^63 "
+                                 f"({2**63}), got {self.seed}")
         check_damping_mode(self.normal_damping_mode)
         check_tangential_model(self.tangential_model)
         for name, value, allowed in (
