@@ -160,6 +160,9 @@ APP_PORT = 8501
 APP_MAX_UPLOAD_MB = 200
 #: Most load cases one DEM sweep started from the app may hold (larger grids: ``pidcore dem``).
 APP_MAX_DEM_CASES = 12
+#: Most cells of one DEM run the app's DEM and Calibrate tabs start (the pages' bound, not
+#: the library's: the library refuses only what memory cannot hold).
+APP_MAX_DEM_CELLS = 64
 #: Fill (packing ratio, %) the app proposes for an upload whose name states none (the paper's
 #: experiments were all at 50 %).
 APP_DEFAULT_FILL_PERCENT = 50.0

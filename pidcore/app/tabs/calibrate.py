@@ -11,6 +11,7 @@ from pathlib import Path
 import pandas as pd
 import streamlit as st
 
+from pidcore import defaults
 from pidcore.app.calibration import (
     calibration_api,
     fittable_names,
@@ -223,7 +224,8 @@ def _form(stores, api, points: list, left_out: list[str]) -> str:
                           key="calibration_fit_extra",
                           help="e.g. friction, restitution (as `pidcore calibrate --fit`)")
     # text read by pidcore (parse_count): the browser's number box made "2,5" 25 cells
-    cells = c2.text_input("cells per DEM run", "4", key="calibration_cells", help="2 to 64")
+    cells = c2.text_input("cells per DEM run", "4", key="calibration_cells",
+                          help=f"2 to {defaults.APP_MAX_DEM_CELLS}")
     design = c3.text_input("design points (0 = default)", "0", key="calibration_design")
     wanted = [*chosen, *(n.strip() for n in extra.split(",") if n.strip())]
     too_few = bool(wanted) and len(points) < points_needed(wanted)
@@ -233,7 +235,8 @@ def _form(stores, api, points: list, left_out: list[str]) -> str:
                  disabled=not points or not wanted or too_few):
         try:
             fit = api.parse_fit(wanted, specimen)
-            n_cells = parse_count(cells, name="cells per DEM run", minimum=2, maximum=64)
+            n_cells = parse_count(cells, name="cells per DEM run", minimum=2,
+                                  maximum=defaults.APP_MAX_DEM_CELLS)
             n_design = parse_count(design, name="design points (0 = default)")
             started = runner_for(stores.path).start(api, points, fit=fit, cells=n_cells,
                                                     design_size=n_design or None,

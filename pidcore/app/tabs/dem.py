@@ -17,8 +17,8 @@ from pidcore.app.tabs import draw_polling, specimen_choice
 from pidcore.constants import DRIVE_DIRECTIONS, PARTICLE_MATERIALS
 from pidcore.loadcase import parse_count, parse_values
 
-#: Most cells a DEM job of the page simulates (the box's former bound).
-MAX_CELLS = 64
+#: Most cells a DEM job of the page simulates.
+MAX_CELLS = defaults.APP_MAX_DEM_CELLS
 
 #: Seconds between refreshes of the job table while jobs run.
 REFRESH_S = 1.0
