@@ -63,7 +63,10 @@ def test_the_largest_coupon_area_is_kept_and_one_more_cell_refused():
     # the bound is on the cells' area: the last whole count inside it passes
     largest = int(MAX_COUPON_AREA_M2 / STEEL_CELL_AREA_M2)
     kept = Specimen.from_text(_edit("count = 286", f"count = {largest}"))
+    # the library's area is the cell's volume over its height, this one the hexagon's formula:
+    # two float routes to one number agree to a few ulps, far inside 1e-12
     assert kept.cells_area_m2() == pytest.approx(largest * STEEL_CELL_AREA_M2, rel=1e-12)
+    assert kept.cells_area_m2() <= MAX_COUPON_AREA_M2 < (largest + 1) * STEEL_CELL_AREA_M2
     with pytest.raises(ParameterError, match=r"\[cell\] count"):
         Specimen.from_text(_edit("count = 286", f"count = {largest + 1}"))
 

@@ -279,6 +279,7 @@ def test_specimen_check_says_what_sets_the_time_step(tmp_path, capsys):
         lines[name] = {line[:16].strip(): line[16:] for line in
                        capsys.readouterr().out.splitlines()}
         step = f"{facts['time_step_s']:.4g} s (auto: 1/10 of "
+        # rel=1e-15 below: the step is that time divided by 10 once, as here (one rounding)
         if name == "constant":  # the contact is the shorter: its tenth is the step
             assert facts["contact_time_s"] < facts["tangential_period_s"]
             assert facts["time_step_s"] == pytest.approx(facts["contact_time_s"] / 10,
