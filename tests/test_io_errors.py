@@ -117,14 +117,9 @@ def test_text_without_numbers_is_not_called_a_header_without_data(tmp_path):
         read_measurement(table)
 
 
-@pytest.mark.parametrize("text", ["Time [s]\n0\n0.001\n0.002\n", "Time\n[s]\n0\n0.001\n0.002\n",
-                                  '"Time [s]",\n0,\n0.001,\n0.002,\n'])
-def test_a_csv_of_only_a_time_column_says_it_has_no_channel(tmp_path, capsys, text):
-    # was "the header has 2 columns but the data rows have 1": 'Time [s]' split at its space
-    path = tmp_path / "times_fill50.csv"
-    path.write_text(text)
-    said = (f"{path}: only a time column ('Time'), no force or velocity channel; expected "
-            "channel columns beside it, e.g. 'Time [s],Force [N],Velocity [m/s]'")
+def _refused_alike_by_reader_and_cli(path, said: str, tmp_path, capsys) -> None:
+    """``path`` is refused with ``said`` by the reader, and by ``pidcore analyze`` in that
+    one line with exit code 2 and no store written."""
     with pytest.raises(InputFileError) as refused:
         read_measurement(path)
     assert str(refused.value) == said
@@ -134,6 +129,17 @@ def test_a_csv_of_only_a_time_column_says_it_has_no_channel(tmp_path, capsys, te
     assert main(["analyze", str(path), "--store", str(store)]) == 2
     assert capsys.readouterr().err == f"pidcore analyze: error: {said}\n"
     assert not store.exists()
+
+
+@pytest.mark.parametrize("text", ["Time [s]\n0\n0.001\n0.002\n", "Time\n[s]\n0\n0.001\n0.002\n",
+                                  '"Time [s]",\n0,\n0.001,\n0.002,\n'])
+def test_a_csv_of_only_a_time_column_says_it_has_no_channel(tmp_path, capsys, text):
+    # was "the header has 2 columns but the data rows have 1": 'Time [s]' split at its space
+    path = tmp_path / "times_fill50.csv"
+    path.write_text(text)
+    said = (f"{path}: only a time column ('Time'), no force or velocity channel; expected "
+            "channel columns beside it, e.g. 'Time [s],Force [N],Velocity [m/s]'")
+    _refused_alike_by_reader_and_cli(path, said, tmp_path, capsys)
 
 
 def test_a_one_column_csv_is_that_column_and_a_wider_header_still_says_so(tmp_path):
@@ -160,15 +166,7 @@ def test_a_csv_channel_shorter_than_its_time_column_says_where_it_ends(tmp_path,
     # the 4th row's time: 3 ms, from the 1 kHz time column
     said = (f"{path}: channel 'Velocity' ends early, at data row 4 of 6 (t = 0.003 s): the 2 "
             "rows after it hold no value; expected a value in every row its time column has")
-    with pytest.raises(InputFileError) as refused:
-        read_measurement(path)
-    assert str(refused.value) == said
-    from pidcore.cli import main
-
-    store = tmp_path / "s.h5"
-    assert main(["analyze", str(path), "--store", str(store)]) == 2
-    assert capsys.readouterr().err == f"pidcore analyze: error: {said}\n"
-    assert not store.exists()
+    _refused_alike_by_reader_and_cli(path, said, tmp_path, capsys)
     empty = tmp_path / "empty_column.csv"
     empty.write_text("Time [s],Force [N],Velocity [m/s]\n"
                      + "\n".join(f"{k / 1000},{k}," for k in range(6)) + "\n")
