@@ -281,6 +281,12 @@ def test_the_settings_grid_edits_numbers_as_text_and_pidcore_reads_them_as_typed
     for fill in ("12,5", "-30", ""):
         with pytest.raises(LoadCaseError, match=re.escape("a_fill50.csv, column fill [%]: ")):
             uploads.fill_of({**row, "fill [%]": fill})
+    # a cell cleared in the grid is None (or blank text): said empty, not "fill None"
+    for cleared in (None, "", "  ", math.nan):
+        with pytest.raises(LoadCaseError) as refused:
+            uploads.fill_of({**row, "fill [%]": cleared})
+        assert str(refused.value) == ("a_fill50.csv, column fill [%]: empty; expected a "
+                                      "packing ratio in (0, 100] %")
 
 
 def test_an_own_specimens_material_is_offered_once_its_dem_runs_are_stored():

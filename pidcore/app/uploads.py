@@ -711,11 +711,16 @@ def fill_of(row: Mapping) -> float:
     """The fill [%] of one file's settings row as typed in the page's editor (text) or given
     by a settings table (a number): a :class:`pidcore.loadcase.LoadCaseError` naming the
     file and the column for anything but a number in (0, 100]."""
-    from ..loadcase import check_fill
+    from ..loadcase import LoadCaseError, check_fill
 
     value = row.get("fill [%]")
-    return check_fill(value.strip() if isinstance(value, str) else value,
-                      f"{row['file']}, column fill [%]")
+    value = value.strip() if isinstance(value, str) else value
+    where = f"{row['file']}, column fill [%]"
+    if _empty(value):
+        # a cell cleared in the grid comes back as None: "fill None is not a number" named
+        # Python's word for nothing on the page
+        raise LoadCaseError(f"{where}: empty; expected a packing ratio in (0, 100] %")
+    return check_fill(value, where)
 
 
 def settings_template(settings: pd.DataFrame) -> bytes:
