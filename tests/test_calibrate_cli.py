@@ -75,6 +75,20 @@ def test_an_out_that_is_a_file_and_a_negative_seed_are_refused_before_any_run(ca
     assert not (tmp_path / "dem.h5").exists()
 
 
+def test_the_dem_runs_own_refusals_name_the_options(capsys, tmp_path, monkeypatch):
+    # more cells than memory holds, and a seed past 2^63, were refused as "cells 2: ..." and
+    # "seed: ...", keywords `pidcore calibrate` has as options
+    import pidcore.dem.simulate as simulate
+
+    table = str(_table(tmp_path))
+    _refused(capsys, tmp_path, ["--data", table, "--fit", "restitution", "--seed",
+                                str(2**63)],
+             "error: --seed: expected a whole number below 2^63")
+    monkeypatch.setattr(simulate, "_physical_memory_bytes", lambda: 1)  # no cell fits
+    _refused(capsys, tmp_path, ["--data", table, "--fit", "restitution"],
+             "error: --cells 2: the state of 2 cells of ")
+
+
 def test_fewer_load_cases_than_parameters_are_refused(capsys, tmp_path):
     # two points cannot fix fixture mass, baseline and the model discrepancy
     path = _table(tmp_path, HEADER + "500,5,50,0.6\n1000,5,50,0.6\n")

@@ -299,6 +299,20 @@ def test_a_negative_seed_is_one_line_naming_the_option(tmp_path, capsys, command
     assert not store.exists()
 
 
+@pytest.mark.parametrize("command", [
+    ["dem", "run", "--frequency", "500", "--acceleration", "5", "--fill", "50"],
+    ["dem", "sweep", "--frequencies", "500", "--accelerations", "5", "--fills", "50"]])
+def test_a_seed_past_the_largest_is_one_line_naming_the_option(tmp_path, capsys, command):
+    # DemConfig's refusal was printed with its keyword: "seed: expected ..."
+    store = tmp_path / "s.h5"
+    assert main([*command, "--seed", str(2**63), "--store", str(store), "--no-progress"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1
+    assert err.endswith(": error: --seed: expected a whole number below 2^63 "
+                        f"({2**63}), got {2**63}\n")
+    assert not store.exists()
+
+
 def test_a_negative_seed_is_refused_by_the_library_too():
     from pidcore.dem.simulate import DemConfig
     from pidcore.errors import ParameterError

@@ -74,7 +74,7 @@ COMMAND_FLAGS: dict[str, dict[str, str]] = {
         "fill_reference='paper'": "--fill-reference paper",
         "fill_reference": "--fill-reference", "time_step": "--time-step",
         "^cells": "--cells", "frequency_hz": "--frequency", "acceleration_g": "--acceleration",
-        "^material": "--material", "^direction": "--direction",
+        "^material": "--material", "^direction": "--direction", "^seed": "--seed",
     },
     "calibrate": {
         "^fit/priors": "--fit/--prior", "^fit": "--fit", "fit=": "--fit ",
@@ -84,6 +84,8 @@ COMMAND_FLAGS: dict[str, dict[str, str]] = {
         "cross_validate": "--cross-validate", "^method": "--method", "method=": "--method ",
         "specimen=": "--specimen ", "read_measured_table": "--data",
         "write_outputs(result, out_dir)": "pidcore calibrate --out",
+        # the DEM runs' own refusals (more cells than memory holds, a seed past 2^63)
+        "^cells": "--cells", "^seed": "--seed",
     },
     "bench signal": {"n_samples": "--samples"},
 }
