@@ -2077,6 +2077,11 @@ def test_a_specimen_file_uploaded_as_a_measurement_is_told_where_it_belongs():
     assert parsed.error == ("my coupon.TOML: a specimen file (TOML), not a shaker-test export; "
                             "upload it on the DEM or Calibrate tab, as 'or a specimen file "
                             "(TOML)'")
+    # the file is what is wrong, as for any other upload that holds no measurement
+    from pidcore.errors import InputFileError
+
+    with pytest.raises(InputFileError, match=r"^my coupon\.TOML: a specimen file"):
+        uploads.read_upload("my coupon.TOML", toml)
 
 
 def test_a_running_calibration_counts_its_design_runs_done(tmp_path):

@@ -32,7 +32,7 @@ from ..compare.loadcase import (
     SETTINGS_COLUMN_LABELS,
 )
 from ..constants import PARTICLE_MATERIALS
-from ..errors import ParameterError, PidcoreError
+from ..errors import InputFileError, ParameterError, PidcoreError
 from ..units import display_number
 from .vocabulary import page_terms
 
@@ -103,7 +103,8 @@ def read_upload(name: str, data: bytes, *, sample_rate_hz: float | None = None) 
     if PurePosixPath(safe_file_name(name)).suffix.lower() == SPECIMEN_SUFFIX:
         # the DEM and Calibrate tabs take these; here it was read as a CSV and refused as
         # "no rows of numbers in its 38 lines", which did not say where it belongs
-        raise ParameterError(f"{name}: a specimen file (TOML), not a shaker-test export; "
+        # the file, not a parameter, is wrong here (errors.InputFileError: holds nothing usable)
+        raise InputFileError(f"{name}: a specimen file (TOML), not a shaker-test export; "
                              f"upload it on the DEM or Calibrate tab, as 'or a specimen file "
                              f"(TOML)'")
     with tempfile.TemporaryDirectory(prefix="pidcore_upload_") as folder:
