@@ -621,7 +621,7 @@ ANALYSIS_UNITS = {
     "loss_factor_stderr": RATIO_UNIT, "sdc": RATIO_UNIT, "sdc_stderr": RATIO_UNIT,
     "damping_ratio": RATIO_UNIT, "energy_per_cycle_j": "J", "max_kinetic_energy_j": "J",
     "force_amplitude_n": "N", "velocity_amplitude_m_s": "m/s", "displacement_amplitude_m": "m",
-    "n_periods": COUNT_UNIT, "fill_percent": "%",
+    "n_periods": COUNT_UNIT, "sdc_stderr_dof": COUNT_UNIT, "fill_percent": "%",
     # arrays (analysis_arrays): harmonic numbers and the phasors x(t) = Re(X e^{j n w t})
     "harmonics": COUNT_UNIT, "force_phasors_n": "N", "velocity_phasors_m_s": "m/s",
 }
@@ -638,6 +638,10 @@ def analysis_record(r: AnalyzedRecord) -> dict:
         notes["damping_ratio_note"] = a.damping_ratio_note
     if not (math.isfinite(a.sdc_stderr) and math.isfinite(a.loss_factor_stderr)):
         notes["uncertainty_note"] = a.uncertainty_note
+    if math.isfinite(a.sdc_stderr_dof):
+        # n_blocks - 1: a 95 % band of sdc_stderr takes Student's t quantile with them; left
+        # out (not NaN) where there is no standard error, as in a record of an older pidcore
+        notes["sdc_stderr_dof"] = a.sdc_stderr_dof
     record = {
         "frequency_hz": a.frequency_hz,
         "acceleration_g": a.acceleration_g,

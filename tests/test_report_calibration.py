@@ -314,7 +314,8 @@ def test_a_measurement_is_checked_against_the_band_of_its_own_stderr(tmp_path):
     assert high[1] == pytest.approx(0.5 + math.hypot(0.12, 1.959964 * 0.001), rel=1e-6)
     assert out["note"][1] == ("calibrated band for this measurement's SDC stderr 0.001 (the "
                               "calibration's own measurement at this load case had SDC "
-                              "stderr 0.1)")
+                              "stderr 0.1); its 95 % widening: normal quantile 1.96, the "
+                              "degrees of freedom of the stderr unknown")
     assert out["note"][0] == out["note"][2] == ""
     # a calibration.json written before the error-free band was kept: the stated band
     old = load_calibration(_write(tmp_path / "old.json", [_prediction(50, 5, 50, 0.5, 0.2,

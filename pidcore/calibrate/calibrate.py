@@ -187,6 +187,8 @@ class CalibrationResult:
                "rms_in_sample": "-", "loo_rms": "-", "energy_per_cycle_per_cell_start_j": "J",
                "energy_per_cycle_per_cell_calibrated_j": "J", "low95_j": "J", "high95_j": "J",
                "wall_s": "s"}
+        if any("measured_stderr_dof" in r for r in self.predictions):
+            out["measured_stderr_dof"] = "-"  # degrees of freedom: a count
         for name in self.fixed:
             out[name] = parameter_spec(name, self.specimen).unit
         out.update((s.name, s.unit) for s in self.specs)
@@ -197,7 +199,10 @@ def _public(row: dict) -> dict:
     keys = ("frequency_hz", "acceleration_g", "fill_percent", "material", "measured",
             "measured_stderr", "predicted", "low95", "high95", "low95_without_stderr",
             "high95_without_stderr")
-    return {k: row[k] for k in keys}
+    out = {k: row[k] for k in keys}
+    if "measured_stderr_dof" in row:
+        out["measured_stderr_dof"] = row["measured_stderr_dof"]
+    return out
 
 
 def _requests(points: Sequence[MeasuredPoint], dem_specs: Sequence[ParameterSpec],
@@ -371,6 +376,14 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: str | Sequence[str],
     if all(p.sdc_stderr == 0 for p in points):
         notes.append("no sdc_stderr in the data: measurement error is carried by the "
                      "model-discrepancy term alone")
+    with_dof = sorted({p.sdc_stderr_dof for p in points
+                       if p.sdc_stderr > 0 and math.isfinite(p.sdc_stderr_dof)})
+    if with_dof:
+        # which quantile the 95 % bands used: it sets how wide the measurement's part is
+        notes.append("95 % bands: the measurement error of a point whose sdc_stderr states its "
+                     "degrees of freedom (" + ", ".join(f"{d:g}" for d in with_dof)
+                     + ") is drawn from Student's t with them (t_0.975,7 = 2.365, not 1.96); "
+                     "of a point without them, from a normal")
     dem_specs = [s for s in specs if s.kind == "dem"]
     if not dem_specs and design_size not in (None, 1):
         # nothing varies between DEM runs: one run per load case, whatever the design asks
@@ -532,6 +545,9 @@ def _row(point: MeasuredPoint, prediction: dict) -> dict:
            "fill_percent": point.fill_percent, "material": point.material,
            "measured": point.sdc,
            "measured_stderr": point.sdc_stderr}
+    if math.isfinite(point.sdc_stderr_dof):
+        # only where known: a calibration from a table without it writes what it always did
+        row["measured_stderr_dof"] = point.sdc_stderr_dof
     row.update(prediction)
     row["inside95"] = bool(row["low95"] <= point.sdc <= row["high95"])
     row["error"] = row["predicted"] - point.sdc

@@ -1,7 +1,9 @@
 """Measured SDCs to calibrate against: a table (CSV) or the store's analysed measurements.
 
 Table columns (one row per load case): ``frequency_hz``, ``acceleration_g``, ``fill_percent``,
-``sdc`` and optionally ``sdc_stderr``, ``energy_per_cycle_j``, ``material``, ``specimen``.
+``sdc`` and optionally ``sdc_stderr``, ``sdc_stderr_dof`` (its degrees of freedom: ``n_blocks - 1``
+of a pidcore analysis, 7 by default; empty or absent: unknown, taken as normal),
+``energy_per_cycle_j``, ``material``, ``specimen``.
 
 A measured point carries its particle material and specimen label: measurements of acrylic and
 steel particles (or of two specimens) at one load case are different points, never averaged;
@@ -21,11 +23,13 @@ import numpy as np
 import pandas as pd
 
 from .. import defaults
+from ..compare.align import stored_stderr_dof
 from ..compare.plausibility import SDC_UPPER_BOUND, stored_findings
 from ..errors import InputFileError, ParameterError, as_given, real_number
 
 REQUIRED_COLUMNS = ("frequency_hz", "acceleration_g", "fill_percent", "sdc")
-OPTIONAL_COLUMNS = ("sdc_stderr", "energy_per_cycle_j", "material", "specimen")
+OPTIONAL_COLUMNS = ("sdc_stderr", "sdc_stderr_dof", "energy_per_cycle_j", "material",
+                    "specimen")
 #: Material of a measurement that states none (the paper's particles).
 DEFAULT_MATERIAL = defaults.COMPARE_DEFAULT_MATERIAL
 
@@ -33,7 +37,9 @@ DEFAULT_MATERIAL = defaults.COMPARE_DEFAULT_MATERIAL
 @dataclass(frozen=True)
 class MeasuredPoint:
     """One measured load case: SDC (Eq. 11) and its standard error (0: not given), with the
-    particle material and the specimen label ("": none named) it was measured on."""
+    particle material and the specimen label ("": none named) it was measured on.
+    ``sdc_stderr_dof``: the degrees of freedom of the standard error (a mean of 8 block
+    estimates: 7), which make its 95 % band Student's t's; NaN where unknown (normal)."""
 
     frequency_hz: float
     acceleration_g: float
@@ -42,6 +48,9 @@ class MeasuredPoint:
     sdc_stderr: float = 0.0
     material: str = DEFAULT_MATERIAL
     specimen: str = ""
+    # how far the stderr can be trusted, not which point it is (and NaN, unknown, would
+    # make a point unequal to its own copy)
+    sdc_stderr_dof: float = field(default=math.nan, compare=False)
     # where the point was read (a table and its line, or a store), for messages naming it; not
     # part of the point's identity
     source: str = field(default="", compare=False)
@@ -63,6 +72,12 @@ class MeasuredPoint:
                                  "in (0, 100] %")
         if self.sdc_stderr < 0:
             raise ParameterError(f"sdc_stderr {as_given(self.sdc_stderr)}: expected >= 0")
+        dof = real_number("sdc_stderr_dof", self.sdc_stderr_dof)
+        if not (math.isnan(dof) or (math.isfinite(dof) and dof > 0)):
+            raise ParameterError(f"sdc_stderr_dof {as_given(dof)}: expected the degrees of "
+                                 "freedom of sdc_stderr (> 0, e.g. n_blocks - 1), or NaN where "
+                                 "unknown")
+        object.__setattr__(self, "sdc_stderr_dof", dof)
         # a negative sdc is a draw of noise around a small one, which a synthetic study
         # (docs/calibration_audit) fits as it is; a measured table refuses it
         if self.sdc > SDC_UPPER_BOUND:
@@ -124,6 +139,13 @@ def read_measured_table(path: str | os.PathLike, *,
                 raise InputFileError(f"{where}: {column} {raw!r} is not a number") from None
         if values["sdc"] < 0:
             raise InputFileError(f"{where}: sdc {as_given(values['sdc'])}: expected >= 0")
+        raw_dof = row.get("sdc_stderr_dof", "")
+        raw_dof = "" if raw_dof is None or (isinstance(raw_dof, float) and math.isnan(raw_dof)) \
+            else raw_dof
+        try:  # empty or absent: unknown, the normal's quantile as before the column existed
+            values["sdc_stderr_dof"] = math.nan if raw_dof == "" else float(raw_dof)
+        except (TypeError, ValueError):
+            raise InputFileError(f"{where}: sdc_stderr_dof {raw_dof!r} is not a number") from None
         try:
             points.append(MeasuredPoint(material=_text_cell(row.get("material"), default_material),
                                         specimen=_text_cell(row.get("specimen"), ""),
@@ -154,7 +176,9 @@ def measured_from_store(store_path: str | os.PathLike, *,
     and steel particles would fit neither); a record without a material is the paper's acrylic,
     one without a specimen label has none (""). A load case measured several times gives the
     mean and the standard error of the mean (or the analysis's own standard error when
-    measured once). Measured frequency and
+    measured once). The standard error's degrees of freedom go with it: repeats - 1, or the
+    analysis's ``sdc_stderr_dof`` (n_blocks - 1; NaN in a record
+    without it, of an older pidcore). Measured frequency and
     acceleration are rounded to 3 and 2 significant digits to find the load case; the
     analyses must carry ``fill_percent`` (from a sidecar). Records the plausibility checks
     refuse (saved with ``--accept-implausible``: a negative SDC beyond its noise, one above
@@ -199,10 +223,14 @@ def measured_from_store(store_path: str | os.PathLike, *,
         sdc = group["sdc"].to_numpy(float)
         if len(sdc) > 1:
             se = float(np.std(sdc, ddof=1) / math.sqrt(len(sdc)))
+            dof = float(len(sdc) - 1)
         else:
             se = float(group.get("sdc_stderr", pd.Series([0.0])).fillna(0.0).iloc[0])
+            dof = stored_stderr_dof(group.get("sdc_stderr_dof", pd.Series([math.nan])).iloc[0]) \
+                if se > 0 else math.nan
         points.append(MeasuredPoint(float(f), float(a), float(p), float(sdc.mean()), se,
-                                    str(material), str(specimen), source=str(store_path)))
+                                    str(material), str(specimen), sdc_stderr_dof=dof,
+                                    source=str(store_path)))
     if not points:
         raise InputFileError(f"{store_path}: no analysed measurement has a complete load case")
     return points

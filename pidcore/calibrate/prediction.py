@@ -27,8 +27,41 @@ if TYPE_CHECKING:  # pragma: no cover
 _REQUIRED = ("frequency_hz", "acceleration_g", "fill_percent", "predicted", "low95", "high95")
 
 
-#: Two-sided 95 % quantile of the normal distribution (a measurement's stderr -> half-width).
+#: Two-sided 95 % quantile of the normal distribution (a measurement's stderr -> half-width)
+#: where the stderr's degrees of freedom are unknown.
 Z95 = 1.959963984540054
+
+
+def band_quantile(dof: float = math.nan) -> float:
+    """Two-sided 95 % quantile that turns a standard error into a half-width: Student's
+    t_{0.975, dof} where the stderr's degrees of freedom are known (``n_blocks - 1`` of an
+    analysis by pidcore: the errors of a mean over 8 block estimates follow a t with 7,
+    whose quantile is 2.365; 1.96 covered ~91 %), else (NaN) the normal's :data:`Z95`.
+
+    Raises
+    ------
+    ParameterError
+        ``dof`` not NaN and not > 0.
+    """
+    from scipy.stats import t as student_t
+
+    dof = real_number("dof", dof)
+    if math.isnan(dof):
+        return Z95
+    if not dof > 0:
+        raise ParameterError(f"dof {dof!r}: expected the degrees of freedom of a standard "
+                             "error (> 0, e.g. n_blocks - 1), or NaN where unknown")
+    return float(student_t.ppf(0.975, dof))
+
+
+def quantile_label(dof: float = math.nan) -> str:
+    """Which quantile :func:`band_quantile` uses, for a line beside a band: e.g.
+    ``'Student t quantile 2.365 of 7 degrees of freedom'`` or ``'normal quantile 1.96, the
+    degrees of freedom of the stderr unknown'``."""
+    q = band_quantile(dof)
+    if math.isnan(dof):
+        return f"normal quantile {q:.3g}, the degrees of freedom of the stderr unknown"
+    return f"Student t quantile {q:.4g} of {dof:.4g} degrees of freedom"
 
 
 @dataclass(frozen=True)
@@ -50,6 +83,9 @@ class CalibratedPrediction:
     measured_stderr : float
         Standard error of that SDC [-] (0: none stated; NaN: a calibration.json written
         before it was kept).
+    measured_stderr_dof : float
+        Degrees of freedom of that standard error (``n_blocks - 1`` of a pidcore analysis;
+        NaN: unknown, its errors taken as normal).
     low95_without_stderr, high95_without_stderr : float
         The band without measurement error [-] (NaN in an older calibration.json).
     """
@@ -62,26 +98,36 @@ class CalibratedPrediction:
     measured_stderr: float = math.nan
     low95_without_stderr: float = math.nan
     high95_without_stderr: float = math.nan
+    measured_stderr_dof: float = math.nan
 
-    def band(self, stderr: float = math.nan) -> tuple[float, float]:
-        """The 95 % band [-] a measurement with standard error ``stderr`` is checked against.
+    def band(self, stderr: float = math.nan, dof: float = math.nan) -> tuple[float, float]:
+        """The 95 % band [-] a measurement with standard error ``stderr`` of ``dof`` degrees
+        of freedom (NaN: unknown) is checked against.
 
-        The fitted point's band (:attr:`low95`, :attr:`high95`) where ``stderr`` is that
-        point's, unknown (NaN) or cannot be told apart (an older calibration.json); else the
-        band without measurement error widened by ``stderr`` (each side's distance from
-        :attr:`sdc` and 1.96 ``stderr`` added in quadrature, as independent normal errors
-        add; cut at 0): a precise new measurement is not judged by the wider band of a noisy
-        fitted one, nor a noisy one by a narrow band.
+        The fitted point's band (:attr:`low95`, :attr:`high95`) where ``stderr`` and ``dof``
+        are that point's, ``stderr`` is unknown (NaN) or they cannot be told apart (an older
+        calibration.json); else the band without measurement error widened by ``stderr``
+        (each side's distance from :attr:`sdc` and q ``stderr`` added in quadrature, q the
+        :func:`band_quantile` of ``dof``: Student's t where known, 1.96 where not; cut at 0):
+        a precise new measurement is not judged by the wider band of a noisy fitted one, nor
+        a noisy one by a narrow band. The quadrature is exact for normal errors; with the
+        t's quantile it is at most ~1 % wider than the exact quantile of normal + t (e.g.
+        3.07 for 3.05 where both parts are equal: on the safe side), and exact where either
+        part dominates (tests/test_calibrate_band_quantile.py checks its coverage).
         """
         stderr = real_number("stderr", stderr)
+        q = band_quantile(dof)  # checks dof before any early return
+        same_dof = (math.isnan(dof) and math.isnan(self.measured_stderr_dof)) or \
+            dof == self.measured_stderr_dof
         same = (not math.isfinite(stderr) or not math.isfinite(self.measured_stderr)
                 or not math.isfinite(self.low95_without_stderr)
-                or math.isclose(stderr, self.measured_stderr, rel_tol=1e-9, abs_tol=1e-12))
+                or (same_dof and math.isclose(stderr, self.measured_stderr, rel_tol=1e-9,
+                                              abs_tol=1e-12)))
         if same:
             return self.low95, self.high95
         if stderr < 0:
             raise ParameterError(f"stderr {stderr!r}: expected a standard error >= 0")
-        width = Z95 * stderr
+        width = q * stderr
         low = self.sdc - math.hypot(self.sdc - self.low95_without_stderr, width)
         high = self.sdc + math.hypot(self.high95_without_stderr - self.sdc, width)
         if not math.isfinite(high):  # a stderr near 1e308: its band has no finite bound
@@ -89,10 +135,11 @@ class CalibratedPrediction:
                                  "standard error of an SDC")
         return max(low, 0.0), high
 
-    def contains(self, sdc: float, stderr: float = math.nan) -> bool:
+    def contains(self, sdc: float, stderr: float = math.nan, dof: float = math.nan) -> bool:
         """True if ``sdc`` lies inside the 95 % band of a measurement with standard error
-        ``stderr`` (:meth:`band`; bounds included); False for NaN."""
-        low, high = self.band(stderr)
+        ``stderr`` of ``dof`` degrees of freedom (:meth:`band`; bounds included); False for
+        NaN."""
+        low, high = self.band(stderr, dof)
         return bool(low <= sdc <= high)
 
 
@@ -141,7 +188,8 @@ class Calibration:
         ``direction``, ``sdc predicted [-]``, ``low95 [-]``, ``high95 [-]`` (the band of a
         measurement with the fitted point's standard error), ``sdc measured [-]``,
         ``sdc measured stderr [-]``, ``low95 without stderr [-]``,
-        ``high95 without stderr [-]`` (NaN where the file does not state them).
+        ``high95 without stderr [-]``, ``sdc measured stderr dof [-]`` (NaN where the file
+        does not state them).
         """
         return pd.DataFrame([{
             "frequency [Hz]": p.load_case.frequency_hz,
@@ -156,6 +204,7 @@ class Calibration:
             "sdc measured stderr [-]": p.measured_stderr,
             "low95 without stderr [-]": p.low95_without_stderr,
             "high95 without stderr [-]": p.high95_without_stderr,
+            "sdc measured stderr dof [-]": p.measured_stderr_dof,
         } for p in self.predictions])
 
     def plot(self, ax: Any = None) -> Any:
@@ -378,11 +427,17 @@ def calibration_from_json(text: str | bytes, source: str | os.PathLike, *,
         if measured_stderr < 0:  # NaN (not stated) passes
             raise ParameterError(f"{path}: predictions[{i}].measured_stderr must be a standard "
                                  f"error >= 0, got {measured_stderr!r}")
+        # absent in a calibration.json of a table without it (or written before it was kept)
+        dof = _optional(row.get("measured_stderr_dof"), f"predictions[{i}].measured_stderr_dof",
+                        path)
+        if not dof > 0 and not math.isnan(dof):
+            raise ParameterError(f"{path}: predictions[{i}].measured_stderr_dof must be degrees "
+                                 f"of freedom > 0, got {dof!r}")
         try:
             case = LoadCase(f, a, fill, str(material))
         except ParameterError as exc:  # said without the file and row before
             raise ParameterError(f"{path}: predictions[{i}]: {exc}") from None
         predictions.append(CalibratedPrediction(case, sdc, low, high, measured,
-                                                measured_stderr, low0, high0))
+                                                measured_stderr, low0, high0, dof))
     return Calibration(path=path, parameters=doc["parameters"], predictions=tuple(predictions),
                        specimen_name=specimen_name)

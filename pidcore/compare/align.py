@@ -267,6 +267,40 @@ def pooled_mean(values: np.ndarray, stderrs: np.ndarray) -> tuple[float, float]:
     return mean, float(np.nanmax([within, between]))
 
 
+def stored_stderr_dof(value: object) -> float:
+    """The ``sdc_stderr_dof`` of a stored analysis record (:attr:`pidcore.signal.power.
+    PowerAnalysis.sdc_stderr_dof`, n_blocks - 1) as a number; NaN where the record has none
+    (an older or foreign store, or no standard error): unknown, taken as normal."""
+    try:
+        dof = float(value)  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        return math.nan
+    return dof if math.isfinite(dof) and dof > 0 else math.nan
+
+
+def pooled_stderr_dof(values: np.ndarray, stderrs: np.ndarray, dofs: np.ndarray) -> float:
+    """Degrees of freedom of :func:`pooled_mean`'s standard error, for its 95 % quantile
+    (:func:`pidcore.calibrate.prediction.band_quantile`): one value's own ``dofs``; of the
+    scatter between several, n - 1; of their propagated errors, Welch-Satterthwaite's
+    (sum se^2)^2 / sum(se^4 / dof). NaN where unknown (a stderr without its degrees of
+    freedom: the normal's quantile, as before they were kept)."""
+    values = np.asarray(values, dtype=float)
+    stderrs = np.asarray(stderrs, dtype=float)
+    dofs = np.asarray(dofs, dtype=float)
+    if values.size == 1:
+        return float(dofs[0])
+    n = values.size
+    within = float(np.sqrt(np.sum(stderrs ** 2)) / n) if np.all(np.isfinite(stderrs)) else math.nan
+    between = float(np.std(values, ddof=1) / math.sqrt(n))
+    if not within > between:  # pooled_mean took the scatter between them (or within is NaN)
+        return float(n - 1)
+    if not (np.all(np.isfinite(dofs)) and np.all(dofs > 0)):
+        return math.nan
+    variances = stderrs ** 2
+    denominator = float(np.sum(variances ** 2 / dofs))
+    return float(np.sum(variances) ** 2 / denominator) if denominator > 0 else math.nan
+
+
 def pooled_sdc_eq10(energy_per_cycle_j: np.ndarray, acceleration_m_s2: np.ndarray,
                     frequency_hz: np.ndarray, sdc_eq11: np.ndarray, sdc_eq11_stderr: np.ndarray,
                     *, vibrated_mass_kg: float) -> tuple[np.ndarray, float, float]:

@@ -22,6 +22,8 @@ from .align import (
     consistency_chi2,
     pooled_mean,
     pooled_sdc_eq10,
+    pooled_stderr_dof,
+    stored_stderr_dof,
 )
 from .loadcase import LoadCase, StatedLoadCase
 
@@ -120,6 +122,9 @@ class CaseComparison:
         with a DEM m_c, ``SDC, E of Eq. 10 [-]``.
     measured_sdc, measured_stderr : float
         Eq. 11 SDC of the records pooled (:func:`pidcore.compare.pooled_mean`), [-].
+    measured_stderr_dof : float
+        Degrees of freedom of ``measured_stderr`` (:func:`pidcore.compare.align.pooled_stderr_dof`;
+        NaN: unknown), which set its 95 % quantile.
     aligned : AlignedCase
         Our DEM (grid value or pchip interpolation) and the paper's values at the case.
     dem_points : pandas.DataFrame
@@ -152,6 +157,7 @@ class CaseComparison:
     measured_stderr_eq10: float = math.nan
     chi2_dof: float = math.nan
     notes: tuple[str, ...] = ()
+    measured_stderr_dof: float = math.nan
 
 
 def _model_point(model, tol: Tolerances, acceleration_g: float,
@@ -233,6 +239,8 @@ class MeasuredEntry:
     #: the first plausibility warning beyond noise (a result kept or saved as accepted), or ""
     implausible: str = ""
     settings: dict = field(default_factory=dict, repr=False, compare=False)
+    #: degrees of freedom of sdc_stderr (the analysis's n_blocks - 1), NaN where unknown
+    sdc_stderr_dof: float = math.nan
 
     @classmethod
     def from_record(cls, record, load_case: LoadCase, *,
@@ -256,7 +264,8 @@ class MeasuredEntry:
                    np.asarray(a.velocity_phasors_m_s), specimen,
                    corrections=describe_corrections(vars(options)) if options else "",
                    measurement_key=content, implausible=found[0].message if found else "",
-                   settings=dict(vars(options)) if options else {})
+                   settings=dict(vars(options)) if options else {},
+                   sdc_stderr_dof=a.sdc_stderr_dof)
 
     @classmethod
     def from_store(cls, row: pd.Series, arrays: dict) -> MeasuredEntry:
@@ -279,7 +288,8 @@ class MeasuredEntry:
                    _specimen_of(row), str(row.get("created_utc", "")),
                    describe_corrections(settings),
                    str(row.get("measurement_key", "") or ""),
-                   found[0].message if found else "", settings)
+                   found[0].message if found else "", settings,
+                   stored_stderr_dof(row.get("sdc_stderr_dof")))
 
     def loop(self):
         """The measured loop (:class:`pidcore.loop.ForceDisplacementLoop`, labelled
@@ -405,6 +415,7 @@ def compare_case(records: Sequence[MeasuredEntry],
     values = measured["SDC [-]"].to_numpy(float)
     errors = measured["SDC stderr [-]"].to_numpy(float)
     sdc, stderr = pooled_mean(values, errors)
+    stderr_dof = pooled_stderr_dof(values, errors, np.array([r.sdc_stderr_dof for r in records]))
     chi2, dof = consistency_chi2(values, errors)
     tol = Tolerances()
     runs = dem_runs if dem_runs is not None and not dem_runs.empty else None
@@ -473,7 +484,7 @@ def compare_case(records: Sequence[MeasuredEntry],
         measured["SDC, E of Eq. 10 [-]"] = eq10
     return CaseComparison(case, measured, sdc, stderr, aligned, dem_points, paper_points,
                           model_x, model_y, sdc10, stderr10, chi2 / dof if dof else math.nan,
-                          tuple(notes))
+                          tuple(notes), stderr_dof)
 
 
 def equivalent_dampers(comparison: CaseComparison) -> dict[str, float]:

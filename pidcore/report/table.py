@@ -35,6 +35,8 @@ from ..compare.align import (
     match_paper,
     pooled_mean,
     pooled_sdc_eq10,
+    pooled_stderr_dof,
+    stored_stderr_dof,
 )
 from ..compare.loadcase import LoadCase, LoadCaseError
 from ..compare.plausibility import stored_findings
@@ -64,7 +66,8 @@ REPORT_COLUMNS: tuple[str, ...] = (
     "frequency [Hz]", "acceleration [g]", "packing ratio [%]", "material", "direction",
     "particles per cell [-]", "DEM runs [-]", "SDC DEM (ours) [-]", "SDC DEM stderr [-]",
     "measured frequency [Hz]", "measured acceleration [g]", "SDC measured [-]",
-    "SDC measured stderr [-]", MEASURED_EQ10_COLUMN, "SDC DEM (paper) [-]",
+    "SDC measured stderr [-]", "SDC measured stderr dof [-]", MEASURED_EQ10_COLUMN,
+    "SDC DEM (paper) [-]",
     "SDC measured (paper) [-]",
     "difference ours - paper DEM [-]", DIFFERENCE_COLUMN, CONSISTENCY_COLUMN, ALIGNMENT_COLUMN,
     "DEM settings", "specimen", "source file(s)", "load case", "note",
@@ -87,6 +90,8 @@ class _Measured(NamedTuple):
     specimen: str
     #: the first plausibility warning beyond noise of the record (kept as accepted), or ""
     implausible: str = ""
+    #: degrees of freedom of sdc_stderr (the analysis's n_blocks - 1; NaN: unknown)
+    sdc_stderr_dof: float = math.nan
 
 
 @dataclass
@@ -294,7 +299,8 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
         entry = _Measured(float(rec["sdc"]), float(rec["sdc_stderr"]), case.frequency_hz,
                           case.acceleration_g, str(rec.get("source", "")),
                           float(rec.get("energy_per_cycle_j", math.nan)), specimen,
-                          found[0].message if found else "")
+                          found[0].message if found else "",
+                          stored_stderr_dof(rec.get("sdc_stderr_dof")))
         base = None
         if aligned.status == "grid" and aligned.grid_case is not None:
             dem = aligned.grid_case
@@ -336,13 +342,15 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
     duplicate_rows: list[str] = []
     for row in (r for group in rows.values() for r in group):
         lc = row.case
-        sdc_m = sdc_m_se = f_m = a_m = chi2_dof = math.nan
+        sdc_m = sdc_m_se = sdc_m_dof = f_m = a_m = chi2_dof = math.nan
         sources = ""
         values = errors = np.empty(0)
         if row.measured:
             values = np.array([m.sdc for m in row.measured])
             errors = np.array([m.sdc_stderr for m in row.measured])
             sdc_m, sdc_m_se = pooled_mean(values, errors)
+            sdc_m_dof = pooled_stderr_dof(values, errors,
+                                          np.array([m.sdc_stderr_dof for m in row.measured]))
             f_m = float(np.mean([m.frequency_hz for m in row.measured]))
             a_m = float(np.mean([m.acceleration_g for m in row.measured]))
             sources = "; ".join(m.source for m in row.measured if m.source)
@@ -391,6 +399,7 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
             "measured acceleration [g]": a_m,
             "SDC measured [-]": sdc_m,
             "SDC measured stderr [-]": sdc_m_se,
+            "SDC measured stderr dof [-]": sdc_m_dof,
             MEASURED_EQ10_COLUMN: sdc_m10,
             "SDC DEM (paper) [-]": row.paper_dem,
             "SDC measured (paper) [-]": row.paper_exp,
@@ -532,6 +541,7 @@ def add_calibration_columns(table: pd.DataFrame, calibration, *,
         material (the default report), each checked against the calibration's specimen.
         Neither: unchecked.
     """
+    from ..calibrate.prediction import quantile_label
     from ..constants import PARTICLE_MATERIALS
     from ..specimen import paper_specimen
 
@@ -560,11 +570,13 @@ def add_calibration_columns(table: pd.DataFrame, calibration, *,
         else:
             measured = _finite_or_nan(row.get("SDC measured [-]"))
             stderr = _finite_or_nan(row.get("SDC measured stderr [-]"))
+            # a table of an older pidcore has no such column: unknown, the normal's quantile
+            dof = _finite_or_nan(row.get("SDC measured stderr dof [-]"))
             # the band of a measurement with this row's own standard error (not the fitted
             # point's, unless it is that measurement)
             extra = ""
             try:
-                band = hit.band(stderr if math.isfinite(measured) else math.nan)
+                band = hit.band(stderr if math.isfinite(measured) else math.nan, dof)
             except ParameterError as exc:
                 # a negative or near-1e308 stderr (a hand-edited store): no band, not a
                 # traceback nor an infinite bound
@@ -590,7 +602,8 @@ def add_calibration_columns(table: pd.DataFrame, calibration, *,
                     # numbered 0, or an SDC of 0: it is the stderr of the fitted point
                     extra = (f"calibrated band for this measurement's SDC stderr {stderr:.3g} "
                              f"(the calibration's own measurement at this load case had SDC "
-                             f"stderr {hit.measured_stderr:.3g})")
+                             f"stderr {hit.measured_stderr:.3g}); its 95 % widening: "
+                             f"{quantile_label(dof)}")
                 inside.append("yes" if band[0] <= measured <= band[1] else "no")
         notes.append("; ".join(n for n in (note, extra) if n))
     at = list(out.columns).index("SDC measured [-]") + 1 if "SDC measured [-]" in out.columns \

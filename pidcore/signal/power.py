@@ -145,6 +145,16 @@ class PowerAnalysis:
     notes: tuple[str, ...] = ()
 
     @property
+    def sdc_stderr_dof(self) -> float:
+        """Degrees of freedom of :attr:`sdc_stderr` (and :attr:`loss_factor_stderr`):
+        ``n_blocks - 1``, the scatter of n_blocks block estimates about their mean, so
+        (estimate - truth) / stderr is Student's t with them (a 95 % band takes t's quantile,
+        2.365 for 8 blocks, not 1.96); NaN where there is no standard error."""
+        if self.n_blocks >= 2 and math.isfinite(self.sdc_stderr):
+            return float(self.n_blocks - 1)
+        return math.nan
+
+    @property
     def acceleration_g(self) -> float:
         """Fundamental acceleration amplitude in g (standard gravity)."""
         return self.acceleration_amplitude_m_s2 / STANDARD_GRAVITY

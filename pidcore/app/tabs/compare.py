@@ -10,6 +10,7 @@ import streamlit as st
 
 from pidcore.app import state, uploads, workbench
 from pidcore.app.vocabulary import page_terms
+from pidcore.calibrate.prediction import quantile_label
 from pidcore.compare.case import equivalent_dampers
 from pidcore.compare.specimens import NOT_PAPER_SPECIMEN_NOTE
 from pidcore.specimen import is_paper_coupon
@@ -82,7 +83,7 @@ def _calibrated(calibrations, comp, head, specimen: str, *, implausible: bool = 
     c2.metric("SDC DEM, raw [-]", display_number(head.dem, missing="none"))
     # the band of a measurement with this one's standard error (the report's)
     low, high = hit.band(comp.measured_stderr if math.isfinite(comp.measured_sdc)
-                         else math.nan)
+                         else math.nan, comp.measured_stderr_dof)
     c3.metric("SDC calibrated DEM, Eq. 11 [-]", display_number(hit.sdc),
               help=f"95 % band {display_number(low)} .. {display_number(high)}")
     if not math.isfinite(comp.measured_sdc):
@@ -92,7 +93,8 @@ def _calibrated(calibrations, comp, head, specimen: str, *, implausible: bool = 
     else:
         verdict = "inside" if low <= comp.measured_sdc <= high else "outside"
     st.caption(f"calibrated 95 % band {display_number(low)} .. {display_number(high)} [-]"
-               + (f" (for this measurement's SDC stderr {comp.measured_stderr:.3g})"
+               + (f" (for this measurement's SDC stderr {comp.measured_stderr:.3g}, "
+                  f"widened by the {quantile_label(comp.measured_stderr_dof)})"
                   if (low, high) != (hit.low95, hit.high95) else "")
                + f"; the measured Eq. 11 SDC is {verdict}.")
 
