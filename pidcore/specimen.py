@@ -47,6 +47,19 @@ coupon, ``pidcore/data/specimens/paper_coupon.toml``)::
     static_friction = 0.14
     rolling_friction = 0.0
 
+A calibrated file (``pidcore calibrate``) also records which file it was made from, so that a
+user's own ``paper_coupon.toml`` and the paper's coupon, which both calibrate to
+``paper_coupon_calibrated``, are told apart (:func:`measured_specimen_name`)::
+
+    [provenance]
+    calibrated_from_name = "paper_coupon"
+    calibrated_from_sha256 = "45d792..."   # Specimen.hash of that file (64 hex digits)
+
+The table is part of the canonical text and hash (as ``name`` and ``description`` are): two
+calibrated files of one set of numbers made from different files model different tests, and
+their runs are not pooled. A file without it (every other file, and calibrated files written
+before it existed) keeps its text and hash.
+
 A material named in the table fills the properties not given inline; the parsed
 :class:`Specimen` always holds the resolved numbers, so its canonical text
 (:attr:`Specimen.text`) and :attr:`Specimen.hash` describe the physics completely, whatever the
@@ -65,6 +78,10 @@ is_paper_coupon, measured_specimen_name, models_paper_coupon, hashed_name
     Whether a specimen (by hash, else by name) is the paper's coupon: the one rule; the name
     a measurement of a specimen file is saved under; whether a file models the coupon; a
     file's name with its hash, ``"name [45d792]"``.
+calibrated_name, uncalibrated_name, calibrated_provenance, ProvenanceSpec, provenance_test_name
+    What ``pidcore calibrate`` names the file it writes, the name it was made from, the
+    ``[provenance]`` table recording the source file's name and sha256, and the name of the
+    source's tests where that table tells it from the paper's coupon.
 CellSpec, CouponSpec, ParticleSpec, PairSpec, PairsSpec
     Its sections (SI units in the field names).
 describe
@@ -471,6 +488,36 @@ class PairsSpec:
                         f"got {_shown(self.tangential_stiffness_model)}")
 
 
+#: A sha256 as :attr:`Specimen.hash` writes it: 64 lowercase hexadecimal digits.
+_SHA256_DIGITS = frozenset("0123456789abcdef")
+
+
+@dataclass(frozen=True)
+class ProvenanceSpec:
+    """Which specimen file a calibrated one was made from (``[provenance]``, written by
+    ``pidcore calibrate``): the tested specimen's ``name`` and :attr:`Specimen.hash`.
+
+    The name alone cannot say it: a user's own ``paper_coupon.toml`` (another cell, another
+    mass) calibrates to ``paper_coupon_calibrated`` as the paper's coupon does, and its tests
+    are saved as ``"paper_coupon [45d792]"`` (:func:`measured_specimen_name`); the hash tells
+    the two apart.
+    """
+
+    calibrated_from_name: str
+    calibrated_from_sha256: str
+
+    def __post_init__(self):
+        if not isinstance(self.calibrated_from_name, str) or not self.calibrated_from_name:
+            raise _fail("[provenance] calibrated_from_name",
+                        f"expected a non-empty name, got {_shown(self.calibrated_from_name)}")
+        _printable("[provenance] calibrated_from_name", self.calibrated_from_name)
+        sha = self.calibrated_from_sha256
+        if not isinstance(sha, str) or len(sha) != 64 or not set(sha) <= _SHA256_DIGITS:
+            raise _fail("[provenance] calibrated_from_sha256",
+                        f"expected the sha256 of the specimen it was calibrated from (64 "
+                        f"lowercase hexadecimal digits), got {_shown(sha)}")
+
+
 @dataclass(frozen=True)
 class Specimen:
     """A honeycomb specimen: cell, coupon, particles, contact pairs (see the module docstring).
@@ -486,6 +533,7 @@ class Specimen:
     particles: ParticleSpec
     pairs: PairsSpec
     description: str = ""
+    provenance: ProvenanceSpec | None = None
     source: str = dataclasses.field(default="<specimen>", compare=False)
 
     def __post_init__(self):
@@ -623,6 +671,10 @@ class Specimen:
                      (("particle_particle", self.pairs.particle_particle),
                       ("particle_wall", self.pairs.particle_wall)))
         out["pairs"] = pairs
+        if self.provenance is not None:
+            # only a calibrated file written since the table existed has it: every other file
+            # keeps its text and hash
+            out["provenance"] = dataclasses.asdict(self.provenance)
         return out
 
     def to_toml(self) -> str:
@@ -728,6 +780,20 @@ def calibrated_name(name: str) -> str:
     return uncalibrated_name(name) + CALIBRATED_SUFFIX
 
 
+def calibrated_provenance(start: Specimen) -> ProvenanceSpec | None:
+    """The ``[provenance]`` of the file ``pidcore calibrate`` writes from ``start``: the
+    specimen that was tested, as the calibrated name says (:func:`calibrated_name` keeps one
+    ``_calibrated``). ``start`` itself (its name and hash) where it is not a calibrated file;
+    a calibrated file's own provenance where it was calibrated again; None for a calibrated
+    file without one (written before the table existed): which file it came from is unknown,
+    and its calibration reads by name, as that file does."""
+    if start.provenance is not None:
+        return start.provenance
+    if uncalibrated_name(start.name) != start.name:
+        return None
+    return ProvenanceSpec(calibrated_from_name=start.name, calibrated_from_sha256=start.hash)
+
+
 # --- schema ---------------------------------------------------------------------------------
 
 #: Keys of each section: name -> (required, kind). kind: "float", "int", "str".
@@ -748,6 +814,8 @@ SCHEMA: dict[str, dict[str, tuple[bool, str]]] = {
              "static_friction": (False, "float"), "rolling_friction": (False, "float"),
              "rolling_damping_ratio": (False, "float")},
     "pairs": {"tangential_stiffness_model": (False, "str")},
+    "provenance": {"calibrated_from_name": (True, "str"),
+                   "calibrated_from_sha256": (True, "str")},
 }
 PAIR_NAMES = ("particle_particle", "particle_wall")
 
@@ -902,15 +970,16 @@ def _tables_are_tables(node: Mapping[str, Any], names: tuple[str, ...], prefix: 
 
 
 def _from_mapping(data: Mapping[str, Any], *, source: str) -> Specimen:
-    _tables_are_tables(data, ("cell", "coupon", "particles", "pairs"), "")
+    _tables_are_tables(data, ("cell", "coupon", "particles", "pairs", "provenance"), "")
     if isinstance(data.get("pairs"), Mapping):
         _tables_are_tables(data["pairs"], PAIR_NAMES, "pairs.")
     top = _take({k: v for k, v in data.items() if not isinstance(v, Mapping)}, "", "top level")
     for key, value in data.items():
-        if isinstance(value, Mapping) and key not in ("cell", "coupon", "particles", "pairs"):
+        if isinstance(value, Mapping) and key not in ("cell", "coupon", "particles", "pairs",
+                                                      "provenance"):
             raise ParameterError(f"[{_clip(key)}]: unknown table; expected [cell], [coupon], "
                                  "[particles], [pairs], [pairs.particle_particle], "
-                                 "[pairs.particle_wall]")
+                                 "[pairs.particle_wall], [provenance]")
     version = top.get("schema_version", SCHEMA_VERSION)
     if version != SCHEMA_VERSION:
         raise ParameterError(f"schema_version: this pidcore reads version {SCHEMA_VERSION}, "
@@ -950,7 +1019,10 @@ def _from_mapping(data: Mapping[str, Any], *, source: str) -> Specimen:
         pair.setdefault("static_friction", pair["sliding_friction"])
         pairs[name] = PairSpec(**pair)
 
+    provenance = (ProvenanceSpec(**_take(data["provenance"], "provenance", "[provenance]"))
+                  if "provenance" in data else None)
     return Specimen(name=top["name"], description=top.get("description", ""),
+                    provenance=provenance,
                     cell=CellSpec(**cell), coupon=CouponSpec(**_take(data["coupon"], "coupon",
                                                                      "[coupon]")),
                     particles=ParticleSpec(**particles), pairs=PairsSpec(**pairs, **shared),
@@ -1126,7 +1198,9 @@ def is_paper_coupon(name: object = "", sha256: object = "") -> bool:
       tests) names the specimen ``x`` that was tested (:func:`uncalibrated_name`): a
       measurement naming ``paper_coupon_calibrated`` is a test of the paper's coupon, for
       Table 3 and for calibration alike. A calibrated file's content (its hash) is not the
-      paper's: its DEM runs model the coupon with fitted values, not the paper's DEM.
+      paper's: its DEM runs model the coupon with fitted values, not the paper's DEM. Where
+      the file records its source (``[provenance]``) and that is another file of the coupon's
+      name, its tests are that file's (:func:`provenance_test_name`), not the coupon's.
     """
     if isinstance(sha256, str) and sha256:
         return sha256 in paper_hashes()
@@ -1146,7 +1220,17 @@ def measured_specimen_name(specimen: Specimen) -> str:
     the paper coupon's tests. A calibrated file of the paper's coupon
     (``paper_coupon_calibrated``: fitted contact, mass or damping values, the paper's cell and
     spheres) keeps its name: its tests are the paper's coupon's.
+
+    A calibrated file that records its source (``[provenance]``, :func:`calibrated_provenance`)
+    made from another file of the paper's coupon's name is named as that file's tests are,
+    ``"paper_coupon [45d792]"`` (the source's hash): ``pidcore calibrate --specimen
+    mine/paper_coupon.toml`` writes ``paper_coupon_calibrated`` as the paper's coupon's
+    calibration does, and its calibration and DEM runs met the paper's coupon's tests instead
+    of its own. A calibrated file without the table (written before it) is named as before.
     """
+    routed = provenance_test_name(specimen)
+    if routed:
+        return routed
     if specimen.is_paper() or not is_paper_coupon(specimen.name):
         return specimen.name
     if specimen.name != uncalibrated_name(specimen.name) and models_paper_coupon(specimen):
@@ -1160,6 +1244,19 @@ def hashed_name(name: str, sha256: str) -> str:
     its tests are saved under (:func:`measured_specimen_name`), one spelling so that the two
     meet."""
     return f"{name or 'unnamed'} [{sha256[:6]}]"
+
+
+def provenance_test_name(specimen: Specimen) -> str:
+    """The name the tests of the file ``specimen`` was calibrated from are saved under, where
+    its ``[provenance]`` says it was made from another file of the paper's coupon's name
+    (``"paper_coupon [45d792]"``: that file's name and hash, as :func:`measured_specimen_name`
+    names its tests); "" otherwise (no provenance, the paper's own coupon, or another name,
+    whose ``x_calibrated`` names its tests by :func:`uncalibrated_name`)."""
+    source = specimen.provenance
+    if source is None or not is_paper_coupon(source.calibrated_from_name) \
+            or is_paper_coupon(source.calibrated_from_name, source.calibrated_from_sha256):
+        return ""
+    return hashed_name(source.calibrated_from_name, source.calibrated_from_sha256)
 
 
 def models_paper_coupon(specimen: Specimen) -> bool:
@@ -1296,8 +1393,10 @@ def _capacity(shape: str, inscribed_diameter_m: float, height_m: float, radius_m
 
 
 __all__ = ["CellSpec", "CouponSpec", "PairSpec", "PairsSpec", "ParticleSpec", "Specimen",
+           "ProvenanceSpec", "calibrated_name", "calibrated_provenance", "uncalibrated_name",
            "cell_geometry", "contact_law", "describe", "hashed_name", "is_paper_coupon",
            "load_specimen",
            "measured_specimen_name", "models_paper_coupon", "numeric_fields",
+           "provenance_test_name",
            "paper_specimen", "particles_for_fill"]
 

@@ -186,7 +186,8 @@ def test_readme_sidecar_table_names_exactly_the_columns_read():
 def test_readme_specimen_table_names_no_key_the_reader_refuses():
     # the other direction (every key documented) is test_specimen_runs'
     cells = _table(README.read_text(encoding="utf-8"), "| key | unit | meaning |")
-    sections = {"cell", "coupon", "particles", "pairs", *(f"pairs.{p}" for p in PAIR_NAMES)}
+    sections = {"cell", "coupon", "particles", "pairs", "provenance",
+                *(f"pairs.{p}" for p in PAIR_NAMES)}
     keys = {k for section in SCHEMA.values() for k in section}
     stale = []
     for cell in cells:

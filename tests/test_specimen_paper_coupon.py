@@ -4,6 +4,7 @@ DEM runs, measurements and specimen files, by hash where the content is known, e
 from __future__ import annotations
 
 import dataclasses
+import math
 import re
 from pathlib import Path
 from types import SimpleNamespace
@@ -311,3 +312,189 @@ def test_a_calibration_of_another_file_named_paper_coupon_speaks_not_for_the_cou
     cal = load_calibration(tmp_path / "calibration.json")
     assert cal.speaks_for("paper_coupon") and cal.speaks_for("paper_coupon_aluminium")
     assert not cal.speaks_for(OTHER_LABEL) and not cal.speaks_for("steel_6mm")
+
+
+# --- a calibrated file records the file it was made from ([provenance]) ---------------------
+
+# the paper's cell and spheres on a heavier coupon: a user's own paper_coupon.toml that models
+# the coupon's cells (so neither the name nor the cell tells its calibrated file apart)
+HEAVIER = PAPER.with_values({"coupon.mass_kg": 0.03})
+HEAVIER_LABEL = f"paper_coupon [{HEAVIER.hash[:6]}]"
+
+
+def _write_test(path: Path, frequency_hz: float, acceleration_g: float) -> Path:
+    """A synthetic shaker record (force and velocity of a 50 g mass with 5 N s/m of viscous
+    damping), as LMS Testlab exports it."""
+    from pidcore.constants import STANDARD_GRAVITY
+    from pidcore.io import write_measurement
+    from pidcore.records import Channel, Measurement
+    from pidcore.signal import synthesize_shaker_record
+
+    rate = 51200.0
+    rec = synthesize_shaker_record(mass_kg=0.05,
+                                   acceleration_amplitude_m_s2=acceleration_g * STANDARD_GRAVITY,
+                                   frequency_hz=frequency_hz, sample_rate_hz=rate, n_periods=40,
+                                   viscous_damping_n_s_m=5.0)
+    write_measurement(Measurement("m", (Channel("Force", "force", rec.force_n, rate, "N"),
+                                        Channel("LDV", "velocity", rec.velocity_m_s, rate,
+                                                "m/s"))), path)
+    return path
+
+
+@pytest.mark.usefixtures("undrawn_report_figures")
+def test_a_calibration_of_a_users_paper_coupon_file_meets_its_tests_not_the_coupons(
+        tmp_path, capsys):
+    """Was: `calibrate --specimen mine/paper_coupon.toml` wrote paper_coupon_calibrated, whose
+    calibration and runs were taken for the paper coupon's (its cell and spheres) and never met
+    the file's own tests, saved as "paper_coupon [hash]": `report --specimen` of the
+    calibrated file showed them with no calibrated band. Now the file records its source
+    ([provenance]) and is named as that source's tests are."""
+    from pidcore.calibrate.prediction import load_calibration
+    from tests.test_calibrate_cli import TINY
+
+    (tmp_path / "mine").mkdir()
+    mine = tmp_path / "mine" / "paper_coupon.toml"
+    mine.write_text(HEAVIER.to_toml())
+    store = tmp_path / "tests.h5"
+    # the load cases of test_calibrate_cli's tiny calibrations (one parameter and a set model
+    # discrepancy need three)
+    for i, (f, a) in enumerate(((500.0, 5.0), (1000.0, 5.0), (500.0, 1.0))):
+        test = _write_test(tmp_path / f"t{i}_fill50.csv", f, a)
+        assert main(["analyze", str(test), "--specimen", str(mine), "--store", str(store)]) == 0
+    assert set(Store(store).list_analyses()["specimen"]) == {HEAVIER_LABEL}
+    out, dem = tmp_path / "cal", tmp_path / "dem.h5"
+    assert main(["calibrate", "--store", str(store), "--specimen", str(mine), "--fit",
+                 "fixture_mass_kg", "--discrepancy", "0.2", "--dem-store", str(dem),
+                 "--out", str(out), *TINY]) == 0
+    cal = load_calibration(out)
+    # a DEM run of the calibrated file (`dem run --specimen`), in a store of its own
+    runs_store = tmp_path / "calibrated_runs.h5"
+    assert main(["dem", "run", "--specimen", str(out / "calibrated_specimen.toml"),
+                 "--frequency", "1000", "--acceleration", "5", "--fill", "50", "--cells", "1",
+                 "--cycles", "2", "--no-progress", "--store", str(runs_store)]) == 0
+    capsys.readouterr()
+    rep = tmp_path / "rep"
+    assert main(["report", "--store", str(store), "--specimen",
+                 str(out / "calibrated_specimen.toml"), "--calibration", str(out),
+                 "--dem-store", str(runs_store), "--out", str(rep), "--format", "csv"]) == 0
+    said = capsys.readouterr().out
+    assert f"note: specimen {HEAVIER_LABEL} is not the paper's coupon: the paper's Table 3 is " \
+           "not compared" in said
+    rows = pd.read_csv(rep / "report.csv", comment="#")
+    assert len(rows) == 3 and set(rows["specimen"]) == {HEAVIER_LABEL}
+    assert rows["SDC DEM (paper) [-]"].isna().all()
+    assert rows["SDC measured (paper) [-]"].isna().all()
+    # each test beside the calibrated band of its own load case (the calibration's in-sample
+    # prediction there: calibration.json, read back independently of the report)
+    from pidcore.dem.simulate import LoadCase
+    from pidcore.report.table import (
+        CALIBRATED_COLUMN,
+        CALIBRATED_HIGH_COLUMN,
+        CALIBRATED_LOW_COLUMN,
+    )
+
+    for _, row in rows.iterrows():
+        hit = cal.lookup(LoadCase(row["frequency [Hz]"], row["acceleration [g]"],
+                                  row["packing ratio [%]"], "acrylic"))
+        assert hit is not None
+        # the CSV's text holds the value to its last digits: 1e-6 is far below any SDC's
+        # sampling error and far above the text's rounding
+        assert row[CALIBRATED_COLUMN] == pytest.approx(hit.sdc, rel=1e-6)
+        assert row[CALIBRATED_LOW_COLUMN] < row[CALIBRATED_COLUMN] < row[CALIBRATED_HIGH_COLUMN]
+
+    # the test at 1000 Hz meets that run (the old code: "no DEM runs of paper_coupon [...]")
+    ran = rows[rows["frequency [Hz]"] == 1000.0].iloc[0]
+    assert math.isfinite(ran["SDC DEM (ours) [-]"]), ran["note"]
+    assert "no DEM runs" not in str(ran["note"])
+
+    # a test of the paper's coupon is never given that calibration's band (the old code gave
+    # it: the calibrated file has the coupon's cell and spheres and its name)
+    paper_store, paper_rep = tmp_path / "paper_tests.h5", tmp_path / "paper_rep"
+    assert main(["analyze", str(tmp_path / "t1_fill50.csv"), "--store", str(paper_store)]) == 0
+    assert main(["report", "--store", str(paper_store), "--calibration", str(out),
+                 "--out", str(paper_rep), "--format", "csv"]) == 0
+    capsys.readouterr()
+    (paper_row,) = pd.read_csv(paper_rep / "report.csv", comment="#").to_dict("records")
+    assert math.isnan(paper_row[CALIBRATED_COLUMN])
+    assert (f"not predicted by the calibration calibration.json: it calibrates specimen "
+            f"{HEAVIER_LABEL}, not paper_coupon") in paper_row["note"]
+
+    from pidcore.specimen import ProvenanceSpec
+
+    calibrated = load_specimen(out / "calibrated_specimen.toml")
+    assert calibrated.name == "paper_coupon_calibrated"
+    assert calibrated.provenance == ProvenanceSpec("paper_coupon", HEAVIER.hash)
+    assert measured_specimen_name(calibrated) == HEAVIER_LABEL
+    # the table is part of the text it is read back from, and of the hash
+    assert load_specimen(out / "calibrated_specimen.toml").to_toml() == calibrated.to_toml()
+    assert dataclasses.replace(calibrated, provenance=None).hash != calibrated.hash
+    assert cal.speaks_for(HEAVIER_LABEL)
+    assert not cal.speaks_for("paper_coupon") and not cal.speaks_for("paper_coupon_calibrated")
+    assert cal.other_specimen_reason(PAPER) == \
+        f"it calibrates specimen {HEAVIER_LABEL}, not paper_coupon"
+
+    # calibrated again, it takes the file's tests and leaves the paper coupon's out
+    from pidcore.calibrate.data import points_for_specimen
+
+    own, papers = (MeasuredPoint(100, 1, 50, 0.2, specimen=HEAVIER_LABEL),
+                   MeasuredPoint(200, 1, 50, 0.3, specimen="paper_coupon"))
+    assert points_for_specimen([own, papers], calibrated)[0] == [own]
+
+    # the runs of that calibrated file meet its tests, never the paper coupon's (whose cell
+    # and spheres it has: the old code met them as the coupon's calibrated file's)
+    runs = pd.DataFrame([_stored_run("c1", calibrated)])
+    met = runs_for_measurement(runs, HEAVIER_LABEL, "acrylic", "z")
+    assert met.runs["case_key"].tolist() == ["c1"] and met.calibrated_from == HEAVIER_LABEL
+    for named in ("paper_coupon", "paper_coupon_calibrated"):
+        assert runs_for_measurement(runs, named, "acrylic", "z").runs is None, named
+
+
+def test_a_calibrated_file_of_the_papers_coupon_with_its_provenance_reads_as_without():
+    """The paper coupon's calibrated file written now ([provenance]: the paper's hash) is the
+    coupon's, as the bundled one written before the table is: same name for its tests, same
+    runs met, same calibration spoken for."""
+    from pidcore.specimen import ProvenanceSpec, calibrated_provenance
+
+    old = load_specimen(CALIBRATED_PAPER)
+    assert old.provenance is None and calibrated_provenance(old) is None  # source unknown
+    assert calibrated_provenance(PAPER) == ProvenanceSpec("paper_coupon", PAPER.hash)
+    new = dataclasses.replace(old, provenance=calibrated_provenance(PAPER))
+    assert "\n[provenance]\ncalibrated_from_name = \"paper_coupon\"\n" \
+           f"calibrated_from_sha256 = \"{PAPER.hash}\"\n" in new.to_toml()
+    assert load_specimen_text(new.to_toml()) == new  # round trip, provenance included
+    assert measured_specimen_name(new) == measured_specimen_name(old) == \
+        "paper_coupon_calibrated"
+    # calibrated again: the tested file stays the one recorded, not the calibrated file
+    assert calibrated_provenance(new) == new.provenance
+    for test in ("paper_coupon", "paper_coupon_calibrated", OTHER_LABEL):
+        met_new = runs_for_measurement(pd.DataFrame([_stored_run("c1", new)]), test,
+                                       "acrylic", "z")
+        met_old = runs_for_measurement(pd.DataFrame([_stored_run("c1", old)]), test,
+                                       "acrylic", "z")
+        assert (met_new.runs is None) == (met_old.runs is None), test
+        assert met_new.calibrated_from == met_old.calibrated_from, test
+    assert runs_for_measurement(pd.DataFrame([_stored_run("c1", new)]), "paper_coupon",
+                                "acrylic", "z").calibrated_from == "paper_coupon"
+
+
+def load_specimen_text(text: str):
+    from pidcore.specimen import Specimen
+
+    return Specimen.from_text(text, source="x.toml")
+
+
+@pytest.mark.parametrize("table, said", [
+    ('calibrated_from_name = "paper_coupon"\ncalibrated_from_sha256 = "45d792"',
+     "x.toml: [provenance] calibrated_from_sha256: expected the sha256 of the specimen it "
+     "was calibrated from (64 lowercase hexadecimal digits), got '45d792'"),
+    ('calibrated_from_name = "paper_coupon"',
+     "x.toml: [provenance] calibrated_from_sha256: missing key"),
+    (f'calibrated_from_name = ""\ncalibrated_from_sha256 = "{"0" * 64}"',
+     "x.toml: [provenance] calibrated_from_name: expected a non-empty name, got ''"),
+])
+def test_a_bad_provenance_table_is_one_line_naming_its_key(table, said):
+    from pidcore.errors import ParameterError
+
+    with pytest.raises(ParameterError) as caught:
+        load_specimen_text(PAPER.to_toml() + f"\n[provenance]\n{table}\n")
+    assert str(caught.value) == said

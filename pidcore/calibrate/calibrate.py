@@ -25,6 +25,7 @@ from ..errors import ParameterError, real_number, whole_number
 from ..specimen import (
     Specimen,
     calibrated_name,
+    calibrated_provenance,
     is_paper_coupon,
     measured_specimen_name,
     paper_specimen,
@@ -121,6 +122,9 @@ class CalibrationResult:
             for s in self.specs if s.kind != "hyper")
         return dataclasses.replace(
             out, name=calibrated_name(self.specimen.name),
+            # the name alone does not say which file was tested: a user's paper_coupon.toml
+            # calibrates to paper_coupon_calibrated as the paper's coupon does
+            provenance=calibrated_provenance(self.specimen),
             description=f"{self.specimen.description} -- calibrated by pidcore calibrate: "
                         f"{fitted} (these replace any value stated above)".strip(" -"))
 

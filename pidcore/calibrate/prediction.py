@@ -252,8 +252,9 @@ class Calibration:
         calibrated file is "<name>_calibrated"), or either unknown. The paper's coupon is
         :func:`pidcore.specimen.is_paper_coupon`'s: its calibration speaks for a test naming
         ``paper_coupon`` or ``paper_coupon_aluminium`` (the material is :meth:`lookup`'s), and
-        a calibrated file named ``paper_coupon_calibrated`` with another cell is named as its
-        tests are (:func:`pidcore.specimen.measured_specimen_name`), not as the coupon's."""
+        a calibrated file named ``paper_coupon_calibrated`` with another cell, or made from
+        another file of the coupon's name (its ``[provenance]``), is named as its tests are
+        (:func:`pidcore.specimen.measured_specimen_name`), not as the coupon's."""
         from ..specimen import is_paper_coupon, measured_specimen_name, uncalibrated_name
 
         calibrated = self.specimen_name
@@ -320,8 +321,14 @@ def _other_specimen(calibrated, specimen) -> str:
         return ""
     # the calibrated file is the starting specimen renamed "<name>_calibrated" with fitted
     # contact, coupon or mass values: the cell and the particles say which specimen it is
-    from ..specimen import uncalibrated_name
+    from ..specimen import measured_specimen_name, provenance_test_name, uncalibrated_name
 
+    routed = provenance_test_name(calibrated)
+    if routed:
+        # made from a user's paper_coupon.toml (its [provenance]): its name is the paper
+        # coupon's calibrated one, and its band was shown beside the coupon's tests
+        own = uncalibrated_name(measured_specimen_name(specimen))
+        return "" if own == routed else f"it calibrates specimen {routed}, not {own}"
     base = uncalibrated_name(calibrated.name)
     names = {calibrated.name, base}
     shape = ("shape", "inscribed_diameter_m", "height_m")

@@ -10,7 +10,9 @@ several others (they are not pooled: which specimen was tested is the user's to 
 measurement named ``x`` with no run of that name meets the runs of ``x_calibrated``, the
 file ``pidcore calibrate`` wrote from it (a model of the specimen tested); for the paper's
 coupon only such a file of its cell and spheres (another file named ``paper_coupon``
-calibrates to the same name). A measurement named ``paper_coupon`` meets the paper's coupon's
+calibrates to the same name; the file written since ``[provenance]`` existed says which it
+was made from, and its runs meet the tests of that file, ``"paper_coupon [45d792]"``, and
+never the paper's coupon's). A measurement named ``paper_coupon`` meets the paper's coupon's
 runs, not another file of that name; a test of such a file is named ``"paper_coupon
 [45d792]"``, as its runs are (:func:`pidcore.specimen.measured_specimen_name`). Which
 specimen is the paper's coupon is :func:`pidcore.specimen.is_paper_coupon`'s to say. Runs
@@ -121,6 +123,30 @@ def _model_the_papers_coupon(runs: pd.DataFrame) -> np.ndarray:
     return np.array(keep, dtype=bool)
 
 
+def _provenance_test_names(runs: pd.DataFrame) -> pd.Series:
+    """Per run: the name of the tests of the file its calibrated specimen was made from, where
+    that file's ``[provenance]`` (in the text the run stored) tells a user's own
+    ``paper_coupon.toml`` from the paper's coupon (:func:`pidcore.specimen.
+    provenance_test_name`: ``"paper_coupon [45d792]"``); "" for every other run (no stored
+    text, no provenance, or one the name already says)."""
+    from ..specimen import Specimen, provenance_test_name
+    from .align import stored_parameters
+
+    if "parameters_json" not in runs.columns:
+        return pd.Series([""] * len(runs), index=runs.index, dtype=object)
+    out = []
+    for params in runs["parameters_json"]:
+        text = (stored_parameters(params) or {}).get("specimen_text")
+        routed = ""
+        if isinstance(text, str) and "[provenance]" in text:  # parsing costs; no table, none
+            try:
+                routed = provenance_test_name(Specimen.from_text(text, source="stored DEM run"))
+            except PidcoreError:
+                routed = ""
+        out.append(routed)
+    return pd.Series(out, index=runs.index, dtype=object)
+
+
 def _listed(labels: pd.Series) -> str:
     counts = labels.value_counts(sort=False)
     return ", ".join(f"{label} ({n} run(s))" for label, n in counts.items())
@@ -152,9 +178,14 @@ def runs_for_measurement(runs: pd.DataFrame | None, specimen: str, material: str
         return _paper_runs(same, labels, paper)
     if specimen:
         names = _names(same, labels)
+        # runs of a file calibrated from a user's paper_coupon.toml are named
+        # paper_coupon_calibrated as the paper coupon's calibrated file's are: its
+        # [provenance] names its tests, "paper_coupon [45d792]", and no other
+        routed = _provenance_test_names(same)
+        by_name = (names == specimen) & (routed == "")
         # a test of a file named like the paper's coupon with other content names it by its
         # label, "paper_coupon [45d792]" (pidcore.specimen.measured_specimen_name), as its runs
-        mine = ((names == specimen) | (labels == specimen)).to_numpy(bool)
+        mine = (by_name | (labels == specimen)).to_numpy(bool)
         of_paper = is_paper_coupon(specimen)
         if of_paper and not specimen.endswith(CALIBRATED_SUFFIX):
             # no run of the paper's coupon: the runs of another file of its name are met (with
@@ -168,8 +199,9 @@ def runs_for_measurement(runs: pd.DataFrame | None, specimen: str, material: str
             # x met no run of `report --specimen x_calibrated.toml` (no_dem_runs on every row)
             from ..specimen import uncalibrated_name
 
-            mine = names.map(lambda n: n.endswith(CALIBRATED_SUFFIX)
-                             and uncalibrated_name(n) == specimen).to_numpy(bool)
+            mine = np.array([n.endswith(CALIBRATED_SUFFIX)
+                             and uncalibrated_name(r or n) == specimen
+                             for n, r in zip(names, routed, strict=True)], dtype=bool)
             if of_paper:
                 # a file calibrated from another file named paper_coupon (another cell) is
                 # paper_coupon_calibrated too: its runs were compared with the paper
