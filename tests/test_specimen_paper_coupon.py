@@ -455,10 +455,15 @@ def test_a_calibrated_file_of_the_papers_coupon_with_its_provenance_reads_as_wit
     runs met, same calibration spoken for."""
     from pidcore.specimen import ProvenanceSpec, calibrated_provenance
 
-    old = load_specimen(CALIBRATED_PAPER)
+    bundled = load_specimen(CALIBRATED_PAPER)  # regenerated with the table
+    assert bundled.provenance == ProvenanceSpec("paper_coupon", PAPER.hash)
+    # a file written before the table: the bundled one without it
+    text = Path(CALIBRATED_PAPER).read_text(encoding="utf-8")
+    old = load_specimen_text(text[:text.index("\n[provenance]\n")] + "\n")
     assert old.provenance is None and calibrated_provenance(old) is None  # source unknown
     assert calibrated_provenance(PAPER) == ProvenanceSpec("paper_coupon", PAPER.hash)
     new = dataclasses.replace(old, provenance=calibrated_provenance(PAPER))
+    assert new.to_toml() == bundled.to_toml()
     assert "\n[provenance]\ncalibrated_from_name = \"paper_coupon\"\n" \
            f"calibrated_from_sha256 = \"{PAPER.hash}\"\n" in new.to_toml()
     assert load_specimen_text(new.to_toml()) == new  # round trip, provenance included
