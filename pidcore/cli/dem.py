@@ -18,7 +18,7 @@ from ..constants import (
     TANGENTIAL_STIFFNESS_MODELS,
     VIBRATED_MASS_CONVENTIONS,
 )
-from ..errors import ParameterError, PidcoreError, as_given
+from ..errors import ParameterError, PidcoreError, apart
 from ._options import (
     add_json_option,
     add_store_option,
@@ -392,8 +392,8 @@ def _same_simulation_note(asked, result) -> str:
     stored = result.case.fill_percent
     if stored == asked.fill_percent:
         return ""
-    return (f"fill {as_given(asked.fill_percent)} % asked; reused the stored run of fill "
-            f"{as_given(stored)} %: "
+    asked_text, stored_text = apart(asked.fill_percent, stored)
+    return (f"fill {asked_text} % asked; reused the stored run of fill {stored_text} %: "
             f"the same simulation ({result.particles_per_cell} particles per cell, seed "
             f"{result.config.seed}, the same settings and specimen), so the numbers are those "
             "of that run and it is stated at its fill")
