@@ -22,7 +22,7 @@ from pathlib import Path
 from ..constants import DriveDirection, ParticleMaterial
 from ..errors import ParameterError, SimulationError, instance_of, whole_number
 from ..records import json_safe
-from ..specimen import Specimen
+from ..specimen import Specimen, fill_override_note
 from .persist import (
     dem_run_entry,
     own_run_keys,
@@ -318,11 +318,14 @@ class SweepSummary:
     wall_s: float = 0.0
     store_path: str = ""
     cases: list[dict] = field(default_factory=list)
+    #: What a reader of the runs should know: the fills given override the one the specimen
+    #: states (:func:`pidcore.specimen.fill_override_note`).
+    notes: list[str] = field(default_factory=list)
 
     def to_dict(self) -> dict:
         return {"completed": len(self.completed), "skipped": len(self.skipped),
                 "wall_s": self.wall_s, "store": self.store_path,
-                "cases": [dict(c) for c in self.cases]}
+                "cases": [dict(c) for c in self.cases], "notes": list(self.notes)}
 
     def fill_results(self, store) -> None:
         """Read each case's results from ``store`` (the runs as stored)."""
@@ -389,6 +392,9 @@ def run_sweep(cases: Sequence[LoadCase], config: DemConfig, *,
     start = time.perf_counter()
     store = Store(store_path)
     summary = SweepSummary(store_path=str(Path(store_path)))
+    overridden = fill_override_note(specimen, [case.fill_percent for case in cases])
+    if overridden:
+        summary.notes.append(overridden)
     todo: list[tuple[LoadCase, str]] = []
     identities = stored_identities(store)  # read once, not once per case
     planned: dict[str, str] = {}  # simulation identity -> key of a case to simulate
