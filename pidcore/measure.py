@@ -439,10 +439,34 @@ NO_LOAD_CASE = "no load case"
 @dataclass(frozen=True)
 class SavedAnalyses:
     """What :func:`save_analyses` wrote: the analysis ``keys`` (one per result; byte-identical
-    files share one) and ``notes`` naming each saved record it replaced."""
+    files share one), ``notes`` naming each saved record it replaced, and of the distinct keys
+    those the store ``already_identical`` held before with the same content (every field but
+    its creation time: the same file saved again with the same settings and load case) and
+    those it held with other content (``replaced``: another name, load case or specimen)."""
 
     keys: list[str]
     notes: list[str]
+    already_identical: list[str] = field(default_factory=list)
+    replaced: list[str] = field(default_factory=list)
+
+    @property
+    def new(self) -> list[str]:
+        """The distinct keys the store did not hold before."""
+        held = {*self.already_identical, *self.replaced}
+        return [key for key in dict.fromkeys(self.keys) if key not in held]
+
+    def breakdown(self) -> str:
+        """How many records were new and how many the store already held (``"0 new, 5
+        already held with identical content"``); ``""`` where all were new. "saved 5" of a
+        save done twice did not say the second one changed nothing."""
+        if not self.already_identical and not self.replaced:
+            return ""
+        parts = [f"{len(self.new)} new"]
+        if self.already_identical:
+            parts.append(f"{len(self.already_identical)} already held with identical content")
+        if self.replaced:
+            parts.append(f"{len(self.replaced)} replacing a held record of other content")
+        return ", ".join(parts)
 
 
 def save_analyses(store: Store | str | os.PathLike, results: Sequence[AnalyzedRecord],
@@ -503,7 +527,8 @@ def save_analyses(store: Store | str | os.PathLike, results: Sequence[AnalyzedRe
     store = store if isinstance(store, Store) else Store(store)
     _refuse_the_store_itself(store, results)
     with store.transaction():
-        notes = replacement_notes(store.list_analyses(), [
+        before = store.list_analyses()
+        notes = replacement_notes(before, [
             (name, measurement_key(r.measurement),
              case.full_label() if case is not None else NO_LOAD_CASE)
             for r, (name, case, _) in zip(results, stated, strict=True)])
@@ -511,7 +536,37 @@ def save_analyses(store: Store | str | os.PathLike, results: Sequence[AnalyzedRe
                     **(case.as_record(origin) if case is not None else {}), **(more or {})})
                 for r, o, (_, case, origin), more in zip(results, per_result, stated, extra,
                                                          strict=True)]
-    return SavedAnalyses(keys, notes)
+        held = set(before["key"]) & set(keys) if "key" in before.columns else set()
+        identical = _identical_entries(before, store.list_analyses(), held) if held else set()
+    distinct = list(dict.fromkeys(keys))
+    return SavedAnalyses(keys, notes, [k for k in distinct if k in identical],
+                         [k for k in distinct if k in held - identical])
+
+
+def _identical_entries(before: pd.DataFrame, after: pd.DataFrame, keys: set[str]) -> set[str]:
+    """Of ``keys``, those whose listed entry (every field but ``created_utc``, which a save
+    always renews) is the same in both listings of :meth:`~pidcore.store.Store.list_analyses`."""
+    def rows(listing: pd.DataFrame) -> dict[str, dict]:
+        return {str(row["key"]): {k: v for k, v in row.items() if k != "created_utc"}
+                for row in listing[listing["key"].isin(keys)].to_dict("records")}
+
+    old, new = rows(before), rows(after)
+    return {key for key in keys if key in new and _same_fields(old.get(key, {}), new[key])}
+
+
+def _same_fields(first: Mapping, second: Mapping) -> bool:
+    """Equal field by field, a missing field and NaN both read as the listing's empty value
+    (NaN == NaN here: an unknown standard error saved again is the same unknown)."""
+    def empty(value: object) -> bool:
+        return value is None or (isinstance(value, float) and math.isnan(value))
+
+    for name in {*first, *second}:
+        a, b = first.get(name), second.get(name)
+        if empty(a) and empty(b):
+            continue
+        if empty(a) or empty(b) or a != b:
+            return False
+    return True
 
 
 def _analyzed_records(results: object) -> list[AnalyzedRecord]:

@@ -115,7 +115,7 @@ from .constants import (
     CellShape,
     TangentialStiffnessModel,
 )
-from .errors import ParameterError, as_given, real_number
+from .errors import ParameterError, apart, as_given, real_number
 from .loadcase import normalize_material
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -915,6 +915,30 @@ _OVERRIDABLE = (tuple(("particles", key, column, "material")
                       for key, column in _PARTICLE_FROM_MATERIAL)
                 + tuple(("cell", key, column, "wall_material")
                         for key, column in _WALL_FROM_MATERIAL))
+
+
+def fill_override_note(specimen: Specimen | None, fills_percent) -> str:
+    """What fills given for a run or sweep of ``specimen`` override: the fill (or particle
+    count) the specimen file states, which a run without a fill simulates; ``""`` where it
+    states none or every fill is the one it states.
+
+    ``dem run --fill 50 --specimen FILE`` of a file stating ``count_per_cell = 5`` simulated
+    50 % without a word that the count written in the file was not used.
+    """
+    stated = specimen.stated_fill() if specimen is not None else None
+    if stated is None:
+        return ""
+    # relative 1e-9: a count's share of the capacity typed back as a percentage is the same fill
+    overriding = [f for f in sorted(set(map(float, fills_percent)))
+                  if not math.isclose(f, stated[0], rel_tol=1e-9)]
+    if not overriding:
+        return ""
+    shown = [apart(f, stated[0]) for f in overriding]
+    stated_text = max((text for _, text in shown), key=len)  # the digits every pair needs
+    several = len(overriding) > 1
+    return (f"fill{'s' if several else ''} {', '.join(text for text, _ in shown)} % "
+            f"override{'' if several else 's'} the {stated_text} % specimen {specimen.name} "
+            f"states ({stated[1]})")
 
 
 def table_overrides(specimen: Specimen) -> tuple[str, ...]:

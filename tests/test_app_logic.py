@@ -463,6 +463,19 @@ def test_save_writes_the_load_case_and_the_report_reads_it(tmp_path, good_csv, o
     assert "specimen S1 is not the paper's coupon" in table["note"].iloc[0]
 
 
+def test_saving_again_says_the_store_already_held_the_records(tmp_path, good_csv, options):
+    # the app's second Save said "saved 1 analysis record(s)" as the first had
+    rec = _record(good_csv, options, name="coupon_fill50.csv")
+    store_file = tmp_path / "store.h5"
+    first = uploads.save_records(store_file, [_file(rec, options)])
+    assert first.breakdown == ""  # all new: nothing to add to the count
+    again = uploads.save_records(store_file, [_file(rec, options)])
+    assert again.keys == first.keys
+    assert again.breakdown == "0 new, 1 already held with identical content"
+    other = uploads.save_records(store_file, [_file(rec, options, fill=75.0)])
+    assert other.breakdown == "0 new, 1 replacing a held record of other content"
+
+
 def test_two_sessions_saving_at_once_keep_the_store_whole(tmp_path, options):
     from pidcore.store import Store
 

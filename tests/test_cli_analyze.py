@@ -107,6 +107,33 @@ def test_the_saved_count_is_of_records_not_of_files(tmp_path, capsys):
             f"one record) to {store_path}") in out
 
 
+def test_saving_the_same_records_again_says_they_were_already_held(tmp_path, capsys):
+    # the second `analyze FILES --store S` said "saved 2 record(s)" as the first did, though
+    # it only rewrote what the store held
+    a = export(tmp_path / "a_fill50.csv", fmt="csv")
+    b = tmp_path / "b_fill50.csv"
+    b.write_bytes(a.read_bytes().replace(b"\n", b"\r\n"))  # other bytes: another record
+    store_path = tmp_path / "s.h5"
+    argv = ["analyze", str(a), "--store", str(store_path)]
+    assert main(argv) == 0
+    assert f"saved 1 record(s) to {store_path}\n" in capsys.readouterr().out  # all new
+    assert main([*argv[:2], str(b), *argv[2:]]) == 0
+    assert (f"saved 2 record(s) to {store_path} (1 new, 1 already held with identical "
+            "content)\n") in capsys.readouterr().out
+    first = Store(store_path).list_analyses().set_index("key")
+    assert main([*argv[:2], str(b), *argv[2:], "--json"]) == 0
+    assert "saved 0 new, 2 already held with identical content" in \
+        json.loads(capsys.readouterr().out)["notes"]
+    again = Store(store_path).list_analyses().set_index("key")
+    assert again.index.tolist() == first.index.tolist()  # the store semantics: replaced,
+    assert again["sdc"].tolist() == first["sdc"].tolist()  # never duplicated
+    # another load case for the same bytes is no identical content: replaced, and said so
+    assert main([*argv, "--fill", "75"]) == 0
+    out = capsys.readouterr().out
+    assert (f"saved 1 record(s) to {store_path} (0 new, 1 replacing a held record of other "
+            "content)\n") in out and "replaces it" in out
+
+
 def test_a_stated_load_case_is_saved_so_that_a_store_report_places_it(tmp_path, capsys):
     # `analyze` saved no load case (it had no way to), so `report --store` never showed a
     # measured row: "stored measurement(s) have no analysis stating a fill"

@@ -380,10 +380,57 @@ def test_a_sweep_over_the_grids_fills_says_it_is_not_the_specimens_fill(tmp_path
     assert (f"pidcore dem sweep: note: fills 25, 50, 75, 90 % are grid table3's, not the "
             f"{100 * 20 / capacity:.6g} % specimen steel_6mm states ([particles] count_per_cell "
             f"20 of capacity {capacity}); give --fills to choose\n") in err
-    # fills given, or a specimen whose fill is on the grid (steel_6mm's 50 %): nothing to say
-    for more, path in ((["--fills", "30"], mine), ([], spec)):
+    # a specimen whose fill is on the grid (steel_6mm's 50 %), or given: nothing to say
+    for more, path in (([], spec), (["--fills", "50"], spec)):
         assert main([*argv[:3], str(path), *argv[4:], *more]) == 130
         assert "note" not in capsys.readouterr().err
+    # fills given override the count the file states: said too (ran 30 % without a word)
+    assert main([*argv, "--fills", "30,50"]) == 130
+    assert capsys.readouterr().err.startswith(
+        f"pidcore dem sweep: note: fills 30, 50 % override the {100 * 20 / capacity:.6g} % "
+        f"specimen steel_6mm states ([particles] count_per_cell 20 of capacity {capacity})\n")
+
+
+def test_a_fill_given_for_a_specimen_stating_its_count_is_said_to_override_it(tmp_path,
+                                                                              capsys):
+    # `dem run --fill 30 --specimen FILE` of a file stating count_per_cell = 20 simulated 30 %
+    # without a word that the count written in the file was not used
+    from pidcore.dem import DemConfig, LoadCase, simulate_load_case
+    from pidcore.dem.sweep import run_sweep
+    from pidcore.specimen import load_specimen
+
+    spec = Path(__file__).resolve().parents[1] / "data_samples" / "specimens" / "steel_6mm.toml"
+    mine = tmp_path / "mine.toml"
+    mine.write_text(spec.read_text().replace("fill_percent = 50.0", "count_per_cell = 20"))
+    specimen = load_specimen(mine)
+    capacity = specimen.capacity_per_cell()
+    stated = f"{100 * 20 / capacity:.6g} % specimen steel_6mm states ([particles] " \
+             f"count_per_cell 20 of capacity {capacity})"
+    argv = ["dem", "run", "--specimen", str(mine), "--frequency", "500", "--acceleration", "5",
+            "--cells", "1", "--cycles", "4", "--no-progress"]
+    assert main([*argv, "--fill", "30", "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    said = [n for n in doc["notes"] if "override" in n]
+    assert said == [f"fill 30 % overrides the {stated}: {doc['particles_per_cell']} particles "
+                    "per cell simulated"]
+    assert doc["particles_per_cell"] != 20  # the count the file states was indeed not run
+    assert main([*argv, "--fill", "30"]) == 0
+    assert f"note            fill 30 % overrides the {stated}" in capsys.readouterr().out
+    # without --fill the file's own count runs, and nothing is said
+    assert main([*argv, "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["particles_per_cell"] == 20 and not any("override" in n for n in doc["notes"])
+    # the library's result and sweep summary say the same
+    config = DemConfig(cells=1, steady_cycles=4)
+    result = simulate_load_case(LoadCase(500.0, 5.0, 30.0, material=specimen.particles.material),
+                                config, progress=False, specimen=specimen)
+    assert f"fill 30 % overrides the {stated}: {result.particles_per_cell} particles per cell " \
+           "simulated" in result.notes
+    summary = run_sweep([LoadCase(500.0, 5.0, 30.0, material=specimen.particles.material)],
+                        config, store_path=tmp_path / "s.h5", workers=1, progress=False,
+                        specimen=specimen)
+    assert summary.notes == [f"fill 30 % overrides the {stated}"]
+    assert summary.to_dict()["notes"] == summary.notes
 
 
 def test_a_read_only_store_is_refused_before_any_simulation(tmp_path, monkeypatch, capsys,

@@ -104,3 +104,45 @@ def test_ctrl_c_to_the_whole_group_prints_only_the_callers_line(tmp_path):
     assert p.returncode == 130 and err == "interrupted\n", err
     pids = [int(f.name) for f in tmp_path.iterdir()]
     assert len(pids) == 2 and not any(_alive(pid) for pid in pids)
+
+
+@pytest.mark.slow
+def test_a_pool_running_in_a_background_thread_does_not_hold_the_exit(tmp_path):
+    # The app runs a calibration's DEM pool in a thread; SIGTERM stops Streamlit's server and
+    # its main thread returns, but concurrent.futures' exit hook then waited for every case
+    # given to the pool (here 60 s each; a calibration's design: its whole run), so the app
+    # ignored SIGTERM. Now the exit terminates the workers first, as Ctrl-C does.
+    code = textwrap.dedent(f"""
+        import signal, sys, threading, time
+        from pidcore.dem.sweep import run_pooled
+        from _pool_probe import wait_in_worker
+        stop = threading.Event()
+
+        def calibration():  # as the app's runner: an error becomes the task's message
+            try:
+                run_pooled(wait_in_worker, [({str(tmp_path)!r}, 60.0)] * 4, workers=2,
+                           finish=print)
+            except Exception:
+                pass
+
+        if __name__ == "__main__":
+            # what Streamlit's handler does: the server stops, the main thread returns
+            signal.signal(signal.SIGTERM, lambda signum, frame: stop.set())
+            threading.Thread(target=calibration, daemon=True).start()
+            stop.wait()
+    """)
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT), str(TESTS)])}
+    p = subprocess.Popen([sys.executable, "-c", code], env=env, stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 90
+    while len(list(tmp_path.iterdir())) < 2 and time.monotonic() < deadline:
+        time.sleep(0.02)
+    p.send_signal(signal.SIGTERM)
+    started = time.monotonic()
+    out, err = p.communicate(timeout=180)
+    # well under the 60 s a case waits, with room for a loaded machine (the stop itself
+    # takes a fraction of a second)
+    assert time.monotonic() - started < 30
+    assert p.returncode == 0 and out == "" and err == "", err  # no case finished, no warning
+    pids = [int(f.name) for f in tmp_path.iterdir()]
+    assert len(pids) == 2 and not any(_alive(pid) for pid in pids)

@@ -163,6 +163,28 @@ def test_dem_run_cli_reuse_note(stored, monkeypatch, capsys, tmp_path):
     assert f"reused from {path} as {run_key(CASE, config)}" in text
 
 
+def test_dem_run_reuse_note_prints_fills_as_the_other_lines_do(tmp_path, monkeypatch,
+                                                              capsys):
+    """A stored fill of 6 of 22 particles read "reused the stored run of fill
+    27.272727272727273 %" where the summary line of the same run says 27.2727 %."""
+    from pidcore.errors import apart
+
+    path = tmp_path / "runs.h5"
+    config = DemConfig(cells=1, steady_cycles=4)  # what the options below ask for
+    stored_fill = 100 * 6 / 22  # exactly 6 of the acrylic cell's 22 particles
+    run_or_load(path, None, LoadCase(1000.0, 5.0, stored_fill), config)
+    monkeypatch.setattr(persist, "simulate_load_case", _no_simulation)
+    assert main(["dem", "run", "--frequency", "1000", "--acceleration", "5", "--fill", "26",
+                 "--cells", "1", "--cycles", "4", "--store", str(path), "--no-progress"]) == 0
+    text = capsys.readouterr().out
+    assert "fill 26 % asked; reused the stored run of fill 27.2727 %: " in text
+    assert "fill 27.2727 % (6 of 22" in text  # the summary's own spelling of the same fill
+    # two fills alike in 6 digits get the digits that tell them apart, no more
+    assert apart(27.2727, stored_fill) == ("27.2727", "27.27273")
+    assert apart(26.0, stored_fill) == ("26", "27.2727")
+    assert apart(0.1 + 0.2, 0.3) == ("0.30000000000000004", "0.3")
+
+
 def test_sweep_skips_a_fill_whose_simulation_is_stored_and_says_so(stored, tmp_path,
                                                                   monkeypatch):
     import shutil

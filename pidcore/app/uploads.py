@@ -800,6 +800,9 @@ class SavedRecords:
 
     keys: list[str]
     notes: tuple[str, ...] = ()
+    #: How many records were new and how many the store held already
+    #: (:meth:`pidcore.measure.SavedAnalyses.breakdown`); "" where all were new.
+    breakdown: str = ""
 
 
 def check_one_load_case_per_content(files: Sequence[AnalysedFile]) -> None:
@@ -863,4 +866,4 @@ def save_records(path: str | os.PathLike, files: Sequence[AnalysedFile], *,
         fields=[{**({"specimen": f.specimen} if f.specimen else {}),
                  **({"plausibility_warnings": "; ".join(str(w) for w in f.warnings)}
                     if f.warnings else {})} for f in files])
-    return SavedRecords(saved.keys, tuple(saved.notes))
+    return SavedRecords(saved.keys, tuple(saved.notes), saved.breakdown())

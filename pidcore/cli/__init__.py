@@ -87,6 +87,12 @@ def _displayable_streams() -> Callable[[], None]:
 
 
 def main(argv: list[str] | None = None) -> int:
+    return _main(argv)[0]
+
+
+def _main(argv: list[str] | None) -> tuple[int, bool]:
+    """:func:`main`'s exit status, and whether the command was interrupted (which the flag,
+    cleared on the way out, no longer says)."""
     # First thing: Ctrl-C during the imports below (every sub-command) or inside Numba must
     # end as one line and exit 130, and an interrupt swallowed somewhere must still stop the
     # store from committing (pidcore.interrupt).
@@ -94,7 +100,8 @@ def main(argv: list[str] | None = None) -> int:
     interrupt.reset()
     streams = _displayable_streams()
     try:
-        return _run(argv)
+        rc = _run(argv)
+        return rc, interrupt.interrupted()
     finally:
         streams()
         restore()
@@ -193,8 +200,10 @@ def console_main(argv: list[str] | None = None) -> int:
     lands while the interpreter shuts down would otherwise end the process by the signal
     (exit status -2) instead of the command's own status.
     """
-    rc = main(argv)
+    rc, interrupted = _main(argv)
     interrupt.ignore()
+    if interrupted:  # what the interrupted run left half-built is torn down at exit
+        interrupt.silence_teardown()
     return rc
 
 

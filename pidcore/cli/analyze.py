@@ -109,18 +109,20 @@ def run(args: argparse.Namespace) -> int:
              ", ".join(w for w in (c.full_label() if c else NO_LOAD_CASE, fs.label()) if w))
             for path, r, c, fs in zip(args.paths, results, cases, settings, strict=True))
         replaced: list[str] = []
+        breakdown = ""
         if store is not None:
             from ..measure import save_analyses
 
-            replaced = save_analyses(  # one transaction
+            saved = save_analyses(  # one transaction
                 store, results, [fs.options for fs in settings],
                 [(Path(path).name, c, st.origin if st is not None else "")
                  for path, c, st in zip(args.paths, cases, stated, strict=True)],
                 fields=[{"specimen": fs.specimen} if fs.specimen else None
-                        for fs in settings]).notes
+                        for fs in settings])
+            replaced, breakdown = saved.notes, saved.breakdown()
         interrupt.raise_if_interrupted()  # an interrupt swallowed on the way still counts
         # inside: a Ctrl-C while the results are written out still says what was saved
-        _print_results(args, results, cases, stated, settings, replaced)
+        _print_results(args, results, cases, stated, settings, replaced, breakdown)
     except (KeyboardInterrupt, Exception) as exc:
         # after SIGINT any error is the interruption: pyuff's bare ``except:`` swallows the
         # KeyboardInterrupt and its half-read file then comes back as "no force channel"
@@ -139,8 +141,9 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _print_results(args: argparse.Namespace, results: list, cases: list, stated: list,
-                   settings: list, replaced: list[str]) -> None:
-    """The results table (or JSON document), each file's load case and settings, notes."""
+                   settings: list, replaced: list[str], breakdown: str = "") -> None:
+    """The results table (or JSON document), each file's load case and settings, notes, and
+    how many of the saved records were new (``breakdown``: :meth:`SavedAnalyses.breakdown`)."""
     overrides = [note for fs in settings for note in (*fs.notes, fs.unmatched) if note]
     if args.json:
         json.dump({"records": [{**r.to_dict(), "notes": [cli_words(n) for n in r.notes],
@@ -151,7 +154,8 @@ def _print_results(args: argparse.Namespace, results: list, cases: list, stated:
                                 "overridden": list(fs.notes),
                                 "sidecar_row_missing": fs.unmatched or None}
                                for r, c, fs in zip(results, cases, settings, strict=True)],
-                   "notes": [*overrides, *replaced]}, sys.stdout)
+                   "notes": [*overrides, *replaced,
+                             *([f"saved {breakdown}"] if breakdown else [])]}, sys.stdout)
         sys.stdout.write("\n")
         return
     print(format_table(results))
@@ -164,7 +168,8 @@ def _print_results(args: argparse.Namespace, results: list, cases: list, stated:
     for note in [*overrides, *replaced]:
         print(f"note: {note}")
     if not args.no_store:
-        print(f"saved {_saved(results)} to {args.store}")
+        print(f"saved {_saved(results)} to {args.store}"
+              + (f" ({breakdown})" if breakdown else ""))
 
 
 def _saved(results: list) -> str:

@@ -18,7 +18,7 @@ from ..constants import (
     TANGENTIAL_STIFFNESS_MODELS,
     VIBRATED_MASS_CONVENTIONS,
 )
-from ..errors import ParameterError, PidcoreError, as_given
+from ..errors import ParameterError, PidcoreError, apart
 from ._options import (
     add_json_option,
     add_store_option,
@@ -209,6 +209,7 @@ def sweep(args: argparse.Namespace) -> int:
     from ..dem.simulate import check_drive
     from ..dem.sweep import cross_cases, grid_axes, grid_fill_note, run_sweep
     from ..loadcase import parse_values
+    from ..specimen import fill_override_note
 
     axes = grid_axes(args.grid)
     values = [axes[axis] if given is None else parse_values(given, name=flag)
@@ -219,7 +220,10 @@ def sweep(args: argparse.Namespace) -> int:
     specimen, material = _specimen(args)
     for fill in values[2]:
         _check_fill(fill, "--fills", args, specimen, material)
-    note = grid_fill_note(specimen, args.grid, values[2]) if args.fills is None else ""
+    # before the run (an interrupted sweep prints no summary); the summary's notes say the
+    # same to a library caller and in --json
+    note = grid_fill_note(specimen, args.grid, values[2]) if args.fills is None else \
+        fill_override_note(specimen, values[2])
     if note:  # on stderr: --json prints one document
         print(f"pidcore dem sweep: note: {cli_words(note, 'dem sweep')}", file=sys.stderr)
     cases = cross_cases(*values, material=material, direction=args.direction)
@@ -392,8 +396,8 @@ def _same_simulation_note(asked, result) -> str:
     stored = result.case.fill_percent
     if stored == asked.fill_percent:
         return ""
-    return (f"fill {as_given(asked.fill_percent)} % asked; reused the stored run of fill "
-            f"{as_given(stored)} %: "
+    asked_text, stored_text = apart(asked.fill_percent, stored)
+    return (f"fill {asked_text} % asked; reused the stored run of fill {stored_text} %: "
             f"the same simulation ({result.particles_per_cell} particles per cell, seed "
             f"{result.config.seed}, the same settings and specimen), so the numbers are those "
             "of that run and it is stated at its fill")

@@ -199,10 +199,12 @@ class DemResult:
         * ``particle_steps_per_s`` was not measured (NaN): every kernel call compiled code;
         * a property of the specimen overrides its table material's
           (:func:`pidcore.specimen.table_overrides`);
+        * the load case's fill overrides the fill or particle count the specimen states
+          (:func:`pidcore.specimen.fill_override_note`);
         * the drive is above :data:`pidcore.defaults.DEM_NOTE_ACCELERATION_G` (m/s^2 typed
           for g?).
         """
-        from ..specimen import table_overrides
+        from ..specimen import fill_override_note, table_overrides
         from .simulate import required_steady_cycles
 
         notes = []
@@ -219,6 +221,10 @@ class DemResult:
                          "included Numba compilation (run again for the compiled speed)")
         if self.specimen is not None:
             notes += table_overrides(self.specimen)
+            overridden = fill_override_note(self.specimen, [self.case.fill_percent])
+            if overridden:
+                notes.append(f"{overridden}: {self.particles_per_cell} particles per cell "
+                             "simulated")
         if cells_ran_one_motion(self.sdc_per_cell):
             notes.append(f"no standard error: the {self.cells_simulated} cells ran the same "
                          "motion (the same SDC to the last bit, as a lone particle bouncing along "

@@ -22,7 +22,7 @@ from pathlib import Path
 from ..constants import DriveDirection, ParticleMaterial
 from ..errors import ParameterError, SimulationError, instance_of, whole_number
 from ..records import json_safe
-from ..specimen import Specimen
+from ..specimen import Specimen, fill_override_note
 from .persist import (
     dem_run_entry,
     own_run_keys,
@@ -241,9 +241,13 @@ def run_pooled(function: Callable, calls: Sequence[tuple], *, workers: int,
 
     from .. import interrupt
 
+    _stop_at_exit_registered()
     pool = ProcessPoolExecutor(max_workers=min(workers, len(calls)),
                                mp_context=dem_process_context(),
                                initializer=init_dem_worker, initargs=(os.getpid(),))
+    import threading
+
+    _RUNNING_POOLS[pool] = threading.current_thread()
     try:
         # submit() starts the workers: a Ctrl-C inside Process.start() could leave a worker
         # forked but not yet in the pool's table, out of reach of _stop_pool; held back until
@@ -263,7 +267,44 @@ def run_pooled(function: Callable, calls: Sequence[tuple], *, workers: int,
     except BaseException:
         _stop_pool(pool)
         raise
+    finally:
+        _RUNNING_POOLS.pop(pool, None)
     pool.shutdown()
+
+
+#: Pools of :func:`run_pooled` still running, each with the thread that runs it.
+_RUNNING_POOLS: dict = {}
+_STOP_AT_EXIT: list[bool] = []
+
+
+def _stop_at_exit_registered() -> None:
+    """Have the interpreter's exit terminate the DEM workers of a pool still running.
+
+    A pool run in a background thread (the app's calibration) held the process's exit until
+    every case it was given had run: concurrent.futures joins its pools at exit, waiting for
+    their pending work. SIGTERM to the app (a service manager, ``kill``) stopped its server
+    and then left the process running for the rest of the calibration. Stopping the workers
+    first ends the pool, as a Ctrl-C does (the runs saved so far are kept). Registered after
+    concurrent.futures' own hook: the interpreter calls these last-registered first.
+    """
+    import concurrent.futures.process  # noqa: F401 - registers its hook first
+    import threading
+
+    if not _STOP_AT_EXIT:
+        threading._register_atexit(_stop_running_pools)  # noqa: SLF001 - as futures does
+        _STOP_AT_EXIT.append(True)
+
+
+def _stop_running_pools() -> None:
+    import threading
+
+    for pool, owner in list(_RUNNING_POOLS.items()):
+        _stop_pool(pool)
+        if owner is threading.current_thread():
+            continue
+        # its thread lets the pool go (its queues' semaphores, which the resource tracker
+        # called leaked at exit) once it has seen the pool end: seconds at most
+        owner.join(timeout=10.0)
 
 
 def _stop_pool(pool) -> None:
@@ -318,11 +359,14 @@ class SweepSummary:
     wall_s: float = 0.0
     store_path: str = ""
     cases: list[dict] = field(default_factory=list)
+    #: What a reader of the runs should know: the fills given override the one the specimen
+    #: states (:func:`pidcore.specimen.fill_override_note`).
+    notes: list[str] = field(default_factory=list)
 
     def to_dict(self) -> dict:
         return {"completed": len(self.completed), "skipped": len(self.skipped),
                 "wall_s": self.wall_s, "store": self.store_path,
-                "cases": [dict(c) for c in self.cases]}
+                "cases": [dict(c) for c in self.cases], "notes": list(self.notes)}
 
     def fill_results(self, store) -> None:
         """Read each case's results from ``store`` (the runs as stored)."""
@@ -389,6 +433,9 @@ def run_sweep(cases: Sequence[LoadCase], config: DemConfig, *,
     start = time.perf_counter()
     store = Store(store_path)
     summary = SweepSummary(store_path=str(Path(store_path)))
+    overridden = fill_override_note(specimen, [case.fill_percent for case in cases])
+    if overridden:
+        summary.notes.append(overridden)
     todo: list[tuple[LoadCase, str]] = []
     identities = stored_identities(store)  # read once, not once per case
     planned: dict[str, str] = {}  # simulation identity -> key of a case to simulate

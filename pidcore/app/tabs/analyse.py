@@ -253,7 +253,8 @@ def render(stores) -> list:
         except PidcoreError as exc:
             st.error(f"not saved: {exc}")
         else:
-            st.success(f"saved {len(saved.keys)} analysis record(s) to {stores.path}")
+            st.success(f"saved {len(saved.keys)} analysis record(s) to {stores.path}"
+                       + (f" ({saved.breakdown})" if saved.breakdown else ""))
             for note in saved.notes:
                 st.warning(note)
     return analysed
