@@ -333,3 +333,38 @@ sys.exit(console_main(["analyze", {str(tmp_path / 'x.csv')!r}, "--no-store"]))
     done = subprocess.run([sys.executable, str(script), "not"], env=env,
                           capture_output=True, text=True, timeout=120)
     assert "AttributeError" in done.stderr  # a real error at exit is still reported
+
+
+def test_an_interrupt_during_a_numba_compilation_is_raised_once_the_function_is_whole():
+    # an interrupt raised inside llvmlite left a module half-built, whose destructor crashed
+    # the process (segfault after the one line: 2 in ~730 interrupted `analyze` runs); the
+    # signal is sent from inside the compilation (Numba's own compile event), so it lands
+    # there on every run, not by timing
+    import numba
+    from numba.core import event
+
+    interrupt.defer_while_compiling()
+
+    class SignalInside(event.Listener):
+        def on_start(self, evt):
+            os.kill(os.getpid(), signal.SIGINT)
+
+        def on_end(self, evt):
+            pass
+
+    @numba.njit  # a new function: compiled here, never loaded from a cache
+    def add_one(x):
+        return x + 1
+
+    restore = interrupt.install()
+    try:
+        with event.install_listener("numba:compile", SignalInside()):
+            with pytest.raises(KeyboardInterrupt):
+                add_one(1)
+        assert interrupt.interrupted()
+        # the compilation finished before the interrupt was raised: the function is whole
+        assert len(add_one.overloads) == 1
+        assert add_one(41) == 42
+    finally:
+        restore()
+        interrupt.reset()

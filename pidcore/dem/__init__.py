@@ -16,6 +16,7 @@ Benchmarks (kernel throughput, a grid sweep into a temporary store) are in
 :mod:`pidcore.dem.bench`.
 """
 
+from .. import interrupt
 from .._numba_cache import tolerate_unwritable_cache
 from .contact import ContactLaw, PairLaw
 from .geometry import CellGeometry, cell_capacity
@@ -26,6 +27,7 @@ from .simulate import DemConfig, LoadCase, particles_per_cell, simulate_load_cas
 
 # before the first call of any cache=True function of this package (compiled, then saved)
 tolerate_unwritable_cache()
+interrupt.defer_while_compiling()
 
 __all__ = ["CellGeometry", "ContactLaw", "DemConfig", "DemResult", "LoadCase",
            "MaterialProperties", "PairLaw", "PairParameters",

@@ -14,6 +14,7 @@ synthesize_shaker_record, SyntheticRecord
     Synthetic records with an analytic answer, and the record they return.
 """
 
+from .. import interrupt
 from .._numba_cache import tolerate_unwritable_cache
 from .frequency import estimate_drive_frequency
 from .power import PowerAnalysis, analyze_channels, analyze_power
@@ -21,6 +22,7 @@ from .synthetic import SyntheticRecord, synthesize_shaker_record
 
 # before the first call of any cache=True function of this package (compiled, then saved)
 tolerate_unwritable_cache()
+interrupt.defer_while_compiling()
 
 __all__ = ["PowerAnalysis", "SyntheticRecord", "analyze_channels", "analyze_power",
            "estimate_drive_frequency", "synthesize_shaker_record"]
