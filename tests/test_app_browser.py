@@ -37,7 +37,10 @@ CANCEL_BUDGET_S = 2.0
 PAGE_SWITCH_BUDGET_S = 1.0
 #: Seconds to wait for the server to answer and for results to appear (cold imports included).
 START_TIMEOUT_S = 45
-RESULT_TIMEOUT_MS = 30_000
+#: (90 s: under pytest-xdist the module's tests may land on both workers, each starting its
+#: own server; the first analysis in the second one, its imports and Numba cache loads beside
+#: the other worker's DEM tests on a 2-core machine, overran 30 s in 2 of 5 full runs)
+RESULT_TIMEOUT_MS = 90_000
 
 
 def _coloured_pixels(png: bytes) -> int:
