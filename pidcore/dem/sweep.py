@@ -241,13 +241,9 @@ def run_pooled(function: Callable, calls: Sequence[tuple], *, workers: int,
 
     from .. import interrupt
 
-    _stop_at_exit_registered()
     pool = ProcessPoolExecutor(max_workers=min(workers, len(calls)),
                                mp_context=dem_process_context(),
                                initializer=init_dem_worker, initargs=(os.getpid(),))
-    import threading
-
-    _RUNNING_POOLS[pool] = threading.current_thread()
     try:
         # submit() starts the workers: a Ctrl-C inside Process.start() could leave a worker
         # forked but not yet in the pool's table, out of reach of _stop_pool; held back until
@@ -267,44 +263,7 @@ def run_pooled(function: Callable, calls: Sequence[tuple], *, workers: int,
     except BaseException:
         _stop_pool(pool)
         raise
-    finally:
-        _RUNNING_POOLS.pop(pool, None)
     pool.shutdown()
-
-
-#: Pools of :func:`run_pooled` still running, each with the thread that runs it.
-_RUNNING_POOLS: dict = {}
-_STOP_AT_EXIT: list[bool] = []
-
-
-def _stop_at_exit_registered() -> None:
-    """Have the interpreter's exit terminate the DEM workers of a pool still running.
-
-    A pool run in a background thread (the app's calibration) held the process's exit until
-    every case it was given had run: concurrent.futures joins its pools at exit, waiting for
-    their pending work. SIGTERM to the app (a service manager, ``kill``) stopped its server
-    and then left the process running for the rest of the calibration. Stopping the workers
-    first ends the pool, as a Ctrl-C does (the runs saved so far are kept). Registered after
-    concurrent.futures' own hook: the interpreter calls these last-registered first.
-    """
-    import concurrent.futures.process  # noqa: F401 - registers its hook first
-    import threading
-
-    if not _STOP_AT_EXIT:
-        threading._register_atexit(_stop_running_pools)  # noqa: SLF001 - as futures does
-        _STOP_AT_EXIT.append(True)
-
-
-def _stop_running_pools() -> None:
-    import threading
-
-    for pool, owner in list(_RUNNING_POOLS.items()):
-        _stop_pool(pool)
-        if owner is threading.current_thread():
-            continue
-        # its thread lets the pool go (its queues' semaphores, which the resource tracker
-        # called leaked at exit) once it has seen the pool end: seconds at most
-        owner.join(timeout=10.0)
 
 
 def _stop_pool(pool) -> None:
