@@ -1344,6 +1344,11 @@ def describe(specimen: Specimen) -> dict[str, Any]:
                    for name, pair in (("pp", law.pair_particle), ("pw", law.pair_wall))}
     return {
         "name": specimen.name, "sha256": specimen.hash, "is_paper": specimen.is_paper(),
+        # the file a calibrated one was made from ([provenance]; None: not recorded)
+        "calibrated_from_name": None if specimen.provenance is None
+        else specimen.provenance.calibrated_from_name,
+        "calibrated_from_sha256": None if specimen.provenance is None
+        else specimen.provenance.calibrated_from_sha256,
         "notes": [*table_overrides(specimen), *_heavy_fixture_note(specimen, count)],
         "cell_shape": specimen.cell.shape, "cells_per_coupon": specimen.cell.count,
         "capacity_per_cell": capacity, "particles_per_cell": count,

@@ -503,3 +503,21 @@ def test_a_bad_provenance_table_is_one_line_naming_its_key(table, said):
     with pytest.raises(ParameterError) as caught:
         load_specimen_text(PAPER.to_toml() + f"\n[provenance]\n{table}\n")
     assert str(caught.value) == said
+
+
+def test_specimen_check_says_which_file_a_calibrated_one_was_made_from(capsys):
+    # the [provenance] table decides which tests a calibrated file models, but `specimen
+    # check` showed nothing of it
+    import json
+
+    assert main(["specimen", "check", str(CALIBRATED_PAPER)]) == 0
+    out = capsys.readouterr().out
+    assert f"calibrated from paper_coupon (sha256 {PAPER.hash[:16]})" in out
+    assert main(["specimen", "check", str(CALIBRATED_PAPER), "--json"]) == 0
+    facts = json.loads(capsys.readouterr().out)
+    assert (facts["calibrated_from_name"], facts["calibrated_from_sha256"]) == \
+        ("paper_coupon", PAPER.hash)
+    # a file without the table (the paper's own coupon) says nothing of it
+    bundled = REPO / "pidcore" / "data" / "specimens" / "paper_coupon.toml"
+    assert main(["specimen", "check", str(bundled)]) == 0
+    assert "calibrated from" not in capsys.readouterr().out

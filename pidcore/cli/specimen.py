@@ -45,6 +45,9 @@ def format_facts(f: dict, source: str) -> str:
     return "\n".join([
         f"specimen        {f['name']} ({source}): OK, {kind}; sha256 {f['sha256'][:16]} "
         "(of every value, name and description included)",
+        *([f"calibrated from {f['calibrated_from_name']} (sha256 "
+           f"{f['calibrated_from_sha256'][:16]}): the tests it models are that file's"]
+          if f.get("calibrated_from_sha256") else []),
         f"cells           {f['cells_per_coupon']} {f['cell_shape']}, capacity "
         f"{f['capacity_per_cell']} particles per cell (dense drop packing)",
         f"gaps            wall to wall {f['wall_to_wall_gap_m'] * 1e3:.4g} mm, floor to "
