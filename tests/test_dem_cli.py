@@ -670,7 +670,6 @@ def test_more_cells_than_memory_holds_are_refused_before_any_work(capsys, tmp_pa
         _physical_memory_bytes,
         check_cells_fit_memory,
         particles_per_cell,
-        state_bytes_per_cell,
     )
     from pidcore.dem.state import CellsState
 
@@ -679,9 +678,9 @@ def test_more_cells_than_memory_holds_are_refused_before_any_work(capsys, tmp_pa
     state = CellsState.from_positions(np.zeros((3, n, 3)), mass_kg=1e-5)
     arrays = [state.pos, state.vel, state.omg, state.frc, state.trq, state.spring_pp,
               state.spring_pw]
-    assert sum(a.nbytes for a in arrays) == 3 * state_bytes_per_cell(n)
+    assert sum(a.nbytes for a in arrays) == 3 * CellsState.bytes_per_cell(n)
     total = _physical_memory_bytes()
-    most = total // state_bytes_per_cell(n)
+    most = total // CellsState.bytes_per_cell(n)
     check_cells_fit_memory(most, n)  # the largest that fits is accepted
     store = tmp_path / "s.h5"
     for command in (["dem", "run", "--fill", "50", "--frequency", "100", "--acceleration", "5"],

@@ -586,15 +586,6 @@ def check_drive_stroke(case: LoadCase, *, what: str = "load case") -> None:
             "the frequency typed in kHz, or the acceleration in m/s^2?")
 
 
-def state_bytes_per_cell(particles: int) -> int:
-    """Bytes of a cell's DEM state (:class:`~pidcore.dem.state.CellsState`: five 3-vectors
-    per particle and the contact histories of every pair and particle-wall slot)."""
-    from .geometry import WALL_NAMES
-    from .kernel import N_HISTORY
-
-    return 8 * (15 * particles + N_HISTORY * particles * (particles + len(WALL_NAMES)))
-
-
 def _physical_memory_bytes() -> int | None:
     """This machine's physical memory, bytes (None where the OS does not say)."""
     import os
@@ -608,7 +599,7 @@ def _physical_memory_bytes() -> int | None:
 def check_cells_fit_memory(cells: int, particles: int, *, what: str = "cells") -> None:
     """Refuse, before any work, more cells than this machine's memory holds the state of:
     ``--cells 1000000000`` packed cells for hours before running out of memory."""
-    per_cell = state_bytes_per_cell(particles)
+    per_cell = CellsState.bytes_per_cell(particles)
     total = _physical_memory_bytes()
     if total is None or cells * per_cell <= total:
         return

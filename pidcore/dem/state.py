@@ -46,6 +46,12 @@ class CellsState:
     spring_pw: np.ndarray
     step: int = 0
 
+    @staticmethod
+    def bytes_per_cell(particles: int) -> int:
+        """Bytes one cell of :meth:`from_positions`'s arrays takes: five 3-vectors per
+        particle and the history of every pair and particle-wall slot."""
+        return 8 * (15 * particles + N_HISTORY * particles * (particles + len(WALL_NAMES)))
+
     @classmethod
     def from_positions(cls, positions: np.ndarray, *, mass_kg: float,
                        gravity_m_s2: float = STANDARD_GRAVITY) -> CellsState:
