@@ -479,21 +479,16 @@ def bound_notes(specs: Sequence[ParameterSpec], samples: np.ndarray, *,
     a stated value that is off (a fixture mass, a baseline) or a prior that is too narrow.
     The median is still reported; the note says not to trust it.
     """
-    from ..units import display_with_uncertainty
-
     notes = []
     for j, spec in enumerate(specs):
         low, high = float(spec.low), float(spec.high)
         if not (math.isfinite(low) and math.isfinite(high) and high > low):
             continue
         x = samples[:, j]
-        # the median as the summary shows it (summary_texts): the note said 0.001285 beside
-        # the table's 0.00128, digits the Monte-Carlo error does not hold
-        errors = quantile_mc_stderr(x, [2.5, 50, 97.5], effective_size=effective_size)
-        low95, median, high95 = (
-            display_with_uncertainty(float(v), float(e))
-            # the table's numbers (summarise)
-            for v, e in zip(np.percentile(x, [2.5, 50, 97.5]), errors, strict=True))
+        # median and interval as the summary table shows them (the note said 0.001285 beside
+        # the table's 0.00128, digits the Monte-Carlo error does not hold)
+        median, low95, high95 = summary_texts(
+            summarise([spec], x[:, None], effective_size=effective_size)[0][spec.name])
         u = _to_unit(spec, x)  # the prior's own scale: log for a log-uniform prior
         q_low, q_high = np.quantile(u, [0.025, 0.975])
         near = OWN_WIDTH_SHARE * float(q_high - q_low)
