@@ -31,11 +31,11 @@ _signal_number = signal.SIGINT
 #: Signals handled as an interruption (SIGHUP where the platform has it).
 _SIGNALS = (signal.SIGINT, signal.SIGTERM) + tuple(
     getattr(signal, name) for name in ("SIGHUP",) if hasattr(signal, name))
-#: Depth of :func:`deferred` blocks the main thread is in (the handler runs in that thread).
+#: Depth of :func:`deferred` blocks and Numba compiler-lock holds (:func:`defer_while_compiling`)
+#: the main thread is in (the handler runs in that thread).
 _deferring = 0
-#: Depth of Numba's compiler lock held by the main thread (:func:`defer_while_compiling`),
-#: and the listener that counts it (registered once).
-_compiling = 0
+#: The listener that defers interrupts while Numba compiles (:func:`defer_while_compiling`;
+#: registered once).
 _compile_guard = None
 
 
@@ -44,7 +44,7 @@ def _handler(signum, frame) -> None:  # noqa: ARG001 - signal handler signature
     if not _interrupted.is_set():  # the first signal is the one the exit status says
         _signal_number = signum
     _interrupted.set()
-    if _deferring or _compiling:
+    if _deferring:
         return  # raised by the deferred block's owner once its step is whole
     raise KeyboardInterrupt
 
@@ -165,8 +165,9 @@ def defer_while_compiling() -> None:
     segmentation fault after the CLI's one line (2 in ~730 runs of ``analyze`` interrupted
     at random moments). While the main thread holds Numba's compiler lock (the cache load
     and the compilation of a function, its callees included), the handler only records the
-    interrupt; it is raised as the outermost lock is released, when the compiled function
-    is whole. Compiling from a cold cache may thus delay a Ctrl-C by its seconds.
+    interrupt (each hold is a :func:`deferred` level); it is raised as the outermost lock is
+    released outside any other deferred block, when the compiled function is whole.
+    Compiling from a cold cache may thus delay a Ctrl-C by its seconds.
     """
     global _compile_guard
     if _compile_guard is not None:
@@ -174,19 +175,19 @@ def defer_while_compiling() -> None:
     from numba.core import event
 
     class CompileGuard(event.Listener):
-        """Counts the main thread's holds of Numba's compiler lock."""
+        """Defers the main thread's interrupts while it holds Numba's compiler lock."""
 
         def on_start(self, event) -> None:  # noqa: ARG002 - Listener signature
-            global _compiling
+            global _deferring
             if threading.current_thread() is threading.main_thread():
-                _compiling += 1
+                _deferring += 1
 
         def on_end(self, event) -> None:  # noqa: ARG002 - Listener signature
-            global _compiling
+            global _deferring
             if threading.current_thread() is not threading.main_thread():
                 return
-            _compiling -= 1
-            if (not _compiling and not _deferring and _interrupted.is_set()
+            _deferring -= 1
+            if (not _deferring and _interrupted.is_set()
                     and signal.getsignal(signal.SIGINT) is _handler):
                 raise KeyboardInterrupt
 
