@@ -39,6 +39,12 @@ _deferring = 0
 _compile_guard = None
 
 
+class StopRequested(Exception):  # noqa: N818 - a request, not an error
+    """Raised by long work that runs in a background thread (a DEM pool of the app's
+    calibration) once its caller set the work's stop event: a Cancel, or the process
+    exiting. The running work was stopped and discarded; what finished before is kept."""
+
+
 def _handler(signum, frame) -> None:  # noqa: ARG001 - signal handler signature
     global _signal_number
     if not _interrupted.is_set():  # the first signal is the one the exit status says

@@ -2142,10 +2142,137 @@ def test_a_cancelled_calibration_stops_at_its_next_run_and_keeps_the_saved_ones(
     task.run_done = first_run_then_cancel
     runner._run(api, task, points, ["restitution"], 2, 3, None)  # 3 design points: 9 runs
     assert (task.state, task.runs_total, task.runs_done) == ("cancelled", 9, 1)
-    assert task.message == ("1 DEM run(s) computed before the cancel are kept in s.h5; run "
-                            "the same calibration again to resume (stored runs are reused)")
+    assert task.message == ("1 DEM run(s) computed before the cancel are kept in s.h5; the "
+                            "running ones were stopped and nothing of them saved; run the same "
+                            "calibration again to resume (stored runs are reused)")
     saved = Store(store)
     # the run saved before the cancel, and nothing after it (the other worker was stopped)
     assert len(saved.list_dem_runs()) == 1
     assert saved.list_calibrations().empty  # no calibration of a cancelled run
     assert not runner.cancel()  # nothing runs any more
+
+
+def test_cancel_stops_the_running_calibration_runs_within_seconds(tmp_path, monkeypatch):
+    # Cancel stopped a calibration only when its next DEM run was saved: a minute or more
+    # with a run going. Here each run but the quick ones takes 60 s (_pool_probe), so only a
+    # stop of the running ones ends the calibration within the budget.
+    import functools
+
+    from _pool_probe import QUICK_FREQUENCY_HZ, alive, slow_calibration_run
+
+    import pidcore.calibrate as api
+    from pidcore.app.calibration import CalibrationRunner
+    from pidcore.calibrate import MeasuredPoint
+    from pidcore.calibrate import runner as calibration_runs
+    from pidcore.store import Store
+
+    folder = tmp_path / "workers"
+    folder.mkdir()
+    monkeypatch.setattr(calibration_runs, "_run_entry",
+                        functools.partial(slow_calibration_run, str(folder)))
+    store = tmp_path / "s.h5"
+    held = {"frequency_hz": 50.0, "acceleration_g": 1.0, "fill_percent": 25.0,
+            "material": "acrylic", "direction": "z", "sdc": 0.1, "sdc_stderr": 0.01}
+    Store(store).add_dem_run("held", held)  # a run of another calibration, kept untouched
+    # the quick point's 3 runs come first in the design (points in order): both workers then
+    # take a run of 60 s
+    points = [MeasuredPoint(QUICK_FREQUENCY_HZ, 5, 50, 0.6), MeasuredPoint(1000, 5, 50, 0.6),
+              MeasuredPoint(1000, 1, 50, 0.2)]
+    runner = CalibrationRunner(store)
+    task = runner.start(api, points, fit=["restitution"], cells=2, design_size=3)
+    deadline = time.monotonic() + 60  # cold imports of the workers on a loaded machine
+    while (task.runs_done < 3 or len(list(folder.glob("slow-*"))) < 2) \
+            and task.state == "running" and time.monotonic() < deadline:
+        time.sleep(0.02)
+    assert (task.state, task.runs_total, task.runs_done) == ("running", 9, 3)
+    assert runner.cancel()
+    asked = time.monotonic()
+    while task.state == "running" and time.monotonic() - asked < 60:
+        time.sleep(0.02)
+    # the stop itself takes ~0.1 s (a look at the stop event, a terminate of 2 workers); 10 s
+    # leaves room for a loaded machine and is far short of the 60 s a running run takes
+    assert time.monotonic() - asked < 10
+    assert task.state == "cancelled"
+    assert task.message == ("3 DEM run(s) computed before the cancel are kept in s.h5; the "
+                            "running ones were stopped and nothing of them saved; run the same "
+                            "calibration again to resume (stored runs are reused)")
+    runs = Store(store).list_dem_runs()
+    # the quick point's 3 runs are kept for a resume, nothing of the stopped ones, the
+    # other calibration's run as it was, and no calibration
+    assert sorted(runs["frequency_hz"]) == [50.0, QUICK_FREQUENCY_HZ, QUICK_FREQUENCY_HZ,
+                                            QUICK_FREQUENCY_HZ]
+    assert Store(store).get_dem_run("held").record["sdc"] == 0.1
+    assert Store(store).list_calibrations().empty
+    workers = {int(f.name.split("-")[1]) for f in folder.iterdir()}
+    assert len(workers) == 2 and not any(alive(pid) for pid in workers)
+    assert not runner.cancel()
+
+
+def test_a_cancel_after_the_dem_runs_saves_no_calibration(tmp_path):
+    # Cancel was looked at only as a DEM run was saved: one clicked after the last (while the
+    # posterior was sampled or the outputs written) was dropped, and the calibration saved
+    import types
+
+    from pidcore.app.calibration import CalibrationRunner, CalibrationTask
+
+    runner = CalibrationRunner(tmp_path / "s.h5")
+    task = runner.task = CalibrationTask(("friction",), 3)
+    saved = []
+
+    def write_outputs(result, folder):  # the user's click while the outputs are written
+        assert runner.cancel()
+        (Path(folder) / "summary.md").write_text("# summary\n")
+        return [Path(folder) / "summary.md"]
+
+    api = types.SimpleNamespace(
+        calibrate=lambda points, **kw: types.SimpleNamespace(notes=[]),
+        write_outputs=write_outputs,
+        save_calibration=lambda result, store_path: saved.append(result) or ("c1", True))
+    runner._run(api, task, [], ["friction"], 2, None, None)
+    assert task.state == "cancelled" and not saved and task.outputs == {}
+    assert not runner.cancel()
+
+
+def test_a_stop_reaches_the_last_run_of_a_resumed_calibration_too(tmp_path, monkeypatch):
+    # One run left (a resume) ran in the calibration's own thread, where nothing can stop it
+    # before its end; with a stop it goes to a worker process like the others.
+    import functools
+    import threading
+
+    from _pool_probe import alive, slow_calibration_run
+
+    from pidcore.calibrate import runner as calibration_runs
+    from pidcore.calibrate.runner import RunRequest
+    from pidcore.dem import DemConfig
+    from pidcore.dem import LoadCase as DemLoadCase
+    from pidcore.interrupt import StopRequested
+    from pidcore.specimen import paper_specimen
+    from pidcore.store import Store
+
+    folder = tmp_path / "workers"
+    folder.mkdir()
+    monkeypatch.setattr(calibration_runs, "_run_entry",
+                        functools.partial(slow_calibration_run, str(folder)))
+    request = RunRequest(DemLoadCase(1000.0, 5.0, 50.0, "acrylic", "z"), paper_specimen(),
+                         DemConfig(cells=2))
+    stop = threading.Event()
+    errors = []
+
+    def resume() -> None:
+        try:
+            calibration_runs.run_requests([request], store_path=tmp_path / "s.h5",
+                                          progress=False, stop=stop)
+        except StopRequested as exc:
+            errors.append(exc)
+
+    thread = threading.Thread(target=resume)
+    thread.start()
+    deadline = time.monotonic() + 60
+    while not list(folder.glob("slow-*")) and time.monotonic() < deadline:
+        time.sleep(0.02)
+    stop.set()
+    thread.join(10)  # as the test above: the stop takes ~0.1 s, the run 60 s
+    assert not thread.is_alive() and len(errors) == 1
+    assert not (tmp_path / "s.h5").exists() or Store(tmp_path / "s.h5").list_dem_runs().empty
+    pids = [int(f.name.split("-")[1]) for f in folder.iterdir()]
+    assert len(pids) == 1 and not alive(pids[0])

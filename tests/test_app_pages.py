@@ -636,7 +636,7 @@ def _fake_calibrate_module(calls: list):
         else [n.strip() for n in text if n.strip()])
 
     def calibrate(points, *, fit, store_path, cells, design_size, progress, on_design,
-                  on_run_done, **given):
+                  on_run_done, stop, **given):
         # the paper's coupon is the library's default: the page names only another specimen
         specimen = given.pop("specimen", None)
         assert not given  # nothing but the specimen beyond the page's own arguments

@@ -12,24 +12,10 @@ import time
 from pathlib import Path
 
 import pytest
+from _pool_probe import alive as _alive
 
 TESTS = Path(__file__).resolve().parent
 ROOT = TESTS.parent
-
-
-def _alive(pid: int) -> bool:
-    """Whether ``pid`` still runs. A terminated worker is the fork server's child and stays a
-    zombie until that server reaps it (later on a loaded machine): it runs no code, so it
-    counts as stopped."""
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    try:  # Linux: the state is the field after the parenthesised command name
-        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
-    except (OSError, IndexError):
-        return True
-    return state not in ("Z", "X")
 
 
 def _pooled_waits(tmp_path: Path) -> subprocess.Popen:

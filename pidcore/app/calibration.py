@@ -23,6 +23,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ..constants import BackgroundState
+from ..interrupt import StopRequested
 
 if TYPE_CHECKING:  # pragma: no cover
     import pandas as pd
@@ -166,9 +167,10 @@ def page_words(text: str) -> str:
     return page_terms(text, names=fittable_names(api) if api is not None else ())
 
 
-class CalibrationCancelled(Exception):  # noqa: N818 - a request, not an error
-    """Raised in the calibration's thread at its next DEM run saved after a cancel: the
-    library stops its DEM workers and keeps the runs saved (as on Ctrl-C)."""
+class CalibrationCancelled(StopRequested):
+    """Raised in the calibration's thread where it tells the page of its design or of a DEM
+    run saved after a cancel (the library's own stop, :class:`~pidcore.interrupt.StopRequested`,
+    comes sooner: within a fraction of a second while DEM runs go)."""
 
 
 @dataclass
@@ -191,8 +193,13 @@ class CalibrationTask:
     runs_total: int = 0
     runs_stored_before: int = 0
     runs_done: int = 0
-    #: Set by :meth:`CalibrationRunner.cancel`; the run stops at its next DEM run saved.
+    #: Set by :meth:`CalibrationRunner.cancel`.
     cancel_requested: bool = False
+    #: The library's stop (``calibrate(stop=)``): set on a cancel, it stops the running DEM
+    #: runs within a fraction of a second.
+    stop: threading.Event = field(default_factory=threading.Event, repr=False, compare=False)
+    #: The calibration is being saved in the store: too late for a cancel.
+    saving: bool = False
 
     def elapsed_s(self) -> float:
         """Seconds since the start (to the end once finished)."""
@@ -258,12 +265,14 @@ class CalibrationRunner:
         return task
 
     def cancel(self) -> bool:
-        """Ask the running calibration to stop (True if one runs): it stops when its next DEM
-        run is saved, keeping every saved run for a later calibration to reuse."""
+        """Ask the running calibration to stop (True if one runs): its running DEM runs are
+        stopped within a fraction of a second and discarded, every saved run is kept for a
+        later calibration to reuse, and no calibration is saved."""
         with self._lock:
-            if self.task is None or self.task.state != "running":
+            if self.task is None or self.task.state != "running" or self.task.saving:
                 return False
             self.task.cancel_requested = True
+            self.task.stop.set()
             return True
 
     def _run(self, api, task: CalibrationTask, points, fit, cells, design_size,
@@ -277,20 +286,25 @@ class CalibrationRunner:
                 points, fit=fit, store_path=self.store_path, cells=cells,
                 design_size=design_size, progress=False,
                 on_design=lambda keys: task.design(keys, self.store_path),
-                on_run_done=task.run_done, **given)
+                on_run_done=task.run_done, stop=task.stop, **given)
             if notes:
                 result.notes = [*notes, *result.notes]
             with tempfile.TemporaryDirectory(prefix="pidcore_calibration_") as folder:
                 paths = api.write_outputs(result, folder)
                 outputs = {Path(p).name: Path(p).read_bytes() for p in paths}
             state, message = "done", f"{len(points)} load case(s), fitted {', '.join(fit)}"
+            with self._lock:  # a cancel that came while the outputs were written wins
+                if task.cancel_requested:
+                    raise CalibrationCancelled
+                task.saving = True  # from here on a cancel is refused: it is saved
             key, saved = _save(api, result, self.store_path)
             message += saved
-        except CalibrationCancelled:
+        except StopRequested:
             outputs, state, key = {}, "cancelled", ""
             message = (f"{task.runs_done} DEM run(s) computed before the cancel are kept in "
-                       f"{self.store_path.name}; run the same calibration again to resume "
-                       "(stored runs are reused)")
+                       f"{self.store_path.name}; the running ones were stopped and nothing "
+                       "of them saved; run the same calibration again to resume (stored "
+                       "runs are reused)")
         except Exception as exc:  # noqa: BLE001 - shown on the page as the task's error
             # a library refusal is its one line (the class name is no news to a user); an
             # unexpected error keeps its name, without which "KeyError: 'x'" says nothing

@@ -10,6 +10,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import os
+import threading
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -336,7 +337,8 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: str | Sequence[str],
               dem_config: DemConfig | None = None,
               specimen: Specimen | None = None,
               on_design: Callable[[list[str]], None] | None = None,
-              on_run_done: Callable[[str], None] | None = None) -> CalibrationResult:
+              on_run_done: Callable[[str], None] | None = None,
+              stop: threading.Event | None = None) -> CalibrationResult:
     """Fit ``fit`` parameters to measured SDCs (see the package docstring for the model).
 
     ``fit``: parameter names, a sequence or ``"a,b"`` as ``--fit`` takes them; ``priors``:
@@ -349,7 +351,11 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: str | Sequence[str],
     specimen to start from (default: the paper's coupon). ``on_design``: called with the DEM
     run keys of the design before any run starts (:class:`pidcore.calibrate.runner.RunTally`
     counts from them what a Ctrl-C kept). ``on_run_done``: called with each DEM run's key as
-    it is saved (the app's progress: runs done of the design's).
+    it is saved (the app's progress: runs done of the design's). ``stop``: set by a caller in
+    another thread (the app's Cancel, or its exit) to end the calibration within a fraction of
+    a second while its DEM runs go (their running ones are discarded, the saved ones kept),
+    or before its next stage after them: :class:`~pidcore.interrupt.StopRequested` is raised
+    and nothing is returned.
     """
     start = time.perf_counter()
     points = list(points)
@@ -406,8 +412,11 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: str | Sequence[str],
         on_design([r.key() for row in requests for r in row])
     # on_done only where asked for: the call is otherwise the CLI's as before
     told = {} if on_run_done is None else {"on_done": on_run_done}
+    if stop is not None:
+        told["stop"] = stop
     runs = run_requests([r for row in requests for r in row], store_path=store_path,
                         workers=workers, progress=progress, **told)
+    _raise_if_stopped(stop)
     from ..store import Store
 
     store = Store(store_path)
@@ -462,6 +471,7 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: str | Sequence[str],
             bar = tqdm(total=len(folds), unit="fold", desc="leave-one-out", dynamic_ncols=True)
         try:
             for i in folds:
+                _raise_if_stopped(stop)  # each fold is a posterior of its own: seconds
                 others = [j for j in everything if j != i]
                 fold = sample_posterior(model, others, seed=posterior_seed + 1 + i,
                                         method=method)
@@ -492,11 +502,19 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: str | Sequence[str],
                 "cross_validate": cross_validate, "store": str(store_path)}
     if posterior.diagnostics is not None:  # emcee's: acceptance, autocorrelation, sample size
         settings["sampler"] = posterior.diagnostics.to_dict()
+    _raise_if_stopped(stop)
     return CalibrationResult(specimen=specimen, specs=specs, samples=samples, parameters=parameters,
                              correlations=correlations, predictions=predictions, loo=loo,
                              fixed=fixed, design=design, observations=observations, runs=runs,
                              settings=settings, notes=notes, energy_check=energy,
                              wall_s=time.perf_counter() - start)
+
+
+def _raise_if_stopped(stop: threading.Event | None) -> None:
+    from ..interrupt import StopRequested
+
+    if stop is not None and stop.is_set():
+        raise StopRequested("calibration stopped; the DEM runs saved before are kept")
 
 
 def _not_converged_note(diagnostics: SamplerDiagnostics) -> str:

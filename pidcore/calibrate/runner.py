@@ -11,6 +11,7 @@ configuration, specimen hash, code version) and its one save path, so a run stor
 from __future__ import annotations
 
 import os
+import threading
 import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -84,11 +85,18 @@ def _run_entry(request: RunRequest) -> tuple[str, dict]:
 
 def run_requests(requests: Sequence[RunRequest], *, store_path: str | os.PathLike,
                  workers: int = 2, progress: bool = True,
-                 on_done: Callable[[str], None] | None = None) -> dict[str, float]:
+                 on_done: Callable[[str], None] | None = None,
+                 stop: threading.Event | None = None) -> dict[str, float]:
     """Run every request whose key is not yet in the store, saving each as it finishes.
 
     An interrupted call (Ctrl-C) keeps every finished run; a re-run skips them. Returns
     ``{"computed": n, "cached": n, "wall_s": s}``.
+
+    ``stop``: a caller in a background thread (the app's calibration) sets it to stop the
+    runs within a fraction of a second (:func:`pidcore.dem.sweep.run_pooled`): the running
+    ones are discarded, the saved ones kept, and :class:`~pidcore.interrupt.StopRequested`
+    raised. Every run then goes to a worker process, even a single one: a run in this
+    process could not be stopped before its end (a minute or more).
     """
     from ..store import Store
 
@@ -118,15 +126,16 @@ def run_requests(requests: Sequence[RunRequest], *, store_path: str | os.PathLik
             on_done(key)
 
     try:
-        if workers <= 1 or len(todo) <= 1:
+        if stop is None and (workers <= 1 or len(todo) <= 1):
             for request in todo:
                 finish(*_run_entry(request))
         elif todo:
             from ..dem.sweep import run_pooled
 
-            # on Ctrl-C the workers are stopped and waited for; finished runs are saved
-            run_pooled(_run_entry, [(request,) for request in todo], workers=workers,
-                       finish=lambda result: finish(*result))
+            # on Ctrl-C or a stop the workers are stopped and waited for; finished runs are
+            # saved
+            run_pooled(_run_entry, [(request,) for request in todo], workers=max(workers, 1),
+                       finish=lambda result: finish(*result), stop=stop)
     finally:
         if bar is not None:
             bar.close()

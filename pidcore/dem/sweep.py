@@ -14,8 +14,9 @@ specimen, code version; :func:`pidcore.dem.persist.run_key`).
 from __future__ import annotations
 
 import os
+import threading
 import time
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -225,8 +226,14 @@ def init_dem_worker(parent_pid: int | None = None) -> None:
     numba.set_num_threads(1)
 
 
+#: Seconds between two looks at a pool's stop event (:func:`run_pooled`): a Cancel or an
+#: exit stops the workers this soon, a fraction of the "few seconds" a user waits.
+STOP_POLL_S = 0.1
+
+
 def run_pooled(function: Callable, calls: Sequence[tuple], *, workers: int,
-               finish: Callable[[object], None]) -> None:
+               finish: Callable[[object], None],
+               stop: threading.Event | None = None) -> None:
     """``function(*call)`` for each of ``calls`` in up to ``workers`` DEM processes; ``finish``
     (in this process) gets each result as it comes, in the order they finish.
 
@@ -235,12 +242,19 @@ def run_pooled(function: Callable, calls: Sequence[tuple], *, workers: int,
     running (``shutdown(wait=False)``) let this process exit first; a worker still starting
     then found the pool's semaphores removed and printed ``FileNotFoundError`` from
     multiprocessing's ``forkserver.py`` after the CLI's one line.
+
+    ``stop``: for a pool run in a background thread, which no Ctrl-C reaches (the app's
+    calibration). Once it is set the workers are stopped the same way, their running calls
+    discarded, no result is given to ``finish`` any more, and
+    :class:`~pidcore.interrupt.StopRequested` is raised; it is looked at every
+    :data:`STOP_POLL_S`. The pool is shut down here, in its own thread, and nowhere else.
     """
-    from concurrent.futures import ProcessPoolExecutor, as_completed
+    from concurrent.futures import ProcessPoolExecutor
     from concurrent.futures.process import BrokenProcessPool
 
     from .. import interrupt
 
+    _raise_if_stopped(stop)  # before any worker starts
     pool = ProcessPoolExecutor(max_workers=min(workers, len(calls)),
                                mp_context=dem_process_context(),
                                initializer=init_dem_worker, initargs=(os.getpid(),))
@@ -251,7 +265,7 @@ def run_pooled(function: Callable, calls: Sequence[tuple], *, workers: int,
         with interrupt.deferred():
             futures = [pool.submit(function, *call) for call in calls]
         interrupt.raise_if_interrupted()
-        for future in as_completed(futures):
+        for future in _finished(futures, stop):
             finish(future.result())
     except BrokenProcessPool:
         # a worker killed from outside (the kernel's OOM killer, kill -9): a traceback of
@@ -264,6 +278,30 @@ def run_pooled(function: Callable, calls: Sequence[tuple], *, workers: int,
         _stop_pool(pool)
         raise
     pool.shutdown()
+
+
+def _raise_if_stopped(stop: threading.Event | None) -> None:
+    from ..interrupt import StopRequested
+
+    if stop is not None and stop.is_set():
+        raise StopRequested("the DEM runs were stopped; the runs finished before are kept")
+
+
+def _finished(futures: list, stop: threading.Event | None) -> Iterator:
+    """``futures`` as they finish; with ``stop``, :class:`~pidcore.interrupt.StopRequested`
+    once it is set (a finished one is then not handed on: nothing is saved after a stop)."""
+    from concurrent.futures import FIRST_COMPLETED, as_completed, wait
+
+    if stop is None:
+        yield from as_completed(futures)
+        return
+    pending = set(futures)
+    while pending:
+        done, pending = wait(pending, timeout=STOP_POLL_S, return_when=FIRST_COMPLETED)
+        for future in done:
+            _raise_if_stopped(stop)
+            yield future
+        _raise_if_stopped(stop)
 
 
 def _stop_pool(pool) -> None:

@@ -53,11 +53,12 @@ def _task(stores, chosen: str, polling: bool) -> None:
         if task.runs_total:
             st.progress((task.runs_stored_before + task.runs_done) / task.runs_total)
         if task.cancel_requested:
-            st.caption("cancelling: it stops when the running DEM run(s) end")
+            st.caption("cancelling: the running DEM run(s) are being stopped")
         else:
             st.button("Cancel calibration", key="calibration_cancel",
                       on_click=runner_for(stores.path).cancel,
-                      help="stops at the next DEM run saved; saved runs are kept and reused")
+                      help="stops the running DEM runs at once (their partial results are "
+                           "discarded); saved runs are kept and reused")
         return
     if task.state == "failed":
         st.error(f"calibration of {task.specimen} failed: {task.message}")
