@@ -17,6 +17,7 @@ import math
 import tempfile
 import threading
 import time
+import weakref
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -195,8 +196,8 @@ class CalibrationTask:
     runs_done: int = 0
     #: Set by :meth:`CalibrationRunner.cancel`.
     cancel_requested: bool = False
-    #: The library's stop (``calibrate(stop=)``): set on a cancel, it stops the running DEM
-    #: runs within a fraction of a second.
+    #: The library's stop (``calibrate(stop=)``): set on a cancel or at the process's exit,
+    #: it stops the running DEM runs within a fraction of a second.
     stop: threading.Event = field(default_factory=threading.Event, repr=False, compare=False)
     #: The calibration is being saved in the store: too late for a cancel.
     saving: bool = False
@@ -244,6 +245,7 @@ class CalibrationRunner:
         self.store_path = Path(store_path)
         self._lock = threading.Lock()
         self.task: CalibrationTask | None = None
+        self._thread: threading.Thread | None = None
 
     def start(self, api, points: Sequence, *, fit: Sequence[str], cells: int,
               design_size: int | None, specimen=None,
@@ -259,9 +261,13 @@ class CalibrationRunner:
                 return None
             task = self.task = CalibrationTask(tuple(fit), len(points),
                                                specimen_label(specimen))
-        threading.Thread(target=self._run, args=(api, task, list(points), list(fit), cells,
-                                                 design_size, specimen, list(notes)),
-                         name="pidcore-calibration", daemon=True).start()
+            _stop_at_exit_registered()
+            _STARTED.add(self)
+            self._thread = threading.Thread(
+                target=self._run, args=(api, task, list(points), list(fit), cells,
+                                        design_size, specimen, list(notes)),
+                name="pidcore-calibration", daemon=True)
+            self._thread.start()
         return task
 
     def cancel(self) -> bool:
@@ -274,6 +280,14 @@ class CalibrationRunner:
             self.task.cancel_requested = True
             self.task.stop.set()
             return True
+
+    def stop_and_wait(self, timeout_s: float) -> None:
+        """Cancel the running calibration and wait up to ``timeout_s`` for its thread to end
+        (its DEM workers then are gone)."""
+        self.cancel()
+        thread = self._thread
+        if thread is not None and thread is not threading.current_thread():
+            thread.join(timeout_s)
 
     def _run(self, api, task: CalibrationTask, points, fit, cells, design_size,
              specimen, notes: Sequence[str] = ()) -> None:
@@ -336,6 +350,39 @@ def _save(api, result, store_path: Path) -> tuple[str, str]:
 
 _RUNNERS: dict[str, CalibrationRunner] = {}
 _RUNNERS_LOCK = threading.Lock()
+#: Runners that started a calibration in this process (:func:`_stop_calibrations_at_exit`).
+_STARTED: weakref.WeakSet[CalibrationRunner] = weakref.WeakSet()
+_EXIT_HOOK_REGISTERED: list[bool] = []
+#: Seconds the process's exit waits for a calibration to stop: its DEM workers end in a
+#: fraction of one; a Numba compilation or a posterior sample under way ends first.
+EXIT_STOP_WAIT_S = 30.0
+
+
+def _stop_at_exit_registered() -> None:
+    """Have the process's exit stop the calibrations still running (once per process).
+
+    SIGTERM to the app (``pidcore app`` passes it on to Streamlit, whose handler stops the
+    server, and the main thread returns) left the process running until the whole
+    calibration had ended: concurrent.futures' exit hook joins every process pool, waiting
+    for its pending DEM runs. This hook runs before that one (threading calls its exit hooks
+    last-registered first, and concurrent.futures registers its own on import), sets each
+    calibration's stop and waits for its thread: the thread stops its pool itself, the one
+    place a pool is shut down (stopping it from here raced the thread's own shutdown and
+    printed 'Bad file descriptor' at exit).
+    """
+    import concurrent.futures.process  # noqa: F401 - registers its exit hook first
+
+    if not _EXIT_HOOK_REGISTERED:
+        threading._register_atexit(_stop_calibrations_at_exit)  # noqa: SLF001 - as futures does
+        _EXIT_HOOK_REGISTERED.append(True)
+
+
+def _stop_calibrations_at_exit() -> None:
+    runners = list(_STARTED)
+    for runner in runners:  # every stop first: they end side by side
+        runner.cancel()
+    for runner in runners:
+        runner.stop_and_wait(EXIT_STOP_WAIT_S)
 
 
 def runner_for(store_path: str | Path) -> CalibrationRunner:

@@ -1,0 +1,90 @@
+"""SIGTERM to ``pidcore app`` while the Calibrate page's calibration runs: the app ends within
+seconds, as a command does (exit 143), keeping the DEM runs saved and leaving no process."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+from pathlib import Path
+
+import pytest
+from _pool_probe import QUICK_FREQUENCY_HZ, alive
+
+from pidcore.store import Store
+
+TESTS = Path(__file__).resolve().parent
+ROOT = TESTS.parent
+
+
+def _pids(folder: Path, prefix: str) -> list[int]:
+    return [int(f.name.rsplit("-", 1)[1]) for f in folder.glob(f"{prefix}-*")]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("whole_group", [False, True], ids=["to the app", "to its group"])
+def test_sigterm_to_the_app_stops_its_calibration_within_seconds(tmp_path, whole_group):
+    # The app's server ran a calibration's DEM pool in a thread: SIGTERM stopped the server,
+    # but concurrent.futures' exit hook then waited for every DEM run left (minutes), until
+    # `pidcore app` killed the server 10 s later (kill -9: no word, no clean-up). The server
+    # here is a stand-in that keeps what matters of Streamlit (tests/_calibrating_server.py).
+    # To the app as `kill PID` sends it; to its whole process group as a service manager
+    # (systemd) or a terminal's group does: the workers then end by it themselves (which
+    # already ended the calibration before; kept so that the exit's stop never adds a word).
+    folder = tmp_path / "workers"
+    folder.mkdir()
+    store = tmp_path / "app.h5"
+    held = {"frequency_hz": 50.0, "acceleration_g": 1.0, "fill_percent": 25.0,
+            "material": "acrylic", "direction": "z", "sdc": 0.1, "sdc_stderr": 0.01}
+    Store(store).add_dem_run("held", held)
+    code = textwrap.dedent(f"""
+        import sys
+        import pidcore.cli.app as app
+        from pidcore.cli import console_main
+        app.streamlit_command = lambda port, python=None: [
+            sys.executable, {str(TESTS / "_calibrating_server.py")!r}, {str(folder)!r}]
+        sys.exit(console_main(["app", "--store", {str(store)!r}, "--port", "8599"]))
+    """)
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT), str(TESTS)])}
+    p = subprocess.Popen([sys.executable, "-c", code], env=env, stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, text=True, start_new_session=True)
+    try:
+        deadline = time.monotonic() + 90  # cold imports and worker starts on a loaded machine
+        while not (folder / "ready").exists() and time.monotonic() < deadline \
+                and p.poll() is None:
+            time.sleep(0.02)
+        assert (folder / "ready").exists(), p.stderr.read() if p.poll() is not None else ""
+        if whole_group:
+            os.killpg(p.pid, signal.SIGTERM)
+        else:
+            p.send_signal(signal.SIGTERM)
+        sent = time.monotonic()
+        # waits for the end of stderr: every process that holds it (the server, its fork
+        # server, resource tracker and workers) has closed it
+        out, err = p.communicate(timeout=60)
+    finally:
+        if p.poll() is None:
+            os.killpg(p.pid, signal.SIGKILL)
+    # the stop itself takes ~0.1 s (a look at the stop event, a terminate of 2 workers); 8 s
+    # is room for a loaded machine, short of the 10 s after which `pidcore app` kills its
+    # server and of the 60 s a running DEM run takes
+    assert time.monotonic() - sent < 8
+    assert p.returncode == 143  # 128 + SIGTERM, as every pidcore command (pidcore.interrupt)
+    assert (folder / "exited").exists()  # the server ended by itself, not killed
+    assert out == ""
+    assert err == (f"pidcore app: http://localhost:8599  (store {store.resolve()}); Ctrl-C "
+                   "stops it\n")  # and nothing else: no traceback, no resource warning
+    runs = Store(store).list_dem_runs()
+    # the 3 quick runs saved before the signal, nothing of the 2 stopped ones, the run held
+    # before as it was, and no calibration
+    assert sorted(runs["frequency_hz"]) == [50.0] + [QUICK_FREQUENCY_HZ] * 3
+    assert Store(store).get_dem_run("held").record["sdc"] == 0.1
+    assert Store(store).list_calibrations().empty
+    assert not list(tmp_path.glob(".app.h5.*.tmp"))  # no working copy left beside the store
+    workers = set(_pids(folder, "quick")) | set(_pids(folder, "slow"))
+    helpers = _pids(folder, "server") + _pids(folder, "forkserver") + _pids(folder, "tracker")
+    assert len(workers) == 2 and len(helpers) == 3
+    assert not any(alive(pid) for pid in workers | set(helpers))
