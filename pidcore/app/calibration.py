@@ -313,11 +313,16 @@ def _save(api, result, store_path: Path) -> tuple[str, str]:
     if save is None:
         return "", "; not saved in the store (this pidcore cannot): download calibration.json below"
     try:
-        key, added = save(result, store_path)
+        saved = save(result, store_path)
     except PidcoreError as exc:
         return "", f"; NOT saved in the store ({exc}): download calibration.json below"
-    return key, (f"; saved in the store as {key}" if added
-                 else f"; the same result is in the store already as {key}")
+    key, added = saved[0], saved[1]
+    superseded = tuple(saved[2]) if len(saved) > 2 else ()
+    if not added:
+        return key, f"; the same result is in the store already as {key}"
+    return key, (f"; saved in the store as {key}"
+                 + (f" (the same fit was stored before as {'; '.join(superseded)}: kept as it "
+                    "was, this one saved beside it)" if superseded else ""))
 
 
 _RUNNERS: dict[str, CalibrationRunner] = {}
