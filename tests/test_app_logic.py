@@ -1870,6 +1870,38 @@ def test_the_report_tab_defaults_to_the_newest_calibration_of_the_specimen_repor
     assert default_calibration_index(newest_first[:1], "my_panel") == 0
 
 
+
+def test_the_report_tab_default_goes_by_the_reported_files_hash(tmp_path):
+    # two files named x (the second an edit of the first): the calibration of the earlier x
+    # saved last was the default for a report of the edited x (by its name), and every
+    # calibrated cell said "not compared" while the edited file's own calibration was offered
+    import dataclasses
+
+    from pidcore.app.calibration import default_calibration_index
+    from pidcore.calibrate.prediction import calibration_from_json
+    from pidcore.specimen import Specimen, calibrated_provenance, paper_specimen
+
+    first = Specimen.from_text(paper_specimen().to_toml().replace(
+        'name = "paper_coupon"', 'name = "x"'))
+    edited = first.with_values({"coupon.mass_kg": 0.03})
+    doc = json.dumps({"parameters": {"fixture_mass_kg": {"median": 0.2, "low95": 0.1,
+                                                         "high95": 0.3}},
+                      "predictions": [{"frequency_hz": 100.0, "acceleration_g": 5.0,
+                                       "fill_percent": 50.0, "material": "acrylic",
+                                       "measured": 0.3, "predicted": 0.3, "low95": 0.1,
+                                       "high95": 0.6}]}).encode()
+
+    def of(start):
+        made = dataclasses.replace(start.with_values({"coupon.fixture_mass_kg": 0.2}),
+                                   name="x_calibrated", provenance=calibrated_provenance(start))
+        read = calibration_from_json(doc, f"{start.hash[:6]}.json", specimen_name="x")
+        return dataclasses.replace(read, specimen_text=made.to_toml())
+
+    newest_first = [(of(first), "of the first x"), (of(edited), "of the edited x")]
+    assert default_calibration_index(newest_first, "x") == 0  # by the name alone: both
+    assert default_calibration_index(newest_first, "x", edited) == 1
+    assert default_calibration_index(newest_first, "x", first) == 0
+
 def test_a_damaged_calibration_in_the_store_does_not_hide_the_others(tmp_path):
     # one calibration of the store whose calibration.json was cut short hid every one of
     # them on Compare, Report and the Calibrate page ("calibrations of the store not shown")

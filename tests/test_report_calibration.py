@@ -398,3 +398,43 @@ def test_a_missing_calibration_names_the_command_that_writes_one(tmp_path, capsy
     # the library, for a Python caller, names its own function
     with pytest.raises(ParameterError, match=r"write_outputs\(result, out_dir\)"):
         load_calibration(path)
+
+
+def test_an_edited_file_of_the_same_name_is_not_the_calibrated_one(calibration_file):
+    # x.toml calibrated, then edited (another coupon mass) and saved under its name: the
+    # calibration's [provenance] names the earlier file's hash, and the name alone (with the
+    # same cell and particles) showed its band beside the edited file's rows
+    from pidcore.specimen import Specimen, calibrated_provenance, paper_specimen
+
+    first = Specimen.from_text(paper_specimen().to_toml().replace(
+        'name = "paper_coupon"', 'name = "x"'))
+    edited = first.with_values({"coupon.mass_kg": 0.03})
+    assert (first.name, first.cell, first.particles) == (edited.name, edited.cell,
+                                                        edited.particles)
+    assert first.hash != edited.hash
+    calibrated = first.with_values({"coupon.fixture_mass_kg": 0.25})
+    import dataclasses
+
+    calibrated = dataclasses.replace(calibrated, name="x_calibrated",
+                                     provenance=calibrated_provenance(first))
+    (calibration_file.parent / "calibrated_specimen.toml").write_text(calibrated.to_toml())
+    cal = load_calibration(calibration_file)
+    table = _table().iloc[[0]]  # 50 Hz, 5 g, 50 % acrylic: a load case it predicts
+
+    def out(specimen):
+        return add_calibration_columns(table, cal, specimen=specimen)
+
+    # the file it was made from, and the calibrated file itself: its band
+    for same in (first, calibrated):
+        assert out(same)[CALIBRATED_COLUMN].iloc[0] == 0.24, same.name
+    # the edited file: not compared, both files named by their hashes
+    refused = out(edited)
+    assert math.isnan(refused[CALIBRATED_COLUMN].iloc[0])
+    assert refused[CALIBRATED_INSIDE_COLUMN].iloc[0] == NOT_COMPARED
+    assert refused["note"].iloc[0].endswith(
+        f": it calibrates specimen x [{first.hash[:6]}], not x [{edited.hash[:6]}] (another "
+        "file of the same name)")
+    # a calibrated file without [provenance] (written before it) still goes by its name
+    old = dataclasses.replace(calibrated, provenance=None)
+    (calibration_file.parent / "calibrated_specimen.toml").write_text(old.to_toml())
+    assert load_calibration(calibration_file).other_specimen_reason(edited) == ""

@@ -370,13 +370,21 @@ def stored_calibration_label(calibration) -> str:
             f"{calibration.created_utc[:16].replace('T', ' ')} UTC)")
 
 
-def default_calibration_index(usable: Sequence[tuple[object, str]], specimen_name: str) -> int:
+def default_calibration_index(usable: Sequence[tuple[object, str]], specimen_name: str,
+                              specimen: object | None = None) -> int:
     """Which of ``usable`` ([(calibration, label)], newest first) the Report tab shows by
     default for a report of specimen ``specimen_name``: the first that speaks for it, as the
     Compare tab takes the first (a steel calibration saved last left the paper coupon's
-    report without a calibrated column); 0 where none does (the report then says why)."""
+    report without a calibrated column); 0 where none does (the report then says why).
+
+    ``specimen``: the specimen file reported (:class:`pidcore.specimen.Specimen`), where the
+    page knows it: then its hash decides as the report's columns do
+    (:meth:`~pidcore.calibrate.prediction.Calibration.other_specimen_reason`), not its name
+    alone, which an edited file keeps (the calibration of the earlier file was the default,
+    and every row said "not compared")."""
     return next((i for i, (calibration, _) in enumerate(usable)
-                 if calibration.speaks_for(specimen_name)), 0)
+                 if calibration.speaks_for(specimen_name)
+                 and (specimen is None or not calibration.other_specimen_reason(specimen))), 0)
 
 
 #: Columns of :func:`saved_calibrations_table`: listing column -> name shown (units named).

@@ -294,6 +294,7 @@ def check_point_specimens(points: Sequence[MeasuredPoint], specimen: Specimen) -
     measurement in the report and the app (:meth:`pidcore.calibrate.prediction.Calibration.
     speaks_for`). Any other was fitted silently against this specimen's DEM runs.
     """
+    # by name only: a measured point records its specimen's name, not the file's hash
     own = uncalibrated_name(measured_specimen_name(specimen))
 
     def of_another(name: str) -> bool:

@@ -257,6 +257,9 @@ class Calibration:
         (:func:`pidcore.specimen.measured_specimen_name`), not as the coupon's."""
         from ..specimen import is_paper_coupon, measured_specimen_name, uncalibrated_name
 
+        # by name only: a measurement records its specimen's name, not its file's hash, so
+        # two files of one name are one specimen here; where the specimen file is known
+        # (a report of it) :meth:`other_specimen_reason` compares the hashes
         calibrated = self.specimen_name
         if specimen_name and (not calibrated or is_paper_coupon(calibrated)):
             # another file named paper_coupon (another cell) calibrates to
@@ -323,6 +326,25 @@ def _other_specimen(calibrated, specimen) -> str:
     # contact, coupon or mass values: the cell and the particles say which specimen it is
     from ..specimen import measured_specimen_name, provenance_test_name, uncalibrated_name
 
+    source = calibrated.provenance
+    tested = tested_sha256(specimen)
+    if source is not None and tested is not None:
+        # both files say which file was tested: the hashes decide, whatever the names (an
+        # edited x.toml keeps its name, and a calibration of the earlier x was shown beside
+        # the new one's rows; a user's paper_coupon.toml calibrates to the paper coupon's
+        # name)
+        if specimen.hash == calibrated.hash or tested == source.calibrated_from_sha256:
+            return ""
+        own = uncalibrated_name(measured_specimen_name(specimen))
+        theirs = provenance_test_name(calibrated) or source.calibrated_from_name
+        if theirs == own:  # one name, two files: their hashes tell them apart
+            from ..specimen import hashed_name
+
+            return (f"it calibrates specimen {hashed_name(theirs, source.calibrated_from_sha256)}"
+                    f", not {hashed_name(own, tested)} (another file of the same name)")
+        return f"it calibrates specimen {theirs}, not {own}"
+    # by name: a calibrated file written before [provenance] existed (on either side) says
+    # only its name, so a file of that name with the same cell and particles is taken for it
     routed = provenance_test_name(calibrated)
     if routed:
         # made from a user's paper_coupon.toml (its [provenance]): its name is the paper
@@ -341,6 +363,20 @@ def _other_specimen(calibrated, specimen) -> str:
         what = "cell" if not same_cell else "particles"
         return f"it calibrates another specimen named {base} (its {what} differ)"
     return ""
+
+
+def tested_sha256(specimen) -> str | None:
+    """The sha256 of the specimen file whose tests ``specimen`` models: the file it was
+    calibrated from (its ``[provenance]``), else its own (a file that is not a calibrated
+    one); None for a calibrated file without ``[provenance]`` (written before the table
+    existed: which file it came from is unknown, only its name is)."""
+    from ..specimen import uncalibrated_name
+
+    if specimen.provenance is not None:
+        return specimen.provenance.calibrated_from_sha256
+    if uncalibrated_name(specimen.name) == specimen.name:
+        return specimen.hash
+    return None
 
 
 def _number(value, what: str, path: Path) -> float:

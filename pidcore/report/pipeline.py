@@ -411,6 +411,7 @@ def unsubtracted_baseline_note(specimen, analyses: pd.DataFrame | None) -> str:
     named = analyses.get("specimen", pd.Series([""] * len(analyses), index=analyses.index))
     from ..specimen import measured_specimen_name
 
+    # by name only: a measurement records its specimen's name, not the file's hash
     mine = analyses[(analyses["material"] == material)
                     & named.fillna("").isin(["", measured_specimen_name(specimen)])]
     subtracted = [float((stored_parameters(p) or {}).get("baseline_loss_factor") or 0.0)

@@ -318,6 +318,7 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
             # values (and the paper's measurement) as if they were that coupon's
             paper_values = (aligned.sdc_paper_dem, aligned.sdc_paper_experimental)
             not_paper = []
+            # by name only: a measurement records its specimen's name, not the file's hash
             if not is_paper_coupon(specimen) and np.isfinite(paper_values).any():
                 paper_values = (math.nan, math.nan)
                 not_paper = [NOT_PAPER_SPECIMEN_NOTE.format(name=specimen)]
