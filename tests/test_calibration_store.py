@@ -328,3 +328,38 @@ def test_the_key_covers_the_calibrated_specimen(calibrated):
     keys = {calibration_key(doc), calibration_key(doc, text), calibration_key(doc, renamed)}
     assert len(keys) == 3
     assert calibration_key(doc, text) == calibration_key(json.loads(json.dumps(doc)), text)
+
+
+def test_a_reports_provenance_names_its_calibration_and_calibrated_file(calibrated, capsys,
+                                                                         tmp_path):
+    # the footer named the specimen and the stores but not the calibration of the calibrated
+    # columns: two calibrations (or two calibrated files of one name) gave one footer
+    import hashlib
+
+    from pidcore.report.downloads import report_files
+    from pidcore.specimen import load_specimen
+
+    folder, store = calibrated
+    written = folder / "out" / "calibration.json"
+    digest = hashlib.sha256(written.read_bytes()).hexdigest()  # the text both hold
+    spec = load_specimen(folder / "out" / "calibrated_specimen.toml")
+    source = spec.provenance
+    said = (f"calibrated specimen {spec.name} sha256 {spec.hash}, calibrated from "
+            f"{source.calibrated_from_name} sha256 {source.calibrated_from_sha256}")
+    key = stored_calibration(store).store_key
+    for name, given, where in (
+            ("from_json", [str(written)], f"{written}"),
+            ("from_store", [str(store), "--calibration-key", key], f"{store} key {key}")):
+        assert main(["report", "--dem-store", str(store), "--calibration", *given,
+                     "--out", str(tmp_path / name), "--format", "csv"]) == 0
+        lines = (tmp_path / name / "report.provenance.txt").read_text().splitlines()
+        assert f"calibration: {where} sha256 {digest}; {said}" in lines, lines
+    capsys.readouterr()
+    # the app's downloads, from its store's calibration, say the same
+    files = report_files(store, calibration=stored_calibration(store))
+    text = files["csv_provenance"][1].decode("utf-8")
+    assert f"calibration: {store} key {key} sha256 {digest}; {said}" in text.splitlines()
+    # no calibration: no such line
+    assert main(["report", "--dem-store", str(store), "--out", str(tmp_path / "none"),
+                 "--format", "csv"]) == 0
+    assert "calibration:" not in (tmp_path / "none" / "report.provenance.txt").read_text()

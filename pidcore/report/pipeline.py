@@ -32,7 +32,7 @@ from ..constants import REPORT_FORMATS
 from ..errors import ParameterError, StoreError
 from ..io import display_path
 from ..loadcase import refuse_identical_contents_stating_apart
-from .provenance import collect_provenance
+from .provenance import calibration_provenance, collect_provenance
 from .render import check_out_dir, parse_formats, write_report
 from .table import add_calibration_columns, report_table_and_aligner
 
@@ -807,7 +807,8 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
                         "fill_atol_percent": tolerances.fill_atol_percent, "pool": pool},
             seeds=seeds, inputs=[r.path for r in results],
             input_hashes={str(r.path): getattr(r.measurement, "sha256", "") for r in results},
-            stores=stores, notes=notes, specimens=specimen_provenance(specimen))
+            stores=stores, notes=notes, specimens=specimen_provenance(specimen),
+            calibrations=calibration_provenance(calibrated))
         paths = write_report(table, figures, provenance, out_dir, formats, progress=progress)
     finally:
         for fig in figures.values():  # bare Figures: drop references to free Agg buffers
