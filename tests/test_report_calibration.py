@@ -438,3 +438,32 @@ def test_an_edited_file_of_the_same_name_is_not_the_calibrated_one(calibration_f
     old = dataclasses.replace(calibrated, provenance=None)
     (calibration_file.parent / "calibrated_specimen.toml").write_text(old.to_toml())
     assert load_calibration(calibration_file).other_specimen_reason(edited) == ""
+
+
+def test_a_calibration_json_alone_speaks_for_the_specimen_it_names(tmp_path):
+    # without calibrated_specimen.toml beside it a calibration.json named no specimen and
+    # spoke for the tests of any; one written now names the file it calibrated
+    from pidcore.calibrate.prediction import calibration_from_json
+    from pidcore.specimen import paper_specimen
+
+    def stated(name, sha):
+        doc = json.loads(BUNDLED.read_text())
+        doc["specimen"] = {"name": name, "sha256": sha}
+        path = tmp_path / f"{name}_{sha[:6]}.json"
+        path.write_text(json.dumps(doc))
+        return load_calibration(path)
+
+    steel = stated("steel_6mm", "ab" * 32)
+    assert steel.specimen_path is None and steel.specimen_name == "steel_6mm"
+    assert steel.speaks_for("steel_6mm") and steel.speaks_for("steel_6mm_calibrated")
+    assert not steel.speaks_for("paper_coupon") and steel.speaks_for("")
+    # a user's own paper_coupon.toml: its tests are "paper_coupon [hash6]", never the paper's
+    own = paper_specimen().with_values({"coupon.mass_kg": 0.03})
+    mine = stated("paper_coupon", own.hash)
+    assert mine.specimen_name == f"paper_coupon [{own.hash[:6]}]"
+    assert mine.speaks_for(f"paper_coupon [{own.hash[:6]}]")
+    assert not mine.speaks_for("paper_coupon")
+    paper = stated("paper_coupon", paper_specimen().hash)
+    assert paper.specimen_name == "paper_coupon" and paper.speaks_for("paper_coupon")
+    # a file written before it stated one: unknown, as before
+    assert calibration_from_json(BUNDLED.read_bytes(), "old").speaks_for("my_panel")

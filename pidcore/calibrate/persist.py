@@ -54,7 +54,10 @@ def calibration_key(document: dict, calibrated_specimen_text: str | None = None)
     document alone, as calibrations were keyed before (:func:`save_calibration` finds those
     by it). The file's comment header (the starting file's path, the intervals in words) is
     not in the key: the same fit from another folder is the same calibration."""
-    what = {k: v for k, v in document.items() if k not in _BOOKKEEPING}
+    # its "specimen" names (start and calibrated file, by name and hash) are in the
+    # calibrated specimen's text below: left out here, the JSON's key is the one a pidcore
+    # that did not write them gave the same fit, so save_calibration still finds that entry
+    what = {k: v for k, v in document.items() if k not in (*_BOOKKEEPING, "specimen")}
     settings = dict(what.get("settings") or {})
     settings.pop("store", None)
     what["settings"] = settings

@@ -365,6 +365,23 @@ def _other_specimen(calibrated, specimen) -> str:
     return ""
 
 
+def _stated_specimen_name(doc: dict) -> str:
+    """The name of the specimen a calibration.json states it calibrated (its ``specimen``
+    ``name``); "" where it states none (written before it did) or not as text."""
+    from ..specimen import hashed_name, is_paper_coupon, uncalibrated_name
+
+    stated = doc.get("specimen")
+    if not isinstance(stated, dict) or not isinstance(stated.get("name"), str):
+        return ""
+    name, sha = stated["name"], stated.get("sha256")
+    if isinstance(sha, str) and sha and uncalibrated_name(name) == name \
+            and is_paper_coupon(name) and not is_paper_coupon(name, sha):
+        # a user's own paper_coupon.toml: its tests are saved as "paper_coupon [45d792]"
+        # (pidcore.specimen.measured_specimen_name), never as the paper coupon's
+        return hashed_name(name, sha)
+    return name
+
+
 def tested_sha256(specimen) -> str | None:
     """The sha256 of the specimen file whose tests ``specimen`` models: the file it was
     calibrated from (its ``[provenance]``), else its own (a file that is not a calibrated
@@ -425,14 +442,16 @@ def load_calibration(path: str | os.PathLike, *, key: str | None = None) -> Cali
     specimen = path.parent / "calibrated_specimen.toml"
     return Calibration(path=path, parameters=calibration.parameters,
                        predictions=calibration.predictions,
-                       specimen_path=specimen if specimen.is_file() else None)
+                       specimen_path=specimen if specimen.is_file() else None,
+                       specimen_name=calibration.specimen_name)
 
 
 def calibration_from_json(text: str | bytes, source: str | os.PathLike, *,
                           specimen_name: str = "") -> Calibration:
     """A calibration from the text of a ``calibration.json`` (``source`` names it in errors
     and in :attr:`Calibration.path`); checked as :func:`load_calibration` does.
-    ``specimen_name``: the specimen it calibrates, where the caller knows it."""
+    ``specimen_name``: the specimen it calibrates, where the caller knows it; else the
+    ``specimen`` ``name`` the file states (written since it has one)."""
     path = Path(source)
     try:
         doc = json.loads(text)
@@ -483,4 +502,4 @@ def calibration_from_json(text: str | bytes, source: str | os.PathLike, *,
         predictions.append(CalibratedPrediction(case, sdc, low, high, measured,
                                                 measured_stderr, low0, high0, dof))
     return Calibration(path=path, parameters=doc["parameters"], predictions=tuple(predictions),
-                       specimen_name=specimen_name)
+                       specimen_name=specimen_name or _stated_specimen_name(doc))
