@@ -363,10 +363,19 @@ def calibration_digest(calibration) -> str:
 
 
 def stored_calibration_label(calibration) -> str:
-    """How the pages name a calibration saved in the app's store."""
+    """How the pages name a calibration saved in the app's store: its key, the specimen file
+    it calibrated (by name and hash, as the pages label DEM runs, where its calibrated file
+    records it: two files of one name read alike), what it fitted and when."""
     fitted = ", ".join(calibration.parameters)
+    of = calibration.specimen_name or "the paper coupon"
+    spec = calibration.calibrated_specimen()
+    if spec is not None and spec.provenance is not None:
+        from ..compare.specimens import specimen_label
+
+        of = specimen_label(spec.provenance.calibrated_from_name,
+                            spec.provenance.calibrated_from_sha256)
     return (f"this store's calibration {calibration.store_key} of "
-            f"{calibration.specimen_name or 'the paper coupon'} ({fitted}; saved "
+            f"{of} ({fitted}; saved "
             f"{calibration.created_utc[:16].replace('T', ' ')} UTC)")
 
 
@@ -447,6 +456,14 @@ def saved_calibrations_table(store_path: str | Path | None = None, *,
     listing = listing.iloc[::-1]
     shown = {c: n for c, n in SAVED_CALIBRATION_COLUMNS.items() if c in listing.columns}
     table = listing[list(shown)].rename(columns=shown).reset_index(drop=True)
+    if "specimen" in shown and "specimen_hash" in listing.columns:
+        # by name and hash, as the pages label DEM runs: calibrations of two files of one
+        # name (an edited x.toml) read alike
+        from ..compare.specimens import specimen_label
+
+        table["specimen"] = [
+            specimen_label(n, h) if isinstance(n, str) and isinstance(h, str) and h else n
+            for n, h in zip(listing["specimen"], listing["specimen_hash"], strict=True)]
     table["saved [UTC]"] = table["saved [UTC]"].str[:19].str.replace("T", " ")
     table = table.astype(object).where(table.notna(), "")
     for column in ("load cases [-]", "inside 95 % band (LOO) [-]"):  # counts, not 10.0
