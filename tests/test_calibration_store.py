@@ -363,3 +363,24 @@ def test_a_reports_provenance_names_its_calibration_and_calibrated_file(calibrat
     assert main(["report", "--dem-store", str(store), "--out", str(tmp_path / "none"),
                  "--format", "csv"]) == 0
     assert "calibration:" not in (tmp_path / "none" / "report.provenance.txt").read_text()
+
+
+def test_the_output_and_summary_name_the_specimen_file_and_the_file_written(calibrated,
+                                                                           capsys, tmp_path):
+    # the command's text and summary.md named neither the specimen calibrated nor the file
+    # written: calibrations of two files of one name read alike
+    from pidcore.specimen import load_specimen, paper_specimen
+
+    folder, store = calibrated
+    copy = tmp_path / "copy.h5"
+    copy.write_bytes(store.read_bytes())
+    out = _calibrate(folder, copy, "0.2", capsys)
+    written = load_specimen(folder / "out_0.2" / "calibrated_specimen.toml")
+    start = paper_specimen()
+    assert (f"Specimen: paper_coupon (sha256 {start.hash[:12]}, from {start.source}); "
+            f"calibrated file: {written.name} (sha256 {written.hash[:12]}).") \
+        in out.splitlines(), out
+    summary = (folder / "out_0.2" / "summary.md").read_text()
+    assert (f"Specimen: paper_coupon (sha256 {start.hash}, from {start.source}); "
+            f"calibrated file: {written.name} (sha256 {written.hash}).") \
+        in summary.splitlines()

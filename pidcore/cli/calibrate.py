@@ -170,8 +170,10 @@ def _print_result(args: argparse.Namespace, result, own_notes: list[str], saved:
         print(document_json(result.document()))
         print(f"pidcore calibrate: {said}", file=sys.stderr)
     else:
+        from ..calibrate.outputs import specimen_words
         from ..calibrate.posterior import summary_texts
 
+        print(specimen_words(result, digits=12))
         for name, p in result.parameters.items():
             median, low, high = summary_texts(p)
             print(f"{name}: {median} (95 % {low} .. {high})")
