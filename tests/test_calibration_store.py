@@ -297,6 +297,14 @@ def test_a_fit_stored_before_provenance_is_saved_again_with_it(calibrated, capsy
     assert row["calibrated_specimen"] == "paper_coupon_calibrated"
     assert row["calibrated_specimen_hash"] == newest.calibrated_specimen().hash
     assert row["document_key"] == legacy
+    # a report must choose: the listing tells the two apart by the file each holds
+    with pytest.raises(ParameterError, match="holds 2 calibrations") as refused:
+        stored_calibration(copy)
+    hash6 = newest.calibrated_specimen().hash[:6]
+    assert (f"{new_key} (paper_coupon, fitted 'fixture_mass_kg'; "
+            in str(refused.value))
+    assert f"; calibrated file paper_coupon_calibrated [{hash6}]); {legacy} (" \
+        in str(refused.value), str(refused.value)
     # made again: this one is stored already, nothing added
     again = _calibrate(folder, copy, "0.2", capsys)
     assert f"calibration {new_key} is stored in {copy} already" in again, again

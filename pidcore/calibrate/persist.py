@@ -286,5 +286,14 @@ def _keys_text(listing) -> str:
     if listing.empty:
         return "none"
     rows = listing.iloc[::-1]
+
+    def written(r) -> str:
+        # the same fit saved with another calibrated file (one stored before [provenance])
+        # read alike but for the time: the file each holds tells them apart
+        name, sha = r.get("calibrated_specimen"), r.get("calibrated_specimen_hash")
+        if not isinstance(name, str) or not isinstance(sha, str) or not sha:
+            return ""
+        return f"; calibrated file {name} [{sha[:6]}]"
+
     return "; ".join(f"{r['key']} ({r.get('specimen', '')}, fitted '{r.get('fit', '')}'; "
-                     f"{str(r['created_utc'])[:16]})" for _, r in rows.iterrows())
+                     f"{str(r['created_utc'])[:16]}{written(r)})" for _, r in rows.iterrows())
