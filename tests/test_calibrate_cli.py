@@ -711,7 +711,12 @@ def test_the_html_summary_carries_the_notes_of_the_markdown_one():
 
     notes = ["neg_fill50.csv: left out, implausible (saved as accepted): SDC -1.26 < 0",
              "fixture_mass_kg: the posterior piles against its prior's lower bound 0 & <more>"]
-    page = summary_html(SimpleNamespace(parameters={}, predictions=[], loo=None, notes=notes))
+    from pidcore.specimen import paper_specimen
+
+    # the page names the specimen calibrated and the file written: the fake has both
+    page = summary_html(SimpleNamespace(parameters={}, predictions=[], loo=None, notes=notes,
+                                        specimen=paper_specimen(),
+                                        calibrated_specimen=paper_specimen))
     for note in notes:
         assert f"<li>{html.escape(note)}</li>" in page
 

@@ -47,13 +47,14 @@ def calibration_key(document: dict, calibrated_specimen_text: str | None = None)
     (:attr:`pidcore.specimen.Specimen.text`: its values, name, description and
     ``[provenance]``).
 
-    The document alone does not say what the calibrated file holds: it names neither the
-    starting specimen nor the file's ``[provenance]``, so two files of the same numbers, or
-    a fit saved before today's pidcore added a table to the file, had one key and the second
-    got the first's file. Without ``calibrated_specimen_text`` the key is that of the
-    document alone, as calibrations were keyed before (:func:`save_calibration` finds those
-    by it). The file's comment header (the starting file's path, the intervals in words) is
-    not in the key: the same fit from another folder is the same calibration."""
+    The document alone does not say what the calibrated file holds (its ``[provenance]``,
+    and, before the document named them, the starting specimen's name and hash), so two
+    files of the same numbers, or a fit saved before today's pidcore added a table to the
+    file, had one key and the second got the first's file. Without
+    ``calibrated_specimen_text`` the key is that of the document alone, as calibrations were
+    keyed before (:func:`save_calibration` finds those by it). The file's comment header
+    (the starting file's path, the intervals in words) is not in the key: the same fit from
+    another folder is the same calibration."""
     # its "specimen" names (start and calibrated file, by name and hash) are in the
     # calibrated specimen's text below: left out here, the JSON's key is the one a pidcore
     # that did not write them gave the same fit, so save_calibration still finds that entry
