@@ -1870,6 +1870,78 @@ def test_the_report_tab_defaults_to_the_newest_calibration_of_the_specimen_repor
     assert default_calibration_index(newest_first[:1], "my_panel") == 0
 
 
+
+def test_the_report_tab_default_goes_by_the_reported_files_hash(tmp_path):
+    # two files named x (the second an edit of the first): the calibration of the earlier x
+    # saved last was the default for a report of the edited x (by its name), and every
+    # calibrated cell said "not compared" while the edited file's own calibration was offered
+    import dataclasses
+
+    from pidcore.app.calibration import default_calibration_index
+    from pidcore.calibrate.prediction import calibration_from_json
+    from pidcore.specimen import Specimen, calibrated_provenance, paper_specimen
+
+    first = Specimen.from_text(paper_specimen().to_toml().replace(
+        'name = "paper_coupon"', 'name = "x"'))
+    edited = first.with_values({"coupon.mass_kg": 0.03})
+    doc = json.dumps({"parameters": {"fixture_mass_kg": {"median": 0.2, "low95": 0.1,
+                                                         "high95": 0.3}},
+                      "predictions": [{"frequency_hz": 100.0, "acceleration_g": 5.0,
+                                       "fill_percent": 50.0, "material": "acrylic",
+                                       "measured": 0.3, "predicted": 0.3, "low95": 0.1,
+                                       "high95": 0.6}]}).encode()
+
+    def of(start):
+        made = dataclasses.replace(start.with_values({"coupon.fixture_mass_kg": 0.2}),
+                                   name="x_calibrated", provenance=calibrated_provenance(start))
+        read = calibration_from_json(doc, f"{start.hash[:6]}.json", specimen_name="x")
+        return dataclasses.replace(read, specimen_text=made.to_toml())
+
+    newest_first = [(of(first), "of the first x"), (of(edited), "of the edited x")]
+    assert default_calibration_index(newest_first, "x") == 0  # by the name alone: both
+    assert default_calibration_index(newest_first, "x", edited) == 1
+    assert default_calibration_index(newest_first, "x", first) == 0
+
+
+def test_the_app_names_a_saved_calibrations_specimen_file_by_its_hash(tmp_path):
+    # calibrations of two files named x (an edited x.toml) were listed and offered as "of x"
+    # alike: which file each was made from is said by its hash, as the DEM runs are labelled
+    import dataclasses
+
+    from pidcore.app.calibration import saved_calibrations_table, stored_calibration_label
+    from pidcore.calibrate import stored_calibrations
+    from pidcore.specimen import Specimen, calibrated_provenance, paper_specimen
+    from pidcore.store import Store
+
+    first = Specimen.from_text(paper_specimen().to_toml().replace(
+        'name = "paper_coupon"', 'name = "x"'))
+    edited = first.with_values({"coupon.mass_kg": 0.03})
+    text = json.dumps({"parameters": {"fixture_mass_kg": {"median": 0.2, "low95": 0.1,
+                                                          "high95": 0.3}},
+                       "predictions": [{"frequency_hz": 100.0, "acceleration_g": 5.0,
+                                        "fill_percent": 50.0, "material": "acrylic",
+                                        "measured": 0.3, "predicted": 0.3, "low95": 0.1,
+                                        "high95": 0.6}]})
+    store = tmp_path / "app.h5"
+    for i, start in enumerate((first, edited)):
+        made = dataclasses.replace(start, name="x_calibrated",
+                                   provenance=calibrated_provenance(start))
+        Store(store).add_calibration(f"cal_{i}", {"specimen": "x", "specimen_hash": start.hash},
+                                     document=text, specimen_toml=made.to_toml())
+    labels = [f"x [{s.hash[:6]}]" for s in (edited, first)]  # newest first
+    assert list(saved_calibrations_table(store)["specimen"]) == labels
+    said = [stored_calibration_label(c) for c in stored_calibrations(store)]
+    assert [f"of {label} (" in text for label, text in zip(labels, said, strict=True)] == \
+        [True, True], said
+    # the paper's coupon keeps its one name
+    paper = paper_specimen()
+    Store(store).add_calibration("cal_p", {"specimen": "paper_coupon", "specimen_hash": paper.hash},
+                                 document=text, specimen_toml=dataclasses.replace(
+                                     paper, name="paper_coupon_calibrated",
+                                     provenance=calibrated_provenance(paper)).to_toml())
+    assert saved_calibrations_table(store)["specimen"].iloc[0] == "paper_coupon"
+    assert " of paper_coupon (" in stored_calibration_label(stored_calibrations(store)[0])
+
 def test_a_damaged_calibration_in_the_store_does_not_hide_the_others(tmp_path):
     # one calibration of the store whose calibration.json was cut short hid every one of
     # them on Compare, Report and the Calibrate page ("calibrations of the store not shown")

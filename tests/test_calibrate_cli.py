@@ -106,7 +106,30 @@ def test_json_document(capsys, tmp_path, tiny_store):
                  "--dem-store", str(tiny_store), "--out", str(tmp_path / "out"), *TINY])
     assert code == 0
     doc = json.loads(capsys.readouterr().out)
-    assert set(doc) == {"parameters", "predictions", "loo", "loo_rms", "units"}
+    assert set(doc) == {"specimen", "parameters", "predictions", "loo", "loo_rms", "units"}
+    # which file was calibrated and which it wrote (the document named neither: a
+    # calibration.json apart from its folder spoke for the tests of any specimen)
+    from pidcore.calibrate.persist import calibration_key
+    from pidcore.specimen import load_specimen, paper_specimen
+
+    written = load_specimen(tmp_path / "out" / "calibrated_specimen.toml")
+    assert doc["specimen"] == {"name": "paper_coupon", "sha256": paper_specimen().hash,
+                               "calibrated_name": written.name,
+                               "calibrated_sha256": written.hash}
+    full = json.loads((tmp_path / "out" / "calibration.json").read_text())
+    assert full["specimen"] == doc["specimen"]
+    # the names are in the calibrated file's text, which the store key covers: the JSON's own
+    # key is the one a pidcore that did not write them gave the same fit
+    bare = {k: v for k, v in full.items() if k != "specimen"}
+    assert calibration_key(full) == calibration_key(bare)
+    alone = tmp_path / "alone"
+    alone.mkdir()
+    (alone / "calibration.json").write_bytes((tmp_path / "out" / "calibration.json").read_bytes())
+    from pidcore.calibrate import load_calibration
+
+    apart = load_calibration(alone)
+    assert apart.specimen_path is None and apart.specimen_name == "paper_coupon"
+    assert apart.speaks_for("paper_coupon") and not apart.speaks_for("steel_6mm")
     assert set(doc["parameters"]) == {"fixture_mass_kg"}
     # every number of the document names its unit, as calibration.json's table does
     assert doc["units"] == {"fixture_mass_kg": "kg", "loo_rms": "-",
@@ -688,7 +711,12 @@ def test_the_html_summary_carries_the_notes_of_the_markdown_one():
 
     notes = ["neg_fill50.csv: left out, implausible (saved as accepted): SDC -1.26 < 0",
              "fixture_mass_kg: the posterior piles against its prior's lower bound 0 & <more>"]
-    page = summary_html(SimpleNamespace(parameters={}, predictions=[], loo=None, notes=notes))
+    from pidcore.specimen import paper_specimen
+
+    # the page names the specimen calibrated and the file written: the fake has both
+    page = summary_html(SimpleNamespace(parameters={}, predictions=[], loo=None, notes=notes,
+                                        specimen=paper_specimen(),
+                                        calibrated_specimen=paper_specimen))
     for note in notes:
         assert f"<li>{html.escape(note)}</li>" in page
 

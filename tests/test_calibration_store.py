@@ -58,7 +58,9 @@ def test_the_stored_calibration_is_the_json_written_beside_it(calibrated):
     assert stored.predictions == written.predictions
     assert stored.calibrated_specimen().hash == written.calibrated_specimen().hash
     assert stored.specimen_name == "paper_coupon"
-    assert stored.store_key == calibration_key(json.loads(stored.document_text))
+    # the key is of what the calibration writes: its JSON and its calibrated specimen
+    assert stored.store_key == calibration_key(json.loads(stored.document_text),
+                                               stored.calibrated_specimen().text)
     # listed with its medians, each named with its unit, and a sound store
     listing = Store(store).list_calibrations()
     assert list(listing["key"]) == [stored.store_key]
@@ -237,3 +239,156 @@ def test_the_listing_of_a_refused_report_keeps_the_fitted_names(calibrated, caps
     # the library says the same names to a Python caller
     with pytest.raises(ParameterError, match="fitted 'fixture_mass_kg,baseline_loss_factor';"):
         stored_calibration(copy)
+
+
+def _as_saved_before_provenance(store, tmp_path, *, strip: bool):
+    """A copy of ``store`` whose calibration is stored as a pidcore of the previous round
+    stored it: under the key of its calibration.json alone, without the record's newer
+    fields, and (``strip``) with the calibrated specimen file that pidcore wrote, without
+    the ``[provenance]`` table (the last table of the file). Returns (copy, key, text)."""
+    copy = tmp_path / ("before.h5" if strip else "before_same.h5")
+    copy.write_bytes(store.read_bytes())
+    stored = stored_calibration(copy)
+    document = json.loads(stored.document_text)
+    text = stored.specimen_text
+    if strip:
+        assert "\n[provenance]\n" in text
+        text = text[:text.index("\n[provenance]\n") + 1]
+    entry = Store(copy).get_calibration(stored.store_key)
+    with h5py.File(copy, "r+") as h5:
+        del h5[f"calibrations/{stored.store_key}"]
+    legacy = calibration_key(document)
+    old_fields = ("calibrated_specimen", "calibrated_specimen_hash", "document_key")
+    record = {k: v for k, v in entry.record.items() if k not in old_fields}
+    Store(copy).add_calibration(legacy, record, document=stored.document_text,
+                                specimen_toml=text)
+    return copy, legacy, text
+
+
+def test_a_fit_stored_before_provenance_is_saved_again_with_it(calibrated, capsys, tmp_path):
+    # "stored already": re-running the calibration that the previous round stored gave the
+    # user that round's calibrated specimen file, without [provenance]
+    folder, store = calibrated
+    copy, legacy, old_text = _as_saved_before_provenance(store, tmp_path, strip=True)
+    before = Store(copy).get_calibration(legacy)
+    out = _calibrate(folder, copy, "0.2", capsys)  # every DEM run cached: the same fit
+    listing = Store(copy).list_calibrations()
+    assert len(listing) == 2 and listing["key"].iloc[0] == legacy
+    new_key = listing["key"].iloc[1]
+    assert new_key != legacy
+    assert (f"saved calibration {new_key} in {copy}" in out
+            and f"the same fit was stored before as {legacy} (its calibrated specimen file, "
+                "written by an earlier pidcore, lacks the [provenance]" in out
+            and "kept as it was, this one saved beside it" in out), out
+    # the new entry is today's file, [provenance] included, the very text --out got
+    newest = stored_calibrations(copy)[0]
+    assert newest.store_key == new_key
+    written = (folder / "out_0.2" / "calibrated_specimen.toml").read_text()
+    assert newest.specimen_text == written and "\n[provenance]\n" in written
+    source = newest.calibrated_specimen().provenance
+    assert source is not None and source.calibrated_from_name == "paper_coupon"
+    # the earlier one is kept byte for byte (the store never loses what it held)
+    kept = Store(copy).get_calibration(legacy)
+    assert kept.attrs["created_utc"] == before.attrs["created_utc"]
+    assert stored_calibration(copy, legacy).specimen_text == old_text
+    assert Store(copy).verify() == []
+    # the listing names the file each entry holds, and the fit they share
+    row = listing.iloc[1]
+    assert row["calibrated_specimen"] == "paper_coupon_calibrated"
+    assert row["calibrated_specimen_hash"] == newest.calibrated_specimen().hash
+    assert row["document_key"] == legacy
+    # a report must choose: the listing tells the two apart by the file each holds
+    with pytest.raises(ParameterError, match="holds 2 calibrations") as refused:
+        stored_calibration(copy)
+    hash6 = newest.calibrated_specimen().hash[:6]
+    assert (f"{new_key} (paper_coupon, fitted 'fixture_mass_kg'; "
+            in str(refused.value))
+    assert f"; calibrated file paper_coupon_calibrated [{hash6}]); {legacy} (" \
+        in str(refused.value), str(refused.value)
+    # made again: this one is stored already, nothing added
+    again = _calibrate(folder, copy, "0.2", capsys)
+    assert f"calibration {new_key} is stored in {copy} already" in again, again
+    assert list(Store(copy).list_calibrations()["key"]) == [legacy, new_key]
+
+
+def test_a_fit_stored_before_with_todays_file_is_not_stored_twice(calibrated, capsys,
+                                                                  tmp_path):
+    # a store whose entry holds the file today's pidcore writes, under the earlier key of the
+    # JSON alone: the same calibration, not a second entry beside it
+    folder, store = calibrated
+    copy, legacy, _ = _as_saved_before_provenance(store, tmp_path, strip=False)
+    out = _calibrate(folder, copy, "0.2", capsys)
+    assert f"calibration {legacy} is stored in {copy} already" in out, out
+    assert list(Store(copy).list_calibrations()["key"]) == [legacy]
+
+
+def test_the_key_covers_the_calibrated_specimen(calibrated):
+    # two starting files of one set of numbers (another name, or the paper's coupon and a
+    # user's paper_coupon.toml) give one calibration.json: the key of the JSON alone gave the
+    # second the first's calibrated file, named and provenanced as the first
+    from pidcore.specimen import Specimen
+
+    folder, _ = calibrated
+    doc = json.loads((folder / "out" / "calibration.json").read_text())
+    text = Specimen.from_text((folder / "out" / "calibrated_specimen.toml").read_text()).text
+    renamed = text.replace('name = "paper_coupon_calibrated"', 'name = "mine_calibrated"')
+    assert renamed != text
+    keys = {calibration_key(doc), calibration_key(doc, text), calibration_key(doc, renamed)}
+    assert len(keys) == 3
+    assert calibration_key(doc, text) == calibration_key(json.loads(json.dumps(doc)), text)
+
+
+def test_a_reports_provenance_names_its_calibration_and_calibrated_file(calibrated, capsys,
+                                                                         tmp_path):
+    # the footer named the specimen and the stores but not the calibration of the calibrated
+    # columns: two calibrations (or two calibrated files of one name) gave one footer
+    import hashlib
+
+    from pidcore.report.downloads import report_files
+    from pidcore.specimen import load_specimen
+
+    folder, store = calibrated
+    written = folder / "out" / "calibration.json"
+    digest = hashlib.sha256(written.read_bytes()).hexdigest()  # the text both hold
+    spec = load_specimen(folder / "out" / "calibrated_specimen.toml")
+    source = spec.provenance
+    said = (f"calibrated specimen {spec.name} sha256 {spec.hash}, calibrated from "
+            f"{source.calibrated_from_name} sha256 {source.calibrated_from_sha256}")
+    key = stored_calibration(store).store_key
+    for name, given, where in (
+            ("from_json", [str(written)], f"{written}"),
+            ("from_store", [str(store), "--calibration-key", key], f"{store} key {key}")):
+        assert main(["report", "--dem-store", str(store), "--calibration", *given,
+                     "--out", str(tmp_path / name), "--format", "csv"]) == 0
+        lines = (tmp_path / name / "report.provenance.txt").read_text().splitlines()
+        assert f"calibration: {where} sha256 {digest}; {said}" in lines, lines
+    capsys.readouterr()
+    # the app's downloads, from its store's calibration, say the same
+    files = report_files(store, calibration=stored_calibration(store))
+    text = files["csv_provenance"][1].decode("utf-8")
+    assert f"calibration: {store} key {key} sha256 {digest}; {said}" in text.splitlines()
+    # no calibration: no such line
+    assert main(["report", "--dem-store", str(store), "--out", str(tmp_path / "none"),
+                 "--format", "csv"]) == 0
+    assert "calibration:" not in (tmp_path / "none" / "report.provenance.txt").read_text()
+
+
+def test_the_output_and_summary_name_the_specimen_file_and_the_file_written(calibrated,
+                                                                           capsys, tmp_path):
+    # the command's text and summary.md named neither the specimen calibrated nor the file
+    # written: calibrations of two files of one name read alike
+    from pidcore.specimen import load_specimen, paper_specimen
+
+    folder, store = calibrated
+    copy = tmp_path / "copy.h5"
+    copy.write_bytes(store.read_bytes())
+    out = _calibrate(folder, copy, "0.2", capsys)
+    written = load_specimen(folder / "out_0.2" / "calibrated_specimen.toml")
+    start = paper_specimen()
+    assert (f"Specimen: paper_coupon (sha256 {start.hash[:12]}, from {start.source}); "
+            f"calibrated file: {written.name} (sha256 {written.hash[:12]}).") \
+        in out.splitlines(), out
+    summary = (folder / "out_0.2" / "summary.md").read_text()
+    assert (f"Specimen: paper_coupon (sha256 {start.hash}, from {start.source}); "
+            f"calibrated file: {written.name} (sha256 {written.hash}).") \
+        in summary.splitlines()

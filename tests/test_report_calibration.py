@@ -398,3 +398,72 @@ def test_a_missing_calibration_names_the_command_that_writes_one(tmp_path, capsy
     # the library, for a Python caller, names its own function
     with pytest.raises(ParameterError, match=r"write_outputs\(result, out_dir\)"):
         load_calibration(path)
+
+
+def test_an_edited_file_of_the_same_name_is_not_the_calibrated_one(calibration_file):
+    # x.toml calibrated, then edited (another coupon mass) and saved under its name: the
+    # calibration's [provenance] names the earlier file's hash, and the name alone (with the
+    # same cell and particles) showed its band beside the edited file's rows
+    from pidcore.specimen import Specimen, calibrated_provenance, paper_specimen
+
+    first = Specimen.from_text(paper_specimen().to_toml().replace(
+        'name = "paper_coupon"', 'name = "x"'))
+    edited = first.with_values({"coupon.mass_kg": 0.03})
+    assert (first.name, first.cell, first.particles) == (edited.name, edited.cell,
+                                                        edited.particles)
+    assert first.hash != edited.hash
+    calibrated = first.with_values({"coupon.fixture_mass_kg": 0.25})
+    import dataclasses
+
+    calibrated = dataclasses.replace(calibrated, name="x_calibrated",
+                                     provenance=calibrated_provenance(first))
+    (calibration_file.parent / "calibrated_specimen.toml").write_text(calibrated.to_toml())
+    cal = load_calibration(calibration_file)
+    table = _table().iloc[[0]]  # 50 Hz, 5 g, 50 % acrylic: a load case it predicts
+
+    def out(specimen):
+        return add_calibration_columns(table, cal, specimen=specimen)
+
+    # the file it was made from, and the calibrated file itself: its band
+    for same in (first, calibrated):
+        assert out(same)[CALIBRATED_COLUMN].iloc[0] == 0.24, same.name
+    # the edited file: not compared, both files named by their hashes
+    refused = out(edited)
+    assert math.isnan(refused[CALIBRATED_COLUMN].iloc[0])
+    assert refused[CALIBRATED_INSIDE_COLUMN].iloc[0] == NOT_COMPARED
+    assert refused["note"].iloc[0].endswith(
+        f": it calibrates specimen x [{first.hash[:6]}], not x [{edited.hash[:6]}] (another "
+        "file of the same name)")
+    # a calibrated file without [provenance] (written before it) still goes by its name
+    old = dataclasses.replace(calibrated, provenance=None)
+    (calibration_file.parent / "calibrated_specimen.toml").write_text(old.to_toml())
+    assert load_calibration(calibration_file).other_specimen_reason(edited) == ""
+
+
+def test_a_calibration_json_alone_speaks_for_the_specimen_it_names(tmp_path):
+    # without calibrated_specimen.toml beside it a calibration.json named no specimen and
+    # spoke for the tests of any; one written now names the file it calibrated
+    from pidcore.calibrate.prediction import calibration_from_json
+    from pidcore.specimen import paper_specimen
+
+    def stated(name, sha):
+        doc = json.loads(BUNDLED.read_text())
+        doc["specimen"] = {"name": name, "sha256": sha}
+        path = tmp_path / f"{name}_{sha[:6]}.json"
+        path.write_text(json.dumps(doc))
+        return load_calibration(path)
+
+    steel = stated("steel_6mm", "ab" * 32)
+    assert steel.specimen_path is None and steel.specimen_name == "steel_6mm"
+    assert steel.speaks_for("steel_6mm") and steel.speaks_for("steel_6mm_calibrated")
+    assert not steel.speaks_for("paper_coupon") and steel.speaks_for("")
+    # a user's own paper_coupon.toml: its tests are "paper_coupon [hash6]", never the paper's
+    own = paper_specimen().with_values({"coupon.mass_kg": 0.03})
+    mine = stated("paper_coupon", own.hash)
+    assert mine.specimen_name == f"paper_coupon [{own.hash[:6]}]"
+    assert mine.speaks_for(f"paper_coupon [{own.hash[:6]}]")
+    assert not mine.speaks_for("paper_coupon")
+    paper = stated("paper_coupon", paper_specimen().hash)
+    assert paper.specimen_name == "paper_coupon" and paper.speaks_for("paper_coupon")
+    # a file written before it stated one: unknown, as before
+    assert calibration_from_json(BUNDLED.read_bytes(), "old").speaks_for("my_panel")

@@ -221,3 +221,20 @@ def test_a_test_of_a_specimen_meets_the_runs_of_its_calibrated_file(steel):
     row = _measured(specimen_report_table(runs, other, specimen=calibrated).table, "steel.h5")
     assert row[ALIGNMENT_COLUMN] == "no_dem_runs"
 
+
+
+def test_a_report_of_an_edited_file_names_the_stored_runs_as_another_file_of_its_name(
+        steel, store_runs, analyses):
+    # steel_6mm.toml edited (another coupon mass) and reported with its test named
+    # steel_6mm: the store's runs of the earlier file were said to be "left out of a report
+    # of another specimen", of a report of steel_6mm itself
+    edited = steel.with_values({"coupon.mass_kg": 0.04})
+    assert edited.name == steel.name and edited.hash != steel.hash
+    named = analyses.assign(specimen=["", "steel_6mm"])
+    row = _measured(specimen_report_table(store_runs, named, specimen=edited).table,
+                    "other.h5")
+    assert row[ALIGNMENT_COLUMN] == "no_dem_runs"
+    assert row["note"] == (f"no DEM runs of steel_6mm for steel, direction z among this "
+                           f"report's runs (the store has 1 of steel_6mm [{steel.hash[:6]}]: "
+                           "another file named steel_6mm than the one reported, whose hash "
+                           "differs; report with their specimen=FILE to compare them)")

@@ -514,3 +514,31 @@ def test_a_calibrated_damping_coefficient_is_refused_for_an_own_material_naming_
         assert "damping_coefficient='calibrated': only for table particles" in err
         assert "not specimen 'steel_6mm'; use 'eq3'" in err
         assert not store.exists()
+
+
+def test_a_sweeps_json_and_summary_name_each_runs_specimen_file(capsys, tmp_path):
+    """`dem sweep --json` gave per case its load case and results but not whose run it was:
+    the sweeps of two files named x (the second an edit of the first) into one store read
+    alike. Each case now carries the stored run's specimen_name and specimen_sha256 (the
+    file's hash), and the text summary names them."""
+    store = tmp_path / "runs.h5"
+    first = Specimen.from_text(paper_specimen().to_toml().replace('name = "paper_coupon"',
+                                                                  'name = "x"'))
+    edited = first.with_values({"coupon.mass_kg": 0.03})
+    said = {}
+    for label, spec in (("first", first), ("edited", edited)):
+        path = tmp_path / label / "x.toml"
+        path.parent.mkdir()
+        path.write_text(spec.to_toml())
+        args = ["dem", "sweep", "--specimen", str(path), "--frequencies", "1000",
+                "--accelerations", "5", "--fills", "25", "--cells", "1", "--cycles", "2",
+                "--workers", "1", "--store", str(store), "--no-progress"]
+        assert main([*args, "--json"]) == 0
+        (case,) = json.loads(capsys.readouterr().out)["cases"]
+        assert (case["specimen_name"], case["specimen_sha256"]) == ("x", spec.hash), label
+        assert main(args) == 0  # stored already: the summary names the stored run's file
+        said[label] = capsys.readouterr().out
+        assert f"1 already in {store}; wall time" in said[label]
+        assert said[label].rstrip().endswith(f"; specimen x (sha256 {spec.hash[:12]})")
+    assert first.hash != edited.hash
+    assert len(Store(store).list_dem_runs()) == 2

@@ -341,11 +341,16 @@ def _save(api, result, store_path: Path) -> tuple[str, str]:
     if save is None:
         return "", "; not saved in the store (this pidcore cannot): download calibration.json below"
     try:
-        key, added = save(result, store_path)
+        saved = save(result, store_path)
     except PidcoreError as exc:
         return "", f"; NOT saved in the store ({exc}): download calibration.json below"
-    return key, (f"; saved in the store as {key}" if added
-                 else f"; the same result is in the store already as {key}")
+    key, added = saved[0], saved[1]
+    superseded = tuple(saved[2]) if len(saved) > 2 else ()
+    if not added:
+        return key, f"; the same result is in the store already as {key}"
+    return key, (f"; saved in the store as {key}"
+                 + (f" (the same fit was stored before as {'; '.join(superseded)}: kept as it "
+                    "was, this one saved beside it)" if superseded else ""))
 
 
 _RUNNERS: dict[str, CalibrationRunner] = {}
@@ -419,20 +424,37 @@ def calibration_digest(calibration) -> str:
 
 
 def stored_calibration_label(calibration) -> str:
-    """How the pages name a calibration saved in the app's store."""
+    """How the pages name a calibration saved in the app's store: its key, the specimen file
+    it calibrated (by name and hash, as the pages label DEM runs, where its calibrated file
+    records it: two files of one name read alike), what it fitted and when."""
     fitted = ", ".join(calibration.parameters)
+    of = calibration.specimen_name or "the paper coupon"
+    spec = calibration.calibrated_specimen()
+    if spec is not None and spec.provenance is not None:
+        from ..compare.specimens import specimen_label
+
+        of = specimen_label(spec.provenance.calibrated_from_name,
+                            spec.provenance.calibrated_from_sha256)
     return (f"this store's calibration {calibration.store_key} of "
-            f"{calibration.specimen_name or 'the paper coupon'} ({fitted}; saved "
+            f"{of} ({fitted}; saved "
             f"{calibration.created_utc[:16].replace('T', ' ')} UTC)")
 
 
-def default_calibration_index(usable: Sequence[tuple[object, str]], specimen_name: str) -> int:
+def default_calibration_index(usable: Sequence[tuple[object, str]], specimen_name: str,
+                              specimen: object | None = None) -> int:
     """Which of ``usable`` ([(calibration, label)], newest first) the Report tab shows by
     default for a report of specimen ``specimen_name``: the first that speaks for it, as the
     Compare tab takes the first (a steel calibration saved last left the paper coupon's
-    report without a calibrated column); 0 where none does (the report then says why)."""
+    report without a calibrated column); 0 where none does (the report then says why).
+
+    ``specimen``: the specimen file reported (:class:`pidcore.specimen.Specimen`), where the
+    page knows it: then its hash decides as the report's columns do
+    (:meth:`~pidcore.calibrate.prediction.Calibration.other_specimen_reason`), not its name
+    alone, which an edited file keeps (the calibration of the earlier file was the default,
+    and every row said "not compared")."""
     return next((i for i, (calibration, _) in enumerate(usable)
-                 if calibration.speaks_for(specimen_name)), 0)
+                 if calibration.speaks_for(specimen_name)
+                 and (specimen is None or not calibration.other_specimen_reason(specimen))), 0)
 
 
 #: Columns of :func:`saved_calibrations_table`: listing column -> name shown (units named).
@@ -495,6 +517,14 @@ def saved_calibrations_table(store_path: str | Path | None = None, *,
     listing = listing.iloc[::-1]
     shown = {c: n for c, n in SAVED_CALIBRATION_COLUMNS.items() if c in listing.columns}
     table = listing[list(shown)].rename(columns=shown).reset_index(drop=True)
+    if "specimen" in shown and "specimen_hash" in listing.columns:
+        # by name and hash, as the pages label DEM runs: calibrations of two files of one
+        # name (an edited x.toml) read alike
+        from ..compare.specimens import specimen_label
+
+        table["specimen"] = [
+            specimen_label(n, h) if isinstance(n, str) and isinstance(h, str) and h else n
+            for n, h in zip(listing["specimen"], listing["specimen_hash"], strict=True)]
     table["saved [UTC]"] = table["saved [UTC]"].str[:19].str.replace("T", " ")
     table = table.astype(object).where(table.notna(), "")
     for column in ("load cases [-]", "inside 95 % band (LOO) [-]"):  # counts, not 10.0

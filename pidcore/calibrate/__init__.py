@@ -29,8 +29,8 @@ Observation, observation_from_run
     The SDC a shaker test of a DEM run would measure.
 write_outputs
     calibration.json, the calibrated specimen, figures and summary.
-save_calibration, stored_calibration, stored_calibrations
-    Calibrations saved in and read from the HDF5 store.
+save_calibration, SavedCalibration, stored_calibration, stored_calibrations
+    Calibrations saved in and read from the HDF5 store (and what a save did).
 load_calibration, calibration_from_json, Calibration, CalibratedPrediction
     A calibration read back (``to_pandas()``, ``plot()``); its prediction and 95 % band at
     a calibrated load case (``Calibration.lookup(case).band(stderr)``).
@@ -41,7 +41,12 @@ from .data import MeasuredPoint, measured_from_store, read_measured_table
 from .observation import Observation, observation_from_run
 from .outputs import write_outputs
 from .parameters import CATALOGUE, ParameterSpec, build_specs, dem_parameter_names, parse_fit
-from .persist import save_calibration, stored_calibration, stored_calibrations
+from .persist import (
+    SavedCalibration,
+    save_calibration,
+    stored_calibration,
+    stored_calibrations,
+)
 from .prediction import CalibratedPrediction, Calibration, calibration_from_json, load_calibration
 
 __all__ = ["calibrate", "base_specimen", "CalibrationResult", "MeasuredPoint",
@@ -49,4 +54,4 @@ __all__ = ["calibrate", "base_specimen", "CalibrationResult", "MeasuredPoint",
            "write_outputs",
            "CATALOGUE", "ParameterSpec", "build_specs", "parse_fit", "dem_parameter_names",
            "Calibration", "CalibratedPrediction", "load_calibration", "calibration_from_json",
-           "save_calibration", "stored_calibration", "stored_calibrations"]
+           "save_calibration", "SavedCalibration", "stored_calibration", "stored_calibrations"]

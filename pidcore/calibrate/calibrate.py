@@ -150,12 +150,20 @@ class CalibrationResult:
         return self.calibration().plot(ax=ax)
 
     def document(self) -> dict:
-        """The ``--json`` document: parameters, predictions, loo, loo_rms, and the units of
-        each of their numbers (``units``: the parameters' and the predictions' fields)."""
+        """The ``--json`` document: parameters, predictions, loo, loo_rms, the units of each of
+        their numbers (``units``: the parameters' and the predictions' fields), and
+        ``specimen``: which specimen file was calibrated and which it wrote (``name``,
+        ``sha256``, ``calibrated_name``, ``calibrated_sha256``)."""
         keep = ("median", "low95", "high95")
         predictions = [_public(r) for r in self.predictions]
         named = {*self.parameters, "loo_rms", *(k for r in predictions for k in r)}
+        calibrated = self.calibrated_specimen()
         return {
+            # a calibration.json (or --json) named no specimen: apart from the file beside
+            # it, it spoke for the tests of any
+            "specimen": {"name": self.specimen.name, "sha256": self.specimen.hash,
+                         "calibrated_name": calibrated.name,
+                         "calibrated_sha256": calibrated.hash},
             "parameters": {n: {k: p[k] for k in keep} for n, p in self.parameters.items()},
             "predictions": predictions,
             "loo": [_public(r) for r in self.loo] if self.loo is not None else None,
@@ -295,6 +303,7 @@ def check_point_specimens(points: Sequence[MeasuredPoint], specimen: Specimen) -
     measurement in the report and the app (:meth:`pidcore.calibrate.prediction.Calibration.
     speaks_for`). Any other was fitted silently against this specimen's DEM runs.
     """
+    # by name only: a measured point records its specimen's name, not the file's hash
     own = uncalibrated_name(measured_specimen_name(specimen))
 
     def of_another(name: str) -> bool:

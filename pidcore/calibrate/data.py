@@ -248,6 +248,8 @@ def points_for_specimen(points: Sequence[MeasuredPoint], specimen) -> tuple[list
     # were made on, as base_specimen reads a point's name: "x", "x_calibrated" and an older
     # "x_calibrated_calibrated" are all x. A file named paper_coupon with another cell is
     # "paper_coupon [45d792]", as its tests are saved: the paper coupon's tests are not its
+    # by name only: a measured point records its specimen's name, not the file's hash (two
+    # files named x are one specimen here; a paper_coupon of other content is named by both)
     tested = uncalibrated_name(measured_specimen_name(specimen))
     kept, other_material, other_specimen = [], {}, {}
     for p in points:
@@ -279,6 +281,7 @@ def points_for_paper(points: Sequence[MeasuredPoint], *, hint: str = "") -> tupl
 
     kept, others = [], {}
     for p in points:
+        # by name only: a measurement records its specimen's name, not the file's hash
         name = str(p.specimen)
         if not is_paper_coupon(name):
             others[name] = others.get(name, 0) + 1

@@ -79,6 +79,16 @@ def _sampler_words(result: CalibrationResult) -> str:
             f"{'converged' if sampler['converged'] else 'NOT converged'})")
 
 
+def specimen_words(result: CalibrationResult, *, digits: int = 64) -> str:
+    """Which specimen file was calibrated and which it wrote, by name and sha256 (``digits``
+    of it): ``"Specimen: my_steel (sha256 9a19..., from my_steel.toml); calibrated file:
+    my_steel_calibrated (sha256 b083...)."``. The summary and the command's output named
+    neither: two files of one name calibrated alike read alike."""
+    start, written = result.specimen, result.calibrated_specimen()
+    return (f"Specimen: {start.name} (sha256 {start.hash[:digits]}, from {start.source}); "
+            f"calibrated file: {written.name} (sha256 {written.hash[:digits]}).")
+
+
 def summary_markdown(result: CalibrationResult) -> str:
     """Markdown summary: parameters, correlations, predictions, LOO table."""
     lines = ["# Calibration summary", ""]
@@ -89,6 +99,7 @@ def summary_markdown(result: CalibrationResult) -> str:
                  f"posterior by {result.settings['method_used']}{_sampler_words(result)}; "
                  f"runs computed {result.runs['computed']}, cached {result.runs['cached']}; "
                  f"{result.wall_s:.1f} s.")
+    lines += ["", specimen_words(result)]
     lines += ["", "| parameter | median | 95 % interval | prior bounds |", "|---|---|---|---|"]
     for name, p in result.parameters.items():
         median, low, high = summary_texts(p)
@@ -129,6 +140,7 @@ def summary_html(result: CalibrationResult) -> str:
     parts = ["<!doctype html><html><head><meta charset='utf-8'><title>Calibration</title>",
              "<style>body{font-family:sans-serif}td,th{border:1px solid #ccc;padding:2px 6px}"
              "table{border-collapse:collapse}</style></head><body><h1>Calibration summary</h1>"]
+    parts.append(f"<p>{html.escape(specimen_words(result))}</p>")
     parts.append("<table><tr><th>parameter</th><th>median</th><th>95 % interval</th></tr>")
     for name, p in result.parameters.items():
         median, low, high = summary_texts(p)

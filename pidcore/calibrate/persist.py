@@ -2,9 +2,14 @@
 reports and the app (which then survive a restart and travel with the store's DEM runs).
 
 * :func:`calibration_key`: what a calibration is called in the store (the same calibration made
-  again gets the same key and is not stored twice);
+  again gets the same key and is not stored twice): its ``calibration.json`` and the
+  calibrated specimen it writes, so that a fit whose calibrated file today's pidcore writes
+  otherwise (``[provenance]`` added) is saved again rather than "stored already" with the
+  earlier text;
 * :func:`save_calibration`: a :class:`~pidcore.calibrate.calibrate.CalibrationResult` into a
   store: its whole ``calibration.json`` and calibrated specimen file, and a listing record;
+  :class:`SavedCalibration` says what became of it, and which earlier entries of the same fit
+  hold another calibrated specimen file (kept as they were: the store never loses data);
 * :func:`stored_calibrations`: every calibration of a store, newest first, as
   :class:`~pidcore.calibrate.prediction.Calibration`;
 * :func:`readable_calibrations`: those that can be read, and what is wrong with the others;
@@ -18,7 +23,7 @@ import hashlib
 import json
 import os
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, NamedTuple
 
 from ..errors import ParameterError
 from .outputs import document_json, specimen_text
@@ -35,21 +40,69 @@ _BOOKKEEPING = ("wall_s", "runs")
 _KEY_PREFIX = "cal_"
 
 
-def calibration_key(document: dict) -> str:
+def calibration_key(document: dict, calibrated_specimen_text: str | None = None) -> str:
     """``"cal_"`` and 16 hex digits of SHA-256 of ``document`` (a calibration.json) without
-    its bookkeeping (wall time, cached-run counts, the caching store's path)."""
-    what = {k: v for k, v in document.items() if k not in _BOOKKEEPING}
+    its bookkeeping (wall time, cached-run counts, the caching store's path), and of
+    ``calibrated_specimen_text``, the canonical text of the calibrated specimen
+    (:attr:`pidcore.specimen.Specimen.text`: its values, name, description and
+    ``[provenance]``).
+
+    The document alone does not say what the calibrated file holds (its ``[provenance]``,
+    and, before the document named them, the starting specimen's name and hash), so two
+    files of the same numbers, or a fit saved before today's pidcore added a table to the
+    file, had one key and the second got the first's file. Without
+    ``calibrated_specimen_text`` the key is that of the document alone, as calibrations were
+    keyed before (:func:`save_calibration` finds those by it). The file's comment header
+    (the starting file's path, the intervals in words) is not in the key: the same fit from
+    another folder is the same calibration."""
+    # its "specimen" names (start and calibrated file, by name and hash) are in the
+    # calibrated specimen's text below: left out here, the JSON's key is the one a pidcore
+    # that did not write them gave the same fit, so save_calibration still finds that entry
+    what = {k: v for k, v in document.items() if k not in (*_BOOKKEEPING, "specimen")}
     settings = dict(what.get("settings") or {})
     settings.pop("store", None)
     what["settings"] = settings
     text = json.dumps(json.loads(document_json(what)), sort_keys=True, separators=(",", ":"))
+    if calibrated_specimen_text is not None:
+        # a separator no JSON text holds: the document's end cannot pass for the specimen's
+        text += "\x00" + calibrated_specimen_text
     return _KEY_PREFIX + hashlib.sha256(text.encode("utf-8")).hexdigest()[:16]
+
+
+class SavedCalibration(NamedTuple):
+    """What :func:`save_calibration` did.
+
+    Attributes
+    ----------
+    key : str
+        The store key of the calibration (the new entry, or the one stored before).
+    added : bool
+        False where the same calibration, with the same calibrated specimen, was stored
+        before (kept as it was).
+    superseded : tuple of str
+        Earlier entries of the same fit (the same calibration.json) whose calibrated specimen
+        file differs from the one saved now, each ``"cal_... (why)"``: written by an earlier
+        pidcore (no ``[provenance]``). They are kept as they were; this one is saved beside
+        them, and readers taking the newest (the app) take it.
+    """
+
+    key: str
+    added: bool
+    superseded: tuple[str, ...] = ()
 
 
 def _record(result) -> tuple[dict, dict]:
     """The listing record of a calibration and its units."""
     units = result.units()
+    calibrated = result.calibrated_specimen()
     record: dict = {"specimen": result.specimen.name, "specimen_hash": result.specimen.hash,
+                    # the file it wrote, by name and hash: the starting file's name and hash
+                    # alone did not say which calibrated file the entry holds
+                    "calibrated_specimen": calibrated.name,
+                    "calibrated_specimen_hash": calibrated.hash,
+                    # the key of its calibration.json alone: the same fit saved with another
+                    # calibrated file (by an earlier or later pidcore) is found by it
+                    "document_key": calibration_key(result.full_document()),
                     "fit": ",".join(result.settings["fit"]),
                     "method_used": str(result.settings.get("method_used", "")),
                     "n_points": len(result.predictions), "rms_in_sample": result.rms,
@@ -64,18 +117,72 @@ def _record(result) -> tuple[dict, dict]:
 
 
 def save_calibration(result: CalibrationResult, store_path: str | os.PathLike
-                     ) -> tuple[str, bool]:
+                     ) -> SavedCalibration:
     """Save ``result`` (:class:`~pidcore.calibrate.calibrate.CalibrationResult`) into the store
-    at ``store_path`` in one transaction; returns ``(key, added)`` (``added`` False: the same
-    calibration was stored before and is kept as it was)."""
+    at ``store_path`` in one transaction; returns a :class:`SavedCalibration` (``added``
+    False: the same calibration, with the same calibrated specimen, was stored before and is
+    kept as it was).
+
+    An entry of the same fit whose calibrated specimen differs (saved by a pidcore that wrote
+    the file otherwise, e.g. before ``[provenance]`` existed) is not "the same": this one is
+    saved beside it under its own key, and :attr:`SavedCalibration.superseded` names it. It
+    is kept, not replaced: the store never loses what it held, and a report made from it can
+    still be read back."""
     from ..store import Store
 
     document = result.full_document()
     record, units = _record(result)
-    return Store(store_path).add_calibration(
-        calibration_key(document), record, document=document_json(document),
+    calibrated_text = result.calibrated_specimen().text
+    key = calibration_key(document, calibrated_text)
+    store = Store(store_path)
+    same_fit = _same_fit(store, record["document_key"]) if Path(store_path).is_file() else []
+    superseded = []
+    for earlier, earlier_text in same_fit:
+        if earlier != key and earlier_text == calibrated_text:
+            return SavedCalibration(earlier, False)  # stored before under another key
+        if earlier != key:
+            superseded.append(f"{earlier} ({_difference(earlier_text, calibrated_text)})")
+    key, added = store.add_calibration(
+        key, record, document=document_json(document),
         specimen_toml=specimen_text(result), units=units,
         parameters={"settings": result.settings})
+    return SavedCalibration(key, added, tuple(superseded) if added else ())
+
+
+def _same_fit(store, document_key: str) -> list[tuple[str, str | None]]:
+    """The calibrations of ``store`` of the fit ``document_key`` (:func:`calibration_key` of
+    the calibration.json alone: the key of one saved before the calibrated specimen entered
+    it, or its ``document_key``), each with the canonical text of its calibrated specimen
+    (None where that file cannot be read)."""
+    from ..errors import PidcoreError
+    from ..specimen import Specimen
+    from ..store import calibration_texts
+
+    listing = store.list_calibrations()
+    if listing.empty:
+        return []
+    named = listing["document_key"] if "document_key" in listing.columns \
+        else [None] * len(listing)
+    out = []
+    for key, of_document in zip(listing["key"], named, strict=True):
+        if key != document_key and of_document != document_key:
+            continue
+        try:
+            _, text = calibration_texts(store.get_calibration(key))
+            out.append((key, Specimen.from_text(text, source=f"{store.path}:{key}").text))
+        except PidcoreError:
+            out.append((key, None))
+    return out
+
+
+def _difference(earlier: str | None, now: str) -> str:
+    """Why an earlier calibrated specimen of the same fit is not the one saved now, in words."""
+    if earlier is None:
+        return "its calibrated specimen file cannot be read"
+    if "[provenance]" in now and "[provenance]" not in earlier:
+        return ("its calibrated specimen file, written by an earlier pidcore, lacks the "
+                "[provenance] of the file it was calibrated from")
+    return "its calibrated specimen file differs from the one written now"
 
 
 def is_store_file(path: str | os.PathLike) -> bool:
@@ -180,5 +287,14 @@ def _keys_text(listing) -> str:
     if listing.empty:
         return "none"
     rows = listing.iloc[::-1]
+
+    def written(r) -> str:
+        # the same fit saved with another calibrated file (one stored before [provenance])
+        # read alike but for the time: the file each holds tells them apart
+        name, sha = r.get("calibrated_specimen"), r.get("calibrated_specimen_hash")
+        if not isinstance(name, str) or not isinstance(sha, str) or not sha:
+            return ""
+        return f"; calibrated file {name} [{sha[:6]}]"
+
     return "; ".join(f"{r['key']} ({r.get('specimen', '')}, fitted '{r.get('fit', '')}'; "
-                     f"{str(r['created_utc'])[:16]})" for _, r in rows.iterrows())
+                     f"{str(r['created_utc'])[:16]}{written(r)})" for _, r in rows.iterrows())

@@ -257,6 +257,9 @@ class Calibration:
         (:func:`pidcore.specimen.measured_specimen_name`), not as the coupon's."""
         from ..specimen import is_paper_coupon, measured_specimen_name, uncalibrated_name
 
+        # by name only: a measurement records its specimen's name, not its file's hash, so
+        # two files of one name are one specimen here; where the specimen file is known
+        # (a report of it) :meth:`other_specimen_reason` compares the hashes
         calibrated = self.specimen_name
         if specimen_name and (not calibrated or is_paper_coupon(calibrated)):
             # another file named paper_coupon (another cell) calibrates to
@@ -323,6 +326,25 @@ def _other_specimen(calibrated, specimen) -> str:
     # contact, coupon or mass values: the cell and the particles say which specimen it is
     from ..specimen import measured_specimen_name, provenance_test_name, uncalibrated_name
 
+    source = calibrated.provenance
+    tested = tested_sha256(specimen)
+    if source is not None and tested is not None:
+        # both files say which file was tested: the hashes decide, whatever the names (an
+        # edited x.toml keeps its name, and a calibration of the earlier x was shown beside
+        # the new one's rows; a user's paper_coupon.toml calibrates to the paper coupon's
+        # name)
+        if specimen.hash == calibrated.hash or tested == source.calibrated_from_sha256:
+            return ""
+        own = uncalibrated_name(measured_specimen_name(specimen))
+        theirs = provenance_test_name(calibrated) or source.calibrated_from_name
+        if theirs == own:  # one name, two files: their hashes tell them apart
+            from ..specimen import hashed_name
+
+            return (f"it calibrates specimen {hashed_name(theirs, source.calibrated_from_sha256)}"
+                    f", not {hashed_name(own, tested)} (another file of the same name)")
+        return f"it calibrates specimen {theirs}, not {own}"
+    # by name: a calibrated file written before [provenance] existed (on either side) says
+    # only its name, so a file of that name with the same cell and particles is taken for it
     routed = provenance_test_name(calibrated)
     if routed:
         # made from a user's paper_coupon.toml (its [provenance]): its name is the paper
@@ -341,6 +363,37 @@ def _other_specimen(calibrated, specimen) -> str:
         what = "cell" if not same_cell else "particles"
         return f"it calibrates another specimen named {base} (its {what} differ)"
     return ""
+
+
+def _stated_specimen_name(doc: dict) -> str:
+    """The name of the specimen a calibration.json states it calibrated (its ``specimen``
+    ``name``); "" where it states none (written before it did) or not as text."""
+    from ..specimen import hashed_name, is_paper_coupon, uncalibrated_name
+
+    stated = doc.get("specimen")
+    if not isinstance(stated, dict) or not isinstance(stated.get("name"), str):
+        return ""
+    name, sha = stated["name"], stated.get("sha256")
+    if isinstance(sha, str) and sha and uncalibrated_name(name) == name \
+            and is_paper_coupon(name) and not is_paper_coupon(name, sha):
+        # a user's own paper_coupon.toml: its tests are saved as "paper_coupon [45d792]"
+        # (pidcore.specimen.measured_specimen_name), never as the paper coupon's
+        return hashed_name(name, sha)
+    return name
+
+
+def tested_sha256(specimen) -> str | None:
+    """The sha256 of the specimen file whose tests ``specimen`` models: the file it was
+    calibrated from (its ``[provenance]``), else its own (a file that is not a calibrated
+    one); None for a calibrated file without ``[provenance]`` (written before the table
+    existed: which file it came from is unknown, only its name is)."""
+    from ..specimen import uncalibrated_name
+
+    if specimen.provenance is not None:
+        return specimen.provenance.calibrated_from_sha256
+    if uncalibrated_name(specimen.name) == specimen.name:
+        return specimen.hash
+    return None
 
 
 def _number(value, what: str, path: Path) -> float:
@@ -389,14 +442,16 @@ def load_calibration(path: str | os.PathLike, *, key: str | None = None) -> Cali
     specimen = path.parent / "calibrated_specimen.toml"
     return Calibration(path=path, parameters=calibration.parameters,
                        predictions=calibration.predictions,
-                       specimen_path=specimen if specimen.is_file() else None)
+                       specimen_path=specimen if specimen.is_file() else None,
+                       specimen_name=calibration.specimen_name)
 
 
 def calibration_from_json(text: str | bytes, source: str | os.PathLike, *,
                           specimen_name: str = "") -> Calibration:
     """A calibration from the text of a ``calibration.json`` (``source`` names it in errors
     and in :attr:`Calibration.path`); checked as :func:`load_calibration` does.
-    ``specimen_name``: the specimen it calibrates, where the caller knows it."""
+    ``specimen_name``: the specimen it calibrates, where the caller knows it; else the
+    ``specimen`` ``name`` the file states (written since it has one)."""
     path = Path(source)
     try:
         doc = json.loads(text)
@@ -447,4 +502,4 @@ def calibration_from_json(text: str | bytes, source: str | os.PathLike, *,
         predictions.append(CalibratedPrediction(case, sdc, low, high, measured,
                                                 measured_stderr, low0, high0, dof))
     return Calibration(path=path, parameters=doc["parameters"], predictions=tuple(predictions),
-                       specimen_name=specimen_name)
+                       specimen_name=specimen_name or _stated_specimen_name(doc))

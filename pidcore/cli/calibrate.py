@@ -170,8 +170,10 @@ def _print_result(args: argparse.Namespace, result, own_notes: list[str], saved:
         print(document_json(result.document()))
         print(f"pidcore calibrate: {said}", file=sys.stderr)
     else:
+        from ..calibrate.outputs import specimen_words
         from ..calibrate.posterior import summary_texts
 
+        print(specimen_words(result, digits=12))
         for name, p in result.parameters.items():
             median, low, high = summary_texts(p)
             print(f"{name}: {median} (95 % {low} .. {high})")
@@ -185,15 +187,22 @@ def _print_result(args: argparse.Namespace, result, own_notes: list[str], saved:
             print(f"wrote {args.out}")
 
 
-def _saved_words(saved: tuple[str, bool] | None, store: Path) -> str:
+def _saved_words(saved, store: Path) -> str:
     """What became of the calibration in the store (:func:`pidcore.calibrate.persist.
-    save_calibration`'s ``(key, added)``; None: not saved)."""
+    save_calibration`'s :class:`~pidcore.calibrate.persist.SavedCalibration`; None: not
+    saved)."""
     if saved is None:
         return f"; the calibration was not saved in {store}"
-    key, added = saved
+    key, added = saved[0], saved[1]
+    superseded = tuple(saved[2]) if len(saved) > 2 else ()
     if added:  # the key in the command: it still reads this one once the store holds more
-        return (f"; saved calibration {key} in {store} (report --calibration {store} "
-                f"--calibration-key {key})")
+        words = (f"; saved calibration {key} in {store} (report --calibration {store} "
+                 f"--calibration-key {key})")
+        if superseded:
+            # "stored already" gave the earlier file: say that one is there, and why not it
+            words += (f"; the same fit was stored before as {'; '.join(superseded)}: kept as "
+                      "it was, this one saved beside it")
+        return words
     return f"; calibration {key} is stored in {store} already (the same result)"
 
 

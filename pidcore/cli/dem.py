@@ -255,6 +255,16 @@ def sweep(args: argparse.Namespace) -> int:
     return 0
 
 
+def _sweep_specimens(cases: list[dict]) -> str:
+    """``"; specimen my_steel (sha256 9a19aa85ea13)"``: whose runs the sweep's cases are, as
+    stored (each its name and hash); "" where no case is stored."""
+    named = dict.fromkeys((c.get("specimen_name"), c.get("specimen_sha256")) for c in cases
+                          if c.get("specimen_sha256"))
+    if not named:
+        return ""
+    return "; specimen " + ", ".join(f"{name} (sha256 {sha[:12]})" for name, sha in named)
+
+
 def _print_sweep(args: argparse.Namespace, summary) -> None:
     """What a finished sweep did: its JSON document, or the counts and the cases it found
     to be the same simulation as another."""
@@ -269,7 +279,7 @@ def _print_sweep(args: argparse.Namespace, summary) -> None:
               f"already in {args.store}"
               + (f" ({meanwhile} of them saved meanwhile by another process, whose runs "
                  "are kept)" if meanwhile else "")
-              + f"; wall time {summary.wall_s:.1f} s")
+              + f"; wall time {summary.wall_s:.1f} s" + _sweep_specimens(summary.cases))
         for case in summary.cases:
             if case["status"].startswith("same simulation"):
                 print(f"fill {case['fill_percent']:g} % ({case['frequency_hz']:g} Hz, "

@@ -423,6 +423,7 @@ def compare_case(records: Sequence[MeasuredEntry],
     # Table 3 describes the paper's coupon: beside a test of another specimen its points, its
     # pchip curve and its values were read as that coupon's (the report's rule too)
     specimen = records[0].specimen
+    # by name only: a measurement records its specimen's name, not the file's hash
     if not is_paper_coupon(specimen):
         if case.material == PAPER_MATERIAL and case.direction == PAPER_DIRECTION:
             notes.append(NOT_PAPER_SPECIMEN_NOTE.format(name=specimen.strip()))

@@ -182,6 +182,8 @@ def runs_for_measurement(runs: pd.DataFrame | None, specimen: str, material: str
         # paper_coupon_calibrated as the paper coupon's calibrated file's are: its
         # [provenance] names its tests, "paper_coupon [45d792]", and no other
         routed = _provenance_test_names(same)
+        # by name only on the test's side: a measurement records its specimen's name, not
+        # the file's hash (runs of two files of that name are refused below, not pooled)
         by_name = (names == specimen) & (routed == "")
         # a test of a file named like the paper's coupon with other content names it by its
         # label, "paper_coupon [45d792]" (pidcore.specimen.measured_specimen_name), as its runs

@@ -328,7 +328,10 @@ SWEEP_CASE_STATUSES = ("simulated", "already stored",
 #: Result fields of each case in :meth:`SweepSummary.to_dict`, named (units as suffixes) as
 #: ``pidcore dem run --json`` names them, read from the stored run.
 SWEEP_CASE_FIELDS = ("sdc", "sdc_stderr", "loss_factor", "particles_per_cell",
-                     "cells_simulated", "seed", "steady_detected")
+                     "cells_simulated", "seed", "steady_detected",
+                     # whose run it is, as stored: --json named no specimen, so a sweep's
+                     # document could not tell the runs of two files of one name apart
+                     "specimen_name", "specimen_sha256")
 
 
 @dataclass

@@ -95,7 +95,7 @@ def report_files(path: str | os.PathLike, dem_store: str | os.PathLike | None = 
     from ..compare import Tolerances
     from .comparison_figures import plot_sdc_comparison
     from .pipeline import open_verified_store, specimen_provenance, stored_parameters
-    from .provenance import collect_provenance
+    from .provenance import calibration_provenance, collect_provenance
     from .render import write_report
 
     stores = [Path(p) for p in (path, dem_store) if p is not None and Path(p).is_file()]
@@ -117,7 +117,8 @@ def report_files(path: str | os.PathLike, dem_store: str | os.PathLike | None = 
                     "acceleration_rtol": tol.acceleration_rtol,
                     "fill_atol_percent": tol.fill_atol_percent, "pool": pool},
         seeds=seeds, stores=stores, notes=table.attrs.get("notes", []),
-        specimens=specimen_provenance(specimen))
+        specimens=specimen_provenance(specimen),
+        calibrations=calibration_provenance(calibration))
     figures = {"sdc_per_load_case": plot_sdc_comparison(table)}
     try:
         with tempfile.TemporaryDirectory(prefix="pidcore_report_") as folder:

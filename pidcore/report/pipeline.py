@@ -32,7 +32,7 @@ from ..constants import REPORT_FORMATS
 from ..errors import ParameterError, StoreError
 from ..io import display_path
 from ..loadcase import refuse_identical_contents_stating_apart
-from .provenance import collect_provenance
+from .provenance import calibration_provenance, collect_provenance
 from .render import check_out_dir, parse_formats, write_report
 from .table import add_calibration_columns, report_table_and_aligner
 
@@ -411,6 +411,7 @@ def unsubtracted_baseline_note(specimen, analyses: pd.DataFrame | None) -> str:
     named = analyses.get("specimen", pd.Series([""] * len(analyses), index=analyses.index))
     from ..specimen import measured_specimen_name
 
+    # by name only: a measurement records its specimen's name, not the file's hash
     mine = analyses[(analyses["material"] == material)
                     & named.fillna("").isin(["", measured_specimen_name(specimen)])]
     subtracted = [float((stored_parameters(p) or {}).get("baseline_loss_factor") or 0.0)
@@ -806,7 +807,8 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
                         "fill_atol_percent": tolerances.fill_atol_percent, "pool": pool},
             seeds=seeds, inputs=[r.path for r in results],
             input_hashes={str(r.path): getattr(r.measurement, "sha256", "") for r in results},
-            stores=stores, notes=notes, specimens=specimen_provenance(specimen))
+            stores=stores, notes=notes, specimens=specimen_provenance(specimen),
+            calibrations=calibration_provenance(calibrated))
         paths = write_report(table, figures, provenance, out_dir, formats, progress=progress)
     finally:
         for fig in figures.values():  # bare Figures: drop references to free Agg buffers

@@ -86,6 +86,11 @@ class Provenance:
         from) and its SHA-256 (:attr:`pidcore.specimen.Specimen.hash`).
     notes : tuple of str
         Records left out and why, and other remarks.
+    calibrations : tuple of (str, str, str)
+        The calibration whose columns the report holds: where it was read from (a
+        calibration.json, or a store and its key), the SHA-256 of its ``calibration.json``
+        text, and its calibrated specimen's name and hash with the file it was calibrated
+        from (:func:`calibration_provenance`).
     """
 
     versions: Mapping[str, str]
@@ -96,6 +101,7 @@ class Provenance:
     created_utc: str = ""
     notes: tuple[str, ...] = ()
     specimens: tuple[tuple[str, str], ...] = ()
+    calibrations: tuple[tuple[str, str, str], ...] = ()
 
     def lines(self) -> list[str]:
         """The provenance as plain text lines (the footer of every format)."""
@@ -107,6 +113,8 @@ class Provenance:
         out.append("seeds: " + (", ".join(str(s) for s in self.seeds) or "none"))
         for name, digest in self.specimens:
             out.append(f"specimen: {name} sha256 {digest}")
+        for name, digest, specimen in self.calibrations:
+            out.append(f"calibration: {name} sha256 {digest}; {specimen}")
         for name, digest in self.stores:
             out.append(f"store: {name} sha256 {digest}")
         for name, digest in self.inputs:
@@ -119,7 +127,8 @@ class Provenance:
         return {"versions": dict(self.versions), "parameters": dict(self.parameters),
                 "seeds": list(self.seeds), "inputs": [list(i) for i in self.inputs],
                 "stores": [list(s) for s in self.stores], "created_utc": self.created_utc,
-                "notes": list(self.notes), "specimens": [list(s) for s in self.specimens]}
+                "notes": list(self.notes), "specimens": [list(s) for s in self.specimens],
+                "calibrations": [list(c) for c in self.calibrations]}
 
 
 def collect_provenance(*, parameters: Mapping[str, object] | None = None,
@@ -127,7 +136,8 @@ def collect_provenance(*, parameters: Mapping[str, object] | None = None,
                        input_hashes: Mapping[str, str] | None = None,
                        stores: Iterable[str | Path] = (), notes: Iterable[str] = (),
                        created_utc: datetime | None = None,
-                       specimens: Iterable[tuple[str, str]] = ()) -> Provenance:
+                       specimens: Iterable[tuple[str, str]] = (),
+                       calibrations: Iterable[tuple[str, str, str]] = ()) -> Provenance:
     """Collect versions, hashes and a time stamp into a :class:`Provenance`.
 
     Parameters
@@ -147,6 +157,8 @@ def collect_provenance(*, parameters: Mapping[str, object] | None = None,
         Time stamp (default: now).
     specimens : iterable of (str, str)
         (label, SHA-256) of each specimen compared.
+    calibrations : iterable of (str, str, str)
+        The calibration of the calibrated columns (:func:`calibration_provenance`).
     """
     from .. import __version__
 
@@ -166,4 +178,34 @@ def collect_provenance(*, parameters: Mapping[str, object] | None = None,
                       seeds=tuple(sorted({int(s) for s in seeds})), inputs=tuple(hashed_inputs),
                       stores=hashed_stores, created_utc=stamp.isoformat(timespec="seconds"),
                       notes=tuple(map(display_path, notes)),
-                      specimens=tuple((display_path(n), h) for n, h in specimens))
+                      specimens=tuple((display_path(n), h) for n, h in specimens),
+                      calibrations=tuple((display_path(n), h, display_path(c))
+                                         for n, h, c in calibrations))
+
+
+def calibration_provenance(calibration) -> list[tuple[str, str, str]]:
+    """(where, SHA-256, specimen) of the calibration a report's calibrated columns come from
+    (:class:`pidcore.calibrate.prediction.Calibration`; None: none): where it was read from
+    (the calibration.json, or the store and key), the SHA-256 of its calibration.json text,
+    and its calibrated specimen's name and hash with the file it was calibrated from
+    (``[provenance]``), in words. A report named no calibration: two calibrations of one name, or
+    of two files of one name, gave the same footer."""
+    if calibration is None:
+        return []
+    if calibration.document_text:
+        digest = hashlib.sha256(calibration.document_text.encode("utf-8")).hexdigest()
+    else:
+        digest = sha256_file(calibration.path)
+    where = f"{calibration.path}" if not calibration.store_key else \
+        f"{str(calibration.path).removesuffix(':' + calibration.store_key)} key " \
+        f"{calibration.store_key}"
+    specimen = calibration.calibrated_specimen()
+    if specimen is None:
+        said = "calibrated specimen unknown (no calibrated_specimen.toml beside it)"
+    else:
+        said = f"calibrated specimen {specimen.name} sha256 {specimen.hash}"
+        source = specimen.provenance
+        if source is not None:
+            said += (f", calibrated from {source.calibrated_from_name} sha256 "
+                     f"{source.calibrated_from_sha256}")
+    return [(where, digest, said)]

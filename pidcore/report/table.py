@@ -135,14 +135,16 @@ def _measured_rows(analyses: pd.DataFrame | None, notes: list[str]) -> list[tupl
 
 
 def no_runs_note(of: str, material: str, direction: str, store_runs: pd.DataFrame | None,
-                 choose_another: str = "", *, named: bool = False) -> str:
+                 choose_another: str = "", *, named: bool = False, report_of: str = "") -> str:
     """Why a measured row has no DEM value: no run of its specimen ``of`` at its material and
     direction, and the runs of other specimens the store holds there (which are another
     specimen's, so not compared), e.g. "no DEM runs of steel_6mm for acrylic, direction z
     (the store has 48 of paper_coupon, another specimen's: report without --specimen to
     compare them)". ``choose_another``: how the reader compares them (default: the CLI's
     words); ``named``: the measurement names ``of`` itself (its record's specimen), so no
-    choice of the report's specimen compares it with the others' runs."""
+    choice of the report's specimen compares it with the others' runs; ``report_of``: the
+    name of the specimen the report is of (its runs are chosen by hash: runs of ``of`` left
+    out of a report of a file named ``of`` are another file's of that name)."""
     from ..compare.specimens import run_specimen_labels
     from ..specimen import PAPER_SPECIMEN_NAME
 
@@ -169,6 +171,12 @@ def no_runs_note(of: str, material: str, direction: str, store_runs: pd.DataFram
                           if set(counts.index) == {PAPER_SPECIMEN_NAME}
                           else "report with their specimen=FILE to compare them")
     listed = ", ".join(f"{n} of {label}" for label, n in counts.items())
+    if own and of != PAPER_SPECIMEN_NAME and report_of == of:
+        # by name the runs are the test's specimen's, but the report's runs are chosen by the
+        # file's hash: they are of another file of that name (an edited x.toml). "x's are
+        # left out of a report of another specimen" was said of a report of x
+        return (f"{note} among this report's runs (the store has {listed}: another file named "
+                f"{of} than the one reported, whose hash differs; {choose_another})")
     if own:
         return (f"{note} among this report's runs (the store has {listed}; {of}'s are left "
                 f"out of a report of another specimen: {choose_another})")
@@ -293,7 +301,7 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
             aligned = replace(aligned, message=no_runs_note(
                 specimen or of_specimen, case.material, case.direction,
                 dem_runs if store_runs is None else store_runs, choose_another,
-                named=bool(specimen)))
+                named=bool(specimen), report_of=of_specimen))
             met_note = ""
         found, _ = stored_findings(rec)
         entry = _Measured(float(rec["sdc"]), float(rec["sdc_stderr"]), case.frequency_hz,
@@ -318,6 +326,7 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
             # values (and the paper's measurement) as if they were that coupon's
             paper_values = (aligned.sdc_paper_dem, aligned.sdc_paper_experimental)
             not_paper = []
+            # by name only: a measurement records its specimen's name, not the file's hash
             if not is_paper_coupon(specimen) and np.isfinite(paper_values).any():
                 paper_values = (math.nan, math.nan)
                 not_paper = [NOT_PAPER_SPECIMEN_NOTE.format(name=specimen)]

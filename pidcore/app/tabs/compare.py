@@ -179,6 +179,7 @@ def render(stores, session_files: list, calibrations: list) -> None:
         c2.metric("SDC paper DEM [-]", display_number(aligned.sdc_paper_dem, missing="none"))
         c3.metric("SDC paper measured [-]",
                   display_number(aligned.sdc_paper_experimental, missing="none"))
+        # by name only: a measurement records its specimen's name, not the file's hash
         if not is_paper_coupon(members[0].specimen):
             # Table 3 may well have this case: its values are of another coupon
             st.caption("paper: none: " + NOT_PAPER_SPECIMEN_NOTE.format(

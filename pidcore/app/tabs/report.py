@@ -73,7 +73,7 @@ def render(stores, calibrations: list) -> None:
     if len(usable) > 1:  # e.g. this store's steel calibration and the paper's bundled one
         labels = [text for _, text in usable]
         default = default_calibration_index(
-            usable, PAPER_SPECIMEN_NAME if specimen is None else specimen.name)
+            usable, PAPER_SPECIMEN_NAME if specimen is None else specimen.name, specimen)
         # a choice per specimen reported: another specimen starts at its own default
         chosen_label = st.selectbox("calibration for the calibrated DEM columns", labels,
                                     index=default,
