@@ -258,3 +258,33 @@ def test_physics_audit_reference_agrees_with_specimen_check(name):
     assert len(compared) >= 12  # masses, stiffnesses, overlaps, speeds, times, gaps
     off = {k: (p, r) for k, (p, r) in compared.items() if p != pytest.approx(r, rel=1e-12)}
     assert off == {}
+
+
+def test_readme_quotes_the_main_jobs_measured_sdcs_and_calibrated_bands():
+    # README's first paragraph: the bundled exports' SDCs and the calibrated DEM's band at their
+    # load cases, as the main job's report gives them (each band that of a measurement with
+    # the row's own stderr and degrees of freedom). It said upper bounds 0.43-0.89; the
+    # report's are 0.43-0.90. Compared at the README's own digits.
+    from pidcore.calibrate import load_calibration
+    from pidcore.dem import LoadCase
+    from pidcore.measure import AnalysisOptions, analyze_file
+
+    text = " ".join(README.read_text(encoding="utf-8").split())
+    quoted = re.search(r"their SDCs \(([\d.]+)–([\d.]+)\).*?predictions ([\d.]+)–([\d.]+), "
+                       r"upper bounds ([\d.]+)–([\d.]+) at", text)
+    assert quoted is not None
+    calibration = load_calibration(ROOT / "data_samples" / "paper_calibration")
+    sdcs, predicted, upper = [], [], []
+    for export in sorted((ROOT / "data_samples" / "exports").iterdir()):
+        # data_samples/loadcases.csv: 50 % fill and a 50 µs vibrometer delay for every file
+        analysis = analyze_file(export, AnalysisOptions(velocity_delay_s=50e-6)).analysis
+        prediction = calibration.lookup(LoadCase(analysis.frequency_hz,
+                                                 analysis.acceleration_g, 50.0))
+        sdcs.append(analysis.sdc)
+        predicted.append(prediction.sdc)
+        upper.append(prediction.band(analysis.sdc_stderr, analysis.sdc_stderr_dof)[1])
+
+    def shown(values, digits):
+        return [f"{min(values):.{digits}f}", f"{max(values):.{digits}f}"]
+
+    assert list(quoted.groups()) == [*shown(sdcs, 1), *shown(predicted, 2), *shown(upper, 2)]
