@@ -315,3 +315,21 @@ def test_calibration_page_shows_the_bundled_calibrations_own_tables():
     rows = [line for line in section.splitlines() if line.startswith("|")]
     assert len(rows) > 40  # four tables of 12 load cases and the posterior's two
     assert [row for row in rows if row not in summary] == []
+
+
+def test_physics_audit_outputs_stay_out_of_git():
+    # run_all.sh writes its results beside itself; round 14's r14_store.h5 (a 14 MB copy of
+    # the bundled store), r14_rep/ and r14_damp/ showed up in `git status` after a run
+    import fnmatch
+
+    script = (AUDIT / "run_all.sh").read_text(encoding="utf-8")
+    written = set(re.findall(r"(?:>|--out|--store|mkdir -p)\s+([\w$./-]+)", script))
+    written |= set(re.findall(r"^cp \S+ ([\w./-]+)$", script, re.M))
+    written = {w.replace("$s", "paper").split("/")[0] for w in written
+               if not w.startswith(("/", "..", "&"))}
+    patterns = [line.strip().rstrip("/") for line in
+                (AUDIT / ".gitignore").read_text(encoding="utf-8").splitlines()
+                if line.strip() and not line.startswith("#")]
+    assert {"r14_store.h5", "r14_rep", "damper"} <= written  # the parse finds them
+    assert sorted(w for w in written
+                  if not any(fnmatch.fnmatch(w, p) for p in patterns)) == []
