@@ -725,3 +725,13 @@ def test_a_material_other_than_the_specimens_is_refused_naming_both(capsys):
                  "--acceleration", "5", "--material", "acrylic"]) == 2
     err = capsys.readouterr().err
     assert "'acrylic'" in err and "'steel'" in err
+
+
+def test_time_step_help_names_every_limit_of_the_automatic_step(capsys):
+    # the help said min(2e-6 s, contact time / 10); a Mindlin spring's period / 10 sets the
+    # automatic step of the paper's coupon with --tangential-stiffness mindlin (8.9e-7 s,
+    # where the contact time gives 1.6e-6 s), as `specimen check` and the README say
+    with pytest.raises(SystemExit):
+        main(["dem", "run", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert "contact time / 10, a stuck tangential spring's period / 10" in text

@@ -98,8 +98,9 @@ def _add_config_options(p: argparse.ArgumentParser) -> None:
                         "detect the steady state, so more may be measured (noted)")
     p.add_argument("--time-step", metavar="S", type=_time_step,
                    default=defaults.DEM_TIME_STEP_MODE,
-                   help=f"time step, s, or 'auto' (default: min(2e-6 s, contact time / "
-                        f"{defaults.DEM_MIN_STEPS_PER_CONTACT}))")
+                   help=f"time step, s, or 'auto' (default: min({defaults.DEM_TIME_STEP_S:g} "
+                        f"s, contact time / {defaults.DEM_MIN_STEPS_PER_CONTACT}, a stuck "
+                        f"tangential spring's period / {defaults.DEM_MIN_STEPS_PER_CONTACT}))")
     p.add_argument("--damping-mode", choices=NORMAL_DAMPING_MODES,
                    default=defaults.DEM_NORMAL_DAMPING_MODE,
                    help=f"normal damping at contact end (default "
