@@ -333,3 +333,14 @@ def test_physics_audit_outputs_stay_out_of_git():
     assert {"r14_store.h5", "r14_rep", "damper"} <= written  # the parse finds them
     assert sorted(w for w in written
                   if not any(fnmatch.fnmatch(w, p) for p in patterns)) == []
+
+
+def test_report_store_option_says_it_has_no_default(parser):
+    # analyze and dem sweep default to ./pid_store.h5; report does not read or write it
+    # unless named: a user who swept into ./pid_store.h5 got `no_dem_runs` rows from
+    # `report FILES --out DIR`, and neither --help nor the README said why
+    report = _subparsers(parser)["report"]
+    store = next(a for a in report._actions if "--store" in a.option_strings)
+    assert store.default is None and "no default" in store.help
+    readme = " ".join(README.read_text(encoding="utf-8").split())
+    assert "(`--store` has no default here, unlike `analyze` and `dem sweep`" in readme
