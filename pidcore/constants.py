@@ -2,9 +2,45 @@
 
 Closed vocabularies are ``Literal`` aliases so that type checkers and ``get_args`` can validate
 user input in one place.
+
+Public API
+----------
+Quantity, ChannelRole, FileFormat, DriveDirection, ParticleMaterial, NormalDampingMode
+    Closed vocabularies (``Literal`` aliases) of channels, files, load cases and contact laws.
+VibratedMassConvention, StartProtocol, TangentialModel, TangentialStiffnessModel
+    The DEM's model options, as ``pidcore dem run`` takes them.
+StartPacking, CellShape, ReportFormat, FillReference, AlignmentStatus, ImpactPair
+    More closed vocabularies: packings, cells, report formats, fill references, alignments.
+DampingCoefficient, BackgroundState
+    The normal damping constant's choice; the states of an app page's background work.
+QUANTITIES, CHANNEL_ROLES, DRIVE_DIRECTIONS, PARTICLE_MATERIALS, NORMAL_DAMPING_MODES
+    Each vocabulary's values as a tuple (``get_args`` of its alias).
+VIBRATED_MASS_CONVENTIONS, START_PROTOCOLS, TANGENTIAL_MODELS, START_PACKINGS
+    The same, for the DEM's model options.
+TANGENTIAL_STIFFNESS_MODELS, REPORT_FORMATS, FILL_REFERENCES, DAMPING_COEFFICIENTS
+    The same, for the rest.
+CELL_SHAPES, BACKGROUND_STATES, ALIGNMENT_STATUSES, IMPACT_PAIRS
+    The same, for the rest.
+UNTABULATED_PARTICLE_MATERIALS
+    Particle materials a file name may state that the material table lacks (refused unless a
+    specimen file gives them).
+STANDARD_GRAVITY, RATIO_UNIT, COUNT_UNIT, SI_UNITS
+    Standard gravity (m/s^2) and the one spelling of each unit in every output.
 """
 
 from typing import Literal, get_args
+
+__all__ = [
+    "Quantity", "ChannelRole", "FileFormat", "DriveDirection", "ParticleMaterial",
+    "NormalDampingMode", "VibratedMassConvention", "StartProtocol", "TangentialModel",
+    "TangentialStiffnessModel", "StartPacking", "CellShape", "ReportFormat", "FillReference",
+    "AlignmentStatus", "ImpactPair", "DampingCoefficient", "BackgroundState", "QUANTITIES",
+    "CHANNEL_ROLES", "DRIVE_DIRECTIONS", "PARTICLE_MATERIALS", "NORMAL_DAMPING_MODES",
+    "VIBRATED_MASS_CONVENTIONS", "START_PROTOCOLS", "TANGENTIAL_MODELS", "START_PACKINGS",
+    "TANGENTIAL_STIFFNESS_MODELS", "REPORT_FORMATS", "FILL_REFERENCES", "DAMPING_COEFFICIENTS",
+    "CELL_SHAPES", "BACKGROUND_STATES", "ALIGNMENT_STATUSES", "IMPACT_PAIRS",
+    "UNTABULATED_PARTICLE_MATERIALS", "STANDARD_GRAVITY", "RATIO_UNIT", "COUNT_UNIT", "SI_UNITS",
+]
 
 #: Physical quantity a channel carries (after unit normalisation).
 Quantity = Literal["force", "velocity", "acceleration", "displacement", "pressure", "voltage",

@@ -692,3 +692,46 @@ def test_more_cells_than_memory_holds_are_refused_before_any_work(capsys, tmp_pa
         assert err.count("\n") == 1 and f"--cells {most + 1}: the state of" in err
         assert f"expected at most {most} cells" in err
         assert not store.exists()
+
+
+STEEL = Path(__file__).resolve().parents[1] / "data_samples" / "specimens" / "steel_6mm.toml"
+
+
+@pytest.mark.parametrize("command", [["dem", "run"], ["dem", "sweep"]])
+def test_material_option_takes_the_specimens_own_material(command):
+    # `--specimen steel_6mm.toml --material steel` was refused by argparse ("invalid choice:
+    # 'steel' (choose from 'acrylic', 'aluminium')") though steel is the specimen's particles
+    # and `report --material steel --specimen ...` takes it
+    from pidcore.cli import build_parser
+    from pidcore.cli.dem import _specimen
+
+    args = build_parser().parse_args(
+        [*command, "--specimen", str(STEEL), "--material", "Steel", "--frequency"
+         if command[1] == "run" else "--frequencies", "500", "--acceleration"
+         if command[1] == "run" else "--accelerations", "5"])
+    specimen, material = _specimen(args)
+    assert (specimen.name, material) == ("steel_6mm", "steel")
+
+
+def test_a_material_the_papers_coupon_lacks_names_the_specimen_option(capsys):
+    assert main(ARGS + ["--material", "steel"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0
+    assert "--material steel" in err and "acrylic or aluminium" in err and "--specimen" in err
+
+
+def test_a_material_other_than_the_specimens_is_refused_naming_both(capsys):
+    assert main(["dem", "run", "--specimen", str(STEEL), "--frequency", "500",
+                 "--acceleration", "5", "--material", "acrylic"]) == 2
+    err = capsys.readouterr().err
+    assert "'acrylic'" in err and "'steel'" in err
+
+
+def test_time_step_help_names_every_limit_of_the_automatic_step(capsys):
+    # the help said min(2e-6 s, contact time / 10); a Mindlin spring's period / 10 sets the
+    # automatic step of the paper's coupon with --tangential-stiffness mindlin (8.9e-7 s,
+    # where the contact time gives 1.6e-6 s), as `specimen check` and the README say
+    with pytest.raises(SystemExit):
+        main(["dem", "run", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert "contact time / 10, a stuck tangential spring's period / 10" in text

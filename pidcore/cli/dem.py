@@ -84,9 +84,10 @@ def _add_config_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--specimen", metavar="FILE", type=path_argument, default=None,
                    help="specimen file (cell, coupon and fixture masses, particles, contact "
                         "pairs; see 'pidcore specimen check'); default: the paper's coupon")
-    p.add_argument("--material", choices=PARTICLE_MATERIALS, default=None,
-                   help="particles of the paper's coupon (default acrylic; with --specimen: "
-                        "the specimen's)")
+    p.add_argument("--material", metavar="NAME", default=None,
+                   help=f"particle material: {', '.join(PARTICLE_MATERIALS)} for the paper's "
+                        "coupon (default acrylic); with --specimen its own particles' (e.g. "
+                        "steel; the default)")
     p.add_argument("--direction", choices=DRIVE_DIRECTIONS, default="z",
                    help="drive direction in the cell frame (z normal to the face sheets; "
                         "default z)")
@@ -97,8 +98,9 @@ def _add_config_options(p: argparse.ArgumentParser) -> None:
                         "detect the steady state, so more may be measured (noted)")
     p.add_argument("--time-step", metavar="S", type=_time_step,
                    default=defaults.DEM_TIME_STEP_MODE,
-                   help=f"time step, s, or 'auto' (default: min(2e-6 s, contact time / "
-                        f"{defaults.DEM_MIN_STEPS_PER_CONTACT}))")
+                   help=f"time step, s, or 'auto' (default: min({defaults.DEM_TIME_STEP_S:g} "
+                        f"s, contact time / {defaults.DEM_MIN_STEPS_PER_CONTACT}, a stuck "
+                        f"tangential spring's period / {defaults.DEM_MIN_STEPS_PER_CONTACT}))")
     p.add_argument("--damping-mode", choices=NORMAL_DAMPING_MODES,
                    default=defaults.DEM_NORMAL_DAMPING_MODE,
                    help=f"normal damping at contact end (default "
@@ -175,13 +177,21 @@ def _specimen(args: argparse.Namespace):
     """(specimen or None, load-case material) from --specimen, --material and
     --tangential-stiffness (a specimen value: the specimen's hash, and so the run's key and
     provenance, say which k_t model ran)."""
+    from ..loadcase import normalize_material
     from ..specimen import load_specimen, paper_specimen
 
-    if args.specimen is None:
-        specimen, material = None, args.material or "acrylic"
+    specimen = None if args.specimen is None else load_specimen(args.specimen)
+    if args.material is None:
+        material = "acrylic" if specimen is None else specimen.particles.material
     else:
-        specimen = load_specimen(args.specimen)
-        material = args.material or specimen.particles.material
+        # a specimen's own material (steel) is a name as good as the table's, as for `report
+        # --material`; one that is not its particles' is refused with the case (names both)
+        material = normalize_material(args.material, "--material", None)
+        if specimen is None and material not in PARTICLE_MATERIALS:
+            raise ParameterError(
+                f"--material {args.material}: the paper's coupon holds "
+                f"{' or '.join(PARTICLE_MATERIALS)} particles; give --specimen FILE whose "
+                f"particles are {material}")
     if args.tangential_stiffness is not None:
         specimen = (specimen or paper_specimen(material)).with_values(
             {"pairs.tangential_stiffness_model": args.tangential_stiffness})

@@ -53,7 +53,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         "report writes, replaced atomically)")
     add_store_option(p, default=None,
                      help="HDF5 store: analyses of FILES are added to it; without FILES its "
-                          "analyses are reported")
+                          "analyses are reported (no default, unlike analyze and dem sweep: "
+                          "without it FILES are analysed for the report only, not saved)")
     p.add_argument("--dem-store", metavar="FILE", type=path_argument, action="append", default=None,
                    help="HDF5 store holding the DEM runs (default: --store); only read; "
                         "repeat it to join the runs of several stores (the first holding a "
