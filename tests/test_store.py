@@ -246,8 +246,12 @@ def test_corrupt_file_is_refused_and_never_overwritten(tmp_path):
     store = Store(path)  # no file yet: fine, created on first write
     path.write_bytes(b"this is not HDF5 at all\n" * 100)  # e.g. a half-copied or foreign file
     before = path.read_bytes()
-    with pytest.raises(StoreError, match=r"pid_store\.h5: not a readable pidcore store \("):
+    with pytest.raises(StoreError,
+                       match=r"pid_store\.h5: not a readable pidcore store \(") as refused:
         Store(path)
+    # in the user's terms, not HDF5's "Unable to synchronously open file (file signature ...)"
+    assert "(not an HDF5 file: a store is the .h5 file pidcore writes)" in str(refused.value)
+    assert "synchronously" not in str(refused.value)
     with pytest.raises(StoreError, match="not a readable pidcore store"):
         store.list_measurements()
     with pytest.raises(StoreError, match="not a readable pidcore store"):

@@ -476,7 +476,12 @@ class Store:
         return self._active is not None and self._active_thread == threading.get_ident()
 
     def _unreadable(self, reason: object) -> StoreError:
-        return StoreError(f"{self.path}: not a readable pidcore store ({_one_line(reason)})")
+        said = _one_line(reason)
+        if "file signature not found" in said:
+            # h5py's "Unable to synchronously open file (...)" is HDF5's wording for a file
+            # of another kind: say that in the user's terms
+            said = "not an HDF5 file: a store is the .h5 file pidcore writes"
+        return StoreError(f"{self.path}: not a readable pidcore store ({said})")
 
     def _check_root(self, h5: h5py.File, *, every_entry: bool = True) -> None:
         """Refuse a file that is not a store of a version this pidcore reads, and, with
