@@ -7,6 +7,7 @@ import os
 import time
 from pathlib import Path
 
+import pandas as pd
 import pytest
 from _app_samples import mass_damper_csv
 
@@ -1525,3 +1526,41 @@ def test_the_calibrate_form_comes_back_from_the_page_address_and_bad_values_are_
     assert not at.exception
     assert "cells per DEM run: '2,5' is not a whole number" in [e.value for e in at.error]
     assert len(calls) == 1  # nothing more ran
+
+
+def test_the_calibrate_pages_measurements_table_names_every_numbers_unit(store_file):
+    # the degrees of freedom of the standard error were headed by the field name,
+    # "sdc_stderr_dof", without a unit
+    files = [(f"c{f:g}_fill50.csv", mass_damper_csv(frequency_hz=f, seed=int(f)))
+             for f in (100.0, 200.0)]
+    at = _upload(_app(), files)
+    at.button(key="save").click()
+    at.run()
+    at.run()
+    points = next(d.value for d in at.dataframe
+                  if "SDC measured, Eq. 11 [-]" in d.value.columns)
+    numeric = [c for c in points.columns if pd.api.types.is_numeric_dtype(points[c])]
+    assert "SDC stderr degrees of freedom [-]" in numeric
+    assert all(c.endswith("]") for c in numeric), numeric
+
+
+@pytest.mark.dem_subprocess
+def test_the_report_tab_says_a_calibrations_design_runs_are_left_out_in_its_own_words(
+        store_file, tmp_path):
+    from pidcore.cli import main
+
+    table = tmp_path / "m.csv"
+    table.write_text("frequency_hz,acceleration_g,fill_percent,sdc\n500,5,50,0.6\n"
+                     "1000,5,50,0.6\n500,1,50,0.2\n")
+    assert main(["calibrate", "--data", str(table), "--fit", "fixture_mass_kg",
+                 "--discrepancy", "0.2", "--dem-store", str(store_file), "--out",
+                 str(tmp_path / "out"), "--cells", "2", "--steady-cycles", "10",
+                 "--workers", "1", "--no-progress"]) == 0
+    at = _app()
+    notes = [c.value for c in at.caption if c.value.startswith("note: 3 DEM run(s) of the "
+                                                                "design of calibration(s)")]
+    # the page's checkbox, not the library's keyword (the notes were shown as the library
+    # wrote them, though the grid's row notes were put in the page's terms)
+    assert len(notes) == 1
+    assert notes[0].endswith("'pool DEM settings and specimens' pools them with the other runs")
+    assert not any("pool=True" in c.value for c in at.caption)

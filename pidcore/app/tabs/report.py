@@ -92,15 +92,16 @@ def render(stores, calibrations: list) -> None:
                 f"of this specimen yet: save analysed files (tab Analyse) or run DEM cases "
                 "(tab DEM).")
         for note in table.attrs.get("notes", []):  # e.g. other specimens' runs left out
-            st.caption(f"note: {note}")
+            st.caption(f"note: {page_terms(note)}")
         return
     st.caption(f"calibrated DEM columns: {label}" if calibration is not None else label)
     # cells empty by design (measured columns of a DEM-only row, DEM columns of a measured-only
     # one) are empty, not the grid's greyed "None"; the two results that can lack a value say
     # why (report_display)
-    st.dataframe(report_display(table), hide_index=True, key="report_table", width="stretch",
-                 placeholder="")
-    for note in table.attrs.get("notes", []):
+    shown = report_display(table)
+    st.dataframe(shown, hide_index=True, key="report_table", width="stretch", placeholder="")
+    # the notes in the page's terms too (report_display's): "pool=True" is the checkbox here
+    for note in shown.attrs.get("notes", []):
         st.caption(f"note: {note}")
     made = (stamp, pool, keys, digest, specimen_label)
     if st.button("Build report files (CSV, Markdown, HTML, LaTeX, PDF)", key="build_report"):
