@@ -222,7 +222,10 @@ def _form(stores, api, points: list, left_out: list[str]) -> str:
         columns=["source", "row"], errors="ignore").rename(columns={
         "frequency_hz": "frequency [Hz]", "acceleration_g": "acceleration [g]",
         "fill_percent": "fill [%]", "sdc": "SDC measured, Eq. 11 [-]",
-        "sdc_stderr": "SDC stderr [-]"}), hide_index=True, width="stretch",
+        "sdc_stderr": "SDC stderr [-]",
+        # every number names its unit: the raw field name was shown as a column head
+        "sdc_stderr_dof": "SDC stderr degrees of freedom [-]"}), hide_index=True,
+        width="stretch",
         key="calibration_points", placeholder="")
     c1, c2, c3 = st.columns(3)
     fittable = fittable_names(api)
