@@ -1544,18 +1544,24 @@ def test_the_calibrate_pages_measurements_table_names_every_numbers_unit(store_f
     assert all(c.endswith("]") for c in numeric), numeric
 
 
-@pytest.mark.dem_subprocess
-def test_the_report_tab_says_a_calibrations_design_runs_are_left_out_in_its_own_words(
-        store_file, tmp_path):
+def _calibrate_tiny(store_file, folder) -> None:
+    """A calibration saved in the app's store with its 3 design runs (2 cells, 10 steady
+    cycles: seconds) at 500 Hz 5 g, 1000 Hz 5 g and 500 Hz 1 g, 50 % acrylic."""
     from pidcore.cli import main
 
-    table = tmp_path / "m.csv"
+    table = folder / "m.csv"
     table.write_text("frequency_hz,acceleration_g,fill_percent,sdc\n500,5,50,0.6\n"
                      "1000,5,50,0.6\n500,1,50,0.2\n")
     assert main(["calibrate", "--data", str(table), "--fit", "fixture_mass_kg",
                  "--discrepancy", "0.2", "--dem-store", str(store_file), "--out",
-                 str(tmp_path / "out"), "--cells", "2", "--steady-cycles", "10",
+                 str(folder / "out"), "--cells", "2", "--steady-cycles", "10",
                  "--workers", "1", "--no-progress"]) == 0
+
+
+@pytest.mark.dem_subprocess
+def test_the_report_tab_says_a_calibrations_design_runs_are_left_out_in_its_own_words(
+        store_file, tmp_path):
+    _calibrate_tiny(store_file, tmp_path)
     at = _app()
     notes = [c.value for c in at.caption if c.value.startswith("note: 3 DEM run(s) of the "
                                                                 "design of calibration(s)")]
@@ -1564,3 +1570,20 @@ def test_the_report_tab_says_a_calibrations_design_runs_are_left_out_in_its_own_
     assert len(notes) == 1
     assert notes[0].endswith("'pool DEM settings and specimens' pools them with the other runs")
     assert not any("pool=True" in c.value for c in at.caption)
+
+
+@pytest.mark.dem_subprocess
+def test_compare_does_not_take_a_calibrations_design_run_for_our_dem(store_file, tmp_path):
+    # the 2-cell run a calibration made at the measured case was the headline's "our DEM"
+    # and the chart's DEM point, as the Report tab showed it as a row of its own
+    from pidcore.store import Store
+
+    _calibrate_tiny(store_file, tmp_path)
+    design = Store(store_file).list_dem_runs()
+    assert len(design) == 3
+    at = _upload(_app(), [("coupon_fill50.csv", mass_damper_csv(frequency_hz=500.0,
+                                                                 acceleration_g=5.0))])
+    assert "vs our DEM none" in _headline(at)
+    assert any(c.value.startswith("note: 3 DEM run(s) of the design of calibration(s) ")
+               and c.value.endswith("(its calibrated DEM columns are its prediction)")
+               for c in at.caption)

@@ -393,10 +393,11 @@ def specimen_dem_runs(stored: pd.DataFrame | None, specimen=None, *,
     return kept, notes
 
 
-def _without_design_runs(runs: pd.DataFrame, design_runs: Mapping[str, str]
-                         ) -> tuple[pd.DataFrame | None, str]:
+def without_design_runs(runs: pd.DataFrame, design_runs: Mapping[str, str], *,
+                        poolable: bool = True) -> tuple[pd.DataFrame | None, str]:
     """``runs`` without the calibrations' design runs, and the note naming them ("" where
-    there were none).
+    there were none); ``poolable``: the note says that ``pool=True`` pools them (a page that
+    does not pool does not).
 
     A calibration's runs (2 to 4 cells each, by default) showed as rows of their own beside the
     specimen's predictions, "DEM settings: cells 2", with an SDC of their own and nothing
@@ -413,7 +414,8 @@ def _without_design_runs(runs: pd.DataFrame, design_runs: Mapping[str, str]
     note = (f"{int(design.sum())} DEM run(s) of the design of calibration(s) "
             f"{', '.join(calibrations)}{of_cells} are not rows of this table: they are the "
             "inputs of its fit, not predictions of the specimen (its calibrated DEM columns "
-            "are its prediction); pool=True pools them with the other runs")
+            "are its prediction)" + ("; pool=True pools them with the other runs" if poolable
+                                     else ""))
     kept = runs[~design].reset_index(drop=True)
     return (kept if not kept.empty else None), note
 
@@ -509,11 +511,11 @@ def specimen_report_table(stored_runs: pd.DataFrame | None, analyses: pd.DataFra
     dem_runs, notes = specimen_dem_runs(stored_runs, specimen, where=where,
                                         choose_another=choose_another)
     if design_runs and not pool and dem_runs is not None:
-        dem_runs, note = _without_design_runs(dem_runs, design_runs)
+        dem_runs, note = without_design_runs(dem_runs, design_runs)
         if note:
             notes.append(note)
             # nor are they "another specimen's runs" in a measured row's note
-            stored_runs, _ = _without_design_runs(stored_runs, design_runs)
+            stored_runs, _ = without_design_runs(stored_runs, design_runs)
     paper = load_paper_table3()
     from ..specimen import PAPER_SPECIMEN_NAME, measured_specimen_name
 
