@@ -1585,5 +1585,5 @@ def test_compare_does_not_take_a_calibrations_design_run_for_our_dem(store_file,
                                                                  acceleration_g=5.0))])
     assert "vs our DEM none" in _headline(at)
     assert any(c.value.startswith("note: 3 DEM run(s) of the design of calibration(s) ")
-               and c.value.endswith("(its calibrated DEM columns are its prediction)")
+               and c.value.endswith("(the calibrated DEM is its prediction)")
                for c in at.caption)

@@ -269,15 +269,15 @@ def test_a_calibrations_design_runs_are_not_reported_as_predictions(calibrated, 
         rows = table[table["DEM runs [-]"] > 0]
         if pool:  # asked for: every run pooled, the design's included
             assert rows["DEM runs [-]"].sum() == 4
-            assert "are not rows of this table" not in printed
+            assert "are left out of the comparison" not in printed
             continue
         # only the user's run is a row, with its own SDC (copied: no tolerance)
         assert len(rows) == 1 and rows["DEM runs [-]"].iloc[0] == 1
         assert rows["SDC DEM (ours) [-]"].iloc[0] == own.record["sdc"]
         assert (f"note: 3 DEM run(s) of the design of calibration(s) {cal_key} (2 cells per "
-                "run) are not rows of this table: they are the inputs of its fit, not "
-                "predictions of the specimen (its calibrated DEM columns are its prediction); "
-                "--pool pools them with the other runs") in printed
+                "run) are left out of the comparison: they are the inputs of its fit, not "
+                "predictions of the specimen (the calibrated DEM is its prediction); --pool "
+                "pools them with the other runs") in printed
     # the app's Report tab builds the same table (its note in the library's words)
     app_table = store_report_table(store, None)
     assert (app_table["DEM runs [-]"] > 0).sum() == 1

@@ -412,9 +412,9 @@ def without_design_runs(runs: pd.DataFrame, design_runs: Mapping[str, str], *,
         if "cells_simulated" in left_out.columns else []
     of_cells = f" ({' or '.join(map(str, cells))} cells per run)" if cells else ""
     note = (f"{int(design.sum())} DEM run(s) of the design of calibration(s) "
-            f"{', '.join(calibrations)}{of_cells} are not rows of this table: they are the "
-            "inputs of its fit, not predictions of the specimen (its calibrated DEM columns "
-            "are its prediction)" + ("; pool=True pools them with the other runs" if poolable
+            f"{', '.join(calibrations)}{of_cells} are left out of the comparison: they are "
+            "the inputs of its fit, not predictions of the specimen (the calibrated DEM is "
+            "its prediction)" + ("; pool=True pools them with the other runs" if poolable
                                      else ""))
     kept = runs[~design].reset_index(drop=True)
     return (kept if not kept.empty else None), note
