@@ -1587,3 +1587,16 @@ def test_compare_does_not_take_a_calibrations_design_run_for_our_dem(store_file,
     assert any(c.value.startswith("note: 3 DEM run(s) of the design of calibration(s) ")
                and c.value.endswith("(the calibrated DEM is its prediction)")
                for c in at.caption)
+
+
+@pytest.mark.dem_subprocess
+def test_the_dem_tab_says_which_listed_runs_are_a_calibrations_design(store_file, tmp_path):
+    # listed with the store's runs without a word, they read as the coupon's 2-cell results
+    from pidcore.calibrate import stored_calibration
+
+    _calibrate_tiny(store_file, tmp_path)
+    at = _app()
+    key = stored_calibration(store_file).store_key
+    assert f"3 of these run(s) are the design runs of calibration(s) {key}: inputs of its " \
+           "fit, not predictions of the specimen; the Compare and Report tabs leave them " \
+           "out" in [c.value for c in at.caption]

@@ -181,6 +181,15 @@ def render(stores) -> None:
         table = jobs.dem_runs_table(runs)
         st.dataframe(table, hide_index=True, width="stretch", key="dem_runs_table",
                      placeholder="")
+        from pidcore.calibrate.persist import calibration_design_runs
+
+        # listed as the store holds them, but said: Compare and Report leave them out
+        design = calibration_design_runs(runs, [stores.path, stores.dem_reference])
+        if design:
+            st.caption(f"{len(design)} of these run(s) are the design runs of calibration(s) "
+                       f"{', '.join(sorted(set(design.values())))}: inputs of its fit, not "
+                       "predictions of the specimen; the Compare and Report tabs leave them "
+                       "out")
         unconverged = int(table["steady state"].str.startswith("NOT").sum())
         if unconverged:
             st.warning(f"{unconverged} run(s) did not converge (steady state NOT detected "
