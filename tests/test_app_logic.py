@@ -1202,6 +1202,24 @@ def test_sdc_chart_ticks_read_the_fills(fills):
     assert labels[title - len(fills):title] == [f"{f:g}" for f in fills]
 
 
+def test_sdc_chart_labels_the_model_curves_ends_beside_a_single_point():
+    # a case off the paper's grid (150 Hz, 40 %): one tick, "40", under a pchip curve from 25
+    # to 90 %: where the curve rose could not be read
+    vl_convert = pytest.importorskip("vl_convert")
+    from pidcore.app.charts import sdc_chart
+    from pidcore.compare.case import SDC_SERIES
+
+    model = np.linspace(25.0, 90.0, 14)
+    data = pd.DataFrame({"series": [SDC_SERIES[0]] * len(model) + ["measured"],
+                         "fill [%]": [*model, 40.0], "SDC [-]": [0.2] * (len(model) + 1),
+                         "low [-]": [0.2] * (len(model) + 1),
+                         "high [-]": [0.2] * (len(model) + 1)})
+    svg = vl_convert.vegalite_to_svg(json.dumps(sdc_chart(data)))
+    labels = re.findall(r'<text[^>]*>([^<]*)</text>', svg)
+    title = labels.index("packing ratio (fill) [%]")
+    assert labels[title - 3:title] == ["25", "40", "90"]
+
+
 def test_calibrate_page_keeps_saved_materials_apart_and_refuses_a_mixed_or_unknown_one(
         tmp_path, options):
     # a saved steel record (specimen steel_6mm_b) and an acrylic one of one load case: the
