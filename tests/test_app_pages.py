@@ -1526,6 +1526,10 @@ def test_the_calibrate_form_comes_back_from_the_page_address_and_bad_values_are_
     assert not at.exception
     assert "cells per DEM run: '2,5' is not a whole number" in [e.value for e in at.error]
     assert len(calls) == 1  # nothing more ran
+    # no parameter chosen is written as an empty value: a cleared field, not a choice
+    at = _app_at({"calibration_fit": ""})
+    assert at.multiselect(key="calibration_fit").value == []
+    assert not at.error
 
 
 def test_the_calibrate_pages_measurements_table_names_every_numbers_unit(store_file):

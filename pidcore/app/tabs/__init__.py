@@ -38,7 +38,8 @@ def refuse_address_choices(key: str, label: str, options: Sequence[str],
     otherwise run something else than the address says). Call before the field is drawn; the
     error stays until the field is changed."""
     refusals = st.session_state.setdefault(_ADDRESS_REFUSALS, {})
-    stated = st.query_params.get_all(key)
+    # an empty value is a cleared field (a multiple choice with nothing chosen), not a choice
+    stated = [v for v in st.query_params.get_all(key) if v != ""]
     unknown = [v for v in stated if v not in options]
     if unknown and key not in st.session_state:  # a fresh session reading its address
         # a multiple choice keeps the address's known values (Streamlit's filter), else the
