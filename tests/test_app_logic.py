@@ -2167,3 +2167,25 @@ def test_a_cancelled_calibration_stops_at_its_next_run_and_keeps_the_saved_ones(
     assert len(saved.list_dem_runs()) == 1
     assert saved.list_calibrations().empty  # no calibration of a cancelled run
     assert not runner.cancel()  # nothing runs any more
+
+
+def test_the_saved_calibrations_table_says_each_calibrations_cells_per_dem_run():
+    # two calibrations of the same fit and cases read alike (fitted, load cases, RMS) though
+    # one ran 2 cells per DEM run and the other 3: the cells come from the stored settings
+    from pidcore.app.calibration import CELLS_COLUMN, saved_calibrations_table
+
+    listing = pd.DataFrame({
+        "key": ["cal_a", "cal_b", "cal_c"], "specimen": ["paper_coupon"] * 3,
+        "fit": ["fixture_mass_kg"] * 3, "n_points": [5.0, 5.0, 5.0],
+        "rms_in_sample": [0.2, 0.1, 0.3], "loo_rms": [np.nan] * 3,
+        "loo_coverage95": [np.nan] * 3,
+        "created_utc": ["2026-12-01T00:00:00+00:00", "2026-12-01T00:01:00+00:00",
+                        "2026-12-01T00:02:00+00:00"],
+        "parameters_json": ['{"settings": {"cells": 2, "seed": 12345}}',
+                            '{"settings": {"cells": 3, "seed": 12345}}',
+                            "{not json"]})
+    table = saved_calibrations_table(listing=listing)
+    # newest first; a record whose settings cannot be read is listed with a blank
+    assert list(table["calibration"]) == ["cal_c", "cal_b", "cal_a"]
+    assert list(table[CELLS_COLUMN]) == ["", 3, 2]
+    assert list(table.columns).index(CELLS_COLUMN) == list(table.columns).index("fitted") + 1
