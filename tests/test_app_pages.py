@@ -1604,3 +1604,23 @@ def test_the_dem_tab_says_which_listed_runs_are_a_calibrations_design(store_file
     assert f"3 of these run(s) are the design runs of calibration(s) {key}: inputs of its " \
            "fit, not predictions of the specimen; the Compare and Report tabs leave them " \
            "out" in [c.value for c in at.caption]
+
+
+def test_the_report_choices_come_back_from_the_page_address(store_file):
+    # as the DEM and Calibrate forms: the files chosen and pooling survive a reload
+    files = [(f"c{f:g}_fill50.csv", mass_damper_csv(frequency_hz=f, seed=int(f)))
+             for f in (100.0, 200.0)]
+    at = _upload(_app(), files)
+    at.button(key="save").click()
+    at.run()
+    at = _app_at({"report_filter_files": "c200_fill50.csv", "report_pool": "true"})
+    assert at.multiselect(key="report_filter_files").value == ["c200_fill50.csv"]
+    assert at.checkbox(key="report_pool").value is True
+    table = _table(at, "SDC measured [-]")
+    assert list(table["SDC measured [-]"].dropna().index) == [0] and len(table) == 1
+    # a file the store does not hold: named in one line, not silently dropped
+    at = _app_at({"report_filter_files": ["c200_fill50.csv", "gone.csv"]})
+    assert [e.value for e in at.error] == [
+        "measurements in the report: 'gone.csv' (from the page address) is not one of "
+        "c100_fill50.csv, c200_fill50.csv; c200_fill50.csv is chosen instead"]
+    assert at.multiselect(key="report_filter_files").value == ["c200_fill50.csv"]
