@@ -1624,3 +1624,16 @@ def test_the_report_choices_come_back_from_the_page_address(store_file):
         "measurements in the report: 'gone.csv' (from the page address) is not one of "
         "c100_fill50.csv, c200_fill50.csv; c200_fill50.csv is chosen instead"]
     assert at.multiselect(key="report_filter_files").value == ["c200_fill50.csv"]
+
+
+def test_a_report_checkbox_or_file_the_page_address_cannot_hold_is_refused(store_file):
+    # Streamlit reads anything but true/false as an unticked box without a word
+    at = _app_at({"report_pool": "maybe", "report_filter_files": "a.csv"})
+    assert [e.value for e in at.error] == [
+        "measurements in the report: 'a.csv' (from the page address) is not offered (there "
+        "is nothing to choose yet); none is chosen instead",
+        "pool DEM settings and specimens: 'maybe' (from the page address) is not one of "
+        "true, false; false is chosen instead"]
+    assert at.checkbox(key="report_pool").value is False
+    at = _app_at({"report_pool": "TRUE"})  # Streamlit's reading: any case
+    assert at.checkbox(key="report_pool").value is True and not at.error

@@ -30,6 +30,16 @@ def draw_polling(body: Callable[..., None], *args, polling: bool, every_s: float
     st.fragment(run_every=every_s if polling else None)(body)(*args, polling)
 
 
+#: A checkbox's value as the page address writes it.
+FLAG_WORDS = {True: "true", False: "false"}
+
+
+def refuse_address_flag(key: str, label: str, default: bool = False) -> None:
+    """:func:`refuse_address_choices` of a checkbox: anything but true or false (Streamlit
+    reads it as the default without a word)."""
+    refuse_address_choices(key, label, list(FLAG_WORDS.values()), FLAG_WORDS[default])
+
+
 def refuse_address_choices(key: str, label: str, options: Sequence[str],
                             default: Sequence[str] | str) -> None:
     """Say, in the one-line style of a refused typed value, where the page address holds a
@@ -38,8 +48,10 @@ def refuse_address_choices(key: str, label: str, options: Sequence[str],
     otherwise run something else than the address says). Call before the field is drawn; the
     error stays until the field is changed."""
     refusals = st.session_state.setdefault(_ADDRESS_REFUSALS, {})
-    # an empty value is a cleared field (a multiple choice with nothing chosen), not a choice
-    stated = [v for v in st.query_params.get_all(key) if v != ""]
+    # an empty value is a cleared field (a multiple choice with nothing chosen), not a choice;
+    # a checkbox's word is read in any case (Streamlit reads "TRUE" as true)
+    stated = [v.lower() if list(options) == list(FLAG_WORDS.values()) else v
+              for v in st.query_params.get_all(key) if v != ""]
     unknown = [v for v in stated if v not in options]
     if unknown and key not in st.session_state:  # a fresh session reading its address
         # a multiple choice keeps the address's known values (Streamlit's filter), else the
@@ -48,13 +60,18 @@ def refuse_address_choices(key: str, label: str, options: Sequence[str],
             [v for v in stated if v in options] or list(default))
         shown = fallback if isinstance(fallback, str) else ", ".join(fallback) or "none"
         quoted = ", ".join(f"'{v}'" for v in unknown)
-        refusals[key] = (f"{label}: {quoted} (from the page address) is not one of "
-                         f"{', '.join(options)}; {shown} is chosen instead", fallback)
+        offered = (f"one of {', '.join(options)}" if options
+                   else "offered (there is nothing to choose yet)")
+        refusals[key] = (f"{label}: {quoted} (from the page address) is not {offered}; "
+                         f"{shown} is chosen instead", fallback)
     refused = refusals.get(key)
     if refused is None:
         return
     message, fallback = refused
-    if st.session_state.get(key, fallback) == fallback:
+    current = st.session_state.get(key, fallback)
+    if isinstance(current, bool):  # a checkbox: its address words
+        current = FLAG_WORDS[current]
+    if current == fallback:
         st.error(message)
     else:  # the user chose: the address's value is no longer the question
         del refusals[key]

@@ -6,7 +6,12 @@ import streamlit as st
 
 from pidcore.app import state
 from pidcore.app.report_builds import start_report_build
-from pidcore.app.tabs import ADDRESS_BINDING, draw_polling, refuse_address_choices
+from pidcore.app.tabs import (
+    ADDRESS_BINDING,
+    draw_polling,
+    refuse_address_choices,
+    refuse_address_flag,
+)
 from pidcore.app.vocabulary import page_terms
 
 #: Seconds between refreshes of the report build's state while it runs.
@@ -50,6 +55,8 @@ def render(stores, calibrations: list) -> None:
         refuse_address_choices("report_filter_files", "measurements in the report", files, [])
     chosen = c1.multiselect("measurements in the report (all when none chosen)", files,
                             key="report_filter_files", bind=ADDRESS_BINDING)
+    with c2:
+        refuse_address_flag("report_pool", "pool DEM settings and specimens")
     pool = c2.checkbox("pool DEM settings and specimens", value=False, key="report_pool",
                        bind=ADDRESS_BINDING,
                        help="one row per load case (default: a row per DEM setting and per "
