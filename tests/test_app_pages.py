@@ -1472,6 +1472,12 @@ def test_the_dem_form_comes_back_from_the_page_address_and_bad_values_are_refuse
     assert at.selectbox(key="dem_material").value == "aluminium"
     assert at.selectbox(key="dem_direction").value == "x"
     assert not at.error
+    # numerical settings that are not the defaults are shown, not hidden in a closed expander
+    (numerical,) = [e for e in at.expander if e.label == "numerical settings"]
+    assert numerical.proto.expanded
+    at = _app_at({"dem_freqs": "50"})
+    (numerical,) = [e for e in at.expander if e.label == "numerical settings"]
+    assert not numerical.proto.expanded
     # a value no field can hold: the error a typed one gets, at Run, and nothing queued
     at = _app_at({"dem_steady": "2,5"})
     assert at.text_input(key="dem_steady").value == "2,5"

@@ -120,16 +120,22 @@ def render(stores) -> None:
                                DRIVE_DIRECTIONS[0])
     direction = c5.selectbox("drive direction", DRIVE_DIRECTIONS, key="dem_direction",
                              bind=ADDRESS_BINDING)
-    with st.expander("numerical settings", expanded=False):
+    numerical = {"dem_cells": str(defaults.DEM_CELLS), "dem_seed": str(defaults.DEM_SEED),
+                 "dem_steady": "0"}
+    # open where a setting is not its default: one a reload or a shared address brought back
+    # (cells 1, say) was hidden under the closed expander and ran with the next Run
+    changed = any(str(st.session_state.get(key, st.query_params.get(key, default))) != default
+                  for key, default in numerical.items())
+    with st.expander("numerical settings", expanded=changed):
         d1, d2, d3 = st.columns(3)
         # text read by pidcore (parse_count): the browser's number box made "1e3" steady
         # cycles 1 and "2,5" cells 25 without a word
-        cells = d1.text_input("cells simulated", str(defaults.DEM_CELLS), key="dem_cells",
+        cells = d1.text_input("cells simulated", numerical["dem_cells"], key="dem_cells",
                               help=f"1 to {MAX_CELLS}", bind=ADDRESS_BINDING)
-        seed = d2.text_input("seed", str(defaults.DEM_SEED), key="dem_seed",
+        seed = d2.text_input("seed", numerical["dem_seed"], key="dem_seed",
                              bind=ADDRESS_BINDING)
-        steady = d3.text_input("steady cycles (0 = automatic)", "0", key="dem_steady",
-                               bind=ADDRESS_BINDING)
+        steady = d3.text_input("steady cycles (0 = automatic)", numerical["dem_steady"],
+                               key="dem_steady", bind=ADDRESS_BINDING)
     b1, b2 = st.columns(2)
     start = b1.button("Run", type="primary", key="dem_run", disabled=refused is not None,
                       help="off while the chosen specimen file is refused"
