@@ -1322,8 +1322,10 @@ def test_stored_calibrations_are_read_once_per_store_state_and_a_new_one_is_seen
     assert not at.exception, at.exception
     # both read once more, and the new one is offered at once, not a stale list
     assert sorted(reads[1:]) == ["cal_00000000000000a1", "cal_00000000000000b2"]
-    assert at.selectbox(key="calibration_saved_key").options == [
-        "cal_00000000000000b2", "cal_00000000000000a1"]
+    saved = next(s for s in at.selectbox if s.label == "download the files of")
+    assert saved.options == ["cal_00000000000000b2", "cal_00000000000000a1"]
+    # and chosen: the box kept showing the older one, whose files its buttons then gave
+    assert saved.value == "cal_00000000000000b2"
 
 
 def test_a_run_the_reference_store_holds_is_shown_stored_and_never_run(store_file, tmp_path,

@@ -150,7 +150,10 @@ def _saved(stored) -> None:
                 "them)")
     st.dataframe(saved_calibrations_table(listing=stored.listing), hide_index=True)
     keys = [c.store_key for c in saved]
-    key = st.selectbox("download the files of", keys, key="calibration_saved_key")
+    # a choice per set of saved calibrations: one saved since (the run just made) is offered
+    # first, not the older one the box showed before
+    listed = hashlib.sha256("\n".join(keys).encode()).hexdigest()[:12]
+    key = st.selectbox("download the files of", keys, key=f"calibration_saved_key_{listed}")
     chosen = saved[keys.index(key)]
     c1, c2 = st.columns(2)
     c1.download_button("calibration.json", chosen.document_text, file_name="calibration.json",
