@@ -486,3 +486,28 @@ def test_a_number_typed_in_the_settings_grid_reaches_the_checks_as_typed(
         error.first.wait_for(timeout=RESULT_TIMEOUT_MS)
         assert f"{sample.name}, column vibrometer delay [µs]: " in error.first.inner_text()
     page.screenshot(path=str(ARTIFACTS / "app_e2e_typed_number_refused.png"), full_page=True)
+
+
+def test_a_reload_keeps_the_dem_form(app_url, browser_page):
+    # a reload reset the DEM form to its defaults (a user who set the fields, started a job
+    # and reloaded lost them): the fields are bound to the page address, which the browser
+    # keeps over a reload; a default is left out of it
+    page = browser_page
+    _open(page, app_url)
+    _fill_dem(page, freqs="50, 200", accs="2", fills="40", cells=3, steady=12)
+    page.wait_for_function("() => location.search.includes('dem_steady=12')",
+                           timeout=RESULT_TIMEOUT_MS)
+    assert "dem_seed" not in page.url  # untouched: its default, not written
+    page.reload()
+    page.locator("input[type=file]").first.wait_for(state="attached",
+                                                    timeout=RESULT_TIMEOUT_MS)
+    page.get_by_role("tab", name="DEM").click()
+    # not its defaults: the numerical settings open by themselves, not hidden under the
+    # closed expander to run with the next Run
+    page.get_by_role("textbox", name="cells simulated", exact=True).wait_for(
+        state="visible", timeout=RESULT_TIMEOUT_MS)
+    got = {label: page.get_by_role("textbox", name=label, exact=True).input_value()
+           for label in ("frequencies [Hz]", "accelerations [g]", "fills [%]",
+                         "cells simulated", "steady cycles (0 = automatic)")}
+    assert got == {"frequencies [Hz]": "50, 200", "accelerations [g]": "2", "fills [%]": "40",
+                   "cells simulated": "3", "steady cycles (0 = automatic)": "12"}

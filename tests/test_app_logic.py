@@ -1202,6 +1202,24 @@ def test_sdc_chart_ticks_read_the_fills(fills):
     assert labels[title - len(fills):title] == [f"{f:g}" for f in fills]
 
 
+def test_sdc_chart_labels_the_model_curves_ends_beside_a_single_point():
+    # a case off the paper's grid (150 Hz, 40 %): one tick, "40", under a pchip curve from 25
+    # to 90 %: where the curve rose could not be read
+    vl_convert = pytest.importorskip("vl_convert")
+    from pidcore.app.charts import sdc_chart
+    from pidcore.compare.case import SDC_SERIES
+
+    model = np.linspace(25.0, 90.0, 14)
+    data = pd.DataFrame({"series": [SDC_SERIES[0]] * len(model) + ["measured"],
+                         "fill [%]": [*model, 40.0], "SDC [-]": [0.2] * (len(model) + 1),
+                         "low [-]": [0.2] * (len(model) + 1),
+                         "high [-]": [0.2] * (len(model) + 1)})
+    svg = vl_convert.vegalite_to_svg(json.dumps(sdc_chart(data)))
+    labels = re.findall(r'<text[^>]*>([^<]*)</text>', svg)
+    title = labels.index("packing ratio (fill) [%]")
+    assert labels[title - 3:title] == ["25", "40", "90"]
+
+
 def test_calibrate_page_keeps_saved_materials_apart_and_refuses_a_mixed_or_unknown_one(
         tmp_path, options):
     # a saved steel record (specimen steel_6mm_b) and an acrylic one of one load case: the
@@ -2348,3 +2366,25 @@ def test_a_stop_reaches_the_last_run_of_a_resumed_calibration_too(tmp_path, monk
     assert not (tmp_path / "s.h5").exists() or Store(tmp_path / "s.h5").list_dem_runs().empty
     pids = [int(f.name.split("-")[1]) for f in folder.iterdir()]
     assert len(pids) == 1 and not alive(pids[0])
+
+
+def test_the_saved_calibrations_table_says_each_calibrations_cells_per_dem_run():
+    # two calibrations of the same fit and cases read alike (fitted, load cases, RMS) though
+    # one ran 2 cells per DEM run and the other 3: the cells come from the stored settings
+    from pidcore.app.calibration import CELLS_COLUMN, saved_calibrations_table
+
+    listing = pd.DataFrame({
+        "key": ["cal_a", "cal_b", "cal_c"], "specimen": ["paper_coupon"] * 3,
+        "fit": ["fixture_mass_kg"] * 3, "n_points": [5.0, 5.0, 5.0],
+        "rms_in_sample": [0.2, 0.1, 0.3], "loo_rms": [np.nan] * 3,
+        "loo_coverage95": [np.nan] * 3,
+        "created_utc": ["2026-12-01T00:00:00+00:00", "2026-12-01T00:01:00+00:00",
+                        "2026-12-01T00:02:00+00:00"],
+        "parameters_json": ['{"settings": {"cells": 2, "seed": 12345}}',
+                            '{"settings": {"cells": 3, "seed": 12345}}',
+                            "{not json"]})
+    table = saved_calibrations_table(listing=listing)
+    # newest first; a record whose settings cannot be read is listed with a blank
+    assert list(table["calibration"]) == ["cal_c", "cal_b", "cal_a"]
+    assert list(table[CELLS_COLUMN]) == ["", 3, 2]
+    assert list(table.columns).index(CELLS_COLUMN) == list(table.columns).index("fitted") + 1

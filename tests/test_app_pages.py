@@ -7,6 +7,7 @@ import os
 import time
 from pathlib import Path
 
+import pandas as pd
 import pytest
 from _app_samples import mass_damper_csv
 
@@ -1321,8 +1322,10 @@ def test_stored_calibrations_are_read_once_per_store_state_and_a_new_one_is_seen
     assert not at.exception, at.exception
     # both read once more, and the new one is offered at once, not a stale list
     assert sorted(reads[1:]) == ["cal_00000000000000a1", "cal_00000000000000b2"]
-    assert at.selectbox(key="calibration_saved_key").options == [
-        "cal_00000000000000b2", "cal_00000000000000a1"]
+    saved = next(s for s in at.selectbox if s.label == "download the files of")
+    assert saved.options == ["cal_00000000000000b2", "cal_00000000000000a1"]
+    # and chosen: the box kept showing the older one, whose files its buttons then gave
+    assert saved.value == "cal_00000000000000b2"
 
 
 def test_a_run_the_reference_store_holds_is_shown_stored_and_never_run(store_file, tmp_path,
@@ -1447,3 +1450,198 @@ def test_whole_numbers_and_the_sample_rate_are_read_as_typed_or_refused(store_fi
     at.run()
     assert any(e.value == "sample rate if no time column [Hz]: '25,6' is not a number; files "
                           "are read without a sample rate" for e in at.error)
+
+
+def _app_at(address: dict) -> AppTest:
+    """The app opened at a page address holding ``address`` (what a reload sends back)."""
+    at = AppTest.from_file(str(SHIM), default_timeout=RUN_TIMEOUT_S)
+    at.query_params = dict(address)
+    at.run()
+    assert not at.exception, at.exception
+    return at
+
+
+def test_the_dem_form_comes_back_from_the_page_address_and_bad_values_are_refused(store_file):
+    # a reload reset the twelve fields to their defaults: they are bound to the page address
+    # now, and what comes back from it is read, or refused, as typed text
+    at = _app_at({"dem_freqs": "50, 200", "dem_accs": "2", "dem_fills": "40",
+                  "dem_material": "aluminium", "dem_direction": "x", "dem_cells": "3",
+                  "dem_seed": "7", "dem_steady": "12"})
+    got = {k: at.text_input(key=k).value for k in
+           ("dem_freqs", "dem_accs", "dem_fills", "dem_cells", "dem_seed", "dem_steady")}
+    assert got == {"dem_freqs": "50, 200", "dem_accs": "2", "dem_fills": "40",
+                   "dem_cells": "3", "dem_seed": "7", "dem_steady": "12"}
+    assert at.selectbox(key="dem_material").value == "aluminium"
+    assert at.selectbox(key="dem_direction").value == "x"
+    assert not at.error
+    # numerical settings that are not the defaults are shown, not hidden in a closed expander
+    (numerical,) = [e for e in at.expander if e.label == "numerical settings"]
+    assert numerical.proto.expanded
+    at = _app_at({"dem_freqs": "50"})
+    (numerical,) = [e for e in at.expander if e.label == "numerical settings"]
+    assert not numerical.proto.expanded
+    # a value no field can hold: the error a typed one gets, at Run, and nothing queued
+    at = _app_at({"dem_steady": "2,5"})
+    assert at.text_input(key="dem_steady").value == "2,5"
+    at.button(key="dem_run").click()
+    at.run()
+    assert not at.exception
+    assert [e.value for e in at.error] == [
+        "steady cycles (0 = automatic): '2,5' is not a whole number"]
+    assert jobs.runner_for(store_file).jobs() == []
+    # a choice the field does not offer: said in one line (Streamlit dropped it silently),
+    # the default shown, and it stays said until the field is changed
+    at = _app_at({"dem_direction": "q", "dem_material": "stel"})
+    want = ["particle material: 'stel' (from the page address) is not one of acrylic, "
+            "aluminium; acrylic is chosen instead",
+            "drive direction: 'q' (from the page address) is not one of z, x, y; z is chosen "
+            "instead"]
+    assert [e.value for e in at.error] == want
+    assert at.selectbox(key="dem_direction").value == "z"
+    at.run()
+    assert [e.value for e in at.error] == want
+    at.selectbox(key="dem_direction").select("y").run()
+    assert [e.value for e in at.error] == want[:1]
+
+
+def test_the_calibrate_form_comes_back_from_the_page_address_and_bad_values_are_refused(
+        store_file, monkeypatch):
+    import sys
+
+    calls: list = []
+    monkeypatch.setitem(sys.modules, "pidcore.calibrate", _fake_calibrate_module(calls))
+    files = [(f"c{f:g}_fill50.csv", mass_damper_csv(frequency_hz=f, seed=int(f)))
+             for f in (100.0, 200.0, 400.0)]
+    at = _upload(_app(), files)
+    at.button(key="save").click()
+    at.run()
+    # the reload: a new session at the address the form wrote
+    at = _app_at({"calibration_fit": "baseline_loss_factor", "calibration_cells": "3",
+                  "calibration_design": "6"})
+    assert at.multiselect(key="calibration_fit").value == ["baseline_loss_factor"]
+    assert at.text_input(key="calibration_cells").value == "3"
+    assert at.text_input(key="calibration_design").value == "6"
+    _run_calibration(at, store_file)
+    assert calls == [(3, ("baseline_loss_factor",), 3)]  # what the address said was run
+    # values it cannot hold: the typed values' errors, and the unknown parameter named
+    at = _app_at({"calibration_fit": ["baseline_loss_factor", "frictoin"],
+                  "calibration_cells": "2,5"})
+    assert [e.value for e in at.error] == [
+        "parameters to fit: 'frictoin' (from the page address) is not one of "
+        "baseline_loss_factor, fixture_mass_kg; baseline_loss_factor is chosen instead"]
+    at.button(key="calibration_run").click()
+    at.run()
+    assert not at.exception
+    assert "cells per DEM run: '2,5' is not a whole number" in [e.value for e in at.error]
+    assert len(calls) == 1  # nothing more ran
+    # no parameter chosen is written as an empty value: a cleared field, not a choice
+    at = _app_at({"calibration_fit": ""})
+    assert at.multiselect(key="calibration_fit").value == []
+    assert not at.error
+
+
+def test_the_calibrate_pages_measurements_table_names_every_numbers_unit(store_file):
+    # the degrees of freedom of the standard error were headed by the field name,
+    # "sdc_stderr_dof", without a unit
+    files = [(f"c{f:g}_fill50.csv", mass_damper_csv(frequency_hz=f, seed=int(f)))
+             for f in (100.0, 200.0)]
+    at = _upload(_app(), files)
+    at.button(key="save").click()
+    at.run()
+    at.run()
+    points = next(d.value for d in at.dataframe
+                  if "SDC measured, Eq. 11 [-]" in d.value.columns)
+    numeric = [c for c in points.columns if pd.api.types.is_numeric_dtype(points[c])]
+    assert "SDC stderr degrees of freedom [-]" in numeric
+    assert all(c.endswith("]") for c in numeric), numeric
+
+
+def _calibrate_tiny(store_file, folder) -> None:
+    """A calibration saved in the app's store with its 3 design runs (2 cells, 10 steady
+    cycles: seconds) at 500 Hz 5 g, 1000 Hz 5 g and 500 Hz 1 g, 50 % acrylic."""
+    from pidcore.cli import main
+
+    table = folder / "m.csv"
+    table.write_text("frequency_hz,acceleration_g,fill_percent,sdc\n500,5,50,0.6\n"
+                     "1000,5,50,0.6\n500,1,50,0.2\n")
+    assert main(["calibrate", "--data", str(table), "--fit", "fixture_mass_kg",
+                 "--discrepancy", "0.2", "--dem-store", str(store_file), "--out",
+                 str(folder / "out"), "--cells", "2", "--steady-cycles", "10",
+                 "--workers", "1", "--no-progress"]) == 0
+
+
+@pytest.mark.dem_subprocess
+def test_the_report_tab_says_a_calibrations_design_runs_are_left_out_in_its_own_words(
+        store_file, tmp_path):
+    _calibrate_tiny(store_file, tmp_path)
+    at = _app()
+    notes = [c.value for c in at.caption if c.value.startswith("note: 3 DEM run(s) of the "
+                                                                "design of calibration(s)")]
+    # the page's checkbox, not the library's keyword (the notes were shown as the library
+    # wrote them, though the grid's row notes were put in the page's terms)
+    assert len(notes) == 1
+    assert notes[0].endswith("'pool DEM settings and specimens' pools them with the other runs")
+    assert not any("pool=True" in c.value for c in at.caption)
+
+
+@pytest.mark.dem_subprocess
+def test_compare_does_not_take_a_calibrations_design_run_for_our_dem(store_file, tmp_path):
+    # the 2-cell run a calibration made at the measured case was the headline's "our DEM"
+    # and the chart's DEM point, as the Report tab showed it as a row of its own
+    from pidcore.store import Store
+
+    _calibrate_tiny(store_file, tmp_path)
+    design = Store(store_file).list_dem_runs()
+    assert len(design) == 3
+    at = _upload(_app(), [("coupon_fill50.csv", mass_damper_csv(frequency_hz=500.0,
+                                                                 acceleration_g=5.0))])
+    assert "vs our DEM none" in _headline(at)
+    assert any(c.value.startswith("note: 3 DEM run(s) of the design of calibration(s) ")
+               and c.value.endswith("(the calibrated DEM is its prediction)")
+               for c in at.caption)
+
+
+@pytest.mark.dem_subprocess
+def test_the_dem_tab_says_which_listed_runs_are_a_calibrations_design(store_file, tmp_path):
+    # listed with the store's runs without a word, they read as the coupon's 2-cell results
+    from pidcore.calibrate import stored_calibration
+
+    _calibrate_tiny(store_file, tmp_path)
+    at = _app()
+    key = stored_calibration(store_file).store_key
+    assert f"3 of these run(s) are the design runs of calibration(s) {key}: inputs of its " \
+           "fit, not predictions of the specimen; the Compare and Report tabs leave them " \
+           "out" in [c.value for c in at.caption]
+
+
+def test_the_report_choices_come_back_from_the_page_address(store_file):
+    # as the DEM and Calibrate forms: the files chosen and pooling survive a reload
+    files = [(f"c{f:g}_fill50.csv", mass_damper_csv(frequency_hz=f, seed=int(f)))
+             for f in (100.0, 200.0)]
+    at = _upload(_app(), files)
+    at.button(key="save").click()
+    at.run()
+    at = _app_at({"report_filter_files": "c200_fill50.csv", "report_pool": "true"})
+    assert at.multiselect(key="report_filter_files").value == ["c200_fill50.csv"]
+    assert at.checkbox(key="report_pool").value is True
+    table = _table(at, "SDC measured [-]")
+    assert list(table["SDC measured [-]"].dropna().index) == [0] and len(table) == 1
+    # a file the store does not hold: named in one line, not silently dropped
+    at = _app_at({"report_filter_files": ["c200_fill50.csv", "gone.csv"]})
+    assert [e.value for e in at.error] == [
+        "measurements in the report: 'gone.csv' (from the page address) is not one of "
+        "c100_fill50.csv, c200_fill50.csv; c200_fill50.csv is chosen instead"]
+    assert at.multiselect(key="report_filter_files").value == ["c200_fill50.csv"]
+
+
+def test_a_report_checkbox_or_file_the_page_address_cannot_hold_is_refused(store_file):
+    # Streamlit reads anything but true/false as an unticked box without a word
+    at = _app_at({"report_pool": "maybe", "report_filter_files": "a.csv"})
+    assert [e.value for e in at.error] == [
+        "measurements in the report: 'a.csv' (from the page address) is not offered (there "
+        "is nothing to choose yet); none is chosen instead",
+        "pool DEM settings and specimens: 'maybe' (from the page address) is not one of "
+        "true, false; false is chosen instead"]
+    assert at.checkbox(key="report_pool").value is False
+    at = _app_at({"report_pool": "TRUE"})  # Streamlit's reading: any case
+    assert at.checkbox(key="report_pool").value is True and not at.error

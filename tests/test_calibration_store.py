@@ -147,7 +147,9 @@ def test_a_report_from_the_store_has_the_numbers_of_its_json(calibrated, capsys,
     key = stored_calibration(store).store_key
     for name, source in (("from_store", [str(store), "--calibration-key", key]),
                          ("from_json", [str(folder / "out" / "calibration.json")])):
-        assert main(["report", "--dem-store", str(store), "--calibration", *source,
+        # --pool: the store holds only the calibration's own design runs, which are no rows
+        # of their own otherwise (no measurement either: nothing else to put its columns on)
+        assert main(["report", "--dem-store", str(store), "--calibration", *source, "--pool",
                      "--out", str(tmp_path / name), "--format", "csv"]) == 0
     capsys.readouterr()
     from_store = _calibration_columns(tmp_path / "from_store")
@@ -392,3 +394,50 @@ def test_the_output_and_summary_name_the_specimen_file_and_the_file_written(cali
     assert (f"Specimen: paper_coupon (sha256 {start.hash}, from {start.source}); "
             f"calibrated file: {written.name} (sha256 {written.hash}).") \
         in summary.splitlines()
+
+
+def test_a_calibrations_design_runs_are_not_reported_as_predictions(calibrated, capsys,
+                                                                     tmp_path):
+    # the calibration's 2-cell runs showed as rows of their own, "DEM settings: cells 2", with
+    # an SDC and no word that they were a fit's inputs; in a store holding no other run, as
+    # the coupon's only DEM prediction
+    import shutil
+
+    from pidcore.dem import DemConfig, LoadCase
+    from pidcore.dem.sweep import run_case
+    from pidcore.report.downloads import store_report_table
+
+    _, calibrated_store = calibrated
+    store = tmp_path / "dem.h5"
+    shutil.copyfile(calibrated_store, store)
+    design = Store(store).list_dem_runs()
+    assert len(design) == 3 and set(design["cells_simulated"]) == {2}
+    # the user's own run at a calibrated load case with another seed is a prediction: kept
+    own = run_case(LoadCase(500.0, 5.0, 50.0),
+                   DemConfig(cells=2, seed=7, steady_cycles=10, max_transient_cycles=4))
+    own.save_to(Store(store))
+    cal_key = stored_calibration(store).store_key
+    for pool in (False, True):
+        out = tmp_path / f"pool_{pool}"
+        assert main(["report", "--dem-store", str(store), "--out", str(out), "--format", "csv",
+                     *(["--pool"] if pool else [])]) == 0
+        printed = capsys.readouterr().out
+        table = pd.read_csv(out / "report.csv")
+        rows = table[table["DEM runs [-]"] > 0]
+        if pool:  # asked for: every run pooled, the design's included
+            assert rows["DEM runs [-]"].sum() == 4
+            assert "are left out of the comparison" not in printed
+            continue
+        # only the user's run is a row, with its own SDC (copied: no tolerance)
+        assert len(rows) == 1 and rows["DEM runs [-]"].iloc[0] == 1
+        assert rows["SDC DEM (ours) [-]"].iloc[0] == own.record["sdc"]
+        assert (f"note: 3 DEM run(s) of the design of calibration(s) {cal_key} (2 cells per "
+                "run) are left out of the comparison: they are the inputs of its fit, not "
+                "predictions of the specimen (the calibrated DEM is its prediction); --pool "
+                "pools them with the other runs") in printed
+    # the app's Report tab builds the same table (its note in the library's words)
+    app_table = store_report_table(store, None)
+    assert (app_table["DEM runs [-]"] > 0).sum() == 1
+    assert any(n.startswith("3 DEM run(s) of the design of calibration(s) ")
+               and n.endswith("pool=True pools them with the other runs")
+               for n in app_table.attrs["notes"])

@@ -526,11 +526,33 @@ def saved_calibrations_table(store_path: str | Path | None = None, *,
             specimen_label(n, h) if isinstance(n, str) and isinstance(h, str) and h else n
             for n, h in zip(listing["specimen"], listing["specimen_hash"], strict=True)]
     table["saved [UTC]"] = table["saved [UTC]"].str[:19].str.replace("T", " ")
+    # two calibrations of the same fit read alike though one ran 2 cells per DEM run and the
+    # other 8: the cells its design ran, from its stored settings
+    if "parameters_json" in listing.columns:
+        table.insert(list(table.columns).index("fitted") + 1 if "fitted" in table.columns
+                     else len(table.columns), CELLS_COLUMN,
+                     [_stored_cells(p) for p in listing["parameters_json"]])
     table = table.astype(object).where(table.notna(), "")
     for column in ("load cases [-]", "inside 95 % band (LOO) [-]"):  # counts, not 10.0
         if column in table.columns:
             table[column] = [_count_cell(v) for v in table[column]]
     return table
+
+
+#: The saved calibrations table's column of the cells per DEM run of each calibration.
+CELLS_COLUMN = "cells per DEM run [-]"
+
+
+def _stored_cells(parameters_json: object) -> object:
+    """The cells per DEM run a stored calibration's settings state; blank where they state
+    none (a calibration stored without them, or a damaged record: the table still lists it)."""
+    import json
+
+    try:
+        cells = json.loads(str(parameters_json))["settings"]["cells"]
+    except (ValueError, KeyError, TypeError):
+        return ""
+    return _count_cell(cells)
 
 
 def _count_cell(value: object) -> object:

@@ -68,8 +68,13 @@ def sdc_chart(data: pd.DataFrame) -> dict[str, Any]:
     present = [s for s in SDC_SERIES if s in set(data["series"])]
     plain = data.rename(columns={"fill [%]": "fill", "SDC [-]": "sdc", "low [-]": "low",
                                  "high [-]": "high"})
-    # ticks at the fills that carry points (Vega's own ticks left 25 % unlabelled)
-    fills = sorted({float(f) for f in plain.loc[plain["series"] != _MODEL, "fill"]})
+    # ticks at the fills that carry points (Vega's own ticks left 25 % unlabelled) and at the
+    # model curve's ends: beside one point (a case off the paper's grid) the curve had no
+    # scale under it, one tick labelled "40" under a curve from 25 to 90 %
+    model_fills = plain.loc[plain["series"] == _MODEL, "fill"].astype(float)
+    ends = {model_fills.min(), model_fills.max()} if not model_fills.empty else set()
+    fills = sorted({float(f) for f in plain.loc[plain["series"] != _MODEL, "fill"]} | ends) \
+        if (plain["series"] != _MODEL).any() else []
     x = _field("fill", "quantitative", title="packing ratio (fill) [%]",
                # ".6~g": 40 and 37.5, not Vega's 40.000000 for a list of floats; the precision
                # stated, or Vega takes it from the tick step and writes 25 as "3e+1"

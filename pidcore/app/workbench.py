@@ -110,16 +110,23 @@ def case_view(entries: Sequence[MeasuredEntry], dem_runs: pd.DataFrame | None,
     specimens' runs would be pooled; empty otherwise) and ``dem_warning`` (the report's note
     for a DEM case with unconverged runs; empty otherwise).
     """
+    from ..calibrate.persist import calibration_design_runs
     from ..compare.specimens import runs_for_measurement
-    from ..report.pipeline import whole_mass_baseline_note
+    from ..report.pipeline import whole_mass_baseline_note, without_design_runs
     from ..report.table import not_converged_note
 
+    # a calibration's design runs (its 2-4 cell inputs) are no prediction to compare with,
+    # as in the Report tab: they were the chart's "our DEM" points beside the real runs
+    design_note = ""
+    design = calibration_design_runs(dem_runs, store_paths)
+    if design and dem_runs is not None:
+        dem_runs, design_note = without_design_runs(dem_runs, design, poolable=False)
     # group_entries never pools specimens: the first entry names the group's
     first = entries[0]
     met = runs_for_measurement(dem_runs, first.specimen, first.load_case.material,
                                first.load_case.direction)
     comparison = compare_case(entries, met.runs, paper)
-    notes = list(comparison.notes)
+    notes = list(comparison.notes) + ([design_note] if design_note else [])
     if met.note and not met.refused:
         notes.append(met.note)
     # the Report tab and `pidcore report` say it; the Compare page showed such a low SDC

@@ -14,6 +14,8 @@ reports and the app (which then survive a restart and travel with the store's DE
   :class:`~pidcore.calibrate.prediction.Calibration`;
 * :func:`readable_calibrations`: those that can be read, and what is wrong with the others;
 * :func:`stored_calibration`: one of them, by key (a store holding one needs none);
+* :func:`calibration_design_runs`: which stored DEM runs are a calibration's design runs (inputs
+  of its fit, kept apart from a report's predictions);
 * :func:`is_store_file`: whether a ``--calibration`` path names a store rather than a JSON file.
 """
 
@@ -22,6 +24,7 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, NamedTuple
 
@@ -298,3 +301,59 @@ def _keys_text(listing) -> str:
 
     return "; ".join(f"{r['key']} ({r.get('specimen', '')}, fitted '{r.get('fit', '')}'; "
                      f"{str(r['created_utc'])[:16]}{written(r)})" for _, r in rows.iterrows())
+
+
+def calibration_design_runs(runs: pd.DataFrame | None,
+                            store_paths: Sequence[str | os.PathLike | None]) -> dict[str, str]:
+    """The DEM runs of ``runs`` (a :func:`pidcore.store.listing.list_dem_runs` listing) that
+    are the design runs of a calibration saved in one of ``store_paths``: run key ->
+    calibration key.
+
+    A calibration runs its start specimen (and, fitting DEM parameters, variants of it with
+    other hashes, which reports leave out as other specimens) at its measured load cases with
+    its own cells per run and seed, usually fewer cells than a prediction would use: such a
+    run is an input of the fit, not a prediction of the specimen. A run is one where its
+    specimen's hash is the calibration's, its cells and seed are the calibration's settings,
+    and its load case (frequency, acceleration, fill, material) is one the calibration
+    predicts: the inputs its cache key is made of, read from what the store holds of both,
+    so the calibrations saved before this existed are recognised too.
+    """
+    import numpy as np
+
+    from ..store import Store
+
+    needed = {"case_key", "specimen_sha256", "cells_simulated", "seed", "frequency_hz",
+              "acceleration_g", "fill_percent", "material"}
+    if runs is None or runs.empty or not needed <= set(runs.columns):
+        return {}
+    found: dict[str, str] = {}
+    for path in dict.fromkeys(Path(p) for p in store_paths if p is not None):
+        if not path.is_file():
+            continue
+        listing = Store(path).list_calibrations()
+        if listing.empty:
+            continue
+        calibrations, _ = readable_calibrations(path, listing=listing)  # damaged: said elsewhere
+        by_key = {c.store_key: c for c in calibrations}
+        for _, record in listing.iterrows():
+            calibration = by_key.get(record["key"])
+            try:
+                settings = json.loads(str(record.get("parameters_json") or "{}"))["settings"]
+                cells, seed = int(settings["cells"]), int(settings["seed"])
+            except (KeyError, TypeError, ValueError):
+                continue  # a calibration that does not state its runs' settings
+            if calibration is None:
+                continue
+            same = runs[(runs["specimen_sha256"] == record.get("specimen_hash"))
+                        & (runs["cells_simulated"] == cells) & (runs["seed"] == seed)]
+            for p in calibration.predictions:
+                case = p.load_case
+                # the calibration made these runs from the cases it predicts: the same
+                # numbers, so only float noise of a round trip through the store is allowed
+                at = (np.isclose(same["frequency_hz"], case.frequency_hz, rtol=1e-9)
+                      & np.isclose(same["acceleration_g"], case.acceleration_g, rtol=1e-9)
+                      & np.isclose(same["fill_percent"], case.fill_percent, rtol=1e-9)
+                      & (same["material"] == case.material))
+                for key in same.loc[at, "case_key"]:
+                    found.setdefault(str(key), str(record["key"]))
+    return found

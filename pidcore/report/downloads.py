@@ -72,10 +72,14 @@ def _store_report(path: str | os.PathLike, dem_store: str | os.PathLike | None, 
         return pd.DataFrame(), None, analyses
     where = " and ".join(str(p) for p in (path, dem_store)
                          if p is not None and Path(p).is_file())
+    from ..calibrate.persist import calibration_design_runs
+
     built = specimen_report_table(dem_runs if not dem_runs.empty else None,
                                   analyses if not analyses.empty else None, specimen=specimen,
                                   where=where or None, pool=pool,
-                                  choose_another=CHOOSE_SPECIMEN_APP)
+                                  choose_another=CHOOSE_SPECIMEN_APP,
+                                  design_runs=calibration_design_runs(dem_runs,
+                                                                      [path, dem_store]))
     table = built.table if calibration is None else add_calibration_columns(
         built.table, calibration, specimen=specimen, paper=specimen is None)
     return table, built.dem_runs, analyses

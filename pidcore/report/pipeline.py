@@ -393,6 +393,33 @@ def specimen_dem_runs(stored: pd.DataFrame | None, specimen=None, *,
     return kept, notes
 
 
+def without_design_runs(runs: pd.DataFrame, design_runs: Mapping[str, str], *,
+                        poolable: bool = True) -> tuple[pd.DataFrame | None, str]:
+    """``runs`` without the calibrations' design runs, and the note naming them ("" where
+    there were none); ``poolable``: the note says that ``pool=True`` pools them (a page that
+    does not pool does not).
+
+    A calibration's runs (2 to 4 cells each, by default) showed as rows of their own beside the
+    specimen's predictions, "DEM settings: cells 2", with an SDC of their own and nothing
+    saying they were a fit's inputs: an engineer read them as another prediction of the
+    coupon, and in a store holding no other runs, as its only one."""
+    design = runs["case_key"].isin(list(design_runs)).to_numpy(bool)
+    if not design.any():
+        return runs, ""
+    left_out = runs[design]
+    calibrations = sorted({design_runs[k] for k in left_out["case_key"]})
+    cells = sorted({int(c) for c in left_out["cells_simulated"].dropna()}) \
+        if "cells_simulated" in left_out.columns else []
+    of_cells = f" ({' or '.join(map(str, cells))} cells per run)" if cells else ""
+    note = (f"{int(design.sum())} DEM run(s) of the design of calibration(s) "
+            f"{', '.join(calibrations)}{of_cells} are left out of the comparison: they are "
+            "the inputs of its fit, not predictions of the specimen (the calibrated DEM is "
+            "its prediction)" + ("; pool=True pools them with the other runs" if poolable
+                                     else ""))
+    kept = runs[~design].reset_index(drop=True)
+    return (kept if not kept.empty else None), note
+
+
 def unsubtracted_baseline_note(specimen, analyses: pd.DataFrame | None) -> str:
     """The note for measurements of ``specimen``'s particles analysed without the empty
     coupon's loss factor its file states (``[coupon] baseline_loss_factor``); "" where it
@@ -463,7 +490,8 @@ class SpecimenTable:
 def specimen_report_table(stored_runs: pd.DataFrame | None, analyses: pd.DataFrame | None, *,
                           specimen: Specimen | None = None, where: str | Path | None = None,
                           tolerances: Tolerances | None = None, pool: bool = False,
-                          choose_another: str = CHOOSE_SPECIMEN_CLI) -> SpecimenTable:
+                          choose_another: str = CHOOSE_SPECIMEN_CLI,
+                          design_runs: Mapping[str, str] | None = None) -> SpecimenTable:
     """The report table of one specimen's DEM runs (:func:`specimen_dem_runs`) beside the
     analyses, as ``pidcore report`` and the app's Report tab show it.
 
@@ -474,11 +502,21 @@ def specimen_report_table(stored_runs: pd.DataFrame | None, analyses: pd.DataFra
     run of its specimen at its material and direction says so (alignment ``no_dem_runs``) and
     names the runs of other specimens the store holds there. The default (the paper's coupon)
     leaves the column empty, as the bundled report always had it.
+
+    ``design_runs``: run key -> calibration key of the runs that are calibrations' design runs
+    (:func:`pidcore.calibrate.persist.calibration_design_runs`); unless ``pool``, they are left
+    out of the rows, and a note says so.
     """
     from ..model import load_paper_table3
 
     dem_runs, notes = specimen_dem_runs(stored_runs, specimen, where=where,
                                         choose_another=choose_another)
+    if design_runs and not pool and dem_runs is not None:
+        dem_runs, note = without_design_runs(dem_runs, design_runs)
+        if note:
+            notes.append(note)
+            # nor are they "another specimen's runs" in a measured row's note
+            stored_runs, _ = without_design_runs(stored_runs, design_runs)
     paper = load_paper_table3()
     from ..specimen import PAPER_SPECIMEN_NAME, measured_specimen_name
 
@@ -777,8 +815,12 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
     dem_runs = _joined_dem_runs(dems)
     if not results:  # the stored records' own settings, not the unused options' defaults
         parameters = stored_parameters(analyses)
+    from ..calibrate.persist import calibration_design_runs
+
+    # a calibration's runs are saved in its --dem-store, beside the calibration itself
     built = specimen_report_table(dem_runs, analyses, specimen=specimen, where=dem_path,
-                                  tolerances=tolerances, pool=pool)
+                                  tolerances=tolerances, pool=pool,
+                                  design_runs=calibration_design_runs(dem_runs, dem_paths))
     table, dem_runs, aligner = built.table, built.dem_runs, built.aligner
     if calibrated is not None:
         table = add_calibration_columns(table, calibrated, tolerances=tolerances,

@@ -2,9 +2,20 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 
 import streamlit as st
+
+#: How the DEM and Calibrate forms keep their values over a page reload: each field is bound
+#: to the page address (Streamlit's own binding; the widget's key names the parameter, a
+#: default value is left out of the address). The address is the browser tab's own, so it
+#: survives a reload, two tabs keep their own settings, and nothing is written to the store
+#: (a store write per keystroke would change its stamp and re-read every listing). Text fields
+#: come back as text and are read, or refused naming the field, at Run as typed text is.
+ADDRESS_BINDING = "query-params"
+
+#: Session-state key of the choices the page address held that a field does not offer.
+_ADDRESS_REFUSALS = "_address_refusals"
 
 
 def draw_polling(body: Callable[..., None], *args, polling: bool, every_s: float) -> None:
@@ -17,6 +28,53 @@ def draw_polling(body: Callable[..., None], *args, polling: bool, every_s: float
     the timer.
     """
     st.fragment(run_every=every_s if polling else None)(body)(*args, polling)
+
+
+#: A checkbox's value as the page address writes it.
+FLAG_WORDS = {True: "true", False: "false"}
+
+
+def refuse_address_flag(key: str, label: str, default: bool = False) -> None:
+    """:func:`refuse_address_choices` of a checkbox: anything but true or false (Streamlit
+    reads it as the default without a word)."""
+    refuse_address_choices(key, label, list(FLAG_WORDS.values()), FLAG_WORDS[default])
+
+
+def refuse_address_choices(key: str, label: str, options: Sequence[str],
+                            default: Sequence[str] | str) -> None:
+    """Say, in the one-line style of a refused typed value, where the page address holds a
+    choice of the field ``key`` (``label``) that is not among ``options``: Streamlit drops it
+    without a word and shows ``default`` (a changed vocabulary, or an edited address, would
+    otherwise run something else than the address says). Call before the field is drawn; the
+    error stays until the field is changed."""
+    refusals = st.session_state.setdefault(_ADDRESS_REFUSALS, {})
+    # an empty value is a cleared field (a multiple choice with nothing chosen), not a choice;
+    # a checkbox's word is read in any case (Streamlit reads "TRUE" as true)
+    stated = [v.lower() if list(options) == list(FLAG_WORDS.values()) else v
+              for v in st.query_params.get_all(key) if v != ""]
+    unknown = [v for v in stated if v not in options]
+    if unknown and key not in st.session_state:  # a fresh session reading its address
+        # a multiple choice keeps the address's known values (Streamlit's filter), else the
+        # default
+        fallback = default if isinstance(default, str) else (
+            [v for v in stated if v in options] or list(default))
+        shown = fallback if isinstance(fallback, str) else ", ".join(fallback) or "none"
+        quoted = ", ".join(f"'{v}'" for v in unknown)
+        offered = (f"one of {', '.join(options)}" if options
+                   else "offered (there is nothing to choose yet)")
+        refusals[key] = (f"{label}: {quoted} (from the page address) is not {offered}; "
+                         f"{shown} is chosen instead", fallback)
+    refused = refusals.get(key)
+    if refused is None:
+        return
+    message, fallback = refused
+    current = st.session_state.get(key, fallback)
+    if isinstance(current, bool):  # a checkbox: its address words
+        current = FLAG_WORDS[current]
+    if current == fallback:
+        st.error(message)
+    else:  # the user chose: the address's value is no longer the question
+        del refusals[key]
 
 
 #: The choice of the paper's coupon in :func:`specimen_choice`.
@@ -39,8 +97,11 @@ def specimen_choice(key: str):
     c1, c2 = st.columns(2)
     upload = c2.file_uploader("or a specimen file (TOML)", type=["toml"],
                               key=f"{key}_specimen_file")
-    choice = c1.selectbox("specimen", [PAPER_CHOICE, *map(str, files)], key=f"{key}_specimen",
-                          disabled=upload is not None)
+    choices = [PAPER_CHOICE, *map(str, files)]
+    with c1:
+        refuse_address_choices(f"{key}_specimen", "specimen", choices, PAPER_CHOICE)
+    choice = c1.selectbox("specimen", choices, key=f"{key}_specimen",
+                          disabled=upload is not None, bind=ADDRESS_BINDING)
     try:
         if upload is not None:
             return jobs.specimen_from_upload(upload.name, upload.getvalue()), None

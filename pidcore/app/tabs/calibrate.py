@@ -24,7 +24,12 @@ from pidcore.app.calibration import (
     runner_for,
     specimen_label,
 )
-from pidcore.app.tabs import draw_polling, specimen_choice
+from pidcore.app.tabs import (
+    ADDRESS_BINDING,
+    draw_polling,
+    refuse_address_choices,
+    specimen_choice,
+)
 from pidcore.loadcase import parse_count
 from pidcore.specimen import calibrated_name
 
@@ -146,7 +151,10 @@ def _saved(stored) -> None:
                 "them)")
     st.dataframe(saved_calibrations_table(listing=stored.listing), hide_index=True)
     keys = [c.store_key for c in saved]
-    key = st.selectbox("download the files of", keys, key="calibration_saved_key")
+    # a choice per set of saved calibrations: one saved since (the run just made) is offered
+    # first, not the older one the box showed before
+    listed = hashlib.sha256("\n".join(keys).encode()).hexdigest()[:12]
+    key = st.selectbox("download the files of", keys, key=f"calibration_saved_key_{listed}")
     chosen = saved[keys.index(key)]
     c1, c2 = st.columns(2)
     c1.download_button("calibration.json", chosen.document_text, file_name="calibration.json",
@@ -200,34 +208,45 @@ def _form(stores, api, points: list, left_out: list[str]) -> str:
             return chosen_label
         points = [p for group in by_material.values() for p in group]
     if len(by_material) > 1:  # one specimen at a time: its particle material first
+        refuse_address_choices("calibration_material", "particle material", list(by_material),
+                               next(iter(by_material)))
         material = st.selectbox("particle material (one calibration per material)",
-                                list(by_material), key="calibration_material")
+                                list(by_material), key="calibration_material",
+                                bind=ADDRESS_BINDING)
         points = by_material[material]
         cases_key = f"calibration_cases_{material}"  # each material keeps its own choice
     labels = [p.label() for p in points]
     # a choice per set of saved cases: cases saved since are chosen, not left out unseen
     cases_key += "_" + hashlib.sha256("\n".join(labels).encode()).hexdigest()[:12]
+    refuse_address_choices(cases_key, "measured load cases", labels, labels)
     chosen_cases = st.multiselect("measured load cases to calibrate against (from the store)",
-                                  labels, default=labels, key=cases_key)
+                                  labels, default=labels, key=cases_key, bind=ADDRESS_BINDING)
     points = [p for p, label in zip(points, labels, strict=True) if label in chosen_cases]
     st.dataframe(pd.DataFrame([dataclasses.asdict(p) for p in points]).drop(
         columns=["source", "row"], errors="ignore").rename(columns={
         "frequency_hz": "frequency [Hz]", "acceleration_g": "acceleration [g]",
         "fill_percent": "fill [%]", "sdc": "SDC measured, Eq. 11 [-]",
-        "sdc_stderr": "SDC stderr [-]"}), hide_index=True, width="stretch",
+        "sdc_stderr": "SDC stderr [-]",
+        # every number names its unit: the raw field name was shown as a column head
+        "sdc_stderr_dof": "SDC stderr degrees of freedom [-]"}), hide_index=True,
+        width="stretch",
         key="calibration_points", placeholder="")
     c1, c2, c3 = st.columns(3)
     fittable = fittable_names(api)
-    chosen = c1.multiselect("parameters to fit", fittable,
-                            default=[n for n in api.parse_fit(None) if n in fittable],
-                            key="calibration_fit")
+    default_fit = [n for n in api.parse_fit(None) if n in fittable]
+    with c1:
+        refuse_address_choices("calibration_fit", "parameters to fit", fittable, default_fit)
+    # the form's fields are bound to the page address: a reload keeps them (ADDRESS_BINDING)
+    chosen = c1.multiselect("parameters to fit", fittable, default=default_fit,
+                            key="calibration_fit", bind=ADDRESS_BINDING)
     extra = c1.text_input("more parameters (specimen fields, comma-separated)", "",
-                          key="calibration_fit_extra",
+                          key="calibration_fit_extra", bind=ADDRESS_BINDING,
                           help="e.g. friction, restitution (as `pidcore calibrate --fit`)")
     # text read by pidcore (parse_count): the browser's number box made "2,5" 25 cells
     cells = c2.text_input("cells per DEM run", "4", key="calibration_cells",
-                          help=f"2 to {defaults.APP_MAX_DEM_CELLS}")
-    design = c3.text_input("design points (0 = default)", "0", key="calibration_design")
+                          help=f"2 to {defaults.APP_MAX_DEM_CELLS}", bind=ADDRESS_BINDING)
+    design = c3.text_input("design points (0 = default)", "0", key="calibration_design",
+                           bind=ADDRESS_BINDING)
     wanted = [*chosen, *(n.strip() for n in extra.split(",") if n.strip())]
     too_few = bool(wanted) and len(points) < points_needed(wanted)
     if too_few:

@@ -13,7 +13,12 @@ import streamlit as st
 
 from pidcore import defaults
 from pidcore.app import jobs, state
-from pidcore.app.tabs import draw_polling, specimen_choice
+from pidcore.app.tabs import (
+    ADDRESS_BINDING,
+    draw_polling,
+    refuse_address_choices,
+    specimen_choice,
+)
 from pidcore.constants import DRIVE_DIRECTIONS, PARTICLE_MATERIALS
 from pidcore.loadcase import parse_count, parse_values
 
@@ -87,10 +92,12 @@ def render(stores) -> None:
                "one after the other, each saved to the store as it finishes; you can switch "
                "tabs or reload meanwhile. Larger grids: `pidcore dem`.")
     c1, c2, c3 = st.columns(3)
+    # every field is bound to the page address: a reload keeps the form (ADDRESS_BINDING)
     freqs = c1.text_input("frequencies [Hz]", "100", key="dem_freqs",
-                          help="one or more values, e.g. 50, 100, 333")
-    accs = c2.text_input("accelerations [g]", "5", key="dem_accs", help="e.g. 1, 5, 7.5")
-    fills = c3.text_input("fills [%]", "50", key="dem_fills",
+                          help="one or more values, e.g. 50, 100, 333", bind=ADDRESS_BINDING)
+    accs = c2.text_input("accelerations [g]", "5", key="dem_accs", help="e.g. 1, 5, 7.5",
+                         bind=ADDRESS_BINDING)
+    fills = c3.text_input("fills [%]", "50", key="dem_fills", bind=ADDRESS_BINDING,
                           help="e.g. 25, 50; empty: the specimen file's own count_per_cell or "
                                "fill_percent")
     specimen, refused = specimen_choice("dem")
@@ -99,20 +106,36 @@ def render(stores) -> None:
         c4.text_input("particle material", "(the specimen file is refused)", disabled=True,
                       key="dem_material_refused")
     elif specimen is None:
-        material = c4.selectbox("particle material", PARTICLE_MATERIALS, key="dem_material")
+        with c4:
+            refuse_address_choices("dem_material", "particle material", PARTICLE_MATERIALS,
+                                   PARTICLE_MATERIALS[0])
+        material = c4.selectbox("particle material", PARTICLE_MATERIALS, key="dem_material",
+                                bind=ADDRESS_BINDING)
     else:
         material = specimen.particles.material
         c4.text_input("particle material (the specimen's)", material, disabled=True,
                       key="dem_material_specimen")
-    direction = c5.selectbox("drive direction", DRIVE_DIRECTIONS, key="dem_direction")
-    with st.expander("numerical settings", expanded=False):
+    with c5:
+        refuse_address_choices("dem_direction", "drive direction", DRIVE_DIRECTIONS,
+                               DRIVE_DIRECTIONS[0])
+    direction = c5.selectbox("drive direction", DRIVE_DIRECTIONS, key="dem_direction",
+                             bind=ADDRESS_BINDING)
+    numerical = {"dem_cells": str(defaults.DEM_CELLS), "dem_seed": str(defaults.DEM_SEED),
+                 "dem_steady": "0"}
+    # open where a setting is not its default: one a reload or a shared address brought back
+    # (cells 1, say) was hidden under the closed expander and ran with the next Run
+    changed = any(str(st.session_state.get(key, st.query_params.get(key, default))) != default
+                  for key, default in numerical.items())
+    with st.expander("numerical settings", expanded=changed):
         d1, d2, d3 = st.columns(3)
         # text read by pidcore (parse_count): the browser's number box made "1e3" steady
         # cycles 1 and "2,5" cells 25 without a word
-        cells = d1.text_input("cells simulated", str(defaults.DEM_CELLS), key="dem_cells",
-                              help=f"1 to {MAX_CELLS}")
-        seed = d2.text_input("seed", str(defaults.DEM_SEED), key="dem_seed")
-        steady = d3.text_input("steady cycles (0 = automatic)", "0", key="dem_steady")
+        cells = d1.text_input("cells simulated", numerical["dem_cells"], key="dem_cells",
+                              help=f"1 to {MAX_CELLS}", bind=ADDRESS_BINDING)
+        seed = d2.text_input("seed", numerical["dem_seed"], key="dem_seed",
+                             bind=ADDRESS_BINDING)
+        steady = d3.text_input("steady cycles (0 = automatic)", numerical["dem_steady"],
+                               key="dem_steady", bind=ADDRESS_BINDING)
     b1, b2 = st.columns(2)
     start = b1.button("Run", type="primary", key="dem_run", disabled=refused is not None,
                       help="off while the chosen specimen file is refused"
@@ -164,6 +187,15 @@ def render(stores) -> None:
         table = jobs.dem_runs_table(runs)
         st.dataframe(table, hide_index=True, width="stretch", key="dem_runs_table",
                      placeholder="")
+        from pidcore.calibrate.persist import calibration_design_runs
+
+        # listed as the store holds them, but said: Compare and Report leave them out
+        design = calibration_design_runs(runs, [stores.path, stores.dem_reference])
+        if design:
+            st.caption(f"{len(design)} of these run(s) are the design runs of calibration(s) "
+                       f"{', '.join(sorted(set(design.values())))}: inputs of its fit, not "
+                       "predictions of the specimen; the Compare and Report tabs leave them "
+                       "out")
         unconverged = int(table["steady state"].str.startswith("NOT").sum())
         if unconverged:
             st.warning(f"{unconverged} run(s) did not converge (steady state NOT detected "

@@ -6,7 +6,12 @@ import streamlit as st
 
 from pidcore.app import state
 from pidcore.app.report_builds import start_report_build
-from pidcore.app.tabs import draw_polling
+from pidcore.app.tabs import (
+    ADDRESS_BINDING,
+    draw_polling,
+    refuse_address_choices,
+    refuse_address_flag,
+)
 from pidcore.app.vocabulary import page_terms
 
 #: Seconds between refreshes of the report build's state while it runs.
@@ -43,10 +48,17 @@ def render(stores, calibrations: list) -> None:
         st.error(f"cannot read the store: {exc}")
         return
     c1, c2 = st.columns([2, 1])  # room for the checkbox's label at 1280-1500 px
-    chosen = c1.multiselect("measurements in the report (all when none chosen)",
-                            sorted(set(saved["file"])) if not saved.empty else [],
-                            key="report_filter_files")
+    files = sorted(set(saved["file"])) if not saved.empty else []
+    # the choices are bound to the page address, as the DEM and Calibrate forms: a reload
+    # keeps them (ADDRESS_BINDING)
+    with c1:
+        refuse_address_choices("report_filter_files", "measurements in the report", files, [])
+    chosen = c1.multiselect("measurements in the report (all when none chosen)", files,
+                            key="report_filter_files", bind=ADDRESS_BINDING)
+    with c2:
+        refuse_address_flag("report_pool", "pool DEM settings and specimens")
     pool = c2.checkbox("pool DEM settings and specimens", value=False, key="report_pool",
+                       bind=ADDRESS_BINDING,
                        help="one row per load case (default: a row per DEM setting and per "
                             "specimen)")
     keys = (tuple(saved[saved["file"].isin(chosen)]["key"]) if chosen and not saved.empty
@@ -61,8 +73,10 @@ def render(stores, calibrations: list) -> None:
     specimen_label = DEFAULT_SPECIMEN
     if others:
         options = [DEFAULT_SPECIMEN, *others]
+        refuse_address_choices("report_specimen", "specimen of the DEM runs compared",
+                               options, DEFAULT_SPECIMEN)
         specimen_label = st.selectbox("specimen of the DEM runs compared", options,
-                                      key="report_specimen",
+                                      key="report_specimen", bind=ADDRESS_BINDING,
                                       help="as `pidcore report --specimen FILE`: the runs of "
                                            "other specimens are left out, the notes name them")
     specimen = others.get(specimen_label)
@@ -92,15 +106,16 @@ def render(stores, calibrations: list) -> None:
                 f"of this specimen yet: save analysed files (tab Analyse) or run DEM cases "
                 "(tab DEM).")
         for note in table.attrs.get("notes", []):  # e.g. other specimens' runs left out
-            st.caption(f"note: {note}")
+            st.caption(f"note: {page_terms(note)}")
         return
     st.caption(f"calibrated DEM columns: {label}" if calibration is not None else label)
     # cells empty by design (measured columns of a DEM-only row, DEM columns of a measured-only
     # one) are empty, not the grid's greyed "None"; the two results that can lack a value say
     # why (report_display)
-    st.dataframe(report_display(table), hide_index=True, key="report_table", width="stretch",
-                 placeholder="")
-    for note in table.attrs.get("notes", []):
+    shown = report_display(table)
+    st.dataframe(shown, hide_index=True, key="report_table", width="stretch", placeholder="")
+    # the notes in the page's terms too (report_display's): "pool=True" is the checkbox here
+    for note in shown.attrs.get("notes", []):
         st.caption(f"note: {note}")
     made = (stamp, pool, keys, digest, specimen_label)
     if st.button("Build report files (CSV, Markdown, HTML, LaTeX, PDF)", key="build_report"):
