@@ -1556,9 +1556,10 @@ def test_the_calibrate_pages_measurements_table_names_every_numbers_unit(store_f
     assert all(c.endswith("]") for c in numeric), numeric
 
 
-def _calibrate_tiny(store_file, folder) -> None:
+def _calibrate_tiny(store_file, folder, *, own_run: bool = False) -> float | None:
     """A calibration saved in the app's store with its 3 design runs (2 cells, 10 steady
-    cycles: seconds) at 500 Hz 5 g, 1000 Hz 5 g and 500 Hz 1 g, 50 % acrylic."""
+    cycles: seconds) at 500 Hz 5 g, 1000 Hz 5 g and 500 Hz 1 g, 50 % acrylic; ``own_run``:
+    and a run of the user's at 500 Hz 5 g (another seed), whose SDC is returned."""
     from pidcore.cli import main
 
     table = folder / "m.csv"
@@ -1568,37 +1569,50 @@ def _calibrate_tiny(store_file, folder) -> None:
                  "--discrepancy", "0.2", "--dem-store", str(store_file), "--out",
                  str(folder / "out"), "--cells", "2", "--steady-cycles", "10",
                  "--workers", "1", "--no-progress"]) == 0
+    if not own_run:
+        return None
+    from pidcore.dem import DemConfig, LoadCase
+    from pidcore.dem.sweep import run_case
+    from pidcore.store import Store
+
+    own = run_case(LoadCase(500.0, 5.0, 50.0),
+                   DemConfig(cells=2, seed=7, steady_cycles=10, max_transient_cycles=4))
+    own.save_to(Store(store_file))
+    return own.record["sdc"]
 
 
 @pytest.mark.dem_subprocess
 def test_the_report_tab_says_a_calibrations_design_runs_are_left_out_in_its_own_words(
         store_file, tmp_path):
-    _calibrate_tiny(store_file, tmp_path)
+    _calibrate_tiny(store_file, tmp_path, own_run=True)
     at = _app()
-    notes = [c.value for c in at.caption if c.value.startswith("note: 3 DEM run(s) of the "
+    notes = [c.value for c in at.caption if c.value.startswith("note: 1 DEM run(s) of the "
                                                                 "design of calibration(s)")]
     # the page's checkbox, not the library's keyword (the notes were shown as the library
     # wrote them, though the grid's row notes were put in the page's terms)
     assert len(notes) == 1
-    assert notes[0].endswith("'pool DEM settings and specimens' pools them with the other runs")
+    assert "'pool DEM settings and specimens' pools them with the other runs; 2 DEM run(s)" \
+        in notes[0]
     assert not any("pool=True" in c.value for c in at.caption)
 
 
 @pytest.mark.dem_subprocess
 def test_compare_does_not_take_a_calibrations_design_run_for_our_dem(store_file, tmp_path):
     # the 2-cell run a calibration made at the measured case was the headline's "our DEM"
-    # and the chart's DEM point, as the Report tab showed it as a row of its own
+    # and the chart's DEM point beside the user's own run there, as the Report tab showed it
+    # as a row of its own
     from pidcore.store import Store
 
-    _calibrate_tiny(store_file, tmp_path)
-    design = Store(store_file).list_dem_runs()
-    assert len(design) == 3
+    own_sdc = _calibrate_tiny(store_file, tmp_path, own_run=True)
+    runs = Store(store_file).list_dem_runs()
+    assert len(runs) == 4
     at = _upload(_app(), [("coupon_fill50.csv", mass_damper_csv(frequency_hz=500.0,
                                                                  acceleration_g=5.0))])
-    assert "vs our DEM none" in _headline(at)
-    assert any(c.value.startswith("note: 3 DEM run(s) of the design of calibration(s) ")
-               and c.value.endswith("(the calibrated DEM is its prediction)")
-               for c in at.caption)
+    # the user's run alone (the design run at this case would make it a mean of two)
+    assert f"vs our DEM {own_sdc:.4f} ±" in _headline(at), _headline(at)
+    assert any(c.value.startswith("note: 1 DEM run(s) of the design of calibration(s) ")
+               and "(the calibrated DEM is its prediction), and other runs of the specimen "
+               "stand at their load cases" in c.value for c in at.caption)
 
 
 @pytest.mark.dem_subprocess
@@ -1611,7 +1625,8 @@ def test_the_dem_tab_says_which_listed_runs_are_a_calibrations_design(store_file
     key = stored_calibration(store_file).store_key
     assert f"3 of these run(s) are the design runs of calibration(s) {key}: inputs of its " \
            "fit, not predictions of the specimen; the Compare and Report tabs leave them " \
-           "out" in [c.value for c in at.caption]
+           "out where another run of the specimen stands at their load case" in \
+           [c.value for c in at.caption]
 
 
 def test_the_report_choices_come_back_from_the_page_address(store_file):

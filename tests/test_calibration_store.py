@@ -360,18 +360,20 @@ def test_a_reports_provenance_names_its_calibration_and_calibrated_file(calibrat
     for name, given, where in (
             ("from_json", [str(written)], f"{written}"),
             ("from_store", [str(store), "--calibration-key", key], f"{store} key {key}")):
-        assert main(["report", "--dem-store", str(store), "--calibration", *given,
+        # --pool: the store holds the calibration's design runs only, which a report leaves
+        # out of its rows otherwise (nothing to report)
+        assert main(["report", "--dem-store", str(store), "--calibration", *given, "--pool",
                      "--out", str(tmp_path / name), "--format", "csv"]) == 0
         lines = (tmp_path / name / "report.provenance.txt").read_text().splitlines()
         assert f"calibration: {where} sha256 {digest}; {said}" in lines, lines
     capsys.readouterr()
     # the app's downloads, from its store's calibration, say the same
-    files = report_files(store, calibration=stored_calibration(store))
+    files = report_files(store, calibration=stored_calibration(store), pool=True)
     text = files["csv_provenance"][1].decode("utf-8")
     assert f"calibration: {store} key {key} sha256 {digest}; {said}" in text.splitlines()
     # no calibration: no such line
-    assert main(["report", "--dem-store", str(store), "--out", str(tmp_path / "none"),
-                 "--format", "csv"]) == 0
+    assert main(["report", "--dem-store", str(store), "--pool", "--out",
+                 str(tmp_path / "none"), "--format", "csv"]) == 0
     assert "calibration:" not in (tmp_path / "none" / "report.provenance.txt").read_text()
 
 
@@ -428,16 +430,26 @@ def test_a_calibrations_design_runs_are_not_reported_as_predictions(calibrated, 
             assert rows["DEM runs [-]"].sum() == 4
             assert "are left out of the comparison" not in printed
             continue
-        # only the user's run is a row, with its own SDC (copied: no tolerance)
-        assert len(rows) == 1 and rows["DEM runs [-]"].iloc[0] == 1
-        assert rows["SDC DEM (ours) [-]"].iloc[0] == own.record["sdc"]
-        assert (f"note: 3 DEM run(s) of the design of calibration(s) {cal_key} (2 cells per "
+        # one run per load case: at 500 Hz 5 g the user's run, with its own SDC (copied: no
+        # tolerance), and not the design run beside it; at the other two cases the design
+        # runs, the only runs of the coupon there (a store of a calibration alone had no DEM
+        # value to compare with)
+        assert len(rows) == 3 and set(rows["DEM runs [-]"]) == {1}
+        at = rows[(rows["frequency [Hz]"] == 500) & (rows["acceleration [g]"] == 5)]
+        assert list(at["SDC DEM (ours) [-]"]) == [own.record["sdc"]]
+        kept = design[design["frequency_hz"].ne(500) | design["acceleration_g"].ne(5)]
+        assert sorted(rows["SDC DEM (ours) [-]"]) == sorted([own.record["sdc"],
+                                                             *kept["sdc"]])
+        assert (f"note: 1 DEM run(s) of the design of calibration(s) {cal_key} (2 cells per "
                 "run) are left out of the comparison: they are the inputs of its fit, not "
-                "predictions of the specimen (the calibrated DEM is its prediction); --pool "
-                "pools them with the other runs") in printed
+                "predictions of the specimen (the calibrated DEM is its prediction), and other "
+                "runs of the specimen stand at their load cases; --pool pools them with the "
+                f"other runs; 2 DEM run(s) of the design of calibration(s) {cal_key} (2 cells "
+                "per run) are compared: the only DEM runs of the specimen at their load cases "
+                "(a fit's inputs, with the few cells of a fit)") in printed
     # the app's Report tab builds the same table (its note in the library's words)
     app_table = store_report_table(store, None)
-    assert (app_table["DEM runs [-]"] > 0).sum() == 1
-    assert any(n.startswith("3 DEM run(s) of the design of calibration(s) ")
-               and n.endswith("pool=True pools them with the other runs")
+    assert (app_table["DEM runs [-]"] > 0).sum() == 3
+    assert any(n.startswith("1 DEM run(s) of the design of calibration(s) ")
+               and "pool=True pools them with the other runs; 2 DEM run(s)" in n
                for n in app_table.attrs["notes"])

@@ -395,29 +395,47 @@ def specimen_dem_runs(stored: pd.DataFrame | None, specimen=None, *,
 
 def without_design_runs(runs: pd.DataFrame, design_runs: Mapping[str, str], *,
                         poolable: bool = True) -> tuple[pd.DataFrame | None, str]:
-    """``runs`` without the calibrations' design runs, and the note naming them ("" where
-    there were none); ``poolable``: the note says that ``pool=True`` pools them (a page that
-    does not pool does not).
+    """``runs`` without the calibrations' design runs that another run of their specimen and
+    load case stands beside, and the note naming the design runs ("" where there were none);
+    ``poolable``: the note says that ``pool=True`` pools them (a page that does not pool does
+    not).
 
     A calibration's runs (2 to 4 cells each, by default) showed as rows of their own beside the
     specimen's predictions, "DEM settings: cells 2", with an SDC of their own and nothing
     saying they were a fit's inputs: an engineer read them as another prediction of the
-    coupon, and in a store holding no other runs, as its only one."""
+    coupon. Where one is the only run of its specimen at its load case it is kept, and the
+    note says what it is: it is a DEM run of that very specimen (a store holding only a
+    calibration's runs had no DEM value to compare with at all)."""
     design = runs["case_key"].isin(list(design_runs)).to_numpy(bool)
     if not design.any():
         return runs, ""
-    left_out = runs[design]
-    calibrations = sorted({design_runs[k] for k in left_out["case_key"]})
-    cells = sorted({int(c) for c in left_out["cells_simulated"].dropna()}) \
-        if "cells_simulated" in left_out.columns else []
+    # a run's load case is its key up to "_seed" (pidcore.dem.persist.run_key: frequency,
+    # acceleration, fill, material, direction as every writer formats them), of its specimen
+    sha = (runs["specimen_sha256"].astype(str) if "specimen_sha256" in runs.columns
+           else pd.Series([""] * len(runs), index=runs.index))
+    where = list(zip(sha, runs["case_key"].astype(str).str.split("_seed").str[0],
+                     strict=True))
+    covered = {w for w, d in zip(where, design, strict=True) if not d}
+    replaced = np.array([d and w in covered for w, d in zip(where, design, strict=True)],
+                        bool)
+    design_keys = runs.loc[design, "case_key"]
+    calibrations = sorted({design_runs[k] for k in design_keys})
+    cells = sorted({int(c) for c in runs.loc[design, "cells_simulated"].dropna()}) \
+        if "cells_simulated" in runs.columns else []
     of_cells = f" ({' or '.join(map(str, cells))} cells per run)" if cells else ""
-    note = (f"{int(design.sum())} DEM run(s) of the design of calibration(s) "
-            f"{', '.join(calibrations)}{of_cells} are left out of the comparison: they are "
-            "the inputs of its fit, not predictions of the specimen (the calibrated DEM is "
-            "its prediction)" + ("; pool=True pools them with the other runs" if poolable
-                                     else ""))
-    kept = runs[~design].reset_index(drop=True)
-    return (kept if not kept.empty else None), note
+    n_out, n_kept = int(replaced.sum()), int(design.sum() - replaced.sum())
+    what = (f"DEM run(s) of the design of calibration(s) {', '.join(calibrations)}{of_cells}")
+    said = []
+    if n_out:
+        said.append(f"{n_out} {what} are left out of the comparison: they are the inputs of "
+                    "its fit, not predictions of the specimen (the calibrated DEM is its "
+                    "prediction), and other runs of the specimen stand at their load cases"
+                    + ("; pool=True pools them with the other runs" if poolable else ""))
+    if n_kept:
+        said.append(f"{n_kept} {what} are compared: the only DEM runs of the specimen at "
+                    "their load cases (a fit's inputs, with the few cells of a fit)")
+    kept = runs[~replaced].reset_index(drop=True)
+    return (kept if not kept.empty else None), "; ".join(said)
 
 
 def unsubtracted_baseline_note(specimen, analyses: pd.DataFrame | None) -> str:

@@ -195,7 +195,7 @@ def render(stores) -> None:
             st.caption(f"{len(design)} of these run(s) are the design runs of calibration(s) "
                        f"{', '.join(sorted(set(design.values())))}: inputs of its fit, not "
                        "predictions of the specimen; the Compare and Report tabs leave them "
-                       "out")
+                       "out where another run of the specimen stands at their load case")
         unconverged = int(table["steady state"].str.startswith("NOT").sum())
         if unconverged:
             st.warning(f"{unconverged} run(s) did not converge (steady state NOT detected "
