@@ -360,20 +360,18 @@ def test_a_reports_provenance_names_its_calibration_and_calibrated_file(calibrat
     for name, given, where in (
             ("from_json", [str(written)], f"{written}"),
             ("from_store", [str(store), "--calibration-key", key], f"{store} key {key}")):
-        # --pool: the store holds the calibration's design runs only, which a report leaves
-        # out of its rows otherwise (nothing to report)
-        assert main(["report", "--dem-store", str(store), "--calibration", *given, "--pool",
+        assert main(["report", "--dem-store", str(store), "--calibration", *given,
                      "--out", str(tmp_path / name), "--format", "csv"]) == 0
         lines = (tmp_path / name / "report.provenance.txt").read_text().splitlines()
         assert f"calibration: {where} sha256 {digest}; {said}" in lines, lines
     capsys.readouterr()
     # the app's downloads, from its store's calibration, say the same
-    files = report_files(store, calibration=stored_calibration(store), pool=True)
+    files = report_files(store, calibration=stored_calibration(store))
     text = files["csv_provenance"][1].decode("utf-8")
     assert f"calibration: {store} key {key} sha256 {digest}; {said}" in text.splitlines()
     # no calibration: no such line
-    assert main(["report", "--dem-store", str(store), "--pool", "--out",
-                 str(tmp_path / "none"), "--format", "csv"]) == 0
+    assert main(["report", "--dem-store", str(store), "--out", str(tmp_path / "none"),
+                 "--format", "csv"]) == 0
     assert "calibration:" not in (tmp_path / "none" / "report.provenance.txt").read_text()
 
 
