@@ -137,6 +137,9 @@ class DemCase:
         or ``run_keys``.
     duplicate_fills : tuple of float
         Fill percentages, %, the duplicates were stored with (for the note).
+    sdc_stderr_dof : float
+        Degrees of freedom of ``sdc_stderr`` (:func:`pooled_stderr_dof`): a run's error is the
+        scatter of its cells' SDCs, cells - 1; NaN where the cells are unknown.
     """
 
     load_case: LoadCase
@@ -151,6 +154,7 @@ class DemCase:
     not_converged: tuple[tuple[int, int], ...] = ()
     duplicate_keys: tuple[str, ...] = ()
     duplicate_fills: tuple[float, ...] = ()
+    sdc_stderr_dof: float = math.nan
 
 
 def duplicates_note(dem: DemCase) -> str:
@@ -515,6 +519,10 @@ def dem_cases(dem_runs: pd.DataFrame, *, tolerances: Tolerances | None = None,
         sub = runs.iloc[members]
         dup = runs.iloc[duplicates]
         sdc, stderr = pooled_mean(sub["sdc"].to_numpy(float), sub["sdc_stderr"].to_numpy(float))
+        cells = cells_of.get(settings, math.nan)
+        stderr_dof = pooled_stderr_dof(sub["sdc"].to_numpy(float),
+                                       sub["sdc_stderr"].to_numpy(float),
+                                       np.full(len(sub), cells - 1.0 if cells > 1 else math.nan))
         ppc = math.nan
         if "particles_per_cell" in sub:
             unique = pd.unique(sub["particles_per_cell"].astype(float))
@@ -528,8 +536,7 @@ def dem_cases(dem_runs: pd.DataFrame, *, tolerances: Tolerances | None = None,
         dup_keys = tuple(str(k) for k in dup[key_column]) if key_column in dup else ()
         dup_fills = tuple(float(f) for f in dup["fill_percent"])
         out.append(DemCase(case, sdc, stderr, len(members), ppc, keys, m_c, settings,
-                           cells_of.get(settings, math.nan), _not_converged(sub),
-                           dup_keys, dup_fills))
+                           cells, _not_converged(sub), dup_keys, dup_fills, stderr_dof))
     return sorted(out, key=lambda c: (*_sort_key(c.load_case), c.settings))
 
 
