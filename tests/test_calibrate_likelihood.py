@@ -112,3 +112,13 @@ def test_a_heavy_outlier_moves_the_posterior_less_than_under_a_normal_likelihood
     # within the grid's Monte-Carlo error (4000 samples: 0.05 of the posterior's sd)
     assert moved["normal"] == pytest.approx(15 / 8 * STDERR, rel=0.1)
     assert 0 < moved["t"] < 0.5 * moved["normal"]
+
+
+def test_a_non_finite_prediction_gives_nan_as_the_normal_does_not_a_table_index():
+    # NaN became a table index of -2^63 (IndexError) before the guard
+    residual = np.array([np.nan, np.inf, 0.01])
+    variance = np.array([0.03**2, 0.03**2, np.nan])
+    got = log_density(residual, variance, stderr=0.02, dof=7.0)
+    assert np.all(np.isnan(got))
+    normal = log_density(residual, variance, stderr=0.02, dof=math.nan)
+    assert np.all(~np.isfinite(normal))

@@ -151,6 +151,9 @@ def log_density(residual: np.ndarray, variance: np.ndarray, *, stderr: float,
     if not np.any(tabulated):
         return normal
     z = np.abs(residual) / total_sd
-    safe_share = np.where(tabulated, share, 1.0)
-    value = _interpolated(z, safe_share, float(dof)) - np.log(total_sd)
-    return np.where(tabulated, value, normal)
+    # a non-finite prediction (outside a surrogate's reach) stays NaN, as the normal's does,
+    # and the posterior drops it; it must not index the table
+    finite = np.isfinite(z) & np.isfinite(share)
+    safe_share = np.where(tabulated & finite, share, 1.0)
+    value = _interpolated(np.where(finite, z, 0.0), safe_share, float(dof)) - np.log(total_sd)
+    return np.where(finite, np.where(tabulated, value, normal), np.nan)
