@@ -85,7 +85,10 @@ def test_unknown_or_missing_degrees_of_freedom_keep_the_normal_likelihood_bit_fo
     residual = np.array([-0.05, 0.0, 0.01, 0.3])
     variance = np.full(4, 0.03**2)
     normal = -0.5 * (residual**2 / variance + np.log(2 * math.pi * variance))
-    for stderr, dof in ((0.02, math.nan), (0.0, 7.0), (0.02, math.inf), (0.02, 1e6)):
+    # unknown, no stderr, infinite, above NORMAL_ABOVE_DOF, and a stderr below
+    # MIN_MEASUREMENT_SHARE of the total standard deviation (1e-5 of 0.03)
+    for stderr, dof in ((0.02, math.nan), (0.0, 7.0), (0.02, math.inf), (0.02, 1e6),
+                        (1e-5, 7.0)):
         np.testing.assert_array_equal(log_density(residual, variance, stderr=stderr, dof=dof),
                                       normal)
 
