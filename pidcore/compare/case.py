@@ -19,6 +19,7 @@ from ..errors import ParameterError, PidcoreError
 from .align import (
     Aligner,
     Tolerances,
+    band_quantile,
     consistency_chi2,
     pooled_mean,
     pooled_sdc_eq10,
@@ -535,7 +536,7 @@ class Headline:
         degrees of freedom, Welch-Satterthwaite)"``, ``"no DEM value at this case"``.
     interval_sigmas : float
         Half-width of the 95 % interval of measured - DEM, in sigma: Student's t_0.975 of
-        ``stderr_dof`` (:func:`pidcore.calibrate.prediction.band_quantile`); NaN when not
+        ``stderr_dof`` (:func:`pidcore.compare.align.band_quantile`); NaN when not
         comparable.
     stderr_dof : float
         Degrees of freedom of sigma: Welch-Satterthwaite's of the two standard errors' own
@@ -562,7 +563,7 @@ class Headline:
 def combined_stderr_dof(stderrs: Sequence[float], dofs: Sequence[float]) -> float:
     """Welch-Satterthwaite degrees of freedom of sqrt(sum se^2): (sum se^2)^2 /
     sum(se^4 / dof), a standard error whose degrees of freedom are unknown (NaN) counted as
-    known exactly (infinite: normal, as :func:`pidcore.calibrate.prediction.band_quantile`
+    known exactly (infinite: normal, as :func:`pidcore.compare.align.band_quantile`
     takes it alone); NaN where none states them."""
     variances = np.asarray(stderrs, dtype=float) ** 2
     dofs = np.asarray(dofs, dtype=float)
@@ -577,8 +578,6 @@ def headline(comparison: CaseComparison) -> Headline:
     inside its 95 % interval, ±t_0.975 sigma with sigma = sqrt(measured stderr^2 + DEM
     stderr^2) and t of their Welch-Satterthwaite degrees of freedom (1.96 where neither states
     them). The verdict names sigma, the interval and its quantile."""
-    from ..calibrate.prediction import band_quantile
-
     c = comparison
     if math.isfinite(c.measured_sdc_eq10):
         m, m_se, kind = c.measured_sdc_eq10, c.measured_stderr_eq10, "Eq. 10 (DEM m_c)"
