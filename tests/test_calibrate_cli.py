@@ -223,6 +223,38 @@ def test_loo_prediction_never_sees_the_held_out_value(tiny_store):
     assert b.predictions[0]["predicted"] != a.predictions[0]["predicted"]  # the full fit sees it
 
 
+PREDICTION_FIELDS = ("predicted", "low95", "high95", "predicted_low95", "predicted_high95",
+                     "low95_without_stderr", "high95_without_stderr")
+
+
+def test_no_loo_fold_sees_its_held_out_value_and_every_other_fold_does(tiny_store):
+    # Every fold, with the model discrepancy fitted and the measurements' t likelihood (stderr
+    # with 7 degrees of freedom): moving one measurement far away must leave its own held-out
+    # prediction bit for bit as it was (a leak of the held-out value into its fold's fit
+    # would move it), while the folds that hold it in their fit must move (else the check
+    # could not see a leak at all).
+    config = DemConfig(steady_cycles=10)
+    points = [MeasuredPoint(500, 5, 50, 0.6, 0.05, sdc_stderr_dof=7),
+              MeasuredPoint(1000, 5, 50, 0.5, 0.05, sdc_stderr_dof=7),
+              MeasuredPoint(500, 1, 50, 0.2, 0.05, sdc_stderr_dof=7)]
+    kw = dict(fit=["fixture_mass_kg"], store_path=tiny_store, cells=2, steady_cycles=10,
+              dem_config=config, workers=1, progress=False, cross_validate="loo")
+    base = calibrate(points, **kw)
+    for i, point in enumerate(points):
+        changed = list(points)
+        changed[i] = MeasuredPoint(point.frequency_hz, point.acceleration_g,
+                                   point.fill_percent, point.sdc + 2.0, point.sdc_stderr,
+                                   sdc_stderr_dof=point.sdc_stderr_dof)
+        moved = calibrate(changed, **kw)
+        assert {k: moved.loo[i][k] for k in PREDICTION_FIELDS} \
+            == {k: base.loo[i][k] for k in PREDICTION_FIELDS}, f"fold {i} saw its own point"
+        # scored against the value it did not see: the row's error is the new one's
+        assert moved.loo[i]["error"] == pytest.approx(base.loo[i]["error"] - 2.0)
+        for j in range(len(points)):
+            if j != i:
+                assert moved.loo[j]["predicted"] != base.loo[j]["predicted"], (i, j)
+
+
 def test_interrupt_keeps_finished_runs(tmp_path):
     config = DemConfig(cells=2, steady_cycles=10, block_cycles=5, max_transient_cycles=10)
     requests = [RunRequest(LoadCase(f, 5, 50), paper_specimen(), config)

@@ -82,12 +82,27 @@ def _entry(rec):
                                                        material="acrylic"))
 
 
-def _dem(sdc: float, stderr: float, m_c: float = 0.3):
+def _dem(sdc: float, stderr: float, m_c: float = 0.3, cells: float | None = None):
     import pandas as pd
 
-    return pd.DataFrame({"case_key": ["r"], "frequency_hz": [100.0], "acceleration_g": [5.0],
-                         "fill_percent": [50.0], "material": ["acrylic"], "direction": ["z"],
-                         "sdc": [sdc], "sdc_stderr": [stderr], "m_c_kg": [m_c]})
+    frame = pd.DataFrame({"case_key": ["r"], "frequency_hz": [100.0], "acceleration_g": [5.0],
+                          "fill_percent": [50.0], "material": ["acrylic"], "direction": ["z"],
+                          "sdc": [sdc], "sdc_stderr": [stderr], "m_c_kg": [m_c]})
+    if cells is not None:
+        frame["cells_simulated"] = [cells]
+    return frame
+
+
+def _ws_quantile(stderrs_and_dofs):
+    """Student t_0.975 of Welch-Satterthwaite's degrees of freedom, an unknown one (NaN)
+    counted as infinite; the normal's 1.96 where none is known."""
+    from scipy import stats
+
+    total = sum(se**2 for se, _ in stderrs_and_dofs)
+    known = [(se, dof) for se, dof in stderrs_and_dofs if math.isfinite(dof)]
+    if not known:
+        return stats.norm.ppf(0.975)
+    return stats.t.ppf(0.975, total**2 / sum(se**4 / dof for se, dof in known))
 
 
 def test_headline_compares_like_with_like_and_counts_sigmas():
@@ -95,25 +110,87 @@ def test_headline_compares_like_with_like_and_counts_sigmas():
     paper = paper_table()
     probe = compare_case([_entry(rec)], _dem(0.3, 0.01), paper)
     m, se = probe.measured_sdc_eq10, probe.measured_stderr_eq10
-    assert np.isfinite(m)
-    agree = headline(compare_case([_entry(rec)], _dem(m + 0.01, 0.01), paper))
+    m_dof = rec.analysis.sdc_stderr_dof
+    assert np.isfinite(m) and probe.measured_stderr_eq10_dof == m_dof
+    # a 4-cell DEM run: its stderr (the scatter of 4 cells' SDCs) has 3 degrees of freedom
+    agree = headline(compare_case([_entry(rec)], _dem(m + 0.01, 0.01, cells=4), paper))
     assert agree.measured_kind.startswith("Eq. 10") and agree.measured == m
     assert agree.sigmas == pytest.approx(0.01 / math.hypot(se, 0.01))
-    assert agree.verdict.startswith("agrees within 2 σ")
+    q = _ws_quantile([(se, m_dof), (0.01, 3.0)])
+    assert agree.interval_sigmas == pytest.approx(q, rel=1e-12) and agree.agrees is True
+    # the verdict says what σ is, which interval and which quantile ("agrees within 2 σ"
+    # before, with 2 neither the normal's 1.96 nor any t's)
+    assert agree.verdict.startswith(f"agrees: |measured − DEM| = {agree.sigmas:.1f} σ, inside "
+                                    f"the 95 % interval ±{q:.3g} σ (σ = √(measured stderr² + "
+                                    "DEM stderr²); Student t of ")
+    assert agree.verdict.endswith("degrees of freedom, Welch-Satterthwaite)")
     far = headline(compare_case([_entry(rec)], _dem(m + 1.0, 0.01), paper))
-    assert far.verdict.startswith("differs by") and far.sigmas > 2
+    assert far.verdict.startswith("differs: |measured − DEM| = ") and far.agrees is False
     # without the DEM case's m_c the Eq. 11 SDC is not passed off as comparable
     unknown = headline(compare_case([_entry(rec)], _dem(0.3, 0.01).drop(columns="m_c_kg"),
                                     paper))
     assert unknown.measured_kind == "Eq. 11" and math.isnan(unknown.sigmas)
+    assert unknown.agrees is None
     # a DEM value without a standard error (a 1-cell run): the σ is the measurement's alone, so
     # the count is only an upper bound, and the verdict says so ("differs by 314.1 σ" before)
     one_cell = headline(compare_case([_entry(rec)], _dem(m + 1.0, float("nan")), paper))
     assert one_cell.sigmas == pytest.approx(1.0 / se)
-    assert one_cell.verdict.startswith(f"differs by up to {1.0 / se:.1f} σ (the DEM value has "
-                                       "no standard error")
+    assert one_cell.verdict.startswith(f"differs by up to {1.0 / se:.1f} σ: outside the 95 % "
+                                       "interval") and "the DEM value has no standard error" \
+        in one_cell.verdict
+    assert one_cell.agrees is None  # outside the measurement's interval, the whole unknown
     near = headline(compare_case([_entry(rec)], _dem(m + 0.5 * se, float("nan")), paper))
-    assert near.verdict == "agrees within 2 σ (≤ 0.5 σ; the DEM value has no standard error)"
+    q_measured = _ws_quantile([(se, m_dof)])
+    assert near.verdict == (f"agrees: |measured − DEM| ≤ 0.5 σ, inside the 95 % interval "
+                            f"±{q_measured:.3g} σ (σ: the measured stderr alone, the DEM value "
+                            f"has no standard error; Student t of {m_dof:.3g} degrees of "
+                            "freedom)")
+    assert near.agrees is True
+
+
+def _comparison(measured, measured_stderr, measured_dof, dem, dem_stderr, dem_dof):
+    """A compared case built by hand: the Eq. 10 measured SDC against a DEM grid case."""
+    import pandas as pd
+
+    from pidcore.compare.align import AlignedCase, DemCase
+    from pidcore.compare.case import CaseComparison
+    from pidcore.compare.loadcase import LoadCase
+
+    case = LoadCase(100.0, 5.0, 50.0)
+    grid = DemCase(case, dem, dem_stderr, 1, vibrated_mass_kg=0.3, sdc_stderr_dof=dem_dof)
+    aligned = AlignedCase(case, "grid", dem, dem_stderr, grid)
+    return CaseComparison(case, pd.DataFrame(), measured, measured_stderr, aligned,
+                          pd.DataFrame(), pd.DataFrame(), np.empty(0), np.empty(0),
+                          measured_sdc_eq10=measured, measured_stderr_eq10=measured_stderr,
+                          measured_stderr_dof=measured_dof,
+                          measured_stderr_eq10_dof=measured_dof)
+
+
+def test_the_count_of_agreeing_cases_uses_the_stated_95_percent_interval():
+    # (measured, stderr, dof, DEM, stderr, dof); the hand count: |Δ| / σ against Student
+    # t_0.975 of Welch-Satterthwaite's dof (1.96 where none is known). Cases 1 and 4 lie at
+    # 2.2 σ: inside t's wider interval, outside the old "2 σ"; case 2 at 1.98 σ with no
+    # degrees of freedom lies outside the normal's 1.96 though "within 2 σ"
+    nan = math.nan
+    cases = [(0.300, 0.010, 7.0, 0.300 + 2.2 * math.hypot(0.010, 0.010), 0.010, 3.0),
+             (0.500, 0.020, nan, 0.500 - 1.98 * 0.020, 0.0, nan),
+             (0.400, 0.010, 7.0, 0.400 + 0.5 * math.hypot(0.010, 0.005), 0.005, 3.0),
+             (0.200, 0.030, 7.0, 0.200 + 2.2 * 0.030, nan, nan),
+             (0.600, 0.010, 7.0, 0.600 + 4.0 * math.hypot(0.010, 0.020), 0.020, 3.0),
+             (0.250, 0.010, nan, 0.250 + 1.5 * math.hypot(0.010, 0.010), 0.010, 3.0)]
+    by_hand = []
+    for m, m_se, m_dof, dem, dem_se, dem_dof in cases:
+        parts = [(m_se, m_dof)] + ([(dem_se, dem_dof)] if math.isfinite(dem_se) else [])
+        sigma = math.sqrt(sum(se**2 for se, _ in parts))
+        by_hand.append(abs(m - dem) <= _ws_quantile(parts) * sigma)
+    heads = [headline(_comparison(*c)) for c in cases]
+    assert by_hand == [True, False, True, True, False, True]
+    assert [h.agrees for h in heads] == by_hand
+    assert sum(h.agrees is True for h in heads) == sum(by_hand) == 4
+    # each verdict states the same check its count made
+    assert [h.verdict.startswith("agrees") for h in heads] == by_hand
+    for h in heads:
+        assert f"±{h.interval_sigmas:.3g} σ" in h.verdict
 
 
 def test_model_curve_is_drawn_for_a_case_a_hair_below_the_grid_edge():

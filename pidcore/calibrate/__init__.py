@@ -8,6 +8,8 @@ Modules, one concern each:
 * :mod:`~pidcore.calibrate.observation`: the SDC a shaker test of the DEM would measure (Eq. 11
   with fixture mass and baseline loss factor);
 * :mod:`~pidcore.calibrate.surrogate`: space-filling design and per-load-case surrogate;
+* :mod:`~pidcore.calibrate.likelihood`: the density of a measured SDC about the model's (a
+  measurement error of Student's t where its degrees of freedom are known, normal model terms);
 * :mod:`~pidcore.calibrate.posterior`: likelihood (measurement error, DEM scatter, model
   discrepancy), exact grid or emcee;
 * :mod:`~pidcore.calibrate.calibrate`: the pipeline and leave-one-out;

@@ -33,6 +33,7 @@ from ..specimen import (
     uncalibrated_name,
 )
 from .data import MeasuredPoint, check_enough_points
+from .likelihood import NORMAL_ABOVE_DOF, uses_student_t
 from .observation import Observation, observation_from_run
 from .parameters import (
     CATALOGUE,
@@ -398,11 +399,18 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: str | Sequence[str],
     with_dof = sorted({p.sdc_stderr_dof for p in points
                        if p.sdc_stderr > 0 and math.isfinite(p.sdc_stderr_dof)})
     if with_dof:
-        # which quantile the 95 % bands used: it sets how wide the measurement's part is
-        notes.append("95 % bands: the measurement error of a point whose sdc_stderr states its "
-                     "degrees of freedom (" + ", ".join(f"{d:g}" for d in with_dof)
-                     + ") is drawn from Student's t with them (t_0.975,7 = 2.365, not 1.96); "
-                     "of a point without them, from a normal")
+        # which error model the fit and the 95 % bands used: it sets how much an outlying
+        # point pulls the fit and how wide the measurement's part of a band is
+        t_dof = [d for d in with_dof if uses_student_t(1.0, d)]
+        notes.append("likelihood and 95 % bands: the measurement error of a point whose "
+                     "sdc_stderr states its degrees of freedom (" + ", ".join(
+                         f"{d:g}" for d in with_dof)
+                     + ") is sdc_stderr times Student's t with them (t_0.975,7 = 2.365, not "
+                     "1.96; an outlying point pulls the fit less than under a normal error)"
+                     + ("" if len(t_dof) == len(with_dof) else
+                        f"; above {NORMAL_ABOVE_DOF:g} degrees of freedom the likelihood takes "
+                        "it as normal")
+                     + "; of a point without them, normal")
     dem_specs = [s for s in specs if s.kind == "dem"]
     if not dem_specs and design_size not in (None, 1):
         # nothing varies between DEM runs: one run per load case, whatever the design asks

@@ -1,16 +1,19 @@
 """Likelihood and posterior of the calibration parameters.
 
-Each measured SDC y_i is normal about the predicted SDC s_i(theta) (observation model through
-the DEM surrogate) with variance::
+Each measured SDC y_i lies about the predicted SDC s_i(theta) (observation model through the
+DEM surrogate) with variance::
 
     sigma_i^2 = sdc_stderr_i^2 + var_DEM_i(theta) + (tau s_i)^2 + floor^2
 
 measurement standard error, the DEM surrogate's own variance (ensemble scatter), and the model
 discrepancy: relative ``model_discrepancy`` tau (fitted, log-uniform prior, unless fixed) plus
-an absolute floor (default DISCREPANCY_FLOOR). The posterior is computed on an exact grid for
-at most GRID_MAX_DIMENSIONS fitted quantities (coarse pass, then fine passes zooming into the
-region holding the mass until it is resolved), else (or where the grid cannot box it) sampled
-with emcee. Either way the result is a set of equally weighted samples.
+an absolute floor (default DISCREPANCY_FLOOR). The model's terms are normal; the measurement's
+error is normal where its standard error's degrees of freedom are unknown, else sdc_stderr_i
+times Student's t with ``sdc_stderr_dof`` (:mod:`pidcore.calibrate.likelihood`: the standard
+error of a mean of 8 blocks is itself estimated from 7 degrees of freedom). The posterior is
+computed on an exact grid for at most GRID_MAX_DIMENSIONS fitted quantities (coarse pass, then
+fine passes zooming into the region holding the mass until it is resolved), else (or where the
+grid cannot box it) sampled with emcee. Either way the result is a set of equally weighted samples.
 """
 
 from __future__ import annotations
@@ -25,6 +28,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from .data import MeasuredPoint
+from .likelihood import log_density
 from .parameters import DISCREPANCY, ParameterSpec
 from .surrogate import CaseSurrogate, predicted_sdc, unique_points
 
@@ -89,8 +93,9 @@ class Model:
         unique = unique_points(self.dem_theta(np.atleast_2d(samples)))
         for i in indices:
             sdc, variance = self.predict(samples, i, unique=unique)
-            total += -0.5 * ((self.points[i].sdc - sdc) ** 2 / variance
-                             + np.log(2 * math.pi * variance))
+            point = self.points[i]
+            total += log_density(point.sdc - sdc, variance, stderr=point.sdc_stderr,
+                                 dof=point.sdc_stderr_dof)
         return total
 
     def log_prior(self, samples: np.ndarray) -> np.ndarray:
@@ -375,7 +380,10 @@ def predictive(model: Model, samples: np.ndarray, index: int, *,
     8-block analysis), its measurement error is drawn from Student's t with them, scaled by
     the stderr: the standardised error of a mean over few blocks is t, not normal, and a
     normal draw made the measurement's part of the band cover ~91 % at 7 degrees of freedom.
-    Without them (NaN) the draws are normal, as they always were."""
+    Without them (NaN) the draws are normal, as they always were. Either way the draws are of
+    the error model whose density the likelihood is (:func:`pidcore.calibrate.likelihood.
+    log_density`; above its NORMAL_ABOVE_DOF degrees of freedom, normal there): the fit and
+    the band it is scored by assume the same errors."""
     sdc, variance = model.predict(samples, index)
     normal = rng.standard_normal(sdc.shape)
     point = model.points[index]

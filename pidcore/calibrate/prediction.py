@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, Any
 import pandas as pd
 
 from .. import defaults
-from ..compare.align import Tolerances
+from ..compare.align import Z95, Tolerances, band_quantile, quantile_label  # noqa: F401 (public here)
 from ..errors import ParameterError, instance_of, real_number
 from ..loadcase import LoadCase
 
@@ -25,43 +25,6 @@ if TYPE_CHECKING:  # pragma: no cover
     from ..specimen import Specimen
 
 _REQUIRED = ("frequency_hz", "acceleration_g", "fill_percent", "predicted", "low95", "high95")
-
-
-#: Two-sided 95 % quantile of the normal distribution (a measurement's stderr -> half-width)
-#: where the stderr's degrees of freedom are unknown.
-Z95 = 1.959963984540054
-
-
-def band_quantile(dof: float = math.nan) -> float:
-    """Two-sided 95 % quantile that turns a standard error into a half-width: Student's
-    t_{0.975, dof} where the stderr's degrees of freedom are known (``n_blocks - 1`` of an
-    analysis by pidcore: the errors of a mean over 8 block estimates follow a t with 7,
-    whose quantile is 2.365; 1.96 covered ~91 %), else (NaN) the normal's :data:`Z95`.
-
-    Raises
-    ------
-    ParameterError
-        ``dof`` not NaN and not > 0.
-    """
-    from scipy.stats import t as student_t
-
-    dof = real_number("dof", dof)
-    if math.isnan(dof):
-        return Z95
-    if not dof > 0:
-        raise ParameterError(f"dof {dof!r}: expected the degrees of freedom of a standard "
-                             "error (> 0, e.g. n_blocks - 1), or NaN where unknown")
-    return float(student_t.ppf(0.975, dof))
-
-
-def quantile_label(dof: float = math.nan) -> str:
-    """Which quantile :func:`band_quantile` uses, for a line beside a band: e.g.
-    ``'Student t quantile 2.365 of 7 degrees of freedom'`` or ``'normal quantile 1.96, the
-    degrees of freedom of the stderr unknown'``."""
-    q = band_quantile(dof)
-    if math.isnan(dof):
-        return f"normal quantile {q:.3g}, the degrees of freedom of the stderr unknown"
-    return f"Student t quantile {q:.4g} of {dof:.4g} degrees of freedom"
 
 
 @dataclass(frozen=True)

@@ -137,6 +137,9 @@ class DemCase:
         or ``run_keys``.
     duplicate_fills : tuple of float
         Fill percentages, %, the duplicates were stored with (for the note).
+    sdc_stderr_dof : float
+        Degrees of freedom of ``sdc_stderr`` (:func:`pooled_stderr_dof`): a run's error is the
+        scatter of its cells' SDCs, cells - 1; NaN where the cells are unknown.
     """
 
     load_case: LoadCase
@@ -151,6 +154,7 @@ class DemCase:
     not_converged: tuple[tuple[int, int], ...] = ()
     duplicate_keys: tuple[str, ...] = ()
     duplicate_fills: tuple[float, ...] = ()
+    sdc_stderr_dof: float = math.nan
 
 
 def duplicates_note(dem: DemCase) -> str:
@@ -280,10 +284,10 @@ def stored_stderr_dof(value: object) -> float:
 
 def pooled_stderr_dof(values: np.ndarray, stderrs: np.ndarray, dofs: np.ndarray) -> float:
     """Degrees of freedom of :func:`pooled_mean`'s standard error, for its 95 % quantile
-    (:func:`pidcore.calibrate.prediction.band_quantile`): one value's own ``dofs``; of the
-    scatter between several, n - 1; of their propagated errors, Welch-Satterthwaite's
-    (sum se^2)^2 / sum(se^4 / dof). NaN where unknown (a stderr without its degrees of
-    freedom: the normal's quantile, as before they were kept)."""
+    (:func:`band_quantile`): one value's own ``dofs``; of the scatter between several, n - 1;
+    of their propagated errors, Welch-Satterthwaite's (sum se^2)^2 / sum(se^4 / dof). NaN
+    where unknown (a stderr without its degrees of freedom: the normal's quantile, as before
+    they were kept)."""
     values = np.asarray(values, dtype=float)
     stderrs = np.asarray(stderrs, dtype=float)
     dofs = np.asarray(dofs, dtype=float)
@@ -299,6 +303,43 @@ def pooled_stderr_dof(values: np.ndarray, stderrs: np.ndarray, dofs: np.ndarray)
     variances = stderrs ** 2
     denominator = float(np.sum(variances ** 2 / dofs))
     return float(np.sum(variances) ** 2 / denominator) if denominator > 0 else math.nan
+
+
+#: Two-sided 95 % quantile of the normal distribution (a measurement's stderr -> half-width)
+#: where the stderr's degrees of freedom are unknown.
+Z95 = 1.959963984540054
+
+
+def band_quantile(dof: float = math.nan) -> float:
+    """Two-sided 95 % quantile that turns a standard error into a half-width: Student's
+    t_{0.975, dof} where the stderr's degrees of freedom are known (``n_blocks - 1`` of an
+    analysis by pidcore: the errors of a mean over 8 block estimates follow a t with 7,
+    whose quantile is 2.365; 1.96 covered ~91 %), else (NaN) the normal's :data:`Z95`.
+
+    Raises
+    ------
+    ParameterError
+        ``dof`` not NaN and not > 0.
+    """
+    from scipy.stats import t as student_t
+
+    dof = real_number("dof", dof)
+    if math.isnan(dof):
+        return Z95
+    if not dof > 0:
+        raise ParameterError(f"dof {dof!r}: expected the degrees of freedom of a standard "
+                             "error (> 0, e.g. n_blocks - 1), or NaN where unknown")
+    return float(student_t.ppf(0.975, dof))
+
+
+def quantile_label(dof: float = math.nan) -> str:
+    """Which quantile :func:`band_quantile` uses, for a line beside a band: e.g.
+    ``'Student t quantile 2.365 of 7 degrees of freedom'`` or ``'normal quantile 1.96, the
+    degrees of freedom of the stderr unknown'``."""
+    q = band_quantile(dof)
+    if math.isnan(dof):
+        return f"normal quantile {q:.3g}, the degrees of freedom of the stderr unknown"
+    return f"Student t quantile {q:.4g} of {dof:.4g} degrees of freedom"
 
 
 def pooled_sdc_eq10(energy_per_cycle_j: np.ndarray, acceleration_m_s2: np.ndarray,
@@ -515,6 +556,10 @@ def dem_cases(dem_runs: pd.DataFrame, *, tolerances: Tolerances | None = None,
         sub = runs.iloc[members]
         dup = runs.iloc[duplicates]
         sdc, stderr = pooled_mean(sub["sdc"].to_numpy(float), sub["sdc_stderr"].to_numpy(float))
+        cells = cells_of.get(settings, math.nan)
+        stderr_dof = pooled_stderr_dof(sub["sdc"].to_numpy(float),
+                                       sub["sdc_stderr"].to_numpy(float),
+                                       np.full(len(sub), cells - 1.0 if cells > 1 else math.nan))
         ppc = math.nan
         if "particles_per_cell" in sub:
             unique = pd.unique(sub["particles_per_cell"].astype(float))
@@ -528,8 +573,7 @@ def dem_cases(dem_runs: pd.DataFrame, *, tolerances: Tolerances | None = None,
         dup_keys = tuple(str(k) for k in dup[key_column]) if key_column in dup else ()
         dup_fills = tuple(float(f) for f in dup["fill_percent"])
         out.append(DemCase(case, sdc, stderr, len(members), ppc, keys, m_c, settings,
-                           cells_of.get(settings, math.nan), _not_converged(sub),
-                           dup_keys, dup_fills))
+                           cells, _not_converged(sub), dup_keys, dup_fills, stderr_dof))
     return sorted(out, key=lambda c: (*_sort_key(c.load_case), c.settings))
 
 

@@ -19,6 +19,7 @@ from ..errors import ParameterError, PidcoreError
 from .align import (
     Aligner,
     Tolerances,
+    band_quantile,
     consistency_chi2,
     pooled_mean,
     pooled_sdc_eq10,
@@ -30,8 +31,6 @@ from .loadcase import LoadCase, StatedLoadCase
 #: Fill (packing ratio, %) proposed for a file whose name states none; the user confirms or
 #: corrects it.
 PROPOSED_FILL_PERCENT = defaults.APP_DEFAULT_FILL_PERCENT
-#: How many standard errors apart measured and DEM may lie and still "agree".
-AGREEMENT_SIGMAS = 2.0
 
 
 def load_case_of(record, *, fill_percent: float, material: str,
@@ -142,6 +141,10 @@ class CaseComparison:
         degree of freedom; NaN for one record.
     notes : tuple of str
         What was adjusted or left out (a model evaluated at the edge of its range, ...).
+    measured_stderr_eq10_dof : float
+        Degrees of freedom of ``measured_stderr_eq10``, as ``measured_stderr_dof`` of the
+        Eq. 11 one (the records' Eq. 10 SDCs keep their relative errors, but their pooled
+        error may be the scatter between them where the Eq. 11 one is not).
     """
 
     load_case: LoadCase
@@ -158,6 +161,7 @@ class CaseComparison:
     chi2_dof: float = math.nan
     notes: tuple[str, ...] = ()
     measured_stderr_dof: float = math.nan
+    measured_stderr_eq10_dof: float = math.nan
 
 
 def _model_point(model, tol: Tolerances, acceleration_g: float,
@@ -481,11 +485,14 @@ def compare_case(records: Sequence[MeasuredEntry],
         np.array([r.acceleration_m_s2 for r in records]),
         np.array([r.frequency_hz for r in records]), values, errors,
         vibrated_mass_kg=m_c)
+    stderr10_dof = math.nan
     if math.isfinite(m_c):
         measured["SDC, E of Eq. 10 [-]"] = eq10
+        stderr10_dof = pooled_stderr_dof(eq10, errors * eq10 / values,
+                                         np.array([r.sdc_stderr_dof for r in records]))
     return CaseComparison(case, measured, sdc, stderr, aligned, dem_points, paper_points,
                           model_x, model_y, sdc10, stderr10, chi2 / dof if dof else math.nan,
-                          tuple(notes), stderr_dof)
+                          tuple(notes), stderr_dof, stderr10_dof)
 
 
 def equivalent_dampers(comparison: CaseComparison) -> dict[str, float]:
@@ -522,9 +529,24 @@ class Headline:
     dem, dem_stderr : float
         Our DEM SDC (grid or pchip) [-]; NaN when there is none.
     sigmas : float
-        |measured - DEM| over the combined standard error; NaN when not comparable.
+        |measured - DEM| / sigma, sigma = sqrt(measured stderr^2 + DEM stderr^2) (the known
+        one alone where the other has none: then an upper bound); NaN when not comparable.
     verdict : str
-        E.g. ``"agrees within 2 σ (0.8 σ)"``, ``"differs by 5.1 σ"``, ``"no DEM value"``.
+        What was checked and what it found, e.g. ``"agrees: |measured - DEM| = 0.8 σ, inside
+        the 95 % interval ±2.45 σ (σ = √(measured stderr² + DEM stderr²); Student t of 6.0
+        degrees of freedom, Welch-Satterthwaite)"``, ``"no DEM value at this case"``.
+    interval_sigmas : float
+        Half-width of the 95 % interval of measured - DEM, in sigma: Student's t_0.975 of
+        ``stderr_dof`` (:func:`pidcore.compare.align.band_quantile`); NaN when not
+        comparable.
+    stderr_dof : float
+        Degrees of freedom of sigma: Welch-Satterthwaite's of the two standard errors' own
+        (:func:`combined_stderr_dof`); NaN where neither states them (normal: 1.96).
+    agrees : bool or None
+        Whether |measured - DEM| <= interval_sigmas x sigma: the verdict's "agrees" and what a
+        count of agreeing cases counts; None when not comparable, or when one side has no
+        standard error and the difference lies outside the other side's interval (then it
+        is unknown whether it lies outside the whole one).
     """
 
     measured: float
@@ -534,38 +556,77 @@ class Headline:
     dem_stderr: float
     sigmas: float
     verdict: str
+    interval_sigmas: float = math.nan
+    stderr_dof: float = math.nan
+    agrees: bool | None = None
 
 
-def headline(comparison: CaseComparison, *, k: float = AGREEMENT_SIGMAS) -> Headline:
-    """Measured (like for like) vs our DEM for one load case, with "agrees within k σ"."""
+def combined_stderr_dof(stderrs: Sequence[float], dofs: Sequence[float]) -> float:
+    """Welch-Satterthwaite degrees of freedom of sqrt(sum se^2): (sum se^2)^2 /
+    sum(se^4 / dof), a standard error whose degrees of freedom are unknown (NaN) counted as
+    known exactly (infinite: normal, as :func:`pidcore.compare.align.band_quantile`
+    takes it alone); NaN where none states them."""
+    variances = np.asarray(stderrs, dtype=float) ** 2
+    dofs = np.asarray(dofs, dtype=float)
+    known = np.isfinite(dofs) & (dofs > 0) & (variances > 0)
+    if not known.any():
+        return math.nan
+    return float(np.sum(variances) ** 2 / np.sum(variances[known] ** 2 / dofs[known]))
+
+
+def headline(comparison: CaseComparison) -> Headline:
+    """Measured (like for like) vs our DEM for one load case: whether their difference lies
+    inside its 95 % interval, ±t_0.975 sigma with sigma = sqrt(measured stderr^2 + DEM
+    stderr^2) and t of their Welch-Satterthwaite degrees of freedom (1.96 where neither states
+    them). The verdict names sigma, the interval and its quantile."""
     c = comparison
     if math.isfinite(c.measured_sdc_eq10):
         m, m_se, kind = c.measured_sdc_eq10, c.measured_stderr_eq10, "Eq. 10 (DEM m_c)"
+        m_dof = c.measured_stderr_eq10_dof
     else:
         m, m_se, kind = c.measured_sdc, c.measured_stderr, "Eq. 11"
+        m_dof = c.measured_stderr_dof
     dem = float(getattr(c.aligned, "sdc_dem", math.nan))
     dem_se = float(getattr(c.aligned, "sdc_dem_stderr", math.nan))
+    grid = getattr(c.aligned, "grid_case", None)
+    dem_dof = float(getattr(grid, "sdc_stderr_dof", math.nan)) if grid is not None else math.nan
     if not math.isfinite(dem):
         return Headline(m, m_se, kind, dem, dem_se, math.nan, "no DEM value at this case")
     if kind == "Eq. 11":
         return Headline(m, m_se, kind, dem, dem_se, math.nan,
                         "not comparable: the DEM case has no m_c for the Eq. 10 energy")
-    se = math.hypot(m_se if math.isfinite(m_se) else 0.0, dem_se if math.isfinite(dem_se)
-                    else 0.0)
+    parts = [(se, dof) for se, dof in ((m_se, m_dof), (dem_se, dem_dof)) if math.isfinite(se)]
+    se = math.sqrt(sum(p[0] ** 2 for p in parts))
     if not se > 0:
         return Headline(m, m_se, kind, dem, dem_se, math.nan, "no standard error to judge by")
+    dof = combined_stderr_dof([p[0] for p in parts], [p[1] for p in parts])
+    q = band_quantile(dof)
+    quantile = ("normal, neither standard error states its degrees of freedom"
+                if math.isnan(dof) else f"Student t of {dof:.3g} degrees of freedom"
+                + (", Welch-Satterthwaite" if len(parts) == 2 else ""))
     z = abs(m - dem) / se
-    if math.isfinite(m_se) and math.isfinite(dem_se):
-        verdict = (f"agrees within {k:g} σ ({z:.1f} σ)" if z <= k else f"differs by {z:.1f} σ")
+    inside = z <= q
+    interval = f"the 95 % interval ±{q:.3g} σ"
+    if len(parts) == 2:
+        basis = f"σ = √(measured stderr² + DEM stderr²); {quantile}"
+        verdict = (f"agrees: |measured − DEM| = {z:.1f} σ, inside {interval} ({basis})"
+                   if inside else
+                   f"differs: |measured − DEM| = {z:.1f} σ, outside {interval} ({basis})")
     else:
         # one side's error is unknown (a 1-cell DEM run, a single record without one): the
         # combined σ is at least the known side's, so z is an upper bound; "differs by" would
         # overstate it ("differs by 314 σ" of a 1-cell run against the measurement's σ alone)
-        unknown = "DEM value" if not math.isfinite(dem_se) else "measured value"
-        verdict = (f"agrees within {k:g} σ (≤ {z:.1f} σ; the {unknown} has no standard error)"
-                   if z <= k else f"differs by up to {z:.1f} σ (the {unknown} has no standard "
-                   "error, e.g. a 1-cell run: σ is the other side's alone)")
-    return Headline(m, m_se, kind, dem, dem_se, z, verdict)
+        unknown, known = (("DEM value", "measured") if not math.isfinite(dem_se)
+                          else ("measured value", "DEM"))
+        basis = f"σ: the {known} stderr alone, the {unknown} has no standard error; {quantile}"
+        if inside:  # inside with the known σ alone: inside the whole, wider interval too
+            verdict = f"agrees: |measured − DEM| ≤ {z:.1f} σ, inside {interval} ({basis})"
+        else:  # outside the known side's interval only: the whole one is unknown
+            verdict = (f"differs by up to {z:.1f} σ: outside {interval} of the {known} stderr "
+                       f"alone; the {unknown} has no standard error (e.g. a 1-cell run), so "
+                       f"whether it lies outside the whole interval is unknown; {quantile}")
+            return Headline(m, m_se, kind, dem, dem_se, z, verdict, q, dof, None)
+    return Headline(m, m_se, kind, dem, dem_se, z, verdict, q, dof, bool(inside))
 
 
 #: Series of :func:`sdc_points`, in legend order.
