@@ -101,6 +101,7 @@ import functools
 import hashlib
 import math
 import os
+import re
 import sys
 import tomllib
 from collections.abc import Mapping
@@ -171,6 +172,24 @@ def _shown(value: object) -> str:
     if isinstance(value, list | tuple) and len(repr(value)) > MAX_SHOWN_CHARS:
         return f"an array of {len(value)} items ({_clip(repr(value))})"
     return _clip(repr(value))
+
+
+def _check_particle_material_name(where: str, name: str) -> None:
+    """Refuse a particle material name that a load case cannot carry as written: every run,
+    file name and sidecar states the material in its canonical form (``normalize_material``),
+    so ``"Acrylic"``, ``"PMMA"`` or ``"tungsten carbide"`` passed ``specimen check`` and were
+    then refused by ``dem run`` as a clash with ``--material``, which nobody had given."""
+    try:
+        canonical = normalize_material(name, where, known=None)
+    except ParameterError:
+        suggestion = re.sub(r"[^a-z0-9_]+", "_", name.strip().lower()).strip("_")
+        raise _fail(where, f"{_shown(name)} is not a material name a load case can carry; "
+                           "expected lower-case letters, digits and '_' starting with a letter"
+                           + (f" (e.g. {suggestion!r})" if re.match(r"^[a-z]", suggestion)
+                              else "")) from None
+    if canonical != name:
+        raise _fail(where, f"{_shown(name)} is written {canonical!r} in load cases, file names "
+                           f"and stored runs; write material = \"{canonical}\"")
 
 
 def _large_count(count: int) -> str:
@@ -410,6 +429,7 @@ class ParticleSpec:
             raise _fail("[particles] material",
                         f"expected a name, got {_shown(self.material)}")
         _printable("[particles] material", self.material)
+        _check_particle_material_name("[particles] material", self.material)
         _positive("[particles] radius_m", self.radius_m, "m")
         _plausible("[particles] radius_m", "radius_m", self.radius_m)
         _positive("[particles] density_kg_m3", self.density_kg_m3, "kg/m^3")
@@ -1019,6 +1039,8 @@ def _from_mapping(data: Mapping[str, Any], *, source: str) -> Specimen:
                             _WALL_FROM_MATERIAL)
 
     particles = _take(data["particles"], "particles", "[particles]")
+    # before the table look-up: "Acrylic" is no row of it, but the row meant
+    _check_particle_material_name("[particles] material", particles["material"])
     _complete_from_material(particles, "[particles] material", particles["material"],
                             "particle",
                             _PARTICLE_FROM_MATERIAL + (("radius_m", "default_radius_m"),))

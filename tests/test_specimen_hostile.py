@@ -163,3 +163,36 @@ def test_a_known_table_written_as_an_array_or_a_value_is_named_as_such(old, new,
     ['tangential_stiffness_model']": a known table called unknown."""
     with pytest.raises(ParameterError, match="^s.toml: " + message):
         Specimen.from_text(_edit(old, new), source="s.toml")
+
+
+@pytest.mark.parametrize("written, message", [
+    # a table material under another spelling: its load cases say "acrylic", the file "Acrylic"
+    ("Acrylic", r"'Acrylic' is written 'acrylic' in load cases, file names and stored runs; "
+                r"write material = \"acrylic\"$"),
+    ("PMMA", r"'PMMA' is written 'acrylic' .*write material = \"acrylic\"$"),
+    ("aluminum", r"'aluminum' is written 'aluminium' .*write material = \"aluminium\"$"),
+    ("steel ", r"'steel ' is written 'steel' .*write material = \"steel\"$"),
+    # no load case can carry a space: file names and run keys are split at '_'
+    ("tungsten carbide", r"'tungsten carbide' is not a material name a load case can carry; "
+                         r"expected lower-case letters, digits and '_' starting with a letter "
+                         r"\(e.g. 'tungsten_carbide'\)$"),
+])
+def test_a_particle_material_name_no_load_case_carries_is_refused_by_check(
+        written, message, tmp_path, capsys):
+    """`specimen check` said OK to `material = "Acrylic"` (or "PMMA", "tungsten carbide"),
+    and `dem run --specimen` then refused it as "--material: the load case says 'acrylic' but
+    specimen ... holds 'Acrylic' particles", naming an option nobody had given."""
+    text = _edit('material = "steel"', f'material = "{written}"')
+    with pytest.raises(ParameterError, match=r"^s.toml: \[particles\] material: " + message):
+        Specimen.from_text(text, source="s.toml")
+    path = tmp_path / "own.toml"
+    path.write_text(text)
+    for argv in (["specimen", "check", str(path)],
+                 ["dem", "run", "--specimen", str(path), "--frequency", "200",
+                  "--acceleration", "5", "--cells", "1", "--no-progress"]):
+        err = _one_line_exit_2(argv, capsys)
+        assert "[particles] material" in err and "--material" not in err, err
+    # the name as a load case writes it is an own material, simulated with its inline numbers
+    own = Specimen.from_text(_edit('material = "steel"', 'material = "tungsten_carbide"'),
+                             source="s.toml")
+    assert own.particles.material == "tungsten_carbide"
