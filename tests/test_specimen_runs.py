@@ -514,3 +514,33 @@ def test_a_calibrated_damping_coefficient_is_refused_for_an_own_material_naming_
         assert "damping_coefficient='calibrated': only for table particles" in err
         assert "not specimen 'steel_6mm'; use 'eq3'" in err
         assert not store.exists()
+
+
+def test_dem_run_and_sweep_take_the_specimens_own_material_by_name(capsys, tmp_path):
+    """`--specimen steel_6mm.toml --material steel` was refused by argparse ("invalid choice:
+    'steel' (choose from 'acrylic', 'aluminium')"), though the material is the specimen's and
+    `analyze`/`report` take it by name."""
+    store = tmp_path / "s.h5"
+    common = ["--specimen", str(STEEL), "--frequency", "1000", "--acceleration", "5",
+              "--cells", "1", "--cycles", "4", "--no-progress", "--json", "--store", str(store)]
+    assert main(["dem", "run", *common]) == 0
+    first = json.loads(capsys.readouterr().out)
+    before = store.read_bytes()
+    # the same run under its own material's name (and its capitalised spelling): reused, one key
+    for name in ("steel", "Steel"):
+        assert main(["dem", "run", *common, "--material", name]) == 0
+        again = json.loads(capsys.readouterr().out)
+        assert again["reused_from_store"] is True and again["store_key"] == first["store_key"]
+    assert main(["dem", "sweep", "--specimen", str(STEEL), "--material", "steel",
+                 "--frequencies", "1000", "--accelerations", "5", "--fills", "50",
+                 "--cells", "1", "--cycles", "4", "--workers", "1", "--no-progress",
+                 "--json", "--store", str(store)]) == 0
+    swept = json.loads(capsys.readouterr().out)
+    assert [c["store_key"] for c in swept["cases"]] == [first["store_key"]]
+    assert swept["completed"] == 0 and swept["skipped"] == 1
+    assert store.read_bytes() == before
+    # without a specimen an own material has no numbers: one line naming both options
+    assert main(["dem", "run", "--material", "steel", "--frequency", "1000",
+                 "--acceleration", "5", "--fill", "50", "--no-progress"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "--material steel" in err and "--specimen" in err, err

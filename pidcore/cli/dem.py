@@ -84,9 +84,10 @@ def _add_config_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--specimen", metavar="FILE", type=path_argument, default=None,
                    help="specimen file (cell, coupon and fixture masses, particles, contact "
                         "pairs; see 'pidcore specimen check'); default: the paper's coupon")
-    p.add_argument("--material", choices=PARTICLE_MATERIALS, default=None,
-                   help="particles of the paper's coupon (default acrylic; with --specimen: "
-                        "the specimen's)")
+    p.add_argument("--material", metavar="NAME", default=None,
+                   help=f"particles of the paper's coupon: {', '.join(PARTICLE_MATERIALS)} "
+                        "(default acrylic); with --specimen: the specimen's, by default and "
+                        "by its own name (e.g. tungsten_carbide)")
     p.add_argument("--direction", choices=DRIVE_DIRECTIONS, default="z",
                    help="drive direction in the cell frame (z normal to the face sheets; "
                         "default z)")
@@ -175,13 +176,23 @@ def _specimen(args: argparse.Namespace):
     """(specimen or None, load-case material) from --specimen, --material and
     --tangential-stiffness (a specimen value: the specimen's hash, and so the run's key and
     provenance, say which k_t model ran)."""
+    from ..loadcase import normalize_material
     from ..specimen import load_specimen, paper_specimen
 
+    # a free name, not argparse choices: the choices refused a specimen's own material
+    # (`--specimen wc.toml --material tungsten_carbide`) as "choose from acrylic, aluminium"
+    given = None if args.material is None else normalize_material(
+        args.material, "--material", known=None)
     if args.specimen is None:
-        specimen, material = None, args.material or "acrylic"
+        if given is not None and given not in PARTICLE_MATERIALS:
+            raise ParameterError(
+                f"--material {args.material}: the paper's coupon holds "
+                f"{' or '.join(PARTICLE_MATERIALS)} particles; give --specimen FILE for "
+                "particles of your own")
+        specimen, material = None, given or "acrylic"
     else:
         specimen = load_specimen(args.specimen)
-        material = args.material or specimen.particles.material
+        material = given or specimen.particles.material
     if args.tangential_stiffness is not None:
         specimen = (specimen or paper_specimen(material)).with_values(
             {"pairs.tangential_stiffness_model": args.tangential_stiffness})
