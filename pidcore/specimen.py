@@ -329,14 +329,25 @@ def _poisson(where: str, value: float) -> None:
         raise _fail(where, f"expected -1 < nu < 0.5, got {value!r}")
 
 
-def particles_for_fill(fill_percent: float, full: int, *, what: str = "fill_percent") -> int:
+#: Largest fill, %, that is refused as ambiguous where it holds a particle: a fraction (0.3,
+#: 0.7, 1) typed for a percentage (30 %, 70 %, 100 %) lies at or below it.
+MAX_AMBIGUOUS_FILL_PERCENT = 1.0
+
+
+def particles_for_fill(fill_percent: float, full: int, *, what: str = "fill_percent",
+                       typed: bool = False) -> int:
     """Particles per cell of a fill percentage of ``full`` (the count taken as 100 %).
 
     The one rounding rule of a fill, for ``specimen check`` and ``dem run`` alike: a fill that
     rounds to no particle is refused (an empty cell damps nothing, and its SDC is 0/0).
     ``what``: how the refusal names the fill, by default the keyword a Python caller gave it
     by (a front end passes its own: ``--fill``, or ``fill`` where its message says where the
-    fill came from).
+    fill came from). ``typed``: the fill is one a person wrote (a specimen's
+    ``fill_percent``, ``--fill``, a file name, a sidecar or data table), where one of at most
+    :data:`MAX_AMBIGUOUS_FILL_PERCENT` that holds a particle is refused too, as a fraction
+    typed for a percentage; a count's own share (``count_per_cell``) is not typed, and
+    :func:`pidcore.dem.simulate.particles_per_cell` takes a specimen stating that count as
+    confirming a typed fill of it.
     """
     fill_percent = real_number(what, fill_percent)
     if not math.isfinite(fill_percent):
@@ -354,6 +365,15 @@ def particles_for_fill(fill_percent: float, full: int, *, what: str = "fill_perc
                 if 0 < fill_percent <= 1.0 and round(fill_percent * full) >= 1 else "")
         raise ParameterError(f"{what} {as_given(fill_percent)} % of {full} particles rounds to "
                              f"none; expected >= {least:.2f} %{hint}")
+    if typed and fill_percent <= MAX_AMBIGUOUS_FILL_PERCENT:
+        # in a cell of more than 50 particles 0.7 (70 % as a fraction) holds one or more, and
+        # ran silently at 3 of 441 particles where 309 were meant
+        raise ParameterError(
+            f"{what} {as_given(fill_percent)} % is {n} of {full} particles per cell; a fill of "
+            f"at most {MAX_AMBIGUOUS_FILL_PERCENT:g} % reads as a fraction: was "
+            f"{as_given(fill_percent)} meant as {fill_percent * 100:g} %? (for so few "
+            f"particles, a specimen file stating [particles] count_per_cell = {n} confirms "
+            "it)")
     return n
 
 
@@ -595,7 +615,7 @@ class Specimen:
         if self.particles.fill_percent is not None:
             try:
                 particles_for_fill(self.particles.fill_percent, self.capacity_per_cell(),
-                                   what="fill")  # the key is named before it
+                                   what="fill", typed=True)  # the key is named before it
             except ParameterError as exc:
                 raise _fail("[particles] fill_percent", f"{exc} (the cell's capacity)") \
                     from None

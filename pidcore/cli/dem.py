@@ -298,7 +298,7 @@ def _check_fill(fill: float, option: str, args: argparse.Namespace, specimen,
     check_fill_range(fill, option)
     # (a fraction typed for a percentage is asked about by particles_for_fill, as for analyze)
     particles_per_cell(fill, material, specimen=specimen, fill_reference=args.fill_reference,
-                       what=option)
+                       what=option, typed=True)
 
 
 def _fill(args: argparse.Namespace, specimen, material: str) -> float:
