@@ -398,3 +398,40 @@ def test_a_missing_calibration_names_the_command_that_writes_one(tmp_path, capsy
     # the library, for a Python caller, names its own function
     with pytest.raises(ParameterError, match=r"write_outputs\(result, out_dir\)"):
         load_calibration(path)
+
+
+def test_a_calibration_made_from_an_earlier_version_of_the_specimen_file_says_so(
+        calibration_file):
+    """`report --specimen wc_3mm.toml --calibration DIR` after the file was edited (another
+    restitution, a corrected radius) showed the calibration's bands, made from the earlier
+    file, beside the edited file's DEM runs without a word: the runs are kept apart by hash,
+    the calibration was matched by name."""
+    from pidcore.specimen import Specimen, load_specimen
+
+    steel = load_specimen(ROOT / "data_samples" / "specimens" / "steel_6mm.toml")
+    calibrated = steel.with_values({"coupon.fixture_mass_kg": 0.2}).to_toml().replace(
+        'name = "steel_6mm"', 'name = "steel_6mm_calibrated"')
+    calibrated += ("\n[provenance]\ncalibrated_from_name = \"steel_6mm\"\n"
+                   f"calibrated_from_sha256 = \"{steel.hash}\"\n")
+    (calibration_file.parent / "calibrated_specimen.toml").write_text(calibrated)
+    cal = load_calibration(calibration_file)
+    assert cal.calibrated_specimen().provenance.calibrated_from_sha256 == steel.hash
+    rows = pd.DataFrame({"frequency [Hz]": [100.0], "acceleration [g]": [1.0],
+                         "packing ratio [%]": [50.0], "material": ["steel"],
+                         "SDC measured [-]": [0.1], "SDC measured stderr [-]": [0.01],
+                         "note": [""]})
+    edited = Specimen.from_text(
+        steel.with_values({"pairs.particle_particle.restitution": 0.5}).to_toml(),
+        source="edited/steel_6mm.toml")
+    assert edited.name == steel.name and edited.hash != steel.hash
+    out = add_calibration_columns(rows, cal, specimen=edited)
+    assert out[CALIBRATED_COLUMN].iloc[0] == 0.09  # still predicted: the same tests' model
+    assert out.attrs["notes"][-1] == (
+        f"calibration {calibration_file} was made from steel_6mm [{steel.hash[:6]}], not from "
+        f"this steel_6mm [{edited.hash[:6]}] (edited/steel_6mm.toml): the file changed since, "
+        "and the calibrated DEM is the earlier file's apart from its fitted values; calibrate "
+        "this file again")
+    # the file it was made from, and the calibrated file itself, are no change
+    for same in (steel, Specimen.from_text(calibrated)):
+        notes = add_calibration_columns(rows, cal, specimen=same).attrs["notes"]
+        assert not any("changed since" in n for n in notes), notes

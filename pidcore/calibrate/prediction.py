@@ -278,6 +278,29 @@ class Calibration:
             return ""
         return _other_specimen(self.calibrated_specimen(), specimen)
 
+    def changed_source_note(self, specimen: Specimen | None) -> str:
+        """A note where ``specimen`` bears the name of the file this calibration was made from
+        (its calibrated file's ``[provenance]``) but not its contents: the file was edited
+        since (a corrected radius, another restitution), and the calibrated DEM beside its
+        rows is the earlier file's; "" otherwise (or where either is unknown).
+
+        DEM runs of the edited file are kept apart by its hash; the calibration's bands were
+        shown beside them without a word."""
+        if specimen is None:
+            return ""
+        calibrated = self.calibrated_specimen()
+        made_from = calibrated.provenance if calibrated is not None else None
+        if made_from is None or specimen.name != made_from.calibrated_from_name \
+                or specimen.hash == made_from.calibrated_from_sha256:
+            return ""
+        from ..specimen import hashed_name
+
+        return (f"calibration {self.path} was made from "
+                f"{hashed_name(made_from.calibrated_from_name, made_from.calibrated_from_sha256)}"
+                f", not from this {hashed_name(specimen.name, specimen.hash)} "
+                f"({specimen.source}): the file changed since, and the calibrated DEM is the "
+                "earlier file's apart from its fitted values; calibrate this file again")
+
     def why_not_predicted(self, case: LoadCase, *,
                           tolerances: Tolerances | None = None) -> str:
         """Why :meth:`lookup` finds no prediction at ``case``: another particle material,

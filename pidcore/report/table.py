@@ -622,5 +622,7 @@ def add_calibration_columns(table: pd.DataFrame, calibration, *,
     summary = (f"calibration {calibration.path}: predicts {sum(math.isfinite(v) for v in sdc)} "
                f"of {len(out)} row(s); measured Eq. 11 SDC inside the 95 % band at "
                f"{inside.count('yes')} of {compared} measured row(s)")
-    out.attrs = {**table.attrs, "notes": [*table.attrs.get("notes", []), summary]}
+    changed = calibration.changed_source_note(specimen)
+    out.attrs = {**table.attrs, "notes": [*table.attrs.get("notes", []), summary,
+                                          *([changed] if changed else [])]}
     return out
