@@ -1391,7 +1391,8 @@ def describe(specimen: Specimen) -> dict[str, Any]:
         else specimen.provenance.calibrated_from_name,
         "calibrated_from_sha256": None if specimen.provenance is None
         else specimen.provenance.calibrated_from_sha256,
-        "notes": [*table_overrides(specimen), *_heavy_fixture_note(specimen, count)],
+        "notes": [*table_overrides(specimen), *_heavy_fixture_note(specimen, count),
+                  *_column_note(specimen, capacity)],
         "cell_shape": specimen.cell.shape, "cells_per_coupon": specimen.cell.count,
         "capacity_per_cell": capacity, "particles_per_cell": count,
         "particles_per_cell_basis": basis,
@@ -1438,6 +1439,20 @@ def _heavy_fixture_note(specimen: Specimen, count: int) -> tuple[str, ...]:
     return (f"[coupon] fixture_mass_kg {fixture:g} kg is {fixture / carried:.0f} x the coupon "
             f"and its particles ({carried * 1e3:.4g} g): E of Eq. 10 (m_c a^2 / (2 w^2)) is "
             "then almost all the fixture's and the SDC small; was it g?",)
+
+
+def _column_note(specimen: Specimen, capacity: int) -> tuple[str, ...]:
+    """A note for spheres that fit the cell only one above another (a diameter typed as the
+    radius: 1.5 mm beads as radius_m = 1.5e-3 in a 3.2 mm cell were 3 per cell, the check said
+    OK); a note, not a refusal: a single column of beads is a possible damper."""
+    radius = specimen.particles.radius_m
+    layers = int(specimen.cell.height_m // (2 * radius))
+    if capacity > layers:
+        return ()
+    return (f"[particles] radius_m {radius * 1e3:.4g} mm: the spheres (diameter "
+            f"{2 * radius * 1e3:.4g} mm) fit the {specimen.cell.inscribed_diameter_m * 1e3:.4g} "
+            f"mm cell only one above another, a column of {capacity}; was the diameter given "
+            "as the radius?",)
 
 
 # --- geometry -------------------------------------------------------------------------------

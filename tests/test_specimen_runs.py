@@ -544,3 +544,22 @@ def test_dem_run_and_sweep_take_the_specimens_own_material_by_name(capsys, tmp_p
                  "--acceleration", "5", "--fill", "50", "--no-progress"]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and "--material steel" in err and "--specimen" in err, err
+
+
+def test_specimen_check_names_spheres_that_fit_only_as_a_column(capsys, tmp_path):
+    """2 mm beads typed as radius_m = 2e-3 (the diameter) in the 6.35 mm steel_6mm cell:
+    4 mm spheres, a column of 3 up a 12.7 mm core, which `specimen check` called OK without a
+    word, 15 x heavier each than the beads meant."""
+    column = tmp_path / "column.toml"
+    column.write_text(STEEL.read_text().replace("radius_m = 1.0e-3", "radius_m = 2.0e-3"))
+    facts = describe(load_specimen(column))
+    # 12.7 mm of core holds 3 spheres of 4 mm one above another, and no two side by side
+    assert facts["capacity_per_cell"] == int(12.7 // 4.0) == 3
+    (note,) = [n for n in facts["notes"] if "radius_m" in n]
+    assert note == ("[particles] radius_m 2 mm: the spheres (diameter 4 mm) fit the 6.35 mm "
+                    "cell only one above another, a column of 3; was the diameter given as "
+                    "the radius?")
+    assert main(["specimen", "check", str(column)]) == 0  # a note, not a refusal
+    assert f"note: {note}" in capsys.readouterr().out
+    # the beads meant pack side by side: no note
+    assert not [n for n in describe(load_specimen(STEEL))["notes"] if "radius_m" in n]
