@@ -528,7 +528,7 @@ def _refuse_fill_of_no_particle(path: str | os.PathLike, stated: StatedLoadCase 
     try:
         # "fill", not the keyword: the fill may come from the file name or a sidecar
         particles_of_stated_fill(stated.fill_percent, stated.material, specimen=specimen,
-                                 what="fill")
+                                 what="fill", typed=True)
     except PidcoreError as exc:
         if not str(exc).startswith("fill "):  # not about the fill
             raise

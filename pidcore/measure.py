@@ -465,7 +465,10 @@ class SavedAnalyses:
         if self.already_identical:
             parts.append(f"{len(self.already_identical)} already held with identical content")
         if self.replaced:
-            parts.append(f"{len(self.replaced)} replacing a held record of other content")
+            # "of other content" beside the note "has the same contents" read as a
+            # contradiction: the file is the same, its name, load case or specimen is not
+            parts.append(f"{len(self.replaced)} replacing the held record of the same file "
+                         "under another name, load case or specimen")
         return ", ".join(parts)
 
 

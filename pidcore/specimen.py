@@ -101,6 +101,7 @@ import functools
 import hashlib
 import math
 import os
+import re
 import sys
 import tomllib
 from collections.abc import Mapping
@@ -171,6 +172,24 @@ def _shown(value: object) -> str:
     if isinstance(value, list | tuple) and len(repr(value)) > MAX_SHOWN_CHARS:
         return f"an array of {len(value)} items ({_clip(repr(value))})"
     return _clip(repr(value))
+
+
+def _check_particle_material_name(where: str, name: str) -> None:
+    """Refuse a particle material name that a load case cannot carry as written: every run,
+    file name and sidecar states the material in its canonical form (``normalize_material``),
+    so ``"Acrylic"``, ``"PMMA"`` or ``"tungsten carbide"`` passed ``specimen check`` and were
+    then refused by ``dem run`` as a clash with ``--material``, which nobody had given."""
+    try:
+        canonical = normalize_material(name, where, known=None)
+    except ParameterError:
+        suggestion = re.sub(r"[^a-z0-9_]+", "_", name.strip().lower()).strip("_")
+        raise _fail(where, f"{_shown(name)} is not a material name a load case can carry; "
+                           "expected lower-case letters, digits and '_' starting with a letter"
+                           + (f" (e.g. {suggestion!r})" if re.match(r"^[a-z]", suggestion)
+                              else "")) from None
+    if canonical != name:
+        raise _fail(where, f"{_shown(name)} is written {canonical!r} in load cases, file names "
+                           f"and stored runs; write material = \"{canonical}\"")
 
 
 def _large_count(count: int) -> str:
@@ -310,14 +329,25 @@ def _poisson(where: str, value: float) -> None:
         raise _fail(where, f"expected -1 < nu < 0.5, got {value!r}")
 
 
-def particles_for_fill(fill_percent: float, full: int, *, what: str = "fill_percent") -> int:
+#: Largest fill, %, that is refused as ambiguous where it holds a particle: a fraction (0.3,
+#: 0.7, 1) typed for a percentage (30 %, 70 %, 100 %) lies at or below it.
+MAX_AMBIGUOUS_FILL_PERCENT = 1.0
+
+
+def particles_for_fill(fill_percent: float, full: int, *, what: str = "fill_percent",
+                       typed: bool = False) -> int:
     """Particles per cell of a fill percentage of ``full`` (the count taken as 100 %).
 
     The one rounding rule of a fill, for ``specimen check`` and ``dem run`` alike: a fill that
     rounds to no particle is refused (an empty cell damps nothing, and its SDC is 0/0).
     ``what``: how the refusal names the fill, by default the keyword a Python caller gave it
     by (a front end passes its own: ``--fill``, or ``fill`` where its message says where the
-    fill came from).
+    fill came from). ``typed``: the fill is one a person wrote (a specimen's
+    ``fill_percent``, ``--fill``, a file name, a sidecar or data table), where one of at most
+    :data:`MAX_AMBIGUOUS_FILL_PERCENT` that holds a particle is refused too, as a fraction
+    typed for a percentage; a count's own share (``count_per_cell``) is not typed, and
+    :func:`pidcore.dem.simulate.particles_per_cell` takes a specimen stating that count as
+    confirming a typed fill of it.
     """
     fill_percent = real_number(what, fill_percent)
     if not math.isfinite(fill_percent):
@@ -335,6 +365,15 @@ def particles_for_fill(fill_percent: float, full: int, *, what: str = "fill_perc
                 if 0 < fill_percent <= 1.0 and round(fill_percent * full) >= 1 else "")
         raise ParameterError(f"{what} {as_given(fill_percent)} % of {full} particles rounds to "
                              f"none; expected >= {least:.2f} %{hint}")
+    if typed and fill_percent <= MAX_AMBIGUOUS_FILL_PERCENT:
+        # in a cell of more than 50 particles 0.7 (70 % as a fraction) holds one or more, and
+        # ran silently at 3 of 441 particles where 309 were meant
+        raise ParameterError(
+            f"{what} {as_given(fill_percent)} % is {n} of {full} particles per cell; a fill of "
+            f"at most {MAX_AMBIGUOUS_FILL_PERCENT:g} % reads as a fraction: was "
+            f"{as_given(fill_percent)} meant as {fill_percent * 100:g} %? (for so few "
+            f"particles, a specimen file stating [particles] count_per_cell = {n} confirms "
+            "it)")
     return n
 
 
@@ -410,6 +449,7 @@ class ParticleSpec:
             raise _fail("[particles] material",
                         f"expected a name, got {_shown(self.material)}")
         _printable("[particles] material", self.material)
+        _check_particle_material_name("[particles] material", self.material)
         _positive("[particles] radius_m", self.radius_m, "m")
         _plausible("[particles] radius_m", "radius_m", self.radius_m)
         _positive("[particles] density_kg_m3", self.density_kg_m3, "kg/m^3")
@@ -575,7 +615,7 @@ class Specimen:
         if self.particles.fill_percent is not None:
             try:
                 particles_for_fill(self.particles.fill_percent, self.capacity_per_cell(),
-                                   what="fill")  # the key is named before it
+                                   what="fill", typed=True)  # the key is named before it
             except ParameterError as exc:
                 raise _fail("[particles] fill_percent", f"{exc} (the cell's capacity)") \
                     from None
@@ -1019,6 +1059,8 @@ def _from_mapping(data: Mapping[str, Any], *, source: str) -> Specimen:
                             _WALL_FROM_MATERIAL)
 
     particles = _take(data["particles"], "particles", "[particles]")
+    # before the table look-up: "Acrylic" is no row of it, but the row meant
+    _check_particle_material_name("[particles] material", particles["material"])
     _complete_from_material(particles, "[particles] material", particles["material"],
                             "particle",
                             _PARTICLE_FROM_MATERIAL + (("radius_m", "default_radius_m"),))
@@ -1349,7 +1391,8 @@ def describe(specimen: Specimen) -> dict[str, Any]:
         else specimen.provenance.calibrated_from_name,
         "calibrated_from_sha256": None if specimen.provenance is None
         else specimen.provenance.calibrated_from_sha256,
-        "notes": [*table_overrides(specimen), *_heavy_fixture_note(specimen, count)],
+        "notes": [*table_overrides(specimen), *_heavy_fixture_note(specimen, count),
+                  *_column_note(specimen, capacity)],
         "cell_shape": specimen.cell.shape, "cells_per_coupon": specimen.cell.count,
         "capacity_per_cell": capacity, "particles_per_cell": count,
         "particles_per_cell_basis": basis,
@@ -1396,6 +1439,20 @@ def _heavy_fixture_note(specimen: Specimen, count: int) -> tuple[str, ...]:
     return (f"[coupon] fixture_mass_kg {fixture:g} kg is {fixture / carried:.0f} x the coupon "
             f"and its particles ({carried * 1e3:.4g} g): E of Eq. 10 (m_c a^2 / (2 w^2)) is "
             "then almost all the fixture's and the SDC small; was it g?",)
+
+
+def _column_note(specimen: Specimen, capacity: int) -> tuple[str, ...]:
+    """A note for spheres that fit the cell only one above another (a diameter typed as the
+    radius: 1.5 mm beads as radius_m = 1.5e-3 in a 3.2 mm cell were 3 per cell, the check said
+    OK); a note, not a refusal: a single column of beads is a possible damper."""
+    radius = specimen.particles.radius_m
+    layers = int(specimen.cell.height_m // (2 * radius))
+    if capacity > layers:
+        return ()
+    return (f"[particles] radius_m {radius * 1e3:.4g} mm: the spheres (diameter "
+            f"{2 * radius * 1e3:.4g} mm) fit the {specimen.cell.inscribed_diameter_m * 1e3:.4g} "
+            f"mm cell only one above another, a column of {capacity}; was the diameter given "
+            "as the radius?",)
 
 
 # --- geometry -------------------------------------------------------------------------------

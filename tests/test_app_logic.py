@@ -473,7 +473,10 @@ def test_saving_again_says_the_store_already_held_the_records(tmp_path, good_csv
     assert again.keys == first.keys
     assert again.breakdown == "0 new, 1 already held with identical content"
     other = uploads.save_records(store_file, [_file(rec, options, fill=75.0)])
-    assert other.breakdown == "0 new, 1 replacing a held record of other content"
+    # the same file, stated otherwise: not "a record of other content" beside the note that
+    # says its contents are the same
+    assert other.breakdown == ("0 new, 1 replacing the held record of the same file under "
+                               "another name, load case or specimen")
 
 
 def test_two_sessions_saving_at_once_keep_the_store_whole(tmp_path, options):

@@ -130,8 +130,9 @@ def test_saving_the_same_records_again_says_they_were_already_held(tmp_path, cap
     # another load case for the same bytes is no identical content: replaced, and said so
     assert main([*argv, "--fill", "75"]) == 0
     out = capsys.readouterr().out
-    assert (f"saved 1 record(s) to {store_path} (0 new, 1 replacing a held record of other "
-            "content)\n") in out and "replaces it" in out
+    assert (f"saved 1 record(s) to {store_path} (0 new, 1 replacing the held record of the "
+            "same file under another name, load case or specimen)\n") in out \
+        and "replaces it" in out
 
 
 def test_a_stated_load_case_is_saved_so_that_a_store_report_places_it(tmp_path, capsys):

@@ -467,3 +467,41 @@ def test_a_calibration_json_alone_speaks_for_the_specimen_it_names(tmp_path):
     assert paper.specimen_name == "paper_coupon" and paper.speaks_for("paper_coupon")
     # a file written before it stated one: unknown, as before
     assert calibration_from_json(BUNDLED.read_bytes(), "old").speaks_for("my_panel")
+
+
+def test_a_calibration_made_from_an_earlier_version_of_the_specimen_file_says_so(
+        calibration_file):
+    """`report --specimen wc_3mm.toml --calibration DIR` after the file was edited (another
+    restitution, a corrected radius) showed the calibration's bands, made from the earlier
+    file, beside the edited file's DEM runs without a word: the runs are kept apart by hash,
+    the calibration was matched by name. Its bands are refused there now, with a note naming
+    both files by hash."""
+    from pidcore.specimen import Specimen, load_specimen
+
+    steel = load_specimen(ROOT / "data_samples" / "specimens" / "steel_6mm.toml")
+    calibrated = steel.with_values({"coupon.fixture_mass_kg": 0.2}).to_toml().replace(
+        'name = "steel_6mm"', 'name = "steel_6mm_calibrated"')
+    calibrated += ("\n[provenance]\ncalibrated_from_name = \"steel_6mm\"\n"
+                   f"calibrated_from_sha256 = \"{steel.hash}\"\n")
+    (calibration_file.parent / "calibrated_specimen.toml").write_text(calibrated)
+    cal = load_calibration(calibration_file)
+    assert cal.calibrated_specimen().provenance.calibrated_from_sha256 == steel.hash
+    rows = pd.DataFrame({"frequency [Hz]": [100.0], "acceleration [g]": [1.0],
+                         "packing ratio [%]": [50.0], "material": ["steel"],
+                         "SDC measured [-]": [0.1], "SDC measured stderr [-]": [0.01],
+                         "note": [""]})
+    edited = Specimen.from_text(
+        steel.with_values({"pairs.particle_particle.restitution": 0.5}).to_toml(),
+        source="edited/steel_6mm.toml")
+    assert edited.name == steel.name and edited.hash != steel.hash
+    out = add_calibration_columns(rows, cal, specimen=edited)
+    # the earlier file's calibrated DEM is no prediction of the edited file: refused, said
+    assert out[CALIBRATED_COLUMN].isna().all()
+    assert out["note"].iloc[0] == (
+        f"not predicted by the calibration {calibration_file.name}: it calibrates specimen "
+        f"steel_6mm [{steel.hash[:6]}], not steel_6mm [{edited.hash[:6]}] (another file of "
+        "the same name)")
+    # the file it was made from, and the calibrated file itself, are its specimen: predicted
+    for same in (steel, Specimen.from_text(calibrated)):
+        assert add_calibration_columns(rows, cal, specimen=same)[CALIBRATED_COLUMN].iloc[0] \
+            == 0.09  # copied from calibration.json: no tolerance

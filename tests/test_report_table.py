@@ -310,3 +310,41 @@ def test_dem_runs_that_did_not_converge_are_named_in_the_row_note_and_counted():
     # a store that does not record convergence is not flagged
     quiet = build_report_table(dem.drop(columns="steady_detected"), None, None)
     assert not any("converge" in n for n in [*quiet["note"], *quiet.attrs["notes"]])
+
+
+def test_an_interpolated_sdc_resting_on_a_run_that_did_not_converge_says_so():
+    """A grid row on a run measured from the transient cap is flagged, but a measurement
+    between grid points got the pchip value interpolated from that run with no word of it."""
+    from pidcore.compare.align import Aligner
+    from pidcore.loadcase import LoadCase
+
+    rows = []
+    for freq in FREQS:
+        for acc in ACCS:
+            for fill in FILLS:
+                rows.append({"frequency_hz": freq, "acceleration_g": acc, "fill_percent": fill,
+                             "material": "acrylic", "direction": "z",
+                             "sdc": _sdc(fill, acc, freq), "sdc_stderr": 0.01,
+                             # one corner of the grid never reached a steady state
+                             "steady_detected": int((freq, acc, fill) != (100.0, 5.0, 50.0)),
+                             "steady_start_cycle": 100, "steady_cycles": 20})
+    dem = pd.DataFrame(rows)
+    aligner = Aligner.from_tables(dem)
+
+    inside = aligner.align(LoadCase(70.0, 3.0, 40.0))  # in the cell that has the corner
+    assert inside.status == "interpolated"
+    assert inside.unconverged_nodes == ("100 Hz, 5 g, 50 %",)
+    assert inside.message.endswith(
+        "it rests on DEM runs that did not converge (no steady state before the transient "
+        "cap) at 100 Hz, 5 g, 50 %: the interpolated SDC may include the transient")
+    analyses = pd.DataFrame({"frequency_hz": [70.0], "acceleration_g": [3.0],
+                             "fill_percent": [40.0], "material": ["acrylic"],
+                             "direction": ["z"], "sdc": [0.27], "sdc_stderr": [0.01],
+                             "source": ["between.csv"]})
+    table = build_report_table(dem, analyses, None)
+    row = table[table[ALIGNMENT_COLUMN] == "interpolated"].iloc[0]
+    assert "did not converge" in row["note"] and "100 Hz, 5 g, 50 %" in row["note"]
+    (said,) = [n for n in table.attrs["notes"]
+               if n.startswith("2 row(s) rest on DEM runs that did not converge")]
+    assert said.endswith("the transient: 100 Hz, 5 g, 50 %; 70 Hz, 3 g, 40 % (interpolated "
+                         "from 100 Hz, 5 g, 50 %)"), said

@@ -163,3 +163,78 @@ def test_a_known_table_written_as_an_array_or_a_value_is_named_as_such(old, new,
     ['tangential_stiffness_model']": a known table called unknown."""
     with pytest.raises(ParameterError, match="^s.toml: " + message):
         Specimen.from_text(_edit(old, new), source="s.toml")
+
+
+@pytest.mark.parametrize("written, message", [
+    # a table material under another spelling: its load cases say "acrylic", the file "Acrylic"
+    ("Acrylic", r"'Acrylic' is written 'acrylic' in load cases, file names and stored runs; "
+                r"write material = \"acrylic\"$"),
+    ("PMMA", r"'PMMA' is written 'acrylic' .*write material = \"acrylic\"$"),
+    ("aluminum", r"'aluminum' is written 'aluminium' .*write material = \"aluminium\"$"),
+    ("steel ", r"'steel ' is written 'steel' .*write material = \"steel\"$"),
+    # no load case can carry a space: file names and run keys are split at '_'
+    ("tungsten carbide", r"'tungsten carbide' is not a material name a load case can carry; "
+                         r"expected lower-case letters, digits and '_' starting with a letter "
+                         r"\(e.g. 'tungsten_carbide'\)$"),
+])
+def test_a_particle_material_name_no_load_case_carries_is_refused_by_check(
+        written, message, tmp_path, capsys):
+    """`specimen check` said OK to `material = "Acrylic"` (or "PMMA", "tungsten carbide"),
+    and `dem run --specimen` then refused it as "--material: the load case says 'acrylic' but
+    specimen ... holds 'Acrylic' particles", naming an option nobody had given."""
+    text = _edit('material = "steel"', f'material = "{written}"')
+    with pytest.raises(ParameterError, match=r"^s.toml: \[particles\] material: " + message):
+        Specimen.from_text(text, source="s.toml")
+    path = tmp_path / "own.toml"
+    path.write_text(text)
+    for argv in (["specimen", "check", str(path)],
+                 ["dem", "run", "--specimen", str(path), "--frequency", "200",
+                  "--acceleration", "5", "--cells", "1", "--no-progress"]):
+        err = _one_line_exit_2(argv, capsys)
+        assert "[particles] material" in err and "--material" not in err, err
+    # the name as a load case writes it is an own material, simulated with its inline numbers
+    own = Specimen.from_text(_edit('material = "steel"', 'material = "tungsten_carbide"'),
+                             source="s.toml")
+    assert own.particles.material == "tungsten_carbide"
+
+
+def test_a_fill_fraction_that_holds_a_particle_is_refused_as_typed_for_a_percentage(
+        tmp_path, capsys):
+    """In a cell of more than 50 particles a fraction typed for a percentage holds one: 0.7
+    (70 %) ran 1 of 120 particles per cell without a word, in `specimen check`, `dem run`
+    and `analyze` alike. A specimen stating that count confirms such a small fill."""
+    import shutil
+
+    from pidcore.dem.simulate import particles_per_cell
+
+    small = _edit("radius_m = 1.0e-3", "radius_m = 0.75e-3")  # 120 spheres fit the cell
+    with pytest.raises(ParameterError,
+                       match=r"^s.toml: \[particles\] fill_percent: fill 0.7 % is 1 of 120 "
+                             r"particles per cell; a fill of at most 1 % reads as a fraction: "
+                             r"was 0.7 meant as 70 %\?"):
+        Specimen.from_text(_edit("fill_percent = 50.0", "fill_percent = 0.7", small),
+                           source="s.toml")
+    two = tmp_path / "two.toml"
+    two.write_text(_edit("fill_percent = 50.0", "count_per_cell = 2", small))
+    store = tmp_path / "runs.h5"
+    err = _one_line_exit_2(["dem", "run", "--specimen", str(two), "--frequency", "200",
+                            "--acceleration", "5", "--fill", "0.7", "--cells", "1",
+                            "--store", str(store), "--no-progress"], capsys)
+    assert "--fill 0.7 % is 1 of 120 particles per cell" in err and "70 %?" in err, err
+    assert not store.exists()
+    export = tmp_path / "run_f500Hz_a1g_fill1.csv"  # fill 1 % of 120: one particle
+    shutil.copy(REPO / "data_samples" / "exports" / "synthetic_f500Hz_a1g_fill50_acrylic.csv",
+                export)
+    err = _one_line_exit_2(["analyze", str(export), "--specimen", str(two), "--no-store",
+                            "--no-progress"], capsys)
+    assert err.endswith("run_f500Hz_a1g_fill1.csv: fill 1 % is 1 of 120 particles per cell; "
+                        "a fill of at most 1 % reads as a fraction: was 1 meant as 100 %? "
+                        "(for so few particles, a specimen file stating [particles] "
+                        "count_per_cell = 1 confirms it) (fill: file name)"), err
+    # a count stated in the file is its own share (0.833 %), and confirms a typed fill of it
+    one = Specimen.from_text(_edit("fill_percent = 50.0", "count_per_cell = 1", small),
+                             source="one.toml")
+    assert one.stated_fill()[0] == pytest.approx(100 / 120, rel=1e-15)
+    assert particles_per_cell(0.7, specimen=one, typed=True) == (1, 120)
+    # a fill above the fractions' range is a percentage, whatever the count
+    assert particles_per_cell(1.5, specimen=one, typed=True) == (2, 120)

@@ -542,3 +542,71 @@ def test_a_sweeps_json_and_summary_name_each_runs_specimen_file(capsys, tmp_path
         assert said[label].rstrip().endswith(f"; specimen x (sha256 {spec.hash[:12]})")
     assert first.hash != edited.hash
     assert len(Store(store).list_dem_runs()) == 2
+
+
+def test_dem_run_and_sweep_take_the_specimens_own_material_by_name(capsys, tmp_path):
+    """`--specimen steel_6mm.toml --material steel` was refused by argparse ("invalid choice:
+    'steel' (choose from 'acrylic', 'aluminium')"), though the material is the specimen's and
+    `analyze`/`report` take it by name."""
+    store = tmp_path / "s.h5"
+    common = ["--specimen", str(STEEL), "--frequency", "1000", "--acceleration", "5",
+              "--cells", "1", "--cycles", "4", "--no-progress", "--json", "--store", str(store)]
+    assert main(["dem", "run", *common]) == 0
+    first = json.loads(capsys.readouterr().out)
+    before = store.read_bytes()
+    # the same run under its own material's name (and its capitalised spelling): reused, one key
+    for name in ("steel", "Steel"):
+        assert main(["dem", "run", *common, "--material", name]) == 0
+        again = json.loads(capsys.readouterr().out)
+        assert again["reused_from_store"] is True and again["store_key"] == first["store_key"]
+    assert main(["dem", "sweep", "--specimen", str(STEEL), "--material", "steel",
+                 "--frequencies", "1000", "--accelerations", "5", "--fills", "50",
+                 "--cells", "1", "--cycles", "4", "--workers", "1", "--no-progress",
+                 "--json", "--store", str(store)]) == 0
+    swept = json.loads(capsys.readouterr().out)
+    assert [c["store_key"] for c in swept["cases"]] == [first["store_key"]]
+    assert swept["completed"] == 0 and swept["skipped"] == 1
+    assert store.read_bytes() == before
+    # without a specimen an own material has no numbers: one line naming both options
+    assert main(["dem", "run", "--material", "steel", "--frequency", "1000",
+                 "--acceleration", "5", "--fill", "50", "--no-progress"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "--material steel" in err and "--specimen" in err, err
+
+
+def test_specimen_check_names_spheres_that_fit_only_as_a_column(capsys, tmp_path):
+    """2 mm beads typed as radius_m = 2e-3 (the diameter) in the 6.35 mm steel_6mm cell:
+    4 mm spheres, a column of 3 up a 12.7 mm core, which `specimen check` called OK without a
+    word, 15 x heavier each than the beads meant."""
+    column = tmp_path / "column.toml"
+    column.write_text(STEEL.read_text().replace("radius_m = 1.0e-3", "radius_m = 2.0e-3"))
+    facts = describe(load_specimen(column))
+    # 12.7 mm of core holds 3 spheres of 4 mm one above another, and no two side by side
+    assert facts["capacity_per_cell"] == int(12.7 // 4.0) == 3
+    (note,) = [n for n in facts["notes"] if "radius_m" in n]
+    assert note == ("[particles] radius_m 2 mm: the spheres (diameter 4 mm) fit the 6.35 mm "
+                    "cell only one above another, a column of 3; was the diameter given as "
+                    "the radius?")
+    assert main(["specimen", "check", str(column)]) == 0  # a note, not a refusal
+    assert f"note: {note}" in capsys.readouterr().out
+    # the beads meant pack side by side: no note
+    assert not [n for n in describe(load_specimen(STEEL))["notes"] if "radius_m" in n]
+
+
+def test_dem_run_numerics_line_says_what_its_wall_time_and_rate_count(tmp_path, capsys):
+    """`numerics ... 779520 steps, 30.4 s wall, 1.74e+07 particle-steps/s`: 4 cells of 6
+    particles over those steps are 1.9e7 particle-steps, 0.6e6 per wall second; the wall time
+    held the settle and the first Numba compile, the rate only the kernel's calls."""
+    import re
+
+    code = main(["dem", "run", "--frequency", "500", "--acceleration", "5", "--fill", "50",
+                 "--cells", "1", "--cycles", "10", "--no-progress"])
+    out = capsys.readouterr().out
+    assert code == 0
+    line = next(x for x in out.splitlines() if x.startswith("numerics"))
+    steps, wall, rate = re.fullmatch(
+        r"numerics\s+dt \S+ s, (\d+) driven steps, (\S+) s wall \(settle and any Numba compile "
+        r"included\), (\S+) particle-steps/s in the kernel", line).groups()
+    # the kernel's time for the driven steps alone (11 acrylic particles, one cell) is within
+    # the wall time: the rate is not of the wall time, which holds more
+    assert int(steps) * 11 / float(rate) <= float(wall) + 0.05  # 0.05: the wall's 0.1 s print

@@ -289,7 +289,7 @@ def check_point_fills(points: Sequence[MeasuredPoint], specimen: Specimen,
     for p in points:
         try:
             particles_per_cell(p.fill_percent, specimen=specimen,
-                               fill_reference=config.fill_reference, what="fill")
+                               fill_reference=config.fill_reference, what="fill", typed=True)
         except ParameterError as exc:
             where = f"{p.source}, line {p.row}" if p.row is not None else \
                 (p.source or "measured point")

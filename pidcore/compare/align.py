@@ -194,6 +194,9 @@ class AlignedCase:
         The Table 3 grid point matched.
     message : str
         Why the status is what it is (model used, range it covers...).
+    unconverged_nodes : tuple of str
+        For an interpolated value: the labels of the DEM cases at the corners of the grid
+        cell it lies in whose runs never reached a steady state (``message`` names them).
     """
 
     load_case: LoadCase
@@ -205,6 +208,7 @@ class AlignedCase:
     sdc_paper_experimental: float = math.nan
     paper_case: LoadCase | None = None
     message: str = ""
+    unconverged_nodes: tuple[str, ...] = ()
 
     def to_dict(self) -> dict[str, float | str]:
         """One row with unit-suffixed column names."""
@@ -892,8 +896,36 @@ class Aligner:
                                message=f"{case.label()} lies outside the range of {source} "
                                        f"({rng}); not extrapolated")
         value = float(np.asarray(model(*point)))
+        unconverged = self._unconverged_nodes(case) if self.model is None else ()
+        message = f"pchip interpolation over {source}"
+        if unconverged:
+            # a grid row on such a run says so; the value interpolated from it said nothing
+            message += ("; it rests on DEM runs that did not converge (no steady state before "
+                        f"the transient cap) at {'; '.join(unconverged)}: the interpolated "
+                        "SDC may include the transient")
         return AlignedCase(case, "interpolated", value, math.nan, None, **common,
-                           message=f"pchip interpolation over {source}")
+                           message=message, unconverged_nodes=unconverged)
+
+    def _unconverged_nodes(self, case: LoadCase) -> tuple[str, ...]:
+        """Labels of the DEM cases (one per grid point, as the model takes them) at the
+        corners of the grid cell holding ``case`` whose runs did not converge."""
+        members, _ = _one_case_per_point(
+            [c for c in self.cases
+             if (c.load_case.material, c.load_case.direction) == (case.material,
+                                                                   case.direction)])
+        corners = []
+        for attr in ("fill_percent", "acceleration_g", "frequency_hz"):
+            values = sorted({getattr(c.load_case, attr) for c in members})
+            x = getattr(case, attr)
+            below = [v for v in values if v <= x]
+            above = [v for v in values if v >= x]
+            corners.append({below[-1] if below else values[0],
+                            above[0] if above else values[-1]})
+        return tuple(c.load_case.label() for c in members
+                     if c.not_converged and all(
+                         getattr(c.load_case, attr) in allowed for attr, allowed in zip(
+                             ("fill_percent", "acceleration_g", "frequency_hz"), corners,
+                             strict=True)))
 
 
 def align_measured(measured: pd.DataFrame, dem_runs: pd.DataFrame | None,

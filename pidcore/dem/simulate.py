@@ -265,14 +265,15 @@ def particles_per_cell(fill_percent: float, material_name: str | None = None, *,
                        specimen: Specimen | None = None,
                        geometry: CellGeometry | None = None,
                        fill_reference: str = defaults.DEM_FILL_REFERENCE,
-                       what: str = "fill_percent") -> tuple[int, int]:
+                       what: str = "fill_percent", typed: bool = False) -> tuple[int, int]:
     """(particles per cell, count taken as 100 %) for a fill percentage.
 
     The particles and cell are the ``specimen``'s (default: the paper's coupon with
     ``material_name`` particles); ``geometry`` overrides its cell.
     ``fill_reference="capacity"``: 100 % is :func:`~pidcore.dem.geometry.cell_capacity`;
     ``"paper"``: 36 particles, refused when 36 do not fit the cell. ``what``: how a refused
-    fill is named (:func:`pidcore.specimen.particles_for_fill`).
+    fill is named, and ``typed`` whether a person wrote it
+    (:func:`pidcore.specimen.particles_for_fill`).
     """
     specimen = specimen or paper_specimen(material_name or "acrylic")
     material_name = specimen.particles.material
@@ -295,12 +296,19 @@ def particles_per_cell(fill_percent: float, material_name: str | None = None, *,
     else:
         raise ParameterError(f"fill_reference: expected one of {FILL_REFERENCES}, "
                              f"got {fill_reference!r}")
-    return particles_for_fill(fill_percent, full, what=what), full
+    # a specimen stating count_per_cell confirms a small typed fill of that count (1 of 441
+    # particles is 0.23 %, which reads as a fraction otherwise)
+    confirmed = (typed and fill_reference == "capacity"
+                 and specimen.particles.count_per_cell is not None
+                 and particles_for_fill(fill_percent, full, what=what)
+                 == specimen.particles.count_per_cell)
+    return particles_for_fill(fill_percent, full, what=what,
+                              typed=typed and not confirmed), full
 
 
 def particles_of_stated_fill(fill_percent: float, material: str, *,
                              specimen: Specimen | None = None,
-                             what: str = "fill_percent") -> int | None:
+                             what: str = "fill_percent", typed: bool = False) -> int | None:
     """Particles per cell of a measurement's stated fill, in the cell it was tested in: the
     ``specimen``'s where its particles are ``material``, else the paper's coupon's for a table
     material (:data:`~pidcore.constants.PARTICLE_MATERIALS`); None where neither says which
@@ -314,7 +322,8 @@ def particles_of_stated_fill(fill_percent: float, material: str, *,
         cell = None  # the paper's coupon with these particles
     else:
         return None
-    return particles_per_cell(fill_percent, material, specimen=cell, what=what)[0]
+    return particles_per_cell(fill_percent, material, specimen=cell, what=what,
+                              typed=typed)[0]
 
 
 def _kernel_specializations() -> int:

@@ -106,6 +106,7 @@ class _Row:
     measured: list[_Measured] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
     specimen: str | None = None  # None: no measurement claimed the row yet
+    unconverged_nodes: tuple[str, ...] = ()  # interpolated from runs that did not converge
 
 
 def _measured_rows(analyses: pd.DataFrame | None, notes: list[str]) -> list[tuple[LoadCase,
@@ -332,13 +333,15 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
                 not_paper = [NOT_PAPER_SPECIMEN_NOTE.format(name=specimen)]
             base = _Row(case, aligned.status, None, aligned.sdc_dem, aligned.sdc_dem_stderr,
                         *paper_values,
-                        notes=[aligned.message] + ([met_note] if met_note else []) + not_paper)
+                        notes=[aligned.message] + ([met_note] if met_note else []) + not_paper,
+                        unconverged_nodes=aligned.unconverged_nodes)
         row = next((r for r in group if r.dem is base.dem and r.specimen == specimen), None)
         if row is None:
             row = next((r for r in group if r.dem is base.dem and r.specimen is None), None)
         if row is None:  # another specimen at this case: a row of its own beside the DEM's
             row = _Row(base.case, base.status, base.dem, base.sdc_dem, base.sdc_dem_stderr,
-                       base.paper_dem, base.paper_exp, notes=list(base.notes))
+                       base.paper_dem, base.paper_exp, notes=list(base.notes),
+                       unconverged_nodes=base.unconverged_nodes)
             group.append(row)
         row.specimen = specimen
         row.measured.append(entry)
@@ -390,6 +393,9 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
         if row.dem is not None and row.dem.not_converged:
             note.append(not_converged_note(row.dem))
             unconverged_rows.append(lc.label())
+        elif row.unconverged_nodes:  # the row's note, from its alignment, names them
+            unconverged_rows.append(f"{lc.label()} (interpolated from "
+                                    f"{'; '.join(row.unconverged_nodes)})")
         if pool:
             note.append("pooled across specimens and DEM settings (pool=True)")
         if row.measured and math.isfinite(row.sdc_dem) and not math.isfinite(sdc_m10):
