@@ -259,13 +259,22 @@ def test_the_calibration_folder_is_accepted_and_another_folder_is_named(tmp_path
         load_calibration(tmp_path)
 
 
+def _before_specimen_block() -> bytes:
+    """The bundled calibration.json as pidcore wrote it before it named the specimen file it
+    calibrated (no "specimen" block)."""
+    doc = json.loads(BUNDLED.read_text(encoding="utf-8"))
+    del doc["specimen"]
+    return json.dumps(doc, indent=2).encode()
+
+
 def test_a_calibration_speaks_for_its_own_specimen_or_an_unnamed_one(tmp_path):
     # the app's Compare asks this by name (its measurements carry a specimen label only)
     import shutil
 
     from pidcore.calibrate.prediction import calibration_from_json, load_calibration
 
-    shutil.copy(BUNDLED, tmp_path / "calibration.json")
+    # as calibration.json was written before it named its specimen
+    (tmp_path / "calibration.json").write_bytes(_before_specimen_block())
     bare = load_calibration(tmp_path / "calibration.json")  # no specimen file: unknown
     assert bare.speaks_for("my_panel")
     shutil.copy(ROOT / "data_samples" / "paper_calibrated_specimen.toml",
@@ -466,7 +475,9 @@ def test_a_calibration_json_alone_speaks_for_the_specimen_it_names(tmp_path):
     paper = stated("paper_coupon", paper_specimen().hash)
     assert paper.specimen_name == "paper_coupon" and paper.speaks_for("paper_coupon")
     # a file written before it stated one: unknown, as before
-    assert calibration_from_json(BUNDLED.read_bytes(), "old").speaks_for("my_panel")
+    assert calibration_from_json(_before_specimen_block(), "old").speaks_for("my_panel")
+    # the bundled one names the paper's coupon
+    assert not calibration_from_json(BUNDLED.read_bytes(), "new").speaks_for("my_panel")
 
 
 def test_a_calibration_made_from_an_earlier_version_of_the_specimen_file_says_so(
