@@ -99,12 +99,16 @@ def flying_run():
 
 
 def test_dem_observation_is_eq11_of_the_virtual_shaker(flying_run):
-    # without fixture and baseline the prediction is Eq. 11 of the DEM's own shaker record
+    # without fixture and baseline the prediction is Eq. 11 of the DEM's own shaker record,
+    # analysed without blocks as the observation is: one DC and trend over the record (a
+    # measurement's blocks bring the drift spline, 0.2 % off here on 20 cycles; a DEM record
+    # has no wander, and the bundled calibration stays as it was)
     entry = dem_run_entry(flying_run)
     obs = observation_from_run(entry["record"], entry["arrays"])
     sl = flying_run.steady_slice()
     eq11 = analyze_power(flying_run.shaker_force_n[sl], flying_run.velocity_m_s[sl],
-                         flying_run.sample_rate_hz, frequency_hz=500.0, n_harmonics=1).sdc
+                         flying_run.sample_rate_hz, frequency_hz=500.0, n_harmonics=1,
+                         n_blocks=0).sdc
     assert obs.sdc() == pytest.approx(eq11, rel=1e-6)
     # power closure: Re(P) x T is the dissipation tally per cycle (2 % as in test_dem_simulate)
     w = 2 * math.pi * 500.0

@@ -23,8 +23,10 @@ from pidcore.measure import analyze_file
 
 F = Path(__file__).resolve().parents[1] / "data_samples" / "exports" / \
     "synthetic_f50Hz_a5g_fill50_acrylic.uff"
-# the two SDCs differ by 0.10; 5e-5 is far below that and far above the last printed digit
-SDC_50US, SDC_0US, TOL = 1.13597, 1.03433, 5e-5
+# the two SDCs differ by 0.10; 5e-5 is far below that and far above the last printed digit.
+# Since the drift became a spline (docs/measurement.md) they are 0.0035 higher (0.15 of their
+# standard error 0.024): the force's slow content leaks less into the harmonics
+SDC_50US, SDC_0US, TOL = 1.13949, 1.03784, 5e-5
 
 
 def analyze_json(args: list[str], capsys) -> dict:

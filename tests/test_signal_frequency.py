@@ -87,3 +87,37 @@ def test_harmonic_fit_matches_dense_least_squares_on_noise():
         np.testing.assert_allclose(got, coef[2:5] - 1j * coef[5:8], atol=1e-10)
         if dc is not None:
             assert dc == pytest.approx(coef[0], abs=1e-10)
+
+
+def test_spline_drift_fit_matches_dense_least_squares_and_keeps_the_segments():
+    """``drift_knots``: the union's fit against numpy's lstsq with the explicit design matrix
+    (harmonics and scipy's cubic B-splines on the same knots, clamped), on noise with a slow
+    wander, knots that do not fall on the segments' edges (one segment of 2 samples, no
+    phasors); the segments' fits stay the DC-and-trend ones, to round-off."""
+    from scipy.interpolate import BSpline
+
+    rng = np.random.default_rng(1)
+    n, n_harm, theta = 5003, 3, 2 * np.pi * 0.0137
+    i = np.arange(n)
+    x = rng.standard_normal(n) + np.cos(theta * i + 0.3) + 0.2 * np.sin(2 * np.pi * i / n * 0.7)
+    y = rng.standard_normal(n) + 2 * np.sin(2 * theta * i) + 3.0
+    edges = np.array([0, 1250, 2500, 3750, 5001, n])
+    knots = np.array([0, 700, 1400, 2100, 2800, 3500, 4200, 4600, n])
+    fit = fit_harmonics(x, y, theta, n_harm, edges, drift_knots=knots)
+    plain = fit_harmonics(x, y, theta, n_harm, edges)
+    between = knots - 0.5  # knots between samples, as the fit places them
+    splines = BSpline.design_matrix(i.astype(float), np.concatenate(
+        ([between[0]] * 3, between, [between[-1]] * 3)), 3).toarray()
+    design = np.column_stack([np.cos(m * theta * i) for m in range(1, n_harm + 1)]
+                             + [np.sin(m * theta * i) for m in range(1, n_harm + 1)]
+                             + [splines])
+    for channel, data in enumerate((x, y)):
+        coef = np.linalg.lstsq(design, data, rcond=None)[0]
+        # 1e-10: round-off of the Schur complement against a dense QR solve
+        np.testing.assert_allclose(fit.total[channel],
+                                   coef[:n_harm] - 1j * coef[n_harm:2 * n_harm], atol=1e-10)
+        assert fit.dc_total[channel] == pytest.approx(np.mean(splines @ coef[2 * n_harm:]),
+                                                      abs=1e-10)
+        np.testing.assert_allclose(fit.phasors[channel, :4], plain.phasors[channel, :4],
+                                   atol=1e-10)
+        assert np.isnan(fit.phasors[channel, 4]).all()

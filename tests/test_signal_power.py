@@ -493,3 +493,97 @@ def test_a_delay_of_several_periods_is_refused_as_the_shift_it_is(delay, said):
     assert str(refused.value).startswith(said), refused.value
     # 4 periods of 500 Hz (0.008 s) is the limit, below the 0.2 s record, whichever the sign
     assert "(0.008 s, record 0.2 s)" in str(refused.value)
+
+
+# --- slow wander (drift that is not linear over the record) ---------------------------------
+
+def _wander_record(*, wander_hz: float, phase: float, snr_db: float | None = None,
+                   fraction: float = 0.05, seed: int = 0):
+    """2 s at 100 Hz (200.37 periods), 5 % of each channel's amplitude wandering at
+    ``wander_hz``: a shaker table under its control loop, as trial T found."""
+    return synthesize_shaker_record(
+        mass_kg=0.5, acceleration_amplitude_m_s2=5 * G, frequency_hz=100.0,
+        sample_rate_hz=10240.0, n_periods=200.37, viscous_damping_n_s_m=2.0, snr_db=snr_db,
+        wander_fraction=fraction, wander_frequency_hz=wander_hz, wander_phase_rad=phase,
+        seed=seed)
+
+
+@pytest.mark.parametrize("wander_hz", [0.37, 0.8, 1.7])
+def test_a_slow_wander_does_not_bias_the_loss_factor(wander_hz):
+    """Noise-free records with a 5 % wander against the analytic loss factor c / (m w).
+
+    The wander carries no power (it is far from every harmonic), so any error is the fit's.
+    One linear trend over the record left 2e-5-1e-4 (2-8 standard errors at 60 dB); the bound
+    is a tenth of the standard error the record has at 60 dB SNR without wander (~1.3e-5): a
+    bias that small moves a 95 % band's coverage by under half a percentage point. The spline
+    leaves 1e-11-2e-9.
+    """
+    lf = truth(0.5, 5 * G, 100.0, c=2.0)[0]
+    noisy = _wander_record(wander_hz=wander_hz, phase=0.0, snr_db=60.0, fraction=0.0)
+    stderr = analyze_power(noisy.force_n, noisy.velocity_m_s, 10240.0,
+                           frequency_hz=100.0).loss_factor_stderr
+    assert 3e-6 < stderr < 3e-5  # the scale the bound is taken from (60 dB, 8 blocks)
+    for phase in (0.1, 1.7, 4.0):
+        rec = _wander_record(wander_hz=wander_hz, phase=phase)
+        res = analyze_power(rec.force_n, rec.velocity_m_s, 10240.0, frequency_hz=100.0)
+        assert abs(res.loss_factor - lf) < 0.1 * stderr, (phase, res.loss_factor - lf)
+        assert res.corrections["drift_model"] == "cubic spline, knots every 4 periods"
+
+
+def _analysed_as_before(monkeypatch, *args, **kwargs):
+    """analyze_power with the drift of pidcore before the spline: no record holds two knot
+    spaces of 1e9 periods, so one DC and trend over the record is fitted, to the last bit."""
+    from pidcore import defaults
+
+    with monkeypatch.context() as patch:
+        patch.setattr(defaults, "DRIFT_KNOT_PERIODS", 10**9)
+        return analyze_power(*args, **kwargs)
+
+
+def test_without_wander_the_result_and_its_standard_error_are_unchanged(monkeypatch):
+    """A noise-free record with DC offsets and force harmonics, all in both models (no Coulomb
+    friction: its harmonics above the fifth are in neither, and each fit leaks them its own
+    way): the spline changes nothing but rounding (1e-12 relative; the fits' round-off is
+    ~1e-15). With noise the standard error is the blocks' own fits', as before, to rounding."""
+    for snr_db in (None, 45.0):
+        rec = synthesize_shaker_record(
+            mass_kg=0.45, acceleration_amplitude_m_s2=5 * G, frequency_hz=100.0,
+            sample_rate_hz=10240.0, n_periods=120.6, viscous_damping_n_s_m=2.0,
+            force_harmonics_n=(0.8, 0.4), force_offset_n=2.0,
+            velocity_offset_m_s=1e-3, snr_db=snr_db, seed=3)
+        args = (rec.force_n, rec.velocity_m_s, 10240.0)
+        now = analyze_power(*args, frequency_hz=100.0)
+        before = _analysed_as_before(monkeypatch, *args, frequency_hz=100.0)
+        assert now.loss_factor_stderr == pytest.approx(before.loss_factor_stderr, rel=1e-12) \
+            or (math.isnan(now.loss_factor_stderr) and snr_db is None)
+        if snr_db is None:
+            assert now.loss_factor == pytest.approx(before.loss_factor, rel=1e-12)
+        else:
+            # two least-squares fits of the same record that differ by the drift's columns:
+            # their difference scatters by ~0.1 standard error (the spline costs 0.2-2 % of
+            # variance); half a standard error is 5 of those
+            assert abs(now.loss_factor - before.loss_factor) < 0.5 * now.loss_factor_stderr
+
+
+def test_a_record_too_short_for_the_spline_keeps_one_trend_and_says_so(monkeypatch):
+    """7 whole periods hold one knot space of 4: the drift stays the one DC and trend over the
+    record (the result to the last bit as before), and a note says a wander is not removed."""
+    rec = synthesize_shaker_record(mass_kg=0.5, acceleration_amplitude_m_s2=G,
+                                   frequency_hz=100.0, sample_rate_hz=10240.0, n_periods=7.5,
+                                   viscous_damping_n_s_m=2.0, snr_db=50.0)
+    args = (rec.force_n, rec.velocity_m_s, 10240.0)
+    kw = dict(frequency_hz=100.0, min_periods=5, n_blocks=2)
+    now = analyze_power(*args, **kw)
+    before = _analysed_as_before(monkeypatch, *args, **kw)
+    assert now.loss_factor == before.loss_factor
+    assert now.corrections["drift_model"] == "DC and linear trend over the record"
+    assert ("drift taken as one linear trend over the record: its 7 whole periods are too few "
+            "for a spline with knots every 4, so a slow wander that is not linear over the "
+            "record is not removed") in now.notes
+
+
+def test_a_wander_faster_than_half_the_drive_is_refused_by_the_synthesizer():
+    with pytest.raises(ParameterError, match="wander_frequency_hz 60"):
+        synthesize_shaker_record(mass_kg=0.5, acceleration_amplitude_m_s2=G,
+                                 frequency_hz=100.0, sample_rate_hz=10240.0, n_periods=20,
+                                 wander_fraction=0.05, wander_frequency_hz=60.0)

@@ -24,6 +24,19 @@ From ``P_c`` (``T = 1/f``, ``w = 2 pi f``):
 * equivalent viscous damping ratio ``zeta = -ln(1 - psi) / (4 pi)`` (paper Sect. 3), defined
   only for ``0 <= psi < 1``.
 
+Drift: the phasors are least-squares fits of the harmonics beside a drift model
+(:mod:`pidcore.signal.harmonics`): a cubic spline with knots every
+:data:`~pidcore.defaults.DRIFT_KNOT_PERIODS` whole periods. A slow wander (a shaker table at
+0.3-1 Hz under its control loop, a vibrometer's drift) is no line over a record of seconds,
+and the one DC and trend over the record that pidcore fitted before leaked the rest into the
+harmonics (5 % of the amplitudes at 0.3-1 Hz moved the loss factor of a 2 s, 100 Hz record by up
+to 1e-4, more than ten standard errors at 60 dB); the spline follows it, and being smooth takes up
+nothing near the harmonics (docs/measurement.md). The blocks of the standard error keep their
+own DC and trend, as before. A record of fewer than two knot spaces, or analysed without
+blocks (``n_blocks`` < 2: the DEM's observations of a calibration), keeps one DC and linear
+trend over the record (noted where there are blocks); ``corrections["drift_model"]`` says
+which.
+
 Corrections (applied to the phasors in this order):
 
 1. ``velocity_delay_s``: a laser vibrometer outputs ``v(t - tau)``; its phasors are multiplied by
@@ -423,6 +436,19 @@ def _check_acceleration_sign(acceleration_phasor: complex, velocity_phasor: comp
         "inverted channel (or the vibrometer delay is far from corrected)")
 
 
+def _drift_knots(whole: int, n_samples: int, sample_rate_hz: float,
+                 frequency_hz: float) -> np.ndarray | None:
+    """Knots of the drift's cubic spline: every ``DRIFT_KNOT_PERIODS`` whole periods, the
+    last space running to the record's end (what is left: less than one more space); None
+    where the record holds fewer than two spaces."""
+    spaces = whole // defaults.DRIFT_KNOT_PERIODS
+    if spaces < 2:
+        return None
+    marks = np.arange(spaces) * defaults.DRIFT_KNOT_PERIODS
+    knots = np.round(marks * sample_rate_hz / frequency_hz).astype(np.int64)
+    return np.append(knots, n_samples)
+
+
 def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz: float, *,
                   acceleration: np.ndarray | None = None,
                   frequency_hz: float | None = None,
@@ -468,7 +494,8 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
         less what ``mass_below_gauge_kg`` cancels), kg: its dissipation ``baseline_loss_factor
         x Q_s`` is subtracted. None: the whole reactive power stands for ``Q_s`` (noted).
     n_blocks : int
-        Blocks of whole periods for the standard errors (0 or 1: none).
+        Blocks of whole periods for the standard errors (0 or 1: none, and one DC and trend
+        over the record as the drift model; see the module docstring).
     min_periods : int
         Fewest drive periods accepted.
     source, force_name, velocity_name, acceleration_name : str
@@ -561,10 +588,19 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
                             f"{k_blocks} blocks (need n_blocks >= 2 and >= 1 period each)")
         k_blocks = 0
 
-    fit = fit_harmonics(f_data, motion, theta, n_harm, edges)
+    # the drift of the result: a cubic spline with knots every few periods where the record
+    # holds two spaces (the blocks keep their DC and trend: the standard error is theirs)
+    drift_knots = (_drift_knots(whole, n_samples, sample_rate_hz, freq) if k_blocks else None)
+    drift_note = ""
+    if k_blocks and drift_knots is None:
+        drift_note = (f"drift taken as one linear trend over the record: its {whole} whole "
+                      f"periods are too few for a spline with knots every "
+                      f"{defaults.DRIFT_KNOT_PERIODS}, so a slow wander that is not linear over "
+                      "the record is not removed")
+    fit = fit_harmonics(f_data, motion, theta, n_harm, edges, drift_knots=drift_knots)
     a_fit = None
     if acc_data is not None and velocity is not None:
-        a_fit = fit_harmonics(acc_data, None, theta, n_harm, edges)
+        a_fit = fit_harmonics(acc_data, None, theta, n_harm, edges, drift_knots=drift_knots)
     if a_fit is not None and mass_below_gauge_kg > 0:
         _check_acceleration_sign(a_fit.total[0, 0], fit.total[1, 0], omega, velocity_delay_s,
                                  source=source, acceleration_name=acc_name,
@@ -639,6 +675,8 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
         "mass_below_gauge_kg": float(mass_below_gauge_kg),
         "baseline_loss_factor": float(baseline_loss_factor),
         "velocity_from_acceleration": velocity is None,
+        "drift_model": ("DC and linear trend over the record" if drift_knots is None else
+                        f"cubic spline, knots every {defaults.DRIFT_KNOT_PERIODS} periods"),
         "mass_acceleration_from": ("none" if not mass_below_gauge_kg else
                                    "acceleration channel" if acc_data is not None
                                    else "velocity (j n w V_n)"),
@@ -673,7 +711,7 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
         n_blocks=k_blocks,
         uncertainty_note=uncertainty_note,
         corrections=corrections,
-        notes=tuple(n for n in (zeta_note, uncertainty_note, baseline_note) if n),
+        notes=tuple(n for n in (zeta_note, uncertainty_note, baseline_note, drift_note) if n),
     )
 
 
