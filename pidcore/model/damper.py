@@ -52,8 +52,38 @@ DAMPER_COLUMNS: dict[str, str] = {
     "vibrated_mass [kg]": "kg",
     "energy_per_cycle [J]": "J",
     "displacement_amplitude [m]": "m",
+    "velocity_amplitude [m/s]": "m/s",
     "c_eq [N s/m]": "N s/m",
     "c_eq_per_area [N s/m^3]": "N s/m^3",
+}
+#: What each column of :data:`DAMPER_COLUMNS` is, per what and where it applies (the JSON
+#: file's ``columns``): the brackets name the unit, not whether a number is the coupon's or
+#: transfers to another panel.
+DAMPER_COLUMN_MEANINGS: dict[str, str] = {
+    "frequency [Hz]": "drive frequency f of the coupon test",
+    "acceleration [g]": "acceleration amplitude a of the coupon (g = 9.80665 m/s^2)",
+    "fill [%]": "fill of every cell of the coupon",
+    "sdc [-]": "specific damping capacity dE/E (Eq. 8, E of Eq. 10), pchip model",
+    SDC_FILLED_COLUMN: "the point is a hole of the model grid, filled (provenance "
+                       "filled_grid_points)",
+    "loss_factor [-]": "SDC/(2 pi) of the coupon, relative to its own m_c: not a loss factor "
+                       "of another panel (its mass differs); use c_eq_per_area there",
+    "damping_ratio [-]": "-ln(1 - SDC)/(4 pi) of the coupon, relative to its own m_c "
+                         "(empty where SDC >= 1)",
+    "vibrated_mass [kg]": "m_c of Eq. 10 the SDC is taken over (provenance vibrated_mass: "
+                          "which masses)",
+    "energy_per_cycle [J]": "energy dissipated per drive cycle in the whole coupon, "
+                            "SDC m_c a^2/(2 w^2)",
+    "displacement_amplitude [m]": "a/w^2, the coupon's displacement amplitude",
+    "velocity_amplitude [m/s]": "a/w, the coupon's velocity amplitude: the damper's force "
+                                "amplitude is c_eq times it",
+    "c_eq [N s/m]": "viscous damper of the whole coupon (provenance area), grounded: on the "
+                    "coupon's absolute velocity along the drive direction (provenance "
+                    "direction); pi c_eq w X^2 = energy_per_cycle",
+    "c_eq_per_area [N s/m^3]": "c_eq per m^2 of panel face (one face): spread over the treated "
+                               "area of a panel at the same fill, acceleration and frequency "
+                               "(e.g. a grounded dashpot of c_eq_per_area x tributary area at "
+                               "each node, along the drive direction)",
 }
 
 
@@ -415,6 +445,7 @@ def equivalent_damper_table(model: SdcModel, *, fills_percent: Sequence[float] |
         "energy_per_cycle [J]": energy_per_cycle(sdc, vibrated_mass_kg=mass,
                                                  acceleration_m_s2=a, frequency_hz=f),
         "displacement_amplitude [m]": displacement_amplitude(a, f),
+        "velocity_amplitude [m/s]": a / (2.0 * np.pi * f),
         "c_eq [N s/m]": c_eq,
         "c_eq_per_area [N s/m^3]": c_eq / area,
     })
@@ -451,8 +482,9 @@ def write_damper_table(table: pd.DataFrame, out_dir: str | Path, *,
                        provenance: dict | None = None) -> list[Path]:
     """Write an :func:`equivalent_damper_table` as CSV and/or JSON; return the paths.
 
-    JSON holds ``{"records": [...], "units": {column: unit}, "provenance": {...}}``; NaN is
-    written as ``null``.
+    JSON holds ``{"records": [...], "units": {column: unit}, "columns": {column: what it is},
+    "provenance": {...}}`` (``columns``: :data:`DAMPER_COLUMN_MEANINGS`); NaN is written as
+    ``null``.
     """
     unknown = sorted(set(formats) - {"csv", "json"})
     if unknown or not formats:
@@ -473,7 +505,8 @@ def write_damper_table(table: pd.DataFrame, out_dir: str | Path, *,
         records = [{k: _json_value(v) for k, v in row.items()}
                    for row in table.to_dict(orient="records")]
         units = {c: DAMPER_COLUMNS.get(c, "") for c in table.columns}
-        p.write_text(json.dumps({"records": records, "units": units, "provenance": prov},
-                                indent=1))
+        meanings = {c: DAMPER_COLUMN_MEANINGS.get(c, "") for c in table.columns}
+        p.write_text(json.dumps({"records": records, "units": units, "columns": meanings,
+                                 "provenance": prov}, indent=1))
         paths.append(p)
     return paths
