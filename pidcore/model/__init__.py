@@ -16,8 +16,8 @@ select_runs, DEM_CONDITION_COLUMNS
 equivalent_damper_table, write_damper_table, DAMPER_COLUMNS, DAMPER_COLUMN_MEANINGS
     The equivalent viscous damper over a grid (a pandas frame whose columns name their
     units; what each is, per what), and its CSV/JSON files.
-SDC_FILLED_COLUMN
-    Its flag: SDC at a filled hole of the grid.
+SDC_FILLED_COLUMN, SDC_HELD_COLUMN
+    Its flags: SDC at a filled hole of the grid, SDC held at the grid's edge.
 loss_factor, damping_ratio, energy_per_cycle, sdc_from_energy_per_cycle, displacement_amplitude
     SDC to loss factor, damping ratio, energy per cycle (Eq. 8-10) and back.
 equivalent_damping_coefficient, sdc_from_damping_coefficient
@@ -37,6 +37,7 @@ from .damper import (
     DAMPER_COLUMN_MEANINGS,
     DAMPER_COLUMNS,
     SDC_FILLED_COLUMN,
+    SDC_HELD_COLUMN,
     coupon_area_m2,
     coupon_vibrated_mass_kg,
     damping_ratio,
@@ -66,7 +67,7 @@ from .table3 import TABLE3_COLUMNS, load_paper_table3
 __all__ = [
     "AXIS_NAMES", "DAMPER_COLUMN_MEANINGS", "DAMPER_COLUMNS", "DEM_CONDITION_COLUMNS",
     "HarmonicResponse",
-    "SDC_FILLED_COLUMN", "SdcModel",
+    "SDC_FILLED_COLUMN", "SDC_HELD_COLUMN", "SdcModel",
     "TABLE3_COLUMNS", "TimeDomainSteadyState", "TreatedMode", "coupon_area_m2",
     "coupon_vibrated_mass_kg", "damping_ratio", "displacement_amplitude", "energy_per_cycle",
     "equivalent_damper_table", "equivalent_damping_coefficient", "harmonic_response",

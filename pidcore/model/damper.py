@@ -39,6 +39,9 @@ from .sdc_model import SdcModel
 #: Like the report's category columns (``alignment [grid/interpolated/...]``) its
 #: brackets list the values it takes, as pandas writes and reads them back (bool).
 SDC_FILLED_COLUMN = "sdc_filled [True/False]"
+#: The flag of :func:`equivalent_damper_table` marking points outside the model's grid whose SDC
+#: is the edge value held there (``clip_to_range=True`` only; False everywhere else).
+SDC_HELD_COLUMN = "sdc_held_at_edge [True/False]"
 #: Output columns of :func:`equivalent_damper_table` and their units, each named in the
 #: column's brackets (the flag's "unit" is its values).
 DAMPER_COLUMNS: dict[str, str] = {
@@ -47,6 +50,7 @@ DAMPER_COLUMNS: dict[str, str] = {
     "fill [%]": "%",
     "sdc [-]": "-",
     SDC_FILLED_COLUMN: "True/False",
+    SDC_HELD_COLUMN: "True/False",
     "loss_factor [-]": "-",
     "damping_ratio [-]": "-",
     "vibrated_mass [kg]": "kg",
@@ -66,6 +70,8 @@ DAMPER_COLUMN_MEANINGS: dict[str, str] = {
     "sdc [-]": "specific damping capacity dE/E (Eq. 8, E of Eq. 10), pchip model",
     SDC_FILLED_COLUMN: "the point is a hole of the model grid, filled (provenance "
                        "filled_grid_points)",
+    SDC_HELD_COLUMN: "the point lies outside the model's grid: its SDC is the nearest edge "
+                     "value held, not modelled there",
     "loss_factor [-]": "SDC/(2 pi) of the coupon, relative to its own m_c: not a loss factor "
                        "of another panel (its mass differs); use c_eq_per_area there",
     "damping_ratio [-]": "-ln(1 - SDC)/(4 pi) of the coupon, relative to its own m_c "
@@ -393,7 +399,8 @@ def equivalent_damper_table(model: SdcModel, *, fills_percent: Sequence[float] |
     area_m2 : float, optional
         Coupon area for the per-area damper; default :func:`coupon_area_m2`.
     clip_to_range : bool
-        Passed to :meth:`SdcModel.evaluate` (default: refuse points outside the model).
+        Passed to :meth:`SdcModel.evaluate` (default: refuse points outside the model); the
+        points it held at the edge are flagged in :data:`SDC_HELD_COLUMN`.
     fills, accelerations, frequencies : sequence of float, optional
         The names of pidcore 0.2, without their units (a ``DeprecationWarning``); giving
         both names of one axis is refused.
@@ -402,7 +409,8 @@ def equivalent_damper_table(model: SdcModel, *, fills_percent: Sequence[float] |
     -------
     pandas.DataFrame
         Columns :data:`DAMPER_COLUMNS` (each names its unit); :data:`SDC_FILLED_COLUMN` (a
-        bool flag) is True where the point coincides with a filled hole of the model grid.
+        bool flag) is True where the point coincides with a filled hole of the model grid,
+        :data:`SDC_HELD_COLUMN` where its SDC is an edge value held beyond the grid.
     """
     # one call each, not a loop: the warning points at the caller's line (stacklevel)
     fills = _one_name("fills_percent", fills_percent, "fills", fills)
@@ -426,6 +434,9 @@ def equivalent_damper_table(model: SdcModel, *, fills_percent: Sequence[float] |
     mass = _positive("vibrated_mass_kg", mass)
     area = coupon_area_m2() if area_m2 is None else float(_positive("area_m2", area_m2))
     sdc = model.evaluate(p, a_g, f, clip_to_range=clip_to_range)
+    # a 20 g row carried the 10 g SDC and a c_eq from it, like a modelled one
+    held = np.array([not model.contains(point) for point in zip(p, a_g, f, strict=True)],
+                    dtype=bool)
     a = _positive("acceleration [g]", a_g) * STANDARD_GRAVITY
     c_eq = equivalent_damping_coefficient(sdc, vibrated_mass_kg=mass, frequency_hz=f)
     filled_pts = model.filled_points()
@@ -439,6 +450,7 @@ def equivalent_damper_table(model: SdcModel, *, fills_percent: Sequence[float] |
         "fill [%]": p,
         "sdc [-]": sdc,
         SDC_FILLED_COLUMN: filled,
+        SDC_HELD_COLUMN: held,
         "loss_factor [-]": loss_factor(sdc),
         "damping_ratio [-]": damping_ratio(sdc),
         "vibrated_mass [kg]": mass,
