@@ -68,9 +68,13 @@ class TreatedMode:
     fill_percent : float
         Fill of the treated cells [%].
     coupon_vibrated_mass_kg : float
-        m_c [kg] of the coupon tests the SDC model comes from (Eq. 10).
+        m_c [kg] of the coupon tests the SDC model comes from (Eq. 10), at ``fill_percent``
+        and by the convention the SDC was divided by: ``paper_vibrated_mass()(fill_percent)``
+        for the paper's Table 3, ``runs_vibrated_mass(runs)(fill_percent)`` for stored DEM
+        runs. Not ``coupon_vibrated_mass_kg()`` alone, which leaves the particles out (c_pd
+        4.5 x low at 50 % fill).
     coupon_area_m2 : float
-        A_c [m^2] of those coupons.
+        A_c [m^2] of those coupons (default: the paper's 0.1 m x 0.1 m).
     """
 
     natural_frequency_hz: float
