@@ -410,3 +410,37 @@ def test_table3_sdc_is_not_put_over_another_materials_mass(tmp_path):
     # an explicit m_c is the user's: the material then only sets its unit-slip range
     assert _run(["model", "damper", "--out", str(tmp_path / "m"), "--material", "aluminium",
                  "--vibrated-mass", "0.1", "--format", "csv"]) == 0
+
+
+def test_the_damper_says_per_what_along_which_direction_and_gives_the_velocity(tmp_path):
+    # a FEM user put the dashpot on a node: the files did not say it is the whole coupon's,
+    # grounded, along z (normal to the faces), nor give the velocity its force is c_eq times
+    assert _run(["model", "damper", "--out", str(tmp_path), "--fills", "50",
+                 "--accelerations", "5", "--frequencies", "500"]) == 0
+    (row,) = pd.read_csv(tmp_path / "equivalent_damper.csv").to_dict(orient="records")
+    # by hand: a = 5 g at 500 Hz, v = a / w
+    assert row["velocity_amplitude [m/s]"] == pytest.approx(5 * 9.80665 / (2 * np.pi * 500),
+                                                            rel=1e-14)
+    # the viscous damper's energy per cycle, pi F X with F = c_eq v, is the table's dE
+    assert np.pi * row["c_eq [N s/m]"] * row["velocity_amplitude [m/s]"] \
+        * row["displacement_amplitude [m]"] == pytest.approx(row["energy_per_cycle [J]"],
+                                                             rel=1e-12)
+    doc = json.loads((tmp_path / "equivalent_damper.json").read_text())
+    assert doc["units"]["velocity_amplitude [m/s]"] == "m/s"
+    assert set(doc["columns"]) == set(doc["units"]) and all(doc["columns"].values())
+    assert "whole coupon" in doc["columns"]["c_eq [N s/m]"]
+    assert "grounded" in doc["columns"]["c_eq [N s/m]"]
+    assert "per m^2 of panel face" in doc["columns"]["c_eq_per_area [N s/m^3]"]
+    assert doc["provenance"]["direction"].startswith("z (normal to the face sheets")
+    assert doc["provenance"]["particle_material"] == "acrylic"
+    assert doc["provenance"]["area"] == "0.01 m^2 (the paper's 0.1 m x 0.1 m coupon)"
+    assert _run(["model", "damper", "--out", str(tmp_path), "--table", "store", "--store",
+                 str(BUNDLED_GRID), "--fills", "50", "--accelerations", "5", "--frequencies",
+                 "500"]) == 0
+    doc = json.loads((tmp_path / "equivalent_damper.json").read_text())
+    assert doc["provenance"]["direction"] == "z (normal to the face sheets: the DEM runs')"
+    # --material with --vibrated-mass sets the m_c check only: the SDC stays Table 3's acrylic
+    assert _run(["model", "damper", "--out", str(tmp_path), "--fills", "50", "--material",
+                 "aluminium", "--vibrated-mass", "0.1"]) == 0
+    doc = json.loads((tmp_path / "equivalent_damper.json").read_text())
+    assert doc["provenance"]["particle_material"] == "acrylic"

@@ -14,6 +14,7 @@ from pidcore.errors import ParameterError
 from pidcore.model import (
     DAMPER_COLUMNS,
     SDC_FILLED_COLUMN,
+    SDC_HELD_COLUMN,
     SdcModel,
     coupon_vibrated_mass_kg,
     damping_ratio,
@@ -113,7 +114,7 @@ def test_damper_table_content(model):
     for column, unit in DAMPER_COLUMNS.items():
         assert column.endswith(f" [{unit}]"), column
         if pd.api.types.is_bool_dtype(t[column]):
-            assert column == SDC_FILLED_COLUMN and unit == "True/False"
+            assert column in (SDC_FILLED_COLUMN, SDC_HELD_COLUMN) and unit == "True/False"
         else:
             assert pd.api.types.is_float_dtype(t[column])
     sdc = model(t["fill [%]"].to_numpy(), t["acceleration [g]"].to_numpy(),
@@ -208,3 +209,19 @@ def test_damper_table_axes_name_their_units_and_the_old_names_still_work(model):
     with pytest.raises(ParameterError, match="^fills_percent and fills name the same axis"):
         equivalent_damper_table(model, fills_percent=[50], fills=[50], accelerations_g=[5],
                                 frequencies_hz=[100], vibrated_mass_kg=0.1)
+
+
+def test_points_held_at_the_edge_are_flagged(model):
+    # with clip_to_range=True a 20 g row carried the 10 g SDC and a c_eq made of it, nothing
+    # in the table telling it from a modelled row
+    t = equivalent_damper_table(model, fills_percent=[50], accelerations_g=[5, 10, 20],
+                                frequencies_hz=[100, 2000], vibrated_mass_kg=0.0988,
+                                clip_to_range=True)
+    outside = (t["acceleration [g]"] > 10) | (t["frequency [Hz]"] > 1000)
+    assert t[SDC_HELD_COLUMN].tolist() == outside.tolist()
+    assert outside.sum() == 4  # 20 g at both frequencies, 5 and 10 g at 2000 Hz
+    held = t[(t["acceleration [g]"] == 20) & (t["frequency [Hz]"] == 100)]
+    assert held["sdc [-]"].item() == float(model(50, 10, 100))  # the edge value, as flagged
+    inside = equivalent_damper_table(model, fills_percent=[50], accelerations_g=[1, 10],
+                                     frequencies_hz=[50, 1000], vibrated_mass_kg=0.0988)
+    assert not inside[SDC_HELD_COLUMN].any()  # the grid's own edges are modelled points

@@ -172,3 +172,35 @@ def test_time_domain_response_refuses_settings_it_cannot_honour(keywords, said):
     if "force_amplitude_n" in keywords:  # harmonic balance takes it by the same rule
         with pytest.raises(ParameterError, match="^force_amplitude_n: expected a number"):
             harmonic_response(model, mode, frequencies_hz=[300.0], force_amplitude_n="2")
+
+
+def test_time_domain_response_refuses_what_harmonic_balance_refuses(model, mode):
+    # 2000 Hz ran on the 1000 Hz SDC and 1000 N settled at ~820 g on the 10 g SDC, both
+    # returned as if the model held a damper there; 0 Hz was a ZeroDivisionError
+    with pytest.raises(ParameterError, match=r"^time_domain_response: frequency 2000 Hz "
+                                             r"outside the SDC model range \[50, 1000\] Hz"):
+        time_domain_response(model, mode, frequency_hz=2000.0, force_amplitude_n=FORCE_N,
+                             settle_cycles=20, measure_cycles=2)
+    for bad in (0.0, -5.0, "300"):
+        with pytest.raises(ParameterError, match=r"^frequency_hz: expected a"):
+            time_domain_response(model, mode, frequency_hz=bad, force_amplitude_n=FORCE_N)
+    with pytest.raises(ParameterError, match=r"^time_domain_response: at 300 Hz the steady "
+                                             r"acceleration 8\d\d g is outside the SDC model "
+                                             r"range \[1, 10\] g"):
+        time_domain_response(model, mode, frequency_hz=300.0, force_amplitude_n=1000.0,
+                             settle_cycles=300, measure_cycles=2)
+    held = time_domain_response(model, mode, frequency_hz=300.0, force_amplitude_n=1000.0,
+                                settle_cycles=300, measure_cycles=2, clip_to_range=True)
+    assert held.clipped
+    # at the edge the damper is linear: the steady amplitude is the closed-form one with the
+    # 10 g SDC (300 settle cycles are 1 s, 19 decay time constants of the structural damping
+    # alone: e^-19 of the start transient is left; 1e-6 allows for the integrator's rtol)
+    w = 2 * np.pi * 300.0
+    c = mode.structural_damping_n_s_m + equivalent_damping_coefficient(
+        float(model(50.0, 10.0, 300.0)), vibrated_mass_kg=mode.coupon_vibrated_mass_kg,
+        frequency_hz=300.0) / 0.01 * 0.2
+    expected = 1000.0 / abs(mode.stiffness_n_m - mode.modal_mass_kg * w**2 + 1j * w * c)
+    assert held.amplitude_m == pytest.approx(expected, rel=1e-6)
+    inside = time_domain_response(model, mode, frequency_hz=300.0, force_amplitude_n=FORCE_N,
+                                  settle_cycles=20, measure_cycles=2)
+    assert not inside.clipped

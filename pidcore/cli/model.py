@@ -242,7 +242,7 @@ def run_damper(args: argparse.Namespace) -> int:
                              "states no coupon area; give the area c_eq per area is taken "
                              "over, e.g. --area 0.01")
     else:
-        area, area_text = None, f"{coupon_area_m2()} m^2 (the paper's 0.1 m x 0.1 m coupon)"
+        area, area_text = None, f"{coupon_area_m2():g} m^2 (the paper's 0.1 m x 0.1 m coupon)"
     table = equivalent_damper_table(
         model, fills_percent=args.fills if args.fills else model.axes[0],
         accelerations_g=args.accelerations if args.accelerations else model.axes[1],
@@ -253,6 +253,12 @@ def run_damper(args: argparse.Namespace) -> int:
         "interpolation": "tensor-product pchip (frequency, fill, acceleration passes)",
         "log_frequency": model.log_frequency, "vibrated_mass": mass_text,
         "area": area_text,
+        # which DOF the dashpot goes on and which particles it is of: the table's numbers
+        # do not say, and a damper along the face (x, y) differs from one normal to it (z)
+        "direction": _direction_text(runs),
+        # the SDC's particles: Table 3's whatever --material set the m_c check for
+        "particle_material": defaults.MODEL_PARTICLE_MATERIAL if runs is None
+        else ", ".join(sorted(runs["material"].dropna().astype(str).unique())),
         "filled_grid_points": model.filled_points().to_dict(orient="records"),
     }
     undefined = int((table["sdc [-]"] >= 1.0).sum())
@@ -267,6 +273,20 @@ def run_damper(args: argparse.Namespace) -> int:
         print(f"pidcore model damper: note: {why} in {undefined} of {len(table)} row(s)",
               file=sys.stderr)
     return 0
+
+
+def _direction_text(runs) -> str:
+    """The drive direction the damper acts along: the DEM runs' own, or Table 3's."""
+    meaning = {"z": "normal to the face sheets", "x": "in the face plane", "y": "in the face "
+               "plane"}
+    if runs is None:
+        # the paper's coupon hangs on a stinger at its centre (Sect. 5); pidcore's Table 3
+        # runs shake it along z
+        return "z (normal to the face sheets: the paper's Table 3 tests)"
+    stated = sorted(runs["direction"].dropna().astype(str).unique()) \
+        if "direction" in runs.columns else []
+    return ", ".join(f"{d} ({meaning.get(d, '?')}: the DEM runs')" for d in stated) \
+        or "not stored with the DEM runs"
 
 
 def run_figures(args: argparse.Namespace) -> int:

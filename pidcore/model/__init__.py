@@ -13,9 +13,11 @@ SdcModel, AXIS_NAMES
     frequency_hz)``; refuses points outside its grid.
 select_runs, DEM_CONDITION_COLUMNS
     The stored DEM runs of one set of conditions, to build a model from.
-equivalent_damper_table, write_damper_table, DAMPER_COLUMNS, SDC_FILLED_COLUMN
+equivalent_damper_table, write_damper_table, DAMPER_COLUMNS, DAMPER_COLUMN_MEANINGS
     The equivalent viscous damper over a grid (a pandas frame whose columns name their
-    units), and its CSV/JSON files.
+    units; what each is, per what), and its CSV/JSON files.
+SDC_FILLED_COLUMN, SDC_HELD_COLUMN
+    Its flags: SDC at a filled hole of the grid, SDC held at the grid's edge.
 loss_factor, damping_ratio, energy_per_cycle, sdc_from_energy_per_cycle, displacement_amplitude
     SDC to loss factor, damping ratio, energy per cycle (Eq. 8-10) and back.
 equivalent_damping_coefficient, sdc_from_damping_coefficient
@@ -32,8 +34,10 @@ time_domain_response, TimeDomainSteadyState
 """
 
 from .damper import (
+    DAMPER_COLUMN_MEANINGS,
     DAMPER_COLUMNS,
     SDC_FILLED_COLUMN,
+    SDC_HELD_COLUMN,
     coupon_area_m2,
     coupon_vibrated_mass_kg,
     damping_ratio,
@@ -61,8 +65,9 @@ from .sdc_model import AXIS_NAMES, DEM_CONDITION_COLUMNS, SdcModel, select_runs
 from .table3 import TABLE3_COLUMNS, load_paper_table3
 
 __all__ = [
-    "AXIS_NAMES", "DAMPER_COLUMNS", "DEM_CONDITION_COLUMNS", "HarmonicResponse",
-    "SDC_FILLED_COLUMN", "SdcModel",
+    "AXIS_NAMES", "DAMPER_COLUMN_MEANINGS", "DAMPER_COLUMNS", "DEM_CONDITION_COLUMNS",
+    "HarmonicResponse",
+    "SDC_FILLED_COLUMN", "SDC_HELD_COLUMN", "SdcModel",
     "TABLE3_COLUMNS", "TimeDomainSteadyState", "TreatedMode", "coupon_area_m2",
     "coupon_vibrated_mass_kg", "damping_ratio", "displacement_amplitude", "energy_per_cycle",
     "equivalent_damper_table", "equivalent_damping_coefficient", "harmonic_response",

@@ -39,6 +39,9 @@ from .sdc_model import SdcModel
 #: Like the report's category columns (``alignment [grid/interpolated/...]``) its
 #: brackets list the values it takes, as pandas writes and reads them back (bool).
 SDC_FILLED_COLUMN = "sdc_filled [True/False]"
+#: The flag of :func:`equivalent_damper_table` marking points outside the model's grid whose SDC
+#: is the edge value held there (``clip_to_range=True`` only; False everywhere else).
+SDC_HELD_COLUMN = "sdc_held_at_edge [True/False]"
 #: Output columns of :func:`equivalent_damper_table` and their units, each named in the
 #: column's brackets (the flag's "unit" is its values).
 DAMPER_COLUMNS: dict[str, str] = {
@@ -47,13 +50,46 @@ DAMPER_COLUMNS: dict[str, str] = {
     "fill [%]": "%",
     "sdc [-]": "-",
     SDC_FILLED_COLUMN: "True/False",
+    SDC_HELD_COLUMN: "True/False",
     "loss_factor [-]": "-",
     "damping_ratio [-]": "-",
     "vibrated_mass [kg]": "kg",
     "energy_per_cycle [J]": "J",
     "displacement_amplitude [m]": "m",
+    "velocity_amplitude [m/s]": "m/s",
     "c_eq [N s/m]": "N s/m",
     "c_eq_per_area [N s/m^3]": "N s/m^3",
+}
+#: What each column of :data:`DAMPER_COLUMNS` is, per what and where it applies (the JSON
+#: file's ``columns``): the brackets name the unit, not whether a number is the coupon's or
+#: transfers to another panel.
+DAMPER_COLUMN_MEANINGS: dict[str, str] = {
+    "frequency [Hz]": "drive frequency f of the coupon test",
+    "acceleration [g]": "acceleration amplitude a of the coupon (g = 9.80665 m/s^2)",
+    "fill [%]": "fill of every cell of the coupon",
+    "sdc [-]": "specific damping capacity dE/E (Eq. 8, E of Eq. 10), pchip model",
+    SDC_FILLED_COLUMN: "the point is a hole of the model grid, filled (provenance "
+                       "filled_grid_points)",
+    SDC_HELD_COLUMN: "the point lies outside the model's grid: its SDC is the nearest edge "
+                     "value held, not modelled there",
+    "loss_factor [-]": "SDC/(2 pi) of the coupon, relative to its own m_c: not a loss factor "
+                       "of another panel (its mass differs); use c_eq_per_area there",
+    "damping_ratio [-]": "-ln(1 - SDC)/(4 pi) of the coupon, relative to its own m_c "
+                         "(empty where SDC >= 1)",
+    "vibrated_mass [kg]": "m_c of Eq. 10 the SDC is taken over (provenance vibrated_mass: "
+                          "which masses)",
+    "energy_per_cycle [J]": "energy dissipated per drive cycle in the whole coupon, "
+                            "SDC m_c a^2/(2 w^2)",
+    "displacement_amplitude [m]": "a/w^2, the coupon's displacement amplitude",
+    "velocity_amplitude [m/s]": "a/w, the coupon's velocity amplitude: the damper's force "
+                                "amplitude is c_eq times it",
+    "c_eq [N s/m]": "viscous damper of the whole coupon (provenance area), grounded: on the "
+                    "coupon's absolute velocity along the drive direction (provenance "
+                    "direction); pi c_eq w X^2 = energy_per_cycle",
+    "c_eq_per_area [N s/m^3]": "c_eq per m^2 of panel face (one face): spread over the treated "
+                               "area of a panel at the same fill, acceleration and frequency "
+                               "(e.g. a grounded dashpot of c_eq_per_area x tributary area at "
+                               "each node, along the drive direction)",
 }
 
 
@@ -363,7 +399,8 @@ def equivalent_damper_table(model: SdcModel, *, fills_percent: Sequence[float] |
     area_m2 : float, optional
         Coupon area for the per-area damper; default :func:`coupon_area_m2`.
     clip_to_range : bool
-        Passed to :meth:`SdcModel.evaluate` (default: refuse points outside the model).
+        Passed to :meth:`SdcModel.evaluate` (default: refuse points outside the model); the
+        points it held at the edge are flagged in :data:`SDC_HELD_COLUMN`.
     fills, accelerations, frequencies : sequence of float, optional
         The names of pidcore 0.2, without their units (a ``DeprecationWarning``); giving
         both names of one axis is refused.
@@ -372,7 +409,8 @@ def equivalent_damper_table(model: SdcModel, *, fills_percent: Sequence[float] |
     -------
     pandas.DataFrame
         Columns :data:`DAMPER_COLUMNS` (each names its unit); :data:`SDC_FILLED_COLUMN` (a
-        bool flag) is True where the point coincides with a filled hole of the model grid.
+        bool flag) is True where the point coincides with a filled hole of the model grid,
+        :data:`SDC_HELD_COLUMN` where its SDC is an edge value held beyond the grid.
     """
     # one call each, not a loop: the warning points at the caller's line (stacklevel)
     fills = _one_name("fills_percent", fills_percent, "fills", fills)
@@ -396,6 +434,9 @@ def equivalent_damper_table(model: SdcModel, *, fills_percent: Sequence[float] |
     mass = _positive("vibrated_mass_kg", mass)
     area = coupon_area_m2() if area_m2 is None else float(_positive("area_m2", area_m2))
     sdc = model.evaluate(p, a_g, f, clip_to_range=clip_to_range)
+    # a 20 g row carried the 10 g SDC and a c_eq from it, like a modelled one
+    held = np.array([not model.contains(point) for point in zip(p, a_g, f, strict=True)],
+                    dtype=bool)
     a = _positive("acceleration [g]", a_g) * STANDARD_GRAVITY
     c_eq = equivalent_damping_coefficient(sdc, vibrated_mass_kg=mass, frequency_hz=f)
     filled_pts = model.filled_points()
@@ -409,12 +450,14 @@ def equivalent_damper_table(model: SdcModel, *, fills_percent: Sequence[float] |
         "fill [%]": p,
         "sdc [-]": sdc,
         SDC_FILLED_COLUMN: filled,
+        SDC_HELD_COLUMN: held,
         "loss_factor [-]": loss_factor(sdc),
         "damping_ratio [-]": damping_ratio(sdc),
         "vibrated_mass [kg]": mass,
         "energy_per_cycle [J]": energy_per_cycle(sdc, vibrated_mass_kg=mass,
                                                  acceleration_m_s2=a, frequency_hz=f),
         "displacement_amplitude [m]": displacement_amplitude(a, f),
+        "velocity_amplitude [m/s]": a / (2.0 * np.pi * f),
         "c_eq [N s/m]": c_eq,
         "c_eq_per_area [N s/m^3]": c_eq / area,
     })
@@ -451,8 +494,9 @@ def write_damper_table(table: pd.DataFrame, out_dir: str | Path, *,
                        provenance: dict | None = None) -> list[Path]:
     """Write an :func:`equivalent_damper_table` as CSV and/or JSON; return the paths.
 
-    JSON holds ``{"records": [...], "units": {column: unit}, "provenance": {...}}``; NaN is
-    written as ``null``.
+    JSON holds ``{"records": [...], "units": {column: unit}, "columns": {column: what it is},
+    "provenance": {...}}`` (``columns``: :data:`DAMPER_COLUMN_MEANINGS`); NaN is written as
+    ``null``.
     """
     unknown = sorted(set(formats) - {"csv", "json"})
     if unknown or not formats:
@@ -473,7 +517,8 @@ def write_damper_table(table: pd.DataFrame, out_dir: str | Path, *,
         records = [{k: _json_value(v) for k, v in row.items()}
                    for row in table.to_dict(orient="records")]
         units = {c: DAMPER_COLUMNS.get(c, "") for c in table.columns}
-        p.write_text(json.dumps({"records": records, "units": units, "provenance": prov},
-                                indent=1))
+        meanings = {c: DAMPER_COLUMN_MEANINGS.get(c, "") for c in table.columns}
+        p.write_text(json.dumps({"records": records, "units": units, "columns": meanings,
+                                 "provenance": prov}, indent=1))
         paths.append(p)
     return paths
