@@ -1,5 +1,6 @@
 """The transient skipped before measuring is capped in cycles and in simulated time."""
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -93,3 +94,24 @@ def test_flying_steel_spheres_are_steady_at_the_cap_with_the_same_sdc(monkeypatc
     assert not flagged.steady_detected
     assert flagged.steady_start_cycle == 100
     assert flagged.sdc == result.sdc
+
+
+def test_an_unconverged_run_notes_the_drift_its_stored_energy_shows():
+    # the loose bed above, still compacting at the cap: the note's share released (from the
+    # kernel's per-cycle tallies of work and dissipation) must be the stored energy's fall
+    # measured from the particles' state at the window's ends (energies(), another path),
+    # to within the run's energy-balance closure error
+    result = simulate_load_case(LoadCase(50.0, 1.0, 25.0),
+                                DemConfig(cells=1, steady_cycles=5, max_transient_s=0.1,
+                                          block_cycles=5, start_packing="loose"))
+    assert not result.steady_detected
+    [note] = [n for n in result.notes if n.startswith("not converged")]
+    found = re.search(r"stored energy (fell|rose) by ([0-9.]+)% of the dissipation", note)
+    share = float(found[2]) / 100
+    sign = 1.0 if found[1] == "fell" else -1.0
+    from_state = -result.stored_energy_change_per_cycle_j / result.energy_per_cycle_j
+    # 0.05 % of rounding in the printed share plus the closure error (relative to the work)
+    assert sign * share == pytest.approx(from_state,
+                                         abs=5e-4 + 2 * abs(result.energy_balance_error))
+    assert f"from cycle {result.steady_start_cycle})" in note
+    assert f"the SDC is {sign * share:+.1%} off" in note

@@ -196,6 +196,8 @@ class DemResult:
         * the steady window measured is longer than asked (``config.steady_cycles``, else
           DEM_MIN_STEADY_CYCLES): the kernel runs whole blocks of ``config.block_cycles``
           cycles, and the two blocks that detect the steady state both belong to the window;
+        * the run did not converge: the share of the dissipation the bed released from its
+          stored energy over the window measured, and what that drift does to the SDC;
         * ``particle_steps_per_s`` was not measured (NaN): every kernel call compiled code;
         * a property of the specimen overrides its table material's
           (:func:`pidcore.specimen.table_overrides`);
@@ -216,6 +218,19 @@ class DemResult:
                 why += ", and the two blocks that detected the steady state are both measured"
             notes.append(f"steady window rounded up: {self.steady_cycles} cycles measured for "
                          f"the {asked} asked ({why})")
+        if not self.steady_detected and self.energy_per_cycle_j > 0:
+            # what a drift does to the number: the steady dissipation is what the walls' work
+            # supplies, so the SDC is off by the share of the dissipation the bed released
+            released = 1.0 - self.work_per_cycle_j / self.energy_per_cycle_j
+            notes.append(
+                f"not converged: no steady state by the transient cap (measured from cycle "
+                f"{self.steady_start_cycle}); over the {self.steady_cycles} cycles measured the "
+                f"bed's stored energy {'fell' if released >= 0 else 'rose'} by "
+                f"{abs(released):.1%} of the dissipation per cycle (walls' work "
+                f"{self.work_per_cycle_j:.4g} J against {self.energy_per_cycle_j:.4g} J "
+                f"dissipated per cycle): if that is a drift, the SDC is {released:+.1%} off "
+                "the one the walls' work gives; where particles fly it is mostly noise "
+                "(docs/calibration.md, 'DEM runs that never reach a steady state')")
         if not math.isfinite(self.particle_steps_per_s):
             notes.append("particle_steps_per_s not measured: every kernel call of this run "
                          "included Numba compilation (run again for the compiled speed)")
