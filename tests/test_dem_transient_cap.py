@@ -89,11 +89,14 @@ def test_flying_steel_spheres_are_steady_at_the_cap_with_the_same_sdc(monkeypatc
     assert result.particles_per_cell == 4
     assert result.steady_detected
     assert result.steady_start_cycle == 100
+    assert any(note.startswith("steady state judged at the transient cap (cycle 100)")
+               for note in result.notes)
     monkeypatch.setattr(simulate, "_steady_by_scatter", lambda *args: False)
     flagged = simulate_load_case(case, config, specimen=steel)
     assert not flagged.steady_detected
     assert flagged.steady_start_cycle == 100
     assert flagged.sdc == result.sdc
+    assert not any("judged at the transient cap" in note for note in flagged.notes)
 
 
 def test_an_unconverged_run_notes_the_drift_its_stored_energy_shows():
@@ -115,3 +118,19 @@ def test_an_unconverged_run_notes_the_drift_its_stored_energy_shows():
                                          abs=5e-4 + 2 * abs(result.energy_balance_error))
     assert f"from cycle {result.steady_start_cycle})" in note
     assert f"the SDC is {sign * share:+.1%} off" in note
+
+
+def test_the_bundled_table3_runs_were_found_steady_by_the_block_rule():
+    # the scatter rule is consulted only where the block rule found nothing by the cap, so the
+    # bundled grid (every run steady from cycle 0 or 10) is what it was, and none of its runs
+    # is told it was judged at the cap or did not converge
+    from pidcore.dem.persist import load_dem_result
+    from pidcore.store import Store
+
+    store = Store(Path(__file__).resolve().parents[1] / "data_samples" / "dem_table3.h5")
+    keys = list(store.list_dem_runs()["case_key"])
+    assert len(keys) == 48
+    for key in keys:
+        run = load_dem_result(store.get_dem_run(key))
+        assert run.steady_detected and run.steady_start_cycle in (0, 10)
+        assert not any("transient cap" in note for note in run.notes)

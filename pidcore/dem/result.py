@@ -196,6 +196,8 @@ class DemResult:
         * the steady window measured is longer than asked (``config.steady_cycles``, else
           DEM_MIN_STEADY_CYCLES): the kernel runs whole blocks of ``config.block_cycles``
           cycles, and the two blocks that detect the steady state both belong to the window;
+        * the steady state was judged at the transient cap against the cycles' scatter
+          (:func:`pidcore.dem.simulate._steady_by_scatter`), not by the block rule;
         * the run did not converge: the share of the dissipation the bed released from its
           stored energy over the window measured, and what that drift does to the SDC;
         * ``particle_steps_per_s`` was not measured (NaN): every kernel call compiled code;
@@ -218,6 +220,18 @@ class DemResult:
                 why += ", and the two blocks that detected the steady state are both measured"
             notes.append(f"steady window rounded up: {self.steady_cycles} cycles measured for "
                          f"the {asked} asked ({why})")
+        b = self.config.block_cycles
+        cap = -(-self.config.transient_cap_cycles(self.case.frequency_hz) // b) * b
+        if self.steady_detected and self.steady_start_cycle == cap:
+            # the block rule's start is at least two blocks before the cycle it is found at,
+            # which is never past the cap: a steady start at the cap is the scatter rule's
+            notes.append(
+                f"steady state judged at the transient cap (cycle {cap}): no two successive "
+                "blocks balanced the walls' work and the dissipation within "
+                f"{defaults.DEM_STEADY_BALANCE_TOLERANCE:.0%}, but over the cycles before the "
+                "cap the stored energy shows no trend and the dissipation no change against "
+                "their scatter (docs/calibration.md, 'DEM runs that never reach a steady "
+                "state')")
         if not self.steady_detected and self.energy_per_cycle_j > 0:
             # what a drift does to the number: the steady dissipation is what the walls' work
             # supplies, so the SDC is off by the share of the dissipation the bed released
