@@ -438,7 +438,9 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: str | Sequence[str],
 
     store = Store(store_path)
     observations = []
-    unsteady: dict[str, int] = {}  # point label -> its runs that never reached steady state
+    # point label -> the share of the dissipation each of its runs that never reached steady
+    # state released from its stored energy over the cycles measured (None: not recorded)
+    unsteady: dict[str, list[float | None]] = {}
     for point, row in zip(points, requests, strict=True):
         obs = []
         for request in row:
@@ -446,13 +448,18 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: str | Sequence[str],
             obs.append(observation_from_run(entry.record, entry.arrays,
                                             coupon_mass_kg=specimen.coupon.mass_kg))
             if steady_stated(entry.record.get("steady_detected")) is False:
-                unsteady[point.label()] = unsteady.get(point.label(), 0) + 1
+                unsteady.setdefault(point.label(), []).append(_released_share(entry.record))
         observations.append(obs)
     if unsteady:
-        notes.append(f"{sum(unsteady.values())} of {sum(len(r) for r in requests)} DEM run(s) "
-                     "never reached steady state (their SDC is that of the last cycles, less "
-                     "certain than the error bar says): "
-                     + "; ".join(f"{label} ({n})" for label, n in unsteady.items()))
+        notes.append(f"{sum(map(len, unsteady.values()))} of {sum(len(r) for r in requests)} "
+                     "DEM run(s) never reached steady state (their SDC is that of the cycles "
+                     "after the transient cap, less certain than the error bar says; the share "
+                     "of the dissipation per cycle the bed's stored energy fell by over them is "
+                     "how much too high the SDC is if that is a drift, mostly noise where "
+                     "particles fly): " + "; ".join(
+                         f"{label} ({len(shares)}: "
+                         + ", ".join("?" if share is None else f"{share:+.1%}" for share in shares)
+                         + ")" for label, shares in unsteady.items()))
     surrogates = tuple(build_surrogate(obs, design, dem_specs) for obs in observations)
     fitted = [s.name for s in specs]
     fixed = {name: parameter_spec(name, specimen).default for name in CATALOGUE
@@ -532,6 +539,20 @@ def _raise_if_stopped(stop: threading.Event | None) -> None:
 
     if stop is not None and stop.is_set():
         raise StopRequested("calibration stopped; the DEM runs saved before are kept")
+
+
+def _released_share(record: dict) -> float | None:
+    """The share of the dissipation per cycle a stored DEM run's bed released from its stored
+    energy over the cycles measured, 1 - work / dissipation (:attr:`pidcore.dem.DemResult.
+    notes` says the same of one run); None where the record lacks either."""
+    try:
+        work = float(record["work_per_cycle_j"])
+        dissipated = float(record["energy_per_cycle_j"])
+    except (KeyError, TypeError, ValueError):
+        return None
+    if not (math.isfinite(work) and math.isfinite(dissipated) and dissipated > 0):
+        return None
+    return 1.0 - work / dissipated
 
 
 def _not_converged_note(diagnostics: SamplerDiagnostics) -> str:

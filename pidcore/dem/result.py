@@ -196,6 +196,10 @@ class DemResult:
         * the steady window measured is longer than asked (``config.steady_cycles``, else
           DEM_MIN_STEADY_CYCLES): the kernel runs whole blocks of ``config.block_cycles``
           cycles, and the two blocks that detect the steady state both belong to the window;
+        * the steady state was judged at the transient cap against the cycles' scatter
+          (:func:`pidcore.dem.simulate._steady_by_scatter`), not by the block rule;
+        * the run did not converge: the share of the dissipation the bed released from its
+          stored energy over the window measured, and what that drift does to the SDC;
         * ``particle_steps_per_s`` was not measured (NaN): every kernel call compiled code;
         * a property of the specimen overrides its table material's
           (:func:`pidcore.specimen.table_overrides`);
@@ -216,6 +220,31 @@ class DemResult:
                 why += ", and the two blocks that detected the steady state are both measured"
             notes.append(f"steady window rounded up: {self.steady_cycles} cycles measured for "
                          f"the {asked} asked ({why})")
+        b = self.config.block_cycles
+        cap = -(-self.config.transient_cap_cycles(self.case.frequency_hz) // b) * b
+        if self.steady_detected and self.steady_start_cycle == cap:
+            # the block rule's start is at least two blocks before the cycle it is found at,
+            # which is never past the cap: a steady start at the cap is the scatter rule's
+            notes.append(
+                f"steady state judged at the transient cap (cycle {cap}): no two successive "
+                "blocks balanced the walls' work and the dissipation within "
+                f"{defaults.DEM_STEADY_BALANCE_TOLERANCE:.0%}, but over the cycles before the "
+                "cap the stored energy shows no trend and the dissipation no change against "
+                "their scatter (docs/calibration.md, 'DEM runs that never reach a steady "
+                "state')")
+        if not self.steady_detected and self.energy_per_cycle_j > 0:
+            # what a drift does to the number: the steady dissipation is what the walls' work
+            # supplies, so the SDC is off by the share of the dissipation the bed released
+            released = 1.0 - self.work_per_cycle_j / self.energy_per_cycle_j
+            notes.append(
+                f"not converged: no steady state by the transient cap (measured from cycle "
+                f"{self.steady_start_cycle}); over the {self.steady_cycles} cycles measured the "
+                f"bed's stored energy {'fell' if released >= 0 else 'rose'} by "
+                f"{abs(released):.1%} of the dissipation per cycle (walls' work "
+                f"{self.work_per_cycle_j:.4g} J against {self.energy_per_cycle_j:.4g} J "
+                f"dissipated per cycle): if that is a drift, the SDC is {released:+.1%} off "
+                "the one the walls' work gives; where particles fly it is mostly noise "
+                "(docs/calibration.md, 'DEM runs that never reach a steady state')")
         if not math.isfinite(self.particle_steps_per_s):
             notes.append("particle_steps_per_s not measured: every kernel call of this run "
                          "included Numba compilation (run again for the compiled speed)")

@@ -33,8 +33,10 @@ Method (choices and why):
 * **Steady state.** Blocks of DEM_STEADY_BLOCK_CYCLES cycles: steady once successive block
   means of the dissipation agree and the walls' work balances the dissipation in both blocks
   (:func:`_steady_start`), at most DEM_MAX_TRANSIENT_CYCLES and DEM_MAX_TRANSIENT_TIME_S
-  skipped (then flagged). Measured window: DEM_MIN_STEADY_CYCLES cycles (80: 1.6 s at
-  50 Hz).
+  skipped; at that cap the cycles skipped are judged against their scatter
+  (:func:`_steady_by_scatter`: no trend of the stored energy, no change of the dissipation)
+  and the run is flagged not converged where they fail that too. Measured window:
+  DEM_MIN_STEADY_CYCLES cycles (80: 1.6 s at 50 Hz).
 * **SDC.** Eq. 8-10: steady dissipation per cycle over E = m_c a^2 / (2 w^2), m_c per
   ``vibrated_mass`` (default: coupon face sheets + core + all particles of the 441 cells).
 """
@@ -555,6 +557,54 @@ def _steady_start(dissipated: np.ndarray, work: np.ndarray, config: DemConfig) -
     return None
 
 
+def _halves_agree(first: np.ndarray, second: np.ndarray, relative_tolerance: float) -> bool:
+    """Whether two runs of cycles dissipate alike: means within ``relative_tolerance`` of the
+    larger plus two combined standard errors (the block rule's test, for any lengths)."""
+    m0, m1 = first.mean(), second.mean()
+    se = math.sqrt(first.var(ddof=1) / len(first) + second.var(ddof=1) / len(second))
+    return abs(m1 - m0) <= relative_tolerance * max(abs(m0), abs(m1)) + 2 * se
+
+
+def _steady_by_scatter(dissipated: np.ndarray, work: np.ndarray, config: DemConfig,
+                       done: int) -> bool:
+    """Whether the bed was steady over the second half of the transient skipped (cycles
+    ``done // 2`` .. ``done`` on block boundaries), judged against the scatter of the cycles:
+    the rule :func:`simulate_load_case` applies where the block rule (:func:`_steady_start`)
+    found nothing by the transient cap.
+
+    The block rule asks each of two blocks to balance the walls' work and the dissipation
+    within DEM_STEADY_BALANCE_TOLERANCE; their difference is the change of the stored energy
+    over the block, and where particles fly (a few steel spheres at 5 g, an alumina bed at
+    5-10 g) its kinetic part at the block's two ends outweighs 2 % of ten cycles' dissipation
+    by chance, so that test fails at random (docs/calibration.md, "DEM runs that never reach a
+    steady state"). Here the stored energy at each cycle's end, the running sum of work minus
+    dissipation, is fitted with a line: its slope is the energy the bed stores (or releases,
+    compacting) per cycle, the error a drift makes in the dissipation per cycle. Steady when
+    (1) that slope is within DEM_STEADY_BALANCE_TOLERANCE of the mean dissipation plus two
+    standard errors of the slope (the scatter about the line taken as independent from cycle
+    to cycle), and (2) the dissipation means of the window's two halves agree as the block
+    rule's blocks must. Fewer than two blocks (and 8 cycles) in the window: not steady.
+    """
+    b = config.block_cycles
+    lo = b * (done // (2 * b))
+    d = np.asarray(dissipated[lo:done], dtype=float)
+    w = np.asarray(work[lo:done], dtype=float)
+    n = len(d)
+    if n < max(2 * b, 8):
+        return False
+    stored = np.cumsum(w - d)
+    cycle = np.arange(n, dtype=float)
+    centred = cycle - cycle.mean()
+    slope = float(centred @ stored / (centred @ centred))
+    residual = stored - stored.mean() - slope * centred
+    slope_se = math.sqrt(float(residual @ residual) / (n - 2) / float(centred @ centred))
+    mean = float(d.mean())
+    drift_ok = abs(slope) <= defaults.DEM_STEADY_BALANCE_TOLERANCE * abs(mean) + 2 * slope_se
+    half = n // 2
+    return bool(drift_ok and _halves_agree(d[:half], d[half:],
+                                           config.steady_relative_tolerance))
+
+
 def required_steady_cycles(case: LoadCase, config: DemConfig) -> int:
     if config.steady_cycles is not None:
         return config.steady_cycles
@@ -821,6 +871,12 @@ def simulate_load_case(case: LoadCase, config: DemConfig | None = None, *,
                 cap = config.transient_cap_cycles(case.frequency_hz)
                 if steady_start is None and done >= cap:
                     steady_start = -(-cap // b) * b  # block boundary
+                    # the block rule's 2 % balance is one of a block's dissipation, which a
+                    # flying bed's stored energy (kinetic at the block's ends) outweighs by
+                    # chance: judged against that scatter the bed may well be steady. The
+                    # window stays at the cap, so the SDC is the same either way
+                    detected = _steady_by_scatter(all_t[:, 1] + all_t[:, 2] + all_t[:, 3],
+                                                  all_t[:, 0], config, done)
                 if bar is not None and steady_start is not None:
                     bar.total = steady_start + need
                     bar.refresh()
