@@ -287,3 +287,26 @@ def test_app_compare_groups_two_files_of_one_name_apart(two_panels, analysed):
     names = sorted(group_name(entries, g) for g in groups)
     assert names == sorted(f"{CASE.full_label()}, specimen panel [{h[:6]}]"
                            for h in (two_panels.first.hash, two_panels.second.hash))
+
+
+def test_report_rows_part_two_files_of_one_name_but_not_the_papers_coupon(two_panels):
+    """Rows are per specimen file where the records saved one; the paper's coupon is one
+    coupon whatever hash (either table material) or none a record saved."""
+    from pidcore.report.table import build_report_table
+
+    paper = paper_specimen()
+    records = [("a.csv", "panel", two_panels.first.hash, 0.10),
+               ("b.csv", "panel", two_panels.second.hash, 0.30),
+               ("c.csv", "paper_coupon", paper.hash, 0.20),
+               ("d.csv", "paper_coupon", math.nan, 0.22)]  # saved before the hash was
+    analyses = pd.DataFrame([{"source": source, "frequency_hz": 1000.0, "acceleration_g": 5.0,
+                              "fill_percent": 25.0, "material": "acrylic", "direction": "z",
+                              "sdc": sdc, "sdc_stderr": 0.01, "specimen": name,
+                              "specimen_sha256": sha} for source, name, sha, sdc in records])
+    table = build_report_table(None, analyses, None)
+    rows = {row["source file(s)"]: row for _, row in table.iterrows()}
+    assert set(rows) == {"a.csv", "b.csv", "c.csv; d.csv"}
+    assert rows["a.csv"]["SDC measured [-]"] == pytest.approx(0.10, rel=1e-12)
+    assert rows["b.csv"]["SDC measured [-]"] == pytest.approx(0.30, rel=1e-12)
+    assert [rows[k][SHA] for k in ("a.csv", "b.csv", "c.csv; d.csv")] == [
+        two_panels.first.hash, two_panels.second.hash, ""]

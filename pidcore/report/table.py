@@ -62,8 +62,9 @@ CONSISTENCY_COLUMN = "measured chi2/dof [-]"
 #: :data:`pidcore.compare.ALIGNMENT_STATUSES`.
 ALIGNMENT_COLUMN = f"alignment [{'/'.join(ALIGNMENT_STATUSES)}]"
 #: The sha256 of the specimen file a row's measurements recorded (``specimen_sha256``): empty
-#: where they recorded only its name (saved without a specimen file, or by an older pidcore:
-#: matched by name). Two files of one name get rows of their own.
+#: where they recorded only its name (saved without a specimen file, or by an older pidcore)
+#: and for the paper's coupon (one coupon of either table material): matched by name. Two
+#: files of one name get rows of their own.
 SPECIMEN_SHA256_COLUMN = "specimen sha256"
 #: Columns of :func:`build_report_table`, in order.
 REPORT_COLUMNS: tuple[str, ...] = (
@@ -282,9 +283,9 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
         # (str(NaN) is "nan", a specimen of its own meeting no DEM run)
         named = rec.get("specimen", "")
         specimen = "" if pool or not isinstance(named, str) else named
-        # its file's hash (a record saved before it was, or without a file: by name)
-        recorded = rec.get(MEASURED_SHA256_FIELD, "")
-        sha256 = recorded if specimen and isinstance(recorded, str) else ""
+        # its file's hash where it decides ("" for a record saved before it was, or without
+        # a file, and for the paper's coupon, one coupon of either material: by name)
+        sha256 = deciding_sha256(rec.get(MEASURED_SHA256_FIELD, "")) if specimen else ""
         met_note, refused, met_calibrated = "", False, ""
         if pool or dem_runs is None or dem_runs.empty:
             own = aligner
@@ -310,7 +311,7 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
             # the test's file by name and hash where it recorded one: "no DEM runs of
             # panel" beside a store of panel's runs named no difference
             shown = specimen
-            if specimen and not specimen.endswith("]") and deciding_sha256(sha256):
+            if specimen and not specimen.endswith("]") and sha256:
                 shown = hashed_name(specimen, sha256)
             aligned = replace(aligned, message=no_runs_note(
                 shown or of_specimen, case.material, case.direction,
