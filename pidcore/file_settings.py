@@ -311,6 +311,10 @@ class FileSettings:
         A note when a table given explicitly (``--sidecar``) has no row for the file: not an
         error (one table may cover several runs), but a misspelt row would otherwise leave the
         file at the defaults without a word. "" otherwise.
+    specimen_sha256 : str
+        The sha256 of the specimen file tested where ``specimen`` is the file given
+        (:func:`pidcore.specimen.measured_specimen_sha256`), saved beside its name; "" where
+        only a name is known (a table naming another specimen).
     """
 
     options: AnalysisOptions
@@ -319,6 +323,18 @@ class FileSettings:
     notes: tuple[str, ...] = ()
     cells: dict[str, tuple[str, str, str]] = field(default_factory=dict)
     unmatched: str = ""
+    specimen_sha256: str = ""
+
+    def record_fields(self) -> dict[str, str]:
+        """The record fields naming the specimen tested (none where no specimen is named): its
+        name and, where its file was given, the file's hash."""
+        from .specimen import MEASURED_SHA256_FIELD
+
+        if not self.specimen:
+            return {}
+        return {SPECIMEN_COLUMN: self.specimen,
+                **({MEASURED_SHA256_FIELD: self.specimen_sha256} if self.specimen_sha256
+                   else {})}
 
     def summary(self) -> str:
         """The settings the table set, in words with their table, e.g. ``'vibrometer delay
@@ -562,13 +578,15 @@ def resolve_files(paths: Sequence[str | os.PathLike], *, options: AnalysisOption
     naming the file: 0.5 typed for 50 % was analysed and saved as a coupon without particles.
     A file named like the paper's coupon with other content (``specimen``, named
     ``specimen_name``) is saved under :func:`pidcore.specimen.measured_specimen_name`
-    (``"paper_coupon [45d792]"``), and so is a file whose sidecar names that name.
+    (``"paper_coupon [45d792]"``), and so is a file whose sidecar names that name. Every
+    file of that specimen carries its file's hash too (:attr:`FileSettings.specimen_sha256`).
     """
-    renamed = ""
+    renamed = sha256 = ""
     if specimen is not None:
-        from .specimen import measured_specimen_name
+        from .specimen import measured_specimen_name, measured_specimen_sha256
 
         renamed = measured_specimen_name(specimen)
+        sha256 = measured_specimen_sha256(specimen)
         if specimen_name == specimen.name:
             specimen_name = renamed
     tables: dict = {}
@@ -593,5 +611,8 @@ def resolve_files(paths: Sequence[str | os.PathLike], *, options: AnalysisOption
                 and stated[-1].material == specimen_material):
             fs = replace(fs, specimen=specimen_name,
                          sources={**fs.sources, SPECIMEN_COLUMN: "--specimen"})
+        if specimen is not None and fs.specimen == renamed:
+            # the file given is the one tested: its hash tells it from another of its name
+            fs = replace(fs, specimen_sha256=sha256)
         settings.append(fs)
     return stated, settings

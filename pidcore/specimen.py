@@ -78,6 +78,10 @@ is_paper_coupon, measured_specimen_name, models_paper_coupon, hashed_name
     Whether a specimen (by hash, else by name) is the paper's coupon: the one rule; the name
     a measurement of a specimen file is saved under; whether a file models the coupon; a
     file's name with its hash, ``"name [45d792]"``.
+measured_specimen_sha256, MEASURED_SHA256_FIELD, deciding_sha256, same_tested_file
+    The file's hash saved beside that name (record field ``specimen_sha256``), and how a
+    measurement's recorded hash meets a DEM run's or a calibration's: by hash where both
+    know it, else by name (a record saved before the hash was).
 calibrated_name, uncalibrated_name, calibrated_provenance, ProvenanceSpec, provenance_test_name
     What ``pidcore calibrate`` names the file it writes, the name it was made from, the
     ``[provenance]`` table recording the source file's name and sha256, and the name of the
@@ -1281,9 +1285,10 @@ def measured_specimen_name(specimen: Specimen) -> str:
     by name) with other content, which is ``"paper_coupon [45d792]"`` (name and hash, as its
     DEM runs are labelled on every page: :func:`pidcore.compare.specimens.specimen_label`).
 
-    A measurement records only this name: under the bare name ``paper_coupon``, a test of a
-    coupon with another cell size was compared with the paper's Table 3 and calibrated with
-    the paper coupon's tests. A calibrated file of the paper's coupon
+    A measurement records this name and its file's hash (:func:`measured_specimen_sha256`;
+    a record of an earlier pidcore, the name only): under the bare name ``paper_coupon``, a
+    test of a coupon with another cell size was compared with the paper's Table 3 and
+    calibrated with the paper coupon's tests. A calibrated file of the paper's coupon
     (``paper_coupon_calibrated``: fitted contact, mass or damping values, the paper's cell and
     spheres) keeps its name: its tests are the paper's coupon's.
 
@@ -1302,6 +1307,43 @@ def measured_specimen_name(specimen: Specimen) -> str:
     if specimen.name != uncalibrated_name(specimen.name) and models_paper_coupon(specimen):
         return specimen.name
     return hashed_name(specimen.name, specimen.hash)
+
+
+#: Record field of a saved analysis: the sha256 of the specimen file its test was made on
+#: (:func:`measured_specimen_sha256`); absent in a record saved without a specimen file, or
+#: before the field existed (matched by its ``specimen`` name, as then).
+MEASURED_SHA256_FIELD = "specimen_sha256"
+
+
+def measured_specimen_sha256(specimen: Specimen) -> str:
+    """The sha256 a measurement analysed with ``specimen`` is saved with (record field
+    :data:`MEASURED_SHA256_FIELD`): that of the file tested, the file given or, for a file
+    ``pidcore calibrate`` wrote that records its source (``[provenance]``), the source's (its
+    tests are that file's, as :func:`measured_specimen_name` names them). A name alone
+    pooled the tests of two files of one name (an edited ``x.toml``) and met the other's
+    DEM runs and calibration."""
+    source = specimen.provenance
+    return source.calibrated_from_sha256 if source is not None else specimen.hash
+
+
+def deciding_sha256(sha256: object) -> str:
+    """A measurement's recorded specimen hash where it decides what the test meets; ``""``
+    where its name does: none recorded (a record saved without a specimen file, or before
+    the hash was saved; a listing's NaN) or the paper's coupon's (either table material: one
+    coupon, whose runs without a hash and calibrations are matched by name as before)."""
+    if not isinstance(sha256, str) or len(sha256) != 64 or not set(sha256) <= _SHA256_DIGITS:
+        return ""
+    return "" if sha256 in paper_hashes() else sha256
+
+
+def same_tested_file(measured_sha256: object, tested: object) -> bool | None:
+    """Whether a measurement recording ``measured_sha256`` is a test of the file whose hash
+    is ``tested`` (a DEM run's specimen, or the file a calibration calibrated); None where
+    either is unknown or the paper's coupon's (:func:`deciding_sha256`): the names decide."""
+    mine, theirs = deciding_sha256(measured_sha256), deciding_sha256(tested)
+    if not mine or not theirs:
+        return None
+    return mine == theirs
 
 
 def hashed_name(name: str, sha256: str) -> str:
@@ -1482,7 +1524,8 @@ __all__ = ["CellSpec", "CouponSpec", "PairSpec", "PairsSpec", "ParticleSpec", "S
            "ProvenanceSpec", "calibrated_name", "calibrated_provenance", "uncalibrated_name",
            "cell_geometry", "contact_law", "describe", "hashed_name", "is_paper_coupon",
            "load_specimen",
-           "measured_specimen_name", "models_paper_coupon", "numeric_fields",
+           "MEASURED_SHA256_FIELD", "deciding_sha256", "measured_specimen_name",
+           "measured_specimen_sha256", "models_paper_coupon", "numeric_fields", "same_tested_file",
            "provenance_test_name",
            "paper_specimen", "particles_for_fill"]
 

@@ -73,8 +73,8 @@ def test_unknown_keyword_arguments_are_rejected():
 
 _BUNDLED = Path(__file__).resolve().parents[1] / "data_samples"
 #: Columns of a result frame that are labels, not quantities (no unit to name).
-_LABEL_COLUMNS = {"material", "direction", "DEM settings", "specimen", "source file(s)",
-                  "load case", "note"}
+_LABEL_COLUMNS = {"material", "direction", "DEM settings", "specimen", "specimen sha256",
+                  "source file(s)", "load case", "note"}
 _UNIT_COLUMN = re.compile(r"^.+ \[[^\[\]]+\]$")
 
 

@@ -56,9 +56,10 @@ def saved_entries(path: str | os.PathLike, rows: pd.DataFrame) -> list[MeasuredE
 def group_entries(entries: Sequence[MeasuredEntry]) -> list[list[int]]:
     """Indices of ``entries`` grouped by load case (and specimen: specimens are never pooled)."""
     out: list[list[int]] = []
-    by_specimen: dict[str, list[int]] = {}
+    # two specimen files of one name are two specimens (a record without the hash: by name)
+    by_specimen: dict[tuple[str, str], list[int]] = {}
     for i, e in enumerate(entries):
-        by_specimen.setdefault(e.specimen, []).append(i)
+        by_specimen.setdefault((e.specimen, e.specimen_sha256), []).append(i)
     for members in by_specimen.values():
         for group in group_load_cases([entries[i].load_case for i in members]):
             out.append([members[j] for j in group])
@@ -73,6 +74,8 @@ def group_name(entries: Sequence[MeasuredEntry], group: Sequence[int]) -> str:
     """
     e = entries[group[0]]
     specimen = f", specimen {e.specimen}" if e.specimen else ""
+    if e.specimen and e.specimen_sha256 and not e.specimen.endswith("]"):
+        specimen += f" [{e.specimen_sha256[:6]}]"  # tells two files of one name apart
     return f"{e.load_case.full_label()}{specimen}"
 
 
@@ -124,7 +127,7 @@ def case_view(entries: Sequence[MeasuredEntry], dem_runs: pd.DataFrame | None,
     # group_entries never pools specimens: the first entry names the group's
     first = entries[0]
     met = runs_for_measurement(dem_runs, first.specimen, first.load_case.material,
-                               first.load_case.direction)
+                               first.load_case.direction, first.specimen_sha256)
     comparison = compare_case(entries, met.runs, paper)
     notes = list(comparison.notes) + ([design_note] if design_note else [])
     if met.note and not met.refused:

@@ -304,10 +304,18 @@ def check_point_specimens(points: Sequence[MeasuredPoint], specimen: Specimen) -
     measurement in the report and the app (:meth:`pidcore.calibrate.prediction.Calibration.
     speaks_for`). Any other was fitted silently against this specimen's DEM runs.
     """
-    # by name only: a measured point records its specimen's name, not the file's hash
-    own = uncalibrated_name(measured_specimen_name(specimen))
+    from ..specimen import hashed_name, same_tested_file
+    from .prediction import tested_sha256
 
-    def of_another(name: str) -> bool:
+    # a point that recorded its specimen file's hash is of this specimen only where it is the
+    # file calibrated (or the one it was calibrated from): two files of one name are two
+    # specimens. One without (a table's row, an older record) by its name, as before
+    own = uncalibrated_name(measured_specimen_name(specimen))
+    own_file = tested_sha256(specimen) or ""
+
+    def of_another(name: str, sha256: str = "") -> bool:
+        if name and same_tested_file(sha256, own_file) is False:
+            return True
         if specimen.is_paper():
             # the paper's coupon with either table material is one coupon: a test naming
             # paper_coupon was refused for the aluminium coupon (and paper_coupon_aluminium
@@ -317,8 +325,10 @@ def check_point_specimens(points: Sequence[MeasuredPoint], specimen: Specimen) -
 
     others: dict[tuple[str, str], list[int | None]] = {}
     for p in points:
-        if of_another(p.specimen):
-            others.setdefault((p.source, p.specimen), []).append(p.row)
+        if of_another(p.specimen, p.specimen_sha256):
+            named = p.specimen if not p.specimen_sha256 or p.specimen.endswith("]") \
+                else hashed_name(p.specimen, p.specimen_sha256)
+            others.setdefault((p.source, named), []).append(p.row)
     if not others:
         return
     said = []
@@ -330,7 +340,11 @@ def check_point_specimens(points: Sequence[MeasuredPoint], specimen: Specimen) -
         else:  # a store's load cases (or points made in code)
             where = f"{len(rows)} measured load case(s)" + (f" of {source}" if source else "")
         said.append(f"{where} name specimen {name!r}")
-    raise ParameterError(f"{'; '.join(said)}, not {measured_specimen_name(specimen)!r}, the "
+    calibrated = measured_specimen_name(specimen)
+    if own_file and any(name.startswith(f"{calibrated} [") for _, name in others) \
+            and not calibrated.endswith("]"):
+        calibrated = hashed_name(calibrated, own_file)  # one name, two files: say which
+    raise ParameterError(f"{'; '.join(said)}, not {calibrated!r}, the "
                          "specimen calibrated; "
                          "calibrate them with their own specimen file (specimen=FILE), or "
                          "leave those rows out")

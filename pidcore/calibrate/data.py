@@ -55,6 +55,10 @@ class MeasuredPoint:
     # part of the point's identity
     source: str = field(default="", compare=False)
     row: int | None = field(default=None, compare=False)
+    # the sha256 of the specimen file its tests recorded (a store's ``specimen_sha256``): two
+    # files of one name are two specimens; "" where only the name is known (a table, an older
+    # record), or the paper's coupon's (pidcore.specimen.deciding_sha256)
+    specimen_sha256: str = ""
 
     def __post_init__(self) -> None:
         # the rule of a table row, for a script's point too: a script's sdc=nan, a negative
@@ -91,6 +95,8 @@ class MeasuredPoint:
         """E.g. ``'500 Hz, 1 g, 50 %, steel, specimen steel_6mm_b'``: material and specimen
         named, since points differing only in them are different points."""
         specimen = f", specimen {self.specimen}" if self.specimen else ""
+        if self.specimen and self.specimen_sha256 and not self.specimen.endswith("]"):
+            specimen += f" [{self.specimen_sha256[:6]}]"  # one of two files of that name
         return (f"{self.frequency_hz:g} Hz, {self.acceleration_g:g} g, {self.fill_percent:g} %, "
                 f"{self.material}{specimen}")
 
@@ -184,6 +190,7 @@ def measured_from_store(store_path: str | os.PathLike, *,
     refuse (saved with ``--accept-implausible``: a negative SDC beyond its noise, one above
     2 pi) are left out; ``left_out``, where given, gains a line naming each.
     """
+    from ..specimen import MEASURED_SHA256_FIELD, deciding_sha256
     from ..store import Store
     from ..store.listing import latest_per_measurement
 
@@ -217,9 +224,16 @@ def measured_from_store(store_path: str | os.PathLike, *,
             "material", pd.Series([None] * len(frame), index=frame.index))],
         specimen=[_text_cell(v, "") for v in frame.get(
             "specimen", pd.Series([None] * len(frame), index=frame.index))])
+    # tests of two files of one name are not averaged into one point (the hash of a record
+    # saved before it was, or of the paper's coupon, is "": by name, as before)
+    frame = frame.assign(specimen_sha256=[
+        deciding_sha256(v) if named else "" for v, named in zip(frame.get(
+            MEASURED_SHA256_FIELD, pd.Series([None] * len(frame), index=frame.index)),
+            frame["specimen"], strict=True)])
     points = []
-    keys = ["frequency_hz", "acceleration_g", "fill_percent", "material", "specimen"]
-    for (f, a, p, material, specimen), group in frame.groupby(keys):
+    keys = ["frequency_hz", "acceleration_g", "fill_percent", "material", "specimen",
+            "specimen_sha256"]
+    for (f, a, p, material, specimen, sha256), group in frame.groupby(keys):
         sdc = group["sdc"].to_numpy(float)
         if len(sdc) > 1:
             se = float(np.std(sdc, ddof=1) / math.sqrt(len(sdc)))
@@ -230,7 +244,7 @@ def measured_from_store(store_path: str | os.PathLike, *,
                 if se > 0 else math.nan
         points.append(MeasuredPoint(float(f), float(a), float(p), float(sdc.mean()), se,
                                     str(material), str(specimen), sdc_stderr_dof=dof,
-                                    source=str(store_path)))
+                                    source=str(store_path), specimen_sha256=str(sha256)))
     if not points:
         raise InputFileError(f"{store_path}: no analysed measurement has a complete load case")
     return points
@@ -241,29 +255,39 @@ def points_for_specimen(points: Sequence[MeasuredPoint], specimen) -> tuple[list
     particle material measured on it (their specimen label is its name, or the name it was
     calibrated from) or on no named specimen; ``note`` says what is left out and why ("" if
     nothing)."""
-    from ..specimen import measured_specimen_name, uncalibrated_name
+    from ..specimen import measured_specimen_name, same_tested_file, uncalibrated_name
+    from .prediction import tested_sha256
 
     material = specimen.particles.material
     # a calibrated file (as pidcore calibrate names it) is the specimen its measurements
     # were made on, as base_specimen reads a point's name: "x", "x_calibrated" and an older
     # "x_calibrated_calibrated" are all x. A file named paper_coupon with another cell is
     # "paper_coupon [45d792]", as its tests are saved: the paper coupon's tests are not its
-    # by name only: a measured point records its specimen's name, not the file's hash (two
-    # files named x are one specimen here; a paper_coupon of other content is named by both)
+    # a point that recorded its specimen file's hash is matched by it where the file
+    # calibrated knows which file was tested (tested_sha256): two files named x are two
+    # specimens. One without (a table, an older record) by name, as before
     tested = uncalibrated_name(measured_specimen_name(specimen))
+    tested_file = tested_sha256(specimen) or ""
     kept, other_material, other_specimen = [], {}, {}
     for p in points:
         if str(p.material) != material:
             other_material[str(p.material)] = other_material.get(str(p.material), 0) + 1
         elif str(p.specimen) and uncalibrated_name(str(p.specimen)) != tested:
             other_specimen[str(p.specimen)] = other_specimen.get(str(p.specimen), 0) + 1
+        elif str(p.specimen) and same_tested_file(p.specimen_sha256, tested_file) is False:
+            label = f"{p.specimen} [{p.specimen_sha256[:6]}] (another file of that name)"
+            other_specimen[label] = other_specimen.get(label, 0) + 1
         else:
             kept.append(p)
     reasons = [f"{n} measured load case(s) of specimen {name}"
                for name, n in other_specimen.items()]
     reasons += [f"{n} measured load case(s) of {name} particles"
                 for name, n in other_material.items()]
-    note = (f"Not used for {measured_specimen_name(specimen)} ({material} particles): "
+    shown = measured_specimen_name(specimen)
+    if any("another file of that name" in name for name in other_specimen) \
+            and not shown.endswith("]"):
+        shown = f"{shown} [{tested_file[:6]}]"
+    note = (f"Not used for {shown} ({material} particles): "
             + "; ".join(reasons)
             + ".") if reasons else ""
     return kept, note
@@ -281,7 +305,9 @@ def points_for_paper(points: Sequence[MeasuredPoint], *, hint: str = "") -> tupl
 
     kept, others = [], {}
     for p in points:
-        # by name only: a measurement records its specimen's name, not the file's hash
+        # by name, even where the point has its file's hash: another file of the coupon's
+        # name is saved as "paper_coupon [45d792]", and a calibrated file of the coupon
+        # (another hash) models the coupon its tests were made on
         name = str(p.specimen)
         if not is_paper_coupon(name):
             others[name] = others.get(name, 0) + 1

@@ -209,7 +209,35 @@ class Calibration:
         except (PidcoreError, OSError):
             return None
 
-    def speaks_for(self, specimen_name: str) -> bool:
+    def tested_sha256(self) -> str:
+        """The sha256 of the specimen file whose tests this calibration fitted (its calibrated
+        file's ``[provenance]``: :func:`tested_sha256`); "" where that is unknown (no
+        readable calibrated file, or one written before ``[provenance]`` existed)."""
+        spec = self.calibrated_specimen()
+        return (tested_sha256(spec) or "") if spec is not None else ""
+
+    def other_file_reason(self, sha256: object, specimen_name: str = "") -> str:
+        """Why this calibration does not speak for a measurement that recorded its specimen
+        file's hash ``sha256`` (``specimen_sha256``): another file, of the same name where the
+        names agree (an edited ``x.toml``); "" where it does, or where either hash is unknown
+        (a record saved before the hash was, a calibrated file without ``[provenance]``:
+        the names decide, :meth:`speaks_for`)."""
+        from ..specimen import hashed_name, same_tested_file, uncalibrated_name
+
+        theirs = self.tested_sha256()
+        if same_tested_file(sha256, theirs) is not False:
+            return ""
+        spec = self.calibrated_specimen()
+        source = spec.provenance if spec is not None else None
+        calibrated = source.calibrated_from_name if source is not None else self.specimen_name
+        tested = uncalibrated_name(specimen_name) if specimen_name else calibrated
+        # "paper_coupon [45d792]" (a test of another file of the coupon's name) says its hash
+        shown = tested if tested.endswith("]") else hashed_name(tested, str(sha256))
+        return (f"it calibrates specimen {hashed_name(calibrated, theirs)}, not "
+                f"{shown} (another file"
+                + (" of the same name)" if tested == calibrated else ")"))
+
+    def speaks_for(self, specimen_name: str, sha256: object = "") -> bool:
         """Whether this calibration may predict a measurement of the specimen named
         ``specimen_name`` ("" : not named): the same name as the specimen it calibrates (its
         calibrated file is "<name>_calibrated"), or either unknown. The paper's coupon is
@@ -220,9 +248,11 @@ class Calibration:
         (:func:`pidcore.specimen.measured_specimen_name`), not as the coupon's."""
         from ..specimen import is_paper_coupon, measured_specimen_name, uncalibrated_name
 
-        # by name only: a measurement records its specimen's name, not its file's hash, so
-        # two files of one name are one specimen here; where the specimen file is known
-        # (a report of it) :meth:`other_specimen_reason` compares the hashes
+        # a measurement that recorded its specimen file's hash (``sha256``) is matched by it
+        # where the calibrated file records its source: two files of one name are two
+        # specimens. Otherwise (an older record or calibration) by name, as before
+        if self.other_file_reason(sha256, specimen_name):
+            return False
         calibrated = self.specimen_name
         if specimen_name and (not calibrated or is_paper_coupon(calibrated)):
             # another file named paper_coupon (another cell) calibrates to

@@ -50,8 +50,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     g.add_argument("--specimen", metavar="FILE", type=path_argument, default=None,
                    help="specimen file whose particle material the files may state (e.g. "
                         "steel, which the material table lacks) and which is the default "
-                        "material; its name is saved with the files of its particles whose "
-                        "sidecar names no specimen")
+                        "material; its name and sha256 are saved with the files of its "
+                        "particles whose sidecar names no specimen")
     p.add_argument("--key", metavar="NAME", default=None,
                    help="which measurement of a pidcore HDF5 store to analyse, when it holds "
                         "several (the error lists them)")
@@ -117,8 +117,7 @@ def run(args: argparse.Namespace) -> int:
                 store, results, [fs.options for fs in settings],
                 [(Path(path).name, c, st.origin if st is not None else "")
                  for path, c, st in zip(args.paths, cases, stated, strict=True)],
-                fields=[{"specimen": fs.specimen} if fs.specimen else None
-                        for fs in settings])
+                fields=[fs.record_fields() or None for fs in settings])
             replaced, breakdown = saved.notes, saved.breakdown()
         interrupt.raise_if_interrupted()  # an interrupt swallowed on the way still counts
         # inside: a Ctrl-C while the results are written out still says what was saved
@@ -149,6 +148,7 @@ def _print_results(args: argparse.Namespace, results: list, cases: list, stated:
         json.dump({"records": [{**r.to_dict(), "notes": [cli_words(n) for n in r.notes],
                                 "load_case": c.key if c else None,
                                 "specimen": fs.specimen or None,
+                                "specimen_sha256": fs.specimen_sha256 or None,
                                 "parameters": fs.options.parameters(),
                                 "settings_from": dict(fs.sources),
                                 "overridden": list(fs.notes),

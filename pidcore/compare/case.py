@@ -221,6 +221,10 @@ class MeasuredEntry:
         The store's key of the measured data (:func:`pidcore.store.measurement_key`): equal
         for byte-identical files under any name, so :func:`unique_entries` counts them once
         (empty where unknown).
+    specimen_sha256 : str
+        The sha256 of the specimen file the record names (``specimen_sha256``), deciding
+        which DEM runs and calibration it meets and keeping two files of one name apart; ""
+        where only the name is known (:func:`pidcore.specimen.deciding_sha256`).
     """
 
     key: str
@@ -245,6 +249,7 @@ class MeasuredEntry:
     settings: dict = field(default_factory=dict, repr=False, compare=False)
     #: degrees of freedom of sdc_stderr (the analysis's n_blocks - 1), NaN where unknown
     sdc_stderr_dof: float = math.nan
+    specimen_sha256: str = ""
 
     @classmethod
     def from_record(cls, record, load_case: LoadCase, *,
@@ -293,7 +298,7 @@ class MeasuredEntry:
                    describe_corrections(settings),
                    str(row.get("measurement_key", "") or ""),
                    found[0].message if found else "", settings,
-                   stored_stderr_dof(row.get("sdc_stderr_dof")))
+                   stored_stderr_dof(row.get("sdc_stderr_dof")), _specimen_sha256_of(row))
 
     def loop(self):
         """The measured loop (:class:`pidcore.loop.ForceDisplacementLoop`, labelled
@@ -351,6 +356,14 @@ def _specimen_of(row) -> str:
     record names none and another does (``str(NaN)`` would be a specimen "nan")."""
     named = row.get("specimen", "")
     return named if isinstance(named, str) else ""
+
+
+def _specimen_sha256_of(row) -> str:
+    """The specimen file's hash a stored analysis recorded where it decides ("" for none, an
+    older record, or the paper's coupon's: by name)."""
+    from ..specimen import MEASURED_SHA256_FIELD, deciding_sha256
+
+    return deciding_sha256(row.get(MEASURED_SHA256_FIELD, "")) if _specimen_of(row) else ""
 
 
 def _json_dict(text) -> dict:
@@ -427,7 +440,8 @@ def compare_case(records: Sequence[MeasuredEntry],
     # Table 3 describes the paper's coupon: beside a test of another specimen its points, its
     # pchip curve and its values were read as that coupon's (the report's rule too)
     specimen = records[0].specimen
-    # by name only: a measurement records its specimen's name, not the file's hash
+    # by name: a test of another file of the paper coupon's name is saved under its hashed
+    # label (measured_specimen_name), and the paper's own hashes decide by name too
     if not is_paper_coupon(specimen):
         if case.material == PAPER_MATERIAL and case.direction == PAPER_DIRECTION:
             notes.append(NOT_PAPER_SPECIMEN_NOTE.format(name=specimen.strip()))

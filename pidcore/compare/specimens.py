@@ -1,24 +1,26 @@
 """Which DEM runs a measurement meets: the runs of its specimen, never another's.
 
 A measurement may name its specimen (the ``specimen`` of a saved analysis: a specimen file's
-``name``); a stored DEM run states ``specimen_name`` and ``specimen_sha256``. A named
-measurement meets only the runs of that name; an unnamed one meets the runs of its material and
-direction when they all come from one specimen, the paper's coupon's among several (the
-default of ``pidcore report``: a calibration's store holds its design runs, files named
-``paper_coupon`` with other values, beside the coupon's own), and none when they come from
-several others (they are not pooled: which specimen was tested is the user's to say). A
-measurement named ``x`` with no run of that name meets the runs of ``x_calibrated``, the
-file ``pidcore calibrate`` wrote from it (a model of the specimen tested); for the paper's
-coupon only such a file of its cell and spheres (another file named ``paper_coupon``
-calibrates to the same name; the file written since ``[provenance]`` existed says which it
-was made from, and its runs meet the tests of that file, ``"paper_coupon [45d792]"``, and
-never the paper's coupon's). A measurement named ``paper_coupon`` meets the paper's coupon's
-runs, not another file of that name; a test of such a file is named ``"paper_coupon
-[45d792]"``, as its runs are (:func:`pidcore.specimen.measured_specimen_name`). Which
-specimen is the paper's coupon is :func:`pidcore.specimen.is_paper_coupon`'s to say. Runs
-stored before specimens
-existed (no hash) and runs of the paper's coupon with either table material are the paper's
-coupon, as in :func:`pidcore.dem.persist.runs_of_specimen`.
+``name``) and, where it was analysed with that file, the file's hash (``specimen_sha256``:
+:func:`pidcore.specimen.measured_specimen_sha256`); a stored DEM run states ``specimen_name``
+and ``specimen_sha256``. A named measurement meets only the runs of that name, and of its file
+where it recorded the hash (two files of one name are two specimens; a record without the hash,
+saved by an earlier pidcore or with a name only, is matched by name); an unnamed one meets the
+runs of its material and direction when they all come from one specimen, the paper's coupon's
+among several (the default of ``pidcore report``: a calibration's store holds its design runs,
+files named ``paper_coupon`` with other values, beside the coupon's own), and none when they
+come from several others (they are not pooled: which specimen was tested is the user's to say).
+A measurement named ``x`` with no run of that name meets the runs of ``x_calibrated``, the file
+``pidcore calibrate`` wrote from it (a model of the specimen tested); for the paper's coupon
+only such a file of its cell and spheres (another file named ``paper_coupon`` calibrates to the
+same name; the file written since ``[provenance]`` existed says which it was made from, and its
+runs meet the tests of that file, ``"paper_coupon [45d792]"``, and never the paper's coupon's).
+A measurement named ``paper_coupon`` meets the paper's coupon's runs, not another file of that
+name; a test of such a file is named ``"paper_coupon [45d792]"``, as its runs are
+(:func:`pidcore.specimen.measured_specimen_name`). Which specimen is the paper's coupon is
+:func:`pidcore.specimen.is_paper_coupon`'s to say. Runs stored before specimens existed (no
+hash) and runs of the paper's coupon with either table material are the paper's coupon, as in
+:func:`pidcore.dem.persist.runs_of_specimen`.
 
 Both the app's Compare tab and the report table choose their runs here.
 """
@@ -147,15 +149,45 @@ def _provenance_test_names(runs: pd.DataFrame) -> pd.Series:
     return pd.Series(out, index=runs.index, dtype=object)
 
 
+def _tested_hashes(runs: pd.DataFrame) -> pd.Series:
+    """Per run: the sha256 of the file whose tests it models: the file it was calibrated from
+    where the text it stored records one (``[provenance]``), else its own ``specimen_sha256``
+    ("" where it has none), as a measurement saves it
+    (:func:`pidcore.specimen.measured_specimen_sha256`)."""
+    from ..specimen import Specimen
+    from .align import stored_parameters
+
+    own = (runs["specimen_sha256"] if "specimen_sha256" in runs.columns
+           else pd.Series([""] * len(runs), index=runs.index))
+    params = (runs["parameters_json"] if "parameters_json" in runs.columns
+              else pd.Series([None] * len(runs), index=runs.index))
+    out = []
+    for sha, stored in zip(own, params, strict=True):
+        tested = sha if isinstance(sha, str) else ""
+        text = (stored_parameters(stored) or {}).get("specimen_text")
+        if isinstance(text, str) and "[provenance]" in text:  # parsing costs; no table, none
+            try:
+                source = Specimen.from_text(text, source="stored DEM run").provenance
+            except PidcoreError:
+                source = None
+            if source is not None:
+                tested = source.calibrated_from_sha256
+        out.append(tested)
+    return pd.Series(out, index=runs.index, dtype=object)
+
+
 def _listed(labels: pd.Series) -> str:
     counts = labels.value_counts(sort=False)
     return ", ".join(f"{label} ({n} run(s))" for label, n in counts.items())
 
 
 def runs_for_measurement(runs: pd.DataFrame | None, specimen: str, material: str,
-                         direction: str) -> SpecimenRuns:
+                         direction: str, sha256: object = "") -> SpecimenRuns:
     """The DEM runs a measurement of ``specimen`` (may be empty: not named) at ``material``
-    and ``direction`` meets (see the module's docstring)."""
+    and ``direction`` meets (see the module's docstring). ``sha256``: the hash of the
+    specimen file the measurement recorded (``specimen_sha256``; "" or NaN: none, an older
+    record): runs of its name whose file is another (:func:`_tested_hashes`) are not its
+    own. Without it, the name decides, as before the hash was saved."""
     if runs is None or runs.empty:
         return SpecimenRuns(None)
     same = runs
@@ -182,12 +214,19 @@ def runs_for_measurement(runs: pd.DataFrame | None, specimen: str, material: str
         # paper_coupon_calibrated as the paper coupon's calibrated file's are: its
         # [provenance] names its tests, "paper_coupon [45d792]", and no other
         routed = _provenance_test_names(same)
-        # by name only on the test's side: a measurement records its specimen's name, not
-        # the file's hash (runs of two files of that name are refused below, not pooled)
+        # a measurement that recorded its file's hash meets the runs of that file only (or
+        # of one calibrated from it): two files of one name are two specimens. One recorded
+        # before the hash was saved meets them by name (runs of two files of that name are
+        # refused below, not pooled)
+        from ..specimen import deciding_sha256
+
+        own_file = deciding_sha256(sha256)
+        of_file = (_tested_hashes(same) == own_file).to_numpy(bool) if own_file \
+            else np.ones(len(same), dtype=bool)
         by_name = (names == specimen) & (routed == "")
         # a test of a file named like the paper's coupon with other content names it by its
         # label, "paper_coupon [45d792]" (pidcore.specimen.measured_specimen_name), as its runs
-        mine = (by_name | (labels == specimen)).to_numpy(bool)
+        mine = (by_name | (labels == specimen)).to_numpy(bool) & of_file
         of_paper = is_paper_coupon(specimen)
         if of_paper and not specimen.endswith(CALIBRATED_SUFFIX):
             # no run of the paper's coupon: the runs of another file of its name are met (with
@@ -203,7 +242,7 @@ def runs_for_measurement(runs: pd.DataFrame | None, specimen: str, material: str
 
             mine = np.array([n.endswith(CALIBRATED_SUFFIX)
                              and uncalibrated_name(r or n) == specimen
-                             for n, r in zip(names, routed, strict=True)], dtype=bool)
+                             for n, r in zip(names, routed, strict=True)], dtype=bool) & of_file
             if of_paper:
                 # a file calibrated from another file named paper_coupon (another cell) is
                 # paper_coupon_calibrated too: its runs were compared with the paper
@@ -214,6 +253,11 @@ def runs_for_measurement(runs: pd.DataFrame | None, specimen: str, material: str
         kept, others = labels[mine], labels[~mine]
         left_out = (f"DEM runs of other specimens not compared: {_listed(others)}"
                     if len(others) else "")
+        if own_file and ((names == specimen) & ~pd.Series(of_file, index=same.index)).any():
+            # "no DEM runs of specimen x" beside a store of x's runs read as a lost match
+            left_out = ((left_out + "; ") if left_out else "") + (
+                f"runs named {specimen} are of another file of that name than the test's "
+                f"(its specimen file's sha256 starts {own_file[:6]})")
         if kept.empty:
             return SpecimenRuns(None, "", f"no DEM runs of specimen {specimen} at {material}, "
                                           f"{direction}" + (f"; {left_out}" if left_out else ""))

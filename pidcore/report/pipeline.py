@@ -91,9 +91,9 @@ class MeasuredResult:
                 **self.fields()}
 
     def fields(self) -> dict[str, object]:
-        """Record fields beyond the analysis and load case: the sidecar's ``specimen``."""
-        specimen = self.settings.specimen if self.settings is not None else ""
-        return {"specimen": specimen} if specimen else {}
+        """Record fields beyond the analysis and load case: the ``specimen`` tested (the
+        sidecar's or ``specimen=``'s) and, where its file was given, its ``specimen_sha256``."""
+        return self.settings.record_fields() if self.settings is not None else {}
 
 
 @dataclass(frozen=True)
@@ -454,11 +454,22 @@ def unsubtracted_baseline_note(specimen, analyses: pd.DataFrame | None) -> str:
         return ""
     material = specimen.particles.material
     named = analyses.get("specimen", pd.Series([""] * len(analyses), index=analyses.index))
-    from ..specimen import measured_specimen_name
+    from ..specimen import (
+        MEASURED_SHA256_FIELD,
+        measured_specimen_name,
+        measured_specimen_sha256,
+        same_tested_file,
+    )
 
-    # by name only: a measurement records its specimen's name, not the file's hash
+    # a record of its name whose file's hash is another's is another file's test (one saved
+    # before the hash was, or without a file, is taken by its name)
+    recorded = analyses.get(MEASURED_SHA256_FIELD,
+                            pd.Series([""] * len(analyses), index=analyses.index))
+    own = measured_specimen_sha256(specimen)
+    other_file = recorded.map(lambda sha: same_tested_file(sha, own) is False)
     mine = analyses[(analyses["material"] == material)
-                    & named.fillna("").isin(["", measured_specimen_name(specimen)])]
+                    & named.fillna("").isin(["", measured_specimen_name(specimen)])
+                    & ~other_file.astype(bool)]
     subtracted = [float((stored_parameters(p) or {}).get("baseline_loss_factor") or 0.0)
                   for p in mine.get("parameters_json", pd.Series([None] * len(mine)))]
     without = sum(1 for value in subtracted if value == 0.0)

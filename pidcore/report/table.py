@@ -45,7 +45,7 @@ from ..compare.specimens import (
     runs_for_measurement,
 )
 from ..errors import ParameterError, instance_of
-from ..specimen import is_paper_coupon
+from ..specimen import MEASURED_SHA256_FIELD, deciding_sha256, hashed_name, is_paper_coupon
 from ..units import g_to_si
 
 #: Measured energy per cycle over the DEM case's E = m_c a^2 / (2 w^2) (Eq. 10): the like-for-like
@@ -61,6 +61,11 @@ CONSISTENCY_COLUMN = "measured chi2/dof [-]"
 #: Column holding the alignment status; the header lists its values,
 #: :data:`pidcore.compare.ALIGNMENT_STATUSES`.
 ALIGNMENT_COLUMN = f"alignment [{'/'.join(ALIGNMENT_STATUSES)}]"
+#: The sha256 of the specimen file a row's measurements recorded (``specimen_sha256``): empty
+#: where they recorded only its name (saved without a specimen file, or by an older pidcore)
+#: and for the paper's coupon (one coupon of either table material): matched by name. Two
+#: files of one name get rows of their own.
+SPECIMEN_SHA256_COLUMN = "specimen sha256"
 #: Columns of :func:`build_report_table`, in order.
 REPORT_COLUMNS: tuple[str, ...] = (
     "frequency [Hz]", "acceleration [g]", "packing ratio [%]", "material", "direction",
@@ -70,7 +75,7 @@ REPORT_COLUMNS: tuple[str, ...] = (
     "SDC DEM (paper) [-]",
     "SDC measured (paper) [-]",
     "difference ours - paper DEM [-]", DIFFERENCE_COLUMN, CONSISTENCY_COLUMN, ALIGNMENT_COLUMN,
-    "DEM settings", "specimen", "source file(s)", "load case", "note",
+    "DEM settings", "specimen", SPECIMEN_SHA256_COLUMN, "source file(s)", "load case", "note",
 )
 #: Columns an analyses table needs (as :meth:`pidcore.store.Store.list_analyses` gives, with the
 #: load case fields the report pipeline stores in each record).
@@ -106,6 +111,7 @@ class _Row:
     measured: list[_Measured] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
     specimen: str | None = None  # None: no measurement claimed the row yet
+    specimen_sha256: str = ""  # of the file its measurements recorded ("" : by name)
     unconverged_nodes: tuple[str, ...] = ()  # interpolated from runs that did not converge
 
 
@@ -271,17 +277,20 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
             _Row(dem.load_case, "grid", dem, dem.sdc, dem.sdc_stderr, paper_dem, paper_exp))
     # a measurement meets only the DEM runs of its specimen (pidcore.compare.specimens); one
     # aligner per (specimen, material, direction) over those runs
-    aligners: dict[tuple[str, str, str], tuple[Aligner, str, bool, str]] = {}
+    aligners: dict[tuple[str, str, str, str], tuple[Aligner, str, bool, str]] = {}
     for case, rec in measured_rows:
         # a store's listing holds NaN where a record names no specimen and another does
         # (str(NaN) is "nan", a specimen of its own meeting no DEM run)
         named = rec.get("specimen", "")
         specimen = "" if pool or not isinstance(named, str) else named
+        # its file's hash where it decides ("" for a record saved before it was, or without
+        # a file, and for the paper's coupon, one coupon of either material: by name)
+        sha256 = deciding_sha256(rec.get(MEASURED_SHA256_FIELD, "")) if specimen else ""
         met_note, refused, met_calibrated = "", False, ""
         if pool or dem_runs is None or dem_runs.empty:
             own = aligner
         else:
-            which = (specimen, case.material, case.direction)
+            which = (specimen, case.material, case.direction, sha256)
             if which not in aligners:
                 met = runs_for_measurement(dem_runs, *which)
                 # the row's specimen column names the test's specimen: say whose runs it met
@@ -299,8 +308,13 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
             # name whose runs are missing and whose the store holds there instead: another
             # specimen's, never compared with this measurement ("of ours" alone misled when a
             # row of those runs stood just above)
+            # the test's file by name and hash where it recorded one: "no DEM runs of
+            # panel" beside a store of panel's runs named no difference
+            shown = specimen
+            if specimen and not specimen.endswith("]") and sha256:
+                shown = hashed_name(specimen, sha256)
             aligned = replace(aligned, message=no_runs_note(
-                specimen or of_specimen, case.material, case.direction,
+                shown or of_specimen, case.material, case.direction,
                 dem_runs if store_runs is None else store_runs, choose_another,
                 named=bool(specimen), report_of=of_specimen))
             met_note = ""
@@ -327,7 +341,9 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
             # values (and the paper's measurement) as if they were that coupon's
             paper_values = (aligned.sdc_paper_dem, aligned.sdc_paper_experimental)
             not_paper = []
-            # by name only: a measurement records its specimen's name, not the file's hash
+            # by name, even where the record saved its file's hash: a test of another file of
+            # the coupon's name is saved as "paper_coupon [45d792]", and a calibrated file of
+            # the coupon (another hash) is a model of the coupon tested
             if not is_paper_coupon(specimen) and np.isfinite(paper_values).any():
                 paper_values = (math.nan, math.nan)
                 not_paper = [NOT_PAPER_SPECIMEN_NOTE.format(name=specimen)]
@@ -335,7 +351,9 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
                         *paper_values,
                         notes=[aligned.message] + ([met_note] if met_note else []) + not_paper,
                         unconverged_nodes=aligned.unconverged_nodes)
-        row = next((r for r in group if r.dem is base.dem and r.specimen == specimen), None)
+        # two files of one name are two specimens: their tests are not pooled
+        row = next((r for r in group if r.dem is base.dem and r.specimen == specimen
+                    and r.specimen_sha256 == sha256), None)
         if row is None:
             row = next((r for r in group if r.dem is base.dem and r.specimen is None), None)
         if row is None:  # another specimen at this case: a row of its own beside the DEM's
@@ -343,7 +361,7 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
                        base.paper_dem, base.paper_exp, notes=list(base.notes),
                        unconverged_nodes=base.unconverged_nodes)
             group.append(row)
-        row.specimen = specimen
+        row.specimen, row.specimen_sha256 = specimen, sha256
         row.measured.append(entry)
         if met_calibrated and aligned.status in ("grid", "interpolated") \
                 and met_calibrated not in row.notes:
@@ -424,6 +442,7 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
             ALIGNMENT_COLUMN: row.status,
             "DEM settings": row.dem.settings if row.dem else "",
             "specimen": row.specimen or "",
+            SPECIMEN_SHA256_COLUMN: row.specimen_sha256,
             "source file(s)": sources,
             "load case": lc.key,
             "note": "; ".join(note),
@@ -496,6 +515,7 @@ def _sort_like_table3(table: pd.DataFrame, aligner: Aligner, paper: pd.DataFrame
         "fx": table["frequency [Hz]"], "ax": table["acceleration [g]"],
         "px": table["packing ratio [%]"], "m": table["material"], "d": table["direction"],
         "s": table["DEM settings"], "sp": table["specimen"],
+        "sh": table[SPECIMEN_SHA256_COLUMN],
     })
     order = keys.sort_values(list(keys.columns), kind="stable").index
     return table.loc[order].reset_index(drop=True)
@@ -574,6 +594,11 @@ def add_calibration_columns(table: pd.DataFrame, calibration, *,
                 of_row = paper_specimen(case.material)
             reasons[case.material] = calibration.other_specimen_reason(of_row)
         other = reasons[case.material]
+        if not other:
+            # the row's tests recorded their specimen file: a calibration of another file of
+            # that name (an edited x.toml) does not predict them
+            other = calibration.other_file_reason(row.get(SPECIMEN_SHA256_COLUMN, ""),
+                                                  str(row.get("specimen", "") or ""))
         hit = None if other else calibration.lookup(case, tolerances=tolerances)
         if hit is None:
             sdc.append(math.nan)

@@ -48,25 +48,30 @@ def _entries(stores, session_files):
 
 
 def _group_key(members) -> str:
-    return "|".join(f"{e.key}:{e.load_case.key}:{e.specimen}:{e.sdc!r}" for e in members)
+    return "|".join(f"{e.key}:{e.load_case.key}:{e.specimen}:{e.specimen_sha256}:{e.sdc!r}"
+                    for e in members)
 
 
-def _calibrated(calibrations, comp, head, specimen: str, *, implausible: bool = False) -> None:
+def _calibrated(calibrations, comp, head, specimen: str, *, implausible: bool = False,
+                specimen_sha256: str = "") -> None:
     """The calibrated DEM's Eq. 11 SDC with its 95 % band beside the raw DEM and the measured
     Eq. 11 SDC (like for like: the calibration predicts what a shaker test of the DEM would
     measure with Eq. 11). ``calibrations``: [(calibration or None, label)], see :func:`render`;
     the first that predicts the case is shown (a calibration of one specimen does not hide
-    another's), of those that speak for the measurement's ``specimen`` ("": not named)."""
+    another's), of those that speak for the measurement's ``specimen`` ("": not named) and
+    its file (``specimen_sha256``: a calibration of another file of that name is not its)."""
     usable = [(c, label) for c, label in calibrations if c is not None]
     for c, reason in calibrations:
         if c is None:  # none at all, or one that cannot be read
             st.caption(reason)
     if not usable:
         return
-    mine = [(c, label) for c, label in usable if c.speaks_for(specimen)]
+    mine = [(c, label) for c, label in usable if c.speaks_for(specimen, specimen_sha256)]
     if not mine:  # the report refuses another specimen's calibration too
+        reasons = [c.other_file_reason(specimen_sha256, specimen) for c, _ in usable]
         st.caption(f"No calibration is of specimen {specimen}: "
-                   + "; ".join(label for _, label in usable) + ".")
+                   + "; ".join(label + (f" ({why})" if why else "")
+                               for (_, label), why in zip(usable, reasons, strict=True)) + ".")
         return
     usable = mine
     hits = [(c, label, c.lookup(comp.load_case)) for c, label in usable]
@@ -179,7 +184,8 @@ def render(stores, session_files: list, calibrations: list) -> None:
         c2.metric("SDC paper DEM [-]", display_number(aligned.sdc_paper_dem, missing="none"))
         c3.metric("SDC paper measured [-]",
                   display_number(aligned.sdc_paper_experimental, missing="none"))
-        # by name only: a measurement records its specimen's name, not the file's hash
+        # by name: a test of another file of the coupon's name is saved as "paper_coupon
+        # [45d792]" (measured_specimen_name), which is not the paper's
         if not is_paper_coupon(members[0].specimen):
             # Table 3 may well have this case: its values are of another coupon
             st.caption("paper: none: " + NOT_PAPER_SPECIMEN_NOTE.format(
@@ -190,7 +196,8 @@ def render(stores, session_files: list, calibrations: list) -> None:
                        "the paper's coupon, acrylic spheres driven along z, at its grid of "
                        "load cases)")
     _calibrated(calibrations, comp, head, members[0].specimen,
-                implausible=any(e.implausible for e in members))
+                implausible=any(e.implausible for e in members),
+                specimen_sha256=members[0].specimen_sha256)
     for note in view["notes"]:
         st.caption(f"note: {note}")
     left, right = st.columns(2)
