@@ -764,6 +764,7 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         if files:  # their analyses are added to it
             main.check_writable()
     from ..compare.plausibility import plausibility_notes, stored_plausibility_notes
+    from ..file_settings import assumed, assumption_notes
 
     options = options or AnalysisOptions()
     results = analyze_files(
@@ -779,6 +780,8 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         said = r.settings.summary() if r.settings is not None else ""
         notes.append(f"{display_path(r.path.name)}: load case {r.load_case.key} ({r.stated.origin})"
                      + (f"; {said}" if said else ""))
+        notes.extend(assumption_notes(display_path(r.path.name), assumed(
+            r.stated, r.settings.specimen if r.settings is not None else "", specimen)))
         # what the plausibility checks found (a result kept as asked, or zero within noise)
         notes.extend(f"{display_path(r.path.name)}: {n}"
                      for n in plausibility_notes(r.analyzed.analysis))
