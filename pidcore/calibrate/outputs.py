@@ -47,6 +47,19 @@ def specimen_text(result: CalibrationResult) -> str:
     return "\n".join(lines) + "\n" + result.calibrated_specimen().to_toml()
 
 
+def _band_text(low: float, high: float, sdc) -> str:
+    """A 95 % band as the summary shows it: an upper bound past 2 pi (an SDC no measurement is
+    kept at: :data:`pidcore.compare.plausibility.SDC_UPPER_BOUND`) is cut there and says the
+    model's own bound, as the report and the app cut it
+    (:meth:`pidcore.calibrate.prediction.CalibratedPrediction.band`)."""
+    from ..compare.plausibility import SDC_UPPER_BOUND
+
+    if high > SDC_UPPER_BOUND:
+        return (f"{sdc(min(low, SDC_UPPER_BOUND))} .. {sdc(SDC_UPPER_BOUND)} (cut at 2 pi; "
+                f"model {high:.3g}: unconstrained)")
+    return f"{sdc(low)} .. {sdc(high)}"
+
+
 def _table_rows(rows: list[dict]) -> list[list[str]]:
     def sdc(value: float) -> str:  # three decimals; a small SDC keeps its digits, not 0.000
         return display_number(value, decimals=3)
@@ -56,7 +69,7 @@ def _table_rows(rows: list[dict]) -> list[list[str]]:
         error = r["predicted"] - r["measured"]
         out.append([f"{r['frequency_hz']:g}", f"{r['acceleration_g']:g}",
                     f"{r['fill_percent']:g}", sdc(r["measured"]), sdc(r["predicted"]),
-                    f"{sdc(r['low95'])} .. {sdc(r['high95'])}",
+                    _band_text(r["low95"], r["high95"], sdc),
                     ("+" if error >= 0 else "") + sdc(error),
                     "yes" if r["low95"] <= r["measured"] <= r["high95"] else "**no**"])
     return out

@@ -565,6 +565,7 @@ def add_calibration_columns(table: pd.DataFrame, calibration, *,
     reasons: dict[str, str] = {}  # per material: why the calibration is of another specimen
     for _, row in out.iterrows():
         note = str(row.get("note", "") or "")
+        cut = ""  # a band reaching past 2 pi, said where it is cut
         case = LoadCase(float(row["frequency [Hz]"]), float(row["acceleration [g]"]),
                         float(row["packing ratio [%]"]),
                         str(row.get("material") or defaults.COMPARE_DEFAULT_MATERIAL))
@@ -600,6 +601,8 @@ def add_calibration_columns(table: pd.DataFrame, calibration, *,
             sdc.append(hit.sdc)
             low.append(band[0])
             high.append(band[1])
+            cut = "" if extra else hit.band_note(stderr if math.isfinite(measured)
+                                                 else math.nan, dof)
             if extra:
                 inside.append(NOT_COMPARED)
             elif not math.isfinite(measured):
@@ -612,7 +615,7 @@ def add_calibration_columns(table: pd.DataFrame, calibration, *,
                 inside.append(NOT_COMPARED)
                 extra = "so not compared with the calibrated band"
             else:
-                if band != (hit.low95, hit.high95):
+                if band != hit.band():
                     # "(the calibration's point at this load case: 0)" read as a point
                     # numbered 0, or an SDC of 0: it is the stderr of the fitted point
                     extra = (f"calibrated band for this measurement's SDC stderr {stderr:.3g} "
@@ -620,7 +623,7 @@ def add_calibration_columns(table: pd.DataFrame, calibration, *,
                              f"stderr {hit.measured_stderr:.3g}); its 95 % widening: "
                              f"{quantile_label(dof)}")
                 inside.append("yes" if band[0] <= measured <= band[1] else "no")
-        notes.append("; ".join(n for n in (note, extra) if n))
+        notes.append("; ".join(n for n in (note, extra, cut) if n))
     at = list(out.columns).index("SDC measured [-]") + 1 if "SDC measured [-]" in out.columns \
         else len(out.columns)
     for offset, (name, values) in enumerate(zip(CALIBRATION_COLUMNS, (sdc, low, high, inside),
