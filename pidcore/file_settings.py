@@ -71,7 +71,7 @@ __all__ = ["ANALYSIS_COLUMNS", "ANALYSIS_SETTINGS_COLUMNS", "AUTO_CHANNEL", "FRE
            "NO_CHANNEL",
            "SETTINGS_COLUMNS", "SPECIMEN_COLUMN", "FileSettings", "SettingsColumn",
            "analysis_overrides", "analyze_with_settings", "assumed", "assumption_notes",
-           "check_columns",
+           "check_columns", "stored_assumption_notes",
            "resolve_file_settings", "resolve_files", "setting_in_words"]
 
 
@@ -652,4 +652,34 @@ def assumption_notes(name: str, assumptions: Mapping[str, str]) -> list[str]:
                      f"({assumptions[SPECIMEN_COLUMN]}) assumed: reports and calibrations "
                      "compare it with that coupon's DEM runs; name another with specimen=FILE "
                      "or a sidecar's specimen column")
+    return notes
+
+
+def stored_assumption_notes(analyses: pd.DataFrame) -> list[str]:
+    """:func:`assumed` of stored analysis records (a store's listing: ``source``,
+    ``material``, ``load_case_origin``, ``specimen``), one note per assumption naming the
+    records' files: a report of a store said nothing of the acrylic and the coupon that
+    ``pidcore analyze`` had assumed for them."""
+    from collections import defaultdict
+
+    by_assumption: dict[tuple[str, str], list[str]] = defaultdict(list)
+    for _, record in analyses.iterrows():
+        origin, material = record.get("load_case_origin"), record.get("material")
+        stated = (StatedLoadCase(math.nan, material, "", origin)
+                  if isinstance(origin, str) and isinstance(material, str) else None)
+        specimen = record.get("specimen")
+        found = assumed(stated, specimen if isinstance(specimen, str) else "")
+        name = display_path(Path(str(record.get("source", "") or record.get("key", ""))).name)
+        for what in ("material", SPECIMEN_COLUMN):
+            if what in found:
+                by_assumption[(what, found[what])].append(name)
+    notes = []
+    for (what, value), names in by_assumption.items():
+        shown = ", ".join(names[:5]) + (f" and {len(names) - 5} more" if len(names) > 5 else "")
+        if what == "material":
+            notes.append(f"{len(names)} stored measurement(s) state no particle material, "
+                         f"{value} assumed (the paper's coupon's particles): {shown}")
+        else:
+            notes.append(f"{len(names)} stored measurement(s) name no specimen, the paper's "
+                         f"coupon ({value}) assumed: {shown}")
     return notes

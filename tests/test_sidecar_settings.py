@@ -419,6 +419,24 @@ def test_report_notes_say_which_material_and_specimen_were_assumed(tmp_path):
         (tmp_path / "rep" / "report.provenance.txt").read_text(encoding="utf-8")
 
 
+def test_a_report_of_a_store_says_what_analyze_assumed_for_its_records(tmp_path, capsys):
+    from pidcore.report import make_report
+
+    a = export(tmp_path / "a_fill50.csv", seed=1)
+    b = export(tmp_path / "b_fill50.csv", seed=2)
+    sidecar(tmp_path, "file,fill_percent,material,specimen\na_fill50.csv,50,,\n"
+                      "b_fill50.csv,50,acrylic,coupon_B\n")
+    store = tmp_path / "s.h5"
+    assert main(["analyze", str(a), str(b), "--store", str(store)]) == 0
+    capsys.readouterr()
+    result = make_report([], out_dir=tmp_path / "rep", store=store, formats="csv")
+    # a: neither stated; b: its sidecar stated both
+    assert "1 stored measurement(s) state no particle material, acrylic assumed (the paper's " \
+           "coupon's particles): a_fill50.csv" in result.notes
+    assert "1 stored measurement(s) name no specimen, the paper's coupon (paper_coupon) " \
+           "assumed: a_fill50.csv" in result.notes
+
+
 # --- one table for the CLI and the app ------------------------------------------------------------
 
 def test_the_app_and_the_cli_know_the_same_columns_and_parse_them_alike():

@@ -764,7 +764,7 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         if files:  # their analyses are added to it
             main.check_writable()
     from ..compare.plausibility import plausibility_notes, stored_plausibility_notes
-    from ..file_settings import assumed, assumption_notes
+    from ..file_settings import assumed, assumption_notes, stored_assumption_notes
 
     options = options or AnalysisOptions()
     results = analyze_files(
@@ -816,6 +816,8 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
     elif main is not None:
         listed = main.list_analyses()
         analyses = latest_per_measurement(listed)
+        # what analyze assumed for them (the paper's acrylic, its coupon) is said again here
+        notes.extend(stored_assumption_notes(analyses))
         # a stored result kept as implausible is said again here, as when it was saved
         for _, record in analyses.iterrows():
             name = Path(str(record.get("source", "") or record["key"])).name
