@@ -555,3 +555,16 @@ def test_the_calibrate_summary_cuts_a_band_past_two_pi():
 
     assert _band_text(0.5, 12.7, sdc) == "0.500 .. 6.283 (cut at 2 pi; model 12.7: unconstrained)"
     assert _band_text(0.12, 0.88, sdc) == "0.120 .. 0.880"
+
+
+def test_the_calibrate_plot_cuts_a_band_past_two_pi():
+    from pidcore.calibrate.outputs import shown_band_bars
+
+    rows = [{"predicted": 3.0, "low95": 0.5, "high95": 12.7},
+            {"predicted": 0.49, "low95": 0.12, "high95": 0.88}]
+    pred, below, above, cut = shown_band_bars(rows)
+    assert cut and pred.tolist() == [3.0, 0.49]
+    # bars end at 2 pi and at the band's own bounds (0.88 - 0.49 exactly as subtracted)
+    assert above.tolist() == [2 * math.pi - 3.0, 0.88 - 0.49]
+    assert below.tolist() == [2.5, 0.49 - 0.12]
+    assert not shown_band_bars(rows[1:])[3]
