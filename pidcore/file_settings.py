@@ -70,7 +70,8 @@ if TYPE_CHECKING:
 __all__ = ["ANALYSIS_COLUMNS", "ANALYSIS_SETTINGS_COLUMNS", "AUTO_CHANNEL", "FREE_TEXT_COLUMNS",
            "NO_CHANNEL",
            "SETTINGS_COLUMNS", "SPECIMEN_COLUMN", "FileSettings", "SettingsColumn",
-           "analysis_overrides", "analyze_with_settings", "check_columns",
+           "analysis_overrides", "analyze_with_settings", "assumed", "assumption_notes",
+           "check_columns", "stored_assumption_notes",
            "resolve_file_settings", "resolve_files", "setting_in_words"]
 
 
@@ -616,3 +617,90 @@ def resolve_files(paths: Sequence[str | os.PathLike], *, options: AnalysisOption
             fs = replace(fs, specimen_sha256=sha256)
         settings.append(fs)
     return stated, settings
+
+
+#: A material name in :data:`StatedLoadCase.origin` that nothing stated (the paper's acrylic).
+_DEFAULT_ORIGIN = "material: default"
+
+
+def assumed(stated: StatedLoadCase | None, specimen: str,
+            specimen_given: Specimen | None = None) -> dict[str, str]:
+    """What a measurement file takes from no statement, by field: ``{"material": "acrylic",
+    "specimen": "paper_coupon"}`` for a file that names neither (``{}`` when both are stated).
+
+    An unnamed measurement is the paper's coupon to ``pidcore report``, ``calibrate`` and the
+    app's Compare; nylon beads analysed without ``specimen=FILE`` were saved as that coupon's
+    acrylic and the output said only "material: default", so the front ends say it in words
+    (:func:`assumption_notes`). ``specimen``: the name saved with the file ("" for none:
+    :attr:`FileSettings.specimen`); ``specimen_given``: ``specimen=FILE``, whose particles a
+    file of another named specimen (a sidecar's ``coupon_B``) takes where nothing states its
+    own (``"material_from"``: the name of ``specimen_given``). A file without a stated fill has no
+    load case, hence no material: only its specimen is assumed.
+    """
+    from .specimen import PAPER_SPECIMEN_NAME
+
+    found: dict[str, str] = {}
+    said = next((part for part in stated.origin.split("; ") if part.startswith("material:")),
+                "") if stated is not None else ""
+    if said == _DEFAULT_ORIGIN:
+        found["material"] = stated.material
+    elif said == "material: specimen" and specimen_given is not None and specimen:
+        from .specimen import measured_specimen_name
+
+        if specimen not in (specimen_given.name, measured_specimen_name(specimen_given)):
+            found["material"] = stated.material
+            found["material_from"] = specimen_given.name
+    if not specimen:
+        found[SPECIMEN_COLUMN] = PAPER_SPECIMEN_NAME
+    return found
+
+
+def assumption_notes(name: str, assumptions: Mapping[str, str]) -> list[str]:
+    """:func:`assumed` in words, one line each, naming the file ``name`` and how to state the
+    value (library keywords: the CLI names its flags, :func:`pidcore.cli._vocabulary.cli_words`)."""
+    notes = []
+    if "material_from" in assumptions:
+        notes.append(f"{name}: particle material not stated, {assumptions['material']} assumed "
+                     f"(those of specimen {assumptions['material_from']!r}, specimen=, although "
+                     "the file names another specimen); if its particles are others, state "
+                     "them with material=NAME or a sidecar's material column")
+    elif "material" in assumptions:
+        notes.append(f"{name}: particle material not stated, {assumptions['material']} assumed "
+                     "(the paper's coupon's particles); if they are others, state them with "
+                     "material=NAME, a sidecar's material column or specimen=FILE")
+    if SPECIMEN_COLUMN in assumptions:
+        notes.append(f"{name}: no specimen named, the paper's coupon "
+                     f"({assumptions[SPECIMEN_COLUMN]}) assumed: reports and calibrations "
+                     "compare it with that coupon's DEM runs; name another with specimen=FILE "
+                     "or a sidecar's specimen column")
+    return notes
+
+
+def stored_assumption_notes(analyses: pd.DataFrame) -> list[str]:
+    """:func:`assumed` of stored analysis records (a store's listing: ``source``,
+    ``material``, ``load_case_origin``, ``specimen``), one note per assumption naming the
+    records' files: a report of a store said nothing of the acrylic and the coupon that
+    ``pidcore analyze`` had assumed for them."""
+    from collections import defaultdict
+
+    by_assumption: dict[tuple[str, str], list[str]] = defaultdict(list)
+    for _, record in analyses.iterrows():
+        origin, material = record.get("load_case_origin"), record.get("material")
+        stated = (StatedLoadCase(math.nan, material, "", origin)
+                  if isinstance(origin, str) and isinstance(material, str) else None)
+        specimen = record.get("specimen")
+        found = assumed(stated, specimen if isinstance(specimen, str) else "")
+        name = display_path(Path(str(record.get("source", "") or record.get("key", ""))).name)
+        for what in ("material", SPECIMEN_COLUMN):
+            if what in found:
+                by_assumption[(what, found[what])].append(name)
+    notes = []
+    for (what, value), names in by_assumption.items():
+        shown = ", ".join(names[:5]) + (f" and {len(names) - 5} more" if len(names) > 5 else "")
+        if what == "material":
+            notes.append(f"{len(names)} stored measurement(s) state no particle material, "
+                         f"{value} assumed (the paper's coupon's particles): {shown}")
+        else:
+            notes.append(f"{len(names)} stored measurement(s) name no specimen, the paper's "
+                         f"coupon ({value}) assumed: {shown}")
+    return notes

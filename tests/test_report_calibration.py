@@ -14,7 +14,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from pidcore.calibrate.prediction import load_calibration
+from pidcore.calibrate.prediction import Z95, load_calibration
 from pidcore.cli import main
 from pidcore.compare import Tolerances
 from pidcore.errors import ParameterError
@@ -516,3 +516,66 @@ def test_a_calibration_made_from_an_earlier_version_of_the_specimen_file_says_so
     for same in (steel, Specimen.from_text(calibrated)):
         assert add_calibration_columns(rows, cal, specimen=same)[CALIBRATED_COLUMN].iloc[0] \
             == 0.09  # copied from calibration.json: no tolerance
+
+
+# --- a band past 2 pi is cut there and said ------------------------------------------------------
+
+def test_a_band_past_two_pi_is_cut_there_with_a_note(tmp_path):
+    # a poorly constrained calibration: model discrepancy tau ~ 2 (its prior's top) at a model
+    # SDC of 3 gives 3 + 1.96 * 2 * 3 ~ 14.8 as the normal model's upper bound; a measurement
+    # above 2 pi is refused by `pidcore analyze` (plausibility.SDC_UPPER_BOUND), so the bound
+    # shown is 2 pi and a note carries the model's own 12.7
+    two_pi = 2 * math.pi
+    wide = {**_prediction(50, 5, 50, 3.0, 0.5, 12.7), "measured_stderr": 0.05,
+            "low95_without_stderr": 0.6, "high95_without_stderr": 12.6}
+    cal = load_calibration(_write(tmp_path / "calibration.json",
+                                  [wide, _prediction(500, 5, 50, 0.49, 0.12, 0.88)]))
+    hit = cal.lookup(LoadCase(50, 5, 50))
+    assert hit.band() == (0.5, two_pi) and hit.model_band() == (0.5, 12.7)
+    assert hit.contains(two_pi) and not hit.contains(two_pi + 1e-9)
+    note = hit.band_note()
+    assert note == ("calibrated 95 % band cut at 2 pi = 6.283 (a loss factor of 1, above which a "
+                    "measured SDC is refused as implausible); the model's own upper bound 12.7 "
+                    "says the calibration does not constrain the SDC here (its model discrepancy "
+                    "and surrogate scatter dominate)")
+    # another measurement's stderr widens the model's band (hypot(12.6 - 3, z 0.5)), and
+    # the cut applies to it too
+    assert hit.model_band(0.5)[1] == pytest.approx(3 + math.hypot(9.6, Z95 * 0.5), rel=1e-12)
+    assert hit.band(0.5)[1] == two_pi and "12.7" not in hit.band_note(0.5)
+    # a band under the bound: untouched, no note
+    low = cal.lookup(LoadCase(500, 5, 50))
+    assert low.band() == (0.12, 0.88) and low.band_note() == ""
+    # the report's row shows the cut bound and says why; the fitted point's own stderr is
+    # not mistaken for another measurement's
+    table = pd.DataFrame({
+        "frequency [Hz]": [50.0, 500.0], "acceleration [g]": [5.0, 5.0],
+        "packing ratio [%]": [50.0, 50.0], "material": ["acrylic", "acrylic"],
+        "SDC measured [-]": [3.2, 0.5], "SDC measured stderr [-]": [0.05, 0.01],
+        "note": ["", ""]})
+    out = add_calibration_columns(table, cal)
+    assert out[CALIBRATED_HIGH_COLUMN].tolist() == [two_pi, 0.88]
+    assert out["note"].iloc[0] == note and out["note"].iloc[1].count("cut at 2 pi") == 0
+    assert out[CALIBRATED_INSIDE_COLUMN].tolist() == ["yes", "yes"]
+
+
+def test_the_calibrate_summary_cuts_a_band_past_two_pi():
+    from pidcore.calibrate.outputs import _band_text
+
+    def sdc(value):
+        return f"{value:.3f}"
+
+    assert _band_text(0.5, 12.7, sdc) == "0.500 .. 6.283 (cut at 2 pi; model 12.7: unconstrained)"
+    assert _band_text(0.12, 0.88, sdc) == "0.120 .. 0.880"
+
+
+def test_the_calibrate_plot_cuts_a_band_past_two_pi():
+    from pidcore.calibrate.outputs import shown_band_bars
+
+    rows = [{"predicted": 3.0, "low95": 0.5, "high95": 12.7},
+            {"predicted": 0.49, "low95": 0.12, "high95": 0.88}]
+    pred, below, above, cut = shown_band_bars(rows)
+    assert cut and pred.tolist() == [3.0, 0.49]
+    # bars end at 2 pi and at the band's own bounds (0.88 - 0.49 exactly as subtracted)
+    assert above.tolist() == [2 * math.pi - 3.0, 0.88 - 0.49]
+    assert below.tolist() == [2.5, 0.49 - 0.12]
+    assert not shown_band_bars(rows[1:])[3]

@@ -348,3 +348,72 @@ def test_an_interpolated_sdc_resting_on_a_run_that_did_not_converge_says_so():
                if n.startswith("2 row(s) rest on DEM runs that did not converge")]
     assert said.endswith("the transient: 100 Hz, 5 g, 50 %; 70 Hz, 3 g, 40 % (interpolated "
                          "from 100 Hz, 5 g, 50 %)"), said
+
+
+# --- an interpolated row's particle count and m_c ------------------------------------------------
+
+def _runs_of(specimen_text: str, **settings) -> pd.DataFrame:
+    """The 8 grid runs of :func:`_dem_items` as a listing with what a DEM run stores: the
+    specimen file and the fill reference and vibrated-mass convention it ran with."""
+    import json
+
+    rows = []
+    for item in _dem_items():
+        rec = dict(item["record"])
+        rec.update({"case_key": item["case_key"], "fill_reference": "capacity",
+                    "vibrated_mass_convention": "coupon_plus_particles", **settings,
+                    "parameters_json": json.dumps({"specimen_text": specimen_text})})
+        rows.append(rec)
+    return pd.DataFrame(rows)
+
+
+def _off_grid_analysis(energy_per_cycle_j: float) -> pd.DataFrame:
+    # 70 Hz, 3 g, 40 %: inside the 50-100 Hz, 1-5 g, 25-50 % grid, on no grid point
+    return pd.DataFrame([{"frequency_hz": 70.0, "acceleration_g": 3.0, "fill_percent": 40.0,
+                          "material": "acrylic", "direction": "z", "sdc": 0.25,
+                          "sdc_stderr": 0.01, "energy_per_cycle_j": energy_per_cycle_j,
+                          "source": "off_grid_fill40.csv"}])
+
+
+def test_an_interpolated_row_gets_the_count_and_eq10_sdc_of_its_specimen_and_fill():
+    from pidcore.specimen import paper_specimen
+
+    runs = _runs_of(paper_specimen("acrylic").to_toml())
+    energy = 3.0e-6  # J per cycle, measured
+    table = build_report_table(runs, _off_grid_analysis(energy), None)
+    row = table[table["source file(s)"] == "off_grid_fill40.csv"].iloc[0]
+    assert row[ALIGNMENT_COLUMN] == "interpolated"
+    # by hand: the paper's coupon holds 22 acrylic spheres (r 1.25 mm) per cell at 100 %
+    # ("capacity"), so 40 % is round(8.8) = 9 per cell; m_c = coupon 22.1534 g + 441 cells x
+    # 9 x (4/3 pi r^3 1180 kg/m^3); E = m_c a^2 / (2 w^2) (Eq. 10); SDC = dE / E
+    assert row["particles per cell [-]"] == 9
+    sphere = 4.0 / 3.0 * math.pi * 1.25e-3**3 * 1180.0
+    m_c = 0.0221534 + 441 * 9 * sphere
+    omega, accel = 2 * math.pi * 70.0, 3.0 * 9.80665
+    expected = energy / (m_c * accel**2 / (2 * omega**2))
+    # the coupon's 22.1534 g is written to 7 digits in the paper's specimen file's sum of
+    # face sheets and core (22.153400000000004): relative 1e-9 holds any such rounding
+    assert row["SDC measured, E of Eq. 10 [-]"] == pytest.approx(expected, rel=1e-9)
+    assert row[DIFFERENCE_COLUMN] == pytest.approx(expected - row["SDC DEM (ours) [-]"],
+                                                   rel=1e-12)
+    assert "no DEM m_c" not in row["note"]
+
+
+def test_an_interpolated_row_without_one_specimen_or_convention_says_why():
+    from pidcore.specimen import paper_specimen
+
+    text = paper_specimen("acrylic").to_toml()
+    mixed = _runs_of(text)
+    mixed.loc[0, "vibrated_mass_convention"] = "coupon"
+    row = build_report_table(mixed, _off_grid_analysis(3.0e-6), None)
+    row = row[row["source file(s)"] == "off_grid_fill40.csv"].iloc[0]
+    assert pd.isna(row["particles per cell [-]"])
+    assert math.isnan(row["SDC measured, E of Eq. 10 [-]"])
+    assert ("no DEM m_c: no like-for-like difference (its DEM runs do not share one vibrated "
+            "mass convention)") in row["note"]
+    # runs that stored no specimen file (the older stores, the fixture above): no guess
+    bare = _runs_of(text).drop(columns=["parameters_json"])
+    row = build_report_table(bare, _off_grid_analysis(3.0e-6), None)
+    row = row[row["source file(s)"] == "off_grid_fill40.csv"].iloc[0]
+    assert pd.isna(row["particles per cell [-]"])
+    assert "(its DEM runs do not record one specimen file" in row["note"]

@@ -353,6 +353,90 @@ def test_report_keeps_a_sidecar_specimen_beside_specimen_and_says_so(tmp_path):
     assert by_file[str(a)] == "coupon_B" and by_file[str(b)] == "steel_6mm"
 
 
+# --- what no statement gave is said -------------------------------------------------------------
+
+MATERIAL_ASSUMED = ("{name}: particle material not stated, acrylic assumed (the paper's coupon's "
+                    "particles); if they are others, state them with --material NAME, a "
+                    "sidecar's material column or --specimen FILE")
+SPECIMEN_ASSUMED = ("{name}: no specimen named, the paper's coupon (paper_coupon) assumed: "
+                    "reports and calibrations compare it with that coupon's DEM runs; name "
+                    "another with --specimen FILE or a sidecar's specimen column")
+
+
+def test_analyze_says_which_material_and_specimen_it_assumed(tmp_path, capsys):
+    # nylon beads analysed without --specimen were saved as the paper's acrylic while the
+    # output said only "material: default" (a file name saying "nylon" is refused already)
+    path = export(tmp_path / "bead_run_fill50.csv")
+    assert main(["analyze", str(path), "--no-store"]) == 0
+    out = capsys.readouterr().out.splitlines()
+    name = path.name
+    assert f"note: {MATERIAL_ASSUMED.format(name=name)}" in out
+    assert f"note: {SPECIMEN_ASSUMED.format(name=name)}" in out
+    (rec,) = run_json([str(path), "--no-store"], capsys)["records"]
+    assert rec["assumed"] == {"material": "acrylic", "specimen": "paper_coupon"}
+    assert rec["load_case"].endswith("_acrylic_z")
+    assert MATERIAL_ASSUMED.format(name=name) in rec["notes"]
+    # the specimen's particles and name, given: nothing assumed, nothing said
+    steel = SAMPLES / "specimens" / "steel_6mm.toml"
+    (rec,) = run_json([str(path), "--no-store", "--specimen", str(steel)], capsys)["records"]
+    assert rec["assumed"] == {} and rec["load_case"].endswith("_steel_z")
+    assert not any("assumed" in n for n in rec["notes"])
+    # a sidecar stating the material leaves only the unnamed specimen assumed
+    sidecar(tmp_path, "file,fill_percent,material\nbead_run_fill50.csv,50,acrylic\n")
+    (rec,) = run_json([str(path), "--no-store"], capsys)["records"]
+    assert rec["assumed"] == {"specimen": "paper_coupon"}
+    assert [n for n in rec["notes"] if "assumed" in n] == [SPECIMEN_ASSUMED.format(name=name)]
+
+
+def test_another_specimen_s_row_taking_the_given_specimen_s_particles_is_said(tmp_path,
+                                                                             capsys):
+    # a row naming coupon_B with no material takes the --specimen's steel: not coupon_B's own
+    path = export(tmp_path / "a_fill50.csv")
+    sidecar(tmp_path, "file,fill_percent,specimen\na_fill50.csv,50,coupon_B\n")
+    steel = SAMPLES / "specimens" / "steel_6mm.toml"
+    (rec,) = run_json([str(path), "--no-store", "--specimen", str(steel)], capsys)["records"]
+    assert rec["assumed"] == {"material": "steel", "material_from": "steel_6mm"}
+    assert ("a_fill50.csv: particle material not stated, steel assumed (those of specimen "
+            "'steel_6mm', --specimen, although the file names another specimen); if its "
+            "particles are others, state them with --material NAME or a sidecar's material "
+            "column") in rec["notes"]
+
+
+def test_report_notes_say_which_material_and_specimen_were_assumed(tmp_path):
+    from pidcore.cli._vocabulary import cli_words
+    from pidcore.report import make_report
+
+    a = export(tmp_path / "a_fill50.csv", seed=1)
+    b = export(tmp_path / "b_fill50.csv", seed=2)
+    sidecar(tmp_path, "file,fill_percent,material,specimen\na_fill50.csv,50,,\n"
+                      "b_fill50.csv,50,acrylic,coupon_B\n")
+    result = make_report([a, b], out_dir=tmp_path / "rep", formats="csv")
+    said = [cli_words(n, "report") for n in result.notes if "assumed" in n]
+    assert said == [MATERIAL_ASSUMED.format(name="a_fill50.csv"),
+                    SPECIMEN_ASSUMED.format(name="a_fill50.csv")]
+    # and the notes file written beside the CSV carries them
+    assert "a_fill50.csv: particle material not stated, acrylic assumed" in \
+        (tmp_path / "rep" / "report.provenance.txt").read_text(encoding="utf-8")
+
+
+def test_a_report_of_a_store_says_what_analyze_assumed_for_its_records(tmp_path, capsys):
+    from pidcore.report import make_report
+
+    a = export(tmp_path / "a_fill50.csv", seed=1)
+    b = export(tmp_path / "b_fill50.csv", seed=2)
+    sidecar(tmp_path, "file,fill_percent,material,specimen\na_fill50.csv,50,,\n"
+                      "b_fill50.csv,50,acrylic,coupon_B\n")
+    store = tmp_path / "s.h5"
+    assert main(["analyze", str(a), str(b), "--store", str(store)]) == 0
+    capsys.readouterr()
+    result = make_report([], out_dir=tmp_path / "rep", store=store, formats="csv")
+    # a: neither stated; b: its sidecar stated both
+    assert "1 stored measurement(s) state no particle material, acrylic assumed (the paper's " \
+           "coupon's particles): a_fill50.csv" in result.notes
+    assert "1 stored measurement(s) name no specimen, the paper's coupon (paper_coupon) " \
+           "assumed: a_fill50.csv" in result.notes
+
+
 # --- one table for the CLI and the app ------------------------------------------------------------
 
 def test_the_app_and_the_cli_know_the_same_columns_and_parse_them_alike():

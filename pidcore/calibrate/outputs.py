@@ -47,6 +47,19 @@ def specimen_text(result: CalibrationResult) -> str:
     return "\n".join(lines) + "\n" + result.calibrated_specimen().to_toml()
 
 
+def _band_text(low: float, high: float, sdc) -> str:
+    """A 95 % band as the summary shows it: an upper bound past 2 pi (an SDC no measurement is
+    kept at: :data:`pidcore.compare.plausibility.SDC_UPPER_BOUND`) is cut there and says the
+    model's own bound, as the report and the app cut it
+    (:meth:`pidcore.calibrate.prediction.CalibratedPrediction.band`)."""
+    from ..compare.plausibility import SDC_UPPER_BOUND
+
+    if high > SDC_UPPER_BOUND:
+        return (f"{sdc(min(low, SDC_UPPER_BOUND))} .. {sdc(SDC_UPPER_BOUND)} (cut at 2 pi; "
+                f"model {high:.3g}: unconstrained)")
+    return f"{sdc(low)} .. {sdc(high)}"
+
+
 def _table_rows(rows: list[dict]) -> list[list[str]]:
     def sdc(value: float) -> str:  # three decimals; a small SDC keeps its digits, not 0.000
         return display_number(value, decimals=3)
@@ -56,7 +69,7 @@ def _table_rows(rows: list[dict]) -> list[list[str]]:
         error = r["predicted"] - r["measured"]
         out.append([f"{r['frequency_hz']:g}", f"{r['acceleration_g']:g}",
                     f"{r['fill_percent']:g}", sdc(r["measured"]), sdc(r["predicted"]),
-                    f"{sdc(r['low95'])} .. {sdc(r['high95'])}",
+                    _band_text(r["low95"], r["high95"], sdc),
                     ("+" if error >= 0 else "") + sdc(error),
                     "yes" if r["low95"] <= r["measured"] <= r["high95"] else "**no**"])
     return out
@@ -165,6 +178,21 @@ def summary_html(result: CalibrationResult) -> str:
     return "\n".join(parts)
 
 
+def shown_band_bars(rows: list[dict]) -> tuple[np.ndarray, np.ndarray, np.ndarray, bool]:
+    """(predicted, distance down to low95, distance up to high95, whether a bound was cut) of
+    prediction rows as the plot draws them: an upper bound past 2 pi is cut there, as
+    :func:`_band_text` and the report cut it."""
+    from ..compare.plausibility import SDC_UPPER_BOUND
+
+    pred = np.array([r["predicted"] for r in rows], dtype=float)
+    low = np.array([r["low95"] for r in rows], dtype=float)
+    high = np.array([r["high95"] for r in rows], dtype=float)
+    shown = np.minimum(high, SDC_UPPER_BOUND)
+    # a median past the bound has no band below it: its bar ends at its point
+    return (pred, pred - np.minimum(low, pred), np.maximum(shown - pred, 0.0),
+            bool((high > SDC_UPPER_BOUND).any()))
+
+
 def plot_predictions(result: CalibrationResult, path: Path) -> None:
     """Measured SDC per load case with the posterior-predictive 95 % bands (and LOO's)."""
     import matplotlib
@@ -172,18 +200,23 @@ def plot_predictions(result: CalibrationResult, path: Path) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    from ..compare.plausibility import SDC_UPPER_BOUND
+
     rows = result.predictions
     x = np.arange(len(rows))
     fig, ax = plt.subplots(figsize=(max(6, 0.7 * len(rows)), 4.5), constrained_layout=True)
+    cut = False
     for offset, data, label, color in ((-0.12, rows, "calibrated (all points)", "C0"),
                                        (0.12, result.loo, "leave-one-out", "C1")):
         if not data:
             continue
-        pred = np.array([r["predicted"] for r in data])
-        low = np.array([r["low95"] for r in data])
-        high = np.array([r["high95"] for r in data])
-        ax.errorbar(x + offset, pred, yerr=[pred - low, high - pred], fmt="o", capsize=3,
+        pred, below, above, cut_here = shown_band_bars(data)
+        cut = cut or cut_here
+        ax.errorbar(x + offset, pred, yerr=[below, above], fmt="o", capsize=3,
                     color=color, label=f"{label}, 95 % band")
+    if cut:  # a band reaching past 2 pi drew a bar to a value no measurement is kept at
+        ax.axhline(SDC_UPPER_BOUND, color="0.5", ls="--", lw=1,
+                   label="2 pi: bands cut here (model unconstrained above)")
     ax.plot(x, [r["measured"] for r in rows], "k*", ms=10, label="measured")
     ax.set_xticks(x, [f"{r['frequency_hz']:g} Hz\n{r['acceleration_g']:g} g" for r in rows],
                   fontsize=8)

@@ -18,6 +18,7 @@ import pandas as pd
 
 from .. import defaults
 from ..compare.align import Z95, Tolerances, band_quantile, quantile_label  # noqa: F401 (public here)
+from ..compare.plausibility import SDC_UPPER_BOUND
 from ..errors import ParameterError, instance_of, real_number
 from ..loadcase import LoadCase
 
@@ -77,7 +78,24 @@ class CalibratedPrediction:
         t's quantile it is at most ~1 % wider than the exact quantile of normal + t (e.g.
         3.07 for 3.05 where both parts are equal: on the safe side), and exact where either
         part dominates (tests/test_calibrate_band_quantile.py checks its coverage).
+
+        The upper bound is cut at :data:`SDC_UPPER_BOUND` (2 pi, a loss factor of 1): the
+        model's normal error (discrepancy tau SDC, surrogate scatter) is unbounded, and a
+        poorly constrained calibration (tau near its prior's 2) reached 12.7, a value no
+        measurement is kept at (``pidcore analyze`` refuses an SDC above 2 pi as a set-up
+        error, :mod:`pidcore.compare.plausibility`). Cut there the band still holds >= 95 %
+        of the measurements that can be kept wherever at most half the model's draws lie
+        above the bound ((0.975 - p) / (1 - p) >= 0.95 for p <= 0.5); :meth:`band_note`
+        says it was cut, and that the model does not constrain the SDC there.
         """
+        low, high = self.model_band(stderr, dof)
+        # a model median above the bound leaves no band below it: [2 pi, 2 pi], noted
+        return min(low, SDC_UPPER_BOUND), min(high, SDC_UPPER_BOUND)
+
+    def model_band(self, stderr: float = math.nan, dof: float = math.nan) -> tuple[float, float]:
+        """:meth:`band` before its upper bound is cut at :data:`SDC_UPPER_BOUND`: the
+        posterior-predictive band as the normal error model gives it (:meth:`band_note` says
+        where it reaches beyond)."""
         stderr = real_number("stderr", stderr)
         q = band_quantile(dof)  # checks dof before any early return
         same_dof = (math.isnan(dof) and math.isnan(self.measured_stderr_dof)) or \
@@ -97,6 +115,17 @@ class CalibratedPrediction:
             raise ParameterError(f"stderr {stderr!r}: no finite 95 % band; expected a "
                                  "standard error of an SDC")
         return max(low, 0.0), high
+
+    def band_note(self, stderr: float = math.nan, dof: float = math.nan) -> str:
+        """Where :meth:`model_band` reaches above :data:`SDC_UPPER_BOUND`: that it was cut
+        there and why, with the model's own bound; "" otherwise."""
+        high = self.model_band(stderr, dof)[1]
+        if not high > SDC_UPPER_BOUND:
+            return ""
+        return (f"calibrated 95 % band cut at 2 pi = {SDC_UPPER_BOUND:.4g} (a loss factor of 1, "
+                "above which a measured SDC is refused as implausible); the model's own upper "
+                f"bound {high:.3g} says the calibration does not constrain the SDC here (its "
+                "model discrepancy and surrogate scatter dominate)")
 
     def contains(self, sdc: float, stderr: float = math.nan, dof: float = math.nan) -> bool:
         """True if ``sdc`` lies inside the 95 % band of a measurement with standard error

@@ -59,10 +59,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run)
 
 
-def _stated(args: argparse.Namespace) -> tuple[list, list]:
+def _stated(args: argparse.Namespace) -> tuple[list, list, object]:
     """What each path states about its load case (None: no fill stated) and how it is analysed
     (:class:`~pidcore.file_settings.FileSettings`), resolved before any analysis so that a bad
-    sidecar or option is refused at once."""
+    sidecar or option is refused at once; and the ``--specimen`` (None: none given)."""
     from ..file_settings import resolve_files
 
     specimen = None
@@ -71,12 +71,14 @@ def _stated(args: argparse.Namespace) -> tuple[list, list]:
 
         specimen = load_specimen(args.specimen)
     # (a missing file is named by its analysis)
-    return resolve_files(args.paths, options=analysis_options(args), given=given_options(args),
-                         fill_percent=args.fill, material=args.material,
-                         direction=args.direction, sidecar=args.sidecar,
-                         specimen_material=specimen.particles.material if specimen else None,
-                         fill_required=False,
-                         specimen_name=specimen.name if specimen else None, specimen=specimen)
+    stated, settings = resolve_files(
+        args.paths, options=analysis_options(args), given=given_options(args),
+        fill_percent=args.fill, material=args.material, direction=args.direction,
+        sidecar=args.sidecar,
+        specimen_material=specimen.particles.material if specimen else None,
+        fill_required=False, specimen_name=specimen.name if specimen else None,
+        specimen=specimen)
+    return stated, settings, specimen
 
 
 def run(args: argparse.Namespace) -> int:
@@ -84,7 +86,7 @@ def run(args: argparse.Namespace) -> int:
     from ..loadcase import refuse_identical_contents_stating_apart
     from ..store import Store
 
-    stated, settings = _stated(args)
+    stated, settings, specimen = _stated(args)
     # refused before any analysis (a folder, a foreign file); its commit count says after a
     # Ctrl-C whether the records were saved, even if it came as the commit returned
     store = None if args.no_store else Store(args.store)
@@ -121,7 +123,8 @@ def run(args: argparse.Namespace) -> int:
             replaced, breakdown = saved.notes, saved.breakdown()
         interrupt.raise_if_interrupted()  # an interrupt swallowed on the way still counts
         # inside: a Ctrl-C while the results are written out still says what was saved
-        _print_results(args, results, cases, stated, settings, replaced, breakdown)
+        _print_results(args, results, cases, stated, settings, replaced, breakdown,
+                       specimen=specimen)
     except (KeyboardInterrupt, Exception) as exc:
         # after SIGINT any error is the interruption: pyuff's bare ``except:`` swallows the
         # KeyboardInterrupt and its half-read file then comes back as "no force channel"
@@ -140,31 +143,47 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _print_results(args: argparse.Namespace, results: list, cases: list, stated: list,
-                   settings: list, replaced: list[str], breakdown: str = "") -> None:
-    """The results table (or JSON document), each file's load case and settings, notes, and
-    how many of the saved records were new (``breakdown``: :meth:`SavedAnalyses.breakdown`)."""
+                   settings: list, replaced: list[str], breakdown: str = "", *,
+                   specimen: object = None) -> None:
+    """The results table (or JSON document), each file's load case and settings, what was
+    assumed for it (``specimen``: the ``--specimen``), notes, and how many of the saved
+    records were new (``breakdown``: :meth:`SavedAnalyses.breakdown`)."""
+    from ..file_settings import assumed, assumption_notes
+
     overrides = [note for fs in settings for note in (*fs.notes, fs.unmatched) if note]
+    # what no statement gave (the paper's coupon and its acrylic), said with each file
+    assumptions = [assumed(st, fs.specimen, specimen)
+                   for st, fs in zip(stated, settings, strict=True)]
+    said_assumed = [[cli_words(n) for n in assumption_notes(display_path(Path(path).name), a)]
+                    for path, a in zip(args.paths, assumptions, strict=True)]
     if args.json:
-        json.dump({"records": [{**r.to_dict(), "notes": [cli_words(n) for n in r.notes],
+        json.dump({"records": [{**r.to_dict(),
+                                "notes": [*(cli_words(n) for n in r.notes), *words],
                                 "load_case": c.key if c else None,
                                 "specimen": fs.specimen or None,
                                 "specimen_sha256": fs.specimen_sha256 or None,
+                                "assumed": a,
                                 "parameters": fs.options.parameters(),
                                 "settings_from": dict(fs.sources),
                                 "overridden": list(fs.notes),
                                 "sidecar_row_missing": fs.unmatched or None}
-                               for r, c, fs in zip(results, cases, settings, strict=True)],
+                               for r, c, fs, a, words in zip(results, cases, settings,
+                                                             assumptions, said_assumed,
+                                                             strict=True)],
                    "notes": [*overrides, *replaced,
                              *([f"saved {breakdown}"] if breakdown else [])]}, sys.stdout)
         sys.stdout.write("\n")
         return
     print(format_table(results))
-    for path, c, st, fs in zip(args.paths, cases, stated, settings, strict=True):
+    for path, c, st, fs, words in zip(args.paths, cases, stated, settings, said_assumed,
+                                      strict=True):
         said = fs.summary()
         print(f"{display_path(Path(path).name)}: " + (f"load case {c.key} ({st.origin})" if c else
               "no fill stated: saved without a load case (state it in the file name, "
               "a sidecar or --fill for `pidcore report --store` to place it)"
               if not args.no_store else "no fill stated") + (f"; {said}" if said else ""))
+        for note in words:
+            print(f"note: {note}")
     for note in [*overrides, *replaced]:
         print(f"note: {note}")
     if not args.no_store:

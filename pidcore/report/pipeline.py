@@ -775,6 +775,7 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         if files:  # their analyses are added to it
             main.check_writable()
     from ..compare.plausibility import plausibility_notes, stored_plausibility_notes
+    from ..file_settings import assumed, assumption_notes, stored_assumption_notes
 
     options = options or AnalysisOptions()
     results = analyze_files(
@@ -790,6 +791,8 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         said = r.settings.summary() if r.settings is not None else ""
         notes.append(f"{display_path(r.path.name)}: load case {r.load_case.key} ({r.stated.origin})"
                      + (f"; {said}" if said else ""))
+        notes.extend(assumption_notes(display_path(r.path.name), assumed(
+            r.stated, r.settings.specimen if r.settings is not None else "", specimen)))
         # what the plausibility checks found (a result kept as asked, or zero within noise)
         notes.extend(f"{display_path(r.path.name)}: {n}"
                      for n in plausibility_notes(r.analyzed.analysis))
@@ -824,6 +827,8 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
     elif main is not None:
         listed = main.list_analyses()
         analyses = latest_per_measurement(listed)
+        # what analyze assumed for them (the paper's acrylic, its coupon) is said again here
+        notes.extend(stored_assumption_notes(analyses))
         # a stored result kept as implausible is said again here, as when it was saved
         for _, record in analyses.iterrows():
             name = Path(str(record.get("source", "") or record["key"])).name

@@ -113,6 +113,50 @@ class _Row:
     specimen: str | None = None  # None: no measurement claimed the row yet
     specimen_sha256: str = ""  # of the file its measurements recorded ("" : by name)
     unconverged_nodes: tuple[str, ...] = ()  # interpolated from runs that did not converge
+    # an interpolated row's own particle count and m_c (a grid row's are its DEM case's), or
+    # why they are unknown
+    particles_per_cell: int | None = None
+    vibrated_mass_kg: float = math.nan
+    no_mass_reason: str = ""
+
+
+def interpolated_count_and_mass(runs: pd.DataFrame | None,
+                                case: LoadCase) -> tuple[int | None, float, str]:
+    """(particles per cell, m_c of Eq. 10 in kg, "") of a load case off the DEM grid, as a DEM
+    run of ``case`` would count them: from the specimen file and the fill reference and
+    vibrated-mass convention that the ``runs`` the pchip model interpolates (those of its
+    material and direction) all share, through the functions the DEM itself uses
+    (:func:`pidcore.dem.simulate.particles_per_cell`, :meth:`pidcore.specimen.Specimen.
+    vibrated_mass_kg`). ``(None, NaN, reason)`` where the runs do not say one specimen or one
+    convention (runs of an older store, pooled runs of several specimens): a guessed m_c
+    would give an Eq. 10 SDC that no run defines."""
+    from ..dem.simulate import particles_per_cell
+    from ..errors import PidcoreError
+    from ..model.damper import runs_specimen
+
+    if runs is None or runs.empty or not {"material", "direction"} <= set(runs.columns):
+        return None, math.nan, "no DEM runs to take the specimen from"
+    same = runs[(runs["material"] == case.material) & (runs["direction"] == case.direction)]
+    try:
+        specimen = runs_specimen(same)
+    except PidcoreError:  # a stored text that no longer reads
+        specimen = None
+    if specimen is None:
+        return (None, math.nan, "its DEM runs do not record one specimen file (an older store, "
+                "or runs of several specimens)")
+    settings = {}
+    for column in ("fill_reference", "vibrated_mass_convention"):
+        values = set(same[column].dropna()) if column in same.columns else set()
+        if len(values) != 1 or same[column].isna().any():
+            return (None, math.nan, f"its DEM runs do not share one {column.replace('_', ' ')}")
+        settings[column] = values.pop()
+    try:
+        count, _ = particles_per_cell(case.fill_percent, specimen=specimen,
+                                      fill_reference=settings["fill_reference"])
+        mass = specimen.vibrated_mass_kg(count, settings["vibrated_mass_convention"])
+    except PidcoreError as exc:  # e.g. a fill that rounds to no particle of that cell
+        return None, math.nan, str(exc)
+    return count, mass, ""
 
 
 def _measured_rows(analyses: pd.DataFrame | None, notes: list[str]) -> list[tuple[LoadCase,
@@ -278,6 +322,8 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
     # a measurement meets only the DEM runs of its specimen (pidcore.compare.specimens); one
     # aligner per (specimen, material, direction) over those runs
     aligners: dict[tuple[str, str, str, str], tuple[Aligner, str, bool, str]] = {}
+    # each one's DEM runs
+    aligner_runs: dict[tuple[str, str, str, str], pd.DataFrame | None] = {}
     for case, rec in measured_rows:
         # a store's listing holds NaN where a record names no specimen and another does
         # (str(NaN) is "nan", a specimen of its own meeting no DEM run)
@@ -288,7 +334,7 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
         sha256 = deciding_sha256(rec.get(MEASURED_SHA256_FIELD, "")) if specimen else ""
         met_note, refused, met_calibrated = "", False, ""
         if pool or dem_runs is None or dem_runs.empty:
-            own = aligner
+            own, own_runs = aligner, dem_runs
         else:
             which = (specimen, case.material, case.direction, sha256)
             if which not in aligners:
@@ -302,7 +348,9 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
                                                        reference_fills=fills),
                                    met.note if met.runs is None else "", met.refused,
                                    calibrated)
+                aligner_runs[which] = met.runs
             own, met_note, refused, met_calibrated = aligners[which]
+            own_runs = aligner_runs[which]
         aligned = own.align(case)
         if aligned.status == "no_dem_runs" and not refused:
             # name whose runs are missing and whose the store holds there instead: another
@@ -351,6 +399,10 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
                         *paper_values,
                         notes=[aligned.message] + ([met_note] if met_note else []) + not_paper,
                         unconverged_nodes=aligned.unconverged_nodes)
+            if aligned.status == "interpolated":
+                # the specimen and fill fix its count and m_c, as a DEM run there would
+                (base.particles_per_cell, base.vibrated_mass_kg,
+                 base.no_mass_reason) = interpolated_count_and_mass(own_runs, case)
         # two files of one name are two specimens: their tests are not pooled
         row = next((r for r in group if r.dem is base.dem and r.specimen == specimen
                     and r.specimen_sha256 == sha256), None)
@@ -359,7 +411,10 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
         if row is None:  # another specimen at this case: a row of its own beside the DEM's
             row = _Row(base.case, base.status, base.dem, base.sdc_dem, base.sdc_dem_stderr,
                        base.paper_dem, base.paper_exp, notes=list(base.notes),
-                       unconverged_nodes=base.unconverged_nodes)
+                       unconverged_nodes=base.unconverged_nodes,
+                       particles_per_cell=base.particles_per_cell,
+                       vibrated_mass_kg=base.vibrated_mass_kg,
+                       no_mass_reason=base.no_mass_reason)
             group.append(row)
         row.specimen, row.specimen_sha256 = specimen, sha256
         row.measured.append(entry)
@@ -386,7 +441,7 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
             sources = "; ".join(m.source for m in row.measured if m.source)
             chi2, dof = consistency_chi2(values, errors)
             chi2_dof = chi2 / dof if dof else math.nan
-        m_c = row.dem.vibrated_mass_kg if row.dem is not None else math.nan
+        m_c = row.dem.vibrated_mass_kg if row.dem is not None else row.vibrated_mass_kg
         _, sdc_m10, _ = pooled_sdc_eq10(
             np.array([m.energy_per_cycle_j for m in row.measured]),
             np.array([g_to_si(m.acceleration_g) for m in row.measured]),
@@ -417,14 +472,16 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
         if pool:
             note.append("pooled across specimens and DEM settings (pool=True)")
         if row.measured and math.isfinite(row.sdc_dem) and not math.isfinite(sdc_m10):
-            note.append("no DEM m_c: no like-for-like difference")
+            note.append("no DEM m_c: no like-for-like difference"
+                        + (f" ({row.no_mass_reason})" if row.no_mass_reason else ""))
         records.append({
             "frequency [Hz]": lc.frequency_hz,
             "acceleration [g]": lc.acceleration_g,
             "packing ratio [%]": lc.fill_percent,
             "material": lc.material,
             "direction": lc.direction,
-            "particles per cell [-]": row.dem.particles_per_cell if row.dem else None,
+            "particles per cell [-]": (row.dem.particles_per_cell if row.dem
+                                       else row.particles_per_cell),
             "DEM runs [-]": row.dem.n_runs if row.dem else 0,
             "SDC DEM (ours) [-]": row.sdc_dem,
             "SDC DEM stderr [-]": row.sdc_dem_stderr,
@@ -585,6 +642,7 @@ def add_calibration_columns(table: pd.DataFrame, calibration, *,
     reasons: dict[str, str] = {}  # per material: why the calibration is of another specimen
     for _, row in out.iterrows():
         note = str(row.get("note", "") or "")
+        cut = ""  # a band reaching past 2 pi, said where it is cut
         case = LoadCase(float(row["frequency [Hz]"]), float(row["acceleration [g]"]),
                         float(row["packing ratio [%]"]),
                         str(row.get("material") or defaults.COMPARE_DEFAULT_MATERIAL))
@@ -625,6 +683,8 @@ def add_calibration_columns(table: pd.DataFrame, calibration, *,
             sdc.append(hit.sdc)
             low.append(band[0])
             high.append(band[1])
+            cut = "" if extra else hit.band_note(stderr if math.isfinite(measured)
+                                                 else math.nan, dof)
             if extra:
                 inside.append(NOT_COMPARED)
             elif not math.isfinite(measured):
@@ -637,7 +697,7 @@ def add_calibration_columns(table: pd.DataFrame, calibration, *,
                 inside.append(NOT_COMPARED)
                 extra = "so not compared with the calibrated band"
             else:
-                if band != (hit.low95, hit.high95):
+                if band != hit.band():
                     # "(the calibration's point at this load case: 0)" read as a point
                     # numbered 0, or an SDC of 0: it is the stderr of the fitted point
                     extra = (f"calibrated band for this measurement's SDC stderr {stderr:.3g} "
@@ -645,7 +705,7 @@ def add_calibration_columns(table: pd.DataFrame, calibration, *,
                              f"stderr {hit.measured_stderr:.3g}); its 95 % widening: "
                              f"{quantile_label(dof)}")
                 inside.append("yes" if band[0] <= measured <= band[1] else "no")
-        notes.append("; ".join(n for n in (note, extra) if n))
+        notes.append("; ".join(n for n in (note, extra, cut) if n))
     at = list(out.columns).index("SDC measured [-]") + 1 if "SDC measured [-]" in out.columns \
         else len(out.columns)
     for offset, (name, values) in enumerate(zip(CALIBRATION_COLUMNS, (sdc, low, high, inside),

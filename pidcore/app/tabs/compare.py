@@ -87,8 +87,8 @@ def _calibrated(calibrations, comp, head, specimen: str, *, implausible: bool = 
               uploads.format_sdc(comp.measured_sdc, comp.measured_stderr))
     c2.metric("SDC DEM, raw [-]", display_number(head.dem, missing="none"))
     # the band of a measurement with this one's standard error (the report's)
-    low, high = hit.band(comp.measured_stderr if math.isfinite(comp.measured_sdc)
-                         else math.nan, comp.measured_stderr_dof)
+    own_stderr = comp.measured_stderr if math.isfinite(comp.measured_sdc) else math.nan
+    low, high = hit.band(own_stderr, comp.measured_stderr_dof)
     c3.metric("SDC calibrated DEM, Eq. 11 [-]", display_number(hit.sdc),
               help=f"95 % band {display_number(low)} .. {display_number(high)}")
     if not math.isfinite(comp.measured_sdc):
@@ -100,8 +100,11 @@ def _calibrated(calibrations, comp, head, specimen: str, *, implausible: bool = 
     st.caption(f"calibrated 95 % band {display_number(low)} .. {display_number(high)} [-]"
                + (f" (for this measurement's SDC stderr {comp.measured_stderr:.3g}, "
                   f"widened by the {quantile_label(comp.measured_stderr_dof)})"
-                  if (low, high) != (hit.low95, hit.high95) else "")
+                  if (low, high) != hit.band() else "")
                + f"; the measured Eq. 11 SDC is {verdict}.")
+    cut = hit.band_note(own_stderr, comp.measured_stderr_dof)
+    if cut:  # a bound no measurement can take is not shown without a word
+        st.caption(cut + ".")
 
 
 def render(stores, session_files: list, calibrations: list) -> None:
