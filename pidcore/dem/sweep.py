@@ -193,7 +193,7 @@ def _exit_with(pid: int) -> None:
 
 
 def init_dem_worker(parent_pid: int | None = None) -> None:
-    """Set up a pool process that runs DEM cases (sweeps, calibration design runs).
+    """Set up a process that runs DEM cases (sweeps, calibration design runs, the app's jobs).
 
     One kernel thread: the parallelism is across cases, threads inside each would
     oversubscribe the cores. Ctrl-C ignored: the parent terminates its workers on an
