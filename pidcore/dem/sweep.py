@@ -433,7 +433,8 @@ def run_sweep(cases: Sequence[LoadCase], config: DemConfig, *,
     start = time.perf_counter()
     store = Store(store_path)
     summary = SweepSummary(store_path=str(Path(store_path)))
-    overridden = fill_override_note(specimen, [case.fill_percent for case in cases])
+    overridden = fill_override_note(specimen, [case.fill_percent for case in cases],
+                                    config.fill_reference)
     if overridden:
         summary.notes.append(overridden)
     todo: list[tuple[LoadCase, str]] = []
