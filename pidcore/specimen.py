@@ -961,20 +961,24 @@ _OVERRIDABLE = (tuple(("particles", key, column, "material")
                         for key, column in _WALL_FROM_MATERIAL))
 
 
-def fill_override_note(specimen: Specimen | None, fills_percent) -> str:
+def fill_override_note(specimen: Specimen | None, fills_percent,
+                       fill_reference: str | None = None) -> str:
     """What fills given for a run or sweep of ``specimen`` override: the fill (or particle
     count) the specimen file states, which a run without a fill simulates; ``""`` where it
-    states none or every fill is the one it states.
+    states none or every fill is the one it states or rounds to its particle count (the
+    same simulation), 100 % being the count ``fill_reference`` names (the run's
+    :attr:`pidcore.dem.DemConfig.fill_reference`; None: the default,
+    :data:`pidcore.defaults.DEM_FILL_REFERENCE`).
 
     ``dem run --fill 50 --specimen FILE`` of a file stating ``count_per_cell = 5`` simulated
-    50 % without a word that the count written in the file was not used.
+    50 % without a word that the count written in the file was not used; ``--fills 8.7`` of
+    one stating 8.69565 % (4 particles of 46, as 8.7 % is) was said to override it.
     """
     stated = specimen.stated_fill() if specimen is not None else None
     if stated is None:
         return ""
-    # relative 1e-9: a count's share of the capacity typed back as a percentage is the same fill
     overriding = [f for f in sorted(set(map(float, fills_percent)))
-                  if not math.isclose(f, stated[0], rel_tol=1e-9)]
+                  if not _same_particle_count(f, stated[0], specimen, fill_reference)]
     if not overriding:
         return ""
     shown = [apart(f, stated[0]) for f in overriding]
@@ -983,6 +987,28 @@ def fill_override_note(specimen: Specimen | None, fills_percent) -> str:
     return (f"fill{'s' if several else ''} {', '.join(text for text, _ in shown)} % "
             f"override{'' if several else 's'} the {stated_text} % specimen {specimen.name} "
             f"states ({stated[1]})")
+
+
+def _same_particle_count(fill_percent: float, stated_percent: float, specimen: Specimen,
+                         fill_reference: str | None) -> bool:
+    """Whether two fills of ``specimen`` are the same particles per cell
+    (:func:`particles_for_fill` of the count ``fill_reference`` takes as 100 %); a fill that
+    rounds to none, or an unknown reference, is refused by the run itself, not here."""
+    from . import defaults
+
+    # relative 1e-9: a count's share of the capacity typed back as a percentage is the same fill
+    if math.isclose(fill_percent, stated_percent, rel_tol=1e-9):
+        return True
+    full = {"capacity": specimen.capacity_per_cell,
+            "paper": lambda: defaults.PAPER_PARTICLES_PER_FULL_CELL}.get(
+                fill_reference or defaults.DEM_FILL_REFERENCE)
+    if full is None:
+        return False
+    try:
+        return particles_for_fill(fill_percent, full()) == particles_for_fill(stated_percent,
+                                                                              full())
+    except ParameterError:
+        return False
 
 
 def table_overrides(specimen: Specimen) -> tuple[str, ...]:

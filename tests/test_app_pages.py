@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import time
 from pathlib import Path
 
@@ -218,6 +219,12 @@ def test_compare_shows_dem_model_and_paper_and_switching_uses_the_cache(store_fi
     # like for like: measured with the DEM case's m_c (Eq. 10) beside our DEM 0.21 ± 0.01
     assert "vs our DEM 0.2100 ± 0.0100" in _headline(at)
     assert "σ" in _headline(at) and _headline(at).startswith("### measured (Eq. 10) ")
+    # the heading ends with the verdict; what σ and its interval are is the caption below it
+    # (inside the heading it wrapped it to three lines)
+    assert "Welch" not in _headline(at) and "√" not in _headline(at)
+    said = re.search(r"side the 95 % interval (±\S+ σ)$", _headline(at))
+    below = [c.value for c in at.caption if c.value.startswith("σ = √(measured stderr² + DEM")]
+    assert said and len(below) == 1 and f"; {said[1]}: Student t of " in below[0]
     assert _metric(at, "SDC paper DEM [-]") == ["0.1891"]
     specs = [json.loads(c.proto.spec) for c in at.get("vega_lite_chart")]
     titles = sorted(json.dumps(s.get("title", "")) for s in specs)

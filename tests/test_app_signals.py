@@ -1,5 +1,6 @@
 """SIGTERM to ``pidcore app`` while the Calibrate page's calibration runs: the app ends within
-seconds, as a command does (exit 143), keeping the DEM runs saved and leaving no process."""
+seconds, as a command does (exit 143), keeping the DEM runs saved and leaving no process.
+Ctrl-C while the DEM page's job runs: the app ends without a word of the resource tracker."""
 
 from __future__ import annotations
 
@@ -88,3 +89,63 @@ def test_sigterm_to_the_app_stops_its_calibration_within_seconds(tmp_path, whole
     helpers = _pids(folder, "server") + _pids(folder, "forkserver") + _pids(folder, "tracker")
     assert len(workers) == 2 and len(helpers) == 3
     assert not any(alive(pid) for pid in workers | set(helpers))
+
+
+@pytest.mark.slow
+@pytest.mark.dem_subprocess
+def test_ctrl_c_to_the_app_while_a_dem_job_runs_leaves_no_resource_warning(tmp_path):
+    # Ctrl-C to `pidcore app` while its DEM tab's job ran: the server stopped and its exit
+    # terminated the job's process, whose Numba had made a named process lock (the start
+    # method the app passed on contains "fork"), and the resource tracker then printed
+    # "There appear to be 1 leaked semaphore objects to clean up at shutdown" after the app
+    # had stopped. The server here keeps what matters of Streamlit: its SIGINT handler stops
+    # the server, whose main thread returns; the job runner lives in the same process.
+    ready, pids = tmp_path / "ready", tmp_path / "job-pids"
+    code = textwrap.dedent(f"""
+        import signal, threading, time
+        from pathlib import Path
+
+        if __name__ == "__main__":
+            import psutil
+
+            from pidcore.app import jobs
+            from pidcore.dem import DemConfig
+
+            stopped = threading.Event()
+            signal.signal(signal.SIGINT, lambda signum, frame: stopped.set())
+            runner = jobs.DemJobRunner({str(tmp_path / "app.h5")!r})
+            # thousands of steady cycles: still running when Ctrl-C comes
+            runner.submit(jobs.plan_dem_cases([50.0], [5.0], [50.0], material="acrylic",
+                                              direction="z"),
+                          DemConfig(cells=1, steady_cycles=5000))
+            while not stopped.wait(0.02):  # the server's event loop
+                job = runner.jobs()[0]
+                if job.state == "running" and (job.settled_s > 0 or job.cycles_done > 0) \\
+                        and not Path({str(ready)!r}).exists():
+                    Path({str(pids)!r}).write_text(" ".join(
+                        str(p.pid) for p in psutil.Process().children(recursive=True)))
+                    Path({str(ready)!r}).touch()
+    """)
+    script = tmp_path / "dem_job_server.py"  # a file: the job's process re-reads __main__
+    script.write_text(code)
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT), str(TESTS)])}
+    p = subprocess.Popen([sys.executable, str(script)], env=env, stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, text=True, start_new_session=True)
+    try:
+        deadline = time.monotonic() + 180  # cold imports and the kernel's load from the cache
+        while not ready.exists() and time.monotonic() < deadline and p.poll() is None:
+            time.sleep(0.02)
+        assert ready.exists(), p.stderr.read() if p.poll() is not None else ""
+        os.killpg(p.pid, signal.SIGINT)  # a terminal's Ctrl-C goes to the whole group
+        # waits for the end of stderr: the server, its fork server, resource tracker and the
+        # job's process have all closed it
+        out, err = p.communicate(timeout=60)
+    finally:
+        if p.poll() is None:
+            os.killpg(p.pid, signal.SIGKILL)
+    assert p.returncode == 0  # the stand-in's main thread returned
+    assert (out, err) == ("", "")  # no resource tracker warning, no traceback
+    helpers = [int(pid) for pid in pids.read_text().split()]
+    assert helpers  # the fork server, the job's process, the resource tracker
+    assert not any(alive(pid) for pid in helpers)
+    assert not (tmp_path / "app.h5").exists() or Store(tmp_path / "app.h5").list_dem_runs().empty

@@ -184,6 +184,38 @@ def test_json_document(capsys, tmp_path, tiny_store):
             f"(95 % {low} .. {high})") in spec.description
 
 
+def test_every_parameter_row_names_its_unit_in_the_command_and_the_summaries(capsys, tmp_path,
+                                                                             tiny_store):
+    # the table of medians and intervals had no unit anywhere: only a name such as
+    # fixture_mass_kg carried one, and baseline_loss_factor's or model_discrepancy's
+    # dimensionless numbers read as of no stated unit (every output column names its unit)
+    import html
+
+    code = main(["calibrate", "--data", str(_table(tmp_path)), "--fit",
+                 "fixture_mass_kg,baseline_loss_factor", "--discrepancy", "0.2",
+                 "--dem-store", str(tiny_store), "--out", str(tmp_path / "out"), *TINY])
+    assert code == 0
+    out = capsys.readouterr().out.splitlines()
+    doc = json.loads((tmp_path / "out" / "calibration.json").read_text())
+    units = {"fixture_mass_kg": "kg", "baseline_loss_factor": "-"}  # the vocabulary's
+    assert {name: doc["units"][name] for name in units} == units
+    from pidcore.calibrate.posterior import summary_texts
+
+    summary = (tmp_path / "out" / "summary.md").read_text().splitlines()
+    page = (tmp_path / "out" / "summary.html").read_text()
+    assert "| parameter | unit | median | 95 % interval | prior bounds |" in summary
+    assert "<tr><th>parameter</th><th>unit</th><th>median</th><th>95 % interval</th></tr>" \
+        in page
+    for name, unit in units.items():
+        p = doc["parameter_details"][name]
+        median, low, high = summary_texts(p)
+        assert f"{name} [{unit}]: {median} (95 % {low} .. {high})" in out
+        assert (f"| {name} | {unit} | {median} | {low} .. {high} | {p['prior_low']:g} .. "
+                f"{p['prior_high']:g} |") in summary
+        assert (f"<tr><td>{name}</td><td>{html.escape(unit)}</td><td>{median}</td>"
+                f"<td>{low} .. {high}</td></tr>") in page
+
+
 def test_a_calibration_result_reads_as_its_calibration_json(tmp_path, tiny_store):
     # a script's calibrate() result had neither to_pandas() nor plot() nor lookup(): only
     # lists of dicts, while the same numbers read back from calibration.json had them all
@@ -757,7 +789,7 @@ def test_the_html_summary_carries_the_notes_of_the_markdown_one():
 
     # the page names the specimen calibrated and the file written: the fake has both
     page = summary_html(SimpleNamespace(parameters={}, predictions=[], loo=None, notes=notes,
-                                        specimen=paper_specimen(),
+                                        units=dict, specimen=paper_specimen(),
                                         calibrated_specimen=paper_specimen))
     for note in notes:
         assert f"<li>{html.escape(note)}</li>" in page

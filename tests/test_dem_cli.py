@@ -391,6 +391,37 @@ def test_a_sweep_over_the_grids_fills_says_it_is_not_the_specimens_fill(tmp_path
         f"specimen steel_6mm states ([particles] count_per_cell 20 of capacity {capacity})\n")
 
 
+def test_a_fill_of_the_specimens_particle_count_is_no_override(tmp_path, capsys, monkeypatch):
+    # `dem sweep --fills 8.7` of a file stating 4 particles of 46 per cell (8.69565 %) said
+    # "fill 8.7 % overrides the 8.69565 % specimen ... states", though 8.7 % of 46 is 4.002,
+    # which rounds to the same 4 particles: the same simulation, nothing overridden
+    import pidcore.dem.sweep as sweep_module
+    from pidcore.specimen import fill_override_note, load_specimen
+
+    def stop(*args, **kwargs):
+        raise KeyboardInterrupt  # the cases are not the point: what was said before them
+
+    monkeypatch.setattr(sweep_module, "run_sweep", stop)
+    spec = Path(__file__).resolve().parents[1] / "data_samples" / "specimens" / "steel_6mm.toml"
+    mine = tmp_path / "mine.toml"
+    mine.write_text(spec.read_text().replace("fill_percent = 50.0", "count_per_cell = 4"))
+    specimen = load_specimen(mine)
+    assert specimen.capacity_per_cell() == 46  # 4 particles: fills 7.61 .. 9.78 % round to 4
+    argv = ["dem", "sweep", "--specimen", str(mine), "--frequencies", "500",
+            "--accelerations", "5", "--store", str(tmp_path / "s.h5"), "--no-progress"]
+    assert main([*argv, "--fills", "8.7"]) == 130
+    assert "note" not in capsys.readouterr().err
+    # a fill of another count beside it is still said, and it alone
+    assert main([*argv, "--fills", "8.7,30"]) == 130
+    assert capsys.readouterr().err.startswith(
+        f"pidcore dem sweep: note: fill 30 % overrides the {400 / 46:.6g} % specimen "
+        "steel_6mm states ([particles] count_per_cell 4 of capacity 46)\n")
+    # counted against the run's 100 %: of the paper's 36, 9.75 % is 3.51 -> 4 particles where
+    # the stated 8.69565 % is 3.13 -> 3 (of the capacity's 46 both are 4)
+    assert fill_override_note(specimen, [9.75]) == ""
+    assert fill_override_note(specimen, [9.75], "paper").startswith("fill 9.75 % overrides")
+
+
 def test_a_fill_given_for_a_specimen_stating_its_count_is_said_to_override_it(tmp_path,
                                                                               capsys):
     # `dem run --fill 30 --specimen FILE` of a file stating count_per_cell = 20 simulated 30 %

@@ -181,6 +181,22 @@ class DemJob:
                 "store key": self.run_key}
 
 
+def _job_process(case, config, specimen, conn, parent_pid: int) -> None:
+    """The process of one job: set up as a pool's DEM worker (:func:`pidcore.dem.sweep.
+    init_dem_worker`), then :func:`_child`.
+
+    Set up so, Numba makes no named process lock in it: one made because the start method
+    the app's process passed on contains "fork" was left behind when the app's exit (Ctrl-C)
+    terminated a running job, and the resource tracker warned of a "leaked semaphore" after
+    the app had stopped. The worker also ends with the app's process (``parent_pid``) where
+    that is killed outright.
+    """
+    from ..dem.sweep import init_dem_worker
+
+    init_dem_worker(parent_pid)
+    _child(case, config, specimen, conn)
+
+
 def _child(case, config, specimen, conn) -> None:
     """Worker process: simulate one case, report progress, send the store entry back."""
     try:
@@ -675,7 +691,8 @@ class DemJobRunner:
             return
         ctx = dem_process_context()
         parent, child = ctx.Pipe(duplex=False)
-        proc = ctx.Process(target=_child, args=(job.case, job.config, job.specimen, child),
+        proc = ctx.Process(target=_job_process,
+                           args=(job.case, job.config, job.specimen, child, os.getpid()),
                            daemon=True,
                            name=f"pidcore-dem-{job.job_id}")
         proc.start()

@@ -60,6 +60,20 @@ def _band_text(low: float, high: float, sdc) -> str:
     return f"{sdc(low)} .. {sdc(high)}"
 
 
+def parameter_units(result: CalibrationResult) -> dict[str, str]:
+    """Unit of each parameter of ``result`` (:attr:`~pidcore.calibrate.parameters.
+    ParameterSpec.unit`, ``"-"`` where dimensionless): the summary's, the app's and the
+    command's table of medians and intervals name it in every row, as calibration.json's
+    ``units`` does; only a name such as fixture_mass_kg said it before."""
+    units = result.units()
+    return {name: units.get(name, "-") for name in result.parameters}
+
+
+#: Head of the table of parameters (their medians, intervals and prior bounds are in the
+#: row's unit).
+PARAMETER_HEAD = ("parameter", "unit", "median", "95 % interval", "prior bounds")
+
+
 def _table_rows(rows: list[dict]) -> list[list[str]]:
     def sdc(value: float) -> str:  # three decimals; a small SDC keeps its digits, not 0.000
         return display_number(value, decimals=3)
@@ -113,10 +127,11 @@ def summary_markdown(result: CalibrationResult) -> str:
                  f"runs computed {result.runs['computed']}, cached {result.runs['cached']}; "
                  f"{result.wall_s:.1f} s.")
     lines += ["", specimen_words(result)]
-    lines += ["", "| parameter | median | 95 % interval | prior bounds |", "|---|---|---|---|"]
+    lines += ["", "| " + " | ".join(PARAMETER_HEAD) + " |", "|---" * len(PARAMETER_HEAD) + "|"]
+    units = parameter_units(result)
     for name, p in result.parameters.items():
         median, low, high = summary_texts(p)
-        lines.append(f"| {name} | {median} | {low} .. {high} | "
+        lines.append(f"| {name} | {units[name]} | {median} | {low} .. {high} | "
                      f"{p['prior_low']:g} .. {p['prior_high']:g} |")
     names = [s.name for s in result.specs]
     lines += ["", "Posterior correlations:", "", "| | " + " | ".join(names) + " |",
@@ -154,11 +169,13 @@ def summary_html(result: CalibrationResult) -> str:
              "<style>body{font-family:sans-serif}td,th{border:1px solid #ccc;padding:2px 6px}"
              "table{border-collapse:collapse}</style></head><body><h1>Calibration summary</h1>"]
     parts.append(f"<p>{html.escape(specimen_words(result))}</p>")
-    parts.append("<table><tr><th>parameter</th><th>median</th><th>95 % interval</th></tr>")
+    parts.append("<table><tr>" + "".join(f"<th>{html.escape(h)}</th>"
+                                         for h in PARAMETER_HEAD[:4]) + "</tr>")
+    units = parameter_units(result)
     for name, p in result.parameters.items():
         median, low, high = summary_texts(p)
-        parts.append(f"<tr><td>{html.escape(name)}</td><td>{median}</td>"
-                     f"<td>{low} .. {high}</td></tr>")
+        parts.append(f"<tr><td>{html.escape(name)}</td><td>{html.escape(units[name])}</td>"
+                     f"<td>{median}</td><td>{low} .. {high}</td></tr>")
     parts.append("</table>")
     for title, rows in (("In-sample predictions", result.predictions),
                         ("Leave-one-out predictions", result.loo)):

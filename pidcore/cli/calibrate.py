@@ -170,13 +170,14 @@ def _print_result(args: argparse.Namespace, result, own_notes: list[str], saved:
         print(document_json(result.document()))
         print(f"pidcore calibrate: {said}", file=sys.stderr)
     else:
-        from ..calibrate.outputs import specimen_words
+        from ..calibrate.outputs import parameter_units, specimen_words
         from ..calibrate.posterior import summary_texts
 
         print(specimen_words(result, digits=12))
+        units = parameter_units(result)
         for name, p in result.parameters.items():
             median, low, high = summary_texts(p)
-            print(f"{name}: {median} (95 % {low} .. {high})")
+            print(f"{name} [{units[name]}]: {median} (95 % {low} .. {high})")
         print(f"in-sample RMS {rms_text(result.rms)}")
         print(runs)
         if result.loo is not None:

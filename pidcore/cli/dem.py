@@ -233,7 +233,7 @@ def sweep(args: argparse.Namespace) -> int:
     # before the run (an interrupted sweep prints no summary); the summary's notes say the
     # same to a library caller and in --json
     note = grid_fill_note(specimen, args.grid, values[2]) if args.fills is None else \
-        fill_override_note(specimen, values[2])
+        fill_override_note(specimen, values[2], args.fill_reference)
     if note:  # on stderr: --json prints one document
         print(f"pidcore dem sweep: note: {cli_words(note, 'dem sweep')}", file=sys.stderr)
     cases = cross_cases(*values, material=material, direction=args.direction)

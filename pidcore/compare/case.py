@@ -546,9 +546,13 @@ class Headline:
         |measured - DEM| / sigma, sigma = sqrt(measured stderr^2 + DEM stderr^2) (the known
         one alone where the other has none: then an upper bound); NaN when not comparable.
     verdict : str
-        What was checked and what it found, e.g. ``"agrees: |measured - DEM| = 0.8 σ, inside
-        the 95 % interval ±2.45 σ (σ = √(measured stderr² + DEM stderr²); Student t of 6.0
-        degrees of freedom, Welch-Satterthwaite)"``, ``"no DEM value at this case"``.
+        What was found, short enough for a heading, e.g. ``"agrees: |measured − DEM| = 0.8 σ,
+        inside the 95 % interval ±2.45 σ"``, ``"no DEM value at this case"``.
+    basis : str
+        What σ and the interval are, with the verdict's numbers, e.g. ``"σ = √(measured
+        stderr² + DEM stderr²); ±2.45 σ: Student t of 6.03 degrees of freedom,
+        Welch-Satterthwaite"`` (shown below the verdict: in the heading it wrapped); ``""``
+        where nothing was judged.
     interval_sigmas : float
         Half-width of the 95 % interval of measured - DEM, in sigma: Student's t_0.975 of
         ``stderr_dof`` (:func:`pidcore.compare.align.band_quantile`); NaN when not
@@ -573,6 +577,7 @@ class Headline:
     interval_sigmas: float = math.nan
     stderr_dof: float = math.nan
     agrees: bool | None = None
+    basis: str = ""
 
 
 def combined_stderr_dof(stderrs: Sequence[float], dofs: Sequence[float]) -> float:
@@ -592,7 +597,7 @@ def headline(comparison: CaseComparison) -> Headline:
     """Measured (like for like) vs our DEM for one load case: whether their difference lies
     inside its 95 % interval, ±t_0.975 sigma with sigma = sqrt(measured stderr^2 + DEM
     stderr^2) and t of their Welch-Satterthwaite degrees of freedom (1.96 where neither states
-    them). The verdict names sigma, the interval and its quantile."""
+    them). The verdict names the interval; its basis says what sigma is and which quantile."""
     c = comparison
     if math.isfinite(c.measured_sdc_eq10):
         m, m_se, kind = c.measured_sdc_eq10, c.measured_stderr_eq10, "Eq. 10 (DEM m_c)"
@@ -621,26 +626,30 @@ def headline(comparison: CaseComparison) -> Headline:
     z = abs(m - dem) / se
     inside = z <= q
     interval = f"the 95 % interval ±{q:.3g} σ"
+    # the verdict is a heading's end; what σ and the interval are goes in its basis, below it
+    quantile_basis = f"±{q:.3g} σ: {quantile}"
     if len(parts) == 2:
-        basis = f"σ = √(measured stderr² + DEM stderr²); {quantile}"
-        verdict = (f"agrees: |measured − DEM| = {z:.1f} σ, inside {interval} ({basis})"
-                   if inside else
-                   f"differs: |measured − DEM| = {z:.1f} σ, outside {interval} ({basis})")
+        basis = f"σ = √(measured stderr² + DEM stderr²); {quantile_basis}"
+        verdict = (f"agrees: |measured − DEM| = {z:.1f} σ, inside {interval}" if inside else
+                   f"differs: |measured − DEM| = {z:.1f} σ, outside {interval}")
     else:
         # one side's error is unknown (a 1-cell DEM run, a single record without one): the
         # combined σ is at least the known side's, so z is an upper bound; "differs by" would
         # overstate it ("differs by 314 σ" of a 1-cell run against the measurement's σ alone)
         unknown, known = (("DEM value", "measured") if not math.isfinite(dem_se)
                           else ("measured value", "DEM"))
-        basis = f"σ: the {known} stderr alone, the {unknown} has no standard error; {quantile}"
+        basis = (f"σ: the {known} stderr alone, the {unknown} has no standard error; "
+                 f"{quantile_basis}")
         if inside:  # inside with the known σ alone: inside the whole, wider interval too
-            verdict = f"agrees: |measured − DEM| ≤ {z:.1f} σ, inside {interval} ({basis})"
+            verdict = f"agrees: |measured − DEM| ≤ {z:.1f} σ, inside {interval}"
         else:  # outside the known side's interval only: the whole one is unknown
             verdict = (f"differs by up to {z:.1f} σ: outside {interval} of the {known} stderr "
-                       f"alone; the {unknown} has no standard error (e.g. a 1-cell run), so "
-                       f"whether it lies outside the whole interval is unknown; {quantile}")
-            return Headline(m, m_se, kind, dem, dem_se, z, verdict, q, dof, None)
-    return Headline(m, m_se, kind, dem, dem_se, z, verdict, q, dof, bool(inside))
+                       "alone")
+            basis = (f"σ: the {known} stderr alone; the {unknown} has no standard error (e.g. "
+                     "a 1-cell run), so whether it lies outside the whole interval is unknown; "
+                     f"{quantile_basis}")
+            return Headline(m, m_se, kind, dem, dem_se, z, verdict, q, dof, None, basis)
+    return Headline(m, m_se, kind, dem, dem_se, z, verdict, q, dof, bool(inside), basis)
 
 
 #: Series of :func:`sdc_points`, in legend order.

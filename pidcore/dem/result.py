@@ -250,7 +250,8 @@ class DemResult:
                          "included Numba compilation (run again for the compiled speed)")
         if self.specimen is not None:
             notes += table_overrides(self.specimen)
-            overridden = fill_override_note(self.specimen, [self.case.fill_percent])
+            overridden = fill_override_note(self.specimen, [self.case.fill_percent],
+                                            self.config.fill_reference)
             if overridden:
                 notes.append(f"{overridden}: {self.particles_per_cell} particles per cell "
                              "simulated")

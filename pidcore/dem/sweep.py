@@ -193,7 +193,7 @@ def _exit_with(pid: int) -> None:
 
 
 def init_dem_worker(parent_pid: int | None = None) -> None:
-    """Set up a pool process that runs DEM cases (sweeps, calibration design runs).
+    """Set up a process that runs DEM cases (sweeps, calibration design runs, the app's jobs).
 
     One kernel thread: the parallelism is across cases, threads inside each would
     oversubscribe the cores. Ctrl-C ignored: the parent terminates its workers on an
@@ -433,7 +433,8 @@ def run_sweep(cases: Sequence[LoadCase], config: DemConfig, *,
     start = time.perf_counter()
     store = Store(store_path)
     summary = SweepSummary(store_path=str(Path(store_path)))
-    overridden = fill_override_note(specimen, [case.fill_percent for case in cases])
+    overridden = fill_override_note(specimen, [case.fill_percent for case in cases],
+                                    config.fill_reference)
     if overridden:
         summary.notes.append(overridden)
     todo: list[tuple[LoadCase, str]] = []

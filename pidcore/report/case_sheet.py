@@ -61,6 +61,7 @@ def case_pdf(view: dict, *, title: str) -> bytes:
         lines = [title,
                  f"measured SDC ({head.measured_kind}) {display_number(head.measured)} ± "
                  f"{display_number(head.measured_stderr)}  vs  our DEM {dem}: {head.verdict}",
+                 *([f"  ({head.basis})"] if head.basis else []),
                  f"DEM alignment: {comp.aligned.status}. {comp.aligned.message}"]
         lines += [f"note: {n}" for n in view["notes"]]
         top.text(0.01, 0.95, "\n".join(lines), va="top", fontsize=9, family="monospace",

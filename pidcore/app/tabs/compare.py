@@ -155,6 +155,8 @@ def render(stores, session_files: list, calibrations: list) -> None:
     st.markdown(f"### measured ({head.measured_kind.split(' (')[0]}) "
                 f"{uploads.format_sdc(head.measured, head.measured_stderr)} "
                 f"vs our DEM {dem_text} — {head.verdict}")
+    if head.basis:  # what σ and the interval are: in the heading it wrapped the line
+        st.caption(head.basis)
     if view["dem_refused"]:
         st.warning(f"No DEM value: {view['dem_refused']}.", icon="⚠️")
     if view["dem_warning"] and math.isfinite(head.dem):
