@@ -1891,6 +1891,22 @@ def test_the_report_tab_defaults_to_the_newest_calibration_of_the_specimen_repor
     assert default_calibration_index(newest_first[:1], "my_panel") == 0
 
 
+def _two_files_named_x():
+    """Two specimen files named x (the second an edit of the first: another coupon mass) and
+    the calibration.json text of a fit of one of them."""
+    from pidcore.specimen import Specimen, paper_specimen
+
+    first = Specimen.from_text(paper_specimen().to_toml().replace(
+        'name = "paper_coupon"', 'name = "x"'))
+    edited = first.with_values({"coupon.mass_kg": 0.03})
+    text = json.dumps({"parameters": {"fixture_mass_kg": {"median": 0.2, "low95": 0.1,
+                                                          "high95": 0.3}},
+                       "predictions": [{"frequency_hz": 100.0, "acceleration_g": 5.0,
+                                        "fill_percent": 50.0, "material": "acrylic",
+                                        "measured": 0.3, "predicted": 0.3, "low95": 0.1,
+                                        "high95": 0.6}]})
+    return first, edited, text
+
 
 def test_the_report_tab_default_goes_by_the_reported_files_hash(tmp_path):
     # two files named x (the second an edit of the first): the calibration of the earlier x
@@ -1900,17 +1916,10 @@ def test_the_report_tab_default_goes_by_the_reported_files_hash(tmp_path):
 
     from pidcore.app.calibration import default_calibration_index
     from pidcore.calibrate.prediction import calibration_from_json
-    from pidcore.specimen import Specimen, calibrated_provenance, paper_specimen
+    from pidcore.specimen import calibrated_provenance
 
-    first = Specimen.from_text(paper_specimen().to_toml().replace(
-        'name = "paper_coupon"', 'name = "x"'))
-    edited = first.with_values({"coupon.mass_kg": 0.03})
-    doc = json.dumps({"parameters": {"fixture_mass_kg": {"median": 0.2, "low95": 0.1,
-                                                         "high95": 0.3}},
-                      "predictions": [{"frequency_hz": 100.0, "acceleration_g": 5.0,
-                                       "fill_percent": 50.0, "material": "acrylic",
-                                       "measured": 0.3, "predicted": 0.3, "low95": 0.1,
-                                       "high95": 0.6}]}).encode()
+    first, edited, text = _two_files_named_x()
+    doc = text.encode()
 
     def of(start):
         made = dataclasses.replace(start.with_values({"coupon.fixture_mass_kg": 0.2}),
@@ -1931,18 +1940,10 @@ def test_the_app_names_a_saved_calibrations_specimen_file_by_its_hash(tmp_path):
 
     from pidcore.app.calibration import saved_calibrations_table, stored_calibration_label
     from pidcore.calibrate import stored_calibrations
-    from pidcore.specimen import Specimen, calibrated_provenance, paper_specimen
+    from pidcore.specimen import calibrated_provenance, paper_specimen
     from pidcore.store import Store
 
-    first = Specimen.from_text(paper_specimen().to_toml().replace(
-        'name = "paper_coupon"', 'name = "x"'))
-    edited = first.with_values({"coupon.mass_kg": 0.03})
-    text = json.dumps({"parameters": {"fixture_mass_kg": {"median": 0.2, "low95": 0.1,
-                                                          "high95": 0.3}},
-                       "predictions": [{"frequency_hz": 100.0, "acceleration_g": 5.0,
-                                        "fill_percent": 50.0, "material": "acrylic",
-                                        "measured": 0.3, "predicted": 0.3, "low95": 0.1,
-                                        "high95": 0.6}]})
+    first, edited, text = _two_files_named_x()
     store = tmp_path / "app.h5"
     for i, start in enumerate((first, edited)):
         made = dataclasses.replace(start, name="x_calibrated",

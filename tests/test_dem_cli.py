@@ -357,21 +357,29 @@ def test_the_flag_wording_leaves_other_words_alone():
     assert cli_words("frequency_hz must be > 0", "dem sweep") == "--frequencies must be > 0"
 
 
+def _steel_stating_count(tmp_path, monkeypatch, count: int) -> tuple[Path, Path]:
+    """The bundled steel_6mm.toml, and a copy of it stating ``count_per_cell = count`` for its
+    fill; `dem sweep` stops (Ctrl-C) before its first case: what it says before is the test."""
+    import pidcore.dem.sweep as sweep_module
+
+    def stop(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(sweep_module, "run_sweep", stop)
+    spec = Path(__file__).resolve().parents[1] / "data_samples" / "specimens" / "steel_6mm.toml"
+    mine = tmp_path / "mine.toml"
+    mine.write_text(spec.read_text().replace("fill_percent = 50.0", f"count_per_cell = {count}"))
+    return spec, mine
+
+
 def test_a_sweep_over_the_grids_fills_says_it_is_not_the_specimens_fill(tmp_path, capsys,
                                                                         monkeypatch):
     # a specimen stating its fill (steel_6mm: fill_percent = 50 of 46 -> 23 per cell; a file
     # stating count_per_cell 20) swept without --fills ran Table 3's 25, 50, 75, 90 % and no
     # word said the specimen's own fill was not among them
-    import pidcore.dem.sweep as sweep_module
     from pidcore.specimen import load_specimen
 
-    def stop(*args, **kwargs):
-        raise KeyboardInterrupt  # the cases are not the point: what was said before them
-
-    monkeypatch.setattr(sweep_module, "run_sweep", stop)
-    spec = Path(__file__).resolve().parents[1] / "data_samples" / "specimens" / "steel_6mm.toml"
-    mine = tmp_path / "mine.toml"
-    mine.write_text(spec.read_text().replace("fill_percent = 50.0", "count_per_cell = 20"))
+    spec, mine = _steel_stating_count(tmp_path, monkeypatch, 20)
     capacity = load_specimen(mine).capacity_per_cell()
     argv = ["dem", "sweep", "--specimen", str(mine), "--frequencies", "500",
             "--accelerations", "5", "--store", str(tmp_path / "s.h5"), "--no-progress"]
@@ -395,16 +403,9 @@ def test_a_fill_of_the_specimens_particle_count_is_no_override(tmp_path, capsys,
     # `dem sweep --fills 8.7` of a file stating 4 particles of 46 per cell (8.69565 %) said
     # "fill 8.7 % overrides the 8.69565 % specimen ... states", though 8.7 % of 46 is 4.002,
     # which rounds to the same 4 particles: the same simulation, nothing overridden
-    import pidcore.dem.sweep as sweep_module
     from pidcore.specimen import fill_override_note, load_specimen
 
-    def stop(*args, **kwargs):
-        raise KeyboardInterrupt  # the cases are not the point: what was said before them
-
-    monkeypatch.setattr(sweep_module, "run_sweep", stop)
-    spec = Path(__file__).resolve().parents[1] / "data_samples" / "specimens" / "steel_6mm.toml"
-    mine = tmp_path / "mine.toml"
-    mine.write_text(spec.read_text().replace("fill_percent = 50.0", "count_per_cell = 4"))
+    _, mine = _steel_stating_count(tmp_path, monkeypatch, 4)
     specimen = load_specimen(mine)
     assert specimen.capacity_per_cell() == 46  # 4 particles: fills 7.61 .. 9.78 % round to 4
     argv = ["dem", "sweep", "--specimen", str(mine), "--frequencies", "500",
