@@ -96,6 +96,11 @@ DEM_TANGENTIAL_MODEL = "stick_slip"
 DEM_TANGENTIAL_REFERENCE_SPEED_M_S = 0.3
 #: Cycles per block for steady-state detection (block means compared).
 DEM_STEADY_BLOCK_CYCLES = 10
+#: Fewest batches (of block_cycles steady cycles each) a DEM run whose cells all ran one
+#: motion takes a batch-means standard error from: with 3 degrees of freedom or fewer the
+#: scatter of the batches is too poor an estimate to print (t_0.975,2 = 4.3), so such a run
+#: keeps no standard error.
+DEM_MIN_STDERR_BATCHES = 4
 
 
 def dem_automatic_steady_cycles(block_cycles: int = DEM_STEADY_BLOCK_CYCLES) -> int:

@@ -430,6 +430,8 @@ def _tangential_stiffness_model(result) -> str:
 
 def format_summary(result, *, reused: bool = False) -> str:
     """Readable multi-line summary with units."""
+    from ..dem.result import cells_ran_one_motion
+
     c = result.case
     s = result.specimen
     material = s.particles.material if s is not None else c.material
@@ -452,6 +454,9 @@ def format_summary(result, *, reused: bool = False) -> str:
     lines += [
         (f"SDC             {result.sdc:.4g} +- {result.sdc_stderr:.2g} [-] (loss factor "
          f"{result.loss_factor:.4g} [-]) over {result.cells_simulated} cells"
+         # the error of cells that ran one motion is from batches of it, not the cells
+         + (" (stderr from batches of one motion: see the note)"
+            if cells_ran_one_motion(result.sdc_per_cell) else "")
          if math.isfinite(result.sdc_stderr) else
          f"SDC             {result.sdc:.4g} [-] (loss factor {result.loss_factor:.4g} [-]) over "
          f"{result.cells_simulated} cell(s): no standard error"

@@ -138,8 +138,9 @@ class DemCase:
     duplicate_fills : tuple of float
         Fill percentages, %, the duplicates were stored with (for the note).
     sdc_stderr_dof : float
-        Degrees of freedom of ``sdc_stderr`` (:func:`pooled_stderr_dof`): a run's error is the
-        scatter of its cells' SDCs, cells - 1; NaN where the cells are unknown.
+        Degrees of freedom of ``sdc_stderr`` (:func:`pooled_stderr_dof`): a run's own, as
+        stored (``sdc_stderr_dof``: batches - 1 for a run whose cells ran one motion), else
+        the scatter of its cells' SDCs, cells - 1; NaN where neither is known.
     """
 
     load_case: LoadCase
@@ -563,7 +564,7 @@ def dem_cases(dem_runs: pd.DataFrame, *, tolerances: Tolerances | None = None,
         cells = cells_of.get(settings, math.nan)
         stderr_dof = pooled_stderr_dof(sub["sdc"].to_numpy(float),
                                        sub["sdc_stderr"].to_numpy(float),
-                                       np.full(len(sub), cells - 1.0 if cells > 1 else math.nan))
+                                       _run_stderr_dofs(sub, cells))
         ppc = math.nan
         if "particles_per_cell" in sub:
             unique = pd.unique(sub["particles_per_cell"].astype(float))
@@ -579,6 +580,18 @@ def dem_cases(dem_runs: pd.DataFrame, *, tolerances: Tolerances | None = None,
         out.append(DemCase(case, sdc, stderr, len(members), ppc, keys, m_c, settings,
                            cells, _not_converged(sub), dup_keys, dup_fills, stderr_dof))
     return sorted(out, key=lambda c: (*_sort_key(c.load_case), c.settings))
+
+
+def _run_stderr_dofs(runs: pd.DataFrame, cells: float) -> np.ndarray:
+    """Degrees of freedom of each run's ``sdc_stderr``: the stored ``sdc_stderr_dof`` where
+    the run has one (a run whose cells ran one motion takes its error from batches of its
+    steady window, batches - 1), else the scatter of its cells', cells - 1 (runs stored
+    before the degrees of freedom were kept); NaN where neither is known."""
+    assumed = cells - 1.0 if cells > 1 else math.nan
+    if "sdc_stderr_dof" not in runs.columns:
+        return np.full(len(runs), assumed)
+    stored = np.array([stored_stderr_dof(v) for v in runs["sdc_stderr_dof"]], dtype=float)
+    return np.where(np.isfinite(stored), stored, assumed)
 
 
 def _same_count(count: float, group: np.ndarray) -> bool:

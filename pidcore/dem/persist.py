@@ -189,6 +189,8 @@ def load_dem_result(entry: StoredEntry) -> DemResult:
         # stored before the key existed: coupon_mass_kg held coupon + fixture then
         values["moving_mass_kg"] = record["coupon_mass_kg"]
     values.setdefault("coupon_cells", specimen.cell.count)
+    # stored before the degrees of freedom were kept: unknown (readers assume cells - 1)
+    values.setdefault("sdc_stderr_dof", float("nan"))
     if "energy_dissipated_rolling_j" not in record and not any(
             pair.rolling_friction for pair in (specimen.pairs.particle_particle,
                                                specimen.pairs.particle_wall)):
@@ -206,7 +208,7 @@ def load_dem_result(entry: StoredEntry) -> DemResult:
                  "steady_start_cycle", "steady_cycles", "samples_per_cycle", "coupon_cells"):
         values[name] = int(values[name])
     values["steady_detected"] = bool(values["steady_detected"])
-    for name in ("sdc", "sdc_stderr"):
+    for name in ("sdc", "sdc_stderr", "sdc_stderr_dof"):
         if values[name] is None or not math.isfinite(float(values[name])):
             values[name] = float("nan")
     return DemResult(**values)

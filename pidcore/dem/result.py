@@ -21,7 +21,8 @@ if TYPE_CHECKING:  # pragma: no cover
 
 #: Unit of every scalar and array of :class:`DemResult`.
 UNITS: dict[str, str] = {
-    "sdc": RATIO_UNIT, "sdc_stderr": RATIO_UNIT, "loss_factor": RATIO_UNIT,
+    "sdc": RATIO_UNIT, "sdc_stderr": RATIO_UNIT, "sdc_stderr_dof": COUNT_UNIT,
+    "loss_factor": RATIO_UNIT,
     "energy_per_cycle_j": "J", "energy_dissipated_normal_j": "J",
     "energy_dissipated_friction_j": "J", "energy_dissipated_rolling_j": "J",
     "max_kinetic_energy_j": "J", "work_per_cycle_j": "J",
@@ -70,6 +71,13 @@ class DemResult:
     coupon (interval means, 441 x cell mean), ``shaker_force_n`` = coupon mass x acceleration +
     ``wall_force_n`` (the force a shaker would measure), ``velocity_m_s`` the coupon velocity,
     all sampled at ``sample_rate_hz`` from the drive start.
+
+    ``sdc_stderr`` is the scatter of the cells' SDCs (``std(ddof=1) / sqrt(K)``) with
+    ``sdc_stderr_dof`` = K - 1; where the cells all ran one motion
+    (:func:`cells_ran_one_motion`) it is the batch-means error of that motion's steady
+    window (:func:`batch_means_stderr`, batches of ``config.block_cycles`` cycles, dof =
+    batches - 1), NaN with fewer than DEM_MIN_STDERR_BATCHES batches. Runs stored before the
+    degrees of freedom were kept read NaN (unknown).
     """
 
     case: LoadCase
@@ -111,6 +119,7 @@ class DemResult:
     samples_per_cycle: int
     specimen: Specimen | None = None
     coupon_cells: int = defaults.COUPON_CELLS
+    sdc_stderr_dof: float = math.nan
 
     @classmethod
     def from_run(cls, *, case: LoadCase, config: DemConfig, law: ContactLaw,
@@ -134,9 +143,17 @@ class DemResult:
         sdc_cells = per_cell / e_max if e_max > 0 else np.full(k, np.nan)
         # cells that ran one motion (a lone particle bouncing along the drive axis touches no
         # side wall, so its random start xy does not matter) are one sample, not K: their
-        # scatter of exactly 0 is no standard error (it printed "+- 0" for an unsettled bouncer)
-        stderr = (float(np.std(sdc_cells, ddof=1) / math.sqrt(k))
-                  if k > 1 and not cells_ran_one_motion(sdc_cells) else float("nan"))
+        # scatter of exactly 0 is no standard error (it printed "+- 0" for an unsettled
+        # bouncer). That motion's own scatter over its steady window is: batch means of it
+        if cells_ran_one_motion(sdc_cells):
+            sdc_cycles = (n_coupon * steady[0, :, 1:].sum(axis=1) / e_max if e_max > 0
+                          else np.full(steady.shape[1], np.nan))
+            stderr, stderr_dof = batch_means_stderr(sdc_cycles, config.block_cycles)
+        elif k > 1:
+            stderr = float(np.std(sdc_cells, ddof=1) / math.sqrt(k))
+            stderr_dof = float(k - 1)
+        else:
+            stderr, stderr_dof = float("nan"), float("nan")
         work = float(tally[:, :, 0].sum())
         # friction and normal summed as before rolling existed (same rounding), rolling added
         dissipated = float(tally[:, :, 1:3].sum()) + float(tally[:, :, 3:].sum())
@@ -180,6 +197,7 @@ class DemResult:
             sample_rate_hz=1.0 / h, sample_time_s=0.5 * (t0 + t1), wall_force_n=wall_n,
             shaker_force_n=moving_mass_kg * acc + wall_n, velocity_m_s=vel,
             samples_per_cycle=int(spc), specimen=specimen, coupon_cells=int(n_coupon),
+            sdc_stderr_dof=stderr_dof,
         )
 
     @property
@@ -256,10 +274,27 @@ class DemResult:
                 notes.append(f"{overridden}: {self.particles_per_cell} particles per cell "
                              "simulated")
         if cells_ran_one_motion(self.sdc_per_cell):
-            notes.append(f"no standard error: the {self.cells_simulated} cells ran the same "
-                         "motion (the same SDC to the last bit, as a lone particle bouncing along "
-                         "the drive axis does), so they are one sample and their scatter says "
-                         "nothing of the SDC's uncertainty")
+            same = (f"the {self.cells_simulated} cells ran the same motion (the same SDC to "
+                    "the last bit, as a lone particle bouncing along the drive axis does), so "
+                    "they are one sample and their scatter says nothing of the SDC's "
+                    "uncertainty")
+            b = self.config.block_cycles
+            batches = self.steady_cycles // b
+            if math.isfinite(self.sdc_stderr):
+                notes.append(
+                    f"standard error from {batches} batches of {b} cycles of one motion, not "
+                    f"from independent cells ({self.sdc_stderr_dof:g} degrees of freedom): "
+                    f"{same}; successive batches of one motion are correlated, so this error "
+                    "may understate the SDC's uncertainty")
+            elif batches < defaults.DEM_MIN_STDERR_BATCHES:
+                notes.append(
+                    f"no standard error: {same}, and its steady window of "
+                    f"{self.steady_cycles} cycles holds {batches} batches of {b} cycles, "
+                    f"fewer than the {defaults.DEM_MIN_STDERR_BATCHES} a batch-means error "
+                    "needs")
+            else:  # a run stored before such runs got a batch-means error
+                notes.append(f"no standard error: {same} (stored before pidcore took one from "
+                             "batches of the motion's steady window)")
         g = self.case.acceleration_g
         if g > defaults.DEM_NOTE_ACCELERATION_G:
             notes.append(f"a {g:g} g drive, above the paper's 1-10 g: if it was typed in "
@@ -311,7 +346,8 @@ class DemResult:
                             self.specimen.pairs.tangential_stiffness_model,
                         "fixture_mass_kg": self.specimen.coupon.fixture_mass_kg,
                         "particle_mass_kg": self.specimen.particles.mass_kg})
-        for name in ("sdc", "sdc_stderr", "loss_factor", "energy_per_cycle_j", "work_per_cycle_j",
+        for name in ("sdc", "sdc_stderr", "sdc_stderr_dof", "loss_factor", "energy_per_cycle_j",
+                     "work_per_cycle_j",
                      "stored_energy_change_per_cycle_j",
                      "energy_dissipated_normal_j", "energy_dissipated_friction_j",
                      "energy_dissipated_rolling_j", "max_kinetic_energy_j",
@@ -391,6 +427,31 @@ def cells_ran_one_motion(sdc_per_cell: np.ndarray) -> bool:
     """Whether two or more cells gave the same SDC to the last bit: the same simulation."""
     sdc = np.asarray(sdc_per_cell, dtype=float)
     return sdc.size > 1 and bool(np.all(np.isfinite(sdc))) and float(np.ptp(sdc)) == 0.0
+
+
+def batch_means_stderr(per_cycle: np.ndarray, batch_cycles: int, *,
+                       min_batches: int = defaults.DEM_MIN_STDERR_BATCHES,
+                       ) -> tuple[float, float]:
+    """Standard error of the mean of ``per_cycle`` (one motion's SDC of each steady cycle) by
+    batch means, and its degrees of freedom: the window cut into whole batches of
+    ``batch_cycles`` cycles (a remainder at its end left out), ``std(batch means, ddof=1) /
+    sqrt(batches)`` with batches - 1 degrees of freedom. (NaN, NaN) with fewer than
+    ``min_batches`` batches or a non-finite cycle. Batches of a correlated motion are not
+    independent: the error may be understated.
+
+    >>> batch_means_stderr(np.array([1.0, 1.0, 2.0, 2.0, 3.0, 3.0, 4.0, 4.0]), 2)
+    (0.6454972243679028, 3.0)
+    """
+    from ..errors import ParameterError
+
+    values = np.asarray(per_cycle, dtype=float)
+    if batch_cycles < 1:
+        raise ParameterError(f"batch_cycles {batch_cycles!r}: expected an integer >= 1")
+    n = values.size // batch_cycles
+    if n < max(min_batches, 2) or not np.all(np.isfinite(values[:n * batch_cycles])):
+        return float("nan"), float("nan")
+    means = values[:n * batch_cycles].reshape(n, batch_cycles).mean(axis=1)
+    return float(np.std(means, ddof=1) / math.sqrt(n)), float(n - 1)
 
 
 def virtual_shaker_loop(force_n: np.ndarray, velocity_m_s: np.ndarray, *,

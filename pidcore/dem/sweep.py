@@ -327,7 +327,7 @@ SWEEP_CASE_STATUSES = ("simulated", "already stored",
                        STORED_MEANWHILE)
 #: Result fields of each case in :meth:`SweepSummary.to_dict`, named (units as suffixes) as
 #: ``pidcore dem run --json`` names them, read from the stored run.
-SWEEP_CASE_FIELDS = ("sdc", "sdc_stderr", "loss_factor", "particles_per_cell",
+SWEEP_CASE_FIELDS = ("sdc", "sdc_stderr", "sdc_stderr_dof", "loss_factor", "particles_per_cell",
                      "cells_simulated", "seed", "steady_detected",
                      # whose run it is, as stored: --json named no specimen, so a sweep's
                      # document could not tell the runs of two files of one name apart
