@@ -82,6 +82,9 @@ measured_specimen_sha256, MEASURED_SHA256_FIELD, deciding_sha256, same_tested_fi
     The file's hash saved beside that name (record field ``specimen_sha256``), and how a
     measurement's recorded hash meets a DEM run's or a calibration's: by hash where both
     know it, else by name (a record saved before the hash was).
+resolve_specimen_name, NamedSpecimen
+    The known file a typed specimen name means (the app's settings grid), saved with its
+    name and hash as ``analyze --specimen`` saves it; else by name, saying so.
 calibrated_name, uncalibrated_name, calibrated_provenance, ProvenanceSpec, provenance_test_name
     What ``pidcore calibrate`` names the file it writes, the name it was made from, the
     ``[provenance]`` table recording the source file's name and sha256, and the name of the
@@ -108,7 +111,7 @@ import os
 import re
 import sys
 import tomllib
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
@@ -1372,6 +1375,43 @@ def same_tested_file(measured_sha256: object, tested: object) -> bool | None:
     return mine == theirs
 
 
+@dataclass(frozen=True)
+class NamedSpecimen:
+    """What a specimen typed by name is saved as (:func:`resolve_specimen_name`): the record's
+    ``name`` and ``sha256`` ("" where no one known file has that name), and ``note``, one line
+    saying why only the name is saved ("" where the file was found or no name was typed)."""
+
+    name: str
+    sha256: str = ""
+    note: str = ""
+
+
+def resolve_specimen_name(typed: str, known: Sequence[Specimen]) -> NamedSpecimen:
+    """The specimen file a typed name means among the ``known`` files (those a page offers),
+    saved as ``pidcore analyze --specimen FILE`` saves it (:func:`measured_specimen_name`,
+    :func:`measured_specimen_sha256`). ``typed`` is a file's name or its
+    :func:`hashed_name` (``"panel [3e945a]"``, which tells two files of one name apart).
+
+    A name no known file has, or that several files of different content have, is saved by
+    name only, as a record of an earlier pidcore (matched by name), with a note saying so: a
+    file picked at random among two of one name would meet the other's DEM runs."""
+    typed = typed.strip()
+    if not typed:
+        return NamedSpecimen("")
+    found = {s.hash: s for s in known
+             if typed in (s.name, hashed_name(s.name, s.hash), measured_specimen_name(s))}
+    if len(found) == 1:
+        (specimen,) = found.values()
+        return NamedSpecimen(measured_specimen_name(specimen), measured_specimen_sha256(specimen))
+    if found:
+        labels = ", ".join(sorted(hashed_name(s.name, s.hash) for s in found.values()))
+        return NamedSpecimen(typed, "", f"specimen {typed}: {len(found)} known files of that "
+                             f"name ({labels}); saved by name only: name one as shown to "
+                             "save its file's sha256")
+    return NamedSpecimen(typed, "", f"specimen {typed}: no known specimen file of that name; "
+                         "saved by name only (its DEM runs are met by name)")
+
+
 def hashed_name(name: str, sha256: str) -> str:
     """A specimen file by its name and the start of its hash, ``"name [45d792]"``: how the
     pages label its DEM runs (:func:`pidcore.compare.specimens.specimen_label`) and the name
@@ -1551,7 +1591,8 @@ __all__ = ["CellSpec", "CouponSpec", "PairSpec", "PairsSpec", "ParticleSpec", "S
            "cell_geometry", "contact_law", "describe", "hashed_name", "is_paper_coupon",
            "load_specimen",
            "MEASURED_SHA256_FIELD", "deciding_sha256", "measured_specimen_name",
-           "measured_specimen_sha256", "models_paper_coupon", "numeric_fields", "same_tested_file",
+           "measured_specimen_sha256", "models_paper_coupon", "NamedSpecimen",
+           "resolve_specimen_name", "numeric_fields", "same_tested_file",
            "provenance_test_name",
            "paper_specimen", "particles_for_fill"]
 

@@ -742,8 +742,12 @@ def test_calibrate_page_calibrates_a_chosen_specimen_file_on_its_own_measurement
     assert not at.exception
     # only the steel measurement of this specimen; the acrylic one is named as left out
     cases = next(m for m in at.multiselect if (m.key or "").startswith("calibration_cases_"))
-    assert cases.options == cases.value == ["100 Hz, 5 g, 50 %, steel, specimen steel_6mm",
-                                            "200 Hz, 5 g, 50 %, steel"]
+    # the file named in the grid is known: its record carries its hash, which the label shows
+    from pidcore.specimen import load_specimen
+
+    short = load_specimen(folder / "steel_6mm.toml").hash[:6]
+    assert cases.options == cases.value == [f"100 Hz, 5 g, 50 %, steel, specimen steel_6mm "
+                                            f"[{short}]", "200 Hz, 5 g, 50 %, steel"]
     assert any("Not used for steel_6mm (steel particles): 1 measured load case(s) of acrylic "
                "particles." in c.value for c in at.caption)
     at.multiselect(key="calibration_fit").set_value(["fixture_mass_kg"])
@@ -1667,3 +1671,80 @@ def test_a_report_checkbox_or_file_the_page_address_cannot_hold_is_refused(store
     assert at.checkbox(key="report_pool").value is False
     at = _app_at({"report_pool": "TRUE"})  # Streamlit's reading: any case
     assert at.checkbox(key="report_pool").value is True and not at.error
+
+
+def _two_files_of_one_name(tmp_path, store_file):
+    """The bundled steel_6mm.toml in the app's specimen folder, another file named steel_6mm
+    (another fixture mass), and one DEM run of each at the test's load case."""
+    import shutil
+
+    from pidcore.specimen import Specimen, load_specimen
+    from pidcore.store import Store
+
+    folder = tmp_path / "data_samples" / "specimens"  # the app runs in tmp_path
+    folder.mkdir(parents=True)
+    shutil.copy(REPO / "data_samples" / "specimens" / "steel_6mm.toml", folder)
+    bundled = load_specimen(folder / "steel_6mm.toml")
+    edited = Specimen.from_text(bundled.with_values({"coupon.fixture_mass_kg": 0.08}).to_toml())
+    assert edited.name == bundled.name == "steel_6mm" and edited.hash != bundled.hash
+    store = Store(store_file)
+    _specimen_run(store, "run_bundled", "steel_6mm", bundled.hash, 0.0197, True)
+    _specimen_run(store, "run_edited", "steel_6mm", edited.hash, 0.02308, True)
+    return bundled, edited
+
+
+def _save(at: AppTest) -> AppTest:
+    at.button(key="save").click()
+    at.run()
+    assert not at.exception, at.exception
+    assert any("saved 1" in s.value for s in at.success)
+    return at
+
+
+def test_a_specimen_named_in_the_grid_is_saved_with_its_files_hash(store_file, tmp_path):
+    """Was: the app saved the name steel_6mm only, and with runs of two files of that name
+    the Compare tab met neither ("vs our DEM none"), before and after the save."""
+    from pidcore.specimen import hashed_name
+    from pidcore.store import Store
+
+    bundled, edited = _two_files_of_one_name(tmp_path, store_file)
+    data = mass_damper_csv(frequency_hz=100.0, acceleration_g=5.0)
+    at = _upload(_app(), [("m_fill50.csv", data), ("settings.csv", _steel_settings("steel_6mm"))])
+    own = f"vs our DEM 0.0197 ± 0.0010 (specimen {hashed_name('steel_6mm', bundled.hash)})"
+    assert own in _headline(at)  # the bundled file's run, not the edited file's 0.0231
+    _save(at)
+    listed = Store(store_file).list_analyses()
+    assert listed["specimen"].tolist() == ["steel_6mm"]
+    assert listed["specimen_sha256"].tolist() == [bundled.hash]
+    # after a restart, the saved record alone meets the same run
+    assert own in _headline(_app())
+
+
+def test_every_files_specimen_may_be_an_uploaded_toml_and_an_unknown_name_says_so(
+        store_file, tmp_path):
+    from pidcore.specimen import hashed_name
+    from pidcore.store import Store
+
+    bundled, edited = _two_files_of_one_name(tmp_path, store_file)
+    data = mass_damper_csv(frequency_hz=100.0, acceleration_g=5.0)
+    at = _app()
+    at.file_uploader(key="dem_specimen_file").set_value(
+        [("panel.toml", edited.to_toml().encode(), "application/toml")])
+    at.run()
+    label = hashed_name("steel_6mm", edited.hash)
+    box = at.selectbox(key="every_file_specimen")
+    assert label in box.options and hashed_name("steel_6mm", bundled.hash) in box.options
+    box.set_value(label)
+    at = _upload(at, [("m_fill50.csv", data), ("settings.csv", _steel_settings(None))])
+    assert f"vs our DEM 0.0231 ± 0.0010 (specimen {label})" in _headline(at)
+    _save(at)
+    assert Store(store_file).list_analyses()["specimen_sha256"].tolist() == [edited.hash]
+    # a name no known file has: saved by name as before, and the page says so in one line
+    at = _upload(_app(), [("m_fill50.csv", data), ("settings.csv", _steel_settings("nosuch"))])
+    said = [i.value for i in at.info if i.value.startswith("specimen nosuch:")]
+    assert said == ["specimen nosuch: no known specimen file of that name; saved by name only "
+                    "(its DEM runs are met by name)"]
+    _save(at)
+    listed = Store(store_file).list_analyses()
+    assert listed["specimen"].tolist() == ["nosuch"]
+    assert "specimen_sha256" not in listed.columns  # the replaced record's hash is gone too

@@ -310,3 +310,24 @@ def test_report_rows_part_two_files_of_one_name_but_not_the_papers_coupon(two_pa
     assert rows["b.csv"]["SDC measured [-]"] == pytest.approx(0.30, rel=1e-12)
     assert [rows[k][SHA] for k in ("a.csv", "b.csv", "c.csv; d.csv")] == [
         two_panels.first.hash, two_panels.second.hash, ""]
+
+
+def test_a_typed_name_resolves_to_its_one_known_file(two_panels):
+    """The app's settings grid: a name meets the known file of that name (saved as
+    `analyze --specimen` saves it); two files of the name need the hashed name."""
+    from pidcore.specimen import hashed_name, resolve_specimen_name
+
+    first, second = two_panels.first, two_panels.second
+    one = resolve_specimen_name(" panel ", [paper_specimen(), first])
+    assert (one.name, one.sha256, one.note) == ("panel", first.hash, "")
+    both = resolve_specimen_name("panel", [first, second])
+    assert (both.name, both.sha256) == ("panel", "")
+    assert both.note.startswith("specimen panel: 2 known files of that name (")
+    picked = resolve_specimen_name(hashed_name("panel", second.hash), [first, second])
+    assert (picked.name, picked.sha256) == ("panel", second.hash)
+    assert resolve_specimen_name("", [first]).name == ""
+    # another file of the paper coupon's name is saved as its tests are by the CLI
+    odd = Specimen.from_text(paper_specimen().with_values(
+        {"coupon.fixture_mass_kg": 0.05}).to_toml())
+    named = resolve_specimen_name("paper_coupon", [odd])
+    assert (named.name, named.sha256) == (f"paper_coupon [{odd.hash[:6]}]", odd.hash)

@@ -383,6 +383,28 @@ def specimen_materials(folders: Iterable[str | os.PathLike]) -> list[str]:
     return found
 
 
+def known_specimens(folders: Iterable[str | os.PathLike],
+                    uploaded: Iterable[tuple[str, bytes]] = ()) -> list:
+    """The specimen files a page knows (:class:`pidcore.specimen.Specimen`), those the DEM
+    tab offers: the paper's coupon, the ``*.toml`` files in ``folders`` and the uploaded ones
+    (``(name, bytes)``, parsed, never executed). Unreadable files are skipped (the DEM page
+    reports them)."""
+    from ..specimen import Specimen, load_specimen, paper_specimen
+
+    found = [paper_specimen()]
+    for path in specimen_files(folders):
+        try:
+            found.append(load_specimen(path))
+        except (PidcoreError, OSError, ValueError):
+            continue
+    for name, data in uploaded:
+        try:
+            found.append(Specimen.from_bytes(data, source=name))
+        except (PidcoreError, ValueError):
+            continue
+    return found
+
+
 #: Appended to an unknown material's error: how an own material becomes one to state.
 MATERIAL_HINT = ("an own material can be stated once a specimen file of it is in the "
                  "specimen folders ("
@@ -761,6 +783,9 @@ class AnalysedFile:
     options: AnalysisOptions
     specimen: str
     warnings: tuple = ()
+    #: sha256 of the specimen file named (:func:`pidcore.specimen.resolve_specimen_name`),
+    #: "" where only its name is known
+    specimen_sha256: str = ""
 
 
 def results_table(files: Sequence[AnalysedFile]) -> pd.DataFrame:
@@ -817,7 +842,7 @@ def check_one_load_case_per_content(files: Sequence[AnalysedFile]) -> None:
 
     refuse_identical_contents_stating_apart(
         ((Path(f.record.measurement.source).name, measurement_key(f.record.measurement),
-          (f.load_case.key, f.specimen), words(f)) for f in files),
+          (f.load_case.key, f.specimen, f.specimen_sha256), words(f)) for f in files),
         remedy="one measurement is one record: state one load case, or remove one of the files")
 
 
@@ -843,12 +868,14 @@ def save_records(path: str | os.PathLike, files: Sequence[AnalysedFile], *,
     """Save analysed files with their load cases to the store in one locked transaction.
 
     Each file's own corrections are its analysis parameters (with its channel mapping); the
-    load case fields and the specimen go into its record. A file with plausibility warnings is
+    load case fields and the specimen (its name, and its file's sha256 where known) go into its
+    record. A file with plausibility warnings is
     only saved with ``confirm_implausible`` (the user's explicit confirmation). The notes say
     which saved record each byte-identical file replaces: :func:`pidcore.measure.save_analyses`,
     the save of ``pidcore analyze`` and ``pidcore report``.
     """
     from ..measure import save_analyses
+    from ..specimen import MEASURED_SHA256_FIELD
 
     if not files:
         raise ParameterError("nothing to save: no file was analysed successfully")
@@ -864,6 +891,8 @@ def save_records(path: str | os.PathLike, files: Sequence[AnalysedFile], *,
         [(Path(f.record.measurement.source).name, f.load_case, "stated in the app")
          for f in files],
         fields=[{**({"specimen": f.specimen} if f.specimen else {}),
+                 **({MEASURED_SHA256_FIELD: f.specimen_sha256}
+                    if f.specimen and f.specimen_sha256 else {}),
                  **({"plausibility_warnings": "; ".join(str(w) for w in f.warnings)}
                     if f.warnings else {})} for f in files])
     return SavedRecords(saved.keys, tuple(saved.notes), saved.breakdown())

@@ -253,10 +253,13 @@ class MeasuredEntry:
 
     @classmethod
     def from_record(cls, record, load_case: LoadCase, *,
-                    specimen: str = "", options=None) -> MeasuredEntry:
+                    specimen: str = "", options=None,
+                    specimen_sha256: str = "") -> MeasuredEntry:
         """Entry of a fresh (unsaved) analysis (:class:`pidcore.measure.AnalyzedRecord`);
-        ``options`` (:class:`pidcore.measure.AnalysisOptions`) names the corrections."""
+        ``options`` (:class:`pidcore.measure.AnalysisOptions`) names the corrections;
+        ``specimen_sha256``: the specimen file's hash as it would be saved ("": none)."""
         from ..records import measurement_key
+        from ..specimen import deciding_sha256
         from .plausibility import implausible_findings
 
         a = record.analysis
@@ -274,7 +277,8 @@ class MeasuredEntry:
                    corrections=describe_corrections(vars(options)) if options else "",
                    measurement_key=content, implausible=found[0].message if found else "",
                    settings=dict(vars(options)) if options else {},
-                   sdc_stderr_dof=a.sdc_stderr_dof)
+                   sdc_stderr_dof=a.sdc_stderr_dof,
+                   specimen_sha256=deciding_sha256(specimen_sha256) if specimen else "")
 
     @classmethod
     def from_store(cls, row: pd.Series, arrays: dict) -> MeasuredEntry:

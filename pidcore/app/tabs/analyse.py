@@ -51,6 +51,10 @@ def _settings_editor(measurements, tables: dict[str, pd.DataFrame], channel_name
                 options=list(materials), required=True,
                 help="the table's materials, those of the specimen files and of the store's "
                      "DEM runs (own specimens)"),
+            "specimen": st.column_config.TextColumn(
+                help="a specimen file's name (or 'name [3e945a]' where two files share it), "
+                     "as the DEM tab offers them: saved with the file's sha256; another name "
+                     "is saved by name only"),
             "direction": st.column_config.SelectboxColumn(options=list(DRIVE_DIRECTIONS),
                                                           required=True),
             "vibrometer delay [µs]": st.column_config.TextColumn(
@@ -73,11 +77,26 @@ def _settings_editor(measurements, tables: dict[str, pd.DataFrame], channel_name
     return edited
 
 
-def _card(upload, row, sample_rate_hz, materials, given=()):
-    """Results of one file; returns an AnalysedFile or None."""
+#: The "Options for every file" specimen choice that leaves each file's row to name one.
+ROW_SPECIMEN_CHOICE = "(as the settings table names it)"
+
+
+def _known_specimens() -> list:
+    """The specimen files the DEM tab offers: bundled, in the specimen folders, and those
+    uploaded on the DEM or Calibrate tab (their widgets keep them for the session)."""
+    uploaded = [(u.name, u.getvalue()) for key in ("dem_specimen_file",
+                                                    "calibration_specimen_file")
+                if (u := st.session_state.get(key)) is not None]
+    return uploads.known_specimens(defaults.APP_SPECIMEN_FOLDERS, uploaded)
+
+
+def _card(upload, row, sample_rate_hz, materials, given=(), known=(), every_file=""):
+    """Results of one file; returns an AnalysedFile or None. ``known``: the specimen files a
+    typed specimen name may mean; ``every_file``: the specimen of a row naming none."""
     from pidcore.compare.case import load_case_of, stated_case
     from pidcore.compare.plausibility import implausible_findings
     from pidcore.errors import PidcoreError
+    from pidcore.specimen import resolve_specimen_name
 
     name = upload.name
     with st.container(border=True):
@@ -130,13 +149,17 @@ def _card(upload, row, sample_rate_hz, materials, given=()):
                        icon="⚠️")
         for note in (*record.notes, *zero_notes):
             st.caption(f"note: {note}")
-        return uploads.AnalysedFile(record, case, options, str(row.get("specimen", "") or ""),
-                                    warnings)
+        named = resolve_specimen_name(str(row.get("specimen", "") or "") or every_file, known)
+        if named.note:  # a name alone meets another file's DEM runs of that name
+            st.info(named.note)
+        return uploads.AnalysedFile(record, case, options, named.name, warnings,
+                                    specimen_sha256=named.sha256)
 
 
 def render(stores) -> list:
     """The page; returns this session's analysed files (for the Compare page)."""
     from pidcore.errors import PidcoreError
+    from pidcore.specimen import hashed_name
 
     st.subheader("Upload & analyse")
     st.caption(f"UFF58 (ASCII or binary), CSV/TXT, MAT and HDF5 exports; several at once. "
@@ -158,6 +181,13 @@ def render(stores) -> list:
         except PidcoreError as exc:
             st.error(f"{exc}; files are read without a sample rate")
             sample_rate_hz = None
+        known = _known_specimens()
+        every_file = st.selectbox(
+            "specimen of every file", [ROW_SPECIMEN_CHOICE, *dict.fromkeys(
+                hashed_name(s.name, s.hash) for s in known)], key="every_file_specimen",
+            help="a specimen file the DEM tab offers, saved with its sha256, for the files "
+                 "whose settings row names no specimen")
+        every_file = "" if every_file == ROW_SPECIMEN_CHOICE else every_file
     measurements, tables, accepted = [], {}, []
     refused: list[uploads.RefusedTable] = []
     try:
@@ -227,7 +257,8 @@ def render(stores) -> list:
                 st.error(held)
             continue
         result = _card(upload, row, sample_rate_hz, materials,
-                       uploads.columns_given(list(tables.values()), upload.name))
+                       uploads.columns_given(list(tables.values()), upload.name), known,
+                       every_file)
         if result is not None:
             analysed.append(result)
     if analysed:

@@ -39,7 +39,9 @@ def _entries(stores, session_files):
                           key="include_session")
     if include:
         entries += [MeasuredEntry.from_record(f.record, f.load_case, specimen=f.specimen,
-                                              options=f.options) for f in session_files]
+                                              options=f.options,
+                                              specimen_sha256=f.specimen_sha256)
+                    for f in session_files]
     # one data set counted once (a saved file uploaded again, or under another name)
     entries, notes = unique_entries(entries)
     for note in notes:
