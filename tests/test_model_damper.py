@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -225,3 +226,31 @@ def test_points_held_at_the_edge_are_flagged(model):
     inside = equivalent_damper_table(model, fills_percent=[50], accelerations_g=[1, 10],
                                      frequencies_hz=[50, 1000], vibrated_mass_kg=0.0988)
     assert not inside[SDC_HELD_COLUMN].any()  # the grid's own edges are modelled points
+
+
+def test_an_area_in_cm2_or_mm2_is_refused_by_the_library(model):
+    # area_m2=100 (cm^2 of the paper's 0.01 m^2 coupon) gave a c_eq_per_area 1e4 x too small
+    # without a word: only the CLI's --area was checked against the specimen's cells
+    from pidcore.specimen import Specimen
+
+    grid = dict(fills_percent=[50], accelerations_g=[5], frequencies_hz=[100],
+                vibrated_mass_kg=0.0988)
+    for typed, slip in ((100.0, "cm^2 or mm^2"), (1e4, "cm^2 or mm^2"),
+                        (1e-6, "one cell's area")):
+        with pytest.raises(ParameterError) as caught:
+            equivalent_damper_table(model, area_m2=typed, **grid)
+        message = str(caught.value)
+        assert message.startswith(f"area_m2 {typed:g} m^2 is ")
+        assert "specimen paper_coupon's 441 cells" in message
+        assert "expected the coupon's face area in m^2" in message and slip in message
+        assert "\n" not in message
+    # the coupon's own area passes; another specimen's cells are what it is checked against
+    ok = equivalent_damper_table(model, area_m2=0.01, **grid)
+    np.testing.assert_allclose(ok["c_eq_per_area [N s/m^3]"], ok["c_eq [N s/m]"] / 0.01,
+                               rtol=1e-15)  # one division
+    text = (Path(__file__).parents[1] / "data_samples" / "specimens"
+            / "steel_6mm.toml").read_text()
+    steel = Specimen.from_text(text, source="steel_6mm.toml")
+    equivalent_damper_table(model, area_m2=0.01, specimen=steel, **grid)  # 286 cells, 0.00999
+    with pytest.raises(ParameterError, match="specimen steel_6mm's 286 cells"):
+        equivalent_damper_table(model, area_m2=100.0, specimen=steel, **grid)

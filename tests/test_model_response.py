@@ -204,3 +204,30 @@ def test_time_domain_response_refuses_what_harmonic_balance_refuses(model, mode)
     inside = time_domain_response(model, mode, frequency_hz=300.0, force_amplitude_n=FORCE_N,
                                   settle_cycles=20, measure_cycles=2)
     assert not inside.clipped
+
+
+def test_a_coupon_area_in_cm2_is_refused(mode):
+    # coupon_area_m2=100 (the paper coupon's 0.01 m^2 typed in cm^2) gave a c_pd 1e4 x too
+    # small without a word: only the CLI's --area was checked
+    import dataclasses
+
+    with pytest.raises(ParameterError) as caught:
+        dataclasses.replace(mode, coupon_area_m2=100.0)
+    message = str(caught.value)
+    assert message.startswith("TreatedMode: coupon_area_m2 100 m^2 is ")
+    assert "paper_coupon's 441 cells" in message and "was it cm^2 or mm^2?" in message
+    with pytest.raises(ParameterError, match=r"coupon_area_m2 1e-05 m\^2 .* one cell's area"):
+        dataclasses.replace(mode, coupon_area_m2=1e-5)
+    # a specimen of 4 cells (its mass scaled with them) has a coupon of 7.8e-5 m^2: checked
+    # against its own cells, that area passes
+    import re
+
+    from pidcore.specimen import Specimen, paper_specimen
+
+    text = re.sub(r"(?m)^count = 441$", "count = 4", paper_specimen().text)
+    text = re.sub(r"(?m)^mass_kg = .*$", "mass_kg = 0.0002", text)
+    four_cells = Specimen.from_text(text, source="four cells")
+    assert dataclasses.replace(mode, coupon_area_m2=5e-5,
+                               coupon_specimen=four_cells).coupon_area_m2 == 5e-5
+    with pytest.raises(ParameterError, match="specimen paper_coupon's 441 cells"):
+        dataclasses.replace(mode, coupon_area_m2=5e-5)  # the same area, the paper's coupon

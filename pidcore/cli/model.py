@@ -227,13 +227,13 @@ def run_damper(args: argparse.Namespace) -> int:
         material = args.material or defaults.MODEL_PARTICLE_MATERIAL
         mass = paper_vibrated_mass(convention, material)
         mass_text = f"{convention} ({material}, paper count per cell)"
-    if args.area is not None:
-        from ..model.damper import check_area, runs_specimen
-        from ..specimen import paper_specimen
+    from ..model.damper import check_area, runs_specimen
+    from ..specimen import paper_specimen
 
-        specimen = paper_specimen() if runs is None else runs_specimen(runs)
-        if specimen is not None:  # runs of an older store name no specimen text
-            check_area(args.area, specimen, "--area")
+    # runs of an older store name no specimen text: the paper's coupon, as the library takes it
+    specimen = (paper_specimen() if runs is None else runs_specimen(runs)) or paper_specimen()
+    if args.area is not None:
+        check_area(args.area, specimen, "--area")  # first, to name the option typed
         area, area_text = args.area, f"{args.area} m^2 (given)"
     elif runs is not None and "specimen_is_paper" in runs.columns \
             and not runs["specimen_is_paper"].fillna(True).astype(bool).all():
@@ -247,7 +247,7 @@ def run_damper(args: argparse.Namespace) -> int:
         model, fills_percent=args.fills if args.fills else model.axes[0],
         accelerations_g=args.accelerations if args.accelerations else model.axes[1],
         frequencies_hz=args.frequencies if args.frequencies else model.axes[2],
-        vibrated_mass_kg=mass, area_m2=area)
+        vibrated_mass_kg=mass, area_m2=area, specimen=specimen)
     provenance = {
         "sdc_source": model.source, "sdc_value": model.value_name,
         "interpolation": "tensor-product pchip (frequency, fill, acceleration passes)",

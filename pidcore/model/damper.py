@@ -25,6 +25,7 @@ from collections.abc import Callable, Sequence
 from datetime import UTC, datetime
 from importlib import resources
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pandas as pd
@@ -34,6 +35,9 @@ from .. import defaults as D
 from ..constants import STANDARD_GRAVITY, VIBRATED_MASS_CONVENTIONS
 from ..errors import ParameterError
 from .sdc_model import SdcModel
+
+if TYPE_CHECKING:  # a name for the hints only: the specimen module is imported where used
+    from ..specimen import Specimen
 
 #: The flag of :func:`equivalent_damper_table` marking points at a filled hole of the model grid.
 #: Like the report's category columns (``alignment [grid/interpolated/...]``) its
@@ -379,6 +383,7 @@ def equivalent_damper_table(model: SdcModel, *, fills_percent: Sequence[float] |
                             frequencies_hz: Sequence[float] | None = None,
                             vibrated_mass_kg: float | Callable[[float], float],
                             area_m2: float | None = None,
+                            specimen: Specimen | None = None,
                             clip_to_range: bool = False,
                             fills: Sequence[float] | None = None,
                             accelerations: Sequence[float] | None = None,
@@ -397,7 +402,13 @@ def equivalent_damper_table(model: SdcModel, *, fills_percent: Sequence[float] |
         coupon's m_c is refused as a unit slip (grams typed for kg), as ``pidcore model
         damper --vibrated-mass`` refuses it.
     area_m2 : float, optional
-        Coupon area for the per-area damper; default :func:`coupon_area_m2`.
+        Coupon area for the per-area damper; default :func:`coupon_area_m2`. An area more
+        than :data:`AREA_TO_CELLS_LIMIT` times off ``specimen``'s cells is refused as a unit
+        slip (cm^2 or mm^2 typed for m^2), as ``pidcore model damper --area`` refuses it.
+    specimen : pidcore.specimen.Specimen, optional
+        The coupon the SDC and m_c are of (default: the paper's,
+        :func:`pidcore.specimen.paper_specimen`; for stored DEM runs :func:`runs_specimen`):
+        ``area_m2`` is checked against its cells.
     clip_to_range : bool
         Passed to :meth:`SdcModel.evaluate` (default: refuse points outside the model); the
         points it held at the edge are flagged in :data:`SDC_HELD_COLUMN`.
@@ -432,7 +443,16 @@ def equivalent_damper_table(model: SdcModel, *, fills_percent: Sequence[float] |
                             model.axes[0], D.MODEL_PARTICLE_MATERIAL)
         mass = np.full(p.shape, float(vibrated_mass_kg))
     mass = _positive("vibrated_mass_kg", mass)
-    area = coupon_area_m2() if area_m2 is None else float(_positive("area_m2", area_m2))
+    if specimen is None:
+        from ..specimen import paper_specimen
+
+        specimen = paper_specimen()
+    if area_m2 is None:
+        area = coupon_area_m2()
+    else:
+        # 100 (cm^2) for 0.01 m^2 gave a c_eq_per_area 1e4 x too small; only --area was checked
+        area = float(_positive("area_m2", area_m2))
+        check_area(area, specimen)
     sdc = model.evaluate(p, a_g, f, clip_to_range=clip_to_range)
     # a 20 g row carried the 10 g SDC and a c_eq from it, like a modelled one
     held = np.array([not model.contains(point) for point in zip(p, a_g, f, strict=True)],

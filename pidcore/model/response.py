@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pandas as pd
@@ -40,8 +40,11 @@ from scipy.optimize import brentq
 
 from ..constants import STANDARD_GRAVITY
 from ..errors import ParameterError, as_given, instance_of, real_number, whole_number
-from .damper import coupon_area_m2, equivalent_damping_coefficient
+from .damper import check_area, coupon_area_m2, equivalent_damping_coefficient
 from .sdc_model import SdcModel
+
+if TYPE_CHECKING:  # a name for the hints only
+    from ..specimen import Specimen
 
 #: Points of the log-spaced scan for sign changes of the harmonic-balance residual.
 _SCAN_POINTS = 400
@@ -74,7 +77,12 @@ class TreatedMode:
         runs. Not ``coupon_vibrated_mass_kg()`` alone, which leaves the particles out (c_pd
         4.5 x low at 50 % fill).
     coupon_area_m2 : float
-        A_c [m^2] of those coupons (default: the paper's 0.1 m x 0.1 m).
+        A_c [m^2] of those coupons (default: the paper's 0.1 m x 0.1 m). More than
+        :data:`~pidcore.model.damper.AREA_TO_CELLS_LIMIT` times off the cells of
+        ``coupon_specimen`` is refused as a unit slip (cm^2 or mm^2 typed for m^2).
+    coupon_specimen : pidcore.specimen.Specimen, optional
+        Those coupons (default: the paper's; for stored DEM runs
+        :func:`~pidcore.model.damper.runs_specimen`), to check ``coupon_area_m2`` against.
     """
 
     natural_frequency_hz: float
@@ -84,6 +92,7 @@ class TreatedMode:
     fill_percent: float
     coupon_vibrated_mass_kg: float
     coupon_area_m2: float = coupon_area_m2()
+    coupon_specimen: Specimen | None = None
 
     def __post_init__(self) -> None:
         for name in ("natural_frequency_hz", "modal_mass_kg", "structural_damping_ratio",
@@ -98,6 +107,11 @@ class TreatedMode:
         if not np.isfinite(self.structural_damping_ratio) or self.structural_damping_ratio < 0:
             raise ParameterError(f"TreatedMode: structural_damping_ratio must be >= 0, got "
                                  f"{self.structural_damping_ratio!r}")
+        from ..specimen import paper_specimen
+
+        # 100 (cm^2) for A_c = 0.01 m^2 gave a c_pd 1e4 x too small without a word
+        check_area(self.coupon_area_m2, self.coupon_specimen or paper_specimen(),
+                   "TreatedMode: coupon_area_m2")
 
     @property
     def stiffness_n_m(self) -> float:
