@@ -254,3 +254,31 @@ def test_an_area_in_cm2_or_mm2_is_refused_by_the_library(model):
     equivalent_damper_table(model, area_m2=0.01, specimen=steel, **grid)  # 286 cells, 0.00999
     with pytest.raises(ParameterError, match="specimen steel_6mm's 286 cells"):
         equivalent_damper_table(model, area_m2=100.0, specimen=steel, **grid)
+
+
+def test_c_eq_per_cell_is_the_coupons_c_eq_shared_by_its_cells(model, tmp_path):
+    # a FEM model of the panel cell by cell needs c_eq per honeycomb cell, which the table did
+    # not give: the coupon's c_eq / its cell count, whichever specimen the SDC is of
+    from pidcore.specimen import Specimen
+
+    grid = dict(fills_percent=[25, 90], accelerations_g=[1, 5], frequencies_hz=[100, 1000],
+                vibrated_mass_kg=0.0988)
+    paper = equivalent_damper_table(model, **grid)
+    text = (Path(__file__).parents[1] / "data_samples" / "specimens"
+            / "steel_6mm.toml").read_text()
+    steel = equivalent_damper_table(model, specimen=Specimen.from_text(text, source="s"),
+                                    area_m2=0.01, **grid)
+    # one division each: to rounding
+    np.testing.assert_allclose(paper["c_eq_per_cell [N s/m]"] * 441, paper["c_eq [N s/m]"],
+                               rtol=1e-15)
+    np.testing.assert_allclose(steel["c_eq_per_cell [N s/m]"] * 286, steel["c_eq [N s/m]"],
+                               rtol=1e-15)
+    # the cells' dashpots in parallel dissipate the coupon's energy per cycle
+    w = 2 * np.pi * paper["frequency [Hz]"]
+    x = paper["displacement_amplitude [m]"]
+    np.testing.assert_allclose(441 * np.pi * paper["c_eq_per_cell [N s/m]"] * w * x**2,
+                               paper["energy_per_cycle [J]"], rtol=1e-13)
+    path = write_damper_table(paper, tmp_path, formats=("json",))[0]
+    doc = json.loads(path.read_text())
+    assert doc["units"]["c_eq_per_cell [N s/m]"] == "N s/m"
+    assert "per honeycomb cell (one cell)" in doc["columns"]["c_eq_per_cell [N s/m]"]

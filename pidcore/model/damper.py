@@ -63,6 +63,7 @@ DAMPER_COLUMNS: dict[str, str] = {
     "velocity_amplitude [m/s]": "m/s",
     "c_eq [N s/m]": "N s/m",
     "c_eq_per_area [N s/m^3]": "N s/m^3",
+    "c_eq_per_cell [N s/m]": "N s/m",
 }
 #: What each column of :data:`DAMPER_COLUMNS` is, per what and where it applies (the JSON
 #: file's ``columns``): the brackets name the unit, not whether a number is the coupon's or
@@ -94,6 +95,9 @@ DAMPER_COLUMN_MEANINGS: dict[str, str] = {
                                "area of a panel at the same fill, acceleration and frequency "
                                "(e.g. a grounded dashpot of c_eq_per_area x tributary area at "
                                "each node, along the drive direction)",
+    "c_eq_per_cell [N s/m]": "c_eq per honeycomb cell (one cell): c_eq / the coupon's cell "
+                             "count (provenance cells), for a panel whose cells are modelled "
+                             "one by one at the same fill, acceleration and frequency",
 }
 
 
@@ -408,7 +412,7 @@ def equivalent_damper_table(model: SdcModel, *, fills_percent: Sequence[float] |
     specimen : pidcore.specimen.Specimen, optional
         The coupon the SDC and m_c are of (default: the paper's,
         :func:`pidcore.specimen.paper_specimen`; for stored DEM runs :func:`runs_specimen`):
-        ``area_m2`` is checked against its cells.
+        ``area_m2`` is checked against its cells, ``c_eq_per_cell`` divides by their count.
     clip_to_range : bool
         Passed to :meth:`SdcModel.evaluate` (default: refuse points outside the model); the
         points it held at the edge are flagged in :data:`SDC_HELD_COLUMN`.
@@ -480,6 +484,7 @@ def equivalent_damper_table(model: SdcModel, *, fills_percent: Sequence[float] |
         "velocity_amplitude [m/s]": a / (2.0 * np.pi * f),
         "c_eq [N s/m]": c_eq,
         "c_eq_per_area [N s/m^3]": c_eq / area,
+        "c_eq_per_cell [N s/m]": c_eq / specimen.cell.count,
     })
     return out
 
