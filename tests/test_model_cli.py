@@ -57,6 +57,11 @@ def test_damper_writes_the_paper_grid(tmp_path):
     assert flagged[["frequency [Hz]", "acceleration [g]", "fill [%]"]].values.tolist() == [
         [1000.0, 1.0, 90.0]]
     assert doc["units"]["sdc_filled [True/False]"] == "True/False"
+    # per honeycomb cell: the coupon's c_eq over the paper's 441 cells, the count named
+    np.testing.assert_allclose(table["c_eq_per_cell [N s/m]"] * 441, table["c_eq [N s/m]"],
+                               rtol=1e-12)  # CSV's 17 significant digits, one division
+    assert doc["units"]["c_eq_per_cell [N s/m]"] == "N s/m"
+    assert doc["provenance"]["cells"].startswith("441 (specimen paper_coupon)")
     assert sum(r["sdc_filled [True/False]"] is True for r in doc["records"]) == 1
 
 
@@ -198,6 +203,9 @@ def test_damper_takes_one_specimens_runs_with_its_masses_and_a_given_area(tmp_pa
     np.testing.assert_allclose(at_grid["sdc [-]"], at_grid["sdc"], rtol=1e-12)
     np.testing.assert_allclose(table["c_eq_per_area [N s/m^3]"], table["c_eq [N s/m]"] / 0.02,
                                rtol=1e-12)
+    # runs that store no specimen text: their cell count is not the paper's 441 (here 100),
+    # so no per-cell damper is written from it
+    assert "c_eq_per_cell [N s/m]" not in table.columns
     # two files of one name are two specimens: told apart by hash
     listed["runs"] = pd.concat([mine, other])
     with pytest.raises(ParameterError, match="--where specimen_sha256=a{64}"):

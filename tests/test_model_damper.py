@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -225,3 +226,59 @@ def test_points_held_at_the_edge_are_flagged(model):
     inside = equivalent_damper_table(model, fills_percent=[50], accelerations_g=[1, 10],
                                      frequencies_hz=[50, 1000], vibrated_mass_kg=0.0988)
     assert not inside[SDC_HELD_COLUMN].any()  # the grid's own edges are modelled points
+
+
+def test_an_area_in_cm2_or_mm2_is_refused_by_the_library(model):
+    # area_m2=100 (cm^2 of the paper's 0.01 m^2 coupon) gave a c_eq_per_area 1e4 x too small
+    # without a word: only the CLI's --area was checked against the specimen's cells
+    from pidcore.specimen import Specimen
+
+    grid = dict(fills_percent=[50], accelerations_g=[5], frequencies_hz=[100],
+                vibrated_mass_kg=0.0988)
+    for typed, slip in ((100.0, "cm^2 or mm^2"), (1e4, "cm^2 or mm^2"),
+                        (1e-6, "one cell's area")):
+        with pytest.raises(ParameterError) as caught:
+            equivalent_damper_table(model, area_m2=typed, **grid)
+        message = str(caught.value)
+        assert message.startswith(f"area_m2 {typed:g} m^2 is ")
+        assert "specimen paper_coupon's 441 cells" in message
+        assert "expected the coupon's face area in m^2" in message and slip in message
+        assert "\n" not in message
+    # the coupon's own area passes; another specimen's cells are what it is checked against
+    ok = equivalent_damper_table(model, area_m2=0.01, **grid)
+    np.testing.assert_allclose(ok["c_eq_per_area [N s/m^3]"], ok["c_eq [N s/m]"] / 0.01,
+                               rtol=1e-15)  # one division
+    text = (Path(__file__).parents[1] / "data_samples" / "specimens"
+            / "steel_6mm.toml").read_text()
+    steel = Specimen.from_text(text, source="steel_6mm.toml")
+    equivalent_damper_table(model, area_m2=0.01, specimen=steel, **grid)  # 286 cells, 0.00999
+    with pytest.raises(ParameterError, match="specimen steel_6mm's 286 cells"):
+        equivalent_damper_table(model, area_m2=100.0, specimen=steel, **grid)
+
+
+def test_c_eq_per_cell_is_the_coupons_c_eq_shared_by_its_cells(model, tmp_path):
+    # a FEM model of the panel cell by cell needs c_eq per honeycomb cell, which the table did
+    # not give: the coupon's c_eq / its cell count, whichever specimen the SDC is of
+    from pidcore.specimen import Specimen
+
+    grid = dict(fills_percent=[25, 90], accelerations_g=[1, 5], frequencies_hz=[100, 1000],
+                vibrated_mass_kg=0.0988)
+    paper = equivalent_damper_table(model, **grid)
+    text = (Path(__file__).parents[1] / "data_samples" / "specimens"
+            / "steel_6mm.toml").read_text()
+    steel = equivalent_damper_table(model, specimen=Specimen.from_text(text, source="s"),
+                                    area_m2=0.01, **grid)
+    # one division each: to rounding
+    np.testing.assert_allclose(paper["c_eq_per_cell [N s/m]"] * 441, paper["c_eq [N s/m]"],
+                               rtol=1e-15)
+    np.testing.assert_allclose(steel["c_eq_per_cell [N s/m]"] * 286, steel["c_eq [N s/m]"],
+                               rtol=1e-15)
+    # the cells' dashpots in parallel dissipate the coupon's energy per cycle
+    w = 2 * np.pi * paper["frequency [Hz]"]
+    x = paper["displacement_amplitude [m]"]
+    np.testing.assert_allclose(441 * np.pi * paper["c_eq_per_cell [N s/m]"] * w * x**2,
+                               paper["energy_per_cycle [J]"], rtol=1e-13)
+    path = write_damper_table(paper, tmp_path, formats=("json",))[0]
+    doc = json.loads(path.read_text())
+    assert doc["units"]["c_eq_per_cell [N s/m]"] == "N s/m"
+    assert "per honeycomb cell (one cell)" in doc["columns"]["c_eq_per_cell [N s/m]"]

@@ -204,3 +204,76 @@ def test_time_domain_response_refuses_what_harmonic_balance_refuses(model, mode)
     inside = time_domain_response(model, mode, frequency_hz=300.0, force_amplitude_n=FORCE_N,
                                   settle_cycles=20, measure_cycles=2)
     assert not inside.clipped
+
+
+def test_a_coupon_area_in_cm2_is_refused(mode):
+    # coupon_area_m2=100 (the paper coupon's 0.01 m^2 typed in cm^2) gave a c_pd 1e4 x too
+    # small without a word: only the CLI's --area was checked
+    import dataclasses
+
+    with pytest.raises(ParameterError) as caught:
+        dataclasses.replace(mode, coupon_area_m2=100.0)
+    message = str(caught.value)
+    assert message.startswith("TreatedMode: coupon_area_m2 100 m^2 is ")
+    assert "paper_coupon's 441 cells" in message and "was it cm^2 or mm^2?" in message
+    with pytest.raises(ParameterError, match=r"coupon_area_m2 1e-05 m\^2 .* one cell's area"):
+        dataclasses.replace(mode, coupon_area_m2=1e-5)
+    # a specimen of 4 cells (its mass scaled with them) has a coupon of 7.8e-5 m^2: checked
+    # against its own cells, that area passes
+    import re
+
+    from pidcore.specimen import Specimen, paper_specimen
+
+    text = re.sub(r"(?m)^count = 441$", "count = 4", paper_specimen().text)
+    text = re.sub(r"(?m)^mass_kg = .*$", "mass_kg = 0.0002", text)
+    four_cells = Specimen.from_text(text, source="four cells")
+    assert dataclasses.replace(mode, coupon_area_m2=5e-5,
+                               coupon_specimen=four_cells).coupon_area_m2 == 5e-5
+    with pytest.raises(ParameterError, match="specimen paper_coupon's 441 cells"):
+        dataclasses.replace(mode, coupon_area_m2=5e-5)  # the same area, the paper's coupon
+
+
+@pytest.mark.parametrize("slope_per_g,said", [
+    (+0.01, "overstates the damping there (amplitude understated: not conservative)"),
+    (-0.01, "understates the damping there (amplitude overstated: conservative)"),
+    (0.0, "errs in a direction the model does not tell"),
+])
+def test_a_held_edge_sdc_says_which_way_it_errs_by_the_models_slope(mode, slope_per_g, said):
+    # clip_to_range=True held the 1 g SDC for a 0.004 g response and flagged the row, but
+    # not that where the SDC rises from 1 g the held value overstates the damping below it.
+    # SDC linear in acceleration: pchip reproduces it, so its continuation below 1 g is the
+    # truth the held value is measured against, and the slope at the edge is slope_per_g.
+    grid = pd.MultiIndex.from_product([[25.0, 90.0], [1.0, 5.0, 10.0], [50.0, 1000.0]],
+                                      names=["fill_percent", "acceleration_g", "frequency_hz"])
+    table = grid.to_frame(index=False)
+    table["sdc"] = 0.2 + slope_per_g * (table["acceleration_g"] - 1.0)
+    linear = SdcModel.from_table(table, value="sdc", source="linear in acceleration")
+    r = harmonic_response(linear, mode, frequencies_hz=[200.0, 220.0], force_amplitude_n=0.1,
+                          clip_to_range=True)
+    assert r.clipped.all() and (r.acceleration_g < 1.0).all()
+    truth = 0.2 + slope_per_g * (r.acceleration_g - 1.0)
+    held_minus_truth = np.sign(r.sdc - truth)
+    assert set(held_minus_truth) == {np.sign(slope_per_g)}  # the direction the note must say
+    note = r.to_pandas().attrs["clipped_note"]
+    assert note == r.clipped_note and "\n" not in note
+    assert note.startswith("200 .. 220 Hz (2 row(s)): response ")
+    assert "below the model's 1 g edge" in note and said in note
+    assert f"model slope there {slope_per_g:+.3g} per g" in note
+    # the time integration says the same of its steady state
+    td = time_domain_response(linear, mode, frequency_hz=200.0, force_amplitude_n=0.1,
+                              clip_to_range=True)
+    assert td.clipped and said in td.clipped_note
+    # nothing held, nothing said
+    inside = harmonic_response(linear, mode, frequencies_hz=[300.0], force_amplitude_n=3.0)
+    assert not inside.clipped.any() and inside.clipped_note == ""
+
+
+def test_the_paper_models_held_1g_sdc_overstates_the_damping_below_it(model, mode):
+    # Table 3 at 50 % fill and 200 Hz: the SDC rises from 1 g to 5 g, so its slope at 1 g
+    # (the model's own) is positive, and holding it below 1 g overstates the damping
+    slope = float(model.acceleration_section(50.0, 200.0).derivative()(1.0))
+    assert slope > 0
+    r = harmonic_response(model, mode, frequencies_hz=[200.0], force_amplitude_n=0.1,
+                          clip_to_range=True)
+    assert "holding the 1 g SDC overstates the damping there" in r.clipped_note
+    assert f"model slope there {slope:+.3g} per g" in r.clipped_note

@@ -227,13 +227,14 @@ def run_damper(args: argparse.Namespace) -> int:
         material = args.material or defaults.MODEL_PARTICLE_MATERIAL
         mass = paper_vibrated_mass(convention, material)
         mass_text = f"{convention} ({material}, paper count per cell)"
-    if args.area is not None:
-        from ..model.damper import check_area, runs_specimen
-        from ..specimen import paper_specimen
+    from ..model.damper import check_area, runs_specimen
+    from ..specimen import paper_specimen
 
-        specimen = paper_specimen() if runs is None else runs_specimen(runs)
-        if specimen is not None:  # runs of an older store name no specimen text
-            check_area(args.area, specimen, "--area")
+    # runs of an older store name no specimen text: the paper's coupon, as the library takes it
+    stated = paper_specimen() if runs is None else runs_specimen(runs)
+    specimen = stated or paper_specimen()
+    if args.area is not None:
+        check_area(args.area, specimen, "--area")  # first, to name the option typed
         area, area_text = args.area, f"{args.area} m^2 (given)"
     elif runs is not None and "specimen_is_paper" in runs.columns \
             and not runs["specimen_is_paper"].fillna(True).astype(bool).all():
@@ -247,12 +248,14 @@ def run_damper(args: argparse.Namespace) -> int:
         model, fills_percent=args.fills if args.fills else model.axes[0],
         accelerations_g=args.accelerations if args.accelerations else model.axes[1],
         frequencies_hz=args.frequencies if args.frequencies else model.axes[2],
-        vibrated_mass_kg=mass, area_m2=area)
+        vibrated_mass_kg=mass, area_m2=area, specimen=specimen)
     provenance = {
         "sdc_source": model.source, "sdc_value": model.value_name,
         "interpolation": "tensor-product pchip (frequency, fill, acceleration passes)",
         "log_frequency": model.log_frequency, "vibrated_mass": mass_text,
         "area": area_text,
+        "cells": f"{specimen.cell.count} (specimen {specimen.name}): c_eq_per_cell is c_eq / "
+                 "this count",
         # which DOF the dashpot goes on and which particles it is of: the table's numbers
         # do not say, and a damper along the face (x, y) differs from one normal to it (z)
         "direction": _direction_text(runs),
@@ -261,6 +264,11 @@ def run_damper(args: argparse.Namespace) -> int:
         else ", ".join(sorted(runs["material"].dropna().astype(str).unique())),
         "filled_grid_points": model.filled_points().to_dict(orient="records"),
     }
+    if stated is None:
+        # the paper's 441 cells are a guess for these runs: a per-cell damper of it is not given
+        table = table.drop(columns="c_eq_per_cell [N s/m]")
+        provenance["cells"] = ("not stored with the DEM runs (an older store): no "
+                               "c_eq_per_cell column")
     undefined = int((table["sdc [-]"] >= 1.0).sum())
     why = ("damping ratio -ln(1 - SDC) / (4 pi) is undefined where SDC >= 1 (a free decay "
            "would lose all its energy within a cycle): left empty")

@@ -25,6 +25,7 @@ from collections.abc import Callable, Sequence
 from datetime import UTC, datetime
 from importlib import resources
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pandas as pd
@@ -34,6 +35,9 @@ from .. import defaults as D
 from ..constants import STANDARD_GRAVITY, VIBRATED_MASS_CONVENTIONS
 from ..errors import ParameterError
 from .sdc_model import SdcModel
+
+if TYPE_CHECKING:  # a name for the hints only: the specimen module is imported where used
+    from ..specimen import Specimen
 
 #: The flag of :func:`equivalent_damper_table` marking points at a filled hole of the model grid.
 #: Like the report's category columns (``alignment [grid/interpolated/...]``) its
@@ -59,6 +63,7 @@ DAMPER_COLUMNS: dict[str, str] = {
     "velocity_amplitude [m/s]": "m/s",
     "c_eq [N s/m]": "N s/m",
     "c_eq_per_area [N s/m^3]": "N s/m^3",
+    "c_eq_per_cell [N s/m]": "N s/m",
 }
 #: What each column of :data:`DAMPER_COLUMNS` is, per what and where it applies (the JSON
 #: file's ``columns``): the brackets name the unit, not whether a number is the coupon's or
@@ -90,6 +95,9 @@ DAMPER_COLUMN_MEANINGS: dict[str, str] = {
                                "area of a panel at the same fill, acceleration and frequency "
                                "(e.g. a grounded dashpot of c_eq_per_area x tributary area at "
                                "each node, along the drive direction)",
+    "c_eq_per_cell [N s/m]": "c_eq per honeycomb cell (one cell): c_eq / the coupon's cell "
+                             "count (provenance cells), for a panel whose cells are modelled "
+                             "one by one at the same fill, acceleration and frequency",
 }
 
 
@@ -379,6 +387,7 @@ def equivalent_damper_table(model: SdcModel, *, fills_percent: Sequence[float] |
                             frequencies_hz: Sequence[float] | None = None,
                             vibrated_mass_kg: float | Callable[[float], float],
                             area_m2: float | None = None,
+                            specimen: Specimen | None = None,
                             clip_to_range: bool = False,
                             fills: Sequence[float] | None = None,
                             accelerations: Sequence[float] | None = None,
@@ -397,7 +406,13 @@ def equivalent_damper_table(model: SdcModel, *, fills_percent: Sequence[float] |
         coupon's m_c is refused as a unit slip (grams typed for kg), as ``pidcore model
         damper --vibrated-mass`` refuses it.
     area_m2 : float, optional
-        Coupon area for the per-area damper; default :func:`coupon_area_m2`.
+        Coupon area for the per-area damper; default :func:`coupon_area_m2`. An area more
+        than :data:`AREA_TO_CELLS_LIMIT` times off ``specimen``'s cells is refused as a unit
+        slip (cm^2 or mm^2 typed for m^2), as ``pidcore model damper --area`` refuses it.
+    specimen : pidcore.specimen.Specimen, optional
+        The coupon the SDC and m_c are of (default: the paper's,
+        :func:`pidcore.specimen.paper_specimen`; for stored DEM runs :func:`runs_specimen`):
+        ``area_m2`` is checked against its cells, ``c_eq_per_cell`` divides by their count.
     clip_to_range : bool
         Passed to :meth:`SdcModel.evaluate` (default: refuse points outside the model); the
         points it held at the edge are flagged in :data:`SDC_HELD_COLUMN`.
@@ -432,7 +447,16 @@ def equivalent_damper_table(model: SdcModel, *, fills_percent: Sequence[float] |
                             model.axes[0], D.MODEL_PARTICLE_MATERIAL)
         mass = np.full(p.shape, float(vibrated_mass_kg))
     mass = _positive("vibrated_mass_kg", mass)
-    area = coupon_area_m2() if area_m2 is None else float(_positive("area_m2", area_m2))
+    if specimen is None:
+        from ..specimen import paper_specimen
+
+        specimen = paper_specimen()
+    if area_m2 is None:
+        area = coupon_area_m2()
+    else:
+        # 100 (cm^2) for 0.01 m^2 gave a c_eq_per_area 1e4 x too small; only --area was checked
+        area = float(_positive("area_m2", area_m2))
+        check_area(area, specimen)
     sdc = model.evaluate(p, a_g, f, clip_to_range=clip_to_range)
     # a 20 g row carried the 10 g SDC and a c_eq from it, like a modelled one
     held = np.array([not model.contains(point) for point in zip(p, a_g, f, strict=True)],
@@ -460,6 +484,7 @@ def equivalent_damper_table(model: SdcModel, *, fills_percent: Sequence[float] |
         "velocity_amplitude [m/s]": a / (2.0 * np.pi * f),
         "c_eq [N s/m]": c_eq,
         "c_eq_per_area [N s/m^3]": c_eq / area,
+        "c_eq_per_cell [N s/m]": c_eq / specimen.cell.count,
     })
     return out
 

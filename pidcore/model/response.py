@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pandas as pd
@@ -40,8 +40,11 @@ from scipy.optimize import brentq
 
 from ..constants import STANDARD_GRAVITY
 from ..errors import ParameterError, as_given, instance_of, real_number, whole_number
-from .damper import coupon_area_m2, equivalent_damping_coefficient
+from .damper import check_area, coupon_area_m2, equivalent_damping_coefficient
 from .sdc_model import SdcModel
+
+if TYPE_CHECKING:  # a name for the hints only
+    from ..specimen import Specimen
 
 #: Points of the log-spaced scan for sign changes of the harmonic-balance residual.
 _SCAN_POINTS = 400
@@ -74,7 +77,12 @@ class TreatedMode:
         runs. Not ``coupon_vibrated_mass_kg()`` alone, which leaves the particles out (c_pd
         4.5 x low at 50 % fill).
     coupon_area_m2 : float
-        A_c [m^2] of those coupons (default: the paper's 0.1 m x 0.1 m).
+        A_c [m^2] of those coupons (default: the paper's 0.1 m x 0.1 m). More than
+        :data:`~pidcore.model.damper.AREA_TO_CELLS_LIMIT` times off the cells of
+        ``coupon_specimen`` is refused as a unit slip (cm^2 or mm^2 typed for m^2).
+    coupon_specimen : pidcore.specimen.Specimen, optional
+        Those coupons (default: the paper's; for stored DEM runs
+        :func:`~pidcore.model.damper.runs_specimen`), to check ``coupon_area_m2`` against.
     """
 
     natural_frequency_hz: float
@@ -84,6 +92,7 @@ class TreatedMode:
     fill_percent: float
     coupon_vibrated_mass_kg: float
     coupon_area_m2: float = coupon_area_m2()
+    coupon_specimen: Specimen | None = None
 
     def __post_init__(self) -> None:
         for name in ("natural_frequency_hz", "modal_mass_kg", "structural_damping_ratio",
@@ -98,6 +107,11 @@ class TreatedMode:
         if not np.isfinite(self.structural_damping_ratio) or self.structural_damping_ratio < 0:
             raise ParameterError(f"TreatedMode: structural_damping_ratio must be >= 0, got "
                                  f"{self.structural_damping_ratio!r}")
+        from ..specimen import paper_specimen
+
+        # 100 (cm^2) for A_c = 0.01 m^2 gave a c_pd 1e4 x too small without a word
+        check_area(self.coupon_area_m2, self.coupon_specimen or paper_specimen(),
+                   "TreatedMode: coupon_area_m2")
 
     @property
     def stiffness_n_m(self) -> float:
@@ -135,6 +149,11 @@ class HarmonicResponse:
         SDC taken at the edge of the model range (only with ``clip_to_range=True``).
     multiple_solutions : ndarray of bool
         More than one amplitude balances the force; the largest is reported.
+    clipped_note : str
+        What the ``clipped`` rows hold and which way that errs ("" where none is clipped):
+        below an edge where the model's SDC rises with acceleration (its own slope there)
+        the held edge SDC overstates the damping (amplitude understated, not conservative);
+        where it falls, understates it.
     """
 
     frequency_hz: np.ndarray
@@ -147,6 +166,7 @@ class HarmonicResponse:
     clipped: np.ndarray
     multiple_solutions: np.ndarray
     force_amplitude_n: float
+    clipped_note: str = ""
 
     def to_pandas(self) -> pd.DataFrame:
         """One row per drive frequency, each column naming its unit.
@@ -154,7 +174,7 @@ class HarmonicResponse:
         Columns ``frequency [Hz]``, ``amplitude [m]``, ``phase [rad]``, ``acceleration [g]``,
         ``sdc [-]``, ``particle damping [N s/m]``, ``amplitude untreated [m]``,
         ``clipped [True/False]``, ``multiple solutions [True/False]``; ``attrs`` hold
-        ``force_amplitude_n``.
+        ``force_amplitude_n`` and ``clipped_note``.
         """
         frame = pd.DataFrame({
             "frequency [Hz]": np.asarray(self.frequency_hz, dtype=float),
@@ -168,6 +188,7 @@ class HarmonicResponse:
             "multiple solutions [True/False]": np.asarray(self.multiple_solutions, dtype=bool),
         })
         frame.attrs["force_amplitude_n"] = float(self.force_amplitude_n)
+        frame.attrs["clipped_note"] = self.clipped_note
         return frame
 
     def plot(self, ax: Any = None) -> Any:
@@ -188,7 +209,8 @@ def _check_force(force_amplitude_n: float) -> None:
 
 def _sdc_section(model: SdcModel, mode: TreatedMode, frequency_hz: float,
                  clip_to_range: bool, caller: str = "harmonic_response"):
-    """SDC as a function of acceleration [g] (clamped to the grid) at this fill and frequency."""
+    """SDC as a function of acceleration [g] (clamped to the grid) at this fill and frequency,
+    whether the frequency was clamped, and the model's section there (for its slope)."""
     f_lo, f_hi = model.bounds["frequency_hz"]
     inside_f = f_lo * (1 - _RANGE_RTOL) <= frequency_hz <= f_hi * (1 + _RANGE_RTOL)
     if not inside_f and not clip_to_range:
@@ -202,7 +224,64 @@ def _sdc_section(model: SdcModel, mode: TreatedMode, frequency_hz: float,
     def sdc(a_g: np.ndarray) -> np.ndarray:
         return section(np.clip(a_g, a_lo, a_hi))
 
-    return sdc, (not inside_f)
+    return sdc, (not inside_f), section
+
+
+def _held_edge_error(section, acceleration_g: float, bounds: tuple[float, float]
+                     ) -> tuple[str, str, float]:
+    """(where, which way, slope per g) of holding the edge SDC at an acceleration beyond the
+    model's range, from the model's own slope at that edge; ("", "", nan) inside it."""
+    a_lo, a_hi = bounds
+    if a_lo * (1 - _RANGE_RTOL) <= acceleration_g <= a_hi * (1 + _RANGE_RTOL):
+        return "", "", math.nan
+    below = acceleration_g < a_lo
+    edge = a_lo if below else a_hi
+    slope = float(section.derivative()(edge))
+    where = f"{'below' if below else 'above'} the model's {edge:g} g edge"
+    if not math.isfinite(slope) or slope == 0:
+        return where, (f"where its SDC is flat: holding the {edge:g} g SDC errs in a "
+                       "direction the model does not tell"), slope
+    # the way a continuation of the edge's own trend goes: lower below a rising edge
+    rises = slope > 0
+    if rises == below:
+        way = (f"where its SDC {'rises' if rises else 'falls'} with acceleration: holding the "
+               f"{edge:g} g SDC overstates the damping there (amplitude understated: not "
+               "conservative)")
+    else:
+        way = (f"where its SDC {'rises' if rises else 'falls'} with acceleration: holding the "
+               f"{edge:g} g SDC understates the damping there (amplitude overstated: "
+               "conservative)")
+    return where, way, slope
+
+
+def _span(values: list[float], fmt: str) -> str:
+    low, high = min(values), max(values)
+    return format(low, fmt) if format(low, fmt) == format(high, fmt) \
+        else f"{format(low, fmt)} .. {format(high, fmt)}"
+
+
+def _clipped_note(rows: list[tuple[float, float, bool, str, str, float]],
+                  frequency_bounds: tuple[float, float]) -> str:
+    """One line for the clipped rows (frequency, acceleration, frequency outside, and
+    :func:`_held_edge_error`'s where, which way, slope), grouped by edge and direction;
+    "" where none is clipped."""
+    groups: dict[tuple[bool, str, str], list[tuple[float, float, float]]] = {}
+    for f, acc, frequency_outside, where, way, slope in rows:
+        groups.setdefault((frequency_outside, where, way), []).append((f, acc, slope))
+    parts = []
+    for (frequency_outside, where, way), members in groups.items():
+        clauses = []
+        if frequency_outside:
+            f_lo, f_hi = frequency_bounds
+            clauses.append(f"frequency outside the model's [{f_lo:g}, {f_hi:g}] Hz, the edge "
+                           "frequency's SDC held (which way that errs is not assessed)")
+        if where:
+            clauses.append(f"response {_span([m[1] for m in members], '.3g')} g {where} "
+                           f"(model slope there {_span([m[2] for m in members], '+.3g')} per "
+                           f"g), {way}")
+        parts.append(f"{_span([m[0] for m in members], 'g')} Hz ({len(members)} row(s)): "
+                     + "; ".join(clauses))
+    return "; ".join(parts)
 
 
 def particle_damping_n_s_m(sdc: np.ndarray | float, mode: TreatedMode,
@@ -249,9 +328,11 @@ def harmonic_response(model: SdcModel, mode: TreatedMode, *, frequencies_hz: np.
            ("x", "phase", "acc", "sdc", "c_pd", "x0")}
     clipped = np.zeros(freqs.shape, dtype=bool)
     multiple = np.zeros(freqs.shape, dtype=bool)
+    # a 0.3 g response took the 1 g SDC, flagged but not which way that errs
+    clip_rows: list[tuple[float, float, bool, str, str, float]] = []
     for i, f in enumerate(freqs):
         w = 2.0 * np.pi * f
-        sdc_of, freq_clipped = _sdc_section(model, mode, f, clip_to_range)
+        sdc_of, freq_clipped, section = _sdc_section(model, mode, f, clip_to_range)
 
         def c_pd(x: np.ndarray, sdc_of=sdc_of, w=w, f=f) -> np.ndarray:
             return particle_damping_n_s_m(sdc_of(w**2 * x / STANDARD_GRAVITY), mode, f)
@@ -288,6 +369,9 @@ def harmonic_response(model: SdcModel, mode: TreatedMode, *, frequencies_hz: np.
                 f"outside the SDC model range [{a_lo:g}, {a_hi:g}] g; change the force or pass "
                 f"clip_to_range=True to hold the edge SDC")
         clipped[i] = acc_outside or freq_clipped
+        if clipped[i]:
+            clip_rows.append((float(f), float(acc), freq_clipped,
+                              *_held_edge_error(section, acc, (a_lo, a_hi))))
         cp = float(c_pd(np.array(x)))
         out["x"][i] = x
         out["phase"][i] = -np.angle(k - m * w**2 + 1j * w * (c_s + cp))
@@ -300,7 +384,9 @@ def harmonic_response(model: SdcModel, mode: TreatedMode, *, frequencies_hz: np.
                             particle_damping_n_s_m=out["c_pd"],
                             amplitude_untreated_m=out["x0"], clipped=clipped,
                             multiple_solutions=multiple,
-                            force_amplitude_n=float(force_amplitude_n))
+                            force_amplitude_n=float(force_amplitude_n),
+                            clipped_note=_clipped_note(clip_rows,
+                                                       model.bounds["frequency_hz"]))
 
 
 @dataclass(frozen=True)
@@ -308,7 +394,8 @@ class TimeDomainSteadyState:
     """Steady state of the time integration: fundamental amplitude [m] and phase [rad].
 
     ``clipped``: the frequency or the steady acceleration amplitude lies outside the SDC
-    model's range and the edge SDC was held there (only with ``clip_to_range=True``).
+    model's range and the edge SDC was held there (only with ``clip_to_range=True``);
+    ``clipped_note`` says which way that errs, as :attr:`HarmonicResponse.clipped_note`.
     """
 
     frequency_hz: float
@@ -317,6 +404,7 @@ class TimeDomainSteadyState:
     peak_amplitude_m: float
     settle_time_s: float
     clipped: bool = False
+    clipped_note: str = ""
 
 
 def time_domain_response(model: SdcModel, mode: TreatedMode, *, frequency_hz: float,
@@ -362,8 +450,8 @@ def time_domain_response(model: SdcModel, mode: TreatedMode, *, frequency_hz: fl
     w = 2.0 * np.pi * frequency_hz
     k, m, c_s = mode.stiffness_n_m, mode.modal_mass_kg, mode.structural_damping_n_s_m
     # 2000 Hz ran on the 1000 Hz SDC without a word, though harmonic_response refused it
-    sdc_of, frequency_clipped = _sdc_section(model, mode, frequency_hz, clip_to_range,
-                                               "time_domain_response")
+    sdc_of, frequency_clipped, section = _sdc_section(model, mode, frequency_hz,
+                                                      clip_to_range, "time_domain_response")
     wn = 2.0 * np.pi * mode.natural_frequency_hz
     if settle_cycles is None:
         zeta = max(mode.structural_damping_ratio, 1e-3)
@@ -406,4 +494,10 @@ def time_domain_response(model: SdcModel, mode: TreatedMode, *, frequency_hz: fl
                                  phase_rad=float(np.angle(coef)),
                                  peak_amplitude_m=float(0.5 * (x.max() - x.min())),
                                  settle_time_s=float(t_settle),
-                                 clipped=bool(acceleration_outside or frequency_clipped))
+                                 clipped=bool(acceleration_outside or frequency_clipped),
+                                 clipped_note=_clipped_note(
+                                     [(frequency_hz, acceleration_g, frequency_clipped,
+                                       *_held_edge_error(section, acceleration_g,
+                                                         (a_lo, a_hi)))]
+                                     if acceleration_outside or frequency_clipped else [],
+                                     model.bounds["frequency_hz"]))
