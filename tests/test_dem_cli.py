@@ -36,11 +36,14 @@ def test_readable_summary_names_units_and_particle_count(capsys):
 
 
 def test_one_cell_has_no_standard_error_and_says_why(capsys):
-    # the SDC's error is the cells' scatter: one cell printed "+- nan"
+    # one cell printed "+- nan"; its error is from batches of its motion, and --cycles 5 is
+    # raised to the least steady window, 20 cycles: 2 batches of 10, fewer than 4
     one = [a if a != "2" else "1" for a in ARGS]
     assert main(one) == 0
     out = capsys.readouterr().out
-    assert "nan" not in out and "no standard error (the cells' scatter; simulate --cells 2" in out
+    assert "nan" not in out and "no standard error (see the note)" in out
+    assert "its one cell is one motion" in out
+    assert "holds 2 batches of 10 cycles, fewer than the 4" in out
 
 
 def test_model_options_reach_the_simulation(capsys):

@@ -9,8 +9,10 @@ import math
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 import pytest
 
+from pidcore.cli.dem import format_summary
 from pidcore.compare.align import dem_cases
 from pidcore.dem.persist import load_dem_result, save_dem_result
 from pidcore.dem.result import DemResult, batch_means_stderr
@@ -123,3 +125,39 @@ def test_one_sphere_per_cell_run_gets_a_finite_stderr_that_survives_the_store(tm
     assert dem_cases(runs)[0].sdc_stderr_dof == batches - 1  # the stored one, not cells - 1
     # a run stored before the degrees of freedom were kept reads as before: cells - 1
     assert dem_cases(runs.drop(columns="sdc_stderr_dof"))[0].sdc_stderr_dof == 1.0
+
+
+def test_one_cell_gets_the_batch_means_error_of_its_window():
+    # one cell is one motion: the same batch-means error as K cells of one motion (it had none)
+    result = _from_tally(SDC_PER_CYCLE[None, :], transient=4, block_cycles=2)
+    assert result.cells_simulated == 1
+    assert result.sdc_stderr == pytest.approx(STDERR, rel=1e-9)  # as for 3 cells, above
+    assert result.sdc_stderr_dof == 4.0  # batches - 1 (cells - 1 would be 0)
+    note = next(n for n in result.notes if n.startswith("standard error from"))
+    assert "5 batches of 2 cycles of one motion, not from independent cells" in note
+    assert "its one cell is one motion" in note
+    summary = format_summary(result)
+    assert "(stderr from batches of one motion: see the note)" in summary
+    # three batches are too few: none, and the note says why
+    short = _from_tally(SDC_PER_CYCLE[None, :6], transient=4, block_cycles=2)
+    assert math.isnan(short.sdc_stderr) and math.isnan(short.sdc_stderr_dof)
+    assert any("its one cell is one motion" in n and "holds 3 batches of 2 cycles" in n
+               for n in short.notes)
+
+
+def _runs(sdcs, stderrs, dofs) -> pd.DataFrame:
+    n = len(sdcs)
+    return pd.DataFrame({"frequency_hz": [100.0] * n, "acceleration_g": [5.0] * n,
+                         "fill_percent": [50.0] * n, "material": ["acrylic"] * n,
+                         "direction": ["z"] * n, "sdc": sdcs, "sdc_stderr": stderrs,
+                         "sdc_stderr_dof": dofs, "cells_simulated": [1] * n})
+
+
+def test_one_cell_runs_are_pooled_with_their_stored_dof():
+    # one 1-cell run: its own error and batches - 1 (cells - 1 = 0 is no dof at all)
+    (case,) = dem_cases(_runs([0.28], [STDERR], [4.0]))
+    assert (case.sdc, case.sdc_stderr, case.sdc_stderr_dof) == (0.28, STDERR, 4.0)
+    # two of equal error whose means lie within it: Welch-Satterthwaite of the stored dofs,
+    # (2 se^2)^2 / (2 se^4 / 4) = 8 exactly in theory; rounding of se^2, se^4 only
+    (pooled,) = dem_cases(_runs([0.28, 0.2801], [STDERR, STDERR], [4.0, 4.0]))
+    assert pooled.sdc_stderr_dof == pytest.approx(8.0, rel=1e-12)

@@ -430,7 +430,7 @@ def _tangential_stiffness_model(result) -> str:
 
 def format_summary(result, *, reused: bool = False) -> str:
     """Readable multi-line summary with units."""
-    from ..dem.result import cells_ran_one_motion
+    from ..dem.result import stderr_from_batches
 
     c = result.case
     s = result.specimen
@@ -456,12 +456,12 @@ def format_summary(result, *, reused: bool = False) -> str:
          f"{result.loss_factor:.4g} [-]) over {result.cells_simulated} cells"
          # the error of cells that ran one motion is from batches of it, not the cells
          + (" (stderr from batches of one motion: see the note)"
-            if cells_ran_one_motion(result.sdc_per_cell) else "")
+            if stderr_from_batches(result.sdc_per_cell) else "")
          if math.isfinite(result.sdc_stderr) else
          f"SDC             {result.sdc:.4g} [-] (loss factor {result.loss_factor:.4g} [-]) over "
          f"{result.cells_simulated} cell(s): no standard error"
-         + (" (see the note)" if result.cells_simulated > 1 else
-            " (the cells' scatter; simulate --cells 2 or more)")),
+         # a run of one cell or of one motion says in a note why it has none
+         + " (see the note)"),
         f"dissipated      {result.energy_per_cycle_j:.4g} J/cycle (coupon, "
         f"{result.coupon_cells} cells): normal "
         f"damping {result.energy_dissipated_normal_j:.4g} J, friction "

@@ -76,8 +76,9 @@ class DemResult:
     ``sdc_stderr_dof`` = K - 1; where the cells all ran one motion
     (:func:`cells_ran_one_motion`) it is the batch-means error of that motion's steady
     window (:func:`batch_means_stderr`, batches of ``config.block_cycles`` cycles, dof =
-    batches - 1), NaN with fewer than DEM_MIN_STDERR_BATCHES batches. Runs stored before the
-    degrees of freedom were kept read NaN (unknown).
+    batches - 1), NaN with fewer than DEM_MIN_STDERR_BATCHES batches; so is a run of one cell
+    (:func:`stderr_from_batches`). Runs stored before the degrees of freedom were kept read NaN
+    (unknown).
     """
 
     case: LoadCase
@@ -145,7 +146,8 @@ class DemResult:
         # side wall, so its random start xy does not matter) are one sample, not K: their
         # scatter of exactly 0 is no standard error (it printed "+- 0" for an unsettled
         # bouncer). That motion's own scatter over its steady window is: batch means of it
-        if cells_ran_one_motion(sdc_cells):
+        # so is one cell: its scatter has no second value
+        if stderr_from_batches(sdc_cells):
             sdc_cycles = (n_coupon * steady[0, :, 1:].sum(axis=1) / e_max if e_max > 0
                           else np.full(steady.shape[1], np.nan))
             stderr, stderr_dof = batch_means_stderr(sdc_cycles, config.block_cycles)
@@ -273,8 +275,10 @@ class DemResult:
             if overridden:
                 notes.append(f"{overridden}: {self.particles_per_cell} particles per cell "
                              "simulated")
-        if cells_ran_one_motion(self.sdc_per_cell):
-            same = (f"the {self.cells_simulated} cells ran the same motion (the same SDC to "
+        if stderr_from_batches(self.sdc_per_cell):
+            same = ("its one cell is one motion, with no second cell to scatter against"
+                    if self.cells_simulated == 1 else
+                    f"the {self.cells_simulated} cells ran the same motion (the same SDC to "
                     "the last bit, as a lone particle bouncing along the drive axis does), so "
                     "they are one sample and their scatter says nothing of the SDC's "
                     "uncertainty")
@@ -427,6 +431,13 @@ def cells_ran_one_motion(sdc_per_cell: np.ndarray) -> bool:
     """Whether two or more cells gave the same SDC to the last bit: the same simulation."""
     sdc = np.asarray(sdc_per_cell, dtype=float)
     return sdc.size > 1 and bool(np.all(np.isfinite(sdc))) and float(np.ptp(sdc)) == 0.0
+
+
+def stderr_from_batches(sdc_per_cell: np.ndarray) -> bool:
+    """Whether a run's SDC standard error is taken from batch means of one motion's steady
+    window rather than its cells' scatter: it ran one cell, or its cells all ran one motion
+    (:func:`cells_ran_one_motion`)."""
+    return np.asarray(sdc_per_cell).size == 1 or cells_ran_one_motion(sdc_per_cell)
 
 
 def batch_means_stderr(per_cycle: np.ndarray, batch_cycles: int, *,
