@@ -101,6 +101,12 @@ DEM_STEADY_BLOCK_CYCLES = 10
 #: scatter of the batches is too poor an estimate to print (t_0.975,2 = 4.3), so such a run
 #: keeps no standard error.
 DEM_MIN_STDERR_BATCHES = 4
+#: Relative spread (max - min over the largest magnitude) of a one-motion DEM run's batch means
+#: at or below which they agree (a periodic steady state whose period divides the batch): a
+#: cycle's dissipation is summed over up to ~1e6 steps, so rounding alone spreads it by up to
+#: ~1e6 x 2.2e-16 = 2e-10; a spread under 1e-9 is rounding, not scatter, and its "error"
+#: (printed "+- 0" or "+- 1e-17") would read as a measured certainty. Such a run keeps none.
+DEM_BATCHES_AGREE_RTOL = 1e-9
 
 
 def dem_automatic_steady_cycles(block_cycles: int = DEM_STEADY_BLOCK_CYCLES) -> int:

@@ -15,7 +15,7 @@ import pytest
 from pidcore.cli.dem import format_summary
 from pidcore.compare.align import dem_cases
 from pidcore.dem.persist import load_dem_result, save_dem_result
-from pidcore.dem.result import DemResult, batch_means_stderr
+from pidcore.dem.result import DemResult, batch_means_agree, batch_means_stderr
 from pidcore.dem.simulate import DemConfig, simulate_load_case
 from pidcore.errors import ParameterError
 from pidcore.loadcase import LoadCase
@@ -161,3 +161,28 @@ def test_one_cell_runs_are_pooled_with_their_stored_dof():
     # (2 se^2)^2 / (2 se^4 / 4) = 8 exactly in theory; rounding of se^2, se^4 only
     (pooled,) = dem_cases(_runs([0.28, 0.2801], [STDERR, STDERR], [4.0, 4.0]))
     assert pooled.sdc_stderr_dof == pytest.approx(8.0, rel=1e-12)
+
+
+PERIODIC = np.tile([0.2, 0.4], 5)  # period 2 cycles = one batch: every batch mean is 0.3
+
+
+@pytest.mark.parametrize("cells", [1, 3])
+def test_a_periodic_motion_has_no_error_not_an_error_of_zero(cells):
+    assert all(math.isnan(v) for v in batch_means_stderr(PERIODIC, 2))  # it was (0.0, 4.0)
+    result = _from_tally(np.tile(PERIODIC, (cells, 1)), transient=4, block_cycles=2)
+    assert result.sdc == pytest.approx(0.3, rel=1e-12)
+    assert math.isnan(result.sdc_stderr) and math.isnan(result.sdc_stderr_dof)
+    note = next(n for n in result.notes if n.startswith("no standard error"))
+    assert ("5 batches of 2 cycles agree to rounding (a periodic motion): no scatter to take "
+            "an error from") in note
+    summary = format_summary(result)
+    assert "+- 0" not in summary and "no standard error (see the note)" in summary
+    # a period that does not divide the batch (3 cycles in batches of 2) scatters: an error
+    odd = _from_tally(np.tile([0.2, 0.3, 0.4], (cells, 4)), transient=4, block_cycles=2)
+    assert odd.sdc_stderr > 0 and odd.sdc_stderr_dof == 5.0
+
+
+def test_batch_means_agree_to_rounding_only():
+    assert not batch_means_agree(np.array([0.3, 0.3 * (1 + 1e-8)]))  # above rounding: scatter
+    assert batch_means_agree(np.array([0.3, 0.3 * (1 + 1e-12)]))  # rounding of the tally
+    assert batch_means_agree(np.zeros(4))  # nothing dissipated: no scatter either

@@ -76,7 +76,8 @@ class DemResult:
     ``sdc_stderr_dof`` = K - 1; where the cells all ran one motion
     (:func:`cells_ran_one_motion`) it is the batch-means error of that motion's steady
     window (:func:`batch_means_stderr`, batches of ``config.block_cycles`` cycles, dof =
-    batches - 1), NaN with fewer than DEM_MIN_STDERR_BATCHES batches; so is a run of one cell
+    batches - 1), NaN with fewer than DEM_MIN_STDERR_BATCHES batches or with batch means that
+    agree (a periodic motion: no scatter to take an error from); so is a run of one cell
     (:func:`stderr_from_batches`). Runs stored before the degrees of freedom were kept read NaN
     (unknown).
     """
@@ -290,6 +291,13 @@ class DemResult:
                     f"from independent cells ({self.sdc_stderr_dof:g} degrees of freedom): "
                     f"{same}; successive batches of one motion are correlated, so this error "
                     "may understate the SDC's uncertainty")
+            elif batches >= defaults.DEM_MIN_STDERR_BATCHES and self._batches_agree():
+                notes.append(
+                    f"no standard error: {same}, and its {batches} batches of {b} cycles "
+                    "agree to rounding (a periodic motion): no scatter to take an error from. A "
+                    "deterministic periodic steady state has no sampling error in its SDC, "
+                    "but an error of 0 would read as a measured certainty; what the model "
+                    "leaves out is not measured by this run")
             elif batches < defaults.DEM_MIN_STDERR_BATCHES:
                 notes.append(
                     f"no standard error: {same}, and its steady window of "
@@ -417,6 +425,19 @@ class DemResult:
                            sample_rate_hz=self.sample_rate_hz)
         return frame
 
+    def _batches_agree(self) -> bool:
+        """Whether the batch means of cell 0's steady SDC per cycle agree
+        (:func:`batch_means_agree`): why a one-motion run with batches enough has no error."""
+        if not self.max_kinetic_energy_j > 0:
+            return False
+        per_cycle = (self.coupon_cells
+                     * np.asarray(self.dissipation_per_cell_cycle_j, dtype=float)[
+                         0, self.steady_start_cycle:] / self.max_kinetic_energy_j)
+        n = per_cycle.size // self.config.block_cycles
+        if n < 2 or not np.all(np.isfinite(per_cycle[:n * self.config.block_cycles])):
+            return False
+        return batch_means_agree(_batch_means(per_cycle, self.config.block_cycles, n))
+
     def plot(self, ax: Any = None) -> Any:
         """Per-cycle dissipation and forces (:func:`pidcore.report.figures_results.plot_dem_run`).
 
@@ -447,8 +468,10 @@ def batch_means_stderr(per_cycle: np.ndarray, batch_cycles: int, *,
     batch means, and its degrees of freedom: the window cut into whole batches of
     ``batch_cycles`` cycles (a remainder at its end left out), ``std(batch means, ddof=1) /
     sqrt(batches)`` with batches - 1 degrees of freedom. (NaN, NaN) with fewer than
-    ``min_batches`` batches or a non-finite cycle. Batches of a correlated motion are not
-    independent: the error may be understated.
+    ``min_batches`` batches or a non-finite cycle, and where the batch means agree
+    (:func:`batch_means_agree`: a periodic motion whose period divides the batch has no scatter
+    to take an error from, and an error of 0 would read as a measured certainty). Batches of a
+    correlated motion are not independent: the error may be understated.
 
     >>> batch_means_stderr(np.array([1.0, 1.0, 2.0, 2.0, 3.0, 3.0, 4.0, 4.0]), 2)
     (0.6454972243679028, 3.0)
@@ -461,8 +484,22 @@ def batch_means_stderr(per_cycle: np.ndarray, batch_cycles: int, *,
     n = values.size // batch_cycles
     if n < max(min_batches, 2) or not np.all(np.isfinite(values[:n * batch_cycles])):
         return float("nan"), float("nan")
-    means = values[:n * batch_cycles].reshape(n, batch_cycles).mean(axis=1)
+    means = _batch_means(values, batch_cycles, n)
+    if batch_means_agree(means):
+        return float("nan"), float("nan")
     return float(np.std(means, ddof=1) / math.sqrt(n)), float(n - 1)
+
+
+def _batch_means(values: np.ndarray, batch_cycles: int, n: int) -> np.ndarray:
+    return values[:n * batch_cycles].reshape(n, batch_cycles).mean(axis=1)
+
+
+def batch_means_agree(means: np.ndarray,
+                      rtol: float = defaults.DEM_BATCHES_AGREE_RTOL) -> bool:
+    """Whether batch means agree to rounding (spread <= ``rtol`` x their largest magnitude):
+    a periodic motion whose period divides the batch, whose scatter is no error."""
+    means = np.asarray(means, dtype=float)
+    return float(np.ptp(means)) <= rtol * float(np.max(np.abs(means)))
 
 
 def virtual_shaker_loop(force_n: np.ndarray, velocity_m_s: np.ndarray, *,
