@@ -71,6 +71,7 @@ __all__ = ["ANALYSIS_COLUMNS", "ANALYSIS_SETTINGS_COLUMNS", "AUTO_CHANNEL", "FRE
            "NO_CHANNEL",
            "SETTINGS_COLUMNS", "SPECIMEN_COLUMN", "FileSettings", "SettingsColumn",
            "analysis_overrides", "analyze_with_settings", "assumed", "assumption_notes",
+           "files_assumption_notes",
            "check_columns", "stored_assumption_notes",
            "resolve_file_settings", "resolve_files", "setting_in_words"]
 
@@ -655,15 +656,19 @@ def assumed(stated: StatedLoadCase | None, specimen: str,
     return found
 
 
-def assumption_notes(name: str, assumptions: Mapping[str, str]) -> list[str]:
+def assumption_notes(name: str, assumptions: Mapping[str, str], *, files: int = 1) -> list[str]:
     """:func:`assumed` in words, one line each, naming the file ``name`` and how to state the
-    value (library keywords: the CLI names its flags, :func:`pidcore.cli._vocabulary.cli_words`)."""
+    value (library keywords: the CLI names its flags, :func:`pidcore.cli._vocabulary.cli_words`).
+    ``files``: how many files ``name`` stands for (:func:`files_assumption_notes`), whose
+    sentence then speaks of them in the plural."""
     notes = []
+    it, its, names = ("it", "its", "names") if files == 1 else ("them", "their", "name")
     if "material_from" in assumptions:
         notes.append(f"{name}: particle material not stated, {assumptions['material']} assumed "
                      f"(those of specimen {assumptions['material_from']!r}, specimen=, although "
-                     "the file names another specimen); if its particles are others, state "
-                     "them with material=NAME or a sidecar's material column")
+                     f"the file{'' if files == 1 else 's'} {names} another specimen); if "
+                     f"{its} particles are others, state them with material=NAME or a "
+                     "sidecar's material column")
     elif "material" in assumptions:
         notes.append(f"{name}: particle material not stated, {assumptions['material']} assumed "
                      "(the paper's coupon's particles); if they are others, state them with "
@@ -671,8 +676,37 @@ def assumption_notes(name: str, assumptions: Mapping[str, str]) -> list[str]:
     if SPECIMEN_COLUMN in assumptions:
         notes.append(f"{name}: no specimen named, the paper's coupon "
                      f"({assumptions[SPECIMEN_COLUMN]}) assumed: reports and calibrations "
-                     "compare it with that coupon's DEM runs; name another with specimen=FILE "
-                     "or a sidecar's specimen column")
+                     f"compare {it} with that coupon's DEM runs; name another with "
+                     "specimen=FILE or a sidecar's specimen column")
+    return notes
+
+
+def _listed(names: Sequence[str]) -> str:
+    """The first five ``names`` and how many more: a note of forty files stays one line."""
+    return ", ".join(names[:5]) + (f" and {len(names) - 5} more" if len(names) > 5 else "")
+
+
+def files_assumption_notes(found: Sequence[tuple[str, Mapping[str, str]]]) -> list[str]:
+    """:func:`assumption_notes` of several files (``(name, assumed(...))`` each), one note per
+    assumption that names the files it holds for and counts them (``"a.csv, b.csv (2 files):
+    no specimen named, ..."``): the README's report of five exports said the same sentence
+    five times. A note of one file reads as :func:`assumption_notes` of it."""
+    grouped: dict[tuple[str, ...], list[str]] = {}
+    for name, assumptions in found:
+        if "material" in assumptions:
+            grouped.setdefault(("material", assumptions["material"],
+                                assumptions.get("material_from", "")), []).append(name)
+        if SPECIMEN_COLUMN in assumptions:
+            grouped.setdefault((SPECIMEN_COLUMN, assumptions[SPECIMEN_COLUMN]),
+                               []).append(name)
+    notes = []
+    for key, names in grouped.items():
+        if key[0] == "material":
+            one = {"material": key[1], **({"material_from": key[2]} if key[2] else {})}
+        else:
+            one = {SPECIMEN_COLUMN: key[1]}
+        subject = names[0] if len(names) == 1 else f"{_listed(names)} ({len(names)} files)"
+        notes.extend(assumption_notes(subject, one, files=len(names)))
     return notes
 
 
@@ -696,7 +730,7 @@ def stored_assumption_notes(analyses: pd.DataFrame) -> list[str]:
                 by_assumption[(what, found[what])].append(name)
     notes = []
     for (what, value), names in by_assumption.items():
-        shown = ", ".join(names[:5]) + (f" and {len(names) - 5} more" if len(names) > 5 else "")
+        shown = _listed(names)
         if what == "material":
             notes.append(f"{len(names)} stored measurement(s) state no particle material, "
                          f"{value} assumed (the paper's coupon's particles): {shown}")

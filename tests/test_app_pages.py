@@ -1748,3 +1748,22 @@ def test_every_files_specimen_may_be_an_uploaded_toml_and_an_unknown_name_says_s
     listed = Store(store_file).list_analyses()
     assert listed["specimen"].tolist() == ["nosuch"]
     assert "specimen_sha256" not in listed.columns  # the replaced record's hash is gone too
+
+
+def test_an_unknown_specimen_name_is_said_once_for_all_its_files(store_file):
+    """Was: three files of one unknown specimen name showed its "saved by name only" note
+    on each card, three times; a second unknown name is still said, once."""
+    names = ["a_fill50.csv", "b_fill50.csv", "c_fill50.csv", "d_fill50.csv"]
+    files = [(n, mass_damper_csv(frequency_hz=100.0 + 10 * i, acceleration_g=5.0))
+             for i, n in enumerate(names)]
+    table = ("file,fill_percent,material,specimen\n"
+             + "".join(f"{n},50,acrylic,nosuch\n" for n in names[:3])
+             + "d_fill50.csv,50,acrylic,other\n").encode()
+    at = _upload(_app(), [*files, ("settings.csv", table)])
+    said = [i.value for i in at.info if i.value.startswith("specimen ")]
+    assert said == ["specimen nosuch: no known specimen file of that name; saved by name only "
+                    "(its DEM runs are met by name)",
+                    "specimen other: no known specimen file of that name; saved by name only "
+                    "(its DEM runs are met by name)"]
+    # each file is still saved under its name
+    assert _table(at, "SDC [-]")["specimen"].tolist() == ["nosuch"] * 3 + ["other"]

@@ -419,6 +419,41 @@ def test_report_notes_say_which_material_and_specimen_were_assumed(tmp_path):
         (tmp_path / "rep" / "report.provenance.txt").read_text(encoding="utf-8")
 
 
+def test_an_assumption_of_several_files_is_said_once_naming_and_counting_them(tmp_path,
+                                                                             capsys):
+    # the README's report of five exports printed the same "no specimen named" sentence five
+    # times, once per file; now one note per assumption names the files it holds for
+    names = [f"{c}_fill50.csv" for c in "abcdefg"]
+    paths = [export(tmp_path / n, seed=i + 1) for i, n in enumerate(names)]
+    # g states its material and specimen: it is in neither note
+    sidecar(tmp_path, "file,fill_percent,material,specimen\n"
+                      + "".join(f"{n},50,,\n" for n in names[:6]) + "g_fill50.csv,50,acrylic,B\n")
+    six = "a_fill50.csv, b_fill50.csv, c_fill50.csv, d_fill50.csv, e_fill50.csv and 1 more " \
+          "(6 files)"
+    material = (f"{six}: particle material not stated, acrylic assumed (the paper's coupon's "
+                "particles); if they are others, state them with --material NAME, a "
+                "sidecar's material column or --specimen FILE")
+    specimen = (f"{six}: no specimen named, the paper's coupon (paper_coupon) assumed: reports "
+                "and calibrations compare them with that coupon's DEM runs; name another "
+                "with --specimen FILE or a sidecar's specimen column")
+    assert main(["analyze", *map(str, paths), "--no-store"]) == 0
+    said = [line for line in capsys.readouterr().out.splitlines() if "assumed" in line]
+    assert said == [f"note: {material}", f"note: {specimen}"]
+    # the JSON keeps each record's own
+    records = run_json([*map(str, paths), "--no-store"], capsys)["records"]
+    assert [r["assumed"] for r in records] == \
+        [{"material": "acrylic", "specimen": "paper_coupon"}] * 6 + [{}]
+    assert SPECIMEN_ASSUMED.format(name="f_fill50.csv") in records[5]["notes"]
+    # and the report, in its text and its notes file
+    assert main(["report", *map(str, paths[:2]), "--out", str(tmp_path / "rep"),
+                 "--format", "csv"]) == 0
+    two = "a_fill50.csv, b_fill50.csv (2 files)"
+    said = [line for line in capsys.readouterr().out.splitlines() if "assumed" in line]
+    assert said == [f"note: {material.replace(six, two)}", f"note: {specimen.replace(six, two)}"]
+    written = (tmp_path / "rep" / "report.provenance.txt").read_text(encoding="utf-8")
+    assert written.count("no specimen named") == 1
+
+
 def test_a_report_of_a_store_says_what_analyze_assumed_for_its_records(tmp_path, capsys):
     from pidcore.report import make_report
 

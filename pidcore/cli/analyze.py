@@ -148,10 +148,10 @@ def _print_results(args: argparse.Namespace, results: list, cases: list, stated:
     """The results table (or JSON document), each file's load case and settings, what was
     assumed for it (``specimen``: the ``--specimen``), notes, and how many of the saved
     records were new (``breakdown``: :meth:`SavedAnalyses.breakdown`)."""
-    from ..file_settings import assumed, assumption_notes
+    from ..file_settings import assumed, assumption_notes, files_assumption_notes
 
     overrides = [note for fs in settings for note in (*fs.notes, fs.unmatched) if note]
-    # what no statement gave (the paper's coupon and its acrylic), said with each file
+    # what no statement gave (the paper's coupon and its acrylic): with each record in JSON
     assumptions = [assumed(st, fs.specimen, specimen)
                    for st, fs in zip(stated, settings, strict=True)]
     said_assumed = [[cli_words(n) for n in assumption_notes(display_path(Path(path).name), a)]
@@ -175,15 +175,16 @@ def _print_results(args: argparse.Namespace, results: list, cases: list, stated:
         sys.stdout.write("\n")
         return
     print(format_table(results))
-    for path, c, st, fs, words in zip(args.paths, cases, stated, settings, said_assumed,
-                                      strict=True):
+    for path, c, st, fs in zip(args.paths, cases, stated, settings, strict=True):
         said = fs.summary()
         print(f"{display_path(Path(path).name)}: " + (f"load case {c.key} ({st.origin})" if c else
               "no fill stated: saved without a load case (state it in the file name, "
               "a sidecar or --fill for `pidcore report --store` to place it)"
               if not args.no_store else "no fill stated") + (f"; {said}" if said else ""))
-        for note in words:
-            print(f"note: {note}")
+    # once for the files it holds for, counted: one sentence per file repeated it
+    for note in files_assumption_notes([(display_path(Path(path).name), a)
+                                        for path, a in zip(args.paths, assumptions, strict=True)]):
+        print(f"note: {cli_words(note)}")
     for note in [*overrides, *replaced]:
         print(f"note: {note}")
     if not args.no_store:

@@ -775,7 +775,7 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         if files:  # their analyses are added to it
             main.check_writable()
     from ..compare.plausibility import plausibility_notes, stored_plausibility_notes
-    from ..file_settings import assumed, assumption_notes, stored_assumption_notes
+    from ..file_settings import assumed, files_assumption_notes, stored_assumption_notes
 
     options = options or AnalysisOptions()
     results = analyze_files(
@@ -791,8 +791,6 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         said = r.settings.summary() if r.settings is not None else ""
         notes.append(f"{display_path(r.path.name)}: load case {r.load_case.key} ({r.stated.origin})"
                      + (f"; {said}" if said else ""))
-        notes.extend(assumption_notes(display_path(r.path.name), assumed(
-            r.stated, r.settings.specimen if r.settings is not None else "", specimen)))
         # what the plausibility checks found (a result kept as asked, or zero within noise)
         notes.extend(f"{display_path(r.path.name)}: {n}"
                      for n in plausibility_notes(r.analyzed.analysis))
@@ -807,6 +805,11 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
                 notes.append(f"{display_path(r.path.name)}: its sidecar row names specimen "
                              f"{named!r}, not {specimen.name!r} (specimen=); compared as "
                              f"{named!r}")
+    # said once for the files it holds for, counted (as a store's records are below): five
+    # exports naming no specimen gave the same sentence five times
+    notes.extend(files_assumption_notes([(display_path(r.path.name), assumed(
+        r.stated, r.settings.specimen if r.settings is not None else "", specimen))
+        for r in results]))
     if len(results) < len(files):
         kept = {r.path for r in results}
         notes += [f"{display_path(f.name)}: identical contents to another file given; counted once"

@@ -90,9 +90,11 @@ def _known_specimens() -> list:
     return uploads.known_specimens(defaults.APP_SPECIMEN_FOLDERS, uploaded)
 
 
-def _card(upload, row, sample_rate_hz, materials, given=(), known=(), every_file=""):
+def _card(upload, row, sample_rate_hz, materials, given=(), known=(), every_file="",
+          said_specimens=None):
     """Results of one file; returns an AnalysedFile or None. ``known``: the specimen files a
-    typed specimen name may mean; ``every_file``: the specimen of a row naming none."""
+    typed specimen name may mean; ``every_file``: the specimen of a row naming none;
+    ``said_specimens``: the specimen notes earlier cards showed (added to), each shown once."""
     from pidcore.compare.case import load_case_of, stated_case
     from pidcore.compare.plausibility import implausible_findings
     from pidcore.errors import PidcoreError
@@ -150,8 +152,12 @@ def _card(upload, row, sample_rate_hz, materials, given=(), known=(), every_file
         for note in (*record.notes, *zero_notes):
             st.caption(f"note: {note}")
         named = resolve_specimen_name(str(row.get("specimen", "") or "") or every_file, known)
-        if named.note:  # a name alone meets another file's DEM runs of that name
+        # a name alone meets another file's DEM runs of that name; said on the first card
+        # naming it (three files of one unknown name showed the same note three times)
+        if named.note and (said_specimens is None or named.note not in said_specimens):
             st.info(named.note)
+            if said_specimens is not None:
+                said_specimens.add(named.note)
         return uploads.AnalysedFile(record, case, options, named.name, warnings,
                                     specimen_sha256=named.sha256)
 
@@ -248,7 +254,7 @@ def render(stores) -> list:
             channel_names += [n for n in found.channels.names if n not in channel_names]
     st.markdown("**Per-file settings** (edit the cells; each file is analysed with its own row)")
     settings = _settings_editor(measurements, tables, channel_names, materials)
-    analysed = []
+    analysed, said_specimens = [], set()
     for upload, (_, row) in zip(measurements, settings.iterrows(), strict=True):
         held = uploads.refusal_of(upload.name, refused)
         if held:  # no numbers, no "none given" notes: its settings were given, and refused
@@ -258,7 +264,7 @@ def render(stores) -> list:
             continue
         result = _card(upload, row, sample_rate_hz, materials,
                        uploads.columns_given(list(tables.values()), upload.name), known,
-                       every_file)
+                       every_file, said_specimens)
         if result is not None:
             analysed.append(result)
     if analysed:
