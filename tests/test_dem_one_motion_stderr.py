@@ -138,6 +138,7 @@ def test_one_cell_gets_the_batch_means_error_of_its_window():
     assert "its one cell is one motion" in note
     summary = format_summary(result)
     assert "(stderr from batches of one motion: see the note)" in summary
+    assert "[-]) over 1 cell (stderr" in summary  # one cell, not "1 cells"
     # three batches are too few: none, and the note says why
     short = _from_tally(SDC_PER_CYCLE[None, :6], transient=4, block_cycles=2)
     assert math.isnan(short.sdc_stderr) and math.isnan(short.sdc_stderr_dof)

@@ -453,7 +453,8 @@ def format_summary(result, *, reused: bool = False) -> str:
         ]
     lines += [
         (f"SDC             {result.sdc:.4g} +- {result.sdc_stderr:.2g} [-] (loss factor "
-         f"{result.loss_factor:.4g} [-]) over {result.cells_simulated} cells"
+         f"{result.loss_factor:.4g} [-]) over {result.cells_simulated} "
+         f"{'cell' if result.cells_simulated == 1 else 'cells'}"
          # the error of cells that ran one motion is from batches of it, not the cells
          + (" (stderr from batches of one motion: see the note)"
             if stderr_from_batches(result.sdc_per_cell) else "")
