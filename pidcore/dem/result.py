@@ -149,9 +149,9 @@ class DemResult:
         # bouncer). That motion's own scatter over its steady window is: batch means of it
         # so is one cell: its scatter has no second value
         if stderr_from_batches(sdc_cells):
-            sdc_cycles = (n_coupon * steady[0, :, 1:].sum(axis=1) / e_max if e_max > 0
-                          else np.full(steady.shape[1], np.nan))
-            stderr, stderr_dof = batch_means_stderr(sdc_cycles, config.block_cycles)
+            stderr, stderr_dof = batch_means_stderr(
+                _one_motion_sdc_per_cycle(per_cell_cycle, steady_start_cycle, n_coupon, e_max),
+                config.block_cycles)
         elif k > 1:
             stderr = float(np.std(sdc_cells, ddof=1) / math.sqrt(k))
             stderr_dof = float(k - 1)
@@ -428,11 +428,9 @@ class DemResult:
     def _batches_agree(self) -> bool:
         """Whether the batch means of cell 0's steady SDC per cycle agree
         (:func:`batch_means_agree`): why a one-motion run with batches enough has no error."""
-        if not self.max_kinetic_energy_j > 0:
-            return False
-        per_cycle = (self.coupon_cells
-                     * np.asarray(self.dissipation_per_cell_cycle_j, dtype=float)[
-                         0, self.steady_start_cycle:] / self.max_kinetic_energy_j)
+        per_cycle = _one_motion_sdc_per_cycle(self.dissipation_per_cell_cycle_j,
+                                              self.steady_start_cycle, self.coupon_cells,
+                                              self.max_kinetic_energy_j)
         n = per_cycle.size // self.config.block_cycles
         if n < 2 or not np.all(np.isfinite(per_cycle[:n * self.config.block_cycles])):
             return False
@@ -488,6 +486,17 @@ def batch_means_stderr(per_cycle: np.ndarray, batch_cycles: int, *,
     if batch_means_agree(means):
         return float("nan"), float("nan")
     return float(np.std(means, ddof=1) / math.sqrt(n)), float(n - 1)
+
+
+def _one_motion_sdc_per_cycle(dissipation_per_cell_cycle_j: np.ndarray, steady_start_cycle: int,
+                              coupon_cells: int, e_max_j: float) -> np.ndarray:
+    """The SDC of each steady cycle of the first cell (the one motion of
+    :func:`stderr_from_batches`): its dissipation scaled to the coupon's cells over E of
+    Eq. 10; NaN where E is not positive."""
+    per_cycle = np.asarray(dissipation_per_cell_cycle_j, dtype=float)[0, steady_start_cycle:]
+    if not e_max_j > 0:
+        return np.full(per_cycle.size, np.nan)
+    return coupon_cells * per_cycle / e_max_j
 
 
 def _batch_means(values: np.ndarray, batch_cycles: int, n: int) -> np.ndarray:
