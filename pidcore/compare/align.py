@@ -26,7 +26,7 @@ within the same tolerances (the paper used acrylic particles driven along z); ot
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -305,9 +305,21 @@ def pooled_stderr_dof(values: np.ndarray, stderrs: np.ndarray, dofs: np.ndarray)
         return float(n - 1)
     if not (np.all(np.isfinite(dofs)) and np.all(dofs > 0)):
         return math.nan
-    variances = stderrs ** 2
-    denominator = float(np.sum(variances ** 2 / dofs))
-    return float(np.sum(variances) ** 2 / denominator) if denominator > 0 else math.nan
+    return welch_satterthwaite_dof(stderrs, dofs)
+
+
+def welch_satterthwaite_dof(stderrs: Sequence[float] | np.ndarray,
+                            dofs: Sequence[float] | np.ndarray) -> float:
+    """Welch-Satterthwaite degrees of freedom of sqrt(sum se^2): (sum se^2)^2 /
+    sum(se^4 / dof), a standard error whose degrees of freedom are unknown (NaN) counted as
+    known exactly (infinite: normal, as :func:`band_quantile` takes it alone); NaN where
+    none states them (or every error is 0)."""
+    variances = np.asarray(stderrs, dtype=float) ** 2
+    dofs = np.asarray(dofs, dtype=float)
+    known = np.isfinite(dofs) & (dofs > 0) & (variances > 0)
+    if not known.any():
+        return math.nan
+    return float(np.sum(variances) ** 2 / np.sum(variances[known] ** 2 / dofs[known]))
 
 
 #: Two-sided 95 % quantile of the normal distribution (a measurement's stderr -> half-width)

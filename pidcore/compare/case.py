@@ -25,6 +25,7 @@ from .align import (
     pooled_sdc_eq10,
     pooled_stderr_dof,
     stored_stderr_dof,
+    welch_satterthwaite_dof,
 )
 from .loadcase import LoadCase, StatedLoadCase
 
@@ -563,7 +564,8 @@ class Headline:
         comparable.
     stderr_dof : float
         Degrees of freedom of sigma: Welch-Satterthwaite's of the two standard errors' own
-        (:func:`combined_stderr_dof`); NaN where neither states them (normal: 1.96).
+        (:func:`pidcore.compare.align.welch_satterthwaite_dof`); NaN where neither
+        states them (normal: 1.96).
     agrees : bool or None
         Whether |measured - DEM| <= interval_sigmas x sigma: the verdict's "agrees" and what a
         count of agreeing cases counts; None when not comparable, or when one side has no
@@ -582,19 +584,6 @@ class Headline:
     stderr_dof: float = math.nan
     agrees: bool | None = None
     basis: str = ""
-
-
-def combined_stderr_dof(stderrs: Sequence[float], dofs: Sequence[float]) -> float:
-    """Welch-Satterthwaite degrees of freedom of sqrt(sum se^2): (sum se^2)^2 /
-    sum(se^4 / dof), a standard error whose degrees of freedom are unknown (NaN) counted as
-    known exactly (infinite: normal, as :func:`pidcore.compare.align.band_quantile`
-    takes it alone); NaN where none states them."""
-    variances = np.asarray(stderrs, dtype=float) ** 2
-    dofs = np.asarray(dofs, dtype=float)
-    known = np.isfinite(dofs) & (dofs > 0) & (variances > 0)
-    if not known.any():
-        return math.nan
-    return float(np.sum(variances) ** 2 / np.sum(variances[known] ** 2 / dofs[known]))
 
 
 def headline(comparison: CaseComparison) -> Headline:
@@ -622,7 +611,7 @@ def headline(comparison: CaseComparison) -> Headline:
     se = math.sqrt(sum(p[0] ** 2 for p in parts))
     if not se > 0:
         return Headline(m, m_se, kind, dem, dem_se, math.nan, "no standard error to judge by")
-    dof = combined_stderr_dof([p[0] for p in parts], [p[1] for p in parts])
+    dof = welch_satterthwaite_dof([p[0] for p in parts], [p[1] for p in parts])
     q = band_quantile(dof)
     quantile = ("normal, neither standard error states its degrees of freedom"
                 if math.isnan(dof) else f"Student t of {dof:.3g} degrees of freedom"
