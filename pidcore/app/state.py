@@ -51,6 +51,17 @@ def store_listing(what: str, stamp: tuple, _stores):
     raise ValueError(what)
 
 
+@st.cache_data(max_entries=4, show_spinner=False)
+def design_runs(stamp: tuple, _stores) -> dict[str, str]:
+    """Which of the stores' DEM runs are a saved calibration's design runs (run key ->
+    calibration key, :func:`pidcore.calibrate.persist.calibration_design_runs`), re-read only
+    when a store file changed: it opens the stores and reads every calibration."""
+    from pidcore.calibrate.persist import calibration_design_runs
+
+    return calibration_design_runs(store_listing("dem_runs", stamp, _stores),
+                                   [_stores.path, _stores.dem_reference])
+
+
 # cache_resource: the calibrations are frozen records, read once per store state (stamp) and
 # shared by the Compare, Report and Calibrate tabs; a saved calibration rewrites the store, so
 # the next draw has another stamp and reads it

@@ -178,7 +178,8 @@ def render(stores) -> None:
     draw_polling(_job_table, stores, polling=_runner(stores).busy(),
                  every_s=REFRESH_S)
     try:
-        runs = state.store_listing("dem_runs", stores.stamp(), stores)
+        stamp = stores.stamp()
+        runs = state.store_listing("dem_runs", stamp, stores)
     except PidcoreError as exc:
         st.error(f"cannot read the DEM runs: {exc}")
         return
@@ -187,10 +188,8 @@ def render(stores) -> None:
         table = jobs.dem_runs_table(runs)
         st.dataframe(table, hide_index=True, width="stretch", key="dem_runs_table",
                      placeholder="")
-        from pidcore.calibrate.persist import calibration_design_runs
-
         # listed as the store holds them, but said: Compare and Report leave them out
-        design = calibration_design_runs(runs, [stores.path, stores.dem_reference])
+        design = state.design_runs(stamp, stores)
         if design:
             st.caption(f"{len(design)} of these run(s) are the design runs of calibration(s) "
                        f"{', '.join(sorted(set(design.values())))}: inputs of its fit, not "
