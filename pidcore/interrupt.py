@@ -45,6 +45,13 @@ class StopRequested(Exception):  # noqa: N818 - a request, not an error
     exiting. The running work was stopped and discarded; what finished before is kept."""
 
 
+def raise_if_stopped(stop: threading.Event | None, message: str) -> None:
+    """Raise :class:`StopRequested` with ``message`` (what was stopped, what is kept) where
+    the work's ``stop`` event is set; nothing where it is None or not set."""
+    if stop is not None and stop.is_set():
+        raise StopRequested(message)
+
+
 def _handler(signum, frame) -> None:  # noqa: ARG001 - signal handler signature
     global _signal_number
     if not _interrupted.is_set():  # the first signal is the one the exit status says

@@ -23,6 +23,7 @@ from ..compare.align import steady_stated
 from ..constants import STANDARD_GRAVITY
 from ..dem.simulate import DemConfig, LoadCase
 from ..errors import ParameterError, real_number, whole_number
+from ..interrupt import raise_if_stopped
 from ..specimen import (
     Specimen,
     calibrated_name,
@@ -447,7 +448,7 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: str | Sequence[str],
         told["stop"] = stop
     runs = run_requests([r for row in requests for r in row], store_path=store_path,
                         workers=workers, progress=progress, **told)
-    _raise_if_stopped(stop)
+    raise_if_stopped(stop, _STOPPED)
     from ..store import Store
 
     store = Store(store_path)
@@ -509,7 +510,7 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: str | Sequence[str],
             bar = tqdm(total=len(folds), unit="fold", desc="leave-one-out", dynamic_ncols=True)
         try:
             for i in folds:
-                _raise_if_stopped(stop)  # each fold is a posterior of its own: seconds
+                raise_if_stopped(stop, _STOPPED)  # each fold is a posterior of its own: seconds
                 others = [j for j in everything if j != i]
                 fold = sample_posterior(model, others, seed=posterior_seed + 1 + i,
                                         method=method)
@@ -540,7 +541,7 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: str | Sequence[str],
                 "cross_validate": cross_validate, "store": str(store_path)}
     if posterior.diagnostics is not None:  # emcee's: acceptance, autocorrelation, sample size
         settings["sampler"] = posterior.diagnostics.to_dict()
-    _raise_if_stopped(stop)
+    raise_if_stopped(stop, _STOPPED)
     return CalibrationResult(specimen=specimen, specs=specs, samples=samples, parameters=parameters,
                              correlations=correlations, predictions=predictions, loo=loo,
                              fixed=fixed, design=design, observations=observations, runs=runs,
@@ -548,11 +549,8 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: str | Sequence[str],
                              wall_s=time.perf_counter() - start)
 
 
-def _raise_if_stopped(stop: threading.Event | None) -> None:
-    from ..interrupt import StopRequested
-
-    if stop is not None and stop.is_set():
-        raise StopRequested("calibration stopped; the DEM runs saved before are kept")
+#: What a stop says (:func:`pidcore.interrupt.raise_if_stopped`).
+_STOPPED = "calibration stopped; the DEM runs saved before are kept"
 
 
 def _released_share(record: dict) -> float | None:

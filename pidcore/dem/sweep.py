@@ -22,6 +22,7 @@ from pathlib import Path
 
 from ..constants import DriveDirection, ParticleMaterial
 from ..errors import ParameterError, SimulationError, instance_of, whole_number
+from ..interrupt import raise_if_stopped
 from ..records import json_safe
 from ..specimen import Specimen, fill_override_note
 from .persist import (
@@ -254,7 +255,7 @@ def run_pooled(function: Callable, calls: Sequence[tuple], *, workers: int,
 
     from .. import interrupt
 
-    _raise_if_stopped(stop)  # before any worker starts
+    raise_if_stopped(stop, _STOPPED)  # before any worker starts
     pool = ProcessPoolExecutor(max_workers=min(workers, len(calls)),
                                mp_context=dem_process_context(),
                                initializer=init_dem_worker, initargs=(os.getpid(),))
@@ -280,11 +281,8 @@ def run_pooled(function: Callable, calls: Sequence[tuple], *, workers: int,
     pool.shutdown()
 
 
-def _raise_if_stopped(stop: threading.Event | None) -> None:
-    from ..interrupt import StopRequested
-
-    if stop is not None and stop.is_set():
-        raise StopRequested("the DEM runs were stopped; the runs finished before are kept")
+#: What a stop says (:func:`pidcore.interrupt.raise_if_stopped`).
+_STOPPED = "the DEM runs were stopped; the runs finished before are kept"
 
 
 def _finished(futures: list, stop: threading.Event | None) -> Iterator:
@@ -299,9 +297,9 @@ def _finished(futures: list, stop: threading.Event | None) -> Iterator:
     while pending:
         done, pending = wait(pending, timeout=STOP_POLL_S, return_when=FIRST_COMPLETED)
         for future in done:
-            _raise_if_stopped(stop)
+            raise_if_stopped(stop, _STOPPED)
             yield future
-        _raise_if_stopped(stop)
+        raise_if_stopped(stop, _STOPPED)
 
 
 def _stop_pool(pool) -> None:
