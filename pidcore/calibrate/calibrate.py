@@ -554,17 +554,16 @@ _STOPPED = "calibration stopped; the DEM runs saved before are kept"
 
 
 def _released_share(record: dict) -> float | None:
-    """The share of the dissipation per cycle a stored DEM run's bed released from its stored
-    energy over the cycles measured, 1 - work / dissipation (:attr:`pidcore.dem.DemResult.
-    notes` says the same of one run); None where the record lacks either."""
+    """:func:`pidcore.dem.result.released_share` of a stored DEM run's record (what
+    :attr:`pidcore.dem.DemResult.notes` says of one run); None where the record lacks either
+    number."""
+    from ..dem.result import released_share
+
     try:
-        work = float(record["work_per_cycle_j"])
-        dissipated = float(record["energy_per_cycle_j"])
+        share = released_share(record["work_per_cycle_j"], record["energy_per_cycle_j"])
     except (KeyError, TypeError, ValueError):
         return None
-    if not (math.isfinite(work) and math.isfinite(dissipated) and dissipated > 0):
-        return None
-    return 1.0 - work / dissipated
+    return None if math.isnan(share) else share
 
 
 def _not_converged_note(diagnostics: SamplerDiagnostics) -> str:

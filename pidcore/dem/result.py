@@ -253,10 +253,8 @@ class DemResult:
                 "cap the stored energy shows no trend and the dissipation no change against "
                 "their scatter (docs/calibration.md, 'DEM runs that never reach a steady "
                 "state')")
-        if not self.steady_detected and self.energy_per_cycle_j > 0:
-            # what a drift does to the number: the steady dissipation is what the walls' work
-            # supplies, so the SDC is off by the share of the dissipation the bed released
-            released = 1.0 - self.work_per_cycle_j / self.energy_per_cycle_j
+        released = released_share(self.work_per_cycle_j, self.energy_per_cycle_j)
+        if not self.steady_detected and math.isfinite(released):
             notes.append(
                 f"not converged: no steady state by the transient cap (measured from cycle "
                 f"{self.steady_start_cycle}); over the {self.steady_cycles} cycles measured the "
@@ -450,6 +448,17 @@ def cells_ran_one_motion(sdc_per_cell: np.ndarray) -> bool:
     """Whether two or more cells gave the same SDC to the last bit: the same simulation."""
     sdc = np.asarray(sdc_per_cell, dtype=float)
     return sdc.size > 1 and bool(np.all(np.isfinite(sdc))) and float(np.ptp(sdc)) == 0.0
+
+
+def released_share(work_per_cycle_j: float, dissipated_per_cycle_j: float) -> float:
+    """The share of the dissipation per cycle a bed released from its stored energy over the
+    cycles measured, 1 - work / dissipation: what a drift of that size puts the SDC off by (the
+    steady dissipation is what the walls' work supplies). NaN where either is not finite or
+    nothing was dissipated."""
+    work, dissipated = float(work_per_cycle_j), float(dissipated_per_cycle_j)
+    if not (math.isfinite(work) and math.isfinite(dissipated) and dissipated > 0):
+        return math.nan
+    return 1.0 - work / dissipated
 
 
 def stderr_from_batches(sdc_per_cell: np.ndarray) -> bool:
