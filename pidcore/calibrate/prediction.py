@@ -408,14 +408,13 @@ def tested_sha256(specimen) -> str | None:
     """The sha256 of the specimen file whose tests ``specimen`` models: the file it was
     calibrated from (its ``[provenance]``), else its own (a file that is not a calibrated
     one); None for a calibrated file without ``[provenance]`` (written before the table
-    existed: which file it came from is unknown, only its name is)."""
-    from ..specimen import uncalibrated_name
+    existed: which file it came from is unknown, only its name is). Otherwise the hash its
+    tests are saved with (:func:`pidcore.specimen.measured_specimen_sha256`)."""
+    from ..specimen import measured_specimen_sha256, uncalibrated_name
 
-    if specimen.provenance is not None:
-        return specimen.provenance.calibrated_from_sha256
-    if uncalibrated_name(specimen.name) == specimen.name:
-        return specimen.hash
-    return None
+    if specimen.provenance is None and uncalibrated_name(specimen.name) != specimen.name:
+        return None
+    return measured_specimen_sha256(specimen)
 
 
 def _number(value, what: str, path: Path) -> float:
