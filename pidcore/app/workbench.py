@@ -85,6 +85,7 @@ def dem_loop(paths: Sequence[str | os.PathLike | None],
     why it cannot be drawn, or None where there is no DEM run at the case."""
     from dataclasses import replace
 
+    from ..dem.persist import run_key_case
     from ..report.comparison_figures import dem_loop_from_arrays
     from ..store import Store
 
@@ -98,7 +99,7 @@ def dem_loop(paths: Sequence[str | os.PathLike | None],
             found = dem_loop_from_arrays(entry.arrays, entry.record)
             if isinstance(found, str):
                 return f"DEM run {key}: {found}"
-            return replace(found, label=f"our DEM: {key.split('_seed')[0]}")
+            return replace(found, label=f"our DEM: {run_key_case(key)}")
     return None
 
 

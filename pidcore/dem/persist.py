@@ -80,6 +80,13 @@ def run_key(case: LoadCase, config: DemConfig, specimen: Specimen | None = None)
     return f"{_key_case(case, specimen)}_seed{config.seed}_cells{config.cells}_{digest[:10]}"
 
 
+def run_key_case(key: str) -> str:
+    """The readable load case a :func:`run_key` begins with (``f50Hz_a5g_fill50pct_acrylic_z``
+    of ``f50Hz_a5g_fill50pct_acrylic_z_seed12345_cells8_<hash>``): what two runs of one load
+    case share, whatever their seed, cells and settings."""
+    return key.split("_seed")[0]
+
+
 def run_key_0_1(case: LoadCase, config: DemConfig) -> str:
     """The key pidcore 0.1 stored the same run under (``acrylic_z_f50_a5_fill50_seed...``), so
     a sweep over a 0.1 store skips the runs it holds."""
@@ -401,6 +408,7 @@ def rekey_dem_store(source: str | os.PathLike[str], target: str | os.PathLike[st
 
 
 __all__ = ["DEM_CODE_VERSION", "cached_run", "CachedRun", "dem_run_entry", "load_dem_result",
-           "own_run_keys", "rekey_dem_store", "run_identity", "run_key", "run_or_load",
+           "own_run_keys", "rekey_dem_store", "run_identity", "run_key", "run_key_case",
+           "run_or_load",
            "run_parameters", "runs_of_specimen", "save_dem_entry", "save_dem_result",
            "stored_identities", "stored_run_key"]

@@ -30,6 +30,7 @@ from .persist import (
     own_run_keys,
     run_identity,
     run_key,
+    run_key_case,
     save_dem_entry,
     stored_identities,
     stored_keys,
@@ -488,7 +489,7 @@ def run_sweep(cases: Sequence[LoadCase], config: DemConfig, *,
             _stored_meanwhile(summary, outcome.key)
         if bar is not None:
             bar.update(1)
-            bar.set_postfix_str(outcome.key.split("_seed")[0])
+            bar.set_postfix_str(run_key_case(outcome.key))
         if on_case is not None:
             on_case(outcome)
 

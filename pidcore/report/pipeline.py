@@ -409,12 +409,13 @@ def without_design_runs(runs: pd.DataFrame, design_runs: Mapping[str, str], *,
     design = runs["case_key"].isin(list(design_runs)).to_numpy(bool)
     if not design.any():
         return runs, ""
-    # a run's load case is its key up to "_seed" (pidcore.dem.persist.run_key: frequency,
-    # acceleration, fill, material, direction as every writer formats them), of its specimen
+    # a run's load case is the start of its key (frequency, acceleration, fill, material,
+    # direction as every writer formats them), of its specimen
+    from ..dem.persist import run_key_case
+
     sha = (runs["specimen_sha256"].astype(str) if "specimen_sha256" in runs.columns
            else pd.Series([""] * len(runs), index=runs.index))
-    where = list(zip(sha, runs["case_key"].astype(str).str.split("_seed").str[0],
-                     strict=True))
+    where = list(zip(sha, runs["case_key"].astype(str).map(run_key_case), strict=True))
     covered = {w for w, d in zip(where, design, strict=True) if not d}
     replaced = np.array([d and w in covered for w, d in zip(where, design, strict=True)],
                         bool)
