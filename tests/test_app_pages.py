@@ -1767,3 +1767,57 @@ def test_an_unknown_specimen_name_is_said_once_for_all_its_files(store_file):
                     "(its DEM runs are met by name)"]
     # each file is still saved under its name
     assert _table(at, "SDC [-]")["specimen"].tolist() == ["nosuch"] * 3 + ["other"]
+
+
+def test_an_uploaded_specimen_file_survives_a_reload_by_its_hash_in_the_address(store_file,
+                                                                                 tmp_path):
+    """The DEM form is bound to the page address, which cannot hold a file: after a reload
+    the uploaded specimen was gone and the form ran the paper's coupon. The file is kept
+    beside the store and the address holds its sha256; a reload restores it."""
+    import hashlib
+
+    from pidcore.specimen import hashed_name
+
+    data = b"# my panel\n" + (REPO / "data_samples" / "specimens" / "steel_6mm.toml").read_bytes()
+    sha = hashlib.sha256(data).hexdigest()
+    at = _app()
+    at.file_uploader(key="dem_specimen_file").set_value([("panel.toml", data,
+                                                          "application/toml")])
+    at.run()
+    assert not at.exception and not at.error
+    assert at.query_params.get("dem_specimen_upload") in (sha, [sha])  # the hash, not the text
+    assert (store_file.parent / f"{store_file.name}.specimens" / f"{sha}.toml").read_bytes() \
+        == data
+    # the reload: a fresh session at that address, the uploader empty
+    at = _app_at({"dem_specimen_upload": sha})
+    assert not at.error
+    assert at.text_input(key="dem_material_specimen").value == "steel"  # not the paper's acrylic
+    assert not at.button(key="dem_run").disabled
+    assert at.selectbox(key="dem_specimen").disabled
+    assert any(c.value.startswith(f"panel.toml: the specimen file uploaded before the page was "
+                                  f"reloaded (sha256 {sha[:12]}") for c in at.caption)
+    # the Analyse tab still offers it as every file's specimen
+    from pidcore.specimen import Specimen
+
+    label = hashed_name("steel_6mm", Specimen.from_bytes(data).hash)
+    assert label in at.selectbox(key="every_file_specimen").options
+    # forgetting it clears the address and gives the list back
+    at.button(key="dem_specimen_forget").click()
+    at.run()
+    assert "dem_specimen_upload" not in at.query_params
+    assert not at.selectbox(key="dem_specimen").disabled
+    assert "dem_material" in {s.key for s in at.selectbox}
+
+
+def test_an_address_naming_an_unknown_specimen_hash_is_refused_in_one_line(store_file):
+    at = _app_at({"dem_specimen_upload": "../x"})
+    assert [e.value for e in at.error] == [
+        "specimen file '../x' (from the page address): expected the sha256 of an uploaded "
+        "specimen file (64 lowercase hexadecimal digits); upload the specimen file again"]
+    at = _app_at({"dem_specimen_upload": "e" * 64})
+    assert [e.value for e in at.error] == [
+        "specimen file eeeeeeeeeeee (from the page address): not an uploaded specimen file "
+        f"this app keeps (none in {store_file}.specimens); upload the specimen file again"]
+    # no fallback to the paper's coupon: nothing runs until the user uploads or forgets it
+    assert at.button(key="dem_run").disabled
+    assert "dem_material" not in {s.key for s in at.selectbox}

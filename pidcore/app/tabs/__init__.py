@@ -81,14 +81,79 @@ def refuse_address_choices(key: str, label: str, options: Sequence[str],
 PAPER_CHOICE = "paper coupon (default)"
 
 
-def specimen_choice(key: str):
+#: The page-address parameter of a form's uploaded specimen file: ``{key}_specimen_upload``
+#: holds its sha256 (:mod:`pidcore.app.kept_specimens`), never its text.
+SPECIMEN_UPLOAD_PARAMETER = "{key}_specimen_upload"
+#: The forms whose specimen uploader the Analyse tab's specimen names may mean.
+SPECIMEN_FORMS = ("dem", "calibration")
+
+
+def _specimen_memory(key: str) -> str:
+    return f"_{key}_specimen_upload"
+
+
+def _forget_specimen_upload(key: str) -> None:
+    # button callback: before the script, so this run draws the form without the file
+    st.session_state[_specimen_memory(key)] = (None, False)
+
+
+def specimen_upload(key: str, store_path, upload):
+    """The form ``key``'s uploaded specimen file this run (:func:`pidcore.app.kept_specimens.
+    specimen_upload`), its hash put in the page address (or taken out of it) so that a
+    reload restores the file; a fresh session reads the address's hash."""
+    from pidcore.app import kept_specimens
+
+    parameter = SPECIMEN_UPLOAD_PARAMETER.format(key=key)
+    memory = _specimen_memory(key)
+    if memory not in st.session_state:  # a fresh session: what the address says
+        st.session_state[memory] = (st.query_params.get(parameter) or None, False)
+    sha256, seen = st.session_state[memory]
+    state = kept_specimens.specimen_upload(
+        kept_specimens.kept_specimens_folder(store_path),
+        upload=None if upload is None else (upload.name, upload.getvalue()),
+        sha256=sha256, upload_seen=seen)
+    st.session_state[memory] = (state.sha256, state.upload_seen)
+    if state.sha256:
+        if st.query_params.get(parameter) != state.sha256:
+            st.query_params[parameter] = state.sha256
+    elif parameter in st.query_params:
+        del st.query_params[parameter]
+    return state
+
+
+def uploaded_specimens(store_path) -> list[tuple[str, bytes]]:
+    """The specimen files uploaded on the DEM and Calibrate forms (``(name, bytes)``), those
+    restored from the page address after a reload included (each form says why one of them
+    is refused; here it is left out)."""
+    from pidcore.app import kept_specimens
+    from pidcore.errors import ParameterError
+
+    found = []
+    for key in SPECIMEN_FORMS:
+        upload = st.session_state.get(f"{key}_specimen_file")
+        if upload is not None:
+            found.append((upload.name, upload.getvalue()))
+            continue
+        sha256, seen = st.session_state.get(_specimen_memory(key), (
+            st.query_params.get(SPECIMEN_UPLOAD_PARAMETER.format(key=key)) or None, False))
+        if sha256 and not seen:
+            try:
+                kept = kept_specimens.restore_specimen(
+                    kept_specimens.kept_specimens_folder(store_path), sha256)
+            except ParameterError:
+                continue
+            found.append((kept.name, kept.data))
+    return found
+
+
+def specimen_choice(key: str, store_path):
     """(specimen, error): the specimen chosen on a page (None: the paper's coupon), a file of
     ``defaults.APP_SPECIMEN_FOLDERS`` or an uploaded TOML (parsed by
-    :func:`pidcore.specimen.Specimen.from_text`, never executed); ``error`` is why the chosen
-    file is refused (None when it is not). Widget keys ``{key}_specimen`` and
+    :func:`pidcore.specimen.Specimen.from_text`, never executed; kept beside the store
+    ``store_path`` and restored after a reload: :func:`specimen_upload`); ``error`` is why
+    the chosen file is refused (None when it is not). Widget keys ``{key}_specimen`` and
     ``{key}_specimen_file``."""
     from pidcore import defaults
-    from pidcore.app import jobs
     from pidcore.app.uploads import specimen_files
     from pidcore.errors import PidcoreError
     from pidcore.specimen import load_specimen
@@ -97,17 +162,31 @@ def specimen_choice(key: str):
     c1, c2 = st.columns(2)
     upload = c2.file_uploader("or a specimen file (TOML)", type=["toml"],
                               key=f"{key}_specimen_file")
+    uploaded = specimen_upload(key, store_path, upload)
+    if upload is None and (uploaded.kept is not None or uploaded.error is not None):
+        # restored from the address (or refused there): the uploader is empty, so say which
+        # file is in use, and let it go without uploading another
+        if uploaded.note:
+            c2.caption(uploaded.note)
+        c2.button("forget this specimen file", key=f"{key}_specimen_forget",
+                  on_click=_forget_specimen_upload, args=(key,),
+                  help="choose from the list instead")
+    elif uploaded.note:  # kept for no reload: the folder cannot be written
+        c2.warning(uploaded.note)
     choices = [PAPER_CHOICE, *map(str, files)]
     with c1:
         refuse_address_choices(f"{key}_specimen", "specimen", choices, PAPER_CHOICE)
     choice = c1.selectbox("specimen", choices, key=f"{key}_specimen",
-                          disabled=upload is not None, bind=ADDRESS_BINDING)
+                          disabled=uploaded.kept is not None or uploaded.error is not None,
+                          bind=ADDRESS_BINDING)
+    if uploaded.error is not None:
+        st.error(uploaded.error)
+        return None, uploaded.error
+    if uploaded.kept is not None:
+        return uploaded.kept.specimen, None
     try:
-        if upload is not None:
-            return jobs.specimen_from_upload(upload.name, upload.getvalue()), None
         return (None if choice == PAPER_CHOICE else load_specimen(choice)), None
     except (PidcoreError, OSError, ValueError) as exc:
-        name = upload.name if upload is not None else choice
-        message = str(exc) if str(exc).startswith(name) else f"{name}: {exc}"
+        message = str(exc) if str(exc).startswith(choice) else f"{choice}: {exc}"
         st.error(message)
         return None, message

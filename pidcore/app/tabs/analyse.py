@@ -81,13 +81,14 @@ def _settings_editor(measurements, tables: dict[str, pd.DataFrame], channel_name
 ROW_SPECIMEN_CHOICE = "(as the settings table names it)"
 
 
-def _known_specimens() -> list:
+def _known_specimens(stores) -> list:
     """The specimen files the DEM tab offers: bundled, in the specimen folders, and those
-    uploaded on the DEM or Calibrate tab (their widgets keep them for the session)."""
-    uploaded = [(u.name, u.getvalue()) for key in ("dem_specimen_file",
-                                                    "calibration_specimen_file")
-                if (u := st.session_state.get(key)) is not None]
-    return uploads.known_specimens(defaults.APP_SPECIMEN_FOLDERS, uploaded)
+    uploaded on the DEM or Calibrate tab (their widgets keep them for the session; after a
+    reload, the files their page address names)."""
+    from pidcore.app.tabs import uploaded_specimens
+
+    return uploads.known_specimens(defaults.APP_SPECIMEN_FOLDERS,
+                                   uploaded_specimens(stores.path))
 
 
 def _card(upload, row, sample_rate_hz, materials, given=(), known=(), every_file="",
@@ -187,7 +188,7 @@ def render(stores) -> list:
         except PidcoreError as exc:
             st.error(f"{exc}; files are read without a sample rate")
             sample_rate_hz = None
-        known = _known_specimens()
+        known = _known_specimens(stores)
         every_file = st.selectbox(
             "specimen of every file", [ROW_SPECIMEN_CHOICE, *dict.fromkeys(
                 hashed_name(s.name, s.hash) for s in known)], key="every_file_specimen",

@@ -171,7 +171,7 @@ def _form(stores, api, points: list, left_out: list[str]) -> str:
     leaves out."""
     from pidcore.errors import PidcoreError
 
-    specimen, refused = specimen_choice("calibration")
+    specimen, refused = specimen_choice("calibration", stores.path)
     if refused is not None:  # nothing runs, and no fallback to the paper's coupon
         st.info("Run is off until the specimen file is fixed or another is chosen.")
         return "a refused specimen file"

@@ -100,7 +100,7 @@ def render(stores) -> None:
     fills = c3.text_input("fills [%]", "50", key="dem_fills", bind=ADDRESS_BINDING,
                           help="e.g. 25, 50; empty: the specimen file's own count_per_cell or "
                                "fill_percent")
-    specimen, refused = specimen_choice("dem")
+    specimen, refused = specimen_choice("dem", stores.path)
     c4, c5 = st.columns(2)
     if refused is not None:  # no fallback to the paper's coupon: nothing runs until fixed
         c4.text_input("particle material", "(the specimen file is refused)", disabled=True,
