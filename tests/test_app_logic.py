@@ -2392,3 +2392,43 @@ def test_the_saved_calibrations_table_says_each_calibrations_cells_per_dem_run()
     assert list(table["calibration"]) == ["cal_c", "cal_b", "cal_a"]
     assert list(table[CELLS_COLUMN]) == ["", 3, 2]
     assert list(table.columns).index(CELLS_COLUMN) == list(table.columns).index("fitted") + 1
+
+
+def test_a_users_material_survives_a_specimen_file_changing_the_default():
+    # the rows kept acrylic, the default before a steel specimen file was uploaded; a
+    # material the user chose, or a table gave, is not the default and stays
+    previous = pd.DataFrame({"file": ["a.csv", "b.csv", "c.csv", "d_acrylic.csv"],
+                             "material": ["acrylic", "aluminium", "acrylic", "acrylic"]})
+    before = {"a.csv": "acrylic", "b.csv": "acrylic", "c.csv": "acrylic",
+              "d_acrylic.csv": "acrylic"}
+    now = {"a.csv": "steel", "b.csv": "steel", "c.csv": "steel", "d_acrylic.csv": "acrylic"}
+    out = uploads.restate_default_material(previous, before, now,
+                                           {"c.csv": {"material", "fill [%]"}})
+    assert out["material"].tolist() == ["steel", "aluminium", "acrylic", "acrylic"]
+    assert previous["material"].tolist()[0] == "acrylic"  # the session's copy is not changed
+
+
+def test_a_file_of_other_particles_is_not_saved_as_the_uploaded_specimens():
+    from pidcore.specimen import Specimen, hashed_name, load_specimen
+
+    path = REPO / "data_samples" / "specimens" / "steel_6mm.toml"
+    given = Specimen.from_bytes(b"# edited\n" + path.read_bytes(), source="panel.toml")
+    other = load_specimen(path).with_values({"coupon.fixture_mass_kg": 0.08})
+    known = [load_specimen(path), other, given]
+    steel = uploads.file_specimen("", "steel", known, given=given, every_file="ignored")
+    assert (steel.name, steel.sha256, steel.note) == ("steel_6mm", given.hash, "")
+    acrylic = uploads.file_specimen("", "acrylic", known, given=given)
+    assert (acrylic.name, acrylic.sha256) == ("", "")
+    assert acrylic.note.startswith("specimen steel_6mm (panel.toml): its particles are steel, "
+                                   "not acrylic")
+    # a row naming the given file's name means the given file, not another of that name
+    named = uploads.file_specimen("steel_6mm", "acrylic", known, given=given)
+    assert (named.name, named.sha256) == ("steel_6mm", given.hash)
+    # a row naming another file by its hashed name gets that one
+    picked = uploads.file_specimen(hashed_name("steel_6mm", other.hash), "steel", known,
+                                   given=given)
+    assert picked.sha256 == other.hash
+    # no specimen uploaded: the page's choice for every file, as before
+    chosen = uploads.file_specimen("", "acrylic", known,
+                                   every_file=hashed_name("steel_6mm", other.hash))
+    assert chosen.sha256 == other.hash

@@ -1821,3 +1821,89 @@ def test_an_address_naming_an_unknown_specimen_hash_is_refused_in_one_line(store
     # no fallback to the paper's coupon: nothing runs until the user uploads or forgets it
     assert at.button(key="dem_run").disabled
     assert "dem_material" not in {s.key for s in at.selectbox}
+
+
+def test_a_specimen_file_uploaded_with_the_exports_is_saved_as_analyze_specimen_saves_it(
+        store_file, tmp_path):
+    """The Analyse uploader refused a specimen TOML ("upload it on the DEM or Calibrate tab"),
+    so exports analysed there could not be tagged with the user's own specimen. Uploaded with
+    them it is `pidcore analyze --specimen FILE`: the default material of a file stating none,
+    and its name and sha256 saved with the files of its particles; the CLI's records of the
+    same files are the truth."""
+    from pidcore.cli import main
+    from pidcore.store import Store
+
+    toml = b"# my copy\n" + (REPO / "data_samples" / "specimens" / "steel_6mm.toml").read_bytes()
+    files = {"m_fill50.csv": mass_damper_csv(frequency_hz=100.0, acceleration_g=5.0),
+             "n_fill50_acrylic.csv": mass_damper_csv(frequency_hz=120.0, acceleration_g=5.0)}
+    cli_dir = tmp_path / "cli"
+    cli_dir.mkdir()
+    (cli_dir / "panel.toml").write_bytes(toml)
+    for name, data in files.items():
+        (cli_dir / name).write_bytes(data)
+    cli_store = tmp_path / "cli_store.h5"
+    assert main(["analyze", *(str(cli_dir / n) for n in files), "--specimen",
+                 str(cli_dir / "panel.toml"), "--store", str(cli_store)]) == 0
+    at = _upload(_app(), [*files.items(), ("panel.toml", toml)])
+    assert not at.error, [e.value for e in at.error]
+    assert at.selectbox(key="every_file_specimen").disabled
+    # the acrylic file (its name says so) is not of the specimen's particles: said, as the
+    # CLI saves it without one
+    assert any(i.value.startswith("specimen steel_6mm (panel.toml): its particles are steel, "
+                                  "not acrylic") for i in at.info)
+    at.button(key="save").click()
+    at.run()
+    assert any(s.value.startswith("saved 2 analysis record(s)") for s in at.success)
+    columns = ["source", "load_case_key", "material", "specimen", "specimen_sha256"]
+    app_saved = Store(store_file).list_analyses()[columns].sort_values("source")
+    cli_saved = Store(cli_store).list_analyses()[columns].sort_values("source")
+    app_saved["source"] = app_saved["source"].map(lambda s: Path(s).name)
+    cli_saved["source"] = cli_saved["source"].map(lambda s: Path(s).name)
+    assert app_saved.fillna("").values.tolist() == cli_saved.fillna("").values.tolist()
+    steel = app_saved[app_saved["source"] == "m_fill50.csv"].iloc[0]
+    assert steel["load_case_key"].endswith("_steel_z") and steel["specimen"] == "steel_6mm"
+    from pidcore.specimen import Specimen
+
+    assert steel["specimen_sha256"] == Specimen.from_bytes(toml).hash
+
+
+def test_a_bad_or_second_specimen_file_with_the_exports_stops_the_analysis_in_one_line(
+        store_file):
+    data = mass_damper_csv(frequency_hz=100.0, acceleration_g=5.0)
+    at = _upload(_app(), [("m_fill50.csv", data), ("bad.toml", b"name = 'x'\n[cell\n")])
+    (error,) = [e.value for e in at.error]
+    assert error.startswith("bad.toml: not valid TOML") and "\n" not in error
+    assert not _metric(at, "SDC ± stderr [-]")  # nothing analysed as the paper's coupon
+    steel = (REPO / "data_samples" / "specimens" / "steel_6mm.toml").read_bytes()
+    at = _upload(_app(), [("m_fill50.csv", data), ("a.toml", steel), ("b.toml", steel)])
+    assert [e.value for e in at.error] == [
+        "a.toml, b.toml: one specimen file at a time, as `pidcore analyze --specimen FILE` "
+        "takes one; remove all but the specimen these files were tested on"]
+    assert not _metric(at, "SDC ± stderr [-]")
+
+
+def test_a_specimen_file_added_after_the_exports_changes_only_the_default_material(store_file):
+    """The settings rows are kept over script runs: a specimen file uploaded after the exports
+    must still make a file that states no material one of its particles (as --specimen), and
+    leave a material a settings table gives alone."""
+    steel = (REPO / "data_samples" / "specimens" / "steel_6mm.toml").read_bytes()
+    files = [("m_fill50.csv", mass_damper_csv(frequency_hz=100.0, acceleration_g=5.0)),
+             ("n_fill50.csv", mass_damper_csv(frequency_hz=120.0, acceleration_g=5.0)),
+             ("settings.csv", b"file,material\nn_fill50.csv,aluminium\n")]
+    at = _upload(_app(), files)
+    assert _materials(at) == ["acrylic", "aluminium"]
+    at = _upload(at, [*files, ("panel.toml", steel)])
+    assert _materials(at) == ["steel", "aluminium"]
+    assert _table(at, "load case")["specimen"].tolist() == ["steel_6mm", ""]
+    # removed again: back to the paper's acrylic, not kept as steel
+    at = _upload(at, files)
+    assert _materials(at) == ["acrylic", "aluminium"]
+
+
+def _materials(at: AppTest) -> list[str]:
+    """The particle material of each file's load case in the results table."""
+    from pidcore.app.uploads import measurement_materials
+
+    known = measurement_materials(["steel"])
+    return [next(m for m in known if f" {m} " in f" {c.replace(',', ' ')} ")
+            for c in _table(at, "load case")["load case"]]

@@ -40,6 +40,7 @@ if TYPE_CHECKING:
     from ..compare import LoadCase
     from ..measure import AnalysisOptions, AnalyzedRecord
     from ..records import Measurement
+    from ..specimen import NamedSpecimen, Specimen
 
 # NO_CHANNEL ("(none)": acceleration is optional) and AUTO_CHANNEL ("(auto)": the channel the
 # readers detect) are the sidecar's words too (pidcore.compare.loadcase): one definition.
@@ -100,9 +101,9 @@ def read_upload(name: str, data: bytes, *, sample_rate_hz: float | None = None) 
     from ..io import read_measurement
 
     check_upload_size(name, len(data))
-    if PurePosixPath(safe_file_name(name)).suffix.lower() == SPECIMEN_SUFFIX:
-        # the DEM and Calibrate tabs take these; here it was read as a CSV and refused as
-        # "no rows of numbers in its 38 lines", which did not say where it belongs
+    if is_specimen_file(name):
+        # the Analyse tab takes these apart before reading (analysis_specimen); read as a
+        # CSV, it was refused as "no rows of numbers in its 38 lines"
         # the file, not a parameter, is wrong here (errors.InputFileError: holds nothing usable)
         raise InputFileError(f"{name}: a specimen file (TOML), not a shaker-test export; "
                              f"upload it on the DEM or Calibrate tab, as 'or a specimen file "
@@ -403,6 +404,88 @@ def known_specimens(folders: Iterable[str | os.PathLike],
         except (PidcoreError, ValueError):
             continue
     return found
+
+
+def is_specimen_file(name: str) -> bool:
+    """Whether the upload ``name`` is a specimen file (``*.toml``, any case), which the
+    Analyse tab takes as the files' specimen rather than as an export."""
+    return PurePosixPath(safe_file_name(name)).suffix.lower() == SPECIMEN_SUFFIX
+
+
+def analysis_specimen(files: Sequence[tuple[str, bytes]]) -> Specimen | None:
+    """The specimen file uploaded with the exports on the Analyse tab (``(name, bytes)`` of
+    the :func:`is_specimen_file` uploads; None for none): the ``--specimen FILE`` of ``pidcore
+    analyze``, checked as ``pidcore specimen check`` checks it (parsed, never executed).
+
+    Raises
+    ------
+    ParameterError
+        One line: the file is not a specimen file (naming it and the key), or more than one
+        was uploaded (the CLI takes one; which one a file was tested on is not guessed).
+    """
+    from ..specimen import Specimen
+
+    if len(files) > 1:
+        raise ParameterError(f"{', '.join(name for name, _ in files)}: one specimen file at a "
+                             "time, as `pidcore analyze --specimen FILE` takes one; remove all "
+                             "but the specimen these files were tested on")
+    if not files:
+        return None
+    name, data = files[0]
+    return Specimen.from_bytes(data, source=name)
+
+
+def file_specimen(typed: str, material: str, known: Sequence[Specimen], *,
+                  given: Specimen | None = None, every_file: str = "") -> NamedSpecimen:
+    """The specimen a file's record is saved with (:class:`pidcore.specimen.NamedSpecimen`:
+    name, sha256 and a note): the one its settings row names (``typed``, among the ``known``
+    files: :func:`pidcore.specimen.resolve_specimen_name`); for a row naming none, the
+    specimen file uploaded with the exports (``given``) where the file's ``material`` is that
+    specimen's particles, as ``pidcore analyze --specimen FILE`` saves it (a file of other
+    particles is saved without a specimen, and the note says why), else the page's choice
+    for every file (``every_file``)."""
+    from ..specimen import (
+        NamedSpecimen,
+        measured_specimen_name,
+        measured_specimen_sha256,
+        resolve_specimen_name,
+    )
+
+    if typed.strip():
+        if given is not None and typed.strip() == given.name:
+            # the file uploaded here is the one its row names, as the CLI's sidecar naming
+            # the --specimen's name: not another known file of that name
+            return NamedSpecimen(measured_specimen_name(given), measured_specimen_sha256(given))
+        return resolve_specimen_name(typed, known)
+    if given is None:
+        return resolve_specimen_name(every_file, known)
+    if material == given.particles.material:
+        return NamedSpecimen(measured_specimen_name(given), measured_specimen_sha256(given))
+    return NamedSpecimen("", "", f"specimen {given.name} ({given.source}): its particles are "
+                         f"{given.particles.material}, not {material}; the files of {material} "
+                         "particles are saved without a specimen (the paper's coupon), as "
+                         "`pidcore analyze --specimen` saves them; name their specimen in the "
+                         "settings table")
+
+
+def restate_default_material(previous: pd.DataFrame | None, before: Mapping[str, str],
+                             now: Mapping[str, str],
+                             given: Mapping[str, Iterable[str]]) -> pd.DataFrame | None:
+    """The settings rows ``previous`` with the material of each file that still holds its
+    default of ``before`` (file -> material nothing stated but the specimen file, or none)
+    set to the one of ``now``: a specimen file uploaded (or removed) on the Analyse tab changes
+    the material of a file stating none, as ``--specimen`` does, and the rows kept the
+    former default. A material the user chose since, or that a settings table gives
+    (``given``: file -> its columns given, :func:`columns_given`), stays."""
+    if previous is None or previous.empty:
+        return previous
+    out = previous.copy()
+    for i, name in zip(out.index, out["file"], strict=True):
+        old, new = before.get(name), now.get(name)
+        if (old is not None and new is not None and old != new
+                and out.at[i, "material"] == old and "material" not in set(given.get(name, ()))):
+            out.at[i, "material"] = new
+    return out
 
 
 #: Appended to an unknown material's error: how an own material becomes one to state.

@@ -44,12 +44,16 @@ def load_case_of(record, *, fill_percent: float, material: str,
 
 
 def stated_case(name: str, sidecar: pd.DataFrame | None = None,
-                materials: tuple[str, ...] = ()) -> StatedLoadCase:
+                materials: tuple[str, ...] = (),
+                specimen_material: str | None = None) -> StatedLoadCase:
     """What the file name and a load-case table state about a file (the table wins).
 
     ``materials``: own materials recognised besides the table's (e.g. ``steel`` of the user's
-    specimens: ``..._steel.csv``). Without a stated fill, :data:`PROPOSED_FILL_PERCENT` is
-    proposed; the origin says so, and which values are defaults.
+    specimens: ``..._steel.csv``). ``specimen_material``: the particles of the specimen file
+    given for the files (``pidcore analyze --specimen``, the Analyse tab's uploaded one): the
+    material of a file that states none (origin ``material: specimen``), as the CLI takes it.
+    Without a stated fill, :data:`PROPOSED_FILL_PERCENT` is proposed; the origin says so, and
+    which values are defaults.
     """
     from ..constants import PARTICLE_MATERIALS
     from .loadcase import (
@@ -62,24 +66,27 @@ def stated_case(name: str, sidecar: pd.DataFrame | None = None,
     table = sidecar if sidecar is not None else pd.DataFrame(columns=list(SIDECAR_COLUMNS))
     untabulated = ""
     try:
-        return resolve_load_case(Path(Path(name).name), sidecar=table, materials=materials)
+        return resolve_load_case(Path(Path(name).name), sidecar=table, materials=materials,
+                                 specimen_material=specimen_material)
     except UntabulatedMaterial as exc:  # "..._steel.csv" without a steel specimen
         untabulated = (f"the file name says {exc.material!r}, which neither the material "
                        "table nor a specimen gives; set the material, or the specimen of "
                        f"{exc.material} particles")
     except PidcoreError:  # no fill stated (or a bad table row): keep what the name states
         pass
-    known = (*PARTICLE_MATERIALS, *(m for m in materials if m not in PARTICLE_MATERIALS))
+    known = (*PARTICLE_MATERIALS, *(m for m in materials if m not in PARTICLE_MATERIALS),
+             *([specimen_material] if specimen_material else []))
     try:
         found = parse_file_name(Path(name).name, known)
     except PidcoreError:
         found = {}
     fill = found.get("fill_percent")
     material = (f"{defaults.COMPARE_DEFAULT_MATERIAL} proposed: {untabulated}" if untabulated
-                else "file name" if "material" in found else "default")
+                else "file name" if "material" in found
+                else "specimen" if specimen_material else "default")
     return StatedLoadCase(
         float(fill) if untabulated and fill is not None else PROPOSED_FILL_PERCENT,
-        str(found.get("material", defaults.COMPARE_DEFAULT_MATERIAL)),
+        str(found.get("material", specimen_material or defaults.COMPARE_DEFAULT_MATERIAL)),
         str(found.get("direction", defaults.COMPARE_DEFAULT_DIRECTION)),
         ("fill: file name" if untabulated and fill is not None else
          f"fill: not stated, {PROPOSED_FILL_PERCENT:g} % proposed")

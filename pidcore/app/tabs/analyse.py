@@ -21,23 +21,34 @@ def _size(n: int) -> str:
 
 
 def _settings_editor(measurements, tables: dict[str, pd.DataFrame], channel_names: list[str],
-                     materials: tuple[str, ...]):
-    """The editable per-file settings table; returns the edited frame."""
+                     materials: tuple[str, ...], specimen_material: str | None = None):
+    """The editable per-file settings table; returns the edited frame. ``specimen_material``:
+    the particles of the specimen file uploaded with the exports, the material of a file that
+    states none."""
     from pidcore.compare.case import stated_case
 
     names = [u.name for u in measurements]
-    sig = (tuple((u.name, state.upload_sha256(u)) for u in measurements), tuple(sorted(tables)))
+    sig = (tuple((u.name, state.upload_sha256(u)) for u in measurements), tuple(sorted(tables)),
+           specimen_material)
     ss = st.session_state
     if ss.get("settings_sig") != sig:
         applied = ss.get("settings_tables_applied", set())
         earlier = [t for sha, t in tables.items() if sha in applied]
         new = [t for sha, t in tables.items() if sha not in applied]
-        ss["settings_base"] = uploads.merge_settings(
-            names, [stated_case(n, materials=materials) for n in names],
-            ss.get("settings_current"), new,
-            earlier_tables=earlier)
+        stated = [stated_case(n, materials=materials, specimen_material=specimen_material)
+                  for n in names]
+        before = ss.get("settings_specimen_material")
+        previous = uploads.restate_default_material(
+            ss.get("settings_current"),
+            {n: stated_case(n, materials=materials, specimen_material=before).material
+             for n in names},
+            {n: s.material for n, s in zip(names, stated, strict=True)},
+            {n: uploads.columns_given(list(tables.values()), n) for n in names})
+        ss["settings_base"] = uploads.merge_settings(names, stated, previous, new,
+                                                     earlier_tables=earlier)
         ss["settings_tables_applied"] = set(tables)
         ss["settings_sig"] = sig
+        ss["settings_specimen_material"] = specimen_material
     channels = [uploads.AUTO_CHANNEL, uploads.NO_CHANNEL, *channel_names]
     key = "settings_" + hashlib.sha256(repr(sig).encode()).hexdigest()[:12]
     # the numbers are edited as text, checked by pidcore (uploads.TEXT_EDITED_NUMBERS): the
@@ -92,15 +103,14 @@ def _known_specimens(stores) -> list:
 
 
 def _card(upload, row, sample_rate_hz, materials, given=(), known=(), every_file="",
-          said_specimens=None):
+          said_specimens=None, specimen=None):
     """Results of one file; returns an AnalysedFile or None. ``known``: the specimen files a
     typed specimen name may mean; ``every_file``: the specimen of a row naming none;
-    ``said_specimens``: the specimen notes earlier cards showed (added to), each shown once."""
+    ``said_specimens``: the specimen notes earlier cards showed (added to), each shown once;
+    ``specimen``: the specimen file uploaded with the exports (``--specimen``)."""
     from pidcore.compare.case import load_case_of, stated_case
     from pidcore.compare.plausibility import implausible_findings
     from pidcore.errors import PidcoreError
-    from pidcore.specimen import resolve_specimen_name
-
     name = upload.name
     with st.container(border=True):
         st.markdown(f"**{name}** · {_size(upload.size)}")
@@ -109,7 +119,9 @@ def _card(upload, row, sample_rate_hz, materials, given=(), known=(), every_file
         if found.error is not None:  # no numbers: nothing assumed for them to say
             st.error(found.error)
             return None
-        assumed = uploads.assumed_note(stated_case(name, materials=materials), row, given)
+        assumed = uploads.assumed_note(stated_case(
+            name, materials=materials,
+            specimen_material=specimen.particles.material if specimen else None), row, given)
         if assumed:  # a default the user has not confirmed: say so next to the numbers
             st.info(f"{assumed} (set it in the settings table)")
         try:
@@ -152,7 +164,8 @@ def _card(upload, row, sample_rate_hz, materials, given=(), known=(), every_file
                        icon="⚠️")
         for note in (*record.notes, *zero_notes):
             st.caption(f"note: {note}")
-        named = resolve_specimen_name(str(row.get("specimen", "") or "") or every_file, known)
+        named = uploads.file_specimen(str(row.get("specimen", "") or ""), case.material, known,
+                                      given=specimen, every_file=every_file)
         # a name alone meets another file's DEM runs of that name; said on the first card
         # naming it (three files of one unknown name showed the same note three times)
         if named.note and (said_specimens is None or named.note not in said_specimens):
@@ -174,10 +187,25 @@ def render(stores) -> list:
                "never executed; nothing is stored until you press Save. A CSV table with a "
                "`file` column and settings columns (e.g. `fill_percent`, `velocity_delay_us`, "
                "as in the template below) is read as per-file settings, under any name and at "
-               "any time.")
-    files = st.file_uploader("shaker-test exports and settings tables",
+               "any time. A specimen file (`.toml`, as `pidcore analyze --specimen FILE`) is "
+               "the specimen of the files of its particles whose row names none: its name and "
+               "sha256 are saved with them.")
+    files = st.file_uploader("shaker-test exports, settings tables and a specimen file (TOML)",
                              accept_multiple_files=True, key="uploads",
                              max_upload_size=defaults.APP_MAX_UPLOAD_MB)
+    specimen_uploads = [u for u in files or [] if uploads.is_specimen_file(u.name)]
+    files = [u for u in files or [] if not uploads.is_specimen_file(u.name)]
+    try:
+        specimen = uploads.analysis_specimen([(u.name, u.getvalue()) for u in specimen_uploads])
+    except PidcoreError as exc:
+        # nothing analysed: saved without it, the files would be the paper's coupon's tests
+        st.error(str(exc))
+        st.info("Nothing is analysed until the specimen file is fixed or removed.")
+        return []
+    if specimen is not None:
+        st.info(f"specimen {specimen.name} ({specimen.source}, {specimen.particles.material} "
+                "particles): the material of the files that state none, and the specimen, "
+                "saved with its sha256, of the files of its particles whose row names none")
     with st.expander("Options for every file", expanded=False):
         # text read by pidcore: the browser's number box made a typed "25,6" 256 Hz
         rate = st.text_input("sample rate if no time column [Hz]", "0", key="sample_rate",
@@ -189,11 +217,16 @@ def render(stores) -> list:
             st.error(f"{exc}; files are read without a sample rate")
             sample_rate_hz = None
         known = _known_specimens(stores)
+        if specimen is not None:
+            known = [*known, specimen]
         every_file = st.selectbox(
             "specimen of every file", [ROW_SPECIMEN_CHOICE, *dict.fromkeys(
                 hashed_name(s.name, s.hash) for s in known)], key="every_file_specimen",
-            help="a specimen file the DEM tab offers, saved with its sha256, for the files "
-                 "whose settings row names no specimen")
+            disabled=specimen is not None,
+            help=f"off while the specimen file {specimen.source} is uploaded with the files"
+            if specimen is not None else
+            "a specimen file the DEM tab offers, saved with its sha256, for the files whose "
+            "settings row names no specimen")
         every_file = "" if every_file == ROW_SPECIMEN_CHOICE else every_file
     measurements, tables, accepted = [], {}, []
     refused: list[uploads.RefusedTable] = []
@@ -204,7 +237,8 @@ def render(stores) -> list:
         runs = None
     materials = uploads.measurement_materials(
         [*(runs["material"] if "material" in getattr(runs, "columns", ()) else ()),
-         *uploads.specimen_materials(defaults.APP_SPECIMEN_FOLDERS)])
+         *uploads.specimen_materials(defaults.APP_SPECIMEN_FOLDERS),
+         *([specimen.particles.material] if specimen is not None else [])])
     for upload in files or []:
         try:
             uploads.check_upload_size(upload.name, upload.size)
@@ -254,7 +288,8 @@ def render(stores) -> list:
         if found.channels is not None:
             channel_names += [n for n in found.channels.names if n not in channel_names]
     st.markdown("**Per-file settings** (edit the cells; each file is analysed with its own row)")
-    settings = _settings_editor(measurements, tables, channel_names, materials)
+    settings = _settings_editor(measurements, tables, channel_names, materials,
+                                specimen.particles.material if specimen is not None else None)
     analysed, said_specimens = [], set()
     for upload, (_, row) in zip(measurements, settings.iterrows(), strict=True):
         held = uploads.refusal_of(upload.name, refused)
@@ -265,7 +300,7 @@ def render(stores) -> list:
             continue
         result = _card(upload, row, sample_rate_hz, materials,
                        uploads.columns_given(list(tables.values()), upload.name), known,
-                       every_file, said_specimens)
+                       every_file, said_specimens, specimen)
         if result is not None:
             analysed.append(result)
     if analysed:
