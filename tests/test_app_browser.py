@@ -511,3 +511,45 @@ def test_a_reload_keeps_the_dem_form(app_url, browser_page):
                          "cells simulated", "steady cycles (0 = automatic)")}
     assert got == {"frequencies [Hz]": "50, 200", "accelerations [g]": "2", "fills [%]": "40",
                    "cells simulated": "3", "steady cycles (0 = automatic)": "12"}
+
+
+def test_a_reload_keeps_an_uploaded_specimen_file(app_url, browser_page):
+    # the DEM form came back from the page address after a reload, but not its uploaded
+    # specimen file (an address cannot hold a file): the form showed the paper's coupon's
+    # acrylic and ran it. The address holds the file's sha256 now, the app keeps the file
+    import hashlib
+
+    steel = REPO / "data_samples" / "specimens" / "steel_6mm.toml"
+    sha = hashlib.sha256(steel.read_bytes()).hexdigest()
+    page = browser_page
+    _open(page, app_url)
+    page.get_by_role("tab", name="DEM").click()
+    panel = page.locator('[role="tabpanel"]:visible')
+    panel.locator("input[type=file]").first.set_input_files(str(steel))
+    page.wait_for_function(f"() => location.search.includes('dem_specimen_upload={sha}')",
+                           timeout=RESULT_TIMEOUT_MS)
+    material = page.get_by_role("textbox", name="particle material (the specimen's)")
+    page.reload()
+    page.locator("input[type=file]").first.wait_for(state="attached",
+                                                    timeout=RESULT_TIMEOUT_MS)
+    page.get_by_role("tab", name="DEM").click()
+    material.wait_for(timeout=RESULT_TIMEOUT_MS)
+    assert material.input_value() == "steel"
+    page.get_by_text("the specimen file uploaded before the page was reloaded").wait_for(
+        timeout=RESULT_TIMEOUT_MS)
+    assert page.get_by_role("button", name="Run", exact=True).is_enabled()
+    # another field bound to the address keeps the hash beside it
+    box = page.get_by_role("textbox", name="frequencies [Hz]", exact=True)
+    box.fill("60")
+    box.press("Enter")
+    page.wait_for_function("() => location.search.includes('dem_freqs=60')",
+                           timeout=RESULT_TIMEOUT_MS)
+    assert f"dem_specimen_upload={sha}" in page.url
+    body = page.locator("body").inner_text()
+    assert not re.search(r"\b(None|nan|Traceback)\b", body), body[:2000]
+    # an address naming a file the app does not keep: one line, and Run is off
+    _open(page, f"{app_url}/?dem_specimen_upload={'e' * 64}")
+    page.get_by_role("tab", name="DEM").click()
+    page.get_by_text("not an uploaded specimen file this app keeps").wait_for(
+        timeout=RESULT_TIMEOUT_MS)
+    assert not page.get_by_role("button", name="Run", exact=True).is_enabled()
