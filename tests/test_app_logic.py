@@ -2182,8 +2182,10 @@ def test_a_specimen_file_uploaded_as_a_measurement_is_told_where_it_belongs():
     parsed = uploads.parse_upload("my coupon.TOML", toml)
     assert parsed.measurement is None
     assert parsed.error == ("my coupon.TOML: a specimen file (TOML), not a shaker-test export; "
-                            "upload it on the DEM or Calibrate tab, as 'or a specimen file "
-                            "(TOML)'")
+                            "the Analyse tab takes it with the exports as their specimen, "
+                            "the DEM and Calibrate tabs as 'or a specimen file (TOML)'")
+    # the Analyse tab takes it apart before reading, any case of its suffix
+    assert uploads.is_specimen_file("my coupon.TOML") and not uploads.is_specimen_file("a.csv")
     # the file is what is wrong, as for any other upload that holds no measurement
     from pidcore.errors import InputFileError
 

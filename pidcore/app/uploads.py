@@ -106,8 +106,9 @@ def read_upload(name: str, data: bytes, *, sample_rate_hz: float | None = None) 
         # CSV, it was refused as "no rows of numbers in its 38 lines"
         # the file, not a parameter, is wrong here (errors.InputFileError: holds nothing usable)
         raise InputFileError(f"{name}: a specimen file (TOML), not a shaker-test export; "
-                             f"upload it on the DEM or Calibrate tab, as 'or a specimen file "
-                             f"(TOML)'")
+                             f"the Analyse tab takes it with the exports as "
+                             f"their specimen, the DEM and Calibrate tabs as 'or a specimen "
+                             f"file (TOML)'")
     with tempfile.TemporaryDirectory(prefix="pidcore_upload_") as folder:
         path = Path(folder) / safe_file_name(name)
         path.write_bytes(data)
