@@ -1907,3 +1907,22 @@ def _materials(at: AppTest) -> list[str]:
     known = measurement_materials(["steel"])
     return [next(m for m in known if f" {m} " in f" {c.replace(',', ' ')} ")
             for c in _table(at, "load case")["load case"]]
+
+
+def test_a_fill_of_no_particle_of_the_uploaded_specimens_cell_is_refused_as_the_cli_does(
+        store_file, tmp_path, capsys):
+    from pidcore.cli import main
+
+    toml = (REPO / "data_samples" / "specimens" / "steel_6mm.toml").read_bytes()  # 46 a cell
+    data = mass_damper_csv(frequency_hz=100.0, acceleration_g=5.0)
+    (tmp_path / "panel.toml").write_bytes(toml)
+    (tmp_path / "m_fill1.csv").write_bytes(data)
+    assert main(["analyze", str(tmp_path / "m_fill1.csv"), "--specimen",
+                 str(tmp_path / "panel.toml"), "--no-store"]) == 2
+    said = "fill 1 % of 46 particles rounds to none; expected >= 1.09 %"
+    assert said in capsys.readouterr().err
+    at = _upload(_app(), [("m_fill1.csv", data), ("panel.toml", toml)])
+    assert [e.value for e in at.error] == [
+        f"m_fill1.csv, column fill [%]: {said}; was 1 meant as 100 %? (the cell of specimen "
+        "steel_6mm, panel.toml); set it in the settings table"]
+    assert at.button(key="save").disabled  # nothing to save: no test without particles

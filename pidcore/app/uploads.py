@@ -469,6 +469,33 @@ def file_specimen(typed: str, material: str, known: Sequence[Specimen], *,
                          "settings table")
 
 
+def check_specimen_fill(name: str, fill_percent: float, material: str,
+                        named: NamedSpecimen, given: Specimen | None) -> None:
+    """Refuse the fill of the file ``name`` where it rounds to no particle of the cell of the
+    specimen file uploaded with it (``given``, the record's specimen ``named``), as ``pidcore
+    analyze --specimen`` refuses it: 0.5 typed for 50 % was saved as a test without particles,
+    a load case no DEM run of the specimen can match (a file of the paper's coupon is refused
+    so at Save).
+
+    Raises
+    ------
+    LoadCaseError
+        Naming the file and the column, with the cell's capacity and the fill expected.
+    """
+    from ..dem.simulate import particles_of_stated_fill
+    from ..loadcase import LoadCaseError
+    from ..specimen import measured_specimen_sha256
+
+    if given is None or not named.sha256 or named.sha256 != measured_specimen_sha256(given):
+        return
+    try:
+        particles_of_stated_fill(fill_percent, material, specimen=given, what="fill",
+                                 typed=True)
+    except PidcoreError as exc:
+        raise LoadCaseError(f"{name}, column fill [%]: {exc} (the cell of specimen "
+                            f"{given.name}, {given.source})") from None
+
+
 def restate_default_material(previous: pd.DataFrame | None, before: Mapping[str, str],
                              now: Mapping[str, str],
                              given: Mapping[str, Iterable[str]]) -> pd.DataFrame | None:

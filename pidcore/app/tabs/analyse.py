@@ -150,6 +150,13 @@ def _card(upload, row, sample_rate_hz, materials, given=(), known=(), every_file
         except (PidcoreError, ValueError, TypeError) as exc:
             st.error(f"{name}: no valid load case ({exc}); set it in the settings table")
             return None
+        named = uploads.file_specimen(str(row.get("specimen", "") or ""), case.material, known,
+                                      given=specimen, every_file=every_file)
+        try:  # before its numbers, as `pidcore analyze --specimen` refuses it before any
+            uploads.check_specimen_fill(name, fill, case.material, named, specimen)
+        except PidcoreError as exc:
+            st.error(f"{exc}; set it in the settings table")
+            return None
         a = record.analysis
         m1, m2, m3, m4 = st.columns([1, 1, 1, 1.6])  # the SDC ± stderr needs the room
         m1.metric("frequency [Hz]", f"{a.frequency_hz:.3f}")
@@ -164,8 +171,6 @@ def _card(upload, row, sample_rate_hz, materials, given=(), known=(), every_file
                        icon="⚠️")
         for note in (*record.notes, *zero_notes):
             st.caption(f"note: {note}")
-        named = uploads.file_specimen(str(row.get("specimen", "") or ""), case.material, known,
-                                      given=specimen, every_file=every_file)
         # a name alone meets another file's DEM runs of that name; said on the first card
         # naming it (three files of one unknown name showed the same note three times)
         if named.note and (said_specimens is None or named.note not in said_specimens):
