@@ -517,10 +517,10 @@ def test_a_reload_keeps_an_uploaded_specimen_file(app_url, browser_page):
     # the DEM form came back from the page address after a reload, but not its uploaded
     # specimen file (an address cannot hold a file): the form showed the paper's coupon's
     # acrylic and ran it. The address holds the file's sha256 now, the app keeps the file
-    import hashlib
+    from pidcore.specimen import load_specimen
 
     steel = REPO / "data_samples" / "specimens" / "steel_6mm.toml"
-    sha = hashlib.sha256(steel.read_bytes()).hexdigest()
+    sha = load_specimen(steel).hash
     page = browser_page
     _open(page, app_url)
     page.get_by_role("tab", name="DEM").click()

@@ -1769,17 +1769,15 @@ def test_an_unknown_specimen_name_is_said_once_for_all_its_files(store_file):
     assert _table(at, "SDC [-]")["specimen"].tolist() == ["nosuch"] * 3 + ["other"]
 
 
-def test_an_uploaded_specimen_file_survives_a_reload_by_its_hash_in_the_address(store_file,
-                                                                                 tmp_path):
+def test_an_uploaded_specimen_file_survives_a_reload_by_its_hash_in_the_address(
+        store_file, tmp_path, monkeypatch):
     """The DEM form is bound to the page address, which cannot hold a file: after a reload
     the uploaded specimen was gone and the form ran the paper's coupon. The file is kept
     beside the store and the address holds its sha256; a reload restores it."""
-    import hashlib
-
-    from pidcore.specimen import hashed_name
+    from pidcore.specimen import Specimen, hashed_name
 
     data = b"# my panel\n" + (REPO / "data_samples" / "specimens" / "steel_6mm.toml").read_bytes()
-    sha = hashlib.sha256(data).hexdigest()
+    sha = Specimen.from_bytes(data).hash  # as its DEM runs and saved tests carry it
     at = _app()
     at.file_uploader(key="dem_specimen_file").set_value([("panel.toml", data,
                                                           "application/toml")])
@@ -1794,12 +1792,20 @@ def test_an_uploaded_specimen_file_survives_a_reload_by_its_hash_in_the_address(
     assert at.text_input(key="dem_material_specimen").value == "steel"  # not the paper's acrylic
     assert not at.button(key="dem_run").disabled
     assert at.selectbox(key="dem_specimen").disabled
-    assert any(c.value.startswith(f"panel.toml: the specimen file uploaded before the page was "
-                                  f"reloaded (sha256 {sha[:12]}") for c in at.caption)
-    # the Analyse tab still offers it as every file's specimen
-    from pidcore.specimen import Specimen
+    submitted = []
 
-    label = hashed_name("steel_6mm", Specimen.from_bytes(data).hash)
+    def submit(self, cases, config, specimen=None):  # record, do not simulate
+        submitted.extend((c.material, specimen.name, specimen.hash) for c in cases)
+        return []
+
+    monkeypatch.setattr(jobs.DemJobRunner, "submit", submit)
+    at.button(key="dem_run").click()
+    at.run()
+    assert submitted == [("steel", "steel_6mm", sha)]  # the file uploaded, not the paper's
+    assert any(c.value.startswith(f"panel.toml (steel_6mm [{sha[:6]}]): the specimen file "
+                                  "uploaded before the page was reloaded") for c in at.caption)
+    # the Analyse tab still offers it as every file's specimen
+    label = hashed_name("steel_6mm", sha)
     assert label in at.selectbox(key="every_file_specimen").options
     # forgetting it clears the address and gives the list back
     at.button(key="dem_specimen_forget").click()

@@ -3,8 +3,10 @@
 The DEM and Calibrate forms keep their fields in the page address, which cannot hold a file:
 after a reload the uploader is empty and the form ran the paper's coupon (or the specimen
 list's choice) instead. An uploaded specimen file is therefore kept, as uploaded, in a folder
-beside the app store (:func:`kept_specimens_folder`), named by the sha256 of its bytes; the
-address holds that hash, never the text, and a reload restores the file from the folder.
+beside the app store (:func:`kept_specimens_folder`), named by its specimen's sha256
+(:attr:`pidcore.specimen.Specimen.hash`, the hash its DEM runs and saved tests carry and the
+pages show, ``steel_6mm [beeac8]``); the address holds that hash, never the text, and a reload
+restores the file from the folder.
 
 The folder is written only with files that :meth:`pidcore.specimen.Specimen.from_bytes` (the
 checker of ``pidcore specimen check``) accepts, and a kept file is checked again when it is
@@ -44,19 +46,14 @@ def kept_specimens_folder(store_path: str | os.PathLike) -> Path:
 
 @dataclass(frozen=True)
 class KeptSpecimen:
-    """An uploaded specimen file: the ``name`` it was uploaded under, its bytes' ``sha256``
-    (what the page address holds), the bytes and the specimen read from them."""
+    """An uploaded specimen file: the ``name`` it was uploaded under, its specimen's
+    ``sha256`` (what the page address holds), the bytes as uploaded and the specimen read from
+    them."""
 
     name: str
     sha256: str
     data: bytes
     specimen: Specimen
-
-
-def _content_sha256(data: bytes) -> str:
-    from .uploads import content_sha256
-
-    return content_sha256(data)
 
 
 def _write_atomically(path: Path, data: bytes) -> None:
@@ -86,13 +83,13 @@ def keep_specimen(folder: str | os.PathLike, name: str,
     from ..specimen import Specimen
 
     specimen = Specimen.from_bytes(data, source=name)  # before anything is written
-    sha256 = _content_sha256(data)
+    sha256 = specimen.hash
     kept = KeptSpecimen(name, sha256, data, specimen)
     folder = Path(folder)
     try:
         folder.mkdir(parents=True, exist_ok=True)
         target = folder / f"{sha256}{_DATA_SUFFIX}"
-        if not target.is_file():  # same hash, same bytes: written once
+        if not target.is_file():  # same hash, same specimen: written once
             _write_atomically(target, data)
         label = folder / f"{sha256}{_NAME_SUFFIX}"
         if _kept_name(label) != name:  # the name it was uploaded under last
@@ -143,11 +140,12 @@ def restore_specimen(folder: str | os.PathLike, sha256: str, *,
                              f"{path} ({exc.strerror or exc}); upload the specimen file "
                              "again") from None
     name = _kept_name(Path(folder) / f"{sha256}{_NAME_SUFFIX}") or f"{sha256[:12]}.toml"
-    if _content_sha256(data) != sha256:
+    specimen = Specimen.from_bytes(data, source=name)
+    if specimen.hash != sha256:
         raise ParameterError(f"{name} (specimen file {sha256[:12]}, from {where}): the kept "
                              f"file {path} was changed since it was uploaded; upload the "
                              "specimen file again")
-    return KeptSpecimen(name, sha256, data, Specimen.from_bytes(data, source=name))
+    return KeptSpecimen(name, sha256, data, specimen)
 
 
 @dataclass(frozen=True)
@@ -191,6 +189,10 @@ def specimen_upload(folder: str | os.PathLike, *, upload: tuple[str, bytes] | No
         kept = restore_specimen(folder, sha256)
     except ParameterError as exc:
         return SpecimenUpload(sha256=sha256, error=str(exc))
+    from ..specimen import hashed_name
+
+    # named as the pages name its DEM runs and tests, so the three are seen to be one file
     return SpecimenUpload(kept, sha256, note=(
-        f"{kept.name}: the specimen file uploaded before the page was reloaded (sha256 "
-        f"{sha256[:12]}, kept beside the store); upload another file to replace it"))
+        f"{kept.name} ({hashed_name(kept.specimen.name, sha256)}): the specimen file uploaded "
+        "before the page was reloaded, kept beside the store; upload another file to replace "
+        "it"))
