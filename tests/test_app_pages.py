@@ -1786,6 +1786,16 @@ def test_an_uploaded_specimen_file_survives_a_reload_by_its_hash_in_the_address(
     assert at.query_params.get("dem_specimen_upload") in (sha, [sha])  # the hash, not the text
     assert (store_file.parent / f"{store_file.name}.specimens" / f"{sha}.toml").read_bytes() \
         == data
+    # the user removing the file from the uploader takes it out of the address (a reload
+    # then shows the list's choice, as the page did before the reload)
+    removed = _app()
+    removed.file_uploader(key="dem_specimen_file").set_value(
+        [("panel.toml", data, "application/toml")])
+    removed.run()
+    removed.file_uploader(key="dem_specimen_file").set_value([])
+    removed.run()
+    assert "dem_specimen_upload" not in removed.query_params
+    assert "dem_material" in {s.key for s in removed.selectbox}
     # the reload: a fresh session at that address, the uploader empty
     at = _app_at({"dem_specimen_upload": sha})
     assert not at.error
