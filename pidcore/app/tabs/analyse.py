@@ -111,6 +111,7 @@ def _card(upload, row, sample_rate_hz, materials, given=(), known=(), every_file
     from pidcore.compare.case import load_case_of, stated_case
     from pidcore.compare.plausibility import implausible_findings
     from pidcore.errors import PidcoreError
+
     name = upload.name
     with st.container(border=True):
         st.markdown(f"**{name}** · {_size(upload.size)}")
