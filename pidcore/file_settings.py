@@ -479,15 +479,22 @@ def resolve_files(paths: Sequence[str | os.PathLike], *, options: AnalysisOption
     ``specimen_name``) is saved under :func:`pidcore.specimen.measured_specimen_name`
     (``"paper_coupon [45d792]"``), and so is a file whose sidecar names that name. Every
     file of that specimen carries its file's hash too (:attr:`FileSettings.specimen_sha256`).
+    A sidecar's specimen is the file given where it names it as the app's settings table
+    does (:func:`pidcore.specimen.resolve_specimen_name`: by its name or by its label
+    ``"panel [3e945a]"``), so that both front ends save one test alike.
     """
-    renamed = sha256 = ""
-    if specimen is not None:
-        from .specimen import measured_specimen_name, measured_specimen_sha256
+    from .specimen import resolve_specimen_name
 
-        renamed = measured_specimen_name(specimen)
-        sha256 = measured_specimen_sha256(specimen)
-        if specimen_name == specimen.name:
-            specimen_name = renamed
+    def named(fs: FileSettings) -> FileSettings:
+        """``fs`` with the file given where its specimen names it; as it is otherwise (a
+        sidecar naming another specimen keeps that name, whose runs are met by name)."""
+        if specimen is None or not fs.specimen:
+            return fs
+        found = resolve_specimen_name(fs.specimen, [specimen])
+        if found.note:  # not the file given
+            return fs
+        return replace(fs, specimen=found.name, specimen_sha256=found.sha256)
+
     tables: dict = {}
     stated: list[StatedLoadCase | None] = []
     settings: list[FileSettings] = []
@@ -503,17 +510,14 @@ def resolve_files(paths: Sequence[str | os.PathLike], *, options: AnalysisOption
             stated.append(None)
         _refuse_fill_of_no_particle(path, stated[-1], specimen)
         fs = resolve_file_settings(path, options, given=given, sidecar=sidecar, tables=tables)
-        if specimen is not None and fs.specimen == specimen.name != renamed:
-            # the sidecar names the file given: its name alone would claim the paper's coupon
-            fs = replace(fs, specimen=renamed)
         if (specimen_name and not fs.specimen and stated[-1] is not None
                 and stated[-1].material == specimen_material):
             fs = replace(fs, specimen=specimen_name,
                          sources={**fs.sources, SPECIMEN_COLUMN: "--specimen"})
-        if specimen is not None and fs.specimen == renamed:
-            # the file given is the one tested: its hash tells it from another of its name
-            fs = replace(fs, specimen_sha256=sha256)
-        settings.append(fs)
+        # the file given is saved by the name its tests are compared under (the bare name of
+        # another paper_coupon file would claim the paper's coupon) and by its hash, which
+        # tells it from another file of its name
+        settings.append(named(fs))
     return stated, settings
 
 
