@@ -74,10 +74,10 @@ Public API
 load_specimen, paper_specimen, Specimen
     A specimen from a TOML file, the bundled paper coupon; ``Specimen.from_text``,
     ``with_values``, ``to_toml``, ``capacity_per_cell``.
-is_paper_coupon, measured_specimen_name, models_paper_coupon, hashed_name
+is_paper_coupon, measured_specimen_name, models_paper_coupon, hashed_name, tested_label
     Whether a specimen (by hash, else by name) is the paper's coupon: the one rule; the name
     a measurement of a specimen file is saved under; whether a file models the coupon; a
-    file's name with its hash, ``"name [45d792]"``.
+    file's name with its hash, ``"name [45d792]"``, and a test's saved specimen so labelled.
 measured_specimen_sha256, MEASURED_SHA256_FIELD, deciding_sha256, same_tested_file
     The file's hash saved beside that name (record field ``specimen_sha256``), and how a
     measurement's recorded hash meets a DEM run's or a calibration's: by hash where both
@@ -1407,6 +1407,16 @@ def hashed_name(name: str, sha256: str) -> str:
     return f"{name or 'unnamed'} [{sha256[:6]}]"
 
 
+def tested_label(name: str, sha256: str) -> str:
+    """The specimen a measurement records (its name and hash, :data:`MEASURED_SHA256_FIELD`)
+    as labels show it: :func:`hashed_name` where a hash is recorded, which tells two files of
+    one name apart; the name as saved where none is, or where it holds one already
+    (``"paper_coupon [45d792]"``: :func:`measured_specimen_name`); "" for none named."""
+    if not name or not sha256 or name.endswith("]"):
+        return name
+    return hashed_name(name, sha256)
+
+
 def provenance_test_name(specimen: Specimen) -> str:
     """The name the tests of the file ``specimen`` was calibrated from are saved under, where
     its ``[provenance]`` says it was made from another file of the paper's coupon's name
@@ -1576,6 +1586,7 @@ def _capacity(shape: str, inscribed_diameter_m: float, height_m: float, radius_m
 __all__ = ["CellSpec", "CouponSpec", "PairSpec", "PairsSpec", "ParticleSpec", "Specimen",
            "ProvenanceSpec", "calibrated_name", "calibrated_provenance", "uncalibrated_name",
            "cell_geometry", "contact_law", "describe", "hashed_name", "is_paper_coupon",
+           "tested_label",
            "load_specimen",
            "MEASURED_SHA256_FIELD", "deciding_sha256", "measured_specimen_name",
            "measured_specimen_sha256", "models_paper_coupon", "NamedSpecimen",

@@ -289,6 +289,8 @@ def _keys_text(listing) -> str:
     read a fitted ``baseline_loss_factor`` as its own option of that name."""
     if listing.empty:
         return "none"
+    from ..specimen import hashed_name
+
     rows = listing.iloc[::-1]
 
     def written(r) -> str:
@@ -297,7 +299,7 @@ def _keys_text(listing) -> str:
         name, sha = r.get("calibrated_specimen"), r.get("calibrated_specimen_hash")
         if not isinstance(name, str) or not isinstance(sha, str) or not sha:
             return ""
-        return f"; calibrated file {name} [{sha[:6]}]"
+        return f"; calibrated file {hashed_name(name, sha)}"
 
     return "; ".join(f"{r['key']} ({r.get('specimen', '')}, fitted '{r.get('fit', '')}'; "
                      f"{str(r['created_utc'])[:16]}{written(r)})" for _, r in rows.iterrows())
