@@ -215,11 +215,7 @@ class AlignedCase:
         """One row with unit-suffixed column names."""
         lc = self.load_case
         return {
-            "frequency [Hz]": lc.frequency_hz,
-            "acceleration [g]": lc.acceleration_g,
-            "packing ratio [%]": lc.fill_percent,
-            "material": lc.material,
-            "direction": lc.direction,
+            **lc.columns(),
             "load case": lc.key,
             "alignment": self.status,
             "SDC DEM (ours) [-]": self.sdc_dem,
