@@ -291,7 +291,7 @@ class MeasuredEntry:
 
         empty = np.empty(0)
         found, _ = stored_findings(row)
-        settings = _json_dict(row.get("parameters_json"))
+        settings = saved_parameters(row.get("parameters_json"))
         return cls(str(row["key"]), Path(str(row.get("source", ""))).name, "store",
                    _row_case(row), float(row["frequency_hz"]),
                    float(row.get("acceleration_m_s2", math.nan)),
@@ -372,7 +372,10 @@ def _specimen_sha256_of(row) -> str:
     return deciding_sha256(row.get(MEASURED_SHA256_FIELD, "")) if _specimen_of(row) else ""
 
 
-def _json_dict(text) -> dict:
+def saved_parameters(text: object) -> dict:
+    """A saved analysis's parameters (a listing's ``parameters_json``) as a dict; ``{}``
+    where none are saved or they are not a readable JSON object (a record of an earlier
+    pidcore, a hand-edited store): its corrections then read as unknown, not as an error."""
     import json
 
     try:
