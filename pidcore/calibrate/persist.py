@@ -16,7 +16,8 @@ reports and the app (which then survive a restart and travel with the store's DE
 * :func:`stored_calibration`: one of them, by key (a store holding one needs none);
 * :func:`calibration_design_runs`: which stored DEM runs are a calibration's design runs (inputs
   of its fit, kept apart from a report's predictions);
-* :func:`is_store_file`: whether a ``--calibration`` path names a store rather than a JSON file.
+* :func:`is_store_file`: whether a ``--calibration`` path names a store rather than a JSON file;
+* :func:`stored_settings`: the settings (cells, seed, ...) a calibration's listing record states.
 """
 
 from __future__ import annotations
@@ -305,6 +306,17 @@ def _keys_text(listing) -> str:
                      f"{str(r['created_utc'])[:16]}{written(r)})" for _, r in rows.iterrows())
 
 
+def stored_settings(parameters_json: object) -> dict:
+    """The settings a stored calibration's listing record states (its ``parameters_json``'s
+    ``"settings"``: cells, seed, fit, ...); ``{}`` where it states none (stored without them)
+    or the record is damaged: the caller says what then lacks, it is no error here."""
+    try:
+        settings = json.loads(str(parameters_json or "{}"))["settings"]
+    except (KeyError, TypeError, ValueError):
+        return {}
+    return settings if isinstance(settings, dict) else {}
+
+
 def calibration_design_runs(runs: pd.DataFrame | None,
                             store_paths: Sequence[str | os.PathLike | None]) -> dict[str, str]:
     """The DEM runs of ``runs`` (a :func:`pidcore.store.listing.list_dem_runs` listing) that
@@ -339,8 +351,8 @@ def calibration_design_runs(runs: pd.DataFrame | None,
         by_key = {c.store_key: c for c in calibrations}
         for _, record in listing.iterrows():
             calibration = by_key.get(record["key"])
+            settings = stored_settings(record.get("parameters_json"))
             try:
-                settings = json.loads(str(record.get("parameters_json") or "{}"))["settings"]
                 cells, seed = int(settings["cells"]), int(settings["seed"])
             except (KeyError, TypeError, ValueError):
                 continue  # a calibration that does not state its runs' settings
