@@ -24,6 +24,8 @@ SettingsTableError, StoreError, SimulationError
     A settings table (sidecar), the store, a DEM run.
 whole_number, real_number, instance_of, as_given
     The checks of a value's type, and a number shown as the user gave it.
+clipped
+    A value quoted in a message, whole where short, else by its start and its size.
 outside_user_names
     A message rewritten everywhere but in the names the user gave.
 KEYWORD_NOT_BEFORE, KEYWORD_NOT_AFTER_WORD
@@ -100,6 +102,22 @@ def apart(first: float, second: float) -> tuple[str, str]:
     return repr(float(first)), repr(float(second))
 
 
+#: Longest value or key quoted whole in a message, characters: a value is a number or a name;
+#: a longer one (a 2-million-item array was quoted whole, a 6 MB error "line") is shown by its
+#: start and its size (:func:`clipped`).
+MAX_SHOWN_CHARS = 80
+
+
+def clipped(text: str, most: int = MAX_SHOWN_CHARS) -> str:
+    """``text`` (a repr, a key, a line of a file) for a one-line message: whole where it has
+    at most ``most`` characters, else its first ``most - 20`` and its size, ``"[0.0, 1.0,
+    ...... (2000000 characters)"``, which together take about ``most``. Every message that
+    quotes a value the user gave shortens it here, so that each says the same of a cut."""
+    if len(text) <= most:
+        return text
+    return f"{text[:max(most - 20, 1)]}... ({len(text)} characters)"
+
+
 def whole_number(name: str, value: object) -> int:
     """``value`` as an ``int``, or a :class:`ParameterError` naming ``name``.
 
@@ -135,8 +153,8 @@ def instance_of(name: str, value: object, kind: type | tuple[type, ...], *,
     expected = " or ".join(dict.fromkeys("None" if k is type(None) else k.__name__
                                          for k in kinds))
     article = "an" if expected[0].lower() in "aeiou" else "a"
-    shown = " ".join(repr(value).split())  # one line, whatever the object's repr
-    shown = shown if len(shown) <= 60 else shown[:57] + "..."
+    # one line, whatever the object's repr; the type's name and the hint need the rest
+    shown = clipped(" ".join(repr(value).split()), 60)
     raise ParameterError(f"{name}: expected {article} {expected}, got {type(value).__name__} "
                          f"{shown}" + (f" ({hint})" if hint else ""))
 
@@ -209,4 +227,4 @@ KEYWORD_NOT_AFTER_WORD = r"(?![\w'])(?! column)"
 __all__ = ["ChannelError", "InputFileError", "KEYWORD_NOT_AFTER_WORD", "KEYWORD_NOT_BEFORE",
            "ParameterError", "PidcoreError",
            "SettingsTableError", "SignalError", "SimulationError", "StoreError", "as_given",
-           "instance_of", "outside_user_names", "real_number", "whole_number"]
+           "clipped", "instance_of", "outside_user_names", "real_number", "whole_number"]

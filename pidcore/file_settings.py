@@ -22,12 +22,14 @@ column                     meaning (:class:`~pidcore.measure.AnalysisOptions` fi
 ``comment``, ``comments``
 =========================  ==================================================================
 
-Any other column is refused (:func:`~pidcore.compare.loadcase.check_columns`): a misspelt
-``velocity_delay_ms`` would otherwise be ignored and the file analysed at 0 µs without a word.
-An empty cell states nothing. Precedence is that of the load case: file name (states no
-analysis setting) < table < options given explicitly (the command line's ``--velocity-delay``
-etc.), and an explicit option that overrides a different table value is said in a note
-(:func:`resolve_file_settings`).
+The columns' units, ranges and words live in :mod:`pidcore.compare.settings_columns`
+(:data:`ANALYSIS_COLUMNS`, re-exported here), where the comparison's corrections column reads
+them too. Any other column is refused (:func:`~pidcore.compare.loadcase.check_columns`): a
+misspelt ``velocity_delay_ms`` would otherwise be ignored and the file analysed at 0 µs
+without a word. An empty cell states nothing. Precedence is that of the load case: file
+name (states no analysis setting) < table < options given explicitly (the command line's
+``--velocity-delay`` etc.), and an explicit option that overrides a different table value
+is said in a note (:func:`resolve_file_settings`).
 """
 
 from __future__ import annotations
@@ -56,6 +58,13 @@ from .compare.loadcase import (
     resolve_load_case,
     sidecar_row,
 )
+from .compare.settings_columns import (
+    ANALYSIS_COLUMNS,
+    COLUMN_WORDS,
+    SettingsColumn,
+    setting_in_words,
+    setting_phrase,
+)
 from .errors import PidcoreError, SettingsTableError
 from .io import display_path
 
@@ -76,79 +85,7 @@ __all__ = ["ANALYSIS_COLUMNS", "ANALYSIS_SETTINGS_COLUMNS", "AUTO_CHANNEL", "FRE
            "resolve_file_settings", "resolve_files", "setting_in_words"]
 
 
-@dataclass(frozen=True)
-class SettingsColumn:
-    """A table column that sets one :class:`~pidcore.measure.AnalysisOptions` field.
-
-    Attributes
-    ----------
-    field : str
-        The options field it sets.
-    kind : str
-        ``"number"`` (finite, >= 0), ``"channel"`` (a name) or ``"channels"`` (``;``-separated).
-    scale : float
-        Column value / ``scale`` = the field's SI value (µs -> s: 1e6). A division, not a
-        product with 1e-6: 50 / 1e6 is the double nearest 5e-5, as the literal ``5e-5`` of
-        ``--velocity-delay 5e-5`` is, so both give the same analysis to the last bit.
-    expected : str
-        What a valid value is, for the error message.
-    smallest : float
-        Smallest plausible positive value in the column's unit: a positive value below it is
-        refused as a unit slip (0 for no such check).
-    slip : str
-        The unit the value was probably typed in: the field's SI unit (``"s"``), whose value
-        times ``scale`` is the column's (``unit``), for the message.
-    unit : str
-        The column's unit (``"µs"``).
-    label : str
-        How messages name the setting (``"vibrometer delay"``); "" for a channel column.
-    """
-
-    field: str
-    kind: str
-    scale: float = 1.0
-    expected: str = ""
-    smallest: float = 0.0
-    slip: str = ""
-    unit: str = ""
-    label: str = ""
-
-
-#: How each column of :data:`~pidcore.compare.loadcase.ANALYSIS_SETTINGS_COLUMNS` sets its
-#: options field.
-ANALYSIS_COLUMNS: dict[str, SettingsColumn] = {
-    # A laser vibrometer's output delay is µs to ms (tens of µs typically, from its data
-    # sheet); 0.01 µs = 10 ns is a thousandth of a sample at 100 kHz and would correct
-    # nothing measurable, so a positive value below it is a delay typed in s (5e-5 for 50 µs).
-    "velocity_delay_us": SettingsColumn("velocity_delay_s", "number", 1e6,
-                                        "a vibrometer output delay in µs >= 0",
-                                        0.01, "s", "µs", "vibrometer delay"),
-    # The mass between force gauge and coupon is the gauge's top half, a screw or an adapter:
-    # grams to hundreds of grams; a positive value below 0.1 g weighs less than an M1 screw
-    # and would change nothing measurable, so it is a mass typed in kg (0.012 for 12 g).
-    "mass_below_gauge_g": SettingsColumn("mass_below_gauge_kg", "number", 1e3,
-                                         "a mass in g >= 0", 0.1, "kg", "g",
-                                         "mass below gauge"),
-    "baseline_loss_factor": SettingsColumn("baseline_loss_factor", "number", 1.0,
-                                           "the empty coupon's loss factor >= 0",
-                                           label="baseline loss factor"),
-    # The empty structure (coupon and fixture above the gauge) weighs tens of grams to kilos;
-    # below 1 g it is a mass typed in kg (0.0222 for the paper's 22.2 g coupon).
-    "structure_mass_g": SettingsColumn("structure_mass_kg", "number", 1e3,
-                                       "the empty structure's mass in g >= 0", 1.0, "kg", "g",
-                                       "structure mass"),
-    "force": SettingsColumn("force", "channel"),
-    "velocity": SettingsColumn("velocity", "channel"),
-    "acceleration": SettingsColumn("acceleration", "channel"),
-    "invert": SettingsColumn("invert", "channels"),
-}
-
 _COLUMN_OF_FIELD = {c.field: name for name, c in ANALYSIS_COLUMNS.items()}
-#: How each numeric setting is said in words: label, factor and unit as the table's, not SI.
-_WORDS = {c.field: (c.label, c.scale, f" {c.unit}" if c.unit else "")
-          for c in ANALYSIS_COLUMNS.values() if c.label}
-
-
 def _stated(value: object) -> bool:
     """Whether a cell states something: None and blank text state nothing (NaN does: it is
     refused as a value, since a float cell that is NaN is no setting anyone meant)."""
@@ -250,47 +187,6 @@ def _same(a: object, b: object) -> bool:
     return a == b
 
 
-#: The analysis settings no settings column states, in words with their unit (those of the
-#: columns: :data:`ANALYSIS_COLUMNS`' labels and units).
-_OTHER_WORDS = {"frequency_hz": ("drive frequency hint", 1.0, " Hz"),
-                "sample_rate_hz": ("sample rate", 1.0, " Hz"),
-                "n_harmonics": ("harmonics analysed", 1.0, "")}
-
-
-def setting_in_words(name: str, value: object) -> tuple[str, str]:
-    """An analysis setting (a :class:`~pidcore.measure.AnalysisOptions` field, or the
-    specimen) as the notes and reports say it: its name in words and its value with the unit
-    of its settings column, e.g. ``("vibrometer delay", "50 µs")`` for ``velocity_delay_s``
-    5e-5, ``("structure mass", "22.2 g")``, ``("force channel", "'Fz'")``. ``None`` is
-    ``"none"``."""
-    if name in _WORDS or name in _OTHER_WORDS:
-        label, factor, unit = _WORDS.get(name) or _OTHER_WORDS[name]
-        return label, "none" if value is None else f"{float(value) * factor:g}{unit}"
-    if value is None:
-        shown = "none"
-    elif isinstance(value, (tuple, list)):
-        shown = ", ".join(map(repr, value))
-    elif isinstance(value, str):
-        shown = repr(value)
-    else:
-        shown = str(value)
-    if name == "invert":
-        return "inverted", shown
-    if name == SPECIMEN_COLUMN:
-        return "specimen", shown
-    if name == "allow_clipped":
-        return "clipped samples", "kept" if value else "refused"
-    if name.endswith("_unit"):
-        return f"{name.removesuffix('_unit')} unit", shown
-    if name in ("force", "velocity", "acceleration"):
-        return f"{name} channel", shown
-    return name, shown
-
-
-def _words(name: str, value: object) -> str:
-    return " ".join(setting_in_words(name, value))
-
-
 @dataclass(frozen=True)
 class FileSettings:
     """How one measurement file is analysed, and who said so.
@@ -344,7 +240,7 @@ class FileSettings:
         by_source: dict[str, list[str]] = {}
         for name, source in self.sources.items():
             value = self.specimen if name == SPECIMEN_COLUMN else getattr(self.options, name)
-            by_source.setdefault(source, []).append(_words(name, value))
+            by_source.setdefault(source, []).append(setting_phrase(name, value))
         return "; ".join(f"{', '.join(words)} ({source})" for source, words in by_source.items())
 
     def statement(self) -> tuple[str, str]:
@@ -356,12 +252,12 @@ class FileSettings:
         from .measure import AnalysisOptions
 
         default = AnalysisOptions()
-        parts = [_words(SPECIMEN_COLUMN, self.specimen)] if self.specimen else []
+        parts = [setting_phrase(SPECIMEN_COLUMN, self.specimen)] if self.specimen else []
         for f in fields(default):
             value = getattr(self.options, f.name)
-            if value != getattr(default, f.name) and (f.name in _WORDS or f.name in (
+            if value != getattr(default, f.name) and (f.name in COLUMN_WORDS or f.name in (
                     "force", "velocity", "acceleration", "invert")):
-                parts.append(_words(f.name, value))
+                parts.append(setting_phrase(f.name, value))
         return ", ".join(parts)
 
     def explain(self, message: str) -> str:
@@ -373,9 +269,10 @@ class FileSettings:
         appended = []
         for name, (column, text, where) in self.cells.items():
             cell = f"column {column} {text!r} of {where}"
-            if name in _WORDS:
+            if name in COLUMN_WORDS:
                 message = re.sub(rf"(?<![\w-]){re.escape(name)}(?!\w)",
-                                 lambda _, n=name, c=cell: f"{_WORDS[n][0]} ({c})", message)
+                                 lambda _, n=name, c=cell: f"{COLUMN_WORDS[n][0]} ({c})",
+                                 message)
                 continue
             value = getattr(self.options, name)
             names = value if isinstance(value, tuple) else (value,)
@@ -473,7 +370,7 @@ def resolve_file_settings(path: str | os.PathLike, options: AnalysisOptions | No
             mine = getattr(options, name)
             if not _same(value, mine):
                 notes.append(f"{display_path(Path(path).name)}: {given[name]} "
-                             f"({_words(name, mine)}) "
+                             f"({setting_phrase(name, mine)}) "
                              f"overrides column {column} {text!r} of {row.where}")
             continue
         changes[name] = value
@@ -582,15 +479,22 @@ def resolve_files(paths: Sequence[str | os.PathLike], *, options: AnalysisOption
     ``specimen_name``) is saved under :func:`pidcore.specimen.measured_specimen_name`
     (``"paper_coupon [45d792]"``), and so is a file whose sidecar names that name. Every
     file of that specimen carries its file's hash too (:attr:`FileSettings.specimen_sha256`).
+    A sidecar's specimen is the file given where it names it as the app's settings table
+    does (:func:`pidcore.specimen.resolve_specimen_name`: by its name or by its label
+    ``"panel [3e945a]"``), so that both front ends save one test alike.
     """
-    renamed = sha256 = ""
-    if specimen is not None:
-        from .specimen import measured_specimen_name, measured_specimen_sha256
+    from .specimen import resolve_specimen_name
 
-        renamed = measured_specimen_name(specimen)
-        sha256 = measured_specimen_sha256(specimen)
-        if specimen_name == specimen.name:
-            specimen_name = renamed
+    def named(fs: FileSettings) -> FileSettings:
+        """``fs`` with the file given where its specimen names it; as it is otherwise (a
+        sidecar naming another specimen keeps that name, whose runs are met by name)."""
+        if specimen is None or not fs.specimen:
+            return fs
+        found = resolve_specimen_name(fs.specimen, [specimen])
+        if found.note:  # not the file given
+            return fs
+        return replace(fs, specimen=found.name, specimen_sha256=found.sha256)
+
     tables: dict = {}
     stated: list[StatedLoadCase | None] = []
     settings: list[FileSettings] = []
@@ -606,17 +510,14 @@ def resolve_files(paths: Sequence[str | os.PathLike], *, options: AnalysisOption
             stated.append(None)
         _refuse_fill_of_no_particle(path, stated[-1], specimen)
         fs = resolve_file_settings(path, options, given=given, sidecar=sidecar, tables=tables)
-        if specimen is not None and fs.specimen == specimen.name != renamed:
-            # the sidecar names the file given: its name alone would claim the paper's coupon
-            fs = replace(fs, specimen=renamed)
         if (specimen_name and not fs.specimen and stated[-1] is not None
                 and stated[-1].material == specimen_material):
             fs = replace(fs, specimen=specimen_name,
                          sources={**fs.sources, SPECIMEN_COLUMN: "--specimen"})
-        if specimen is not None and fs.specimen == renamed:
-            # the file given is the one tested: its hash tells it from another of its name
-            fs = replace(fs, specimen_sha256=sha256)
-        settings.append(fs)
+        # the file given is saved by the name its tests are compared under (the bare name of
+        # another paper_coupon file would claim the paper's coupon) and by its hash, which
+        # tells it from another file of its name
+        settings.append(named(fs))
     return stated, settings
 
 

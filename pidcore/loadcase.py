@@ -161,6 +161,14 @@ class LoadCase:
                 "direction": self.direction, "load_case_key": self.key,
                 "load_case_origin": origin}
 
+    def columns(self) -> dict[str, float | str]:
+        """The load case as the first columns of a table row, units in the names
+        (``frequency [Hz]``, ``acceleration [g]``, ``packing ratio [%]``, ``material``,
+        ``direction``): one spelling for the alignment's rows and the report's table."""
+        return {"frequency [Hz]": self.frequency_hz, "acceleration [g]": self.acceleration_g,
+                "packing ratio [%]": self.fill_percent, "material": self.material,
+                "direction": self.direction}
+
     def label(self) -> str:
         """Short human label, e.g. ``'500 Hz, 5 g, 50 %'``."""
         return f"{self.frequency_hz:.4g} Hz, {self.acceleration_g:.3g} g, {self.fill_percent:.3g} %"

@@ -74,10 +74,10 @@ Public API
 load_specimen, paper_specimen, Specimen
     A specimen from a TOML file, the bundled paper coupon; ``Specimen.from_text``,
     ``with_values``, ``to_toml``, ``capacity_per_cell``.
-is_paper_coupon, measured_specimen_name, models_paper_coupon, hashed_name
+is_paper_coupon, measured_specimen_name, models_paper_coupon, hashed_name, tested_label
     Whether a specimen (by hash, else by name) is the paper's coupon: the one rule; the name
     a measurement of a specimen file is saved under; whether a file models the coupon; a
-    file's name with its hash, ``"name [45d792]"``.
+    file's name with its hash, ``"name [45d792]"``, and a test's saved specimen so labelled.
 measured_specimen_sha256, MEASURED_SHA256_FIELD, deciding_sha256, same_tested_file
     The file's hash saved beside that name (record field ``specimen_sha256``), and how a
     measurement's recorded hash meets a DEM run's or a calibration's: by hash where both
@@ -123,7 +123,7 @@ from .constants import (
     CellShape,
     TangentialStiffnessModel,
 )
-from .errors import ParameterError, apart, as_given, real_number
+from .errors import MAX_SHOWN_CHARS, ParameterError, apart, as_given, clipped, real_number
 from .loadcase import normalize_material
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -159,26 +159,13 @@ def _printable(where: str, text: str) -> None:
                            f"(it holds {bad!r})")
 
 
-#: Longest value or key quoted whole in a message, characters: a specimen's values are a
-#: number or a name; a longer one (a 2-million-item array was quoted whole, a 6 MB error
-#: "line") is shown by its start and its size.
-MAX_SHOWN_CHARS = 80
-
-
-def _clip(text: str) -> str:
-    """``text`` (a repr or a key) for a message: whole where short, else its start and size."""
-    if len(text) <= MAX_SHOWN_CHARS:
-        return text
-    return f"{text[:MAX_SHOWN_CHARS - 20]}... ({len(text)} characters)"
-
-
 def _shown(value: object) -> str:
-    """A refused value for a message, as Python writes it (clipped: :func:`_clip`)."""
+    """A refused value for a message, as Python writes it (clipped: :func:`clipped`)."""
     if isinstance(value, int) and not isinstance(value, bool):
         return _large_count(value)  # repr refuses more than 4300 digits
     if isinstance(value, list | tuple) and len(repr(value)) > MAX_SHOWN_CHARS:
-        return f"an array of {len(value)} items ({_clip(repr(value))})"
-    return _clip(repr(value))
+        return f"an array of {len(value)} items ({clipped(repr(value))})"
+    return clipped(repr(value))
 
 
 def _check_particle_material_name(where: str, name: str) -> None:
@@ -902,7 +889,7 @@ def _take(table: Mapping[str, Any], section: str, where: str) -> dict[str, Any]:
         raise ParameterError(f"{where}: expected a table")
     for key in table:
         if key not in schema:
-            raise ParameterError(f"{where} {_clip(key)}: unknown key; expected one of "
+            raise ParameterError(f"{where} {clipped(key)}: unknown key; expected one of "
                                  f"{list(schema)}")
     out: dict[str, Any] = {}
     for key, (required, kind) in schema.items():
@@ -1074,7 +1061,7 @@ def _from_mapping(data: Mapping[str, Any], *, source: str) -> Specimen:
     for key, value in data.items():
         if isinstance(value, Mapping) and key not in ("cell", "coupon", "particles", "pairs",
                                                       "provenance"):
-            raise ParameterError(f"[{_clip(key)}]: unknown table; expected [cell], [coupon], "
+            raise ParameterError(f"[{clipped(key)}]: unknown table; expected [cell], [coupon], "
                                  "[particles], [pairs], [pairs.particle_particle], "
                                  "[pairs.particle_wall], [provenance]")
     version = top.get("schema_version", SCHEMA_VERSION)
@@ -1107,7 +1094,7 @@ def _from_mapping(data: Mapping[str, Any], *, source: str) -> Specimen:
                    "pairs", "[pairs]")
     for key, value in pairs_table.items():
         if isinstance(value, Mapping) and key not in PAIR_NAMES:
-            raise ParameterError(f"[pairs.{_clip(key)}]: unknown pair; expected one of "
+            raise ParameterError(f"[pairs.{clipped(key)}]: unknown pair; expected one of "
                                  f"{PAIR_NAMES}")
     pairs = {}
     for name in PAIR_NAMES:
@@ -1420,6 +1407,16 @@ def hashed_name(name: str, sha256: str) -> str:
     return f"{name or 'unnamed'} [{sha256[:6]}]"
 
 
+def tested_label(name: str, sha256: str) -> str:
+    """The specimen a measurement records (its name and hash, :data:`MEASURED_SHA256_FIELD`)
+    as labels show it: :func:`hashed_name` where a hash is recorded, which tells two files of
+    one name apart; the name as saved where none is, or where it holds one already
+    (``"paper_coupon [45d792]"``: :func:`measured_specimen_name`); "" for none named."""
+    if not name or not sha256 or name.endswith("]"):
+        return name
+    return hashed_name(name, sha256)
+
+
 def provenance_test_name(specimen: Specimen) -> str:
     """The name the tests of the file ``specimen`` was calibrated from are saved under, where
     its ``[provenance]`` says it was made from another file of the paper's coupon's name
@@ -1589,6 +1586,7 @@ def _capacity(shape: str, inscribed_diameter_m: float, height_m: float, radius_m
 __all__ = ["CellSpec", "CouponSpec", "PairSpec", "PairsSpec", "ParticleSpec", "Specimen",
            "ProvenanceSpec", "calibrated_name", "calibrated_provenance", "uncalibrated_name",
            "cell_geometry", "contact_law", "describe", "hashed_name", "is_paper_coupon",
+           "tested_label",
            "load_specimen",
            "MEASURED_SHA256_FIELD", "deciding_sha256", "measured_specimen_name",
            "measured_specimen_sha256", "models_paper_coupon", "NamedSpecimen",

@@ -2021,6 +2021,27 @@ def test_the_corrections_say_how_the_baseline_went_off():
     assert describe_corrections({"structure_mass_kg": 0.28}).endswith("baseline loss factor 0")
 
 
+def test_the_corrections_word_each_setting_as_the_settings_notes_do():
+    # Compare's corrections column and the settings' notes (FileSettings.label, the report's
+    # parameters) each wrote the words and units of the delay, masses and baseline: one
+    # table now (pidcore.compare.settings_columns), which the comparison layer may import
+    from pidcore.compare.case import describe_corrections
+    from pidcore.file_settings import FileSettings
+    from pidcore.measure import AnalysisOptions
+    from pidcore.report.provenance import parameter_in_words
+
+    options = AnalysisOptions(velocity_delay_s=5e-5, mass_below_gauge_kg=0.012,
+                              baseline_loss_factor=0.0152, structure_mass_kg=0.0222)
+    corrections = describe_corrections(vars(options))
+    assert corrections == ("vibrometer delay 50 µs, mass below gauge 12 g, baseline loss "
+                           "factor 0.0152 (of a structure mass 22.2 g)")
+    label = FileSettings(options).label().split(", ")
+    for name in ("velocity_delay_s", "mass_below_gauge_kg", "baseline_loss_factor",
+                 "structure_mass_kg"):
+        said = parameter_in_words(name, getattr(options, name))
+        assert said in label and said in corrections, (said, label, corrections)
+
+
 def test_compare_notes_a_saved_baseline_off_the_whole_vibrated_mass(tmp_path, good_csv,
                                                                    options):
     # the Report tab and `pidcore report` note a record whose baseline loss factor went off

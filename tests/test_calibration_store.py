@@ -451,3 +451,14 @@ def test_a_calibrations_design_runs_are_not_reported_as_predictions(calibrated, 
     assert any(n.startswith("1 DEM run(s) of the design of calibration(s) ")
                and "pool=True pools them with the other runs; 2 DEM run(s)" in n
                for n in app_table.attrs["notes"])
+
+
+def test_a_calibrations_stored_settings_are_read_by_one_reader():
+    # the design-run lookup and the app's table of saved calibrations each parsed a record's
+    # parameters_json and its "settings" themselves: one reader, {} for what states none
+    from pidcore.calibrate.persist import stored_settings
+
+    assert stored_settings('{"settings": {"cells": 3, "seed": 7}}') == {"cells": 3, "seed": 7}
+    for damaged in (None, "", float("nan"), "{broken", "[1, 2]", '{"settings": [3]}',
+                    '{"other": {}}'):
+        assert stored_settings(damaged) == {}, damaged

@@ -45,6 +45,25 @@ def test_every_help_page_renders():
         assert parser.prog in text
 
 
+def test_the_sidecar_help_lists_every_column_the_table_reader_takes():
+    # analyze and report each wrote the sidecar's columns and the --material default by hand
+    # (one table, one rule: resolve_files); a column added to the reader went unlisted
+    from pidcore.compare.loadcase import SETTINGS_COLUMNS
+
+    helps = {}
+    for parser in _all_parsers(build_parser()):
+        if parser.prog.split()[-1] in ("analyze", "report"):
+            helps[parser.prog] = {a.dest: " ".join(a.help.split()) for a in parser._actions
+                                  if a.dest in ("sidecar", "material")}
+    assert len(helps) == 2, helps
+    for said in helps.values():
+        # every column named as a word of the help
+        named = {c for c in said["sidecar"].replace("(", " ").replace(")", " ")
+                 .replace(",", " ").replace(";", " ").split() if c in SETTINGS_COLUMNS}
+        assert named == set(SETTINGS_COLUMNS), said["sidecar"]
+    assert len({said["material"].replace("PATH", "FILE") for said in helps.values()}) == 1
+
+
 def test_errors_name_the_sub_command_and_its_action(capsys):
     # the message points at the --help that explains the option: `pidcore dem sweep --help`,
     # not `pidcore dem --help`, which lists no sweep option

@@ -306,3 +306,25 @@ def test_dem_run_with_the_default_cycles_stated_reuses_the_defaults_run(tmp_path
     assert main(["dem", "run", *case, "--cycles", "80"]) == 0
     assert "reused from" in capsys.readouterr().out
     assert store.read_bytes() == before  # nothing simulated, nothing written
+
+
+def test_a_runs_key_and_its_identity_hash_its_inputs_by_one_rule():
+    # run_key, run_key_0_1, simulation_identity and the settings hash each wrote the sha256
+    # of the sorted JSON themselves; a run meets its cached copy only where they agree
+    import hashlib
+    import json
+
+    from pidcore.compare.align import parameters_digest, simulation_identity
+    from pidcore.dem.persist import run_key, run_parameters
+    from pidcore.dem.simulate import DemConfig, LoadCase
+
+    case, config = LoadCase(50.0, 5.0, 50.0), DemConfig(cells=2, seed=7)
+    params = run_parameters(case, config)
+    keyed = {k: v for k, v in params.items() if k != "specimen_text"}
+    # the stored spelling, to the letter: a key written by any earlier pidcore is found again
+    expected = hashlib.sha256(json.dumps(keyed, sort_keys=True, default=str).encode())
+    assert parameters_digest(keyed) == expected.hexdigest()
+    assert run_key(case, config).endswith(f"_seed7_cells2_{expected.hexdigest()[:10]}")
+    identity = {k: v for k, v in keyed.items() if k != "case_fill_percent"}
+    assert simulation_identity(params, 11) == parameters_digest({**identity,
+                                                                 "particles_per_cell": 11})

@@ -173,3 +173,33 @@ def test_a_csv_channel_shorter_than_its_time_column_says_where_it_ends(tmp_path,
     with pytest.raises(InputFileError, match=r"channel 'Velocity' holds no value in any of "
                                              r"its 6 rows; expected a value in every row$"):
         read_measurement(empty)
+
+
+def test_a_long_first_line_is_quoted_by_its_start_and_size(tmp_path):
+    # the line was cut at 60 characters without a word of it (the reader may think the file
+    # holds that short line); every message now says a cut and the size alike
+    # (pidcore.errors.clipped, as a specimen's long value)
+    line = "text," * 2000
+    table = tmp_path / "notes.csv"
+    table.write_text(f"{line}\n{line}\n")
+    with pytest.raises(InputFileError) as refused:
+        read_measurement(table)
+    said = str(refused.value)
+    shown = repr(line.strip())
+    assert f"(the first: {shown[:42]}... ({len(shown)} characters))" in said, said
+    assert len(said) < 300, said
+
+
+def test_instance_of_quotes_a_long_value_by_its_start_and_size():
+    # instance_of cut a long repr at 57 characters with "...", the specimen's refusals at 60
+    # with the size: one helper, one way of saying a cut
+    from pidcore.errors import clipped, instance_of
+
+    value = list(range(10_000))
+    with pytest.raises(ParameterError) as refused:
+        instance_of("cells", value, int)
+    shown = repr(value)
+    assert str(refused.value) == (f"cells: expected an int, got list {shown[:40]}... "
+                                  f"({len(shown)} characters)")
+    assert clipped("short", 60) == "short"  # a value that fits is quoted whole
+    assert clipped("x" * 81) == "x" * 60 + "... (81 characters)"

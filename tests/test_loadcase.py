@@ -167,3 +167,17 @@ def test_a_rate_typed_in_a_field_is_a_positive_number_or_none():
         with pytest.raises(ParameterError, match=re.escape(
                 f"rate [Hz]: {typed!r}, expected a positive number (0 or blank: none)")):
             parse_optional_rate(typed, name="rate [Hz]")
+
+
+def test_a_load_case_gives_its_columns_as_the_alignment_and_the_report_table_name_them():
+    # the alignment's rows and the report's table each wrote the five load-case columns and
+    # their units: one spelling now (LoadCase.columns), which the report's CSV readers rely on
+    from pidcore.compare.align import AlignedCase
+
+    case = LoadCase(500.0, 5.0, 50.0, "steel", "x")
+    assert case.columns() == {"frequency [Hz]": 500.0, "acceleration [g]": 5.0,
+                              "packing ratio [%]": 50.0, "material": "steel",
+                              "direction": "x"}
+    row = AlignedCase(case, "no_dem_runs").to_dict()
+    assert list(row)[:6] == [*case.columns(), "load case"]
+    assert {k: row[k] for k in case.columns()} == case.columns()

@@ -284,3 +284,20 @@ def test_provenance_says_its_parameters_as_quantities_with_units_not_keywords():
     assert per_file == ("parameters: vibrometer delay 0 µs (a_fill50.csv), 200 µs "
                         "(b_fill50.csv); structure mass none (a_fill50.csv), 48.3 g "
                         "(b_fill50.csv)")
+
+
+def test_a_saved_analysis_parameters_read_alike_by_the_report_and_compare():
+    # the report's provenance and Compare's corrections each read a record's parameters_json
+    # (and its refusal of a non-object or broken text) themselves: one reader now
+    import pandas as pd
+
+    from pidcore.compare.case import saved_parameters
+    from pidcore.report.pipeline import stored_parameters
+
+    texts = ['{"velocity_delay_s": 5e-05}', "[1, 2]", "{not json", float("nan")]
+    assert [saved_parameters(t) for t in texts] == [{"velocity_delay_s": 5e-05}, {}, {}, {}]
+    analyses = pd.DataFrame({"file": ["a.csv", "b.csv", "c.csv", "d.csv"],
+                             "parameters_json": texts})
+    # one file's delay, none known of the others: said per file, not taken as shared
+    assert stored_parameters(analyses) == {
+        "velocity_delay_s": {"a.csv": 5e-05, "b.csv": None, "c.csv": None, "d.csv": None}}

@@ -202,6 +202,35 @@ def test_a_sidecar_specimen_is_saved_with_the_record(tmp_path, capsys):
     assert (entries["rec.csv"].specimen, entries["other.csv"].specimen) == ("coupon_B", "")
 
 
+def test_a_sidecar_naming_the_specimen_file_by_its_label_saves_it_as_the_app_does(tmp_path,
+                                                                                 capsys):
+    # the app's settings table offers a specimen file by its label "panel [3e945a]" (two files
+    # of one name told apart) and saves the file's name and hash; `pidcore analyze --specimen
+    # panel.toml` with a sidecar naming that label saved the label itself as the specimen, with
+    # no hash: a specimen "panel [3e945a]" whose tests met no run and no calibration of panel
+    from pidcore.specimen import Specimen, hashed_name, paper_specimen, resolve_specimen_name
+
+    text = paper_specimen().with_values({"coupon.fixture_mass_kg": 0.05}).to_toml()
+    panel = Specimen.from_text(text.replace('name = "paper_coupon"', 'name = "panel"', 1))
+    specimen_file = tmp_path / "panel.toml"
+    specimen_file.write_text(panel.to_toml())
+    label = hashed_name(panel.name, panel.hash)
+    path = export(tmp_path / "rec.csv")
+    other = export(tmp_path / "other.csv", seed=2)
+    sidecar(tmp_path, f"file,fill_percent,specimen\nrec.csv,50,{label}\nother.csv,50,panel\n")
+    store = tmp_path / "s.h5"
+    doc = run_json([str(path), str(other), "--specimen", str(specimen_file),
+                    "--store", str(store)], capsys)
+    app = resolve_specimen_name(label, [panel])  # what the app saves for that cell
+    assert (app.name, app.sha256) == ("panel", panel.hash)
+    # by label and by name alike: the file given, as the app saves it
+    assert [(r["specimen"], r["specimen_sha256"]) for r in doc["records"]] == \
+        [(app.name, app.sha256)] * 2
+    listed = Store(store).list_analyses()
+    assert listed["specimen"].tolist() == ["panel"] * 2
+    assert listed["specimen_sha256"].tolist() == [panel.hash] * 2
+
+
 # --- refusals -------------------------------------------------------------------------------------
 
 @pytest.mark.parametrize("command", ["analyze", "report"])

@@ -331,3 +331,19 @@ def test_a_typed_name_resolves_to_its_one_known_file(two_panels):
         {"coupon.fixture_mass_kg": 0.05}).to_toml())
     named = resolve_specimen_name("paper_coupon", [odd])
     assert (named.name, named.sha256) == (f"paper_coupon [{odd.hash[:6]}]", odd.hash)
+
+
+def test_a_tests_specimen_is_labelled_by_one_rule():
+    # calibrate's point labels and the app's Compare groups each wrote "name [hash6]" and its
+    # exception (a name holding its hash already) themselves: one function now
+    from pidcore.calibrate.data import MeasuredPoint
+    from pidcore.specimen import hashed_name, tested_label
+
+    sha = "ab94ff" + "0" * 58
+    assert tested_label("panel", sha) == hashed_name("panel", sha) == "panel [ab94ff]"
+    # the name a paper_coupon file's tests are saved under carries its hash once
+    assert tested_label("paper_coupon [45d792]", sha) == "paper_coupon [45d792]"
+    assert tested_label("panel", "") == "panel"  # saved before the hash was: by name
+    assert tested_label("", sha) == ""  # no specimen named
+    point = MeasuredPoint(500.0, 1.0, 50.0, 0.5, specimen="panel", specimen_sha256=sha)
+    assert point.label() == "500 Hz, 1 g, 50 %, acrylic, specimen panel [ab94ff]"

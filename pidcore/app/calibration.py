@@ -546,13 +546,10 @@ CELLS_COLUMN = "cells per DEM run [-]"
 def _stored_cells(parameters_json: object) -> object:
     """The cells per DEM run a stored calibration's settings state; blank where they state
     none (a calibration stored without them, or a damaged record: the table still lists it)."""
-    import json
+    from ..calibrate.persist import stored_settings
 
-    try:
-        cells = json.loads(str(parameters_json))["settings"]["cells"]
-    except (ValueError, KeyError, TypeError):
-        return ""
-    return _count_cell(cells)
+    settings = stored_settings(parameters_json)
+    return _count_cell(settings["cells"]) if "cells" in settings else ""
 
 
 def _count_cell(value: object) -> object:

@@ -44,7 +44,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from .. import defaults
-from ..errors import ParameterError, PidcoreError
+from ..errors import ParameterError, PidcoreError, clipped
 from .vocabulary import page_terms
 
 if TYPE_CHECKING:  # pragma: no cover - for the hints; the functions import them where used
@@ -523,9 +523,7 @@ class DemJobRunner:
                 if live:  # another running server's: written back as it is
                     foreign_entries.append(entry)
                     continue
-                name = entry.get("job_id") if isinstance(entry, dict) else None
-                lost.append(f"{str(name)[:40] if name else f'entry {number}'} "
-                            f"({type(exc).__name__}: {str(exc)[:200]})")
+                lost.append(_unreadable_entry(entry, number, exc))
                 continue
             if live:
                 job.server = owner.describe()
@@ -804,13 +802,22 @@ def _job_number(job_id: str) -> int:
     return int(job_id[3:]) if _JOB_ID.fullmatch(job_id) else 0
 
 
+def _unreadable_entry(entry: object, number: int, exc: Exception) -> str:
+    """A journal entry left out, for the note of those lost: its job id (or its place) and
+    why, clipped (:func:`pidcore.errors.clipped`): an id or error of a hostile journal can be
+    megabytes long."""
+    name = entry.get("job_id") if isinstance(entry, dict) else None
+    return (f"{clipped(str(name), 40) if name else f'entry {number}'} "
+            f"({type(exc).__name__}: {clipped(str(exc), 200)})")
+
+
 def _time_s(value: object, name: str) -> float | None:
     """A journal's time stamp: None (not yet) or a finite number of seconds since the epoch
     (a text there made every row of the job table a TypeError)."""
     if value is None:
         return None
     if not _finite_number(value):
-        raise ValueError(f"{name} must be a time in s or null, got {repr(value)[:40]}")
+        raise ValueError(f"{name} must be a time in s or null, got {clipped(repr(value), 40)}")
     return float(value)
 
 
@@ -946,9 +953,7 @@ def read_journal(path: Path) -> tuple[list[DemJob], str]:
                 raise ValueError(f"job id {job.job_id} listed twice")
             found.append(job)
         except _UNREADABLE as exc:
-            name = entry.get("job_id") if isinstance(entry, dict) else None
-            lost.append(f"{str(name)[:40] if name else f'entry {number}'} "
-                        f"({type(exc).__name__}: {str(exc)[:200]})")
+            lost.append(_unreadable_entry(entry, number, exc))
     if not lost:
         return found, ""
     return found, (f"{len(lost)} job(s) of the job table of the last run of the app ({path}) "

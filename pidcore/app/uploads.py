@@ -31,6 +31,7 @@ from ..compare.loadcase import (
     NO_CHANNEL,  # noqa: F401 - the pages read it from here
     SETTINGS_COLUMN_LABELS,
 )
+from ..compare.settings_columns import setting_phrase
 from ..constants import PARTICLE_MATERIALS
 from ..errors import InputFileError, ParameterError, PidcoreError
 from ..units import display_number
@@ -279,8 +280,8 @@ def channels_caption(names: Sequence[str], outcome: UploadOutcome,
         roles = outcome.record.channels_used
         used = " · used: " + ", ".join(f"{role} {roles[role]}" for role in
                                        ("force", "velocity", "acceleration") if role in roles)
-    return (f"channels: {', '.join(names)}{used} · vibrometer delay "
-            f"{options.velocity_delay_s * 1e6:g} µs")
+    return (f"channels: {', '.join(names)}{used} · "
+            f"{setting_phrase('velocity_delay_s', options.velocity_delay_s)}")
 
 
 def options_to_json(options: AnalysisOptions) -> str:

@@ -72,10 +72,10 @@ def group_name(entries: Sequence[MeasuredEntry], group: Sequence[int]) -> str:
     Stays the same when records are added to the group or the groups are listed in another
     order (a save re-sorts them), so it can name the user's choice of group.
     """
+    from ..specimen import tested_label
+
     e = entries[group[0]]
-    specimen = f", specimen {e.specimen}" if e.specimen else ""
-    if e.specimen and e.specimen_sha256 and not e.specimen.endswith("]"):
-        specimen += f" [{e.specimen_sha256[:6]}]"  # tells two files of one name apart
+    specimen = f", specimen {tested_label(e.specimen, e.specimen_sha256)}" if e.specimen else ""
     return f"{e.load_case.full_label()}{specimen}"
 
 

@@ -94,9 +94,10 @@ class MeasuredPoint:
     def label(self) -> str:
         """E.g. ``'500 Hz, 1 g, 50 %, steel, specimen steel_6mm_b'``: material and specimen
         named, since points differing only in them are different points."""
-        specimen = f", specimen {self.specimen}" if self.specimen else ""
-        if self.specimen and self.specimen_sha256 and not self.specimen.endswith("]"):
-            specimen += f" [{self.specimen_sha256[:6]}]"  # one of two files of that name
+        from ..specimen import tested_label
+
+        specimen = (f", specimen {tested_label(self.specimen, self.specimen_sha256)}"
+                    if self.specimen else "")
         return (f"{self.frequency_hz:g} Hz, {self.acceleration_g:g} g, {self.fill_percent:g} %, "
                 f"{self.material}{specimen}")
 
@@ -255,7 +256,13 @@ def points_for_specimen(points: Sequence[MeasuredPoint], specimen) -> tuple[list
     particle material measured on it (their specimen label is its name, or the name it was
     calibrated from) or on no named specimen; ``note`` says what is left out and why ("" if
     nothing)."""
-    from ..specimen import measured_specimen_name, same_tested_file, uncalibrated_name
+    from ..specimen import (
+        hashed_name,
+        measured_specimen_name,
+        same_tested_file,
+        tested_label,
+        uncalibrated_name,
+    )
     from .prediction import tested_sha256
 
     material = specimen.particles.material
@@ -275,7 +282,7 @@ def points_for_specimen(points: Sequence[MeasuredPoint], specimen) -> tuple[list
         elif str(p.specimen) and uncalibrated_name(str(p.specimen)) != tested:
             other_specimen[str(p.specimen)] = other_specimen.get(str(p.specimen), 0) + 1
         elif str(p.specimen) and same_tested_file(p.specimen_sha256, tested_file) is False:
-            label = f"{p.specimen} [{p.specimen_sha256[:6]}] (another file of that name)"
+            label = f"{hashed_name(p.specimen, p.specimen_sha256)} (another file of that name)"
             other_specimen[label] = other_specimen.get(label, 0) + 1
         else:
             kept.append(p)
@@ -284,9 +291,8 @@ def points_for_specimen(points: Sequence[MeasuredPoint], specimen) -> tuple[list
     reasons += [f"{n} measured load case(s) of {name} particles"
                 for name, n in other_material.items()]
     shown = measured_specimen_name(specimen)
-    if any("another file of that name" in name for name in other_specimen) \
-            and not shown.endswith("]"):
-        shown = f"{shown} [{tested_file[:6]}]"
+    if any("another file of that name" in name for name in other_specimen):
+        shown = tested_label(shown, tested_file)
     note = (f"Not used for {shown} ({material} particles): "
             + "; ".join(reasons)
             + ".") if reasons else ""

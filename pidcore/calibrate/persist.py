@@ -16,7 +16,8 @@ reports and the app (which then survive a restart and travel with the store's DE
 * :func:`stored_calibration`: one of them, by key (a store holding one needs none);
 * :func:`calibration_design_runs`: which stored DEM runs are a calibration's design runs (inputs
   of its fit, kept apart from a report's predictions);
-* :func:`is_store_file`: whether a ``--calibration`` path names a store rather than a JSON file.
+* :func:`is_store_file`: whether a ``--calibration`` path names a store rather than a JSON file;
+* :func:`stored_settings`: the settings (cells, seed, ...) a calibration's listing record states.
 """
 
 from __future__ import annotations
@@ -289,6 +290,8 @@ def _keys_text(listing) -> str:
     read a fitted ``baseline_loss_factor`` as its own option of that name."""
     if listing.empty:
         return "none"
+    from ..specimen import hashed_name
+
     rows = listing.iloc[::-1]
 
     def written(r) -> str:
@@ -297,10 +300,21 @@ def _keys_text(listing) -> str:
         name, sha = r.get("calibrated_specimen"), r.get("calibrated_specimen_hash")
         if not isinstance(name, str) or not isinstance(sha, str) or not sha:
             return ""
-        return f"; calibrated file {name} [{sha[:6]}]"
+        return f"; calibrated file {hashed_name(name, sha)}"
 
     return "; ".join(f"{r['key']} ({r.get('specimen', '')}, fitted '{r.get('fit', '')}'; "
                      f"{str(r['created_utc'])[:16]}{written(r)})" for _, r in rows.iterrows())
+
+
+def stored_settings(parameters_json: object) -> dict:
+    """The settings a stored calibration's listing record states (its ``parameters_json``'s
+    ``"settings"``: cells, seed, fit, ...); ``{}`` where it states none (stored without them)
+    or the record is damaged: the caller says what then lacks, it is no error here."""
+    try:
+        settings = json.loads(str(parameters_json or "{}"))["settings"]
+    except (KeyError, TypeError, ValueError):
+        return {}
+    return settings if isinstance(settings, dict) else {}
 
 
 def calibration_design_runs(runs: pd.DataFrame | None,
@@ -337,8 +351,8 @@ def calibration_design_runs(runs: pd.DataFrame | None,
         by_key = {c.store_key: c for c in calibrations}
         for _, record in listing.iterrows():
             calibration = by_key.get(record["key"])
+            settings = stored_settings(record.get("parameters_json"))
             try:
-                settings = json.loads(str(record.get("parameters_json") or "{}"))["settings"]
                 cells, seed = int(settings["cells"]), int(settings["seed"])
             except (KeyError, TypeError, ValueError):
                 continue  # a calibration that does not state its runs' settings

@@ -128,11 +128,7 @@ def _run(argv: list[str] | None) -> int:
     except PidcoreError as exc:
         if interrupt.interrupted():  # an interrupt swallowed by a library (pyuff's bare
             # ``except:``) left data out and surfaced as a refusal: it is the interruption
-            said = _what_an_interrupt_left(args) if started and args is not None \
-                else "nothing was done"
-            print(f"pidcore {command}: interrupted; {said}", file=sys.stderr)
-            interrupt.mark_handled()
-            return interrupt.exit_status()
+            return _interrupted(command, args if started else None)
         print(f"pidcore {command}: error: {_in_flags(exc, command, words)}", file=sys.stderr)
         return 2
     except BrokenPipeError:  # the reader of stdout (| head) stopped: end quietly
@@ -147,11 +143,17 @@ def _run(argv: list[str] | None) -> int:
         # commands that count what they saved say so themselves (analyze, dem, calibrate);
         # here only what holds for every command: a store write is whole or absent, never
         # half-done, and an output folder may hold part of the files
-        said = _what_an_interrupt_left(args) if started and args is not None \
-            else "nothing was done"
-        print(f"pidcore {command}: interrupted; {said}", file=sys.stderr)
-        interrupt.mark_handled()
-        return interrupt.exit_status()
+        return _interrupted(command, args if started else None)
+
+
+def _interrupted(command: str, args: argparse.Namespace | None) -> int:
+    """Say on stderr that ``pidcore COMMAND`` was interrupted and what it may have left
+    (``args``: the command's, None before it started: nothing was done); returns the exit
+    status of an interruption, marked handled."""
+    said = _what_an_interrupt_left(args) if args is not None else "nothing was done"
+    print(f"pidcore {command}: interrupted; {said}", file=sys.stderr)
+    interrupt.mark_handled()
+    return interrupt.exit_status()
 
 
 def _in_flags(exc: PidcoreError, command: str, words: list[str]) -> str:

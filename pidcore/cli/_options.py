@@ -42,26 +42,32 @@ def non_negative_int(text: str) -> int:
     return _whole_number(text, 0)
 
 
-def add_load_case_options(p: argparse._ActionsContainer, *, what: str,
-                          material_help: str) -> None:
+def add_load_case_options(p: argparse._ActionsContainer, *, what: str) -> None:
     """``--fill``, ``--material``, ``--direction``, ``--sidecar``: the load case of every
     ``what`` (the positional's name), as :func:`pidcore.compare.loadcase.resolve_load_case`
-    reads them; ``material_help`` ends the help of ``--material`` (its default)."""
+    reads them (``pidcore analyze`` and ``pidcore report`` alike, ``--specimen`` included)."""
+    from ..compare.loadcase import (
+        ANALYSIS_SETTINGS_COLUMNS,
+        SIDECAR_COLUMNS,
+        SIDECAR_NAME,
+        SPECIMEN_COLUMN,
+    )
     from ..constants import DRIVE_DIRECTIONS, PARTICLE_MATERIALS
 
     p.add_argument("--fill", metavar="PERCENT", type=float, default=None,
                    help=f"packing ratio of every {what}, %% (overrides file name and sidecar)")
     p.add_argument("--material", metavar="NAME", default=None,
                    help=f"particle material of every {what}: {', '.join(PARTICLE_MATERIALS)}"
-                        f"{material_help}")
+                        " or the --specimen's (default: stated, else the specimen's, else "
+                        "acrylic)")
     p.add_argument("--direction", choices=DRIVE_DIRECTIONS, default=None,
                    help=f"drive direction of every {what} (default: stated or z)")
+    # the table's columns as the reader knows them: a column added there is listed here
     p.add_argument("--sidecar", metavar="CSV", type=path_argument, default=None,
-                   help="per-file table: load case (file, fill_percent, material, direction) "
-                        "and analysis settings (velocity_delay_us, mass_below_gauge_g, "
-                        "baseline_loss_factor, structure_mass_g, force, velocity, acceleration, "
-                        "invert, specimen); options given override it; default: "
-                        "loadcases.csv beside each file")
+                   help=f"per-file table: load case ({', '.join(SIDECAR_COLUMNS)}) and "
+                        f"analysis settings ({', '.join(ANALYSIS_SETTINGS_COLUMNS)}, "
+                        f"{SPECIMEN_COLUMN}); options given override it; default: "
+                        f"{SIDECAR_NAME} beside each file")
 
 
 def check_out_folder(out: Path) -> None:

@@ -44,9 +44,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     g = p.add_argument_group(
         "load case (saved with each analysis, so that `pidcore report --store` places it; "
         "a file with no fill stated is saved without one)")
-    add_load_case_options(g, what="PATH", material_help=" or the --specimen's (default: "
-                                                         "stated, else the specimen's, else "
-                                                         "acrylic)")
+    add_load_case_options(g, what="PATH")
     g.add_argument("--specimen", metavar="FILE", type=path_argument, default=None,
                    help="specimen file whose particle material the files may state (e.g. "
                         "steel, which the material table lacks) and which is the default "

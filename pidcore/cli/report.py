@@ -63,9 +63,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--format", metavar="FMT", default="all",
                    help="all or a comma-separated list of csv, md, html, tex, pdf (default "
                         "all); the figures (PNG and SVG, figures/) are written with any")
-    add_load_case_options(p, what="FILE", material_help=" or the --specimen's (default: "
-                                                         "stated, else the specimen's, else "
-                                                         "acrylic)")
+    add_load_case_options(p, what="FILE")
     p.add_argument("--specimen", metavar="FILE", type=path_argument, default=None,
                    help="compare only DEM runs of this specimen file (default: the paper's "
                         "coupon); the paper's Table 3 only for the paper's coupon; FILES of "

@@ -2,7 +2,9 @@
 
 :mod:`.loadcase` says which load case a measurement belongs to (measured frequency and
 acceleration, stated fill/material/direction); :mod:`.align` pairs measured cases with our DEM
-grid, the pchip model over it (never extrapolated) and the paper's Table 3.
+grid, the pchip model over it (never extrapolated) and the paper's Table 3;
+:mod:`.settings_columns` says what each analysis column of a settings table sets and how every
+analysis setting is said in words.
 
 Public API
 ----------

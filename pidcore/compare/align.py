@@ -26,7 +26,7 @@ within the same tolerances (the paper used acrylic particles driven along z); ot
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -215,11 +215,7 @@ class AlignedCase:
         """One row with unit-suffixed column names."""
         lc = self.load_case
         return {
-            "frequency [Hz]": lc.frequency_hz,
-            "acceleration [g]": lc.acceleration_g,
-            "packing ratio [%]": lc.fill_percent,
-            "material": lc.material,
-            "direction": lc.direction,
+            **lc.columns(),
             "load case": lc.key,
             "alignment": self.status,
             "SDC DEM (ours) [-]": self.sdc_dem,
@@ -416,6 +412,16 @@ def stored_parameters(parameters_json: object) -> dict | None:
     return _automatic_cycles_unstated(params) if isinstance(params, dict) else None
 
 
+def parameters_digest(params: Mapping[str, object]) -> str:
+    """The sha256 (hex) of a DEM run's inputs: their JSON with sorted keys, any value JSON
+    lacks as its text. The one spelling of a run's key (:func:`pidcore.dem.persist.run_key`),
+    its simulation identity and its settings hash, which must hash alike to meet."""
+    import hashlib
+    import json
+
+    return hashlib.sha256(json.dumps(params, sort_keys=True, default=str).encode()).hexdigest()
+
+
 def _automatic_cycles_unstated(params: dict) -> dict:
     """``params`` with a stated ``config_steady_cycles`` that equals the automatic count
     written as unstated (""), as :func:`pidcore.dem.simulate.config_parameters` now writes it:
@@ -451,9 +457,6 @@ def simulation_identity(parameters_json: object, particles_per_cell: object) -> 
     cell. ``parameters_json``: a JSON string (a store listing's column) or a dict
     (:func:`pidcore.dem.persist.run_parameters`).
     """
-    import hashlib
-    import json
-
     params = stored_parameters(parameters_json)
     if params is None:
         return None
@@ -468,15 +471,11 @@ def simulation_identity(parameters_json: object, particles_per_cell: object) -> 
     # runs stored before the version was recorded are version 1 (pidcore.dem.persist)
     params.setdefault("dem_code_version", 1)
     params["particles_per_cell"] = int(count)
-    return hashlib.sha256(json.dumps(params, sort_keys=True, default=str).encode()).hexdigest()
+    return parameters_digest(params)
 
 
 def _settings_digest(settings: dict) -> str:
-    import hashlib
-    import json
-
-    return hashlib.sha256(json.dumps(settings, sort_keys=True, default=str).encode()) \
-        .hexdigest()[:6]
+    return parameters_digest(settings)[:6]
 
 
 def settings_hash(parameters_json: object) -> str:

@@ -28,6 +28,7 @@ from .align import (
     welch_satterthwaite_dof,
 )
 from .loadcase import LoadCase, StatedLoadCase
+from .settings_columns import describe_corrections
 
 #: Fill (packing ratio, %) proposed for a file whose name states none; the user confirms or
 #: corrects it.
@@ -297,7 +298,7 @@ class MeasuredEntry:
 
         empty = np.empty(0)
         found, _ = stored_findings(row)
-        settings = _json_dict(row.get("parameters_json"))
+        settings = saved_parameters(row.get("parameters_json"))
         return cls(str(row["key"]), Path(str(row.get("source", ""))).name, "store",
                    _row_case(row), float(row["frequency_hz"]),
                    float(row.get("acceleration_m_s2", math.nan)),
@@ -378,7 +379,10 @@ def _specimen_sha256_of(row) -> str:
     return deciding_sha256(row.get(MEASURED_SHA256_FIELD, "")) if _specimen_of(row) else ""
 
 
-def _json_dict(text) -> dict:
+def saved_parameters(text: object) -> dict:
+    """A saved analysis's parameters (a listing's ``parameters_json``) as a dict; ``{}``
+    where none are saved or they are not a readable JSON object (a record of an earlier
+    pidcore, a hand-edited store): its corrections then read as unknown, not as an error."""
     import json
 
     try:
@@ -386,23 +390,6 @@ def _json_dict(text) -> dict:
     except ValueError:
         return {}
     return found if isinstance(found, dict) else {}
-
-
-def describe_corrections(parameters: dict) -> str:
-    """The corrections of an analysis in words, units at the edge (µs, g)."""
-    if not parameters:
-        return ""
-    delay = float(parameters.get("velocity_delay_s", 0.0) or 0.0) * 1e6
-    mass = float(parameters.get("mass_below_gauge_kg", 0.0) or 0.0) * 1e3
-    baseline = float(parameters.get("baseline_loss_factor", 0.0) or 0.0)
-    # how the baseline went off: of the structure's own reactive power, or of the whole
-    # (too much); two records of one baseline differ by that, and read the same without it
-    structure_kg = float(parameters.get("structure_mass_kg") or 0.0)
-    how = ("" if baseline <= 0 else
-           f" (of a structure mass {structure_kg * 1e3:g} g)" if structure_kg > 0
-           else " (off the whole vibrated mass)")
-    return (f"vibrometer delay {delay:g} µs, mass below gauge {mass:g} g, "
-            f"baseline loss factor {baseline:g}{how}")
 
 
 def compare_case(records: Sequence[MeasuredEntry],

@@ -17,8 +17,6 @@ such runs once (:func:`pidcore.compare.align.simulation_identity`).
 from __future__ import annotations
 
 import dataclasses
-import hashlib
-import json
 import math
 import os
 from collections.abc import Iterable, Mapping
@@ -27,6 +25,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..compare.align import parameters_digest
 from ..errors import StoreError
 from ..loadcase import key_0_1
 from ..specimen import Specimen, is_paper_coupon, paper_specimen
@@ -76,7 +75,7 @@ def run_key(case: LoadCase, config: DemConfig, specimen: Specimen | None = None)
     specimen = resolve_specimen(case, specimen)
     params = run_parameters(case, config, specimen)
     params.pop("specimen_text")  # the hash stands for it
-    digest = hashlib.sha256(json.dumps(params, sort_keys=True, default=str).encode()).hexdigest()
+    digest = parameters_digest(params)
     return f"{_key_case(case, specimen)}_seed{config.seed}_cells{config.cells}_{digest[:10]}"
 
 
@@ -91,7 +90,7 @@ def run_key_0_1(case: LoadCase, config: DemConfig) -> str:
     """The key pidcore 0.1 stored the same run under (``acrylic_z_f50_a5_fill50_seed...``), so
     a sweep over a 0.1 store skips the runs it holds."""
     params = config_parameters(case, config)
-    digest = hashlib.sha256(json.dumps(params, sort_keys=True, default=str).encode()).hexdigest()
+    digest = parameters_digest(params)
     return f"{key_0_1(case)}_seed{config.seed}_cells{config.cells}_{digest[:10]}"
 
 

@@ -32,7 +32,7 @@ import re
 import numpy as np
 import pandas as pd
 
-from ..errors import InputFileError, ParameterError
+from ..errors import InputFileError, ParameterError, clipped
 from ..records import Measurement
 from ._common import (
     atomic_path,
@@ -156,9 +156,11 @@ def _layout(lines: list[str], where: str) -> tuple[int, str, list[str], list[str
     if first is None:
         # "header but no data rows" was said of any text without a row of numbers: a report
         # CSV, a TOML file, a load-case table of 40 rows
+        # the first line quoted whole up to 60 characters (62 with its quotes)
         what = "header but no data rows" if len(candidates) == 1 else \
             f"no rows of numbers in its {len(candidates)} lines (the first: " \
-            f"{lines[candidates[0]].strip()[:60]!r})" if candidates else "no rows of numbers"
+            f"{clipped(repr(lines[candidates[0]].strip()), 62)})" if candidates \
+            else "no rows of numbers"
         raise InputFileError(f"{where}: {what}; expected a header row such as "
                              "'Time [s],Force [N],Velocity [m/s]' and data rows")
     data = [lines[j] for j in candidates if j >= first][:200]

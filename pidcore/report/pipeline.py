@@ -14,7 +14,6 @@ Order matters for the guarantees of the command:
 
 from __future__ import annotations
 
-import json
 import math
 import os
 from collections.abc import Callable, Iterable, Mapping, Sequence
@@ -26,6 +25,7 @@ import numpy as np
 import pandas as pd
 
 from ..compare.align import Aligner, Tolerances
+from ..compare.case import saved_parameters
 from ..compare.loadcase import LoadCase, StatedLoadCase
 from ..compare.specimens import NOT_PAPER_SPECIMEN_NOTE
 from ..constants import REPORT_FORMATS
@@ -257,13 +257,8 @@ def stored_parameters(analyses: pd.DataFrame | None) -> dict:
         return {}
     names = analyses["file"] if "file" in analyses.columns else analyses["source"].map(
         lambda s: Path(str(s)).name)
-    per_file = []
-    for name, text in zip(names, analyses["parameters_json"], strict=True):
-        try:
-            stated = json.loads(text) if isinstance(text, str) and text else {}
-        except ValueError:
-            stated = {}
-        per_file.append((str(name), stated if isinstance(stated, dict) else {}))
+    per_file = [(str(name), saved_parameters(text))
+                for name, text in zip(names, analyses["parameters_json"], strict=True)]
     # by file name: the CLI and the app list a store's analyses in different orders
     return _shared_parameters(sorted(per_file, key=lambda item: item[0]))
 

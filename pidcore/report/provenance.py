@@ -44,9 +44,10 @@ _COMPARISON_WORDS: dict[str, tuple[str, Callable[[object], str]]] = {
 def parameter_in_words(name: str, value: object) -> str:
     """A report parameter as a reader of the report says it: ``"structure mass 22.2 g"``,
     not the keyword ``structure_mass_kg=0.0222`` (the analysis settings in the words and
-    units of the notes and the settings table: :func:`pidcore.file_settings.setting_in_words`);
+    units of the notes and the settings table:
+    :func:`pidcore.compare.settings_columns.setting_in_words`);
     one that differs between files as ``"vibrometer delay 0 µs (a.csv), 50 µs (b.csv)"``."""
-    from ..file_settings import setting_in_words
+    from ..compare.settings_columns import setting_in_words
 
     def said(v: object) -> tuple[str, str]:
         if name in _COMPARISON_WORDS:

@@ -475,11 +475,7 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
             note.append("no DEM m_c: no like-for-like difference"
                         + (f" ({row.no_mass_reason})" if row.no_mass_reason else ""))
         records.append({
-            "frequency [Hz]": lc.frequency_hz,
-            "acceleration [g]": lc.acceleration_g,
-            "packing ratio [%]": lc.fill_percent,
-            "material": lc.material,
-            "direction": lc.direction,
+            **lc.columns(),
             "particles per cell [-]": (row.dem.particles_per_cell if row.dem
                                        else row.particles_per_cell),
             "DEM runs [-]": row.dem.n_runs if row.dem else 0,
