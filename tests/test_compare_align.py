@@ -83,6 +83,23 @@ def test_outside_the_model_range_is_refused_not_extrapolated(aligner, case):
     assert "not extrapolated" in out.message
 
 
+@pytest.mark.parametrize(("case", "outside", "inside"), [
+    (LoadCase(200.0, 2.0, 30.0), "frequency 200 Hz outside 50-100 Hz",
+     "fill 25-50 %, acceleration 1-5 g"),
+    (LoadCase(75.0, 2.0, 10.0), "fill 10 % outside 25-50 %",
+     "acceleration 1-5 g, frequency 50-100 Hz"),
+])
+def test_out_of_range_note_names_the_axis_outside_and_each_range_with_its_unit(
+        aligner, case, outside, inside):
+    # report.csv showed "(--fill in [25, 90], acceleration_g in [1, 10], --frequency in
+    # [50, 1000])": keywords without units, two of them turned into CLI flags by its wording
+    from pidcore.cli._vocabulary import cli_words
+
+    message = aligner.align(case).message
+    assert f"({outside}; {inside})" in message
+    assert cli_words(message, "report") == message  # no keyword left for the CLI to rewrite
+
+
 def test_other_material_or_direction_never_borrows_acrylic_results(aligner):
     out = aligner.align(LoadCase(50.0, 5.0, 50.0, "aluminium"))
     assert out.status == "no_dem_runs" and math.isnan(out.sdc_dem)

@@ -832,6 +832,32 @@ def complete_grid(table: pd.DataFrame) -> tuple[pd.DataFrame, str]:
     return rows, "; ".join(words)
 
 
+#: Words and units of the pchip model's axes as a report's note names them.
+_AXIS_WORDS: dict[str, tuple[str, str]] = {"fill_percent": ("fill", "%"),
+                                           "acceleration_g": ("acceleration", "g"),
+                                           "frequency_hz": ("frequency", "Hz")}
+
+
+def model_range_text(model: object, point: tuple[float, float, float]) -> str:
+    """The model's range per axis in words with units, the axes ``point`` (fill %,
+    acceleration g, frequency Hz) lies outside first, e.g. ``"fill 95 % outside 25-90 %;
+    acceleration 1-10 g, frequency 50-1000 Hz"``.
+
+    The keywords (``fill_percent in [25, 90]``) named no unit, and the command line's wording
+    turned two of them into its flags (``--fill in [25, 90], acceleration_g in [1, 10],
+    --frequency in [50, 1000]``) in report.csv's note."""
+    bounds = getattr(model, "bounds", {}) or {}
+    outside, inside = [], []
+    for (name, (lo, hi)), value in zip(bounds.items(), point, strict=False):
+        word, unit = _AXIS_WORDS.get(name, (name, ""))
+        span = f"{lo:g}-{hi:g} {unit}".rstrip()
+        if value < lo or value > hi:
+            outside.append(f"{word} {value:g} {unit} outside {span}".replace("  ", " "))
+        else:
+            inside.append(f"{word} {span}")
+    return "; ".join(part for part in (", ".join(outside), ", ".join(inside)) if part)
+
+
 @dataclass(frozen=True)
 class Aligner:
     """Aligns measured cases with our DEM cases and the paper (see the module docstring).
@@ -915,11 +941,10 @@ class Aligner:
         point = (case.fill_percent, case.acceleration_g, case.frequency_hz)
         source = getattr(model, "source", "") or "pchip model"
         if not model.contains(point):
-            bounds = getattr(model, "bounds", {})
-            rng = ", ".join(f"{k} in [{lo:g}, {hi:g}]" for k, (lo, hi) in bounds.items())
             return AlignedCase(case, "out_of_range", **common,
                                message=f"{case.label()} lies outside the range of {source} "
-                                       f"({rng}); not extrapolated")
+                                       f"({model_range_text(model, point)}); not "
+                                       "extrapolated")
         value = float(np.asarray(model(*point)))
         unconverged = self._unconverged_nodes(case) if self.model is None else ()
         message = f"pchip interpolation over {source}"
