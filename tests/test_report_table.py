@@ -417,3 +417,20 @@ def test_an_interpolated_row_without_one_specimen_or_convention_says_why():
     row = row[row["source file(s)"] == "off_grid_fill40.csv"].iloc[0]
     assert pd.isna(row["particles per cell [-]"])
     assert "(its DEM runs do not record one specimen file" in row["note"]
+
+
+def test_the_paper_dem_gap_is_explained_in_the_row_not_left_blank():
+    # Table 3 prints no DEM value at 1000 Hz, 1 g, 90 % (the transcription keeps the row with
+    # an empty value): the report's row showed empty paper and difference cells and no word
+    dem = pd.DataFrame({"frequency_hz": [1000.0, 1000.0], "acceleration_g": [1.0, 1.0],
+                        "fill_percent": [90.0, 75.0], "material": ["acrylic"] * 2,
+                        "direction": ["z"] * 2, "sdc": [2.742, 2.6], "sdc_stderr": [0.3, 0.3]})
+    table = build_report_table(dem, None, load_paper_table3()).set_index("load case")
+    gap = table.loc["f1000Hz_a1g_fill90pct_acrylic_z"]
+    assert math.isnan(gap["SDC DEM (paper) [-]"])
+    assert math.isnan(gap["difference ours - paper DEM [-]"])
+    assert ("the paper's Table 3 prints no DEM value at 1000 Hz, 1 g, 90 %: no paper DEM SDC and "
+            "no difference ours - paper DEM here") in gap["note"]
+    # beside it the table has a value (0.8078) and the row says nothing of a gap
+    printed = table.loc["f1000Hz_a1g_fill75pct_acrylic_z"]
+    assert printed["SDC DEM (paper) [-]"] == 0.8078 and "prints no" not in printed["note"]

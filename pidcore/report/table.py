@@ -234,6 +234,18 @@ def no_runs_note(of: str, material: str, direction: str, store_runs: pd.DataFram
     return f"{note} (the store has {listed}, another specimen's: {choose_another})"
 
 
+def _paper_dem_gap(case: LoadCase, paper: pd.DataFrame | None,
+                   tolerances: Tolerances) -> str:
+    """Why the paper's DEM column of a row at a Table 3 load case is empty: the printed table
+    has no DEM value there (1000 Hz, 1 g, 90 %: the transcription keeps the row empty); "" where
+    the row is no Table 3 point or the table has a value."""
+    dem, _, point = match_paper(case, paper, tolerances=tolerances)
+    if point is None or not math.isnan(dem):
+        return ""
+    return (f"the paper's Table 3 prints no DEM value at {point.label()}: no paper DEM SDC "
+            "and no difference ours - paper DEM here")
+
+
 def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | None,
                        paper: pd.DataFrame | None, *, model: object | None = None,
                        tolerances: Tolerances | None = None,
@@ -471,6 +483,10 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
                                     f"{'; '.join(row.unconverged_nodes)})")
         if pool:
             note.append("pooled across specimens and DEM settings (pool=True)")
+        if math.isnan(row.paper_dem) and is_paper_coupon(row.specimen or ""):
+            gap = _paper_dem_gap(lc, paper, tolerances)
+            if gap:
+                note.append(gap)
         if row.measured and math.isfinite(row.sdc_dem) and not math.isfinite(sdc_m10):
             note.append("no DEM m_c: no like-for-like difference"
                         + (f" ({row.no_mass_reason})" if row.no_mass_reason else ""))
