@@ -100,6 +100,21 @@ def test_out_of_range_note_names_the_axis_outside_and_each_range_with_its_unit(
     assert cli_words(message, "report") == message  # no keyword left for the CLI to rewrite
 
 
+def test_an_interpolated_value_resting_on_a_filled_grid_point_says_so(aligner):
+    # an interrupted sweep: no run at 50 Hz, 1 g, 25 %; the model holds the 50 % run's SDC
+    # there (nearest fill) and the row was labelled "interpolated" with no word of it
+    runs = dem_grid()
+    holed = runs[~((runs.frequency_hz == 50) & (runs.acceleration_g == 1)
+                   & (runs.fill_percent == 25))]
+    out = Aligner.from_tables(holed).align(LoadCase(73.0, 2.7, 37.5))
+    assert out.status == "interpolated"
+    assert "no DEM run at 50 Hz, 1 g, 25 %, a corner of its grid cell" in out.message
+    # the held value, not the linear field's: the note is about a real difference
+    assert out.sdc_dem != pytest.approx(linear_sdc(37.5, 2.7, 73.0), rel=1e-6)
+    # with every corner run there is no such note
+    assert "no DEM run at" not in aligner.align(LoadCase(73.0, 2.7, 37.5)).message
+
+
 def test_other_material_or_direction_never_borrows_acrylic_results(aligner):
     out = aligner.align(LoadCase(50.0, 5.0, 50.0, "aluminium"))
     assert out.status == "no_dem_runs" and math.isnan(out.sdc_dem)

@@ -832,6 +832,28 @@ def complete_grid(table: pd.DataFrame) -> tuple[pd.DataFrame, str]:
     return rows, "; ".join(words)
 
 
+def filled_corners(model: object, point: tuple[float, float, float]) -> tuple[str, ...]:
+    """Labels (``"500 Hz, 5 g, 90 %"``) of the model's grid points at the corners of the
+    grid cell holding ``point`` (fill %, acceleration g, frequency Hz) whose value no data
+    gave: :attr:`pidcore.model.SdcModel.filled`. Empty for a model that flags none."""
+    filled = getattr(model, "filled", None)
+    axes = getattr(model, "axes", None)
+    if filled is None or axes is None or not np.any(filled):
+        return ()
+    indices = []
+    for axis, x in zip(axes, point, strict=True):
+        below = int(np.clip(np.searchsorted(axis, x, side="right") - 1, 0, axis.size - 1))
+        above = int(np.clip(np.searchsorted(axis, x, side="left"), 0, axis.size - 1))
+        indices.append(sorted({below, above}))
+    labels = []
+    for i in indices[0]:
+        for j in indices[1]:
+            for k in indices[2]:
+                if filled[i, j, k]:
+                    labels.append(f"{axes[2][k]:g} Hz, {axes[1][j]:g} g, {axes[0][i]:g} %")
+    return tuple(labels)
+
+
 #: Words and units of the pchip model's axes as a report's note names them.
 _AXIS_WORDS: dict[str, tuple[str, str]] = {"fill_percent": ("fill", "%"),
                                            "acceleration_g": ("acceleration", "g"),
@@ -953,6 +975,14 @@ class Aligner:
             message += ("; it rests on DEM runs that did not converge (no steady state before "
                         f"the transient cap) at {'; '.join(unconverged)}: the interpolated "
                         "SDC may include the transient")
+        filled = filled_corners(model, point)
+        if filled:
+            # an interrupted sweep left 500 Hz, 5 g, 90 % unrun: the model held the 75 % SDC
+            # there, and a measurement at 85 % got that held value as "interpolated"
+            message += (f"; no DEM run at {'; '.join(filled)}, a corner of its grid cell: the "
+                        "model fills it along fill from the runs at that frequency and "
+                        "acceleration (pchip between runs, the nearest run's SDC held beyond "
+                        "the last), so the SDC here rests partly on no run")
         return AlignedCase(case, "interpolated", value, math.nan, None, **common,
                            message=message, unconverged_nodes=unconverged)
 
