@@ -69,6 +69,9 @@ def test_off_grid_case_is_interpolated_exactly_for_a_linear_field(aligner):
     assert out.sdc_dem == pytest.approx(linear_sdc(37.5, 2.7, 73.0), rel=1e-12)
     assert math.isnan(out.sdc_dem_stderr)
     assert "pchip" in out.message
+    # the empty stderr cell is explained, not left blank
+    assert "(no DEM stderr: the model interpolates the runs' SDCs, not their errors)" \
+        in out.message
 
 
 @pytest.mark.parametrize("case", [

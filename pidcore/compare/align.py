@@ -969,7 +969,9 @@ class Aligner:
                                        "extrapolated")
         value = float(np.asarray(model(*point)))
         unconverged = self._unconverged_nodes(case) if self.model is None else ()
-        message = f"pchip interpolation over {source}"
+        # the row's empty "SDC DEM stderr" cell was left unexplained
+        message = (f"pchip interpolation over {source} (no DEM stderr: the model interpolates "
+                   "the runs' SDCs, not their errors)")
         if unconverged:
             # a grid row on such a run says so; the value interpolated from it said nothing
             message += ("; it rests on DEM runs that did not converge (no steady state before "
