@@ -316,3 +316,21 @@ def test_an_sdc_above_the_bound_without_a_vibrometer_names_the_channels_lead(tmp
     err = capsys.readouterr().err
     assert "above the physical bound" in err and "vibrometer" not in err
     assert "lead of the acceleration channel over the force" in err
+
+
+def test_the_paper_curve_over_table3s_gap_says_it_is_held_not_the_papers():
+    # Table 3 prints no DEM value at 1000 Hz, 1 g, 90 %: the model holds the 75 % value
+    # (0.8078) there, and the Compare page drew that flat stretch as the paper's curve
+    rec = _analysis(mass_damper_csv(frequency_hz=50.0))
+    entry = _entry(rec)
+    at_gap = MeasuredEntry(**{**entry.__dict__, "load_case": entry.load_case.__class__(
+        1000.0, 1.0, 50.0)})
+    comp = compare_case([at_gap], None, paper_table())
+    assert comp.model_sdc[-1] == pytest.approx(0.8078, rel=1e-12)  # the held 75 % value
+    assert ("the paper's pchip curve has no Table 3 DEM value at 1000 Hz, 1 g, 90 %: the model "
+            "holds the nearest printed fill's SDC there, not a value of the paper's") in comp.notes
+    # where every point of the curve is printed, no such note
+    full = MeasuredEntry(**{**entry.__dict__, "load_case": entry.load_case.__class__(
+        500.0, 1.0, 50.0)})
+    assert not any("no Table 3 DEM value" in n for n in compare_case([full], None,
+                                                                       paper_table()).notes)
