@@ -537,8 +537,40 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
                      "seed, settings and specimen under another key: another stated fill, or "
                      "the automatic count of steady cycles stated): "
                      f"{'; '.join(duplicate_rows)}")
+    counted = paper_fill_count_note(table)
+    if counted:
+        notes.append(counted)
     table.attrs["notes"] = notes
     return table, aligner
+
+
+def paper_fill_count_note(table: pd.DataFrame) -> str:
+    """Where rows set our DEM beside Table 3 at one packing ratio with another particle
+    count: the paper counts :data:`pidcore.defaults.PAPER_PARTICLES_PER_FULL_CELL` (36)
+    spheres per cell as 100 % (Sect. 5.1), our runs their cell's capacity (22 acrylic spheres
+    fit the paper's cell), so at the paper's 50 % ours hold 11 where its count is 18. ""
+    where every compared row's count is the paper's, or no row is compared."""
+    from ..specimen import particles_for_fill
+
+    paper_dem = table["SDC DEM (paper) [-]"].to_numpy(dtype=float)
+    ours = table["SDC DEM (ours) [-]"].to_numpy(dtype=float)
+    counts = table["particles per cell [-]"]
+    compared = table[np.isfinite(paper_dem) & np.isfinite(ours) & counts.notna().to_numpy()]
+    pairs = []
+    for fill in sorted(compared["packing ratio [%]"].astype(float).unique()):
+        held = sorted({int(n) for n in compared.loc[compared["packing ratio [%]"] == fill,
+                                                   "particles per cell [-]"]})
+        theirs = particles_for_fill(fill, defaults.PAPER_PARTICLES_PER_FULL_CELL)
+        if held != [theirs]:
+            pairs.append(f"{fill:g} %: ours {'/'.join(str(n) for n in held)}, the paper's "
+                         f"{theirs}")
+    if not pairs:
+        return ""
+    # the difference column read as the same bed at the same packing ratio
+    return (f"Table 3's packing ratio counts {defaults.PAPER_PARTICLES_PER_FULL_CELL} spheres "
+            "per cell as 100 % (paper Sect. 5.1), our DEM runs their cell's capacity: particles "
+            f"per cell at {'; '.join(pairs)}; 'difference ours - paper DEM' sets beds of "
+            "different particle counts side by side at one packing ratio")
 
 
 def not_converged_note(dem: DemCase) -> str:
