@@ -749,6 +749,45 @@ def _one_case_per_point(cases: list[DemCase]) -> tuple[list[DemCase], int]:
     return list(best.values()), len(crowded)
 
 
+def interpolated_count_and_mass(runs: pd.DataFrame | None,
+                                case: LoadCase) -> tuple[int | None, float, str]:
+    """(particles per cell, m_c of Eq. 10 in kg, "") of a load case off the DEM grid, as a DEM
+    run of ``case`` would count them: from the specimen file and the fill reference and
+    vibrated-mass convention that the ``runs`` the pchip model interpolates (those of its
+    material and direction) all share, through the functions the DEM itself uses
+    (:func:`pidcore.dem.simulate.particles_per_cell`, :meth:`pidcore.specimen.Specimen.
+    vibrated_mass_kg`). ``(None, NaN, reason)`` where the runs do not say one specimen or one
+    convention (runs of an older store, pooled runs of several specimens): a guessed m_c
+    would give an Eq. 10 SDC that no run defines."""
+    from ..dem.simulate import particles_per_cell
+    from ..errors import PidcoreError
+    from ..model.damper import runs_specimen
+
+    if runs is None or runs.empty or not {"material", "direction"} <= set(runs.columns):
+        return None, math.nan, "no DEM runs to take the specimen from"
+    same = runs[(runs["material"] == case.material) & (runs["direction"] == case.direction)]
+    try:
+        specimen = runs_specimen(same)
+    except PidcoreError:  # a stored text that no longer reads
+        specimen = None
+    if specimen is None:
+        return (None, math.nan, "its DEM runs do not record one specimen file (an older store, "
+                "or runs of several specimens)")
+    settings = {}
+    for column in ("fill_reference", "vibrated_mass_convention"):
+        values = set(same[column].dropna()) if column in same.columns else set()
+        if len(values) != 1 or same[column].isna().any():
+            return (None, math.nan, f"its DEM runs do not share one {column.replace('_', ' ')}")
+        settings[column] = values.pop()
+    try:
+        count, _ = particles_per_cell(case.fill_percent, specimen=specimen,
+                                      fill_reference=settings["fill_reference"])
+        mass = specimen.vibrated_mass_kg(count, settings["vibrated_mass_convention"])
+    except PidcoreError as exc:  # e.g. a fill that rounds to no particle of that cell
+        return None, math.nan, str(exc)
+    return count, mass, ""
+
+
 def build_dem_models(cases: list[DemCase]) -> dict[tuple[str, str], object]:
     """pchip models over our DEM cases, one per (material, direction); failures map to a message.
 

@@ -22,6 +22,7 @@ from .align import (
     band_quantile,
     consistency_chi2,
     filled_corners,
+    interpolated_count_and_mass,
     pooled_mean,
     pooled_sdc_eq10,
     pooled_stderr_dof,
@@ -508,6 +509,13 @@ def compare_case(records: Sequence[MeasuredEntry],
     # beside these notes)
     grid = getattr(aligned, "grid_case", None)
     m_c = float(grid.vibrated_mass_kg) if grid is not None else math.nan
+    if grid is None and aligned.status == "interpolated":
+        # the m_c a run at this fill would divide by, as `pidcore report` takes it: the
+        # headline said "not comparable: the DEM case has no m_c" where the report's row
+        # compared the like-for-like SDC
+        _, m_c, no_mass = interpolated_count_and_mass(runs, case)
+        if no_mass:
+            notes.append(f"no DEM m_c at {case.label()}: no like-for-like SDC ({no_mass})")
     eq10, sdc10, stderr10 = pooled_sdc_eq10(
         np.array([r.energy_per_cycle_j for r in records]),
         np.array([r.acceleration_m_s2 for r in records]),
