@@ -69,6 +69,9 @@ def test_off_grid_case_is_interpolated_exactly_for_a_linear_field(aligner):
     assert out.sdc_dem == pytest.approx(linear_sdc(37.5, 2.7, 73.0), rel=1e-12)
     assert math.isnan(out.sdc_dem_stderr)
     assert "pchip" in out.message
+    # the empty stderr cell is explained, not left blank
+    assert "(no DEM stderr: the model interpolates the runs' SDCs, not their errors)" \
+        in out.message
 
 
 @pytest.mark.parametrize("case", [
@@ -81,6 +84,38 @@ def test_outside_the_model_range_is_refused_not_extrapolated(aligner, case):
     assert out.status == "out_of_range"
     assert math.isnan(out.sdc_dem)
     assert "not extrapolated" in out.message
+
+
+@pytest.mark.parametrize(("case", "outside", "inside"), [
+    (LoadCase(200.0, 2.0, 30.0), "frequency 200 Hz outside 50-100 Hz",
+     "fill 25-50 %, acceleration 1-5 g"),
+    (LoadCase(75.0, 2.0, 10.0), "fill 10 % outside 25-50 %",
+     "acceleration 1-5 g, frequency 50-100 Hz"),
+])
+def test_out_of_range_note_names_the_axis_outside_and_each_range_with_its_unit(
+        aligner, case, outside, inside):
+    # report.csv showed "(--fill in [25, 90], acceleration_g in [1, 10], --frequency in
+    # [50, 1000])": keywords without units, two of them turned into CLI flags by its wording
+    from pidcore.cli._vocabulary import cli_words
+
+    message = aligner.align(case).message
+    assert f"({outside}; {inside})" in message
+    assert cli_words(message, "report") == message  # no keyword left for the CLI to rewrite
+
+
+def test_an_interpolated_value_resting_on_a_filled_grid_point_says_so(aligner):
+    # an interrupted sweep: no run at 50 Hz, 1 g, 25 %; the model holds the 50 % run's SDC
+    # there (nearest fill) and the row was labelled "interpolated" with no word of it
+    runs = dem_grid()
+    holed = runs[~((runs.frequency_hz == 50) & (runs.acceleration_g == 1)
+                   & (runs.fill_percent == 25))]
+    out = Aligner.from_tables(holed).align(LoadCase(73.0, 2.7, 37.5))
+    assert out.status == "interpolated"
+    assert "no DEM run at 50 Hz, 1 g, 25 %, a corner of its grid cell" in out.message
+    # the held value, not the linear field's: the note is about a real difference
+    assert out.sdc_dem != pytest.approx(linear_sdc(37.5, 2.7, 73.0), rel=1e-6)
+    # with every corner run there is no such note
+    assert "no DEM run at" not in aligner.align(LoadCase(73.0, 2.7, 37.5)).message
 
 
 def test_other_material_or_direction_never_borrows_acrylic_results(aligner):

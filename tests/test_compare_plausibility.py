@@ -316,3 +316,46 @@ def test_an_sdc_above_the_bound_without_a_vibrometer_names_the_channels_lead(tmp
     err = capsys.readouterr().err
     assert "above the physical bound" in err and "vibrometer" not in err
     assert "lead of the acceleration channel over the force" in err
+
+
+def test_the_paper_curve_over_table3s_gap_says_it_is_held_not_the_papers():
+    # Table 3 prints no DEM value at 1000 Hz, 1 g, 90 %: the model holds the 75 % value
+    # (0.8078) there, and the Compare page drew that flat stretch as the paper's curve
+    rec = _analysis(mass_damper_csv(frequency_hz=50.0))
+    entry = _entry(rec)
+    at_gap = MeasuredEntry(**{**entry.__dict__, "load_case": entry.load_case.__class__(
+        1000.0, 1.0, 50.0)})
+    comp = compare_case([at_gap], None, paper_table())
+    assert comp.model_sdc[-1] == pytest.approx(0.8078, rel=1e-12)  # the held 75 % value
+    assert ("the paper's pchip curve has no Table 3 DEM value at 1000 Hz, 1 g, 90 %: the model "
+            "holds the nearest printed fill's SDC there, not a value of the paper's") in comp.notes
+    # where every point of the curve is printed, no such note
+    full = MeasuredEntry(**{**entry.__dict__, "load_case": entry.load_case.__class__(
+        500.0, 1.0, 50.0)})
+    assert not any("no Table 3 DEM value" in n for n in compare_case([full], None,
+                                                                       paper_table()).notes)
+
+
+def test_an_interpolated_case_is_judged_like_for_like_as_the_report_judges_it():
+    # 70 Hz, 7 g, 50 % lies between the bundled DEM grid's points: the report's row gives the
+    # Eq. 10 SDC over the m_c a run at 50 % would have (11 spheres per cell), the Compare
+    # headline said "not comparable: the DEM case has no m_c for the Eq. 10 energy"
+    from pathlib import Path
+
+    from pidcore.store import Store
+    from pidcore.units import g_to_si
+
+    bundled = Path(__file__).resolve().parents[1] / "data_samples" / "dem_table3.h5"
+    runs = Store(bundled).list_dem_runs()
+    rec = _analysis(mass_damper_csv(frequency_hz=70.0, acceleration_g=7.0))
+    comp = compare_case([_entry(rec)], runs, paper_table())
+    assert comp.aligned.status == "interpolated"
+    # a run at 50 % holds the same 11 spheres, so its m_c is the one (any 50 % run's)
+    m_c = float(runs.loc[runs["fill_percent"] == 50.0, "vibrated_mass_kg"].iloc[0])
+    w = 2 * math.pi * rec.analysis.frequency_hz
+    eq10 = rec.analysis.energy_per_cycle_j / (
+        m_c * g_to_si(rec.analysis.acceleration_g) ** 2 / (2 * w ** 2))
+    assert comp.measured_sdc_eq10 == pytest.approx(eq10, rel=1e-12)
+    head = headline(comp)
+    assert head.measured_kind == "Eq. 10 (DEM m_c)" and head.measured == comp.measured_sdc_eq10
+    assert head.verdict.startswith(("agrees", "differs"))

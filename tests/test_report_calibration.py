@@ -520,6 +520,32 @@ def test_a_calibration_made_from_an_earlier_version_of_the_specimen_file_says_so
 
 # --- a band past 2 pi is cut there and said ------------------------------------------------------
 
+def test_a_band_cut_by_the_measurements_own_scatter_blames_the_measurement(tmp_path):
+    # the bundled calibration at 500 Hz, 5 g, 50 %: prediction 0.492, band without
+    # measurement error 0.121 .. 0.860; two records pooled there (SDC 4.09 and 0.50) have
+    # stderr 1.795 of 1 degree of freedom, t = 12.71: the band reached 0.492 +
+    # hypot(0.368, 22.8) = 23.3, all of it the measurement's. The note said "the calibration
+    # does not constrain the SDC here (its model discrepancy ... dominate)".
+    point = {**_prediction(500, 5, 50, 0.492, 0.121, 0.860), "measured_stderr": 0.0,
+             "low95_without_stderr": 0.121, "high95_without_stderr": 0.860}
+    hit = load_calibration(_write(tmp_path / "calibration.json", [point])).lookup(
+        LoadCase(500, 5, 50))
+    t_1 = 12.706204736174707  # Student t 0.975 quantile, 1 degree of freedom (tables)
+    high = 0.492 + math.hypot(0.860 - 0.492, t_1 * 1.795)
+    assert hit.model_band(1.795, 1.0)[1] == pytest.approx(high, rel=1e-12)
+    note = hit.band_note(1.795, 1.0)
+    assert note.startswith("calibrated 95 % band cut at 2 pi = 6.283")
+    assert "does not constrain" not in note and "model discrepancy" not in note
+    assert (f"the band's own upper bound {high:.3g} comes from this measurement's standard "
+            f"error (stderr {1.795:.3g} x its 95 % quantile 12.71 = {t_1 * 1.795:.3g}, beside the "
+            "calibrated model's 0.368 above its prediction)") in note
+    # the model's own width past 2 pi (tau near its prior's top) is still the model's
+    wide = {**_prediction(50, 5, 50, 3.0, 0.5, 12.7), "measured_stderr": 0.0,
+            "low95_without_stderr": 0.6, "high95_without_stderr": 12.6}
+    own = load_calibration(_write(tmp_path / "wide.json", [wide])).lookup(LoadCase(50, 5, 50))
+    assert "does not constrain the SDC here" in own.band_note(0.5, 7.0)
+
+
 def test_a_band_past_two_pi_is_cut_there_with_a_note(tmp_path):
     # a poorly constrained calibration: model discrepancy tau ~ 2 (its prior's top) at a model
     # SDC of 3 gives 3 + 1.96 * 2 * 3 ~ 14.8 as the normal model's upper bound; a measurement

@@ -301,3 +301,34 @@ def test_a_saved_analysis_parameters_read_alike_by_the_report_and_compare():
     # one file's delay, none known of the others: said per file, not taken as shared
     assert stored_parameters(analyses) == {
         "velocity_delay_s": {"a.csv": 5e-05, "b.csv": None, "c.csv": None, "d.csv": None}}
+
+
+def test_pdf_table_sets_the_like_for_like_measured_sdc_beside_ours():
+    # the PDF showed only the Eq. 11 SDC (1.139) beside our DEM's 0.6054 at 50 Hz, 5 g, 50 %:
+    # a reader saw a factor 2 where the like-for-like Eq. 10 value, 0.624, agrees within
+    # 0.019; nor did it show the calibrated prediction or the band verdict
+    from pidcore.report.render import pdf_table_cells
+    from pidcore.report.table import (
+        CALIBRATED_COLUMN,
+        CALIBRATED_INSIDE_COLUMN,
+        DIFFERENCE_COLUMN,
+        MEASURED_EQ10_COLUMN,
+        REPORT_COLUMNS,
+    )
+
+    row = dict.fromkeys(REPORT_COLUMNS, float("nan"))
+    row.update({"frequency [Hz]": 50.0, "acceleration [g]": 5.0, "packing ratio [%]": 50.0,
+                "SDC DEM (ours) [-]": 0.6054300359935463, "SDC measured [-]": 1.1394946,
+                MEASURED_EQ10_COLUMN: 0.6239845632800883,
+                DIFFERENCE_COLUMN: 0.6239845632800883 - 0.6054300359935463,
+                CALIBRATED_COLUMN: 0.2399096, CALIBRATED_INSIDE_COLUMN: "no",
+                "alignment [grid/interpolated/out_of_range/no_dem_runs]": "grid"})
+    labels, rows = pdf_table_cells(pd.DataFrame([row]))
+    shown = {label.replace("\n", " "): cell for label, cell in zip(labels, rows[0], strict=True)}
+    assert shown["SDC DEM (ours) [-]"] == "0.6054"
+    assert shown["SDC measured, E of Eq. 10 [-]"] == "0.624"
+    assert shown["difference measured (E of Eq. 10) - ours [-]"] == "0.01855"
+    # the Eq. 11 value says it is the other SDC
+    assert shown["SDC measured (Eq. 11) [-]"] == "1.139"
+    assert shown["SDC calibrated DEM (Eq. 11) [-]"] == "0.2399"
+    assert shown["measured in calibrated 95 % band"] == "no"

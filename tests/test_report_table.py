@@ -417,3 +417,40 @@ def test_an_interpolated_row_without_one_specimen_or_convention_says_why():
     row = row[row["source file(s)"] == "off_grid_fill40.csv"].iloc[0]
     assert pd.isna(row["particles per cell [-]"])
     assert "(its DEM runs do not record one specimen file" in row["note"]
+
+
+def test_the_paper_dem_gap_is_explained_in_the_row_not_left_blank():
+    # Table 3 prints no DEM value at 1000 Hz, 1 g, 90 % (the transcription keeps the row with
+    # an empty value): the report's row showed empty paper and difference cells and no word
+    dem = pd.DataFrame({"frequency_hz": [1000.0, 1000.0], "acceleration_g": [1.0, 1.0],
+                        "fill_percent": [90.0, 75.0], "material": ["acrylic"] * 2,
+                        "direction": ["z"] * 2, "sdc": [2.742, 2.6], "sdc_stderr": [0.3, 0.3]})
+    table = build_report_table(dem, None, load_paper_table3()).set_index("load case")
+    gap = table.loc["f1000Hz_a1g_fill90pct_acrylic_z"]
+    assert math.isnan(gap["SDC DEM (paper) [-]"])
+    assert math.isnan(gap["difference ours - paper DEM [-]"])
+    assert ("the paper's Table 3 prints no DEM value at 1000 Hz, 1 g, 90 %: no paper DEM SDC and "
+            "no difference ours - paper DEM here") in gap["note"]
+    # beside it the table has a value (0.8078) and the row says nothing of a gap
+    printed = table.loc["f1000Hz_a1g_fill75pct_acrylic_z"]
+    assert printed["SDC DEM (paper) [-]"] == 0.8078 and "prints no" not in printed["note"]
+
+
+def test_rows_beside_table3_say_the_papers_particle_count_differs_from_ours():
+    # Table 3's packing ratio counts 36 spheres per cell as 100 % (paper Sect. 5.1); our runs
+    # count the cell's capacity (22 acrylic spheres): at 50 % ours hold 11, the paper's 18.
+    # The report set them side by side in one row, with a difference column, and no word.
+    dem = pd.DataFrame({"frequency_hz": [50.0, 50.0], "acceleration_g": [5.0, 5.0],
+                        "fill_percent": [50.0, 75.0], "material": ["acrylic"] * 2,
+                        "direction": ["z"] * 2, "sdc": [0.6, 0.7], "sdc_stderr": [0.01, 0.01],
+                        "particles_per_cell": [11, 16]})
+    notes = build_report_table(dem, None, load_paper_table3()).attrs["notes"]
+    said = [n for n in notes if n.startswith("Table 3's packing ratio counts 36 spheres")]
+    assert len(said) == 1
+    # round(0.50 * 36) = 18, round(0.75 * 36) = 27: the paper's own rule
+    assert "particles per cell at 50 %: ours 11, the paper's 18; 75 %: ours 16, the paper's 27" \
+        in said[0]
+    # runs that hold the paper's count (18 at 50 %) need no such note
+    same = dem.assign(particles_per_cell=[18, 27])
+    assert not any("packing ratio counts" in n for n in
+                   build_report_table(same, None, load_paper_table3()).attrs["notes"])

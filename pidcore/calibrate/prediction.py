@@ -98,13 +98,7 @@ class CalibratedPrediction:
         where it reaches beyond)."""
         stderr = real_number("stderr", stderr)
         q = band_quantile(dof)  # checks dof before any early return
-        same_dof = (math.isnan(dof) and math.isnan(self.measured_stderr_dof)) or \
-            dof == self.measured_stderr_dof
-        same = (not math.isfinite(stderr) or not math.isfinite(self.measured_stderr)
-                or not math.isfinite(self.low95_without_stderr)
-                or (same_dof and math.isclose(stderr, self.measured_stderr, rel_tol=1e-9,
-                                              abs_tol=1e-12)))
-        if same:
+        if self._fitted_band_applies(stderr, dof):
             return self.low95, self.high95
         if stderr < 0:
             raise ParameterError(f"stderr {stderr!r}: expected a standard error >= 0")
@@ -122,10 +116,40 @@ class CalibratedPrediction:
         high = self.model_band(stderr, dof)[1]
         if not high > SDC_UPPER_BOUND:
             return ""
-        return (f"calibrated 95 % band cut at 2 pi = {SDC_UPPER_BOUND:.4g} (a loss factor of 1, "
-                "above which a measured SDC is refused as implausible); the model's own upper "
-                f"bound {high:.3g} says the calibration does not constrain the SDC here (its "
-                "model discrepancy and surrogate scatter dominate)")
+        cut = (f"calibrated 95 % band cut at 2 pi = {SDC_UPPER_BOUND:.4g} (a loss factor of 1, "
+               "above which a measured SDC is refused as implausible); ")
+        widening = self._measurement_widening(stderr, dof)
+        # a pooled pair of records (stderr 1.8, t of 1 degree of freedom: 12.7) reached 23.3
+        # by its own scatter, beside a model half-width of 0.41: blaming the calibration
+        # told the user the model was at fault where the measurement was
+        if widening > self.high95_without_stderr - self.sdc:
+            return (cut + f"the band's own upper bound {high:.3g} comes from this "
+                    f"measurement's standard error (stderr {stderr:.3g} x its 95 % quantile "
+                    f"{band_quantile(dof):.4g} = {widening:.3g}, beside the calibrated "
+                    f"model's {self.high95_without_stderr - self.sdc:.3g} above its "
+                    "prediction): the measurement is too uncertain here for the band to "
+                    "judge it")
+        return (cut + f"the model's own upper bound {high:.3g} says the calibration does not "
+                "constrain the SDC here (its model discrepancy and surrogate scatter dominate)")
+
+    def _fitted_band_applies(self, stderr: float, dof: float) -> bool:
+        """Whether :meth:`model_band` takes the fitted point's band (``stderr`` unknown, an
+        older calibration.json, or the fitted point's own stderr and dof) rather than
+        widening the band without measurement error by ``stderr``."""
+        same_dof = (math.isnan(dof) and math.isnan(self.measured_stderr_dof)) or \
+            dof == self.measured_stderr_dof
+        return (not math.isfinite(stderr) or not math.isfinite(self.measured_stderr)
+                or not math.isfinite(self.low95_without_stderr)
+                or (same_dof and math.isclose(stderr, self.measured_stderr, rel_tol=1e-9,
+                                              abs_tol=1e-12)))
+
+    def _measurement_widening(self, stderr: float, dof: float) -> float:
+        """The half-width ``q x stderr`` :meth:`model_band` adds in quadrature for a
+        measurement's standard error; 0 where it takes the fitted point's band instead."""
+        stderr = real_number("stderr", stderr)
+        if self._fitted_band_applies(stderr, dof):
+            return 0.0
+        return band_quantile(dof) * stderr
 
     def contains(self, sdc: float, stderr: float = math.nan, dof: float = math.nan) -> bool:
         """True if ``sdc`` lies inside the 95 % band of a measurement with standard error

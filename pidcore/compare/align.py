@@ -748,6 +748,45 @@ def _one_case_per_point(cases: list[DemCase]) -> tuple[list[DemCase], int]:
     return list(best.values()), len(crowded)
 
 
+def interpolated_count_and_mass(runs: pd.DataFrame | None,
+                                case: LoadCase) -> tuple[int | None, float, str]:
+    """(particles per cell, m_c of Eq. 10 in kg, "") of a load case off the DEM grid, as a DEM
+    run of ``case`` would count them: from the specimen file and the fill reference and
+    vibrated-mass convention that the ``runs`` the pchip model interpolates (those of its
+    material and direction) all share, through the functions the DEM itself uses
+    (:func:`pidcore.dem.simulate.particles_per_cell`, :meth:`pidcore.specimen.Specimen.
+    vibrated_mass_kg`). ``(None, NaN, reason)`` where the runs do not say one specimen or one
+    convention (runs of an older store, pooled runs of several specimens): a guessed m_c
+    would give an Eq. 10 SDC that no run defines."""
+    from ..dem.simulate import particles_per_cell
+    from ..errors import PidcoreError
+    from ..model.damper import runs_specimen
+
+    if runs is None or runs.empty or not {"material", "direction"} <= set(runs.columns):
+        return None, math.nan, "no DEM runs to take the specimen from"
+    same = runs[(runs["material"] == case.material) & (runs["direction"] == case.direction)]
+    try:
+        specimen = runs_specimen(same)
+    except PidcoreError:  # a stored text that no longer reads
+        specimen = None
+    if specimen is None:
+        return (None, math.nan, "its DEM runs do not record one specimen file (an older store, "
+                "or runs of several specimens)")
+    settings = {}
+    for column in ("fill_reference", "vibrated_mass_convention"):
+        values = set(same[column].dropna()) if column in same.columns else set()
+        if len(values) != 1 or same[column].isna().any():
+            return (None, math.nan, f"its DEM runs do not share one {column.replace('_', ' ')}")
+        settings[column] = values.pop()
+    try:
+        count, _ = particles_per_cell(case.fill_percent, specimen=specimen,
+                                      fill_reference=settings["fill_reference"])
+        mass = specimen.vibrated_mass_kg(count, settings["vibrated_mass_convention"])
+    except PidcoreError as exc:  # e.g. a fill that rounds to no particle of that cell
+        return None, math.nan, str(exc)
+    return count, mass, ""
+
+
 def build_dem_models(cases: list[DemCase]) -> dict[tuple[str, str], object]:
     """pchip models over our DEM cases, one per (material, direction); failures map to a message.
 
@@ -829,6 +868,54 @@ def complete_grid(table: pd.DataFrame) -> tuple[pd.DataFrame, str]:
                  (left["frequency_hz"], "Hz", "acceleration"),
                  (left["acceleration_g"], "g", "frequency")) if values]
     return rows, "; ".join(words)
+
+
+def filled_corners(model: object, point: tuple[float, float, float]) -> tuple[str, ...]:
+    """Labels (``"500 Hz, 5 g, 90 %"``) of the model's grid points at the corners of the
+    grid cell holding ``point`` (fill %, acceleration g, frequency Hz) whose value no data
+    gave: :attr:`pidcore.model.SdcModel.filled`. Empty for a model that flags none."""
+    filled = getattr(model, "filled", None)
+    axes = getattr(model, "axes", None)
+    if filled is None or axes is None or not np.any(filled):
+        return ()
+    indices = []
+    for axis, x in zip(axes, point, strict=True):
+        below = int(np.clip(np.searchsorted(axis, x, side="right") - 1, 0, axis.size - 1))
+        above = int(np.clip(np.searchsorted(axis, x, side="left"), 0, axis.size - 1))
+        indices.append(sorted({below, above}))
+    labels = []
+    for i in indices[0]:
+        for j in indices[1]:
+            for k in indices[2]:
+                if filled[i, j, k]:
+                    labels.append(f"{axes[2][k]:g} Hz, {axes[1][j]:g} g, {axes[0][i]:g} %")
+    return tuple(labels)
+
+
+#: Words and units of the pchip model's axes as a report's note names them.
+_AXIS_WORDS: dict[str, tuple[str, str]] = {"fill_percent": ("fill", "%"),
+                                           "acceleration_g": ("acceleration", "g"),
+                                           "frequency_hz": ("frequency", "Hz")}
+
+
+def model_range_text(model: object, point: tuple[float, float, float]) -> str:
+    """The model's range per axis in words with units, the axes ``point`` (fill %,
+    acceleration g, frequency Hz) lies outside first, e.g. ``"fill 95 % outside 25-90 %;
+    acceleration 1-10 g, frequency 50-1000 Hz"``.
+
+    The keywords (``fill_percent in [25, 90]``) named no unit, and the command line's wording
+    turned two of them into its flags (``--fill in [25, 90], acceleration_g in [1, 10],
+    --frequency in [50, 1000]``) in report.csv's note."""
+    bounds = getattr(model, "bounds", {}) or {}
+    outside, inside = [], []
+    for (name, (lo, hi)), value in zip(bounds.items(), point, strict=False):
+        word, unit = _AXIS_WORDS.get(name, (name, ""))
+        span = f"{lo:g}-{hi:g} {unit}".rstrip()
+        if value < lo or value > hi:
+            outside.append(f"{word} {value:g} {unit} outside {span}".replace("  ", " "))
+        else:
+            inside.append(f"{word} {span}")
+    return "; ".join(part for part in (", ".join(outside), ", ".join(inside)) if part)
 
 
 @dataclass(frozen=True)
@@ -914,19 +1001,28 @@ class Aligner:
         point = (case.fill_percent, case.acceleration_g, case.frequency_hz)
         source = getattr(model, "source", "") or "pchip model"
         if not model.contains(point):
-            bounds = getattr(model, "bounds", {})
-            rng = ", ".join(f"{k} in [{lo:g}, {hi:g}]" for k, (lo, hi) in bounds.items())
             return AlignedCase(case, "out_of_range", **common,
                                message=f"{case.label()} lies outside the range of {source} "
-                                       f"({rng}); not extrapolated")
+                                       f"({model_range_text(model, point)}); not "
+                                       "extrapolated")
         value = float(np.asarray(model(*point)))
         unconverged = self._unconverged_nodes(case) if self.model is None else ()
-        message = f"pchip interpolation over {source}"
+        # the row's empty "SDC DEM stderr" cell was left unexplained
+        message = (f"pchip interpolation over {source} (no DEM stderr: the model interpolates "
+                   "the runs' SDCs, not their errors)")
         if unconverged:
             # a grid row on such a run says so; the value interpolated from it said nothing
             message += ("; it rests on DEM runs that did not converge (no steady state before "
                         f"the transient cap) at {'; '.join(unconverged)}: the interpolated "
                         "SDC may include the transient")
+        filled = filled_corners(model, point)
+        if filled:
+            # an interrupted sweep left 500 Hz, 5 g, 90 % unrun: the model held the 75 % SDC
+            # there, and a measurement at 85 % got that held value as "interpolated"
+            message += (f"; no DEM run at {'; '.join(filled)}, a corner of its grid cell: the "
+                        "model fills it along fill from the runs at that frequency and "
+                        "acceleration (pchip between runs, the nearest run's SDC held beyond "
+                        "the last), so the SDC here rests partly on no run")
         return AlignedCase(case, "interpolated", value, math.nan, None, **common,
                            message=message, unconverged_nodes=unconverged)
 

@@ -21,6 +21,8 @@ from .align import (
     Tolerances,
     band_quantile,
     consistency_chi2,
+    filled_corners,
+    interpolated_count_and_mass,
     pooled_mean,
     pooled_sdc_eq10,
     pooled_stderr_dof,
@@ -489,10 +491,25 @@ def compare_case(records: Sequence[MeasuredEntry],
             model_y = np.asarray(model(model_x, point[0], point[1]), dtype=float)
             if point[2]:
                 notes.append(point[2])
+            # at 1000 Hz, 1 g the curve's 75-90 % stretch is Table 3's gap held flat: it was
+            # drawn as the paper's model with no word
+            held = sorted({label for fill in model.axes[0]
+                           for label in filled_corners(model, (fill, point[0], point[1]))})
+            if held:
+                notes.append(f"the paper's pchip curve has no Table 3 DEM value at "
+                             f"{'; '.join(held)}: the model holds the nearest printed fill's "
+                             "SDC there, not a value of the paper's")
     # (runs counted once as the same simulation are said by the alignment's message, shown
     # beside these notes)
     grid = getattr(aligned, "grid_case", None)
     m_c = float(grid.vibrated_mass_kg) if grid is not None else math.nan
+    if grid is None and aligned.status == "interpolated":
+        # the m_c a run at this fill would divide by, as `pidcore report` takes it: the
+        # headline said "not comparable: the DEM case has no m_c" where the report's row
+        # compared the like-for-like SDC
+        _, m_c, no_mass = interpolated_count_and_mass(runs, case)
+        if no_mass:
+            notes.append(f"no DEM m_c at {case.label()}: no like-for-like SDC ({no_mass})")
     eq10, sdc10, stderr10 = pooled_sdc_eq10(
         np.array([r.energy_per_cycle_j for r in records]),
         np.array([r.acceleration_m_s2 for r in records]),

@@ -30,18 +30,32 @@ from ..constants import REPORT_FORMATS
 from ..errors import ParameterError
 from ..io import display_path
 from .provenance import Provenance
-from .table import ALIGNMENT_COLUMN
+from .table import (
+    ALIGNMENT_COLUMN,
+    CALIBRATED_COLUMN,
+    CALIBRATED_INSIDE_COLUMN,
+    DIFFERENCE_COLUMN,
+    MEASURED_EQ10_COLUMN,
+)
 
 #: File written into every report folder; only folders holding it are ever replaced.
 REPORT_MARKER = ".pidcore-report"
 #: Base name of the table files (``report.csv``, ``report.md``...).
 REPORT_STEM = "report"
 #: Columns shown in the PDF table (the full table is in every other format).
+#: The like-for-like measured SDC (Eq. 10's E) and its difference stand beside our DEM: with
+#: the Eq. 11 SDC alone the PDF set 1.14 against our 0.61 where the like-for-like 0.62 agrees;
+#: the calibrated columns only where the table has them.
 PDF_COLUMNS: tuple[str, ...] = (
     "frequency [Hz]", "acceleration [g]", "packing ratio [%]", "SDC DEM (ours) [-]",
-    "SDC DEM stderr [-]", "SDC measured [-]", "SDC measured stderr [-]", "SDC DEM (paper) [-]",
-    "SDC measured (paper) [-]", ALIGNMENT_COLUMN,
+    "SDC DEM stderr [-]", MEASURED_EQ10_COLUMN, DIFFERENCE_COLUMN, "SDC measured [-]",
+    "SDC measured stderr [-]", CALIBRATED_COLUMN, CALIBRATED_INSIDE_COLUMN,
+    "SDC DEM (paper) [-]", "SDC measured (paper) [-]", ALIGNMENT_COLUMN,
 )
+#: The PDF's header of a column whose name alone does not say which SDC it is.
+PDF_LABELS: dict[str, str] = {"SDC measured [-]": "SDC measured (Eq. 11) [-]",
+                              "SDC measured stderr [-]": "SDC measured (Eq. 11) stderr [-]",
+                              CALIBRATED_INSIDE_COLUMN: "measured in calibrated 95 % band"}
 _TITLE = "Specific damping capacity: our DEM, our measurements and the paper (Table 3)"
 
 
@@ -195,30 +209,40 @@ def _write_tex(table: pd.DataFrame, figures: Mapping[str, Path], prov: Provenanc
     return path
 
 
+def pdf_table_cells(table: pd.DataFrame) -> tuple[list[str], list[list[str]]]:
+    """The PDF table's header labels (wrapped) and its rows' display text, of the
+    :data:`PDF_COLUMNS` the table has."""
+    cols = [c for c in PDF_COLUMNS if c in table.columns]
+    labels = ["\n".join(textwrap.wrap(PDF_LABELS.get(c, c.split(" [grid/")[0]), 12))
+              for c in cols]
+    return labels, _display_rows(table, cols)
+
+
 def _write_pdf(table: pd.DataFrame, figures: Mapping[str, Path], prov: Provenance,
                folder: Path, *, figure_objects: Mapping[str, object] | None = None) -> Path:
     import matplotlib.pyplot as plt
     from matplotlib.backends.backend_pdf import PdfPages
 
     path = folder / f"{REPORT_STEM}.pdf"
-    cols = [c for c in PDF_COLUMNS if c in table.columns]
-    rows = _display_rows(table, cols)
+    labels, rows = pdf_table_cells(table)
     per_page = 28
     with PdfPages(path) as pdf:
         for start in range(0, max(len(rows), 1), per_page):
             fig, ax = plt.subplots(figsize=(11.69, 8.27))  # A4 landscape, inches
             ax.axis("off")
             ax.set_title(_TITLE if start == 0 else f"{_TITLE} (continued)", fontsize=10)
-            chunk = rows[start:start + per_page] or [[""] * len(cols)]
-            labels = ["\n".join(textwrap.wrap(c.split(" [grid/")[0], 14)) for c in cols]
+            chunk = rows[start:start + per_page] or [[""] * len(labels)]
             tab = ax.table(cellText=chunk, colLabels=labels, loc="upper center",
                            cellLoc="right")
             tab.auto_set_font_size(False)
-            tab.set_fontsize(7)
+            tab.set_fontsize(6.5)
             tab.scale(1.0, 1.3)
+            # up to 14 columns on A4: each as wide as its widest text, none cut at its edge
+            tab.auto_set_column_width(list(range(len(labels))))
+            lines = max(label.count("\n") + 1 for label in labels)
             for (row, _), cell in tab.get_celld().items():
-                if row == 0:  # room for three lines of header text
-                    cell.set_height(cell.get_height() * 2.6)
+                if row == 0:  # room for the longest header's lines
+                    cell.set_height(cell.get_height() * (0.9 * lines))
             pdf.savefig(fig)
             plt.close(fig)
         for fig in (figure_objects or {}).values():

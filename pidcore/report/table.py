@@ -32,6 +32,7 @@ from ..compare.align import (
     Tolerances,
     consistency_chi2,
     duplicates_note,
+    interpolated_count_and_mass,
     match_paper,
     pooled_mean,
     pooled_sdc_eq10,
@@ -120,45 +121,6 @@ class _Row:
     no_mass_reason: str = ""
 
 
-def interpolated_count_and_mass(runs: pd.DataFrame | None,
-                                case: LoadCase) -> tuple[int | None, float, str]:
-    """(particles per cell, m_c of Eq. 10 in kg, "") of a load case off the DEM grid, as a DEM
-    run of ``case`` would count them: from the specimen file and the fill reference and
-    vibrated-mass convention that the ``runs`` the pchip model interpolates (those of its
-    material and direction) all share, through the functions the DEM itself uses
-    (:func:`pidcore.dem.simulate.particles_per_cell`, :meth:`pidcore.specimen.Specimen.
-    vibrated_mass_kg`). ``(None, NaN, reason)`` where the runs do not say one specimen or one
-    convention (runs of an older store, pooled runs of several specimens): a guessed m_c
-    would give an Eq. 10 SDC that no run defines."""
-    from ..dem.simulate import particles_per_cell
-    from ..errors import PidcoreError
-    from ..model.damper import runs_specimen
-
-    if runs is None or runs.empty or not {"material", "direction"} <= set(runs.columns):
-        return None, math.nan, "no DEM runs to take the specimen from"
-    same = runs[(runs["material"] == case.material) & (runs["direction"] == case.direction)]
-    try:
-        specimen = runs_specimen(same)
-    except PidcoreError:  # a stored text that no longer reads
-        specimen = None
-    if specimen is None:
-        return (None, math.nan, "its DEM runs do not record one specimen file (an older store, "
-                "or runs of several specimens)")
-    settings = {}
-    for column in ("fill_reference", "vibrated_mass_convention"):
-        values = set(same[column].dropna()) if column in same.columns else set()
-        if len(values) != 1 or same[column].isna().any():
-            return (None, math.nan, f"its DEM runs do not share one {column.replace('_', ' ')}")
-        settings[column] = values.pop()
-    try:
-        count, _ = particles_per_cell(case.fill_percent, specimen=specimen,
-                                      fill_reference=settings["fill_reference"])
-        mass = specimen.vibrated_mass_kg(count, settings["vibrated_mass_convention"])
-    except PidcoreError as exc:  # e.g. a fill that rounds to no particle of that cell
-        return None, math.nan, str(exc)
-    return count, mass, ""
-
-
 def _measured_rows(analyses: pd.DataFrame | None, notes: list[str]) -> list[tuple[LoadCase,
                                                                                   pd.Series]]:
     if analyses is None or analyses.empty:
@@ -232,6 +194,18 @@ def no_runs_note(of: str, material: str, direction: str, store_runs: pd.DataFram
         return (f"{note} among this report's runs (the store has {listed}; {of}'s are left "
                 f"out of a report of another specimen: {choose_another})")
     return f"{note} (the store has {listed}, another specimen's: {choose_another})"
+
+
+def _paper_dem_gap(case: LoadCase, paper: pd.DataFrame | None,
+                   tolerances: Tolerances) -> str:
+    """Why the paper's DEM column of a row at a Table 3 load case is empty: the printed table
+    has no DEM value there (1000 Hz, 1 g, 90 %: the transcription keeps the row empty); "" where
+    the row is no Table 3 point or the table has a value."""
+    dem, _, point = match_paper(case, paper, tolerances=tolerances)
+    if point is None or not math.isnan(dem):
+        return ""
+    return (f"the paper's Table 3 prints no DEM value at {point.label()}: no paper DEM SDC "
+            "and no difference ours - paper DEM here")
 
 
 def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | None,
@@ -471,6 +445,10 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
                                     f"{'; '.join(row.unconverged_nodes)})")
         if pool:
             note.append("pooled across specimens and DEM settings (pool=True)")
+        if math.isnan(row.paper_dem) and is_paper_coupon(row.specimen or ""):
+            gap = _paper_dem_gap(lc, paper, tolerances)
+            if gap:
+                note.append(gap)
         if row.measured and math.isfinite(row.sdc_dem) and not math.isfinite(sdc_m10):
             note.append("no DEM m_c: no like-for-like difference"
                         + (f" ({row.no_mass_reason})" if row.no_mass_reason else ""))
@@ -517,8 +495,40 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
                      "seed, settings and specimen under another key: another stated fill, or "
                      "the automatic count of steady cycles stated): "
                      f"{'; '.join(duplicate_rows)}")
+    counted = paper_fill_count_note(table)
+    if counted:
+        notes.append(counted)
     table.attrs["notes"] = notes
     return table, aligner
+
+
+def paper_fill_count_note(table: pd.DataFrame) -> str:
+    """Where rows set our DEM beside Table 3 at one packing ratio with another particle
+    count: the paper counts :data:`pidcore.defaults.PAPER_PARTICLES_PER_FULL_CELL` (36)
+    spheres per cell as 100 % (Sect. 5.1), our runs their cell's capacity (22 acrylic spheres
+    fit the paper's cell), so at the paper's 50 % ours hold 11 where its count is 18. ""
+    where every compared row's count is the paper's, or no row is compared."""
+    from ..specimen import particles_for_fill
+
+    paper_dem = table["SDC DEM (paper) [-]"].to_numpy(dtype=float)
+    ours = table["SDC DEM (ours) [-]"].to_numpy(dtype=float)
+    counts = table["particles per cell [-]"]
+    compared = table[np.isfinite(paper_dem) & np.isfinite(ours) & counts.notna().to_numpy()]
+    pairs = []
+    for fill in sorted(compared["packing ratio [%]"].astype(float).unique()):
+        held = sorted({int(n) for n in compared.loc[compared["packing ratio [%]"] == fill,
+                                                   "particles per cell [-]"]})
+        theirs = particles_for_fill(fill, defaults.PAPER_PARTICLES_PER_FULL_CELL)
+        if held != [theirs]:
+            pairs.append(f"{fill:g} %: ours {'/'.join(str(n) for n in held)}, the paper's "
+                         f"{theirs}")
+    if not pairs:
+        return ""
+    # the difference column read as the same bed at the same packing ratio
+    return (f"Table 3's packing ratio counts {defaults.PAPER_PARTICLES_PER_FULL_CELL} spheres "
+            "per cell as 100 % (paper Sect. 5.1), our DEM runs their cell's capacity: particles "
+            f"per cell at {'; '.join(pairs)}; 'difference ours - paper DEM' sets beds of "
+            "different particle counts side by side at one packing ratio")
 
 
 def not_converged_note(dem: DemCase) -> str:
