@@ -238,3 +238,30 @@ def test_a_report_of_an_edited_file_names_the_stored_runs_as_another_file_of_its
                            f"report's runs (the store has 1 of steel_6mm [{steel.hash[:6]}]: "
                            "another file named steel_6mm than the one reported, whose hash "
                            "differs; report with their specimen=FILE to compare them)")
+
+
+def test_a_calibrated_files_baseline_is_said_beside_the_tests_of_the_file_it_was_made_from(
+        steel, store_runs, analyses):
+    # report --specimen x_calibrated.toml: its tests are saved as "x" (with x's sha256), and
+    # the baseline loss factor calibrate fitted into the file went unsaid beside them
+    import dataclasses
+    import json
+
+    from pidcore.specimen import calibrated_name, calibrated_provenance
+
+    calibrated = dataclasses.replace(
+        steel.with_values({"coupon.baseline_loss_factor": 0.0187}),
+        name=calibrated_name(steel.name), provenance=calibrated_provenance(steel))
+    tests = analyses.assign(material="steel", specimen=[steel.name, "other_coupon"],
+                            specimen_sha256=[steel.hash, ""],
+                            parameters_json=[json.dumps({"baseline_loss_factor": 0.0})] * 2)
+    notes = specimen_report_table(store_runs, tests, specimen=calibrated).table.attrs["notes"]
+    (note,) = [n for n in notes if "baseline_loss_factor" in n]
+    # the steel_6mm test only: other_coupon's is another specimen's
+    assert "states [coupon] baseline_loss_factor 0.0187" in note
+    assert "1 measured record(s)" in note
+    # a test of another file of that name (another sha256) is not this file's
+    other_file = tests.assign(specimen_sha256=["f" * 64, ""])
+    notes = specimen_report_table(store_runs, other_file,
+                                  specimen=calibrated).table.attrs["notes"]
+    assert not [n for n in notes if "baseline_loss_factor" in n]
