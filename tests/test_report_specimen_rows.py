@@ -265,3 +265,22 @@ def test_a_calibrated_files_baseline_is_said_beside_the_tests_of_the_file_it_was
     notes = specimen_report_table(store_runs, other_file,
                                   specimen=calibrated).table.attrs["notes"]
     assert not [n for n in notes if "baseline_loss_factor" in n]
+
+
+def test_the_baseline_notes_sidecar_columns_stay_column_names_in_the_cli(steel, store_runs,
+                                                                        analyses):
+    # pidcore report printed "or a sidecar's --baseline-loss-factor and structure_mass_g":
+    # a flag where the sidecar's column name belongs
+    import json
+
+    from pidcore.cli._vocabulary import cli_words
+
+    damped = steel.with_values({"coupon.baseline_loss_factor": 0.002})
+    mine = analyses.assign(material="steel", specimen=["", "other_coupon"],
+                           parameters_json=[json.dumps({"baseline_loss_factor": 0.0})] * 2)
+    notes = specimen_report_table(store_runs, mine, specimen=damped).table.attrs["notes"]
+    (note,) = [cli_words(n, "report") for n in notes if "baseline_loss_factor" in n]
+    structure = damped.coupon.mass_kg + damped.coupon.fixture_mass_kg
+    assert f"with --baseline-loss-factor 0.002 --structure-mass {structure:.4g} " in note
+    assert "sidecar's baseline_loss_factor column and structure_mass_g column" in note
+    assert note.count("--baseline-loss-factor") == 1

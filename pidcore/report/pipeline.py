@@ -488,7 +488,9 @@ def unsubtracted_baseline_note(specimen, analyses: pd.DataFrame | None) -> str:
             f"{eta:g} x its share of the vibrated mass, at most {2 * math.pi * eta:.3g}) and the "
             f"DEM's, of the particles alone, does not; analyse them with baseline_loss_factor="
             f"{eta:g} structure_mass_kg={structure_kg:.4g} (coupon and fixture; or a sidecar's "
-            "baseline_loss_factor and structure_mass_g) to subtract it")
+            # "column" keeps the sidecar's column names as written: the CLI's words turned
+            # the first into the flag --baseline-loss-factor, which no sidecar column is
+            "baseline_loss_factor column and structure_mass_g column) to subtract it")
 
 
 def whole_mass_baseline_note(settings: Iterable[Mapping | None]) -> str:
