@@ -1530,23 +1530,27 @@ def describe(specimen: Specimen) -> dict[str, Any]:
     }
 
 
-#: A fixture this many times the coupon and its particles is named in `specimen check`'s
-#: notes: m_c, and so E of Eq. 10, is then almost all fixture (a 35 g fixture typed as 35 kg
-#: on a 16 g coupon with 91 g of particles is 330 x; the paper's calibrated 0.256 kg fixture is
-#: 3.7 x its 69 g).
+#: A fixture this many times the coupon (its particles left out) is named in `specimen
+#: check`'s notes: m_c, and so E of Eq. 10, is then almost all fixture (a 35 g fixture typed as
+#: 35 kg on a 16 g coupon is 2200 x; the paper's calibrated 0.254 kg fixture is 11 x its 22 g
+#: coupon). The particles are left out because heavy ones hid the slip: a 15 g fixture typed
+#: as 15 kg on a 40 g coupon with 263 g of 2 mm steel spheres is 375 x the coupon but only
+#: 50 x the coupon and its particles, and passed in silence.
 HEAVY_FIXTURE_RATIO = 100.0
 
 
 def _heavy_fixture_note(specimen: Specimen, count: int) -> tuple[str, ...]:
-    """A note for a fixture far heavier than what it carries (a likely g typed as kg); a note,
-    not a refusal: a heavy head expander is possible, but the SDC then measures little."""
-    carried = specimen.coupon.mass_kg + specimen.cell.count * count * specimen.particles.mass_kg
+    """A note for a fixture far heavier than the coupon it carries (a likely g typed as kg); a
+    note, not a refusal: a heavy head expander is possible, but the SDC then measures little."""
+    coupon = specimen.coupon.mass_kg
+    carried = coupon + specimen.cell.count * count * specimen.particles.mass_kg
     fixture = specimen.coupon.fixture_mass_kg
-    if carried <= 0 or fixture <= HEAVY_FIXTURE_RATIO * carried:
+    if coupon <= 0 or fixture <= HEAVY_FIXTURE_RATIO * coupon:
         return ()
-    return (f"[coupon] fixture_mass_kg {fixture:g} kg is {fixture / carried:.0f} x the coupon "
-            f"and its particles ({carried * 1e3:.4g} g): E of Eq. 10 (m_c a^2 / (2 w^2)) is "
-            "then almost all the fixture's and the SDC small; was it g?",)
+    return (f"[coupon] fixture_mass_kg {fixture:g} kg is {fixture / coupon:.0f} x the coupon "
+            f"({coupon * 1e3:.4g} g) and {fixture / carried:.0f} x the coupon and its particles "
+            f"({carried * 1e3:.4g} g): E of Eq. 10 (m_c a^2 / (2 w^2)) is then "
+            f"{fixture / (fixture + carried):.1%} the fixture's and the SDC small; was it g?",)
 
 
 def _column_note(specimen: Specimen, capacity: int) -> tuple[str, ...]:

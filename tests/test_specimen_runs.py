@@ -496,6 +496,30 @@ def test_specimen_check_names_a_fixture_far_heavier_than_the_coupon(capsys, tmp_
     assert not [n for n in describe(load_specimen(STEEL))["notes"] if "fixture_mass_kg" in n]
 
 
+def test_heavy_particles_do_not_hide_a_fixture_typed_in_grams(tmp_path):
+    # 2 mm steel spheres at 60 % fill (263 g) in a 40 g coupon: a 15 g fixture typed as 15 (kg)
+    # is 375 x the coupon but only 50 x the coupon and its particles, and passed in silence
+    heavy = tmp_path / "heavy.toml"
+    heavy.write_text(STEEL.read_text().replace("fixture_mass_kg = 0.015", "fixture_mass_kg = 15")
+                     .replace("mass_kg = 0.0333", "mass_kg = 0.040")
+                     .replace("fill_percent = 50.0", "fill_percent = 60.0"))
+    spec = load_specimen(heavy)
+    facts = describe(spec)
+    carried = spec.coupon.mass_kg + spec.cell.count * facts["particles_per_cell"] * \
+        spec.particles.mass_kg
+    assert 40 < 15 / carried < 100  # under the old rule's threshold: the case that was missed
+    (note,) = [n for n in facts["notes"] if "fixture_mass_kg" in n]
+    assert "is 375 x the coupon (40 g)" in note and "was it g?" in note
+    assert f"{15 / (15 + carried):.1%} the fixture's" in note
+    # the same fixture in grams, and the paper's calibrated 0.254 kg fixture (11 x its 22 g
+    # coupon), are not named
+    grams = load_specimen(heavy).with_values({"coupon.fixture_mass_kg": 0.015})
+    assert not [n for n in describe(grams)["notes"] if "fixture_mass_kg" in n]
+    calibrated = load_specimen(Path(__file__).resolve().parents[1] / "data_samples"
+                               / "paper_calibrated_specimen.toml")
+    assert not [n for n in describe(calibrated)["notes"] if "fixture_mass_kg" in n]
+
+
 def test_a_calibrated_damping_coefficient_is_refused_for_an_own_material_naming_the_option(
         capsys, tmp_path):
     """`--damping-coefficient calibrated` with the steel specimen was refused as "--material:
