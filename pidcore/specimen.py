@@ -895,6 +895,24 @@ def numeric_fields(specimen: Specimen) -> list[str]:
     return out
 
 
+_TABLE_OF_SECTION = {"": "the top level", "cell": "[cell]", "coupon": "[coupon]",
+                     "particles": "[particles]", "pair": "[pairs.particle_particle] and "
+                     "[pairs.particle_wall]", "pairs": "[pairs]", "provenance": "[provenance]"}
+
+
+def _key_of_another_table(key: str, section: str) -> str:
+    """The end of an unknown key's message where the key is another table's: a table header
+    left out puts its keys in the table above it (``[cell]`` missing: "top level shape:
+    unknown key; expected one of ['schema_version', 'name', 'description']", which sent the
+    user to the key they wrote right)."""
+    owners = [_TABLE_OF_SECTION[name] for name, keys in SCHEMA.items()
+              if name != section and key in keys]
+    if not owners:
+        return ""
+    return (f"; {key} belongs in {' and '.join(owners)}: is that table's header missing or "
+            "below it?")
+
+
 def _take(table: Mapping[str, Any], section: str, where: str) -> dict[str, Any]:
     """Check keys (unknown, missing, type) of one table; returns a plain dict."""
     schema = SCHEMA[section]
@@ -903,7 +921,7 @@ def _take(table: Mapping[str, Any], section: str, where: str) -> dict[str, Any]:
     for key in table:
         if key not in schema:
             raise ParameterError(f"{where} {_clip(key)}: unknown key; expected one of "
-                                 f"{list(schema)}")
+                                 f"{list(schema)}{_key_of_another_table(key, section)}")
     out: dict[str, Any] = {}
     for key, (required, kind) in schema.items():
         if key not in table:
