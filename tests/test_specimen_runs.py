@@ -634,3 +634,45 @@ def test_dem_run_numerics_line_says_what_its_wall_time_and_rate_count(tmp_path, 
     # the kernel's time for the driven steps alone (11 acrylic particles, one cell) is within
     # the wall time: the rate is not of the wall time, which holds more
     assert int(steps) * 11 / float(rate) <= float(wall) + 0.05  # 0.05: the wall's 0.1 s print
+
+
+def test_runs_of_an_edited_file_of_the_same_name_are_said_not_reused(tmp_path, monkeypatch,
+                                                                     capsys):
+    # a specimen file edited after its runs were stored (even its description) is another
+    # specimen: dem sweep simulated every case again saying "0 already in STORE", as if the
+    # store held none of that name
+    store = tmp_path / "runs.h5"
+    case = LoadCase(1000.0, 5.0, 25.0, material="steel")
+    steel = load_specimen(STEEL)
+    run_or_load(store, steel, case, TINY)
+    edited_path = tmp_path / "steel_6mm.toml"
+    edited_path.write_text(STEEL.read_text().replace('description = "', 'description = "v2 '))
+    edited = load_specimen(edited_path)
+    assert edited.name == steel.name and edited.hash != steel.hash
+    note = persist.other_files_runs_note(store, [case], TINY, edited)
+    assert note.startswith(f"{store} holds 1 run(s) of these load cases (seed 12345, 1 cells) "
+                           f"by other files named steel_6mm (sha256 {steel.hash[:12]}:")
+    assert f"this file's is sha256 {edited.hash[:12]}" in note
+    # nothing to say: the file's own run, another load case, another cell count, another name
+    assert persist.other_files_runs_note(store, [case], TINY, steel) == ""
+    assert persist.other_files_runs_note(
+        store, [LoadCase(500.0, 5.0, 25.0, material="steel")], TINY, edited) == ""
+    assert persist.other_files_runs_note(
+        store, [case], DemConfig(cells=2, steady_cycles=4), edited) == ""
+    renamed = Specimen.from_text(edited.to_toml().replace('name = "steel_6mm"',
+                                                          'name = "other"'))
+    assert persist.other_files_runs_note(store, [case], TINY, renamed) == ""
+    # the CLI says it before the sweep runs (a Ctrl-C here: exit 130, the store unchanged)
+    from pidcore.dem import sweep as sweep_module
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(sweep_module, "run_sweep", interrupted)
+    before = store.read_bytes()
+    assert main(["dem", "sweep", "--specimen", str(edited_path), "--frequencies", "1000",
+                 "--accelerations", "5", "--fills", "25", "--cells", "1", "--store",
+                 str(store), "--no-progress"]) == 130
+    err = capsys.readouterr().err
+    assert f"pidcore dem sweep: note: {store} holds 1 run(s) of these load cases" in err
+    assert store.read_bytes() == before
