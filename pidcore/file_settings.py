@@ -600,17 +600,21 @@ def resolve_files(paths: Sequence[str | os.PathLike], *, options: AnalysisOption
                                             direction=direction, sidecar=sidecar,
                                             specimen_material=specimen_material,
                                             tables=tables))
-        except FillNotStated:
+            particles = stated[-1].material
+        except FillNotStated as exc:
             if fill_required:
                 raise
             stated.append(None)
+            # a file stating no fill is still a test of --specimen where its particles are
+            # the specimen's: it was saved unnamed, and the output said "no specimen named,
+            # the paper's coupon assumed ... name another with --specimen FILE" beside it
+            particles = exc.material
         _refuse_fill_of_no_particle(path, stated[-1], specimen)
         fs = resolve_file_settings(path, options, given=given, sidecar=sidecar, tables=tables)
         if specimen is not None and fs.specimen == specimen.name != renamed:
             # the sidecar names the file given: its name alone would claim the paper's coupon
             fs = replace(fs, specimen=renamed)
-        if (specimen_name and not fs.specimen and stated[-1] is not None
-                and stated[-1].material == specimen_material):
+        if specimen_name and not fs.specimen and particles == specimen_material:
             fs = replace(fs, specimen=specimen_name,
                          sources={**fs.sources, SPECIMEN_COLUMN: "--specimen"})
         if specimen is not None and fs.specimen == renamed:

@@ -50,7 +50,14 @@ from ..tables import header_key, line_where, read_text_table_file
 class FillNotStated(LoadCaseError):
     """No fill is stated for a measurement file (by name, sidecar or option): the one
     :class:`LoadCaseError` a caller may accept (``pidcore analyze`` saves the analysis without
-    a load case)."""
+    a load case). ``material``: the particle material the file states or takes from the
+    specimen given ("" where neither says one), so that a file of the specimen's particles is
+    still saved as its test."""
+
+    # ``material`` has a default: the CLI re-raises errors from their message alone
+    def __init__(self, message: str, material: str = "") -> None:
+        super().__init__(message)
+        self.material = material
 
 
 class UntabulatedMaterial(LoadCaseError):
@@ -581,7 +588,7 @@ def resolve_load_case(
     take(options, "option")
 
     if "fill_percent" not in values:
-        raise FillNotStated(missing_fill_message(path))
+        raise FillNotStated(missing_fill_message(path), str(values.get("material", "")))
     values.setdefault("material", defaults.COMPARE_DEFAULT_MATERIAL)
     values.setdefault("direction", defaults.COMPARE_DEFAULT_DIRECTION)
     text = "; ".join(f"{name.split('_')[0]}: {origin.get(name, 'default')}"
