@@ -284,3 +284,36 @@ def test_the_baseline_notes_sidecar_columns_stay_column_names_in_the_cli(steel, 
     assert f"with --baseline-loss-factor 0.002 --structure-mass {structure:.4g} " in note
     assert "sidecar's baseline_loss_factor column and structure_mass_g column" in note
     assert note.count("--baseline-loss-factor") == 1
+
+
+def test_a_test_of_the_runs_particle_count_meets_the_run_whatever_fill_it_states(steel):
+    # a specimen stating count_per_cell = 28 (of 46) runs at 60.87 %; its test at 60 % (28
+    # spheres, the same simulation) was "out_of_range" beside that run: outside the 0.5-point
+    # fill tolerance and no second fill for a pchip model
+    from pidcore.compare.align import Aligner
+
+    fill = 100 * 28 / 46
+    runs = pd.DataFrame([{**_run("k28", "steel", 1.889, steel), "frequency_hz": 500.0,
+                          "fill_percent": fill, "particles_per_cell": 28,
+                          "particles_full_cell": 46}])
+    aligner = Aligner.from_tables(runs)
+    for measured, status in ((60.0, "grid"), (59.8, "grid"), (61.9, "grid"),
+                             # 27 and 29 spheres of 46: another bed, not this run's
+                             (58.0, "out_of_range"), (62.0, "out_of_range")):
+        out = aligner.align(LoadCase(500.0, 5.0, measured, material="steel"))
+        assert out.status == status, measured
+        if status == "grid":
+            assert out.sdc_dem == 1.889
+    # another frequency is another case, whatever the count
+    assert aligner.align(LoadCase(1000.0, 5.0, 60.0, material="steel")).status != "grid"
+    tests = pd.DataFrame({
+        "frequency_hz": [500.0], "acceleration_g": [5.0], "fill_percent": [60.0],
+        "material": ["steel"], "direction": ["z"], "sdc": [1.571], "sdc_stderr": [0.01],
+        "source": ["t60.csv"], "specimen": [""]})
+    table = specimen_report_table(runs, tests, specimen=steel).table
+    assert len(table) == 1  # one row: the run and its test
+    row = _measured(table, "t60.csv")
+    assert row[ALIGNMENT_COLUMN] == "grid" and row["SDC DEM (ours) [-]"] == 1.889
+    # (the runs here record no m_c: the note says so after)
+    assert row["note"].startswith("measured at 60 % fill: 28 of 46 particles per cell, as the "
+                                  f"DEM runs at {fill:g} %: the same simulation")
