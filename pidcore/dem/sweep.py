@@ -363,9 +363,19 @@ class SweepSummary:
     notes: list[str] = field(default_factory=list)
 
     def to_dict(self) -> dict:
+        """The JSON document of ``pidcore dem sweep --json``, with ``units`` naming the unit of
+        every number in it (as ``dem run --json`` and ``calibrate --json`` do: a case's
+        ``sdc``, ``loss_factor`` and ``particles_per_cell`` named none)."""
+        from .result import UNITS
+
+        cases = [dict(c) for c in self.cases]
+        # the seed is a name of the packings, not a quantity: no unit, as in dem run --json
+        units = {**UNITS, "wall_s": "s", "stored_fill_percent": "%"}
+        named = {name for case in cases for name in case} | {"wall_s"}
         return {"completed": len(self.completed), "skipped": len(self.skipped),
-                "wall_s": self.wall_s, "store": self.store_path,
-                "cases": [dict(c) for c in self.cases], "notes": list(self.notes)}
+                "wall_s": self.wall_s, "store": self.store_path, "cases": cases,
+                "notes": list(self.notes),
+                "units": {name: units[name] for name in sorted(named) if name in units}}
 
     def fill_results(self, store) -> None:
         """Read each case's results from ``store`` (the runs as stored)."""
