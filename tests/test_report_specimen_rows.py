@@ -304,6 +304,13 @@ def test_a_test_of_the_runs_particle_count_meets_the_run_whatever_fill_it_states
         assert out.status == status, measured
         if status == "grid":
             assert out.sdc_dem == 1.889
+    # a nearer fill of another count (59.7 % of 46: 27 spheres) is another bed: the 28's run
+    # is met first
+    beside = pd.concat([runs, pd.DataFrame([{**runs.iloc[0].to_dict(), "case_key": "k27",
+                                             "fill_percent": 59.7, "particles_per_cell": 27,
+                                             "sdc": 1.7}])], ignore_index=True)
+    out = Aligner.from_tables(beside).align(LoadCase(500.0, 5.0, 60.0, material="steel"))
+    assert out.status == "grid" and out.sdc_dem == 1.889
     # another frequency is another case, whatever the count
     assert aligner.align(LoadCase(1000.0, 5.0, 60.0, material="steel")).status != "grid"
     tests = pd.DataFrame({

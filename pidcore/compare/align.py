@@ -925,13 +925,18 @@ class Aligner:
         """Our DEM case nearest to ``case`` within the tolerances, or None.
 
         Of several numerical settings at one load case the one with the most cells simulated
-        is preferred (then the most runs): the least noisy estimate.
+        is preferred (then the most runs): the least noisy estimate. A case whose particles
+        per cell are those ``case``'s fill rounds to comes first: within the fill tolerance
+        a nearer fill of another count (59.7 % of 46 is 27 spheres, 60 % is 28) is another
+        bed.
         """
-        hits = [c for c in self.cases if self.tolerances.matches(case, c.load_case)
-                or _same_particle_count(case, c, self.tolerances)]
+        counted = {id(c) for c in self.cases if _same_particle_count(case, c, self.tolerances)}
+        hits = [c for c in self.cases
+                if id(c) in counted or self.tolerances.matches(case, c.load_case)]
         if not hits:
             return None
-        return min(hits, key=lambda c: (self.tolerances.distance(case, c.load_case),
+        return min(hits, key=lambda c: (id(c) not in counted,
+                                        self.tolerances.distance(case, c.load_case),
                                         *_preference(c)))
 
     def align(self, case: LoadCase) -> AlignedCase:
