@@ -503,7 +503,10 @@ def missing_fill_message(path: str | Path) -> str:
     return (f"{display_path(Path(path).name)}: no fill (packing ratio, %) stated; state it "
             "(1) in the file name, "
             f"e.g. '..._fill50_...' or '..._50pct_...', (2) in a sidecar table {SIDECAR_NAME} "
-            f"beside the file or given with sidecar=PATH (columns {', '.join(SIDECAR_COLUMNS)}), "
+            # quoted: the CLI's words read a bare fill_percent as the flag --fill, and the
+            # message named a sidecar column "--fill"
+            f"beside the file or given with sidecar=PATH (columns "
+            f"{', '.join(repr(c) for c in SIDECAR_COLUMNS)}), "
             "or (3) with fill_percent")
 
 
