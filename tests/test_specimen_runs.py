@@ -662,8 +662,15 @@ def test_runs_of_an_edited_file_of_the_same_name_are_said_not_reused(tmp_path, m
     renamed = Specimen.from_text(edited.to_toml().replace('name = "steel_6mm"',
                                                           'name = "other"'))
     assert persist.other_files_runs_note(store, [case], TINY, renamed) == ""
-    # the CLI says it before the sweep runs (a Ctrl-C here: exit 130, the store unchanged)
+    # a library sweep says it in its notes (the --json document's)
     from pidcore.dem import sweep as sweep_module
+
+    other_store = tmp_path / "copy.h5"
+    other_store.write_bytes(store.read_bytes())
+    summary = sweep_module.run_sweep([case], TINY, store_path=other_store, workers=1,
+                                     progress=False, specimen=edited)
+    assert summary.completed and note.replace(str(store), str(other_store)) in summary.notes
+    # the CLI says it before the sweep runs (a Ctrl-C here: exit 130, the store unchanged)
 
     def interrupted(*args, **kwargs):
         raise KeyboardInterrupt

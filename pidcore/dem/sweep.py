@@ -27,6 +27,7 @@ from ..records import json_safe
 from ..specimen import Specimen, fill_override_note
 from .persist import (
     dem_run_entry,
+    other_files_runs_note,
     own_run_keys,
     run_identity,
     run_key,
@@ -471,6 +472,12 @@ def run_sweep(cases: Sequence[LoadCase], config: DemConfig, *,
             planned[identity] = key
             todo.append((case, key))
             summary.cases.append({**record, "store_key": key, "status": "simulated"})
+    # an edited specimen file (another hash, the same name) reuses none of its stored runs:
+    # said, as `dem sweep` says it before the run, to a library caller and in --json
+    other_files = other_files_runs_note(store_path, [case for case, _ in todo], config,
+                                        specimen)
+    if other_files:
+        summary.notes.append(other_files)
     bar = None
     if todo:
         store.check_writable()  # before the simulations, not at the first commit
