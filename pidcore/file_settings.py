@@ -504,14 +504,18 @@ def resolve_files(paths: Sequence[str | os.PathLike], *, options: AnalysisOption
                                             direction=direction, sidecar=sidecar,
                                             specimen_material=specimen_material,
                                             tables=tables))
-        except FillNotStated:
+            particles = stated[-1].material
+        except FillNotStated as exc:
             if fill_required:
                 raise
             stated.append(None)
+            # a file stating no fill is still a test of --specimen where its particles are
+            # the specimen's: it was saved unnamed, and the output said "no specimen named,
+            # the paper's coupon assumed ... name another with --specimen FILE" beside it
+            particles = exc.material
         _refuse_fill_of_no_particle(path, stated[-1], specimen)
         fs = resolve_file_settings(path, options, given=given, sidecar=sidecar, tables=tables)
-        if (specimen_name and not fs.specimen and stated[-1] is not None
-                and stated[-1].material == specimen_material):
+        if specimen_name and not fs.specimen and particles == specimen_material:
             fs = replace(fs, specimen=specimen_name,
                          sources={**fs.sources, SPECIMEN_COLUMN: "--specimen"})
         # the file given is saved by the name its tests are compared under (the bare name of

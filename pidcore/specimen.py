@@ -882,6 +882,24 @@ def numeric_fields(specimen: Specimen) -> list[str]:
     return out
 
 
+_TABLE_OF_SECTION = {"": "the top level", "cell": "[cell]", "coupon": "[coupon]",
+                     "particles": "[particles]", "pair": "[pairs.particle_particle] and "
+                     "[pairs.particle_wall]", "pairs": "[pairs]", "provenance": "[provenance]"}
+
+
+def _key_of_another_table(key: str, section: str) -> str:
+    """The end of an unknown key's message where the key is another table's: a table header
+    left out puts its keys in the table above it (``[cell]`` missing: "top level shape:
+    unknown key; expected one of ['schema_version', 'name', 'description']", which sent the
+    user to the key they wrote right)."""
+    owners = [_TABLE_OF_SECTION[name] for name, keys in SCHEMA.items()
+              if name != section and key in keys]
+    if not owners:
+        return ""
+    return (f"; {key} belongs in {' and '.join(owners)}: is that table's header missing or "
+            "below it?")
+
+
 def _take(table: Mapping[str, Any], section: str, where: str) -> dict[str, Any]:
     """Check keys (unknown, missing, type) of one table; returns a plain dict."""
     schema = SCHEMA[section]
@@ -890,7 +908,7 @@ def _take(table: Mapping[str, Any], section: str, where: str) -> dict[str, Any]:
     for key in table:
         if key not in schema:
             raise ParameterError(f"{where} {clipped(key)}: unknown key; expected one of "
-                                 f"{list(schema)}")
+                                 f"{list(schema)}{_key_of_another_table(key, section)}")
     out: dict[str, Any] = {}
     for key, (required, kind) in schema.items():
         if key not in table:
@@ -1527,23 +1545,27 @@ def describe(specimen: Specimen) -> dict[str, Any]:
     }
 
 
-#: A fixture this many times the coupon and its particles is named in `specimen check`'s
-#: notes: m_c, and so E of Eq. 10, is then almost all fixture (a 35 g fixture typed as 35 kg
-#: on a 16 g coupon with 91 g of particles is 330 x; the paper's calibrated 0.256 kg fixture is
-#: 3.7 x its 69 g).
+#: A fixture this many times the coupon (its particles left out) is named in `specimen
+#: check`'s notes: m_c, and so E of Eq. 10, is then almost all fixture (a 35 g fixture typed as
+#: 35 kg on a 16 g coupon is 2200 x; the paper's calibrated 0.254 kg fixture is 11 x its 22 g
+#: coupon). The particles are left out because heavy ones hid the slip: a 15 g fixture typed
+#: as 15 kg on a 40 g coupon with 263 g of 2 mm steel spheres is 375 x the coupon but only
+#: 50 x the coupon and its particles, and passed in silence.
 HEAVY_FIXTURE_RATIO = 100.0
 
 
 def _heavy_fixture_note(specimen: Specimen, count: int) -> tuple[str, ...]:
-    """A note for a fixture far heavier than what it carries (a likely g typed as kg); a note,
-    not a refusal: a heavy head expander is possible, but the SDC then measures little."""
-    carried = specimen.coupon.mass_kg + specimen.cell.count * count * specimen.particles.mass_kg
+    """A note for a fixture far heavier than the coupon it carries (a likely g typed as kg); a
+    note, not a refusal: a heavy head expander is possible, but the SDC then measures little."""
+    coupon = specimen.coupon.mass_kg
+    carried = coupon + specimen.cell.count * count * specimen.particles.mass_kg
     fixture = specimen.coupon.fixture_mass_kg
-    if carried <= 0 or fixture <= HEAVY_FIXTURE_RATIO * carried:
+    if coupon <= 0 or fixture <= HEAVY_FIXTURE_RATIO * coupon:
         return ()
-    return (f"[coupon] fixture_mass_kg {fixture:g} kg is {fixture / carried:.0f} x the coupon "
-            f"and its particles ({carried * 1e3:.4g} g): E of Eq. 10 (m_c a^2 / (2 w^2)) is "
-            "then almost all the fixture's and the SDC small; was it g?",)
+    return (f"[coupon] fixture_mass_kg {fixture:g} kg is {fixture / coupon:.0f} x the coupon "
+            f"({coupon * 1e3:.4g} g) and {fixture / carried:.0f} x the coupon and its particles "
+            f"({carried * 1e3:.4g} g): E of Eq. 10 (m_c a^2 / (2 w^2)) is then "
+            f"{fixture / (fixture + carried):.1%} the fixture's and the SDC small; was it g?",)
 
 
 def _column_note(specimen: Specimen, capacity: int) -> tuple[str, ...]:

@@ -742,6 +742,40 @@ def test_a_record_saved_as_implausible_is_left_out_of_a_store_calibration(tmp_pa
                                                          "implausible")
 
 
+def test_a_store_of_implausible_records_only_says_so_not_that_no_load_case_is_complete(
+        tmp_path, capsys):
+    # calibrate --store on a store whose only test was kept with --accept-implausible said
+    # "no analysed measurement has a complete load case", though its load case was complete
+    from _shaker_files import write_force_velocity
+
+    from pidcore.calibrate import measured_from_store
+    from pidcore.constants import STANDARD_GRAVITY
+    from pidcore.errors import InputFileError
+    from pidcore.signal.synthetic import synthesize_shaker_record
+
+    only_bad = tmp_path / "bad.h5"
+
+    rec = synthesize_shaker_record(mass_kg=0.25, acceleration_amplitude_m_s2=5 * STANDARD_GRAVITY,
+                                   frequency_hz=500.0, sample_rate_hz=25_600.0, n_periods=40,
+                                   viscous_damping_n_s_m=-2.0, snr_db=60, seed=3)
+    path = write_force_velocity(tmp_path / "neg_fill50_acrylic.csv", rec.force_n,
+                                rec.velocity_m_s, 25_600.0, "csv")
+    assert main(["analyze", str(path), "--store", str(only_bad), "--accept-implausible"]) == 0
+    capsys.readouterr()
+    with pytest.raises(InputFileError) as info:
+        measured_from_store(only_bad)
+    message = str(info.value)
+    assert message.startswith(f"{only_bad}: no analysed measurement to calibrate against: 1 "
+                              "record(s) with a complete load case, all implausible and saved "
+                              "as accepted (first: negative loss factor")
+    assert "complete load case" in message and "\n" not in message
+    before = only_bad.read_bytes()
+    assert main(["calibrate", "--store", str(only_bad), "--dem-store", str(only_bad),
+                 *TINY]) == 2
+    assert "all implausible and saved as accepted" in capsys.readouterr().err
+    assert only_bad.read_bytes() == before
+
+
 def test_a_record_left_out_of_a_store_calibration_is_named_in_its_outputs(tmp_path, capsys,
                                                                         monkeypatch):
     # calibrate --store said on stderr that a record saved as implausible was left out, but

@@ -395,6 +395,30 @@ def test_files_of_a_specimens_particles_are_saved_as_its_tests(tmp_path, capsys)
     assert doc["records"][0]["specimen"] == "rig_c"
 
 
+def test_a_file_stating_no_fill_is_saved_as_a_test_of_the_specimen_given(tmp_path, capsys):
+    # `analyze run7.csv --specimen panel.toml` (no fill in the name): saved unnamed, and the
+    # output said "no specimen named, the paper's coupon assumed ... name another with
+    # --specimen FILE" beside the --specimen given
+    from pidcore.specimen import load_specimen
+
+    spec = tmp_path / "panel.toml"
+    spec.write_text(STEEL_SPECIMEN)
+    store = tmp_path / "s.h5"
+    bare = export(tmp_path / "run7.csv", fmt="csv")
+    acrylic = export(tmp_path / "run8_acrylic.uff", fmt="uff")  # no fill, other particles
+    doc = run_json([str(bare), str(acrylic), "--specimen", str(spec), "--store", str(store)],
+                   capsys)
+    mine, other = doc["records"]
+    assert mine["load_case"] is None and mine["specimen"] == "my_steel"
+    assert mine["specimen_sha256"] == load_specimen(spec).hash and mine["assumed"] == {}
+    assert not [n for n in mine["notes"] if "paper's coupon" in n]
+    # a file stating other particles is not the specimen's test: the coupon is assumed, said
+    assert other["specimen"] is None and other["assumed"] == {"specimen": "paper_coupon"}
+    saved = Store(store).list_analyses().set_index("source")
+    assert saved.loc[str(bare), "specimen"] == "my_steel"
+    assert saved.loc[str(bare), "specimen_sha256"] == load_specimen(spec).hash
+
+
 def test_a_file_of_other_particles_than_the_specimens_names_the_specimens(tmp_path, capsys):
     # `analyze coupon_fill20_steel.csv --specimen wc.toml` (tungsten carbide) said the table
     # lacks steel and to "give --specimen FILE whose particles are steel", as if none was given

@@ -193,6 +193,29 @@ def test_ctrl_c_in_a_sweep_counts_the_cases_stored(tmp_path, monkeypatch, capsys
     assert "nothing saved" in err and "are saved" not in err
 
 
+def test_sweep_json_names_the_unit_of_every_number(tmp_path, capsys):
+    # dem run --json and calibrate --json carry a units map; a sweep's document named none,
+    # so its sdc, loss_factor and particles_per_cell were numbers without a unit
+    assert main(["dem", "sweep", "--frequencies", "500", "--accelerations", "5",
+                 "--fills", "50", "--cells", "1", "--cycles", "2", "--workers", "1",
+                 "--store", str(tmp_path / "s.h5"), "--no-progress", "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    (case,) = doc["cases"]
+    numbers = {k for k, v in case.items() if isinstance(v, int | float)
+               and not isinstance(v, bool)} - {"seed"}  # a name of the packings
+    assert numbers >= {"sdc", "loss_factor", "particles_per_cell", "frequency_hz",
+                       "acceleration_g", "fill_percent"}
+    assert numbers | {"wall_s"} <= set(doc["units"])
+    assert doc["units"]["sdc_stderr"] == "-"  # named though one cell gives none (null)
+    assert {k: doc["units"][k] for k in ("sdc", "loss_factor", "frequency_hz",
+                                         "acceleration_g", "fill_percent",
+                                         "stored_fill_percent", "particles_per_cell",
+                                         "wall_s")} == {
+        "sdc": "-", "loss_factor": "-", "frequency_hz": "Hz", "acceleration_g": "g",
+        "fill_percent": "%", "stored_fill_percent": "%", "particles_per_cell": "1",
+        "wall_s": "s"}
+
+
 def test_sweep_runs_the_values_given_in_place_of_the_grids(tmp_path, capsys):
     from pidcore.loadcase import parse_key
     from pidcore.store import Store

@@ -444,3 +444,25 @@ def test_every_flag_a_command_names_for_a_keyword_is_one_of_its_own():
              for flag in re.findall(r"--[a-z][a-z0-9-]*", said)
              if flag not in own[tuple(command.split())]]
     assert not wrong, wrong
+
+
+def test_a_missing_fill_names_the_sidecar_column_as_a_column_in_the_cli(tmp_path, capsys):
+    # pidcore report on a file stating no fill said to state it in a sidecar "(columns file,
+    # --fill, material, direction)": the column fill_percent printed as the flag
+    from _shaker_files import write_force_velocity
+
+    from pidcore.cli import main
+    from pidcore.constants import STANDARD_GRAVITY
+    from pidcore.signal.synthetic import synthesize_shaker_record
+
+    rec = synthesize_shaker_record(mass_kg=0.25, acceleration_amplitude_m_s2=5 * STANDARD_GRAVITY,
+                                   frequency_hz=500.0, sample_rate_hz=25_600.0, n_periods=40,
+                                   viscous_damping_n_s_m=2.0, snr_db=60, seed=3)
+    path = write_force_velocity(tmp_path / "run7.csv", rec.force_n, rec.velocity_m_s,
+                                25_600.0, "csv")
+    assert main(["report", str(path), "--out", str(tmp_path / "rep"), "--no-progress"]) == 2
+    err = capsys.readouterr().err
+    assert "(columns 'file', 'fill_percent', 'material', 'direction'), or (3) with --fill" \
+        in err
+    assert "--sidecar PATH" in err and err.count("--fill") == 1
+    assert not (tmp_path / "rep").exists()

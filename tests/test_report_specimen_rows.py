@@ -238,3 +238,89 @@ def test_a_report_of_an_edited_file_names_the_stored_runs_as_another_file_of_its
                            f"report's runs (the store has 1 of steel_6mm [{steel.hash[:6]}]: "
                            "another file named steel_6mm than the one reported, whose hash "
                            "differs; report with their specimen=FILE to compare them)")
+
+
+def test_a_calibrated_files_baseline_is_said_beside_the_tests_of_the_file_it_was_made_from(
+        steel, store_runs, analyses):
+    # report --specimen x_calibrated.toml: its tests are saved as "x" (with x's sha256), and
+    # the baseline loss factor calibrate fitted into the file went unsaid beside them
+    import dataclasses
+    import json
+
+    from pidcore.specimen import calibrated_name, calibrated_provenance
+
+    calibrated = dataclasses.replace(
+        steel.with_values({"coupon.baseline_loss_factor": 0.0187}),
+        name=calibrated_name(steel.name), provenance=calibrated_provenance(steel))
+    tests = analyses.assign(material="steel", specimen=[steel.name, "other_coupon"],
+                            specimen_sha256=[steel.hash, ""],
+                            parameters_json=[json.dumps({"baseline_loss_factor": 0.0})] * 2)
+    notes = specimen_report_table(store_runs, tests, specimen=calibrated).table.attrs["notes"]
+    (note,) = [n for n in notes if "baseline_loss_factor" in n]
+    # the steel_6mm test only: other_coupon's is another specimen's
+    assert "states [coupon] baseline_loss_factor 0.0187" in note
+    assert "1 measured record(s)" in note
+    # a test of another file of that name (another sha256) is not this file's
+    other_file = tests.assign(specimen_sha256=["f" * 64, ""])
+    notes = specimen_report_table(store_runs, other_file,
+                                  specimen=calibrated).table.attrs["notes"]
+    assert not [n for n in notes if "baseline_loss_factor" in n]
+
+
+def test_the_baseline_notes_sidecar_columns_stay_column_names_in_the_cli(steel, store_runs,
+                                                                        analyses):
+    # pidcore report printed "or a sidecar's --baseline-loss-factor and structure_mass_g":
+    # a flag where the sidecar's column name belongs
+    import json
+
+    from pidcore.cli._vocabulary import cli_words
+
+    damped = steel.with_values({"coupon.baseline_loss_factor": 0.002})
+    mine = analyses.assign(material="steel", specimen=["", "other_coupon"],
+                           parameters_json=[json.dumps({"baseline_loss_factor": 0.0})] * 2)
+    notes = specimen_report_table(store_runs, mine, specimen=damped).table.attrs["notes"]
+    (note,) = [cli_words(n, "report") for n in notes if "baseline_loss_factor" in n]
+    structure = damped.coupon.mass_kg + damped.coupon.fixture_mass_kg
+    assert f"with --baseline-loss-factor 0.002 --structure-mass {structure:.4g} " in note
+    assert "sidecar's baseline_loss_factor column and structure_mass_g column" in note
+    assert note.count("--baseline-loss-factor") == 1
+
+
+def test_a_test_of_the_runs_particle_count_meets_the_run_whatever_fill_it_states(steel):
+    # a specimen stating count_per_cell = 28 (of 46) runs at 60.87 %; its test at 60 % (28
+    # spheres, the same simulation) was "out_of_range" beside that run: outside the 0.5-point
+    # fill tolerance and no second fill for a pchip model
+    from pidcore.compare.align import Aligner
+
+    fill = 100 * 28 / 46
+    runs = pd.DataFrame([{**_run("k28", "steel", 1.889, steel), "frequency_hz": 500.0,
+                          "fill_percent": fill, "particles_per_cell": 28,
+                          "particles_full_cell": 46}])
+    aligner = Aligner.from_tables(runs)
+    for measured, status in ((60.0, "grid"), (59.8, "grid"), (61.9, "grid"),
+                             # 27 and 29 spheres of 46: another bed, not this run's
+                             (58.0, "out_of_range"), (62.0, "out_of_range")):
+        out = aligner.align(LoadCase(500.0, 5.0, measured, material="steel"))
+        assert out.status == status, measured
+        if status == "grid":
+            assert out.sdc_dem == 1.889
+    # a nearer fill of another count (59.7 % of 46: 27 spheres) is another bed: the 28's run
+    # is met first
+    beside = pd.concat([runs, pd.DataFrame([{**runs.iloc[0].to_dict(), "case_key": "k27",
+                                             "fill_percent": 59.7, "particles_per_cell": 27,
+                                             "sdc": 1.7}])], ignore_index=True)
+    out = Aligner.from_tables(beside).align(LoadCase(500.0, 5.0, 60.0, material="steel"))
+    assert out.status == "grid" and out.sdc_dem == 1.889
+    # another frequency is another case, whatever the count
+    assert aligner.align(LoadCase(1000.0, 5.0, 60.0, material="steel")).status != "grid"
+    tests = pd.DataFrame({
+        "frequency_hz": [500.0], "acceleration_g": [5.0], "fill_percent": [60.0],
+        "material": ["steel"], "direction": ["z"], "sdc": [1.571], "sdc_stderr": [0.01],
+        "source": ["t60.csv"], "specimen": [""]})
+    table = specimen_report_table(runs, tests, specimen=steel).table
+    assert len(table) == 1  # one row: the run and its test
+    row = _measured(table, "t60.csv")
+    assert row[ALIGNMENT_COLUMN] == "grid" and row["SDC DEM (ours) [-]"] == 1.889
+    # (the runs here record no m_c: the note says so after)
+    assert row["note"].startswith("measured at 60 % fill: 28 of 46 particles per cell, as the "
+                                  f"DEM runs at {fill:g} %: the same simulation")

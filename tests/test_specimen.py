@@ -122,3 +122,29 @@ def test_a_specimen_file_nested_past_the_stack_is_one_line(tmp_path, capsys):
     err = capsys.readouterr().err.strip()
     assert code == 2 and len(err.splitlines()) == 1 and str(deep) in err, err
     assert "nested too deeply" in err
+
+
+@pytest.mark.parametrize(("old", "new", "message"), [
+    # [cell] header left out: its keys are the top level's, and the error named `shape` (typed
+    # right) as unknown, listing only name, description and schema_version
+    ("[cell]\n", "", r"top level shape: unknown key; expected one of \['schema_version', "
+                     r"'name', 'description'\]; shape belongs in \[cell\]: is that table's "
+                     r"header missing or below it\?$"),
+    # a coupon key typed under [particles] (header of [coupon] below it)
+    ("poisson_ratio = 0.402", "poisson_ratio = 0.402\nfixture_mass_kg = 0.01",
+     r"\[particles\] fixture_mass_kg: unknown key; .*; fixture_mass_kg belongs in \[coupon\]"),
+    # a contact value in [pairs] itself belongs in both pair tables
+    ("[pairs.particle_particle]", "[pairs]\nrestitution = 0.5\n[pairs.particle_particle]",
+     r"\[pairs\] restitution: unknown key; .*; restitution belongs in "
+     r"\[pairs.particle_particle\] and \[pairs.particle_wall\]"),
+])
+def test_a_key_of_another_table_names_the_table_it_belongs_in(tmp_path, old, new, message):
+    path = tmp_path / "bad.toml"
+    path.write_text(_edit(PAPER.to_toml(), old, new))
+    with pytest.raises(ParameterError, match=message) as info:
+        load_specimen(path)
+    assert "\n" not in str(info.value)
+    # a key of no table keeps the message it had
+    path.write_text(_edit(PAPER.to_toml(), "count = 441", "count = 441\ncolour = 3"))
+    with pytest.raises(ParameterError, match=r"colour: unknown key; expected one of \[[^]]*\]$"):
+        load_specimen(path)

@@ -496,6 +496,30 @@ def test_specimen_check_names_a_fixture_far_heavier_than_the_coupon(capsys, tmp_
     assert not [n for n in describe(load_specimen(STEEL))["notes"] if "fixture_mass_kg" in n]
 
 
+def test_heavy_particles_do_not_hide_a_fixture_typed_in_grams(tmp_path):
+    # 2 mm steel spheres at 60 % fill (263 g) in a 40 g coupon: a 15 g fixture typed as 15 (kg)
+    # is 375 x the coupon but only 50 x the coupon and its particles, and passed in silence
+    heavy = tmp_path / "heavy.toml"
+    heavy.write_text(STEEL.read_text().replace("fixture_mass_kg = 0.015", "fixture_mass_kg = 15")
+                     .replace("mass_kg = 0.0333", "mass_kg = 0.040")
+                     .replace("fill_percent = 50.0", "fill_percent = 60.0"))
+    spec = load_specimen(heavy)
+    facts = describe(spec)
+    carried = spec.coupon.mass_kg + spec.cell.count * facts["particles_per_cell"] * \
+        spec.particles.mass_kg
+    assert 40 < 15 / carried < 100  # under the old rule's threshold: the case that was missed
+    (note,) = [n for n in facts["notes"] if "fixture_mass_kg" in n]
+    assert "is 375 x the coupon (40 g)" in note and "was it g?" in note
+    assert f"{15 / (15 + carried):.1%} the fixture's" in note
+    # the same fixture in grams, and the paper's calibrated 0.254 kg fixture (11 x its 22 g
+    # coupon), are not named
+    grams = load_specimen(heavy).with_values({"coupon.fixture_mass_kg": 0.015})
+    assert not [n for n in describe(grams)["notes"] if "fixture_mass_kg" in n]
+    calibrated = load_specimen(Path(__file__).resolve().parents[1] / "data_samples"
+                               / "paper_calibrated_specimen.toml")
+    assert not [n for n in describe(calibrated)["notes"] if "fixture_mass_kg" in n]
+
+
 def test_a_calibrated_damping_coefficient_is_refused_for_an_own_material_naming_the_option(
         capsys, tmp_path):
     """`--damping-coefficient calibrated` with the steel specimen was refused as "--material:
@@ -610,3 +634,52 @@ def test_dem_run_numerics_line_says_what_its_wall_time_and_rate_count(tmp_path, 
     # the kernel's time for the driven steps alone (11 acrylic particles, one cell) is within
     # the wall time: the rate is not of the wall time, which holds more
     assert int(steps) * 11 / float(rate) <= float(wall) + 0.05  # 0.05: the wall's 0.1 s print
+
+
+def test_runs_of_an_edited_file_of_the_same_name_are_said_not_reused(tmp_path, monkeypatch,
+                                                                     capsys):
+    # a specimen file edited after its runs were stored (even its description) is another
+    # specimen: dem sweep simulated every case again saying "0 already in STORE", as if the
+    # store held none of that name
+    store = tmp_path / "runs.h5"
+    case = LoadCase(1000.0, 5.0, 25.0, material="steel")
+    steel = load_specimen(STEEL)
+    run_or_load(store, steel, case, TINY)
+    edited_path = tmp_path / "steel_6mm.toml"
+    edited_path.write_text(STEEL.read_text().replace('description = "', 'description = "v2 '))
+    edited = load_specimen(edited_path)
+    assert edited.name == steel.name and edited.hash != steel.hash
+    note = persist.other_files_runs_note(store, [case], TINY, edited)
+    assert note.startswith(f"{store} holds 1 run(s) of these load cases (seed 12345, 1 cells) "
+                           f"by other files named steel_6mm (sha256 {steel.hash[:12]}:")
+    assert f"this file's is sha256 {edited.hash[:12]}" in note
+    # nothing to say: the file's own run, another load case, another cell count, another name
+    assert persist.other_files_runs_note(store, [case], TINY, steel) == ""
+    assert persist.other_files_runs_note(
+        store, [LoadCase(500.0, 5.0, 25.0, material="steel")], TINY, edited) == ""
+    assert persist.other_files_runs_note(
+        store, [case], DemConfig(cells=2, steady_cycles=4), edited) == ""
+    renamed = Specimen.from_text(edited.to_toml().replace('name = "steel_6mm"',
+                                                          'name = "other"'))
+    assert persist.other_files_runs_note(store, [case], TINY, renamed) == ""
+    # a library sweep says it in its notes (the --json document's)
+    from pidcore.dem import sweep as sweep_module
+
+    other_store = tmp_path / "copy.h5"
+    other_store.write_bytes(store.read_bytes())
+    summary = sweep_module.run_sweep([case], TINY, store_path=other_store, workers=1,
+                                     progress=False, specimen=edited)
+    assert summary.completed and note.replace(str(store), str(other_store)) in summary.notes
+    # the CLI says it before the sweep runs (a Ctrl-C here: exit 130, the store unchanged)
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(sweep_module, "run_sweep", interrupted)
+    before = store.read_bytes()
+    assert main(["dem", "sweep", "--specimen", str(edited_path), "--frequencies", "1000",
+                 "--accelerations", "5", "--fills", "25", "--cells", "1", "--store",
+                 str(store), "--no-progress"]) == 130
+    err = capsys.readouterr().err
+    assert f"pidcore dem sweep: note: {store} holds 1 run(s) of these load cases" in err
+    assert store.read_bytes() == before

@@ -247,6 +247,14 @@ def measured_from_store(store_path: str | os.PathLike, *,
                                     str(material), str(specimen), sdc_stderr_dof=dof,
                                     source=str(store_path), specimen_sha256=str(sha256)))
     if not points:
+        dropped = [found[0].message for found in implausible if found]
+        if dropped:
+            # they have a complete load case: "no analysed measurement has a complete load
+            # case" sent the user to fills and sidecars, not to the records left out
+            raise InputFileError(
+                f"{store_path}: no analysed measurement to calibrate against: "
+                f"{len(dropped)} record(s) with a complete load case, all implausible and "
+                f"saved as accepted (first: {dropped[0]}); a fit takes none of them")
         raise InputFileError(f"{store_path}: no analysed measurement has a complete load case")
     return points
 

@@ -244,6 +244,13 @@ def sweep(args: argparse.Namespace) -> int:
     # could miss one that committed as the interrupt came.
     keys = [run_key(case, config, specimen) for case in cases]
     before = stored_keys(args.store, keys)
+    from ..dem.persist import other_files_runs_note
+
+    other_files = other_files_runs_note(
+        args.store, [c for c, k in zip(cases, keys, strict=True) if k not in before], config,
+        specimen)
+    if other_files:  # before the run, as the fill's note: an edited file runs every case
+        print(f"pidcore dem sweep: note: {other_files}", file=sys.stderr)
     try:
         summary = run_sweep(cases, config, store_path=args.store, workers=args.workers,
                             scheduler=args.scheduler, progress=progress_wanted(args),
@@ -346,11 +353,15 @@ def run(args: argparse.Namespace) -> int:
             store = Store(args.store)
             cached = persist.cached_run(store, specimen, case, config, progress=progress)
             result, key, reused = cached.result, cached.key, cached.reused
+            other_files = "" if reused else \
+                persist.other_files_runs_note(args.store, [case], config, specimen)
         else:
             result = simulate_load_case(case, config, progress=progress, specimen=specimen)
+            other_files = ""
         # inside: a Ctrl-C as the result is printed said "no store write was left
         # half-done" instead of whether the run was saved
-        _print_run(args, result, case, specimen, key=key, reused=reused)
+        _print_run(args, result, case, specimen, key=key, reused=reused,
+                   other_files=other_files)
         interrupt.raise_if_interrupted()
     except KeyboardInterrupt:
         # the run is saved in one transaction at its end: committed now, or not at all
@@ -361,11 +372,11 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _print_run(args: argparse.Namespace, result, case, specimen, *, key: str | None,
-               reused: bool) -> None:
+               reused: bool, other_files: str = "") -> None:
     """One run's summary and notes, or its JSON document, and where it is stored."""
     notes = list(result.notes)
     said = [note for note in (_same_simulation_note(case, result) if reused else "",
-                              _baseline_note(specimen, result)) if note]
+                              _baseline_note(specimen, result), other_files) if note]
     notes += said
     if args.json:
         out = {k: result.to_dict()[k] for k in JSON_KEYS}

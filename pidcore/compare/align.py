@@ -141,6 +141,10 @@ class DemCase:
         Degrees of freedom of ``sdc_stderr`` (:func:`pooled_stderr_dof`): a run's own, as
         stored (``sdc_stderr_dof``: batches - 1 for a run whose cells ran one motion), else
         the scatter of its cells' SDCs, cells - 1; NaN where neither is known.
+    particles_full_cell : float
+        The particle count the runs took as 100 % fill (their cell's capacity, or the paper's
+        36), NaN if unknown or differing: a measured fill that rounds to the case's
+        ``particles_per_cell`` of it is the same simulation (:meth:`Aligner.grid_case`).
     """
 
     load_case: LoadCase
@@ -156,6 +160,7 @@ class DemCase:
     duplicate_keys: tuple[str, ...] = ()
     duplicate_fills: tuple[float, ...] = ()
     sdc_stderr_dof: float = math.nan
+    particles_full_cell: float = math.nan
 
 
 def duplicates_note(dem: DemCase) -> str:
@@ -576,11 +581,15 @@ def dem_cases(dem_runs: pd.DataFrame, *, tolerances: Tolerances | None = None,
         stderr_dof = pooled_stderr_dof(sub["sdc"].to_numpy(float),
                                        sub["sdc_stderr"].to_numpy(float),
                                        _run_stderr_dofs(sub, cells))
-        ppc = math.nan
+        ppc = full = math.nan
         if "particles_per_cell" in sub:
             unique = pd.unique(sub["particles_per_cell"].astype(float))
             if unique.size == 1:
                 ppc = float(unique[0])
+        if "particles_full_cell" in sub:
+            unique = pd.unique(pd.to_numeric(sub["particles_full_cell"], errors="coerce"))
+            if unique.size == 1:
+                full = float(unique[0])
         key_column = "case_key" if "case_key" in sub else "key"
         keys = tuple(str(k) for k in sub[key_column]) if key_column in sub else ()
         # "m_c_kg": the column's name in stores written by pidcore 0.1
@@ -589,8 +598,42 @@ def dem_cases(dem_runs: pd.DataFrame, *, tolerances: Tolerances | None = None,
         dup_keys = tuple(str(k) for k in dup[key_column]) if key_column in dup else ()
         dup_fills = tuple(float(f) for f in dup["fill_percent"])
         out.append(DemCase(case, sdc, stderr, len(members), ppc, keys, m_c, settings,
-                           cells, _not_converged(sub), dup_keys, dup_fills, stderr_dof))
+                           cells, _not_converged(sub), dup_keys, dup_fills, stderr_dof, full))
     return sorted(out, key=lambda c: (*_sort_key(c.load_case), c.settings))
+
+
+def _same_particle_count(case: LoadCase, dem: DemCase, tolerances: Tolerances) -> bool:
+    """Whether ``case`` is ``dem``'s simulation though its fill lies outside the fill
+    tolerance: same frequency, acceleration, material and direction, and a fill that rounds
+    to the case's particles per cell (:func:`pidcore.specimen.particles_for_fill`, the rule
+    the DEM runs by). A specimen stating ``count_per_cell = 28`` of 46 runs at 60.87 %: a test
+    at 60 % (28 spheres too) was "out_of_range" beside that very run."""
+    from ..specimen import particles_for_fill
+
+    if not (math.isfinite(dem.particles_per_cell) and math.isfinite(dem.particles_full_cell)
+            and dem.particles_full_cell >= 1):
+        return False
+    at_fill = replace(dem.load_case, fill_percent=case.fill_percent)
+    if not tolerances.matches(case, at_fill):
+        return False
+    try:
+        count = particles_for_fill(case.fill_percent, int(dem.particles_full_cell))
+    except ParameterError:  # a fill of no particle is no run's
+        return False
+    return count == dem.particles_per_cell
+
+
+def same_count_note(case: LoadCase, dem: DemCase, tolerances: Tolerances | None = None) -> str:
+    """The note for a measured ``case`` met by the DEM case ``dem`` through its particle count
+    (:func:`_same_particle_count`), its fill outside the fill tolerance; "" otherwise: the
+    row shows the DEM case's fill, and the measured one would go unsaid."""
+    tolerances = tolerances or Tolerances()
+    if abs(case.fill_percent - dem.load_case.fill_percent) <= tolerances.fill_atol_percent \
+            or not _same_particle_count(case, dem, tolerances):
+        return ""
+    return (f"measured at {case.fill_percent:g} % fill: {dem.particles_per_cell:g} of "
+            f"{dem.particles_full_cell:g} particles per cell, as the DEM runs at "
+            f"{dem.load_case.fill_percent:g} %: the same simulation")
 
 
 def _run_stderr_dofs(runs: pd.DataFrame, cells: float) -> np.ndarray:
@@ -968,12 +1011,18 @@ class Aligner:
         """Our DEM case nearest to ``case`` within the tolerances, or None.
 
         Of several numerical settings at one load case the one with the most cells simulated
-        is preferred (then the most runs): the least noisy estimate.
+        is preferred (then the most runs): the least noisy estimate. A case whose particles
+        per cell are those ``case``'s fill rounds to comes first: within the fill tolerance
+        a nearer fill of another count (59.7 % of 46 is 27 spheres, 60 % is 28) is another
+        bed.
         """
-        hits = [c for c in self.cases if self.tolerances.matches(case, c.load_case)]
+        counted = {id(c) for c in self.cases if _same_particle_count(case, c, self.tolerances)}
+        hits = [c for c in self.cases
+                if id(c) in counted or self.tolerances.matches(case, c.load_case)]
         if not hits:
             return None
-        return min(hits, key=lambda c: (self.tolerances.distance(case, c.load_case),
+        return min(hits, key=lambda c: (id(c) not in counted,
+                                        self.tolerances.distance(case, c.load_case),
                                         *_preference(c)))
 
     def align(self, case: LoadCase) -> AlignedCase:

@@ -50,7 +50,14 @@ from ..tables import header_key, line_where, read_text_table_file
 class FillNotStated(LoadCaseError):
     """No fill is stated for a measurement file (by name, sidecar or option): the one
     :class:`LoadCaseError` a caller may accept (``pidcore analyze`` saves the analysis without
-    a load case)."""
+    a load case). ``material``: the particle material the file states or takes from the
+    specimen given ("" where neither says one), so that a file of the specimen's particles is
+    still saved as its test."""
+
+    # ``material`` has a default: the CLI re-raises errors from their message alone
+    def __init__(self, message: str, material: str = "") -> None:
+        super().__init__(message)
+        self.material = material
 
 
 class UntabulatedMaterial(LoadCaseError):
@@ -496,7 +503,10 @@ def missing_fill_message(path: str | Path) -> str:
     return (f"{display_path(Path(path).name)}: no fill (packing ratio, %) stated; state it "
             "(1) in the file name, "
             f"e.g. '..._fill50_...' or '..._50pct_...', (2) in a sidecar table {SIDECAR_NAME} "
-            f"beside the file or given with sidecar=PATH (columns {', '.join(SIDECAR_COLUMNS)}), "
+            # quoted: the CLI's words read a bare fill_percent as the flag --fill, and the
+            # message named a sidecar column "--fill"
+            f"beside the file or given with sidecar=PATH (columns "
+            f"{', '.join(repr(c) for c in SIDECAR_COLUMNS)}), "
             "or (3) with fill_percent")
 
 
@@ -581,7 +591,7 @@ def resolve_load_case(
     take(options, "option")
 
     if "fill_percent" not in values:
-        raise FillNotStated(missing_fill_message(path))
+        raise FillNotStated(missing_fill_message(path), str(values.get("material", "")))
     values.setdefault("material", defaults.COMPARE_DEFAULT_MATERIAL)
     values.setdefault("direction", defaults.COMPARE_DEFAULT_DIRECTION)
     text = "; ".join(f"{name.split('_')[0]}: {origin.get(name, 'default')}"

@@ -406,8 +406,43 @@ def rekey_dem_store(source: str | os.PathLike[str], target: str | os.PathLike[st
     return len(items)
 
 
+def other_files_runs_note(store_path: str | os.PathLike[str], cases: Iterable[LoadCase],
+                          config: DemConfig, specimen: Specimen | None = None) -> str:
+    """The note for runs a store holds of ``cases`` at ``config``'s seed and cell count by
+    other specimen files of ``specimen``'s name (an edited ``x.toml``, or a calibration's
+    design points): "" where it holds none.
+
+    A run is reused only for the same file content (:attr:`Specimen.hash`), so a file edited
+    after its runs were stored, even its description, simulates every case again; ``dem
+    run`` and ``dem sweep`` did so saying "0 already in STORE", as if the store held none."""
+    from ..store import Store
+
+    cases = list(cases)
+    if not cases or not Path(store_path).exists():
+        return ""
+    runs = Store(store_path).list_dem_runs()
+    if runs.empty or "specimen_sha256" not in runs.columns:
+        return ""
+    own = resolve_specimen(cases[0], specimen)
+    wanted = {_key_case(case, resolve_specimen(case, specimen)) for case in cases}
+    # a run stored before specimens had none: the paper's coupon, matched by the name alone
+    sha = runs["specimen_sha256"].map(lambda value: value if isinstance(value, str)
+                                      and len(value) == 64 else "")
+    others = runs[(runs["specimen_name"] == own.name) & (sha != "") & (sha != own.hash)
+                  & runs["case_key"].map(run_key_case).isin(wanted)
+                  & (runs["seed"] == config.seed) & (runs["cells_simulated"] == config.cells)]
+    if others.empty:
+        return ""
+    files = ", ".join(f"sha256 {h[:12]}" for h in dict.fromkeys(others["specimen_sha256"]))
+    return (f"{store_path} holds {len(others)} run(s) of these load cases (seed {config.seed}, "
+            f"{config.cells} cells) by other files named {own.name} ({files}: an earlier "
+            f"version of this file, or a calibration's design points); not reused: a run is "
+            f"reused only for the same file content, and this file's is sha256 "
+            f"{own.hash[:12]} (any edit, its description too, makes another specimen)")
+
+
 __all__ = ["DEM_CODE_VERSION", "cached_run", "CachedRun", "dem_run_entry", "load_dem_result",
-           "own_run_keys", "rekey_dem_store", "run_identity", "run_key", "run_key_case",
-           "run_or_load",
+           "other_files_runs_note", "own_run_keys", "rekey_dem_store", "run_identity", "run_key",
+           "run_key_case", "run_or_load",
            "run_parameters", "runs_of_specimen", "save_dem_entry", "save_dem_result",
            "stored_identities", "stored_run_key"]

@@ -27,6 +27,7 @@ from ..records import json_safe
 from ..specimen import Specimen, fill_override_note
 from .persist import (
     dem_run_entry,
+    other_files_runs_note,
     own_run_keys,
     run_identity,
     run_key,
@@ -363,9 +364,19 @@ class SweepSummary:
     notes: list[str] = field(default_factory=list)
 
     def to_dict(self) -> dict:
+        """The JSON document of ``pidcore dem sweep --json``, with ``units`` naming the unit of
+        every number in it (as ``dem run --json`` and ``calibrate --json`` do: a case's
+        ``sdc``, ``loss_factor`` and ``particles_per_cell`` named none)."""
+        from .result import UNITS
+
+        cases = [dict(c) for c in self.cases]
+        # the seed is a name of the packings, not a quantity: no unit, as in dem run --json
+        units = {**UNITS, "wall_s": "s", "stored_fill_percent": "%"}
+        named = {name for case in cases for name in case} | {"wall_s"}
         return {"completed": len(self.completed), "skipped": len(self.skipped),
-                "wall_s": self.wall_s, "store": self.store_path,
-                "cases": [dict(c) for c in self.cases], "notes": list(self.notes)}
+                "wall_s": self.wall_s, "store": self.store_path, "cases": cases,
+                "notes": list(self.notes),
+                "units": {name: units[name] for name in sorted(named) if name in units}}
 
     def fill_results(self, store) -> None:
         """Read each case's results from ``store`` (the runs as stored)."""
@@ -461,6 +472,12 @@ def run_sweep(cases: Sequence[LoadCase], config: DemConfig, *,
             planned[identity] = key
             todo.append((case, key))
             summary.cases.append({**record, "store_key": key, "status": "simulated"})
+    # an edited specimen file (another hash, the same name) reuses none of its stored runs:
+    # said, as `dem sweep` says it before the run, to a library caller and in --json
+    other_files = other_files_runs_note(store_path, [case for case, _ in todo], config,
+                                        specimen)
+    if other_files:
+        summary.notes.append(other_files)
     bar = None
     if todo:
         store.check_writable()  # before the simulations, not at the first commit

@@ -455,6 +455,7 @@ def unsubtracted_baseline_note(specimen, analyses: pd.DataFrame | None) -> str:
         measured_specimen_name,
         measured_specimen_sha256,
         same_tested_file,
+        uncalibrated_name,
     )
 
     # a record of its name whose file's hash is another's is another file's test (one saved
@@ -463,8 +464,12 @@ def unsubtracted_baseline_note(specimen, analyses: pd.DataFrame | None) -> str:
                             pd.Series([""] * len(analyses), index=analyses.index))
     own = measured_specimen_sha256(specimen)
     other_file = recorded.map(lambda sha: same_tested_file(sha, own) is False)
+    # the tests a calibrated file models are saved under the name of the file it was made
+    # from ("x" for x_calibrated, as report and calibrate match them): its fitted baseline,
+    # the one case where a file states one, went unsaid beside them
+    tested = measured_specimen_name(specimen)
     mine = analyses[(analyses["material"] == material)
-                    & named.fillna("").isin(["", measured_specimen_name(specimen)])
+                    & named.fillna("").isin(["", tested, uncalibrated_name(tested)])
                     & ~other_file.astype(bool)]
     subtracted = [float((stored_parameters(p) or {}).get("baseline_loss_factor") or 0.0)
                   for p in mine.get("parameters_json", pd.Series([None] * len(mine)))]
@@ -478,7 +483,9 @@ def unsubtracted_baseline_note(specimen, analyses: pd.DataFrame | None) -> str:
             f"{eta:g} x its share of the vibrated mass, at most {2 * math.pi * eta:.3g}) and the "
             f"DEM's, of the particles alone, does not; analyse them with baseline_loss_factor="
             f"{eta:g} structure_mass_kg={structure_kg:.4g} (coupon and fixture; or a sidecar's "
-            "baseline_loss_factor and structure_mass_g) to subtract it")
+            # "column" keeps the sidecar's column names as written: the CLI's words turned
+            # the first into the flag --baseline-loss-factor, which no sidecar column is
+            "baseline_loss_factor column and structure_mass_g column) to subtract it")
 
 
 def whole_mass_baseline_note(settings: Iterable[Mapping | None]) -> str:

@@ -37,6 +37,7 @@ from ..compare.align import (
     pooled_mean,
     pooled_sdc_eq10,
     pooled_stderr_dof,
+    same_count_note,
     stored_stderr_dof,
 )
 from ..compare.loadcase import LoadCase, LoadCaseError
@@ -392,6 +393,10 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
             group.append(row)
         row.specimen, row.specimen_sha256 = specimen, sha256
         row.measured.append(entry)
+        if aligned.status == "grid" and aligned.grid_case is not None:
+            counted = same_count_note(case, aligned.grid_case, tolerances)
+            if counted and counted not in row.notes:
+                row.notes.append(counted)
         if met_calibrated and aligned.status in ("grid", "interpolated") \
                 and met_calibrated not in row.notes:
             row.notes.append(met_calibrated)
