@@ -116,19 +116,23 @@ def test_damper_table_content(model):
         assert column.endswith(f" [{unit}]"), column
         if pd.api.types.is_bool_dtype(t[column]):
             assert column in (SDC_FILLED_COLUMN, SDC_HELD_COLUMN) and unit == "True/False"
+        elif column == "coupon_cells [-]":  # a count
+            assert pd.api.types.is_integer_dtype(t[column])
         else:
             assert pd.api.types.is_float_dtype(t[column])
     sdc = model(t["fill [%]"].to_numpy(), t["acceleration [g]"].to_numpy(),
                 t["frequency [Hz]"].to_numpy())
     np.testing.assert_array_equal(t["sdc [-]"], sdc)
-    np.testing.assert_allclose(t["vibrated_mass [kg]"], 0.02 + t["fill [%]"] / 1000)
-    np.testing.assert_allclose(t["c_eq_per_area [N s/m^3]"], t["c_eq [N s/m]"] / 0.01,
+    np.testing.assert_allclose(t["coupon_vibrated_mass [kg]"], 0.02 + t["fill [%]"] / 1000)
+    np.testing.assert_allclose(t["c_eq_per_treated_area [N s/m^3]"],
+                               t["c_eq_per_coupon [N s/m]"] / 0.01,
                                rtol=1e-14)
     w = 2 * np.pi * t["frequency [Hz]"]
     x = t["displacement_amplitude [m]"]
     np.testing.assert_allclose(x * w**2, t["acceleration [g]"] * STANDARD_GRAVITY, rtol=1e-14)
     # c_eq = dE / (pi w X^2) by definition of the equivalent damper
-    np.testing.assert_allclose(t["c_eq [N s/m]"], t["energy_per_cycle [J]"] / (np.pi * w * x**2),
+    np.testing.assert_allclose(t["c_eq_per_coupon [N s/m]"],
+                               t["coupon_energy_per_cycle [J]"] / (np.pi * w * x**2),
                                rtol=1e-13)
     flagged = t[t[SDC_FILLED_COLUMN]]
     assert flagged[["fill [%]", "acceleration [g]", "frequency [Hz]"]].values.tolist() == [
@@ -152,7 +156,7 @@ def test_damper_table_refuses_a_vibrated_mass_in_grams(model):
                                 frequencies_hz=[100], vibrated_mass_kg=98.8)
     kept = equivalent_damper_table(model, fills_percent=[50], accelerations_g=[5],
                                    frequencies_hz=[100], vibrated_mass_kg=0.0988)
-    assert kept["vibrated_mass [kg]"].tolist() == [0.0988]
+    assert kept["coupon_vibrated_mass [kg]"].tolist() == [0.0988]
 
 
 def test_written_files_round_trip(tmp_path):
@@ -168,11 +172,11 @@ def test_written_files_round_trip(tmp_path):
     back = pd.read_csv(paths[0])
     pd.testing.assert_frame_equal(back, table, check_exact=False, rtol=1e-15)
     doc = json.loads(paths[1].read_text())
-    assert doc["units"]["c_eq_per_area [N s/m^3]"] == "N s/m^3"
+    assert doc["units"]["c_eq_per_treated_area [N s/m^3]"] == "N s/m^3"
     assert doc["provenance"]["sdc_source"] == "synthetic"
-    energies = [r["energy_per_cycle [J]"] for r in doc["records"]]
-    assert energies == table["energy_per_cycle [J]"].tolist()  # full precision in JSON
-    assert doc["records"][-1]["damping_ratio [-]"] is None
+    energies = [r["coupon_energy_per_cycle [J]"] for r in doc["records"]]
+    assert energies == table["coupon_energy_per_cycle [J]"].tolist()  # full precision in JSON
+    assert doc["records"][-1]["coupon_damping_ratio [-]"] is None
     with pytest.raises(ParameterError, match="formats"):
         write_damper_table(table, tmp_path, formats=("xlsx",))
 
@@ -229,7 +233,7 @@ def test_points_held_at_the_edge_are_flagged(model):
 
 
 def test_an_area_in_cm2_or_mm2_is_refused_by_the_library(model):
-    # area_m2=100 (cm^2 of the paper's 0.01 m^2 coupon) gave a c_eq_per_area 1e4 x too small
+    # area_m2=100 (cm^2 of the paper's 0.01 m^2 coupon) gave a c_eq per area 1e4 x too small
     # without a word: only the CLI's --area was checked against the specimen's cells
     from pidcore.specimen import Specimen
 
@@ -246,7 +250,8 @@ def test_an_area_in_cm2_or_mm2_is_refused_by_the_library(model):
         assert "\n" not in message
     # the coupon's own area passes; another specimen's cells are what it is checked against
     ok = equivalent_damper_table(model, area_m2=0.01, **grid)
-    np.testing.assert_allclose(ok["c_eq_per_area [N s/m^3]"], ok["c_eq [N s/m]"] / 0.01,
+    np.testing.assert_allclose(ok["c_eq_per_treated_area [N s/m^3]"],
+                               ok["c_eq_per_coupon [N s/m]"] / 0.01,
                                rtol=1e-15)  # one division
     text = (Path(__file__).parents[1] / "data_samples" / "specimens"
             / "steel_6mm.toml").read_text()
@@ -269,15 +274,17 @@ def test_c_eq_per_cell_is_the_coupons_c_eq_shared_by_its_cells(model, tmp_path):
     steel = equivalent_damper_table(model, specimen=Specimen.from_text(text, source="s"),
                                     area_m2=0.01, **grid)
     # one division each: to rounding
-    np.testing.assert_allclose(paper["c_eq_per_cell [N s/m]"] * 441, paper["c_eq [N s/m]"],
+    np.testing.assert_allclose(paper["c_eq_per_cell [N s/m]"] * 441,
+                               paper["c_eq_per_coupon [N s/m]"],
                                rtol=1e-15)
-    np.testing.assert_allclose(steel["c_eq_per_cell [N s/m]"] * 286, steel["c_eq [N s/m]"],
+    np.testing.assert_allclose(steel["c_eq_per_cell [N s/m]"] * 286,
+                               steel["c_eq_per_coupon [N s/m]"],
                                rtol=1e-15)
     # the cells' dashpots in parallel dissipate the coupon's energy per cycle
     w = 2 * np.pi * paper["frequency [Hz]"]
     x = paper["displacement_amplitude [m]"]
     np.testing.assert_allclose(441 * np.pi * paper["c_eq_per_cell [N s/m]"] * w * x**2,
-                               paper["energy_per_cycle [J]"], rtol=1e-13)
+                               paper["coupon_energy_per_cycle [J]"], rtol=1e-13)
     path = write_damper_table(paper, tmp_path, formats=("json",))[0]
     doc = json.loads(path.read_text())
     assert doc["units"]["c_eq_per_cell [N s/m]"] == "N s/m"

@@ -254,8 +254,8 @@ def run_damper(args: argparse.Namespace) -> int:
         "interpolation": "tensor-product pchip (frequency, fill, acceleration passes)",
         "log_frequency": model.log_frequency, "vibrated_mass": mass_text,
         "area": area_text,
-        "cells": f"{specimen.cell.count} (specimen {specimen.name}): c_eq_per_cell is c_eq / "
-                 "this count",
+        "cells": f"{specimen.cell.count} (specimen {specimen.name}): c_eq_per_cell is "
+                 "c_eq_per_coupon / this count",
         # which DOF the dashpot goes on and which particles it is of: the table's numbers
         # do not say, and a damper along the face (x, y) differs from one normal to it (z)
         "direction": _direction_text(runs),
@@ -266,9 +266,9 @@ def run_damper(args: argparse.Namespace) -> int:
     }
     if stated is None:
         # the paper's 441 cells are a guess for these runs: a per-cell damper of it is not given
-        table = table.drop(columns="c_eq_per_cell [N s/m]")
+        table = table.drop(columns=["c_eq_per_cell [N s/m]", "coupon_cells [-]"])
         provenance["cells"] = ("not stored with the DEM runs (an older store): no "
-                               "c_eq_per_cell column")
+                               "c_eq_per_cell and coupon_cells columns")
     undefined = int((table["sdc [-]"] >= 1.0).sum())
     why = ("damping ratio -ln(1 - SDC) / (4 pi) is undefined where SDC >= 1 (a free decay "
            "would lose all its energy within a cycle): left empty")

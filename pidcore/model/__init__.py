@@ -14,8 +14,9 @@ SdcModel, AXIS_NAMES
 select_runs, DEM_CONDITION_COLUMNS
     The stored DEM runs of one set of conditions, to build a model from.
 equivalent_damper_table, write_damper_table, DAMPER_COLUMNS, DAMPER_COLUMN_MEANINGS
-    The equivalent viscous damper over a grid (a pandas frame whose columns name their
-    units; what each is, per what), and its CSV/JSON files.
+    The equivalent viscous damper over a grid (a pandas frame whose columns name what each
+    is per, coupon, cell or treated area, and their units; what each is), and its CSV/JSON
+    files. DAMPER_COLUMNS_RENAMED: the older names of its columns -> the present ones.
 SDC_FILLED_COLUMN, SDC_HELD_COLUMN
     Its flags: SDC at a filled hole of the grid, SDC held at the grid's edge.
 loss_factor, damping_ratio, energy_per_cycle, sdc_from_energy_per_cycle, displacement_amplitude
@@ -36,6 +37,7 @@ time_domain_response, TimeDomainSteadyState
 from .damper import (
     DAMPER_COLUMN_MEANINGS,
     DAMPER_COLUMNS,
+    DAMPER_COLUMNS_RENAMED,
     SDC_FILLED_COLUMN,
     SDC_HELD_COLUMN,
     coupon_area_m2,
@@ -65,7 +67,8 @@ from .sdc_model import AXIS_NAMES, DEM_CONDITION_COLUMNS, SdcModel, select_runs
 from .table3 import TABLE3_COLUMNS, load_paper_table3
 
 __all__ = [
-    "AXIS_NAMES", "DAMPER_COLUMN_MEANINGS", "DAMPER_COLUMNS", "DEM_CONDITION_COLUMNS",
+    "AXIS_NAMES", "DAMPER_COLUMN_MEANINGS", "DAMPER_COLUMNS",
+    "DAMPER_COLUMNS_RENAMED", "DEM_CONDITION_COLUMNS",
     "HarmonicResponse",
     "SDC_FILLED_COLUMN", "SDC_HELD_COLUMN", "SdcModel",
     "TABLE3_COLUMNS", "TimeDomainSteadyState", "TreatedMode", "coupon_area_m2",

@@ -55,15 +55,29 @@ DAMPER_COLUMNS: dict[str, str] = {
     "sdc [-]": "-",
     SDC_FILLED_COLUMN: "True/False",
     SDC_HELD_COLUMN: "True/False",
-    "loss_factor [-]": "-",
-    "damping_ratio [-]": "-",
-    "vibrated_mass [kg]": "kg",
-    "energy_per_cycle [J]": "J",
+    "coupon_loss_factor [-]": "-",
+    "coupon_damping_ratio [-]": "-",
+    "coupon_vibrated_mass [kg]": "kg",
+    "coupon_area [m^2]": "m^2",
+    "coupon_cells [-]": "-",
+    "coupon_energy_per_cycle [J]": "J",
     "displacement_amplitude [m]": "m",
     "velocity_amplitude [m/s]": "m/s",
-    "c_eq [N s/m]": "N s/m",
-    "c_eq_per_area [N s/m^3]": "N s/m^3",
+    "c_eq_per_coupon [N s/m]": "N s/m",
+    "c_eq_per_treated_area [N s/m^3]": "N s/m^3",
     "c_eq_per_cell [N s/m]": "N s/m",
+}
+#: The names :data:`DAMPER_COLUMNS` had before pidcore said in each name what it is per (a
+#: reader of the CSV alone took the coupon's ``c_eq`` or ``loss_factor`` for its panel's):
+#: old name -> new name, for scripts reading an older file
+#: (``pd.read_csv(path).rename(columns=DAMPER_COLUMNS_RENAMED)``).
+DAMPER_COLUMNS_RENAMED: dict[str, str] = {
+    "loss_factor [-]": "coupon_loss_factor [-]",
+    "damping_ratio [-]": "coupon_damping_ratio [-]",
+    "vibrated_mass [kg]": "coupon_vibrated_mass [kg]",
+    "energy_per_cycle [J]": "coupon_energy_per_cycle [J]",
+    "c_eq [N s/m]": "c_eq_per_coupon [N s/m]",
+    "c_eq_per_area [N s/m^3]": "c_eq_per_treated_area [N s/m^3]",
 }
 #: What each column of :data:`DAMPER_COLUMNS` is, per what and where it applies (the JSON
 #: file's ``columns``): the brackets name the unit, not whether a number is the coupon's or
@@ -77,27 +91,34 @@ DAMPER_COLUMN_MEANINGS: dict[str, str] = {
                        "filled_grid_points)",
     SDC_HELD_COLUMN: "the point lies outside the model's grid: its SDC is the nearest edge "
                      "value held, not modelled there",
-    "loss_factor [-]": "SDC/(2 pi) of the coupon, relative to its own m_c: not a loss factor "
-                       "of another panel (its mass differs); use c_eq_per_area there",
-    "damping_ratio [-]": "-ln(1 - SDC)/(4 pi) of the coupon, relative to its own m_c "
-                         "(empty where SDC >= 1)",
-    "vibrated_mass [kg]": "m_c of Eq. 10 the SDC is taken over (provenance vibrated_mass: "
-                          "which masses)",
-    "energy_per_cycle [J]": "energy dissipated per drive cycle in the whole coupon, "
-                            "SDC m_c a^2/(2 w^2)",
+    "coupon_loss_factor [-]": "SDC/(2 pi) of the coupon, relative to its own m_c: not a loss "
+                              "factor of another panel (its mass differs); use "
+                              "c_eq_per_treated_area there",
+    "coupon_damping_ratio [-]": "-ln(1 - SDC)/(4 pi) of the coupon, relative to its own m_c "
+                                "(empty where SDC >= 1)",
+    "coupon_vibrated_mass [kg]": "m_c of Eq. 10 the SDC is taken over (provenance "
+                                 "vibrated_mass: which masses)",
+    "coupon_area [m^2]": "face area (one face) of the coupon c_eq_per_coupon is of: "
+                         "c_eq_per_treated_area = c_eq_per_coupon / coupon_area",
+    "coupon_cells [-]": "honeycomb cells of the coupon c_eq_per_coupon is of: c_eq_per_cell = "
+                        "c_eq_per_coupon / coupon_cells",
+    "coupon_energy_per_cycle [J]": "energy dissipated per drive cycle in the whole coupon, "
+                                   "SDC m_c a^2/(2 w^2)",
     "displacement_amplitude [m]": "a/w^2, the coupon's displacement amplitude",
     "velocity_amplitude [m/s]": "a/w, the coupon's velocity amplitude: the damper's force "
-                                "amplitude is c_eq times it",
-    "c_eq [N s/m]": "viscous damper of the whole coupon (provenance area), grounded: on the "
-                    "coupon's absolute velocity along the drive direction (provenance "
-                    "direction); pi c_eq w X^2 = energy_per_cycle",
-    "c_eq_per_area [N s/m^3]": "c_eq per m^2 of panel face (one face): spread over the treated "
-                               "area of a panel at the same fill, acceleration and frequency "
-                               "(e.g. a grounded dashpot of c_eq_per_area x tributary area at "
-                               "each node, along the drive direction)",
-    "c_eq_per_cell [N s/m]": "c_eq per honeycomb cell (one cell): c_eq / the coupon's cell "
-                             "count (provenance cells), for a panel whose cells are modelled "
-                             "one by one at the same fill, acceleration and frequency",
+                                "amplitude is c_eq_per_coupon times it",
+    "c_eq_per_coupon [N s/m]": "viscous damper of the whole coupon (coupon_area, coupon_cells), "
+                               "grounded: on the coupon's absolute velocity along the drive "
+                               "direction (provenance direction); pi c_eq_per_coupon w X^2 = "
+                               "coupon_energy_per_cycle",
+    "c_eq_per_treated_area [N s/m^3]": "c_eq_per_coupon per m^2 of coupon face (one face): "
+                                       "spread over the treated (filled) area of a panel at "
+                                       "the same fill, acceleration and frequency (e.g. a "
+                                       "grounded dashpot of c_eq_per_treated_area x tributary "
+                                       "treated area at each node, along the drive direction)",
+    "c_eq_per_cell [N s/m]": "c_eq_per_coupon per honeycomb cell (one cell): c_eq_per_coupon / "
+                             "coupon_cells, for a panel whose cells are modelled one by one at "
+                             "the same fill, acceleration and frequency",
 }
 
 
@@ -454,7 +475,7 @@ def equivalent_damper_table(model: SdcModel, *, fills_percent: Sequence[float] |
     if area_m2 is None:
         area = coupon_area_m2()
     else:
-        # 100 (cm^2) for 0.01 m^2 gave a c_eq_per_area 1e4 x too small; only --area was checked
+        # 100 (cm^2) for 0.01 m^2 gave a c_eq per area 1e4 x too small; only --area was checked
         area = float(_positive("area_m2", area_m2))
         check_area(area, specimen)
     sdc = model.evaluate(p, a_g, f, clip_to_range=clip_to_range)
@@ -475,15 +496,17 @@ def equivalent_damper_table(model: SdcModel, *, fills_percent: Sequence[float] |
         "sdc [-]": sdc,
         SDC_FILLED_COLUMN: filled,
         SDC_HELD_COLUMN: held,
-        "loss_factor [-]": loss_factor(sdc),
-        "damping_ratio [-]": damping_ratio(sdc),
-        "vibrated_mass [kg]": mass,
-        "energy_per_cycle [J]": energy_per_cycle(sdc, vibrated_mass_kg=mass,
+        "coupon_loss_factor [-]": loss_factor(sdc),
+        "coupon_damping_ratio [-]": damping_ratio(sdc),
+        "coupon_vibrated_mass [kg]": mass,
+        "coupon_area [m^2]": np.full(p.shape, area),
+        "coupon_cells [-]": np.full(p.shape, specimen.cell.count, dtype=int),
+        "coupon_energy_per_cycle [J]": energy_per_cycle(sdc, vibrated_mass_kg=mass,
                                                  acceleration_m_s2=a, frequency_hz=f),
         "displacement_amplitude [m]": displacement_amplitude(a, f),
         "velocity_amplitude [m/s]": a / (2.0 * np.pi * f),
-        "c_eq [N s/m]": c_eq,
-        "c_eq_per_area [N s/m^3]": c_eq / area,
+        "c_eq_per_coupon [N s/m]": c_eq,
+        "c_eq_per_treated_area [N s/m^3]": c_eq / area,
         "c_eq_per_cell [N s/m]": c_eq / specimen.cell.count,
     })
     return out
