@@ -16,6 +16,7 @@ from pidcore.model import (
     DAMPER_COLUMNS,
     SDC_FILLED_COLUMN,
     SDC_HELD_COLUMN,
+    SDC_HELD_ERROR_COLUMN,
     SdcModel,
     coupon_vibrated_mass_kg,
     damping_ratio,
@@ -116,6 +117,8 @@ def test_damper_table_content(model):
         assert column.endswith(f" [{unit}]"), column
         if pd.api.types.is_bool_dtype(t[column]):
             assert column in (SDC_FILLED_COLUMN, SDC_HELD_COLUMN) and unit == "True/False"
+        elif column == SDC_HELD_ERROR_COLUMN:  # its brackets name its values
+            assert set(t[column]) <= {"overstated", "understated", "unknown", "not held"}
         elif column == "coupon_cells [-]":  # a count
             assert pd.api.types.is_integer_dtype(t[column])
         else:
@@ -289,3 +292,58 @@ def test_c_eq_per_cell_is_the_coupons_c_eq_shared_by_its_cells(model, tmp_path):
     doc = json.loads(path.read_text())
     assert doc["units"]["c_eq_per_cell [N s/m]"] == "N s/m"
     assert "per honeycomb cell (one cell)" in doc["columns"]["c_eq_per_cell [N s/m]"]
+
+
+@pytest.mark.parametrize("frequency_slope,acceleration_slope", [(+2e-4, -0.01), (-2e-4, +0.01)])
+def test_a_held_sdc_says_which_way_it_errs(frequency_slope, acceleration_slope):
+    # a 20 g or 2000 Hz row was flagged held, but not whether its SDC (and its c_eq) is too
+    # high or too low there. SDC linear along each axis: pchip reproduces it, so its
+    # continuation beyond the grid is the truth the held value is measured against.
+    grid = pd.MultiIndex.from_product([[25.0, 90.0], [1.0, 5.0, 10.0], [50.0, 500.0, 1000.0]],
+                                      names=["fill_percent", "acceleration_g", "frequency_hz"])
+    t = grid.to_frame(index=False)
+
+    def truth(a, f):
+        return 0.4 + acceleration_slope * (a - 5.0) + frequency_slope * (f - 500.0)
+
+    t["sdc"] = truth(t["acceleration_g"], t["frequency_hz"])
+    linear = SdcModel.from_table(t, value="sdc", source="linear")
+    # beyond one edge each, then two edges whose trends agree (both held values too high or
+    # both too low), then a point inside
+    points = [(5.0, 2000.0), (5.0, 20.0), (20.0, 500.0), (0.5, 500.0), (0.5, 2000.0),
+              (5.0, 500.0)]
+    table = pd.concat([equivalent_damper_table(linear, fills_percent=[50],
+                                               accelerations_g=[a], frequencies_hz=[f],
+                                               vibrated_mass_kg=0.1, clip_to_range=True)
+                       for a, f in points], ignore_index=True)
+    held_minus_truth = table["sdc [-]"] - truth(table["acceleration [g]"],
+                                                 table["frequency [Hz]"])
+    said = {"overstated": 1.0, "understated": -1.0, "not held": 0.0}
+    # the sign the column states is the sign of (held - truth), row by row
+    np.testing.assert_array_equal(np.sign(held_minus_truth.round(12)),
+                                  table[SDC_HELD_ERROR_COLUMN].map(said))
+    assert table[SDC_HELD_ERROR_COLUMN].iloc[-1] == "not held"
+    assert table[SDC_HELD_ERROR_COLUMN].iloc[-2] == ("understated" if frequency_slope > 0
+                                                     else "overstated")
+    # beyond two edges whose trends disagree (both held above, one rising, one falling) the
+    # model does not tell which wins
+    (two,) = equivalent_damper_table(linear, fills_percent=[50], accelerations_g=[20],
+                                     frequencies_hz=[2000], vibrated_mass_kg=0.1,
+                                     clip_to_range=True)[SDC_HELD_ERROR_COLUMN]
+    assert two == "unknown"
+
+
+def test_a_held_sdc_at_a_flat_edge_is_said_unknown():
+    # pchip sets the edge slope to 0 where its end formula turns against the first interval
+    # (here a slow rise from 1 to 5 g before a steep one to 10 g):
+    # the model then says nothing of the SDC beyond the edge
+    grid = pd.MultiIndex.from_product([[25.0, 90.0], [1.0, 5.0, 10.0], [50.0, 1000.0]],
+                                      names=["fill_percent", "acceleration_g", "frequency_hz"])
+    t = grid.to_frame(index=False)
+    t["sdc"] = t["acceleration_g"].map({1.0: 0.1, 5.0: 0.11, 10.0: 0.5})
+    turning = SdcModel.from_table(t, value="sdc", source="turning")
+    assert turning.held_edges(50.0, 0.5, 100.0)[0].slope == 0.0  # pchip's own edge slope
+    (said,) = equivalent_damper_table(turning, fills_percent=[50], accelerations_g=[0.5],
+                                      frequencies_hz=[100], vibrated_mass_kg=0.1,
+                                      clip_to_range=True)[SDC_HELD_ERROR_COLUMN]
+    assert said == "unknown"

@@ -277,3 +277,33 @@ def test_the_paper_models_held_1g_sdc_overstates_the_damping_below_it(model, mod
                           clip_to_range=True)
     assert "holding the 1 g SDC overstates the damping there" in r.clipped_note
     assert f"model slope there {slope:+.3g} per g" in r.clipped_note
+
+
+@pytest.mark.parametrize("slope_per_hz,said", [
+    (+4e-4, "rises with frequency: holding it understates the damping there (amplitude "
+            "overstated: conservative)"),
+    (-4e-4, "falls with frequency: holding it overstates the damping there (amplitude "
+            "understated: not conservative)"),
+    (0.0, "flat in frequency: holding it errs in a direction the model does not tell"),
+])
+def test_a_frequency_held_at_the_edge_says_which_way_it_errs(mode, slope_per_hz, said):
+    # a 300 Hz row beyond a 250 Hz model said "which way that errs is not assessed". SDC
+    # linear in frequency: pchip reproduces it, so its continuation beyond 250 Hz is the
+    # truth the held value is measured against.
+    grid = pd.MultiIndex.from_product([[25.0, 90.0], [1.0, 5.0, 10.0], [50.0, 150.0, 250.0]],
+                                      names=["fill_percent", "acceleration_g", "frequency_hz"])
+    table = grid.to_frame(index=False)
+    table["sdc"] = 0.2 + slope_per_hz * (table["frequency_hz"] - 250.0)
+    linear = SdcModel.from_table(table, value="sdc", source="linear in frequency")
+    r = harmonic_response(linear, mode, frequencies_hz=[280.0, 300.0], force_amplitude_n=10.0,
+                          clip_to_range=True)
+    assert r.clipped.all() and ((r.acceleration_g >= 1) & (r.acceleration_g <= 10)).all()
+    truth = 0.2 + slope_per_hz * (r.frequency_hz - 250.0)
+    # the way the note says it errs: held minus truth, positive where it "overstates"
+    assert set(np.sign(r.sdc - truth)) == {np.sign(slope_per_hz) * -1 or 0.0}
+    assert "frequency outside the model's [50, 250] Hz, the 250 Hz SDC held (model slope " \
+           f"there {slope_per_hz:+.3g} per Hz)" in r.clipped_note
+    assert said in r.clipped_note and "not assessed" not in r.clipped_note
+    td = time_domain_response(linear, mode, frequency_hz=300.0, force_amplitude_n=10.0,
+                              clip_to_range=True)
+    assert td.clipped and said in td.clipped_note

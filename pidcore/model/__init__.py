@@ -17,8 +17,9 @@ equivalent_damper_table, write_damper_table, DAMPER_COLUMNS, DAMPER_COLUMN_MEANI
     The equivalent viscous damper over a grid (a pandas frame whose columns name what each
     is per, coupon, cell or treated area, and their units; what each is), and its CSV/JSON
     files. DAMPER_COLUMNS_RENAMED: the older names of its columns -> the present ones.
-SDC_FILLED_COLUMN, SDC_HELD_COLUMN
-    Its flags: SDC at a filled hole of the grid, SDC held at the grid's edge.
+SDC_FILLED_COLUMN, SDC_HELD_COLUMN, SDC_HELD_ERROR_COLUMN
+    Its flags: SDC at a filled hole of the grid, SDC held at the grid's edge, and which way
+    that errs (SdcModel.held_edges: the model's slope at the edge).
 loss_factor, damping_ratio, energy_per_cycle, sdc_from_energy_per_cycle, displacement_amplitude
     SDC to loss factor, damping ratio, energy per cycle (Eq. 8-10) and back.
 equivalent_damping_coefficient, sdc_from_damping_coefficient
@@ -40,6 +41,7 @@ from .damper import (
     DAMPER_COLUMNS_RENAMED,
     SDC_FILLED_COLUMN,
     SDC_HELD_COLUMN,
+    SDC_HELD_ERROR_COLUMN,
     coupon_area_m2,
     coupon_vibrated_mass_kg,
     damping_ratio,
@@ -63,14 +65,21 @@ from .response import (
     particle_damping_n_s_m,
     time_domain_response,
 )
-from .sdc_model import AXIS_NAMES, DEM_CONDITION_COLUMNS, SdcModel, select_runs
+from .sdc_model import (
+    AXIS_NAMES,
+    DEM_CONDITION_COLUMNS,
+    HELD_ERRORS,
+    HeldEdge,
+    SdcModel,
+    select_runs,
+)
 from .table3 import TABLE3_COLUMNS, load_paper_table3
 
 __all__ = [
     "AXIS_NAMES", "DAMPER_COLUMN_MEANINGS", "DAMPER_COLUMNS",
     "DAMPER_COLUMNS_RENAMED", "DEM_CONDITION_COLUMNS",
-    "HarmonicResponse",
-    "SDC_FILLED_COLUMN", "SDC_HELD_COLUMN", "SdcModel",
+    "HELD_ERRORS", "HarmonicResponse", "HeldEdge",
+    "SDC_FILLED_COLUMN", "SDC_HELD_COLUMN", "SDC_HELD_ERROR_COLUMN", "SdcModel",
     "TABLE3_COLUMNS", "TimeDomainSteadyState", "TreatedMode", "coupon_area_m2",
     "coupon_vibrated_mass_kg", "damping_ratio", "displacement_amplitude", "energy_per_cycle",
     "equivalent_damper_table", "equivalent_damping_coefficient", "harmonic_response",

@@ -35,6 +35,7 @@ from .. import defaults as D
 from ..constants import STANDARD_GRAVITY, VIBRATED_MASS_CONVENTIONS
 from ..errors import ParameterError
 from .sdc_model import SdcModel
+from .sdc_model import held_error as held_error_of
 
 if TYPE_CHECKING:  # a name for the hints only: the specimen module is imported where used
     from ..specimen import Specimen
@@ -46,6 +47,9 @@ SDC_FILLED_COLUMN = "sdc_filled [True/False]"
 #: The flag of :func:`equivalent_damper_table` marking points outside the model's grid whose SDC
 #: is the edge value held there (``clip_to_range=True`` only; False everywhere else).
 SDC_HELD_COLUMN = "sdc_held_at_edge [True/False]"
+#: Which way the SDC of a point flagged in :data:`SDC_HELD_COLUMN` errs, by the model's own
+#: slope at the edge held (:meth:`SdcModel.held_edges`); "not held" on the rows modelled.
+SDC_HELD_ERROR_COLUMN = "sdc_held_error [overstated/understated/unknown/not held]"
 #: Output columns of :func:`equivalent_damper_table` and their units, each named in the
 #: column's brackets (the flag's "unit" is its values).
 DAMPER_COLUMNS: dict[str, str] = {
@@ -55,6 +59,7 @@ DAMPER_COLUMNS: dict[str, str] = {
     "sdc [-]": "-",
     SDC_FILLED_COLUMN: "True/False",
     SDC_HELD_COLUMN: "True/False",
+    SDC_HELD_ERROR_COLUMN: "overstated/understated/unknown/not held",
     "coupon_loss_factor [-]": "-",
     "coupon_damping_ratio [-]": "-",
     "coupon_vibrated_mass [kg]": "kg",
@@ -91,6 +96,11 @@ DAMPER_COLUMN_MEANINGS: dict[str, str] = {
                        "filled_grid_points)",
     SDC_HELD_COLUMN: "the point lies outside the model's grid: its SDC is the nearest edge "
                      "value held, not modelled there",
+    SDC_HELD_ERROR_COLUMN: "which way a held SDC (and every damper of it) errs if the model's "
+                           "trend at the edge held (its slope there) continues beyond it: "
+                           "overstated below a rising edge or above a falling one, "
+                           "understated the other way; unknown where that slope is flat or "
+                           "two edges held disagree; not a bound",
     "coupon_loss_factor [-]": "SDC/(2 pi) of the coupon, relative to its own m_c: not a loss "
                               "factor of another panel (its mass differs); use "
                               "c_eq_per_treated_area there",
@@ -446,7 +456,8 @@ def equivalent_damper_table(model: SdcModel, *, fills_percent: Sequence[float] |
     pandas.DataFrame
         Columns :data:`DAMPER_COLUMNS` (each names its unit); :data:`SDC_FILLED_COLUMN` (a
         bool flag) is True where the point coincides with a filled hole of the model grid,
-        :data:`SDC_HELD_COLUMN` where its SDC is an edge value held beyond the grid.
+        :data:`SDC_HELD_COLUMN` where its SDC is an edge value held beyond the grid, and
+        :data:`SDC_HELD_ERROR_COLUMN` which way that errs by the model's slope at the edge.
     """
     # one call each, not a loop: the warning points at the caller's line (stacklevel)
     fills = _one_name("fills_percent", fills_percent, "fills", fills)
@@ -480,8 +491,10 @@ def equivalent_damper_table(model: SdcModel, *, fills_percent: Sequence[float] |
         check_area(area, specimen)
     sdc = model.evaluate(p, a_g, f, clip_to_range=clip_to_range)
     # a 20 g row carried the 10 g SDC and a c_eq from it, like a modelled one
-    held = np.array([not model.contains(point) for point in zip(p, a_g, f, strict=True)],
-                    dtype=bool)
+    edges = [model.held_edges(*point) for point in zip(p, a_g, f, strict=True)]
+    held = np.array([bool(e) for e in edges], dtype=bool)
+    # the flag said a 20 g row was held at 10 g, not whether its damper is too high or too low
+    held_error = [held_error_of(e) or "not held" for e in edges]
     a = _positive("acceleration [g]", a_g) * STANDARD_GRAVITY
     c_eq = equivalent_damping_coefficient(sdc, vibrated_mass_kg=mass, frequency_hz=f)
     filled_pts = model.filled_points()
@@ -496,6 +509,7 @@ def equivalent_damper_table(model: SdcModel, *, fills_percent: Sequence[float] |
         "sdc [-]": sdc,
         SDC_FILLED_COLUMN: filled,
         SDC_HELD_COLUMN: held,
+        SDC_HELD_ERROR_COLUMN: held_error,
         "coupon_loss_factor [-]": loss_factor(sdc),
         "coupon_damping_ratio [-]": damping_ratio(sdc),
         "coupon_vibrated_mass [kg]": mass,

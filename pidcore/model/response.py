@@ -153,7 +153,9 @@ class HarmonicResponse:
         What the ``clipped`` rows hold and which way that errs ("" where none is clipped):
         below an edge where the model's SDC rises with acceleration (its own slope there)
         the held edge SDC overstates the damping (amplitude understated, not conservative);
-        where it falls, understates it.
+        where it falls, understates it. A frequency beyond the model's range is judged
+        alike by the model's slope along frequency at its edge; where a slope is flat the
+        note says the direction is unknown.
     """
 
     frequency_hz: np.ndarray
@@ -254,27 +256,53 @@ def _held_edge_error(section, acceleration_g: float, bounds: tuple[float, float]
     return where, way, slope
 
 
+#: What holding an SDC that errs this way (:data:`~pidcore.model.sdc_model.HELD_ERRORS`)
+#: does to the response.
+_HELD_CONSEQUENCE = {
+    "overstated": "overstates the damping there (amplitude understated: not conservative)",
+    "understated": "understates the damping there (amplitude overstated: conservative)",
+}
+
+
+def _held_frequency_error(model: SdcModel, fill_percent: float, acceleration_g: float,
+                          frequency_hz: float) -> str:
+    """The clause of a frequency beyond the model's range: the edge held and which way that
+    errs by the model's slope along frequency there; "" inside the range."""
+    edges = [e for e in model.held_edges(fill_percent, acceleration_g, frequency_hz)
+             if e.axis == "frequency_hz"]
+    if not edges:
+        return ""
+    (edge,) = edges
+    f_lo, f_hi = model.bounds["frequency_hz"]
+    held = (f"frequency outside the model's [{f_lo:g}, {f_hi:g}] Hz, the {edge.edge:g} Hz SDC "
+            f"held (model slope there {edge.slope:+.3g} per Hz)")
+    if edge.error == "unknown":
+        return (f"{held}, where its SDC is flat in frequency: holding it errs in a direction "
+                "the model does not tell")
+    trend = "rises" if edge.slope > 0 else "falls"
+    return (f"{held}, where its SDC {trend} with frequency: holding it "
+            f"{_HELD_CONSEQUENCE[edge.error]}")
+
+
 def _span(values: list[float], fmt: str) -> str:
     low, high = min(values), max(values)
     return format(low, fmt) if format(low, fmt) == format(high, fmt) \
         else f"{format(low, fmt)} .. {format(high, fmt)}"
 
 
-def _clipped_note(rows: list[tuple[float, float, bool, str, str, float]],
-                  frequency_bounds: tuple[float, float]) -> str:
-    """One line for the clipped rows (frequency, acceleration, frequency outside, and
-    :func:`_held_edge_error`'s where, which way, slope), grouped by edge and direction;
-    "" where none is clipped."""
-    groups: dict[tuple[bool, str, str], list[tuple[float, float, float]]] = {}
-    for f, acc, frequency_outside, where, way, slope in rows:
-        groups.setdefault((frequency_outside, where, way), []).append((f, acc, slope))
+def _clipped_note(rows: list[tuple[float, float, str, str, str, float]]) -> str:
+    """One line for the clipped rows (frequency, acceleration, the clause of a frequency held
+    (:func:`_held_frequency_error`), and :func:`_held_edge_error`'s where, which way, slope),
+    grouped by edge and direction; "" where none is clipped."""
+    groups: dict[tuple[str, str, str], list[tuple[float, float, float]]] = {}
+    for f, acc, frequency_held, where, way, slope in rows:
+        groups.setdefault((frequency_held, where, way), []).append((f, acc, slope))
     parts = []
-    for (frequency_outside, where, way), members in groups.items():
+    for (frequency_held, where, way), members in groups.items():
         clauses = []
-        if frequency_outside:
-            f_lo, f_hi = frequency_bounds
-            clauses.append(f"frequency outside the model's [{f_lo:g}, {f_hi:g}] Hz, the edge "
-                           "frequency's SDC held (which way that errs is not assessed)")
+        if frequency_held:
+            # a 2000 Hz row said only that its 1000 Hz SDC was held, not which way that errs
+            clauses.append(frequency_held)
         if where:
             clauses.append(f"response {_span([m[1] for m in members], '.3g')} g {where} "
                            f"(model slope there {_span([m[2] for m in members], '+.3g')} per "
@@ -329,7 +357,7 @@ def harmonic_response(model: SdcModel, mode: TreatedMode, *, frequencies_hz: np.
     clipped = np.zeros(freqs.shape, dtype=bool)
     multiple = np.zeros(freqs.shape, dtype=bool)
     # a 0.3 g response took the 1 g SDC, flagged but not which way that errs
-    clip_rows: list[tuple[float, float, bool, str, str, float]] = []
+    clip_rows: list[tuple[float, float, str, str, str, float]] = []
     for i, f in enumerate(freqs):
         w = 2.0 * np.pi * f
         sdc_of, freq_clipped, section = _sdc_section(model, mode, f, clip_to_range)
@@ -370,7 +398,9 @@ def harmonic_response(model: SdcModel, mode: TreatedMode, *, frequencies_hz: np.
                 f"clip_to_range=True to hold the edge SDC")
         clipped[i] = acc_outside or freq_clipped
         if clipped[i]:
-            clip_rows.append((float(f), float(acc), freq_clipped,
+            clip_rows.append((float(f), float(acc),
+                              _held_frequency_error(model, mode.fill_percent,
+                                                    float(np.clip(acc, a_lo, a_hi)), f),
                               *_held_edge_error(section, acc, (a_lo, a_hi))))
         cp = float(c_pd(np.array(x)))
         out["x"][i] = x
@@ -385,8 +415,7 @@ def harmonic_response(model: SdcModel, mode: TreatedMode, *, frequencies_hz: np.
                             amplitude_untreated_m=out["x0"], clipped=clipped,
                             multiple_solutions=multiple,
                             force_amplitude_n=float(force_amplitude_n),
-                            clipped_note=_clipped_note(clip_rows,
-                                                       model.bounds["frequency_hz"]))
+                            clipped_note=_clipped_note(clip_rows))
 
 
 @dataclass(frozen=True)
@@ -496,8 +525,11 @@ def time_domain_response(model: SdcModel, mode: TreatedMode, *, frequency_hz: fl
                                  settle_time_s=float(t_settle),
                                  clipped=bool(acceleration_outside or frequency_clipped),
                                  clipped_note=_clipped_note(
-                                     [(frequency_hz, acceleration_g, frequency_clipped,
+                                     [(frequency_hz, acceleration_g,
+                                       _held_frequency_error(
+                                           model, mode.fill_percent,
+                                           float(np.clip(acceleration_g, a_lo, a_hi)),
+                                           frequency_hz),
                                        *_held_edge_error(section, acceleration_g,
                                                          (a_lo, a_hi)))]
-                                     if acceleration_outside or frequency_clipped else [],
-                                     model.bounds["frequency_hz"]))
+                                     if acceleration_outside or frequency_clipped else []))
