@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 
 import numpy as np
@@ -307,3 +308,101 @@ def test_a_frequency_held_at_the_edge_says_which_way_it_errs(mode, slope_per_hz,
     td = time_domain_response(linear, mode, frequency_hz=300.0, force_amplitude_n=10.0,
                               clip_to_range=True)
     assert td.clipped and said in td.clipped_note
+
+
+def _constant_sdc_model(sdc: float) -> SdcModel:
+    grid = pd.MultiIndex.from_product([[25.0, 90.0], [1.0, 10.0], [50.0, 1000.0]],
+                                      names=["fill_percent", "acceleration_g", "frequency_hz"])
+    table = grid.to_frame(index=False)
+    table["sdc"] = sdc
+    return SdcModel.from_table(table, value="sdc", source="constant")
+
+
+def test_treated_regions_weight_the_damper_by_the_mode_shape_squared_exactly_as_a_2dof():
+    # harmonic_response put the whole treated area on the modal coordinate (no sum of
+    # c_i phi_i^2). Truth: a physical 2-DOF (two treated patches, masses proportional to
+    # their areas) solved directly, (K - w^2 M + j w C) x = F. With an SDC constant in
+    # acceleration each patch's damper is c_per_area x its area, so C is proportional to M:
+    # the modes stay uncoupled and a force shaped M phi excites mode 1 alone, making the
+    # single-mode answer exact (textbook proportional damping).
+    sdc, m_c, a_c = 0.3, 0.1, 0.01
+    model = _constant_sdc_model(sdc)
+    areas = np.array([0.05, 0.15])
+    masses = 40.0 * areas  # kg: 40 kg/m^2 panel
+    K = np.array([[6e5 + 3e5, -3e5], [-3e5, 3e5 + 9e5]])
+    M = np.diag(masses)
+    eigenvalues, vectors = np.linalg.eig(np.linalg.solve(M, K))
+    first = int(np.argmin(eigenvalues))
+    phi = vectors[:, first] / vectors[0, first] * 0.7  # any scaling: the mode's own is used
+    modal_mass = float(phi @ M @ phi)
+    f_n = float(np.sqrt(eigenvalues[first]) / (2 * np.pi))
+    mode = TreatedMode(natural_frequency_hz=f_n, modal_mass_kg=modal_mass,
+                       structural_damping_ratio=0.0, treated_area_m2=float(areas.sum()),
+                       fill_percent=50.0, coupon_vibrated_mass_kg=m_c,
+                       treated_regions=tuple(zip(areas, phi, strict=True)))
+    scale = 3.0
+    force = M @ phi * scale
+    f = np.array([0.9, 0.99, 1.1]) * f_n
+    r = harmonic_response(model, mode, frequencies_hz=f, force_amplitude_n=float(phi @ force),
+                          clip_to_range=True)  # constant SDC: the held edge value is exact
+    for fi, q in zip(f, r.amplitude_m, strict=True):
+        w = 2 * np.pi * fi
+        C = np.diag(sdc * m_c * fi / a_c * areas)  # c_eq per area x area, by hand
+        x = np.linalg.solve(K - w**2 * M + 1j * w * C, force)
+        # one linear solve against one scalar harmonic balance: round-off only
+        np.testing.assert_allclose(np.abs(x), np.abs(phi) * q, rtol=1e-9)
+    # the modal damper is sum c_i phi_i^2, so its ratio is that over 2 w m
+    c_modal = sdc * m_c * f[1] / a_c * float(np.sum(areas * phi**2))
+    assert r.particle_damping_n_s_m[1] == pytest.approx(c_modal, rel=1e-12)
+    # the whole treated area at amplitude 1 (the old assumption) is another damper here
+    uniform = harmonic_response(model, dataclasses.replace(mode, treated_regions=()),
+                                frequencies_hz=f, force_amplitude_n=float(phi @ force),
+                                clip_to_range=True)
+    c_uniform = sdc * m_c * f[1] / a_c * float(areas.sum())
+    assert uniform.particle_damping_n_s_m[1] == pytest.approx(c_uniform, rel=1e-12)
+    assert abs(c_uniform / c_modal - 1) > 0.2  # 27 %: far beyond the 2-DOF check's 1e-9
+    assert "2 treated region(s)" in r.mode_shape_note
+    assert "whole treated area (0.2 m^2) moves with the modal coordinate" in \
+        uniform.to_pandas().attrs["mode_shape_note"]
+
+
+def test_treated_regions_do_not_depend_on_the_mode_shapes_scaling(model):
+    # phi x s with the modal mass x s^2 and the modal force x s is the same physical mode:
+    # each region's physical amplitude |phi_i| X (and so its SDC) must not change
+    base = dict(natural_frequency_hz=300.0, structural_damping_ratio=0.01,
+                treated_area_m2=0.2, fill_percent=50.0,
+                coupon_vibrated_mass_kg=coupon_vibrated_mass_kg(
+                    particles_mass_kg=paper_particles_mass_kg(50)))
+    regions = ((0.05, 1.0), (0.1, 0.6), (0.05, -0.8))
+    f = np.array([280.0, 300.0, 320.0])
+    one = harmonic_response(model, TreatedMode(modal_mass_kg=2.0, treated_regions=regions,
+                                               **base), frequencies_hz=f, force_amplitude_n=8.0)
+    s = 2.5
+    scaled = TreatedMode(modal_mass_kg=2.0 * s**2, **base,
+                         treated_regions=tuple((a, p * s) for a, p in regions))
+    two = harmonic_response(model, scaled, frequencies_hz=f, force_amplitude_n=8.0 * s)
+    # the same residual solved to brentq's 1e-13: agreement to 1e-10
+    np.testing.assert_allclose(two.amplitude_m * s, one.amplitude_m, rtol=1e-10)
+    np.testing.assert_allclose(two.acceleration_g, one.acceleration_g, rtol=1e-10)
+    np.testing.assert_allclose(two.particle_damping_n_s_m / s**2, one.particle_damping_n_s_m,
+                               rtol=1e-10)
+    # the time integration of the same regions settles on the harmonic balance's amplitude
+    td = time_domain_response(model, TreatedMode(modal_mass_kg=2.0, treated_regions=regions,
+                                                 **base),
+                              frequency_hz=300.0, force_amplitude_n=8.0)
+    assert td.amplitude_m == pytest.approx(one.amplitude_m[1], rel=1e-4)  # settle residue
+
+
+@pytest.mark.parametrize("regions,message", [
+    (((0.1, 1.0), (0.05, 0.5)), r"treated_regions' areas sum to 0.15 m\^2, but "
+                                r"treated_area_m2 is 0.2 m\^2"),
+    (((0.25, 1.0), (-0.05, 0.5)), r"treated_regions\[1\] area_m2 must be finite and > 0"),
+    (((0.1, 0.0), (0.1, 0.0)), "every mode_shape_amplitude is 0"),
+    (((0.1, float("nan")), (0.1, 1.0)), r"treated_regions\[0\] mode_shape_amplitude must be "
+                                        "finite"),
+    ((0.1, 0.1), "expected \\(area_m2, mode_shape_amplitude\\) pairs"),
+])
+def test_treated_regions_that_do_not_split_the_treated_area_are_refused(mode, regions,
+                                                                        message):
+    with pytest.raises(ParameterError, match=message):
+        dataclasses.replace(mode, treated_regions=regions)
