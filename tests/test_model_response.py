@@ -342,7 +342,7 @@ def test_treated_regions_weight_the_damper_by_the_mode_shape_squared_exactly_as_
                        treated_regions=tuple(zip(areas, phi, strict=True)))
     scale = 3.0
     force = M @ phi * scale
-    f = np.array([0.9, 0.99, 1.1]) * f_n
+    f = np.array([0.9, 0.99, 1.0, 1.1]) * f_n  # at f_n only the particles damp it
     r = harmonic_response(model, mode, frequencies_hz=f, force_amplitude_n=float(phi @ force),
                           clip_to_range=True)  # constant SDC: the held edge value is exact
     for fi, q in zip(f, r.amplitude_m, strict=True):
@@ -406,3 +406,27 @@ def test_treated_regions_that_do_not_split_the_treated_area_are_refused(mode, re
                                                                         message):
     with pytest.raises(ParameterError, match=message):
         dataclasses.replace(mode, treated_regions=regions)
+
+
+def test_a_mode_without_structural_damping_at_its_natural_frequency_is_bounded_by_the_particles(
+        model):
+    # structural_damping_ratio=0 driven at f_n: the untreated bound F0/0 made the scan run on
+    # NaN and the solver refused with "response acceleration nan g"; the particles alone
+    # bound it. At resonance k = m w^2, so the balance is X w c_pd(X) = F0 by hand.
+    mc = coupon_vibrated_mass_kg(particles_mass_kg=paper_particles_mass_kg(50))
+    mode = TreatedMode(natural_frequency_hz=300.0, modal_mass_kg=2.0,
+                       structural_damping_ratio=0.0, treated_area_m2=0.2, fill_percent=50.0,
+                       coupon_vibrated_mass_kg=mc)
+    r = harmonic_response(model, mode, frequencies_hz=[300.0], force_amplitude_n=5.0)
+    x, w = r.amplitude_m[0], 2 * np.pi * 300.0
+    assert np.isfinite(x) and 1.0 <= r.acceleration_g[0] <= 10.0
+    sdc = float(model(50.0, w**2 * x / STANDARD_GRAVITY, 300.0))
+    c_by_hand = sdc * mc * 300.0 / 0.01 * 0.2  # SDC m_c f / A_c x A_t
+    assert x * w * c_by_hand == pytest.approx(5.0, rel=1e-10)  # brentq's 1e-13 on log X
+    assert r.amplitude_untreated_m[0] == np.inf  # undamped at resonance: unbounded
+    assert r.phase_rad[0] == pytest.approx(-np.pi / 2, abs=1e-12)
+    # where the model's SDC also reaches 0 nothing bounds it: refused, naming why
+    zero = _constant_sdc_model(0.0)
+    with pytest.raises(ParameterError, match=r"^harmonic_response: at 300 Hz \(the natural "
+                                             r"frequency\) nothing bounds the response"):
+        harmonic_response(zero, mode, frequencies_hz=[300.0], force_amplitude_n=5.0)

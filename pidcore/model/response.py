@@ -219,7 +219,8 @@ class HarmonicResponse:
     particle_damping_n_s_m : ndarray
         Modal c_pd [N s/m] at the solution: sum c_i phi_i^2 over the treated regions.
     amplitude_untreated_m : ndarray
-        Amplitude without particles [m], for comparison.
+        Amplitude without particles [m], for comparison (inf for a mode without structural
+        damping driven at its natural frequency).
     clipped : ndarray of bool
         SDC taken at the edge of the model range (only with ``clip_to_range=True``).
     multiple_solutions : ndarray of bool
@@ -459,7 +460,7 @@ def harmonic_response(model: SdcModel, mode: TreatedMode, *, frequencies_hz: np.
         raise ParameterError("frequencies_hz must be finite and > 0")
     k, m, c_s = mode.stiffness_n_m, mode.modal_mass_kg, mode.structural_damping_n_s_m
     a_lo, a_hi = model.bounds["acceleration_g"]
-    sdc_max = float(np.max(model.values))
+    sdc_max, sdc_min = float(np.max(model.values)), float(np.min(model.values))
     out = {name: np.empty(freqs.shape) for name in
            ("x", "phase", "acc", "sdc", "c_pd", "x0")}
     clipped = np.zeros(freqs.shape, dtype=bool)
@@ -478,9 +479,21 @@ def harmonic_response(model: SdcModel, mode: TreatedMode, *, frequencies_hz: np.
             x = np.exp(log_x)
             return x * np.abs(k - m * w**2 + 1j * w * (c_s + c_pd(x))) / force_amplitude_n - 1.0
 
-        x_hi = force_amplitude_n / abs(k - m * w**2 + 1j * w * c_s)
-        c_max = float(_modal_particle_damping(mode, lambda _a: np.asarray(max(sdc_max, 0.0)),
-                                              f, np.asarray(1.0)))
+        with np.errstate(divide="ignore"):  # undamped at its natural frequency: inf
+            x_untreated = force_amplitude_n / abs(k - m * w**2 + 1j * w * c_s)
+        c_max, c_min = (float(_modal_particle_damping(mode, lambda _a, s=s: np.asarray(s), f,
+                                                      np.asarray(1.0)))
+                        for s in (max(sdc_max, 0.0), max(sdc_min, 0.0)))
+        # the least damping the model can give bounds the amplitude from above: with no
+        # structural damping at the natural frequency the untreated bound was 1/0, and the
+        # scan from it ran on NaN ("response acceleration nan g")
+        lightest = abs(k - m * w**2 + 1j * w * (c_s + c_min))
+        if lightest == 0.0:
+            raise ParameterError(
+                f"harmonic_response: at {f:g} Hz (the natural frequency) nothing bounds the "
+                "response: structural_damping_ratio is 0 and the SDC model reaches 0; give "
+                "the mode's structural damping ratio (> 0)")
+        x_hi = force_amplitude_n / lightest
         x_lo = force_amplitude_n / abs(k - m * w**2 + 1j * w * (c_s + c_max))
         if x_hi <= x_lo * (1 + 1e-14):
             roots = [np.log(x_hi)]
@@ -523,7 +536,7 @@ def harmonic_response(model: SdcModel, mode: TreatedMode, *, frequencies_hz: np.
         out["acc"][i] = acc
         out["sdc"][i] = float(sdc_of(np.array(acc)))
         out["c_pd"][i] = cp
-        out["x0"][i] = x_hi
+        out["x0"][i] = x_untreated
     return HarmonicResponse(frequency_hz=freqs, amplitude_m=out["x"], phase_rad=out["phase"],
                             acceleration_g=out["acc"], sdc=out["sdc"],
                             particle_damping_n_s_m=out["c_pd"],
