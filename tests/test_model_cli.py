@@ -491,3 +491,56 @@ def test_an_older_damper_csv_reads_into_the_present_names(tmp_path):
     assert set(DAMPER_COLUMNS_RENAMED.values()) <= set(DAMPER_COLUMNS)
     back = older.rename(columns=DAMPER_COLUMNS_RENAMED)
     pd.testing.assert_frame_equal(back, table[list(back.columns)])
+
+
+def test_the_panel_loss_factor_is_a_viscous_sdofs_by_its_free_decay(tmp_path):
+    # an analyst knowing a panel's areal mass had no loss factor of it, only the coupon's
+    # (over the coupon's own m_c). Truth: a 1 m^2 panel of 8 kg/m^2 as a rigid mass on a
+    # spring tuned to the drive frequency, its treated half carrying c_eq_per_treated_area
+    # x 0.5 m^2 as a dashpot; its free decay's logarithmic decrement gives zeta, and the
+    # loss factor at resonance is 2 zeta (a viscous SDOF: exact, not a small-damping form).
+    from scipy.integrate import solve_ivp
+
+    assert _run(["model", "damper", "--out", str(tmp_path), "--format", "csv", "--fills", "50",
+                 "--accelerations", "5", "--frequencies", "100", "--panel-areal-mass", "8",
+                 "--panel-treated-fraction", "0.5"]) == 0
+    (row,) = pd.read_csv(tmp_path / "equivalent_damper.csv").to_dict(orient="records")
+    mass, w = 8.0 * 1.0, 2 * np.pi * 100.0
+    c = row["c_eq_per_treated_area [N s/m^3]"] * 0.5
+    k = mass * w**2
+
+    def peak(t, y):
+        return y[1]
+    peak.direction = -1  # velocity crossing zero downwards: a displacement maximum
+
+    sol = solve_ivp(lambda t, y: [y[1], -(c * y[1] + k * y[0]) / mass], (0.0, 0.2),
+                    [1e-3, 0.0], method="DOP853", rtol=1e-12, atol=1e-18, events=peak)
+    maxima = sol.y_events[0][:, 0]
+    decrement = np.mean(np.log(maxima[:-1] / maxima[1:]))
+    zeta = decrement / np.sqrt(4 * np.pi**2 + decrement**2)
+    # both the product of the CSV's 17 digits and an integration at rtol 1e-12: 1e-7
+    assert row["panel_loss_factor [-]"] == pytest.approx(2 * zeta, rel=1e-7)
+    # and by the coupon's own numbers: its loss factor x (m_c / coupon area) / 8 x 0.5
+    assert row["panel_loss_factor [-]"] == pytest.approx(
+        row["coupon_loss_factor [-]"] * row["coupon_vibrated_mass [kg]"]
+        / row["coupon_area [m^2]"] / 8.0 * 0.5, rel=1e-12)
+    assert row["panel_areal_mass [kg/m^2]"] == 8.0 and row["panel_treated_fraction [-]"] == 0.5
+
+
+@pytest.mark.parametrize("argv,message", [
+    (["--panel-areal-mass", "8000"], "--panel-areal-mass 8000 kg/m^2 is 505 x the coupons' own "
+                                     "areal mass (6.05 .. 15.8 kg/m^2, m_c / coupon area); "
+                                     "expected the panel's mass per m^2 in kg/m^2; was it "
+                                     "g/m^2?"),
+    (["--panel-areal-mass", "8", "--panel-treated-fraction", "50"],
+     "--panel-treated-fraction 50: expected the treated share of the panel's area, in (0, 1]; "
+     "was it a percentage?"),
+    (["--panel-treated-fraction", "0.5"], "--panel-treated-fraction 0.5: the share of a panel "
+                                          "given by --panel-areal-mass; give that too"),
+])
+def test_a_panel_areal_mass_or_share_in_the_wrong_unit_is_refused(tmp_path, argv, message):
+    out = tmp_path / "out"
+    with pytest.raises(ParameterError) as caught:
+        _run(["model", "damper", "--out", str(out), *argv])
+    assert str(caught.value) == message
+    assert not out.exists()  # nothing written

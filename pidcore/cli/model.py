@@ -101,6 +101,14 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         "0.1 m; required for runs of another specimen, whose file has no "
                         "coupon area; more than 100 x off its cells' cross-section is refused "
                         "as a unit slip)")
+    d.add_argument("--panel-areal-mass", metavar="KG_M2", type=_positive_float, default=None,
+                   help="mass per m^2 of your panel, with its particles, kg/m^2: adds "
+                        "panel_loss_factor, the loss factor the particles add to it moving as "
+                        "the coupon did (one amplitude everywhere; not a mode's); more than "
+                        "100 x outside the coupons' own m_c / area is refused as a unit slip")
+    d.add_argument("--panel-treated-fraction", metavar="F", type=_positive_float, default=None,
+                   help="with --panel-areal-mass: share of the panel's area filled, in (0, 1] "
+                        "(default 1)")
     d.set_defaults(func=run_damper)
 
     f = sub.add_parser("figures", help="SDC figures (paper Figs. 8-14), PNG and SVG")
@@ -244,11 +252,24 @@ def run_damper(args: argparse.Namespace) -> int:
                              "over, e.g. --area 0.01")
     else:
         area, area_text = None, f"{coupon_area_m2():g} m^2 (the paper's 0.1 m x 0.1 m coupon)"
-    table = equivalent_damper_table(
-        model, fills_percent=args.fills if args.fills else model.axes[0],
-        accelerations_g=args.accelerations if args.accelerations else model.axes[1],
-        frequencies_hz=args.frequencies if args.frequencies else model.axes[2],
-        vibrated_mass_kg=mass, area_m2=area, specimen=specimen)
+    if args.panel_treated_fraction is not None and args.panel_areal_mass is None:
+        raise ParameterError(f"--panel-treated-fraction {as_given(args.panel_treated_fraction)}:"
+                             " the share of a panel given by --panel-areal-mass; give that too")
+    if args.panel_treated_fraction is not None and args.panel_treated_fraction > 1:
+        raise ParameterError(f"--panel-treated-fraction {as_given(args.panel_treated_fraction)}:"
+                             " expected the treated share of the panel's area, in (0, 1]; was "
+                             "it a percentage?")
+    try:
+        table = equivalent_damper_table(
+            model, fills_percent=args.fills if args.fills else model.axes[0],
+            accelerations_g=args.accelerations if args.accelerations else model.axes[1],
+            frequencies_hz=args.frequencies if args.frequencies else model.axes[2],
+            vibrated_mass_kg=mass, area_m2=area, specimen=specimen,
+            panel_areal_mass_kg_m2=args.panel_areal_mass,
+            panel_treated_fraction=args.panel_treated_fraction or 1.0)
+    except ParameterError as exc:  # the option as typed, not the library's keyword
+        raise ParameterError(str(exc).replace("panel_areal_mass_kg_m2", "--panel-areal-mass")
+                             ) from None
     provenance = {
         "sdc_source": model.source, "sdc_value": model.value_name,
         "interpolation": "tensor-product pchip (frequency, fill, acceleration passes)",
@@ -264,6 +285,12 @@ def run_damper(args: argparse.Namespace) -> int:
         else ", ".join(sorted(runs["material"].dropna().astype(str).unique())),
         "filled_grid_points": model.filled_points().to_dict(orient="records"),
     }
+    if args.panel_areal_mass is not None:
+        provenance["panel"] = (
+            f"{args.panel_areal_mass:g} kg/m^2 with its particles, "
+            f"{args.panel_treated_fraction or 1.0:g} of its area treated (given): "
+            "panel_loss_factor = c_eq_per_treated_area x treated fraction / (areal mass x w), "
+            "the panel moving as the coupon did (one amplitude everywhere), not a mode's")
     if stated is None:
         # the paper's 441 cells are a guess for these runs: a per-cell damper of it is not given
         table = table.drop(columns=["c_eq_per_cell [N s/m]", "coupon_cells [-]"])

@@ -22,6 +22,9 @@ SDC_FILLED_COLUMN, SDC_HELD_COLUMN, SDC_HELD_ERROR_COLUMN
     that errs (SdcModel.held_edges: the model's slope at the edge).
 loss_factor, damping_ratio, energy_per_cycle, sdc_from_energy_per_cycle, displacement_amplitude
     SDC to loss factor, damping ratio, energy per cycle (Eq. 8-10) and back.
+panel_loss_factor, PANEL_COLUMNS
+    The loss factor the particles add to a panel of known areal mass moving as the coupon
+    did (equivalent_damper_table's panel_areal_mass_kg_m2; CLI --panel-areal-mass).
 equivalent_damping_coefficient, sdc_from_damping_coefficient
     SDC to c_eq [N s/m] and back.
 coupon_area_m2, coupon_vibrated_mass_kg, paper_particles_mass_kg
@@ -39,6 +42,7 @@ from .damper import (
     DAMPER_COLUMN_MEANINGS,
     DAMPER_COLUMNS,
     DAMPER_COLUMNS_RENAMED,
+    PANEL_COLUMNS,
     SDC_FILLED_COLUMN,
     SDC_HELD_COLUMN,
     SDC_HELD_ERROR_COLUMN,
@@ -50,6 +54,7 @@ from .damper import (
     equivalent_damper_table,
     equivalent_damping_coefficient,
     loss_factor,
+    panel_loss_factor,
     paper_particles_mass_kg,
     paper_vibrated_mass,
     runs_vibrated_mass,
@@ -77,7 +82,7 @@ from .table3 import TABLE3_COLUMNS, load_paper_table3
 
 __all__ = [
     "AXIS_NAMES", "DAMPER_COLUMN_MEANINGS", "DAMPER_COLUMNS",
-    "DAMPER_COLUMNS_RENAMED", "DEM_CONDITION_COLUMNS",
+    "DAMPER_COLUMNS_RENAMED", "PANEL_COLUMNS", "panel_loss_factor", "DEM_CONDITION_COLUMNS",
     "HELD_ERRORS", "HarmonicResponse", "HeldEdge",
     "SDC_FILLED_COLUMN", "SDC_HELD_COLUMN", "SDC_HELD_ERROR_COLUMN", "SdcModel",
     "TABLE3_COLUMNS", "TimeDomainSteadyState", "TreatedMode", "coupon_area_m2",

@@ -132,6 +132,63 @@ DAMPER_COLUMN_MEANINGS: dict[str, str] = {
 }
 
 
+#: The columns :func:`equivalent_damper_table` adds for a panel of known areal mass
+#: (``panel_areal_mass_kg_m2``), and their units.
+PANEL_COLUMNS: dict[str, str] = {
+    "panel_areal_mass [kg/m^2]": "kg/m^2",
+    "panel_treated_fraction [-]": "-",
+    "panel_loss_factor [-]": "-",
+}
+DAMPER_COLUMN_MEANINGS.update({
+    "panel_areal_mass [kg/m^2]": "mass per m^2 of the panel the loss factor is of, with its "
+                                 "particles (all the mass that moves)",
+    "panel_treated_fraction [-]": "share of the panel's face area filled at this fill "
+                                  "(treated area / panel area)",
+    "panel_loss_factor [-]": "loss factor the particles add to that panel if all of it moves "
+                             "as the coupon did (one amplitude everywhere, along the drive "
+                             "direction, at this acceleration and frequency): "
+                             "c_eq_per_treated_area x panel_treated_fraction / "
+                             "(panel_areal_mass x w); not a mode's, whose amplitude varies "
+                             "over the panel (harmonic_response with treated_regions)",
+})
+#: Most a panel's areal mass may lie outside the coupons' own (m_c / coupon area over the
+#: table) before it is refused as a unit slip: g/m^2 typed for kg/m^2 is 1000 x off, while a
+#: light 1 kg/m^2 skin or a heavy 50 kg/m^2 panel beside the paper coupon's 2.2-16 kg/m^2
+#: stays well within it.
+AREAL_MASS_LIMIT = 100.0
+
+
+def panel_loss_factor(c_eq_per_treated_area: float | np.ndarray, *,
+                      frequency_hz: float | np.ndarray, panel_areal_mass_kg_m2: float,
+                      treated_fraction: float = 1.0) -> np.ndarray:
+    """Loss factor [-] the particles add to a panel moving as the coupon did.
+
+    Every point of the panel (areal mass ``mu`` [kg/m^2] with its particles, a share
+    ``treated_fraction`` of its area ``A_p`` treated) moves at one amplitude X along the drive
+    direction: the treated area dissipates ``c'' A_t pi w X^2`` per cycle (``c''`` =
+    ``c_eq_per_treated_area``), the panel's peak kinetic energy is ``mu A_p w^2 X^2 / 2``,
+    and the loss factor, dissipation over 2 pi times it, is
+
+        eta = c'' (A_t / A_p) / (mu w).
+
+    Not a mode's: there the amplitude varies over the panel (use
+    :func:`~pidcore.model.harmonic_response` with ``treated_regions``).
+
+    Examples
+    --------
+    >>> float(panel_loss_factor(10.0, frequency_hz=100 / np.pi, panel_areal_mass_kg_m2=5.0,
+    ...                         treated_fraction=0.5))  # 10 x 0.5 / (5 x 200)
+    0.005
+    """
+    mu = float(_positive("panel_areal_mass_kg_m2", panel_areal_mass_kg_m2))
+    fraction = float(_positive("treated_fraction", treated_fraction))
+    if fraction > 1.0:
+        raise ParameterError(f"treated_fraction must be in (0, 1] (treated area / panel "
+                             f"area), got {treated_fraction!r}")
+    w = 2.0 * np.pi * _positive("frequency_hz", frequency_hz)
+    return np.asarray(c_eq_per_treated_area, dtype=float) * fraction / (mu * w)
+
+
 def _positive(name: str, value: np.ndarray) -> np.ndarray:
     arr = np.asarray(value, dtype=float)
     if not np.all(np.isfinite(arr)) or np.any(arr <= 0):
@@ -420,6 +477,8 @@ def equivalent_damper_table(model: SdcModel, *, fills_percent: Sequence[float] |
                             area_m2: float | None = None,
                             specimen: Specimen | None = None,
                             clip_to_range: bool = False,
+                            panel_areal_mass_kg_m2: float | None = None,
+                            panel_treated_fraction: float = 1.0,
                             fills: Sequence[float] | None = None,
                             accelerations: Sequence[float] | None = None,
                             frequencies: Sequence[float] | None = None) -> pd.DataFrame:
@@ -447,6 +506,13 @@ def equivalent_damper_table(model: SdcModel, *, fills_percent: Sequence[float] |
     clip_to_range : bool
         Passed to :meth:`SdcModel.evaluate` (default: refuse points outside the model); the
         points it held at the edge are flagged in :data:`SDC_HELD_COLUMN`.
+    panel_areal_mass_kg_m2 : float, optional
+        A panel's mass per m^2 of face, with its particles: adds :data:`PANEL_COLUMNS`, its
+        :func:`panel_loss_factor` (the panel moving as the coupon did). More than
+        :data:`AREAL_MASS_LIMIT` times outside the coupons' own m_c / area is refused as a
+        unit slip (g/m^2 typed for kg/m^2).
+    panel_treated_fraction : float
+        The share of that panel's area filled (default 1: all of it), in (0, 1].
     fills, accelerations, frequencies : sequence of float, optional
         The names of pidcore 0.2, without their units (a ``DeprecationWarning``); giving
         both names of one axis is refused.
@@ -523,6 +589,21 @@ def equivalent_damper_table(model: SdcModel, *, fills_percent: Sequence[float] |
         "c_eq_per_treated_area [N s/m^3]": c_eq / area,
         "c_eq_per_cell [N s/m]": c_eq / specimen.cell.count,
     })
+    if panel_areal_mass_kg_m2 is not None:
+        mu = float(_positive("panel_areal_mass_kg_m2", panel_areal_mass_kg_m2))
+        coupon = mass / area
+        low, high = float(coupon.min()), float(coupon.max())
+        if not low / AREAL_MASS_LIMIT <= mu <= high * AREAL_MASS_LIMIT:
+            hint = "was it g/m^2?" if mu > high else "was it in another unit?"
+            raise ParameterError(
+                f"panel_areal_mass_kg_m2 {mu:g} kg/m^2 is {mu / (high if mu > high else low):.3g}"
+                f" x the coupons' own areal mass ({low:.3g} .. {high:.3g} kg/m^2, m_c / "
+                f"coupon area); expected the panel's mass per m^2 in kg/m^2; {hint}")
+        out["panel_areal_mass [kg/m^2]"] = mu
+        out["panel_treated_fraction [-]"] = float(panel_treated_fraction)
+        out["panel_loss_factor [-]"] = panel_loss_factor(
+            out["c_eq_per_treated_area [N s/m^3]"].to_numpy(), frequency_hz=f,
+            panel_areal_mass_kg_m2=mu, treated_fraction=panel_treated_fraction)
     return out
 
 
@@ -578,7 +659,7 @@ def write_damper_table(table: pd.DataFrame, out_dir: str | Path, *,
         # to_dict keeps full float precision (to_json rounds to 10 significant digits)
         records = [{k: _json_value(v) for k, v in row.items()}
                    for row in table.to_dict(orient="records")]
-        units = {c: DAMPER_COLUMNS.get(c, "") for c in table.columns}
+        units = {c: {**DAMPER_COLUMNS, **PANEL_COLUMNS}.get(c, "") for c in table.columns}
         meanings = {c: DAMPER_COLUMN_MEANINGS.get(c, "") for c in table.columns}
         p.write_text(json.dumps({"records": records, "units": units, "columns": meanings,
                                  "provenance": prov}, indent=1))
