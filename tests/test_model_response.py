@@ -430,3 +430,20 @@ def test_a_mode_without_structural_damping_at_its_natural_frequency_is_bounded_b
     with pytest.raises(ParameterError, match=r"^harmonic_response: at 300 Hz \(the natural "
                                              r"frequency\) nothing bounds the response"):
         harmonic_response(zero, mode, frequencies_hz=[300.0], force_amplitude_n=5.0)
+
+
+def test_a_fill_outside_the_model_or_beyond_100_percent_is_refused_by_name(model, mode):
+    # fill_percent=150 was taken; a 95 % fill was then refused as "fill_percent=95 %,
+    # frequency_hz=300 Hz outside the model range {...}", clip_to_range or not
+    with pytest.raises(ParameterError, match=r"^TreatedMode: fill_percent must be in \(0, 100\] "
+                                             r"%, got 150"):
+        dataclasses.replace(mode, fill_percent=150.0)
+    beyond = dataclasses.replace(mode, fill_percent=95.0)
+    for clip in (False, True):
+        with pytest.raises(ParameterError) as caught:
+            harmonic_response(model, beyond, frequencies_hz=[300.0], force_amplitude_n=5.0,
+                              clip_to_range=clip)
+        assert str(caught.value).startswith(
+            "harmonic_response: fill_percent 95 % outside the SDC model range [25, 90] %;")
+    with pytest.raises(ParameterError, match=r"^time_domain_response: fill_percent 95 %"):
+        time_domain_response(model, beyond, frequency_hz=300.0, force_amplitude_n=5.0)

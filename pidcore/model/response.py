@@ -125,6 +125,10 @@ class TreatedMode:
             v = getattr(self, name)
             if not np.isfinite(v) or v <= 0:
                 raise ParameterError(f"TreatedMode: {name} must be finite and > 0, got {v!r}")
+        if not (math.isfinite(self.fill_percent) and 0 < self.fill_percent <= 100):
+            # 150 was taken, and refused later as a frequency "outside the model range"
+            raise ParameterError(f"TreatedMode: fill_percent must be in (0, 100] %, got "
+                                 f"{self.fill_percent!r}; was it a fraction or a count?")
         if not np.isfinite(self.structural_damping_ratio) or self.structural_damping_ratio < 0:
             raise ParameterError(f"TreatedMode: structural_damping_ratio must be >= 0, got "
                                  f"{self.structural_damping_ratio!r}")
@@ -300,6 +304,13 @@ def _sdc_section(model: SdcModel, mode: TreatedMode, frequency_hz: float,
         raise ParameterError(f"{caller}: frequency {as_given(frequency_hz)} Hz outside "
                              f"the SDC model range [{f_lo:g}, {f_hi:g}] Hz; pass "
                              f"clip_to_range=True to hold the edge SDC")
+    p_lo, p_hi = model.bounds["fill_percent"]
+    if not p_lo * (1 - _RANGE_RTOL) <= mode.fill_percent <= p_hi * (1 + _RANGE_RTOL):
+        # a 95 % fill was refused naming the frequency and the whole range dict
+        raise ParameterError(f"{caller}: fill_percent {as_given(mode.fill_percent)} % outside "
+                             f"the SDC model range [{p_lo:g}, {p_hi:g}] %; the fill is the "
+                             "treatment's own: clip_to_range holds acceleration and frequency "
+                             "at the model's edge, not the fill")
     section = model.acceleration_section(mode.fill_percent,
                                          float(np.clip(frequency_hz, f_lo, f_hi)))
     a_lo, a_hi = model.bounds["acceleration_g"]
