@@ -544,3 +544,24 @@ def test_a_panel_areal_mass_or_share_in_the_wrong_unit_is_refused(tmp_path, argv
         _run(["model", "damper", "--out", str(out), *argv])
     assert str(caught.value) == message
     assert not out.exists()  # nothing written
+
+
+@pytest.mark.parametrize("argv,message", [
+    (["--accelerations", "49"], "--accelerations 49: outside the model's range 1 .. 10 g (never "
+                                "extrapolated); expected g: was it m/s^2?"),
+    (["--fills", "0.5"], "--fills 0.5: outside the model's range 25 .. 90 % (never "
+                         "extrapolated); expected %: was it a fraction?"),
+    (["--frequencies", "0.2"], "--frequencies 0.2: outside the model's range 50 .. 1000 Hz "
+                               "(never extrapolated); expected Hz: was it kHz?"),
+    (["--frequencies", "1257"], "--frequencies 1257: outside the model's range 50 .. 1000 Hz "
+                                "(never extrapolated); expected Hz: was it rad/s?"),
+    (["--fills", "95"], "--fills 95: outside the model's range 25 .. 90 % (never "
+                        "extrapolated)"),
+])
+def test_a_grid_value_outside_the_model_names_its_unit_and_a_likely_slip(tmp_path, argv,
+                                                                         message):
+    # "--accelerations 49: outside the model's range 1 .. 10" named no unit: 49 m/s^2 typed
+    # for 5 g was left to guess
+    with pytest.raises(ParameterError) as caught:
+        _run(["model", "damper", "--out", str(tmp_path / "out"), *argv])
+    assert str(caught.value) == message

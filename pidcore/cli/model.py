@@ -188,14 +188,25 @@ def run_damper(args: argparse.Namespace) -> int:
             f"--vibrated-mass {as_given(args.vibrated_mass)}: the DEM runs in {args.store} divided "
             "their SDC by their own m_c, which c_eq = SDC m_c w / (2 pi) must use; leave "
             "--vibrated-mass out")
-    for option, axis, values in (("--fills", 0, args.fills), ("--accelerations", 1,
-                                                                args.accelerations),
-                                 ("--frequencies", 2, args.frequencies)):
+    # the unit each list is in, and the other units whose values would fall inside: 49
+    # (m/s^2 for 5 g) or 0.5 (a fraction for 50 %) was refused without naming the unit
+    from ..constants import STANDARD_GRAVITY
+
+    for option, axis, values, unit, slips in (
+            ("--fills", 0, args.fills, "%", (("a fraction", 100.0),)),
+            ("--accelerations", 1, args.accelerations, "g",
+             (("m/s^2", 1.0 / STANDARD_GRAVITY),)),
+            ("--frequencies", 2, args.frequencies, "Hz",
+             (("kHz", 1000.0), ("rad/s", 1.0 / (2.0 * math.pi))))):
         lo, hi = model.axes[axis][0], model.axes[axis][-1]
         outside = [v for v in values or () if not lo <= v <= hi]
         if outside:
-            raise ParameterError(f"{option} {','.join(as_given(v) for v in outside)}: outside "
-                                 f"the model's range {lo:g} .. {hi:g} (never extrapolated)")
+            hints = [name for name, factor in slips
+                     if all(lo <= v * factor <= hi for v in outside)]
+            raise ParameterError(
+                f"{option} {','.join(as_given(v) for v in outside)}: outside the model's range "
+                f"{lo:g} .. {hi:g} {unit} (never extrapolated)"
+                + (f"; expected {unit}: was it {' or '.join(hints)}?" if hints else ""))
     table3 = defaults.MODEL_PARTICLE_MATERIAL  # Table 3's particles (paper Sect. 4)
     if runs is None and args.vibrated_mass is None and args.material not in (None, table3):
         # Table 3's SDC is the acrylic coupon's dissipation over its own m_c: times the m_c
