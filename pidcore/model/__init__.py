@@ -11,12 +11,17 @@ load_paper_table3, TABLE3_COLUMNS
 SdcModel, AXIS_NAMES
     The pchip SDC model: ``SdcModel.from_table(table)(fill_percent, acceleration_g,
     frequency_hz)``; refuses points outside its grid.
+HeldEdge, HELD_ERRORS
+    ``SdcModel.held_edges(point)``: the axes a point lies beyond, the model's slope at each
+    edge and which way holding the edge SDC errs there.
 select_runs, DEM_CONDITION_COLUMNS
     The stored DEM runs of one set of conditions, to build a model from.
 equivalent_damper_table, write_damper_table, DAMPER_COLUMNS, DAMPER_COLUMN_MEANINGS
     The equivalent viscous damper over a grid (a pandas frame whose columns name what each
     is per, coupon, cell or treated area, and their units; what each is), and its CSV/JSON
-    files. DAMPER_COLUMNS_RENAMED: the older names of its columns -> the present ones.
+    files.
+DAMPER_COLUMNS_RENAMED
+    The older names of its columns -> the present ones (``.rename(columns=...)``).
 SDC_FILLED_COLUMN, SDC_HELD_COLUMN, SDC_HELD_ERROR_COLUMN
     Its flags: SDC at a filled hole of the grid, SDC held at the grid's edge, and which way
     that errs (SdcModel.held_edges: the model's slope at the edge).
