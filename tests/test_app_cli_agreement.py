@@ -92,7 +92,7 @@ def test_the_compare_pages_loop_energy_is_the_energy_pidcore_analyze_prints(tmp_
 
 def test_the_compare_pages_equivalent_damper_is_pidcore_model_dampers(tmp_path, capsys):
     # the app had no equivalent damper; Compare now gives c_eq at a DEM grid case, which must
-    # be the c_eq [N s/m] `pidcore model damper --table store` writes for the same runs
+    # be the c_eq_per_coupon [N s/m] `pidcore model damper --table store` writes for the same runs
     from pathlib import Path
 
     import pandas as pd
@@ -119,7 +119,7 @@ def test_the_compare_pages_equivalent_damper_is_pidcore_model_dampers(tmp_path, 
                  "--fills", "50", "--accelerations", "5", "--frequencies", "1000",
                  "--format", "csv", "--out", str(tmp_path)]) == 0
     capsys.readouterr()
-    (cli,) = pd.read_csv(tmp_path / "equivalent_damper.csv")["c_eq [N s/m]"]
+    (cli,) = pd.read_csv(tmp_path / "equivalent_damper.csv")["c_eq_per_coupon [N s/m]"]
     # the same SDC and m_c (rebuilt from the runs' specimen columns, equal to rounding)
     assert dampers["our DEM"] == pytest.approx(cli, rel=1e-12)
     # the measured damper dissipates the measured energy per cycle: dE / (pi w X^2), X = a/w^2

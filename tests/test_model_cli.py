@@ -42,7 +42,7 @@ def test_damper_writes_the_paper_grid(tmp_path):
     assert _run(["model", "damper", "--out", str(tmp_path), "--mass-convention", "coupon"]) == 0
     table = pd.read_csv(tmp_path / "equivalent_damper.csv")
     assert len(table) == 48
-    np.testing.assert_allclose(table["vibrated_mass [kg]"], coupon_vibrated_mass_kg())
+    np.testing.assert_allclose(table["coupon_vibrated_mass [kg]"], coupon_vibrated_mass_kg())
     ref = load_paper_table3().dropna(subset=["sdc_dem"])
     merged = table.merge(ref, left_on=["frequency [Hz]", "acceleration [g]", "fill [%]"],
                          right_on=["frequency_hz", "acceleration_g", "fill_percent"])
@@ -58,7 +58,8 @@ def test_damper_writes_the_paper_grid(tmp_path):
         [1000.0, 1.0, 90.0]]
     assert doc["units"]["sdc_filled [True/False]"] == "True/False"
     # per honeycomb cell: the coupon's c_eq over the paper's 441 cells, the count named
-    np.testing.assert_allclose(table["c_eq_per_cell [N s/m]"] * 441, table["c_eq [N s/m]"],
+    np.testing.assert_allclose(table["c_eq_per_cell [N s/m]"] * 441,
+                               table["c_eq_per_coupon [N s/m]"],
                                rtol=1e-12)  # CSV's 17 significant digits, one division
     assert doc["units"]["c_eq_per_cell [N s/m]"] == "N s/m"
     assert doc["provenance"]["cells"].startswith("441 (specimen paper_coupon)")
@@ -70,7 +71,7 @@ def test_damper_options(tmp_path):
           "--accelerations", "2", "--frequencies", "75,300", "--vibrated-mass", "0.5"])
     assert not (tmp_path / "equivalent_damper.json").exists()
     table = pd.read_csv(tmp_path / "equivalent_damper.csv")
-    assert len(table) == 4 and set(table["vibrated_mass [kg]"]) == {0.5}
+    assert len(table) == 4 and set(table["coupon_vibrated_mass [kg]"]) == {0.5}
     with pytest.raises(ParameterError, match="--fills 95: outside the model's range 25 .. 90"):
         _run(["model", "damper", "--out", str(tmp_path), "--fills", "95"])
     with pytest.raises(SystemExit):
@@ -137,15 +138,15 @@ def test_damper_from_store_runs_gives_back_their_dissipated_energy(tmp_path):
                          right_on=["frequency_hz", "acceleration_g", "fill_percent"])
     assert len(merged) == len(runs) == 48
     # the same sums of the same stored numbers: equal to rounding
-    np.testing.assert_allclose(merged["vibrated_mass [kg]"], merged["vibrated_mass_kg"],
+    np.testing.assert_allclose(merged["coupon_vibrated_mass [kg]"], merged["vibrated_mass_kg"],
                                rtol=1e-12)
-    np.testing.assert_allclose(merged["energy_per_cycle [J]"], merged["energy_per_cycle_j"],
+    np.testing.assert_allclose(merged["coupon_energy_per_cycle [J]"], merged["energy_per_cycle_j"],
                                rtol=1e-9)
     provenance = json.loads((tmp_path / "equivalent_damper.json").read_text())["provenance"]
     assert "the m_c the DEM runs divided their SDC by" in provenance["vibrated_mass"]
     # the rows with SDC >= 1 have no damping ratio, and the output says why (it was blank)
     undefined = int((table["sdc [-]"] >= 1).sum())
-    assert undefined > 0 and table["damping_ratio [-]"].isna().sum() == undefined
+    assert undefined > 0 and table["coupon_damping_ratio [-]"].isna().sum() == undefined
     assert "undefined where SDC >= 1" in provenance["damping_ratio"]
     # the runs' m_c convention is the only one that gives their energy back
     with pytest.raises(ParameterError, match="--mass-convention coupon: the DEM runs in .* "
@@ -198,10 +199,11 @@ def test_damper_takes_one_specimens_runs_with_its_masses_and_a_given_area(tmp_pa
     at_grid = table.merge(mine, left_on=["frequency [Hz]", "acceleration [g]", "fill [%]"],
                           right_on=["frequency_hz", "acceleration_g", "fill_percent"])
     assert len(at_grid) == 47
-    np.testing.assert_allclose(at_grid["vibrated_mass [kg]"], at_grid["vibrated_mass_kg"],
+    np.testing.assert_allclose(at_grid["coupon_vibrated_mass [kg]"], at_grid["vibrated_mass_kg"],
                                rtol=1e-12)
     np.testing.assert_allclose(at_grid["sdc [-]"], at_grid["sdc"], rtol=1e-12)
-    np.testing.assert_allclose(table["c_eq_per_area [N s/m^3]"], table["c_eq [N s/m]"] / 0.02,
+    np.testing.assert_allclose(table["c_eq_per_treated_area [N s/m^3]"],
+                               table["c_eq_per_coupon [N s/m]"] / 0.02,
                                rtol=1e-12)
     # runs that store no specimen text: their cell count is not the paper's 441 (here 100),
     # so no per-cell damper is written from it
@@ -212,7 +214,7 @@ def test_damper_takes_one_specimens_runs_with_its_masses_and_a_given_area(tmp_pa
         _run(argv)
     # by the hash's first digits, as `specimen check` prints 16 of them
     _run([*argv, "--where", "specimen_sha256=aaaaaaaaaaaaaaaa", "--area", "0.02"])
-    assert pd.read_csv(tmp_path / "equivalent_damper.csv")["vibrated_mass [kg]"].max() \
+    assert pd.read_csv(tmp_path / "equivalent_damper.csv")["coupon_vibrated_mass [kg]"].max() \
         == pytest.approx(mine["vibrated_mass_kg"].max(), rel=1e-12)
 
 
@@ -318,8 +320,8 @@ def test_an_area_in_another_unit_is_refused(tmp_path, area, said):
     for ok in ("0.01", "0.5"):
         _run(["model", "damper", "--out", str(tmp_path / ok), "--area", ok, "--format", "csv"])
         table = pd.read_csv(tmp_path / ok / "equivalent_damper.csv")
-        np.testing.assert_allclose(table["c_eq_per_area [N s/m^3]"],
-                                   table["c_eq [N s/m]"] / float(ok), rtol=1e-12)
+        np.testing.assert_allclose(table["c_eq_per_treated_area [N s/m^3]"],
+                                   table["c_eq_per_coupon [N s/m]"] / float(ok), rtol=1e-12)
 
 
 def test_an_area_is_checked_against_the_stored_runs_specimen(tmp_path):
@@ -355,7 +357,8 @@ def test_a_vibrated_mass_in_grams_is_refused(tmp_path):
         out = tmp_path / f"{mass:g}"
         _run(["model", "damper", "--out", str(out), "--vibrated-mass", f"{mass}",
               "--format", "csv"])
-        tables[mass] = pd.read_csv(out / "equivalent_damper.csv")["c_eq [N s/m]"].to_numpy()
+        tables[mass] = pd.read_csv(out / "equivalent_damper.csv")[
+            "c_eq_per_coupon [N s/m]"].to_numpy()
     small, large = tables.values()
     np.testing.assert_allclose(large, 10 * small, rtol=1e-9)
 
@@ -411,9 +414,10 @@ def test_table3_sdc_is_not_put_over_another_materials_mass(tmp_path):
     table = pd.read_csv(tmp_path / "ac" / "equivalent_damper.csv")
     w = 2 * np.pi * table["frequency [Hz]"]
     a = 9.80665 * table["acceleration [g]"]
-    energy = table["sdc [-]"] * table["vibrated_mass [kg]"] * a**2 / (2 * w**2)
+    energy = table["sdc [-]"] * table["coupon_vibrated_mass [kg]"] * a**2 / (2 * w**2)
     # the same products in another order: equal to round-off
-    np.testing.assert_allclose(table["c_eq [N s/m]"], energy / (np.pi * w * (a / w**2) ** 2),
+    np.testing.assert_allclose(table["c_eq_per_coupon [N s/m]"],
+                               energy / (np.pi * w * (a / w**2) ** 2),
                                rtol=1e-12)
     # an explicit m_c is the user's: the material then only sets its unit-slip range
     assert _run(["model", "damper", "--out", str(tmp_path / "m"), "--material", "aluminium",
@@ -430,15 +434,15 @@ def test_the_damper_says_per_what_along_which_direction_and_gives_the_velocity(t
     assert row["velocity_amplitude [m/s]"] == pytest.approx(5 * 9.80665 / (2 * np.pi * 500),
                                                             rel=1e-14)
     # the viscous damper's energy per cycle, pi F X with F = c_eq v, is the table's dE
-    assert np.pi * row["c_eq [N s/m]"] * row["velocity_amplitude [m/s]"] \
-        * row["displacement_amplitude [m]"] == pytest.approx(row["energy_per_cycle [J]"],
+    assert np.pi * row["c_eq_per_coupon [N s/m]"] * row["velocity_amplitude [m/s]"] \
+        * row["displacement_amplitude [m]"] == pytest.approx(row["coupon_energy_per_cycle [J]"],
                                                              rel=1e-12)
     doc = json.loads((tmp_path / "equivalent_damper.json").read_text())
     assert doc["units"]["velocity_amplitude [m/s]"] == "m/s"
     assert set(doc["columns"]) == set(doc["units"]) and all(doc["columns"].values())
-    assert "whole coupon" in doc["columns"]["c_eq [N s/m]"]
-    assert "grounded" in doc["columns"]["c_eq [N s/m]"]
-    assert "per m^2 of panel face" in doc["columns"]["c_eq_per_area [N s/m^3]"]
+    assert "whole coupon" in doc["columns"]["c_eq_per_coupon [N s/m]"]
+    assert "grounded" in doc["columns"]["c_eq_per_coupon [N s/m]"]
+    assert "per m^2 of coupon face" in doc["columns"]["c_eq_per_treated_area [N s/m^3]"]
     assert doc["provenance"]["direction"].startswith("z (normal to the face sheets")
     assert doc["provenance"]["particle_material"] == "acrylic"
     assert doc["provenance"]["area"] == "0.01 m^2 (the paper's 0.1 m x 0.1 m coupon)"
@@ -452,3 +456,112 @@ def test_the_damper_says_per_what_along_which_direction_and_gives_the_velocity(t
                  "aluminium", "--vibrated-mass", "0.1"]) == 0
     doc = json.loads((tmp_path / "equivalent_damper.json").read_text())
     assert doc["provenance"]["particle_material"] == "acrylic"
+
+
+def test_the_damper_csv_read_alone_says_what_each_damper_is_per(tmp_path):
+    # the CSV's "c_eq [N s/m]" and "loss_factor [-]" did not say they were the 0.01 m^2,
+    # 441-cell coupon's: an analyst reading the CSV alone could put them on a whole panel
+    assert _run(["model", "damper", "--out", str(tmp_path), "--format", "csv", "--fills", "50",
+                 "--accelerations", "5", "--frequencies", "100"]) == 0
+    (row,) = pd.read_csv(tmp_path / "equivalent_damper.csv").to_dict(orient="records")
+    assert not {"c_eq [N s/m]", "c_eq_per_area [N s/m^3]", "loss_factor [-]",
+                "damping_ratio [-]", "energy_per_cycle [J]"} & set(row)
+    # by hand, Table 2 and Sect. 5.1: faces 2 x 0.01 m^2 x 0.25 mm x 2800 kg/m^3, core
+    # 0.01 m^2 x 25.4 mm x 32.1 kg/m^3, 18 acrylic spheres (r 1.25 mm, 1180 kg/m^3) per cell
+    m_c = 2 * 0.01 * 0.25e-3 * 2800 + 0.01 * 0.0254 * 32.1 \
+        + 441 * 18 * 1180 * 4 / 3 * np.pi * 1.25e-3**3
+    sdc = 0.1891  # Table 3, 50 %, 5 g, 100 Hz (a grid point)
+    # c_eq = SDC m_c w / (2 pi) = SDC m_c f; the CSV's 17 digits: only round-off differs
+    assert row["c_eq_per_coupon [N s/m]"] == pytest.approx(sdc * m_c * 100.0, rel=1e-12)
+    assert row["coupon_area [m^2]"] == pytest.approx(0.01, rel=1e-15)  # 0.1 m squared
+    assert row["coupon_cells [-]"] == 441
+    assert row["c_eq_per_treated_area [N s/m^3]"] == pytest.approx(
+        sdc * m_c * 100.0 / 0.01, rel=1e-12)
+    assert row["c_eq_per_cell [N s/m]"] == pytest.approx(sdc * m_c * 100.0 / 441, rel=1e-12)
+    assert row["coupon_loss_factor [-]"] == pytest.approx(sdc / (2 * np.pi), rel=1e-12)
+
+
+def test_an_older_damper_csv_reads_into_the_present_names(tmp_path):
+    from pidcore.model import DAMPER_COLUMNS, DAMPER_COLUMNS_RENAMED
+
+    assert _run(["model", "damper", "--out", str(tmp_path), "--format", "csv"]) == 0
+    table = pd.read_csv(tmp_path / "equivalent_damper.csv")
+    older = table.rename(columns={new: old for old, new in DAMPER_COLUMNS_RENAMED.items()})
+    older = older.drop(columns=["coupon_area [m^2]", "coupon_cells [-]"])  # new columns
+    assert set(DAMPER_COLUMNS_RENAMED.values()) <= set(DAMPER_COLUMNS)
+    back = older.rename(columns=DAMPER_COLUMNS_RENAMED)
+    pd.testing.assert_frame_equal(back, table[list(back.columns)])
+
+
+def test_the_panel_loss_factor_is_a_viscous_sdofs_by_its_free_decay(tmp_path):
+    # an analyst knowing a panel's areal mass had no loss factor of it, only the coupon's
+    # (over the coupon's own m_c). Truth: a 1 m^2 panel of 8 kg/m^2 as a rigid mass on a
+    # spring tuned to the drive frequency, its treated half carrying c_eq_per_treated_area
+    # x 0.5 m^2 as a dashpot; its free decay's logarithmic decrement gives zeta, and the
+    # loss factor at resonance is 2 zeta (a viscous SDOF: exact, not a small-damping form).
+    from scipy.integrate import solve_ivp
+
+    assert _run(["model", "damper", "--out", str(tmp_path), "--format", "csv", "--fills", "50",
+                 "--accelerations", "5", "--frequencies", "100", "--panel-areal-mass", "8",
+                 "--panel-treated-fraction", "0.5"]) == 0
+    (row,) = pd.read_csv(tmp_path / "equivalent_damper.csv").to_dict(orient="records")
+    mass, w = 8.0 * 1.0, 2 * np.pi * 100.0
+    c = row["c_eq_per_treated_area [N s/m^3]"] * 0.5
+    k = mass * w**2
+
+    def peak(t, y):
+        return y[1]
+    peak.direction = -1  # velocity crossing zero downwards: a displacement maximum
+
+    sol = solve_ivp(lambda t, y: [y[1], -(c * y[1] + k * y[0]) / mass], (0.0, 0.2),
+                    [1e-3, 0.0], method="DOP853", rtol=1e-12, atol=1e-18, events=peak)
+    maxima = sol.y_events[0][:, 0]
+    decrement = np.mean(np.log(maxima[:-1] / maxima[1:]))
+    zeta = decrement / np.sqrt(4 * np.pi**2 + decrement**2)
+    # both the product of the CSV's 17 digits and an integration at rtol 1e-12: 1e-7
+    assert row["panel_loss_factor [-]"] == pytest.approx(2 * zeta, rel=1e-7)
+    # and by the coupon's own numbers: its loss factor x (m_c / coupon area) / 8 x 0.5
+    assert row["panel_loss_factor [-]"] == pytest.approx(
+        row["coupon_loss_factor [-]"] * row["coupon_vibrated_mass [kg]"]
+        / row["coupon_area [m^2]"] / 8.0 * 0.5, rel=1e-12)
+    assert row["panel_areal_mass [kg/m^2]"] == 8.0 and row["panel_treated_fraction [-]"] == 0.5
+
+
+@pytest.mark.parametrize("argv,message", [
+    (["--panel-areal-mass", "8000"], "--panel-areal-mass 8000 kg/m^2 is 505 x the coupons' own "
+                                     "areal mass (6.05 .. 15.8 kg/m^2, m_c / coupon area); "
+                                     "expected the panel's mass per m^2 in kg/m^2; was it "
+                                     "g/m^2?"),
+    (["--panel-areal-mass", "8", "--panel-treated-fraction", "50"],
+     "--panel-treated-fraction 50: expected the treated share of the panel's area, in (0, 1]; "
+     "was it a percentage?"),
+    (["--panel-treated-fraction", "0.5"], "--panel-treated-fraction 0.5: the share of a panel "
+                                          "given by --panel-areal-mass; give that too"),
+])
+def test_a_panel_areal_mass_or_share_in_the_wrong_unit_is_refused(tmp_path, argv, message):
+    out = tmp_path / "out"
+    with pytest.raises(ParameterError) as caught:
+        _run(["model", "damper", "--out", str(out), *argv])
+    assert str(caught.value) == message
+    assert not out.exists()  # nothing written
+
+
+@pytest.mark.parametrize("argv,message", [
+    (["--accelerations", "49"], "--accelerations 49: outside the model's range 1 .. 10 g (never "
+                                "extrapolated); expected g: was it m/s^2?"),
+    (["--fills", "0.5"], "--fills 0.5: outside the model's range 25 .. 90 % (never "
+                         "extrapolated); expected %: was it a fraction?"),
+    (["--frequencies", "0.2"], "--frequencies 0.2: outside the model's range 50 .. 1000 Hz "
+                               "(never extrapolated); expected Hz: was it kHz?"),
+    (["--frequencies", "1257"], "--frequencies 1257: outside the model's range 50 .. 1000 Hz "
+                                "(never extrapolated); expected Hz: was it rad/s?"),
+    (["--fills", "95"], "--fills 95: outside the model's range 25 .. 90 % (never "
+                        "extrapolated)"),
+])
+def test_a_grid_value_outside_the_model_names_its_unit_and_a_likely_slip(tmp_path, argv,
+                                                                         message):
+    # "--accelerations 49: outside the model's range 1 .. 10" named no unit: 49 m/s^2 typed
+    # for 5 g was left to guess
+    with pytest.raises(ParameterError) as caught:
+        _run(["model", "damper", "--out", str(tmp_path / "out"), *argv])
+    assert str(caught.value) == message

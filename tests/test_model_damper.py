@@ -16,6 +16,7 @@ from pidcore.model import (
     DAMPER_COLUMNS,
     SDC_FILLED_COLUMN,
     SDC_HELD_COLUMN,
+    SDC_HELD_ERROR_COLUMN,
     SdcModel,
     coupon_vibrated_mass_kg,
     damping_ratio,
@@ -116,19 +117,25 @@ def test_damper_table_content(model):
         assert column.endswith(f" [{unit}]"), column
         if pd.api.types.is_bool_dtype(t[column]):
             assert column in (SDC_FILLED_COLUMN, SDC_HELD_COLUMN) and unit == "True/False"
+        elif column == SDC_HELD_ERROR_COLUMN:  # its brackets name its values
+            assert set(t[column]) <= {"overstated", "understated", "unknown", "not held"}
+        elif column == "coupon_cells [-]":  # a count
+            assert pd.api.types.is_integer_dtype(t[column])
         else:
             assert pd.api.types.is_float_dtype(t[column])
     sdc = model(t["fill [%]"].to_numpy(), t["acceleration [g]"].to_numpy(),
                 t["frequency [Hz]"].to_numpy())
     np.testing.assert_array_equal(t["sdc [-]"], sdc)
-    np.testing.assert_allclose(t["vibrated_mass [kg]"], 0.02 + t["fill [%]"] / 1000)
-    np.testing.assert_allclose(t["c_eq_per_area [N s/m^3]"], t["c_eq [N s/m]"] / 0.01,
+    np.testing.assert_allclose(t["coupon_vibrated_mass [kg]"], 0.02 + t["fill [%]"] / 1000)
+    np.testing.assert_allclose(t["c_eq_per_treated_area [N s/m^3]"],
+                               t["c_eq_per_coupon [N s/m]"] / 0.01,
                                rtol=1e-14)
     w = 2 * np.pi * t["frequency [Hz]"]
     x = t["displacement_amplitude [m]"]
     np.testing.assert_allclose(x * w**2, t["acceleration [g]"] * STANDARD_GRAVITY, rtol=1e-14)
     # c_eq = dE / (pi w X^2) by definition of the equivalent damper
-    np.testing.assert_allclose(t["c_eq [N s/m]"], t["energy_per_cycle [J]"] / (np.pi * w * x**2),
+    np.testing.assert_allclose(t["c_eq_per_coupon [N s/m]"],
+                               t["coupon_energy_per_cycle [J]"] / (np.pi * w * x**2),
                                rtol=1e-13)
     flagged = t[t[SDC_FILLED_COLUMN]]
     assert flagged[["fill [%]", "acceleration [g]", "frequency [Hz]"]].values.tolist() == [
@@ -152,7 +159,7 @@ def test_damper_table_refuses_a_vibrated_mass_in_grams(model):
                                 frequencies_hz=[100], vibrated_mass_kg=98.8)
     kept = equivalent_damper_table(model, fills_percent=[50], accelerations_g=[5],
                                    frequencies_hz=[100], vibrated_mass_kg=0.0988)
-    assert kept["vibrated_mass [kg]"].tolist() == [0.0988]
+    assert kept["coupon_vibrated_mass [kg]"].tolist() == [0.0988]
 
 
 def test_written_files_round_trip(tmp_path):
@@ -168,11 +175,11 @@ def test_written_files_round_trip(tmp_path):
     back = pd.read_csv(paths[0])
     pd.testing.assert_frame_equal(back, table, check_exact=False, rtol=1e-15)
     doc = json.loads(paths[1].read_text())
-    assert doc["units"]["c_eq_per_area [N s/m^3]"] == "N s/m^3"
+    assert doc["units"]["c_eq_per_treated_area [N s/m^3]"] == "N s/m^3"
     assert doc["provenance"]["sdc_source"] == "synthetic"
-    energies = [r["energy_per_cycle [J]"] for r in doc["records"]]
-    assert energies == table["energy_per_cycle [J]"].tolist()  # full precision in JSON
-    assert doc["records"][-1]["damping_ratio [-]"] is None
+    energies = [r["coupon_energy_per_cycle [J]"] for r in doc["records"]]
+    assert energies == table["coupon_energy_per_cycle [J]"].tolist()  # full precision in JSON
+    assert doc["records"][-1]["coupon_damping_ratio [-]"] is None
     with pytest.raises(ParameterError, match="formats"):
         write_damper_table(table, tmp_path, formats=("xlsx",))
 
@@ -229,7 +236,7 @@ def test_points_held_at_the_edge_are_flagged(model):
 
 
 def test_an_area_in_cm2_or_mm2_is_refused_by_the_library(model):
-    # area_m2=100 (cm^2 of the paper's 0.01 m^2 coupon) gave a c_eq_per_area 1e4 x too small
+    # area_m2=100 (cm^2 of the paper's 0.01 m^2 coupon) gave a c_eq per area 1e4 x too small
     # without a word: only the CLI's --area was checked against the specimen's cells
     from pidcore.specimen import Specimen
 
@@ -246,7 +253,8 @@ def test_an_area_in_cm2_or_mm2_is_refused_by_the_library(model):
         assert "\n" not in message
     # the coupon's own area passes; another specimen's cells are what it is checked against
     ok = equivalent_damper_table(model, area_m2=0.01, **grid)
-    np.testing.assert_allclose(ok["c_eq_per_area [N s/m^3]"], ok["c_eq [N s/m]"] / 0.01,
+    np.testing.assert_allclose(ok["c_eq_per_treated_area [N s/m^3]"],
+                               ok["c_eq_per_coupon [N s/m]"] / 0.01,
                                rtol=1e-15)  # one division
     text = (Path(__file__).parents[1] / "data_samples" / "specimens"
             / "steel_6mm.toml").read_text()
@@ -269,16 +277,73 @@ def test_c_eq_per_cell_is_the_coupons_c_eq_shared_by_its_cells(model, tmp_path):
     steel = equivalent_damper_table(model, specimen=Specimen.from_text(text, source="s"),
                                     area_m2=0.01, **grid)
     # one division each: to rounding
-    np.testing.assert_allclose(paper["c_eq_per_cell [N s/m]"] * 441, paper["c_eq [N s/m]"],
+    np.testing.assert_allclose(paper["c_eq_per_cell [N s/m]"] * 441,
+                               paper["c_eq_per_coupon [N s/m]"],
                                rtol=1e-15)
-    np.testing.assert_allclose(steel["c_eq_per_cell [N s/m]"] * 286, steel["c_eq [N s/m]"],
+    np.testing.assert_allclose(steel["c_eq_per_cell [N s/m]"] * 286,
+                               steel["c_eq_per_coupon [N s/m]"],
                                rtol=1e-15)
     # the cells' dashpots in parallel dissipate the coupon's energy per cycle
     w = 2 * np.pi * paper["frequency [Hz]"]
     x = paper["displacement_amplitude [m]"]
     np.testing.assert_allclose(441 * np.pi * paper["c_eq_per_cell [N s/m]"] * w * x**2,
-                               paper["energy_per_cycle [J]"], rtol=1e-13)
+                               paper["coupon_energy_per_cycle [J]"], rtol=1e-13)
     path = write_damper_table(paper, tmp_path, formats=("json",))[0]
     doc = json.loads(path.read_text())
     assert doc["units"]["c_eq_per_cell [N s/m]"] == "N s/m"
     assert "per honeycomb cell (one cell)" in doc["columns"]["c_eq_per_cell [N s/m]"]
+
+
+@pytest.mark.parametrize("frequency_slope,acceleration_slope", [(+2e-4, -0.01), (-2e-4, +0.01)])
+def test_a_held_sdc_says_which_way_it_errs(frequency_slope, acceleration_slope):
+    # a 20 g or 2000 Hz row was flagged held, but not whether its SDC (and its c_eq) is too
+    # high or too low there. SDC linear along each axis: pchip reproduces it, so its
+    # continuation beyond the grid is the truth the held value is measured against.
+    grid = pd.MultiIndex.from_product([[25.0, 90.0], [1.0, 5.0, 10.0], [50.0, 500.0, 1000.0]],
+                                      names=["fill_percent", "acceleration_g", "frequency_hz"])
+    t = grid.to_frame(index=False)
+
+    def truth(a, f):
+        return 0.4 + acceleration_slope * (a - 5.0) + frequency_slope * (f - 500.0)
+
+    t["sdc"] = truth(t["acceleration_g"], t["frequency_hz"])
+    linear = SdcModel.from_table(t, value="sdc", source="linear")
+    # beyond one edge each, then two edges whose trends agree (both held values too high or
+    # both too low), then a point inside
+    points = [(5.0, 2000.0), (5.0, 20.0), (20.0, 500.0), (0.5, 500.0), (0.5, 2000.0),
+              (5.0, 500.0)]
+    table = pd.concat([equivalent_damper_table(linear, fills_percent=[50],
+                                               accelerations_g=[a], frequencies_hz=[f],
+                                               vibrated_mass_kg=0.1, clip_to_range=True)
+                       for a, f in points], ignore_index=True)
+    held_minus_truth = table["sdc [-]"] - truth(table["acceleration [g]"],
+                                                 table["frequency [Hz]"])
+    said = {"overstated": 1.0, "understated": -1.0, "not held": 0.0}
+    # the sign the column states is the sign of (held - truth), row by row
+    np.testing.assert_array_equal(np.sign(held_minus_truth.round(12)),
+                                  table[SDC_HELD_ERROR_COLUMN].map(said))
+    assert table[SDC_HELD_ERROR_COLUMN].iloc[-1] == "not held"
+    assert table[SDC_HELD_ERROR_COLUMN].iloc[-2] == ("understated" if frequency_slope > 0
+                                                     else "overstated")
+    # beyond two edges whose trends disagree (both held above, one rising, one falling) the
+    # model does not tell which wins
+    (two,) = equivalent_damper_table(linear, fills_percent=[50], accelerations_g=[20],
+                                     frequencies_hz=[2000], vibrated_mass_kg=0.1,
+                                     clip_to_range=True)[SDC_HELD_ERROR_COLUMN]
+    assert two == "unknown"
+
+
+def test_a_held_sdc_at_a_flat_edge_is_said_unknown():
+    # pchip sets the edge slope to 0 where its end formula turns against the first interval
+    # (here a slow rise from 1 to 5 g before a steep one to 10 g):
+    # the model then says nothing of the SDC beyond the edge
+    grid = pd.MultiIndex.from_product([[25.0, 90.0], [1.0, 5.0, 10.0], [50.0, 1000.0]],
+                                      names=["fill_percent", "acceleration_g", "frequency_hz"])
+    t = grid.to_frame(index=False)
+    t["sdc"] = t["acceleration_g"].map({1.0: 0.1, 5.0: 0.11, 10.0: 0.5})
+    turning = SdcModel.from_table(t, value="sdc", source="turning")
+    assert turning.held_edges(50.0, 0.5, 100.0)[0].slope == 0.0  # pchip's own edge slope
+    (said,) = equivalent_damper_table(turning, fills_percent=[50], accelerations_g=[0.5],
+                                      frequencies_hz=[100], vibrated_mass_kg=0.1,
+                                      clip_to_range=True)[SDC_HELD_ERROR_COLUMN]
+    assert said == "unknown"

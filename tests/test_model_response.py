@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 
 import numpy as np
@@ -277,3 +278,172 @@ def test_the_paper_models_held_1g_sdc_overstates_the_damping_below_it(model, mod
                           clip_to_range=True)
     assert "holding the 1 g SDC overstates the damping there" in r.clipped_note
     assert f"model slope there {slope:+.3g} per g" in r.clipped_note
+
+
+@pytest.mark.parametrize("slope_per_hz,said", [
+    (+4e-4, "rises with frequency: holding it understates the damping there (amplitude "
+            "overstated: conservative)"),
+    (-4e-4, "falls with frequency: holding it overstates the damping there (amplitude "
+            "understated: not conservative)"),
+    (0.0, "flat in frequency: holding it errs in a direction the model does not tell"),
+])
+def test_a_frequency_held_at_the_edge_says_which_way_it_errs(mode, slope_per_hz, said):
+    # a 300 Hz row beyond a 250 Hz model said "which way that errs is not assessed". SDC
+    # linear in frequency: pchip reproduces it, so its continuation beyond 250 Hz is the
+    # truth the held value is measured against.
+    grid = pd.MultiIndex.from_product([[25.0, 90.0], [1.0, 5.0, 10.0], [50.0, 150.0, 250.0]],
+                                      names=["fill_percent", "acceleration_g", "frequency_hz"])
+    table = grid.to_frame(index=False)
+    table["sdc"] = 0.2 + slope_per_hz * (table["frequency_hz"] - 250.0)
+    linear = SdcModel.from_table(table, value="sdc", source="linear in frequency")
+    r = harmonic_response(linear, mode, frequencies_hz=[280.0, 300.0], force_amplitude_n=10.0,
+                          clip_to_range=True)
+    assert r.clipped.all() and ((r.acceleration_g >= 1) & (r.acceleration_g <= 10)).all()
+    truth = 0.2 + slope_per_hz * (r.frequency_hz - 250.0)
+    # the way the note says it errs: held minus truth, positive where it "overstates"
+    assert set(np.sign(r.sdc - truth)) == {np.sign(slope_per_hz) * -1 or 0.0}
+    assert "frequency outside the model's [50, 250] Hz, the 250 Hz SDC held (model slope " \
+           f"there {slope_per_hz:+.3g} per Hz)" in r.clipped_note
+    assert said in r.clipped_note and "not assessed" not in r.clipped_note
+    td = time_domain_response(linear, mode, frequency_hz=300.0, force_amplitude_n=10.0,
+                              clip_to_range=True)
+    assert td.clipped and said in td.clipped_note
+
+
+def _constant_sdc_model(sdc: float) -> SdcModel:
+    grid = pd.MultiIndex.from_product([[25.0, 90.0], [1.0, 10.0], [50.0, 1000.0]],
+                                      names=["fill_percent", "acceleration_g", "frequency_hz"])
+    table = grid.to_frame(index=False)
+    table["sdc"] = sdc
+    return SdcModel.from_table(table, value="sdc", source="constant")
+
+
+def test_treated_regions_weight_the_damper_by_the_mode_shape_squared_exactly_as_a_2dof():
+    # harmonic_response put the whole treated area on the modal coordinate (no sum of
+    # c_i phi_i^2). Truth: a physical 2-DOF (two treated patches, masses proportional to
+    # their areas) solved directly, (K - w^2 M + j w C) x = F. With an SDC constant in
+    # acceleration each patch's damper is c_per_area x its area, so C is proportional to M:
+    # the modes stay uncoupled and a force shaped M phi excites mode 1 alone, making the
+    # single-mode answer exact (textbook proportional damping).
+    sdc, m_c, a_c = 0.3, 0.1, 0.01
+    model = _constant_sdc_model(sdc)
+    areas = np.array([0.05, 0.15])
+    masses = 40.0 * areas  # kg: 40 kg/m^2 panel
+    K = np.array([[6e5 + 3e5, -3e5], [-3e5, 3e5 + 9e5]])
+    M = np.diag(masses)
+    eigenvalues, vectors = np.linalg.eig(np.linalg.solve(M, K))
+    first = int(np.argmin(eigenvalues))
+    phi = vectors[:, first] / vectors[0, first] * 0.7  # any scaling: the mode's own is used
+    modal_mass = float(phi @ M @ phi)
+    f_n = float(np.sqrt(eigenvalues[first]) / (2 * np.pi))
+    mode = TreatedMode(natural_frequency_hz=f_n, modal_mass_kg=modal_mass,
+                       structural_damping_ratio=0.0, treated_area_m2=float(areas.sum()),
+                       fill_percent=50.0, coupon_vibrated_mass_kg=m_c,
+                       treated_regions=tuple(zip(areas, phi, strict=True)))
+    scale = 3.0
+    force = M @ phi * scale
+    f = np.array([0.9, 0.99, 1.0, 1.1]) * f_n  # at f_n only the particles damp it
+    r = harmonic_response(model, mode, frequencies_hz=f, force_amplitude_n=float(phi @ force),
+                          clip_to_range=True)  # constant SDC: the held edge value is exact
+    for fi, q in zip(f, r.amplitude_m, strict=True):
+        w = 2 * np.pi * fi
+        C = np.diag(sdc * m_c * fi / a_c * areas)  # c_eq per area x area, by hand
+        x = np.linalg.solve(K - w**2 * M + 1j * w * C, force)
+        # one linear solve against one scalar harmonic balance: round-off only
+        np.testing.assert_allclose(np.abs(x), np.abs(phi) * q, rtol=1e-9)
+    # the modal damper is sum c_i phi_i^2, so its ratio is that over 2 w m
+    c_modal = sdc * m_c * f[1] / a_c * float(np.sum(areas * phi**2))
+    assert r.particle_damping_n_s_m[1] == pytest.approx(c_modal, rel=1e-12)
+    # the whole treated area at amplitude 1 (the old assumption) is another damper here
+    uniform = harmonic_response(model, dataclasses.replace(mode, treated_regions=()),
+                                frequencies_hz=f, force_amplitude_n=float(phi @ force),
+                                clip_to_range=True)
+    c_uniform = sdc * m_c * f[1] / a_c * float(areas.sum())
+    assert uniform.particle_damping_n_s_m[1] == pytest.approx(c_uniform, rel=1e-12)
+    assert abs(c_uniform / c_modal - 1) > 0.2  # 27 %: far beyond the 2-DOF check's 1e-9
+    assert "2 treated region(s)" in r.mode_shape_note
+    assert "whole treated area (0.2 m^2) moves with the modal coordinate" in \
+        uniform.to_pandas().attrs["mode_shape_note"]
+
+
+def test_treated_regions_do_not_depend_on_the_mode_shapes_scaling(model):
+    # phi x s with the modal mass x s^2 and the modal force x s is the same physical mode:
+    # each region's physical amplitude |phi_i| X (and so its SDC) must not change
+    base = dict(natural_frequency_hz=300.0, structural_damping_ratio=0.01,
+                treated_area_m2=0.2, fill_percent=50.0,
+                coupon_vibrated_mass_kg=coupon_vibrated_mass_kg(
+                    particles_mass_kg=paper_particles_mass_kg(50)))
+    regions = ((0.05, 1.0), (0.1, 0.6), (0.05, -0.8))
+    f = np.array([280.0, 300.0, 320.0])
+    one = harmonic_response(model, TreatedMode(modal_mass_kg=2.0, treated_regions=regions,
+                                               **base), frequencies_hz=f, force_amplitude_n=8.0)
+    s = 2.5
+    scaled = TreatedMode(modal_mass_kg=2.0 * s**2, **base,
+                         treated_regions=tuple((a, p * s) for a, p in regions))
+    two = harmonic_response(model, scaled, frequencies_hz=f, force_amplitude_n=8.0 * s)
+    # the same residual solved to brentq's 1e-13: agreement to 1e-10
+    np.testing.assert_allclose(two.amplitude_m * s, one.amplitude_m, rtol=1e-10)
+    np.testing.assert_allclose(two.acceleration_g, one.acceleration_g, rtol=1e-10)
+    np.testing.assert_allclose(two.particle_damping_n_s_m / s**2, one.particle_damping_n_s_m,
+                               rtol=1e-10)
+    # the time integration of the same regions settles on the harmonic balance's amplitude
+    td = time_domain_response(model, TreatedMode(modal_mass_kg=2.0, treated_regions=regions,
+                                                 **base),
+                              frequency_hz=300.0, force_amplitude_n=8.0)
+    assert td.amplitude_m == pytest.approx(one.amplitude_m[1], rel=1e-4)  # settle residue
+
+
+@pytest.mark.parametrize("regions,message", [
+    (((0.1, 1.0), (0.05, 0.5)), r"treated_regions' areas sum to 0.15 m\^2, but "
+                                r"treated_area_m2 is 0.2 m\^2"),
+    (((0.25, 1.0), (-0.05, 0.5)), r"treated_regions\[1\] area_m2 must be finite and > 0"),
+    (((0.1, 0.0), (0.1, 0.0)), "every mode_shape_amplitude is 0"),
+    (((0.1, float("nan")), (0.1, 1.0)), r"treated_regions\[0\] mode_shape_amplitude must be "
+                                        "finite"),
+    ((0.1, 0.1), "expected \\(area_m2, mode_shape_amplitude\\) pairs"),
+])
+def test_treated_regions_that_do_not_split_the_treated_area_are_refused(mode, regions,
+                                                                        message):
+    with pytest.raises(ParameterError, match=message):
+        dataclasses.replace(mode, treated_regions=regions)
+
+
+def test_a_mode_without_structural_damping_at_its_natural_frequency_is_bounded_by_the_particles(
+        model):
+    # structural_damping_ratio=0 driven at f_n: the untreated bound F0/0 made the scan run on
+    # NaN and the solver refused with "response acceleration nan g"; the particles alone
+    # bound it. At resonance k = m w^2, so the balance is X w c_pd(X) = F0 by hand.
+    mc = coupon_vibrated_mass_kg(particles_mass_kg=paper_particles_mass_kg(50))
+    mode = TreatedMode(natural_frequency_hz=300.0, modal_mass_kg=2.0,
+                       structural_damping_ratio=0.0, treated_area_m2=0.2, fill_percent=50.0,
+                       coupon_vibrated_mass_kg=mc)
+    r = harmonic_response(model, mode, frequencies_hz=[300.0], force_amplitude_n=5.0)
+    x, w = r.amplitude_m[0], 2 * np.pi * 300.0
+    assert np.isfinite(x) and 1.0 <= r.acceleration_g[0] <= 10.0
+    sdc = float(model(50.0, w**2 * x / STANDARD_GRAVITY, 300.0))
+    c_by_hand = sdc * mc * 300.0 / 0.01 * 0.2  # SDC m_c f / A_c x A_t
+    assert x * w * c_by_hand == pytest.approx(5.0, rel=1e-10)  # brentq's 1e-13 on log X
+    assert r.amplitude_untreated_m[0] == np.inf  # undamped at resonance: unbounded
+    assert r.phase_rad[0] == pytest.approx(-np.pi / 2, abs=1e-12)
+    # where the model's SDC also reaches 0 nothing bounds it: refused, naming why
+    zero = _constant_sdc_model(0.0)
+    with pytest.raises(ParameterError, match=r"^harmonic_response: at 300 Hz \(the natural "
+                                             r"frequency\) nothing bounds the response"):
+        harmonic_response(zero, mode, frequencies_hz=[300.0], force_amplitude_n=5.0)
+
+
+def test_a_fill_outside_the_model_or_beyond_100_percent_is_refused_by_name(model, mode):
+    # fill_percent=150 was taken; a 95 % fill was then refused as "fill_percent=95 %,
+    # frequency_hz=300 Hz outside the model range {...}", clip_to_range or not
+    with pytest.raises(ParameterError, match=r"^TreatedMode: fill_percent must be in \(0, 100\] "
+                                             r"%, got 150"):
+        dataclasses.replace(mode, fill_percent=150.0)
+    beyond = dataclasses.replace(mode, fill_percent=95.0)
+    for clip in (False, True):
+        with pytest.raises(ParameterError) as caught:
+            harmonic_response(model, beyond, frequencies_hz=[300.0], force_amplitude_n=5.0,
+                              clip_to_range=clip)
+        assert str(caught.value).startswith(
+            "harmonic_response: fill_percent 95 % outside the SDC model range [25, 90] %;")
+    with pytest.raises(ParameterError, match=r"^time_domain_response: fill_percent 95 %"):
+        time_domain_response(model, beyond, frequency_hz=300.0, force_amplitude_n=5.0)

@@ -48,7 +48,7 @@ def test_the_readme_python_api_block_runs(tmp_path, monkeypatch, capsys):
     assert set(measured["packing ratio [%]"]) == {50.0}
     assert not any("no fill" in note for note in table.attrs.get("notes", []))
     assert namespace["run"].sdc > 0
-    assert list(namespace["damper"]["c_eq [N s/m]"] > 0) == [True, True]
+    assert list(namespace["damper"]["c_eq_per_coupon [N s/m]"] > 0) == [True, True]
 
 
 def test_the_refusals_the_python_api_section_promises():

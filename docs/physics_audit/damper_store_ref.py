@@ -40,13 +40,13 @@ def main(out_dir: str, store_h5: str) -> None:
         m_c = 441 * run.particles_per_cell * 4 / 3 * math.pi * 1.25e-3**3 * 1180 \
             + 2 * 0.01 * 0.25e-3 * 2800 + 0.01 * 0.0254 * 32.1
         sdc = run.energy_per_cycle_j / (m_c * a**2 / (2 * w**2))
-        mine = {"sdc [-]": sdc, "vibrated_mass [kg]": m_c,
-                "energy_per_cycle [J]": run.energy_per_cycle_j,
+        mine = {"sdc [-]": sdc, "coupon_vibrated_mass [kg]": m_c,
+                "coupon_energy_per_cycle [J]": run.energy_per_cycle_j,
                 "displacement_amplitude [m]": x,
-                "c_eq [N s/m]": run.energy_per_cycle_j / (math.pi * w * x**2),
-                "c_eq_per_area [N s/m^3]": run.energy_per_cycle_j / (math.pi * w * x**2) / 0.01,
-                "loss_factor [-]": sdc / (2 * math.pi),
-                "damping_ratio [-]": -math.log(1 - sdc) / (4 * math.pi) if sdc < 1 else math.nan}
+                "c_eq_per_coupon [N s/m]": run.energy_per_cycle_j / (math.pi * w * x**2),
+                "c_eq_per_treated_area [N s/m^3]": run.energy_per_cycle_j / (math.pi * w * x**2) / 0.01,
+                "coupon_loss_factor [-]": sdc / (2 * math.pi),
+                "coupon_damping_ratio [-]": -math.log(1 - sdc) / (4 * math.pi) if sdc < 1 else math.nan}
         for column, value in mine.items():
             if math.isnan(value):
                 assert math.isnan(row[column]), (column, row[column])
@@ -54,7 +54,7 @@ def main(out_dir: str, store_h5: str) -> None:
             worst[column] = max(worst.get(column, 0.0), abs(row[column] / value - 1))
     for column, rel in worst.items():
         print(f"| damper --table store {column} | {len(runs)} runs | {rel:.1e} |")
-    print("NaN damping ratio where SDC >= 1:", int(table["damping_ratio [-]"].isna().sum()),
+    print("NaN damping ratio where SDC >= 1:", int(table["coupon_damping_ratio [-]"].isna().sum()),
           "rows; SDC >= 1 in", int((table["sdc [-]"] >= 1).sum()))
 
 

@@ -101,6 +101,14 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         "0.1 m; required for runs of another specimen, whose file has no "
                         "coupon area; more than 100 x off its cells' cross-section is refused "
                         "as a unit slip)")
+    d.add_argument("--panel-areal-mass", metavar="KG_M2", type=_positive_float, default=None,
+                   help="mass per m^2 of your panel, with its particles, kg/m^2: adds "
+                        "panel_loss_factor, the loss factor the particles add to it moving as "
+                        "the coupon did (one amplitude everywhere; not a mode's); more than "
+                        "100 x outside the coupons' own m_c / area is refused as a unit slip")
+    d.add_argument("--panel-treated-fraction", metavar="F", type=_positive_float, default=None,
+                   help="with --panel-areal-mass: share of the panel's area filled, in (0, 1] "
+                        "(default 1)")
     d.set_defaults(func=run_damper)
 
     f = sub.add_parser("figures", help="SDC figures (paper Figs. 8-14), PNG and SVG")
@@ -180,14 +188,25 @@ def run_damper(args: argparse.Namespace) -> int:
             f"--vibrated-mass {as_given(args.vibrated_mass)}: the DEM runs in {args.store} divided "
             "their SDC by their own m_c, which c_eq = SDC m_c w / (2 pi) must use; leave "
             "--vibrated-mass out")
-    for option, axis, values in (("--fills", 0, args.fills), ("--accelerations", 1,
-                                                                args.accelerations),
-                                 ("--frequencies", 2, args.frequencies)):
+    # the unit each list is in, and the other units whose values would fall inside: 49
+    # (m/s^2 for 5 g) or 0.5 (a fraction for 50 %) was refused without naming the unit
+    from ..constants import STANDARD_GRAVITY
+
+    for option, axis, values, unit, slips in (
+            ("--fills", 0, args.fills, "%", (("a fraction", 100.0),)),
+            ("--accelerations", 1, args.accelerations, "g",
+             (("m/s^2", 1.0 / STANDARD_GRAVITY),)),
+            ("--frequencies", 2, args.frequencies, "Hz",
+             (("kHz", 1000.0), ("rad/s", 1.0 / (2.0 * math.pi))))):
         lo, hi = model.axes[axis][0], model.axes[axis][-1]
         outside = [v for v in values or () if not lo <= v <= hi]
         if outside:
-            raise ParameterError(f"{option} {','.join(as_given(v) for v in outside)}: outside "
-                                 f"the model's range {lo:g} .. {hi:g} (never extrapolated)")
+            hints = [name for name, factor in slips
+                     if all(lo <= v * factor <= hi for v in outside)]
+            raise ParameterError(
+                f"{option} {','.join(as_given(v) for v in outside)}: outside the model's range "
+                f"{lo:g} .. {hi:g} {unit} (never extrapolated)"
+                + (f"; expected {unit}: was it {' or '.join(hints)}?" if hints else ""))
     table3 = defaults.MODEL_PARTICLE_MATERIAL  # Table 3's particles (paper Sect. 4)
     if runs is None and args.vibrated_mass is None and args.material not in (None, table3):
         # Table 3's SDC is the acrylic coupon's dissipation over its own m_c: times the m_c
@@ -244,18 +263,31 @@ def run_damper(args: argparse.Namespace) -> int:
                              "over, e.g. --area 0.01")
     else:
         area, area_text = None, f"{coupon_area_m2():g} m^2 (the paper's 0.1 m x 0.1 m coupon)"
-    table = equivalent_damper_table(
-        model, fills_percent=args.fills if args.fills else model.axes[0],
-        accelerations_g=args.accelerations if args.accelerations else model.axes[1],
-        frequencies_hz=args.frequencies if args.frequencies else model.axes[2],
-        vibrated_mass_kg=mass, area_m2=area, specimen=specimen)
+    if args.panel_treated_fraction is not None and args.panel_areal_mass is None:
+        raise ParameterError(f"--panel-treated-fraction {as_given(args.panel_treated_fraction)}:"
+                             " the share of a panel given by --panel-areal-mass; give that too")
+    if args.panel_treated_fraction is not None and args.panel_treated_fraction > 1:
+        raise ParameterError(f"--panel-treated-fraction {as_given(args.panel_treated_fraction)}:"
+                             " expected the treated share of the panel's area, in (0, 1]; was "
+                             "it a percentage?")
+    try:
+        table = equivalent_damper_table(
+            model, fills_percent=args.fills if args.fills else model.axes[0],
+            accelerations_g=args.accelerations if args.accelerations else model.axes[1],
+            frequencies_hz=args.frequencies if args.frequencies else model.axes[2],
+            vibrated_mass_kg=mass, area_m2=area, specimen=specimen,
+            panel_areal_mass_kg_m2=args.panel_areal_mass,
+            panel_treated_fraction=args.panel_treated_fraction or 1.0)
+    except ParameterError as exc:  # the option as typed, not the library's keyword
+        raise ParameterError(str(exc).replace("panel_areal_mass_kg_m2", "--panel-areal-mass")
+                             ) from None
     provenance = {
         "sdc_source": model.source, "sdc_value": model.value_name,
         "interpolation": "tensor-product pchip (frequency, fill, acceleration passes)",
         "log_frequency": model.log_frequency, "vibrated_mass": mass_text,
         "area": area_text,
-        "cells": f"{specimen.cell.count} (specimen {specimen.name}): c_eq_per_cell is c_eq / "
-                 "this count",
+        "cells": f"{specimen.cell.count} (specimen {specimen.name}): c_eq_per_cell is "
+                 "c_eq_per_coupon / this count",
         # which DOF the dashpot goes on and which particles it is of: the table's numbers
         # do not say, and a damper along the face (x, y) differs from one normal to it (z)
         "direction": _direction_text(runs),
@@ -264,11 +296,17 @@ def run_damper(args: argparse.Namespace) -> int:
         else ", ".join(sorted(runs["material"].dropna().astype(str).unique())),
         "filled_grid_points": model.filled_points().to_dict(orient="records"),
     }
+    if args.panel_areal_mass is not None:
+        provenance["panel"] = (
+            f"{args.panel_areal_mass:g} kg/m^2 with its particles, "
+            f"{args.panel_treated_fraction or 1.0:g} of its area treated (given): "
+            "panel_loss_factor = c_eq_per_treated_area x treated fraction / (areal mass x w), "
+            "the panel moving as the coupon did (one amplitude everywhere), not a mode's")
     if stated is None:
         # the paper's 441 cells are a guess for these runs: a per-cell damper of it is not given
-        table = table.drop(columns="c_eq_per_cell [N s/m]")
+        table = table.drop(columns=["c_eq_per_cell [N s/m]", "coupon_cells [-]"])
         provenance["cells"] = ("not stored with the DEM runs (an older store): no "
-                               "c_eq_per_cell column")
+                               "c_eq_per_cell and coupon_cells columns")
     undefined = int((table["sdc [-]"] >= 1.0).sum())
     why = ("damping ratio -ln(1 - SDC) / (4 pi) is undefined where SDC >= 1 (a free decay "
            "would lose all its energy within a cycle): left empty")

@@ -527,8 +527,8 @@ def compare_case(records: Sequence[MeasuredEntry],
 
 def equivalent_dampers(comparison: CaseComparison) -> dict[str, float]:
     """The equivalent viscous damper ``c_eq = SDC m_c w / (2 pi)`` [N s/m] of a compared case,
-    the ``c_eq [N s/m]`` of ``pidcore model damper``: ``"our DEM"`` (its grid case's SDC and
-    m_c) and ``"measured"`` (the pooled Eq. 10 SDC with the same m_c, at the measured
+    the ``c_eq_per_coupon [N s/m]`` of ``pidcore model damper``: ``"our DEM"`` (its grid
+    case's SDC and m_c) and ``"measured"`` (the pooled Eq. 10 SDC with the same m_c, at the measured
     frequency: ``dE / (pi w X^2)`` of the measured energy per cycle). Empty where no DEM grid
     case states m_c (an interpolated DEM value has none); a value is left out where its SDC
     is not finite."""

@@ -11,15 +11,25 @@ load_paper_table3, TABLE3_COLUMNS
 SdcModel, AXIS_NAMES
     The pchip SDC model: ``SdcModel.from_table(table)(fill_percent, acceleration_g,
     frequency_hz)``; refuses points outside its grid.
+HeldEdge, HELD_ERRORS
+    ``SdcModel.held_edges(point)``: the axes a point lies beyond, the model's slope at each
+    edge and which way holding the edge SDC errs there.
 select_runs, DEM_CONDITION_COLUMNS
     The stored DEM runs of one set of conditions, to build a model from.
 equivalent_damper_table, write_damper_table, DAMPER_COLUMNS, DAMPER_COLUMN_MEANINGS
-    The equivalent viscous damper over a grid (a pandas frame whose columns name their
-    units; what each is, per what), and its CSV/JSON files.
-SDC_FILLED_COLUMN, SDC_HELD_COLUMN
-    Its flags: SDC at a filled hole of the grid, SDC held at the grid's edge.
+    The equivalent viscous damper over a grid (a pandas frame whose columns name what each
+    is per, coupon, cell or treated area, and their units; what each is), and its CSV/JSON
+    files.
+DAMPER_COLUMNS_RENAMED
+    The older names of its columns -> the present ones (``.rename(columns=...)``).
+SDC_FILLED_COLUMN, SDC_HELD_COLUMN, SDC_HELD_ERROR_COLUMN
+    Its flags: SDC at a filled hole of the grid, SDC held at the grid's edge, and which way
+    that errs (SdcModel.held_edges: the model's slope at the edge).
 loss_factor, damping_ratio, energy_per_cycle, sdc_from_energy_per_cycle, displacement_amplitude
     SDC to loss factor, damping ratio, energy per cycle (Eq. 8-10) and back.
+panel_loss_factor, PANEL_COLUMNS
+    The loss factor the particles add to a panel of known areal mass moving as the coupon
+    did (equivalent_damper_table's panel_areal_mass_kg_m2; CLI --panel-areal-mass).
 equivalent_damping_coefficient, sdc_from_damping_coefficient
     SDC to c_eq [N s/m] and back.
 coupon_area_m2, coupon_vibrated_mass_kg, paper_particles_mass_kg
@@ -36,8 +46,11 @@ time_domain_response, TimeDomainSteadyState
 from .damper import (
     DAMPER_COLUMN_MEANINGS,
     DAMPER_COLUMNS,
+    DAMPER_COLUMNS_RENAMED,
+    PANEL_COLUMNS,
     SDC_FILLED_COLUMN,
     SDC_HELD_COLUMN,
+    SDC_HELD_ERROR_COLUMN,
     coupon_area_m2,
     coupon_vibrated_mass_kg,
     damping_ratio,
@@ -46,6 +59,7 @@ from .damper import (
     equivalent_damper_table,
     equivalent_damping_coefficient,
     loss_factor,
+    panel_loss_factor,
     paper_particles_mass_kg,
     paper_vibrated_mass,
     runs_vibrated_mass,
@@ -61,13 +75,21 @@ from .response import (
     particle_damping_n_s_m,
     time_domain_response,
 )
-from .sdc_model import AXIS_NAMES, DEM_CONDITION_COLUMNS, SdcModel, select_runs
+from .sdc_model import (
+    AXIS_NAMES,
+    DEM_CONDITION_COLUMNS,
+    HELD_ERRORS,
+    HeldEdge,
+    SdcModel,
+    select_runs,
+)
 from .table3 import TABLE3_COLUMNS, load_paper_table3
 
 __all__ = [
-    "AXIS_NAMES", "DAMPER_COLUMN_MEANINGS", "DAMPER_COLUMNS", "DEM_CONDITION_COLUMNS",
-    "HarmonicResponse",
-    "SDC_FILLED_COLUMN", "SDC_HELD_COLUMN", "SdcModel",
+    "AXIS_NAMES", "DAMPER_COLUMN_MEANINGS", "DAMPER_COLUMNS",
+    "DAMPER_COLUMNS_RENAMED", "PANEL_COLUMNS", "panel_loss_factor", "DEM_CONDITION_COLUMNS",
+    "HELD_ERRORS", "HarmonicResponse", "HeldEdge",
+    "SDC_FILLED_COLUMN", "SDC_HELD_COLUMN", "SDC_HELD_ERROR_COLUMN", "SdcModel",
     "TABLE3_COLUMNS", "TimeDomainSteadyState", "TreatedMode", "coupon_area_m2",
     "coupon_vibrated_mass_kg", "damping_ratio", "displacement_amplitude", "energy_per_cycle",
     "equivalent_damper_table", "equivalent_damping_coefficient", "harmonic_response",

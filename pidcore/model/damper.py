@@ -35,6 +35,7 @@ from .. import defaults as D
 from ..constants import STANDARD_GRAVITY, VIBRATED_MASS_CONVENTIONS
 from ..errors import ParameterError
 from .sdc_model import SdcModel
+from .sdc_model import held_error as held_error_of
 
 if TYPE_CHECKING:  # a name for the hints only: the specimen module is imported where used
     from ..specimen import Specimen
@@ -46,6 +47,9 @@ SDC_FILLED_COLUMN = "sdc_filled [True/False]"
 #: The flag of :func:`equivalent_damper_table` marking points outside the model's grid whose SDC
 #: is the edge value held there (``clip_to_range=True`` only; False everywhere else).
 SDC_HELD_COLUMN = "sdc_held_at_edge [True/False]"
+#: Which way the SDC of a point flagged in :data:`SDC_HELD_COLUMN` errs, by the model's own
+#: slope at the edge held (:meth:`SdcModel.held_edges`); "not held" on the rows modelled.
+SDC_HELD_ERROR_COLUMN = "sdc_held_error [overstated/understated/unknown/not held]"
 #: Output columns of :func:`equivalent_damper_table` and their units, each named in the
 #: column's brackets (the flag's "unit" is its values).
 DAMPER_COLUMNS: dict[str, str] = {
@@ -55,15 +59,30 @@ DAMPER_COLUMNS: dict[str, str] = {
     "sdc [-]": "-",
     SDC_FILLED_COLUMN: "True/False",
     SDC_HELD_COLUMN: "True/False",
-    "loss_factor [-]": "-",
-    "damping_ratio [-]": "-",
-    "vibrated_mass [kg]": "kg",
-    "energy_per_cycle [J]": "J",
+    SDC_HELD_ERROR_COLUMN: "overstated/understated/unknown/not held",
+    "coupon_loss_factor [-]": "-",
+    "coupon_damping_ratio [-]": "-",
+    "coupon_vibrated_mass [kg]": "kg",
+    "coupon_area [m^2]": "m^2",
+    "coupon_cells [-]": "-",
+    "coupon_energy_per_cycle [J]": "J",
     "displacement_amplitude [m]": "m",
     "velocity_amplitude [m/s]": "m/s",
-    "c_eq [N s/m]": "N s/m",
-    "c_eq_per_area [N s/m^3]": "N s/m^3",
+    "c_eq_per_coupon [N s/m]": "N s/m",
+    "c_eq_per_treated_area [N s/m^3]": "N s/m^3",
     "c_eq_per_cell [N s/m]": "N s/m",
+}
+#: The names :data:`DAMPER_COLUMNS` had before pidcore said in each name what it is per (a
+#: reader of the CSV alone took the coupon's ``c_eq`` or ``loss_factor`` for its panel's):
+#: old name -> new name, for scripts reading an older file
+#: (``pd.read_csv(path).rename(columns=DAMPER_COLUMNS_RENAMED)``).
+DAMPER_COLUMNS_RENAMED: dict[str, str] = {
+    "loss_factor [-]": "coupon_loss_factor [-]",
+    "damping_ratio [-]": "coupon_damping_ratio [-]",
+    "vibrated_mass [kg]": "coupon_vibrated_mass [kg]",
+    "energy_per_cycle [J]": "coupon_energy_per_cycle [J]",
+    "c_eq [N s/m]": "c_eq_per_coupon [N s/m]",
+    "c_eq_per_area [N s/m^3]": "c_eq_per_treated_area [N s/m^3]",
 }
 #: What each column of :data:`DAMPER_COLUMNS` is, per what and where it applies (the JSON
 #: file's ``columns``): the brackets name the unit, not whether a number is the coupon's or
@@ -77,28 +96,97 @@ DAMPER_COLUMN_MEANINGS: dict[str, str] = {
                        "filled_grid_points)",
     SDC_HELD_COLUMN: "the point lies outside the model's grid: its SDC is the nearest edge "
                      "value held, not modelled there",
-    "loss_factor [-]": "SDC/(2 pi) of the coupon, relative to its own m_c: not a loss factor "
-                       "of another panel (its mass differs); use c_eq_per_area there",
-    "damping_ratio [-]": "-ln(1 - SDC)/(4 pi) of the coupon, relative to its own m_c "
-                         "(empty where SDC >= 1)",
-    "vibrated_mass [kg]": "m_c of Eq. 10 the SDC is taken over (provenance vibrated_mass: "
-                          "which masses)",
-    "energy_per_cycle [J]": "energy dissipated per drive cycle in the whole coupon, "
-                            "SDC m_c a^2/(2 w^2)",
+    SDC_HELD_ERROR_COLUMN: "which way a held SDC (and every damper of it) errs if the model's "
+                           "trend at the edge held (its slope there) continues beyond it: "
+                           "overstated below a rising edge or above a falling one, "
+                           "understated the other way; unknown where that slope is flat or "
+                           "two edges held disagree; not a bound",
+    "coupon_loss_factor [-]": "SDC/(2 pi) of the coupon, relative to its own m_c: not a loss "
+                              "factor of another panel (its mass differs); use "
+                              "c_eq_per_treated_area there",
+    "coupon_damping_ratio [-]": "-ln(1 - SDC)/(4 pi) of the coupon, relative to its own m_c "
+                                "(empty where SDC >= 1)",
+    "coupon_vibrated_mass [kg]": "m_c of Eq. 10 the SDC is taken over (provenance "
+                                 "vibrated_mass: which masses)",
+    "coupon_area [m^2]": "face area (one face) of the coupon c_eq_per_coupon is of: "
+                         "c_eq_per_treated_area = c_eq_per_coupon / coupon_area",
+    "coupon_cells [-]": "honeycomb cells of the coupon c_eq_per_coupon is of: c_eq_per_cell = "
+                        "c_eq_per_coupon / coupon_cells",
+    "coupon_energy_per_cycle [J]": "energy dissipated per drive cycle in the whole coupon, "
+                                   "SDC m_c a^2/(2 w^2)",
     "displacement_amplitude [m]": "a/w^2, the coupon's displacement amplitude",
     "velocity_amplitude [m/s]": "a/w, the coupon's velocity amplitude: the damper's force "
-                                "amplitude is c_eq times it",
-    "c_eq [N s/m]": "viscous damper of the whole coupon (provenance area), grounded: on the "
-                    "coupon's absolute velocity along the drive direction (provenance "
-                    "direction); pi c_eq w X^2 = energy_per_cycle",
-    "c_eq_per_area [N s/m^3]": "c_eq per m^2 of panel face (one face): spread over the treated "
-                               "area of a panel at the same fill, acceleration and frequency "
-                               "(e.g. a grounded dashpot of c_eq_per_area x tributary area at "
-                               "each node, along the drive direction)",
-    "c_eq_per_cell [N s/m]": "c_eq per honeycomb cell (one cell): c_eq / the coupon's cell "
-                             "count (provenance cells), for a panel whose cells are modelled "
-                             "one by one at the same fill, acceleration and frequency",
+                                "amplitude is c_eq_per_coupon times it",
+    "c_eq_per_coupon [N s/m]": "viscous damper of the whole coupon (coupon_area, coupon_cells), "
+                               "grounded: on the coupon's absolute velocity along the drive "
+                               "direction (provenance direction); pi c_eq_per_coupon w X^2 = "
+                               "coupon_energy_per_cycle",
+    "c_eq_per_treated_area [N s/m^3]": "c_eq_per_coupon per m^2 of coupon face (one face): "
+                                       "spread over the treated (filled) area of a panel at "
+                                       "the same fill, acceleration and frequency (e.g. a "
+                                       "grounded dashpot of c_eq_per_treated_area x tributary "
+                                       "treated area at each node, along the drive direction)",
+    "c_eq_per_cell [N s/m]": "c_eq_per_coupon per honeycomb cell (one cell): c_eq_per_coupon / "
+                             "coupon_cells, for a panel whose cells are modelled one by one at "
+                             "the same fill, acceleration and frequency",
 }
+
+
+#: The columns :func:`equivalent_damper_table` adds for a panel of known areal mass
+#: (``panel_areal_mass_kg_m2``), and their units.
+PANEL_COLUMNS: dict[str, str] = {
+    "panel_areal_mass [kg/m^2]": "kg/m^2",
+    "panel_treated_fraction [-]": "-",
+    "panel_loss_factor [-]": "-",
+}
+DAMPER_COLUMN_MEANINGS.update({
+    "panel_areal_mass [kg/m^2]": "mass per m^2 of the panel the loss factor is of, with its "
+                                 "particles (all the mass that moves)",
+    "panel_treated_fraction [-]": "share of the panel's face area filled at this fill "
+                                  "(treated area / panel area)",
+    "panel_loss_factor [-]": "loss factor the particles add to that panel if all of it moves "
+                             "as the coupon did (one amplitude everywhere, along the drive "
+                             "direction, at this acceleration and frequency): "
+                             "c_eq_per_treated_area x panel_treated_fraction / "
+                             "(panel_areal_mass x w); not a mode's, whose amplitude varies "
+                             "over the panel (harmonic_response with treated_regions)",
+})
+#: Most a panel's areal mass may lie outside the coupons' own (m_c / coupon area over the
+#: table) before it is refused as a unit slip: g/m^2 typed for kg/m^2 is 1000 x off, while a
+#: light 1 kg/m^2 skin or a heavy 50 kg/m^2 panel beside the paper coupon's 2.2-16 kg/m^2
+#: stays well within it.
+AREAL_MASS_LIMIT = 100.0
+
+
+def panel_loss_factor(c_eq_per_treated_area: float | np.ndarray, *,
+                      frequency_hz: float | np.ndarray, panel_areal_mass_kg_m2: float,
+                      treated_fraction: float = 1.0) -> np.ndarray:
+    """Loss factor [-] the particles add to a panel moving as the coupon did.
+
+    Every point of the panel (areal mass ``mu`` [kg/m^2] with its particles, a share
+    ``treated_fraction`` of its area ``A_p`` treated) moves at one amplitude X along the drive
+    direction: the treated area dissipates ``c'' A_t pi w X^2`` per cycle (``c''`` =
+    ``c_eq_per_treated_area``), the panel's peak kinetic energy is ``mu A_p w^2 X^2 / 2``,
+    and the loss factor, dissipation over 2 pi times it, is
+
+        eta = c'' (A_t / A_p) / (mu w).
+
+    Not a mode's: there the amplitude varies over the panel (use
+    :func:`~pidcore.model.harmonic_response` with ``treated_regions``).
+
+    Examples
+    --------
+    >>> float(panel_loss_factor(10.0, frequency_hz=100 / np.pi, panel_areal_mass_kg_m2=5.0,
+    ...                         treated_fraction=0.5))  # 10 x 0.5 / (5 x 200)
+    0.005
+    """
+    mu = float(_positive("panel_areal_mass_kg_m2", panel_areal_mass_kg_m2))
+    fraction = float(_positive("treated_fraction", treated_fraction))
+    if fraction > 1.0:
+        raise ParameterError(f"treated_fraction must be in (0, 1] (treated area / panel "
+                             f"area), got {treated_fraction!r}")
+    w = 2.0 * np.pi * _positive("frequency_hz", frequency_hz)
+    return np.asarray(c_eq_per_treated_area, dtype=float) * fraction / (mu * w)
 
 
 def _positive(name: str, value: np.ndarray) -> np.ndarray:
@@ -389,6 +477,8 @@ def equivalent_damper_table(model: SdcModel, *, fills_percent: Sequence[float] |
                             area_m2: float | None = None,
                             specimen: Specimen | None = None,
                             clip_to_range: bool = False,
+                            panel_areal_mass_kg_m2: float | None = None,
+                            panel_treated_fraction: float = 1.0,
                             fills: Sequence[float] | None = None,
                             accelerations: Sequence[float] | None = None,
                             frequencies: Sequence[float] | None = None) -> pd.DataFrame:
@@ -416,6 +506,13 @@ def equivalent_damper_table(model: SdcModel, *, fills_percent: Sequence[float] |
     clip_to_range : bool
         Passed to :meth:`SdcModel.evaluate` (default: refuse points outside the model); the
         points it held at the edge are flagged in :data:`SDC_HELD_COLUMN`.
+    panel_areal_mass_kg_m2 : float, optional
+        A panel's mass per m^2 of face, with its particles: adds :data:`PANEL_COLUMNS`, its
+        :func:`panel_loss_factor` (the panel moving as the coupon did). More than
+        :data:`AREAL_MASS_LIMIT` times outside the coupons' own m_c / area is refused as a
+        unit slip (g/m^2 typed for kg/m^2).
+    panel_treated_fraction : float
+        The share of that panel's area filled (default 1: all of it), in (0, 1].
     fills, accelerations, frequencies : sequence of float, optional
         The names of pidcore 0.2, without their units (a ``DeprecationWarning``); giving
         both names of one axis is refused.
@@ -425,7 +522,8 @@ def equivalent_damper_table(model: SdcModel, *, fills_percent: Sequence[float] |
     pandas.DataFrame
         Columns :data:`DAMPER_COLUMNS` (each names its unit); :data:`SDC_FILLED_COLUMN` (a
         bool flag) is True where the point coincides with a filled hole of the model grid,
-        :data:`SDC_HELD_COLUMN` where its SDC is an edge value held beyond the grid.
+        :data:`SDC_HELD_COLUMN` where its SDC is an edge value held beyond the grid, and
+        :data:`SDC_HELD_ERROR_COLUMN` which way that errs by the model's slope at the edge.
     """
     # one call each, not a loop: the warning points at the caller's line (stacklevel)
     fills = _one_name("fills_percent", fills_percent, "fills", fills)
@@ -454,13 +552,15 @@ def equivalent_damper_table(model: SdcModel, *, fills_percent: Sequence[float] |
     if area_m2 is None:
         area = coupon_area_m2()
     else:
-        # 100 (cm^2) for 0.01 m^2 gave a c_eq_per_area 1e4 x too small; only --area was checked
+        # 100 (cm^2) for 0.01 m^2 gave a c_eq per area 1e4 x too small; only --area was checked
         area = float(_positive("area_m2", area_m2))
         check_area(area, specimen)
     sdc = model.evaluate(p, a_g, f, clip_to_range=clip_to_range)
     # a 20 g row carried the 10 g SDC and a c_eq from it, like a modelled one
-    held = np.array([not model.contains(point) for point in zip(p, a_g, f, strict=True)],
-                    dtype=bool)
+    edges = [model.held_edges(*point) for point in zip(p, a_g, f, strict=True)]
+    held = np.array([bool(e) for e in edges], dtype=bool)
+    # the flag said a 20 g row was held at 10 g, not whether its damper is too high or too low
+    held_error = [held_error_of(e) or "not held" for e in edges]
     a = _positive("acceleration [g]", a_g) * STANDARD_GRAVITY
     c_eq = equivalent_damping_coefficient(sdc, vibrated_mass_kg=mass, frequency_hz=f)
     filled_pts = model.filled_points()
@@ -475,17 +575,35 @@ def equivalent_damper_table(model: SdcModel, *, fills_percent: Sequence[float] |
         "sdc [-]": sdc,
         SDC_FILLED_COLUMN: filled,
         SDC_HELD_COLUMN: held,
-        "loss_factor [-]": loss_factor(sdc),
-        "damping_ratio [-]": damping_ratio(sdc),
-        "vibrated_mass [kg]": mass,
-        "energy_per_cycle [J]": energy_per_cycle(sdc, vibrated_mass_kg=mass,
+        SDC_HELD_ERROR_COLUMN: held_error,
+        "coupon_loss_factor [-]": loss_factor(sdc),
+        "coupon_damping_ratio [-]": damping_ratio(sdc),
+        "coupon_vibrated_mass [kg]": mass,
+        "coupon_area [m^2]": np.full(p.shape, area),
+        "coupon_cells [-]": np.full(p.shape, specimen.cell.count, dtype=int),
+        "coupon_energy_per_cycle [J]": energy_per_cycle(sdc, vibrated_mass_kg=mass,
                                                  acceleration_m_s2=a, frequency_hz=f),
         "displacement_amplitude [m]": displacement_amplitude(a, f),
         "velocity_amplitude [m/s]": a / (2.0 * np.pi * f),
-        "c_eq [N s/m]": c_eq,
-        "c_eq_per_area [N s/m^3]": c_eq / area,
+        "c_eq_per_coupon [N s/m]": c_eq,
+        "c_eq_per_treated_area [N s/m^3]": c_eq / area,
         "c_eq_per_cell [N s/m]": c_eq / specimen.cell.count,
     })
+    if panel_areal_mass_kg_m2 is not None:
+        mu = float(_positive("panel_areal_mass_kg_m2", panel_areal_mass_kg_m2))
+        coupon = mass / area
+        low, high = float(coupon.min()), float(coupon.max())
+        if not low / AREAL_MASS_LIMIT <= mu <= high * AREAL_MASS_LIMIT:
+            hint = "was it g/m^2?" if mu > high else "was it in another unit?"
+            raise ParameterError(
+                f"panel_areal_mass_kg_m2 {mu:g} kg/m^2 is {mu / (high if mu > high else low):.3g}"
+                f" x the coupons' own areal mass ({low:.3g} .. {high:.3g} kg/m^2, m_c / "
+                f"coupon area); expected the panel's mass per m^2 in kg/m^2; {hint}")
+        out["panel_areal_mass [kg/m^2]"] = mu
+        out["panel_treated_fraction [-]"] = float(panel_treated_fraction)
+        out["panel_loss_factor [-]"] = panel_loss_factor(
+            out["c_eq_per_treated_area [N s/m^3]"].to_numpy(), frequency_hz=f,
+            panel_areal_mass_kg_m2=mu, treated_fraction=panel_treated_fraction)
     return out
 
 
@@ -541,7 +659,7 @@ def write_damper_table(table: pd.DataFrame, out_dir: str | Path, *,
         # to_dict keeps full float precision (to_json rounds to 10 significant digits)
         records = [{k: _json_value(v) for k, v in row.items()}
                    for row in table.to_dict(orient="records")]
-        units = {c: DAMPER_COLUMNS.get(c, "") for c in table.columns}
+        units = {c: {**DAMPER_COLUMNS, **PANEL_COLUMNS}.get(c, "") for c in table.columns}
         meanings = {c: DAMPER_COLUMN_MEANINGS.get(c, "") for c in table.columns}
         p.write_text(json.dumps({"records": records, "units": units, "columns": meanings,
                                  "provenance": prov}, indent=1))

@@ -13,6 +13,19 @@ with ``m_c`` and ``A_c`` the vibrated mass and area of the coupon tests behind t
 ``A_t`` the treated area: the damper dissipates, per unit treated area, what the coupon
 dissipated per unit area at the same acceleration amplitude and frequency.
 
+By default the whole treated area moves with the modal coordinate X (mode-shape amplitude 1
+over it; the result's ``mode_shape_note`` says so). Where the mode shape varies over the
+treated area, :attr:`TreatedMode.treated_regions` gives each region's area ``A_i`` and
+mode-shape amplitude ``phi_i`` (scaled as the modal mass is, ``m = sum m_j phi_j^2``): region
+``i`` moves ``|phi_i| X``, its damper ``c_i`` is taken at its own acceleration
+``w^2 |phi_i| X``, and projected on the mode (virtual work of the dashpot forces on the
+displacements ``phi_i X``) the modal damper is
+
+    c_pd(X, w) = sum_i c_i(|phi_i| X, w) phi_i^2,
+
+so the particles add a modal damping ratio ``c_pd / (2 w m)``. The mode is assumed to stay
+uncoupled from the others (the particle damping is light, or proportional to the mass).
+
 First-order harmonic balance gives the amplitude as the root of
 
     X |k - m w^2 + j w (c_s + c_pd(X, w))| = F0,    k = m (2 pi f_n)^2,  c_s = 2 zeta_s m 2 pi f_n.
@@ -67,7 +80,8 @@ class TreatedMode:
     structural_damping_ratio : float
         Viscous damping ratio of the untreated mode zeta_s [-] (loss factor / 2 at resonance).
     treated_area_m2 : float
-        Area A_t filled with particles [m^2] moving with the modal coordinate.
+        Area A_t filled with particles [m^2]; without ``treated_regions`` all of it moves with
+        the modal coordinate.
     fill_percent : float
         Fill of the treated cells [%].
     coupon_vibrated_mass_kg : float
@@ -83,6 +97,12 @@ class TreatedMode:
     coupon_specimen : pidcore.specimen.Specimen, optional
         Those coupons (default: the paper's; for stored DEM runs
         :func:`~pidcore.model.damper.runs_specimen`), to check ``coupon_area_m2`` against.
+    treated_regions : sequence of (area_m2, mode_shape_amplitude), optional
+        The treated area split into regions (cells, patches, FE element groups), each with its
+        area [m^2] and the mode's amplitude phi_i [-] there, in the scaling the modal mass is
+        of (``m = sum m_j phi_j^2`` over the structure: 1 for a mass-normalised shape with
+        ``modal_mass_kg=1``). The areas sum to ``treated_area_m2``. Default: one region,
+        ``treated_area_m2`` at amplitude 1.
     """
 
     natural_frequency_hz: float
@@ -93,6 +113,7 @@ class TreatedMode:
     coupon_vibrated_mass_kg: float
     coupon_area_m2: float = coupon_area_m2()
     coupon_specimen: Specimen | None = None
+    treated_regions: tuple[tuple[float, float], ...] = ()
 
     def __post_init__(self) -> None:
         for name in ("natural_frequency_hz", "modal_mass_kg", "structural_damping_ratio",
@@ -104,14 +125,69 @@ class TreatedMode:
             v = getattr(self, name)
             if not np.isfinite(v) or v <= 0:
                 raise ParameterError(f"TreatedMode: {name} must be finite and > 0, got {v!r}")
+        if not (math.isfinite(self.fill_percent) and 0 < self.fill_percent <= 100):
+            # 150 was taken, and refused later as a frequency "outside the model range"
+            raise ParameterError(f"TreatedMode: fill_percent must be in (0, 100] %, got "
+                                 f"{self.fill_percent!r}; was it a fraction or a count?")
         if not np.isfinite(self.structural_damping_ratio) or self.structural_damping_ratio < 0:
             raise ParameterError(f"TreatedMode: structural_damping_ratio must be >= 0, got "
                                  f"{self.structural_damping_ratio!r}")
+        object.__setattr__(self, "treated_regions", self._checked_regions())
         from ..specimen import paper_specimen
 
         # 100 (cm^2) for A_c = 0.01 m^2 gave a c_pd 1e4 x too small without a word
         check_area(self.coupon_area_m2, self.coupon_specimen or paper_specimen(),
                    "TreatedMode: coupon_area_m2")
+
+    def _checked_regions(self) -> tuple[tuple[float, float], ...]:
+        try:
+            regions = tuple((a, phi) for a, phi in self.treated_regions)
+        except (TypeError, ValueError):
+            raise ParameterError(f"TreatedMode: treated_regions: expected (area_m2, "
+                                 f"mode_shape_amplitude) pairs, got "
+                                 f"{self.treated_regions!r}") from None
+        for k, (area, phi) in enumerate(regions):
+            real_number(f"TreatedMode: treated_regions[{k}] area_m2", area)
+            real_number(f"TreatedMode: treated_regions[{k}] mode_shape_amplitude", phi)
+            if not (math.isfinite(area) and area > 0):
+                raise ParameterError(f"TreatedMode: treated_regions[{k}] area_m2 must be "
+                                     f"finite and > 0, got {area!r}")
+            if not math.isfinite(phi):
+                raise ParameterError(f"TreatedMode: treated_regions[{k}] mode_shape_amplitude "
+                                     f"must be finite, got {phi!r}")
+        if regions and all(phi == 0.0 for _, phi in regions):
+            raise ParameterError("TreatedMode: treated_regions: every mode_shape_amplitude is "
+                                 "0 (the treated area lies on a node line of the mode); "
+                                 "expected the mode to move some treated region")
+        if regions:
+            total = math.fsum(a for a, _ in regions)
+            # the regions split the treated area: a sum off it is a region left out or
+            # counted twice (float sums of many cells: 1e-9)
+            if not math.isclose(total, self.treated_area_m2, rel_tol=1e-9):
+                raise ParameterError(
+                    f"TreatedMode: treated_regions' areas sum to {total:g} m^2, but "
+                    f"treated_area_m2 is {self.treated_area_m2:g} m^2; expected the regions "
+                    "to split the treated area")
+        return tuple((float(a), float(phi)) for a, phi in regions)
+
+    @property
+    def regions(self) -> tuple[tuple[float, float], ...]:
+        """(area [m^2], mode-shape amplitude [-]) of each treated region: ``treated_regions``,
+        or the whole treated area at amplitude 1."""
+        return self.treated_regions or ((self.treated_area_m2, 1.0),)
+
+    @property
+    def mode_shape_note(self) -> str:
+        """What the particle damper assumes of the mode shape over the treated area."""
+        if not self.treated_regions:
+            return (f"the whole treated area ({self.treated_area_m2:g} m^2) moves with the "
+                    "modal coordinate (mode-shape amplitude 1 over it): the particle damper "
+                    "is not weighted by phi^2; give treated_regions (area, amplitude) where "
+                    "the mode shape varies over it")
+        amplitudes = [abs(phi) for _, phi in self.treated_regions]
+        return (f"{len(self.treated_regions)} treated region(s), mode-shape amplitude "
+                f"{min(amplitudes):.3g} .. {max(amplitudes):.3g}: modal particle damper "
+                "sum c_i(|phi_i| X) phi_i^2, each region's SDC at its own acceleration")
 
     @property
     def stiffness_n_m(self) -> float:
@@ -134,26 +210,35 @@ class HarmonicResponse:
     frequency_hz : ndarray
         Drive frequency [Hz].
     amplitude_m : ndarray
-        Displacement amplitude X [m].
+        Displacement amplitude X [m] of the modal coordinate (of the treated area where the
+        mode gives no ``treated_regions``).
     phase_rad : ndarray
         Phase of the displacement relative to the force [rad] (negative: lagging).
     acceleration_g : ndarray
-        Acceleration amplitude w^2 X [g] at which the SDC was taken.
+        Acceleration amplitude w^2 |phi| X [g] at which the SDC was taken, of the treated
+        region moving most (largest |phi|; phi = 1 without ``treated_regions``); another
+        region's is its |phi_i| / max |phi| times it.
     sdc : ndarray
-        SDC [-] used at the solution.
+        SDC [-] used at the solution, of that region.
     particle_damping_n_s_m : ndarray
-        c_pd [N s/m] at the solution.
+        Modal c_pd [N s/m] at the solution: sum c_i phi_i^2 over the treated regions.
     amplitude_untreated_m : ndarray
-        Amplitude without particles [m], for comparison.
+        Amplitude without particles [m], for comparison (inf for a mode without structural
+        damping driven at its natural frequency).
     clipped : ndarray of bool
         SDC taken at the edge of the model range (only with ``clip_to_range=True``).
     multiple_solutions : ndarray of bool
         More than one amplitude balances the force; the largest is reported.
+    mode_shape_note : str
+        What the particle damper assumed of the mode shape over the treated area
+        (:attr:`TreatedMode.mode_shape_note`).
     clipped_note : str
         What the ``clipped`` rows hold and which way that errs ("" where none is clipped):
         below an edge where the model's SDC rises with acceleration (its own slope there)
         the held edge SDC overstates the damping (amplitude understated, not conservative);
-        where it falls, understates it.
+        where it falls, understates it. A frequency beyond the model's range is judged
+        alike by the model's slope along frequency at its edge; where a slope is flat the
+        note says the direction is unknown.
     """
 
     frequency_hz: np.ndarray
@@ -167,6 +252,7 @@ class HarmonicResponse:
     multiple_solutions: np.ndarray
     force_amplitude_n: float
     clipped_note: str = ""
+    mode_shape_note: str = ""
 
     def to_pandas(self) -> pd.DataFrame:
         """One row per drive frequency, each column naming its unit.
@@ -174,7 +260,7 @@ class HarmonicResponse:
         Columns ``frequency [Hz]``, ``amplitude [m]``, ``phase [rad]``, ``acceleration [g]``,
         ``sdc [-]``, ``particle damping [N s/m]``, ``amplitude untreated [m]``,
         ``clipped [True/False]``, ``multiple solutions [True/False]``; ``attrs`` hold
-        ``force_amplitude_n`` and ``clipped_note``.
+        ``force_amplitude_n``, ``clipped_note`` and ``mode_shape_note``.
         """
         frame = pd.DataFrame({
             "frequency [Hz]": np.asarray(self.frequency_hz, dtype=float),
@@ -189,6 +275,7 @@ class HarmonicResponse:
         })
         frame.attrs["force_amplitude_n"] = float(self.force_amplitude_n)
         frame.attrs["clipped_note"] = self.clipped_note
+        frame.attrs["mode_shape_note"] = self.mode_shape_note
         return frame
 
     def plot(self, ax: Any = None) -> Any:
@@ -217,6 +304,13 @@ def _sdc_section(model: SdcModel, mode: TreatedMode, frequency_hz: float,
         raise ParameterError(f"{caller}: frequency {as_given(frequency_hz)} Hz outside "
                              f"the SDC model range [{f_lo:g}, {f_hi:g}] Hz; pass "
                              f"clip_to_range=True to hold the edge SDC")
+    p_lo, p_hi = model.bounds["fill_percent"]
+    if not p_lo * (1 - _RANGE_RTOL) <= mode.fill_percent <= p_hi * (1 + _RANGE_RTOL):
+        # a 95 % fill was refused naming the frequency and the whole range dict
+        raise ParameterError(f"{caller}: fill_percent {as_given(mode.fill_percent)} % outside "
+                             f"the SDC model range [{p_lo:g}, {p_hi:g}] %; the fill is the "
+                             "treatment's own: clip_to_range holds acceleration and frequency "
+                             "at the model's edge, not the fill")
     section = model.acceleration_section(mode.fill_percent,
                                          float(np.clip(frequency_hz, f_lo, f_hi)))
     a_lo, a_hi = model.bounds["acceleration_g"]
@@ -254,27 +348,53 @@ def _held_edge_error(section, acceleration_g: float, bounds: tuple[float, float]
     return where, way, slope
 
 
+#: What holding an SDC that errs this way (:data:`~pidcore.model.sdc_model.HELD_ERRORS`)
+#: does to the response.
+_HELD_CONSEQUENCE = {
+    "overstated": "overstates the damping there (amplitude understated: not conservative)",
+    "understated": "understates the damping there (amplitude overstated: conservative)",
+}
+
+
+def _held_frequency_error(model: SdcModel, fill_percent: float, acceleration_g: float,
+                          frequency_hz: float) -> str:
+    """The clause of a frequency beyond the model's range: the edge held and which way that
+    errs by the model's slope along frequency there; "" inside the range."""
+    edges = [e for e in model.held_edges(fill_percent, acceleration_g, frequency_hz)
+             if e.axis == "frequency_hz"]
+    if not edges:
+        return ""
+    (edge,) = edges
+    f_lo, f_hi = model.bounds["frequency_hz"]
+    held = (f"frequency outside the model's [{f_lo:g}, {f_hi:g}] Hz, the {edge.edge:g} Hz SDC "
+            f"held (model slope there {edge.slope:+.3g} per Hz)")
+    if edge.error == "unknown":
+        return (f"{held}, where its SDC is flat in frequency: holding it errs in a direction "
+                "the model does not tell")
+    trend = "rises" if edge.slope > 0 else "falls"
+    return (f"{held}, where its SDC {trend} with frequency: holding it "
+            f"{_HELD_CONSEQUENCE[edge.error]}")
+
+
 def _span(values: list[float], fmt: str) -> str:
     low, high = min(values), max(values)
     return format(low, fmt) if format(low, fmt) == format(high, fmt) \
         else f"{format(low, fmt)} .. {format(high, fmt)}"
 
 
-def _clipped_note(rows: list[tuple[float, float, bool, str, str, float]],
-                  frequency_bounds: tuple[float, float]) -> str:
-    """One line for the clipped rows (frequency, acceleration, frequency outside, and
-    :func:`_held_edge_error`'s where, which way, slope), grouped by edge and direction;
-    "" where none is clipped."""
-    groups: dict[tuple[bool, str, str], list[tuple[float, float, float]]] = {}
-    for f, acc, frequency_outside, where, way, slope in rows:
-        groups.setdefault((frequency_outside, where, way), []).append((f, acc, slope))
+def _clipped_note(rows: list[tuple[float, float, str, str, str, float]]) -> str:
+    """One line for the clipped rows (frequency, acceleration, the clause of a frequency held
+    (:func:`_held_frequency_error`), and :func:`_held_edge_error`'s where, which way, slope),
+    grouped by edge and direction; "" where none is clipped."""
+    groups: dict[tuple[str, str, str], list[tuple[float, float, float]]] = {}
+    for f, acc, frequency_held, where, way, slope in rows:
+        groups.setdefault((frequency_held, where, way), []).append((f, acc, slope))
     parts = []
-    for (frequency_outside, where, way), members in groups.items():
+    for (frequency_held, where, way), members in groups.items():
         clauses = []
-        if frequency_outside:
-            f_lo, f_hi = frequency_bounds
-            clauses.append(f"frequency outside the model's [{f_lo:g}, {f_hi:g}] Hz, the edge "
-                           "frequency's SDC held (which way that errs is not assessed)")
+        if frequency_held:
+            # a 2000 Hz row said only that its 1000 Hz SDC was held, not which way that errs
+            clauses.append(frequency_held)
         if where:
             clauses.append(f"response {_span([m[1] for m in members], '.3g')} g {where} "
                            f"(model slope there {_span([m[2] for m in members], '+.3g')} per "
@@ -285,12 +405,40 @@ def _clipped_note(rows: list[tuple[float, float, bool, str, str, float]],
 
 
 def particle_damping_n_s_m(sdc: np.ndarray | float, mode: TreatedMode,
-                           frequency_hz: float) -> np.ndarray:
-    """c_pd [N s/m] of the treated area for a given SDC (module docstring)."""
+                           frequency_hz: float, *, area_m2: float | None = None) -> np.ndarray:
+    """c_pd [N s/m] of the treated area (or of ``area_m2`` of it) for a given SDC, on that
+    area's own velocity (module docstring)."""
     per_area = equivalent_damping_coefficient(
         sdc, vibrated_mass_kg=mode.coupon_vibrated_mass_kg,
         frequency_hz=frequency_hz) / mode.coupon_area_m2
-    return per_area * mode.treated_area_m2
+    return per_area * (mode.treated_area_m2 if area_m2 is None else area_m2)
+
+
+def _modal_particle_damping(mode: TreatedMode, sdc_of, frequency_hz: float, x: np.ndarray
+                            ) -> np.ndarray:
+    """Modal c_pd [N s/m] at modal amplitude ``x``: sum over the treated regions of their
+    damper at their own acceleration w^2 |phi_i| x, times phi_i^2 (module docstring)."""
+    w = 2.0 * np.pi * frequency_hz
+    total = 0.0
+    for area, phi in mode.regions:
+        if phi == 0.0:  # a region on a node line neither moves nor damps the mode
+            continue
+        sdc = sdc_of(w**2 * abs(phi) * x / STANDARD_GRAVITY)
+        total = total + particle_damping_n_s_m(sdc, mode, frequency_hz, area_m2=area) * phi**2
+    return np.asarray(total, dtype=float)
+
+
+def _largest_amplitude(mode: TreatedMode) -> float:
+    """max |phi_i| over the treated regions: the region whose acceleration leaves the model's
+    range first above it (1 without regions)."""
+    return max(abs(phi) for _, phi in mode.regions)
+
+
+def _smallest_moving_amplitude(mode: TreatedMode) -> float:
+    """min |phi_i| > 0: the region whose acceleration leaves the model's range first below it
+    (a region at phi = 0 takes no SDC)."""
+    moving = [abs(phi) for _, phi in mode.regions if phi != 0.0]
+    return min(moving) if moving else math.nan
 
 
 def harmonic_response(model: SdcModel, mode: TreatedMode, *, frequencies_hz: np.ndarray,
@@ -323,26 +471,40 @@ def harmonic_response(model: SdcModel, mode: TreatedMode, *, frequencies_hz: np.
         raise ParameterError("frequencies_hz must be finite and > 0")
     k, m, c_s = mode.stiffness_n_m, mode.modal_mass_kg, mode.structural_damping_n_s_m
     a_lo, a_hi = model.bounds["acceleration_g"]
-    sdc_max = float(np.max(model.values))
+    sdc_max, sdc_min = float(np.max(model.values)), float(np.min(model.values))
     out = {name: np.empty(freqs.shape) for name in
            ("x", "phase", "acc", "sdc", "c_pd", "x0")}
     clipped = np.zeros(freqs.shape, dtype=bool)
     multiple = np.zeros(freqs.shape, dtype=bool)
     # a 0.3 g response took the 1 g SDC, flagged but not which way that errs
-    clip_rows: list[tuple[float, float, bool, str, str, float]] = []
+    clip_rows: list[tuple[float, float, str, str, str, float]] = []
+    phi_top, phi_low = _largest_amplitude(mode), _smallest_moving_amplitude(mode)
     for i, f in enumerate(freqs):
         w = 2.0 * np.pi * f
         sdc_of, freq_clipped, section = _sdc_section(model, mode, f, clip_to_range)
 
-        def c_pd(x: np.ndarray, sdc_of=sdc_of, w=w, f=f) -> np.ndarray:
-            return particle_damping_n_s_m(sdc_of(w**2 * x / STANDARD_GRAVITY), mode, f)
+        def c_pd(x: np.ndarray, sdc_of=sdc_of, f=f) -> np.ndarray:
+            return _modal_particle_damping(mode, sdc_of, f, x)
 
         def residual(log_x: np.ndarray, c_pd=c_pd, w=w) -> np.ndarray:
             x = np.exp(log_x)
             return x * np.abs(k - m * w**2 + 1j * w * (c_s + c_pd(x))) / force_amplitude_n - 1.0
 
-        x_hi = force_amplitude_n / abs(k - m * w**2 + 1j * w * c_s)
-        c_max = float(particle_damping_n_s_m(max(sdc_max, 0.0), mode, f))
+        with np.errstate(divide="ignore"):  # undamped at its natural frequency: inf
+            x_untreated = force_amplitude_n / abs(k - m * w**2 + 1j * w * c_s)
+        c_max, c_min = (float(_modal_particle_damping(mode, lambda _a, s=s: np.asarray(s), f,
+                                                      np.asarray(1.0)))
+                        for s in (max(sdc_max, 0.0), max(sdc_min, 0.0)))
+        # the least damping the model can give bounds the amplitude from above: with no
+        # structural damping at the natural frequency the untreated bound was 1/0, and the
+        # scan from it ran on NaN ("response acceleration nan g")
+        lightest = abs(k - m * w**2 + 1j * w * (c_s + c_min))
+        if lightest == 0.0:
+            raise ParameterError(
+                f"harmonic_response: at {f:g} Hz (the natural frequency) nothing bounds the "
+                "response: structural_damping_ratio is 0 and the SDC model reaches 0; give "
+                "the mode's structural damping ratio (> 0)")
+        x_hi = force_amplitude_n / lightest
         x_lo = force_amplitude_n / abs(k - m * w**2 + 1j * w * (c_s + c_max))
         if x_hi <= x_lo * (1 + 1e-14):
             roots = [np.log(x_hi)]
@@ -361,32 +523,39 @@ def harmonic_response(model: SdcModel, mode: TreatedMode, *, frequencies_hz: np.
         x = float(np.exp(max(roots)))
         # roots closer than 1e-9 in log(X) are one root found twice
         multiple[i] = np.unique(np.round(np.asarray(roots), 9)).size > 1
-        acc = w**2 * x / STANDARD_GRAVITY
-        acc_outside = not (a_lo * (1 - _RANGE_RTOL) <= acc <= a_hi * (1 + _RANGE_RTOL))
-        if acc_outside and not clip_to_range:
+        acc = w**2 * phi_top * x / STANDARD_GRAVITY
+        # the regions moving most and least take the highest and lowest accelerations
+        extremes = sorted({acc, w**2 * phi_low * x / STANDARD_GRAVITY})
+        outside = [a for a in extremes
+                   if not a_lo * (1 - _RANGE_RTOL) <= a <= a_hi * (1 + _RANGE_RTOL)]
+        if outside and not clip_to_range:
+            which = "" if len(mode.regions) == 1 else (
+                " of the treated region moving " + ("most" if outside[-1] == acc else "least"))
             raise ParameterError(
-                f"harmonic_response: at {f:g} Hz the response acceleration {acc:.3g} g is "
-                f"outside the SDC model range [{a_lo:g}, {a_hi:g}] g; change the force or pass "
-                f"clip_to_range=True to hold the edge SDC")
-        clipped[i] = acc_outside or freq_clipped
-        if clipped[i]:
-            clip_rows.append((float(f), float(acc), freq_clipped,
-                              *_held_edge_error(section, acc, (a_lo, a_hi))))
+                f"harmonic_response: at {f:g} Hz the response acceleration{which} "
+                f"{outside[-1]:.3g} g is outside the SDC model range [{a_lo:g}, {a_hi:g}] g; "
+                "change the force or pass clip_to_range=True to hold the edge SDC")
+        clipped[i] = bool(outside) or freq_clipped
+        for held_acc in outside or ([acc] if freq_clipped else []):
+            clip_rows.append((float(f), float(held_acc),
+                              _held_frequency_error(model, mode.fill_percent,
+                                                    float(np.clip(held_acc, a_lo, a_hi)), f),
+                              *_held_edge_error(section, held_acc, (a_lo, a_hi))))
         cp = float(c_pd(np.array(x)))
         out["x"][i] = x
         out["phase"][i] = -np.angle(k - m * w**2 + 1j * w * (c_s + cp))
         out["acc"][i] = acc
         out["sdc"][i] = float(sdc_of(np.array(acc)))
         out["c_pd"][i] = cp
-        out["x0"][i] = x_hi
+        out["x0"][i] = x_untreated
     return HarmonicResponse(frequency_hz=freqs, amplitude_m=out["x"], phase_rad=out["phase"],
                             acceleration_g=out["acc"], sdc=out["sdc"],
                             particle_damping_n_s_m=out["c_pd"],
                             amplitude_untreated_m=out["x0"], clipped=clipped,
                             multiple_solutions=multiple,
                             force_amplitude_n=float(force_amplitude_n),
-                            clipped_note=_clipped_note(clip_rows,
-                                                       model.bounds["frequency_hz"]))
+                            clipped_note=_clipped_note(clip_rows),
+                            mode_shape_note=mode.mode_shape_note)
 
 
 @dataclass(frozen=True)
@@ -462,12 +631,16 @@ def time_domain_response(model: SdcModel, mode: TreatedMode, *, frequency_hz: fl
 
     # c_pd is proportional to the SDC: its factor once, not its checks at every evaluation
     # (tens of thousands per integration)
-    c_per_sdc = float(particle_damping_n_s_m(1.0, mode, frequency_hz))
+    # per region: its modal damper per unit SDC (c_i phi_i^2) and |phi_i|
+    regions = [(float(particle_damping_n_s_m(1.0, mode, frequency_hz, area_m2=area)) * phi**2,
+                abs(phi)) for area, phi in mode.regions if phi != 0.0]
 
     def rhs(t: float, y: np.ndarray) -> list[float]:
         x, v = y
         amp = np.sqrt(x * x + (v / w) ** 2)
-        c = c_s + c_per_sdc * float(sdc_of(np.array(w**2 * amp / STANDARD_GRAVITY)))
+        c = c_s
+        for c_per_sdc, phi in regions:
+            c += c_per_sdc * float(sdc_of(np.array(w**2 * phi * amp / STANDARD_GRAVITY)))
         return [v, (force_amplitude_n * np.cos(w * t) - c * v - k * x) / m]
 
     x_scale = force_amplitude_n / k
@@ -481,8 +654,11 @@ def time_domain_response(model: SdcModel, mode: TreatedMode, *, frequency_hz: fl
     # fundamental by projection over whole cycles: x ~ X cos(w t + phase)
     coef = 2.0 * np.mean(x * np.exp(-1j * w * t))
     # a steady state at 817 g was returned as if the model held a damper there
-    acceleration_g = w**2 * float(abs(coef)) / STANDARD_GRAVITY
+    acceleration_g = w**2 * _largest_amplitude(mode) * float(abs(coef)) / STANDARD_GRAVITY
     a_lo, a_hi = model.bounds["acceleration_g"]
+    lowest = w**2 * _smallest_moving_amplitude(mode) * float(abs(coef)) / STANDARD_GRAVITY
+    if lowest < a_lo * (1 - _RANGE_RTOL):  # the region moving least is the one below
+        acceleration_g = lowest
     acceleration_outside = not (a_lo * (1 - _RANGE_RTOL) <= acceleration_g
                                 <= a_hi * (1 + _RANGE_RTOL))
     if acceleration_outside and not clip_to_range:
@@ -496,8 +672,11 @@ def time_domain_response(model: SdcModel, mode: TreatedMode, *, frequency_hz: fl
                                  settle_time_s=float(t_settle),
                                  clipped=bool(acceleration_outside or frequency_clipped),
                                  clipped_note=_clipped_note(
-                                     [(frequency_hz, acceleration_g, frequency_clipped,
+                                     [(frequency_hz, acceleration_g,
+                                       _held_frequency_error(
+                                           model, mode.fill_percent,
+                                           float(np.clip(acceleration_g, a_lo, a_hi)),
+                                           frequency_hz),
                                        *_held_edge_error(section, acceleration_g,
                                                          (a_lo, a_hi)))]
-                                     if acceleration_outside or frequency_clipped else [],
-                                     model.bounds["frequency_hz"]))
+                                     if acceleration_outside or frequency_clipped else []))

@@ -55,6 +55,54 @@ _AXIS_UNITS = {"fill_percent": "%", "acceleration_g": "g", "frequency_hz": "Hz"}
 #: Relative slack on the grid bounds in :meth:`SdcModel.contains` (float noise from unit
 #: conversions such as g -> m/s^2 -> g must not push a grid-edge point outside).
 _BOUND_RTOL = 1e-9
+#: Which way an SDC held at the model's edge errs (:attr:`HeldEdge.error`): the model's own
+#: trend at the edge, continued beyond it, lies below the held value ("overstated"), above
+#: it ("understated"), or the trend is flat there or the axes held disagree ("unknown").
+HELD_ERRORS: tuple[str, str, str] = ("overstated", "understated", "unknown")
+#: Step of the one-sided difference that takes the model's slope at an edge, relative to the
+#: axis span: the model is a C1 piecewise cubic, so the step's own error (its curvature x
+#: step) is 1e-8 of the SDC's change over the axis, and round-off (1e-16 / 1e-8) as small.
+_EDGE_STEP = 1e-8
+#: A slope whose change over the axis span is below this share of the model's largest SDC is
+#: flat: pchip sets an edge slope to exactly 0 where the data turn, and the difference then
+#: holds only the curvature x step (about 1e-8 of it).
+_FLAT_SLOPE = 1e-5
+
+
+@dataclass(frozen=True)
+class HeldEdge:
+    """One axis on which a point lies beyond the model's grid, its SDC held at the edge.
+
+    Attributes
+    ----------
+    axis : str
+        One of :data:`AXIS_NAMES`.
+    below : bool
+        The point lies below the axis's first value (else above its last).
+    edge : float
+        The edge value held, in the axis's unit (%, g or Hz).
+    slope : float
+        The model's slope there, d SDC / d axis [1 / unit], taken inward at the held point.
+    error : str
+        Which way the held SDC errs if the model's trend at the edge continues beyond it
+        (:data:`HELD_ERRORS`): below a rising edge (or above a falling one) the held value
+        is "overstated"; "unknown" where the slope is flat.
+    """
+
+    axis: str
+    below: bool
+    edge: float
+    slope: float
+    error: str
+
+
+def held_error(edges: Sequence[HeldEdge]) -> str:
+    """The one direction of :func:`SdcModel.held_edges`' edges ("" for none; "unknown" where
+    they disagree: the model does not tell which trend wins beyond two edges)."""
+    errors = {e.error for e in edges}
+    if not errors:
+        return ""
+    return errors.pop() if len(errors) == 1 else "unknown"
 
 
 def _pchip_select(x: np.ndarray, y: np.ndarray, xq: np.ndarray, *,
@@ -297,6 +345,45 @@ class SdcModel:
         # pass 3: acceleration -> (N,)
         v = _pchip_select(self.axes[1], v, acc)
         return v.reshape(shape)
+
+    def held_edges(self, fill_percent: float, acceleration_g: float, frequency_hz: float
+                   ) -> tuple[HeldEdge, ...]:
+        """The axes on which a point lies beyond the grid, each with the model's slope at its
+        edge and the way holding the edge SDC errs there (:class:`HeldEdge`); empty inside.
+
+        The slope is taken at the held point (the other coordinates clamped as
+        :meth:`evaluate` with ``clip_to_range=True`` clamps them), one-sided into the grid.
+        It is the model's own trend, not a bound: beyond the edge no data say how the SDC
+        goes on.
+        """
+        point = [float(v) for v in (fill_percent, acceleration_g, frequency_hz)]
+        if not all(np.isfinite(point)):
+            raise ParameterError(f"SdcModel.held_edges: point {point} must be finite")
+        held = [float(np.clip(v, ax[0], ax[-1])) for v, ax in zip(point, self.axes,
+                                                                  strict=True)]
+        scale = max(float(np.max(np.abs(self.values))), np.finfo(float).tiny)
+        edges = []
+        for k, (name, ax) in enumerate(zip(AXIS_NAMES, self.axes, strict=True)):
+            slack = _BOUND_RTOL * max(abs(ax[0]), abs(ax[-1]))
+            if ax[0] - slack <= point[k] <= ax[-1] + slack:
+                continue
+            below = bool(point[k] < ax[0])
+            span = float(ax[-1] - ax[0])
+            step = _EDGE_STEP * span
+            inner = list(held)
+            inner[k] = held[k] + (step if below else -step)
+            at_edge, inside = (float(self.evaluate(*map(np.asarray, q))) for q in (held, inner))
+            # + 0.0: a flat edge read -0 per Hz
+            slope = (inside - at_edge) / step * (1.0 if below else -1.0) + 0.0
+            if abs(slope) * span <= _FLAT_SLOPE * scale:
+                error = "unknown"
+            else:
+                # the edge's own trend continued: lower below a rising edge, higher above it
+                error = "overstated" if (slope > 0) == below else "understated"
+            edges.append(HeldEdge(axis=name, below=below,
+                                  edge=float(ax[0] if below else ax[-1]), slope=slope,
+                                  error=error))
+        return tuple(edges)
 
     def acceleration_section(self, fill_percent: float, frequency_hz: float) -> PchipInterpolator:
         """The model along acceleration at a fixed fill and frequency, as a 1-D pchip in g.

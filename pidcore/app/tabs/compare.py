@@ -169,9 +169,9 @@ def render(stores, session_files: list, calibrations: list) -> None:
                + f". DEM alignment: {aligned.status}. {aligned.message}")
     dampers = equivalent_dampers(comp)
     if dampers:  # the FEM number of `pidcore model damper` at this case
-        st.caption("equivalent viscous damper c_eq = SDC m_c ω/(2π) (as `pidcore model "
-                   "damper`): " + " · ".join(f"{name} **{c:.4g} N s/m**"
-                                             for name, c in dampers.items())
+        st.caption("equivalent viscous damper of the whole coupon c_eq = SDC m_c ω/(2π) (as "
+                   "`pidcore model damper`'s c_eq_per_coupon): "
+                   + " · ".join(f"{name} **{c:.4g} N s/m**" for name, c in dampers.items())
                    + f" (m_c = {comp.aligned.grid_case.vibrated_mass_kg:.4g} kg of the DEM "
                      "case)")
     if len(members) > 1:
