@@ -135,7 +135,13 @@ def rate_from_times(times: np.ndarray, *, what: str, with_note: bool = False):
     residual = np.max(np.abs(t - (t[0] + dt * index)))
     note = ""
     if residual <= EVEN_SPACING_TOLERANCE * dt:
-        rate, start = snap_rate(1.0 / dt, FLOAT64_RATE_RESOLUTION), float(t[0])
+        # the end points carry the column's rounding too: printed with 9 digits, 2 s at
+        # 12 800 Hz gave 12 799.99997 Hz, and an x/y pair column of the same clock printed
+        # exactly gave 12 800 Hz, so the two were refused as different rates ("12800 Hz
+        # differs from 12800 Hz"). Whole Hz within what the scatter about the grid allows.
+        span = float(t[-1] - t[0])
+        rate = snap_rate(1.0 / dt, max(2.0 * float(residual) / span, FLOAT64_RATE_RESOLUTION))
+        start = float(t[0])
     else:
         # half a unit in the last printed digit of the largest time
         magnitude = float(np.max(np.abs(t[[0, -1]])))
