@@ -281,9 +281,14 @@ def check_same_sampling(names: list[str], sample_rates_hz: list[float], lengths:
     ref_rate, ref_len = sample_rates_hz[0], lengths[0]
     for name, rate, length in zip(names[1:], sample_rates_hz[1:], lengths[1:], strict=True):
         if abs(rate - ref_rate) > SAME_RATE_RELATIVE_TOLERANCE * ref_rate:
-            raise ChannelError(f"{_label(source, name)}: sample rate {rate:g} Hz differs from "
-                               f"{ref_rate:g} Hz of channel {names[0]!r}; expected simultaneous "
-                               "channels")
+            # as many digits as show the difference: '12800 Hz differs from 12800 Hz' (6
+            # digits of rates 2.5e-9 apart) read as a contradiction
+            digits = 6
+            while f"{rate:.{digits}g}" == f"{ref_rate:.{digits}g}" and digits < 17:
+                digits += 1
+            raise ChannelError(f"{_label(source, name)}: sample rate {rate:.{digits}g} Hz "
+                               f"differs from {ref_rate:.{digits}g} Hz of channel "
+                               f"{names[0]!r}; expected simultaneous channels")
         if length != ref_len:
             raise ChannelError(f"{_label(source, name)}: {length} samples differs from "
                                f"{ref_len} samples of channel {names[0]!r}; expected channels "
