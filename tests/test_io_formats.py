@@ -205,6 +205,29 @@ def test_csv_time_rounded_to_printed_digits_is_accepted(tmp_path):
     assert read_measurement(path).channels[0].sample_rate_hz == pytest.approx(3000.0, rel=1e-6)
 
 
+def _bytes_kept_alive(array: np.ndarray) -> int:
+    """Size of the memory ``array`` keeps alive: its own, or that of the array it views."""
+    while isinstance(array.base, np.ndarray):
+        array = array.base
+    return array.nbytes
+
+
+def test_csv_channels_do_not_keep_the_whole_table_alive(tmp_path):
+    # channels in SI units were column views of the (rows x columns) table, which a
+    # measurement then kept whole (time and every other column: 7 x the channel here) for as
+    # long as `analyze` held its record, one per file given
+    n = 2000
+    t = np.arange(n) / 1000.0
+    path = tmp_path / "wide.csv"
+    path.write_text("Time [s],Force [N],Velocity [m/s],A1 [g],A2 [g],A3 [m/s^2],Mic [Pa]\n"
+                    + "".join(f"{x:.6f},{np.sin(x)},{np.cos(x)},1,2,3,4\n" for x in t))
+    m = read_measurement(path)
+    assert [c.n_samples for c in m.channels] == [n] * 6
+    for channel in m.channels:
+        assert _bytes_kept_alive(channel.data) == n * 8, channel.name
+    np.testing.assert_allclose(m.channel("Force").data, np.sin(t), rtol=1e-15)
+
+
 def test_csv_nan_passes_through_reader(tmp_path):
     path = tmp_path / "nan.csv"
     path.write_text("Time [s],F [N],V [m/s]\n0,1,nan\n0.1,,2\n0.2,3,inf\n")
