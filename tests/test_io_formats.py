@@ -198,6 +198,48 @@ def test_csv_uneven_time_column_rejected(tmp_path):
         read_measurement(path)
 
 
+def _time_csv(path, times, digits):
+    path.write_text("Time [s],F [N]\n" + "".join(f"{x:.{digits}g},1.0\n" for x in times))
+    return path
+
+
+def test_csv_missing_sample_is_refused_whatever_the_digits_assumed(tmp_path):
+    # 20 s at 2048 Hz with one sample missing, printed with 9 digits: the rounding of 5
+    # digits was assumed (5e-4 s, a whole interval) and the gap was read as rounding, noted
+    # as "printed with about 5 significant digits", at 2047.95 Hz
+    t = np.delete(np.arange(20 * 2048) / 2048.0, 30_000)
+    with pytest.raises(InputFileError) as exc:
+        read_measurement(_time_csv(tmp_path / "gap.csv", t, 9))
+    message = str(exc.value)
+    assert "not evenly spaced" in message and "interval after sample 29999 is 0.0009766 s" \
+        in message and "printed with 9 significant digits" in message
+    # the same clock printed with 5 digits (MATLAB csvwrite) is off the grid by rounding: read
+    # at its rate, the digits said
+    m = read_measurement(_time_csv(tmp_path / "csvwrite.csv", np.arange(20 * 2048) / 2048.0, 5))
+    assert m.channels[0].sample_rate_hz == 2048.0
+    assert any("time printed with 5 significant digits" in n
+               for n in m.metadata["reader_notes"])
+
+
+def test_mat_time_vector_single_precision_accepted_full_precision_gap_refused(tmp_path):
+    t = np.arange(600 * 1000) / 1000.0
+    single = tmp_path / "single.mat"
+    scipy.io.savemat(single, {"time": t.astype(np.float32), "F": np.ones(t.size)})
+    m = read_measurement(single)
+    # float32 rounds 600 s to 3e-5 s, 0.03 of an interval: on the grid within its precision
+    assert m.channels[0].sample_rate_hz == 1000.0
+    assert any("time stored in single precision" in n for n in m.metadata["reader_notes"])
+    # k/3000 s is on no decimal grid and not single precision; one sample missing in 60 s was
+    # taken for the rounding of 5 printed digits (5e-4 s, 1.5 intervals)
+    gap = tmp_path / "gap.mat"
+    scipy.io.savemat(gap, {"time": np.delete(np.arange(60 * 3000) / 3000.0, 1000),
+                           "F": np.ones(60 * 3000 - 1)})
+    with pytest.raises(InputFileError, match=r"gap\.mat.*not evenly spaced.*interval after "
+                                             r"sample 999 is 0\.000666667 s; stored to full "
+                                             r"precision"):
+        read_measurement(gap)
+
+
 def test_csv_time_rounded_to_printed_digits_is_accepted(tmp_path):
     t = np.arange(5000) / 3000.0  # 1/3000 s does not print exactly
     path = tmp_path / "rounded.csv"
