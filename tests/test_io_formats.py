@@ -334,6 +334,33 @@ def test_mat_v73_hdf5_simple_layout(tmp_path):
     np.testing.assert_allclose(ch.data, 1e3 * np.cos(t), rtol=1e-15)
 
 
+def _hand_made_hdf5(path, velocity_unit, velocity):
+    """A measurement file another program wrote in pidcore's layout (h5py, no pidcore)."""
+    with h5py.File(path, "w") as h5:
+        h5.attrs["pidcore_layout"] = "measurement"
+        channels = h5.create_group("channels")
+        for i, (name, quantity, unit, data) in enumerate(
+                [("Force", "force", "N", np.ones(64)),
+                 ("Velocity", "velocity", velocity_unit, velocity)]):
+            ds = channels.create_dataset(f"{i:03d}", data=data)
+            ds.attrs.update(name=name, quantity=quantity, unit=unit, source_unit=unit,
+                            sample_rate_hz=1000.0)
+    return path
+
+
+def test_hdf5_layout_channel_stating_a_unit_other_than_si_is_refused(tmp_path):
+    # samples in mm/s with unit 'mm/s' were read as m/s: 5000 g and 1000 x the energy per
+    # cycle for a 5 g test, the channel listed as 'm/s' from 'mm/s' as if converted
+    velocity = np.full(64, 25.0)
+    with pytest.raises(InputFileError, match=r"mm\.h5.*/channels/001: attribute unit is "
+                                             r"'mm/s', not the SI unit of its quantity velocity "
+                                             r"\('m/s'\)"):
+        read_measurement(_hand_made_hdf5(tmp_path / "mm.h5", "mm/s", velocity))
+    # an SI unit spelt otherwise is SI: the samples as they are
+    m = read_measurement(_hand_made_hdf5(tmp_path / "si.h5", "m/sec", velocity))
+    np.testing.assert_array_equal(m.channel("Velocity").data, velocity)
+
+
 def test_hdf5_store_with_several_measurements(tmp_path):
     path = tmp_path / "store.h5"
     a, b = _measurement(), _measurement(rate=1000.0, n=50)
