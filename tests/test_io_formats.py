@@ -361,6 +361,26 @@ def test_hdf5_layout_channel_stating_a_unit_other_than_si_is_refused(tmp_path):
     np.testing.assert_array_equal(m.channel("Velocity").data, velocity)
 
 
+def test_mat_pidcore_layout_channel_stating_a_unit_other_than_si_is_refused(tmp_path):
+    # the MATLAB form of the same layout ignored its 'unit' field the same way
+    def write(path, unit):
+        channels = np.empty((1, 2), dtype=object)
+        for i, (name, quantity, u, data) in enumerate([("Force", "force", "N", np.ones(64)),
+                                                        ("Acc", "acceleration", unit,
+                                                         np.full(64, 2.0))]):
+            channels[0, i] = {"name": name, "quantity": quantity, "unit": u, "source_unit": u,
+                              "data": data, "sample_rate_hz": 1000.0, "start_time_s": 0.0}
+        scipy.io.savemat(path, {"pidcore_layout": "measurement", "pidcore_channels": channels})
+        return path
+
+    with pytest.raises(InputFileError, match=r"g\.mat: pidcore_channels\{2\}: field unit is "
+                                             r"'g', not the SI unit of its quantity "
+                                             r"acceleration \('m/s\^2'\)"):
+        read_measurement(write(tmp_path / "g.mat", "g"))
+    m = read_measurement(write(tmp_path / "si.mat", "m/s2"))
+    np.testing.assert_array_equal(m.channel("Acc").data, 2.0)
+
+
 def test_hdf5_store_with_several_measurements(tmp_path):
     path = tmp_path / "store.h5"
     a, b = _measurement(), _measurement(rate=1000.0, n=50)

@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..constants import SI_UNITS
 from ..errors import InputFileError
 from ..records import Channel
 from ..units import canonical_unit_text, lookup_unit
@@ -228,6 +229,23 @@ def interpret_unit(unit_text: str) -> tuple[str, float]:
     if info is None:
         return "unknown", 1.0
     return info.quantity, info.factor
+
+
+def refuse_unit_other_than_si(quantity: str, unit: str, *, where: str) -> None:
+    """Refuse the unit a pidcore layout (HDF5, MATLAB) states for a channel's samples where it
+    is not the SI unit of the channel's quantity: the layouts hold samples in SI, and a file
+    written by another program that states its samples' own unit there ('mm/s') was read as
+    m/s without a word (5000 g for 5 g). Which of the two is wrong, the samples or the unit,
+    cannot be told. No unit stated, or a quantity without one, is not checked."""
+    quantity, unit = quantity.strip(), unit.strip()
+    si_unit = SI_UNITS.get(quantity)
+    if not unit or si_unit is None or quantity == "unknown":
+        return
+    info = lookup_unit(unit)
+    if info is not None and info.quantity == quantity and abs(info.factor - 1.0) <= 1e-12:
+        return  # an SI spelling ('m/s2' for 'm/s^2')
+    raise InputFileError(f"{where} is {unit!r}, not the SI unit of its quantity {quantity} "
+                         f"({si_unit!r}); pidcore's layout holds samples in SI")
 
 
 def make_channel(name: str, values: np.ndarray, *, sample_rate_hz: float, unit: str,

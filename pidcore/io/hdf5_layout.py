@@ -21,11 +21,9 @@ import json
 import h5py
 import numpy as np
 
-from ..constants import SI_UNITS
 from ..errors import InputFileError
 from ..records import Channel, Measurement
-from ..units import lookup_unit
-from ._common import real_samples, real_scalar
+from ._common import real_samples, real_scalar, refuse_unit_other_than_si
 
 LAYOUT_TAG = "measurement"
 #: Samples compared at a time when deciding whether a channel is float32 (8 MB widened).
@@ -87,23 +85,6 @@ def _channel_dataset(channels: h5py.Group, key: str, where: str) -> h5py.Dataset
     return item
 
 
-def _refuse_unit_other_than_si(ds: h5py.Dataset, at: str) -> None:
-    """Refuse a channel whose ``unit`` attribute is not the SI unit of its quantity: the
-    layout holds samples in SI, and a file written by another program that states its
-    samples' own unit there ('mm/s') was read as m/s without a word (5000 g for 5 g). Which
-    of the two is wrong, the samples or the attribute, cannot be told."""
-    quantity = _text(ds.attrs.get("quantity", "")).strip()
-    unit = _text(ds.attrs.get("unit", "")).strip()
-    si_unit = SI_UNITS.get(quantity)
-    if not unit or si_unit is None or quantity == "unknown":
-        return
-    info = lookup_unit(unit)
-    if info is not None and info.quantity == quantity and abs(info.factor - 1.0) <= 1e-12:
-        return  # an SI spelling ('m/s2' for 'm/s^2')
-    raise InputFileError(f"{at}: attribute unit is {unit!r}, not the SI unit of its quantity "
-                         f"{quantity} ({si_unit!r}); pidcore's HDF5 layout holds samples in SI")
-
-
 def read_measurement_group(group: h5py.Group, *, where: str = "") -> Measurement:
     """Read a measurement group written by :func:`write_measurement_group`.
 
@@ -124,7 +105,8 @@ def read_measurement_group(group: h5py.Group, *, where: str = "") -> Measurement
     for key in sorted(channels_group):
         ds = _channel_dataset(channels_group, key, where)
         at = f"{where}/channels/{key}"
-        _refuse_unit_other_than_si(ds, at)
+        refuse_unit_other_than_si(_text(ds.attrs.get("quantity", "")),
+                                  _text(ds.attrs.get("unit", "")), where=f"{at}: attribute unit")
         try:
             channels.append(Channel(
                 name=_text(ds.attrs["name"]),
