@@ -113,6 +113,27 @@ def test_uff_units_from_data_type_code_and_dataset_164(tmp_path):
     np.testing.assert_allclose(ch.data, data / 1000.0, rtol=1e-11)
 
 
+@pytest.mark.parametrize("label,quantity,note", [
+    ("lb", "unknown", False),       # a unit no table reads: it was taken as N (x 4.45)
+    ("in/s pk", "unknown", False),  # it was taken as m/s (x 39)
+    ("NONE", "force", True),        # no unit stated: the code's, in SI, said so
+])
+def test_uff_label_no_table_reads_is_not_replaced_by_the_code(tmp_path, label, quantity, note):
+    path = tmp_path / "label.uff"
+    data = np.linspace(-5.0, 5.0, 64)
+    pyuff.UFF(str(path)).write_sets(pyuff.prepare_58(
+        binary=0, func_type=1, rsp_node=1, rsp_dir=3, ref_node=0, ref_dir=0,
+        ordinate_spec_data_type=13, ordinate_axis_units_lab=label, abscissa_spec_data_type=17,
+        orddenom_spec_data_type=0, z_axis_spec_data_type=0, data=data,
+        x=np.arange(64) / 100.0), mode="add")
+    m = read_measurement(path)
+    (ch,) = m.channels
+    assert ch.quantity == quantity
+    np.testing.assert_allclose(ch.data, data, rtol=1e-11)  # the file's numbers, unscaled
+    said = [n for n in m.metadata.get("reader_notes", ()) if "has no unit label" in n]
+    assert bool(said) == note
+
+
 def test_csv_unit_conversion_and_delimiters(tmp_path):
     rows = [(0.0, 1.5, 2.0, 1.0), (0.001, 1.6, 3.0, -0.5), (0.002, 1.7, 4.0, 0.25)]
     variants = {
