@@ -159,6 +159,23 @@ def test_csv_unit_conversion_and_delimiters(tmp_path):
         assert force.sample_rate_hz == 1000.0, name
 
 
+@pytest.mark.parametrize("cell,name,unit,quantity,scale", [
+    # two units in one cell that read differently: the last brackets were taken (kN) for a
+    # column of newtons, a silent x1000; now no unit, which the analysis asks for
+    ("Force (N) [kN]", "Force", "N in the name, kN in brackets", "unknown", 1.0),
+    ("Force (kN) [kN]", "Force", "kN", "force", 1e3),
+    # the unit in the name's brackets, a description in the last ones: it was no unit at all
+    ("Force [kN] (Drive point)", "Force (Drive point)", "kN", "force", 1e3),
+    ("Force (Drive point) [kN]", "Force (Drive point)", "kN", "force", 1e3),
+])
+def test_csv_header_cell_with_two_brackets(tmp_path, cell, name, unit, quantity, scale):
+    path = tmp_path / "two.csv"
+    path.write_text(f"Time [s],{cell}\n0,1.5\n0.001,2.5\n0.002,-1\n")
+    (ch,) = read_measurement(path).channels
+    assert (ch.name, ch.source_unit, ch.quantity) == (name, unit, quantity)
+    np.testing.assert_allclose(ch.data, scale * np.array([1.5, 2.5, -1.0]), rtol=1e-15)
+
+
 def test_csv_sample_rate_given_equals_time_column(tmp_path):
     t = np.arange(200) / 500.0
     force, vel = np.sin(t), np.cos(t)
