@@ -12,7 +12,7 @@ import numpy as np
 from numba import njit
 
 from .. import defaults
-from ..errors import ChannelError
+from ..errors import ChannelError, apart
 
 #: A run of identical samples longer than this fraction of a drive period, away from the
 #: channel's extremes, is a dropout (a sampled sine changes value at every sample except within
@@ -283,12 +283,10 @@ def check_same_sampling(names: list[str], sample_rates_hz: list[float], lengths:
         if abs(rate - ref_rate) > SAME_RATE_RELATIVE_TOLERANCE * ref_rate:
             # as many digits as show the difference: '12800 Hz differs from 12800 Hz' (6
             # digits of rates 2.5e-9 apart) read as a contradiction
-            digits = 6
-            while f"{rate:.{digits}g}" == f"{ref_rate:.{digits}g}" and digits < 17:
-                digits += 1
-            raise ChannelError(f"{_label(source, name)}: sample rate {rate:.{digits}g} Hz "
-                               f"differs from {ref_rate:.{digits}g} Hz of channel "
-                               f"{names[0]!r}; expected simultaneous channels")
+            shown, ref_shown = apart(rate, ref_rate)
+            raise ChannelError(f"{_label(source, name)}: sample rate {shown} Hz differs from "
+                               f"{ref_shown} Hz of channel {names[0]!r}; expected "
+                               "simultaneous channels")
         if length != ref_len:
             raise ChannelError(f"{_label(source, name)}: {length} samples differs from "
                                f"{ref_len} samples of channel {names[0]!r}; expected channels "
