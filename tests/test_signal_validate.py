@@ -119,7 +119,9 @@ def test_zero_or_constant_channel(value, word):
 
 def test_wrong_quantity():
     force, vel, acc = _record()
-    with pytest.raises(ChannelError, match=r"'Az': is a acceleration channel, expected a velocity"):
+    # "is a acceleration channel" was printed
+    with pytest.raises(ChannelError, match=r"'Az': is an acceleration channel, expected a "
+                                           r"velocity"):
         analyze_channels(force, acc, source="q.uff")
 
 

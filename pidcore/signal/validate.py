@@ -12,7 +12,7 @@ import numpy as np
 from numba import njit
 
 from .. import defaults
-from ..errors import ChannelError, apart
+from ..errors import ChannelError, a_or_an, apart
 
 #: A run of identical samples longer than this fraction of a drive period, away from the
 #: channel's extremes, is a dropout (a sampled sine changes value at every sample except within
@@ -296,5 +296,5 @@ def check_same_sampling(names: list[str], sample_rates_hz: list[float], lengths:
 def check_quantity(quantity: str, expected: str, *, source: str, channel: str) -> None:
     """Reject a channel of another physical quantity ('unknown' is accepted)."""
     if quantity not in (expected, "unknown"):
-        raise ChannelError(f"{_label(source, channel)}: is a {quantity} channel, expected a "
-                           f"{expected} channel")
+        raise ChannelError(f"{_label(source, channel)}: is {a_or_an(quantity)} channel, "
+                           f"expected {a_or_an(expected)} channel")
