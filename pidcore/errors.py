@@ -214,5 +214,5 @@ KEYWORD_NOT_AFTER_WORD = r"(?![\w'])(?! column)"
 
 __all__ = ["ChannelError", "InputFileError", "KEYWORD_NOT_AFTER_WORD", "KEYWORD_NOT_BEFORE",
            "ParameterError", "PidcoreError",
-           "SettingsTableError", "SignalError", "SimulationError", "StoreError", "a_or_an",
-           "as_given", "instance_of", "outside_user_names", "real_number", "whole_number"]
+           "SettingsTableError", "SignalError", "SimulationError", "StoreError", "as_given",
+           "instance_of", "outside_user_names", "real_number", "whole_number"]
