@@ -86,6 +86,12 @@ def as_given(value: float) -> str:
         return repr(value)
 
 
+def a_or_an(word: str) -> str:
+    """``word`` after its indefinite article, for messages that name a quantity or role:
+    "an acceleration", "a force" ("a acceleration unit" was printed)."""
+    return f"{'an' if word[:1].lower() in 'aeiou' else 'a'} {word}"
+
+
 def apart(first: float, second: float) -> tuple[str, str]:
     """Two numbers said side by side (a fill asked and the fill of the run used): each as the
     other lines print it (``:g``, 6 significant digits), with only as many more digits as it

@@ -383,15 +383,25 @@ def resolve_file_settings(path: str | os.PathLike, options: AnalysisOptions | No
 
 
 def analyze_each(paths: Sequence[str | os.PathLike], settings: Sequence[FileSettings], *,
-                 key: str | None = None, progress: bool = False) -> list[AnalyzedRecord]:
+                 key: str | None = None, progress: bool = False,
+                 keep_unused_channels: bool = True) -> list[AnalyzedRecord]:
     """:func:`analyze_with_settings` of every file with its own settings, in order.
 
     ``progress``: a bar with the files done and the time left on stderr where there are
     several (the caller asks for it on a terminal only); forty exports took 7-12 s with no
-    sign of life."""
+    sign of life.
+    ``keep_unused_channels=False``: each record's measurement keeps only the channels its
+    analysis used, the others dropped as soon as the file is analysed; for a caller that
+    saves no measurement (``analyze --no-store``): every record is held until the last file
+    is done, and an export of eight channels held all eight."""
     pairs = list(zip(paths, settings, strict=True))
+
+    def analyzed(path: str | os.PathLike, fs: FileSettings) -> AnalyzedRecord:
+        record = analyze_with_settings(path, fs, key=key)
+        return record if keep_unused_channels else _without_unused_channels(record)
+
     if not progress or len(pairs) < 2:
-        return [analyze_with_settings(path, fs, key=key) for path, fs in pairs]
+        return [analyzed(path, fs) for path, fs in pairs]
     from tqdm import tqdm
 
     records = []
@@ -400,9 +410,18 @@ def analyze_each(paths: Sequence[str | os.PathLike], settings: Sequence[FileSett
     with tqdm(total=len(pairs), unit="file", desc="analysing", leave=False,
               dynamic_ncols=True) as bar:
         for path, fs in pairs:
-            records.append(analyze_with_settings(path, fs, key=key))
+            records.append(analyzed(path, fs))
             bar.update(1)
     return records
+
+
+def _without_unused_channels(record: AnalyzedRecord) -> AnalyzedRecord:
+    """``record`` whose measurement holds only the channels its analysis used (its source,
+    SHA-256 and metadata as read)."""
+    used = set(record.channels_used.values())
+    measurement = record.measurement
+    return replace(record, measurement=replace(
+        measurement, channels=tuple(c for c in measurement.channels if c.name in used)))
 
 
 def analyze_with_settings(path: str | os.PathLike, settings: FileSettings, *,

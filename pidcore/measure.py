@@ -37,7 +37,15 @@ import numpy as np
 
 from . import defaults
 from .constants import COUNT_UNIT, RATIO_UNIT
-from .errors import ChannelError, ParameterError, SignalError, StoreError, as_given, instance_of
+from .errors import (
+    ChannelError,
+    ParameterError,
+    SignalError,
+    StoreError,
+    a_or_an,
+    as_given,
+    instance_of,
+)
 from .io import assign_roles, read_measurement
 from .records import Channel, Measurement
 from .signal import PowerAnalysis, analyze_channels
@@ -179,7 +187,7 @@ def _with_unit(ch: Channel, role: str, unit: str | None, source: str,
         old = lookup_unit(ch.source_unit)
         old_factor = old.factor if old is not None and old.quantity == ch.quantity else 1.0
         raw = np.asarray(ch.data) / old_factor
-        kind = "" if ch.quantity == role else f", a {ch.quantity} unit"
+        kind = "" if ch.quantity == role else f", {a_or_an(ch.quantity)} unit"
         notes.append(f"channel {ch.name!r}: the file says {ch.source_unit!r}{kind}; taken as "
                      f"{unit!r} ({_UNIT_OPTIONS[role]})")
     else:

@@ -15,7 +15,7 @@ import re
 from dataclasses import dataclass
 
 from .constants import SI_UNITS, STANDARD_GRAVITY
-from .errors import ParameterError
+from .errors import ParameterError, a_or_an
 
 
 @dataclass(frozen=True)
@@ -159,8 +159,8 @@ def to_si_factor(unit: str, quantity: str | None = None, *, what: str = "unit") 
         raise ParameterError(f"{what}: unknown unit {unit!r}; expected one of "
                              f"{', '.join(sorted(_TABLE))}")
     if quantity is not None and info.quantity != quantity:
-        raise ParameterError(f"{what}: unit {unit!r} is a {info.quantity} unit, "
-                             f"expected a {quantity} unit ({SI_UNITS[quantity]})")
+        raise ParameterError(f"{what}: unit {unit!r} is {a_or_an(info.quantity)} unit, "
+                             f"expected {a_or_an(quantity)} unit ({SI_UNITS[quantity]})")
     return info.factor
 
 

@@ -113,6 +113,27 @@ def test_uff_units_from_data_type_code_and_dataset_164(tmp_path):
     np.testing.assert_allclose(ch.data, data / 1000.0, rtol=1e-11)
 
 
+@pytest.mark.parametrize("label,quantity,note", [
+    ("lb", "unknown", False),       # a unit no table reads: it was taken as N (x 4.45)
+    ("in/s pk", "unknown", False),  # it was taken as m/s (x 39)
+    ("NONE", "force", True),        # no unit stated: the code's, in SI, said so
+])
+def test_uff_label_no_table_reads_is_not_replaced_by_the_code(tmp_path, label, quantity, note):
+    path = tmp_path / "label.uff"
+    data = np.linspace(-5.0, 5.0, 64)
+    pyuff.UFF(str(path)).write_sets(pyuff.prepare_58(
+        binary=0, func_type=1, rsp_node=1, rsp_dir=3, ref_node=0, ref_dir=0,
+        ordinate_spec_data_type=13, ordinate_axis_units_lab=label, abscissa_spec_data_type=17,
+        orddenom_spec_data_type=0, z_axis_spec_data_type=0, data=data,
+        x=np.arange(64) / 100.0), mode="add")
+    m = read_measurement(path)
+    (ch,) = m.channels
+    assert ch.quantity == quantity
+    np.testing.assert_allclose(ch.data, data, rtol=1e-11)  # the file's numbers, unscaled
+    said = [n for n in m.metadata.get("reader_notes", ()) if "has no unit label" in n]
+    assert bool(said) == note
+
+
 def test_csv_unit_conversion_and_delimiters(tmp_path):
     rows = [(0.0, 1.5, 2.0, 1.0), (0.001, 1.6, 3.0, -0.5), (0.002, 1.7, 4.0, 0.25)]
     variants = {
@@ -136,6 +157,23 @@ def test_csv_unit_conversion_and_delimiters(tmp_path):
         np.testing.assert_allclose(acceleration.data,
                                    np.array([1.0, -0.5, 0.25]) * STANDARD_GRAVITY, rtol=1e-15)
         assert force.sample_rate_hz == 1000.0, name
+
+
+@pytest.mark.parametrize("cell,name,unit,quantity,scale", [
+    # two units in one cell that read differently: the last brackets were taken (kN) for a
+    # column of newtons, a silent x1000; now no unit, which the analysis asks for
+    ("Force (N) [kN]", "Force", "N in the name, kN in brackets", "unknown", 1.0),
+    ("Force (kN) [kN]", "Force", "kN", "force", 1e3),
+    # the unit in the name's brackets, a description in the last ones: it was no unit at all
+    ("Force [kN] (Drive point)", "Force (Drive point)", "kN", "force", 1e3),
+    ("Force (Drive point) [kN]", "Force (Drive point)", "kN", "force", 1e3),
+])
+def test_csv_header_cell_with_two_brackets(tmp_path, cell, name, unit, quantity, scale):
+    path = tmp_path / "two.csv"
+    path.write_text(f"Time [s],{cell}\n0,1.5\n0.001,2.5\n0.002,-1\n")
+    (ch,) = read_measurement(path).channels
+    assert (ch.name, ch.source_unit, ch.quantity) == (name, unit, quantity)
+    np.testing.assert_allclose(ch.data, scale * np.array([1.5, 2.5, -1.0]), rtol=1e-15)
 
 
 def test_csv_sample_rate_given_equals_time_column(tmp_path):
@@ -198,11 +236,76 @@ def test_csv_uneven_time_column_rejected(tmp_path):
         read_measurement(path)
 
 
+def _time_csv(path, times, digits):
+    path.write_text("Time [s],F [N]\n" + "".join(f"{x:.{digits}g},1.0\n" for x in times))
+    return path
+
+
+def test_csv_missing_sample_is_refused_whatever_the_digits_assumed(tmp_path):
+    # 20 s at 2048 Hz with one sample missing, printed with 9 digits: the rounding of 5
+    # digits was assumed (5e-4 s, a whole interval) and the gap was read as rounding, noted
+    # as "printed with about 5 significant digits", at 2047.95 Hz
+    t = np.delete(np.arange(20 * 2048) / 2048.0, 30_000)
+    with pytest.raises(InputFileError) as exc:
+        read_measurement(_time_csv(tmp_path / "gap.csv", t, 9))
+    message = str(exc.value)
+    assert "not evenly spaced" in message and "interval after sample 29999 is 0.0009766 s" \
+        in message and "printed with 9 significant digits" in message
+    # the same clock printed with 5 digits (MATLAB csvwrite) is off the grid by rounding: read
+    # at its rate, the digits said
+    m = read_measurement(_time_csv(tmp_path / "csvwrite.csv", np.arange(20 * 2048) / 2048.0, 5))
+    assert m.channels[0].sample_rate_hz == 2048.0
+    assert any("time printed with 5 significant digits" in n
+               for n in m.metadata["reader_notes"])
+
+
+def test_mat_time_vector_single_precision_accepted_full_precision_gap_refused(tmp_path):
+    t = np.arange(600 * 1000) / 1000.0
+    single = tmp_path / "single.mat"
+    scipy.io.savemat(single, {"time": t.astype(np.float32), "F": np.ones(t.size)})
+    m = read_measurement(single)
+    # float32 rounds 600 s to 3e-5 s, 0.03 of an interval: on the grid within its precision
+    assert m.channels[0].sample_rate_hz == 1000.0
+    assert any("time stored in single precision" in n for n in m.metadata["reader_notes"])
+    # k/3000 s is on no decimal grid and not single precision; one sample missing in 60 s was
+    # taken for the rounding of 5 printed digits (5e-4 s, 1.5 intervals)
+    gap = tmp_path / "gap.mat"
+    scipy.io.savemat(gap, {"time": np.delete(np.arange(60 * 3000) / 3000.0, 1000),
+                           "F": np.ones(60 * 3000 - 1)})
+    with pytest.raises(InputFileError, match=r"gap\.mat.*not evenly spaced.*interval after "
+                                             r"sample 999 is 0\.000666667 s; stored to full "
+                                             r"precision"):
+        read_measurement(gap)
+
+
 def test_csv_time_rounded_to_printed_digits_is_accepted(tmp_path):
     t = np.arange(5000) / 3000.0  # 1/3000 s does not print exactly
     path = tmp_path / "rounded.csv"
     path.write_text("Time [s],F [N]\n" + "".join(f"{x:.7g},1.0\n" for x in t))
     assert read_measurement(path).channels[0].sample_rate_hz == pytest.approx(3000.0, rel=1e-6)
+
+
+def _bytes_kept_alive(array: np.ndarray) -> int:
+    """Size of the memory ``array`` keeps alive: its own, or that of the array it views."""
+    while isinstance(array.base, np.ndarray):
+        array = array.base
+    return array.nbytes
+
+
+def test_csv_channels_do_not_keep_the_whole_table_alive(tmp_path):
+    # channels in SI units were column views of the (rows x columns) table, which a
+    # measurement then kept whole (time and every other column: 7 x the channel here) for as
+    # long as `analyze` held its record, one per file given
+    n = 2000
+    t = np.arange(n) / 1000.0
+    path = tmp_path / "wide.csv"
+    path.write_text("Time [s],Force [N],Velocity [m/s],A1 [g],A2 [g],A3 [m/s^2],Mic [Pa]\n"
+                    + "".join(f"{x:.6f},{np.sin(x)},{np.cos(x)},1,2,3,4\n" for x in t))
+    m = read_measurement(path)
+    assert [c.n_samples for c in m.channels] == [n] * 6
+    for channel in m.channels:
+        assert _bytes_kept_alive(channel.data) == n * 8, channel.name
+    np.testing.assert_allclose(m.channel("Force").data, np.sin(t), rtol=1e-15)
 
 
 def test_csv_nan_passes_through_reader(tmp_path):
@@ -267,6 +370,53 @@ def test_mat_v73_hdf5_simple_layout(tmp_path):
     (ch,) = m.channels
     assert ch.name == "Force" and ch.sample_rate_hz == 200.0
     np.testing.assert_allclose(ch.data, 1e3 * np.cos(t), rtol=1e-15)
+
+
+def _hand_made_hdf5(path, velocity_unit, velocity):
+    """A measurement file another program wrote in pidcore's layout (h5py, no pidcore)."""
+    with h5py.File(path, "w") as h5:
+        h5.attrs["pidcore_layout"] = "measurement"
+        channels = h5.create_group("channels")
+        for i, (name, quantity, unit, data) in enumerate(
+                [("Force", "force", "N", np.ones(64)),
+                 ("Velocity", "velocity", velocity_unit, velocity)]):
+            ds = channels.create_dataset(f"{i:03d}", data=data)
+            ds.attrs.update(name=name, quantity=quantity, unit=unit, source_unit=unit,
+                            sample_rate_hz=1000.0)
+    return path
+
+
+def test_hdf5_layout_channel_stating_a_unit_other_than_si_is_refused(tmp_path):
+    # samples in mm/s with unit 'mm/s' were read as m/s: 5000 g and 1000 x the energy per
+    # cycle for a 5 g test, the channel listed as 'm/s' from 'mm/s' as if converted
+    velocity = np.full(64, 25.0)
+    with pytest.raises(InputFileError, match=r"mm\.h5.*/channels/001: attribute unit is "
+                                             r"'mm/s', not the SI unit of its quantity velocity "
+                                             r"\('m/s'\)"):
+        read_measurement(_hand_made_hdf5(tmp_path / "mm.h5", "mm/s", velocity))
+    # an SI unit spelt otherwise is SI: the samples as they are
+    m = read_measurement(_hand_made_hdf5(tmp_path / "si.h5", "m/sec", velocity))
+    np.testing.assert_array_equal(m.channel("Velocity").data, velocity)
+
+
+def test_mat_pidcore_layout_channel_stating_a_unit_other_than_si_is_refused(tmp_path):
+    # the MATLAB form of the same layout ignored its 'unit' field the same way
+    def write(path, unit):
+        channels = np.empty((1, 2), dtype=object)
+        for i, (name, quantity, u, data) in enumerate([("Force", "force", "N", np.ones(64)),
+                                                        ("Acc", "acceleration", unit,
+                                                         np.full(64, 2.0))]):
+            channels[0, i] = {"name": name, "quantity": quantity, "unit": u, "source_unit": u,
+                              "data": data, "sample_rate_hz": 1000.0, "start_time_s": 0.0}
+        scipy.io.savemat(path, {"pidcore_layout": "measurement", "pidcore_channels": channels})
+        return path
+
+    with pytest.raises(InputFileError, match=r"g\.mat: pidcore_channels\{2\}: field unit is "
+                                             r"'g', not the SI unit of its quantity "
+                                             r"acceleration \('m/s\^2'\)"):
+        read_measurement(write(tmp_path / "g.mat", "g"))
+    m = read_measurement(write(tmp_path / "si.mat", "m/s2"))
+    np.testing.assert_array_equal(m.channel("Acc").data, 2.0)
 
 
 def test_hdf5_store_with_several_measurements(tmp_path):

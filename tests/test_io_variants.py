@@ -223,6 +223,11 @@ def test_unit_option_overrides_a_unit_of_another_kind(tmp_path, capsys):
     assert code == 2 and "is a velocity channel" in err and "--force-unit UNIT" in err
     code, _, err = _cli([str(path), "--no-store", "--force", "Accel"], capsys)
     assert code == 2 and "is an acceleration channel" in err
+    # a force exported under an acceleration's unit: the note read "a acceleration unit"
+    accel = _write_csv(tmp_path / "acc.csv", "Time [s],Force [m/s^2],Velocity [m/s]", rec)
+    noted = analyze_file(accel, AnalysisOptions(force="Force", force_unit="N")).notes
+    assert any("says 'm/s^2', an acceleration unit; taken as 'N' (force_unit)" in n
+               for n in noted)
     result = analyze_file(path, AnalysisOptions(force="Force", force_unit="N"))
     _assert_truth(result.analysis)
     assert any("says 'm/s', a velocity unit; taken as 'N' (force_unit)" in n

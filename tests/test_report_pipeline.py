@@ -403,3 +403,21 @@ def test_markup_in_a_file_name_reads_as_typed_in_the_markdown_report(tmp_path, d
             "_fill50_acrylic.csv") in text
     assert "<b>" not in text.replace(r"\<b\>", "") and "<img" not in text.replace(r"\<img", "")
     assert "[x](" not in text.replace(r"\[x\](", "")
+
+
+def test_report_files_without_a_store_keep_only_the_channels_used(tmp_path):
+    # a report of files it saves nowhere held every channel of every file until the last was
+    # analysed; saved to a store, each file keeps all of its channels
+    from pidcore.report.pipeline import analyze_files
+
+    rec = _record(0, 3.0)
+    path = tmp_path / "wide.csv"
+    write_measurement(Measurement(source=str(path), channels=(
+        Channel("Force", "force", rec.force_n, rec.sample_rate_hz, "N"),
+        Channel("Mic", "pressure", np.ones(rec.force_n.size), rec.sample_rate_hz, "Pa"),
+        Channel("Velocity", "velocity", rec.velocity_m_s, rec.sample_rate_hz, "m/s"))), path)
+    (whole,) = analyze_files([path], fill_percent=50.0)
+    (lean,) = analyze_files([path], fill_percent=50.0, keep_unused_channels=False)
+    assert whole.measurement.channel_names == ["Force", "Mic", "Velocity"]
+    assert lean.measurement.channel_names == ["Force", "Velocity"]
+    assert lean.analyzed.to_dict() == whole.analyzed.to_dict()

@@ -97,6 +97,11 @@ def test_different_sample_rate_and_length():
         analyze_channels(force, _with(vel, sample_rate_hz=2 * FS), source="r.uff")
     msg = _one_line(exc)
     assert "'vib'" in msg and "sample rate 20480 Hz differs from 10240 Hz" in msg
+    # rates 1e-7 apart (above the round-off tolerance of one clock) are refused in digits that
+    # show the difference, not as '10240 Hz differs from 10240 Hz'
+    with pytest.raises(ChannelError) as exc:
+        analyze_channels(force, _with(vel, sample_rate_hz=FS * (1 + 1e-7)), source="r.uff")
+    assert "sample rate 10240.001 Hz differs from 10240 Hz" in _one_line(exc)
     with pytest.raises(ChannelError) as exc:
         analyze_channels(force, _with(vel, vel.data[:-3]), source="r.uff")
     msg = _one_line(exc)
@@ -114,7 +119,9 @@ def test_zero_or_constant_channel(value, word):
 
 def test_wrong_quantity():
     force, vel, acc = _record()
-    with pytest.raises(ChannelError, match=r"'Az': is a acceleration channel, expected a velocity"):
+    # "is a acceleration channel" was printed
+    with pytest.raises(ChannelError, match=r"'Az': is an acceleration channel, expected a "
+                                           r"velocity"):
         analyze_channels(force, acc, source="q.uff")
 
 

@@ -97,7 +97,8 @@ def run(args: argparse.Namespace) -> int:
     try:
         # Analyse everything before writing anything: one bad file leaves the store untouched.
         results = refuse_implausible(
-            analyze_each(args.paths, settings, key=args.key, progress=progress_wanted(args)),
+            analyze_each(args.paths, settings, key=args.key, progress=progress_wanted(args),
+                         keep_unused_channels=store is not None),
             [display_path(Path(path).name) for path in args.paths],
             accept=args.accept_implausible)
         cases = [st.load_case(r.analysis.frequency_hz, r.analysis.acceleration_g)

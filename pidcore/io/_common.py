@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..constants import SI_UNITS
 from ..errors import InputFileError
 from ..records import Channel
 from ..units import canonical_unit_text, lookup_unit
@@ -85,7 +86,8 @@ def snap_rate(rate_hz: float, relative_resolution: float) -> float:
     return float(rate_hz)
 
 
-#: Fewest significant digits a printed time column is assumed to keep (MATLAB csvwrite: 5).
+#: Fewest significant digits whose rounding a printed time column is allowed (MATLAB
+#: csvwrite: 5); a column of more digits is held to its own (:func:`printed_digits`).
 PRINTED_TIME_DIGITS = 5
 
 
@@ -108,13 +110,44 @@ def overridden_rate(times: np.ndarray, rate_hz: float) -> str:
     return f"; the column gives {column_rate:.6g} Hz, {ratio:.4g} x the rate given"
 
 
+#: Most significant digits :func:`printed_digits` tells: beyond, the float64 round-off of
+#: the scaled values (up to 1e11) nears the tolerance of the test (1e-3 of a unit).
+MAX_PRINTED_DIGITS = 11
+
+
+def printed_digits(times: np.ndarray) -> int | None:
+    """Significant digits a time column was printed with: the most any of its values needs to
+    lie on the decimal grid of its own magnitude (``%.5g`` gives 5; ``%.6f`` up to 2 s gives
+    7); ``None`` beyond :data:`MAX_PRINTED_DIGITS` (a computed, unrounded column). Read in
+    blocks: no copy of a long column."""
+    t = np.asarray(times, dtype=np.float64)
+    digits = 1
+    for start in range(0, t.size, 1 << 16):
+        block = t[start:start + (1 << 16)]
+        pending = block[block != 0.0]
+        exponents = np.floor(np.log10(np.abs(pending)))
+        while pending.size:
+            # on the grid of `digits` digits, then of any more: only the rest is looked at again
+            scaled = pending * np.power(10.0, digits - 1 - exponents)
+            off = np.abs(scaled - np.rint(scaled)) > 1e-3
+            if not off.any():
+                break
+            if digits == MAX_PRINTED_DIGITS:
+                return None
+            pending, exponents = pending[off], exponents[off]
+            digits += 1
+    return digits
+
+
 def rate_from_times(times: np.ndarray, *, what: str, with_note: bool = False):
     """Sample rate (Hz) and start time (s) of an evenly spaced time vector.
 
     The samples must lie on an even grid within :data:`EVEN_SPACING_TOLERANCE` of the interval,
     or within the precision the column was printed with: a time printed with
     :data:`PRINTED_TIME_DIGITS` significant digits (MATLAB ``csvwrite``, UFF E13.5 abscissas)
-    is off the grid by up to half a unit in its last digit. Such a column gives the rate and
+    is off the grid by up to half a unit in its last digit, a column of more digits
+    (:func:`printed_digits`) by less, a single-precision vector by half a float32 step; a
+    missing sample in a column of 9 digits is refused. Such a column gives the rate and
     start of a least-squares line through it, snapped to whole Hz within its resolution, and
     (``with_note=True``) a note saying so, returned as a third element ('' otherwise).
 
@@ -135,11 +168,29 @@ def rate_from_times(times: np.ndarray, *, what: str, with_note: bool = False):
     residual = np.max(np.abs(t - (t[0] + dt * index)))
     note = ""
     if residual <= EVEN_SPACING_TOLERANCE * dt:
-        rate, start = snap_rate(1.0 / dt, FLOAT64_RATE_RESOLUTION), float(t[0])
+        # the end points carry the column's rounding too: printed with 9 digits, 2 s at
+        # 12 800 Hz gave 12 799.99997 Hz, and an x/y pair column of the same clock printed
+        # exactly gave 12 800 Hz, so the two were refused as different rates ("12800 Hz
+        # differs from 12800 Hz"). Whole Hz within what the scatter about the grid allows.
+        span = float(t[-1] - t[0])
+        rate = snap_rate(1.0 / dt, max(2.0 * float(residual) / span, FLOAT64_RATE_RESOLUTION))
+        start = float(t[0])
     else:
-        # half a unit in the last printed digit of the largest time
+        # half a unit in the last printed digit of the largest time: of the digits the column
+        # has, not of the fewest assumed; assumed, a column of 9 digits with samples missing
+        # (a 10-sample gap in 60 s) was taken as printed with 5 and read at 12 799.75 Hz
         magnitude = float(np.max(np.abs(t[[0, -1]])))
-        printed = 0.5 * 10.0 ** (math.floor(math.log10(magnitude)) - (PRINTED_TIME_DIGITS - 1))
+        exponent = math.floor(math.log10(magnitude))
+        digits = printed_digits(t)
+        if digits is not None:
+            printed = 0.5 * 10.0 ** (exponent - (max(digits, PRINTED_TIME_DIGITS) - 1))
+            precision = f"printed with {digits} significant digits"
+        elif np.array_equal(t, t.astype(np.float32)):
+            # a MATLAB single() time vector: rounded to float32, not to decimal digits
+            printed = 0.5 * float(np.spacing(np.float32(magnitude)))
+            precision = "stored in single precision"
+        else:
+            printed, precision = 0.0, "stored to full precision"
         slope, intercept = np.polyfit(index, t, 1)
         fitted_residual = float(np.max(np.abs(t - (intercept + slope * index))))
         # a dropped or repeated sample in a column whose rounding is finer than the interval
@@ -149,14 +200,15 @@ def rate_from_times(times: np.ndarray, *, what: str, with_note: bool = False):
             worst = int(np.argmax(np.abs(np.diff(t) - dt)))
             raise InputFileError(
                 f"{what}: time is not evenly spaced (mean interval {dt:.6g} s, interval after "
-                f"sample {worst} is {t[worst + 1] - t[worst]:.6g} s); expected a constant sample "
-                "interval")
+                f"sample {worst} is {t[worst + 1] - t[worst]:.6g} s"
+                + f"; {precision}"
+                + "); expected a constant sample interval")
         span = float(slope) * (t.size - 1)
         rate = snap_rate(1.0 / float(slope), max(printed / span, FLOAT64_RATE_RESOLUTION))
         start = float(intercept)
         if t[0] == 0.0 and abs(start) <= printed:
             start = 0.0  # a record that starts at 0 as printed
-        note = (f"{what}: time printed with about {PRINTED_TIME_DIGITS} significant digits "
+        note = (f"{what}: time {precision} "
                 f"(off an even grid by up to {fitted_residual:.3g} s); rate {rate:.9g} Hz from a "
                 "line fitted through it")
     if with_note:
@@ -177,6 +229,23 @@ def interpret_unit(unit_text: str) -> tuple[str, float]:
     if info is None:
         return "unknown", 1.0
     return info.quantity, info.factor
+
+
+def refuse_unit_other_than_si(quantity: str, unit: str, *, where: str) -> None:
+    """Refuse the unit a pidcore layout (HDF5, MATLAB) states for a channel's samples where it
+    is not the SI unit of the channel's quantity: the layouts hold samples in SI, and a file
+    written by another program that states its samples' own unit there ('mm/s') was read as
+    m/s without a word (5000 g for 5 g). Which of the two is wrong, the samples or the unit,
+    cannot be told. No unit stated, or a quantity without one, is not checked."""
+    quantity, unit = quantity.strip(), unit.strip()
+    si_unit = SI_UNITS.get(quantity)
+    if not unit or si_unit is None or quantity == "unknown":
+        return
+    info = lookup_unit(unit)
+    if info is not None and info.quantity == quantity and abs(info.factor - 1.0) <= 1e-12:
+        return  # an SI spelling ('m/s2' for 'm/s^2')
+    raise InputFileError(f"{where} is {unit!r}, not the SI unit of its quantity {quantity} "
+                         f"({si_unit!r}); pidcore's layout holds samples in SI")
 
 
 def make_channel(name: str, values: np.ndarray, *, sample_rate_hz: float, unit: str,

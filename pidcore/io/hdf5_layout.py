@@ -23,7 +23,7 @@ import numpy as np
 
 from ..errors import InputFileError
 from ..records import Channel, Measurement
-from ._common import real_samples, real_scalar
+from ._common import real_samples, real_scalar, refuse_unit_other_than_si
 
 LAYOUT_TAG = "measurement"
 #: Samples compared at a time when deciding whether a channel is float32 (8 MB widened).
@@ -105,6 +105,8 @@ def read_measurement_group(group: h5py.Group, *, where: str = "") -> Measurement
     for key in sorted(channels_group):
         ds = _channel_dataset(channels_group, key, where)
         at = f"{where}/channels/{key}"
+        refuse_unit_other_than_si(_text(ds.attrs.get("quantity", "")),
+                                  _text(ds.attrs.get("unit", "")), where=f"{at}: attribute unit")
         try:
             channels.append(Channel(
                 name=_text(ds.attrs["name"]),

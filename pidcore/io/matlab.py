@@ -47,6 +47,7 @@ from ._common import (
     real_numbers,
     real_samples,
     real_scalar,
+    refuse_unit_other_than_si,
     reraise_interrupt,
     unique_names,
 )
@@ -246,6 +247,8 @@ def _pidcore_layout(variables: Mapping, where: str) -> list[Channel]:
         what = f"{where}: pidcore_channels{{{i + 1}}}"
         if not isinstance(item, Mapping):
             raise InputFileError(f"{what} is not a struct")
+        refuse_unit_other_than_si(_text(item.get("quantity")), _text(item.get("unit")),
+                                  where=f"{what}: field unit")
         try:
             channels.append(Channel(
                 name=_text(item["name"]), quantity=_text(item["quantity"]),

@@ -30,7 +30,7 @@ import re
 from collections.abc import Collection
 from dataclasses import dataclass
 
-from ..errors import ChannelError
+from ..errors import ChannelError, a_or_an
 from ..records import Channel, Measurement
 
 _NAME_TOKENS = {
@@ -146,12 +146,11 @@ def _detect(measurement: Measurement, role: str, taken: set[str]) -> Channel | N
 def _named(measurement: Measurement, role: str, name: str, retyped: bool) -> Channel:
     channel = measurement.channel(name)  # ChannelError listing the channels there are
     if channel.quantity not in (role, "unknown") and not retyped:
-        article = "an" if channel.quantity[0] in "aeiou" else "a"
-        wanted = "an" if role[0] in "aeiou" else "a"  # "expected a acceleration channel"
-        raise ChannelError(f"{measurement.source}: {_OPTIONS[role]}{name!r} is {article} "
-                           f"{channel.quantity} channel ({channel.source_unit or channel.unit});"
-                           f" expected {wanted} {role} channel or one without a unit, or give its "
-                           f"unit with {role}_unit=UNIT if the file's is wrong")
+        raise ChannelError(f"{measurement.source}: {_OPTIONS[role]}{name!r} is "
+                           f"{a_or_an(channel.quantity)} channel "
+                           f"({channel.source_unit or channel.unit}); expected {a_or_an(role)} "
+                           "channel or one without a unit, or give its unit with "
+                           f"{role}_unit=UNIT if the file's is wrong")
     return channel
 
 

@@ -14,9 +14,10 @@ Reading and writing go through :mod:`pyuff`. What this module adds on top:
 * Direction: a record measured in a negative direction (record 6 ``-Z`` etc.) is negated, so
   that every channel follows the +axis convention (noted in ``reader_notes``).
 * Units: the ordinate units label when :mod:`pidcore.units` recognises it (``"m/s2"``, ``"g"``,
-  ``"N"``, ``"Pa"``); otherwise the specific data type code (8, 9, 11, 12, 13, 15) with the
-  dataset 164 unit factors of the file (SI when the file has no dataset 164); otherwise the
-  channel keeps its values with quantity ``"unknown"`` (e.g. ``"V^2"``).
+  ``"N"``, ``"Pa"``); where it states none (empty, ``"NONE"``), the specific data type code
+  (8, 9, 11, 12, 13, 15) with the dataset 164 unit factors of the file (SI when the file has no
+  dataset 164), noted; otherwise (a label no table reads: ``"V^2"``, ``"lb"``) the channel keeps
+  its values with quantity ``"unknown"``, whose unit the analysis asks for.
 * Quirks handled: the zero padding of the last data line (values beyond ``num_pts`` are
   dropped), an extra CR LF after 58b binary data (pyuff ignores the stray bytes), E13.5 fields
   without separating blanks and 3-digit exponents (pyuff reads fixed columns), Latin-1 header
@@ -39,6 +40,7 @@ import pyuff
 from ..constants import SI_UNITS
 from ..errors import InputFileError, ParameterError
 from ..records import Channel, Measurement
+from ..units import canonical_unit_text
 from ._common import (
     atomic_path,
     file_sha256,
@@ -111,6 +113,10 @@ def _described_names(records: list[dict]) -> list[str] | None:
     return None
 
 
+#: Unit labels (as :func:`~pidcore.units.canonical_unit_text` writes them) that state no unit.
+_NO_UNIT_LABELS = frozenset({"", "none", "-", "1"})
+
+
 def _ordinate_unit(dset: dict, unit_factors: tuple[float, float]) -> tuple[str, float, str]:
     """Quantity, SI factor and source-unit text of a record's ordinate."""
     label = _label(dset.get("ordinate_axis_units_lab"))
@@ -118,12 +124,15 @@ def _ordinate_unit(dset: dict, unit_factors: tuple[float, float]) -> tuple[str, 
     if quantity != "unknown":
         return quantity, factor, label
     code = int(dset.get("ordinate_spec_data_type", 0) or 0)
-    if code in _DATA_TYPE_CODES:
+    # only a record that states no unit takes the code's in the file's units: a label no
+    # table reads ('lb', 'LBS', 'in/s pk') states one, and read as N or m/s it was a silent
+    # x4.45 or x39; left unknown, the analysis asks for the unit naming the channel
+    if code in _DATA_TYPE_CODES and canonical_unit_text(label) in _NO_UNIT_LABELS:
         quantity, len_exp, force_exp = _DATA_TYPE_CODES[code]
         length_factor, force_factor = unit_factors
         # Dataset 164: "to convert from universal file units to SI divide by the factor".
         factor = 1.0 / (length_factor**len_exp * force_factor**force_exp)
-        return quantity, factor, label or f"UFF data type {code}"
+        return quantity, factor, f"UFF data type {code}"
     return "unknown", 1.0, label
 
 

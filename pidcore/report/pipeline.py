@@ -180,7 +180,8 @@ def analyze_files(paths: Sequence[str | Path], *, fill_percent: float | None = N
                   specimen_name: str | None = None,
                   specimen: Specimen | None = None,
                   accept_implausible: bool = False,
-                  progress: bool = False, key: str | None = None) -> list[MeasuredResult]:
+                  progress: bool = False, key: str | None = None,
+                  keep_unused_channels: bool = True) -> list[MeasuredResult]:
     """Read, assign roles, analyze (Eq. 11) and attach the load case of every file.
 
     The load case and the analysis settings are resolved first for every file, so a missing
@@ -199,6 +200,8 @@ def analyze_files(paths: Sequence[str | Path], *, fill_percent: float | None = N
     ``progress``: a bar over the files on stderr (:func:`pidcore.file_settings.analyze_each`).
     ``key``: which measurement of a pidcore HDF5 store among ``paths`` to read, where it holds
     several (as :func:`pidcore.measure.analyze_file` takes it).
+    ``keep_unused_channels=False``: each result's measurement keeps only the channels its
+    analysis used, for a caller that saves none (:func:`pidcore.file_settings.analyze_each`).
     """
     from ..compare.plausibility import refuse_implausible
     from ..file_settings import analyze_each, resolve_files
@@ -214,7 +217,8 @@ def analyze_files(paths: Sequence[str | Path], *, fill_percent: float | None = N
                                      specimen_material=specimen_material,
                                      specimen_name=specimen_name, specimen=specimen)
     analyzed_files = refuse_implausible(
-        analyze_each(paths, settings, key=key, progress=progress),
+        analyze_each(paths, settings, key=key, progress=progress,
+                     keep_unused_channels=keep_unused_channels),
         [display_path(Path(path).name) for path in paths], accept=accept_implausible)
     results = []
     for path, st, fs, analyzed in zip(paths, stated, settings, analyzed_files, strict=True):
@@ -787,6 +791,7 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         specimen_material=specimen.particles.material if specimen is not None else None,
         specimen_name=specimen.name if specimen is not None else None, specimen=specimen,
         accept_implausible=accept_implausible, progress=progress, key=key,
+        keep_unused_channels=main is not None,  # a store saves every channel of each file
     ) if files else []
     parameters = _parameters(results, options)
     notes: list[str] = []

@@ -12,7 +12,7 @@ import numpy as np
 from numba import njit
 
 from .. import defaults
-from ..errors import ChannelError
+from ..errors import ChannelError, a_or_an, apart
 
 #: A run of identical samples longer than this fraction of a drive period, away from the
 #: channel's extremes, is a dropout (a sampled sine changes value at every sample except within
@@ -281,9 +281,12 @@ def check_same_sampling(names: list[str], sample_rates_hz: list[float], lengths:
     ref_rate, ref_len = sample_rates_hz[0], lengths[0]
     for name, rate, length in zip(names[1:], sample_rates_hz[1:], lengths[1:], strict=True):
         if abs(rate - ref_rate) > SAME_RATE_RELATIVE_TOLERANCE * ref_rate:
-            raise ChannelError(f"{_label(source, name)}: sample rate {rate:g} Hz differs from "
-                               f"{ref_rate:g} Hz of channel {names[0]!r}; expected simultaneous "
-                               "channels")
+            # as many digits as show the difference: '12800 Hz differs from 12800 Hz' (6
+            # digits of rates 2.5e-9 apart) read as a contradiction
+            shown, ref_shown = apart(rate, ref_rate)
+            raise ChannelError(f"{_label(source, name)}: sample rate {shown} Hz differs from "
+                               f"{ref_shown} Hz of channel {names[0]!r}; expected "
+                               "simultaneous channels")
         if length != ref_len:
             raise ChannelError(f"{_label(source, name)}: {length} samples differs from "
                                f"{ref_len} samples of channel {names[0]!r}; expected channels "
@@ -293,5 +296,5 @@ def check_same_sampling(names: list[str], sample_rates_hz: list[float], lengths:
 def check_quantity(quantity: str, expected: str, *, source: str, channel: str) -> None:
     """Reject a channel of another physical quantity ('unknown' is accepted)."""
     if quantity not in (expected, "unknown"):
-        raise ChannelError(f"{_label(source, channel)}: is a {quantity} channel, expected a "
-                           f"{expected} channel")
+        raise ChannelError(f"{_label(source, channel)}: is {a_or_an(quantity)} channel, "
+                           f"expected {a_or_an(expected)} channel")
