@@ -398,28 +398,62 @@ def _steel_stating_count(tmp_path, monkeypatch, count: int) -> tuple[Path, Path]
     return spec, mine
 
 
-def test_a_sweep_over_the_grids_fills_says_it_is_not_the_specimens_fill(tmp_path, capsys,
-                                                                        monkeypatch):
-    # a specimen stating its fill (steel_6mm: fill_percent = 50 of 46 -> 23 per cell; a file
-    # stating count_per_cell 20) swept without --fills ran Table 3's 25, 50, 75, 90 % and no
-    # word said the specimen's own fill was not among them
+def test_a_sweep_without_fills_runs_the_fill_the_specimen_states(tmp_path, capsys,
+                                                                  monkeypatch):
+    # a specimen stating its fill (steel_6mm: fill_percent = 50; a file stating count_per_cell
+    # 20) swept without --fills ran Table 3's 25, 50, 75, 90 % (4 x the runs), where `dem run`
+    # and the app's DEM tab simulate the stated fill; the paper's coupon keeps its grid
+    import pidcore.dem.sweep as sweep_module
+    from pidcore.dem.simulate import particles_per_cell
+    from pidcore.dem.sweep import GRIDS
     from pidcore.specimen import load_specimen
 
     spec, mine = _steel_stating_count(tmp_path, monkeypatch, 20)
-    capacity = load_specimen(mine).capacity_per_cell()
+    swept: list = []
+
+    def stop(cases, *args, **kwargs):
+        swept.append(sorted({case.fill_percent for case in cases}))
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(sweep_module, "run_sweep", stop)
+    specimen = load_specimen(mine)
+    capacity = specimen.capacity_per_cell()
     argv = ["dem", "sweep", "--specimen", str(mine), "--frequencies", "500",
             "--accelerations", "5", "--store", str(tmp_path / "s.h5"), "--no-progress"]
     assert main(argv) == 130
-    err = capsys.readouterr().err
-    assert (f"pidcore dem sweep: note: fills 25, 50, 75, 90 % are grid table3's, not the "
-            f"{100 * 20 / capacity:.6g} % specimen steel_6mm states ([particles] count_per_cell "
-            f"20 of capacity {capacity}); give --fills to choose\n") in err
-    # a specimen whose fill is on the grid (steel_6mm's 50 %), or given: nothing to say
-    for more, path in (([], spec), (["--fills", "50"], spec)):
-        assert main([*argv[:3], str(path), *argv[4:], *more]) == 130
+    assert swept.pop() == [pytest.approx(100 * 20 / capacity, rel=1e-12)]
+    # the fill swept is the file's 20 particles per cell, not a neighbour of it
+    stated = specimen.stated_fill()[0]
+    assert particles_per_cell(stated, specimen=specimen)[0] == 20
+    grid_fills = "25, 50, 75, 90"
+    assert capsys.readouterr().err.startswith(
+        f"pidcore dem sweep: note: fill {100 * 20 / capacity:.6g} % is the one specimen "
+        f"steel_6mm states ([particles] count_per_cell 20 of capacity {capacity}), as a run "
+        f"of it without a fill simulates; give --fills for others (grid table3's: "
+        f"{grid_fills} %)\n")
+    assert main([*argv[:3], str(spec), *argv[4:]]) == 130  # steel_6mm: fill_percent = 50.0
+    assert swept.pop() == [50.0]
+    assert "fill 50 % is the one specimen steel_6mm states ([particles] fill_percent)" in \
+        capsys.readouterr().err
+    # a file stating no fill: the grid's, and the note says why
+    none = tmp_path / "none.toml"
+    none.write_text(spec.read_text().replace("fill_percent = 50.0", ""))
+    assert load_specimen(none).stated_fill() is None
+    assert main([*argv[:3], str(none), *argv[4:]]) == 130
+    assert swept.pop() == list(GRIDS["table3"]["fill_percent"])
+    assert capsys.readouterr().err.startswith(
+        f"pidcore dem sweep: note: fills {grid_fills} % are grid table3's: specimen steel_6mm "
+        "states no fill (count_per_cell or fill_percent); give --fills to choose\n")
+    # the paper's coupon, named or not, keeps the bundled Table 3 grid, without a note
+    paper = Path(__file__).resolve().parents[1] / "pidcore" / "data" / "specimens" / \
+        "paper_coupon.toml"
+    for more in ([], ["--specimen", str(paper)], ["--tangential-stiffness", "mindlin"]):
+        assert main([*argv[:2], *argv[4:], *more]) == 130
+        assert swept.pop() == [25.0, 50.0, 75.0, 90.0]
         assert "note" not in capsys.readouterr().err
-    # fills given override the count the file states: said too (ran 30 % without a word)
+    # fills given: those, and what they override is said (ran 30 % without a word)
     assert main([*argv, "--fills", "30,50"]) == 130
+    assert swept.pop() == [30.0, 50.0]
     assert capsys.readouterr().err.startswith(
         f"pidcore dem sweep: note: fills 30, 50 % override the {100 * 20 / capacity:.6g} % "
         f"specimen steel_6mm states ([particles] count_per_cell 20 of capacity {capacity})\n")

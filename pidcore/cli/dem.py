@@ -148,7 +148,10 @@ def _register_sweep(sub: argparse._SubParsersAction) -> None:
         p.add_argument(flag, metavar="X,X", default=None,
                        help=f"{what}, comma-separated, in place of the grid's (every "
                             "combination is run, each value once, in Table 3's order: "
-                            "ascending, whatever the order given)")
+                            "ascending, whatever the order given)"
+                            + ("; default for a --specimen stating its fill (count_per_cell "
+                               "or fill_percent): that fill alone, as dem run's"
+                               if flag == "--fills" else ""))
     _add_config_options(p)
     p.add_argument("--workers", metavar="N", type=positive_int, default=None,
                    help="local processes (default: all cores)")
@@ -217,7 +220,7 @@ def _interrupted(command: str, saved: int, store, *, left: int = 1) -> int:
 def sweep(args: argparse.Namespace) -> int:
     from ..dem.persist import run_key, stored_keys
     from ..dem.simulate import check_drive
-    from ..dem.sweep import cross_cases, grid_axes, grid_fill_note, run_sweep
+    from ..dem.sweep import cross_cases, grid_axes, run_sweep, sweep_fills
     from ..loadcase import parse_values
     from ..specimen import fill_override_note
 
@@ -228,12 +231,14 @@ def sweep(args: argparse.Namespace) -> int:
                                          "--accelerations"),
                                         ("fill_percent", args.fills, "--fills"))]
     specimen, material = _specimen(args)
+    if args.fills is None:  # an own specimen's stated fill, else the grid's (and why)
+        values[2], note = sweep_fills(specimen, args.grid)
+    else:
+        # the summary's notes say the same to a library caller and in --json
+        note = fill_override_note(specimen, values[2], args.fill_reference)
     for fill in values[2]:
         _check_fill(fill, "--fills", args, specimen, material)
-    # before the run (an interrupted sweep prints no summary); the summary's notes say the
-    # same to a library caller and in --json
-    note = grid_fill_note(specimen, args.grid, values[2]) if args.fills is None else \
-        fill_override_note(specimen, values[2], args.fill_reference)
+    # before the run (an interrupted sweep prints no summary)
     if note:  # on stderr: --json prints one document
         print(f"pidcore dem sweep: note: {cli_words(note, 'dem sweep')}", file=sys.stderr)
     cases = cross_cases(*values, material=material, direction=args.direction)
