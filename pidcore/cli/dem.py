@@ -278,13 +278,16 @@ def sweep(args: argparse.Namespace) -> int:
 
 
 def _sweep_specimens(cases: list[dict]) -> str:
-    """``"; specimen my_steel (sha256 9a19aa85ea13)"``: whose runs the sweep's cases are, as
-    stored (each its name and hash); "" where no case is stored."""
+    """``"; specimen my_steel [9a19aa]"``: whose runs the sweep's cases are, as stored, each
+    by the label the app and reports show (:func:`pidcore.specimen.hashed_name`); "" where
+    no case is stored."""
+    from ..specimen import hashed_name
+
     named = dict.fromkeys((c.get("specimen_name"), c.get("specimen_sha256")) for c in cases
                           if c.get("specimen_sha256"))
     if not named:
         return ""
-    return "; specimen " + ", ".join(f"{name} (sha256 {sha[:12]})" for name, sha in named)
+    return "; specimen " + ", ".join(hashed_name(name, sha) for name, sha in named)
 
 
 def _print_sweep(args: argparse.Namespace, summary) -> None:
@@ -447,6 +450,7 @@ def _tangential_stiffness_model(result) -> str:
 def format_summary(result, *, reused: bool = False) -> str:
     """Readable multi-line summary with units."""
     from ..dem.result import stderr_from_batches
+    from ..specimen import hashed_name
 
     c = result.case
     s = result.specimen
@@ -461,7 +465,7 @@ def format_summary(result, *, reused: bool = False) -> str:
         kind = "the paper's coupon" if s.is_paper() else "own specimen"
         particles = result.coupon_cells * result.particles_per_cell * s.particles.mass_kg
         lines += [
-            f"specimen        {s.name} ({kind}, sha256 {s.hash[:12]}): {result.coupon_cells} "
+            f"specimen        {hashed_name(s.name, s.hash)} ({kind}): {result.coupon_cells} "
             f"{s.cell.shape} cells {s.cell.inscribed_diameter_m * 1e3:.4g} x "
             f"{s.cell.height_m * 1e3:.4g} mm, particles r = {s.particles.radius_m * 1e3:.4g} mm",
             f"masses          coupon {s.coupon.mass_kg * 1e3:.4g} g + fixture "

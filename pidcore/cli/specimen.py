@@ -41,12 +41,15 @@ def run_check(args: argparse.Namespace) -> int:
 
 def format_facts(f: dict, source: str) -> str:
     """Readable lines with units."""
+    from ..specimen import hashed_name
+
     kind = "the paper's coupon" if f["is_paper"] else "not the paper's coupon"
+    # the label the app, reports and dem run/sweep show (16 hex digits here matched none)
     return "\n".join([
-        f"specimen        {f['name']} ({source}): OK, {kind}; sha256 {f['sha256'][:16]} "
-        "(of every value, name and description included)",
-        *([f"calibrated from {f['calibrated_from_name']} (sha256 "
-           f"{f['calibrated_from_sha256'][:16]}): the tests it models are that file's"]
+        f"specimen        {hashed_name(f['name'], f['sha256'])} ({source}): OK, {kind}; "
+        "[...] starts its sha256 (of every value, name and description included)",
+        *([f"calibrated from {hashed_name(f['calibrated_from_name'], f['calibrated_from_sha256'])}"
+           ": the tests it models are that file's"]
           if f.get("calibrated_from_sha256") else []),
         f"cells           {f['cells_per_coupon']} {f['cell_shape']}, capacity "
         f"{f['capacity_per_cell']} particles per cell (dense drop packing)",
