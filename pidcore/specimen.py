@@ -119,6 +119,7 @@ from typing import TYPE_CHECKING, Any
 
 from .constants import (
     CELL_SHAPES,
+    FILL_REFERENCES,
     TANGENTIAL_STIFFNESS_MODELS,
     CellShape,
     TangentialStiffnessModel,
@@ -750,22 +751,40 @@ class Specimen:
         return _capacity(self.cell.shape, self.cell.inscribed_diameter_m, self.cell.height_m,
                          self.particles.radius_m)
 
-    def stated_fill(self) -> tuple[float, str] | None:
+    def stated_fill(self, fill_reference: str = "capacity") -> tuple[float, str] | None:
         """The specimen's own fill (% of :meth:`capacity_per_cell`) and where it comes from
         in words, or None when it states neither ``count_per_cell`` nor ``fill_percent``.
 
         What a DEM run of this specimen simulates when no fill is given (``pidcore dem run
         --specimen`` without ``--fill``, the app's DEM page with its fills field empty). A
         count is its share of the capacity, which rounds back to that count.
+
+        ``fill_reference="paper"`` (a run's :attr:`pidcore.dem.DemConfig.fill_reference`):
+        the same particles per cell as a share of the paper's 36, which a run of that
+        reference takes as 100 %. The capacity's percentage there simulated another count
+        (a file stating 20 of 46 particles ran 16 of 36 without a word).
         """
+        from . import defaults
+
         p = self.particles
         if p.fill_percent is not None:
-            return p.fill_percent, "[particles] fill_percent"
-        if p.count_per_cell is not None:
+            stated: tuple[float, str] = (p.fill_percent, "[particles] fill_percent")
+        elif p.count_per_cell is not None:
             capacity = self.capacity_per_cell()
-            return (100.0 * p.count_per_cell / capacity,
-                    f"[particles] count_per_cell {p.count_per_cell} of capacity {capacity}")
-        return None
+            stated = (100.0 * p.count_per_cell / capacity,
+                      f"[particles] count_per_cell {p.count_per_cell} of capacity {capacity}")
+        else:
+            return None
+        if fill_reference == "capacity":
+            return stated
+        if fill_reference != "paper":
+            raise ParameterError(f"fill_reference: expected one of {FILL_REFERENCES}, got "
+                                 f"{fill_reference!r}")
+        count = p.count_per_cell if p.count_per_cell is not None else \
+            particles_for_fill(p.fill_percent, self.capacity_per_cell())
+        full = defaults.PAPER_PARTICLES_PER_FULL_CELL
+        return (100.0 * count / full,
+                f"{stated[1]}: {count} particles, of the paper's {full} per full cell")
 
     def geometry(self) -> CellGeometry:
         """The cell as a DEM geometry record (dispatch on ``cell.shape``)."""
@@ -982,7 +1001,11 @@ def fill_override_note(specimen: Specimen | None, fills_percent,
     50 % without a word that the count written in the file was not used; ``--fills 8.7`` of
     one stating 8.69565 % (4 particles of 46, as 8.7 % is) was said to override it.
     """
-    stated = specimen.stated_fill() if specimen is not None else None
+    from . import defaults
+
+    # in the run's own reference: the same particles per cell as the fills compared with it
+    stated = specimen.stated_fill(fill_reference or defaults.DEM_FILL_REFERENCE) \
+        if specimen is not None else None
     if stated is None:
         return ""
     overriding = [f for f in sorted(set(map(float, fills_percent)))

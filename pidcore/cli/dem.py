@@ -232,7 +232,7 @@ def sweep(args: argparse.Namespace) -> int:
                                         ("fill_percent", args.fills, "--fills"))]
     specimen, material = _specimen(args)
     if args.fills is None:  # an own specimen's stated fill, else the grid's (and why)
-        values[2], note = sweep_fills(specimen, args.grid)
+        values[2], note = sweep_fills(specimen, args.grid, args.fill_reference)
     else:
         # the summary's notes say the same to a library caller and in --json
         note = fill_override_note(specimen, values[2], args.fill_reference)
@@ -329,7 +329,7 @@ def _fill(args: argparse.Namespace, specimen, material: str) -> float:
     if args.fill is not None:
         _check_fill(args.fill, "--fill", args, specimen, material)
         return args.fill
-    stated = specimen.stated_fill() if specimen is not None else None
+    stated = specimen.stated_fill(args.fill_reference) if specimen is not None else None
     if stated is not None:
         return stated[0]
     if specimen is None:

@@ -56,8 +56,8 @@ def grid_axes(grid: str = "table3") -> dict[str, tuple[float, ...]]:
     return GRIDS[grid]
 
 
-def sweep_fills(specimen: Specimen | None,
-                grid: str = "table3") -> tuple[tuple[float, ...], str]:
+def sweep_fills(specimen: Specimen | None, grid: str = "table3",
+                fill_reference: str = "capacity") -> tuple[tuple[float, ...], str]:
     """The fills a sweep of ``specimen`` runs when none are given, and why, in words (``""``
     for the paper's coupon, whose sweep is ``grid``'s as it always was).
 
@@ -67,12 +67,14 @@ def sweep_fills(specimen: Specimen | None,
     particles per cell ran Table 3's 25, 50, 75 and 90 %, four times the runs asked for. The
     paper's coupon (which states no fill) keeps ``grid``'s fills, so the bundled Table 3 grid
     and its benchmark are unchanged; so does a file stating none, and the words say so.
+    ``fill_reference``: the sweep's :attr:`~pidcore.dem.DemConfig.fill_reference`, in which
+    the stated fill is given (the same particles per cell in either).
     """
     grid_fills = grid_axes(grid)["fill_percent"]
     shown = ", ".join(f"{f:g}" for f in sorted(grid_fills))
     if specimen is None or specimen.is_paper():
         return grid_fills, ""
-    stated = specimen.stated_fill()
+    stated = specimen.stated_fill(fill_reference)
     if stated is None:
         if is_paper_coupon(specimen.name):
             return grid_fills, ""  # the paper's coupon with another k_t model: its grid
