@@ -119,6 +119,7 @@ from typing import TYPE_CHECKING, Any
 
 from .constants import (
     CELL_SHAPES,
+    FILL_REFERENCES,
     TANGENTIAL_STIFFNESS_MODELS,
     CellShape,
     TangentialStiffnessModel,
@@ -750,22 +751,40 @@ class Specimen:
         return _capacity(self.cell.shape, self.cell.inscribed_diameter_m, self.cell.height_m,
                          self.particles.radius_m)
 
-    def stated_fill(self) -> tuple[float, str] | None:
+    def stated_fill(self, fill_reference: str = "capacity") -> tuple[float, str] | None:
         """The specimen's own fill (% of :meth:`capacity_per_cell`) and where it comes from
         in words, or None when it states neither ``count_per_cell`` nor ``fill_percent``.
 
         What a DEM run of this specimen simulates when no fill is given (``pidcore dem run
         --specimen`` without ``--fill``, the app's DEM page with its fills field empty). A
         count is its share of the capacity, which rounds back to that count.
+
+        ``fill_reference="paper"`` (a run's :attr:`pidcore.dem.DemConfig.fill_reference`):
+        the same particles per cell as a share of the paper's 36, which a run of that
+        reference takes as 100 %. The capacity's percentage there simulated another count
+        (a file stating 20 of 46 particles ran 16 of 36 without a word).
         """
+        from . import defaults
+
         p = self.particles
         if p.fill_percent is not None:
-            return p.fill_percent, "[particles] fill_percent"
-        if p.count_per_cell is not None:
+            stated: tuple[float, str] = (p.fill_percent, "[particles] fill_percent")
+        elif p.count_per_cell is not None:
             capacity = self.capacity_per_cell()
-            return (100.0 * p.count_per_cell / capacity,
-                    f"[particles] count_per_cell {p.count_per_cell} of capacity {capacity}")
-        return None
+            stated = (100.0 * p.count_per_cell / capacity,
+                      f"[particles] count_per_cell {p.count_per_cell} of capacity {capacity}")
+        else:
+            return None
+        if fill_reference == "capacity":
+            return stated
+        if fill_reference != "paper":
+            raise ParameterError(f"fill_reference: expected one of {FILL_REFERENCES}, got "
+                                 f"{fill_reference!r}")
+        count = p.count_per_cell if p.count_per_cell is not None else \
+            particles_for_fill(p.fill_percent, self.capacity_per_cell())
+        full = defaults.PAPER_PARTICLES_PER_FULL_CELL
+        return (100.0 * count / full,
+                f"{stated[1]}: {count} particles, of the paper's {full} per full cell")
 
     def geometry(self) -> CellGeometry:
         """The cell as a DEM geometry record (dispatch on ``cell.shape``)."""
@@ -982,7 +1001,11 @@ def fill_override_note(specimen: Specimen | None, fills_percent,
     50 % without a word that the count written in the file was not used; ``--fills 8.7`` of
     one stating 8.69565 % (4 particles of 46, as 8.7 % is) was said to override it.
     """
-    stated = specimen.stated_fill() if specimen is not None else None
+    from . import defaults
+
+    # in the run's own reference: the same particles per cell as the fills compared with it
+    stated = specimen.stated_fill(fill_reference or defaults.DEM_FILL_REFERENCE) \
+        if specimen is not None else None
     if stated is None:
         return ""
     overriding = [f for f in sorted(set(map(float, fills_percent)))
@@ -1464,7 +1487,9 @@ def models_paper_coupon(specimen: Specimen) -> bool:
 # --- what follows from a specimen ------------------------------------------------------------
 
 #: Load case whose impacts are the hardest of the paper's Table 3 grid (largest 2 a/w): the
-#: time step :func:`describe` reports is the one ``time_step="auto"`` picks for it.
+#: time step :func:`describe` reports is the one ``time_step="auto"`` picks for it, and so
+#: the smallest of the grid's (a softer load case's contact lasts longer: 6.98e-7 s at
+#: 500 Hz, 5 g beside 6.01e-7 s here for steel_6mm), not the step of every run.
 DESCRIBE_FREQUENCY_HZ = 50.0
 DESCRIBE_ACCELERATION_G = 10.0
 
@@ -1474,7 +1499,9 @@ def describe(specimen: Specimen) -> dict[str, Any]:
 
     Particle counts and masses are for the specimen's stated fill (``count_per_cell`` or
     ``fill_percent`` of the capacity) where it states one, else for a full cell. Contact time
-    and time step are for the hardest impact of the Table 3 grid (50 Hz, 10 g).
+    and time step are for the hardest impact of the Table 3 grid (``reference_frequency_hz``,
+    ``reference_acceleration_g``: 50 Hz, 10 g), so the step is the grid's smallest; a run at
+    another load case takes its own (:func:`pidcore.dem.simulate.choose_time_step`).
 
     ``tangential_stiffness_*_n_m`` is the constant k_t (Mindlin's at the overlap of a
     DEM_TANGENTIAL_REFERENCE_SPEED_M_S impact); with ``tangential_stiffness_model = "mindlin"``
@@ -1537,6 +1564,9 @@ def describe(specimen: Specimen) -> dict[str, Any]:
         "reference_impact_overlap_pw_m": overlap["pw"],
         "mindlin_tangential_stiffness_pp_n_m": k_t_mindlin["pp"],
         "mindlin_tangential_stiffness_pw_n_m": k_t_mindlin["pw"],
+        # the load case the contact time and time step are for (a run takes its own's)
+        "reference_frequency_hz": DESCRIBE_FREQUENCY_HZ,
+        "reference_acceleration_g": DESCRIBE_ACCELERATION_G,
         "reference_impact_speed_m_s": speed,
         "contact_time_s": law.contact_time(speed),
         "tangential_period_s": law.tangential_period(),

@@ -965,8 +965,9 @@ def test_an_empty_fills_field_takes_the_specimens_own_fill_as_the_cli_does():
     from pidcore.cli.dem import _fill
 
     for specimen in (steel, counted):
-        assert [_fill(Namespace(fill=None), specimen, "steel")] == jobs.dem_fills("",
-                                                                                 specimen)[0]
+        # the app's runs take the capacity as 100 %, as dem run's default
+        args = Namespace(fill=None, fill_reference="capacity")
+        assert [_fill(args, specimen, "steel")] == jobs.dem_fills("", specimen)[0]
     # typed values win over the specimen's; an empty field with nothing to fall back on is
     # one line that says where a fill could come from
     assert jobs.dem_fills("25, 75", counted) == ([25.0, 75.0], None)

@@ -387,8 +387,9 @@ def test_the_output_and_summary_name_the_specimen_file_and_the_file_written(cali
     out = _calibrate(folder, copy, "0.2", capsys)
     written = load_specimen(folder / "out_0.2" / "calibrated_specimen.toml")
     start = paper_specimen()
-    assert (f"Specimen: paper_coupon (sha256 {start.hash[:12]}, from {start.source}); "
-            f"calibrated file: {written.name} (sha256 {written.hash[:12]}).") \
+    # the output labels files as the app, reports and dem run do (name [6 hex digits])
+    assert (f"Specimen: paper_coupon [{start.hash[:6]}] (from {start.source}); "
+            f"calibrated file: {written.name} [{written.hash[:6]}].") \
         in out.splitlines(), out
     summary = (folder / "out_0.2" / "summary.md").read_text()
     assert (f"Specimen: paper_coupon (sha256 {start.hash}, from {start.source}); "

@@ -398,28 +398,62 @@ def _steel_stating_count(tmp_path, monkeypatch, count: int) -> tuple[Path, Path]
     return spec, mine
 
 
-def test_a_sweep_over_the_grids_fills_says_it_is_not_the_specimens_fill(tmp_path, capsys,
-                                                                        monkeypatch):
-    # a specimen stating its fill (steel_6mm: fill_percent = 50 of 46 -> 23 per cell; a file
-    # stating count_per_cell 20) swept without --fills ran Table 3's 25, 50, 75, 90 % and no
-    # word said the specimen's own fill was not among them
+def test_a_sweep_without_fills_runs_the_fill_the_specimen_states(tmp_path, capsys,
+                                                                  monkeypatch):
+    # a specimen stating its fill (steel_6mm: fill_percent = 50; a file stating count_per_cell
+    # 20) swept without --fills ran Table 3's 25, 50, 75, 90 % (4 x the runs), where `dem run`
+    # and the app's DEM tab simulate the stated fill; the paper's coupon keeps its grid
+    import pidcore.dem.sweep as sweep_module
+    from pidcore.dem.simulate import particles_per_cell
+    from pidcore.dem.sweep import GRIDS
     from pidcore.specimen import load_specimen
 
     spec, mine = _steel_stating_count(tmp_path, monkeypatch, 20)
-    capacity = load_specimen(mine).capacity_per_cell()
+    swept: list = []
+
+    def stop(cases, *args, **kwargs):
+        swept.append(sorted({case.fill_percent for case in cases}))
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(sweep_module, "run_sweep", stop)
+    specimen = load_specimen(mine)
+    capacity = specimen.capacity_per_cell()
     argv = ["dem", "sweep", "--specimen", str(mine), "--frequencies", "500",
             "--accelerations", "5", "--store", str(tmp_path / "s.h5"), "--no-progress"]
     assert main(argv) == 130
-    err = capsys.readouterr().err
-    assert (f"pidcore dem sweep: note: fills 25, 50, 75, 90 % are grid table3's, not the "
-            f"{100 * 20 / capacity:.6g} % specimen steel_6mm states ([particles] count_per_cell "
-            f"20 of capacity {capacity}); give --fills to choose\n") in err
-    # a specimen whose fill is on the grid (steel_6mm's 50 %), or given: nothing to say
-    for more, path in (([], spec), (["--fills", "50"], spec)):
-        assert main([*argv[:3], str(path), *argv[4:], *more]) == 130
+    assert swept.pop() == [pytest.approx(100 * 20 / capacity, rel=1e-12)]
+    # the fill swept is the file's 20 particles per cell, not a neighbour of it
+    stated = specimen.stated_fill()[0]
+    assert particles_per_cell(stated, specimen=specimen)[0] == 20
+    grid_fills = "25, 50, 75, 90"
+    assert capsys.readouterr().err.startswith(
+        f"pidcore dem sweep: note: fill {100 * 20 / capacity:.6g} % is the one specimen "
+        f"steel_6mm states ([particles] count_per_cell 20 of capacity {capacity}), as a run "
+        f"of it without a fill simulates; give --fills for others (grid table3's: "
+        f"{grid_fills} %)\n")
+    assert main([*argv[:3], str(spec), *argv[4:]]) == 130  # steel_6mm: fill_percent = 50.0
+    assert swept.pop() == [50.0]
+    assert "fill 50 % is the one specimen steel_6mm states ([particles] fill_percent)" in \
+        capsys.readouterr().err
+    # a file stating no fill: the grid's, and the note says why
+    none = tmp_path / "none.toml"
+    none.write_text(spec.read_text().replace("fill_percent = 50.0", ""))
+    assert load_specimen(none).stated_fill() is None
+    assert main([*argv[:3], str(none), *argv[4:]]) == 130
+    assert swept.pop() == list(GRIDS["table3"]["fill_percent"])
+    assert capsys.readouterr().err.startswith(
+        f"pidcore dem sweep: note: fills {grid_fills} % are grid table3's: specimen steel_6mm "
+        "states no fill (count_per_cell or fill_percent); give --fills to choose\n")
+    # the paper's coupon, named or not, keeps the bundled Table 3 grid, without a note
+    paper = Path(__file__).resolve().parents[1] / "pidcore" / "data" / "specimens" / \
+        "paper_coupon.toml"
+    for more in ([], ["--specimen", str(paper)], ["--tangential-stiffness", "mindlin"]):
+        assert main([*argv[:2], *argv[4:], *more]) == 130
+        assert swept.pop() == [25.0, 50.0, 75.0, 90.0]
         assert "note" not in capsys.readouterr().err
-    # fills given override the count the file states: said too (ran 30 % without a word)
+    # fills given: those, and what they override is said (ran 30 % without a word)
     assert main([*argv, "--fills", "30,50"]) == 130
+    assert swept.pop() == [30.0, 50.0]
     assert capsys.readouterr().err.startswith(
         f"pidcore dem sweep: note: fills 30, 50 % override the {100 * 20 / capacity:.6g} % "
         f"specimen steel_6mm states ([particles] count_per_cell 20 of capacity {capacity})\n")
@@ -443,10 +477,12 @@ def test_a_fill_of_the_specimens_particle_count_is_no_override(tmp_path, capsys,
     assert capsys.readouterr().err.startswith(
         f"pidcore dem sweep: note: fill 30 % overrides the {400 / 46:.6g} % specimen "
         "steel_6mm states ([particles] count_per_cell 4 of capacity 46)\n")
-    # counted against the run's 100 %: of the paper's 36, 9.75 % is 3.51 -> 4 particles where
-    # the stated 8.69565 % is 3.13 -> 3 (of the capacity's 46 both are 4)
+    # counted against the run's 100 %: of the paper's 36, 9.75 % is 3.51 -> 4 particles, the
+    # stated 4; the capacity's 8.69565 % is 3.13 -> 3 there (of the capacity's 46 both are 4)
     assert fill_override_note(specimen, [9.75]) == ""
-    assert fill_override_note(specimen, [9.75], "paper").startswith("fill 9.75 % overrides")
+    assert fill_override_note(specimen, [9.75], "paper") == ""
+    assert fill_override_note(specimen, [400 / 46], "paper").startswith(
+        f"fill {400 / 46:.6g} % overrides the {400 / 36:.6g} % specimen steel_6mm states")
 
 
 def test_a_fill_given_for_a_specimen_stating_its_count_is_said_to_override_it(tmp_path,
@@ -793,3 +829,46 @@ def test_time_step_help_names_every_limit_of_the_automatic_step(capsys):
         main(["dem", "run", "--help"])
     text = " ".join(capsys.readouterr().out.split())
     assert "contact time / 10, a stuck tangential spring's period / 10" in text
+
+
+def test_the_specimens_stated_fill_keeps_its_particle_count_under_the_papers_reference(
+        tmp_path, capsys, monkeypatch):
+    # `dem run --fill-reference paper` of a file stating count_per_cell = 20 (of a capacity
+    # of 46) took the capacity's 43.5 % as a share of the paper's 36 and simulated 16
+    # particles per cell, without a word; `dem sweep` (its stated fill now its default) too
+    import pidcore.dem.sweep as sweep_module
+    from pidcore.dem.simulate import particles_per_cell
+    from pidcore.specimen import fill_override_note, load_specimen
+
+    spec, mine = _steel_stating_count(tmp_path, monkeypatch, 20)
+    for path, count in ((mine, 20), (spec, 23)):  # steel_6mm: fill_percent 50 of 46 -> 23
+        specimen = load_specimen(path)
+        for reference in ("capacity", "paper"):
+            fill = specimen.stated_fill(reference)[0]
+            assert particles_per_cell(fill, specimen=specimen,
+                                      fill_reference=reference)[0] == count, (path, reference)
+        # the capacity's percentage unchanged (the run keys of stored runs hold it)
+        assert specimen.stated_fill("capacity") == specimen.stated_fill()
+    specimen = load_specimen(mine)
+    paper_fill = 100 * 20 / 36
+    # a fill typed as that count's share of 36 overrides nothing; 50 % of 36 (18) does
+    assert fill_override_note(specimen, [paper_fill], "paper") == ""
+    assert fill_override_note(specimen, [50.0], "paper").startswith("fill 50 % overrides")
+    swept: list = []
+
+    def stop(cases, *args, **kwargs):
+        swept.append(sorted({case.fill_percent for case in cases}))
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(sweep_module, "run_sweep", stop)
+    assert main(["dem", "sweep", "--specimen", str(mine), "--frequencies", "500",
+                 "--accelerations", "5", "--fill-reference", "paper", "--store",
+                 str(tmp_path / "s.h5"), "--no-progress"]) == 130
+    assert swept == [[pytest.approx(paper_fill, rel=1e-12)]]
+    assert ("count_per_cell 20 of capacity 46: 20 particles, of the paper's 36 per full cell"
+            in capsys.readouterr().err)
+    assert main(["dem", "run", "--specimen", str(mine), "--frequency", "1000",
+                 "--acceleration", "5", "--fill-reference", "paper", "--cells", "1",
+                 "--cycles", "4", "--json", "--no-progress"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert (doc["particles_per_cell"], doc["fill_reference"]) == (20, "paper")

@@ -148,3 +148,49 @@ def test_a_key_of_another_table_names_the_table_it_belongs_in(tmp_path, old, new
     path.write_text(_edit(PAPER.to_toml(), "count = 441", "count = 441\ncolour = 3"))
     with pytest.raises(ParameterError, match=r"colour: unknown key; expected one of \[[^]]*\]$"):
         load_specimen(path)
+
+
+def test_specimen_check_labels_its_time_step_with_the_load_case_it_is_for(tmp_path, capsys):
+    """`specimen check` printed "time step 6.009e-07 s", read as a run's step, though a run at
+    500 Hz, 5 g takes 6.8e-07 s: the step is 50 Hz, 10 g's, the Table 3 grid's hardest
+    impact. The line now names that load case and that it is the grid's smallest."""
+    import json
+    from pathlib import Path
+
+    from pidcore.cli import main
+    from pidcore.dem.simulate import LoadCase, choose_time_step
+    from pidcore.dem.sweep import grid_cases
+    from pidcore.specimen import describe
+
+    steel = Path(__file__).resolve().parents[1] / "data_samples" / "specimens" / "steel_6mm.toml"
+    for path in (steel, None):
+        specimen = load_specimen(path) if path else PAPER
+        if path is None:
+            path = tmp_path / "paper_coupon.toml"
+            path.write_text(PAPER.to_toml())
+        law, geometry = contact_law(specimen), specimen.geometry()
+
+        def step(frequency_hz: float, acceleration_g: float, law=law,
+                 geometry=geometry) -> float:
+            # what a run at that load case takes (time_step "auto", the default k_t model)
+            return choose_time_step(LoadCase(frequency_hz, acceleration_g, 50.0), law,
+                                    geometry, "auto")
+
+        facts = describe(specimen)
+        assert (facts["reference_frequency_hz"], facts["reference_acceleration_g"]) == (50, 10)
+        # exact: the same function of the same inputs
+        assert facts["time_step_s"] == step(50.0, 10.0)
+        assert facts["time_step_s"] == min(step(c.frequency_hz, c.acceleration_g)
+                                           for c in grid_cases("table3"))
+        # why the label is needed: another load case of the grid runs at another step
+        assert step(500.0, 5.0) > 1.1 * facts["time_step_s"]
+        assert main(["specimen", "check", str(path)]) == 0
+        lines = {line[:16].strip(): line[16:] for line in capsys.readouterr().out.splitlines()}
+        assert lines["time step"] == (
+            f"{facts['time_step_s']:.4g} s at 50 Hz, 10 g (auto: 1/10 of that contact time), "
+            "the smallest of the Table 3 grid; a run takes its own load case's (dem run "
+            "prints it as dt)")
+        assert "(50 Hz, 10 g)" in lines["contact time"]
+        assert main(["specimen", "check", str(path), "--json"]) == 0
+        doc = json.loads(capsys.readouterr().out)
+        assert (doc["reference_frequency_hz"], doc["reference_acceleration_g"]) == (50, 10)

@@ -278,18 +278,20 @@ def test_specimen_check_says_what_sets_the_time_step(tmp_path, capsys):
         assert main(["specimen", "check", str(path)]) == 0
         lines[name] = {line[:16].strip(): line[16:] for line in
                        capsys.readouterr().out.splitlines()}
-        step = f"{facts['time_step_s']:.4g} s (auto: 1/10 of "
+        step = f"{facts['time_step_s']:.4g} s at 50 Hz, 10 g (auto: 1/10 of "
+        grid = ("), the smallest of the Table 3 grid; a run takes its own load case's (dem run "
+                "prints it as dt)")
         # rel=1e-15 below: the step is that time divided by 10 once, as here (one rounding)
         if name == "constant":  # the contact is the shorter: its tenth is the step
             assert facts["contact_time_s"] < facts["tangential_period_s"]
             assert facts["time_step_s"] == pytest.approx(facts["contact_time_s"] / 10,
                                                          rel=1e-15)
-            assert lines[name]["time step"] == step + "that contact time)"
+            assert lines[name]["time step"] == step + "that contact time" + grid
         else:
             assert facts["tangential_period_s"] < facts["contact_time_s"]
             assert facts["time_step_s"] == pytest.approx(facts["tangential_period_s"] / 10,
                                                          rel=1e-15)
-            assert lines[name]["time step"] == step + "the stuck tangential period)"
+            assert lines[name]["time step"] == step + "the stuck tangential period" + grid
             assert lines[name]["contact time"].endswith(
                 "(at the largest overlap the DEM takes, 5 % of the radius)")
     assert "largest overlap" not in lines["constant"]["contact time"]

@@ -512,7 +512,7 @@ def test_specimen_check_says_which_file_a_calibrated_one_was_made_from(capsys):
 
     assert main(["specimen", "check", str(CALIBRATED_PAPER)]) == 0
     out = capsys.readouterr().out
-    assert f"calibrated from paper_coupon (sha256 {PAPER.hash[:16]})" in out
+    assert f"calibrated from paper_coupon [{PAPER.hash[:6]}]: the tests it models" in out
     assert main(["specimen", "check", str(CALIBRATED_PAPER), "--json"]) == 0
     facts = json.loads(capsys.readouterr().out)
     assert (facts["calibrated_from_name"], facts["calibrated_from_sha256"]) == \

@@ -140,6 +140,37 @@ def test_specimen_check_cli(capsys, tmp_path):
     assert err.count("\n") == 1 and str(bad) in err and "[coupon] mass_kg" in err
 
 
+def test_a_specimen_file_is_labelled_by_its_name_and_six_hex_digits_in_every_command(
+        capsys, tmp_path):
+    """`specimen check` showed 16 hex digits of the file's sha256, `dem run` and `dem sweep` 12,
+    the app and reports `steel_6mm [beeac8]` (6): one file read as three. Every command now
+    labels it as the pages do (:func:`pidcore.specimen.hashed_name`)."""
+    from pidcore.specimen import hashed_name, tested_label
+
+    steel = load_specimen(STEEL)
+    label = f"steel_6mm [{steel.hash[:6]}]"
+    # the one rule: the label a test of this file is shown under, and a DEM run of it
+    assert hashed_name(steel.name, steel.hash) == tested_label(steel.name, steel.hash) == label
+    longer = steel.hash[:7]  # any longer prefix shown is another spelling of the label
+    assert main(["specimen", "check", str(STEEL)]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith(f"specimen        {label} ({STEEL}): OK, not the paper's coupon")
+    assert longer not in out
+    store = tmp_path / "s.h5"
+    common = ["--specimen", str(STEEL), "--cells", "1", "--cycles", "4", "--no-progress",
+              "--store", str(store)]
+    assert main(["dem", "run", "--frequency", "1000", "--acceleration", "5", *common]) == 0
+    out = capsys.readouterr().out
+    assert f"specimen        {label} (own specimen): 286 hexagonal cells" in out
+    assert longer not in out
+    # the sweep (of the file's stated 50 %: the run above, reused) names the stored run's file
+    assert main(["dem", "sweep", "--frequencies", "1000", "--accelerations", "5",
+                 "--workers", "1", *common]) == 0
+    out = capsys.readouterr().out
+    assert f"1 already in {store}" in out and out.rstrip().endswith(f"; specimen {label}")
+    assert longer not in out
+
+
 def test_dem_run_cli_with_specimen_and_run_cache(capsys, tmp_path):
     store = tmp_path / "s.h5"
     args = ["dem", "run", "--specimen", str(STEEL), "--frequency", "1000", "--acceleration",
@@ -563,7 +594,7 @@ def test_a_sweeps_json_and_summary_name_each_runs_specimen_file(capsys, tmp_path
         assert main(args) == 0  # stored already: the summary names the stored run's file
         said[label] = capsys.readouterr().out
         assert f"1 already in {store}; wall time" in said[label]
-        assert said[label].rstrip().endswith(f"; specimen x (sha256 {spec.hash[:12]})")
+        assert said[label].rstrip().endswith(f"; specimen x [{spec.hash[:6]}]")
     assert first.hash != edited.hash
     assert len(Store(store).list_dem_runs()) == 2
 
@@ -651,8 +682,8 @@ def test_runs_of_an_edited_file_of_the_same_name_are_said_not_reused(tmp_path, m
     assert edited.name == steel.name and edited.hash != steel.hash
     note = persist.other_files_runs_note(store, [case], TINY, edited)
     assert note.startswith(f"{store} holds 1 run(s) of these load cases (seed 12345, 1 cells) "
-                           f"by other files named steel_6mm (sha256 {steel.hash[:12]}:")
-    assert f"this file's is sha256 {edited.hash[:12]}" in note
+                           f"by other files named steel_6mm (steel_6mm [{steel.hash[:6]}]:")
+    assert f"this file is steel_6mm [{edited.hash[:6]}] (any edit" in note
     # nothing to say: the file's own run, another load case, another cell count, another name
     assert persist.other_files_runs_note(store, [case], TINY, steel) == ""
     assert persist.other_files_runs_note(

@@ -106,14 +106,22 @@ def _sampler_words(result: CalibrationResult) -> str:
             f"{'converged' if sampler['converged'] else 'NOT converged'})")
 
 
-def specimen_words(result: CalibrationResult, *, digits: int = 64) -> str:
-    """Which specimen file was calibrated and which it wrote, by name and sha256 (``digits``
-    of it): ``"Specimen: my_steel (sha256 9a19..., from my_steel.toml); calibrated file:
-    my_steel_calibrated (sha256 b083...)."``. The summary and the command's output named
+def specimen_words(result: CalibrationResult, *, full_hash: bool = True) -> str:
+    """Which specimen file was calibrated and which it wrote, by name and sha256:
+    ``"Specimen: my_steel (sha256 9a19..., from my_steel.toml); calibrated file:
+    my_steel_calibrated (sha256 b083...)."`` with the whole hash (the summary's provenance),
+    else by the label the app, reports and ``dem run`` show (``full_hash=False``, the
+    command's output: ``"Specimen: my_steel [9a19aa] (from my_steel.toml); ..."``,
+    :func:`pidcore.specimen.hashed_name`). The summary and the command's output named
     neither: two files of one name calibrated alike read alike."""
+    from ..specimen import hashed_name
+
     start, written = result.specimen, result.calibrated_specimen()
-    return (f"Specimen: {start.name} (sha256 {start.hash[:digits]}, from {start.source}); "
-            f"calibrated file: {written.name} (sha256 {written.hash[:digits]}).")
+    if not full_hash:
+        return (f"Specimen: {hashed_name(start.name, start.hash)} (from {start.source}); "
+                f"calibrated file: {hashed_name(written.name, written.hash)}.")
+    return (f"Specimen: {start.name} (sha256 {start.hash}, from {start.source}); "
+            f"calibrated file: {written.name} (sha256 {written.hash}).")
 
 
 def summary_markdown(result: CalibrationResult) -> str:

@@ -173,7 +173,7 @@ def _print_result(args: argparse.Namespace, result, own_notes: list[str], saved:
         from ..calibrate.outputs import parameter_units, specimen_words
         from ..calibrate.posterior import summary_texts
 
-        print(specimen_words(result, digits=12))
+        print(specimen_words(result, full_hash=False))
         units = parameter_units(result)
         for name, p in result.parameters.items():
             median, low, high = summary_texts(p)

@@ -148,7 +148,10 @@ def _register_sweep(sub: argparse._SubParsersAction) -> None:
         p.add_argument(flag, metavar="X,X", default=None,
                        help=f"{what}, comma-separated, in place of the grid's (every "
                             "combination is run, each value once, in Table 3's order: "
-                            "ascending, whatever the order given)")
+                            "ascending, whatever the order given)"
+                            + ("; default for a --specimen stating its fill (count_per_cell "
+                               "or fill_percent): that fill alone, as dem run's"
+                               if flag == "--fills" else ""))
     _add_config_options(p)
     p.add_argument("--workers", metavar="N", type=positive_int, default=None,
                    help="local processes (default: all cores)")
@@ -217,7 +220,7 @@ def _interrupted(command: str, saved: int, store, *, left: int = 1) -> int:
 def sweep(args: argparse.Namespace) -> int:
     from ..dem.persist import run_key, stored_keys
     from ..dem.simulate import check_drive
-    from ..dem.sweep import cross_cases, grid_axes, grid_fill_note, run_sweep
+    from ..dem.sweep import cross_cases, grid_axes, run_sweep, sweep_fills
     from ..loadcase import parse_values
     from ..specimen import fill_override_note
 
@@ -228,12 +231,14 @@ def sweep(args: argparse.Namespace) -> int:
                                          "--accelerations"),
                                         ("fill_percent", args.fills, "--fills"))]
     specimen, material = _specimen(args)
+    if args.fills is None:  # an own specimen's stated fill, else the grid's (and why)
+        values[2], note = sweep_fills(specimen, args.grid, args.fill_reference)
+    else:
+        # the summary's notes say the same to a library caller and in --json
+        note = fill_override_note(specimen, values[2], args.fill_reference)
     for fill in values[2]:
         _check_fill(fill, "--fills", args, specimen, material)
-    # before the run (an interrupted sweep prints no summary); the summary's notes say the
-    # same to a library caller and in --json
-    note = grid_fill_note(specimen, args.grid, values[2]) if args.fills is None else \
-        fill_override_note(specimen, values[2], args.fill_reference)
+    # before the run (an interrupted sweep prints no summary)
     if note:  # on stderr: --json prints one document
         print(f"pidcore dem sweep: note: {cli_words(note, 'dem sweep')}", file=sys.stderr)
     cases = cross_cases(*values, material=material, direction=args.direction)
@@ -273,13 +278,16 @@ def sweep(args: argparse.Namespace) -> int:
 
 
 def _sweep_specimens(cases: list[dict]) -> str:
-    """``"; specimen my_steel (sha256 9a19aa85ea13)"``: whose runs the sweep's cases are, as
-    stored (each its name and hash); "" where no case is stored."""
+    """``"; specimen my_steel [9a19aa]"``: whose runs the sweep's cases are, as stored, each
+    by the label the app and reports show (:func:`pidcore.specimen.hashed_name`); "" where
+    no case is stored."""
+    from ..specimen import hashed_name
+
     named = dict.fromkeys((c.get("specimen_name"), c.get("specimen_sha256")) for c in cases
                           if c.get("specimen_sha256"))
     if not named:
         return ""
-    return "; specimen " + ", ".join(f"{name} (sha256 {sha[:12]})" for name, sha in named)
+    return "; specimen " + ", ".join(hashed_name(name, sha) for name, sha in named)
 
 
 def _print_sweep(args: argparse.Namespace, summary) -> None:
@@ -321,7 +329,7 @@ def _fill(args: argparse.Namespace, specimen, material: str) -> float:
     if args.fill is not None:
         _check_fill(args.fill, "--fill", args, specimen, material)
         return args.fill
-    stated = specimen.stated_fill() if specimen is not None else None
+    stated = specimen.stated_fill(args.fill_reference) if specimen is not None else None
     if stated is not None:
         return stated[0]
     if specimen is None:
@@ -442,6 +450,7 @@ def _tangential_stiffness_model(result) -> str:
 def format_summary(result, *, reused: bool = False) -> str:
     """Readable multi-line summary with units."""
     from ..dem.result import stderr_from_batches
+    from ..specimen import hashed_name
 
     c = result.case
     s = result.specimen
@@ -456,7 +465,7 @@ def format_summary(result, *, reused: bool = False) -> str:
         kind = "the paper's coupon" if s.is_paper() else "own specimen"
         particles = result.coupon_cells * result.particles_per_cell * s.particles.mass_kg
         lines += [
-            f"specimen        {s.name} ({kind}, sha256 {s.hash[:12]}): {result.coupon_cells} "
+            f"specimen        {hashed_name(s.name, s.hash)} ({kind}): {result.coupon_cells} "
             f"{s.cell.shape} cells {s.cell.inscribed_diameter_m * 1e3:.4g} x "
             f"{s.cell.height_m * 1e3:.4g} mm, particles r = {s.particles.radius_m * 1e3:.4g} mm",
             f"masses          coupon {s.coupon.mass_kg * 1e3:.4g} g + fixture "

@@ -41,12 +41,15 @@ def run_check(args: argparse.Namespace) -> int:
 
 def format_facts(f: dict, source: str) -> str:
     """Readable lines with units."""
+    from ..specimen import hashed_name
+
     kind = "the paper's coupon" if f["is_paper"] else "not the paper's coupon"
+    # the label the app, reports and dem run/sweep show (16 hex digits here matched none)
     return "\n".join([
-        f"specimen        {f['name']} ({source}): OK, {kind}; sha256 {f['sha256'][:16]} "
-        "(of every value, name and description included)",
-        *([f"calibrated from {f['calibrated_from_name']} (sha256 "
-           f"{f['calibrated_from_sha256'][:16]}): the tests it models are that file's"]
+        f"specimen        {hashed_name(f['name'], f['sha256'])} ({source}): OK, {kind}; "
+        "[...] starts its sha256 (of every value, name and description included)",
+        *([f"calibrated from {hashed_name(f['calibrated_from_name'], f['calibrated_from_sha256'])}"
+           ": the tests it models are that file's"]
           if f.get("calibrated_from_sha256") else []),
         f"cells           {f['cells_per_coupon']} {f['cell_shape']}, capacity "
         f"{f['capacity_per_cell']} particles per cell (dense drop packing)",
@@ -65,13 +68,21 @@ def format_facts(f: dict, source: str) -> str:
         f"{f['tangential_stiffness_pp_n_m']:.4g}, {f['tangential_stiffness_pw_n_m']:.4g} N/m",
         _tangential_line(f),
         f"contact time    {f['contact_time_s']:.4g} s at {f['reference_impact_speed_m_s']:.3g} "
-        f"m/s (50 Hz, 10 g); stuck tangential period {f['tangential_period_s']:.4g} s"
+        f"m/s ({_reference_case(f)}); stuck tangential period {f['tangential_period_s']:.4g} s"
         + (f" (at the largest overlap the DEM takes, "
            f"{defaults.DEM_MAX_OVERLAP_FRACTION * 100:g} % of the radius)"
            if f["tangential_stiffness_model"] == "mindlin" else ""),
-        f"time step       {f['time_step_s']:.4g} s (auto: {_step_limit(f)})",
+        # a run at 500 Hz takes a longer step than this one: the line read as the run's step
+        f"time step       {f['time_step_s']:.4g} s at {_reference_case(f)} (auto: "
+        f"{_step_limit(f)}), the smallest of the Table 3 grid; a run takes its own load "
+        "case's (dem run prints it as dt)",
         *(f"note: {note}" for note in f["notes"]),
     ])
+
+
+def _reference_case(f: dict) -> str:
+    """The load case the contact time and time step are for: ``"50 Hz, 10 g"``."""
+    return f"{f['reference_frequency_hz']:g} Hz, {f['reference_acceleration_g']:g} g"
 
 
 def _step_limit(f: dict) -> str:

@@ -28,7 +28,7 @@ import numpy as np
 from ..compare.align import parameters_digest
 from ..errors import StoreError
 from ..loadcase import key_0_1
-from ..specimen import Specimen, is_paper_coupon, paper_specimen
+from ..specimen import Specimen, hashed_name, is_paper_coupon, paper_specimen
 from .result import UNITS, DemResult
 from .simulate import (
     DemConfig,
@@ -433,12 +433,13 @@ def other_files_runs_note(store_path: str | os.PathLike[str], cases: Iterable[Lo
                   & (runs["seed"] == config.seed) & (runs["cells_simulated"] == config.cells)]
     if others.empty:
         return ""
-    files = ", ".join(f"sha256 {h[:12]}" for h in dict.fromkeys(others["specimen_sha256"]))
+    files = ", ".join(hashed_name(own.name, h) for h in dict.fromkeys(others["specimen_sha256"]))
     return (f"{store_path} holds {len(others)} run(s) of these load cases (seed {config.seed}, "
             f"{config.cells} cells) by other files named {own.name} ({files}: an earlier "
             f"version of this file, or a calibration's design points); not reused: a run is "
-            f"reused only for the same file content, and this file's is sha256 "
-            f"{own.hash[:12]} (any edit, its description too, makes another specimen)")
+            f"reused only for the same file content, and this file is "
+            f"{hashed_name(own.name, own.hash)} (any edit, its description too, makes another "
+            "specimen)")
 
 
 __all__ = ["DEM_CODE_VERSION", "cached_run", "CachedRun", "dem_run_entry", "load_dem_result",

@@ -24,7 +24,7 @@ from ..constants import DriveDirection, ParticleMaterial
 from ..errors import ParameterError, SimulationError, instance_of, whole_number
 from ..interrupt import raise_if_stopped
 from ..records import json_safe
-from ..specimen import Specimen, fill_override_note
+from ..specimen import Specimen, fill_override_note, is_paper_coupon
 from .persist import (
     dem_run_entry,
     other_files_runs_note,
@@ -56,18 +56,34 @@ def grid_axes(grid: str = "table3") -> dict[str, tuple[float, ...]]:
     return GRIDS[grid]
 
 
-def grid_fill_note(specimen: Specimen | None, grid: str, fills_percent: Iterable[float]) -> str:
-    """What a sweep of ``specimen`` over ``grid``'s fills (no fills given) leaves out: the
-    fill the specimen file states, which ``dem run`` simulates without ``--fill``; ``""``
-    where it states none or the grid holds it. A sweep of a specimen stating 20 particles per
-    cell ran Table 3's 25, 50, 75 and 90 % without a word."""
-    stated = specimen.stated_fill() if specimen is not None else None
-    fills = sorted(set(map(float, fills_percent)))
-    if stated is None or any(abs(f - stated[0]) < 1e-9 for f in fills):
-        return ""
-    return (f"fills {', '.join(f'{f:g}' for f in fills)} % are grid {grid}'s, not the "
-            f"{stated[0]:.6g} % specimen {specimen.name} states ({stated[1]}); give "
-            "fills_percent to choose")
+def sweep_fills(specimen: Specimen | None, grid: str = "table3",
+                fill_reference: str = "capacity") -> tuple[tuple[float, ...], str]:
+    """The fills a sweep of ``specimen`` runs when none are given, and why, in words (``""``
+    for the paper's coupon, whose sweep is ``grid``'s as it always was).
+
+    A specimen file of one's own stating its fill (``count_per_cell`` or ``fill_percent``:
+    :meth:`~pidcore.specimen.Specimen.stated_fill`) is swept at that fill alone, the one
+    ``dem run`` and the app's DEM tab simulate without a fill: a sweep of a file stating 20
+    particles per cell ran Table 3's 25, 50, 75 and 90 %, four times the runs asked for. The
+    paper's coupon (which states no fill) keeps ``grid``'s fills, so the bundled Table 3 grid
+    and its benchmark are unchanged; so does a file stating none, and the words say so.
+    ``fill_reference``: the sweep's :attr:`~pidcore.dem.DemConfig.fill_reference`, in which
+    the stated fill is given (the same particles per cell in either).
+    """
+    grid_fills = grid_axes(grid)["fill_percent"]
+    shown = ", ".join(f"{f:g}" for f in sorted(grid_fills))
+    if specimen is None or specimen.is_paper():
+        return grid_fills, ""
+    stated = specimen.stated_fill(fill_reference)
+    if stated is None:
+        if is_paper_coupon(specimen.name):
+            return grid_fills, ""  # the paper's coupon with another k_t model: its grid
+        return grid_fills, (f"fills {shown} % are grid {grid}'s: specimen {specimen.name} "
+                            "states no fill (count_per_cell or fill_percent); give "
+                            "fills_percent to choose")
+    return (stated[0],), (f"fill {stated[0]:.6g} % is the one specimen {specimen.name} "
+                          f"states ({stated[1]}), as a run of it without a fill simulates; "
+                          f"give fills_percent for others (grid {grid}'s: {shown} %)")
 
 
 def cross_cases(frequencies_hz: Iterable[float], accelerations_g: Iterable[float],
