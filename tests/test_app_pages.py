@@ -1274,14 +1274,15 @@ def test_compare_gives_the_equivalent_damper_of_the_dem_case_and_the_measurement
 
 def test_compare_names_a_saved_implausible_result_and_judges_no_band_of_its_pool(
         store_file, tmp_path, monkeypatch):
-    # Compare pooled a record saved as implausible (loss factor 1.5: SDC 9.4 > 2 pi) with a
+    # Compare pooled a record saved as implausible (loss factor 3: SDC 18.8 above the paper
+    # coupon's bound at 50 %, 8 m_p/m_s = 16.9; loss factor 1.5 before that bound) with a
     # good one of its load case, without a word, and judged the mean (4.9, its stderr the
     # scatter of the two) 'inside' the calibrated band widened by that stderr; report --store
     # names such a record and calibrate --store leaves it out
     from pidcore.app.calibration import CALIBRATION_ENV_VAR
     from pidcore.cli import main
 
-    for name, eta, seed in (("bad_fill50.csv", 1.5, 1), ("ok_fill50.csv", 0.05, 2)):
+    for name, eta, seed in (("bad_fill50.csv", 3.0, 1), ("ok_fill50.csv", 0.05, 2)):
         (tmp_path / name).write_bytes(mass_damper_csv(loss_factor=eta, seed=seed))
     assert main(["analyze", str(tmp_path / "bad_fill50.csv"), str(tmp_path / "ok_fill50.csv"),
                  "--store", str(store_file), "--accept-implausible"]) == 0
@@ -1296,7 +1297,7 @@ def test_compare_names_a_saved_implausible_result_and_judges_no_band_of_its_pool
     assert not at.exception
     captions = " ".join(c.value for c in at.caption)
     assert "the measured Eq. 11 SDC is not compared (it pools an implausible result" in captions
-    assert "bad_fill50.csv: implausible, saved as accepted: SDC 9.4" in captions
+    assert "bad_fill50.csv: implausible, saved as accepted: SDC 18.8" in captions
     assert "ok_fill50.csv: implausible" not in captions
 
 
@@ -1942,3 +1943,22 @@ def test_a_fill_of_no_particle_of_the_uploaded_specimens_cell_is_refused_as_the_
         f"m_fill1.csv, column fill [%]: {said}; was 1 meant as 100 %? (the cell of specimen "
         "steel_6mm, panel.toml); set it in the settings table"]
     assert at.button(key="save").disabled  # nothing to save: no test without particles
+
+
+def test_a_heavy_particle_sdc_above_2_pi_is_no_implausible_result_of_its_specimen(
+        store_file, tmp_path):
+    """Was: the Analyse card warned 'Implausible: SDC 9.4 is above the physical bound 6.28' for
+    a test of steel_6mm (216 g of steel spheres on 48.3 g at 50 %), whose particles can
+    dissipate up to SDC 8 m_p/m_s = 35.8, and asked to confirm its save."""
+    import shutil
+
+    folder = tmp_path / "data_samples" / "specimens"  # the app runs in tmp_path
+    folder.mkdir(parents=True)
+    shutil.copy(REPO / "data_samples" / "specimens" / "steel_6mm.toml", folder)
+    data = mass_damper_csv(frequency_hz=100.0, acceleration_g=5.0, loss_factor=1.5)
+    at = _upload(_app(), [("m_fill50.csv", data), ("settings.csv", _steel_settings("steel_6mm"))])
+    assert not [w.value for w in at.warning if "Implausible" in w.value]
+    # a specimen whose file is not at hand: its masses unknown, the bound is 2 pi
+    at = _upload(_app(), [("m_fill50.csv", data), ("settings.csv", _steel_settings("nosuch"))])
+    (warned,) = [w.value for w in at.warning if "Implausible" in w.value]
+    assert "is above the physical bound 6.28 (loss factor 1.5" in warned

@@ -388,11 +388,13 @@ def test_a_count_below_one_is_refused_as_dem_sweep_refuses_it(capsys, tmp_path, 
 
 def test_an_sdc_in_percent_is_refused_naming_its_line(capsys, tmp_path):
     # 42 typed for 0.42 (an SDC in %) ran the whole calibration, exit 0, and only said the
-    # posterior piled against a prior bound. Above 2 pi (a loss factor of 1) is the bound the
-    # analysis' plausibility check uses (pidcore.compare.plausibility.SDC_UPPER_BOUND)
+    # posterior piled against a prior bound. The bound is the analysis' plausibility check's
+    # (pidcore.compare.plausibility.sdc_bound): the paper coupon's 46.8 g of acrylic at 50 %
+    # on its 22.2 g can dissipate at most SDC 8 m_p/m_s = 16.9
     table = _table(tmp_path, HEADER + "500,5,50,0.6\n1000,5,50,42\n500,1,50,0.2\n")
     _refused(capsys, tmp_path, ["--data", str(table)],
-             "m.csv, line 3: sdc 42 is above 6.283 (2 pi, a loss factor of 1")
+             "m.csv, line 3: sdc 42 is above 16.91 (particles of 46.8 g on a 22.2 g structure "
+             "can dissipate at most SDC 8 m_p/m_s = 16.9")
 
 
 def test_a_field_of_value_zero_asks_for_its_prior_by_name(capsys, tmp_path):
@@ -440,6 +442,12 @@ def test_a_scripts_measured_point_is_held_to_the_tables_rules(tmp_path, keywords
 
         with pytest.raises(InputFileError) as in_table:
             read_measured_table(table)
+        if column == "sdc" and value == 42.0:
+            # a script's point states no specimen (2 pi); a table's row is of the paper's
+            # coupon, whose 46.8 g of acrylic at 50 % on 22.2 g bound the SDC at 16.9
+            said = ("sdc 42 is above 16.91 (particles of 46.8 g on a 22.2 g structure can "
+                    "dissipate at most SDC 8 m_p/m_s = 16.9, two fully inelastic impacts per "
+                    "cycle; Table 3's largest is 0.88); expected the SDC as a ratio; was it %?")
         assert str(in_table.value) == f"{table}, line 2: {said}"
 
 

@@ -89,9 +89,11 @@ def report_table(stamp: tuple, pool: bool, keys: tuple[str, ...] | None,
 
 
 @st.cache_resource(max_entries=_CACHE_ENTRIES, show_spinner=False)
-def saved_entries(keys: tuple[str, ...], stamp: tuple, _stores, _rows):
-    """Measured entries of saved analyses (phasors read once per store state)."""
-    return workbench.saved_entries(_stores.path, _rows)
+def saved_entries(keys: tuple[str, ...], stamp: tuple, _stores, _rows,
+                  known_hashes: tuple[str, ...] = (), _known=()):
+    """Measured entries of saved analyses (phasors read once per store state), judged against
+    the SDC bound of the specimen files the page knows (``_known``, keyed by their hashes)."""
+    return workbench.saved_entries(_stores.path, _rows, _known)
 
 
 @st.cache_data(show_spinner=False)

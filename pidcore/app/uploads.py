@@ -898,6 +898,9 @@ class AnalysedFile:
     #: sha256 of the specimen file named (:func:`pidcore.specimen.resolve_specimen_name`),
     #: "" where only its name is known
     specimen_sha256: str = ""
+    #: the SDC bound it was judged against (:func:`pidcore.compare.plausibility.
+    #: tested_sdc_bound`; None: 2 pi)
+    sdc_bound: object = None
 
 
 def results_table(files: Sequence[AnalysedFile]) -> pd.DataFrame:

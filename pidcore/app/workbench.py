@@ -40,16 +40,18 @@ def loop_frame(loops: Sequence[ForceDisplacementLoop]) -> pd.DataFrame:
             else pd.DataFrame(columns=list(LOOP_COLUMNS)))
 
 
-def saved_entries(path: str | os.PathLike, rows: pd.DataFrame) -> list[MeasuredEntry]:
+def saved_entries(path: str | os.PathLike, rows: pd.DataFrame,
+                  known: Sequence = ()) -> list[MeasuredEntry]:
     """Entries of the saved analyses ``rows`` (from :func:`pidcore.store.listing.saved_analyses`),
-    with their harmonic phasors read from the store."""
+    with their harmonic phasors read from the store; ``known``: the specimen files at hand,
+    whose tests are judged against their SDC bound (:meth:`MeasuredEntry.from_store`)."""
     from ..store import Store
 
     if rows.empty:
         return []
     # one opening of the store for all of them, not one per row
     stored = Store(path).get_analyses(str(key) for key in rows["key"])
-    return [MeasuredEntry.from_store(row, entry.arrays)
+    return [MeasuredEntry.from_store(row, entry.arrays, known=known)
             for (_, row), entry in zip(rows.iterrows(), stored, strict=True)]
 
 

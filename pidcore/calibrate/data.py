@@ -18,14 +18,23 @@ import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pandas as pd
 
 from .. import defaults
 from ..compare.align import stored_stderr_dof
-from ..compare.plausibility import SDC_UPPER_BOUND, stored_findings
+from ..compare.plausibility import (
+    SDC_UPPER_BOUND,
+    UNKNOWN_SPECIMEN_BOUND,
+    SdcBound,
+    stored_findings,
+)
 from ..errors import InputFileError, ParameterError, as_given, real_number
+
+if TYPE_CHECKING:  # pragma: no cover
+    from ..specimen import Specimen
 
 REQUIRED_COLUMNS = ("frequency_hz", "acceleration_g", "fill_percent", "sdc")
 OPTIONAL_COLUMNS = ("sdc_stderr", "sdc_stderr_dof", "energy_per_cycle_j", "material",
@@ -59,6 +68,10 @@ class MeasuredPoint:
     # files of one name are two specimens; "" where only the name is known (a table, an older
     # record), or the paper's coupon's (pidcore.specimen.deciding_sha256)
     specimen_sha256: str = ""
+    # the SDC above which the point is refused (pidcore.compare.plausibility.sdc_bound of the
+    # specimen it was measured on at its fill; 2 pi where that is not known): a property of
+    # its specimen, not of the point
+    sdc_bound: SdcBound = field(default=UNKNOWN_SPECIMEN_BOUND, compare=False)
 
     def __post_init__(self) -> None:
         # the rule of a table row, for a script's point too: a script's sdc=nan, a negative
@@ -84,12 +97,14 @@ class MeasuredPoint:
         object.__setattr__(self, "sdc_stderr_dof", dof)
         # a negative sdc is a draw of noise around a small one, which a synthetic study
         # (docs/calibration_audit) fits as it is; a measured table refuses it
-        if self.sdc > SDC_UPPER_BOUND:
+        bound = self.sdc_bound
+        if self.sdc > bound.sdc:
             # a fit to it runs to the end and only says its posterior piles at a bound
+            basis = ("2 pi, a loss factor of 1: more dissipated per radian than the coupon "
+                     "stores" if bound.sdc <= SDC_UPPER_BOUND else bound.basis())
             raise ParameterError(
-                f"sdc {as_given(self.sdc)} is above {SDC_UPPER_BOUND:.4g} (2 pi, a loss factor "
-                "of 1: more dissipated per radian than the coupon stores; Table 3's largest is "
-                "0.88); expected the SDC as a ratio; was it %?")
+                f"sdc {as_given(self.sdc)} is above {bound.sdc:.4g} ({basis}; Table 3's "
+                "largest is 0.88); expected the SDC as a ratio; was it %?")
 
     def label(self) -> str:
         """E.g. ``'500 Hz, 1 g, 50 %, steel, specimen steel_6mm_b'``: material and specimen
@@ -110,11 +125,14 @@ def _text_cell(value, default: str) -> str:
 
 
 def read_measured_table(path: str | os.PathLike, *,
-                        default_material: str = DEFAULT_MATERIAL) -> list[MeasuredPoint]:
+                        default_material: str = DEFAULT_MATERIAL,
+                        specimen: Specimen | None = None) -> list[MeasuredPoint]:
     """Read a measured-SDC table; one-line errors for missing columns or bad values.
 
     A row without a ``material`` takes ``default_material`` (the calibrated specimen's when
     one is given, as a measurement compared with a specimen does; else the paper's acrylic).
+    An SDC above its specimen's bound is refused (:func:`_point_sdc_bound`: ``specimen``,
+    the file calibrated, or the paper's coupon).
     """
     from ..tables import line_where, read_text_table_file
 
@@ -154,9 +172,13 @@ def read_measured_table(path: str | os.PathLike, *,
         except (TypeError, ValueError):
             raise InputFileError(f"{where}: sdc_stderr_dof {raw_dof!r} is not a number") from None
         try:
-            points.append(MeasuredPoint(material=_text_cell(row.get("material"), default_material),
-                                        specimen=_text_cell(row.get("specimen"), ""),
-                                        source=str(path), row=int(line), **values))
+            material = _text_cell(row.get("material"), default_material)
+            named = _text_cell(row.get("specimen"), "")
+            points.append(MeasuredPoint(material=material, specimen=named,
+                                        source=str(path), row=int(line), **values,
+                                        sdc_bound=_point_sdc_bound(
+                                            values["fill_percent"], material, named, "",
+                                            specimen)))
         except ParameterError as exc:  # the row's values, named by their columns
             raise InputFileError(f"{where}: {exc}") from None
     if not points:
@@ -174,8 +196,24 @@ def read_measured_table(path: str | os.PathLike, *,
     return points
 
 
+def _point_sdc_bound(fill_percent: float, material: str, specimen_name: str,
+                     specimen_sha256: str, given: Specimen | None) -> SdcBound:
+    """The SDC bound of a measured point (:func:`pidcore.compare.plausibility.sdc_bound`):
+    one naming no specimen is a test of ``given`` where its particles are ``given``'s (as
+    :func:`points_for_specimen` takes it), else of the paper's coupon; one naming a specimen
+    is judged as :func:`~pidcore.compare.plausibility.tested_sdc_bound` does."""
+    from ..compare.plausibility import sdc_bound, tested_sdc_bound
+
+    if given is not None and not specimen_name and material == given.particles.material:
+        return sdc_bound(fill_percent=fill_percent, material=material, specimen=given)
+    return tested_sdc_bound(fill_percent=fill_percent, material=material,
+                            specimen_name=specimen_name, specimen_sha256=specimen_sha256,
+                            given=given)
+
+
 def measured_from_store(store_path: str | os.PathLike, *,
-                        left_out: list[str] | None = None) -> list[MeasuredPoint]:
+                        left_out: list[str] | None = None,
+                        specimen: Specimen | None = None) -> list[MeasuredPoint]:
     """Analysed measurements of a store, grouped per load case, particle material and specimen
     label (mean SDC, standard error), of the newest analysis of each measurement.
 
@@ -189,7 +227,8 @@ def measured_from_store(store_path: str | os.PathLike, *,
     acceleration are rounded to 3 and 2 significant digits to find the load case; the
     analyses must carry ``fill_percent`` (from a sidecar). Records the plausibility checks
     refuse (saved with ``--accept-implausible``: a negative SDC beyond its noise, one above
-    2 pi) are left out; ``left_out``, where given, gains a line naming each.
+    its specimen's bound, :func:`_point_sdc_bound` with ``specimen`` the file calibrated, or
+    2 pi where not known) are left out; ``left_out``, where given, gains a line naming each.
     """
     from ..specimen import MEASURED_SHA256_FIELD, deciding_sha256
     from ..store import Store
@@ -209,7 +248,13 @@ def measured_from_store(store_path: str | os.PathLike, *,
     frame = latest_per_measurement(frame)
     # a result no passive coupon gives, kept as asked for the record, fits no parameter: an
     # SDC of -1.26 and one of 9.4 were averaged into the load case (in-sample RMS 2.7)
-    implausible = [stored_findings(row)[0] for _, row in frame.iterrows()]
+    bounds = [_point_sdc_bound(
+        float(row["fill_percent"]), _text_cell(row.get("material"), DEFAULT_MATERIAL),
+        _text_cell(row.get("specimen"), ""), _text_cell(row.get(MEASURED_SHA256_FIELD), ""),
+        specimen) for _, row in frame.iterrows()]
+    frame = frame.assign(sdc_bound=bounds)
+    implausible = [stored_findings(row, bound=bound)[0]
+                   for (_, row), bound in zip(frame.iterrows(), bounds, strict=True)]
     if left_out is not None:
         left_out.extend(f"{Path(str(row.get('source', '') or row['key'])).name}: left out, "
                         f"implausible (saved as accepted): {found[0].message}"
@@ -234,7 +279,7 @@ def measured_from_store(store_path: str | os.PathLike, *,
     points = []
     keys = ["frequency_hz", "acceleration_g", "fill_percent", "material", "specimen",
             "specimen_sha256"]
-    for (f, a, p, material, specimen, sha256), group in frame.groupby(keys):
+    for (f, a, p, material, named, sha256), group in frame.groupby(keys):
         sdc = group["sdc"].to_numpy(float)
         if len(sdc) > 1:
             se = float(np.std(sdc, ddof=1) / math.sqrt(len(sdc)))
@@ -244,8 +289,10 @@ def measured_from_store(store_path: str | os.PathLike, *,
             dof = stored_stderr_dof(group.get("sdc_stderr_dof", pd.Series([math.nan])).iloc[0]) \
                 if se > 0 else math.nan
         points.append(MeasuredPoint(float(f), float(a), float(p), float(sdc.mean()), se,
-                                    str(material), str(specimen), sdc_stderr_dof=dof,
-                                    source=str(store_path), specimen_sha256=str(sha256)))
+                                    str(material), str(named), sdc_stderr_dof=dof,
+                                    source=str(store_path), specimen_sha256=str(sha256),
+                                    # one specimen and fill: one bound
+                                    sdc_bound=group["sdc_bound"].iloc[0]))
     if not points:
         dropped = [found[0].message for found in implausible if found]
         if dropped:

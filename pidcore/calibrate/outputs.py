@@ -47,15 +47,18 @@ def specimen_text(result: CalibrationResult) -> str:
     return "\n".join(lines) + "\n" + result.calibrated_specimen().to_toml()
 
 
-def _band_text(low: float, high: float, sdc) -> str:
-    """A 95 % band as the summary shows it: an upper bound past 2 pi (an SDC no measurement is
-    kept at: :data:`pidcore.compare.plausibility.SDC_UPPER_BOUND`) is cut there and says the
-    model's own bound, as the report and the app cut it
+def _band_text(low: float, high: float, sdc, bound: float | None = None) -> str:
+    """A 95 % band as the summary shows it: an upper bound past ``bound`` (an SDC no
+    measurement is kept at: :func:`pidcore.compare.plausibility.sdc_bound` of the specimen at
+    this fill; default 2 pi, :data:`~pidcore.compare.plausibility.SDC_UPPER_BOUND`) is cut
+    there and says the model's own bound, as the report and the app cut it
     (:meth:`pidcore.calibrate.prediction.CalibratedPrediction.band`)."""
     from ..compare.plausibility import SDC_UPPER_BOUND
 
-    if high > SDC_UPPER_BOUND:
-        return (f"{sdc(min(low, SDC_UPPER_BOUND))} .. {sdc(SDC_UPPER_BOUND)} (cut at 2 pi; "
+    bound = SDC_UPPER_BOUND if bound is None else bound
+    if high > bound:
+        at = "2 pi" if bound == SDC_UPPER_BOUND else f"the specimen's SDC bound {bound:.4g}"
+        return (f"{sdc(min(low, bound))} .. {sdc(bound)} (cut at {at}; "
                 f"model {high:.3g}: unconstrained)")
     return f"{sdc(low)} .. {sdc(high)}"
 
@@ -74,16 +77,34 @@ def parameter_units(result: CalibrationResult) -> dict[str, str]:
 PARAMETER_HEAD = ("parameter", "unit", "median", "95 % interval", "prior bounds")
 
 
-def _table_rows(rows: list[dict]) -> list[list[str]]:
+def row_sdc_bounds(result: CalibrationResult | None, rows: list[dict]) -> list[float]:
+    """The SDC bound of each prediction row (:func:`pidcore.calibrate.prediction.
+    calibrated_sdc_bound` at the row's fill), where the summary and the plot cut its band, as
+    the report does; 2 pi where the specimen is not known (``result`` None)."""
+    from ..compare.plausibility import SDC_UPPER_BOUND
+    from .prediction import calibrated_sdc_bound
+
+    if result is None:
+        return [SDC_UPPER_BOUND] * len(rows)
+    specimen = result.calibrated_specimen()
+    return [calibrated_sdc_bound(specimen, fill_percent=r["fill_percent"],
+                                 material=r.get("material") or specimen.particles.material).sdc
+            for r in rows]
+
+
+def _table_rows(rows: list[dict], bounds: list[float] | None = None) -> list[list[str]]:
+    from ..compare.plausibility import SDC_UPPER_BOUND
+
     def sdc(value: float) -> str:  # three decimals; a small SDC keeps its digits, not 0.000
         return display_number(value, decimals=3)
 
+    bounds = [SDC_UPPER_BOUND] * len(rows) if bounds is None else bounds
     out = []
-    for r in rows:
+    for r, bound in zip(rows, bounds, strict=True):
         error = r["predicted"] - r["measured"]
         out.append([f"{r['frequency_hz']:g}", f"{r['acceleration_g']:g}",
                     f"{r['fill_percent']:g}", sdc(r["measured"]), sdc(r["predicted"]),
-                    _band_text(r["low95"], r["high95"], sdc),
+                    _band_text(r["low95"], r["high95"], sdc, bound),
                     ("+" if error >= 0 else "") + sdc(error),
                     "yes" if r["low95"] <= r["measured"] <= r["high95"] else "**no**"])
     return out
@@ -155,7 +176,8 @@ def summary_markdown(result: CalibrationResult) -> str:
         lines += ["", f"## {title}: RMS {rms_text(rms)}, {inside}/{len(rows)} inside the 95 % "
                   "band",
                   "", "| " + " | ".join(_HEAD) + " |", "|---" * len(_HEAD) + "|"]
-        lines += ["| " + " | ".join(cells) + " |" for cells in _table_rows(rows)]
+        lines += ["| " + " | ".join(cells) + " |"
+                  for cells in _table_rows(rows, row_sdc_bounds(result, rows))]
     if any(s.kind == "dem" for s in result.specs):
         lines += ["", "## Energy per cycle per cell: starting specimen vs calibrated DEM", "",
                   "| f [Hz] | a [g] | start [J] | calibrated median [J] | 95 % band [J] | "
@@ -191,7 +213,7 @@ def summary_html(result: CalibrationResult) -> str:
             continue
         parts.append(f"<h2>{title}</h2><table><tr>"
                      + "".join(f"<th>{html.escape(h)}</th>" for h in _HEAD) + "</tr>")
-        for cells in _table_rows(rows):
+        for cells in _table_rows(rows, row_sdc_bounds(result, rows)):
             parts.append("<tr>" + "".join(f"<td>{html.escape(c.strip('*'))}</td>"
                                           for c in cells) + "</tr>")
         parts.append("</table>")
@@ -203,19 +225,22 @@ def summary_html(result: CalibrationResult) -> str:
     return "\n".join(parts)
 
 
-def shown_band_bars(rows: list[dict]) -> tuple[np.ndarray, np.ndarray, np.ndarray, bool]:
+def shown_band_bars(rows: list[dict], bounds: list[float] | None = None
+                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, bool]:
     """(predicted, distance down to low95, distance up to high95, whether a bound was cut) of
-    prediction rows as the plot draws them: an upper bound past 2 pi is cut there, as
-    :func:`_band_text` and the report cut it."""
+    prediction rows as the plot draws them: an upper bound past the row's SDC bound
+    (``bounds``, :func:`row_sdc_bounds`; default 2 pi) is cut there, as :func:`_band_text`
+    and the report cut it."""
     from ..compare.plausibility import SDC_UPPER_BOUND
 
     pred = np.array([r["predicted"] for r in rows], dtype=float)
     low = np.array([r["low95"] for r in rows], dtype=float)
     high = np.array([r["high95"] for r in rows], dtype=float)
-    shown = np.minimum(high, SDC_UPPER_BOUND)
+    limit = np.full(len(rows), SDC_UPPER_BOUND) if bounds is None else np.asarray(bounds, float)
+    shown = np.minimum(high, limit)
     # a median past the bound has no band below it: its bar ends at its point
     return (pred, pred - np.minimum(low, pred), np.maximum(shown - pred, 0.0),
-            bool((high > SDC_UPPER_BOUND).any()))
+            bool((high > limit).any()))
 
 
 def plot_predictions(result: CalibrationResult, path: Path) -> None:
@@ -230,18 +255,23 @@ def plot_predictions(result: CalibrationResult, path: Path) -> None:
     rows = result.predictions
     x = np.arange(len(rows))
     fig, ax = plt.subplots(figsize=(max(6, 0.7 * len(rows)), 4.5), constrained_layout=True)
-    cut = False
+    cut, cut_at = False, set()
     for offset, data, label, color in ((-0.12, rows, "calibrated (all points)", "C0"),
                                        (0.12, result.loo, "leave-one-out", "C1")):
         if not data:
             continue
-        pred, below, above, cut_here = shown_band_bars(data)
+        bounds = row_sdc_bounds(result, data)
+        pred, below, above, cut_here = shown_band_bars(data, bounds)
+        if cut_here:
+            cut_at.update(b for b, r in zip(bounds, data, strict=True) if r["high95"] > b)
         cut = cut or cut_here
         ax.errorbar(x + offset, pred, yerr=[below, above], fmt="o", capsize=3,
                     color=color, label=f"{label}, 95 % band")
-    if cut:  # a band reaching past 2 pi drew a bar to a value no measurement is kept at
-        ax.axhline(SDC_UPPER_BOUND, color="0.5", ls="--", lw=1,
-                   label="2 pi: bands cut here (model unconstrained above)")
+    for bound in sorted(cut_at):  # a band past its bound reached a value no measurement is
+        # kept at: drawn cut there, one line per bound (a fill of its own has its own)
+        ax.axhline(bound, color="0.5", ls="--", lw=1,
+                   label=("2 pi" if bound == SDC_UPPER_BOUND else f"SDC bound {bound:.3g}")
+                   + ": bands cut here (model unconstrained above)")
     ax.plot(x, [r["measured"] for r in rows], "k*", ms=10, label="measured")
     ax.set_xticks(x, [f"{r['frequency_hz']:g} Hz\n{r['acceleration_g']:g} g" for r in rows],
                   fontsize=8)

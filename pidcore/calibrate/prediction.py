@@ -10,7 +10,7 @@ from __future__ import annotations
 import json
 import math
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -18,7 +18,7 @@ import pandas as pd
 
 from .. import defaults
 from ..compare.align import Z95, Tolerances, band_quantile, quantile_label  # noqa: F401 (public here)
-from ..compare.plausibility import SDC_UPPER_BOUND
+from ..compare.plausibility import SDC_UPPER_BOUND, UNKNOWN_SPECIMEN_BOUND, SdcBound
 from ..errors import ParameterError, instance_of, real_number
 from ..loadcase import LoadCase
 
@@ -26,6 +26,34 @@ if TYPE_CHECKING:  # pragma: no cover
     from ..specimen import Specimen
 
 _REQUIRED = ("frequency_hz", "acceleration_g", "fill_percent", "predicted", "low95", "high95")
+
+
+def calibrated_sdc_bound(calibrated: Specimen | None, specimen_name: str = "", *,
+                         fill_percent: float, material: str) -> SdcBound:
+    """The SDC bound (:func:`pidcore.compare.plausibility.sdc_bound`) of a test of the specimen
+    a calibration is of (``calibrated``: its calibrated specimen, None where not at hand;
+    ``specimen_name``: the name it states): the paper's coupon's where it calibrates that (the
+    bound its tests were judged by when analysed: the fitted fixture, 254 g in the bundled
+    calibration, is no mass of the tested coupon), else the calibrated specimen's, else 2 pi."""
+    from ..compare.plausibility import sdc_bound
+    from ..specimen import is_paper_coupon, measured_specimen_name
+
+    tested = measured_specimen_name(calibrated) if calibrated is not None else specimen_name
+    if is_paper_coupon(tested):
+        return sdc_bound(fill_percent=fill_percent, material=material)
+    if calibrated is not None:
+        return sdc_bound(fill_percent=fill_percent, material=material, specimen=calibrated)
+    return UNKNOWN_SPECIMEN_BOUND
+
+
+def band_cut_words(bound: SdcBound) -> str:
+    """Where a calibrated band is cut and why, e.g. ``'2 pi = 6.283 (a loss factor of 1, above
+    which a measured SDC is refused as implausible)'``."""
+    if bound.sdc > SDC_UPPER_BOUND:
+        return (f"{bound.sdc:.4g}, the SDC bound of the specimen's particles ({bound.basis()}; "
+                "a measured SDC above it is refused as implausible)")
+    return (f"2 pi = {SDC_UPPER_BOUND:.4g} (a loss factor of 1, above which a measured SDC is "
+            "refused as implausible)")
 
 
 @dataclass(frozen=True)
@@ -52,6 +80,10 @@ class CalibratedPrediction:
         NaN: unknown, its errors taken as normal).
     low95_without_stderr, high95_without_stderr : float
         The band without measurement error [-] (NaN in an older calibration.json).
+    sdc_bound : SdcBound
+        The SDC above which a measurement of this load case is refused as implausible
+        (:func:`pidcore.compare.plausibility.sdc_bound` of the calibrated specimen and this
+        fill; 2 pi where the specimen is not known): :meth:`band` is cut there.
     """
 
     load_case: LoadCase
@@ -63,6 +95,9 @@ class CalibratedPrediction:
     low95_without_stderr: float = math.nan
     high95_without_stderr: float = math.nan
     measured_stderr_dof: float = math.nan
+    # where the band is cut, from the specimen the calibration is of, not part of the
+    # prediction's identity (:meth:`Calibration.lookup` sets it)
+    sdc_bound: SdcBound = field(default=UNKNOWN_SPECIMEN_BOUND, compare=False)
 
     def band(self, stderr: float = math.nan, dof: float = math.nan) -> tuple[float, float]:
         """The 95 % band [-] a measurement with standard error ``stderr`` of ``dof`` degrees
@@ -79,21 +114,24 @@ class CalibratedPrediction:
         3.07 for 3.05 where both parts are equal: on the safe side), and exact where either
         part dominates (tests/test_calibrate_band_quantile.py checks its coverage).
 
-        The upper bound is cut at :data:`SDC_UPPER_BOUND` (2 pi, a loss factor of 1): the
-        model's normal error (discrepancy tau SDC, surrogate scatter) is unbounded, and a
-        poorly constrained calibration (tau near its prior's 2) reached 12.7, a value no
-        measurement is kept at (``pidcore analyze`` refuses an SDC above 2 pi as a set-up
-        error, :mod:`pidcore.compare.plausibility`). Cut there the band still holds >= 95 %
+        The upper bound is cut at :attr:`sdc_bound` (``max(2 pi, 8 m_p / m_s)`` of the
+        calibrated specimen at this fill; :data:`SDC_UPPER_BOUND`, 2 pi, a loss factor of 1,
+        where the specimen is not known): the model's normal error (discrepancy tau SDC,
+        surrogate scatter) is unbounded, and a poorly constrained calibration (tau near its
+        prior's 2) reached 12.7, a value no measurement is kept at (``pidcore analyze``
+        refuses an SDC above that bound as a set-up error, :mod:`pidcore.compare.
+        plausibility`). Cut there the band still holds >= 95 %
         of the measurements that can be kept wherever at most half the model's draws lie
         above the bound ((0.975 - p) / (1 - p) >= 0.95 for p <= 0.5); :meth:`band_note`
         says it was cut, and that the model does not constrain the SDC there.
         """
         low, high = self.model_band(stderr, dof)
-        # a model median above the bound leaves no band below it: [2 pi, 2 pi], noted
-        return min(low, SDC_UPPER_BOUND), min(high, SDC_UPPER_BOUND)
+        # a model median above the bound leaves no band below it: [bound, bound], noted
+        bound = self.sdc_bound.sdc
+        return min(low, bound), min(high, bound)
 
     def model_band(self, stderr: float = math.nan, dof: float = math.nan) -> tuple[float, float]:
-        """:meth:`band` before its upper bound is cut at :data:`SDC_UPPER_BOUND`: the
+        """:meth:`band` before its upper bound is cut at :attr:`sdc_bound`: the
         posterior-predictive band as the normal error model gives it (:meth:`band_note` says
         where it reaches beyond)."""
         stderr = real_number("stderr", stderr)
@@ -111,13 +149,12 @@ class CalibratedPrediction:
         return max(low, 0.0), high
 
     def band_note(self, stderr: float = math.nan, dof: float = math.nan) -> str:
-        """Where :meth:`model_band` reaches above :data:`SDC_UPPER_BOUND`: that it was cut
+        """Where :meth:`model_band` reaches above :attr:`sdc_bound`: that it was cut
         there and why, with the model's own bound; "" otherwise."""
         high = self.model_band(stderr, dof)[1]
-        if not high > SDC_UPPER_BOUND:
+        if not high > self.sdc_bound.sdc:
             return ""
-        cut = (f"calibrated 95 % band cut at 2 pi = {SDC_UPPER_BOUND:.4g} (a loss factor of 1, "
-               "above which a measured SDC is refused as implausible); ")
+        cut = f"calibrated 95 % band cut at {band_cut_words(self.sdc_bound)}; "
         widening = self._measurement_widening(stderr, dof)
         # a pooled pair of records (stderr 1.8, t of 1 degree of freedom: 12.7) reached 23.3
         # by its own scatter, beside a model half-width of 0.41: blaming the calibration
@@ -242,9 +279,19 @@ class Calibration:
         if not hits:
             return None
         # the nearest in frequency, then acceleration, then fill, if tolerances admit several
-        return min(hits, key=lambda p: (abs(p.load_case.frequency_hz - case.frequency_hz),
-                                        abs(p.load_case.acceleration_g - case.acceleration_g),
-                                        abs(p.load_case.fill_percent - case.fill_percent)))
+        hit = min(hits, key=lambda p: (abs(p.load_case.frequency_hz - case.frequency_hz),
+                                       abs(p.load_case.acceleration_g - case.acceleration_g),
+                                       abs(p.load_case.fill_percent - case.fill_percent)))
+        return replace(hit, sdc_bound=self.sdc_bound(hit.load_case))
+
+    def sdc_bound(self, case: LoadCase) -> SdcBound:
+        """The SDC bound of a measurement at ``case`` (:func:`pidcore.compare.plausibility.
+        sdc_bound`) of the specimen this calibration is of: the paper's coupon's where it
+        calibrates that (the bound its tests were judged by when analysed: the calibration's
+        fitted fixture, 254 g in the bundled one, is no mass of the tested coupon), else its
+        calibrated specimen's, else 2 pi (not known)."""
+        return calibrated_sdc_bound(self.calibrated_specimen(), self.specimen_name,
+                                    fill_percent=case.fill_percent, material=case.material)
 
     def calibrated_specimen(self) -> Specimen | None:
         """The calibrated specimen: read with it from a store (:attr:`specimen_text`), else

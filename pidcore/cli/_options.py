@@ -146,8 +146,10 @@ def add_measurement_options(p: argparse.ArgumentParser) -> None:
                    help="analyse clipped channels anyway (reported in the output)")
     g.add_argument("--accept-implausible", action="store_true",
                    help="keep a result the plausibility checks refuse (a negative loss factor "
-                        "beyond its noise, an SDC above 2 pi: usually a wrong delay, sign or "
-                        "correction), noted with the record")
+                        "beyond its noise, an SDC above the bound of the specimen's "
+                        "particles, max(2 pi, 8 m_p/m_s), 2 pi where the specimen or fill is "
+                        "unknown: usually a wrong delay, sign or correction), noted with the "
+                        "record")
     g.add_argument("--force-unit", metavar="UNIT", default=None,
                    help="unit of the force channel's values (N, kN, lbf, ...) when the file "
                         "gives none or a wrong one")

@@ -80,7 +80,7 @@ def _stated(args: argparse.Namespace) -> tuple[list, list, object]:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..compare.plausibility import refuse_implausible
+    from ..compare.plausibility import refuse_implausible, stated_sdc_bounds
     from ..loadcase import refuse_identical_contents_stating_apart
     from ..store import Store
 
@@ -100,7 +100,8 @@ def run(args: argparse.Namespace) -> int:
             analyze_each(args.paths, settings, key=args.key, progress=progress_wanted(args),
                          keep_unused_channels=store is not None),
             [display_path(Path(path).name) for path in args.paths],
-            accept=args.accept_implausible)
+            accept=args.accept_implausible,
+            bounds=stated_sdc_bounds(stated, settings, specimen))
         cases = [st.load_case(r.analysis.frequency_hz, r.analysis.acceleration_g)
                  if st is not None else None for r, st in zip(results, stated, strict=True)]
         # one content is one measurement: two statements (load case, specimen, settings) about

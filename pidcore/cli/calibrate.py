@@ -109,9 +109,10 @@ def run(args: argparse.Namespace) -> int:
     # of the record left out as implausible
     left_out: list[str] = []
     if args.data is not None:
-        points = read_measured_table(args.data, default_material=default_material)
+        points = read_measured_table(args.data, default_material=default_material,
+                                     specimen=specimen)
     else:
-        measured = measured_from_store(args.store, left_out=left_out)
+        measured = measured_from_store(args.store, left_out=left_out, specimen=specimen)
         points = _store_points(measured, specimen, args.store, left_out)
         for note in left_out:
             print(f"pidcore calibrate: note: {cli_words(note, 'calibrate')}", file=sys.stderr)

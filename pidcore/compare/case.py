@@ -265,16 +265,18 @@ class MeasuredEntry:
     @classmethod
     def from_record(cls, record, load_case: LoadCase, *,
                     specimen: str = "", options=None,
-                    specimen_sha256: str = "") -> MeasuredEntry:
+                    specimen_sha256: str = "", sdc_bound=None) -> MeasuredEntry:
         """Entry of a fresh (unsaved) analysis (:class:`pidcore.measure.AnalyzedRecord`);
         ``options`` (:class:`pidcore.measure.AnalysisOptions`) names the corrections;
-        ``specimen_sha256``: the specimen file's hash as it would be saved ("": none)."""
+        ``specimen_sha256``: the specimen file's hash as it would be saved ("": none);
+        ``sdc_bound``: the SDC bound of its specimen
+        (:func:`pidcore.compare.plausibility.tested_sdc_bound`; None: 2 pi)."""
         from ..records import measurement_key
         from ..specimen import deciding_sha256
         from .plausibility import implausible_findings
 
         a = record.analysis
-        found, _ = implausible_findings(a)
+        found, _ = implausible_findings(a, bound=sdc_bound)
         try:
             content = measurement_key(record.measurement)
         except PidcoreError:  # a malformed digest: the entry is never taken for a copy
@@ -292,14 +294,25 @@ class MeasuredEntry:
                    specimen_sha256=deciding_sha256(specimen_sha256) if specimen else "")
 
     @classmethod
-    def from_store(cls, row: pd.Series, arrays: dict) -> MeasuredEntry:
+    def from_store(cls, row: pd.Series, arrays: dict, *, known=()) -> MeasuredEntry:
         """Entry of a saved analysis: a row of :func:`pidcore.store.listing.saved_analyses`
-        and the entry's arrays (:meth:`pidcore.store.Store.get_analysis`)."""
+        and the entry's arrays (:meth:`pidcore.store.Store.get_analysis`). ``known``: the
+        specimen files at hand (:class:`pidcore.specimen.Specimen`), among which the one the
+        record names gives its SDC bound (:func:`pidcore.compare.plausibility.
+        stored_sdc_bound`; 2 pi where its file is not among them)."""
+        from ..specimen import MEASURED_SHA256_FIELD, measured_specimen_name
+        from ..specimen import measured_specimen_sha256 as tested_sha256
         from .align import _row_case
         from .plausibility import stored_findings
 
         empty = np.empty(0)
-        found, _ = stored_findings(row)
+        named = row.get("specimen", "")
+        sha256 = row.get(MEASURED_SHA256_FIELD, "")
+        sha256 = sha256 if isinstance(sha256, str) else ""
+        given = next((s for s in known if isinstance(named, str) and named
+                      and measured_specimen_name(s) == named
+                      and (not sha256 or tested_sha256(s) == sha256)), None)
+        found, _ = stored_findings(row, given=given)
         settings = saved_parameters(row.get("parameters_json"))
         return cls(str(row["key"]), Path(str(row.get("source", ""))).name, "store",
                    _row_case(row), float(row["frequency_hz"]),

@@ -13,19 +13,148 @@ and a small positive ``Re P`` (the damping). So:
   passive damper. A velocity delayed by ``tau`` turns the phase by ``-w tau``; the delay that
   would make the loss factor zero is reported.
 * ``Im P < 0`` is a force lagging the velocity: a spring, or a channel of inverted sign.
-* An SDC above :data:`SDC_UPPER_BOUND` dissipates more per radian of motion than the coupon
-  stores; no particle damper in the paper comes near (Table 3's largest SDC is 0.88).
+* An SDC above the bound of :func:`sdc_bound` dissipates more per cycle than the particles
+  can. Where the specimen and its fill are known, the bound is that of the particles' impacts,
+  ``max(2 pi, 8 m_p / m_s)``; else :data:`SDC_UPPER_BOUND` (2 pi, a loss factor of 1). Table 3's
+  largest SDC is 0.88.
+
+The particle-impact bound. With ``P = F V* / 2`` the loss factor is ``eta = Re P / Im P`` and
+``SDC = 2 pi eta`` (:mod:`pidcore.signal.power`). ``Re P = D / T = D omega / (2 pi)`` for an
+energy ``D`` dissipated per cycle. The structure that moves rigidly with the drive (coupon and
+fixture, ``m_s``, without the particles, which may decouple from it) gives
+``Im P >= omega m_s |V|^2 / 2`` wherever the particles' own reactive part is not negative: they
+add inertia while they ride with the walls and little while they fly. (A bed moving against
+the walls makes it slightly negative: -2 g beside the 55 g below in pidcore's DEM at 200 Hz,
+20 g; the margin of the dissipation bound covers it.) Particles of total mass ``m_p`` in cells
+driven at velocity amplitude ``V`` lose at most about two fully inelastic impacts per cycle at
+the largest relative speed ``2 V``: ``D <= 2 x m_p (2 V)^2 / 2 = 4 m_p V^2``. Hence
+``eta = D / (pi m_s V^2) <= 4 m_p / (pi m_s)`` and ``SDC <= 8 m_p / m_s``. A linear check: a
+mass ``m_p`` on a dashpot ``c`` to the base absorbs ``Re P = omega m_p V^2 / 4`` at most (at
+``c = omega m_p``), an SDC below ``pi m_p / m_s``, below the impact bound. It is the bound of a
+perfect damper, not a prediction: a user's panel of 263 g of 2 mm steel spheres on a 40 g
+coupon and a 15 g fixture, whose bound is 38.3, gave an Eq. 11 SDC of 8.4 in pidcore's DEM
+virtual shaker (12.9 at 50 Hz, 10 g on 2 cells), above 2 pi; its dissipation per cycle was at
+most 0.4 x 4 m_p V^2 (tests/test_sdc_bound.py).
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
-#: SDC above which a result is implausible for a particle damper on a coupon: 2*pi, a loss
-#: factor of 1 (the energy dissipated per radian equals the peak stored energy). Table 3's
-#: largest SDC is 0.88 (DEM) and 0.71 (measured), so this bound only catches gross set-up errors.
+if TYPE_CHECKING:  # pragma: no cover
+    from ..specimen import Specimen
+
+#: SDC above which a result is implausible where the specimen or its fill is not known, and the
+#: least bound where they are (:func:`sdc_bound`): 2*pi, a loss factor of 1 (the energy
+#: dissipated per radian equals the peak stored energy). Table 3's largest SDC is 0.88 (DEM) and
+#: 0.71 (measured), so this bound only catches gross set-up errors.
 SDC_UPPER_BOUND = 2 * math.pi
+
+#: Fully inelastic impacts per drive cycle at twice the drive velocity that bound what the
+#: particles dissipate (module docstring): ``SDC <= PARTICLE_IMPACT_SDC_FACTOR m_p / m_s``.
+PARTICLE_IMPACT_SDC_FACTOR = 8.0
+
+
+def particle_impact_sdc(particle_mass_kg: float, structure_mass_kg: float) -> float:
+    """Largest SDC particles of ``particle_mass_kg`` in cells of a structure of
+    ``structure_mass_kg`` (coupon and fixture, without the particles) can give:
+    ``8 m_p / m_s`` (two fully inelastic impacts per cycle at twice the drive velocity; the
+    module docstring derives it)."""
+    return PARTICLE_IMPACT_SDC_FACTOR * particle_mass_kg / structure_mass_kg
+
+
+@dataclass(frozen=True)
+class SdcBound:
+    """The SDC above which a result is implausible, and what it comes from.
+
+    Attributes
+    ----------
+    sdc : float
+        The bound: ``max(2 pi, 8 m_p / m_s)``, or 2 pi where the masses are not known.
+    particle_mass_kg, structure_mass_kg : float
+        ``m_p`` (particles per cell x cells x one particle's mass) and ``m_s`` (coupon plus
+        fixture), kg; NaN where the specimen or its fill is not known.
+    """
+
+    sdc: float = SDC_UPPER_BOUND
+    particle_mass_kg: float = math.nan
+    structure_mass_kg: float = math.nan
+
+    @property
+    def known(self) -> bool:
+        """Whether the bound comes from the specimen's masses."""
+        return math.isfinite(self.particle_mass_kg) and math.isfinite(self.structure_mass_kg)
+
+    def basis(self) -> str:
+        """Where the bound comes from, in words (empty for the plain 2 pi)."""
+        if not self.known:
+            return ""
+        impact = particle_impact_sdc(self.particle_mass_kg, self.structure_mass_kg)
+        return (f"particles of {self.particle_mass_kg * 1e3:.3g} g on a "
+                f"{self.structure_mass_kg * 1e3:.3g} g structure can dissipate at most "
+                f"SDC 8 m_p/m_s = {impact:.3g}, two fully inelastic impacts per cycle")
+
+    def words(self, loss_factor: float) -> str:
+        """``'the physical bound 38.3 (particles of ...)'`` for a result of ``loss_factor``."""
+        if self.sdc > SDC_UPPER_BOUND:
+            return f"the physical bound {self.sdc:.3g} ({self.basis()})"
+        known = f"; {self.basis()}" if self.known else ""
+        return (f"the physical bound {self.sdc:.3g} (loss factor {loss_factor:.3g} > 1{known})")
+
+
+#: The bound where the specimen or its fill is not known: 2 pi.
+UNKNOWN_SPECIMEN_BOUND = SdcBound()
+
+
+def sdc_bound(*, fill_percent: float | None, material: str | None = None,
+              specimen: Specimen | None = None) -> SdcBound:
+    """The SDC bound of a test of ``specimen`` (:class:`pidcore.specimen.Specimen`; None: the
+    paper's coupon assumed, with ``material`` particles) at ``fill_percent``: 2 pi, or
+    ``8 m_p / m_s`` where larger. 2 pi where the fill is not known, or ``material`` (given) is
+    neither the specimen's nor a table material the paper's coupon can be filled with."""
+    from ..constants import PARTICLE_MATERIALS
+    from ..dem.simulate import particles_per_cell
+    from ..errors import PidcoreError
+    from ..specimen import paper_specimen
+
+    if fill_percent is None or not math.isfinite(float(fill_percent)) or fill_percent <= 0:
+        return UNKNOWN_SPECIMEN_BOUND
+    if specimen is not None and (not material or material == specimen.particles.material):
+        tested = specimen
+    elif not material or material in PARTICLE_MATERIALS:
+        tested = paper_specimen(material or "acrylic")
+    else:  # an own material without its specimen file: no cell, no particle mass
+        return UNKNOWN_SPECIMEN_BOUND
+    try:
+        per_cell, _ = particles_per_cell(float(fill_percent), specimen=tested)
+    except PidcoreError:  # a fill the DEM refuses (its own message says so elsewhere)
+        return UNKNOWN_SPECIMEN_BOUND
+    particles = per_cell * tested.cell.count * tested.particles.mass_kg
+    structure = tested.coupon.moving_mass_kg
+    return SdcBound(max(SDC_UPPER_BOUND, particle_impact_sdc(particles, structure)),
+                    particles, structure)
+
+
+def tested_sdc_bound(*, fill_percent: float | None, material: str | None,
+                     specimen_name: str = "", specimen_sha256: str = "",
+                     given: Specimen | None = None) -> SdcBound:
+    """:func:`sdc_bound` of a measurement that names ``specimen_name`` (a record's
+    ``specimen``; "": none, the paper's coupon assumed): ``given`` (the ``--specimen`` file)
+    where it names that file, the paper's coupon where it names the coupon, else 2 pi (a
+    specimen whose file is not at hand)."""
+    from ..specimen import is_paper_coupon, measured_specimen_name, measured_specimen_sha256
+
+    name = specimen_name.strip() if isinstance(specimen_name, str) else ""
+    sha256 = specimen_sha256 if isinstance(specimen_sha256, str) else ""
+    if given is not None and name and name in (given.name, measured_specimen_name(given)) \
+            and (not sha256 or sha256 == measured_specimen_sha256(given)):
+        return sdc_bound(fill_percent=fill_percent, material=material, specimen=given)
+    if is_paper_coupon(name, sha256):
+        return sdc_bound(fill_percent=fill_percent, material=material)
+    return UNKNOWN_SPECIMEN_BOUND
 
 
 @dataclass(frozen=True)
@@ -50,14 +179,18 @@ class PlausibilityWarning:
         return f"{self.message}. Likely cause: {self.likely_cause}"
 
 
-def check_analysis(analysis) -> tuple[PlausibilityWarning, ...]:
+def check_analysis(analysis, *, bound: SdcBound | None = None
+                   ) -> tuple[PlausibilityWarning, ...]:
     """Plausibility warnings of one Eq. 11 analysis (empty when it looks physical).
 
     Parameters
     ----------
     analysis : PowerAnalysis
         Needs ``complex_power_w``, ``loss_factor``, ``sdc`` and ``omega_rad_s``.
+    bound : SdcBound, optional
+        The SDC bound of the specimen tested (:func:`sdc_bound`); default 2 pi (not known).
     """
+    bound = bound or UNKNOWN_SPECIMEN_BOUND
     p = complex(analysis.complex_power_w)
     eta = float(analysis.loss_factor)
     sdc = float(analysis.sdc)
@@ -95,11 +228,9 @@ def check_analysis(analysis) -> tuple[PlausibilityWarning, ...]:
                           "the loss factor to zero")
         out.append(PlausibilityWarning("negative_loss_factor",
                                        f"negative loss factor {eta:.4g} (SDC {sdc:.4g})", cause))
-    if math.isfinite(sdc) and sdc > SDC_UPPER_BOUND:
+    if math.isfinite(sdc) and sdc > bound.sdc:
         out.append(PlausibilityWarning(
-            "sdc_above_bound",
-            f"SDC {sdc:.4g} is above the physical bound {SDC_UPPER_BOUND:.3g} (loss factor "
-            f"{eta:.3g} > 1)",
+            "sdc_above_bound", f"SDC {sdc:.4g} is above {bound.words(eta)}",
             ("a lead of the acceleration channel over the force (their signal conditioning "
              "or anti-aliasing filters differ: it turns the force-velocity phase and inflates "
              "Re P)" if from_acceleration else
@@ -114,16 +245,18 @@ def check_analysis(analysis) -> tuple[PlausibilityWarning, ...]:
 NEGATIVE_WITHIN_STDERRS = 3.0
 
 
-def implausible_findings(analysis) -> tuple[tuple[PlausibilityWarning, ...], tuple[str, ...]]:
-    """(warnings beyond noise, notes) of one analysis: :func:`check_analysis`'s warnings,
-    except a negative loss factor within :data:`NEGATIVE_WITHIN_STDERRS` standard errors of
-    zero, which becomes a note (zero damping, measured with noise)."""
+def implausible_findings(analysis, *, bound: SdcBound | None = None
+                         ) -> tuple[tuple[PlausibilityWarning, ...], tuple[str, ...]]:
+    """(warnings beyond noise, notes) of one analysis: :func:`check_analysis`'s warnings
+    (``bound``: the specimen's SDC bound, default 2 pi), except a negative loss factor within
+    :data:`NEGATIVE_WITHIN_STDERRS` standard errors of zero, which becomes a note (zero
+    damping, measured with noise)."""
     from ..defaults import REACTIVE_POWER_MIN_FRACTION
 
     stderr = float(getattr(analysis, "sdc_stderr", math.nan))
     power = complex(analysis.complex_power_w)
     warnings, notes = [], []
-    for w in check_analysis(analysis):
+    for w in check_analysis(analysis, bound=bound):
         if (w.check == "negative_loss_factor" and math.isfinite(stderr)
                 and analysis.sdc + NEGATIVE_WITHIN_STDERRS * stderr >= 0):
             notes.append(f"SDC {analysis.sdc:.3g} is zero within its uncertainty "
@@ -149,27 +282,31 @@ def _findings_notes(findings, kept: str) -> tuple[str, ...]:
     return notes + tuple(f"implausible, {kept}: {w}" for w in warnings)
 
 
-def plausibility_notes(analysis) -> tuple[str, ...]:
+def plausibility_notes(analysis, *, bound: SdcBound | None = None) -> tuple[str, ...]:
     """The notes a kept result carries: a negative SDC read as zero within its noise, and
     each warning beyond noise kept as asked (:func:`refuse_implausible` with ``accept``)."""
-    return _findings_notes(implausible_findings(analysis), "kept as asked")
+    return _findings_notes(implausible_findings(analysis, bound=bound), "kept as asked")
 
 
-def refuse_implausible(records, names, *, accept: bool) -> list:
+def refuse_implausible(records, names, *, accept: bool,
+                       bounds: Sequence[SdcBound | None] | None = None) -> list:
     """``records`` (:class:`pidcore.measure.AnalyzedRecord`) checked for plausibility before
     anything is saved or reported, as the app asks for confirmation before it saves.
 
     A warning beyond noise (:func:`implausible_findings`: a negative loss factor, an SDC
-    above :data:`SDC_UPPER_BOUND`) refuses the file (``names``: how messages name each), with
-    the likely cause, unless ``accept``: then the record is kept and its notes say what was
-    accepted (:func:`plausibility_notes`). Returns the records with those notes added.
+    above its specimen's bound, ``bounds``: one :class:`SdcBound` or None per record, default
+    2 pi) refuses the file (``names``: how messages name each), with the likely cause, unless
+    ``accept``: then the record is kept and its notes say what was accepted
+    (:func:`plausibility_notes`). Returns the records with those notes added.
     """
     from dataclasses import replace
 
     from ..errors import SignalError
 
     records = list(records)
-    findings = [implausible_findings(record.analysis) for record in records]
+    bounds = [None] * len(records) if bounds is None else list(bounds)
+    findings = [implausible_findings(record.analysis, bound=bound)
+                for record, bound in zip(records, bounds, strict=True)]
     flagged = [(name, warnings[0])
                for (warnings, _), name in zip(findings, names, strict=True) if warnings]
     if flagged and not accept:
@@ -185,10 +322,47 @@ def refuse_implausible(records, names, *, accept: bool) -> list:
     return out
 
 
-def stored_findings(record) -> tuple[tuple[PlausibilityWarning, ...], tuple[str, ...]]:
+def stated_sdc_bounds(stated: Sequence[Any], settings: Sequence[Any],
+                      given: Specimen | None = None) -> list[SdcBound]:
+    """Each file's SDC bound (:func:`tested_sdc_bound`) from what is stated about it
+    (:func:`pidcore.file_settings.resolve_files`' load cases, None where no fill is stated,
+    and :class:`~pidcore.file_settings.FileSettings`, which name its specimen); ``given``: the
+    ``--specimen`` file."""
+    return [tested_sdc_bound(fill_percent=st.fill_percent if st is not None else None,
+                             material=st.material if st is not None else None,
+                             specimen_name=fs.specimen if fs is not None else "",
+                             specimen_sha256=fs.specimen_sha256 if fs is not None else "",
+                             given=given)
+            for st, fs in zip(stated, settings, strict=True)]
+
+
+def stored_sdc_bound(record: Any, *, given: Specimen | None = None) -> SdcBound:
+    """:func:`tested_sdc_bound` of a stored analysis (a row of
+    :meth:`pidcore.store.Store.list_analyses`): its fill, material and specimen; ``given``:
+    the ``--specimen`` file of the command reading it."""
+    from ..specimen import MEASURED_SHA256_FIELD
+
+    def text(name: str) -> str:
+        value = record.get(name, "")
+        return value.strip() if isinstance(value, str) else ""
+
+    try:
+        fill = float(record.get("fill_percent", math.nan))
+    except (TypeError, ValueError):
+        fill = math.nan
+    return tested_sdc_bound(fill_percent=fill if math.isfinite(fill) else None,
+                            material=text("material") or None, specimen_name=text("specimen"),
+                            specimen_sha256=text(MEASURED_SHA256_FIELD), given=given)
+
+
+def stored_findings(record: Any, *, given: Specimen | None = None,
+                    bound: SdcBound | None = None
+                    ) -> tuple[tuple[PlausibilityWarning, ...], tuple[str, ...]]:
     """:func:`implausible_findings` of a stored analysis (a row of
     :meth:`pidcore.store.Store.list_analyses`: its complex power, loss factor, SDC, standard
-    error and frequency); nothing where the row lacks those numbers."""
+    error and frequency), judged against ``bound`` or else its specimen's
+    (:func:`stored_sdc_bound`, ``given``: the ``--specimen`` file at hand); nothing where the
+    row lacks those numbers."""
     from types import SimpleNamespace
 
     try:
@@ -204,13 +378,15 @@ def stored_findings(record) -> tuple[tuple[PlausibilityWarning, ...], tuple[str,
                          and bool(record.get("acceleration_channel", ""))})
     except (KeyError, TypeError, ValueError):  # a listing without the numbers: nothing to say
         return (), ()
-    return implausible_findings(analysis)
+    return implausible_findings(analysis,
+                                bound=bound or stored_sdc_bound(record, given=given))
 
 
-def stored_plausibility_notes(record) -> tuple[str, ...]:
+def stored_plausibility_notes(record: Any, *, given: Specimen | None = None
+                              ) -> tuple[str, ...]:
     """The notes a stored analysis carries (:func:`stored_findings`), as
     :func:`plausibility_notes` gives them for an analysis in memory. A store keeps the numbers,
     not the notes: a record saved with ``--accept-implausible`` was reported from the store
     as any other (its SDC -1.26 pooled into a row without a word)."""
-    return _findings_notes(stored_findings(record),
+    return _findings_notes(stored_findings(record, given=given),
                            "saved as accepted (accept_implausible=True)")

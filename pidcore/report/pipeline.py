@@ -195,7 +195,8 @@ def analyze_files(paths: Sequence[str | Path], *, fill_percent: float | None = N
     of its particles whose sidecar names no specimen; ``specimen``: its cell, against which a
     stated fill of its particles must round to a particle at least
     (:func:`pidcore.file_settings.resolve_files`). A result the plausibility checks refuse (a
-    negative loss factor beyond its noise, an SDC above 2 pi) is refused unless
+    negative loss factor beyond its noise, an SDC above its specimen's bound,
+    :func:`pidcore.compare.plausibility.sdc_bound`) is refused unless
     ``accept_implausible`` (:func:`pidcore.compare.plausibility.refuse_implausible`).
     ``progress``: a bar over the files on stderr (:func:`pidcore.file_settings.analyze_each`).
     ``key``: which measurement of a pidcore HDF5 store among ``paths`` to read, where it holds
@@ -203,7 +204,7 @@ def analyze_files(paths: Sequence[str | Path], *, fill_percent: float | None = N
     ``keep_unused_channels=False``: each result's measurement keeps only the channels its
     analysis used, for a caller that saves none (:func:`pidcore.file_settings.analyze_each`).
     """
-    from ..compare.plausibility import refuse_implausible
+    from ..compare.plausibility import refuse_implausible, stated_sdc_bounds
     from ..file_settings import analyze_each, resolve_files
     from ..io import detect_file_format
     from ..measure import AnalysisOptions
@@ -219,7 +220,8 @@ def analyze_files(paths: Sequence[str | Path], *, fill_percent: float | None = N
     analyzed_files = refuse_implausible(
         analyze_each(paths, settings, key=key, progress=progress,
                      keep_unused_channels=keep_unused_channels),
-        [display_path(Path(path).name) for path in paths], accept=accept_implausible)
+        [display_path(Path(path).name) for path in paths], accept=accept_implausible,
+        bounds=stated_sdc_bounds(stated, settings, specimen))
     results = []
     for path, st, fs, analyzed in zip(paths, stated, settings, analyzed_files, strict=True):
         a = analyzed.analysis
@@ -566,7 +568,7 @@ def specimen_report_table(stored_runs: pd.DataFrame | None, analyses: pd.DataFra
 
     table, aligner = report_table_and_aligner(
         dem_runs, analyses, paper, tolerances=tolerances, pool=pool, store_runs=stored_runs,
-        of_specimen=name,
+        of_specimen=name, given_specimen=specimen,
         choose_another="" if choose_another == CHOOSE_SPECIMEN_CLI
         else f"choose theirs with {choose_another.removesuffix(' for another')} to compare "
              "them")
@@ -781,7 +783,11 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         refuse_store_among_inputs(main, files)  # before reading (it may hold many measurements)
         if files:  # their analyses are added to it
             main.check_writable()
-    from ..compare.plausibility import plausibility_notes, stored_plausibility_notes
+    from ..compare.plausibility import (
+        plausibility_notes,
+        stated_sdc_bounds,
+        stored_plausibility_notes,
+    )
     from ..file_settings import assumed, files_assumption_notes, stored_assumption_notes
 
     options = options or AnalysisOptions()
@@ -801,7 +807,8 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
                      + (f"; {said}" if said else ""))
         # what the plausibility checks found (a result kept as asked, or zero within noise)
         notes.extend(f"{display_path(r.path.name)}: {n}"
-                     for n in plausibility_notes(r.analyzed.analysis))
+                     for n in plausibility_notes(r.analyzed.analysis, bound=stated_sdc_bounds(
+                         [r.stated], [r.settings], specimen)[0]))
         if r.settings is not None:
             notes.extend(r.settings.notes)
             if r.settings.unmatched:
@@ -844,7 +851,7 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         for _, record in analyses.iterrows():
             name = Path(str(record.get("source", "") or record["key"])).name
             notes.extend(f"{display_path(name)}: "
-                         f"{n}" for n in stored_plausibility_notes(record))
+                         f"{n}" for n in stored_plausibility_notes(record, given=specimen))
         if not listed.empty:
             left_out = listed["measurement_key"].nunique() - analyses["measurement_key"].nunique()
             if left_out:

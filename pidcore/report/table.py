@@ -278,9 +278,12 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
                               tolerances: Tolerances | None = None,
                               pool: bool = False, store_runs: pd.DataFrame | None = None,
                               of_specimen: str = "", choose_another: str = "",
+                              given_specimen: object | None = None,
                               ) -> tuple[pd.DataFrame, Aligner]:
     """:func:`build_report_table` and the aligner of its DEM rows (the runs it counted, its
-    pchip models), for figures that must show what the table compared."""
+    pchip models), for figures that must show what the table compared. ``given_specimen``:
+    the specimen file given (``--specimen``), whose tests are judged against its SDC bound
+    (:func:`pidcore.compare.plausibility.stored_sdc_bound`)."""
     tolerances = tolerances or Tolerances()
     notes: list[str] = []
     measured_rows = _measured_rows(analyses, notes)
@@ -341,7 +344,7 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
                 dem_runs if store_runs is None else store_runs, choose_another,
                 named=bool(specimen), report_of=of_specimen))
             met_note = ""
-        found, _ = stored_findings(rec)
+        found, _ = stored_findings(rec, given=given_specimen)
         entry = _Measured(float(rec["sdc"]), float(rec["sdc_stderr"]), case.frequency_hz,
                           case.acceleration_g, str(rec.get("source", "")),
                           float(rec.get("energy_per_cycle_j", math.nan)), specimen,

@@ -109,8 +109,9 @@ def _card(upload, row, sample_rate_hz, materials, given=(), known=(), every_file
     ``said_specimens``: the specimen notes earlier cards showed (added to), each shown once;
     ``specimen``: the specimen file uploaded with the exports (``--specimen``)."""
     from pidcore.compare.case import load_case_of, stated_case
-    from pidcore.compare.plausibility import implausible_findings
+    from pidcore.compare.plausibility import implausible_findings, tested_sdc_bound
     from pidcore.errors import PidcoreError
+    from pidcore.specimen import measured_specimen_sha256
 
     name = upload.name
     with st.container(border=True):
@@ -166,7 +167,14 @@ def _card(upload, row, sample_rate_hz, materials, given=(), known=(), every_file
         m4.metric("SDC ± stderr [-]", uploads.format_sdc(a.sdc, a.sdc_stderr))
         # as the CLI: a negative SDC within its noise is zero damping (a note), not a
         # warning to confirm
-        warnings, zero_notes = implausible_findings(a)
+        # judged against the bound of the specimen tested (its particles' mass on its coupon
+        # at this fill), as `pidcore analyze` judges it; 2 pi where its file is not at hand
+        tested = next((s for s in (specimen, *known) if s is not None and named.sha256
+                       and measured_specimen_sha256(s) == named.sha256), specimen)
+        bound = tested_sdc_bound(fill_percent=case.fill_percent, material=case.material,
+                                 specimen_name=named.name, specimen_sha256=named.sha256,
+                                 given=tested)
+        warnings, zero_notes = implausible_findings(a, bound=bound)
         for w in warnings:
             st.warning(f"**Implausible:** {w.message}. *Likely cause:* {w.likely_cause}.",
                        icon="⚠️")
@@ -179,7 +187,7 @@ def _card(upload, row, sample_rate_hz, materials, given=(), known=(), every_file
             if said_specimens is not None:
                 said_specimens.add(named.note)
         return uploads.AnalysedFile(record, case, options, named.name, warnings,
-                                    specimen_sha256=named.sha256)
+                                    specimen_sha256=named.sha256, sdc_bound=bound)
 
 
 def render(stores) -> list:

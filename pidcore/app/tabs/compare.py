@@ -33,14 +33,21 @@ def _entries(stores, session_files):
                                key="filter_date")
         files = f3.multiselect("file", sorted(set(saved["file"])), key="filter_file")
         saved = filter_analyses(saved, specimens=specimens, dates=dates, files=files)
+    # a record of a specimen file at hand is judged against that file's SDC bound, as
+    # `pidcore analyze --specimen FILE` judged it
+    from pidcore.app.tabs.analyse import _known_specimens
+
+    known = _known_specimens(stores) if not saved.empty else []
     entries = list(state.saved_entries(tuple(saved["key"]) if not saved.empty else (), stamp,
-                                       stores, saved)) if not saved.empty else []
+                                       stores, saved, tuple(s.hash for s in known),
+                                       known)) if not saved.empty else []
     include = st.checkbox("include this session's unsaved analyses", value=True,
                           key="include_session")
     if include:
         entries += [MeasuredEntry.from_record(f.record, f.load_case, specimen=f.specimen,
                                               options=f.options,
-                                              specimen_sha256=f.specimen_sha256)
+                                              specimen_sha256=f.specimen_sha256,
+                                              sdc_bound=f.sdc_bound)
                     for f in session_files]
     # one data set counted once (a saved file uploaded again, or under another name)
     entries, notes = unique_entries(entries)
