@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 import os
 import re
 import time
@@ -843,8 +844,10 @@ def _calibration_json(path, f, a, fill, predicted, low, high):
 
 # The mass-damper upload is 100 Hz, 5 g, fill 50 % with loss factor 0.05: Eq. 11 SDC = 2π·0.05
 # = 0.314, so a band 0.10..0.60 holds it and 0.50..0.90 does not (margins far above the noise).
+# A band 0 .. 7, cut at 2 pi, spans every plausible SDC: uninformative, as the report's row.
 @pytest.mark.parametrize("predicted, band, verdict", [(0.3456, (0.10, 0.60), "inside"),
-                                                      (0.6789, (0.50, 0.90), "outside")])
+                                                      (0.6789, (0.50, 0.90), "outside"),
+                                                      (0.5678, (0.0, 7.0), "uninformative")])
 def test_compare_shows_the_calibrated_band_beside_raw_dem_and_measurement(
         store_file, tmp_path, monkeypatch, predicted, band, verdict):
     from pidcore.app.calibration import CALIBRATION_ENV_VAR
@@ -857,8 +860,15 @@ def test_compare_shows_the_calibrated_band_beside_raw_dem_and_measurement(
     assert metrics["SDC calibrated DEM, Eq. 11 [-]"] == f"{predicted:.4f}"
     assert "SDC DEM, raw [-]" in metrics and "SDC measured, Eq. 11 [-]" in metrics
     captions = " ".join(c.value for c in at.caption)
-    assert f"calibrated 95 % band {band[0]:.4f} .. {band[1]:.4f}" in captions
-    assert f"the measured Eq. 11 SDC is {verdict}." in captions
+    shown = (band[0], min(band[1], 2 * math.pi))
+    assert f"calibrated 95 % band {shown[0]:.4f} .. {shown[1]:.4f}" in captions
+    if verdict == "uninformative":
+        assert ("the measured Eq. 11 SDC is uninformative: the calibrated 95 % band 0 .. 6.283 "
+                "spans every plausible SDC (0 to 2 pi; the calibration does not constrain the "
+                "SDC here), so it cannot test the model: not judged and not counted as "
+                "inside.") in captions
+    else:
+        assert f"the measured Eq. 11 SDC is {verdict}." in captions
     # the Report tab's table has the same prediction and verdict once the record is saved
     # (columns of `pidcore report --calibration`; they were missing in the app)
     at.button(key="save").click()
@@ -866,7 +876,8 @@ def test_compare_shows_the_calibrated_band_beside_raw_dem_and_measurement(
     table = _table(at, "SDC calibrated DEM (Eq. 11) [-]")
     row = table[table["SDC measured [-]"].notna()]
     assert row["SDC calibrated DEM (Eq. 11) [-]"].tolist() == [predicted]
-    assert row[CALIBRATED_INSIDE_COLUMN].tolist() == [{"inside": "yes", "outside": "no"}[verdict]]
+    assert row[CALIBRATED_INSIDE_COLUMN].tolist() == [{"inside": "yes", "outside": "no",
+                                                       "uninformative": "uninformative"}[verdict]]
 
 
 def test_a_calibration_saved_in_the_store_is_listed_and_used_after_a_restart(store_file,

@@ -605,3 +605,66 @@ def test_the_calibrate_plot_cuts_a_band_past_two_pi():
     assert above.tolist() == [2 * math.pi - 3.0, 0.88 - 0.49]
     assert below.tolist() == [2.5, 0.49 - 0.12]
     assert not shown_band_bars(rows[1:])[3]
+
+
+def test_a_band_spanning_every_plausible_sdc_is_uninformative_and_not_counted(tmp_path):
+    # the bundled calibration at 500 Hz, 5 g, 50 %: band without measurement error
+    # 0.121 .. 0.860 about 0.492. Two records pooled there (stderr 1.795 of 1 degree of
+    # freedom, t = 12.71) widen it to 0.492 -/+ hypot(0.37, 22.8): below 0 and past 2 pi, so
+    # cut to 0 .. 2 pi, every SDC a coupon can give. The row read "yes" and the report
+    # "inside 1 of 1"; a precise measurement at 50 Hz is still judged, as before.
+    from pidcore.constants import BAND_VERDICTS
+    from pidcore.report.table import UNINFORMATIVE
+
+    two_pi = 2 * math.pi
+    pooled = {**_prediction(500, 5, 50, 0.492, 0.121, 0.860), "measured_stderr": 0.0,
+              "low95_without_stderr": 0.121, "high95_without_stderr": 0.860}
+    cal = load_calibration(_write(tmp_path / "calibration.json",
+                                  [pooled, _prediction(50, 5, 50, 0.24, 0.05, 0.43)]))
+    hit = cal.lookup(LoadCase(500, 5, 50))
+    assert hit.band(1.795, 1.0) == (0.0, two_pi)
+    reason = hit.uninformative_reason(1.795, 1.0)
+    assert reason.startswith("uninformative: the calibrated 95 % band 0 .. 6.283 spans every "
+                             "plausible SDC (0 to 2 pi; this measurement's own scatter widens it)")
+    # a band cut at 0 only, or at 2 pi only, still tests the model
+    assert hit.uninformative_reason(0.0, 1.0) == ""
+    assert hit.uninformative_reason(0.3, 1.0) == ""   # 0.492 - hypot(0.371, 3.81) < 0 only
+    assert hit.band(0.3, 1.0)[0] == 0.0 and hit.band(0.3, 1.0)[1] < two_pi
+    table = pd.DataFrame({
+        "frequency [Hz]": [500.0, 50.0, 500.0], "acceleration [g]": [5.0, 5.0, 5.0],
+        "packing ratio [%]": [50.0, 50.0, 50.0], "material": ["acrylic"] * 3,
+        "SDC measured [-]": [2.295, 0.30, 0.50], "SDC measured stderr [-]": [1.795, 0.01, 0.3],
+        "SDC measured stderr dof [-]": [1.0, 9.0, 1.0], "note": ["pooled 2 records", "", ""]})
+    out = add_calibration_columns(table, cal)
+    assert out[CALIBRATED_INSIDE_COLUMN].tolist() == [UNINFORMATIVE, "yes", "yes"]
+    assert UNINFORMATIVE in BAND_VERDICTS and f"/{UNINFORMATIVE}]" in CALIBRATED_INSIDE_COLUMN
+    assert out["note"].iloc[0].startswith("pooled 2 records; " + reason)
+    assert (out[CALIBRATED_LOW_COLUMN].iloc[0], out[CALIBRATED_HIGH_COLUMN].iloc[0]) == (0.0,
+                                                                                          two_pi)
+    summary = out.attrs["notes"][-1]
+    assert summary.endswith("inside the 95 % band at 2 of 2 measured row(s) (1 more "
+                            "uninformative: a band of 0 .. 2 pi, spanning every plausible SDC, "
+                            "cannot test the model)")
+
+
+def test_the_report_files_show_the_uninformative_verdict(tmp_path):
+    # CSV reads the verdict back; the MD, HTML and PDF tables carry it as the CSV does
+    from pidcore.report.render import PDF_COLUMNS, PDF_LABELS
+    from pidcore.report.table import UNINFORMATIVE
+
+    assert CALIBRATED_INSIDE_COLUMN in PDF_COLUMNS
+    assert PDF_LABELS[CALIBRATED_INSIDE_COLUMN] == "measured in calibrated 95 % band"
+    pooled = {**_prediction(500, 5, 50, 0.492, 0.121, 0.860), "measured_stderr": 0.0,
+              "low95_without_stderr": 0.121, "high95_without_stderr": 0.860}
+    cal = load_calibration(_write(tmp_path / "calibration.json", [pooled]))
+    table = pd.DataFrame({
+        "frequency [Hz]": [500.0], "acceleration [g]": [5.0], "packing ratio [%]": [50.0],
+        "material": ["acrylic"], "SDC measured [-]": [2.295], "SDC measured stderr [-]": [1.795],
+        "SDC measured stderr dof [-]": [1.0], "note": [""]})
+    out = add_calibration_columns(table, cal)
+    path = tmp_path / "t.csv"
+    out.to_csv(path, index=False)
+    assert pd.read_csv(path)[CALIBRATED_INSIDE_COLUMN].tolist() == [UNINFORMATIVE]
+    assert out.attrs["notes"][-1].endswith("at 0 of 0 measured row(s) (1 more uninformative: a "
+                                           "band of 0 .. 2 pi, spanning every plausible SDC, "
+                                           "cannot test the model)")

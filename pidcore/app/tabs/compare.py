@@ -97,6 +97,9 @@ def _calibrated(calibrations, comp, head, specimen: str, *, implausible: bool = 
         verdict = "not compared (no Eq. 11 SDC)"
     elif implausible:  # as the report judges such a row: its stderr is an impossible scatter
         verdict = "not compared (it pools an implausible result, named below)"
+    elif uninformative := hit.uninformative_reason(own_stderr, comp.measured_stderr_dof):
+        # as the report's row: a band of 0 .. 2 pi holds every measurement, so "inside" lied
+        verdict = uninformative
     else:
         verdict = "inside" if low <= comp.measured_sdc <= high else "outside"
     st.caption(f"calibrated 95 % band {display_number(low)} .. {display_number(high)} [-]"
