@@ -175,8 +175,10 @@ def render(stores, session_files: list, calibrations: list) -> None:
         st.caption("equivalent viscous damper of the whole coupon c_eq = SDC m_c ω/(2π) (as "
                    "`pidcore model damper`'s c_eq_per_coupon): "
                    + " · ".join(f"{name} **{c:.4g} N s/m**" for name, c in dampers.items())
-                   + f" (m_c = {comp.aligned.grid_case.vibrated_mass_kg:.4g} kg of the DEM "
-                     "case)")
+                   + (f" (m_c = {comp.aligned.grid_case.vibrated_mass_kg:.4g} kg of the DEM "
+                      "case)" if comp.aligned.grid_case is not None else
+                      f" (m_c = {comp.vibrated_mass_kg:.4g} kg a DEM run at this fill would "
+                      "have, as the report takes it; the DEM's SDC is the interpolated one)"))
     if len(members) > 1:
         if math.isfinite(comp.chi2_dof) and comp.chi2_dof > 3:
             st.warning(f"The {len(members)} pooled files scatter more than their errors allow "
