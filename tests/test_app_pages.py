@@ -1283,6 +1283,37 @@ def test_compare_gives_the_equivalent_damper_of_the_dem_case_and_the_measurement
     assert "measured **" in caption
 
 
+def test_compare_gives_the_equivalent_damper_of_an_interpolated_case(store_file, tmp_path,
+                                                                      monkeypatch):
+    # at 40 % fill (between the bundled store's 25 and 50 %) the DEM value is the pchip
+    # model's and no grid case states m_c: the page showed no damper, though the report
+    # takes the m_c a run at this fill would have (0.06047 kg: the paper's coupon with 40 %
+    # of its 36 spheres per cell); c_eq = SDC m_c w/(2 pi) = SDC m_c f of the DEM value shown
+    import shutil
+
+    from pidcore.compare.case import INTERPOLATED_DAMPER_NAME
+
+    ref = tmp_path / "dem_table3.h5"
+    shutil.copy(Path(__file__).resolve().parents[1] / "data_samples" / "dem_table3.h5", ref)
+    monkeypatch.setenv(stores.DEM_STORE_ENV_VAR, str(ref))
+    at = _upload(_app(), [("a_fill40.csv", mass_damper_csv(frequency_hz=1000.0,
+                                                           acceleration_g=5.0,
+                                                           sample_rate_hz=51_200.0))])
+    # the m_c `pidcore model damper` takes at 40 % (test_app_cli_agreement checks the two)
+    from pidcore.compare.align import interpolated_count_and_mass
+    from pidcore.loadcase import LoadCase
+    from pidcore.store.listing import list_dem_runs
+
+    _, m_c, _ = interpolated_count_and_mass(list_dem_runs(ref), LoadCase(1000.0, 5.0, 40.0))
+    caption = next(c.value for c in at.caption if c.value.startswith("equivalent viscous"))
+    found = re.search(re.escape(INTERPOLATED_DAMPER_NAME) + r" \*\*(\S+) N s/m\*\*", caption)
+    assert found and f"m_c = {m_c:.4g} kg a DEM run at this fill would have" in caption
+    dem = float(re.search(r"vs our DEM (\S+)", _headline(at))[1])
+    # the headline's 4 decimals of the SDC and the page's 4 digits of c_eq: 1e-3 relative
+    assert float(found[1]) == pytest.approx(dem * m_c * 1000.0, rel=1e-3)
+    assert "measured **" in caption
+
+
 def test_compare_names_a_saved_implausible_result_and_judges_no_band_of_its_pool(
         store_file, tmp_path, monkeypatch):
     # Compare pooled a record saved as implausible (loss factor 1.5: SDC 9.4 > 2 pi) with a
