@@ -648,23 +648,40 @@ def test_a_band_spanning_every_plausible_sdc_is_uninformative_and_not_counted(tm
 
 
 def test_the_report_files_show_the_uninformative_verdict(tmp_path):
-    # CSV reads the verdict back; the MD, HTML and PDF tables carry it as the CSV does
-    from pidcore.report.render import PDF_COLUMNS, PDF_LABELS
+    # the verdict reaches every format: the CSV reads it back, MD and HTML show it in the
+    # row, the PDF's table has it under its short label
+    from datetime import UTC, datetime
+
+    from pidcore.model import load_paper_table3
+    from pidcore.report import build_report_table
+    from pidcore.report.provenance import collect_provenance
+    from pidcore.report.render import pdf_table_cells, write_report
     from pidcore.report.table import UNINFORMATIVE
 
-    assert CALIBRATED_INSIDE_COLUMN in PDF_COLUMNS
-    assert PDF_LABELS[CALIBRATED_INSIDE_COLUMN] == "measured in calibrated 95 % band"
     pooled = {**_prediction(500, 5, 50, 0.492, 0.121, 0.860), "measured_stderr": 0.0,
               "low95_without_stderr": 0.121, "high95_without_stderr": 0.860}
     cal = load_calibration(_write(tmp_path / "calibration.json", [pooled]))
-    table = pd.DataFrame({
-        "frequency [Hz]": [500.0], "acceleration [g]": [5.0], "packing ratio [%]": [50.0],
-        "material": ["acrylic"], "SDC measured [-]": [2.295], "SDC measured stderr [-]": [1.795],
-        "SDC measured stderr dof [-]": [1.0], "note": [""]})
-    out = add_calibration_columns(table, cal)
-    path = tmp_path / "t.csv"
-    out.to_csv(path, index=False)
-    assert pd.read_csv(path)[CALIBRATED_INSIDE_COLUMN].tolist() == [UNINFORMATIVE]
-    assert out.attrs["notes"][-1].endswith("at 0 of 0 measured row(s) (1 more uninformative: a "
-                                           "band of 0 .. 2 pi, spanning every plausible SDC, "
-                                           "cannot test the model)")
+    dem = pd.DataFrame({"frequency_hz": [500.0], "acceleration_g": [5.0],
+                        "fill_percent": [50.0], "material": ["acrylic"], "direction": ["z"],
+                        "sdc": [0.55], "sdc_stderr": [0.01], "case_key": ["b"]})
+    analyses = pd.DataFrame({"frequency_hz": [500.0], "acceleration_g": [5.0],
+                             "fill_percent": [50.0], "sdc": [2.295], "sdc_stderr": [1.795],
+                             "sdc_stderr_dof": [1.0], "source": ["pooled.uff"]})
+    table = add_calibration_columns(build_report_table(dem, analyses, load_paper_table3()), cal)
+    assert table[CALIBRATED_INSIDE_COLUMN].tolist() == [UNINFORMATIVE]
+    prov = collect_provenance(parameters={}, seeds=[], inputs=[], input_hashes={}, stores=[],
+                              notes=table.attrs["notes"],
+                              created_utc=datetime(2026, 1, 2, tzinfo=UTC))
+    out = tmp_path / "report"
+    written = write_report(table, {}, prov, out, "all")
+    assert pd.read_csv(written["csv"])[CALIBRATED_INSIDE_COLUMN].tolist() == [UNINFORMATIVE]
+    for fmt in ("md", "html"):
+        text = written[fmt].read_text(encoding="utf-8")
+        assert f"{UNINFORMATIVE}: the calibrated 95 % band 0 .. 6.283" in text  # the row note
+        assert "(1 more uninformative: a band of 0 .. 2 pi" in text  # the report's note
+    labels, rows = pdf_table_cells(table)
+    shown = {label.replace("\n", " "): cell for label, cell in zip(labels, rows[0], strict=True)}
+    assert shown["measured in calibrated 95 % band"] == UNINFORMATIVE
+    assert table.attrs["notes"][-1].endswith("at 0 of 0 measured row(s) (1 more uninformative: a "
+                                             "band of 0 .. 2 pi, spanning every plausible SDC, "
+                                             "cannot test the model)")
