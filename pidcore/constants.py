@@ -11,15 +11,16 @@ VibratedMassConvention, StartProtocol, TangentialModel, TangentialStiffnessModel
     The DEM's model options, as ``pidcore dem run`` takes them.
 StartPacking, CellShape, ReportFormat, FillReference, AlignmentStatus, ImpactPair
     More closed vocabularies: packings, cells, report formats, fill references, alignments.
-DampingCoefficient, BackgroundState
-    The normal damping constant's choice; the states of an app page's background work.
+DampingCoefficient, BackgroundState, BandVerdict
+    The normal damping constant's choice; the states of an app page's background work; a
+    measured SDC's verdict against the calibrated DEM's 95 % band.
 QUANTITIES, CHANNEL_ROLES, DRIVE_DIRECTIONS, PARTICLE_MATERIALS, NORMAL_DAMPING_MODES
     Each vocabulary's values as a tuple (``get_args`` of its alias).
 VIBRATED_MASS_CONVENTIONS, START_PROTOCOLS, TANGENTIAL_MODELS, START_PACKINGS
     The same, for the DEM's model options.
 TANGENTIAL_STIFFNESS_MODELS, REPORT_FORMATS, FILL_REFERENCES, DAMPING_COEFFICIENTS
     The same, for the rest.
-CELL_SHAPES, BACKGROUND_STATES, ALIGNMENT_STATUSES, IMPACT_PAIRS
+CELL_SHAPES, BACKGROUND_STATES, ALIGNMENT_STATUSES, IMPACT_PAIRS, BAND_VERDICTS
     The same, for the rest.
 UNTABULATED_PARTICLE_MATERIALS
     Particle materials a file name may state that the material table lacks (refused unless a
@@ -34,11 +35,12 @@ __all__ = [
     "Quantity", "ChannelRole", "FileFormat", "DriveDirection", "ParticleMaterial",
     "NormalDampingMode", "VibratedMassConvention", "StartProtocol", "TangentialModel",
     "TangentialStiffnessModel", "StartPacking", "CellShape", "ReportFormat", "FillReference",
-    "AlignmentStatus", "ImpactPair", "DampingCoefficient", "BackgroundState", "QUANTITIES",
+    "AlignmentStatus", "ImpactPair", "DampingCoefficient", "BackgroundState", "BandVerdict",
+    "QUANTITIES",
     "CHANNEL_ROLES", "DRIVE_DIRECTIONS", "PARTICLE_MATERIALS", "NORMAL_DAMPING_MODES",
     "VIBRATED_MASS_CONVENTIONS", "START_PROTOCOLS", "TANGENTIAL_MODELS", "START_PACKINGS",
     "TANGENTIAL_STIFFNESS_MODELS", "REPORT_FORMATS", "FILL_REFERENCES", "DAMPING_COEFFICIENTS",
-    "CELL_SHAPES", "BACKGROUND_STATES", "ALIGNMENT_STATUSES", "IMPACT_PAIRS",
+    "CELL_SHAPES", "BACKGROUND_STATES", "ALIGNMENT_STATUSES", "IMPACT_PAIRS", "BAND_VERDICTS",
     "UNTABULATED_PARTICLE_MATERIALS", "STANDARD_GRAVITY", "RATIO_UNIT", "COUNT_UNIT", "SI_UNITS",
 ]
 
@@ -85,6 +87,11 @@ DampingCoefficient = Literal["eq3", "calibrated"]
 #: State of work an app page runs outside Streamlit's script run (a report build, a
 #: calibration), in the order it passes through them: running, then done or failed.
 BackgroundState = Literal["running", "done", "failed", "cancelled"]
+#: Whether a measured Eq. 11 SDC lies in the calibrated DEM's 95 % band (the report's column,
+#: the app's Compare page): "yes", "no", "not compared" (no band or no measurement to judge;
+#: not "n/a", which pandas.read_csv reads back as NaN), or "uninformative" (the band spans
+#: every plausible SDC, 0 .. the SDC bound, so it cannot test the model; not counted as inside).
+BandVerdict = Literal["yes", "no", "not compared", "uninformative"]
 
 #: Particle materials in use for particle dampers that the material table does not hold: a
 #: file name stating one (``..._fill50_steel.csv``) is refused unless a specimen file gives
@@ -111,6 +118,7 @@ FILL_REFERENCES: tuple[str, ...] = get_args(FillReference)
 DAMPING_COEFFICIENTS: tuple[str, ...] = get_args(DampingCoefficient)
 CELL_SHAPES: tuple[str, ...] = get_args(CellShape)
 BACKGROUND_STATES: tuple[str, ...] = get_args(BackgroundState)
+BAND_VERDICTS: tuple[str, ...] = get_args(BandVerdict)
 
 #: Standard gravity, m/s^2 (ISO 80000-3); used for g <-> m/s^2 and for gravity on particles.
 STANDARD_GRAVITY = 9.80665

@@ -78,6 +78,8 @@ is_paper_coupon, measured_specimen_name, models_paper_coupon, hashed_name, teste
     Whether a specimen (by hash, else by name) is the paper's coupon: the one rule; the name
     a measurement of a specimen file is saved under; whether a file models the coupon; a
     file's name with its hash, ``"name [45d792]"``, and a test's saved specimen so labelled.
+tabulated_by_paper
+    Whether Table 3 is compared with a specimen file's tests (as with a row of them).
 measured_specimen_sha256, MEASURED_SHA256_FIELD, deciding_sha256, same_tested_file
     The file's hash saved beside that name (record field ``specimen_sha256``), and how a
     measurement's recorded hash meets a DEM run's or a calibration's: by hash where both
@@ -1472,16 +1474,37 @@ def provenance_test_name(specimen: Specimen) -> str:
 
 
 def models_paper_coupon(specimen: Specimen) -> bool:
-    """Whether ``specimen`` holds the paper coupon's cells and spheres (of its particle
-    material), whatever its contact, mass and damping values: a calibration's design point or
+    """Whether ``specimen`` holds the paper coupon's physics: its cells, its spheres (of its
+    particle material: radius and density) and its coupon mass, whatever its contact values
+    and the test rig's fixture mass and baseline damping: a calibration's design point or
     calibrated file of the coupon, a model of the coupon its tests were made on. A file with
-    another cell or other spheres models another coupon, whatever its name."""
+    another cell, other spheres or another coupon mass models another coupon, whatever its
+    name."""
     try:
         paper = paper_specimen(specimen.particles.material)
     except ParameterError:  # a material the tables lack: not the paper's spheres
         return False
+    # the masses too: a calibration that fitted the spheres' density or the coupon's mass
+    # modelled another coupon, yet its tests met Table 3 as the paper's
     return (specimen.cell == paper.cell
-            and specimen.particles.radius_m == paper.particles.radius_m)
+            and specimen.particles.radius_m == paper.particles.radius_m
+            and specimen.particles.density_kg_m3 == paper.particles.density_kg_m3
+            and specimen.coupon.mass_kg == paper.coupon.mass_kg)
+
+
+def tabulated_by_paper(specimen: Specimen) -> bool:
+    """Whether the paper's Table 3 is compared with the tests ``specimen`` models: by the one
+    rule a measured row is judged by, :func:`is_paper_coupon` of the name its tests are saved
+    under (:func:`measured_specimen_name`). The paper's coupon itself; a file ``pidcore
+    calibrate`` wrote from it (``[provenance]`` naming the coupon's hash, or without the table
+    a calibrated name of the coupon) that keeps its physics (:func:`models_paper_coupon`:
+    fitted contact, fixture and baseline values only). Not a file that only takes the
+    coupon's name, nor one calibrated from such a file.
+
+    ``report --specimen paper_calibrated_specimen.toml`` decided by the file's own hash (not
+    the paper's: Table 3 dropped) while the rows of its tests, saved as
+    ``paper_coupon_calibrated``, were the paper's coupon's by name (Table 3 shown)."""
+    return is_paper_coupon(measured_specimen_name(specimen))
 
 
 # --- what follows from a specimen ------------------------------------------------------------
@@ -1643,6 +1666,6 @@ __all__ = ["CellSpec", "CouponSpec", "PairSpec", "PairsSpec", "ParticleSpec", "S
            "MEASURED_SHA256_FIELD", "deciding_sha256", "measured_specimen_name",
            "measured_specimen_sha256", "models_paper_coupon", "NamedSpecimen",
            "resolve_specimen_name", "numeric_fields", "same_tested_file",
-           "provenance_test_name",
+           "provenance_test_name", "tabulated_by_paper",
            "paper_specimen", "particles_for_fill"]
 

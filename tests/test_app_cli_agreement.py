@@ -131,6 +131,56 @@ def test_the_compare_pages_equivalent_damper_is_pidcore_model_dampers(tmp_path, 
     assert equivalent_dampers(compare_case([entry], None, paper_table())) == {}
 
 
+def test_the_compare_pages_damper_of_an_interpolated_case_is_pidcore_model_dampers(tmp_path,
+                                                                                   capsys):
+    # at 40 % fill (between the store's 25 and 50 %) the DEM value is the pchip model's and
+    # no grid case states m_c: the page showed no damper, though the report knows the m_c a
+    # run at this fill would have. `pidcore model damper --table store` interpolates the same
+    # runs and takes m_c of the fill from their specimen: an independent path to c_eq
+    from pathlib import Path
+
+    import pandas as pd
+
+    from pidcore.compare.case import (
+        INTERPOLATED_DAMPER_NAME,
+        MeasuredEntry,
+        compare_case,
+        equivalent_dampers,
+        load_case_of,
+        paper_table,
+    )
+    from pidcore.measure import AnalysisOptions
+    from pidcore.store.listing import list_dem_runs
+
+    root = Path(__file__).parents[1] / "data_samples"
+    sample = root / "exports" / "synthetic_f1000Hz_a5g_fill50_acrylic.h5"
+    record = uploads.analyze_upload(sample.name, sample.read_bytes(),
+                                    AnalysisOptions(velocity_delay_s=5e-5)).record
+    entry = MeasuredEntry.from_record(record, load_case_of(record, fill_percent=40,
+                                                           material="acrylic"))
+    comparison = compare_case([entry], list_dem_runs(root / "dem_table3.h5"), paper_table())
+    assert comparison.aligned.status == "interpolated" and comparison.aligned.grid_case is None
+    dampers = equivalent_dampers(comparison)
+    case = comparison.load_case
+    assert main(["model", "damper", "--table", "store", "--store", str(root / "dem_table3.h5"),
+                 "--fills", "40", "--accelerations", repr(case.acceleration_g),
+                 "--frequencies", repr(case.frequency_hz), "--format", "csv",
+                 "--out", str(tmp_path)]) == 0
+    capsys.readouterr()
+    cli = pd.read_csv(tmp_path / "equivalent_damper.csv", comment="#")
+    # the same pchip value and m_c computed by the same functions: equal to rounding
+    assert comparison.vibrated_mass_kg == pytest.approx(cli["coupon_vibrated_mass [kg]"][0],
+                                                        rel=1e-12)
+    assert set(dampers) == {INTERPOLATED_DAMPER_NAME, "measured"}
+    assert dampers[INTERPOLATED_DAMPER_NAME] == pytest.approx(
+        cli["c_eq_per_coupon [N s/m]"][0], rel=1e-12)
+    # the measured damper dissipates the measured energy per cycle: dE / (pi w X^2)
+    w = 2 * math.pi * record.analysis.frequency_hz
+    x = record.analysis.acceleration_amplitude_m_s2 / w**2
+    assert dampers["measured"] == pytest.approx(
+        record.analysis.energy_per_cycle_j / (math.pi * w * x**2), rel=1e-12)
+
+
 def _dem_record(sdc: float, fill: float) -> dict:
     return {"frequency_hz": 100.0, "acceleration_g": 5.0, "fill_percent": fill,
             "material": "acrylic", "direction": "z", "sdc": sdc, "sdc_stderr": 0.01}

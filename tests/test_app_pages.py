@@ -843,11 +843,15 @@ def _calibration_json(path, f, a, fill, predicted, low, high):
 
 # The mass-damper upload is 100 Hz, 5 g, fill 50 % with loss factor 0.05: Eq. 11 SDC = 2π·0.05
 # = 0.314, so a band 0.10..0.60 holds it and 0.50..0.90 does not (margins far above the noise).
+# A band 0 .. 20, cut at the paper coupon's SDC bound at 50 % (8 m_p/m_s = 16.9), spans every
+# plausible SDC: uninformative, as the report's row.
 @pytest.mark.parametrize("predicted, band, verdict", [(0.3456, (0.10, 0.60), "inside"),
-                                                      (0.6789, (0.50, 0.90), "outside")])
+                                                      (0.6789, (0.50, 0.90), "outside"),
+                                                      (0.5678, (0.0, 20.0), "uninformative")])
 def test_compare_shows_the_calibrated_band_beside_raw_dem_and_measurement(
         store_file, tmp_path, monkeypatch, predicted, band, verdict):
     from pidcore.app.calibration import CALIBRATION_ENV_VAR
+    from pidcore.compare.plausibility import sdc_bound
     from pidcore.report.table import CALIBRATED_INSIDE_COLUMN
 
     cal = _calibration_json(tmp_path / "calibration.json", 100, 5, 50, predicted, *band)
@@ -857,8 +861,16 @@ def test_compare_shows_the_calibrated_band_beside_raw_dem_and_measurement(
     assert metrics["SDC calibrated DEM, Eq. 11 [-]"] == f"{predicted:.4f}"
     assert "SDC DEM, raw [-]" in metrics and "SDC measured, Eq. 11 [-]" in metrics
     captions = " ".join(c.value for c in at.caption)
-    assert f"calibrated 95 % band {band[0]:.4f} .. {band[1]:.4f}" in captions
-    assert f"the measured Eq. 11 SDC is {verdict}." in captions
+    bound = sdc_bound(fill_percent=50.0, material="acrylic").sdc
+    shown = (band[0], min(band[1], bound))
+    assert f"calibrated 95 % band {shown[0]:.4f} .. {shown[1]:.4f}" in captions
+    if verdict == "uninformative":
+        assert ("the measured Eq. 11 SDC is uninformative: the calibrated 95 % band 0 .. 16.91 "
+                "spans every plausible SDC (0 to 16.91, the bound of the specimen's particles; "
+                "the calibration does not constrain the SDC here), so it cannot test the "
+                "model: not judged and not counted as inside.") in captions
+    else:
+        assert f"the measured Eq. 11 SDC is {verdict}." in captions
     # the Report tab's table has the same prediction and verdict once the record is saved
     # (columns of `pidcore report --calibration`; they were missing in the app)
     at.button(key="save").click()
@@ -866,7 +878,8 @@ def test_compare_shows_the_calibrated_band_beside_raw_dem_and_measurement(
     table = _table(at, "SDC calibrated DEM (Eq. 11) [-]")
     row = table[table["SDC measured [-]"].notna()]
     assert row["SDC calibrated DEM (Eq. 11) [-]"].tolist() == [predicted]
-    assert row[CALIBRATED_INSIDE_COLUMN].tolist() == [{"inside": "yes", "outside": "no"}[verdict]]
+    assert row[CALIBRATED_INSIDE_COLUMN].tolist() == [{"inside": "yes", "outside": "no",
+                                                       "uninformative": "uninformative"}[verdict]]
 
 
 def test_a_calibration_saved_in_the_store_is_listed_and_used_after_a_restart(store_file,
@@ -1269,6 +1282,37 @@ def test_compare_gives_the_equivalent_damper_of_the_dem_case_and_the_measurement
                                                            acceleration_g=5.0))])
     caption = next(c.value for c in at.caption if c.value.startswith("equivalent viscous"))
     assert "our DEM **6.3 N s/m**" in caption and "m_c = 0.3 kg" in caption
+    assert "measured **" in caption
+
+
+def test_compare_gives_the_equivalent_damper_of_an_interpolated_case(store_file, tmp_path,
+                                                                      monkeypatch):
+    # at 40 % fill (between the bundled store's 25 and 50 %) the DEM value is the pchip
+    # model's and no grid case states m_c: the page showed no damper, though the report
+    # takes the m_c a run at this fill would have (0.06047 kg: the paper's coupon with 40 %
+    # of its 36 spheres per cell); c_eq = SDC m_c w/(2 pi) = SDC m_c f of the DEM value shown
+    import shutil
+
+    from pidcore.compare.case import INTERPOLATED_DAMPER_NAME
+
+    ref = tmp_path / "dem_table3.h5"
+    shutil.copy(Path(__file__).resolve().parents[1] / "data_samples" / "dem_table3.h5", ref)
+    monkeypatch.setenv(stores.DEM_STORE_ENV_VAR, str(ref))
+    at = _upload(_app(), [("a_fill40.csv", mass_damper_csv(frequency_hz=1000.0,
+                                                           acceleration_g=5.0,
+                                                           sample_rate_hz=51_200.0))])
+    # the m_c `pidcore model damper` takes at 40 % (test_app_cli_agreement checks the two)
+    from pidcore.compare.align import interpolated_count_and_mass
+    from pidcore.loadcase import LoadCase
+    from pidcore.store.listing import list_dem_runs
+
+    _, m_c, _ = interpolated_count_and_mass(list_dem_runs(ref), LoadCase(1000.0, 5.0, 40.0))
+    caption = next(c.value for c in at.caption if c.value.startswith("equivalent viscous"))
+    found = re.search(re.escape(INTERPOLATED_DAMPER_NAME) + r" \*\*(\S+) N s/m\*\*", caption)
+    assert found and f"m_c = {m_c:.4g} kg a DEM run at this fill would have" in caption
+    dem = float(re.search(r"vs our DEM (\S+)", _headline(at))[1])
+    # the headline's 4 decimals of the SDC and the page's 4 digits of c_eq: 1e-3 relative
+    assert float(found[1]) == pytest.approx(dem * m_c * 1000.0, rel=1e-3)
     assert "measured **" in caption
 
 

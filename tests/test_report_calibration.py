@@ -6,6 +6,7 @@ expected value is read off the file, not recomputed.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 from pathlib import Path
@@ -608,3 +609,96 @@ def test_the_calibrate_plot_cuts_a_band_past_two_pi():
     assert above.tolist() == [2 * math.pi - 3.0, 0.88 - 0.49]
     assert below.tolist() == [2.5, 0.49 - 0.12]
     assert not shown_band_bars(rows[1:])[3]
+
+
+def test_a_band_spanning_every_plausible_sdc_is_uninformative_and_not_counted(tmp_path):
+    # the bundled calibration at 500 Hz, 5 g, 50 %: band without measurement error
+    # 0.121 .. 0.860 about 0.492. Two records pooled there (stderr 1.795 of 1 degree of
+    # freedom, t = 12.71) widen it to 0.492 -/+ hypot(0.37, 22.8): below 0 and past the paper
+    # coupon's SDC bound at 50 % (8 m_p/m_s = 16.9: 46.8 g of spheres on 22.2 g), so cut to
+    # 0 .. 16.9, every SDC that coupon can give. The row read "yes" and the report "inside 1
+    # of 1"; a precise measurement at 50 Hz is still judged, as before.
+    from pidcore.compare.plausibility import UNKNOWN_SPECIMEN_BOUND, sdc_bound
+    from pidcore.constants import BAND_VERDICTS
+    from pidcore.report.table import UNINFORMATIVE
+
+    bound = sdc_bound(fill_percent=50.0, material="acrylic")
+    assert bound.sdc > 2 * math.pi
+    pooled = {**_prediction(500, 5, 50, 0.492, 0.121, 0.860), "measured_stderr": 0.0,
+              "low95_without_stderr": 0.121, "high95_without_stderr": 0.860}
+    cal = load_calibration(_write(tmp_path / "calibration.json",
+                                  [pooled, _prediction(50, 5, 50, 0.24, 0.05, 0.43)]))
+    hit = cal.lookup(LoadCase(500, 5, 50))
+    assert hit.band(1.795, 1.0) == (0.0, bound.sdc)
+    reason = hit.uninformative_reason(1.795, 1.0)
+    assert reason.startswith("uninformative: the calibrated 95 % band 0 .. 16.91 spans every "
+                             "plausible SDC (0 to 16.91, the bound of the specimen's particles; "
+                             "this measurement's own scatter widens it)")
+    # a band cut at 0 only, or at the bound only, still tests the model
+    assert hit.uninformative_reason(0.0, 1.0) == ""
+    assert hit.uninformative_reason(0.3, 1.0) == ""   # 0.492 - hypot(0.371, 3.81) < 0 only
+    assert hit.band(0.3, 1.0)[0] == 0.0 and hit.band(0.3, 1.0)[1] < bound.sdc
+    # where the specimen is not known the bound is 2 pi, and the same rule holds there
+    unknown = dataclasses.replace(hit, sdc_bound=UNKNOWN_SPECIMEN_BOUND)
+    assert unknown.band(1.795, 1.0) == (0.0, 2 * math.pi)
+    assert unknown.uninformative_reason(1.795, 1.0).startswith(
+        "uninformative: the calibrated 95 % band 0 .. 6.283 spans every plausible SDC (0 to "
+        "2 pi; this measurement's own scatter widens it)")
+    table = pd.DataFrame({
+        "frequency [Hz]": [500.0, 50.0, 500.0], "acceleration [g]": [5.0, 5.0, 5.0],
+        "packing ratio [%]": [50.0, 50.0, 50.0], "material": ["acrylic"] * 3,
+        "SDC measured [-]": [2.295, 0.30, 0.50], "SDC measured stderr [-]": [1.795, 0.01, 0.3],
+        "SDC measured stderr dof [-]": [1.0, 9.0, 1.0], "note": ["pooled 2 records", "", ""]})
+    out = add_calibration_columns(table, cal)
+    assert out[CALIBRATED_INSIDE_COLUMN].tolist() == [UNINFORMATIVE, "yes", "yes"]
+    assert UNINFORMATIVE in BAND_VERDICTS and f"/{UNINFORMATIVE}]" in CALIBRATED_INSIDE_COLUMN
+    assert out["note"].iloc[0].startswith("pooled 2 records; " + reason)
+    assert (out[CALIBRATED_LOW_COLUMN].iloc[0], out[CALIBRATED_HIGH_COLUMN].iloc[0]) == (
+        0.0, bound.sdc)
+    summary = out.attrs["notes"][-1]
+    assert summary.endswith("inside the 95 % band at 2 of 2 measured row(s) (1 more "
+                            "uninformative: a band of 0 .. the SDC bound, spanning every "
+                            "plausible SDC, "
+                            "cannot test the model)")
+
+
+def test_the_report_files_show_the_uninformative_verdict(tmp_path):
+    # the verdict reaches every format: the CSV reads it back, MD and HTML show it in the
+    # row, the PDF's table has it under its short label
+    from datetime import UTC, datetime
+
+    from pidcore.model import load_paper_table3
+    from pidcore.report import build_report_table
+    from pidcore.report.provenance import collect_provenance
+    from pidcore.report.render import pdf_table_cells, write_report
+    from pidcore.report.table import UNINFORMATIVE
+
+    pooled = {**_prediction(500, 5, 50, 0.492, 0.121, 0.860), "measured_stderr": 0.0,
+              "low95_without_stderr": 0.121, "high95_without_stderr": 0.860}
+    cal = load_calibration(_write(tmp_path / "calibration.json", [pooled]))
+    dem = pd.DataFrame({"frequency_hz": [500.0], "acceleration_g": [5.0],
+                        "fill_percent": [50.0], "material": ["acrylic"], "direction": ["z"],
+                        "sdc": [0.55], "sdc_stderr": [0.01], "case_key": ["b"]})
+    analyses = pd.DataFrame({"frequency_hz": [500.0], "acceleration_g": [5.0],
+                             "fill_percent": [50.0], "sdc": [2.295], "sdc_stderr": [1.795],
+                             "sdc_stderr_dof": [1.0], "source": ["pooled.uff"]})
+    table = add_calibration_columns(build_report_table(dem, analyses, load_paper_table3()), cal)
+    assert table[CALIBRATED_INSIDE_COLUMN].tolist() == [UNINFORMATIVE]
+    prov = collect_provenance(parameters={}, seeds=[], inputs=[], input_hashes={}, stores=[],
+                              notes=table.attrs["notes"],
+                              created_utc=datetime(2026, 1, 2, tzinfo=UTC))
+    out = tmp_path / "report"
+    written = write_report(table, {}, prov, out, "all")
+    assert pd.read_csv(written["csv"])[CALIBRATED_INSIDE_COLUMN].tolist() == [UNINFORMATIVE]
+    for fmt in ("md", "html"):
+        text = written[fmt].read_text(encoding="utf-8")
+        # the row note: the paper coupon's bound at 50 %, 8 m_p/m_s (46.8 g on 22.2 g)
+        assert f"{UNINFORMATIVE}: the calibrated 95 % band 0 .. 16.91" in text
+        assert "(1 more uninformative: a band of 0 .. the SDC bound" in text  # the report's note
+    labels, rows = pdf_table_cells(table)
+    shown = {label.replace("\n", " "): cell for label, cell in zip(labels, rows[0], strict=True)}
+    assert shown["measured in calibrated 95 % band"] == UNINFORMATIVE
+    assert table.attrs["notes"][-1].endswith("at 0 of 0 measured row(s) (1 more uninformative: a "
+                                             "band of 0 .. the SDC bound, spanning every "
+                                             "plausible SDC, "
+                                             "cannot test the model)")

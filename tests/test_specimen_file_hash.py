@@ -192,7 +192,8 @@ def _calibration_of(specimen: Specimen, path: Path):
 
     written = dataclasses.replace(specimen, name=calibrated_name(specimen.name),
                                   provenance=calibrated_provenance(specimen))
-    return Calibration(path, {}, (CalibratedPrediction(CASE, 0.2, 0.0, 10.0),),
+    # a band that can judge a measurement: 0 .. 10 spans every plausible SDC (uninformative)
+    return Calibration(path, {}, (CalibratedPrediction(CASE, 0.2, 0.05, 0.5),),
                        specimen_text=written.to_toml())
 
 

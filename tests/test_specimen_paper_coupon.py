@@ -521,3 +521,47 @@ def test_specimen_check_says_which_file_a_calibrated_one_was_made_from(capsys):
     bundled = REPO / "pidcore" / "data" / "specimens" / "paper_coupon.toml"
     assert main(["specimen", "check", str(bundled)]) == 0
     assert "calibrated from" not in capsys.readouterr().out
+
+
+# --- Table 3 for a calibrated file of the coupon: one rule for a report of the file and a row
+
+def _table3_cells(csv: Path) -> tuple[float, float, str]:
+    row = pd.read_csv(csv, comment="#").iloc[0]
+    return row["SDC DEM (paper) [-]"], row["SDC measured (paper) [-]"], str(row["note"])
+
+
+@pytest.mark.usefixtures("undrawn_report_figures")
+@pytest.mark.parametrize("fitted, tabulated", [
+    ({}, True),  # the bundled calibration: contact, fixture and baseline fitted
+    ({"particles.density_kg_m3": 1300.0}, False),  # another sphere mass: not the paper's
+])
+def test_a_report_of_a_calibrated_file_and_a_row_of_its_tests_agree_on_table3(
+        tmp_path, capsys, other_cell_tests, fitted, tabulated):
+    """Was: `report --specimen paper_calibrated_specimen.toml` dropped Table 3 (the file's
+    hash is not the paper's) while `report --store` set it beside the same tests, saved as
+    paper_coupon_calibrated (by name). Table 3 holds at 1000 Hz, 5 g, 50 %: DEM 0.5612,
+    measured 0.63 (the paper's)."""
+    calibrated = load_specimen(CALIBRATED_PAPER).with_values(fitted) if fitted else \
+        load_specimen(CALIBRATED_PAPER)
+    specimen_file = tmp_path / "calibrated.toml"
+    specimen_file.write_text(calibrated.to_toml())
+    store = tmp_path / "tests.h5"
+    _analyze(capsys, other_cell_tests, specimen_file, store)
+    by_row, by_file = tmp_path / "by_row", tmp_path / "by_file"
+    assert main(["report", "--store", str(store), "--out", str(by_row),
+                 "--format", "csv"]) == 0
+    assert main(["report", "--store", str(store), "--specimen", str(specimen_file),
+                 "--out", str(by_file), "--format", "csv"]) == 0
+    said = capsys.readouterr().out
+    row_dem, row_measured, row_note = _table3_cells(by_row / "report.csv")
+    file_dem, file_measured, file_note = _table3_cells(by_file / "report.csv")
+    name = measured_specimen_name(calibrated)
+    if tabulated:
+        assert name == "paper_coupon_calibrated"
+        assert (row_dem, row_measured) == (file_dem, file_measured) == (0.5612, 0.63)
+        assert "not the paper's coupon" not in said + row_note + file_note
+    else:
+        assert name == f"paper_coupon_calibrated [{calibrated.hash[:6]}]"
+        assert all(math.isnan(v) for v in (row_dem, row_measured, file_dem, file_measured))
+        assert f"specimen {name} is not the paper's coupon" in row_note
+        assert f"note: specimen {name} is not the paper's coupon" in said

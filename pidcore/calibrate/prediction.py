@@ -188,6 +188,30 @@ class CalibratedPrediction:
             return 0.0
         return band_quantile(dof) * stderr
 
+    def uninformative_reason(self, stderr: float = math.nan, dof: float = math.nan) -> str:
+        """Why the 95 % band (:meth:`band`) of a measurement with standard error ``stderr``
+        of ``dof`` degrees of freedom cannot judge it: it spans every plausible SDC, 0 to
+        :attr:`sdc_bound` (the bound a measurement is kept below), so any measurement that can
+        be kept lies inside and "inside" says nothing about the model; "" where the band can
+        judge it.
+
+        A pooled pair of records (stderr 1.8 of 1 degree of freedom, t = 12.7) widened the
+        bundled calibration's 0.12 .. 0.86 to 0 .. 2 pi, and the report counted the row as
+        "inside 1 of 1"."""
+        low, high = self.band(stderr, dof)
+        bound = self.sdc_bound.sdc
+        if not (low <= 0.0 and high >= bound):
+            return ""
+        widening = self._measurement_widening(stderr, dof)
+        cause = ("this measurement's own scatter widens it" if widening
+                 > self.high95_without_stderr - self.sdc else
+                 "the calibration does not constrain the SDC here")
+        upper = ("2 pi" if bound <= SDC_UPPER_BOUND else
+                 f"{bound:.4g}, the bound of the specimen's particles")
+        return (f"uninformative: the calibrated 95 % band 0 .. {bound:.4g} spans every "
+                f"plausible SDC (0 to {upper}; {cause}), so it cannot test the model: not "
+                "judged and not counted as inside")
+
     def contains(self, sdc: float, stderr: float = math.nan, dof: float = math.nan) -> bool:
         """True if ``sdc`` lies inside the 95 % band of a measurement with standard error
         ``stderr`` of ``dof`` degrees of freedom (:meth:`band`; bounds included); False for

@@ -156,6 +156,11 @@ class CaseComparison:
         Degrees of freedom of ``measured_stderr_eq10``, as ``measured_stderr_dof`` of the
         Eq. 11 one (the records' Eq. 10 SDCs keep their relative errors, but their pooled
         error may be the scatter between them where the Eq. 11 one is not).
+    vibrated_mass_kg : float
+        The DEM's m_c of Eq. 10 at this case [kg]: its grid case's, or for an interpolated
+        value the m_c a run at this fill would have
+        (:func:`pidcore.compare.align.interpolated_count_and_mass`, as ``pidcore report``
+        takes it); NaN where neither is known.
     """
 
     load_case: LoadCase
@@ -173,6 +178,7 @@ class CaseComparison:
     notes: tuple[str, ...] = ()
     measured_stderr_dof: float = math.nan
     measured_stderr_eq10_dof: float = math.nan
+    vibrated_mass_kg: float = math.nan
 
 
 def _model_point(model, tol: Tolerances, acceleration_g: float,
@@ -535,23 +541,38 @@ def compare_case(records: Sequence[MeasuredEntry],
                                          np.array([r.sdc_stderr_dof for r in records]))
     return CaseComparison(case, measured, sdc, stderr, aligned, dem_points, paper_points,
                           model_x, model_y, sdc10, stderr10, chi2 / dof if dof else math.nan,
-                          tuple(notes), stderr_dof, stderr10_dof)
+                          tuple(notes), stderr_dof, stderr10_dof, m_c)
+
+
+#: Name of the DEM's damper of :func:`equivalent_dampers` for an interpolated case: its SDC is
+#: the pchip model's, not a run's.
+INTERPOLATED_DAMPER_NAME = "our DEM (from the interpolated SDC)"
 
 
 def equivalent_dampers(comparison: CaseComparison) -> dict[str, float]:
     """The equivalent viscous damper ``c_eq = SDC m_c w / (2 pi)`` [N s/m] of a compared case,
     the ``c_eq_per_coupon [N s/m]`` of ``pidcore model damper``: ``"our DEM"`` (its grid
-    case's SDC and m_c) and ``"measured"`` (the pooled Eq. 10 SDC with the same m_c, at the measured
-    frequency: ``dE / (pi w X^2)`` of the measured energy per cycle). Empty where no DEM grid
-    case states m_c (an interpolated DEM value has none); a value is left out where its SDC
-    is not finite."""
+    case's SDC and m_c; :data:`INTERPOLATED_DAMPER_NAME` for an interpolated case: the pchip
+    model's SDC at the measured frequency with the m_c a run at this fill would have,
+    :attr:`CaseComparison.vibrated_mass_kg`) and ``"measured"`` (the pooled Eq. 10 SDC with
+    the same m_c, at the measured frequency: ``dE / (pi w X^2)`` of the measured energy per
+    cycle). Empty where the DEM states no m_c (no DEM value, or runs that do not say one
+    specimen); a value is left out where its SDC is not finite."""
     from ..model.damper import equivalent_damping_coefficient
 
     grid = getattr(comparison.aligned, "grid_case", None)
-    m_c = float(getattr(grid, "vibrated_mass_kg", math.nan))
+    m_c = float(getattr(grid, "vibrated_mass_kg", comparison.vibrated_mass_kg))
     if not (math.isfinite(m_c) and m_c > 0):
         return {}
-    found = {"our DEM": (grid.sdc, grid.load_case.frequency_hz),
+    if grid is not None:
+        dem = ("our DEM", grid.sdc, grid.load_case.frequency_hz)
+    elif getattr(comparison.aligned, "status", "") == "interpolated":
+        # the report's row has this m_c too; the page left the damper empty
+        dem = (INTERPOLATED_DAMPER_NAME, float(comparison.aligned.sdc_dem),
+               comparison.load_case.frequency_hz)
+    else:
+        return {}
+    found = {dem[0]: dem[1:],
              "measured": (comparison.measured_sdc_eq10, comparison.load_case.frequency_hz)}
     return {name: float(equivalent_damping_coefficient(sdc, vibrated_mass_kg=m_c,
                                                        frequency_hz=freq))

@@ -103,10 +103,10 @@ def _names(runs: pd.DataFrame, labels: pd.Series) -> pd.Series:
 
 def _model_the_papers_coupon(runs: pd.DataFrame) -> np.ndarray:
     """Per run: whether the specimen file it stored (``parameters_json``'s ``specimen_text``)
-    models the paper's coupon (:func:`pidcore.specimen.models_paper_coupon`: its cell and
-    spheres). A run that stored no text (runs of the paper's coupon's name before specimen
-    files were stored) is taken as its name says, as before; one whose text no longer reads
-    is not."""
+    models the paper's coupon (:func:`pidcore.specimen.models_paper_coupon`: its cell,
+    spheres and coupon mass). A run that stored no text (runs of the paper's coupon's name
+    before specimen files were stored) is taken as its name says, as before; one whose text
+    no longer reads is not."""
     from ..specimen import Specimen, models_paper_coupon
     from .align import stored_parameters
 

@@ -556,13 +556,15 @@ def specimen_report_table(stored_runs: pd.DataFrame | None, analyses: pd.DataFra
             # nor are they "another specimen's runs" in a measured row's note
             stored_runs, _ = without_design_runs(stored_runs, design_runs)
     paper = load_paper_table3()
-    from ..specimen import PAPER_SPECIMEN_NAME, measured_specimen_name
+    from ..specimen import PAPER_SPECIMEN_NAME, measured_specimen_name, tabulated_by_paper
 
     # a file named paper_coupon with another cell is "paper_coupon [45d792]" here, as its
     # tests and DEM runs are: "specimen paper_coupon is not the paper's coupon" contradicted
     # itself, and its rows were named as the paper's coupon's
     name = measured_specimen_name(specimen) if specimen is not None else PAPER_SPECIMEN_NAME
-    if specimen is not None and not specimen.is_paper():
+    # as a row of its tests is judged (by the name they are saved under): a calibrated file
+    # of the paper's coupon (another hash, the coupon's physics) lost Table 3 here only
+    if specimen is not None and not tabulated_by_paper(specimen):
         paper = None
         notes.append(NOT_PAPER_SPECIMEN_NOTE.format(name=name))
 

@@ -46,6 +46,7 @@ from ..compare.specimens import (
     NOT_PAPER_SPECIMEN_NOTE,
     runs_for_measurement,
 )
+from ..constants import BAND_VERDICTS
 from ..errors import ParameterError, instance_of
 from ..specimen import MEASURED_SHA256_FIELD, deciding_sha256, hashed_name, is_paper_coupon
 from ..units import g_to_si
@@ -601,9 +602,12 @@ IMPLAUSIBLE_ROW_NOTE = "includes a result no passive coupon gives, kept as accep
 CALIBRATED_COLUMN = "SDC calibrated DEM (Eq. 11) [-]"
 CALIBRATED_LOW_COLUMN = "calibrated low 95 % [-]"
 CALIBRATED_HIGH_COLUMN = "calibrated high 95 % [-]"
-#: ``not compared`` rather than ``n/a``: pandas.read_csv would read ``n/a`` back as NaN.
-NOT_COMPARED = "not compared"
-CALIBRATED_INSIDE_COLUMN = "measured in calibrated 95 % band [yes/no/not compared]"
+#: The verdicts of :data:`pidcore.constants.BandVerdict`: ``not compared`` rather than ``n/a``
+#: (pandas.read_csv would read ``n/a`` back as NaN); ``uninformative`` where the band spans
+#: every plausible SDC (:meth:`~pidcore.calibrate.prediction.CalibratedPrediction.
+#: uninformative_reason`), neither inside nor outside.
+INSIDE, OUTSIDE, NOT_COMPARED, UNINFORMATIVE = BAND_VERDICTS
+CALIBRATED_INSIDE_COLUMN = f"measured in calibrated 95 % band [{'/'.join(BAND_VERDICTS)}]"
 CALIBRATION_COLUMNS: tuple[str, ...] = (CALIBRATED_COLUMN, CALIBRATED_LOW_COLUMN,
                                         CALIBRATED_HIGH_COLUMN, CALIBRATED_INSIDE_COLUMN)
 
@@ -718,7 +722,12 @@ def add_calibration_columns(table: pd.DataFrame, calibration, *,
                              f"(the calibration's own measurement at this load case had SDC "
                              f"stderr {hit.measured_stderr:.3g}); its 95 % widening: "
                              f"{quantile_label(dof)}")
-                inside.append("yes" if band[0] <= measured <= band[1] else "no")
+                uninformative = hit.uninformative_reason(stderr, dof)
+                if uninformative:
+                    inside.append(UNINFORMATIVE)
+                    extra = "; ".join(n for n in (uninformative, extra) if n)  # verdict first
+                else:
+                    inside.append(INSIDE if band[0] <= measured <= band[1] else OUTSIDE)
         notes.append("; ".join(n for n in (note, extra, cut) if n))
     at = list(out.columns).index("SDC measured [-]") + 1 if "SDC measured [-]" in out.columns \
         else len(out.columns)
@@ -726,9 +735,14 @@ def add_calibration_columns(table: pd.DataFrame, calibration, *,
                                                 strict=True)):
         out.insert(at + offset, name, values)
     out["note"] = notes
-    compared = sum(v != NOT_COMPARED for v in inside)
+    # a band of 0 .. the SDC bound holds every measurement: counted neither inside nor among
+    # those judged
+    compared = sum(v in (INSIDE, OUTSIDE) for v in inside)
+    unjudged = inside.count(UNINFORMATIVE)
     summary = (f"calibration {calibration.path}: predicts {sum(math.isfinite(v) for v in sdc)} "
                f"of {len(out)} row(s); measured Eq. 11 SDC inside the 95 % band at "
-               f"{inside.count('yes')} of {compared} measured row(s)")
+               f"{inside.count(INSIDE)} of {compared} measured row(s)"
+               + (f" ({unjudged} more {UNINFORMATIVE}: a band of 0 .. the SDC bound, spanning "
+                  "every plausible SDC, cannot test the model)" if unjudged else ""))
     out.attrs = {**table.attrs, "notes": [*table.attrs.get("notes", []), summary]}
     return out

@@ -104,6 +104,9 @@ def _calibrated(calibrations, comp, head, specimen: str, *, implausible: bool = 
         verdict = "not compared (no Eq. 11 SDC)"
     elif implausible:  # as the report judges such a row: its stderr is an impossible scatter
         verdict = "not compared (it pools an implausible result, named below)"
+    elif uninformative := hit.uninformative_reason(own_stderr, comp.measured_stderr_dof):
+        # as the report's row: a band of 0 .. 2 pi holds every measurement, so "inside" lied
+        verdict = uninformative
     else:
         verdict = "inside" if low <= comp.measured_sdc <= high else "outside"
     st.caption(f"calibrated 95 % band {display_number(low)} .. {display_number(high)} [-]"
@@ -179,8 +182,10 @@ def render(stores, session_files: list, calibrations: list) -> None:
         st.caption("equivalent viscous damper of the whole coupon c_eq = SDC m_c ω/(2π) (as "
                    "`pidcore model damper`'s c_eq_per_coupon): "
                    + " · ".join(f"{name} **{c:.4g} N s/m**" for name, c in dampers.items())
-                   + f" (m_c = {comp.aligned.grid_case.vibrated_mass_kg:.4g} kg of the DEM "
-                     "case)")
+                   + (f" (m_c = {comp.aligned.grid_case.vibrated_mass_kg:.4g} kg of the DEM "
+                      "case)" if comp.aligned.grid_case is not None else
+                      f" (m_c = {comp.vibrated_mass_kg:.4g} kg a DEM run at this fill would "
+                      "have, as the report takes it; the DEM's SDC is the interpolated one)"))
     if len(members) > 1:
         if math.isfinite(comp.chi2_dof) and comp.chi2_dof > 3:
             st.warning(f"The {len(members)} pooled files scatter more than their errors allow "
