@@ -59,6 +59,9 @@ class MeasuredPoint:
     # files of one name are two specimens; "" where only the name is known (a table, an older
     # record), or the paper's coupon's (pidcore.specimen.deciding_sha256)
     specimen_sha256: str = ""
+    # a record without its file's hash whose name several files' tests carry
+    # (pidcore.specimen.match_hashless_records): no file of that name may take it
+    specimen_ambiguous: bool = field(default=False, compare=False)
 
     def __post_init__(self) -> None:
         # the rule of a table row, for a script's point too: a script's sdc=nan, a negative
@@ -175,7 +178,8 @@ def read_measured_table(path: str | os.PathLike, *,
 
 
 def measured_from_store(store_path: str | os.PathLike, *,
-                        left_out: list[str] | None = None) -> list[MeasuredPoint]:
+                        left_out: list[str] | None = None,
+                        specimen=None) -> list[MeasuredPoint]:
     """Analysed measurements of a store, grouped per load case, particle material and specimen
     label (mean SDC, standard error), of the newest analysis of each measurement.
 
@@ -190,8 +194,14 @@ def measured_from_store(store_path: str | os.PathLike, *,
     analyses must carry ``fill_percent`` (from a sidecar). Records the plausibility checks
     refuse (saved with ``--accept-implausible``: a negative SDC beyond its noise, one above
     2 pi) are left out; ``left_out``, where given, gains a line naming each.
+
+    A record of a specimen name saved without its file's hash (an older pidcore) is pooled
+    with the tests of the one file of that name the store's other records name, or kept apart
+    where they (or ``specimen``, the file calibrated) name two files
+    (:func:`pidcore.specimen.match_hashless_records`); ``left_out`` gains the note. The store
+    is only read.
     """
-    from ..specimen import MEASURED_SHA256_FIELD, deciding_sha256
+    from ..specimen import MEASURED_SHA256_FIELD, match_hashless_records
     from ..store import Store
     from ..store.listing import latest_per_measurement
 
@@ -225,16 +235,25 @@ def measured_from_store(store_path: str | os.PathLike, *,
             "material", pd.Series([None] * len(frame), index=frame.index))],
         specimen=[_text_cell(v, "") for v in frame.get(
             "specimen", pd.Series([None] * len(frame), index=frame.index))])
-    # tests of two files of one name are not averaged into one point (the hash of a record
-    # saved before it was, or of the paper's coupon, is "": by name, as before)
-    frame = frame.assign(specimen_sha256=[
-        deciding_sha256(v) if named else "" for v, named in zip(frame.get(
-            MEASURED_SHA256_FIELD, pd.Series([None] * len(frame), index=frame.index)),
-            frame["specimen"], strict=True)])
+    # tests of two files of one name are not averaged into one point; a record saved before
+    # the hash was joins the tests of its name's one file, or stays apart where the name
+    # means two (the paper's coupon's hash is "": by name, as before)
+    given = {}
+    if specimen is not None:
+        from ..specimen import measured_specimen_name
+        from .prediction import tested_sha256
+
+        given = {measured_specimen_name(specimen): tested_sha256(specimen) or ""}
+    matched = match_hashless_records(list(frame["specimen"]), list(frame.get(
+        MEASURED_SHA256_FIELD, pd.Series([None] * len(frame), index=frame.index))), given=given)
+    frame = frame.assign(specimen_sha256=list(matched.sha256),
+                         specimen_ambiguous=list(matched.ambiguous))
+    if left_out is not None:
+        left_out.extend(note for note in dict.fromkeys(matched.notes) if note)
     points = []
     keys = ["frequency_hz", "acceleration_g", "fill_percent", "material", "specimen",
-            "specimen_sha256"]
-    for (f, a, p, material, specimen, sha256), group in frame.groupby(keys):
+            "specimen_sha256", "specimen_ambiguous"]
+    for (f, a, p, material, specimen_name, sha256, ambiguous), group in frame.groupby(keys):
         sdc = group["sdc"].to_numpy(float)
         if len(sdc) > 1:
             se = float(np.std(sdc, ddof=1) / math.sqrt(len(sdc)))
@@ -244,8 +263,9 @@ def measured_from_store(store_path: str | os.PathLike, *,
             dof = stored_stderr_dof(group.get("sdc_stderr_dof", pd.Series([math.nan])).iloc[0]) \
                 if se > 0 else math.nan
         points.append(MeasuredPoint(float(f), float(a), float(p), float(sdc.mean()), se,
-                                    str(material), str(specimen), sdc_stderr_dof=dof,
-                                    source=str(store_path), specimen_sha256=str(sha256)))
+                                    str(material), str(specimen_name), sdc_stderr_dof=dof,
+                                    source=str(store_path), specimen_sha256=str(sha256),
+                                    specimen_ambiguous=bool(ambiguous)))
     if not points:
         dropped = [found[0].message for found in implausible if found]
         if dropped:
@@ -291,6 +311,12 @@ def points_for_specimen(points: Sequence[MeasuredPoint], specimen) -> tuple[list
             other_specimen[str(p.specimen)] = other_specimen.get(str(p.specimen), 0) + 1
         elif str(p.specimen) and same_tested_file(p.specimen_sha256, tested_file) is False:
             label = f"{hashed_name(p.specimen, p.specimen_sha256)} (another file of that name)"
+            other_specimen[label] = other_specimen.get(label, 0) + 1
+        elif p.specimen_ambiguous:
+            # by name it is this file's, and just as much another's: fitted beside this
+            # file's own tests it was a second point of one load case
+            label = (f"{p.specimen} saved without its file's sha256 (the name means several "
+                     "files)")
             other_specimen[label] = other_specimen.get(label, 0) + 1
         else:
             kept.append(p)

@@ -111,7 +111,7 @@ def run(args: argparse.Namespace) -> int:
     if args.data is not None:
         points = read_measured_table(args.data, default_material=default_material)
     else:
-        measured = measured_from_store(args.store, left_out=left_out)
+        measured = measured_from_store(args.store, left_out=left_out, specimen=specimen)
         points = _store_points(measured, specimen, args.store, left_out)
         for note in left_out:
             print(f"pidcore calibrate: note: {cli_words(note, 'calibrate')}", file=sys.stderr)

@@ -236,6 +236,11 @@ class MeasuredEntry:
         The sha256 of the specimen file the record names (``specimen_sha256``), deciding
         which DEM runs and calibration it meets and keeping two files of one name apart; ""
         where only the name is known (:func:`pidcore.specimen.deciding_sha256`).
+    specimen_note : str
+        Where a record without its file's hash was matched by name only to its name's one
+        file (``specimen_sha256`` is then that file's), or kept apart since the name means
+        several files, the note saying so (:func:`pidcore.app.workbench.matched_specimens`);
+        empty otherwise.
     """
 
     key: str
@@ -261,6 +266,9 @@ class MeasuredEntry:
     #: degrees of freedom of sdc_stderr (the analysis's n_blocks - 1), NaN where unknown
     sdc_stderr_dof: float = math.nan
     specimen_sha256: str = ""
+    #: how a record saved without its file's hash met its specimen's file (joined by name to
+    #: the one file of that name, or kept apart: pidcore.specimen.match_hashless_records)
+    specimen_note: str = ""
 
     @classmethod
     def from_record(cls, record, load_case: LoadCase, *,

@@ -554,7 +554,11 @@ def specimen_report_table(stored_runs: pd.DataFrame | None, analyses: pd.DataFra
             # nor are they "another specimen's runs" in a measured row's note
             stored_runs, _ = without_design_runs(stored_runs, design_runs)
     paper = load_paper_table3()
-    from ..specimen import PAPER_SPECIMEN_NAME, measured_specimen_name
+    from ..specimen import (
+        PAPER_SPECIMEN_NAME,
+        measured_specimen_name,
+        measured_specimen_sha256,
+    )
 
     # a file named paper_coupon with another cell is "paper_coupon [45d792]" here, as its
     # tests and DEM runs are: "specimen paper_coupon is not the paper's coupon" contradicted
@@ -569,7 +573,9 @@ def specimen_report_table(stored_runs: pd.DataFrame | None, analyses: pd.DataFra
         of_specimen=name,
         choose_another="" if choose_another == CHOOSE_SPECIMEN_CLI
         else f"choose theirs with {choose_another.removesuffix(' for another')} to compare "
-             "them")
+             "them",
+        tested_files={name: measured_specimen_sha256(specimen)} if specimen is not None
+        else None)
     baseline = unsubtracted_baseline_note(specimen, analyses)
     if baseline:
         notes.append(baseline)
