@@ -1420,14 +1420,17 @@ class NameMatch:
 
 
 def match_hashless_records(names: Sequence[object], sha256s: Sequence[object], *,
-                           given: Mapping[str, str] | None = None) -> NameMatch:
+                           given: Mapping[str, str] | None = None,
+                           others: Sequence[tuple[object, object]] = ()) -> NameMatch:
     """The one rule for a measurement saved with a specimen name but no file hash (by a
     pidcore before :data:`MEASURED_SHA256_FIELD` existed, or without a known file), for
     ``calibrate --store``, reports and the app's Compare alike.
 
     ``names`` and ``sha256s``: each record's saved specimen name and hash (NaN or "" for
     none); ``given``: name -> hash of the specimen files the caller was given
-    (:func:`measured_specimen_sha256`), e.g. ``calibrate --specimen FILE``.
+    (:func:`measured_specimen_sha256`), e.g. ``calibrate --specimen FILE``; ``others``: (name,
+    hash) of the store's records not among them (a page's filter, a report of some files),
+    which count as they do but are not resolved: a filter does not change what a record is.
 
     A hashless record of name N is a test of the one file every hashed record of N names
     where they all name the same file (and a given file of that name is that file): it then
@@ -1442,7 +1445,9 @@ def match_hashless_records(names: Sequence[object], sha256s: Sequence[object], *
     named = [n.strip() if isinstance(n, str) else "" for n in names]
     hashes = [deciding_sha256(h) if n else "" for n, h in zip(named, sha256s, strict=True)]
     files: dict[str, list[str]] = {}
-    for n, h in zip(named, hashes, strict=True):
+    context = [(n.strip() if isinstance(n, str) else "", h) for n, h in others]
+    for n, h in [*zip(named, hashes, strict=True),
+                 *((n, deciding_sha256(h) if n else "") for n, h in context)]:
         if n and h and h not in files.setdefault(n, []):
             files[n].append(h)
     out_hashes, ambiguous, notes = list(hashes), [False] * len(named), [""] * len(named)

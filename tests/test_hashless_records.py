@@ -215,3 +215,25 @@ def test_app_compare_groups_a_hashless_record_with_its_names_one_file(tests_anal
     alone = matched_specimens(saved_entries(store, shown), listing)
     assert [e.specimen_sha256 for e in alone] == [first.hash]
     assert _digest(store) == before
+
+
+def test_a_report_of_the_hashless_test_alone_still_reads_it_as_its_names_one_file(
+        tests_analysed, tmp_path):
+    """The app's Report of chosen files (and `report FILES --store`) decides with the whole
+    store: chosen alone, the older record was "panel" by name, another row than its file's."""
+    from pidcore.report.downloads import store_report_table
+    from pidcore.report.table import build_report_table
+    from pidcore.store.listing import saved_analyses
+
+    first = tests_analysed.first
+    store = _store(tmp_path / "chosen.h5", tests_analysed.results[:2], [first.hash, None])
+    before = _digest(store)
+    listing = saved_analyses(store)
+    old = listing[listing[MEASURED_SHA256_FIELD].isna()]
+    table = build_report_table(None, old, None, store_analyses=listing)
+    assert table[SHA_COLUMN].tolist() == [first.hash]
+    assert "matched by name only" in table["note"].iloc[0]
+    app_table = store_report_table(store, analysis_keys=list(old["key"]))
+    measured = app_table[app_table["source file(s)"].fillna("") != ""]
+    assert measured[SHA_COLUMN].tolist() == [first.hash]
+    assert _digest(store) == before

@@ -66,19 +66,15 @@ def matched_specimens(entries: Sequence[MeasuredEntry],
 
     from ..specimen import MEASURED_SHA256_FIELD, match_hashless_records
 
-    names = [e.specimen for e in entries]
-    hashes: list[object] = [e.specimen_sha256 for e in entries]
+    others: list[tuple[object, object]] = []
     if listing is not None and not listing.empty and "specimen" in listing.columns:
-        shown = {e.key for e in entries}
-        rest = listing[~listing["key"].astype(str).isin(shown)] if "key" in listing.columns \
-            else listing
-        names += list(rest["specimen"])
-        hashes += list(rest.get(MEASURED_SHA256_FIELD,
-                                pd.Series([""] * len(rest), index=rest.index)))
-    matched = match_hashless_records(names, hashes)
+        others = list(zip(listing["specimen"], listing.get(
+            MEASURED_SHA256_FIELD, pd.Series([""] * len(listing), index=listing.index)),
+            strict=True))
+    matched = match_hashless_records([e.specimen for e in entries],
+                                     [e.specimen_sha256 for e in entries], others=others)
     return [replace(e, specimen_sha256=sha256, specimen_note=note) if note else e
-            for e, sha256, note in zip(entries, matched.sha256[:len(entries)],
-                                       matched.notes[:len(entries)], strict=True)]
+            for e, sha256, note in zip(entries, matched.sha256, matched.notes, strict=True)]
 
 
 def group_entries(entries: Sequence[MeasuredEntry]) -> list[list[int]]:

@@ -220,7 +220,8 @@ def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | N
                        tolerances: Tolerances | None = None,
                        pool: bool = False, store_runs: pd.DataFrame | None = None,
                        of_specimen: str = "", choose_another: str = "",
-                       tested_files: Mapping[str, str] | None = None) -> pd.DataFrame:
+                       tested_files: Mapping[str, str] | None = None,
+                       store_analyses: pd.DataFrame | None = None) -> pd.DataFrame:
     """Table 3-style comparison of our DEM, our measurements and the paper.
 
     Parameters
@@ -256,6 +257,10 @@ def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | N
         Specimen name -> sha256 of the specimen file the report is of: a record of that name
         saved without its file's hash joins the tests of its name's one file only where that
         file is this one (:func:`pidcore.specimen.match_hashless_records`).
+    store_analyses : pandas.DataFrame, optional
+        Every analysis of the store ``analyses`` are some of (a report of chosen files):
+        their specimens and hashes decide that rule too, so that the choice does not change
+        which file a hashless record is of. Default: ``analyses``.
 
     Returns
     -------
@@ -282,7 +287,8 @@ def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | N
     return report_table_and_aligner(dem_runs, analyses, paper, model=model,
                                     tolerances=tolerances, pool=pool, store_runs=store_runs,
                                     of_specimen=of_specimen, choose_another=choose_another,
-                                    tested_files=tested_files)[0]
+                                    tested_files=tested_files,
+                                    store_analyses=store_analyses)[0]
 
 
 def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | None,
@@ -291,6 +297,7 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
                               pool: bool = False, store_runs: pd.DataFrame | None = None,
                               of_specimen: str = "", choose_another: str = "",
                               tested_files: Mapping[str, str] | None = None,
+                              store_analyses: pd.DataFrame | None = None,
                               ) -> tuple[pd.DataFrame, Aligner]:
     """:func:`build_report_table` and the aligner of its DEM rows (the runs it counted, its
     pchip models), for figures that must show what the table compared."""
@@ -319,7 +326,11 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
     matched = match_hashless_records(
         ["" if pool else rec.get("specimen", "") for _, rec in measured_rows],
         [rec.get(MEASURED_SHA256_FIELD, "") for _, rec in measured_rows],
-        given=tested_files)
+        given=tested_files, others=[] if pool or store_analyses is None
+        or "specimen" not in store_analyses.columns else list(zip(
+            store_analyses["specimen"], store_analyses.get(
+                MEASURED_SHA256_FIELD, pd.Series([""] * len(store_analyses),
+                                                 index=store_analyses.index)), strict=True)))
     for (case, rec), sha256, name_note in zip(measured_rows, matched.sha256, matched.notes,
                                               strict=True):
         named = rec.get("specimen", "")
