@@ -209,6 +209,9 @@ def test_app_compare_groups_a_hashless_record_with_its_names_one_file(tests_anal
         f"{CASE.full_label()}, specimen panel [{first.hash[:6]}]")
     view = case_view(entries, None, load_paper_table3(), [store])
     assert any("matched by name only" in note for note in view["notes"])
+    assert sorted(view["comparison"].measured["specimen"]) == [
+        "panel", "panel",
+        f"panel (no file hash saved; matched by name to panel [{first.hash[:6]}])"]
     # a filter showing the hashless record alone does not make it another specimen
     old = [f for f in listing["file"] if f.startswith("t2")]
     shown = filter_analyses(listing, files=old)
@@ -237,3 +240,22 @@ def test_a_report_of_the_hashless_test_alone_still_reads_it_as_its_names_one_fil
     measured = app_table[app_table["source file(s)"].fillna("") != ""]
     assert measured[SHA_COLUMN].tolist() == [first.hash]
     assert _digest(store) == before
+
+
+def test_compares_per_file_table_says_which_test_recorded_only_a_name(tests_analysed,
+                                                                     tmp_path):
+    from pidcore.app.workbench import case_view, matched_specimens, saved_entries
+    from pidcore.model import load_paper_table3
+    from pidcore.store.listing import saved_analyses
+
+    first, second = tests_analysed.first, tests_analysed.second
+    store = _store(tmp_path / "shown.h5", tests_analysed.results, [first.hash, first.hash,
+                                                                   second.hash, None])
+    listing = saved_analyses(store)
+    entries = matched_specimens(saved_entries(store, listing), listing)
+    hashless = [e for e in entries if e.specimen_note]
+    assert len(hashless) == 1 and hashless[0].specimen_sha256 == ""
+    view = case_view(hashless, None, load_paper_table3(), [store])
+    assert view["comparison"].measured["specimen"].tolist() == [
+        "panel (no file hash saved; several files of that name)"]
+    assert any("kept apart" in note for note in view["notes"])

@@ -381,6 +381,21 @@ def _specimen_of(row) -> str:
     return named if isinstance(named, str) else ""
 
 
+def _specimen_shown(entry: MeasuredEntry) -> str:
+    """The specimen of a record as the per-file table shows it: its name, and for a record
+    saved without its file's hash beside hashed tests of that name
+    (:attr:`MeasuredEntry.specimen_note`), whether it was matched to their one file or kept
+    apart."""
+    from ..specimen import hashed_name
+
+    if not entry.specimen_note:
+        return entry.specimen
+    if entry.specimen_sha256:
+        return (f"{entry.specimen} (no file hash saved; matched by name to "
+                f"{hashed_name(entry.specimen, entry.specimen_sha256)})")
+    return f"{entry.specimen} (no file hash saved; several files of that name)"
+
+
 def _specimen_sha256_of(row) -> str:
     """The specimen file's hash a stored analysis recorded where it decides ("" for none, an
     older record, or the paper's coupon's: by name)."""
@@ -432,7 +447,8 @@ def compare_case(records: Sequence[MeasuredEntry],
     measured = pd.DataFrame({
         "file": [r.file for r in records],
         "origin": [r.origin for r in records],
-        "specimen": [r.specimen for r in records],
+        # which of the pooled tests recorded only its specimen's name is seen per file
+        "specimen": [_specimen_shown(r) for r in records],
         "corrections": [r.corrections for r in records],
         "fill [%]": [r.load_case.fill_percent for r in records],
         "SDC [-]": [r.sdc for r in records],
