@@ -134,6 +134,14 @@ def test_a_hashless_record_of_a_name_of_two_files_is_kept_apart_and_said(
     kept, note = points_for_specimen(points, first)
     assert [p.specimen_sha256 for p in kept] == [first.hash]
     assert "panel saved without its file's sha256 (the name means several files)" in note
+    # nor does the library fit it when a script passes it (a second point of the case)
+    from pidcore.calibrate.calibrate import check_point_specimens
+    from pidcore.errors import ParameterError
+
+    with pytest.raises(ParameterError, match=r"name specimen \"panel \(saved without its "
+                       r"file's sha256; several files of that name\)\", not 'panel'"):
+        check_point_specimens([by_hash[first.hash], hashless], first)
+    check_point_specimens([by_hash[first.hash]], first)
     assert _digest(store) == before
 
 
