@@ -1475,7 +1475,7 @@ def match_hashless_records(names: Sequence[object], sha256s: Sequence[object], *
         else:
             where = f"the tests recorded {len(stored)} files of that name ({', '.join(labels)})"
         notes[i] = (f"{how_many} kept apart: {where}, and a name alone does not say which "
-                    "was tested (analyse them again with --specimen FILE to record it)")
+                    "was tested (analyse them again with their specimen file to record it)")
     return NameMatch(tuple(out_hashes), tuple(ambiguous), tuple(notes))
 
 
@@ -1719,6 +1719,7 @@ __all__ = ["CellSpec", "CouponSpec", "PairSpec", "PairsSpec", "ParticleSpec", "S
            "MEASURED_SHA256_FIELD", "deciding_sha256", "measured_specimen_name",
            "measured_specimen_sha256", "models_paper_coupon", "NamedSpecimen",
            "resolve_specimen_name", "numeric_fields", "same_tested_file",
+           "match_hashless_records", "NameMatch",
            "provenance_test_name",
            "paper_specimen", "particles_for_fill"]
 

@@ -18,6 +18,7 @@ import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pandas as pd
@@ -26,6 +27,9 @@ from .. import defaults
 from ..compare.align import stored_stderr_dof
 from ..compare.plausibility import SDC_UPPER_BOUND, stored_findings
 from ..errors import InputFileError, ParameterError, as_given, real_number
+
+if TYPE_CHECKING:  # pragma: no cover
+    from ..specimen import Specimen
 
 REQUIRED_COLUMNS = ("frequency_hz", "acceleration_g", "fill_percent", "sdc")
 OPTIONAL_COLUMNS = ("sdc_stderr", "sdc_stderr_dof", "energy_per_cycle_j", "material",
@@ -179,7 +183,7 @@ def read_measured_table(path: str | os.PathLike, *,
 
 def measured_from_store(store_path: str | os.PathLike, *,
                         left_out: list[str] | None = None,
-                        specimen=None) -> list[MeasuredPoint]:
+                        specimen: Specimen | None = None) -> list[MeasuredPoint]:
     """Analysed measurements of a store, grouped per load case, particle material and specimen
     label (mean SDC, standard error), of the newest analysis of each measurement.
 
