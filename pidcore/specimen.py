@@ -84,6 +84,9 @@ measured_specimen_sha256, MEASURED_SHA256_FIELD, deciding_sha256, same_tested_fi
     The file's hash saved beside that name (record field ``specimen_sha256``), and how a
     measurement's recorded hash meets a DEM run's or a calibration's: by hash where both
     know it, else by name (a record saved before the hash was).
+match_hashless_records, NameMatch
+    The one rule for a record saved with a name but no hash beside hashed records of that
+    name: joined to their one file, or kept apart where the name means two files.
 resolve_specimen_name, NamedSpecimen
     The known file a typed specimen name means (the app's settings grid), saved with its
     name and hash as ``analyze --specimen`` saves it; else by name, saying so.
@@ -1406,6 +1409,79 @@ def same_tested_file(measured_sha256: object, tested: object) -> bool | None:
 
 
 @dataclass(frozen=True)
+class NameMatch:
+    """How each of a set of measurement records meets its specimen file
+    (:func:`match_hashless_records`): ``sha256``, per record, the hash it is grouped and matched
+    by ("" where its name decides); ``ambiguous``, per record, whether it is a record without
+    its file's hash that several files of its name could have been tested with (kept apart);
+    ``notes``, per record, what was decided for it ("" where nothing was)."""
+
+    sha256: tuple[str, ...]
+    ambiguous: tuple[bool, ...]
+    notes: tuple[str, ...]
+
+
+def match_hashless_records(names: Sequence[object], sha256s: Sequence[object], *,
+                           given: Mapping[str, str] | None = None,
+                           others: Sequence[tuple[object, object]] = ()) -> NameMatch:
+    """The one rule for a measurement saved with a specimen name but no file hash (by a
+    pidcore before :data:`MEASURED_SHA256_FIELD` existed, or without a known file), for
+    ``calibrate --store``, reports and the app's Compare alike.
+
+    ``names`` and ``sha256s``: each record's saved specimen name and hash (NaN or "" for
+    none); ``given``: name -> hash of the specimen files the caller was given
+    (:func:`measured_specimen_sha256`), e.g. ``calibrate --specimen FILE``; ``others``: (name,
+    hash) of the store's records not among them (a page's filter, a report of some files),
+    which count as they do but are not resolved: a filter does not change what a record is.
+
+    A hashless record of name N is a test of the one file every hashed record of N names
+    where they all name the same file (and a given file of that name is that file): it then
+    carries that hash, with a note that it was matched by name only. Where the hashed
+    records of N (or they and the given file) name two files, a name alone cannot say which
+    was tested: the record keeps no hash, is flagged ambiguous, and its note says so; it is
+    never pooled with either file's tests. Records of N with no hashed record beside them
+    are matched by name, as before (no note). The paper's coupon is one coupon by name
+    (:func:`deciding_sha256`): never concerned.
+    """
+    given = {str(k): deciding_sha256(v) for k, v in (given or {}).items()}
+    named = [n.strip() if isinstance(n, str) else "" for n in names]
+    hashes = [deciding_sha256(h) if n else "" for n, h in zip(named, sha256s, strict=True)]
+    files: dict[str, list[str]] = {}
+    context = [(n.strip() if isinstance(n, str) else "", h) for n, h in others]
+    for n, h in [*zip(named, hashes, strict=True),
+                 *((n, deciding_sha256(h) if n else "") for n, h in context)]:
+        if n and h and h not in files.setdefault(n, []):
+            files[n].append(h)
+    out_hashes, ambiguous, notes = list(hashes), [False] * len(named), [""] * len(named)
+    counts: dict[str, int] = {}
+    for n, h in zip(named, hashes, strict=True):
+        if n and not h:
+            counts[n] = counts.get(n, 0) + 1
+    for i, (n, h) in enumerate(zip(named, hashes, strict=True)):
+        if not n or h or n not in files or is_paper_coupon(n):
+            continue
+        stored = files[n]
+        mine = given.get(n, "")
+        how_many = f"{counts[n]} record(s) of specimen {n} saved without its file's sha256"
+        if len(stored) == 1 and mine in ("", stored[0]):
+            out_hashes[i] = stored[0]
+            notes[i] = (f"{how_many} (an older pidcore, or no file given) matched by name only "
+                        f"to {hashed_name(n, stored[0])}, the one file of that name its other "
+                        "tests recorded")
+            continue
+        ambiguous[i] = True
+        labels = [hashed_name(n, h) for h in stored]
+        if mine and mine not in stored:
+            where = (f"the tests recorded {', '.join(labels)} and the specimen given is "
+                     f"{hashed_name(n, mine)}")
+        else:
+            where = f"the tests recorded {len(stored)} files of that name ({', '.join(labels)})"
+        notes[i] = (f"{how_many} kept apart: {where}, and a name alone does not say which "
+                    "was tested (analyse them again with their specimen file to record it)")
+    return NameMatch(tuple(out_hashes), tuple(ambiguous), tuple(notes))
+
+
+@dataclass(frozen=True)
 class NamedSpecimen:
     """What a specimen typed by name is saved as (:func:`resolve_specimen_name`): the record's
     ``name`` and ``sha256`` ("" where no one known file has that name), and ``note``, one line
@@ -1667,5 +1743,6 @@ __all__ = ["CellSpec", "CouponSpec", "PairSpec", "PairsSpec", "ParticleSpec", "S
            "measured_specimen_sha256", "models_paper_coupon", "NamedSpecimen",
            "resolve_specimen_name", "numeric_fields", "same_tested_file",
            "provenance_test_name", "tabulated_by_paper",
+           "match_hashless_records", "NameMatch",
            "paper_specimen", "particles_for_fill"]
 

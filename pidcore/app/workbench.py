@@ -55,6 +55,30 @@ def saved_entries(path: str | os.PathLike, rows: pd.DataFrame,
             for (_, row), entry in zip(rows.iterrows(), stored, strict=True)]
 
 
+def matched_specimens(entries: Sequence[MeasuredEntry],
+                      listing: pd.DataFrame | None = None) -> list[MeasuredEntry]:
+    """``entries`` with each record saved without its file's hash (an older pidcore's) met
+    as ``pidcore calibrate --store`` and reports meet it
+    (:func:`pidcore.specimen.match_hashless_records`): given the hash of its name's one file,
+    or kept apart where the name means two, with :attr:`MeasuredEntry.specimen_note` saying
+    which. Decided over the entries and every record of ``listing`` (the store's saved
+    analyses before the page's filters), so that a filter does not change which file a
+    record is of."""
+    from dataclasses import replace
+
+    from ..specimen import MEASURED_SHA256_FIELD, match_hashless_records
+
+    others: list[tuple[object, object]] = []
+    if listing is not None and not listing.empty and "specimen" in listing.columns:
+        others = list(zip(listing["specimen"], listing.get(
+            MEASURED_SHA256_FIELD, pd.Series([""] * len(listing), index=listing.index)),
+            strict=True))
+    matched = match_hashless_records([e.specimen for e in entries],
+                                     [e.specimen_sha256 for e in entries], others=others)
+    return [replace(e, specimen_sha256=sha256, specimen_note=note) if note else e
+            for e, sha256, note in zip(entries, matched.sha256, matched.notes, strict=True)]
+
+
 def group_entries(entries: Sequence[MeasuredEntry]) -> list[list[int]]:
     """Indices of ``entries`` grouped by load case (and specimen: specimens are never pooled)."""
     out: list[list[int]] = []
@@ -133,6 +157,8 @@ def case_view(entries: Sequence[MeasuredEntry], dem_runs: pd.DataFrame | None,
                                first.load_case.direction, first.specimen_sha256)
     comparison = compare_case(entries, met.runs, paper)
     notes = list(comparison.notes) + ([design_note] if design_note else [])
+    # a record matched by name only (or kept apart) is said where it is shown
+    notes.extend(dict.fromkeys(e.specimen_note for e in entries if e.specimen_note))
     if met.note and not met.refused:
         notes.append(met.note)
     # the Report tab and `pidcore report` say it; the Compare page showed such a low SDC

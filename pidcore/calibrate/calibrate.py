@@ -326,7 +326,12 @@ def check_point_specimens(points: Sequence[MeasuredPoint], specimen: Specimen) -
 
     others: dict[tuple[str, str], list[int | None]] = {}
     for p in points:
-        if of_another(p.specimen, p.specimen_sha256):
+        if p.specimen_ambiguous:
+            # its name is this file's and another's (match_hashless_records): by name it
+            # was a second point of its load case beside this file's own tests
+            named = f"{p.specimen} (saved without its file's sha256; several files of that name)"
+            others.setdefault((p.source, named), []).append(p.row)
+        elif of_another(p.specimen, p.specimen_sha256):
             named = p.specimen if not p.specimen_sha256 or p.specimen.endswith("]") \
                 else hashed_name(p.specimen, p.specimen_sha256)
             others.setdefault((p.source, named), []).append(p.row)

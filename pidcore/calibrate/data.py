@@ -72,6 +72,9 @@ class MeasuredPoint:
     # specimen it was measured on at its fill; 2 pi where that is not known): a property of
     # its specimen, not of the point
     sdc_bound: SdcBound = field(default=UNKNOWN_SPECIMEN_BOUND, compare=False)
+    # a record without its file's hash whose name several files' tests carry
+    # (pidcore.specimen.match_hashless_records): no file of that name may take it
+    specimen_ambiguous: bool = field(default=False, compare=False)
 
     def __post_init__(self) -> None:
         # the rule of a table row, for a script's point too: a script's sdc=nan, a negative
@@ -229,8 +232,14 @@ def measured_from_store(store_path: str | os.PathLike, *,
     refuse (saved with ``--accept-implausible``: a negative SDC beyond its noise, one above
     its specimen's bound, :func:`_point_sdc_bound` with ``specimen`` the file calibrated, or
     2 pi where not known) are left out; ``left_out``, where given, gains a line naming each.
+
+    A record of a specimen name saved without its file's hash (an older pidcore) is pooled
+    with the tests of the one file of that name the store's other records name, or kept apart
+    where they (or ``specimen``, the file calibrated) name two files
+    (:func:`pidcore.specimen.match_hashless_records`); ``left_out`` gains the note. The store
+    is only read.
     """
-    from ..specimen import MEASURED_SHA256_FIELD, deciding_sha256
+    from ..specimen import MEASURED_SHA256_FIELD, match_hashless_records
     from ..store import Store
     from ..store.listing import latest_per_measurement
 
@@ -270,16 +279,25 @@ def measured_from_store(store_path: str | os.PathLike, *,
             "material", pd.Series([None] * len(frame), index=frame.index))],
         specimen=[_text_cell(v, "") for v in frame.get(
             "specimen", pd.Series([None] * len(frame), index=frame.index))])
-    # tests of two files of one name are not averaged into one point (the hash of a record
-    # saved before it was, or of the paper's coupon, is "": by name, as before)
-    frame = frame.assign(specimen_sha256=[
-        deciding_sha256(v) if named else "" for v, named in zip(frame.get(
-            MEASURED_SHA256_FIELD, pd.Series([None] * len(frame), index=frame.index)),
-            frame["specimen"], strict=True)])
+    # tests of two files of one name are not averaged into one point; a record saved before
+    # the hash was joins the tests of its name's one file, or stays apart where the name
+    # means two (the paper's coupon's hash is "": by name, as before)
+    given = {}
+    if specimen is not None:
+        from ..specimen import measured_specimen_name
+        from .prediction import tested_sha256
+
+        given = {measured_specimen_name(specimen): tested_sha256(specimen) or ""}
+    matched = match_hashless_records(list(frame["specimen"]), list(frame.get(
+        MEASURED_SHA256_FIELD, pd.Series([None] * len(frame), index=frame.index))), given=given)
+    frame = frame.assign(specimen_sha256=list(matched.sha256),
+                         specimen_ambiguous=list(matched.ambiguous))
+    if left_out is not None:
+        left_out.extend(note for note in dict.fromkeys(matched.notes) if note)
     points = []
     keys = ["frequency_hz", "acceleration_g", "fill_percent", "material", "specimen",
-            "specimen_sha256"]
-    for (f, a, p, material, named, sha256), group in frame.groupby(keys):
+            "specimen_sha256", "specimen_ambiguous"]
+    for (f, a, p, material, named, sha256, ambiguous), group in frame.groupby(keys):
         sdc = group["sdc"].to_numpy(float)
         if len(sdc) > 1:
             se = float(np.std(sdc, ddof=1) / math.sqrt(len(sdc)))
@@ -291,6 +309,7 @@ def measured_from_store(store_path: str | os.PathLike, *,
         points.append(MeasuredPoint(float(f), float(a), float(p), float(sdc.mean()), se,
                                     str(material), str(named), sdc_stderr_dof=dof,
                                     source=str(store_path), specimen_sha256=str(sha256),
+                                    specimen_ambiguous=bool(ambiguous),
                                     # one specimen and fill: one bound
                                     sdc_bound=group["sdc_bound"].iloc[0]))
     if not points:
@@ -338,6 +357,12 @@ def points_for_specimen(points: Sequence[MeasuredPoint], specimen) -> tuple[list
             other_specimen[str(p.specimen)] = other_specimen.get(str(p.specimen), 0) + 1
         elif str(p.specimen) and same_tested_file(p.specimen_sha256, tested_file) is False:
             label = f"{hashed_name(p.specimen, p.specimen_sha256)} (another file of that name)"
+            other_specimen[label] = other_specimen.get(label, 0) + 1
+        elif p.specimen_ambiguous:
+            # by name it is this file's, and just as much another's: fitted beside this
+            # file's own tests it was a second point of one load case
+            label = (f"{p.specimen} saved without its file's sha256 (the name means several "
+                     "files)")
             other_specimen[label] = other_specimen.get(label, 0) + 1
         else:
             kept.append(p)

@@ -242,6 +242,11 @@ class MeasuredEntry:
         The sha256 of the specimen file the record names (``specimen_sha256``), deciding
         which DEM runs and calibration it meets and keeping two files of one name apart; ""
         where only the name is known (:func:`pidcore.specimen.deciding_sha256`).
+    specimen_note : str
+        Where a record without its file's hash was matched by name only to its name's one
+        file (``specimen_sha256`` is then that file's), or kept apart since the name means
+        several files, the note saying so (:func:`pidcore.app.workbench.matched_specimens`);
+        empty otherwise.
     """
 
     key: str
@@ -267,6 +272,9 @@ class MeasuredEntry:
     #: degrees of freedom of sdc_stderr (the analysis's n_blocks - 1), NaN where unknown
     sdc_stderr_dof: float = math.nan
     specimen_sha256: str = ""
+    #: how a record saved without its file's hash met its specimen's file (joined by name to
+    #: the one file of that name, or kept apart: pidcore.specimen.match_hashless_records)
+    specimen_note: str = ""
 
     @classmethod
     def from_record(cls, record, load_case: LoadCase, *,
@@ -392,6 +400,21 @@ def _specimen_of(row) -> str:
     return named if isinstance(named, str) else ""
 
 
+def _specimen_shown(entry: MeasuredEntry) -> str:
+    """The specimen of a record as the per-file table shows it: its name, and for a record
+    saved without its file's hash beside hashed tests of that name
+    (:attr:`MeasuredEntry.specimen_note`), whether it was matched to their one file or kept
+    apart."""
+    from ..specimen import hashed_name
+
+    if not entry.specimen_note:
+        return entry.specimen
+    if entry.specimen_sha256:
+        return (f"{entry.specimen} (no file hash saved; matched by name to "
+                f"{hashed_name(entry.specimen, entry.specimen_sha256)})")
+    return f"{entry.specimen} (no file hash saved; several files of that name)"
+
+
 def _specimen_sha256_of(row) -> str:
     """The specimen file's hash a stored analysis recorded where it decides ("" for none, an
     older record, or the paper's coupon's: by name)."""
@@ -443,7 +466,8 @@ def compare_case(records: Sequence[MeasuredEntry],
     measured = pd.DataFrame({
         "file": [r.file for r in records],
         "origin": [r.origin for r in records],
-        "specimen": [r.specimen for r in records],
+        # which of the pooled tests recorded only its specimen's name is seen per file
+        "specimen": [_specimen_shown(r) for r in records],
         "corrections": [r.corrections for r in records],
         "fill [%]": [r.load_case.fill_percent for r in records],
         "SDC [-]": [r.sdc for r in records],

@@ -64,7 +64,7 @@ def _store_report(path: str | os.PathLike, dem_store: str | os.PathLike | None, 
     from .pipeline import specimen_report_table
     from .table import add_calibration_columns
 
-    analyses = saved_analyses(path)
+    analyses = store_analyses = saved_analyses(path)
     if analysis_keys is not None and not analyses.empty:
         analyses = analyses[analyses["key"].isin(analysis_keys)]
     dem_runs = list_dem_runs(path, dem_store)
@@ -79,7 +79,8 @@ def _store_report(path: str | os.PathLike, dem_store: str | os.PathLike | None, 
                                   where=where or None, pool=pool,
                                   choose_another=CHOOSE_SPECIMEN_APP,
                                   design_runs=calibration_design_runs(dem_runs,
-                                                                      [path, dem_store]))
+                                                                      [path, dem_store]),
+                                  store_analyses=store_analyses)
     table = built.table if calibration is None else add_calibration_columns(
         built.table, calibration, specimen=specimen, paper=specimen is None)
     return table, built.dem_runs, analyses

@@ -529,7 +529,8 @@ def specimen_report_table(stored_runs: pd.DataFrame | None, analyses: pd.DataFra
                           specimen: Specimen | None = None, where: str | Path | None = None,
                           tolerances: Tolerances | None = None, pool: bool = False,
                           choose_another: str = CHOOSE_SPECIMEN_CLI,
-                          design_runs: Mapping[str, str] | None = None) -> SpecimenTable:
+                          design_runs: Mapping[str, str] | None = None,
+                          store_analyses: pd.DataFrame | None = None) -> SpecimenTable:
     """The report table of one specimen's DEM runs (:func:`specimen_dem_runs`) beside the
     analyses, as ``pidcore report`` and the app's Report tab show it.
 
@@ -543,7 +544,9 @@ def specimen_report_table(stored_runs: pd.DataFrame | None, analyses: pd.DataFra
 
     ``design_runs``: run key -> calibration key of the runs that are calibrations' design runs
     (:func:`pidcore.calibrate.persist.calibration_design_runs`); unless ``pool``, they are left
-    out of the rows, and a note says so.
+    out of the rows, and a note says so. ``store_analyses``: every analysis of the store
+    ``analyses`` are chosen from, deciding with them which file a record saved without its
+    file's hash is of (:func:`pidcore.report.table.build_report_table`).
     """
     from ..model import load_paper_table3
 
@@ -556,7 +559,12 @@ def specimen_report_table(stored_runs: pd.DataFrame | None, analyses: pd.DataFra
             # nor are they "another specimen's runs" in a measured row's note
             stored_runs, _ = without_design_runs(stored_runs, design_runs)
     paper = load_paper_table3()
-    from ..specimen import PAPER_SPECIMEN_NAME, measured_specimen_name, tabulated_by_paper
+    from ..specimen import (
+        PAPER_SPECIMEN_NAME,
+        measured_specimen_name,
+        measured_specimen_sha256,
+        tabulated_by_paper,
+    )
 
     # a file named paper_coupon with another cell is "paper_coupon [45d792]" here, as its
     # tests and DEM runs are: "specimen paper_coupon is not the paper's coupon" contradicted
@@ -573,7 +581,9 @@ def specimen_report_table(stored_runs: pd.DataFrame | None, analyses: pd.DataFra
         of_specimen=name, given_specimen=specimen,
         choose_another="" if choose_another == CHOOSE_SPECIMEN_CLI
         else f"choose theirs with {choose_another.removesuffix(' for another')} to compare "
-             "them")
+             "them",
+        tested_files={name: measured_specimen_sha256(specimen)} if specimen is not None
+        else None, store_analyses=store_analyses)
     baseline = unsubtracted_baseline_note(specimen, analyses)
     if baseline:
         notes.append(baseline)
@@ -831,6 +841,7 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         kept = {r.path for r in results}
         notes += [f"{display_path(f.name)}: identical contents to another file given; counted once"
                   for f in files if f not in kept]
+    listed = None  # the store's every record: which file a hashless one is of
     if main is not None and results:
         # Same entry as `pidcore analyze` for the same file and options (replaced, not
         # duplicated), with the load case fields
@@ -873,7 +884,7 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
 
     # a calibration's runs are saved in its --dem-store, beside the calibration itself
     built = specimen_report_table(dem_runs, analyses, specimen=specimen, where=dem_path,
-                                  tolerances=tolerances, pool=pool,
+                                  tolerances=tolerances, pool=pool, store_analyses=listed,
                                   design_runs=calibration_design_runs(dem_runs, dem_paths))
     table, dem_runs, aligner = built.table, built.dem_runs, built.aligner
     if calibrated is not None:

@@ -17,6 +17,7 @@ case's E = m_c a^2 / (2 w^2) (Eq. 10), as our DEM SDC is defined, minus our DEM 
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import NamedTuple
@@ -48,7 +49,12 @@ from ..compare.specimens import (
 )
 from ..constants import BAND_VERDICTS
 from ..errors import ParameterError, instance_of
-from ..specimen import MEASURED_SHA256_FIELD, deciding_sha256, hashed_name, is_paper_coupon
+from ..specimen import (
+    MEASURED_SHA256_FIELD,
+    hashed_name,
+    is_paper_coupon,
+    match_hashless_records,
+)
 from ..units import g_to_si
 
 #: Measured energy per cycle over the DEM case's E = m_c a^2 / (2 w^2) (Eq. 10): the like-for-like
@@ -214,7 +220,9 @@ def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | N
                        paper: pd.DataFrame | None, *, model: object | None = None,
                        tolerances: Tolerances | None = None,
                        pool: bool = False, store_runs: pd.DataFrame | None = None,
-                       of_specimen: str = "", choose_another: str = "") -> pd.DataFrame:
+                       of_specimen: str = "", choose_another: str = "",
+                       tested_files: Mapping[str, str] | None = None,
+                       store_analyses: pd.DataFrame | None = None) -> pd.DataFrame:
     """Table 3-style comparison of our DEM, our measurements and the paper.
 
     Parameters
@@ -246,6 +254,14 @@ def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | N
         none (default: "ours").
     choose_another : str
         How those notes say the other specimens' runs are compared (default: the CLI's words).
+    tested_files : Mapping[str, str], optional
+        Specimen name -> sha256 of the specimen file the report is of: a record of that name
+        saved without its file's hash joins the tests of its name's one file only where that
+        file is this one (:func:`pidcore.specimen.match_hashless_records`).
+    store_analyses : pandas.DataFrame, optional
+        Every analysis of the store ``analyses`` are some of (a report of chosen files):
+        their specimens and hashes decide that rule too, so that the choice does not change
+        which file a hashless record is of. Default: ``analyses``.
 
     Returns
     -------
@@ -271,7 +287,9 @@ def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | N
         instance_of(name, table, (pd.DataFrame, type(None)), hint=f"e.g. {listing}")
     return report_table_and_aligner(dem_runs, analyses, paper, model=model,
                                     tolerances=tolerances, pool=pool, store_runs=store_runs,
-                                    of_specimen=of_specimen, choose_another=choose_another)[0]
+                                    of_specimen=of_specimen, choose_another=choose_another,
+                                    tested_files=tested_files,
+                                    store_analyses=store_analyses)[0]
 
 
 def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | None,
@@ -280,6 +298,8 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
                               pool: bool = False, store_runs: pd.DataFrame | None = None,
                               of_specimen: str = "", choose_another: str = "",
                               given_specimen: object | None = None,
+                              tested_files: Mapping[str, str] | None = None,
+                              store_analyses: pd.DataFrame | None = None,
                               ) -> tuple[pd.DataFrame, Aligner]:
     """:func:`build_report_table` and the aligner of its DEM rows (the runs it counted, its
     pchip models), for figures that must show what the table compared. ``given_specimen``:
@@ -303,14 +323,22 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
     aligners: dict[tuple[str, str, str, str], tuple[Aligner, str, bool, str]] = {}
     # each one's DEM runs
     aligner_runs: dict[tuple[str, str, str, str], pd.DataFrame | None] = {}
-    for case, rec in measured_rows:
-        # a store's listing holds NaN where a record names no specimen and another does
-        # (str(NaN) is "nan", a specimen of its own meeting no DEM run)
+    # its file's hash where it decides ("" for the paper's coupon, one coupon of either
+    # material: by name); a record saved before the hash was joins its name's one file, or
+    # stays apart (by name) where the name means two: calibrate and Compare decide alike
+    # (a store's listing holds NaN where a record names no specimen and another does)
+    matched = match_hashless_records(
+        ["" if pool else rec.get("specimen", "") for _, rec in measured_rows],
+        [rec.get(MEASURED_SHA256_FIELD, "") for _, rec in measured_rows],
+        given=tested_files, others=[] if pool or store_analyses is None
+        or "specimen" not in store_analyses.columns else list(zip(
+            store_analyses["specimen"], store_analyses.get(
+                MEASURED_SHA256_FIELD, pd.Series([""] * len(store_analyses),
+                                                 index=store_analyses.index)), strict=True)))
+    for (case, rec), sha256, name_note in zip(measured_rows, matched.sha256, matched.notes,
+                                              strict=True):
         named = rec.get("specimen", "")
         specimen = "" if pool or not isinstance(named, str) else named
-        # its file's hash where it decides ("" for a record saved before it was, or without
-        # a file, and for the paper's coupon, one coupon of either material: by name)
-        sha256 = deciding_sha256(rec.get(MEASURED_SHA256_FIELD, "")) if specimen else ""
         met_note, refused, met_calibrated = "", False, ""
         if pool or dem_runs is None or dem_runs.empty:
             own, own_runs = aligner, dem_runs
@@ -397,6 +425,8 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
             group.append(row)
         row.specimen, row.specimen_sha256 = specimen, sha256
         row.measured.append(entry)
+        if name_note and name_note not in row.notes:
+            row.notes.append(name_note)
         if aligned.status == "grid" and aligned.grid_case is not None:
             counted = same_count_note(case, aligned.grid_case, tolerances)
             if counted and counted not in row.notes:

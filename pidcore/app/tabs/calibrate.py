@@ -178,6 +178,18 @@ def _form(stores, api, points: list, left_out: list[str]) -> str:
     chosen_label = specimen_label(specimen)
     cases_key = "calibration_cases"
     if specimen is not None:
+        # read again for this file: a record saved without its file's hash joins its name's
+        # tests only where they and this file are one file (as calibrate --specimen reads)
+        again: list[str] = []
+        try:
+            points = api.measured_from_store(stores.path, left_out=again, specimen=specimen)
+        except PidcoreError as exc:
+            st.info(f"Nothing to calibrate against: {exc}")
+            return chosen_label
+        for said in again:
+            if said not in left_out:
+                st.caption(f"Note: {said}")
+        left_out = again
         points, note = points_for_specimen(points, specimen)
         if note:
             st.caption(note)
@@ -223,7 +235,8 @@ def _form(stores, api, points: list, left_out: list[str]) -> str:
                                   labels, default=labels, key=cases_key, bind=ADDRESS_BINDING)
     points = [p for p, label in zip(points, labels, strict=True) if label in chosen_cases]
     st.dataframe(pd.DataFrame([dataclasses.asdict(p) for p in points]).drop(
-        columns=["source", "row"], errors="ignore").rename(columns={
+        # a point kept apart as ambiguous is never offered for a file (points_for_specimen)
+        columns=["source", "row", "specimen_ambiguous"], errors="ignore").rename(columns={
         "frequency_hz": "frequency [Hz]", "acceleration_g": "acceleration [g]",
         "fill_percent": "fill [%]", "sdc": "SDC measured, Eq. 11 [-]",
         "sdc_stderr": "SDC stderr [-]",

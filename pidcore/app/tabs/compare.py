@@ -24,6 +24,7 @@ def _entries(stores, session_files):
 
     stamp = stores.stamp()
     saved = state.store_listing("analyses", stamp, stores)
+    listing = saved  # every saved record decides which file a hashless one is of
     if not saved.empty:
         f1, f2, f3 = st.columns(3)
         specimens = f1.multiselect("specimen", sorted(set(saved["specimen"])),
@@ -53,7 +54,8 @@ def _entries(stores, session_files):
     entries, notes = unique_entries(entries)
     for note in notes:
         st.caption(note)
-    return entries
+    # a record saved without its file's hash is grouped as calibrate and report group it
+    return workbench.matched_specimens(entries, listing)
 
 
 def _group_key(members) -> str:
