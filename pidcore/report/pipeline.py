@@ -849,7 +849,10 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
                               [r.settings.options if r.settings is not None else options
                                for r in results],
                               [(r.path.name, r.load_case, r.stated.origin) for r in results],
-                              fields=[r.fields() or None for r in results])
+                              # with the bound each was judged with, as analyze saves it
+                              fields=[{**r.fields(), **stated_sdc_bounds(
+                                  [r.stated], [r.settings], specimen)[0].as_record()} or None
+                                  for r in results])
         keys = saved.keys
         notes += saved.notes
         listed = main.list_analyses()
