@@ -431,13 +431,17 @@ def store_analysis(store: Store, result: AnalyzedRecord, parameters: Mapping, *,
     the same file analysed with the same options replaces its entry. ``fields`` adds record
     fields (the load case, :meth:`pidcore.compare.LoadCase.as_record`). Returns the key.
     """
+    from .compare.plausibility import RECORDED_BOUND_UNITS
+
     measurement_key, _ = store.add_measurement(result.measurement)
     record = {**analysis_record(result), **(fields or {})}
     arrays = analysis_arrays(result.analysis)
+    # the SDC bound a record was judged with (fields, SdcBound.as_record) keeps its units
+    units = {**ANALYSIS_UNITS, **RECORDED_BOUND_UNITS}
     return store.add_analysis(
         measurement_key, record, arrays=arrays,
         parameters={**parameters, "channels": result.channels_used},
-        units={k: v for k, v in ANALYSIS_UNITS.items() if k in record or k in arrays})
+        units={k: v for k, v in units.items() if k in record or k in arrays})
 
 
 #: How a saved analysis without a load case is named in notes.
@@ -497,7 +501,8 @@ def save_analyses(store: Store | str | os.PathLike, results: Sequence[AnalyzedRe
     ``stated``: per result, (file name, its :class:`~pidcore.loadcase.LoadCase` or None, who
     stated it); the load case goes into the record (:meth:`~pidcore.loadcase.LoadCase.as_record`);
     default: each file's name and no load case.
-    ``fields``: per result, further record fields or None (the ``specimen`` a sidecar names).
+    ``fields``: per result, further record fields or None (the ``specimen`` a sidecar names,
+    the SDC bound it was judged with: :meth:`pidcore.compare.plausibility.SdcBound.as_record`).
     A saved record of the same bytes under another name or load case is replaced, and the
     notes say so (:func:`replacement_notes`).
     """

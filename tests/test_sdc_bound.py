@@ -15,9 +15,17 @@ from _shaker_files import write_force_velocity
 
 from pidcore.cli import main
 from pidcore.compare.plausibility import (
+    RECORDED_BOUND_FIELD,
+    RECORDED_BOUND_ORIGIN,
+    RECORDED_BOUND_UNITS,
+    RECORDED_PARTICLE_MASS_FIELD,
+    RECORDED_STRUCTURE_MASS_FIELD,
     SDC_UPPER_BOUND,
     particle_impact_sdc,
+    recorded_sdc_bound,
     sdc_bound,
+    stored_findings,
+    stored_sdc_bound,
 )
 from pidcore.compare.plausibility import tested_sdc_bound as bound_of_tested
 from pidcore.constants import STANDARD_GRAVITY
@@ -147,24 +155,144 @@ def test_analyze_keeps_a_heavy_particle_sdc_above_2_pi_and_calibrate_keeps_it(
     assert point.sdc == pytest.approx(8.4, rel=1e-2) and left_out == []
     assert point.sdc_bound.sdc == pytest.approx(sdc_bound(fill_percent=60.0,
                                                           specimen=heavy_specimen()).sdc)
-    # read without the specimen file (its masses unknown) it is judged at 2 pi: left out
+    # read without the specimen file (the store keeps its name and hash, not its masses) it
+    # is judged against the bound analyze saved with it: kept, as analyze kept it (it was
+    # judged at 2 pi and left out as "all implausible")
     left_out = []
-    with pytest.raises(Exception, match="all implausible"):
-        measured_from_store(store, left_out=left_out)
-    assert "above the physical bound 6.28" in left_out[0]
-    # the app's Compare page judges the saved record as analyze did where it knows the file
+    (alone,) = measured_from_store(store, left_out=left_out)
+    assert alone.sdc == point.sdc and left_out == []
+    # the same bound as the file's (equal by construction), said to come from the record
+    assert alone.sdc_bound == point.sdc_bound and alone.sdc_bound.origin == RECORDED_BOUND_ORIGIN
+    # the app's Compare page judges the saved record as analyze did, file known or not
     from pidcore.app.workbench import saved_entries
     from pidcore.store.listing import saved_analyses
 
     (entry,) = saved_entries(store, saved_analyses(store), [heavy_specimen()])
     assert entry.implausible == ""
     (unknown,) = saved_entries(store, saved_analyses(store))
-    assert "above the physical bound 6.28" in unknown.implausible
-    # and so does report --store --specimen: no note of an implausible record
+    assert unknown.implausible == ""
+    # and so does report --store, with --specimen or without: no note of an implausible record
+    for given in (["--specimen", str(heavy_file)], []):
+        capsys.readouterr()
+        assert main(["report", "--store", str(store), *given, "--out",
+                     str(tmp_path / f"r{len(given)}"), "--format", "csv"]) == 0
+        said = capsys.readouterr()
+        assert "implausible" not in said.out + said.err
+
+
+def _saved_heavy_record(tmp_path, heavy_file) -> tuple[Path, str]:
+    """A store holding the 8.4 SDC record of the heavy panel saved by analyze --specimen, and
+    its analysis key."""
+    from pidcore.store import Store
+
+    path = _export(tmp_path / "rec.csv", 210.0)
+    store = tmp_path / "s.h5"
+    assert main(["analyze", str(path), "--specimen", str(heavy_file), "--fill", "60",
+                 "--store", str(store)]) == 0
+    (key,) = Store(store).list_analyses()["key"]
+    return store, key
+
+
+def _edit_record(store: Path, key: str, **values: float | None) -> None:
+    """Set (None: delete) record fields of a stored analysis in place, as an older pidcore
+    (no bound stored) or a hand-edited store (a bound below 2 pi) left them."""
+    import h5py
+
+    with h5py.File(store, "r+") as h5:
+        group = h5["analyses"][key]
+        for name, value in values.items():
+            if value is None:
+                del group["record"].attrs[name]
+                del group["units"].attrs[name]
+            else:
+                group["record"].attrs[name] = value
+
+
+def test_the_store_keeps_the_bound_analyze_judged_with_its_basis_and_units(tmp_path,
+                                                                            heavy_file):
+    from pidcore.store import Store
+
+    store, key = _saved_heavy_record(tmp_path, heavy_file)
+    entry = Store(store).get_analysis(key)
+    expected = sdc_bound(fill_percent=60.0, specimen=heavy_specimen())
+    particles, structure = _heavy_masses()
+    # the round trip is exact (HDF5 keeps float64 as written)
+    assert entry.record[RECORDED_BOUND_FIELD] == expected.sdc
+    assert entry.record[RECORDED_PARTICLE_MASS_FIELD] == expected.particle_mass_kg
+    assert entry.record[RECORDED_STRUCTURE_MASS_FIELD] == expected.structure_mass_kg
+    # the masses are the specimen's own (263 g of spheres, 55 g of coupon and fixture)
+    assert expected.particle_mass_kg == pytest.approx(particles, rel=1e-12)
+    assert expected.structure_mass_kg == pytest.approx(structure, rel=1e-12)
+    assert {name: entry.units[name] for name in RECORDED_BOUND_UNITS} == {
+        RECORDED_BOUND_FIELD: "1", RECORDED_PARTICLE_MASS_FIELD: "kg",
+        RECORDED_STRUCTURE_MASS_FIELD: "kg"}
+    # with the file at hand (its hash the record's) the file's bound is used; it equals the
+    # stored one by construction
+    row = Store(store).list_analyses().iloc[0]
+    from_file = stored_sdc_bound(row, given=heavy_specimen())
+    from_record, note = recorded_sdc_bound(row)
+    assert from_file == from_record == expected and note == ""
+    assert from_file.origin == "" and from_record.origin == RECORDED_BOUND_ORIGIN
+    assert stored_sdc_bound(row).origin == RECORDED_BOUND_ORIGIN
+    # a record of the paper's coupon (no specimen named) keeps its bound too, though never
+    # read back: the coupon is always at hand (specimen_at_hand)
+    plain = _export(tmp_path / "plain.csv", 2.5)  # SDC 0.1
+    assert main(["analyze", str(plain), "--fill", "50", "--store", str(tmp_path / "p.h5")]) == 0
+    entry = Store(tmp_path / "p.h5").get_analysis(Store(tmp_path / "p.h5").list_analyses()[
+        "key"].iloc[0])
+    assert entry.record[RECORDED_BOUND_FIELD] == sdc_bound(fill_percent=50.0).sdc
+
+
+def test_a_record_saved_before_the_bound_was_stored_is_judged_at_2_pi_as_before(
+        tmp_path, capsys, heavy_file):
+    from pidcore.calibrate.data import measured_from_store
+
+    store, key = _saved_heavy_record(tmp_path, heavy_file)
+    _edit_record(store, key, **dict.fromkeys(RECORDED_BOUND_UNITS))
+    left_out: list[str] = []
+    with pytest.raises(Exception, match="all implausible"):
+        measured_from_store(store, left_out=left_out)
+    assert "above the physical bound 6.28 (loss factor" in left_out[0]
+    # with its file it is kept as before
+    (point,) = measured_from_store(store, specimen=heavy_specimen())
+    assert point.sdc == pytest.approx(8.4, rel=1e-2)  # 210 / 25 within the 60 dB noise
     capsys.readouterr()
-    assert main(["report", "--store", str(store), "--specimen", str(heavy_file), "--out",
-                 str(tmp_path / "r"), "--format", "csv"]) == 0
-    assert "implausible" not in capsys.readouterr().out
+    assert main(["report", "--store", str(store), "--out", str(tmp_path / "r"),
+                 "--format", "csv"]) == 0
+    assert "implausible, saved as accepted" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("stored, problem", [
+    (3.0, "is below 2 pi (6.283), the least bound of any specimen"),
+    (20.0, "is not max(2 pi, 8 m_p/m_s) of its stored masses"),
+])
+def test_a_stored_bound_that_is_not_one_is_ignored_with_a_note(tmp_path, heavy_file, stored,
+                                                              problem):
+    from pidcore.store import Store
+
+    store, key = _saved_heavy_record(tmp_path, heavy_file)
+    _edit_record(store, key, **{RECORDED_BOUND_FIELD: stored})
+    row = Store(store).list_analyses().iloc[0]
+    assert recorded_sdc_bound(row)[0] is None
+    warnings, notes = stored_findings(row)
+    # judged without it: at 2 pi, never below it (a bound of 3 would flag an SDC of 4)
+    assert "above the physical bound 6.28 (loss factor" in warnings[0].message
+    assert notes[0] == (f"the SDC bound stored with the record ({RECORDED_BOUND_FIELD} "
+                        f"{stored:.4g}) {problem}" + notes[0].split(problem)[1])
+    assert notes[0].endswith(": ignored, judged as without it")
+    # the file at hand decides alone: no note of the stored value
+    assert stored_findings(row, given=heavy_specimen()) == ((), ())
+
+
+def test_a_flagged_record_says_its_bound_came_from_the_record(tmp_path, heavy_file):
+    from pidcore.store import Store
+
+    store, key = _saved_heavy_record(tmp_path, heavy_file)
+    _edit_record(store, key, sdc=50.0)  # above the panel's 38.3
+    (warning,), _ = stored_findings(Store(store).list_analyses().iloc[0])
+    assert warning.message.startswith("SDC 50 is above the physical bound 38.3 (particles of "
+                                      "263 g on a 55 g structure")
+    assert warning.message.endswith(f"; {RECORDED_BOUND_ORIGIN})")
 
 
 def test_analyze_refuses_an_sdc_above_the_particles_bound_naming_it(tmp_path, capsys,
@@ -228,3 +356,36 @@ def test_the_bundled_paper_calibration_keeps_its_bands():
             fill_percent=p.load_case.fill_percent, material=p.load_case.material).sdc,
             rel=1e-12)
         assert hit.band() == (p.low95, p.high95) and hit.band_note() == ""
+
+
+def test_the_apps_save_keeps_the_bound_and_calibrate_without_the_file_keeps_the_record(
+        tmp_path):
+    # the app's Analyse page judges a known specimen's upload against its particles' bound
+    # and saves it; read later without that file (calibrate --store, report --store) it was
+    # judged at 2 pi and left out
+    from pidcore.app import uploads
+    from pidcore.calibrate.data import measured_from_store
+    from pidcore.compare.case import load_case_of
+    from pidcore.compare.plausibility import implausible_findings, tested_sdc_bound
+    from pidcore.measure import AnalysisOptions
+    from pidcore.specimen import measured_specimen_name, measured_specimen_sha256
+    from pidcore.store import Store
+
+    heavy = heavy_specimen()
+    data = _export(tmp_path / "rec.csv", 210.0).read_bytes()
+    options = AnalysisOptions()
+    record = uploads.analyze_upload("rec.csv", data, options).record
+    case = load_case_of(record, fill_percent=60, material="steel")
+    name, sha256 = measured_specimen_name(heavy), measured_specimen_sha256(heavy)
+    bound = tested_sdc_bound(fill_percent=60.0, material="steel", specimen_name=name,
+                             specimen_sha256=sha256, given=heavy)
+    assert implausible_findings(record.analysis, bound=bound) == ((), ())  # as the page shows
+    store = tmp_path / "app.h5"
+    uploads.save_records(store, [uploads.AnalysedFile(record, case, options, name,
+                                                      specimen_sha256=sha256, sdc_bound=bound)])
+    entry = Store(store).get_analysis(Store(store).list_analyses()["key"].iloc[0])
+    assert entry.record[RECORDED_BOUND_FIELD] == bound.sdc  # exact round trip
+    assert entry.units[RECORDED_BOUND_FIELD] == "1"
+    left_out: list[str] = []
+    (point,) = measured_from_store(store, left_out=left_out)
+    assert left_out == [] and point.sdc == pytest.approx(8.4, rel=1e-2)  # 60 dB noise

@@ -348,3 +348,24 @@ def test_a_tests_specimen_is_labelled_by_one_rule():
     assert tested_label("", sha) == ""  # no specimen named
     point = MeasuredPoint(500.0, 1.0, 50.0, 0.5, specimen="panel", specimen_sha256=sha)
     assert point.label() == "500 Hz, 1 g, 50 %, acrylic, specimen panel [ab94ff]"
+
+
+def test_dem_only_rows_of_a_specimens_report_carry_its_files_hash(two_panels):
+    """Was: a DEM-only row of `report --specimen panel.toml` named the specimen "panel" and
+    left "specimen sha256" empty, though the footer named the file's hash and the rows of its
+    tests carried it."""
+    from pidcore.report.pipeline import specimen_report_table
+
+    runs = Store(two_panels.runs).list_dem_runs()
+    for own in (two_panels.first, two_panels.second):
+        table = specimen_report_table(runs, None, specimen=own).table
+        (row,) = [r for _, r in table.iterrows() if r["DEM runs [-]"] > 0]
+        assert (row["specimen"], row[SHA]) == ("panel", own.hash)
+    # the paper's coupon stays matched by name: its rows' cell is empty, as its tests' are
+    paper = paper_specimen()
+    Store(two_panels.where / "paper.h5").add_dem_run("coupon", {
+        "frequency_hz": 100.0, "acceleration_g": 5.0, "fill_percent": 50.0,
+        "material": "acrylic", "direction": "z", "sdc": 0.2, "sdc_stderr": 0.01})
+    table = specimen_report_table(Store(two_panels.where / "paper.h5").list_dem_runs(), None,
+                                  specimen=paper).table
+    assert table["specimen"].tolist() == ["paper_coupon"] and table[SHA].tolist() == [""]

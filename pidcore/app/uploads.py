@@ -1009,5 +1009,8 @@ def save_records(path: str | os.PathLike, files: Sequence[AnalysedFile], *,
                  **({MEASURED_SHA256_FIELD: f.specimen_sha256}
                     if f.specimen and f.specimen_sha256 else {}),
                  **({"plausibility_warnings": "; ".join(str(w) for w in f.warnings)}
-                    if f.warnings else {})} for f in files])
+                    if f.warnings else {}),
+                 # as `pidcore analyze` keeps it: judged alike where the file is not at hand
+                 **(f.sdc_bound.as_record() if f.sdc_bound is not None else {})}
+                for f in files])
     return SavedRecords(saved.keys, tuple(saved.notes), saved.breakdown())

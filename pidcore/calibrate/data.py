@@ -15,10 +15,10 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pandas as pd
@@ -200,18 +200,29 @@ def read_measured_table(path: str | os.PathLike, *,
 
 
 def _point_sdc_bound(fill_percent: float, material: str, specimen_name: str,
-                     specimen_sha256: str, given: Specimen | None) -> SdcBound:
+                     specimen_sha256: str, given: Specimen | None,
+                     record: Mapping[str, Any] | None = None) -> SdcBound:
     """The SDC bound of a measured point (:func:`pidcore.compare.plausibility.sdc_bound`):
     one naming no specimen is a test of ``given`` where its particles are ``given``'s (as
     :func:`points_for_specimen` takes it), else of the paper's coupon; one naming a specimen
-    is judged as :func:`~pidcore.compare.plausibility.tested_sdc_bound` does."""
-    from ..compare.plausibility import sdc_bound, tested_sdc_bound
+    is judged as :func:`~pidcore.compare.plausibility.tested_sdc_bound` does, and, where its
+    file is not at hand, against the bound saved with its stored ``record``
+    (:func:`~pidcore.compare.plausibility.recorded_sdc_bound`) where it has one."""
+    from ..compare.plausibility import (
+        recorded_sdc_bound,
+        sdc_bound,
+        specimen_at_hand,
+        tested_sdc_bound,
+    )
 
     if given is not None and not specimen_name and material == given.particles.material:
         return sdc_bound(fill_percent=fill_percent, material=material, specimen=given)
-    return tested_sdc_bound(fill_percent=fill_percent, material=material,
-                            specimen_name=specimen_name, specimen_sha256=specimen_sha256,
-                            given=given)
+    bound = tested_sdc_bound(fill_percent=fill_percent, material=material,
+                             specimen_name=specimen_name, specimen_sha256=specimen_sha256,
+                             given=given)
+    if record is None or specimen_at_hand(specimen_name, specimen_sha256, given):
+        return bound
+    return recorded_sdc_bound(record)[0] or bound
 
 
 def measured_from_store(store_path: str | os.PathLike, *,
@@ -260,7 +271,7 @@ def measured_from_store(store_path: str | os.PathLike, *,
     bounds = [_point_sdc_bound(
         float(row["fill_percent"]), _text_cell(row.get("material"), DEFAULT_MATERIAL),
         _text_cell(row.get("specimen"), ""), _text_cell(row.get(MEASURED_SHA256_FIELD), ""),
-        specimen) for _, row in frame.iterrows()]
+        specimen, row) for _, row in frame.iterrows()]
     frame = frame.assign(sdc_bound=bounds)
     implausible = [stored_findings(row, bound=bound)[0]
                    for (_, row), bound in zip(frame.iterrows(), bounds, strict=True)]

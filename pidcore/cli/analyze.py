@@ -94,14 +94,14 @@ def run(args: argparse.Namespace) -> int:
         refuse_store_among_inputs(store, args.paths)
         store.check_writable()  # before the analyses, in one line naming the store
     results: list = []
+    bounds = stated_sdc_bounds(stated, settings, specimen)
     try:
         # Analyse everything before writing anything: one bad file leaves the store untouched.
         results = refuse_implausible(
             analyze_each(args.paths, settings, key=args.key, progress=progress_wanted(args),
                          keep_unused_channels=store is not None),
             [display_path(Path(path).name) for path in args.paths],
-            accept=args.accept_implausible,
-            bounds=stated_sdc_bounds(stated, settings, specimen))
+            accept=args.accept_implausible, bounds=bounds)
         cases = [st.load_case(r.analysis.frequency_hz, r.analysis.acceleration_g)
                  if st is not None else None for r, st in zip(results, stated, strict=True)]
         # one content is one measurement: two statements (load case, specimen, settings) about
@@ -119,7 +119,10 @@ def run(args: argparse.Namespace) -> int:
                 store, results, [fs.options for fs in settings],
                 [(Path(path).name, c, st.origin if st is not None else "")
                  for path, c, st in zip(args.paths, cases, stated, strict=True)],
-                fields=[fs.record_fields() or None for fs in settings])
+                # the bound each was judged with: a later reading without the specimen
+                # file judges it alike (the store keeps the file's name and hash only)
+                fields=[{**fs.record_fields(), **bound.as_record()} or None
+                        for fs, bound in zip(settings, bounds, strict=True)])
             replaced, breakdown = saved.notes, saved.breakdown()
         interrupt.raise_if_interrupted()  # an interrupt swallowed on the way still counts
         # inside: a Ctrl-C while the results are written out still says what was saved

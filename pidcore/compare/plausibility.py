@@ -40,8 +40,8 @@ most 0.4 x 4 m_p V^2 (tests/test_sdc_bound.py).
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
-from dataclasses import dataclass
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -82,6 +82,10 @@ class SdcBound:
     sdc: float = SDC_UPPER_BOUND
     particle_mass_kg: float = math.nan
     structure_mass_kg: float = math.nan
+    #: where it was read from: "" (a specimen file at hand, or 2 pi), or a stored record's
+    #: words for it (:func:`recorded_sdc_bound`); not part of the bound's value, so that the
+    #: bound stored with a record equals its file's
+    origin: str = field(default="", compare=False)
 
     @property
     def known(self) -> bool:
@@ -99,14 +103,43 @@ class SdcBound:
 
     def words(self, loss_factor: float) -> str:
         """``'the physical bound 38.3 (particles of ...)'`` for a result of ``loss_factor``."""
+        origin = f"; {self.origin}" if self.origin else ""
         if self.sdc > SDC_UPPER_BOUND:
-            return f"the physical bound {self.sdc:.3g} ({self.basis()})"
+            return f"the physical bound {self.sdc:.3g} ({self.basis()}{origin})"
         known = f"; {self.basis()}" if self.known else ""
-        return (f"the physical bound {self.sdc:.3g} (loss factor {loss_factor:.3g} > 1{known})")
+        return (f"the physical bound {self.sdc:.3g} (loss factor {loss_factor:.3g} > 1"
+                f"{known}{origin})")
+
+    def as_record(self) -> dict[str, float]:
+        """The record fields that keep this bound with a saved analysis
+        (:data:`RECORDED_BOUND_UNITS`), so that the record is judged alike where its specimen
+        file is not at hand (the store keeps the specimen's name and hash, not its masses);
+        none for the plain 2 pi (nothing to keep: that is the bound without them)."""
+        if not self.known:
+            return {}
+        return {RECORDED_BOUND_FIELD: float(self.sdc),
+                RECORDED_PARTICLE_MASS_FIELD: float(self.particle_mass_kg),
+                RECORDED_STRUCTURE_MASS_FIELD: float(self.structure_mass_kg)}
 
 
 #: The bound where the specimen or its fill is not known: 2 pi.
 UNKNOWN_SPECIMEN_BOUND = SdcBound()
+
+#: Record fields of a saved analysis that keep the bound it was judged with at its save
+#: (:meth:`SdcBound.as_record`), and their units.
+RECORDED_BOUND_FIELD = "plausibility_sdc_bound"
+RECORDED_PARTICLE_MASS_FIELD = "plausibility_particle_mass_kg"
+RECORDED_STRUCTURE_MASS_FIELD = "plausibility_structure_mass_kg"
+RECORDED_BOUND_UNITS = {RECORDED_BOUND_FIELD: "1", RECORDED_PARTICLE_MASS_FIELD: "kg",
+                        RECORDED_STRUCTURE_MASS_FIELD: "kg"}
+
+#: What a bound read from a record says of itself.
+RECORDED_BOUND_ORIGIN = ("the bound stored with the record when it was saved: its specimen file "
+                         "is not at hand")
+
+#: Relative difference within which a stored bound is its stored masses' (a float's round
+#: trip through HDF5 is exact; this only absorbs another pidcore's summation order).
+_RECORDED_BOUND_RTOL = 1e-9
 
 
 def sdc_bound(*, fill_percent: float | None, material: str | None = None,
@@ -145,16 +178,25 @@ def tested_sdc_bound(*, fill_percent: float | None, material: str | None,
     ``specimen``; "": none, the paper's coupon assumed): ``given`` (the ``--specimen`` file)
     where it names that file, the paper's coupon where it names the coupon, else 2 pi (a
     specimen whose file is not at hand)."""
-    from ..specimen import is_paper_coupon, measured_specimen_name, measured_specimen_sha256
+    from ..specimen import is_paper_coupon
 
     name = specimen_name.strip() if isinstance(specimen_name, str) else ""
     sha256 = specimen_sha256 if isinstance(specimen_sha256, str) else ""
-    if given is not None and name and name in (given.name, measured_specimen_name(given)) \
-            and (not sha256 or sha256 == measured_specimen_sha256(given)):
+    if _names_given(name, sha256, given):
         return sdc_bound(fill_percent=fill_percent, material=material, specimen=given)
     if is_paper_coupon(name, sha256):
         return sdc_bound(fill_percent=fill_percent, material=material)
     return UNKNOWN_SPECIMEN_BOUND
+
+
+def _names_given(name: str, sha256: str, given: Specimen | None) -> bool:
+    """Whether a measurement naming ``name`` (with its file's ``sha256``, "" where not
+    recorded) is a test of ``given``."""
+    from ..specimen import measured_specimen_name, measured_specimen_sha256
+
+    return (given is not None and bool(name) and name in (given.name,
+                                                          measured_specimen_name(given))
+            and (not sha256 or sha256 == measured_specimen_sha256(given)))
 
 
 @dataclass(frozen=True)
@@ -336,10 +378,62 @@ def stated_sdc_bounds(stated: Sequence[Any], settings: Sequence[Any],
             for st, fs in zip(stated, settings, strict=True)]
 
 
-def stored_sdc_bound(record: Any, *, given: Specimen | None = None) -> SdcBound:
-    """:func:`tested_sdc_bound` of a stored analysis (a row of
-    :meth:`pidcore.store.Store.list_analyses`): its fill, material and specimen; ``given``:
-    the ``--specimen`` file of the command reading it."""
+def specimen_at_hand(specimen_name: str = "", specimen_sha256: str = "",
+                     given: Specimen | None = None) -> bool:
+    """Whether the specimen a measurement names is at hand for :func:`tested_sdc_bound`:
+    ``given`` (the ``--specimen`` file) where it names that file (its hash, where recorded,
+    the file's), or the paper's coupon (no specimen named, or the coupon)."""
+    from ..specimen import is_paper_coupon
+
+    name = specimen_name.strip() if isinstance(specimen_name, str) else ""
+    sha256 = specimen_sha256 if isinstance(specimen_sha256, str) else ""
+    return _names_given(name, sha256, given) or is_paper_coupon(name, sha256)
+
+
+def _recorded_number(record: Mapping[str, Any], name: str) -> float:
+    try:
+        value = record.get(name)
+        return math.nan if value is None or isinstance(value, bool) else float(value)
+    except (TypeError, ValueError):
+        return math.nan
+
+
+def recorded_sdc_bound(record: Mapping[str, Any]) -> tuple[SdcBound | None, str]:
+    """``(bound, note)``: the SDC bound stored with a saved analysis (a row of
+    :meth:`pidcore.store.Store.list_analyses`, :meth:`SdcBound.as_record`), marked as read
+    from the record; None where it stored none (saved by an older pidcore, or with no
+    specimen's masses known). A stored bound that is not one (below 2 pi, which no specimen
+    gives, not finite, or not ``max(2 pi, 8 m_p/m_s)`` of its stored masses) is not trusted:
+    None, and the note says it was ignored."""
+    if not any(name in record for name in RECORDED_BOUND_UNITS):
+        return None, ""
+    sdc = _recorded_number(record, RECORDED_BOUND_FIELD)
+    particles = _recorded_number(record, RECORDED_PARTICLE_MASS_FIELD)
+    structure = _recorded_number(record, RECORDED_STRUCTURE_MASS_FIELD)
+    if all(math.isnan(v) for v in (sdc, particles, structure)):
+        return None, ""  # a listing of other records' fields: this one stored none
+    problem = ""
+    if not math.isfinite(sdc):
+        problem = "is not a number"
+    elif sdc < SDC_UPPER_BOUND:
+        problem = f"is below 2 pi ({SDC_UPPER_BOUND:.4g}), the least bound of any specimen"
+    elif not (math.isfinite(particles) and math.isfinite(structure) and particles > 0
+              and structure > 0):
+        problem = "has no positive particle and structure masses beside it"
+    elif not math.isclose(sdc, max(SDC_UPPER_BOUND, particle_impact_sdc(particles, structure)),
+                          rel_tol=_RECORDED_BOUND_RTOL):
+        problem = (f"is not max(2 pi, 8 m_p/m_s) of its stored masses ({particles:.4g} kg, "
+                   f"{structure:.4g} kg)")
+    if problem:
+        return None, (f"the SDC bound stored with the record ({RECORDED_BOUND_FIELD} "
+                      f"{sdc:.4g}) {problem}: ignored, judged as without it")
+    return SdcBound(sdc, particles, structure, origin=RECORDED_BOUND_ORIGIN), ""
+
+
+def stored_sdc_bound_and_note(record: Any, *, given: Specimen | None = None
+                              ) -> tuple[SdcBound, str]:
+    """:func:`stored_sdc_bound` and the note of a stored bound ignored
+    (:func:`recorded_sdc_bound`; "" where none was)."""
     from ..specimen import MEASURED_SHA256_FIELD
 
     def text(name: str) -> str:
@@ -350,9 +444,23 @@ def stored_sdc_bound(record: Any, *, given: Specimen | None = None) -> SdcBound:
         fill = float(record.get("fill_percent", math.nan))
     except (TypeError, ValueError):
         fill = math.nan
-    return tested_sdc_bound(fill_percent=fill if math.isfinite(fill) else None,
-                            material=text("material") or None, specimen_name=text("specimen"),
-                            specimen_sha256=text(MEASURED_SHA256_FIELD), given=given)
+    name, sha256 = text("specimen"), text(MEASURED_SHA256_FIELD)
+    bound = tested_sdc_bound(fill_percent=fill if math.isfinite(fill) else None,
+                             material=text("material") or None, specimen_name=name,
+                             specimen_sha256=sha256, given=given)
+    if specimen_at_hand(name, sha256, given):
+        return bound, ""  # the file's own bound wins (equal to a stored one by construction)
+    recorded, note = recorded_sdc_bound(record)
+    return (recorded or bound), note
+
+
+def stored_sdc_bound(record: Any, *, given: Specimen | None = None) -> SdcBound:
+    """:func:`tested_sdc_bound` of a stored analysis (a row of
+    :meth:`pidcore.store.Store.list_analyses`): its fill, material and specimen; ``given``:
+    the ``--specimen`` file of the command reading it. Where its specimen file is not at hand
+    (:func:`specimen_at_hand`), the bound saved with the record (:func:`recorded_sdc_bound`:
+    ``pidcore analyze`` and the app keep it), else 2 pi."""
+    return stored_sdc_bound_and_note(record, given=given)[0]
 
 
 def stored_findings(record: Any, *, given: Specimen | None = None,
@@ -378,8 +486,11 @@ def stored_findings(record: Any, *, given: Specimen | None = None,
                          and bool(record.get("acceleration_channel", ""))})
     except (KeyError, TypeError, ValueError):  # a listing without the numbers: nothing to say
         return (), ()
-    return implausible_findings(analysis,
-                                bound=bound or stored_sdc_bound(record, given=given))
+    ignored = ""
+    if bound is None:
+        bound, ignored = stored_sdc_bound_and_note(record, given=given)
+    warnings, notes = implausible_findings(analysis, bound=bound)
+    return warnings, ((ignored,) if ignored else ()) + notes
 
 
 def stored_plausibility_notes(record: Any, *, given: Specimen | None = None

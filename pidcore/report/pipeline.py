@@ -34,7 +34,7 @@ from ..io import display_path
 from ..loadcase import refuse_identical_contents_stating_apart
 from .provenance import calibration_provenance, collect_provenance
 from .render import check_out_dir, parse_formats, write_report
-from .table import add_calibration_columns, report_table_and_aligner
+from .table import SPECIMEN_SHA256_COLUMN, add_calibration_columns, report_table_and_aligner
 
 if TYPE_CHECKING:  # pragma: no cover
     from ..file_settings import FileSettings
@@ -536,7 +536,9 @@ def specimen_report_table(stored_runs: pd.DataFrame | None, analyses: pd.DataFra
 
     The paper's Table 3 is compared only for the paper's coupon. With a ``specimen`` (and not
     ``pool``) the ``specimen`` column names it on every row of its particle material that
-    does not name its own (its DEM runs', and the files given as its tests); a measurement of
+    does not name its own (its DEM runs', and the files given as its tests), and the
+    ``specimen sha256`` column its file's hash where the row has none (the paper's coupon's
+    stays empty: matched by name, :func:`pidcore.specimen.deciding_sha256`); a measurement of
     another material names none (it is not this specimen's test). A measured row with no DEM
     run of its specimen at its material and direction says so (alignment ``no_dem_runs``) and
     names the runs of other specimens the store holds there. The default (the paper's coupon)
@@ -561,6 +563,7 @@ def specimen_report_table(stored_runs: pd.DataFrame | None, analyses: pd.DataFra
     paper = load_paper_table3()
     from ..specimen import (
         PAPER_SPECIMEN_NAME,
+        deciding_sha256,
         measured_specimen_name,
         measured_specimen_sha256,
         tabulated_by_paper,
@@ -600,6 +603,12 @@ def specimen_report_table(stored_runs: pd.DataFrame | None, analyses: pd.DataFra
         # uploads, a sidecar's) keeps that one
         mine = (table["specimen"] == "") & (table["material"] == specimen.particles.material)
         table.loc[mine, "specimen"] = name
+        # and its file's hash, as a row of its tests that recorded it shows it (the footer
+        # named the hash, the DEM-only rows' cell was empty): "" for the paper's coupon,
+        # matched by name (deciding_sha256)
+        unhashed = mine & (table[SPECIMEN_SHA256_COLUMN] == "")
+        table.loc[unhashed, SPECIMEN_SHA256_COLUMN] = deciding_sha256(
+            measured_specimen_sha256(specimen))
     table.attrs["notes"] = notes + list(table.attrs.get("notes", []))
     return SpecimenTable(table, dem_runs, paper, aligner)
 
@@ -849,7 +858,10 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
                               [r.settings.options if r.settings is not None else options
                                for r in results],
                               [(r.path.name, r.load_case, r.stated.origin) for r in results],
-                              fields=[r.fields() or None for r in results])
+                              # with the bound each was judged with, as analyze saves it
+                              fields=[{**r.fields(), **stated_sdc_bounds(
+                                  [r.stated], [r.settings], specimen)[0].as_record()} or None
+                                  for r in results])
         keys = saved.keys
         notes += saved.notes
         listed = main.list_analyses()
