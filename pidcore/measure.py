@@ -454,7 +454,8 @@ class SavedAnalyses:
     files share one), ``notes`` naming each saved record it replaced, and of the distinct keys
     those the store ``already_identical`` held before with the same content (every field but
     its creation time: the same file saved again with the same settings and load case) and
-    those it held with other content (``replaced``: another name, load case or specimen)."""
+    those it held with other content (``replaced``: another name, load case or specimen, or
+    a record an older pidcore saved without a field saved now)."""
 
     keys: list[str]
     notes: list[str]
@@ -478,9 +479,11 @@ class SavedAnalyses:
             parts.append(f"{len(self.already_identical)} already held with identical content")
         if self.replaced:
             # "of other content" beside the note "has the same contents" read as a
-            # contradiction: the file is the same, its name, load case or specimen is not
+            # contradiction: the file is the same, its name, load case, specimen or a field
+            # an older pidcore did not save (the SDC bound judged with) is not
             parts.append(f"{len(self.replaced)} replacing the held record of the same file "
-                         "under another name, load case or specimen")
+                         "under another name, load case or specimen, or one saved without "
+                         "a field saved now")
         return ", ".join(parts)
 
 
