@@ -362,6 +362,7 @@ def analyze_measurement(measurement: Measurement, options: AnalysisOptions | Non
                          acceleration=options.acceleration,
                          mass_cancellation=options.mass_below_gauge_kg > 0,
                          retyped={role for role, unit in units.items() if unit is not None})
+    notes.extend(roles.notes)
     chosen = {role: _with_unit(ch, role, units[role], measurement.source, notes, corrections)
               for role, ch in (("force", roles.force), ("velocity", roles.velocity),
                                ("acceleration", roles.acceleration)) if ch is not None}

@@ -565,3 +565,64 @@ def test_a_grid_value_outside_the_model_names_its_unit_and_a_likely_slip(tmp_pat
     with pytest.raises(ParameterError) as caught:
         _run(["model", "damper", "--out", str(tmp_path / "out"), *argv])
     assert str(caught.value) == message
+
+
+# the steel_6mm coupon by hand: 286 regular hexagons 6.35 mm across the flats, each
+# (sqrt(3)/2) d^2 = 34.9203 mm^2: 0.00998721 m^2
+STEEL_CELLS_AREA_M2 = 286 * (3**0.5 / 2) * 6.35e-3**2
+
+
+def test_damper_takes_a_specimens_area_from_its_cells_and_says_so(tmp_path, monkeypatch,
+                                                                   capsys):
+    # runs of a specimen stored with its text were refused without --area although its cell
+    # count and size give the area its cells treat
+    from pidcore.specimen import load_specimen
+
+    steel = load_specimen(Path(__file__).resolve().parents[1] / "data_samples" / "specimens"
+                          / "steel_6mm.toml")
+    runs = _specimen_runs("steel_6mm", steel.hash, coupon_kg=0.05, fixture_kg=0.12,
+                          sdc_scale=0.5).assign(
+        parameters_json=json.dumps({"specimen_text": steel.text}))
+    _fake_store(monkeypatch, lambda: runs)
+    argv = ["model", "damper", "--out", str(tmp_path), "--table", "store", "--store",
+            str(tmp_path / "s.h5"), "--format", "csv,json"]
+    capsys.readouterr()
+    _run(argv)
+    table = pd.read_csv(tmp_path / "equivalent_damper.csv")
+    # one product and one division each: to rounding
+    np.testing.assert_allclose(table["coupon_area [m^2]"], STEEL_CELLS_AREA_M2, rtol=1e-12)
+    np.testing.assert_allclose(table["c_eq_per_treated_area [N s/m^3]"],
+                               table["c_eq_per_coupon [N s/m]"] / STEEL_CELLS_AREA_M2,
+                               rtol=1e-12)
+    said = ("0.00998721 m^2 (specimen steel_6mm's 286 cells x 34.9203 mm^2 each: the area its "
+            "cells treat; the file states no coupon face)")
+    assert json.loads((tmp_path / "equivalent_damper.json").read_text())["provenance"][
+        "area"] == said
+    assert f"note: coupon area {said}" in capsys.readouterr().err
+    # --area overrides; one 2 x the cells' is noted, one within rounding of them is not
+    _run([*argv, "--area", "0.02"])
+    err = capsys.readouterr().err
+    assert "--area 0.02 m^2 is 2 x specimen steel_6mm's own 0.00998721 m^2" in err
+    assert "c_eq per area is taken over the area given" in err
+    assert pd.read_csv(tmp_path / "equivalent_damper.csv")["coupon_area [m^2]"].iloc[0] == 0.02
+    _run([*argv, "--area", "0.01"])
+    assert "x specimen" not in capsys.readouterr().err
+
+
+def test_the_library_default_area_of_another_specimen_is_its_cells(paper_model):
+    # the paper's 0.01 m^2 face was taken for any specimen without an area_m2
+    from pidcore.model import equivalent_damper_table
+    from pidcore.model.damper import area_override_note, specimen_area_m2
+    from pidcore.specimen import load_specimen, paper_specimen
+
+    steel = load_specimen(Path(__file__).resolve().parents[1] / "data_samples" / "specimens"
+                          / "steel_6mm.toml")
+    assert specimen_area_m2(steel)[0] == pytest.approx(STEEL_CELLS_AREA_M2, rel=1e-12)
+    table = equivalent_damper_table(paper_model, fills_percent=[50], accelerations_g=[5],
+                                    frequencies_hz=[100], vibrated_mass_kg=0.1, specimen=steel)
+    assert table["coupon_area [m^2]"].iloc[0] == pytest.approx(STEEL_CELLS_AREA_M2, rel=1e-12)
+    # the paper's coupon keeps its stated 0.1 m x 0.1 m face (its 441 cells cover 1/1.16 of it)
+    assert specimen_area_m2(paper_specimen())[0] == pytest.approx(0.01, rel=1e-15)
+    assert area_override_note(0.0104, paper_specimen()) == ""  # 4 %: within the tolerance
+    assert area_override_note(0.0106, paper_specimen()).startswith(
+        "area_m2 0.0106 m^2 is 1.06 x specimen paper_coupon's own 0.01 m^2")

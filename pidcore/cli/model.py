@@ -98,9 +98,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         "outside the paper coupon's m_c is refused as a unit slip)")
     d.add_argument("--area", metavar="M2", type=_positive_float, default=None,
                    help="coupon area for c_eq per area, m^2 (default: the paper's 0.1 m x "
-                        "0.1 m; required for runs of another specimen, whose file has no "
-                        "coupon area; more than 100 x off its cells' cross-section is refused "
-                        "as a unit slip)")
+                        "0.1 m; for runs of another specimen its cells' cross-section, cell "
+                        "count x hexagon area; a value more than 5 %% off the default is noted, "
+                        "more than 100 x off is refused as a unit slip)")
     d.add_argument("--panel-areal-mass", metavar="KG_M2", type=_positive_float, default=None,
                    help="mass per m^2 of your panel, with its particles, kg/m^2: adds "
                         "panel_loss_factor, the loss factor the particles add to it moving as "
@@ -174,10 +174,13 @@ def _cli_where(message: str, where: dict) -> str:
 
 def run_damper(args: argparse.Namespace) -> int:
     from ..model.damper import (
-        coupon_area_m2,
+        area_override_note,
+        check_area,
         equivalent_damper_table,
         paper_vibrated_mass,
+        runs_specimen,
         runs_vibrated_mass,
+        specimen_area_m2,
         write_damper_table,
     )
 
@@ -246,7 +249,6 @@ def run_damper(args: argparse.Namespace) -> int:
         material = args.material or defaults.MODEL_PARTICLE_MATERIAL
         mass = paper_vibrated_mass(convention, material)
         mass_text = f"{convention} ({material}, paper count per cell)"
-    from ..model.damper import check_area, runs_specimen
     from ..specimen import paper_specimen
 
     # runs of an older store name no specimen text: the paper's coupon, as the library takes it
@@ -255,14 +257,17 @@ def run_damper(args: argparse.Namespace) -> int:
     if args.area is not None:
         check_area(args.area, specimen, "--area")  # first, to name the option typed
         area, area_text = args.area, f"{args.area} m^2 (given)"
-    elif runs is not None and "specimen_is_paper" in runs.columns \
+        differs = area_override_note(args.area, specimen, "--area") if stated is not None else ""
+        area_text += f"; {differs}" if differs else ""
+    elif stated is None and runs is not None and "specimen_is_paper" in runs.columns \
             and not runs["specimen_is_paper"].fillna(True).astype(bool).all():
         name = runs["specimen_name"].iloc[0] if "specimen_name" in runs.columns else "?"
-        raise ParameterError(f"--area: the DEM runs are of specimen {name}, whose file "
-                             "states no coupon area; give the area c_eq per area is taken "
-                             "over, e.g. --area 0.01")
+        raise ParameterError(f"--area: the DEM runs are of specimen {name}, whose text is "
+                             "not stored with them (an older store): its cells' area is not "
+                             "known; give the area c_eq per area is taken over, e.g. "
+                             "--area 0.01")
     else:
-        area, area_text = None, f"{coupon_area_m2():g} m^2 (the paper's 0.1 m x 0.1 m coupon)"
+        area, area_text = specimen_area_m2(specimen)
     if args.panel_treated_fraction is not None and args.panel_areal_mass is None:
         raise ParameterError(f"--panel-treated-fraction {as_given(args.panel_treated_fraction)}:"
                              " the share of a panel given by --panel-areal-mass; give that too")
@@ -315,6 +320,7 @@ def run_damper(args: argparse.Namespace) -> int:
     paths = write_damper_table(table, args.out, formats=args.format, provenance=provenance)
     for path in paths:
         print(path)
+    print(f"pidcore model damper: note: coupon area {area_text}", file=sys.stderr)
     if undefined:
         print(f"pidcore model damper: note: {why} in {undefined} of {len(table)} row(s)",
               file=sys.stderr)

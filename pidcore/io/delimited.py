@@ -2,9 +2,11 @@
 
 Understood as spreadsheet tools, MATLAB and acquisition software write them:
 
-* header cells ``Time [s]``, ``Force (kN)``, ``Velocity [mm/s]``, or a bare name with the units
-  in a **unit row** under the names (``s;N;mm/s`` or ``[s];[N];[mm/s]``); a bare name without a
-  unit has quantity ``"unknown"`` (the analysis asks for its unit, never takes it as SI);
+* header cells ``Time [s]``, ``Force (kN)``, ``Velocity [mm/s]``, DIN-style ``Time/s``,
+  ``Force/N``, ``Velocity in m/s`` (only where the unit is one of the quantity the name says:
+  ``Velocity/Force`` stays a name), or a bare name with the units in a **unit row** under the
+  names (``s;N;mm/s`` or ``[s];[N];[mm/s]``); a bare name without a unit has quantity
+  ``"unknown"`` (the analysis asks for its unit, never takes it as SI);
 * **free-text lines** before the header (title, date, comments, ``#`` lines) are skipped: the
   header is the last text line before the numbers;
 * delimiters comma, semicolon, tab or runs of blanks; a **decimal comma** when the delimiter is
@@ -60,12 +62,52 @@ _SCAN_CHUNK_BYTES = 1 << 20
 
 
 def _split_header(cell: str) -> tuple[str, str]:
-    """``"Velocity [mm/s]"`` -> ``("Velocity", "mm/s")``; a bare name has unit ``""``."""
+    """``"Velocity [mm/s]"`` -> ``("Velocity", "mm/s")``, ``"Time/s"`` or ``"Time in s"`` ->
+    ``("Time", "s")`` (:func:`_quantity_and_unit`); a bare name has unit ``""``."""
     cell = cell.strip().strip('"').strip()
     match = _HEADER_CELL.match(cell)
     if match is None or not match.group("name"):
         return cell, ""
-    return match.group("name"), (match.group("unit") or "").strip()
+    if not match.group("unit"):
+        return _quantity_and_unit(match.group("name")) or (match.group("name"), "")
+    return match.group("name"), match.group("unit").strip()
+
+
+#: Where a DIN-style header (DIN 1313 ``Quantity/unit``, German ``Größe in Einheit``) may
+#: split into its quantity and unit.
+_QUANTITY_UNIT_SEPARATOR = re.compile(r"\s*/\s*|\s+in\s+", re.IGNORECASE)
+#: The header spellings of a unit read, as the refusals of a header not read list them.
+ACCEPTED_HEADER_SPELLINGS = ("'Time [s]', 'Time (s)', 'Time/s', 'Time in s' or 'Time' over "
+                             "a unit row 's'")
+
+
+def _named_quantity(name: str) -> str | None:
+    """The quantity a channel name says (time, force, velocity, acceleration), or None where
+    it says none or several."""
+    from .roles import name_suggests  # roles is the one place of the role words
+
+    if name.strip().lower() in _TIME_NAMES:
+        return "time"
+    said = [role for role in ("force", "velocity", "acceleration") if name_suggests(name, role)]
+    return said[0] if len(said) == 1 else None
+
+
+def _quantity_and_unit(cell: str) -> tuple[str, str] | None:
+    """Name and unit of a DIN-style header (``Time/s``, ``Velocity in m/s``, ``Force/kN``),
+    or None where the cell is not one.
+
+    Only where the unit is a known one of the quantity the name says: a ``/`` is also a ratio
+    (``Velocity/Force`` a mobility, ``F/V`` a sensitivity) and ``in`` a word of a name, so a
+    cell split any other way would read a name as a unit; such a cell stays a name without a
+    unit (the analysis asks for its unit, never takes it as SI)."""
+    for separator in _QUANTITY_UNIT_SEPARATOR.finditer(cell):
+        name, unit = cell[:separator.start()].strip(), cell[separator.end():].strip()
+        if not name or not unit:
+            continue
+        quantity = _named_quantity(name)
+        if quantity is not None and interpret_unit(unit)[0] == quantity:
+            return name, unit
+    return None
 
 
 def _name_and_unit(cell: str, row_unit: str) -> tuple[str, str]:
@@ -332,8 +374,10 @@ def read_csv(path: str | os.PathLike[str], *, sample_rate_hz: float | None = Non
                          f"(sample rate {rate:.6g} Hz); if it is not, write its unit in the "
                          "header ('Time [ms]') or give the sample rate (sample_rate_hz)")
     else:
-        raise InputFileError(f"{where}: no time column (e.g. 'Time [s]') and no sample rate; "
-                             "add a time column or give the sample rate (sample_rate_hz)")
+        raise InputFileError(f"{where}: no time column{_unread_time_header(header_cells)} "
+                             f"and no sample rate (a time column is headed "
+                             f"{ACCEPTED_HEADER_SPELLINGS}); add a time column or give the "
+                             "sample rate (sample_rate_hz)")
 
     pair_times = _pair_time_columns(cells, time_index, values)
     keep = [i for i in range(len(cells)) if i != time_index and i not in pair_times]
@@ -402,6 +446,19 @@ def _pair_time_columns(cells: list[tuple[str, str]], time_index: int | None,
             if given.size >= 2 and given[-1] > given[0]:
                 pairs.append(i)
     return pairs
+
+
+def _unread_time_header(header_cells: list[str]) -> str:
+    """`` (header cell 'Time/xyz' not read: 'xyz' is no unit of time)`` for the first header
+    cell named like a time whose unit was not read, else ``""``: "no time column" of a file
+    with one did not say which cell was meant nor why it was not taken."""
+    for cell in header_cells:
+        text = cell.strip().strip('"').strip()
+        parts = re.split(r"\s*[/\[(]\s*|\s+in\s+", text, maxsplit=1, flags=re.IGNORECASE)
+        if len(parts) == 2 and parts[0].lower() in _TIME_NAMES - {"x"}:
+            unit = parts[1].rstrip("])").strip()
+            return f" (header cell {text!r} not read: {unit!r} is no unit of time such as s, ms)"
+    return ""
 
 
 def _is_time_unit(unit: str) -> bool:

@@ -22,6 +22,10 @@ mass cancellation (``mass_cancellation=True``), where it must be the acceleratio
 point*: with several acceleration channels, or one named like a reference or shaker
 accelerometer (``"Ref"``, ``"Shaker"``, ``"Table"``, ...), it must be named. Channels no role
 uses are listed in :attr:`RoleAssignment.ignored`.
+
+A channel detected by its unit whose name says another role (``Velocity [N]``) is used as its
+unit says, and :attr:`RoleAssignment.notes` says so: the unit scales the numbers, the name is
+free text. Where the unit leaves a role its name says empty, the refusal names the column.
 """
 
 from __future__ import annotations
@@ -76,12 +80,16 @@ class RoleAssignment:
         Drive-point acceleration, m/s^2.
     ignored : tuple of str
         Names of the channels no role uses.
+    notes : tuple of str
+        What the output must say: a channel taken for a role by its unit while its name says
+        another role (``"Velocity [N]"`` used as the force).
     """
 
     force: Channel
     velocity: Channel | None
     acceleration: Channel | None
     ignored: tuple[str, ...] = ()
+    notes: tuple[str, ...] = ()
 
 
 def name_suggests(name: str, role: str) -> bool:
@@ -94,6 +102,43 @@ def name_suggests(name: str, role: str) -> bool:
     if any(t in _NAME_TOKENS[role] for t in tokens):
         return True
     return any(t.startswith(_NAME_PREFIXES[role]) for t in tokens if len(t) > 2)
+
+
+def _role_of_the_name(channel: Channel, role: str) -> str | None:
+    """The one other role ``channel``'s name says where its unit says ``role`` (``"Velocity"``
+    in N -> ``"velocity"``), else None."""
+    said = [r for r in _OPTIONS if name_suggests(channel.name, r)]
+    return said[0] if len(said) == 1 and said[0] != role else None
+
+
+def _unit_over_name_note(source: str, channel: Channel, role: str) -> str | None:
+    """The note that a channel detected by its unit is used against what its name says: a
+    column 'Velocity [N]' was used as the force without a word."""
+    named = _role_of_the_name(channel, role)
+    if named is None or channel.quantity != role:
+        return None
+    return (f"{source}: channel {channel.name!r} is named like {a_or_an(named)} but its unit "
+            f"{channel.source_unit or channel.unit!r} is {a_or_an(role)} unit: used as the "
+            f"{role}, as its unit says (the unit scales its numbers; a name is free text); if "
+            f"it is the {named}, name it with {_OPTIONS[named]}{channel.name!r} and give its "
+            f"unit with {named}_unit=UNIT")
+
+
+def _misnamed_hint(measurement: Measurement, roles: tuple[str, ...],
+                   taken: set[str]) -> str:
+    """`` ('Velocity' is named like a velocity but its unit 'N' is a force unit: ...)`` for an
+    unused channel whose name says one of ``roles`` but whose unit another quantity: "no
+    velocity channel" of a file with a column 'Velocity [N]' did not say why it was not one."""
+    for channel in measurement.channels:
+        if channel.name in taken or channel.quantity in ("unknown", *roles):
+            continue
+        named = [r for r in roles if _role_of_the_name(channel, channel.quantity) == r]
+        if named:
+            return (f" ({channel.name!r} is named like {a_or_an(named[0])} but its unit "
+                    f"{channel.source_unit or channel.unit!r} is {a_or_an(channel.quantity)} "
+                    f"unit: if it is the {named[0]}, name it with {_OPTIONS[named[0]]}"
+                    f"{channel.name!r} and give its unit with {named[0]}_unit=UNIT)")
+    return ""
 
 
 def _names(channels: list[Channel]) -> str:
@@ -222,14 +267,20 @@ def assign_roles(measurement: Measurement, *, force: str | None = None,
         if role == "force" and chosen["force"] is None:
             # Checked before the other roles: a missing force is the more basic problem.
             raise ChannelError(f"{measurement.source}: no force channel among "
-                               f"{_names(list(measurement.channels))}; name one with "
-                               "force=NAME")
+                               f"{_names(list(measurement.channels))}"
+                               f"{_misnamed_hint(measurement, ('force',), taken)}; name one "
+                               "with force=NAME")
     if chosen["velocity"] is None and chosen["acceleration"] is None:
         raise ChannelError(f"{measurement.source}: no velocity or acceleration channel among "
-                           f"{_names(list(measurement.channels))}; name one with velocity=NAME "
-                           "or acceleration=NAME")
+                           f"{_names(list(measurement.channels))}"
+                           f"{_misnamed_hint(measurement, ('velocity', 'acceleration'), taken)}"
+                           "; name one with velocity=NAME or acceleration=NAME")
     used = {c.name for c in chosen.values() if c is not None}
+    notes = [_unit_over_name_note(measurement.source, channel, role)
+             for role, channel in chosen.items()
+             if channel is not None and explicit[role] is None]
     return RoleAssignment(force=chosen["force"], velocity=chosen["velocity"],
                           acceleration=chosen["acceleration"],
                           ignored=tuple(c.name for c in measurement.channels
-                                        if c.name not in used))
+                                        if c.name not in used),
+                          notes=tuple(note for note in notes if note))

@@ -302,6 +302,42 @@ def runs_specimen(runs: pd.DataFrame):
     return Specimen.from_text(texts.pop(), source="stored DEM runs")
 
 
+#: How far a given coupon area may differ from its specimen's own (:func:`specimen_area_m2`)
+#: before the output notes it: a coupon cut a cell row larger or smaller differs by some 10 %,
+#: rounding the area to two digits by under 5 %.
+AREA_NOTE_TOLERANCE = 0.05
+
+
+def specimen_area_m2(specimen: Specimen) -> tuple[float, str]:
+    """The coupon area of ``specimen`` for c_eq per area, m^2, and where it comes from.
+
+    The paper coupon's cells (the coupon, a calibrated file of it, another particle fill):
+    its 0.1 m x 0.1 m face (:func:`coupon_area_m2`), as the paper states it. Another
+    specimen's file states no face area, but its cells give the area they treat: ``[cell]
+    count`` x one hexagon's (:meth:`pidcore.specimen.Specimen.cells_area_m2`); the paper's
+    0.01 m^2 face was taken for it, whatever its cells."""
+    from ..specimen import paper_specimen
+
+    if specimen.cell == paper_specimen().cell:
+        return coupon_area_m2(), f"{coupon_area_m2():g} m^2 (the paper's 0.1 m x 0.1 m coupon)"
+    area = specimen.cells_area_m2()
+    return area, (f"{area:.6g} m^2 (specimen {specimen.name}'s {specimen.cell.count} cells x "
+                  f"{area / specimen.cell.count * 1e6:.6g} mm^2 each: the area its cells "
+                  "treat; the file states no coupon face)")
+
+
+def area_override_note(area_m2: float, specimen: Specimen, what: str = "area_m2") -> str:
+    """A note where a given coupon area differs from :func:`specimen_area_m2` by more than
+    :data:`AREA_NOTE_TOLERANCE`, else ``""``: the area divides every c_eq per area, and a
+    value typed for another coupon is not otherwise visible in the table."""
+    own, origin = specimen_area_m2(specimen)
+    ratio = float(area_m2) / own
+    if abs(ratio - 1.0) <= AREA_NOTE_TOLERANCE:
+        return ""
+    return (f"{what} {float(area_m2):g} m^2 is {ratio:.3g} x specimen {specimen.name}'s own "
+            f"{origin}: c_eq per area is taken over the area given")
+
+
 def check_area(area_m2: float, specimen, what: str = "area_m2") -> None:
     """Refuse a coupon area more than :data:`AREA_TO_CELLS_LIMIT` times off the cross-section
     of ``specimen``'s cells as a unit slip (``what``: the option as messages name it)."""
@@ -496,7 +532,8 @@ def equivalent_damper_table(model: SdcModel, *, fills_percent: Sequence[float] |
         coupon's m_c is refused as a unit slip (grams typed for kg), as ``pidcore model
         damper --vibrated-mass`` refuses it.
     area_m2 : float, optional
-        Coupon area for the per-area damper; default :func:`coupon_area_m2`. An area more
+        Coupon area for the per-area damper; default :func:`specimen_area_m2` (the paper's
+        0.01 m^2, another specimen's cells' cross-section). An area more
         than :data:`AREA_TO_CELLS_LIMIT` times off ``specimen``'s cells is refused as a unit
         slip (cm^2 or mm^2 typed for m^2), as ``pidcore model damper --area`` refuses it.
     specimen : pidcore.specimen.Specimen, optional
@@ -550,7 +587,7 @@ def equivalent_damper_table(model: SdcModel, *, fills_percent: Sequence[float] |
 
         specimen = paper_specimen()
     if area_m2 is None:
-        area = coupon_area_m2()
+        area = specimen_area_m2(specimen)[0]
     else:
         # 100 (cm^2) for 0.01 m^2 gave a c_eq per area 1e4 x too small; only --area was checked
         area = float(_positive("area_m2", area_m2))
