@@ -14,37 +14,14 @@ from types import SimpleNamespace
 import numpy as np
 import pandas as pd
 import pytest
+from _panel_tests import panel_export, panel_specimen
 
 from pidcore.loadcase import LoadCase
-from pidcore.specimen import MEASURED_SHA256_FIELD, Specimen, paper_specimen
+from pidcore.specimen import MEASURED_SHA256_FIELD
 from pidcore.store import Store
 
 CASE = LoadCase(1000.0, 5.0, 25.0, "acrylic", "z")
 SHA_COLUMN = "specimen sha256"
-
-
-def _panel(fixture_mass_kg: float) -> Specimen:
-    """The paper's coupon renamed "panel" (not the paper's), with its own fixture mass: two
-    masses are two files of one name."""
-    text = paper_specimen().with_values({"coupon.fixture_mass_kg": fixture_mass_kg}).to_toml()
-    return Specimen.from_text(text.replace('name = "paper_coupon"', 'name = "panel"', 1))
-
-
-def _export(path: Path, damping_n_s_m: float) -> Path:
-    from pidcore.constants import STANDARD_GRAVITY
-    from pidcore.io import write_measurement
-    from pidcore.records import Channel, Measurement
-    from pidcore.signal import synthesize_shaker_record
-
-    rate = 51200.0
-    rec = synthesize_shaker_record(mass_kg=0.05,
-                                   acceleration_amplitude_m_s2=5 * STANDARD_GRAVITY,
-                                   frequency_hz=1000.0, sample_rate_hz=rate, n_periods=40,
-                                   viscous_damping_n_s_m=damping_n_s_m)
-    write_measurement(Measurement(path.stem, (
-        Channel("Force", "force", rec.force_n, rate, "N"),
-        Channel("LDV", "velocity", rec.velocity_m_s, rate, "m/s"))), path)
-    return path
 
 
 @pytest.fixture(scope="module")
@@ -54,10 +31,10 @@ def tests_analysed(tmp_path_factory):
     from pidcore.measure import analyze_file
 
     where = tmp_path_factory.mktemp("hashless")
-    results = [analyze_file(_export(where / f"t{i}_fill25.csv", damping))
+    results = [analyze_file(panel_export(where / f"t{i}_fill25.csv", damping))
                for i, damping in enumerate((4.0, 6.0, 9.0, 12.0))]
-    return SimpleNamespace(where=where, results=results, first=_panel(0.05),
-                           second=_panel(0.08))
+    return SimpleNamespace(where=where, results=results, first=panel_specimen(0.05),
+                           second=panel_specimen(0.08))
 
 
 def _store(path: Path, results, hashes: list[str | None]) -> Path:

@@ -13,6 +13,7 @@ from types import SimpleNamespace
 
 import pandas as pd
 import pytest
+from _panel_tests import panel_export, panel_specimen
 
 from pidcore.cli import main
 from pidcore.dem.persist import run_or_load
@@ -32,35 +33,12 @@ CASE = LoadCase(1000.0, 5.0, 25.0)
 SHA = "specimen sha256"
 
 
-def _panel(fixture_mass_kg: float) -> Specimen:
-    """The paper's coupon renamed "panel" (not the paper's), with its own fixture mass."""
-    text = paper_specimen().with_values({"coupon.fixture_mass_kg": fixture_mass_kg}).to_toml()
-    return Specimen.from_text(text.replace('name = "paper_coupon"', 'name = "panel"', 1))
-
-
-def _export(path: Path, damping_n_s_m: float) -> Path:
-    from pidcore.constants import STANDARD_GRAVITY
-    from pidcore.io import write_measurement
-    from pidcore.records import Channel, Measurement
-    from pidcore.signal import synthesize_shaker_record
-
-    rate = 51200.0
-    rec = synthesize_shaker_record(mass_kg=0.05,
-                                   acceleration_amplitude_m_s2=5 * STANDARD_GRAVITY,
-                                   frequency_hz=1000.0, sample_rate_hz=rate, n_periods=40,
-                                   viscous_damping_n_s_m=damping_n_s_m)
-    write_measurement(Measurement(path.stem, (
-        Channel("Force", "force", rec.force_n, rate, "N"),
-        Channel("LDV", "velocity", rec.velocity_m_s, rate, "m/s"))), path)
-    return path
-
-
 @pytest.fixture(scope="module")
 def two_panels(tmp_path_factory):
     """Two specimen files named "panel" with different contents (fixture mass), one DEM run
     of each at CASE, and one test analysed with each (`pidcore analyze --specimen`)."""
     where = tmp_path_factory.mktemp("two_panels")
-    first, second = _panel(0.05), _panel(0.08)
+    first, second = panel_specimen(0.05), panel_specimen(0.08)
     assert first.name == second.name == "panel" and first.hash != second.hash
     (where / "a").mkdir()
     (where / "b").mkdir()
@@ -74,7 +52,7 @@ def two_panels(tmp_path_factory):
     docs = []
     for export, specimen_file, damping in (("ta_fill25.csv", first_file, 5.0),
                                            ("tb_fill25.csv", second_file, 9.0)):
-        path = _export(where / export, damping)
+        path = panel_export(where / export, damping)
         docs.append((path, specimen_file))
     return SimpleNamespace(where=where, first=first, second=second, first_file=first_file,
                            second_file=second_file, runs=runs, run_a=run_a, run_b=run_b,
