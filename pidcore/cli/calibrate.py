@@ -157,7 +157,7 @@ def _print_result(args: argparse.Namespace, result, own_notes: list[str], saved:
     """The calibration's notes (stderr), its parameters and scores or its JSON document, how
     many DEM runs it computed and reused, and ``saved`` (:func:`_saved_words`: where the store
     keeps it)."""
-    from ..calibrate.outputs import document_json, rms_text
+    from ..calibrate.outputs import coverage_text, document_json, rms_text
 
     for note in own_notes:  # the library's words, kept so with the outputs and the store
         print(f"pidcore calibrate: note: {cli_words(note, 'calibrate')}", file=sys.stderr)
@@ -182,8 +182,8 @@ def _print_result(args: argparse.Namespace, result, own_notes: list[str], saved:
         print(f"in-sample RMS {rms_text(result.rms)}")
         print(runs)
         if result.loo is not None:
-            print(f"leave-one-out RMS {rms_text(result.loo_rms)}, {result.loo_coverage}/"
-                  f"{len(result.loo)} inside the 95 % band")
+            print(f"leave-one-out RMS {rms_text(result.loo_rms)}, "
+                  f"{coverage_text(result.band_verdicts(result.loo))}")
         print(said)
         if args.out is not None:
             print(f"wrote {args.out}")
