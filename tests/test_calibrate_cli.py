@@ -589,9 +589,9 @@ def test_summary_table_shows_small_sdc_with_its_digits():
              "measured": 2.9705e-4, "predicted": 4.1e-4, "low95": 1.2e-4, "high95": 8.8e-4},
             {"frequency_hz": 50.0, "acceleration_g": 5.0, "fill_percent": 50.0,
              "measured": 0.23, "predicted": 0.24, "low95": 0.052, "high95": 0.436}]
-    small, usual = _table_rows(rows)
-    assert small[3:7] == ["0.000297", "0.00041", "0.00012 .. 0.00088", "+0.000113"]
-    assert usual[3:7] == ["0.230", "0.240", "0.052 .. 0.436", "+0.010"]
+    small, usual = _table_rows(rows, [2 * math.pi] * 2, ["yes", "yes"])
+    assert small[3:8] == ["0.000297", "0.00041", "0.00012 .. 0.00088", "+0.000113", "yes"]
+    assert usual[3:8] == ["0.230", "0.240", "0.052 .. 0.436", "+0.010", "yes"]
 
 
 def _mixed_store(monkeypatch):

@@ -490,3 +490,23 @@ def test_calibrate_refuses_what_its_options_refuse_before_any_dem_run(tmp_path, 
                   **{"workers": 1, **keywords})
     assert str(refused.value) == said
     assert not store.exists()
+
+
+def test_store_without_the_specimens_measurements_says_why_in_one_sentence(tmp_path):
+    # round 17: the left-out note, a sentence of its own, was appended after "; " as it was:
+    # "...of an unnamed specimen of them; Not used for steel_6mm (...): ... ." mid-sentence
+    from pidcore.cli.calibrate import _store_points
+    from pidcore.specimen import load_specimen
+
+    steel = load_specimen(Path(__file__).resolve().parents[1] / "data_samples" / "specimens"
+                          / "steel_6mm.toml")
+    acrylic = [MeasuredPoint(500, 5, 50, 0.6, material="acrylic", source="s.h5")]
+    store = tmp_path / "s.h5"
+    left_out: list[str] = []
+    with pytest.raises(ParameterError) as raised:
+        _store_points(acrylic, steel, store, left_out)
+    assert str(raised.value) == (
+        f"--store {store}: no measurement of specimen steel_6mm (steel particles) or of an "
+        "unnamed specimen of them; not used for steel_6mm (steel particles): 1 measured load "
+        "case(s) of acrylic particles")
+    assert left_out == []  # refused: nothing said as left out of a calibration

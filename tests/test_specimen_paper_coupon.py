@@ -205,8 +205,8 @@ def test_calibrating_the_papers_coupon_refuses_the_test_of_the_other_file(
     assert code == 2
     assert err.strip().splitlines() == [
         f"pidcore calibrate: error: --store {store}: no measurement of the paper's coupon or of "
-        f"an unnamed specimen; Not used for the paper's coupon: 1 measured load case(s) of "
-        f"specimen {OTHER_LABEL} (--specimen FILE of theirs)."]
+        f"an unnamed specimen; not used for the paper's coupon: 1 measured load case(s) of "
+        f"specimen {OTHER_LABEL} (--specimen FILE of theirs)"]
     assert not (tmp_path / "cal").exists()
     pd.testing.assert_frame_equal(Store(store).list_analyses(), before)
 

@@ -462,6 +462,7 @@ SAVED_CALIBRATION_COLUMNS = {"key": "calibration", "specimen": "specimen", "fit"
                              "n_points": "load cases [-]", "rms_in_sample": "in-sample RMS [-]",
                              "loo_rms": "leave-one-out RMS [-]",
                              "loo_coverage95": "inside 95 % band (LOO) [-]",
+                             "loo_uninformative95": "uninformative 95 % band (LOO) [-]",
                              "created_utc": "saved [UTC]"}
 
 
@@ -515,6 +516,15 @@ def saved_calibrations_table(store_path: str | Path | None = None, *,
     if listing is None:
         listing = Store(store_path).list_calibrations()
     listing = listing.iloc[::-1]
+    if "loo_coverage95" in listing.columns:
+        # an entry of an older pidcore has no such field: it counted no fold apart (a
+        # calibration without leave-one-out keeps its blank)
+        import pandas as pd
+
+        stated = (listing["loo_uninformative95"] if "loo_uninformative95" in listing.columns
+                  else pd.Series(math.nan, index=listing.index))
+        listing = listing.assign(loo_uninformative95=stated.where(
+            stated.notna() | listing["loo_coverage95"].isna(), 0))
     shown = {c: n for c, n in SAVED_CALIBRATION_COLUMNS.items() if c in listing.columns}
     table = listing[list(shown)].rename(columns=shown).reset_index(drop=True)
     if "specimen" in shown and "specimen_hash" in listing.columns:
@@ -533,7 +543,8 @@ def saved_calibrations_table(store_path: str | Path | None = None, *,
                      else len(table.columns), CELLS_COLUMN,
                      [_stored_cells(p) for p in listing["parameters_json"]])
     table = table.astype(object).where(table.notna(), "")
-    for column in ("load cases [-]", "inside 95 % band (LOO) [-]"):  # counts, not 10.0
+    for column in ("load cases [-]", "inside 95 % band (LOO) [-]",  # counts, not 10.0
+                   "uninformative 95 % band (LOO) [-]"):
         if column in table.columns:
             table[column] = [_count_cell(v) for v in table[column]]
     return table

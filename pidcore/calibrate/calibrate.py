@@ -20,7 +20,8 @@ import numpy as np
 
 from .. import defaults
 from ..compare.align import steady_stated
-from ..constants import STANDARD_GRAVITY
+from ..compare.plausibility import SdcBound
+from ..constants import BAND_VERDICTS, STANDARD_GRAVITY
 from ..dem.simulate import DemConfig, LoadCase
 from ..errors import ParameterError, real_number, whole_number
 from ..interrupt import raise_if_stopped
@@ -67,6 +68,7 @@ if TYPE_CHECKING:  # pragma: no cover
 #: cells keep a 12-case design within minutes on two cores.
 CALIBRATION_CELLS = 4
 CROSS_VALIDATIONS = ("loo",)
+INSIDE, _, _, UNINFORMATIVE = BAND_VERDICTS
 
 
 @dataclass
@@ -97,9 +99,43 @@ class CalibrationResult:
 
     @property
     def loo_coverage(self) -> int | None:
+        """How many leave-one-out folds' 95 % bands hold their held-out measurement, among
+        the folds whose band can judge it (``len(loo) - loo_uninformative`` of them; None
+        without leave-one-out): calibration.json's ``loo_coverage95``. A fold whose band
+        spans every plausible SDC (:func:`~pidcore.calibrate.prediction.row_verdict`
+        ``uninformative``) holds any measurement; it was counted inside."""
         if not self.loo:
             return None
-        return int(sum(r["low95"] <= r["measured"] <= r["high95"] for r in self.loo))
+        return self.band_verdicts(self.loo).count(INSIDE)
+
+    @property
+    def loo_uninformative(self) -> int | None:
+        """How many leave-one-out folds' 95 % bands are uninformative (0 .. the SDC bound):
+        counted neither inside nor among the folds judged (calibration.json's
+        ``loo_uninformative95``; a file without it had none counted apart)."""
+        if not self.loo:
+            return None
+        return self.band_verdicts(self.loo).count(UNINFORMATIVE)
+
+    def sdc_bounds(self, rows: Sequence[dict]) -> list[SdcBound]:
+        """The SDC bound of each prediction row (:func:`pidcore.calibrate.prediction.
+        calibrated_sdc_bound` of the calibrated specimen at the row's fill), where its band is
+        cut, as the report cuts it."""
+        from .prediction import calibrated_sdc_bound
+
+        specimen = self.calibrated_specimen()
+        return [calibrated_sdc_bound(specimen, fill_percent=r["fill_percent"],
+                                     material=r.get("material") or specimen.particles.material)
+                for r in rows]
+
+    def band_verdicts(self, rows: Sequence[dict]) -> list[str]:
+        """``yes``, ``no`` or ``uninformative`` (:data:`pidcore.constants.BAND_VERDICTS`) for
+        each of ``rows`` (:attr:`predictions` or :attr:`loo`):
+        :func:`~pidcore.calibrate.prediction.row_verdict` at its SDC bound."""
+        from .prediction import row_verdict
+
+        return [row_verdict(r, bound) for r, bound in zip(rows, self.sdc_bounds(rows),
+                                                          strict=True)]
 
     @property
     def rms(self) -> float:
@@ -181,7 +217,10 @@ class CalibrationResult:
             "correlations": {"names": [s.name for s in self.specs],
                              "matrix": self.correlations},
             "fixed": self.fixed, "rms_in_sample": self.rms,
+            # among the folds whose band can judge them (loo_coverage); absent in a file
+            # of an older pidcore, which counted an uninformative band inside
             "loo_coverage95": self.loo_coverage,
+            "loo_uninformative95": self.loo_uninformative,
             "n_points": len(self.predictions),
             "design": {"names": [s.name for s in self.specs if s.kind == "dem"],
                        "points": self.design.tolist()},
@@ -625,7 +664,6 @@ def _row(point: MeasuredPoint, prediction: dict) -> dict:
         # only where known: a calibration from a table without it writes what it always did
         row["measured_stderr_dof"] = point.sdc_stderr_dof
     row.update(prediction)
-    row["inside95"] = bool(row["low95"] <= point.sdc <= row["high95"])
     row["error"] = row["predicted"] - point.sdc
     if not all(math.isfinite(row[k]) for k in ("predicted", "low95", "high95")):
         raise ParameterError(f"calibration: prediction at {point.label()} is not finite")

@@ -82,37 +82,51 @@ def row_sdc_bounds(result: CalibrationResult | None, rows: list[dict]) -> list[f
     calibrated_sdc_bound` at the row's fill), where the summary and the plot cut its band, as
     the report does; 2 pi where the specimen is not known (``result`` None)."""
     from ..compare.plausibility import SDC_UPPER_BOUND
-    from .prediction import calibrated_sdc_bound
 
     if result is None:
         return [SDC_UPPER_BOUND] * len(rows)
-    specimen = result.calibrated_specimen()
-    return [calibrated_sdc_bound(specimen, fill_percent=r["fill_percent"],
-                                 material=r.get("material") or specimen.particles.material).sdc
-            for r in rows]
+    return [bound.sdc for bound in result.sdc_bounds(rows)]
 
 
-def _table_rows(rows: list[dict], bounds: list[float] | None = None) -> list[list[str]]:
-    from ..compare.plausibility import SDC_UPPER_BOUND
+def coverage_text(verdicts: list[str]) -> str:
+    """How many rows' 95 % bands hold their measurement, of those that can judge it, as
+    every output of a calibration says it (summary.md, summary.html, the command):
+    ``"10/12 inside the 95 % band"``, with ``" (1 more uninformative: ...)"`` where bands
+    span every plausible SDC (``verdicts``: :meth:`~pidcore.calibrate.calibrate.
+    CalibrationResult.band_verdicts`), counted neither inside nor among those judged, as the
+    report counts them."""
+    from ..constants import BAND_VERDICTS
+
+    inside, outside, _, uninformative = BAND_VERDICTS
+    judged = verdicts.count(inside) + verdicts.count(outside)
+    unjudged = verdicts.count(uninformative)
+    return (f"{verdicts.count(inside)}/{judged} inside the 95 % band"
+            + (f" ({unjudged} more {uninformative}: a band of 0 .. the SDC bound, spanning "
+               "every plausible SDC, cannot test the model)" if unjudged else ""))
+
+
+def _table_rows(rows: list[dict], bounds: list[float], verdicts: list[str]
+                ) -> list[list[str]]:
+    from ..constants import BAND_VERDICTS
 
     def sdc(value: float) -> str:  # three decimals; a small SDC keeps its digits, not 0.000
         return display_number(value, decimals=3)
 
-    bounds = [SDC_UPPER_BOUND] * len(rows) if bounds is None else bounds
+    outside = BAND_VERDICTS[1]
     out = []
-    for r, bound in zip(rows, bounds, strict=True):
+    for r, bound, verdict in zip(rows, bounds, verdicts, strict=True):
         error = r["predicted"] - r["measured"]
         out.append([f"{r['frequency_hz']:g}", f"{r['acceleration_g']:g}",
                     f"{r['fill_percent']:g}", sdc(r["measured"]), sdc(r["predicted"]),
                     _band_text(r["low95"], r["high95"], sdc, bound),
                     ("+" if error >= 0 else "") + sdc(error),
-                    "yes" if r["low95"] <= r["measured"] <= r["high95"] else "**no**"])
+                    f"**{verdict}**" if verdict == outside else verdict])
     return out
 
 
 #: Every column names its unit, as the report's (SDC and its error are dimensionless).
 _HEAD = ["f [Hz]", "a [g]", "fill [%]", "measured SDC [-]", "predicted SDC [-]",
-         "95 % band [-]", "error [-]", "inside [yes/no]"]
+         "95 % band [-]", "error [-]", "inside [yes/no/uninformative]"]
 
 
 def _sampler_words(result: CalibrationResult) -> str:
@@ -172,12 +186,11 @@ def summary_markdown(result: CalibrationResult) -> str:
         if not rows:
             continue
         rms = float(np.sqrt(np.mean([(r["predicted"] - r["measured"]) ** 2 for r in rows])))
-        inside = sum(r["low95"] <= r["measured"] <= r["high95"] for r in rows)
-        lines += ["", f"## {title}: RMS {rms_text(rms)}, {inside}/{len(rows)} inside the 95 % "
-                  "band",
+        verdicts = result.band_verdicts(rows)
+        lines += ["", f"## {title}: RMS {rms_text(rms)}, {coverage_text(verdicts)}",
                   "", "| " + " | ".join(_HEAD) + " |", "|---" * len(_HEAD) + "|"]
         lines += ["| " + " | ".join(cells) + " |"
-                  for cells in _table_rows(rows, row_sdc_bounds(result, rows))]
+                  for cells in _table_rows(rows, row_sdc_bounds(result, rows), verdicts)]
     if any(s.kind == "dem" for s in result.specs):
         lines += ["", "## Energy per cycle per cell: starting specimen vs calibrated DEM", "",
                   "| f [Hz] | a [g] | start [J] | calibrated median [J] | 95 % band [J] | "
@@ -211,9 +224,11 @@ def summary_html(result: CalibrationResult) -> str:
                         ("Leave-one-out predictions", result.loo)):
         if not rows:
             continue
-        parts.append(f"<h2>{title}</h2><table><tr>"
+        verdicts = result.band_verdicts(rows)
+        # the count summary.md heads its table with: the page showed yes/no alone
+        parts.append(f"<h2>{title}: {html.escape(coverage_text(verdicts))}</h2><table><tr>"
                      + "".join(f"<th>{html.escape(h)}</th>" for h in _HEAD) + "</tr>")
-        for cells in _table_rows(rows, row_sdc_bounds(result, rows)):
+        for cells in _table_rows(rows, row_sdc_bounds(result, rows), verdicts):
             parts.append("<tr>" + "".join(f"<td>{html.escape(c.strip('*'))}</td>"
                                           for c in cells) + "</tr>")
         parts.append("</table>")

@@ -62,7 +62,10 @@ def calibration_key(document: dict, calibrated_specimen_text: str | None = None)
     # its "specimen" names (start and calibrated file, by name and hash) are in the
     # calibrated specimen's text below: left out here, the JSON's key is the one a pidcore
     # that did not write them gave the same fit, so save_calibration still finds that entry
-    what = {k: v for k, v in document.items() if k not in (*_BOOKKEEPING, "specimen")}
+    # loo_uninformative95 follows from the loo rows and the specimen, both keyed: left out,
+    # a fit saved before it existed keeps its key
+    what = {k: v for k, v in document.items()
+            if k not in (*_BOOKKEEPING, "specimen", "loo_uninformative95")}
     settings = dict(what.get("settings") or {})
     settings.pop("store", None)
     what["settings"] = settings
@@ -110,9 +113,12 @@ def _record(result) -> tuple[dict, dict]:
                     "fit": ",".join(result.settings["fit"]),
                     "method_used": str(result.settings.get("method_used", "")),
                     "n_points": len(result.predictions), "rms_in_sample": result.rms,
-                    "loo_rms": result.loo_rms, "loo_coverage95": result.loo_coverage}
+                    "loo_rms": result.loo_rms, "loo_coverage95": result.loo_coverage,
+                    # the folds counted apart from loo_coverage95's (absent in an entry of
+                    # an older pidcore: none were)
+                    "loo_uninformative95": result.loo_uninformative}
     out_units = {"n_points": "count", "rms_in_sample": "-", "loo_rms": "-",
-                 "loo_coverage95": "count"}
+                 "loo_coverage95": "count", "loo_uninformative95": "count"}
     for name, p in result.parameters.items():
         for stat in ("median", "low95", "high95"):
             record[f"{name}_{stat}"] = p[stat]

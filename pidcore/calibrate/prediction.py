@@ -220,6 +220,35 @@ class CalibratedPrediction:
         return bool(low <= sdc <= high)
 
 
+def row_verdict(row: dict, bound: SdcBound) -> str:
+    """The verdict of :data:`pidcore.constants.BAND_VERDICTS` on one prediction row of a
+    calibration (``predictions`` or ``loo`` of its calibration.json, or of
+    :class:`~pidcore.calibrate.calibrate.CalibrationResult`): ``yes`` where its measured SDC
+    lies inside its 95 % band cut at ``bound`` (:func:`calibrated_sdc_bound` at the row's
+    fill), ``no`` where outside, ``uninformative`` where the band spans every plausible SDC
+    (:meth:`CalibratedPrediction.uninformative_reason`), the rule the report and the app
+    judge a measurement by: such a row is counted neither inside nor among those judged."""
+    from ..constants import BAND_VERDICTS
+
+    inside, outside, _, uninformative = BAND_VERDICTS
+
+    def number(key: str) -> float:  # absent or null (an older calibration.json): unknown
+        value = row.get(key)
+        return math.nan if value is None else float(value)
+
+    prediction = CalibratedPrediction(
+        LoadCase(row["frequency_hz"], row["acceleration_g"], row["fill_percent"],
+                 str(row.get("material") or defaults.COMPARE_DEFAULT_MATERIAL)),
+        number("predicted"), number("low95"), number("high95"), number("measured"),
+        number("measured_stderr"), number("low95_without_stderr"),
+        number("high95_without_stderr"), number("measured_stderr_dof"), sdc_bound=bound)
+    # the row's own stderr and dof: the fitted point's band, as the row states it
+    stderr, dof = prediction.measured_stderr, prediction.measured_stderr_dof
+    if prediction.uninformative_reason(stderr, dof):
+        return uninformative
+    return inside if prediction.contains(prediction.measured, stderr, dof) else outside
+
+
 @dataclass(frozen=True)
 class Calibration:
     """A calibration read from ``calibration.json``.

@@ -157,7 +157,7 @@ def _print_result(args: argparse.Namespace, result, own_notes: list[str], saved:
     """The calibration's notes (stderr), its parameters and scores or its JSON document, how
     many DEM runs it computed and reused, and ``saved`` (:func:`_saved_words`: where the store
     keeps it)."""
-    from ..calibrate.outputs import document_json, rms_text
+    from ..calibrate.outputs import coverage_text, document_json, rms_text
 
     for note in own_notes:  # the library's words, kept so with the outputs and the store
         print(f"pidcore calibrate: note: {cli_words(note, 'calibrate')}", file=sys.stderr)
@@ -182,8 +182,8 @@ def _print_result(args: argparse.Namespace, result, own_notes: list[str], saved:
         print(f"in-sample RMS {rms_text(result.rms)}")
         print(runs)
         if result.loo is not None:
-            print(f"leave-one-out RMS {rms_text(result.loo_rms)}, {result.loo_coverage}/"
-                  f"{len(result.loo)} inside the 95 % band")
+            print(f"leave-one-out RMS {rms_text(result.loo_rms)}, "
+                  f"{coverage_text(result.band_verdicts(result.loo))}")
         print(said)
         if args.out is not None:
             print(f"wrote {args.out}")
@@ -222,7 +222,7 @@ def _store_points(points: list, specimen, store: Path, left_out: list[str]) -> l
         if not kept:  # the library's 'no measured points' would not say why
             raise ParameterError(
                 f"--store {store}: no measurement of the paper's coupon or of an unnamed "
-                f"specimen{'; ' + note if note else ''}")
+                f"specimen{_continued(note)}")
         materials = sorted({str(p.material) for p in kept})
         if len(materials) > 1:
             raise ParameterError(
@@ -236,10 +236,18 @@ def _store_points(points: list, specimen, store: Path, left_out: list[str]) -> l
             raise ParameterError(
                 f"--store {store}: no measurement of specimen {measured_specimen_name(specimen)} "
                 f"({specimen.particles.material} particles) or of an unnamed specimen of them"
-                f"{'; ' + note if note else ''}")
+                f"{_continued(note)}")
     if note and kept:
         left_out.append(note)  # said with the others by the caller
     return kept
+
+
+def _continued(note: str) -> str:
+    """``note`` (a sentence of its own, "Not used for ...: ... .") continuing an error after
+    "; ": it read "...specimen; Not used for the paper's coupon: ... ." mid-sentence."""
+    if not note:
+        return ""
+    return "; " + note[:1].lower() + note[1:].removesuffix(".")
 
 
 def _out_words(out: Path | None, written: bool) -> str:

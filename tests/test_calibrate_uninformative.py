@@ -1,0 +1,187 @@
+"""A calibration's own outputs judge its bands as the report does: a fold (or in-sample point)
+whose 95 % band spans every plausible SDC (0 .. the SDC bound) is "uninformative", counted
+neither inside nor among those judged (summary.md, summary.html, calibration.json's
+``loo_coverage95``, the store's listing, the command's line). Before, such a band counted as
+"inside": a calibration that constrains nothing at a load case scored a hit there."""
+
+from __future__ import annotations
+
+import importlib
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from pidcore.calibrate.calibrate import CalibrationResult
+from pidcore.calibrate.parameters import parameter_spec
+from pidcore.calibrate.prediction import calibrated_sdc_bound, row_verdict
+from pidcore.cli import main
+from pidcore.compare.plausibility import SDC_UPPER_BOUND
+from pidcore.specimen import paper_specimen
+
+REPO = Path(__file__).resolve().parents[1]
+
+
+def _row(frequency_hz: float, measured: float, predicted: float, low: float,
+         high: float) -> dict:
+    # no measurement stderr: the band is the fitted point's as it stands
+    return {"frequency_hz": frequency_hz, "acceleration_g": 5.0, "fill_percent": 50.0,
+            "material": "acrylic", "measured": measured, "measured_stderr": 0.0,
+            "predicted": predicted, "low95": low, "high95": high,
+            "low95_without_stderr": low, "high95_without_stderr": high,
+            "predicted_low95": low, "predicted_high95": high}
+
+
+#: Three leave-one-out folds: one inside, one outside, one whose band 0 .. 30 reaches past
+#: the paper coupon's SDC bound (16.9 at 50 % acrylic) from 0: it holds any measurement.
+LOO = [_row(100, 0.30, 0.32, 0.10, 0.60), _row(500, 0.90, 0.40, 0.20, 0.70),
+       _row(1000, 0.50, 0.45, 0.0, 30.0)]
+PREDICTIONS = [_row(100, 0.30, 0.31, 0.12, 0.55), _row(500, 0.90, 0.60, 0.30, 0.95),
+               _row(1000, 0.50, 0.47, 0.0, 25.0)]
+
+
+def _result() -> CalibrationResult:
+    specimen = paper_specimen()
+    spec = parameter_spec("fixture_mass_kg", specimen)
+    return CalibrationResult(
+        specimen=specimen, specs=[spec], samples=np.full((4, 1), 0.02),
+        parameters={"fixture_mass_kg": {"median": 0.02, "low95": 0.015, "high95": 0.025,
+                                        "prior_low": spec.low, "prior_high": spec.high}},
+        correlations=[[1.0]], predictions=[dict(r) for r in PREDICTIONS],
+        loo=[dict(r) for r in LOO], fixed={"baseline_loss_factor": 0.0},
+        design=np.zeros((1, 0)), observations=[], runs={"computed": 0, "cached": 3},
+        settings={"fit": ["fixture_mass_kg"], "cells": 2, "design_size": 1,
+                  "method_used": "grid"})
+
+
+def test_the_bound_of_the_constructed_folds_is_the_one_their_band_spans():
+    # the premise: the third band reaches from 0 past the bound, the others judge
+    bound = calibrated_sdc_bound(paper_specimen(), fill_percent=50.0, material="acrylic")
+    assert SDC_UPPER_BOUND < bound.sdc < 25.0
+    assert [row_verdict(r, bound) for r in LOO] == ["yes", "no", "uninformative"]
+    # a band from 0 that stops below the bound still judges: 0.5 is inside 0 .. bound - 1
+    below = bound.sdc - 1.0
+    assert row_verdict({**LOO[2], "high95": below, "high95_without_stderr": below},
+                       bound) == "yes"
+    # and one reaching past it from above 0 judges too (0.5 is below 0.6: outside)
+    assert row_verdict({**LOO[2], "low95": 0.6, "low95_without_stderr": 0.6, "predicted": 1.0},
+                       bound) == "no"
+
+
+def test_an_uninformative_fold_is_not_counted_inside():
+    result = _result()
+    # was 2: the 0 .. 2 pi band counted as holding its measurement
+    assert result.loo_coverage == 1
+    assert result.loo_uninformative == 1
+    document = result.full_document()
+    assert document["loo_coverage95"] == 1 and document["loo_uninformative95"] == 1
+    # the RMS is of every fold, as before: the prediction is a number all the same
+    errors = [r["predicted"] - r["measured"] for r in LOO]
+    assert result.loo_rms == pytest.approx(math.sqrt(np.mean(np.square(errors))), rel=1e-12)
+
+
+def test_the_summaries_say_k_of_n_with_the_uninformative_apart():
+    from pidcore.calibrate.outputs import rms_text, summary_html, summary_markdown
+
+    result = _result()
+    text = summary_markdown(result)
+    said = ("inside the 95 % band (1 more uninformative: a band of 0 .. the SDC bound, "
+            "spanning every plausible SDC, cannot test the model)")
+    loo_rms, rms = rms_text(result.loo_rms), rms_text(result.rms)  # 0.2903, 0.1742
+    assert f"## Leave-one-out predictions: RMS {loo_rms}, 1/2 {said}" in text.splitlines()
+    assert f"## In-sample posterior predictions: RMS {rms}, 2/2 {said}" in text.splitlines()
+    # each table's rows, in-sample then leave-one-out (the third was "yes")
+    verdicts = [line.rstrip(" |").rsplit("| ", 1)[1] for line in text.splitlines()
+                if line.startswith(("| 100 | 5 |", "| 500 | 5 |", "| 1000 | 5 |"))
+                and line.count("|") == 9]
+    assert verdicts == ["yes", "yes", "uninformative", "yes", "**no**", "uninformative"]
+    assert "| inside [yes/no/uninformative] |" in text
+    page = summary_html(_result())
+    assert f"<h2>Leave-one-out predictions: 1/2 {said}</h2>" in page
+    assert page.count("<td>uninformative</td>") == 2
+
+
+def test_the_command_prints_the_leave_one_out_count_without_the_uninformative_fold(
+        tmp_path, capsys, monkeypatch):
+    library = importlib.import_module("pidcore.calibrate.calibrate")
+    outputs = importlib.import_module("pidcore.calibrate.outputs")
+    monkeypatch.setattr(library, "calibrate", lambda points, **kwargs: _result())
+    monkeypatch.setattr(outputs, "write_outputs", lambda result, out: [])
+    monkeypatch.setattr(importlib.import_module("pidcore.calibrate.persist"),
+                        "save_calibration", lambda result, store: ("cal_0", True))
+    table = tmp_path / "m.csv"
+    table.write_text("frequency_hz,acceleration_g,fill_percent,sdc\n100,5,50,0.3\n"
+                     "500,5,50,0.9\n1000,5,50,0.5\n")
+    assert main(["calibrate", "--data", str(table), "--fit", "fixture_mass_kg",
+                 "--dem-store", str(tmp_path / "d.h5"), "--cells", "2", "--workers", "1",
+                 "--no-progress"]) == 0
+    out = capsys.readouterr().out.splitlines()
+    (line,) = [s for s in out if s.startswith("leave-one-out RMS")]
+    assert line.startswith("leave-one-out RMS 0.2903, 1/2 inside the 95 % band (1 more "
+                           "uninformative: ")
+
+
+def test_the_stores_listing_counts_the_uninformative_folds_and_reads_older_entries(tmp_path):
+    from pidcore.app.calibration import saved_calibrations_table
+    from pidcore.calibrate.persist import save_calibration
+    from pidcore.store import Store
+
+    store = tmp_path / "s.h5"
+    save_calibration(_result(), store)
+    listing = Store(store).list_calibrations()
+    assert listing["loo_coverage95"].tolist() == [1]
+    assert listing["loo_uninformative95"].tolist() == [1]
+    table = saved_calibrations_table(listing=listing)
+    assert table["inside 95 % band (LOO) [-]"].tolist() == [1]
+    assert table["uninformative 95 % band (LOO) [-]"].tolist() == [1]
+    # an entry of an older pidcore has no such field: none counted apart; one without
+    # leave-one-out stays blank
+    older = pd.DataFrame({"key": ["cal_a", "cal_b"], "specimen": ["paper_coupon"] * 2,
+                          "fit": ["fixture_mass_kg"] * 2, "n_points": [12.0, 12.0],
+                          "rms_in_sample": [0.08, 0.09], "loo_rms": [0.097, np.nan],
+                          "loo_coverage95": [10.0, np.nan],
+                          "created_utc": ["2026-12-01T00:00:00+00:00",
+                                          "2026-12-01T00:01:00+00:00"]})
+    table = saved_calibrations_table(listing=older)
+    assert table["inside 95 % band (LOO) [-]"].tolist() == ["", 10]
+    assert table["uninformative 95 % band (LOO) [-]"].tolist() == ["", 0]
+
+
+def test_the_bundled_paper_calibration_has_no_uninformative_fold_and_keeps_its_counts():
+    # the bundled files are not regenerated: judged by the rule they give what they state
+    # (calibration.json's loo_coverage95 10, summary.md's 11/12 and 10/12)
+    folder = REPO / "data_samples" / "paper_calibration"
+    document = json.loads((folder / "calibration.json").read_text())
+    assert "loo_uninformative95" not in document  # written before it: read as 0
+
+    from pidcore.calibrate.prediction import load_calibration
+    from pidcore.loadcase import LoadCase
+
+    # each row cut where the report cuts it: the bound of the specimen the calibration is of
+    calibration = load_calibration(folder)
+
+    def verdicts(rows):
+        return [row_verdict(r, calibration.sdc_bound(LoadCase(
+            r["frequency_hz"], r["acceleration_g"], r["fill_percent"], r["material"])))
+            for r in rows]
+
+    loo, in_sample = verdicts(document["loo"]), verdicts(document["predictions"])
+    assert "uninformative" not in loo + in_sample
+    assert loo.count("yes") == document["loo_coverage95"] == 10 and len(loo) == 12
+    summary = (folder / "summary.md").read_text()
+    assert f"RMS 0.0970, {loo.count('yes')}/12 inside the 95 % band" in summary
+    assert f"{in_sample.count('yes')}/12 inside the 95 % band" in summary
+
+
+def test_the_new_count_leaves_the_key_of_a_fit_saved_before_it_as_it_was():
+    # a calibration saved by a pidcore that wrote no loo_uninformative95 is found again by its
+    # key (save_calibration keeps the same fit once): the count follows from the keyed loo rows
+    from pidcore.calibrate.persist import calibration_key
+
+    document = _result().full_document()
+    older = {k: v for k, v in document.items() if k != "loo_uninformative95"}
+    assert calibration_key(document) == calibration_key(older)
+    assert calibration_key(document) != calibration_key({**older, "loo_rms": 0.5})
