@@ -1847,6 +1847,9 @@ def test_an_uploaded_specimen_file_survives_a_reload_by_its_hash_in_the_address(
     assert at.text_input(key="dem_material_specimen").value == "steel"  # not the paper's acrylic
     assert not at.button(key="dem_run").disabled
     assert at.selectbox(key="dem_specimen").disabled
+    # the greyed list read "specimen: paper coupon (default)" beside the file used
+    assert at.selectbox(key="dem_specimen").label == \
+        "specimen (not used: see the specimen file at the right)"
     submitted = []
 
     def submit(self, cases, config, specimen=None):  # record, do not simulate
@@ -1867,6 +1870,7 @@ def test_an_uploaded_specimen_file_survives_a_reload_by_its_hash_in_the_address(
     at.run()
     assert "dem_specimen_upload" not in at.query_params
     assert not at.selectbox(key="dem_specimen").disabled
+    assert at.selectbox(key="dem_specimen").label == "specimen"
     assert "dem_material" in {s.key for s in at.selectbox}
 
 
@@ -1881,6 +1885,8 @@ def test_an_address_naming_an_unknown_specimen_hash_is_refused_in_one_line(store
         f"this app keeps (none in {store_file}.specimens); upload the specimen file again"]
     # no fallback to the paper's coupon: nothing runs until the user uploads or forgets it
     assert at.button(key="dem_run").disabled
+    assert at.selectbox(key="dem_specimen").label == \
+        "specimen (not used: see the specimen file at the right)"
     assert "dem_material" not in {s.key for s in at.selectbox}
 
 
