@@ -280,6 +280,36 @@ def test_the_chosen_load_case_stays_chosen_when_a_save_reorders_the_list(store_f
     assert shown() == {"hi_fill50.csv"}
 
 
+def test_the_chosen_load_case_comes_back_after_a_reload(store_file):
+    # a reload showed the first load case again: the choice is bound to the page address now
+    files = [("hi_fill50.csv", mass_damper_csv(frequency_hz=500.0, acceleration_g=5.0)),
+             ("lo_fill50.csv", mass_damper_csv(frequency_hz=50.0, acceleration_g=5.0))]
+    at = _upload(_app(), files)
+    at.button(key="save").click()
+    at.run()
+    box = at.selectbox(key="compare_case")
+    first = _app().selectbox(key="compare_case").value  # what a fresh page shows
+    label = next(o for o in box.options if not o.startswith(f"{first} ("))
+    chosen = label.removesuffix(" (1 file(s))")
+    box.set_value(chosen)
+    at.run()
+    # a fresh session at the address the browser writes: the label shown (Streamlit binds
+    # the formatted option)
+    reloaded = _app_at({"compare_case": label})
+    assert reloaded.selectbox(key="compare_case").value == chosen
+    assert not reloaded.error
+    measured = next(d.value for d in reloaded.dataframe if "origin" in d.value.columns)
+    assert set(measured["file"]) == {"hi_fill50.csv" if chosen.startswith("500 Hz")
+                                     else "lo_fill50.csv"}
+    # a case the store does not hold (an unsaved analysis, gone with its session) is refused
+    # in one line naming what is shown instead, not dropped without a word
+    gone = _app_at({"compare_case": "200 Hz, 5 g, 50 %, acrylic, z (1 file(s))"})
+    assert gone.selectbox(key="compare_case").value == first
+    assert [e.value for e in gone.error] == [
+        "load case: '200 Hz, 5 g, 50 %, acrylic, z (1 file(s))' (from the page address) is "
+        f"not one of {', '.join(box.options)}; {first} (1 file(s)) is chosen instead"]
+
+
 def test_an_identical_file_under_another_name_is_compared_once(store_file):
     # the trial pooled a saved file and its copy as "2 files pooled" (stderr / sqrt(2))
     data = mass_damper_csv(frequency_hz=100.0)
