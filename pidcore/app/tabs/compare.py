@@ -153,8 +153,10 @@ def render(stores, session_files: list, calibrations: list) -> None:
     # case, not the one looked at. The address holds the label shown (Streamlit binds the
     # formatted option); a case gone since (an unsaved analysis, after a reload) or with
     # another file count is refused in one line, not dropped unseen
+    # (the fallback is the name, the widget's value, so that the message stays until the
+    # user chooses another case)
     refuse_address_choices("compare_case", "load case", list(labels.values()),
-                           next(iter(labels.values())))
+                           next(iter(by_name)))
     choice = st.selectbox("load case", list(by_name), format_func=labels.__getitem__,
                           key="compare_case", bind=ADDRESS_BINDING)
     if choice not in by_name:
