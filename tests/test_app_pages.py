@@ -2046,3 +2046,7 @@ def test_a_heavy_particle_sdc_above_2_pi_is_no_implausible_result_of_its_specime
     at = _upload(_app(), [("m_fill50.csv", data), ("settings.csv", _steel_settings("nosuch"))])
     (warned,) = [w.value for w in at.warning if "Implausible" in w.value]
     assert "is above the physical bound 6.28 (loss factor 1.5" in warned
+    # the missing file is named as a cause, in the page's words (not the library's keyword)
+    assert warned.endswith("; or particles heavier than their coupon whose specimen file is "
+                           "not given (without it the bound is 2 pi; with it, 8 m_p/m_s: give "
+                           "its specimen file, the 'specimen' choice).")

@@ -87,8 +87,7 @@ def test_an_sdc_above_2_pi_without_a_specimen_file_names_the_file_as_a_cause():
     assert unknown.check == "sdc_above_bound"
     assert unknown.likely_cause.endswith(
         "; or particles heavier than their coupon whose specimen file is not given (without "
-        "it the bound is 2 pi; with it, 8 m_p/m_s: pidcore analyze --specimen FILE, or the "
-        ".toml uploaded with the files)")
+        "it the bound is 2 pi; with it, 8 m_p/m_s: give its specimen file, specimen=FILE)")
     # a bound from the specimen's masses that the result still exceeds: the file was given
     known = SdcBound(6.5, particle_mass_kg=0.04, structure_mass_kg=0.0492)
     [within_file] = check_analysis(rec.analysis, bound=known)

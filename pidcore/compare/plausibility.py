@@ -283,8 +283,8 @@ def check_analysis(analysis, *, bound: SdcBound | None = None
             # where their specimen file, not given, would have allowed it
             + ("" if bound.known else
                "; or particles heavier than their coupon whose specimen file is not given "
-               "(without it the bound is 2 pi; with it, 8 m_p/m_s: pidcore analyze "
-               "--specimen FILE, or the .toml uploaded with the files)")))
+               "(without it the bound is 2 pi; with it, 8 m_p/m_s: give its specimen file, "
+               "specimen=FILE)")))
     return tuple(out)
 
 
