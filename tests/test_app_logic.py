@@ -2457,3 +2457,29 @@ def test_a_file_of_other_particles_is_not_saved_as_the_uploaded_specimens():
     chosen = uploads.file_specimen("", "acrylic", known,
                                    every_file=hashed_name("steel_6mm", other.hash))
     assert chosen.sha256 == other.hash
+
+
+def test_calibrate_points_table_names_a_unit_per_number_and_shows_the_sdc_bound_as_one():
+    # The Calibrate page listed the measured points with dataclasses.asdict: the newer fields
+    # showed as their raw names, and the SDC bound as a dict of masses in kg without a unit.
+    from pidcore.app.calibration import points_table
+    from pidcore.calibrate import MeasuredPoint
+    from pidcore.compare.plausibility import SDC_UPPER_BOUND, sdc_bound
+    from pidcore.specimen import load_specimen
+
+    steel = load_specimen(Path(__file__).resolve().parents[1]
+                          / "data_samples/specimens/steel_6mm.toml")
+    heavy = sdc_bound(fill_percent=50.0, specimen=steel)
+    assert heavy.sdc > SDC_UPPER_BOUND  # heavy particles: a bound above 2 pi to show
+    points = [MeasuredPoint(500.0, 5.0, 50.0, 7.0, 0.1, material="steel", specimen="steel_6mm",
+                            specimen_sha256="ab" * 32, sdc_bound=heavy, sdc_stderr_dof=7.0),
+              MeasuredPoint(100.0, 10.0, 50.0, 0.5)]
+    table = points_table(points)
+    assert len(table) == 2
+    for column in table.columns:
+        numeric = pd.api.types.is_numeric_dtype(table[column])
+        assert not numeric or re.search(r"\[.+\]$", column), column
+        assert "_" not in column, column  # no raw field name
+    assert table["SDC bound [-]"].tolist() == [heavy.sdc, SDC_UPPER_BOUND]
+    assert table["SDC measured, Eq. 11 [-]"].tolist() == [7.0, 0.5]
+    assert table["specimen sha256"].tolist() == ["ab" * 32, ""]

@@ -280,6 +280,40 @@ def test_the_chosen_load_case_stays_chosen_when_a_save_reorders_the_list(store_f
     assert shown() == {"hi_fill50.csv"}
 
 
+def test_the_chosen_load_case_comes_back_after_a_reload(store_file):
+    # a reload showed the first load case again: the choice is bound to the page address now
+    files = [("hi_fill50.csv", mass_damper_csv(frequency_hz=500.0, acceleration_g=5.0)),
+             ("lo_fill50.csv", mass_damper_csv(frequency_hz=50.0, acceleration_g=5.0))]
+    at = _upload(_app(), files)
+    at.button(key="save").click()
+    at.run()
+    box = at.selectbox(key="compare_case")
+    first = _app().selectbox(key="compare_case").value  # what a fresh page shows
+    label = next(o for o in box.options if not o.startswith(f"{first} ("))
+    chosen = label.removesuffix(" (1 file(s))")
+    box.set_value(chosen)
+    at.run()
+    # a fresh session at the address the browser writes: the label shown (Streamlit binds
+    # the formatted option)
+    reloaded = _app_at({"compare_case": label})
+    assert reloaded.selectbox(key="compare_case").value == chosen
+    assert not reloaded.error
+    measured = next(d.value for d in reloaded.dataframe if "origin" in d.value.columns)
+    assert set(measured["file"]) == {"hi_fill50.csv" if chosen.startswith("500 Hz")
+                                     else "lo_fill50.csv"}
+    # a case the store does not hold (an unsaved analysis, gone with its session) is refused
+    # in one line naming what is shown instead, not dropped without a word
+    gone = _app_at({"compare_case": "200 Hz, 5 g, 50 %, acrylic, z (1 file(s))"})
+    assert gone.selectbox(key="compare_case").value == first
+    assert [e.value for e in gone.error] == [
+        "load case: '200 Hz, 5 g, 50 %, acrylic, z (1 file(s))' (from the page address) is "
+        f"not one of {', '.join(box.options)}; {first} is chosen instead"]
+    gone.run()  # it stays said until another case is chosen
+    assert len(gone.error) == 1
+    gone.selectbox(key="compare_case").set_value(chosen).run()
+    assert not gone.error
+
+
 def test_an_identical_file_under_another_name_is_compared_once(store_file):
     # the trial pooled a saved file and its copy as "2 files pooled" (stderr / sqrt(2))
     data = mass_damper_csv(frequency_hz=100.0)
@@ -1847,6 +1881,9 @@ def test_an_uploaded_specimen_file_survives_a_reload_by_its_hash_in_the_address(
     assert at.text_input(key="dem_material_specimen").value == "steel"  # not the paper's acrylic
     assert not at.button(key="dem_run").disabled
     assert at.selectbox(key="dem_specimen").disabled
+    # the greyed list read "specimen: paper coupon (default)" beside the file used
+    assert at.selectbox(key="dem_specimen").label == \
+        "specimen (not used: see the specimen file at the right)"
     submitted = []
 
     def submit(self, cases, config, specimen=None):  # record, do not simulate
@@ -1867,6 +1904,7 @@ def test_an_uploaded_specimen_file_survives_a_reload_by_its_hash_in_the_address(
     at.run()
     assert "dem_specimen_upload" not in at.query_params
     assert not at.selectbox(key="dem_specimen").disabled
+    assert at.selectbox(key="dem_specimen").label == "specimen"
     assert "dem_material" in {s.key for s in at.selectbox}
 
 
@@ -1881,6 +1919,8 @@ def test_an_address_naming_an_unknown_specimen_hash_is_refused_in_one_line(store
         f"this app keeps (none in {store_file}.specimens); upload the specimen file again"]
     # no fallback to the paper's coupon: nothing runs until the user uploads or forgets it
     assert at.button(key="dem_run").disabled
+    assert at.selectbox(key="dem_specimen").label == \
+        "specimen (not used: see the specimen file at the right)"
     assert "dem_material" not in {s.key for s in at.selectbox}
 
 
@@ -2006,3 +2046,7 @@ def test_a_heavy_particle_sdc_above_2_pi_is_no_implausible_result_of_its_specime
     at = _upload(_app(), [("m_fill50.csv", data), ("settings.csv", _steel_settings("nosuch"))])
     (warned,) = [w.value for w in at.warning if "Implausible" in w.value]
     assert "is above the physical bound 6.28 (loss factor 1.5" in warned
+    # the missing file is named as a cause, in the page's words (not the library's keyword)
+    assert warned.endswith("; or particles heavier than their coupon whose specimen file is "
+                           "not given (without it the bound is 2 pi; with it, 8 m_p/m_s: give "
+                           "its specimen file, the 'specimen' choice).")

@@ -77,6 +77,23 @@ def test_sdc_above_the_bound_is_flagged():
     assert [w.check for w in check_analysis(rec.analysis)] == ["sdc_above_bound"]
 
 
+def test_an_sdc_above_2_pi_without_a_specimen_file_names_the_file_as_a_cause():
+    # 2 mm steel spheres (216 g on a 48 g structure) dissipate SDC 8: without their specimen
+    # file the only causes named were set-up errors, none of which the user had made
+    from pidcore.compare.plausibility import SdcBound
+
+    rec = _analysis(mass_damper_csv(loss_factor=1.3))
+    unknown = check_analysis(rec.analysis)[0]
+    assert unknown.check == "sdc_above_bound"
+    assert unknown.likely_cause.endswith(
+        "; or particles heavier than their coupon whose specimen file is not given (without "
+        "it the bound is 2 pi; with it, 8 m_p/m_s: give its specimen file, specimen=FILE)")
+    # a bound from the specimen's masses that the result still exceeds: the file was given
+    known = SdcBound(6.5, particle_mass_kg=0.04, structure_mass_kg=0.0492)
+    [within_file] = check_analysis(rec.analysis, bound=known)
+    assert "specimen file" not in within_file.likely_cause
+
+
 def _entry(rec):
     return MeasuredEntry.from_record(rec, load_case_of(rec, fill_percent=50.0,
                                                        material="acrylic"))

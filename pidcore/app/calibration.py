@@ -119,6 +119,28 @@ def points_needed(fit: Sequence[str]) -> int:
     return len(set(fit)) + 1
 
 
+#: The measured points' table on the page: field -> column head naming its unit. A field not
+#: named here is not shown (a new field of MeasuredPoint once showed as its raw name, the SDC
+#: bound as a dict of masses in kg with no unit).
+POINT_COLUMNS = {
+    "frequency_hz": "frequency [Hz]", "acceleration_g": "acceleration [g]",
+    "fill_percent": "fill [%]", "sdc": "SDC measured, Eq. 11 [-]",
+    "sdc_stderr": "SDC stderr [-]", "sdc_stderr_dof": "SDC stderr degrees of freedom [-]",
+    "material": "material", "specimen": "specimen", "specimen_sha256": "specimen sha256",
+    "sdc_bound": "SDC bound [-]"}
+
+
+def points_table(points: Sequence) -> pd.DataFrame:
+    """The measured points (:class:`pidcore.calibrate.MeasuredPoint`) as the page shows them:
+    one row each, the columns of :data:`POINT_COLUMNS`; ``SDC bound [-]`` is the SDC above
+    which the point would be refused (its specimen's, 2 pi where not known)."""
+    import pandas as pd
+
+    rows = [{**{name: getattr(p, name) for name in POINT_COLUMNS},
+             "sdc_bound": float(p.sdc_bound.sdc)} for p in points]
+    return pd.DataFrame(rows, columns=list(POINT_COLUMNS)).rename(columns=POINT_COLUMNS)
+
+
 def points_needed_text(n_points: int, fit: Sequence[str]) -> str:
     """Why ``n_points`` load cases are too few for ``fit``, in the page's terms."""
     return (f"{n_points} measured load case(s) cannot determine {', '.join(fit)} and the "

@@ -278,7 +278,13 @@ def check_analysis(analysis, *, bound: SdcBound | None = None
              "Re P)" if from_acceleration else
              "a wrong vibrometer delay (a delay too large turns the force-velocity phase and "
              "inflates Re P)")
-            + ", or a mass-below-gauge correction close to the whole moving mass"))
+            + ", or a mass-below-gauge correction close to the whole moving mass"
+            # heavy particles (steel) read as implausible with only set-up errors named,
+            # where their specimen file, not given, would have allowed it
+            + ("" if bound.known else
+               "; or particles heavier than their coupon whose specimen file is not given "
+               "(without it the bound is 2 pi; with it, 8 m_p/m_s: give its specimen file, "
+               "specimen=FILE)")))
     return tuple(out)
 
 

@@ -79,6 +79,9 @@ def refuse_address_choices(key: str, label: str, options: Sequence[str],
 
 #: The choice of the paper's coupon in :func:`specimen_choice`.
 PAPER_CHOICE = "paper coupon (default)"
+#: The specimen list's label while an uploaded specimen file (or the page address's, refused)
+#: takes its place.
+SPECIMEN_REPLACED_LABEL = "specimen (not used: see the specimen file at the right)"
 
 
 #: The page-address parameter of a form's uploaded specimen file: ``{key}_specimen_upload``
@@ -176,9 +179,12 @@ def specimen_choice(key: str, store_path):
     choices = [PAPER_CHOICE, *map(str, files)]
     with c1:
         refuse_address_choices(f"{key}_specimen", "specimen", choices, PAPER_CHOICE)
-    choice = c1.selectbox("specimen", choices, key=f"{key}_specimen",
-                          disabled=uploaded.kept is not None or uploaded.error is not None,
-                          bind=ADDRESS_BINDING)
+    replaced = uploaded.kept is not None or uploaded.error is not None
+    # the greyed list read "specimen: paper coupon (default)" beside the note that an uploaded
+    # file is the one used; its choice is kept (bound to the address) for when the file is
+    # forgotten, so only its label says so (a user key keeps the widget's identity over it)
+    choice = c1.selectbox(SPECIMEN_REPLACED_LABEL if replaced else "specimen", choices,
+                          key=f"{key}_specimen", disabled=replaced, bind=ADDRESS_BINDING)
     if uploaded.error is not None:
         st.error(uploaded.error)
         return None, uploaded.error

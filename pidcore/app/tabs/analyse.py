@@ -10,6 +10,7 @@ import streamlit as st
 
 from pidcore import defaults
 from pidcore.app import state, uploads
+from pidcore.app.vocabulary import page_terms
 from pidcore.constants import DRIVE_DIRECTIONS
 from pidcore.loadcase import parse_optional_rate
 from pidcore.units import display_number
@@ -176,8 +177,9 @@ def _card(upload, row, sample_rate_hz, materials, given=(), known=(), every_file
                                  given=tested)
         warnings, zero_notes = implausible_findings(a, bound=bound)
         for w in warnings:
-            st.warning(f"**Implausible:** {w.message}. *Likely cause:* {w.likely_cause}.",
-                       icon="⚠️")
+            # in the page's words: the library's keywords (specimen=FILE) showed as written
+            st.warning(f"**Implausible:** {page_terms(w.message)}. *Likely cause:* "
+                       f"{page_terms(w.likely_cause)}.", icon="⚠️")
         for note in (*record.notes, *zero_notes):
             st.caption(f"note: {note}")
         # a name alone meets another file's DEM runs of that name; said on the first card

@@ -3,12 +3,10 @@ show the posterior and the measured-vs-predicted plot with bands, download the s
 
 from __future__ import annotations
 
-import dataclasses
 import hashlib
 import re
 from pathlib import Path
 
-import pandas as pd
 import streamlit as st
 
 from pidcore import defaults
@@ -21,6 +19,7 @@ from pidcore.app.calibration import (
     points_for_specimen,
     points_needed,
     points_needed_text,
+    points_table,
     runner_for,
     specimen_label,
 )
@@ -234,16 +233,8 @@ def _form(stores, api, points: list, left_out: list[str]) -> str:
     chosen_cases = st.multiselect("measured load cases to calibrate against (from the store)",
                                   labels, default=labels, key=cases_key, bind=ADDRESS_BINDING)
     points = [p for p, label in zip(points, labels, strict=True) if label in chosen_cases]
-    st.dataframe(pd.DataFrame([dataclasses.asdict(p) for p in points]).drop(
-        # a point kept apart as ambiguous is never offered for a file (points_for_specimen)
-        columns=["source", "row", "specimen_ambiguous"], errors="ignore").rename(columns={
-        "frequency_hz": "frequency [Hz]", "acceleration_g": "acceleration [g]",
-        "fill_percent": "fill [%]", "sdc": "SDC measured, Eq. 11 [-]",
-        "sdc_stderr": "SDC stderr [-]",
-        # every number names its unit: the raw field name was shown as a column head
-        "sdc_stderr_dof": "SDC stderr degrees of freedom [-]"}), hide_index=True,
-        width="stretch",
-        key="calibration_points", placeholder="")
+    st.dataframe(points_table(points), hide_index=True, width="stretch",
+                 key="calibration_points", placeholder="")
     c1, c2, c3 = st.columns(3)
     fittable = fittable_names(api)
     default_fit = [n for n in api.parse_fit(None) if n in fittable]

@@ -9,6 +9,7 @@ import math
 import streamlit as st
 
 from pidcore.app import state, uploads, workbench
+from pidcore.app.tabs import ADDRESS_BINDING, refuse_address_choices
 from pidcore.app.vocabulary import page_terms
 from pidcore.calibrate.prediction import quantile_label
 from pidcore.compare.case import equivalent_dampers
@@ -148,8 +149,16 @@ def render(stores, session_files: list, calibrations: list) -> None:
             name = f"{base} #{len(by_name)}"
         by_name[name] = g
     labels = {name: f"{name} ({len(g)} file(s))" for name, g in by_name.items()}
+    # bound to the page address as the other tabs' fields: a reload showed the first load
+    # case, not the one looked at. The address holds the label shown (Streamlit binds the
+    # formatted option); a case gone since (an unsaved analysis, after a reload) or with
+    # another file count is refused in one line, not dropped unseen
+    # (the fallback is the name, the widget's value, so that the message stays until the
+    # user chooses another case)
+    refuse_address_choices("compare_case", "load case", list(labels.values()),
+                           next(iter(by_name)))
     choice = st.selectbox("load case", list(by_name), format_func=labels.__getitem__,
-                          key="compare_case")
+                          key="compare_case", bind=ADDRESS_BINDING)
     if choice not in by_name:
         choice = next(iter(by_name))
     members = [entries[i] for i in by_name[choice]]
