@@ -107,7 +107,8 @@ def test_json_document(capsys, tmp_path, tiny_store):
                  "--dem-store", str(tiny_store), "--out", str(tmp_path / "out"), *TINY])
     assert code == 0
     doc = json.loads(capsys.readouterr().out)
-    assert set(doc) == {"specimen", "parameters", "predictions", "loo", "loo_rms", "units"}
+    assert set(doc) == {"specimen", "parameters", "predictions", "loo", "loo_rms",
+                        "loo_coverage95", "loo_uninformative95", "units"}
     # which file was calibrated and which it wrote (the document named neither: a
     # calibration.json apart from its folder spoke for the tests of any specimen)
     from pidcore.calibrate.persist import calibration_key

@@ -124,6 +124,28 @@ def test_the_command_prints_the_leave_one_out_count_without_the_uninformative_fo
                            "uninformative: ")
 
 
+def test_the_commands_json_carries_the_leave_one_out_counts(tmp_path, capsys, monkeypatch):
+    # --json had loo_rms but not the k/n the text line prints: a script could not tell 1/2
+    # inside with 1 uninformative from 2/3 inside without recomputing every fold's SDC bound
+    library = importlib.import_module("pidcore.calibrate.calibrate")
+    monkeypatch.setattr(library, "calibrate", lambda points, **kwargs: _result())
+    monkeypatch.setattr(importlib.import_module("pidcore.calibrate.persist"),
+                        "save_calibration", lambda result, store: ("cal_0", True))
+    table = tmp_path / "m.csv"
+    table.write_text("frequency_hz,acceleration_g,fill_percent,sdc\n100,5,50,0.3\n"
+                     "500,5,50,0.9\n1000,5,50,0.5\n")
+    out = tmp_path / "out"
+    assert main(["calibrate", "--data", str(table), "--fit", "fixture_mass_kg",
+                 "--dem-store", str(tmp_path / "d.h5"), "--cells", "2", "--workers", "1",
+                 "--no-progress", "--json", "--out", str(out)]) == 0
+    document = json.loads(capsys.readouterr().out)
+    # the constructed folds: one inside, one outside, one uninformative
+    assert document["loo_coverage95"] == 1 and document["loo_uninformative95"] == 1
+    # the same names and numbers as calibration.json beside it
+    written = json.loads((out / "calibration.json").read_text())
+    assert (written["loo_coverage95"], written["loo_uninformative95"]) == (1, 1)
+
+
 def test_the_stores_listing_counts_the_uninformative_folds_and_reads_older_entries(tmp_path):
     from pidcore.app.calibration import saved_calibrations_table
     from pidcore.calibrate.persist import save_calibration

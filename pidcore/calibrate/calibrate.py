@@ -188,8 +188,9 @@ class CalibrationResult:
         return self.calibration().plot(ax=ax)
 
     def document(self) -> dict:
-        """The ``--json`` document: parameters, predictions, loo, loo_rms, the units of each of
-        their numbers (``units``: the parameters' and the predictions' fields), and
+        """The ``--json`` document: parameters, predictions, loo, loo_rms, loo_coverage95 and
+        loo_uninformative95 (:attr:`loo_coverage`, :attr:`loo_uninformative`), the units of
+        each of their numbers (``units``: the parameters' and the predictions' fields), and
         ``specimen``: which specimen file was calibrated and which it wrote (``name``,
         ``sha256``, ``calibrated_name``, ``calibrated_sha256``)."""
         keep = ("median", "low95", "high95")
@@ -206,6 +207,11 @@ class CalibrationResult:
             "predictions": predictions,
             "loo": [_public(r) for r in self.loo] if self.loo is not None else None,
             "loo_rms": self.loo_rms,
+            # the command's "k/n inside (m more uninformative)" as numbers: without them a
+            # script reading --json had to recompute the SDC bound of every fold; absent in a
+            # calibration.json of an older pidcore, which counted an uninformative band inside
+            "loo_coverage95": self.loo_coverage,
+            "loo_uninformative95": self.loo_uninformative,
             "units": {k: u for k, u in self.units().items() if k in named},
         }
 
@@ -217,10 +223,6 @@ class CalibrationResult:
             "correlations": {"names": [s.name for s in self.specs],
                              "matrix": self.correlations},
             "fixed": self.fixed, "rms_in_sample": self.rms,
-            # among the folds whose band can judge them (loo_coverage); absent in a file
-            # of an older pidcore, which counted an uninformative band inside
-            "loo_coverage95": self.loo_coverage,
-            "loo_uninformative95": self.loo_uninformative,
             "n_points": len(self.predictions),
             "design": {"names": [s.name for s in self.specs if s.kind == "dem"],
                        "points": self.design.tolist()},
