@@ -459,6 +459,44 @@ def test_a_sweep_without_fills_runs_the_fill_the_specimen_states(tmp_path, capsy
         f"specimen steel_6mm states ([particles] count_per_cell 20 of capacity {capacity})\n")
 
 
+def test_a_sweeps_json_notes_say_which_fills_run_and_why(tmp_path, capsys, monkeypatch):
+    # the note on which fills a sweep of one's own specimen runs (the one it states, or the
+    # grid's as it states none) was on stderr only: --json, read by a script, had no word of it
+    import pidcore.dem.sweep as sweep_module
+    from pidcore.dem.sweep import SweepSummary
+
+    spec, mine = _steel_stating_count(tmp_path, monkeypatch, 20)
+    given: list = []
+
+    def summarize(cases, config, *, store_path, **kwargs):
+        # the cases run_sweep was given, and no note of its own: what is in --json's notes
+        # then came from the command
+        given.append(sorted({case.fill_percent for case in cases}))
+        return SweepSummary(store_path=str(store_path))
+
+    monkeypatch.setattr(sweep_module, "run_sweep", summarize)
+    none = tmp_path / "none.toml"
+    none.write_text(spec.read_text().replace("fill_percent = 50.0", ""))
+    argv = ["dem", "sweep", "--frequencies", "500", "--accelerations", "5", "--store",
+            str(tmp_path / "s.h5"), "--no-progress", "--json"]
+    assert main([*argv, "--specimen", str(none)]) == 0
+    captured = capsys.readouterr()
+    said = ("fills 25, 50, 75, 90 % are grid table3's: specimen steel_6mm states no fill "
+            "(count_per_cell or fill_percent); give --fills to choose")
+    assert json.loads(captured.out)["notes"] == [said]
+    assert f"pidcore dem sweep: note: {said}\n" in captured.err  # the same words on stderr
+    assert given.pop() == [25.0, 50.0, 75.0, 90.0]
+    assert main([*argv, "--specimen", str(spec)]) == 0  # steel_6mm states fill_percent 50
+    (note,) = json.loads(capsys.readouterr().out)["notes"]
+    assert note.startswith("fill 50 % is the one specimen steel_6mm states ([particles] "
+                           "fill_percent), as a run of it without a fill simulates; give "
+                           "--fills for others")
+    assert given.pop() == [50.0]
+    # the paper's coupon runs its grid as always, and nothing is said
+    assert main(argv) == 0
+    assert json.loads(capsys.readouterr().out)["notes"] == []
+
+
 def test_a_fill_of_the_specimens_particle_count_is_no_override(tmp_path, capsys, monkeypatch):
     # `dem sweep --fills 8.7` of a file stating 4 particles of 46 per cell (8.69565 %) said
     # "fill 8.7 % overrides the 8.69565 % specimen ... states", though 8.7 % of 46 is 4.002,

@@ -231,8 +231,10 @@ def sweep(args: argparse.Namespace) -> int:
                                          "--accelerations"),
                                         ("fill_percent", args.fills, "--fills"))]
     specimen, material = _specimen(args)
+    fills_note = ""  # which fills run and why: run_sweep, given only the cases, cannot say
     if args.fills is None:  # an own specimen's stated fill, else the grid's (and why)
         values[2], note = sweep_fills(specimen, args.grid, args.fill_reference)
+        fills_note = cli_words(note, "dem sweep") if note else ""
     else:
         # the summary's notes say the same to a library caller and in --json
         note = fill_override_note(specimen, values[2], args.fill_reference)
@@ -260,6 +262,8 @@ def sweep(args: argparse.Namespace) -> int:
         summary = run_sweep(cases, config, store_path=args.store, workers=args.workers,
                             scheduler=args.scheduler, progress=progress_wanted(args),
                             specimen=specimen)
+        if fills_note:  # first, as on stderr: --json said nothing of which fills ran, or why
+            summary.notes.insert(0, fills_note)
         # inside: a Ctrl-C as the summary is printed (every case done) said "no store write
         # was left half-done" instead of what the sweep saved
         _print_sweep(args, summary)
