@@ -209,3 +209,37 @@ def test_the_new_count_leaves_the_key_of_a_fit_saved_before_it_as_it_was():
     older = {k: v for k, v in document.items() if k != "loo_uninformative95"}
     assert calibration_key(document) == calibration_key(older)
     assert calibration_key(document) != calibration_key({**older, "loo_rms": 0.5})
+
+
+def test_the_predictions_figure_draws_an_uninformative_band_apart():
+    # predictions.png drew the 0 .. 25 band (in-sample) and the 0 .. 30 fold (LOO) as filled
+    # points like the others: a reader took a band that holds any measurement for a hit
+    import matplotlib.pyplot as plt
+    from matplotlib.colors import to_rgba
+
+    from pidcore.calibrate.outputs import UNINFORMATIVE_LABEL, predictions_figure
+
+    figure = predictions_figure(_result())
+    try:
+        (ax,) = figure.axes
+        drawn = {c.get_label(): c for c in ax.containers}
+        # per series, the two judging bands (x 0 and 1 shifted) and the uninformative one apart
+        expected = {("calibrated (all points)", -0.12): ([0, 1], [2]),
+                    ("leave-one-out", 0.12): ([0, 1], [2])}
+        for (series, offset), (judging, apart) in expected.items():
+            filled = drawn[f"{series}, 95 % band"].lines[0]
+            hollow = drawn[f"{series}, {UNINFORMATIVE_LABEL}"].lines[0]
+            # positions exact: the index plus a fixed offset, as drawn
+            assert filled.get_xdata() == pytest.approx(np.add(judging, offset), abs=1e-12)
+            assert hollow.get_xdata() == pytest.approx(np.add(apart, offset), abs=1e-12)
+            assert to_rgba(hollow.get_markerfacecolor())[3] == 0.0  # hollow
+            assert to_rgba(filled.get_markerfacecolor())[3] == 1.0
+            # the bars: dashed (a dash pattern) for the uninformative, solid (none) otherwise
+            (dashed,) = drawn[f"{series}, {UNINFORMATIVE_LABEL}"].lines[2][0].get_linestyle()
+            (solid,) = drawn[f"{series}, 95 % band"].lines[2][0].get_linestyle()
+            assert dashed[1] is not None and solid[1] is None
+        legend = [t.get_text() for t in ax.get_legend().get_texts()]
+        assert f"leave-one-out, {UNINFORMATIVE_LABEL}" in legend
+        assert f"calibrated (all points), {UNINFORMATIVE_LABEL}" in legend
+    finally:
+        plt.close(figure)

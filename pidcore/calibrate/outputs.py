@@ -7,6 +7,7 @@ import html
 import json
 import os
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -258,19 +259,30 @@ def shown_band_bars(rows: list[dict], bounds: list[float] | None = None
             bool((high > limit).any()))
 
 
-def plot_predictions(result: CalibrationResult, path: Path) -> None:
-    """Measured SDC per load case with the posterior-predictive 95 % bands (and LOO's)."""
+#: The legend's words for points whose band spans 0 .. the SDC bound, drawn hollow with a
+#: dashed bar (:func:`predictions_figure`).
+UNINFORMATIVE_LABEL = "95 % band uninformative (0 .. SDC bound: cannot test the model)"
+
+
+def predictions_figure(result: CalibrationResult) -> Any:
+    """The figure of predictions.png: measured SDC per load case with the
+    posterior-predictive 95 % bands (and LOO's). A band that spans every plausible SDC
+    (:func:`~pidcore.calibrate.prediction.row_verdict` ``uninformative``) is drawn with a
+    hollow marker and a dashed bar, under a legend entry of its own (:data:`UNINFORMATIVE_LABEL`),
+    as the summary marks and counts it apart; returns the matplotlib figure (not closed)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     from ..compare.plausibility import SDC_UPPER_BOUND
+    from ..constants import BAND_VERDICTS
 
+    uninformative = BAND_VERDICTS[3]
     rows = result.predictions
     x = np.arange(len(rows))
     fig, ax = plt.subplots(figsize=(max(6, 0.7 * len(rows)), 4.5), constrained_layout=True)
-    cut, cut_at = False, set()
+    cut_at = set()
     for offset, data, label, color in ((-0.12, rows, "calibrated (all points)", "C0"),
                                        (0.12, result.loo, "leave-one-out", "C1")):
         if not data:
@@ -279,9 +291,18 @@ def plot_predictions(result: CalibrationResult, path: Path) -> None:
         pred, below, above, cut_here = shown_band_bars(data, bounds)
         if cut_here:
             cut_at.update(b for b, r in zip(bounds, data, strict=True) if r["high95"] > b)
-        cut = cut or cut_here
-        ax.errorbar(x + offset, pred, yerr=[below, above], fmt="o", capsize=3,
-                    color=color, label=f"{label}, 95 % band")
+        # drawn like the others, a band that holds any measurement read as a hit
+        apart = np.array([v == uninformative for v in result.band_verdicts(data)], dtype=bool)
+        for chosen, style, words in ((~apart, {"fmt": "o"}, "95 % band"),
+                                     (apart, {"fmt": "o", "mfc": "none"},
+                                      UNINFORMATIVE_LABEL)):
+            if not chosen.any():
+                continue
+            drawn = ax.errorbar((x + offset)[chosen], pred[chosen],
+                                yerr=[below[chosen], above[chosen]], capsize=3, color=color,
+                                label=f"{label}, {words}", **style)
+            if chosen is apart:
+                drawn.lines[2][0].set_linestyle("--")
     for bound in sorted(cut_at):  # a band past its bound reached a value no measurement is
         # kept at: drawn cut there, one line per bound (a fill of its own has its own)
         ax.axhline(bound, color="0.5", ls="--", lw=1,
@@ -292,8 +313,18 @@ def plot_predictions(result: CalibrationResult, path: Path) -> None:
                   fontsize=8)
     ax.set_ylabel("SDC [-]")
     ax.legend(fontsize=8)
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    return fig
+
+
+def plot_predictions(result: CalibrationResult, path: Path) -> None:
+    """predictions.png (:func:`predictions_figure`) written to ``path``."""
+    import matplotlib.pyplot as plt
+
+    fig = predictions_figure(result)
+    try:
+        fig.savefig(path, dpi=120)
+    finally:
+        plt.close(fig)
 
 
 def plot_pairs(result: CalibrationResult, path: Path) -> None:
