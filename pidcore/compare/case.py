@@ -16,6 +16,7 @@ import pandas as pd
 
 from .. import defaults
 from ..errors import ParameterError, PidcoreError
+from ..units import display_sigmas
 from .align import (
     Aligner,
     Tolerances,
@@ -620,7 +621,7 @@ class Headline:
         |measured - DEM| / sigma, sigma = sqrt(measured stderr^2 + DEM stderr^2) (the known
         one alone where the other has none: then an upper bound); NaN when not comparable.
     verdict : str
-        What was found, short enough for a heading, e.g. ``"agrees: |measured − DEM| = 0.8 σ,
+        What was found, short enough for a heading, e.g. ``"agrees: |measured − DEM| = 0.83 σ,
         inside the 95 % interval ±2.45 σ"``, ``"no DEM value at this case"``.
     basis : str
         What σ and the interval are, with the verdict's numbers, e.g. ``"σ = √(measured
@@ -687,13 +688,14 @@ def headline(comparison: CaseComparison) -> Headline:
                 + (", Welch-Satterthwaite" if len(parts) == 2 else ""))
     z = abs(m - dem) / se
     inside = z <= q
+    z_text = display_sigmas(z)
     interval = f"the 95 % interval ±{q:.3g} σ"
     # the verdict is a heading's end; what σ and the interval are goes in its basis, below it
     quantile_basis = f"±{q:.3g} σ: {quantile}"
     if len(parts) == 2:
         basis = f"σ = √(measured stderr² + DEM stderr²); {quantile_basis}"
-        verdict = (f"agrees: |measured − DEM| = {z:.1f} σ, inside {interval}" if inside else
-                   f"differs: |measured − DEM| = {z:.1f} σ, outside {interval}")
+        verdict = (f"agrees: |measured − DEM| = {z_text} σ, inside {interval}" if inside else
+                   f"differs: |measured − DEM| = {z_text} σ, outside {interval}")
     else:
         # one side's error is unknown (a 1-cell DEM run, a single record without one): the
         # combined σ is at least the known side's, so z is an upper bound; "differs by" would
@@ -703,9 +705,9 @@ def headline(comparison: CaseComparison) -> Headline:
         basis = (f"σ: the {known} stderr alone, the {unknown} has no standard error; "
                  f"{quantile_basis}")
         if inside:  # inside with the known σ alone: inside the whole, wider interval too
-            verdict = f"agrees: |measured − DEM| ≤ {z:.1f} σ, inside {interval}"
+            verdict = f"agrees: |measured − DEM| ≤ {z_text} σ, inside {interval}"
         else:  # outside the known side's interval only: the whole one is unknown
-            verdict = (f"differs by up to {z:.1f} σ: outside {interval} of the {known} stderr "
+            verdict = (f"differs by up to {z_text} σ: outside {interval} of the {known} stderr "
                        "alone")
             basis = (f"σ: the {known} stderr alone; the {unknown} has no standard error (e.g. "
                      "a 1-cell run), so whether it lies outside the whole interval is unknown; "
