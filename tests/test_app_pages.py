@@ -897,8 +897,13 @@ def test_compare_shows_the_calibrated_band_beside_raw_dem_and_measurement(
     captions = " ".join(c.value for c in at.caption)
     bound = sdc_bound(fill_percent=50.0, material="acrylic").sdc
     shown = (band[0], min(band[1], bound))
-    assert f"calibrated 95 % band {shown[0]:.4f} .. {shown[1]:.4f}" in captions
+    # in the report's cell format (4 significant digits): "0.0000 .. 16.9115" here read
+    # "0 .. 16.91" in the verdict's sentence after it, the same band in two spellings
+    assert f"calibrated 95 % band {shown[0]:.4g} .. {shown[1]:.4g} [-]" in captions
+    assert [m.help for m in at.metric if m.label == "SDC calibrated DEM, Eq. 11 [-]"] == [
+        f"95 % band {shown[0]:.4g} .. {shown[1]:.4g}"]
     if verdict == "uninformative":
+        assert "calibrated 95 % band 0 .. 16.91 [-]" in captions  # as the sentence below
         assert ("the measured Eq. 11 SDC is uninformative: the calibrated 95 % band 0 .. 16.91 "
                 "spans every plausible SDC (0 to 16.91, the bound of the specimen's particles; "
                 "the calibration does not constrain the SDC here), so it cannot test the "

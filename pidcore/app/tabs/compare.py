@@ -11,7 +11,7 @@ import streamlit as st
 from pidcore.app import state, uploads, workbench
 from pidcore.app.tabs import ADDRESS_BINDING, refuse_address_choices
 from pidcore.app.vocabulary import page_terms
-from pidcore.calibrate.prediction import quantile_label
+from pidcore.calibrate.prediction import band_text, quantile_label
 from pidcore.compare.case import equivalent_dampers
 from pidcore.compare.specimens import NOT_PAPER_SPECIMEN_NOTE
 from pidcore.specimen import is_paper_coupon
@@ -102,7 +102,7 @@ def _calibrated(calibrations, comp, head, specimen: str, *, implausible: bool = 
     own_stderr = comp.measured_stderr if math.isfinite(comp.measured_sdc) else math.nan
     low, high = hit.band(own_stderr, comp.measured_stderr_dof)
     c3.metric("SDC calibrated DEM, Eq. 11 [-]", display_number(hit.sdc),
-              help=f"95 % band {display_number(low)} .. {display_number(high)}")
+              help=f"95 % band {band_text(low, high)}")
     if not math.isfinite(comp.measured_sdc):
         verdict = "not compared (no Eq. 11 SDC)"
     elif implausible:  # as the report judges such a row: its stderr is an impossible scatter
@@ -112,7 +112,8 @@ def _calibrated(calibrations, comp, head, specimen: str, *, implausible: bool = 
         verdict = uninformative
     else:
         verdict = "inside" if low <= comp.measured_sdc <= high else "outside"
-    st.caption(f"calibrated 95 % band {display_number(low)} .. {display_number(high)} [-]"
+    # the report's format: its uninformative reason below writes this band "0 .. 16.91"
+    st.caption(f"calibrated 95 % band {band_text(low, high)} [-]"
                + (f" (for this measurement's SDC stderr {comp.measured_stderr:.3g}, "
                   f"widened by the {quantile_label(comp.measured_stderr_dof)})"
                   if (low, high) != hit.band() else "")
