@@ -6,6 +6,7 @@ Records come from this session's uploads and from every saved analysis of the st
 
 from __future__ import annotations
 
+import math
 import os
 from collections.abc import Sequence
 from pathlib import Path
@@ -14,6 +15,7 @@ import pandas as pd
 
 from ..compare.case import (
     CaseComparison,
+    Headline,
     MeasuredEntry,
     compare_case,
     group_load_cases,
@@ -185,7 +187,12 @@ def case_view(entries: Sequence[MeasuredEntry], dem_runs: pd.DataFrame | None,
         notes.append(found)
     elif found is not None:
         loops.append(found)
-    return {"comparison": comparison, "headline": headline(comparison),
+    # the runs the page's warning names are not "no runs"; another specimen's runs left out are
+    # said in the note of the specimen rule, more precisely than the alignment's message
+    why_no_dem = ("the DEM runs met are not pooled (named in the warning below)" if met.refused
+                  else met.note if met.runs is None or met.runs.empty else "")
+    return {"comparison": comparison,
+            "headline": headline(comparison, why_no_dem=why_no_dem),
             "sdc_points": sdc_points(comparison), "loops": loop_frame(loops),
             "energies": {loop.label: loop.energy_per_cycle_j for loop in loops},
             "spectrum": entries[0].spectrum(), "notes": notes,
@@ -193,6 +200,22 @@ def case_view(entries: Sequence[MeasuredEntry], dem_runs: pd.DataFrame | None,
             "dem_warning": (not_converged_note(grid) if grid is not None and grid.not_converged
                             else "")}
 
+
+
+def headline_heading(head: Headline, dem_specimen: str = "") -> str:
+    """The Compare page's heading of one load case: the like-for-like measured SDC, our DEM's
+    (naming the specimen of its runs, ``dem_specimen``: another specimen's are never met) and
+    the verdict; without a DEM value only the measured SDC and the verdict saying so and why
+    ("vs our DEM none" read as a number)."""
+    from .uploads import format_sdc
+
+    measured = (f"measured ({head.measured_kind.split(' (')[0]}) "
+                f"{format_sdc(head.measured, head.measured_stderr)}")
+    if not math.isfinite(head.dem):
+        return f"{measured} — {head.verdict}"
+    dem = format_sdc(head.dem, head.dem_stderr) + (f" (specimen {dem_specimen})"
+                                                   if dem_specimen else "")
+    return f"{measured} vs our DEM {dem} — {head.verdict}"
 
 #: Report columns whose missing number is a result without a value, shown with the reason.
 REPORT_STDERR_COLUMN = "SDC DEM stderr [-]"

@@ -622,7 +622,8 @@ class Headline:
         one alone where the other has none: then an upper bound); NaN when not comparable.
     verdict : str
         What was found, short enough for a heading, e.g. ``"agrees: |measured − DEM| = 0.83 σ,
-        inside the 95 % interval ±2.45 σ"``, ``"no DEM value at this case"``.
+        inside the 95 % interval ±2.45 σ"``, ``"no DEM value at this case: no DEM runs of ours
+        for acrylic, direction z"``.
     basis : str
         What σ and the interval are, with the verdict's numbers, e.g. ``"σ = √(measured
         stderr² + DEM stderr²); ±2.45 σ: Student t of 6.03 degrees of freedom,
@@ -656,11 +657,13 @@ class Headline:
     basis: str = ""
 
 
-def headline(comparison: CaseComparison) -> Headline:
+def headline(comparison: CaseComparison, *, why_no_dem: str = "") -> Headline:
     """Measured (like for like) vs our DEM for one load case: whether their difference lies
     inside its 95 % interval, ±t_0.975 sigma with sigma = sqrt(measured stderr^2 + DEM
     stderr^2) and t of their Welch-Satterthwaite degrees of freedom (1.96 where neither states
-    them). The verdict names the interval; its basis says what sigma is and which quantile."""
+    them). The verdict names the interval; its basis says what sigma is and which quantile.
+    Without a DEM value the verdict says why: ``why_no_dem`` (what the caller knows of the
+    runs, e.g. those of another specimen left out), else the alignment's message."""
     c = comparison
     if math.isfinite(c.measured_sdc_eq10):
         m, m_se, kind = c.measured_sdc_eq10, c.measured_stderr_eq10, "Eq. 10 (DEM m_c)"
@@ -673,7 +676,10 @@ def headline(comparison: CaseComparison) -> Headline:
     grid = getattr(c.aligned, "grid_case", None)
     dem_dof = float(getattr(grid, "sdc_stderr_dof", math.nan)) if grid is not None else math.nan
     if not math.isfinite(dem):
-        return Headline(m, m_se, kind, dem, dem_se, math.nan, "no DEM value at this case")
+        # "vs our DEM none" read as a number; the reason was only in a caption further down
+        why = why_no_dem or getattr(c.aligned, "message", "")
+        return Headline(m, m_se, kind, dem, dem_se, math.nan,
+                        "no DEM value at this case" + (f": {why}" if why else ""))
     if kind == "Eq. 11":
         return Headline(m, m_se, kind, dem, dem_se, math.nan,
                         "not comparable: the DEM case has no m_c for the Eq. 10 energy")

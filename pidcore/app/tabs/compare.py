@@ -172,13 +172,7 @@ def render(stores, session_files: list, calibrations: list) -> None:
     comp, head = view["comparison"], view["headline"]
     aligned = comp.aligned
     # the DEM number names its specimen: runs of another specimen are never met
-    dem_text = (uploads.format_sdc(head.dem, head.dem_stderr)
-                + (f" (specimen {view['dem_specimen']})" if view["dem_specimen"] else "")
-                if math.isfinite(head.dem) else "none")
-    # the headline names its SDC: the calibrated section below shows the Eq. 11 one
-    st.markdown(f"### measured ({head.measured_kind.split(' (')[0]}) "
-                f"{uploads.format_sdc(head.measured, head.measured_stderr)} "
-                f"vs our DEM {dem_text} — {head.verdict}")
+    st.markdown("### " + workbench.headline_heading(head, view["dem_specimen"]))
     if head.basis:  # what σ and the interval are: in the heading it wrapped the line
         st.caption(head.basis)
     if view["dem_refused"]:
