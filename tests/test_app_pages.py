@@ -1481,9 +1481,12 @@ def test_compare_of_another_specimen_says_why_neither_paper_nor_dem_is_shown(sto
     assert any("DEM alignment: no_dem_runs. no DEM runs of specimen my_coupon for acrylic, "
                "direction z" in c for c in captions), captions
     assert not any("Table 3 has no value at this case" in c for c in captions), captions
-    assert "paper: none: specimen my_coupon is not the paper's coupon: the paper's Table 3 " \
-           "is not compared (it tabulates the paper's coupon)" in captions
-    assert _metric(at, "SDC paper DEM [-]") == ["none"]
+    # said plainly, not as a missing value ("SDC paper DEM: none", "paper: none: ..." before):
+    # Table 3 has 0.1891 at this case, for the paper's coupon
+    assert "specimen my_coupon is not the paper's coupon: the paper's Table 3 is not compared " \
+           "(it tabulates the paper's coupon)" in captions
+    assert _metric(at, "SDC paper DEM [-]") == [] and _metric(at, "SDC paper measured [-]") == []
+    assert not any("paper: none" in c for c in captions), captions
 
 
 def test_report_files_of_an_older_store_state_are_said_to_be_stale(store_file):

@@ -217,6 +217,33 @@ def headline_heading(head: Headline, dem_specimen: str = "") -> str:
                                                    if dem_specimen else "")
     return f"{measured} vs our DEM {dem} — {head.verdict}"
 
+
+def paper_details(comparison: CaseComparison, specimen: str) -> tuple[dict[str, str], str]:
+    """The paper's Table 3 beside one load case of the Compare page: its metrics (label ->
+    shown value; ``"none"`` where Table 3 has no value, which fits a metric's width) and a
+    caption saying why a value is missing. A test of another specimen than the paper's
+    coupon (``specimen``, the name its tests are saved under) gets no metrics, only the
+    caption: Table 3 is not compared for it ("SDC paper DEM: none" read as if the paper had
+    no value at a case it tabulates for its own coupon)."""
+    from ..compare.specimens import NOT_PAPER_SPECIMEN_NOTE
+    from ..specimen import is_paper_coupon
+    from ..units import display_number
+
+    # by name: a test of another file of the coupon's name is saved as "paper_coupon
+    # [45d792]" (measured_specimen_name), which is not the paper's
+    if not is_paper_coupon(specimen):
+        return {}, (NOT_PAPER_SPECIMEN_NOTE.format(name=specimen.strip())
+                    + " (it tabulates the paper's coupon)")
+    aligned = comparison.aligned
+    values = (aligned.sdc_paper_dem, aligned.sdc_paper_experimental)
+    metrics = {label: display_number(v, missing="none")
+               for label, v in zip(("SDC paper DEM [-]", "SDC paper measured [-]"), values,
+                                   strict=True)}
+    caption = ("" if all(math.isfinite(v) for v in values) else
+               "paper: none where Table 3 has no value at this case (it tabulates the paper's "
+               "coupon, acrylic spheres driven along z, at its grid of load cases)")
+    return metrics, caption
+
 #: Report columns whose missing number is a result without a value, shown with the reason.
 REPORT_STDERR_COLUMN = "SDC DEM stderr [-]"
 REPORT_CHI2_COLUMN = CONSISTENCY_COLUMN

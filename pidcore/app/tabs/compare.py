@@ -13,8 +13,6 @@ from pidcore.app.tabs import ADDRESS_BINDING, refuse_address_choices
 from pidcore.app.vocabulary import page_terms
 from pidcore.calibrate.prediction import band_text, quantile_label
 from pidcore.compare.case import equivalent_dampers
-from pidcore.compare.specimens import NOT_PAPER_SPECIMEN_NOTE
-from pidcore.specimen import is_paper_coupon
 from pidcore.units import display_number
 
 
@@ -205,21 +203,11 @@ def render(stores, session_files: list, calibrations: list) -> None:
         c1.metric("SDC measured, Eq. 11 ± stderr [-]",
                   uploads.format_sdc(comp.measured_sdc, comp.measured_stderr),
                   help="energy per cycle over the reactive energy Im(P)/w")
-        # "none" fits the metric's width ("not a Table 3 case" was cut); the caption says why
-        c2.metric("SDC paper DEM [-]", display_number(aligned.sdc_paper_dem, missing="none"))
-        c3.metric("SDC paper measured [-]",
-                  display_number(aligned.sdc_paper_experimental, missing="none"))
-        # by name: a test of another file of the coupon's name is saved as "paper_coupon
-        # [45d792]" (measured_specimen_name), which is not the paper's
-        if not is_paper_coupon(members[0].specimen):
-            # Table 3 may well have this case: its values are of another coupon
-            st.caption("paper: none: " + NOT_PAPER_SPECIMEN_NOTE.format(
-                name=members[0].specimen.strip()) + " (it tabulates the paper's coupon)")
-        elif not (math.isfinite(aligned.sdc_paper_dem)
-                  and math.isfinite(aligned.sdc_paper_experimental)):
-            st.caption("paper: none where Table 3 has no value at this case (it tabulates "
-                       "the paper's coupon, acrylic spheres driven along z, at its grid of "
-                       "load cases)")
+        paper_metrics, paper_caption = workbench.paper_details(comp, members[0].specimen)
+        for column, (label, value) in zip((c2, c3), paper_metrics.items(), strict=False):
+            column.metric(label, value)
+        if paper_caption:
+            st.caption(paper_caption)
     _calibrated(calibrations, comp, head, members[0].specimen,
                 implausible=any(e.implausible for e in members),
                 specimen_sha256=members[0].specimen_sha256)
