@@ -186,6 +186,17 @@ def display_number(value: float | None, *, decimals: int = 4, missing: str = "�
     return f"{value:.3g}"
 
 
+def display_sigmas(multiple: float) -> str:
+    """A multiple of sigma as a verdict states it: three significant digits, without an
+    exponent or a trailing ``.0`` (``"4874.0 σ"`` read as a measured, exact count).
+
+    >>> display_sigmas(4874.04), display_sigmas(0.8312), display_sigmas(12.0), display_sigmas(2.0)
+    ('4870', '0.831', '12', '2')
+    """
+    rounded = float(f"{multiple:.3g}")
+    return f"{rounded:.0f}" if abs(rounded) >= 100 else f"{rounded:g}"
+
+
 def display_with_uncertainty(value: float, stderr: float, *, digits: int = 4,
                              missing: str = "—") -> str:
     """``value`` rounded at the first significant digit of its standard error ``stderr`` (the

@@ -244,7 +244,10 @@ def test_compare_shows_dem_model_and_paper_and_switching_uses_the_cache(store_fi
     # "none" fits the metric ("not a Table 3 case" was cut to "not a Table 3 c…" at 1280 px)
     assert _metric(at, "SDC paper measured [-]") == ["none"]
     assert any("Table 3 has no value at this case" in c.value for c in at.caption)
-    assert "vs our DEM none — no DEM value" in _headline(at)
+    # no DEM value said plainly, with why ("vs our DEM none" read as a number before)
+    assert "none" not in _headline(at) and "vs our DEM" not in _headline(at)
+    assert " — no DEM value at this case: no pchip model over our DEM runs (acrylic, z)" \
+        in _headline(at)
     assert calls == ["a_fill50.csv", "b_fill90.csv"]  # switching never re-analyses
     ARTIFACTS.mkdir(exist_ok=True)
     (ARTIFACTS / "app_switch_timing.json").write_text(json.dumps(
@@ -460,7 +463,8 @@ def test_dem_tab_runs_in_the_background_and_the_compare_tab_uses_the_run(store_f
 
     at = _upload(_app(), [("coupon_fill50.csv", mass_damper_csv(frequency_hz=100.0,
                                                                  acceleration_g=5.0))])
-    assert "vs our DEM none" in _headline(at)
+    assert _headline(at).endswith(" — no DEM value at this case: no DEM runs of ours for "
+                                  "acrylic, direction z")
     _fill_dem(at, freqs="100", accs="5", fills="50", cells=2, steady=20)
     at.run()
     assert not store_file.exists()
@@ -897,8 +901,13 @@ def test_compare_shows_the_calibrated_band_beside_raw_dem_and_measurement(
     captions = " ".join(c.value for c in at.caption)
     bound = sdc_bound(fill_percent=50.0, material="acrylic").sdc
     shown = (band[0], min(band[1], bound))
-    assert f"calibrated 95 % band {shown[0]:.4f} .. {shown[1]:.4f}" in captions
+    # in the report's cell format (4 significant digits): "0.0000 .. 16.9115" here read
+    # "0 .. 16.91" in the verdict's sentence after it, the same band in two spellings
+    assert f"calibrated 95 % band {shown[0]:.4g} .. {shown[1]:.4g} [-]" in captions
+    assert [m.help for m in at.metric if m.label == "SDC calibrated DEM, Eq. 11 [-]"] == [
+        f"95 % band {shown[0]:.4g} .. {shown[1]:.4g}"]
     if verdict == "uninformative":
+        assert "calibrated 95 % band 0 .. 16.91 [-]" in captions  # as the sentence below
         assert ("the measured Eq. 11 SDC is uninformative: the calibrated 95 % band 0 .. 16.91 "
                 "spans every plausible SDC (0 to 16.91, the bound of the specimen's particles; "
                 "the calibration does not constrain the SDC here), so it cannot test the "
@@ -1141,7 +1150,8 @@ def test_compare_meets_the_dem_run_of_the_files_specimen_and_says_it_did_not_con
                                       "fill [%]", "material", "SDC [-]", "SDC stderr [-]"]
     # no specimen named, runs of two: no DEM value, and the page says which and what to do
     at = _upload(_app(), [("m_fill50.csv", data), ("settings.csv", _steel_settings(None))])
-    assert "vs our DEM none" in _headline(at)
+    assert _headline(at).endswith(" — no DEM value at this case: the DEM runs met are not "
+                                  "pooled (named in the warning below)")
     said = " ".join(w.value for w in at.warning)
     assert "steel_6mm [aaaaaa]" in said and "steel_6mm_b [bbbbbb]" in said
     assert "Name the file's specimen" in said
@@ -1463,15 +1473,20 @@ def test_compare_of_another_specimen_says_why_neither_paper_nor_dem_is_shown(sto
     at = _upload(_app(), [("m_fill50.csv", mass_damper_csv(frequency_hz=100.0,
                                                            acceleration_g=5.0)),
                           ("settings.csv", settings)])
-    assert "vs our DEM none" in _headline(at)
+    assert _headline(at).endswith(" — no DEM value at this case: no DEM runs of specimen "
+                                  "my_coupon at acrylic, z; DEM runs of other specimens not "
+                                  "compared: paper_coupon (2 run(s))")
     captions = [c.value for c in at.caption]
     assert not any("no DEM runs of ours" in c for c in captions), captions
     assert any("DEM alignment: no_dem_runs. no DEM runs of specimen my_coupon for acrylic, "
                "direction z" in c for c in captions), captions
     assert not any("Table 3 has no value at this case" in c for c in captions), captions
-    assert "paper: none: specimen my_coupon is not the paper's coupon: the paper's Table 3 " \
-           "is not compared (it tabulates the paper's coupon)" in captions
-    assert _metric(at, "SDC paper DEM [-]") == ["none"]
+    # said plainly, not as a missing value ("SDC paper DEM: none", "paper: none: ..." before):
+    # Table 3 has 0.1891 at this case, for the paper's coupon
+    assert "specimen my_coupon is not the paper's coupon: the paper's Table 3 is not compared " \
+           "(it tabulates the paper's coupon)" in captions
+    assert _metric(at, "SDC paper DEM [-]") == [] and _metric(at, "SDC paper measured [-]") == []
+    assert not any("paper: none" in c for c in captions), captions
 
 
 def test_report_files_of_an_older_store_state_are_said_to_be_stale(store_file):

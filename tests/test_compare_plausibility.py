@@ -140,7 +140,7 @@ def test_headline_compares_like_with_like_and_counts_sigmas():
     # as the end of the app's heading (its basis inside it wrapped the heading), and the basis
     # states the same interval
     dof = (se**2 + 0.01**2) ** 2 / (se**4 / m_dof + 0.01**4 / 3.0)
-    assert agree.verdict == (f"agrees: |measured − DEM| = {agree.sigmas:.1f} σ, inside the "
+    assert agree.verdict == (f"agrees: |measured − DEM| = {agree.sigmas:.3g} σ, inside the "
                              f"95 % interval ±{q:.3g} σ")
     assert agree.basis == (f"σ = √(measured stderr² + DEM stderr²); ±{q:.3g} σ: Student t of "
                            f"{dof:.3g} degrees of freedom, Welch-Satterthwaite")
@@ -155,9 +155,14 @@ def test_headline_compares_like_with_like_and_counts_sigmas():
     # the count is only an upper bound, and the verdict says so ("differs by 314.1 σ" before)
     one_cell = headline(compare_case([_entry(rec)], _dem(m + 1.0, float("nan")), paper))
     assert one_cell.sigmas == pytest.approx(1.0 / se)
-    assert one_cell.verdict.startswith(f"differs by up to {1.0 / se:.1f} σ: outside the 95 % "
-                                       "interval") and "the DEM value has no standard error" \
-        in one_cell.basis
+    assert 1000 <= 1.0 / se < 10_000  # 3 significant digits: rounded to tens
+    assert one_cell.verdict.startswith(f"differs by up to {round(1.0 / se, -1):.0f} σ: "
+                                       "outside the 95 % interval")
+    assert "the DEM value has no standard error" in one_cell.basis
+    # a multiple in the thousands reads as its 3 significant digits ("differs by up to 4874.0
+    # σ" before: a decimal the stderr does not carry)
+    huge = headline(compare_case([_entry(rec)], _dem(m + 4874.04 * se, float("nan")), paper))
+    assert huge.verdict.startswith("differs by up to 4870 σ: outside the 95 % interval")
     assert one_cell.agrees is None  # outside the measurement's interval, the whole unknown
     near = headline(compare_case([_entry(rec)], _dem(m + 0.5 * se, float("nan")), paper))
     q_measured = _ws_quantile([(se, m_dof)])

@@ -6,6 +6,7 @@ Records come from this session's uploads and from every saved analysis of the st
 
 from __future__ import annotations
 
+import math
 import os
 from collections.abc import Sequence
 from pathlib import Path
@@ -14,6 +15,7 @@ import pandas as pd
 
 from ..compare.case import (
     CaseComparison,
+    Headline,
     MeasuredEntry,
     compare_case,
     group_load_cases,
@@ -185,7 +187,12 @@ def case_view(entries: Sequence[MeasuredEntry], dem_runs: pd.DataFrame | None,
         notes.append(found)
     elif found is not None:
         loops.append(found)
-    return {"comparison": comparison, "headline": headline(comparison),
+    # the runs the page's warning names are not "no runs"; another specimen's runs left out are
+    # said in the note of the specimen rule, more precisely than the alignment's message
+    why_no_dem = ("the DEM runs met are not pooled (named in the warning below)" if met.refused
+                  else met.note if met.runs is None or met.runs.empty else "")
+    return {"comparison": comparison,
+            "headline": headline(comparison, why_no_dem=why_no_dem),
             "sdc_points": sdc_points(comparison), "loops": loop_frame(loops),
             "energies": {loop.label: loop.energy_per_cycle_j for loop in loops},
             "spectrum": entries[0].spectrum(), "notes": notes,
@@ -193,6 +200,49 @@ def case_view(entries: Sequence[MeasuredEntry], dem_runs: pd.DataFrame | None,
             "dem_warning": (not_converged_note(grid) if grid is not None and grid.not_converged
                             else "")}
 
+
+
+def headline_heading(head: Headline, dem_specimen: str = "") -> str:
+    """The Compare page's heading of one load case: the like-for-like measured SDC, our DEM's
+    (naming the specimen of its runs, ``dem_specimen``: another specimen's are never met) and
+    the verdict; without a DEM value only the measured SDC and the verdict saying so and why
+    ("vs our DEM none" read as a number)."""
+    from .uploads import format_sdc
+
+    measured = (f"measured ({head.measured_kind.split(' (')[0]}) "
+                f"{format_sdc(head.measured, head.measured_stderr)}")
+    if not math.isfinite(head.dem):
+        return f"{measured} — {head.verdict}"
+    dem = format_sdc(head.dem, head.dem_stderr) + (f" (specimen {dem_specimen})"
+                                                   if dem_specimen else "")
+    return f"{measured} vs our DEM {dem} — {head.verdict}"
+
+
+def paper_details(comparison: CaseComparison, specimen: str) -> tuple[dict[str, str], str]:
+    """The paper's Table 3 beside one load case of the Compare page: its metrics (label ->
+    shown value; ``"none"`` where Table 3 has no value, which fits a metric's width) and a
+    caption saying why a value is missing. A test of another specimen than the paper's
+    coupon (``specimen``, the name its tests are saved under) gets no metrics, only the
+    caption: Table 3 is not compared for it ("SDC paper DEM: none" read as if the paper had
+    no value at a case it tabulates for its own coupon)."""
+    from ..compare.specimens import NOT_PAPER_SPECIMEN_NOTE
+    from ..specimen import is_paper_coupon
+    from ..units import display_number
+
+    # by name: a test of another file of the coupon's name is saved as "paper_coupon
+    # [45d792]" (measured_specimen_name), which is not the paper's
+    if not is_paper_coupon(specimen):
+        return {}, (NOT_PAPER_SPECIMEN_NOTE.format(name=specimen.strip())
+                    + " (it tabulates the paper's coupon)")
+    aligned = comparison.aligned
+    values = (aligned.sdc_paper_dem, aligned.sdc_paper_experimental)
+    metrics = {label: display_number(v, missing="none")
+               for label, v in zip(("SDC paper DEM [-]", "SDC paper measured [-]"), values,
+                                   strict=True)}
+    caption = ("" if all(math.isfinite(v) for v in values) else
+               "paper: none where Table 3 has no value at this case (it tabulates the paper's "
+               "coupon, acrylic spheres driven along z, at its grid of load cases)")
+    return metrics, caption
 
 #: Report columns whose missing number is a result without a value, shown with the reason.
 REPORT_STDERR_COLUMN = "SDC DEM stderr [-]"

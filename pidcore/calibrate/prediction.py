@@ -56,6 +56,13 @@ def band_cut_words(bound: SdcBound) -> str:
             "refused as implausible)")
 
 
+
+def band_text(low: float, high: float) -> str:
+    """A 95 % band as the report's cells write its bounds (4 significant digits, e.g.
+    ``"0 .. 16.91"``), so that the one band reads the same in every sentence of a page;
+    ``"—"`` for a bound that is not a number."""
+    return " .. ".join(f"{v:.4g}" if math.isfinite(v) else "—" for v in (low, high))
+
 @dataclass(frozen=True)
 class CalibratedPrediction:
     """The calibrated DEM's prediction at one load case.
@@ -208,7 +215,7 @@ class CalibratedPrediction:
                  "the calibration does not constrain the SDC here")
         upper = ("2 pi" if bound <= SDC_UPPER_BOUND else
                  f"{bound:.4g}, the bound of the specimen's particles")
-        return (f"uninformative: the calibrated 95 % band 0 .. {bound:.4g} spans every "
+        return (f"uninformative: the calibrated 95 % band {band_text(0.0, bound)} spans every "
                 f"plausible SDC (0 to {upper}; {cause}), so it cannot test the model: not "
                 "judged and not counted as inside")
 

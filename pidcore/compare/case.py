@@ -16,6 +16,7 @@ import pandas as pd
 
 from .. import defaults
 from ..errors import ParameterError, PidcoreError
+from ..units import display_sigmas
 from .align import (
     Aligner,
     Tolerances,
@@ -620,8 +621,9 @@ class Headline:
         |measured - DEM| / sigma, sigma = sqrt(measured stderr^2 + DEM stderr^2) (the known
         one alone where the other has none: then an upper bound); NaN when not comparable.
     verdict : str
-        What was found, short enough for a heading, e.g. ``"agrees: |measured − DEM| = 0.8 σ,
-        inside the 95 % interval ±2.45 σ"``, ``"no DEM value at this case"``.
+        What was found, short enough for a heading, e.g. ``"agrees: |measured − DEM| = 0.83 σ,
+        inside the 95 % interval ±2.45 σ"``, ``"no DEM value at this case: no DEM runs of ours
+        for acrylic, direction z"``.
     basis : str
         What σ and the interval are, with the verdict's numbers, e.g. ``"σ = √(measured
         stderr² + DEM stderr²); ±2.45 σ: Student t of 6.03 degrees of freedom,
@@ -655,11 +657,13 @@ class Headline:
     basis: str = ""
 
 
-def headline(comparison: CaseComparison) -> Headline:
+def headline(comparison: CaseComparison, *, why_no_dem: str = "") -> Headline:
     """Measured (like for like) vs our DEM for one load case: whether their difference lies
     inside its 95 % interval, ±t_0.975 sigma with sigma = sqrt(measured stderr^2 + DEM
     stderr^2) and t of their Welch-Satterthwaite degrees of freedom (1.96 where neither states
-    them). The verdict names the interval; its basis says what sigma is and which quantile."""
+    them). The verdict names the interval; its basis says what sigma is and which quantile.
+    Without a DEM value the verdict says why: ``why_no_dem`` (what the caller knows of the
+    runs, e.g. those of another specimen left out), else the alignment's message."""
     c = comparison
     if math.isfinite(c.measured_sdc_eq10):
         m, m_se, kind = c.measured_sdc_eq10, c.measured_stderr_eq10, "Eq. 10 (DEM m_c)"
@@ -672,7 +676,10 @@ def headline(comparison: CaseComparison) -> Headline:
     grid = getattr(c.aligned, "grid_case", None)
     dem_dof = float(getattr(grid, "sdc_stderr_dof", math.nan)) if grid is not None else math.nan
     if not math.isfinite(dem):
-        return Headline(m, m_se, kind, dem, dem_se, math.nan, "no DEM value at this case")
+        # "vs our DEM none" read as a number; the reason was only in a caption further down
+        why = why_no_dem or getattr(c.aligned, "message", "")
+        return Headline(m, m_se, kind, dem, dem_se, math.nan,
+                        "no DEM value at this case" + (f": {why}" if why else ""))
     if kind == "Eq. 11":
         return Headline(m, m_se, kind, dem, dem_se, math.nan,
                         "not comparable: the DEM case has no m_c for the Eq. 10 energy")
@@ -687,13 +694,14 @@ def headline(comparison: CaseComparison) -> Headline:
                 + (", Welch-Satterthwaite" if len(parts) == 2 else ""))
     z = abs(m - dem) / se
     inside = z <= q
+    z_text = display_sigmas(z)
     interval = f"the 95 % interval ±{q:.3g} σ"
     # the verdict is a heading's end; what σ and the interval are goes in its basis, below it
     quantile_basis = f"±{q:.3g} σ: {quantile}"
     if len(parts) == 2:
         basis = f"σ = √(measured stderr² + DEM stderr²); {quantile_basis}"
-        verdict = (f"agrees: |measured − DEM| = {z:.1f} σ, inside {interval}" if inside else
-                   f"differs: |measured − DEM| = {z:.1f} σ, outside {interval}")
+        verdict = (f"agrees: |measured − DEM| = {z_text} σ, inside {interval}" if inside else
+                   f"differs: |measured − DEM| = {z_text} σ, outside {interval}")
     else:
         # one side's error is unknown (a 1-cell DEM run, a single record without one): the
         # combined σ is at least the known side's, so z is an upper bound; "differs by" would
@@ -703,9 +711,9 @@ def headline(comparison: CaseComparison) -> Headline:
         basis = (f"σ: the {known} stderr alone, the {unknown} has no standard error; "
                  f"{quantile_basis}")
         if inside:  # inside with the known σ alone: inside the whole, wider interval too
-            verdict = f"agrees: |measured − DEM| ≤ {z:.1f} σ, inside {interval}"
+            verdict = f"agrees: |measured − DEM| ≤ {z_text} σ, inside {interval}"
         else:  # outside the known side's interval only: the whole one is unknown
-            verdict = (f"differs by up to {z:.1f} σ: outside {interval} of the {known} stderr "
+            verdict = (f"differs by up to {z_text} σ: outside {interval} of the {known} stderr "
                        "alone")
             basis = (f"σ: the {known} stderr alone; the {unknown} has no standard error (e.g. "
                      "a 1-cell run), so whether it lies outside the whole interval is unknown; "

@@ -56,11 +56,12 @@ def case_pdf(view: dict, *, title: str) -> bytes:
     with PdfPages(buffer) as pdf:
         fig = Figure(figsize=PAGE_IN, layout="constrained")
         top, bottom = fig.subfigures(2, 1, height_ratios=[1, 3])
-        dem = (f"{display_number(head.dem)} ± {display_number(head.dem_stderr)}"
-               if math.isfinite(head.dem) else "none")
+        # without a DEM value the verdict says so and why ("vs our DEM none" read as a number)
+        dem = (f"  vs  our DEM {display_number(head.dem)} ± {display_number(head.dem_stderr)}"
+               if math.isfinite(head.dem) else "")
         lines = [title,
                  f"measured SDC ({head.measured_kind}) {display_number(head.measured)} ± "
-                 f"{display_number(head.measured_stderr)}  vs  our DEM {dem}: {head.verdict}",
+                 f"{display_number(head.measured_stderr)}{dem}: {head.verdict}",
                  *([f"  ({head.basis})"] if head.basis else []),
                  f"DEM alignment: {comp.aligned.status}. {comp.aligned.message}"]
         lines += [f"note: {n}" for n in view["notes"]]

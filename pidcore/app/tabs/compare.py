@@ -11,10 +11,8 @@ import streamlit as st
 from pidcore.app import state, uploads, workbench
 from pidcore.app.tabs import ADDRESS_BINDING, refuse_address_choices
 from pidcore.app.vocabulary import page_terms
-from pidcore.calibrate.prediction import quantile_label
+from pidcore.calibrate.prediction import band_text, quantile_label
 from pidcore.compare.case import equivalent_dampers
-from pidcore.compare.specimens import NOT_PAPER_SPECIMEN_NOTE
-from pidcore.specimen import is_paper_coupon
 from pidcore.units import display_number
 
 
@@ -102,7 +100,7 @@ def _calibrated(calibrations, comp, head, specimen: str, *, implausible: bool = 
     own_stderr = comp.measured_stderr if math.isfinite(comp.measured_sdc) else math.nan
     low, high = hit.band(own_stderr, comp.measured_stderr_dof)
     c3.metric("SDC calibrated DEM, Eq. 11 [-]", display_number(hit.sdc),
-              help=f"95 % band {display_number(low)} .. {display_number(high)}")
+              help=f"95 % band {band_text(low, high)}")
     if not math.isfinite(comp.measured_sdc):
         verdict = "not compared (no Eq. 11 SDC)"
     elif implausible:  # as the report judges such a row: its stderr is an impossible scatter
@@ -112,7 +110,8 @@ def _calibrated(calibrations, comp, head, specimen: str, *, implausible: bool = 
         verdict = uninformative
     else:
         verdict = "inside" if low <= comp.measured_sdc <= high else "outside"
-    st.caption(f"calibrated 95 % band {display_number(low)} .. {display_number(high)} [-]"
+    # the report's format: its uninformative reason below writes this band "0 .. 16.91"
+    st.caption(f"calibrated 95 % band {band_text(low, high)} [-]"
                + (f" (for this measurement's SDC stderr {comp.measured_stderr:.3g}, "
                   f"widened by the {quantile_label(comp.measured_stderr_dof)})"
                   if (low, high) != hit.band() else "")
@@ -171,13 +170,7 @@ def render(stores, session_files: list, calibrations: list) -> None:
     comp, head = view["comparison"], view["headline"]
     aligned = comp.aligned
     # the DEM number names its specimen: runs of another specimen are never met
-    dem_text = (uploads.format_sdc(head.dem, head.dem_stderr)
-                + (f" (specimen {view['dem_specimen']})" if view["dem_specimen"] else "")
-                if math.isfinite(head.dem) else "none")
-    # the headline names its SDC: the calibrated section below shows the Eq. 11 one
-    st.markdown(f"### measured ({head.measured_kind.split(' (')[0]}) "
-                f"{uploads.format_sdc(head.measured, head.measured_stderr)} "
-                f"vs our DEM {dem_text} — {head.verdict}")
+    st.markdown("### " + workbench.headline_heading(head, view["dem_specimen"]))
     if head.basis:  # what σ and the interval are: in the heading it wrapped the line
         st.caption(head.basis)
     if view["dem_refused"]:
@@ -210,21 +203,11 @@ def render(stores, session_files: list, calibrations: list) -> None:
         c1.metric("SDC measured, Eq. 11 ± stderr [-]",
                   uploads.format_sdc(comp.measured_sdc, comp.measured_stderr),
                   help="energy per cycle over the reactive energy Im(P)/w")
-        # "none" fits the metric's width ("not a Table 3 case" was cut); the caption says why
-        c2.metric("SDC paper DEM [-]", display_number(aligned.sdc_paper_dem, missing="none"))
-        c3.metric("SDC paper measured [-]",
-                  display_number(aligned.sdc_paper_experimental, missing="none"))
-        # by name: a test of another file of the coupon's name is saved as "paper_coupon
-        # [45d792]" (measured_specimen_name), which is not the paper's
-        if not is_paper_coupon(members[0].specimen):
-            # Table 3 may well have this case: its values are of another coupon
-            st.caption("paper: none: " + NOT_PAPER_SPECIMEN_NOTE.format(
-                name=members[0].specimen.strip()) + " (it tabulates the paper's coupon)")
-        elif not (math.isfinite(aligned.sdc_paper_dem)
-                  and math.isfinite(aligned.sdc_paper_experimental)):
-            st.caption("paper: none where Table 3 has no value at this case (it tabulates "
-                       "the paper's coupon, acrylic spheres driven along z, at its grid of "
-                       "load cases)")
+        paper_metrics, paper_caption = workbench.paper_details(comp, members[0].specimen)
+        for column, (label, value) in zip((c2, c3), paper_metrics.items(), strict=False):
+            column.metric(label, value)
+        if paper_caption:
+            st.caption(paper_caption)
     _calibrated(calibrations, comp, head, members[0].specimen,
                 implausible=any(e.implausible for e in members),
                 specimen_sha256=members[0].specimen_sha256)
