@@ -1070,6 +1070,7 @@ def test_calibrate_page_runs_the_real_library_and_compare_shows_its_band(store_f
     import shutil
 
     from pidcore.app.calibration import CALIBRATION_ENV_VAR, runner_for
+    from pidcore.calibrate.prediction import band_text
     from pidcore.cli import main
 
     monkeypatch.delenv(CALIBRATION_ENV_VAR, raising=False)
@@ -1100,7 +1101,7 @@ def test_calibrate_page_runs_the_real_library_and_compare_shows_its_band(store_f
     row = next(r for r in doc["predictions"] if r["frequency_hz"] == 50.0)
     metrics = {m.label: m.value for m in at.metric}
     assert metrics["SDC calibrated DEM, Eq. 11 [-]"] == f"{row['predicted']:.4f}"
-    assert any(f"calibrated 95 % band {row['low95']:.4f} .. {row['high95']:.4f}" in c.value
+    assert any(f"calibrated 95 % band {band_text(row['low95'], row['high95'])}" in c.value
                for c in at.caption)
     # the calibration's design runs (files named paper_coupon with other values) made Compare
     # refuse every case ("the DEM runs ... are of 6 specimens"); the coupon's own runs are

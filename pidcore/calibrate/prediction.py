@@ -63,6 +63,7 @@ def band_text(low: float, high: float) -> str:
     ``"—"`` for a bound that is not a number."""
     return " .. ".join(f"{v:.4g}" if math.isfinite(v) else "—" for v in (low, high))
 
+
 @dataclass(frozen=True)
 class CalibratedPrediction:
     """The calibrated DEM's prediction at one load case.
