@@ -227,19 +227,29 @@ class CalibratedPrediction:
         low, high = self.band(stderr, dof)
         return bool(low <= sdc <= high)
 
+    def judge(self, sdc: float, stderr: float = math.nan, dof: float = math.nan
+              ) -> tuple[str, str]:
+        """``(verdict, reason)`` of a measured ``sdc`` with standard error ``stderr`` of
+        ``dof`` degrees of freedom: ``uninformative`` with :meth:`uninformative_reason`
+        where the band cannot judge it, else ``yes`` or ``no`` (:meth:`contains`) and ""
+        (words of :data:`pidcore.constants.BAND_VERDICTS`). The one rule of the report's
+        rows, the app's Compare page and the calibration's own summaries."""
+        from ..constants import BAND_VERDICTS
+
+        inside, outside, _, uninformative = BAND_VERDICTS
+        reason = self.uninformative_reason(stderr, dof)
+        if reason:
+            return uninformative, reason
+        return (inside if self.contains(sdc, stderr, dof) else outside), ""
+
 
 def row_verdict(row: dict, bound: SdcBound) -> str:
     """The verdict of :data:`pidcore.constants.BAND_VERDICTS` on one prediction row of a
     calibration (``predictions`` or ``loo`` of its calibration.json, or of
-    :class:`~pidcore.calibrate.calibrate.CalibrationResult`): ``yes`` where its measured SDC
-    lies inside its 95 % band cut at ``bound`` (:func:`calibrated_sdc_bound` at the row's
-    fill), ``no`` where outside, ``uninformative`` where the band spans every plausible SDC
-    (:meth:`CalibratedPrediction.uninformative_reason`), the rule the report and the app
-    judge a measurement by: such a row is counted neither inside nor among those judged."""
-    from ..constants import BAND_VERDICTS
-
-    inside, outside, _, uninformative = BAND_VERDICTS
-
+    :class:`~pidcore.calibrate.calibrate.CalibrationResult`), its band cut at ``bound``
+    (:func:`calibrated_sdc_bound` at the row's fill): :meth:`CalibratedPrediction.judge`, the
+    rule the report and the app judge a measurement by (an ``uninformative`` row is counted
+    neither inside nor among those judged)."""
     def number(key: str) -> float:  # absent or null (an older calibration.json): unknown
         value = row.get(key)
         return math.nan if value is None else float(value)
@@ -251,10 +261,8 @@ def row_verdict(row: dict, bound: SdcBound) -> str:
         number("measured_stderr"), number("low95_without_stderr"),
         number("high95_without_stderr"), number("measured_stderr_dof"), sdc_bound=bound)
     # the row's own stderr and dof: the fitted point's band, as the row states it
-    stderr, dof = prediction.measured_stderr, prediction.measured_stderr_dof
-    if prediction.uninformative_reason(stderr, dof):
-        return uninformative
-    return inside if prediction.contains(prediction.measured, stderr, dof) else outside
+    return prediction.judge(prediction.measured, prediction.measured_stderr,
+                            prediction.measured_stderr_dof)[0]
 
 
 @dataclass(frozen=True)

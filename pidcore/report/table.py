@@ -752,12 +752,10 @@ def add_calibration_columns(table: pd.DataFrame, calibration, *,
                              f"(the calibration's own measurement at this load case had SDC "
                              f"stderr {hit.measured_stderr:.3g}); its 95 % widening: "
                              f"{quantile_label(dof)}")
-                uninformative = hit.uninformative_reason(stderr, dof)
+                verdict, uninformative = hit.judge(measured, stderr, dof)
+                inside.append(verdict)
                 if uninformative:
-                    inside.append(UNINFORMATIVE)
                     extra = "; ".join(n for n in (uninformative, extra) if n)  # verdict first
-                else:
-                    inside.append(INSIDE if band[0] <= measured <= band[1] else OUTSIDE)
         notes.append("; ".join(n for n in (note, extra, cut) if n))
     at = list(out.columns).index("SDC measured [-]") + 1 if "SDC measured [-]" in out.columns \
         else len(out.columns)

@@ -13,6 +13,7 @@ from pidcore.app.tabs import ADDRESS_BINDING, refuse_address_choices
 from pidcore.app.vocabulary import page_terms
 from pidcore.calibrate.prediction import band_text, quantile_label
 from pidcore.compare.case import equivalent_dampers
+from pidcore.constants import BAND_VERDICTS
 from pidcore.units import display_number
 
 
@@ -105,11 +106,12 @@ def _calibrated(calibrations, comp, head, specimen: str, *, implausible: bool = 
         verdict = "not compared (no Eq. 11 SDC)"
     elif implausible:  # as the report judges such a row: its stderr is an impossible scatter
         verdict = "not compared (it pools an implausible result, named below)"
-    elif uninformative := hit.uninformative_reason(own_stderr, comp.measured_stderr_dof):
-        # as the report's row: a band of 0 .. 2 pi holds every measurement, so "inside" lied
-        verdict = uninformative
     else:
-        verdict = "inside" if low <= comp.measured_sdc <= high else "outside"
+        # as the report's row: a band of 0 .. the SDC bound holds every measurement, so
+        # "inside" lied; its reason is the verdict then
+        judged, reason = hit.judge(comp.measured_sdc, own_stderr, comp.measured_stderr_dof)
+        yes, no = BAND_VERDICTS[:2]
+        verdict = reason or {yes: "inside", no: "outside"}[judged]
     # the report's format: its uninformative reason below writes this band "0 .. 16.91"
     st.caption(f"calibrated 95 % band {band_text(low, high)} [-]"
                + (f" (for this measurement's SDC stderr {comp.measured_stderr:.3g}, "
