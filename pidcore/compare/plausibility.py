@@ -180,13 +180,18 @@ def tested_sdc_bound(*, fill_percent: float | None, material: str | None,
     specimen whose file is not at hand)."""
     from ..specimen import is_paper_coupon
 
-    name = specimen_name.strip() if isinstance(specimen_name, str) else ""
-    sha256 = specimen_sha256 if isinstance(specimen_sha256, str) else ""
+    name, sha256 = _name_and_hash(specimen_name, specimen_sha256)
     if _names_given(name, sha256, given):
         return sdc_bound(fill_percent=fill_percent, material=material, specimen=given)
     if is_paper_coupon(name, sha256):
         return sdc_bound(fill_percent=fill_percent, material=material)
     return UNKNOWN_SPECIMEN_BOUND
+
+
+def _name_and_hash(specimen_name: object, specimen_sha256: object) -> tuple[str, str]:
+    """A record's specimen name (stripped) and file hash, "" for each that is not text."""
+    return (specimen_name.strip() if isinstance(specimen_name, str) else "",
+            specimen_sha256 if isinstance(specimen_sha256, str) else "")
 
 
 def _names_given(name: str, sha256: str, given: Specimen | None) -> bool:
@@ -391,8 +396,7 @@ def specimen_at_hand(specimen_name: str = "", specimen_sha256: str = "",
     the file's), or the paper's coupon (no specimen named, or the coupon)."""
     from ..specimen import is_paper_coupon
 
-    name = specimen_name.strip() if isinstance(specimen_name, str) else ""
-    sha256 = specimen_sha256 if isinstance(specimen_sha256, str) else ""
+    name, sha256 = _name_and_hash(specimen_name, specimen_sha256)
     return _names_given(name, sha256, given) or is_paper_coupon(name, sha256)
 
 
@@ -451,13 +455,13 @@ def stored_sdc_bound_and_note(record: Any, *, given: Specimen | None = None
     except (TypeError, ValueError):
         fill = math.nan
     name, sha256 = text("specimen"), text(MEASURED_SHA256_FIELD)
-    bound = tested_sdc_bound(fill_percent=fill if math.isfinite(fill) else None,
-                             material=text("material") or None, specimen_name=name,
-                             specimen_sha256=sha256, given=given)
     if specimen_at_hand(name, sha256, given):
-        return bound, ""  # the file's own bound wins (equal to a stored one by construction)
+        # the file's own bound wins (equal to a stored one by construction)
+        return tested_sdc_bound(fill_percent=fill if math.isfinite(fill) else None,
+                                material=text("material") or None, specimen_name=name,
+                                specimen_sha256=sha256, given=given), ""
     recorded, note = recorded_sdc_bound(record)
-    return (recorded or bound), note
+    return (recorded or UNKNOWN_SPECIMEN_BOUND), note
 
 
 def stored_sdc_bound(record: Any, *, given: Specimen | None = None) -> SdcBound:
