@@ -208,21 +208,13 @@ def _point_sdc_bound(fill_percent: float, material: str, specimen_name: str,
     is judged as :func:`~pidcore.compare.plausibility.tested_sdc_bound` does, and, where its
     file is not at hand, against the bound saved with its stored ``record``
     (:func:`~pidcore.compare.plausibility.recorded_sdc_bound`) where it has one."""
-    from ..compare.plausibility import (
-        recorded_sdc_bound,
-        sdc_bound,
-        specimen_at_hand,
-        tested_sdc_bound,
-    )
+    from ..compare.plausibility import measured_sdc_bound, sdc_bound
 
     if given is not None and not specimen_name and material == given.particles.material:
         return sdc_bound(fill_percent=fill_percent, material=material, specimen=given)
-    bound = tested_sdc_bound(fill_percent=fill_percent, material=material,
-                             specimen_name=specimen_name, specimen_sha256=specimen_sha256,
-                             given=given)
-    if record is None or specimen_at_hand(specimen_name, specimen_sha256, given):
-        return bound
-    return recorded_sdc_bound(record)[0] or bound
+    return measured_sdc_bound(fill_percent=fill_percent, material=material,
+                              specimen_name=specimen_name, specimen_sha256=specimen_sha256,
+                              given=given, record=record)[0]
 
 
 def measured_from_store(store_path: str | os.PathLike, *,

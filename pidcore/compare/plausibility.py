@@ -454,12 +454,25 @@ def stored_sdc_bound_and_note(record: Any, *, given: Specimen | None = None
         fill = float(record.get("fill_percent", math.nan))
     except (TypeError, ValueError):
         fill = math.nan
-    name, sha256 = text("specimen"), text(MEASURED_SHA256_FIELD)
-    if specimen_at_hand(name, sha256, given):
-        # the file's own bound wins (equal to a stored one by construction)
-        return tested_sdc_bound(fill_percent=fill if math.isfinite(fill) else None,
-                                material=text("material") or None, specimen_name=name,
-                                specimen_sha256=sha256, given=given), ""
+    return measured_sdc_bound(fill_percent=fill if math.isfinite(fill) else None,
+                              material=text("material") or None,
+                              specimen_name=text("specimen"),
+                              specimen_sha256=text(MEASURED_SHA256_FIELD), given=given,
+                              record=record)
+
+
+def measured_sdc_bound(*, fill_percent: float | None, material: str | None,
+                       specimen_name: str, specimen_sha256: str, given: Specimen | None,
+                       record: Mapping[str, Any] | None) -> tuple[SdcBound, str]:
+    """``(bound, note)`` of a measurement naming ``specimen_name`` (file hash
+    ``specimen_sha256``): :func:`tested_sdc_bound` where its specimen is at hand
+    (:func:`specimen_at_hand`; the file's own bound wins, equal to a stored one by
+    construction), else the bound saved with its stored ``record``
+    (:func:`recorded_sdc_bound`, with its note where one was ignored), else 2 pi."""
+    if record is None or specimen_at_hand(specimen_name, specimen_sha256, given):
+        return tested_sdc_bound(fill_percent=fill_percent, material=material,
+                                specimen_name=specimen_name, specimen_sha256=specimen_sha256,
+                                given=given), ""
     recorded, note = recorded_sdc_bound(record)
     return (recorded or UNKNOWN_SPECIMEN_BOUND), note
 
