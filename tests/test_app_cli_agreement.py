@@ -4,6 +4,7 @@ app against ``pidcore analyze`` on the same files and tables)."""
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import pytest
 from _app_samples import mass_damper_csv
@@ -11,6 +12,8 @@ from _app_samples import mass_damper_csv
 from pidcore.app import uploads
 from pidcore.cli import main
 from pidcore.errors import ParameterError
+
+SAMPLES_ROOT = Path(__file__).parents[1] / "data_samples"
 
 
 def cli_error(args: list[str], capsys) -> str:
@@ -90,43 +93,49 @@ def test_the_compare_pages_loop_energy_is_the_energy_pidcore_analyze_prints(tmp_
     assert loop.energy_per_cycle_j == pytest.approx(cli["energy_per_cycle_j"], rel=1e-12)
 
 
-def test_the_compare_pages_equivalent_damper_is_pidcore_model_dampers(tmp_path, capsys):
-    # the app had no equivalent damper; Compare now gives c_eq at a DEM grid case, which must
-    # be the c_eq_per_coupon [N s/m] `pidcore model damper --table store` writes for the same runs
-    from pathlib import Path
-
-    import pandas as pd
-
-    from pidcore.compare.case import (
-        MeasuredEntry,
-        compare_case,
-        equivalent_dampers,
-        load_case_of,
-        paper_table,
-    )
+def _bundled_sample_compared(fill_percent: float):
+    """(record, entry, comparison): the bundled 1000 Hz, 5 g export as the app analyses it,
+    stated at ``fill_percent``, compared with the bundled DEM store as Compare does."""
+    from pidcore.compare.case import MeasuredEntry, compare_case, load_case_of, paper_table
     from pidcore.measure import AnalysisOptions
     from pidcore.store.listing import list_dem_runs
 
-    root = Path(__file__).parents[1] / "data_samples"
-    sample = root / "exports" / "synthetic_f1000Hz_a5g_fill50_acrylic.h5"
+    sample = SAMPLES_ROOT / "exports" / "synthetic_f1000Hz_a5g_fill50_acrylic.h5"
     record = uploads.analyze_upload(sample.name, sample.read_bytes(),
                                     AnalysisOptions(velocity_delay_s=5e-5)).record
-    entry = MeasuredEntry.from_record(record, load_case_of(record, fill_percent=50,
+    entry = MeasuredEntry.from_record(record, load_case_of(record, fill_percent=fill_percent,
                                                            material="acrylic"))
-    comparison = compare_case([entry], list_dem_runs(root / "dem_table3.h5"), paper_table())
+    comparison = compare_case([entry], list_dem_runs(SAMPLES_ROOT / "dem_table3.h5"),
+                              paper_table())
+    return record, entry, comparison
+
+
+def _measured_damper(record) -> float:
+    """The damper that dissipates the measured energy per cycle: dE / (pi w X^2), X = a/w^2
+    (computed here from the analysis, apart from pidcore.model)."""
+    w = 2 * math.pi * record.analysis.frequency_hz
+    x = record.analysis.acceleration_amplitude_m_s2 / w**2
+    return record.analysis.energy_per_cycle_j / (math.pi * w * x**2)
+
+
+def test_the_compare_pages_equivalent_damper_is_pidcore_model_dampers(tmp_path, capsys):
+    # the app had no equivalent damper; Compare now gives c_eq at a DEM grid case, which must
+    # be the c_eq_per_coupon [N s/m] `pidcore model damper --table store` writes for the same runs
+    import pandas as pd
+
+    from pidcore.compare.case import compare_case, equivalent_dampers, paper_table
+
+    record, entry, comparison = _bundled_sample_compared(50)
     dampers = equivalent_dampers(comparison)
-    assert main(["model", "damper", "--table", "store", "--store", str(root / "dem_table3.h5"),
+    assert main(["model", "damper", "--table", "store", "--store",
+                 str(SAMPLES_ROOT / "dem_table3.h5"),
                  "--fills", "50", "--accelerations", "5", "--frequencies", "1000",
                  "--format", "csv", "--out", str(tmp_path)]) == 0
     capsys.readouterr()
     (cli,) = pd.read_csv(tmp_path / "equivalent_damper.csv")["c_eq_per_coupon [N s/m]"]
     # the same SDC and m_c (rebuilt from the runs' specimen columns, equal to rounding)
     assert dampers["our DEM"] == pytest.approx(cli, rel=1e-12)
-    # the measured damper dissipates the measured energy per cycle: dE / (pi w X^2), X = a/w^2
-    w = 2 * math.pi * record.analysis.frequency_hz
-    x = record.analysis.acceleration_amplitude_m_s2 / w**2
-    assert dampers["measured"] == pytest.approx(
-        record.analysis.energy_per_cycle_j / (math.pi * w * x**2), rel=1e-12)
+    assert dampers["measured"] == pytest.approx(_measured_damper(record), rel=1e-12)
     # a DEM value without m_c (no grid case) gives no damper rather than a guessed one
     assert equivalent_dampers(compare_case([entry], None, paper_table())) == {}
 
@@ -137,32 +146,16 @@ def test_the_compare_pages_damper_of_an_interpolated_case_is_pidcore_model_dampe
     # no grid case states m_c: the page showed no damper, though the report knows the m_c a
     # run at this fill would have. `pidcore model damper --table store` interpolates the same
     # runs and takes m_c of the fill from their specimen: an independent path to c_eq
-    from pathlib import Path
-
     import pandas as pd
 
-    from pidcore.compare.case import (
-        INTERPOLATED_DAMPER_NAME,
-        MeasuredEntry,
-        compare_case,
-        equivalent_dampers,
-        load_case_of,
-        paper_table,
-    )
-    from pidcore.measure import AnalysisOptions
-    from pidcore.store.listing import list_dem_runs
+    from pidcore.compare.case import INTERPOLATED_DAMPER_NAME, equivalent_dampers
 
-    root = Path(__file__).parents[1] / "data_samples"
-    sample = root / "exports" / "synthetic_f1000Hz_a5g_fill50_acrylic.h5"
-    record = uploads.analyze_upload(sample.name, sample.read_bytes(),
-                                    AnalysisOptions(velocity_delay_s=5e-5)).record
-    entry = MeasuredEntry.from_record(record, load_case_of(record, fill_percent=40,
-                                                           material="acrylic"))
-    comparison = compare_case([entry], list_dem_runs(root / "dem_table3.h5"), paper_table())
+    record, _, comparison = _bundled_sample_compared(40)
     assert comparison.aligned.status == "interpolated" and comparison.aligned.grid_case is None
     dampers = equivalent_dampers(comparison)
     case = comparison.load_case
-    assert main(["model", "damper", "--table", "store", "--store", str(root / "dem_table3.h5"),
+    assert main(["model", "damper", "--table", "store", "--store",
+                 str(SAMPLES_ROOT / "dem_table3.h5"),
                  "--fills", "40", "--accelerations", repr(case.acceleration_g),
                  "--frequencies", repr(case.frequency_hz), "--format", "csv",
                  "--out", str(tmp_path)]) == 0
@@ -174,11 +167,7 @@ def test_the_compare_pages_damper_of_an_interpolated_case_is_pidcore_model_dampe
     assert set(dampers) == {INTERPOLATED_DAMPER_NAME, "measured"}
     assert dampers[INTERPOLATED_DAMPER_NAME] == pytest.approx(
         cli["c_eq_per_coupon [N s/m]"][0], rel=1e-12)
-    # the measured damper dissipates the measured energy per cycle: dE / (pi w X^2)
-    w = 2 * math.pi * record.analysis.frequency_hz
-    x = record.analysis.acceleration_amplitude_m_s2 / w**2
-    assert dampers["measured"] == pytest.approx(
-        record.analysis.energy_per_cycle_j / (math.pi * w * x**2), rel=1e-12)
+    assert dampers["measured"] == pytest.approx(_measured_damper(record), rel=1e-12)
 
 
 def _dem_record(sdc: float, fill: float) -> dict:
