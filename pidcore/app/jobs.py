@@ -44,6 +44,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from .. import defaults
+from ..atomic_files import write_atomically
 from ..errors import ParameterError, PidcoreError, clipped
 from .vocabulary import page_terms
 
@@ -866,12 +867,8 @@ def write_journal(path: Path, jobs: Sequence[DemJob], *, owner: JournalOwner | N
     text = json.dumps({"pidcore_jobs_version": _JOURNAL_VERSION,
                        "jobs": [*foreign, *(_job_document(j, owner) for j in jobs)]},
                       indent=1)
-    tmp = path.with_name(f".{path.name}.{secrets.token_hex(4)}.tmp")
-    try:
-        tmp.write_text(text, encoding="utf-8")
-        os.replace(tmp, path)
-    finally:
-        tmp.unlink(missing_ok=True)
+    # fsync'ed: a power loss must not leave an empty journal, whose queued jobs were then lost
+    write_atomically(path, text)
 
 
 def _job_from_document(doc: dict, *, live: bool = False) -> DemJob:

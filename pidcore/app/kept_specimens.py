@@ -19,11 +19,11 @@ from __future__ import annotations
 import json
 import os
 import re
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from ..atomic_files import write_atomically
 from ..errors import ParameterError
 
 if TYPE_CHECKING:
@@ -56,18 +56,6 @@ class KeptSpecimen:
     specimen: Specimen
 
 
-def _write_atomically(path: Path, data: bytes) -> None:
-    # a reader (another session restoring the same hash) never sees half a file
-    handle, temporary = tempfile.mkstemp(dir=path.parent, prefix=".kept_", suffix=".part")
-    try:
-        with os.fdopen(handle, "wb") as file:
-            file.write(data)
-        os.replace(temporary, path)
-    except BaseException:
-        Path(temporary).unlink(missing_ok=True)
-        raise
-
-
 def keep_specimen(folder: str | os.PathLike, name: str,
                   data: bytes) -> tuple[KeptSpecimen, str]:
     """Check the uploaded specimen file ``name`` (``data``) as ``pidcore specimen check``
@@ -90,10 +78,11 @@ def keep_specimen(folder: str | os.PathLike, name: str,
         folder.mkdir(parents=True, exist_ok=True)
         target = folder / f"{sha256}{_DATA_SUFFIX}"
         if not target.is_file():  # same hash, same specimen: written once
-            _write_atomically(target, data)
+            # whole or not at all: another session may restore the same hash meanwhile
+            write_atomically(target, data)
         label = folder / f"{sha256}{_NAME_SUFFIX}"
         if _kept_name(label) != name:  # the name it was uploaded under last
-            _write_atomically(label, json.dumps({"name": name}).encode())
+            write_atomically(label, json.dumps({"name": name}).encode())
     except OSError as exc:
         return kept, (f"{name}: not kept for a page reload: cannot write {folder} "
                       f"({exc.strerror or exc}); upload it again after a reload")

@@ -1,14 +1,12 @@
-"""Helpers shared by the readers and writers: hashing, naming, time bases, units, atomic writes."""
+"""Helpers shared by the readers and writers: hashing, naming, time bases, units (atomic
+writes: :mod:`pidcore.atomic_files`)."""
 
 from __future__ import annotations
 
-import contextlib
 import hashlib
 import math
 import os
-import tempfile
-from collections.abc import Iterator, Sequence
-from pathlib import Path
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -259,26 +257,6 @@ def make_channel(name: str, values: np.ndarray, *, sample_rate_hz: float, unit: 
         data = data * factor
     return Channel(name=name, quantity=quantity, data=data, sample_rate_hz=float(sample_rate_hz),
                    source_unit=unit.strip(), start_time_s=float(start_time_s))
-
-
-@contextlib.contextmanager
-def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
-    """Yield a temporary path beside ``path``; on success move it over ``path`` in one step.
-
-    A crash or exception leaves any existing file at ``path`` untouched and removes the
-    temporary file.
-    """
-    target = Path(path)
-    directory = target.parent if str(target.parent) else Path(".")
-    fd, tmp_name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=directory)
-    os.close(fd)
-    tmp = Path(tmp_name)
-    try:
-        yield tmp
-        os.replace(tmp, target)
-    finally:
-        if tmp.exists():
-            tmp.unlink()
 
 
 _KIND_WORDS = {"c": "complex numbers", "S": "text", "U": "text", "O": "objects (references, "

@@ -34,10 +34,10 @@ import re
 import numpy as np
 import pandas as pd
 
+from ..atomic_files import atomic_path
 from ..errors import InputFileError, ParameterError, clipped
 from ..records import Measurement
 from ._common import (
-    atomic_path,
     file_sha256,
     interpret_unit,
     make_channel,

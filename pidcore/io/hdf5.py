@@ -13,9 +13,10 @@ from dataclasses import replace
 
 import h5py
 
+from ..atomic_files import atomic_path
 from ..errors import InputFileError, ParameterError
 from ..records import Measurement
-from ._common import atomic_path, file_sha256, unique_names
+from ._common import file_sha256, unique_names
 from ._hdf5_safety import check_hdf5_input
 from .hdf5_layout import LAYOUT_TAG, read_measurement_group, write_measurement_group
 

@@ -34,12 +34,12 @@ import h5py
 import numpy as np
 import scipy.io
 
+from ..atomic_files import atomic_path
 from ..constants import SI_UNITS
 from ..errors import InputFileError, ParameterError
 from ..records import Channel, Measurement
 from ._common import (
     HDF5_SIGNATURE,
-    atomic_path,
     file_sha256,
     make_channel,
     overridden_rate,

@@ -37,12 +37,12 @@ from pathlib import Path
 import numpy as np
 import pyuff
 
+from ..atomic_files import atomic_path
 from ..constants import SI_UNITS
 from ..errors import InputFileError, ParameterError
 from ..records import Channel, Measurement
 from ..units import canonical_unit_text
 from ._common import (
-    atomic_path,
     file_sha256,
     interpret_unit,
     rate_from_times,

@@ -41,9 +41,7 @@ from __future__ import annotations
 import io
 import json
 import os
-import re
 import resource
-import secrets
 import shutil
 import threading
 from collections.abc import Callable, Iterable, Iterator, Mapping
@@ -58,6 +56,7 @@ import numpy as np
 import pandas as pd
 
 from .. import __version__, defaults, interrupt
+from ..atomic_files import fsync_path, new_file_mode, temporary_name_pattern, temporary_path_for
 from ..errors import InputFileError, ParameterError, StoreError
 from ..io._hdf5_safety import check_self_contained
 from ..io.hdf5_layout import read_measurement_group, write_measurement_group
@@ -174,22 +173,6 @@ def _write_image(path: Path, image: memoryview) -> None:
         file.write(image)
         file.flush()
         os.fsync(file.fileno())
-
-
-def _fsync_path(path: Path, *, directory: bool = False) -> None:
-    fd = os.open(path, os.O_RDONLY | (os.O_DIRECTORY if directory else 0))
-    try:
-        os.fsync(fd)
-    finally:
-        os.close(fd)
-
-
-def _new_file_mode() -> int:
-    # A new store gets the permissions any new file would get (0o666 less the umask); os.umask
-    # can only be read by setting it, so set it back at once.
-    umask = os.umask(0)
-    os.umask(umask)
-    return 0o666 & ~umask
 
 
 def _prepare_entry(record: Mapping[str, Any], arrays: Mapping[str, Any] | None,
@@ -586,7 +569,7 @@ class Store:
         # Exactly this store's names (see transaction()): a prefix match took the working copy
         # of a store named like this one plus a suffix ("s.h5" and "s.h5.old.h5"), whose
         # writer, not excluded by this store's lock, then failed its commit.
-        pattern = re.compile(re.escape(f".{self._file.name}.") + r"[0-9a-f]{16}\.tmp")
+        pattern = temporary_name_pattern(self._file)
         for stale in self._file.parent.iterdir():
             if pattern.fullmatch(stale.name):
                 stale.unlink(missing_ok=True)
@@ -623,7 +606,7 @@ class Store:
                 self._check_single_link()
                 with self._reading():
                     pass  # validates: a foreign or corrupt file must never be replaced
-            tmp = directory / f".{target.name}.{secrets.token_hex(8)}.tmp"
+            tmp = temporary_path_for(target)
             try:
                 h5, buffer = self._working_copy(tmp, exists=exists)
                 try:
@@ -638,7 +621,7 @@ class Store:
                 try:
                     h5.close()  # flushes every change into the buffer (or the copy on disk)
                     if buffer is None:
-                        _fsync_path(tmp)
+                        fsync_path(tmp)
                     else:
                         _write_image(tmp, buffer.getbuffer())
                     # The rename and its count are one step for Ctrl-C (a caller reads
@@ -654,7 +637,7 @@ class Store:
                 # Makes the rename itself durable; the commit has happened either way, and some
                 # file systems cannot fsync a directory, so a failure here is not an error.
                 with suppress(OSError):
-                    _fsync_path(directory, directory=True)
+                    fsync_path(directory, directory=True)
                 interrupt.raise_if_interrupted()  # one that came during the commit
             except BaseException:
                 tmp.unlink(missing_ok=True)
@@ -699,7 +682,7 @@ class Store:
             if exists:
                 shutil.copymode(self._file, tmp)
             else:
-                os.chmod(tmp, _new_file_mode())
+                os.chmod(tmp, new_file_mode())
             if exists and self._file.stat().st_size > defaults.STORE_IN_MEMORY_MAX_BYTES:
                 # HDF5 writes this copy itself: a write it fails (no room, a file size limit)
                 # ends in errors from h5py's destructors, not one line, so the room is checked

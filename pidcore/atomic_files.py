@@ -1,0 +1,108 @@
+"""Files written whole or not at all: a temporary file beside the target, renamed over it.
+
+Every file pidcore writes that a user relies on (exported measurements, CSV and JSON tables,
+figures, the app's job journal and kept specimen files; the store commits the same way, with
+its own lock and buffer, through :func:`fsync_path` and :func:`new_file_mode`) is first
+written to a temporary file in the target's own folder, so that the final
+:func:`os.replace` is a rename on one file system: atomic, never a copy. Ctrl-C
+(KeyboardInterrupt), SIGTERM, a full disk or a failing writer therefore leave the previous file
+as it was and no temporary file behind; a reader sees the old file or the new one, never half
+of one.
+
+``durable`` (the default) fsyncs the new file before the rename and the folder after it: a
+power loss right after the call then finds the new file, not an empty one under its name (a
+rename can reach the disk before the data it names). Files rewritten many times a second
+and rebuilt from the store at will may pass ``durable=False``.
+
+The temporary file gets the permissions the target has (a new target: those any new file
+gets, 0o666 less the umask); :func:`tempfile.mkstemp`'s 0o600 made an exported file
+unreadable to the colleagues its plain write had let read it.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import secrets
+import stat
+from collections.abc import Iterator
+from contextlib import contextmanager, suppress
+from pathlib import Path
+
+#: Marks a temporary file of :func:`atomic_path` (``.<name>.<16 hex>.tmp``), so that a folder
+#: listing can leave out one that a killed process (SIGKILL, power loss) left behind.
+TEMPORARY_SUFFIX = ".tmp"
+
+
+def new_file_mode() -> int:
+    """The permissions a new file gets here: 0o666 less the process's umask."""
+    # os.umask can only be read by setting it, so set it back at once
+    umask = os.umask(0)
+    os.umask(umask)
+    return 0o666 & ~umask
+
+
+def fsync_path(path: str | os.PathLike[str], *, directory: bool = False) -> None:
+    """Flush the file (or, with ``directory``, the folder's entries) at ``path`` to the disk;
+    an ``OSError`` where that fails."""
+    fd = os.open(path, os.O_RDONLY | (os.O_DIRECTORY if directory else 0))
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)
+
+
+def temporary_path_for(target: str | os.PathLike[str]) -> Path:
+    """A fresh hidden name beside ``target`` (``.<name>.<16 hex>.tmp``), in its folder, so that
+    the rename over ``target`` stays on one file system."""
+    target = Path(target)
+    return target.with_name(f".{target.name}.{secrets.token_hex(8)}{TEMPORARY_SUFFIX}")
+
+
+def temporary_name_pattern(target: str | os.PathLike[str]) -> re.Pattern[str]:
+    """The names :func:`temporary_path_for` gives beside ``target``, and no others (a prefix
+    match took the temporary file of a target named like this one plus a suffix, ``s.h5`` and
+    ``s.h5.old.h5``)."""
+    return re.compile(re.escape(f".{Path(target).name}.") + r"[0-9a-f]{16}"
+                      + re.escape(TEMPORARY_SUFFIX))
+
+
+@contextmanager
+def atomic_path(path: str | os.PathLike[str], *, durable: bool = True) -> Iterator[Path]:
+    """Yield a new empty temporary file beside ``path`` for a writer to fill (by its path:
+    h5py, pyuff, pandas, matplotlib); when the block ends without an exception, the file is
+    fsync'ed (``durable``) and moved over ``path`` in one step.
+
+    Any exception, KeyboardInterrupt included, removes the temporary file and leaves the file
+    at ``path`` as it was (absent, if it was).
+    """
+    target = Path(path)
+    tmp = temporary_path_for(target)
+    os.close(os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600))
+    try:
+        yield tmp
+        try:
+            mode = stat.S_IMODE(target.stat().st_mode)
+        except OSError:  # a new file (or none readable there: the rename will say)
+            mode = new_file_mode()
+        # after the writer: a read-only target's mode would have refused the writer's open
+        os.chmod(tmp, mode)
+        if durable:
+            fsync_path(tmp)
+        os.replace(tmp, target)
+    finally:
+        tmp.unlink(missing_ok=True)  # gone after a rename; the failed write's otherwise
+    if durable:
+        # the rename itself made durable; some file systems cannot fsync a folder, and the
+        # file is in place either way, so a failure here is not an error
+        with suppress(OSError):
+            fsync_path(target.parent if str(target.parent) else ".", directory=True)
+
+
+def write_atomically(path: str | os.PathLike[str], data: bytes | str, *,
+                     durable: bool = True, encoding: str = "utf-8") -> None:
+    """Write ``data`` (text is encoded with ``encoding``) as the whole file at ``path``
+    (:func:`atomic_path`): the previous file stays until the new one is complete."""
+    raw = data.encode(encoding) if isinstance(data, str) else bytes(data)
+    with atomic_path(path, durable=durable) as tmp, open(tmp, "wb") as file:
+        file.write(raw)

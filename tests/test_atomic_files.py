@@ -1,0 +1,103 @@
+"""Files a user relies on are written whole or not at all (:mod:`pidcore.atomic_files`): a
+failing writer, Ctrl-C or a full disk leaves the previous file and no temporary file."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import stat
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from pidcore import atomic_files
+from pidcore.app import jobs, kept_specimens
+from pidcore.io import write_measurement
+from pidcore.records import Channel, Measurement
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _digest(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def _only(folder: Path) -> list[str]:
+    # every entry, hidden ones included: a left temporary file is one of them
+    return sorted(p.name for p in folder.iterdir())
+
+
+def test_a_writer_that_fails_half_way_leaves_the_previous_file_and_no_temporary(tmp_path):
+    target = tmp_path / "table.csv"
+    target.write_text("old,whole\n1,2\n")
+    before = _digest(target)
+    for failure in (KeyboardInterrupt, OSError):
+        with pytest.raises(failure), atomic_files.atomic_path(target) as tmp:
+            tmp.write_text("new,half")  # the writer got this far
+            raise failure()
+        assert _digest(target) == before and _only(tmp_path) == ["table.csv"]
+    atomic_files.write_atomically(target, "new,whole\n3,4\n")
+    assert target.read_text() == "new,whole\n3,4\n" and _only(tmp_path) == ["table.csv"]
+
+
+def test_the_rename_comes_after_the_file_and_before_the_folder_is_flushed(tmp_path,
+                                                                          monkeypatch):
+    # a rename can reach the disk before the data it names: without the fsync a power loss
+    # right after a journal's rewrite left an empty journal, whose queued jobs were lost
+    steps: list[str] = []
+    real_fsync, real_replace = os.fsync, os.replace
+
+    def fsync(fd: int) -> None:
+        steps.append("fsync folder" if stat.S_ISDIR(os.fstat(fd).st_mode) else "fsync file")
+        real_fsync(fd)
+
+    def replace(source, target) -> None:
+        steps.append("rename")
+        real_replace(source, target)
+
+    monkeypatch.setattr(os, "fsync", fsync)
+    monkeypatch.setattr(os, "replace", replace)
+    jobs.write_journal(jobs.journal_path(tmp_path / "app.h5"), [])
+    assert steps == ["fsync file", "rename", "fsync folder"]
+    assert json.loads((tmp_path / "app.h5.jobs.json").read_text())["jobs"] == []
+
+
+def test_a_full_disk_at_the_flush_keeps_no_kept_specimen_and_no_temporary(tmp_path,
+                                                                          monkeypatch):
+    # the kept file is the one a reload restores: one the disk could not hold must not be
+    # left under its hash as an empty file (which a restore then refused as another file)
+    data = (ROOT / "data_samples" / "specimens" / "steel_6mm.toml").read_bytes()
+    folder = tmp_path / "app.h5.specimens"
+
+    def full(fd: int) -> None:
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(os, "fsync", full)
+    kept, problem = kept_specimens.keep_specimen(folder, "steel_6mm.toml", data)
+    assert problem == (f"steel_6mm.toml: not kept for a page reload: cannot write {folder} "
+                       "(No space left on device); upload it again after a reload")
+    assert _only(folder) == []
+    monkeypatch.undo()
+    kept, problem = kept_specimens.keep_specimen(folder, "steel_6mm.toml", data)
+    assert problem == "" and _only(folder) == [f"{kept.sha256}.json", f"{kept.sha256}.toml"]
+    assert (folder / f"{kept.sha256}.toml").read_bytes() == data
+
+
+def test_an_exported_measurement_has_the_permissions_of_any_new_file(tmp_path):
+    # the temporary file of the atomic write was made by mkstemp, 0o600: an exported CSV
+    # was unreadable to the colleagues a plain write (0o666 less the umask) let read it
+    channel = Channel(name="Force", quantity="force", data=np.sin(np.arange(64.0)),
+                      sample_rate_hz=1024.0, source_unit="N")
+    measurement = Measurement(channels=(channel,), source="f.csv")
+    previous = os.umask(0o022)
+    try:
+        write_measurement(measurement, tmp_path / "f.csv", "csv")
+        assert stat.S_IMODE((tmp_path / "f.csv").stat().st_mode) == 0o644
+        os.chmod(tmp_path / "f.csv", 0o640)  # a file the user restricted stays so
+        write_measurement(measurement, tmp_path / "f.csv", "csv")
+        assert stat.S_IMODE((tmp_path / "f.csv").stat().st_mode) == 0o640
+    finally:
+        os.umask(previous)
+    assert _only(tmp_path) == ["f.csv"]
