@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .atomic_files import write_atomically
 from .errors import StoreError
 from .records import Channel, Measurement
 
@@ -157,8 +158,8 @@ def make_samples(out_dir: str | os.PathLike = "data_samples", *, run_sweep: bool
     sidecar = out / "loadcases.csv"
     # the exports' vibrometer delay too: `--sidecar loadcases.csv` (CLI) and the app's settings
     # table analyse them at it without a --velocity-delay
-    sidecar.write_text("file,fill_percent,material,direction,velocity_delay_us\n" + "".join(
-        f"{s.file_name},{s.fill_percent:g},acrylic,z,{EXPORT_VELOCITY_DELAY_S * 1e6:g}\n"
-        for s in SAMPLE_CASES))
+    write_atomically(sidecar, "file,fill_percent,material,direction,velocity_delay_us\n"
+                     + "".join(f"{s.file_name},{s.fill_percent:g},acrylic,z,"
+                               f"{EXPORT_VELOCITY_DELAY_S * 1e6:g}\n" for s in SAMPLE_CASES))
     written["loadcases"] = sidecar
     return written

@@ -6,16 +6,22 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import resource
 import stat
+import subprocess
+import sys
+import textwrap
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from pidcore import atomic_files
 from pidcore.app import jobs, kept_specimens
 from pidcore.io import write_measurement
 from pidcore.records import Channel, Measurement
+from pidcore.report.figures import save_figure
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -27,6 +33,15 @@ def _digest(path: Path) -> str:
 def _only(folder: Path) -> list[str]:
     # every entry, hidden ones included: a left temporary file is one of them
     return sorted(p.name for p in folder.iterdir())
+
+
+def _with_file_size_limit(limit_bytes: int):
+    """A ``preexec_fn``: the child may write no file beyond ``limit_bytes`` (``ulimit -f``;
+    a full disk fails the same writes with ENOSPC). Python ignores SIGXFSZ, so the write
+    fails with EFBIG instead of killing the child."""
+    def limit() -> None:
+        resource.setrlimit(resource.RLIMIT_FSIZE, (limit_bytes, limit_bytes))
+    return limit
 
 
 def test_a_writer_that_fails_half_way_leaves_the_previous_file_and_no_temporary(tmp_path):
@@ -83,6 +98,60 @@ def test_a_full_disk_at_the_flush_keeps_no_kept_specimen_and_no_temporary(tmp_pa
     kept, problem = kept_specimens.keep_specimen(folder, "steel_6mm.toml", data)
     assert problem == "" and _only(folder) == [f"{kept.sha256}.json", f"{kept.sha256}.toml"]
     assert (folder / f"{kept.sha256}.toml").read_bytes() == data
+
+
+def test_model_tables_past_a_file_size_limit_leave_the_previous_tables_whole(tmp_path):
+    # `pidcore model damper --out` wrote the CSV in place: a full disk (or Ctrl-C) left half
+    # a CSV that read as a shorter table of plausible numbers
+    from pidcore.model import write_damper_table
+
+    small = pd.DataFrame({"fill_percent": [50.0], "c_eq_per_coupon": [1.5]})
+    write_damper_table(small, tmp_path, provenance={"model": "old"})
+    before = {name: _digest(tmp_path / name) for name in _only(tmp_path)}
+    code = textwrap.dedent(f"""
+        import numpy as np, pandas as pd
+        from pidcore.model import write_damper_table
+        rows = 20_000  # about 1 MB of CSV: past the limit below
+        table = pd.DataFrame({{"fill_percent": np.linspace(0, 100, rows),
+                               "c_eq_per_coupon": np.linspace(1, 2, rows)}})
+        try:
+            write_damper_table(table, {str(tmp_path)!r})
+        except OSError as exc:
+            print(exc.errno)
+    """)
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         timeout=120, env={**os.environ, "PYTHONPATH": str(ROOT)},
+                         preexec_fn=_with_file_size_limit(200_000))
+    assert run.returncode == 0 and run.stdout.strip() == "27", run.stderr[-2000:]  # EFBIG
+    assert {name: _digest(tmp_path / name) for name in _only(tmp_path)} == before
+    assert sorted(before) == ["equivalent_damper.csv", "equivalent_damper.json"]
+
+
+def test_a_figure_interrupted_while_drawn_leaves_the_previous_figure(tmp_path, monkeypatch):
+    # save_figure wrote the PNG in place while matplotlib drew it: Ctrl-C mid-way left a
+    # truncated PNG under the figure's name
+    import matplotlib.figure
+
+    fig = matplotlib.figure.Figure()
+    fig.subplots().plot([0, 1], [0, 1])
+    old = save_figure(fig, tmp_path, "sdc")
+    before = {p.name: _digest(p) for p in old}
+    real = matplotlib.figure.Figure.savefig
+
+    def interrupted(self, target, *args, **kwargs):
+        # the first bytes reach the target, then Ctrl-C
+        if hasattr(target, "write"):
+            target.write(b"\x89PNG\r\n")
+        else:
+            Path(target).write_bytes(b"\x89PNG\r\n")
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(matplotlib.figure.Figure, "savefig", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        save_figure(fig, tmp_path, "sdc")
+    assert {p.name: _digest(p) for p in old} == before
+    assert _only(tmp_path) == ["sdc.png", "sdc.svg"]
+    monkeypatch.setattr(matplotlib.figure.Figure, "savefig", real)
 
 
 def test_an_exported_measurement_has_the_permissions_of_any_new_file(tmp_path):

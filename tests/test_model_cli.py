@@ -109,9 +109,9 @@ def test_figures_writes_every_family(tmp_path, monkeypatch):
 
     built = []
 
-    def save_undrawn(fig, path, **_):
+    def save_undrawn(fig, target, **_):
         built.append(fig)
-        path.write_bytes(b"x")
+        target.write(b"x")  # drawn into memory, then written whole beside the others
 
     monkeypatch.setattr(Figure, "savefig", save_undrawn)
     assert _run(["model", "figures", "--out", str(tmp_path)]) == 0

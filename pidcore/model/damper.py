@@ -32,6 +32,7 @@ import pandas as pd
 
 from .. import __version__
 from .. import defaults as D
+from ..atomic_files import write_atomically
 from ..constants import STANDARD_GRAVITY, VIBRATED_MASS_CONVENTIONS
 from ..errors import ParameterError
 from .sdc_model import SdcModel
@@ -681,15 +682,14 @@ def write_damper_table(table: pd.DataFrame, out_dir: str | Path, *,
     unknown = sorted(set(formats) - {"csv", "json"})
     if unknown or not formats:
         raise ParameterError(f"formats: unknown {unknown or list(formats)}; expected csv, json")
+    # every text made before any file is written, each file then replaced whole
+    # (:func:`pidcore.atomic_files.write_atomically`): a Ctrl-C or a full disk leaves the
+    # previous table, never half a CSV that reads as a shorter table
+    texts: dict[Path, str] = {}
     out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    paths: list[Path] = []
     if "csv" in formats:
-        p = out / f"{stem}.csv"
-        table.to_csv(p, index=False)
-        paths.append(p)
+        texts[out / f"{stem}.csv"] = table.to_csv(index=False)
     if "json" in formats:
-        p = out / f"{stem}.json"
         prov = {"pidcore_version": __version__,
                 "created_utc": datetime.now(UTC).isoformat(timespec="seconds")}
         prov.update(provenance or {})
@@ -698,7 +698,12 @@ def write_damper_table(table: pd.DataFrame, out_dir: str | Path, *,
                    for row in table.to_dict(orient="records")]
         units = {c: {**DAMPER_COLUMNS, **PANEL_COLUMNS}.get(c, "") for c in table.columns}
         meanings = {c: DAMPER_COLUMN_MEANINGS.get(c, "") for c in table.columns}
-        p.write_text(json.dumps({"records": records, "units": units, "columns": meanings,
-                                 "provenance": prov}, indent=1))
-        paths.append(p)
+        texts[out / f"{stem}.json"] = json.dumps({"records": records, "units": units,
+                                                  "columns": meanings, "provenance": prov},
+                                                 indent=1)
+    out.mkdir(parents=True, exist_ok=True)
+    paths: list[Path] = []
+    for path, text in texts.items():
+        write_atomically(path, text)
+        paths.append(path)
     return paths

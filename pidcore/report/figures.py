@@ -14,6 +14,7 @@ drawn as open markers labelled ``"... filled"``.
 
 from __future__ import annotations
 
+import io
 import textwrap
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -21,6 +22,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from ..atomic_files import write_atomically
 from ..errors import ParameterError
 from ..model.sdc_model import SdcModel
 
@@ -186,6 +188,13 @@ def save_figure(fig, out_dir: str | Path, stem: str) -> list[Path]:
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     paths = [out / f"{stem}.png", out / f"{stem}.svg"]
-    fig.savefig(paths[0], dpi=150)
-    fig.savefig(paths[1])
+    # both drawn before either is written, each then replaced whole: a Ctrl-C while drawing
+    # (seconds for a large family) left a truncated PNG under the figure's name
+    images = []
+    for path, options in zip(paths, ({"dpi": 150}, {}), strict=True):
+        buffer = io.BytesIO()
+        fig.savefig(buffer, format=path.suffix[1:], **options)
+        images.append(buffer.getvalue())
+    for path, image in zip(paths, images, strict=True):
+        write_atomically(path, image)
     return paths
