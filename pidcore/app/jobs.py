@@ -957,6 +957,33 @@ def read_journal(path: Path) -> tuple[list[DemJob], str]:
                    f"cannot be read: {'; '.join(lost)}; their saved runs are in the store")
 
 
+def waiting_job_specimens(store_path: str | Path) -> dict[str, str]:
+    """``{sha256: job id}`` of the specimen of every job that the store's journal lists as
+    queued or running (or waiting for the same run), whichever server wrote it, as written
+    (a stopped server's too: whether it still runs is not told apart here).
+
+    Raises
+    ------
+    ParameterError
+        The journal, or one of those jobs, cannot be read (one line naming the journal): what
+        it runs is then unknown, so no file it may need can be called unused.
+    """
+    path = journal_path(store_path)
+    entries, problem = _journal_entries(path)
+    if problem:
+        raise ParameterError(problem)
+    found: dict[str, str] = {}
+    for number, (entry, _) in enumerate(entries, start=1):
+        try:
+            job = _job_from_document(entry, live=True)  # the state as written
+        except _UNREADABLE as exc:
+            raise ParameterError(f"the job table of the app ({path}) cannot be read: "
+                                 f"{_unreadable_entry(entry, number, exc)}") from None
+        if job.state in ("queued", "running", SAME_RUN_STATE) and job.specimen is not None:
+            found.setdefault(job.specimen.hash, job.job_id)
+    return found
+
+
 _RUNNERS: dict[str, DemJobRunner] = {}
 _RUNNERS_LOCK = threading.Lock()
 

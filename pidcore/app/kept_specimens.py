@@ -19,6 +19,7 @@ from __future__ import annotations
 import json
 import os
 import re
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -185,3 +186,157 @@ def specimen_upload(folder: str | os.PathLike, *, upload: tuple[str, bytes] | No
         f"{kept.name} ({hashed_name(kept.specimen.name, sha256)}): the specimen file uploaded "
         "before the page was reloaded, kept beside the store; upload another file to replace "
         "it"))
+
+
+@dataclass(frozen=True)
+class KeptFile:
+    """One uploaded specimen kept in a store's kept folder (:func:`keep_specimen`):
+    its ``sha256``, the ``name`` it was uploaded under ("" where its label is lost), its
+    ``files`` there (``<sha256>.toml`` and ``<sha256>.json``, those present), their
+    ``size_bytes``, and ``referred_by``: what still needs it ("" where nothing does), e.g.
+    ``record dem_runs/f50Hz_a5g_...`` or ``job job0003 (queued or running)``."""
+
+    sha256: str
+    name: str
+    files: tuple[Path, ...]
+    size_bytes: int
+    referred_by: str
+
+    def to_dict(self) -> dict:
+        return {"sha256": self.sha256, "name": self.name, "files": [str(f) for f in self.files],
+                "size_bytes": self.size_bytes, "referred_by": self.referred_by or None}
+
+
+@dataclass(frozen=True)
+class KeptFolder:
+    """What :func:`prune_kept_specimens` found in (and removed from) a store's kept folder:
+    ``folder``; ``files`` (:class:`KeptFile`, by sha256); ``removed``: whether the unused
+    ones (:attr:`unused`) were removed; ``others``: entries the app did not write there
+    (never touched)."""
+
+    folder: Path
+    files: tuple[KeptFile, ...]
+    removed: bool
+    others: tuple[Path, ...]
+
+    @property
+    def unused(self) -> tuple[KeptFile, ...]:
+        """The kept files that no record of the store and no waiting job refers to."""
+        return tuple(f for f in self.files if not f.referred_by)
+
+    def to_dict(self) -> dict:
+        return {"folder": str(self.folder), "removed": self.removed,
+                "files": [f.to_dict() for f in self.files],
+                "others": [str(p) for p in self.others]}
+
+
+def _kept_entries(folder: Path) -> tuple[dict[str, list[Path]], list[Path]]:
+    """The app's files in ``folder`` by sha256, and every other entry (a file of another
+    name, a link, a folder, a temporary file a killed write left)."""
+    by_hash: dict[str, list[Path]] = {}
+    others = []
+    for entry in sorted(folder.iterdir()):
+        if _is_kept_file(entry):
+            by_hash.setdefault(entry.stem, []).append(entry)
+        else:
+            others.append(entry)
+    return by_hash, others
+
+
+def _is_kept_file(path: Path) -> bool:
+    """Whether ``path`` is named and made as the app keeps a file (``<sha256>.toml`` or
+    ``.json``, a plain file): a link is never the app's, and is never followed."""
+    return path.suffix in (_DATA_SUFFIX, _NAME_SUFFIX) and bool(_SHA256.fullmatch(path.stem)) \
+        and not path.is_symlink() and path.is_file()
+
+
+def _remove_kept(folder: Path, path: Path) -> None:
+    """Remove one file the app kept in ``folder``; anything else is refused in one line."""
+    if path.parent.resolve() != folder.resolve() or not _is_kept_file(path):
+        raise ParameterError(f"{path}: not a specimen file kept in {folder} (<sha256>.toml "
+                             "or .json); only those are ever removed")
+    path.unlink()
+
+
+def prune_kept_specimens(store_path: str | os.PathLike, *, remove: bool = False,
+                         only: Sequence[str | os.PathLike] = ()) -> KeptFolder:
+    """The specimen files kept beside the store ``store_path`` (:func:`kept_specimens_folder`)
+    and what still needs each: a record of the store naming its sha256 anywhere
+    (:meth:`pidcore.store.Store.sha256_references`) or a queued or running job of the app
+    (:func:`pidcore.app.jobs.waiting_job_specimens`). With ``remove``, those nothing needs
+    are removed; a file a record names is never removed. ``only``: the kept files to look at
+    (each a sha256 or a path of one in the folder; default all).
+
+    A kept file serves a page reload of the app only (a job and a calibration hold their
+    specimen's text): one removed while a page names it asks for the file to be uploaded
+    again. Files of other names in the folder are listed and never touched. The store is
+    only read: the check and the removal are made under its write lock, so no record that
+    names a file is saved in between.
+
+    Raises
+    ------
+    ParameterError
+        An ``only`` entry that is not a kept file of this store (a path outside the folder),
+        or the app's job table cannot be read (with ``remove``: what its jobs need is then
+        unknown); nothing is removed.
+    StoreError
+        The store cannot be read, or (``remove``) its lock cannot be taken.
+    """
+    from ..defaults import STORE_LOCK_TIMEOUT_S
+    from ..store import Store
+    from ..store.lock import exclusive_lock
+    from .jobs import waiting_job_specimens
+
+    folder = kept_specimens_folder(store_path)
+    if not folder.exists():
+        return KeptFolder(folder, (), remove, ())
+    if not folder.is_dir() or folder.is_symlink():
+        raise ParameterError(f"{folder}: expected the folder of the specimen files the app "
+                             "keeps beside the store (a plain folder)")
+    by_hash, others = _kept_entries(folder)
+    if only:
+        chosen = {_chosen_hash(folder, entry, by_hash) for entry in only}
+        by_hash = {h: paths for h, paths in by_hash.items() if h in chosen}
+        others = []
+
+    def survey() -> tuple[KeptFile, ...]:
+        records = Store(store_path).sha256_references()
+        waiting = waiting_job_specimens(store_path)
+        files = []
+        for sha256, paths in sorted(by_hash.items()):
+            if sha256 in records:
+                why = f"record {records[sha256]}"
+            elif sha256 in waiting:
+                why = f"job {waiting[sha256]} (queued or running)"
+            else:
+                why = ""
+            size = sum(p.stat().st_size for p in paths)
+            name = _kept_name(folder / f"{sha256}{_NAME_SUFFIX}") or ""
+            files.append(KeptFile(sha256, name, tuple(paths), size, why))
+        return tuple(files)
+
+    if not remove:
+        return KeptFolder(folder, survey(), False, tuple(others))
+    with exclusive_lock(Path(store_path), timeout_s=STORE_LOCK_TIMEOUT_S):
+        files = survey()
+        for kept in files:
+            if not kept.referred_by:
+                for path in kept.files:
+                    _remove_kept(folder, path)
+    return KeptFolder(folder, files, True, tuple(others))
+
+
+def _chosen_hash(folder: Path, entry: str | os.PathLike,
+                 by_hash: dict[str, list[Path]]) -> str:
+    """The sha256 of the kept file ``entry`` names (its sha256, or the path of its
+    ``.toml`` or ``.json`` in ``folder``); anything else is refused in one line."""
+    text = os.fspath(entry)
+    if _SHA256.fullmatch(text) and text in by_hash:
+        return text
+    path = Path(text)
+    if path.parent.resolve() == folder.resolve() and _is_kept_file(path) \
+            and path.stem in by_hash:
+        return path.stem
+    raise ParameterError(f"{text}: not a specimen file kept in {folder} (expected the "
+                         "sha256 of one, or the path of its .toml or .json there); nothing "
+                         "was removed")

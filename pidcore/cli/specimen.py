@@ -1,12 +1,18 @@
-"""``pidcore specimen check FILE``: validate a specimen file and print what follows from it."""
+"""``pidcore specimen check FILE``: validate a specimen file and print what follows from it;
+``pidcore specimen kept``: the specimen files the app keeps beside a store, and removing those
+nothing needs."""
 
 from __future__ import annotations
 
 import argparse
 import json
+from typing import TYPE_CHECKING
 
 from .. import defaults
-from ._options import add_json_option, path_argument
+from ._options import add_json_option, add_store_option, path_argument
+
+if TYPE_CHECKING:
+    from ..app.kept_specimens import KeptFolder
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -26,6 +32,25 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     check.add_argument("file", metavar="FILE", type=path_argument, help="specimen TOML file")
     add_json_option(check)
     check.set_defaults(func=run_check)
+    kept = sub.add_parser(
+        "kept", help="list the specimen files the app keeps beside a store; --remove the "
+                     "unused ones",
+        description="List the specimen files uploaded to the app and kept beside the store "
+                    "(<store>.specimens/, one per sha256, for a page reload), each with what "
+                    "still needs it: a record of the store that names its sha256, or a queued "
+                    "or running job of the app. Nothing is removed without --remove, which "
+                    "removes the files nothing needs; a file a record names is never "
+                    "removed, and the store is only read. Exit 2, nothing removed, where the "
+                    "store or the app's job table cannot be read or a FILE is not a kept "
+                    "file of the store.")
+    add_store_option(kept, help=f"the app's store (default ./{defaults.STORE_PATH})")
+    kept.add_argument("files", metavar="FILE", nargs="*",
+                      help="only these kept files (a sha256, or the path of its .toml or "
+                           ".json in the kept folder; default: all)")
+    kept.add_argument("--remove", action="store_true",
+                      help="remove the listed files no record and no waiting job needs")
+    add_json_option(kept)
+    kept.set_defaults(func=run_kept)
 
 
 def run_check(args: argparse.Namespace) -> int:
@@ -37,6 +62,35 @@ def run_check(args: argparse.Namespace) -> int:
         return 0
     print(format_facts(facts, str(args.file)))
     return 0
+
+
+def run_kept(args: argparse.Namespace) -> int:
+    from ..app.kept_specimens import prune_kept_specimens
+
+    found = prune_kept_specimens(args.store, remove=args.remove, only=args.files)
+    if args.json:
+        print(json.dumps(found.to_dict()))
+        return 0
+    print(format_kept(found))
+    return 0
+
+
+def format_kept(found: KeptFolder) -> str:
+    """One line per kept file (what needs it, or that it was or would be removed) and a
+    closing line with the count and the bytes freed."""
+    if not found.files and not found.others:
+        return f"no specimen files kept in {found.folder}"
+    verb = "removed" if found.removed else "unused: would be removed with --remove"
+    lines = [f"{f.sha256}  {f.name or '(name lost)'}  {f.size_bytes} B  "
+             + (f"kept: {f.referred_by}" if f.referred_by else verb)
+             for f in found.files]
+    lines += [f"{p.name}: not a file the app keeps; left as it is" for p in found.others]
+    unused = found.unused
+    freed = sum(f.size_bytes for f in unused)
+    lines.append(f"{found.folder}: {len(found.files)} kept specimen file(s), {len(unused)} "
+                 f"unused ({freed} B) " + ("removed" if found.removed else
+                                           "(nothing removed: --remove removes them)"))
+    return "\n".join(lines)
 
 
 def format_facts(f: dict, source: str) -> str:

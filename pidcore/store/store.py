@@ -41,6 +41,7 @@ from __future__ import annotations
 import io
 import json
 import os
+import re
 import resource
 import shutil
 import threading
@@ -173,6 +174,22 @@ def _write_image(path: Path, image: memoryview) -> None:
         file.write(image)
         file.flush()
         os.fsync(file.fileno())
+
+
+#: A sha256 in a stored text: 64 hexadecimal digits, not part of a longer run of them.
+_SHA256_IN_TEXT = re.compile(r"(?<![0-9a-fA-F])[0-9a-fA-F]{64}(?![0-9a-fA-F])")
+
+
+def _texts_of(value: object) -> Iterator[str]:
+    """The texts an HDF5 attribute holds (a string, bytes, or an array of them); none for
+    a number."""
+    if isinstance(value, bytes):
+        yield value.decode("utf-8", errors="replace")
+    elif isinstance(value, str):
+        yield value
+    elif isinstance(value, np.ndarray) and value.dtype.kind in "SUO":
+        for item in value.ravel():
+            yield from _texts_of(item)
 
 
 def _prepare_entry(record: Mapping[str, Any], arrays: Mapping[str, Any] | None,
@@ -1027,6 +1044,43 @@ class Store:
         pidcore_version (oldest first)."""
         with self._reading() as h5:
             return self._listing(h5, _CALIBRATIONS, [], lambda group: {})
+
+    def sha256_references(self) -> dict[str, str]:
+        """``{sha256: the entry that names it first}`` for every sha256 (64 hexadecimal
+        digits, lowercase) that the store names anywhere: in any attribute of any entry (a
+        record's fields, its parameters) or in a text array (a calibration's document and its
+        calibrated specimen file), e.g. ``{"beeac8...": "dem_runs/f50Hz_a5g_..."}``; empty
+        for a store not written yet.
+
+        Where a file kept by its hash (the app's uploaded specimen files) may be deleted only
+        when no record refers to it, every field is searched, not the few known to hold a
+        specimen's hash: a field added later, or a calibrated file's source hash inside its
+        text, still keeps its file.
+
+        Raises
+        ------
+        StoreError
+            The file at the path is not a readable pidcore store.
+        """
+        found: dict[str, str] = {}
+
+        def note(text: str, where: str) -> None:
+            for match in _SHA256_IN_TEXT.finditer(text):
+                found.setdefault(match.group(0).lower(), where)
+
+        def visit(name: str, item: h5py.Group | h5py.Dataset) -> None:
+            entry = "/".join(name.split("/")[:2])  # "dem_runs/<key>": what a user can find
+            for value in item.attrs.values():
+                for text in _texts_of(value):
+                    note(text, entry)
+            if isinstance(item, h5py.Dataset) and item.dtype == np.uint8 and item.ndim == 1:
+                note(item[()].tobytes().decode("utf-8", errors="replace"), entry)
+
+        with self._reading() as h5:
+            if h5 is None:
+                return {}
+            h5.visititems(visit)  # hard links only: a link to another file is never followed
+        return found
 
     # --- shared reading helpers ----------------------------------------------------------------
 
