@@ -7,7 +7,8 @@ written to a temporary file in the target's own folder, so that the final
 :func:`os.replace` is a rename on one file system: atomic, never a copy. Ctrl-C
 (KeyboardInterrupt), SIGTERM, a full disk or a failing writer therefore leave the previous file
 as it was and no temporary file behind; a reader sees the old file or the new one, never half
-of one.
+of one. A folder of several outputs is built beside its place and moved there whole, after
+:func:`fsync_tree`.
 
 ``durable`` (the default) fsyncs the new file before the rename and the folder after it: a
 power loss right after the call then finds the new file, not an empty one under its name (a
@@ -50,6 +51,19 @@ def fsync_path(path: str | os.PathLike[str], *, directory: bool = False) -> None
         os.fsync(fd)
     finally:
         os.close(fd)
+
+
+def fsync_tree(folder: str | os.PathLike[str]) -> None:
+    """Flush every file under ``folder``, then each folder's entries, to the disk: for a
+    folder of outputs built beside its place and moved there whole (a report, a
+    calibration's files), whose rename could otherwise reach the disk before their data.
+    An ``OSError`` where a file cannot be flushed; a folder that cannot be is no error
+    (some file systems cannot fsync one)."""
+    for root, _, names in os.walk(folder):
+        for name in names:
+            fsync_path(Path(root, name))
+        with suppress(OSError):
+            fsync_path(root, directory=True)
 
 
 def temporary_path_for(target: str | os.PathLike[str]) -> Path:

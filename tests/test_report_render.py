@@ -332,3 +332,34 @@ def test_pdf_table_sets_the_like_for_like_measured_sdc_beside_ours():
     assert shown["SDC measured (Eq. 11) [-]"] == "1.139"
     assert shown["SDC calibrated DEM (Eq. 11) [-]"] == "0.2399"
     assert shown["measured in calibrated 95 % band"] == "no"
+
+
+def test_every_report_file_is_on_disk_before_the_rename_that_names_it(tmp_path, table,
+                                                                      provenance, monkeypatch):
+    # the folder is renamed into place whole; a rename can reach the disk before the data it
+    # names, so without a flush a power loss just after `pidcore report` ended could leave
+    # the report's files empty under their names
+    import os
+    import stat
+
+    flushed: set[int] = set()
+    renamed_after: list[set[int]] = []
+    real_fsync, real_replace = os.fsync, os.replace
+
+    def fsync(fd: int) -> None:
+        info = os.fstat(fd)
+        if stat.S_ISREG(info.st_mode):
+            flushed.add(info.st_ino)  # an inode survives the rename
+        real_fsync(fd)
+
+    def replace(source, target) -> None:
+        renamed_after.append(set(flushed))
+        real_replace(source, target)
+
+    monkeypatch.setattr(os, "fsync", fsync)
+    monkeypatch.setattr(os, "replace", replace)
+    out = tmp_path / "report"
+    write_report(table, _figures(), provenance, out, ("csv", "md"))
+    files = {p.stat().st_ino for p in out.rglob("*") if p.is_file()}
+    assert len(files) == 6  # csv, its notes, md, marker, the figure's png and svg
+    assert renamed_after and files <= renamed_after[0]

@@ -11,6 +11,7 @@ from typing import Any
 
 import numpy as np
 
+from ..atomic_files import fsync_tree
 from ..records import json_safe
 from ..units import display_number
 from .calibrate import CalibrationResult
@@ -392,6 +393,7 @@ def write_outputs(result: CalibrationResult, out_dir: str | os.PathLike) -> list
                            ("posterior_pairs.png", plot_pairs)):
             plot(result, work / name)
             names.append(name)
+        fsync_tree(work)  # the files on disk before the renames that name them
         with interrupt.deferred():
             if not out.exists():
                 os.replace(work, out)

@@ -26,6 +26,7 @@ from pathlib import Path
 import pandas as pd
 
 from .. import defaults, interrupt
+from ..atomic_files import fsync_tree
 from ..constants import REPORT_FORMATS
 from ..errors import ParameterError
 from ..io import display_path
@@ -406,6 +407,7 @@ def write_report(table: pd.DataFrame, figures: Mapping[str, object], provenance:
             bar.close()  # before the "wrote ..." lines
         (tmp / REPORT_MARKER).write_text("written by pidcore report\n", encoding="utf-8")
         os.chmod(tmp, 0o755)  # mkdtemp makes 0700; a report folder is meant to be shared
+        fsync_tree(tmp)  # the files on disk before the rename that names them
         # the swap and the earlier report's removal are one step for Ctrl-C: cut between them,
         # a '.<name>.*.old' folder was left beside the report (interrupt.deferred)
         with interrupt.deferred():
