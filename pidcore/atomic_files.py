@@ -37,10 +37,23 @@ TEMPORARY_SUFFIX = ".tmp"
 
 def new_file_mode() -> int:
     """The permissions a new file gets here: 0o666 less the process's umask."""
-    # os.umask can only be read by setting it, so set it back at once
-    umask = os.umask(0)
+    return 0o666 & ~_process_umask()
+
+
+def _process_umask() -> int:
+    # os.umask can only be read by setting it, and the app writes files from worker threads:
+    # a file another thread created between the two calls would get umask 0 (world-writable).
+    # Linux states the umask in /proc (since 4.7); only where it does not is it set and reset.
+    try:
+        with open("/proc/self/status", encoding="ascii") as status:
+            for line in status:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except (OSError, ValueError, IndexError):
+        pass
+    umask = os.umask(0o077)  # the strictest mask meanwhile, should another thread create a file
     os.umask(umask)
-    return 0o666 & ~umask
+    return umask
 
 
 def fsync_path(path: str | os.PathLike[str], *, directory: bool = False) -> None:

@@ -170,3 +170,36 @@ def test_an_exported_measurement_has_the_permissions_of_any_new_file(tmp_path):
     finally:
         os.umask(previous)
     assert _only(tmp_path) == ["f.csv"]
+
+
+def test_the_new_file_mode_reads_the_umask_without_opening_it_to_other_threads(monkeypatch):
+    # os.umask can only be read by setting it; set to 0 even for a moment, a file the app's
+    # job thread created meanwhile would be world-writable. The mode must follow the real
+    # umask, read from /proc where Linux states it, by set-and-reset (never 0) elsewhere.
+    previous = os.umask(0o027)
+    try:
+        assert atomic_files.new_file_mode() == 0o640
+        seen = []
+        real_umask = os.umask
+
+        def recording_umask(mask):
+            seen.append(mask)
+            return real_umask(mask)
+
+        monkeypatch.setattr(atomic_files.os, "umask", recording_umask)
+        if Path("/proc/self/status").is_file():
+            assert atomic_files.new_file_mode() == 0o640
+            assert seen == []  # read, not set
+        real_open = open
+
+        def no_proc(path, *args, **kwargs):
+            if str(path).startswith("/proc/"):
+                raise OSError("no /proc here")
+            return real_open(path, *args, **kwargs)
+
+        monkeypatch.setattr("builtins.open", no_proc)
+        assert atomic_files.new_file_mode() == 0o640
+        assert seen and 0 not in seen  # the fallback never opens the mask
+        assert real_umask(0o027) == 0o027  # and leaves it as it was
+    finally:
+        os.umask(previous)
