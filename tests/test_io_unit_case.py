@@ -304,3 +304,35 @@ def test_ambiguous_or_implausible_prefixes_are_refused(label):
 
     reading = read_unit(label)
     assert lookup_unit(label) is None and reading.problem.startswith(repr(label))
+
+
+# --- time columns and abscissas -------------------------------------------------------------
+
+def test_a_time_column_in_capitals_is_read_and_said_or_refused(tmp_path):
+    # the sample's time in µs headed 'Time [US]': its one reading is µs, said; 'MS' is ms or Ms
+    original = read_measurement(SAMPLE_CSV).channels[0]
+    lines = SAMPLE_CSV.read_text().splitlines()
+    values = np.loadtxt(SAMPLE_CSV, delimiter=",", skiprows=1)
+    values[:, 0] *= 1e6
+    body = [",".join(f"{x:.17g}" for x in row) for row in values]
+    micro = tmp_path / "micro.csv"
+    micro.write_text("\n".join([lines[0].replace("Time [s]", "Time [US]"), *body]) + "\n")
+    measurement = read_measurement(micro)
+    assert measurement.channels[0].sample_rate_hz == original.sample_rate_hz == 25600.0
+    assert measurement.metadata["reader_notes"] == [
+        f"{micro}: time column 'Time': unit 'US' read as us (1e-06 s): unit symbols are "
+        "case-sensitive, and us is the one time unit it can be"]
+    milli = tmp_path / "milli.csv"
+    milli.write_text("\n".join([lines[0].replace("Time [s]", "Time [MS]"), *body]) + "\n")
+    with pytest.raises(InputFileError, match=r"header cell 'Time \[MS\]' not read: 'MS' is "
+                                             r"ambiguous: .* ms \(0\.001 s\) or Ms \(1e\+06 s\)"):
+        read_measurement(milli)
+
+
+def test_a_uff_abscissa_label_of_another_case_is_said():
+    # the DT9837-A export's abscissa '(Sec)': seconds, and the reading said
+    path = FIXTURES / "UFFFilesjl_dataset58_nospacing.uff"
+    measurement = read_measurement(path)
+    assert measurement.channels[0].sample_rate_hz == pytest.approx(1 / 4.99942e-04, rel=1e-6)
+    assert f"{path}: record 1 ('Time Waveform') abscissa unit '(Sec)' read as sec (1 s)" in \
+        "\n".join(measurement.metadata["reader_notes"])

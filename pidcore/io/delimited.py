@@ -377,6 +377,9 @@ def read_csv(path: str | os.PathLike[str], *, sample_rate_hz: float | None = Non
     elif time_index is not None:
         name, unit = cells[time_index]
         factor = _seconds_per(unit)
+        if read_unit(unit).corrected:
+            # 'Time [US]' is µs, a factor the header's case did not state: said
+            notes.append(f"{where}: time column {name!r}: {read_unit(unit).correction}")
         rate, start_time, note = rate_from_times(values[:, time_index] * factor,
                                                  what=f"{where}: column {name!r}",
                                                  with_note=True)
@@ -508,6 +511,8 @@ def _pair_time_bases(values: np.ndarray, cells: list[tuple[str, str]], pair_time
         name, unit = cells[t_index]
         factor = _seconds_per(unit)
         what = f"{where}: column {name!r} (time of column {owned[0] + 1})"
+        if read_unit(unit).corrected:
+            notes.append(f"{what}: {read_unit(unit).correction}")
         if length < 2:
             raise InputFileError(f"{what}: holds {length} times; expected the time of each "
                                  "sample of its channels")

@@ -331,7 +331,10 @@ def read_uff(path: str | os.PathLike[str]) -> Measurement:
                              "(function type 1); expected time histories")
     channels = [_record_channel(d, k, where, unit_factors) for k, d in enumerate(time_records)]
     notes: list[str] = []
-    for k, c in enumerate(channels):
+    for k, (c, d) in enumerate(zip(channels, time_records, strict=True)):
+        abscissa = read_unit(_label(d.get("abscissa_axis_units_lab")))
+        if abscissa.corrected and abscissa.quantity == "time":
+            notes.append(f"{where}: record {k + 1} ({c.name!r}) abscissa {abscissa.correction}")
         if c.source_unit.startswith("UFF data type"):
             basis = ("the file's dataset 164 unit factors" if has_units_dataset
                      else "SI (no dataset 164 in the file)")
