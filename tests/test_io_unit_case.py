@@ -336,3 +336,25 @@ def test_a_uff_abscissa_label_of_another_case_is_said():
     assert measurement.channels[0].sample_rate_hz == pytest.approx(1 / 4.99942e-04, rel=1e-6)
     assert f"{path}: record 1 ('Time Waveform') abscissa unit '(Sec)' read as sec (1 s)" in \
         "\n".join(measurement.metadata["reader_notes"])
+
+
+# --- the app reads an upload's units as the CLI reads the file's ---------------------------
+
+def test_the_app_refuses_and_says_what_the_cli_does(tmp_path):
+    from pidcore.app.uploads import analyze_upload
+    from pidcore.measure import AnalysisOptions
+
+    truth = analyze_upload("run_fill50.csv", SAMPLE_CSV.read_bytes(), AnalysisOptions())
+    mega = derived_csv(tmp_path / "ldv_fill50.csv", {"Velocity [m/s]": "Velocity [Mm/s]"},
+                       {"Velocity": 1e3})
+    refused = analyze_upload("ldv_fill50.csv", mega.read_bytes(), AnalysisOptions())
+    assert refused.record is None and refused.error.startswith(
+        "ldv_fill50.csv: channel 'Velocity' (velocity) has a unit pidcore refuses: 'Mm/s' is "
+        "1e+06 m/s, not a plausible velocity unit (expected 1e-09 to 1 m/s per unit, such as "
+        "'mm/s'); state it in the export")
+    kilo = derived_csv(tmp_path / "head_fill50.csv", {"Force [N]": "Force [KN]"},
+                       {"Force": 1e-3})
+    taken = analyze_upload("head_fill50.csv", kilo.read_bytes(), AnalysisOptions()).record
+    assert taken.analysis.complex_power_w == pytest.approx(truth.record.analysis.complex_power_w,
+                                                         rel=SAME)
+    assert "channel 'Force': unit 'KN' read as kN (1000 N)" in "\n".join(taken.notes)
