@@ -358,3 +358,17 @@ def test_the_app_refuses_and_says_what_the_cli_does(tmp_path):
     assert taken.analysis.complex_power_w == pytest.approx(truth.record.analysis.complex_power_w,
                                                          rel=SAME)
     assert "channel 'Force': unit 'KN' read as kN (1000 N)" in "\n".join(taken.notes)
+
+
+def test_a_vibrometer_channel_of_a_refused_unit_is_not_passed_over(tmp_path, capsys):
+    # a Testlab point name says no role: its 'Mm/s' left it a channel of no unit, ignored, and
+    # the acceleration channel was analysed as the motion instead without a word
+    path = derived_csv(tmp_path / "point_fill50.csv",
+                       {"Velocity [m/s]": "Point1:+Z [Mm/s]"}, {"Velocity": 1e3})
+    err = refusal(["analyze", str(path), "--no-store", "--no-progress"], capsys)
+    assert err == (f"pidcore analyze: error: {path}: channel 'Point1:+Z' (velocity) has a unit "
+                   "pidcore refuses: 'Mm/s' is 1e+06 m/s, not a plausible velocity unit "
+                   "(expected 1e-09 to 1 m/s per unit, such as 'mm/s'); give it with "
+                   "--velocity-unit UNIT and name it with --velocity 'Point1:+Z'\n")
+    record = analyze_json(path, capsys, "--velocity", "Point1:+Z", "--velocity-unit", "mm/s")
+    same_power(record, sample_record(capsys))
