@@ -74,6 +74,7 @@ _TABLE: dict[str, UnitInfo] = {
     "s": UnitInfo("time", 1.0),
     "sec": UnitInfo("time", 1.0),
     "ms": UnitInfo("time", 1e-3),
+    "us": UnitInfo("time", 1e-6),
 }
 #: Each table spelling by its lower-case form, for a label written in another case.
 _TABLE_BY_FOLDED = {spelling.lower(): spelling for spelling in _TABLE}
@@ -221,7 +222,8 @@ def read_unit(text: str) -> UnitReading:
     1e6 m/s), then checked against :data:`PLAUSIBLE_FACTORS`.
 
     A label of no unit in its own case (``KN``, ``G``, ``M/S``, all capitals) is read as the
-    table's spelling of another case where that is its only reading of the quantity; where
+    table's spelling of another case where that is its only reading of the quantity (another
+    case of a spelling pint alone reads is not guessed: ``Nm`` is no nanometre); where
     another casing reads as the same quantity by another factor (``MM/S``: mm/s or Mm/s;
     ``MN``: mN or MN) it is refused as ambiguous, as is a reading outside the plausible range
     (``Mm/s``, ``MN``, ``km/s``): ``info`` None and ``problem`` says why.
@@ -255,10 +257,11 @@ def read_unit(text: str) -> UnitReading:
         return UnitReading(label, None)
     spelling = _TABLE_BY_FOLDED.get(folded)
     if spelling is None:
+        # only the table's spellings are corrected: another case of a pint unit is often
+        # another unit ('Nm', a torque, is no nanometre); several readings are refused below
         if len({(r.quantity, r.factor) for r in readings.values()}) == 1:
-            spelling = next(iter(readings))
-        else:
-            spelling = min(readings)  # one of several: refused below, named in the message
+            return UnitReading(label, None)
+        spelling = min(readings)
     meant = readings[spelling]
     others = {c: r for c, r in readings.items() if r.quantity == meant.quantity
               and not math.isclose(r.factor, meant.factor, rel_tol=1e-9)}

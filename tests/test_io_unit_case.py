@@ -372,3 +372,13 @@ def test_a_vibrometer_channel_of_a_refused_unit_is_not_passed_over(tmp_path, cap
                    "--velocity-unit UNIT and name it with --velocity 'Point1:+Z'\n")
     record = analyze_json(path, capsys, "--velocity", "Point1:+Z", "--velocity-unit", "mm/s")
     same_power(record, sample_record(capsys))
+
+
+@pytest.mark.parametrize("label", ["Nm", "IN/SEC", "A", "Hz"])
+def test_another_case_of_a_unit_only_pint_reads_is_not_guessed(label):
+    # 'Nm' (a torque) read as nm (pint's nanometre) with a note was a guess; such a label is
+    # of no unit pidcore knows, and the analysis asks for the unit of a channel that has it
+    from pidcore.units import read_unit
+
+    reading = read_unit(label)
+    assert (reading.info, reading.corrected, reading.problem) == (None, False, "")
