@@ -382,3 +382,19 @@ def test_another_case_of_a_unit_only_pint_reads_is_not_guessed(label):
 
     reading = read_unit(label)
     assert (reading.info, reading.corrected, reading.problem) == (None, False, "")
+
+
+def test_an_accelerometer_of_a_refused_unit_is_not_passed_over_for_mass_cancellation(
+        tmp_path, capsys):
+    # --mass-below-gauge cancels with the drive point's acceleration: one in 'MM/S^2' was
+    # ignored ('not needed') and the velocity's derivative used instead, without a word
+    path = derived_csv(tmp_path / "point_fill50.csv",
+                       {"Acceleration [m/s^2]": "Point2 [MM/S^2]"}, {"Acceleration": 1e3})
+    err = refusal(["analyze", str(path), "--no-store", "--no-progress", "--mass-below-gauge",
+                   "0.001"], capsys)
+    assert (f"{path}: channel 'Point2' (acceleration) has a unit pidcore refuses: 'MM/S^2' is "
+            "ambiguous") in err and "--acceleration 'Point2'" in err
+    truth = analyze_json(derived_csv(tmp_path / "acc_fill50.csv", {}), capsys,
+                         "--mass-below-gauge", "0.001")
+    same_power(analyze_json(path, capsys, "--mass-below-gauge", "0.001", "--acceleration",
+                            "Point2", "--acceleration-unit", "mm/s^2"), truth)

@@ -166,6 +166,9 @@ def _drive_point_acceleration(measurement: Measurement, taken: set[str],
                            f"{found[0].name!r} is named like a reference/shaker accelerometer; "
                            f"{why} needs the acceleration at the drive point: confirm it with "
                            f"acceleration={found[0].name!r} or remove the option")
+    if not found:
+        _refuse_a_refused_unit_of(measurement, "acceleration",
+                                  [c for c in measurement.channels if c.name not in taken])
     return found[0] if found else None
 
 
