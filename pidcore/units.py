@@ -250,7 +250,10 @@ def read_unit(text: str) -> UnitReading:
         problem = _implausible(label, exact, cased)
         return UnitReading(label, None if problem else exact, cased, exact.quantity,
                            problem=problem)
-    if sum(c.isalpha() for c in folded) > _MAX_CASED_LETTERS:
+    if sum(c.isalpha() for c in folded) > _MAX_CASED_LETTERS or (
+            folded not in _TABLE_BY_FOLDED and _pint_lookup(folded) is None):
+        # no unit in lower case either: its other cases are not parsed one by one (a header
+        # cell such as 'Velocity', tried as a possible unit row, was parsed 256 times)
         return UnitReading(label, None)
     readings = {c: r for c in _casings(folded) if (r := _exact_reading(c)) is not None}
     if not readings:
