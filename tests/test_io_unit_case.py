@@ -398,3 +398,18 @@ def test_an_accelerometer_of_a_refused_unit_is_not_passed_over_for_mass_cancella
                          "--mass-below-gauge", "0.001")
     same_power(analyze_json(path, capsys, "--mass-below-gauge", "0.001", "--acceleration",
                             "Point2", "--acceleration-unit", "mm/s^2"), truth)
+
+
+def test_a_mega_unit_in_the_name_contradicts_a_milli_unit_row(tmp_path, capsys):
+    # 'Velocity (Mm/s)' over a unit row 'mm/s': lower-cased, the two agreed and the row was
+    # taken; they differ by 1e9, and which is right the option says
+    values = np.loadtxt(SAMPLE_CSV, delimiter=",", skiprows=1)
+    values[:, COLUMN["Velocity"]] *= 1e3
+    path = tmp_path / "rowed_fill50.csv"
+    path.write_text("\n".join(["Time,Force,Velocity (Mm/s),Acceleration", "s,N,mm/s,m/s^2",
+                               *(",".join(f"{x:.17g}" for x in row) for row in values)]) + "\n")
+    assert read_measurement(path).channel("Velocity").source_unit == \
+        "Mm/s in the name, mm/s in the unit row"
+    err = refusal(["analyze", str(path), "--no-store", "--no-progress"], capsys)
+    assert "'Mm/s in the name, mm/s in the unit row'" in err and "--velocity-unit" in err
+    same_power(analyze_json(path, capsys, "--velocity-unit", "mm/s"), sample_record(capsys))
