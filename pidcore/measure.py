@@ -51,7 +51,7 @@ from .records import Channel, Measurement
 from .signal import PowerAnalysis, analyze_channels
 from .signal.power import PROBABLY_INVERTED, check_analysis_settings
 from .signal.validate import SAME_RATE_RELATIVE_TOLERANCE
-from .units import lookup_unit
+from .units import lookup_unit, read_unit
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -173,14 +173,25 @@ def _with_unit(ch: Channel, role: str, unit: str | None, source: str,
     """The channel in SI: its file unit, or ``unit`` (an option) which overrides it."""
     if unit is None:
         if ch.quantity == "unknown":
-            said = f"the file gives {ch.source_unit!r}" if ch.source_unit else "the file gives none"
+            problem = read_unit(ch.source_unit).problem
+            said = (f"has a unit pidcore refuses: {problem}" if problem else
+                    f"has no recognised unit (the file gives {ch.source_unit!r})"
+                    if ch.source_unit else "has no recognised unit (the file gives none)")
             raise ChannelError(
-                f"{source}: channel {ch.name!r} ({role}) has no recognised unit ({said}); give "
-                f"it with {_UNIT_OPTIONS[role]}=UNIT (e.g. {_UNIT_EXAMPLES[role]})")
+                f"{source}: channel {ch.name!r} ({role}) {said}; give it with "
+                f"{_UNIT_OPTIONS[role]}=UNIT (e.g. {_UNIT_EXAMPLES[role]})")
+        corrected = read_unit(ch.source_unit).correction
+        if corrected:
+            # the case of a prefix is its meaning: a reading of another case is said
+            notes.append(f"channel {ch.name!r}: {corrected}")
         return ch
-    info = lookup_unit(unit)
+    reading = read_unit(unit)
+    info = reading.info
     if info is None or info.quantity != role:
-        raise ParameterError(f"{_UNIT_OPTIONS[role]}={unit!r}: not a {role} unit")
+        why = f": {reading.problem}" if reading.problem else ""
+        raise ParameterError(f"{_UNIT_OPTIONS[role]}={unit!r}: not a {role} unit{why}")
+    if reading.corrected:
+        notes.append(f"{_UNIT_OPTIONS[role]}: {reading.correction}")
     if ch.quantity != "unknown":
         # the reader scaled the file's numbers to SI by the file's unit, of whatever quantity
         # (a force exported as "m/s"): undo that, then apply the unit the user gives

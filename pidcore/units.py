@@ -10,6 +10,7 @@ never taken as SI (the analysis asks for ``--force-unit`` etc.).
 
 from __future__ import annotations
 
+import functools
 import math
 import re
 from dataclasses import dataclass
@@ -33,12 +34,16 @@ class UnitInfo:
 _LBF = 4.4482216152605
 _INCH = 0.0254
 
+#: The spellings exporters write, with the case SI gives them: a prefix's case is its
+#: meaning (m = 1e-3, M = 1e6), so the keys are matched exactly (see :func:`read_unit` for a
+#: spelling in another case). ``g`` and its plural spellings are standard gravity, the unit
+#: of shaker and accelerometer channels, never the gram.
 _TABLE: dict[str, UnitInfo] = {
     # force
-    "n": UnitInfo("force", 1.0),
+    "N": UnitInfo("force", 1.0),
     "newton": UnitInfo("force", 1.0),
-    "kn": UnitInfo("force", 1e3),
-    "mn": UnitInfo("force", 1e-3),
+    "kN": UnitInfo("force", 1e3),
+    "mN": UnitInfo("force", 1e-3),
     "lbf": UnitInfo("force", _LBF),
     # velocity
     "m/s": UnitInfo("velocity", 1.0),
@@ -53,6 +58,8 @@ _TABLE: dict[str, UnitInfo] = {
     "g": UnitInfo("acceleration", STANDARD_GRAVITY),
     "g0": UnitInfo("acceleration", STANDARD_GRAVITY),
     "gn": UnitInfo("acceleration", STANDARD_GRAVITY),
+    "g's": UnitInfo("acceleration", STANDARD_GRAVITY),
+    "gs": UnitInfo("acceleration", STANDARD_GRAVITY),
     "in/s^2": UnitInfo("acceleration", _INCH),
     # displacement
     "m": UnitInfo("displacement", 1.0),
@@ -60,30 +67,53 @@ _TABLE: dict[str, UnitInfo] = {
     "um": UnitInfo("displacement", 1e-6),
     "in": UnitInfo("displacement", _INCH),
     # others seen in exports
-    "pa": UnitInfo("pressure", 1.0),
-    "kpa": UnitInfo("pressure", 1e3),
-    "v": UnitInfo("voltage", 1.0),
-    "mv": UnitInfo("voltage", 1e-3),
+    "Pa": UnitInfo("pressure", 1.0),
+    "kPa": UnitInfo("pressure", 1e3),
+    "V": UnitInfo("voltage", 1.0),
+    "mV": UnitInfo("voltage", 1e-3),
     "s": UnitInfo("time", 1.0),
     "sec": UnitInfo("time", 1.0),
     "ms": UnitInfo("time", 1e-3),
+    "us": UnitInfo("time", 1e-6),
 }
+#: Each table spelling by its lower-case form, for a label written in another case.
+_TABLE_BY_FOLDED = {spelling.lower(): spelling for spelling in _TABLE}
+
+#: SI per unit that an export of each quantity plausibly uses, from the smallest to the
+#: largest (both included). A prefix read in the wrong case is a factor of 1e6 to 1e9 (mm/s
+#: as Mm/s, mN as MN), far outside; the ranges hold every unit an impedance head (uN to kip),
+#: a laser vibrometer (nm/s to m/s), an accelerometer (ug to g) or a time column (ns to
+#: min) is exported in.
+PLAUSIBLE_FACTORS: dict[str, tuple[float, float]] = {
+    "force": (1e-6, 1e4),
+    "velocity": (1e-9, 1.0),
+    "acceleration": (1e-6, 10.0),
+    "displacement": (1e-12, 1.0),
+    "time": (1e-9, 60.0),
+}
+#: Most letters of a label whose other casings :func:`read_unit` reads (2**letters readings).
+_MAX_CASED_LETTERS = 8
 
 
 def canonical_unit_text(text: str) -> str:
-    """Normalise the spelling of a unit: case, blanks, brackets, superscripts, ``**``.
+    """Normalise the spelling of a unit for comparisons that ignore its case (``none``, ``-``):
+    case, blanks, brackets, superscripts, ``**``. Units are read by :func:`read_unit`, which
+    keeps the case.
 
     >>> canonical_unit_text(" (m/s²) ")
     'm/s^2'
     """
-    t = text.strip().strip("()[]{} ").lower()
+    return _cased_text(text).lower()
+
+
+def _cased_text(text: str) -> str:
+    """A unit label without brackets, blanks and typographic variants, its case kept."""
+    t = text.strip().strip("()[]{} ")
     t = t.replace("µ", "u").replace("μ", "u")  # micro sign and Greek mu
     t = t.replace("²", "^2").replace("\ufffd", "^2")  # Latin-1 0xB2 decoded with errors='replace'
     t = t.replace("**", "^").replace(" ", "")
-    t = re.sub(r"/s2$", "/s^2", t)
-    t = t.replace("sec^2", "s^2")
-    if t in {"g's", "gs"}:
-        t = "g"
+    t = re.sub(r"/([sS])2$", r"/\1^2", t)
+    t = re.sub(r"(?i)sec\^2$", lambda m: m.group(0)[0] + "^2", t)
     return t
 
 
@@ -97,23 +127,29 @@ _PINT_DIMENSIONS = {
     (("[current]", -1), ("[length]", 2), ("[mass]", 1), ("[time]", -3)): "voltage",
     (("[time]", 1),): "time",
 }
+#: pint units of a quantity that no vibration export is in: pint reads ``kn`` as the knot, a
+#: ship's speed, where an export's ``kn`` is kN in lower case.
+_PINT_NOT_EXPORTED = frozenset({"knot"})
 _PINT_REGISTRY = None
 
 
 def _pint_lookup(text: str) -> UnitInfo | None:
+    """pint's reading of a label (case sensitive: mN is not MN), where it is a quantity
+    pidcore knows."""
     global _PINT_REGISTRY
     import pint  # lazy: only for spellings outside the table
 
     if _PINT_REGISTRY is None:
         _PINT_REGISTRY = pint.UnitRegistry()
-    # pint is case sensitive (mN vs MN): keep the case, normalise the rest as the table does
-    t = text.strip().strip("()[]{} ").replace("µ", "u").replace("μ", "u")
-    t = t.replace("²", "^2").replace("\ufffd", "^2").replace("**", "^").replace(" ", "")
-    t = re.sub(r"/s2$", "/s^2", t)
+    t = _cased_text(text)
     if not re.fullmatch(r"[A-Za-z0-9/^.*()_-]+", t) or not re.search(r"[A-Za-z]", t):
         return None
     try:
-        quantity = _PINT_REGISTRY.Quantity(1.0, t.replace("^", "**")).to_base_units()
+        quantity = _PINT_REGISTRY.Quantity(1.0, t.replace("^", "**"))
+        names = {str(name) for name, _ in quantity.unit_items()}
+        if names & _PINT_NOT_EXPORTED:
+            return None
+        quantity = quantity.to_base_units()
     except Exception:  # pint raises many kinds (UndefinedUnitError, DefinitionSyntaxError, ...)
         return None
     name = _PINT_DIMENSIONS.get(tuple(sorted(dict(quantity.dimensionality).items())))
@@ -122,17 +158,134 @@ def _pint_lookup(text: str) -> UnitInfo | None:
     return UnitInfo(name, float(quantity.magnitude))
 
 
+def _exact_reading(cased: str) -> UnitInfo | None:
+    return _TABLE.get(cased) or _pint_lookup(cased)
+
+
+@dataclass(frozen=True)
+class UnitReading:
+    """How pidcore reads a unit label: ``info`` where it is taken, else ``problem`` (a phrase,
+    empty for a label that names no unit pidcore knows).
+
+    ``spelling`` is the unit read (the label itself, or the table's spelling where the label's
+    case was corrected: ``corrected``); ``quantity`` is its quantity also where it is refused
+    (a label such as ``Mm/s`` is a unit, of velocity, not free text)."""
+
+    label: str
+    info: UnitInfo | None
+    spelling: str = ""
+    quantity: str | None = None
+    corrected: bool = False
+    problem: str = ""
+
+    @property
+    def correction(self) -> str:
+        """The phrase that says a corrected case, ``"'KN' read as kN (1000 N): ..."``, or
+        ``""``."""
+        if not self.corrected or self.info is None:
+            return ""
+        return (f"unit {self.label!r} read as {self.spelling} ({_per_unit(self.info)}): unit "
+                f"symbols are case-sensitive, and {self.spelling} is the one "
+                f"{self.info.quantity} unit it can be")
+
+
+def _casings(folded: str) -> list[str]:
+    letters = [i for i, c in enumerate(folded) if c.isalpha()]
+    out = []
+    for mask in range(1 << len(letters)):
+        chars = list(folded)
+        for bit, i in enumerate(letters):
+            if mask >> bit & 1:
+                chars[i] = chars[i].upper()
+        out.append("".join(chars))
+    return out
+
+
+def _per_unit(info: UnitInfo) -> str:
+    return f"{info.factor:.6g} {info.si_unit}"
+
+
+def _implausible(label: str, info: UnitInfo, spelling: str) -> str:
+    low, high = PLAUSIBLE_FACTORS.get(info.quantity, (0.0, math.inf))
+    if low <= info.factor <= high:
+        return ""
+    folded = _TABLE_BY_FOLDED.get(spelling.lower())
+    meant = (f", such as {folded!r}" if folded is not None and folded != spelling
+             and _TABLE[folded].quantity == info.quantity else "")
+    return (f"{label!r} is {_per_unit(info)}, not a plausible {info.quantity} unit (expected "
+            f"{low:g} to {high:g} {info.si_unit} per unit{meant})")
+
+
+@functools.lru_cache(maxsize=1024)
+def read_unit(text: str) -> UnitReading:
+    """Read a unit label as SI units write it: case-sensitive (``mm/s`` is 1e-3 m/s, ``Mm/s``
+    1e6 m/s), then checked against :data:`PLAUSIBLE_FACTORS`.
+
+    A label of no unit in its own case (``KN``, ``G``, ``M/S``, all capitals) is read as the
+    table's spelling of another case where that is its only reading of the quantity (another
+    case of a spelling pint alone reads is not guessed: ``Nm`` is no nanometre); where
+    another casing reads as the same quantity by another factor (``MM/S``: mm/s or Mm/s;
+    ``MN``: mN or MN) it is refused as ambiguous, as is a reading outside the plausible range
+    (``Mm/s``, ``MN``, ``km/s``): ``info`` None and ``problem`` says why.
+
+    >>> read_unit("KN").info.factor, read_unit("KN").corrected, read_unit("kN").corrected
+    (1000.0, True, False)
+    >>> read_unit("Mm/s").info is None, read_unit("MM/S").info is None
+    (True, True)
+    """
+    label = text.strip()
+    cased = _cased_text(label)
+    if not cased:
+        return UnitReading(label, None)
+    folded = cased.lower()
+    exact = _TABLE.get(cased)
+    if exact is None and (exact := _pint_lookup(cased)) is not None:
+        # pint reads many a mis-cased label as something else: 'pa' a picoyear, 'Gs' a
+        # gigasecond. Only a reading of the quantity the table's spelling names (Mm/s beside
+        # mm/s, MN beside mN) is what the label says; another is its case slipped.
+        meant = _TABLE_BY_FOLDED.get(folded)
+        if meant is not None and _TABLE[meant].quantity != exact.quantity:
+            exact = None
+    if exact is not None:
+        problem = _implausible(label, exact, cased)
+        return UnitReading(label, None if problem else exact, cased, exact.quantity,
+                           problem=problem)
+    if sum(c.isalpha() for c in folded) > _MAX_CASED_LETTERS or (
+            folded not in _TABLE_BY_FOLDED and _pint_lookup(folded) is None):
+        # no unit in lower case either: its other cases are not parsed one by one (a header
+        # cell such as 'Velocity', tried as a possible unit row, was parsed 256 times)
+        return UnitReading(label, None)
+    readings = {c: r for c in _casings(folded) if (r := _exact_reading(c)) is not None}
+    if not readings:
+        return UnitReading(label, None)
+    spelling = _TABLE_BY_FOLDED.get(folded)
+    if spelling is None:
+        # only the table's spellings are corrected: another case of a pint unit is often
+        # another unit ('Nm', a torque, is no nanometre); several readings are refused below
+        if len({(r.quantity, r.factor) for r in readings.values()}) == 1:
+            return UnitReading(label, None)
+        spelling = min(readings)
+    meant = readings[spelling]
+    others = {c: r for c, r in readings.items() if r.quantity == meant.quantity
+              and not math.isclose(r.factor, meant.factor, rel_tol=1e-9)}
+    if others:
+        said = " or ".join(f"{c} ({_per_unit(r)})" for c, r in
+                           sorted({spelling: meant, **others}.items(), key=lambda cr: cr[1].factor))
+        return UnitReading(label, None, spelling, meant.quantity, problem=(
+            f"{label!r} is ambiguous: unit prefixes are case-sensitive, and it reads as {said}"))
+    problem = _implausible(label, meant, spelling)
+    return UnitReading(label, None if problem else meant, spelling, meant.quantity,
+                       corrected=not problem, problem=problem)
+
+
 def lookup_unit(text: str) -> UnitInfo | None:
-    """Return the :class:`UnitInfo` of a unit string, or ``None`` if it is not known.
+    """Return the :class:`UnitInfo` of a unit string, or ``None`` if it is not known or is
+    refused (:func:`read_unit` says why).
 
     >>> lookup_unit("mm/sec").factor, lookup_unit("g").quantity, lookup_unit("V^2")
     (0.001, 'acceleration', None)
     """
-    canonical = canonical_unit_text(text)
-    if canonical == "mn" and "M" in text:
-        return UnitInfo("force", 1e6)  # MN (meganewton), not the table's mN
-    info = _TABLE.get(canonical)
-    return info if info is not None else _pint_lookup(text)
+    return read_unit(text).info
 
 
 def to_si_factor(unit: str, quantity: str | None = None, *, what: str = "unit") -> float:
@@ -154,8 +307,11 @@ def to_si_factor(unit: str, quantity: str | None = None, *, what: str = "unit") 
     >>> round(to_si_factor("g", "acceleration"), 5)
     9.80665
     """
-    info = lookup_unit(unit)
+    reading = read_unit(unit)
+    info = reading.info
     if info is None:
+        if reading.problem:
+            raise ParameterError(f"{what}: {reading.problem}")
         raise ParameterError(f"{what}: unknown unit {unit!r}; expected one of "
                              f"{', '.join(sorted(_TABLE))}")
     if quantity is not None and info.quantity != quantity:

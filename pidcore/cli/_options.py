@@ -151,12 +151,15 @@ def add_measurement_options(p: argparse.ArgumentParser) -> None:
                         "unknown: usually a wrong delay, sign or correction), noted with the "
                         "record")
     g.add_argument("--force-unit", metavar="UNIT", default=None,
-                   help="unit of the force channel's values (N, kN, lbf, ...) when the file "
-                        "gives none or a wrong one")
+                   help="unit of the force channel's values (N, kN, mN, lbf, ...) when the "
+                        "file gives none or a wrong one; case-sensitive as SI writes it (mN, "
+                        "not MN)")
     g.add_argument("--velocity-unit", metavar="UNIT", default=None,
-                   help="unit of the velocity channel's values (m/s, mm/s, in/s, ...)")
+                   help="unit of the velocity channel's values (m/s, mm/s, um/s, in/s, ...); "
+                        "case-sensitive (mm/s, not Mm/s)")
     g.add_argument("--acceleration-unit", metavar="UNIT", default=None,
-                   help="unit of the acceleration channel's values (m/s^2, g, ...)")
+                   help="unit of the acceleration channel's values (m/s^2, g, ...); "
+                        "case-sensitive")
     g.add_argument("--invert", metavar="NAME", action="append", default=None,
                    help="invert the sign of this channel (a sensor mounted the other way); "
                         "repeatable; replaces the sidecar's invert column")

@@ -37,6 +37,7 @@ import pandas as pd
 from ..atomic_files import atomic_path
 from ..errors import InputFileError, ParameterError, clipped
 from ..records import Measurement
+from ..units import read_unit
 from ._common import (
     file_sha256,
     interpret_unit,
@@ -105,8 +106,8 @@ def _quantity_and_unit(cell: str) -> tuple[str, str] | None:
         if not name or not unit:
             continue
         quantity = _named_quantity(name)
-        if quantity is not None and interpret_unit(unit)[0] == quantity:
-            return name, unit
+        if quantity is not None and read_unit(unit).quantity == quantity:
+            return name, unit  # also a unit refused (Mm/s): the analysis says why
     return None
 
 
@@ -124,11 +125,10 @@ def _name_and_unit(cell: str, row_unit: str) -> tuple[str, str]:
         return _unit_in_the_name(name, own)
     if not row_unit or not own:
         return name, own or row_unit
-    own_reading, row_reading = interpret_unit(own), interpret_unit(row_unit)
-    if own_reading[0] == "unknown":
+    own_reading, row_reading = _unit_key(own), _unit_key(row_unit)
+    if own_reading is None:
         return cell.strip().strip('"').strip(), row_unit
-    if row_reading[0] == "unknown" or (own_reading[0] == row_reading[0] and math.isclose(
-            own_reading[1], row_reading[1], rel_tol=1e-9)):
+    if row_reading is None or _same_unit(own_reading, row_reading):
         return name, own  # a row of '-' (no unit) does not contradict the name
     return name, f"{own} in the name, {row_unit} in the unit row"
 
@@ -142,15 +142,30 @@ def _unit_in_the_name(name: str, own: str) -> tuple[str, str]:
     inner_name, inner = _split_header(name)
     if not inner or not inner_name:
         return name, own
-    inner_reading, own_reading = interpret_unit(inner), interpret_unit(own)
-    if inner_reading[0] == "unknown":
+    inner_reading, own_reading = _unit_key(inner), _unit_key(own)
+    if inner_reading is None:
         return name, own
-    if own_reading[0] == "unknown":
+    if own_reading is None:
         return f"{inner_name} ({own})", inner  # Testlab-like 'Force [N] (Drive point)'
-    if own_reading[0] == inner_reading[0] and math.isclose(own_reading[1], inner_reading[1],
-                                                           rel_tol=1e-9):
+    if _same_unit(own_reading, inner_reading):
         return inner_name, own
     return inner_name, f"{inner} in the name, {own} in brackets"
+
+
+def _unit_key(text: str) -> tuple[str, float | str] | None:
+    """Quantity and SI factor of a unit text; ``("refused", text)`` for a unit pidcore reads
+    but refuses (``Mm/s``, ``MM/S``: a unit, not words of a name, whose refusal the analysis
+    gives); None for text that is no unit (``Drive point``, ``-``)."""
+    reading = read_unit(text)
+    if reading.info is not None:
+        return reading.info.quantity, reading.info.factor
+    return ("refused", text.strip()) if reading.quantity is not None else None
+
+
+def _same_unit(first: tuple[str, float | str], second: tuple[str, float | str]) -> bool:
+    if first[0] == "refused" or second[0] == "refused":
+        return first == second
+    return first[0] == second[0] and math.isclose(first[1], second[1], rel_tol=1e-9)
 
 
 def _encoding(head: bytes) -> str:
@@ -201,7 +216,7 @@ def _is_numeric_row(line: str, delimiter: str) -> bool:
 
 def _looks_like_unit(cell: str) -> bool:
     text = cell.strip().strip("[]()").strip()
-    return not text or text.lower() in {"-", "1", "none"} or interpret_unit(text)[0] != "unknown"
+    return not text or text.lower() in {"-", "1", "none"} or _unit_key(text) is not None
 
 
 def _layout(lines: list[str], where: str) -> tuple[int, str, list[str], list[str], str]:
@@ -362,6 +377,9 @@ def read_csv(path: str | os.PathLike[str], *, sample_rate_hz: float | None = Non
     elif time_index is not None:
         name, unit = cells[time_index]
         factor = _seconds_per(unit)
+        if read_unit(unit).corrected:
+            # 'Time [US]' is µs, a factor the header's case did not state: said
+            notes.append(f"{where}: time column {name!r}: {read_unit(unit).correction}")
         rate, start_time, note = rate_from_times(values[:, time_index] * factor,
                                                  what=f"{where}: column {name!r}",
                                                  with_note=True)
@@ -457,7 +475,8 @@ def _unread_time_header(header_cells: list[str]) -> str:
         parts = re.split(r"\s*[/\[(]\s*|\s+in\s+", text, maxsplit=1, flags=re.IGNORECASE)
         if len(parts) == 2 and parts[0].lower() in _TIME_NAMES - {"x"}:
             unit = parts[1].rstrip("])").strip()
-            return f" (header cell {text!r} not read: {unit!r} is no unit of time such as s, ms)"
+            why = read_unit(unit).problem or f"{unit!r} is no unit of time such as s, ms"
+            return f" (header cell {text!r} not read: {why})"
     return ""
 
 
@@ -492,6 +511,8 @@ def _pair_time_bases(values: np.ndarray, cells: list[tuple[str, str]], pair_time
         name, unit = cells[t_index]
         factor = _seconds_per(unit)
         what = f"{where}: column {name!r} (time of column {owned[0] + 1})"
+        if read_unit(unit).corrected:
+            notes.append(f"{what}: {read_unit(unit).correction}")
         if length < 2:
             raise InputFileError(f"{what}: holds {length} times; expected the time of each "
                                  "sample of its channels")

@@ -36,6 +36,7 @@ from dataclasses import dataclass
 
 from ..errors import ChannelError, a_or_an
 from ..records import Channel, Measurement
+from ..units import read_unit
 
 _NAME_TOKENS = {
     "force": {"force", "f", "fz", "kraft", "load", "forcecell", "loadcell"},
@@ -165,6 +166,9 @@ def _drive_point_acceleration(measurement: Measurement, taken: set[str],
                            f"{found[0].name!r} is named like a reference/shaker accelerometer; "
                            f"{why} needs the acceleration at the drive point: confirm it with "
                            f"acceleration={found[0].name!r} or remove the option")
+    if not found:
+        _refuse_a_refused_unit_of(measurement, "acceleration",
+                                  [c for c in measurement.channels if c.name not in taken])
     return found[0] if found else None
 
 
@@ -185,7 +189,21 @@ def _detect(measurement: Measurement, role: str, taken: set[str]) -> Channel | N
     if len(by_name) > 1:
         raise ChannelError(f"{measurement.source}: {len(by_name)} channels look like {role} "
                            f"({_names(by_name)}); choose one with {_OPTIONS[role]}NAME")
+    _refuse_a_refused_unit_of(measurement, role, free)
     return None
+
+
+def _refuse_a_refused_unit_of(measurement: Measurement, role: str, free: list[Channel]) -> None:
+    """Refuse a measurement whose only channel of ``role`` has a unit of that quantity which
+    pidcore refuses (``Point1:+Z`` in ``Mm/s``): left out as of no unit, the analysis went on
+    without it (another channel as the motion, or 'no velocity channel')."""
+    for channel in free:
+        reading = read_unit(channel.source_unit)
+        if channel.quantity == "unknown" and reading.quantity == role and reading.problem:
+            raise ChannelError(
+                f"{measurement.source}: channel {channel.name!r} ({role}) has a unit pidcore "
+                f"refuses: {reading.problem}; give it with {role}_unit=UNIT and name it with "
+                f"{_OPTIONS[role]}{channel.name!r}")
 
 
 def _named(measurement: Measurement, role: str, name: str, retyped: bool) -> Channel:

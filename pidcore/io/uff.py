@@ -41,7 +41,7 @@ from ..atomic_files import atomic_path
 from ..constants import SI_UNITS
 from ..errors import InputFileError, ParameterError
 from ..records import Channel, Measurement
-from ..units import canonical_unit_text
+from ..units import canonical_unit_text, read_unit
 from ._common import (
     file_sha256,
     interpret_unit,
@@ -136,8 +136,16 @@ def _ordinate_unit(dset: dict, unit_factors: tuple[float, float]) -> tuple[str, 
     return "unknown", 1.0, label
 
 
-def _time_factor(dset: dict) -> float:
-    quantity, factor = interpret_unit(_label(dset.get("abscissa_axis_units_lab")))
+def _time_factor(dset: dict, what: str) -> float:
+    """Seconds per abscissa unit: its label's unit of time; 1 for a label of none (the
+    abscissa of a time record is in seconds, the file's unit), but a label that reads as a
+    time unit pidcore refuses (``MS``: ms or Ms) is refused, not taken as seconds."""
+    label = _label(dset.get("abscissa_axis_units_lab"))
+    reading = read_unit(label)
+    if reading.quantity == "time" and reading.info is None:
+        raise InputFileError(f"{what}: abscissa unit {reading.problem}; expected a unit of "
+                             "time such as s or ms")
+    quantity, factor = interpret_unit(label)
     return factor if quantity == "time" else 1.0
 
 
@@ -177,7 +185,7 @@ def _record_channel(dset: dict, index: int, where: str,
                              f"{num_pts} samples; the file is truncated or corrupt")
     # Writers pad the last E13.5 line with zeros; the header's num_pts is authoritative.
     values = values[:num_pts].astype(np.float64, copy=False)
-    time_factor = _time_factor(dset)
+    time_factor = _time_factor(dset, f"{where}: record {index + 1}")
     if int(dset.get("abscissa_spacing", 1)) == 1:
         dt = float(dset["abscissa_inc"]) * time_factor
         start = float(dset.get("abscissa_min", 0.0)) * time_factor
@@ -323,7 +331,10 @@ def read_uff(path: str | os.PathLike[str]) -> Measurement:
                              "(function type 1); expected time histories")
     channels = [_record_channel(d, k, where, unit_factors) for k, d in enumerate(time_records)]
     notes: list[str] = []
-    for k, c in enumerate(channels):
+    for k, (c, d) in enumerate(zip(channels, time_records, strict=True)):
+        abscissa = read_unit(_label(d.get("abscissa_axis_units_lab")))
+        if abscissa.corrected and abscissa.quantity == "time":
+            notes.append(f"{where}: record {k + 1} ({c.name!r}) abscissa {abscissa.correction}")
         if c.source_unit.startswith("UFF data type"):
             basis = ("the file's dataset 164 unit factors" if has_units_dataset
                      else "SI (no dataset 164 in the file)")
