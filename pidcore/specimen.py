@@ -21,6 +21,7 @@ coupon, ``pidcore/data/specimens/paper_coupon.toml``)::
     mass_kg = 0.0221534                # face sheets + core, without particles
     fixture_mass_kg = 0.0              # moves with the coupon above the force gauge
     baseline_loss_factor = 0.0         # damping of the empty structure [-]
+    face_area_m2 = 0.01                # optional: one face of the coupon (0.1 m x 0.1 m)
 
     [particles]
     material = "acrylic"               # a materials.csv row, or any name with inline:
@@ -46,6 +47,16 @@ coupon, ``pidcore/data/specimens/paper_coupon.toml``)::
     sliding_friction = 0.14
     static_friction = 0.14
     rolling_friction = 0.0
+
+``[coupon] face_area_m2`` (optional) is the area of one face of the coupon, m^2: the area
+``pidcore model damper``'s ``c_eq_per_treated_area`` (and a panel's loss factor from it) is
+per. A file that states none is taken over its cells' cross-section, ``[cell] count`` x one
+hexagon (:meth:`Specimen.cells_area_m2`): one rule for every file, the paper's coupon stating
+its 0.1 m x 0.1 m face (1.16 x its 441 cells). It is at least the cells' area (the cells lie
+within the face) and at most :data:`MAX_FACE_TO_CELLS_AREA` times it (cm^2 or mm^2 typed for
+m^2). It is no physics the DEM simulates: it is left out of the canonical text and hash
+(:attr:`Specimen.text`), so stating it keeps a file's hash, its DEM runs and its recorded
+tests; :meth:`Specimen.to_toml` writes it. Nor does it enter equality (``==``, as the hash).
 
 A calibrated file (``pidcore calibrate``) also records which file it was made from, so that a
 user's own ``paper_coupon.toml`` and the paper's coupon, which both calibrate to
@@ -104,6 +115,10 @@ cell_geometry, contact_law
     The DEM's cell geometry and contact law of a specimen.
 numeric_fields
     Dotted paths of its numeric fields (what calibration can fit).
+bundled_face_area
+    A specimen rebuilt from its canonical text (a stored run's), with the ``[coupon]
+    face_area_m2`` of the bundled file of its hash (the paper's coupon) that the text leaves
+    out.
 """
 
 from __future__ import annotations
@@ -284,6 +299,15 @@ MAX_COUPON_AREAL_MASS_KG_M2 = 1000.0
 #: a cell count that does not describe a coupon (10^20 cells of 6.35 mm passed, and a run of
 #: them simulated to the end before the store refused to save its count).
 MAX_COUPON_AREA_M2 = 100.0
+#: Most a stated ``[coupon] face_area_m2`` may be of its cells' cross-section (``[cell] count``
+#: x one hexagon): cm^2 or mm^2 typed for m^2 is 1e4 or 1e6 times off, while a coupon with a
+#: wide unfilled margin, or the paper's 0.01 m^2 over its 441 cells (1.16 x), stays well within.
+#: The same bound as a coupon area given to the damper (:data:`pidcore.model.damper.
+#: AREA_TO_CELLS_LIMIT`).
+MAX_FACE_TO_CELLS_AREA = 100.0
+#: Relative slack of "face area >= cells' area": a face area written to 15 digits from the
+#: cells' own may round below it in the last bit.
+_FACE_AREA_RTOL = 1e-12
 PLAUSIBLE_RANGES["wall_density_kg_m3"] = PLAUSIBLE_RANGES["density_kg_m3"]
 PLAUSIBLE_RANGES["wall_youngs_modulus_pa"] = PLAUSIBLE_RANGES["youngs_modulus_pa"]
 
@@ -411,13 +435,20 @@ class CellSpec:
 
 @dataclass(frozen=True)
 class CouponSpec:
-    """Masses a shaker moves besides the particles (kg) and the empty structure's damping."""
+    """Masses a shaker moves besides the particles (kg), the empty structure's damping, and
+    the area of one face of the coupon (m^2; None: not stated, its cells' area is taken)."""
 
     mass_kg: float
     fixture_mass_kg: float = 0.0
     baseline_loss_factor: float = 0.0
+    # not in the canonical text nor the hash, so not in equality either: a specimen rebuilt
+    # from a stored run's text is the specimen that ran
+    face_area_m2: float | None = dataclasses.field(default=None, compare=False)
 
     def __post_init__(self):
+        if self.face_area_m2 is not None:
+            # against the cells in Specimen: this record does not know them
+            _positive("[coupon] face_area_m2", self.face_area_m2, "m^2")
         _positive("[coupon] mass_kg", self.mass_kg, "kg")
         _plausible("[coupon] mass_kg", "mass_kg", self.mass_kg)
         _non_negative("[coupon] fixture_mass_kg", self.fixture_mass_kg, "kg")
@@ -600,6 +631,7 @@ class Specimen:
                         "number of cells in the coupon (a shaker-test coupon is at most a few "
                         "m^2)")
         area = self.cells_area_m2(geometry)
+        self._check_face_area(area)
         if self.coupon.mass_kg / area > MAX_COUPON_AREAL_MASS_KG_M2:
             raise _fail("[coupon] mass_kg",
                         f"{as_given(self.coupon.mass_kg)} kg on {self.cell.count} cells "
@@ -625,6 +657,26 @@ class Specimen:
                 raise _fail("[particles] count_per_cell",
                             f"{_large_count(self.particles.count_per_cell)} particles do not "
                             f"fit the cell (capacity {capacity})")
+
+    def _check_face_area(self, cells_area_m2: float) -> None:
+        """Refuse a stated face area below the cells' cross-section (the cells lie within the
+        face) or more than :data:`MAX_FACE_TO_CELLS_AREA` times it (a unit slip)."""
+        face = self.coupon.face_area_m2
+        if face is None:
+            return
+        ratio = face / cells_area_m2
+        cells = (f"the cross-section of its {self.cell.count} cells "
+                 f"({cells_area_m2:.6g} m^2, [cell] count x one hexagon)")
+        if ratio < 1.0 - _FACE_AREA_RTOL:
+            raise _fail("[coupon] face_area_m2",
+                        f"{face:.6g} m^2 is {ratio:.3g} x {cells}; expected the area of "
+                        "one face of the coupon in m^2, at least its cells' (leave the key out "
+                        "to take the cells' area); was it one cell's area, or is [cell] count "
+                        "wrong?")
+        if ratio > MAX_FACE_TO_CELLS_AREA:
+            raise _fail("[coupon] face_area_m2",
+                        f"{face:.6g} m^2 is {ratio:.3g} x {cells}; expected the area of "
+                        "one face of the coupon in m^2; was it cm^2 or mm^2?")
 
     # --- construction --------------------------------------------------------------------
 
@@ -667,7 +719,9 @@ class Specimen:
         return cls.from_text(text, source=source)
 
     def with_values(self, values: Mapping[str, Any]) -> Specimen:
-        """A new specimen with fields replaced by dotted path, checked like a file.
+        """A new specimen with fields replaced by dotted path, checked like a file; a value
+        None leaves the key out, as a file without it (``{"coupon.face_area_m2": None}``: the
+        cells' area, for a variant whose cells no longer fit the face stated).
 
         Examples
         --------
@@ -684,7 +738,9 @@ class Specimen:
                 if not isinstance(node, dict) or part not in _allowed_keys(parts[:i]):
                     raise ParameterError(f"{self.source}: unknown specimen field {path!r}; "
                                          f"expected one of {numeric_fields(self)}")
-                if last:
+                if last and value is None:
+                    node.pop(part, None)  # a required key is then refused as missing
+                elif last:
                     node[part] = value
                 else:
                     node = node.setdefault(part, {})
@@ -695,13 +751,16 @@ class Specimen:
 
     # --- identity ------------------------------------------------------------------------
 
-    def to_mapping(self) -> dict[str, Any]:
-        """Nested dict of the resolved specimen, as the TOML file would hold it."""
+    def to_mapping(self, *, face_area: bool = True) -> dict[str, Any]:
+        """Nested dict of the resolved specimen, as the TOML file would hold it
+        (``face_area=False``: without ``[coupon] face_area_m2``, as :attr:`text` is)."""
         out: dict[str, Any] = {"schema_version": SCHEMA_VERSION, "name": self.name,
                                "description": self.description}
         for section in ("cell", "coupon", "particles"):
             out[section] = {k: v for k, v in dataclasses.asdict(getattr(self, section)).items()
                             if v is not None}
+        if not face_area:
+            out["coupon"].pop("face_area_m2", None)
         pairs: dict[str, Any] = {}
         model = self.pairs.tangential_stiffness_model
         if model != DEFAULT_TANGENTIAL_STIFFNESS_MODEL:
@@ -718,7 +777,8 @@ class Specimen:
         return out
 
     def to_toml(self) -> str:
-        """Canonical TOML text (resolved values, fixed key order, floats as ``repr``).
+        """TOML text of the whole specimen (resolved values, fixed key order, floats as
+        ``repr``): :attr:`text` plus a stated ``[coupon] face_area_m2``.
 
         Written by a small writer for this schema (scalars in at most two levels of tables):
         no TOML writer is in the standard library, and none is a dependency of pidcore.
@@ -728,8 +788,10 @@ class Specimen:
 
     @property
     def text(self) -> str:
-        """Canonical text, stored with every DEM run as provenance."""
-        return self.to_toml()
+        """Canonical text, stored with every DEM run as provenance: :meth:`to_toml` without
+        ``[coupon] face_area_m2``, which the DEM does not simulate (a file that states it
+        keeps the text and hash it had without it)."""
+        return _dump_toml(self.to_mapping(face_area=False))
 
     @property
     def hash(self) -> str:
@@ -863,7 +925,7 @@ SCHEMA: dict[str, dict[str, tuple[bool, str]]] = {
              "wall_material": (True, "str"), "wall_youngs_modulus_pa": (False, "float"),
              "wall_poisson_ratio": (False, "float"), "wall_density_kg_m3": (False, "float")},
     "coupon": {"mass_kg": (True, "float"), "fixture_mass_kg": (False, "float"),
-               "baseline_loss_factor": (False, "float")},
+               "baseline_loss_factor": (False, "float"), "face_area_m2": (False, "float")},
     "particles": {"material": (True, "str"), "radius_m": (False, "float"),
                   "density_kg_m3": (False, "float"), "youngs_modulus_pa": (False, "float"),
                   "poisson_ratio": (False, "float"), "count_per_cell": (False, "int"),
@@ -902,7 +964,8 @@ def numeric_fields(specimen: Specimen) -> list[str]:
                     and key != "schema_version":
                 out.append(prefix + key)
 
-    walk(specimen.to_mapping(), "")
+    # the face area enters no DEM run: a fit of it would vary nothing the SDC depends on
+    walk(specimen.to_mapping(face_area=False), "")
     return out
 
 
@@ -924,6 +987,25 @@ def _key_of_another_table(key: str, section: str) -> str:
             "below it?")
 
 
+#: The SI units specimen keys end with (longest first: ``_kg_m3`` before ``_m3``).
+_SI_KEY_UNITS = ("_kg_m3", "_percent", "_kg", "_pa", "_m2", "_m")
+
+
+def _key_in_another_unit(key: str, schema: Mapping[str, Any]) -> str:
+    """The end of an unknown key's message where it is a known key in another unit, or
+    without one (``face_area_cm2``, ``face_area`` for ``face_area_m2``): the value is read in
+    the unit the known key names, so the value must be converted, not only the key renamed."""
+    if not isinstance(key, str):
+        return ""
+    stem = key.rsplit("_", 1)[0]
+    known = [k for k in schema for unit in _SI_KEY_UNITS
+             if k.endswith(unit) and k.removesuffix(unit) in (stem, key)]
+    if not known:
+        return ""
+    return (f"; units are in the key names (SI): write {' or '.join(known)}, with the value "
+            "in that unit")
+
+
 def _take(table: Mapping[str, Any], section: str, where: str) -> dict[str, Any]:
     """Check keys (unknown, missing, type) of one table; returns a plain dict."""
     schema = SCHEMA[section]
@@ -932,7 +1014,8 @@ def _take(table: Mapping[str, Any], section: str, where: str) -> dict[str, Any]:
     for key in table:
         if key not in schema:
             raise ParameterError(f"{where} {clipped(key)}: unknown key; expected one of "
-                                 f"{list(schema)}{_key_of_another_table(key, section)}")
+                                 f"{list(schema)}{_key_of_another_table(key, section)}"
+                                 f"{_key_in_another_unit(key, schema)}")
     out: dict[str, Any] = {}
     for key, (required, kind) in schema.items():
         if key not in table:
@@ -1295,6 +1378,23 @@ def paper_hashes() -> frozenset[str]:
     return frozenset(paper_specimen(m).hash for m in PARTICLE_MATERIALS)
 
 
+def bundled_face_area(specimen: Specimen) -> Specimen:
+    """``specimen`` with the ``[coupon] face_area_m2`` of the file pidcore bundles of the same
+    hash (the paper's coupon, any table particle material) where it states none itself: a
+    specimen rebuilt from its canonical text (a stored DEM run's), which leaves the face area
+    out, is then taken over the face that file states, as the file itself is. Any other
+    specimen unchanged."""
+    from .constants import PARTICLE_MATERIALS
+
+    if specimen.coupon.face_area_m2 is not None or specimen.hash not in paper_hashes():
+        return specimen
+    for material in PARTICLE_MATERIALS:
+        bundled = paper_specimen(material)
+        if bundled.hash == specimen.hash:  # one text: every other coupon value is the same
+            return dataclasses.replace(specimen, coupon=bundled.coupon)
+    return specimen
+
+
 @functools.cache
 def _paper_names() -> frozenset[str]:
     from .constants import PARTICLE_MATERIALS
@@ -1602,6 +1702,9 @@ def describe(specimen: Specimen) -> dict[str, Any]:
     ``reference_acceleration_g``: 50 Hz, 10 g), so the step is the grid's smallest; a run at
     another load case takes its own (:func:`pidcore.dem.simulate.choose_time_step`).
 
+    ``coupon_area_m2`` is the area ``pidcore model damper``'s c_eq per treated area is per
+    (:func:`pidcore.model.damper.specimen_area_m2`), ``coupon_area_from`` where it comes from.
+
     ``tangential_stiffness_*_n_m`` is the constant k_t (Mindlin's at the overlap of a
     DEM_TANGENTIAL_REFERENCE_SPEED_M_S impact); with ``tangential_stiffness_model = "mindlin"``
     ``mindlin_tangential_stiffness_*_n_m`` is k_t = 8 G* sqrt(R* delta) at the Hertz overlap
@@ -1611,10 +1714,12 @@ def describe(specimen: Specimen) -> dict[str, Any]:
     from .constants import PARTICLE_MATERIALS
     from .dem.contact import maximum_overlap
     from .dem.simulate import LoadCase, choose_time_step, max_impact_speed
+    from .model.damper import specimen_area_m2
 
     law = contact_law(specimen)
     geometry = specimen.geometry()
     capacity = specimen.capacity_per_cell()
+    area, area_from = specimen_area_m2(specimen)
     p = specimen.particles
     if p.count_per_cell is not None:
         count, basis = p.count_per_cell, "count_per_cell"
@@ -1643,6 +1748,9 @@ def describe(specimen: Specimen) -> dict[str, Any]:
         "notes": [*table_overrides(specimen), *_heavy_fixture_note(specimen, count),
                   *_column_note(specimen, capacity)],
         "cell_shape": specimen.cell.shape, "cells_per_coupon": specimen.cell.count,
+        "cells_area_m2": specimen.cells_area_m2(geometry),
+        # the area pidcore model damper's c_eq per treated area is per, and why that one
+        "coupon_area_m2": area, "coupon_area_from": area_from,
         "capacity_per_cell": capacity, "particles_per_cell": count,
         "particles_per_cell_basis": basis,
         "particle_radius_m": p.radius_m,
@@ -1741,7 +1849,7 @@ __all__ = ["CellSpec", "CouponSpec", "PairSpec", "PairsSpec", "ParticleSpec", "S
            "load_specimen",
            "MEASURED_SHA256_FIELD", "deciding_sha256", "measured_specimen_name",
            "measured_specimen_sha256", "models_paper_coupon", "NamedSpecimen",
-           "resolve_specimen_name", "numeric_fields", "same_tested_file",
+           "resolve_specimen_name", "numeric_fields", "same_tested_file", "bundled_face_area",
            "provenance_test_name", "tabulated_by_paper",
            "match_hashless_records", "NameMatch",
            "paper_specimen", "particles_for_fill"]

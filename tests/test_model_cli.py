@@ -445,7 +445,8 @@ def test_the_damper_says_per_what_along_which_direction_and_gives_the_velocity(t
     assert "per m^2 of coupon face" in doc["columns"]["c_eq_per_treated_area [N s/m^3]"]
     assert doc["provenance"]["direction"].startswith("z (normal to the face sheets")
     assert doc["provenance"]["particle_material"] == "acrylic"
-    assert doc["provenance"]["area"] == "0.01 m^2 (the paper's 0.1 m x 0.1 m coupon)"
+    assert doc["provenance"]["area"] == ("0.01 m^2 ([coupon] face_area_m2 of specimen "
+                                         "paper_coupon: 1.16 x its 441 cells' 0.00865333 m^2)")
     assert _run(["model", "damper", "--out", str(tmp_path), "--table", "store", "--store",
                  str(BUNDLED_GRID), "--fills", "50", "--accelerations", "5", "--frequencies",
                  "500"]) == 0
@@ -594,8 +595,10 @@ def test_damper_takes_a_specimens_area_from_its_cells_and_says_so(tmp_path, monk
     np.testing.assert_allclose(table["c_eq_per_treated_area [N s/m^3]"],
                                table["c_eq_per_coupon [N s/m]"] / STEEL_CELLS_AREA_M2,
                                rtol=1e-12)
-    said = ("0.00998721 m^2 (specimen steel_6mm's 286 cells x 34.9203 mm^2 each: the area its "
-            "cells treat; the file states no coupon face)")
+    said = ("0.00998721 m^2 (specimen steel_6mm's 286 cells x 34.9203 mm^2 each: the text its "
+            "DEM runs stored (a run stores its specimen without it: give --specimen FILE for "
+            "the one its file states) states no [coupon] face_area_m2, so the area its cells "
+            "treat)")
     assert json.loads((tmp_path / "equivalent_damper.json").read_text())["provenance"][
         "area"] == said
     assert f"note: coupon area {said}" in capsys.readouterr().err

@@ -202,7 +202,8 @@ def test_not_predicted_rows_name_another_specimen(calibration_file):
     cal = load_calibration(calibration_file)
     assert cal.calibrated_specimen().name == "paper_coupon_calibrated"
     table = _table().iloc[[2]]  # 1000 Hz: outside the range too, the specimen comes first
-    own = paper.with_values({"cell.inscribed_diameter_m": 6.35e-3})
+    own = paper.with_values({"cell.inscribed_diameter_m": 6.35e-3,
+                             "coupon.face_area_m2": None})
     renamed = own.to_toml().replace('name = "paper_coupon"', 'name = "hc635"')
     from pidcore.specimen import Specimen
 
@@ -226,7 +227,8 @@ def test_a_calibration_of_another_specimen_predicts_no_row_even_at_its_load_case
     # another coupon would put its band (and a yes/no) on a row at one of its load cases
     from pidcore.specimen import paper_specimen
 
-    own = paper_specimen().with_values({"cell.inscribed_diameter_m": 6.35e-3})
+    own = paper_specimen().with_values({"cell.inscribed_diameter_m": 6.35e-3,
+                                        "coupon.face_area_m2": None})
     (calibration_file.parent / "calibrated_specimen.toml").write_text(
         own.to_toml().replace('name = "paper_coupon"', 'name = "hc635_calibrated"'))
     cal = load_calibration(calibration_file)

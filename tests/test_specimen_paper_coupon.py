@@ -28,8 +28,10 @@ from pidcore.store import Store
 
 PAPER = paper_specimen("acrylic")
 ALUMINIUM = paper_specimen("aluminium")
-# the paper's cell with 1/4 in cells instead of 3/16 in: another coupon, same name
-OTHER_CELL = PAPER.with_values({"cell.inscribed_diameter_m": 6.35e-3})
+# the paper's cell with 1/4 in cells instead of 3/16 in: another coupon, same name (without
+# the paper's stated face: 441 such cells cover more than its 0.1 m x 0.1 m)
+OTHER_CELL = PAPER.with_values({"cell.inscribed_diameter_m": 6.35e-3,
+                                "coupon.face_area_m2": None})
 
 
 def test_the_hash_decides_where_the_content_is_known_else_the_name():

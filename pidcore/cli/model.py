@@ -97,10 +97,16 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         "stored runs divided their SDC by their own m_c; more than 100 x "
                         "outside the paper coupon's m_c is refused as a unit slip)")
     d.add_argument("--area", metavar="M2", type=_positive_float, default=None,
-                   help="coupon area for c_eq per area, m^2 (default: the paper's 0.1 m x "
-                        "0.1 m; for runs of another specimen its cells' cross-section, cell "
-                        "count x hexagon area; a value more than 5 %% off the default is noted, "
-                        "more than 100 x off is refused as a unit slip)")
+                   help="coupon area for c_eq per area, m^2 (default: the specimen's [coupon] "
+                        "face_area_m2, the paper's 0.1 m x 0.1 m, else its cells' "
+                        "cross-section, cell count x hexagon area; a value more than 5 %% off "
+                        "the default is noted, more than 100 x off the cells' is refused as a "
+                        "unit slip)")
+    d.add_argument("--specimen", metavar="FILE", type=path_argument, default=None,
+                   help="the specimen file the SDC is of (the runs' with --table store, the "
+                        "paper's coupon with --table paper), for the [coupon] face_area_m2 it "
+                        "states: a DEM run stores its specimen without it; another specimen "
+                        "(another sha256) is refused")
     d.add_argument("--panel-areal-mass", metavar="KG_M2", type=_positive_float, default=None,
                    help="mass per m^2 of your panel, with its particles, kg/m^2: adds "
                         "panel_loss_factor, the loss factor the particles add to it moving as "
@@ -253,6 +259,8 @@ def run_damper(args: argparse.Namespace) -> int:
 
     # runs of an older store name no specimen text: the paper's coupon, as the library takes it
     stated = paper_specimen() if runs is None else runs_specimen(runs)
+    if args.specimen is not None:
+        stated = _specimen_file_of(args.specimen, stated, runs is None)
     specimen = stated or paper_specimen()
     if args.area is not None:
         check_area(args.area, specimen, "--area")  # first, to name the option typed
@@ -267,7 +275,13 @@ def run_damper(args: argparse.Namespace) -> int:
                              "known; give the area c_eq per area is taken over, e.g. "
                              "--area 0.01")
     else:
-        area, area_text = specimen_area_m2(specimen)
+        # the runs' text is their file's without the key: whether the file states one is
+        # not known from them
+        area, area_text = specimen_area_m2(specimen, read_from="its file" if runs is None or
+                                           args.specimen is not None else
+                                           "the text its DEM runs stored (a run stores its "
+                                           "specimen without it: give --specimen FILE for "
+                                           "the one its file states)")
     if args.panel_treated_fraction is not None and args.panel_areal_mass is None:
         raise ParameterError(f"--panel-treated-fraction {as_given(args.panel_treated_fraction)}:"
                              " the share of a panel given by --panel-areal-mass; give that too")
@@ -325,6 +339,26 @@ def run_damper(args: argparse.Namespace) -> int:
         print(f"pidcore model damper: note: {why} in {undefined} of {len(table)} row(s)",
               file=sys.stderr)
     return 0
+
+
+def _specimen_file_of(path, stated, paper_table: bool):
+    """The ``--specimen`` file, where it is the specimen the SDC is of (``stated``: the
+    paper's coupon, or the one the DEM runs stored): its face area, which the runs' canonical
+    text leaves out, is then the damper's. Any other file is refused: its area would divide an
+    SDC that is not its own."""
+    from ..specimen import hashed_name, load_specimen
+
+    given = load_specimen(path)
+    of = "the paper's Table 3 (--table paper)" if paper_table else "the DEM runs"
+    if stated is None:
+        raise ParameterError(f"--specimen {path}: the DEM runs store no specimen text (an "
+                             "older store), so that they are of this file cannot be checked; "
+                             "give the area c_eq per area is taken over with --area")
+    if given.hash != stated.hash:
+        raise ParameterError(
+            f"--specimen {path}: {hashed_name(given.name, given.hash)} is not the specimen of "
+            f"{of}, {hashed_name(stated.name, stated.hash)}; expected that specimen's file")
+    return given
 
 
 def _direction_text(runs) -> str:

@@ -101,12 +101,15 @@ def format_facts(f: dict, source: str) -> str:
     # the label the app, reports and dem run/sweep show (16 hex digits here matched none)
     return "\n".join([
         f"specimen        {hashed_name(f['name'], f['sha256'])} ({source}): OK, {kind}; "
-        "[...] starts its sha256 (of every value, name and description included)",
+        "[...] starts its sha256 (of every value, name and description included, but "
+        "[coupon] face_area_m2, which no DEM run simulates)",
         *([f"calibrated from {hashed_name(f['calibrated_from_name'], f['calibrated_from_sha256'])}"
            ": the tests it models are that file's"]
           if f.get("calibrated_from_sha256") else []),
         f"cells           {f['cells_per_coupon']} {f['cell_shape']}, capacity "
         f"{f['capacity_per_cell']} particles per cell (dense drop packing)",
+        f"coupon area     {f['coupon_area_from']}: what c_eq_per_treated_area (pidcore "
+        "model damper) is per",
         f"gaps            wall to wall {f['wall_to_wall_gap_m'] * 1e3:.4g} mm, floor to "
         f"ceiling {f['floor_to_ceiling_gap_m'] * 1e3:.4g} mm beside one particle",
         f"particles       {f['particles_per_cell']} per cell ({f['particles_per_cell_basis']}), "

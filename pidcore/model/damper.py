@@ -14,7 +14,9 @@ For a coupon driven at constant acceleration amplitude ``a`` [m/s^2] and angular
 
 ``c_eq`` per unit area divides by the coupon area: the particles in a cell respond to the motion
 of the cell, so the dissipation (not the mass) is what carries over to another structure with
-the same fill, acceleration and frequency.
+the same fill, acceleration and frequency. The coupon area is one rule for every specimen
+(:func:`specimen_area_m2`): the face area its file states (``[coupon] face_area_m2``; the
+paper's coupon states its 0.1 m x 0.1 m face), else its cells' cross-section.
 """
 
 from __future__ import annotations
@@ -35,6 +37,7 @@ from .. import defaults as D
 from ..atomic_files import write_atomically
 from ..constants import STANDARD_GRAVITY, VIBRATED_MASS_CONVENTIONS
 from ..errors import ParameterError
+from ..specimen import MAX_FACE_TO_CELLS_AREA
 from .sdc_model import SdcModel
 from .sdc_model import held_error as held_error_of
 
@@ -109,8 +112,11 @@ DAMPER_COLUMN_MEANINGS: dict[str, str] = {
                                 "(empty where SDC >= 1)",
     "coupon_vibrated_mass [kg]": "m_c of Eq. 10 the SDC is taken over (provenance "
                                  "vibrated_mass: which masses)",
-    "coupon_area [m^2]": "face area (one face) of the coupon c_eq_per_coupon is of: "
-                         "c_eq_per_treated_area = c_eq_per_coupon / coupon_area",
+    "coupon_area [m^2]": "face area (one face) of the coupon c_eq_per_coupon is of: its "
+                         "specimen file's [coupon] face_area_m2 (the paper's 0.1 m x 0.1 m), "
+                         "else its cells' cross-section, cell count x hexagon (provenance "
+                         "area: which, and from where); c_eq_per_treated_area = "
+                         "c_eq_per_coupon / coupon_area",
     "coupon_cells [-]": "honeycomb cells of the coupon c_eq_per_coupon is of: c_eq_per_cell = "
                         "c_eq_per_coupon / coupon_cells",
     "coupon_energy_per_cycle [J]": "energy dissipated per drive cycle in the whole coupon, "
@@ -122,7 +128,8 @@ DAMPER_COLUMN_MEANINGS: dict[str, str] = {
                                "grounded: on the coupon's absolute velocity along the drive "
                                "direction (provenance direction); pi c_eq_per_coupon w X^2 = "
                                "coupon_energy_per_cycle",
-    "c_eq_per_treated_area [N s/m^3]": "c_eq_per_coupon per m^2 of coupon face (one face): "
+    "c_eq_per_treated_area [N s/m^3]": "c_eq_per_coupon per m^2 of coupon face (one face, "
+                                       "coupon_area): "
                                        "spread over the treated (filled) area of a panel at "
                                        "the same fill, acceleration and frequency (e.g. a "
                                        "grounded dashpot of c_eq_per_treated_area x tributary "
@@ -285,22 +292,27 @@ def coupon_area_m2(side_m: float = D.COUPON_SIDE_M) -> float:
 #: Most a coupon area may differ from its cells' cross-section (count x hexagon) before it is
 #: refused as a unit slip: cm^2 or mm^2 typed for m^2 is 1e4 or 1e6 times off, while a panel
 #: whose filled cells are a patch of it, or the paper's 0.01 m^2 over its 441 cells (1.16 x),
-#: stay well within it.
-AREA_TO_CELLS_LIMIT = 100.0
+#: stay well within it. The bound a specimen file's ``[coupon] face_area_m2`` is held to.
+AREA_TO_CELLS_LIMIT = MAX_FACE_TO_CELLS_AREA
 
 
 def runs_specimen(runs: pd.DataFrame):
     """The specimen of DEM runs (its canonical text, stored with each run), None where the
-    runs hold none (an older store) or several."""
+    runs hold none (an older store) or several.
+
+    The canonical text leaves ``[coupon] face_area_m2`` out (no DEM physics): runs of a file
+    pidcore bundles (the paper's coupon, of any table material; same hash) take that file's
+    face area, as that file does; runs of any other file state none, and are taken over their
+    cells' area (:func:`specimen_area_m2`) unless an area is given."""
     from ..compare.align import stored_parameters
-    from ..specimen import Specimen
+    from ..specimen import Specimen, bundled_face_area
 
     if "parameters_json" not in runs.columns or runs.empty:
         return None
     texts = {(stored_parameters(p) or {}).get("specimen_text") for p in runs["parameters_json"]}
     if len(texts) != 1 or None in texts:
         return None
-    return Specimen.from_text(texts.pop(), source="stored DEM runs")
+    return bundled_face_area(Specimen.from_text(texts.pop(), source="stored DEM runs"))
 
 
 #: How far a given coupon area may differ from its specimen's own (:func:`specimen_area_m2`)
@@ -309,22 +321,26 @@ def runs_specimen(runs: pd.DataFrame):
 AREA_NOTE_TOLERANCE = 0.05
 
 
-def specimen_area_m2(specimen: Specimen) -> tuple[float, str]:
-    """The coupon area of ``specimen`` for c_eq per area, m^2, and where it comes from.
+def specimen_area_m2(specimen: Specimen, *, read_from: str = "its file"
+                     ) -> tuple[float, str]:
+    """The coupon area of ``specimen`` for c_eq per area, m^2, and where it comes from
+    (``read_from``: what ``specimen`` was read from, as the words name it).
 
-    The paper coupon's cells (the coupon, a calibrated file of it, another particle fill):
-    its 0.1 m x 0.1 m face (:func:`coupon_area_m2`), as the paper states it. Another
-    specimen's file states no face area, but its cells give the area they treat: ``[cell]
-    count`` x one hexagon's (:meth:`pidcore.specimen.Specimen.cells_area_m2`); the paper's
-    0.01 m^2 face was taken for it, whatever its cells."""
-    from ..specimen import paper_specimen
-
-    if specimen.cell == paper_specimen().cell:
-        return coupon_area_m2(), f"{coupon_area_m2():g} m^2 (the paper's 0.1 m x 0.1 m coupon)"
-    area = specimen.cells_area_m2()
-    return area, (f"{area:.6g} m^2 (specimen {specimen.name}'s {specimen.cell.count} cells x "
-                  f"{area / specimen.cell.count * 1e6:.6g} mm^2 each: the area its cells "
-                  "treat; the file states no coupon face)")
+    One rule for every specimen: the face area its file states (``[coupon] face_area_m2``;
+    the paper's coupon states its 0.1 m x 0.1 m face, 1.16 x its 441 cells), else the
+    cross-section of its cells, ``[cell] count`` x one hexagon's
+    (:meth:`pidcore.specimen.Specimen.cells_area_m2`). The paper coupon's cells took its
+    0.01 m^2 whatever the file (a calibrated file, another particle fill), any other file its
+    cells' area, and no file could state its face."""
+    cells = specimen.cells_area_m2()
+    count = specimen.cell.count
+    face = specimen.coupon.face_area_m2
+    if face is not None:
+        return face, (f"{face:.6g} m^2 ([coupon] face_area_m2 of specimen {specimen.name}: "
+                      f"{face / cells:.3g} x its {count} cells' {cells:.6g} m^2)")
+    return cells, (f"{cells:.6g} m^2 (specimen {specimen.name}'s {count} cells x "
+                   f"{cells / count * 1e6:.6g} mm^2 each: {read_from} states no [coupon] "
+                   "face_area_m2, so the area its cells treat)")
 
 
 def area_override_note(area_m2: float, specimen: Specimen, what: str = "area_m2") -> str:
@@ -533,8 +549,9 @@ def equivalent_damper_table(model: SdcModel, *, fills_percent: Sequence[float] |
         coupon's m_c is refused as a unit slip (grams typed for kg), as ``pidcore model
         damper --vibrated-mass`` refuses it.
     area_m2 : float, optional
-        Coupon area for the per-area damper; default :func:`specimen_area_m2` (the paper's
-        0.01 m^2, another specimen's cells' cross-section). An area more
+        Coupon area for the per-area damper; default :func:`specimen_area_m2` (the
+        specimen's ``[coupon] face_area_m2``, the paper's 0.01 m^2, else its cells'
+        cross-section). An area more
         than :data:`AREA_TO_CELLS_LIMIT` times off ``specimen``'s cells is refused as a unit
         slip (cm^2 or mm^2 typed for m^2), as ``pidcore model damper --area`` refuses it.
     specimen : pidcore.specimen.Specimen, optional

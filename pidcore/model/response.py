@@ -53,7 +53,7 @@ from scipy.optimize import brentq
 
 from ..constants import STANDARD_GRAVITY
 from ..errors import ParameterError, as_given, instance_of, real_number, whole_number
-from .damper import check_area, coupon_area_m2, equivalent_damping_coefficient
+from .damper import check_area, equivalent_damping_coefficient, specimen_area_m2
 from .sdc_model import SdcModel
 
 if TYPE_CHECKING:  # a name for the hints only
@@ -90,8 +90,11 @@ class TreatedMode:
         for the paper's Table 3, ``runs_vibrated_mass(runs)(fill_percent)`` for stored DEM
         runs. Not ``coupon_vibrated_mass_kg()`` alone, which leaves the particles out (c_pd
         4.5 x low at 50 % fill).
-    coupon_area_m2 : float
-        A_c [m^2] of those coupons (default: the paper's 0.1 m x 0.1 m). More than
+    coupon_area_m2 : float, optional
+        A_c [m^2] of those coupons; default (None) the area ``pidcore model damper`` takes
+        for ``coupon_specimen`` (:func:`~pidcore.model.damper.specimen_area_m2`: the face
+        area its file states, the paper's 0.1 m x 0.1 m, else its cells' cross-section), set
+        when the mode is made. More than
         :data:`~pidcore.model.damper.AREA_TO_CELLS_LIMIT` times off the cells of
         ``coupon_specimen`` is refused as a unit slip (cm^2 or mm^2 typed for m^2).
     coupon_specimen : pidcore.specimen.Specimen, optional
@@ -111,11 +114,18 @@ class TreatedMode:
     treated_area_m2: float
     fill_percent: float
     coupon_vibrated_mass_kg: float
-    coupon_area_m2: float = coupon_area_m2()
+    coupon_area_m2: float | None = None
     coupon_specimen: Specimen | None = None
     treated_regions: tuple[tuple[float, float], ...] = ()
 
     def __post_init__(self) -> None:
+        from ..specimen import paper_specimen
+
+        if self.coupon_area_m2 is None:
+            # the paper's 0.01 m^2 was the default whatever coupon_specimen, while the damper
+            # table took another specimen's cells' area: one rule for both
+            object.__setattr__(self, "coupon_area_m2", specimen_area_m2(
+                self.coupon_specimen or paper_specimen())[0])
         for name in ("natural_frequency_hz", "modal_mass_kg", "structural_damping_ratio",
                      "treated_area_m2", "fill_percent", "coupon_vibrated_mass_kg",
                      "coupon_area_m2"):
@@ -133,8 +143,6 @@ class TreatedMode:
             raise ParameterError(f"TreatedMode: structural_damping_ratio must be >= 0, got "
                                  f"{self.structural_damping_ratio!r}")
         object.__setattr__(self, "treated_regions", self._checked_regions())
-        from ..specimen import paper_specimen
-
         # 100 (cm^2) for A_c = 0.01 m^2 gave a c_pd 1e4 x too small without a word
         check_area(self.coupon_area_m2, self.coupon_specimen or paper_specimen(),
                    "TreatedMode: coupon_area_m2")
