@@ -243,3 +243,47 @@ def test_the_predictions_figure_draws_an_uninformative_band_apart():
         assert f"calibrated (all points), {UNINFORMATIVE_LABEL}" in legend
     finally:
         plt.close(figure)
+
+
+def test_calibration_plot_draws_an_uninformative_band_apart_and_cut_at_its_bound():
+    # Calibration.plot (plot_calibration) drew the 0 .. 25 band as a filled point with a bar
+    # up to 25, past the SDC bound 16.9 no measurement is kept at, beside the judging ones
+    import matplotlib.pyplot as plt
+    from matplotlib.colors import to_rgba
+
+    from pidcore.calibrate.outputs import UNINFORMATIVE_LABEL
+    from pidcore.calibrate.prediction import VERDICT_COLUMN
+
+    result = _result()
+    bound = calibrated_sdc_bound(paper_specimen(), fill_percent=50.0, material="acrylic").sdc
+    frame = result.to_pandas()
+    assert list(frame[VERDICT_COLUMN]) == ["yes", "yes", "uninformative"]
+    assert list(frame["sdc bound [-]"]) == [bound] * 3
+    assert list(frame[VERDICT_COLUMN]) == result.band_verdicts(result.predictions)
+    _, ax = plt.subplots()
+    try:
+        assert result.plot(ax=ax) is ax
+        drawn = {c.get_label(): c for c in ax.containers}
+        assert set(drawn) == {"calibrated DEM, 95 % band",
+                              f"calibrated DEM, {UNINFORMATIVE_LABEL}"}
+        filled = drawn["calibrated DEM, 95 % band"]
+        hollow = drawn[f"calibrated DEM, {UNINFORMATIVE_LABEL}"]
+        assert list(filled.lines[0].get_xdata()) == [0, 1]
+        assert list(hollow.lines[0].get_xdata()) == [2]
+        assert to_rgba(hollow.lines[0].get_markerfacecolor())[3] == 0.0
+        assert to_rgba(filled.lines[0].get_markerfacecolor())[3] == 1.0
+        (dashed,) = hollow.lines[2][0].get_linestyle()
+        (solid,) = filled.lines[2][0].get_linestyle()
+        assert dashed[1] is not None and solid[1] is None
+        # the bar ends at the bound, as predictions.png and the report cut it (exact: the
+        # bar is drawn as predicted + (min(high, bound) - predicted))
+        (segment,) = hollow.lines[2][0].get_segments()
+        assert segment[:, 1] == pytest.approx([0.0, bound], abs=1e-12)
+        cut = [line for line in ax.get_lines()
+               if line.get_label() == f"SDC bound {bound:.3g}: bands cut here (model "
+                                      "unconstrained above)"]
+        assert len(cut) == 1 and list(cut[0].get_ydata()) == [bound, bound]
+        legend = [t.get_text() for t in ax.get_legend().get_texts()]
+        assert f"calibrated DEM, {UNINFORMATIVE_LABEL}" in legend
+    finally:
+        plt.close("all")
