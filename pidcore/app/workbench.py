@@ -168,6 +168,9 @@ def case_view(entries: Sequence[MeasuredEntry], dem_runs: pd.DataFrame | None,
     whole = whole_mass_baseline_note(e.settings for e in entries)
     if whole:
         notes.append(whole)
+    # a stored bound that is not one was ignored (judged at 2 pi), said as report --store and
+    # calibrate --store say it
+    notes.extend(f"{e.file}: {e.bound_note}" for e in entries if e.bound_note)
     # a record the plausibility checks refuse, saved as confirmed, was pooled here without a
     # word (report --store names it, calibrate --store leaves it out)
     notes.extend(f"{e.file}: implausible, "
