@@ -923,6 +923,12 @@ def test_compare_shows_the_calibrated_band_beside_raw_dem_and_measurement(
     assert row["SDC calibrated DEM (Eq. 11) [-]"].tolist() == [predicted]
     assert row[CALIBRATED_INSIDE_COLUMN].tolist() == [{"inside": "yes", "outside": "no",
                                                        "uninformative": "uninformative"}[verdict]]
+    # its band as Compare writes it, one cell: the grid wrote the two numbers in its own
+    # format ("0.0000", "16.9115") beside the note's "0 .. 16.91"
+    assert row["calibrated 95 % band [-]"].tolist() == [f"{shown[0]:.4g} .. {shown[1]:.4g}"]
+    assert "calibrated low 95 % [-]" not in row and "calibrated high 95 % [-]" not in row
+    if verdict == "uninformative":
+        assert row["calibrated 95 % band [-]"].tolist() == ["0 .. 16.91"]
 
 
 def test_a_calibration_saved_in_the_store_is_listed_and_used_after_a_restart(store_file,

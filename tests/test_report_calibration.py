@@ -702,3 +702,62 @@ def test_the_report_files_show_the_uninformative_verdict(tmp_path):
                                              "band of 0 .. the SDC bound, spanning every "
                                              "plausible SDC, "
                                              "cannot test the model)")
+
+
+def test_every_page_writes_the_band_as_band_text_beside_its_verdict(tmp_path):
+    # the app's Report grid wrote the band's two numbers in its own format (0.0000, 16.9115),
+    # the terminal's table wrote them without the verdict, the PDF not at all, while the row's
+    # note said "0 .. 16.91": one band, now written one way (band_text) on every page
+    from pidcore.app.workbench import report_display
+    from pidcore.cli.report import short_table
+    from pidcore.model import load_paper_table3
+    from pidcore.report import build_report_table
+    from pidcore.report.render import pdf_table_cells
+    from pidcore.report.table import CALIBRATED_BAND_COLUMN, UNINFORMATIVE, with_band_text
+
+    pooled = {**_prediction(500, 5, 50, 0.492, 0.121, 0.860), "measured_stderr": 0.0,
+              "low95_without_stderr": 0.121, "high95_without_stderr": 0.860}
+    fitted = {**_prediction(50, 5, 50, 0.30, 0.1234567, 0.5678912), "measured_stderr": 0.0}
+    cal = load_calibration(_write(tmp_path / "calibration.json", [pooled, fitted]))
+    dem = pd.DataFrame({"frequency_hz": [500.0, 50.0, 100.0], "acceleration_g": [5.0] * 3,
+                        "fill_percent": [50.0] * 3, "material": ["acrylic"] * 3,
+                        "direction": ["z"] * 3, "sdc": [0.55, 0.3, 0.4],
+                        "sdc_stderr": [0.01] * 3, "case_key": ["b", "c", "d"]})
+    # two records pooled at 500 Hz (stderr 1.795 of 1 dof): the band 0 .. the paper coupon's
+    # bound at 50 %, 16.91; a measurement at 50 Hz with the fitted point's stderr 0: its band
+    analyses = pd.DataFrame({"frequency_hz": [500.0, 50.0], "acceleration_g": [5.0, 5.0],
+                             "fill_percent": [50.0, 50.0], "sdc": [2.295, 0.3],
+                             "sdc_stderr": [1.795, 0.0], "sdc_stderr_dof": [1.0, math.nan],
+                             "source": ["pooled.uff", "fitted.uff"]})
+    table = add_calibration_columns(build_report_table(dem, analyses, load_paper_table3()), cal)
+    by_f = table.set_index("frequency [Hz]")
+    assert by_f.loc[500.0, CALIBRATED_INSIDE_COLUMN] == UNINFORMATIVE
+    assert by_f.loc[50.0, CALIBRATED_INSIDE_COLUMN] == "yes"
+    # the bound 16.91 (8 m_p/m_s: 46.8 g of spheres on 22.2 g) and the file's band, 4 digits;
+    # the 100 Hz row is not predicted: no band
+    expected = {500.0: "0 .. 16.91", 50.0: "0.1235 .. 0.5679", 100.0: ""}
+    shown = with_band_text(table)
+    assert CALIBRATED_LOW_COLUMN not in shown and CALIBRATED_HIGH_COLUMN not in shown
+    assert dict(zip(shown["frequency [Hz]"], shown[CALIBRATED_BAND_COLUMN],
+                    strict=True)) == expected
+    assert f"{UNINFORMATIVE}: the calibrated 95 % band 0 .. 16.91 spans" in \
+        by_f.loc[500.0, "note"]  # the note's words are the cell's
+    # the app's Report grid
+    grid = report_display(table)
+    assert dict(zip(grid["frequency [Hz]"], grid[CALIBRATED_BAND_COLUMN], strict=True)) == \
+        expected and CALIBRATED_LOW_COLUMN not in grid
+    # the PDF's table
+    labels, rows = pdf_table_cells(table)
+    heads = [label.replace("\n", " ") for label in labels]
+    cells = [dict(zip(heads, row, strict=True)) for row in rows]
+    assert {float(c["frequency [Hz]"]): c["calibrated 95 % band [-]"] for c in cells} == expected
+    assert {float(c["frequency [Hz]"]): c["measured in calibrated 95 % band"]
+            for c in cells}[500.0] == UNINFORMATIVE
+    # the terminal's table: the band and its verdict in the row
+    text = short_table(table).splitlines()
+    assert "calibrated 95 % band [-]" in text[0]
+    assert "measured in calibrated 95 % band" in text[0]
+    (row,) = [line for line in text[2:] if line.split()[0] == "500"]
+    assert "0 .. 16.91" in row and row.split().count(UNINFORMATIVE) == 1
+    (row,) = [line for line in text[2:] if line.split()[0] == "50"]
+    assert "0.1235 .. 0.5679" in row and "yes" in row.split()

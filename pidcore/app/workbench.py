@@ -23,7 +23,7 @@ from ..compare.case import (
     sdc_points,
 )
 from ..loop import ForceDisplacementLoop
-from ..report.table import CONSISTENCY_COLUMN
+from ..report.table import CONSISTENCY_COLUMN, with_band_text
 from .vocabulary import page_terms
 
 #: Columns of :func:`loop_frame`.
@@ -277,12 +277,14 @@ def report_display(table: pd.DataFrame) -> pd.DataFrame:
     simulated one cell (one cell has no scatter to take a standard error from; the DEM tab says
     the same), ``"n/a"`` where it is missing otherwise, empty where no DEM ran. The measured
     chi2/dof: ``"n/a (1 measurement)"`` for one measurement (nothing to scatter), empty where
-    none. The downloads keep the table as ``pidcore report`` writes it (empty cells)."""
+    none. The calibrated band in one cell, as :func:`pidcore.report.table.with_band_text`
+    writes it (the grid wrote its two numbers ``0.0000`` and ``16.9115``). The downloads keep
+    the table as ``pidcore report`` writes it (empty cells, the band's two numbers)."""
     import numpy as np
 
     if table.empty or not {REPORT_STDERR_COLUMN, REPORT_CHI2_COLUMN} <= set(table.columns):
-        return table
-    out = table.copy()
+        return with_band_text(table)
+    out = with_band_text(table).copy()
     dem = np.isfinite(pd.to_numeric(table["SDC DEM (ours) [-]"], errors="coerce"))
     settings = table.get("DEM settings", pd.Series("", index=table.index))
     out[REPORT_STDERR_COLUMN] = _with_reason(  # 3 digits, as the DEM tab's runs table

@@ -640,6 +640,34 @@ INSIDE, OUTSIDE, NOT_COMPARED, UNINFORMATIVE = BAND_VERDICTS
 CALIBRATED_INSIDE_COLUMN = f"measured in calibrated 95 % band [{'/'.join(BAND_VERDICTS)}]"
 CALIBRATION_COLUMNS: tuple[str, ...] = (CALIBRATED_COLUMN, CALIBRATED_LOW_COLUMN,
                                         CALIBRATED_HIGH_COLUMN, CALIBRATED_INSIDE_COLUMN)
+#: The one column a page shows the calibrated band in (:func:`with_band_text`): the terminal's
+#: table, the PDF's and the app's Report tab; the CSV, Markdown, HTML and LaTeX files keep
+#: its two numbers (:data:`CALIBRATED_LOW_COLUMN`, :data:`CALIBRATED_HIGH_COLUMN`).
+CALIBRATED_BAND_COLUMN = "calibrated 95 % band [-]"
+
+
+def with_band_text(table: pd.DataFrame) -> pd.DataFrame:
+    """A copy of a report table for display, its calibrated low and high 95 % columns
+    replaced by one :data:`CALIBRATED_BAND_COLUMN` as
+    :func:`~pidcore.calibrate.prediction.band_text` writes a band (``"0 .. 16.91"``, as the
+    row's note and the app's Compare page write it; empty where no band), in the place of
+    the low column; the table unchanged where it has no such columns. The app's grid showed
+    the two numbers with its own 4 decimals (``0.0000``, ``16.9115``) beside a note saying
+    ``0 .. 16.91``."""
+    from ..calibrate.prediction import band_text
+
+    if not {CALIBRATED_LOW_COLUMN, CALIBRATED_HIGH_COLUMN} <= set(table.columns):
+        return table
+    texts = ["" if math.isnan(low) and math.isnan(high) else band_text(low, high)
+             for low, high in zip(table[CALIBRATED_LOW_COLUMN].map(_finite_or_nan),
+                                  table[CALIBRATED_HIGH_COLUMN].map(_finite_or_nan),
+                                  strict=True)]
+    out = table.drop(columns=[CALIBRATED_HIGH_COLUMN])
+    at = list(out.columns).index(CALIBRATED_LOW_COLUMN)
+    out = out.drop(columns=[CALIBRATED_LOW_COLUMN])
+    out.insert(at, CALIBRATED_BAND_COLUMN, texts)
+    out.attrs = dict(table.attrs)
+    return out
 
 
 def _finite_or_nan(value) -> float:
