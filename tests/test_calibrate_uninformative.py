@@ -6,6 +6,7 @@ neither inside nor among those judged (summary.md, summary.html, calibration.jso
 
 from __future__ import annotations
 
+import html
 import importlib
 import json
 import math
@@ -287,3 +288,27 @@ def test_calibration_plot_draws_an_uninformative_band_apart_and_cut_at_its_bound
         assert f"calibrated DEM, {UNINFORMATIVE_LABEL}" in legend
     finally:
         plt.close("all")
+
+
+def test_the_summary_writes_an_uninformative_band_as_its_reason_does():
+    # summary.md wrote the in-sample 0 .. 25 band "0.000 .. 16.911 (cut ...)" where the
+    # report's reason, the app and the notes write "0 .. 16.91" (band_text)
+    from pidcore.calibrate.outputs import summary_html, summary_markdown
+    from pidcore.calibrate.prediction import CalibratedPrediction, band_text
+    from pidcore.loadcase import LoadCase
+
+    bound = calibrated_sdc_bound(paper_specimen(), fill_percent=50.0, material="acrylic")
+    cell = "0 .. 16.91 (cut at the specimen's SDC bound 16.91; model 25: unconstrained)"
+    assert band_text(0.0, bound.sdc) == "0 .. 16.91"  # 8 m_p/m_s of 46.8 g on 22.2 g
+    rows = [line for line in summary_markdown(_result()).splitlines()
+            if line.startswith("| 1000 | 5 | 50 |")]
+    assert rows[0] == f"| 1000 | 5 | 50 | 0.500 | 0.470 | {cell} | -0.030 | uninformative |"
+    assert f"<td>{html.escape(cell)}</td>" in summary_html(_result())  # its ' escaped
+    # and the reason the report gives such a row names the same band
+    hit = CalibratedPrediction(LoadCase(1000, 5, 50), 0.47, 0.0, 25.0, 0.5, 0.0, 0.0, 25.0,
+                               sdc_bound=bound)
+    assert hit.uninformative_reason(0.0).startswith(
+        "uninformative: the calibrated 95 % band 0 .. 16.91 spans every plausible SDC")
+    # a judging band is written the same way: 4 significant digits
+    assert any(line.startswith("| 100 | 5 | 50 | 0.300 | 0.310 | 0.12 .. 0.55 |")
+               for line in summary_markdown(_result()).splitlines())

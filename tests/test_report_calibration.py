@@ -591,11 +591,12 @@ def test_a_band_past_two_pi_is_cut_there_with_a_note(tmp_path):
 def test_the_calibrate_summary_cuts_a_band_past_two_pi():
     from pidcore.calibrate.outputs import _band_text
 
-    def sdc(value):
-        return f"{value:.3f}"
-
-    assert _band_text(0.5, 12.7, sdc) == "0.500 .. 6.283 (cut at 2 pi; model 12.7: unconstrained)"
-    assert _band_text(0.12, 0.88, sdc) == "0.120 .. 0.880"
+    # the bounds as band_text writes every band (4 significant digits), the report's and the
+    # app's "0.5 .. 6.283", not the summary's own "0.500 .. 6.283"
+    assert _band_text(0.5, 12.7) == "0.5 .. 6.283 (cut at 2 pi; model 12.7: unconstrained)"
+    assert _band_text(0.12, 0.88) == "0.12 .. 0.88"
+    assert _band_text(0.0, 25.0, 16.9115) == ("0 .. 16.91 (cut at the specimen's SDC bound "
+                                             "16.91; model 25: unconstrained)")
 
 
 def test_the_calibrate_plot_cuts_a_band_past_two_pi():

@@ -48,20 +48,23 @@ def specimen_text(result: CalibrationResult) -> str:
     return "\n".join(lines) + "\n" + result.calibrated_specimen().to_toml()
 
 
-def _band_text(low: float, high: float, sdc, bound: float | None = None) -> str:
-    """A 95 % band as the summary shows it: an upper bound past ``bound`` (an SDC no
-    measurement is kept at: :func:`pidcore.compare.plausibility.sdc_bound` of the specimen at
-    this fill; default 2 pi, :data:`~pidcore.compare.plausibility.SDC_UPPER_BOUND`) is cut
-    there and says the model's own bound, as the report and the app cut it
+def _band_text(low: float, high: float, bound: float | None = None) -> str:
+    """A 95 % band as the summary shows it: as every page writes a band
+    (:func:`~pidcore.calibrate.prediction.band_text`: the summary wrote ``0.000 .. 6.283``
+    where the report and the app wrote ``0 .. 6.283``), an upper bound past ``bound`` (an SDC
+    no measurement is kept at: :func:`pidcore.compare.plausibility.sdc_bound` of the specimen
+    at this fill; default 2 pi, :data:`~pidcore.compare.plausibility.SDC_UPPER_BOUND`) cut
+    there with the model's own bound said, as the report and the app cut it
     (:meth:`pidcore.calibrate.prediction.CalibratedPrediction.band`)."""
     from ..compare.plausibility import SDC_UPPER_BOUND
+    from .prediction import band_text
 
     bound = SDC_UPPER_BOUND if bound is None else bound
     if high > bound:
         at = "2 pi" if bound == SDC_UPPER_BOUND else f"the specimen's SDC bound {bound:.4g}"
-        return (f"{sdc(min(low, bound))} .. {sdc(bound)} (cut at {at}; "
+        return (f"{band_text(min(low, bound), bound)} (cut at {at}; "
                 f"model {high:.3g}: unconstrained)")
-    return f"{sdc(low)} .. {sdc(high)}"
+    return band_text(low, high)
 
 
 def parameter_units(result: CalibrationResult) -> dict[str, str]:
@@ -119,7 +122,7 @@ def _table_rows(rows: list[dict], bounds: list[float], verdicts: list[str]
         error = r["predicted"] - r["measured"]
         out.append([f"{r['frequency_hz']:g}", f"{r['acceleration_g']:g}",
                     f"{r['fill_percent']:g}", sdc(r["measured"]), sdc(r["predicted"]),
-                    _band_text(r["low95"], r["high95"], sdc, bound),
+                    _band_text(r["low95"], r["high95"], bound),
                     ("+" if error >= 0 else "") + sdc(error),
                     f"**{verdict}**" if verdict == outside else verdict])
     return out
