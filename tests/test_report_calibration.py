@@ -99,8 +99,8 @@ def _table():
         "acceleration [g]": [5.0, 5.0, 5.0, 5.0],
         "packing ratio [%]": [50.0, 50.0, 50.0, 75.0],
         "material": ["acrylic"] * 4,
-        "SDC measured [-]": [0.30, 1.2, 0.5, math.nan],
-        "SDC measured stderr [-]": [0.01] * 4,
+        "SDC measured (Eq. 11) [-]": [0.30, 1.2, 0.5, math.nan],
+        "SDC measured (Eq. 11) stderr [-]": [0.01] * 4,
         "note": ["", "kept note", "", ""],
     })
 
@@ -117,7 +117,7 @@ def test_calibration_columns_per_row(calibration_file):
     assert out["note"].iloc[1] == "kept note"
     # the band sits right after the measured Eq. 11 SDC
     cols = list(out.columns)
-    assert cols[cols.index("SDC measured [-]") + 1] == CALIBRATED_COLUMN
+    assert cols[cols.index("SDC measured (Eq. 11) [-]") + 1] == CALIBRATED_COLUMN
 
 
 @pytest.mark.usefixtures("undrawn_report_figures")
@@ -179,7 +179,8 @@ def test_not_predicted_rows_say_why(calibration_file):
         "acceleration [g]": [5.0, 5.0, 5.0, 1.0],
         "packing ratio [%]": [50.0, 75.0, 50.0, 50.0],
         "material": ["acrylic", "acrylic", "acrylic", "aluminium"],
-        "SDC measured [-]": [math.nan] * 4, "SDC measured stderr [-]": [math.nan] * 4,
+        "SDC measured (Eq. 11) [-]": [math.nan] * 4,
+        "SDC measured (Eq. 11) stderr [-]": [math.nan] * 4,
         "note": [""] * 4})
     notes = add_calibration_columns(table, load_calibration(calibration_file))["note"].tolist()
     head = "not predicted by the calibration calibration.json: "
@@ -312,8 +313,8 @@ def test_a_measurement_is_checked_against_the_band_of_its_own_stderr(tmp_path):
     table = pd.DataFrame({
         "frequency [Hz]": [50.0, 50.0, 50.0], "acceleration [g]": [5.0] * 3,
         "packing ratio [%]": [50.0] * 3, "material": ["acrylic"] * 3,
-        "SDC measured [-]": [0.25, 0.25, 0.25],
-        "SDC measured stderr [-]": [0.1, 0.001, math.nan], "note": [""] * 3})
+        "SDC measured (Eq. 11) [-]": [0.25, 0.25, 0.25],
+        "SDC measured (Eq. 11) stderr [-]": [0.1, 0.001, math.nan], "note": [""] * 3})
     out = add_calibration_columns(table, cal)
     low, high = out[CALIBRATED_LOW_COLUMN], out[CALIBRATED_HIGH_COLUMN]
     # the fitted point's own stderr, or none known: the band calibration.json states
@@ -381,7 +382,8 @@ def test_a_row_whose_stderr_gives_no_band_is_not_compared_and_says_why(tmp_path)
     table = pd.DataFrame({
         "frequency [Hz]": [50.0] * 3, "acceleration [g]": [5.0] * 3,
         "packing ratio [%]": [50.0] * 3, "material": ["acrylic"] * 3,
-        "SDC measured [-]": [0.25] * 3, "SDC measured stderr [-]": [1e308, -0.01, 0.001],
+        "SDC measured (Eq. 11) [-]": [0.25] * 3,
+        "SDC measured (Eq. 11) stderr [-]": [1e308, -0.01, 0.001],
         "note": [""] * 3})
     out = add_calibration_columns(table, cal)
     bounds = out[[CALIBRATED_LOW_COLUMN, CALIBRATED_HIGH_COLUMN]].to_numpy()
@@ -500,7 +502,8 @@ def test_a_calibration_made_from_an_earlier_version_of_the_specimen_file_says_so
     assert cal.calibrated_specimen().provenance.calibrated_from_sha256 == steel.hash
     rows = pd.DataFrame({"frequency [Hz]": [100.0], "acceleration [g]": [1.0],
                          "packing ratio [%]": [50.0], "material": ["steel"],
-                         "SDC measured [-]": [0.1], "SDC measured stderr [-]": [0.01],
+                         "SDC measured (Eq. 11) [-]": [0.1],
+                         "SDC measured (Eq. 11) stderr [-]": [0.01],
                          "note": [""]})
     edited = Specimen.from_text(
         steel.with_values({"pairs.particle_particle.restitution": 0.5}).to_toml(),
@@ -580,7 +583,7 @@ def test_a_band_past_two_pi_is_cut_there_with_a_note(tmp_path):
     table = pd.DataFrame({
         "frequency [Hz]": [50.0, 500.0], "acceleration [g]": [5.0, 5.0],
         "packing ratio [%]": [10.0, 10.0], "material": ["acrylic", "acrylic"],
-        "SDC measured [-]": [3.2, 0.5], "SDC measured stderr [-]": [0.05, 0.01],
+        "SDC measured (Eq. 11) [-]": [3.2, 0.5], "SDC measured (Eq. 11) stderr [-]": [0.05, 0.01],
         "note": ["", ""]})
     out = add_calibration_columns(table, cal)
     assert out[CALIBRATED_HIGH_COLUMN].tolist() == [two_pi, 0.88]
@@ -648,8 +651,10 @@ def test_a_band_spanning_every_plausible_sdc_is_uninformative_and_not_counted(tm
     table = pd.DataFrame({
         "frequency [Hz]": [500.0, 50.0, 500.0], "acceleration [g]": [5.0, 5.0, 5.0],
         "packing ratio [%]": [50.0, 50.0, 50.0], "material": ["acrylic"] * 3,
-        "SDC measured [-]": [2.295, 0.30, 0.50], "SDC measured stderr [-]": [1.795, 0.01, 0.3],
-        "SDC measured stderr dof [-]": [1.0, 9.0, 1.0], "note": ["pooled 2 records", "", ""]})
+        "SDC measured (Eq. 11) [-]": [2.295, 0.30, 0.50],
+        "SDC measured (Eq. 11) stderr [-]": [1.795, 0.01, 0.3],
+        "SDC measured (Eq. 11) stderr dof [-]": [1.0, 9.0, 1.0],
+        "note": ["pooled 2 records", "", ""]})
     out = add_calibration_columns(table, cal)
     assert out[CALIBRATED_INSIDE_COLUMN].tolist() == [UNINFORMATIVE, "yes", "yes"]
     assert UNINFORMATIVE in BAND_VERDICTS and f"/{UNINFORMATIVE}]" in CALIBRATED_INSIDE_COLUMN

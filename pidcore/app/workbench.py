@@ -23,7 +23,7 @@ from ..compare.case import (
     sdc_points,
 )
 from ..loop import ForceDisplacementLoop
-from ..report.table import CONSISTENCY_COLUMN, with_band_text
+from ..report.table import CONSISTENCY_COLUMN, MEASURED_EQ11_COLUMN, with_band_text
 from .vocabulary import page_terms
 
 #: Columns of :func:`loop_frame`.
@@ -290,7 +290,7 @@ def report_display(table: pd.DataFrame) -> pd.DataFrame:
     out[REPORT_STDERR_COLUMN] = _with_reason(  # 3 digits, as the DEM tab's runs table
         table[REPORT_STDERR_COLUMN], dem,
         ["n/a (1 cell)" if _one_cell(s) else "n/a" for s in settings], ".3g")
-    measured = np.isfinite(pd.to_numeric(table["SDC measured [-]"], errors="coerce"))
+    measured = np.isfinite(pd.to_numeric(table[MEASURED_EQ11_COLUMN], errors="coerce"))
     sources = table.get("source file(s)", pd.Series("", index=table.index))
     out[REPORT_CHI2_COLUMN] = _with_reason(  # 2 digits, as the Compare tab says it
         table[REPORT_CHI2_COLUMN], measured,

@@ -16,6 +16,7 @@ from ..report.table import (
     CALIBRATED_BAND_COLUMN,
     CALIBRATED_COLUMN,
     CALIBRATED_INSIDE_COLUMN,
+    MEASURED_EQ11_COLUMN,
     with_band_text,
 )
 from ._options import (
@@ -34,7 +35,7 @@ from ._vocabulary import cli_words
 #: Eq. 11 one beside the calibrated DEM's, which predicts it.
 _STDOUT_COLUMNS = (
     "frequency [Hz]", "acceleration [g]", "packing ratio [%]", "SDC DEM (ours) [-]",
-    "SDC measured, E of Eq. 10 [-]", "SDC measured [-]", CALIBRATED_COLUMN,
+    "SDC measured, E of Eq. 10 [-]", MEASURED_EQ11_COLUMN, CALIBRATED_COLUMN,
     CALIBRATED_BAND_COLUMN, CALIBRATED_INSIDE_COLUMN, "SDC DEM (paper) [-]",
     "SDC measured (paper) [-]", ALIGNMENT_COLUMN,
 )
@@ -152,7 +153,6 @@ def short_table(table) -> str:
     cols = [c for c in _STDOUT_COLUMNS if c in table.columns]
     short = {ALIGNMENT_COLUMN: "alignment",
              "SDC measured, E of Eq. 10 [-]": "SDC measured (Eq. 10) [-]",
-             "SDC measured [-]": "SDC measured (Eq. 11) [-]",
              CALIBRATED_INSIDE_COLUMN: "measured in calibrated 95 % band"}
     heads = [short.get(c, c) for c in cols]
     rows = [[format_cell(v) for v in row] for row in table.loc[:, cols].itertuples(index=False)]
