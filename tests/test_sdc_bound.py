@@ -416,8 +416,14 @@ def test_calibrate_store_and_compare_say_why_a_stored_bound_was_ignored(
     line = f"rec.csv: {note}"
     left_out: list[str] = []
     if sdc is None:
-        with pytest.raises(Exception, match="all implausible"):
+        with pytest.raises(Exception, match="all implausible") as refused:
             measured_from_store(store, left_out=left_out)
+        # the error, all that calibrate --store prints then, says why too
+        assert f"(loss factor 1.34 > 1); {note}); a fit takes none of them" in \
+            str(refused.value)
+        assert main(["calibrate", "--store", str(store), "--fit", "fixture_mass_kg",
+                     "--dem-store", str(tmp_path / "d.h5"), "--no-progress"]) == 2
+        assert f"; {note}); a fit takes none of them" in capsys.readouterr().err
         assert left_out[0] == line  # first: why it is judged at 2 pi, then what that left out
         assert left_out[1].startswith("rec.csv: left out, implausible (saved as accepted): "
                                       "SDC 8.399 is above the physical bound 6.28 (loss")

@@ -324,7 +324,11 @@ def measured_from_store(store_path: str | os.PathLike, *,
                                     # one specimen and fill: one bound
                                     sdc_bound=group["sdc_bound"].iloc[0]))
     if not points:
-        dropped = [found[0].message for found in implausible if found]
+        # with why its bound is 2 pi where the stored one was ignored: the error is all the
+        # command prints then, and "above the physical bound 6.28" of a record analyze kept
+        # below its particles' 38.3 read as a contradiction
+        dropped = [found[0].message + (f"; {note}" if note else "")
+                   for found, (_, note) in zip(implausible, judged, strict=True) if found]
         if dropped:
             # they have a complete load case: "no analysed measurement has a complete load
             # case" sent the user to fills and sidecars, not to the records left out
