@@ -457,7 +457,7 @@ def test_save_writes_the_load_case_and_the_report_reads_it(tmp_path, good_csv, o
     assert (row["fill_percent"], row["material"], row["direction"]) == (50.0, "acrylic", "z")
     assert row["specimen"] == "S1"
     table = store_report_table(store_file)
-    assert table["SDC measured [-]"].tolist() == [rec.analysis.sdc]
+    assert table["SDC measured (Eq. 11) [-]"].tolist() == [rec.analysis.sdc]
     # S1 is not the paper's coupon: Table 3 (DEM 0.1891 here) is not set beside its test
     assert table["SDC DEM (paper) [-]"].isna().all()
     assert "specimen S1 is not the paper's coupon" in table["note"].iloc[0]
@@ -527,7 +527,7 @@ def test_report_downloads_hold_the_saved_numbers(tmp_path, good_csv, options):
     # a plain read_csv reads exactly the table: no footer lines
     table = pd.read_csv(io.BytesIO(files["csv"][1]))
     assert len(table) == 1 and b"sha256" in files["csv_provenance"][1]
-    assert table["SDC measured [-]"].iloc[0] == pytest.approx(rec.analysis.sdc, rel=1e-9)
+    assert table["SDC measured (Eq. 11) [-]"].iloc[0] == pytest.approx(rec.analysis.sdc, rel=1e-9)
     assert b"<table" in files["html"][1]
     assert b"\\begin{" in files["tex"][1]
 
@@ -799,7 +799,7 @@ def test_reference_dem_store_joins_the_app_store_read_only(tmp_path, good_csv, o
     table = store_report_table(app_file, ref_file)
     assert table["packing ratio [%]"].tolist() == [50.0, 75.0]
     assert table["SDC DEM (ours) [-]"].tolist() == [0.20, 0.30]
-    assert table["SDC measured [-]"].iloc[0] == rec.analysis.sdc
+    assert table["SDC measured (Eq. 11) [-]"].iloc[0] == rec.analysis.sdc
     files = report_files(app_file, ref_file)
     html = files["html"][1].decode()
     assert str(ref_file.name) in html and str(app_file.name) in html  # provenance: both stores
@@ -939,7 +939,7 @@ def test_a_file_saved_again_with_other_corrections_counts_once(tmp_path, good_cs
     assert len(saved) == 1 and saved["sdc"].iloc[0] == rec2.analysis.sdc
     assert saved["file"].tolist() == ["c_fill50.csv"]
     table = store_report_table(store_file)
-    assert table["SDC measured [-]"].dropna().tolist() == [rec2.analysis.sdc]
+    assert table["SDC measured (Eq. 11) [-]"].dropna().tolist() == [rec2.analysis.sdc]
 
 
 def test_an_empty_fills_field_takes_the_specimens_own_fill_as_the_cli_does():
@@ -1128,7 +1128,7 @@ def test_compare_and_report_say_a_dem_run_did_not_converge_alike(good_csv, optio
     analyses = pd.DataFrame([{**analysis_record(rec), "fill_percent": 50.0, "material": "steel",
                               "direction": "z", "specimen": "steel_6mm_b"}])
     table = build_report_table(runs, analyses, paper_table())
-    row = table[table["SDC measured [-]"].notna()]
+    row = table[table["SDC measured (Eq. 11) [-]"].notna()]
     assert view["dem_warning"] in row["note"].iloc[0]
 
 
@@ -1144,7 +1144,7 @@ def test_the_report_table_pairs_a_measurement_with_its_specimens_dem_run(good_cs
                                   "material": "steel", "direction": "z",
                                   "specimen": specimen}])
         table = build_report_table(runs, analyses, paper_table())
-        return table[table["SDC measured [-]"].notna()].iloc[0]
+        return table[table["SDC measured (Eq. 11) [-]"].notna()].iloc[0]
 
     assert measured_row("steel_6mm_b")["SDC DEM (ours) [-]"] == 0.02308
     assert measured_row("steel_6mm")["SDC DEM (ours) [-]"] == 0.0197
@@ -1595,7 +1595,7 @@ def test_the_report_tab_says_why_a_result_has_no_number():
     table = pd.DataFrame({
         "SDC DEM (ours) [-]": [1.1, 0.5, math.nan, 0.7],
         "SDC DEM stderr [-]": [math.nan, 0.0123456, math.nan, math.nan],
-        "SDC measured [-]": [1.13, math.nan, 0.9, 0.8],
+        "SDC measured (Eq. 11) [-]": [1.13, math.nan, 0.9, 0.8],
         "measured chi2/dof [-]": [math.nan, math.nan, 1.234, math.nan],
         "DEM settings": ["cells 1, steady cycles auto, settings hash 44136f",
                          "cells 4, steady cycles auto, settings hash 44136f", "", ""],

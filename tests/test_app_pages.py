@@ -78,7 +78,7 @@ def _wait_for_jobs(store_path, timeout_s: float = 300.0) -> None:
 
 def _table(at: AppTest, column: str):
     """The first dataframe shown that has ``column`` (results: "velocity channel";
-    report: "SDC measured [-]")."""
+    report: "SDC measured (Eq. 11) [-]")."""
     return next(d.value for d in at.dataframe if column in d.value.columns)
 
 
@@ -384,8 +384,8 @@ def test_report_tab_shows_the_table_and_offers_clean_downloads(store_file):
     at.run()
     shown_sdc = _table(at, "warnings")["SDC [-]"].iloc[0]
     at.run()  # the report tab reads the store written by the previous run
-    table = _table(at, "SDC measured [-]")
-    assert table["SDC measured [-]"].tolist() == [shown_sdc]
+    table = _table(at, "SDC measured (Eq. 11) [-]")
+    assert table["SDC measured (Eq. 11) [-]"].tolist() == [shown_sdc]
     assert table["SDC DEM (paper) [-]"].tolist() == [0.1891]
     at.button(key="build_report").click()
     at.run(timeout=RUN_TIMEOUT_S)
@@ -398,7 +398,7 @@ def test_report_tab_shows_the_table_and_offers_clean_downloads(store_file):
 
     files = report_files(store_file)
     back = pd.read_csv(io.BytesIO(files["csv"][1]))
-    assert len(back) == 1 and back["SDC measured [-]"].iloc[0] == shown_sdc
+    assert len(back) == 1 and back["SDC measured (Eq. 11) [-]"].iloc[0] == shown_sdc
 
 
 def _wait_report(at: AppTest, timeout_s: float = 120.0) -> None:
@@ -815,11 +815,11 @@ def test_report_chooses_among_the_saved_records(store_file):
     at.button(key="save").click()
     at.run()
     at.run()
-    table = _table(at, "SDC measured [-]")
+    table = _table(at, "SDC measured (Eq. 11) [-]")
     assert sorted(s for s in table["source file(s)"] if s) == ["a_fill50.csv", "b_fill75.csv"]
     at.multiselect(key="report_filter_files").set_value(["b_fill75.csv"])
     at.run()
-    table = _table(at, "SDC measured [-]")
+    table = _table(at, "SDC measured (Eq. 11) [-]")
     assert [s for s in table["source file(s)"] if s] == ["b_fill75.csv"]
 
 
@@ -919,10 +919,16 @@ def test_compare_shows_the_calibrated_band_beside_raw_dem_and_measurement(
     at.button(key="save").click()
     at.run()
     table = _table(at, "SDC calibrated DEM (Eq. 11) [-]")
-    row = table[table["SDC measured [-]"].notna()]
+    row = table[table["SDC measured (Eq. 11) [-]"].notna()]
     assert row["SDC calibrated DEM (Eq. 11) [-]"].tolist() == [predicted]
     assert row[CALIBRATED_INSIDE_COLUMN].tolist() == [{"inside": "yes", "outside": "no",
                                                        "uninformative": "uninformative"}[verdict]]
+    # its band as Compare writes it, one cell: the grid wrote the two numbers in its own
+    # format ("0.0000", "16.9115") beside the note's "0 .. 16.91"
+    assert row["calibrated 95 % band [-]"].tolist() == [f"{shown[0]:.4g} .. {shown[1]:.4g}"]
+    assert "calibrated low 95 % [-]" not in row and "calibrated high 95 % [-]" not in row
+    if verdict == "uninformative":
+        assert row["calibrated 95 % band [-]"].tolist() == ["0 .. 16.91"]
 
 
 def test_a_calibration_saved_in_the_store_is_listed_and_used_after_a_restart(store_file,
@@ -1023,7 +1029,8 @@ def test_a_calibration_of_another_specimen_does_not_hide_the_papers_band(store_f
     assert box.options[0].startswith("this store's calibration of steel_6mm")
     assert box.value == box.options[1]
     table = _table(at, "SDC calibrated DEM (Eq. 11) [-]")
-    assert table.loc[table["SDC measured [-]"].notna(), "SDC calibrated DEM (Eq. 11) [-]"] \
+    measured = table["SDC measured (Eq. 11) [-]"].notna()
+    assert table.loc[measured, "SDC calibrated DEM (Eq. 11) [-]"] \
         .tolist() == [0.3456]
     box.set_value(box.options[0])  # the steel one, chosen: no acrylic row predicted
     at.run()
@@ -1248,7 +1255,8 @@ def test_the_report_tab_says_a_one_cell_run_has_no_standard_error(store_file):
         "material": "acrylic", "direction": "z", "sdc": 1.1, "sdc_stderr": float("nan"),
         "m_c_kg": 0.3, "cells_simulated": 1})
     at = _app()
-    assert _table(at, "SDC measured [-]")["SDC DEM stderr [-]"].tolist() == ["n/a (1 cell)"]
+    shown = _table(at, "SDC measured (Eq. 11) [-]")
+    assert shown["SDC DEM stderr [-]"].tolist() == ["n/a (1 cell)"]
     back = pd.read_csv(io.BytesIO(report_files(store_file)["csv"][1]))
     assert back["SDC DEM stderr [-]"].isna().all()
 
@@ -1283,8 +1291,8 @@ def test_the_report_grid_leaves_cells_empty_by_design_empty(store_file):
         "material": "acrylic", "direction": "z", "sdc": 1.1, "sdc_stderr": 0.01,
         "m_c_kg": 0.3, "cells_simulated": 2})
     at = _app()
-    (grid,) = [d for d in at.dataframe if "SDC measured [-]" in d.value.columns]
-    assert grid.value["SDC measured [-]"].isna().all()  # missing by design: no measurement
+    (grid,) = [d for d in at.dataframe if "SDC measured (Eq. 11) [-]" in d.value.columns]
+    assert grid.value["SDC measured (Eq. 11) [-]"].isna().all()  # missing by design: no measurement
     assert grid.proto.HasField("placeholder") and grid.proto.placeholder == ""
 
 
@@ -1745,8 +1753,8 @@ def test_the_report_choices_come_back_from_the_page_address(store_file):
     at = _app_at({"report_filter_files": "c200_fill50.csv", "report_pool": "true"})
     assert at.multiselect(key="report_filter_files").value == ["c200_fill50.csv"]
     assert at.checkbox(key="report_pool").value is True
-    table = _table(at, "SDC measured [-]")
-    assert list(table["SDC measured [-]"].dropna().index) == [0] and len(table) == 1
+    table = _table(at, "SDC measured (Eq. 11) [-]")
+    assert list(table["SDC measured (Eq. 11) [-]"].dropna().index) == [0] and len(table) == 1
     # a file the store does not hold: named in one line, not silently dropped
     at = _app_at({"report_filter_files": ["c200_fill50.csv", "gone.csv"]})
     assert [e.value for e in at.error] == [

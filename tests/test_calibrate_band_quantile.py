@@ -245,8 +245,8 @@ def test_the_report_widens_by_the_t_quantile_and_says_so(tmp_path):
     table = pd.DataFrame({
         "frequency [Hz]": [50.0, 50.0], "acceleration [g]": [5.0] * 2,
         "packing ratio [%]": [50.0] * 2, "material": ["acrylic"] * 2,
-        "SDC measured [-]": [0.45, 0.45], "SDC measured stderr [-]": [0.01, 0.01],
-        "SDC measured stderr dof [-]": [7.0, math.nan], "note": [""] * 2})
+        "SDC measured (Eq. 11) [-]": [0.45, 0.45], "SDC measured (Eq. 11) stderr [-]": [0.01, 0.01],
+        "SDC measured (Eq. 11) stderr dof [-]": [7.0, math.nan], "note": [""] * 2})
     out = report_table.add_calibration_columns(table, load_calibration(path))
     high = out[report_table.CALIBRATED_HIGH_COLUMN].tolist()
     assert high[0] == pytest.approx(0.5 + math.hypot(0.06, 2.364624 * 0.01), rel=1e-6)

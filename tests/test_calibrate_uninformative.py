@@ -6,6 +6,7 @@ neither inside nor among those judged (summary.md, summary.html, calibration.jso
 
 from __future__ import annotations
 
+import html
 import importlib
 import json
 import math
@@ -243,3 +244,71 @@ def test_the_predictions_figure_draws_an_uninformative_band_apart():
         assert f"calibrated (all points), {UNINFORMATIVE_LABEL}" in legend
     finally:
         plt.close(figure)
+
+
+def test_calibration_plot_draws_an_uninformative_band_apart_and_cut_at_its_bound():
+    # Calibration.plot (plot_calibration) drew the 0 .. 25 band as a filled point with a bar
+    # up to 25, past the SDC bound 16.9 no measurement is kept at, beside the judging ones
+    import matplotlib.pyplot as plt
+    from matplotlib.colors import to_rgba
+
+    from pidcore.calibrate.outputs import UNINFORMATIVE_LABEL
+    from pidcore.calibrate.prediction import VERDICT_COLUMN
+
+    result = _result()
+    bound = calibrated_sdc_bound(paper_specimen(), fill_percent=50.0, material="acrylic").sdc
+    frame = result.to_pandas()
+    assert list(frame[VERDICT_COLUMN]) == ["yes", "yes", "uninformative"]
+    assert list(frame["sdc bound [-]"]) == [bound] * 3
+    assert list(frame[VERDICT_COLUMN]) == result.band_verdicts(result.predictions)
+    _, ax = plt.subplots()
+    try:
+        assert result.plot(ax=ax) is ax
+        drawn = {c.get_label(): c for c in ax.containers}
+        assert set(drawn) == {"calibrated DEM, 95 % band",
+                              f"calibrated DEM, {UNINFORMATIVE_LABEL}"}
+        filled = drawn["calibrated DEM, 95 % band"]
+        hollow = drawn[f"calibrated DEM, {UNINFORMATIVE_LABEL}"]
+        assert list(filled.lines[0].get_xdata()) == [0, 1]
+        assert list(hollow.lines[0].get_xdata()) == [2]
+        assert to_rgba(hollow.lines[0].get_markerfacecolor())[3] == 0.0
+        assert to_rgba(filled.lines[0].get_markerfacecolor())[3] == 1.0
+        (dashed,) = hollow.lines[2][0].get_linestyle()
+        (solid,) = filled.lines[2][0].get_linestyle()
+        assert dashed[1] is not None and solid[1] is None
+        # the bar ends at the bound, as predictions.png and the report cut it (exact: the
+        # bar is drawn as predicted + (min(high, bound) - predicted))
+        (segment,) = hollow.lines[2][0].get_segments()
+        assert segment[:, 1] == pytest.approx([0.0, bound], abs=1e-12)
+        cut = [line for line in ax.get_lines()
+               if line.get_label() == f"SDC bound {bound:.3g}: bands cut here (model "
+                                      "unconstrained above)"]
+        assert len(cut) == 1 and list(cut[0].get_ydata()) == [bound, bound]
+        legend = [t.get_text() for t in ax.get_legend().get_texts()]
+        assert f"calibrated DEM, {UNINFORMATIVE_LABEL}" in legend
+    finally:
+        plt.close("all")
+
+
+def test_the_summary_writes_an_uninformative_band_as_its_reason_does():
+    # summary.md wrote the in-sample 0 .. 25 band "0.000 .. 16.911 (cut ...)" where the
+    # report's reason, the app and the notes write "0 .. 16.91" (band_text)
+    from pidcore.calibrate.outputs import summary_html, summary_markdown
+    from pidcore.calibrate.prediction import CalibratedPrediction, band_text
+    from pidcore.loadcase import LoadCase
+
+    bound = calibrated_sdc_bound(paper_specimen(), fill_percent=50.0, material="acrylic")
+    cell = "0 .. 16.91 (cut at the specimen's SDC bound 16.91; model 25: unconstrained)"
+    assert band_text(0.0, bound.sdc) == "0 .. 16.91"  # 8 m_p/m_s of 46.8 g on 22.2 g
+    rows = [line for line in summary_markdown(_result()).splitlines()
+            if line.startswith("| 1000 | 5 | 50 |")]
+    assert rows[0] == f"| 1000 | 5 | 50 | 0.500 | 0.470 | {cell} | -0.030 | uninformative |"
+    assert f"<td>{html.escape(cell)}</td>" in summary_html(_result())  # its ' escaped
+    # and the reason the report gives such a row names the same band
+    hit = CalibratedPrediction(LoadCase(1000, 5, 50), 0.47, 0.0, 25.0, 0.5, 0.0, 0.0, 25.0,
+                               sdc_bound=bound)
+    assert hit.uninformative_reason(0.0).startswith(
+        "uninformative: the calibrated 95 % band 0 .. 16.91 spans every plausible SDC")
+    # a judging band is written the same way: 4 significant digits
+    assert any(line.startswith("| 100 | 5 | 50 | 0.300 | 0.310 | 0.12 .. 0.55 |")
+               for line in summary_markdown(_result()).splitlines())

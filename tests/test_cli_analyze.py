@@ -155,7 +155,7 @@ def test_a_stated_load_case_is_saved_so_that_a_store_report_places_it(tmp_path, 
     assert stored.loc[str(named), "fill_percent"] == 50.0
     assert not np.isfinite(float(stored.loc[str(bare), "fill_percent"]))
     report = make_report([], out_dir=tmp_path / "rep", store=store_path, formats="csv")
-    assert report.table["SDC measured [-]"].notna().sum() == 1
+    assert report.table["SDC measured (Eq. 11) [-]"].notna().sum() == 1
     # analysed again stating another fill: the saved record is replaced, and that is said
     assert main(["analyze", str(named), "--fill", "75", "--store", str(store_path)]) == 0
     out = capsys.readouterr().out

@@ -413,12 +413,12 @@ def test_a_row_pooling_a_stored_implausible_result_says_so_and_judges_no_band(tm
     assert main(["report", "--store", str(store), "--calibration", str(calibration),
                  "--out", str(out), "--format", "csv"]) == 0
     table = pd.read_csv(out / "report.csv")
-    (pooled,) = (r for _, r in table[table["SDC measured [-]"].notna()].iterrows())
+    (pooled,) = (r for _, r in table[table["SDC measured (Eq. 11) [-]"].notna()].iterrows())
     # the premise: both records pooled, the mean's standard error wide enough for the band
     # of its own stderr to hold the mean (the old verdict 'yes')
     assert "2 measurements pooled" in pooled["note"]
-    assert pooled["SDC measured [-]"] > 2 * math.pi / 2
-    assert pooled["calibrated high 95 % [-]"] >= pooled["SDC measured [-]"]
+    assert pooled["SDC measured (Eq. 11) [-]"] > 2 * math.pi / 2
+    assert pooled["calibrated high 95 % [-]"] >= pooled["SDC measured (Eq. 11) [-]"]
     assert pooled[CALIBRATED_INSIDE_COLUMN] == NOT_COMPARED
     assert "kept as accepted: rec_fill50.csv (SDC 20" in pooled["note"]
     assert "ok_fill50.csv (" not in pooled["note"]

@@ -42,8 +42,8 @@ def test_the_readme_python_api_block_runs(tmp_path, monkeypatch, capsys):
     table = namespace["table"]
     # every saved measurement is in the table, at its file name's load case (saved without
     # `stated` they had no fill: 'have no fill stated; not in the table', 0 measured rows)
-    measured = table[table["SDC measured [-]"].notna()]
-    assert sorted(measured["SDC measured [-]"]) == sorted(r.analysis.sdc
+    measured = table[table["SDC measured (Eq. 11) [-]"].notna()]
+    assert sorted(measured["SDC measured (Eq. 11) [-]"]) == sorted(r.analysis.sdc
                                                           for r in namespace["records"])
     assert set(measured["packing ratio [%]"]) == {50.0}
     assert not any("no fill" in note for note in table.attrs.get("notes", []))

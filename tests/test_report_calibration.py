@@ -99,8 +99,8 @@ def _table():
         "acceleration [g]": [5.0, 5.0, 5.0, 5.0],
         "packing ratio [%]": [50.0, 50.0, 50.0, 75.0],
         "material": ["acrylic"] * 4,
-        "SDC measured [-]": [0.30, 1.2, 0.5, math.nan],
-        "SDC measured stderr [-]": [0.01] * 4,
+        "SDC measured (Eq. 11) [-]": [0.30, 1.2, 0.5, math.nan],
+        "SDC measured (Eq. 11) stderr [-]": [0.01] * 4,
         "note": ["", "kept note", "", ""],
     })
 
@@ -117,7 +117,7 @@ def test_calibration_columns_per_row(calibration_file):
     assert out["note"].iloc[1] == "kept note"
     # the band sits right after the measured Eq. 11 SDC
     cols = list(out.columns)
-    assert cols[cols.index("SDC measured [-]") + 1] == CALIBRATED_COLUMN
+    assert cols[cols.index("SDC measured (Eq. 11) [-]") + 1] == CALIBRATED_COLUMN
 
 
 @pytest.mark.usefixtures("undrawn_report_figures")
@@ -179,7 +179,8 @@ def test_not_predicted_rows_say_why(calibration_file):
         "acceleration [g]": [5.0, 5.0, 5.0, 1.0],
         "packing ratio [%]": [50.0, 75.0, 50.0, 50.0],
         "material": ["acrylic", "acrylic", "acrylic", "aluminium"],
-        "SDC measured [-]": [math.nan] * 4, "SDC measured stderr [-]": [math.nan] * 4,
+        "SDC measured (Eq. 11) [-]": [math.nan] * 4,
+        "SDC measured (Eq. 11) stderr [-]": [math.nan] * 4,
         "note": [""] * 4})
     notes = add_calibration_columns(table, load_calibration(calibration_file))["note"].tolist()
     head = "not predicted by the calibration calibration.json: "
@@ -314,8 +315,8 @@ def test_a_measurement_is_checked_against_the_band_of_its_own_stderr(tmp_path):
     table = pd.DataFrame({
         "frequency [Hz]": [50.0, 50.0, 50.0], "acceleration [g]": [5.0] * 3,
         "packing ratio [%]": [50.0] * 3, "material": ["acrylic"] * 3,
-        "SDC measured [-]": [0.25, 0.25, 0.25],
-        "SDC measured stderr [-]": [0.1, 0.001, math.nan], "note": [""] * 3})
+        "SDC measured (Eq. 11) [-]": [0.25, 0.25, 0.25],
+        "SDC measured (Eq. 11) stderr [-]": [0.1, 0.001, math.nan], "note": [""] * 3})
     out = add_calibration_columns(table, cal)
     low, high = out[CALIBRATED_LOW_COLUMN], out[CALIBRATED_HIGH_COLUMN]
     # the fitted point's own stderr, or none known: the band calibration.json states
@@ -383,7 +384,8 @@ def test_a_row_whose_stderr_gives_no_band_is_not_compared_and_says_why(tmp_path)
     table = pd.DataFrame({
         "frequency [Hz]": [50.0] * 3, "acceleration [g]": [5.0] * 3,
         "packing ratio [%]": [50.0] * 3, "material": ["acrylic"] * 3,
-        "SDC measured [-]": [0.25] * 3, "SDC measured stderr [-]": [1e308, -0.01, 0.001],
+        "SDC measured (Eq. 11) [-]": [0.25] * 3,
+        "SDC measured (Eq. 11) stderr [-]": [1e308, -0.01, 0.001],
         "note": [""] * 3})
     out = add_calibration_columns(table, cal)
     bounds = out[[CALIBRATED_LOW_COLUMN, CALIBRATED_HIGH_COLUMN]].to_numpy()
@@ -502,7 +504,8 @@ def test_a_calibration_made_from_an_earlier_version_of_the_specimen_file_says_so
     assert cal.calibrated_specimen().provenance.calibrated_from_sha256 == steel.hash
     rows = pd.DataFrame({"frequency [Hz]": [100.0], "acceleration [g]": [1.0],
                          "packing ratio [%]": [50.0], "material": ["steel"],
-                         "SDC measured [-]": [0.1], "SDC measured stderr [-]": [0.01],
+                         "SDC measured (Eq. 11) [-]": [0.1],
+                         "SDC measured (Eq. 11) stderr [-]": [0.01],
                          "note": [""]})
     edited = Specimen.from_text(
         steel.with_values({"pairs.particle_particle.restitution": 0.5}).to_toml(),
@@ -582,7 +585,7 @@ def test_a_band_past_two_pi_is_cut_there_with_a_note(tmp_path):
     table = pd.DataFrame({
         "frequency [Hz]": [50.0, 500.0], "acceleration [g]": [5.0, 5.0],
         "packing ratio [%]": [10.0, 10.0], "material": ["acrylic", "acrylic"],
-        "SDC measured [-]": [3.2, 0.5], "SDC measured stderr [-]": [0.05, 0.01],
+        "SDC measured (Eq. 11) [-]": [3.2, 0.5], "SDC measured (Eq. 11) stderr [-]": [0.05, 0.01],
         "note": ["", ""]})
     out = add_calibration_columns(table, cal)
     assert out[CALIBRATED_HIGH_COLUMN].tolist() == [two_pi, 0.88]
@@ -593,11 +596,12 @@ def test_a_band_past_two_pi_is_cut_there_with_a_note(tmp_path):
 def test_the_calibrate_summary_cuts_a_band_past_two_pi():
     from pidcore.calibrate.outputs import _band_text
 
-    def sdc(value):
-        return f"{value:.3f}"
-
-    assert _band_text(0.5, 12.7, sdc) == "0.500 .. 6.283 (cut at 2 pi; model 12.7: unconstrained)"
-    assert _band_text(0.12, 0.88, sdc) == "0.120 .. 0.880"
+    # the bounds as band_text writes every band (4 significant digits), the report's and the
+    # app's "0.5 .. 6.283", not the summary's own "0.500 .. 6.283"
+    assert _band_text(0.5, 12.7) == "0.5 .. 6.283 (cut at 2 pi; model 12.7: unconstrained)"
+    assert _band_text(0.12, 0.88) == "0.12 .. 0.88"
+    assert _band_text(0.0, 25.0, 16.9115) == ("0 .. 16.91 (cut at the specimen's SDC bound "
+                                             "16.91; model 25: unconstrained)")
 
 
 def test_the_calibrate_plot_cuts_a_band_past_two_pi():
@@ -649,8 +653,10 @@ def test_a_band_spanning_every_plausible_sdc_is_uninformative_and_not_counted(tm
     table = pd.DataFrame({
         "frequency [Hz]": [500.0, 50.0, 500.0], "acceleration [g]": [5.0, 5.0, 5.0],
         "packing ratio [%]": [50.0, 50.0, 50.0], "material": ["acrylic"] * 3,
-        "SDC measured [-]": [2.295, 0.30, 0.50], "SDC measured stderr [-]": [1.795, 0.01, 0.3],
-        "SDC measured stderr dof [-]": [1.0, 9.0, 1.0], "note": ["pooled 2 records", "", ""]})
+        "SDC measured (Eq. 11) [-]": [2.295, 0.30, 0.50],
+        "SDC measured (Eq. 11) stderr [-]": [1.795, 0.01, 0.3],
+        "SDC measured (Eq. 11) stderr dof [-]": [1.0, 9.0, 1.0],
+        "note": ["pooled 2 records", "", ""]})
     out = add_calibration_columns(table, cal)
     assert out[CALIBRATED_INSIDE_COLUMN].tolist() == [UNINFORMATIVE, "yes", "yes"]
     assert UNINFORMATIVE in BAND_VERDICTS and f"/{UNINFORMATIVE}]" in CALIBRATED_INSIDE_COLUMN
@@ -704,3 +710,62 @@ def test_the_report_files_show_the_uninformative_verdict(tmp_path):
                                              "band of 0 .. the SDC bound, spanning every "
                                              "plausible SDC, "
                                              "cannot test the model)")
+
+
+def test_every_page_writes_the_band_as_band_text_beside_its_verdict(tmp_path):
+    # the app's Report grid wrote the band's two numbers in its own format (0.0000, 16.9115),
+    # the terminal's table wrote them without the verdict, the PDF not at all, while the row's
+    # note said "0 .. 16.91": one band, now written one way (band_text) on every page
+    from pidcore.app.workbench import report_display
+    from pidcore.cli.report import short_table
+    from pidcore.model import load_paper_table3
+    from pidcore.report import build_report_table
+    from pidcore.report.render import pdf_table_cells
+    from pidcore.report.table import CALIBRATED_BAND_COLUMN, UNINFORMATIVE, with_band_text
+
+    pooled = {**_prediction(500, 5, 50, 0.492, 0.121, 0.860), "measured_stderr": 0.0,
+              "low95_without_stderr": 0.121, "high95_without_stderr": 0.860}
+    fitted = {**_prediction(50, 5, 50, 0.30, 0.1234567, 0.5678912), "measured_stderr": 0.0}
+    cal = load_calibration(_write(tmp_path / "calibration.json", [pooled, fitted]))
+    dem = pd.DataFrame({"frequency_hz": [500.0, 50.0, 100.0], "acceleration_g": [5.0] * 3,
+                        "fill_percent": [50.0] * 3, "material": ["acrylic"] * 3,
+                        "direction": ["z"] * 3, "sdc": [0.55, 0.3, 0.4],
+                        "sdc_stderr": [0.01] * 3, "case_key": ["b", "c", "d"]})
+    # two records pooled at 500 Hz (stderr 1.795 of 1 dof): the band 0 .. the paper coupon's
+    # bound at 50 %, 16.91; a measurement at 50 Hz with the fitted point's stderr 0: its band
+    analyses = pd.DataFrame({"frequency_hz": [500.0, 50.0], "acceleration_g": [5.0, 5.0],
+                             "fill_percent": [50.0, 50.0], "sdc": [2.295, 0.3],
+                             "sdc_stderr": [1.795, 0.0], "sdc_stderr_dof": [1.0, math.nan],
+                             "source": ["pooled.uff", "fitted.uff"]})
+    table = add_calibration_columns(build_report_table(dem, analyses, load_paper_table3()), cal)
+    by_f = table.set_index("frequency [Hz]")
+    assert by_f.loc[500.0, CALIBRATED_INSIDE_COLUMN] == UNINFORMATIVE
+    assert by_f.loc[50.0, CALIBRATED_INSIDE_COLUMN] == "yes"
+    # the bound 16.91 (8 m_p/m_s: 46.8 g of spheres on 22.2 g) and the file's band, 4 digits;
+    # the 100 Hz row is not predicted: no band
+    expected = {500.0: "0 .. 16.91", 50.0: "0.1235 .. 0.5679", 100.0: ""}
+    shown = with_band_text(table)
+    assert CALIBRATED_LOW_COLUMN not in shown and CALIBRATED_HIGH_COLUMN not in shown
+    assert dict(zip(shown["frequency [Hz]"], shown[CALIBRATED_BAND_COLUMN],
+                    strict=True)) == expected
+    assert f"{UNINFORMATIVE}: the calibrated 95 % band 0 .. 16.91 spans" in \
+        by_f.loc[500.0, "note"]  # the note's words are the cell's
+    # the app's Report grid
+    grid = report_display(table)
+    assert dict(zip(grid["frequency [Hz]"], grid[CALIBRATED_BAND_COLUMN], strict=True)) == \
+        expected and CALIBRATED_LOW_COLUMN not in grid
+    # the PDF's table
+    labels, rows = pdf_table_cells(table)
+    heads = [label.replace("\n", " ") for label in labels]
+    cells = [dict(zip(heads, row, strict=True)) for row in rows]
+    assert {float(c["frequency [Hz]"]): c["calibrated 95 % band [-]"] for c in cells} == expected
+    assert {float(c["frequency [Hz]"]): c["measured in calibrated 95 % band"]
+            for c in cells}[500.0] == UNINFORMATIVE
+    # the terminal's table: the band and its verdict in the row
+    text = short_table(table).splitlines()
+    assert "calibrated 95 % band [-]" in text[0]
+    assert "measured in calibrated 95 % band" in text[0]
+    (row,) = [line for line in text[2:] if line.split()[0] == "500"]
+    assert "0 .. 16.91" in row and row.split().count(UNINFORMATIVE) == 1
+    (row,) = [line for line in text[2:] if line.split()[0] == "50"]
+    assert "0.1235 .. 0.5679" in row and "yes" in row.split()

@@ -180,7 +180,7 @@ def test_sdc_comparison_sets_the_eq10_measured_sdc_beside_our_dem(one_measured_c
     # errorbar containers: (data line, caps, bars); find each series' drawn y value
     drawn = {c.get_label(): c.lines[0].get_ydata() for c in ax.containers}
     assert list(drawn[eq10[0]]) == [row[MEASURED_EQ10_COLUMN]]
-    assert list(drawn[eq11[0]]) == [row["SDC measured [-]"]]
+    assert list(drawn[eq11[0]]) == [row["SDC measured (Eq. 11) [-]"]]
     # what the figure sets side by side is what the table subtracts
     dem_label = next(lb for lb in drawn if lb.startswith("DEM (ours)"))
     assert drawn[eq10[0]][0] - drawn[dem_label][0] == pytest.approx(row[DIFFERENCE_COLUMN],

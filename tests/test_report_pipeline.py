@@ -91,8 +91,8 @@ def test_report_end_to_end(e2e, dem_store):
     assert (stored["fill_percent"], stored["material"], stored["direction"]) == \
         (50.0, "acrylic", "z")
     row = result.table[result.table["source file(s)"] != ""].iloc[0]
-    assert row["SDC measured [-]"] == stored["sdc"] == result.measured[0].analysis.sdc
-    assert row["SDC measured stderr [-]"] == stored["sdc_stderr"]
+    assert row["SDC measured (Eq. 11) [-]"] == stored["sdc"] == result.measured[0].analysis.sdc
+    assert row["SDC measured (Eq. 11) stderr [-]"] == stored["sdc_stderr"]
     assert row[ALIGNMENT_COLUMN] == "grid"
     dem_rec = Store(dem_store).get_dem_run("f500_a5_fill50_seed11").record
     assert row["SDC DEM (ours) [-]"] == dem_rec["sdc"]
@@ -388,7 +388,7 @@ def test_a_store_of_several_measurements_is_reported_with_the_key_its_refusal_na
     (analyzed,) = json.loads(capsys.readouterr().out)["records"]
     table = pd.read_csv(out / "report.csv")
     # the measurement the key names, analysed as `analyze --key` analyses it, bit for bit
-    assert list(table["SDC measured [-]"].dropna()) == [analyzed["sdc"]]
+    assert list(table["SDC measured (Eq. 11) [-]"].dropna()) == [analyzed["sdc"]]
 
 
 @pytest.mark.usefixtures("undrawn_report_figures")

@@ -318,7 +318,7 @@ def test_pdf_table_sets_the_like_for_like_measured_sdc_beside_ours():
 
     row = dict.fromkeys(REPORT_COLUMNS, float("nan"))
     row.update({"frequency [Hz]": 50.0, "acceleration [g]": 5.0, "packing ratio [%]": 50.0,
-                "SDC DEM (ours) [-]": 0.6054300359935463, "SDC measured [-]": 1.1394946,
+                "SDC DEM (ours) [-]": 0.6054300359935463, "SDC measured (Eq. 11) [-]": 1.1394946,
                 MEASURED_EQ10_COLUMN: 0.6239845632800883,
                 DIFFERENCE_COLUMN: 0.6239845632800883 - 0.6054300359935463,
                 CALIBRATED_COLUMN: 0.2399096, CALIBRATED_INSIDE_COLUMN: "no",
@@ -363,3 +363,32 @@ def test_every_report_file_is_on_disk_before_the_rename_that_names_it(tmp_path, 
     files = {p.stat().st_ino for p in out.rglob("*") if p.is_file()}
     assert len(files) == 6  # csv, its notes, md, marker, the figure's png and svg
     assert renamed_after and files <= renamed_after[0]
+
+
+def test_every_file_names_the_eq11_sdc_as_such_and_an_older_csv_reads_into_the_new_names(
+        report, table):
+    # report.csv, .md, .html and .tex headed the Eq. 11 SDC "SDC measured [-]" beside "SDC DEM
+    # (ours) [-]" (whose like-for-like counterpart is Eq. 10's), while the PDF and the terminal
+    # called the one column "SDC measured (Eq. 11) [-]"
+    from pidcore.report import REPORT_COLUMNS, REPORT_COLUMNS_RENAMED
+
+    assert REPORT_COLUMNS_RENAMED == {
+        "SDC measured [-]": "SDC measured (Eq. 11) [-]",
+        "SDC measured stderr [-]": "SDC measured (Eq. 11) stderr [-]",
+        "SDC measured stderr dof [-]": "SDC measured (Eq. 11) stderr dof [-]"}
+    assert set(REPORT_COLUMNS_RENAMED.values()) <= set(REPORT_COLUMNS)
+    assert not set(REPORT_COLUMNS_RENAMED) & set(REPORT_COLUMNS)
+    _, written = report
+    back = pd.read_csv(written["csv"])
+    assert back["SDC measured (Eq. 11) [-]"].dropna().tolist() == [0.62]  # the analysis's
+    assert back["SDC measured (Eq. 11) stderr [-]"].dropna().tolist() == [0.03]
+    # Markdown escapes the brackets (a link otherwise)
+    for fmt, head in (("md", "SDC measured (Eq. 11) \\[-\\]"),
+                      ("html", "SDC measured (Eq. 11) [-]")):
+        text = written[fmt].read_text(encoding="utf-8")
+        assert head in text and "SDC measured [-]" not in text and \
+            "SDC measured \\[-\\]" not in text
+    # a report.csv of an earlier pidcore reads into the present names, every value as it was
+    older = back.rename(columns={new: old for old, new in REPORT_COLUMNS_RENAMED.items()})
+    assert "SDC measured [-]" in older.columns
+    pd.testing.assert_frame_equal(older.rename(columns=REPORT_COLUMNS_RENAMED), back)

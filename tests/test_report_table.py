@@ -109,8 +109,8 @@ def test_measured_numbers_equal_the_stores_exactly(store, table):
     for name, freq, _acc, _fill, sdc, se in MEASURED:
         stored = analyses[analyses["source"] == name].iloc[0]
         row = table[table["source file(s)"] == name].iloc[0]
-        assert row["SDC measured [-]"] == stored["sdc"] == sdc
-        assert row["SDC measured stderr [-]"] == stored["sdc_stderr"] == se
+        assert row["SDC measured (Eq. 11) [-]"] == stored["sdc"] == sdc
+        assert row["SDC measured (Eq. 11) stderr [-]"] == stored["sdc_stderr"] == se
         assert row["measured frequency [Hz]"] == freq
 
 
@@ -152,8 +152,8 @@ def test_repeated_measurements_at_one_case_are_pooled():
                              "sdc_stderr": [0.001, 0.001], "source": ["a.csv", "b.csv"]})
     t = build_report_table(dem, analyses, None)
     row = t[t["source file(s)"] == "a.csv; b.csv"].iloc[0]
-    assert row["SDC measured [-]"] == pytest.approx(0.25)
-    assert row["SDC measured stderr [-]"] == pytest.approx(0.05)  # std(ddof=1)/sqrt(2)
+    assert row["SDC measured (Eq. 11) [-]"] == pytest.approx(0.25)
+    assert row["SDC measured (Eq. 11) stderr [-]"] == pytest.approx(0.05)  # std(ddof=1)/sqrt(2)
     assert row["measured frequency [Hz]"] == pytest.approx(50.0)
 
 
@@ -206,7 +206,7 @@ def test_measured_sdc_with_eq10_energy_uses_the_dem_vibrated_mass(one_measured_c
     w = 2 * math.pi * 500.2
     expected = energy / (m_c * (4.98 * STANDARD_GRAVITY) ** 2 / (2 * w**2))
     assert row[MEASURED_EQ10_COLUMN] == pytest.approx(expected, rel=1e-12)
-    assert row["SDC measured [-]"] == 4.3  # Eq. 11 value kept as measured
+    assert row["SDC measured (Eq. 11) [-]"] == 4.3  # Eq. 11 value kept as measured
     # the same SDC (Eq. 10 energy) on both sides of the difference, named in its header
     assert "Eq. 10" in DIFFERENCE_COLUMN
     assert row[DIFFERENCE_COLUMN] == pytest.approx(expected - 1.5, rel=1e-12)
@@ -265,7 +265,7 @@ def test_specimens_are_separate_rows_and_pooled_files_get_a_consistency_check():
     t = build_report_table(None, measured, None)
     assert sorted(t["specimen"]) == ["A", "B"]
     row_a = t[t["specimen"] == "A"].iloc[0]
-    assert row_a["SDC measured [-]"] == pytest.approx(0.61)
+    assert row_a["SDC measured (Eq. 11) [-]"] == pytest.approx(0.61)
     # two values 0.02 apart with errors 0.01: chi2 = 2 * (0.01 / 0.01)^2 = 2, dof 1
     assert row_a[CONSISTENCY_COLUMN] == pytest.approx(2.0)
     assert math.isnan(t[t["specimen"] == "B"].iloc[0][CONSISTENCY_COLUMN])

@@ -389,3 +389,62 @@ def test_the_apps_save_keeps_the_bound_and_calibrate_without_the_file_keeps_the_
     left_out: list[str] = []
     (point,) = measured_from_store(store, left_out=left_out)
     assert left_out == [] and point.sdc == pytest.approx(8.4, rel=1e-2)  # 60 dB noise
+
+
+@pytest.mark.parametrize("stored, sdc", [
+    (3.0, 5.0),    # below 2 pi: ignored; an SDC of 5 is kept at 2 pi (a bound of 3 refused it)
+    (20.0, None),  # not the stored masses' 38.3: ignored; the 8.4 record is left out at 2 pi
+])
+def test_calibrate_store_and_compare_say_why_a_stored_bound_was_ignored(
+        tmp_path, capsys, heavy_file, stored, sdc):
+    # report --store said "the SDC bound stored with the record ... ignored"; calibrate
+    # --store (and the app's Calibrate page) and the app's Compare page judged the record at
+    # 2 pi alike, and said nothing of why
+    from pidcore.app.workbench import case_view, saved_entries
+    from pidcore.calibrate.data import measured_from_store
+    from pidcore.compare.case import paper_table
+    from pidcore.store import Store
+    from pidcore.store.listing import saved_analyses
+
+    store, key = _saved_heavy_record(tmp_path, heavy_file)
+    _edit_record(store, key, **{RECORDED_BOUND_FIELD: stored},
+                 **({} if sdc is None else {"sdc": sdc}))
+    note = recorded_sdc_bound(Store(store).list_analyses().iloc[0])[1]
+    assert note.startswith(f"the SDC bound stored with the record ({RECORDED_BOUND_FIELD} "
+                           f"{stored:.4g}) is ") and note.endswith(": ignored, judged as "
+                                                                   "without it")
+    line = f"rec.csv: {note}"
+    left_out: list[str] = []
+    if sdc is None:
+        with pytest.raises(Exception, match="all implausible") as refused:
+            measured_from_store(store, left_out=left_out)
+        # the error, all that calibrate --store prints then, says why too
+        assert f"(loss factor 1.34 > 1); {note}); a fit takes none of them" in \
+            str(refused.value)
+        assert main(["calibrate", "--store", str(store), "--fit", "fixture_mass_kg",
+                     "--dem-store", str(tmp_path / "d.h5"), "--no-progress"]) == 2
+        assert f"; {note}); a fit takes none of them" in capsys.readouterr().err
+        assert left_out[0] == line  # first: why it is judged at 2 pi, then what that left out
+        assert left_out[1].startswith("rec.csv: left out, implausible (saved as accepted): "
+                                      "SDC 8.399 is above the physical bound 6.28 (loss")
+        assert len(left_out) == 2
+    else:
+        (point,) = measured_from_store(store, left_out=left_out)
+        assert point.sdc == sdc and point.sdc_bound.sdc == SDC_UPPER_BOUND
+        assert left_out == [line]
+    # with the file at hand its own bound decides: nothing ignored, nothing said
+    left_out = []
+    (point,) = measured_from_store(store, left_out=left_out, specimen=heavy_specimen())
+    assert left_out == []
+    # the app's Compare page: the entry carries the note, and the case's notes say it
+    (entry,) = saved_entries(store, saved_analyses(store))
+    assert entry.bound_note == note
+    view = case_view([entry], None, paper_table(), (store, None))
+    assert view["notes"].count(line) == 1
+    (known,) = saved_entries(store, saved_analyses(store), [heavy_specimen()])
+    assert known.bound_note == ""
+    # report --store says the same line
+    capsys.readouterr()
+    assert main(["report", "--store", str(store), "--out", str(tmp_path / "r"),
+                 "--format", "csv"]) == 0
+    assert f"note: {line}\n" in capsys.readouterr().out

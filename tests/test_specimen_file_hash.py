@@ -111,7 +111,7 @@ def test_tests_of_two_files_of_one_name_are_not_pooled_and_meet_their_own_runs(
         # one row per test: each row's measured SDC is its single record's, not a mean
         assert sorted(table["source file(s)"]) == ["ta_fill25.csv", "tb_fill25.csv"]
         for _, row in table.iterrows():
-            assert row["SDC measured [-]"] == pytest.approx(sdc[row["source file(s)"]],
+            assert row["SDC measured (Eq. 11) [-]"] == pytest.approx(sdc[row["source file(s)"]],
                                                             rel=1e-9)  # as printed: 6+ digits
         row = table[table["source file(s)"] == mine].iloc[0]
         other = table[table["source file(s)"] != mine].iloc[0]
@@ -202,7 +202,7 @@ def test_reports_calibrated_band_goes_to_the_rows_of_its_file_only(two_panels, a
     table = pd.DataFrame({
         "frequency [Hz]": [1000.0, 1000.0], "acceleration [g]": [5.0, 5.0],
         "packing ratio [%]": [25.0, 25.0], "material": ["acrylic", "acrylic"],
-        "SDC measured [-]": [0.1, 0.1], "SDC measured stderr [-]": [0.01, 0.01],
+        "SDC measured (Eq. 11) [-]": [0.1, 0.1], "SDC measured (Eq. 11) stderr [-]": [0.01, 0.01],
         "specimen": ["panel", "panel"],
         SHA: [two_panels.first.hash, two_panels.second.hash], "note": ["", ""]})
     out = add_calibration_columns(table, calibration)
@@ -285,8 +285,8 @@ def test_report_rows_part_two_files_of_one_name_but_not_the_papers_coupon(two_pa
     table = build_report_table(None, analyses, None)
     rows = {row["source file(s)"]: row for _, row in table.iterrows()}
     assert set(rows) == {"a.csv", "b.csv", "c.csv; d.csv"}
-    assert rows["a.csv"]["SDC measured [-]"] == pytest.approx(0.10, rel=1e-12)
-    assert rows["b.csv"]["SDC measured [-]"] == pytest.approx(0.30, rel=1e-12)
+    assert rows["a.csv"]["SDC measured (Eq. 11) [-]"] == pytest.approx(0.10, rel=1e-12)
+    assert rows["b.csv"]["SDC measured (Eq. 11) [-]"] == pytest.approx(0.30, rel=1e-12)
     assert [rows[k][SHA] for k in ("a.csv", "b.csv", "c.csv; d.csv")] == [
         two_panels.first.hash, two_panels.second.hash, ""]
 

@@ -260,7 +260,7 @@ def test_a_measurement_of_an_own_specimen_meets_its_dem_run_in_the_report(tmp_pa
 
     table, out = report("--specimen", str(STEEL))
     assert "material: specimen" in out
-    both = table[table["SDC measured [-]"].notna()]
+    both = table[table["SDC measured (Eq. 11) [-]"].notna()]
     assert len(table) == 1 and len(both) == 1  # one row: measurement and run together
     assert both["SDC DEM (ours) [-]"].tolist() == pytest.approx([run.sdc])
     table, _ = report()  # the paper's coupon: an acrylic measurement, no steel run

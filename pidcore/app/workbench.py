@@ -23,7 +23,7 @@ from ..compare.case import (
     sdc_points,
 )
 from ..loop import ForceDisplacementLoop
-from ..report.table import CONSISTENCY_COLUMN
+from ..report.table import CONSISTENCY_COLUMN, MEASURED_EQ11_COLUMN, with_band_text
 from .vocabulary import page_terms
 
 #: Columns of :func:`loop_frame`.
@@ -168,6 +168,9 @@ def case_view(entries: Sequence[MeasuredEntry], dem_runs: pd.DataFrame | None,
     whole = whole_mass_baseline_note(e.settings for e in entries)
     if whole:
         notes.append(whole)
+    # a stored bound that is not one was ignored (judged at 2 pi), said as report --store and
+    # calibrate --store say it
+    notes.extend(f"{e.file}: {e.bound_note}" for e in entries if e.bound_note)
     # a record the plausibility checks refuse, saved as confirmed, was pooled here without a
     # word (report --store names it, calibrate --store leaves it out)
     notes.extend(f"{e.file}: implausible, "
@@ -274,18 +277,20 @@ def report_display(table: pd.DataFrame) -> pd.DataFrame:
     simulated one cell (one cell has no scatter to take a standard error from; the DEM tab says
     the same), ``"n/a"`` where it is missing otherwise, empty where no DEM ran. The measured
     chi2/dof: ``"n/a (1 measurement)"`` for one measurement (nothing to scatter), empty where
-    none. The downloads keep the table as ``pidcore report`` writes it (empty cells)."""
+    none. The calibrated band in one cell, as :func:`pidcore.report.table.with_band_text`
+    writes it (the grid wrote its two numbers ``0.0000`` and ``16.9115``). The downloads keep
+    the table as ``pidcore report`` writes it (empty cells, the band's two numbers)."""
     import numpy as np
 
     if table.empty or not {REPORT_STDERR_COLUMN, REPORT_CHI2_COLUMN} <= set(table.columns):
-        return table
-    out = table.copy()
+        return with_band_text(table)
+    out = with_band_text(table).copy()
     dem = np.isfinite(pd.to_numeric(table["SDC DEM (ours) [-]"], errors="coerce"))
     settings = table.get("DEM settings", pd.Series("", index=table.index))
     out[REPORT_STDERR_COLUMN] = _with_reason(  # 3 digits, as the DEM tab's runs table
         table[REPORT_STDERR_COLUMN], dem,
         ["n/a (1 cell)" if _one_cell(s) else "n/a" for s in settings], ".3g")
-    measured = np.isfinite(pd.to_numeric(table["SDC measured [-]"], errors="coerce"))
+    measured = np.isfinite(pd.to_numeric(table[MEASURED_EQ11_COLUMN], errors="coerce"))
     sources = table.get("source file(s)", pd.Series("", index=table.index))
     out[REPORT_CHI2_COLUMN] = _with_reason(  # 2 digits, as the Compare tab says it
         table[REPORT_CHI2_COLUMN], measured,

@@ -173,9 +173,13 @@ class CalibrationResult:
         from .outputs import document_json
         from .prediction import calibration_from_json
 
-        return calibration_from_json(document_json(self.document()),
-                                     "<calibration in memory>",
-                                     specimen_name=self.calibrated_specimen().name)
+        calibrated = self.calibrated_specimen()
+        # with its calibrated file's text, as a store reads it back: without it the bands of
+        # heavy particles were cut at 2 pi here and at their own bound in predictions.png
+        return dataclasses.replace(
+            calibration_from_json(document_json(self.document()), "<calibration in memory>",
+                                  specimen_name=calibrated.name),
+            specimen_text=calibrated.to_toml())
 
     def to_pandas(self) -> pd.DataFrame:
         """The in-sample predictions with their 95 % bands, one row per measured load case,

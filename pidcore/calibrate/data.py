@@ -30,6 +30,7 @@ from ..compare.plausibility import (
     UNKNOWN_SPECIMEN_BOUND,
     SdcBound,
     stored_findings,
+    stored_record_name,
 )
 from ..errors import InputFileError, ParameterError, as_given, real_number
 
@@ -181,7 +182,7 @@ def read_measured_table(path: str | os.PathLike, *,
                                         source=str(path), row=int(line), **values,
                                         sdc_bound=_point_sdc_bound(
                                             values["fill_percent"], material, named, "",
-                                            specimen)))
+                                            specimen)[0]))
         except ParameterError as exc:  # the row's values, named by their columns
             raise InputFileError(f"{where}: {exc}") from None
     if not points:
@@ -201,20 +202,22 @@ def read_measured_table(path: str | os.PathLike, *,
 
 def _point_sdc_bound(fill_percent: float, material: str, specimen_name: str,
                      specimen_sha256: str, given: Specimen | None,
-                     record: Mapping[str, Any] | None = None) -> SdcBound:
-    """The SDC bound of a measured point (:func:`pidcore.compare.plausibility.sdc_bound`):
+                     record: Mapping[str, Any] | None = None) -> tuple[SdcBound, str]:
+    """``(bound, note)``: the SDC bound of a measured point
+    (:func:`pidcore.compare.plausibility.sdc_bound`):
     one naming no specimen is a test of ``given`` where its particles are ``given``'s (as
     :func:`points_for_specimen` takes it), else of the paper's coupon; one naming a specimen
     is judged as :func:`~pidcore.compare.plausibility.tested_sdc_bound` does, and, where its
     file is not at hand, against the bound saved with its stored ``record``
-    (:func:`~pidcore.compare.plausibility.recorded_sdc_bound`) where it has one."""
+    (:func:`~pidcore.compare.plausibility.recorded_sdc_bound`) where it has one; ``note``
+    says where a stored bound was ignored ("" otherwise)."""
     from ..compare.plausibility import measured_sdc_bound, sdc_bound
 
     if given is not None and not specimen_name and material == given.particles.material:
-        return sdc_bound(fill_percent=fill_percent, material=material, specimen=given)
+        return sdc_bound(fill_percent=fill_percent, material=material, specimen=given), ""
     return measured_sdc_bound(fill_percent=fill_percent, material=material,
                               specimen_name=specimen_name, specimen_sha256=specimen_sha256,
-                              given=given, record=record)[0]
+                              given=given, record=record)
 
 
 def measured_from_store(store_path: str | os.PathLike, *,
@@ -260,18 +263,23 @@ def measured_from_store(store_path: str | os.PathLike, *,
     frame = latest_per_measurement(frame)
     # a result no passive coupon gives, kept as asked for the record, fits no parameter: an
     # SDC of -1.26 and one of 9.4 were averaged into the load case (in-sample RMS 2.7)
-    bounds = [_point_sdc_bound(
+    judged = [_point_sdc_bound(
         float(row["fill_percent"]), _text_cell(row.get("material"), DEFAULT_MATERIAL),
         _text_cell(row.get("specimen"), ""), _text_cell(row.get(MEASURED_SHA256_FIELD), ""),
         specimen, row) for _, row in frame.iterrows()]
+    bounds = [bound for bound, _ in judged]
     frame = frame.assign(sdc_bound=bounds)
     implausible = [stored_findings(row, bound=bound)[0]
                    for (_, row), bound in zip(frame.iterrows(), bounds, strict=True)]
     if left_out is not None:
-        left_out.extend(f"{Path(str(row.get('source', '') or row['key'])).name}: left out, "
-                        f"implausible (saved as accepted): {found[0].message}"
-                        for (_, row), found in zip(frame.iterrows(), implausible, strict=True)
-                        if found)
+        names = [stored_record_name(row) for _, row in frame.iterrows()]
+        # a stored bound that is not one is judged at 2 pi: said, as report --store says it
+        # (the record was judged right, and a user saw no word of why)
+        left_out.extend(f"{name}: {note}" for name, (_, note) in zip(names, judged, strict=True)
+                        if note)
+        left_out.extend(f"{name}: left out, implausible (saved as accepted): "
+                        f"{found[0].message}"
+                        for name, found in zip(names, implausible, strict=True) if found)
     frame = frame[[not found for found in implausible]]
     # measured frequency and acceleration scatter about the nominal ones: a load case is the
     # frequency to 3 significant digits, the acceleration to 2 (e.g. 50.02 Hz, 4.97 g -> 50, 5)
@@ -316,7 +324,11 @@ def measured_from_store(store_path: str | os.PathLike, *,
                                     # one specimen and fill: one bound
                                     sdc_bound=group["sdc_bound"].iloc[0]))
     if not points:
-        dropped = [found[0].message for found in implausible if found]
+        # with why its bound is 2 pi where the stored one was ignored: the error is all the
+        # command prints then, and "above the physical bound 6.28" of a record analyze kept
+        # below its particles' 38.3 read as a contradiction
+        dropped = [found[0].message + (f"; {note}" if note else "")
+                   for found, (_, note) in zip(implausible, judged, strict=True) if found]
         if dropped:
             # they have a complete load case: "no analysed measurement has a complete load
             # case" sent the user to fills and sidecars, not to the records left out

@@ -49,20 +49,23 @@ def specimen_text(result: CalibrationResult) -> str:
     return "\n".join(lines) + "\n" + result.calibrated_specimen().to_toml()
 
 
-def _band_text(low: float, high: float, sdc, bound: float | None = None) -> str:
-    """A 95 % band as the summary shows it: an upper bound past ``bound`` (an SDC no
-    measurement is kept at: :func:`pidcore.compare.plausibility.sdc_bound` of the specimen at
-    this fill; default 2 pi, :data:`~pidcore.compare.plausibility.SDC_UPPER_BOUND`) is cut
-    there and says the model's own bound, as the report and the app cut it
+def _band_text(low: float, high: float, bound: float | None = None) -> str:
+    """A 95 % band as the summary shows it: as every page writes a band
+    (:func:`~pidcore.calibrate.prediction.band_text`: the summary wrote ``0.000 .. 6.283``
+    where the report and the app wrote ``0 .. 6.283``), an upper bound past ``bound`` (an SDC
+    no measurement is kept at: :func:`pidcore.compare.plausibility.sdc_bound` of the specimen
+    at this fill; default 2 pi, :data:`~pidcore.compare.plausibility.SDC_UPPER_BOUND`) cut
+    there with the model's own bound said, as the report and the app cut it
     (:meth:`pidcore.calibrate.prediction.CalibratedPrediction.band`)."""
     from ..compare.plausibility import SDC_UPPER_BOUND
+    from .prediction import band_text
 
     bound = SDC_UPPER_BOUND if bound is None else bound
     if high > bound:
         at = "2 pi" if bound == SDC_UPPER_BOUND else f"the specimen's SDC bound {bound:.4g}"
-        return (f"{sdc(min(low, bound))} .. {sdc(bound)} (cut at {at}; "
+        return (f"{band_text(min(low, bound), bound)} (cut at {at}; "
                 f"model {high:.3g}: unconstrained)")
-    return f"{sdc(low)} .. {sdc(high)}"
+    return band_text(low, high)
 
 
 def parameter_units(result: CalibrationResult) -> dict[str, str]:
@@ -120,7 +123,7 @@ def _table_rows(rows: list[dict], bounds: list[float], verdicts: list[str]
         error = r["predicted"] - r["measured"]
         out.append([f"{r['frequency_hz']:g}", f"{r['acceleration_g']:g}",
                     f"{r['fill_percent']:g}", sdc(r["measured"]), sdc(r["predicted"]),
-                    _band_text(r["low95"], r["high95"], sdc, bound),
+                    _band_text(r["low95"], r["high95"], bound),
                     ("+" if error >= 0 else "") + sdc(error),
                     f"**{verdict}**" if verdict == outside else verdict])
     return out
@@ -242,73 +245,99 @@ def summary_html(result: CalibrationResult) -> str:
     return "\n".join(parts)
 
 
+def cut_band_bars(predicted, low, high, bounds) -> tuple[np.ndarray, np.ndarray, np.ndarray,
+                                                           np.ndarray]:
+    """(distance down to the low bound, distance up to the high bound, whether each upper
+    bound was cut) of 95 % bands as every figure draws them: an upper bound past its SDC bound
+    (``bounds``, one per band) is cut there, as :func:`_band_text` and the report cut it
+    (:meth:`~pidcore.calibrate.prediction.CalibratedPrediction.band`)."""
+    pred, low, high, limit = (np.asarray(v, dtype=float) for v in (predicted, low, high,
+                                                                      bounds))
+    shown = np.minimum(high, limit)
+    # a median past the bound has no band below it: its bar ends at its point
+    return pred - np.minimum(low, pred), np.maximum(shown - pred, 0.0), high > limit
+
+
 def shown_band_bars(rows: list[dict], bounds: list[float] | None = None
                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, bool]:
     """(predicted, distance down to low95, distance up to high95, whether a bound was cut) of
-    prediction rows as the plot draws them: an upper bound past the row's SDC bound
-    (``bounds``, :func:`row_sdc_bounds`; default 2 pi) is cut there, as :func:`_band_text`
-    and the report cut it."""
+    prediction rows as the plot draws them (:func:`cut_band_bars`; ``bounds``:
+    :func:`row_sdc_bounds`, default 2 pi)."""
     from ..compare.plausibility import SDC_UPPER_BOUND
 
     pred = np.array([r["predicted"] for r in rows], dtype=float)
-    low = np.array([r["low95"] for r in rows], dtype=float)
-    high = np.array([r["high95"] for r in rows], dtype=float)
-    limit = np.full(len(rows), SDC_UPPER_BOUND) if bounds is None else np.asarray(bounds, float)
-    shown = np.minimum(high, limit)
-    # a median past the bound has no band below it: its bar ends at its point
-    return (pred, pred - np.minimum(low, pred), np.maximum(shown - pred, 0.0),
-            bool((high > limit).any()))
+    limit = np.full(len(rows), SDC_UPPER_BOUND) if bounds is None else bounds
+    below, above, cut = cut_band_bars(pred, [r["low95"] for r in rows],
+                                      [r["high95"] for r in rows], limit)
+    return pred, below, above, bool(cut.any())
 
 
 #: The legend's words for points whose band spans 0 .. the SDC bound, drawn hollow with a
-#: dashed bar (:func:`predictions_figure`).
+#: dashed bar (:func:`draw_bands`).
 UNINFORMATIVE_LABEL = "95 % band uninformative (0 .. SDC bound: cannot test the model)"
+
+
+def draw_bands(ax: Any, x, predicted, low, high, bounds, verdicts, *, label: str,
+               color: str | None = None) -> set[float]:
+    """Calibrated predictions at ``x`` with their 95 % bands as error bars, cut at their SDC
+    bounds (:func:`cut_band_bars`), as predictions.png, :meth:`~pidcore.calibrate.prediction.
+    Calibration.plot` and the report's and the app's figures draw them: a band whose verdict
+    (``verdicts``, words of :data:`pidcore.constants.BAND_VERDICTS`) is ``uninformative``
+    spans every plausible SDC, and is drawn with a hollow marker and a dashed bar under a
+    legend entry of its own (``"<label>, "`` + :data:`UNINFORMATIVE_LABEL`); drawn like the
+    others, a band that holds any measurement read as a hit. Returns the bounds a band was
+    cut at (:func:`draw_cut_bounds` draws them)."""
+    from ..constants import BAND_VERDICTS
+
+    x, pred = np.asarray(x, dtype=float), np.asarray(predicted, dtype=float)
+    bounds = np.asarray(bounds, dtype=float)
+    below, above, cut = cut_band_bars(pred, low, high, bounds)
+    apart = np.array([v == BAND_VERDICTS[3] for v in verdicts], dtype=bool)
+    for chosen, style, words in ((~apart, {"fmt": "o"}, "95 % band"),
+                                 (apart, {"fmt": "o", "mfc": "none"}, UNINFORMATIVE_LABEL)):
+        if not chosen.any():
+            continue
+        drawn = ax.errorbar(x[chosen], pred[chosen], yerr=[below[chosen], above[chosen]],
+                            capsize=3, color=color, label=f"{label}, {words}", **style)
+        if chosen is apart:
+            drawn.lines[2][0].set_linestyle("--")
+    return {float(b) for b in bounds[cut]}
+
+
+def draw_cut_bounds(ax: Any, bounds: set[float]) -> None:
+    """One dashed line per SDC bound a band was cut at (:func:`draw_bands`): a band past its
+    bound reached a value no measurement is kept at (a fill of its own has its own bound)."""
+    from ..compare.plausibility import SDC_UPPER_BOUND
+
+    for bound in sorted(bounds):
+        ax.axhline(bound, color="0.5", ls="--", lw=1,
+                   label=("2 pi" if bound == SDC_UPPER_BOUND else f"SDC bound {bound:.3g}")
+                   + ": bands cut here (model unconstrained above)")
 
 
 def predictions_figure(result: CalibrationResult) -> Any:
     """The figure of predictions.png: measured SDC per load case with the
-    posterior-predictive 95 % bands (and LOO's). A band that spans every plausible SDC
-    (:func:`~pidcore.calibrate.prediction.row_verdict` ``uninformative``) is drawn with a
-    hollow marker and a dashed bar, under a legend entry of its own (:data:`UNINFORMATIVE_LABEL`),
-    as the summary marks and counts it apart; returns the matplotlib figure (not closed)."""
+    posterior-predictive 95 % bands (and LOO's), drawn by :func:`draw_bands` (an
+    uninformative band apart, as the summary marks and counts it); returns the matplotlib
+    figure (not closed)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from ..compare.plausibility import SDC_UPPER_BOUND
-    from ..constants import BAND_VERDICTS
-
-    uninformative = BAND_VERDICTS[3]
     rows = result.predictions
     x = np.arange(len(rows))
     fig, ax = plt.subplots(figsize=(max(6, 0.7 * len(rows)), 4.5), constrained_layout=True)
-    cut_at = set()
+    cut_at: set[float] = set()
     for offset, data, label, color in ((-0.12, rows, "calibrated (all points)", "C0"),
                                        (0.12, result.loo, "leave-one-out", "C1")):
         if not data:
             continue
-        bounds = row_sdc_bounds(result, data)
-        pred, below, above, cut_here = shown_band_bars(data, bounds)
-        if cut_here:
-            cut_at.update(b for b, r in zip(bounds, data, strict=True) if r["high95"] > b)
-        # drawn like the others, a band that holds any measurement read as a hit
-        apart = np.array([v == uninformative for v in result.band_verdicts(data)], dtype=bool)
-        for chosen, style, words in ((~apart, {"fmt": "o"}, "95 % band"),
-                                     (apart, {"fmt": "o", "mfc": "none"},
-                                      UNINFORMATIVE_LABEL)):
-            if not chosen.any():
-                continue
-            drawn = ax.errorbar((x + offset)[chosen], pred[chosen],
-                                yerr=[below[chosen], above[chosen]], capsize=3, color=color,
-                                label=f"{label}, {words}", **style)
-            if chosen is apart:
-                drawn.lines[2][0].set_linestyle("--")
-    for bound in sorted(cut_at):  # a band past its bound reached a value no measurement is
-        # kept at: drawn cut there, one line per bound (a fill of its own has its own)
-        ax.axhline(bound, color="0.5", ls="--", lw=1,
-                   label=("2 pi" if bound == SDC_UPPER_BOUND else f"SDC bound {bound:.3g}")
-                   + ": bands cut here (model unconstrained above)")
+        cut_at |= draw_bands(ax, x + offset, [r["predicted"] for r in data],
+                             [r["low95"] for r in data], [r["high95"] for r in data],
+                             row_sdc_bounds(result, data), result.band_verdicts(data),
+                             label=label, color=color)
+    draw_cut_bounds(ax, cut_at)
     ax.plot(x, [r["measured"] for r in rows], "k*", ms=10, label="measured")
     ax.set_xticks(x, [f"{r['frequency_hz']:g} Hz\n{r['acceleration_g']:g} g" for r in rows],
                   fontsize=8)

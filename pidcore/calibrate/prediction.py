@@ -19,6 +19,7 @@ import pandas as pd
 from .. import defaults
 from ..compare.align import Z95, Tolerances, band_quantile, quantile_label  # noqa: F401 (public here)
 from ..compare.plausibility import SDC_UPPER_BOUND, UNKNOWN_SPECIMEN_BOUND, SdcBound
+from ..constants import BAND_VERDICTS
 from ..errors import ParameterError, instance_of, real_number
 from ..loadcase import LoadCase
 
@@ -62,6 +63,11 @@ def band_text(low: float, high: float) -> str:
     ``"0 .. 16.91"``), so that the one band reads the same in every sentence of a page;
     ``"—"`` for a bound that is not a number."""
     return " .. ".join(f"{v:.4g}" if math.isfinite(v) else "—" for v in (low, high))
+
+
+#: Column of :meth:`Calibration.to_pandas` holding each fitted measurement's verdict (words of
+#: :data:`pidcore.constants.BAND_VERDICTS`).
+VERDICT_COLUMN = f"measured in 95 % band [{'/'.join(BAND_VERDICTS)}]"
 
 
 @dataclass(frozen=True)
@@ -311,8 +317,20 @@ class Calibration:
         measurement with the fitted point's standard error), ``sdc measured [-]``,
         ``sdc measured stderr [-]``, ``low95 without stderr [-]``,
         ``high95 without stderr [-]``, ``sdc measured stderr dof [-]`` (NaN where the file
-        does not state them).
+        does not state them), ``sdc bound [-]`` (where the band is cut: :meth:`sdc_bound`)
+        and :data:`VERDICT_COLUMN` (:meth:`CalibratedPrediction.judge` of the fitted
+        measurement at that bound; ``not compared`` where none is stated): what
+        :meth:`plot` draws, so that an uninformative band is not drawn as a hit.
         """
+        specimen = self.calibrated_specimen()  # read once, not once per row
+        not_compared = BAND_VERDICTS[2]
+        rows = []
+        for p in self.predictions:
+            judged = replace(p, sdc_bound=calibrated_sdc_bound(
+                specimen, self.specimen_name, fill_percent=p.load_case.fill_percent,
+                material=p.load_case.material))
+            rows.append((judged, not_compared if math.isnan(p.measured) else judged.judge(
+                p.measured, p.measured_stderr, p.measured_stderr_dof)[0]))
         return pd.DataFrame([{
             "frequency [Hz]": p.load_case.frequency_hz,
             "acceleration [g]": p.load_case.acceleration_g,
@@ -327,7 +345,9 @@ class Calibration:
             "low95 without stderr [-]": p.low95_without_stderr,
             "high95 without stderr [-]": p.high95_without_stderr,
             "sdc measured stderr dof [-]": p.measured_stderr_dof,
-        } for p in self.predictions])
+            "sdc bound [-]": p.sdc_bound.sdc,
+            VERDICT_COLUMN: verdict,
+        } for p, verdict in rows])
 
     def plot(self, ax: Any = None) -> Any:
         """Predictions with their 95 % bands beside the measured SDCs

@@ -11,7 +11,14 @@ import sys
 from .. import interrupt
 from ..interrupt import untouched
 from ..report.render import folder_identity, format_cell
-from ..report.table import ALIGNMENT_COLUMN
+from ..report.table import (
+    ALIGNMENT_COLUMN,
+    CALIBRATED_BAND_COLUMN,
+    CALIBRATED_COLUMN,
+    CALIBRATED_INSIDE_COLUMN,
+    MEASURED_EQ11_COLUMN,
+    with_band_text,
+)
 from ._options import (
     add_load_case_options,
     add_measurement_options,
@@ -28,10 +35,9 @@ from ._vocabulary import cli_words
 #: Eq. 11 one beside the calibrated DEM's, which predicts it.
 _STDOUT_COLUMNS = (
     "frequency [Hz]", "acceleration [g]", "packing ratio [%]", "SDC DEM (ours) [-]",
-    "SDC measured, E of Eq. 10 [-]", "SDC measured [-]", "SDC calibrated DEM (Eq. 11) [-]",
-    "calibrated low 95 % [-]",
-    "calibrated high 95 % [-]", "SDC DEM (paper) [-]", "SDC measured (paper) [-]",
-    ALIGNMENT_COLUMN,
+    "SDC measured, E of Eq. 10 [-]", MEASURED_EQ11_COLUMN, CALIBRATED_COLUMN,
+    CALIBRATED_BAND_COLUMN, CALIBRATED_INSIDE_COLUMN, "SDC DEM (paper) [-]",
+    "SDC measured (paper) [-]", ALIGNMENT_COLUMN,
 )
 
 
@@ -140,11 +146,14 @@ def run(args: argparse.Namespace) -> int:
 
 
 def short_table(table) -> str:
-    """A fixed-width text table of the main columns."""
+    """A fixed-width text table of the main columns (the calibrated band in one cell, as
+    :func:`~pidcore.report.table.with_band_text` writes it, and its verdict: an
+    ``uninformative`` band showed as two numbers without a word)."""
+    table = with_band_text(table)
     cols = [c for c in _STDOUT_COLUMNS if c in table.columns]
     short = {ALIGNMENT_COLUMN: "alignment",
              "SDC measured, E of Eq. 10 [-]": "SDC measured (Eq. 10) [-]",
-             "SDC measured [-]": "SDC measured (Eq. 11) [-]"}
+             CALIBRATED_INSIDE_COLUMN: "measured in calibrated 95 % band"}
     heads = [short.get(c, c) for c in cols]
     rows = [[format_cell(v) for v in row] for row in table.loc[:, cols].itertuples(index=False)]
     widths = [max([len(h), *(len(r[i]) for r in rows)]) for i, h in enumerate(heads)]

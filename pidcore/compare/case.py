@@ -248,6 +248,9 @@ class MeasuredEntry:
         file (``specimen_sha256`` is then that file's), or kept apart since the name means
         several files, the note saying so (:func:`pidcore.app.workbench.matched_specimens`);
         empty otherwise.
+    bound_note : str
+        Where the SDC bound stored with a saved record is not one and was ignored (judged at
+        2 pi), the note saying so; empty otherwise.
     """
 
     key: str
@@ -276,6 +279,8 @@ class MeasuredEntry:
     #: how a record saved without its file's hash met its specimen's file (joined by name to
     #: the one file of that name, or kept apart: pidcore.specimen.match_hashless_records)
     specimen_note: str = ""
+    #: the note of :func:`pidcore.compare.plausibility.stored_sdc_bound_and_note`, else ""
+    bound_note: str = ""
 
     @classmethod
     def from_record(cls, record, load_case: LoadCase, *,
@@ -318,7 +323,7 @@ class MeasuredEntry:
         from ..specimen import MEASURED_SHA256_FIELD, measured_specimen_name
         from ..specimen import measured_specimen_sha256 as tested_sha256
         from .align import _row_case
-        from .plausibility import stored_findings
+        from .plausibility import stored_findings, stored_sdc_bound_and_note
 
         empty = np.empty(0)
         named = row.get("specimen", "")
@@ -327,7 +332,8 @@ class MeasuredEntry:
         given = next((s for s in known if isinstance(named, str) and named
                       and measured_specimen_name(s) == named
                       and (not sha256 or tested_sha256(s) == sha256)), None)
-        found, _ = stored_findings(row, given=given)
+        bound, bound_note = stored_sdc_bound_and_note(row, given=given)
+        found, _ = stored_findings(row, bound=bound)
         settings = saved_parameters(row.get("parameters_json"))
         return cls(str(row["key"]), Path(str(row.get("source", ""))).name, "store",
                    _row_case(row), float(row["frequency_hz"]),
@@ -341,7 +347,8 @@ class MeasuredEntry:
                    describe_corrections(settings),
                    str(row.get("measurement_key", "") or ""),
                    found[0].message if found else "", settings,
-                   stored_stderr_dof(row.get("sdc_stderr_dof")), _specimen_sha256_of(row))
+                   stored_stderr_dof(row.get("sdc_stderr_dof")), _specimen_sha256_of(row),
+                   bound_note=bound_note)
 
     def loop(self):
         """The measured loop (:class:`pidcore.loop.ForceDisplacementLoop`, labelled

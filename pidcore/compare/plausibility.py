@@ -440,6 +440,18 @@ def recorded_sdc_bound(record: Mapping[str, Any]) -> tuple[SdcBound | None, str]
     return SdcBound(sdc, particles, structure, origin=RECORDED_BOUND_ORIGIN), ""
 
 
+def stored_record_name(record: Mapping[str, Any]) -> str:
+    """How a note names a stored analysis (a row of :meth:`pidcore.store.Store.
+    list_analyses`): its file's name, printable (:func:`pidcore.io.display_path`), else its
+    key. ``report --store``, ``calibrate --store`` and the app's Compare page head the note of
+    a stored bound ignored (:func:`stored_sdc_bound_and_note`) with it."""
+    from pathlib import Path
+
+    from ..io import display_path
+
+    return display_path(Path(str(record.get("source", "") or record.get("key", ""))).name)
+
+
 def stored_sdc_bound_and_note(record: Any, *, given: Specimen | None = None
                               ) -> tuple[SdcBound, str]:
     """:func:`stored_sdc_bound` and the note of a stored bound ignored

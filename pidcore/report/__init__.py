@@ -16,6 +16,8 @@ analyze_files, MeasuredResult
     Files analysed with their load cases (the first step of a report).
 build_report_table, REPORT_COLUMNS, ALIGNMENT_COLUMN
     The Table 3-style comparison (a pandas frame whose columns name their units).
+REPORT_COLUMNS_RENAMED
+    Old column name -> new, for a report.csv of an earlier pidcore.
 write_report, parse_formats, RENDERERS, REPORT_MARKER
     The report files (CSV, Markdown, HTML, LaTeX, PDF).
 collect_provenance, Provenance, sha256_file
@@ -27,10 +29,11 @@ open_verified_store
 from .pipeline import MeasuredResult, ReportResult, analyze_files, make_report, open_verified_store
 from .provenance import Provenance, collect_provenance, sha256_file
 from .render import RENDERERS, REPORT_MARKER, parse_formats, write_report
-from .table import ALIGNMENT_COLUMN, REPORT_COLUMNS, build_report_table
+from .table import ALIGNMENT_COLUMN, REPORT_COLUMNS, REPORT_COLUMNS_RENAMED, build_report_table
 
 __all__ = [
-    "ALIGNMENT_COLUMN", "RENDERERS", "REPORT_COLUMNS", "REPORT_MARKER", "MeasuredResult",
+    "ALIGNMENT_COLUMN", "RENDERERS", "REPORT_COLUMNS", "REPORT_COLUMNS_RENAMED", "REPORT_MARKER",
+    "MeasuredResult",
     "Provenance", "ReportResult", "analyze_files", "build_report_table", "collect_provenance",
     "make_report", "open_verified_store", "parse_formats", "sha256_file", "write_report",
 ]

@@ -19,7 +19,12 @@ import pandas as pd
 
 from .. import defaults
 from ..loop import ForceDisplacementLoop
-from .table import ALIGNMENT_COLUMN, MEASURED_EQ10_COLUMN
+from .table import (
+    ALIGNMENT_COLUMN,
+    MEASURED_EQ10_COLUMN,
+    MEASURED_EQ11_COLUMN,
+    MEASURED_EQ11_STDERR_COLUMN,
+)
 
 #: Force arrays looked for in a DEM run, in order: the force a shaker's gauge would measure
 #: (coupon inertia + particles, :class:`pidcore.dem.result.DemResult`), comparable with a
@@ -43,7 +48,7 @@ SDC_FIGURE_ROWS_PER_PANEL = 16
 #: Table columns the SDC-per-load-case figure draws: a row with a finite value in any is drawn.
 _DRAWN_COLUMNS: tuple[str, ...] = (MEASURED_EQ10_COLUMN, "SDC DEM (ours) [-]",
                                    "SDC DEM (paper) [-]", "SDC measured (paper) [-]",
-                                   "SDC measured [-]")
+                                   MEASURED_EQ11_COLUMN)
 
 
 def plot_sdc_comparison(table: pd.DataFrame, *, ax=None):
@@ -111,8 +116,8 @@ def _draw_sdc_rows(ax, rows: pd.DataFrame, several_materials: bool) -> None:
               f"{r['packing ratio [%]']:.3g} %"
               + (f"\n{r['material']}" if several_materials else "")
               for _, r in rows.iterrows()]
-    sdc11 = rows["SDC measured [-]"].astype(float).to_numpy()
-    sdc11_se = rows["SDC measured stderr [-]"].astype(float).to_numpy()
+    sdc11 = rows[MEASURED_EQ11_COLUMN].astype(float).to_numpy()
+    sdc11_se = rows[MEASURED_EQ11_STDERR_COLUMN].astype(float).to_numpy()
     sdc10 = rows[MEASURED_EQ10_COLUMN].astype(float).to_numpy()
     with np.errstate(divide="ignore", invalid="ignore"):
         sdc10_se = sdc11_se * sdc10 / sdc11

@@ -110,21 +110,29 @@ def plot_dem_run(result: DemResult, *, ax: Any = None) -> Any:
 
 
 def plot_calibration(frame: pd.DataFrame, *, ax: Any = None) -> Any:
-    """Calibrated predictions (points, 95 % band as error bars) and the measured SDCs they
-    were fitted to (crosses), one position per load case. Returns ``ax``.
+    """Calibrated predictions (points, 95 % band as error bars, cut at each case's SDC bound)
+    and the measured SDCs they were fitted to (crosses), one position per load case. A band
+    that spans every plausible SDC (verdict ``uninformative``) is drawn hollow and dashed
+    under a legend entry of its own, as predictions.png draws it
+    (:func:`pidcore.calibrate.outputs.draw_bands`). Returns ``ax``.
 
-    ``frame`` is :meth:`pidcore.calibrate.Calibration.to_pandas`.
+    ``frame`` is :meth:`pidcore.calibrate.Calibration.to_pandas` (a frame without its
+    ``sdc bound [-]`` and verdict columns is cut at 2 pi and judged by nothing).
     """
     import matplotlib.pyplot as plt
+
+    from ..calibrate.outputs import draw_bands, draw_cut_bounds
+    from ..calibrate.prediction import VERDICT_COLUMN
+    from ..compare.plausibility import SDC_UPPER_BOUND
 
     if ax is None:
         _, ax = plt.subplots(figsize=(max(6.0, 0.5 * len(frame)), 4.0), constrained_layout=True)
     x = np.arange(len(frame))
-    sdc = frame["sdc predicted [-]"].to_numpy(float)
-    below = sdc - frame["low95 [-]"].to_numpy(float)
-    above = frame["high95 [-]"].to_numpy(float) - sdc
-    ax.errorbar(x, sdc, yerr=[below, above], fmt="o", capsize=3,
-                label="calibrated DEM (95 % band)")
+    bounds = frame.get("sdc bound [-]", pd.Series(SDC_UPPER_BOUND, index=frame.index))
+    verdicts = frame.get(VERDICT_COLUMN, pd.Series("", index=frame.index))
+    draw_cut_bounds(ax, draw_bands(ax, x, frame["sdc predicted [-]"], frame["low95 [-]"],
+                                   frame["high95 [-]"], bounds, verdicts,
+                                   label="calibrated DEM", color="C0"))
     ax.plot(x, frame["sdc measured [-]"].to_numpy(float), "x", color="k", label="measured")
     ax.set_xticks(x)
     ax.set_xticklabels([f"{f:g} Hz, {a:g} g, {p:g} %" for f, a, p in zip(

@@ -808,6 +808,7 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         plausibility_notes,
         stated_sdc_bounds,
         stored_plausibility_notes,
+        stored_record_name,
     )
     from ..file_settings import assumed, files_assumption_notes, stored_assumption_notes
 
@@ -874,8 +875,7 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         notes.extend(stored_assumption_notes(analyses))
         # a stored result kept as implausible is said again here, as when it was saved
         for _, record in analyses.iterrows():
-            name = Path(str(record.get("source", "") or record["key"])).name
-            notes.extend(f"{display_path(name)}: "
+            notes.extend(f"{stored_record_name(record)}: "
                          f"{n}" for n in stored_plausibility_notes(record, given=specimen))
         if not listed.empty:
             left_out = listed["measurement_key"].nunique() - analyses["measurement_key"].nunique()

@@ -33,10 +33,13 @@ from ..io import display_path
 from .provenance import Provenance
 from .table import (
     ALIGNMENT_COLUMN,
+    CALIBRATED_BAND_COLUMN,
     CALIBRATED_COLUMN,
     CALIBRATED_INSIDE_COLUMN,
     DIFFERENCE_COLUMN,
     MEASURED_EQ10_COLUMN,
+    MEASURED_EQ11_COLUMN,
+    MEASURED_EQ11_STDERR_COLUMN,
 )
 
 #: File written into every report folder; only folders holding it are ever replaced.
@@ -49,14 +52,13 @@ REPORT_STEM = "report"
 #: the calibrated columns only where the table has them.
 PDF_COLUMNS: tuple[str, ...] = (
     "frequency [Hz]", "acceleration [g]", "packing ratio [%]", "SDC DEM (ours) [-]",
-    "SDC DEM stderr [-]", MEASURED_EQ10_COLUMN, DIFFERENCE_COLUMN, "SDC measured [-]",
-    "SDC measured stderr [-]", CALIBRATED_COLUMN, CALIBRATED_INSIDE_COLUMN,
+    "SDC DEM stderr [-]", MEASURED_EQ10_COLUMN, DIFFERENCE_COLUMN, MEASURED_EQ11_COLUMN,
+    MEASURED_EQ11_STDERR_COLUMN, CALIBRATED_COLUMN, CALIBRATED_BAND_COLUMN,
+    CALIBRATED_INSIDE_COLUMN,
     "SDC DEM (paper) [-]", "SDC measured (paper) [-]", ALIGNMENT_COLUMN,
 )
 #: The PDF's header of a column whose name alone does not say which SDC it is.
-PDF_LABELS: dict[str, str] = {"SDC measured [-]": "SDC measured (Eq. 11) [-]",
-                              "SDC measured stderr [-]": "SDC measured (Eq. 11) stderr [-]",
-                              CALIBRATED_INSIDE_COLUMN: "measured in calibrated 95 % band"}
+PDF_LABELS: dict[str, str] = {CALIBRATED_INSIDE_COLUMN: "measured in calibrated 95 % band"}
 _TITLE = "Specific damping capacity: our DEM, our measurements and the paper (Table 3)"
 
 
@@ -212,7 +214,11 @@ def _write_tex(table: pd.DataFrame, figures: Mapping[str, Path], prov: Provenanc
 
 def pdf_table_cells(table: pd.DataFrame) -> tuple[list[str], list[list[str]]]:
     """The PDF table's header labels (wrapped) and its rows' display text, of the
-    :data:`PDF_COLUMNS` the table has."""
+    :data:`PDF_COLUMNS` the table has (the calibrated band in one cell, as
+    :func:`~pidcore.report.table.with_band_text` writes it)."""
+    from .table import with_band_text
+
+    table = with_band_text(table)
     cols = [c for c in PDF_COLUMNS if c in table.columns]
     labels = ["\n".join(textwrap.wrap(PDF_LABELS.get(c, c.split(" [grid/")[0]), 12))
               for c in cols]
@@ -238,7 +244,7 @@ def _write_pdf(table: pd.DataFrame, figures: Mapping[str, Path], prov: Provenanc
             tab.auto_set_font_size(False)
             tab.set_fontsize(6.5)
             tab.scale(1.0, 1.3)
-            # up to 14 columns on A4: each as wide as its widest text, none cut at its edge
+            # up to 15 columns on A4: each as wide as its widest text, none cut at its edge
             tab.auto_set_column_width(list(range(len(labels))))
             lines = max(label.count("\n") + 1 for label in labels)
             for (row, _), cell in tab.get_celld().items():

@@ -67,6 +67,22 @@ DIFFERENCE_COLUMN = "difference measured (E of Eq. 10) - ours [-]"
 #: Chi-square per degree of freedom of the pooled measurements about their mean (~1: they agree
 #: within their errors; NaN for a single measurement).
 CONSISTENCY_COLUMN = "measured chi2/dof [-]"
+#: The measured Eq. 11 SDC (Im(P_c)/w as the energy), its standard error and that error's
+#: degrees of freedom: the SDC the calibrated DEM predicts, not the like-for-like counterpart
+#: of our DEM's (:data:`MEASURED_EQ10_COLUMN`). Named "SDC measured [-]" before: beside
+#: "SDC DEM (ours) [-]" in the HTML, Markdown and LaTeX files a reader compared 1.139 with
+#: 0.6054 (a factor 2) where the like-for-like 0.624 agrees, and the PDF and the terminal
+#: called the one column "SDC measured (Eq. 11) [-]".
+MEASURED_EQ11_COLUMN = "SDC measured (Eq. 11) [-]"
+MEASURED_EQ11_STDERR_COLUMN = "SDC measured (Eq. 11) stderr [-]"
+MEASURED_EQ11_DOF_COLUMN = "SDC measured (Eq. 11) stderr dof [-]"
+#: Report columns renamed: old name -> new name, for scripts reading a report.csv of an earlier
+#: pidcore (``pd.read_csv(path).rename(columns=REPORT_COLUMNS_RENAMED)``).
+REPORT_COLUMNS_RENAMED: dict[str, str] = {
+    "SDC measured [-]": MEASURED_EQ11_COLUMN,
+    "SDC measured stderr [-]": MEASURED_EQ11_STDERR_COLUMN,
+    "SDC measured stderr dof [-]": MEASURED_EQ11_DOF_COLUMN,
+}
 #: Column holding the alignment status; the header lists its values,
 #: :data:`pidcore.compare.ALIGNMENT_STATUSES`.
 ALIGNMENT_COLUMN = f"alignment [{'/'.join(ALIGNMENT_STATUSES)}]"
@@ -79,8 +95,8 @@ SPECIMEN_SHA256_COLUMN = "specimen sha256"
 REPORT_COLUMNS: tuple[str, ...] = (
     "frequency [Hz]", "acceleration [g]", "packing ratio [%]", "material", "direction",
     "particles per cell [-]", "DEM runs [-]", "SDC DEM (ours) [-]", "SDC DEM stderr [-]",
-    "measured frequency [Hz]", "measured acceleration [g]", "SDC measured [-]",
-    "SDC measured stderr [-]", "SDC measured stderr dof [-]", MEASURED_EQ10_COLUMN,
+    "measured frequency [Hz]", "measured acceleration [g]", MEASURED_EQ11_COLUMN,
+    MEASURED_EQ11_STDERR_COLUMN, MEASURED_EQ11_DOF_COLUMN, MEASURED_EQ10_COLUMN,
     "SDC DEM (paper) [-]",
     "SDC measured (paper) [-]",
     "difference ours - paper DEM [-]", DIFFERENCE_COLUMN, CONSISTENCY_COLUMN, ALIGNMENT_COLUMN,
@@ -500,9 +516,9 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
             "SDC DEM stderr [-]": row.sdc_dem_stderr,
             "measured frequency [Hz]": f_m,
             "measured acceleration [g]": a_m,
-            "SDC measured [-]": sdc_m,
-            "SDC measured stderr [-]": sdc_m_se,
-            "SDC measured stderr dof [-]": sdc_m_dof,
+            MEASURED_EQ11_COLUMN: sdc_m,
+            MEASURED_EQ11_STDERR_COLUMN: sdc_m_se,
+            MEASURED_EQ11_DOF_COLUMN: sdc_m_dof,
             MEASURED_EQ10_COLUMN: sdc_m10,
             "SDC DEM (paper) [-]": row.paper_dem,
             "SDC measured (paper) [-]": row.paper_exp,
@@ -628,7 +644,7 @@ def _sort_like_table3(table: pd.DataFrame, aligner: Aligner, paper: pd.DataFrame
 #: for such a row.
 IMPLAUSIBLE_ROW_NOTE = "includes a result no passive coupon gives, kept as accepted: "
 
-#: Columns added by :func:`add_calibration_columns` (after "SDC measured [-]").
+#: Columns added by :func:`add_calibration_columns` (after :data:`MEASURED_EQ11_COLUMN`).
 CALIBRATED_COLUMN = "SDC calibrated DEM (Eq. 11) [-]"
 CALIBRATED_LOW_COLUMN = "calibrated low 95 % [-]"
 CALIBRATED_HIGH_COLUMN = "calibrated high 95 % [-]"
@@ -640,6 +656,34 @@ INSIDE, OUTSIDE, NOT_COMPARED, UNINFORMATIVE = BAND_VERDICTS
 CALIBRATED_INSIDE_COLUMN = f"measured in calibrated 95 % band [{'/'.join(BAND_VERDICTS)}]"
 CALIBRATION_COLUMNS: tuple[str, ...] = (CALIBRATED_COLUMN, CALIBRATED_LOW_COLUMN,
                                         CALIBRATED_HIGH_COLUMN, CALIBRATED_INSIDE_COLUMN)
+#: The one column a page shows the calibrated band in (:func:`with_band_text`): the terminal's
+#: table, the PDF's and the app's Report tab; the CSV, Markdown, HTML and LaTeX files keep
+#: its two numbers (:data:`CALIBRATED_LOW_COLUMN`, :data:`CALIBRATED_HIGH_COLUMN`).
+CALIBRATED_BAND_COLUMN = "calibrated 95 % band [-]"
+
+
+def with_band_text(table: pd.DataFrame) -> pd.DataFrame:
+    """A copy of a report table for display, its calibrated low and high 95 % columns
+    replaced by one :data:`CALIBRATED_BAND_COLUMN` as
+    :func:`~pidcore.calibrate.prediction.band_text` writes a band (``"0 .. 16.91"``, as the
+    row's note and the app's Compare page write it; empty where no band), in the place of
+    the low column; the table unchanged where it has no such columns. The app's grid showed
+    the two numbers with its own 4 decimals (``0.0000``, ``16.9115``) beside a note saying
+    ``0 .. 16.91``."""
+    from ..calibrate.prediction import band_text
+
+    if not {CALIBRATED_LOW_COLUMN, CALIBRATED_HIGH_COLUMN} <= set(table.columns):
+        return table
+    texts = ["" if math.isnan(low) and math.isnan(high) else band_text(low, high)
+             for low, high in zip(table[CALIBRATED_LOW_COLUMN].map(_finite_or_nan),
+                                  table[CALIBRATED_HIGH_COLUMN].map(_finite_or_nan),
+                                  strict=True)]
+    out = table.drop(columns=[CALIBRATED_HIGH_COLUMN])
+    at = list(out.columns).index(CALIBRATED_LOW_COLUMN)
+    out = out.drop(columns=[CALIBRATED_LOW_COLUMN])
+    out.insert(at, CALIBRATED_BAND_COLUMN, texts)
+    out.attrs = dict(table.attrs)
+    return out
 
 
 def _finite_or_nan(value) -> float:
@@ -656,7 +700,7 @@ def add_calibration_columns(table: pd.DataFrame, calibration, *,
     """A copy of a report table with the calibrated DEM's prediction beside each row.
 
     Like for like: the calibration predicts the Eq. 11 SDC a shaker test of the DEM would
-    measure, so the band is compared with ``SDC measured [-]`` (Eq. 11), not with Eq. 10.
+    measure, so the band is compared with ``SDC measured (Eq. 11) [-]``, not with Eq. 10.
     Rows whose load case the calibration does not predict (material, and frequency,
     acceleration, fill within ``tolerances``) get empty numbers, ``not compared`` and a note
     saying so and why (another specimen:
@@ -714,10 +758,10 @@ def add_calibration_columns(table: pd.DataFrame, calibration, *,
             why = other or calibration.why_not_predicted(case, tolerances=tolerances)
             extra = f"not predicted by the calibration {calibration.path.name}: {why}"
         else:
-            measured = _finite_or_nan(row.get("SDC measured [-]"))
-            stderr = _finite_or_nan(row.get("SDC measured stderr [-]"))
+            measured = _finite_or_nan(row.get(MEASURED_EQ11_COLUMN))
+            stderr = _finite_or_nan(row.get(MEASURED_EQ11_STDERR_COLUMN))
             # a table of an older pidcore has no such column: unknown, the normal's quantile
-            dof = _finite_or_nan(row.get("SDC measured stderr dof [-]"))
+            dof = _finite_or_nan(row.get(MEASURED_EQ11_DOF_COLUMN))
             # the band of a measurement with this row's own standard error (not the fitted
             # point's, unless it is that measurement)
             extra = ""
@@ -757,8 +801,8 @@ def add_calibration_columns(table: pd.DataFrame, calibration, *,
                 if uninformative:
                     extra = "; ".join(n for n in (uninformative, extra) if n)  # verdict first
         notes.append("; ".join(n for n in (note, extra, cut) if n))
-    at = list(out.columns).index("SDC measured [-]") + 1 if "SDC measured [-]" in out.columns \
-        else len(out.columns)
+    at = list(out.columns).index(MEASURED_EQ11_COLUMN) + 1 \
+        if MEASURED_EQ11_COLUMN in out.columns else len(out.columns)
     for offset, (name, values) in enumerate(zip(CALIBRATION_COLUMNS, (sdc, low, high, inside),
                                                 strict=True)):
         out.insert(at + offset, name, values)
