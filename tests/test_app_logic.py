@@ -387,6 +387,35 @@ def test_a_load_case_address_names_its_case_when_files_are_saved_to_it_later(goo
                            "(7 file(s))", entries, groups) == 4
 
 
+def test_a_load_case_keeps_its_name_when_a_later_file_is_saved_to_it(good_csv, options):
+    # the store lists its newest records first, and the first record named the case: a file
+    # saved later at 500.5 Hz renamed "500 Hz, 5 g, ..." to "500.5 Hz, 5 g, ..." (and wrote
+    # another page address)
+    from dataclasses import replace
+
+    from pidcore.app.workbench import case_address, group_entries, group_name
+    from pidcore.compare.case import LoadCase
+
+    one = _entry(_record(good_csv, options))
+
+    def saved(f, when, key):
+        return replace(one, key=key, created_utc=when, origin="store",
+                       load_case=LoadCase(f, 5.0, 50.0, "acrylic", "z"))
+
+    first = [saved(500.0, "2026-11-30T10:00:00Z", "a")]
+    later = [saved(500.5, "2026-12-01T09:00:00Z", "b"), *first]  # as the store lists them
+    unsaved = replace(one, key="upload:x", created_utc="",
+                      load_case=LoadCase(499.6, 5.0, 50.0, "acrylic", "z"))
+    for entries in (first, later, [unsaved, *later], [*later, unsaved]):
+        (group,) = group_entries(entries)
+        assert group_name(entries, group) == "500 Hz, 5 g, 50 %, acrylic, z"
+        assert case_address(entries, group) == "f500Hz_a5g_fill50pct_acrylic_z"
+    # unsaved records only: the first of them, as before
+    (group,) = group_entries([unsaved, replace(unsaved, key="upload:y")])
+    assert group_name([unsaved], [0]) == "499.6 Hz, 5 g, 50 %, acrylic, z"
+    assert len(group) == 2
+
+
 def test_measured_loop_area_is_the_dissipated_energy(good_csv, options):
     from _app_samples import MASS_KG, damper_for
 

@@ -103,9 +103,18 @@ def group_name(entries: Sequence[MeasuredEntry], group: Sequence[int]) -> str:
     """
     from ..specimen import tested_label
 
-    e = entries[group[0]]
+    e = _naming_entry(entries, group)
     specimen = f", specimen {tested_label(e.specimen, e.specimen_sha256)}" if e.specimen else ""
     return f"{e.load_case.full_label()}{specimen}"
+
+
+def _naming_entry(entries: Sequence[MeasuredEntry], group: Sequence[int]) -> MeasuredEntry:
+    """The record whose load case names the group: its first saved, then the unsaved ones in
+    their order. The store lists its newest records first, so the group's first record was
+    the latest saved, and a file saved to the case renamed it ("500 Hz" to "500.5 Hz")."""
+    order = sorted(range(len(group)), key=lambda n: (not entries[group[n]].created_utc,
+                                                     entries[group[n]].created_utc, n))
+    return entries[group[order[0]]]
 
 
 #: The file count the Compare page's load-case labels end with, e.g. " (2 file(s))".
@@ -113,16 +122,16 @@ _FILE_COUNT = re.compile(r" \(\d+ file\(s\)\)$")
 
 
 def case_address(entries: Sequence[MeasuredEntry], group: Sequence[int]) -> str:
-    """The group's load case as the page address names it: the store's load-case key of its
-    first record, then its specimen as labels name it (name and start of its hash,
-    :func:`pidcore.specimen.tested_label`) where one is named, e.g.
+    """The group's load case as the page address names it: the store's load-case key of the
+    record that names it (:func:`group_name`'s), then its specimen as labels name it (name
+    and start of its hash, :func:`pidcore.specimen.tested_label`) where one is named, e.g.
     ``'f500Hz_a4.99967g_fill50pct_acrylic_z steel_6mm [3e945a]'``.
 
     Not the label shown, which counts the group's files: a file saved to the group later
     made that address name nothing. :func:`case_at_address` reads it back."""
     from ..specimen import tested_label
 
-    e = entries[group[0]]
+    e = _naming_entry(entries, group)
     specimen = tested_label(e.specimen, e.specimen_sha256)
     return f"{e.load_case.key} {specimen}" if specimen else e.load_case.key
 
