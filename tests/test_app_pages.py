@@ -378,6 +378,14 @@ def test_a_file_saved_later_keeps_the_compare_address_and_its_filters(store_file
         "file: 'gone.csv' (from the page address) is not one of hi_fill50.csv, "
         "later_fill50.csv, lo_fill50.csv, mid_fill50.csv; hi_fill50.csv is chosen instead"]
     assert refused.selectbox(key="compare_case").value == hi
+    # the session's unsaved analyses left out stay left out; a word the box cannot hold is
+    # refused as the other tabs' boxes refuse it
+    assert _app_at({"include_session": "false"}).checkbox(key="include_session").value is False
+    maybe = _app_at({"include_session": "maybe"})
+    assert maybe.checkbox(key="include_session").value is True
+    assert [e.value for e in maybe.error] == [
+        "include this session's unsaved analyses: 'maybe' (from the page address) is not one "
+        "of true, false; true is chosen instead"]
 
 
 def test_an_identical_file_under_another_name_is_compared_once(store_file):
