@@ -142,8 +142,9 @@ def case_at_address(address: str, entries: Sequence[MeasuredEntry],
     :func:`case_address` wrote ``address`` for, or None where no group is that case any more.
 
     The case is met within the Compare tolerances (:class:`pidcore.compare.align.Tolerances`,
-    the nearest group of its specimen where several are): a record saved later may become a
-    group's first, whose measured frequency and acceleration differ in the last digits. The
+    the nearest group of its specimen where several are): the record that names a group may
+    be another one by now (its first saved, re-saved since), whose measured frequency and
+    acceleration differ in the last digits, and a hand-typed ``f500Hz_a5g...`` meets it. The
     label an older pidcore wrote there (:func:`group_name` and a file count) is read too,
     whatever the count."""
     from ..compare.align import Tolerances

@@ -111,8 +111,8 @@ def address_choice(key: str, label: str, options: Mapping[str, str],
             refusals = st.session_state.setdefault(_ADDRESS_REFUSALS, {})
             refusals[key] = (_address_refusal(label, [stated], offered, options[current]),
                              current)
-    # set before the box is drawn: the box then opens on it (the name it held may have
-    # changed when a record saved later became its group's first)
+    # set before the box is drawn: the box then opens on it (what ``resolve`` found may be
+    # spelled otherwise than the address or the last run held it)
     st.session_state[key] = current
     _say_address_refusal(key)
     choice = st.selectbox(label, names, format_func=options.__getitem__, key=key)
