@@ -564,9 +564,20 @@ def _shown_choice(page, label: str) -> str:
                                        for i in range(box.locator("input").count()))
 
 
-def _choose(page, label: str, option: str) -> None:
-    page.get_by_role("combobox", name=label).click()
-    page.get_by_role("option", name=option).first.click()
+def _choose(page, label: str, option: str, tries: int = 6) -> None:
+    """Choose ``option`` of the box ``label``; again where the page's script run, still going
+    after the last choice, drew the box anew and closed its list (seen under load)."""
+    from playwright.sync_api import TimeoutError as PlaywrightTimeout
+
+    for attempt in range(tries):
+        page.get_by_role("combobox", name=label).click()
+        try:
+            page.get_by_role("option", name=option).first.click(timeout=10_000)
+            break
+        except PlaywrightTimeout:
+            if attempt == tries - 1:
+                raise
+            page.keyboard.press("Escape")
     page.keyboard.press("Escape")  # a multiselect stays open after a choice
 
 
