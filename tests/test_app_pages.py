@@ -304,6 +304,9 @@ def test_the_chosen_load_case_comes_back_after_a_reload(store_file):
     reloaded = _app_at({"compare_case": chosen})
     assert reloaded.selectbox(key="compare_case").value == chosen
     assert not reloaded.error
+    # a run that changes nothing sends the box no new value (the address's choice was set
+    # anew on every run, and the browser redrew the box each time)
+    assert not reloaded.run().selectbox(key="compare_case").proto.set_value
     measured = next(d.value for d in reloaded.dataframe if "origin" in d.value.columns)
     assert set(measured["file"]) == {"hi_fill50.csv" if chosen.startswith("f500Hz")
                                      else "lo_fill50.csv"}

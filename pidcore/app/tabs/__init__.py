@@ -112,8 +112,10 @@ def address_choice(key: str, label: str, options: Mapping[str, str],
             refusals[key] = (_address_refusal(label, [stated], offered, options[current]),
                              current)
     # set before the box is drawn: the box then opens on it (what ``resolve`` found may be
-    # spelled otherwise than the address or the last run held it)
-    st.session_state[key] = current
+    # spelled otherwise than the address or the last run held it); only when it changes: a
+    # value set this way is sent to the browser as a new value, which redraws the box
+    if fresh or st.session_state[key] != current:
+        st.session_state[key] = current
     _say_address_refusal(key)
     choice = st.selectbox(label, names, format_func=options.__getitem__, key=key)
     if st.query_params.get(key) != choice:
