@@ -13,6 +13,7 @@ import re
 import socket
 import subprocess
 import time
+import urllib.parse
 import urllib.request
 from pathlib import Path
 
@@ -553,3 +554,92 @@ def test_a_reload_keeps_an_uploaded_specimen_file(app_url, browser_page):
     page.get_by_text("not an uploaded specimen file this app keeps").wait_for(
         timeout=RESULT_TIMEOUT_MS)
     assert not page.get_by_role("button", name="Run", exact=True).is_enabled()
+
+
+def _shown_choice(page, label: str) -> str:
+    """What the select box or multiselect ``label`` shows (its chips and typed value)."""
+    box = page.locator('[data-testid="stSelectbox"], [data-testid="stMultiSelect"]').filter(
+        has=page.get_by_text(label, exact=True)).first
+    return box.inner_text() + " ".join(box.locator("input").nth(i).input_value()
+                                       for i in range(box.locator("input").count()))
+
+
+def _choose(page, label: str, option: str, tries: int = 6) -> None:
+    """Choose ``option`` of the box ``label``; again where the page's script run, still going
+    after the last choice, drew the box anew and closed its list (seen under load)."""
+    from playwright.sync_api import TimeoutError as PlaywrightTimeout
+
+    for attempt in range(tries):
+        page.get_by_role("combobox", name=label).click()
+        try:
+            page.get_by_role("option", name=option).first.click(timeout=10_000)
+            break
+        except PlaywrightTimeout:
+            if attempt == tries - 1:
+                raise
+            page.keyboard.press("Escape")
+    page.keyboard.press("Escape")  # a multiselect stays open after a choice
+
+
+def test_a_reload_keeps_the_compare_case_and_filters_when_a_file_is_saved_between(
+        tmp_path, browser_page):
+    # a reload lost the Compare filters (not in the page address), and the chosen case was
+    # kept by its label "... (1 file(s))": a file of that case saved from the CLI in
+    # between made the reload refuse a case the store still held
+    from pidcore.cli import main
+
+    store = tmp_path / "compare_store.h5"
+    for name, frequency in (("hi_fill50.csv", 500.0), ("lo_fill50.csv", 50.0),
+                            ("mid_fill50.csv", 200.0)):
+        (tmp_path / name).write_bytes(mass_damper_csv(frequency_hz=frequency))
+        assert main(["analyze", str(tmp_path / name), "--store", str(store),
+                     "--no-progress"]) == 0
+    proc, log, url = _serve(tmp_path, store)  # its own store: this test saves into it
+    try:
+        page = browser_page
+        _open(page, url)
+        page.get_by_role("tab", name="Compare").click()
+        page.get_by_role("heading").filter(has_text="measured").first.wait_for(
+            timeout=RESULT_TIMEOUT_MS)
+        _choose(page, "file", "hi_fill50.csv")
+        page.wait_for_function("() => location.search.includes('filter_file=hi_fill50.csv')",
+                               timeout=RESULT_TIMEOUT_MS)
+        _choose(page, "file", "lo_fill50.csv")
+        page.wait_for_function("() => location.search.includes('filter_file=lo_fill50.csv')",
+                               timeout=RESULT_TIMEOUT_MS)
+        _choose(page, "load case", "500 Hz, 5 g, 50 %, acrylic, z (1 file(s))")
+        page.wait_for_function("() => location.search.includes('compare_case=f500Hz_a')",
+                               timeout=RESULT_TIMEOUT_MS)
+        # another file of the 500 Hz case (0.1 % off: one case within the tolerances)
+        later = tmp_path / "later_fill50.csv"
+        later.write_bytes(mass_damper_csv(frequency_hz=500.5, seed=11))
+        assert main(["analyze", str(later), "--store", str(store), "--no-progress"]) == 0
+        address = page.url
+        case_only = f"{url}/?" + urllib.parse.urlencode(  # the address without the filters
+            {"compare_case": urllib.parse.parse_qs(urllib.parse.urlsplit(address).query)[
+                "compare_case"][0]})
+        for filtered in (True, False):
+            page.reload() if filtered else page.goto(case_only)
+            page.locator("input[type=file]").first.wait_for(state="attached",
+                                                            timeout=RESULT_TIMEOUT_MS)
+            page.get_by_role("tab", name="Compare").click()
+            page.get_by_role("heading").filter(has_text="measured").first.wait_for(
+                timeout=RESULT_TIMEOUT_MS)
+            panel = page.locator('[role="tabpanel"]:visible')
+            assert not panel.locator('[data-testid="stAlertContentError"]').count(), \
+                panel.inner_text()[:2000]
+            body = page.locator("body").inner_text()
+            assert not re.search(r"\b(None|nan|NaN|Traceback)\b", body), body[:2000]
+            case = _shown_choice(page, "load case")
+            files = _shown_choice(page, "file")
+            if filtered:  # the filters came back: the later file is not shown
+                assert "500 Hz, 5 g, 50 %, acrylic, z (1 file(s))" in case, case
+                assert "hi_fill50.csv" in files and "lo_fill50.csv" in files, files
+                assert "mid_fill50.csv" not in files and "later" not in files, files
+                assert page.url == address  # nothing refused, nothing rewritten
+            else:  # no filter: the later file pooled with it, the case still chosen
+                assert "500 Hz, 5 g, 50 %, acrylic, z (2 file(s))" in case, case
+                assert "hi_fill50.csv" not in files, files
+        page.screenshot(path=str(ARTIFACTS / "app_e2e_compare_address.png"), full_page=True)
+    finally:
+        _stop(proc, log)

@@ -332,6 +332,90 @@ def test_load_cases_group_within_the_compare_tolerances(options):
     assert group_load_cases(cases) == [[0, 1], [2], [3]]
 
 
+def test_a_load_case_address_names_its_case_when_files_are_saved_to_it_later(good_csv,
+                                                                               options):
+    # The Compare page's address held the case's label, which counts its files: a file saved
+    # to the case later made the old address refused although the case was still there.
+    from dataclasses import replace
+
+    from pidcore.app.workbench import case_address, case_at_address, group_entries
+    from pidcore.compare.case import LoadCase
+
+    one = _entry(_record(good_csv, options))
+
+    def at(f, a, fill=50.0, specimen="", sha256="", key=""):
+        return replace(one, key=key or f"k{f}_{a}_{fill}_{specimen}{sha256[:1]}",
+                       load_case=LoadCase(f, a, fill, "acrylic", "z"), specimen=specimen,
+                       specimen_sha256=sha256)
+
+    entries = [at(100.0, 5.0), at(500.0, 5.0), at(100.0, 5.0, fill=75.0),
+               at(100.0, 5.0, specimen="steel_6mm", sha256="a" * 64),
+               at(100.0, 5.0, specimen="steel_6mm", sha256="b" * 64),
+               at(100.0, 5.0, specimen="old_name")]  # a record saved without the hash
+    groups = group_entries(entries)
+    assert len(groups) == len(entries)  # each its own case (load case or specimen file)
+    addresses = [case_address(entries, g) for g in groups]
+    assert len(set(addresses)) == len(groups)
+    assert addresses[0] == "f100Hz_a5g_fill50pct_acrylic_z"  # the store's load-case key
+    assert "steel_6mm [aaaaaa]" in addresses[3] and "steel_6mm [bbbbbb]" in addresses[4]
+    for n, address in enumerate(addresses):  # the round trip
+        assert case_at_address(address, entries, groups) == n
+    # a file saved later, 0.2 % off in frequency and listed first in its case: the old
+    # address still names the case (the label, "... (2 file(s))", did not), now 2 files
+    # (0.2 % and 0.4 % are inside the Compare tolerances, asserted so the test means it)
+    later = [at(100.2, 5.02, key="later"), *entries]
+    regrouped = group_entries(later)
+    assert any(len(g) == 2 for g in regrouped)
+    for n, address in enumerate(addresses):
+        found = case_at_address(address, later, regrouped)
+        assert found is not None
+        assert {later[i].key for i in regrouped[found]} >= {entries[groups[n][0]].key}
+    assert [later[i].key for i in regrouped[case_at_address(addresses[0], later, regrouped)]
+            ] == ["later", entries[0].key]
+    # what no longer exists is not met: another load case, specimen, hash, or no key at all
+    for gone in ("f200Hz_a5g_fill50pct_acrylic_z", "f100Hz_a5g_fill60pct_acrylic_z",
+                 "f100Hz_a5g_fill50pct_steel_z", "f100Hz_a5g_fill50pct_acrylic_x",
+                 "f100Hz_a5g_fill50pct_acrylic_z steel_6mm [cccccc]",
+                 "f100Hz_a5g_fill50pct_acrylic_z other", "acrylic_z_f100_a5_fill50",
+                 "f100Hz_a5g_fill50pct_acrylic_z_seed1", "f100Hz_a5g_fill500pct_acrylic_z",
+                 "200 Hz, 5 g, 50 %, acrylic, z (1 file(s))", "", "steel_6mm [aaaaaa]"):
+        assert case_at_address(gone, entries, groups) is None, gone
+    # the label an older page address held still names its case, whatever its file count
+    assert case_at_address("500 Hz, 5 g, 50 %, acrylic, z (1 file(s))", later,
+                           regrouped) == case_at_address(addresses[1], later, regrouped)
+    assert case_at_address("100 Hz, 5 g, 50 %, acrylic, z, specimen steel_6mm [bbbbbb] "
+                           "(7 file(s))", entries, groups) == 4
+
+
+def test_a_load_case_keeps_its_name_when_a_later_file_is_saved_to_it(good_csv, options):
+    # the store lists its newest records first, and the first record named the case: a file
+    # saved later at 500.5 Hz renamed "500 Hz, 5 g, ..." to "500.5 Hz, 5 g, ..." (and wrote
+    # another page address)
+    from dataclasses import replace
+
+    from pidcore.app.workbench import case_address, group_entries, group_name
+    from pidcore.compare.case import LoadCase
+
+    one = _entry(_record(good_csv, options))
+
+    def saved(f, when, key):
+        return replace(one, key=key, created_utc=when, origin="store",
+                       load_case=LoadCase(f, 5.0, 50.0, "acrylic", "z"))
+
+    first = [saved(500.0, "2026-11-30T10:00:00Z", "a")]
+    later = [saved(500.5, "2026-12-01T09:00:00Z", "b"), *first]  # as the store lists them
+    unsaved = replace(one, key="upload:x", created_utc="",
+                      load_case=LoadCase(499.6, 5.0, 50.0, "acrylic", "z"))
+    for entries in (first, later, [unsaved, *later], [*later, unsaved]):
+        (group,) = group_entries(entries)
+        assert group_name(entries, group) == "500 Hz, 5 g, 50 %, acrylic, z"
+        assert case_address(entries, group) == "f500Hz_a5g_fill50pct_acrylic_z"
+    # unsaved records only: the first of them, as before
+    (group,) = group_entries([unsaved, replace(unsaved, key="upload:y")])
+    assert group_name([unsaved], [0]) == "499.6 Hz, 5 g, 50 %, acrylic, z"
+    assert len(group) == 2
+
+
 def test_measured_loop_area_is_the_dissipated_energy(good_csv, options):
     from _app_samples import MASS_KG, damper_for
 

@@ -232,12 +232,12 @@ def test_compare_shows_dem_model_and_paper_and_switching_uses_the_cache(store_fi
     fill50, fill90 = "100 Hz, 5 g, 50 %, acrylic, z", "100 Hz, 5 g, 90 %, acrylic, z"
     timings = []
     for choice in (fill90, fill50, fill90, fill50):
-        at.selectbox(key="compare_case").set_value(choice)
+        _choose_case(at, choice)
         start = time.perf_counter()
         at.run()
         timings.append(time.perf_counter() - start)
         assert not at.exception
-    at.selectbox(key="compare_case").set_value(fill90)
+    _choose_case(at, fill90)
     at.run()
     # Table 3 at 100 Hz, 5 g, 90 %: DEM 0.3190, no measured value: said, never "nan"
     assert _metric(at, "SDC paper DEM [-]") == ["0.3190"]
@@ -266,7 +266,7 @@ def test_the_chosen_load_case_stays_chosen_when_a_save_reorders_the_list(store_f
     box = at.selectbox(key="compare_case")
     assert len(box.options) == 2
     chosen = "500 Hz, 5 g, 50 %, acrylic, z"
-    box.set_value(chosen)
+    _choose_case(at, chosen)
     at.run()
 
     def shown() -> set[str]:
@@ -277,14 +277,16 @@ def test_the_chosen_load_case_stays_chosen_when_a_save_reorders_the_list(store_f
     at.button(key="save").click()
     at.run()
     at.run()  # the page after the save, as the browser shows it
-    assert at.selectbox(key="compare_case").value == chosen
+    assert at.selectbox(key="compare_case").value.startswith("f500Hz_a")
     assert at.selectbox(key="compare_case").options[
         at.selectbox(key="compare_case").index].startswith(chosen)
     assert shown() == {"hi_fill50.csv"}
 
 
 def test_the_chosen_load_case_comes_back_after_a_reload(store_file):
-    # a reload showed the first load case again: the choice is bound to the page address now
+    # a reload showed the first load case again: the choice is kept in the page address, by
+    # the store's load-case key (the label counts the files, and a file saved since made
+    # that address refused)
     files = [("hi_fill50.csv", mass_damper_csv(frequency_hz=500.0, acceleration_g=5.0)),
              ("lo_fill50.csv", mass_damper_csv(frequency_hz=50.0, acceleration_g=5.0))]
     at = _upload(_app(), files)
@@ -292,29 +294,101 @@ def test_the_chosen_load_case_comes_back_after_a_reload(store_file):
     at.run()
     box = at.selectbox(key="compare_case")
     first = _app().selectbox(key="compare_case").value  # what a fresh page shows
-    label = next(o for o in box.options if not o.startswith(f"{first} ("))
-    chosen = label.removesuffix(" (1 file(s))")
-    box.set_value(chosen)
+    first_label = box.options[0]
+    box.select_index(1)
     at.run()
-    # a fresh session at the address the browser writes: the label shown (Streamlit binds
-    # the formatted option)
-    reloaded = _app_at({"compare_case": label})
+    chosen = at.selectbox(key="compare_case").value
+    assert chosen != first
+    assert re.fullmatch(r"f50{1,2}Hz_a[0-9.]+g_fill50pct_acrylic_z", chosen), chosen
+    assert at.query_params["compare_case"] in (chosen, [chosen])  # what the browser keeps
+    reloaded = _app_at({"compare_case": chosen})
     assert reloaded.selectbox(key="compare_case").value == chosen
     assert not reloaded.error
+    # a run that changes nothing sends the box no new value (the address's choice was set
+    # anew on every run, and the browser redrew the box each time)
+    assert not reloaded.run().selectbox(key="compare_case").proto.set_value
     measured = next(d.value for d in reloaded.dataframe if "origin" in d.value.columns)
-    assert set(measured["file"]) == {"hi_fill50.csv" if chosen.startswith("500 Hz")
+    assert set(measured["file"]) == {"hi_fill50.csv" if chosen.startswith("f500Hz")
                                      else "lo_fill50.csv"}
+    # the label an older page address held still names its case
+    label = at.selectbox(key="compare_case").options[1]
+    assert label.endswith(" (1 file(s))") and label[:3] == chosen[1:4]
+    assert _app_at({"compare_case": label}).selectbox(key="compare_case").value == chosen
     # a case the store does not hold (an unsaved analysis, gone with its session) is refused
     # in one line naming what is shown instead, not dropped without a word
-    gone = _app_at({"compare_case": "200 Hz, 5 g, 50 %, acrylic, z (1 file(s))"})
+    gone = _app_at({"compare_case": "f200Hz_a5g_fill50pct_acrylic_z"})
     assert gone.selectbox(key="compare_case").value == first
     assert [e.value for e in gone.error] == [
-        "load case: '200 Hz, 5 g, 50 %, acrylic, z (1 file(s))' (from the page address) is "
-        f"not one of {', '.join(box.options)}; {first} is chosen instead"]
+        "load case: 'f200Hz_a5g_fill50pct_acrylic_z' (from the page address) is not among the "
+        f"2 load case(s) of the records shown; {first_label} is chosen instead"]
     gone.run()  # it stays said until another case is chosen
     assert len(gone.error) == 1
     gone.selectbox(key="compare_case").set_value(chosen).run()
     assert not gone.error
+
+
+def test_a_file_saved_later_keeps_the_compare_address_and_its_filters(store_file):
+    # the address held "500 Hz, ... (1 file(s))": a second file of that case saved from the
+    # CLI turned it into "(2 file(s))" and the reload refused the case; the filters (file,
+    # specimen, date) were not in the address at all and came back empty
+    from pidcore.cli import main
+    from pidcore.store import Store, listing
+
+    files = [("hi_fill50.csv", mass_damper_csv(frequency_hz=500.0, acceleration_g=5.0)),
+             ("lo_fill50.csv", mass_damper_csv(frequency_hz=50.0, acceleration_g=5.0)),
+             ("mid_fill50.csv", mass_damper_csv(frequency_hz=200.0, acceleration_g=5.0))]
+    at = _upload(_app(), files)
+    at.button(key="save").click()
+    at.run()
+    at = _app()
+    at.multiselect(key="filter_file").set_value(["hi_fill50.csv", "lo_fill50.csv"]).run()
+    date = sorted(set(listing.saved_analyses(store_file)["date"]))[0]
+    at.multiselect(key="filter_date").set_value([date]).run()
+    box = at.selectbox(key="compare_case")
+    box.select_index(next(n for n, o in enumerate(box.options) if o.startswith("500 Hz"))).run()
+    hi = at.selectbox(key="compare_case").value
+    assert hi.startswith("f500Hz_a")
+    # the address as the browser writes it (the filters are bound by Streamlit, which writes
+    # them in the browser: test_app_browser reloads one)
+    assert at.query_params["compare_case"] in (hi, [hi])
+    address = {"compare_case": hi, "filter_file": ["hi_fill50.csv", "lo_fill50.csv"],
+               "filter_date": date}
+    # another file of the 500 Hz case, 0.1 % off, saved by `pidcore analyze` in between
+    later = Path("later_fill50.csv")
+    later.write_bytes(mass_damper_csv(frequency_hz=500.5, acceleration_g=5.0, seed=11))
+    assert main(["analyze", str(later), "--store", str(store_file), "--no-progress"]) == 0
+    assert len(Store(store_file).list_analyses()) == 4
+    reloaded = _app_at(address)
+    assert not reloaded.error
+    assert reloaded.multiselect(key="filter_file").value == ["hi_fill50.csv", "lo_fill50.csv"]
+    assert reloaded.multiselect(key="filter_date").value == [date]
+    assert reloaded.selectbox(key="compare_case").value == hi
+    assert sorted(o.split(",")[0] for o in reloaded.selectbox(key="compare_case").options) == [
+        "50 Hz", "500 Hz"]  # the 200 Hz case stays filtered out
+    measured = next(d.value for d in reloaded.dataframe if "origin" in d.value.columns)
+    assert list(measured["file"]) == ["hi_fill50.csv"]
+    # without the file filter the later file joins the case: the address still names it
+    unfiltered = _app_at({"compare_case": address["compare_case"]})
+    assert not unfiltered.error
+    shown = unfiltered.selectbox(key="compare_case")
+    assert shown.options[shown.index].startswith("500") and shown.options[
+        shown.index].endswith(" (2 file(s))")
+    measured = next(d.value for d in unfiltered.dataframe if "origin" in d.value.columns)
+    assert sorted(measured["file"]) == ["hi_fill50.csv", "later_fill50.csv"]
+    # only what the store no longer holds is refused, in one line
+    refused = _app_at({**address, "filter_file": ["hi_fill50.csv", "gone.csv"]})
+    assert [e.value for e in refused.error] == [
+        "file: 'gone.csv' (from the page address) is not one of hi_fill50.csv, "
+        "later_fill50.csv, lo_fill50.csv, mid_fill50.csv; hi_fill50.csv is chosen instead"]
+    assert refused.selectbox(key="compare_case").value == hi
+    # the session's unsaved analyses left out stay left out; a word the box cannot hold is
+    # refused as the other tabs' boxes refuse it
+    assert _app_at({"include_session": "false"}).checkbox(key="include_session").value is False
+    maybe = _app_at({"include_session": "maybe"})
+    assert maybe.checkbox(key="include_session").value is True
+    assert [e.value for e in maybe.error] == [
+        "include this session's unsaved analyses: 'maybe' (from the page address) is not one "
+        "of true, false; true is chosen instead"]
 
 
 def test_an_identical_file_under_another_name_is_compared_once(store_file):
@@ -648,7 +722,7 @@ def test_bundled_samples_switch_load_cases_within_a_second(store_file, monkeypat
     timings = []
     for _ in range(2):
         for choice in names:
-            at.selectbox(key="compare_case").set_value(choice)
+            _choose_case(at, choice)
             start = time.perf_counter()
             at.run()
             timings.append(time.perf_counter() - start)
@@ -1564,6 +1638,14 @@ def test_whole_numbers_and_the_sample_rate_are_read_as_typed_or_refused(store_fi
     at.run()
     assert any(e.value == "sample rate if no time column [Hz]: '25,6' is not a number; files "
                           "are read without a sample rate" for e in at.error)
+
+
+def _choose_case(at: AppTest, name: str):
+    """The Compare page's load-case box with the case shown as ``name`` (its label without
+    the file count) chosen: the box's values are the cases' page-address names."""
+    box = at.selectbox(key="compare_case")
+    return box.select_index(next(n for n, o in enumerate(box.options)
+                                 if o.rsplit(" (", 1)[0] == name))
 
 
 def _app_at(address: dict) -> AppTest:

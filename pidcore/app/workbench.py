@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -102,9 +103,71 @@ def group_name(entries: Sequence[MeasuredEntry], group: Sequence[int]) -> str:
     """
     from ..specimen import tested_label
 
-    e = entries[group[0]]
+    e = _naming_entry(entries, group)
     specimen = f", specimen {tested_label(e.specimen, e.specimen_sha256)}" if e.specimen else ""
     return f"{e.load_case.full_label()}{specimen}"
+
+
+def _naming_entry(entries: Sequence[MeasuredEntry], group: Sequence[int]) -> MeasuredEntry:
+    """The record whose load case names the group: its first saved, then the unsaved ones in
+    their order. The store lists its newest records first, so the group's first record was
+    the latest saved, and a file saved to the case renamed it ("500 Hz" to "500.5 Hz")."""
+    order = sorted(range(len(group)), key=lambda n: (not entries[group[n]].created_utc,
+                                                     entries[group[n]].created_utc, n))
+    return entries[group[order[0]]]
+
+
+#: The file count the Compare page's load-case labels end with, e.g. " (2 file(s))".
+_FILE_COUNT = re.compile(r" \(\d+ file\(s\)\)$")
+
+
+def case_address(entries: Sequence[MeasuredEntry], group: Sequence[int]) -> str:
+    """The group's load case as the page address names it: the store's load-case key of the
+    record that names it (:func:`group_name`'s), then its specimen as labels name it (name
+    and start of its hash, :func:`pidcore.specimen.tested_label`) where one is named, e.g.
+    ``'f500Hz_a4.99967g_fill50pct_acrylic_z steel_6mm [3e945a]'``.
+
+    Not the label shown, which counts the group's files: a file saved to the group later
+    made that address name nothing. :func:`case_at_address` reads it back."""
+    from ..specimen import tested_label
+
+    e = _naming_entry(entries, group)
+    specimen = tested_label(e.specimen, e.specimen_sha256)
+    return f"{e.load_case.key} {specimen}" if specimen else e.load_case.key
+
+
+def case_at_address(address: str, entries: Sequence[MeasuredEntry],
+                    groups: Sequence[Sequence[int]]) -> int | None:
+    """Index into ``groups`` (:func:`group_entries` of ``entries``) of the load case that
+    :func:`case_address` wrote ``address`` for, or None where no group is that case any more.
+
+    The case is met within the Compare tolerances (:class:`pidcore.compare.align.Tolerances`,
+    the nearest group of its specimen where several are): the record that names a group may
+    be another one by now (its first saved, re-saved since), whose measured frequency and
+    acceleration differ in the last digits, and a hand-typed ``f500Hz_a5g...`` meets it. The
+    label an older pidcore wrote there (:func:`group_name` and a file count) is read too,
+    whatever the count."""
+    from ..compare.align import Tolerances
+    from ..loadcase import KEY_PATTERN, LoadCaseError, parse_key
+    from ..specimen import tested_label
+
+    key, _, specimen = str(address).strip().partition(" ")
+    found = KEY_PATTERN.match(key)
+    if found is None or found.end() != len(key):  # a DEM run key is not a load case's
+        named = _FILE_COUNT.sub("", str(address))
+        return next((n for n, group in enumerate(groups)
+                     if named and group_name(entries, group) == named), None)
+    try:
+        case = parse_key(key)
+    except LoadCaseError:  # e.g. a fill over 100 % typed into the address
+        return None
+    tolerances = Tolerances()
+    near = [(tolerances.distance(entries[i].load_case, case), n)
+            for n, group in enumerate(groups)
+            if tested_label(entries[group[0]].specimen,
+                            entries[group[0]].specimen_sha256) == specimen.strip()
+            for i in group if tolerances.matches(entries[i].load_case, case)]
+    return min(near)[1] if near else None
 
 
 def dem_loop(paths: Sequence[str | os.PathLike | None],

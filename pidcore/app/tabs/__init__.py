@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 
 import streamlit as st
 
@@ -59,11 +59,22 @@ def refuse_address_choices(key: str, label: str, options: Sequence[str],
         fallback = default if isinstance(default, str) else (
             [v for v in stated if v in options] or list(default))
         shown = fallback if isinstance(fallback, str) else ", ".join(fallback) or "none"
-        quoted = ", ".join(f"'{v}'" for v in unknown)
         offered = (f"one of {', '.join(options)}" if options
                    else "offered (there is nothing to choose yet)")
-        refusals[key] = (f"{label}: {quoted} (from the page address) is not {offered}; "
-                         f"{shown} is chosen instead", fallback)
+        refusals[key] = (_address_refusal(label, unknown, offered, shown), fallback)
+    _say_address_refusal(key)
+
+
+def _address_refusal(label: str, unknown: Sequence[str], offered: str, shown: str) -> str:
+    """The one line that refuses the page address's ``unknown`` values of a field."""
+    quoted = ", ".join(f"'{v}'" for v in unknown)
+    return f"{label}: {quoted} (from the page address) is not {offered}; {shown} is chosen instead"
+
+
+def _say_address_refusal(key: str) -> None:
+    """Show the field ``key``'s refusal of its address value while the field holds what was
+    chosen instead; forget it once the user chose another."""
+    refusals = st.session_state.setdefault(_ADDRESS_REFUSALS, {})
     refused = refusals.get(key)
     if refused is None:
         return
@@ -75,6 +86,41 @@ def refuse_address_choices(key: str, label: str, options: Sequence[str],
         st.error(message)
     else:  # the user chose: the address's value is no longer the question
         del refusals[key]
+
+
+def address_choice(key: str, label: str, options: Mapping[str, str],
+                   resolve: Callable[[str], str | None], *, offered: str) -> str:
+    """A select box ``key`` (``label``) of ``options`` (each option's page-address name ->
+    the label shown), kept in the page address under ``key`` by that name: Streamlit's own
+    binding (:data:`ADDRESS_BINDING`) writes the label shown, and a label that changes with
+    the data (a count of files) made an older address name nothing.
+
+    ``resolve`` finds today's option of a name the address (or the last run) holds, None
+    where nothing is that option any more; a fresh session's address naming nothing is
+    refused in one line (as :func:`refuse_address_choices`: ``offered`` says what would have
+    been taken) and the first option shown. Returns the chosen option's name."""
+    names = list(options)
+    fresh = key not in st.session_state
+    stated = st.query_params.get(key) if fresh else st.session_state[key]
+    current = None
+    if stated:
+        current = stated if stated in options else resolve(stated)
+    if current is None:
+        current = names[0]
+        if stated and fresh:
+            refusals = st.session_state.setdefault(_ADDRESS_REFUSALS, {})
+            refusals[key] = (_address_refusal(label, [stated], offered, options[current]),
+                             current)
+    # set before the box is drawn: the box then opens on it (what ``resolve`` found may be
+    # spelled otherwise than the address or the last run held it); only when it changes: a
+    # value set this way is sent to the browser as a new value, which redraws the box
+    if fresh or st.session_state[key] != current:
+        st.session_state[key] = current
+    _say_address_refusal(key)
+    choice = st.selectbox(label, names, format_func=options.__getitem__, key=key)
+    if st.query_params.get(key) != choice:
+        st.query_params[key] = choice
+    return choice
 
 
 #: The choice of the paper's coupon in :func:`specimen_choice`.

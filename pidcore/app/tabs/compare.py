@@ -9,7 +9,12 @@ import math
 import streamlit as st
 
 from pidcore.app import state, uploads, workbench
-from pidcore.app.tabs import ADDRESS_BINDING, refuse_address_choices
+from pidcore.app.tabs import (
+    ADDRESS_BINDING,
+    address_choice,
+    refuse_address_choices,
+    refuse_address_flag,
+)
 from pidcore.app.vocabulary import page_terms
 from pidcore.calibrate.prediction import band_text, quantile_label
 from pidcore.compare.case import equivalent_dampers
@@ -26,13 +31,23 @@ def _entries(stores, session_files):
     saved = state.store_listing("analyses", stamp, stores)
     listing = saved  # every saved record decides which file a hashless one is of
     if not saved.empty:
+        # bound to the page address as the other tabs' fields (ADDRESS_BINDING): a reload
+        # showed every record again; a value the store no longer holds is refused in one line
         f1, f2, f3 = st.columns(3)
-        specimens = f1.multiselect("specimen", sorted(set(saved["specimen"])),
-                                   key="filter_specimen",
-                                   format_func=lambda s: s or "(none named)")
-        dates = f2.multiselect("date saved", sorted(set(saved["date"]), reverse=True),
-                               key="filter_date")
-        files = f3.multiselect("file", sorted(set(saved["file"])), key="filter_file")
+        specimen_names = sorted(set(saved["specimen"]))
+        with f1:
+            refuse_address_choices("filter_specimen", "specimen",
+                                   [_specimen_option(s) for s in specimen_names], [])
+        specimens = f1.multiselect("specimen", specimen_names, key="filter_specimen",
+                                   format_func=_specimen_option, bind=ADDRESS_BINDING)
+        dates = sorted(set(saved["date"]), reverse=True)
+        with f2:
+            refuse_address_choices("filter_date", "date saved", dates, [])
+        dates = f2.multiselect("date saved", dates, key="filter_date", bind=ADDRESS_BINDING)
+        files = sorted(set(saved["file"]))
+        with f3:
+            refuse_address_choices("filter_file", "file", files, [])
+        files = f3.multiselect("file", files, key="filter_file", bind=ADDRESS_BINDING)
         saved = filter_analyses(saved, specimens=specimens, dates=dates, files=files)
     # a record of a specimen file at hand is judged against that file's SDC bound, as
     # `pidcore analyze --specimen FILE` judged it
@@ -42,8 +57,10 @@ def _entries(stores, session_files):
     entries = list(state.saved_entries(tuple(saved["key"]) if not saved.empty else (), stamp,
                                        stores, saved, tuple(s.hash for s in known),
                                        known)) if not saved.empty else []
+    refuse_address_flag("include_session", "include this session's unsaved analyses",
+                        default=True)
     include = st.checkbox("include this session's unsaved analyses", value=True,
-                          key="include_session")
+                          key="include_session", bind=ADDRESS_BINDING)
     if include:
         entries += [MeasuredEntry.from_record(f.record, f.load_case, specimen=f.specimen,
                                               options=f.options,
@@ -56,6 +73,10 @@ def _entries(stores, session_files):
         st.caption(note)
     # a record saved without its file's hash is grouped as calibrate and report group it
     return workbench.matched_specimens(entries, listing)
+
+
+def _specimen_option(name: str) -> str:
+    return name or "(none named)"
 
 
 def _group_key(members) -> str:
@@ -141,27 +162,26 @@ def render(stores, session_files: list, calibrations: list) -> None:
                 "Upload and save measurements on the Analyse tab.")
         return
     groups = workbench.group_entries(entries)
-    # The choice is the group's name, not its position: saving re-sorts the groups, and a
-    # position would then show another load case's numbers under the chosen one's label.
-    by_name: dict[str, list[int]] = {}
-    for g in groups:  # two groups whose rounded names agree stay apart
-        name = base = workbench.group_name(entries, g)
-        while name in by_name:
-            name = f"{base} #{len(by_name)}"
-        by_name[name] = g
-    labels = {name: f"{name} ({len(g)} file(s))" for name, g in by_name.items()}
-    # bound to the page address as the other tabs' fields: a reload showed the first load
-    # case, not the one looked at. The address holds the label shown (Streamlit binds the
-    # formatted option); a case gone since (an unsaved analysis, after a reload) or with
-    # another file count is refused in one line, not dropped unseen
-    # (the fallback is the name, the widget's value, so that the message stays until the
-    # user chooses another case)
-    refuse_address_choices("compare_case", "load case", list(labels.values()),
-                           next(iter(by_name)))
-    choice = st.selectbox("load case", list(by_name), format_func=labels.__getitem__,
-                          key="compare_case", bind=ADDRESS_BINDING)
-    if choice not in by_name:
-        choice = next(iter(by_name))
+    # The choice is the group's load case, not its position: saving re-sorts the groups, and a
+    # position would then show another load case's numbers under the chosen one's label. The
+    # page address keeps it by the store's load-case key and the specimen
+    # (workbench.case_address), not by the label, which counts the files: a file saved since
+    # made a reload refuse a case that is still there.
+    by_name = {workbench.case_address(entries, g): g for g in groups}
+    if len(by_name) < len(groups):  # two groups whose keys agree: apart by position
+        by_name = {f"{workbench.case_address(entries, g)} #{n}" if n else
+                   workbench.case_address(entries, g): g for n, g in enumerate(groups)}
+    labels = {name: f"{workbench.group_name(entries, g)} ({len(g)} file(s))"
+              for name, g in by_name.items()}
+    names = list(by_name)
+
+    def resolve(address: str) -> str | None:
+        found = workbench.case_at_address(address, entries, list(by_name.values()))
+        return None if found is None else names[found]
+
+    choice = address_choice("compare_case", "load case", labels, resolve,
+                            offered=f"among the {len(groups)} load case(s) of the records "
+                                    "shown")
     members = [entries[i] for i in by_name[choice]]
     stamp = stores.stamp()
     try:
@@ -243,7 +263,7 @@ def render(stores, session_files: list, calibrations: list) -> None:
     # Warm the cache for the other load cases after this one is on screen, so that switching
     # to any of them is a cache hit.
     warmed = st.session_state.setdefault("_compare_warmed", set())
-    for other, indices in enumerate(groups):
+    for other, indices in by_name.items():
         rest = [entries[i] for i in indices]
         key = (_group_key(rest), stamp)
         if other == choice or key in warmed:
