@@ -331,6 +331,29 @@ def test_measurement_page_quotes_the_bundled_exports_loss_factors_as_analysed_to
     assert quoted is not None and list(quoted.groups()) == shown
 
 
+def test_readme_quotes_steel_6mm_time_steps_as_specimen_check_and_dem_run_print_them():
+    # README's specimen section: the automatic step at 50 Hz, 10 g (specimen check) and at
+    # 500 Hz, 5 g, and the dt `dem run` prints at both. It said dem run prints 6.98e-7 s at
+    # 500 Hz, 5 g; it printed 6.793e-07 (the step shortened to whole steps per sample).
+    from pidcore.dem.simulate import DemConfig, LoadCase, choose_time_step, drive_sampling
+    from pidcore.specimen import contact_law, load_specimen
+
+    text = " ".join(README.read_text(encoding="utf-8").split())
+    quoted = re.search(r"([\d.e-]+) s here is ([\d.e-]+) s at 500 Hz, 5 g for `steel_6mm`;.*?"
+                       r"prints that step as `dt`: ([\d.e-]+) s at 50 Hz, 10 g, ([\d.e-]+) s at "
+                       r"500 Hz, 5 g;", text)
+    assert quoted is not None
+    steel = load_specimen(ROOT / "data_samples" / "specimens" / "steel_6mm.toml")
+    law, geometry = contact_law(steel), steel.geometry()
+    automatic, run = [], []
+    for frequency_hz, acceleration_g in ((50.0, 10.0), (500.0, 5.0)):
+        case = LoadCase(frequency_hz, acceleration_g, 50.0, material="steel")
+        automatic.append(choose_time_step(case, law, geometry, "auto"))
+        run.append(drive_sampling(case, automatic[-1], DemConfig().samples_per_cycle)[1])
+    assert list(quoted.groups()) == [f"{value:.2e}".replace("e-0", "e-")
+                                     for value in (*automatic, *run)]
+
+
 def test_calibration_page_shows_the_bundled_calibrations_own_tables():
     # docs/calibration.md's "The chosen model" tables (posterior, correlations, in-sample,
     # leave-one-out, energy check) are data_samples/paper_calibration/summary.md's: its energy
