@@ -510,3 +510,15 @@ def test_store_without_the_specimens_measurements_says_why_in_one_sentence(tmp_p
         "unnamed specimen of them; not used for steel_6mm (steel particles): 1 measured load "
         "case(s) of acrylic particles")
     assert left_out == []  # refused: nothing said as left out of a calibration
+
+
+def test_a_mistyped_store_is_named_not_found_and_none_is_created(capsys, tmp_path):
+    # `calibrate --store nope.h5` said "nope.h5: no analysed measurements with frequency_hz
+    # and sdc", as of an empty store: the user looked for what the store lacked
+    missing = tmp_path / "nope.h5"
+    assert main(["calibrate", "--store", str(missing), "--dem-store",
+                 str(tmp_path / "cal.h5"), "--no-progress"]) == 2
+    err = capsys.readouterr().err
+    assert err == (f"pidcore calibrate: error: {missing}: store not found; expected the store "
+                   "that pidcore analyze saved the measurements in\n")
+    assert sorted(tmp_path.iterdir()) == []

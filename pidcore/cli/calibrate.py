@@ -89,7 +89,7 @@ def run(args: argparse.Namespace) -> int:
     from ..calibrate.parameters import parse_fit
     from ..calibrate.persist import save_calibration
     from ..calibrate.runner import RunTally
-    from ..errors import ParameterError
+    from ..errors import InputFileError, ParameterError
     from ..specimen import load_specimen
 
     if args.out is not None:  # said before the DEM runs and the fit, not after them
@@ -112,6 +112,10 @@ def run(args: argparse.Namespace) -> int:
         points = read_measured_table(args.data, default_material=default_material,
                                      specimen=specimen)
     else:
+        if not Path(args.store).is_file():
+            # read as an empty store, a mistyped path said it held no analysed measurements
+            raise InputFileError(f"{args.store}: store not found; expected the store that "
+                                 "pidcore analyze saved the measurements in")
         measured = measured_from_store(args.store, left_out=left_out, specimen=specimen)
         points = _store_points(measured, specimen, args.store, left_out)
         for note in left_out:
