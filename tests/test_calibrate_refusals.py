@@ -522,3 +522,17 @@ def test_a_mistyped_store_is_named_not_found_and_none_is_created(capsys, tmp_pat
     assert err == (f"pidcore calibrate: error: {missing}: store not found; expected the store "
                    "that pidcore analyze saved the measurements in\n")
     assert sorted(tmp_path.iterdir()) == []
+
+
+def test_calibrate_help_names_every_column_the_data_table_reader_takes(capsys):
+    # --help listed the optional columns without sdc_stderr_dof, which the reader takes (and
+    # its missing-column error names), so a user could not learn it from the help
+    from pidcore.calibrate.data import OPTIONAL_COLUMNS, REQUIRED_COLUMNS
+    from pidcore.cli import build_parser
+
+    with pytest.raises(SystemExit):
+        build_parser().parse_args(["calibrate", "--help"])
+    help_text = " ".join(capsys.readouterr().out.split())
+    listed = help_text[help_text.index("--data TABLE.csv measured SDCs:"):
+                       help_text.index("; a row without a material")]
+    assert [c for c in (*REQUIRED_COLUMNS, *OPTIONAL_COLUMNS) if c not in listed] == []

@@ -36,7 +36,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     source = p.add_mutually_exclusive_group(required=True)
     source.add_argument("--data", metavar="TABLE.csv", type=path_argument,
                         help="measured SDCs: frequency_hz, acceleration_g, fill_percent, sdc "
-                             "[, sdc_stderr, energy_per_cycle_j, material, specimen]; a row "
+                             "[, sdc_stderr, sdc_stderr_dof, energy_per_cycle_j, material, "
+                             "specimen]; a row "
                              "without a material is of --specimen's particles (else acrylic); "
                              "one of another material than the specimen's is refused")
     source.add_argument("--store", metavar="FILE", type=path_argument,
