@@ -536,3 +536,18 @@ def test_calibrate_help_names_every_column_the_data_table_reader_takes(capsys):
     listed = help_text[help_text.index("--data TABLE.csv measured SDCs:"):
                        help_text.index("; a row without a material")]
     assert [c for c in (*REQUIRED_COLUMNS, *OPTIONAL_COLUMNS) if c not in listed] == []
+
+
+def test_calibrate_help_says_the_fewest_cells_it_takes(capsys, tmp_path):
+    # --help said "cells per DEM run (default 4)"; --cells 1 was then refused as below 2
+    from pidcore.calibrate.calibrate import CALIBRATION_CELLS
+    from pidcore.cli import build_parser
+
+    with pytest.raises(SystemExit):
+        build_parser().parse_args(["calibrate", "--help"])
+    help_text = " ".join(capsys.readouterr().out.split())
+    assert (f"--cells K cells per DEM run, at least 2: the run's error is their scatter "
+            f"(default {CALIBRATION_CELLS})") in help_text
+    assert main(["calibrate", "--data", str(tmp_path / "none.csv"), "--cells", "1",
+                 "--dem-store", str(tmp_path / "cal.h5")]) == 2
+    assert "--cells: expected >= 2" in capsys.readouterr().err

@@ -57,7 +57,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--discrepancy-floor", metavar="SDC", type=float, default=DISCREPANCY_FLOOR,
                    help="absolute model-error floor on the SDC (default %(default)s)")
     p.add_argument("--cells", metavar="K", type=positive_int, default=None,
-                   help="cells per DEM run (default 4)")
+                   help="cells per DEM run, at least 2: the run's error is their scatter "
+                        "(default 4)")
     p.add_argument("--steady-cycles", metavar="N", type=positive_int, default=None,
                    help="steady cycles measured per DEM run (default: the DEM's)")
     p.add_argument("--design-size", metavar="N", type=positive_int, default=None,
