@@ -72,7 +72,7 @@ def test_the_time_step_printed_is_the_one_taken_as_its_help_says(capsys):
         parser.parse_args(["dem", "run", "--help"])
     help_text = " ".join(capsys.readouterr().out.split())
     assert ("either is shortened to a whole number of steps per output sample (128 per drive "
-            "period): the step taken is printed as dt") in help_text
+            "period; dem run prints the step taken as dt))") in help_text
 
 
 def test_unsafe_time_step_is_one_line_error_exit_2(capsys):
