@@ -1688,7 +1688,8 @@ def tabulated_by_paper(specimen: Specimen) -> bool:
 #: Load case whose impacts are the hardest of the paper's Table 3 grid (largest 2 a/w): the
 #: time step :func:`describe` reports is the one ``time_step="auto"`` picks for it, and so
 #: the smallest of the grid's (a softer load case's contact lasts longer: 6.98e-7 s at
-#: 500 Hz, 5 g beside 6.01e-7 s here for steel_6mm), not the step of every run.
+#: 500 Hz, 5 g beside 6.01e-7 s here for steel_6mm), not the step of every run (each run also
+#: shortens its own to whole steps per output sample: :func:`pidcore.dem.simulate.drive_sampling`).
 DESCRIBE_FREQUENCY_HZ = 50.0
 DESCRIBE_ACCELERATION_G = 10.0
 

@@ -668,6 +668,31 @@ def test_app_command_serves_the_packaged_entry_on_localhost(tmp_path):
     assert "from pidcore.app.main import main" in shim
 
 
+def test_print_command_names_the_stores_the_app_would_serve(tmp_path, monkeypatch, capsys):
+    # `pidcore app --store X --print-command` printed the bare streamlit line: run as printed,
+    # the app read no PIDCORE_STORE and served ./pid_store.h5 instead of X; a missing
+    # --dem-store was refused only when the app was started, not when its line was printed
+    import shlex
+
+    from pidcore.cli import main
+    from pidcore.cli.app import streamlit_command
+
+    monkeypatch.delenv(stores.STORE_ENV_VAR, raising=False)
+    monkeypatch.delenv(stores.DEM_STORE_ENV_VAR, raising=False)
+    monkeypatch.chdir(tmp_path)
+    reference = tmp_path / "reference runs.h5"
+    reference.write_bytes(b"")
+    assert main(["app", "--port", "8777", "--store", "my store.h5",
+                 "--dem-store", reference.name, "--print-command"]) == 0
+    words = shlex.split(capsys.readouterr().out)
+    assert words[:2] == [f"{stores.STORE_ENV_VAR}={tmp_path / 'my store.h5'}",
+                         f"{stores.DEM_STORE_ENV_VAR}={reference}"]
+    assert words[2:] == streamlit_command(8777)
+    assert main(["app", "--dem-store", "missing.h5", "--print-command"]) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and err.count("\n") == 1 and "--dem-store missing.h5" in err
+
+
 @pytest.mark.parametrize("script", ["pidcore/app/entry.py", "app/pidcore_app.py"])
 def test_a_worker_process_rerunning_the_entry_script_draws_nothing(script, monkeypatch):
     # multiprocessing re-runs the parent's main script in each worker as "__mp_main__";

@@ -622,6 +622,8 @@ def test_store_of_two_materials_calibrates_the_specimens_points(capsys, monkeypa
     library = importlib.import_module("pidcore.calibrate.calibrate")
 
     _mixed_store(monkeypatch)
+    with Store(tmp_path / "s.h5").transaction():  # an empty store, listed as the frame above
+        pass
     seen = {}
 
     def fake_calibrate(points, **kwargs):
@@ -699,6 +701,8 @@ def test_store_of_only_another_specimens_tests_says_why_none_is_used(capsys, mon
                           "sdc_stderr": [0.01] * 2, "material": ["steel"] * 2,
                           "specimen": ["steel_6mm"] * 2})
     monkeypatch.setattr(Store, "list_analyses", lambda self: frame)
+    with Store(tmp_path / "s.h5").transaction():  # an empty store, listed as the frame above
+        pass
     _refused(capsys, tmp_path, ["--store", str(tmp_path / "s.h5")],
              "no measurement of the paper's coupon",
              "2 measured load case(s) of specimen steel_6mm", "--specimen FILE of theirs")

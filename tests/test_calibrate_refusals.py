@@ -510,3 +510,44 @@ def test_store_without_the_specimens_measurements_says_why_in_one_sentence(tmp_p
         "unnamed specimen of them; not used for steel_6mm (steel particles): 1 measured load "
         "case(s) of acrylic particles")
     assert left_out == []  # refused: nothing said as left out of a calibration
+
+
+def test_a_mistyped_store_is_named_not_found_and_none_is_created(capsys, tmp_path):
+    # `calibrate --store nope.h5` said "nope.h5: no analysed measurements with frequency_hz
+    # and sdc", as of an empty store: the user looked for what the store lacked
+    missing = tmp_path / "nope.h5"
+    assert main(["calibrate", "--store", str(missing), "--dem-store",
+                 str(tmp_path / "cal.h5"), "--no-progress"]) == 2
+    err = capsys.readouterr().err
+    assert err == (f"pidcore calibrate: error: {missing}: store not found; expected the store "
+                   "that pidcore analyze saved the measurements in\n")
+    assert sorted(tmp_path.iterdir()) == []
+
+
+def test_calibrate_help_names_every_column_the_data_table_reader_takes(capsys):
+    # --help listed the optional columns without sdc_stderr_dof, which the reader takes (and
+    # its missing-column error names), so a user could not learn it from the help
+    from pidcore.calibrate.data import OPTIONAL_COLUMNS, REQUIRED_COLUMNS
+    from pidcore.cli import build_parser
+
+    with pytest.raises(SystemExit):
+        build_parser().parse_args(["calibrate", "--help"])
+    help_text = " ".join(capsys.readouterr().out.split())
+    listed = help_text[help_text.index("--data TABLE.csv measured SDCs:"):
+                       help_text.index("; a row without a material")]
+    assert [c for c in (*REQUIRED_COLUMNS, *OPTIONAL_COLUMNS) if c not in listed] == []
+
+
+def test_calibrate_help_says_the_fewest_cells_it_takes(capsys, tmp_path):
+    # --help said "cells per DEM run (default 4)"; --cells 1 was then refused as below 2
+    from pidcore.calibrate.calibrate import CALIBRATION_CELLS
+    from pidcore.cli import build_parser
+
+    with pytest.raises(SystemExit):
+        build_parser().parse_args(["calibrate", "--help"])
+    help_text = " ".join(capsys.readouterr().out.split())
+    assert (f"--cells K cells per DEM run, at least 2: the run's error is their scatter "
+            f"(default {CALIBRATION_CELLS})") in help_text
+    assert main(["calibrate", "--data", str(tmp_path / "none.csv"), "--cells", "1",
+                 "--dem-store", str(tmp_path / "cal.h5")]) == 2
+    assert "--cells: expected >= 2" in capsys.readouterr().err

@@ -4,6 +4,7 @@ the CLI flag, exit 2, the store byte-identical."""
 from __future__ import annotations
 
 import math
+import re
 from pathlib import Path
 
 import pytest
@@ -120,8 +121,10 @@ def test_a_store_with_several_measurements_names_the_key_option(tmp_path, capsys
     assert main(["analyze", str(store), "--no-store"]) == 2
     err = capsys.readouterr().err
     assert "--key NAME" in err and "key=" not in err and len(err.strip().splitlines()) == 1
-    keys = err.split("measurements (")[1].split(")")[0].split(", ")
-    assert len(keys) == 2
+    # each key is named with the file it came from: "KEY (a.csv), KEY (b.csv)"
+    listed = re.findall(r"([0-9a-f]{16}) \(([^)]*)\)", err)
+    assert sorted(name for _, name in listed) == ["a.csv", "b.csv"]
+    keys = [key for key, _ in listed]
     found = []
     for key in keys:
         assert main(["analyze", str(store), "--key", key, "--no-store", "--json"]) == 0

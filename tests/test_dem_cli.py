@@ -57,6 +57,24 @@ def test_model_options_reach_the_simulation(capsys):
     assert default["sdc"] != doc["sdc"]  # a different model gives a different number
 
 
+def test_the_time_step_printed_is_the_one_taken_as_its_help_says(capsys):
+    # --help said the step is the one asked (or min(2e-6 s, ...)); a run takes it shortened
+    # to whole steps per output sample: 1e-6 s asked at 500 Hz is 2e-3 s / (16 x 128)
+    # = 9.765625e-7 s, which --json and the text's dt show, and --help now says so
+    from pidcore.cli import build_parser
+
+    assert main(ARGS + ["--json", "--time-step", "1e-6"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["time_step_s"] == pytest.approx(2e-3 / (16 * 128), rel=1e-15)
+    assert doc["samples_per_cycle"] == 128
+    parser = build_parser()
+    with pytest.raises(SystemExit):
+        parser.parse_args(["dem", "run", "--help"])
+    help_text = " ".join(capsys.readouterr().out.split())
+    assert ("either is shortened to a whole number of steps per output sample (128 per drive "
+            "period; dem run prints the step taken as dt))") in help_text
+
+
 def test_unsafe_time_step_is_one_line_error_exit_2(capsys):
     code = main(["dem", "run", "--frequency", "50", "--acceleration", "10", "--fill", "50",
                  "--time-step", "2e-6", "--no-progress"])

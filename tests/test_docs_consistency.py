@@ -303,6 +303,57 @@ def test_readme_quotes_the_main_jobs_measured_sdcs_and_calibrated_bands():
     assert list(quoted.groups()) == [*shown(sdcs, 1), *shown(predicted, 2), *shown(upper, 2)]
 
 
+def test_measurement_page_quotes_the_bundled_exports_loss_factors_as_analysed_today():
+    # docs/measurement.md's table of the drift model's moves: the "after" loss factor of each
+    # bundled export (50 µs delay, as data_samples/loadcases.csv states) and the MAT sample's
+    # SDC, as `pidcore analyze --sidecar data_samples/loadcases.csv` prints them. It said
+    # SDC 4.091 for 0.651017, whose 2 pi x is 4.0905 (printed 4.09046). Compared at the page's
+    # own digits; data_samples/README.md's 4.09 (with the delay) and 2.81 (without) as well.
+    from pidcore.measure import AnalysisOptions, analyze_file
+
+    page = (ROOT / "docs" / "measurement.md").read_text(encoding="utf-8")
+    rows = re.findall(r"^\| (f\d+Hz_a\d+g) \([^)]*\) \| [\d.]+ → ([\d.]+)(?: \(SDC [\d.]+ → "
+                      r"([\d.]+)\))? \|", page, re.M)
+    assert len(rows) == 5
+    exports = ROOT / "data_samples" / "exports"
+    for case, loss_factor, sdc in rows:
+        export, = exports.glob(f"synthetic_{case}_fill50_*")
+        analysis = analyze_file(export, AnalysisOptions(velocity_delay_s=50e-6)).analysis
+        assert f"{analysis.loss_factor:.6f}" == loss_factor, export.name
+        if sdc:
+            assert f"{analysis.sdc:.3f}" == sdc, export.name
+    notes = " ".join((ROOT / "data_samples" / "README.md").read_text(encoding="utf-8").split())
+    quoted = re.search(r"MAT sample: SDC ([\d.]+); without the delay it would be ([\d.]+)\)",
+                       notes)
+    mat, = exports.glob("*.mat")
+    shown = [f"{analyze_file(mat, AnalysisOptions(velocity_delay_s=delay)).analysis.sdc:.2f}"
+             for delay in (50e-6, 0.0)]
+    assert quoted is not None and list(quoted.groups()) == shown
+
+
+def test_readme_quotes_steel_6mm_time_steps_as_specimen_check_and_dem_run_print_them():
+    # README's specimen section: the automatic step at 50 Hz, 10 g (specimen check) and at
+    # 500 Hz, 5 g, and the dt `dem run` prints at both. It said dem run prints 6.98e-7 s at
+    # 500 Hz, 5 g; it printed 6.793e-07 (the step shortened to whole steps per sample).
+    from pidcore.dem.simulate import DemConfig, LoadCase, choose_time_step, drive_sampling
+    from pidcore.specimen import contact_law, load_specimen
+
+    text = " ".join(README.read_text(encoding="utf-8").split())
+    quoted = re.search(r"([\d.e-]+) s here is ([\d.e-]+) s at 500 Hz, 5 g for `steel_6mm`;.*?"
+                       r"prints that step as `dt`: ([\d.e-]+) s at 50 Hz, 10 g, ([\d.e-]+) s at "
+                       r"500 Hz, 5 g;", text)
+    assert quoted is not None
+    steel = load_specimen(ROOT / "data_samples" / "specimens" / "steel_6mm.toml")
+    law, geometry = contact_law(steel), steel.geometry()
+    automatic, run = [], []
+    for frequency_hz, acceleration_g in ((50.0, 10.0), (500.0, 5.0)):
+        case = LoadCase(frequency_hz, acceleration_g, 50.0, material="steel")
+        automatic.append(choose_time_step(case, law, geometry, "auto"))
+        run.append(drive_sampling(case, automatic[-1], DemConfig().samples_per_cycle)[1])
+    assert list(quoted.groups()) == [f"{value:.2e}".replace("e-0", "e-")
+                                     for value in (*automatic, *run)]
+
+
 def test_calibration_page_shows_the_bundled_calibrations_own_tables():
     # docs/calibration.md's "The chosen model" tables (posterior, correlations, in-sample,
     # leave-one-out, energy check) are data_samples/paper_calibration/summary.md's: its energy

@@ -425,7 +425,8 @@ def test_hdf5_store_with_several_measurements(tmp_path):
     with h5py.File(path, "w") as h5:
         write_measurement_group(h5.create_group("measurements/run_a"), a)
         write_measurement_group(h5.create_group("measurements/run_b"), b)
-    with pytest.raises(InputFileError, match=r"store\.h5.*run_a, run_b"):
+    with pytest.raises(InputFileError,
+                       match=r"store\.h5.*run_a \(made-up\.csv\), run_b \(made-up\.csv\)"):
         read_measurement(path)
     got = read_measurement(path, key="run_b")
     _assert_same(got, b, rtol=0.0)

@@ -629,3 +629,22 @@ def test_the_library_default_area_of_another_specimen_is_its_cells(paper_model):
     assert area_override_note(0.0104, paper_specimen()) == ""  # 4 %: within the tolerance
     assert area_override_note(0.0106, paper_specimen()).startswith(
         "area_m2 0.0106 m^2 is 1.06 x specimen paper_coupon's own 0.01 m^2")
+
+
+def test_stored_runs_of_one_fill_are_refused_naming_the_store(tmp_path, monkeypatch, capsys):
+    # `model damper --table store` of a store whose runs hold one fill said "SDC table:
+    # column fill_percent has 1 distinct value(s)", naming neither the store nor the fill
+    from pidcore.cli import main
+
+    runs = _specimen_runs("steel_6mm", "a" * 64, coupon_kg=0.05, fixture_kg=0.12,
+                          sdc_scale=0.5)
+    one_fill = runs[runs["fill_percent"] == 50.0]
+    _fake_store(monkeypatch, lambda: one_fill)
+    store = tmp_path / "s.h5"
+    assert main(["model", "damper", "--out", str(tmp_path / "out"), "--table", "store",
+                 "--store", str(store)]) == 2
+    err = capsys.readouterr().err
+    assert err == (f"pidcore model damper: error: DEM runs of steel_6mm [aaaaaa] in {store}: "
+                   "column fill_percent has 1 distinct value(s) (50); the model needs at "
+                   "least 2 per axis\n")
+    assert not (tmp_path / "out").exists()

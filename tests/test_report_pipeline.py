@@ -379,7 +379,13 @@ def test_a_store_of_several_measurements_is_reported_with_the_key_its_refusal_na
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and "choose one with --key NAME" in err, err
     assert not out.exists()
-    key = Store(held).list_measurements()["key"].iloc[0]
+    # each key beside the file it was imported from: the bare hashes said nothing of which
+    # test is which (`analyze STORE.h5` lists them the same way)
+    listing = Store(held).list_measurements()
+    for key, source in zip(listing["key"], listing["source"], strict=True):
+        assert f"{key} ({Path(source).name})" in err, err
+    assert {Path(f).name for f in files} == {Path(s).name for s in listing["source"]}
+    key = listing["key"].iloc[0]
     assert main(["report", str(held), "--key", key, "--fill", "50", "--out", str(out),
                  "--format", "csv", "--dem-store", str(samples.parent / "dem_table3.h5")]) == 0
     capsys.readouterr()

@@ -421,6 +421,11 @@ def test_harmonics_above_nyquist_are_dropped():
     res = analyze_power(rec.force_n, rec.velocity_m_s, fs, n_harmonics=5)
     assert list(res.harmonics) == [1, 2, 3]
     assert res.loss_factor == pytest.approx(truth(0.5, G, f, 2.0)[0], rel=1e-9)
+    # dropped without a word before, while the record's parameters keep the 5 asked
+    assert ("3 of the 5 drive harmonics asked fitted: harmonics 4 and above of 280 Hz lie "
+            "above 900 Hz, 0.9 x the Nyquist frequency of 2000 Hz sampling") in res.notes
+    every_one = analyze_power(rec.force_n, rec.velocity_m_s, fs, n_harmonics=3)
+    assert not [note for note in every_one.notes if "harmonics asked" in note]
 
 
 def test_bad_parameters_raise_parameter_error():

@@ -188,8 +188,8 @@ def test_specimen_check_labels_its_time_step_with_the_load_case_it_is_for(tmp_pa
         lines = {line[:16].strip(): line[16:] for line in capsys.readouterr().out.splitlines()}
         assert lines["time step"] == (
             f"{facts['time_step_s']:.4g} s at 50 Hz, 10 g (auto: 1/10 of that contact time), "
-            "the smallest of the Table 3 grid; a run takes its own load case's (dem run "
-            "prints it as dt)")
+            "the smallest of the Table 3 grid; a run takes its own load case's, shortened "
+            "to a whole number of steps per output sample (dem run prints that as dt)")
         assert "(50 Hz, 10 g)" in lines["contact time"]
         assert main(["specimen", "check", str(path), "--json"]) == 0
         doc = json.loads(capsys.readouterr().out)

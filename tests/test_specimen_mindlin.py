@@ -279,8 +279,9 @@ def test_specimen_check_says_what_sets_the_time_step(tmp_path, capsys):
         lines[name] = {line[:16].strip(): line[16:] for line in
                        capsys.readouterr().out.splitlines()}
         step = f"{facts['time_step_s']:.4g} s at 50 Hz, 10 g (auto: 1/10 of "
-        grid = ("), the smallest of the Table 3 grid; a run takes its own load case's (dem run "
-                "prints it as dt)")
+        grid = ("), the smallest of the Table 3 grid; a run takes its own load case's, "
+                "shortened to a whole number of steps per output sample (dem run prints that "
+                "as dt)")
         # rel=1e-15 below: the step is that time divided by 10 once, as here (one rounding)
         if name == "constant":  # the contact is the shorter: its tenth is the step
             assert facts["contact_time_s"] < facts["tangential_period_s"]

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import importlib.util
 import os
+import shlex
 import signal
 import subprocess
 import sys
@@ -31,7 +32,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                      help="read-only store of reference DEM runs shown next to the store's own "
                           "(default: data_samples/dem_table3.h5 if it exists here)")
     p.add_argument("--print-command", action="store_true",
-                   help="print the streamlit command line instead of running it")
+                   help="print the streamlit command line instead of running it, with the "
+                        "environment variables that name --store and --dem-store to it")
     p.set_defaults(func=run)
 
 
@@ -76,15 +78,27 @@ def app_environment(store: Path, dem_store: Path | None = None,
     return env
 
 
+def printed_command(command: list[str], env: dict[str, str]) -> str:
+    """``command`` as one shell line that serves what ``pidcore app`` would: the app reads
+    its stores from the environment, so the line sets those variables first (printed without
+    them it served ./pid_store.h5 whatever --store said)."""
+    from ..app.stores import DEM_STORE_ENV_VAR, STORE_ENV_VAR
+
+    assignments = [f"{name}={shlex.quote(env[name])}"
+                   for name in (STORE_ENV_VAR, DEM_STORE_ENV_VAR) if name in env]
+    return " ".join([*assignments, shlex.join(command)])
+
+
 def run(args: argparse.Namespace) -> int:
     command = streamlit_command(args.port)
+    # the environment first: --print-command refuses a missing --dem-store as a start does
+    env = app_environment(args.store, args.dem_store)
     if args.print_command:
-        print(" ".join(command))
+        print(printed_command(command, env))
         return 0
     if importlib.util.find_spec("streamlit") is None:
         raise ParameterError("the app needs Streamlit, which is not installed; "
                              "install it with: pip install 'pidcore[app]'")
-    env = app_environment(args.store, args.dem_store)
     print(f"pidcore app: http://localhost:{args.port}  (store {env['PIDCORE_STORE']}); "
           "Ctrl-C stops it", file=sys.stderr)
     server = subprocess.Popen(command, env=env)

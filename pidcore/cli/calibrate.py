@@ -36,7 +36,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     source = p.add_mutually_exclusive_group(required=True)
     source.add_argument("--data", metavar="TABLE.csv", type=path_argument,
                         help="measured SDCs: frequency_hz, acceleration_g, fill_percent, sdc "
-                             "[, sdc_stderr, energy_per_cycle_j, material, specimen]; a row "
+                             "[, sdc_stderr, sdc_stderr_dof, energy_per_cycle_j, material, "
+                             "specimen]; a row "
                              "without a material is of --specimen's particles (else acrylic); "
                              "one of another material than the specimen's is refused")
     source.add_argument("--store", metavar="FILE", type=path_argument,
@@ -56,7 +57,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--discrepancy-floor", metavar="SDC", type=float, default=DISCREPANCY_FLOOR,
                    help="absolute model-error floor on the SDC (default %(default)s)")
     p.add_argument("--cells", metavar="K", type=positive_int, default=None,
-                   help="cells per DEM run (default 4)")
+                   help="cells per DEM run, at least 2: the run's error is their scatter "
+                        "(default 4)")
     p.add_argument("--steady-cycles", metavar="N", type=positive_int, default=None,
                    help="steady cycles measured per DEM run (default: the DEM's)")
     p.add_argument("--design-size", metavar="N", type=positive_int, default=None,
@@ -89,7 +91,7 @@ def run(args: argparse.Namespace) -> int:
     from ..calibrate.parameters import parse_fit
     from ..calibrate.persist import save_calibration
     from ..calibrate.runner import RunTally
-    from ..errors import ParameterError
+    from ..errors import InputFileError, ParameterError
     from ..specimen import load_specimen
 
     if args.out is not None:  # said before the DEM runs and the fit, not after them
@@ -112,6 +114,10 @@ def run(args: argparse.Namespace) -> int:
         points = read_measured_table(args.data, default_material=default_material,
                                      specimen=specimen)
     else:
+        if not Path(args.store).is_file():
+            # read as an empty store, a mistyped path said it held no analysed measurements
+            raise InputFileError(f"{args.store}: store not found; expected the store that "
+                                 "pidcore analyze saved the measurements in")
         measured = measured_from_store(args.store, left_out=left_out, specimen=specimen)
         points = _store_points(measured, specimen, args.store, left_out)
         for note in left_out:

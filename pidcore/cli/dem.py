@@ -100,7 +100,10 @@ def _add_config_options(p: argparse.ArgumentParser) -> None:
                    default=defaults.DEM_TIME_STEP_MODE,
                    help=f"time step, s, or 'auto' (default: min({defaults.DEM_TIME_STEP_S:g} "
                         f"s, contact time / {defaults.DEM_MIN_STEPS_PER_CONTACT}, a stuck "
-                        f"tangential spring's period / {defaults.DEM_MIN_STEPS_PER_CONTACT}))")
+                        f"tangential spring's period / {defaults.DEM_MIN_STEPS_PER_CONTACT}); "
+                        "either is shortened to a whole number of steps per output sample "
+                        f"({defaults.DEM_SAMPLES_PER_CYCLE} per drive period; dem run "
+                        "prints the step taken as dt))")
     p.add_argument("--damping-mode", choices=NORMAL_DAMPING_MODES,
                    default=defaults.DEM_NORMAL_DAMPING_MODE,
                    help=f"normal damping at contact end (default "

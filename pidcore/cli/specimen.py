@@ -132,7 +132,8 @@ def format_facts(f: dict, source: str) -> str:
         # a run at 500 Hz takes a longer step than this one: the line read as the run's step
         f"time step       {f['time_step_s']:.4g} s at {_reference_case(f)} (auto: "
         f"{_step_limit(f)}), the smallest of the Table 3 grid; a run takes its own load "
-        "case's (dem run prints it as dt)",
+        "case's, shortened to a whole number of steps per output sample (dem run prints "
+        "that as dt)",
         *(f"note: {note}" for note in f["notes"]),
     ])
 

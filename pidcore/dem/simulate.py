@@ -680,15 +680,24 @@ def check_drive(case: LoadCase, config: DemConfig | None = None,
     law = contact_law(specimen, alpha_pp=config.alpha_pp, alpha_pw=config.alpha_pw)
     dt_req = choose_time_step(case, law, specimen.geometry(), config.time_step,
                               config.tangential_model)
-    period = 1.0 / case.frequency_hz
-    steps_per_cycle = math.ceil(period / (config.samples_per_cycle * dt_req)) \
-        * config.samples_per_cycle
-    check_drive_sampling(case, dt_s=period / steps_per_cycle, contact_step_s=dt_req,
+    _, dt = drive_sampling(case, dt_req, config.samples_per_cycle)
+    check_drive_sampling(case, dt_s=dt, contact_step_s=dt_req,
                          samples_per_cycle=config.samples_per_cycle,
                          what=what.split("/")[0])  # the frequency's option
     n, _ = particles_per_cell(case.fill_percent, specimen=specimen,
                               fill_reference=config.fill_reference)
     check_cells_fit_memory(config.cells, n)
+
+
+def drive_sampling(case: LoadCase, contact_step_s: float,
+                   samples_per_cycle: int) -> tuple[int, float]:
+    """(steps per output sample, time step in s) of a run: the contacts' step
+    (:func:`choose_time_step`) shortened so that a drive period is a whole number of steps
+    per each of its ``samples_per_cycle`` samples. This is the ``dt`` a run reports, up to a
+    few % below the automatic step (steel_6mm at 500 Hz, 5 g: 6.98e-7 s -> 6.79e-7 s)."""
+    period = 1.0 / case.frequency_hz
+    sample_every = math.ceil(period / (samples_per_cycle * contact_step_s))
+    return sample_every, period / (sample_every * samples_per_cycle)
 
 
 def check_drive_sampling(case: LoadCase, *, dt_s: float, contact_step_s: float,
@@ -763,10 +772,8 @@ def simulate_load_case(case: LoadCase, config: DemConfig | None = None, *,
     check_cells_fit_memory(config.cells, n)
     dt_req = choose_time_step(case, law, geometry, config.time_step, config.tangential_model)
     spc_samples = config.samples_per_cycle
-    period = 1.0 / case.frequency_hz
-    sample_every = math.ceil(period / (spc_samples * dt_req))
+    sample_every, dt = drive_sampling(case, dt_req, spc_samples)
     steps_per_cycle = sample_every * spc_samples
-    dt = period / steps_per_cycle
     check_drive_sampling(case, dt_s=dt, contact_step_s=dt_req, samples_per_cycle=spc_samples)
     if config.damping_coefficient == "calibrated":
         from .impact import calibrate_damping_coefficient
@@ -926,6 +933,7 @@ def config_parameters(case: LoadCase, config: DemConfig) -> dict:
 
 
 __all__ = ["LoadCase", "DemConfig", "simulate_load_case", "resolve_specimen", "choose_time_step",
+           "drive_sampling",
            "particles_of_stated_fill", "particles_per_cell", "vibrated_mass_kg",
            "coupon_mass_kg", "max_impact_speed",
            "settle", "settle_bed", "clear_settled_beds", "config_parameters"]

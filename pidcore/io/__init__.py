@@ -55,7 +55,7 @@ from ..errors import InputFileError, ParameterError, PidcoreError, instance_of
 from ..records import Measurement
 from ._common import HDF5_SIGNATURE, reraise_interrupt
 from .delimited import read_csv, write_csv
-from .hdf5 import hdf5_keys, read_hdf5, write_hdf5
+from .hdf5 import hdf5_key_sources, hdf5_keys, read_hdf5, write_hdf5
 from .matlab import read_mat, write_mat
 from .roles import RoleAssignment, assign_roles, name_suggests
 from .uff import read_uff, write_uff
@@ -251,8 +251,10 @@ def _read(path: str | os.PathLike[str], fmt: str, sample_rate_hz: float | None,
                           sample_rate_hz, path)
     keys = hdf5_keys(path)
     if key is None and len(keys) > 1:
+        sources = hdf5_key_sources(path, keys)
+        listed = ", ".join(f"{k} ({sources[k]})" if k in sources else k for k in keys)
         raise InputFileError(f"{display_path(path)}: holds {len(keys)} measurements "
-                             f"({', '.join(keys)}); choose one with key=NAME")
+                             f"({listed}); choose one with key=NAME")
     return _rate_kept(_displayed(read_hdf5(path, key=key)[0], path), sample_rate_hz, path)
 
 

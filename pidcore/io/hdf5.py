@@ -68,6 +68,23 @@ def hdf5_keys(path: str | os.PathLike[str]) -> list[str]:
                          f"'/{MEASUREMENTS_GROUP}/'")
 
 
+def hdf5_key_sources(path: str | os.PathLike[str], keys: list[str]) -> dict[str, str]:
+    """The file name each measurement ``key`` of a store was imported from (its ``source``,
+    without folders), for a message that asks the user to choose one by key: the keys alone
+    are hashes that say nothing of which test is which. A key without one is left out."""
+    names: dict[str, str] = {}
+    with h5py.File(str(path), "r") as h5:  # checked by hdf5_keys before any key is known
+        group = h5.get(MEASUREMENTS_GROUP)
+        for key in keys:
+            item = group.get(key) if isinstance(group, h5py.Group) else None
+            source = item.attrs.get("source") if isinstance(item, h5py.Group) else None
+            if isinstance(source, bytes):
+                source = source.decode("utf-8", "replace")
+            if isinstance(source, str) and source.strip():
+                names[key] = os.path.basename(source.strip())
+    return names
+
+
 def _contents(h5: h5py.File) -> str:
     """What a file without measurements holds, for the message: ``48 dem_runs, ...``."""
     parts = [f"{len(item)} {name}" if isinstance(item, h5py.Group) else name

@@ -252,8 +252,12 @@ class SdcModel:
         axes = tuple(np.unique(coords[name].to_numpy()) for name in AXIS_NAMES)
         for name, ax in zip(AXIS_NAMES, axes, strict=True):
             if ax.size < 2:
-                raise ParameterError(f"SDC table: column {name} has {ax.size} distinct value(s); "
-                                     f"the model needs at least 2 per axis")
+                # named by its source: `model damper --table store` of a store holding one
+                # fill said only "SDC table", not which store's runs fell short
+                values = ", ".join(f"{v:g}" for v in ax)
+                raise ParameterError(f"{source or 'SDC table'}: column {name} has {ax.size} "
+                                     f"distinct value(s) ({values}); the model needs at least "
+                                     "2 per axis")
         full = pd.MultiIndex.from_product(axes, names=list(AXIS_NAMES))
         grid = mean.reindex(full).to_numpy().reshape(tuple(a.size for a in axes))
         values, filled = _fill_holes_along_fill(grid, axes)

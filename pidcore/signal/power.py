@@ -568,6 +568,15 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
     if n_harm < 1:
         raise SignalError(f"{what}: drive frequency {freq:.6g} Hz is too close to the Nyquist "
                           f"frequency {sample_rate_hz / 2:g} Hz")
+    harmonics_note = ""
+    if n_harm < int(n_harmonics):
+        # the fit cannot resolve them; the record's parameters keep the number asked, so say
+        # how many the result holds (--harmonics 20 at 1000 Hz fitted 11 without a word)
+        limit_hz = defaults.HARMONIC_MAX_FRACTION_OF_NYQUIST * 0.5 * sample_rate_hz
+        harmonics_note = (f"{n_harm} of the {int(n_harmonics)} drive harmonics asked fitted: "
+                          f"harmonics {n_harm + 1} and above of {freq:.6g} Hz lie above "
+                          f"{limit_hz:.6g} Hz, {defaults.HARMONIC_MAX_FRACTION_OF_NYQUIST:g} x "
+                          f"the Nyquist frequency of {sample_rate_hz:g} Hz sampling")
     harmonics = np.arange(1, n_harm + 1)
     omega = 2 * np.pi * freq
     theta = omega / sample_rate_hz
@@ -711,7 +720,8 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
         n_blocks=k_blocks,
         uncertainty_note=uncertainty_note,
         corrections=corrections,
-        notes=tuple(n for n in (zeta_note, uncertainty_note, baseline_note, drift_note) if n),
+        notes=tuple(n for n in (zeta_note, uncertainty_note, baseline_note, drift_note,
+                                harmonics_note) if n),
     )
 
 
