@@ -51,7 +51,7 @@ from .records import Channel, Measurement
 from .signal import PowerAnalysis, analyze_channels
 from .signal.power import PROBABLY_INVERTED, check_analysis_settings
 from .signal.validate import SAME_RATE_RELATIVE_TOLERANCE
-from .units import lookup_unit, read_unit
+from .units import given_time_unit, lookup_unit, read_unit
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -90,6 +90,7 @@ class AnalysisOptions:
     velocity_unit: str | None = None
     acceleration_unit: str | None = None
     invert: tuple[str, ...] = ()
+    time_unit: str | None = None
 
     def __post_init__(self) -> None:
         if isinstance(self.invert, str):
@@ -99,10 +100,11 @@ class AnalysisOptions:
         # refused when made, naming the keyword, not when the first file is analysed (or, for
         # a string, as a TypeError from inside the analysis)
         for name in ("force", "velocity", "acceleration", "force_unit", "velocity_unit",
-                     "acceleration_unit"):
+                     "acceleration_unit", "time_unit"):
             instance_of(name, getattr(self, name), (str, type(None)))
         for name in self.invert:
             instance_of("invert", name, str)
+        given_time_unit(self.time_unit)  # a unit of time, refused naming the keyword
         instance_of("allow_clipped", self.allow_clipped, (bool, np.bool_))
         for name in ("velocity_delay_s", "mass_below_gauge_kg", "baseline_loss_factor"):
             # -0 (a sidecar's '-0', --velocity-delay -0) is no correction: saved as -0.0 it
@@ -431,7 +433,8 @@ def analyze_file(path: str | os.PathLike, options: AnalysisOptions | None = None
     options = AnalysisOptions() if options is None else options
     instance_of("options", options, AnalysisOptions,
                 hint="e.g. AnalysisOptions(velocity_delay_s=5e-5)")
-    measurement = read_measurement(Path(path), sample_rate_hz=options.sample_rate_hz, key=key)
+    measurement = read_measurement(Path(path), sample_rate_hz=options.sample_rate_hz, key=key,
+                                   time_unit=options.time_unit)
     return analyze_measurement(measurement, options)
 
 

@@ -16,7 +16,7 @@ import re
 from dataclasses import dataclass
 
 from .constants import SI_UNITS, STANDARD_GRAVITY
-from .errors import ParameterError, a_or_an
+from .errors import ParameterError, a_or_an, instance_of
 
 
 @dataclass(frozen=True)
@@ -318,6 +318,21 @@ def to_si_factor(unit: str, quantity: str | None = None, *, what: str = "unit") 
         raise ParameterError(f"{what}: unit {unit!r} is {a_or_an(info.quantity)} unit, "
                              f"expected {a_or_an(quantity)} unit ({SI_UNITS[quantity]})")
     return info.factor
+
+
+def given_time_unit(time_unit: str | None) -> UnitReading | None:
+    """The reading of ``time_unit``, the unit a user states for a file's time base (a UFF
+    abscissa, a time column), or None where none is given; a unit that is not one of time
+    is refused naming the keyword."""
+    if time_unit is None:
+        return None
+    instance_of("time_unit", time_unit, str, hint="e.g. 'ms'")
+    reading = read_unit(time_unit)
+    if reading.info is None or reading.info.quantity != "time":
+        why = f": {reading.problem}" if reading.problem else ""
+        raise ParameterError(f"time_unit={time_unit!r}: not a unit of time{why}; expected "
+                             "s, ms or us")
+    return reading
 
 
 def g_to_si(value_g: float) -> float:

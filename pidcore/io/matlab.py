@@ -38,6 +38,7 @@ from ..atomic_files import atomic_path
 from ..constants import SI_UNITS
 from ..errors import InputFileError, ParameterError
 from ..records import Channel, Measurement
+from ..units import UnitReading, given_time_unit
 from ._common import (
     HDF5_SIGNATURE,
     file_sha256,
@@ -355,8 +356,8 @@ def _lms_layout(signal: object, where: str) -> list[Channel]:
     return channels
 
 
-def _simple_layout(variables: Mapping, where: str,
-                   sample_rate_hz: float | None) -> tuple[list[Channel], list[str]]:
+def _simple_layout(variables: Mapping, where: str, sample_rate_hz: float | None,
+                   time_unit: UnitReading | None = None) -> tuple[list[Channel], list[str]]:
     public = {k: v for k, v in variables.items() if not k.startswith("__")}
     time_key = next((k for k in _TIME_VARIABLES if _numeric_vector(public.get(k)) is not None),
                     None)
@@ -369,15 +370,21 @@ def _simple_layout(variables: Mapping, where: str,
                      f"{rate:g} Hz was given (sample_rate_hz)"
                      + overridden_rate(_numeric_vector(public[time_key]), rate))
     elif time_key is not None:
-        rate, start, note = rate_from_times(_numeric_vector(public[time_key]),
-                                            what=f"{where}: variable {time_key!r}",
-                                            with_note=True)
+        seconds_per_unit = 1.0 if time_unit is None else time_unit.info.factor
+        rate, start, note = rate_from_times(
+            _numeric_vector(public[time_key]) * seconds_per_unit,
+            what=f"{where}: variable {time_key!r}", with_note=True)
         n = _numeric_vector(public[time_key]).size
         notes += [note] if note else []
-        # a vector states no unit: as for a CSV time column without one, the assumption is said
-        notes.append(f"{where}: time vector {time_key!r} states no unit: taken as seconds "
-                     f"(sample rate {rate:.6g} Hz); if it is not, give the sample rate "
-                     "(sample_rate_hz)")
+        if time_unit is not None:
+            notes.append(f"{where}: time vector {time_key!r} taken as {time_unit.label!r} "
+                         f"(time_unit), sample rate {rate:.6g} Hz")
+        else:
+            # a vector states no unit: as for a CSV time column without one, the assumption
+            # is said
+            notes.append(f"{where}: time vector {time_key!r} states no unit: taken as seconds "
+                         f"(sample rate {rate:.6g} Hz); if it is not, give its unit "
+                         "(time_unit=UNIT) or the sample rate (sample_rate_hz)")
     elif rate_key is not None or sample_rate_hz is not None:
         try:
             rate = (real_scalar(public[rate_key], where=f"{where}: variable {rate_key}",
@@ -412,8 +419,13 @@ def _simple_layout(variables: Mapping, where: str,
             for k, v in vectors.items()], notes
 
 
-def read_mat(path: str | os.PathLike[str], *, sample_rate_hz: float | None = None) -> Measurement:
+def read_mat(path: str | os.PathLike[str], *, sample_rate_hz: float | None = None,
+             time_unit: str | None = None) -> Measurement:
     """Read a MATLAB file in one of the layouts of this module into a SI measurement.
+
+    ``time_unit`` (``"ms"``) is the unit of a simple layout's time vector, which states none
+    (seconds without it, noted); the pidcore and Test.Lab layouts state their rate in Hz and
+    increment in s, and keep them (a note says the unit given was not applied).
 
     Raises
     ------
@@ -421,6 +433,7 @@ def read_mat(path: str | os.PathLike[str], *, sample_rate_hz: float | None = Non
         Unreadable file, or none of the layouts found (the message lists the variables).
     """
     where = str(path)
+    given_time = given_time_unit(time_unit)
     variables = _load(where)
     notes: list[str] = []
     if _text(variables.get("pidcore_layout")) == "measurement":
@@ -430,8 +443,11 @@ def read_mat(path: str | os.PathLike[str], *, sample_rate_hz: float | None = Non
         channels = _lms_layout(variables["Signal"], where)
         layout = "lms_testlab"
     else:
-        channels, notes = _simple_layout(variables, where, sample_rate_hz)
+        channels, notes = _simple_layout(variables, where, sample_rate_hz, given_time)
         layout = "simple"
+    if given_time is not None and layout != "simple":
+        notes.append(f"{where}: the time unit {time_unit!r} given (time_unit) is not applied: "
+                     f"the {layout} layout states its rate in Hz (its increment in s)")
     if not channels:
         names = ", ".join(k for k in variables if not k.startswith("__")) or "none"
         raise InputFileError(f"{where}: no channel found (variables: {names}); expected numeric "
