@@ -51,7 +51,7 @@ from .records import Channel, Measurement
 from .signal import PowerAnalysis, analyze_channels
 from .signal.power import PROBABLY_INVERTED, check_analysis_settings
 from .signal.validate import SAME_RATE_RELATIVE_TOLERANCE
-from .units import given_time_unit, lookup_unit, read_unit
+from .units import given_time_unit, lookup_unit, milli_g, read_unit
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -173,6 +173,14 @@ _UNIT_EXAMPLES = {"force": "N, kN, lbf", "velocity": "m/s, mm/s, in/s",
 def _with_unit(ch: Channel, role: str, unit: str | None, source: str,
                notes: list[str], corrections: dict) -> Channel:
     """The channel in SI: its file unit, or ``unit`` (an option) which overrides it."""
+    if unit is None and role == "acceleration" and ch.quantity == "unknown" and \
+            (thousandth := milli_g(ch.source_unit)) is not None:
+        # 'mg' is a milligram in SI (pint's reading), a milli-g on an accelerometer: a
+        # channel that is an acceleration by its name or its option can only mean the latter
+        notes.append(f"channel {ch.name!r} (acceleration): unit {ch.source_unit!r} read as "
+                     f"milli-g ({thousandth.factor:.6g} m/s^2), not the milligram")
+        return Channel(ch.name, role, np.asarray(ch.data) * thousandth.factor,
+                       ch.sample_rate_hz, ch.source_unit, ch.start_time_s)
     if unit is None:
         if ch.quantity == "unknown":
             problem = read_unit(ch.source_unit).problem
@@ -189,9 +197,15 @@ def _with_unit(ch: Channel, role: str, unit: str | None, source: str,
         return ch
     reading = read_unit(unit)
     info = reading.info
-    if info is None or info.quantity != role:
+    thousandth = milli_g(unit) if role == "acceleration" else None
+    if thousandth is not None:
+        # an acceleration's unit: 'mg' can only be the milli-g here, not the milligram
+        info = thousandth
+        notes.append(f"{_UNIT_OPTIONS[role]}: {unit!r} read as milli-g "
+                     f"({info.factor:.6g} m/s^2), not the milligram")
+    elif info is None or info.quantity != role:
         why = f": {reading.problem}" if reading.problem else ""
-        raise ParameterError(f"{_UNIT_OPTIONS[role]}={unit!r}: not a {role} unit{why}")
+        raise ParameterError(f"{_UNIT_OPTIONS[role]}={unit!r}: not {a_or_an(role)} unit{why}")
     if reading.corrected:
         notes.append(f"{_UNIT_OPTIONS[role]}: {reading.correction}")
     if ch.quantity != "unknown":

@@ -335,6 +335,23 @@ def given_time_unit(time_unit: str | None) -> UnitReading | None:
     return reading
 
 
+#: Spellings of milli-g (1e-3 standard gravity) that accelerometer channels are exported in.
+#: SI reads ``mg`` as the milligram, a mass, so :func:`read_unit` does not take them: only a
+#: channel that is an acceleration by its name or role is read so (:func:`milli_g`), and said.
+MILLI_G_SPELLINGS = frozenset({"mg", "mgn", "milli-g", "milli-gn"})
+
+
+def milli_g(label: str) -> UnitInfo | None:
+    """1e-3 g where ``label`` is a spelling of milli-g (:data:`MILLI_G_SPELLINGS`, its case
+    kept: ``MG`` is no milli-g), else None. For a channel known to be an acceleration only.
+
+    >>> milli_g("mg").factor, milli_g("mm")
+    (0.00980665, None)
+    """
+    return (UnitInfo("acceleration", 1e-3 * STANDARD_GRAVITY)
+            if _cased_text(label) in MILLI_G_SPELLINGS else None)
+
+
 def g_to_si(value_g: float) -> float:
     """Acceleration in g to m/s^2 (standard gravity)."""
     return value_g * STANDARD_GRAVITY
