@@ -191,3 +191,34 @@ def test_a_time_unit_is_not_applied_to_an_hdf5_rate(tmp_path):
         f"{SAMPLE_H5}: the time unit 'ms' given (time_unit) is not applied: an HDF5 file "
         "states its channels' rate in Hz; the option sets the unit of UFF abscissas, CSV time "
         "columns and MATLAB time vectors")
+
+
+# --- the drive frequency the user expects tells a time base read in the wrong unit ---------
+
+def test_a_hint_above_the_rate_of_a_time_base_in_ms_names_the_time_unit(tmp_path, capsys):
+    # the label says s, the increments are ms: the rate read is 25.6 Hz, and the 50 Hz the
+    # user expects cannot be in it
+    path = uff_in_ms(tmp_path / "s", b"s   ")
+    err = refusal(["analyze", str(path), "--no-store", "--no-progress", "--frequency", "50"],
+                  capsys)
+    assert err == ("pidcore analyze: error: --frequency: 50 Hz is not below the Nyquist "
+                   "frequency 12.8 Hz of the sample rate 25.6 Hz; correct the hint, or the "
+                   "file's time unit (--time-unit UNIT) where its time base is in ms or us "
+                   "read as s")
+    record = analyze_json(path, capsys, "--frequency", "50", "--time-unit", "ms")
+    assert record["frequency_hz"] == pytest.approx(50.0, rel=2e-7)
+
+
+def test_a_drive_found_1000_x_the_hint_names_the_time_unit(tmp_path, capsys):
+    # the label says ms, the increments are seconds: the drive is found at 50 kHz
+    raw = SAMPLE_UFF.read_bytes()
+    path = tmp_path / SAMPLE_UFF.name
+    path.write_bytes(raw.replace(SECONDS_LABEL, SECONDS_LABEL[:-4] + b"ms  "))
+    err = refusal(["analyze", str(path), "--no-store", "--no-progress", "--frequency", "50"],
+                  capsys)
+    assert err.startswith(f"pidcore analyze: error: {path}: ")
+    assert err.endswith("outside +-5 % of the frequency hint 50 Hz; it is 1000 x the hint, as "
+                        "from a time base read in the wrong unit (s read as ms): give the "
+                        "file's time unit (--time-unit UNIT) or correct the hint (--frequency) "
+                        "or leave it out")
+    assert "50000 Hz" in err  # the line found: 1000 x the 50 Hz drive
