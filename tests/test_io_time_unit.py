@@ -222,3 +222,38 @@ def test_a_drive_found_1000_x_the_hint_names_the_time_unit(tmp_path, capsys):
                         "file's time unit (--time-unit UNIT) or correct the hint (--frequency) "
                         "or leave it out")
     assert "50000 Hz" in err  # the line found: 1000 x the 50 Hz drive
+
+
+# --- MATLAB Test.Lab signals: x_values in the unit their quantity states ------------------
+
+def exported_testlab_mat(path: Path, x_quantity: dict) -> Path:
+    """A Test.Lab ``Signal`` struct of the sample CSV's force whose x_values are written in
+    ms (increment 3.90625e-02) under ``x_quantity``."""
+    force = np.loadtxt(SAMPLE_CSV, delimiter=",", skiprows=1)[:, 1]
+    scipy.io.savemat(path, {"Signal": {
+        "x_values": {"start_value": 0.0, "increment": 3.90625e-02,
+                     "number_of_values": force.size, "quantity": x_quantity},
+        "y_values": {"values": force, "quantity": {"label": "Force", "unit": "N"}},
+        "function_record": {"name": "Force"}}})
+    return path
+
+
+def test_a_testlab_increment_in_ms_is_read_in_ms(tmp_path):
+    path = exported_testlab_mat(tmp_path / "ms.mat", {"label": "Time", "unit": "ms"})
+    assert read_measurement(path).channels[0].sample_rate_hz == pytest.approx(RATE_HZ, rel=1e-12)
+    seconds = exported_testlab_mat(tmp_path / "s.mat", {"label": "Time"})  # no unit: Test.Lab's s
+    assert read_measurement(seconds).channels[0].sample_rate_hz == pytest.approx(RATE_HZ / 1e3)
+
+
+def test_a_testlab_increment_of_no_time_unit_is_refused_until_given(tmp_path):
+    path = exported_testlab_mat(tmp_path / "msek.mat", {"label": "Time", "unit": "msek"})
+    with pytest.raises(InputFileError) as info:
+        read_measurement(path)
+    assert str(info.value) == (f"{path}: Signal(1): x_values unit 'msek' is no unit of time "
+                               "pidcore reads; expected a unit of time such as s or ms "
+                               "(x_values.increment is in it, so it sets the sample rate); give "
+                               "it with time_unit=UNIT")
+    given = read_measurement(path, time_unit="ms")
+    assert given.channels[0].sample_rate_hz == pytest.approx(RATE_HZ, rel=1e-12)
+    assert given.metadata["reader_notes"] == [
+        f"{path}: Signal(1): x_values unit 'msek' overridden: taken as 'ms' (time_unit)"]

@@ -163,8 +163,8 @@ def add_measurement_options(p: argparse.ArgumentParser) -> None:
     g.add_argument("--time-unit", metavar="UNIT", default=None,
                    help="unit of the file's time base (s, ms, us): a UFF abscissa whose label "
                         "pidcore does not read (refused without it), a CSV time column or "
-                        "MATLAB time vector without a unit (otherwise seconds, noted); "
-                        "overrides the file's (noted)")
+                        "MATLAB time vector without a unit (otherwise seconds, noted), a "
+                        "Testlab MAT signal's x_values; overrides the file's (noted)")
     g.add_argument("--invert", metavar="NAME", action="append", default=None,
                    help="invert the sign of this channel (a sensor mounted the other way); "
                         "repeatable; replaces the sidecar's invert column")
