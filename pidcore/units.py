@@ -73,6 +73,11 @@ _TABLE: dict[str, UnitInfo] = {
     "mV": UnitInfo("voltage", 1e-3),
     "s": UnitInfo("time", 1.0),
     "sec": UnitInfo("time", 1.0),
+    # time axes written as words ('Seconds', 'SECS'): no prefix in them, so their case is
+    # corrected (noted); a UFF abscissa label of no unit is refused
+    "secs": UnitInfo("time", 1.0),
+    "second": UnitInfo("time", 1.0),
+    "seconds": UnitInfo("time", 1.0),
     "ms": UnitInfo("time", 1e-3),
     "us": UnitInfo("time", 1e-6),
 }

@@ -257,3 +257,17 @@ def test_a_testlab_increment_of_no_time_unit_is_refused_until_given(tmp_path):
     assert given.channels[0].sample_rate_hz == pytest.approx(RATE_HZ, rel=1e-12)
     assert given.metadata["reader_notes"] == [
         f"{path}: Signal(1): x_values unit 'msek' overridden: taken as 'ms' (time_unit)"]
+
+
+@pytest.mark.parametrize("label", [b"Seconds ", b"SECS    "])
+def test_an_abscissa_in_seconds_written_as_a_word_is_read_and_said(tmp_path, label):
+    # no prefix in the word, so its case is no factor: read as seconds (it was, by luck, when
+    # every label pidcore did not read was taken as seconds), and the reading said
+    path = tmp_path / SAMPLE_UFF.name
+    path.write_bytes(SAMPLE_UFF.read_bytes().replace(SECONDS_LABEL + b"    ",
+                                                     SECONDS_LABEL[:-4] + label + b"    "))
+    measurement = read_measurement(path)
+    assert [c.sample_rate_hz for c in measurement.channels] == [25600.0] * 3  # 1 / 3.90625e-05
+    word = label.decode().strip()
+    assert (f"{path}: record 1 ('Force') abscissa unit {word!r} read as "
+            f"{word.lower()} (1 s)") in "\n".join(measurement.metadata["reader_notes"])
