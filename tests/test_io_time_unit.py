@@ -190,7 +190,7 @@ def test_a_time_unit_is_not_applied_to_an_hdf5_rate(tmp_path):
     assert kept.metadata["reader_notes"][-1] == (
         f"{SAMPLE_H5}: the time unit 'ms' given (time_unit) is not applied: an HDF5 file "
         "states its channels' rate in Hz; the option sets the unit of UFF abscissas, CSV time "
-        "columns and MATLAB time vectors")
+        "columns and MATLAB time vectors and x_values")
 
 
 # --- the drive frequency the user expects tells a time base read in the wrong unit ---------

@@ -203,11 +203,11 @@ def read_measurement(path: str | os.PathLike[str], *, sample_rate_hz: float | No
     key : str, optional
         Which measurement of a pidcore store (``/measurements/<key>``) to read.
     time_unit : str, optional
-        Unit of the file's time base (``"ms"``): a UFF abscissa and a CSV time column, where
-        the file states none or one that is no unit of time pidcore reads (refused without
-        it), and a MATLAB time vector; it overrides the file's (noted). HDF5 files and the
-        structured MATLAB layouts state their rate in Hz: a reader note says the unit given
-        was not applied.
+        Unit of the file's time base (``"ms"``): a UFF abscissa, a CSV time column, a MATLAB
+        time vector or Test.Lab ``x_values``, where the file states none (taken as seconds,
+        noted) or one that is no unit of time pidcore reads (refused without it); it
+        overrides the file's (noted). HDF5 files and pidcore's MATLAB layout state their rate
+        in Hz: a reader note says the unit given was not applied.
 
     Returns
     -------
@@ -258,7 +258,7 @@ def _time_unit_kept(measurement: Measurement, fmt: str, time_unit: str | None,
     notes = [*measurement.metadata.get("reader_notes", ()),
              f"{display_path(path)}: the time unit {time_unit!r} given (time_unit) is not "
              f"applied: an HDF5 file states its channels' rate in Hz; the option sets the unit "
-             "of UFF abscissas, CSV time columns and MATLAB time vectors"]
+             "of UFF abscissas, CSV time columns and MATLAB time vectors and x_values"]
     return replace(measurement, metadata={**measurement.metadata, "reader_notes": notes})
 
 
