@@ -51,7 +51,7 @@ from .records import Channel, Measurement
 from .signal import PowerAnalysis, analyze_channels
 from .signal.power import PROBABLY_INVERTED, check_analysis_settings
 from .signal.validate import SAME_RATE_RELATIVE_TOLERANCE
-from .units import lookup_unit, read_unit
+from .units import given_time_unit, lookup_unit, milli_g, read_unit
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -90,6 +90,7 @@ class AnalysisOptions:
     velocity_unit: str | None = None
     acceleration_unit: str | None = None
     invert: tuple[str, ...] = ()
+    time_unit: str | None = None
 
     def __post_init__(self) -> None:
         if isinstance(self.invert, str):
@@ -99,10 +100,11 @@ class AnalysisOptions:
         # refused when made, naming the keyword, not when the first file is analysed (or, for
         # a string, as a TypeError from inside the analysis)
         for name in ("force", "velocity", "acceleration", "force_unit", "velocity_unit",
-                     "acceleration_unit"):
+                     "acceleration_unit", "time_unit"):
             instance_of(name, getattr(self, name), (str, type(None)))
         for name in self.invert:
             instance_of("invert", name, str)
+        given_time_unit(self.time_unit)  # a unit of time, refused naming the keyword
         instance_of("allow_clipped", self.allow_clipped, (bool, np.bool_))
         for name in ("velocity_delay_s", "mass_below_gauge_kg", "baseline_loss_factor"):
             # -0 (a sidecar's '-0', --velocity-delay -0) is no correction: saved as -0.0 it
@@ -171,6 +173,14 @@ _UNIT_EXAMPLES = {"force": "N, kN, lbf", "velocity": "m/s, mm/s, in/s",
 def _with_unit(ch: Channel, role: str, unit: str | None, source: str,
                notes: list[str], corrections: dict) -> Channel:
     """The channel in SI: its file unit, or ``unit`` (an option) which overrides it."""
+    if unit is None and role == "acceleration" and ch.quantity == "unknown" and \
+            (thousandth := milli_g(ch.source_unit)) is not None:
+        # 'mg' is a milligram in SI (pint's reading), a milli-g on an accelerometer: a
+        # channel that is an acceleration by its name or its option can only mean the latter
+        notes.append(f"channel {ch.name!r} (acceleration): unit {ch.source_unit!r} read as "
+                     f"milli-g ({thousandth.factor:.6g} m/s^2), not the milligram")
+        return Channel(ch.name, role, np.asarray(ch.data) * thousandth.factor,
+                       ch.sample_rate_hz, ch.source_unit, ch.start_time_s)
     if unit is None:
         if ch.quantity == "unknown":
             problem = read_unit(ch.source_unit).problem
@@ -187,9 +197,15 @@ def _with_unit(ch: Channel, role: str, unit: str | None, source: str,
         return ch
     reading = read_unit(unit)
     info = reading.info
-    if info is None or info.quantity != role:
+    thousandth = milli_g(unit) if role == "acceleration" else None
+    if thousandth is not None:
+        # an acceleration's unit: 'mg' can only be the milli-g here, not the milligram
+        info = thousandth
+        notes.append(f"{_UNIT_OPTIONS[role]}: {unit!r} read as milli-g "
+                     f"({info.factor:.6g} m/s^2), not the milligram")
+    elif info is None or info.quantity != role:
         why = f": {reading.problem}" if reading.problem else ""
-        raise ParameterError(f"{_UNIT_OPTIONS[role]}={unit!r}: not a {role} unit{why}")
+        raise ParameterError(f"{_UNIT_OPTIONS[role]}={unit!r}: not {a_or_an(role)} unit{why}")
     if reading.corrected:
         notes.append(f"{_UNIT_OPTIONS[role]}: {reading.correction}")
     if ch.quantity != "unknown":
@@ -431,7 +447,8 @@ def analyze_file(path: str | os.PathLike, options: AnalysisOptions | None = None
     options = AnalysisOptions() if options is None else options
     instance_of("options", options, AnalysisOptions,
                 hint="e.g. AnalysisOptions(velocity_delay_s=5e-5)")
-    measurement = read_measurement(Path(path), sample_rate_hz=options.sample_rate_hz, key=key)
+    measurement = read_measurement(Path(path), sample_rate_hz=options.sample_rate_hz, key=key,
+                                   time_unit=options.time_unit)
     return analyze_measurement(measurement, options)
 
 

@@ -16,7 +16,7 @@ import re
 from dataclasses import dataclass
 
 from .constants import SI_UNITS, STANDARD_GRAVITY
-from .errors import ParameterError, a_or_an
+from .errors import ParameterError, a_or_an, instance_of
 
 
 @dataclass(frozen=True)
@@ -73,6 +73,11 @@ _TABLE: dict[str, UnitInfo] = {
     "mV": UnitInfo("voltage", 1e-3),
     "s": UnitInfo("time", 1.0),
     "sec": UnitInfo("time", 1.0),
+    # time axes written as words ('Seconds', 'SECS'): no prefix in them, so their case is
+    # corrected (noted); a UFF abscissa label of no unit is refused
+    "secs": UnitInfo("time", 1.0),
+    "second": UnitInfo("time", 1.0),
+    "seconds": UnitInfo("time", 1.0),
     "ms": UnitInfo("time", 1e-3),
     "us": UnitInfo("time", 1e-6),
 }
@@ -318,6 +323,38 @@ def to_si_factor(unit: str, quantity: str | None = None, *, what: str = "unit") 
         raise ParameterError(f"{what}: unit {unit!r} is {a_or_an(info.quantity)} unit, "
                              f"expected {a_or_an(quantity)} unit ({SI_UNITS[quantity]})")
     return info.factor
+
+
+def given_time_unit(time_unit: str | None) -> UnitReading | None:
+    """The reading of ``time_unit``, the unit a user states for a file's time base (a UFF
+    abscissa, a time column), or None where none is given; a unit that is not one of time
+    is refused naming the keyword."""
+    if time_unit is None:
+        return None
+    instance_of("time_unit", time_unit, str, hint="e.g. 'ms'")
+    reading = read_unit(time_unit)
+    if reading.info is None or reading.info.quantity != "time":
+        why = f": {reading.problem}" if reading.problem else ""
+        raise ParameterError(f"time_unit={time_unit!r}: not a unit of time{why}; expected "
+                             "s, ms or us")
+    return reading
+
+
+#: Spellings of milli-g (1e-3 standard gravity) that accelerometer channels are exported in.
+#: SI reads ``mg`` as the milligram, a mass, so :func:`read_unit` does not take them: only a
+#: channel that is an acceleration by its name or role is read so (:func:`milli_g`), and said.
+MILLI_G_SPELLINGS = frozenset({"mg", "mgn", "milli-g", "milli-gn"})
+
+
+def milli_g(label: str) -> UnitInfo | None:
+    """1e-3 g where ``label`` is a spelling of milli-g (:data:`MILLI_G_SPELLINGS`, its case
+    kept: ``MG`` is no milli-g), else None. For a channel known to be an acceleration only.
+
+    >>> milli_g("mg").factor, milli_g("mm")
+    (0.00980665, None)
+    """
+    return (UnitInfo("acceleration", 1e-3 * STANDARD_GRAVITY)
+            if _cased_text(label) in MILLI_G_SPELLINGS else None)
 
 
 def g_to_si(value_g: float) -> float:

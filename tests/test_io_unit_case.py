@@ -238,9 +238,11 @@ def test_uff_abscissa_in_an_ambiguous_time_unit_is_refused(tmp_path):
     path = _with_label(TESTLAB_LIKE_UFF, tmp_path / "ms.unv", line, line[:-4] + b"MS  ")
     with pytest.raises(InputFileError) as info:
         read_measurement(path)
-    assert str(info.value) == (f"{path}: record 1: abscissa unit 'MS' is ambiguous: unit prefixes "
-                               "are case-sensitive, and it reads as ms (0.001 s) or Ms (1e+06 s);"
-                               " expected a unit of time such as s or ms")
+    assert str(info.value) == (f"{path}: record 1 ('.1.Z-'): abscissa unit 'MS' is ambiguous: "
+                               "unit prefixes are case-sensitive, and it reads as ms (0.001 s) or "
+                               "Ms (1e+06 s); expected a unit of time such as s or ms (the "
+                               "abscissa increment 0.000488281 is in it, so it sets the sample "
+                               "rate); give it with time_unit=UNIT")
 
 
 def test_uff_velocity_label_in_capitals(tmp_path, capsys):

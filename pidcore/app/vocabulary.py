@@ -42,6 +42,7 @@ LABEL_OF_KEYWORD: dict[str, str] = {
     "force_unit": "`pidcore analyze --force-unit`",
     "velocity_unit": "`pidcore analyze --velocity-unit`",
     "acceleration_unit": "`pidcore analyze --acceleration-unit`",
+    "time_unit": "`pidcore analyze --time-unit`",
     "key=": "`pidcore analyze --key`",
     "dem_store": "the DEM store",
     "pool=True": "'pool DEM settings and specimens'",

@@ -160,6 +160,11 @@ def add_measurement_options(p: argparse.ArgumentParser) -> None:
     g.add_argument("--acceleration-unit", metavar="UNIT", default=None,
                    help="unit of the acceleration channel's values (m/s^2, g, ...); "
                         "case-sensitive")
+    g.add_argument("--time-unit", metavar="UNIT", default=None,
+                   help="unit of the file's time base (s, ms, us): a UFF abscissa whose label "
+                        "pidcore does not read (refused without it), a CSV time column or "
+                        "MATLAB time vector without a unit (otherwise seconds, noted), a "
+                        "Testlab MAT signal's x_values; overrides the file's (noted)")
     g.add_argument("--invert", metavar="NAME", action="append", default=None,
                    help="invert the sign of this channel (a sensor mounted the other way); "
                         "repeatable; replaces the sidecar's invert column")
@@ -196,5 +201,5 @@ def analysis_options(args: argparse.Namespace) -> AnalysisOptions:
         n_harmonics=args.harmonics, sample_rate_hz=args.sample_rate,
         allow_clipped=args.allow_clipped, force_unit=args.force_unit,
         velocity_unit=args.velocity_unit, acceleration_unit=args.acceleration_unit,
-        invert=tuple(args.invert or ()),
+        invert=tuple(args.invert or ()), time_unit=args.time_unit,
     )

@@ -36,6 +36,7 @@ FLAG_OF_KEYWORD: dict[str, str] = {
     "force_unit": "--force-unit",
     "velocity_unit": "--velocity-unit",
     "acceleration_unit": "--acceleration-unit",
+    "time_unit": "--time-unit",
     "force=": "--force ",
     "velocity=": "--velocity ",
     "acceleration=": "--acceleration ",

@@ -53,6 +53,7 @@ from pathlib import Path
 from ..constants import FileFormat
 from ..errors import InputFileError, ParameterError, PidcoreError, instance_of
 from ..records import Measurement
+from ..units import given_time_unit
 from ._common import HDF5_SIGNATURE, reraise_interrupt
 from .delimited import read_csv, write_csv
 from .hdf5 import hdf5_key_sources, hdf5_keys, read_hdf5, write_hdf5
@@ -184,8 +185,8 @@ def read_measurements(path: str | os.PathLike[str], *, sample_rate_hz: float | N
 
 
 def read_measurement(path: str | os.PathLike[str], *, sample_rate_hz: float | None = None,
-                     file_format: FileFormat | None = None, key: str | None = None
-                     ) -> Measurement:
+                     file_format: FileFormat | None = None, key: str | None = None,
+                     time_unit: str | None = None) -> Measurement:
     """Read one measurement file into SI channels.
 
     Parameters
@@ -201,6 +202,12 @@ def read_measurement(path: str | os.PathLike[str], *, sample_rate_hz: float | No
         Skip detection.
     key : str, optional
         Which measurement of a pidcore store (``/measurements/<key>``) to read.
+    time_unit : str, optional
+        Unit of the file's time base (``"ms"``): a UFF abscissa, a CSV time column, a MATLAB
+        time vector or Test.Lab ``x_values``, where the file states none (taken as seconds,
+        noted) or one that is no unit of time pidcore reads (refused without it); it
+        overrides the file's (noted). HDF5 files and pidcore's MATLAB layout state their rate
+        in Hz: a reader note says the unit given was not applied.
 
     Returns
     -------
@@ -222,8 +229,10 @@ def read_measurement(path: str | os.PathLike[str], *, sample_rate_hz: float | No
     if key is not None and fmt != "hdf5":
         raise ParameterError(f"{display_path(path)}: key={key!r} picks a measurement of a "
                              f"pidcore HDF5 store; this is a {fmt} file")
+    given_time_unit(time_unit)  # refused before the file is read, naming the keyword
     with _one_line_errors(path, fmt):
-        return _read(path, fmt, sample_rate_hz, key)
+        return _time_unit_kept(_read(path, fmt, sample_rate_hz, key, time_unit), fmt,
+                               time_unit, path)
 
 
 @contextmanager
@@ -240,14 +249,30 @@ def _one_line_errors(path: str | os.PathLike[str], fmt: str) -> Iterator[None]:
                              f"({type(exc).__name__}: {exc})") from None
 
 
+def _time_unit_kept(measurement: Measurement, fmt: str, time_unit: str | None,
+                    path: str | os.PathLike[str]) -> Measurement:
+    """``measurement`` with a reader note where ``time_unit`` was given for an HDF5 file,
+    which states its channels' rate in Hz (the MATLAB reader says so for its layouts)."""
+    if time_unit is None or fmt != "hdf5":
+        return measurement
+    notes = [*measurement.metadata.get("reader_notes", ()),
+             f"{display_path(path)}: the time unit {time_unit!r} given (time_unit) is not "
+             f"applied: an HDF5 file states its channels' rate in Hz; the option sets the unit "
+             "of UFF abscissas, CSV time columns and MATLAB time vectors and x_values"]
+    return replace(measurement, metadata={**measurement.metadata, "reader_notes": notes})
+
+
 def _read(path: str | os.PathLike[str], fmt: str, sample_rate_hz: float | None,
-          key: str | None) -> Measurement:
+          key: str | None, time_unit: str | None) -> Measurement:
     if fmt == "uff":
-        return _rate_kept(_displayed(read_uff(path), path), sample_rate_hz, path)
+        return _rate_kept(_displayed(read_uff(path, time_unit=time_unit), path),
+                          sample_rate_hz, path)
     if fmt == "csv":
-        return _displayed(read_csv(path, sample_rate_hz=sample_rate_hz), path)
+        return _displayed(read_csv(path, sample_rate_hz=sample_rate_hz, time_unit=time_unit),
+                          path)
     if fmt == "mat":
-        return _rate_kept(_displayed(read_mat(path, sample_rate_hz=sample_rate_hz), path),
+        return _rate_kept(_displayed(read_mat(path, sample_rate_hz=sample_rate_hz,
+                                              time_unit=time_unit), path),
                           sample_rate_hz, path)
     keys = hdf5_keys(path)
     if key is None and len(keys) > 1:

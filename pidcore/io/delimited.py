@@ -37,7 +37,7 @@ import pandas as pd
 from ..atomic_files import atomic_path
 from ..errors import InputFileError, ParameterError, clipped
 from ..records import Measurement
-from ..units import read_unit
+from ..units import UnitReading, given_time_unit, read_unit
 from ._common import (
     file_sha256,
     interpret_unit,
@@ -299,7 +299,8 @@ def _check_line_lengths(path: str | os.PathLike[str], where: str) -> None:
                                      "(is the file one line, or binary?)")
 
 
-def read_csv(path: str | os.PathLike[str], *, sample_rate_hz: float | None = None) -> Measurement:
+def read_csv(path: str | os.PathLike[str], *, sample_rate_hz: float | None = None,
+             time_unit: str | None = None) -> Measurement:
     """Read a delimited text file of channels into a SI :class:`Measurement`.
 
     Parameters
@@ -308,6 +309,9 @@ def read_csv(path: str | os.PathLike[str], *, sample_rate_hz: float | None = Non
     sample_rate_hz : float, optional
         Sample rate, Hz, for files without a time column; with a time column it overrides the
         column (the measurement's ``reader_notes`` say so).
+    time_unit : str, optional
+        Unit of the time columns (``"ms"``): for a column without one, which is otherwise
+        taken as seconds (noted); it overrides a column's own unit (noted).
 
     Examples
     --------
@@ -315,6 +319,7 @@ def read_csv(path: str | os.PathLike[str], *, sample_rate_hz: float | None = Non
     quantity ``force`` in N sampled at 1000 Hz.
     """
     where = str(path)
+    given_time = given_time_unit(time_unit)
     with open(path, "rb") as fh:
         head = fh.read(_HEAD_BYTES)
         complete = not fh.read(1)
@@ -369,15 +374,15 @@ def read_csv(path: str | os.PathLike[str], *, sample_rate_hz: float | None = Non
         rate, start_time = float(sample_rate_hz), 0.0
         if time_index is not None:
             name, unit = cells[time_index]
-            factor = _seconds_per(unit)
+            factor = _seconds_per(unit, given_time)
             start_time = float(values[0, time_index]) * factor
             notes.append(f"{where}: time column {name!r} ignored: the sample rate "
                          f"{rate:g} Hz was given (sample_rate_hz)"
                          + overridden_rate(values[:, time_index] * factor, rate))
     elif time_index is not None:
         name, unit = cells[time_index]
-        factor = _seconds_per(unit)
-        if read_unit(unit).corrected:
+        factor = _seconds_per(unit, given_time)
+        if read_unit(unit).corrected and given_time is None:
             # 'Time [US]' is µs, a factor the header's case did not state: said
             notes.append(f"{where}: time column {name!r}: {read_unit(unit).correction}")
         rate, start_time, note = rate_from_times(values[:, time_index] * factor,
@@ -385,12 +390,17 @@ def read_csv(path: str | os.PathLike[str], *, sample_rate_hz: float | None = Non
                                                  with_note=True)
         if note:
             notes.append(note)
-        if not unit:
+        if given_time is not None:
+            if _overridden(unit, given_time):
+                notes.append(f"{where}: time column {name!r} ({unit or 'no unit'}) taken as "
+                             f"{given_time.label!r} (time_unit), sample rate {rate:.6g} Hz")
+        elif not unit:
             # a time in ms read as s makes the frequency, acceleration and energy per cycle
             # 1000 x off (the loss factor and SDC unchanged): the assumption is said
             notes.append(f"{where}: time column {name!r} has no unit: taken as seconds "
                          f"(sample rate {rate:.6g} Hz); if it is not, write its unit in the "
-                         "header ('Time [ms]') or give the sample rate (sample_rate_hz)")
+                         "header ('Time [ms]'), give it (time_unit=UNIT) or give the sample "
+                         "rate (sample_rate_hz)")
     else:
         raise InputFileError(f"{where}: no time column{_unread_time_header(header_cells)} "
                              f"and no sample rate (a time column is headed "
@@ -406,7 +416,7 @@ def read_csv(path: str | os.PathLike[str], *, sample_rate_hz: float | None = Non
     names = unique_names([cells[i][0] or f"column {i + 1}" for i in keep])
     bases = _pair_time_bases(values, cells, pair_times, keep, names, where=where,
                              main=(rate, start_time, values.shape[0]),
-                             given_rate=sample_rate_hz, notes=notes)
+                             given_rate=sample_rate_hz, notes=notes, given_time=given_time)
     for name, i in zip(names, keep, strict=True):
         _refuse_a_channel_ending_early(values[:bases[i][2], i], name, bases[i], where)
     # each channel its own copy: a column of the table is a strided view that kept the whole
@@ -484,16 +494,24 @@ def _is_time_unit(unit: str) -> bool:
     return interpret_unit(unit)[0] == "time"
 
 
-def _seconds_per(unit: str) -> float:
-    """Seconds per unit of a time column (a column without a unit is taken as seconds, which
-    the caller notes)."""
+def _seconds_per(unit: str, given: UnitReading | None = None) -> float:
+    """Seconds per unit of a time column: ``given`` (the user's time_unit) where there is one;
+    a column without a unit is taken as seconds, which the caller notes."""
+    if given is not None:
+        return given.info.factor
     return interpret_unit(unit)[1] if unit else 1.0
+
+
+def _overridden(unit: str, given: UnitReading) -> bool:
+    """Whether ``given`` reads a time column otherwise than its own ``unit`` does."""
+    return not unit or not math.isclose(_seconds_per(unit), given.info.factor, rel_tol=1e-12)
 
 
 def _pair_time_bases(values: np.ndarray, cells: list[tuple[str, str]], pair_times: list[int],
                      keep: list[int], names: list[str], *, where: str,
                      main: tuple[float, float, int], given_rate: float | None,
-                     notes: list[str]) -> dict[int, tuple[float, float, int]]:
+                     notes: list[str], given_time: UnitReading | None = None
+                     ) -> dict[int, tuple[float, float, int]]:
     """Rate, start and length of each channel column from the time column left of it.
 
     A later time column was read as a channel and ignored, so its channels took the first
@@ -509,9 +527,13 @@ def _pair_time_bases(values: np.ndarray, cells: list[tuple[str, str]], pair_time
         times = values[:, t_index]
         length = int(np.argmax(np.isnan(times))) if np.isnan(times).any() else times.size
         name, unit = cells[t_index]
-        factor = _seconds_per(unit)
+        factor = _seconds_per(unit, given_time)
         what = f"{where}: column {name!r} (time of column {owned[0] + 1})"
-        if read_unit(unit).corrected:
+        if given_time is not None:
+            if _overridden(unit, given_time):
+                notes.append(f"{what}: ({unit or 'no unit'}) taken as {given_time.label!r} "
+                             "(time_unit)")
+        elif read_unit(unit).corrected:
             notes.append(f"{what}: {read_unit(unit).correction}")
         if length < 2:
             raise InputFileError(f"{what}: holds {length} times; expected the time of each "

@@ -6,7 +6,8 @@ Three layouts are understood, tried in this order:
    ``pidcore_channels``, a cell array of structs with fields ``name``, ``quantity``, ``unit``
    (SI), ``source_unit``, ``data`` (SI samples), ``sample_rate_hz``, ``start_time_s``.
 2. **LMS Test.Lab export**: a struct (or struct array) ``Signal`` with
-   ``x_values.start_value``, ``x_values.increment`` (s), ``x_values.number_of_values``,
+   ``x_values.start_value``, ``x_values.increment`` (in the unit ``x_values.quantity`` states
+   like ``y_values.quantity``, else s), ``x_values.number_of_values``,
    ``y_values.values`` (one column per channel) and, where present,
    ``function_record.name`` (channel name; a cell of names for several columns) and the unit in
    ``y_values.quantity`` (fields ``unit``/``units``/``unit_label``, a unit struct
@@ -38,6 +39,7 @@ from ..atomic_files import atomic_path
 from ..constants import SI_UNITS
 from ..errors import InputFileError, ParameterError
 from ..records import Channel, Measurement
+from ..units import UnitReading, given_time_unit, read_unit
 from ._common import (
     HDF5_SIGNATURE,
     file_sha256,
@@ -310,7 +312,33 @@ def _lms_unit(quantity_struct: object) -> str:
     return label
 
 
-def _lms_layout(signal: object, where: str) -> list[Channel]:
+def _lms_seconds_per_unit(x_values: Mapping, what: str, given: UnitReading | None,
+                          notes: list[str]) -> float:
+    """Seconds per unit of a Test.Lab signal's ``x_values``: the unit its ``quantity``
+    states (the increment is in it: ms read as s gave a rate 1000 x too low), seconds where
+    it states none (Test.Lab's unit of time), ``given`` (the user's time_unit) over both."""
+    stated = _lms_unit(x_values.get("quantity"))
+    if stated.strip().lower() == "time":  # a bare label names the quantity, not a unit
+        stated = ""
+    reading = read_unit(stated)
+    if given is not None:
+        if reading.info is None or reading.info.factor != given.info.factor:
+            notes.append(f"{what}: x_values unit {stated or 'none'!r} overridden: taken as "
+                         f"{given.label!r} (time_unit)")
+        return given.info.factor
+    if not stated:
+        return 1.0
+    if reading.info is not None and reading.quantity == "time":
+        return reading.info.factor
+    why = reading.problem or f"{stated!r} is no unit of time pidcore reads"
+    raise InputFileError(f"{what}: x_values unit {why}; expected a unit of time such as s or "
+                         "ms (x_values.increment is in it, so it sets the sample rate); give "
+                         "it with time_unit=UNIT")
+
+
+def _lms_layout(signal: object, where: str, given_time: UnitReading | None = None,
+                notes: list[str] | None = None) -> list[Channel]:
+    notes = [] if notes is None else notes
     channels: list[Channel] = []
     for k, sig in enumerate(_as_list(signal)):
         what = f"{where}: Signal({k + 1})"
@@ -329,6 +357,8 @@ def _lms_layout(signal: object, where: str) -> list[Channel]:
         if not increment > 0:
             raise InputFileError(f"{what}: x_values.increment is {increment!r}; expected a "
                                  "positive sample interval in s")
+        seconds_per_unit = _lms_seconds_per_unit(x, what, given_time, notes)
+        start, increment = start * seconds_per_unit, increment * seconds_per_unit
         values = values.reshape(values.shape[0], -1) if values.ndim > 1 else values[:, None]
         if "number_of_values" in x:
             n_given = real_scalar(x["number_of_values"], where=f"{what}: x_values.number_of_values",
@@ -355,8 +385,8 @@ def _lms_layout(signal: object, where: str) -> list[Channel]:
     return channels
 
 
-def _simple_layout(variables: Mapping, where: str,
-                   sample_rate_hz: float | None) -> tuple[list[Channel], list[str]]:
+def _simple_layout(variables: Mapping, where: str, sample_rate_hz: float | None,
+                   time_unit: UnitReading | None = None) -> tuple[list[Channel], list[str]]:
     public = {k: v for k, v in variables.items() if not k.startswith("__")}
     time_key = next((k for k in _TIME_VARIABLES if _numeric_vector(public.get(k)) is not None),
                     None)
@@ -369,15 +399,21 @@ def _simple_layout(variables: Mapping, where: str,
                      f"{rate:g} Hz was given (sample_rate_hz)"
                      + overridden_rate(_numeric_vector(public[time_key]), rate))
     elif time_key is not None:
-        rate, start, note = rate_from_times(_numeric_vector(public[time_key]),
-                                            what=f"{where}: variable {time_key!r}",
-                                            with_note=True)
+        seconds_per_unit = 1.0 if time_unit is None else time_unit.info.factor
+        rate, start, note = rate_from_times(
+            _numeric_vector(public[time_key]) * seconds_per_unit,
+            what=f"{where}: variable {time_key!r}", with_note=True)
         n = _numeric_vector(public[time_key]).size
         notes += [note] if note else []
-        # a vector states no unit: as for a CSV time column without one, the assumption is said
-        notes.append(f"{where}: time vector {time_key!r} states no unit: taken as seconds "
-                     f"(sample rate {rate:.6g} Hz); if it is not, give the sample rate "
-                     "(sample_rate_hz)")
+        if time_unit is not None:
+            notes.append(f"{where}: time vector {time_key!r} taken as {time_unit.label!r} "
+                         f"(time_unit), sample rate {rate:.6g} Hz")
+        else:
+            # a vector states no unit: as for a CSV time column without one, the assumption
+            # is said
+            notes.append(f"{where}: time vector {time_key!r} states no unit: taken as seconds "
+                         f"(sample rate {rate:.6g} Hz); if it is not, give its unit "
+                         "(time_unit=UNIT) or the sample rate (sample_rate_hz)")
     elif rate_key is not None or sample_rate_hz is not None:
         try:
             rate = (real_scalar(public[rate_key], where=f"{where}: variable {rate_key}",
@@ -412,8 +448,15 @@ def _simple_layout(variables: Mapping, where: str,
             for k, v in vectors.items()], notes
 
 
-def read_mat(path: str | os.PathLike[str], *, sample_rate_hz: float | None = None) -> Measurement:
+def read_mat(path: str | os.PathLike[str], *, sample_rate_hz: float | None = None,
+             time_unit: str | None = None) -> Measurement:
     """Read a MATLAB file in one of the layouts of this module into a SI measurement.
+
+    ``time_unit`` (``"ms"``) is the unit of a simple layout's time vector, which states none
+    (seconds without it, noted), and of a Test.Lab signal's ``x_values`` (the unit their
+    ``quantity`` states, else seconds; one that is no unit of time is refused without it);
+    the pidcore layout states its rate in Hz and keeps it (a note says the unit given was
+    not applied).
 
     Raises
     ------
@@ -421,17 +464,21 @@ def read_mat(path: str | os.PathLike[str], *, sample_rate_hz: float | None = Non
         Unreadable file, or none of the layouts found (the message lists the variables).
     """
     where = str(path)
+    given_time = given_time_unit(time_unit)
     variables = _load(where)
     notes: list[str] = []
     if _text(variables.get("pidcore_layout")) == "measurement":
         channels = _pidcore_layout(variables, where)
         layout = "pidcore"
     elif "Signal" in variables:
-        channels = _lms_layout(variables["Signal"], where)
+        channels = _lms_layout(variables["Signal"], where, given_time, notes)
         layout = "lms_testlab"
     else:
-        channels, notes = _simple_layout(variables, where, sample_rate_hz)
+        channels, notes = _simple_layout(variables, where, sample_rate_hz, given_time)
         layout = "simple"
+    if given_time is not None and layout == "pidcore":
+        notes.append(f"{where}: the time unit {time_unit!r} given (time_unit) is not applied: "
+                     "the pidcore layout states its rate in Hz")
     if not channels:
         names = ", ".join(k for k in variables if not k.startswith("__")) or "none"
         raise InputFileError(f"{where}: no channel found (variables: {names}); expected numeric "

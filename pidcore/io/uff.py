@@ -39,9 +39,9 @@ import pyuff
 
 from ..atomic_files import atomic_path
 from ..constants import SI_UNITS
-from ..errors import InputFileError, ParameterError
+from ..errors import InputFileError, ParameterError, a_or_an
 from ..records import Channel, Measurement
-from ..units import canonical_unit_text, read_unit
+from ..units import UnitReading, canonical_unit_text, given_time_unit, read_unit
 from ._common import (
     file_sha256,
     interpret_unit,
@@ -136,17 +136,35 @@ def _ordinate_unit(dset: dict, unit_factors: tuple[float, float]) -> tuple[str, 
     return "unknown", 1.0, label
 
 
-def _time_factor(dset: dict, what: str) -> float:
-    """Seconds per abscissa unit: its label's unit of time; 1 for a label of none (the
-    abscissa of a time record is in seconds, the file's unit), but a label that reads as a
-    time unit pidcore refuses (``MS``: ms or Ms) is refused, not taken as seconds."""
+def _time_factor(dset: dict, what: str, given: UnitReading | None) -> float:
+    """Seconds per abscissa unit.
+
+    The abscissa increment is in the abscissa's unit, so that unit sets the sample rate (a
+    record in ms read as seconds gave every frequency 1000 x too low). Record 8 states the
+    quantity (specific data type 17, time) but not the unit: dataset 164 scales length, force
+    and temperature only, so a record without a label is in seconds, the time unit of every
+    UFF unit system (noted by :func:`read_uff`). A label overrides that (the format gives it
+    precedence); one that reads as no unit of time (``msek``, ``Hz``) or as two (``MS``: ms
+    or Ms) is refused, naming what states it instead: ``given``, the user's ``time_unit``,
+    which overrides the label (noted)."""
+    if given is not None:
+        return given.info.factor
     label = _label(dset.get("abscissa_axis_units_lab"))
+    if not label:
+        return 1.0
     reading = read_unit(label)
-    if reading.quantity == "time" and reading.info is None:
-        raise InputFileError(f"{what}: abscissa unit {reading.problem}; expected a unit of "
-                             "time such as s or ms")
-    quantity, factor = interpret_unit(label)
-    return factor if quantity == "time" else 1.0
+    if reading.info is not None and reading.quantity == "time":
+        return reading.info.factor
+    if reading.quantity == "time":
+        why = f"abscissa unit {reading.problem}"
+    elif reading.quantity is not None:
+        why = (f"abscissa unit {label!r} is {a_or_an(reading.quantity)} unit, not a unit of "
+               "time")
+    else:
+        why = f"abscissa unit {label!r} is no unit of time pidcore reads"
+    raise InputFileError(f"{what}: {why}; expected a unit of time such as s or ms (the "
+                         f"abscissa increment {float(dset.get('abscissa_inc', 0.0)):.6g} is in "
+                         "it, so it sets the sample rate); give it with time_unit=UNIT")
 
 
 def _is_time_record(dset: dict) -> bool:
@@ -170,8 +188,8 @@ def _describe(set_types: list[int], func_types: list[int]) -> str:
     return f"datasets {', '.join(str(t) for t in seen)} ({', '.join(words)})"
 
 
-def _record_channel(dset: dict, index: int, where: str,
-                    unit_factors: tuple[float, float]) -> Channel:
+def _record_channel(dset: dict, index: int, where: str, unit_factors: tuple[float, float],
+                    time_unit: UnitReading | None) -> Channel:
     num_pts = int(dset["num_pts"])
     if num_pts < 1:  # values[:num_pts] would keep all but |num_pts| samples, or none
         raise InputFileError(f"{where}: record {index + 1} declares {num_pts} samples (record "
@@ -185,7 +203,8 @@ def _record_channel(dset: dict, index: int, where: str,
                              f"{num_pts} samples; the file is truncated or corrupt")
     # Writers pad the last E13.5 line with zeros; the header's num_pts is authoritative.
     values = values[:num_pts].astype(np.float64, copy=False)
-    time_factor = _time_factor(dset, f"{where}: record {index + 1}")
+    time_factor = _time_factor(
+        dset, f"{where}: record {index + 1} ({_channel_name(dset, index)!r})", time_unit)
     if int(dset.get("abscissa_spacing", 1)) == 1:
         dt = float(dset["abscissa_inc"]) * time_factor
         start = float(dset.get("abscissa_min", 0.0)) * time_factor
@@ -255,13 +274,16 @@ def _fallback_records(where: str, raw: bytes, expected: int) -> list[dict]:
     return records
 
 
-def read_uff(path: str | os.PathLike[str]) -> Measurement:
+def read_uff(path: str | os.PathLike[str], *, time_unit: str | None = None) -> Measurement:
     """Read the dataset 58 time records of a UFF file (ASCII or binary) as one measurement.
 
     Parameters
     ----------
     path : str or path-like
         ``.uff`` / ``.unv`` file.
+    time_unit : str, optional
+        Unit of the records' abscissa (``"ms"``), for a file whose abscissa label pidcore
+        does not read as a unit of time (refused without it); it overrides the label (noted).
 
     Returns
     -------
@@ -272,9 +294,10 @@ def read_uff(path: str | os.PathLike[str]) -> Measurement:
     ------
     InputFileError
         The file is missing, truncated or corrupt, or holds no time record (the message lists
-        the datasets it does hold).
+        the datasets it does hold), or an abscissa label is no unit of time.
     """
     where = str(path)
+    given_time = given_time_unit(time_unit)
     # the whole file is read only where pyuff fails on an ASCII record (the fallback parser
     # needs it): kept all along, it was one more copy of a long 58b export in memory
     with open(path, "rb") as fh:
@@ -329,12 +352,26 @@ def read_uff(path: str | os.PathLike[str]) -> Measurement:
         what = _describe(set_types, [int(d.get("func_type", -1)) for d in records])
         raise InputFileError(f"{where}: holds {what} but no UFF58 time record "
                              "(function type 1); expected time histories")
-    channels = [_record_channel(d, k, where, unit_factors) for k, d in enumerate(time_records)]
+    channels = [_record_channel(d, k, where, unit_factors, given_time)
+                for k, d in enumerate(time_records)]
     notes: list[str] = []
     for k, (c, d) in enumerate(zip(channels, time_records, strict=True)):
-        abscissa = read_unit(_label(d.get("abscissa_axis_units_lab")))
-        if abscissa.corrected and abscissa.quantity == "time":
-            notes.append(f"{where}: record {k + 1} ({c.name!r}) abscissa {abscissa.correction}")
+        label = _label(d.get("abscissa_axis_units_lab"))
+        abscissa = read_unit(label)
+        said = f"{where}: record {k + 1} ({c.name!r}) abscissa"
+        if given_time is not None:
+            if abscissa.info is None or abscissa.quantity != "time" or \
+                    abscissa.info.factor != given_time.info.factor:
+                notes.append(f"{said} unit {label or 'none'!r} overridden: taken as "
+                             f"{given_time.label!r} (time_unit), sample rate "
+                             f"{c.sample_rate_hz:.6g} Hz")
+        elif not label:
+            # an abscissa in ms without a label gives a rate 1000 x too low: the reading is said
+            notes.append(f"{said} states no unit: taken as seconds, the unit of time of every "
+                         f"UFF unit system (sample rate {c.sample_rate_hz:.6g} Hz); if it is "
+                         "not, give it with time_unit=UNIT")
+        elif abscissa.corrected and abscissa.quantity == "time":
+            notes.append(f"{said} {abscissa.correction}")
         if c.source_unit.startswith("UFF data type"):
             basis = ("the file's dataset 164 unit factors" if has_units_dataset
                      else "SI (no dataset 164 in the file)")

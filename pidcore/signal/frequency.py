@@ -118,7 +118,8 @@ def estimate_drive_frequency(x: np.ndarray, sample_rate_hz: float, *,
             if outside and ratio_all >= defaults.DOMINANT_PEAK_MIN_POWER_RATIO:
                 raise SignalError(
                     f"{what}: the drive line is at {f_all:.6g} Hz, outside +-{100 * rel:g} % of "
-                    f"the frequency hint {frequency_hint_hz:g} Hz; correct the hint "
+                    f"the frequency hint {frequency_hint_hz:g} Hz; "
+                    f"{_time_base_slip(f_all, frequency_hint_hz, rel)}correct the hint "
                     "(frequency_hz) or leave it out")
     if not np.isfinite(f0) or ratio < defaults.DOMINANT_PEAK_MIN_POWER_RATIO:
         near = f" near the hint {frequency_hint_hz:g} Hz" if frequency_hint_hz else ""
@@ -131,8 +132,27 @@ def estimate_drive_frequency(x: np.ndarray, sample_rate_hz: float, *,
             abs(f - frequency_hint_hz) > rel * frequency_hint_hz + 3 * bin_hz:
         raise SignalError(f"{what}: the drive frequency {f:.6g} Hz lies outside "
                           f"+-{100 * rel:g} % of the frequency hint {frequency_hint_hz:g} Hz; "
-                          "correct the hint (frequency_hz) or leave it out")
+                          f"{_time_base_slip(f, frequency_hint_hz, rel)}correct the hint "
+                          "(frequency_hz) or leave it out")
     return f
+
+
+#: Factors between time units an export is written in (s, ms, us): a drive frequency found
+#: this far off the one the user expects is the time base read in the wrong unit.
+_TIME_UNIT_RATIOS = {1e-6: "us read as s", 1e-3: "ms read as s", 1e3: "s read as ms",
+                     1e6: "s read as us"}
+
+
+def _time_base_slip(found_hz: float, hint_hz: float, relative_width: float) -> str:
+    """The phrase that names a time base read in the wrong unit where ``found_hz`` is a
+    factor of 1000 or 1e6 off the hint (a UFF abscissa in ms labelled s, a CSV time column
+    in ms without a unit), else ``""``: correcting the hint alone would keep every frequency
+    of that file wrong."""
+    for ratio, slip in _TIME_UNIT_RATIOS.items():
+        if abs(found_hz - ratio * hint_hz) <= relative_width * ratio * hint_hz:
+            return (f"it is {ratio:g} x the hint, as from a time base read in the wrong unit "
+                    f"({slip}): give the file's time unit (time_unit=UNIT) or ")
+    return ""
 
 
 def refine_frequency(x: np.ndarray, sample_rate_hz: float, frequency_hz: float, *,

@@ -388,8 +388,12 @@ def _check_parameters(sample_rate_hz: float, n_harmonics: int, n_blocks: int, mi
     if int(min_periods) != min_periods or min_periods < 1:
         raise ParameterError(f"min_periods: {min_periods!r}, expected an integer >= 1")
     if frequency_hz is not None and frequency_hz >= sample_rate_hz / 2:
+        # a hint the rate cannot hold is a wrong hint or a wrong rate: a time base in ms read
+        # as s (a UFF abscissa labelled s, a CSV time column without a unit) is 1000 x too low
         raise ParameterError(f"frequency_hz: {as_given(frequency_hz)} Hz is not below the Nyquist "
-                             f"frequency {sample_rate_hz / 2:g} Hz")
+                             f"frequency {sample_rate_hz / 2:g} Hz of the sample rate "
+                             f"{sample_rate_hz:g} Hz; correct the hint, or the file's time unit "
+                             "(time_unit=UNIT) where its time base is in ms or us read as s")
 
 
 #: The refusal of a negative reactive power says a channel "is probably inverted".
