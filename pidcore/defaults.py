@@ -189,6 +189,11 @@ APP_DEFAULT_FILL_PERCENT = 50.0
 #: Folders (relative to the working folder) the app searches for specimen files: the DEM page
 #: offers them, and their particle materials are materials a measurement may state.
 APP_SPECIMEN_FOLDERS: tuple[Path, ...] = (Path("data_samples") / "specimens", Path("specimens"))
+#: Hours since the app last used a kept specimen file (kept it from an upload, or restored it
+#: for a page) within which ``pidcore specimen kept --remove`` leaves it: an open page names
+#: it in its address without any record or job doing so yet, and a reload the next morning
+#: should still find it. A kept file is a few kB.
+KEPT_SPECIMEN_RECENT_HOURS = 24.0
 
 # --- Compare (measured vs DEM vs paper) -----------------------------------------------------
 #: A measured case sits on a DEM grid point when its frequency is within this relative
