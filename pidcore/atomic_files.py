@@ -26,7 +26,8 @@ import os
 import re
 import secrets
 import stat
-from collections.abc import Iterator
+import time
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager, suppress
 from pathlib import Path
 
@@ -92,6 +93,42 @@ def temporary_name_pattern(target: str | os.PathLike[str]) -> re.Pattern[str]:
     ``s.h5.old.h5``)."""
     return re.compile(re.escape(f".{Path(target).name}.") + r"[0-9a-f]{16}"
                       + re.escape(TEMPORARY_SUFFIX))
+
+
+#: Any name :func:`temporary_path_for` gives, its target's name as ``target``: the hex part
+#: and suffix are fixed, so the target is whatever stands before them.
+_TEMPORARY_NAME = re.compile(r"\.(?P<target>.+)\.[0-9a-f]{16}" + re.escape(TEMPORARY_SUFFIX))
+
+
+def remove_stale_temporaries(folder: str | os.PathLike[str], is_target: Callable[[str], bool],
+                             *, min_age_s: float = 0.0, now: float | None = None) -> list[Path]:
+    """Remove the temporary files :func:`atomic_path` made in ``folder`` for a target whose
+    name ``is_target`` accepts, and that were last changed at least ``min_age_s`` ago; returns
+    those removed.
+
+    Call it only where no live writer of those targets can hold one: under the lock every
+    writer of them takes (the store's write lock, the kept specimens' folder lock), so that a
+    file left is one whose writer was killed (SIGKILL, a power loss). ``min_age_s`` guards
+    against a writer that does not take that lock (an older pidcore). Only exact names
+    (``.<target>.<16 hex>.tmp``, a plain file, no link) are ever removed: a user's
+    ``.notes.tmp`` is not one.
+    """
+    now = time.time() if now is None else now
+    removed = []
+    for entry in Path(folder).iterdir():
+        match = _TEMPORARY_NAME.fullmatch(entry.name)
+        if match is None or not is_target(match["target"]):
+            continue
+        try:
+            info = entry.lstat()
+        except FileNotFoundError:
+            continue
+        if not stat.S_ISREG(info.st_mode) or now - info.st_mtime < min_age_s:
+            continue
+        with suppress(FileNotFoundError):
+            entry.unlink()
+            removed.append(entry)
+    return removed
 
 
 @contextmanager

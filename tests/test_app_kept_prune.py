@@ -313,3 +313,37 @@ def test_the_apps_calibration_holds_its_uploaded_file_while_it_runs(app_store):
     assert [f.sha256 for f in after.unused] == [unused.sha256]
     assert not (folder / f"{unused.sha256}.toml").exists()
 
+
+def test_temporary_files_of_killed_writes_are_removed_by_exact_name_once_old(app_store,
+                                                                             capsys):
+    # a kill -9 or a power loss during a write leaves .<name>.<16 hex>.tmp: never cleaned
+    store_path, folder, kept = app_store
+    sha = kept["in_store"].sha256
+    hex16 = "0123456789abcdef"
+    stale = [folder / f".{sha}.toml.{hex16}.tmp", folder / f".{sha}.json.{hex16}.tmp",
+             store_path.parent / f".app.h5.jobs.json.{hex16}.tmp"]
+    fresh = folder / f".{sha}.toml.fedcba9876543210.tmp"  # a write under way (or just killed)
+    users = [folder / f".{sha}.toml.0123.tmp",            # not the helper's 16 hex digits
+             folder / f".notes.txt.{hex16}.tmp",          # not of a file the app keeps there
+             folder / f".{sha}.toml.{hex16}.tmp.keep",    # more after the suffix
+             store_path.parent / f".app.h5.jobs.json.old.{hex16}.tmp",  # another file's
+             store_path.parent / f".other.h5.jobs.json.{hex16}.tmp"]
+    for path in [*stale, fresh, *users]:
+        path.write_text("partial")
+    (folder / f".{sha}.json.{'a' * 16}.tmp").mkdir()  # not a plain file
+    _age([*stale, *users, folder / f".{sha}.json.{'a' * 16}.tmp"], hours=48)
+    store_before = _digest(store_path)
+
+    assert main(["specimen", "kept", "--store", str(store_path)]) == 0  # a dry run: none
+    capsys.readouterr()
+    assert all(p.exists() for p in [*stale, fresh, *users])
+    assert main(["specimen", "kept", "--store", str(store_path), "--remove"]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert not any(p.exists() for p in stale)
+    assert fresh.exists() and all(p.read_text() == "partial" for p in users)
+    assert (folder / f".{sha}.json.{'a' * 16}.tmp").is_dir()
+    for path in stale:
+        assert f"{path.name}: temporary file of a killed write; removed" in out
+    assert f"{fresh.name}: not a file the app keeps; left as it is" in out
+    assert _digest(store_path) == store_before
+    assert restore_specimen(folder, sha).data == _variant("in_store")

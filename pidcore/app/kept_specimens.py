@@ -27,7 +27,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from ..atomic_files import write_atomically
+from ..atomic_files import remove_stale_temporaries, write_atomically
 from ..errors import ParameterError, StoreError
 
 try:  # POSIX: keeping a file and removing unused ones exclude each other
@@ -336,13 +336,15 @@ class KeptFolder:
     ``folder``; ``files`` (:class:`KeptFile`, by sha256); ``removed``: whether the unused
     ones (:attr:`unused`) were removed; ``others``: entries the app did not write there
     (never touched); ``recent_hours``: the grace period, h (a file the app used within it
-    is left)."""
+    is left); ``temporaries_removed``: temporary files of killed writes removed (in the
+    folder, and of the app's job table beside the store)."""
 
     folder: Path
     files: tuple[KeptFile, ...]
     removed: bool
     others: tuple[Path, ...]
     recent_hours: float = 0.0
+    temporaries_removed: tuple[Path, ...] = ()
 
     @property
     def unused(self) -> tuple[KeptFile, ...]:
@@ -354,7 +356,8 @@ class KeptFolder:
         return {"folder": str(self.folder), "removed": self.removed,
                 "keep_recent_hours": self.recent_hours,
                 "files": [f.to_dict() for f in self.files],
-                "others": [str(p) for p in self.others]}
+                "others": [str(p) for p in self.others],
+                "temporaries_removed": [str(p) for p in self.temporaries_removed]}
 
 
 def _kept_entries(folder: Path) -> tuple[dict[str, list[Path]], list[Path]]:
@@ -405,7 +408,9 @@ def prune_kept_specimens(store_path: str | os.PathLike, *, remove: bool = False,
     (:func:`holding_kept_specimen`: a calibration), or a page that used it within
     ``recent_hours`` (default :data:`pidcore.defaults.KEPT_SPECIMEN_RECENT_HOURS`; a page's
     address names it before any record or job does). With ``remove``, those nothing needs
-    are removed; a file a record names is never removed. ``only``: the kept files
+    are removed, and so are temporary files of killed writes in the folder and of the job
+    table beside the store (:func:`pidcore.atomic_files.remove_stale_temporaries`, older
+    than the grace period); a file a record names is never removed. ``only``: the kept files
     to look at (each a sha256 or a path of one in the folder; default all).
 
     A kept file serves a page reload of the app only (a job and a calibration hold their
@@ -428,7 +433,7 @@ def prune_kept_specimens(store_path: str | os.PathLike, *, remove: bool = False,
     from ..defaults import KEPT_SPECIMEN_RECENT_HOURS, STORE_LOCK_TIMEOUT_S
     from ..store import Store
     from ..store.lock import exclusive_lock
-    from .jobs import exclusive_journal_lock, waiting_job_specimens
+    from .jobs import exclusive_journal_lock, journal_path, waiting_job_specimens
 
     recent_hours = KEPT_SPECIMEN_RECENT_HOURS if recent_hours is None else recent_hours
     if not (isinstance(recent_hours, (int, float)) and math.isfinite(recent_hours)
@@ -492,7 +497,14 @@ def prune_kept_specimens(store_path: str | os.PathLike, *, remove: bool = False,
             if not kept.referred_by and not kept.left_because:
                 for path in kept.files:
                     _remove_kept(folder, path)
-    return KeptFolder(folder, files, True, tuple(others), recent_hours)
+        # under the folder's lock every page that writes there waits: a temporary file left
+        # is a killed write's (the grace period also spares a writer of an older pidcore)
+        temporaries = remove_stale_temporaries(folder, _is_kept_name, min_age_s=grace_s)
+        journal = journal_path(store_path)
+        temporaries += remove_stale_temporaries(journal.parent, journal.name.__eq__,
+                                                min_age_s=grace_s)
+    others = [p for p in others if p not in temporaries]
+    return KeptFolder(folder, files, True, tuple(others), recent_hours, tuple(temporaries))
 
 
 def _chosen_hash(folder: Path, entry: str | os.PathLike,

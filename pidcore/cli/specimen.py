@@ -42,7 +42,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                     "removes the files nothing needs; a file a record names is never "
                     "removed, and the store is only read. A file the app used (kept from an "
                     "upload, restored for a page) within --keep-recent-hours, or holds now "
-                    "(a calibration of it runs), is left: an open page may name it. Checked "
+                    "(a calibration of it runs), is left: an open page may name it. --remove "
+                    "also removes temporary files (.<name>.<16 hex>.tmp) that killed writes "
+                    "left in the folder and of the job table, once older than that. Checked "
                     "and removed under the locks of the store, the job table and the folder. "
                     "Exit 2, nothing removed, where the store or the app's job table cannot be "
                     "read, a lock cannot be taken or a FILE is not a kept file of the store.")
@@ -86,7 +88,7 @@ def run_kept(args: argparse.Namespace) -> int:
 def format_kept(found: KeptFolder) -> str:
     """One line per kept file (what needs it, or that it was or would be removed) and a
     closing line with the count and the bytes freed."""
-    if not found.files and not found.others:
+    if not found.files and not found.others and not found.temporaries_removed:
         return f"no specimen files kept in {found.folder}"
     verb = "removed" if found.removed else "unused: would be removed with --remove"
     lines = [f"{f.sha256}  {f.name or '(name lost)'}  {f.size_bytes} B  "
@@ -94,6 +96,8 @@ def format_kept(found: KeptFolder) -> str:
                 else f"left: {f.left_because}" if f.left_because else verb)
              for f in found.files]
     lines += [f"{p.name}: not a file the app keeps; left as it is" for p in found.others]
+    lines += [f"{p.name}: temporary file of a killed write; removed"
+              for p in found.temporaries_removed]
     unused = found.unused
     freed = sum(f.size_bytes for f in unused)
     lines.append(f"{found.folder}: {len(found.files)} kept specimen file(s), {len(unused)} "
