@@ -138,9 +138,18 @@ def atomic_path(path: str | os.PathLike[str], *, durable: bool = True) -> Iterat
     fsync'ed (``durable``) and moved over ``path`` in one step.
 
     Any exception, KeyboardInterrupt included, removes the temporary file and leaves the file
-    at ``path`` as it was (absent, if it was).
+    at ``path`` as it was (absent, if it was). Temporary files of ``path`` that a write killed
+    outright left (SIGKILL, a power loss) are removed first, once older than
+    :data:`pidcore.defaults.STALE_TEMPORARY_FILE_AGE_S`: the next write of a file cleans up
+    after its killed one, as the store's next write does.
     """
+    from .defaults import STALE_TEMPORARY_FILE_AGE_S
+
     target = Path(path)
+    # a folder that cannot be listed (write-only) still gets the file
+    with suppress(OSError):
+        remove_stale_temporaries(target.parent, target.name.__eq__,
+                                 min_age_s=STALE_TEMPORARY_FILE_AGE_S)
     tmp = temporary_path_for(target)
     os.close(os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600))
     try:
