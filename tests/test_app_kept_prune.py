@@ -347,3 +347,30 @@ def test_temporary_files_of_killed_writes_are_removed_by_exact_name_once_old(app
     assert f"{fresh.name}: not a file the app keeps; left as it is" in out
     assert _digest(store_path) == store_before
     assert restore_specimen(folder, sha).data == _variant("in_store")
+
+
+def test_a_calibration_starting_while_a_listing_looks_at_its_file_still_holds_it(app_store):
+    # a listing looks whether the app holds a file by taking its lock for a moment; a
+    # calibration that started in that moment held nothing, and a removal took its file
+    import fcntl
+    import threading
+
+    from pidcore.app.kept_specimens import holding_kept_specimen
+
+    store_path, folder, kept = app_store
+    unused = kept["unused"].sha256
+    fd = os.open(folder / f"{unused}.toml", os.O_RDONLY)
+    fcntl.flock(fd, fcntl.LOCK_EX)  # the listing's look
+    looked = threading.Event()
+
+    def look_over() -> None:
+        os.close(fd)
+        looked.set()
+
+    threading.Timer(0.3, look_over).start()  # ... over a moment later
+    with holding_kept_specimen(store_path, unused):
+        assert looked.wait(10)
+        found = prune_kept_specimens(store_path, remove=True, recent_hours=0)
+    assert {f.sha256: f.left_because for f in found.files}[unused] == (
+        "in use by the app now (a calibration of it runs)")
+    assert (folder / f"{unused}.toml").is_file()

@@ -268,7 +268,9 @@ def holding_kept_specimen(store_path: str | os.PathLike, sha256: str) -> Iterato
             except OSError:
                 fd = None
             if fd is not None and fcntl is not None:
-                _flock_within(fd, fcntl.LOCK_SH, 0.0)
+                # only a listing's look (:func:`_held_by_the_app`, a moment) can hold it
+                # exclusively now: a removal takes it under the folder's lock, held here
+                _flock_within(fd, fcntl.LOCK_SH, KEPT_FOLDER_LOCK_WAIT_S)
                 _mark_used(folder / f"{sha256}{_DATA_SUFFIX}")
     try:
         yield
