@@ -101,10 +101,11 @@ _TEMPORARY_NAME = re.compile(r"\.(?P<target>.+)\.[0-9a-f]{16}" + re.escape(TEMPO
 
 
 def remove_stale_temporaries(folder: str | os.PathLike[str], is_target: Callable[[str], bool],
-                             *, min_age_s: float = 0.0, now: float | None = None) -> list[Path]:
+                             *, min_age_s: float = 0.0, now: float | None = None,
+                             dry_run: bool = False) -> list[Path]:
     """Remove the temporary files :func:`atomic_path` made in ``folder`` for a target whose
     name ``is_target`` accepts, and that were last changed at least ``min_age_s`` ago; returns
-    those removed.
+    those removed (``dry_run``: those it would remove, none removed).
 
     Call it only where no live writer of those targets can hold one: under the lock every
     writer of them takes (the store's write lock, the kept specimens' folder lock), so that a
@@ -126,7 +127,8 @@ def remove_stale_temporaries(folder: str | os.PathLike[str], is_target: Callable
         if not stat.S_ISREG(info.st_mode) or now - info.st_mtime < min_age_s:
             continue
         with suppress(FileNotFoundError):
-            entry.unlink()
+            if not dry_run:
+                entry.unlink()
             removed.append(entry)
     return removed
 

@@ -335,6 +335,12 @@ def test_temporary_files_of_killed_writes_are_removed_by_exact_name_once_old(app
     store_before = _digest(store_path)
 
     assert main(["specimen", "kept", "--store", str(store_path)]) == 0  # a dry run: none
+    out = capsys.readouterr().out.splitlines()
+    for path in stale:
+        assert f"{path.name}: temporary file of a killed write; would be removed with " \
+               "--remove" in out
+    # limited to some kept files, it removes no temporary file either
+    assert main(["specimen", "kept", "--store", str(store_path), "--remove", sha]) == 0
     capsys.readouterr()
     assert all(p.exists() for p in [*stale, fresh, *users])
     assert main(["specimen", "kept", "--store", str(store_path), "--remove"]) == 0

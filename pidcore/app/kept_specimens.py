@@ -339,7 +339,8 @@ class KeptFolder:
     ones (:attr:`unused`) were removed; ``others``: entries the app did not write there
     (never touched); ``recent_hours``: the grace period, h (a file the app used within it
     is left); ``temporaries_removed``: temporary files of killed writes removed (in the
-    folder, and of the app's job table beside the store)."""
+    folder, and of the app's job table beside the store; without ``removed``: those
+    ``--remove`` removes)."""
 
     folder: Path
     files: tuple[KeptFile, ...]
@@ -481,9 +482,18 @@ def prune_kept_specimens(store_path: str | os.PathLike, *, remove: bool = False,
             files.append(KeptFile(sha256, name, tuple(paths), size, why, used_at, left))
         return tuple(files), others
 
+    def stale_temporaries(dry_run: bool) -> list[Path]:
+        journal = journal_path(store_path)
+        return [*remove_stale_temporaries(folder, _is_kept_name, min_age_s=grace_s,
+                                          dry_run=dry_run),
+                *remove_stale_temporaries(journal.parent, journal.name.__eq__,
+                                          min_age_s=grace_s, dry_run=dry_run)]
+
     if not remove:
         files, others = survey()
-        return KeptFolder(folder, files, False, tuple(others), recent_hours)
+        temporaries = [] if only else stale_temporaries(dry_run=True)
+        return KeptFolder(folder, files, False, tuple(p for p in others if p not in temporaries),
+                          recent_hours, tuple(temporaries))
     # the writers' own locks, in the order a worker saving a run takes them (the store's,
     # then the job table's), so that none of them changes what needs a file in between
     with exclusive_lock(Path(store_path), timeout_s=STORE_LOCK_TIMEOUT_S), \
@@ -501,10 +511,7 @@ def prune_kept_specimens(store_path: str | os.PathLike, *, remove: bool = False,
                     _remove_kept(folder, path)
         # under the folder's lock every page that writes there waits: a temporary file left
         # is a killed write's (the grace period also spares a writer of an older pidcore)
-        temporaries = remove_stale_temporaries(folder, _is_kept_name, min_age_s=grace_s)
-        journal = journal_path(store_path)
-        temporaries += remove_stale_temporaries(journal.parent, journal.name.__eq__,
-                                                min_age_s=grace_s)
+        temporaries = [] if only else stale_temporaries(dry_run=False)
     others = [p for p in others if p not in temporaries]
     return KeptFolder(folder, files, True, tuple(others), recent_hours, tuple(temporaries))
 

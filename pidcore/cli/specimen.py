@@ -96,7 +96,8 @@ def format_kept(found: KeptFolder) -> str:
                 else f"left: {f.left_because}" if f.left_because else verb)
              for f in found.files]
     lines += [f"{p.name}: not a file the app keeps; left as it is" for p in found.others]
-    lines += [f"{p.name}: temporary file of a killed write; removed"
+    lines += [f"{p.name}: temporary file of a killed write; "
+              + ("removed" if found.removed else "would be removed with --remove")
               for p in found.temporaries_removed]
     unused = found.unused
     freed = sum(f.size_bytes for f in unused)
