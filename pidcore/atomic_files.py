@@ -26,7 +26,8 @@ import os
 import re
 import secrets
 import stat
-from collections.abc import Iterator
+import time
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager, suppress
 from pathlib import Path
 
@@ -94,6 +95,44 @@ def temporary_name_pattern(target: str | os.PathLike[str]) -> re.Pattern[str]:
                       + re.escape(TEMPORARY_SUFFIX))
 
 
+#: Any name :func:`temporary_path_for` gives, its target's name as ``target``: the hex part
+#: and suffix are fixed, so the target is whatever stands before them.
+_TEMPORARY_NAME = re.compile(r"\.(?P<target>.+)\.[0-9a-f]{16}" + re.escape(TEMPORARY_SUFFIX))
+
+
+def remove_stale_temporaries(folder: str | os.PathLike[str], is_target: Callable[[str], bool],
+                             *, min_age_s: float = 0.0, now: float | None = None,
+                             dry_run: bool = False) -> list[Path]:
+    """Remove the temporary files :func:`atomic_path` made in ``folder`` for a target whose
+    name ``is_target`` accepts, and that were last changed at least ``min_age_s`` ago; returns
+    those removed (``dry_run``: those it would remove, none removed).
+
+    Call it only where no live writer of those targets can hold one: under the lock every
+    writer of them takes (the store's write lock, the kept specimens' folder lock), so that a
+    file left is one whose writer was killed (SIGKILL, a power loss). ``min_age_s`` guards
+    against a writer that does not take that lock (an older pidcore). Only exact names
+    (``.<target>.<16 hex>.tmp``, a plain file, no link) are ever removed: a user's
+    ``.notes.tmp`` is not one.
+    """
+    now = time.time() if now is None else now
+    removed = []
+    for entry in Path(folder).iterdir():
+        match = _TEMPORARY_NAME.fullmatch(entry.name)
+        if match is None or not is_target(match["target"]):
+            continue
+        try:
+            info = entry.lstat()
+        except FileNotFoundError:
+            continue
+        if not stat.S_ISREG(info.st_mode) or now - info.st_mtime < min_age_s:
+            continue
+        with suppress(FileNotFoundError):
+            if not dry_run:
+                entry.unlink()
+            removed.append(entry)
+    return removed
+
+
 @contextmanager
 def atomic_path(path: str | os.PathLike[str], *, durable: bool = True) -> Iterator[Path]:
     """Yield a new empty temporary file beside ``path`` for a writer to fill (by its path:
@@ -101,9 +140,18 @@ def atomic_path(path: str | os.PathLike[str], *, durable: bool = True) -> Iterat
     fsync'ed (``durable``) and moved over ``path`` in one step.
 
     Any exception, KeyboardInterrupt included, removes the temporary file and leaves the file
-    at ``path`` as it was (absent, if it was).
+    at ``path`` as it was (absent, if it was). Temporary files of ``path`` that a write killed
+    outright left (SIGKILL, a power loss) are removed first, once older than
+    :data:`pidcore.defaults.STALE_TEMPORARY_FILE_AGE_S`: the next write of a file cleans up
+    after its killed one, as the store's next write does.
     """
+    from .defaults import STALE_TEMPORARY_FILE_AGE_S
+
     target = Path(path)
+    # a folder that cannot be listed (write-only) still gets the file
+    with suppress(OSError):
+        remove_stale_temporaries(target.parent, target.name.__eq__,
+                                 min_age_s=STALE_TEMPORARY_FILE_AGE_S)
     tmp = temporary_path_for(target)
     os.close(os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600))
     try:

@@ -16,6 +16,11 @@ STORE_LOCK_TIMEOUT_S = 60.0
 #: holding it in memory made every commit of a store of long records need its size in RAM
 #: (10 GB for ~25 ten-minute records).
 STORE_IN_MEMORY_MAX_BYTES = 256 * 2**20
+#: Age, s, past which the next write of a file removes a temporary file of that file
+#: (``.<name>.<16 hex>.tmp``) a write killed outright left beside it: a live writer's is
+#: younger, as its writes set its time (an export takes seconds to minutes), and no lock tells
+#: a live writer's apart from a dead one's beside an exported file.
+STALE_TEMPORARY_FILE_AGE_S = 24 * 3600.0
 
 # --- Measurement (Eq. 11) -------------------------------------------------------------------
 #: Number of drive harmonics fitted (1 = fundamental only). Harmonics above Nyquist are dropped.
@@ -189,6 +194,11 @@ APP_DEFAULT_FILL_PERCENT = 50.0
 #: Folders (relative to the working folder) the app searches for specimen files: the DEM page
 #: offers them, and their particle materials are materials a measurement may state.
 APP_SPECIMEN_FOLDERS: tuple[Path, ...] = (Path("data_samples") / "specimens", Path("specimens"))
+#: Hours since the app last used a kept specimen file (kept it from an upload, or restored it
+#: for a page) within which ``pidcore specimen kept --remove`` leaves it: an open page names
+#: it in its address without any record or job doing so yet, and a reload the next morning
+#: should still find it. A kept file is a few kB.
+KEPT_SPECIMEN_RECENT_HOURS = 24.0
 
 # --- Compare (measured vs DEM vs paper) -----------------------------------------------------
 #: A measured case sits on a DEM grid point when its frequency is within this relative

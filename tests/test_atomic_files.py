@@ -203,3 +203,29 @@ def test_the_new_file_mode_reads_the_umask_without_opening_it_to_other_threads(m
         assert real_umask(0o027) == 0o027  # and leaves it as it was
     finally:
         os.umask(previous)
+
+
+def test_the_next_write_of_a_file_removes_the_temporary_files_killed_writes_of_it_left(
+        tmp_path):
+    # a kill -9 or a power loss mid-write leaves .<name>.<16 hex>.tmp beside an export, and
+    # nothing ever removed it; only that file's exact names, and only once a day old (a live
+    # writer's is younger: its writes set its time)
+    import time
+
+    target = tmp_path / "case.csv"
+    stale = tmp_path / ".case.csv.0123456789abcdef.tmp"
+    fresh = tmp_path / ".case.csv.fedcba9876543210.tmp"  # another writer's, under way
+    users = [tmp_path / ".case.csv.backup.tmp",           # not 16 hex digits
+             tmp_path / ".case.csv.old.csv.0123456789abcdef.tmp",  # case.csv.old.csv's
+             tmp_path / ".case.csv.0123456789abcdef.tmp.txt"]
+    for path in [stale, fresh, *users]:
+        path.write_text("partial")
+    day_and_a_minute = time.time() - 24 * 3600 - 60
+    for path in [stale, *users]:
+        os.utime(path, (day_and_a_minute, day_and_a_minute))
+    hour_ago = time.time() - 3600
+    os.utime(fresh, (hour_ago, hour_ago))
+    atomic_files.write_atomically(target, "f [Hz]\n50\n")
+    assert target.read_text() == "f [Hz]\n50\n"
+    assert not stale.exists()
+    assert fresh.read_text() == "partial" and all(p.read_text() == "partial" for p in users)

@@ -313,6 +313,15 @@ class CalibrationRunner:
 
     def _run(self, api, task: CalibrationTask, points, fit, cells, design_size,
              specimen, notes: Sequence[str] = ()) -> None:
+        from .kept_specimens import holding_kept_specimen
+
+        # not in the job table: an uploaded specimen's kept file is held while it runs, so
+        # `pidcore specimen kept --remove` leaves it for the page that names it
+        with holding_kept_specimen(self.store_path, getattr(specimen, "hash", "")):
+            self._run_calibration(api, task, points, fit, cells, design_size, specimen, notes)
+
+    def _run_calibration(self, api, task: CalibrationTask, points, fit, cells, design_size,
+                         specimen, notes: Sequence[str] = ()) -> None:
         from ..errors import PidcoreError
 
         # the paper's coupon is the library's default: no specimen argument for it

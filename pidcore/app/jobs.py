@@ -38,14 +38,14 @@ import secrets
 import socket
 import threading
 import time
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 from .. import defaults
 from ..atomic_files import write_atomically
-from ..errors import ParameterError, PidcoreError, clipped
+from ..errors import ParameterError, PidcoreError, StoreError, clipped
 from .vocabulary import page_terms
 
 if TYPE_CHECKING:  # pragma: no cover - for the hints; the functions import them where used
@@ -471,8 +471,7 @@ class DemJobRunner:
             finally:
                 self._journal_lock_depth -= 1
             return
-        path = journal_path(self.store_path)
-        lock_path = path.with_name(path.name + ".lock")
+        lock_path = journal_lock_path(self.store_path)
         unlocked = ""  # why the journal is changed without the lock
         try:
             fd = os.open(lock_path, os.O_RDWR | os.O_CREAT, 0o644)
@@ -774,6 +773,42 @@ def journal_path(store_path: str | Path) -> Path:
     """The journal of a store's jobs: ``<store>.jobs.json`` beside it."""
     path = Path(store_path)
     return path.with_name(path.name + JOURNAL_SUFFIX)
+
+
+def journal_lock_path(store_path: str | Path) -> Path:
+    """The lock file every change of a store's journal is made under:
+    ``<store>.jobs.json.lock``."""
+    path = journal_path(store_path)
+    return path.with_name(path.name + ".lock")
+
+
+@contextlib.contextmanager
+def exclusive_journal_lock(store_path: str | Path, *,
+                           wait_s: float = JOURNAL_LOCK_WAIT_S) -> Iterator[None]:
+    """Hold the lock a runner holds from reading the journal to writing it (a submission,
+    a job's change of state), for a reader whose decision must not meet a job queued
+    meanwhile (``pidcore specimen kept --remove``). Where the folder has no locks (a file
+    system without them, Windows) nothing is excluded.
+
+    Raises
+    ------
+    StoreError
+        Another process held the lock for ``wait_s`` (an app server that hangs?), or the lock
+        file cannot be made: one line naming it.
+    """
+    lock_path = journal_lock_path(store_path)
+    try:
+        fd = os.open(lock_path, os.O_RDWR | os.O_CREAT, 0o644)
+    except OSError as exc:
+        raise StoreError(f"{lock_path}: cannot open the lock file of the app's job table "
+                         f"({exc.strerror or exc})") from None
+    try:
+        if fcntl is not None and not _lock_within(fd, wait_s):
+            raise StoreError(f"{lock_path}: held by another process for over {wait_s:g} s "
+                             "(an app server that hangs?); try again later")
+        yield
+    finally:
+        os.close(fd)  # releases the lock
 
 
 #: A job id as the runner makes them (``job0001``): ASCII digits only (``str.isdigit`` also

@@ -40,15 +40,24 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                     "still needs it: a record of the store that names its sha256, or a queued "
                     "or running job of the app. Nothing is removed without --remove, which "
                     "removes the files nothing needs; a file a record names is never "
-                    "removed, and the store is only read. Exit 2, nothing removed, where the "
-                    "store or the app's job table cannot be read or a FILE is not a kept "
-                    "file of the store.")
+                    "removed, and the store is only read. A file the app used (kept from an "
+                    "upload, restored for a page) within --keep-recent-hours, or holds now "
+                    "(a calibration of it runs), is left: an open page may name it. --remove "
+                    "also removes temporary files (.<name>.<16 hex>.tmp) that killed writes "
+                    "left in the folder and of the job table, once older than that. Checked "
+                    "and removed under the locks of the store, the job table and the folder. "
+                    "Exit 2, nothing removed, where the store or the app's job table cannot be "
+                    "read, a lock cannot be taken or a FILE is not a kept file of the store.")
     add_store_option(kept, help=f"the app's store (default ./{defaults.STORE_PATH})")
     kept.add_argument("files", metavar="FILE", nargs="*",
                       help="only these kept files (a sha256, or the path of its .toml or "
                            ".json in the kept folder; default: all)")
     kept.add_argument("--remove", action="store_true",
                       help="remove the listed files no record and no waiting job needs")
+    kept.add_argument("--keep-recent-hours", type=float, metavar="HOURS",
+                      default=defaults.KEPT_SPECIMEN_RECENT_HOURS,
+                      help="leave the files the app used within this many hours, h "
+                           "(default: %(default)g)")
     add_json_option(kept)
     kept.set_defaults(func=run_kept)
 
@@ -67,7 +76,8 @@ def run_check(args: argparse.Namespace) -> int:
 def run_kept(args: argparse.Namespace) -> int:
     from ..app.kept_specimens import prune_kept_specimens
 
-    found = prune_kept_specimens(args.store, remove=args.remove, only=args.files)
+    found = prune_kept_specimens(args.store, remove=args.remove, only=args.files,
+                                 recent_hours=args.keep_recent_hours)
     if args.json:
         print(json.dumps(found.to_dict()))
         return 0
@@ -78,18 +88,24 @@ def run_kept(args: argparse.Namespace) -> int:
 def format_kept(found: KeptFolder) -> str:
     """One line per kept file (what needs it, or that it was or would be removed) and a
     closing line with the count and the bytes freed."""
-    if not found.files and not found.others:
+    if not found.files and not found.others and not found.temporaries_removed:
         return f"no specimen files kept in {found.folder}"
     verb = "removed" if found.removed else "unused: would be removed with --remove"
     lines = [f"{f.sha256}  {f.name or '(name lost)'}  {f.size_bytes} B  "
-             + (f"kept: {f.referred_by}" if f.referred_by else verb)
+             + (f"kept: {f.referred_by}" if f.referred_by
+                else f"left: {f.left_because}" if f.left_because else verb)
              for f in found.files]
     lines += [f"{p.name}: not a file the app keeps; left as it is" for p in found.others]
+    lines += [f"{p.name}: temporary file of a killed write; "
+              + ("removed" if found.removed else "would be removed with --remove")
+              for p in found.temporaries_removed]
     unused = found.unused
     freed = sum(f.size_bytes for f in unused)
     lines.append(f"{found.folder}: {len(found.files)} kept specimen file(s), {len(unused)} "
                  f"unused ({freed} B) " + ("removed" if found.removed else
-                                           "(nothing removed: --remove removes them)"))
+                                           "(nothing removed: --remove removes them)")
+                 + f"; files the app used in the last {found.recent_hours:g} h are left "
+                   "(--keep-recent-hours)")
     return "\n".join(lines)
 
 

@@ -57,7 +57,12 @@ import numpy as np
 import pandas as pd
 
 from .. import __version__, defaults, interrupt
-from ..atomic_files import fsync_path, new_file_mode, temporary_name_pattern, temporary_path_for
+from ..atomic_files import (
+    fsync_path,
+    new_file_mode,
+    remove_stale_temporaries,
+    temporary_path_for,
+)
 from ..errors import InputFileError, ParameterError, StoreError
 from ..io._hdf5_safety import check_self_contained
 from ..io.hdf5_layout import read_measurement_group, write_measurement_group
@@ -586,10 +591,7 @@ class Store:
         # Exactly this store's names (see transaction()): a prefix match took the working copy
         # of a store named like this one plus a suffix ("s.h5" and "s.h5.old.h5"), whose
         # writer, not excluded by this store's lock, then failed its commit.
-        pattern = temporary_name_pattern(self._file)
-        for stale in self._file.parent.iterdir():
-            if pattern.fullmatch(stale.name):
-                stale.unlink(missing_ok=True)
+        remove_stale_temporaries(self._file.parent, self._file.name.__eq__)
 
     @contextmanager
     def transaction(self) -> Iterator[h5py.File]:
