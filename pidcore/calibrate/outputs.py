@@ -101,13 +101,12 @@ def coverage_text(verdicts: list[str]) -> str:
     CalibrationResult.band_verdicts`), counted neither inside nor among those judged, as the
     report counts them."""
     from ..constants import BAND_VERDICTS
+    from .prediction import uninformative_count_text
 
     inside, outside, _, uninformative = BAND_VERDICTS
     judged = verdicts.count(inside) + verdicts.count(outside)
-    unjudged = verdicts.count(uninformative)
     return (f"{verdicts.count(inside)}/{judged} inside the 95 % band"
-            + (f" ({unjudged} more {uninformative}: a band of 0 .. the SDC bound, spanning "
-               "every plausible SDC, cannot test the model)" if unjudged else ""))
+            + uninformative_count_text(verdicts.count(uninformative)))
 
 
 def _table_rows(rows: list[dict], bounds: list[float], verdicts: list[str]

@@ -65,6 +65,20 @@ def band_text(low: float, high: float) -> str:
     return " .. ".join(f"{v:.4g}" if math.isfinite(v) else "—" for v in (low, high))
 
 
+def uninformative_count_text(count: int) -> str:
+    """How many more bands were ``uninformative`` (:meth:`CalibratedPrediction.judge`),
+    counted neither inside nor among those judged, as every count of a calibration's verdicts
+    says it after its "k of n inside": the report's note (:func:`pidcore.report.table.
+    add_calibration_columns`) and the calibration's summaries and command
+    (:func:`pidcore.calibrate.outputs.coverage_text`) wrote these words each in its own copy;
+    ``" (1 more uninformative: a band of 0 .. the SDC bound, spanning every plausible SDC,
+    cannot test the model)"``, "" for none."""
+    if count <= 0:
+        return ""
+    return (f" ({count} more {BAND_VERDICTS[3]}: a band of 0 .. the SDC bound, spanning "
+            "every plausible SDC, cannot test the model)")
+
+
 #: Column of :meth:`Calibration.to_pandas` holding each fitted measurement's verdict (words of
 #: :data:`pidcore.constants.BAND_VERDICTS`).
 VERDICT_COLUMN = f"measured in 95 % band [{'/'.join(BAND_VERDICTS)}]"

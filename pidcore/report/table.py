@@ -725,7 +725,7 @@ def add_calibration_columns(table: pd.DataFrame, calibration, *,
         material (the default report), each checked against the calibration's specimen.
         Neither: unchecked.
     """
-    from ..calibrate.prediction import quantile_label
+    from ..calibrate.prediction import quantile_label, uninformative_count_text
     from ..constants import PARTICLE_MATERIALS
     from ..specimen import paper_specimen
 
@@ -814,7 +814,6 @@ def add_calibration_columns(table: pd.DataFrame, calibration, *,
     summary = (f"calibration {calibration.path}: predicts {sum(math.isfinite(v) for v in sdc)} "
                f"of {len(out)} row(s); measured Eq. 11 SDC inside the 95 % band at "
                f"{inside.count(INSIDE)} of {compared} measured row(s)"
-               + (f" ({unjudged} more {UNINFORMATIVE}: a band of 0 .. the SDC bound, spanning "
-                  "every plausible SDC, cannot test the model)" if unjudged else ""))
+               + uninformative_count_text(unjudged))
     out.attrs = {**table.attrs, "notes": [*table.attrs.get("notes", []), summary]}
     return out
