@@ -445,6 +445,12 @@ def calibration_digest(calibration) -> str:
     return hashlib.sha256(repr(calibration).encode()).hexdigest()[:16]
 
 
+#: Caption of the figure of a saved calibration on the Calibrate tab (after its key).
+SAVED_FIGURE_CAPTION = ("calibrated SDC per load case with its 95 % band beside the SDC "
+                        "measured there; a hollow point with a dashed band is uninformative "
+                        "(0 .. the SDC bound: it cannot test the model)")
+
+
 def stored_calibration_label(calibration) -> str:
     """How the pages name a calibration saved in the app's store: its key, the specimen file
     it calibrated (by name and hash, as the pages label DEM runs, where its calibrated file
