@@ -24,9 +24,10 @@ match_paper
     The paper's Table 3 SDCs at a grid point.
 DEM_COLUMNS, MEASURED_COLUMNS
     Columns the aligner reads.
-MEASURED_EQ11_COLUMN, MEASURED_EQ11_STDERR_COLUMN, MEASURED_EQ11_DOF_COLUMN,
+MEASURED_EQ11_COLUMN, MEASURED_EQ11_STDERR_COLUMN, MEASURED_EQ11_DOF_COLUMN
+    The measured Eq. 11 SDC's columns as every table names them.
 MEASURED_COLUMNS_RENAMED
-    The measured Eq. 11 SDC's columns as every table names them; their old names -> these.
+    Their old names -> these, for a table an earlier pidcore wrote.
 """
 
 from .align import (
