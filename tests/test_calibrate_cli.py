@@ -108,7 +108,8 @@ def test_json_document(capsys, tmp_path, tiny_store):
     assert code == 0
     doc = json.loads(capsys.readouterr().out)
     assert set(doc) == {"specimen", "parameters", "predictions", "loo", "loo_rms",
-                        "loo_coverage95", "loo_uninformative95", "units"}
+                        "loo_coverage95", "loo_uninformative95", "units", "rms_in_sample",
+                        "coverage95", "uninformative95"}
     # which file was calibrated and which it wrote (the document named neither: a
     # calibration.json apart from its folder spoke for the tests of any specimen)
     from pidcore.calibrate.persist import calibration_key
@@ -138,14 +139,17 @@ def test_json_document(capsys, tmp_path, tiny_store):
                             "frequency_hz": "Hz", "acceleration_g": "g", "fill_percent": "%",
                             "measured": "-", "measured_stderr": "-", "predicted": "-",
                             "low95": "-", "high95": "-", "low95_without_stderr": "-",
-                            "high95_without_stderr": "-"}
+                            "high95_without_stderr": "-", "rms_in_sample": "-",
+                            "inside95": "yes/no/uninformative", "coverage95": "count",
+                            "uninformative95": "count", "loo_coverage95": "count",
+                            "loo_uninformative95": "count"}
     p = doc["parameters"]["fixture_mass_kg"]
     assert set(p) == {"median", "low95", "high95"} and p["low95"] <= p["median"] <= p["high95"]
     keys = {"frequency_hz", "acceleration_g", "fill_percent", "material", "measured",
             "measured_stderr", "predicted", "low95", "high95", "low95_without_stderr",
             "high95_without_stderr"}
     assert len(doc["predictions"]) == len(doc["loo"]) == 3
-    assert all(set(r) == keys for r in doc["predictions"] + doc["loo"])
+    assert all(set(r) == keys | {"inside95"} for r in doc["predictions"] + doc["loo"])
     rms = math.sqrt(sum((r["predicted"] - r["measured"]) ** 2 for r in doc["loo"]) / 3)
     assert doc["loo_rms"] == pytest.approx(rms, rel=1e-12)
     out = tmp_path / "out"

@@ -312,3 +312,65 @@ def test_the_summary_writes_an_uninformative_band_as_its_reason_does():
     # a judging band is written the same way: 4 significant digits
     assert any(line.startswith("| 100 | 5 | 50 | 0.300 | 0.310 | 0.12 .. 0.55 |")
                for line in summary_markdown(_result()).splitlines())
+
+
+def test_every_file_states_each_rows_verdict_and_the_in_sample_count_as_the_summary(
+        tmp_path, capsys, monkeypatch):
+    # summary.md judged each row (yes / no / uninformative) and counted the in-sample rows
+    # (2/2 and 1 more uninformative); calibration.json and --json carried neither, so a script
+    # judging low95 <= measured <= high95 itself read "yes" at the 0 .. 25 band, and the
+    # command printed the in-sample RMS without its count
+    from pidcore.calibrate.calibrate import ROW_VERDICT_KEY
+    from pidcore.calibrate.outputs import coverage_text, summary_markdown
+    from pidcore.calibrate.persist import calibration_key
+
+    library = importlib.import_module("pidcore.calibrate.calibrate")
+    monkeypatch.setattr(library, "calibrate", lambda points, **kwargs: _result())
+    monkeypatch.setattr(importlib.import_module("pidcore.calibrate.persist"),
+                        "save_calibration", lambda result, store: ("cal_0", True))
+    table = tmp_path / "m.csv"
+    table.write_text("frequency_hz,acceleration_g,fill_percent,sdc\n100,5,50,0.3\n"
+                     "500,5,50,0.9\n1000,5,50,0.5\n")
+    out = tmp_path / "out"
+    args = ["calibrate", "--data", str(table), "--fit", "fixture_mass_kg", "--dem-store",
+            str(tmp_path / "d.h5"), "--cells", "2", "--workers", "1", "--no-progress"]
+    assert main([*args, "--json", "--out", str(out)]) == 0
+    printed = json.loads(capsys.readouterr().out)
+    written = json.loads((out / "calibration.json").read_text())
+    summary = (out / "summary.md").read_text()
+    table_verdicts = [line.rstrip(" |").rsplit("| ", 1)[1].strip("*")
+                      for line in summary.splitlines()
+                      if line.startswith(("| 100 | 5 |", "| 500 | 5 |", "| 1000 | 5 |"))]
+    for document in (printed, written):
+        rows = [r[ROW_VERDICT_KEY] for r in document["predictions"] + document["loo"]]
+        # the constructed rows: in-sample yes, yes, uninformative; folds yes, no, uninf.
+        assert rows == table_verdicts == ["yes", "yes", "uninformative", "yes", "no",
+                                          "uninformative"]
+        assert (document["coverage95"], document["uninformative95"]) == (2, 1)
+        assert document["units"][ROW_VERDICT_KEY] == "yes/no/uninformative"
+        assert document["rms_in_sample"] == pytest.approx(_result().rms, rel=1e-12)
+    assert f"RMS {rms_text_of(_result().rms)}, 2/2 inside the 95 % band (1 more " in summary
+    # the command's text line says the summary's count
+    assert main(args) == 0
+    (line,) = [s for s in capsys.readouterr().out.splitlines()
+               if s.startswith("in-sample RMS")]
+    assert line == (f"in-sample RMS {rms_text_of(_result().rms)}, "
+                    + coverage_text(["yes", "yes", "uninformative"]))
+    assert summary_markdown(_result()) == summary
+    # derived from the keyed rows: a fit saved before these fields keeps its key
+    document = _result().full_document()
+    older = {k: v for k, v in document.items() if k not in ("coverage95", "uninformative95")}
+    older["predictions"] = [{k: v for k, v in r.items() if k != ROW_VERDICT_KEY}
+                            for r in document["predictions"]]
+    older["loo"] = [{k: v for k, v in r.items() if k != ROW_VERDICT_KEY}
+                    for r in document["loo"]]
+    assert calibration_key(document) == calibration_key(older)
+    moved = [dict(r) for r in older["predictions"]]
+    moved[0]["predicted"] += 0.01
+    assert calibration_key(document) != calibration_key({**older, "predictions": moved})
+
+
+def rms_text_of(value: float) -> str:
+    from pidcore.calibrate.outputs import rms_text
+
+    return rms_text(value)

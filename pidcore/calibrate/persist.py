@@ -64,8 +64,15 @@ def calibration_key(document: dict, calibrated_specimen_text: str | None = None)
     # that did not write them gave the same fit, so save_calibration still finds that entry
     # loo_uninformative95 follows from the loo rows and the specimen, both keyed: left out,
     # a fit saved before it existed keeps its key
+    # so do the in-sample counts and each row's verdict (inside95), written since: they
+    # follow from the keyed rows and the specimen
     what = {k: v for k, v in document.items()
-            if k not in (*_BOOKKEEPING, "specimen", "loo_uninformative95")}
+            if k not in (*_BOOKKEEPING, "specimen", "loo_uninformative95", "coverage95",
+                         "uninformative95")}
+    for rows in ("predictions", "loo"):
+        if isinstance(what.get(rows), list):
+            what[rows] = [{k: v for k, v in r.items() if k != "inside95"}
+                          if isinstance(r, dict) else r for r in what[rows]]
     settings = dict(what.get("settings") or {})
     settings.pop("store", None)
     what["settings"] = settings
