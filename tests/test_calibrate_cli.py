@@ -209,8 +209,9 @@ def test_every_parameter_row_names_its_unit_in_the_command_and_the_summaries(cap
     summary = (tmp_path / "out" / "summary.md").read_text().splitlines()
     page = (tmp_path / "out" / "summary.html").read_text()
     assert "| parameter | unit | median | 95 % interval | prior bounds |" in summary
-    assert "<tr><th>parameter</th><th>unit</th><th>median</th><th>95 % interval</th></tr>" \
-        in page
+    # the page's table as summary.md's, prior bounds included (it left them out)
+    assert ("<tr><th>parameter</th><th>unit</th><th>median</th><th>95 % interval</th>"
+            "<th>prior bounds</th></tr>") in page
     for name, unit in units.items():
         p = doc["parameter_details"][name]
         median, low, high = summary_texts(p)
@@ -218,7 +219,8 @@ def test_every_parameter_row_names_its_unit_in_the_command_and_the_summaries(cap
         assert (f"| {name} | {unit} | {median} | {low} .. {high} | {p['prior_low']:g} .. "
                 f"{p['prior_high']:g} |") in summary
         assert (f"<tr><td>{name}</td><td>{html.escape(unit)}</td><td>{median}</td>"
-                f"<td>{low} .. {high}</td></tr>") in page
+                f"<td>{low} .. {high}</td><td>{p['prior_low']:g} .. {p['prior_high']:g}</td>"
+                "</tr>") in page
 
 
 def test_a_calibration_result_reads_as_its_calibration_json(tmp_path, tiny_store):
@@ -829,7 +831,11 @@ def test_the_html_summary_carries_the_notes_of_the_markdown_one():
     # the page names the specimen calibrated and the file written: the fake has both
     page = summary_html(SimpleNamespace(parameters={}, predictions=[], loo=None, notes=notes,
                                         units=dict, specimen=paper_specimen(),
-                                        calibrated_specimen=paper_specimen))
+                                        calibrated_specimen=paper_specimen, specs=[],
+                                        correlations=[], energy_check=[], wall_s=0.0,
+                                        runs={"computed": 0, "cached": 0},
+                                        settings={"cells": 2, "design_size": 1,
+                                                  "method_used": "grid"}))
     for note in notes:
         assert f"<li>{html.escape(note)}</li>" in page
 

@@ -101,7 +101,7 @@ def test_the_summaries_say_k_of_n_with_the_uninformative_apart():
     assert verdicts == ["yes", "yes", "uninformative", "yes", "**no**", "uninformative"]
     assert "| inside [yes/no/uninformative] |" in text
     page = summary_html(_result())
-    assert f"<h2>Leave-one-out predictions: 1/2 {said}</h2>" in page
+    assert f"<h2>Leave-one-out predictions: RMS {loo_rms}, 1/2 {said}</h2>" in page
     assert page.count("<td>uninformative</td>") == 2
 
 
@@ -374,3 +374,50 @@ def rms_text_of(value: float) -> str:
     from pidcore.calibrate.outputs import rms_text
 
     return rms_text(value)
+
+
+def test_summary_html_holds_the_lines_headings_and_tables_of_summary_md():
+    # summary.html left out the prior bounds, the RMS of each prediction table, the
+    # correlations and the energy check with its "start inside: no" verdicts, and titled the
+    # in-sample table otherwise: a reader of one file saw other numbers and verdicts than a
+    # reader of the other. Both are written from one content now.
+    import dataclasses
+    import re
+
+    from pidcore.calibrate.outputs import summary_html, summary_markdown
+
+    specimen = paper_specimen()
+    dem = parameter_spec("rolling_friction", specimen)
+    base = _result()
+    result = dataclasses.replace(
+        base, specs=[dem, *base.specs],
+        parameters={"rolling_friction": {"median": 0.05, "low95": 0.01, "high95": 0.09,
+                                         "prior_low": dem.low, "prior_high": dem.high},
+                    **base.parameters},
+        correlations=[[1.0, -0.25], [-0.25, 1.0]],
+        energy_check=[{"frequency_hz": f, "acceleration_g": 5.0,
+                       "energy_per_cycle_per_cell_start_j": start,
+                       "energy_per_cycle_per_cell_calibrated_j": 1e-9, "low95_j": 5e-10,
+                       "high95_j": 2e-9, "within": within}
+                      for f, start, within in ((100, 1e-9, True), (500, 3e-9, False))],
+        notes=["a note"], wall_s=1.5)
+    text, page = summary_markdown(result), summary_html(result)
+
+    def plain(cell: str) -> str:
+        return cell.strip().strip("*")
+
+    md_rows = [[plain(c) for c in line.strip().strip("|").split("|")]
+               for line in text.splitlines() if line.startswith("|")
+               and not line.startswith("|---")]
+    html_rows = [[re.sub(r"</?b>", "", html.unescape(c)) for c in
+                  re.findall(r"<t[dh]>(.*?)</t[dh]>", row)]
+                 for row in re.findall(r"<tr>(.*?)</tr>", page)]
+    assert html_rows == md_rows
+    assert ["500", "5", "3e-09", "1e-09", "5e-10 .. 2e-09", "no"] in html_rows  # the miss
+    assert "<td><b>no</b></td>" in page  # a miss stands out as **no** does in summary.md
+    md_headings = [line[3:] for line in text.splitlines() if line.startswith("## ")]
+    html_headings = [html.unescape(h) for h in re.findall(r"<h2>(.*?)</h2>", page)]
+    assert html_headings == ["Posterior correlations", *md_headings, "Notes"]
+    assert md_headings[0].startswith("In-sample posterior predictions: RMS ")
+    for line in text.splitlines()[2:5:2]:  # the "Fitted: ..." and the specimen's lines
+        assert f"<p>{html.escape(line)}</p>" in page
