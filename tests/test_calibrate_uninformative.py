@@ -364,6 +364,10 @@ def test_every_file_states_each_rows_verdict_and_the_in_sample_count_as_the_summ
                             for r in document["predictions"]]
     older["loo"] = [{k: v for k, v in r.items() if k != ROW_VERDICT_KEY}
                     for r in document["loo"]]
+    older["units"] = {k: v for k, v in document["units"].items()
+                      if k not in (ROW_VERDICT_KEY, "coverage95", "uninformative95",
+                                   "loo_coverage95", "loo_uninformative95")}
+    assert set(older["units"]) < set(document["units"])  # the units were keyed, and differ
     assert calibration_key(document) == calibration_key(older)
     moved = [dict(r) for r in older["predictions"]]
     moved[0]["predicted"] += 0.01
