@@ -588,8 +588,8 @@ def test_auto_falling_back_from_the_grid_to_emcee_is_said(tiny_store, tmp_path, 
 def test_summary_table_shows_small_sdc_with_its_digits():
     """The summary's prediction table printed SDCs with three fixed decimals: a load case of
     SDC 2.97e-4 (the paper's 100 Hz, 1 g, 25 %) read 0.000 measured, predicted and in its
-    band, as if there were no damping. Small values keep three significant digits; the
-    usual look (0.230, 0.052 .. 0.436, +0.010) is kept."""
+    band, as if there were no damping. Every SDC is written as the report writes it, 4
+    significant digits (0.23, 0.052 .. 0.436, +0.01), a small one too."""
     from pidcore.calibrate.outputs import _table_rows
 
     rows = [{"frequency_hz": 100.0, "acceleration_g": 1.0, "fill_percent": 25.0,
@@ -598,7 +598,7 @@ def test_summary_table_shows_small_sdc_with_its_digits():
              "measured": 0.23, "predicted": 0.24, "low95": 0.052, "high95": 0.436}]
     small, usual = _table_rows(rows, [2 * math.pi] * 2, ["yes", "yes"])
     assert small[3:8] == ["0.000297", "0.00041", "0.00012 .. 0.00088", "+0.000113", "yes"]
-    assert usual[3:8] == ["0.230", "0.240", "0.052 .. 0.436", "+0.010", "yes"]
+    assert usual[3:8] == ["0.23", "0.24", "0.052 .. 0.436", "+0.01", "yes"]
 
 
 def _mixed_store(monkeypatch):

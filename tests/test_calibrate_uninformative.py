@@ -302,7 +302,7 @@ def test_the_summary_writes_an_uninformative_band_as_its_reason_does():
     assert band_text(0.0, bound.sdc) == "0 .. 16.91"  # 8 m_p/m_s of 46.8 g on 22.2 g
     rows = [line for line in summary_markdown(_result()).splitlines()
             if line.startswith("| 1000 | 5 | 50 |")]
-    assert rows[0] == f"| 1000 | 5 | 50 | 0.500 | 0.470 | {cell} | -0.030 | uninformative |"
+    assert rows[0] == f"| 1000 | 5 | 50 | 0.5 | 0.47 | {cell} | -0.03 | uninformative |"
     assert f"<td>{html.escape(cell)}</td>" in summary_html(_result())  # its ' escaped
     # and the reason the report gives such a row names the same band
     hit = CalibratedPrediction(LoadCase(1000, 5, 50), 0.47, 0.0, 25.0, 0.5, 0.0, 0.0, 25.0,
@@ -310,7 +310,7 @@ def test_the_summary_writes_an_uninformative_band_as_its_reason_does():
     assert hit.uninformative_reason(0.0).startswith(
         "uninformative: the calibrated 95 % band 0 .. 16.91 spans every plausible SDC")
     # a judging band is written the same way: 4 significant digits
-    assert any(line.startswith("| 100 | 5 | 50 | 0.300 | 0.310 | 0.12 .. 0.55 |")
+    assert any(line.startswith("| 100 | 5 | 50 | 0.3 | 0.31 | 0.12 .. 0.55 |")
                for line in summary_markdown(_result()).splitlines())
 
 
@@ -425,3 +425,26 @@ def test_summary_html_holds_the_lines_headings_and_tables_of_summary_md():
     assert md_headings[0].startswith("In-sample posterior predictions: RMS ")
     for line in text.splitlines()[2:5:2]:  # the "Fitted: ..." and the specimen's lines
         assert f"<p>{html.escape(line)}</p>" in page
+
+
+def test_the_summaries_write_each_sdc_as_the_report_writes_it():
+    # summary.md and summary.html wrote the calibrated SDC at 3 decimals (0.083, 0.492) where
+    # the report's column (format_cell) and the band beside it show 4 significant digits
+    # (0.08264, 0.4921; band 0.01469 .. 0.2024): one SDC, two roundings between files
+    import dataclasses
+
+    from pidcore.calibrate.outputs import summary_html, summary_markdown
+    from pidcore.report.render import format_cell
+
+    # the bundled calibration's in-sample row at 50 Hz, 1 g
+    row = {**_row(50, 0.1, 0.08264491889512958, 0.014692871979610054, 0.20244814105328074),
+           "acceleration_g": 1.0}
+    result = dataclasses.replace(_result(), predictions=[row], loo=None)
+    text = summary_markdown(result)
+    cells = next(line for line in text.splitlines() if line.startswith("| 50 | 1 | 50 |"))
+    shown = [c.strip() for c in cells.strip("|").split("|")]
+    assert shown[3:7] == [format_cell(0.1), format_cell(row["predicted"]),
+                          f"{format_cell(row['low95'])} .. {format_cell(row['high95'])}",
+                          "-0.01736"]  # 0.08264 - 0.1, to 4 significant digits
+    assert shown[3:5] == ["0.1", "0.08264"]
+    assert "<td>0.08264</td>" in summary_html(result)

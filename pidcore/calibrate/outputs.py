@@ -112,18 +112,17 @@ def coverage_text(verdicts: list[str]) -> str:
 def _table_rows(rows: list[dict], bounds: list[float], verdicts: list[str]
                 ) -> list[list[str]]:
     from ..constants import BAND_VERDICTS
-
-    def sdc(value: float) -> str:  # three decimals; a small SDC keeps its digits, not 0.000
-        return display_number(value, decimals=3)
+    from .prediction import sdc_text
 
     outside = BAND_VERDICTS[1]
     out = []
     for r, bound, verdict in zip(rows, bounds, verdicts, strict=True):
-        error = r["predicted"] - r["measured"]
+        # every SDC as its band and the report write one: they were at 3 decimals (0.492,
+        # 0.083) beside a band of 4 significant digits (0.01469 .. 0.2024)
         out.append([f"{r['frequency_hz']:g}", f"{r['acceleration_g']:g}",
-                    f"{r['fill_percent']:g}", sdc(r["measured"]), sdc(r["predicted"]),
-                    _band_text(r["low95"], r["high95"], bound),
-                    ("+" if error >= 0 else "") + sdc(error),
+                    f"{r['fill_percent']:g}", sdc_text(r["measured"]),
+                    sdc_text(r["predicted"]), _band_text(r["low95"], r["high95"], bound),
+                    sdc_text(r["predicted"] - r["measured"], signed=True),
                     f"**{verdict}**" if verdict == outside else verdict])
     return out
 
