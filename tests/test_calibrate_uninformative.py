@@ -448,3 +448,23 @@ def test_the_summaries_write_each_sdc_as_the_report_writes_it():
                           "-0.01736"]  # 0.08264 - 0.1, to 4 significant digits
     assert shown[3:5] == ["0.1", "0.08264"]
     assert "<td>0.08264</td>" in summary_html(result)
+
+
+def test_the_apps_list_of_saved_calibrations_writes_each_rms_as_the_command_does():
+    # a listing with one calibration without leave-one-out (a blank) showed the other's RMS
+    # as stored, 0.08119027550622598, where the command, summary.md and the calibrated file
+    # write 0.0812
+    from pidcore.app.calibration import saved_calibrations_table
+    from pidcore.calibrate.outputs import rms_text
+
+    listing = pd.DataFrame({"key": ["cal_a", "cal_b"], "specimen": ["paper_coupon"] * 2,
+                            "fit": ["fixture_mass_kg"] * 2, "n_points": [12.0, 12.0],
+                            "rms_in_sample": [0.08119027550622598, 0.14133994501447378],
+                            "loo_rms": [0.0969918244662864, np.nan],
+                            "loo_coverage95": [10.0, np.nan],
+                            "created_utc": ["2026-12-01T00:00:00+00:00",
+                                            "2026-12-01T00:01:00+00:00"]})
+    table = saved_calibrations_table(listing=listing)  # newest first
+    assert table["in-sample RMS [-]"].tolist() == ["0.1413", "0.0812"]
+    assert table["leave-one-out RMS [-]"].tolist() == ["", "0.0970"]
+    assert rms_text(0.0969918244662864) == "0.0970"
