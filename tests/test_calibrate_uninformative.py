@@ -468,3 +468,34 @@ def test_the_apps_list_of_saved_calibrations_writes_each_rms_as_the_command_does
     assert table["in-sample RMS [-]"].tolist() == ["0.1413", "0.0812"]
     assert table["leave-one-out RMS [-]"].tolist() == ["", "0.0970"]
     assert rms_text(0.0969918244662864) == "0.0970"
+
+
+def test_the_posterior_pairs_figure_names_each_axis_unit():
+    # posterior_pairs.png labelled its axes "rolling_friction", "fixture_mass_kg" and its
+    # histograms' counts not at all: numbers without a unit beside the summary's table that
+    # names them (parameter_units)
+    import dataclasses
+
+    import matplotlib.pyplot as plt
+
+    from pidcore.calibrate.outputs import pairs_figure, parameter_units
+
+    specimen = paper_specimen()
+    dem = parameter_spec("rolling_friction", specimen)
+    base = _result()
+    result = dataclasses.replace(
+        base, specs=[dem, *base.specs], samples=np.column_stack([
+            np.linspace(0.01, 0.09, 50), np.linspace(0.2, 0.3, 50)]),
+        parameters={"rolling_friction": {"median": 0.05, "low95": 0.01, "high95": 0.09,
+                                         "prior_low": dem.low, "prior_high": dem.high},
+                    **base.parameters})
+    fig = pairs_figure(result)
+    try:
+        axes = fig.axes
+        bottom = [ax.get_xlabel() for ax in axes[2:]]  # the last row: scatter, histogram
+        assert bottom == ["rolling_friction [-]", "fixture_mass_kg [kg]"]
+        assert parameter_units(result) == {"rolling_friction": "-", "fixture_mass_kg": "kg"}
+        assert axes[2].get_ylabel() == "fixture_mass_kg [kg]"
+        assert axes[0].get_ylabel() == axes[3].get_ylabel() == "posterior samples [count]"
+    finally:
+        plt.close(fig)
