@@ -499,3 +499,18 @@ def test_the_posterior_pairs_figure_names_each_axis_unit():
         assert axes[0].get_ylabel() == axes[3].get_ylabel() == "posterior samples [count]"
     finally:
         plt.close(fig)
+
+
+def test_the_calibrated_specimens_header_names_each_parameters_unit():
+    # its header wrote "rolling_friction = 0.05  (95 %: ...)": a number without its unit,
+    # where the command and the summaries write "rolling_friction [-]" and "fixture_mass_kg
+    # [kg]"; the file's values (and so its hash) are not in the comments
+    from pidcore.calibrate.outputs import specimen_text
+    from pidcore.calibrate.posterior import summary_texts
+    from pidcore.specimen import Specimen
+
+    result = _result()
+    text = specimen_text(result)
+    _, low, high = summary_texts(result.parameters["fixture_mass_kg"])
+    assert f"#   fixture_mass_kg [kg] = 0.02  (95 %: {low} .. {high})" in text.splitlines()
+    assert Specimen.from_text(text).hash == result.calibrated_specimen().hash

@@ -38,10 +38,13 @@ def specimen_text(result: CalibrationResult) -> str:
     lines = ["# pidcore calibrated specimen: posterior medians of `pidcore calibrate`",
              f"# started from {result.specimen.name} ({result.specimen.source}); "
              f"fitted: {', '.join(result.settings['fit'])}"]
+    units = parameter_units(result)
     for name, p in result.parameters.items():
-        # the value the file sets, in full; the interval to the digits its sampling leaves
+        # the value the file sets, in full; the interval to the digits its sampling leaves;
+        # its unit as the command and the summaries name it (rolling_friction had none)
         _, low, high = summary_texts(p)
-        lines.append(f"#   {name} = {p['median']:.6g}  (95 %: {low} .. {high})")
+        lines.append(f"#   {name} [{units[name]}] = {p['median']:.6g}  "
+                     f"(95 %: {low} .. {high})")
     if result.loo_rms is not None:
         lines.append(f"# leave-one-out RMS of the SDC: {rms_text(result.loo_rms)}")
     lines.append(f"# in-sample RMS of the SDC: {rms_text(result.rms)}")
