@@ -2156,3 +2156,65 @@ def test_a_heavy_particle_sdc_above_2_pi_is_no_implausible_result_of_its_specime
     assert warned.endswith("; or particles heavier than their coupon whose specimen file is "
                            "not given (without it the bound is 2 pi; with it, 8 m_p/m_s: give "
                            "its specimen file, the 'specimen' choice).")
+
+
+def _image_captions(at: AppTest) -> list[str]:
+    """The captions of every image the page shows (AppTest has no accessor of its own)."""
+    return [caption for element in at.main.get("image") for caption in element.captions]
+
+
+def test_a_saved_calibration_is_drawn_with_its_uninformative_band_marked(store_file, tmp_path,
+                                                                         monkeypatch):
+    # the list of saved calibrations showed a table and two downloads, no figure: a saved
+    # calibration's bands were never drawn there. The chosen one is drawn now by the plotting
+    # module (figures_results.calibration_png of Calibration.to_pandas), whose frame carries
+    # the verdicts that mark a band of 0 .. the SDC bound apart
+    import pidcore.report.figures_results as figures_results
+    from pidcore.app.calibration import SAVED_FIGURE_CAPTION
+    from pidcore.calibrate.prediction import VERDICT_COLUMN
+    from pidcore.specimen import paper_specimen
+    from pidcore.store import Store
+
+    store = Store(store_file)
+    # 0 .. 20 at 50 % is cut at the coupon's bound (16.9): uninformative; 0.1 .. 0.6 judges
+    for key, predicted, band in (("cal_00000000000000a1", 0.5678, (0.0, 20.0)),
+                                 ("cal_00000000000000b2", 0.3456, (0.10, 0.60))):
+        doc = _calibration_json(tmp_path / f"{key}.json", 100, 5, 50, predicted,
+                                *band).read_text()
+        store.add_calibration(key, {"specimen": "paper_coupon", "fit": "fixture_mass_kg"},
+                              document=doc, specimen_toml=paper_specimen().text)
+    drawn: list = []
+    real = figures_results.calibration_png
+
+    pngs: list[bytes] = []
+
+    def recorded(frame, **kwargs):
+        drawn.append(frame)
+        pngs.append(real(frame, **kwargs))
+        return pngs[-1]
+
+    monkeypatch.setattr(figures_results, "calibration_png", recorded)
+    at = _app()
+    captions = _image_captions(at)
+    # the box's first (newest) calibration drawn, with the words that read its marks
+    shown = next(s for s in at.selectbox if s.label == "download the files of").value
+    assert captions == [f"{shown}: {SAVED_FIGURE_CAPTION}"], captions
+    assert len(drawn) == 1
+    want = {"cal_00000000000000a1": ([0.5678], ["uninformative"]),
+            "cal_00000000000000b2": ([0.3456], ["yes"])}[shown]
+    assert (drawn[0]["sdc predicted [-]"].tolist(), drawn[0][VERDICT_COLUMN].tolist()) == want
+    assert "uninformative" in SAVED_FIGURE_CAPTION and "hollow" in SAVED_FIGURE_CAPTION
+    assert pngs[0].startswith(b"\x89PNG\r\n\x1a\n")  # the image sent is a drawn PNG
+    # the other one chosen: its own figure
+    other = next(k for k in ("cal_00000000000000a1", "cal_00000000000000b2") if k != shown)
+    box = next(s for s in at.selectbox if s.label == "download the files of")
+    box.set_value(other)
+    at.run()
+    assert not at.exception, at.exception
+    assert _image_captions(at) == [f"{other}: {SAVED_FIGURE_CAPTION}"]
+    assert drawn[-1][VERDICT_COLUMN].tolist() == {"cal_00000000000000a1": ["uninformative"],
+                                                 "cal_00000000000000b2": ["yes"]}[other]
+    # and drawn once per calibration: a rerun takes the cached image
+    count = len(drawn)
+    at.run()
+    assert len(drawn) == count

@@ -108,7 +108,8 @@ def test_json_document(capsys, tmp_path, tiny_store):
     assert code == 0
     doc = json.loads(capsys.readouterr().out)
     assert set(doc) == {"specimen", "parameters", "predictions", "loo", "loo_rms",
-                        "loo_coverage95", "loo_uninformative95", "units"}
+                        "loo_coverage95", "loo_uninformative95", "units", "rms_in_sample",
+                        "coverage95", "uninformative95"}
     # which file was calibrated and which it wrote (the document named neither: a
     # calibration.json apart from its folder spoke for the tests of any specimen)
     from pidcore.calibrate.persist import calibration_key
@@ -138,14 +139,17 @@ def test_json_document(capsys, tmp_path, tiny_store):
                             "frequency_hz": "Hz", "acceleration_g": "g", "fill_percent": "%",
                             "measured": "-", "measured_stderr": "-", "predicted": "-",
                             "low95": "-", "high95": "-", "low95_without_stderr": "-",
-                            "high95_without_stderr": "-"}
+                            "high95_without_stderr": "-", "rms_in_sample": "-",
+                            "inside95": "yes/no/uninformative", "coverage95": "count",
+                            "uninformative95": "count", "loo_coverage95": "count",
+                            "loo_uninformative95": "count"}
     p = doc["parameters"]["fixture_mass_kg"]
     assert set(p) == {"median", "low95", "high95"} and p["low95"] <= p["median"] <= p["high95"]
     keys = {"frequency_hz", "acceleration_g", "fill_percent", "material", "measured",
             "measured_stderr", "predicted", "low95", "high95", "low95_without_stderr",
             "high95_without_stderr"}
     assert len(doc["predictions"]) == len(doc["loo"]) == 3
-    assert all(set(r) == keys for r in doc["predictions"] + doc["loo"])
+    assert all(set(r) == keys | {"inside95"} for r in doc["predictions"] + doc["loo"])
     rms = math.sqrt(sum((r["predicted"] - r["measured"]) ** 2 for r in doc["loo"]) / 3)
     assert doc["loo_rms"] == pytest.approx(rms, rel=1e-12)
     out = tmp_path / "out"
@@ -205,8 +209,9 @@ def test_every_parameter_row_names_its_unit_in_the_command_and_the_summaries(cap
     summary = (tmp_path / "out" / "summary.md").read_text().splitlines()
     page = (tmp_path / "out" / "summary.html").read_text()
     assert "| parameter | unit | median | 95 % interval | prior bounds |" in summary
-    assert "<tr><th>parameter</th><th>unit</th><th>median</th><th>95 % interval</th></tr>" \
-        in page
+    # the page's table as summary.md's, prior bounds included (it left them out)
+    assert ("<tr><th>parameter</th><th>unit</th><th>median</th><th>95 % interval</th>"
+            "<th>prior bounds</th></tr>") in page
     for name, unit in units.items():
         p = doc["parameter_details"][name]
         median, low, high = summary_texts(p)
@@ -214,7 +219,8 @@ def test_every_parameter_row_names_its_unit_in_the_command_and_the_summaries(cap
         assert (f"| {name} | {unit} | {median} | {low} .. {high} | {p['prior_low']:g} .. "
                 f"{p['prior_high']:g} |") in summary
         assert (f"<tr><td>{name}</td><td>{html.escape(unit)}</td><td>{median}</td>"
-                f"<td>{low} .. {high}</td></tr>") in page
+                f"<td>{low} .. {high}</td><td>{p['prior_low']:g} .. {p['prior_high']:g}</td>"
+                "</tr>") in page
 
 
 def test_a_calibration_result_reads_as_its_calibration_json(tmp_path, tiny_store):
@@ -582,8 +588,8 @@ def test_auto_falling_back_from_the_grid_to_emcee_is_said(tiny_store, tmp_path, 
 def test_summary_table_shows_small_sdc_with_its_digits():
     """The summary's prediction table printed SDCs with three fixed decimals: a load case of
     SDC 2.97e-4 (the paper's 100 Hz, 1 g, 25 %) read 0.000 measured, predicted and in its
-    band, as if there were no damping. Small values keep three significant digits; the
-    usual look (0.230, 0.052 .. 0.436, +0.010) is kept."""
+    band, as if there were no damping. Every SDC is written as the report writes it, 4
+    significant digits (0.23, 0.052 .. 0.436, +0.01), a small one too."""
     from pidcore.calibrate.outputs import _table_rows
 
     rows = [{"frequency_hz": 100.0, "acceleration_g": 1.0, "fill_percent": 25.0,
@@ -592,7 +598,7 @@ def test_summary_table_shows_small_sdc_with_its_digits():
              "measured": 0.23, "predicted": 0.24, "low95": 0.052, "high95": 0.436}]
     small, usual = _table_rows(rows, [2 * math.pi] * 2, ["yes", "yes"])
     assert small[3:8] == ["0.000297", "0.00041", "0.00012 .. 0.00088", "+0.000113", "yes"]
-    assert usual[3:8] == ["0.230", "0.240", "0.052 .. 0.436", "+0.010", "yes"]
+    assert usual[3:8] == ["0.23", "0.24", "0.052 .. 0.436", "+0.01", "yes"]
 
 
 def _mixed_store(monkeypatch):
@@ -829,7 +835,11 @@ def test_the_html_summary_carries_the_notes_of_the_markdown_one():
     # the page names the specimen calibrated and the file written: the fake has both
     page = summary_html(SimpleNamespace(parameters={}, predictions=[], loo=None, notes=notes,
                                         units=dict, specimen=paper_specimen(),
-                                        calibrated_specimen=paper_specimen))
+                                        calibrated_specimen=paper_specimen, specs=[],
+                                        correlations=[], energy_check=[], wall_s=0.0,
+                                        runs={"computed": 0, "cached": 0},
+                                        settings={"cells": 2, "design_size": 1,
+                                                  "method_used": "grid"}))
     for note in notes:
         assert f"<li>{html.escape(note)}</li>" in page
 

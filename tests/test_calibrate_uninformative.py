@@ -101,7 +101,7 @@ def test_the_summaries_say_k_of_n_with_the_uninformative_apart():
     assert verdicts == ["yes", "yes", "uninformative", "yes", "**no**", "uninformative"]
     assert "| inside [yes/no/uninformative] |" in text
     page = summary_html(_result())
-    assert f"<h2>Leave-one-out predictions: 1/2 {said}</h2>" in page
+    assert f"<h2>Leave-one-out predictions: RMS {loo_rms}, 1/2 {said}</h2>" in page
     assert page.count("<td>uninformative</td>") == 2
 
 
@@ -302,7 +302,7 @@ def test_the_summary_writes_an_uninformative_band_as_its_reason_does():
     assert band_text(0.0, bound.sdc) == "0 .. 16.91"  # 8 m_p/m_s of 46.8 g on 22.2 g
     rows = [line for line in summary_markdown(_result()).splitlines()
             if line.startswith("| 1000 | 5 | 50 |")]
-    assert rows[0] == f"| 1000 | 5 | 50 | 0.500 | 0.470 | {cell} | -0.030 | uninformative |"
+    assert rows[0] == f"| 1000 | 5 | 50 | 0.5 | 0.47 | {cell} | -0.03 | uninformative |"
     assert f"<td>{html.escape(cell)}</td>" in summary_html(_result())  # its ' escaped
     # and the reason the report gives such a row names the same band
     hit = CalibratedPrediction(LoadCase(1000, 5, 50), 0.47, 0.0, 25.0, 0.5, 0.0, 0.0, 25.0,
@@ -310,5 +310,207 @@ def test_the_summary_writes_an_uninformative_band_as_its_reason_does():
     assert hit.uninformative_reason(0.0).startswith(
         "uninformative: the calibrated 95 % band 0 .. 16.91 spans every plausible SDC")
     # a judging band is written the same way: 4 significant digits
-    assert any(line.startswith("| 100 | 5 | 50 | 0.300 | 0.310 | 0.12 .. 0.55 |")
+    assert any(line.startswith("| 100 | 5 | 50 | 0.3 | 0.31 | 0.12 .. 0.55 |")
                for line in summary_markdown(_result()).splitlines())
+
+
+def test_every_file_states_each_rows_verdict_and_the_in_sample_count_as_the_summary(
+        tmp_path, capsys, monkeypatch):
+    # summary.md judged each row (yes / no / uninformative) and counted the in-sample rows
+    # (2/2 and 1 more uninformative); calibration.json and --json carried neither, so a script
+    # judging low95 <= measured <= high95 itself read "yes" at the 0 .. 25 band, and the
+    # command printed the in-sample RMS without its count
+    from pidcore.calibrate.calibrate import ROW_VERDICT_KEY
+    from pidcore.calibrate.outputs import coverage_text, summary_markdown
+    from pidcore.calibrate.persist import calibration_key
+
+    library = importlib.import_module("pidcore.calibrate.calibrate")
+    monkeypatch.setattr(library, "calibrate", lambda points, **kwargs: _result())
+    monkeypatch.setattr(importlib.import_module("pidcore.calibrate.persist"),
+                        "save_calibration", lambda result, store: ("cal_0", True))
+    table = tmp_path / "m.csv"
+    table.write_text("frequency_hz,acceleration_g,fill_percent,sdc\n100,5,50,0.3\n"
+                     "500,5,50,0.9\n1000,5,50,0.5\n")
+    out = tmp_path / "out"
+    args = ["calibrate", "--data", str(table), "--fit", "fixture_mass_kg", "--dem-store",
+            str(tmp_path / "d.h5"), "--cells", "2", "--workers", "1", "--no-progress"]
+    assert main([*args, "--json", "--out", str(out)]) == 0
+    printed = json.loads(capsys.readouterr().out)
+    written = json.loads((out / "calibration.json").read_text())
+    summary = (out / "summary.md").read_text()
+    table_verdicts = [line.rstrip(" |").rsplit("| ", 1)[1].strip("*")
+                      for line in summary.splitlines()
+                      if line.startswith(("| 100 | 5 |", "| 500 | 5 |", "| 1000 | 5 |"))]
+    for document in (printed, written):
+        rows = [r[ROW_VERDICT_KEY] for r in document["predictions"] + document["loo"]]
+        # the constructed rows: in-sample yes, yes, uninformative; folds yes, no, uninf.
+        assert rows == table_verdicts == ["yes", "yes", "uninformative", "yes", "no",
+                                          "uninformative"]
+        assert (document["coverage95"], document["uninformative95"]) == (2, 1)
+        assert document["units"][ROW_VERDICT_KEY] == "yes/no/uninformative"
+        assert document["rms_in_sample"] == pytest.approx(_result().rms, rel=1e-12)
+    assert f"RMS {rms_text_of(_result().rms)}, 2/2 inside the 95 % band (1 more " in summary
+    # the command's text line says the summary's count
+    assert main(args) == 0
+    (line,) = [s for s in capsys.readouterr().out.splitlines()
+               if s.startswith("in-sample RMS")]
+    assert line == (f"in-sample RMS {rms_text_of(_result().rms)}, "
+                    + coverage_text(["yes", "yes", "uninformative"]))
+    assert summary_markdown(_result()) == summary
+    # derived from the keyed rows: a fit saved before these fields keeps its key
+    document = _result().full_document()
+    older = {k: v for k, v in document.items() if k not in ("coverage95", "uninformative95")}
+    older["predictions"] = [{k: v for k, v in r.items() if k != ROW_VERDICT_KEY}
+                            for r in document["predictions"]]
+    older["loo"] = [{k: v for k, v in r.items() if k != ROW_VERDICT_KEY}
+                    for r in document["loo"]]
+    older["units"] = {k: v for k, v in document["units"].items()
+                      if k not in (ROW_VERDICT_KEY, "coverage95", "uninformative95",
+                                   "loo_coverage95", "loo_uninformative95")}
+    assert set(older["units"]) < set(document["units"])  # the units were keyed, and differ
+    assert calibration_key(document) == calibration_key(older)
+    moved = [dict(r) for r in older["predictions"]]
+    moved[0]["predicted"] += 0.01
+    assert calibration_key(document) != calibration_key({**older, "predictions": moved})
+
+
+def rms_text_of(value: float) -> str:
+    from pidcore.calibrate.outputs import rms_text
+
+    return rms_text(value)
+
+
+def test_summary_html_holds_the_lines_headings_and_tables_of_summary_md():
+    # summary.html left out the prior bounds, the RMS of each prediction table, the
+    # correlations and the energy check with its "start inside: no" verdicts, and titled the
+    # in-sample table otherwise: a reader of one file saw other numbers and verdicts than a
+    # reader of the other. Both are written from one content now.
+    import dataclasses
+    import re
+
+    from pidcore.calibrate.outputs import summary_html, summary_markdown
+
+    specimen = paper_specimen()
+    dem = parameter_spec("rolling_friction", specimen)
+    base = _result()
+    result = dataclasses.replace(
+        base, specs=[dem, *base.specs],
+        parameters={"rolling_friction": {"median": 0.05, "low95": 0.01, "high95": 0.09,
+                                         "prior_low": dem.low, "prior_high": dem.high},
+                    **base.parameters},
+        correlations=[[1.0, -0.25], [-0.25, 1.0]],
+        energy_check=[{"frequency_hz": f, "acceleration_g": 5.0,
+                       "energy_per_cycle_per_cell_start_j": start,
+                       "energy_per_cycle_per_cell_calibrated_j": 1e-9, "low95_j": 5e-10,
+                       "high95_j": 2e-9, "within": within}
+                      for f, start, within in ((100, 1e-9, True), (500, 3e-9, False))],
+        notes=["a note"], wall_s=1.5)
+    text, page = summary_markdown(result), summary_html(result)
+
+    def plain(cell: str) -> str:
+        return cell.strip().strip("*")
+
+    md_rows = [[plain(c) for c in line.strip().strip("|").split("|")]
+               for line in text.splitlines() if line.startswith("|")
+               and not line.startswith("|---")]
+    html_rows = [[re.sub(r"</?b>", "", html.unescape(c)) for c in
+                  re.findall(r"<t[dh]>(.*?)</t[dh]>", row)]
+                 for row in re.findall(r"<tr>(.*?)</tr>", page)]
+    assert html_rows == md_rows
+    assert ["500", "5", "3e-09", "1e-09", "5e-10 .. 2e-09", "no"] in html_rows  # the miss
+    assert "<td><b>no</b></td>" in page  # a miss stands out as **no** does in summary.md
+    md_headings = [line[3:] for line in text.splitlines() if line.startswith("## ")]
+    html_headings = [html.unescape(h) for h in re.findall(r"<h2>(.*?)</h2>", page)]
+    assert html_headings == ["Posterior correlations", *md_headings, "Notes"]
+    assert md_headings[0].startswith("In-sample posterior predictions: RMS ")
+    for line in text.splitlines()[2:5:2]:  # the "Fitted: ..." and the specimen's lines
+        assert f"<p>{html.escape(line)}</p>" in page
+
+
+def test_the_summaries_write_each_sdc_as_the_report_writes_it():
+    # summary.md and summary.html wrote the calibrated SDC at 3 decimals (0.083, 0.492) where
+    # the report's column (format_cell) and the band beside it show 4 significant digits
+    # (0.08264, 0.4921; band 0.01469 .. 0.2024): one SDC, two roundings between files
+    import dataclasses
+
+    from pidcore.calibrate.outputs import summary_html, summary_markdown
+    from pidcore.report.render import format_cell
+
+    # the bundled calibration's in-sample row at 50 Hz, 1 g
+    row = {**_row(50, 0.1, 0.08264491889512958, 0.014692871979610054, 0.20244814105328074),
+           "acceleration_g": 1.0}
+    result = dataclasses.replace(_result(), predictions=[row], loo=None)
+    text = summary_markdown(result)
+    cells = next(line for line in text.splitlines() if line.startswith("| 50 | 1 | 50 |"))
+    shown = [c.strip() for c in cells.strip("|").split("|")]
+    assert shown[3:7] == [format_cell(0.1), format_cell(row["predicted"]),
+                          f"{format_cell(row['low95'])} .. {format_cell(row['high95'])}",
+                          "-0.01736"]  # 0.08264 - 0.1, to 4 significant digits
+    assert shown[3:5] == ["0.1", "0.08264"]
+    assert "<td>0.08264</td>" in summary_html(result)
+
+
+def test_the_apps_list_of_saved_calibrations_writes_each_rms_as_the_command_does():
+    # a listing with one calibration without leave-one-out (a blank) showed the other's RMS
+    # as stored, 0.08119027550622598, where the command, summary.md and the calibrated file
+    # write 0.0812
+    from pidcore.app.calibration import saved_calibrations_table
+    from pidcore.calibrate.outputs import rms_text
+
+    listing = pd.DataFrame({"key": ["cal_a", "cal_b"], "specimen": ["paper_coupon"] * 2,
+                            "fit": ["fixture_mass_kg"] * 2, "n_points": [12.0, 12.0],
+                            "rms_in_sample": [0.08119027550622598, 0.14133994501447378],
+                            "loo_rms": [0.0969918244662864, np.nan],
+                            "loo_coverage95": [10.0, np.nan],
+                            "created_utc": ["2026-12-01T00:00:00+00:00",
+                                            "2026-12-01T00:01:00+00:00"]})
+    table = saved_calibrations_table(listing=listing)  # newest first
+    assert table["in-sample RMS [-]"].tolist() == ["0.1413", "0.0812"]
+    assert table["leave-one-out RMS [-]"].tolist() == ["", "0.0970"]
+    assert rms_text(0.0969918244662864) == "0.0970"
+
+
+def test_the_posterior_pairs_figure_names_each_axis_unit():
+    # posterior_pairs.png labelled its axes "rolling_friction", "fixture_mass_kg" and its
+    # histograms' counts not at all: numbers without a unit beside the summary's table that
+    # names them (parameter_units)
+    import dataclasses
+
+    import matplotlib.pyplot as plt
+
+    from pidcore.calibrate.outputs import pairs_figure, parameter_units
+
+    specimen = paper_specimen()
+    dem = parameter_spec("rolling_friction", specimen)
+    base = _result()
+    result = dataclasses.replace(
+        base, specs=[dem, *base.specs], samples=np.column_stack([
+            np.linspace(0.01, 0.09, 50), np.linspace(0.2, 0.3, 50)]),
+        parameters={"rolling_friction": {"median": 0.05, "low95": 0.01, "high95": 0.09,
+                                         "prior_low": dem.low, "prior_high": dem.high},
+                    **base.parameters})
+    fig = pairs_figure(result)
+    try:
+        axes = fig.axes
+        bottom = [ax.get_xlabel() for ax in axes[2:]]  # the last row: scatter, histogram
+        assert bottom == ["rolling_friction [-]", "fixture_mass_kg [kg]"]
+        assert parameter_units(result) == {"rolling_friction": "-", "fixture_mass_kg": "kg"}
+        assert axes[2].get_ylabel() == "fixture_mass_kg [kg]"
+        assert axes[0].get_ylabel() == axes[3].get_ylabel() == "posterior samples [count]"
+    finally:
+        plt.close(fig)
+
+
+def test_the_calibrated_specimens_header_names_each_parameters_unit():
+    # its header wrote "rolling_friction = 0.05  (95 %: ...)": a number without its unit,
+    # where the command and the summaries write "rolling_friction [-]" and "fixture_mass_kg
+    # [kg]"; the file's values (and so its hash) are not in the comments
+    from pidcore.calibrate.outputs import specimen_text
+    from pidcore.calibrate.posterior import summary_texts
+    from pidcore.specimen import Specimen
+
+    result = _result()
+    text = specimen_text(result)
+    _, low, high = summary_texts(result.parameters["fixture_mass_kg"])
+    assert f"#   fixture_mass_kg [kg] = 0.02  (95 %: {low} .. {high})" in text.splitlines()
+    assert Specimen.from_text(text).hash == result.calibrated_specimen().hash

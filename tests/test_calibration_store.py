@@ -85,7 +85,8 @@ def test_the_same_calibration_again_is_not_stored_twice(calibrated, capsys):
     assert list(after["created_utc"]) == list(before["created_utc"])  # kept as it was
     # one number, one text: the CLI, summary.md and the specimen's header showed the in-sample
     # RMS to 4 decimals, 3 decimals and 4 significant digits
-    (rms,) = [line.split()[-1] for line in out.splitlines() if line.startswith("in-sample RMS")]
+    (rms,) = [line.split()[2].rstrip(",") for line in out.splitlines()
+              if line.startswith("in-sample RMS")]
     summary = (folder / "out_0.2" / "summary.md").read_text()
     assert f"## In-sample posterior predictions: RMS {rms}," in summary
     header = (folder / "out_0.2" / "calibrated_specimen.toml").read_text()

@@ -179,11 +179,40 @@ def test_align_measured_returns_unit_suffixed_rows():
         "source": ["a.uff", "b.uff", "c.uff"]})
     out = align_measured(measured, dem_grid(), load_paper_table3())
     assert list(out["alignment"]) == ["grid", "interpolated", "out_of_range"]
-    assert list(out["SDC measured [-]"]) == [0.3, 0.4, 0.5]
+    assert list(out["SDC measured (Eq. 11) [-]"]) == [0.3, 0.4, 0.5]
     assert out.loc[0, "SDC DEM (paper) [-]"] == 0.2210  # Table 3: 50 Hz, 5 g, 25 %
     for column in ("frequency [Hz]", "acceleration [g]", "packing ratio [%]",
-                   "SDC DEM (ours) [-]", "SDC measured stderr [-]"):
+                   "SDC DEM (ours) [-]", "SDC measured (Eq. 11) stderr [-]"):
         assert column in out.columns
+
+
+def test_align_measured_names_the_measured_sdc_as_the_report_does():
+    # the frame said "SDC measured [-]" beside "SDC DEM (ours) [-]" while the report's files
+    # say "SDC measured (Eq. 11) [-]" for the same Eq. 11 SDC: one name for one concept, and
+    # a frame saved with the old names reads into the present ones, as a report.csv does
+    from pidcore.compare import (
+        MEASURED_COLUMNS_RENAMED,
+        MEASURED_EQ11_COLUMN,
+        MEASURED_EQ11_STDERR_COLUMN,
+    )
+    from pidcore.report import REPORT_COLUMNS_RENAMED
+    from pidcore.report.table import MEASURED_EQ11_COLUMN as REPORT_EQ11_COLUMN
+    from pidcore.report.table import MEASURED_EQ11_STDERR_COLUMN as REPORT_EQ11_STDERR_COLUMN
+
+    measured = pd.DataFrame({
+        "frequency_hz": [50.0], "acceleration_g": [5.0], "fill_percent": [25.0],
+        "material": ["acrylic"], "direction": ["z"], "sdc": [0.3], "sdc_stderr": [0.01],
+        "source": ["a.uff"]})
+    out = align_measured(measured, dem_grid(), load_paper_table3())
+    assert (MEASURED_EQ11_COLUMN, MEASURED_EQ11_STDERR_COLUMN) == (
+        REPORT_EQ11_COLUMN, REPORT_EQ11_STDERR_COLUMN)
+    assert (out.loc[0, MEASURED_EQ11_COLUMN], out.loc[0, MEASURED_EQ11_STDERR_COLUMN]) == (
+        0.3, 0.01)
+    assert "SDC measured [-]" not in out.columns and "SDC measured stderr [-]" not in out.columns
+    older = out.rename(columns={MEASURED_EQ11_COLUMN: "SDC measured [-]",
+                                MEASURED_EQ11_STDERR_COLUMN: "SDC measured stderr [-]"})
+    pd.testing.assert_frame_equal(older.rename(columns=MEASURED_COLUMNS_RENAMED), out)
+    assert REPORT_COLUMNS_RENAMED == MEASURED_COLUMNS_RENAMED
 
 
 def test_tolerances_are_validated():

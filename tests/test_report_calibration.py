@@ -769,3 +769,46 @@ def test_every_page_writes_the_band_as_band_text_beside_its_verdict(tmp_path):
     assert "0 .. 16.91" in row and row.split().count(UNINFORMATIVE) == 1
     (row,) = [line for line in text[2:] if line.split()[0] == "50"]
     assert "0.1235 .. 0.5679" in row and "yes" in row.split()
+
+
+def test_the_report_and_the_calibration_summaries_count_uninformative_bands_in_one_text(
+        tmp_path, monkeypatch):
+    # the words after "k of n inside" were written twice, in the report's note and in
+    # coverage_text (summary.md/html and the command): now uninformative_count_text writes
+    # them for both, so that a change in it reaches both
+    import pidcore.calibrate.prediction as prediction
+    from pidcore.calibrate.outputs import coverage_text
+
+    pooled = {**_prediction(500, 5, 50, 0.492, 0.121, 0.860), "measured_stderr": 0.0,
+              "low95_without_stderr": 0.121, "high95_without_stderr": 0.860}
+    cal = load_calibration(_write(tmp_path / "calibration.json",
+                                  [pooled, _prediction(50, 5, 50, 0.24, 0.05, 0.43)]))
+    # the same two measurements: a pooled pair (stderr 1.795 of 1 dof: band 0 .. the bound)
+    # and a precise one inside 0.05 .. 0.43
+    measured = [(LoadCase(500, 5, 50), 2.295, 1.795, 1.0), (LoadCase(50, 5, 50), 0.30, 0.01, 9.0)]
+    table = pd.DataFrame({
+        "frequency [Hz]": [c.frequency_hz for c, *_ in measured],
+        "acceleration [g]": [c.acceleration_g for c, *_ in measured],
+        "packing ratio [%]": [c.fill_percent for c, *_ in measured],
+        "material": ["acrylic"] * 2,
+        "SDC measured (Eq. 11) [-]": [m[1] for m in measured],
+        "SDC measured (Eq. 11) stderr [-]": [m[2] for m in measured],
+        "SDC measured (Eq. 11) stderr dof [-]": [m[3] for m in measured],
+        "note": ["", ""]})
+    verdicts = [cal.lookup(case).judge(sdc, stderr, dof)[0]
+                for case, sdc, stderr, dof in measured]
+    assert verdicts == ["uninformative", "yes"]
+    words = prediction.uninformative_count_text(1)
+    assert words == (" (1 more uninformative: a band of 0 .. the SDC bound, spanning every "
+                     "plausible SDC, cannot test the model)")
+    assert prediction.uninformative_count_text(0) == ""
+    note = add_calibration_columns(table, cal).attrs["notes"][-1]
+    assert note.endswith("at 1 of 1 measured row(s)" + words)
+    assert coverage_text(verdicts) == "1/1 inside the 95 % band" + words
+    # one function: another wording in it is the wording of both
+    monkeypatch.setattr(prediction, "uninformative_count_text",
+                        lambda count: f" [{count} apart: band spans every plausible SDC]")
+    changed = " [1 apart: band spans every plausible SDC]"
+    assert add_calibration_columns(table, cal).attrs["notes"][-1].endswith(
+        "at 1 of 1 measured row(s)" + changed)
+    assert coverage_text(verdicts) == "1/1 inside the 95 % band" + changed

@@ -454,6 +454,12 @@ def calibration_digest(calibration) -> str:
     return hashlib.sha256(repr(calibration).encode()).hexdigest()[:16]
 
 
+#: Caption of the figure of a saved calibration on the Calibrate tab (after its key).
+SAVED_FIGURE_CAPTION = ("calibrated SDC per load case with its 95 % band beside the SDC "
+                        "measured there; a hollow point with a dashed band is uninformative "
+                        "(0 .. the SDC bound: it cannot test the model)")
+
+
 def stored_calibration_label(calibration) -> str:
     """How the pages name a calibration saved in the app's store: its key, the specimen file
     it calibrated (by name and hash, as the pages label DEM runs, where its calibrated file
@@ -578,7 +584,23 @@ def saved_calibrations_table(store_path: str | Path | None = None, *,
                    "uninformative 95 % band (LOO) [-]"):
         if column in table.columns:
             table[column] = [_count_cell(v) for v in table[column]]
+    for column in ("in-sample RMS [-]", "leave-one-out RMS [-]"):
+        # as the command, summary.md and the calibrated file write it (0.0812): a column
+        # with a blank showed 0.08119027550622598 beside them
+        if column in table.columns:
+            table[column] = [_rms_cell(v) for v in table[column]]
     return table
+
+
+def _rms_cell(value: object) -> object:
+    """A stored RMS as :func:`pidcore.calibrate.outputs.rms_text` writes it; blank stays
+    blank; anything else (a damaged record) shown as stored."""
+    from ..calibrate.outputs import rms_text
+
+    if isinstance(value, int | float) and not isinstance(value, bool) \
+            and math.isfinite(value):
+        return rms_text(float(value))
+    return value
 
 
 #: The saved calibrations table's column of the cells per DEM run of each calibration.

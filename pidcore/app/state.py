@@ -117,3 +117,14 @@ def case_view(group_key: str, stamp: tuple, _entries, _stores) -> dict:
     view["loop_spec"] = charts.loop_chart(view["loops"])
     view["spectrum_spec"] = charts.spectrum_chart(view["spectrum"])
     return view
+
+
+@st.cache_data(max_entries=8, show_spinner=False)
+def calibration_png(calibration_digest: str, _calibration) -> bytes:
+    """The figure of a calibration's bands (:func:`pidcore.report.figures_results.
+    calibration_png` of its :meth:`~pidcore.calibrate.Calibration.to_pandas`), drawn once per
+    calibration (``calibration_digest``: :func:`pidcore.app.calibration.calibration_digest`),
+    not on every script run."""
+    from pidcore.report.figures_results import calibration_png as draw
+
+    return draw(_calibration.to_pandas())

@@ -192,14 +192,23 @@ class CalibrationResult:
         return self.calibration().plot(ax=ax)
 
     def document(self) -> dict:
-        """The ``--json`` document: parameters, predictions, loo, loo_rms, loo_coverage95 and
-        loo_uninformative95 (:attr:`loo_coverage`, :attr:`loo_uninformative`), the units of
+        """The ``--json`` document: parameters, predictions and loo (each row with its
+        verdict ``inside95``, words of :data:`pidcore.constants.BAND_VERDICTS`:
+        :meth:`band_verdicts`, as summary.md's table), rms_in_sample, coverage95 and
+        uninformative95 (the in-sample counts summary.md heads its table with), loo_rms,
+        loo_coverage95 and loo_uninformative95 (:attr:`loo_coverage`,
+        :attr:`loo_uninformative`), the units of
         each of their numbers (``units``: the parameters' and the predictions' fields), and
         ``specimen``: which specimen file was calibrated and which it wrote (``name``,
         ``sha256``, ``calibrated_name``, ``calibrated_sha256``)."""
         keep = ("median", "low95", "high95")
-        predictions = [_public(r) for r in self.predictions]
-        named = {*self.parameters, "loo_rms", *(k for r in predictions for k in r)}
+        # each row's verdict as summary.md's table and its count state it: a script reading
+        # the file judged low95 <= measured <= high95 itself, "yes" where the summary said
+        # "uninformative" (a band cut at the SDC bound), and found no in-sample count at all
+        predictions = _judged(self.predictions, self.band_verdicts(self.predictions))
+        loo = _judged(self.loo, self.band_verdicts(self.loo)) if self.loo is not None else None
+        named = {*self.parameters, "loo_rms", "rms_in_sample", "coverage95", "uninformative95",
+                 "loo_coverage95", "loo_uninformative95", *(k for r in predictions for k in r)}
         calibrated = self.calibrated_specimen()
         return {
             # a calibration.json (or --json) named no specimen: apart from the file beside
@@ -209,7 +218,11 @@ class CalibrationResult:
                          "calibrated_sha256": calibrated.hash},
             "parameters": {n: {k: p[k] for k in keep} for n, p in self.parameters.items()},
             "predictions": predictions,
-            "loo": [_public(r) for r in self.loo] if self.loo is not None else None,
+            "loo": loo,
+            # the command prints it beside the leave-one-out RMS; --json left it out
+            "rms_in_sample": self.rms,
+            "coverage95": self.band_verdicts(self.predictions).count(INSIDE),
+            "uninformative95": self.band_verdicts(self.predictions).count(UNINFORMATIVE),
             "loo_rms": self.loo_rms,
             # the command's "k/n inside (m more uninformative)" as numbers: without them a
             # script reading --json had to recompute the SDC bound of every fold; absent in a
@@ -246,13 +259,27 @@ class CalibrationResult:
                "high95": "-", "low95_without_stderr": "-", "high95_without_stderr": "-",
                "rms_in_sample": "-", "loo_rms": "-", "energy_per_cycle_per_cell_start_j": "J",
                "energy_per_cycle_per_cell_calibrated_j": "J", "low95_j": "J", "high95_j": "J",
-               "wall_s": "s"}
+               "wall_s": "s",
+               # words, not numbers: their vocabulary, as the report's column header names it
+               ROW_VERDICT_KEY: "/".join(BAND_VERDICTS[:2] + BAND_VERDICTS[3:]),
+               "coverage95": "count", "uninformative95": "count",
+               "loo_coverage95": "count", "loo_uninformative95": "count"}
         if any("measured_stderr_dof" in r for r in self.predictions):
             out["measured_stderr_dof"] = "-"  # degrees of freedom: a count
         for name in self.fixed:
             out[name] = parameter_spec(name, self.specimen).unit
         out.update((s.name, s.unit) for s in self.specs)
         return out
+
+
+#: Key of each prediction row's verdict in calibration.json and ``--json``
+#: (:meth:`CalibrationResult.document`).
+ROW_VERDICT_KEY = "inside95"
+
+
+def _judged(rows: Sequence[dict], verdicts: Sequence[str]) -> list[dict]:
+    """The public fields of ``rows``, each with its verdict under :data:`ROW_VERDICT_KEY`."""
+    return [{**_public(r), ROW_VERDICT_KEY: v} for r, v in zip(rows, verdicts, strict=True)]
 
 
 def _public(row: dict) -> dict:

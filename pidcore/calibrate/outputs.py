@@ -38,10 +38,13 @@ def specimen_text(result: CalibrationResult) -> str:
     lines = ["# pidcore calibrated specimen: posterior medians of `pidcore calibrate`",
              f"# started from {result.specimen.name} ({result.specimen.source}); "
              f"fitted: {', '.join(result.settings['fit'])}"]
+    units = parameter_units(result)
     for name, p in result.parameters.items():
-        # the value the file sets, in full; the interval to the digits its sampling leaves
+        # the value the file sets, in full; the interval to the digits its sampling leaves;
+        # its unit as the command and the summaries name it (rolling_friction had none)
         _, low, high = summary_texts(p)
-        lines.append(f"#   {name} = {p['median']:.6g}  (95 %: {low} .. {high})")
+        lines.append(f"#   {name} [{units[name]}] = {p['median']:.6g}  "
+                     f"(95 %: {low} .. {high})")
     if result.loo_rms is not None:
         lines.append(f"# leave-one-out RMS of the SDC: {rms_text(result.loo_rms)}")
     lines.append(f"# in-sample RMS of the SDC: {rms_text(result.rms)}")
@@ -101,30 +104,28 @@ def coverage_text(verdicts: list[str]) -> str:
     CalibrationResult.band_verdicts`), counted neither inside nor among those judged, as the
     report counts them."""
     from ..constants import BAND_VERDICTS
+    from .prediction import uninformative_count_text
 
     inside, outside, _, uninformative = BAND_VERDICTS
     judged = verdicts.count(inside) + verdicts.count(outside)
-    unjudged = verdicts.count(uninformative)
     return (f"{verdicts.count(inside)}/{judged} inside the 95 % band"
-            + (f" ({unjudged} more {uninformative}: a band of 0 .. the SDC bound, spanning "
-               "every plausible SDC, cannot test the model)" if unjudged else ""))
+            + uninformative_count_text(verdicts.count(uninformative)))
 
 
 def _table_rows(rows: list[dict], bounds: list[float], verdicts: list[str]
                 ) -> list[list[str]]:
     from ..constants import BAND_VERDICTS
-
-    def sdc(value: float) -> str:  # three decimals; a small SDC keeps its digits, not 0.000
-        return display_number(value, decimals=3)
+    from .prediction import sdc_text
 
     outside = BAND_VERDICTS[1]
     out = []
     for r, bound, verdict in zip(rows, bounds, verdicts, strict=True):
-        error = r["predicted"] - r["measured"]
+        # every SDC as its band and the report write one: they were at 3 decimals (0.492,
+        # 0.083) beside a band of 4 significant digits (0.01469 .. 0.2024)
         out.append([f"{r['frequency_hz']:g}", f"{r['acceleration_g']:g}",
-                    f"{r['fill_percent']:g}", sdc(r["measured"]), sdc(r["predicted"]),
-                    _band_text(r["low95"], r["high95"], bound),
-                    ("+" if error >= 0 else "") + sdc(error),
+                    f"{r['fill_percent']:g}", sdc_text(r["measured"]),
+                    sdc_text(r["predicted"]), _band_text(r["low95"], r["high95"], bound),
+                    sdc_text(r["predicted"] - r["measured"], signed=True),
                     f"**{verdict}**" if verdict == outside else verdict])
     return out
 
@@ -164,78 +165,93 @@ def specimen_words(result: CalibrationResult, *, full_hash: bool = True) -> str:
             f"calibrated file: {written.name} (sha256 {written.hash}).")
 
 
-def summary_markdown(result: CalibrationResult) -> str:
-    """Markdown summary: parameters, correlations, predictions, LOO table."""
-    lines = ["# Calibration summary", ""]
-    lines.append(f"Fitted: {', '.join(s.name for s in result.specs)}; "
-                 f"{len(result.predictions)} measured load cases; "
-                 f"{result.settings['cells']} cells per DEM run, design of "
-                 f"{result.settings['design_size']} point(s); "
-                 f"posterior by {result.settings['method_used']}{_sampler_words(result)}; "
-                 f"runs computed {result.runs['computed']}, cached {result.runs['cached']}; "
-                 f"{result.wall_s:.1f} s.")
-    lines += ["", specimen_words(result)]
-    lines += ["", "| " + " | ".join(PARAMETER_HEAD) + " |", "|---" * len(PARAMETER_HEAD) + "|"]
+def _fitted_words(result: CalibrationResult) -> str:
+    """The summary's first line: what was fitted, against what, and how."""
+    return (f"Fitted: {', '.join(s.name for s in result.specs)}; "
+            f"{len(result.predictions)} measured load cases; "
+            f"{result.settings['cells']} cells per DEM run, design of "
+            f"{result.settings['design_size']} point(s); "
+            f"posterior by {result.settings['method_used']}{_sampler_words(result)}; "
+            f"runs computed {result.runs['computed']}, cached {result.runs['cached']}; "
+            f"{result.wall_s:.1f} s.")
+
+
+#: Head of the energy check's table (:attr:`CalibrationResult.energy_check`).
+_ENERGY_HEAD = ["f [Hz]", "a [g]", "start [J]", "calibrated median [J]", "95 % band [J]",
+                "start inside [yes/no]"]
+
+
+def _summary_tables(result: CalibrationResult) -> list[tuple[str, list[str], list[list[str]]]]:
+    """Every table of the summary as ``(heading, head, rows of cells)``, the one content
+    summary.md and summary.html write (a verdict that is a miss in ``**bold**``; heading ""
+    for the parameters' table, which follows the specimen's line). summary.html showed four of
+    the five columns of the parameters, its prediction headings without their RMS, and neither
+    the correlations nor the energy check with its verdicts."""
     units = parameter_units(result)
+    parameters = []
     for name, p in result.parameters.items():
         median, low, high = summary_texts(p)
-        lines.append(f"| {name} | {units[name]} | {median} | {low} .. {high} | "
-                     f"{p['prior_low']:g} .. {p['prior_high']:g} |")
+        parameters.append([name, units[name], median, f"{low} .. {high}",
+                           f"{p['prior_low']:g} .. {p['prior_high']:g}"])
+    tables = [("", list(PARAMETER_HEAD), parameters)]
     names = [s.name for s in result.specs]
-    lines += ["", "Posterior correlations:", "", "| | " + " | ".join(names) + " |",
-              "|---" * (len(names) + 1) + "|"]
-    for name, row in zip(names, result.correlations, strict=True):
-        lines.append(f"| {name} | " + " | ".join(f"{c:+.2f}" for c in row) + " |")
+    tables.append(("Posterior correlations", ["", *names],
+                   [[name, *(f"{c:+.2f}" for c in row)]
+                    for name, row in zip(names, result.correlations, strict=True)]))
     for title, rows in (("In-sample posterior predictions", result.predictions),
                         ("Leave-one-out predictions", result.loo)):
         if not rows:
             continue
         rms = float(np.sqrt(np.mean([(r["predicted"] - r["measured"]) ** 2 for r in rows])))
         verdicts = result.band_verdicts(rows)
-        lines += ["", f"## {title}: RMS {rms_text(rms)}, {coverage_text(verdicts)}",
-                  "", "| " + " | ".join(_HEAD) + " |", "|---" * len(_HEAD) + "|"]
-        lines += ["| " + " | ".join(cells) + " |"
-                  for cells in _table_rows(rows, row_sdc_bounds(result, rows), verdicts)]
+        tables.append((f"{title}: RMS {rms_text(rms)}, {coverage_text(verdicts)}", list(_HEAD),
+                       _table_rows(rows, row_sdc_bounds(result, rows), verdicts)))
     if any(s.kind == "dem" for s in result.specs):
-        lines += ["", "## Energy per cycle per cell: starting specimen vs calibrated DEM", "",
-                  "| f [Hz] | a [g] | start [J] | calibrated median [J] | 95 % band [J] | "
-                  "start inside [yes/no] |", "|---|---|---|---|---|---|"]
-        for r in result.energy_check:
-            lines.append(f"| {r['frequency_hz']:g} | {r['acceleration_g']:g} | "
-                         f"{r['energy_per_cycle_per_cell_start_j']:.3g} | "
-                         f"{r['energy_per_cycle_per_cell_calibrated_j']:.3g} | "
-                         f"{r['low95_j']:.3g} .. {r['high95_j']:.3g} | "
-                         f"{'yes' if r['within'] else '**no**'} |")
+        tables.append(("Energy per cycle per cell: starting specimen vs calibrated DEM",
+                       list(_ENERGY_HEAD),
+                       [[f"{r['frequency_hz']:g}", f"{r['acceleration_g']:g}",
+                         f"{r['energy_per_cycle_per_cell_start_j']:.3g}",
+                         f"{r['energy_per_cycle_per_cell_calibrated_j']:.3g}",
+                         f"{r['low95_j']:.3g} .. {r['high95_j']:.3g}",
+                         "yes" if r["within"] else "**no**"] for r in result.energy_check]))
+    return tables
+
+
+def summary_markdown(result: CalibrationResult) -> str:
+    """Markdown summary: parameters, correlations, predictions, LOO table, energy check."""
+    lines = ["# Calibration summary", "", _fitted_words(result), "", specimen_words(result)]
+    for heading, head, rows in _summary_tables(result):
+        if heading.startswith("Posterior correlations"):
+            lines += ["", f"{heading}:"]
+        elif heading:
+            lines += ["", f"## {heading}"]
+        lines += ["", "| " + " | ".join(head) + " |", "|---" * len(head) + "|"]
+        # a blank head cell (the correlations' corner) as "| |", as it was written
+        lines[-2] = lines[-2].replace("|  |", "| |")
+        lines += ["| " + " | ".join(cells) + " |" for cells in rows]
     if result.notes:
         lines += ["", "Notes:", ""] + [f"- {n}" for n in result.notes]
     return "\n".join(lines) + "\n"
 
 
 def summary_html(result: CalibrationResult) -> str:
-    """The Markdown summary's content as a standalone HTML page."""
+    """The Markdown summary's content as a standalone HTML page: the same lines and tables
+    (:func:`_summary_tables`), a miss in bold."""
+    def cell(text: str, tag: str = "td") -> str:
+        bold = text.startswith("**") and text.endswith("**") and len(text) > 4
+        inner = html.escape(text[2:-2] if bold else text)
+        return f"<{tag}>{'<b>' + inner + '</b>' if bold else inner}</{tag}>"
+
     parts = ["<!doctype html><html><head><meta charset='utf-8'><title>Calibration</title>",
              "<style>body{font-family:sans-serif}td,th{border:1px solid #ccc;padding:2px 6px}"
-             "table{border-collapse:collapse}</style></head><body><h1>Calibration summary</h1>"]
-    parts.append(f"<p>{html.escape(specimen_words(result))}</p>")
-    parts.append("<table><tr>" + "".join(f"<th>{html.escape(h)}</th>"
-                                         for h in PARAMETER_HEAD[:4]) + "</tr>")
-    units = parameter_units(result)
-    for name, p in result.parameters.items():
-        median, low, high = summary_texts(p)
-        parts.append(f"<tr><td>{html.escape(name)}</td><td>{html.escape(units[name])}</td>"
-                     f"<td>{median}</td><td>{low} .. {high}</td></tr>")
-    parts.append("</table>")
-    for title, rows in (("In-sample predictions", result.predictions),
-                        ("Leave-one-out predictions", result.loo)):
-        if not rows:
-            continue
-        verdicts = result.band_verdicts(rows)
-        # the count summary.md heads its table with: the page showed yes/no alone
-        parts.append(f"<h2>{title}: {html.escape(coverage_text(verdicts))}</h2><table><tr>"
-                     + "".join(f"<th>{html.escape(h)}</th>" for h in _HEAD) + "</tr>")
-        for cells in _table_rows(rows, row_sdc_bounds(result, rows), verdicts):
-            parts.append("<tr>" + "".join(f"<td>{html.escape(c.strip('*'))}</td>"
-                                          for c in cells) + "</tr>")
+             "table{border-collapse:collapse}</style></head><body><h1>Calibration summary</h1>",
+             f"<p>{html.escape(_fitted_words(result))}</p>",
+             f"<p>{html.escape(specimen_words(result))}</p>"]
+    for heading, head, rows in _summary_tables(result):
+        if heading:
+            parts.append(f"<h2>{html.escape(heading)}</h2>")
+        parts.append("<table><tr>" + "".join(cell(h, "th") for h in head) + "</tr>")
+        parts += ["<tr>" + "".join(cell(c) for c in cells) + "</tr>" for cells in rows]
         parts.append("</table>")
     if result.notes:  # summary.md's notes (a value set by its prior, records left out)
         parts.append("<h2>Notes</h2><ul>"
@@ -357,14 +373,20 @@ def plot_predictions(result: CalibrationResult, path: Path) -> None:
         plt.close(fig)
 
 
-def plot_pairs(result: CalibrationResult, path: Path) -> None:
-    """Posterior pairs: histograms on the diagonal, scatter below it."""
+def pairs_figure(result: CalibrationResult) -> Any:
+    """The figure of posterior_pairs.png: histograms of the posterior samples on the diagonal
+    (their count on its axis), scatter below it, each axis labelled with its parameter and
+    unit as the summary's table names them (``fixture_mass_kg [kg]``; the axes named the
+    parameter alone, so 0.25 of a dimensionless friction read like 0.25 kg); returns the
+    matplotlib figure (not closed)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    units = parameter_units(result)
     names = [s.name for s in result.specs]
+    labels = [f"{name} [{units.get(name, '-')}]" for name in names]
     k = len(names)
     fig, axes = plt.subplots(k, k, figsize=(2.6 * k, 2.6 * k), squeeze=False,
                              constrained_layout=True)
@@ -376,14 +398,25 @@ def plot_pairs(result: CalibrationResult, path: Path) -> None:
                 ax.axis("off")
             elif i == j:
                 ax.hist(s[:, i], bins=40, color="C0")
+                ax.set_ylabel("posterior samples [count]", fontsize=7)
             else:
                 ax.plot(s[:, j], s[:, i], ".", ms=1, alpha=0.3)
             if i == k - 1:
-                ax.set_xlabel(names[j], fontsize=8)
+                ax.set_xlabel(labels[j], fontsize=8)
             if j == 0 and i > 0:
-                ax.set_ylabel(names[i], fontsize=8)
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
+                ax.set_ylabel(labels[i], fontsize=8)
+    return fig
+
+
+def plot_pairs(result: CalibrationResult, path: Path) -> None:
+    """posterior_pairs.png (:func:`pairs_figure`) written to ``path``."""
+    import matplotlib.pyplot as plt
+
+    fig = pairs_figure(result)
+    try:
+        fig.savefig(path, dpi=100)
+    finally:
+        plt.close(fig)
 
 
 def write_outputs(result: CalibrationResult, out_dir: str | os.PathLike) -> list[Path]:

@@ -41,6 +41,10 @@ if TYPE_CHECKING:  # pragma: no cover
 #: Fields of calibration.json that describe how a calibration was made, not what it is: the
 #: wall time, how many runs came from the cache, the path of the store that cached them.
 _BOOKKEEPING = ("wall_s", "runs")
+#: Units of the fields a calibration.json states since 2026-12 that follow from its keyed
+#: rows (the verdicts and their counts): left out of its key, as the fields themselves.
+_DERIVED_UNITS = ("inside95", "coverage95", "uninformative95", "loo_coverage95",
+                  "loo_uninformative95")
 _KEY_PREFIX = "cal_"
 
 
@@ -64,8 +68,17 @@ def calibration_key(document: dict, calibrated_specimen_text: str | None = None)
     # that did not write them gave the same fit, so save_calibration still finds that entry
     # loo_uninformative95 follows from the loo rows and the specimen, both keyed: left out,
     # a fit saved before it existed keeps its key
+    # so do the in-sample counts and each row's verdict (inside95), written since: they
+    # follow from the keyed rows and the specimen
     what = {k: v for k, v in document.items()
-            if k not in (*_BOOKKEEPING, "specimen", "loo_uninformative95")}
+            if k not in (*_BOOKKEEPING, "specimen", "loo_uninformative95", "coverage95",
+                         "uninformative95")}
+    for rows in ("predictions", "loo"):
+        if isinstance(what.get(rows), list):
+            what[rows] = [{k: v for k, v in r.items() if k != "inside95"}
+                          if isinstance(r, dict) else r for r in what[rows]]
+    if isinstance(what.get("units"), dict):  # and the units of those derived fields
+        what["units"] = {k: v for k, v in what["units"].items() if k not in _DERIVED_UNITS}
     settings = dict(what.get("settings") or {})
     settings.pop("store", None)
     what["settings"] = settings

@@ -58,11 +58,36 @@ def band_cut_words(bound: SdcBound) -> str:
 
 
 
+def sdc_text(value: float, *, signed: bool = False) -> str:
+    """An SDC as the report's cells write it (4 significant digits, ``"0.4921"``,
+    ``"0.08264"``; with its sign where ``signed``: a difference), so that one SDC reads the same
+    in every file: calibrate's summaries wrote the calibrated SDC the report shows as 0.4921
+    as 0.492, and 0.08264 as 0.083 beside its band's 0.01469; ``"—"`` for a value that is not
+    a number."""
+    if not math.isfinite(value):
+        return "—"
+    return f"{value:+.4g}" if signed else f"{value:.4g}"
+
+
 def band_text(low: float, high: float) -> str:
-    """A 95 % band as the report's cells write its bounds (4 significant digits, e.g.
+    """A 95 % band as the report's cells write its bounds (:func:`sdc_text`, e.g.
     ``"0 .. 16.91"``), so that the one band reads the same in every sentence of a page;
     ``"—"`` for a bound that is not a number."""
-    return " .. ".join(f"{v:.4g}" if math.isfinite(v) else "—" for v in (low, high))
+    return " .. ".join(sdc_text(v) for v in (low, high))
+
+
+def uninformative_count_text(count: int) -> str:
+    """How many more bands were ``uninformative`` (:meth:`CalibratedPrediction.judge`),
+    counted neither inside nor among those judged, as every count of a calibration's verdicts
+    says it after its "k of n inside": the report's note (:func:`pidcore.report.table.
+    add_calibration_columns`) and the calibration's summaries and command
+    (:func:`pidcore.calibrate.outputs.coverage_text`) wrote these words each in its own copy;
+    ``" (1 more uninformative: a band of 0 .. the SDC bound, spanning every plausible SDC,
+    cannot test the model)"``, "" for none."""
+    if count <= 0:
+        return ""
+    return (f" ({count} more {BAND_VERDICTS[3]}: a band of 0 .. the SDC bound, spanning "
+            "every plausible SDC, cannot test the model)")
 
 
 #: Column of :meth:`Calibration.to_pandas` holding each fitted measurement's verdict (words of

@@ -185,7 +185,9 @@ def _print_result(args: argparse.Namespace, result, own_notes: list[str], saved:
         for name, p in result.parameters.items():
             median, low, high = summary_texts(p)
             print(f"{name} [{units[name]}]: {median} (95 % {low} .. {high})")
-        print(f"in-sample RMS {rms_text(result.rms)}")
+        # with its count, as summary.md heads its in-sample table
+        print(f"in-sample RMS {rms_text(result.rms)}, "
+              f"{coverage_text(result.band_verdicts(result.predictions))}")
         print(runs)
         if result.loo is not None:
             print(f"leave-one-out RMS {rms_text(result.loo_rms)}, "

@@ -24,12 +24,20 @@ match_paper
     The paper's Table 3 SDCs at a grid point.
 DEM_COLUMNS, MEASURED_COLUMNS
     Columns the aligner reads.
+MEASURED_EQ11_COLUMN, MEASURED_EQ11_STDERR_COLUMN, MEASURED_EQ11_DOF_COLUMN
+    The measured Eq. 11 SDC's columns as every table names them.
+MEASURED_COLUMNS_RENAMED
+    Their old names -> these, for a table an earlier pidcore wrote.
 """
 
 from .align import (
     ALIGNMENT_STATUSES,
     DEM_COLUMNS,
     MEASURED_COLUMNS,
+    MEASURED_COLUMNS_RENAMED,
+    MEASURED_EQ11_COLUMN,
+    MEASURED_EQ11_DOF_COLUMN,
+    MEASURED_EQ11_STDERR_COLUMN,
     AlignedCase,
     Aligner,
     AlignmentStatus,
@@ -57,7 +65,9 @@ from .loadcase import (
 
 __all__ = [
     "ALIGNMENT_STATUSES", "DEM_COLUMNS", "DIRECTION_PATTERN", "FILL_PATTERN", "MATERIAL_PATTERN",
-    "MEASURED_COLUMNS", "SIDECAR_COLUMNS", "SIDECAR_NAME", "AlignedCase", "Aligner",
+    "MEASURED_COLUMNS", "MEASURED_COLUMNS_RENAMED", "MEASURED_EQ11_COLUMN",
+    "MEASURED_EQ11_DOF_COLUMN", "MEASURED_EQ11_STDERR_COLUMN", "SIDECAR_COLUMNS", "SIDECAR_NAME",
+    "AlignedCase", "Aligner",
     "AlignmentStatus", "DemCase", "LoadCase", "LoadCaseError", "StatedLoadCase", "Tolerances",
     "align_measured", "dem_cases", "match_paper", "parse_file_name", "pooled_mean",
     "read_sidecar", "resolve_load_case", "simulation_identity",

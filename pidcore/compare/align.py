@@ -43,6 +43,23 @@ MEASURED_COLUMNS: tuple[str, ...] = ("frequency_hz", "acceleration_g", "fill_per
 #: Columns a table of DEM runs must have (as :meth:`pidcore.store.Store.list_dem_runs` gives).
 DEM_COLUMNS: tuple[str, ...] = ("frequency_hz", "acceleration_g", "fill_percent", "material",
                                 "direction", "sdc", "sdc_stderr")
+#: The measured Eq. 11 SDC (Im(P_c)/w as the energy), its standard error and that error's
+#: degrees of freedom, as every table of pidcore names them (:func:`align_measured`'s frame,
+#: the report's files, :mod:`pidcore.report.table`): the SDC the calibrated DEM predicts, not
+#: the like-for-like counterpart of our DEM's (Eq. 10's energy). Named "SDC measured [-]"
+#: before: beside "SDC DEM (ours) [-]" a reader compared 1.139 with 0.6054 (a factor 2) where
+#: the like-for-like 0.624 agrees.
+MEASURED_EQ11_COLUMN = "SDC measured (Eq. 11) [-]"
+MEASURED_EQ11_STDERR_COLUMN = "SDC measured (Eq. 11) stderr [-]"
+MEASURED_EQ11_DOF_COLUMN = "SDC measured (Eq. 11) stderr dof [-]"
+#: The Eq. 11 columns renamed in 2026-12: old name -> new name, for scripts reading a table an
+#: earlier pidcore wrote (``frame.rename(columns=MEASURED_COLUMNS_RENAMED)``): a report.csv
+#: (:data:`pidcore.report.REPORT_COLUMNS_RENAMED`) or a saved :func:`align_measured` frame.
+MEASURED_COLUMNS_RENAMED: dict[str, str] = {
+    "SDC measured [-]": MEASURED_EQ11_COLUMN,
+    "SDC measured stderr [-]": MEASURED_EQ11_STDERR_COLUMN,
+    "SDC measured stderr dof [-]": MEASURED_EQ11_DOF_COLUMN,
+}
 #: The paper's particles and drive direction (Sect. 4): Table 3 applies to these only.
 PAPER_MATERIAL = "acrylic"
 PAPER_DIRECTION = "z"
@@ -1116,15 +1133,18 @@ def align_measured(measured: pd.DataFrame, dem_runs: pd.DataFrame | None,
     Returns
     -------
     pandas.DataFrame
-        :meth:`AlignedCase.to_dict` columns plus ``SDC measured [-]``,
-        ``SDC measured stderr [-]`` and ``source file(s)``.
+        :meth:`AlignedCase.to_dict` columns plus :data:`MEASURED_EQ11_COLUMN`
+        (``SDC measured (Eq. 11) [-]``), :data:`MEASURED_EQ11_STDERR_COLUMN` and
+        ``source file(s)``: the report's names of the measured SDC (``SDC measured [-]`` and
+        ``SDC measured stderr [-]`` before 2026-12: :data:`MEASURED_COLUMNS_RENAMED` reads a
+        frame saved with them).
     """
     _check_columns(measured, MEASURED_COLUMNS, "measured cases")
     aligner = Aligner.from_tables(dem_runs, paper, model=model, tolerances=tolerances)
     rows = []
     for _, row in measured.iterrows():
         aligned = aligner.align(_row_case(row))
-        rows.append({**aligned.to_dict(), "SDC measured [-]": float(row["sdc"]),
-                     "SDC measured stderr [-]": float(row["sdc_stderr"]),
+        rows.append({**aligned.to_dict(), MEASURED_EQ11_COLUMN: float(row["sdc"]),
+                     MEASURED_EQ11_STDERR_COLUMN: float(row["sdc_stderr"]),
                      "source file(s)": str(row["source"])})
     return pd.DataFrame(rows)

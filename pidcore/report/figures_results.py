@@ -10,7 +10,8 @@
 * :func:`plot_harmonic_response` - a treated mode's amplitude against frequency
   (:meth:`pidcore.model.HarmonicResponse.to_pandas`).
 * :func:`plot_calibration` - a calibration's predictions with their 95 % bands beside the
-  SDCs it was fitted to (:meth:`pidcore.calibrate.Calibration.to_pandas`).
+  SDCs it was fitted to (:meth:`pidcore.calibrate.Calibration.to_pandas`);
+  :func:`calibration_png` draws it as a PNG for a page.
 
 ``Measurement.plot``, ``PowerAnalysis.plot``, ``ForceDisplacementLoop.plot``,
 ``DemResult.plot``, ``HarmonicResponse.plot`` and ``Calibration.plot`` forward here
@@ -141,6 +142,27 @@ def plot_calibration(frame: pd.DataFrame, *, ax: Any = None) -> Any:
     ax.set_ylabel("SDC [-]")
     ax.legend()
     return ax
+
+
+def calibration_png(frame: pd.DataFrame, *, dpi: int = 150) -> bytes:
+    """PNG of :func:`plot_calibration` of ``frame`` (:meth:`pidcore.calibrate.Calibration.
+    to_pandas`) on a figure of its own, for a page that shows an image (the app's list of
+    saved calibrations): a bare matplotlib Figure, so that a server drawing it for every
+    session keeps no pyplot figure alive and needs no GUI backend."""
+    import io
+
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(max(6.0, 0.5 * len(frame)), 5.5), layout="constrained")
+    ax = plot_calibration(frame, ax=fig.subplots())
+    # below the axes: inside them its long entries (the uninformative band's, the cut bound's)
+    # were wider than a 6 in axes and covered the points, their markers cut off at its edge
+    ax.get_legend().remove()
+    fig.legend(*ax.get_legend_handles_labels(), loc="outside lower center",
+               fontsize="small")
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png", dpi=dpi)
+    return buffer.getvalue()
 
 
 def plot_harmonic_response(frame: pd.DataFrame, *, ax: Any = None) -> Any:

@@ -28,6 +28,10 @@ import pandas as pd
 from .. import defaults
 from ..compare.align import (
     ALIGNMENT_STATUSES,
+    MEASURED_COLUMNS_RENAMED,
+    MEASURED_EQ11_COLUMN,
+    MEASURED_EQ11_DOF_COLUMN,
+    MEASURED_EQ11_STDERR_COLUMN,
     Aligner,
     DemCase,
     Tolerances,
@@ -67,22 +71,14 @@ DIFFERENCE_COLUMN = "difference measured (E of Eq. 10) - ours [-]"
 #: Chi-square per degree of freedom of the pooled measurements about their mean (~1: they agree
 #: within their errors; NaN for a single measurement).
 CONSISTENCY_COLUMN = "measured chi2/dof [-]"
-#: The measured Eq. 11 SDC (Im(P_c)/w as the energy), its standard error and that error's
-#: degrees of freedom: the SDC the calibrated DEM predicts, not the like-for-like counterpart
-#: of our DEM's (:data:`MEASURED_EQ10_COLUMN`). Named "SDC measured [-]" before: beside
-#: "SDC DEM (ours) [-]" in the HTML, Markdown and LaTeX files a reader compared 1.139 with
-#: 0.6054 (a factor 2) where the like-for-like 0.624 agrees, and the PDF and the terminal
-#: called the one column "SDC measured (Eq. 11) [-]".
-MEASURED_EQ11_COLUMN = "SDC measured (Eq. 11) [-]"
-MEASURED_EQ11_STDERR_COLUMN = "SDC measured (Eq. 11) stderr [-]"
-MEASURED_EQ11_DOF_COLUMN = "SDC measured (Eq. 11) stderr dof [-]"
-#: Report columns renamed: old name -> new name, for scripts reading a report.csv of an earlier
-#: pidcore (``pd.read_csv(path).rename(columns=REPORT_COLUMNS_RENAMED)``).
-REPORT_COLUMNS_RENAMED: dict[str, str] = {
-    "SDC measured [-]": MEASURED_EQ11_COLUMN,
-    "SDC measured stderr [-]": MEASURED_EQ11_STDERR_COLUMN,
-    "SDC measured stderr dof [-]": MEASURED_EQ11_DOF_COLUMN,
-}
+#: The measured Eq. 11 SDC, its standard error and that error's degrees of freedom
+#: (:data:`pidcore.compare.align.MEASURED_EQ11_COLUMN`, defined there for every table of
+#: pidcore): named "SDC measured [-]" before, beside "SDC DEM (ours) [-]" in the HTML, Markdown
+#: and LaTeX files, while the PDF and the terminal called the one column
+#: "SDC measured (Eq. 11) [-]". Report columns renamed: old name -> new name, for scripts
+#: reading a report.csv of an earlier pidcore
+#: (``pd.read_csv(path).rename(columns=REPORT_COLUMNS_RENAMED)``).
+REPORT_COLUMNS_RENAMED: dict[str, str] = dict(MEASURED_COLUMNS_RENAMED)
 #: Column holding the alignment status; the header lists its values,
 #: :data:`pidcore.compare.ALIGNMENT_STATUSES`.
 ALIGNMENT_COLUMN = f"alignment [{'/'.join(ALIGNMENT_STATUSES)}]"
@@ -725,7 +721,7 @@ def add_calibration_columns(table: pd.DataFrame, calibration, *,
         material (the default report), each checked against the calibration's specimen.
         Neither: unchecked.
     """
-    from ..calibrate.prediction import quantile_label
+    from ..calibrate.prediction import quantile_label, uninformative_count_text
     from ..constants import PARTICLE_MATERIALS
     from ..specimen import paper_specimen
 
@@ -814,7 +810,6 @@ def add_calibration_columns(table: pd.DataFrame, calibration, *,
     summary = (f"calibration {calibration.path}: predicts {sum(math.isfinite(v) for v in sdc)} "
                f"of {len(out)} row(s); measured Eq. 11 SDC inside the 95 % band at "
                f"{inside.count(INSIDE)} of {compared} measured row(s)"
-               + (f" ({unjudged} more {UNINFORMATIVE}: a band of 0 .. the SDC bound, spanning "
-                  "every plausible SDC, cannot test the model)" if unjudged else ""))
+               + uninformative_count_text(unjudged))
     out.attrs = {**table.attrs, "notes": [*table.attrs.get("notes", []), summary]}
     return out

@@ -10,8 +10,11 @@ from pathlib import Path
 import streamlit as st
 
 from pidcore import defaults
+from pidcore.app import state
 from pidcore.app.calibration import (
+    SAVED_FIGURE_CAPTION,
     calibration_api,
+    calibration_digest,
     fittable_names,
     page_words,
     points_by_material,
@@ -155,6 +158,9 @@ def _saved(stored) -> None:
     listed = hashlib.sha256("\n".join(keys).encode()).hexdigest()[:12]
     key = st.selectbox("download the files of", keys, key=f"calibration_saved_key_{listed}")
     chosen = saved[keys.index(key)]
+    # its bands as predictions.png draws them: only the run just made showed a figure
+    st.image(state.calibration_png(calibration_digest(chosen), chosen),
+             caption=f"{key}: {SAVED_FIGURE_CAPTION}")
     c1, c2 = st.columns(2)
     c1.download_button("calibration.json", chosen.document_text, file_name="calibration.json",
                        mime="application/json", key="calibration_saved_json")
