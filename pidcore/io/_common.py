@@ -289,7 +289,9 @@ def real_samples(values: object, *, where: str) -> np.ndarray:
                              "per channel")
     if arr.size == 0:
         raise InputFileError(f"{where}: holds no samples")
-    return arr.astype(np.float64).reshape(-1)
+    # copy=False: float64 samples as read (h5py, loadmat) are the channel's; a copy of each
+    # doubled the peak of reading a MATLAB export while the file's arrays were still held
+    return arr.astype(np.float64, copy=False).reshape(-1)
 
 
 def real_scalar(value: object, *, where: str, positive: bool = False) -> float:
