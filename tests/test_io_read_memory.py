@@ -6,8 +6,10 @@ and generous, not timings; every read is also checked to give the very samples w
 from __future__ import annotations
 
 import tracemalloc
+from pathlib import Path
 
 import numpy as np
+import pytest
 
 from pidcore.io import read_measurement, write_measurement
 from pidcore.records import Channel, Measurement
@@ -51,3 +53,35 @@ def test_a_long_matlab_export_is_read_without_a_second_copy_of_its_samples(tmp_p
     read, peak = _read_peak(tmp_path / "long.mat")
     _same_samples(read, written)
     assert peak <= 1.5 * 2 * N_SAMPLES * 8, peak / (2 * N_SAMPLES * 8)
+
+
+FIXTURES = Path(__file__).resolve().parents[1] / "data_samples" / "exports"
+#: The third-party exports (../shared/fixtures/real_exports beside the checkout).
+REAL_EXPORTS = next((p for p in (
+    Path(__file__).resolve().parents[1] / ".." / "shared" / "fixtures" / "real_exports",
+    Path("/work/shared/fixtures/real_exports")) if p.is_dir()), None)
+
+
+@pytest.mark.skipif(REAL_EXPORTS is None, reason="real UFF fixtures not present")
+@pytest.mark.parametrize("chunk_bytes", [1 << 24, 4096, 97, 7])
+def test_the_chunked_block_scan_finds_the_blocks_pyuff_finds(monkeypatch, chunk_bytes):
+    """The index the chunked scan builds is pyuff's, block for block and type for type, on
+    real exports (the 58b fixture with a stray CR LF before its closing tag, Fortran D
+    exponents, Latin-1 headers, blocks padded to column 80) and the bundled samples, also
+    with chunks so small that tags and the 80-column look-ahead straddle chunk ends."""
+    import pyuff
+
+    from pidcore.io import uff
+
+    monkeypatch.setattr(uff, "_SCAN_CHUNK_BYTES", chunk_bytes)
+    files = [p for p in [*REAL_EXPORTS.glob("*"), *FIXTURES.glob("*.uff")]
+             if p.suffix.lower() in (".uff", ".unv", ".frf")]
+    assert len(files) >= 10
+    for path in files:
+        theirs, ours = pyuff.UFF(str(path)), uff._BlockScannedUFF(str(path))
+        assert ours._n_sets == theirs._n_sets, path.name
+        np.testing.assert_array_equal(np.asarray(ours._block_ind),
+                                      np.asarray(theirs._block_ind), err_msg=path.name)
+        np.testing.assert_array_equal(ours._set_types, theirs._set_types, err_msg=path.name)
+        np.testing.assert_array_equal(ours._set_formats, theirs._set_formats,
+                                      err_msg=path.name)

@@ -212,6 +212,97 @@ _HEADER_LINES_58 = 13
 _BINARY_DTYPES = {(2, 1): "<f4", (2, 2): ">f4", (4, 1): "<f8", (4, 2): ">f8"}
 
 
+_BLOCK_TAG = b"    -1"
+#: Bytes after a tag that pyuff looks at to tell a block delimiter (74 blanks up to column 80).
+_TAG_LOOKAHEAD = 81
+#: Bytes of the file read at a time while looking for block delimiters.
+_SCAN_CHUNK_BYTES = 1 << 24
+#: Bytes read of a block to find its dataset type (the line after its opening tag).
+_BLOCK_HEAD_BYTES = 4096
+
+
+class _BlockScannedUFF(pyuff.UFF):
+    """:class:`pyuff.UFF` whose block index is found by reading the file in chunks.
+
+    pyuff's ``refresh`` reads the whole file into one bytes object and copies every block,
+    split into lines, to read its type: for a long export the file once and its largest
+    block about twice more, beside the channels read afterwards (58b: 1.6x the samples,
+    ASCII 58 more). This finds the same delimiters by the same rule and reads only the
+    head of each block, so the index (``_block_ind``, ``_set_types``) is pyuff's own and
+    pyuff reads the blocks from it as before.
+    """
+
+    def refresh(self) -> bool:
+        self._refreshed = False
+        if not self.file_exists():
+            return False
+        try:
+            with open(self._filename, "rb") as fh:
+                size = fh.seek(0, os.SEEK_END)
+                tags = self._tag_offsets(fh, size)
+                n_blocks = len(tags) // 2
+                if n_blocks == 0:
+                    self._refreshed = True
+                    return True
+                self._block_ind = np.zeros((n_blocks, 2), dtype="int64")
+                self._block_ind[:, 0] = tags[:-1:2][:n_blocks]
+                self._block_ind[:, 1] = np.asarray(tags[1::2][:n_blocks]) - 1
+                self._n_sets = n_blocks
+                self._set_types = np.zeros(n_blocks).astype(int)
+                # pyuff never marks a set binary here (it compares an int with 'b'); its
+                # reader tells 58b from the dataset line itself
+                self._set_formats = np.zeros(n_blocks)
+                for ii in range(n_blocks):
+                    set_type = self._block_type(fh, int(self._block_ind[ii, 0]),
+                                                int(self._block_ind[ii, 1]))
+                    if set_type is not None:
+                        self._set_types[ii] = set_type
+        except Exception as exc:
+            reraise_interrupt(exc)
+            raise Exception(f"Error refreshing UFF file: {self._filename}") from None
+        self._refreshed = True
+        return True
+
+    @staticmethod
+    def _tag_offsets(fh, size: int) -> list[int]:
+        """Offsets of the ``'    -1'`` tags pyuff counts as delimiters: at the end of the
+        file, before a line break, or followed by blanks up to column 80."""
+        offsets = []
+        blanks = b" " * (80 - len(_BLOCK_TAG))
+        for start in range(0, size, _SCAN_CHUNK_BYTES):
+            fh.seek(start)
+            window = fh.read(_SCAN_CHUNK_BYTES + _TAG_LOOKAHEAD)
+            ind = -1
+            while True:
+                ind = window.find(_BLOCK_TAG, ind + 1)
+                if ind == -1 or ind >= _SCAN_CHUNK_BYTES:
+                    break  # a tag from there on starts in the next chunk
+                at = start + ind
+                end = ind + len(_BLOCK_TAG)
+                if at + len(_BLOCK_TAG) == size \
+                        or (at + len(_BLOCK_TAG) < size and window[end] in (10, 13)) \
+                        or (at + 80 < size and window[end:ind + 80] == blanks):
+                    offsets.append(at)
+        return offsets
+
+    @staticmethod
+    def _block_type(fh, first: int, last: int) -> int | None:
+        """Dataset type of the block from ``first`` to ``last`` (bytes, inclusive): the
+        first six characters of its second line, as pyuff reads them; None where they are
+        not a number (pyuff leaves such a block's type 0)."""
+        length = last - first + 1
+        fh.seek(first)
+        head = fh.read(min(length, _BLOCK_HEAD_BYTES))
+        lines = head.splitlines()
+        if len(head) < length and len(lines) < 3:  # the second line goes on: read it all
+            fh.seek(first)
+            lines = fh.read(length).splitlines()
+        try:
+            return int(lines[1][0:6])
+        except (IndexError, ValueError):
+            return None
+
+
 def _binary_58_record(path: str | os.PathLike[str], start: int) -> dict | None:
     """The dataset 58b record whose block starts at byte ``start``: its header parsed by
     pyuff, its samples read straight from the file into one array. None for a record this
@@ -287,7 +378,7 @@ def read_uff(path: str | os.PathLike[str]) -> Measurement:
         raise InputFileError(f"{where}: the file ends inside a UFF dataset (no closing '    -1' "
                              "line); it is truncated or not a UFF file")
     try:
-        uff = pyuff.UFF(where)
+        uff = _BlockScannedUFF(where)
         set_types = [int(t) for t in uff.get_set_types()]
     except Exception as exc:  # pyuff raises bare Exception for every failure
         reraise_interrupt(exc)
