@@ -59,7 +59,7 @@ def test_reading_a_long_binary_export_needs_a_bounded_multiple_of_its_samples(tm
     abscissa array): 5.5x the samples by tracemalloc here. Then pyuff's scan of the blocks
     held the whole file (1x) and a copy of each block split into lines (up to 1x more): 2.7x.
     The scan now reads the file in chunks and each block's head only, so what is left is the
-    channels (1x): checked with 0.5x for the 16 MiB scan chunk and pyuff's header parse."""
+    channels (1x): checked with 0.5x for the 4 MiB scan chunk and pyuff's header parse."""
     n = 1_000_000
     t = np.arange(n) / 51_200.0
     path = tmp_path / "long_58b.uff"
