@@ -187,3 +187,17 @@ def test_ascii_records_of_odd_line_layouts_read_as_pyuff_reads_them(tmp_path, mo
     path = tmp_path / "variant.uff"
     path.write_bytes(variant((FIXTURES / "synthetic_f50Hz_a5g_fill50_acrylic.uff").read_bytes()))
     _bit_identical(read_uff(path), _read_by_pyuff(monkeypatch, path))
+
+
+def test_a_long_csv_export_is_read_holding_its_table_once(tmp_path):
+    """The table was parsed as one pandas block (time column and all: 1.5x the two channels
+    here), each channel then copied out of it (1x more) and the time column compared with
+    its grid over its whole length (3 temporaries of its size): 3.5x by tracemalloc, and the
+    resident set as much. Now the rows are parsed a chunk at a time straight into columns
+    sized by the line count, each channel is its column, and the grid is compared in blocks:
+    the table (1.5x), checked with 0.5x for a chunk's block and pandas' buffers. The samples
+    are the file's, bit for bit (written with 17 digits)."""
+    written = _export(tmp_path / "long.csv", N_SAMPLES // 2)
+    read, peak = _read_peak(tmp_path / "long.csv")
+    _same_samples(read, written)
+    assert peak <= 2.0 * 2 * (N_SAMPLES // 2) * 8, peak / (2 * (N_SAMPLES // 2) * 8)
