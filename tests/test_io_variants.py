@@ -613,13 +613,14 @@ def test_ctrl_c_while_reading_or_writing_leaves_the_store(tmp_path, capsys, monk
     uff = _write_uff(tmp_path / "r.uff", [Channel("Force", "force", rec.force_n, FS, "N"),
                                           Channel("V", "velocity", rec.velocity_m_s, FS, "m/s")])
     with monkeypatch.context() as mp:  # pyuff turns Ctrl-C into a plain Exception
-        def swallowing(self, *a, **k):
+        def swallowing(*a, **k):
             try:
                 raise KeyboardInterrupt
             except BaseException:
                 raise Exception("Error reading data-set") from None  # noqa: B904
 
-        mp.setattr(pyuff_module.UFF, "read_sets", swallowing)
+        # where pyuff parses a record's header (pidcore reads ASCII 58 samples itself)
+        mp.setattr(pyuff_module.datasets.dataset_58, "_extract58", swallowing)
         code, out, err = _cli([str(uff), "--store", str(store)], capsys)
         assert code == 130 and "interrupted" in err and len(err.strip().splitlines()) == 1
     with monkeypatch.context() as mp:

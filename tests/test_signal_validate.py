@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import tracemalloc
+
 import numpy as np
 import pytest
 
@@ -141,3 +143,28 @@ def test_clipping_at_negative_extreme():
     with pytest.raises(ChannelError) as exc:
         analyze_channels(force, _with(vel, clipped), source="neg.uff")
     assert f"'vib' clipped: {expected} samples at {level:+.6g} m/s" in _one_line(exc)
+
+
+def test_the_outlier_check_of_a_long_channel_copies_it_once():
+    """The outlier check copied a channel without its markers (always, a boolean index
+    copies) and percentile copied that again to partition it: 2x the channel on top of it
+    for each channel analysed. Without markers the samples are handed to percentile as they
+    are (its one copy), and with markers the copy is partitioned in place: 1x, checked with
+    0.25x for the marker mask (1/8) and small buffers. The percentiles, and so the verdict,
+    are the same numbers (a marker is still found, with the same message)."""
+    from pidcore.errors import ChannelError
+    from pidcore.signal.validate import check_outliers
+
+    data = np.sin(np.arange(1_000_000) * 0.01)
+    tracemalloc.start()
+    try:
+        check_outliers(data, source="x", channel="Force")
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak <= 1.25 * data.nbytes, peak / data.nbytes
+    data[1234] = 3.4e38
+    with pytest.raises(ChannelError, match=r"1 sample far outside the signal, first at index "
+                                           r"1234 \(3\.4e\+38; 99 % of the other samples lie "
+                                           r"within -0\.999\d* \.\. 0\.999\d*\)"):
+        check_outliers(data, source="x", channel="Force")

@@ -18,6 +18,22 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help="timed repetitions (best is kept; default 3)")
     s.add_argument("--json", action="store_true", help="one JSON document on stdout")
     s.set_defaults(func=_bench_signal)
+    r = sub.add_parser("read", help="peak memory of reading a long export in each format "
+                                    "and of analysing it with and without a store",
+                       description="Writes a force/velocity export (and --unused acceleration "
+                                   "channels) as CSV, ASCII and binary UFF, MAT and HDF5, and "
+                                   "measures in a fresh process per case the peak memory of "
+                                   "reading each, and of `pidcore analyze` of the CSV and 58b "
+                                   "files with --no-store and with a store: resident set "
+                                   "growth and tracemalloc peak, as multiples of the bytes of "
+                                   "the two channels the analysis uses, against targets.")
+    r.add_argument("--samples", type=positive_int, default=1_000_000,
+                   help="samples per channel (default 1 000 000)")
+    r.add_argument("--unused", type=int, default=0, metavar="N",
+                   help="acceleration channels in the file besides force and velocity "
+                        "(default 0)")
+    r.add_argument("--json", action="store_true", help="one JSON document on stdout")
+    r.set_defaults(func=_bench_read)
     t = sub.add_parser("store", help="store listing, reads by key, batch reads and verify "
                                      "on a store of years of tests",
                        description="Builds a temporary store of many small entries (default "
@@ -73,6 +89,16 @@ def _bench_signal(args: argparse.Namespace) -> int:
     from ..signal.bench import run_signal_bench
 
     _emit(run_signal_bench(args.samples, repeat=args.repeat), args.json)
+    return 0
+
+
+def _bench_read(args: argparse.Namespace) -> int:
+    from ..errors import ParameterError
+    from ..signal.bench import run_read_bench
+
+    if args.unused < 0:
+        raise ParameterError(f"--unused {args.unused}: expected 0 or more channels")
+    _emit(run_read_bench(args.samples, n_unused=args.unused), args.json)
     return 0
 
 

@@ -338,29 +338,27 @@ def read_csv(path: str | os.PathLike[str], *, sample_rate_hz: float | None = Non
     notes: list[str] = []
     try:
         # skiprows skips raw lines (blank ones included), as counted by _LINE_BREAK
-        frame = pd.read_csv(path, sep=delimiter, decimal=decimal, header=None, skiprows=first,
-                            dtype=np.float64, encoding=encoding, skipinitialspace=True,
-                            skip_blank_lines=True, engine="c", comment="#")
+        columns = _numeric_columns(path, sep=delimiter, decimal=decimal, skiprows=first,
+                                   encoding=encoding)
     except (pd.errors.ParserError, ValueError, UnicodeDecodeError) as exc:
         first_line = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         raise InputFileError(f"{where}: not a numeric delimited table ({first_line}); expected "
                              "one header row of names and units followed by numbers") from None
-    values = frame.to_numpy(dtype=np.float64, copy=False)
-    del frame
     # A trailing delimiter makes an empty last column; drop it.
-    while header_cells and not header_cells[-1].strip() and values.shape[1] == len(header_cells) \
-            and np.all(np.isnan(values[:, -1])):
+    while header_cells and not header_cells[-1].strip() and len(columns) == len(header_cells) \
+            and np.all(np.isnan(columns[-1])):
         header_cells.pop()
         unit_cells = unit_cells[:len(header_cells)]
-        values = values[:, :-1]
-    while values.shape[1] > len(header_cells) and np.all(np.isnan(values[:, -1])):
-        values = values[:, :-1]
-    if values.shape[1] != len(header_cells):
+        columns.pop()
+    while len(columns) > len(header_cells) and np.all(np.isnan(columns[-1])):
+        columns.pop()
+    if len(columns) != len(header_cells):
         raise InputFileError(f"{where}: the header has {len(header_cells)} columns but the data "
-                             f"rows have {values.shape[1]}")
+                             f"rows have {len(columns)}")
     cells = [_name_and_unit(cell, unit) for cell, unit in zip(header_cells, unit_cells,
                                                                strict=True)]
-    if len(cells) < 1 or values.shape[0] < 2:
+    n_rows = columns[0].size if columns else 0
+    if len(cells) < 1 or n_rows < 2:
         raise InputFileError(f"{where}: expected at least one channel and two data rows")
 
     time_index = None
@@ -375,17 +373,17 @@ def read_csv(path: str | os.PathLike[str], *, sample_rate_hz: float | None = Non
         if time_index is not None:
             name, unit = cells[time_index]
             factor = _seconds_per(unit, given_time)
-            start_time = float(values[0, time_index]) * factor
+            start_time = float(columns[time_index][0]) * factor
             notes.append(f"{where}: time column {name!r} ignored: the sample rate "
                          f"{rate:g} Hz was given (sample_rate_hz)"
-                         + overridden_rate(values[:, time_index] * factor, rate))
+                         + overridden_rate(_in_seconds(columns[time_index], factor), rate))
     elif time_index is not None:
         name, unit = cells[time_index]
         factor = _seconds_per(unit, given_time)
         if read_unit(unit).corrected and given_time is None:
             # 'Time [US]' is µs, a factor the header's case did not state: said
             notes.append(f"{where}: time column {name!r}: {read_unit(unit).correction}")
-        rate, start_time, note = rate_from_times(values[:, time_index] * factor,
+        rate, start_time, note = rate_from_times(_in_seconds(columns[time_index], factor),
                                                  what=f"{where}: column {name!r}",
                                                  with_note=True)
         if note:
@@ -407,30 +405,84 @@ def read_csv(path: str | os.PathLike[str], *, sample_rate_hz: float | None = Non
                              f"{ACCEPTED_HEADER_SPELLINGS}); add a time column or give the "
                              "sample rate (sample_rate_hz)")
 
-    pair_times = _pair_time_columns(cells, time_index, values)
+    pair_times = _pair_time_columns(cells, time_index, columns)
     keep = [i for i in range(len(cells)) if i != time_index and i not in pair_times]
     if not keep:
         raise InputFileError(f"{where}: only a time column ({cells[time_index][0]!r}), no force "
                              "or velocity channel; expected channel columns beside it, e.g. "
                              "'Time [s],Force [N],Velocity [m/s]'")
     names = unique_names([cells[i][0] or f"column {i + 1}" for i in keep])
-    bases = _pair_time_bases(values, cells, pair_times, keep, names, where=where,
-                             main=(rate, start_time, values.shape[0]),
+    bases = _pair_time_bases(columns, cells, pair_times, keep, names, where=where,
+                             main=(rate, start_time, n_rows),
                              given_rate=sample_rate_hz, notes=notes, given_time=given_time)
     for name, i in zip(names, keep, strict=True):
-        _refuse_a_channel_ending_early(values[:bases[i][2], i], name, bases[i], where)
-    # each channel its own copy: a column of the table is a strided view that kept the whole
-    # table (time column and all) alive as long as the measurement, 1.8 x the channels' size
-    # for a 7-column export (each further file of `analyze` held one more)
-    channels = tuple(make_channel(n, values[:bases[i][2], i].copy(), sample_rate_hz=bases[i][0],
+        _refuse_a_channel_ending_early(columns[i][:bases[i][2]], name, bases[i], where)
+    # each column is an array of its own: a channel holds its column, not the whole table
+    # (time column and all) as a view of pandas' block did
+    channels = tuple(make_channel(n, columns[i][:bases[i][2]], sample_rate_hz=bases[i][0],
                                   unit=cells[i][1], start_time_s=bases[i][1])
                      for n, i in zip(names, keep, strict=True))
-    del values
+    del columns
     metadata: dict = {"csv_encoding": encoding}
     if notes:
         metadata["reader_notes"] = notes
     return Measurement(source=where, channels=channels, sha256=file_sha256(path),
                        file_format="csv", metadata=metadata)
+
+
+#: Rows parsed at a time: each chunk goes straight into the columns, so the table is held
+#: once, not as pandas' block and then again as the channels' copies (2x the table).
+_CSV_CHUNK_ROWS = 1 << 14
+
+
+def _line_count(path: str | os.PathLike[str]) -> int:
+    """Lines of a file at most (LF or CR line ends, a last line without one), counted in
+    blocks: the rows a table can hold, to size its columns before parsing."""
+    feeds = returns = 0
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(_SCAN_CHUNK_BYTES), b""):
+            feeds += block.count(b"\n")
+            returns += block.count(b"\r")
+    return max(feeds, returns) + 1
+
+
+def _numeric_columns(path: str | os.PathLike[str], *, sep: str, decimal: str, skiprows: int,
+                     encoding: str) -> list[np.ndarray]:
+    """The numbers of a delimited table, one float64 array per column, parsed by pandas' C
+    parser :data:`_CSV_CHUNK_ROWS` rows at a time (the same parser and numbers as one call)
+    into columns sized by the file's line count. Pieces joined at the end were 2x the table
+    in resident memory (the heap kept the freed pieces)."""
+    capacity = max(_line_count(path) - skiprows, 0)
+    columns: list[np.ndarray] = []
+    filled = 0
+    with pd.read_csv(path, sep=sep, decimal=decimal, header=None, skiprows=skiprows,
+                     dtype=np.float64, encoding=encoding, skipinitialspace=True,
+                     skip_blank_lines=True, engine="c", comment="#",
+                     chunksize=_CSV_CHUNK_ROWS) as reader:
+        for chunk in reader:
+            block = chunk.to_numpy(dtype=np.float64, copy=False)
+            rows, width = block.shape
+            if not columns:
+                columns = [np.empty(capacity) for _ in range(width)]
+            if width != len(columns) or filled + rows > capacity:
+                raise ValueError(f"rows of {len(columns)} and of {width} columns, or more "
+                                 f"rows ({filled + rows}) than lines ({capacity})")
+            for column, values in zip(columns, block.T, strict=True):
+                column[filled:filled + rows] = values
+            filled += rows
+            del chunk, block
+    for column in columns:
+        # the room blank, comment and the header's lines left: given back in place (a
+        # realloc; the columns are ours, no view of them exists), so that each channel
+        # holds its samples only
+        column.resize(filled, refcheck=False)
+    return columns
+
+
+def _in_seconds(times: np.ndarray, factor: float) -> np.ndarray:
+    """A time column in s: itself where it is in s already (x 1.0 changes no bit; the copy
+    was one more column beside the table)."""
+    return times if factor == 1.0 else times * factor
 
 
 def _refuse_a_channel_ending_early(column: np.ndarray, name: str,
@@ -453,7 +505,7 @@ def _refuse_a_channel_ending_early(column: np.ndarray, name: str,
 
 
 def _pair_time_columns(cells: list[tuple[str, str]], time_index: int | None,
-                       values: np.ndarray) -> list[int]:
+                       columns: list[np.ndarray]) -> list[int]:
     """Time columns after the first one: the x of x/y pairs (``Time;Force;Time;Point1:+Z``,
     as Testlab exports signals of their own time axis). Such a column has a time's name (the
     first time column's, or ``time``), or a time unit and times that advance; each is the time
@@ -470,7 +522,7 @@ def _pair_time_columns(cells: list[tuple[str, str]], time_index: int | None,
         if name.strip().lower() in time_names and (not unit or _is_time_unit(unit)):
             pairs.append(i)
         elif _is_time_unit(unit):
-            given = values[:, i][np.isfinite(values[:, i])]
+            given = columns[i][np.isfinite(columns[i])]
             if given.size >= 2 and given[-1] > given[0]:
                 pairs.append(i)
     return pairs
@@ -507,7 +559,8 @@ def _overridden(unit: str, given: UnitReading) -> bool:
     return not unit or not math.isclose(_seconds_per(unit), given.info.factor, rel_tol=1e-12)
 
 
-def _pair_time_bases(values: np.ndarray, cells: list[tuple[str, str]], pair_times: list[int],
+def _pair_time_bases(columns: list[np.ndarray], cells: list[tuple[str, str]],
+                     pair_times: list[int],
                      keep: list[int], names: list[str], *, where: str,
                      main: tuple[float, float, int], given_rate: float | None,
                      notes: list[str], given_time: UnitReading | None = None
@@ -524,7 +577,7 @@ def _pair_time_bases(values: np.ndarray, cells: list[tuple[str, str]], pair_time
         owned = [i for i in keep if t_index < i < end]
         if not owned:
             continue
-        times = values[:, t_index]
+        times = columns[t_index]
         length = int(np.argmax(np.isnan(times))) if np.isnan(times).any() else times.size
         name, unit = cells[t_index]
         factor = _seconds_per(unit, given_time)
@@ -541,7 +594,7 @@ def _pair_time_bases(values: np.ndarray, cells: list[tuple[str, str]], pair_time
         if given_rate is not None:
             base = (float(given_rate), float(times[0]) * factor, length)
         else:
-            rate, start = rate_from_times(times[:length] * factor, what=what)
+            rate, start = rate_from_times(_in_seconds(times[:length], factor), what=what)
             base = (rate, start, length)
         if base == main:
             continue

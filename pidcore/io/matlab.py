@@ -88,7 +88,7 @@ def _numeric_vector(value: object) -> np.ndarray | None:
     if isinstance(value, np.ndarray) and value.dtype.kind in "fiub" and value.size >= 2:
         squeezed = np.squeeze(value)
         if squeezed.ndim == 1:
-            return squeezed.astype(np.float64)
+            return squeezed.astype(np.float64, copy=False)  # float64 as loaded: no copy
     return None
 
 
@@ -353,7 +353,8 @@ def _lms_layout(signal: object, where: str, given_time: UnitReading | None = Non
         except (KeyError, AttributeError, TypeError, ValueError) as exc:
             raise InputFileError(f"{what}: incomplete x_values/y_values ({exc})") from None
         # real numbers in any shape: a matrix holds one channel per column or row
-        values = real_numbers(values, where=f"{what}: y_values.values").astype(np.float64)
+        values = real_numbers(values, where=f"{what}: y_values.values").astype(np.float64,
+                                                                             copy=False)
         if not increment > 0:
             raise InputFileError(f"{what}: x_values.increment is {increment!r}; expected a "
                                  "positive sample interval in s")

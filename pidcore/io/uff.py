@@ -1,6 +1,9 @@
 """Universal File Format (UFF/UNV) dataset 58 time records, ASCII and binary (58b).
 
-Reading and writing go through :mod:`pyuff`. What this module adds on top:
+Reading and writing go through :mod:`pyuff`, but for memory: the blocks are found by a
+chunked scan of the file (pyuff's index, not its whole-file read), and the samples of 58b
+records and of evenly spaced real ASCII records are read straight into one array each (as
+pyuff reads them, bit for bit) instead of through Python lists. What this module adds on top:
 
 * Only time records become channels: function type 1 ("time response"), or type 0
   ("general") with a time abscissa (specific data type 17). FRFs, spectra and geometry are
@@ -231,6 +234,98 @@ _HEADER_LINES_58 = 13
 _BINARY_DTYPES = {(2, 1): "<f4", (2, 2): ">f4", (4, 1): "<f8", (4, 2): ">f8"}
 
 
+_BLOCK_TAG = b"    -1"
+#: Bytes after a tag that pyuff looks at to tell a block delimiter (74 blanks up to column 80).
+_TAG_LOOKAHEAD = 81
+#: Bytes of the file read at a time while looking for block delimiters.
+_SCAN_CHUNK_BYTES = 1 << 22
+#: Bytes read of a block to find its dataset type (the line after its opening tag).
+_BLOCK_HEAD_BYTES = 4096
+
+
+class _BlockScannedUFF(pyuff.UFF):
+    """:class:`pyuff.UFF` whose block index is found by reading the file in chunks.
+
+    pyuff's ``refresh`` reads the whole file into one bytes object and copies every block,
+    split into lines, to read its type: for a long export the file once and its largest
+    block about twice more, beside the channels read afterwards (58b: 1.6x the samples,
+    ASCII 58 more). This finds the same delimiters by the same rule and reads only the
+    head of each block, so the index (``_block_ind``, ``_set_types``) is pyuff's own and
+    pyuff reads the blocks from it as before.
+    """
+
+    def refresh(self) -> bool:
+        self._refreshed = False
+        if not self.file_exists():
+            return False
+        try:
+            with open(self._filename, "rb") as fh:
+                size = fh.seek(0, os.SEEK_END)
+                tags = self._tag_offsets(fh, size)
+                n_blocks = len(tags) // 2
+                if n_blocks == 0:
+                    self._refreshed = True
+                    return True
+                self._block_ind = np.zeros((n_blocks, 2), dtype="int64")
+                self._block_ind[:, 0] = tags[:-1:2][:n_blocks]
+                self._block_ind[:, 1] = np.asarray(tags[1::2][:n_blocks]) - 1
+                self._n_sets = n_blocks
+                self._set_types = np.zeros(n_blocks).astype(int)
+                # pyuff never marks a set binary here (it compares an int with 'b'); its
+                # reader tells 58b from the dataset line itself
+                self._set_formats = np.zeros(n_blocks)
+                for ii in range(n_blocks):
+                    set_type = self._block_type(fh, int(self._block_ind[ii, 0]),
+                                                int(self._block_ind[ii, 1]))
+                    if set_type is not None:
+                        self._set_types[ii] = set_type
+        except Exception as exc:
+            reraise_interrupt(exc)
+            raise Exception(f"Error refreshing UFF file: {self._filename}") from None
+        self._refreshed = True
+        return True
+
+    @staticmethod
+    def _tag_offsets(fh, size: int) -> list[int]:
+        """Offsets of the ``'    -1'`` tags pyuff counts as delimiters: at the end of the
+        file, before a line break, or followed by blanks up to column 80."""
+        offsets = []
+        blanks = b" " * (80 - len(_BLOCK_TAG))
+        for start in range(0, size, _SCAN_CHUNK_BYTES):
+            fh.seek(start)
+            window = fh.read(_SCAN_CHUNK_BYTES + _TAG_LOOKAHEAD)
+            ind = -1
+            while True:
+                ind = window.find(_BLOCK_TAG, ind + 1)
+                if ind == -1 or ind >= _SCAN_CHUNK_BYTES:
+                    break  # a tag from there on starts in the next chunk
+                at = start + ind
+                end = ind + len(_BLOCK_TAG)
+                if at + len(_BLOCK_TAG) == size \
+                        or (at + len(_BLOCK_TAG) < size and window[end] in (10, 13)) \
+                        or (at + 80 < size and window[end:ind + 80] == blanks):
+                    offsets.append(at)
+            del window  # else held while the next one is read: two chunks at a time
+        return offsets
+
+    @staticmethod
+    def _block_type(fh, first: int, last: int) -> int | None:
+        """Dataset type of the block from ``first`` to ``last`` (bytes, inclusive): the
+        first six characters of its second line, as pyuff reads them; None where they are
+        not a number (pyuff leaves such a block's type 0)."""
+        length = last - first + 1
+        fh.seek(first)
+        head = fh.read(min(length, _BLOCK_HEAD_BYTES))
+        lines = head.splitlines()
+        if len(head) < length and len(lines) < 3:  # the second line goes on: read it all
+            fh.seek(first)
+            lines = fh.read(length).splitlines()
+        try:
+            return int(lines[1][0:6])
+        except (IndexError, ValueError):
+            return None
+
+
 def _binary_58_record(path: str | os.PathLike[str], start: int) -> dict | None:
     """The dataset 58b record whose block starts at byte ``start``: its header parsed by
     pyuff, its samples read straight from the file into one array. None for a record this
@@ -256,6 +351,105 @@ def _binary_58_record(path: str | os.PathLike[str], start: int) -> dict | None:
             return None
         values = np.fromfile(fh, dtype=dtype, count=num_pts)
     dset["data"] = values.astype(np.float64, copy=False)
+    return dset
+
+
+#: Bytes an ASCII dataset 58 holds in its data lines where pidcore parses them (digits,
+#: signs, points, exponents, blanks, LF or CR LF): anything else is left to pyuff.
+_ASCII_58_DATA_BYTES = np.zeros(256, dtype=bool)
+_ASCII_58_DATA_BYTES[list(b"0123456789+-.Ee \r\n")] = True
+#: Field width of ASCII 58 real ordinates by ordinate data type: 2 E13.5, 4 E20.12.
+_ASCII_58_WIDTHS = {2: 13, 4: 20}
+#: Bytes of data lines read and parsed at a time (their masks: some 5x this, transient).
+_ASCII_58_CHUNK_BYTES = 1 << 18
+
+
+def _regular_lines(raw: np.ndarray, line_bytes: int, ending: int) -> int:
+    """How many of the lines that start ``raw`` are ``line_bytes`` long, end in LF (``ending``
+    1) or CR LF (2) and hold only :data:`_ASCII_58_DATA_BYTES` with no other line break."""
+    complete = raw.size // line_bytes
+    lines = raw[:complete * line_bytes].reshape(complete, line_bytes)
+    body = lines[:, :line_bytes - ending]
+    good = _ASCII_58_DATA_BYTES[body].all(axis=1) & (lines[:, -1] == 10)
+    good &= ~((body == 10) | (body == 13)).any(axis=1)
+    if ending == 2:
+        good &= lines[:, -2] == 13
+    return int(np.argmin(np.append(good, False)))
+
+
+def _ascii_58_record(path: str | os.PathLike[str], first: int, last: int) -> dict | None:
+    """The ASCII dataset 58 record in bytes ``first`` to ``last`` (inclusive) of the file,
+    its header parsed by pyuff and its evenly spaced real samples parsed as pyuff parses
+    them (each fixed-width field by ``float``), a chunk of lines at a time straight into
+    one array. None for a record this does not read (complex, uneven abscissa, a header
+    pyuff would split otherwise): pyuff reads those whole.
+
+    pyuff decodes the block, splits it into line objects and collects the samples as a list
+    of Python floats: some 5x the block, 13x the samples of an E20.12 record, beside the
+    channels read before it.
+    """
+    from pyuff.datasets.dataset_58 import _extract58
+
+    with open(path, "rb") as fh:
+        fh.seek(first)
+        header = b"".join(fh.readline() for _ in range(_HEADER_LINES_58))
+        lines = header.splitlines()
+        # pyuff splits the decoded text (str.splitlines): where that finds the same 13 lines
+        # as the line feeds, its data lines are the ones that follow
+        if len(lines) < _HEADER_LINES_58 or not header.endswith(b"\n") \
+                or lines[1][6:7].lower() == b"b" or len(header.decode(
+                    "utf-8", "replace").splitlines(True)) != _HEADER_LINES_58:
+            return None
+        dset = _extract58(header, header_only=True)
+        width = _ASCII_58_WIDTHS.get(int(dset.get("ord_data_type", 0)))
+        if width is None or int(dset.get("abscissa_spacing", 0)) != 1:
+            return None
+        remaining = last - first + 1 - len(header)
+        start = fh.tell()
+        first_line = fh.readline(remaining)
+        fh.seek(start)
+        line_bytes = len(first_line)
+        ending = 2 if first_line.endswith(b"\r\n") else 1
+        n_fields = line_bytes // width  # pyuff: len(line) // width, the line ending counted
+        if not first_line.endswith(b"\n") or n_fields == 0 \
+                or n_fields * width > line_bytes - ending:
+            return None
+        # room for the last line too: appended by a concatenation, it copied the samples
+        values = np.empty((remaining // line_bytes + 1) * n_fields)
+        filled = 0
+        per_chunk = max(1, _ASCII_58_CHUNK_BYTES // line_bytes) * line_bytes
+        tail = b""
+        try:
+            while remaining > 0:
+                chunk = fh.read(min(per_chunk, remaining))
+                remaining -= len(chunk)
+                raw = np.frombuffer(chunk, np.uint8)
+                regular = _regular_lines(raw, line_bytes, ending)
+                if remaining == 0:
+                    # pyuff's own rule for the last line of a record (blank fields skipped)
+                    regular = min(regular, -(-raw.size // line_bytes) - 1)
+                fields = np.ndarray((regular, n_fields), dtype=f"S{width}", buffer=chunk,
+                                    strides=(line_bytes, width))
+                values[filled:filled + fields.size] = fields.astype(np.float64).reshape(-1)
+                filled += fields.size
+                if regular * line_bytes < len(chunk):
+                    tail = chunk[regular * line_bytes:] + fh.read(remaining)
+                    break
+            rest = []
+            text = tail.decode("ascii").splitlines(True)
+            for k, line in enumerate(text):
+                cells = [line[width * i:width * (i + 1)] for i in range(len(line) // width)]
+                if width == 13 and k == len(text) - 1:
+                    cells = [c for c in cells if c != " " * 13]  # pyuff's last E13.5 line
+                rest.extend(float(c) for c in cells)
+        except (ValueError, UnicodeDecodeError):
+            return None  # a field float() refuses: pyuff refuses it too, then the fallback
+    if filled + len(rest) <= values.size:
+        values[filled:filled + len(rest)] = rest
+        values = values[:filled + len(rest)]
+    else:  # lines of other lengths at the end
+        values = np.concatenate([values[:filled], np.asarray(rest, dtype=np.float64)])
+    dset["data"] = values
     return dset
 
 
@@ -310,7 +504,7 @@ def read_uff(path: str | os.PathLike[str], *, time_unit: str | None = None) -> M
         raise InputFileError(f"{where}: the file ends inside a UFF dataset (no closing '    -1' "
                              "line); it is truncated or not a UFF file")
     try:
-        uff = pyuff.UFF(where)
+        uff = _BlockScannedUFF(where)
         set_types = [int(t) for t in uff.get_set_types()]
     except Exception as exc:  # pyuff raises bare Exception for every failure
         reraise_interrupt(exc)
@@ -329,7 +523,9 @@ def read_uff(path: str | os.PathLike[str], *, time_unit: str | None = None) -> M
         try:
             dset = None
             if set_type == 58 and hasattr(uff, "_block_ind"):  # pyuff's block offsets
-                dset = _binary_58_record(path, int(uff._block_ind[i][0]))
+                dset = _binary_58_record(path, int(uff._block_ind[i][0])) \
+                    or _ascii_58_record(path, int(uff._block_ind[i][0]),
+                                        int(uff._block_ind[i][1]))
             if dset is None:
                 dset = uff.read_sets(i)
         except Exception as exc:
