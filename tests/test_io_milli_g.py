@@ -7,11 +7,11 @@ the original's in m/s^2."""
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import numpy as np
 import pytest
+from _cli_runs import analyze_json
 
 from pidcore.cli import main
 from pidcore.constants import STANDARD_GRAVITY
@@ -45,12 +45,6 @@ def original_without_velocity(path: Path) -> Path:
     lines += [",".join(f"{x:.17g}" for x in row) for row in values]
     path.write_text("\n".join(lines) + "\n")
     return path
-
-
-def analyze_json(path: Path, capsys, *extra: str) -> dict:
-    assert main(["analyze", str(path), "--json", "--no-store", "--no-progress", *extra]) == 0
-    (record,) = json.loads(capsys.readouterr().out)["records"]
-    return record
 
 
 def test_milli_g_is_not_a_unit_by_itself():

@@ -3,13 +3,13 @@ the analytic truth of F = F0 sin(wt), V = V0 sin(wt - phi): P_c = 1/2 F0 V0 e^{j
 
 from __future__ import annotations
 
-import json
 import math
 import re
 from pathlib import Path
 
 import numpy as np
 import pytest
+from _cli_runs import analyze_json
 
 from pidcore.cli import main
 from pidcore.errors import InputFileError
@@ -40,12 +40,6 @@ def shaker_columns(force_name: str, force_unit: str, force_scale: float, velocit
     return [("Time", "s", t),
             (velocity_name, velocity_unit, V0 * np.sin(w * t - PHI) * velocity_scale),
             (force_name, force_unit, F0 * np.sin(w * t) * force_scale)]
-
-
-def analyze_json(path: Path, capsys, *extra: str) -> dict:
-    assert main(["analyze", str(path), "--json", "--no-store", "--no-progress", *extra]) == 0
-    (record,) = json.loads(capsys.readouterr().out)["records"]
-    return record
 
 
 def test_bracketed_words_in_a_name_above_a_unit_row_stay_in_the_name(tmp_path, capsys):

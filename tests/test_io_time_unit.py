@@ -9,7 +9,6 @@ checked against the original's and against the rate computed here from the incre
 from __future__ import annotations
 
 import hashlib
-import json
 import shutil
 from pathlib import Path
 
@@ -17,6 +16,7 @@ import h5py
 import numpy as np
 import pytest
 import scipy.io
+from _cli_runs import analyze_json, refusal
 
 from pidcore.cli import main
 from pidcore.errors import InputFileError, ParameterError
@@ -47,19 +47,6 @@ def uff_in_ms(folder: Path, label: bytes) -> Path:
     path.write_bytes(raw.replace(SECONDS_RECORD_7, MILLISECONDS_RECORD_7)
                      .replace(SECONDS_LABEL, SECONDS_LABEL[:-4] + label))
     return path
-
-
-def analyze_json(path: Path, capsys, *extra: str) -> dict:
-    assert main(["analyze", str(path), "--json", "--no-store", "--no-progress", *extra]) == 0
-    (record,) = json.loads(capsys.readouterr().out)["records"]
-    return record
-
-
-def refusal(args: list[str], capsys) -> str:
-    assert main(args) == 2
-    err = capsys.readouterr().err
-    assert len(err.strip().splitlines()) == 1, err
-    return err.strip()
 
 
 @pytest.fixture(scope="module")

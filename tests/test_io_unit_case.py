@@ -7,13 +7,13 @@ and checks the numbers against the original file or the refusal against what it 
 from __future__ import annotations
 
 import hashlib
-import json
 import shutil
 from pathlib import Path
 
 import numpy as np
 import pytest
 import scipy.io
+from _cli_runs import analyze_json, refusal
 
 from pidcore.cli import main
 from pidcore.constants import STANDARD_GRAVITY
@@ -46,19 +46,6 @@ def derived_csv(path: Path, renamed: dict[str, str], scale: dict[str, float] | N
     lines = [",".join(cells)] + [",".join(f"{x:.17g}" for x in row) for row in values[:, keep]]
     path.write_text("\n".join(lines) + "\n")
     return path
-
-
-def analyze_json(path: Path, capsys, *extra: str) -> dict:
-    assert main(["analyze", str(path), "--json", "--no-store", "--no-progress", *extra]) == 0
-    (record,) = json.loads(capsys.readouterr().out)["records"]
-    return record
-
-
-def refusal(args: list[str], capsys) -> str:
-    assert main(args) == 2
-    err = capsys.readouterr().err
-    assert len(err.strip().splitlines()) == 1, err
-    return err
 
 
 def same_power(record: dict, truth: dict) -> None:
@@ -112,7 +99,7 @@ def test_a_velocity_in_mega_metre_per_second_is_refused_and_the_store_kept(
     err = refusal(["analyze", str(path), "--store", str(store), "--no-progress"], capsys)
     assert err == (f"pidcore analyze: error: {path}: channel 'Velocity' (velocity) has a unit "
                    f"pidcore refuses: {why}; give it with --velocity-unit UNIT (e.g. m/s, mm/s, "
-                   "in/s)\n")
+                   "in/s)")
     assert hashlib.sha256(store.read_bytes()).hexdigest() == before
     # the unit confirmed by the option reads the numbers as mm/s
     same_power(analyze_json(path, capsys, "--velocity-unit", "mm/s"), sample_record(capsys))
@@ -198,7 +185,7 @@ def test_a_unit_option_keeps_its_case(tmp_path, capsys):
                    "Mm/s"], capsys)
     assert err == ("pidcore analyze: error: --velocity-unit 'Mm/s': not a velocity unit: 'Mm/s' "
                    "is 1e+06 m/s, not a plausible velocity unit (expected 1e-09 to 1 m/s per "
-                   "unit, such as 'mm/s')\n")
+                   "unit, such as 'mm/s')")
     truth = sample_record(capsys)
     same_power(analyze_json(path, capsys, "--velocity-unit", "mm/s"), truth)
     forces = derived_csv(tmp_path / "head_fill50.csv", {"Force [N]": "Force"}, {"Force": 1e-3})
@@ -371,7 +358,7 @@ def test_a_vibrometer_channel_of_a_refused_unit_is_not_passed_over(tmp_path, cap
     assert err == (f"pidcore analyze: error: {path}: channel 'Point1:+Z' (velocity) has a unit "
                    "pidcore refuses: 'Mm/s' is 1e+06 m/s, not a plausible velocity unit "
                    "(expected 1e-09 to 1 m/s per unit, such as 'mm/s'); give it with "
-                   "--velocity-unit UNIT and name it with --velocity 'Point1:+Z'\n")
+                   "--velocity-unit UNIT and name it with --velocity 'Point1:+Z'")
     record = analyze_json(path, capsys, "--velocity", "Point1:+Z", "--velocity-unit", "mm/s")
     same_power(record, sample_record(capsys))
 
