@@ -67,12 +67,19 @@ def exclusive_lock(store_path: Path, *, timeout_s: float) -> Iterator[None]:
     """
     lock_path = lock_path_for(store_path)
     deadline = time.monotonic() + timeout_s
-    while True:
-        fd = _open_lock_file(store_path, lock_path)
-        try:
+    # One try/finally from the open to the release: an interrupt (Ctrl-C, SIGTERM, a
+    # notebook's KeyboardInterrupt) between the flock and the block's own try left the
+    # descriptor open and locked, so every later write of this process to the store waited
+    # out its timeout ("another pidcore process is writing"), and the lock file stayed.
+    fd: int | None = None
+    held = False
+    try:
+        while True:
+            fd = _open_lock_file(store_path, lock_path)
             while True:
                 try:
                     fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                    held = True
                     break
                 except BlockingIOError:
                     if time.monotonic() >= deadline:
@@ -83,16 +90,33 @@ def exclusive_lock(store_path: Path, *, timeout_s: float) -> Iterator[None]:
                     time.sleep(_POLL_INTERVAL_S)
             if _is_current(fd, lock_path):
                 break
-        except BaseException:
-            os.close(fd)
-            raise
-        os.close(fd)  # the lock of a removed file: try again on the current one
-    try:
+            held = False
+            os.close(fd)  # the lock of a removed file: try again on the current one
+            fd = None
         yield
     finally:
+        if fd is not None:
+            # closed here, not in the function: an interrupt is delivered on entry to a
+            # function too, and closing the descriptor is what releases the lock
+            try:
+                _remove_lock_file(fd, lock_path, held=held)
+            finally:
+                os.close(fd)
+
+
+def _remove_lock_file(fd: int, lock_path: Path, *, held: bool) -> None:
+    """Remove the lock file and unlock ``fd`` (its caller closes it). The file is removed
+    while the lock is held, so nobody can take the path's lock meanwhile (see
+    :func:`exclusive_lock`); one this process opened but had not locked yet (interrupted
+    while it waited, or created by it and free) is removed only where its lock can be taken
+    at once and it is still the path's file, else another writer holds it and removes it."""
+    if not held:
         try:
-            with suppress(OSError):  # still held: nobody can take the path's lock meanwhile
-                os.unlink(lock_path)
-            fcntl.flock(fd, fcntl.LOCK_UN)
-        finally:
-            os.close(fd)
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            return  # another writer's: it removes the file
+        if not _is_current(fd, lock_path):
+            return
+    with suppress(OSError):
+        os.unlink(lock_path)
+    fcntl.flock(fd, fcntl.LOCK_UN)
