@@ -7,8 +7,9 @@ written to a temporary file in the target's own folder, so that the final
 :func:`os.replace` is a rename on one file system: atomic, never a copy. Ctrl-C
 (KeyboardInterrupt), SIGTERM, a full disk or a failing writer therefore leave the previous file
 as it was and no temporary file behind; a reader sees the old file or the new one, never half
-of one. A folder of several outputs is built beside its place and moved there whole, after
-:func:`fsync_tree`.
+of one. A folder of several outputs is built beside its place
+(:func:`new_temporary_folder_for`) and moved there whole, after :func:`fsync_tree`; the next
+build of that folder removes the build folders a killed one left, by the files' rule.
 
 ``durable`` (the default) fsyncs the new file before the rename and the folder after it: a
 power loss right after the call then finds the new file, not an empty one under its name (a
@@ -131,6 +132,77 @@ def remove_stale_temporaries(folder: str | os.PathLike[str], is_target: Callable
                 entry.unlink()
             removed.append(entry)
     return removed
+
+
+#: Marks a folder :func:`new_temporary_folder_for` builds beside its target
+#: (``.<name>.<16 hex>.tmpdir``): a suffix of its own, so that neither clean-up rule can take
+#: the other's kind (a file rule that met a folder, or the reverse).
+TEMPORARY_FOLDER_SUFFIX = ".tmpdir"
+
+
+def temporary_folder_path_for(target: str | os.PathLike[str]) -> Path:
+    """A fresh hidden name beside the folder ``target`` (``.<name>.<16 hex>.tmpdir``), for a
+    folder of outputs built there and renamed into place (a report, a calibration's files)."""
+    target = Path(target)
+    return target.with_name(f".{target.name}.{secrets.token_hex(8)}{TEMPORARY_FOLDER_SUFFIX}")
+
+
+def temporary_folder_name_pattern(target: str | os.PathLike[str]) -> re.Pattern[str]:
+    """The names :func:`temporary_folder_path_for` gives beside ``target``, and no others (a
+    user's ``.<name>.backup`` is not one)."""
+    return re.compile(re.escape(f".{Path(target).name}.") + r"[0-9a-f]{16}"
+                      + re.escape(TEMPORARY_FOLDER_SUFFIX))
+
+
+def remove_stale_temporary_folders(target: str | os.PathLike[str], *, min_age_s: float = 0.0,
+                                   now: float | None = None,
+                                   dry_run: bool = False) -> list[Path]:
+    """Remove the build folders :func:`new_temporary_folder_for` made beside ``target`` that
+    were last changed at least ``min_age_s`` ago; returns those removed (``dry_run``: those it
+    would remove, none removed).
+
+    The rule of :func:`remove_stale_temporaries`, for folders: only an exact name
+    (:func:`temporary_folder_name_pattern`) that is a folder itself, not a link to one, is
+    removed, and a link inside it is removed as a link (:func:`shutil.rmtree` never follows
+    one), so that nothing outside the folder is ever touched.
+    """
+    import shutil
+
+    target = Path(target)
+    pattern = temporary_folder_name_pattern(target)
+    now = time.time() if now is None else now
+    removed = []
+    for entry in target.parent.iterdir():
+        if pattern.fullmatch(entry.name) is None:
+            continue
+        try:
+            info = entry.lstat()
+        except FileNotFoundError:
+            continue
+        if not stat.S_ISDIR(info.st_mode) or now - info.st_mtime < min_age_s:
+            continue
+        if not dry_run:
+            # a file in it that cannot be removed leaves the rest for the next write to retry
+            shutil.rmtree(entry, ignore_errors=True)
+        removed.append(entry)
+    return removed
+
+
+def new_temporary_folder_for(target: str | os.PathLike[str]) -> Path:
+    """Create and return an empty build folder beside the folder ``target``
+    (:func:`temporary_folder_path_for`), with the permissions of any new folder (it may
+    become ``target`` itself), after removing those a build of ``target`` killed outright
+    left (SIGKILL, a power loss) once older than
+    :data:`pidcore.defaults.STALE_TEMPORARY_FILE_AGE_S`: a live build's is younger, as its
+    files set its time. ``target``'s parent must exist."""
+    from .defaults import STALE_TEMPORARY_FILE_AGE_S
+
+    # a folder that cannot be listed (write-only) still gets the build
+    with suppress(OSError):
+        remove_stale_temporary_folders(target, min_age_s=STALE_TEMPORARY_FILE_AGE_S)
+    work = temporary_folder_path_for(target)
+    work.mkdir()
+    return work
 
 
 @contextmanager

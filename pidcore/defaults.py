@@ -17,9 +17,10 @@ STORE_LOCK_TIMEOUT_S = 60.0
 #: (10 GB for ~25 ten-minute records).
 STORE_IN_MEMORY_MAX_BYTES = 256 * 2**20
 #: Age, s, past which the next write of a file removes a temporary file of that file
-#: (``.<name>.<16 hex>.tmp``) a write killed outright left beside it: a live writer's is
-#: younger, as its writes set its time (an export takes seconds to minutes), and no lock tells
-#: a live writer's apart from a dead one's beside an exported file.
+#: (``.<name>.<16 hex>.tmp``), and the next ``--out`` of a report's or calibration's folder its
+#: build folder (``.<name>.<16 hex>.tmpdir``), that one killed outright left beside it: a live
+#: writer's is younger, as its writes set its time (an export takes seconds to minutes), and no
+#: lock tells a live writer's apart from a dead one's beside an exported file.
 STALE_TEMPORARY_FILE_AGE_S = 24 * 3600.0
 
 # --- Measurement (Eq. 11) -------------------------------------------------------------------

@@ -229,3 +229,61 @@ def test_the_next_write_of_a_file_removes_the_temporary_files_killed_writes_of_i
     assert target.read_text() == "f [Hz]\n50\n"
     assert not stale.exists()
     assert fresh.read_text() == "partial" and all(p.read_text() == "partial" for p in users)
+
+
+def _left_build_folder(target: Path, name: str, *, age_s: float) -> Path:
+    """A folder ``name`` beside ``target`` as a killed build leaves it: holding a file, last
+    changed ``age_s`` ago (the file's creation set the folder's time, so it is set after)."""
+    folder = target.parent / name
+    folder.mkdir()
+    (folder / "calibration.json").write_text("{}")
+    old = os.stat(folder).st_mtime - age_s
+    os.utime(folder, (old, old))
+    return folder
+
+
+def test_a_killed_builds_folder_is_removed_by_the_next_build_of_its_target_only(tmp_path):
+    # `pidcore calibrate --out cal` / `pidcore report --out rp` killed outright (kill -9, a
+    # power loss) left their hidden build folders beside the target for ever
+    from pidcore.defaults import STALE_TEMPORARY_FILE_AGE_S
+
+    target = tmp_path / "cal"
+    day = STALE_TEMPORARY_FILE_AGE_S
+    stale = _left_build_folder(target, f".cal.{'0a' * 8}.tmpdir", age_s=day + 60)
+    fresh = _left_build_folder(target, f".cal.{'0b' * 8}.tmpdir", age_s=day - 60)  # live
+    kept = [fresh,
+            _left_build_folder(target, ".cal.backup", age_s=10 * day),  # a user's
+            _left_build_folder(target, f".cal.{'0c' * 8}.tmpdir.keep", age_s=10 * day),
+            _left_build_folder(target, f".cal.x.{'0d' * 8}.tmpdir", age_s=10 * day),  # cal.x's
+            _left_build_folder(target, f".cal.{'0e' * 7}.tmpdir", age_s=10 * day)]  # 14 hex
+    work = atomic_files.new_temporary_folder_for(target)
+    assert atomic_files.temporary_folder_name_pattern(target).fullmatch(work.name)
+    assert work.is_dir() and list(work.iterdir()) == []
+    assert not stale.exists()
+    for folder in kept:
+        assert (folder / "calibration.json").read_text() == "{}", folder.name
+    assert _only(tmp_path) == sorted([work.name, *(f.name for f in kept)])
+
+
+def test_clearing_build_folders_never_follows_a_link(tmp_path):
+    # a link named like a build folder, and a link inside a stale one: what they point at is
+    # not the build's and must survive (rmtree of the link's target would delete it)
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    precious = elsewhere / "precious.txt"
+    precious.write_text("keep")
+    beside = tmp_path / "work"
+    beside.mkdir()
+    target = beside / "rp"
+    linked = beside / f".rp.{'1f' * 8}.tmpdir"
+    linked.symlink_to(elsewhere, target_is_directory=True)
+    stale = _left_build_folder(target, f".rp.{'2e' * 8}.tmpdir", age_s=1e9)
+    (stale / "into_elsewhere").symlink_to(elsewhere, target_is_directory=True)
+    (stale / "the_file").symlink_to(precious)
+    os.utime(stale, (1.0, 1.0))
+    os.utime(linked, (1.0, 1.0), follow_symlinks=False)
+    os.utime(elsewhere, (1.0, 1.0))
+    removed = atomic_files.remove_stale_temporary_folders(target, min_age_s=3600.0)
+    assert removed == [stale] and not stale.exists()
+    assert linked.is_symlink() and precious.read_text() == "keep"
+    assert sorted(p.name for p in elsewhere.iterdir()) == ["precious.txt"]

@@ -890,3 +890,35 @@ def test_on_run_done_tells_each_computed_run_of_the_design_once(tmp_path):
     again: list[str] = []
     calibrate(points, on_run_done=again.append, **kw)
     assert again == []  # every run reused from the store
+
+
+def test_a_killed_calibrations_build_folder_is_removed_by_the_next_out(capsys, tmp_path,
+                                                                       tiny_store):
+    # `pidcore calibrate --out cal` killed outright (kill -9, a power loss) left its hidden
+    # build folder beside cal for ever; the next --out cal removes it once a day old, and
+    # keeps a younger one (a live run's) and a user's folder named like it
+    import os
+
+    from pidcore.defaults import STALE_TEMPORARY_FILE_AGE_S
+
+    out = tmp_path / "cal"
+    names = {"stale": f".cal.{'5a' * 8}.tmpdir", "fresh": f".cal.{'6b' * 8}.tmpdir",
+             "user's": ".cal.backup"}
+    for key, name in names.items():
+        (tmp_path / name).mkdir()
+        (tmp_path / name / "calibration.json").write_text("{}")
+        age = STALE_TEMPORARY_FILE_AGE_S + (60 if key != "fresh" else -60)
+        when = os.stat(tmp_path / name).st_mtime - age
+        os.utime(tmp_path / name, (when, when))
+    code = main(["calibrate", "--data", str(_table(tmp_path)), "--fit", "fixture_mass_kg",
+                 "--discrepancy", "0.2", "--dem-store", str(tiny_store), "--out", str(out),
+                 *TINY])
+    assert code == 0, capsys.readouterr().err
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(
+        ["cal", "m.csv", names["fresh"], names["user's"]])
+    # the outputs landed whole, and the calibration reads back from them
+    assert sorted(p.name for p in out.iterdir()) == sorted(
+        ["calibration.json", "calibrated_specimen.toml", "summary.md", "summary.html",
+         "predictions.png", "posterior_pairs.png"])
+    assert set(json.loads((out / "calibration.json").read_text())["parameters"]) == \
+        {"fixture_mass_kg"}

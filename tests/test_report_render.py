@@ -392,3 +392,29 @@ def test_every_file_names_the_eq11_sdc_as_such_and_an_older_csv_reads_into_the_n
     older = back.rename(columns={new: old for old, new in REPORT_COLUMNS_RENAMED.items()})
     assert "SDC measured [-]" in older.columns
     pd.testing.assert_frame_equal(older.rename(columns=REPORT_COLUMNS_RENAMED), back)
+
+
+def test_a_killed_reports_build_folder_is_removed_by_the_next_report_of_that_folder(
+        tmp_path, table, provenance):
+    # `pidcore report --out rp` killed outright left its hidden build folder beside rp for
+    # ever; the next report of rp removes it once a day old, and nothing else beside rp
+    import os
+
+    from pidcore.defaults import STALE_TEMPORARY_FILE_AGE_S
+
+    out = tmp_path / "rp"
+    names = {"stale": f".rp.{'3c' * 8}.tmpdir", "fresh": f".rp.{'4d' * 8}.tmpdir",
+             "user's": ".rp.backup"}
+    for key, name in names.items():
+        (tmp_path / name).mkdir()
+        (tmp_path / name / "report.csv").write_text("left")
+        age = STALE_TEMPORARY_FILE_AGE_S + (60 if key != "fresh" else -60)
+        when = os.stat(tmp_path / name).st_mtime - age
+        os.utime(tmp_path / name, (when, when))
+    paths = write_report(table, {}, provenance, out, "csv")
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(["rp", names["fresh"],
+                                                                 names["user's"]])
+    # the report itself landed whole: the marker, the table and its notes, nothing else
+    assert sorted(p.name for p in out.iterdir()) == sorted([REPORT_MARKER, "report.csv",
+                                                            "report.provenance.txt"])
+    assert len(pd.read_csv(paths["csv"])) == len(table)

@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from ..atomic_files import fsync_tree
+from ..atomic_files import fsync_tree, new_temporary_folder_for
 from ..records import json_safe
 from ..units import display_number
 from .calibrate import CalibrationResult
@@ -429,7 +429,6 @@ def write_outputs(result: CalibrationResult, out_dir: str | os.PathLike) -> list
     a finished calibration; now ``out_dir`` is as it was, or holds the whole new set (files
     of other names in it are kept).
     """
-    import secrets
     import shutil
 
     from .. import interrupt
@@ -442,10 +441,8 @@ def write_outputs(result: CalibrationResult, out_dir: str | os.PathLike) -> list
              ("summary.md", summary_markdown(result)),
              ("summary.html", summary_html(result)))
     out.parent.mkdir(parents=True, exist_ok=True)
-    # beside out_dir: on its file system, so that the moves below are renames (made with
-    # mkdir, not mkdtemp, for the umask's permissions: it may become out_dir itself)
-    work = out.parent / f".{out.name}.{os.getpid()}.{secrets.token_hex(4)}.tmp"
-    work.mkdir()
+    # beside out_dir: on its file system, so that the moves below are renames
+    work = new_temporary_folder_for(out)
     try:
         names = []
         for name, text in texts:

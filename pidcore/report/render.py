@@ -26,7 +26,7 @@ from pathlib import Path
 import pandas as pd
 
 from .. import defaults, interrupt
-from ..atomic_files import fsync_tree
+from ..atomic_files import fsync_tree, new_temporary_folder_for
 from ..constants import REPORT_FORMATS
 from ..errors import ParameterError
 from ..io import display_path
@@ -379,8 +379,7 @@ def write_report(table: pd.DataFrame, figures: Mapping[str, object], provenance:
     out_dir = Path(out_dir)
     check_out_dir(out_dir)
     out_dir.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.", suffix=".partial",
-                                dir=out_dir.parent))
+    tmp = new_temporary_folder_for(out_dir)
     written: dict[str, Path] = {}
     bar = None
     if progress:
@@ -412,7 +411,7 @@ def write_report(table: pd.DataFrame, figures: Mapping[str, object], provenance:
         if bar is not None:
             bar.close()  # before the "wrote ..." lines
         (tmp / REPORT_MARKER).write_text("written by pidcore report\n", encoding="utf-8")
-        os.chmod(tmp, 0o755)  # mkdtemp makes 0700; a report folder is meant to be shared
+        os.chmod(tmp, 0o755)  # a report folder is meant to be shared, whatever the umask
         fsync_tree(tmp)  # the files on disk before the rename that names them
         # the swap and the earlier report's removal are one step for Ctrl-C: cut between them,
         # a '.<name>.*.old' folder was left beside the report (interrupt.deferred)
