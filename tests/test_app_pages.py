@@ -2218,3 +2218,33 @@ def test_a_saved_calibration_is_drawn_with_its_uninformative_band_marked(store_f
     count = len(drawn)
     at.run()
     assert len(drawn) == count
+
+
+def test_the_time_base_unit_field_reads_an_export_in_ms_again(store_file, tmp_path):
+    # a UFF whose abscissa is in ms under a label pidcore does not read was refused pointing
+    # to `pidcore analyze --time-unit`, which the page user has not got; now it names the
+    # page's field, and the unit typed there reads the file again (the parsed upload is
+    # cached per time unit) with the CLI's --time-unit analysis
+    from test_io_time_unit import uff_in_ms
+
+    from pidcore.measure import AnalysisOptions, analyze_file
+
+    path = uff_in_ms(tmp_path / "ms", b"msek")
+    at = _upload(_app(), [(path.name, path.read_bytes())])
+    (error,) = [e.value for e in at.error]
+    assert error.endswith("give it as 'time base unit' under 'Options for every file'")
+    assert "--time-unit" not in error
+    at.text_input(key="time_unit").set_value("ms")
+    at.run()
+    assert not at.exception and not at.error
+    expected = analyze_file(path, AnalysisOptions(time_unit="ms")).analysis
+    table = _table(at, "warnings")
+    assert table["file"].tolist() == [path.name]
+    # the same samples at the same rate: the library's numbers, to the last bit
+    assert table["frequency [Hz]"].tolist() == [expected.frequency_hz]
+    assert table["loss factor [-]"].tolist() == [expected.loss_factor]
+    # a typed unit that is none is refused naming the field; the files are read as stated
+    at.text_input(key="time_unit").set_value("m")
+    at.run()
+    assert "time base unit: 'm' is not a unit of time; expected s, ms or us; files are read " \
+           "with the time units they state" in [e.value for e in at.error]

@@ -14,16 +14,19 @@ _PARSED_ENTRIES = 16
 # cache_resource, not cache_data: measurements can be large, and cache_data would unpickle a
 # copy on every hit. The records are frozen and never mutated, so sharing them is safe.
 @st.cache_resource(max_entries=_PARSED_ENTRIES, show_spinner="Reading file ...")
-def parsed(sha256: str, name: str, sample_rate_hz: float | None, _upload):
-    """The upload read and its channels detected (once per content and sample rate)."""
-    return uploads.parse_upload(name, _upload.getvalue(), sample_rate_hz=sample_rate_hz)
+def parsed(sha256: str, name: str, sample_rate_hz: float | None, time_unit: str | None,
+           _upload):
+    """The upload read and its channels detected (once per content, sample rate and time
+    unit: a changed unit reads the file again)."""
+    return uploads.parse_upload(name, _upload.getvalue(), sample_rate_hz=sample_rate_hz,
+                                time_unit=time_unit)
 
 
 @st.cache_resource(max_entries=4 * _PARSED_ENTRIES, show_spinner="Analysing ...")
-def analysed(sha256: str, name: str, sample_rate_hz: float | None, options_json: str,
-             _upload):
+def analysed(sha256: str, name: str, sample_rate_hz: float | None, time_unit: str | None,
+             options_json: str, _upload):
     """The upload analysed with one set of options (once per content and options)."""
-    found = parsed(sha256, name, sample_rate_hz, _upload)
+    found = parsed(sha256, name, sample_rate_hz, time_unit, _upload)
     return uploads.analyze_parsed(found, uploads.options_from_json(options_json))
 
 

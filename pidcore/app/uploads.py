@@ -96,9 +96,11 @@ def safe_file_name(name: str) -> str:
     return base[:200] or "upload"
 
 
-def read_upload(name: str, data: bytes, *, sample_rate_hz: float | None = None) -> Measurement:
+def read_upload(name: str, data: bytes, *, sample_rate_hz: float | None = None,
+                time_unit: str | None = None) -> Measurement:
     """Parse uploaded bytes with :func:`pidcore.io.read_measurement` (via a private temporary
-    file); the measurement's ``source`` is the uploaded name."""
+    file); the measurement's ``source`` is the uploaded name. ``time_unit``: the unit of a time
+    base the file does not state readably (``pidcore analyze --time-unit``)."""
     from ..io import read_measurement
 
     check_upload_size(name, len(data))
@@ -113,7 +115,8 @@ def read_upload(name: str, data: bytes, *, sample_rate_hz: float | None = None) 
     with tempfile.TemporaryDirectory(prefix="pidcore_upload_") as folder:
         path = Path(folder) / safe_file_name(name)
         path.write_bytes(data)
-        measurement = read_measurement(path, sample_rate_hz=sample_rate_hz)
+        measurement = read_measurement(path, sample_rate_hz=sample_rate_hz,
+                                       time_unit=time_unit)
     # the readers' notes name the file they read: the private copy, whose folder is gone
     # once read ("/tmp/pidcore_upload_x1/a.txt: column 'Time' is the time of 'Velocity'",
     # shown on the card and saved with the record)
@@ -207,6 +210,10 @@ def app_words(text: str, *, names: Iterable[str] = ()) -> str:
                   r"'inverted channels' \1: no such channel", text)
     text = re.sub(r" inverted \(invert='[^']*'\)", " inverted ('inverted channels' column)",
                   text)
+    # the page has the time unit as a field (it said "give it with `pidcore analyze
+    # --time-unit`", an option the page user has not got)
+    text = text.replace("give it with time_unit=UNIT",
+                        "give it as 'time base unit' under 'Options for every file'")
     # the reader's hint is a keyword of read_measurement; the page has no choice of record
     text = text.replace("choose one with key=NAME", "upload one measurement per file, or "
                                                     "analyse one with `pidcore analyze FILE "
@@ -239,11 +246,36 @@ _BAD_INPUT_ERRORS = (PidcoreError, ValueError, OSError, KeyError, IndexError, Ty
                      UnicodeError, EOFError, OverflowError, AttributeError)
 
 
-def parse_upload(name: str, data: bytes, *, sample_rate_hz: float | None = None) -> ParsedUpload:
-    """Read one upload and detect its channel roles; never raises for bad data."""
+#: The Analyse page's field of the time unit (``time_unit``, ``pidcore analyze --time-unit``),
+#: one of its options for every file.
+TIME_UNIT_FIELD = "time base unit"
+
+
+def page_time_unit(typed: str) -> str | None:
+    """The time unit typed in the page's :data:`TIME_UNIT_FIELD` (blank: None, each file's
+    own), refused naming the field where it is not a unit of time: read with it, every file
+    would be refused naming the keyword, or an HDF5 file analysed with it unsaid."""
+    from ..units import given_time_unit
+
+    typed = typed.strip()
+    if not typed:
+        return None
+    try:
+        given_time_unit(typed)
+    except ParameterError as exc:
+        reason = str(exc).split(": ", 1)[1]  # after the keyword: what the unit is not
+        raise ParameterError(f"{TIME_UNIT_FIELD}: {typed!r} is {reason}") from None
+    return typed
+
+
+def parse_upload(name: str, data: bytes, *, sample_rate_hz: float | None = None,
+                 time_unit: str | None = None) -> ParsedUpload:
+    """Read one upload (``time_unit``: :func:`read_upload`) and detect its channel roles;
+    never raises for bad data."""
     sha = content_sha256(data)
     try:
-        measurement = read_upload(name, data, sample_rate_hz=sample_rate_hz)
+        measurement = read_upload(name, data, sample_rate_hz=sample_rate_hz,
+                                  time_unit=time_unit)
         return ParsedUpload(name, sha, measurement, detect_channels(measurement))
     except _BAD_INPUT_ERRORS as exc:
         return ParsedUpload(name, sha, error=error_message(name, exc))
@@ -267,8 +299,8 @@ def analyze_parsed(parsed: ParsedUpload, options: AnalysisOptions) -> UploadOutc
 
 def analyze_upload(name: str, data: bytes, options: AnalysisOptions) -> UploadOutcome:
     """Read and analyse one upload; never raises for bad user data."""
-    return analyze_parsed(parse_upload(name, data, sample_rate_hz=options.sample_rate_hz),
-                          options)
+    return analyze_parsed(parse_upload(name, data, sample_rate_hz=options.sample_rate_hz,
+                                       time_unit=options.time_unit), options)
 
 
 def channels_caption(names: Sequence[str], outcome: UploadOutcome,
@@ -863,10 +895,13 @@ def settings_template(settings: pd.DataFrame) -> bytes:
     return settings.rename(columns=FILE_TABLE_COLUMNS).to_csv(index=False).encode()
 
 
-def options_of(row: Mapping, *, sample_rate_hz: float | None = None) -> AnalysisOptions:
+def options_of(row: Mapping, *, sample_rate_hz: float | None = None,
+               time_unit: str | None = None) -> AnalysisOptions:
     """Analysis options of one file's settings row (SI inside: µs and g converted by
     :func:`pidcore.file_settings.analysis_overrides`, the parsing ``pidcore analyze`` applies
-    to a sidecar row: one set of checks, errors naming the file and the column)."""
+    to a sidecar row: one set of checks, errors naming the file and the column), with the
+    page's options for every file (saved with the record, as ``pidcore analyze`` saves its
+    ``--sample-rate`` and ``--time-unit``)."""
     from ..file_settings import analysis_overrides
     from ..measure import AnalysisOptions
 
@@ -875,7 +910,7 @@ def options_of(row: Mapping, *, sample_rate_hz: float | None = None) -> Analysis
     # NaN cells as no channel named (a NaN cell was passed on as a channel named "nan")
     cells = {column: row.get(label) for column, label in labels.items()}
     return AnalysisOptions(**analysis_overrides(cells, str(row["file"]), labels=labels),
-                           sample_rate_hz=sample_rate_hz)
+                           sample_rate_hz=sample_rate_hz, time_unit=time_unit)
 
 
 # --- results and saving ------------------------------------------------------------------------

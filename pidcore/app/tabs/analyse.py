@@ -103,8 +103,8 @@ def _known_specimens(stores) -> list:
                                    uploaded_specimens(stores.path))
 
 
-def _card(upload, row, sample_rate_hz, materials, given=(), known=(), every_file="",
-          said_specimens=None, specimen=None):
+def _card(upload, row, sample_rate_hz, time_unit, materials, given=(), known=(),
+          every_file="", said_specimens=None, specimen=None):
     """Results of one file; returns an AnalysedFile or None. ``known``: the specimen files a
     typed specimen name may mean; ``every_file``: the specimen of a row naming none;
     ``said_specimens``: the specimen notes earlier cards showed (added to), each shown once;
@@ -118,7 +118,7 @@ def _card(upload, row, sample_rate_hz, materials, given=(), known=(), every_file
     with st.container(border=True):
         st.markdown(f"**{name}** · {_size(upload.size)}")
         sha = state.upload_sha256(upload)
-        found = state.parsed(sha, name, sample_rate_hz, upload)
+        found = state.parsed(sha, name, sample_rate_hz, time_unit, upload)
         if found.error is not None:  # no numbers: nothing assumed for them to say
             st.error(found.error)
             return None
@@ -128,12 +128,13 @@ def _card(upload, row, sample_rate_hz, materials, given=(), known=(), every_file
         if assumed:  # a default the user has not confirmed: say so next to the numbers
             st.info(f"{assumed} (set it in the settings table)")
         try:
-            options = uploads.options_of(row, sample_rate_hz=sample_rate_hz)
+            options = uploads.options_of(row, sample_rate_hz=sample_rate_hz,
+                                         time_unit=time_unit)
         except PidcoreError as exc:
             st.error(str(exc))
             return None
-        outcome = state.analysed(sha, name, sample_rate_hz, uploads.options_to_json(options),
-                                 upload)
+        outcome = state.analysed(sha, name, sample_rate_hz, time_unit,
+                                 uploads.options_to_json(options), upload)
         st.caption(uploads.channels_caption(found.channels.names, outcome, options))
         if outcome.error is not None:
             st.error(outcome.error)
@@ -232,6 +233,16 @@ def render(stores) -> list:
         except PidcoreError as exc:
             st.error(f"{exc}; files are read without a sample rate")
             sample_rate_hz = None
+        typed_unit = st.text_input(
+            uploads.TIME_UNIT_FIELD, "", key="time_unit",
+            help="s, ms, us: the unit of a UFF abscissa whose label pidcore does not read, of "
+                 "a CSV time column or MATLAB time vector that states none (otherwise "
+                 "seconds, noted); overrides a file's own (noted); blank = each file's own")
+        try:
+            time_unit = uploads.page_time_unit(typed_unit)
+        except PidcoreError as exc:
+            st.error(f"{exc}; files are read with the time units they state")
+            time_unit = None
         known = _known_specimens(stores)
         if specimen is not None:
             known = [*known, specimen]
@@ -300,7 +311,8 @@ def render(stores) -> list:
         st.warning(note)
     channel_names = []
     for upload in measurements:
-        found = state.parsed(state.upload_sha256(upload), upload.name, sample_rate_hz, upload)
+        found = state.parsed(state.upload_sha256(upload), upload.name, sample_rate_hz,
+                             time_unit, upload)
         if found.channels is not None:
             channel_names += [n for n in found.channels.names if n not in channel_names]
     st.markdown("**Per-file settings** (edit the cells; each file is analysed with its own row)")
@@ -314,7 +326,7 @@ def render(stores) -> list:
                 st.markdown(f"**{upload.name}** · {_size(upload.size)}")
                 st.error(held)
             continue
-        result = _card(upload, row, sample_rate_hz, materials,
+        result = _card(upload, row, sample_rate_hz, time_unit, materials,
                        uploads.columns_given(list(tables.values()), upload.name), known,
                        every_file, said_specimens, specimen)
         if result is not None:
