@@ -1011,6 +1011,27 @@ def test_compare_shows_the_calibrated_band_beside_raw_dem_and_measurement(
         assert row["calibrated 95 % band [-]"].tolist() == ["0 .. 16.91"]
 
 
+def test_compare_writes_the_raw_dem_sdc_as_the_report_row_does(store_file, tmp_path,
+                                                                monkeypatch):
+    # the raw DEM metric beside the calibrated one wrote 4 decimals (0.0123) where the
+    # report's cell and the Report tab's row write 4 significant digits (0.01235)
+    from pidcore.app.calibration import CALIBRATION_ENV_VAR
+    from pidcore.calibrate.prediction import sdc_text
+    from pidcore.report.render import format_cell
+
+    _dem_store_with_runs(store_file, runs=(("dem_a", 0.0123456),))
+    cal = _calibration_json(tmp_path / "calibration.json", 100, 5, 50, 0.3456, 0.10, 0.60)
+    monkeypatch.setenv(CALIBRATION_ENV_VAR, str(cal))
+    at = _upload(_app(), [("c_fill50.csv", mass_damper_csv())])
+    metrics = {m.label: m.value for m in at.metric}
+    assert metrics["SDC DEM, raw [-]"] == sdc_text(0.0123456) == "0.01235"
+    at.button(key="save").click()
+    at.run()
+    table = _table(at, "SDC DEM (ours) [-]")
+    (dem,) = table["SDC DEM (ours) [-]"].dropna().tolist()
+    assert format_cell(dem) == metrics["SDC DEM, raw [-]"]
+
+
 def test_a_calibration_saved_in_the_store_is_listed_and_used_after_a_restart(store_file,
                                                                             tmp_path):
     # the app kept its calibrations in memory: a restart lost them. One saved in the store
