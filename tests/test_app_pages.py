@@ -956,21 +956,27 @@ def _calibration_json(path, f, a, fill, predicted, low, high):
 # The mass-damper upload is 100 Hz, 5 g, fill 50 % with loss factor 0.05: Eq. 11 SDC = 2π·0.05
 # = 0.314, so a band 0.10..0.60 holds it and 0.50..0.90 does not (margins far above the noise).
 # A band 0 .. 20, cut at the paper coupon's SDC bound at 50 % (8 m_p/m_s = 16.9), spans every
-# plausible SDC: uninformative, as the report's row.
+# plausible SDC: uninformative, as the report's row. 0.08264 reads 0.0826 with 4 decimals and
+# 0.08264 in the report's cell: the metric was the one spelling apart.
 @pytest.mark.parametrize("predicted, band, verdict", [(0.3456, (0.10, 0.60), "inside"),
                                                       (0.6789, (0.50, 0.90), "outside"),
-                                                      (0.5678, (0.0, 20.0), "uninformative")])
+                                                      (0.5678, (0.0, 20.0), "uninformative"),
+                                                      (0.08264, (0.05, 0.12), "outside")])
 def test_compare_shows_the_calibrated_band_beside_raw_dem_and_measurement(
         store_file, tmp_path, monkeypatch, predicted, band, verdict):
     from pidcore.app.calibration import CALIBRATION_ENV_VAR
+    from pidcore.calibrate.prediction import sdc_text
     from pidcore.compare.plausibility import sdc_bound
+    from pidcore.report.render import format_cell
     from pidcore.report.table import CALIBRATED_INSIDE_COLUMN
 
     cal = _calibration_json(tmp_path / "calibration.json", 100, 5, 50, predicted, *band)
     monkeypatch.setenv(CALIBRATION_ENV_VAR, str(cal))
     at = _upload(_app(), [("c_fill50.csv", mass_damper_csv())])
     metrics = {m.label: m.value for m in at.metric}
-    assert metrics["SDC calibrated DEM, Eq. 11 [-]"] == f"{predicted:.4f}"
+    # the calibrated SDC as the report's cell (format_cell) and the bands (sdc_text) write it
+    assert metrics["SDC calibrated DEM, Eq. 11 [-]"] == format_cell(predicted) == \
+        sdc_text(predicted) == f"{predicted:.4g}"
     assert "SDC DEM, raw [-]" in metrics and "SDC measured, Eq. 11 [-]" in metrics
     captions = " ".join(c.value for c in at.caption)
     bound = sdc_bound(fill_percent=50.0, material="acrylic").sdc
@@ -1003,6 +1009,27 @@ def test_compare_shows_the_calibrated_band_beside_raw_dem_and_measurement(
     assert "calibrated low 95 % [-]" not in row and "calibrated high 95 % [-]" not in row
     if verdict == "uninformative":
         assert row["calibrated 95 % band [-]"].tolist() == ["0 .. 16.91"]
+
+
+def test_compare_writes_the_raw_dem_sdc_as_the_report_row_does(store_file, tmp_path,
+                                                                monkeypatch):
+    # the raw DEM metric beside the calibrated one wrote 4 decimals (0.0123) where the
+    # report's cell and the Report tab's row write 4 significant digits (0.01235)
+    from pidcore.app.calibration import CALIBRATION_ENV_VAR
+    from pidcore.calibrate.prediction import sdc_text
+    from pidcore.report.render import format_cell
+
+    _dem_store_with_runs(store_file, runs=(("dem_a", 0.0123456),))
+    cal = _calibration_json(tmp_path / "calibration.json", 100, 5, 50, 0.3456, 0.10, 0.60)
+    monkeypatch.setenv(CALIBRATION_ENV_VAR, str(cal))
+    at = _upload(_app(), [("c_fill50.csv", mass_damper_csv())])
+    metrics = {m.label: m.value for m in at.metric}
+    assert metrics["SDC DEM, raw [-]"] == sdc_text(0.0123456) == "0.01235"
+    at.button(key="save").click()
+    at.run()
+    table = _table(at, "SDC DEM (ours) [-]")
+    (dem,) = table["SDC DEM (ours) [-]"].dropna().tolist()
+    assert format_cell(dem) == metrics["SDC DEM, raw [-]"]
 
 
 def test_a_calibration_saved_in_the_store_is_listed_and_used_after_a_restart(store_file,
@@ -1151,7 +1178,7 @@ def test_calibrate_page_runs_the_real_library_and_compare_shows_its_band(store_f
     import shutil
 
     from pidcore.app.calibration import CALIBRATION_ENV_VAR, runner_for
-    from pidcore.calibrate.prediction import band_text
+    from pidcore.calibrate.prediction import band_text, sdc_text
     from pidcore.cli import main
 
     monkeypatch.delenv(CALIBRATION_ENV_VAR, raising=False)
@@ -1181,7 +1208,7 @@ def test_calibrate_page_runs_the_real_library_and_compare_shows_its_band(store_f
     doc = json.loads(task.outputs["calibration.json"])
     row = next(r for r in doc["predictions"] if r["frequency_hz"] == 50.0)
     metrics = {m.label: m.value for m in at.metric}
-    assert metrics["SDC calibrated DEM, Eq. 11 [-]"] == f"{row['predicted']:.4f}"
+    assert metrics["SDC calibrated DEM, Eq. 11 [-]"] == sdc_text(row["predicted"])
     assert any(f"calibrated 95 % band {band_text(row['low95'], row['high95'])}" in c.value
                for c in at.caption)
     # the calibration's design runs (files named paper_coupon with other values) made Compare

@@ -173,7 +173,7 @@ def test_the_degrees_of_freedom_go_through_calibration_json():
         _calibration_row()]}), "old.json")
     (hit,), (hit_old,) = new.predictions, old.predictions
     assert hit.measured_stderr_dof == 7.0 and math.isnan(hit_old.measured_stderr_dof)
-    assert new.to_pandas()["sdc measured stderr dof [-]"].tolist() == [7.0]
+    assert new.to_pandas()["SDC measured (Eq. 11) stderr dof [-]"].tolist() == [7.0]
     # its own stderr and dof: the stated band; another measurement's: widened by its quantile
     assert hit.band(0.02, 7) == (0.40, 0.62)
     assert hit_old.band(0.02) == (0.40, 0.62)
@@ -187,6 +187,44 @@ def test_the_degrees_of_freedom_go_through_calibration_json():
                                              r".measured_stderr_dof must be degrees"):
         calibration_from_json(json.dumps({"parameters": {}, "predictions": [
             _calibration_row(measured_stderr_dof=-1)]}), "calibration.json")
+
+
+
+def test_calibration_frame_names_the_measured_sdc_as_align_measured_and_the_report_do():
+    # Calibration.to_pandas() said "sdc measured [-]" where align_measured and report.csv say
+    # "SDC measured (Eq. 11) [-]" for the same Eq. 11 SDC: a third spelling of one quantity.
+    # A frame saved with the old names reads into the present ones and still plots.
+    import matplotlib.pyplot as plt
+
+    from pidcore.calibrate import CALIBRATION_COLUMNS_RENAMED
+    from pidcore.compare.align import (
+        MEASURED_COLUMNS_RENAMED,
+        MEASURED_EQ11_COLUMN,
+        MEASURED_EQ11_DOF_COLUMN,
+        MEASURED_EQ11_STDERR_COLUMN,
+    )
+    from pidcore.report.figures_results import plot_calibration
+    from pidcore.report.table import MEASURED_EQ11_COLUMN as REPORT_EQ11_COLUMN
+
+    frame = calibration_from_json(json.dumps({"parameters": {}, "predictions": [
+        _calibration_row(measured_stderr_dof=7)]}), "calibration.json").to_pandas()
+    assert REPORT_EQ11_COLUMN == MEASURED_EQ11_COLUMN == "SDC measured (Eq. 11) [-]"
+    assert frame.loc[0, [MEASURED_EQ11_COLUMN, MEASURED_EQ11_STDERR_COLUMN,
+                         MEASURED_EQ11_DOF_COLUMN]].tolist() == [0.5, 0.02, 7.0]
+    assert not [c for c in frame.columns if c.startswith("sdc measured")]
+    # one mapping mechanism, one target name per quantity: the old names map to align's
+    assert set(CALIBRATION_COLUMNS_RENAMED.values()) == set(MEASURED_COLUMNS_RENAMED.values())
+    older = frame.rename(columns={new: old for old, new in CALIBRATION_COLUMNS_RENAMED.items()})
+    assert "sdc measured [-]" in older.columns
+    pd.testing.assert_frame_equal(older.rename(columns=CALIBRATION_COLUMNS_RENAMED), frame)
+    for drawn in (frame, older):
+        _, ax = plt.subplots()
+        try:
+            (crosses,) = [line for line in plot_calibration(drawn, ax=ax).get_lines()
+                          if line.get_label() == "measured"]
+            assert list(crosses.get_ydata()) == [0.5]  # the measured SDC, exact
+        finally:
+            plt.close("all")
 
 
 def test_an_analysis_in_the_store_keeps_n_blocks_minus_1(tmp_path, monkeypatch):

@@ -812,3 +812,33 @@ def test_the_report_and_the_calibration_summaries_count_uninformative_bands_in_o
     assert add_calibration_columns(table, cal).attrs["notes"][-1].endswith(
         "at 1 of 1 measured row(s)" + changed)
     assert coverage_text(verdicts) == "1/1 inside the 95 % band" + changed
+
+
+def test_the_terminal_table_names_the_measured_sdcs_as_report_csv_and_the_pdf_do(tmp_path):
+    # the terminal's table headed "SDC measured (Eq. 10) [-]" the column report.csv, the PDF
+    # and the app call "SDC measured, E of Eq. 10 [-]": one measured SDC, two names, the short
+    # one reading as an SDC given by Eq. 10 (Eq. 10 gives only the energy E it divides by)
+    from pidcore.app.workbench import report_display
+    from pidcore.cli.report import short_table
+    from pidcore.model import load_paper_table3
+    from pidcore.report import build_report_table
+    from pidcore.report.render import pdf_table_cells
+    from pidcore.report.table import MEASURED_EQ10_COLUMN, MEASURED_EQ11_COLUMN
+
+    dem = pd.DataFrame({"frequency_hz": [500.0], "acceleration_g": [5.0],
+                        "fill_percent": [50.0], "material": ["acrylic"], "direction": ["z"],
+                        "sdc": [0.55], "sdc_stderr": [0.01], "case_key": ["b"]})
+    analyses = pd.DataFrame({"frequency_hz": [500.0], "acceleration_g": [5.0],
+                             "fill_percent": [50.0], "sdc": [0.6], "sdc_stderr": [0.01],
+                             "source": ["a.uff"]})
+    table = build_report_table(dem, analyses, load_paper_table3())
+    names = (MEASURED_EQ10_COLUMN, MEASURED_EQ11_COLUMN)
+    assert names == ("SDC measured, E of Eq. 10 [-]", "SDC measured (Eq. 11) [-]")
+    labels, _ = pdf_table_cells(table)
+    pdf_heads = [label.replace("\n", " ") for label in labels]
+    terminal_head = short_table(table).splitlines()[0]
+    for name in names:
+        assert name in table.columns  # report.csv writes the table's columns
+        assert name in pdf_heads and name in report_display(table).columns
+        assert name in terminal_head
+    assert "(Eq. 10)" not in terminal_head

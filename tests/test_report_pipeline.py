@@ -143,9 +143,11 @@ def test_cli_with_dem_store_only_stores_nothing(tmp_path, dem_store, capsys):
     assert code == 0
     assert "wrote md:" in out and "wrote html:" in out and "out_of_range" in out
     # the console shows the like-for-like (Eq. 10) measured SDC beside ours, and names the
-    # Eq. 11 one as such (it showed only "SDC measured", the Eq. 11 value)
+    # Eq. 11 one as such (it showed only "SDC measured", the Eq. 11 value). Under report.csv's
+    # name: it was headed "SDC measured (Eq. 10) [-]" here, as if Eq. 10 gave the SDC, where
+    # the CSV, PDF and app say "SDC measured, E of Eq. 10 [-]" (Eq. 10 gives the energy E)
     header = out.splitlines()[0]
-    assert header.index("SDC DEM (ours) [-]") < header.index("SDC measured (Eq. 10) [-]") \
+    assert header.index("SDC DEM (ours) [-]") < header.index("SDC measured, E of Eq. 10 [-]") \
         < header.index("SDC measured (Eq. 11) [-]")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["coupon2_75pct.csv", "out"]
     # 75 % is above our DEM fills (25, 50): never extrapolated

@@ -36,6 +36,8 @@ save_calibration, SavedCalibration, stored_calibration, stored_calibrations
 load_calibration, calibration_from_json, Calibration, CalibratedPrediction
     A calibration read back (``to_pandas()``, ``plot()``); its prediction and 95 % band at
     a calibrated load case (``Calibration.lookup(case).band(stderr)``).
+CALIBRATION_COLUMNS_RENAMED
+    The older names of ``Calibration.to_pandas()``'s columns -> the present ones.
 """
 
 from .calibrate import CalibrationResult, base_specimen, calibrate
@@ -49,11 +51,18 @@ from .persist import (
     stored_calibration,
     stored_calibrations,
 )
-from .prediction import CalibratedPrediction, Calibration, calibration_from_json, load_calibration
+from .prediction import (
+    CALIBRATION_COLUMNS_RENAMED,
+    CalibratedPrediction,
+    Calibration,
+    calibration_from_json,
+    load_calibration,
+)
 
 __all__ = ["calibrate", "base_specimen", "CalibrationResult", "MeasuredPoint",
            "read_measured_table", "measured_from_store", "Observation", "observation_from_run",
            "write_outputs",
            "CATALOGUE", "ParameterSpec", "build_specs", "parse_fit", "dem_parameter_names",
            "Calibration", "CalibratedPrediction", "load_calibration", "calibration_from_json",
+           "CALIBRATION_COLUMNS_RENAMED",
            "save_calibration", "SavedCalibration", "stored_calibration", "stored_calibrations"]

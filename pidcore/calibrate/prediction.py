@@ -17,7 +17,15 @@ from typing import TYPE_CHECKING, Any
 import pandas as pd
 
 from .. import defaults
-from ..compare.align import Z95, Tolerances, band_quantile, quantile_label  # noqa: F401 (public here)
+from ..compare.align import (  # noqa: F401 (public here)
+    MEASURED_EQ11_COLUMN,
+    MEASURED_EQ11_DOF_COLUMN,
+    MEASURED_EQ11_STDERR_COLUMN,
+    Z95,
+    Tolerances,
+    band_quantile,
+    quantile_label,
+)
 from ..compare.plausibility import SDC_UPPER_BOUND, UNKNOWN_SPECIMEN_BOUND, SdcBound
 from ..constants import BAND_VERDICTS
 from ..errors import ParameterError, instance_of, real_number
@@ -25,6 +33,18 @@ from ..loadcase import LoadCase
 
 if TYPE_CHECKING:  # pragma: no cover
     from ..specimen import Specimen
+
+#: :meth:`Calibration.to_pandas`'s measured Eq. 11 columns as pidcore before 2026-12 named
+#: them -> the names every other table gives that quantity (:data:`pidcore.compare.align.
+#: MEASURED_COLUMNS_RENAMED`): it was a third spelling, "sdc measured [-]" beside the report's
+#: "SDC measured (Eq. 11) [-]". An older saved frame reads as today's with
+#: ``frame.rename(columns=CALIBRATION_COLUMNS_RENAMED)`` (as :func:`pidcore.report.
+#: figures_results.plot_calibration` does).
+CALIBRATION_COLUMNS_RENAMED: dict[str, str] = {
+    "sdc measured [-]": MEASURED_EQ11_COLUMN,
+    "sdc measured stderr [-]": MEASURED_EQ11_STDERR_COLUMN,
+    "sdc measured stderr dof [-]": MEASURED_EQ11_DOF_COLUMN,
+}
 
 _REQUIRED = ("frequency_hz", "acceleration_g", "fill_percent", "predicted", "low95", "high95")
 
@@ -339,9 +359,11 @@ class Calibration:
 
         Columns ``frequency [Hz]``, ``acceleration [g]``, ``fill [%]``, ``material``,
         ``direction``, ``sdc predicted [-]``, ``low95 [-]``, ``high95 [-]`` (the band of a
-        measurement with the fitted point's standard error), ``sdc measured [-]``,
-        ``sdc measured stderr [-]``, ``low95 without stderr [-]``,
-        ``high95 without stderr [-]``, ``sdc measured stderr dof [-]`` (NaN where the file
+        measurement with the fitted point's standard error), ``SDC measured (Eq. 11) [-]``,
+        ``SDC measured (Eq. 11) stderr [-]``, ``low95 without stderr [-]``,
+        ``high95 without stderr [-]``, ``SDC measured (Eq. 11) stderr dof [-]`` (the names of
+        :mod:`pidcore.compare.align`; :data:`CALIBRATION_COLUMNS_RENAMED` renames an older
+        frame's; NaN where the file
         does not state them), ``sdc bound [-]`` (where the band is cut: :meth:`sdc_bound`)
         and :data:`VERDICT_COLUMN` (:meth:`CalibratedPrediction.judge` of the fitted
         measurement at that bound; ``not compared`` where none is stated): what
@@ -365,11 +387,11 @@ class Calibration:
             "sdc predicted [-]": p.sdc,
             "low95 [-]": p.low95,
             "high95 [-]": p.high95,
-            "sdc measured [-]": p.measured,
-            "sdc measured stderr [-]": p.measured_stderr,
+            MEASURED_EQ11_COLUMN: p.measured,
+            MEASURED_EQ11_STDERR_COLUMN: p.measured_stderr,
             "low95 without stderr [-]": p.low95_without_stderr,
             "high95 without stderr [-]": p.high95_without_stderr,
-            "sdc measured stderr dof [-]": p.measured_stderr_dof,
+            MEASURED_EQ11_DOF_COLUMN: p.measured_stderr_dof,
             "sdc bound [-]": p.sdc_bound.sdc,
             VERDICT_COLUMN: verdict,
         } for p, verdict in rows])

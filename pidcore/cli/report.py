@@ -16,6 +16,7 @@ from ..report.table import (
     CALIBRATED_BAND_COLUMN,
     CALIBRATED_COLUMN,
     CALIBRATED_INSIDE_COLUMN,
+    MEASURED_EQ10_COLUMN,
     MEASURED_EQ11_COLUMN,
     with_band_text,
 )
@@ -35,7 +36,7 @@ from ._vocabulary import cli_words
 #: Eq. 11 one beside the calibrated DEM's, which predicts it.
 _STDOUT_COLUMNS = (
     "frequency [Hz]", "acceleration [g]", "packing ratio [%]", "SDC DEM (ours) [-]",
-    "SDC measured, E of Eq. 10 [-]", MEASURED_EQ11_COLUMN, CALIBRATED_COLUMN,
+    MEASURED_EQ10_COLUMN, MEASURED_EQ11_COLUMN, CALIBRATED_COLUMN,
     CALIBRATED_BAND_COLUMN, CALIBRATED_INSIDE_COLUMN, "SDC DEM (paper) [-]",
     "SDC measured (paper) [-]", ALIGNMENT_COLUMN,
 )
@@ -151,8 +152,10 @@ def short_table(table) -> str:
     ``uninformative`` band showed as two numbers without a word)."""
     table = with_band_text(table)
     cols = [c for c in _STDOUT_COLUMNS if c in table.columns]
+    # the measured SDCs keep report.csv's names: "SDC measured (Eq. 10)" here named as an
+    # SDC of Eq. 10 the column report.csv calls "SDC measured, E of Eq. 10" (Eq. 10 gives
+    # the energy E the measured dE is divided by, not an SDC)
     short = {ALIGNMENT_COLUMN: "alignment",
-             "SDC measured, E of Eq. 10 [-]": "SDC measured (Eq. 10) [-]",
              CALIBRATED_INSIDE_COLUMN: "measured in calibrated 95 % band"}
     heads = [short.get(c, c) for c in cols]
     rows = [[format_cell(v) for v in row] for row in table.loc[:, cols].itertuples(index=False)]

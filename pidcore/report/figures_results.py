@@ -123,9 +123,11 @@ def plot_calibration(frame: pd.DataFrame, *, ax: Any = None) -> Any:
     import matplotlib.pyplot as plt
 
     from ..calibrate.outputs import draw_bands, draw_cut_bounds
-    from ..calibrate.prediction import VERDICT_COLUMN
+    from ..calibrate.prediction import CALIBRATION_COLUMNS_RENAMED, VERDICT_COLUMN
+    from ..compare.align import MEASURED_EQ11_COLUMN
     from ..compare.plausibility import SDC_UPPER_BOUND
 
+    frame = frame.rename(columns=CALIBRATION_COLUMNS_RENAMED)  # a frame saved before 2026-12
     if ax is None:
         _, ax = plt.subplots(figsize=(max(6.0, 0.5 * len(frame)), 4.0), constrained_layout=True)
     x = np.arange(len(frame))
@@ -134,7 +136,7 @@ def plot_calibration(frame: pd.DataFrame, *, ax: Any = None) -> Any:
     draw_cut_bounds(ax, draw_bands(ax, x, frame["sdc predicted [-]"], frame["low95 [-]"],
                                    frame["high95 [-]"], bounds, verdicts,
                                    label="calibrated DEM", color="C0"))
-    ax.plot(x, frame["sdc measured [-]"].to_numpy(float), "x", color="k", label="measured")
+    ax.plot(x, frame[MEASURED_EQ11_COLUMN].to_numpy(float), "x", color="k", label="measured")
     ax.set_xticks(x)
     ax.set_xticklabels([f"{f:g} Hz, {a:g} g, {p:g} %" for f, a, p in zip(
         frame["frequency [Hz]"], frame["acceleration [g]"], frame["fill [%]"], strict=True)],

@@ -16,10 +16,9 @@ from pidcore.app.tabs import (
     refuse_address_flag,
 )
 from pidcore.app.vocabulary import page_terms
-from pidcore.calibrate.prediction import band_text, quantile_label
+from pidcore.calibrate.prediction import band_text, quantile_label, sdc_text
 from pidcore.compare.case import equivalent_dampers
 from pidcore.constants import BAND_VERDICTS
-from pidcore.units import display_number
 
 
 def _entries(stores, session_files):
@@ -117,11 +116,13 @@ def _calibrated(calibrations, comp, head, specimen: str, *, implausible: bool = 
     c1, c2, c3 = st.columns(3)
     c1.metric("SDC measured, Eq. 11 [-]",
               uploads.format_sdc(comp.measured_sdc, comp.measured_stderr))
-    c2.metric("SDC DEM, raw [-]", display_number(head.dem, missing="none"))
+    # an SDC as the report's cell and the band beside it write it (sdc_text, 4 significant
+    # digits): 4 decimals showed the calibrated SDC the report writes 0.08264 as 0.0826
+    c2.metric("SDC DEM, raw [-]", sdc_text(head.dem) if math.isfinite(head.dem) else "none")
     # the band of a measurement with this one's standard error (the report's)
     own_stderr = comp.measured_stderr if math.isfinite(comp.measured_sdc) else math.nan
     low, high = hit.band(own_stderr, comp.measured_stderr_dof)
-    c3.metric("SDC calibrated DEM, Eq. 11 [-]", display_number(hit.sdc),
+    c3.metric("SDC calibrated DEM, Eq. 11 [-]", sdc_text(hit.sdc),
               help=f"95 % band {band_text(low, high)}")
     if not math.isfinite(comp.measured_sdc):
         verdict = "not compared (no Eq. 11 SDC)"
