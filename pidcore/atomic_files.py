@@ -205,6 +205,77 @@ def new_temporary_folder_for(target: str | os.PathLike[str]) -> Path:
     return work
 
 
+#: Marks an earlier folder moved aside (``.<name>.<16 hex>.old``) while :func:`replace_folder`
+#: renames its replacement into place.
+PREVIOUS_FOLDER_SUFFIX = ".old"
+
+
+def previous_folder_name_pattern(target: str | os.PathLike[str]) -> re.Pattern[str]:
+    """The names :func:`replace_folder` moves the earlier ``target`` to, and no others: 16 hex
+    digits, or the 8 characters of :func:`tempfile.mkdtemp` that earlier versions used (a
+    user's ``.<name>.backup.old`` is not one)."""
+    return re.compile(re.escape(f".{Path(target).name}.") + r"(?:[0-9a-f]{16}|[a-z0-9_]{8})"
+                      + re.escape(PREVIOUS_FOLDER_SUFFIX))
+
+
+def replace_folder(new: str | os.PathLike[str], target: str | os.PathLike[str]) -> None:
+    """Rename the folder ``new`` to ``target``, replacing the folder there, if any.
+
+    A folder cannot be renamed over a non-empty one, so the earlier ``target`` is first moved
+    aside (:func:`previous_folder_name_pattern`), then removed. An exception between the two
+    renames puts it back; a process killed there (SIGKILL, a power loss) leaves no
+    ``target`` and the earlier one hidden beside it, which :func:`restore_previous_folder`
+    (called by the next write, before anything else) puts back: no earlier folder is lost.
+    """
+    import shutil
+
+    new, target = Path(new), Path(target)
+    if not target.exists():
+        os.replace(new, target)
+        return
+    old = target.with_name(f".{target.name}.{secrets.token_hex(8)}{PREVIOUS_FOLDER_SUFFIX}")
+    os.replace(target, old)
+    try:
+        os.replace(new, target)
+    except BaseException:
+        os.replace(old, target)
+        raise
+    shutil.rmtree(old, ignore_errors=True)
+
+
+def restore_previous_folder(target: str | os.PathLike[str], *,
+                            is_previous: Callable[[Path], bool] = lambda folder: True
+                            ) -> Path | None:
+    """Where ``target`` is missing, rename back the earlier folder a killed
+    :func:`replace_folder` left hidden beside it; returns the folder restored (None: none).
+
+    Only an exact name (:func:`previous_folder_name_pattern`) that is a folder itself, not a
+    link, and that ``is_previous`` accepts (a report's marker) is taken; of several, the one
+    moved aside last (its change time, which the rename set). An existing ``target`` is
+    never touched.
+    """
+    target = Path(target)
+    if os.path.lexists(target):
+        return None
+    pattern = previous_folder_name_pattern(target)
+    found: list[tuple[float, Path]] = []
+    with suppress(OSError):
+        for entry in target.parent.iterdir():
+            if pattern.fullmatch(entry.name) is None:
+                continue
+            try:
+                info = entry.lstat()
+            except FileNotFoundError:
+                continue
+            if stat.S_ISDIR(info.st_mode) and is_previous(entry):
+                found.append((info.st_ctime, entry))
+    if not found:
+        return None
+    _, previous = max(found)
+    os.replace(previous, target)
+    return target
+
+
 @contextmanager
 def atomic_path(path: str | os.PathLike[str], *, durable: bool = True) -> Iterator[Path]:
     """Yield a new empty temporary file beside ``path`` for a writer to fill (by its path:

@@ -418,3 +418,66 @@ def test_a_killed_reports_build_folder_is_removed_by_the_next_report_of_that_fol
     assert sorted(p.name for p in out.iterdir()) == sorted([REPORT_MARKER, "report.csv",
                                                             "report.provenance.txt"])
     assert len(pd.read_csv(paths["csv"])) == len(table)
+
+
+def test_a_write_killed_between_its_renames_loses_no_earlier_report(tmp_path, table, provenance,
+                                                                    monkeypatch):
+    # The earlier report is moved aside, then the new one renamed into place: a SIGKILL
+    # between the two left no rp and the earlier report hidden as '.rp.<hex>.old'. The kill
+    # is stood for by an exception os.replace raises at the second rename, with the first
+    # one's undo (the except branch a SIGKILL never reaches) disabled too.
+    import os
+
+    import pidcore.atomic_files as atomic_files
+
+    out = tmp_path / "rp"
+    write_report(table, {}, provenance, out, "csv")
+    earlier = {p.name: p.read_bytes() for p in out.iterdir()}
+    renames = []
+
+    def killed_at_the_second_rename(src, dst):
+        renames.append((src, dst))
+        if len(renames) >= 2:  # the second rename, and the undo of the first
+            raise SystemExit("killed")
+        os.rename(src, dst)
+
+    monkeypatch.setattr(atomic_files.os, "replace", killed_at_the_second_rename)
+    with pytest.raises(SystemExit):
+        write_report(table.iloc[:1], {}, provenance, out, "csv")
+    monkeypatch.undo()
+    # the state a kill leaves: no rp, the earlier report hidden beside it
+    hidden = [p for p in tmp_path.iterdir() if p.name.endswith(".old")]
+    assert not out.exists() and len(hidden) == 1, sorted(os.listdir(tmp_path))
+    assert re.fullmatch(r"\.rp\.[0-9a-f]{16}\.old", hidden[0].name)
+    # the next write finds it, and a failing one leaves it back in place, whole
+    import pidcore.report.render as render
+
+    def failing_renderer(*args, **kwargs):
+        raise OSError("disk full")
+
+    with monkeypatch.context() as patch:
+        patch.setitem(render.RENDERERS, "csv", failing_renderer)
+        with pytest.raises(OSError, match="disk full"):
+            write_report(table, {}, provenance, out, "csv")
+    assert {p.name: p.read_bytes() for p in out.iterdir()} == earlier
+    # and a write that succeeds replaces it as any earlier report
+    paths = write_report(table.iloc[:1], {}, provenance, out, "csv")
+    assert paths["csv"].read_bytes() != earlier["report.csv"]
+    assert sorted(os.listdir(tmp_path)) == ["rp"]
+
+
+def test_only_a_hidden_earlier_report_of_the_exact_name_is_restored(tmp_path):
+    from pidcore.report.render import restore_previous_report
+
+    (tmp_path / ".rp.backup.old").mkdir()  # a user's: not the pattern
+    (tmp_path / ".rp.backup.old" / REPORT_MARKER).write_text("x")
+    (tmp_path / ".rp.0123456789abcdef.old").mkdir()  # the pattern, but no report in it
+    assert restore_previous_report(tmp_path / "rp") is None
+    assert not (tmp_path / "rp").exists()
+    (tmp_path / ".rp.0123456789abcdef.old" / REPORT_MARKER).write_text("x")
+    (tmp_path / "rp").mkdir()  # an existing rp is never touched
+    assert restore_previous_report(tmp_path / "rp") is None
+    (tmp_path / "rp").rmdir()
+    assert restore_previous_report(tmp_path / "rp") == tmp_path / "rp"
+    assert (tmp_path / "rp" / REPORT_MARKER).read_text() == "x"
+    assert sorted(p.name for p in tmp_path.iterdir()) == [".rp.backup.old", "rp"]

@@ -10,7 +10,7 @@ import sys
 
 from .. import interrupt
 from ..interrupt import untouched
-from ..report.render import folder_identity, format_cell
+from ..report.render import folder_identity, format_cell, restore_previous_report
 from ..report.table import (
     ALIGNMENT_COLUMN,
     CALIBRATED_BAND_COLUMN,
@@ -104,6 +104,9 @@ def run(args: argparse.Namespace) -> int:
     from ..specimen import load_specimen
 
     specimen = load_specimen(args.specimen) if args.specimen is not None else None
+    # a hidden earlier report back first (a killed write's): else the identity below would
+    # call the restored folder this run's report after a Ctrl-C
+    restore_previous_report(args.out)
     before = folder_identity(args.out)
     # a commit puts a new store file in place (copy, then rename): its identity says after a
     # Ctrl-C whether the analyses of FILES were saved

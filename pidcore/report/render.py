@@ -18,7 +18,6 @@ import html
 import math
 import os
 import shutil
-import tempfile
 import textwrap
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from pathlib import Path
@@ -26,7 +25,12 @@ from pathlib import Path
 import pandas as pd
 
 from .. import defaults, interrupt
-from ..atomic_files import fsync_tree, new_temporary_folder_for
+from ..atomic_files import (
+    fsync_tree,
+    new_temporary_folder_for,
+    replace_folder,
+    restore_previous_folder,
+)
 from ..constants import REPORT_FORMATS
 from ..errors import ParameterError
 from ..io import display_path
@@ -328,18 +332,15 @@ def _not_written_by_a_report(out_dir: Path) -> str:
 
 
 def _move_into_place(tmp: Path, out_dir: Path) -> None:
-    if not out_dir.exists():
-        os.replace(tmp, out_dir)
-        return
-    old = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.", suffix=".old", dir=out_dir.parent))
-    old.rmdir()
-    os.replace(out_dir, old)
-    try:
-        os.replace(tmp, out_dir)
-    except BaseException:
-        os.replace(old, out_dir)
-        raise
-    shutil.rmtree(old, ignore_errors=True)
+    replace_folder(tmp, out_dir)
+
+
+def restore_previous_report(out_dir: str | Path) -> Path | None:
+    """Where ``out_dir`` is missing, put back the earlier report a write killed between its
+    two renames (SIGKILL, a power loss) left hidden beside it (``.<name>.<16 hex>.old``);
+    returns the folder restored, None if none was. :func:`write_report` calls it first."""
+    return restore_previous_folder(
+        out_dir, is_previous=lambda folder: (folder / REPORT_MARKER).is_file())
 
 
 def write_report(table: pd.DataFrame, figures: Mapping[str, object], provenance: Provenance,
@@ -377,6 +378,7 @@ def write_report(table: pd.DataFrame, figures: Mapping[str, object], provenance:
     """
     formats = parse_formats(formats)
     out_dir = Path(out_dir)
+    restore_previous_report(out_dir)  # before the check: a hidden report is the earlier one
     check_out_dir(out_dir)
     out_dir.parent.mkdir(parents=True, exist_ok=True)
     tmp = new_temporary_folder_for(out_dir)
