@@ -394,3 +394,40 @@ def test_ctrl_c_while_the_cli_loads_exits_130_with_one_line(tmp_path):
     assert done.returncode == 130, done.stderr
     assert done.stderr.splitlines() == ["pidcore dem: interrupted; nothing was done"]
     assert not store.exists()
+
+
+def test_ctrl_c_while_the_installed_pidcore_script_loads_exits_130_with_one_line(tmp_path):
+    # The installed `pidcore` script (pyproject's [project.scripts]) imported pidcore.cli
+    # itself, before any guard: a Ctrl-C in its first ~0.2 s ended in a traceback and status
+    # -2, while `python -m pidcore` said one line and exited 130. The probe does what the
+    # script pip writes does (import the entry's module, call its function), with the
+    # interrupt raised by an import hook where the CLI loads, as in the test above.
+    import json
+    import tomllib
+
+    scripts = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))[
+        "project"]["scripts"]
+    module, function = scripts["pidcore"].split(":")
+    probe = (
+        "import sys\n"
+        "class Interrupt:\n"
+        "    def find_spec(self, name, path=None, target=None):\n"
+        "        if name == 'pidcore.errors':\n"
+        "            raise KeyboardInterrupt\n"
+        "sys.meta_path.insert(0, Interrupt())\n"
+        "sys.argv = ['pidcore', 'dem', 'sweep', '--store', sys.argv[1]]\n"
+        f"from {module} import {function}\n"
+        f"sys.exit({function}())\n")
+    store = tmp_path / "s.h5"
+    done = subprocess.run([sys.executable, "-c", probe, str(store)], capture_output=True,
+                          text=True, env={**os.environ, "PYTHONPATH": str(ROOT)}, timeout=120)
+    assert done.returncode == 130, done.stderr
+    assert done.stderr.splitlines() == ["pidcore dem: interrupted; nothing was done"]
+    assert not store.exists()
+    # the guard only helps if the entry's module loads nothing of pidcore's before it
+    loaded = subprocess.run(
+        [sys.executable, "-c", f"import json, sys, {module}\n"
+         "print(json.dumps(sorted(m for m in sys.modules if m.split('.')[0] == 'pidcore')))"],
+        capture_output=True, text=True, env={**os.environ, "PYTHONPATH": str(ROOT)},
+        timeout=120, check=True)
+    assert json.loads(loaded.stdout) == sorted({"pidcore", module})
