@@ -178,7 +178,8 @@ def test_result_frames_hold_the_results_arrays():
     calibration = _calibration()
     frame = calibration.to_pandas()
     assert len(frame) == len(calibration.predictions)
-    np.testing.assert_array_equal(frame["high95 [-]"], [p.high95 for p in calibration.predictions])
+    np.testing.assert_array_equal(frame["calibrated high 95 % [-]"],
+                                  [p.high95 for p in calibration.predictions])
     report = _report_result()
     assert report.to_pandas() is report.table
 

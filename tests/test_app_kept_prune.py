@@ -380,3 +380,46 @@ def test_a_calibration_starting_while_a_listing_looks_at_its_file_still_holds_it
     assert {f.sha256: f.left_because for f in found.files}[unused] == (
         "in use by the app now (a calibration of it runs)")
     assert (folder / f"{unused}.toml").is_file()
+
+
+def test_a_store_no_app_ran_on_gets_no_job_table_lock_file(tmp_path, capsys):
+    # --remove took the job table's lock by creating <store>.jobs.json.lock beside a store on
+    # which no app ever ran (no journal, no lock file): a file left behind by a command that
+    # says it only reads the store. No job can wait there: a runner makes the lock file
+    # before it writes the journal, and queues a job only in that step.
+    store_path = tmp_path / "app.h5"
+    folder = kept_specimens_folder(store_path)
+    kept, _ = keep_specimen(folder, "mine.toml", _variant("mine"))
+    Store(store_path).add_dem_run("other", {"sdc": 0.1})
+    _age(folder.iterdir(), hours=48)
+    store_before = _digest(store_path)
+    beside = sorted(p.name for p in tmp_path.iterdir())
+    assert beside == ["app.h5", "app.h5.specimens"]
+    assert main(["specimen", "kept", "--store", str(store_path)]) == 0
+    assert f"{kept.sha256}  mine.toml" in capsys.readouterr().out
+    assert sorted(p.name for p in tmp_path.iterdir()) == beside
+    assert main(["specimen", "kept", "--store", str(store_path), "--remove", "--json"]) == 0
+    document = json.loads(capsys.readouterr().out)
+    assert [f["sha256"] for f in document["files"]] == [kept.sha256]
+    assert document["removed"] is True and list(folder.iterdir()) == []  # removed, unused
+    assert sorted(p.name for p in tmp_path.iterdir()) == beside  # no new file beside it
+    assert _digest(store_path) == store_before
+    # a submission under way (the lock file made, the journal not yet written): the
+    # removal still waits for its lock
+    import threading
+
+    kept, _ = keep_specimen(folder, "mine.toml", _variant("mine"))
+    _age(folder.iterdir(), hours=48)
+    fd = _hold_journal_lock(store_path)
+    removal = threading.Thread(target=prune_kept_specimens, args=(store_path,),
+                               kwargs={"remove": True})
+    try:
+        removal.start()
+        removal.join(0.5)
+        waited = removal.is_alive()
+        still_there = (folder / f"{kept.sha256}.toml").is_file()
+    finally:
+        os.close(fd)
+        removal.join(30)
+    assert waited and still_there, "the removal did not wait for the job table's lock"
+    assert not (folder / f"{kept.sha256}.toml").exists()  # removed once the lock was free

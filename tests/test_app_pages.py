@@ -2229,7 +2229,8 @@ def test_a_saved_calibration_is_drawn_with_its_uninformative_band_marked(store_f
     assert len(drawn) == 1
     want = {"cal_00000000000000a1": ([0.5678], ["uninformative"]),
             "cal_00000000000000b2": ([0.3456], ["yes"])}[shown]
-    assert (drawn[0]["sdc predicted [-]"].tolist(), drawn[0][VERDICT_COLUMN].tolist()) == want
+    assert (drawn[0]["SDC calibrated DEM (Eq. 11) [-]"].tolist(),
+            drawn[0][VERDICT_COLUMN].tolist()) == want
     assert "uninformative" in SAVED_FIGURE_CAPTION and "hollow" in SAVED_FIGURE_CAPTION
     assert pngs[0].startswith(b"\x89PNG\r\n\x1a\n")  # the image sent is a drawn PNG
     # the other one chosen: its own figure

@@ -842,3 +842,52 @@ def test_the_terminal_table_names_the_measured_sdcs_as_report_csv_and_the_pdf_do
         assert name in pdf_heads and name in report_display(table).columns
         assert name in terminal_head
     assert "(Eq. 10)" not in terminal_head
+
+
+def _drawn_points(ax) -> tuple[list, list]:
+    """Every marker and every error-bar segment a calibration figure holds, in drawing order."""
+    lines = [(line.get_label(), np.asarray(line.get_xydata()).tolist()) for line in ax.get_lines()]
+    bars = [[np.asarray(s).tolist() for s in c.get_segments()] for c in ax.collections]
+    return lines, bars
+
+
+def test_calibration_frame_names_the_prediction_and_band_as_the_report(calibration_file):
+    # Calibration.to_pandas() said "sdc predicted [-]", "low95 [-]", "high95 [-]" where the
+    # report's table says "SDC calibrated DEM (Eq. 11) [-]" and "calibrated low/high 95 % [-]"
+    # for the same numbers: a script joining the two had to know both spellings.
+    import matplotlib.pyplot as plt
+
+    from pidcore.calibrate import CALIBRATION_COLUMNS_RENAMED
+    from pidcore.compare.align import CALIBRATED_COLUMN as ALIGN_CALIBRATED_COLUMN
+    from pidcore.report.figures_results import plot_calibration
+
+    assert (CALIBRATED_COLUMN, CALIBRATED_LOW_COLUMN, CALIBRATED_HIGH_COLUMN) == (
+        "SDC calibrated DEM (Eq. 11) [-]", "calibrated low 95 % [-]", "calibrated high 95 % [-]")
+    assert ALIGN_CALIBRATED_COLUMN is CALIBRATED_COLUMN  # one definition, imported
+    calibration = load_calibration(calibration_file)
+    frame = calibration.to_pandas()
+    band = [CALIBRATED_COLUMN, CALIBRATED_LOW_COLUMN, CALIBRATED_HIGH_COLUMN]
+    assert not {"sdc predicted [-]", "low95 [-]", "high95 [-]"} & set(frame.columns)
+    # the numbers of the file, exactly, under the report's names
+    assert frame[band].to_numpy().tolist() == [[0.24, 0.05, 0.43], [0.49, 0.12, 0.88],
+                                               [0.09, 0.02, 0.20]]
+    # the report's rows of the same load cases carry the same numbers under the same names
+    report = add_calibration_columns(_table(), calibration)
+    assert report.loc[:1, band].to_numpy().tolist() == frame.loc[:1, band].to_numpy().tolist()
+    # an older frame reads into today's and plots the same points, exactly
+    older = frame.rename(columns={new: old for old, new in CALIBRATION_COLUMNS_RENAMED.items()})
+    assert {"sdc predicted [-]", "low95 [-]", "high95 [-]"} <= set(older.columns)
+    pd.testing.assert_frame_equal(older.rename(columns=CALIBRATION_COLUMNS_RENAMED), frame)
+    drawn = []
+    for each in (frame, older):
+        _, ax = plt.subplots()
+        try:
+            drawn.append(_drawn_points(plot_calibration(each, ax=ax)))
+        finally:
+            plt.close("all")
+    assert drawn[0] == drawn[1]
+    (points, *_), (bars,) = drawn[0]
+    assert points[1] == [[0.0, 0.24], [1.0, 0.49], [2.0, 0.09]]  # the predictions, drawn
+    # the bars end where the file's bands do (to rounding: errorbar adds pred - low back)
+    assert np.allclose([[a[1], b[1]] for a, b in bars], [[0.05, 0.43], [0.12, 0.88], [0.02, 0.2]],
+                       rtol=0, atol=1e-12)

@@ -784,11 +784,18 @@ def journal_lock_path(store_path: str | Path) -> Path:
 
 @contextlib.contextmanager
 def exclusive_journal_lock(store_path: str | Path, *,
-                           wait_s: float = JOURNAL_LOCK_WAIT_S) -> Iterator[None]:
+                           wait_s: float = JOURNAL_LOCK_WAIT_S,
+                           only_where_used: bool = False) -> Iterator[None]:
     """Hold the lock a runner holds from reading the journal to writing it (a submission,
     a job's change of state), for a reader whose decision must not meet a job queued
     meanwhile (``pidcore specimen kept --remove``). Where the folder has no locks (a file
     system without them, Windows) nothing is excluded.
+
+    ``only_where_used``: where neither the journal nor its lock file exists, no app ever
+    queued a job on this store (a runner creates the lock file before it writes the journal,
+    and a job is queued only in the step that writes it), so nothing is locked and no lock
+    file is left beside a store no app ran on. A submission that creates them after this
+    look is one made after the reader's decision, as one that waited for the lock would be.
 
     Raises
     ------
@@ -797,6 +804,9 @@ def exclusive_journal_lock(store_path: str | Path, *,
         file cannot be made: one line naming it.
     """
     lock_path = journal_lock_path(store_path)
+    if only_where_used and not lock_path.exists() and not journal_path(store_path).exists():
+        yield
+        return
     try:
         fd = os.open(lock_path, os.O_RDWR | os.O_CREAT, 0o644)
     except OSError as exc:

@@ -497,7 +497,7 @@ def prune_kept_specimens(store_path: str | os.PathLike, *, remove: bool = False,
     # the writers' own locks, in the order a worker saving a run takes them (the store's,
     # then the job table's), so that none of them changes what needs a file in between
     with exclusive_lock(Path(store_path), timeout_s=STORE_LOCK_TIMEOUT_S), \
-            exclusive_journal_lock(store_path), \
+            exclusive_journal_lock(store_path, only_where_used=True), \
             _folder_locked(folder, exclusive=True) as held:
         if not held and fcntl is not None:
             raise StoreError(f"{folder}: could not take its lock within "

@@ -18,6 +18,9 @@ import pandas as pd
 
 from .. import defaults
 from ..compare.align import (  # noqa: F401 (public here)
+    CALIBRATED_COLUMN,
+    CALIBRATED_HIGH_COLUMN,
+    CALIBRATED_LOW_COLUMN,
     MEASURED_EQ11_COLUMN,
     MEASURED_EQ11_DOF_COLUMN,
     MEASURED_EQ11_STDERR_COLUMN,
@@ -34,16 +37,22 @@ from ..loadcase import LoadCase
 if TYPE_CHECKING:  # pragma: no cover
     from ..specimen import Specimen
 
-#: :meth:`Calibration.to_pandas`'s measured Eq. 11 columns as pidcore before 2026-12 named
-#: them -> the names every other table gives that quantity (:data:`pidcore.compare.align.
-#: MEASURED_COLUMNS_RENAMED`): it was a third spelling, "sdc measured [-]" beside the report's
-#: "SDC measured (Eq. 11) [-]". An older saved frame reads as today's with
+#: :meth:`Calibration.to_pandas`'s measured Eq. 11 columns, calibrated prediction and band as
+#: pidcore before 2026-12 named them -> the names every other table gives those quantities
+#: (:data:`pidcore.compare.align.MEASURED_COLUMNS_RENAMED`, :data:`pidcore.compare.align.
+#: CALIBRATED_COLUMN`): it was a third spelling, "sdc measured [-]" beside the report's
+#: "SDC measured (Eq. 11) [-]", and "sdc predicted [-]", "low95 [-]", "high95 [-]" beside the
+#: report's "SDC calibrated DEM (Eq. 11) [-]" and its band. An older saved frame reads as
+#: today's with
 #: ``frame.rename(columns=CALIBRATION_COLUMNS_RENAMED)`` (as :func:`pidcore.report.
 #: figures_results.plot_calibration` does).
 CALIBRATION_COLUMNS_RENAMED: dict[str, str] = {
     "sdc measured [-]": MEASURED_EQ11_COLUMN,
     "sdc measured stderr [-]": MEASURED_EQ11_STDERR_COLUMN,
     "sdc measured stderr dof [-]": MEASURED_EQ11_DOF_COLUMN,
+    "sdc predicted [-]": CALIBRATED_COLUMN,
+    "low95 [-]": CALIBRATED_LOW_COLUMN,
+    "high95 [-]": CALIBRATED_HIGH_COLUMN,
 }
 
 _REQUIRED = ("frequency_hz", "acceleration_g", "fill_percent", "predicted", "low95", "high95")
@@ -358,8 +367,10 @@ class Calibration:
         """The predictions, one row per calibrated load case, each column naming its unit.
 
         Columns ``frequency [Hz]``, ``acceleration [g]``, ``fill [%]``, ``material``,
-        ``direction``, ``sdc predicted [-]``, ``low95 [-]``, ``high95 [-]`` (the band of a
-        measurement with the fitted point's standard error), ``SDC measured (Eq. 11) [-]``,
+        ``direction``, ``SDC calibrated DEM (Eq. 11) [-]``, ``calibrated low 95 % [-]``,
+        ``calibrated high 95 % [-]`` (the band of a measurement with the fitted point's
+        standard error; the report's names, :data:`~pidcore.compare.align.CALIBRATED_COLUMN`),
+        ``SDC measured (Eq. 11) [-]``,
         ``SDC measured (Eq. 11) stderr [-]``, ``low95 without stderr [-]``,
         ``high95 without stderr [-]``, ``SDC measured (Eq. 11) stderr dof [-]`` (the names of
         :mod:`pidcore.compare.align`; :data:`CALIBRATION_COLUMNS_RENAMED` renames an older
@@ -384,9 +395,9 @@ class Calibration:
             "fill [%]": p.load_case.fill_percent,
             "material": p.load_case.material,
             "direction": p.load_case.direction,
-            "sdc predicted [-]": p.sdc,
-            "low95 [-]": p.low95,
-            "high95 [-]": p.high95,
+            CALIBRATED_COLUMN: p.sdc,
+            CALIBRATED_LOW_COLUMN: p.low95,
+            CALIBRATED_HIGH_COLUMN: p.high95,
             MEASURED_EQ11_COLUMN: p.measured,
             MEASURED_EQ11_STDERR_COLUMN: p.measured_stderr,
             "low95 without stderr [-]": p.low95_without_stderr,

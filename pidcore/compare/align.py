@@ -60,6 +60,15 @@ MEASURED_COLUMNS_RENAMED: dict[str, str] = {
     "SDC measured stderr [-]": MEASURED_EQ11_STDERR_COLUMN,
     "SDC measured stderr dof [-]": MEASURED_EQ11_DOF_COLUMN,
 }
+#: The calibrated DEM's Eq. 11 SDC and its 95 % band (a measurement's, with its standard error),
+#: as every table of pidcore names them: the report's columns
+#: (:func:`pidcore.report.table.add_calibration_columns`) and
+#: :meth:`pidcore.calibrate.Calibration.to_pandas`, which said "sdc predicted [-]",
+#: "low95 [-]" and "high95 [-]" before 2026-12
+#: (:data:`pidcore.calibrate.CALIBRATION_COLUMNS_RENAMED`).
+CALIBRATED_COLUMN = "SDC calibrated DEM (Eq. 11) [-]"
+CALIBRATED_LOW_COLUMN = "calibrated low 95 % [-]"
+CALIBRATED_HIGH_COLUMN = "calibrated high 95 % [-]"
 #: The paper's particles and drive direction (Sect. 4): Table 3 applies to these only.
 PAPER_MATERIAL = "acrylic"
 PAPER_DIRECTION = "z"

@@ -124,7 +124,12 @@ def plot_calibration(frame: pd.DataFrame, *, ax: Any = None) -> Any:
 
     from ..calibrate.outputs import draw_bands, draw_cut_bounds
     from ..calibrate.prediction import CALIBRATION_COLUMNS_RENAMED, VERDICT_COLUMN
-    from ..compare.align import MEASURED_EQ11_COLUMN
+    from ..compare.align import (
+        CALIBRATED_COLUMN,
+        CALIBRATED_HIGH_COLUMN,
+        CALIBRATED_LOW_COLUMN,
+        MEASURED_EQ11_COLUMN,
+    )
     from ..compare.plausibility import SDC_UPPER_BOUND
 
     frame = frame.rename(columns=CALIBRATION_COLUMNS_RENAMED)  # a frame saved before 2026-12
@@ -133,8 +138,8 @@ def plot_calibration(frame: pd.DataFrame, *, ax: Any = None) -> Any:
     x = np.arange(len(frame))
     bounds = frame.get("sdc bound [-]", pd.Series(SDC_UPPER_BOUND, index=frame.index))
     verdicts = frame.get(VERDICT_COLUMN, pd.Series("", index=frame.index))
-    draw_cut_bounds(ax, draw_bands(ax, x, frame["sdc predicted [-]"], frame["low95 [-]"],
-                                   frame["high95 [-]"], bounds, verdicts,
+    draw_cut_bounds(ax, draw_bands(ax, x, frame[CALIBRATED_COLUMN], frame[CALIBRATED_LOW_COLUMN],
+                                   frame[CALIBRATED_HIGH_COLUMN], bounds, verdicts,
                                    label="calibrated DEM", color="C0"))
     ax.plot(x, frame[MEASURED_EQ11_COLUMN].to_numpy(float), "x", color="k", label="measured")
     ax.set_xticks(x)

@@ -28,6 +28,9 @@ import pandas as pd
 from .. import defaults
 from ..compare.align import (
     ALIGNMENT_STATUSES,
+    CALIBRATED_COLUMN,
+    CALIBRATED_HIGH_COLUMN,
+    CALIBRATED_LOW_COLUMN,
     MEASURED_COLUMNS_RENAMED,
     MEASURED_EQ11_COLUMN,
     MEASURED_EQ11_DOF_COLUMN,
@@ -641,9 +644,8 @@ def _sort_like_table3(table: pd.DataFrame, aligner: Aligner, paper: pd.DataFrame
 IMPLAUSIBLE_ROW_NOTE = "includes a result no passive coupon gives, kept as accepted: "
 
 #: Columns added by :func:`add_calibration_columns` (after :data:`MEASURED_EQ11_COLUMN`).
-CALIBRATED_COLUMN = "SDC calibrated DEM (Eq. 11) [-]"
-CALIBRATED_LOW_COLUMN = "calibrated low 95 % [-]"
-CALIBRATED_HIGH_COLUMN = "calibrated high 95 % [-]"
+#: (:data:`pidcore.compare.align.CALIBRATED_COLUMN` and its band, defined there for every
+#: table of pidcore, :meth:`pidcore.calibrate.Calibration.to_pandas` included.)
 #: The verdicts of :data:`pidcore.constants.BandVerdict`: ``not compared`` rather than ``n/a``
 #: (pandas.read_csv would read ``n/a`` back as NaN); ``uninformative`` where the band spans
 #: every plausible SDC (:meth:`~pidcore.calibrate.prediction.CalibratedPrediction.
