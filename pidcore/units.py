@@ -379,6 +379,54 @@ def display_number(value: float | None, *, decimals: int = 4, missing: str = "�
     return f"{value:.3g}"
 
 
+def value_and_error_texts(value: float, stderr: float, *, max_digits: int = 4,
+                          missing: str = "—") -> tuple[str, str]:
+    """``value`` and its standard error ``stderr`` as every page and the terminal write them
+    (GUM 7.2.6): the error with two significant digits, the value rounded at the error's last
+    digit, with two to ``max_digits`` significant digits (a noise-free record's error of 1e-14
+    asked for fifteen); the error's text ``""`` where it is unknown (NaN), ``"0"`` where zero;
+    ``(missing, "")`` for a value that is not a number. The app showed 0.2100 ± 0.0100 and
+    0.0123 ± 0.0006 (four decimals) where ``pidcore analyze`` wrote 0.21 and 0.012340
+    beside 0.01 and 0.00056.
+
+    >>> value_and_error_texts(0.01234, 0.00056), value_and_error_texts(4.09, 0.2)
+    (('0.01234', '0.00056'), ('4.09', '0.20'))
+    >>> value_and_error_texts(0.25, 1.1e-14), value_and_error_texts(5.09e-5, 4.4e-5)
+    (('0.2500', '1.1e-14'), ('5.1e-05', '4.4e-05'))
+    """
+    if value is None or not math.isfinite(value):
+        return missing, ""
+    if stderr is None or not math.isfinite(stderr):
+        return f"{value:.{max_digits}g}", ""
+    if stderr == 0:
+        error_text, place = "0", -math.inf
+    else:
+        error = float(f"{abs(stderr):.2g}")  # rounded first: 0.0996 is shown as 0.10
+        place = math.floor(math.log10(error)) - 1  # of the error's last digit shown
+        error_text = f"{error:.0f}" if place >= 0 else f"{error:.{-place}f}"
+        if error < 1e-4:  # as Python's g writes it: no run of zeros to count
+            error_text = f"{error:.1e}"
+    if value == 0:
+        return (f"{0:.{-place}f}" if 0 > place > -math.inf else "0"), error_text
+    top = math.floor(math.log10(abs(value)))
+    digits = int(min(max(top - place + 1, 2), max_digits))
+    if abs(round(value, digits - 1 - top)) >= 10.0 ** (top + 1):  # 0.0996 rounds to 0.100
+        top += 1
+        digits = int(min(max(top - place + 1, 2), max_digits))
+    if top >= digits - 1:  # 1230, not an exponent, for a value above its shown digits
+        return f"{round(value, digits - 1 - top):.0f}", error_text
+    if abs(value) < 1e-4 and value != 0:
+        return f"{value:.{digits - 1}e}", error_text
+    return f"{value:.{digits - 1 - top}f}", error_text
+
+
+def display_value_with_error(value: float, stderr: float, *, missing: str = "—") -> str:
+    """``"value ± error"`` by :func:`value_and_error_texts` (``"0.01234 ± 0.00056"``,
+    ``"4.09 ± 0.20"``); the value alone where its error is unknown."""
+    value_text, error_text = value_and_error_texts(value, stderr, missing=missing)
+    return f"{value_text} ± {error_text}" if error_text else value_text
+
+
 def display_sigmas(multiple: float) -> str:
     """A multiple of sigma as a verdict states it: three significant digits, without an
     exponent or a trailing ``.0`` (``"4874.0 σ"`` read as a measured, exact count).

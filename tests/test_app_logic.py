@@ -1938,7 +1938,8 @@ def test_the_sample_rate_hint_names_the_apps_option():
     (0.1856, 0.0042, "0.1856 ± 0.0042"),  # the usual look is kept
     (0.0231, 0.0010, "0.0231 ± 0.0010"),
     (1.5702e-4, float("nan"), "0.000157"),  # the paper's 50 Hz, 1 g, 25 % DEM value
-    (5.09e-5, 4.4e-5, "5.09e-05 ± 4.4e-05"),  # a mass without damping, within noise
+    # a mass without damping, within noise: rounded at the error's last digit
+    (5.09e-5, 4.4e-5, "5.1e-05 ± 4.4e-05"),
     (0.25, 1.1e-14, "0.2500 ± 1.1e-14"),  # a noise-free record's round-off error
 ])
 def test_sdc_shown_on_the_pages_keeps_its_digits(sdc, stderr, shown):

@@ -584,3 +584,33 @@ def test_unused_channels_are_dropped_only_where_no_measurement_is_saved(tmp_path
     (key,) = Store(store_path).list_measurements()["key"]
     assert Store(store_path).get_measurement(key).channel_names == ["Force", "Mic", "Velocity",
                                                                     "Volt"]
+
+
+@pytest.mark.parametrize(("sdc", "stderr", "shown"), [
+    (0.01234, 0.00056, "0.01234 ± 0.00056"),  # the app wrote 0.0123 ± 0.0006
+    (4.09, 0.2, "4.09 ± 0.20"),  # the app wrote 4.0900 ± 0.2000, analyze 4.09000 and 0.2
+    (0.21, 0.01, "0.210 ± 0.010"),  # the app wrote 0.2100 ± 0.0100
+])
+def test_analyze_table_and_app_write_one_sdc_with_its_error(tmp_path, sdc, stderr, shown):
+    """One record's SDC ± stderr read the same in the terminal and the app (GUM 7.2.6: the
+    error with two significant digits, the value rounded at its last digit): ``analyze``
+    wrote 6 significant digits beside a 2-digit error, the Analyse and Compare pages and the
+    case sheet four decimals of each."""
+    from dataclasses import replace
+    from types import SimpleNamespace
+
+    from pidcore.app import workbench
+    from pidcore.app.uploads import format_sdc
+    from pidcore.cli.analyze import format_table
+    from pidcore.measure import analyze_file
+
+    record = analyze_file(export(tmp_path / "one.csv", fmt="csv"))
+    record = replace(record, analysis=replace(record.analysis, sdc=sdc, sdc_stderr=stderr))
+    table = format_table([record])
+    cells = _table_cells(table, ("SDC [-]", "± SE [-]"))
+    assert f"{cells['SDC [-]']} ± {cells['± SE [-]']}" == shown
+    assert format_sdc(sdc, stderr) == shown
+    # the fields the Compare heading reads of a pidcore.compare.case.Headline
+    head = SimpleNamespace(measured=sdc, measured_stderr=stderr, measured_kind="Eq. 10",
+                           dem=sdc, dem_stderr=stderr, verdict="v")
+    assert workbench.headline_heading(head) == f"measured (Eq. 10) {shown} vs our DEM {shown} — v"

@@ -187,3 +187,18 @@ def test_batch_means_agree_to_rounding_only():
     assert not batch_means_agree(np.array([0.3, 0.3 * (1 + 1e-8)]))  # above rounding: scatter
     assert batch_means_agree(np.array([0.3, 0.3 * (1 + 1e-12)]))  # rounding of the tally
     assert batch_means_agree(np.zeros(4))  # nothing dissipated: no scatter either
+
+
+@pytest.mark.parametrize(("sdc", "stderr", "shown"), [
+    (0.01234, 0.00056, "0.01234 ± 0.00056"), (4.09, 0.2, "4.09 ± 0.20")])
+def test_summary_writes_the_sdc_with_its_error_as_the_app_does(sdc, stderr, shown):
+    """``dem run`` printed 4.09 +- 0.2 where the app's Compare heading showed the same run's
+    SDC by its own rule: one rule (:func:`pidcore.units.display_value_with_error`)."""
+    from dataclasses import replace
+
+    from pidcore.app.uploads import format_sdc
+
+    result = replace(_from_tally(SDC_PER_CYCLE[None, :], transient=4, block_cycles=2),
+                     sdc=sdc, sdc_stderr=stderr)
+    assert f"SDC             {shown} [-] (loss factor" in format_summary(result)
+    assert format_sdc(sdc, stderr) == shown

@@ -34,7 +34,7 @@ from ..compare.loadcase import (
 from ..compare.settings_columns import setting_phrase
 from ..constants import PARTICLE_MATERIALS
 from ..errors import InputFileError, ParameterError, PidcoreError
-from ..units import display_number
+from ..units import display_value_with_error
 from .vocabulary import page_terms
 
 if TYPE_CHECKING:
@@ -960,12 +960,10 @@ def results_table(files: Sequence[AnalysedFile]) -> pd.DataFrame:
 
 
 def format_sdc(sdc: float, stderr: float) -> str:
-    """SDC with its standard error as shown, e.g. ``'0.1856 ± 0.0042'``, ``'5.09e-05 ±
-    4.4e-05'`` (:func:`pidcore.units.display_number`); ``'—'`` for none."""
-    if not math.isfinite(sdc):
-        return "—"
-    shown = display_number(sdc)
-    return f"{shown} ± {display_number(stderr)}" if math.isfinite(stderr) else shown
+    """SDC with its standard error as shown, e.g. ``'0.1856 ± 0.0042'``, ``'5.1e-05 ±
+    4.4e-05'``, as ``pidcore analyze`` writes it (:func:`pidcore.units.
+    display_value_with_error`); ``'—'`` for none."""
+    return display_value_with_error(sdc, stderr)
 
 
 @dataclass(frozen=True)

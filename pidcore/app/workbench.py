@@ -291,9 +291,9 @@ def paper_details(comparison: CaseComparison, specimen: str) -> tuple[dict[str, 
     coupon (``specimen``, the name its tests are saved under) gets no metrics, only the
     caption: Table 3 is not compared for it ("SDC paper DEM: none" read as if the paper had
     no value at a case it tabulates for its own coupon)."""
+    from ..calibrate.prediction import sdc_text
     from ..compare.specimens import NOT_PAPER_SPECIMEN_NOTE
     from ..specimen import is_paper_coupon
-    from ..units import display_number
 
     # by name: a test of another file of the coupon's name is saved as "paper_coupon
     # [45d792]" (measured_specimen_name), which is not the paper's
@@ -302,7 +302,8 @@ def paper_details(comparison: CaseComparison, specimen: str) -> tuple[dict[str, 
                     + " (it tabulates the paper's coupon)")
     aligned = comparison.aligned
     values = (aligned.sdc_paper_dem, aligned.sdc_paper_experimental)
-    metrics = {label: display_number(v, missing="none")
+    # an SDC alone reads as the report's cells and Compare's DEM metric write it
+    metrics = {label: sdc_text(v) if math.isfinite(v) else "none"
                for label, v in zip(("SDC paper DEM [-]", "SDC paper measured [-]"), values,
                                    strict=True)}
     caption = ("" if all(math.isfinite(v) for v in values) else

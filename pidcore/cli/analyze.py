@@ -13,6 +13,7 @@ from ..file_settings import analyze_each
 from ..interrupt import untouched
 from ..io import display_path
 from ..measure import NO_LOAD_CASE
+from ..units import value_and_error_texts
 from ._options import (
     add_json_option,
     add_load_case_options,
@@ -224,10 +225,12 @@ def format_table(results: list) -> str:
     lines = [header, "-" * len(header)]
     for r, name in zip(results, names, strict=True):
         a = r.analysis
+        # as the app shows it (pidcore.app.uploads.format_sdc): one SDC, one text
+        sdc_shown, stderr_shown = value_and_error_texts(a.sdc, a.sdc_stderr, missing="n/a")
         lines.append(f"{name:<{width}} {a.frequency_hz:14.4f} "
                      f"{_significant(a.acceleration_g, 5):>10} "
-                     f"{_significant(a.loss_factor, 6):>15} {_significant(a.sdc, 6):>12} "
-                     f"{_significant(a.sdc_stderr, 2, keep_zeros=False):>9} "
+                     f"{_significant(a.loss_factor, 6):>15} {sdc_shown:>12} "
+                     f"{stderr_shown or 'n/a':>9} "
                      f"{_significant(a.damping_ratio, 4):>10} {a.energy_per_cycle_j:12.4e}")
         lines += [f"    note: {cli_words(note)}" for note in r.notes]
     return "\n".join(lines)

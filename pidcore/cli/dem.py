@@ -458,6 +458,7 @@ def format_summary(result, *, reused: bool = False) -> str:
     """Readable multi-line summary with units."""
     from ..dem.result import stderr_from_batches
     from ..specimen import hashed_name
+    from ..units import display_value_with_error
 
     c = result.case
     s = result.specimen
@@ -479,7 +480,9 @@ def format_summary(result, *, reused: bool = False) -> str:
             f"{s.coupon.fixture_mass_kg * 1e3:.4g} g + particles {particles * 1e3:.4g} g",
         ]
     lines += [
-        (f"SDC             {result.sdc:.4g} +- {result.sdc_stderr:.2g} [-] (loss factor "
+        # as analyze and the app write an SDC with its error (it printed 0.2635 +- 0.0038)
+        (f"SDC             {display_value_with_error(result.sdc, result.sdc_stderr)} [-] "
+         f"(loss factor "
          f"{result.loss_factor:.4g} [-]) over {result.cells_simulated} "
          f"{'cell' if result.cells_simulated == 1 else 'cells'}"
          # the error of cells that ran one motion is from batches of it, not the cells

@@ -12,7 +12,7 @@ import math
 
 import pandas as pd
 
-from ..units import display_number
+from ..units import display_value_with_error
 
 #: Page size of the sheet, inches (A4 landscape).
 PAGE_IN = (11.69, 8.27)
@@ -57,11 +57,12 @@ def case_pdf(view: dict, *, title: str) -> bytes:
         fig = Figure(figsize=PAGE_IN, layout="constrained")
         top, bottom = fig.subfigures(2, 1, height_ratios=[1, 3])
         # without a DEM value the verdict says so and why ("vs our DEM none" read as a number)
-        dem = (f"  vs  our DEM {display_number(head.dem)} ± {display_number(head.dem_stderr)}"
+        dem = (f"  vs  our DEM {display_value_with_error(head.dem, head.dem_stderr)}"
                if math.isfinite(head.dem) else "")
         lines = [title,
-                 f"measured SDC ({head.measured_kind}) {display_number(head.measured)} ± "
-                 f"{display_number(head.measured_stderr)}{dem}: {head.verdict}",
+                 f"measured SDC ({head.measured_kind}) "
+                 f"{display_value_with_error(head.measured, head.measured_stderr)}{dem}: "
+                 f"{head.verdict}",
                  *([f"  ({head.basis})"] if head.basis else []),
                  f"DEM alignment: {comp.aligned.status}. {comp.aligned.message}"]
         lines += [f"note: {n}" for n in view["notes"]]
