@@ -340,6 +340,15 @@ def test_plot_shows_dissipation_and_wall_force(run_500hz):
     np.testing.assert_array_equal(a0.lines[0].get_ydata(), run_500hz.dissipation_per_cycle_j)
     assert len(a0.lines[0].get_xdata()) == n_cycles
     assert len(a1.lines) == 2 and "[N]" in a1.get_ylabel()
+    # the title writes the SDC with its error as dem run, analyze and the app do
+    from pidcore.units import display_value_with_error
+
+    shown = display_value_with_error(run_500hz.sdc, run_500hz.sdc_stderr)
+    assert f"SDC {shown}," in a0.get_title() and "+-" not in a0.get_title()
+    # a run whose cells all ran one motion keeps no standard error: the SDC alone, no "nan"
+    b0, _ = dataclasses.replace(run_500hz, sdc_stderr=math.nan).plot()
+    assert f"SDC {display_value_with_error(run_500hz.sdc, math.nan)}," in b0.get_title()
+    assert "nan" not in b0.get_title().lower()
     import matplotlib.pyplot as plt
 
     plt.close("all")

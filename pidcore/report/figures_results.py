@@ -28,6 +28,7 @@ import pandas as pd
 
 from .. import defaults
 from ..errors import ParameterError
+from ..units import display_value_with_error
 
 if TYPE_CHECKING:  # pragma: no cover
     from ..dem.result import DemResult
@@ -105,8 +106,10 @@ def plot_dem_run(result: DemResult, *, ax: Any = None) -> Any:
     a1.set_xlabel("time [s]")
     a1.set_ylabel("force [N]")
     a1.legend()
-    a0.set_title(f"{result.case.key}: SDC {result.sdc:.4g} +- {result.sdc_stderr:.2g}, "
-                 f"{result.particles_per_cell} particles/cell")
+    # the SDC with its error as dem run's summary, analyze and the app write it (it wrote
+    # "+- nan" for a run whose cells all ran one motion and so keep no standard error)
+    a0.set_title(f"{result.case.key}: SDC {display_value_with_error(result.sdc, result.sdc_stderr)}"
+                 f", {result.particles_per_cell} particles/cell")
     return ax
 
 
