@@ -115,23 +115,34 @@ def remove_stale_temporaries(folder: str | os.PathLike[str], is_target: Callable
     (``.<target>.<16 hex>.tmp``, a plain file, no link) are ever removed: a user's
     ``.notes.tmp`` is not one.
     """
-    now = time.time() if now is None else now
+    def named(name: str) -> bool:
+        match = _TEMPORARY_NAME.fullmatch(name)
+        return match is not None and is_target(match["target"])
+
     removed = []
-    for entry in Path(folder).iterdir():
-        match = _TEMPORARY_NAME.fullmatch(entry.name)
-        if match is None or not is_target(match["target"]):
-            continue
-        try:
-            info = entry.lstat()
-        except FileNotFoundError:
-            continue
-        if not stat.S_ISREG(info.st_mode) or now - info.st_mtime < min_age_s:
-            continue
+    for entry in _stale_entries(Path(folder), named, stat.S_ISREG, min_age_s, now):
         with suppress(FileNotFoundError):
             if not dry_run:
                 entry.unlink()
             removed.append(entry)
     return removed
+
+
+def _stale_entries(folder: Path, named: Callable[[str], bool], of_kind: Callable[[int], bool],
+                   min_age_s: float, now: float | None) -> Iterator[Path]:
+    """The entries of ``folder`` whose name ``named`` takes, whose own kind (``lstat``: a
+    link is no file and no folder) ``of_kind`` takes, last changed at least ``min_age_s``
+    before ``now``: the one rule of both clean-ups."""
+    now = time.time() if now is None else now
+    for entry in folder.iterdir():
+        if not named(entry.name):
+            continue
+        try:
+            info = entry.lstat()
+        except FileNotFoundError:
+            continue
+        if of_kind(info.st_mode) and now - info.st_mtime >= min_age_s:
+            yield entry
 
 
 #: Marks a folder :func:`new_temporary_folder_for` builds beside its target
@@ -170,17 +181,9 @@ def remove_stale_temporary_folders(target: str | os.PathLike[str], *, min_age_s:
 
     target = Path(target)
     pattern = temporary_folder_name_pattern(target)
-    now = time.time() if now is None else now
     removed = []
-    for entry in target.parent.iterdir():
-        if pattern.fullmatch(entry.name) is None:
-            continue
-        try:
-            info = entry.lstat()
-        except FileNotFoundError:
-            continue
-        if not stat.S_ISDIR(info.st_mode) or now - info.st_mtime < min_age_s:
-            continue
+    for entry in _stale_entries(target.parent, lambda name: pattern.fullmatch(name) is not None,
+                                stat.S_ISDIR, min_age_s, now):
         if not dry_run:
             # a file in it that cannot be removed leaves the rest for the next write to retry
             shutil.rmtree(entry, ignore_errors=True)
