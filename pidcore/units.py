@@ -379,25 +379,29 @@ def display_number(value: float | None, *, decimals: int = 4, missing: str = "�
     return f"{value:.3g}"
 
 
-def value_and_error_texts(value: float, stderr: float, *, max_digits: int = 4,
+def value_and_error_texts(value: float, stderr: float, *, max_digits: int = 6,
                           missing: str = "—") -> tuple[str, str]:
     """``value`` and its standard error ``stderr`` as every page and the terminal write them
     (GUM 7.2.6): the error with two significant digits, the value rounded at the error's last
     digit, with two to ``max_digits`` significant digits (a noise-free record's error of 1e-14
-    asked for fifteen); the error's text ``""`` where it is unknown (NaN), ``"0"`` where zero;
-    ``(missing, "")`` for a value that is not a number. The app showed 0.2100 ± 0.0100 and
-    0.0123 ± 0.0006 (four decimals) where ``pidcore analyze`` wrote 0.21 and 0.012340
-    beside 0.01 and 0.00056.
+    asked for fifteen; with four at most, 8.16812 ± 0.00030 was shown as 8.168, coarser than
+    its own error); the error's text ``""`` where it is unknown (NaN), ``"0"`` where zero;
+    ``(missing, "")`` for a value that is not a number, and a value without an error with
+    four significant digits, as an SDC shown alone (``sdc_text``). The app showed
+    0.2100 ± 0.0100 and 0.0123 ± 0.0006 (four decimals) where ``pidcore analyze`` wrote 0.21
+    and 0.012340 beside 0.01 and 0.00056.
 
     >>> value_and_error_texts(0.01234, 0.00056), value_and_error_texts(4.09, 0.2)
     (('0.01234', '0.00056'), ('4.09', '0.20'))
+    >>> value_and_error_texts(8.168123, 0.0003), value_and_error_texts(1.367, 0.00046)
+    (('8.16812', '0.00030'), ('1.36700', '0.00046'))
     >>> value_and_error_texts(0.25, 1.1e-14), value_and_error_texts(5.09e-5, 4.4e-5)
-    (('0.2500', '1.1e-14'), ('5.1e-05', '4.4e-05'))
+    (('0.250000', '1.1e-14'), ('5.1e-05', '4.4e-05'))
     """
     if value is None or not math.isfinite(value):
         return missing, ""
     if stderr is None or not math.isfinite(stderr):
-        return f"{value:.{max_digits}g}", ""
+        return f"{value:.4g}", ""
     if stderr == 0:
         error_text, place = "0", -math.inf
     else:
