@@ -364,11 +364,15 @@ def predictions_figure(result: CalibrationResult) -> Any:
 
 def plot_predictions(result: CalibrationResult, path: Path) -> None:
     """predictions.png (:func:`predictions_figure`) written to ``path``."""
+    _write_and_close(predictions_figure(result), path, dpi=120)
+
+
+def _write_and_close(fig: Any, path: Path, *, dpi: int) -> None:
+    # the figure is closed even where writing fails: pyplot keeps every open figure alive
     import matplotlib.pyplot as plt
 
-    fig = predictions_figure(result)
     try:
-        fig.savefig(path, dpi=120)
+        fig.savefig(path, dpi=dpi)
     finally:
         plt.close(fig)
 
@@ -410,13 +414,7 @@ def pairs_figure(result: CalibrationResult) -> Any:
 
 def plot_pairs(result: CalibrationResult, path: Path) -> None:
     """posterior_pairs.png (:func:`pairs_figure`) written to ``path``."""
-    import matplotlib.pyplot as plt
-
-    fig = pairs_figure(result)
-    try:
-        fig.savefig(path, dpi=100)
-    finally:
-        plt.close(fig)
+    _write_and_close(pairs_figure(result), path, dpi=100)
 
 
 def write_outputs(result: CalibrationResult, out_dir: str | os.PathLike) -> list[Path]:
