@@ -340,6 +340,15 @@ def given_time_unit(time_unit: str | None) -> UnitReading | None:
     return reading
 
 
+def overrides_stated_time(stated: str, given: UnitReading) -> bool:
+    """Whether the user's ``given`` time unit (:func:`given_time_unit`) reads a time base
+    otherwise than the label its file states (``stated``: none, no unit of time, or one of
+    another factor), which the readers then say."""
+    reading = read_unit(stated)
+    return (reading.info is None or reading.quantity != "time"
+            or not math.isclose(reading.info.factor, given.info.factor, rel_tol=1e-12))
+
+
 #: Spellings of milli-g (1e-3 standard gravity) that accelerometer channels are exported in.
 #: SI reads ``mg`` as the milligram, a mass, so :func:`read_unit` does not take them: only a
 #: channel that is an acceleration by its name or role is read so (:func:`milli_g`), and said.

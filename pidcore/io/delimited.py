@@ -37,7 +37,7 @@ import pandas as pd
 from ..atomic_files import atomic_path
 from ..errors import InputFileError, ParameterError, clipped
 from ..records import Measurement
-from ..units import UnitReading, given_time_unit, read_unit
+from ..units import UnitReading, given_time_unit, overrides_stated_time, read_unit
 from ._common import (
     file_sha256,
     interpret_unit,
@@ -389,7 +389,7 @@ def read_csv(path: str | os.PathLike[str], *, sample_rate_hz: float | None = Non
         if note:
             notes.append(note)
         if given_time is not None:
-            if _overridden(unit, given_time):
+            if overrides_stated_time(unit, given_time):
                 notes.append(f"{where}: time column {name!r} ({unit or 'no unit'}) taken as "
                              f"{given_time.label!r} (time_unit), sample rate {rate:.6g} Hz")
         elif not unit:
@@ -554,11 +554,6 @@ def _seconds_per(unit: str, given: UnitReading | None = None) -> float:
     return interpret_unit(unit)[1] if unit else 1.0
 
 
-def _overridden(unit: str, given: UnitReading) -> bool:
-    """Whether ``given`` reads a time column otherwise than its own ``unit`` does."""
-    return not unit or not math.isclose(_seconds_per(unit), given.info.factor, rel_tol=1e-12)
-
-
 def _pair_time_bases(columns: list[np.ndarray], cells: list[tuple[str, str]],
                      pair_times: list[int],
                      keep: list[int], names: list[str], *, where: str,
@@ -583,7 +578,7 @@ def _pair_time_bases(columns: list[np.ndarray], cells: list[tuple[str, str]],
         factor = _seconds_per(unit, given_time)
         what = f"{where}: column {name!r} (time of column {owned[0] + 1})"
         if given_time is not None:
-            if _overridden(unit, given_time):
+            if overrides_stated_time(unit, given_time):
                 notes.append(f"{what}: ({unit or 'no unit'}) taken as {given_time.label!r} "
                              "(time_unit)")
         elif read_unit(unit).corrected:

@@ -39,7 +39,7 @@ from ..atomic_files import atomic_path
 from ..constants import SI_UNITS
 from ..errors import InputFileError, ParameterError
 from ..records import Channel, Measurement
-from ..units import UnitReading, given_time_unit, read_unit
+from ..units import UnitReading, given_time_unit, overrides_stated_time, read_unit
 from ._common import (
     HDF5_SIGNATURE,
     file_sha256,
@@ -322,7 +322,7 @@ def _lms_seconds_per_unit(x_values: Mapping, what: str, given: UnitReading | Non
         stated = ""
     reading = read_unit(stated)
     if given is not None:
-        if reading.info is None or reading.info.factor != given.info.factor:
+        if overrides_stated_time(stated, given):
             notes.append(f"{what}: x_values unit {stated or 'none'!r} overridden: taken as "
                          f"{given.label!r} (time_unit)")
         return given.info.factor

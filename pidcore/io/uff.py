@@ -44,7 +44,13 @@ from ..atomic_files import atomic_path
 from ..constants import SI_UNITS
 from ..errors import InputFileError, ParameterError, a_or_an
 from ..records import Channel, Measurement
-from ..units import UnitReading, canonical_unit_text, given_time_unit, read_unit
+from ..units import (
+    UnitReading,
+    canonical_unit_text,
+    given_time_unit,
+    overrides_stated_time,
+    read_unit,
+)
 from ._common import (
     file_sha256,
     interpret_unit,
@@ -556,8 +562,7 @@ def read_uff(path: str | os.PathLike[str], *, time_unit: str | None = None) -> M
         abscissa = read_unit(label)
         said = f"{where}: record {k + 1} ({c.name!r}) abscissa"
         if given_time is not None:
-            if abscissa.info is None or abscissa.quantity != "time" or \
-                    abscissa.info.factor != given_time.info.factor:
+            if overrides_stated_time(label, given_time):
                 notes.append(f"{said} unit {label or 'none'!r} overridden: taken as "
                              f"{given_time.label!r} (time_unit), sample rate "
                              f"{c.sample_rate_hz:.6g} Hz")
