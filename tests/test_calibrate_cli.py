@@ -897,19 +897,10 @@ def test_a_killed_calibrations_build_folder_is_removed_by_the_next_out(capsys, t
     # `pidcore calibrate --out cal` killed outright (kill -9, a power loss) left its hidden
     # build folder beside cal for ever; the next --out cal removes it once a day old, and
     # keeps a younger one (a live run's) and a user's folder named like it
-    import os
-
-    from pidcore.defaults import STALE_TEMPORARY_FILE_AGE_S
+    from _build_leftovers import leave_build_folders
 
     out = tmp_path / "cal"
-    names = {"stale": f".cal.{'5a' * 8}.tmpdir", "fresh": f".cal.{'6b' * 8}.tmpdir",
-             "user's": ".cal.backup"}
-    for key, name in names.items():
-        (tmp_path / name).mkdir()
-        (tmp_path / name / "calibration.json").write_text("{}")
-        age = STALE_TEMPORARY_FILE_AGE_S + (60 if key != "fresh" else -60)
-        when = os.stat(tmp_path / name).st_mtime - age
-        os.utime(tmp_path / name, (when, when))
+    names = leave_build_folders(out, "calibration.json", ('5a', '6b'))
     code = main(["calibrate", "--data", str(_table(tmp_path)), "--fit", "fixture_mass_kg",
                  "--discrepancy", "0.2", "--dem-store", str(tiny_store), "--out", str(out),
                  *TINY])

@@ -125,9 +125,10 @@ def test_the_command_prints_the_leave_one_out_count_without_the_uninformative_fo
                            "uninformative: ")
 
 
-def test_the_commands_json_carries_the_leave_one_out_counts(tmp_path, capsys, monkeypatch):
-    # --json had loo_rms but not the k/n the text line prints: a script could not tell 1/2
-    # inside with 1 uninformative from 2/3 inside without recomputing every fold's SDC bound
+def _calibrate_args_of_the_constructed_result(tmp_path, monkeypatch) -> tuple[list[str], Path]:
+    """``pidcore calibrate`` arguments (without --json/--out) whose calibration is
+    :func:`_result` (the library's calibrate and the store's save stood in for), and the
+    ``--out`` folder to give them."""
     library = importlib.import_module("pidcore.calibrate.calibrate")
     monkeypatch.setattr(library, "calibrate", lambda points, **kwargs: _result())
     monkeypatch.setattr(importlib.import_module("pidcore.calibrate.persist"),
@@ -135,10 +136,16 @@ def test_the_commands_json_carries_the_leave_one_out_counts(tmp_path, capsys, mo
     table = tmp_path / "m.csv"
     table.write_text("frequency_hz,acceleration_g,fill_percent,sdc\n100,5,50,0.3\n"
                      "500,5,50,0.9\n1000,5,50,0.5\n")
-    out = tmp_path / "out"
-    assert main(["calibrate", "--data", str(table), "--fit", "fixture_mass_kg",
-                 "--dem-store", str(tmp_path / "d.h5"), "--cells", "2", "--workers", "1",
-                 "--no-progress", "--json", "--out", str(out)]) == 0
+    return (["calibrate", "--data", str(table), "--fit", "fixture_mass_kg", "--dem-store",
+             str(tmp_path / "d.h5"), "--cells", "2", "--workers", "1", "--no-progress"],
+            tmp_path / "out")
+
+
+def test_the_commands_json_carries_the_leave_one_out_counts(tmp_path, capsys, monkeypatch):
+    # --json had loo_rms but not the k/n the text line prints: a script could not tell 1/2
+    # inside with 1 uninformative from 2/3 inside without recomputing every fold's SDC bound
+    args, out = _calibrate_args_of_the_constructed_result(tmp_path, monkeypatch)
+    assert main([*args, "--json", "--out", str(out)]) == 0
     document = json.loads(capsys.readouterr().out)
     # the constructed folds: one inside, one outside, one uninformative
     assert document["loo_coverage95"] == 1 and document["loo_uninformative95"] == 1
@@ -324,16 +331,7 @@ def test_every_file_states_each_rows_verdict_and_the_in_sample_count_as_the_summ
     from pidcore.calibrate.outputs import coverage_text, summary_markdown
     from pidcore.calibrate.persist import calibration_key
 
-    library = importlib.import_module("pidcore.calibrate.calibrate")
-    monkeypatch.setattr(library, "calibrate", lambda points, **kwargs: _result())
-    monkeypatch.setattr(importlib.import_module("pidcore.calibrate.persist"),
-                        "save_calibration", lambda result, store: ("cal_0", True))
-    table = tmp_path / "m.csv"
-    table.write_text("frequency_hz,acceleration_g,fill_percent,sdc\n100,5,50,0.3\n"
-                     "500,5,50,0.9\n1000,5,50,0.5\n")
-    out = tmp_path / "out"
-    args = ["calibrate", "--data", str(table), "--fit", "fixture_mass_kg", "--dem-store",
-            str(tmp_path / "d.h5"), "--cells", "2", "--workers", "1", "--no-progress"]
+    args, out = _calibrate_args_of_the_constructed_result(tmp_path, monkeypatch)
     assert main([*args, "--json", "--out", str(out)]) == 0
     printed = json.loads(capsys.readouterr().out)
     written = json.loads((out / "calibration.json").read_text())

@@ -374,6 +374,19 @@ def test_an_interrupt_during_a_numba_compilation_is_raised_once_the_function_is_
         interrupt.reset()
 
 
+#: Probe lines (after ``import sys``) that raise KeyboardInterrupt where the CLI imports
+#: pidcore.errors, as a Ctrl-C in its first ~0.2 s does, for ``pidcore dem sweep --store
+#: ARGV[1]``.
+_INTERRUPT_AS_THE_CLI_LOADS = (
+    "class Interrupt:\n"
+    "    def find_spec(self, name, path=None, target=None):\n"
+    "        if name == 'pidcore.errors':\n"
+    "            raise KeyboardInterrupt\n"
+    "sys.meta_path.insert(0, Interrupt())\n"
+    "sys.argv = ['pidcore', 'dem', 'sweep', '--store', sys.argv[1]]\n"
+)
+
+
 def test_ctrl_c_while_the_cli_loads_exits_130_with_one_line(tmp_path):
     # Found by sending SIGINT to `python -m pidcore dem sweep` at random moments: one at
     # 0.05 s landed while pidcore.cli imported its modules, before main installs the handler,
@@ -381,12 +394,7 @@ def test_ctrl_c_while_the_cli_loads_exits_130_with_one_line(tmp_path):
     # raised here by an import hook at the same import, where the traceback showed it.
     probe = (
         "import runpy, sys\n"
-        "class Interrupt:\n"
-        "    def find_spec(self, name, path=None, target=None):\n"
-        "        if name == 'pidcore.errors':\n"
-        "            raise KeyboardInterrupt\n"
-        "sys.meta_path.insert(0, Interrupt())\n"
-        "sys.argv = ['pidcore', 'dem', 'sweep', '--store', sys.argv[1]]\n"
+        + _INTERRUPT_AS_THE_CLI_LOADS +
         "runpy.run_module('pidcore', run_name='__main__', alter_sys=True)\n")
     store = tmp_path / "s.h5"
     done = subprocess.run([sys.executable, "-c", probe, str(store)], capture_output=True,
@@ -410,12 +418,7 @@ def test_ctrl_c_while_the_installed_pidcore_script_loads_exits_130_with_one_line
     module, function = scripts["pidcore"].split(":")
     probe = (
         "import sys\n"
-        "class Interrupt:\n"
-        "    def find_spec(self, name, path=None, target=None):\n"
-        "        if name == 'pidcore.errors':\n"
-        "            raise KeyboardInterrupt\n"
-        "sys.meta_path.insert(0, Interrupt())\n"
-        "sys.argv = ['pidcore', 'dem', 'sweep', '--store', sys.argv[1]]\n"
+        + _INTERRUPT_AS_THE_CLI_LOADS +
         f"from {module} import {function}\n"
         f"sys.exit({function}())\n")
     store = tmp_path / "s.h5"

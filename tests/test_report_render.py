@@ -398,19 +398,10 @@ def test_a_killed_reports_build_folder_is_removed_by_the_next_report_of_that_fol
         tmp_path, table, provenance):
     # `pidcore report --out rp` killed outright left its hidden build folder beside rp for
     # ever; the next report of rp removes it once a day old, and nothing else beside rp
-    import os
-
-    from pidcore.defaults import STALE_TEMPORARY_FILE_AGE_S
+    from _build_leftovers import leave_build_folders
 
     out = tmp_path / "rp"
-    names = {"stale": f".rp.{'3c' * 8}.tmpdir", "fresh": f".rp.{'4d' * 8}.tmpdir",
-             "user's": ".rp.backup"}
-    for key, name in names.items():
-        (tmp_path / name).mkdir()
-        (tmp_path / name / "report.csv").write_text("left")
-        age = STALE_TEMPORARY_FILE_AGE_S + (60 if key != "fresh" else -60)
-        when = os.stat(tmp_path / name).st_mtime - age
-        os.utime(tmp_path / name, (when, when))
+    names = leave_build_folders(out, "report.csv", ('3c', '4d'))
     paths = write_report(table, {}, provenance, out, "csv")
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(["rp", names["fresh"],
                                                                  names["user's"]])
