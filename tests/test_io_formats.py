@@ -83,6 +83,43 @@ def test_uff_non_integer_rate_within_format_resolution(tmp_path):
     assert rate == pytest.approx(2000.232, rel=5e-6)  # E13.5 interval: 6 significant digits
 
 
+# Rates above ~200 kHz, where UFF's six-digit interval (and a time column printed with six
+# digits) resolves the rate to more than 1 Hz: the nearest whole Hz of 1/2.44141e-06 s is
+# 409 599 Hz, not the 409 600 Hz the instrument ran at.
+@pytest.mark.parametrize("rate", [262144.0, 409600.0, 1e6, 1638400.0, 3276800.0, 5.12e6])
+def test_high_rates_read_back_exactly_from_six_digit_time_bases(tmp_path, rate):
+    from pidcore.io.delimited import read_csv
+
+    written = _measurement(rate=rate, n=4096)
+    path = tmp_path / "r.uff"
+    write_measurement(written, path)
+    assert read_measurement(path).channels[0].sample_rate_hz == rate
+    times = np.arange(4096) / rate
+    for scale, unit in ((1.0, "s"), (1e3, "ms")):  # in ms: the float round-off of the factor
+        csv = tmp_path / f"r_{unit}.csv"
+        np.savetxt(csv, np.column_stack([times * scale, np.sin(times)]), fmt=["%.6g", "%.6g"],
+                   delimiter=",", header=f"Time [{unit}],Force [N]", comments="")
+        assert read_csv(csv).channels[0].sample_rate_hz == rate
+
+
+def test_drive_line_of_a_uff_export_at_409600_hz(tmp_path):
+    from pidcore.measure import analyze_file
+    from pidcore.signal.synthetic import synthesize_shaker_record
+
+    rate = 409600.0
+    record = synthesize_shaker_record(mass_kg=0.05, acceleration_amplitude_m_s2=49.0,
+                                      frequency_hz=1000.0, sample_rate_hz=rate, n_periods=40,
+                                      viscous_damping_n_s_m=2.0)
+    path = tmp_path / "fast.uff"
+    write_measurement(Measurement("fast", (
+        Channel("Force", "force", record.force_n, rate, "N"),
+        Channel("Velocity", "velocity", record.velocity_m_s, rate, "m/s"))), path)
+    result = analyze_file(path)
+    # noiseless 40 periods: the estimate is good to ~1e-15; the rate snapped to 409 599 Hz
+    # read every frequency 2.4e-6 low (999.99756 Hz)
+    assert result.analysis.frequency_hz == pytest.approx(1000.0, rel=1e-9)
+
+
 def test_uff_refuses_to_write_nan(tmp_path):
     m = _measurement()
     bad = Measurement("x", (Channel("F", "force", np.array([0.0, np.nan, 1.0]), 10.0),))

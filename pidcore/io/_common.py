@@ -73,15 +73,27 @@ def unique_names(names: Sequence[str]) -> list[str]:
 
 
 def snap_rate(rate_hz: float, relative_resolution: float) -> float:
-    """Round a sample rate to whole Hz when it lies within the file's number resolution.
+    """The roundest rate (fewest significant digits, whole Hz at the finest) within the file's
+    number resolution of ``rate_hz``; ``rate_hz`` itself where none is.
 
     UFF writes the sample interval with six significant digits, so 65 536 Hz reads back as
-    1/1.52588e-05 = 65 535.95 Hz; snapping restores the rate the instrument used.
+    1/1.52588e-05 = 65 535.95 Hz; snapping restores the rate the instrument used. The nearest
+    whole Hz is not that rate once the resolution is wider than 1 Hz (above ~200 kHz for UFF):
+    409 600 Hz read back as 1/2.44141e-06 = 409 599.37 Hz and was snapped to 409 599 Hz, and
+    3 276 800 Hz to 3 276 798 Hz, each frequency and the record's duration off by that much.
+    Every rate within the resolution reads the file alike, so the one of fewest digits is
+    the one an instrument is set to (409 600, 3 276 800, 51 200, 65 536).
     """
-    nearest = round(rate_hz)
-    if nearest > 0 and abs(rate_hz - nearest) <= relative_resolution * rate_hz:
-        return float(nearest)
-    return float(rate_hz)
+    rate = float(rate_hz)
+    if not (math.isfinite(rate) and rate >= 1.0):
+        return rate
+    tolerance = relative_resolution * rate
+    for place in range(math.floor(math.log10(rate)), -1, -1):
+        step = 10.0 ** place
+        candidate = float(round(rate / step) * step)  # an integer: exact in float64
+        if candidate > 0 and abs(rate - candidate) <= tolerance:
+            return candidate
+    return rate
 
 
 #: Fewest significant digits whose rounding a printed time column is allowed (MATLAB

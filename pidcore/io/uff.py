@@ -25,8 +25,9 @@ pyuff reads them, bit for bit) instead of through Python lists. What this module
   dropped), an extra CR LF after 58b binary data (pyuff ignores the stray bytes), E13.5 fields
   without separating blanks and 3-digit exponents (pyuff reads fixed columns), Latin-1 header
   bytes (decoded with replacement; they only occur in labels).
-* The sample interval is written with six significant digits (E13.5), so a sample rate within
-  that resolution of a whole number of Hz is snapped to it (65 535.95 Hz -> 65 536 Hz).
+* The sample interval is written with six significant digits (E13.5), so the rate is snapped to
+  the roundest one within that resolution (65 535.95 Hz -> 65 536 Hz, 409 599.37 Hz ->
+  409 600 Hz).
 """
 
 from __future__ import annotations
@@ -656,7 +657,8 @@ def write_uff(measurement: Measurement, path: str | os.PathLike[str], *,
     Notes
     -----
     The sample interval is stored with six significant digits (the E13.5 field of the
-    format); readers snap rates within that resolution to whole Hz.
+    format); readers snap rates to the roundest one within that resolution
+    (:func:`pidcore.io._common.snap_rate`).
     """
     if not measurement.channels:
         raise ParameterError(f"{measurement.source}: nothing to write (no channels)")
