@@ -164,7 +164,9 @@ def add_measurement_options(p: argparse.ArgumentParser) -> None:
                    help="unit of the file's time base (s, ms, us): a UFF abscissa whose label "
                         "pidcore does not read (refused without it), a CSV time column or "
                         "MATLAB time vector without a unit (otherwise seconds, noted), a "
-                        "Testlab MAT signal's x_values; overrides the file's (noted)")
+                        "Testlab MAT signal's x_values; overrides the file's (noted); a CSV "
+                        "whose time header is not read (Abscissa) takes its first column "
+                        "as the time in this unit")
     g.add_argument("--invert", metavar="NAME", action="append", default=None,
                    help="invert the sign of this channel (a sensor mounted the other way); "
                         "repeatable; replaces the sidecar's invert column")

@@ -206,7 +206,9 @@ def read_measurement(path: str | os.PathLike[str], *, sample_rate_hz: float | No
         Unit of the file's time base (``"ms"``): a UFF abscissa, a CSV time column, a MATLAB
         time vector or Test.Lab ``x_values``, where the file states none (taken as seconds,
         noted) or one that is no unit of time pidcore reads (refused without it); it
-        overrides the file's (noted). HDF5 files and pidcore's MATLAB layout state their rate
+        overrides the file's (noted). A CSV whose time header is not read (``Abscissa``) takes
+        its first column as the time base in this unit (:func:`pidcore.io.delimited.read_csv`).
+        HDF5 files and pidcore's MATLAB layout state their rate
         in Hz: a reader note says the unit given was not applied.
 
     Returns

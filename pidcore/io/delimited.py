@@ -13,8 +13,12 @@ Understood as spreadsheet tools, MATLAB and acquisition software write them:
   not a comma, recognised from any of the first data rows (the first may hold integers only);
 * encodings UTF-8 (with or without BOM), **UTF-16** (BOM or NUL pattern), else Latin-1.
 
-The time base is the first column whose unit is a time unit or whose name is ``time``/``t``;
-later time columns (x/y pairs) are the time base of the columns up to the next one.
+The time base is the first column whose unit is a time unit or whose name is ``time``/``t``
+(``zeit``, ``temps``, ``x``); with ``time_unit`` given, else the first column named so whose
+unit is not read (``Time [msek]``), else the first column where its header states no other
+quantity (``Abscissa``, ``Zeit_ms``), read in that unit (noted). Without ``time_unit`` such a
+column is refused by name, never taken as seconds. Later time columns (x/y pairs) are the
+time base of the columns up to the next one.
 It must be evenly spaced within the precision it was printed with (a column printed with 5-6
 significant digits is fitted, see :func:`pidcore.io._common.rate_from_times`). Without one,
 ``sample_rate_hz`` must be given; with one, ``sample_rate_hz`` overrides it (noted).
@@ -35,7 +39,7 @@ import numpy as np
 import pandas as pd
 
 from ..atomic_files import atomic_path
-from ..errors import InputFileError, ParameterError, clipped
+from ..errors import InputFileError, ParameterError, a_or_an, clipped
 from ..records import Measurement
 from ..units import UnitReading, given_time_unit, overrides_stated_time, read_unit
 from ._common import (
@@ -76,10 +80,10 @@ def _split_header(cell: str) -> tuple[str, str]:
 
 #: Where a DIN-style header (DIN 1313 ``Quantity/unit``, German ``Größe in Einheit``) may
 #: split into its quantity and unit.
-_QUANTITY_UNIT_SEPARATOR = re.compile(r"\s*/\s*|\s+in\s+", re.IGNORECASE)
+_QUANTITY_UNIT_SEPARATOR = re.compile(r"\s*/\s*|\s+in\s+|\s+-\s+", re.IGNORECASE)
 #: The header spellings of a unit read, as the refusals of a header not read list them.
-ACCEPTED_HEADER_SPELLINGS = ("'Time [s]', 'Time (s)', 'Time/s', 'Time in s' or 'Time' over "
-                             "a unit row 's'")
+ACCEPTED_HEADER_SPELLINGS = ("'Time [s]', 'Time (s)', 'Time/s', 'Time in s', 'Time - s' or "
+                             "'Time' over a unit row 's'")
 
 
 def _named_quantity(name: str) -> str | None:
@@ -311,7 +315,10 @@ def read_csv(path: str | os.PathLike[str], *, sample_rate_hz: float | None = Non
         column (the measurement's ``reader_notes`` say so).
     time_unit : str, optional
         Unit of the time columns (``"ms"``): for a column without one, which is otherwise
-        taken as seconds (noted); it overrides a column's own unit (noted).
+        taken as seconds (noted); it overrides a column's own unit (noted). Where no header
+        reads as a time, the time column is the first named as one whose unit is not read
+        (``Time [msek]``), else the first column where its header states no other quantity
+        (``Abscissa``; noted); without ``time_unit`` such a file is refused naming it.
 
     Examples
     --------
@@ -361,11 +368,7 @@ def read_csv(path: str | os.PathLike[str], *, sample_rate_hz: float | None = Non
     if len(cells) < 1 or n_rows < 2:
         raise InputFileError(f"{where}: expected at least one channel and two data rows")
 
-    time_index = None
-    for i, (name, unit) in enumerate(cells):
-        if _is_time_unit(unit) or (not unit and name.strip().lower() in _TIME_NAMES):
-            time_index = i
-            break
+    time_index, by_rule = _time_column(cells, header_cells, given_time)
     if sample_rate_hz is not None:
         if not sample_rate_hz > 0:
             raise ParameterError(f"sample_rate_hz must be positive, got {sample_rate_hz!r}")
@@ -391,7 +394,8 @@ def read_csv(path: str | os.PathLike[str], *, sample_rate_hz: float | None = Non
         if given_time is not None:
             if overrides_stated_time(unit, given_time):
                 notes.append(f"{where}: time column {name!r} ({unit or 'no unit'}) taken as "
-                             f"{given_time.label!r} (time_unit), sample rate {rate:.6g} Hz")
+                             f"{given_time.label!r} (time_unit), sample rate {rate:.6g} Hz"
+                             + (f" ({by_rule})" if by_rule else ""))
         elif not unit:
             # a time in ms read as s makes the frequency, acceleration and energy per cycle
             # 1000 x off (the loss factor and SDC unchanged): the assumption is said
@@ -400,7 +404,8 @@ def read_csv(path: str | os.PathLike[str], *, sample_rate_hz: float | None = Non
                          "header ('Time [ms]'), give it (time_unit=UNIT) or give the sample "
                          "rate (sample_rate_hz)")
     else:
-        raise InputFileError(f"{where}: no time column{_unread_time_header(header_cells)} "
+        raise InputFileError(f"{where}: no time column"
+                             f"{_why_no_time_column(cells, header_cells, given_time)} "
                              f"and no sample rate (a time column is headed "
                              f"{ACCEPTED_HEADER_SPELLINGS}); add a time column or give the "
                              "sample rate (sample_rate_hz)")
@@ -528,17 +533,73 @@ def _pair_time_columns(cells: list[tuple[str, str]], time_index: int | None,
     return pairs
 
 
-def _unread_time_header(header_cells: list[str]) -> str:
-    """`` (header cell 'Time/xyz' not read: 'xyz' is no unit of time)`` for the first header
-    cell named like a time whose unit was not read, else ``""``: "no time column" of a file
-    with one did not say which cell was meant nor why it was not taken."""
-    for cell in header_cells:
+def _unread_time_header(header_cells: list[str]) -> tuple[int, str] | None:
+    """Index of the first header cell named like a time whose unit was not read, and
+    `` (header cell 'Time/xyz' not read: 'xyz' is no unit of time)``, or None: "no time
+    column" of a file with one did not say which cell was meant nor why it was not taken."""
+    for i, cell in enumerate(header_cells):
         text = cell.strip().strip('"').strip()
-        parts = re.split(r"\s*[/\[(]\s*|\s+in\s+", text, maxsplit=1, flags=re.IGNORECASE)
+        parts = re.split(r"\s*[/\[(]\s*|\s+in\s+|\s+-\s+", text, maxsplit=1,
+                         flags=re.IGNORECASE)
         if len(parts) == 2 and parts[0].lower() in _TIME_NAMES - {"x"}:
             unit = parts[1].rstrip("])").strip()
             why = read_unit(unit).problem or f"{unit!r} is no unit of time such as s, ms"
-            return f" (header cell {text!r} not read: {why})"
+            return i, f" (header cell {text!r} not read: {why}; give its unit with time_unit=UNIT)"
+    return None
+
+
+def _states_other_quantity(cell: tuple[str, str]) -> str | None:
+    """The quantity other than time a column's header states by its unit or its name
+    (``Force [N]``: force), or None."""
+    name, unit = cell
+    by_unit = interpret_unit(unit)[0] if unit else "unknown"
+    if by_unit not in ("unknown", "time"):
+        return by_unit
+    return _named_quantity(name) if _named_quantity(name) != "time" else None
+
+
+def _time_column(cells: list[tuple[str, str]], header_cells: list[str],
+                 given_time: UnitReading | None) -> tuple[int | None, str]:
+    """Index of the time column and, where the rule for a header pidcore does not read as a
+    time chose it, how (for the note); ``(None, "")`` for none.
+
+    The first column of a time unit or a time's name without a unit; with ``time_unit``
+    given, else the first named as a time whose unit is not read (``Time [msek]``), else the
+    first column where its header states no other quantity (``Abscissa``, ``Zeit_ms``): the
+    user's unit says what it is. Without ``time_unit`` these are refused
+    (:func:`_why_no_time_column`): read as seconds or as a channel, a column in ms gave every
+    frequency 1000 x off, or the file was refused without the column named."""
+    for i, (name, unit) in enumerate(cells):
+        if _is_time_unit(unit) or (not unit and name.strip().lower() in _TIME_NAMES):
+            return i, ""
+    if given_time is None:
+        return None, ""
+    unread = _unread_time_header(header_cells)
+    if unread is not None:
+        return unread[0], "its header's unit not read"
+    if cells and _states_other_quantity(cells[0]) is None:
+        return 0, "the first column, its header not read as a time"
+    return None, ""
+
+
+def _why_no_time_column(cells: list[tuple[str, str]], header_cells: list[str],
+                        given_time: UnitReading | None) -> str:
+    """Why no column was taken as the time, naming the column meant: a time header of an
+    unread unit, or a first column whose header says no quantity (read with ``time_unit``)."""
+    unread = _unread_time_header(header_cells)
+    if unread is not None:
+        return unread[1]
+    if not cells:
+        return ""
+    name, unit = cells[0]
+    shown = header_cells[0].strip().strip('"').strip() or "column 1"
+    other = _states_other_quantity(cells[0])
+    if given_time is not None:
+        return (f" (time_unit={given_time.label!r} reads a first column whose header is not "
+                f"read as a time, but {shown!r} is {a_or_an(other)} channel)") if other else ""
+    if other is None:
+        return (f" (the first column {shown!r} is not read as one: its header states no unit "
+                "of time; if it is the time, give its unit with time_unit=UNIT)")
     return ""
 
 
