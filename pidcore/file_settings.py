@@ -17,6 +17,8 @@ column                     meaning (:class:`~pidcore.measure.AnalysisOptions` fi
 ``force``, ``velocity``,   channel names (``force``, ``velocity``, ``acceleration``);
 ``acceleration``           ``(auto)`` and ``(none)`` (the app's template) name none: detected
 ``invert``                 channels whose sign is flipped, ``;``-separated (``invert``)
+``time_unit``              unit of the file's time base (``s``, ``ms``, ``us``; ``time_unit``):
+                           as ``--time-unit`` reads it, for this file only
 ``specimen``               the specimen tested (a name, saved with the analysis record)
 ``note``, ``notes``,       free text for the user's own remarks: read and ignored
 ``comment``, ``comments``
@@ -29,7 +31,9 @@ misspelt ``velocity_delay_ms`` would otherwise be ignored and the file analysed 
 without a word. An empty cell states nothing. Precedence is that of the load case: file
 name (states no analysis setting) < table < options given explicitly (the command line's
 ``--velocity-delay`` etc.), and an explicit option that overrides a different table value
-is said in a note (:func:`resolve_file_settings`).
+is said in a note (:func:`resolve_file_settings`); but a time unit given for every file that
+reads a file's time otherwise than its row's ``time_unit`` is refused: one of the two is
+wrong, and either gives every frequency 1000 x off.
 """
 
 from __future__ import annotations
@@ -120,6 +124,32 @@ def _number(value: object, column: str, spec: SettingsColumn, where: str) -> flo
     return number / spec.scale
 
 
+def _time_unit(value: object, column: str, spec: SettingsColumn, where: str) -> str:
+    """A time unit cell as ``time_unit=`` takes it (its text), refused as
+    :func:`pidcore.units.given_time_unit` refuses the keyword, naming the cell instead."""
+    from .errors import ParameterError
+    from .units import given_time_unit
+
+    text = str(value).strip()
+    try:
+        given_time_unit(text)
+    except ParameterError as exc:
+        why = str(exc).split(": not a unit of time", 1)[-1].split("; expected", 1)[0]
+        raise SettingsTableError(f"{where}, column {column}: {text!r} is not a unit of "
+                                 f"time{why}; expected {spec.expected}") from None
+    return text
+
+
+def same_time_unit(first: str | None, second: str | None) -> bool:
+    """Whether two time units given (``time_unit=``, a ``time_unit`` cell) read a time base
+    alike (``ms`` and ``msec``); None (none given) agrees with anything."""
+    from .units import given_time_unit, overrides_stated_time
+
+    if first is None or second is None:
+        return True
+    return not overrides_stated_time(first, given_time_unit(second))
+
+
 def analysis_overrides(values: Mapping[str, object], where: str, *,
                        labels: Mapping[str, str] | None = None) -> dict[str, object]:
     """The :class:`~pidcore.measure.AnalysisOptions` fields one settings row states.
@@ -160,6 +190,10 @@ def analysis_overrides(values: Mapping[str, object], where: str, *,
         name = labels.get(column, column)
         if spec.kind == "number":
             out[spec.field] = _number(value, name, spec, where)
+            continue
+        if spec.kind == "time unit":
+            if not (isinstance(value, float) and math.isnan(value)):
+                out[spec.field] = _time_unit(value, name, spec, where)
             continue
         if isinstance(value, float) and math.isnan(value):
             continue  # a text column's empty cell, as pandas holds it
@@ -368,7 +402,14 @@ def resolve_file_settings(path: str | os.PathLike, options: AnalysisOptions | No
         text = str(row.values[column]).strip()
         if name in given:
             mine = getattr(options, name)
-            if not _same(value, mine):
+            if name == "time_unit" and not same_time_unit(mine, value):
+                # not an override to note: one of the two is wrong, and either reading gives
+                # every frequency of the file 1000 x off the other's
+                raise SettingsTableError(
+                    f"{display_path(Path(path).name)}: {given[name]} {mine!r} disagrees with "
+                    f"column {column} {text!r} of {row.where}; expected one unit of the "
+                    f"file's time base (leave the cell empty or {given[name]} out)")
+            if name != "time_unit" and not _same(value, mine):
                 notes.append(f"{display_path(Path(path).name)}: {given[name]} "
                              f"({setting_phrase(name, mine)}) "
                              f"overrides column {column} {text!r} of {row.where}")
@@ -441,14 +482,22 @@ def analyze_with_settings(path: str | os.PathLike, settings: FileSettings, *,
         if explained == str(exc):
             raise
         raise type(exc)(explained) from None
-    if invert_cell is None:
-        return record
-    # "channel 'V' inverted (invert='V')" of a channel the table's invert column named: the
-    # note names the cell, as the settings line and the errors do
-    column, _, where = invert_cell
-    return replace(record, notes=tuple(
-        re.sub(r" inverted \(invert='[^']*'\)", f" inverted (column {column} of {where})", n)
-        for n in record.notes))
+    notes = record.notes
+    time_unit_cell = settings.cells.get("time_unit")
+    if time_unit_cell is not None:
+        # "taken as 'ms' (time_unit)" of a unit the table's row stated: said of the option
+        # for every file, which was not given
+        column, _, where = time_unit_cell
+        notes = tuple(n.replace(" (time_unit)", f" (column {column} of {where})")
+                      for n in notes)
+    if invert_cell is not None:
+        # "channel 'V' inverted (invert='V')" of a channel the table's invert column named:
+        # the note names the cell, as the settings line and the errors do
+        column, _, where = invert_cell
+        notes = tuple(
+            re.sub(r" inverted \(invert='[^']*'\)", f" inverted (column {column} of {where})",
+                   n) for n in notes)
+    return record if notes == record.notes else replace(record, notes=notes)
 
 
 def _refuse_fill_of_no_particle(path: str | os.PathLike, stated: StatedLoadCase | None,

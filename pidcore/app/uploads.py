@@ -33,7 +33,7 @@ from ..compare.loadcase import (
 )
 from ..compare.settings_columns import setting_phrase
 from ..constants import PARTICLE_MATERIALS
-from ..errors import InputFileError, ParameterError, PidcoreError
+from ..errors import InputFileError, ParameterError, PidcoreError, SettingsTableError
 from ..units import display_value_with_error
 from .vocabulary import page_terms
 
@@ -749,7 +749,7 @@ def default_settings_row(name: str, stated) -> dict:
             "mass below gauge [g]": 0.0, "baseline loss factor [-]": 0.0,
             "structure mass [g]": 0.0, "force channel": AUTO_CHANNEL,
             "velocity channel": AUTO_CHANNEL, "acceleration channel": AUTO_CHANNEL,
-            "inverted channels": ""}
+            "inverted channels": "", "time base unit": ""}
 
 
 def assumed_note(stated, row: Mapping, given: Iterable[str] = ()) -> str:
@@ -909,8 +909,30 @@ def options_of(row: Mapping, *, sample_rate_hz: float | None = None,
     # channel cells as the table holds them: the overrides read "(auto)", "(none)", blank and
     # NaN cells as no channel named (a NaN cell was passed on as a channel named "nan")
     cells = {column: row.get(label) for column, label in labels.items()}
-    return AnalysisOptions(**analysis_overrides(cells, str(row["file"]), labels=labels),
-                           sample_rate_hz=sample_rate_hz, time_unit=time_unit)
+    overrides = analysis_overrides(cells, str(row["file"]), labels=labels)
+    overrides.pop("time_unit", None)
+    return AnalysisOptions(**overrides, sample_rate_hz=sample_rate_hz,
+                           time_unit=file_time_unit(row, time_unit))
+
+
+def file_time_unit(row: Mapping, time_unit: str | None = None) -> str | None:
+    """The unit of one file's time base: its row's *time base unit* cell, else ``time_unit``
+    (the page's, for every file); a cell and a page's unit that read the time otherwise are
+    refused naming both, as ``pidcore analyze`` refuses ``--time-unit`` beside a sidecar's
+    ``time_unit`` (one of the two is wrong, either a frequency 1000 x off)."""
+    from ..file_settings import analysis_overrides, same_time_unit
+
+    label = next(k for k, v in FILE_TABLE_COLUMNS.items() if v == "time_unit")
+    stated = analysis_overrides({"time_unit": row.get(label)}, str(row["file"]),
+                                labels={"time_unit": label}).get("time_unit")
+    if stated is None:
+        return time_unit
+    if not same_time_unit(time_unit, stated):
+        raise SettingsTableError(
+            f"{row['file']}: {TIME_UNIT_FIELD} {time_unit!r} (for every file) disagrees with "
+            f"column {label} {stated!r}; expected one unit of the file's time base (leave the "
+            f"cell or the {TIME_UNIT_FIELD} field empty)")
+    return time_unit if time_unit is not None else stated
 
 
 # --- results and saving ------------------------------------------------------------------------

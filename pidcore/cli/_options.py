@@ -177,7 +177,7 @@ SIDECAR_OPTION_FLAGS: dict[str, str] = {
     "force": "--force", "velocity": "--velocity", "acceleration": "--acceleration",
     "velocity_delay_s": "--velocity-delay", "mass_below_gauge_kg": "--mass-below-gauge",
     "baseline_loss_factor": "--baseline-loss-factor", "structure_mass_kg": "--structure-mass",
-    "invert": "--invert",
+    "invert": "--invert", "time_unit": "--time-unit",
 }
 
 

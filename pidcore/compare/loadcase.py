@@ -81,7 +81,7 @@ SPECIMEN_COLUMN = "specimen"
 #: Columns stating how a file is analysed (read by :mod:`pidcore.file_settings`).
 ANALYSIS_SETTINGS_COLUMNS: tuple[str, ...] = (
     "velocity_delay_us", "mass_below_gauge_g", "baseline_loss_factor", "structure_mass_g",
-    "force", "velocity", "acceleration", "invert")
+    "force", "velocity", "acceleration", "invert", "time_unit")
 #: Every column of a sidecar / the app's settings table (its template's columns, in its order).
 SETTINGS_COLUMNS: tuple[str, ...] = (*SIDECAR_COLUMNS, SPECIMEN_COLUMN,
                                      *ANALYSIS_SETTINGS_COLUMNS)
@@ -105,6 +105,7 @@ SETTINGS_COLUMN_LABELS: dict[str, str] = {
     "velocity channel": "velocity",
     "acceleration channel": "acceleration",
     "inverted channels": "invert",
+    "time base unit": "time_unit",
 }
 #: Numeric columns by either name, as :func:`pidcore.tables.read_text_table` takes them.
 NUMERIC_HEADERS: tuple[str, ...] = (

@@ -40,7 +40,8 @@ class SettingsColumn:
     field : str
         The options field it sets.
     kind : str
-        ``"number"`` (finite, >= 0), ``"channel"`` (a name) or ``"channels"`` (``;``-separated).
+        ``"number"`` (finite, >= 0), ``"channel"`` (a name), ``"channels"`` (``;``-separated)
+        or ``"time unit"`` (a unit of time, as ``time_unit=`` / ``--time-unit`` takes it).
     scale : float
         Column value / ``scale`` = the field's SI value (µs -> s: 1e6). A division, not a
         product with 1e-6: 50 / 1e6 is the double nearest 5e-5, as the literal ``5e-5`` of
@@ -96,6 +97,8 @@ ANALYSIS_COLUMNS: dict[str, SettingsColumn] = {
     "velocity": SettingsColumn("velocity", "channel"),
     "acceleration": SettingsColumn("acceleration", "channel"),
     "invert": SettingsColumn("invert", "channels"),
+    # per file, so that a batch of exports in s and in ms is read each in its own unit
+    "time_unit": SettingsColumn("time_unit", "time unit", expected="a unit of time: s, ms or us"),
 }
 
 #: How each numeric setting a column states is said in words: its options field -> label,

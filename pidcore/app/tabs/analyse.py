@@ -81,6 +81,9 @@ def _settings_editor(measurements, tables: dict[str, pd.DataFrame], channel_name
                for role in ("force", "velocity", "acceleration")},
             "inverted channels": st.column_config.TextColumn(
                 help="channels whose sign is flipped, separated by ';' (e.g. Force)"),
+            "time base unit": st.column_config.TextColumn(
+                help="unit of this file's time base (s, ms, us) where its time column states "
+                     "none or one pidcore does not read; empty: the one for every file"),
         })
     ss["settings_current"] = edited
     st.download_button("Download these settings as a CSV template", uploads.settings_template(
@@ -118,7 +121,12 @@ def _card(upload, row, sample_rate_hz, time_unit, materials, given=(), known=(),
     with st.container(border=True):
         st.markdown(f"**{name}** · {_size(upload.size)}")
         sha = state.upload_sha256(upload)
-        found = state.parsed(sha, name, sample_rate_hz, time_unit, upload)
+        try:  # the row's own time base unit reads the file (a batch of exports in s and ms)
+            file_time_unit = uploads.file_time_unit(row, time_unit)
+        except PidcoreError as exc:
+            st.error(str(exc))
+            return None
+        found = state.parsed(sha, name, sample_rate_hz, file_time_unit, upload)
         if found.error is not None:  # no numbers: nothing assumed for them to say
             st.error(found.error)
             return None
@@ -133,7 +141,7 @@ def _card(upload, row, sample_rate_hz, time_unit, materials, given=(), known=(),
         except PidcoreError as exc:
             st.error(str(exc))
             return None
-        outcome = state.analysed(sha, name, sample_rate_hz, time_unit,
+        outcome = state.analysed(sha, name, sample_rate_hz, file_time_unit,
                                  uploads.options_to_json(options), upload)
         st.caption(uploads.channels_caption(found.channels.names, outcome, options))
         if outcome.error is not None:
