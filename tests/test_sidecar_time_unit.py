@@ -101,3 +101,20 @@ def test_the_app_reads_each_upload_in_its_rows_unit():
     with pytest.raises(SettingsTableError, match=r"time base unit 's' \(for every file\) "
                                                  r"disagrees with column time base unit 'ms'"):
         uploads.options_of(row, time_unit="s")
+
+
+def test_the_app_reads_an_upload_in_its_rows_unit_and_says_so(tmp_path):
+    from pidcore.app import uploads
+
+    path = export(tmp_path / "b_fill50.csv", 1e-3)
+    row = {"file": path.name, "time base unit": "ms"}
+    unit = uploads.file_time_unit(row, None)
+    outcome = uploads.analyze_parsed(
+        uploads.parse_upload(path.name, path.read_bytes(), time_unit=unit),
+        uploads.options_of(row))
+    assert outcome.ok, outcome.error
+    record = uploads.row_time_unit_notes(outcome.record, row, None)
+    assert record.analysis.frequency_hz == pytest.approx(DRIVE_HZ, rel=1e-6)  # not 0.125 Hz
+    # the row's cell stated it, not the page's field for every file, which was empty
+    assert any("taken as 'ms' (the settings table's column 'time base unit')" in n
+               for n in record.notes), record.notes

@@ -915,6 +915,25 @@ def options_of(row: Mapping, *, sample_rate_hz: float | None = None,
                            time_unit=file_time_unit(row, time_unit))
 
 
+def row_time_unit_notes(record: AnalyzedRecord, row: Mapping,
+                        time_unit: str | None) -> AnalyzedRecord:
+    """``record`` whose notes say the unit its row's *time base unit* cell stated came from
+    that cell: read with it, the reader's note named the field for every file, which was
+    empty (:func:`file_time_unit`). As it is where the page's field gave the unit."""
+    from .vocabulary import LABEL_OF_KEYWORD
+
+    if time_unit is not None or file_time_unit(row, None) is None:
+        return record
+    page, label = LABEL_OF_KEYWORD["time_unit"], _time_unit_label()
+    notes = tuple(n.replace(f"({page})", f"(the settings table's column '{label}')")
+                  for n in record.notes)
+    return record if notes == record.notes else replace(record, notes=notes)
+
+
+def _time_unit_label() -> str:
+    return next(k for k, v in FILE_TABLE_COLUMNS.items() if v == "time_unit")
+
+
 def file_time_unit(row: Mapping, time_unit: str | None = None) -> str | None:
     """The unit of one file's time base: its row's *time base unit* cell, else ``time_unit``
     (the page's, for every file); a cell and a page's unit that read the time otherwise are
@@ -922,7 +941,7 @@ def file_time_unit(row: Mapping, time_unit: str | None = None) -> str | None:
     ``time_unit`` (one of the two is wrong, either a frequency 1000 x off)."""
     from ..file_settings import analysis_overrides, same_time_unit
 
-    label = next(k for k, v in FILE_TABLE_COLUMNS.items() if v == "time_unit")
+    label = _time_unit_label()
     stated = analysis_overrides({"time_unit": row.get(label)}, str(row["file"]),
                                 labels={"time_unit": label}).get("time_unit")
     if stated is None:

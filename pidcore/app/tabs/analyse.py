@@ -147,7 +147,7 @@ def _card(upload, row, sample_rate_hz, time_unit, materials, given=(), known=(),
         if outcome.error is not None:
             st.error(outcome.error)
             return None
-        record = outcome.record
+        record = uploads.row_time_unit_notes(outcome.record, row, time_unit)
         delay = uploads.delay_note(row, given, velocity_used="velocity" in record.channels_used)
         if delay:
             st.info(f"{delay} (set it in the settings table)")
