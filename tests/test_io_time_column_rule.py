@@ -67,6 +67,15 @@ def test_a_first_column_of_an_unread_header_is_refused_by_name(tmp_path, capsys,
     assert "give its unit with --time-unit UNIT" in err
 
 
+def test_a_first_column_that_is_no_time_says_why_it_was_taken(tmp_path, capsys):
+    path = tmp_path / "points_fill50.csv"
+    path.write_text("Point1:+Z,Force [N]\n" + "".join(
+        f"{np.sin(i / 7):.6g},{np.cos(i / 7):.6g}\n" for i in range(300)))
+    err = refusal(["analyze", str(path), "--no-store", "--time-unit", "ms"], capsys)
+    assert (f"{path}: column 'Point1:+Z' (taken as the time with --time-unit: the first "
+            "column, its header not read as a time): time does not increase") in err
+
+
 def test_time_unit_does_not_take_a_force_column_for_the_time(tmp_path, capsys):
     path = tmp_path / "bare_fill50.csv"
     path.write_text("Force [N],Velocity [m/s]\n" + "".join(

@@ -387,7 +387,9 @@ def read_csv(path: str | os.PathLike[str], *, sample_rate_hz: float | None = Non
             # 'Time [US]' is µs, a factor the header's case did not state: said
             notes.append(f"{where}: time column {name!r}: {read_unit(unit).correction}")
         rate, start_time, note = rate_from_times(_in_seconds(columns[time_index], factor),
-                                                 what=f"{where}: column {name!r}",
+                                                 what=f"{where}: column {name!r}" + (
+                                                     f" (taken as the time with time_unit: "
+                                                     f"{by_rule})" if by_rule else ""),
                                                  with_note=True)
         if note:
             notes.append(note)
