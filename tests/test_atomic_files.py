@@ -287,3 +287,49 @@ def test_clearing_build_folders_never_follows_a_link(tmp_path):
     assert removed == [stale] and not stale.exists()
     assert linked.is_symlink() and precious.read_text() == "keep"
     assert sorted(p.name for p in elsewhere.iterdir()) == ["precious.txt"]
+
+
+def test_exchanging_paths_swaps_two_folders_or_says_it_cannot(tmp_path, monkeypatch):
+    # the swap is what keeps a replaced report folder in place at every instant; where it
+    # cannot be made, False (nothing changed) lets the caller fall back, any other failure
+    # is an error naming the paths
+    first, second = tmp_path / "first", tmp_path / "second"
+    for folder in (first, second):
+        folder.mkdir()
+        (folder / "name.txt").write_text(folder.name)
+    if not atomic_files.exchange_paths(first, second):
+        pytest.skip("this file system cannot swap two folders in one step")
+    assert (first / "name.txt").read_text() == "second"
+    assert (second / "name.txt").read_text() == "first"
+    with pytest.raises(FileNotFoundError, match="missing"):
+        atomic_files.exchange_paths(tmp_path / "missing", first)
+    assert (first / "name.txt").read_text() == "second"
+    monkeypatch.setattr(sys, "platform", "darwin")
+    assert atomic_files.exchange_paths(first, second) is False
+    assert (first / "name.txt").read_text() == "second"
+
+
+@pytest.mark.parametrize("exchange", [True, False], ids=["exchange", "two renames"])
+def test_a_folder_replacing_a_link_leaves_what_it_linked_and_nothing_beside(tmp_path,
+                                                                          monkeypatch, exchange):
+    # a target that is a link to a folder is moved aside (or swapped) as the link: what it
+    # linked is never removed, and the link itself is not left beside the target for ever
+    # (rmtree refuses a link); a dangling link is replaced as before
+    if not exchange:
+        monkeypatch.setattr(atomic_files, "exchange_paths", lambda first, second: False)
+    linked = tmp_path / "linked"
+    linked.mkdir()
+    (linked / "report.csv").write_text("linked")
+    beside = tmp_path / "beside"
+    beside.mkdir()
+    for target_of_link in (linked, tmp_path / "gone"):
+        target = beside / "rp"
+        target.symlink_to(target_of_link, target_is_directory=True)
+        new = atomic_files.new_temporary_folder_for(target)
+        (new / "report.csv").write_text("new")
+        atomic_files.replace_folder(new, target)
+        assert not target.is_symlink() and (target / "report.csv").read_text() == "new"
+        assert _only(beside) == ["rp"]
+        assert _only(linked) == ["report.csv"] and (linked / "report.csv").read_text() == "linked"
+        (target / "report.csv").unlink()
+        target.rmdir()
