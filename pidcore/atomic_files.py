@@ -11,7 +11,9 @@ of one. A folder of several outputs is built beside its place
 (:func:`new_temporary_folder_for`) and moved there whole, after :func:`fsync_tree`
 (:func:`replace_folder`: swapped with the earlier folder in one step where the system can);
 the next build of that folder removes the build folders a killed one left, by the files'
-rule, and puts back an earlier folder a kill left moved aside.
+rule, and puts back an earlier folder a kill left moved aside. Files moved one by one into a
+folder that keeps others (:func:`move_files_into_folder`) are moved from a committed build
+folder that the next write finishes moving (:func:`finish_committed_moves`).
 
 ``durable`` (the default) fsyncs the new file before the rename and the folder after it: a
 power loss right after the call then finds the new file, not an empty one under its name (a
@@ -365,6 +367,87 @@ def restore_previous_folder(target: str | os.PathLike[str], *,
     os.replace(found[0], target)
     _fsync_folder_of(target)
     return target
+
+
+#: Marks a build folder whose files are being moved into their folder
+#: (``.<name>.<16 hex>.commit``, :func:`move_files_into_folder`): renamed so once complete, it
+#: is the journal of the moves still to do, which no clean-up of build folders may take.
+COMMITTED_FOLDER_SUFFIX = ".commit"
+
+
+def committed_folder_name_pattern(target: str | os.PathLike[str]) -> re.Pattern[str]:
+    """The names :func:`move_files_into_folder` gives its committed build folder beside
+    ``target``, and no others."""
+    return re.compile(re.escape(f".{Path(target).name}.") + r"[0-9a-f]{16}"
+                      + re.escape(COMMITTED_FOLDER_SUFFIX))
+
+
+def move_files_into_folder(work: str | os.PathLike[str], target: str | os.PathLike[str]) -> None:
+    """Move every file of the build folder ``work`` into the existing folder ``target``,
+    replacing those of the same names, as one step for anyone who looks after a kill.
+
+    A folder whose other files must be kept cannot be swapped whole, and files are moved
+    one rename each, so a kill (SIGKILL, a power loss) between two renames left some files
+    new and the others earlier. Here ``work`` (complete, flushed by the caller) is first
+    renamed to a committed name (:func:`committed_folder_name_pattern`): that rename is the
+    commit point, and the folder's files are the moves still to do. A kill before it leaves
+    ``target`` as it was (and a build folder, removed by the build folders' clean-up); a
+    kill after it, moves that :func:`finish_committed_moves`, called by the next write
+    before anything else, completes (rolls forward). Files of other names in ``target`` are
+    never touched.
+    """
+    work, target = Path(work), Path(target)
+    commit = target.with_name(f".{target.name}.{secrets.token_hex(8)}{COMMITTED_FOLDER_SUFFIX}")
+    os.replace(work, commit)
+    _fsync_folder_of(target)  # the commit on disk before the moves it allows
+    _finish_moves(commit, target)
+
+
+def _finish_moves(commit: Path, target: Path) -> list[Path]:
+    """Move the plain files left in ``commit`` into ``target`` and remove ``commit``;
+    returns the files moved."""
+    import shutil
+
+    moved = []
+    with suppress(FileNotFoundError):  # all moved, and the folder removed, by another finisher
+        for entry in sorted(_stale_entries(commit, lambda name: True, stat.S_ISREG, 0.0, None)):
+            with suppress(FileNotFoundError):  # this one moved meanwhile by another finisher
+                os.replace(entry, target / entry.name)
+                moved.append(target / entry.name)
+    with suppress(OSError):
+        fsync_path(target, directory=True)  # the moves on disk before the journal goes
+    shutil.rmtree(commit, ignore_errors=True)
+    return moved
+
+
+def finish_committed_moves(target: str | os.PathLike[str]) -> list[Path]:
+    """Complete the moves into the folder ``target`` that a killed
+    :func:`move_files_into_folder` left after its commit; returns the files moved now
+    (empty: nothing was left), for the caller to say so.
+
+    Only an exact name (:func:`committed_folder_name_pattern`) that is a folder itself, not
+    a link, is taken (by the rule of the build folders' clean-up), and of it only plain
+    files; of several (only writes running at once leave more than one), the least recently
+    changed first. Where ``target`` is no folder (removed since, with the files already moved
+    into it), the rest cannot make a whole set and is removed.
+    """
+    import shutil
+
+    target = Path(target)
+    pattern = committed_folder_name_pattern(target)
+    try:
+        found = sorted((entry.lstat().st_ctime, entry) for entry in _stale_entries(
+            target.parent, lambda name: pattern.fullmatch(name) is not None, stat.S_ISDIR,
+            0.0, None))
+    except OSError:  # no parent yet, or one that cannot be listed: nothing left there
+        return []
+    moved: list[Path] = []
+    for _, commit in found:
+        if target.is_dir():  # a link to a folder too: the outputs were moved through it
+            moved += _finish_moves(commit, target)
+        else:
+            shutil.rmtree(commit, ignore_errors=True)
+    return moved
 
 
 @contextmanager

@@ -289,6 +289,53 @@ def test_clearing_build_folders_never_follows_a_link(tmp_path):
     assert sorted(p.name for p in elsewhere.iterdir()) == ["precious.txt"]
 
 
+def test_finishing_committed_moves_takes_only_plain_files_of_its_own_exact_name(tmp_path):
+    # the roll-forward of a killed move_files_into_folder: only the committed folder of
+    # this target is finished, its links are no file of the build's (moving one would put a
+    # link where the output was), and a target removed since leaves nothing to finish into
+    elsewhere = tmp_path / "elsewhere.txt"
+    elsewhere.write_text("keep")
+    target = tmp_path / "cal"
+    target.mkdir()
+    (target / "summary.md").write_text("earlier")
+    (target / "notes.txt").write_text("a user's")
+    committed = tmp_path / f".cal.{'1a' * 8}.commit"
+    committed.mkdir()
+    (committed / "summary.md").write_text("new")
+    (committed / "calibration.json").symlink_to(elsewhere)
+    others = [tmp_path / ".cal.backup.commit", tmp_path / f".cal.x.{'2b' * 8}.commit"]
+    for folder in others:  # a user's; target cal.x's
+        folder.mkdir()
+        (folder / "summary.md").write_text("not cal's")
+    moved = atomic_files.finish_committed_moves(target)
+    assert moved == [target / "summary.md"]
+    assert {p.name: p.read_text() for p in target.iterdir()} == {"summary.md": "new",
+                                                                "notes.txt": "a user's"}
+    assert _only(tmp_path) == sorted(["cal", "elsewhere.txt", *(f.name for f in others)])
+    assert elsewhere.read_text() == "keep"
+    # nothing left: nothing said
+    assert atomic_files.finish_committed_moves(target) == []
+    # a target that is a link to a folder (--out given as one) is finished through the link
+    linked = tmp_path / "cal"
+    target = tmp_path / "link"
+    target.symlink_to(linked, target_is_directory=True)
+    through = tmp_path / f".link.{'3c' * 8}.commit"
+    through.mkdir()
+    (through / "summary.md").write_text("newer")
+    assert atomic_files.finish_committed_moves(target) == [target / "summary.md"]
+    assert (linked / "summary.md").read_text() == "newer" and not through.exists()
+    target.unlink()
+    target = linked
+    # cal removed after the kill: the files moved before it went with it, the rest is no set
+    committed.mkdir()
+    (committed / "summary.md").write_text("new")
+    (target / "summary.md").unlink()
+    (target / "notes.txt").unlink()
+    target.rmdir()
+    assert atomic_files.finish_committed_moves(target) == []
+    assert _only(tmp_path) == sorted(["elsewhere.txt", *(f.name for f in others)])
+
+
 def test_exchanging_paths_swaps_two_folders_or_says_it_cannot(tmp_path, monkeypatch):
     # the swap is what keeps a replaced report folder in place at every instant; where it
     # cannot be made, False (nothing changed) lets the caller fall back, any other failure
