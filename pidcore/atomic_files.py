@@ -8,8 +8,12 @@ written to a temporary file in the target's own folder, so that the final
 (KeyboardInterrupt), SIGTERM, a full disk or a failing writer therefore leave the previous file
 as it was and no temporary file behind; a reader sees the old file or the new one, never half
 of one. A folder of several outputs is built beside its place
-(:func:`new_temporary_folder_for`) and moved there whole, after :func:`fsync_tree`; the next
-build of that folder removes the build folders a killed one left, by the files' rule.
+(:func:`new_temporary_folder_for`) and moved there whole, after :func:`fsync_tree`
+(:func:`replace_folder`: swapped with the earlier folder in one step where the system can);
+the next build of that folder removes the build folders a killed one left, by the files'
+rule, and puts back an earlier folder a kill left moved aside. Files moved one by one into a
+folder that keeps others (:func:`move_files_into_folder`) are moved from a committed build
+folder that the next write finishes moving (:func:`finish_committed_moves`).
 
 ``durable`` (the default) fsyncs the new file before the rename and the folder after it: a
 power loss right after the call then finds the new file, not an empty one under its name (a
@@ -209,7 +213,7 @@ def new_temporary_folder_for(target: str | os.PathLike[str]) -> Path:
 
 
 #: Marks an earlier folder moved aside (``.<name>.<16 hex>.old``) while :func:`replace_folder`
-#: renames its replacement into place.
+#: renames its replacement into place, where the system cannot swap the two in one step.
 PREVIOUS_FOLDER_SUFFIX = ".old"
 
 
@@ -221,20 +225,75 @@ def previous_folder_name_pattern(target: str | os.PathLike[str]) -> re.Pattern[s
                       + re.escape(PREVIOUS_FOLDER_SUFFIX))
 
 
+#: ``renameat2``'s flag that swaps its two paths (linux/fs.h).
+_RENAME_EXCHANGE = 2
+#: ``renameat2``'s "path relative to the current folder" (fcntl.h's AT_FDCWD).
+_AT_FDCWD = -100
+
+
+def exchange_paths(first: str | os.PathLike[str], second: str | os.PathLike[str]) -> bool:
+    """Swap the entries at ``first`` and ``second`` in one atomic step; True if done, False
+    where this system or file system cannot (nothing changed then). An ``OSError`` for any
+    other failure (a path missing, no permission).
+
+    The standard library renames one path over another, and a folder cannot be renamed over
+    a non-empty one; only Linux's ``renameat2(RENAME_EXCHANGE)`` (3.15, glibc 2.28) swaps
+    two, so it is called through :mod:`ctypes`. Without it (another system, an older glibc)
+    or where the file system refuses the flag (EINVAL) or the kernel lacks the call (ENOSYS),
+    False lets the caller fall back to two renames.
+    """
+    import ctypes
+    import errno
+    import sys
+
+    if not sys.platform.startswith("linux"):
+        return False
+    try:
+        libc = ctypes.CDLL(None, use_errno=True)
+        renameat2 = libc.renameat2
+    except (OSError, AttributeError):
+        return False
+    renameat2.argtypes = [ctypes.c_int, ctypes.c_char_p, ctypes.c_int, ctypes.c_char_p,
+                          ctypes.c_uint]
+    renameat2.restype = ctypes.c_int
+    if renameat2(_AT_FDCWD, os.fsencode(first), _AT_FDCWD, os.fsencode(second),
+                 _RENAME_EXCHANGE) == 0:
+        return True
+    code = ctypes.get_errno()
+    if code in (errno.EINVAL, errno.ENOSYS, errno.EOPNOTSUPP):
+        return False
+    raise OSError(code, os.strerror(code), os.fspath(first), None, os.fspath(second))
+
+
+def _fsync_folder_of(path: Path) -> None:
+    # the renames in it made durable; some file systems cannot fsync a folder, and the
+    # renames are done either way, so a failure here is not an error
+    with suppress(OSError):
+        fsync_path(path.parent if str(path.parent) else ".", directory=True)
+
+
 def replace_folder(new: str | os.PathLike[str], target: str | os.PathLike[str]) -> None:
     """Rename the folder ``new`` to ``target``, replacing the folder there, if any.
 
-    A folder cannot be renamed over a non-empty one, so the earlier ``target`` is first moved
-    aside (:func:`previous_folder_name_pattern`), then removed. An exception between the two
-    renames puts it back; a process killed there (SIGKILL, a power loss) leaves no
-    ``target`` and the earlier one hidden beside it, which :func:`restore_previous_folder`
-    (called by the next write, before anything else) puts back: no earlier folder is lost.
-    """
-    import shutil
+    Where the system can (:func:`exchange_paths`), the two are swapped in one step and the
+    earlier folder, now under ``new``'s name (a build folder's), is removed: a process killed
+    at any point (SIGKILL, a power loss) leaves ``target`` whole, earlier or new, and at most
+    a build folder that the next build's clean-up removes (:func:`new_temporary_folder_for`).
 
+    Elsewhere a folder cannot be renamed over a non-empty one, so the earlier ``target`` is
+    first moved aside (:func:`previous_folder_name_pattern`), then removed. An exception
+    between the two renames puts it back; a process killed there leaves no ``target`` and
+    the earlier one hidden beside it, which :func:`restore_previous_folder` (called by the
+    next write, before anything else) puts back: no earlier folder is lost.
+    """
     new, target = Path(new), Path(target)
-    if not target.exists():
+    if not os.path.lexists(target):  # a dangling link is no folder a folder renames over
         os.replace(new, target)
+        _fsync_folder_of(target)
+        return
+    if exchange_paths(new, target):
+        _fsync_folder_of(target)
+        _remove_folder_or_link(new)
         return
     old = target.with_name(f".{target.name}.{secrets.token_hex(8)}{PREVIOUS_FOLDER_SUFFIX}")
     os.replace(target, old)
@@ -243,40 +302,152 @@ def replace_folder(new: str | os.PathLike[str], target: str | os.PathLike[str]) 
     except BaseException:
         os.replace(old, target)
         raise
-    shutil.rmtree(old, ignore_errors=True)
+    _fsync_folder_of(target)
+    # under a build folder's name before it is removed: a removal cut short leaves part of
+    # the earlier folder where the build folders' clean-up takes it, never as a '.old' that
+    # the next write would put back in place of a folder it had replaced
+    trash = temporary_folder_path_for(target)
+    try:
+        os.replace(old, trash)
+    except OSError:
+        trash = old  # the next write's restore_previous_folder removes what is left
+    _remove_folder_or_link(trash)
+
+
+def _remove_folder_or_link(path: Path) -> None:
+    # a target that was a link to a folder was moved as the link: removed as one, never
+    # followed (rmtree refuses a link, which was left for ever beside the target)
+    import shutil
+
+    if path.is_symlink():
+        with suppress(OSError):
+            path.unlink()
+    else:
+        shutil.rmtree(path, ignore_errors=True)
 
 
 def restore_previous_folder(target: str | os.PathLike[str], *,
                             is_previous: Callable[[Path], bool] = lambda folder: True
                             ) -> Path | None:
-    """Where ``target`` is missing, rename back the earlier folder a killed
-    :func:`replace_folder` left hidden beside it; returns the folder restored (None: none).
+    """Settle what a killed :func:`replace_folder` left beside ``target``; returns the folder
+    restored (None: none was). Call it before any other write of ``target``.
 
-    Only an exact name (:func:`previous_folder_name_pattern`) that is a folder itself, not a
-    link, and that ``is_previous`` accepts (a report's marker) is taken; of several, the one
-    moved aside last (its change time, which the rename set). An existing ``target`` is
-    never touched.
+    Where ``target`` is missing, the earlier folder moved aside (SIGKILL, a power loss
+    between the two renames) is renamed back. Where ``target`` exists, such folders are
+    what remained of a replacement that had finished (killed before they were removed) and
+    are removed. Only an exact name (:func:`previous_folder_name_pattern`) that is a folder
+    itself, not a link, and that ``is_previous`` accepts (a report's marker) is taken, by
+    the rule of the build folders' clean-up. Several beside a missing ``target`` are
+    refused (a ``ParameterError`` naming them): which was the last is no longer certain,
+    and none is removed or guessed at. An existing ``target`` is never touched.
     """
+    import shutil
+
+    from .errors import ParameterError
+
     target = Path(target)
-    if os.path.lexists(target):
-        return None
     pattern = previous_folder_name_pattern(target)
-    found: list[tuple[float, Path]] = []
-    with suppress(OSError):
-        for entry in target.parent.iterdir():
-            if pattern.fullmatch(entry.name) is None:
-                continue
-            try:
-                info = entry.lstat()
-            except FileNotFoundError:
-                continue
-            if stat.S_ISDIR(info.st_mode) and is_previous(entry):
-                found.append((info.st_ctime, entry))
+    try:
+        found = [entry for entry in _stale_entries(
+            target.parent, lambda name: pattern.fullmatch(name) is not None, stat.S_ISDIR,
+            0.0, None) if is_previous(entry)]
+    except OSError:  # no parent yet, or one that cannot be listed: nothing left there
+        return None
+    if os.path.lexists(target):
+        for entry in found:
+            shutil.rmtree(entry, ignore_errors=True)
+        return None
     if not found:
         return None
-    _, previous = max(found)
-    os.replace(previous, target)
+    if len(found) > 1:
+        raise ParameterError(
+            f"{target}: missing, and {len(found)} earlier folders that killed writes left "
+            f"hidden beside it ({', '.join(sorted(entry.name for entry in found))}); rename "
+            f"the one to keep to {target.name} and remove the others")
+    os.replace(found[0], target)
+    _fsync_folder_of(target)
     return target
+
+
+#: Marks a build folder whose files are being moved into their folder
+#: (``.<name>.<16 hex>.commit``, :func:`move_files_into_folder`): renamed so once complete, it
+#: is the journal of the moves still to do, which no clean-up of build folders may take.
+COMMITTED_FOLDER_SUFFIX = ".commit"
+
+
+def committed_folder_name_pattern(target: str | os.PathLike[str]) -> re.Pattern[str]:
+    """The names :func:`move_files_into_folder` gives its committed build folder beside
+    ``target``, and no others."""
+    return re.compile(re.escape(f".{Path(target).name}.") + r"[0-9a-f]{16}"
+                      + re.escape(COMMITTED_FOLDER_SUFFIX))
+
+
+def move_files_into_folder(work: str | os.PathLike[str], target: str | os.PathLike[str]) -> None:
+    """Move every file of the build folder ``work`` into the existing folder ``target``,
+    replacing those of the same names, as one step for anyone who looks after a kill.
+
+    A folder whose other files must be kept cannot be swapped whole, and files are moved
+    one rename each, so a kill (SIGKILL, a power loss) between two renames left some files
+    new and the others earlier. Here ``work`` (complete, flushed by the caller) is first
+    renamed to a committed name (:func:`committed_folder_name_pattern`): that rename is the
+    commit point, and the folder's files are the moves still to do. A kill before it leaves
+    ``target`` as it was (and a build folder, removed by the build folders' clean-up); a
+    kill after it, moves that :func:`finish_committed_moves`, called by the next write
+    before anything else, completes (rolls forward). Files of other names in ``target`` are
+    never touched.
+    """
+    work, target = Path(work), Path(target)
+    commit = target.with_name(f".{target.name}.{secrets.token_hex(8)}{COMMITTED_FOLDER_SUFFIX}")
+    os.replace(work, commit)
+    _fsync_folder_of(target)  # the commit on disk before the moves it allows
+    _finish_moves(commit, target)
+
+
+def _finish_moves(commit: Path, target: Path) -> list[Path]:
+    """Move the plain files left in ``commit`` into ``target`` and remove ``commit``;
+    returns the files moved."""
+    import shutil
+
+    moved = []
+    with suppress(FileNotFoundError):  # all moved, and the folder removed, by another finisher
+        for entry in sorted(_stale_entries(commit, lambda name: True, stat.S_ISREG, 0.0, None)):
+            with suppress(FileNotFoundError):  # this one moved meanwhile by another finisher
+                os.replace(entry, target / entry.name)
+                moved.append(target / entry.name)
+    with suppress(OSError):
+        fsync_path(target, directory=True)  # the moves on disk before the journal goes
+    shutil.rmtree(commit, ignore_errors=True)
+    return moved
+
+
+def finish_committed_moves(target: str | os.PathLike[str]) -> list[Path]:
+    """Complete the moves into the folder ``target`` that a killed
+    :func:`move_files_into_folder` left after its commit; returns the files moved now
+    (empty: nothing was left), for the caller to say so.
+
+    Only an exact name (:func:`committed_folder_name_pattern`) that is a folder itself, not
+    a link, is taken (by the rule of the build folders' clean-up), and of it only plain
+    files; of several (only writes running at once leave more than one), the least recently
+    changed first. Where ``target`` is no folder (removed since, with the files already moved
+    into it), the rest cannot make a whole set and is removed.
+    """
+    import shutil
+
+    target = Path(target)
+    pattern = committed_folder_name_pattern(target)
+    try:
+        found = sorted((entry.lstat().st_ctime, entry) for entry in _stale_entries(
+            target.parent, lambda name: pattern.fullmatch(name) is not None, stat.S_ISDIR,
+            0.0, None))
+    except OSError:  # no parent yet, or one that cannot be listed: nothing left there
+        return []
+    moved: list[Path] = []
+    for _, commit in found:
+        if target.is_dir():  # a link to a folder too: the outputs were moved through it
+            moved += _finish_moves(commit, target)
+        else:
+            shutil.rmtree(commit, ignore_errors=True)
+    return moved
 
 
 @contextmanager

@@ -24,3 +24,82 @@ def leave_build_folders(target: Path, holding: str, hex_pairs: tuple[str, str]) 
         when = os.stat(folder).st_mtime - age
         os.utime(folder, (when, when))
     return names
+
+
+#: The exit status of a process :func:`run_killed_at_rename` ended (none of Python's own).
+KILLED_STATUS = 86
+
+#: Run first in the process of :func:`run_killed_at_rename`: ``arm_the_kill()``, called by
+#: the script just before the write it tests, makes its rename number ``sys.argv[1]`` (from
+#: 0) end the process with ``os._exit``, which runs no ``except``, ``finally`` or ``atexit``:
+#: a SIGKILL's effect on the files. With ``sys.argv[2] == "exchange"`` the atomic swap of two
+#: folders counts as one rename; otherwise it is made unavailable, so that the two-rename
+#: fallback is what runs.
+_KILLER = f'''
+import os
+import sys
+
+import pidcore.atomic_files as atomic_files
+
+
+def arm_the_kill():
+    left = [int(sys.argv[1])]
+
+    def killing(real):
+        def step(*args, **kwargs):
+            if left[0] == 0:
+                os._exit({KILLED_STATUS})
+            left[0] -= 1
+            return real(*args, **kwargs)
+        return step
+
+    os.replace, os.rename = killing(os.replace), killing(os.rename)
+    if sys.argv[2] == "exchange":
+        atomic_files.exchange_paths = killing(atomic_files.exchange_paths)
+    else:
+        atomic_files.exchange_paths = lambda first, second: False
+'''
+
+
+def run_killed_at_rename(script: str, renames: int, *, exchange: bool, args: tuple[str, ...] = (),
+                         cwd: Path) -> bool:
+    """Run ``script`` (which calls ``arm_the_kill()`` before its write; ``sys.argv[3:]`` are
+    ``args``) in a fresh interpreter killed at its rename number ``renames`` (counted from
+    0); True if it was killed there, False if it finished with fewer renames. Any other end
+    fails with its stderr."""
+    import subprocess
+    import sys
+
+    import pidcore
+
+    # the pidcore under test, wherever the interpreter's own install points
+    here = str(Path(pidcore.__file__).resolve().parents[1])
+    env = {**os.environ, "MPLBACKEND": "Agg",
+           "PYTHONPATH": os.pathsep.join([here, *filter(None, [os.environ.get("PYTHONPATH")])])}
+    done = subprocess.run([sys.executable, "-c", _KILLER + script, str(renames),
+                           "exchange" if exchange else "two renames", *args],
+                          cwd=cwd, env=env, capture_output=True, text=True, timeout=120)
+    assert done.returncode in (0, KILLED_STATUS), done.stderr
+    return done.returncode == KILLED_STATUS
+
+
+def exchange_available(folder: Path) -> bool:
+    """Whether the file system of ``folder`` swaps two folders in one step here."""
+    from pidcore.atomic_files import exchange_paths
+
+    first, second = folder / ".probe-first", folder / ".probe-second"
+    first.mkdir()
+    second.mkdir()
+    try:
+        return exchange_paths(first, second)
+    finally:
+        first.rmdir()
+        second.rmdir()
+
+
+def folder_contents(folder: Path) -> dict[str, bytes] | None:
+    """Every file under ``folder`` by its path there -> its bytes; None where it is missing."""
+    if not folder.exists():
+        return None
+    return {str(p.relative_to(folder)): p.read_bytes() for p in sorted(folder.rglob("*"))
+            if p.is_file()}

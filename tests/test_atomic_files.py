@@ -287,3 +287,96 @@ def test_clearing_build_folders_never_follows_a_link(tmp_path):
     assert removed == [stale] and not stale.exists()
     assert linked.is_symlink() and precious.read_text() == "keep"
     assert sorted(p.name for p in elsewhere.iterdir()) == ["precious.txt"]
+
+
+def test_finishing_committed_moves_takes_only_plain_files_of_its_own_exact_name(tmp_path):
+    # the roll-forward of a killed move_files_into_folder: only the committed folder of
+    # this target is finished, its links are no file of the build's (moving one would put a
+    # link where the output was), and a target removed since leaves nothing to finish into
+    elsewhere = tmp_path / "elsewhere.txt"
+    elsewhere.write_text("keep")
+    target = tmp_path / "cal"
+    target.mkdir()
+    (target / "summary.md").write_text("earlier")
+    (target / "notes.txt").write_text("a user's")
+    committed = tmp_path / f".cal.{'1a' * 8}.commit"
+    committed.mkdir()
+    (committed / "summary.md").write_text("new")
+    (committed / "calibration.json").symlink_to(elsewhere)
+    others = [tmp_path / ".cal.backup.commit", tmp_path / f".cal.x.{'2b' * 8}.commit"]
+    for folder in others:  # a user's; target cal.x's
+        folder.mkdir()
+        (folder / "summary.md").write_text("not cal's")
+    moved = atomic_files.finish_committed_moves(target)
+    assert moved == [target / "summary.md"]
+    assert {p.name: p.read_text() for p in target.iterdir()} == {"summary.md": "new",
+                                                                "notes.txt": "a user's"}
+    assert _only(tmp_path) == sorted(["cal", "elsewhere.txt", *(f.name for f in others)])
+    assert elsewhere.read_text() == "keep"
+    # nothing left: nothing said
+    assert atomic_files.finish_committed_moves(target) == []
+    # a target that is a link to a folder (--out given as one) is finished through the link
+    linked = tmp_path / "cal"
+    target = tmp_path / "link"
+    target.symlink_to(linked, target_is_directory=True)
+    through = tmp_path / f".link.{'3c' * 8}.commit"
+    through.mkdir()
+    (through / "summary.md").write_text("newer")
+    assert atomic_files.finish_committed_moves(target) == [target / "summary.md"]
+    assert (linked / "summary.md").read_text() == "newer" and not through.exists()
+    target.unlink()
+    target = linked
+    # cal removed after the kill: the files moved before it went with it, the rest is no set
+    committed.mkdir()
+    (committed / "summary.md").write_text("new")
+    (target / "summary.md").unlink()
+    (target / "notes.txt").unlink()
+    target.rmdir()
+    assert atomic_files.finish_committed_moves(target) == []
+    assert _only(tmp_path) == sorted(["elsewhere.txt", *(f.name for f in others)])
+
+
+def test_exchanging_paths_swaps_two_folders_or_says_it_cannot(tmp_path, monkeypatch):
+    # the swap is what keeps a replaced report folder in place at every instant; where it
+    # cannot be made, False (nothing changed) lets the caller fall back, any other failure
+    # is an error naming the paths
+    first, second = tmp_path / "first", tmp_path / "second"
+    for folder in (first, second):
+        folder.mkdir()
+        (folder / "name.txt").write_text(folder.name)
+    if not atomic_files.exchange_paths(first, second):
+        pytest.skip("this file system cannot swap two folders in one step")
+    assert (first / "name.txt").read_text() == "second"
+    assert (second / "name.txt").read_text() == "first"
+    with pytest.raises(FileNotFoundError, match="missing"):
+        atomic_files.exchange_paths(tmp_path / "missing", first)
+    assert (first / "name.txt").read_text() == "second"
+    monkeypatch.setattr(sys, "platform", "darwin")
+    assert atomic_files.exchange_paths(first, second) is False
+    assert (first / "name.txt").read_text() == "second"
+
+
+@pytest.mark.parametrize("exchange", [True, False], ids=["exchange", "two renames"])
+def test_a_folder_replacing_a_link_leaves_what_it_linked_and_nothing_beside(tmp_path,
+                                                                          monkeypatch, exchange):
+    # a target that is a link to a folder is moved aside (or swapped) as the link: what it
+    # linked is never removed, and the link itself is not left beside the target for ever
+    # (rmtree refuses a link); a dangling link is replaced as before
+    if not exchange:
+        monkeypatch.setattr(atomic_files, "exchange_paths", lambda first, second: False)
+    linked = tmp_path / "linked"
+    linked.mkdir()
+    (linked / "report.csv").write_text("linked")
+    beside = tmp_path / "beside"
+    beside.mkdir()
+    for target_of_link in (linked, tmp_path / "gone"):
+        target = beside / "rp"
+        target.symlink_to(target_of_link, target_is_directory=True)
+        new = atomic_files.new_temporary_folder_for(target)
+        (new / "report.csv").write_text("new")
+        atomic_files.replace_folder(new, target)
+        assert not target.is_symlink() and (target / "report.csv").read_text() == "new"
+        assert _only(beside) == ["rp"]
+        assert _only(linked) == ["report.csv"] and (linked / "report.csv").read_text() == "linked"
+        (target / "report.csv").unlink()
+        target.rmdir()

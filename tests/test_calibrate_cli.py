@@ -896,20 +896,108 @@ def test_a_killed_calibrations_build_folder_is_removed_by_the_next_out(capsys, t
                                                                        tiny_store):
     # `pidcore calibrate --out cal` killed outright (kill -9, a power loss) left its hidden
     # build folder beside cal for ever; the next --out cal removes it once a day old, and
-    # keeps a younger one (a live run's) and a user's folder named like it
+    # keeps a younger one (a live run's) and a user's folder named like it. One killed while
+    # it moved its outputs into cal left them half-moved: the next --out cal completes the
+    # moves first and says so (kill points: test_outputs_killed_at_any_move_...)
     from _build_leftovers import leave_build_folders
 
     out = tmp_path / "cal"
     names = leave_build_folders(out, "calibration.json", ('5a', '6b'))
+    out.mkdir()
+    (out / "notes.txt").write_text("a user's")
+    committed = tmp_path / f".cal.{'7c' * 8}.commit"  # its commit made, one file left
+    committed.mkdir()
+    (committed / "summary.md").write_text("the killed run's")
     code = main(["calibrate", "--data", str(_table(tmp_path)), "--fit", "fixture_mass_kg",
                  "--discrepancy", "0.2", "--dem-store", str(tiny_store), "--out", str(out),
                  *TINY])
-    assert code == 0, capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert code == 0, err
+    assert (f"pidcore calibrate: note: {out}: a calibration killed while moving its outputs "
+            "into it had left 1 of them to move (summary.md); moved now, so it holds that "
+            "calibration's whole set, not a mix with the earlier one") in err
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(
         ["cal", "m.csv", names["fresh"], names["user's"]])
-    # the outputs landed whole, and the calibration reads back from them
+    # the outputs landed whole, and the calibration reads back from them; a user's file kept
     assert sorted(p.name for p in out.iterdir()) == sorted(
         ["calibration.json", "calibrated_specimen.toml", "summary.md", "summary.html",
-         "predictions.png", "posterior_pairs.png"])
+         "predictions.png", "posterior_pairs.png", "notes.txt"])
+    assert (out / "notes.txt").read_text() == "a user's"
+    assert (out / "summary.md").read_text() != "the killed run's"
     assert set(json.loads((out / "calibration.json").read_text())["parameters"]) == \
         {"fixture_mass_kg"}
+
+
+#: The outputs of a calibration, each file's text naming ``sys.argv[4]``, written into
+#: ``sys.argv[3]`` by write_outputs, for :func:`_build_leftovers.run_killed_at_rename`
+#: (what the files hold is not what is tested, so the result and its texts are stand-ins).
+_OUTPUTS_SCRIPT = """
+from pathlib import Path
+from types import SimpleNamespace
+
+import pidcore.calibrate.outputs as outputs
+
+run = sys.argv[4]
+outputs.document_json = lambda document: f"calibration.json of {run}"
+for name in ("specimen_text", "summary_markdown", "summary_html"):
+    setattr(outputs, name, lambda result, name=name: f"{name} of {run}")
+for name in ("plot_predictions", "plot_pairs"):
+    setattr(outputs, name,
+            lambda result, path, name=name: Path(path).write_text(f"{name} of {run}"))
+arm_the_kill()
+outputs.write_outputs(SimpleNamespace(full_document=dict), sys.argv[3])
+"""
+
+
+def test_outputs_killed_at_any_move_are_the_earlier_or_the_new_set_after_the_next_run(tmp_path):
+    # `pidcore calibrate --out cal` into an existing cal renamed its six outputs into it one
+    # by one: killed (SIGKILL, power loss) between two, cal held some new files and some of
+    # the earlier calibration, for ever. Killed at each rename in turn, cal now holds the
+    # earlier set or the new one, file for file, once the next run's clean-up has run (as it
+    # does first), a user's files in cal untouched and nothing left beside it.
+    import os
+    import shutil
+    import time
+
+    from _build_leftovers import folder_contents, run_killed_at_rename
+
+    from pidcore.atomic_files import remove_stale_temporary_folders
+    from pidcore.calibrate import finish_interrupted_outputs
+    from pidcore.defaults import STALE_TEMPORARY_FILE_AGE_S
+
+    references = tmp_path / "references"
+    references.mkdir()
+    for run in ("earlier", "new"):
+        assert not run_killed_at_rename(_OUTPUTS_SCRIPT, 99, exchange=False, cwd=tmp_path,
+                                        args=(str(references / run), run))
+    earlier, new = folder_contents(references / "earlier"), folder_contents(references / "new")
+    assert len(earlier) == len(new) == 6 and not set(earlier.values()) & set(new.values())
+    users = {"notes.txt": b"a user's", "summary.md.bak": b"a user's copy"}
+    work = tmp_path / "work"
+    outcomes = []
+    for renames in range(12):
+        shutil.rmtree(work, ignore_errors=True)
+        work.mkdir()
+        out = work / "cal"
+        shutil.copytree(references / "earlier", out)
+        for name, data in users.items():
+            (out / name).write_bytes(data)
+        (work / ".cal.backup.commit").mkdir()  # a user's, named like ours
+        killed = run_killed_at_rename(_OUTPUTS_SCRIPT, renames, exchange=False, cwd=tmp_path,
+                                      args=(str(out), "new"))
+        note = finish_interrupted_outputs(out)
+        # a kill before the commit leaves a build folder, removed once a day old (only its
+        # age is not simulated)
+        remove_stale_temporary_folders(out, now=time.time() + STALE_TEMPORARY_FILE_AGE_S + 1)
+        after = folder_contents(out)
+        assert after in ({**earlier, **users}, {**new, **users}), renames
+        assert sorted(os.listdir(work)) == [".cal.backup.commit", "cal"], renames
+        outcomes.append("new" if after == {**new, **users} else "earlier")
+        # said where moves were finished: the commit made, 6 - (renames - 1) files left
+        left = 6 - (renames - 1) if killed and renames >= 1 else 0
+        assert (f"left {left} of them to move" in note) if left else note == "", (renames, note)
+        if not killed:
+            break
+    # every point reached: killed before the commit (the first rename) the earlier set,
+    # after it (at each of the 6 moves) the new one, and a run that finished
+    assert outcomes == ["earlier"] + ["new"] * 7

@@ -478,6 +478,37 @@ def test_a_read_only_store_is_named_as_such_before_any_analysis(tmp_path, capsys
                  "--format", "csv"]) == 0
 
 
+def test_an_earlier_report_a_killed_report_left_hidden_is_put_back_and_said_so(tmp_path,
+                                                                               capsys):
+    # the next report of rp put back an earlier report that a report killed between its two
+    # renames had left hidden, without a word: the user saw a report appear, or be replaced,
+    # that no run of theirs had just made. Said by the command, and by make_report's notes
+    # (not in the report's own provenance: it is of this run, not of the report)
+    import os
+
+    from pidcore.report import make_report
+
+    path = export(tmp_path / "rec_fill50_acrylic.csv", fmt="csv")
+    store = tmp_path / "s.h5"
+    assert main(["analyze", str(path), "--store", str(store)]) == 0
+    out = tmp_path / "rep"
+    report = ["report", "--store", str(store), "--out", str(out), "--format", "csv"]
+    assert main(report) == 0
+    said = (f"note: {out}: put back the earlier report, which a report killed while replacing "
+            "it had left hidden beside it")
+    assert said not in capsys.readouterr().out  # nothing hidden, nothing said
+    os.replace(out, tmp_path / ".rep.0123456789abcdef.old")  # the kill's state
+    assert main(report) == 0
+    printed = capsys.readouterr().out
+    assert printed.count(said) == 1
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["rec_fill50_acrylic.csv", "rep", "s.h5"]
+    os.replace(out, tmp_path / ".rep.0123456789abcdef.old")
+    result = make_report([], out_dir=out, store=store, formats="csv")
+    assert result.notes[-1] == said.removeprefix("note: ")
+    assert "put back the earlier report" not in result.paths["csv_provenance"].read_text()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["rec_fill50_acrylic.csv", "rep", "s.h5"]
+
+
 def test_a_file_of_other_particles_than_a_table_material_specimens_names_them(tmp_path, capsys):
     # with a --specimen of acrylic particles (a table material) the refusal of a ..._steel
     # file still read as if no specimen was given ("give --specimen FILE whose particles are

@@ -416,7 +416,9 @@ def test_a_write_killed_between_its_renames_loses_no_earlier_report(tmp_path, ta
     # The earlier report is moved aside, then the new one renamed into place: a SIGKILL
     # between the two left no rp and the earlier report hidden as '.rp.<hex>.old'. The kill
     # is stood for by an exception os.replace raises at the second rename, with the first
-    # one's undo (the except branch a SIGKILL never reaches) disabled too.
+    # one's undo (the except branch a SIGKILL never reaches) disabled too. Only where the
+    # system cannot swap the two folders in one step (the swap's kill points:
+    # test_a_report_killed_at_any_rename_leaves_the_earlier_or_the_new_report_whole).
     import os
 
     import pidcore.atomic_files as atomic_files
@@ -433,6 +435,7 @@ def test_a_write_killed_between_its_renames_loses_no_earlier_report(tmp_path, ta
         os.rename(src, dst)
 
     monkeypatch.setattr(atomic_files.os, "replace", killed_at_the_second_rename)
+    monkeypatch.setattr(atomic_files, "exchange_paths", lambda first, second: False)
     with pytest.raises(SystemExit):
         write_report(table.iloc[:1], {}, provenance, out, "csv")
     monkeypatch.undo()
@@ -466,9 +469,127 @@ def test_only_a_hidden_earlier_report_of_the_exact_name_is_restored(tmp_path):
     assert restore_previous_report(tmp_path / "rp") is None
     assert not (tmp_path / "rp").exists()
     (tmp_path / ".rp.0123456789abcdef.old" / REPORT_MARKER).write_text("x")
-    (tmp_path / "rp").mkdir()  # an existing rp is never touched
-    assert restore_previous_report(tmp_path / "rp") is None
-    (tmp_path / "rp").rmdir()
     assert restore_previous_report(tmp_path / "rp") == tmp_path / "rp"
     assert (tmp_path / "rp" / REPORT_MARKER).read_text() == "x"
     assert sorted(p.name for p in tmp_path.iterdir()) == [".rp.backup.old", "rp"]
+
+
+def test_a_hidden_earlier_report_beside_an_existing_one_is_removed_and_rp_untouched(tmp_path):
+    # a write killed after the new report was in place, before the earlier one moved aside
+    # was removed, left it hidden for ever (it was put back only where rp was missing); and
+    # had rp been removed later, a report it had replaced came back in its place
+    from pidcore.report.render import restore_previous_report
+
+    (tmp_path / "rp").mkdir()
+    (tmp_path / "rp" / REPORT_MARKER).write_text("the new one")
+    for name in (".rp.0123456789abcdef.old", ".rp.backup.old"):  # the pattern; a user's
+        (tmp_path / name).mkdir()
+        (tmp_path / name / REPORT_MARKER).write_text("the earlier one")
+    assert restore_previous_report(tmp_path / "rp") is None
+    assert sorted(p.name for p in tmp_path.iterdir()) == [".rp.backup.old", "rp"]
+    assert (tmp_path / "rp" / REPORT_MARKER).read_text() == "the new one"
+
+
+def test_several_hidden_earlier_reports_are_refused_not_guessed_at(tmp_path):
+    # which was moved aside last is no longer certain (a change time is not a write order
+    # a user can check): none is put back or removed, the error names each
+    from pidcore.report.render import restore_previous_report
+
+    names = [".rp.0123456789abcdef.old", ".rp.fedcba9876543210.old"]
+    for name in names:
+        (tmp_path / name).mkdir()
+        (tmp_path / name / REPORT_MARKER).write_text(name)
+    with pytest.raises(ParameterError) as refused:
+        restore_previous_report(tmp_path / "rp")
+    assert str(refused.value) == (
+        f"{tmp_path / 'rp'}: missing, and 2 earlier folders that killed writes left hidden "
+        f"beside it ({', '.join(names)}); rename the one to keep to rp and remove the others")
+    assert sorted(p.name for p in tmp_path.iterdir()) == names
+    for name in names:
+        assert (tmp_path / name / REPORT_MARKER).read_text() == name
+
+
+#: A report of the first ``sys.argv[4]`` rows of a fixed table into ``sys.argv[3]``, for
+#: :func:`_build_leftovers.run_killed_at_rename`.
+_REPORT_SCRIPT = '''
+from datetime import UTC, datetime
+
+import pandas as pd
+
+from pidcore.model import load_paper_table3
+from pidcore.report import build_report_table, collect_provenance, write_report
+
+dem = pd.DataFrame({"frequency_hz": [50.0, 500.0], "acceleration_g": [5.0, 5.0],
+                    "fill_percent": [50.0, 50.0], "material": ["acrylic"] * 2,
+                    "direction": ["z"] * 2, "sdc": [0.19, 0.55], "sdc_stderr": [0.004, 0.01],
+                    "case_key": ["a", "b"]})
+table = build_report_table(dem, dem.iloc[:0], load_paper_table3()).iloc[:int(sys.argv[4])]
+provenance = collect_provenance(created_utc=datetime(2026, 1, 2, tzinfo=UTC))
+arm_the_kill()
+write_report(table, {}, provenance, sys.argv[3], ("csv", "md"))
+'''
+
+
+@pytest.mark.parametrize("exchange", [True, False], ids=["exchange", "two renames"])
+def test_a_report_killed_at_any_rename_leaves_the_earlier_or_the_new_report_whole(
+        tmp_path, exchange):
+    # `pidcore report --out rp` killed (SIGKILL, power loss) between the renames that put a
+    # new report in place of an earlier one left no rp and the earlier one hidden. Where the
+    # system swaps two folders in one step there is no such point; elsewhere the next run
+    # puts the hidden one back. Killed at each rename in turn, rp is the earlier report or
+    # the new one, file for file, at once or after the next run's clean-up, and nothing
+    # beside it but what a user put there.
+    import os
+    import shutil
+    import time
+
+    from _build_leftovers import (
+        exchange_available,
+        folder_contents,
+        run_killed_at_rename,
+    )
+
+    from pidcore.atomic_files import remove_stale_temporary_folders
+    from pidcore.defaults import STALE_TEMPORARY_FILE_AGE_S
+    from pidcore.report.render import restore_previous_report
+
+    if exchange and not exchange_available(tmp_path):
+        pytest.skip("this file system cannot swap two folders in one step")
+    references = tmp_path / "references"
+    references.mkdir()
+    for rows in ("1", "2"):
+        assert not run_killed_at_rename(_REPORT_SCRIPT, 99, exchange=exchange, cwd=tmp_path,
+                                        args=(str(references / rows), rows))
+    earlier, new = folder_contents(references / "1"), folder_contents(references / "2")
+    assert earlier != new and REPORT_MARKER in earlier
+    work = tmp_path / "work"
+    outcomes = []
+    for renames in range(10):
+        shutil.rmtree(work, ignore_errors=True)
+        work.mkdir()
+        out = work / "rp"
+        shutil.copytree(references / "1", out)
+        (work / "notes.txt").write_text("a user's")
+        (work / ".rp.backup").mkdir()  # a user's, named like ours
+        killed = run_killed_at_rename(_REPORT_SCRIPT, renames, exchange=exchange, cwd=tmp_path,
+                                      args=(str(out), "2"))
+        left = folder_contents(out)
+        if exchange or not killed:  # no point without an rp
+            assert left in (earlier, new), (renames, sorted(os.listdir(work)))
+        # the next run's clean-up: the hidden earlier report back, and the build folders
+        # removed as they will be once a day old (their age is the only thing not simulated)
+        restore_previous_report(out)
+        remove_stale_temporary_folders(out, now=time.time() + STALE_TEMPORARY_FILE_AGE_S + 1)
+        after = folder_contents(out)
+        assert after in (earlier, new), (renames, sorted(os.listdir(work)))
+        assert after == left or left is None  # a report in place stays as it was
+        assert sorted(os.listdir(work)) == [".rp.backup", "notes.txt", "rp"], renames
+        assert (work / "notes.txt").read_text() == "a user's"
+        outcomes.append("new" if after == new else "earlier")
+        if not killed:
+            break
+    # every point was reached: before the swap the earlier report, after it the new one
+    renames_needed = 1 if exchange else 3  # swap | aside, into place, the earlier to removal
+    assert len(outcomes) == renames_needed + 1
+    assert outcomes == ["earlier"] * (1 if exchange else 2) + ["new"] * (len(outcomes) - (
+        1 if exchange else 2))

@@ -29,8 +29,9 @@ CATALOGUE, ParameterSpec, build_specs, parse_fit, dem_parameter_names
     What can be fitted, its bounds and priors.
 Observation, observation_from_run
     The SDC a shaker test of a DEM run would measure.
-write_outputs
-    calibration.json, the calibrated specimen, figures and summary.
+write_outputs, finish_interrupted_outputs
+    calibration.json, the calibrated specimen, figures and summary; the moves of a write
+    killed while it moved them into its folder, completed.
 save_calibration, SavedCalibration, stored_calibration, stored_calibrations
     Calibrations saved in and read from the HDF5 store (and what a save did).
 load_calibration, calibration_from_json, Calibration, CalibratedPrediction
@@ -43,7 +44,7 @@ CALIBRATION_COLUMNS_RENAMED
 from .calibrate import CalibrationResult, base_specimen, calibrate
 from .data import MeasuredPoint, measured_from_store, read_measured_table
 from .observation import Observation, observation_from_run
-from .outputs import write_outputs
+from .outputs import finish_interrupted_outputs, write_outputs
 from .parameters import CATALOGUE, ParameterSpec, build_specs, dem_parameter_names, parse_fit
 from .persist import (
     SavedCalibration,
@@ -61,7 +62,7 @@ from .prediction import (
 
 __all__ = ["calibrate", "base_specimen", "CalibrationResult", "MeasuredPoint",
            "read_measured_table", "measured_from_store", "Observation", "observation_from_run",
-           "write_outputs",
+           "write_outputs", "finish_interrupted_outputs",
            "CATALOGUE", "ParameterSpec", "build_specs", "parse_fit", "dem_parameter_names",
            "Calibration", "CalibratedPrediction", "load_calibration", "calibration_from_json",
            "CALIBRATION_COLUMNS_RENAMED",

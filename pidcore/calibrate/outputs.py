@@ -11,7 +11,12 @@ from typing import Any
 
 import numpy as np
 
-from ..atomic_files import fsync_tree, new_temporary_folder_for
+from ..atomic_files import (
+    finish_committed_moves,
+    fsync_tree,
+    move_files_into_folder,
+    new_temporary_folder_for,
+)
 from ..records import json_safe
 from ..units import display_number
 from .calibrate import CalibrationResult
@@ -417,6 +422,20 @@ def plot_pairs(result: CalibrationResult, path: Path) -> None:
     _write_and_close(pairs_figure(result), path, dpi=100)
 
 
+def finish_interrupted_outputs(out_dir: str | os.PathLike) -> str:
+    """Complete the outputs a calibration killed while moving them into ``out_dir``
+    (SIGKILL, a power loss) left half-moved, so that it holds that calibration's whole set;
+    returns a note saying so ("" where nothing was left). :func:`write_outputs` calls it
+    first; a front-end calls it before its work, to say so at once."""
+    moved = finish_committed_moves(out_dir)
+    if not moved:
+        return ""
+    return (f"{out_dir}: a calibration killed while moving its outputs into it had left "
+            f"{len(moved)} of them to move ({', '.join(sorted(p.name for p in moved))}); "
+            "moved now, so it holds that calibration's whole set, not a mix with the earlier "
+            "one")
+
+
 def write_outputs(result: CalibrationResult, out_dir: str | os.PathLike) -> list[Path]:
     """Write every output into ``out_dir`` (created); returns the paths written.
 
@@ -425,7 +444,9 @@ def write_outputs(result: CalibrationResult, out_dir: str | os.PathLike) -> list
     (:func:`pidcore.interrupt.deferred`). A Ctrl-C while they were written (the figures take
     seconds) used to leave a folder with a calibration.json and no figures, which looked like
     a finished calibration; now ``out_dir`` is as it was, or holds the whole new set (files
-    of other names in it are kept).
+    of other names in it are kept). A kill (SIGKILL, a power loss) while the files are moved
+    into an existing ``out_dir`` is completed by the next write
+    (:func:`finish_interrupted_outputs`, :func:`pidcore.atomic_files.move_files_into_folder`).
     """
     import shutil
 
@@ -439,6 +460,7 @@ def write_outputs(result: CalibrationResult, out_dir: str | os.PathLike) -> list
              ("summary.md", summary_markdown(result)),
              ("summary.html", summary_html(result)))
     out.parent.mkdir(parents=True, exist_ok=True)
+    finish_interrupted_outputs(out)  # before this write's: the earlier set whole, then replaced
     # beside out_dir: on its file system, so that the moves below are renames
     work = new_temporary_folder_for(out)
     try:
@@ -455,8 +477,7 @@ def write_outputs(result: CalibrationResult, out_dir: str | os.PathLike) -> list
             if not out.exists():
                 os.replace(work, out)
             else:  # a folder (check_out_folder): each file replaced, the set in one step
-                for name in names:
-                    os.replace(work / name, out / name)
+                move_files_into_folder(work, out)
     finally:
         shutil.rmtree(work, ignore_errors=True)
     return [out / name for name in names]

@@ -87,7 +87,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     from ..calibrate.calibrate import CALIBRATION_CELLS, calibrate
     from ..calibrate.data import DEFAULT_MATERIAL, measured_from_store, read_measured_table
-    from ..calibrate.outputs import write_outputs
+    from ..calibrate.outputs import finish_interrupted_outputs, write_outputs
     from ..calibrate.parameters import parse_fit
     from ..calibrate.persist import save_calibration
     from ..calibrate.runner import RunTally
@@ -96,6 +96,11 @@ def run(args: argparse.Namespace) -> int:
 
     if args.out is not None:  # said before the DEM runs and the fit, not after them
         check_out_folder(args.out)
+        # a killed run's half-moved outputs completed first: said now, and the earlier set
+        # this run replaces is then whole
+        finished = finish_interrupted_outputs(args.out)
+        if finished:
+            print(f"pidcore calibrate: note: {finished}", file=sys.stderr)
     specimen = load_specimen(args.specimen) if args.specimen is not None else None
     fit = parse_fit(args.fit, specimen)
     cells = CALIBRATION_CELLS if args.cells is None else args.cells

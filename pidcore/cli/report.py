@@ -10,7 +10,12 @@ import sys
 
 from .. import interrupt
 from ..interrupt import untouched
-from ..report.render import folder_identity, format_cell, restore_previous_report
+from ..report.render import (
+    folder_identity,
+    format_cell,
+    restore_previous_report,
+    restored_report_note,
+)
 from ..report.table import (
     ALIGNMENT_COLUMN,
     CALIBRATED_BAND_COLUMN,
@@ -106,7 +111,8 @@ def run(args: argparse.Namespace) -> int:
     specimen = load_specimen(args.specimen) if args.specimen is not None else None
     # a hidden earlier report back first (a killed write's): else the identity below would
     # call the restored folder this run's report after a Ctrl-C
-    restore_previous_report(args.out)
+    if restore_previous_report(args.out) is not None:  # said at once: the run may fail
+        print(f"note: {restored_report_note(args.out)}")
     before = folder_identity(args.out)
     # a commit puts a new store file in place (copy, then rename): its identity says after a
     # Ctrl-C whether the analyses of FILES were saved

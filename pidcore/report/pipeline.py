@@ -33,7 +33,13 @@ from ..errors import ParameterError, StoreError
 from ..io import display_path
 from ..loadcase import refuse_identical_contents_stating_apart
 from .provenance import calibration_provenance, collect_provenance
-from .render import check_out_dir, parse_formats, write_report
+from .render import (
+    check_out_dir,
+    parse_formats,
+    restore_previous_report,
+    restored_report_note,
+    write_report,
+)
 from .table import SPECIMEN_SHA256_COLUMN, add_calibration_columns, report_table_and_aligner
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -109,7 +115,8 @@ class ReportResult:
     measured : list of MeasuredResult
         The files analysed in this call.
     notes : list of str
-        Records left out, figures skipped, and why.
+        Records left out, figures skipped, and why; an earlier report that a killed one
+        had left hidden, put back before this one replaced it.
     """
 
     paths: dict[str, Path]
@@ -775,6 +782,8 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         raise ParameterError(f"calibration_key={calibration_key}: give the store holding it "
                              "as calibration=PATH")
     out_dir = Path(out_dir)
+    # a hidden earlier report back before the check (write_report would do it silently)
+    restored = restore_previous_report(out_dir) is not None
     check_out_dir(out_dir)
     tolerances = tolerances or Tolerances()
     files = [Path(f) for f in files]
@@ -932,4 +941,7 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
     finally:
         for fig in figures.values():  # bare Figures: drop references to free Agg buffers
             fig.clear()
+    if restored:  # of this run, not of the report: after its provenance took the notes
+        note = restored_report_note(out_dir)
+        notes = [*notes, wording(note) if wording is not None else note]
     return ReportResult(paths, table, results, notes)

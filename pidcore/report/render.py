@@ -337,10 +337,19 @@ def _move_into_place(tmp: Path, out_dir: Path) -> None:
 
 def restore_previous_report(out_dir: str | Path) -> Path | None:
     """Where ``out_dir`` is missing, put back the earlier report a write killed between its
-    two renames (SIGKILL, a power loss) left hidden beside it (``.<name>.<16 hex>.old``);
-    returns the folder restored, None if none was. :func:`write_report` calls it first."""
+    two renames (SIGKILL, a power loss; only where the system cannot swap folders in one
+    step) left hidden beside it (``.<name>.<16 hex>.old``); where it exists, remove such a
+    folder left after the replacement had finished. Returns the folder restored, None if
+    none was (:func:`restored_report_note` says so); a ``ParameterError`` where several are
+    hidden beside a missing ``out_dir``. :func:`write_report` calls it first."""
     return restore_previous_folder(
         out_dir, is_previous=lambda folder: (folder / REPORT_MARKER).is_file())
+
+
+def restored_report_note(out_dir: str | Path) -> str:
+    """The note that :func:`restore_previous_report` put the earlier report back."""
+    return (f"{out_dir}: put back the earlier report, which a report killed while replacing "
+            "it had left hidden beside it")
 
 
 def write_report(table: pd.DataFrame, figures: Mapping[str, object], provenance: Provenance,
