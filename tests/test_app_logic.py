@@ -2595,7 +2595,8 @@ def test_calibrate_points_table_names_a_unit_per_number_and_shows_the_sdc_bound_
         assert not numeric or re.search(r"\[.+\]$", column), column
         assert "_" not in column, column  # no raw field name
     assert table["SDC bound [-]"].tolist() == [heavy.sdc, SDC_UPPER_BOUND]
-    assert table["SDC measured, Eq. 11 [-]"].tolist() == [7.0, 0.5]
+    # the report's and Calibration.to_pandas()'s name (it said "SDC measured, Eq. 11 [-]")
+    assert table["SDC measured (Eq. 11) [-]"].tolist() == [7.0, 0.5]
     assert table["specimen sha256"].tolist() == ["ab" * 32, ""]
 
 

@@ -31,7 +31,12 @@ from ..compare.align import (  # noqa: F401 (public here)
     band_quantile,
     quantile_label,
 )
-from ..compare.plausibility import SDC_UPPER_BOUND, UNKNOWN_SPECIMEN_BOUND, SdcBound
+from ..compare.plausibility import (
+    SDC_BOUND_COLUMN,
+    SDC_UPPER_BOUND,
+    UNKNOWN_SPECIMEN_BOUND,
+    SdcBound,
+)
 from ..constants import BAND_VERDICTS
 from ..errors import ParameterError, instance_of, real_number
 from ..loadcase import LoadCase
@@ -61,15 +66,13 @@ CALIBRATION_COLUMNS_RENAMED: dict[str, str] = {
     f"measured in 95 % band [{'/'.join(BAND_VERDICTS)}]": CALIBRATED_INSIDE_COLUMN,
     "low95 without stderr [-]": "calibrated low 95 % without measurement stderr [-]",
     "high95 without stderr [-]": "calibrated high 95 % without measurement stderr [-]",
-    "sdc bound [-]": "SDC bound [-]",
+    "sdc bound [-]": SDC_BOUND_COLUMN,
 }
 #: The calibrated band of the model's SDC alone (calibration.json's ``low95_without_stderr``,
 #: ``high95_without_stderr``): :data:`CALIBRATED_LOW_COLUMN`'s band without the measurement's
 #: standard error.
 CALIBRATED_LOW_WITHOUT_STDERR_COLUMN = CALIBRATION_COLUMNS_RENAMED["low95 without stderr [-]"]
 CALIBRATED_HIGH_WITHOUT_STDERR_COLUMN = CALIBRATION_COLUMNS_RENAMED["high95 without stderr [-]"]
-#: The SDC a band is cut at (:func:`calibrated_sdc_bound`), as the app's Calibrate page names it.
-SDC_BOUND_COLUMN = CALIBRATION_COLUMNS_RENAMED["sdc bound [-]"]
 #: The calibrated DEM's SDC minus the measured one, as calibration's summaries name it.
 CALIBRATED_DIFFERENCE_COLUMN = "difference calibrated DEM - measured (Eq. 11) [-]"
 
