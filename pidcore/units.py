@@ -411,8 +411,10 @@ def value_and_error_texts(value: float, stderr: float, *, max_digits: int = 6,
       a value that is not a number.
 
     Before, the value was cut at six significant digits while the error kept its own
-    (``0.250000 ± 1.1e-14``), and an error below 1e-4 had an exponent beside a value of fixed
-    decimals (``0.250000 ± 3.0e-05``) and the reverse (``5.00e-05 ± 0.0000030``-like).
+    (``0.250000 ± 1.1e-14``), an error below 1e-4 had an exponent beside a value of fixed
+    decimals (``0.000150 ± 2.0e-05``), each number its own exponent (``5.00e-05 ±
+    3.0e-06``), and a value below its error kept two digits finer than it (``1.0e-07 ±
+    4.4e-05``, ``0.012 ± 0.50``).
 
     >>> value_and_error_texts(0.01234, 0.00056), value_and_error_texts(4.09, 0.2)
     (('0.01234', '0.00056'), ('4.09', '0.20'))

@@ -23,6 +23,7 @@ from pidcore.units import display_value_with_error, value_and_error_texts
     (0.5, 0.0996, "0.50", "0.10"),
     # an error below 1e-4 beside a value above it: fixed decimals on both (was 3.0e-05)
     (0.25, 3e-5, "0.250000", "0.000030"),
+    (1.5e-4, 2e-5, "0.000150", "0.000020"),  # was 0.000150 ± 2.0e-05
     # a noise-free record: six digits of 0.25 reach 1e-6; 1.1e-14 is below that place
     (0.25, 1.1e-14, "0.250000", "<0.000001"),
     # 1.5e-6 at the value's last place (1e-6) is 2e-6: one digit, not "<"
