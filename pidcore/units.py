@@ -14,6 +14,7 @@ import functools
 import math
 import re
 from dataclasses import dataclass
+from decimal import ROUND_HALF_EVEN, Decimal
 
 from .constants import SI_UNITS, STANDARD_GRAVITY
 from .errors import ParameterError, a_or_an, instance_of
@@ -391,46 +392,81 @@ def display_number(value: float | None, *, decimals: int = 4, missing: str = "�
 def value_and_error_texts(value: float, stderr: float, *, max_digits: int = 6,
                           missing: str = "—") -> tuple[str, str]:
     """``value`` and its standard error ``stderr`` as every page and the terminal write them
-    (GUM 7.2.6): the error with two significant digits, the value rounded at the error's last
-    digit, with two to ``max_digits`` significant digits (a noise-free record's error of 1e-14
-    asked for fifteen; with four at most, 8.16812 ± 0.00030 was shown as 8.168, coarser than
-    its own error); the error's text ``""`` where it is unknown (NaN), ``"0"`` where zero;
-    ``(missing, "")`` for a value that is not a number, and a value without an error with
-    four significant digits, as an SDC shown alone (``sdc_text``). The app showed
-    0.2100 ± 0.0100 and 0.0123 ± 0.0006 (four decimals) where ``pidcore analyze`` wrote 0.21
-    and 0.012340 beside 0.01 and 0.00056.
+    (GUM 7.2.6), the one rule of reports, ``pidcore analyze``, ``dem run`` and the app:
+
+    * the error with two significant digits, the value rounded at the same decimal place
+      (``0.01234 ± 0.00056``; a value below its error reads ``0.00 ± 0.25``, not finer than
+      what its error allows);
+    * both in one notation with one exponent: fixed decimals where the larger of the two is
+      from 1e-4 up to 1e6, else the exponent of the larger on both (``5.00e-05 ± 0.30e-05``,
+      never ``5.00e-05`` beside ``0.0000030``);
+    * the value with ``max_digits`` significant digits at most: an error below its last
+      place is said to be below one unit of that place (``0.250000 ± <0.000001``, a
+      noise-free record), one at or above it is shown at that place with one digit;
+    * a negative value (a loss factor within its noise of zero is kept) keeps its sign,
+      except where it rounds to zero (``0.0e-05``, not ``-0.0e-05``);
+    * the error's text ``"0"`` where it is zero (the value at ``max_digits`` significant
+      digits), ``"inf"`` where infinite, ``""`` where unknown (NaN: the value alone, with
+      four significant digits, as an SDC shown alone, ``sdc_text``); ``(missing, "")`` for
+      a value that is not a number.
+
+    Before, the value was cut at six significant digits while the error kept its own
+    (``0.250000 ± 1.1e-14``), an error below 1e-4 had an exponent beside a value of fixed
+    decimals (``0.000150 ± 2.0e-05``), each number its own exponent (``5.00e-05 ±
+    3.0e-06``), and a value below its error kept two digits finer than it (``1.0e-07 ±
+    4.4e-05``, ``0.012 ± 0.50``).
 
     >>> value_and_error_texts(0.01234, 0.00056), value_and_error_texts(4.09, 0.2)
     (('0.01234', '0.00056'), ('4.09', '0.20'))
-    >>> value_and_error_texts(8.168123, 0.0003), value_and_error_texts(1.367, 0.00046)
-    (('8.16812', '0.00030'), ('1.36700', '0.00046'))
+    >>> value_and_error_texts(8.168123, 0.0003), value_and_error_texts(0.25, 3e-5)
+    (('8.16812', '0.00030'), ('0.250000', '0.000030'))
     >>> value_and_error_texts(0.25, 1.1e-14), value_and_error_texts(5.09e-5, 4.4e-5)
-    (('0.250000', '1.1e-14'), ('5.1e-05', '4.4e-05'))
+    (('0.250000', '<0.000001'), ('5.1e-05', '4.4e-05'))
+    >>> value_and_error_texts(5.0e-5, 3e-6), value_and_error_texts(-3.2e-5, 4.4e-5)
+    (('5.00e-05', '0.30e-05'), ('-3.2e-05', '4.4e-05'))
     """
     if value is None or not math.isfinite(value):
         return missing, ""
-    if stderr is None or not math.isfinite(stderr):
+    if stderr is None or math.isnan(stderr):
         return f"{value:.4g}", ""
+    if math.isinf(stderr):
+        return f"{value:.4g}", "inf"
+    exact = Decimal(repr(float(value)))
     if stderr == 0:
-        error_text, place = "0", -math.inf
+        if value == 0:
+            return "0", "0"
+        error = error_top = error_place = None
     else:
-        error = float(f"{abs(stderr):.2g}")  # rounded first: 0.0996 is shown as 0.10
-        place = math.floor(math.log10(error)) - 1  # of the error's last digit shown
-        error_text = f"{error:.0f}" if place >= 0 else f"{error:.{-place}f}"
-        if error < 1e-4:  # as Python's g writes it: no run of zeros to count
-            error_text = f"{error:.1e}"
-    if value == 0:
-        return (f"{0:.{-place}f}" if 0 > place > -math.inf else "0"), error_text
-    top = math.floor(math.log10(abs(value)))
-    digits = int(min(max(top - place + 1, 2), max_digits))
-    if abs(round(value, digits - 1 - top)) >= 10.0 ** (top + 1):  # 0.0996 rounds to 0.100
-        top += 1
-        digits = int(min(max(top - place + 1, 2), max_digits))
-    if top >= digits - 1:  # 1230, not an exponent, for a value above its shown digits
-        return f"{round(value, digits - 1 - top):.0f}", error_text
-    if abs(value) < 1e-4 and value != 0:
-        return f"{value:.{digits - 1}e}", error_text
-    return f"{value:.{digits - 1 - top}f}", error_text
+        error = Decimal(f"{abs(stderr):.1e}")  # two significant digits: 0.0996 reads 0.10
+        error_top = error.adjusted()
+        place = error_place = error_top - 1
+    top = None
+    if value != 0:
+        top = exact.adjusted()
+        for _ in range(2):  # once more where rounding carries into a new decade (0.0996)
+            cap = top - max_digits + 1
+            place = cap if error_place is None else max(error_place, cap)
+            rounded = exact.quantize(Decimal(1).scaleb(place), rounding=ROUND_HALF_EVEN)
+            if rounded == 0 or rounded.adjusted() <= top:
+                break
+            top = rounded.adjusted()
+    larger = max(t for t in (top, error_top) if t is not None)
+    exponent = 0 if -4 <= larger < 6 else larger
+
+    def shown(number: Decimal) -> str:
+        at = number.scaleb(-exponent).quantize(Decimal(1).scaleb(place - exponent),
+                                               rounding=ROUND_HALF_EVEN)
+        text = f"{abs(at) if at == 0 else at:f}"
+        return text if exponent == 0 else f"{text}e{exponent:+03d}"
+
+    if error is None:
+        error_text = "0"
+    elif place > error_place and error.quantize(Decimal(1).scaleb(place),
+                                                  rounding=ROUND_HALF_EVEN) == 0:
+        error_text = "<" + shown(Decimal(1).scaleb(place))  # below the value's last place
+    else:
+        error_text = shown(error)
+    return shown(exact), error_text
 
 
 def display_value_with_error(value: float, stderr: float, *, missing: str = "—") -> str:

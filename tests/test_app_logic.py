@@ -1940,8 +1940,9 @@ def test_the_sample_rate_hint_names_the_apps_option():
     (1.5702e-4, float("nan"), "0.000157"),  # the paper's 50 Hz, 1 g, 25 % DEM value
     # a mass without damping, within noise: rounded at the error's last digit
     (5.09e-5, 4.4e-5, "5.1e-05 ± 4.4e-05"),
-    # a noise-free record's round-off error: six significant digits at most
-    (0.25, 1.1e-14, "0.250000 ± 1.1e-14"),
+    # a noise-free record's round-off error: six significant digits at most, and the error
+    # said to be below their last place (it read 0.250000 ± 1.1e-14)
+    (0.25, 1.1e-14, "0.250000 ± <0.000001"),
     # never coarser than its own error where six digits reach it (it showed 8.168 ± 0.00030)
     (8.168123, 0.0003, "8.16812 ± 0.00030"),
 ])
@@ -2594,5 +2595,27 @@ def test_calibrate_points_table_names_a_unit_per_number_and_shows_the_sdc_bound_
         assert not numeric or re.search(r"\[.+\]$", column), column
         assert "_" not in column, column  # no raw field name
     assert table["SDC bound [-]"].tolist() == [heavy.sdc, SDC_UPPER_BOUND]
-    assert table["SDC measured, Eq. 11 [-]"].tolist() == [7.0, 0.5]
+    # the report's and Calibration.to_pandas()'s name (it said "SDC measured, Eq. 11 [-]")
+    assert table["SDC measured (Eq. 11) [-]"].tolist() == [7.0, 0.5]
     assert table["specimen sha256"].tolist() == ["ab" * 32, ""]
+
+
+@pytest.mark.parametrize(("sdc", "stderr", "shown"), [
+    (1.5702e-4, math.nan, "0.000157"),  # the paper's 50 Hz, 1 g, 25 % DEM value: was 0.0002
+    (5.09e-5, 4.4e-5, "5.1e-05 ± 4.4e-05"),  # was 0.0001, "- stderr" 0.0000, "+" 0.0001
+    (0.1856, 0.0042, "0.1856 ± 0.0042"),
+])
+def test_the_sdc_charts_tooltip_writes_the_sdc_as_the_pages_do(sdc, stderr, shown):
+    # the Compare page's SDC chart wrote its points' SDC and bounds with four fixed decimals
+    from pidcore.app.charts import sdc_chart
+    from pidcore.app.uploads import format_sdc
+
+    err = 0.0 if math.isnan(stderr) else stderr  # as sdc_points writes a point without one
+    data = pd.DataFrame({"series": ["measured (± stderr)"], "fill [%]": [50.0],
+                         "SDC [-]": [sdc], "low [-]": [sdc - err], "high [-]": [sdc + err]})
+    spec = sdc_chart(data)
+    (row,) = spec["datasets"]["sdc"]
+    assert row["sdc_text"] == shown == format_sdc(sdc, stderr)
+    tooltips = [t for layer in spec["layer"] for t in layer["encoding"].get("tooltip", [])]
+    assert {"field": "sdc_text", "type": "nominal", "title": "SDC ± stderr [-]"} in tooltips
+    assert not any(t.get("format", "").endswith("f") for t in tooltips)  # no fixed decimals

@@ -78,7 +78,8 @@ def _wait_for_jobs(store_path, timeout_s: float = 300.0) -> None:
 
 def _table(at: AppTest, column: str):
     """The first dataframe shown that has ``column`` (results: "velocity channel";
-    report: "SDC measured (Eq. 11) [-]")."""
+    report: "SDC DEM (ours) [-]": the Calibrate page's measured points name their SDC
+    "SDC measured (Eq. 11) [-]" too, as the report does)."""
     return next(d.value for d in at.dataframe if column in d.value.columns)
 
 
@@ -460,7 +461,7 @@ def test_report_tab_shows_the_table_and_offers_clean_downloads(store_file):
     at.run()
     shown_sdc = _table(at, "warnings")["SDC [-]"].iloc[0]
     at.run()  # the report tab reads the store written by the previous run
-    table = _table(at, "SDC measured (Eq. 11) [-]")
+    table = _table(at, "SDC DEM (ours) [-]")
     assert table["SDC measured (Eq. 11) [-]"].tolist() == [shown_sdc]
     assert table["SDC DEM (paper) [-]"].tolist() == [0.1891]
     at.button(key="build_report").click()
@@ -891,11 +892,11 @@ def test_report_chooses_among_the_saved_records(store_file):
     at.button(key="save").click()
     at.run()
     at.run()
-    table = _table(at, "SDC measured (Eq. 11) [-]")
+    table = _table(at, "SDC DEM (ours) [-]")
     assert sorted(s for s in table["source file(s)"] if s) == ["a_fill50.csv", "b_fill75.csv"]
     at.multiselect(key="report_filter_files").set_value(["b_fill75.csv"])
     at.run()
-    table = _table(at, "SDC measured (Eq. 11) [-]")
+    table = _table(at, "SDC DEM (ours) [-]")
     assert [s for s in table["source file(s)"] if s] == ["b_fill75.csv"]
 
 
@@ -1358,7 +1359,7 @@ def test_the_report_tab_says_a_one_cell_run_has_no_standard_error(store_file):
         "material": "acrylic", "direction": "z", "sdc": 1.1, "sdc_stderr": float("nan"),
         "m_c_kg": 0.3, "cells_simulated": 1})
     at = _app()
-    shown = _table(at, "SDC measured (Eq. 11) [-]")
+    shown = _table(at, "SDC DEM (ours) [-]")
     assert shown["SDC DEM stderr [-]"].tolist() == ["n/a (1 cell)"]
     back = pd.read_csv(io.BytesIO(report_files(store_file)["csv"][1]))
     assert back["SDC DEM stderr [-]"].isna().all()
@@ -1775,9 +1776,9 @@ def test_the_calibrate_pages_measurements_table_names_every_numbers_unit(store_f
     at.run()
     at.run()
     points = next(d.value for d in at.dataframe
-                  if "SDC measured, Eq. 11 [-]" in d.value.columns)
+                  if "SDC measured (Eq. 11) [-]" in d.value.columns)
     numeric = [c for c in points.columns if pd.api.types.is_numeric_dtype(points[c])]
-    assert "SDC stderr degrees of freedom [-]" in numeric
+    assert "SDC measured (Eq. 11) stderr dof [-]" in numeric
     assert all(c.endswith("]") for c in numeric), numeric
 
 
@@ -1865,7 +1866,7 @@ def test_the_report_choices_come_back_from_the_page_address(store_file):
     at = _app_at({"report_filter_files": "c200_fill50.csv", "report_pool": "true"})
     assert at.multiselect(key="report_filter_files").value == ["c200_fill50.csv"]
     assert at.checkbox(key="report_pool").value is True
-    table = _table(at, "SDC measured (Eq. 11) [-]")
+    table = _table(at, "SDC DEM (ours) [-]")
     assert list(table["SDC measured (Eq. 11) [-]"].dropna().index) == [0] and len(table) == 1
     # a file the store does not hold: named in one line, not silently dropped
     at = _app_at({"report_filter_files": ["c200_fill50.csv", "gone.csv"]})

@@ -165,7 +165,7 @@ def test_json_document(capsys, tmp_path, tiny_store):
     # every column of the summary's prediction tables names its unit (it said "measured SDC",
     # "error", "inside"); parameters carry theirs in their names (fixture_mass_kg)
     summary = (out / "summary.md").read_text()
-    heads = [line for line in summary.splitlines() if line.startswith("| f [Hz]")]
+    heads = [line for line in summary.splitlines() if line.startswith("| frequency [Hz]")]
     assert len(heads) == 2  # in-sample and leave-one-out
     for head in heads:
         cells = [c.strip() for c in head.strip("|").split("|")]

@@ -99,7 +99,7 @@ def test_the_summaries_say_k_of_n_with_the_uninformative_apart():
                 if line.startswith(("| 100 | 5 |", "| 500 | 5 |", "| 1000 | 5 |"))
                 and line.count("|") == 9]
     assert verdicts == ["yes", "yes", "uninformative", "yes", "**no**", "uninformative"]
-    assert "| inside [yes/no/uninformative] |" in text
+    assert "| measured in calibrated 95 % band [yes/no/not compared/uninformative] |" in text
     page = summary_html(_result())
     assert f"<h2>Leave-one-out predictions: RMS {loo_rms}, 1/2 {said}</h2>" in page
     assert page.count("<td>uninformative</td>") == 2
@@ -266,7 +266,7 @@ def test_calibration_plot_draws_an_uninformative_band_apart_and_cut_at_its_bound
     bound = calibrated_sdc_bound(paper_specimen(), fill_percent=50.0, material="acrylic").sdc
     frame = result.to_pandas()
     assert list(frame[VERDICT_COLUMN]) == ["yes", "yes", "uninformative"]
-    assert list(frame["sdc bound [-]"]) == [bound] * 3
+    assert list(frame["SDC bound [-]"]) == [bound] * 3
     assert list(frame[VERDICT_COLUMN]) == result.band_verdicts(result.predictions)
     _, ax = plt.subplots()
     try:
@@ -512,3 +512,58 @@ def test_the_calibrated_specimens_header_names_each_parameters_unit():
     _, low, high = summary_texts(result.parameters["fixture_mass_kg"])
     assert f"#   fixture_mass_kg [kg] = 0.02  (95 %: {low} .. {high})" in text.splitlines()
     assert Specimen.from_text(text).hash == result.calibrated_specimen().hash
+
+
+def test_the_frame_the_report_and_the_summary_name_each_quantity_alike(tmp_path):
+    # Calibration.to_pandas() named its verdict "measured in 95 % band [...]" where the report
+    # says "measured in calibrated 95 % band [...]", and summary.md said "f [Hz]", "measured
+    # SDC [-]", "predicted SDC [-]", "95 % band [-]", "inside [...]" for the same quantities:
+    # a script joining them had to know three spellings.
+    from pidcore.calibrate.outputs import summary_markdown
+    from pidcore.calibrate.prediction import CALIBRATION_COLUMNS_RENAMED
+    from pidcore.compare.align import (
+        CALIBRATED_BAND_COLUMN,
+        CALIBRATED_COLUMN,
+        CALIBRATED_HIGH_COLUMN,
+        CALIBRATED_INSIDE_COLUMN,
+        CALIBRATED_LOW_COLUMN,
+        MEASURED_EQ11_COLUMN,
+        MEASURED_EQ11_STDERR_COLUMN,
+    )
+    from pidcore.report.table import add_calibration_columns, with_band_text
+
+    result = _result()
+    frame = result.to_pandas()
+    report = add_calibration_columns(pd.DataFrame({
+        "frequency [Hz]": [r["frequency_hz"] for r in PREDICTIONS],
+        "acceleration [g]": [r["acceleration_g"] for r in PREDICTIONS],
+        "packing ratio [%]": [r["fill_percent"] for r in PREDICTIONS],
+        "material": ["acrylic"] * 3,
+        MEASURED_EQ11_COLUMN: [r["measured"] for r in PREDICTIONS],
+        # the fitted points' own stderr: the report judges each by the band the frame holds
+        MEASURED_EQ11_STDERR_COLUMN: [r["measured_stderr"] for r in PREDICTIONS],
+        "note": [""] * 3}), result.calibration())
+    head = next(line for line in summary_markdown(result).splitlines()
+                if line.startswith("| frequency [Hz] |"))
+    summary = [cell.strip() for cell in head.strip("|").split("|")]
+    shared = ["frequency [Hz]", "acceleration [g]", MEASURED_EQ11_COLUMN, CALIBRATED_COLUMN,
+              CALIBRATED_INSIDE_COLUMN]
+    for name in shared:
+        assert name in frame.columns and name in report.columns and name in summary, name
+    for name in (CALIBRATED_LOW_COLUMN, CALIBRATED_HIGH_COLUMN):
+        assert name in frame.columns and name in report.columns
+    assert CALIBRATED_BAND_COLUMN in summary and CALIBRATED_BAND_COLUMN in with_band_text(
+        report).columns
+    # the same quantity under the same name holds the same values in frame and report
+    for name in shared:
+        assert frame[name].tolist() == report[name].tolist(), name
+    assert frame[CALIBRATED_INSIDE_COLUMN].tolist() == ["yes", "yes", "uninformative"]
+    # every column names its unit or is a word of a closed vocabulary
+    assert all(name.endswith("]") for name in frame.columns
+               if name not in ("material", "direction")), list(frame.columns)
+    assert all(name.endswith("]") for name in summary), summary
+    # a frame of an older pidcore reads as today's
+    older = frame.rename(columns={new: old for old, new in CALIBRATION_COLUMNS_RENAMED.items()})
+    assert {"measured in 95 % band [yes/no/not compared/uninformative]",
+            "low95 without stderr [-]", "sdc bound [-]"} <= set(older.columns)
+    pd.testing.assert_frame_equal(older.rename(columns=CALIBRATION_COLUMNS_RENAMED), frame)

@@ -593,3 +593,38 @@ def test_a_report_killed_at_any_rename_leaves_the_earlier_or_the_new_report_whol
     assert len(outcomes) == renames_needed + 1
     assert outcomes == ["earlier"] * (1 if exchange else 2) + ["new"] * (len(outcomes) - (
         1 if exchange else 2))
+
+
+def test_every_page_writes_an_sdc_beside_its_stderr_by_the_one_rule(tmp_path, provenance):
+    """Four significant digits per cell wrote 8.168123 ± 0.0003 as 8.168 and 0.0003 (the SDC
+    coarser than its own error) and a noise-free 0.25 ± 1.1e-14 as 0.25 and 1.1e-14 in the
+    Markdown, HTML, LaTeX, PDF and terminal tables, where the app, ``analyze`` and the case
+    sheet write 8.16812 ± 0.00030 and 0.250000 ± <0.000001
+    (:func:`pidcore.units.value_and_error_texts`)."""
+    from pidcore.cli.report import short_table
+    from pidcore.report import render
+    from pidcore.report.render import pdf_table_cells
+    from pidcore.report.table import MEASURED_EQ11_COLUMN, MEASURED_EQ11_STDERR_COLUMN
+
+    dem = pd.DataFrame({"frequency_hz": [500.0], "acceleration_g": [5.0], "fill_percent": [50.0],
+                        "material": ["acrylic"], "direction": ["z"], "sdc": [8.168123],
+                        "sdc_stderr": [0.0003], "case_key": ["a"]})
+    analyses = pd.DataFrame({"frequency_hz": [500.0], "acceleration_g": [5.0],
+                             "fill_percent": [50.0], "sdc": [0.25], "sdc_stderr": [1.1e-14],
+                             "source": ["run.uff"]})
+    table = build_report_table(dem, analyses, load_paper_table3())
+    paths = write_report(table, {}, provenance, tmp_path / "report", "md,html,tex")
+    markdown = paths["md"].read_text(encoding="utf-8")
+    assert "| 8.16812 | 0.00030 |" in markdown
+    assert r"| 0.250000 | \<0.000001 |" in markdown  # "<" escaped: no HTML tag
+    assert '<td class="num">8.16812</td><td class="num">0.00030</td>' in (
+        paths["html"].read_text(encoding="utf-8"))
+    assert "8.16812 & 0.00030" in paths["tex"].read_text(encoding="utf-8")
+    labels, rows = pdf_table_cells(table)
+    cols = [c for c in render.PDF_COLUMNS if c in table.columns]
+    shown = dict(zip(cols, rows[0], strict=True))
+    assert (shown["SDC DEM (ours) [-]"], shown["SDC DEM stderr [-]"]) == ("8.16812", "0.00030")
+    assert (shown[MEASURED_EQ11_COLUMN], shown[MEASURED_EQ11_STDERR_COLUMN]) == (
+        "0.250000", "<0.000001")
+    header, _, row = short_table(table).splitlines()[:3]
+    assert row.split()[3] == "8.16812"  # our DEM's SDC, rounded at its error's place

@@ -23,6 +23,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from ..compare.align import (
+    MEASURED_EQ11_COLUMN,
+    MEASURED_EQ11_DOF_COLUMN,
+    MEASURED_EQ11_STDERR_COLUMN,
+)
+from ..compare.plausibility import SDC_BOUND_COLUMN
 from ..constants import BackgroundState
 from ..interrupt import StopRequested
 
@@ -121,13 +127,16 @@ def points_needed(fit: Sequence[str]) -> int:
 
 #: The measured points' table on the page: field -> column head naming its unit. A field not
 #: named here is not shown (a new field of MeasuredPoint once showed as its raw name, the SDC
-#: bound as a dict of masses in kg with no unit).
+#: bound as a dict of masses in kg with no unit). The measured SDC, its stderr and that
+#: error's degrees of freedom by the names of the report and of
+#: :meth:`pidcore.calibrate.Calibration.to_pandas` (this table said "SDC measured, Eq. 11",
+#: "SDC stderr" and "SDC stderr degrees of freedom" for them).
 POINT_COLUMNS = {
     "frequency_hz": "frequency [Hz]", "acceleration_g": "acceleration [g]",
-    "fill_percent": "fill [%]", "sdc": "SDC measured, Eq. 11 [-]",
-    "sdc_stderr": "SDC stderr [-]", "sdc_stderr_dof": "SDC stderr degrees of freedom [-]",
+    "fill_percent": "fill [%]", "sdc": MEASURED_EQ11_COLUMN,
+    "sdc_stderr": MEASURED_EQ11_STDERR_COLUMN, "sdc_stderr_dof": MEASURED_EQ11_DOF_COLUMN,
     "material": "material", "specimen": "specimen", "specimen_sha256": "specimen sha256",
-    "sdc_bound": "SDC bound [-]"}
+    "sdc_bound": SDC_BOUND_COLUMN}
 
 
 def points_table(points: Sequence) -> pd.DataFrame:

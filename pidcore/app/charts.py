@@ -21,6 +21,7 @@ from typing import Any
 import pandas as pd
 
 from pidcore.compare.case import SDC_SERIES
+from pidcore.units import display_value_with_error
 
 #: The Vega-Lite major version the specs are written for (Streamlit >= 1.56 draws v6).
 VEGA_LITE_SCHEMA = "https://vega.github.io/schema/vega-lite/v6.json"
@@ -68,6 +69,13 @@ def sdc_chart(data: pd.DataFrame) -> dict[str, Any]:
     present = [s for s in SDC_SERIES if s in set(data["series"])]
     plain = data.rename(columns={"fill [%]": "fill", "SDC [-]": "sdc", "low [-]": "low",
                                  "high [-]": "high"})
+    # the tooltip's SDC as every page writes it with its error (value_and_error_texts):
+    # four fixed decimals showed the paper's 1.5702e-4 as 0.0002 and an undamped mass's
+    # 5.1e-5 ± 4.4e-5 as 0.0001 between 0.0000 and 0.0001; a point without an error has
+    # low == high == sdc (sdc_points), shown alone
+    plain = plain.assign(sdc_text=[
+        display_value_with_error(float(s), float(h) - float(s) if h > s else math.nan)
+        for s, h in zip(plain["sdc"], plain["high"], strict=True)])
     # ticks at the fills that carry points (Vega's own ticks left 25 % unlabelled) and at the
     # model curve's ends: beside one point (a case off the paper's grid) the curve had no
     # scale under it, one tick labelled "40" under a curve from 25 to 90 %
@@ -99,10 +107,7 @@ def sdc_chart(data: pd.DataFrame) -> dict[str, Any]:
                            "shape": shape, "tooltip": [
                                _field("series", "nominal"),
                                _field("fill", "quantitative", title="fill [%]"),
-                               _field("sdc", "quantitative", title="SDC [-]", format=".4f"),
-                               _field("low", "quantitative", title="- stderr", format=".4f"),
-                               _field("high", "quantitative", title="+ stderr",
-                                      format=".4f")]}}
+                               _field("sdc_text", "nominal", title="SDC ± stderr [-]")]}}
     return _top("sdc", plain, layer=[curve, bars, points], height=300,
                 title="SDC against fill", autosize=_AUTOSIZE)
 

@@ -135,9 +135,23 @@ def _table_rows(rows: list[dict], bounds: list[float], verdicts: list[str]
     return out
 
 
-#: Every column names its unit, as the report's (SDC and its error are dimensionless).
-_HEAD = ["f [Hz]", "a [g]", "fill [%]", "measured SDC [-]", "predicted SDC [-]",
-         "95 % band [-]", "error [-]", "inside [yes/no/uninformative]"]
+def _prediction_head() -> list[str]:
+    """Head of the summary's tables of predictions: every column names its unit, by the names
+    the report and :meth:`pidcore.calibrate.Calibration.to_pandas` give the same quantity
+    (the summary said "measured SDC", "predicted SDC", "95 % band" and "inside" where they
+    say "SDC measured (Eq. 11)", "SDC calibrated DEM (Eq. 11)", "calibrated 95 % band" and
+    "measured in calibrated 95 % band")."""
+    from .prediction import (
+        CALIBRATED_BAND_COLUMN,
+        CALIBRATED_COLUMN,
+        CALIBRATED_DIFFERENCE_COLUMN,
+        MEASURED_EQ11_COLUMN,
+        VERDICT_COLUMN,
+    )
+
+    return ["frequency [Hz]", "acceleration [g]", "fill [%]", MEASURED_EQ11_COLUMN,
+            CALIBRATED_COLUMN, CALIBRATED_BAND_COLUMN, CALIBRATED_DIFFERENCE_COLUMN,
+            VERDICT_COLUMN]
 
 
 def _sampler_words(result: CalibrationResult) -> str:
@@ -182,8 +196,8 @@ def _fitted_words(result: CalibrationResult) -> str:
 
 
 #: Head of the energy check's table (:attr:`CalibrationResult.energy_check`).
-_ENERGY_HEAD = ["f [Hz]", "a [g]", "start [J]", "calibrated median [J]", "95 % band [J]",
-                "start inside [yes/no]"]
+_ENERGY_HEAD = ["frequency [Hz]", "acceleration [g]", "start [J]", "calibrated median [J]",
+                "95 % band [J]", "start inside [yes/no]"]
 
 
 def _summary_tables(result: CalibrationResult) -> list[tuple[str, list[str], list[list[str]]]]:
@@ -209,7 +223,8 @@ def _summary_tables(result: CalibrationResult) -> list[tuple[str, list[str], lis
             continue
         rms = float(np.sqrt(np.mean([(r["predicted"] - r["measured"]) ** 2 for r in rows])))
         verdicts = result.band_verdicts(rows)
-        tables.append((f"{title}: RMS {rms_text(rms)}, {coverage_text(verdicts)}", list(_HEAD),
+        tables.append((f"{title}: RMS {rms_text(rms)}, {coverage_text(verdicts)}",
+                       _prediction_head(),
                        _table_rows(rows, row_sdc_bounds(result, rows), verdicts)))
     if any(s.kind == "dem" for s in result.specs):
         tables.append(("Energy per cycle per cell: starting specimen vs calibrated DEM",

@@ -18,8 +18,10 @@ import pandas as pd
 
 from .. import defaults
 from ..compare.align import (  # noqa: F401 (public here)
+    CALIBRATED_BAND_COLUMN,
     CALIBRATED_COLUMN,
     CALIBRATED_HIGH_COLUMN,
+    CALIBRATED_INSIDE_COLUMN,
     CALIBRATED_LOW_COLUMN,
     MEASURED_EQ11_COLUMN,
     MEASURED_EQ11_DOF_COLUMN,
@@ -29,7 +31,12 @@ from ..compare.align import (  # noqa: F401 (public here)
     band_quantile,
     quantile_label,
 )
-from ..compare.plausibility import SDC_UPPER_BOUND, UNKNOWN_SPECIMEN_BOUND, SdcBound
+from ..compare.plausibility import (
+    SDC_BOUND_COLUMN,
+    SDC_UPPER_BOUND,
+    UNKNOWN_SPECIMEN_BOUND,
+    SdcBound,
+)
 from ..constants import BAND_VERDICTS
 from ..errors import ParameterError, instance_of, real_number
 from ..loadcase import LoadCase
@@ -45,7 +52,10 @@ if TYPE_CHECKING:  # pragma: no cover
 #: report's "SDC calibrated DEM (Eq. 11) [-]" and its band. An older saved frame reads as
 #: today's with
 #: ``frame.rename(columns=CALIBRATION_COLUMNS_RENAMED)`` (as :func:`pidcore.report.
-#: figures_results.plot_calibration` does).
+#: figures_results.plot_calibration` does). Its verdict column, "measured in 95 % band [...]"
+#: beside the report's "measured in calibrated 95 % band [...]" for the same verdict, its
+#: "sdc bound [-]" and its "low95 without stderr [-]" (named after calibration.json's key, not
+#: beside the band it narrows) followed in 2026-12.
 CALIBRATION_COLUMNS_RENAMED: dict[str, str] = {
     "sdc measured [-]": MEASURED_EQ11_COLUMN,
     "sdc measured stderr [-]": MEASURED_EQ11_STDERR_COLUMN,
@@ -53,7 +63,18 @@ CALIBRATION_COLUMNS_RENAMED: dict[str, str] = {
     "sdc predicted [-]": CALIBRATED_COLUMN,
     "low95 [-]": CALIBRATED_LOW_COLUMN,
     "high95 [-]": CALIBRATED_HIGH_COLUMN,
+    f"measured in 95 % band [{'/'.join(BAND_VERDICTS)}]": CALIBRATED_INSIDE_COLUMN,
+    "low95 without stderr [-]": "calibrated low 95 % without measurement stderr [-]",
+    "high95 without stderr [-]": "calibrated high 95 % without measurement stderr [-]",
+    "sdc bound [-]": SDC_BOUND_COLUMN,
 }
+#: The calibrated band of the model's SDC alone (calibration.json's ``low95_without_stderr``,
+#: ``high95_without_stderr``): :data:`CALIBRATED_LOW_COLUMN`'s band without the measurement's
+#: standard error.
+CALIBRATED_LOW_WITHOUT_STDERR_COLUMN = CALIBRATION_COLUMNS_RENAMED["low95 without stderr [-]"]
+CALIBRATED_HIGH_WITHOUT_STDERR_COLUMN = CALIBRATION_COLUMNS_RENAMED["high95 without stderr [-]"]
+#: The calibrated DEM's SDC minus the measured one, as calibration's summaries name it.
+CALIBRATED_DIFFERENCE_COLUMN = "difference calibrated DEM - measured (Eq. 11) [-]"
 
 _REQUIRED = ("frequency_hz", "acceleration_g", "fill_percent", "predicted", "low95", "high95")
 
@@ -120,8 +141,9 @@ def uninformative_count_text(count: int) -> str:
 
 
 #: Column of :meth:`Calibration.to_pandas` holding each fitted measurement's verdict (words of
-#: :data:`pidcore.constants.BAND_VERDICTS`).
-VERDICT_COLUMN = f"measured in 95 % band [{'/'.join(BAND_VERDICTS)}]"
+#: :data:`pidcore.constants.BAND_VERDICTS`): the report's column
+#: (:data:`pidcore.compare.align.CALIBRATED_INSIDE_COLUMN`).
+VERDICT_COLUMN = CALIBRATED_INSIDE_COLUMN
 
 
 @dataclass(frozen=True)
@@ -371,12 +393,16 @@ class Calibration:
         ``calibrated high 95 % [-]`` (the band of a measurement with the fitted point's
         standard error; the report's names, :data:`~pidcore.compare.align.CALIBRATED_COLUMN`),
         ``SDC measured (Eq. 11) [-]``,
-        ``SDC measured (Eq. 11) stderr [-]``, ``low95 without stderr [-]``,
-        ``high95 without stderr [-]``, ``SDC measured (Eq. 11) stderr dof [-]`` (the names of
+        ``SDC measured (Eq. 11) stderr [-]``,
+        ``calibrated low 95 % without measurement stderr [-]``,
+        ``calibrated high 95 % without measurement stderr [-]`` (the model's SDC alone),
+        ``SDC measured (Eq. 11) stderr dof [-]`` (the names of
         :mod:`pidcore.compare.align`; :data:`CALIBRATION_COLUMNS_RENAMED` renames an older
         frame's; NaN where the file
-        does not state them), ``sdc bound [-]`` (where the band is cut: :meth:`sdc_bound`)
-        and :data:`VERDICT_COLUMN` (:meth:`CalibratedPrediction.judge` of the fitted
+        does not state them), ``SDC bound [-]`` (where the band is cut: :meth:`sdc_bound`)
+        and :data:`VERDICT_COLUMN` (the report's
+        ``measured in calibrated 95 % band [yes/no/not compared/uninformative]``:
+        :meth:`CalibratedPrediction.judge` of the fitted
         measurement at that bound; ``not compared`` where none is stated): what
         :meth:`plot` draws, so that an uninformative band is not drawn as a hit.
         """
@@ -400,10 +426,10 @@ class Calibration:
             CALIBRATED_HIGH_COLUMN: p.high95,
             MEASURED_EQ11_COLUMN: p.measured,
             MEASURED_EQ11_STDERR_COLUMN: p.measured_stderr,
-            "low95 without stderr [-]": p.low95_without_stderr,
-            "high95 without stderr [-]": p.high95_without_stderr,
+            CALIBRATED_LOW_WITHOUT_STDERR_COLUMN: p.low95_without_stderr,
+            CALIBRATED_HIGH_WITHOUT_STDERR_COLUMN: p.high95_without_stderr,
             MEASURED_EQ11_DOF_COLUMN: p.measured_stderr_dof,
-            "sdc bound [-]": p.sdc_bound.sdc,
+            SDC_BOUND_COLUMN: p.sdc_bound.sdc,
             VERDICT_COLUMN: verdict,
         } for p, verdict in rows])
 

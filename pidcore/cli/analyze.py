@@ -220,7 +220,7 @@ def format_table(results: list) -> str:
     names = [Path(r.analysis.source).name for r in results]
     width = max([40, *map(len, names)])
     header = (f"{'source':<{width}} {'frequency [Hz]':>14} {'accel. [g]':>10} "
-              f"{'loss factor [-]':>15} {'SDC [-]':>12} {'± SE [-]':>9} {'zeta [-]':>10} "
+              f"{'loss factor [-]':>15} {'SDC [-]':>12} {'± SE [-]':>12} {'zeta [-]':>10} "
               f"{'dE/cycle [J]':>12}")
     lines = [header, "-" * len(header)]
     for r, name in zip(results, names, strict=True):
@@ -230,7 +230,7 @@ def format_table(results: list) -> str:
         lines.append(f"{name:<{width}} {a.frequency_hz:14.4f} "
                      f"{_significant(a.acceleration_g, 5):>10} "
                      f"{_significant(a.loss_factor, 6):>15} {sdc_shown:>12} "
-                     f"{stderr_shown or 'n/a':>9} "
+                     f"{stderr_shown or 'n/a':>12} "
                      f"{_significant(a.damping_ratio, 4):>10} {a.energy_per_cycle_j:12.4e}")
         lines += [f"    note: {cli_words(note)}" for note in r.notes]
     return "\n".join(lines)

@@ -11,8 +11,8 @@ import sys
 from .. import interrupt
 from ..interrupt import untouched
 from ..report.render import (
+    display_rows,
     folder_identity,
-    format_cell,
     restore_previous_report,
     restored_report_note,
 )
@@ -167,7 +167,7 @@ def short_table(table) -> str:
     short = {ALIGNMENT_COLUMN: "alignment",
              CALIBRATED_INSIDE_COLUMN: "measured in calibrated 95 % band"}
     heads = [short.get(c, c) for c in cols]
-    rows = [[format_cell(v) for v in row] for row in table.loc[:, cols].itertuples(index=False)]
+    rows = display_rows(table, cols)
     widths = [max([len(h), *(len(r[i]) for r in rows)]) for i, h in enumerate(heads)]
     lines = ["  ".join(h.rjust(w) for h, w in zip(heads, widths, strict=True))]
     lines.append("  ".join("-" * w for w in widths))

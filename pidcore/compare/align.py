@@ -33,7 +33,11 @@ import numpy as np
 import pandas as pd
 
 from .. import defaults
-from ..constants import ALIGNMENT_STATUSES, AlignmentStatus  # noqa: F401 (kept: defined here before)
+from ..constants import (  # noqa: F401 (AlignmentStatus kept: defined here before)
+    ALIGNMENT_STATUSES,
+    BAND_VERDICTS,
+    AlignmentStatus,
+)
 from ..errors import ParameterError, real_number
 from .loadcase import LoadCase
 
@@ -69,6 +73,15 @@ MEASURED_COLUMNS_RENAMED: dict[str, str] = {
 CALIBRATED_COLUMN = "SDC calibrated DEM (Eq. 11) [-]"
 CALIBRATED_LOW_COLUMN = "calibrated low 95 % [-]"
 CALIBRATED_HIGH_COLUMN = "calibrated high 95 % [-]"
+#: Whether the measured Eq. 11 SDC lies in that band (words of
+#: :data:`pidcore.constants.BAND_VERDICTS`): the report's column and
+#: :meth:`pidcore.calibrate.Calibration.to_pandas`'s, which said "measured in 95 % band [...]"
+#: before 2026-12.
+CALIBRATED_INSIDE_COLUMN = f"measured in calibrated 95 % band [{'/'.join(BAND_VERDICTS)}]"
+#: The one column a page shows the calibrated band in, as :func:`pidcore.calibrate.prediction.
+#: band_text` writes it (the terminal's and PDF's report tables, the app's Report tab, the
+#: calibration's summary.md and summary.html).
+CALIBRATED_BAND_COLUMN = "calibrated 95 % band [-]"
 #: The paper's particles and drive direction (Sect. 4): Table 3 applies to these only.
 PAPER_MATERIAL = "acrylic"
 PAPER_DIRECTION = "z"

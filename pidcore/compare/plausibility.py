@@ -52,6 +52,9 @@ if TYPE_CHECKING:  # pragma: no cover
 #: dissipated per radian equals the peak stored energy). Table 3's largest SDC is 0.88 (DEM) and
 #: 0.71 (measured), so this bound only catches gross set-up errors.
 SDC_UPPER_BOUND = 2 * math.pi
+#: Column of an SDC bound (:func:`sdc_bound`) in every table: the app's Calibrate page and
+#: :meth:`pidcore.calibrate.Calibration.to_pandas` (which said "sdc bound [-]" before 2026-12).
+SDC_BOUND_COLUMN = "SDC bound [-]"
 
 #: Fully inelastic impacts per drive cycle at twice the drive velocity that bound what the
 #: particles dissipate (module docstring): ``SDC <= PARTICLE_IMPACT_SDC_FACTOR m_p / m_s``.

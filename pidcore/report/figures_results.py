@@ -121,12 +121,16 @@ def plot_calibration(frame: pd.DataFrame, *, ax: Any = None) -> Any:
     (:func:`pidcore.calibrate.outputs.draw_bands`). Returns ``ax``.
 
     ``frame`` is :meth:`pidcore.calibrate.Calibration.to_pandas` (a frame without its
-    ``sdc bound [-]`` and verdict columns is cut at 2 pi and judged by nothing).
+    ``SDC bound [-]`` and verdict columns is cut at 2 pi and judged by nothing).
     """
     import matplotlib.pyplot as plt
 
     from ..calibrate.outputs import draw_bands, draw_cut_bounds
-    from ..calibrate.prediction import CALIBRATION_COLUMNS_RENAMED, VERDICT_COLUMN
+    from ..calibrate.prediction import (
+        CALIBRATION_COLUMNS_RENAMED,
+        SDC_BOUND_COLUMN,
+        VERDICT_COLUMN,
+    )
     from ..compare.align import (
         CALIBRATED_COLUMN,
         CALIBRATED_HIGH_COLUMN,
@@ -139,7 +143,7 @@ def plot_calibration(frame: pd.DataFrame, *, ax: Any = None) -> Any:
     if ax is None:
         _, ax = plt.subplots(figsize=(max(6.0, 0.5 * len(frame)), 4.0), constrained_layout=True)
     x = np.arange(len(frame))
-    bounds = frame.get("sdc bound [-]", pd.Series(SDC_UPPER_BOUND, index=frame.index))
+    bounds = frame.get(SDC_BOUND_COLUMN, pd.Series(SDC_UPPER_BOUND, index=frame.index))
     verdicts = frame.get(VERDICT_COLUMN, pd.Series("", index=frame.index))
     draw_cut_bounds(ax, draw_bands(ax, x, frame[CALIBRATED_COLUMN], frame[CALIBRATED_LOW_COLUMN],
                                    frame[CALIBRATED_HIGH_COLUMN], bounds, verdicts,

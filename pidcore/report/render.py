@@ -34,6 +34,7 @@ from ..atomic_files import (
 from ..constants import REPORT_FORMATS
 from ..errors import ParameterError
 from ..io import display_path
+from ..units import value_and_error_texts
 from .provenance import Provenance
 from .table import (
     ALIGNMENT_COLUMN,
@@ -75,9 +76,34 @@ def format_cell(value: object) -> str:
     return str(value)
 
 
-def _display_rows(table: pd.DataFrame, columns: Sequence[str] | None = None) -> list[list[str]]:
+#: The report's SDCs beside a column of their standard error: each pair is written by
+#: :func:`pidcore.units.value_and_error_texts`, the rule of the app, ``analyze`` and the case
+#: sheet (four significant digits each wrote 8.168123 ± 0.0003 as 8.168 and 0.0003, and a
+#: noise-free 0.25 ± 1.1e-14 as 0.25 and 1.1e-14); the value so rounded also where its error's
+#: column is not shown (the terminal's table).
+VALUE_STDERR_COLUMNS: dict[str, str] = {"SDC DEM (ours) [-]": "SDC DEM stderr [-]",
+                                        MEASURED_EQ11_COLUMN: MEASURED_EQ11_STDERR_COLUMN}
+
+
+def display_rows(table: pd.DataFrame, columns: Sequence[str] | None = None) -> list[list[str]]:
+    """Display text of each row's ``columns`` (default all): :func:`format_cell`, except each
+    SDC of :data:`VALUE_STDERR_COLUMNS` and its standard error, written as one pair."""
     cols = list(columns) if columns is not None else list(table.columns)
-    return [[format_cell(v) for v in row] for row in table.loc[:, cols].itertuples(index=False)]
+    names = list(table.columns)
+    out = []
+    for row in table.itertuples(index=False):
+        cells = dict(zip(names, row, strict=True))
+        texts = {c: format_cell(cells[c]) for c in cols}
+        for value_column, error_column in VALUE_STDERR_COLUMNS.items():
+            value, error = cells.get(value_column), cells.get(error_column)
+            if isinstance(value, float) and isinstance(error, float) and math.isfinite(value):
+                value_text, error_text = value_and_error_texts(value, error)
+                if value_column in texts:
+                    texts[value_column] = value_text
+                if error_column in texts and error_text:
+                    texts[error_column] = error_text
+        out.append([texts[c] for c in cols])
+    return out
 
 
 def parse_formats(formats: str | Iterable[str]) -> tuple[str, ...]:
@@ -132,7 +158,7 @@ def _write_md(table: pd.DataFrame, figures: Mapping[str, Path], prov: Provenance
     lines.append("| " + " | ".join(_md_escape(c) for c in table.columns) + " |")
     numeric = [pd.api.types.is_numeric_dtype(table[c]) for c in table.columns]
     lines.append("|" + "|".join("---:" if n else "---" for n in numeric) + "|")
-    for row in _display_rows(table):
+    for row in display_rows(table):
         lines.append("| " + " | ".join(_md_escape(c) for c in row) + " |")
     lines.append("")
     for stem, png in figures.items():
@@ -161,7 +187,7 @@ def _write_html(table: pd.DataFrame, figures: Mapping[str, Path], prov: Provenan
     numeric = [pd.api.types.is_numeric_dtype(table[c]) for c in table.columns]
     head = "".join(f"<th>{html.escape(c)}</th>" for c in table.columns)
     body = []
-    for row in _display_rows(table):
+    for row in display_rows(table):
         cells = "".join(f'<td class="num">{html.escape(v)}</td>' if n
                         else f"<td>{html.escape(v)}</td>" for v, n in zip(row, numeric,
                                                                             strict=True))
@@ -203,7 +229,7 @@ def _write_tex(table: pd.DataFrame, figures: Mapping[str, Path], prov: Provenanc
              rf"\section*{{{tex_escape(_TITLE)}}}", r"\begin{table}[ht]\centering",
              r"\resizebox{\textwidth}{!}{%", rf"\begin{{tabular}}{{{spec}}}", r"\toprule",
              " & ".join(tex_escape(c) for c in table.columns) + r" \\", r"\midrule"]
-    lines += [" & ".join(tex_escape(v) for v in row) + r" \\" for row in _display_rows(table)]
+    lines += [" & ".join(tex_escape(v) for v in row) + r" \\" for row in display_rows(table)]
     lines += [r"\bottomrule", r"\end{tabular}}", r"\end{table}"]
     for stem, png in figures.items():
         lines += [r"\begin{figure}[ht]\centering",
@@ -226,7 +252,7 @@ def pdf_table_cells(table: pd.DataFrame) -> tuple[list[str], list[list[str]]]:
     cols = [c for c in PDF_COLUMNS if c in table.columns]
     labels = ["\n".join(textwrap.wrap(PDF_LABELS.get(c, c.split(" [grid/")[0]), 12))
               for c in cols]
-    return labels, _display_rows(table, cols)
+    return labels, display_rows(table, cols)
 
 
 def _write_pdf(table: pd.DataFrame, figures: Mapping[str, Path], prov: Provenance,

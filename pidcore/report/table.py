@@ -28,8 +28,10 @@ import pandas as pd
 from .. import defaults
 from ..compare.align import (
     ALIGNMENT_STATUSES,
+    CALIBRATED_BAND_COLUMN,
     CALIBRATED_COLUMN,
     CALIBRATED_HIGH_COLUMN,
+    CALIBRATED_INSIDE_COLUMN,
     CALIBRATED_LOW_COLUMN,
     MEASURED_COLUMNS_RENAMED,
     MEASURED_EQ11_COLUMN,
@@ -651,13 +653,12 @@ IMPLAUSIBLE_ROW_NOTE = "includes a result no passive coupon gives, kept as accep
 #: every plausible SDC (:meth:`~pidcore.calibrate.prediction.CalibratedPrediction.
 #: uninformative_reason`), neither inside nor outside.
 INSIDE, OUTSIDE, NOT_COMPARED, UNINFORMATIVE = BAND_VERDICTS
-CALIBRATED_INSIDE_COLUMN = f"measured in calibrated 95 % band [{'/'.join(BAND_VERDICTS)}]"
 CALIBRATION_COLUMNS: tuple[str, ...] = (CALIBRATED_COLUMN, CALIBRATED_LOW_COLUMN,
                                         CALIBRATED_HIGH_COLUMN, CALIBRATED_INSIDE_COLUMN)
-#: The one column a page shows the calibrated band in (:func:`with_band_text`): the terminal's
-#: table, the PDF's and the app's Report tab; the CSV, Markdown, HTML and LaTeX files keep
-#: its two numbers (:data:`CALIBRATED_LOW_COLUMN`, :data:`CALIBRATED_HIGH_COLUMN`).
-CALIBRATED_BAND_COLUMN = "calibrated 95 % band [-]"
+#: :data:`CALIBRATED_BAND_COLUMN` is the one column a page shows the calibrated band in
+#: (:func:`with_band_text`): the terminal's table, the PDF's and the app's Report tab; the CSV,
+#: Markdown, HTML and LaTeX files keep its two numbers (:data:`CALIBRATED_LOW_COLUMN`,
+#: :data:`CALIBRATED_HIGH_COLUMN`).
 
 
 def with_band_text(table: pd.DataFrame) -> pd.DataFrame:
