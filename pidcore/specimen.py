@@ -1158,13 +1158,31 @@ def _complete_from_material(table: dict[str, Any], where: str, name: str, role: 
     inline from material ``name``'s row; a key neither stated nor in the table is an error
     naming ``where`` (the material key)."""
     row = _table_material(name, where, role)
+    missing = [key for key, _ in columns if key not in table]
+    if row is None and missing:
+        raise ParameterError(f"{where}: unknown material {_shown(name)} (not in materials.csv) "
+                             f"and no inline {', '.join(missing)}; " + _material_hint(name, role))
     for key, column in columns:
         if key not in table:
-            if row is None:
-                raise ParameterError(
-                    f"{where}: unknown material {_shown(name)} (not in materials.csv) and no "
-                    f"inline {key}")
             table[key] = getattr(row, column)
+
+
+def _material_hint(name: Any, role: str | None) -> str:
+    """What an unknown material should have been: the table's names of its role and the
+    closest one (a typo such as 'aluminum_wall' or 'acrylc' was only called unknown, and the
+    message named one missing inline key, so a user adding it met the next)."""
+    import difflib
+
+    from .dem.materials import material_table
+
+    table = material_table()
+    names = [str(n) for n in (table.index if role is None
+                              else table.index[table["role"] == role])]
+    hint = (f"expected a {role + ' ' if role else ''}material of materials.csv "
+            f"({', '.join(names)}), or those keys inline")
+    close = difflib.get_close_matches(str(name), names, n=1, cutoff=0.75) if isinstance(
+        name, str) and len(name) <= MAX_SHOWN_CHARS else []
+    return hint + (f"; did you mean {close[0]!r}?" if close else "")
 
 
 def _tables_are_tables(node: Mapping[str, Any], names: tuple[str, ...], prefix: str) -> None:

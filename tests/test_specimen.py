@@ -194,3 +194,35 @@ def test_specimen_check_labels_its_time_step_with_the_load_case_it_is_for(tmp_pa
         assert main(["specimen", "check", str(path), "--json"]) == 0
         doc = json.loads(capsys.readouterr().out)
         assert (doc["reference_frequency_hz"], doc["reference_acceleration_g"]) == (50, 10)
+
+
+@pytest.mark.parametrize(("old", "new", "message"), [
+    # a typo of the wall row: the error said 'unknown' and named one inline key, so a user
+    # added wall_youngs_modulus_pa, then met wall_poisson_ratio, then the density
+    ('wall_material = "aluminium_wall"\nwall_youngs_modulus_pa = 72000000000.0\n'
+     'wall_poisson_ratio = 0.33\nwall_density_kg_m3 = 2800.0',
+     'wall_material = "aluminum_wall"',
+     "[cell] wall_material: unknown material 'aluminum_wall' (not in materials.csv) and no "
+     "inline wall_youngs_modulus_pa, wall_poisson_ratio, wall_density_kg_m3; expected a wall "
+     "material of materials.csv (aluminium_wall), or those keys inline; did you mean "
+     "'aluminium_wall'?"),
+    ('material = "acrylic"\nradius_m = 0.00125\ndensity_kg_m3 = 1180.0\n'
+     'youngs_modulus_pa = 2840000000.0\npoisson_ratio = 0.402',
+     'material = "acrylc"\nradius_m = 0.00125',
+     "[particles] material: unknown material 'acrylc' (not in materials.csv) and no inline "
+     "density_kg_m3, youngs_modulus_pa, poisson_ratio; expected a particle material of "
+     "materials.csv (acrylic, aluminium), or those keys inline; did you mean 'acrylic'?"),
+    # a material of one's own, partly inline: every key still missing, no guess
+    ('material = "acrylic"\nradius_m = 0.00125\ndensity_kg_m3 = 1180.0',
+     'material = "steel"\ndensity_kg_m3 = 7850.0',
+     "[particles] material: unknown material 'steel' (not in materials.csv) and no inline "
+     "radius_m; expected a particle material of materials.csv (acrylic, aluminium), or those "
+     "keys inline"),
+])
+def test_unknown_material_names_every_missing_key_and_the_closest_table_row(tmp_path, old, new,
+                                                                            message):
+    path = tmp_path / "typo.toml"
+    path.write_text(_edit(PAPER.to_toml(), old, new))
+    with pytest.raises(ParameterError) as info:
+        load_specimen(path)
+    assert str(info.value) == f"{path}: {message}"
