@@ -226,3 +226,23 @@ def test_unknown_material_names_every_missing_key_and_the_closest_table_row(tmp_
     with pytest.raises(ParameterError) as info:
         load_specimen(path)
     assert str(info.value) == f"{path}: {message}"
+
+
+def test_a_file_of_ones_own_without_a_fixture_is_named_in_a_note():
+    """A fixture left out reads as 0 kg (the same specimen as 0 stated), and specimen check
+    said nothing: a forgotten adapter plate changes m_c of Eq. 10, so the DEM's SDC, silently."""
+    from pidcore.specimen import describe
+
+    steel = load_specimen("data_samples/specimens/steel_6mm.toml")
+    assert steel.coupon.fixture_mass_kg > 0
+    assert not [n for n in describe(steel)["notes"] if "fixture_mass_kg" in n]
+    text = steel.to_toml()
+    left_out = Specimen.from_text(_edit(text, "fixture_mass_kg = 0.015\n", ""))
+    stated_zero = Specimen.from_text(_edit(text, "fixture_mass_kg = 0.015", "fixture_mass_kg = 0"))
+    assert left_out.hash == stated_zero.hash  # one specimen: the note says both readings
+    for specimen in (left_out, stated_zero):
+        (note,) = [n for n in describe(specimen)["notes"] if "fixture_mass_kg" in n]
+        assert note.startswith("[coupon] fixture_mass_kg is 0 kg (stated, or left out: 0 is its "
+                               "default)")
+    # the paper's coupon runs without one: no note on the bundled file
+    assert not [n for n in describe(PAPER)["notes"] if "fixture_mass_kg" in n]
