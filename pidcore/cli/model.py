@@ -103,10 +103,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         "the default is noted, more than 100 x off the cells' is refused as a "
                         "unit slip)")
     d.add_argument("--specimen", metavar="FILE", type=path_argument, default=None,
-                   help="the specimen file the SDC is of (the runs' with --table store, the "
-                        "paper's coupon with --table paper), for the [coupon] face_area_m2 it "
-                        "states: a DEM run stores its specimen without it; another specimen "
-                        "(another sha256) is refused")
+                   help="the specimen file the SDC is of (with --table store: the store's "
+                        "runs of this file, by its sha256; with --table paper: the paper's "
+                        "coupon), for the [coupon] face_area_m2 it states: a DEM run stores "
+                        "its specimen without it; another specimen (another sha256) is "
+                        "refused")
     d.add_argument("--panel-areal-mass", metavar="KG_M2", type=_positive_float, default=None,
                    help="mass per m^2 of your panel, with its particles, kg/m^2: adds "
                         "panel_loss_factor, the loss factor the particles add to it moving as "
@@ -151,6 +152,8 @@ def build_model(args: argparse.Namespace):
     if runs.empty:
         raise ParameterError(f"{args.store}: no DEM runs stored; run `pidcore dem` first or use "
                              f"--table paper")
+    if getattr(args, "specimen", None) is not None:
+        runs = _runs_of_specimen_file(runs, args.specimen, args.store)
     try:
         runs = select_runs(runs, where=where)
     except ParameterError as exc:
@@ -163,6 +166,26 @@ def build_model(args: argparse.Namespace):
         " where " + ", ".join(f"{k}={v}" for k, v in where.items()) if where else "")
     return SdcModel.from_table(runs, value="sdc", log_frequency=args.log_frequency,
                                source=text), runs
+
+
+def _runs_of_specimen_file(runs, path, store):
+    """The runs of the ``--specimen`` file (its sha256): a store holding runs of two files (an
+    edited one, the paper's coupon) was refused as "of 2 specimens", asking for a --where of
+    the hash that --specimen already gave."""
+    from ..compare.specimens import run_specimen_labels
+    from ..dem.persist import runs_of_specimen
+    from ..specimen import hashed_name, load_specimen
+
+    given = load_specimen(path)
+    mine = runs_of_specimen(runs, given)
+    if mine.empty:
+        held = run_specimen_labels(runs).value_counts(sort=False)
+        raise ParameterError(
+            f"--specimen {path}: {store} holds no DEM runs of "
+            f"{hashed_name(given.name, given.hash)} (it holds "
+            + ", ".join(f"{n} of {label}" for label, n in held.items())
+            + f"); run them with pidcore dem sweep --specimen {path} --store {store}")
+    return mine
 
 
 def _cli_where(message: str, where: dict) -> str:
