@@ -987,6 +987,25 @@ def _key_of_another_table(key: str, section: str) -> str:
             "below it?")
 
 
+#: Length units a diameter key may end with, and their factor to metres.
+_DIAMETER_UNITS = {"_m": 1.0, "_mm": 1e-3, "_cm": 1e-2, "_um": 1e-6, "": None}
+
+
+def _diameter_for_radius(key: Any, value: Any, section: str) -> str:
+    """The end of an unknown key's message for a sphere diameter (``diameter_m``,
+    ``diameter_mm``): beads are sold by their diameter, the file states the radius, and the
+    message only listed the keys, so a user could write the diameter as ``radius_m``, twice
+    the spheres' size (a note catches that only where they then fit one above another)."""
+    if section != "particles" or not isinstance(key, str) or "diameter" not in key:
+        return ""
+    unit = next((u for u in _DIAMETER_UNITS if u and key.endswith(u)), "")
+    factor = _DIAMETER_UNITS[unit]
+    if factor is None or isinstance(value, bool) or not isinstance(value, int | float):
+        return "; the spheres are given by their radius: write radius_m, half the diameter, in m"
+    return (f"; the spheres are given by their radius: write radius_m = {value * factor / 2:g} "
+            "(half the diameter, in m)")
+
+
 #: The SI units specimen keys end with (longest first: ``_kg_m3`` before ``_m3``).
 _SI_KEY_UNITS = ("_kg_m3", "_percent", "_kg", "_pa", "_m2", "_m")
 
@@ -1015,7 +1034,8 @@ def _take(table: Mapping[str, Any], section: str, where: str) -> dict[str, Any]:
         if key not in schema:
             raise ParameterError(f"{where} {clipped(key)}: unknown key; expected one of "
                                  f"{list(schema)}{_key_of_another_table(key, section)}"
-                                 f"{_key_in_another_unit(key, schema)}")
+                                 f"{_key_in_another_unit(key, schema)}"
+                                 f"{_diameter_for_radius(key, table[key], section)}")
     out: dict[str, Any] = {}
     for key, (required, kind) in schema.items():
         if key not in table:

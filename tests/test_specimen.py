@@ -246,3 +246,18 @@ def test_a_file_of_ones_own_without_a_fixture_is_named_in_a_note():
                                "default)")
     # the paper's coupon runs without one: no note on the bundled file
     assert not [n for n in describe(PAPER)["notes"] if "fixture_mass_kg" in n]
+
+
+@pytest.mark.parametrize(("key_line", "hint"), [
+    # 2 mm beads, as sold: by their diameter
+    ("diameter_m = 2.0e-3", "write radius_m = 0.001 (half the diameter, in m)"),
+    ("diameter_mm = 2.5", "write radius_m = 0.00125 (half the diameter, in m)"),
+    ('diameter = "2 mm"', "write radius_m, half the diameter, in m"),
+])
+def test_a_sphere_diameter_key_says_the_file_takes_the_radius(key_line, hint):
+    text = _edit(PAPER.to_toml(), "radius_m = 0.00125", key_line)
+    with pytest.raises(ParameterError) as info:
+        Specimen.from_text(text, source="beads.toml")
+    message = str(info.value)
+    assert message.startswith(f"beads.toml: [particles] {key_line.split(' ')[0]}: unknown key")
+    assert message.endswith(f"; the spheres are given by their radius: {hint}")
