@@ -422,3 +422,21 @@ def test_own_specimen_exports_are_pointed_to_from_readme_and_samples_help(parser
     samples = _subparsers(parser)["samples"]
     for command in (samples, _subparsers(samples)["make"]):
         assert script in command.description, command.prog
+
+
+def test_mass_convention_says_the_coupon_mass_holds_the_fixture(parser):
+    # "m_c = coupon + particles" (README, --mass-convention's help): a 41 g coupon with a 120 g
+    # fixture divided by 0.395 kg, not the 0.275 kg the words gave, and the user's hand check
+    # of E (Eq. 10) was off by 44 %; both now name the fixture
+    from pidcore.specimen import load_specimen
+
+    steel = load_specimen(ROOT / "data_samples" / "specimens" / "steel_6mm.toml")
+    assert steel.vibrated_mass_kg(0, "coupon") == steel.coupon.mass_kg + \
+        steel.coupon.fixture_mass_kg
+    dem = _subparsers(_subparsers(parser)["dem"])
+    for command in ("run", "sweep"):
+        (action,) = [a for a in dem[command]._actions if "--mass-convention" in a.option_strings]
+        assert "coupon and fixture" in action.help, command
+    text = " ".join(README.read_text(encoding="utf-8").split())
+    assert ("m_c = coupon + particles by default (`--mass-convention`; the coupon's mass there "
+            "is the moving mass, `[coupon] mass_kg` + `fixture_mass_kg`)") in text
