@@ -747,7 +747,7 @@ class Specimen:
         try:
             return _from_mapping(data, source=self.source)
         except ParameterError as exc:
-            raise ParameterError(f"{self.source}: {exc}") from None
+            raise ParameterError(f"{self.source}: {exc}{_static_too(values, str(exc))}") from None
 
     # --- identity ------------------------------------------------------------------------
 
@@ -972,6 +972,21 @@ def numeric_fields(specimen: Specimen) -> list[str]:
 _TABLE_OF_SECTION = {"": "the top level", "cell": "[cell]", "coupon": "[coupon]",
                      "particles": "[particles]", "pair": "[pairs.particle_particle] and "
                      "[pairs.particle_wall]", "pairs": "[pairs]", "provenance": "[provenance]"}
+
+
+def _static_too(values: Mapping[str, Any], complaint: str) -> str:
+    """The end of a ``with_values`` refusal where a pair's sliding friction was raised past
+    the static friction the specimen holds, which was not set: a file without static_friction
+    holds its sliding friction there, so {"...sliding_friction": 0.4} was refused naming a
+    static 0.3 the user never wrote."""
+    for path in values:
+        parts = path.split(".") if isinstance(path, str) else []
+        if (len(parts) == 3 and parts[2] == "sliding_friction"
+                and f"[pairs.{parts[1]}] static_friction" in complaint
+                and f"pairs.{parts[1]}.static_friction" not in values):
+            return (f"; set pairs.{parts[1]}.static_friction too (a file without it holds its "
+                    "sliding friction there)")
+    return ""
 
 
 def _key_of_another_table(key: str, section: str) -> str:

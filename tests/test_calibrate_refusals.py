@@ -565,8 +565,9 @@ def test_a_dotted_sliding_friction_past_the_static_one_names_the_alias_moving_bo
                               "pairs.particle_wall.sliding_friction=0.2 is outside its physical "
                               "domain ([pairs.particle_wall] static_friction: 0.14 is below "
                               "sliding_friction 0.2")
-    assert message.endswith("give a range inside it, or fit friction_pw (sliding and static "
-                            "friction of that pair together; a file without static_friction "
-                            "has it equal to its sliding friction)")
+    assert message.endswith("; set pairs.particle_wall.static_friction too (a file without it "
+                            "holds its sliding friction there)); give a range inside it, or "
+                            "fit friction_pw (sliding and static friction of that pair "
+                            "together)")
     # the alias named fits the same range
     build_specs(["friction_pw"], ["friction_pw=0.1:0.2"])

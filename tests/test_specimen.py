@@ -261,3 +261,20 @@ def test_a_sphere_diameter_key_says_the_file_takes_the_radius(key_line, hint):
     message = str(info.value)
     assert message.startswith(f"beads.toml: [particles] {key_line.split(' ')[0]}: unknown key")
     assert message.endswith(f"; the spheres are given by their radius: {hint}")
+
+
+def test_with_values_raising_a_sliding_friction_past_the_static_names_the_static_key():
+    # the trial script's TRUTH {"pairs.particle_wall.sliding_friction": 0.4} on a file stating
+    # no static friction was refused naming a static 0.3 the user never wrote
+    text = _edit(PAPER.to_toml(), "static_friction = 0.14\n", "")
+    wall_default = Specimen.from_text(text, source="mine.toml")
+    assert wall_default.pairs.particle_wall.static_friction == 0.14  # its sliding friction
+    with pytest.raises(ParameterError) as info:
+        wall_default.with_values({"pairs.particle_wall.sliding_friction": 0.4})
+    assert str(info.value) == (
+        "mine.toml: [pairs.particle_wall] static_friction: 0.14 is below sliding_friction 0.4; "
+        "expected static >= sliding; set pairs.particle_wall.static_friction too (a file "
+        "without it holds its sliding friction there)")
+    both = wall_default.with_values({"pairs.particle_wall.sliding_friction": 0.4,
+                                     "pairs.particle_wall.static_friction": 0.4})
+    assert both.pairs.particle_wall.static_friction == 0.4

@@ -404,8 +404,7 @@ def _together_hint(name: str, complaint: str) -> str:
     alias = {"particle_particle": "friction_pp", "particle_wall": "friction_pw"}.get(parts[1])
     if alias is None:
         return ""
-    return (f", or fit {alias} (sliding and static friction of that pair together; a "
-            "file without static_friction has it equal to its sliding friction)")
+    return f", or fit {alias} (sliding and static friction of that pair together)"
 
 
 def _check_static_friction(dem: Sequence[ParameterSpec], specimen,
