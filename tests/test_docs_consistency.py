@@ -440,3 +440,18 @@ def test_mass_convention_says_the_coupon_mass_holds_the_fixture(parser):
     text = " ".join(README.read_text(encoding="utf-8").split())
     assert ("m_c = coupon + particles by default (`--mass-convention`; the coupon's mass there "
             "is the moving mass, `[coupon] mass_kg` + `fixture_mass_kg`)") in text
+
+
+def test_own_specimen_section_sets_the_dem_beside_the_like_for_like_measured_column():
+    # a user of heavy beads set `SDC DEM (ours)` 0.96 beside `SDC measured (Eq. 11)` 2.64 and
+    # read the DEM as 2.7 x low; the like-for-like column (1.03) was named only deep in the
+    # report section. The own-specimen paragraph names it, by the report's own column names.
+    from pidcore.report.render import PDF_COLUMNS
+
+    section = _specimen_section()
+    start = section.index("**Measurements of your own specimen.**")
+    paragraph = " ".join(section[start:section.index("\n\n", start)].split())
+    assert ("set `SDC DEM (ours)` beside `SDC measured, E of Eq. 10`, not beside `SDC measured "
+            "(Eq. 11)`") in paragraph
+    for name in ("SDC DEM (ours)", "SDC measured, E of Eq. 10", "SDC measured (Eq. 11)"):
+        assert f"{name} [-]" in PDF_COLUMNS, name
