@@ -1799,7 +1799,7 @@ def describe(specimen: Specimen) -> dict[str, Any]:
         else specimen.provenance.calibrated_from_name,
         "calibrated_from_sha256": None if specimen.provenance is None
         else specimen.provenance.calibrated_from_sha256,
-        "notes": [*table_overrides(specimen), *_heavy_fixture_note(specimen, count),
+        "notes": [*table_overrides(specimen), *heavy_fixture_note(specimen, count),
                   *_no_fixture_note(specimen), *_column_note(specimen, capacity)],
         "cell_shape": specimen.cell.shape, "cells_per_coupon": specimen.cell.count,
         "cells_area_m2": specimen.cells_area_m2(geometry),
@@ -1845,7 +1845,7 @@ def describe(specimen: Specimen) -> dict[str, Any]:
 HEAVY_FIXTURE_RATIO = 100.0
 
 
-def _heavy_fixture_note(specimen: Specimen, count: int) -> tuple[str, ...]:
+def heavy_fixture_note(specimen: Specimen, count: int) -> tuple[str, ...]:
     """A note for a fixture far heavier than the coupon it carries (a likely g typed as kg); a
     note, not a refusal: a heavy head expander is possible, but the SDC then measures little."""
     coupon = specimen.coupon.mass_kg
@@ -1911,7 +1911,8 @@ def _capacity(shape: str, inscribed_diameter_m: float, height_m: float, radius_m
 
 __all__ = ["CellSpec", "CouponSpec", "PairSpec", "PairsSpec", "ParticleSpec", "Specimen",
            "ProvenanceSpec", "calibrated_name", "calibrated_provenance", "uncalibrated_name",
-           "cell_geometry", "contact_law", "describe", "hashed_name", "is_paper_coupon",
+           "cell_geometry", "contact_law", "describe", "hashed_name", "heavy_fixture_note",
+           "is_paper_coupon",
            "tested_label",
            "load_specimen",
            "MEASURED_SHA256_FIELD", "deciding_sha256", "measured_specimen_name",
