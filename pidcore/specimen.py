@@ -1800,7 +1800,7 @@ def describe(specimen: Specimen) -> dict[str, Any]:
         "calibrated_from_sha256": None if specimen.provenance is None
         else specimen.provenance.calibrated_from_sha256,
         "notes": [*table_overrides(specimen), *heavy_fixture_note(specimen, count),
-                  *_no_fixture_note(specimen), *_column_note(specimen, capacity)],
+                  *_no_fixture_note(specimen), *column_note(specimen, capacity)],
         "cell_shape": specimen.cell.shape, "cells_per_coupon": specimen.cell.count,
         "cells_area_m2": specimen.cells_area_m2(geometry),
         # the area pidcore model damper's c_eq per treated area is per, and why that one
@@ -1872,7 +1872,7 @@ def _no_fixture_note(specimen: Specimen) -> tuple[str, ...]:
             "Eq. 10 and the virtual shaker's force)",)
 
 
-def _column_note(specimen: Specimen, capacity: int) -> tuple[str, ...]:
+def column_note(specimen: Specimen, capacity: int) -> tuple[str, ...]:
     """A note for spheres that fit the cell only one above another (a diameter typed as the
     radius: 1.5 mm beads as radius_m = 1.5e-3 in a 3.2 mm cell were 3 per cell, the check said
     OK); a note, not a refusal: a single column of beads is a possible damper."""
@@ -1911,7 +1911,8 @@ def _capacity(shape: str, inscribed_diameter_m: float, height_m: float, radius_m
 
 __all__ = ["CellSpec", "CouponSpec", "PairSpec", "PairsSpec", "ParticleSpec", "Specimen",
            "ProvenanceSpec", "calibrated_name", "calibrated_provenance", "uncalibrated_name",
-           "cell_geometry", "contact_law", "describe", "hashed_name", "heavy_fixture_note",
+           "cell_geometry", "column_note", "contact_law", "describe", "hashed_name",
+           "heavy_fixture_note",
            "is_paper_coupon",
            "tested_label",
            "load_specimen",

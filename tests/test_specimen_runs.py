@@ -742,3 +742,18 @@ def test_a_run_of_a_fixture_far_heavier_than_the_coupon_names_it():
     grams = simulate_load_case(CASE, TINY, specimen=paper_specimen().with_values(
         {"coupon.fixture_mass_kg": 0.005}))
     assert not [n for n in grams.notes if "fixture_mass_kg" in n]
+
+
+def test_a_run_of_spheres_that_fit_only_as_a_column_names_it():
+    # as specimen check does (test above): a run of 2 mm beads typed as radius_m = 2e-3 in the
+    # steel_6mm cell simulated a column of 4 mm spheres with no note
+    column = Specimen.from_text(STEEL.read_text().replace("radius_m = 1.0e-3",
+                                                          "radius_m = 2.0e-3"))
+    run = simulate_load_case(LoadCase(1000.0, 5.0, 100.0, "steel"), TINY, specimen=column)
+    (note,) = [n for n in run.notes if "radius_m" in n]
+    assert note == ("[particles] radius_m 2 mm: the spheres (diameter 4 mm) fit the 6.35 mm "
+                    "cell only one above another, a column of 3; was the diameter given as "
+                    "the radius?")
+    beads = simulate_load_case(LoadCase(1000.0, 5.0, 25.0, "steel"), TINY,
+                               specimen=load_specimen(STEEL))
+    assert not [n for n in beads.notes if "radius_m" in n]

@@ -226,13 +226,20 @@ class DemResult:
           (:func:`pidcore.specimen.table_overrides`);
         * the specimen's fixture is far heavier than its coupon, a likely g typed as kg
           (:func:`pidcore.specimen.heavy_fixture_note`: only `specimen check` said so, and a
-          run of a 120 kg fixture on a 41 g coupon printed an SDC of 0.003 in silence);
+          run of a 120 kg fixture on a 41 g coupon printed an SDC of 0.003 in silence), or its
+          spheres fit the cell only one above another, a likely diameter typed as the radius
+          (:func:`pidcore.specimen.column_note`);
         * the load case's fill overrides the fill or particle count the specimen states
           (:func:`pidcore.specimen.fill_override_note`);
         * the drive is above :data:`pidcore.defaults.DEM_NOTE_ACCELERATION_G` (m/s^2 typed
           for g?).
         """
-        from ..specimen import fill_override_note, heavy_fixture_note, table_overrides
+        from ..specimen import (
+            column_note,
+            fill_override_note,
+            heavy_fixture_note,
+            table_overrides,
+        )
         from .simulate import required_steady_cycles
 
         notes = []
@@ -273,6 +280,7 @@ class DemResult:
         if self.specimen is not None:
             notes += table_overrides(self.specimen)
             notes += heavy_fixture_note(self.specimen, self.particles_per_cell)
+            notes += column_note(self.specimen, self.specimen.capacity_per_cell())
             overridden = fill_override_note(self.specimen, [self.case.fill_percent],
                                             self.config.fill_reference)
             if overridden:
