@@ -173,7 +173,7 @@ def test_unconstrained_notes_flag_a_parameter_the_data_leave_at_its_prior():
     # specimen and to "not fit it", which --discrepancy TAU does
     assert note.endswith("its median is the prior's more than the data's, no specimen value "
                          "(the calibrated specimen holds none) but it widens every band; fix "
-                         "it (--discrepancy TAU) where the model's relative error is known")
+                         "it (discrepancy=TAU) where the model's relative error is known")
     half_log = np.exp(rng.uniform(math.log(0.02), math.log(0.2), (4000, 1)))
     assert unconstrained_notes([tau], half_log) == []
     # a truncated normal prior is compared with its own 95 % interval, not its bounds: the

@@ -556,7 +556,7 @@ def unconstrained_notes(specs: Sequence[ParameterSpec], samples: np.ndarray) -> 
             # the calibrated specimen, which holds no such key
             consequence = (
                 "no specimen value (the calibrated specimen holds none) but it widens every "
-                "band; fix it (--discrepancy TAU) where the model's relative error is known"
+                "band; fix it (discrepancy=TAU) where the model's relative error is known"
                 if spec.name == DISCREPANCY else
                 "no measured value, and so is the value written to the calibrated specimen; "
                 "measure load cases where it changes the SDC, or do not fit it")
