@@ -107,8 +107,9 @@ calibrated_name, uncalibrated_name, calibrated_provenance, ProvenanceSpec, prove
     source's tests where that table tells it from the paper's coupon.
 CellSpec, CouponSpec, ParticleSpec, PairSpec, PairsSpec
     Its sections (SI units in the field names).
-describe
-    What follows from it: capacity, masses, contact numbers, time step.
+describe, heavy_fixture_note, column_note
+    What follows from it: capacity, masses, contact numbers, time step; the notes a run of it
+    repeats (a fixture far heavier than the coupon, spheres that fit only as a column).
 particles_for_fill
     Particles per cell of a fill percentage (the one rounding rule).
 cell_geometry, contact_law
