@@ -316,3 +316,42 @@ def test_damper_specimen_file_selects_its_runs_in_a_store_of_two_specimens(tmp_p
     assert len(common) > 10
     np.testing.assert_allclose(at.loc[common].to_numpy(), grid.loc[common].to_numpy(),
                                rtol=1e-12)  # the pchip model passes through its nodes
+
+
+def test_figures_specimen_file_selects_its_runs_in_a_store_of_two_specimens(tmp_path,
+                                                                           monkeypatch, capsys):
+    """`model figures` of a store holding two files' runs asked for --where specimen_sha256=
+    and had no --specimen, as damper now has: it draws the file's runs."""
+    import pidcore.store
+
+    path = _steel_with_face(tmp_path)
+    stated = load_specimen(path)
+    mine = _steel_runs(stated)
+    other = _steel_runs(stated.with_values({"coupon.fixture_mass_kg": 0.5}))
+
+    class FakeStore:
+        def __init__(self, _path):
+            pass
+
+        def list_dem_runs(self):
+            return pd.concat([other, mine], ignore_index=True)
+
+    monkeypatch.setattr(pidcore.store, "Store", FakeStore, raising=False)
+    argv = ["model", "figures", "--out", str(tmp_path / "figs"), "--table", "store", "--store",
+            str(tmp_path / "s.h5")]
+    with pytest.raises(ParameterError, match="DEM runs are of 2 specimens"):
+        _run_model(argv)
+    seen = {}
+    real = model_cli.build_model
+
+    def spy(args):
+        seen["model"], seen["runs"] = real(args)
+        return seen["model"], seen["runs"]
+
+    monkeypatch.setattr(model_cli, "build_model", spy)
+    assert _run_model([*argv, "--specimen", str(path)]) == 0
+    assert set(seen["runs"]["specimen_sha256"]) == {stated.hash}
+    assert len(seen["runs"]) == len(mine)
+    assert (tmp_path / "figs").is_dir() and any((tmp_path / "figs").iterdir())
+    with pytest.raises(ParameterError, match=r"selects DEM runs: use it with --table store"):
+        _run_model(["model", "figures", "--out", str(tmp_path / "p"), "--specimen", str(path)])

@@ -120,6 +120,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
     f = sub.add_parser("figures", help="SDC figures (paper Figs. 8-14), PNG and SVG")
     _add_model_source(f)
+    f.add_argument("--specimen", metavar="FILE", type=path_argument, default=None,
+                   help="with --table store: draw the store's runs of this specimen file (by "
+                        "its sha256), the other specimens' left out")
     f.set_defaults(func=run_figures)
 
 
@@ -402,6 +405,9 @@ def run_figures(args: argparse.Namespace) -> int:
     from ..report.figures import plot_sdc_vs_acceleration, plot_sdc_vs_frequency, save_figure
 
     check_out_folder(args.out)
+    if args.specimen is not None and args.table == "paper":
+        raise ParameterError(f"--specimen {args.specimen}: selects DEM runs: use it with "
+                             "--table store (--table paper draws the paper's coupon)")
     model, _ = build_model(args)
 
     def curves(extra: tuple[float, ...], axis) -> list[float]:
