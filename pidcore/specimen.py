@@ -124,6 +124,7 @@ bundled_face_area
 
 from __future__ import annotations
 
+import codecs
 import dataclasses
 import functools
 import hashlib
@@ -711,8 +712,13 @@ class Specimen:
                                  f"{MAX_SPECIMEN_FILE_BYTES // 1024} KiB; a specimen file is "
                                  "a few kB of TOML)")
         try:
-            # utf-8-sig: Windows editors write a byte-order mark, which TOML does not allow
-            text = data.decode("utf-8-sig")
+            if data.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):
+                # Notepad's "Unicode": UTF-16 behind its byte-order mark, unambiguous; it was
+                # refused as "not UTF-8 (byte 0xff on line 1)"
+                text = data.decode("utf-16")
+            else:
+                # utf-8-sig: Windows editors write a byte-order mark, which TOML does not allow
+                text = data.decode("utf-8-sig")
         except UnicodeDecodeError as exc:
             line = data[:exc.start].count(b"\n") + 1
             raise ParameterError(f"{source}: not UTF-8 text (byte 0x{data[exc.start]:02x} on "

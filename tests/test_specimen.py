@@ -278,3 +278,21 @@ def test_with_values_raising_a_sliding_friction_past_the_static_names_the_static
     both = wall_default.with_values({"pairs.particle_wall.sliding_friction": 0.4,
                                      "pairs.particle_wall.static_friction": 0.4})
     assert both.pairs.particle_wall.static_friction == 0.4
+
+
+@pytest.mark.parametrize("encoding", ["utf-16", "utf-16-le", "utf-16-be"])
+def test_a_utf16_file_behind_its_byte_order_mark_is_the_same_specimen(tmp_path, encoding):
+    # Notepad's "Unicode" (UTF-16 with a byte-order mark) was refused as "not UTF-8 text
+    # (byte 0xff on line 1)"; the mark makes it unambiguous, and its text is the file's
+    import codecs
+
+    mark = {"utf-16": b"", "utf-16-le": codecs.BOM_UTF16_LE, "utf-16-be": codecs.BOM_UTF16_BE}
+    path = tmp_path / "notepad.toml"
+    text = PAPER.to_toml().replace("\n", "\r\n")
+    path.write_bytes(mark[encoding] + text.encode(encoding))
+    assert path.read_bytes()[:2] in (codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)
+    assert load_specimen(path).hash == PAPER.hash
+    # without the mark UTF-16 is not read as text: refused in one line, not guessed
+    path.write_bytes(text.encode("utf-16-le"))
+    with pytest.raises(ParameterError, match=r"^.*notepad\.toml: not valid TOML"):
+        load_specimen(path)
