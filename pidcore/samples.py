@@ -10,17 +10,25 @@ one of the formats users export (UFF58 ASCII, UFF58b binary, CSV, MAT, HDF5).
 
 from __future__ import annotations
 
+import csv
 import os
 import shutil
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from fractions import Fraction
+from io import StringIO
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from .atomic_files import write_atomically
-from .errors import StoreError
+from .errors import ParameterError, StoreError
 from .records import Channel, Measurement
+
+if TYPE_CHECKING:
+    from .dem.simulate import DemConfig
+    from .specimen import Specimen
 
 #: Sampling rate of the exports, Hz (a common Testlab setting).
 EXPORT_SAMPLE_RATE_HZ = 25_600.0
@@ -163,3 +171,70 @@ def make_samples(out_dir: str | os.PathLike = "data_samples", *, run_sweep: bool
                                f"{EXPORT_VELOCITY_DELAY_S * 1e6:g}\n" for s in SAMPLE_CASES))
     written["loadcases"] = sidecar
     return written
+
+
+#: File extension of each export format :func:`own_specimen_exports` writes.
+OWN_EXPORT_EXTENSIONS = {"uff": "uff", "uff58b": "uff", "csv": "csv", "mat": "mat", "hdf5": "h5"}
+
+
+def own_specimen_exports(
+    specimen: Specimen, cases: Sequence[tuple[float, float, float, str]],
+    out_dir: str | os.PathLike, *, config: DemConfig, snr_db: float = 40.0,
+    velocity_delay_s: float = EXPORT_VELOCITY_DELAY_S, first_noise_seed: int = 50,
+    prefix: str = "trial", report: Callable[[str], None] | None = None,
+) -> list[Path]:
+    """Virtual shaker exports of ``specimen`` (its values the hidden truth) and their sidecar.
+
+    One DEM run per case ``(frequency_hz, acceleration_g, fill_percent, file_format)``
+    (``file_format`` one of :data:`OWN_EXPORT_EXTENSIONS`), the empty structure's loss factor
+    ``[coupon] baseline_loss_factor`` added to the shaker force as the viscous force
+    eta0 * omega * m_s * v, written as a sensor would record it (:func:`virtual_shaker_measurement`)
+    into ``out_dir`` with a ``loadcases.csv`` naming each file's fill, the specimen's particle
+    material and name, and the vibrometer delay. The material and name are the specimen's: a
+    copy of the trial script for another specimen wrote the trial's ``alumina`` into every
+    load case and failed (or, with a table material, mislabelled the tests). Each file name
+    states its fill, so two fills of one frequency, acceleration and format are two files
+    (they overwrote one another). Returns the export paths in ``cases`` order.
+    """
+    from .dem.simulate import LoadCase, simulate_load_case
+    from .io import write_measurement
+
+    out = Path(out_dir)
+    formats = set(OWN_EXPORT_EXTENSIONS)
+    names: list[str] = []
+    for f, a, fill, fmt in cases:
+        if fmt not in formats:
+            raise ParameterError(f"cases: format {fmt!r}; expected one of {sorted(formats)}")
+        name = (f"{prefix}_f{f:g}Hz_a{a:g}g_fill{fill:g}pct"
+                f"{'_58b' if fmt == 'uff58b' else ''}.{OWN_EXPORT_EXTENSIONS[fmt]}")
+        if name in names:
+            raise ParameterError(f"cases: two cases write {name}; give each load case once")
+        names.append(name)
+    out.mkdir(parents=True, exist_ok=True)
+    eta0 = specimen.coupon.baseline_loss_factor
+    material = specimen.particles.material
+    sidecar = StringIO()
+    rows = csv.writer(sidecar, lineterminator="\n")
+    rows.writerow(["file", "fill_percent", "material", "direction", "velocity_delay_us",
+                   "specimen"])
+    paths: list[Path] = []
+    for i, ((f, a, fill, fmt), name) in enumerate(zip(cases, names, strict=True)):
+        case = LoadCase(float(f), float(a), float(fill), material=material)
+        run = simulate_load_case(case, config, specimen=specimen)
+        steady = run.steady_slice()
+        force = (run.shaker_force_n[steady]
+                 + eta0 * case.omega_rad_s * run.moving_mass_kg * run.velocity_m_s[steady])
+        measurement = virtual_shaker_measurement(
+            time_s=run.sample_time_s[steady], shaker_force_n=force, frequency_hz=float(f),
+            acceleration_m_s2=case.acceleration_m_s2, source=name, snr_db=snr_db,
+            velocity_delay_s=velocity_delay_s, seed=first_noise_seed + i)
+        path = out / name
+        write_measurement(measurement, path, "uff" if fmt.startswith("uff") else fmt,
+                          binary=fmt == "uff58b")
+        paths.append(path)
+        rows.writerow([name, f"{fill:g}", material, case.direction,
+                       f"{velocity_delay_s * 1e6:g}", specimen.name])
+        if report is not None:
+            report(f"wrote {path}")
+    write_atomically(out / "loadcases.csv", sidecar.getvalue())
+    return paths

@@ -107,8 +107,9 @@ calibrated_name, uncalibrated_name, calibrated_provenance, ProvenanceSpec, prove
     source's tests where that table tells it from the paper's coupon.
 CellSpec, CouponSpec, ParticleSpec, PairSpec, PairsSpec
     Its sections (SI units in the field names).
-describe
-    What follows from it: capacity, masses, contact numbers, time step.
+describe, heavy_fixture_note, column_note
+    What follows from it: capacity, masses, contact numbers, time step; the notes a run of it
+    repeats (a fixture far heavier than the coupon, spheres that fit only as a column).
 particles_for_fill
     Particles per cell of a fill percentage (the one rounding rule).
 cell_geometry, contact_law
@@ -123,6 +124,7 @@ bundled_face_area
 
 from __future__ import annotations
 
+import codecs
 import dataclasses
 import functools
 import hashlib
@@ -710,8 +712,13 @@ class Specimen:
                                  f"{MAX_SPECIMEN_FILE_BYTES // 1024} KiB; a specimen file is "
                                  "a few kB of TOML)")
         try:
-            # utf-8-sig: Windows editors write a byte-order mark, which TOML does not allow
-            text = data.decode("utf-8-sig")
+            if data.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):
+                # Notepad's "Unicode": UTF-16 behind its byte-order mark, unambiguous; it was
+                # refused as "not UTF-8 (byte 0xff on line 1)"
+                text = data.decode("utf-16")
+            else:
+                # utf-8-sig: Windows editors write a byte-order mark, which TOML does not allow
+                text = data.decode("utf-8-sig")
         except UnicodeDecodeError as exc:
             line = data[:exc.start].count(b"\n") + 1
             raise ParameterError(f"{source}: not UTF-8 text (byte 0x{data[exc.start]:02x} on "
@@ -747,7 +754,7 @@ class Specimen:
         try:
             return _from_mapping(data, source=self.source)
         except ParameterError as exc:
-            raise ParameterError(f"{self.source}: {exc}") from None
+            raise ParameterError(f"{self.source}: {exc}{_static_too(values, str(exc))}") from None
 
     # --- identity ------------------------------------------------------------------------
 
@@ -974,6 +981,21 @@ _TABLE_OF_SECTION = {"": "the top level", "cell": "[cell]", "coupon": "[coupon]"
                      "[pairs.particle_wall]", "pairs": "[pairs]", "provenance": "[provenance]"}
 
 
+def _static_too(values: Mapping[str, Any], complaint: str) -> str:
+    """The end of a ``with_values`` refusal where a pair's sliding friction was raised past
+    the static friction the specimen holds, which was not set: a file without static_friction
+    holds its sliding friction there, so {"...sliding_friction": 0.4} was refused naming a
+    static 0.3 the user never wrote."""
+    for path in values:
+        parts = path.split(".") if isinstance(path, str) else []
+        if (len(parts) == 3 and parts[2] == "sliding_friction"
+                and f"[pairs.{parts[1]}] static_friction" in complaint
+                and f"pairs.{parts[1]}.static_friction" not in values):
+            return (f"; set pairs.{parts[1]}.static_friction too (a file without it holds its "
+                    "sliding friction there)")
+    return ""
+
+
 def _key_of_another_table(key: str, section: str) -> str:
     """The end of an unknown key's message where the key is another table's: a table header
     left out puts its keys in the table above it (``[cell]`` missing: "top level shape:
@@ -985,6 +1007,25 @@ def _key_of_another_table(key: str, section: str) -> str:
         return ""
     return (f"; {key} belongs in {' and '.join(owners)}: is that table's header missing or "
             "below it?")
+
+
+#: Length units a diameter key may end with, and their factor to metres.
+_DIAMETER_UNITS = {"_m": 1.0, "_mm": 1e-3, "_cm": 1e-2, "_um": 1e-6, "": None}
+
+
+def _diameter_for_radius(key: Any, value: Any, section: str) -> str:
+    """The end of an unknown key's message for a sphere diameter (``diameter_m``,
+    ``diameter_mm``): beads are sold by their diameter, the file states the radius, and the
+    message only listed the keys, so a user could write the diameter as ``radius_m``, twice
+    the spheres' size (a note catches that only where they then fit one above another)."""
+    if section != "particles" or not isinstance(key, str) or "diameter" not in key:
+        return ""
+    unit = next((u for u in _DIAMETER_UNITS if u and key.endswith(u)), "")
+    factor = _DIAMETER_UNITS[unit]
+    if factor is None or isinstance(value, bool) or not isinstance(value, int | float):
+        return "; the spheres are given by their radius: write radius_m, half the diameter, in m"
+    return (f"; the spheres are given by their radius: write radius_m = {value * factor / 2:g} "
+            "(half the diameter, in m)")
 
 
 #: The SI units specimen keys end with (longest first: ``_kg_m3`` before ``_m3``).
@@ -1015,7 +1056,8 @@ def _take(table: Mapping[str, Any], section: str, where: str) -> dict[str, Any]:
         if key not in schema:
             raise ParameterError(f"{where} {clipped(key)}: unknown key; expected one of "
                                  f"{list(schema)}{_key_of_another_table(key, section)}"
-                                 f"{_key_in_another_unit(key, schema)}")
+                                 f"{_key_in_another_unit(key, schema)}"
+                                 f"{_diameter_for_radius(key, table[key], section)}")
     out: dict[str, Any] = {}
     for key, (required, kind) in schema.items():
         if key not in table:
@@ -1158,13 +1200,31 @@ def _complete_from_material(table: dict[str, Any], where: str, name: str, role: 
     inline from material ``name``'s row; a key neither stated nor in the table is an error
     naming ``where`` (the material key)."""
     row = _table_material(name, where, role)
+    missing = [key for key, _ in columns if key not in table]
+    if row is None and missing:
+        raise ParameterError(f"{where}: unknown material {_shown(name)} (not in materials.csv) "
+                             f"and no inline {', '.join(missing)}; " + _material_hint(name, role))
     for key, column in columns:
         if key not in table:
-            if row is None:
-                raise ParameterError(
-                    f"{where}: unknown material {_shown(name)} (not in materials.csv) and no "
-                    f"inline {key}")
             table[key] = getattr(row, column)
+
+
+def _material_hint(name: Any, role: str | None) -> str:
+    """What an unknown material should have been: the table's names of its role and the
+    closest one (a typo such as 'aluminum_wall' or 'acrylc' was only called unknown, and the
+    message named one missing inline key, so a user adding it met the next)."""
+    import difflib
+
+    from .dem.materials import material_table
+
+    table = material_table()
+    names = [str(n) for n in (table.index if role is None
+                              else table.index[table["role"] == role])]
+    hint = (f"expected a {role + ' ' if role else ''}material of materials.csv "
+            f"({', '.join(names)}), or those keys inline")
+    close = difflib.get_close_matches(str(name), names, n=1, cutoff=0.75) if isinstance(
+        name, str) and len(name) <= MAX_SHOWN_CHARS else []
+    return hint + (f"; did you mean {close[0]!r}?" if close else "")
 
 
 def _tables_are_tables(node: Mapping[str, Any], names: tuple[str, ...], prefix: str) -> None:
@@ -1746,8 +1806,8 @@ def describe(specimen: Specimen) -> dict[str, Any]:
         else specimen.provenance.calibrated_from_name,
         "calibrated_from_sha256": None if specimen.provenance is None
         else specimen.provenance.calibrated_from_sha256,
-        "notes": [*table_overrides(specimen), *_heavy_fixture_note(specimen, count),
-                  *_column_note(specimen, capacity)],
+        "notes": [*table_overrides(specimen), *heavy_fixture_note(specimen, count),
+                  *_no_fixture_note(specimen), *column_note(specimen, capacity)],
         "cell_shape": specimen.cell.shape, "cells_per_coupon": specimen.cell.count,
         "cells_area_m2": specimen.cells_area_m2(geometry),
         # the area pidcore model damper's c_eq per treated area is per, and why that one
@@ -1792,7 +1852,7 @@ def describe(specimen: Specimen) -> dict[str, Any]:
 HEAVY_FIXTURE_RATIO = 100.0
 
 
-def _heavy_fixture_note(specimen: Specimen, count: int) -> tuple[str, ...]:
+def heavy_fixture_note(specimen: Specimen, count: int) -> tuple[str, ...]:
     """A note for a fixture far heavier than the coupon it carries (a likely g typed as kg); a
     note, not a refusal: a heavy head expander is possible, but the SDC then measures little."""
     coupon = specimen.coupon.mass_kg
@@ -1806,7 +1866,20 @@ def _heavy_fixture_note(specimen: Specimen, count: int) -> tuple[str, ...]:
             f"{fixture / (fixture + carried):.1%} the fixture's and the SDC small; was it g?",)
 
 
-def _column_note(specimen: Specimen, capacity: int) -> tuple[str, ...]:
+def _no_fixture_note(specimen: Specimen) -> tuple[str, ...]:
+    """A note for a file of one's own without a fixture: a key left out reads as 0 kg, the
+    same specimen (hash) as 0 stated, and nothing said so; a 120 g adapter plate forgotten on
+    a 41 g coupon with 234 g of spheres raised the DEM's SDC from 1.0 to 1.43 (E of Eq. 10 has
+    0.28 kg, not 0.40 kg) in silence. Not for the paper's coupon, whose runs are of none."""
+    if specimen.coupon.fixture_mass_kg > 0 or specimen.is_paper():
+        return ()
+    return ("[coupon] fixture_mass_kg is 0 kg (stated, or left out: 0 is its default): the "
+            "shaker moves the coupon alone above the force gauge; state the mass of an adapter "
+            "plate, bolts or head expander between gauge and coupon there (it is in m_c of "
+            "Eq. 10 and the virtual shaker's force)",)
+
+
+def column_note(specimen: Specimen, capacity: int) -> tuple[str, ...]:
     """A note for spheres that fit the cell only one above another (a diameter typed as the
     radius: 1.5 mm beads as radius_m = 1.5e-3 in a 3.2 mm cell were 3 per cell, the check said
     OK); a note, not a refusal: a single column of beads is a possible damper."""
@@ -1845,7 +1918,9 @@ def _capacity(shape: str, inscribed_diameter_m: float, height_m: float, radius_m
 
 __all__ = ["CellSpec", "CouponSpec", "PairSpec", "PairsSpec", "ParticleSpec", "Specimen",
            "ProvenanceSpec", "calibrated_name", "calibrated_provenance", "uncalibrated_name",
-           "cell_geometry", "contact_law", "describe", "hashed_name", "is_paper_coupon",
+           "cell_geometry", "column_note", "contact_law", "describe", "hashed_name",
+           "heavy_fixture_note",
+           "is_paper_coupon",
            "tested_label",
            "load_specimen",
            "MEASURED_SHA256_FIELD", "deciding_sha256", "measured_specimen_name",

@@ -1289,7 +1289,8 @@ def test_an_uploaded_specimen_error_names_the_users_file():
         jobs.specimen_from_upload("syntax.toml", b"name = 'x'\n[cell\n")
     with pytest.raises(ParameterError, match=r"syntax\.toml: not UTF-8 text \(byte 0xff on "
                                              r"line 1\)"):
-        jobs.specimen_from_upload("syntax.toml", b"\xff\xfe")
+        # (not b"\xff\xfe": that is UTF-16's byte-order mark, read as Notepad writes it)
+        jobs.specimen_from_upload("syntax.toml", b"\xff\x00")
     # decoded as a file on disk is: an editor's byte-order mark was refused as "not valid
     # TOML" on upload while the same file loaded from disk
     from pidcore.specimen import load_specimen

@@ -384,6 +384,28 @@ def test_a_table_without_materials_is_of_the_specimen_given(tmp_path):
     assert [p.material for p in read_measured_table(table)] == ["acrylic", "acrylic"]
 
 
+def test_a_tables_material_is_read_as_the_sidecar_reads_it(tmp_path):
+    # 'Tungsten_Carbide' or 'PMMA' typed in a spreadsheet: the sidecar of `analyze` reads them
+    # as tungsten_carbide and acrylic, while the calibrate --data table kept them verbatim and
+    # refused the points as "of Tungsten_Carbide particles, the specimen holds tungsten_carbide"
+    from pidcore.calibrate import read_measured_table
+    from pidcore.errors import InputFileError
+
+    table = tmp_path / "m.csv"
+    table.write_text("frequency_hz,acceleration_g,fill_percent,sdc,material\n"
+                     "500,1,50,0.4,Tungsten_Carbide\n500,5,50,0.5, tungsten_carbide\n"
+                     "500,8,50,0.5,PMMA\n500,10,50,0.5,Aluminum\n")
+    assert [p.material for p in read_measured_table(table)] == [
+        "tungsten_carbide", "tungsten_carbide", "acrylic", "aluminium"]
+    table.write_text("frequency_hz,acceleration_g,fill_percent,sdc,material\n"
+                     "500,1,50,0.4,Tungsten Carbide\n")
+    with pytest.raises(InputFileError) as caught:
+        read_measured_table(table)
+    assert str(caught.value) == (f"{table}, line 2: material: particle material 'Tungsten "
+                                 "Carbide' is not a name (expected lower-case letters, digits "
+                                 "and '_', e.g. 'acrylic')")
+
+
 def test_repeated_rows_of_one_load_case_are_refused(tmp_path):
     # three rows of 500 Hz, 1 g, 40 % passed as three load cases: a 3-parameter fit ran on
     # one case (two distinct cases were refused as too few)

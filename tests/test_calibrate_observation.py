@@ -168,7 +168,12 @@ def test_unconstrained_notes_flag_a_parameter_the_data_leave_at_its_prior():
     # 0.02 .. 0.2 taken linearly is only 9 % of the range but half of it in log
     tau = parameter_spec(DISCREPANCY)
     flat_log = np.exp(rng.uniform(math.log(0.02), math.log(2.0), (4000, 1)))
-    assert len(unconstrained_notes([tau], flat_log)) == 1
+    (note,) = unconstrained_notes([tau], flat_log)
+    # the discrepancy is no specimen field: the note said it was written to the calibrated
+    # specimen and to "not fit it", which --discrepancy TAU does
+    assert note.endswith("its median is the prior's more than the data's, no specimen value "
+                         "(the calibrated specimen holds none) but it widens every band; fix "
+                         "it (discrepancy=TAU) where the model's relative error is known")
     half_log = np.exp(rng.uniform(math.log(0.02), math.log(0.2), (4000, 1)))
     assert unconstrained_notes([tau], half_log) == []
     # a truncated normal prior is compared with its own 95 % interval, not its bounds: the

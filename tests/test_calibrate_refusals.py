@@ -551,3 +551,23 @@ def test_calibrate_help_says_the_fewest_cells_it_takes(capsys, tmp_path):
     assert main(["calibrate", "--data", str(tmp_path / "none.csv"), "--cells", "1",
                  "--dem-store", str(tmp_path / "cal.h5")]) == 2
     assert "--cells: expected >= 2" in capsys.readouterr().err
+
+
+def test_a_dotted_sliding_friction_past_the_static_one_names_the_alias_moving_both():
+    # a file without static_friction has it equal to its sliding friction: a dotted sliding
+    # friction's default prior (0.5 .. 1.5 x) then passes it, and the refusal only asked for
+    # another range, without the alias that moves both (the paper's wall pair: 0.14 static)
+    with pytest.raises(ParameterError) as caught:
+        build_specs(["pairs.particle_wall.sliding_friction"],
+                    ["pairs.particle_wall.sliding_friction=0.1:0.2"])
+    message = str(caught.value)
+    assert message.startswith("priors=pairs.particle_wall.sliding_friction=0.1:0.2: "
+                              "pairs.particle_wall.sliding_friction=0.2 is outside its physical "
+                              "domain ([pairs.particle_wall] static_friction: 0.14 is below "
+                              "sliding_friction 0.2")
+    assert message.endswith("; set pairs.particle_wall.static_friction too (a file without it "
+                            "holds its sliding friction there)); give a range inside it, or "
+                            "fit friction_pw (sliding and static friction of that pair "
+                            "together)")
+    # the alias named fits the same range
+    build_specs(["friction_pw"], ["friction_pw=0.1:0.2"])

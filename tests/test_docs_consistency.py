@@ -422,3 +422,36 @@ def test_own_specimen_exports_are_pointed_to_from_readme_and_samples_help(parser
     samples = _subparsers(parser)["samples"]
     for command in (samples, _subparsers(samples)["make"]):
         assert script in command.description, command.prog
+
+
+def test_mass_convention_says_the_coupon_mass_holds_the_fixture(parser):
+    # "m_c = coupon + particles" (README, --mass-convention's help): a 41 g coupon with a 120 g
+    # fixture divided by 0.395 kg, not the 0.275 kg the words gave, and the user's hand check
+    # of E (Eq. 10) was off by 44 %; both now name the fixture
+    from pidcore.specimen import load_specimen
+
+    steel = load_specimen(ROOT / "data_samples" / "specimens" / "steel_6mm.toml")
+    assert steel.vibrated_mass_kg(0, "coupon") == steel.coupon.mass_kg + \
+        steel.coupon.fixture_mass_kg
+    dem = _subparsers(_subparsers(parser)["dem"])
+    for command in ("run", "sweep"):
+        (action,) = [a for a in dem[command]._actions if "--mass-convention" in a.option_strings]
+        assert "coupon and fixture" in action.help, command
+    text = " ".join(README.read_text(encoding="utf-8").split())
+    assert ("m_c = coupon + particles by default (`--mass-convention`; the coupon's mass there "
+            "is the moving mass, `[coupon] mass_kg` + `fixture_mass_kg`)") in text
+
+
+def test_own_specimen_section_sets_the_dem_beside_the_like_for_like_measured_column():
+    # a user of heavy beads set `SDC DEM (ours)` 0.96 beside `SDC measured (Eq. 11)` 2.64 and
+    # read the DEM as 2.7 x low; the like-for-like column (1.03) was named only deep in the
+    # report section. The own-specimen paragraph names it, by the report's own column names.
+    from pidcore.report.render import PDF_COLUMNS
+
+    section = _specimen_section()
+    start = section.index("**Measurements of your own specimen.**")
+    paragraph = " ".join(section[start:section.index("\n\n", start)].split())
+    assert ("set `SDC DEM (ours)` beside `SDC measured, E of Eq. 10`, not beside `SDC measured "
+            "(Eq. 11)`") in paragraph
+    for name in ("SDC DEM (ours)", "SDC measured, E of Eq. 10", "SDC measured (Eq. 11)"):
+        assert f"{name} [-]" in PDF_COLUMNS, name

@@ -324,3 +324,21 @@ def test_a_test_of_the_runs_particle_count_meets_the_run_whatever_fill_it_states
     # (the runs here record no m_c: the note says so after)
     assert row["note"].startswith("measured at 60 % fill: 28 of 46 particles per cell, as the "
                                   f"DEM runs at {fill:g} %: the same simulation")
+
+
+def test_tests_near_no_run_sort_by_their_load_case_not_their_last_digits(steel):
+    """Two tests at 100 Hz (measured 99.999977 and 99.999986 Hz) of a specimen with runs at
+    1000 Hz only were listed 70 % before 30 %: they sorted by those digits first, since only
+    values near a DEM run's or the paper's were taken as one frequency."""
+    runs = pd.DataFrame([_run("s1", "steel", 1.75, steel)])
+    tests = pd.DataFrame({
+        "frequency_hz": [99.999977, 99.999986, 1000.0], "acceleration_g": [4.99966, 4.9999, 5.0],
+        "fill_percent": [70.0, 30.0, 50.0], "material": ["steel"] * 3, "direction": ["z"] * 3,
+        "sdc": [3.6, 2.6, 1.7], "sdc_stderr": [0.1] * 3,
+        "source": ["f100_fill70.uff", "f100_fill30.uff", "f1000.uff"], "specimen": [""] * 3})
+    table = specimen_report_table(runs, tests, specimen=steel).table
+    measured = table[table["source file(s)"] != ""]
+    assert list(measured["source file(s)"]) == ["f100_fill30.uff", "f100_fill70.uff",
+                                                "f1000.uff"]
+    # the measured values themselves are kept: only the order groups them
+    assert list(measured["frequency [Hz]"][:2]) == [99.999986, 99.999977]

@@ -92,3 +92,45 @@ def test_make_samples_refuses_a_store_holding_other_settings(tmp_path):
     with pytest.raises(StoreError, match="other settings"):
         make_samples(tmp_path, run_sweep=False, progress=False)
     assert path.read_bytes() == before  # untouched
+
+
+def test_own_specimen_exports_carry_the_specimens_material_and_name(tmp_path, capsys):
+    """The trial script (docs/trial_own_specimen/make_measurements.py), copied for another
+    specimen as the README says, wrote the trial's 'alumina' into every load case (a DEM error
+    for steel; for a table material, tests labelled with the wrong particles) and named its
+    files without the fill, so two fills of one frequency, acceleration and format overwrote
+    one another. The exports of a steel specimen at two fills must be two files that
+    `pidcore analyze --sidecar --specimen` places as steel tests of that specimen at their fills."""
+    import json
+
+    from pidcore.cli import main
+    from pidcore.samples import own_specimen_exports
+    from pidcore.specimen import load_specimen
+
+    specimen_file = "data_samples/specimens/steel_6mm.toml"
+    truth = load_specimen(specimen_file).with_values({"coupon.fixture_mass_kg": 0.03})
+    cases = [(500, 5, 25.0, "csv"), (500, 5, 50.0, "csv")]
+    # 20 cycles: the export drops two periods each end and the analysis needs 10
+    paths = own_specimen_exports(truth, cases, tmp_path,
+                                 config=DemConfig(cells=1, steady_cycles=20))
+    assert len({p.name for p in paths}) == 2 and all(p.is_file() for p in paths)
+    code = main(["analyze", *map(str, paths), "--sidecar", str(tmp_path / "loadcases.csv"),
+                 "--specimen", specimen_file, "--no-store", "--json", "--no-progress"])
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    records = {r["source"].rsplit("/", 1)[-1]: r for r in json.loads(out)["records"]}
+    for path, (_, _, fill, _) in zip(paths, cases, strict=True):
+        record = records[path.name]
+        assert record["load_case"].endswith(f"_fill{fill:g}pct_steel_z"), record["load_case"]
+        assert record["specimen"] == "steel_6mm"
+
+
+def test_own_specimen_exports_refuse_one_file_written_twice(tmp_path):
+    from pidcore.errors import ParameterError
+    from pidcore.samples import own_specimen_exports
+    from pidcore.specimen import paper_specimen
+
+    with pytest.raises(ParameterError, match=r"two cases write trial_f500Hz_a5g_fill50pct\.csv"):
+        own_specimen_exports(paper_specimen(), [(500, 5, 50, "csv"), (500, 5, 50, "csv")],
+                             tmp_path, config=DemConfig(cells=1, steady_cycles=10))
+    assert not any(tmp_path.iterdir())  # refused before any run or file

@@ -194,3 +194,105 @@ def test_specimen_check_labels_its_time_step_with_the_load_case_it_is_for(tmp_pa
         assert main(["specimen", "check", str(path), "--json"]) == 0
         doc = json.loads(capsys.readouterr().out)
         assert (doc["reference_frequency_hz"], doc["reference_acceleration_g"]) == (50, 10)
+
+
+@pytest.mark.parametrize(("old", "new", "message"), [
+    # a typo of the wall row: the error said 'unknown' and named one inline key, so a user
+    # added wall_youngs_modulus_pa, then met wall_poisson_ratio, then the density
+    ('wall_material = "aluminium_wall"\nwall_youngs_modulus_pa = 72000000000.0\n'
+     'wall_poisson_ratio = 0.33\nwall_density_kg_m3 = 2800.0',
+     'wall_material = "aluminum_wall"',
+     "[cell] wall_material: unknown material 'aluminum_wall' (not in materials.csv) and no "
+     "inline wall_youngs_modulus_pa, wall_poisson_ratio, wall_density_kg_m3; expected a wall "
+     "material of materials.csv (aluminium_wall), or those keys inline; did you mean "
+     "'aluminium_wall'?"),
+    ('material = "acrylic"\nradius_m = 0.00125\ndensity_kg_m3 = 1180.0\n'
+     'youngs_modulus_pa = 2840000000.0\npoisson_ratio = 0.402',
+     'material = "acrylc"\nradius_m = 0.00125',
+     "[particles] material: unknown material 'acrylc' (not in materials.csv) and no inline "
+     "density_kg_m3, youngs_modulus_pa, poisson_ratio; expected a particle material of "
+     "materials.csv (acrylic, aluminium), or those keys inline; did you mean 'acrylic'?"),
+    # a material of one's own, partly inline: every key still missing, no guess
+    ('material = "acrylic"\nradius_m = 0.00125\ndensity_kg_m3 = 1180.0',
+     'material = "steel"\ndensity_kg_m3 = 7850.0',
+     "[particles] material: unknown material 'steel' (not in materials.csv) and no inline "
+     "radius_m; expected a particle material of materials.csv (acrylic, aluminium), or those "
+     "keys inline"),
+])
+def test_unknown_material_names_every_missing_key_and_the_closest_table_row(tmp_path, old, new,
+                                                                            message):
+    path = tmp_path / "typo.toml"
+    path.write_text(_edit(PAPER.to_toml(), old, new))
+    with pytest.raises(ParameterError) as info:
+        load_specimen(path)
+    assert str(info.value) == f"{path}: {message}"
+
+
+def test_a_file_of_ones_own_without_a_fixture_is_named_in_a_note():
+    """A fixture left out reads as 0 kg (the same specimen as 0 stated), and specimen check
+    said nothing: a forgotten adapter plate changes m_c of Eq. 10, so the DEM's SDC, silently."""
+    from pidcore.specimen import describe
+
+    steel = load_specimen("data_samples/specimens/steel_6mm.toml")
+    assert steel.coupon.fixture_mass_kg > 0
+    assert not [n for n in describe(steel)["notes"] if "fixture_mass_kg" in n]
+    text = steel.to_toml()
+    left_out = Specimen.from_text(_edit(text, "fixture_mass_kg = 0.015\n", ""))
+    stated_zero = Specimen.from_text(_edit(text, "fixture_mass_kg = 0.015", "fixture_mass_kg = 0"))
+    assert left_out.hash == stated_zero.hash  # one specimen: the note says both readings
+    for specimen in (left_out, stated_zero):
+        (note,) = [n for n in describe(specimen)["notes"] if "fixture_mass_kg" in n]
+        assert note.startswith("[coupon] fixture_mass_kg is 0 kg (stated, or left out: 0 is its "
+                               "default)")
+    # the paper's coupon runs without one: no note on the bundled file
+    assert not [n for n in describe(PAPER)["notes"] if "fixture_mass_kg" in n]
+
+
+@pytest.mark.parametrize(("key_line", "hint"), [
+    # 2 mm beads, as sold: by their diameter
+    ("diameter_m = 2.0e-3", "write radius_m = 0.001 (half the diameter, in m)"),
+    ("diameter_mm = 2.5", "write radius_m = 0.00125 (half the diameter, in m)"),
+    ('diameter = "2 mm"', "write radius_m, half the diameter, in m"),
+])
+def test_a_sphere_diameter_key_says_the_file_takes_the_radius(key_line, hint):
+    text = _edit(PAPER.to_toml(), "radius_m = 0.00125", key_line)
+    with pytest.raises(ParameterError) as info:
+        Specimen.from_text(text, source="beads.toml")
+    message = str(info.value)
+    assert message.startswith(f"beads.toml: [particles] {key_line.split(' ')[0]}: unknown key")
+    assert message.endswith(f"; the spheres are given by their radius: {hint}")
+
+
+def test_with_values_raising_a_sliding_friction_past_the_static_names_the_static_key():
+    # the trial script's TRUTH {"pairs.particle_wall.sliding_friction": 0.4} on a file stating
+    # no static friction was refused naming a static 0.3 the user never wrote
+    text = _edit(PAPER.to_toml(), "static_friction = 0.14\n", "")
+    wall_default = Specimen.from_text(text, source="mine.toml")
+    assert wall_default.pairs.particle_wall.static_friction == 0.14  # its sliding friction
+    with pytest.raises(ParameterError) as info:
+        wall_default.with_values({"pairs.particle_wall.sliding_friction": 0.4})
+    assert str(info.value) == (
+        "mine.toml: [pairs.particle_wall] static_friction: 0.14 is below sliding_friction 0.4; "
+        "expected static >= sliding; set pairs.particle_wall.static_friction too (a file "
+        "without it holds its sliding friction there)")
+    both = wall_default.with_values({"pairs.particle_wall.sliding_friction": 0.4,
+                                     "pairs.particle_wall.static_friction": 0.4})
+    assert both.pairs.particle_wall.static_friction == 0.4
+
+
+@pytest.mark.parametrize("encoding", ["utf-16", "utf-16-le", "utf-16-be"])
+def test_a_utf16_file_behind_its_byte_order_mark_is_the_same_specimen(tmp_path, encoding):
+    # Notepad's "Unicode" (UTF-16 with a byte-order mark) was refused as "not UTF-8 text
+    # (byte 0xff on line 1)"; the mark makes it unambiguous, and its text is the file's
+    import codecs
+
+    mark = {"utf-16": b"", "utf-16-le": codecs.BOM_UTF16_LE, "utf-16-be": codecs.BOM_UTF16_BE}
+    path = tmp_path / "notepad.toml"
+    text = PAPER.to_toml().replace("\n", "\r\n")
+    path.write_bytes(mark[encoding] + text.encode(encoding))
+    assert path.read_bytes()[:2] in (codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)
+    assert load_specimen(path).hash == PAPER.hash
+    # without the mark UTF-16 is not read as text: refused in one line, not guessed
+    path.write_bytes(text.encode("utf-16-le"))
+    with pytest.raises(ParameterError, match=r"^.*notepad\.toml: not valid TOML"):
+        load_specimen(path)

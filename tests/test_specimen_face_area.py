@@ -261,9 +261,10 @@ def test_damper_of_stored_runs_takes_the_face_of_the_specimen_file_given(tmp_pat
     with pytest.raises(ParameterError) as caught:
         _run_model([*argv, "--specimen", str(PAPER_FILE)])
     assert str(caught.value) == (
-        f"--specimen {PAPER_FILE}: paper_coupon [{paper_specimen().hash[:6]}] is not the "
-        f"specimen of the DEM runs, steel_6mm [{stated.hash[:6]}]; expected that specimen's "
-        "file")
+        f"--specimen {PAPER_FILE}: {tmp_path / 's.h5'} holds no DEM runs of paper_coupon "
+        f"[{paper_specimen().hash[:6]}] (it holds {len(runs)} of steel_6mm "
+        f"[{stated.hash[:6]}]); run them with pidcore dem sweep --specimen {PAPER_FILE} "
+        f"--store {tmp_path / 's.h5'}")
     with pytest.raises(ParameterError, match=r"is not the specimen of the paper's Table 3 "
                                              r"\(--table paper\), paper_coupon"):
         _run_model(["model", "damper", "--out", str(tmp_path / "p"), "--specimen", str(path)])
@@ -278,3 +279,79 @@ def test_the_old_rule_gave_a_copy_of_the_papers_cells_its_face_whatever_its_file
     area, said = specimen_area_m2(copy)
     assert area == copy.cells_area_m2() and area < coupon_area_m2() / 1.15
     assert "its file states no [coupon] face_area_m2" in said
+
+
+def test_damper_specimen_file_selects_its_runs_in_a_store_of_two_specimens(tmp_path,
+                                                                          monkeypatch):
+    """A store holding runs of an edited file of the same name (or of the paper's coupon)
+    beside the file's own was refused as "DEM runs are of 2 specimens ... select one, e.g.
+    --where specimen_sha256=...", although --specimen had named the file: its runs are the
+    SDC, the other file's are left out."""
+    import pidcore.store
+
+    path = _steel_with_face(tmp_path)
+    stated = load_specimen(path)
+    edited = stated.with_values({"coupon.fixture_mass_kg": 0.5})
+    mine, other = _steel_runs(stated), _steel_runs(edited)
+    other = other.assign(sdc=other["sdc"] * 3)  # a different SDC: a mix-up would show
+
+    class FakeStore:
+        def __init__(self, _path):
+            pass
+
+        def list_dem_runs(self):
+            return pd.concat([other, mine], ignore_index=True)
+
+    monkeypatch.setattr(pidcore.store, "Store", FakeStore, raising=False)
+    argv = ["model", "damper", "--out", str(tmp_path / "out"), "--table", "store", "--store",
+            str(tmp_path / "s.h5"), "--format", "csv"]
+    with pytest.raises(ParameterError, match="DEM runs are of 2 specimens"):
+        _run_model(argv)  # without a file: which one is not guessed
+    assert _run_model([*argv, "--specimen", str(path)]) == 0
+    table = pd.read_csv(tmp_path / "out" / "equivalent_damper.csv")
+    grid = mine.set_index(["frequency_hz", "acceleration_g", "fill_percent"])["sdc"]
+    # the model's grid points are the runs' own load cases: the SDC there is the run's
+    at = table.set_index(["frequency [Hz]", "acceleration [g]", "fill [%]"])["sdc [-]"]
+    common = at.index.intersection(grid.index)
+    assert len(common) > 10
+    np.testing.assert_allclose(at.loc[common].to_numpy(), grid.loc[common].to_numpy(),
+                               rtol=1e-12)  # the pchip model passes through its nodes
+
+
+def test_figures_specimen_file_selects_its_runs_in_a_store_of_two_specimens(tmp_path,
+                                                                           monkeypatch, capsys):
+    """`model figures` of a store holding two files' runs asked for --where specimen_sha256=
+    and had no --specimen, as damper now has: it draws the file's runs."""
+    import pidcore.store
+
+    path = _steel_with_face(tmp_path)
+    stated = load_specimen(path)
+    mine = _steel_runs(stated)
+    other = _steel_runs(stated.with_values({"coupon.fixture_mass_kg": 0.5}))
+
+    class FakeStore:
+        def __init__(self, _path):
+            pass
+
+        def list_dem_runs(self):
+            return pd.concat([other, mine], ignore_index=True)
+
+    monkeypatch.setattr(pidcore.store, "Store", FakeStore, raising=False)
+    argv = ["model", "figures", "--out", str(tmp_path / "figs"), "--table", "store", "--store",
+            str(tmp_path / "s.h5")]
+    with pytest.raises(ParameterError, match="DEM runs are of 2 specimens"):
+        _run_model(argv)
+    seen = {}
+    real = model_cli.build_model
+
+    def spy(args):
+        seen["model"], seen["runs"] = real(args)
+        return seen["model"], seen["runs"]
+
+    monkeypatch.setattr(model_cli, "build_model", spy)
+    assert _run_model([*argv, "--specimen", str(path)]) == 0
+    assert set(seen["runs"]["specimen_sha256"]) == {stated.hash}
+    assert len(seen["runs"]) == len(mine)
+    assert (tmp_path / "figs").is_dir() and any((tmp_path / "figs").iterdir())
+    with pytest.raises(ParameterError, match=r"selects DEM runs: use it with --table store"):
+        _run_model(["model", "figures", "--out", str(tmp_path / "p"), "--specimen", str(path)])

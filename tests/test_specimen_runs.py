@@ -725,3 +725,35 @@ def test_runs_of_an_edited_file_of_the_same_name_are_said_not_reused(tmp_path, m
     err = capsys.readouterr().err
     assert f"pidcore dem sweep: note: {store} holds 1 run(s) of these load cases" in err
     assert store.read_bytes() == before
+
+
+def test_a_run_of_a_fixture_far_heavier_than_the_coupon_names_it():
+    # only `specimen check` named a fixture typed in kg for g: `dem run` of a 120 kg fixture on
+    # a 41 g coupon printed an SDC of 0.003 with no note. The run's notes name it as check does.
+    typed_kg = paper_specimen().with_values({"coupon.fixture_mass_kg": 5.0})  # 5 g meant
+    run = simulate_load_case(CASE, TINY, specimen=typed_kg)
+    (note,) = [n for n in run.notes if "fixture_mass_kg" in n]
+    (checked,) = [n for n in describe(typed_kg)["notes"] if "fixture_mass_kg" in n]
+    assert CASE.fill_percent == 25.0 and note.endswith("was it g?")
+    # the same words as `specimen check` where the run's fill is the one check counts
+    at_run_fill = typed_kg.with_values({"particles.count_per_cell": run.particles_per_cell})
+    assert note == [n for n in describe(at_run_fill)["notes"] if "fixture_mass_kg" in n][0]
+    assert checked.startswith("[coupon] fixture_mass_kg 5 kg is 226 x the coupon")
+    grams = simulate_load_case(CASE, TINY, specimen=paper_specimen().with_values(
+        {"coupon.fixture_mass_kg": 0.005}))
+    assert not [n for n in grams.notes if "fixture_mass_kg" in n]
+
+
+def test_a_run_of_spheres_that_fit_only_as_a_column_names_it():
+    # as specimen check does (test above): a run of 2 mm beads typed as radius_m = 2e-3 in the
+    # steel_6mm cell simulated a column of 4 mm spheres with no note
+    column = Specimen.from_text(STEEL.read_text().replace("radius_m = 1.0e-3",
+                                                          "radius_m = 2.0e-3"))
+    run = simulate_load_case(LoadCase(1000.0, 5.0, 100.0, "steel"), TINY, specimen=column)
+    (note,) = [n for n in run.notes if "radius_m" in n]
+    assert note == ("[particles] radius_m 2 mm: the spheres (diameter 4 mm) fit the 6.35 mm "
+                    "cell only one above another, a column of 3; was the diameter given as "
+                    "the radius?")
+    beads = simulate_load_case(LoadCase(1000.0, 5.0, 25.0, "steel"), TINY,
+                               specimen=load_specimen(STEEL))
+    assert not [n for n in beads.notes if "radius_m" in n]

@@ -33,6 +33,7 @@ from ..compare.plausibility import (
     stored_record_name,
 )
 from ..errors import InputFileError, ParameterError, as_given, real_number
+from ..loadcase import normalize_material
 
 if TYPE_CHECKING:  # pragma: no cover
     from ..specimen import Specimen
@@ -176,7 +177,11 @@ def read_measured_table(path: str | os.PathLike, *,
         except (TypeError, ValueError):
             raise InputFileError(f"{where}: sdc_stderr_dof {raw_dof!r} is not a number") from None
         try:
-            material = _text_cell(row.get("material"), default_material)
+            # as the sidecar reads it: 'Acrylic', 'PMMA' or 'Tungsten_Carbide' typed in a
+            # spreadsheet are the canonical names, which a point was compared with verbatim
+            # (refused as "another material" than the specimen's tungsten_carbide)
+            material = normalize_material(_text_cell(row.get("material"), default_material),
+                                          "material", known=None)
             named = _text_cell(row.get("specimen"), "")
             points.append(MeasuredPoint(material=material, specimen=named,
                                         source=str(path), row=int(line), **values,

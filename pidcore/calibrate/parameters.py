@@ -354,7 +354,7 @@ def check_domains(specs: Sequence[ParameterSpec], specimen=None,
     def outside(spec: ParameterSpec, bound: float, complaint: str) -> ParameterError:
         return ParameterError(f"{_prior_words(spec, given)}: {spec.name}={as_given(bound)} "
                               f"is outside its physical domain ({complaint}); give a range "
-                              "inside it")
+                              f"inside it{_together_hint(spec.name, complaint)}")
 
     def check_each_bound(spec: ParameterSpec) -> None:
         """Each bound of ``spec`` alone, the other parameters at their starting values."""
@@ -391,6 +391,20 @@ def check_domains(specs: Sequence[ParameterSpec], specimen=None,
     priors = "; ".join(_prior_words(s, given) for s in dem)
     raise ParameterError(f"{priors}: the prior corner {values} is outside the physical "
                          f"domain ({complaint}); narrow the ranges")
+
+
+def _together_hint(name: str, complaint: str) -> str:
+    """The alias that moves a pair's sliding and static friction together, for a dotted
+    sliding friction whose range passed the static one the file states (or left to its
+    default, the sliding friction): the refusal only asked for another range, and a user of a
+    file without static_friction did not know it was there to pass."""
+    parts = name.split(".")
+    if len(parts) != 3 or parts[2] != "sliding_friction" or "static_friction" not in complaint:
+        return ""
+    alias = {"particle_particle": "friction_pp", "particle_wall": "friction_pw"}.get(parts[1])
+    if alias is None:
+        return ""
+    return f", or fit {alias} (sliding and static friction of that pair together)"
 
 
 def _check_static_friction(dem: Sequence[ParameterSpec], specimen,

@@ -552,10 +552,16 @@ def unconstrained_notes(specs: Sequence[ParameterSpec], samples: np.ndarray) -> 
         q_low, q_high = np.quantile(_to_unit(spec, samples[:, j]), [0.025, 0.975])
         share = float(q_high - q_low) / _prior_central_width(spec)
         if share >= UNCONSTRAINED_SHARE:
+            # the discrepancy is no specimen field: the note said its median was written to
+            # the calibrated specimen, which holds no such key
+            consequence = (
+                "no specimen value (the calibrated specimen holds none) but it widens every "
+                "band; fix it (discrepancy=TAU) where the model's relative error is known"
+                if spec.name == DISCREPANCY else
+                "no measured value, and so is the value written to the calibrated specimen; "
+                "measure load cases where it changes the SDC, or do not fit it")
             notes.append(
                 f"{spec.name}: the data hardly constrain it (its 95 % interval spans "
                 f"{100 * min(share, 1.0):.0f} % of its prior's, {low:g} .. {high:g}): its "
-                "median is the prior's more than the data's, no measured value, and so is the "
-                "value written to the calibrated specimen; measure load cases where it changes "
-                "the SDC, or do not fit it")
+                f"median is the prior's more than the data's, {consequence}")
     return notes

@@ -114,7 +114,8 @@ def _add_config_options(p: argparse.ArgumentParser) -> None:
                         f"{defaults.DEM_DAMPING_COEFFICIENT})")
     p.add_argument("--mass-convention", choices=VIBRATED_MASS_CONVENTIONS,
                    default=defaults.DEM_VIBRATED_MASS_CONVENTION,
-                   help="mass m_c in E = m_c a^2 / (2 w^2) (default "
+                   help="mass m_c in E = m_c a^2 / (2 w^2); 'coupon' is the moving mass, "
+                        "the specimen's coupon and fixture (default "
                         f"{defaults.DEM_VIBRATED_MASS_CONVENTION})")
     p.add_argument("--start", choices=START_PROTOCOLS, default=defaults.DEM_START_PROTOCOL,
                    help="particles at rest or moving with the cell when the drive starts "

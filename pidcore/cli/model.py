@@ -103,10 +103,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         "the default is noted, more than 100 x off the cells' is refused as a "
                         "unit slip)")
     d.add_argument("--specimen", metavar="FILE", type=path_argument, default=None,
-                   help="the specimen file the SDC is of (the runs' with --table store, the "
-                        "paper's coupon with --table paper), for the [coupon] face_area_m2 it "
-                        "states: a DEM run stores its specimen without it; another specimen "
-                        "(another sha256) is refused")
+                   help="the specimen file the SDC is of (with --table store: the store's "
+                        "runs of this file, by its sha256; with --table paper: the paper's "
+                        "coupon), for the [coupon] face_area_m2 it states: a DEM run stores "
+                        "its specimen without it; another specimen (another sha256) is "
+                        "refused")
     d.add_argument("--panel-areal-mass", metavar="KG_M2", type=_positive_float, default=None,
                    help="mass per m^2 of your panel, with its particles, kg/m^2: adds "
                         "panel_loss_factor, the loss factor the particles add to it moving as "
@@ -119,6 +120,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
     f = sub.add_parser("figures", help="SDC figures (paper Figs. 8-14), PNG and SVG")
     _add_model_source(f)
+    f.add_argument("--specimen", metavar="FILE", type=path_argument, default=None,
+                   help="with --table store: draw the store's runs of this specimen file (by "
+                        "its sha256), the other specimens' left out")
     f.set_defaults(func=run_figures)
 
 
@@ -151,6 +155,8 @@ def build_model(args: argparse.Namespace):
     if runs.empty:
         raise ParameterError(f"{args.store}: no DEM runs stored; run `pidcore dem` first or use "
                              f"--table paper")
+    if getattr(args, "specimen", None) is not None:
+        runs = _runs_of_specimen_file(runs, args.specimen, args.store)
     try:
         runs = select_runs(runs, where=where)
     except ParameterError as exc:
@@ -163,6 +169,26 @@ def build_model(args: argparse.Namespace):
         " where " + ", ".join(f"{k}={v}" for k, v in where.items()) if where else "")
     return SdcModel.from_table(runs, value="sdc", log_frequency=args.log_frequency,
                                source=text), runs
+
+
+def _runs_of_specimen_file(runs, path, store):
+    """The runs of the ``--specimen`` file (its sha256): a store holding runs of two files (an
+    edited one, the paper's coupon) was refused as "of 2 specimens", asking for a --where of
+    the hash that --specimen already gave."""
+    from ..compare.specimens import run_specimen_labels
+    from ..dem.persist import runs_of_specimen
+    from ..specimen import hashed_name, load_specimen
+
+    given = load_specimen(path)
+    mine = runs_of_specimen(runs, given)
+    if mine.empty:
+        held = run_specimen_labels(runs).value_counts(sort=False)
+        raise ParameterError(
+            f"--specimen {path}: {store} holds no DEM runs of "
+            f"{hashed_name(given.name, given.hash)} (it holds "
+            + ", ".join(f"{n} of {label}" for label, n in held.items())
+            + f"); run them with pidcore dem sweep --specimen {path} --store {store}")
+    return mine
 
 
 def _cli_where(message: str, where: dict) -> str:
@@ -379,6 +405,9 @@ def run_figures(args: argparse.Namespace) -> int:
     from ..report.figures import plot_sdc_vs_acceleration, plot_sdc_vs_frequency, save_figure
 
     check_out_folder(args.out)
+    if args.specimen is not None and args.table == "paper":
+        raise ParameterError(f"--specimen {args.specimen}: selects DEM runs: use it with "
+                             "--table store (--table paper draws the paper's coupon)")
     model, _ = build_model(args)
 
     def curves(extra: tuple[float, ...], axis) -> list[float]:

@@ -224,12 +224,22 @@ class DemResult:
         * ``particle_steps_per_s`` was not measured (NaN): every kernel call compiled code;
         * a property of the specimen overrides its table material's
           (:func:`pidcore.specimen.table_overrides`);
+        * the specimen's fixture is far heavier than its coupon, a likely g typed as kg
+          (:func:`pidcore.specimen.heavy_fixture_note`: only `specimen check` said so, and a
+          run of a 120 kg fixture on a 41 g coupon printed an SDC of 0.003 in silence), or its
+          spheres fit the cell only one above another, a likely diameter typed as the radius
+          (:func:`pidcore.specimen.column_note`);
         * the load case's fill overrides the fill or particle count the specimen states
           (:func:`pidcore.specimen.fill_override_note`);
         * the drive is above :data:`pidcore.defaults.DEM_NOTE_ACCELERATION_G` (m/s^2 typed
           for g?).
         """
-        from ..specimen import fill_override_note, table_overrides
+        from ..specimen import (
+            column_note,
+            fill_override_note,
+            heavy_fixture_note,
+            table_overrides,
+        )
         from .simulate import required_steady_cycles
 
         notes = []
@@ -269,6 +279,8 @@ class DemResult:
                          "included Numba compilation (run again for the compiled speed)")
         if self.specimen is not None:
             notes += table_overrides(self.specimen)
+            notes += heavy_fixture_note(self.specimen, self.particles_per_cell)
+            notes += column_note(self.specimen, self.specimen.capacity_per_cell())
             overridden = fill_override_note(self.specimen, [self.case.fill_percent],
                                             self.config.fill_reference)
             if overridden:

@@ -612,10 +612,30 @@ def _snap(values: pd.Series, grid: np.ndarray, *, rtol: float = 0.0,
     return out
 
 
+def _snap_to_own(values: np.ndarray, grid: np.ndarray, *, rtol: float = 0.0,
+                 atol: float = 0.0) -> np.ndarray:
+    """Each value off ``grid`` replaced by the smallest of those within the tolerance of it,
+    walking up (grid values are kept, however close): measured values near no grid value sort
+    as one block (99.99997 and 99.99998 Hz, two tests at 100 Hz of a specimen with runs at
+    200 Hz only, sorted by those digits first, putting the 70 % fill before the 30 % one)."""
+    out = values.copy()
+    order = np.argsort(values, kind="stable")
+    start = np.nan
+    for i in order:
+        v = values[i]
+        if not np.isfinite(v) or np.isin(v, grid):
+            continue
+        if not np.isfinite(start) or v - start > rtol * abs(start) + atol:
+            start = v
+        out[i] = start
+    return out
+
+
 def _sort_like_table3(table: pd.DataFrame, aligner: Aligner, paper: pd.DataFrame | None,
                       tolerances: Tolerances) -> pd.DataFrame:
     """Sort by frequency, acceleration, fill as Table 3 does; a measured case sorts by the grid
-    value it is within tolerance of, so 499.97 Hz sorts with the 500 Hz block, not before it."""
+    value it is within tolerance of, so 499.97 Hz sorts with the 500 Hz block, not before it,
+    and cases near no grid value by the lowest of their own within that tolerance."""
     axes = {"frequency_hz": [], "acceleration_g": [], "fill_percent": []}
     for case in aligner.cases:
         for name in axes:
@@ -625,10 +645,12 @@ def _sort_like_table3(table: pd.DataFrame, aligner: Aligner, paper: pd.DataFrame
             axes[name].extend(paper[name].astype(float).tolist())
     grid = {name: np.unique(np.asarray(v, dtype=float)) for name, v in axes.items()}
     keys = pd.DataFrame({
-        "f": _snap(table["frequency [Hz]"], grid["frequency_hz"],
-                   rtol=tolerances.frequency_rtol),
-        "a": _snap(table["acceleration [g]"], grid["acceleration_g"],
-                   rtol=tolerances.acceleration_rtol),
+        "f": _snap_to_own(_snap(table["frequency [Hz]"], grid["frequency_hz"],
+                                rtol=tolerances.frequency_rtol), grid["frequency_hz"],
+                          rtol=tolerances.frequency_rtol),
+        "a": _snap_to_own(_snap(table["acceleration [g]"], grid["acceleration_g"],
+                                rtol=tolerances.acceleration_rtol), grid["acceleration_g"],
+                          rtol=tolerances.acceleration_rtol),
         "p": _snap(table["packing ratio [%]"], grid["fill_percent"],
                    atol=tolerances.fill_atol_percent),
         "fx": table["frequency [Hz]"], "ax": table["acceleration [g]"],
