@@ -11,7 +11,10 @@ the store the app was given (``PIDCORE_STORE``). Its DEM runs are
 ``python _calibrating_server.py FOLDER``: the workers' pid files go to FOLDER; ``ready`` there
 once the quick runs are saved and both workers run a slow one, ``server-PID``,
 ``forkserver-PID`` and ``tracker-PID`` name this process and its helpers, and ``exited`` is
-written by the interpreter's last exit hook (absent when the process was killed).
+written by the interpreter's last exit hook (absent when the process was killed): the
+:func:`time.monotonic` at which it ran, after the calibration's stop and the pools' joins
+(CLOCK_MONOTONIC on Linux: one clock for every process, so the test compares it with the
+moment it sent the signal).
 """
 
 from __future__ import annotations
@@ -22,6 +25,7 @@ import os
 import signal
 import sys
 import threading
+import time
 from pathlib import Path
 
 if __name__ == "__main__":
@@ -33,7 +37,8 @@ if __name__ == "__main__":
     from pidcore.calibrate import runner as calibration_runs
 
     folder = Path(sys.argv[1])
-    atexit.register(lambda: (folder / "exited").touch())  # runs after threading's hooks
+    # runs after threading's hooks: the calibration's stop and concurrent.futures' joins
+    atexit.register(lambda: (folder / "exited").write_text(repr(time.monotonic())))
     stopped = threading.Event()
     for signum in (signal.SIGTERM, signal.SIGINT):  # as Streamlit handles them
         signal.signal(signum, lambda signum, frame: stopped.set())

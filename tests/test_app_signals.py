@@ -69,12 +69,17 @@ def test_sigterm_to_the_app_stops_its_calibration_within_seconds(tmp_path, whole
     finally:
         if p.poll() is None:
             os.killpg(p.pid, signal.SIGKILL)
-    # the stop itself takes ~0.1 s (a look at the stop event, a terminate of 2 workers); 8 s
-    # is room for a loaded machine, short of the 10 s after which `pidcore app` kills its
-    # server and of the 60 s a running DEM run takes
-    assert time.monotonic() - sent < 8
     assert p.returncode == 143  # 128 + SIGTERM, as every pidcore command (pidcore.interrupt)
     assert (folder / "exited").exists()  # the server ended by itself, not killed
+    # Timed: the signal to the server's last exit hook, which runs once the calibration is
+    # stopped and its pool joined (the defect held it there for the 60 s of a running DEM
+    # run, until `pidcore app` killed the server at 10 s: no hook at all). Not timed: the
+    # two interpreters' teardown after it (freeing numpy, Numba, h5py), ~0.1 s idle but
+    # up to ~1.5 s beside 4 CPU burners on 2 cores and growing with the load (a flake took
+    # 10.1 s in all under a loaded `pytest -n 2`), while the stop itself took <= 0.1 s under
+    # those burners. 8 s: room for a loaded machine, short of the 10 s kill and the 60 s run.
+    stopped_after_s = float((folder / "exited").read_text()) - sent
+    assert stopped_after_s < 8
     assert out == ""
     assert err == (f"pidcore app: http://localhost:8599  (store {store.resolve()}); Ctrl-C "
                    "stops it\n")  # and nothing else: no traceback, no resource warning

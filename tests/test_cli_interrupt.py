@@ -404,6 +404,23 @@ def test_ctrl_c_while_the_cli_loads_exits_130_with_one_line(tmp_path):
     assert not store.exists()
 
 
+def _installed_entry() -> tuple[str, str]:
+    """(module, function) of the installed ``pidcore`` script (pyproject's
+    [project.scripts])."""
+    import tomllib
+
+    scripts = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))[
+        "project"]["scripts"]
+    module, function = scripts["pidcore"].split(":")
+    return module, function
+
+
+def _as_the_installed_script_runs() -> str:
+    """The lines of the script pip writes for the entry (import its module, call it)."""
+    module, function = _installed_entry()
+    return f"from {module} import {function}\nsys.exit({function}())\n"
+
+
 def test_ctrl_c_while_the_installed_pidcore_script_loads_exits_130_with_one_line(tmp_path):
     # The installed `pidcore` script (pyproject's [project.scripts]) imported pidcore.cli
     # itself, before any guard: a Ctrl-C in its first ~0.2 s ended in a traceback and status
@@ -411,16 +428,9 @@ def test_ctrl_c_while_the_installed_pidcore_script_loads_exits_130_with_one_line
     # script pip writes does (import the entry's module, call its function), with the
     # interrupt raised by an import hook where the CLI loads, as in the test above.
     import json
-    import tomllib
 
-    scripts = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))[
-        "project"]["scripts"]
-    module, function = scripts["pidcore"].split(":")
-    probe = (
-        "import sys\n"
-        + _INTERRUPT_AS_THE_CLI_LOADS +
-        f"from {module} import {function}\n"
-        f"sys.exit({function}())\n")
+    module, function = _installed_entry()
+    probe = "import sys\n" + _INTERRUPT_AS_THE_CLI_LOADS + _as_the_installed_script_runs()
     store = tmp_path / "s.h5"
     done = subprocess.run([sys.executable, "-c", probe, str(store)], capture_output=True,
                           text=True, env={**os.environ, "PYTHONPATH": str(ROOT)}, timeout=120)
@@ -434,3 +444,46 @@ def test_ctrl_c_while_the_installed_pidcore_script_loads_exits_130_with_one_line
         capture_output=True, text=True, env={**os.environ, "PYTHONPATH": str(ROOT)},
         timeout=120, check=True)
     assert json.loads(loaded.stdout) == sorted({"pidcore", module})
+
+
+@pytest.mark.parametrize("delay_s", [0.0, 0.02, 0.05, 0.1, 0.2])
+def test_a_real_sigint_early_in_the_installed_pidcore_script_exits_130_with_one_line(
+        tmp_path, delay_s):
+    # The probes above raise the interrupt at one import; this one sends SIGINT at moments
+    # from the start of the CLI's import, as a user's Ctrl-C lands: the old entry
+    # (pidcore.cli:console_main) imported the CLI unguarded and ended in a traceback and
+    # status -2 there. The delays count from a mark the child writes as it begins to import
+    # pidcore.cli, not from its start: on a loaded machine the interpreter's own start-up
+    # (site's .pth files, before any code of pidcore runs, where nothing can be handled)
+    # took 20-40 ms, so a delay from the spawn landed there or well past the imports by
+    # chance. What runs before the mark is pidcore.console alone (the test above: it loads
+    # nothing else of pidcore's).
+    probe = (
+        "import sys\n"
+        "class Mark:\n"
+        "    def find_spec(self, name, path=None, target=None):\n"
+        "        if name == 'pidcore.cli':\n"
+        "            sys.stdout.write('importing the CLI\\n')\n"
+        "            sys.stdout.flush()\n"
+        "sys.meta_path.insert(0, Mark())\n"
+        "sys.argv = ['pidcore', 'dem', 'sweep', '--store', sys.argv[1]]\n"
+        + _as_the_installed_script_runs())
+    store = tmp_path / "s.h5"
+    p = subprocess.Popen([sys.executable, "-c", probe, str(store)], stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, text=True,
+                         env={**os.environ, "PYTHONPATH": str(ROOT)})
+    try:
+        assert p.stdout.readline() == "importing the CLI\n"
+        time.sleep(delay_s)
+        p.send_signal(signal.SIGINT)
+        out, err = p.communicate(timeout=120)
+    finally:
+        if p.poll() is None:
+            p.kill()
+    assert p.returncode == 130, err
+    # one line, whichever part of the command it cut (the CLI's import: "pidcore dem: ...
+    # nothing was done"; or the sweep's own word once it started), and no traceback
+    assert len(err.splitlines()) == 1 and re.fullmatch(r"pidcore dem( sweep)?: interrupted; .*\n",
+                                                       err), err
+    assert out == ""
+    assert not store.exists()  # nothing written: no DEM case ends within 0.2 s
