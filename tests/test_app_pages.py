@@ -1775,10 +1775,15 @@ def test_the_calibrate_pages_measurements_table_names_every_numbers_unit(store_f
     at.button(key="save").click()
     at.run()
     at.run()
+    # the SDC and its stderr in one text column by the one rule (points_display), not two
+    # numbers at the grid's precision
     points = next(d.value for d in at.dataframe
-                  if "SDC measured (Eq. 11) [-]" in d.value.columns)
+                  if "SDC measured (Eq. 11) ± stderr [-]" in d.value.columns)
+    assert all(re.fullmatch(r"[\d.e+-]+ ± [\d.e+-]+", text)
+               for text in points["SDC measured (Eq. 11) ± stderr [-]"]), points
     numeric = [c for c in points.columns if pd.api.types.is_numeric_dtype(points[c])]
     assert "SDC measured (Eq. 11) stderr dof [-]" in numeric
+    assert "SDC measured (Eq. 11) stderr [-]" not in points.columns
     assert all(c.endswith("]") for c in numeric), numeric
 
 
