@@ -2310,3 +2310,22 @@ def test_the_report_grid_writes_each_sdc_with_four_significant_digits(store_file
     assert printf == "%.4g"
     # printf's %.4g is the report's sdc_text: four significant digits, not four decimals
     assert printf % 0.001101234 == sdc_text(0.001101234) == "0.001101"
+
+
+def test_the_dem_tabs_runs_table_writes_the_sdc_with_four_significant_digits(store_file):
+    # as the Report grid: the DEM tab's runs table wrote an SDC of 0.001137 as "0.0011"
+    import json
+
+    from pidcore.dem.persist import run_or_load
+    from pidcore.dem.simulate import DemConfig, LoadCase
+    from pidcore.specimen import paper_specimen
+
+    run = run_or_load(store_file, paper_specimen(), LoadCase(1000.0, 5.0, 25.0),
+                      DemConfig(cells=1, steady_cycles=4, block_cycles=2,
+                                max_transient_cycles=2))
+    at = _app()
+    grid = next(d for d in at.dataframe if "cells simulated [-]" in d.value.columns)
+    assert run.sdc in grid.value["SDC [-]"].tolist()  # still a number
+    formats = {column: config.get("type_config", {}).get("format")
+               for column, config in json.loads(grid.proto.columns).items()}
+    assert formats["SDC [-]"] == "%.4g"

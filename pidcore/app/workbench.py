@@ -341,7 +341,8 @@ REPORT_SDC_FORMAT = "%.4g"
 
 
 def report_number_formats(table: pd.DataFrame) -> dict[str, str]:
-    """Column -> printf format for the Report tab's grid of :func:`report_display`'s ``table``:
+    """Column -> printf format for the Report tab's grid of :func:`report_display`'s ``table``
+    (and the DEM tab's runs table, :func:`pidcore.app.jobs.dem_runs_table`):
     each numeric SDC column (``SDC ... [-]``) by :data:`REPORT_SDC_FORMAT`. The values stay
     numbers (the grid sorts them); only their text changes."""
     return {column: REPORT_SDC_FORMAT for column in table.columns
