@@ -2620,3 +2620,24 @@ def test_the_sdc_charts_tooltip_writes_the_sdc_as_the_pages_do(sdc, stderr, show
     tooltips = [t for layer in spec["layer"] for t in layer["encoding"].get("tooltip", [])]
     assert {"field": "sdc_text", "type": "nominal", "title": "SDC ± stderr [-]"} in tooltips
     assert not any(t.get("format", "").endswith("f") for t in tooltips)  # no fixed decimals
+
+
+def test_calibrate_points_display_writes_sdc_and_stderr_by_the_one_rule():
+    # The Calibrate page's grid showed the SDC and its stderr as two numbers at the grid's own
+    # precision (1.0378 beside 0.024; 0.6285 beside 0.00008): digits the error does not
+    # support, unlike `pidcore analyze` and the other pages (1.038 ± 0.024).
+    from pidcore.app.calibration import MEASURED_EQ11_WITH_ERROR_COLUMN, points_display
+    from pidcore.calibrate import MeasuredPoint
+
+    points = [MeasuredPoint(50.0, 5.0, 50.0, 1.037812, 0.02412, sdc_stderr_dof=7.0),
+              MeasuredPoint(200.0, 5.0, 50.0, 0.628512, 0.0000812, sdc_stderr_dof=7.0),
+              MeasuredPoint(100.0, 10.0, 50.0, 0.012, 0.5, sdc_stderr_dof=7.0)]
+    table = points_display(points)
+    # analytic: two significant digits of the error, the value rounded at its place
+    assert table[MEASURED_EQ11_WITH_ERROR_COLUMN].tolist() == [
+        "1.038 ± 0.024", "0.628512 ± 0.000081", "0.01 ± 0.50"]
+    assert "SDC measured (Eq. 11) [-]" not in table.columns
+    assert "SDC measured (Eq. 11) stderr [-]" not in table.columns
+    # the column sits where the SDC was; the rest of points_table is kept
+    assert list(table.columns)[3] == MEASURED_EQ11_WITH_ERROR_COLUMN
+    assert table["SDC measured (Eq. 11) stderr dof [-]"].tolist()[:2] == [7.0, 7.0]

@@ -72,3 +72,21 @@ def test_a_typed_time_unit_that_is_none_is_refused_naming_the_field(typed, said)
     with pytest.raises(ParameterError) as info:
         uploads.page_time_unit(typed)
     assert str(info.value) == said
+
+
+def test_the_time_base_unit_columns_help_says_it_overrides_a_stated_unit():
+    # The column's help said the cell applies "where its time column states none or one
+    # pidcore does not read", but a cell of 'ms' beside a CSV time column stated in s reads
+    # that time in ms (as `pidcore analyze --time-unit` does): the help must say so.
+    from pathlib import Path
+
+    sample = Path(__file__).resolve().parents[1] / (
+        "data_samples/exports/synthetic_f500Hz_a1g_fill50_acrylic.csv")
+    as_stated = uploads.parse_upload(sample.name, sample.read_bytes())
+    overridden = uploads.parse_upload(sample.name, sample.read_bytes(), time_unit="ms")
+    assert as_stated.error is None and overridden.error is None
+    rate = as_stated.measurement.channels[0].sample_rate_hz
+    # the stated 's' is overridden, not kept: every time 1000 x shorter, the rate 1000 x higher
+    assert overridden.measurement.channels[0].sample_rate_hz == pytest.approx(1000 * rate)
+    assert "overrides the unit its time column states" in uploads.TIME_UNIT_COLUMN_HELP
+    assert "(a note says so)" in uploads.TIME_UNIT_COLUMN_HELP

@@ -150,6 +150,27 @@ def points_table(points: Sequence) -> pd.DataFrame:
     return pd.DataFrame(rows, columns=list(POINT_COLUMNS)).rename(columns=POINT_COLUMNS)
 
 
+#: The page's one column of the measured SDC and its standard error, written by the one rule
+#: of every page and report (:func:`pidcore.units.display_value_with_error`).
+MEASURED_EQ11_WITH_ERROR_COLUMN = "SDC measured (Eq. 11) ± stderr [-]"
+
+
+def points_display(points: Sequence) -> pd.DataFrame:
+    """:func:`points_table` as the Calibrate page shows it: the SDC and its standard error in
+    one text column as ``pidcore analyze`` and the other pages write them (``1.038 ± 0.024``);
+    the grid wrote the two numbers apart at its own precision (``1.0378`` beside ``0.024``,
+    ``0.6285`` beside ``0.00008``), digits the error does not support."""
+    from ..units import display_value_with_error
+
+    table = points_table(points)
+    texts = [display_value_with_error(sdc, stderr) for sdc, stderr in
+             zip(table[MEASURED_EQ11_COLUMN], table[MEASURED_EQ11_STDERR_COLUMN], strict=True)]
+    at = table.columns.get_loc(MEASURED_EQ11_COLUMN)
+    table = table.drop(columns=[MEASURED_EQ11_COLUMN, MEASURED_EQ11_STDERR_COLUMN])
+    table.insert(at, MEASURED_EQ11_WITH_ERROR_COLUMN, texts)
+    return table
+
+
 def points_needed_text(n_points: int, fit: Sequence[str]) -> str:
     """Why ``n_points`` load cases are too few for ``fit``, in the page's terms."""
     return (f"{n_points} measured load case(s) cannot determine {', '.join(fit)} and the "

@@ -251,6 +251,15 @@ _BAD_INPUT_ERRORS = (PidcoreError, ValueError, OSError, KeyError, IndexError, Ty
 TIME_UNIT_FIELD = "time base unit"
 
 
+#: The settings table's help of its *time base unit* column. The cell is read as
+#: ``pidcore analyze --time-unit`` reads it: it also overrides a unit the file's time column
+#: states (noted under the file), which the help left unsaid ("where its time column states
+#: none or one pidcore does not read"), so an 'ms' typed beside a time in s read as a guess.
+TIME_UNIT_COLUMN_HELP = ("unit of this file's time base (s, ms, us); it overrides the unit its "
+                         "time column states (a note says so) and is needed where that states "
+                         "none or one pidcore does not read; empty: the one for every file")
+
+
 def page_time_unit(typed: str) -> str | None:
     """The time unit typed in the page's :data:`TIME_UNIT_FIELD` (blank: None, each file's
     own), refused naming the field where it is not a unit of time: read with it, every file

@@ -333,6 +333,23 @@ def _with_reason(values: pd.Series, present: pd.Series, reasons: list[str],
             for v, there, reason in zip(values, present, reasons, strict=True)]
 
 
+#: The printf format (the grid's ``NumberColumn(format=...)``) of the report grid's SDC
+#: columns: four significant digits, as :func:`pidcore.calibrate.prediction.sdc_text` writes a
+#: report cell. The grid's default wrote four decimals: an SDC of 0.001101 as "0.0011" beside
+#: its stderr "0.000254", the value coarser than its own error.
+REPORT_SDC_FORMAT = "%.4g"
+
+
+def report_number_formats(table: pd.DataFrame) -> dict[str, str]:
+    """Column -> printf format for the Report tab's grid of :func:`report_display`'s ``table``
+    (and the DEM tab's runs table, :func:`pidcore.app.jobs.dem_runs_table`):
+    each numeric SDC column (``SDC ... [-]``) by :data:`REPORT_SDC_FORMAT`. The values stay
+    numbers (the grid sorts them); only their text changes."""
+    return {column: REPORT_SDC_FORMAT for column in table.columns
+            if str(column).startswith("SDC ") and str(column).endswith("[-]")
+            and pd.api.types.is_numeric_dtype(table[column])}
+
+
 def report_display(table: pd.DataFrame) -> pd.DataFrame:
     """The Report tab's view of :func:`pidcore.report.downloads.store_report_table`: the grid
     shows a cell empty by design (a measured column of a DEM-only row) empty (its

@@ -82,8 +82,7 @@ def _settings_editor(measurements, tables: dict[str, pd.DataFrame], channel_name
             "inverted channels": st.column_config.TextColumn(
                 help="channels whose sign is flipped, separated by ';' (e.g. Force)"),
             "time base unit": st.column_config.TextColumn(
-                help="unit of this file's time base (s, ms, us) where its time column states "
-                     "none or one pidcore does not read; empty: the one for every file"),
+                help=uploads.TIME_UNIT_COLUMN_HELP),
         })
     ss["settings_current"] = edited
     st.download_button("Download these settings as a CSV template", uploads.settings_template(

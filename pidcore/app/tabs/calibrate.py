@@ -18,11 +18,11 @@ from pidcore.app.calibration import (
     fittable_names,
     page_words,
     points_by_material,
+    points_display,
     points_for_paper,
     points_for_specimen,
     points_needed,
     points_needed_text,
-    points_table,
     runner_for,
     specimen_label,
 )
@@ -239,7 +239,7 @@ def _form(stores, api, points: list, left_out: list[str]) -> str:
     chosen_cases = st.multiselect("measured load cases to calibrate against (from the store)",
                                   labels, default=labels, key=cases_key, bind=ADDRESS_BINDING)
     points = [p for p, label in zip(points, labels, strict=True) if label in chosen_cases]
-    st.dataframe(points_table(points), hide_index=True, width="stretch",
+    st.dataframe(points_display(points), hide_index=True, width="stretch",
                  key="calibration_points", placeholder="")
     c1, c2, c3 = st.columns(3)
     fittable = fittable_names(api)

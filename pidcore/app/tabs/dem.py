@@ -19,6 +19,7 @@ from pidcore.app.tabs import (
     refuse_address_choices,
     specimen_choice,
 )
+from pidcore.app.workbench import report_number_formats
 from pidcore.constants import DRIVE_DIRECTIONS, PARTICLE_MATERIALS
 from pidcore.loadcase import parse_count, parse_values
 
@@ -186,8 +187,11 @@ def render(stores) -> None:
     if not runs.empty:
         st.markdown(f"**DEM runs in the stores** ({len(runs)})")
         table = jobs.dem_runs_table(runs)
+        # the SDC as the report's cells write it (4 significant digits, not 4 decimals)
         st.dataframe(table, hide_index=True, width="stretch", key="dem_runs_table",
-                     placeholder="")
+                     placeholder="", column_config={
+                         column: st.column_config.NumberColumn(format=number_format)
+                         for column, number_format in report_number_formats(table).items()})
         # listed as the store holds them, but said: Compare and Report leave them out
         design = state.design_runs(stamp, stores)
         if design:

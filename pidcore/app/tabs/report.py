@@ -34,7 +34,7 @@ def render(stores, calibrations: list) -> None:
     """The page. ``calibrations``: [(calibration or None, label)], as the Compare tab's; the
     calibrated columns show the one chosen (the first by default)."""
     from pidcore.app.calibration import calibration_digest, default_calibration_index
-    from pidcore.app.workbench import report_display
+    from pidcore.app.workbench import report_display, report_number_formats
     from pidcore.compare.specimens import run_specimens
     from pidcore.errors import PidcoreError
     from pidcore.report.downloads import report_files
@@ -113,7 +113,9 @@ def render(stores, calibrations: list) -> None:
     # one) are empty, not the grid's greyed "None"; the two results that can lack a value say
     # why (report_display)
     shown = report_display(table)
-    st.dataframe(shown, hide_index=True, key="report_table", width="stretch", placeholder="")
+    st.dataframe(shown, hide_index=True, key="report_table", width="stretch", placeholder="",
+                 column_config={column: st.column_config.NumberColumn(format=number_format)
+                                for column, number_format in report_number_formats(shown).items()})
     # the notes in the page's terms too (report_display's): "pool=True" is the checkbox here
     for note in shown.attrs.get("notes", []):
         st.caption(f"note: {note}")
