@@ -33,9 +33,10 @@ import numpy as np
 import pandas as pd
 
 from .. import defaults
-from ..constants import (  # noqa: F401 (AlignmentStatus kept: defined here before)
+from ..constants import (  # noqa: F401 (AlignmentStatus kept: defined here before; PACKING_RATIO_COLUMN public here)
     ALIGNMENT_STATUSES,
     BAND_VERDICTS,
+    PACKING_RATIO_COLUMN,
     AlignmentStatus,
 )
 from ..errors import ParameterError, real_number
@@ -53,12 +54,6 @@ DEM_COLUMNS: tuple[str, ...] = ("frequency_hz", "acceleration_g", "fill_percent"
 #: the like-for-like counterpart of our DEM's (Eq. 10's energy). Named "SDC measured [-]"
 #: before: beside "SDC DEM (ours) [-]" a reader compared 1.139 with 0.6054 (a factor 2) where
 #: the like-for-like 0.624 agrees.
-#: The fill of the cells with particles, by the paper's term, as every table and figure of
-#: pidcore names it (the report's files, :meth:`pidcore.calibrate.Calibration.to_pandas`,
-#: calibration's summary.md/html, the app's tables). Calibration called it "fill [%]" before
-#: 2026-12 (:data:`pidcore.calibrate.CALIBRATION_COLUMNS_RENAMED`) beside the report's name for
-#: the same number.
-PACKING_RATIO_COLUMN = "packing ratio [%]"
 MEASURED_EQ11_COLUMN = "SDC measured (Eq. 11) [-]"
 MEASURED_EQ11_STDERR_COLUMN = "SDC measured (Eq. 11) stderr [-]"
 MEASURED_EQ11_DOF_COLUMN = "SDC measured (Eq. 11) stderr dof [-]"
