@@ -25,6 +25,8 @@ CELL_SHAPES, BACKGROUND_STATES, ALIGNMENT_STATUSES, IMPACT_PAIRS, BAND_VERDICTS
 UNTABULATED_PARTICLE_MATERIALS
     Particle materials a file name may state that the material table lacks (refused unless a
     specimen file gives them).
+PACKING_RATIO_COLUMN
+    The fill of the cells with particles as every table and figure names it.
 STANDARD_GRAVITY, RATIO_UNIT, COUNT_UNIT, SI_UNITS
     Standard gravity (m/s^2) and the one spelling of each unit in every output.
 """
@@ -41,7 +43,8 @@ __all__ = [
     "VIBRATED_MASS_CONVENTIONS", "START_PROTOCOLS", "TANGENTIAL_MODELS", "START_PACKINGS",
     "TANGENTIAL_STIFFNESS_MODELS", "REPORT_FORMATS", "FILL_REFERENCES", "DAMPING_COEFFICIENTS",
     "CELL_SHAPES", "BACKGROUND_STATES", "ALIGNMENT_STATUSES", "IMPACT_PAIRS", "BAND_VERDICTS",
-    "UNTABULATED_PARTICLE_MATERIALS", "STANDARD_GRAVITY", "RATIO_UNIT", "COUNT_UNIT", "SI_UNITS",
+    "UNTABULATED_PARTICLE_MATERIALS", "PACKING_RATIO_COLUMN", "STANDARD_GRAVITY", "RATIO_UNIT",
+    "COUNT_UNIT", "SI_UNITS",
 ]
 
 #: Physical quantity a channel carries (after unit normalisation).
@@ -119,6 +122,14 @@ DAMPING_COEFFICIENTS: tuple[str, ...] = get_args(DampingCoefficient)
 CELL_SHAPES: tuple[str, ...] = get_args(CellShape)
 BACKGROUND_STATES: tuple[str, ...] = get_args(BackgroundState)
 BAND_VERDICTS: tuple[str, ...] = get_args(BandVerdict)
+#: The fill of the cells with particles, by the paper's term, as every table and figure of
+#: pidcore names it (the report's files, :meth:`pidcore.calibrate.Calibration.to_pandas`,
+#: calibration's summary.md/html, the equivalent damper's table, the app's tables and charts).
+#: Calibration and the damper table called it "fill [%]" before 2026-12
+#: (:data:`pidcore.calibrate.CALIBRATION_COLUMNS_RENAMED`,
+#: :data:`pidcore.model.DAMPER_COLUMNS_RENAMED`) beside the report's name for the same number.
+#: Here, not in :mod:`pidcore.compare.align`, so that :mod:`pidcore.model` can use it too.
+PACKING_RATIO_COLUMN = "packing ratio [%]"
 
 #: Standard gravity, m/s^2 (ISO 80000-3); used for g <-> m/s^2 and for gravity on particles.
 STANDARD_GRAVITY = 9.80665

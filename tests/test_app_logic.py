@@ -462,15 +462,16 @@ def test_compare_case_on_the_paper_grid(good_csv, options):
     assert comp.aligned.status == "grid"
     assert comp.aligned.sdc_dem == pytest.approx(0.21)
     assert comp.aligned.sdc_dem_stderr == pytest.approx(0.01)
-    assert comp.dem_points["fill [%]"].tolist() == [50.0, 75.0]
+    assert comp.dem_points["packing ratio [%]"].tolist() == [50.0, 75.0]
     # Table 3 at 100 Hz, 5 g: DEM 0.1891 and measured 0.21 at 50 % fill.
-    row = comp.paper_points.set_index("fill [%]").loc[50.0]
+    row = comp.paper_points.set_index("packing ratio [%]").loc[50.0]
     assert row["SDC DEM (paper) [-]"] == 0.1891
     assert row["SDC measured (paper) [-]"] == 0.21
     # Without the DEM's m_c the like-for-like SDC is unknown.
     assert math.isnan(comp.measured_sdc_eq10)
     # pchip interpolates: the curve passes through the paper's DEM values at its grid fills.
-    at_grid = np.interp(comp.paper_points["fill [%]"], comp.model_fill_percent, comp.model_sdc)
+    at_grid = np.interp(comp.paper_points["packing ratio [%]"], comp.model_fill_percent,
+                        comp.model_sdc)
     np.testing.assert_allclose(at_grid, comp.paper_points["SDC DEM (paper) [-]"], rtol=2e-2)
 
 
@@ -492,7 +493,7 @@ def test_compare_case_of_another_specimen_shows_no_paper_table3(good_csv, option
     for name in ("", "paper_coupon"):
         theirs = compare_case([_entry(rec, specimen=name)], None, paper)
         assert theirs.aligned.sdc_paper_dem == 0.1891  # Table 3: 100 Hz, 5 g, 50 %
-        assert theirs.paper_points.set_index("fill [%]").loc[50.0,
+        assert theirs.paper_points.set_index("packing ratio [%]").loc[50.0,
                                                              "SDC measured (paper) [-]"] == 0.21
 
 
@@ -509,15 +510,15 @@ def test_chart_data_hold_every_series_with_their_errors(good_csv, options):
     by = {name: g for name, g in data.groupby("series")}
     measured = by["measured (± stderr)"].iloc[0]
     a = rec.analysis
-    assert (measured["fill [%]"], measured["SDC [-]"]) == (50.0, a.sdc)
+    assert (measured["packing ratio [%]"], measured["SDC [-]"]) == (50.0, a.sdc)
     assert measured["low [-]"] == a.sdc - a.sdc_stderr
     assert measured["high [-]"] == a.sdc + a.sdc_stderr
     dem = by["our DEM (mean ± stderr)"].iloc[0]
-    assert dem["fill [%]"] == 25.0
+    assert dem["packing ratio [%]"] == 25.0
     assert (dem["low [-]"], dem["high [-]"]) == pytest.approx((0.13, 0.17), abs=1e-15)
     # Only 50 % fill has a measured value in Table 3: NaN rows are left out.
-    assert by["paper measured"]["fill [%]"].tolist() == [50.0]
-    assert by["paper DEM"]["fill [%]"].tolist() == [25.0, 50.0, 75.0, 90.0]
+    assert by["paper measured"]["packing ratio [%]"].tolist() == [50.0]
+    assert by["paper DEM"]["packing ratio [%]"].tolist() == [25.0, 50.0, 75.0, 90.0]
     loop = _entry(rec).loop()
     loops = loop_frame([loop])
     # Closed: last point repeats the first; SI units (the chart converts to µm).
@@ -1308,12 +1309,12 @@ def test_sdc_chart_ticks_read_the_fills(fills):
     vl_convert = pytest.importorskip("vl_convert")
     from pidcore.app.charts import sdc_chart
 
-    data = pd.DataFrame({"series": ["paper DEM"] * len(fills), "fill [%]": fills,
+    data = pd.DataFrame({"series": ["paper DEM"] * len(fills), "packing ratio [%]": fills,
                          "SDC [-]": [0.2] * len(fills), "low [-]": [0.2] * len(fills),
                          "high [-]": [0.2] * len(fills)})
     svg = vl_convert.vegalite_to_svg(json.dumps(sdc_chart(data)))
     labels = re.findall(r'<text[^>]*>([^<]*)</text>', svg)
-    title = labels.index("packing ratio (fill) [%]")
+    title = labels.index("packing ratio [%]")
     assert labels[title - len(fills):title] == [f"{f:g}" for f in fills]
 
 
@@ -1326,12 +1327,12 @@ def test_sdc_chart_labels_the_model_curves_ends_beside_a_single_point():
 
     model = np.linspace(25.0, 90.0, 14)
     data = pd.DataFrame({"series": [SDC_SERIES[0]] * len(model) + ["measured"],
-                         "fill [%]": [*model, 40.0], "SDC [-]": [0.2] * (len(model) + 1),
+                         "packing ratio [%]": [*model, 40.0], "SDC [-]": [0.2] * (len(model) + 1),
                          "low [-]": [0.2] * (len(model) + 1),
                          "high [-]": [0.2] * (len(model) + 1)})
     svg = vl_convert.vegalite_to_svg(json.dumps(sdc_chart(data)))
     labels = re.findall(r'<text[^>]*>([^<]*)</text>', svg)
-    title = labels.index("packing ratio (fill) [%]")
+    title = labels.index("packing ratio [%]")
     assert labels[title - 3:title] == ["25", "40", "90"]
 
 
@@ -2612,7 +2613,7 @@ def test_the_sdc_charts_tooltip_writes_the_sdc_as_the_pages_do(sdc, stderr, show
     from pidcore.app.uploads import format_sdc
 
     err = 0.0 if math.isnan(stderr) else stderr  # as sdc_points writes a point without one
-    data = pd.DataFrame({"series": ["measured (± stderr)"], "fill [%]": [50.0],
+    data = pd.DataFrame({"series": ["measured (± stderr)"], "packing ratio [%]": [50.0],
                          "SDC [-]": [sdc], "low [-]": [sdc - err], "high [-]": [sdc + err]})
     spec = sdc_chart(data)
     (row,) = spec["datasets"]["sdc"]

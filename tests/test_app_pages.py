@@ -1259,7 +1259,7 @@ def test_compare_meets_the_dem_run_of_the_files_specimen_and_says_it_did_not_con
     assert runs["specimen"].tolist() == ["steel_6mm [aaaaaa]", "steel_6mm_b [bbbbbb]"]
     assert runs["steady state"].tolist() == ["reached", "NOT reached"]
     assert list(runs.columns[:7]) == ["specimen", "frequency [Hz]", "acceleration [g]",
-                                      "fill [%]", "material", "SDC [-]", "SDC stderr [-]"]
+                                      "packing ratio [%]", "material", "SDC [-]", "SDC stderr [-]"]
     # no specimen named, runs of two: no DEM value, and the page says which and what to do
     at = _upload(_app(), [("m_fill50.csv", data), ("settings.csv", _steel_settings(None))])
     assert _headline(at).endswith(" — no DEM value at this case: the DEM runs met are not "

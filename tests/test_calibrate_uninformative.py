@@ -518,7 +518,10 @@ def test_the_frame_the_report_and_the_summary_name_each_quantity_alike(tmp_path)
     # Calibration.to_pandas() named its verdict "measured in 95 % band [...]" where the report
     # says "measured in calibrated 95 % band [...]", and summary.md said "f [Hz]", "measured
     # SDC [-]", "predicted SDC [-]", "95 % band [-]", "inside [...]" for the same quantities:
-    # a script joining them had to know three spellings.
+    # a script joining them had to know three spellings. The fill of the cells was "fill [%]"
+    # in the frame, the summary and the app's tables but "packing ratio [%]" in the report.
+    from pidcore.app.calibration import POINT_COLUMNS
+    from pidcore.app.jobs import DEM_RUN_COLUMNS
     from pidcore.calibrate.outputs import summary_markdown
     from pidcore.calibrate.prediction import CALIBRATION_COLUMNS_RENAMED
     from pidcore.compare.align import (
@@ -529,15 +532,16 @@ def test_the_frame_the_report_and_the_summary_name_each_quantity_alike(tmp_path)
         CALIBRATED_LOW_COLUMN,
         MEASURED_EQ11_COLUMN,
         MEASURED_EQ11_STDERR_COLUMN,
+        PACKING_RATIO_COLUMN,
     )
-    from pidcore.report.table import add_calibration_columns, with_band_text
+    from pidcore.report.table import REPORT_COLUMNS, add_calibration_columns, with_band_text
 
     result = _result()
     frame = result.to_pandas()
     report = add_calibration_columns(pd.DataFrame({
         "frequency [Hz]": [r["frequency_hz"] for r in PREDICTIONS],
         "acceleration [g]": [r["acceleration_g"] for r in PREDICTIONS],
-        "packing ratio [%]": [r["fill_percent"] for r in PREDICTIONS],
+        PACKING_RATIO_COLUMN: [r["fill_percent"] for r in PREDICTIONS],
         "material": ["acrylic"] * 3,
         MEASURED_EQ11_COLUMN: [r["measured"] for r in PREDICTIONS],
         # the fitted points' own stderr: the report judges each by the band the frame holds
@@ -546,8 +550,13 @@ def test_the_frame_the_report_and_the_summary_name_each_quantity_alike(tmp_path)
     head = next(line for line in summary_markdown(result).splitlines()
                 if line.startswith("| frequency [Hz] |"))
     summary = [cell.strip() for cell in head.strip("|").split("|")]
-    shared = ["frequency [Hz]", "acceleration [g]", MEASURED_EQ11_COLUMN, CALIBRATED_COLUMN,
-              CALIBRATED_INSIDE_COLUMN]
+    shared = ["frequency [Hz]", "acceleration [g]", PACKING_RATIO_COLUMN, MEASURED_EQ11_COLUMN,
+              CALIBRATED_COLUMN, CALIBRATED_INSIDE_COLUMN]
+    assert PACKING_RATIO_COLUMN == "packing ratio [%]" and PACKING_RATIO_COLUMN in REPORT_COLUMNS
+    # the app's measured points and DEM runs show the fill under the report's name
+    assert POINT_COLUMNS["fill_percent"] == DEM_RUN_COLUMNS["fill_percent"] == PACKING_RATIO_COLUMN
+    assert not any("fill" in name for name in [*frame.columns, *summary]), (
+        list(frame.columns), summary)
     for name in shared:
         assert name in frame.columns and name in report.columns and name in summary, name
     for name in (CALIBRATED_LOW_COLUMN, CALIBRATED_HIGH_COLUMN):
@@ -565,5 +574,5 @@ def test_the_frame_the_report_and_the_summary_name_each_quantity_alike(tmp_path)
     # a frame of an older pidcore reads as today's
     older = frame.rename(columns={new: old for old, new in CALIBRATION_COLUMNS_RENAMED.items()})
     assert {"measured in 95 % band [yes/no/not compared/uninformative]",
-            "low95 without stderr [-]", "sdc bound [-]"} <= set(older.columns)
+            "low95 without stderr [-]", "sdc bound [-]", "fill [%]"} <= set(older.columns)
     pd.testing.assert_frame_equal(older.rename(columns=CALIBRATION_COLUMNS_RENAMED), frame)

@@ -230,7 +230,7 @@ def test_model_curve_is_drawn_for_a_case_a_hair_below_the_grid_edge():
     assert comp.model_sdc.size > 0
     assert any("edge of its range" in n for n in comp.notes)
     # pchip through the paper's DEM values at 50 Hz, 5 g
-    at = np.interp(comp.paper_points["fill [%]"], comp.model_fill_percent, comp.model_sdc)
+    at = np.interp(comp.paper_points["packing ratio [%]"], comp.model_fill_percent, comp.model_sdc)
     np.testing.assert_allclose(at, comp.paper_points["SDC DEM (paper) [-]"], rtol=2e-2)
 
 

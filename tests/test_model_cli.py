@@ -44,7 +44,7 @@ def test_damper_writes_the_paper_grid(tmp_path):
     assert len(table) == 48
     np.testing.assert_allclose(table["coupon_vibrated_mass [kg]"], coupon_vibrated_mass_kg())
     ref = load_paper_table3().dropna(subset=["sdc_dem"])
-    merged = table.merge(ref, left_on=["frequency [Hz]", "acceleration [g]", "fill [%]"],
+    merged = table.merge(ref, left_on=["frequency [Hz]", "acceleration [g]", "packing ratio [%]"],
                          right_on=["frequency_hz", "acceleration_g", "fill_percent"])
     assert len(merged) == 47
     np.testing.assert_allclose(merged["sdc [-]"], merged["sdc_dem"], rtol=1e-12)
@@ -54,7 +54,7 @@ def test_damper_writes_the_paper_grid(tmp_path):
     # the flag reads back as bool under its bracketed name, in the CSV as in the JSON
     assert table["sdc_filled [True/False]"].dtype == bool
     flagged = table[table["sdc_filled [True/False]"]]
-    assert flagged[["frequency [Hz]", "acceleration [g]", "fill [%]"]].values.tolist() == [
+    assert flagged[["frequency [Hz]", "acceleration [g]", "packing ratio [%]"]].values.tolist() == [
         [1000.0, 1.0, 90.0]]
     assert doc["units"]["sdc_filled [True/False]"] == "True/False"
     # per honeycomb cell: the coupon's c_eq over the paper's 441 cells, the count named
@@ -97,7 +97,7 @@ def test_damper_from_store_runs(tmp_path, monkeypatch):
     table = pd.read_csv(tmp_path / "equivalent_damper.csv")
     # duplicates averaged: mean of 0.9 x and 1.1 x is the paper value
     expected = SdcModel.from_table(load_paper_table3())
-    np.testing.assert_allclose(table["sdc [-]"], expected(table["fill [%]"],
+    np.testing.assert_allclose(table["sdc [-]"], expected(table["packing ratio [%]"],
                                table["acceleration [g]"], table["frequency [Hz]"]), rtol=1e-12)
 
 
@@ -134,7 +134,7 @@ def test_damper_from_store_runs_gives_back_their_dissipated_energy(tmp_path):
                  str(BUNDLED_GRID), "--format", "csv,json"]) == 0
     table = pd.read_csv(tmp_path / "equivalent_damper.csv")
     runs = Store(BUNDLED_GRID).list_dem_runs()
-    merged = table.merge(runs, left_on=["frequency [Hz]", "acceleration [g]", "fill [%]"],
+    merged = table.merge(runs, left_on=["frequency [Hz]", "acceleration [g]", "packing ratio [%]"],
                          right_on=["frequency_hz", "acceleration_g", "fill_percent"])
     assert len(merged) == len(runs) == 48
     # the same sums of the same stored numbers: equal to rounding
@@ -196,7 +196,7 @@ def test_damper_takes_one_specimens_runs_with_its_masses_and_a_given_area(tmp_pa
         _run([*argv, "--where", "specimen_name=steel_6mm"])
     _run([*argv, "--where", "specimen_name=steel_6mm", "--area", "0.02"])
     table = pd.read_csv(tmp_path / "equivalent_damper.csv")
-    at_grid = table.merge(mine, left_on=["frequency [Hz]", "acceleration [g]", "fill [%]"],
+    at_grid = table.merge(mine, left_on=["frequency [Hz]", "acceleration [g]", "packing ratio [%]"],
                           right_on=["frequency_hz", "acceleration_g", "fill_percent"])
     assert len(at_grid) == 47
     np.testing.assert_allclose(at_grid["coupon_vibrated_mass [kg]"], at_grid["vibrated_mass_kg"],
@@ -261,7 +261,7 @@ def test_runs_of_two_numerical_settings_are_refused_and_chosen_by_settings_hash(
         _run(argv)
     _run([*argv, "--where", f"settings_hash={wanted}"])
     table = pd.read_csv(tmp_path / "equivalent_damper.csv")
-    at_grid = table.merge(eq3, left_on=["frequency [Hz]", "acceleration [g]", "fill [%]"],
+    at_grid = table.merge(eq3, left_on=["frequency [Hz]", "acceleration [g]", "packing ratio [%]"],
                           right_on=["frequency_hz", "acceleration_g", "fill_percent"])
     np.testing.assert_allclose(at_grid["sdc [-]"], at_grid["sdc"], rtol=1e-12)
     # the runs' own m_c is the only one: an explicit one is refused, not used
@@ -490,6 +490,8 @@ def test_an_older_damper_csv_reads_into_the_present_names(tmp_path):
     older = table.rename(columns={new: old for old, new in DAMPER_COLUMNS_RENAMED.items()})
     older = older.drop(columns=["coupon_area [m^2]", "coupon_cells [-]"])  # new columns
     assert set(DAMPER_COLUMNS_RENAMED.values()) <= set(DAMPER_COLUMNS)
+    # the fill was "fill [%]" here and "packing ratio [%]" in the report for the same number
+    assert "fill [%]" in older.columns and "packing ratio [%]" in table.columns
     back = older.rename(columns=DAMPER_COLUMNS_RENAMED)
     pd.testing.assert_frame_equal(back, table[list(back.columns)])
 

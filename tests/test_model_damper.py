@@ -123,10 +123,10 @@ def test_damper_table_content(model):
             assert pd.api.types.is_integer_dtype(t[column])
         else:
             assert pd.api.types.is_float_dtype(t[column])
-    sdc = model(t["fill [%]"].to_numpy(), t["acceleration [g]"].to_numpy(),
+    sdc = model(t["packing ratio [%]"].to_numpy(), t["acceleration [g]"].to_numpy(),
                 t["frequency [Hz]"].to_numpy())
     np.testing.assert_array_equal(t["sdc [-]"], sdc)
-    np.testing.assert_allclose(t["coupon_vibrated_mass [kg]"], 0.02 + t["fill [%]"] / 1000)
+    np.testing.assert_allclose(t["coupon_vibrated_mass [kg]"], 0.02 + t["packing ratio [%]"] / 1000)
     np.testing.assert_allclose(t["c_eq_per_treated_area [N s/m^3]"],
                                t["c_eq_per_coupon [N s/m]"] / 0.01,
                                rtol=1e-14)
@@ -138,7 +138,7 @@ def test_damper_table_content(model):
                                t["coupon_energy_per_cycle [J]"] / (np.pi * w * x**2),
                                rtol=1e-13)
     flagged = t[t[SDC_FILLED_COLUMN]]
-    assert flagged[["fill [%]", "acceleration [g]", "frequency [Hz]"]].values.tolist() == [
+    assert flagged[["packing ratio [%]", "acceleration [g]", "frequency [Hz]"]].values.tolist() == [
         [90.0, 1.0, 1000.0]]
 
 

@@ -311,7 +311,7 @@ def test_damper_specimen_file_selects_its_runs_in_a_store_of_two_specimens(tmp_p
     table = pd.read_csv(tmp_path / "out" / "equivalent_damper.csv")
     grid = mine.set_index(["frequency_hz", "acceleration_g", "fill_percent"])["sdc"]
     # the model's grid points are the runs' own load cases: the SDC there is the run's
-    at = table.set_index(["frequency [Hz]", "acceleration [g]", "fill [%]"])["sdc [-]"]
+    at = table.set_index(["frequency [Hz]", "acceleration [g]", "packing ratio [%]"])["sdc [-]"]
     common = at.index.intersection(grid.index)
     assert len(common) > 10
     np.testing.assert_allclose(at.loc[common].to_numpy(), grid.loc[common].to_numpy(),

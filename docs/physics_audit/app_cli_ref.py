@@ -29,7 +29,7 @@ for _, row in saved_analyses(store_h5).iterrows():
     g = comp.aligned.grid_case.load_case
     cli = damper[(damper["frequency [Hz]"] == g.frequency_hz)
                  & (damper["acceleration [g]"] == g.acceleration_g)
-                 & (damper["fill [%]"] == g.fill_percent)]["c_eq_per_coupon [N s/m]"].iloc[0]
+                 & (damper["packing ratio [%]"] == g.fill_percent)]["c_eq_per_coupon [N s/m]"].iloc[0]
     rep = report[report["source file(s)"].fillna("").str.endswith(entry.file)].iloc[0]
     worst[0] = max(worst[0], abs(equivalent_dampers(comp)["our DEM"] / cli - 1))
     worst[1] = max(worst[1], abs(comp.measured_sdc_eq10 / rep["SDC measured, E of Eq. 10 [-]"]

@@ -33,7 +33,7 @@ def main(out_dir: str, store_h5: str) -> None:
     for _, run in runs.iterrows():
         row = table[(table["frequency [Hz]"] == run.frequency_hz)
                     & (table["acceleration [g]"] == run.acceleration_g)
-                    & (table["fill [%]"] == run.fill_percent)].iloc[0]
+                    & (table["packing ratio [%]"] == run.fill_percent)].iloc[0]
         w = 2 * math.pi * run.frequency_hz
         a = run.acceleration_g * G
         x = a / w**2

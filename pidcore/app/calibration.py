@@ -27,6 +27,7 @@ from ..compare.align import (
     MEASURED_EQ11_COLUMN,
     MEASURED_EQ11_DOF_COLUMN,
     MEASURED_EQ11_STDERR_COLUMN,
+    PACKING_RATIO_COLUMN,
 )
 from ..compare.plausibility import SDC_BOUND_COLUMN
 from ..constants import BackgroundState
@@ -133,7 +134,7 @@ def points_needed(fit: Sequence[str]) -> int:
 #: "SDC stderr" and "SDC stderr degrees of freedom" for them).
 POINT_COLUMNS = {
     "frequency_hz": "frequency [Hz]", "acceleration_g": "acceleration [g]",
-    "fill_percent": "fill [%]", "sdc": MEASURED_EQ11_COLUMN,
+    "fill_percent": PACKING_RATIO_COLUMN, "sdc": MEASURED_EQ11_COLUMN,
     "sdc_stderr": MEASURED_EQ11_STDERR_COLUMN, "sdc_stderr_dof": MEASURED_EQ11_DOF_COLUMN,
     "material": "material", "specimen": "specimen", "specimen_sha256": "specimen sha256",
     "sdc_bound": SDC_BOUND_COLUMN}

@@ -20,6 +20,7 @@ from typing import Any
 
 import pandas as pd
 
+from pidcore.compare.align import PACKING_RATIO_COLUMN
 from pidcore.compare.case import SDC_SERIES
 from pidcore.units import display_value_with_error
 
@@ -67,7 +68,7 @@ def sdc_chart(data: pd.DataFrame) -> dict[str, Any]:
     that no label is cut.
     """
     present = [s for s in SDC_SERIES if s in set(data["series"])]
-    plain = data.rename(columns={"fill [%]": "fill", "SDC [-]": "sdc", "low [-]": "low",
+    plain = data.rename(columns={PACKING_RATIO_COLUMN: "fill", "SDC [-]": "sdc", "low [-]": "low",
                                  "high [-]": "high"})
     # the tooltip's SDC as every page writes it with its error (value_and_error_texts):
     # four fixed decimals showed the paper's 1.5702e-4 as 0.0002 and an undamped mass's
@@ -83,7 +84,7 @@ def sdc_chart(data: pd.DataFrame) -> dict[str, Any]:
     ends = {model_fills.min(), model_fills.max()} if not model_fills.empty else set()
     fills = sorted({float(f) for f in plain.loc[plain["series"] != _MODEL, "fill"]} | ends) \
         if (plain["series"] != _MODEL).any() else []
-    x = _field("fill", "quantitative", title="packing ratio (fill) [%]",
+    x = _field("fill", "quantitative", title=PACKING_RATIO_COLUMN,
                # ".6~g": 40 and 37.5, not Vega's 40.000000 for a list of floats; the precision
                # stated, or Vega takes it from the tick step and writes 25 as "3e+1"
                **({"axis": {"values": fills, "format": ".6~g"}} if fills else {}))
@@ -106,7 +107,7 @@ def sdc_chart(data: pd.DataFrame) -> dict[str, Any]:
               "encoding": {"x": x, "color": colour, "y": _field("sdc", "quantitative"),
                            "shape": shape, "tooltip": [
                                _field("series", "nominal"),
-                               _field("fill", "quantitative", title="fill [%]"),
+                               _field("fill", "quantitative", title=PACKING_RATIO_COLUMN),
                                _field("sdc_text", "nominal", title="SDC ± stderr [-]")]}}
     return _top("sdc", plain, layer=[curve, bars, points], height=300,
                 title="SDC against fill", autosize=_AUTOSIZE)

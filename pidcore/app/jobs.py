@@ -45,6 +45,7 @@ from typing import TYPE_CHECKING
 
 from .. import defaults
 from ..atomic_files import write_atomically
+from ..compare.align import PACKING_RATIO_COLUMN
 from ..errors import ParameterError, PidcoreError, StoreError, clipped
 from .vocabulary import page_terms
 
@@ -1110,7 +1111,7 @@ def check_dem_cases(cases: Sequence[LoadCase], config: DemConfig,
 #: The specimen, the load case and the result come first: at 1280 px the table shows about
 #: eight columns before it scrolls, and the SDC was cut off behind the run key.
 DEM_RUN_COLUMNS = {"specimen": "specimen", "frequency_hz": "frequency [Hz]",
-                   "acceleration_g": "acceleration [g]", "fill_percent": "fill [%]",
+                   "acceleration_g": "acceleration [g]", "fill_percent": PACKING_RATIO_COLUMN,
                    "material": "material", "sdc": "SDC [-]", "sdc_stderr": "SDC stderr [-]",
                    "steady state": "steady state", "direction": "direction",
                    "cells_simulated": "cells simulated [-]", "seed": "seed [-]",

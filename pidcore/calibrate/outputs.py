@@ -146,10 +146,11 @@ def _prediction_head() -> list[str]:
         CALIBRATED_COLUMN,
         CALIBRATED_DIFFERENCE_COLUMN,
         MEASURED_EQ11_COLUMN,
+        PACKING_RATIO_COLUMN,
         VERDICT_COLUMN,
     )
 
-    return ["frequency [Hz]", "acceleration [g]", "fill [%]", MEASURED_EQ11_COLUMN,
+    return ["frequency [Hz]", "acceleration [g]", PACKING_RATIO_COLUMN, MEASURED_EQ11_COLUMN,
             CALIBRATED_COLUMN, CALIBRATED_BAND_COLUMN, CALIBRATED_DIFFERENCE_COLUMN,
             VERDICT_COLUMN]
 

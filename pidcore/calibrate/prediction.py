@@ -26,6 +26,7 @@ from ..compare.align import (  # noqa: F401 (public here)
     MEASURED_EQ11_COLUMN,
     MEASURED_EQ11_DOF_COLUMN,
     MEASURED_EQ11_STDERR_COLUMN,
+    PACKING_RATIO_COLUMN,
     Z95,
     Tolerances,
     band_quantile,
@@ -55,7 +56,8 @@ if TYPE_CHECKING:  # pragma: no cover
 #: figures_results.plot_calibration` does). Its verdict column, "measured in 95 % band [...]"
 #: beside the report's "measured in calibrated 95 % band [...]" for the same verdict, its
 #: "sdc bound [-]" and its "low95 without stderr [-]" (named after calibration.json's key, not
-#: beside the band it narrows) followed in 2026-12.
+#: beside the band it narrows) followed in 2026-12, and its "fill [%]" beside the report's
+#: "packing ratio [%]" (:data:`pidcore.compare.align.PACKING_RATIO_COLUMN`).
 CALIBRATION_COLUMNS_RENAMED: dict[str, str] = {
     "sdc measured [-]": MEASURED_EQ11_COLUMN,
     "sdc measured stderr [-]": MEASURED_EQ11_STDERR_COLUMN,
@@ -67,6 +69,7 @@ CALIBRATION_COLUMNS_RENAMED: dict[str, str] = {
     "low95 without stderr [-]": "calibrated low 95 % without measurement stderr [-]",
     "high95 without stderr [-]": "calibrated high 95 % without measurement stderr [-]",
     "sdc bound [-]": SDC_BOUND_COLUMN,
+    "fill [%]": PACKING_RATIO_COLUMN,
 }
 #: The calibrated band of the model's SDC alone (calibration.json's ``low95_without_stderr``,
 #: ``high95_without_stderr``): :data:`CALIBRATED_LOW_COLUMN`'s band without the measurement's
@@ -388,7 +391,7 @@ class Calibration:
     def to_pandas(self) -> pd.DataFrame:
         """The predictions, one row per calibrated load case, each column naming its unit.
 
-        Columns ``frequency [Hz]``, ``acceleration [g]``, ``fill [%]``, ``material``,
+        Columns ``frequency [Hz]``, ``acceleration [g]``, ``packing ratio [%]``, ``material``,
         ``direction``, ``SDC calibrated DEM (Eq. 11) [-]``, ``calibrated low 95 % [-]``,
         ``calibrated high 95 % [-]`` (the band of a measurement with the fitted point's
         standard error; the report's names, :data:`~pidcore.compare.align.CALIBRATED_COLUMN`),
@@ -418,7 +421,7 @@ class Calibration:
         return pd.DataFrame([{
             "frequency [Hz]": p.load_case.frequency_hz,
             "acceleration [g]": p.load_case.acceleration_g,
-            "fill [%]": p.load_case.fill_percent,
+            PACKING_RATIO_COLUMN: p.load_case.fill_percent,
             "material": p.load_case.material,
             "direction": p.load_case.direction,
             CALIBRATED_COLUMN: p.sdc,

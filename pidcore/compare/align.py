@@ -33,9 +33,10 @@ import numpy as np
 import pandas as pd
 
 from .. import defaults
-from ..constants import (  # noqa: F401 (AlignmentStatus kept: defined here before)
+from ..constants import (  # noqa: F401 (AlignmentStatus kept: defined here before; PACKING_RATIO_COLUMN public here)
     ALIGNMENT_STATUSES,
     BAND_VERDICTS,
+    PACKING_RATIO_COLUMN,
     AlignmentStatus,
 )
 from ..errors import ParameterError, real_number

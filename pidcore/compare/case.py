@@ -18,6 +18,7 @@ from .. import defaults
 from ..errors import ParameterError, PidcoreError
 from ..units import display_sigmas
 from .align import (
+    PACKING_RATIO_COLUMN,
     Aligner,
     Tolerances,
     band_quantile,
@@ -129,8 +130,8 @@ class CaseComparison:
         Mean measured frequency [Hz] and acceleration [g] of the records, stated fill,
         material and direction.
     measured : pandas.DataFrame
-        One row per record: ``file``, ``fill [%]``, ``SDC [-]``, ``SDC stderr [-]`` (Eq. 11) and,
-        with a DEM m_c, ``SDC, E of Eq. 10 [-]``.
+        One row per record: ``file``, ``packing ratio [%]``, ``SDC [-]``, ``SDC stderr [-]``
+        (Eq. 11) and, with a DEM m_c, ``SDC, E of Eq. 10 [-]``.
     measured_sdc, measured_stderr : float
         Eq. 11 SDC of the records pooled (:func:`pidcore.compare.pooled_mean`), [-].
     measured_stderr_dof : float
@@ -140,7 +141,7 @@ class CaseComparison:
         Our DEM (grid value or pchip interpolation) and the paper's values at the case.
     dem_points : pandas.DataFrame
         Our DEM cases at this frequency, acceleration, material and direction, every fill:
-        ``fill [%]``, ``SDC [-]``, ``SDC stderr [-]``, ``runs [-]``.
+        ``packing ratio [%]``, ``SDC [-]``, ``SDC stderr [-]``, ``runs [-]``.
     paper_points : pandas.DataFrame
         Table 3 rows at this frequency and acceleration.
     model_fill_percent, model_sdc : numpy.ndarray
@@ -477,7 +478,7 @@ def compare_case(records: Sequence[MeasuredEntry],
         # which of the pooled tests recorded only its specimen's name is seen per file
         "specimen": [_specimen_shown(r) for r in records],
         "corrections": [r.corrections for r in records],
-        "fill [%]": [r.load_case.fill_percent for r in records],
+        PACKING_RATIO_COLUMN: [r.load_case.fill_percent for r in records],
         "SDC [-]": [r.sdc for r in records],
         "SDC stderr [-]": [r.sdc_stderr for r in records],
     })
@@ -512,13 +513,13 @@ def compare_case(records: Sequence[MeasuredEntry],
     for c in aligner.cases:
         probe = replace(case, fill_percent=c.load_case.fill_percent)
         if tol.matches(probe, c.load_case):
-            dem_rows.append({"fill [%]": c.load_case.fill_percent, "SDC [-]": c.sdc,
+            dem_rows.append({PACKING_RATIO_COLUMN: c.load_case.fill_percent, "SDC [-]": c.sdc,
                              "SDC stderr [-]": c.sdc_stderr, "runs [-]": c.n_runs,
                              "settings": c.settings})
-    dem_points = pd.DataFrame(dem_rows, columns=["fill [%]", "SDC [-]", "SDC stderr [-]",
+    dem_points = pd.DataFrame(dem_rows, columns=[PACKING_RATIO_COLUMN, "SDC [-]", "SDC stderr [-]",
                                                  "runs [-]", "settings"])
 
-    paper_cols = ["fill [%]", "SDC DEM (paper) [-]", "SDC measured (paper) [-]"]
+    paper_cols = [PACKING_RATIO_COLUMN, "SDC DEM (paper) [-]", "SDC measured (paper) [-]"]
     paper_points = pd.DataFrame(columns=paper_cols)
     model_x = model_y = np.empty(0)
     if case.material == PAPER_MATERIAL and case.direction == PAPER_DIRECTION and not paper.empty:
@@ -528,7 +529,7 @@ def compare_case(records: Sequence[MeasuredEntry],
                    & (np.abs(a - case.acceleration_g) <= tol.acceleration_rtol * a))
         rows = paper[at_case].sort_values("fill_percent")
         paper_points = pd.DataFrame({
-            "fill [%]": rows["fill_percent"].to_numpy(float),
+            PACKING_RATIO_COLUMN: rows["fill_percent"].to_numpy(float),
             "SDC DEM (paper) [-]": rows["sdc_dem"].to_numpy(float),
             "SDC measured (paper) [-]": rows["sdc_experimental"].to_numpy(float)})
         model = SdcModel.from_table(paper, value="sdc_dem", source="paper Table 3 (DEM)")
@@ -738,8 +739,9 @@ SDC_SERIES = ("pchip model (paper Table 3 DEM)", "paper DEM", "paper measured",
 def sdc_points(comparison: CaseComparison) -> pd.DataFrame:
     """SDC against fill for one load case, one row per point (the chart's data).
 
-    Columns ``series`` (one of :data:`SDC_SERIES`), ``fill [%]``, ``SDC [-]``, ``low [-]`` and
-    ``high [-]`` (value ± standard error; equal to the value where there is no error).
+    Columns ``series`` (one of :data:`SDC_SERIES`), ``packing ratio [%]``, ``SDC [-]``,
+    ``low [-]`` and ``high [-]`` (value ± standard error; equal to the value where there is no
+    error).
     """
     c = comparison
     parts = []
@@ -749,14 +751,15 @@ def sdc_points(comparison: CaseComparison) -> pd.DataFrame:
         sdc = np.asarray(sdc, dtype=float)
         err = np.zeros_like(sdc) if err is None else np.nan_to_num(np.asarray(err, float))
         keep = np.isfinite(sdc)
-        parts.append(pd.DataFrame({"series": series, "fill [%]": fill[keep],
+        parts.append(pd.DataFrame({"series": series, PACKING_RATIO_COLUMN: fill[keep],
                                    "SDC [-]": sdc[keep], "low [-]": (sdc - err)[keep],
                                    "high [-]": (sdc + err)[keep]}))
 
     add(SDC_SERIES[0], c.model_fill_percent, c.model_sdc)
-    add(SDC_SERIES[1], c.paper_points["fill [%]"], c.paper_points["SDC DEM (paper) [-]"])
-    add(SDC_SERIES[2], c.paper_points["fill [%]"], c.paper_points["SDC measured (paper) [-]"])
-    add(SDC_SERIES[3], c.dem_points["fill [%]"], c.dem_points["SDC [-]"],
+    paper_fill = c.paper_points[PACKING_RATIO_COLUMN]
+    add(SDC_SERIES[1], paper_fill, c.paper_points["SDC DEM (paper) [-]"])
+    add(SDC_SERIES[2], paper_fill, c.paper_points["SDC measured (paper) [-]"])
+    add(SDC_SERIES[3], c.dem_points[PACKING_RATIO_COLUMN], c.dem_points["SDC [-]"],
         c.dem_points["SDC stderr [-]"])
     if getattr(c.aligned, "status", "") == "interpolated":
         add(SDC_SERIES[4], [c.load_case.fill_percent], [c.aligned.sdc_dem])

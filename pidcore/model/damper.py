@@ -35,7 +35,7 @@ import pandas as pd
 from .. import __version__
 from .. import defaults as D
 from ..atomic_files import write_atomically
-from ..constants import STANDARD_GRAVITY, VIBRATED_MASS_CONVENTIONS
+from ..constants import PACKING_RATIO_COLUMN, STANDARD_GRAVITY, VIBRATED_MASS_CONVENTIONS
 from ..errors import ParameterError
 from ..specimen import MAX_FACE_TO_CELLS_AREA
 from .sdc_model import SdcModel
@@ -59,7 +59,7 @@ SDC_HELD_ERROR_COLUMN = "sdc_held_error [overstated/understated/unknown/not held
 DAMPER_COLUMNS: dict[str, str] = {
     "frequency [Hz]": "Hz",
     "acceleration [g]": "g",
-    "fill [%]": "%",
+    PACKING_RATIO_COLUMN: "%",
     "sdc [-]": "-",
     SDC_FILLED_COLUMN: "True/False",
     SDC_HELD_COLUMN: "True/False",
@@ -87,6 +87,7 @@ DAMPER_COLUMNS_RENAMED: dict[str, str] = {
     "energy_per_cycle [J]": "coupon_energy_per_cycle [J]",
     "c_eq [N s/m]": "c_eq_per_coupon [N s/m]",
     "c_eq_per_area [N s/m^3]": "c_eq_per_treated_area [N s/m^3]",
+    "fill [%]": PACKING_RATIO_COLUMN,  # the report's name for the fill, since 2026-12
 }
 #: What each column of :data:`DAMPER_COLUMNS` is, per what and where it applies (the JSON
 #: file's ``columns``): the brackets name the unit, not whether a number is the coupon's or
@@ -94,7 +95,7 @@ DAMPER_COLUMNS_RENAMED: dict[str, str] = {
 DAMPER_COLUMN_MEANINGS: dict[str, str] = {
     "frequency [Hz]": "drive frequency f of the coupon test",
     "acceleration [g]": "acceleration amplitude a of the coupon (g = 9.80665 m/s^2)",
-    "fill [%]": "fill of every cell of the coupon",
+    PACKING_RATIO_COLUMN: "fill of every cell of the coupon",
     "sdc [-]": "specific damping capacity dE/E (Eq. 8, E of Eq. 10), pchip model",
     SDC_FILLED_COLUMN: "the point is a hole of the model grid, filled (provenance "
                        "filled_grid_points)",
@@ -626,7 +627,7 @@ def equivalent_damper_table(model: SdcModel, *, fills_percent: Sequence[float] |
     out = pd.DataFrame({
         "frequency [Hz]": f,
         "acceleration [g]": a_g,
-        "fill [%]": p,
+        PACKING_RATIO_COLUMN: p,
         "sdc [-]": sdc,
         SDC_FILLED_COLUMN: filled,
         SDC_HELD_COLUMN: held,

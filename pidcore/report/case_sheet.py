@@ -12,6 +12,7 @@ import math
 
 import pandas as pd
 
+from ..compare.align import PACKING_RATIO_COLUMN
 from ..units import display_value_with_error
 
 #: Page size of the sheet, inches (A4 landscape).
@@ -21,13 +22,13 @@ PAGE_IN = (11.69, 8.27)
 def plot_sdc_points(points: pd.DataFrame, ax) -> None:
     """SDC against fill: the model as a line, every other series as points with error bars."""
     for k, (series, group) in enumerate(points.groupby("series", sort=False)):
-        x, y = group["fill [%]"].to_numpy(float), group["SDC [-]"].to_numpy(float)
+        x, y = group[PACKING_RATIO_COLUMN].to_numpy(float), group["SDC [-]"].to_numpy(float)
         if series.startswith("pchip model"):
             ax.plot(x, y, color="0.5", label=series)
             continue
         err = [y - group["low [-]"].to_numpy(float), group["high [-]"].to_numpy(float) - y]
         ax.errorbar(x, y, yerr=err, fmt="os^Dv<>"[k % 7], capsize=3, label=series)
-    ax.set_xlabel("packing ratio (fill) [%]")
+    ax.set_xlabel(PACKING_RATIO_COLUMN)
     ax.set_ylabel("SDC [-]")
     ax.grid(alpha=0.3)
     ax.legend(fontsize="x-small")

@@ -24,6 +24,7 @@ from .table import (
     MEASURED_EQ10_COLUMN,
     MEASURED_EQ11_COLUMN,
     MEASURED_EQ11_STDERR_COLUMN,
+    PACKING_RATIO_COLUMN,
 )
 
 #: Force arrays looked for in a DEM run, in order: the force a shaker's gauge would measure
@@ -113,7 +114,7 @@ def _draw_sdc_rows(ax, rows: pd.DataFrame, several_materials: bool) -> None:
     x = np.arange(n, dtype=float)
     width = 0.15
     labels = [f"{r['frequency [Hz]']:.4g} Hz\n{r['acceleration [g]']:.3g} g\n"
-              f"{r['packing ratio [%]']:.3g} %"
+              f"{r[PACKING_RATIO_COLUMN]:.3g} %"
               + (f"\n{r['material']}" if several_materials else "")
               for _, r in rows.iterrows()]
     sdc11 = rows[MEASURED_EQ11_COLUMN].astype(float).to_numpy()

@@ -136,6 +136,7 @@ def plot_calibration(frame: pd.DataFrame, *, ax: Any = None) -> Any:
         CALIBRATED_HIGH_COLUMN,
         CALIBRATED_LOW_COLUMN,
         MEASURED_EQ11_COLUMN,
+        PACKING_RATIO_COLUMN,
     )
     from ..compare.plausibility import SDC_UPPER_BOUND
 
@@ -151,7 +152,8 @@ def plot_calibration(frame: pd.DataFrame, *, ax: Any = None) -> Any:
     ax.plot(x, frame[MEASURED_EQ11_COLUMN].to_numpy(float), "x", color="k", label="measured")
     ax.set_xticks(x)
     ax.set_xticklabels([f"{f:g} Hz, {a:g} g, {p:g} %" for f, a, p in zip(
-        frame["frequency [Hz]"], frame["acceleration [g]"], frame["fill [%]"], strict=True)],
+        frame["frequency [Hz]"], frame["acceleration [g]"], frame[PACKING_RATIO_COLUMN],
+        strict=True)],
         rotation=60, ha="right", fontsize="small")
     ax.set_ylabel("SDC [-]")
     ax.legend()

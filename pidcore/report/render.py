@@ -45,6 +45,7 @@ from .table import (
     MEASURED_EQ10_COLUMN,
     MEASURED_EQ11_COLUMN,
     MEASURED_EQ11_STDERR_COLUMN,
+    PACKING_RATIO_COLUMN,
 )
 
 #: File written into every report folder; only folders holding it are ever replaced.
@@ -56,7 +57,7 @@ REPORT_STEM = "report"
 #: the Eq. 11 SDC alone the PDF set 1.14 against our 0.61 where the like-for-like 0.62 agrees;
 #: the calibrated columns only where the table has them.
 PDF_COLUMNS: tuple[str, ...] = (
-    "frequency [Hz]", "acceleration [g]", "packing ratio [%]", "SDC DEM (ours) [-]",
+    "frequency [Hz]", "acceleration [g]", PACKING_RATIO_COLUMN, "SDC DEM (ours) [-]",
     "SDC DEM stderr [-]", MEASURED_EQ10_COLUMN, DIFFERENCE_COLUMN, MEASURED_EQ11_COLUMN,
     MEASURED_EQ11_STDERR_COLUMN, CALIBRATED_COLUMN, CALIBRATED_BAND_COLUMN,
     CALIBRATED_INSIDE_COLUMN,

@@ -37,6 +37,7 @@ from ..compare.align import (
     MEASURED_EQ11_COLUMN,
     MEASURED_EQ11_DOF_COLUMN,
     MEASURED_EQ11_STDERR_COLUMN,
+    PACKING_RATIO_COLUMN,
     Aligner,
     DemCase,
     Tolerances,
@@ -94,7 +95,7 @@ ALIGNMENT_COLUMN = f"alignment [{'/'.join(ALIGNMENT_STATUSES)}]"
 SPECIMEN_SHA256_COLUMN = "specimen sha256"
 #: Columns of :func:`build_report_table`, in order.
 REPORT_COLUMNS: tuple[str, ...] = (
-    "frequency [Hz]", "acceleration [g]", "packing ratio [%]", "material", "direction",
+    "frequency [Hz]", "acceleration [g]", PACKING_RATIO_COLUMN, "material", "direction",
     "particles per cell [-]", "DEM runs [-]", "SDC DEM (ours) [-]", "SDC DEM stderr [-]",
     "measured frequency [Hz]", "measured acceleration [g]", MEASURED_EQ11_COLUMN,
     MEASURED_EQ11_STDERR_COLUMN, MEASURED_EQ11_DOF_COLUMN, MEASURED_EQ10_COLUMN,
@@ -571,8 +572,8 @@ def paper_fill_count_note(table: pd.DataFrame) -> str:
     counts = table["particles per cell [-]"]
     compared = table[np.isfinite(paper_dem) & np.isfinite(ours) & counts.notna().to_numpy()]
     pairs = []
-    for fill in sorted(compared["packing ratio [%]"].astype(float).unique()):
-        held = sorted({int(n) for n in compared.loc[compared["packing ratio [%]"] == fill,
+    for fill in sorted(compared[PACKING_RATIO_COLUMN].astype(float).unique()):
+        held = sorted({int(n) for n in compared.loc[compared[PACKING_RATIO_COLUMN] == fill,
                                                    "particles per cell [-]"]})
         theirs = particles_for_fill(fill, defaults.PAPER_PARTICLES_PER_FULL_CELL)
         if held != [theirs]:
@@ -651,10 +652,10 @@ def _sort_like_table3(table: pd.DataFrame, aligner: Aligner, paper: pd.DataFrame
         "a": _snap_to_own(_snap(table["acceleration [g]"], grid["acceleration_g"],
                                 rtol=tolerances.acceleration_rtol), grid["acceleration_g"],
                           rtol=tolerances.acceleration_rtol),
-        "p": _snap(table["packing ratio [%]"], grid["fill_percent"],
+        "p": _snap(table[PACKING_RATIO_COLUMN], grid["fill_percent"],
                    atol=tolerances.fill_atol_percent),
         "fx": table["frequency [Hz]"], "ax": table["acceleration [g]"],
-        "px": table["packing ratio [%]"], "m": table["material"], "d": table["direction"],
+        "px": table[PACKING_RATIO_COLUMN], "m": table["material"], "d": table["direction"],
         "s": table["DEM settings"], "sp": table["specimen"],
         "sh": table[SPECIMEN_SHA256_COLUMN],
     })
@@ -757,7 +758,7 @@ def add_calibration_columns(table: pd.DataFrame, calibration, *,
         note = str(row.get("note", "") or "")
         cut = ""  # a band reaching past 2 pi, said where it is cut
         case = LoadCase(float(row["frequency [Hz]"]), float(row["acceleration [g]"]),
-                        float(row["packing ratio [%]"]),
+                        float(row[PACKING_RATIO_COLUMN]),
                         str(row.get("material") or defaults.COMPARE_DEFAULT_MATERIAL))
         if case.material not in reasons:
             of_row = specimen
