@@ -2287,26 +2287,36 @@ def test_the_time_base_unit_field_reads_an_export_in_ms_again(store_file, tmp_pa
            "with the time units they state" in [e.value for e in at.error]
 
 
-def test_the_report_grid_writes_each_sdc_with_four_significant_digits(store_file):
-    # The Report grid wrote its numbers with four decimals: an SDC DEM of 0.001101 read
-    # "0.0011" beside its stderr "0.000254" (coarser than its own error), where the report's
-    # cells (sdc_text) write "0.001101". The values stay numbers; the column's format says it.
-    import json
-
-    from pidcore.calibrate.prediction import sdc_text
+def _one_short_dem_run(store_file):
+    """A one-cell DEM run of the paper's coupon (1 kHz, 5 g, 25 %) saved in ``store_file``."""
     from pidcore.dem.persist import run_or_load
     from pidcore.dem.simulate import DemConfig, LoadCase
     from pidcore.specimen import paper_specimen
 
-    run = run_or_load(store_file, paper_specimen(), LoadCase(1000.0, 5.0, 25.0),
-                      DemConfig(cells=1, steady_cycles=4, block_cycles=2,
-                                max_transient_cycles=2))
+    return run_or_load(store_file, paper_specimen(), LoadCase(1000.0, 5.0, 25.0),
+                       DemConfig(cells=1, steady_cycles=4, block_cycles=2,
+                                 max_transient_cycles=2))
+
+
+def _column_formats(grid) -> dict:
+    """Each column's display format (printf) of a rendered Streamlit dataframe."""
+    import json
+
+    return {column: config.get("type_config", {}).get("format")
+            for column, config in json.loads(grid.proto.columns).items()}
+
+
+def test_the_report_grid_writes_each_sdc_with_four_significant_digits(store_file):
+    # The Report grid wrote its numbers with four decimals: an SDC DEM of 0.001101 read
+    # "0.0011" beside its stderr "0.000254" (coarser than its own error), where the report's
+    # cells (sdc_text) write "0.001101". The values stay numbers; the column's format says it.
+    from pidcore.calibrate.prediction import sdc_text
+
+    run = _one_short_dem_run(store_file)
     at = _app()
     grid = next(d for d in at.dataframe if "SDC DEM (ours) [-]" in d.value.columns)
     assert run.sdc in grid.value["SDC DEM (ours) [-]"].tolist()  # still a number
-    formats = {column: config.get("type_config", {}).get("format")
-               for column, config in json.loads(grid.proto.columns).items()}
-    printf = formats["SDC DEM (ours) [-]"]
+    printf = _column_formats(grid)["SDC DEM (ours) [-]"]
     assert printf == "%.4g"
     # printf's %.4g is the report's sdc_text: four significant digits, not four decimals
     assert printf % 0.001101234 == sdc_text(0.001101234) == "0.001101"
@@ -2314,18 +2324,8 @@ def test_the_report_grid_writes_each_sdc_with_four_significant_digits(store_file
 
 def test_the_dem_tabs_runs_table_writes_the_sdc_with_four_significant_digits(store_file):
     # as the Report grid: the DEM tab's runs table wrote an SDC of 0.001137 as "0.0011"
-    import json
-
-    from pidcore.dem.persist import run_or_load
-    from pidcore.dem.simulate import DemConfig, LoadCase
-    from pidcore.specimen import paper_specimen
-
-    run = run_or_load(store_file, paper_specimen(), LoadCase(1000.0, 5.0, 25.0),
-                      DemConfig(cells=1, steady_cycles=4, block_cycles=2,
-                                max_transient_cycles=2))
+    run = _one_short_dem_run(store_file)
     at = _app()
     grid = next(d for d in at.dataframe if "cells simulated [-]" in d.value.columns)
     assert run.sdc in grid.value["SDC [-]"].tolist()  # still a number
-    formats = {column: config.get("type_config", {}).get("format")
-               for column, config in json.loads(grid.proto.columns).items()}
-    assert formats["SDC [-]"] == "%.4g"
+    assert _column_formats(grid)["SDC [-]"] == "%.4g"

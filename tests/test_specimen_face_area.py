@@ -220,22 +220,28 @@ def _steel_runs(steel: Specimen) -> pd.DataFrame:
         parameters_json=json.dumps({"specimen_text": steel.text}))
 
 
-def test_damper_of_stored_runs_takes_the_face_of_the_specimen_file_given(tmp_path, monkeypatch,
-                                                                         capsys):
+def _store_of_runs(monkeypatch, *runs: pd.DataFrame) -> None:
+    """pidcore.store.Store replaced by one whose DEM-run listing is ``runs`` in that order
+    (runs of two specimens in one store, without computing them)."""
     import pidcore.store
-
-    path = _steel_with_face(tmp_path)
-    stated = load_specimen(path)
-    runs = _steel_runs(stated)
 
     class FakeStore:
         def __init__(self, _path):
             pass
 
         def list_dem_runs(self):
-            return runs
+            return pd.concat(list(runs), ignore_index=True)
 
     monkeypatch.setattr(pidcore.store, "Store", FakeStore, raising=False)
+
+
+def test_damper_of_stored_runs_takes_the_face_of_the_specimen_file_given(tmp_path, monkeypatch,
+                                                                         capsys):
+    path = _steel_with_face(tmp_path)
+    stated = load_specimen(path)
+    runs = _steel_runs(stated)
+
+    _store_of_runs(monkeypatch, runs)
     argv = ["model", "damper", "--out", str(tmp_path / "out"), "--table", "store", "--store",
             str(tmp_path / "s.h5"), "--format", "csv,json"]
     capsys.readouterr()
@@ -287,22 +293,13 @@ def test_damper_specimen_file_selects_its_runs_in_a_store_of_two_specimens(tmp_p
     beside the file's own was refused as "DEM runs are of 2 specimens ... select one, e.g.
     --where specimen_sha256=...", although --specimen had named the file: its runs are the
     SDC, the other file's are left out."""
-    import pidcore.store
-
     path = _steel_with_face(tmp_path)
     stated = load_specimen(path)
     edited = stated.with_values({"coupon.fixture_mass_kg": 0.5})
     mine, other = _steel_runs(stated), _steel_runs(edited)
     other = other.assign(sdc=other["sdc"] * 3)  # a different SDC: a mix-up would show
 
-    class FakeStore:
-        def __init__(self, _path):
-            pass
-
-        def list_dem_runs(self):
-            return pd.concat([other, mine], ignore_index=True)
-
-    monkeypatch.setattr(pidcore.store, "Store", FakeStore, raising=False)
+    _store_of_runs(monkeypatch, other, mine)
     argv = ["model", "damper", "--out", str(tmp_path / "out"), "--table", "store", "--store",
             str(tmp_path / "s.h5"), "--format", "csv"]
     with pytest.raises(ParameterError, match="DEM runs are of 2 specimens"):
@@ -322,21 +319,12 @@ def test_figures_specimen_file_selects_its_runs_in_a_store_of_two_specimens(tmp_
                                                                            monkeypatch, capsys):
     """`model figures` of a store holding two files' runs asked for --where specimen_sha256=
     and had no --specimen, as damper now has: it draws the file's runs."""
-    import pidcore.store
-
     path = _steel_with_face(tmp_path)
     stated = load_specimen(path)
     mine = _steel_runs(stated)
     other = _steel_runs(stated.with_values({"coupon.fixture_mass_kg": 0.5}))
 
-    class FakeStore:
-        def __init__(self, _path):
-            pass
-
-        def list_dem_runs(self):
-            return pd.concat([other, mine], ignore_index=True)
-
-    monkeypatch.setattr(pidcore.store, "Store", FakeStore, raising=False)
+    _store_of_runs(monkeypatch, other, mine)
     argv = ["model", "figures", "--out", str(tmp_path / "figs"), "--table", "store", "--store",
             str(tmp_path / "s.h5")]
     with pytest.raises(ParameterError, match="DEM runs are of 2 specimens"):
