@@ -81,10 +81,11 @@ def install() -> Callable[[], None]:
     """Route SIGINT, SIGTERM and SIGHUP through the flag (main thread only; a no-op elsewhere).
 
     Returns a function that puts back the previous handler and unraisable hook (for callers
-    such as tests that run the CLI in-process).
+    such as tests that run the CLI in-process), or with ``ignore_signals=True`` ignores the
+    signals from then on instead.
     """
     if threading.current_thread() is not threading.main_thread():
-        return lambda: None
+        return lambda *, ignore_signals=False: None  # noqa: ARG005 - restore's signature
     # a SIGTERM or SIGHUP ignored by whoever started the process stays ignored (as Python leaves a
     # SIGINT ignored at start-up alone)
     previous_handlers = {signum: signal.signal(signum, _handler) for signum in _SIGNALS
@@ -93,9 +94,13 @@ def install() -> Callable[[], None]:
     previous_hook = sys.unraisablehook
     sys.unraisablehook = _unraisable_hook
 
-    def restore() -> None:
-        for signum, previous in previous_handlers.items():
-            signal.signal(signum, previous)
+    def restore(*, ignore_signals: bool = False) -> None:
+        # ignore_signals: a command that is over (console_main) goes straight from this
+        # handler to SIG_IGN; putting Python's default back first left a moment in which a
+        # Ctrl-C escaped as a traceback
+        with deferred():
+            for signum, previous in previous_handlers.items():
+                signal.signal(signum, signal.SIG_IGN if ignore_signals else previous)
         sys.unraisablehook = previous_hook
 
     return restore

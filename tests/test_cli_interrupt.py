@@ -487,3 +487,79 @@ def test_a_real_sigint_early_in_the_installed_pidcore_script_exits_130_with_one_
                                                        err), err
     assert out == ""
     assert not store.exists()  # nothing written: no DEM case ends within 0.2 s
+
+
+def _deliver_sigint() -> None:
+    """Deliver SIGINT in-process to whatever handler is in place now, as the OS would."""
+    handler = signal.getsignal(signal.SIGINT)
+    if callable(handler):
+        handler(signal.SIGINT, None)
+
+
+def _console_status(argv: list[str]) -> int:
+    """console_main's status; an interrupt escaping it (a traceback for the user) fails the
+    test instead of ending the pytest session."""
+    from pidcore.cli import console_main
+
+    try:
+        return console_main(argv)
+    except KeyboardInterrupt:
+        pytest.fail("a Ctrl-C escaped console_main as a KeyboardInterrupt traceback")
+
+
+@pytest.fixture
+def _handlers_kept():
+    # an interrupt injected inside install() loses its restore(); put the test process's
+    # handlers and hook back whatever the CLI leaves
+    signums = [s for s in (signal.SIGINT, signal.SIGTERM, getattr(signal, "SIGHUP", None)) if s]
+    before = {s: signal.getsignal(s) for s in signums}
+    hook = sys.unraisablehook
+    yield
+    for s, handler in before.items():
+        signal.signal(s, handler)
+    sys.unraisablehook = hook
+    interrupt.reset()
+
+
+def test_a_ctrl_c_right_after_install_exits_130_with_one_line(tmp_path, capsys, monkeypatch,
+                                                              _handlers_kept):
+    # the gap between install() and _run's try: the old code let it escape as a traceback
+    real_install = interrupt.install
+
+    def install_then_sigint():
+        real_install()
+        _deliver_sigint()  # our handler is in place: records and raises
+        raise AssertionError("the handler installed by install() did not raise")
+
+    monkeypatch.setattr(interrupt, "install", install_then_sigint)
+    missing = tmp_path / "x.csv"
+    assert _console_status(["analyze", str(missing), "--no-store"]) == 130
+    err = capsys.readouterr().err
+    assert err.strip().splitlines() == ["pidcore analyze: interrupted; nothing was done"]
+    assert "Traceback" not in err
+    assert not missing.exists()
+
+
+def test_a_ctrl_c_right_after_restore_keeps_the_commands_status(tmp_path, capsys, monkeypatch,
+                                                                _handlers_kept):
+    # the gap between restore() and ignore() in console_main: the old code had Python's
+    # default handler there and the signal escaped as a KeyboardInterrupt traceback. The
+    # command is over by then (console_main's contract): its own status and one line stand.
+    real_install = interrupt.install
+
+    def install_with_sigint_after_restore():
+        real_restore = real_install()
+
+        def restore_then_sigint(**kwargs):
+            real_restore(**kwargs)
+            _deliver_sigint()
+
+        return restore_then_sigint
+
+    monkeypatch.setattr(interrupt, "install", install_with_sigint_after_restore)
+    missing = tmp_path / "x.csv"
+    assert _console_status(["analyze", str(missing), "--no-store"]) == 2  # the file is missing
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1 and "x.csv" in err
+    assert "Traceback" not in err and "interrupted" not in err
+    assert signal.getsignal(signal.SIGINT) is signal.SIG_IGN  # ignored from then on

@@ -90,21 +90,34 @@ def main(argv: list[str] | None = None) -> int:
     return _main(argv)[0]
 
 
-def _main(argv: list[str] | None) -> tuple[int, bool]:
+def _main(argv: list[str] | None, *, then_ignore: bool = False) -> tuple[int, bool]:
     """:func:`main`'s exit status, and whether the command was interrupted (which the flag,
-    cleared on the way out, no longer says)."""
+    cleared on the way out, no longer says). ``then_ignore``: leave SIGINT, SIGTERM and SIGHUP
+    ignored afterwards (:func:`console_main`) instead of putting the previous handlers back."""
     # First thing: Ctrl-C during the imports below (every sub-command) or inside Numba must
     # end as one line and exit 130, and an interrupt swallowed somewhere must still stop the
-    # store from committing (pidcore.interrupt).
-    restore = interrupt.install()
+    # store from committing (pidcore.interrupt). Install and restore lie inside the try: a
+    # Ctrl-C just after install, before _run's own try, escaped as a traceback.
+    restore = None
+    streams = None
     interrupt.reset()
-    streams = _displayable_streams()
     try:
+        restore = interrupt.install()
+        streams = _displayable_streams()
         rc = _run(argv)
         return rc, interrupt.interrupted()
+    except KeyboardInterrupt:  # before _run's try, or after it returned
+        words = sys.argv[1:] if argv is None else argv
+        command = next((w for w in words if not w.startswith("-")), "COMMAND")
+        return _interrupted(command, None), True
     finally:
-        streams()
-        restore()
+        with interrupt.deferred():  # a Ctrl-C here is recorded, not raised: the run is over
+            if streams is not None:
+                streams()
+            if restore is not None:
+                restore(ignore_signals=then_ignore)
+            elif then_ignore:
+                interrupt.ignore()
         interrupt.reset()  # an in-process caller (app, tests) may commit again afterwards
 
 
@@ -202,8 +215,9 @@ def console_main(argv: list[str] | None = None) -> int:
     lands while the interpreter shuts down would otherwise end the process by the signal
     (exit status -2) instead of the command's own status.
     """
-    rc, interrupted = _main(argv)
-    interrupt.ignore()
+    # _main ignores the signals itself, straight from its own handler: a separate ignore()
+    # here left a moment with Python's default handler (a Ctrl-C there was a traceback)
+    rc, interrupted = _main(argv, then_ignore=True)
     if interrupted:  # what the interrupted run left half-built is torn down at exit
         interrupt.silence_teardown()
     return rc
