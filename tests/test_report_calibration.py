@@ -891,3 +891,30 @@ def test_calibration_frame_names_the_prediction_and_band_as_the_report(calibrati
     # the bars end where the file's bands do (to rounding: errorbar adds pred - low back)
     assert np.allclose([[a[1], b[1]] for a, b in bars], [[0.05, 0.43], [0.12, 0.88], [0.02, 0.2]],
                        rtol=0, atol=1e-12)
+
+
+def test_cli_report_of_a_calibration_folder_a_kill_left_half_moved_reads_the_new_one(
+        tmp_path, capsys, monkeypatch):
+    # `calibrate --out cal` killed while moving its outputs in: cal/calibration.json is still
+    # the earlier one, the new one waits in the committed build folder. The report used to
+    # read the earlier numbers silently; it finishes the moves first and says so
+    monkeypatch.chdir(tmp_path)
+    out = tmp_path / "cal"
+    out.mkdir()
+    _write(out / "calibration.json", [_prediction(50, 5, 50, 0.11, 0.01, 0.21),
+                                      _prediction(500, 5, 50, 0.12, 0.02, 0.22)])
+    committed = tmp_path / f".cal.{'7c' * 8}.commit"
+    committed.mkdir()
+    _write(committed / "calibration.json", [_prediction(50, 5, 50, 0.24, 0.05, 0.43),
+                                            _prediction(500, 5, 50, 0.49, 0.12, 0.88)])
+    rc = main(["report", "--dem-store", str(ROOT / "data_samples" / "dem_table3.h5"),
+               "--calibration", str(out / "calibration.json"), "--format", "csv",
+               "--out", str(tmp_path / "report")])
+    captured = capsys.readouterr()
+    err = captured.out + captured.err
+    assert rc == 0, err
+    assert (f"{out}: a calibration killed while moving its outputs into it had left 1 of them "
+            "to move (calibration.json); moved now") in err
+    table = pd.read_csv(tmp_path / "report" / "report.csv")
+    # exact: the new file's numbers pass through unchanged (read, not computed)
+    assert sorted(table[CALIBRATED_COLUMN].dropna()) == [0.24, 0.49]

@@ -452,6 +452,28 @@ def finish_interrupted_outputs(out_dir: str | os.PathLike) -> str:
             "one")
 
 
+def finish_outputs_before_reading(out_dir: str | os.PathLike) -> str:
+    """For every reader of a ``calibrate --out`` folder: finish the moves a killed
+    calibration left (:func:`finish_interrupted_outputs`, as a database replays its journal
+    on open), so that a reader never gets a mix of two calibrations; returns its note.
+
+    Raises
+    ------
+    ParameterError
+        Where the moves cannot be finished (a read-only folder): naming the folder and
+        what to run.
+    """
+    from ..errors import ParameterError
+
+    try:
+        return finish_interrupted_outputs(out_dir)
+    except OSError as exc:
+        raise ParameterError(
+            f"{out_dir}: holds the half-moved outputs of a killed calibration (a mix of two "
+            f"calibrations) and they cannot be finished here ({exc.strerror}); make it "
+            f"writable and read it again, or run `pidcore calibrate --out {out_dir}`") from None
+
+
 def write_outputs(result: CalibrationResult, out_dir: str | os.PathLike) -> list[Path]:
     """Write every output into ``out_dir`` (created); returns the paths written.
 

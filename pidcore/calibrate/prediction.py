@@ -387,6 +387,8 @@ class Calibration:
     document_text: str = ""
     store_key: str = ""
     created_utc: str = ""
+    #: Said on reading it: the half-moved outputs of a killed calibration finished first.
+    read_note: str = ""
 
     def to_pandas(self) -> pd.DataFrame:
         """The predictions, one row per calibrated load case, each column naming its unit.
@@ -697,6 +699,10 @@ def load_calibration(path: str | os.PathLike, *, key: str | None = None) -> Cali
     if key is not None:
         raise ParameterError(f"{path}: a calibration key ({key}) chooses among the "
                              "calibrations of an HDF5 store; this is not one")
+    from .outputs import finish_outputs_before_reading
+
+    # before any file is read: a killed --out may have left a mix of two calibrations
+    read_note = finish_outputs_before_reading(path if path.is_dir() else path.parent)
     if path.is_dir() and (path / "calibration.json").is_file():
         path = path / "calibration.json"  # the folder `pidcore calibrate --out` wrote
     if path.is_dir():
@@ -711,7 +717,7 @@ def load_calibration(path: str | os.PathLike, *, key: str | None = None) -> Cali
     return Calibration(path=path, parameters=calibration.parameters,
                        predictions=calibration.predictions,
                        specimen_path=specimen if specimen.is_file() else None,
-                       specimen_name=calibration.specimen_name)
+                       specimen_name=calibration.specimen_name, read_note=read_note)
 
 
 def calibration_from_json(text: str | bytes, source: str | os.PathLike, *,

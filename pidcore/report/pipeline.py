@@ -831,7 +831,7 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         keep_unused_channels=main is not None,  # a store saves every channel of each file
     ) if files else []
     parameters = _parameters(results, options)
-    notes: list[str] = []
+    notes: list[str] = [calibrated.read_note] if calibrated and calibrated.read_note else []
     for r in results:
         said = r.settings.summary() if r.settings is not None else ""
         notes.append(f"{display_path(r.path.name)}: load case {r.load_case.key} ({r.stated.origin})"
