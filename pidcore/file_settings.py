@@ -127,16 +127,13 @@ def _number(value: object, column: str, spec: SettingsColumn, where: str) -> flo
 def _time_unit(value: object, column: str, spec: SettingsColumn, where: str) -> str:
     """A time unit cell as ``time_unit=`` takes it (its text), refused as
     :func:`pidcore.units.given_time_unit` refuses the keyword, naming the cell instead."""
-    from .errors import ParameterError
-    from .units import given_time_unit
+    from .units import why_not_a_time_unit
 
     text = str(value).strip()
-    try:
-        given_time_unit(text)
-    except ParameterError as exc:
-        why = str(exc).split(": not a unit of time", 1)[-1].split("; expected", 1)[0]
+    why = why_not_a_time_unit(text)
+    if why is not None:
         raise SettingsTableError(f"{where}, column {column}: {text!r} is not a unit of "
-                                 f"time{why}; expected {spec.expected}") from None
+                                 f"time{why}; expected {spec.expected}")
     return text
 
 

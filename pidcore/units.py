@@ -333,12 +333,22 @@ def given_time_unit(time_unit: str | None) -> UnitReading | None:
     if time_unit is None:
         return None
     instance_of("time_unit", time_unit, str, hint="e.g. 'ms'")
-    reading = read_unit(time_unit)
-    if reading.info is None or reading.info.quantity != "time":
-        why = f": {reading.problem}" if reading.problem else ""
+    why = why_not_a_time_unit(time_unit)
+    if why is not None:
         raise ParameterError(f"time_unit={time_unit!r}: not a unit of time{why}; expected "
                              "s, ms or us")
-    return reading
+    return read_unit(time_unit)
+
+
+def why_not_a_time_unit(text: str) -> str | None:
+    """None where ``text`` reads as a unit of time; else what to add to "not a unit of
+    time": ``": <what is wrong with it>"``, or ``""`` where there is no more to say. The one
+    reason of every refusal of a given time unit (the keyword, a settings cell, the app's
+    field), each naming its own source."""
+    reading = read_unit(text)
+    if reading.info is not None and reading.info.quantity == "time":
+        return None
+    return f": {reading.problem}" if reading.problem else ""
 
 
 def overrides_stated_time(stated: str, given: UnitReading) -> bool:

@@ -264,16 +264,15 @@ def page_time_unit(typed: str) -> str | None:
     """The time unit typed in the page's :data:`TIME_UNIT_FIELD` (blank: None, each file's
     own), refused naming the field where it is not a unit of time: read with it, every file
     would be refused naming the keyword, or an HDF5 file analysed with it unsaid."""
-    from ..units import given_time_unit
+    from ..units import why_not_a_time_unit
 
     typed = typed.strip()
     if not typed:
         return None
-    try:
-        given_time_unit(typed)
-    except ParameterError as exc:
-        reason = str(exc).split(": ", 1)[1]  # after the keyword: what the unit is not
-        raise ParameterError(f"{TIME_UNIT_FIELD}: {typed!r} is {reason}") from None
+    why = why_not_a_time_unit(typed)
+    if why is not None:
+        raise ParameterError(f"{TIME_UNIT_FIELD}: {typed!r} is not a unit of time{why}; "
+                             "expected s, ms or us")
     return typed
 
 

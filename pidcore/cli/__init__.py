@@ -107,9 +107,7 @@ def _main(argv: list[str] | None, *, then_ignore: bool = False) -> tuple[int, bo
         rc = _run(argv)
         return rc, interrupt.interrupted()
     except KeyboardInterrupt:  # before _run's try, or after it returned
-        words = sys.argv[1:] if argv is None else argv
-        command = next((w for w in words if not w.startswith("-")), "COMMAND")
-        return _interrupted(command, None), True
+        return _interrupted(_command_word(argv), None), True
     finally:
         with interrupt.deferred():  # a Ctrl-C here is recorded, not raised: the run is over
             if streams is not None:
@@ -121,9 +119,16 @@ def _main(argv: list[str] | None, *, then_ignore: bool = False) -> tuple[int, bo
         interrupt.reset()  # an in-process caller (app, tests) may commit again afterwards
 
 
+def _command_word(argv: list[str] | None) -> str:
+    """The sub-command a command line names (its first word that is no option), for its
+    messages; ``COMMAND`` where it names none."""
+    words = sys.argv[1:] if argv is None else argv
+    return next((w for w in words if not w.startswith("-")), "COMMAND")
+
+
 def _run(argv: list[str] | None) -> int:
     words = sys.argv[1:] if argv is None else argv
-    command = next((w for w in words if not w.startswith("-")), "COMMAND")
+    command = _command_word(words)
     started = False
     args: argparse.Namespace | None = None
     try:

@@ -82,6 +82,10 @@ def _split_header(cell: str) -> tuple[str, str]:
 #: split into its quantity and unit.
 _QUANTITY_UNIT_SEPARATOR = re.compile(r"\s*/\s*|\s+in\s+|\s+-\s+", re.IGNORECASE)
 #: The header spellings of a unit read, as the refusals of a header not read list them.
+#: Where a header named like a time splits into its name and unit, to say why its unit was
+#: not read: the DIN-style separators or an opening bracket (``Time [msek]``).
+_TIME_HEADER_SPLIT = re.compile(r"\s*[\[(]\s*|" + _QUANTITY_UNIT_SEPARATOR.pattern,
+                                re.IGNORECASE)
 ACCEPTED_HEADER_SPELLINGS = ("'Time [s]', 'Time (s)', 'Time/s', 'Time in s', 'Time - s' or "
                              "'Time' over a unit row 's'")
 
@@ -541,8 +545,7 @@ def _unread_time_header(header_cells: list[str]) -> tuple[int, str] | None:
     column" of a file with one did not say which cell was meant nor why it was not taken."""
     for i, cell in enumerate(header_cells):
         text = cell.strip().strip('"').strip()
-        parts = re.split(r"\s*[/\[(]\s*|\s+in\s+|\s+-\s+", text, maxsplit=1,
-                         flags=re.IGNORECASE)
+        parts = _TIME_HEADER_SPLIT.split(text, maxsplit=1)
         if len(parts) == 2 and parts[0].lower() in _TIME_NAMES - {"x"}:
             unit = parts[1].rstrip("])").strip()
             why = read_unit(unit).problem or f"{unit!r} is no unit of time such as s, ms"
@@ -557,7 +560,8 @@ def _states_other_quantity(cell: tuple[str, str]) -> str | None:
     by_unit = interpret_unit(unit)[0] if unit else "unknown"
     if by_unit not in ("unknown", "time"):
         return by_unit
-    return _named_quantity(name) if _named_quantity(name) != "time" else None
+    by_name = _named_quantity(name)
+    return by_name if by_name != "time" else None
 
 
 def _time_column(cells: list[tuple[str, str]], header_cells: list[str],
