@@ -175,19 +175,17 @@ def _runs_of_specimen_file(runs, path, store):
     """The runs of the ``--specimen`` file (its sha256): a store holding runs of two files (an
     edited one, the paper's coupon) was refused as "of 2 specimens", asking for a --where of
     the hash that --specimen already gave."""
-    from ..compare.specimens import run_specimen_labels
+    from ..compare.specimens import runs_per_specimen_text
     from ..dem.persist import runs_of_specimen
     from ..specimen import hashed_name, load_specimen
 
     given = load_specimen(path)
     mine = runs_of_specimen(runs, given)
     if mine.empty:
-        held = run_specimen_labels(runs).value_counts(sort=False)
         raise ParameterError(
             f"--specimen {path}: {store} holds no DEM runs of "
-            f"{hashed_name(given.name, given.hash)} (it holds "
-            + ", ".join(f"{n} of {label}" for label, n in held.items())
-            + f"); run them with pidcore dem sweep --specimen {path} --store {store}")
+            f"{hashed_name(given.name, given.hash)} (it holds {runs_per_specimen_text(runs)}); "
+            f"run them with pidcore dem sweep --specimen {path} --store {store}")
     return mine
 
 

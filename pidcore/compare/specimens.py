@@ -90,6 +90,13 @@ def run_specimen_labels(runs: pd.DataFrame) -> pd.Series:
         index=runs.index, dtype=object)
 
 
+def runs_per_specimen_text(runs: pd.DataFrame) -> str:
+    """How many of ``runs`` are of each specimen, by :func:`run_specimen_labels`, in the
+    order first met: ``"3 of a [1b8b5d], 1 of paper_coupon"``."""
+    counts = run_specimen_labels(runs).value_counts(sort=False)
+    return ", ".join(f"{n} of {label}" for label, n in counts.items())
+
+
 def _names(runs: pd.DataFrame, labels: pd.Series) -> pd.Series:
     """The specimen name of each run (the paper's coupon for every paper run)."""
     from ..specimen import PAPER_SPECIMEN_NAME

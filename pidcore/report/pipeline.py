@@ -350,14 +350,12 @@ def _other_specimens(stored: pd.DataFrame, kept: pd.DataFrame) -> str:
     ``stored`` not in ``kept``; "" if none. Labelled as Compare labels them
     (:func:`~pidcore.compare.specimens.run_specimen_labels`): the hash is named too, as an
     edited specimen file keeps its name but is another specimen."""
-    from ..compare.specimens import run_specimen_labels
+    from ..compare.specimens import runs_per_specimen_text
 
     left_out = stored[~stored["case_key"].isin(set(kept["case_key"]))]
     if left_out.empty:
         return ""
-    counts = run_specimen_labels(left_out).value_counts(sort=False)
-    return (f"{len(left_out)} run(s) of other specimens: "
-            + ", ".join(f"{n} of {label}" for label, n in counts.items()))
+    return f"{len(left_out)} run(s) of other specimens: {runs_per_specimen_text(left_out)}"
 
 
 #: How ``pidcore report`` says another specimen is chosen (the app says its own way).
