@@ -117,7 +117,6 @@ def make_samples(out_dir: str | os.PathLike = "data_samples", *, run_sweep: bool
     from .dem.simulate import DemConfig
     from .dem.sweep import grid_cases, run_key
     from .dem.sweep import run_sweep as sweep
-    from .io import write_measurement
     from .store import Store
 
     out = Path(out_dir)
@@ -160,8 +159,7 @@ def make_samples(out_dir: str | os.PathLike = "data_samples", *, run_sweep: bool
             frequency_hz=case.frequency_hz, acceleration_m_s2=case.acceleration_m_s2,
             source=sample.file_name, seed=1000 + i)
         path = out / "exports" / sample.file_name
-        fmt = "uff" if sample.file_format.startswith("uff") else sample.file_format
-        write_measurement(m, path, fmt, binary=sample.file_format == "uff58b")
+        _write_export(m, path, sample.file_format)
         written[sample.file_name] = path
     sidecar = out / "loadcases.csv"
     # the exports' vibrometer delay too: `--sidecar loadcases.csv` (CLI) and the app's settings
@@ -171,6 +169,15 @@ def make_samples(out_dir: str | os.PathLike = "data_samples", *, run_sweep: bool
                                f"{EXPORT_VELOCITY_DELAY_S * 1e6:g}\n" for s in SAMPLE_CASES))
     written["loadcases"] = sidecar
     return written
+
+
+def _write_export(measurement, path: Path, file_format: str) -> None:
+    """``measurement`` written to ``path`` in an export format of the samples (``uff58b``:
+    binary UFF 58b; ``uff``: ASCII)."""
+    from .io import write_measurement
+
+    write_measurement(measurement, path, "uff" if file_format.startswith("uff") else file_format,
+                      binary=file_format == "uff58b")
 
 
 #: File extension of each export format :func:`own_specimen_exports` writes.
@@ -197,7 +204,6 @@ def own_specimen_exports(
     (they overwrote one another). Returns the export paths in ``cases`` order.
     """
     from .dem.simulate import LoadCase, simulate_load_case
-    from .io import write_measurement
 
     out = Path(out_dir)
     formats = set(OWN_EXPORT_EXTENSIONS)
@@ -229,8 +235,7 @@ def own_specimen_exports(
             acceleration_m_s2=case.acceleration_m_s2, source=name, snr_db=snr_db,
             velocity_delay_s=velocity_delay_s, seed=first_noise_seed + i)
         path = out / name
-        write_measurement(measurement, path, "uff" if fmt.startswith("uff") else fmt,
-                          binary=fmt == "uff58b")
+        _write_export(measurement, path, fmt)
         paths.append(path)
         rows.writerow([name, f"{fill:g}", material, case.direction,
                        f"{velocity_delay_s * 1e6:g}", specimen.name])
