@@ -62,5 +62,11 @@ def test_reading_a_killed_out_folder_that_cannot_be_written_refuses_in_one_line(
     message = str(caught.value)
     assert "\n" not in message
     assert message.startswith(f"{out}: holds the half-moved outputs of a killed calibration")
-    assert f"pidcore calibrate --out {out}" in message
+    # the library names the call that writes the folder; the CLI says it as its command
+    assert message.endswith("or write the calibration into it again "
+                            "(write_outputs(result, out_dir))")
+    from pidcore.cli._vocabulary import cli_words
+
+    assert cli_words(message, "report", names=[str(out)]).endswith(
+        "or write the calibration into it again (pidcore calibrate --out)")
     assert (out / "calibration.json").exists() and committed.exists()  # nothing changed

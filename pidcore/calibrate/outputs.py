@@ -471,7 +471,8 @@ def finish_outputs_before_reading(out_dir: str | os.PathLike) -> str:
         raise ParameterError(
             f"{out_dir}: holds the half-moved outputs of a killed calibration (a mix of two "
             f"calibrations) and they cannot be finished here ({exc.strerror}); make it "
-            f"writable and read it again, or run `pidcore calibrate --out {out_dir}`") from None
+            "writable and read it again, or write the calibration into it again "
+            "(write_outputs(result, out_dir))") from None
 
 
 def write_outputs(result: CalibrationResult, out_dir: str | os.PathLike) -> list[Path]:
