@@ -21,9 +21,12 @@ import os
 import signal
 import sys
 import threading
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
+
+#: Seconds a terminated process (a DEM worker or job) gets to end before it is killed.
+TERMINATE_GRACE_S = 1.0
 
 _interrupted = threading.Event()
 #: The signal that interrupted (SIGINT where the flag was set by other means).
@@ -255,3 +258,25 @@ def untouched(path: str | os.PathLike) -> str:
     created"`` where it never existed (a first run into a new store or folder was told it was
     'unchanged'). One wording for every command and the calibration runner."""
     return f"{path} unchanged" if Path(path).exists() else f"{path} not created"
+
+
+def stop_processes(processes: Iterable, grace_s: float = TERMINATE_GRACE_S) -> None:
+    """Terminate ``processes`` (:class:`multiprocessing.Process` objects), kill those still
+    alive after ``grace_s`` in all, and wait until every one is gone.
+
+    The kill is what bounds the wait: a process that inherited SIGTERM ignored (a fork server
+    started while its parent ignored it, as ``console_main`` does once its command is over)
+    went on with its DEM case, and a caller joining it waited for the case to end: minutes.
+    """
+    import time
+
+    processes = list(processes)
+    for process in processes:
+        if process.is_alive():
+            process.terminate()
+    deadline = time.monotonic() + grace_s
+    for process in processes:
+        process.join(max(0.0, deadline - time.monotonic()))
+        if process.is_alive():
+            process.kill()
+            process.join()

@@ -32,6 +32,6 @@ def read_peak_memory(path: Path) -> tuple[int, str]:
     said: ``"samples N"`` of its first channel, or ``"refused <message>"``)."""
     env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[1])}
     out = subprocess.run([sys.executable, "-c", _SCRIPT, str(path)], capture_output=True,
-                         text=True, env=env, check=True).stdout
+                         text=True, env=env, check=True, timeout=300).stdout
     grown, said = out.strip().split(" ", 1)
     return int(grown), said

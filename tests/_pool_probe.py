@@ -58,3 +58,10 @@ def slow_calibration_run(folder: str, request) -> tuple[str, dict]:
               "fill_percent": case.fill_percent, "material": case.material,
               "direction": case.direction, "sdc": 0.3, "sdc_stderr": 0.01}
     return request.key(), {"record": record, "arrays": {}, "parameters": {}, "units": {}}
+
+
+def wait_ignoring_sigterm(folder: str, seconds: float) -> int:
+    """:func:`wait_in_worker` in a worker that ignores SIGTERM, as every worker does whose
+    fork server was started while its parent ignored it."""
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)
+    return wait_in_worker(folder, seconds)

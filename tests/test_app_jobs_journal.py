@@ -42,7 +42,10 @@ cases = jobs.plan_dem_cases([50.0, 60.0], [5.0], [50.0], material=specimen.parti
                             direction="z")
 runner = jobs.DemJobRunner(sys.argv[1])
 runner.submit(cases, DemConfig(cells=1, steady_cycles=5000), specimen)
+deadline = time.monotonic() + 120
 while not any(j.state == "running" for j in runner.jobs()):
+    if time.monotonic() > deadline:  # ends, so that the test's readline ends too
+        sys.exit(f"no job running after 120 s: {[j.row() for j in runner.jobs()]}")
     time.sleep(0.05)
 print(" ".join(j.job_id for j in runner.jobs()), flush=True)
 time.sleep(600)

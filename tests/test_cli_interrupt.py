@@ -41,7 +41,7 @@ def test_sigint_at_any_time_exits_130_with_one_line_and_commits_nothing(tmp_path
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
     cmd = [sys.executable, "-m", "pidcore", "analyze"]
     subprocess.run([*cmd, str(small), "--store", str(store)], env=env, check=True,
-                   capture_output=True)
+                   capture_output=True, timeout=120)
     before = file_sha256(store)
     interrupted = 0
     # Delays from the interpreter start-up (the handler is installed first thing in main)

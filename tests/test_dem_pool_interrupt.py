@@ -8,6 +8,7 @@ import signal
 import subprocess
 import sys
 import textwrap
+import threading
 import time
 from pathlib import Path
 
@@ -90,3 +91,41 @@ def test_ctrl_c_to_the_whole_group_prints_only_the_callers_line(tmp_path):
     assert p.returncode == 130 and err == "interrupted\n", err
     pids = [int(f.name) for f in tmp_path.iterdir()]
     assert len(pids) == 2 and not any(_alive(pid) for pid in pids)
+
+
+@pytest.mark.slow
+def test_a_stopped_pool_kills_workers_that_ignore_sigterm_instead_of_waiting_their_case_out(
+        tmp_path):
+    # A fork server started while its parent ignored SIGTERM (console_main ignores it once
+    # its command is over; a test process calls it) hands that on to every worker: the stop
+    # terminated them, and the pool's shutdown then waited for their running case, here 60 s,
+    # a DEM case minutes. Now a worker still alive after the grace is killed.
+    from _pool_probe import wait_ignoring_sigterm
+
+    from pidcore.dem.sweep import run_pooled
+    from pidcore.interrupt import TERMINATE_GRACE_S, StopRequested
+
+    stop, raised = threading.Event(), []
+
+    def pooled() -> None:
+        try:
+            run_pooled(wait_ignoring_sigterm, [(str(tmp_path), 60.0)] * 2, workers=2,
+                       finish=lambda result: None, stop=stop)
+        except StopRequested as exc:
+            raised.append(exc)
+
+    thread = threading.Thread(target=pooled, daemon=True)
+    thread.start()
+    deadline = time.monotonic() + 90  # cold fork server and worker starts on a loaded machine
+    while len(list(tmp_path.iterdir())) < 2 and time.monotonic() < deadline:
+        time.sleep(0.02)
+    pids = [int(f.name) for f in tmp_path.iterdir()]
+    assert len(pids) == 2
+    sent = time.monotonic()
+    stop.set()
+    thread.join(45)
+    # the stop is seen within STOP_POLL_S, the kill follows the grace: ~1.1 s idle; 30 s is
+    # room for a loaded machine and half the 60 s the old code waited
+    assert not thread.is_alive() and time.monotonic() - sent < 30 + TERMINATE_GRACE_S
+    assert len(raised) == 1
+    assert not any(_alive(pid) for pid in pids)

@@ -643,7 +643,7 @@ def test_output_piped_into_head_ends_quietly(tmp_path):
     env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[1])}
     proc = subprocess.run(
         f"{sys.executable} -m pidcore analyze --no-store {' '.join(paths)} | head -n 1",
-        shell=True, capture_output=True, text=True, env=env)
+        shell=True, capture_output=True, text=True, env=env, timeout=120)
     assert proc.stdout.startswith("source")
     assert "Traceback" not in proc.stderr and "BrokenPipe" not in proc.stderr
 

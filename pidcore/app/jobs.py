@@ -47,6 +47,7 @@ from .. import defaults
 from ..atomic_files import write_atomically
 from ..compare.align import PACKING_RATIO_COLUMN
 from ..errors import ParameterError, PidcoreError, StoreError, clipped
+from ..interrupt import TERMINATE_GRACE_S, stop_processes
 from .vocabulary import page_terms
 
 if TYPE_CHECKING:  # pragma: no cover - for the hints; the functions import them where used
@@ -86,8 +87,6 @@ _LIVE_RUNNERS: set[str] = set()
 JOURNAL_LOCK_WAIT_S = 10.0
 #: Seconds between checks of the running case (progress, cancel).
 _POLL_S = 0.05
-#: Seconds a terminated process gets before it is killed.
-_TERMINATE_GRACE_S = 1.0
 #: Least wall seconds between two reports of the settle's progress by a worker (a report per
 #: kernel call would be thousands a second).
 _SETTLE_REPORT_S = 0.5
@@ -702,18 +701,14 @@ class DemJobRunner:
                 with self._lock:
                     cancelled = job.job_id in self._cancel
                 if cancelled:
-                    proc.terminate()
-                    proc.join(_TERMINATE_GRACE_S)
-                    if proc.is_alive():
-                        proc.kill()
-                        proc.join()
+                    stop_processes([proc])
                     self._finish(job, "cancelled", "cancelled while running; nothing saved")
                     return
                 if parent.poll(_POLL_S):
                     try:
                         message = parent.recv()
                     except EOFError:
-                        proc.join(_TERMINATE_GRACE_S)
+                        proc.join(TERMINATE_GRACE_S)
                         self._finish(job, "failed",
                                      f"the DEM process ended (exit code {proc.exitcode})")
                         return
@@ -733,7 +728,7 @@ class DemJobRunner:
         finally:
             parent.close()
             if proc.is_alive():
-                proc.join(_TERMINATE_GRACE_S)
+                proc.join(TERMINATE_GRACE_S)
                 if proc.is_alive():
                     proc.kill()
         with self._lock:

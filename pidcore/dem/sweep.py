@@ -22,7 +22,7 @@ from pathlib import Path
 
 from ..constants import DriveDirection, ParticleMaterial
 from ..errors import ParameterError, SimulationError, instance_of, whole_number
-from ..interrupt import raise_if_stopped
+from ..interrupt import raise_if_stopped, stop_processes
 from ..records import json_safe
 from ..specimen import Specimen, fill_override_note, is_paper_coupon
 from .persist import (
@@ -325,12 +325,9 @@ def _stop_pool(pool) -> None:
     # The executor has no public way to stop running work before Python 3.14
     # (terminate_workers); its process table is read before shutdown() clears it.
     processes = list((getattr(pool, "_processes", None) or {}).values())
-    for process in processes:
-        if process.is_alive():
-            process.terminate()
+    # stopped before the shutdown: it waits for the calls its workers are running
+    stop_processes(processes)
     pool.shutdown(wait=True, cancel_futures=True)
-    for process in processes:
-        process.join()
 
 
 #: Status of a case another process (a second sweep on the same store) stored while this
