@@ -187,6 +187,11 @@ def browser_page(_shared_page):
 
 def _open(page, url: str) -> None:
     page.goto(url)
+    # the page's first script run over (Streamlit marks its root element): a file set on the
+    # uploader while that run still drew the page was once lost, and the test waited 90 s
+    # for an analysis that never ran
+    page.locator('[data-testid="stApp"][data-test-script-state="notRunning"]').wait_for(
+        state="attached", timeout=RESULT_TIMEOUT_MS)
     page.locator("input[type=file]").first.wait_for(state="attached", timeout=RESULT_TIMEOUT_MS)
 
 
