@@ -138,9 +138,9 @@ def _run(argv: list[str] | None) -> int:
         if unknown:  # reported by the top parser, which would not name the sub-command
             parser.exit(2, f"pidcore {command}: error: unrecognized arguments: "
                            f"{' '.join(unknown)} (see pidcore {command} --help)\n")
-        started = True
-        from ..specimen import hearing_read_notes
+        from ..specimen import hearing_read_notes  # before the start: nothing done yet
 
+        started = True
         # what reading a --specimen file did first (a killed calibration's moves into its
         # folder finished) said here, for every command that takes one, as their notes are
         with hearing_read_notes(lambda note: _say_note(note, command, words)):
