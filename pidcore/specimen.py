@@ -125,6 +125,7 @@ bundled_face_area
 from __future__ import annotations
 
 import codecs
+import contextvars
 import dataclasses
 import functools
 import hashlib
@@ -133,7 +134,8 @@ import os
 import re
 import sys
 import tomllib
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
@@ -608,6 +610,10 @@ class Specimen:
     description: str = ""
     provenance: ProvenanceSpec | None = None
     source: str = dataclasses.field(default="<specimen>", compare=False)
+    #: What reading the file did first, to be said to the user ("" where nothing): the note
+    #: of a killed calibration's moves finished in the folder of a calibrated specimen file
+    #: (:func:`load_specimen`). Not part of the specimen's identity.
+    read_note: str = dataclasses.field(default="", compare=False, repr=False)
 
     def __post_init__(self):
         if not isinstance(self.name, str) or not self.name:
@@ -1338,9 +1344,92 @@ def _dump_toml(data: Mapping[str, Any]) -> str:
 
 # --- loading --------------------------------------------------------------------------------
 
+#: The calibrated specimen's file in a folder ``pidcore calibrate --out`` wrote
+#: (:data:`pidcore.calibrate.outputs.SPECIMEN_FILE`); :func:`load_specimen` finishes a killed
+#: calibration's moves into its folder before reading it.
+CALIBRATED_SPECIMEN_FILE = "calibrated_specimen.toml"
+
+#: Who hears the notes of :func:`load_specimen` as it reads (:func:`hearing_read_notes`): a
+#: context variable, so that one app session's or thread's hearer hears only its own reads.
+_READ_NOTE_HEARERS: contextvars.ContextVar[tuple[Callable[[str], None], ...]] = \
+    contextvars.ContextVar("pidcore_specimen_read_note_hearers", default=())
+
+
+@contextmanager
+def hearing_read_notes(hear: Callable[[str], None]) -> Iterator[None]:
+    """Within the block, ``hear(note)`` is called with each :attr:`Specimen.read_note`
+    :func:`load_specimen` makes (a killed calibration's moves finished): the one place a
+    front-end says it (the CLI on stderr, for every command that takes ``--specimen``), rather
+    than each command that loads a file."""
+    token = _READ_NOTE_HEARERS.set((*_READ_NOTE_HEARERS.get(), hear))
+    try:
+        yield
+    finally:
+        _READ_NOTE_HEARERS.reset(token)
+
+
+def _calibration_folder(path: Path) -> Path | None:
+    """The folder of ``path`` where it is a calibrated specimen file (by its name,
+    :data:`CALIBRATED_SPECIMEN_FILE`) and a killed calibration left moves into that folder
+    (:func:`pidcore.atomic_files.committed_folder_name_pattern`); None otherwise. Cheap: one
+    listing of the folder above, no import of the calibration package."""
+    if path.name != CALIBRATED_SPECIMEN_FILE:
+        return None
+    folder = path.parent
+    if folder.name in ("", ".", ".."):  # "calibrated_specimen.toml", "../x": a named folder
+        folder = Path(os.path.abspath(folder))
+    from .atomic_files import committed_folder_name_pattern
+
+    pattern = committed_folder_name_pattern(folder)
+    try:
+        with os.scandir(folder.parent) as entries:
+            left = any(pattern.fullmatch(entry.name) for entry in entries)
+    except OSError:  # a folder above that cannot be listed: no journal can be read there
+        return None
+    return folder if left else None
+
+
+def _finish_calibration_moves(path: Path) -> str:
+    """Before a calibrated specimen file is read: finish the moves a calibration killed while
+    writing its folder left (:func:`pidcore.calibrate.outputs.finish_outputs_before_reading`),
+    so that the file read is of the same calibration as the calibration.json beside it, not
+    the earlier one; returns its note ("" where nothing was left).
+
+    Raises
+    ------
+    ParameterError
+        Where the moves cannot be finished (a read-only folder): one line naming the folder;
+        nothing is changed.
+    """
+    folder = _calibration_folder(path)
+    if folder is None:
+        return ""
+    from .calibrate.outputs import finish_outputs_before_reading
+
+    return finish_outputs_before_reading(folder)
+
+
 def load_specimen(path: str | os.PathLike[str]) -> Specimen:
-    """Read and check a specimen file; a bad file is one ParameterError line naming it."""
+    """Read and check a specimen file; a bad file is one ParameterError line naming it.
+
+    A calibrated specimen file (``calibrated_specimen.toml`` of ``pidcore calibrate --out``)
+    whose calibration was killed while its outputs were moved into the folder is read after
+    those moves are finished, as the calibration's readers do: the file is then the same
+    calibration's as calibration.json beside it, never the earlier one. The note saying so is
+    the specimen's :attr:`Specimen.read_note`, and is told to :func:`hearing_read_notes`; a
+    folder where they cannot be finished (read-only) is refused (ParameterError).
+    """
     path = Path(path)
+    note = _finish_calibration_moves(path)
+    specimen = _read_specimen_file(path)
+    if not note:
+        return specimen
+    for hear in _READ_NOTE_HEARERS.get():
+        hear(note)
+    return dataclasses.replace(specimen, read_note=note)
+
+
+def _read_specimen_file(path: Path) -> Specimen:
     try:
         with path.open("rb") as file:
             # one byte past the limit tells a file at the limit from a larger one, and a
@@ -1922,7 +2011,7 @@ __all__ = ["CellSpec", "CouponSpec", "PairSpec", "PairsSpec", "ParticleSpec", "S
            "heavy_fixture_note",
            "is_paper_coupon",
            "tested_label",
-           "load_specimen",
+           "load_specimen", "hearing_read_notes", "CALIBRATED_SPECIMEN_FILE",
            "MEASURED_SHA256_FIELD", "deciding_sha256", "measured_specimen_name",
            "measured_specimen_sha256", "models_paper_coupon", "NamedSpecimen",
            "resolve_specimen_name", "numeric_fields", "same_tested_file", "bundled_face_area",

@@ -1106,6 +1106,28 @@ def test_compare_says_when_the_calibration_does_not_predict_the_case(store_file,
                for c in at.caption)
 
 
+def test_the_page_says_that_reading_the_calibration_finished_a_killed_ones_moves(
+        store_file, tmp_path, monkeypatch):
+    # $PIDCORE_CALIBRATION a folder a killed `pidcore calibrate --out` left half-moved: the
+    # read finished the moves (the new calibration whole) and the page said nothing of it
+    from pidcore.app.calibration import CALIBRATION_ENV_VAR
+
+    out = tmp_path / "cal"
+    out.mkdir()
+    _calibration_json(out / "calibration.json", 500, 5, 50, 0.3, 0.1, 0.6)
+    committed = tmp_path / f".cal.{'7c' * 8}.commit"
+    committed.mkdir()
+    _calibration_json(committed / "calibration.json", 100, 5, 50, 0.3, 0.1, 0.6)
+    monkeypatch.setenv(CALIBRATION_ENV_VAR, str(out))
+    at = _app()
+    said = f"{out}: a calibration killed while moving its outputs into it had left 1 of them"
+    assert [i.value for i in at.info if i.value.startswith(said)], [i.value for i in at.info]
+    assert not committed.exists()
+    at.run()  # the next rerun's read has nothing to say; the session still shows it, once
+    assert not at.exception
+    assert len([i.value for i in at.info if i.value.startswith(said)]) == 1
+
+
 def test_a_calibration_of_another_specimen_does_not_hide_the_papers_band(store_file, tmp_path,
                                                                          monkeypatch):
     # a steel calibration on the Calibrate page took over Compare and Report for every case:

@@ -711,3 +711,24 @@ def available_calibrations(task: CalibrationTask | None,
     return [(None, "no calibration: run one on the Calibrate page (or set "
                    f"{CALIBRATION_ENV_VAR})")]
 
+
+
+def calibration_read_notes(calibrations: Sequence[tuple[object | None, str]]) -> list[str]:
+    """What reading the offered calibrations (:func:`available_calibrations`) did first, to
+    be shown: the note of each whose folder a killed ``pidcore calibrate --out`` had left
+    half-moved, the moves then finished (:attr:`pidcore.calibrate.Calibration.read_note`);
+    the CLI says it on stderr, the page said nothing. Empty where nothing was done."""
+    return [note for calibration, _ in calibrations if calibration is not None
+            for note in [getattr(calibration, "read_note", "")] if note]
+
+
+def remember_read_notes(kept: list[str], notes: Sequence[str]) -> list[str]:
+    """Add each of ``notes`` not yet in ``kept`` (the session's, kept across reruns: the moves
+    are finished once, by the read of one rerun, and the next reads have nothing to say) to
+    it; returns ``kept``, the notes to show, oldest first. Fed by
+    :func:`calibration_read_notes` and by the specimen files the pages load
+    (:func:`pidcore.specimen.hearing_read_notes`)."""
+    for note in notes:
+        if note and note not in kept:
+            kept.append(note)
+    return kept

@@ -11,9 +11,15 @@ import streamlit as st
 
 from pidcore import __version__, defaults
 from pidcore.app import state
-from pidcore.app.calibration import available_calibrations, runner_for
+from pidcore.app.calibration import (
+    available_calibrations,
+    calibration_read_notes,
+    remember_read_notes,
+    runner_for,
+)
 from pidcore.app.stores import AppStores
 from pidcore.app.tabs import analyse, calibrate, compare, dem, report
+from pidcore.specimen import hearing_read_notes
 
 
 def main() -> None:
@@ -32,15 +38,25 @@ def main() -> None:
     stored = state.store_calibrations(stores.stamp(), stores)
     calibrations = available_calibrations(runner_for(stores.path).task, store_path=stores.path,
                                           stored=stored)
+    # what reading a calibration folder or a calibrated specimen file did first (a killed
+    # calibration's moves finished), kept for the session: only the read that finished them
+    # has it to say; shown above the tabs once they are drawn (their reads are heard too)
+    read_notes = remember_read_notes(st.session_state.setdefault("_read_notes", []),
+                                     calibration_read_notes(calibrations))
+    notes_box = st.container()
     t_analyse, t_compare, t_dem, t_cal, t_report = st.tabs(
         ["Analyse", "Compare", "DEM", "Calibrate", "Report"])
-    with t_analyse:
-        analysed = analyse.render(stores)
-    with t_compare:
-        compare.render(stores, analysed, calibrations)
-    with t_dem:
-        dem.render(stores)
-    with t_cal:
-        calibrate.render(stores, stored)
-    with t_report:
-        report.render(stores, calibrations)
+    with hearing_read_notes(lambda note: remember_read_notes(read_notes, [note])):
+        with t_analyse:
+            analysed = analyse.render(stores)
+        with t_compare:
+            compare.render(stores, analysed, calibrations)
+        with t_dem:
+            dem.render(stores)
+        with t_cal:
+            calibrate.render(stores, stored)
+        with t_report:
+            report.render(stores, calibrations)
+    with notes_box:
+        for note in read_notes:
+            st.info(note)

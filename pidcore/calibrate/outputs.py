@@ -18,11 +18,14 @@ from ..atomic_files import (
     new_temporary_folder_for,
 )
 from ..records import json_safe
+from ..specimen import CALIBRATED_SPECIMEN_FILE
 from ..units import display_number
 from .calibrate import CalibrationResult
 from .posterior import summary_texts
 
-SPECIMEN_FILE = "calibrated_specimen.toml"
+#: The calibrated specimen's file among the outputs (one name with the specimen loader's, which
+#: finishes a killed calibration's moves before reading it).
+SPECIMEN_FILE = CALIBRATED_SPECIMEN_FILE
 
 
 def document_json(document: dict) -> str:

@@ -138,8 +138,13 @@ def _run(argv: list[str] | None) -> int:
         if unknown:  # reported by the top parser, which would not name the sub-command
             parser.exit(2, f"pidcore {command}: error: unrecognized arguments: "
                            f"{' '.join(unknown)} (see pidcore {command} --help)\n")
+        from ..specimen import hearing_read_notes  # before the start: nothing done yet
+
         started = True
-        rc = int(args.func(args) or 0)
+        # what reading a --specimen file did first (a killed calibration's moves into its
+        # folder finished) said here, for every command that takes one, as their notes are
+        with hearing_read_notes(lambda note: _say_note(note, command, words)):
+            rc = int(args.func(args) or 0)
         if rc != interrupt.exit_status() and interrupt.interrupted():
             raise KeyboardInterrupt  # swallowed on the way: still the interruption
         return rc
@@ -172,6 +177,16 @@ def _interrupted(command: str, args: argparse.Namespace | None) -> int:
     print(f"pidcore {command}: interrupted; {said}", file=sys.stderr)
     interrupt.mark_handled()
     return interrupt.exit_status()
+
+
+def _say_note(note: str, command: str, words: list[str]) -> None:
+    """Say a library's note on stderr as ``pidcore COMMAND: note: ...``, in the command's
+    words (stderr: a command's --json prints one document on stdout)."""
+    from ._vocabulary import cli_words
+
+    given = [w.split("=", 1)[1] if w.startswith("--") and "=" in w else w for w in words]
+    said = cli_words(note, command, names=[w for w in given if not w.startswith("-")])
+    print(f"pidcore {command}: note: {said}", file=sys.stderr)
 
 
 def _in_flags(exc: PidcoreError, command: str, words: list[str]) -> str:

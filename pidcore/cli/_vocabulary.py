@@ -53,12 +53,19 @@ FLAG_OF_KEYWORD: dict[str, str] = {
     "sidecar=": "--sidecar ",
 }
 
+#: The call that writes a calibration folder, as the command that does: named by the refusal
+#: of a half-moved folder (:func:`pidcore.calibrate.outputs.finish_outputs_before_reading`),
+#: which every command that reads a calibration or a calibrated specimen file (``--specimen
+#: DIR/calibrated_specimen.toml``: :func:`pidcore.specimen.load_specimen`) may say.
+CALIBRATION_WRITER: dict[str, str] = {
+    "write_outputs(result, out_dir)": "pidcore calibrate --out"}
+
 #: Each sub-command's keywords and flags (a command not named here has no parameter a
 #: library message names: its messages stay as they are). Only the command's own: a
 #: calibration's fitted ``baseline_loss_factor`` is no ``--baseline-loss-factor``, and a
 #: calibration table's ``frequency_hz`` column no ``--frequency``.
 COMMAND_FLAGS: dict[str, dict[str, str]] = {
-    "analyze": FLAG_OF_KEYWORD,
+    "analyze": {**FLAG_OF_KEYWORD, **CALIBRATION_WRITER},
     "report": {
         **FLAG_OF_KEYWORD,
         "store=": "--store ", "dem_store=": "--dem-store ", "dem_store": "--dem-store",
@@ -76,6 +83,7 @@ COMMAND_FLAGS: dict[str, dict[str, str]] = {
         "fill_reference": "--fill-reference", "time_step": "--time-step",
         "^cells": "--cells", "frequency_hz": "--frequency", "acceleration_g": "--acceleration",
         "^material": "--material", "^direction": "--direction", "^seed": "--seed",
+        **CALIBRATION_WRITER,
     },
     "calibrate": {
         "^fit/priors": "--fit/--prior", "^fit": "--fit", "fit=": "--fit ",
@@ -89,6 +97,9 @@ COMMAND_FLAGS: dict[str, dict[str, str]] = {
         "^cells": "--cells", "^seed": "--seed",
     },
     "bench signal": {"n_samples": "--samples"},
+    # commands that read a --specimen file (or FILE) and no other library keyword
+    "model damper": CALIBRATION_WRITER, "model figures": CALIBRATION_WRITER,
+    "specimen check": CALIBRATION_WRITER,
 }
 COMMAND_FLAGS["dem sweep"] = {
     **COMMAND_FLAGS["dem run"],
