@@ -712,7 +712,6 @@ def available_calibrations(task: CalibrationTask | None,
                    f"{CALIBRATION_ENV_VAR})")]
 
 
-
 def calibration_read_notes(calibrations: Sequence[tuple[object | None, str]]) -> list[str]:
     """What reading the offered calibrations (:func:`available_calibrations`) did first, to
     be shown: the note of each whose folder a killed ``pidcore calibrate --out`` had left
