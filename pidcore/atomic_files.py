@@ -450,6 +450,43 @@ def finish_committed_moves(target: str | os.PathLike[str]) -> list[Path]:
     return moved
 
 
+def finished_moves_note(target: str | os.PathLike[str], *, kind: str) -> str:
+    """:func:`finish_committed_moves` of ``target``, the folder a ``kind`` (``"calibration"``)
+    writes its outputs into; returns the note that says what was moved ("" where nothing was
+    left), for the caller to say."""
+    moved = finish_committed_moves(target)
+    if not moved:
+        return ""
+    return (f"{target}: a {kind} killed while moving its outputs into it had left "
+            f"{len(moved)} of them to move ({', '.join(sorted(p.name for p in moved))}); "
+            f"moved now, so it holds that {kind}'s whole set, not a mix with the earlier "
+            "one")
+
+
+def finish_moves_before_reading(target: str | os.PathLike[str], *, kind: str,
+                                writer: str) -> str:
+    """For every reader of the folder ``target`` a ``kind`` writes with ``writer`` (the call
+    that writes it): finish the moves a killed write left (:func:`finished_moves_note`, as a
+    database replays its journal on open), so that a reader never gets a mix of two; returns
+    the note.
+
+    Raises
+    ------
+    ParameterError
+        Where the moves cannot be finished (a read-only folder): naming the folder and what
+        to run.
+    """
+    from .errors import ParameterError
+
+    try:
+        return finished_moves_note(target, kind=kind)
+    except OSError as exc:
+        raise ParameterError(
+            f"{target}: holds the half-moved outputs of a killed {kind} (a mix of two "
+            f"{kind}s) and they cannot be finished here ({exc.strerror}); make it writable "
+            f"and read it again, or write the {kind} into it again ({writer})") from None
+
+
 @contextmanager
 def atomic_path(path: str | os.PathLike[str], *, durable: bool = True) -> Iterator[Path]:
     """Yield a new empty temporary file beside ``path`` for a writer to fill (by its path:

@@ -120,6 +120,10 @@ bundled_face_area
     A specimen rebuilt from its canonical text (a stored run's), with the ``[coupon]
     face_area_m2`` of the bundled file of its hash (the paper's coupon) that the text leaves
     out.
+CALIBRATED_SPECIMEN_FILE, finish_calibration_moves, hearing_read_notes
+    The calibrated specimen file of a ``pidcore calibrate --out`` folder; the moves a killed
+    calibration left in that folder, finished before it is read (:func:`load_specimen` does
+    so for that file); who hears the note a load makes of it (the CLI, the app).
 """
 
 from __future__ import annotations
@@ -1389,11 +1393,10 @@ def _calibration_folder(path: Path) -> Path | None:
     return folder if left else None
 
 
-def _finish_calibration_moves(path: Path) -> str:
-    """Before a calibrated specimen file is read: finish the moves a calibration killed while
-    writing its folder left (:func:`pidcore.calibrate.outputs.finish_outputs_before_reading`),
-    so that the file read is of the same calibration as the calibration.json beside it, not
-    the earlier one; returns its note ("" where nothing was left).
+def finish_calibration_moves(folder: str | os.PathLike[str]) -> str:
+    """Finish the moves a calibration killed while writing its outputs into ``folder``
+    (``pidcore calibrate --out``) left, before anything there is read; returns the note that
+    says so ("" where nothing was left).
 
     Raises
     ------
@@ -1401,12 +1404,18 @@ def _finish_calibration_moves(path: Path) -> str:
         Where the moves cannot be finished (a read-only folder): one line naming the folder;
         nothing is changed.
     """
-    folder = _calibration_folder(path)
-    if folder is None:
-        return ""
-    from .calibrate.outputs import finish_outputs_before_reading
+    from .atomic_files import finish_moves_before_reading
 
-    return finish_outputs_before_reading(folder)
+    return finish_moves_before_reading(folder, kind="calibration",
+                                       writer="write_outputs(result, out_dir)")
+
+
+def _finish_calibration_moves(path: Path) -> str:
+    """Before a calibrated specimen file is read: :func:`finish_calibration_moves` of its
+    folder where a killed calibration left moves there, so that the file read is of the same
+    calibration as the calibration.json beside it, not the earlier one."""
+    folder = _calibration_folder(path)
+    return "" if folder is None else finish_calibration_moves(folder)
 
 
 def load_specimen(path: str | os.PathLike[str]) -> Specimen:
@@ -2012,6 +2021,7 @@ __all__ = ["CellSpec", "CouponSpec", "PairSpec", "PairsSpec", "ParticleSpec", "S
            "is_paper_coupon",
            "tested_label",
            "load_specimen", "hearing_read_notes", "CALIBRATED_SPECIMEN_FILE",
+           "finish_calibration_moves",
            "MEASURED_SHA256_FIELD", "deciding_sha256", "measured_specimen_name",
            "measured_specimen_sha256", "models_paper_coupon", "NamedSpecimen",
            "resolve_specimen_name", "numeric_fields", "same_tested_file", "bundled_face_area",

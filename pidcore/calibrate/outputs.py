@@ -12,13 +12,13 @@ from typing import Any
 import numpy as np
 
 from ..atomic_files import (
-    finish_committed_moves,
+    finished_moves_note,
     fsync_tree,
     move_files_into_folder,
     new_temporary_folder_for,
 )
 from ..records import json_safe
-from ..specimen import CALIBRATED_SPECIMEN_FILE
+from ..specimen import CALIBRATED_SPECIMEN_FILE, finish_calibration_moves
 from ..units import display_number
 from .calibrate import CalibrationResult
 from .posterior import summary_texts
@@ -446,19 +446,15 @@ def finish_interrupted_outputs(out_dir: str | os.PathLike) -> str:
     (SIGKILL, a power loss) left half-moved, so that it holds that calibration's whole set;
     returns a note saying so ("" where nothing was left). :func:`write_outputs` calls it
     first; a front-end calls it before its work, to say so at once."""
-    moved = finish_committed_moves(out_dir)
-    if not moved:
-        return ""
-    return (f"{out_dir}: a calibration killed while moving its outputs into it had left "
-            f"{len(moved)} of them to move ({', '.join(sorted(p.name for p in moved))}); "
-            "moved now, so it holds that calibration's whole set, not a mix with the earlier "
-            "one")
+    return finished_moves_note(out_dir, kind="calibration")
 
 
 def finish_outputs_before_reading(out_dir: str | os.PathLike) -> str:
     """For every reader of a ``calibrate --out`` folder: finish the moves a killed
-    calibration left (:func:`finish_interrupted_outputs`, as a database replays its journal
-    on open), so that a reader never gets a mix of two calibrations; returns its note.
+    calibration left (:func:`finish_interrupted_outputs`), so that a reader never gets a mix
+    of two calibrations; returns its note
+    (:func:`pidcore.specimen.finish_calibration_moves`, which the specimen loader calls for a
+    calibrated specimen file).
 
     Raises
     ------
@@ -466,16 +462,7 @@ def finish_outputs_before_reading(out_dir: str | os.PathLike) -> str:
         Where the moves cannot be finished (a read-only folder): naming the folder and
         what to run.
     """
-    from ..errors import ParameterError
-
-    try:
-        return finish_interrupted_outputs(out_dir)
-    except OSError as exc:
-        raise ParameterError(
-            f"{out_dir}: holds the half-moved outputs of a killed calibration (a mix of two "
-            f"calibrations) and they cannot be finished here ({exc.strerror}); make it "
-            "writable and read it again, or write the calibration into it again "
-            "(write_outputs(result, out_dir))") from None
+    return finish_calibration_moves(out_dir)
 
 
 def write_outputs(result: CalibrationResult, out_dir: str | os.PathLike) -> list[Path]:
