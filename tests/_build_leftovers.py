@@ -103,3 +103,24 @@ def folder_contents(folder: Path) -> dict[str, bytes] | None:
         return None
     return {str(p.relative_to(folder)): p.read_bytes() for p in sorted(folder.rglob("*"))
             if p.is_file()}
+
+
+def calibration_outputs_script(stand_ins: str = "") -> str:
+    """A script for :func:`run_killed_at_rename`: ``write_outputs`` of a calibration into
+    ``sys.argv[3]``, each output a stand-in text naming ``sys.argv[4]`` (what the files hold
+    is not what the kill tests test); ``stand_ins``, code run before the write, may replace
+    some of them (``outputs.document_json``, ``outputs.specimen_text``)."""
+    return (
+        "from pathlib import Path\n"
+        "from types import SimpleNamespace\n\n"
+        "import pidcore.calibrate.outputs as outputs\n\n"
+        "run = sys.argv[4]\n"
+        'outputs.document_json = lambda document: f"calibration.json of {run}"\n'
+        'for name in ("specimen_text", "summary_markdown", "summary_html"):\n'
+        '    setattr(outputs, name, lambda result, name=name: f"{name} of {run}")\n'
+        'for name in ("plot_predictions", "plot_pairs"):\n'
+        "    setattr(outputs, name,\n"
+        '            lambda result, path, name=name: Path(path).write_text(f"{name} of {run}"))\n'
+        + stand_ins
+        + "arm_the_kill()\n"
+        "outputs.write_outputs(SimpleNamespace(full_document=dict), sys.argv[3])\n")

@@ -950,27 +950,6 @@ def test_a_killed_calibrations_build_folder_is_removed_by_the_next_out(capsys, t
         {"fixture_mass_kg"}
 
 
-#: The outputs of a calibration, each file's text naming ``sys.argv[4]``, written into
-#: ``sys.argv[3]`` by write_outputs, for :func:`_build_leftovers.run_killed_at_rename`
-#: (what the files hold is not what is tested, so the result and its texts are stand-ins).
-_OUTPUTS_SCRIPT = """
-from pathlib import Path
-from types import SimpleNamespace
-
-import pidcore.calibrate.outputs as outputs
-
-run = sys.argv[4]
-outputs.document_json = lambda document: f"calibration.json of {run}"
-for name in ("specimen_text", "summary_markdown", "summary_html"):
-    setattr(outputs, name, lambda result, name=name: f"{name} of {run}")
-for name in ("plot_predictions", "plot_pairs"):
-    setattr(outputs, name,
-            lambda result, path, name=name: Path(path).write_text(f"{name} of {run}"))
-arm_the_kill()
-outputs.write_outputs(SimpleNamespace(full_document=dict), sys.argv[3])
-"""
-
-
 def test_outputs_killed_at_any_move_are_the_earlier_or_the_new_set_after_the_next_run(tmp_path):
     # `pidcore calibrate --out cal` into an existing cal renamed its six outputs into it one
     # by one: killed (SIGKILL, power loss) between two, cal held some new files and some of
@@ -981,16 +960,17 @@ def test_outputs_killed_at_any_move_are_the_earlier_or_the_new_set_after_the_nex
     import shutil
     import time
 
-    from _build_leftovers import folder_contents, run_killed_at_rename
+    from _build_leftovers import calibration_outputs_script, folder_contents, run_killed_at_rename
 
     from pidcore.atomic_files import remove_stale_temporary_folders
     from pidcore.calibrate import finish_interrupted_outputs
     from pidcore.defaults import STALE_TEMPORARY_FILE_AGE_S
 
+    script = calibration_outputs_script()
     references = tmp_path / "references"
     references.mkdir()
     for run in ("earlier", "new"):
-        assert not run_killed_at_rename(_OUTPUTS_SCRIPT, 99, exchange=False, cwd=tmp_path,
+        assert not run_killed_at_rename(script, 99, exchange=False, cwd=tmp_path,
                                         args=(str(references / run), run))
     earlier, new = folder_contents(references / "earlier"), folder_contents(references / "new")
     assert len(earlier) == len(new) == 6 and not set(earlier.values()) & set(new.values())
@@ -1005,7 +985,7 @@ def test_outputs_killed_at_any_move_are_the_earlier_or_the_new_set_after_the_nex
         for name, data in users.items():
             (out / name).write_bytes(data)
         (work / ".cal.backup.commit").mkdir()  # a user's, named like ours
-        killed = run_killed_at_rename(_OUTPUTS_SCRIPT, renames, exchange=False, cwd=tmp_path,
+        killed = run_killed_at_rename(script, renames, exchange=False, cwd=tmp_path,
                                       args=(str(out), "new"))
         note = finish_interrupted_outputs(out)
         # a kill before the commit leaves a build folder, removed once a day old (only its

@@ -4,6 +4,7 @@ refused where the folder cannot be written; the app shows what reading a calibra
 import json
 
 import pytest
+from _build_leftovers import calibration_outputs_script
 
 from pidcore.calibrate.outputs import SPECIMEN_FILE
 from pidcore.cli import main
@@ -14,30 +15,16 @@ from pidcore.specimen import hearing_read_notes, load_specimen, paper_specimen
 #: hashes) that differ in one value, each a valid specimen.
 _RESTITUTIONS = {"earlier": 0.6, "new": 0.8}
 
-#: ``pidcore calibrate --out`` as the kill tests run it (tests/test_calibrate_cli.py's
-#: _OUTPUTS_SCRIPT), with a real calibrated specimen: calibration.json names its hash, so a
-#: mix of two calibrations shows as a specimen whose hash calibration.json does not name.
-_OUTPUTS_SCRIPT = """
-import json
-from pathlib import Path
-from types import SimpleNamespace
-
-import pidcore.calibrate.outputs as outputs
-from pidcore.specimen import paper_specimen
-
-run = sys.argv[4]
-specimen = paper_specimen().with_values(
-    {"pairs.particle_particle.restitution": {"earlier": 0.6, "new": 0.8}[run]})
-outputs.document_json = lambda document: json.dumps({"specimen_sha256": specimen.hash})
-outputs.specimen_text = lambda result: specimen.to_toml()
-for name in ("summary_markdown", "summary_html"):
-    setattr(outputs, name, lambda result, name=name: f"{name} of {run}")
-for name in ("plot_predictions", "plot_pairs"):
-    setattr(outputs, name,
-            lambda result, path, name=name: Path(path).write_text(f"{name} of {run}"))
-arm_the_kill()
-outputs.write_outputs(SimpleNamespace(full_document=dict), sys.argv[3])
-"""
+#: ``pidcore calibrate --out`` as the kill tests run it (tests/_build_leftovers.py's
+#: calibration_outputs_script), with a real calibrated specimen: calibration.json names its
+#: hash, so a mix of two calibrations shows as a specimen whose hash calibration.json does not name.
+_OUTPUTS_SCRIPT = calibration_outputs_script(
+    "import json\n"
+    "from pidcore.specimen import paper_specimen\n"
+    "specimen = paper_specimen().with_values(\n"
+    '    {"pairs.particle_particle.restitution": {"earlier": 0.6, "new": 0.8}[run]})\n'
+    "outputs.document_json = lambda document: json.dumps({'specimen_sha256': specimen.hash})\n"
+    "outputs.specimen_text = lambda result: specimen.to_toml()\n")
 
 
 def _hash(run: str) -> str:
