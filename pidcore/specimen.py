@@ -1372,27 +1372,6 @@ def hearing_read_notes(hear: Callable[[str], None]) -> Iterator[None]:
         _READ_NOTE_HEARERS.reset(token)
 
 
-def _calibration_folder(path: Path) -> Path | None:
-    """The folder of ``path`` where it is a calibrated specimen file (by its name,
-    :data:`CALIBRATED_SPECIMEN_FILE`) and a killed calibration left moves into that folder
-    (:func:`pidcore.atomic_files.committed_folder_name_pattern`); None otherwise. Cheap: one
-    listing of the folder above, no import of the calibration package."""
-    if path.name != CALIBRATED_SPECIMEN_FILE:
-        return None
-    folder = path.parent
-    if folder.name in ("", ".", ".."):  # "calibrated_specimen.toml", "../x": a named folder
-        folder = Path(os.path.abspath(folder))
-    from .atomic_files import committed_folder_name_pattern
-
-    pattern = committed_folder_name_pattern(folder)
-    try:
-        with os.scandir(folder.parent) as entries:
-            left = any(pattern.fullmatch(entry.name) for entry in entries)
-    except OSError:  # a folder above that cannot be listed: no journal can be read there
-        return None
-    return folder if left else None
-
-
 def finish_calibration_moves(folder: str | os.PathLike[str]) -> str:
     """Finish the moves a calibration killed while writing its outputs into ``folder``
     (``pidcore calibrate --out``) left, before anything there is read; returns the note that
@@ -1411,11 +1390,16 @@ def finish_calibration_moves(folder: str | os.PathLike[str]) -> str:
 
 
 def _finish_calibration_moves(path: Path) -> str:
-    """Before a calibrated specimen file is read: :func:`finish_calibration_moves` of its
-    folder where a killed calibration left moves there, so that the file read is of the same
-    calibration as the calibration.json beside it, not the earlier one."""
-    folder = _calibration_folder(path)
-    return "" if folder is None else finish_calibration_moves(folder)
+    """Before a calibrated specimen file (by its name, :data:`CALIBRATED_SPECIMEN_FILE`) is
+    read: :func:`finish_calibration_moves` of its folder, so that the file read is of the same
+    calibration as the calibration.json beside it, not the earlier one. Any other file: ""
+    at once; this one costs a listing of the folder above (no journal: nothing to do)."""
+    if path.name != CALIBRATED_SPECIMEN_FILE:
+        return ""
+    folder = path.parent
+    if folder.name in ("", ".", ".."):  # "calibrated_specimen.toml", "../x": a named folder
+        folder = Path(os.path.abspath(folder))
+    return finish_calibration_moves(folder)
 
 
 def load_specimen(path: str | os.PathLike[str]) -> Specimen:

@@ -18,7 +18,7 @@ from ..atomic_files import (
     new_temporary_folder_for,
 )
 from ..records import json_safe
-from ..specimen import CALIBRATED_SPECIMEN_FILE, finish_calibration_moves
+from ..specimen import CALIBRATED_SPECIMEN_FILE
 from ..units import display_number
 from .calibrate import CalibrationResult
 from .posterior import summary_texts
@@ -447,22 +447,6 @@ def finish_interrupted_outputs(out_dir: str | os.PathLike) -> str:
     returns a note saying so ("" where nothing was left). :func:`write_outputs` calls it
     first; a front-end calls it before its work, to say so at once."""
     return finished_moves_note(out_dir, kind="calibration")
-
-
-def finish_outputs_before_reading(out_dir: str | os.PathLike) -> str:
-    """For every reader of a ``calibrate --out`` folder: finish the moves a killed
-    calibration left (:func:`finish_interrupted_outputs`), so that a reader never gets a mix
-    of two calibrations; returns its note
-    (:func:`pidcore.specimen.finish_calibration_moves`, which the specimen loader calls for a
-    calibrated specimen file).
-
-    Raises
-    ------
-    ParameterError
-        Where the moves cannot be finished (a read-only folder): naming the folder and
-        what to run.
-    """
-    return finish_calibration_moves(out_dir)
 
 
 def write_outputs(result: CalibrationResult, out_dir: str | os.PathLike) -> list[Path]:

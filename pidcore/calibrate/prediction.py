@@ -699,10 +699,10 @@ def load_calibration(path: str | os.PathLike, *, key: str | None = None) -> Cali
     if key is not None:
         raise ParameterError(f"{path}: a calibration key ({key}) chooses among the "
                              "calibrations of an HDF5 store; this is not one")
-    from .outputs import finish_outputs_before_reading
+    from ..specimen import finish_calibration_moves
 
     # before any file is read: a killed --out may have left a mix of two calibrations
-    read_note = finish_outputs_before_reading(path if path.is_dir() else path.parent)
+    read_note = finish_calibration_moves(path if path.is_dir() else path.parent)
     if path.is_dir() and (path / "calibration.json").is_file():
         path = path / "calibration.json"  # the folder `pidcore calibrate --out` wrote
     if path.is_dir():

@@ -182,11 +182,18 @@ def _interrupted(command: str, args: argparse.Namespace | None) -> int:
 def _say_note(note: str, command: str, words: list[str]) -> None:
     """Say a library's note on stderr as ``pidcore COMMAND: note: ...``, in the command's
     words (stderr: a command's --json prints one document on stdout)."""
+    print(f"pidcore {command}: note: {_in_command_words(note, command, words)}",
+          file=sys.stderr)
+
+
+def _in_command_words(text: str, command: str, words: list[str]) -> str:
+    """A library text in the words of ``pidcore COMMAND`` (:func:`cli_words`), the names the
+    command line gave (a file, a folder, a key) left as the user wrote them."""
     from ._vocabulary import cli_words
 
+    # what the command line gave is the user's, whatever it holds
     given = [w.split("=", 1)[1] if w.startswith("--") and "=" in w else w for w in words]
-    said = cli_words(note, command, names=[w for w in given if not w.startswith("-")])
-    print(f"pidcore {command}: note: {said}", file=sys.stderr)
+    return cli_words(text, command, names=[w for w in given if not w.startswith("-")])
 
 
 def _in_flags(exc: PidcoreError, command: str, words: list[str]) -> str:
@@ -195,12 +202,9 @@ def _in_flags(exc: PidcoreError, command: str, words: list[str]) -> str:
     settings table's refusal names the table's columns, which are no flags, and stays as it
     is."""
     from ..errors import SettingsTableError
-    from ._vocabulary import cli_words
 
-    # what the command line gave (a file, a folder, a key) is the user's, whatever it holds
-    given = [w.split("=", 1)[1] if w.startswith("--") and "=" in w else w for w in words]
     return str(exc) if isinstance(exc, SettingsTableError) else \
-        cli_words(str(exc), command, names=[w for w in given if not w.startswith("-")])
+        _in_command_words(str(exc), command, words)
 
 
 def _what_an_interrupt_left(args: argparse.Namespace) -> str:

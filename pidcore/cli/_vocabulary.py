@@ -54,7 +54,7 @@ FLAG_OF_KEYWORD: dict[str, str] = {
 }
 
 #: The call that writes a calibration folder, as the command that does: named by the refusal
-#: of a half-moved folder (:func:`pidcore.calibrate.outputs.finish_outputs_before_reading`),
+#: of a half-moved folder (:func:`pidcore.specimen.finish_calibration_moves`),
 #: which every command that reads a calibration or a calibrated specimen file (``--specimen
 #: DIR/calibrated_specimen.toml``: :func:`pidcore.specimen.load_specimen`) may say.
 CALIBRATION_WRITER: dict[str, str] = {
