@@ -22,7 +22,7 @@ _OUTPUTS_SCRIPT = calibration_outputs_script(
     "import json\n"
     "from pidcore.specimen import paper_specimen\n"
     "specimen = paper_specimen().with_values(\n"
-    '    {"pairs.particle_particle.restitution": {"earlier": 0.6, "new": 0.8}[run]})\n'
+    f'    {{"pairs.particle_particle.restitution": {_RESTITUTIONS!r}[run]}})\n'
     "outputs.document_json = lambda document: json.dumps({'specimen_sha256': specimen.hash})\n"
     "outputs.specimen_text = lambda result: specimen.to_toml()\n")
 
