@@ -176,6 +176,16 @@ def _fail(where: str, message: str) -> ParameterError:
     return ParameterError(f"{where}: {message}")
 
 
+class StaticBelowSlidingError(ParameterError):
+    """A pair's static friction is below its sliding friction. ``pair`` names the pair
+    (``"particle_wall"``), so that :meth:`Specimen.with_values` can tell the user which key to
+    set too without reading the message's text."""
+
+    def __init__(self, message: str, *, pair: str) -> None:
+        super().__init__(message)
+        self.pair = pair
+
+
 def _printable(where: str, text: str) -> None:
     """Refuse a name holding a control character or a lone surrogate (TOML allows both as
     escapes): the name goes into every stored run's record, where HDF5 can hold neither
@@ -540,9 +550,10 @@ class PairSpec:
         _plausible(f"{where} rolling_damping_ratio", "rolling_damping_ratio",
                    self.rolling_damping_ratio)
         if self.static_friction < self.sliding_friction:
-            raise _fail(f"{where} static_friction",
-                        f"{self.static_friction!r} is below sliding_friction "
-                        f"{self.sliding_friction!r}; expected static >= sliding")
+            raise StaticBelowSlidingError(
+                f"{where} static_friction: {self.static_friction!r} is below sliding_friction "
+                f"{self.sliding_friction!r}; expected static >= sliding",
+                pair=where.strip("[]").rpartition(".")[2])
 
 
 @dataclass(frozen=True)
@@ -763,8 +774,10 @@ class Specimen:
                     node = node.setdefault(part, {})
         try:
             return _from_mapping(data, source=self.source)
+        except StaticBelowSlidingError as exc:
+            raise ParameterError(f"{self.source}: {exc}{_static_too(values, exc.pair)}") from None
         except ParameterError as exc:
-            raise ParameterError(f"{self.source}: {exc}{_static_too(values, str(exc))}") from None
+            raise ParameterError(f"{self.source}: {exc}") from None
 
     # --- identity ------------------------------------------------------------------------
 
@@ -991,18 +1004,15 @@ _TABLE_OF_SECTION = {"": "the top level", "cell": "[cell]", "coupon": "[coupon]"
                      "[pairs.particle_wall]", "pairs": "[pairs]", "provenance": "[provenance]"}
 
 
-def _static_too(values: Mapping[str, Any], complaint: str) -> str:
-    """The end of a ``with_values`` refusal where a pair's sliding friction was raised past
+def _static_too(values: Mapping[str, Any], pair: str) -> str:
+    """The end of a ``with_values`` refusal where ``pair``'s sliding friction was raised past
     the static friction the specimen holds, which was not set: a file without static_friction
     holds its sliding friction there, so {"...sliding_friction": 0.4} was refused naming a
     static 0.3 the user never wrote."""
-    for path in values:
-        parts = path.split(".") if isinstance(path, str) else []
-        if (len(parts) == 3 and parts[2] == "sliding_friction"
-                and f"[pairs.{parts[1]}] static_friction" in complaint
-                and f"pairs.{parts[1]}.static_friction" not in values):
-            return (f"; set pairs.{parts[1]}.static_friction too (a file without it holds its "
-                    "sliding friction there)")
+    if (f"pairs.{pair}.sliding_friction" in values
+            and f"pairs.{pair}.static_friction" not in values):
+        return (f"; set pairs.{pair}.static_friction too (a file without it holds its "
+                "sliding friction there)")
     return ""
 
 

@@ -280,6 +280,23 @@ def test_with_values_raising_a_sliding_friction_past_the_static_names_the_static
     assert both.pairs.particle_wall.static_friction == 0.4
 
 
+def test_with_values_names_the_static_key_only_of_the_pair_whose_sliding_friction_was_raised():
+    # the hint comes from the refusal's pair, not from its text: a static friction lowered by
+    # the user gets no hint (the user wrote it), and raising one pair's sliding friction never
+    # sends the user to the other pair's static key
+    with pytest.raises(ParameterError) as info:
+        PAPER.with_values({"pairs.particle_particle.static_friction": 0.05})
+    assert str(info.value).endswith("expected static >= sliding")
+    with pytest.raises(ParameterError) as info:
+        PAPER.with_values({"pairs.particle_particle.sliding_friction": 0.9,
+                           "pairs.particle_wall.sliding_friction": 0.1})
+    message = str(info.value)
+    assert "[pairs.particle_particle] static_friction" in message
+    assert message.endswith("; set pairs.particle_particle.static_friction too (a file without "
+                            "it holds its sliding friction there)")
+    assert "pairs.particle_wall.static_friction" not in message
+
+
 @pytest.mark.parametrize("encoding", ["utf-16", "utf-16-le", "utf-16-be"])
 def test_a_utf16_file_behind_its_byte_order_mark_is_the_same_specimen(tmp_path, encoding):
     # Notepad's "Unicode" (UTF-16 with a byte-order mark) was refused as "not UTF-8 text
