@@ -920,6 +920,38 @@ def test_dem_page_offers_the_specimen_files_and_takes_their_material(store_file,
     assert at.text_input(key="dem_material_specimen").value == want
 
 
+def test_a_calibrated_specimen_file_left_half_moved_is_refused_in_the_pages_words(
+        store_file, tmp_path, monkeypatch):
+    # the refusal named write_outputs(result, out_dir), a Python call the page's user cannot
+    # make; the folder is written again by `pidcore calibrate --out`
+    import shutil
+
+    import pidcore.atomic_files as atomic_files
+
+    folder = tmp_path / "data_samples" / "specimens"  # the app runs in tmp_path
+    folder.mkdir(parents=True)
+    shutil.copy(REPO / "data_samples" / "specimens" / "steel_6mm.toml",
+                folder / "calibrated_specimen.toml")
+    committed = folder.parent / f".specimens.{'7c' * 8}.commit"  # a killed --out's journal
+    committed.mkdir()
+    (committed / "calibration.json").write_text("{}", encoding="utf-8")
+
+    def refused(commit, target):  # a read-only folder (as root, chmod does not stop a rename)
+        raise PermissionError(13, "Permission denied", str(target))
+
+    monkeypatch.setattr(atomic_files, "_finish_moves", refused)
+    at = _app()
+    box = at.selectbox(key="dem_specimen")
+    box.set_value(next(o for o in box.options if o.endswith("calibrated_specimen.toml")))
+    at.run()
+    assert not at.exception
+    [message] = [e.value for e in at.error if "half-moved" in e.value]
+    assert message.endswith("or write the calibration into it again "
+                            "(`pidcore calibrate --out`)")
+    assert "write_outputs" not in message
+    assert committed.exists()  # nothing changed
+
+
 def test_dem_page_runs_the_specimens_own_fill_when_the_fills_field_is_empty(
         store_file, tmp_path, monkeypatch):
     import shutil

@@ -70,3 +70,25 @@ def test_reading_a_killed_out_folder_that_cannot_be_written_refuses_in_one_line(
     assert cli_words(message, "report", names=[str(out)]).endswith(
         "or write the calibration into it again (pidcore calibrate --out)")
     assert (out / "calibration.json").exists() and committed.exists()  # nothing changed
+
+
+def test_the_app_says_the_refusal_of_a_half_moved_folder_as_the_command_that_writes_it(
+        tmp_path, monkeypatch):
+    # the Compare page showed "... (write_outputs(result, out_dir))", a Python call the page's
+    # user has no way to make; the page writes no calibration folder, the CLI does
+    import pidcore.atomic_files as atomic_files
+    from pidcore.app.calibration import CALIBRATION_ENV_VAR, available_calibrations
+
+    out, committed = _killed_mid_move(tmp_path)
+
+    def refused(commit, target):
+        raise PermissionError(13, "Permission denied", str(target))
+
+    monkeypatch.setattr(atomic_files, "_finish_moves", refused)
+    [(calibration, reason)] = available_calibrations(
+        None, environ={CALIBRATION_ENV_VAR: str(out)}, cwd=tmp_path)
+    assert calibration is None
+    assert reason.startswith(f"calibration not shown: {out}: holds the half-moved outputs")
+    assert reason.endswith("or write the calibration into it again (`pidcore calibrate --out`)")
+    assert "write_outputs" not in reason
+    assert committed.exists()  # nothing changed

@@ -694,7 +694,7 @@ def available_calibrations(task: CalibrationTask | None,
                           f"this store's calibration of {task.specimen or 'the paper coupon'} "
                           f"on the Calibrate page ({', '.join(task.fit)})"))
         except PidcoreError as exc:
-            problems.append(f"calibration not shown: {exc}")
+            problems.append(f"calibration not shown: {page_words(str(exc))}")
     path = calibration_path(environ, cwd=cwd)
     if path is not None:
         label = ("the bundled calibration of the paper's 12 measured points"
@@ -703,7 +703,7 @@ def available_calibrations(task: CalibrationTask | None,
         try:
             found.append((load_calibration(path), label))
         except PidcoreError as exc:
-            problems.append(f"calibration not shown: {exc}")
+            problems.append(f"calibration not shown: {page_words(str(exc))}")
     if found:  # a calibration that cannot be read is still said, after those that can
         return found + [(None, problem) for problem in problems]
     if problems:

@@ -47,6 +47,9 @@ LABEL_OF_KEYWORD: dict[str, str] = {
     "dem_store": "the DEM store",
     "pool=True": "'pool DEM settings and specimens'",
     "calibration_key=": "`pidcore report --calibration-key`",
+    # the call that writes a calibration folder, named by the refusal of a half-moved one
+    # (pidcore.specimen.finish_calibration_moves): the page writes no folder, the CLI does
+    "write_outputs(result, out_dir)": "`pidcore calibrate --out`",
 }
 
 #: The SI unit a message gives after a keyword, the page's unit of its field where it is not
@@ -87,7 +90,7 @@ def page_terms(message: str, *, names: Iterable[str] = ()) -> str:
 
 def _in_page_terms(message: str) -> str:
     def labelled(named: str, scale: float, m: re.Match) -> str:
-        value = m.group("value")
+        value = m.groupdict().get("value")  # a call's name takes none
         if value is None or (value.isupper() and not value.startswith("'")):
             return named
         try:

@@ -203,7 +203,7 @@ def specimen_choice(key: str, store_path):
     the chosen file is refused (None when it is not). Widget keys ``{key}_specimen`` and
     ``{key}_specimen_file``."""
     from pidcore import defaults
-    from pidcore.app.uploads import specimen_files
+    from pidcore.app.uploads import app_words, specimen_files
     from pidcore.errors import PidcoreError
     from pidcore.specimen import load_specimen
 
@@ -239,6 +239,8 @@ def specimen_choice(key: str, store_path):
     try:
         return (None if choice == PAPER_CHOICE else load_specimen(choice)), None
     except (PidcoreError, OSError, ValueError) as exc:
-        message = str(exc) if str(exc).startswith(choice) else f"{choice}: {exc}"
+        # a calibrated specimen file's refusal names the call that writes its folder
+        message = app_words(str(exc) if str(exc).startswith(choice) else f"{choice}: {exc}",
+                            names=[choice])
         st.error(message)
         return None, message
