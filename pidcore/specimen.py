@@ -1067,6 +1067,10 @@ def _key_in_another_unit(key: str, schema: Mapping[str, Any]) -> str:
             "in that unit")
 
 
+# What a key of each kind of the schema holds, in a refusal's words.
+_EXPECTED_OF_KIND = {"float": "a number", "int": "a whole number", "str": "text"}
+
+
 def _take(table: Mapping[str, Any], section: str, where: str) -> dict[str, Any]:
     """Check keys (unknown, missing, type) of one table; returns a plain dict."""
     schema = SCHEMA[section]
@@ -1082,7 +1086,8 @@ def _take(table: Mapping[str, Any], section: str, where: str) -> dict[str, Any]:
     for key, (required, kind) in schema.items():
         if key not in table:
             if required:
-                raise ParameterError(f"{where} {key}: missing key")
+                raise ParameterError(f"{where} {key}: missing key; expected "
+                                     f"{_EXPECTED_OF_KIND[kind]}")
             continue
         value = table[key]
         if kind == "float":

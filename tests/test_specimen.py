@@ -92,6 +92,20 @@ def test_bad_specimen_is_one_line_naming_file_and_key(tmp_path, old, new, messag
     assert "\n" not in text and text.startswith(str(path))
 
 
+@pytest.mark.parametrize(("old", "said"), [
+    # a user writing a specimen from scratch learns from the refusal what the key holds
+    ("count = 441\n", "[cell] count: missing key; expected a whole number"),
+    ("mass_kg = 0.022153400000000004\n", "[coupon] mass_kg: missing key; expected a number"),
+    ('shape = "hexagonal"\n', "[cell] shape: missing key; expected text"),
+])
+def test_a_missing_key_says_what_to_write(tmp_path, old, said):
+    path = tmp_path / "bad.toml"
+    path.write_text(_edit(PAPER.to_toml(), old, ""))
+    with pytest.raises(ParameterError) as info:
+        load_specimen(path)
+    assert str(info.value) == f"{path}: {said}"
+
+
 def test_inline_particle_properties_need_no_table_row():
     text = _edit(PAPER.to_toml(), 'material = "acrylic"', 'material = "steel"')
     text = _edit(text, "density_kg_m3 = 1180.0", "density_kg_m3 = 7850.0")

@@ -495,7 +495,7 @@ def load_specimen_text(text: str):
      "x.toml: [provenance] calibrated_from_sha256: expected the sha256 of the specimen it "
      "was calibrated from (64 lowercase hexadecimal digits), got '45d792'"),
     ('calibrated_from_name = "paper_coupon"',
-     "x.toml: [provenance] calibrated_from_sha256: missing key"),
+     "x.toml: [provenance] calibrated_from_sha256: missing key; expected text"),
     (f'calibrated_from_name = ""\ncalibrated_from_sha256 = "{"0" * 64}"',
      "x.toml: [provenance] calibrated_from_name: expected a non-empty name, got ''"),
 ])
