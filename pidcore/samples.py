@@ -27,7 +27,7 @@ from .errors import ParameterError, StoreError
 from .records import Channel, Measurement
 
 if TYPE_CHECKING:
-    from .dem.simulate import DemConfig
+    from .dem.simulate import DemConfig, LoadCase
     from .specimen import Specimen
 
 #: Sampling rate of the exports, Hz (a common Testlab setting).
@@ -36,6 +36,8 @@ EXPORT_SAMPLE_RATE_HZ = 25_600.0
 EXPORT_VELOCITY_DELAY_S = 5e-5
 #: Sensor signal-to-noise ratio of the exports, dB.
 EXPORT_SNR_DB = 45.0
+#: Drive periods dropped at each end of an export (the resampling filter's edges).
+EXPORT_TRIM_PERIODS = 2
 
 
 @dataclass(frozen=True)
@@ -85,7 +87,7 @@ def virtual_shaker_measurement(
 
     force = resample_poly(shaker_force_n, ratio.numerator, ratio.denominator)
     t = time_s[0] + np.arange(force.size) / sample_rate_hz
-    trim = int(round(2 * sample_rate_hz / frequency_hz))  # two periods each end
+    trim = int(round(EXPORT_TRIM_PERIODS * sample_rate_hz / frequency_hz))  # each end
     force, t = force[trim:-trim], t[trim:-trim]
     w = 2 * np.pi * frequency_hz
     accel = acceleration_m_s2 * np.sin(w * t)
@@ -184,6 +186,27 @@ def _write_export(measurement, path: Path, file_format: str) -> None:
 OWN_EXPORT_EXTENSIONS = {"uff": "uff", "uff58b": "uff", "csv": "csv", "mat": "mat", "hdf5": "h5"}
 
 
+def _check_export_periods(case: LoadCase, config: DemConfig) -> None:
+    """Refuse a DEM config whose exports ``pidcore analyze`` would refuse, before any run.
+
+    A run that reaches its transient cap measures ``steady_cycles`` cycles; the export drops
+    :data:`EXPORT_TRIM_PERIODS` periods at each end, so ``steady_cycles = 10`` wrote files of 6
+    drive periods, which the analysis refuses (at least ``MIN_PERIODS``) -- found only after
+    every DEM run of the trial had been simulated and written.
+    """
+    from . import defaults
+    from .dem.simulate import required_steady_cycles
+
+    cycles = required_steady_cycles(case, config)
+    periods = cycles - 2 * EXPORT_TRIM_PERIODS
+    if periods < defaults.MIN_PERIODS:
+        raise ParameterError(
+            f"config: steady_cycles {cycles} gives exports of {periods} drive periods (the "
+            f"export drops {EXPORT_TRIM_PERIODS} at each end), fewer than the "
+            f"{defaults.MIN_PERIODS} pidcore analyze needs; expected steady_cycles >= "
+            f"{defaults.MIN_PERIODS + 2 * EXPORT_TRIM_PERIODS}")
+
+
 def own_specimen_exports(
     specimen: Specimen, cases: Sequence[tuple[float, float, float, str]],
     out_dir: str | os.PathLike, *, config: DemConfig, snr_db: float = 40.0,
@@ -216,9 +239,12 @@ def own_specimen_exports(
         if name in names:
             raise ParameterError(f"cases: two cases write {name}; give each load case once")
         names.append(name)
-    out.mkdir(parents=True, exist_ok=True)
     eta0 = specimen.coupon.baseline_loss_factor
     material = specimen.particles.material
+    for f, a, fill, _ in cases:
+        _check_export_periods(LoadCase(float(f), float(a), float(fill), material=material),
+                              config)
+    out.mkdir(parents=True, exist_ok=True)
     sidecar = StringIO()
     rows = csv.writer(sidecar, lineterminator="\n")
     rows.writerow(["file", "fill_percent", "material", "direction", "velocity_delay_us",

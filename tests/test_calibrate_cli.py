@@ -691,13 +691,18 @@ def test_a_file_analysed_twice_is_one_measured_point_of_its_newest_analysis(tmp_
     write_force_velocity(path, rec.force_n, rec.velocity_m_s, 25_600.0, "csv")
     store = tmp_path / "s.h5"
     assert main(["analyze", str(path), "--store", str(store)]) == 0
+    # another vibrometer delay too: the two analyses' P_c differ, not only their baselines
     assert main(["analyze", str(path), "--store", str(store), "--baseline-loss-factor",
-                 "0.002"]) == 0
-    analyses = Store(store).list_analyses()
+                 "0.002", "--velocity-delay", "2e-6"]) == 0
+    analyses = Store(store).list_analyses().sort_values("created_utc")
     assert len(analyses) == 2  # the store keeps both analyses of the one measurement
-    newest = analyses.sort_values("created_utc").iloc[-1]
+    oldest, newest = analyses.iloc[0], analyses.iloc[-1]
     (point,) = measured_from_store(store)
-    assert point.sdc == newest["sdc"]  # the baseline-corrected one, not the mean of both
+    # the newest one, not the mean of both; its SDC before the baseline it took off, which
+    # the calibration's observation model adds (rel 1e-12: one division and product)
+    assert point.sdc == pytest.approx(2 * math.pi * newest["complex_power_real_w"]
+                                      / newest["complex_power_imag_w"], rel=1e-12)
+    assert point.sdc != pytest.approx(oldest["sdc"], rel=1e-6)
     assert point.sdc_stderr == newest["sdc_stderr"]
 
 
@@ -1003,3 +1008,41 @@ def test_outputs_killed_at_any_move_are_the_earlier_or_the_new_set_after_the_nex
     # every point reached: killed before the commit (the first rename) the earlier set,
     # after it (at each of the 6 moves) the new one, and a run that finished
     assert outcomes == ["earlier"] + ["new"] * 7
+
+
+def test_store_measurements_analysed_with_a_baseline_are_calibrated_before_it(monkeypatch,
+                                                                             tmp_path):
+    # `analyze --baseline-loss-factor 0.003 --structure-mass 0.17` (what report advises, to set
+    # the measurement beside the raw DEM's particles-only SDC) saved the SDC with the empty
+    # coupon's damping taken off; calibrate --store fitted that SDC with an observation model
+    # that adds the baseline again (predicted_sdc): counted twice, a fixed baseline
+    # over-predicted every point and a fitted one went to about 0. The stored complex power is
+    # that before the subtraction: 2 pi Re/Im is the SDC the observation model predicts.
+    import pandas as pd
+
+    from pidcore.calibrate import measured_from_store
+
+    re_w, im_w = 0.0491936, 0.160121  # a 200 Hz, 5 g tungsten carbide test's P_c
+    raw = 2 * math.pi * re_w / im_w
+    # taken off: eta_0 Q_s / Im with Q_s = 1/2 w m_s V^2 = 0.16258 W (0.17 kg, 0.039 m/s)
+    subtracted = raw - 2 * math.pi * 0.003 * 0.16258 / im_w
+    frame = pd.DataFrame({
+        "source": ["with.uff", "without.uff"],
+        "frequency_hz": [200.0, 400.0], "acceleration_g": [5.0, 5.0],
+        "fill_percent": [20.0, 20.0], "sdc": [subtracted, 2.22], "sdc_stderr": [0.69, 0.77],
+        "complex_power_real_w": [re_w, 0.0305], "complex_power_imag_w": [im_w, 0.0863],
+        "parameters_json": [json.dumps({"baseline_loss_factor": 0.003,
+                                        "structure_mass_kg": 0.17}),
+                            json.dumps({"baseline_loss_factor": 0.0})]})
+    monkeypatch.setattr(Store, "list_analyses", lambda self: frame)
+    notes: list[str] = []
+    points = {p.frequency_hz: p for p in measured_from_store(tmp_path / "s.h5", left_out=notes)}
+    # exactly the SDC before the subtraction (rel 1e-12: one division and product)
+    assert points[200.0].sdc == pytest.approx(raw, rel=1e-12)
+    assert points[200.0].sdc != pytest.approx(subtracted, rel=1e-3)  # 0.0319 apart
+    assert points[200.0].sdc_stderr == pytest.approx(0.69)
+    # a record analysed without a baseline keeps its stored SDC, whatever its P_c says
+    assert points[400.0].sdc == pytest.approx(2.22, rel=1e-12)
+    (note,) = notes
+    assert note.startswith("with.uff: analysed with baseline_loss_factor 0.003 taken off")
+    assert f"{raw:.4g} (not {subtracted:.4g})" in note

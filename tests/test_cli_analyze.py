@@ -645,3 +645,20 @@ def test_analyze_table_and_app_write_one_sdc_with_its_error(tmp_path, sdc, stder
     head = SimpleNamespace(measured=sdc, measured_stderr=stderr, measured_kind="Eq. 10",
                            dem=sdc, dem_stderr=stderr, verdict="v")
     assert workbench.headline_heading(head) == f"measured (Eq. 10) {shown} vs our DEM {shown} — v"
+
+
+def test_a_two_word_material_in_a_file_name_is_named_whole(tmp_path, capsys):
+    # `analyze panel_fill40_tungsten_carbide.csv` without --specimen said the file name states
+    # 'carbide' (the alphabetically first of its words) and to "give --specimen FILE whose
+    # particles are carbide": a specimen of tungsten_carbide, as its file spells it, is meant
+    path = export(tmp_path / "panel_fill40_tungsten_carbide.csv", fmt="csv")
+    assert main(["analyze", str(path), "--no-store"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1
+    assert "file name states particle material 'tungsten_carbide'" in err
+    assert "whose particles are tungsten_carbide" in err
+    # the same file analysed with the tungsten carbide specimen is that specimen's test
+    spec = tmp_path / "wc.toml"
+    spec.write_text(STEEL_SPECIMEN.replace('material = "steel"', 'material = "tungsten_carbide"'))
+    doc = run_json([str(path), "--specimen", str(spec), "--no-store"], capsys)
+    assert doc["records"][0]["load_case"].endswith("_fill40pct_tungsten_carbide_z")

@@ -134,3 +134,57 @@ def test_own_specimen_exports_refuse_one_file_written_twice(tmp_path):
         own_specimen_exports(paper_specimen(), [(500, 5, 50, "csv"), (500, 5, 50, "csv")],
                              tmp_path, config=DemConfig(cells=1, steady_cycles=10))
     assert not any(tmp_path.iterdir())  # refused before any run or file
+
+
+def _synthetic_dem_record(cycles: int, frequency_hz: float = 200.0):
+    """A DEM-like shaker record of ``cycles`` whole drive periods at the DEM's 128 samples per
+    period: a mass-like force with a damping part (Re(P_c) > 0, Im(P_c) > 0)."""
+    n = cycles * 128
+    t = np.arange(n) / (128 * frequency_hz)
+    w = 2 * math.pi * frequency_hz
+    # velocity is -a/w cos(wt) in virtual_shaker_measurement: damping force in phase with it
+    return t, 0.2 * 49.0 * np.sin(w * t) - 0.5 * np.cos(w * t)
+
+
+@pytest.mark.parametrize("cycles,accepted", [(13, False), (14, True)])
+def test_export_trim_leaves_what_the_analysis_needs(cycles, accepted):
+    """The bound own_specimen_exports checks is the real one: a steady record of 14 cycles
+    exports 10 whole periods, which the analysis takes; 13 cycles export 9, refused."""
+    from pidcore.errors import PidcoreError
+
+    t, force = _synthetic_dem_record(cycles)
+    m = virtual_shaker_measurement(time_s=t, shaker_force_n=force, frequency_hz=200.0,
+                                   acceleration_m_s2=49.0, source="x", velocity_delay_s=0.0,
+                                   snr_db=60.0, seed=1)
+    if accepted:
+        assert analyze_measurement(m, AnalysisOptions()).analysis.loss_factor > 0
+    else:
+        with pytest.raises(PidcoreError, match="expected at least 10"):
+            analyze_measurement(m, AnalysisOptions())
+
+
+def test_own_specimen_exports_refuse_too_few_cycles_before_any_run(tmp_path, monkeypatch):
+    """steady_cycles = 10 (a quick trial of docs/trial_own_specimen/make_measurements.py) wrote
+    exports of 6 drive periods wherever a run reached its transient cap (the export drops two
+    periods each end), which `pidcore analyze` refuses (10 needed) -- found only after every
+    DEM run. It must be refused before any run or file; 14 cycles, 10 periods, pass."""
+    import pidcore.dem.simulate as simulate
+    from pidcore.errors import ParameterError
+    from pidcore.samples import own_specimen_exports
+    from pidcore.specimen import paper_specimen
+
+    class Ran(Exception):
+        pass
+
+    def no_run(*args, **kwargs):
+        raise Ran
+
+    monkeypatch.setattr(simulate, "simulate_load_case", no_run)
+    with pytest.raises(ParameterError, match=r"steady_cycles 10 gives exports of 6 drive "
+                                             r"periods.*expected steady_cycles >= 14"):
+        own_specimen_exports(paper_specimen(), [(500, 5, 50, "csv")], tmp_path / "out",
+                             config=DemConfig(cells=1, steady_cycles=10))
+    assert not (tmp_path / "out").exists()
+    with pytest.raises(Ran):  # 14 cycles pass the check and reach the DEM
+        own_specimen_exports(paper_specimen(), [(500, 5, 50, "csv")], tmp_path / "out",
+                             config=DemConfig(cells=1, steady_cycles=14))

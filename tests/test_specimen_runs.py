@@ -757,3 +757,33 @@ def test_a_run_of_spheres_that_fit_only_as_a_column_names_it():
     beads = simulate_load_case(LoadCase(1000.0, 5.0, 25.0, "steel"), TINY,
                                specimen=load_specimen(STEEL))
     assert not [n for n in beads.notes if "radius_m" in n]
+
+
+def test_dem_run_baseline_note_does_not_put_the_structure_in_a_particles_only_m_c(capsys,
+                                                                                  tmp_path):
+    # under --mass-convention particles m_c is the particles' mass alone, yet the note said
+    # "0.0483 kg of m_c = ... kg" as if the coupon and fixture were part of it; the share
+    # 2 pi eta_0 m_structure / m_c it prints is right either way
+    import math
+
+    damped = tmp_path / "damped.toml"
+    damped.write_text(STEEL.read_text().replace("baseline_loss_factor = 0.0",
+                                                "baseline_loss_factor = 0.002"))
+    args = ["dem", "run", "--specimen", str(damped), "--frequency", "1000", "--acceleration",
+            "5", "--cells", "1", "--cycles", "2", "--no-progress", "--json"]
+    assert main([*args, "--mass-convention", "particles"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    (note,) = [n for n in doc["notes"] if "baseline_loss_factor" in n]
+    particles = doc["particles_per_cell"] * doc["coupon_cells"] * doc["particle_mass_kg"]
+    # m_c is the particles alone (rel 1e-9: the same sum, another order of additions)
+    assert doc["vibrated_mass_kg"] == pytest.approx(particles, rel=1e-9)
+    assert " kg of m_c = " not in note
+    assert (f"0.0483 kg beside m_c = {doc['vibrated_mass_kg']:.4g} kg of the particles alone"
+            in note)
+    share = 0.0483 / doc["vibrated_mass_kg"]
+    assert f"i.e. {2 * math.pi * 0.002 * share:.3g} in this SDC" in note
+    # the default convention keeps its wording: m_c holds the structure
+    assert main(args) == 0
+    (note,) = [n for n in json.loads(capsys.readouterr().out)["notes"]
+               if "baseline_loss_factor" in n]
+    assert " kg of m_c = " in note

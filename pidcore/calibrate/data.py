@@ -225,6 +225,49 @@ def _point_sdc_bound(fill_percent: float, material: str, specimen_name: str,
                               given=given, record=record)
 
 
+def _stored_baseline(parameters: object) -> float:
+    """The ``baseline_loss_factor`` a stored analysis subtracted (its ``parameters_json``);
+    0 where none, or where the record states no parameters."""
+    import json
+
+    if not isinstance(parameters, str) or not parameters:
+        return 0.0
+    try:
+        value = json.loads(parameters).get("baseline_loss_factor", 0.0)
+    except (ValueError, AttributeError):
+        return 0.0
+    return float(value) if isinstance(value, (int, float)) and math.isfinite(value) else 0.0
+
+
+def _before_baseline(frame: pd.DataFrame, notes: list[str] | None) -> pd.DataFrame:
+    """Each record's Eq. 11 SDC before the empty coupon's damping was taken off it.
+
+    The observation model adds the baseline (fitted, or the specimen's) to the DEM's SDC
+    (:func:`pidcore.calibrate.surrogate.predicted_sdc`), so a record analysed with
+    ``baseline_loss_factor`` (``analyze --baseline-loss-factor``, as ``report`` advises for
+    the raw DEM's comparison) lost it twice: the fitted baseline went to about 0, or a fixed
+    one over-predicted every point by 2 pi eta_0 m_s / m_c. The stored complex power is that
+    before the subtraction (:class:`pidcore.signal.PowerAnalysis`), so 2 pi Re/Im is that SDC;
+    its standard error is the record's (the subtraction is of the drive's own amplitude).
+    """
+    if "parameters_json" not in frame.columns or frame.empty:
+        return frame
+    eta = frame["parameters_json"].map(_stored_baseline)
+    raw = 2 * math.pi * (pd.to_numeric(frame.get("complex_power_real_w"), errors="coerce")
+                         / pd.to_numeric(frame.get("complex_power_imag_w"), errors="coerce"))
+    undo = (eta > 0) & raw.notna() & np.isfinite(raw)
+    if not undo.any():
+        return frame
+    if notes is not None:
+        for (_, row), value, subtracted in zip(frame[undo].iterrows(), raw[undo], eta[undo],
+                                               strict=True):
+            notes.append(f"{stored_record_name(row)}: analysed with baseline_loss_factor "
+                         f"{subtracted:g} taken off; its SDC before that, {value:.4g} (not "
+                         f"{float(row['sdc']):.4g}), is calibrated, since the calibration "
+                         "adds the baseline to its prediction")
+    return frame.assign(sdc=frame["sdc"].where(~undo, raw))
+
+
 def measured_from_store(store_path: str | os.PathLike, *,
                         left_out: list[str] | None = None,
                         specimen: Specimen | None = None) -> list[MeasuredPoint]:
@@ -286,6 +329,7 @@ def measured_from_store(store_path: str | os.PathLike, *,
                         f"{found[0].message}"
                         for name, found in zip(names, implausible, strict=True) if found)
     frame = frame[[not found for found in implausible]]
+    frame = _before_baseline(frame, left_out)
     # measured frequency and acceleration scatter about the nominal ones: a load case is the
     # frequency to 3 significant digits, the acceleration to 2 (e.g. 50.02 Hz, 4.97 g -> 50, 5)
     frame = frame.assign(

@@ -430,10 +430,15 @@ def _baseline_note(specimen, result) -> str:
     if eta <= 0:
         return ""
     share = result.moving_mass_kg / result.vibrated_mass_kg
+    # m_c holds the coupon and fixture except under --mass-convention particles, where the
+    # note said "0.17 kg of m_c = 0.2528 kg" of an m_c of the particles alone
+    within = (f"{result.moving_mass_kg:.4g} kg beside m_c = {result.vibrated_mass_kg:.4g} kg "
+              "of the particles alone (--mass-convention particles)"
+              if result.config.vibrated_mass == "particles" else
+              f"{result.moving_mass_kg:.4g} kg of m_c = {result.vibrated_mass_kg:.4g} kg")
     return (f"SDC of the particles alone: the specimen's [coupon] baseline_loss_factor {eta:g} "
             f"(the empty coupon's damping: 2 pi x {eta:g} of the coupon and fixture's own "
-            f"kinetic energy, {result.moving_mass_kg:.4g} kg of m_c = "
-            f"{result.vibrated_mass_kg:.4g} kg, i.e. {2 * math.pi * eta * share:.3g} in this "
+            f"kinetic energy, {within}, i.e. {2 * math.pi * eta * share:.3g} in this "
             "SDC) is not in it; pidcore calibrate's prediction adds it")
 
 

@@ -179,6 +179,23 @@ def _own_material_tokens(stem: str, materials: tuple[str, ...]) -> set[str]:
     return _material_tokens(stem, (m for m in materials if m not in PARTICLE_MATERIALS))
 
 
+def _untabulated_names(stem: str, parts: set[str]) -> list[str]:
+    """Particle materials the table lacks that ``stem`` names, in its order, each as a
+    specimen file writes it: adjacent tokens joined by ``_`` (``..._tungsten_carbide`` is
+    ``tungsten_carbide``; the refusal named ``'carbide'``, the first of its tokens in
+    alphabetical order, and asked for a specimen "whose particles are carbide"). Tokens of
+    ``parts`` (the known materials' words) are none."""
+    names: list[str] = []
+    run: list[str] = []
+    for token in [*re.split(r"[_\-. ]", stem.lower()), ""]:
+        if token in UNTABULATED_PARTICLE_MATERIALS and token not in parts:
+            run.append(token)
+        elif run:
+            names.append("_".join(run))
+            run = []
+    return names
+
+
 def _refuse_untabulated_material(path: Path, known: tuple[str, ...],
                                  specimen_material: str | None = None) -> None:
     """A file name naming a particle material that neither the table nor a specimen knows
@@ -187,7 +204,7 @@ def _refuse_untabulated_material(path: Path, known: tuple[str, ...],
     whose particles are steel" of a user who had given one of tungsten carbide)."""
     # a specimen's "steel_440c" is the file name's "steel"
     parts = {part for k in known for part in k.split("_")}
-    named = sorted(_material_tokens(path.stem, UNTABULATED_PARTICLE_MATERIALS) - parts)
+    named = _untabulated_names(path.stem, parts)
     if named:
         lacks = f"material table ({', '.join(PARTICLE_MATERIALS)}) lacks"
         if specimen_material is not None and specimen_material not in PARTICLE_MATERIALS:
