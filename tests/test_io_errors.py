@@ -249,3 +249,36 @@ def test_a_header_of_fewer_names_than_columns_says_so(tmp_path):
                                              r"columns but the data rows hold 3 cells; expected "
                                              r"one name per column"):
         read_measurement(path)
+
+
+def test_a_58b_record_declaring_more_samples_than_its_block_holds_is_refused(tmp_path):
+    # record 7's num_pts 100 above the ID line's byte count: the samples were read on into the
+    # next dataset's header bytes (100 values of ~1e-157 appended to the force, kept: only
+    # the last record of a file ran into its end and was refused)
+    import re
+
+    from pidcore.measure import analyze_measurement
+
+    fs, f, phi, n = 5120.0, 100.0, np.radians(80.0), 10240
+    t = np.arange(n) / fs
+    channels = (Channel("Force", "force", 10.0 * np.sin(2 * np.pi * f * t), fs, "N"),
+                Channel("Velocity", "velocity", 0.05 * np.sin(2 * np.pi * f * t - phi), fs,
+                        "m/s"),
+                Channel("Tacho", "voltage", np.sign(np.sin(2 * np.pi * f * t)), fs, "V"))
+    good = tmp_path / "good.uff"
+    write_measurement(Measurement("m", channels), good, "uff", binary=True)
+    # the intact file reads to its samples and the analytic loss factor cot(phi) (paper
+    # Eq. 11, P_c = 1/2 F0 V0 e^{j phi}); float64 samples, noise-free: 1e-9 of it
+    read = read_measurement(good)
+    assert [c.data.size for c in read.channels] == [n, n, n]
+    assert analyze_measurement(read).analysis.loss_factor == pytest.approx(1 / np.tan(phi),
+                                                                           rel=1e-9)
+    raw = good.read_bytes()
+    record_7 = re.compile(rb"(\n\s+4\s+)" + str(n).encode() + rb"(\s)")
+    assert len(record_7.findall(raw)) == 3
+    bad = tmp_path / "num_pts.uff"
+    bad.write_bytes(record_7.sub(lambda m: m.group(1) + str(n + 100).encode() + m.group(2), raw,
+                                 count=1))
+    with pytest.raises(InputFileError, match=r"num_pts\.uff: record 1 holds 10240 of its 10340 "
+                                             r"samples; the file is truncated or corrupt"):
+        read_measurement(bad)

@@ -356,7 +356,13 @@ def _binary_58_record(path: str | os.PathLike[str], start: int) -> dict | None:
         num_pts = int(dset.get("num_pts", 0))
         if dtype is None or int(dset.get("abscissa_spacing", 0)) != 1 or num_pts < 1:
             return None
-        values = np.fromfile(fh, dtype=dtype, count=num_pts)
+        # no further than the block's binary bytes the ID line states (field 6), which is
+        # where pyuff ends the block: a num_pts (record 7) larger than they hold read the
+        # next dataset's header as samples (1e-157 ...), silently kept where that record
+        # was not the last of the file; a short read is refused by _record_channel
+        n_bytes = int(dset.get("n_bytes", 0) or 0)
+        count = num_pts if n_bytes <= 0 else min(num_pts, n_bytes // np.dtype(dtype).itemsize)
+        values = np.fromfile(fh, dtype=dtype, count=count)
     dset["data"] = values.astype(np.float64, copy=False)
     return dset
 
