@@ -112,10 +112,21 @@ def canonical_unit_text(text: str) -> str:
     return _cased_text(text).lower()
 
 
+#: A product or negative power of units written as the SI brochure writes it (m·s⁻¹).
+_SI_PRODUCT = re.compile("[·⋅⁻]")
+_SI_PRODUCT_CHARACTERS = str.maketrans({"·": "*", "⋅": "*", "⁻": "^-", "¹": "1", "²": "2",
+                                        "³": "3", "⁴": "4"})
+
+
 def _cased_text(text: str) -> str:
     """A unit label without brackets, blanks and typographic variants, its case kept."""
     t = text.strip().strip("()[]{} ")
     t = t.replace("µ", "u").replace("μ", "u")  # micro sign and Greek mu
+    if _SI_PRODUCT.search(t):
+        # the SI brochure's notation, m·s⁻¹, m s⁻²: a product of powers (refused as no unit,
+        # and 'm s^-1' with its blank taken out was 'ms^-1', per millisecond)
+        t = re.sub(r"(?<=[^\s/*·⋅])\s+(?=[A-Za-z])", "*", t.strip())
+        t = t.translate(_SI_PRODUCT_CHARACTERS)
     t = t.replace("²", "^2").replace("\ufffd", "^2")  # Latin-1 0xB2 decoded with errors='replace'
     t = t.replace("**", "^").replace(" ", "")
     t = re.sub(r"/([sS])2$", r"/\1^2", t)

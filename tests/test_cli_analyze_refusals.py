@@ -7,6 +7,7 @@ import math
 import re
 from pathlib import Path
 
+import numpy as np
 import pytest
 from _shaker_files import file_sha256, write_force_velocity
 
@@ -425,3 +426,44 @@ def test_a_row_pooling_a_stored_implausible_result_says_so_and_judges_no_band(tm
     assert pooled[CALIBRATED_INSIDE_COLUMN] == NOT_COMPARED
     assert "kept as accepted: rec_fill50.csv (SDC 20" in pooled["note"]
     assert "ok_fill50.csv (" not in pooled["note"]
+
+
+def _export_without_velocity(path: Path) -> Path:
+    """Force and acceleration only (no vibrometer): the velocity comes from the acceleration."""
+    from pidcore.io import write_measurement
+    from pidcore.records import Channel, Measurement
+
+    rec = synthesize_shaker_record(mass_kg=MASS, acceleration_amplitude_m_s2=ACCEL,
+                                   frequency_hz=FREQ, sample_rate_hz=FS, n_periods=15.0,
+                                   viscous_damping_n_s_m=C_VISCOUS, snr_db=60, seed=5)
+    acceleration = np.gradient(rec.velocity_m_s, 1.0 / FS)
+    write_measurement(Measurement(path.name, (
+        Channel("Force", "force", rec.force_n, FS, "N"),
+        Channel("Acc", "acceleration", acceleration, FS, "m/s^2"))), path, "csv")
+    return path
+
+
+@pytest.mark.parametrize("option, refused_file, said", [
+    # the second file of the batch has no vibrometer: the delay given for every file cannot
+    # apply to it ("--velocity-delay: a vibrometer delay needs a velocity channel" named no file)
+    (["--velocity-delay", "2e-4"], "acc_only.csv", "--velocity-delay: a vibrometer delay needs "
+     "a velocity channel"),
+    # 0.1 s is beyond 4 periods of 100 Hz (0.04 s) of both files; the first one is refused
+    (["--velocity-delay", "0.1"], "rec.csv", "--velocity-delay: 0.1 s is longer than 4 drive "
+     "periods of 100 Hz"),
+    # a hint above the Nyquist frequency of the files' rate (12.8 kHz)
+    (["--frequency", "20000"], "rec.csv", "--frequency: 20000 Hz is not below the Nyquist "
+     "frequency 12800 Hz"),
+])
+def test_a_per_file_refusal_of_an_option_names_the_file(tmp_path, capsys, option, refused_file,
+                                                         said):
+    # an option applies to every file of a batch, and these refusals depend on the file (its
+    # channels, drive frequency, sample rate): without the file's name the user of a batch
+    # could not tell which export to look at
+    store = tmp_path / "s.h5"
+    first = export(tmp_path / "rec.csv")
+    assert main(["analyze", str(first), "--store", str(store), "--no-progress"]) == 0
+    capsys.readouterr()
+    second = _export_without_velocity(tmp_path / "acc_only.csv")
+    err = _refused([str(first), str(second), *option, "--no-progress"], store, capsys)
+    assert f"{tmp_path / refused_file}: {said}" in err, err

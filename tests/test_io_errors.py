@@ -203,3 +203,82 @@ def test_instance_of_quotes_a_long_value_by_its_start_and_size():
                                   f"({len(shown)} characters)")
     assert clipped("short", 60) == "short"  # a value that fits is quoted whole
     assert clipped("x" * 81) == "x" * 60 + "... (81 characters)"
+
+
+def _shaker_rows(separator: str) -> tuple[str, float]:
+    """Rows of F = F0 sin(wt), V = V0 sin(wt - phi) with decimal commas, and the loss factor
+    cot(phi) they hold (paper Eq. 11: P_c = 1/2 F0 V0 e^{j phi})."""
+    fs, f, phi = 5120.0, 100.0, np.radians(80.0)
+    t = np.arange(int(fs)) / fs
+    force, velocity = 10.0 * np.sin(2 * np.pi * f * t), 0.05 * np.sin(2 * np.pi * f * t - phi)
+    rows = "".join(separator.join(f"{x:.9g}".replace(".", ",") for x in row) + "\n"
+                   for row in zip(t, force, velocity, strict=True))
+    return rows, 1.0 / np.tan(phi)
+
+
+def test_a_decimal_comma_in_a_comma_separated_export_is_named_not_a_missing_header(tmp_path):
+    # German Excel saving "CSV (comma delimited)" writes 0,5,12,3: every number split in two,
+    # six cells under three names; refused as "no header row before the numbers", which sent
+    # the user looking for a header that is there
+    rows, _ = _shaker_rows(",")
+    path = tmp_path / "run 7.csv"
+    path.write_text("Testlab export\nTime [s],Force [N],Velocity [m/s]\n" + rows)
+    with pytest.raises(InputFileError) as refused:
+        read_measurement(path)
+    said = str(refused.value)
+    # the first row (t = 0, F = 0) is "0,0,-0,0492..." (4 cells), the others 6
+    assert said.startswith(f"{path}: the header (line 2) names 3 columns but the data rows "
+                           "hold 4 to 6 cells; numbers with a decimal comma"), said
+    assert "';' or tab" in said and "\n" not in said
+    # the same numbers separated by ';' (the advice) read and analyse to the truth
+    from pidcore.measure import analyze_measurement
+
+    rows, eta = _shaker_rows(";")
+    path.write_text("Testlab export\nTime [s];Force [N];Velocity [m/s]\n" + rows)
+    # noise-free, 9 significant digits (relative rounding 5e-9 per sample): 1e-6 catches any
+    # mis-split column (a loss factor off by 100 %) and any unit or phase slip
+    assert analyze_measurement(read_measurement(path)).analysis.loss_factor == \
+        pytest.approx(eta, rel=1e-6)
+
+
+def test_a_header_of_fewer_names_than_columns_says_so(tmp_path):
+    rows, _ = _shaker_rows(";")
+    path = tmp_path / "short.csv"
+    path.write_text("Time [s];Force [N]\n" + rows)  # the velocity column has no name
+    with pytest.raises(InputFileError, match=r"short\.csv: the header \(line 1\) names 2 "
+                                             r"columns but the data rows hold 3 cells; expected "
+                                             r"one name per column"):
+        read_measurement(path)
+
+
+def test_a_58b_record_declaring_more_samples_than_its_block_holds_is_refused(tmp_path):
+    # record 7's num_pts 100 above the ID line's byte count: the samples were read on into the
+    # next dataset's header bytes (100 values of ~1e-157 appended to the force, kept: only
+    # the last record of a file ran into its end and was refused)
+    import re
+
+    from pidcore.measure import analyze_measurement
+
+    fs, f, phi, n = 5120.0, 100.0, np.radians(80.0), 10240
+    t = np.arange(n) / fs
+    channels = (Channel("Force", "force", 10.0 * np.sin(2 * np.pi * f * t), fs, "N"),
+                Channel("Velocity", "velocity", 0.05 * np.sin(2 * np.pi * f * t - phi), fs,
+                        "m/s"),
+                Channel("Tacho", "voltage", np.sign(np.sin(2 * np.pi * f * t)), fs, "V"))
+    good = tmp_path / "good.uff"
+    write_measurement(Measurement("m", channels), good, "uff", binary=True)
+    # the intact file reads to its samples and the analytic loss factor cot(phi) (paper
+    # Eq. 11, P_c = 1/2 F0 V0 e^{j phi}); float64 samples, noise-free: 1e-9 of it
+    read = read_measurement(good)
+    assert [c.data.size for c in read.channels] == [n, n, n]
+    assert analyze_measurement(read).analysis.loss_factor == pytest.approx(1 / np.tan(phi),
+                                                                           rel=1e-9)
+    raw = good.read_bytes()
+    record_7 = re.compile(rb"(\n\s+4\s+)" + str(n).encode() + rb"(\s)")
+    assert len(record_7.findall(raw)) == 3
+    bad = tmp_path / "num_pts.uff"
+    bad.write_bytes(record_7.sub(lambda m: m.group(1) + str(n + 100).encode() + m.group(2), raw,
+                                 count=1))
+    with pytest.raises(InputFileError, match=r"num_pts\.uff: record 1 holds 10240 of its 10340 "
+                                             r"samples; the file is truncated or corrupt"):
+        read_measurement(bad)

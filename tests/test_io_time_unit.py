@@ -188,7 +188,7 @@ def test_a_hint_above_the_rate_of_a_time_base_in_ms_names_the_time_unit(tmp_path
     path = uff_in_ms(tmp_path / "s", b"s   ")
     err = refusal(["analyze", str(path), "--no-store", "--no-progress", "--frequency", "50"],
                   capsys)
-    assert err == ("pidcore analyze: error: --frequency: 50 Hz is not below the Nyquist "
+    assert err == (f"pidcore analyze: error: {path}: --frequency: 50 Hz is not below the Nyquist "
                    "frequency 12.8 Hz of the sample rate 25.6 Hz; correct the hint, or the "
                    "file's time unit (--time-unit UNIT) where its time base is in ms or us "
                    "read as s")

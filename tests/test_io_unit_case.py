@@ -402,3 +402,28 @@ def test_a_mega_unit_in_the_name_contradicts_a_milli_unit_row(tmp_path, capsys):
     err = refusal(["analyze", str(path), "--no-store", "--no-progress"], capsys)
     assert "'Mm/s in the name, mm/s in the unit row'" in err and "--velocity-unit" in err
     same_power(analyze_json(path, capsys, "--velocity-unit", "mm/s"), sample_record(capsys))
+
+
+# --- the SI brochure's notation: products and negative powers ------------------------------
+
+@pytest.mark.parametrize(("velocity", "v_scale", "acceleration", "a_scale"), [
+    ("m·s⁻¹", 1.0, "m·s⁻²", 1.0),
+    ("mm·s⁻¹", 1e3, "mm·s⁻²", 1e3),
+    ("m s⁻¹", 1.0, "m s⁻²", 1.0),  # the blank as the product, as SI also writes it
+    ("mm⋅s⁻¹", 1e3, "m⋅s⁻²", 1.0),  # U+22C5, the dot operator
+])
+def test_units_written_as_products_of_powers_are_read(tmp_path, capsys, velocity, v_scale,
+                                                      acceleration, a_scale):
+    # 'm·s⁻¹' (how the SI brochure and ISO 80000 write m/s) was refused as no unit, and
+    # 'm s⁻¹' with its blank taken out would read as 'ms^-1', per millisecond
+    truth = sample_record(capsys)
+    path = derived_csv(tmp_path / "iso_fill50.csv",
+                       {"Velocity [m/s]": f"Velocity [{velocity}]",
+                        "Acceleration [m/s^2]": f"Acceleration [{acceleration}]"},
+                       {"Velocity": v_scale, "Acceleration": a_scale})
+    measured = read_measurement(path)
+    original = np.loadtxt(SAMPLE_CSV, delimiter=",", skiprows=1)
+    for name in ("Velocity", "Acceleration"):  # each in SI as the original file holds it
+        np.testing.assert_allclose(measured.channel(name).data, original[:, COLUMN[name]],
+                                   rtol=SAME)
+    same_power(analyze_json(path, capsys), truth)

@@ -253,10 +253,24 @@ def _layout(lines: list[str], where: str) -> tuple[int, str, list[str], list[str
     data = [lines[j] for j in candidates if j >= first][:200]
     delimiter = _delimiter(data[:3])
     n_cols = len(_cells(data[0], delimiter))
-    text_rows = [lines[j] for j in candidates if j < first and not lines[j].lstrip()
-                 .startswith("#")]
-    text_rows = [r for r in text_rows if len(_cells(r, delimiter)) >= n_cols
-                 or (delimiter == r"\s+" and len(_cells(r, delimiter)) >= 1)]
+    before = [j for j in candidates if j < first and not lines[j].lstrip().startswith("#")]
+    text_rows = [lines[j] for j in before if len(_cells(lines[j], delimiter)) >= n_cols
+                 or (delimiter == r"\s+" and len(_cells(lines[j], delimiter)) >= 1)]
+    if not text_rows and before and 2 <= len(_cells(lines[before[-1]], delimiter)) < n_cols:
+        # a header of fewer names than the rows have cells: "no header row" sent the user
+        # looking for a header that is there; a decimal comma in a comma-separated export
+        # (0,5,12,3 under Time,Force) splits every number in two
+        short = len(_cells(lines[before[-1]], delimiter))
+        counts = [len(_cells(row, delimiter)) for row in data]
+        low, high = min(counts), max(counts)
+        # a number printed without decimals (0) stays one cell: rows of 4 to 6 under 3 names
+        why = ("; numbers with a decimal comma in a comma-separated file split in two: "
+               "export with ';' or tab as the separator, or quote the cells"
+               if delimiter == "," and (high == 2 * short or low != high) else "")
+        held = f"{low}" if low == high else f"{low} to {high}"
+        raise InputFileError(f"{where}: the header (line {before[-1] + 1}) names {short} "
+                             f"columns but the data rows hold {held} cells{why}; expected "
+                             "one name per column, such as 'Time [s],Force [N],Velocity [m/s]'")
     if not text_rows:
         raise InputFileError(f"{where}: no header row before the numbers; expected names such "
                              "as 'Time [s],Force [N],Velocity [m/s]'")

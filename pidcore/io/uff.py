@@ -23,8 +23,10 @@ pyuff reads them, bit for bit) instead of through Python lists. What this module
   its values with quantity ``"unknown"``, whose unit the analysis asks for.
 * Quirks handled: the zero padding of the last data line (values beyond ``num_pts`` are
   dropped), an extra CR LF after 58b binary data (pyuff ignores the stray bytes), E13.5 fields
-  without separating blanks and 3-digit exponents (pyuff reads fixed columns), Latin-1 header
-  bytes (decoded with replacement; they only occur in labels).
+  without separating blanks and 3-digit exponents (pyuff reads fixed columns), header text
+  that is not UTF-8 (read as Windows-1252, as Windows exporters write ``µm/s`` and
+  ``Prüfling``: decoded with replacement, the unit was refused and the name could not be
+  typed).
 * The sample interval is written with six significant digits (E13.5), so the rate is snapped to
   the roundest one within that resolution (65 535.95 Hz -> 65 536 Hz, 409 599.37 Hz ->
   409 600 Hz).
@@ -333,6 +335,27 @@ class _BlockScannedUFF(pyuff.UFF):
             return None
 
 
+def _utf8_header(header: bytes) -> bytes:
+    """A record's header lines as UTF-8, which pyuff decodes (with replacement: every other
+    byte above 0x7F became U+FFFD). Header text that is not UTF-8 is Windows-1252, which
+    Test.Lab and other Windows exporters write: ``µm/s`` (0xB5) was refused as no unit and a
+    channel ``Prüfling`` (0xFC) could not be named with ``--force``. Each byte is one
+    character either way, so pyuff's fixed columns stay where they were."""
+    try:
+        header.decode("utf-8")
+    except UnicodeDecodeError:
+        return header.decode("cp1252", errors="replace").encode("utf-8")
+    return header
+
+
+def _utf8_text(raw: bytes) -> str:
+    """A whole file's text for the fallback parser: UTF-8, else Windows-1252."""
+    try:
+        return raw.decode("utf-8")
+    except UnicodeDecodeError:
+        return raw.decode("cp1252", errors="replace")
+
+
 def _binary_58_record(path: str | os.PathLike[str], start: int) -> dict | None:
     """The dataset 58b record whose block starts at byte ``start``: its header parsed by
     pyuff, its samples read straight from the file into one array. None for a record this
@@ -350,13 +373,19 @@ def _binary_58_record(path: str | os.PathLike[str], start: int) -> dict | None:
         lines = header.splitlines()
         if len(lines) < _HEADER_LINES_58 or lines[1][6:7].lower() != b"b":
             return None
-        dset = _extract58(header, header_only=True)
+        dset = _extract58(_utf8_header(header), header_only=True)
         dtype = _BINARY_DTYPES.get((int(dset.get("ord_data_type", 0)),
                                     int(dset.get("byte_ordering", 0))))
         num_pts = int(dset.get("num_pts", 0))
         if dtype is None or int(dset.get("abscissa_spacing", 0)) != 1 or num_pts < 1:
             return None
-        values = np.fromfile(fh, dtype=dtype, count=num_pts)
+        # no further than the block's binary bytes the ID line states (field 6), which is
+        # where pyuff ends the block: a num_pts (record 7) larger than they hold read the
+        # next dataset's header as samples (1e-157 ...), silently kept where that record
+        # was not the last of the file; a short read is refused by _record_channel
+        n_bytes = int(dset.get("n_bytes", 0) or 0)
+        count = num_pts if n_bytes <= 0 else min(num_pts, n_bytes // np.dtype(dtype).itemsize)
+        values = np.fromfile(fh, dtype=dtype, count=count)
     dset["data"] = values.astype(np.float64, copy=False)
     return dset
 
@@ -407,7 +436,7 @@ def _ascii_58_record(path: str | os.PathLike[str], first: int, last: int) -> dic
                 or lines[1][6:7].lower() == b"b" or len(header.decode(
                     "utf-8", "replace").splitlines(True)) != _HEADER_LINES_58:
             return None
-        dset = _extract58(header, header_only=True)
+        dset = _extract58(_utf8_header(header), header_only=True)
         width = _ASCII_58_WIDTHS.get(int(dset.get("ord_data_type", 0)))
         if width is None or int(dset.get("abscissa_spacing", 0)) != 1:
             return None
@@ -463,9 +492,8 @@ def _ascii_58_record(path: str | os.PathLike[str], first: int, last: int) -> dic
 def _fallback_records(where: str, raw: bytes, expected: int) -> list[dict]:
     """Dataset 58 records parsed by :mod:`._uff_ascii` (Fortran number rules)."""
     try:
-        # UTF-8 with replacement, as pyuff decodes: a Latin-1 '²' becomes U+FFFD, which
-        # pidcore.units reads as '^2' in a unit label.
-        records = [d for t, d in parse_uff_ascii(raw.decode("utf-8", "replace")) if t == 58]
+        # UTF-8, else Windows-1252 as the fast paths read a header (_utf8_header)
+        records = [d for t, d in parse_uff_ascii(_utf8_text(raw)) if t == 58]
     except ValueError as exc:
         raise InputFileError(f"{where}: dataset 58 is corrupt ({exc}); expected E13.5 or "
                              "E20.12 numbers in fixed columns") from None

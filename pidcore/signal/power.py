@@ -378,7 +378,7 @@ def check_analysis_settings(*, n_harmonics: int = defaults.N_HARMONICS,
 def _check_parameters(sample_rate_hz: float, n_harmonics: int, n_blocks: int, min_periods: int,
                       mass_below_gauge_kg: float, frequency_hz: float | None,
                       velocity_delay_s: float, baseline_loss_factor: float,
-                      structure_mass_kg: float | None = None) -> None:
+                      structure_mass_kg: float | None = None, source: str = "") -> None:
     check_analysis_settings(n_harmonics=n_harmonics, mass_below_gauge_kg=mass_below_gauge_kg,
                             frequency_hz=frequency_hz, velocity_delay_s=velocity_delay_s,
                             baseline_loss_factor=baseline_loss_factor,
@@ -390,17 +390,26 @@ def _check_parameters(sample_rate_hz: float, n_harmonics: int, n_blocks: int, mi
     if frequency_hz is not None and frequency_hz >= sample_rate_hz / 2:
         # a hint the rate cannot hold is a wrong hint or a wrong rate: a time base in ms read
         # as s (a UFF abscissa labelled s, a CSV time column without a unit) is 1000 x too low
-        raise ParameterError(f"frequency_hz: {as_given(frequency_hz)} Hz is not below the Nyquist "
-                             f"frequency {sample_rate_hz / 2:g} Hz of the sample rate "
-                             f"{sample_rate_hz:g} Hz; correct the hint, or the file's time unit "
-                             "(time_unit=UNIT) where its time base is in ms or us read as s")
+        # the rate is this record's: the refusal names it (in a batch, which file)
+        raise ParameterError(f"{_of(source)}frequency_hz: {as_given(frequency_hz)} Hz is not "
+                             f"below the Nyquist frequency {sample_rate_hz / 2:g} Hz of the "
+                             f"sample rate {sample_rate_hz:g} Hz; correct the hint, or the "
+                             "file's time unit (time_unit=UNIT) where its time base is in ms or "
+                             "us read as s")
 
 
 #: The refusal of a negative reactive power says a channel "is probably inverted".
 PROBABLY_INVERTED = "is probably inverted"
 
 
-def _check_delay(velocity_delay_s: float, frequency_hz: float, duration_s: float) -> None:
+def _of(source: str) -> str:
+    """``"SOURCE: "`` that starts a refusal of one record's parameter, ``""`` without one:
+    an option given for every file of a batch is refused for one of them, which it names."""
+    return f"{source}: " if source else ""
+
+
+def _check_delay(velocity_delay_s: float, frequency_hz: float, duration_s: float,
+                 source: str = "") -> None:
     # A vibrometer's output delay is tens of µs to a few ms; a value of several drive periods
     # (or longer than the record) is a unit slip (ms typed as s): the phase correction wraps
     # every period, so such a value cannot be told from a small one and must not pass.
@@ -410,7 +419,7 @@ def _check_delay(velocity_delay_s: float, frequency_hz: float, duration_s: float
         # "longer" delay: it is said as the shift it is
         said = "is longer than" if velocity_delay_s > 0 else "shifts the velocity by more than"
         raise ParameterError(
-            f"velocity_delay_s: {velocity_delay_s:g} s {said} "
+            f"{_of(source)}velocity_delay_s: {velocity_delay_s:g} s {said} "
             f"{defaults.MAX_VELOCITY_DELAY_PERIODS} drive periods of {frequency_hz:.6g} Hz "
             f"({limit:.6g} s, record {duration_s:.6g} s); expected a vibrometer delay in s "
             "(e.g. 2e-4)")
@@ -533,13 +542,14 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
     (0.0064, 0.0064)
     """
     _check_parameters(sample_rate_hz, n_harmonics, n_blocks, min_periods, mass_below_gauge_kg,
-                      frequency_hz, velocity_delay_s, baseline_loss_factor, structure_mass_kg)
+                      frequency_hz, velocity_delay_s, baseline_loss_factor, structure_mass_kg,
+                      source)
     if velocity is None and acceleration is None:
         raise ParameterError(f"{source or 'record'}: neither a velocity nor an acceleration "
                              "channel given; expected at least one")
     if velocity is None and velocity_delay_s:
-        raise ParameterError("velocity_delay_s: a vibrometer delay needs a velocity channel; "
-                             "the velocity here comes from the acceleration")
+        raise ParameterError(f"{_of(source)}velocity_delay_s: a vibrometer delay needs a "
+                             "velocity channel; the velocity here comes from the acceleration")
     acc_name = acceleration_name if velocity is not None else velocity_name
     channels: list[tuple[str, np.ndarray]] = [(force_name, np.asarray(force, dtype=np.float64))]
     if velocity is not None:
@@ -566,7 +576,7 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
     if n_periods < min_periods - 0.005:
         raise SignalError(f"{what}: {n_periods:.2f} drive periods of {freq:.6g} Hz in "
                           f"{n_samples} samples, expected at least {min_periods}")
-    _check_delay(velocity_delay_s, freq, n_samples / sample_rate_hz)
+    _check_delay(velocity_delay_s, freq, n_samples / sample_rate_hz, source)
     max_harm = int(defaults.HARMONIC_MAX_FRACTION_OF_NYQUIST * 0.5 * sample_rate_hz / freq)
     n_harm = min(int(n_harmonics), max_harm)
     if n_harm < 1:
