@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 import os
 import re
 import time
@@ -164,6 +165,34 @@ def test_each_file_is_analysed_with_its_own_corrections_and_mapping(store_file, 
     template = next(b for b in at.get("download_button")
                     if b.proto.label.startswith("Download these settings"))
     assert template is not None
+
+
+def test_compare_judges_a_test_with_its_baseline_taken_off_at_its_sdc_before_it(
+        store_file, tmp_path, monkeypatch):
+    # the upload's loss factor 0.05 (Eq. 11 SDC 0.314) with the empty coupon's 0.02 taken off
+    # reads 2 pi 0.03 = 0.188; the calibration predicts the whole coupon's SDC (it adds a
+    # baseline of its own), so the band 0.25 .. 0.40 holds the test: Compare said 'outside'
+    from pidcore.app.calibration import CALIBRATION_ENV_VAR
+    from pidcore.report.table import CALIBRATED_INSIDE_COLUMN
+
+    cal = _calibration_json(tmp_path / "calibration.json", 100, 5, 50, 0.32, 0.25, 0.40)
+    monkeypatch.setenv(CALIBRATION_ENV_VAR, str(cal))
+    data = mass_damper_csv(frequency_hz=100.0, acceleration_g=5.0, loss_factor=0.05)
+    settings = b"file,baseline_loss_factor\nc_fill50.csv,0.02\n"
+    at = _upload(_app(), [("c_fill50.csv", data), ("setup.csv", settings)])
+    captions = " ".join(c.value for c in at.caption)
+    taken = 2 * math.pi * 0.02  # the whole loss factor: no structure mass given
+    assert "the measured Eq. 11 SDC is inside (judged before the empty coupon's damping, SDC " \
+           f"{taken:.4g}, was taken off: " in captions, captions
+    # the Report tab's row of the saved record: the same verdict, the same part taken off
+    at.button(key="save").click()
+    at.run()
+    table = _table(at, "SDC calibrated DEM (Eq. 11) [-]")
+    row = table[table["SDC measured (Eq. 11) [-]"].notna()]
+    assert row[CALIBRATED_INSIDE_COLUMN].tolist() == ["yes"]
+    # one subtraction's round-off (rel 1e-9)
+    assert row["baseline SDC taken off the measured (Eq. 11) [-]"].tolist() == pytest.approx(
+        [taken], rel=1e-9)
 
 
 def test_negative_loss_factor_is_flagged_and_saving_needs_confirmation(store_file):

@@ -1044,5 +1044,6 @@ def test_store_measurements_analysed_with_a_baseline_are_calibrated_before_it(mo
     # a record analysed without a baseline keeps its stored SDC, whatever its P_c says
     assert points[400.0].sdc == pytest.approx(2.22, rel=1e-12)
     (note,) = notes
-    assert note.startswith("with.uff: analysed with baseline_loss_factor 0.003 taken off")
+    assert note.startswith(f"with.uff: analysed with the empty coupon's damping "
+                           f"(baseline_loss_factor, SDC {raw - subtracted:.3g}) taken off")
     assert f"{raw:.4g} (not {subtracted:.4g})" in note

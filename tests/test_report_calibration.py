@@ -918,3 +918,46 @@ def test_cli_report_of_a_calibration_folder_a_kill_left_half_moved_reads_the_new
     table = pd.read_csv(tmp_path / "report" / "report.csv")
     # exact: the new file's numbers pass through unchanged (read, not computed)
     assert sorted(table[CALIBRATED_COLUMN].dropna()) == [0.24, 0.49]
+
+
+@pytest.mark.usefixtures("undrawn_report_figures")
+def test_a_measurement_with_a_baseline_taken_off_is_judged_at_its_sdc_before_it(tmp_path,
+                                                                                 monkeypatch):
+    # `analyze --baseline-loss-factor` takes the empty coupon's damping off the SDC (as report
+    # advises, to set it beside the raw DEM); the calibration's prediction adds a baseline of
+    # its own, so the verdict compared a particles-only SDC with a prediction of the whole
+    # coupon's: 2 pi 0.03 = 0.188 'outside' a band 0.25 .. 0.40 that holds the test's 0.314
+    from _app_samples import mass_damper_csv
+
+    from pidcore.compare import MEASURED_BASELINE_COLUMN
+
+    monkeypatch.chdir(tmp_path)
+    path = tmp_path / "c_fill50.csv"
+    path.write_bytes(mass_damper_csv(frequency_hz=100.0, acceleration_g=5.0, loss_factor=0.05))
+    store = tmp_path / "s.h5"
+    assert main(["analyze", str(path), "--store", str(store),
+                 "--baseline-loss-factor", "0.02"]) == 0
+    cal = _write(tmp_path / "calibration.json", [_prediction(100, 5, 50, 0.32, 0.25, 0.40)])
+    out = tmp_path / "report"
+    assert main(["report", "--store", str(store), "--calibration", str(cal),
+                 "--format", "csv", "--out", str(out)]) == 0
+    table = pd.read_csv(out / "report.csv")
+    (row,) = table[table["SDC measured (Eq. 11) [-]"].notna()].to_dict("records")
+    # without --structure-mass the whole loss factor 0.02 is taken off: 2 pi 0.02 exactly, up
+    # to the round-off of one subtraction and the CSV's 15+ digits (rel 1e-9)
+    assert row[MEASURED_BASELINE_COLUMN] == pytest.approx(2 * math.pi * 0.02, rel=1e-9)
+    before = row["SDC measured (Eq. 11) [-]"] + row[MEASURED_BASELINE_COLUMN]
+    # the test's own SDC, 2 pi 0.05, within its noise (0.1 % noise: 1e-3 absolute is ~10 sigma)
+    assert before == pytest.approx(2 * math.pi * 0.05, abs=1e-3)
+    assert row[CALIBRATED_INSIDE_COLUMN] == "yes"
+    assert (f"judged at the measured SDC before the empty coupon's damping "
+            f"({2 * math.pi * 0.02:.4g}) was taken off, {before:.4g}") in row["note"]
+    # a record analysed without a baseline: nothing taken off, judged at its own SDC
+    plain = tmp_path / "plain.h5"
+    assert main(["analyze", str(path), "--store", str(plain)]) == 0
+    assert main(["report", "--store", str(plain), "--calibration", str(cal),
+                 "--format", "csv", "--out", str(tmp_path / "plain")]) == 0
+    table = pd.read_csv(tmp_path / "plain" / "report.csv")
+    (row,) = table[table["SDC measured (Eq. 11) [-]"].notna()].to_dict("records")
+    assert row[MEASURED_BASELINE_COLUMN] == 0.0 and row[CALIBRATED_INSIDE_COLUMN] == "yes"
+    assert "judged at the measured SDC before" not in str(row["note"])

@@ -225,20 +225,6 @@ def _point_sdc_bound(fill_percent: float, material: str, specimen_name: str,
                               given=given, record=record)
 
 
-def _stored_baseline(parameters: object) -> float:
-    """The ``baseline_loss_factor`` a stored analysis subtracted (its ``parameters_json``);
-    0 where none, or where the record states no parameters."""
-    import json
-
-    if not isinstance(parameters, str) or not parameters:
-        return 0.0
-    try:
-        value = json.loads(parameters).get("baseline_loss_factor", 0.0)
-    except (ValueError, AttributeError):
-        return 0.0
-    return float(value) if isinstance(value, (int, float)) and math.isfinite(value) else 0.0
-
-
 def _before_baseline(frame: pd.DataFrame, notes: list[str] | None) -> pd.DataFrame:
     """Each record's Eq. 11 SDC before the empty coupon's damping was taken off it.
 
@@ -250,21 +236,30 @@ def _before_baseline(frame: pd.DataFrame, notes: list[str] | None) -> pd.DataFra
     before the subtraction (:class:`pidcore.signal.PowerAnalysis`), so 2 pi Re/Im is that SDC;
     its standard error is the record's (the subtraction is of the drive's own amplitude).
     """
+    from ..measure import baseline_sdc_taken_off
+
     if "parameters_json" not in frame.columns or frame.empty:
         return frame
-    eta = frame["parameters_json"].map(_stored_baseline)
-    raw = 2 * math.pi * (pd.to_numeric(frame.get("complex_power_real_w"), errors="coerce")
-                         / pd.to_numeric(frame.get("complex_power_imag_w"), errors="coerce"))
-    undo = (eta > 0) & raw.notna() & np.isfinite(raw)
+    taken = pd.Series([baseline_sdc_taken_off(row) for _, row in frame.iterrows()],
+                      index=frame.index, dtype=float)
+    raw = pd.to_numeric(frame["sdc"], errors="coerce") + taken
+    undo = (taken != 0) & np.isfinite(raw)
+    if notes is not None:
+        for _, row in frame[~np.isfinite(raw) & frame["sdc"].notna()].iterrows():
+            notes.append(f"{stored_record_name(row)}: analysed with the empty coupon's "
+                         "damping taken off, and no complex power stored to undo it: "
+                         "calibrated at its SDC after the subtraction, which the calibration "
+                         "adds again")
     if not undo.any():
         return frame
     if notes is not None:
-        for (_, row), value, subtracted in zip(frame[undo].iterrows(), raw[undo], eta[undo],
-                                               strict=True):
-            notes.append(f"{stored_record_name(row)}: analysed with baseline_loss_factor "
-                         f"{subtracted:g} taken off; its SDC before that, {value:.4g} (not "
-                         f"{float(row['sdc']):.4g}), is calibrated, since the calibration "
-                         "adds the baseline to its prediction")
+        for (_, row), value, off in zip(frame[undo].iterrows(), raw[undo], taken[undo],
+                                        strict=True):
+            notes.append(f"{stored_record_name(row)}: analysed with the empty coupon's "
+                         f"damping (baseline_loss_factor, SDC {off:.3g}) taken off; its SDC "
+                         "before that, "
+                         f"{value:.4g} (not {float(row['sdc']):.4g}), is calibrated, since "
+                         "the calibration adds the baseline to its prediction")
     return frame.assign(sdc=frame["sdc"].where(~undo, raw))
 
 

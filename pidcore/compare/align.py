@@ -57,6 +57,11 @@ DEM_COLUMNS: tuple[str, ...] = ("frequency_hz", "acceleration_g", "fill_percent"
 MEASURED_EQ11_COLUMN = "SDC measured (Eq. 11) [-]"
 MEASURED_EQ11_STDERR_COLUMN = "SDC measured (Eq. 11) stderr [-]"
 MEASURED_EQ11_DOF_COLUMN = "SDC measured (Eq. 11) stderr dof [-]"
+#: The part of the measured Eq. 11 SDC that its analysis took off as the empty coupon's damping
+#: (``analyze --baseline-loss-factor``; pooled as the SDC is; 0 where none was taken off, NaN
+#: where a record did but its SDC before that is not known): the calibrated DEM predicts the SDC
+#: before the subtraction (it adds a baseline of its own), so its band judges the sum.
+MEASURED_BASELINE_COLUMN = "baseline SDC taken off the measured (Eq. 11) [-]"
 #: The Eq. 11 columns renamed in 2026-12: old name -> new name, for scripts reading a table an
 #: earlier pidcore wrote (``frame.rename(columns=MEASURED_COLUMNS_RENAMED)``): a report.csv
 #: (:data:`pidcore.report.REPORT_COLUMNS_RENAMED`) or a saved :func:`align_measured` frame.
@@ -315,6 +320,19 @@ def pooled_mean(values: np.ndarray, stderrs: np.ndarray) -> tuple[float, float]:
     within = float(np.sqrt(np.sum(stderrs ** 2)) / n) if np.all(np.isfinite(stderrs)) else math.nan
     between = float(np.std(values, ddof=1) / math.sqrt(n))
     return mean, float(np.nanmax([within, between]))
+
+
+def pooled_baseline_sdc(values: np.ndarray, stderrs: np.ndarray, taken: np.ndarray) -> float:
+    """The part of the pooled SDC (:func:`pooled_mean` of ``values``) that the records'
+    analyses took off as the empty coupon's damping, ``taken`` each
+    (:func:`pidcore.measure.baseline_sdc_taken_off`): the pooled SDC before the subtraction
+    less the pooled SDC, whatever weights the pooling gives. 0 where no record took any off;
+    NaN where one did by an unknown amount."""
+    taken = np.asarray(taken, dtype=float)
+    if not np.any(taken):
+        return 0.0
+    values = np.asarray(values, dtype=float)
+    return pooled_mean(values + taken, stderrs)[0] - pooled_mean(values, stderrs)[0]
 
 
 def stored_stderr_dof(value: object) -> float:

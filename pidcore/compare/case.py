@@ -25,6 +25,7 @@ from .align import (
     consistency_chi2,
     filled_corners,
     interpolated_count_and_mass,
+    pooled_baseline_sdc,
     pooled_mean,
     pooled_sdc_eq10,
     pooled_stderr_dof,
@@ -163,6 +164,10 @@ class CaseComparison:
         value the m_c a run at this fill would have
         (:func:`pidcore.compare.align.interpolated_count_and_mass`, as ``pidcore report``
         takes it); NaN where neither is known.
+    measured_baseline_sdc : float
+        The part of ``measured_sdc`` its analyses took off as the empty coupon's damping,
+        pooled alike (:data:`pidcore.compare.align.MEASURED_BASELINE_COLUMN`; 0: none, NaN:
+        not known): ``measured_sdc`` plus it is the SDC the calibrated DEM predicts.
     """
 
     load_case: LoadCase
@@ -181,6 +186,7 @@ class CaseComparison:
     measured_stderr_dof: float = math.nan
     measured_stderr_eq10_dof: float = math.nan
     vibrated_mass_kg: float = math.nan
+    measured_baseline_sdc: float = 0.0
 
 
 def _model_point(model, tol: Tolerances, acceleration_g: float,
@@ -282,6 +288,9 @@ class MeasuredEntry:
     specimen_note: str = ""
     #: the note of :func:`pidcore.compare.plausibility.stored_sdc_bound_and_note`, else ""
     bound_note: str = ""
+    #: the part of ``sdc`` taken off as the empty coupon's damping
+    #: (:func:`pidcore.measure.baseline_sdc_taken_off`; NaN: taken off, amount unknown)
+    baseline_sdc: float = 0.0
 
     @classmethod
     def from_record(cls, record, load_case: LoadCase, *,
@@ -292,6 +301,7 @@ class MeasuredEntry:
         ``specimen_sha256``: the specimen file's hash as it would be saved ("": none);
         ``sdc_bound``: the SDC bound of its specimen
         (:func:`pidcore.compare.plausibility.tested_sdc_bound`; None: 2 pi)."""
+        from ..measure import baseline_sdc_taken_off
         from ..records import measurement_key
         from ..specimen import deciding_sha256
         from .plausibility import implausible_findings
@@ -312,7 +322,8 @@ class MeasuredEntry:
                    measurement_key=content, implausible=found[0].message if found else "",
                    settings=dict(vars(options)) if options else {},
                    sdc_stderr_dof=a.sdc_stderr_dof,
-                   specimen_sha256=deciding_sha256(specimen_sha256) if specimen else "")
+                   specimen_sha256=deciding_sha256(specimen_sha256) if specimen else "",
+                   baseline_sdc=baseline_sdc_taken_off(a))
 
     @classmethod
     def from_store(cls, row: pd.Series, arrays: dict, *, known=()) -> MeasuredEntry:
@@ -321,6 +332,7 @@ class MeasuredEntry:
         specimen files at hand (:class:`pidcore.specimen.Specimen`), among which the one the
         record names gives its SDC bound (:func:`pidcore.compare.plausibility.
         stored_sdc_bound`; 2 pi where its file is not among them)."""
+        from ..measure import baseline_sdc_taken_off
         from ..specimen import MEASURED_SHA256_FIELD, measured_specimen_name
         from ..specimen import measured_specimen_sha256 as tested_sha256
         from .align import _row_case
@@ -349,7 +361,7 @@ class MeasuredEntry:
                    str(row.get("measurement_key", "") or ""),
                    found[0].message if found else "", settings,
                    stored_stderr_dof(row.get("sdc_stderr_dof")), _specimen_sha256_of(row),
-                   bound_note=bound_note)
+                   bound_note=bound_note, baseline_sdc=baseline_sdc_taken_off(row))
 
     def loop(self):
         """The measured loop (:class:`pidcore.loop.ForceDisplacementLoop`, labelled
@@ -486,6 +498,7 @@ def compare_case(records: Sequence[MeasuredEntry],
     errors = measured["SDC stderr [-]"].to_numpy(float)
     sdc, stderr = pooled_mean(values, errors)
     stderr_dof = pooled_stderr_dof(values, errors, np.array([r.sdc_stderr_dof for r in records]))
+    baseline_sdc = pooled_baseline_sdc(values, errors, [r.baseline_sdc for r in records])
     chi2, dof = consistency_chi2(values, errors)
     tol = Tolerances()
     runs = dem_runs if dem_runs is not None and not dem_runs.empty else None
@@ -574,7 +587,7 @@ def compare_case(records: Sequence[MeasuredEntry],
                                          np.array([r.sdc_stderr_dof for r in records]))
     return CaseComparison(case, measured, sdc, stderr, aligned, dem_points, paper_points,
                           model_x, model_y, sdc10, stderr10, chi2 / dof if dof else math.nan,
-                          tuple(notes), stderr_dof, stderr10_dof, m_c)
+                          tuple(notes), stderr_dof, stderr10_dof, m_c, baseline_sdc)
 
 
 #: Name of the DEM's damper of :func:`equivalent_dampers` for an interpolated case: its SDC is

@@ -33,6 +33,7 @@ from ..compare.align import (
     CALIBRATED_HIGH_COLUMN,
     CALIBRATED_INSIDE_COLUMN,
     CALIBRATED_LOW_COLUMN,
+    MEASURED_BASELINE_COLUMN,
     MEASURED_COLUMNS_RENAMED,
     MEASURED_EQ11_COLUMN,
     MEASURED_EQ11_DOF_COLUMN,
@@ -45,6 +46,7 @@ from ..compare.align import (
     duplicates_note,
     interpolated_count_and_mass,
     match_paper,
+    pooled_baseline_sdc,
     pooled_mean,
     pooled_sdc_eq10,
     pooled_stderr_dof,
@@ -59,6 +61,7 @@ from ..compare.specimens import (
 )
 from ..constants import BAND_VERDICTS
 from ..errors import ParameterError, instance_of
+from ..measure import baseline_sdc_taken_off
 from ..specimen import (
     MEASURED_SHA256_FIELD,
     hashed_name,
@@ -98,8 +101,8 @@ REPORT_COLUMNS: tuple[str, ...] = (
     "frequency [Hz]", "acceleration [g]", PACKING_RATIO_COLUMN, "material", "direction",
     "particles per cell [-]", "DEM runs [-]", "SDC DEM (ours) [-]", "SDC DEM stderr [-]",
     "measured frequency [Hz]", "measured acceleration [g]", MEASURED_EQ11_COLUMN,
-    MEASURED_EQ11_STDERR_COLUMN, MEASURED_EQ11_DOF_COLUMN, MEASURED_EQ10_COLUMN,
-    "SDC DEM (paper) [-]",
+    MEASURED_EQ11_STDERR_COLUMN, MEASURED_EQ11_DOF_COLUMN, MEASURED_BASELINE_COLUMN,
+    MEASURED_EQ10_COLUMN, "SDC DEM (paper) [-]",
     "SDC measured (paper) [-]",
     "difference ours - paper DEM [-]", DIFFERENCE_COLUMN, CONSISTENCY_COLUMN, ALIGNMENT_COLUMN,
     "DEM settings", "specimen", SPECIMEN_SHA256_COLUMN, "source file(s)", "load case", "note",
@@ -124,6 +127,9 @@ class _Measured(NamedTuple):
     implausible: str = ""
     #: degrees of freedom of sdc_stderr (the analysis's n_blocks - 1; NaN: unknown)
     sdc_stderr_dof: float = math.nan
+    #: the part of sdc taken off as the empty coupon's damping
+    #: (:func:`pidcore.measure.baseline_sdc_taken_off`; NaN: taken off, amount unknown)
+    baseline_sdc: float = 0.0
 
 
 @dataclass
@@ -396,7 +402,8 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
                           case.acceleration_g, str(rec.get("source", "")),
                           float(rec.get("energy_per_cycle_j", math.nan)), specimen,
                           found[0].message if found else "",
-                          stored_stderr_dof(rec.get("sdc_stderr_dof")))
+                          stored_stderr_dof(rec.get("sdc_stderr_dof")),
+                          baseline_sdc_taken_off(rec))
         base = None
         if aligned.status == "grid" and aligned.grid_case is not None:
             dem = aligned.grid_case
@@ -458,7 +465,7 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
     duplicate_rows: list[str] = []
     for row in (r for group in rows.values() for r in group):
         lc = row.case
-        sdc_m = sdc_m_se = sdc_m_dof = f_m = a_m = chi2_dof = math.nan
+        sdc_m = sdc_m_se = sdc_m_dof = f_m = a_m = chi2_dof = baseline_m = math.nan
         sources = ""
         values = errors = np.empty(0)
         if row.measured:
@@ -472,6 +479,8 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
             sources = "; ".join(m.source for m in row.measured if m.source)
             chi2, dof = consistency_chi2(values, errors)
             chi2_dof = chi2 / dof if dof else math.nan
+            baseline_m = pooled_baseline_sdc(values, errors,
+                                             [m.baseline_sdc for m in row.measured])
         m_c = row.dem.vibrated_mass_kg if row.dem is not None else row.vibrated_mass_kg
         _, sdc_m10, _ = pooled_sdc_eq10(
             np.array([m.energy_per_cycle_j for m in row.measured]),
@@ -521,6 +530,7 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
             MEASURED_EQ11_COLUMN: sdc_m,
             MEASURED_EQ11_STDERR_COLUMN: sdc_m_se,
             MEASURED_EQ11_DOF_COLUMN: sdc_m_dof,
+            MEASURED_BASELINE_COLUMN: baseline_m,
             MEASURED_EQ10_COLUMN: sdc_m10,
             "SDC DEM (paper) [-]": row.paper_dem,
             "SDC measured (paper) [-]": row.paper_exp,
@@ -747,7 +757,7 @@ def add_calibration_columns(table: pd.DataFrame, calibration, *,
         material (the default report), each checked against the calibration's specimen.
         Neither: unchecked.
     """
-    from ..calibrate.prediction import quantile_label, uninformative_count_text
+    from ..calibrate.prediction import quantile_label, sdc_text, uninformative_count_text
     from ..constants import PARTICLE_MATERIALS
     from ..specimen import paper_specimen
 
@@ -781,6 +791,10 @@ def add_calibration_columns(table: pd.DataFrame, calibration, *,
             extra = f"not predicted by the calibration {calibration.path.name}: {why}"
         else:
             measured = _finite_or_nan(row.get(MEASURED_EQ11_COLUMN))
+            # the calibration predicts the SDC before the empty coupon's damping was taken
+            # off (it adds a baseline of its own): judged at that SDC. A table of an older
+            # pidcore has no such column: nothing taken off
+            taken = _finite_or_nan(row.get(MEASURED_BASELINE_COLUMN, 0.0))
             stderr = _finite_or_nan(row.get(MEASURED_EQ11_STDERR_COLUMN))
             # a table of an older pidcore has no such column: unknown, the normal's quantile
             dof = _finite_or_nan(row.get(MEASURED_EQ11_DOF_COLUMN))
@@ -804,6 +818,11 @@ def add_calibration_columns(table: pd.DataFrame, calibration, *,
             elif not math.isfinite(measured):
                 inside.append(NOT_COMPARED)
                 extra = "no Eq. 11 measurement to compare with the calibrated band"
+            elif not math.isfinite(taken):
+                inside.append(NOT_COMPARED)
+                extra = ("the measured SDC had the empty coupon's damping taken off, and its "
+                         "SDC before that (which the calibration predicts) is not stored: not "
+                         "compared with the calibrated band")
             elif IMPLAUSIBLE_ROW_NOTE in note:
                 # its standard error is the scatter of an impossible SDC about the others
                 # (22 for 46.1 pooled with 2.19): the band it gives holds anything, and the
@@ -818,8 +837,13 @@ def add_calibration_columns(table: pd.DataFrame, calibration, *,
                              f"(the calibration's own measurement at this load case had SDC "
                              f"stderr {hit.measured_stderr:.3g}); its 95 % widening: "
                              f"{quantile_label(dof)}")
-                verdict, uninformative = hit.judge(measured, stderr, dof)
+                verdict, uninformative = hit.judge(measured + taken, stderr, dof)
                 inside.append(verdict)
+                if taken:
+                    extra = "; ".join(n for n in (
+                        f"judged at the measured SDC before the empty coupon's damping "
+                        f"({sdc_text(taken)}) was taken off, {sdc_text(measured + taken)}, "
+                        "the SDC the calibration predicts", extra) if n)
                 if uninformative:
                     extra = "; ".join(n for n in (uninformative, extra) if n)  # verdict first
         notes.append("; ".join(n for n in (note, extra, cut) if n))

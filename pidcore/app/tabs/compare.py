@@ -124,16 +124,26 @@ def _calibrated(calibrations, comp, head, specimen: str, *, implausible: bool = 
     low, high = hit.band(own_stderr, comp.measured_stderr_dof)
     c3.metric("SDC calibrated DEM, Eq. 11 [-]", sdc_text(hit.sdc),
               help=f"95 % band {band_text(low, high)}")
+    # the calibration predicts the SDC before the empty coupon's damping was taken off
+    taken = comp.measured_baseline_sdc
     if not math.isfinite(comp.measured_sdc):
         verdict = "not compared (no Eq. 11 SDC)"
     elif implausible:  # as the report judges such a row: its stderr is an impossible scatter
         verdict = "not compared (it pools an implausible result, named below)"
+    elif not math.isfinite(taken):
+        verdict = ("not compared (the empty coupon's damping was taken off it, and its SDC "
+                   "before that, which the calibration predicts, is not stored)")
     else:
         # as the report's row: a band of 0 .. the SDC bound holds every measurement, so
         # "inside" lied; its reason is the verdict then
-        judged, reason = hit.judge(comp.measured_sdc, own_stderr, comp.measured_stderr_dof)
+        judged, reason = hit.judge(comp.measured_sdc + taken, own_stderr,
+                                   comp.measured_stderr_dof)
         yes, no = BAND_VERDICTS[:2]
         verdict = reason or {yes: "inside", no: "outside"}[judged]
+        if taken:
+            verdict += (f" (judged before the empty coupon's damping, SDC {sdc_text(taken)}, "
+                        f"was taken off: {sdc_text(comp.measured_sdc + taken)}, the SDC the "
+                        "calibration predicts)")
     # the report's format: its uninformative reason below writes this band "0 .. 16.91"
     st.caption(f"calibrated 95 % band {band_text(low, high)} [-]"
                + (f" (for this measurement's SDC stderr {comp.measured_stderr:.3g}, "
