@@ -423,3 +423,19 @@ def test_a_store_no_app_ran_on_gets_no_job_table_lock_file(tmp_path, capsys):
         removal.join(30)
     assert waited and still_there, "the removal did not wait for the job table's lock"
     assert not (folder / f"{kept.sha256}.toml").exists()  # removed once the lock was free
+
+
+def test_a_store_that_is_not_there_is_named_not_listed_as_keeping_nothing(tmp_path, capsys):
+    # a mistyped --store read "no specimen files kept in ...", as if the app's store had none
+    missing = tmp_path / "pidcore_stor.h5"
+    assert main(["specimen", "kept", "--store", str(missing)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and f"{missing}: no such store" in err
+    # a store with no kept folder keeps nothing, and says so
+    from pidcore.store import Store
+
+    with Store(tmp_path / "s.h5").transaction():
+        pass  # an empty store, as the app makes
+    assert main(["specimen", "kept", "--store", str(tmp_path / "s.h5")]) == 0
+    assert "no specimen files kept" in capsys.readouterr().out
+    assert not (tmp_path / "pidcore_stor.h5").exists()  # nothing was created for the typo

@@ -446,6 +446,11 @@ def prune_kept_specimens(store_path: str | os.PathLike, *, remove: bool = False,
     grace_s = recent_hours * 3600.0
     folder = kept_specimens_folder(store_path)
     if not folder.exists():
+        if not Path(store_path).exists():
+            # a mistyped --store read "no specimen files kept", as if the app's store had none
+            raise ParameterError(f"{store_path}: no such store, and no kept specimen folder "
+                                 f"{folder.name} beside it; expected the app's store file "
+                                 "(--store)")
         return KeptFolder(folder, (), remove, (), recent_hours)
     if not folder.is_dir() or folder.is_symlink():
         raise ParameterError(f"{folder}: expected the folder of the specimen files the app "
