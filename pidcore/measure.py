@@ -769,41 +769,6 @@ def analysis_record(r: AnalyzedRecord) -> dict:
     return record | notes
 
 
-def baseline_sdc_taken_off(record: PowerAnalysis | Mapping) -> float:
-    """The part of an analysis's Eq. 11 SDC that its baseline subtraction took off
-    (``analyze --baseline-loss-factor``: 2 pi eta_0 x the structure's share of the reactive
-    power), [-]: the SDC before the subtraction less ``sdc``.
-
-    ``record`` is a :class:`~pidcore.signal.PowerAnalysis`, or a stored analysis (a row of
-    :meth:`pidcore.store.Store.list_analyses`), whose SDC before the subtraction is 2 pi
-    Re/Im of its stored complex power (which is that before it). 0 where it subtracted none,
-    or states no parameters (a record of an older pidcore); NaN where it did but its complex
-    power is not stored. The calibrated DEM predicts the SDC before the subtraction (it adds
-    the baseline itself), so that is the SDC to judge against its band.
-    """
-    import json
-
-    if isinstance(record, PowerAnalysis):
-        return float(2 * np.pi * (record.loss_factor_raw - record.loss_factor))
-    text = record.get("parameters_json")
-    try:
-        stated = json.loads(text) if isinstance(text, str) and text else {}
-    except ValueError:
-        stated = {}
-    eta = stated.get("baseline_loss_factor", 0.0) if isinstance(stated, dict) else 0.0
-    if isinstance(eta, bool) or not isinstance(eta, int | float) or not eta > 0:
-        return 0.0
-    try:
-        real = float(record.get("complex_power_real_w"))
-        imag = float(record.get("complex_power_imag_w"))
-        sdc = float(record.get("sdc"))
-    except (TypeError, ValueError):
-        return math.nan
-    if not (math.isfinite(real) and math.isfinite(sdc) and math.isfinite(imag) and imag > 0):
-        return math.nan
-    return float(2 * np.pi * real / imag - sdc)
-
-
 def analysis_arrays(a: PowerAnalysis) -> dict:
     return {
         "harmonics": a.harmonics,

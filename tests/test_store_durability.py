@@ -191,11 +191,14 @@ def test_the_workers_of_a_killed_sweep_end_with_it(tmp_path, signum):
     # their parent are gone within the 20 s given.
     tests = Path(__file__).resolve().parent
     code = textwrap.dedent(f"""
-        import sys
+        import signal, sys
         from _pool_probe import wait_in_worker
         from pidcore import interrupt
         from pidcore.dem.sweep import run_pooled
         if __name__ == "__main__":
+            # as a shell starts it: a suite run under nohup passes SIGHUP ignored, which
+            # pidcore rightly keeps ignoring
+            signal.signal(signal.SIGHUP, signal.SIG_DFL)
             interrupt.install()  # as pidcore.cli.main does
             try:
                 run_pooled(wait_in_worker, [({str(tmp_path)!r}, 60.0)] * 4, workers=2,
@@ -247,6 +250,9 @@ def test_sigterm_mid_commit_is_an_interruption_exit_143_store_unchanged(tmp_path
     digest = file_sha256(store.path)
     code = textwrap.dedent(f"""
         import os, signal, sys
+        # as a shell starts it: a suite run under nohup passes SIGHUP ignored, which pidcore
+        # rightly keeps ignoring
+        signal.signal(signal.SIGHUP, signal.SIG_DFL)
         import pidcore.measure as measure
         from pidcore.cli import console_main
         saved = measure.store_analysis

@@ -236,7 +236,7 @@ def _before_baseline(frame: pd.DataFrame, notes: list[str] | None) -> pd.DataFra
     before the subtraction (:class:`pidcore.signal.PowerAnalysis`), so 2 pi Re/Im is that SDC;
     its standard error is the record's (the subtraction is of the drive's own amplitude).
     """
-    from ..measure import baseline_sdc_taken_off
+    from ..signal.power import baseline_sdc_taken_off
 
     if "parameters_json" not in frame.columns or frame.empty:
         return frame

@@ -325,7 +325,7 @@ def pooled_mean(values: np.ndarray, stderrs: np.ndarray) -> tuple[float, float]:
 def pooled_baseline_sdc(values: np.ndarray, stderrs: np.ndarray, taken: np.ndarray) -> float:
     """The part of the pooled SDC (:func:`pooled_mean` of ``values``) that the records'
     analyses took off as the empty coupon's damping, ``taken`` each
-    (:func:`pidcore.measure.baseline_sdc_taken_off`): the pooled SDC before the subtraction
+    (:func:`pidcore.signal.power.baseline_sdc_taken_off`): the pooled SDC before the subtraction
     less the pooled SDC, whatever weights the pooling gives. 0 where no record took any off;
     NaN where one did by an unknown amount."""
     taken = np.asarray(taken, dtype=float)

@@ -289,7 +289,7 @@ class MeasuredEntry:
     #: the note of :func:`pidcore.compare.plausibility.stored_sdc_bound_and_note`, else ""
     bound_note: str = ""
     #: the part of ``sdc`` taken off as the empty coupon's damping
-    #: (:func:`pidcore.measure.baseline_sdc_taken_off`; NaN: taken off, amount unknown)
+    #: (:func:`pidcore.signal.power.baseline_sdc_taken_off`; NaN: taken off, amount unknown)
     baseline_sdc: float = 0.0
 
     @classmethod
@@ -301,8 +301,8 @@ class MeasuredEntry:
         ``specimen_sha256``: the specimen file's hash as it would be saved ("": none);
         ``sdc_bound``: the SDC bound of its specimen
         (:func:`pidcore.compare.plausibility.tested_sdc_bound`; None: 2 pi)."""
-        from ..measure import baseline_sdc_taken_off
         from ..records import measurement_key
+        from ..signal.power import baseline_sdc_taken_off
         from ..specimen import deciding_sha256
         from .plausibility import implausible_findings
 
@@ -332,7 +332,7 @@ class MeasuredEntry:
         specimen files at hand (:class:`pidcore.specimen.Specimen`), among which the one the
         record names gives its SDC bound (:func:`pidcore.compare.plausibility.
         stored_sdc_bound`; 2 pi where its file is not among them)."""
-        from ..measure import baseline_sdc_taken_off
+        from ..signal.power import baseline_sdc_taken_off
         from ..specimen import MEASURED_SHA256_FIELD, measured_specimen_name
         from ..specimen import measured_specimen_sha256 as tested_sha256
         from .align import _row_case

@@ -61,7 +61,7 @@ from ..compare.specimens import (
 )
 from ..constants import BAND_VERDICTS
 from ..errors import ParameterError, instance_of
-from ..measure import baseline_sdc_taken_off
+from ..signal.power import baseline_sdc_taken_off
 from ..specimen import (
     MEASURED_SHA256_FIELD,
     hashed_name,
@@ -128,7 +128,7 @@ class _Measured(NamedTuple):
     #: degrees of freedom of sdc_stderr (the analysis's n_blocks - 1; NaN: unknown)
     sdc_stderr_dof: float = math.nan
     #: the part of sdc taken off as the empty coupon's damping
-    #: (:func:`pidcore.measure.baseline_sdc_taken_off`; NaN: taken off, amount unknown)
+    #: (:func:`pidcore.signal.power.baseline_sdc_taken_off`; NaN: taken off, amount unknown)
     baseline_sdc: float = 0.0
 
 

@@ -8,6 +8,8 @@ analyze_channels
     The same on :class:`~pidcore.records.Channel` records, after validation.
 PowerAnalysis
     Frozen result (phasors, complex power, loss factor, SDC, damping ratio, uncertainty).
+baseline_sdc_taken_off
+    The part of an analysis's SDC (fresh or stored) taken off as the empty coupon's damping.
 estimate_drive_frequency
     Drive frequency of the motion channel (FFT peak + Gauss-Newton phase refinement).
 synthesize_shaker_record, SyntheticRecord
@@ -17,7 +19,7 @@ synthesize_shaker_record, SyntheticRecord
 from .. import interrupt
 from .._numba_cache import tolerate_unwritable_cache
 from .frequency import estimate_drive_frequency
-from .power import PowerAnalysis, analyze_channels, analyze_power
+from .power import PowerAnalysis, analyze_channels, analyze_power, baseline_sdc_taken_off
 from .synthetic import SyntheticRecord, synthesize_shaker_record
 
 # before the first call of any cache=True function of this package (compiled, then saved)
@@ -25,4 +27,4 @@ tolerate_unwritable_cache()
 interrupt.defer_while_compiling()
 
 __all__ = ["PowerAnalysis", "SyntheticRecord", "analyze_channels", "analyze_power",
-           "estimate_drive_frequency", "synthesize_shaker_record"]
+           "baseline_sdc_taken_off", "estimate_drive_frequency", "synthesize_shaker_record"]
