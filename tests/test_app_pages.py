@@ -195,6 +195,30 @@ def test_compare_judges_a_test_with_its_baseline_taken_off_at_its_sdc_before_it(
         [taken], rel=1e-9)
 
 
+def test_compare_gives_the_energy_per_cycle_analyze_prints_beside_the_loop_area(store_file,
+                                                                                 tmp_path,
+                                                                                 capsys):
+    # with a baseline loss factor taken off, `pidcore analyze` prints (and Eq. 10 uses) the
+    # loop's energy less the empty coupon's share; the page showed only the loop's area
+    # (here 2 pi 0.02 / (2 pi 0.05) = 40 % more) as "energy per cycle", a number the CLI
+    # never printed for that file and settings
+    from pidcore.cli import main
+
+    data = mass_damper_csv(frequency_hz=100.0, acceleration_g=5.0, loss_factor=0.05)
+    (tmp_path / "c_fill50.csv").write_bytes(data)
+    assert main(["analyze", str(tmp_path / "c_fill50.csv"), "--no-store", "--json",
+                 "--baseline-loss-factor", "0.02"]) == 0
+    printed = json.loads(capsys.readouterr().out)["records"][0]["energy_per_cycle_j"]
+    settings = b"file,baseline_loss_factor\nc_fill50.csv,0.02\n"
+    at = _upload(_app(), [("c_fill50.csv", data), ("setup.csv", settings)])
+    energies = [m.value for m in at.markdown if m.value.startswith("energy per cycle")]
+    assert len(energies) == 1
+    # the page's 4 significant digits of the same analysis
+    assert f"**{printed:.4e} J**" in energies[0], (energies, printed)
+    # the loop's own area (the baseline's share more) is still the loop's: named as such
+    assert "loop area" in energies[0]
+
+
 def test_negative_loss_factor_is_flagged_and_saving_needs_confirmation(store_file):
     from pidcore.store import Store
 

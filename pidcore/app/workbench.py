@@ -199,7 +199,10 @@ def case_view(entries: Sequence[MeasuredEntry], dem_runs: pd.DataFrame | None,
     """Everything the Compare page draws for one load case, as plain data.
 
     Keys: ``comparison``, ``headline``, ``sdc_points`` (frame), ``loops`` (frame, SI),
-    ``energies`` (series -> J per cycle), ``spectrum`` (frame of the first record), ``notes``,
+    ``energies`` (series -> J per cycle: the loop's area), ``energies_analysed`` (label ->
+    J per cycle as the analysis states it, for the measurements analysed with a baseline loss
+    factor, whose loop area holds the empty coupon's damping too), ``spectrum`` (frame of the
+    first record), ``notes``,
     ``dem_specimen`` (the specimen of the DEM runs met, e.g. ``"steel_6mm_b [3e945a]"``; empty
     where none), ``dem_refused`` (why no DEM run is met although there are runs: several
     specimens' runs would be pooled; empty otherwise) and ``dem_warning`` (the report's note
@@ -261,6 +264,11 @@ def case_view(entries: Sequence[MeasuredEntry], dem_runs: pd.DataFrame | None,
             "headline": headline(comparison, why_no_dem=why_no_dem),
             "sdc_points": sdc_points(comparison), "loops": loop_frame(loops),
             "energies": {loop.label: loop.energy_per_cycle_j for loop in loops},
+            # the energy `pidcore analyze` prints (and Eq. 10 uses) where it is not the loop's
+            # area: an analysis with the empty coupon's damping taken off
+            "energies_analysed": {
+                f"measured: {e.file}": e.energy_per_cycle_j for e in entries
+                if e.baseline_sdc != 0 and math.isfinite(e.energy_per_cycle_j)},
             "spectrum": entries[0].spectrum(), "notes": notes,
             "dem_specimen": met.specimen, "dem_refused": met.note if met.refused else "",
             "dem_warning": (not_converged_note(grid) if grid is not None and grid.not_converged

@@ -250,8 +250,14 @@ def render(stores, session_files: list, calibrations: list) -> None:
     left.vega_lite_chart(spec=view["sdc_spec"], key="sdc_chart", width="stretch")
     right.vega_lite_chart(spec=view["loop_spec"], key="loop_chart", width="stretch")
     if view["energies"]:
+        analysed = view.get("energies_analysed", {})
+        # a baseline loss factor taken off: the analysis's energy (`pidcore analyze` prints
+        # it, Eq. 10 uses it) is the loop's area less the empty coupon's share
         st.markdown("energy per cycle (loop area): " + " · ".join(
-            f"{label}: **{energy:.4e} J**" for label, energy in view["energies"].items()))
+            f"{label}: **{energy:.4e} J**" + (
+                f" (**{analysed[label]:.4e} J** with the empty coupon's damping taken off, as "
+                "`pidcore analyze` prints it)" if label in analysed else "")
+            for label, energy in view["energies"].items()))
     # the two fixed-width spectra (~600 px) overflowed half a page into the table beside them
     st.vega_lite_chart(spec=view["spectrum_spec"], key="spectrum_chart")
     # in the chart's unit: harmonics of a few µm/s read as 0.0000 in m/s
