@@ -267,7 +267,7 @@ def case_view(entries: Sequence[MeasuredEntry], dem_runs: pd.DataFrame | None,
             # the energy `pidcore analyze` prints (and Eq. 10 uses) where it is not the loop's
             # area: an analysis with the empty coupon's damping taken off
             "energies_analysed": {
-                f"measured: {e.file}": e.energy_per_cycle_j for e in entries
+                e.loop_label: e.energy_per_cycle_j for e in entries
                 if e.baseline_sdc != 0 and math.isfinite(e.energy_per_cycle_j)},
             "spectrum": entries[0].spectrum(), "notes": notes,
             "dem_specimen": met.specimen, "dem_refused": met.note if met.refused else "",

@@ -363,6 +363,11 @@ class MeasuredEntry:
                    stored_stderr_dof(row.get("sdc_stderr_dof")), _specimen_sha256_of(row),
                    bound_note=bound_note, baseline_sdc=baseline_sdc_taken_off(row))
 
+    @property
+    def loop_label(self) -> str:
+        """The label of :meth:`loop`: ``"measured: <file>"``."""
+        return f"measured: {self.file}"
+
     def loop(self):
         """The measured loop (:class:`pidcore.loop.ForceDisplacementLoop`, labelled
         ``"measured: <file>"``), or a note why there is none."""
@@ -373,7 +378,7 @@ class MeasuredEntry:
             return "no harmonic phasors stored with this analysis"
         return ForceDisplacementLoop.from_phasors(
             self.harmonics, self.force_phasors_n, self.velocity_phasors_m_s, self.frequency_hz,
-            label=f"measured: {self.file}")
+            label=self.loop_label)
 
     def spectrum(self) -> pd.DataFrame:
         """Amplitudes of the fitted force and velocity harmonics (units in the columns)."""

@@ -122,8 +122,9 @@ NO_CHANNEL = "(none)"
 #: and refusing them would make users delete documentation to run an analysis.
 FREE_TEXT_COLUMNS: tuple[str, ...] = ("note", "notes", "comment", "comments")
 
-_SEP = r"(?:^|(?<=[_\-. ]))"  # token start: beginning of the stem or after a separator
-_END = r"(?=$|[_\-. ])"  # token end
+_SEPARATOR = r"[_\-. ]"  # between the tokens of a file name
+_SEP = rf"(?:^|(?<={_SEPARATOR}))"  # token start: beginning of the stem or after a separator
+_END = rf"(?=$|{_SEPARATOR})"  # token end
 #: Fill token in a file name: ``fill50``, ``fill-50``, ``fill_62.5``, ``50pct``, ``50percent``.
 FILL_PATTERN = re.compile(
     _SEP + r"(?:fill[_\-]?(?P<fill>\d+(?:\.\d+)?)(?:pct|percent)?"
@@ -187,7 +188,7 @@ def _untabulated_names(stem: str, parts: set[str]) -> list[str]:
     ``parts`` (the known materials' words) are none."""
     names: list[str] = []
     run: list[str] = []
-    for token in [*re.split(r"[_\-. ]", stem.lower()), ""]:
+    for token in [*re.split(_SEPARATOR, stem.lower()), ""]:
         if token in UNTABULATED_PARTICLE_MATERIALS and token not in parts:
             run.append(token)
         elif run:

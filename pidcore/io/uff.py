@@ -341,15 +341,11 @@ def _utf8_header(header: bytes) -> bytes:
     Test.Lab and other Windows exporters write: ``µm/s`` (0xB5) was refused as no unit and a
     channel ``Prüfling`` (0xFC) could not be named with ``--force``. Each byte is one
     character either way, so pyuff's fixed columns stay where they were."""
-    try:
-        header.decode("utf-8")
-    except UnicodeDecodeError:
-        return header.decode("cp1252", errors="replace").encode("utf-8")
-    return header
+    return _utf8_text(header).encode("utf-8")
 
 
 def _utf8_text(raw: bytes) -> str:
-    """A whole file's text for the fallback parser: UTF-8, else Windows-1252."""
+    """Header or whole-file text (the fallback parser's): UTF-8, else Windows-1252."""
     try:
         return raw.decode("utf-8")
     except UnicodeDecodeError:
