@@ -131,6 +131,19 @@ def test_latex_uses_booktabs_and_escapes(report, table):
     assert text.count(r"\begin{") == text.count(r"\end{")
 
 
+def test_latex_braces_a_dotted_figure_name_off_its_extension(tmp_path, table, provenance):
+    """A loop figure is named by its load case (loop_00_f62.5Hz_a1.5g_...): graphicx before
+    2019 took the first dot for the extension's and the .tex did not compile. The base name
+    is braced, leaving ".png" the only dot graphicx reads, and names the file written."""
+    stem = "loop_00_f62.5Hz_a1.5g_fill50pct_acrylic_z"
+    paths = write_report(table, {stem: _figures()["parabola"]}, provenance,
+                         tmp_path / "report", "all")
+    text = paths["tex"].read_text(encoding="utf-8")
+    links = re.findall(r"\\includegraphics\[[^]]*\]\{\{([^{}]+)\}(\.[a-z]+)\}", text)
+    assert links == [(f"figures/{stem}", ".png")]
+    assert (paths["tex"].parent / (links[0][0] + links[0][1])).read_bytes()[:4] == b"\x89PNG"
+
+
 def test_pdf_has_table_figure_and_provenance_pages(report):
     data = report[1]["pdf"].read_bytes()
     assert data.startswith(b"%PDF")

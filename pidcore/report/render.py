@@ -233,8 +233,10 @@ def _write_tex(table: pd.DataFrame, figures: Mapping[str, Path], prov: Provenanc
     lines += [" & ".join(tex_escape(v) for v in row) + r" \\" for row in display_rows(table)]
     lines += [r"\bottomrule", r"\end{tabular}}", r"\end{table}"]
     for stem, png in figures.items():
+        # the base name braced off its extension: graphicx before 2019 took the first dot of
+        # a load case's name (loop_00_f62.5Hz_...) as the extension's and did not compile
         lines += [r"\begin{figure}[ht]\centering",
-                  rf"\includegraphics[width=0.8\textwidth]{{figures/{png.name}}}",
+                  rf"\includegraphics[width=0.8\textwidth]{{{{figures/{png.stem}}}{png.suffix}}}",
                   rf"\caption{{{tex_escape(stem)}}}", r"\end{figure}"]
     lines += [r"\section*{Provenance}", r"{\footnotesize\begin{itemize}"]
     lines += [rf"\item {tex_escape(line)}" for line in prov.lines()]
