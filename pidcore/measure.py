@@ -62,7 +62,8 @@ __all__ = ["AnalysisOptions", "AnalyzedRecord", "SavedAnalyses", "analyze_file",
            "analyze_measurement", "save_analyses", "store_analysis"]
 
 #: Largest fractional-sample offset between the start times of the force channel and an
-#: acceleration channel that is ignored (the velocity's is corrected as a delay instead).
+#: acceleration channel beside a velocity channel that is ignored (the motion channel's, the
+#: velocity or an acceleration the velocity is integrated from, is corrected as a delay).
 MAX_IGNORED_OFFSET_SAMPLES = 0.02
 #: An acceleration channel whose drive-line amplitude differs from omega |V| of the velocity
 #: channel by more than this factor (either way) is noted as a likely unit slip: a rigid coupon
@@ -230,8 +231,9 @@ def _with_unit(ch: Channel, role: str, unit: str | None, source: str,
 
 def _align(channels: dict[str, Channel], source: str, notes: list[str],
            corrections: dict) -> tuple[dict[str, Channel], float]:
-    """Cut the channels to their common time span; returns them and the velocity delay (s)
-    that corrects a fractional-sample start offset of the velocity against the force."""
+    """Cut the channels to their common time span; returns them and the delay (s) that
+    corrects a fractional-sample start offset of the motion channel against the force: the
+    velocity, or without one the acceleration the velocity is integrated from."""
     rate = channels["force"].sample_rate_hz
     # equal within the analysis's tolerance, not bit for bit: two time columns printed with 8
     # digits give rates 1e-12 apart, and the start offset between them was then ignored
@@ -247,12 +249,15 @@ def _align(channels: dict[str, Channel], source: str, notes: list[str],
     offsets = {r: (s - force_start) * rate for r, s in starts.items()}
     shift = {r: math.floor(o + 0.5) for r, o in offsets.items()}
     frac = {r: offsets[r] - shift[r] for r in offsets}
+    # the channel the velocity comes from: integrating an acceleration sampled off the force's
+    # instants gives a velocity off them by as much, corrected alike
+    motion = "velocity" if "velocity" in channels else "acceleration"
     delay = 0.0
     for role, f in frac.items():
         if abs(f) <= 1e-6:
             continue
-        if role == "velocity":
-            # sampled f samples after the force's instants: the channel holds v(t + f/rate),
+        if role == motion:
+            # sampled f samples after the force's instants: the channel holds x(t + f/rate),
             # a delay of -f/rate in the convention of velocity_delay_s (v(t - tau))
             delay = -f / rate
         elif abs(f) > MAX_IGNORED_OFFSET_SAMPLES:
@@ -276,10 +281,10 @@ def _align(channels: dict[str, Channel], source: str, notes: list[str],
                  + "; lengths " + ", ".join(str(n) for n in lengths.values()) + ")")
     corrections["aligned_span_s"] = [force_start + first / rate, force_start + last / rate]
     if delay:
-        notes.append(f"channel {channels['velocity'].name!r} starts {frac['velocity']:+.4f} "
+        # the analysis carries the delay in its corrections (start_offset_delay_s)
+        notes.append(f"channel {channels[motion].name!r} starts {frac[motion]:+.4f} "
                      "samples off the force's grid: corrected as a velocity delay of "
                      f"{delay:.6g} s")
-        corrections["start_offset_delay_s"] = delay
     return out, delay
 
 
@@ -371,7 +376,8 @@ def analyze_measurement(measurement: Measurement, options: AnalysisOptions | Non
     Preparation, each step announced in the notes: channels inverted on request
     (``invert``), units given by option for channels without one (a channel of unknown unit is
     never taken as SI), channels cut to their common time span when their start times or
-    lengths differ (a fractional-sample start offset of the velocity is corrected as a delay),
+    lengths differ (a fractional-sample start offset of the velocity, or of the acceleration a
+    velocity is integrated from, is corrected as a delay),
     channels no role needs named as ignored.
     """
     options = AnalysisOptions() if options is None else options
@@ -406,7 +412,7 @@ def analyze_measurement(measurement: Measurement, options: AnalysisOptions | Non
         analysis = analyze_channels(
             chosen["force"], chosen.get("velocity"), acceleration=chosen.get("acceleration"),
             source=measurement.source,
-            velocity_delay_s=options.velocity_delay_s + start_delay,
+            velocity_delay_s=options.velocity_delay_s, start_offset_delay_s=start_delay,
             mass_below_gauge_kg=options.mass_below_gauge_kg,
             baseline_loss_factor=options.baseline_loss_factor,
             structure_mass_kg=options.structure_mass_kg,
