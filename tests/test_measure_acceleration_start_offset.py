@@ -195,3 +195,46 @@ def test_a_start_offset_delay_beyond_half_a_sample_is_refused():
                           start_offset_delay_s=-0.5 / FS)
     assert exact.loss_factor == pytest.approx(ETA, abs=1e-9)  # noise-free float64
 
+
+
+# A UFF states each record's start (abscissa minimum, E13.5) with six significant digits: two
+# records 0.37 samples apart from 0.5 s at 51.2 kHz read 0.358 samples apart (0.5 and
+# 0.500007), each start known to +-5e-7 s. At 1 kHz that is up to 6.3e-3 rad, and the loss
+# factor came out 1.4e-3 off (3 % of 0.05) with a note saying the offset was corrected.
+LATE_START_S, FAST_RATE_HZ, FAST_DRIVE_HZ = 0.5, 51_200.0, 1000.0
+
+
+def _late_export(path: Path, role: str, start_samples: float) -> Path:
+    w = 2 * math.pi * FAST_DRIVE_HZ
+    n = int(0.5 * FAST_RATE_HZ)
+    t = LATE_START_S + np.arange(n) / FAST_RATE_HZ
+    t_resp = t + start_samples / FAST_RATE_HZ
+    response = (A0 * np.cos(w * t_resp + PHI) if role == "acceleration" else
+                A0 / w * np.sin(w * t_resp + PHI))
+    unit = "m/s^2" if role == "acceleration" else "m/s"
+    write_measurement(Measurement(path.name, (
+        Channel("Force", "force", F0 * np.cos(w * t), FAST_RATE_HZ, "N",
+                start_time_s=LATE_START_S),
+        Channel("Response", role, response, FAST_RATE_HZ, unit,
+                start_time_s=float(t_resp[0])))), path)
+    return path
+
+
+@pytest.mark.parametrize("start_samples", [0.37, 3.0])
+@pytest.mark.parametrize("role", ["acceleration", "velocity"])
+def test_a_start_offset_finer_than_a_uffs_six_digits_is_refused(tmp_path, capsys, role,
+                                                                start_samples):
+    path = _late_export(tmp_path / "late.uff", role, start_samples)
+    err = _refusal(path, capsys)
+    assert "channel 'Response' starts" in err and "channel 'Force'" in err
+    assert "6 significant digits" in err and "±0.051 samples" in err  # 2 x 5e-7 s x 51.2 kHz
+    # the same channels with their starts in float64: corrected to the truth (noise-free;
+    # the 0.5 s start leaves 1e-16 s x 2 pi 1 kHz of phase)
+    exact = analyze_file(_late_export(tmp_path / "late.h5", role, start_samples))
+    assert exact.analysis.loss_factor == pytest.approx(ETA, abs=1e-7)
+
+
+def test_uff_records_of_one_start_are_one_clock_reading(tmp_path):
+    # both records from 0.5 s print the same six digits: no offset between them to doubt
+    path = _late_export(tmp_path / "together.uff", "acceleration", 0.0)
+    assert analyze_file(path).analysis.loss_factor == pytest.approx(ETA, abs=1e-7)
