@@ -302,7 +302,7 @@ def _align(channels: dict[str, Channel], source: str, notes: list[str],
     corrections["aligned_span_s"] = [force_start + first / rate, force_start + last / rate]
     if delay:
         # the analysis carries the delay in its corrections (start_offset_delay_s)
-        notes.append(f"channel {channels[motion].name!r} starts {frac[motion]:+.4f} "
+        notes.append(f"channel {channels[motion].name!r} starts {frac[motion]:+.4g} "
                      "samples off the force's grid: corrected as a velocity delay of "
                      f"{delay:.6g} s")
     return out, delay, offset_uncertainty

@@ -106,7 +106,7 @@ def test_acceleration_only_fractional_start_offset_is_corrected_like_the_velocit
     (said,) = _offset_notes(record.notes)
     (said_for_velocity,) = _offset_notes(by_velocity.notes)
     assert said.replace("'Acceleration'", "'X'") == said_for_velocity.replace("'Velocity'", "'X'")
-    head = (f"channel 'Acceleration' starts {fraction:+.4f} samples off the force's grid: "
+    head = (f"channel 'Acceleration' starts {fraction:+.4g} samples off the force's grid: "
             "corrected as a velocity delay of ")
     assert said.startswith(head) and said.endswith(" s")
     assert float(said[len(head):-2]) == pytest.approx(-fraction / FS, rel=1e-5)
@@ -116,13 +116,13 @@ def test_the_correction_is_printed_by_pidcore_analyze(tmp_path, capsys):
     path = _export(tmp_path / "acc.uff", _response("acceleration", 0.37))
     assert main(["analyze", str(path), "--no-store", "--no-progress"]) == 0
     out = capsys.readouterr().out
-    assert ("note: channel 'Acceleration' starts +0.3700 samples off the force's grid: "
+    assert ("note: channel 'Acceleration' starts +0.37 samples off the force's grid: "
             "corrected as a velocity delay of -7.22656e-05 s") in out
 
 
 # starts the UFF's six digits hold exactly (2/5120 = 3.90625e-4 s, -4/5120 = -7.8125e-4 s):
-# -3/5120 = -5.859375e-4 s is printed -5.85938e-4, 2.6e-6 samples off the grid, which the
-# file then states and pidcore corrects as a delay, as it does a velocity's
+# -3/5120 = -5.859375e-4 s needs seven: printed with six it is 2.6e-6 samples off the grid,
+# which the file then states and pidcore corrects as a delay, as it does a velocity's
 @pytest.mark.parametrize("start_samples", [0, 2, -4])
 @pytest.mark.parametrize("suffix", [".uff", ".csv"])
 def test_acceleration_only_whole_sample_or_no_offset_is_cut_not_delayed(tmp_path, suffix,
@@ -238,3 +238,15 @@ def test_uff_records_of_one_start_are_one_clock_reading(tmp_path):
     # both records from 0.5 s print the same six digits: no offset between them to doubt
     path = _late_export(tmp_path / "together.uff", "acceleration", 0.0)
     assert analyze_file(path).analysis.loss_factor == pytest.approx(ETA, abs=1e-7)
+
+
+def test_a_start_offset_of_a_millionth_of_a_sample_is_said_as_it_is(tmp_path):
+    # -3 samples at 5120 Hz (-5.859375e-4 s) is printed with six digits (E13.5) in the UFF:
+    # the file states 2.6e-6 samples off the grid, which is corrected; the note said "starts
+    # +0.0000 samples off the force's grid", a correction of nothing by its own words
+    path = _export(tmp_path / "acc.uff", _response("acceleration", -3))
+    (said,) = _offset_notes(analyze_file(path).notes)
+    stated = float(f"{-3 / FS:.5e}") * FS + 3  # the fraction the six digits leave
+    assert abs(stated) > 1e-6  # beyond the 1e-6 samples taken for none
+    fraction = float(said.split(" starts ")[1].split(" samples")[0])
+    assert fraction == pytest.approx(stated, rel=1e-3)  # printed with 4 digits
