@@ -62,8 +62,14 @@ __all__ = ["AnalysisOptions", "AnalyzedRecord", "SavedAnalyses", "analyze_file",
            "analyze_measurement", "save_analyses", "store_analysis"]
 
 #: Largest fractional-sample offset between the start times of the force channel and an
-#: acceleration channel that is ignored (the velocity's is corrected as a delay instead).
+#: acceleration channel beside a velocity channel that is ignored (the motion channel's, the
+#: velocity or an acceleration the velocity is integrated from, is corrected as a delay).
 MAX_IGNORED_OFFSET_SAMPLES = 0.02
+#: Largest uncertainty, as a phase at the drive frequency, of the start offset between the force
+#: and the motion channel: the loss factor moves by the phase error (d eta = d phi near eta = 0),
+#: so 1e-4 rad keeps it within the 1.5e-4 absolute of the accuracy target (README). A start
+#: time printed with six digits (UFF) misses that from a few ms on at 1 kHz.
+MAX_START_OFFSET_PHASE_UNCERTAINTY_RAD = 1e-4
 #: An acceleration channel whose drive-line amplitude differs from omega |V| of the velocity
 #: channel by more than this factor (either way) is noted as a likely unit slip: a rigid coupon
 #: and the shaker head beside it move alike (a fixture resonance may give a factor of 2 or
@@ -228,31 +234,50 @@ def _with_unit(ch: Channel, role: str, unit: str | None, source: str,
                    ch.start_time_s)
 
 
+def _half_unit(value: float, digits: int | None) -> float:
+    """Half a unit in the last of ``digits`` significant digits of ``value`` (0 for an exact
+    value: no digits stated, or zero)."""
+    if not digits or value == 0 or not math.isfinite(value):
+        return 0.0
+    return 0.5 * 10.0 ** (math.floor(math.log10(abs(value))) - digits + 1)
+
+
 def _align(channels: dict[str, Channel], source: str, notes: list[str],
-           corrections: dict) -> tuple[dict[str, Channel], float]:
-    """Cut the channels to their common time span; returns them and the velocity delay (s)
-    that corrects a fractional-sample start offset of the velocity against the force."""
+           corrections: dict, start_digits: int | None = None
+           ) -> tuple[dict[str, Channel], float, float]:
+    """Cut the channels to their common time span; returns them, the delay (s) that
+    corrects a fractional-sample start offset of the motion channel against the force (the
+    velocity, or without one the acceleration the velocity is integrated from) and how far
+    off that offset may be (s) where the file states its start times with ``start_digits``
+    significant digits."""
     rate = channels["force"].sample_rate_hz
     # equal within the analysis's tolerance, not bit for bit: two time columns printed with 8
     # digits give rates 1e-12 apart, and the start offset between them was then ignored
     if any(abs(ch.sample_rate_hz - rate) > SAME_RATE_RELATIVE_TOLERANCE * rate
            for ch in channels.values()):
-        return channels, 0.0  # refused by the analysis with both rates named
+        return channels, 0.0, 0.0  # refused by the analysis with both rates named
     starts = {r: ch.start_time_s for r, ch in channels.items()}
     lengths = {r: ch.n_samples for r, ch in channels.items()}
     if len(set(starts.values())) == 1 and len(set(lengths.values())) == 1:
-        return channels, 0.0
+        return channels, 0.0, 0.0
     force_start = starts["force"]
     # offsets of each channel from the force in samples: integer part cut, fraction corrected
     offsets = {r: (s - force_start) * rate for r, s in starts.items()}
     shift = {r: math.floor(o + 0.5) for r, o in offsets.items()}
     frac = {r: offsets[r] - shift[r] for r in offsets}
+    # the channel the velocity comes from: integrating an acceleration sampled off the force's
+    # instants gives a velocity off them by as much, corrected alike
+    motion = "velocity" if "velocity" in channels else "acceleration"
+    # one start printed as the other is one clock reading: their offset is exact
+    offset_uncertainty = (0.0 if starts[motion] == force_start else
+                          _half_unit(starts[motion], start_digits)
+                          + _half_unit(force_start, start_digits))
     delay = 0.0
     for role, f in frac.items():
         if abs(f) <= 1e-6:
             continue
-        if role == "velocity":
-            # sampled f samples after the force's instants: the channel holds v(t + f/rate),
+        if role == motion:
+            # sampled f samples after the force's instants: the channel holds x(t + f/rate),
             # a delay of -f/rate in the convention of velocity_delay_s (v(t - tau))
             delay = -f / rate
         elif abs(f) > MAX_IGNORED_OFFSET_SAMPLES:
@@ -276,11 +301,33 @@ def _align(channels: dict[str, Channel], source: str, notes: list[str],
                  + "; lengths " + ", ".join(str(n) for n in lengths.values()) + ")")
     corrections["aligned_span_s"] = [force_start + first / rate, force_start + last / rate]
     if delay:
-        notes.append(f"channel {channels['velocity'].name!r} starts {frac['velocity']:+.4f} "
+        # the analysis carries the delay in its corrections (start_offset_delay_s)
+        notes.append(f"channel {channels[motion].name!r} starts {frac[motion]:+.4g} "
                      "samples off the force's grid: corrected as a velocity delay of "
                      f"{delay:.6g} s")
-        corrections["start_offset_delay_s"] = delay
-    return out, delay
+    return out, delay, offset_uncertainty
+
+
+def _check_start_offset_known(chosen: Mapping[str, Channel], uncertainty_s: float,
+                              digits: int | None, analysis: PowerAnalysis,
+                              source: str) -> None:
+    """Refuse a record whose motion channel's start offset against the force the file states
+    too coarsely to correct: the loss factor would move by the phase it may be off."""
+    phase = analysis.omega_rad_s * uncertainty_s
+    if not phase > MAX_START_OFFSET_PHASE_UNCERTAINTY_RAD:
+        return
+    motion = chosen.get("velocity", chosen.get("acceleration"))
+    force = chosen["force"]
+    rate = force.sample_rate_hz
+    raise ChannelError(
+        f"{source}: channel {motion.name!r} starts "
+        f"{(motion.start_time_s - force.start_time_s) * rate:+.4f} samples from channel "
+        f"{force.name!r} by the start times the file states with {digits} significant digits, "
+        f"known to ±{uncertainty_s * rate:.2g} samples only: {phase:.2g} rad at "
+        f"{analysis.frequency_hz:.6g} Hz, up to {phase:.2g} off in the loss factor (expected "
+        f"within {MAX_START_OFFSET_PHASE_UNCERTAINTY_RAD:g}); export the channels with one "
+        "start time (one trigger), or in a format that states it finely (CSV time columns, "
+        "MAT, HDF5)")
 
 
 def _invert(measurement: Measurement, names: Sequence[str], notes: list[str]) -> Measurement:
@@ -371,7 +418,8 @@ def analyze_measurement(measurement: Measurement, options: AnalysisOptions | Non
     Preparation, each step announced in the notes: channels inverted on request
     (``invert``), units given by option for channels without one (a channel of unknown unit is
     never taken as SI), channels cut to their common time span when their start times or
-    lengths differ (a fractional-sample start offset of the velocity is corrected as a delay),
+    lengths differ (a fractional-sample start offset of the velocity, or of the acceleration a
+    velocity is integrated from, is corrected as a delay),
     channels no role needs named as ignored.
     """
     options = AnalysisOptions() if options is None else options
@@ -397,7 +445,10 @@ def analyze_measurement(measurement: Measurement, options: AnalysisOptions | Non
         if unit is not None and role not in chosen:
             raise ParameterError(f"{_UNIT_OPTIONS[role]}={unit!r}: {measurement.source} has no "
                                  f"{role} channel in use")
-    chosen, start_delay = _align(chosen, measurement.source, notes, corrections)
+    as_started = chosen  # the channels' own start times, for a refusal to name
+    start_digits = measurement.metadata.get("start_time_significant_digits")
+    chosen, start_delay, start_uncertainty_s = _align(chosen, measurement.source, notes,
+                                                      corrections, start_digits)
     if roles.ignored:
         notes.append("ignored channels (not needed): "
                      + ", ".join(repr(n) for n in roles.ignored))
@@ -406,7 +457,7 @@ def analyze_measurement(measurement: Measurement, options: AnalysisOptions | Non
         analysis = analyze_channels(
             chosen["force"], chosen.get("velocity"), acceleration=chosen.get("acceleration"),
             source=measurement.source,
-            velocity_delay_s=options.velocity_delay_s + start_delay,
+            velocity_delay_s=options.velocity_delay_s, start_offset_delay_s=start_delay,
             mass_below_gauge_kg=options.mass_below_gauge_kg,
             baseline_loss_factor=options.baseline_loss_factor,
             structure_mass_kg=options.structure_mass_kg,
@@ -422,6 +473,8 @@ def analyze_measurement(measurement: Measurement, options: AnalysisOptions | Non
                               + ", ".join(f"invert={n!r}" for n in options.invert)
                               + "; is that one right?)") from None
         raise
+    _check_start_offset_known(as_started, start_uncertainty_s, start_digits, analysis,
+                              measurement.source)
     notes.extend(_unit_slip_notes(measurement, chosen, analysis,
                                   mass_below_gauge_kg=options.mass_below_gauge_kg))
     if options.structure_mass_kg is not None and not options.baseline_loss_factor > 0:

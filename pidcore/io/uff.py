@@ -66,6 +66,9 @@ from ._uff_ascii import parse_uff_ascii
 
 #: Relative resolution of an E13.5 field (six significant digits): half a unit in the sixth.
 UFF_INTERVAL_RESOLUTION = 5e-6
+#: Significant digits of a record's start time, its abscissa minimum (an E13.5 field): two
+#: records that start 0.37 samples apart at 0.5 s and 51.2 kHz read 0.358 samples apart.
+UFF_START_TIME_DIGITS = 6
 
 _DATASET_NAMES = {
     15: "nodes", 18: "coordinate systems", 55: "data at nodes", 58: "functions",
@@ -619,7 +622,9 @@ def read_uff(path: str | os.PathLike[str], *, time_unit: str | None = None) -> M
     channels = [c if c.name == n else Channel(n, c.quantity, c.data, c.sample_rate_hz,
                                               c.source_unit, c.start_time_s)
                 for c, n in zip(channels, names, strict=True)]
-    metadata: dict = {"uff_time_records": len(channels)}
+    # the analysis judges from it how well a start offset between two records is known
+    metadata: dict = {"uff_time_records": len(channels),
+                      "start_time_significant_digits": UFF_START_TIME_DIGITS}
     if notes:
         metadata["reader_notes"] = notes
     date = _label(time_records[0].get("id3"))

@@ -40,7 +40,9 @@ which.
 Corrections (applied to the phasors in this order):
 
 1. ``velocity_delay_s``: a laser vibrometer outputs ``v(t - tau)``; its phasors are multiplied by
-   ``exp(+j n w tau)``.
+   ``exp(+j n w tau)``. ``start_offset_delay_s`` (a motion channel sampled a fraction of a
+   sample off the force's instants) adds to that ``tau`` and is corrected by the same factor,
+   on the velocity channel or, without one, on the acceleration the velocity comes from.
 2. Velocity from acceleration when there is no velocity channel: ``V_n = A_n / (j n w)``.
 3. Mass cancellation: the gauge also feels the inertia of the mass between it and the coupon
    (impedance-head seismic mass, fixture): ``F_n -= m_below A_n`` with ``A_n`` from the
@@ -314,10 +316,11 @@ def _complex_power(f_ph: np.ndarray, m_ph: np.ndarray, a_ph: np.ndarray | None,
                    mass_kg: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Corrected (F, V) phasors and P_c; arrays over (..., harmonic)."""
     jnw = 1j * n * omega
-    if motion_is_velocity:
-        v = m_ph * np.exp(1j * n * omega * delay_s)
-    else:
-        v = m_ph / jnw
+    # x(t - tau) recorded for either motion channel: a velocity integrated from a delayed
+    # acceleration is the delayed velocity, so the one phase factor serves both
+    v = m_ph * np.exp(1j * n * omega * delay_s)
+    if not motion_is_velocity:
+        v = v / jnw
     if mass_kg:
         acc = a_ph if a_ph is not None else jnw * v
         f = f_ph - mass_kg * acc
@@ -426,6 +429,19 @@ def _check_delay(velocity_delay_s: float, frequency_hz: float, duration_s: float
             "(e.g. 2e-4)")
 
 
+def _check_start_offset(start_offset_delay_s: float, sample_rate_hz: float,
+                        source: str = "") -> None:
+    # what is left of a start offset once whole samples are cut: half a sample at most (a
+    # larger value is whole samples that belong cut, or a time in the wrong unit)
+    real_number("start_offset_delay_s", start_offset_delay_s)
+    half = 0.5 / sample_rate_hz
+    if not (math.isfinite(start_offset_delay_s)
+            and abs(start_offset_delay_s) <= half * (1 + 1e-9)):
+        raise ParameterError(f"{_of(source)}start_offset_delay_s: {start_offset_delay_s!r} s, "
+                             f"expected a fraction of a sample, at most {half:.6g} s (half a "
+                             f"sample at {sample_rate_hz:g} Hz)")
+
+
 def _check_acceleration_sign(acceleration_phasor: complex, velocity_phasor: complex,
                              omega: float, velocity_delay_s: float, *, source: str,
                              acceleration_name: str, velocity_name: str) -> None:
@@ -468,6 +484,7 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
                   frequency_hz: float | None = None,
                   n_harmonics: int = defaults.N_HARMONICS,
                   velocity_delay_s: float = 0.0,
+                  start_offset_delay_s: float = 0.0,
                   mass_below_gauge_kg: float = 0.0,
                   baseline_loss_factor: float = 0.0,
                   structure_mass_kg: float | None = None,
@@ -498,6 +515,12 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
         Harmonics fitted; those above 0.9 x Nyquist are dropped.
     velocity_delay_s : float
         Output delay of the velocity signal (vibrometer), s; requires a velocity channel.
+    start_offset_delay_s : float
+        Delay, s, in the convention of ``velocity_delay_s`` (the channel holds ``x(t - tau)``),
+        of a motion channel whose samples lie a fraction of a sample off the force's: the
+        velocity, or without one the acceleration the velocity comes from. Corrected with
+        ``velocity_delay_s`` (the two add); at most half a sample.
+        :func:`pidcore.measure.analyze_measurement` passes it from the channels' start times.
     mass_below_gauge_kg : float
         Mass between force gauge and structure whose inertia force is cancelled, kg.
     baseline_loss_factor : float
@@ -551,6 +574,9 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
     if velocity is None and velocity_delay_s:
         raise ParameterError(f"{_of(source)}velocity_delay_s: a vibrometer delay needs a "
                              "velocity channel; the velocity here comes from the acceleration")
+    _check_start_offset(start_offset_delay_s, sample_rate_hz, source)
+    # the one phase correction of the motion channel (correction 1 of the module docstring)
+    motion_delay_s = float(velocity_delay_s) + float(start_offset_delay_s)
     acc_name = acceleration_name if velocity is not None else velocity_name
     channels: list[tuple[str, np.ndarray]] = [(force_name, np.asarray(force, dtype=np.float64))]
     if velocity is not None:
@@ -626,10 +652,10 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
     if acc_data is not None and velocity is not None:
         a_fit = fit_harmonics(acc_data, None, theta, n_harm, edges, drift_knots=drift_knots)
     if a_fit is not None and mass_below_gauge_kg > 0:
-        _check_acceleration_sign(a_fit.total[0, 0], fit.total[1, 0], omega, velocity_delay_s,
+        _check_acceleration_sign(a_fit.total[0, 0], fit.total[1, 0], omega, motion_delay_s,
                                  source=source, acceleration_name=acc_name,
                                  velocity_name=velocity_name)
-    kw = dict(motion_is_velocity=velocity is not None, delay_s=float(velocity_delay_s),
+    kw = dict(motion_is_velocity=velocity is not None, delay_s=motion_delay_s,
               mass_kg=float(mass_below_gauge_kg))
     f_ph, v_ph, p_c = _complex_power(fit.total[0], fit.total[1],
                                      None if a_fit is None else a_fit.total[0],
@@ -705,6 +731,8 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
                                    "acceleration channel" if acc_data is not None
                                    else "velocity (j n w V_n)"),
     }
+    if start_offset_delay_s:
+        corrections["start_offset_delay_s"] = float(start_offset_delay_s)
     if baseline_loss_factor > 0:
         corrections["baseline_structure_share"] = float(structure_share)
         if structure_mass_kg is not None:
@@ -793,6 +821,7 @@ def analyze_channels(force: Channel, velocity: Channel | None, *,
                      frequency_hz: float | None = None,
                      n_harmonics: int = defaults.N_HARMONICS,
                      velocity_delay_s: float = 0.0,
+                     start_offset_delay_s: float = 0.0,
                      mass_below_gauge_kg: float = 0.0,
                      baseline_loss_factor: float = 0.0,
                      structure_mass_kg: float | None = None,
@@ -843,7 +872,7 @@ def analyze_channels(force: Channel, velocity: Channel | None, *,
             by_role["force"], by_role.get("velocity"), force.sample_rate_hz,
             acceleration=by_role.get("acceleration"),
             frequency_hz=frequency_hz, n_harmonics=n_harmonics,
-            velocity_delay_s=velocity_delay_s,
+            velocity_delay_s=velocity_delay_s, start_offset_delay_s=start_offset_delay_s,
             mass_below_gauge_kg=mass_below_gauge_kg, baseline_loss_factor=baseline_loss_factor,
             structure_mass_kg=structure_mass_kg, n_blocks=n_blocks, min_periods=min_periods,
             source=source, force_name=force.name, velocity_name=motion.name,
