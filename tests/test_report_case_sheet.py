@@ -13,6 +13,7 @@ from __future__ import annotations
 import json
 import re
 import zlib
+from pathlib import Path
 
 import pandas as pd
 import pytest
@@ -26,11 +27,16 @@ from pidcore.compare.align import (
     CALIBRATED_LOW_COLUMN,
     MEASURED_BASELINE_COLUMN,
     MEASURED_EQ11_COLUMN,
+    MEASURED_EQ11_STDERR_COLUMN,
 )
 from pidcore.model import load_paper_table3
 from pidcore.report.case_sheet import calibrated_case, case_pdf, sheet_lines
+from pidcore.units import display_value_with_error
 
 TITLE = "100 Hz, 5 g, 50 %, acrylic, z (1 file(s))"
+#: The bundled DEM runs of Table 3's grid, 100 Hz, 5 g, 50 % among them: the headline is the
+#: Eq. 10 SDC of that case's m_c, and the Eq. 11 SDC the band judges is a line of its own.
+DEM_STORE = Path(__file__).resolve().parents[1] / "data_samples" / "dem_table3.h5"
 
 
 def _pdf_text(data: bytes) -> str:
@@ -85,8 +91,8 @@ def _calibration(tmp_path, predicted: float, low: float, high: float, *, f: floa
 def _report_row(tmp_path, store, calibration=None) -> dict:
     out = tmp_path / "report"
     extra = ["--calibration", str(calibration)] if calibration else []
-    assert main(["report", "--store", str(store), *extra, "--format", "csv",
-                 "--out", str(out)]) == 0
+    assert main(["report", "--store", str(store), "--dem-store", str(DEM_STORE), *extra,
+                 "--format", "csv", "--out", str(out)]) == 0
     table = pd.read_csv(out / "report.csv", keep_default_na=False, na_values=[""])
     (row,) = table[table[MEASURED_EQ11_COLUMN].notna()].to_dict("records")
     return row
@@ -96,13 +102,14 @@ def _compare_view(store):
     """The Compare page's view of the store's one load case (as :func:`pidcore.app.state.
     case_view` builds it, without Streamlit)."""
     from pidcore.app import workbench
-    from pidcore.store.listing import saved_analyses
+    from pidcore.store.listing import list_dem_runs, saved_analyses
 
     saved = saved_analyses(store)
     entries = workbench.matched_specimens(workbench.saved_entries(store, saved), saved)
     (group,) = workbench.group_entries(entries)
     members = [entries[i] for i in group]
-    return members, workbench.case_view(members, None, load_paper_table3(), (store,))
+    return members, workbench.case_view(members, list_dem_runs(store, DEM_STORE),
+                                        load_paper_table3(), (store, DEM_STORE))
 
 
 # 0.26 .. 0.39 (the test's band of 0.25 .. 0.40) holds the test's own 0.314 (judged before the
@@ -136,6 +143,17 @@ def test_the_case_sheet_gives_the_report_rows_calibrated_prediction_band_and_ver
     assert ("judged at the measured SDC before the empty coupon's damping "
             f"({sdc_text(taken)}) was taken off" in judged.note) == bool(baseline_loss_factor)
     lines = sheet_lines(view, title=TITLE, calibrated=shown)
+    # the SDC the band judges, as the row's Eq. 11 columns give it, on a line of its own (the
+    # headline's is the Eq. 10 SDC of the DEM case's m_c)
+    comp = view["comparison"]
+    assert view["headline"].measured_kind.startswith("Eq. 10")
+    assert (comp.measured_sdc, comp.measured_stderr) == pytest.approx(
+        (row[MEASURED_EQ11_COLUMN], row[MEASURED_EQ11_STDERR_COLUMN]), rel=1e-12)
+    assert comp.measured_baseline_sdc == pytest.approx(taken, rel=1e-12)
+    measured_line = ("measured SDC (Eq. 11) " + display_value_with_error(
+        row[MEASURED_EQ11_COLUMN], row[MEASURED_EQ11_STDERR_COLUMN])
+        + (f", the empty coupon's damping (SDC {sdc_text(taken)}) taken off" if taken else ""))
+    assert measured_line in lines
     calibrated_lines = shown.sheet_lines()
     assert all(line in lines for line in calibrated_lines)
     assert calibrated_lines[0] == (
@@ -145,7 +163,7 @@ def test_the_case_sheet_gives_the_report_rows_calibrated_prediction_band_and_ver
     assert calibrated_lines[2] == f"  ({judged.note})"
     # and the PDF shows them
     text = _pdf_text(case_pdf(view, title=TITLE, calibrated=shown))
-    for line in calibrated_lines:
+    for line in [measured_line, *calibrated_lines]:
         assert _words(line) in text, line
 
 

@@ -130,7 +130,8 @@ def plot_loops(loops: pd.DataFrame, ax) -> None:
 def sheet_lines(view: dict, *, title: str, calibrated: CalibratedCase | None = None
                 ) -> list[str]:
     """The text lines at the top of :func:`case_pdf`'s first page: the title, the headline
-    (measured SDC against our DEM and the verdict), the calibrated DEM's SDC, 95 % band and
+    (measured SDC against our DEM and the verdict), the measured Eq. 11 SDC (where the headline's
+    is Eq. 10's), the calibrated DEM's SDC, 95 % band and
     verdict in the words of the report's row (``calibrated``:
     :func:`calibrated_case`; None: no calibration given, said so), the
     DEM alignment and the view's notes."""
@@ -143,6 +144,16 @@ def sheet_lines(view: dict, *, title: str, calibrated: CalibratedCase | None = N
              f"{display_value_with_error(head.measured, head.measured_stderr)}{dem}: "
              f"{head.verdict}",
              *([f"  ({head.basis})"] if head.basis else [])]
+    if head.measured_kind != "Eq. 11":
+        # the SDC the calibrated band judges, the report's "SDC measured (Eq. 11)": the sheet
+        # gave the verdict on a number it did not show
+        taken = comp.measured_baseline_sdc
+        lines.append(f"measured SDC (Eq. 11) "
+                     f"{display_value_with_error(comp.measured_sdc, comp.measured_stderr)}"
+                     + (f", the empty coupon's damping (SDC {sdc_text(taken)}) taken off"
+                        if taken and math.isfinite(taken) else
+                        ", the empty coupon's damping taken off (SDC not stored)"
+                        if not math.isfinite(taken) else ""))
     # the report's row of this case says the calibrated verdict; a sheet handed on without it
     # read as if no calibration had been asked for
     lines += (calibrated or _NO_CALIBRATION).sheet_lines()
