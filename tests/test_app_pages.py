@@ -182,8 +182,9 @@ def test_compare_judges_a_test_with_its_baseline_taken_off_at_its_sdc_before_it(
     at = _upload(_app(), [("c_fill50.csv", data), ("setup.csv", settings)])
     captions = " ".join(c.value for c in at.caption)
     taken = 2 * math.pi * 0.02  # the whole loss factor: no structure mass given
-    assert "the measured Eq. 11 SDC is inside (judged before the empty coupon's damping, SDC " \
-           f"{taken:.4g}, was taken off: " in captions, captions
+    # in the words of the report row's note (judge_measurement writes both)
+    assert "the measured Eq. 11 SDC is inside (judged at the measured SDC before the empty " \
+           f"coupon's damping ({taken:.4g}) was taken off, " in captions, captions
     # the Report tab's row of the saved record: the same verdict, the same part taken off
     at.button(key="save").click()
     at.run()

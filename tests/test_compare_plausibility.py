@@ -381,3 +381,25 @@ def test_an_interpolated_case_is_judged_like_for_like_as_the_report_judges_it():
     head = headline(comp)
     assert head.measured_kind == "Eq. 10 (DEM m_c)" and head.measured == comp.measured_sdc_eq10
     assert head.verdict.startswith(("agrees", "differs"))
+
+
+def test_the_paper_curve_of_a_case_within_tolerance_of_a_grid_point_is_that_points():
+    # the sample test at 500.0005 Hz, 4.99967 g is Table 3's 500 Hz, 5 g case (as the report
+    # aligns it): its curve was drawn between the 500 and 1000 Hz grid points, leaning on the
+    # 1000 Hz values by a part in a million, and its note named the 1000 Hz, 1 g, 90 % gap on
+    # a 500 Hz, 5 g sheet
+    rec = _analysis(mass_damper_csv(frequency_hz=50.0))
+    entry = _entry(rec)
+    near = MeasuredEntry(**{**entry.__dict__, "load_case": entry.load_case.__class__(
+        500.0005, 4.99967, 50.0)})
+    paper = paper_table()
+    comp = compare_case([near], None, paper)
+    assert not any("no Table 3 DEM value" in n for n in comp.notes), comp.notes
+    assert any(n.startswith("model drawn at 500 Hz, 5 g: the case (500.0005 Hz, 4.99967 g) "
+                            "lies at that grid point") for n in comp.notes), comp.notes
+    # pchip passes through its nodes: the curve's ends are Table 3's printed 25 % and 90 %
+    # values (to round-off; a part in a million off before)
+    printed = paper[(paper["frequency_hz"] == 500.0) & (paper["acceleration_g"] == 5.0)]
+    by_fill = dict(zip(printed["fill_percent"], printed["sdc_dem"], strict=True))
+    assert (comp.model_sdc[0], comp.model_sdc[-1]) == pytest.approx(
+        (by_fill[25.0], by_fill[90.0]), rel=1e-12)

@@ -328,6 +328,110 @@ class CalibratedPrediction:
         return (inside if self.contains(sdc, stderr, dof) else outside), ""
 
 
+#: Why a measured SDC that pools a record the plausibility checks refuse (kept with
+#: --accept-implausible) is not judged: its standard error is the scatter of an impossible SDC
+#: about the others (22 for 46.1 pooled with 2.19), so the band it gives holds anything.
+POOLS_IMPLAUSIBLE_REASON = ("it pools an implausible result, so the calibrated band does not "
+                            "judge it")
+
+
+@dataclass(frozen=True)
+class MeasurementJudgement:
+    """The calibrated prediction beside one measured Eq. 11 SDC, and its verdict
+    (:func:`judge_measurement`): what a report row, the app's Compare page and the load-case
+    PDF sheet each show, from the one rule.
+
+    Attributes
+    ----------
+    sdc : float
+        The calibrated DEM's Eq. 11 SDC at the load case [-].
+    low, high : float
+        The 95 % band of a measurement with the measured SDC's own standard error [-] (NaN:
+        none for that standard error, :attr:`reason` says why).
+    verdict : str
+        A word of :data:`pidcore.constants.BAND_VERDICTS`.
+    reason : str
+        Why the verdict is ``not compared`` or ``uninformative``; "" where judged.
+    before_baseline : str
+        Where the empty coupon's damping was taken off the measured SDC: that it was judged
+        at the SDC before (the calibration predicts the whole coupon's); "" otherwise.
+    widened : str
+        Where the band is not the calibration's own point's: for which standard error and
+        with which quantile it was widened; "" otherwise.
+    cut : str
+        Where the band is cut at the SDC bound, and why (:meth:`CalibratedPrediction.
+        band_note`); "" otherwise.
+    """
+
+    sdc: float
+    low: float
+    high: float
+    verdict: str
+    reason: str = ""
+    before_baseline: str = ""
+    widened: str = ""
+    cut: str = ""
+
+    @property
+    def note(self) -> str:
+        """The words a report row's note gains (its verdict's reason first; the band's cut
+        last), "; "-joined; "" where there are none."""
+        return "; ".join(n for n in (self.reason, self.before_baseline, self.widened,
+                                     self.cut) if n)
+
+
+def judge_measurement(hit: CalibratedPrediction, measured: float, stderr: float,
+                      dof: float = math.nan, baseline_sdc: float = 0.0, *,
+                      pools_implausible: bool = False) -> MeasurementJudgement:
+    """The calibrated prediction ``hit`` beside a measured Eq. 11 SDC ``measured`` (NaN: none)
+    with standard error ``stderr`` of ``dof`` degrees of freedom, from which ``baseline_sdc``
+    was taken off as the empty coupon's damping (:func:`pidcore.signal.power.
+    baseline_sdc_taken_off`; 0: nothing, NaN: taken off, amount unknown).
+
+    The one rule of the report's rows (:func:`pidcore.report.table.add_calibration_columns`),
+    the app's Compare page and the load-case sheet: the band is that of a measurement with
+    this one's standard error; the measurement is judged (:meth:`CalibratedPrediction.judge`)
+    at its SDC before the baseline was taken off (the calibration predicts the whole coupon's
+    SDC, adding a baseline of its own); ``not compared`` without a measurement, with an
+    unknown baseline, where it ``pools_implausible`` records, or where its standard error
+    gives no band (a negative or near-1e308 stderr of a hand-edited store)."""
+    not_compared = BAND_VERDICTS[2]
+    own_stderr = stderr if math.isfinite(measured) else math.nan
+    try:
+        low, high = hit.band(own_stderr, dof)
+    except ParameterError as exc:
+        return MeasurementJudgement(hit.sdc, math.nan, math.nan, not_compared,
+                                    f"no calibrated band for this measurement's SDC stderr: "
+                                    f"{exc}")
+    cut = hit.band_note(own_stderr, dof)
+    if not math.isfinite(measured):
+        return MeasurementJudgement(hit.sdc, low, high, not_compared,
+                                    "no Eq. 11 measurement to compare with the calibrated band",
+                                    cut=cut)
+    if not math.isfinite(baseline_sdc):
+        return MeasurementJudgement(
+            hit.sdc, low, high, not_compared,
+            "the measured SDC had the empty coupon's damping taken off, and its SDC before "
+            "that (which the calibration predicts) is not stored: not compared with the "
+            "calibrated band", cut=cut)
+    if pools_implausible:
+        return MeasurementJudgement(hit.sdc, low, high, not_compared, POOLS_IMPLAUSIBLE_REASON,
+                                    cut=cut)
+    widened = ""
+    if (low, high) != hit.band():
+        # "(the calibration's point at this load case: 0)" read as a point numbered 0, or an
+        # SDC of 0: it is the stderr of the fitted point
+        widened = (f"calibrated band for this measurement's SDC stderr {stderr:.3g} (the "
+                   f"calibration's own measurement at this load case had SDC stderr "
+                   f"{hit.measured_stderr:.3g}); its 95 % widening: {quantile_label(dof)}")
+    judged_at = measured + baseline_sdc
+    verdict, uninformative = hit.judge(judged_at, stderr, dof)
+    before = (f"judged at the measured SDC before the empty coupon's damping "
+              f"({sdc_text(baseline_sdc)}) was taken off, {sdc_text(judged_at)}, the SDC the "
+              "calibration predicts") if baseline_sdc else ""
+    return MeasurementJudgement(hit.sdc, low, high, verdict, uninformative, before, widened, cut)
+
+
 def row_verdict(row: dict, bound: SdcBound) -> str:
     """The verdict of :data:`pidcore.constants.BAND_VERDICTS` on one prediction row of a
     calibration (``predictions`` or ``loo`` of its calibration.json, or of

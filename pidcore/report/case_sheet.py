@@ -1,4 +1,5 @@
-"""One load case on paper: a PDF with the headline, SDC against fill, the loops and the
+"""One load case on paper: a PDF with the headline, the calibrated DEM's prediction, band and
+verdict (as the report's row of the case gives them), SDC against fill, the loops and the
 corrections each file was analysed with.
 
 Drawn with matplotlib from the same frames the app's charts draw
@@ -9,14 +10,95 @@ from __future__ import annotations
 
 import io
 import math
+from collections.abc import Sequence
+from dataclasses import dataclass
 
 import pandas as pd
 
-from ..compare.align import PACKING_RATIO_COLUMN
+from ..calibrate.prediction import (
+    MeasurementJudgement,
+    band_text,
+    judge_measurement,
+    sdc_text,
+)
+from ..compare.align import CALIBRATED_INSIDE_COLUMN, PACKING_RATIO_COLUMN
+from ..compare.case import CaseComparison
 from ..units import display_value_with_error
 
 #: Page size of the sheet, inches (A4 landscape).
 PAGE_IN = (11.69, 8.27)
+
+
+@dataclass(frozen=True)
+class CalibratedCase:
+    """The calibrated DEM beside one load case's measurement, as the Compare page and the
+    load-case PDF sheet (:func:`case_pdf`) show it
+    (:func:`calibrated_case`).
+
+    ``label`` names the calibration shown ("" where none speaks for the measurement's
+    specimen); ``judgement`` is its prediction, band and verdict (:func:`pidcore.calibrate.
+    prediction.judge_measurement`, the report row's rule), None where it predicts nothing
+    here; ``said`` is what is said instead or besides: calibrations that cannot be read, none
+    of this specimen, none predicting this load case.
+    """
+
+    label: str = ""
+    judgement: MeasurementJudgement | None = None
+    said: tuple[str, ...] = ()
+
+    def sheet_lines(self) -> list[str]:
+        """The lines a printed page gives it: the calibrated SDC, its 95 % band and the
+        verdict in the words of the report's columns and note; without a judgement, that
+        there is no calibrated verdict and why (a sheet with nothing read as one judged by
+        no calibration, or as one whose calibration was lost)."""
+        j = self.judgement
+        if j is None:
+            why = "; ".join(self.said) or "no calibration given"
+            return [f"calibrated DEM: no calibrated verdict ({why})"]
+        lines = [f"calibrated DEM ({self.label}): SDC (Eq. 11) {sdc_text(j.sdc)}, 95 % band "
+                 f"{band_text(j.low, j.high)} [-]",
+                 f"{CALIBRATED_INSIDE_COLUMN}: {j.verdict}"]
+        if j.note:
+            lines.append(f"  ({j.note})")
+        return lines
+
+
+def calibrated_case(calibrations: Sequence[tuple[object | None, str]],
+                    comparison: CaseComparison, specimen: str, *,
+                    implausible: bool = False, specimen_sha256: str = "") -> CalibratedCase:
+    """The calibrated DEM's Eq. 11 SDC, 95 % band and verdict at ``comparison``'s load case.
+
+    ``calibrations``: [(calibration or None, label)] of
+    :func:`pidcore.app.calibration.available_calibrations`; the first that predicts the case
+    is shown (a calibration of one specimen does not hide another's), of those that speak for
+    the measurement's ``specimen`` ("": not named) and its file (``specimen_sha256``: a
+    calibration of another file of that name is not its). ``implausible``: the measurement
+    pools a record the plausibility checks refuse (not judged, as the report's row)."""
+    said = [reason for c, reason in calibrations if c is None]  # none, or unreadable
+    usable = [(c, label) for c, label in calibrations if c is not None]
+    if not usable:
+        return CalibratedCase(said=tuple(said))
+    mine = [(c, label) for c, label in usable if c.speaks_for(specimen, specimen_sha256)]
+    if not mine:  # the report refuses another specimen's calibration too
+        reasons = [c.other_file_reason(specimen_sha256, specimen) for c, _ in usable]
+        said.append(f"No calibration is of specimen {specimen}: "
+                    + "; ".join(label + (f" ({why})" if why else "")
+                                for (_, label), why in zip(usable, reasons, strict=True)) + ".")
+        return CalibratedCase(said=tuple(said))
+    hits = [(c, label, c.lookup(comparison.load_case)) for c, label in mine]
+    _, label, hit = next((h for h in hits if h[2] is not None), hits[0])
+    if hit is None:
+        said.append(f"No calibration predicts {comparison.load_case.full_label()}: "
+                    + "; ".join(f"{label} predicts {len(c.predictions)} measured load case(s)"
+                                for c, label, _ in hits) + ".")
+        return CalibratedCase(label=label, said=tuple(said))
+    return CalibratedCase(label=label, said=tuple(said), judgement=judge_measurement(
+        hit, comparison.measured_sdc, comparison.measured_stderr,
+        comparison.measured_stderr_dof, comparison.measured_baseline_sdc,
+        pools_implausible=implausible))
+
+
+_NO_CALIBRATION = CalibratedCase()
 
 
 def plot_sdc_points(points: pd.DataFrame, ax) -> None:
@@ -45,28 +127,55 @@ def plot_loops(loops: pd.DataFrame, ax) -> None:
     ax.legend(fontsize="x-small")
 
 
-def case_pdf(view: dict, *, title: str) -> bytes:
+def sheet_lines(view: dict, *, title: str, calibrated: CalibratedCase | None = None
+                ) -> list[str]:
+    """The text lines at the top of :func:`case_pdf`'s first page: the title, the headline
+    (measured SDC against our DEM and the verdict), the measured Eq. 11 SDC (where the headline's
+    is Eq. 10's), the calibrated DEM's SDC, 95 % band and
+    verdict in the words of the report's row (``calibrated``:
+    :func:`calibrated_case`; None: no calibration given, said so), the
+    DEM alignment and the view's notes."""
+    head, comp = view["headline"], view["comparison"]
+    # without a DEM value the verdict says so and why ("vs our DEM none" read as a number)
+    dem = (f"  vs  our DEM {display_value_with_error(head.dem, head.dem_stderr)}"
+           if math.isfinite(head.dem) else "")
+    lines = [title,
+             f"measured SDC ({head.measured_kind}) "
+             f"{display_value_with_error(head.measured, head.measured_stderr)}{dem}: "
+             f"{head.verdict}",
+             *([f"  ({head.basis})"] if head.basis else [])]
+    if head.measured_kind != "Eq. 11":
+        # the SDC the calibrated band judges, the report's "SDC measured (Eq. 11)": the sheet
+        # gave the verdict on a number it did not show
+        taken = comp.measured_baseline_sdc
+        lines.append(f"measured SDC (Eq. 11) "
+                     f"{display_value_with_error(comp.measured_sdc, comp.measured_stderr)}"
+                     + (f", the empty coupon's damping (SDC {sdc_text(taken)}) taken off"
+                        if taken and math.isfinite(taken) else
+                        ", the empty coupon's damping taken off (SDC not stored)"
+                        if not math.isfinite(taken) else ""))
+    # the report's row of this case says the calibrated verdict; a sheet handed on without it
+    # read as if no calibration had been asked for
+    lines += (calibrated or _NO_CALIBRATION).sheet_lines()
+    lines.append(f"DEM alignment: {comp.aligned.status}. {comp.aligned.message}")
+    lines += [f"note: {n}" for n in view["notes"]]
+    return lines
+
+
+def case_pdf(view: dict, *, title: str, calibrated: CalibratedCase | None = None) -> bytes:
     """PDF bytes of one load case from the app's case view
     (:func:`pidcore.app.workbench.case_view`: ``comparison``, ``headline``, ``sdc_points``,
-    ``loops``, ``energies``, ``notes``)."""
+    ``loops``, ``energies``, ``notes``) and the calibrated DEM beside it (``calibrated``, see
+    :func:`sheet_lines`)."""
     from matplotlib.backends.backend_pdf import PdfPages
     from matplotlib.figure import Figure
 
-    head, comp = view["headline"], view["comparison"]
+    comp = view["comparison"]
+    lines = sheet_lines(view, title=title, calibrated=calibrated)
     buffer = io.BytesIO()
     with PdfPages(buffer) as pdf:
         fig = Figure(figsize=PAGE_IN, layout="constrained")
         top, bottom = fig.subfigures(2, 1, height_ratios=[1, 3])
-        # without a DEM value the verdict says so and why ("vs our DEM none" read as a number)
-        dem = (f"  vs  our DEM {display_value_with_error(head.dem, head.dem_stderr)}"
-               if math.isfinite(head.dem) else "")
-        lines = [title,
-                 f"measured SDC ({head.measured_kind}) "
-                 f"{display_value_with_error(head.measured, head.measured_stderr)}{dem}: "
-                 f"{head.verdict}",
-                 *([f"  ({head.basis})"] if head.basis else []),
-                 f"DEM alignment: {comp.aligned.status}. {comp.aligned.message}"]
-        lines += [f"note: {n}" for n in view["notes"]]
         top.text(0.01, 0.95, "\n".join(lines), va="top", fontsize=9, family="monospace",
                  wrap=True)
         left, right = bottom.subplots(1, 2)

@@ -60,7 +60,7 @@ from ..compare.specimens import (
     runs_for_measurement,
 )
 from ..constants import BAND_VERDICTS
-from ..errors import ParameterError, instance_of
+from ..errors import instance_of
 from ..signal.power import baseline_sdc_taken_off
 from ..specimen import (
     MEASURED_SHA256_FIELD,
@@ -757,7 +757,7 @@ def add_calibration_columns(table: pd.DataFrame, calibration, *,
         material (the default report), each checked against the calibration's specimen.
         Neither: unchecked.
     """
-    from ..calibrate.prediction import quantile_label, sdc_text, uninformative_count_text
+    from ..calibrate.prediction import judge_measurement, uninformative_count_text
     from ..constants import PARTICLE_MATERIALS
     from ..specimen import paper_specimen
 
@@ -766,7 +766,6 @@ def add_calibration_columns(table: pd.DataFrame, calibration, *,
     reasons: dict[str, str] = {}  # per material: why the calibration is of another specimen
     for _, row in out.iterrows():
         note = str(row.get("note", "") or "")
-        cut = ""  # a band reaching past 2 pi, said where it is cut
         case = LoadCase(float(row["frequency [Hz]"]), float(row["acceleration [g]"]),
                         float(row[PACKING_RATIO_COLUMN]),
                         str(row.get("material") or defaults.COMPARE_DEFAULT_MATERIAL))
@@ -790,63 +789,22 @@ def add_calibration_columns(table: pd.DataFrame, calibration, *,
             why = other or calibration.why_not_predicted(case, tolerances=tolerances)
             extra = f"not predicted by the calibration {calibration.path.name}: {why}"
         else:
-            measured = _finite_or_nan(row.get(MEASURED_EQ11_COLUMN))
             # the calibration predicts the SDC before the empty coupon's damping was taken
             # off (it adds a baseline of its own): judged at that SDC. A table of an older
-            # pidcore has no such column: nothing taken off
-            taken = _finite_or_nan(row.get(MEASURED_BASELINE_COLUMN, 0.0))
-            stderr = _finite_or_nan(row.get(MEASURED_EQ11_STDERR_COLUMN))
-            # a table of an older pidcore has no such column: unknown, the normal's quantile
-            dof = _finite_or_nan(row.get(MEASURED_EQ11_DOF_COLUMN))
-            # the band of a measurement with this row's own standard error (not the fitted
-            # point's, unless it is that measurement)
-            extra = ""
-            try:
-                band = hit.band(stderr if math.isfinite(measured) else math.nan, dof)
-            except ParameterError as exc:
-                # a negative or near-1e308 stderr (a hand-edited store): no band, not a
-                # traceback nor an infinite bound
-                band = (math.nan, math.nan)
-                extra = f"no calibrated band for this measurement's SDC stderr: {exc}"
-            sdc.append(hit.sdc)
-            low.append(band[0])
-            high.append(band[1])
-            cut = "" if extra else hit.band_note(stderr if math.isfinite(measured)
-                                                 else math.nan, dof)
-            if extra:
-                inside.append(NOT_COMPARED)
-            elif not math.isfinite(measured):
-                inside.append(NOT_COMPARED)
-                extra = "no Eq. 11 measurement to compare with the calibrated band"
-            elif not math.isfinite(taken):
-                inside.append(NOT_COMPARED)
-                extra = ("the measured SDC had the empty coupon's damping taken off, and its "
-                         "SDC before that (which the calibration predicts) is not stored: not "
-                         "compared with the calibrated band")
-            elif IMPLAUSIBLE_ROW_NOTE in note:
-                # its standard error is the scatter of an impossible SDC about the others
-                # (22 for 46.1 pooled with 2.19): the band it gives holds anything, and the
-                # row read 'inside' where calibrate --store leaves that record out
-                inside.append(NOT_COMPARED)
-                extra = "so not compared with the calibrated band"
-            else:
-                if band != hit.band():
-                    # "(the calibration's point at this load case: 0)" read as a point
-                    # numbered 0, or an SDC of 0: it is the stderr of the fitted point
-                    extra = (f"calibrated band for this measurement's SDC stderr {stderr:.3g} "
-                             f"(the calibration's own measurement at this load case had SDC "
-                             f"stderr {hit.measured_stderr:.3g}); its 95 % widening: "
-                             f"{quantile_label(dof)}")
-                verdict, uninformative = hit.judge(measured + taken, stderr, dof)
-                inside.append(verdict)
-                if taken:
-                    extra = "; ".join(n for n in (
-                        f"judged at the measured SDC before the empty coupon's damping "
-                        f"({sdc_text(taken)}) was taken off, {sdc_text(measured + taken)}, "
-                        "the SDC the calibration predicts", extra) if n)
-                if uninformative:
-                    extra = "; ".join(n for n in (uninformative, extra) if n)  # verdict first
-        notes.append("; ".join(n for n in (note, extra, cut) if n))
+            # pidcore has no such column: nothing taken off; nor a dof column: unknown, the
+            # normal's quantile
+            judged = judge_measurement(
+                hit, _finite_or_nan(row.get(MEASURED_EQ11_COLUMN)),
+                _finite_or_nan(row.get(MEASURED_EQ11_STDERR_COLUMN)),
+                _finite_or_nan(row.get(MEASURED_EQ11_DOF_COLUMN)),
+                _finite_or_nan(row.get(MEASURED_BASELINE_COLUMN, 0.0)),
+                pools_implausible=IMPLAUSIBLE_ROW_NOTE in note)
+            sdc.append(judged.sdc)
+            low.append(judged.low)
+            high.append(judged.high)
+            inside.append(judged.verdict)
+            extra = judged.note
+        notes.append("; ".join(n for n in (note, extra) if n))
     at = list(out.columns).index(MEASURED_EQ11_COLUMN) + 1 \
         if MEASURED_EQ11_COLUMN in out.columns else len(out.columns)
     for offset, (name, values) in enumerate(zip(CALIBRATION_COLUMNS, (sdc, low, high, inside),

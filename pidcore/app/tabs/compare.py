@@ -16,9 +16,10 @@ from pidcore.app.tabs import (
     refuse_address_flag,
 )
 from pidcore.app.vocabulary import page_terms
-from pidcore.calibrate.prediction import band_text, quantile_label, sdc_text
+from pidcore.calibrate.prediction import band_text, sdc_text
 from pidcore.compare.case import equivalent_dampers
 from pidcore.constants import BAND_VERDICTS
+from pidcore.report.case_sheet import CalibratedCase, calibrated_case
 
 
 def _entries(stores, session_files):
@@ -83,35 +84,17 @@ def _group_key(members) -> str:
                     for e in members)
 
 
-def _calibrated(calibrations, comp, head, specimen: str, *, implausible: bool = False,
-                specimen_sha256: str = "") -> None:
+def _calibrated(shown: CalibratedCase, comp, head) -> None:
     """The calibrated DEM's Eq. 11 SDC with its 95 % band beside the raw DEM and the measured
     Eq. 11 SDC (like for like: the calibration predicts what a shaker test of the DEM would
-    measure with Eq. 11). ``calibrations``: [(calibration or None, label)], see :func:`render`;
-    the first that predicts the case is shown (a calibration of one specimen does not hide
-    another's), of those that speak for the measurement's ``specimen`` ("": not named) and
-    its file (``specimen_sha256``: a calibration of another file of that name is not its)."""
-    usable = [(c, label) for c, label in calibrations if c is not None]
-    for c, reason in calibrations:
-        if c is None:  # none at all, or one that cannot be read
-            st.caption(reason)
-    if not usable:
-        return
-    mine = [(c, label) for c, label in usable if c.speaks_for(specimen, specimen_sha256)]
-    if not mine:  # the report refuses another specimen's calibration too
-        reasons = [c.other_file_reason(specimen_sha256, specimen) for c, _ in usable]
-        st.caption(f"No calibration is of specimen {specimen}: "
-                   + "; ".join(label + (f" ({why})" if why else "")
-                               for (_, label), why in zip(usable, reasons, strict=True)) + ".")
-        return
-    usable = mine
-    hits = [(c, label, c.lookup(comp.load_case)) for c, label in usable]
-    calibration, label, hit = next((h for h in hits if h[2] is not None), hits[0])
-    st.markdown("**calibrated DEM** (" + label + ")")
-    if hit is None:
-        st.caption(f"No calibration predicts {comp.load_case.full_label()}: "
-                   + "; ".join(f"{label} predicts {len(c.predictions)} measured load case(s)"
-                               for c, label, _ in hits) + ".")
+    measure with Eq. 11), and the verdict of the report's row (:func:`pidcore.report.
+    case_sheet.calibrated_case`)."""
+    for said in shown.said:
+        st.caption(said)
+    if shown.label:
+        st.markdown("**calibrated DEM** (" + shown.label + ")")
+    j = shown.judgement
+    if j is None:
         return
     c1, c2, c3 = st.columns(3)
     c1.metric("SDC measured, Eq. 11 [-]",
@@ -119,40 +102,22 @@ def _calibrated(calibrations, comp, head, specimen: str, *, implausible: bool = 
     # an SDC as the report's cell and the band beside it write it (sdc_text, 4 significant
     # digits): 4 decimals showed the calibrated SDC the report writes 0.08264 as 0.0826
     c2.metric("SDC DEM, raw [-]", sdc_text(head.dem) if math.isfinite(head.dem) else "none")
-    # the band of a measurement with this one's standard error (the report's)
-    own_stderr = comp.measured_stderr if math.isfinite(comp.measured_sdc) else math.nan
-    low, high = hit.band(own_stderr, comp.measured_stderr_dof)
-    c3.metric("SDC calibrated DEM, Eq. 11 [-]", sdc_text(hit.sdc),
-              help=f"95 % band {band_text(low, high)}")
-    # the calibration predicts the SDC before the empty coupon's damping was taken off
-    taken = comp.measured_baseline_sdc
-    if not math.isfinite(comp.measured_sdc):
-        verdict = "not compared (no Eq. 11 SDC)"
-    elif implausible:  # as the report judges such a row: its stderr is an impossible scatter
-        verdict = "not compared (it pools an implausible result, named below)"
-    elif not math.isfinite(taken):
-        verdict = ("not compared (the empty coupon's damping was taken off it, and its SDC "
-                   "before that, which the calibration predicts, is not stored)")
-    else:
-        # as the report's row: a band of 0 .. the SDC bound holds every measurement, so
-        # "inside" lied; its reason is the verdict then
-        judged, reason = hit.judge(comp.measured_sdc + taken, own_stderr,
-                                   comp.measured_stderr_dof)
-        yes, no = BAND_VERDICTS[:2]
-        verdict = reason or {yes: "inside", no: "outside"}[judged]
-        if taken:
-            verdict += (f" (judged before the empty coupon's damping, SDC {sdc_text(taken)}, "
-                        f"was taken off: {sdc_text(comp.measured_sdc + taken)}, the SDC the "
-                        "calibration predicts)")
+    c3.metric("SDC calibrated DEM, Eq. 11 [-]", sdc_text(j.sdc),
+              help=f"95 % band {band_text(j.low, j.high)}")
+    yes, no, _, uninformative = BAND_VERDICTS
+    # an uninformative band's reason says the verdict ("uninformative: ..."); a band not
+    # compared says why in brackets
+    verdict = (j.reason if j.verdict == uninformative else
+               {yes: "inside", no: "outside"}.get(j.verdict, j.verdict)
+               + (f" ({j.reason})" if j.reason else ""))
+    if j.before_baseline:
+        verdict += f" ({j.before_baseline})"
     # the report's format: its uninformative reason below writes this band "0 .. 16.91"
-    st.caption(f"calibrated 95 % band {band_text(low, high)} [-]"
-               + (f" (for this measurement's SDC stderr {comp.measured_stderr:.3g}, "
-                  f"widened by the {quantile_label(comp.measured_stderr_dof)})"
-                  if (low, high) != hit.band() else "")
+    st.caption(f"calibrated 95 % band {band_text(j.low, j.high)} [-]"
+               + (f" ({j.widened})" if j.widened else "")
                + f"; the measured Eq. 11 SDC is {verdict}.")
-    cut = hit.band_note(own_stderr, comp.measured_stderr_dof)
-    if cut:  # a bound no measurement can take is not shown without a word
-        st.caption(cut + ".")
+    if j.cut:  # a bound no measurement can take is not shown without a word
+        st.caption(j.cut + ".")
 
 
 def render(stores, session_files: list, calibrations: list) -> None:
@@ -241,9 +206,11 @@ def render(stores, session_files: list, calibrations: list) -> None:
             column.metric(label, value)
         if paper_caption:
             st.caption(paper_caption)
-    _calibrated(calibrations, comp, head, members[0].specimen,
-                implausible=any(e.implausible for e in members),
-                specimen_sha256=members[0].specimen_sha256)
+    calibrated = calibrated_case(
+        calibrations, comp, members[0].specimen,
+        implausible=any(e.implausible for e in members),
+        specimen_sha256=members[0].specimen_sha256)
+    _calibrated(calibrated, comp, head)
     for note in view["notes"]:
         st.caption(f"note: {note}")
     left, right = st.columns(2)
@@ -270,10 +237,12 @@ def render(stores, session_files: list, calibrations: list) -> None:
     if st.button("PDF of this load case (plots and corrections)", key="case_pdf"):
         from pidcore.report.case_sheet import case_pdf
 
-        st.session_state["case_pdf_bytes"] = (_group_key(members), case_pdf(
-            view, title=labels[choice]))
+        # keyed by the calibration's verdict too: another calibration chosen since made the
+        # sheet of the same files another one
+        st.session_state["case_pdf_bytes"] = ((_group_key(members), calibrated), case_pdf(
+            view, title=labels[choice], calibrated=calibrated))
     made = st.session_state.get("case_pdf_bytes")
-    if made and made[0] == _group_key(members):
+    if made and made[0] == (_group_key(members), calibrated):
         st.download_button("Download the load case PDF", made[1], mime="application/pdf",
                            file_name=f"pidcore_{comp.load_case.key}.pdf",
                            key="case_pdf_download")
