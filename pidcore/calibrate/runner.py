@@ -63,11 +63,16 @@ def specimen_with(specimen: Specimen, values: Mapping[str, float]) -> Specimen:
 
 @dataclass(frozen=True)
 class RunRequest:
-    """One DEM run of a calibration design: load case, specimen (with the design's values)."""
+    """One DEM run of a calibration design: load case, specimen (with the design's values).
+
+    ``variant``: where ``specimen`` is the calibration's variant of the file it started from
+    (another hash), which file and design values (:func:`variant_provenance`), stored with the
+    run so that pages name it as such, not as another file of that name; None: the file."""
 
     case: LoadCase
     specimen: Specimen
     config: DemConfig
+    variant: Mapping[str, object] | None = field(default=None, compare=False)
 
     def key(self) -> str:
         """The DEM run cache key (:func:`pidcore.dem.persist.run_key`)."""
@@ -80,7 +85,20 @@ def simulate_request(request: RunRequest):
 
 
 def _run_entry(request: RunRequest) -> tuple[str, dict]:
-    return request.key(), dem_run_entry(simulate_request(request))
+    return request.key(), dem_run_entry(simulate_request(request),
+                                        calibration_variant=request.variant)
+
+
+def variant_provenance(start: Specimen, variant: Specimen,
+                       values: Mapping[str, float]) -> dict[str, object] | None:
+    """What a run of ``variant`` (``start`` with the design's ``values``, by the names the fit
+    takes) stores of its origin (:data:`pidcore.compare.align.CALIBRATION_VARIANT_FIELD`);
+    None where the design point is ``start`` itself (same hash: its runs are the file's)."""
+    if variant.hash == start.hash:
+        return None
+    return {"of_name": start.name, "of_sha256": start.hash,
+            # pairs, in the order of the fit: a store's JSON sorts an object's keys
+            "values": [[name, float(value)] for name, value in values.items()]}
 
 
 def run_requests(requests: Sequence[RunRequest], *, store_path: str | os.PathLike,
