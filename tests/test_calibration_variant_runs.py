@@ -181,3 +181,33 @@ def test_rekeying_keeps_what_a_run_says_of_its_origin(variants, tmp_path):
         stated = after.get_dem_run(key).parameters.get("calibration_variant", "absent")
         assert stated == before[key]  # unstated stays unstated, not "the file as given"
     assert sorted(map(str, before.values())).count("absent") == 1
+
+
+def test_calibrate_lists_its_runs_as_the_dem_tab_and_the_report_do(tmp_path, capsys):
+    # pidcore calibrate said "DEM runs: 2 computed" and no more; the store's listings then
+    # named the same runs
+    from pidcore.app.jobs import dem_runs_table
+    from pidcore.cli import main
+    from pidcore.compare.specimens import runs_per_specimen_text
+    from pidcore.specimen import load_specimen
+
+    text = paper_specimen().to_toml().replace('name = "paper_coupon"', 'name = "mycoupon"')
+    (tmp_path / "mycoupon.toml").write_text(text)
+    mine = load_specimen(tmp_path / "mycoupon.toml")
+    (tmp_path / "m.csv").write_text("frequency_hz,acceleration_g,fill_percent,sdc\n"
+                                    "500,5,50,0.5\n")
+    store = tmp_path / "dem.h5"
+    assert main(["calibrate", "--data", str(tmp_path / "m.csv"), "--specimen",
+                 str(tmp_path / "mycoupon.toml"), "--fit", "rolling_friction",
+                 "--discrepancy", "0.3", "--design-size", "2", "--cells", "2",
+                 "--steady-cycles", "10", "--workers", "1", "--no-progress",
+                 "--dem-store", str(store)]) == 0
+    printed = capsys.readouterr().out
+    runs = Store(store).list_dem_runs()
+    listed = set(dem_runs_table(runs)["specimen"])
+    assert len(listed) == 2 and all(
+        f": calibration variant of {_label(mine.hash)} (rolling_friction " in d for d in listed)
+    line = next(x for x in printed.splitlines() if x.startswith("DEM runs: 2 computed"))
+    assert line == (f"DEM runs: 2 computed, 0 reused from {store} "
+                    f"({runs_per_specimen_text(runs)})")
+    assert all(f"1 of {d}" in line for d in listed)

@@ -179,6 +179,19 @@ class RunTally:
         self.before = stored_keys(self.store_path, self.keys)
         self.known = True
 
+    def specimens(self) -> str:
+        """The specimens of the design's runs the store holds, as every listing of runs names
+        them (:func:`pidcore.compare.specimens.runs_per_specimen_text`: a variant of the file
+        calibrated as such), e.g. ``"2 of mycoupon [65a6d7]: calibration variant of mycoupon
+        [072027] (static_friction 0.325, rolling_friction 0.025), ..."``; "" where none."""
+        from ..compare.specimens import runs_per_specimen_text
+        from ..store import Store
+
+        if not self.keys or not Path(self.store_path).exists():
+            return ""
+        runs = Store(self.store_path).list_dem_runs()
+        return runs_per_specimen_text(runs[runs["case_key"].isin(self.keys)])
+
     def interrupted(self) -> str:
         """What an interrupted calibration kept, e.g. ``"3 DEM run(s) finished before the
         interrupt are saved in dem.h5 (10 of the calibration's 24 stored now); re-run the same
