@@ -211,3 +211,29 @@ def test_calibrate_lists_its_runs_as_the_dem_tab_and_the_report_do(tmp_path, cap
     assert line == (f"DEM runs: 2 computed, 0 reused from {store} "
                     f"({runs_per_specimen_text(runs)})")
     assert all(f"1 of {d}" in line for d in listed)
+
+
+def test_a_static_friction_raised_to_a_pairs_sliding_friction_is_stated_as_run():
+    """A design's static friction below a pair's sliding friction is run at the sliding one
+    (specimen_with): the paper coupon's 0.096 between particles and 0.14 at the wall make a
+    design value of 0.12 into 0.12 and 0.14. The run's statement gives what was run, per pair,
+    not the 0.12 asked for."""
+    from pidcore.calibrate.runner import variant_provenance
+    from pidcore.compare.specimens import run_origin
+
+    start = paper_specimen()
+    values = {"static_friction": 0.12, "rolling_friction": 0.02}
+    variant = specimen_with(start, values)
+    stated = variant_provenance(start, variant, values)
+    origin = run_origin(json.dumps({"calibration_variant": stated}))
+    held = dict(origin.values)
+    assert held == {"pairs.particle_particle.static_friction": 0.12,
+                    "pairs.particle_wall.static_friction":
+                        start.pairs.particle_wall.sliding_friction,
+                    "rolling_friction": 0.02}
+    assert held["pairs.particle_wall.static_friction"] == \
+        variant.pairs.particle_wall.static_friction
+    # a value no pair raises is stated by the name the fit took, as before
+    plain = {"static_friction": 0.5}
+    assert variant_provenance(start, specimen_with(start, plain), plain)["values"] == \
+        [["static_friction", 0.5]]

@@ -98,7 +98,26 @@ def variant_provenance(start: Specimen, variant: Specimen,
         return None
     return {"of_name": start.name, "of_sha256": start.hash,
             # pairs, in the order of the fit: a store's JSON sorts an object's keys
-            "values": [[name, float(value)] for name, value in values.items()]}
+            "values": [[name, value] for name, value in _values_as_set(variant, values)]}
+
+
+def _values_as_set(variant: Specimen, values: Mapping[str, float]) -> list[tuple[str, float]]:
+    """The design's ``values`` as ``variant`` holds them: a static friction that
+    :func:`specimen_with` raised to a pair's sliding friction is given per pair by its dotted
+    path (``static_friction 0.12`` of the paper's coupon is 0.12 between particles and 0.14,
+    the sliding friction, at the wall: a label of 0.12 misstated the run)."""
+    out: list[tuple[str, float]] = []
+    for name, value in values.items():
+        alias = friction_paths(name)
+        if alias is None or alias[0] != "static_friction":
+            out.append((name, float(value)))
+            continue
+        held = {pair: float(getattr(variant.pairs, pair).static_friction) for pair in alias[1]}
+        if all(v == float(value) for v in held.values()):
+            out.append((name, float(value)))
+        else:
+            out.extend((f"pairs.{pair}.static_friction", v) for pair, v in held.items())
+    return out
 
 
 def run_requests(requests: Sequence[RunRequest], *, store_path: str | os.PathLike,
