@@ -1162,11 +1162,12 @@ def steady_state_text(detected) -> str:
 def dem_runs_table(runs):
     """The DEM tab's table of stored runs (:func:`pidcore.store.listing.list_dem_runs`):
     columns :data:`DEM_RUN_COLUMNS` present, with each run's specimen
-    (:func:`pidcore.compare.specimens.run_specimen_labels`) and whether it converged."""
-    from ..compare.specimens import run_specimen_labels
+    (:func:`pidcore.compare.specimens.run_specimen_descriptions`: a calibration's variant
+    as such) and whether it converged."""
+    from ..compare.specimens import run_specimen_descriptions
 
     runs = runs.assign(
-        specimen=run_specimen_labels(runs),
+        specimen=run_specimen_descriptions(runs),
         **{"steady state": runs["steady_detected"].map(steady_state_text)
            if "steady_detected" in runs.columns else ""})
     import pandas as pd

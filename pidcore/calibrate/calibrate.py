@@ -56,7 +56,7 @@ from .posterior import (
     summary_texts,
     unconstrained_notes,
 )
-from .runner import RunRequest, run_requests, specimen_with
+from .runner import RunRequest, run_requests, specimen_with, variant_provenance
 from .surrogate import build_surrogate, default_design_size, design_points
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -299,7 +299,8 @@ def _requests(points: Sequence[MeasuredPoint], dem_specs: Sequence[ParameterSpec
     for row in design:
         values = {s.name: float(v) for s, v in zip(dem_specs, row, strict=True)}
         try:
-            specimens.append(specimen_with(specimen, values))
+            variant = specimen_with(specimen, values)
+            specimens.append((variant, variant_provenance(specimen, variant, values)))
         except ParameterError as exc:
             # the design point's fault, not the specimen file's (check_domains catches the
             # prior's corners; a constraint that is not monotone could still fail inside)
@@ -312,7 +313,7 @@ def _requests(points: Sequence[MeasuredPoint], dem_specs: Sequence[ParameterSpec
     for point in points:
         case = LoadCase(point.frequency_hz, point.acceleration_g, point.fill_percent,
                         point.material)
-        out.append([RunRequest(case, s, config) for s in specimens])
+        out.append([RunRequest(case, s, config, variant) for s, variant in specimens])
     return out
 
 

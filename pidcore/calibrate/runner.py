@@ -63,11 +63,16 @@ def specimen_with(specimen: Specimen, values: Mapping[str, float]) -> Specimen:
 
 @dataclass(frozen=True)
 class RunRequest:
-    """One DEM run of a calibration design: load case, specimen (with the design's values)."""
+    """One DEM run of a calibration design: load case, specimen (with the design's values).
+
+    ``variant``: where ``specimen`` is the calibration's variant of the file it started from
+    (another hash), which file and design values (:func:`variant_provenance`), stored with the
+    run so that pages name it as such, not as another file of that name; None: the file."""
 
     case: LoadCase
     specimen: Specimen
     config: DemConfig
+    variant: Mapping[str, object] | None = field(default=None, compare=False)
 
     def key(self) -> str:
         """The DEM run cache key (:func:`pidcore.dem.persist.run_key`)."""
@@ -80,7 +85,39 @@ def simulate_request(request: RunRequest):
 
 
 def _run_entry(request: RunRequest) -> tuple[str, dict]:
-    return request.key(), dem_run_entry(simulate_request(request))
+    return request.key(), dem_run_entry(simulate_request(request),
+                                        calibration_variant=request.variant)
+
+
+def variant_provenance(start: Specimen, variant: Specimen,
+                       values: Mapping[str, float]) -> dict[str, object] | None:
+    """What a run of ``variant`` (``start`` with the design's ``values``, by the names the fit
+    takes) stores of its origin (:data:`pidcore.compare.align.CALIBRATION_VARIANT_FIELD`);
+    None where the design point is ``start`` itself (same hash: its runs are the file's)."""
+    if variant.hash == start.hash:
+        return None
+    return {"of_name": start.name, "of_sha256": start.hash,
+            # pairs, in the order of the fit: a store's JSON sorts an object's keys
+            "values": [[name, value] for name, value in _values_as_set(variant, values)]}
+
+
+def _values_as_set(variant: Specimen, values: Mapping[str, float]) -> list[tuple[str, float]]:
+    """The design's ``values`` as ``variant`` holds them: a static friction that
+    :func:`specimen_with` raised to a pair's sliding friction is given per pair by its dotted
+    path (``static_friction 0.12`` of the paper's coupon is 0.12 between particles and 0.14,
+    the sliding friction, at the wall: a label of 0.12 misstated the run)."""
+    out: list[tuple[str, float]] = []
+    for name, value in values.items():
+        alias = friction_paths(name)
+        if alias is None or alias[0] != "static_friction":
+            out.append((name, float(value)))
+            continue
+        held = {pair: float(getattr(variant.pairs, pair).static_friction) for pair in alias[1]}
+        if all(v == float(value) for v in held.values()):
+            out.append((name, float(value)))
+        else:
+            out.extend((f"pairs.{pair}.static_friction", v) for pair, v in held.items())
+    return out
 
 
 def run_requests(requests: Sequence[RunRequest], *, store_path: str | os.PathLike,
@@ -160,6 +197,19 @@ class RunTally:
         self.keys = list(dict.fromkeys(keys))
         self.before = stored_keys(self.store_path, self.keys)
         self.known = True
+
+    def specimens(self) -> str:
+        """The specimens of the design's runs the store holds, as every listing of runs names
+        them (:func:`pidcore.compare.specimens.runs_per_specimen_text`: a variant of the file
+        calibrated as such), e.g. ``"2 of mycoupon [65a6d7]: calibration variant of mycoupon
+        [072027] (static_friction 0.325, rolling_friction 0.025), ..."``; "" where none."""
+        from ..compare.specimens import runs_per_specimen_text
+        from ..store import Store
+
+        if not self.keys or not Path(self.store_path).exists():
+            return ""
+        runs = Store(self.store_path).list_dem_runs()
+        return runs_per_specimen_text(runs[runs["case_key"].isin(self.keys)])
 
     def interrupted(self) -> str:
         """What an interrupted calibration kept, e.g. ``"3 DEM run(s) finished before the

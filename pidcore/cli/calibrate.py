@@ -149,7 +149,8 @@ def run(args: argparse.Namespace) -> int:
         saved = save_calibration(result, args.dem_store)
         # inside: a Ctrl-C as the result printed was answered by the generic line, which
         # said the complete --out "may hold part of this run's files"
-        _print_result(args, result, own_notes, _saved_words(saved, args.dem_store))
+        _print_result(args, result, own_notes, _saved_words(saved, args.dem_store),
+                      tally.specimens())
         interrupt.raise_if_interrupted()  # one swallowed on the way, or held by the move
     except BaseException as exc:  # noqa: BLE001 - an interrupt, or what one became in C code
         if not interrupt.is_interruption(exc):
@@ -164,10 +165,12 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _print_result(args: argparse.Namespace, result, own_notes: list[str], saved: str) -> None:
+def _print_result(args: argparse.Namespace, result, own_notes: list[str], saved: str,
+                  specimens: str = "") -> None:
     """The calibration's notes (stderr), its parameters and scores or its JSON document, how
-    many DEM runs it computed and reused, and ``saved`` (:func:`_saved_words`: where the store
-    keeps it)."""
+    many DEM runs it computed and reused and of which specimens (``specimens``:
+    :meth:`~pidcore.calibrate.runner.RunTally.specimens`, as the report and the app list
+    them), and ``saved`` (:func:`_saved_words`: where the store keeps it)."""
     from ..calibrate.outputs import coverage_text, document_json, rms_text
 
     for note in own_notes:  # the library's words, kept so with the outputs and the store
@@ -176,7 +179,7 @@ def _print_result(args: argparse.Namespace, result, own_notes: list[str], saved:
     # a re-run (after Ctrl-C, or with other priors) says that it reused its stored runs; on
     # stderr beside --json's one document
     runs = (f"DEM runs: {result.runs['computed']} computed, {result.runs['cached']} reused "
-            f"from {args.dem_store}")
+            f"from {args.dem_store}" + (f" ({specimens})" if specimens else ""))
     if args.json:
         print(f"pidcore calibrate: note: {runs}", file=sys.stderr)
         print(document_json(result.document()))

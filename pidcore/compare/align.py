@@ -475,6 +475,18 @@ def stored_parameters(parameters_json: object) -> dict | None:
     return _automatic_cycles_unstated(params) if isinstance(params, dict) else None
 
 
+#: The entry of a stored DEM run's inputs (``parameters_json``) that says where its specimen
+#: came from, not an input of its numbers (no key, identity or settings hash holds it):
+#: ``null`` for the run of a specimen file as given (``pidcore dem run``, sweeps, the app),
+#: ``{"of_name", "of_sha256", "values"}`` for a run of a calibration's variant of the file
+#: ``of_name`` [``of_sha256``] at a design point (``values``: ``[name, value]`` pairs of the
+#: fitted DEM parameters by the names ``--fit`` took, as the design set them), absent in a
+#: run stored before pidcore recorded it (either). Written by
+#: :func:`pidcore.dem.persist.dem_run_entry`, read by :func:`pidcore.compare.specimens.
+#: run_origin`.
+CALIBRATION_VARIANT_FIELD = "calibration_variant"
+
+
 def parameters_digest(params: Mapping[str, object]) -> str:
     """The sha256 (hex) of a DEM run's inputs: their JSON with sorted keys, any value JSON
     lacks as its text. The one spelling of a run's key (:func:`pidcore.dem.persist.run_key`),
@@ -504,7 +516,8 @@ def run_settings(parameters_json: object) -> dict | None:
     params = stored_parameters(parameters_json)
     if params is None:
         return None
-    return {k: v for k, v in params.items() if not k.startswith("case_") and k != "config_seed"}
+    return {k: v for k, v in params.items() if not k.startswith("case_")
+            and k not in ("config_seed", CALIBRATION_VARIANT_FIELD)}
 
 
 def simulation_identity(parameters_json: object, particles_per_cell: object) -> str | None:
@@ -531,6 +544,9 @@ def simulation_identity(parameters_json: object, particles_per_cell: object) -> 
         return None
     params.pop("case_fill_percent", None)
     params.pop("specimen_text", None)
+    # where the specimen came from: the same simulation, whether a calibration or a user
+    # stored it
+    params.pop(CALIBRATION_VARIANT_FIELD, None)
     # runs stored before the version was recorded are version 1 (pidcore.dem.persist)
     params.setdefault("dem_code_version", 1)
     params["particles_per_cell"] = int(count)

@@ -90,10 +90,81 @@ def run_specimen_labels(runs: pd.DataFrame) -> pd.Series:
         index=runs.index, dtype=object)
 
 
+@dataclass(frozen=True)
+class CalibrationVariant:
+    """A stored DEM run's specimen as a calibration made it: the file ``of_name``
+    [``of_sha256``] with the design point's ``values`` (fitted DEM parameters by the names
+    ``--fit`` takes), stored under the variant's own text and hash
+    (:data:`pidcore.compare.align.CALIBRATION_VARIANT_FIELD`)."""
+
+    of_name: str
+    of_sha256: str
+    values: tuple[tuple[str, float], ...]
+
+    def text(self) -> str:
+        """``"calibration variant of mycoupon [072027] (static_friction 0.4537,
+        rolling_friction 0.0213)"``: 4 significant digits tell a design's points apart (its
+        own hash, beside it in every label, names it in full)."""
+        values = ", ".join(f"{name} {value:.4g}" for name, value in self.values)
+        return (f"calibration variant of {specimen_label(self.of_name, self.of_sha256)}"
+                + (f" ({values})" if values else ""))
+
+
+#: :func:`run_origin` of a run of the specimen file as given (``pidcore dem run``, a sweep,
+#: the app, a calibration's run of its start file).
+AS_GIVEN = "as given"
+#: :func:`run_origin` of a run that does not say (stored before pidcore recorded it, or a
+#: damaged statement): a file as given or a calibration's variant of one.
+UNSTATED = "unstated"
+
+
+def run_origin(parameters_json: object) -> CalibrationVariant | str:
+    """Where a stored run's specimen came from, by what the run stored
+    (:data:`pidcore.compare.align.CALIBRATION_VARIANT_FIELD`): its
+    :class:`CalibrationVariant`, :data:`AS_GIVEN` or :data:`UNSTATED`."""
+    from .align import CALIBRATION_VARIANT_FIELD, stored_parameters
+
+    params = stored_parameters(parameters_json)
+    if params is None or CALIBRATION_VARIANT_FIELD not in params:
+        return UNSTATED
+    stated = params[CALIBRATION_VARIANT_FIELD]
+    if stated is None:
+        return AS_GIVEN
+    try:
+        values = tuple((str(name), float(value)) for name, value in stated["values"])
+        return CalibrationVariant(str(stated["of_name"]), str(stated["of_sha256"]), values)
+    except (AttributeError, KeyError, TypeError, ValueError):
+        return UNSTATED  # a damaged statement says nothing
+
+
+def run_origins(runs: pd.DataFrame) -> pd.Series:
+    """:func:`run_origin` per run of a listing (:data:`UNSTATED` for every run where the
+    listing has no ``parameters_json``)."""
+    if "parameters_json" not in runs.columns:
+        return pd.Series([UNSTATED] * len(runs), index=runs.index, dtype=object)
+    return pd.Series([run_origin(p) for p in runs["parameters_json"]], index=runs.index,
+                     dtype=object)
+
+
+def run_specimen_descriptions(runs: pd.DataFrame) -> pd.Series:
+    """Per run, its specimen as lists of runs name it: its :func:`specimen_label`, and for a
+    calibration's variant of a file what it is (``"mycoupon [7167f7]: calibration variant of
+    mycoupon [072027] (static_friction 0.4537, rolling_friction 0.0213)"``: its label alone
+    read as another file of the name, as if the user had edited theirs). One description per
+    label: a run that does not say (stored before pidcore recorded it) is described as the
+    other runs of its specimen say."""
+    labels = run_specimen_labels(runs)
+    known: dict[str, str] = {}
+    for label, variant in zip(labels, run_origins(runs), strict=True):
+        if isinstance(variant, CalibrationVariant):
+            known.setdefault(label, f"{label}: {variant.text()}")
+    return labels.map(lambda label: known.get(label, label))
+
+
 def runs_per_specimen_text(runs: pd.DataFrame) -> str:
-    """How many of ``runs`` are of each specimen, by :func:`run_specimen_labels`, in the
-    order first met: ``"3 of a [1b8b5d], 1 of paper_coupon"``."""
-    counts = run_specimen_labels(runs).value_counts(sort=False)
+    """How many of ``runs`` are of each specimen, by :func:`run_specimen_descriptions`, in
+    the order first met: ``"3 of a [1b8b5d], 1 of paper_coupon"``."""
+    counts = run_specimen_descriptions(runs).value_counts(sort=False)
     return ", ".join(f"{n} of {label}" for label, n in counts.items())
 
 
@@ -183,9 +254,27 @@ def _tested_hashes(runs: pd.DataFrame) -> pd.Series:
     return pd.Series(out, index=runs.index, dtype=object)
 
 
-def _listed(labels: pd.Series) -> str:
-    counts = labels.value_counts(sort=False)
+def _listed(runs: pd.DataFrame) -> str:
+    """``"a [1b8b5d] (3 run(s)), ..."``: the specimens of ``runs`` as
+    :func:`run_specimen_descriptions` names them, a calibration's variants as such."""
+    counts = run_specimen_descriptions(runs).value_counts(sort=False)
     return ", ".join(f"{label} ({n} run(s))" for label, n in counts.items())
+
+
+def _other_files_words(runs: pd.DataFrame, specimen: str, own_file: str) -> str:
+    """Why runs named ``specimen`` (``runs``: those not of the test's file ``own_file``) are
+    not the test's: "" where each is a calibration's variant (their description in the list
+    says so); for runs of another file as given, another file of that name; for runs that
+    do not say (stored before pidcore recorded it), either."""
+    origins = run_origins(runs)
+    if origins.map(lambda o: isinstance(o, CalibrationVariant)).all():
+        return ""
+    if (origins == UNSTATED).any():
+        return (f"runs named {specimen} hold other content than the test's file (its "
+                f"sha256 starts {own_file[:6]}): another file of that name, or a "
+                "calibration's variants of one, stored before pidcore recorded which")
+    return (f"runs named {specimen} are of another file of that name than the test's "
+            f"(its specimen file's sha256 starts {own_file[:6]})")
 
 
 def runs_for_measurement(runs: pd.DataFrame | None, specimen: str, material: str,
@@ -258,20 +347,23 @@ def runs_for_measurement(runs: pd.DataFrame | None, specimen: str, material: str
                 mine = mine & _model_the_papers_coupon(same)
             calibrated_from = specimen if mine.any() else ""
         kept, others = labels[mine], labels[~mine]
-        left_out = (f"DEM runs of other specimens not compared: {_listed(others)}"
+        left_out = (f"DEM runs of other specimens not compared: {_listed(same[~mine])}"
                     if len(others) else "")
-        if own_file and ((names == specimen) & ~pd.Series(of_file, index=same.index)).any():
-            # "no DEM runs of specimen x" beside a store of x's runs read as a lost match
-            left_out = ((left_out + "; ") if left_out else "") + (
-                f"runs named {specimen} are of another file of that name than the test's "
-                f"(its specimen file's sha256 starts {own_file[:6]})")
+        named_other_file = (names == specimen) & ~pd.Series(of_file, index=same.index)
+        if own_file and named_other_file.any():
+            # "no DEM runs of specimen x" beside a store of x's runs read as a lost match; a
+            # calibration's variants of the test's file are no other file of its name
+            why = _other_files_words(same[named_other_file], specimen, own_file)
+            if why:
+                left_out = ((left_out + "; ") if left_out else "") + why
         if kept.empty:
             return SpecimenRuns(None, "", f"no DEM runs of specimen {specimen} at {material}, "
                                           f"{direction}" + (f"; {left_out}" if left_out else ""))
         if kept.nunique() > 1:  # an edited file keeps its name but is another specimen
             return SpecimenRuns(None, "", f"DEM runs of {kept.nunique()} different specimen "
-                                          f"files named {specimen}: {_listed(kept)}; not pooled "
-                                          "(keep one version's runs, or rename the other)",
+                                          f"files named {specimen}: {_listed(same[mine])}; not "
+                                          "pooled (keep one version's runs, or rename the "
+                                          "other)",
                                 refused=True)
         return SpecimenRuns(same[mine].reset_index(drop=True), str(kept.iloc[0]), left_out,
                             calibrated_from=calibrated_from)
@@ -280,7 +372,7 @@ def runs_for_measurement(runs: pd.DataFrame | None, specimen: str, material: str
         return _paper_runs(same, labels, paper)
     if labels.nunique() > 1:
         return SpecimenRuns(None, "", f"the DEM runs at {material}, {direction} are of "
-                                      f"{labels.nunique()} specimens: {_listed(labels)}; not "
+                                      f"{labels.nunique()} specimens: {_listed(same)}; not "
                                       "pooled. Name the file's specimen (column `specimen` of "
                                       "the settings table) to compare it with one of them",
                             refused=True)
@@ -295,8 +387,10 @@ def _paper_runs(runs: pd.DataFrame, labels: pd.Series, paper) -> SpecimenRuns:
     others = labels[~paper]
     note = ""
     if len(others):
-        same_name = (_names(runs, labels)[~paper] == PAPER_SPECIMEN_NAME).any()
-        note = (f"DEM runs of other specimens not compared: {_listed(others)} (the paper's "
+        # a calibration's variant of the coupon is described as such in the list
+        not_variant = ~run_origins(runs).map(lambda o: isinstance(o, CalibrationVariant))
+        same_name = ((_names(runs, labels) == PAPER_SPECIMEN_NAME) & not_variant)[~paper].any()
+        note = (f"DEM runs of other specimens not compared: {_listed(runs[~paper])} (the paper's "
                 f"coupon is compared, as in pidcore report"
                 + ("; a run named paper_coupon with a hash is another file of that name, "
                    "e.g. a calibration's design point" if same_name else "")

@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..compare.align import parameters_digest
+from ..compare.align import CALIBRATION_VARIANT_FIELD, parameters_digest
 from ..errors import StoreError
 from ..loadcase import key_0_1
 from ..specimen import Specimen, hashed_name, is_paper_coupon, paper_specimen
@@ -94,15 +94,24 @@ def run_key_0_1(case: LoadCase, config: DemConfig) -> str:
     return f"{key_0_1(case)}_seed{config.seed}_cells{config.cells}_{digest[:10]}"
 
 
-def dem_run_entry(result: DemResult) -> dict:
-    """``record``, ``arrays``, ``parameters`` and ``units`` of a run, as the store takes them."""
+def dem_run_entry(result: DemResult, *,
+                  calibration_variant: Mapping[str, Any] | None = None) -> dict:
+    """``record``, ``arrays``, ``parameters`` and ``units`` of a run, as the store takes them.
+
+    ``calibration_variant``: where the run's specimen is a calibration's variant of a file at
+    a design point, which file and values (:data:`pidcore.compare.align.
+    CALIBRATION_VARIANT_FIELD`); None: the specimen file as given. Stored beside the inputs,
+    outside the key: its run of the same specimen elsewhere is the same run."""
     record = result.to_dict()
     record.pop("case_key", None)  # reserved listing column; the key is the entry name
     arrays = result.arrays()
     units = {k: v for k, v in UNITS.items() if k in record or k in arrays}
-    return {"record": record, "arrays": arrays,
-            "parameters": run_parameters(result.case, result.config, result.specimen),
-            "units": units}
+    parameters = run_parameters(result.case, result.config, result.specimen)
+    # stated for every run saved now: a run that lacks it was stored before pidcore told a
+    # calibration's variants from the files they vary, and is either
+    parameters[CALIBRATION_VARIANT_FIELD] = (None if calibration_variant is None
+                                             else dict(calibration_variant))
+    return {"record": record, "arrays": arrays, "parameters": parameters, "units": units}
 
 
 def _open(store: Store | str | os.PathLike[str]) -> Store:
@@ -398,6 +407,13 @@ def rekey_dem_store(source: str | os.PathLike[str], target: str | os.PathLike[st
                              f"this is {DEM_CODE_VERSION}: simulate it again instead")
         result = load_dem_result(entry)
         new = dem_run_entry(result)  # the stored numbers, with today's provenance fields
+        # whether it was a calibration's variant is the stored run's to say: unstated stays
+        # unstated, not "the file as given"
+        if CALIBRATION_VARIANT_FIELD in entry.parameters:
+            new["parameters"][CALIBRATION_VARIANT_FIELD] = \
+                entry.parameters[CALIBRATION_VARIANT_FIELD]
+        else:
+            new["parameters"].pop(CALIBRATION_VARIANT_FIELD)
         new["arrays"] = dict(entry.arrays)  # not the NaN stand-ins for arrays it lacks
         new["units"] = {k: v for k, v in new["units"].items()
                         if k in new["record"] or k in new["arrays"]}
@@ -433,11 +449,26 @@ def other_files_runs_note(store_path: str | os.PathLike[str], cases: Iterable[Lo
                   & (runs["seed"] == config.seed) & (runs["cells_simulated"] == config.cells)]
     if others.empty:
         return ""
-    files = ", ".join(hashed_name(own.name, h) for h in dict.fromkeys(others["specimen_sha256"]))
+    from ..compare.specimens import (
+        AS_GIVEN,
+        CalibrationVariant,
+        run_origins,
+        run_specimen_descriptions,
+    )
+
+    # a calibration's variants by what they stored: "an earlier version of this file" was
+    # said of runs pidcore knew a calibration had made
+    origins = run_origins(others)
+    variants = origins.map(lambda o: isinstance(o, CalibrationVariant))
+    files = ", ".join(dict.fromkeys(run_specimen_descriptions(others)))
+    whose, origin = (
+        ("of a calibration's variants", "its design points") if variants.all()
+        else ("by other files", "an earlier version of this file") if (origins == AS_GIVEN).all()
+        else ("by other files", "an earlier version of this file, or a calibration's design "
+                                "points"))
     return (f"{store_path} holds {len(others)} run(s) of these load cases (seed {config.seed}, "
-            f"{config.cells} cells) by other files named {own.name} ({files}: an earlier "
-            f"version of this file, or a calibration's design points); not reused: a run is "
-            f"reused only for the same file content, and this file is "
+            f"{config.cells} cells) {whose} named {own.name} ({files}: {origin}); "
+            f"not reused: a run is reused only for the same file content, and this file is "
             f"{hashed_name(own.name, own.hash)} (any edit, its description too, makes another "
             "specimen)")
 

@@ -190,7 +190,12 @@ def no_runs_note(of: str, material: str, direction: str, store_runs: pd.DataFram
     choice of the report's specimen compares it with the others' runs; ``report_of``: the
     name of the specimen the report is of (its runs are chosen by hash: runs of ``of`` left
     out of a report of a file named ``of`` are another file's of that name)."""
-    from ..compare.specimens import run_specimen_labels
+    from ..compare.specimens import (
+        CalibrationVariant,
+        run_origins,
+        run_specimen_labels,
+        runs_per_specimen_text,
+    )
     from ..specimen import PAPER_SPECIMEN_NAME
 
     note = f"no DEM runs of {of or 'ours'} for {material}, direction {direction}"
@@ -215,8 +220,16 @@ def no_runs_note(of: str, material: str, direction: str, store_runs: pd.DataFram
         choose_another = ("report without specimen= to compare them"
                           if set(counts.index) == {PAPER_SPECIMEN_NAME}
                           else "report with their specimen=FILE to compare them")
-    listed = ", ".join(f"{n} of {label}" for label, n in counts.items())
+    # a calibration's variants named as such: "3 of x [7167f7]" read as an edited x.toml
+    listed = runs_per_specimen_text(there)
     if own and of != PAPER_SPECIMEN_NAME and report_of == of:
+        named_of = there[there["specimen_name"] == of] if "specimen_name" in there.columns \
+            else there.iloc[:0]
+        if not named_of.empty and run_origins(named_of).map(
+                lambda o: isinstance(o, CalibrationVariant)).all():
+            return (f"{note} among this report's runs (the store has {listed}: a "
+                    f"calibration's variants, not a file named {of} as given; "
+                    f"{choose_another})")
         # by name the runs are the test's specimen's, but the report's runs are chosen by the
         # file's hash: they are of another file of that name (an edited x.toml). "x's are
         # left out of a report of another specimen" was said of a report of x
