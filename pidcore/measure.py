@@ -61,14 +61,12 @@ if TYPE_CHECKING:
 __all__ = ["AnalysisOptions", "AnalyzedRecord", "SavedAnalyses", "analyze_file",
            "analyze_measurement", "save_analyses", "store_analysis"]
 
-#: Largest fractional-sample offset between the start times of the force channel and an
-#: acceleration channel beside a velocity channel that is ignored (the motion channel's, the
-#: velocity or an acceleration the velocity is integrated from, is corrected as a delay).
-MAX_IGNORED_OFFSET_SAMPLES = 0.02
 #: Largest uncertainty, as a phase at the drive frequency, of the start offset between the force
 #: and the motion channel: the loss factor moves by the phase error (d eta = d phi near eta = 0),
 #: so 1e-4 rad keeps it within the 1.5e-4 absolute of the accuracy target (README). A start
-#: time printed with six digits (UFF) misses that from a few ms on at 1 kHz.
+#: time printed with six digits (UFF) misses that from a few ms on at 1 kHz. The same 1e-4 is
+#: the budget of the loss factor for the motion channel's and the mass-cancelling
+#: acceleration's start offsets together (:func:`_check_start_offset_known`).
 MAX_START_OFFSET_PHASE_UNCERTAINTY_RAD = 1e-4
 #: An acceleration channel whose drive-line amplitude differs from omega |V| of the velocity
 #: channel by more than this factor (either way) is noted as a likely unit slip: a rigid coupon
@@ -242,48 +240,51 @@ def _half_unit(value: float, digits: int | None) -> float:
     return 0.5 * 10.0 ** (math.floor(math.log10(abs(value))) - digits + 1)
 
 
+def _motion_role(channels: Mapping[str, Channel]) -> str:
+    """The role of the channel the velocity comes from: the velocity, or without one the
+    acceleration it is integrated from."""
+    return "velocity" if "velocity" in channels else "acceleration"
+
+
 def _align(channels: dict[str, Channel], source: str, notes: list[str],
            corrections: dict, start_digits: int | None = None
-           ) -> tuple[dict[str, Channel], float, float]:
-    """Cut the channels to their common time span; returns them, the delay (s) that
-    corrects a fractional-sample start offset of the motion channel against the force (the
-    velocity, or without one the acceleration the velocity is integrated from) and how far
-    off that offset may be (s) where the file states its start times with ``start_digits``
-    significant digits."""
+           ) -> tuple[dict[str, Channel], dict[str, float], dict[str, float]]:
+    """Cut the channels to their common time span; returns them, per role other than the
+    force the delay (s) that corrects its fractional-sample start offset against the force
+    (absent where none is), and how far off that offset may be (s) where the file states its
+    start times with ``start_digits`` significant digits."""
     rate = channels["force"].sample_rate_hz
     # equal within the analysis's tolerance, not bit for bit: two time columns printed with 8
     # digits give rates 1e-12 apart, and the start offset between them was then ignored
     if any(abs(ch.sample_rate_hz - rate) > SAME_RATE_RELATIVE_TOLERANCE * rate
            for ch in channels.values()):
-        return channels, 0.0, 0.0  # refused by the analysis with both rates named
+        return channels, {}, {}  # refused by the analysis with both rates named
     starts = {r: ch.start_time_s for r, ch in channels.items()}
     lengths = {r: ch.n_samples for r, ch in channels.items()}
     if len(set(starts.values())) == 1 and len(set(lengths.values())) == 1:
-        return channels, 0.0, 0.0
+        return channels, {}, {}
     force_start = starts["force"]
     # offsets of each channel from the force in samples: integer part cut, fraction corrected
     offsets = {r: (s - force_start) * rate for r, s in starts.items()}
     shift = {r: math.floor(o + 0.5) for r, o in offsets.items()}
     frac = {r: offsets[r] - shift[r] for r in offsets}
-    # the channel the velocity comes from: integrating an acceleration sampled off the force's
-    # instants gives a velocity off them by as much, corrected alike
-    motion = "velocity" if "velocity" in channels else "acceleration"
-    # one start printed as the other is one clock reading: their offset is exact
-    offset_uncertainty = (0.0 if starts[motion] == force_start else
-                          _half_unit(starts[motion], start_digits)
-                          + _half_unit(force_start, start_digits))
-    delay = 0.0
+    delays: dict[str, float] = {}
+    uncertainties: dict[str, float] = {}
     for role, f in frac.items():
-        if abs(f) <= 1e-6:
+        if role == "force":
             continue
-        if role == motion:
+        # one start printed as the other is one clock reading: their offset is exact
+        uncertainties[role] = (0.0 if starts[role] == force_start else
+                               _half_unit(starts[role], start_digits)
+                               + _half_unit(force_start, start_digits))
+        if abs(f) > 1e-6:
             # sampled f samples after the force's instants: the channel holds x(t + f/rate),
-            # a delay of -f/rate in the convention of velocity_delay_s (v(t - tau))
-            delay = -f / rate
-        elif abs(f) > MAX_IGNORED_OFFSET_SAMPLES:
-            raise ChannelError(f"{source}: channel {channels[role].name!r} starts "
-                               f"{f:+.3f} samples off the force channel's sample grid; "
-                               "expected channels sampled at the same instants")
+            # a delay of -f/rate in the convention of velocity_delay_s (x(t - tau)). The
+            # motion channel (a velocity integrated from a delayed acceleration is delayed
+            # alike) and the acceleration mass cancellation takes m a from are corrected by
+            # the one rule: ignoring 0.02 samples of the latter's turned m a by 2.5e-3 rad
+            # at 1 kHz, 51.2 kHz, and Re(P_c) with it
+            delays[role] = -f / rate
     first = max(shift.values())
     last = min(shift[r] + lengths[r] for r in channels)
     if last - first < 8:
@@ -300,31 +301,70 @@ def _align(channels: dict[str, Channel], source: str, notes: list[str],
                  + ", ".join(f"{ch.name!r} {starts[r]:.6g} s" for r, ch in channels.items())
                  + "; lengths " + ", ".join(str(n) for n in lengths.values()) + ")")
     corrections["aligned_span_s"] = [force_start + first / rate, force_start + last / rate]
-    if delay:
-        # the analysis carries the delay in its corrections (start_offset_delay_s)
-        notes.append(f"channel {channels[motion].name!r} starts {frac[motion]:+.4g} "
-                     "samples off the force's grid: corrected as a velocity delay of "
-                     f"{delay:.6g} s")
-    return out, delay, offset_uncertainty
+    # the analysis carries the delays in its corrections (start_offset_delay_s,
+    # acceleration_start_offset_delay_s); each channel's is said in the same words
+    notes.extend(f"channel {channels[role].name!r} starts {frac[role]:+.4g} samples off the "
+                 f"force's grid: corrected as a delay of {delay:.6g} s"
+                 for role, delay in delays.items())
+    return out, delays, uncertainties
 
 
-def _check_start_offset_known(chosen: Mapping[str, Channel], uncertainty_s: float,
-                              digits: int | None, analysis: PowerAnalysis,
+def _inertia_weight(chosen: Mapping[str, Channel], analysis: PowerAnalysis,
+                    mass_below_gauge_kg: float) -> float:
+    """How much of a phase error of the mass-cancelling acceleration goes into the loss factor.
+
+    An error d tau of its delay turns m A_1 by w d tau, which moves F_1 by m |A_1| w d tau
+    and P_c = 1/2 F conj(V) by half that times |V_1|; all of it goes into Re(P_c) where A_1
+    lies along j w V_1, as mass cancellation expects. The loss factor Re/Im moves by that over
+    Im(P_c): d eta = w d tau x m |A_1| |V_1| / Im(F_1 conj V_1) = w d tau x m |A_1| / (|F_1|
+    cos phi) (phi = atan eta), the phase error weighed by the inertia force's share of the
+    force. As for the motion channel (weight 1) the fundamental stands for the record: the
+    harmonics' n w d tau turns shares of P_c too small to count."""
+    omega = analysis.omega_rad_s
+    held = float(np.imag(analysis.force_phasors_n[0] * np.conj(analysis.velocity_phasors_m_s[0])))
+    if not held > 0:
+        return math.inf  # no stored energy at the drive line for the error to be a share of
+    inertia = mass_below_gauge_kg * _drive_amplitude(chosen["acceleration"], omega)
+    return inertia * abs(analysis.velocity_phasors_m_s[0]) / held
+
+
+def _check_start_offset_known(as_started: Mapping[str, Channel], chosen: Mapping[str, Channel],
+                              uncertainties_s: Mapping[str, float], digits: int | None,
+                              analysis: PowerAnalysis, mass_below_gauge_kg: float,
                               source: str) -> None:
-    """Refuse a record whose motion channel's start offset against the force the file states
-    too coarsely to correct: the loss factor would move by the phase it may be off."""
-    phase = analysis.omega_rad_s * uncertainty_s
-    if not phase > MAX_START_OFFSET_PHASE_UNCERTAINTY_RAD:
+    """Refuse a record whose start offsets against the force the file states too coarsely to
+    correct: the motion channel's, whose phase error is the loss factor's, and the
+    acceleration's that mass cancellation takes beside a velocity, whose phase error weighs
+    in by :func:`_inertia_weight`. The two may add: their sum is held to the one budget."""
+    motion = _motion_role(chosen)
+    weights = {motion: 1.0}
+    if (motion == "velocity" and "acceleration" in chosen and mass_below_gauge_kg > 0
+            and uncertainties_s.get("acceleration")):
+        weights["acceleration"] = _inertia_weight(chosen, analysis, mass_below_gauge_kg)
+    omega = analysis.omega_rad_s
+    total = sum(weight * omega * uncertainties_s.get(role, 0.0)
+                for role, weight in weights.items())
+    if not total > MAX_START_OFFSET_PHASE_UNCERTAINTY_RAD:
         return
-    motion = chosen.get("velocity", chosen.get("acceleration"))
-    force = chosen["force"]
+    force = as_started["force"]
     rate = force.sample_rate_hz
+    said = []
+    for role, weight in weights.items():
+        uncertainty_s = uncertainties_s.get(role, 0.0)
+        if not uncertainty_s:
+            continue
+        ch = as_started[role]
+        phase = omega * uncertainty_s
+        said.append(
+            f"channel {ch.name!r} starts {(ch.start_time_s - force.start_time_s) * rate:+.4f} "
+            f"samples from channel {force.name!r} by the start times the file states with "
+            f"{digits} significant digits, known to ±{uncertainty_s * rate:.2g} samples only: "
+            f"{phase:.2g} rad at {analysis.frequency_hz:.6g} Hz"
+            + ("" if role == motion else
+               f" on the inertia force m a it cancels, weighed by m|A|/(|F| cos phi) = "
+               f"{weight:.2g}"))
     raise ChannelError(
-        f"{source}: channel {motion.name!r} starts "
-        f"{(motion.start_time_s - force.start_time_s) * rate:+.4f} samples from channel "
-        f"{force.name!r} by the start times the file states with {digits} significant digits, "
-        f"known to ±{uncertainty_s * rate:.2g} samples only: {phase:.2g} rad at "
-        f"{analysis.frequency_hz:.6g} Hz, up to {phase:.2g} off in the loss factor (expected "
+        f"{source}: {'; '.join(said)}, up to {total:.2g} off in the loss factor (expected "
         f"within {MAX_START_OFFSET_PHASE_UNCERTAINTY_RAD:g}); export the channels with one "
         "start time (one trigger), or in a format that states it finely (CSV time columns, "
         "MAT, HDF5)")
@@ -418,8 +458,9 @@ def analyze_measurement(measurement: Measurement, options: AnalysisOptions | Non
     Preparation, each step announced in the notes: channels inverted on request
     (``invert``), units given by option for channels without one (a channel of unknown unit is
     never taken as SI), channels cut to their common time span when their start times or
-    lengths differ (a fractional-sample start offset of the velocity, or of the acceleration a
-    velocity is integrated from, is corrected as a delay),
+    lengths differ (a fractional-sample start offset of the velocity, of the acceleration a
+    velocity is integrated from, or of the acceleration mass cancellation takes beside a
+    velocity, is corrected as a delay of that channel),
     channels no role needs named as ignored.
     """
     options = AnalysisOptions() if options is None else options
@@ -447,8 +488,9 @@ def analyze_measurement(measurement: Measurement, options: AnalysisOptions | Non
                                  f"{role} channel in use")
     as_started = chosen  # the channels' own start times, for a refusal to name
     start_digits = measurement.metadata.get("start_time_significant_digits")
-    chosen, start_delay, start_uncertainty_s = _align(chosen, measurement.source, notes,
-                                                      corrections, start_digits)
+    chosen, start_delays, start_uncertainties_s = _align(chosen, measurement.source, notes,
+                                                         corrections, start_digits)
+    motion = _motion_role(chosen)
     if roles.ignored:
         notes.append("ignored channels (not needed): "
                      + ", ".join(repr(n) for n in roles.ignored))
@@ -457,7 +499,10 @@ def analyze_measurement(measurement: Measurement, options: AnalysisOptions | Non
         analysis = analyze_channels(
             chosen["force"], chosen.get("velocity"), acceleration=chosen.get("acceleration"),
             source=measurement.source,
-            velocity_delay_s=options.velocity_delay_s, start_offset_delay_s=start_delay,
+            velocity_delay_s=options.velocity_delay_s,
+            start_offset_delay_s=start_delays.get(motion, 0.0),
+            acceleration_start_offset_delay_s=(start_delays.get("acceleration", 0.0)
+                                               if motion == "velocity" else 0.0),
             mass_below_gauge_kg=options.mass_below_gauge_kg,
             baseline_loss_factor=options.baseline_loss_factor,
             structure_mass_kg=options.structure_mass_kg,
@@ -473,8 +518,8 @@ def analyze_measurement(measurement: Measurement, options: AnalysisOptions | Non
                               + ", ".join(f"invert={n!r}" for n in options.invert)
                               + "; is that one right?)") from None
         raise
-    _check_start_offset_known(as_started, start_uncertainty_s, start_digits, analysis,
-                              measurement.source)
+    _check_start_offset_known(as_started, chosen, start_uncertainties_s, start_digits,
+                              analysis, options.mass_below_gauge_kg, measurement.source)
     notes.extend(_unit_slip_notes(measurement, chosen, analysis,
                                   mass_below_gauge_kg=options.mass_below_gauge_kg))
     if options.structure_mass_kg is not None and not options.baseline_loss_factor > 0:

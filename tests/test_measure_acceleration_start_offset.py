@@ -11,15 +11,16 @@ P_c = 1/2 F conj(V) = F0 A / (2w) (sin phi + j cos phi): loss factor tan(phi), S
 from __future__ import annotations
 
 import math
+import re
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from pidcore.cli import main
-from pidcore.errors import ParameterError
+from pidcore.errors import ParameterError, SignalError
 from pidcore.io import write_measurement
-from pidcore.measure import analyze_file
+from pidcore.measure import AnalysisOptions, analyze_file
 from pidcore.records import Channel, Measurement
 from pidcore.signal import analyze_power
 
@@ -107,7 +108,7 @@ def test_acceleration_only_fractional_start_offset_is_corrected_like_the_velocit
     (said_for_velocity,) = _offset_notes(by_velocity.notes)
     assert said.replace("'Acceleration'", "'X'") == said_for_velocity.replace("'Velocity'", "'X'")
     head = (f"channel 'Acceleration' starts {fraction:+.4g} samples off the force's grid: "
-            "corrected as a velocity delay of ")
+            "corrected as a delay of ")
     assert said.startswith(head) and said.endswith(" s")
     assert float(said[len(head):-2]) == pytest.approx(-fraction / FS, rel=1e-5)
 
@@ -117,7 +118,7 @@ def test_the_correction_is_printed_by_pidcore_analyze(tmp_path, capsys):
     assert main(["analyze", str(path), "--no-store", "--no-progress"]) == 0
     out = capsys.readouterr().out
     assert ("note: channel 'Acceleration' starts +0.37 samples off the force's grid: "
-            "corrected as a velocity delay of -7.22656e-05 s") in out
+            "corrected as a delay of -7.22656e-05 s") in out
 
 
 # starts the UFF's six digits hold exactly (2/5120 = 3.90625e-4 s, -4/5120 = -7.8125e-4 s):
@@ -168,19 +169,115 @@ def test_a_vibrometer_delay_is_still_refused_without_a_velocity_channel(tmp_path
     assert "a vibrometer delay needs a velocity channel" in err
 
 
-def test_an_acceleration_beside_a_velocity_off_the_grid_is_still_refused(tmp_path, capsys):
-    # mass cancellation takes m a off the force at the force's instants: the acceleration
-    # there is not the channel the velocity comes from, and its own offset is not corrected
+# An acceleration channel beside the velocity, taken by mass cancellation (--mass-below-gauge):
+# the gauge reads F = F_s + m a, with F_s = F0 cos(wt) the structure's force, v the velocity
+# above (loss factor tan(phi) against F_s) and a = dv/dt. Taking m a off at the force's
+# instants leaves F_s, and the loss factor tan(phi), only if the acceleration channel's own
+# start offset is corrected: a phase error d of m a moves the loss factor by d m|a|/(|F_s| cos
+# phi) (measure._inertia_weight), 0.6 d here. Ignored, 0.013 samples (w x 0.013/FS = 1.6e-3
+# rad) left the loss factor 9.6e-4 off without a word; 0.37 samples was refused.
+MASS_KG = 0.2  # m A0 = 6 N beside F0 = 10 N
+
+
+def _export_with_mass(path: Path, velocity_samples: float, acceleration_samples: float,
+                      start_s: float = 0.0, rate_hz: float = FS, freq_hz: float = FREQ,
+                      n: int = N, mass_kg: float = MASS_KG, turn_rad: float = 0.0) -> Path:
+    """Force (from ``start_s``), velocity and acceleration sampled the given fractions of a
+    sample after the force's instants; the accelerometer reads the motion turned by
+    ``turn_rad`` (a fixture between it and the velocity's point), the gauge its inertia."""
+    w = 2 * math.pi * freq_hz
+    t = start_s + np.arange(n) / rate_hz
+    t_v, t_a = t + velocity_samples / rate_hz, t + acceleration_samples / rate_hz
+
+    def accelerometer(at):
+        return A0 * np.cos(w * at + PHI + turn_rad)
+
+    channels = (
+        Channel("Force", "force", F0 * np.cos(w * t) + mass_kg * accelerometer(t), rate_hz,
+                "N", start_time_s=start_s),
+        Channel("Velocity", "velocity", A0 / w * np.sin(w * t_v + PHI), rate_hz, "m/s",
+                start_time_s=float(t_v[0])),
+        Channel("Acceleration", "acceleration", accelerometer(t_a), rate_hz, "m/s^2",
+                start_time_s=float(t_a[0])))
+    if path.suffix == ".csv":
+        columns = [(f"Time [s],{c.name} [{c.source_unit}]",
+                    c.start_time_s + np.arange(n) / rate_hz, c.data) for c in channels]
+        rows = "".join(",".join(f"{x[i]:.9g},{y[i]:.9g}" for _, x, y in columns) + "\n"
+                       for i in range(n))
+        path.write_text(",".join(head for head, _, _ in columns) + "\n" + rows)
+        return path
+    binary = path.suffix == ".uff58b"
+    path = path.with_suffix(".uff") if binary else path
+    write_measurement(Measurement(path.name, channels), path, binary=binary)
+    return path
+
+
+_OFFSET_NOTE = re.compile(r"channel '(\w+)' starts ([-+][0-9.e+-]+) samples off the force's "
+                          r"grid: corrected as a delay of ([-+0-9.e]+) s")
+
+
+@pytest.mark.parametrize(("velocity_samples", "acceleration_samples"),
+                         [(0.0, 0.37), (0.0, 0.013), (0.21, -2.37)])
+@pytest.mark.parametrize("suffix", [".uff", ".uff58b", ".csv", ".h5"])
+def test_the_mass_cancelling_accelerations_start_offset_is_corrected_by_the_same_rule(
+        tmp_path, suffix, velocity_samples, acceleration_samples):
+    path = _export_with_mass(tmp_path / f"both{suffix}", velocity_samples,
+                             acceleration_samples)
+    record = analyze_file(path, AnalysisOptions(mass_below_gauge_kg=MASS_KG))
+    a = record.analysis
+    assert record.channels_used["acceleration"] == "Acceleration"
+    assert a.corrections["mass_acceleration_from"] == "acceleration channel"
+    # the start digits (UFF six, CSV nine) leave <= 5e-10 s, 3e-7 rad x 0.6 at 100 Hz; the
+    # samples' digits average out over 10240 of them
+    assert a.loss_factor == pytest.approx(ETA, abs=LOSS_TOLERANCE)
+    # after cancellation the force is F_s: Im(P_c) = F0 A0 cos(phi)/(2w), not that plus the
+    # mass's 1/2 m A0^2/w
+    assert a.complex_power_w.imag == pytest.approx(F0 * A0 * math.cos(PHI) / (2 * W), rel=1e-5)
+    fraction = acceleration_samples - round(acceleration_samples)
+    assert a.corrections["acceleration_start_offset_delay_s"] == pytest.approx(
+        -fraction / FS, rel=1e-5)
+    # each channel its own delay, the velocity's not the acceleration's
+    if velocity_samples:
+        assert a.corrections["start_offset_delay_s"] == pytest.approx(-velocity_samples / FS,
+                                                                      rel=1e-5)
+    else:
+        assert "start_offset_delay_s" not in a.corrections
+    # said in the motion channel's words, naming the acceleration channel
+    said = {m[1]: m for m in map(_OFFSET_NOTE.fullmatch, _offset_notes(record.notes))}
+    assert None not in said and set(said) == ({"Acceleration", "Velocity"} if velocity_samples
+                                              else {"Acceleration"})
+    assert float(said["Acceleration"][2]) == pytest.approx(fraction, rel=1e-3)  # 4 digits
+    assert float(said["Acceleration"][3]) == pytest.approx(-fraction / FS, rel=1e-5)
+    if velocity_samples:
+        assert float(said["Velocity"][2]) == pytest.approx(velocity_samples, rel=1e-3)
+
+
+def test_the_acceleration_sign_is_judged_with_the_accelerations_own_delay(tmp_path):
+    # near the Nyquist limit (1900 Hz at 5120 Hz) -0.45 samples turns the acceleration by
+    # -60 degrees; with a fixture's -35 the channel as recorded lies 95 degrees from j w V and
+    # was taken for an inverted accelerometer. Corrected it is the -35 it is, and m a
+    # (that channel's, turned alike) comes off the force: tan(phi). HDF5 keeps the starts
+    # in float64: 1e-12 of the loss factor is round-off
+    fast = 1900.0
+    path = _export_with_mass(tmp_path / "fast.h5", 0.0, -0.45, freq_hz=fast,
+                             turn_rad=math.radians(-35.0))
+    record = analyze_file(path, AnalysisOptions(mass_below_gauge_kg=MASS_KG))
+    assert record.analysis.frequency_hz == pytest.approx(fast, rel=1e-9)
+    assert record.analysis.loss_factor == pytest.approx(ETA, abs=1e-9)
+    # the same accelerometer turned past 90 degrees by its mounting is still refused
+    flipped = _export_with_mass(tmp_path / "flipped.h5", 0.0, -0.45, freq_hz=fast,
+                                turn_rad=math.radians(-100.0))
+    with pytest.raises(SignalError, match="channel 'Acceleration' moves against the velocity "
+                                          r"'Velocity' at the drive line \(100°"):
+        analyze_file(flipped, AnalysisOptions(mass_below_gauge_kg=MASS_KG))
+
+
+def test_an_acceleration_start_offset_is_the_motion_channels_without_a_velocity():
     t = np.arange(N) / FS
-    start = 0.37 / FS
-    path = tmp_path / "both.uff"
-    write_measurement(Measurement(path.name, (
-        Channel("Force", "force", _force(t), FS, "N"),
-        Channel("Velocity", "velocity", _velocity(t), FS, "m/s"),
-        Channel("Acceleration", "acceleration", _acceleration(t + start), FS, "m/s^2",
-                start_time_s=start))), path)
-    err = _refusal(path, capsys, "--mass-below-gauge", "0.01")
-    assert "channel 'Acceleration' starts +0.370 samples off the force channel's" in err
+    with pytest.raises(ParameterError, match=r"^acc\.uff: acceleration_start_offset_delay_s: "
+                                             "the acceleration is the motion channel here"):
+        analyze_power(_force(t), None, FS, acceleration=_acceleration(t),
+                      acceleration_start_offset_delay_s=0.2 / FS, source="acc.uff")
 
 
 def test_a_start_offset_delay_beyond_half_a_sample_is_refused():
@@ -250,3 +347,33 @@ def test_a_start_offset_of_a_millionth_of_a_sample_is_said_as_it_is(tmp_path):
     assert abs(stated) > 1e-6  # beyond the 1e-6 samples taken for none
     fraction = float(said.split(" starts ")[1].split(" samples")[0])
     assert fraction == pytest.approx(stated, rel=1e-3)  # printed with 4 digits
+
+
+# The acceleration's start uncertainty weighs in by the inertia force it cancels: 0.37 samples
+# from 0.5 s at 51.2 kHz is stated to +-1e-6 s, 6.3e-3 rad at 1 kHz; times m|A|/(|F_s| cos phi)
+# = 0.6 that is 3.8e-3 of the loss factor (refused), times 6e-4 (a 0.2 g mass) 3.8e-6 (kept).
+@pytest.mark.parametrize("suffix", [".uff", ".uff58b"])
+def test_a_mass_cancelling_accelerations_start_the_uff_cannot_place_is_refused(tmp_path,
+                                                                              capsys, suffix):
+    late = dict(start_s=LATE_START_S, rate_hz=FAST_RATE_HZ, freq_hz=FAST_DRIVE_HZ,
+                n=int(0.5 * FAST_RATE_HZ))
+    path = _export_with_mass(tmp_path / f"late{suffix}", 0.0, 0.37, **late)
+    err = _refusal(path, capsys, "--mass-below-gauge", str(MASS_KG))
+    assert "channel 'Acceleration' starts" in err and "channel 'Force'" in err
+    assert "6 significant digits" in err and "±0.051 samples" in err  # 2 x 5e-7 s x 51.2 kHz
+    assert "m|A|/(|F| cos phi) = 0.6" in err and "'Velocity' starts" not in err
+    # the same channels with their starts in float64: corrected to the truth (noise-free)
+    exact = analyze_file(_export_with_mass(tmp_path / "late.h5", 0.0, 0.37, **late),
+                         AnalysisOptions(mass_below_gauge_kg=MASS_KG))
+    assert exact.analysis.loss_factor == pytest.approx(ETA, abs=1e-7)
+    # a mass whose inertia is 6e-4 of the force: within the budget, the loss factor within
+    # the bound the six digits leave (2.3e-7 s off here: 1.4e-3 rad x 6e-4)
+    light_kg = 2e-4
+    light = _export_with_mass(tmp_path / f"light{suffix}", 0.0, 0.37, mass_kg=light_kg,
+                              **late)
+    record = analyze_file(light, AnalysisOptions(mass_below_gauge_kg=light_kg))
+    bound = (2 * math.pi * FAST_DRIVE_HZ * 1e-6 * light_kg * A0 / (F0 * math.cos(PHI)))
+    assert bound < 1e-4
+    assert record.analysis.loss_factor == pytest.approx(ETA, abs=bound)
+    assert record.analysis.corrections["acceleration_start_offset_delay_s"] == pytest.approx(
+        -0.37 / FAST_RATE_HZ, abs=1e-6)

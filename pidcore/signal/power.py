@@ -43,10 +43,13 @@ Corrections (applied to the phasors in this order):
    ``exp(+j n w tau)``. ``start_offset_delay_s`` (a motion channel sampled a fraction of a
    sample off the force's instants) adds to that ``tau`` and is corrected by the same factor,
    on the velocity channel or, without one, on the acceleration the velocity comes from.
+   ``acceleration_start_offset_delay_s`` is the same for an acceleration channel beside a
+   velocity channel (the one mass cancellation takes), by the same factor on its phasors; the
+   vibrometer's delay is not its.
 2. Velocity from acceleration when there is no velocity channel: ``V_n = A_n / (j n w)``.
 3. Mass cancellation: the gauge also feels the inertia of the mass between it and the coupon
    (impedance-head seismic mass, fixture): ``F_n -= m_below A_n`` with ``A_n`` from the
-   acceleration channel when there is one, else ``j n w V_n``.
+   acceleration channel when there is one (corrected by correction 1), else ``j n w V_n``.
 4. Baseline subtraction: the empty structure (coupon and fixture, measured the same way)
    dissipates ``eta_baseline`` of its *own* reactive power, ``Q_s = sum_n 1/2 n w m_s |V_n|^2``
    for its mass ``m_s`` (``structure_mass_kg``), so ``eta_baseline Q_s`` is taken off
@@ -311,18 +314,30 @@ def _check_reactive_power_resolved(p_c: complex, p_blocks: np.ndarray | None, *,
             "a purely resistive load, or a velocity channel that is not the structure's)")
 
 
+def _undelayed(phasors: np.ndarray | complex, n: np.ndarray | int, omega: float,
+               delay_s: float) -> np.ndarray | complex:
+    """Phasors of ``x(t)`` from those of a channel that recorded ``x(t - delay_s)``: the one
+    phase correction of every channel's delay (a vibrometer's, a start offset's)."""
+    return phasors * np.exp(1j * n * omega * delay_s)
+
+
 def _complex_power(f_ph: np.ndarray, m_ph: np.ndarray, a_ph: np.ndarray | None,
                    n: np.ndarray, omega: float, *, motion_is_velocity: bool, delay_s: float,
-                   mass_kg: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                   acceleration_delay_s: float, mass_kg: float
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Corrected (F, V) phasors and P_c; arrays over (..., harmonic)."""
     jnw = 1j * n * omega
     # x(t - tau) recorded for either motion channel: a velocity integrated from a delayed
     # acceleration is the delayed velocity, so the one phase factor serves both
-    v = m_ph * np.exp(1j * n * omega * delay_s)
+    v = _undelayed(m_ph, n, omega, delay_s)
     if not motion_is_velocity:
         v = v / jnw
     if mass_kg:
-        acc = a_ph if a_ph is not None else jnw * v
+        # the inertia force m a at the force's instants: an acceleration sampled off them
+        # turns m a by n w tau against the force, which moves Re(P_c) by that phase times
+        # the inertia force's share of the force
+        acc = (_undelayed(a_ph, n, omega, acceleration_delay_s) if a_ph is not None
+               else jnw * v)
         f = f_ph - mass_kg * acc
     else:
         f = f_ph
@@ -430,20 +445,21 @@ def _check_delay(velocity_delay_s: float, frequency_hz: float, duration_s: float
 
 
 def _check_start_offset(start_offset_delay_s: float, sample_rate_hz: float,
-                        source: str = "") -> None:
+                        source: str = "", name: str = "start_offset_delay_s") -> None:
     # what is left of a start offset once whole samples are cut: half a sample at most (a
     # larger value is whole samples that belong cut, or a time in the wrong unit)
-    real_number("start_offset_delay_s", start_offset_delay_s)
+    real_number(name, start_offset_delay_s)
     half = 0.5 / sample_rate_hz
     if not (math.isfinite(start_offset_delay_s)
             and abs(start_offset_delay_s) <= half * (1 + 1e-9)):
-        raise ParameterError(f"{_of(source)}start_offset_delay_s: {start_offset_delay_s!r} s, "
+        raise ParameterError(f"{_of(source)}{name}: {start_offset_delay_s!r} s, "
                              f"expected a fraction of a sample, at most {half:.6g} s (half a "
                              f"sample at {sample_rate_hz:g} Hz)")
 
 
 def _check_acceleration_sign(acceleration_phasor: complex, velocity_phasor: complex,
-                             omega: float, velocity_delay_s: float, *, source: str,
+                             omega: float, velocity_delay_s: float,
+                             acceleration_delay_s: float, *, source: str,
                              acceleration_name: str, velocity_name: str) -> None:
     """Refuse an acceleration channel that moves against the velocity at the drive line.
 
@@ -452,11 +468,16 @@ def _check_acceleration_sign(acceleration_phasor: complex, velocity_phasor: comp
     too small by the share of that mass in the reactive power (0.015 for 0.02 with 50 g on
     a 0.3 kg coupon) without a word: the reactive power stays positive, so nothing else
     catches it. The same point moves alike in both channels (a fixture resonance turns the
-    phase by tens of degrees, not past 90)."""
-    expected = 1j * omega * velocity_phasor * np.exp(1j * omega * velocity_delay_s)
-    if not (acceleration_phasor * np.conj(expected)).real < 0:
+    phase by tens of degrees, not past 90).
+
+    Each channel is judged as corrected, by its own delay: an acceleration half a sample off
+    the force's instants near the Nyquist limit is turned by up to 80 degrees, which with a
+    fixture's tens of degrees took a sound channel past 90."""
+    expected = 1j * omega * _undelayed(velocity_phasor, 1, omega, velocity_delay_s)
+    acceleration = _undelayed(acceleration_phasor, 1, omega, acceleration_delay_s)
+    if not (acceleration * np.conj(expected)).real < 0:
         return
-    phase = math.degrees(abs(np.angle(acceleration_phasor * np.conj(expected))))
+    phase = math.degrees(abs(np.angle(acceleration * np.conj(expected))))
     raise SignalError(
         f"{source or 'record'}: channel {acceleration_name!r} moves against the velocity "
         f"{velocity_name!r} at the drive line ({phase:.0f}° from j omega V, expected about 0°): "
@@ -485,6 +506,7 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
                   n_harmonics: int = defaults.N_HARMONICS,
                   velocity_delay_s: float = 0.0,
                   start_offset_delay_s: float = 0.0,
+                  acceleration_start_offset_delay_s: float = 0.0,
                   mass_below_gauge_kg: float = 0.0,
                   baseline_loss_factor: float = 0.0,
                   structure_mass_kg: float | None = None,
@@ -521,6 +543,12 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
         velocity, or without one the acceleration the velocity comes from. Corrected with
         ``velocity_delay_s`` (the two add); at most half a sample.
         :func:`pidcore.measure.analyze_measurement` passes it from the channels' start times.
+    acceleration_start_offset_delay_s : float
+        The same for an ``acceleration`` channel beside a ``velocity`` channel (the one mass
+        cancellation takes), corrected on its phasors by the same factor (without
+        ``velocity_delay_s``, the vibrometer's); at most half a sample. Refused without a
+        velocity channel: the acceleration is then the motion channel, whose offset is
+        ``start_offset_delay_s``.
     mass_below_gauge_kg : float
         Mass between force gauge and structure whose inertia force is cancelled, kg.
     baseline_loss_factor : float
@@ -575,8 +603,15 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
         raise ParameterError(f"{_of(source)}velocity_delay_s: a vibrometer delay needs a "
                              "velocity channel; the velocity here comes from the acceleration")
     _check_start_offset(start_offset_delay_s, sample_rate_hz, source)
+    _check_start_offset(acceleration_start_offset_delay_s, sample_rate_hz, source,
+                        "acceleration_start_offset_delay_s")
+    if velocity is None and acceleration_start_offset_delay_s:
+        raise ParameterError(f"{_of(source)}acceleration_start_offset_delay_s: the acceleration "
+                             "is the motion channel here (no velocity channel); its start "
+                             "offset is start_offset_delay_s")
     # the one phase correction of the motion channel (correction 1 of the module docstring)
     motion_delay_s = float(velocity_delay_s) + float(start_offset_delay_s)
+    acceleration_delay_s = float(acceleration_start_offset_delay_s)
     acc_name = acceleration_name if velocity is not None else velocity_name
     channels: list[tuple[str, np.ndarray]] = [(force_name, np.asarray(force, dtype=np.float64))]
     if velocity is not None:
@@ -653,10 +688,10 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
         a_fit = fit_harmonics(acc_data, None, theta, n_harm, edges, drift_knots=drift_knots)
     if a_fit is not None and mass_below_gauge_kg > 0:
         _check_acceleration_sign(a_fit.total[0, 0], fit.total[1, 0], omega, motion_delay_s,
-                                 source=source, acceleration_name=acc_name,
-                                 velocity_name=velocity_name)
+                                 acceleration_delay_s, source=source,
+                                 acceleration_name=acc_name, velocity_name=velocity_name)
     kw = dict(motion_is_velocity=velocity is not None, delay_s=motion_delay_s,
-              mass_kg=float(mass_below_gauge_kg))
+              acceleration_delay_s=acceleration_delay_s, mass_kg=float(mass_below_gauge_kg))
     f_ph, v_ph, p_c = _complex_power(fit.total[0], fit.total[1],
                                      None if a_fit is None else a_fit.total[0],
                                      harmonics, omega, **kw)
@@ -733,6 +768,8 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
     }
     if start_offset_delay_s:
         corrections["start_offset_delay_s"] = float(start_offset_delay_s)
+    if acceleration_start_offset_delay_s:
+        corrections["acceleration_start_offset_delay_s"] = acceleration_delay_s
     if baseline_loss_factor > 0:
         corrections["baseline_structure_share"] = float(structure_share)
         if structure_mass_kg is not None:
@@ -822,6 +859,7 @@ def analyze_channels(force: Channel, velocity: Channel | None, *,
                      n_harmonics: int = defaults.N_HARMONICS,
                      velocity_delay_s: float = 0.0,
                      start_offset_delay_s: float = 0.0,
+                     acceleration_start_offset_delay_s: float = 0.0,
                      mass_below_gauge_kg: float = 0.0,
                      baseline_loss_factor: float = 0.0,
                      structure_mass_kg: float | None = None,
@@ -873,6 +911,7 @@ def analyze_channels(force: Channel, velocity: Channel | None, *,
             acceleration=by_role.get("acceleration"),
             frequency_hz=frequency_hz, n_harmonics=n_harmonics,
             velocity_delay_s=velocity_delay_s, start_offset_delay_s=start_offset_delay_s,
+            acceleration_start_offset_delay_s=acceleration_start_offset_delay_s,
             mass_below_gauge_kg=mass_below_gauge_kg, baseline_loss_factor=baseline_loss_factor,
             structure_mass_kg=structure_mass_kg, n_blocks=n_blocks, min_periods=min_periods,
             source=source, force_name=force.name, velocity_name=motion.name,
