@@ -269,7 +269,7 @@ class MeasuredEntry:
     specimen_note : str
         Where a record without its file's hash was matched by name only to its name's one
         file (``specimen_sha256`` is then that file's), or kept apart since the name means
-        several files, the note saying so (:func:`pidcore.app.workbench.matched_specimens`);
+        several files, the note saying so (:func:`pidcore.report.case_view.matched_specimens`);
         empty otherwise.
     bound_note : str
         Where the SDC bound stored with a saved record is not one and was ignored (judged at
