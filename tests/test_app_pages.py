@@ -486,6 +486,10 @@ def test_saved_records_are_compared_after_a_reload_and_filtered(store_file):
     assert labels == ["100 Hz, 5 g, 50 %, acrylic, z (2 file(s))"]
     measured = next(d.value for d in fresh.dataframe if "origin" in d.value.columns)
     assert sorted(measured["file"]) == ["s1_fill50.csv", "s2_fill50.csv"]
+    # each file's SDC under the report's names (it was "SDC [-]", "SDC stderr [-]")
+    assert {"SDC measured (Eq. 11) [-]", "SDC measured (Eq. 11) stderr [-]"} <= set(
+        measured.columns)
+    assert not {"SDC [-]", "SDC stderr [-]"} & set(measured.columns)
     assert set(measured["origin"]) == {"store"}
     # the corrections each record was saved with come back from the store
     assert set(measured["corrections"]) == {

@@ -349,3 +349,27 @@ def test_report_case_sheets_are_written_whole_or_not_at_all(tmp_path, monkeypatc
     (line,) = capsys.readouterr().err.strip().splitlines()
     assert "--case-sheets: not with --pool" in line
     assert not pooled.exists()
+
+
+@pytest.mark.usefixtures("undrawn_report_figures")
+def test_the_case_sheets_file_table_names_its_sdcs_as_the_report_does(tmp_path, monkeypatch):
+    # the sheet's page 2 (and the Compare page's table) headed the report's "SDC measured
+    # (Eq. 11) [-]" as "SDC [-]": one measured SDC, two names, one of them the DEM's too
+    from pidcore.report.table import MEASURED_EQ10_COLUMN
+
+    monkeypatch.chdir(tmp_path)
+    store = _store(tmp_path, 0.0)
+    row = _report_row(tmp_path, store)
+    _, view = _compare_view(store)
+    table = view["comparison"].measured
+    # the bundled DEM case has an m_c: the Eq. 10 SDC is a column too
+    names = (MEASURED_EQ11_COLUMN, MEASURED_EQ11_STDERR_COLUMN, MEASURED_EQ10_COLUMN)
+    assert set(names) <= set(table.columns)
+    assert not {"SDC [-]", "SDC stderr [-]", "SDC, E of Eq. 10 [-]"} & set(table.columns)
+    # one file: its numbers are the row's (the CSV keeps every digit: rel 1e-12)
+    (shown,) = table.to_dict("records")
+    assert [shown[n] for n in names] == pytest.approx([row[n] for n in names], rel=1e-12)
+    # page 1 says "measured SDC (Eq. 11)" in its lines: these names are page 2's headers
+    text = _pdf_text(case_pdf(view, title=TITLE))
+    assert all(_words(n) in text for n in names)
+    assert "SDC stderr [-]" not in text
