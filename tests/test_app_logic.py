@@ -20,7 +20,6 @@ from _app_samples import analytic_sdc, mass_damper_csv
 from pidcore import defaults
 from pidcore.app import jobs, stores, uploads
 from pidcore.app.uploads import AnalysedFile
-from pidcore.app.workbench import loop_frame
 from pidcore.compare.case import (
     PROPOSED_FILL_PERCENT,
     MeasuredEntry,
@@ -32,6 +31,7 @@ from pidcore.compare.case import (
     stated_case,
 )
 from pidcore.errors import ParameterError
+from pidcore.report.case_view import loop_frame
 from pidcore.report.comparison_figures import dem_loop_from_arrays
 from pidcore.report.downloads import report_files, store_report_table
 from pidcore.store.listing import list_dem_runs
@@ -338,8 +338,9 @@ def test_a_load_case_address_names_its_case_when_files_are_saved_to_it_later(goo
     # to the case later made the old address refused although the case was still there.
     from dataclasses import replace
 
-    from pidcore.app.workbench import case_address, case_at_address, group_entries
+    from pidcore.app.workbench import case_address, case_at_address
     from pidcore.compare.case import LoadCase
+    from pidcore.report.case_view import group_entries
 
     one = _entry(_record(good_csv, options))
 
@@ -393,8 +394,9 @@ def test_a_load_case_keeps_its_name_when_a_later_file_is_saved_to_it(good_csv, o
     # another page address)
     from dataclasses import replace
 
-    from pidcore.app.workbench import case_address, group_entries, group_name
+    from pidcore.app.workbench import case_address
     from pidcore.compare.case import LoadCase
+    from pidcore.report.case_view import group_entries, group_name
 
     one = _entry(_record(good_csv, options))
 
@@ -1015,8 +1017,8 @@ def test_like_for_like_sdc_uses_the_dem_vibrated_mass_as_the_report_does(good_cs
 def test_load_case_pdf_has_the_plots_and_the_corrections_page(good_csv, options):
     from dataclasses import replace
 
-    from pidcore.app.workbench import case_view
     from pidcore.report.case_sheet import case_pdf
+    from pidcore.report.case_view import case_view
 
     rec = _record(good_csv, options, name="c_fill50.csv")
     corrected = replace(options, velocity_delay_s=50e-6, mass_below_gauge_kg=2e-3)
@@ -1158,7 +1160,7 @@ def _steel_entry(rec, specimen=""):
 
 
 def test_a_measurement_meets_only_the_dem_runs_of_its_specimen(good_csv, options):
-    from pidcore.app.workbench import case_view
+    from pidcore.report.case_view import case_view
 
     rec = _record(good_csv, options)
     runs = _two_specimens_runs()
@@ -1183,7 +1185,7 @@ def test_a_measurement_meets_only_the_dem_runs_of_its_specimen(good_csv, options
 
 
 def test_unnamed_acrylic_measurements_still_meet_the_papers_coupon(good_csv, options):
-    from pidcore.app.workbench import case_view
+    from pidcore.report.case_view import case_view
     from pidcore.specimen import paper_specimen
 
     rec = _record(good_csv, options)
@@ -1202,7 +1204,7 @@ def test_a_calibrations_design_runs_do_not_hide_the_papers_coupon(good_csv, opti
     # Compare refused every case ("the DEM runs ... are of 2 specimens"; named paper_coupon:
     # "2 different specimen files named paper_coupon"); `pidcore report` on the same store
     # compares the paper's coupon and names the others left out: so does Compare now
-    from pidcore.app.workbench import case_view
+    from pidcore.report.case_view import case_view
     from pidcore.specimen import paper_specimen
 
     rec = _record(good_csv, options)
@@ -1222,9 +1224,9 @@ def test_a_calibrations_design_runs_do_not_hide_the_papers_coupon(good_csv, opti
 
 
 def test_compare_and_report_say_a_dem_run_did_not_converge_alike(good_csv, options):
-    from pidcore.app.workbench import case_view
     from pidcore.measure import analysis_record
     from pidcore.report import build_report_table
+    from pidcore.report.case_view import case_view
 
     rec = _record(good_csv, options)
     runs = _two_specimens_runs()
@@ -1420,8 +1422,8 @@ def test_a_byte_identical_file_under_another_name_says_what_it_replaces(tmp_path
 def test_identical_contents_are_pooled_once(tmp_path, good_csv, options):
     # the saved a.csv and this session's b.csv (same bytes) and a second session copy: one
     # measurement; pooling them would count the data three times (stderr / sqrt(3))
-    from pidcore.app.workbench import saved_entries
     from pidcore.compare.case import unique_entries
+    from pidcore.report.case_view import saved_entries
     from pidcore.store.listing import saved_analyses
 
     store_file = tmp_path / "s.h5"
@@ -2168,7 +2170,7 @@ def test_compare_notes_a_saved_baseline_off_the_whole_vibrated_mass(tmp_path, go
     # the whole vibrated mass (its SDC low); Compare showed the saved record without it
     from dataclasses import replace
 
-    from pidcore.app.workbench import case_view, saved_entries
+    from pidcore.report.case_view import case_view, saved_entries
     from pidcore.report.pipeline import whole_mass_baseline_note
     from pidcore.store.listing import saved_analyses
 

@@ -486,6 +486,10 @@ def test_saved_records_are_compared_after_a_reload_and_filtered(store_file):
     assert labels == ["100 Hz, 5 g, 50 %, acrylic, z (2 file(s))"]
     measured = next(d.value for d in fresh.dataframe if "origin" in d.value.columns)
     assert sorted(measured["file"]) == ["s1_fill50.csv", "s2_fill50.csv"]
+    # each file's SDC under the report's names (it was "SDC [-]", "SDC stderr [-]")
+    assert {"SDC measured (Eq. 11) [-]", "SDC measured (Eq. 11) stderr [-]"} <= set(
+        measured.columns)
+    assert not {"SDC [-]", "SDC stderr [-]"} & set(measured.columns)
     assert set(measured["origin"]) == {"store"}
     # the corrections each record was saved with come back from the store
     assert set(measured["corrections"]) == {
@@ -2437,3 +2441,41 @@ def test_the_dem_tabs_runs_table_writes_the_sdc_with_four_significant_digits(sto
     grid = next(d for d in at.dataframe if "cells simulated [-]" in d.value.columns)
     assert run.sdc in grid.value["SDC [-]"].tolist()  # still a number
     assert _column_formats(grid)["SDC [-]"] == "%.4g"
+
+
+def test_the_compare_pages_load_case_pdf_is_the_sheet_report_case_sheets_writes(
+        store_file, tmp_path, monkeypatch):
+    # `pidcore report --case-sheets` prints the Compare page's sheet of each case: a CLI user
+    # hands on the sheet a colleague gets from the page, word for word (not byte for byte:
+    # each PDF records when it was made)
+    from test_report_case_sheet import _pdf_text
+
+    from pidcore.app.calibration import CALIBRATION_ENV_VAR
+    from pidcore.cli import main
+    from pidcore.report.table import CALIBRATED_INSIDE_COLUMN
+
+    dem = REPO / "data_samples" / "dem_table3.h5"
+    upload = tmp_path / "c_fill50.csv"
+    upload.write_bytes(mass_damper_csv(frequency_hz=100.0, acceleration_g=5.0,
+                                       loss_factor=0.05))
+    assert main(["analyze", str(upload), "--store", str(store_file),
+                 "--baseline-loss-factor", "0.02"]) == 0
+    # 0.25 .. 0.40 holds the 0.314 judged (before the 2 pi 0.02 taken off): a verdict to print
+    cal = _calibration_json(tmp_path / "calibration.json", 100, 5, 50, 0.325, 0.25, 0.40)
+    monkeypatch.setenv(stores.DEM_STORE_ENV_VAR, str(dem))
+    monkeypatch.setenv(CALIBRATION_ENV_VAR, str(cal))
+    out = tmp_path / "rep"
+    # the page joins its store's DEM runs with the reference store's, in that order
+    assert main(["report", "--store", str(store_file), "--dem-store", str(store_file),
+                 "--dem-store", str(dem), "--calibration", str(cal), "--format", "csv",
+                 "--case-sheets", "--out", str(out)]) == 0
+    (written,) = (out / "cases").iterdir()
+    at = _app()
+    at.button(key="case_pdf").click()
+    at.run()
+    assert not at.exception, at.exception
+    page = at.session_state["case_pdf_bytes"][1]
+    text = _pdf_text(page)
+    # a verdict printed, so that the comparison below compares one
+    assert f"{CALIBRATED_INSIDE_COLUMN}: yes" in text
+    assert text == _pdf_text(written.read_bytes())

@@ -172,14 +172,14 @@ def test_report_rows_pool_a_hashless_record_with_its_names_one_file(tests_analys
 
 def test_app_compare_groups_a_hashless_record_with_its_names_one_file(tests_analysed,
                                                                       tmp_path):
-    from pidcore.app.workbench import (
+    from pidcore.model import load_paper_table3
+    from pidcore.report.case_view import (
         case_view,
         group_entries,
         group_name,
         matched_specimens,
         saved_entries,
     )
-    from pidcore.model import load_paper_table3
     from pidcore.store.listing import filter_analyses, saved_analyses
 
     first = tests_analysed.first
@@ -229,8 +229,8 @@ def test_a_report_of_the_hashless_test_alone_still_reads_it_as_its_names_one_fil
 
 def test_compares_per_file_table_says_which_test_recorded_only_a_name(tests_analysed,
                                                                      tmp_path):
-    from pidcore.app.workbench import case_view, matched_specimens, saved_entries
     from pidcore.model import load_paper_table3
+    from pidcore.report.case_view import case_view, matched_specimens, saved_entries
     from pidcore.store.listing import saved_analyses
 
     first, second = tests_analysed.first, tests_analysed.second

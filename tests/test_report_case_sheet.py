@@ -10,6 +10,7 @@ store, and its text is read back out of the PDF.
 
 from __future__ import annotations
 
+import hashlib
 import json
 import re
 import zlib
@@ -101,15 +102,15 @@ def _report_row(tmp_path, store, calibration=None) -> dict:
 def _compare_view(store):
     """The Compare page's view of the store's one load case (as :func:`pidcore.app.state.
     case_view` builds it, without Streamlit)."""
-    from pidcore.app import workbench
+    from pidcore.report import case_view as views
     from pidcore.store.listing import list_dem_runs, saved_analyses
 
     saved = saved_analyses(store)
-    entries = workbench.matched_specimens(workbench.saved_entries(store, saved), saved)
-    (group,) = workbench.group_entries(entries)
+    entries = views.matched_specimens(views.saved_entries(store, saved), saved)
+    (group,) = views.group_entries(entries)
     members = [entries[i] for i in group]
-    return members, workbench.case_view(members, list_dem_runs(store, DEM_STORE),
-                                        load_paper_table3(), (store, DEM_STORE))
+    return members, views.case_view(members, list_dem_runs(store, DEM_STORE),
+                                    load_paper_table3(), (store, DEM_STORE))
 
 
 # 0.26 .. 0.39 (the test's band of 0.25 .. 0.40) holds the test's own 0.314 (judged before the
@@ -196,3 +197,179 @@ def test_a_case_sheet_of_a_case_the_calibration_does_not_predict_gives_no_verdic
     assert ("calibrated DEM: no calibrated verdict (No calibration predicts 100 Hz, 5 g, 50 %, "
             "acrylic, z: calibration.json predicts 1 measured load case(s).)") in text
     assert "95 % band" not in text
+
+
+# --- `pidcore report --case-sheets`: the Compare page's sheet of every measured case ---------
+
+#: The two tests of :func:`_two_case_store`: (file, frequency [Hz], fill [%], calibrated band).
+#: Analysed with baseline loss factor 0.02, each is judged at its SDC before the 2 pi 0.02 taken
+#: off, 0.314: inside 0.25 .. 0.40, outside 0.50 .. 0.90 (margins of ~0.06 above the 0.1 %
+#: noise of the upload), so the two sheets carry the report's two verdicts.
+TWO_CASES = (("c_fill50.csv", 100.0, 50.0, (0.25, 0.40)),
+             ("d_fill25.csv", 500.0, 25.0, (0.50, 0.90)))
+
+
+def _two_case_store(tmp_path):
+    """A store of two tests at two load cases of the bundled DEM grid, and a calibration that
+    predicts both (a band each, :data:`TWO_CASES`)."""
+    from _app_samples import mass_damper_csv
+
+    store = tmp_path / "s.h5"
+    predictions = []
+    for name, f, fill, (low, high) in TWO_CASES:
+        path = tmp_path / name
+        path.write_bytes(mass_damper_csv(frequency_hz=f, acceleration_g=5.0, loss_factor=0.05))
+        assert main(["analyze", str(path), "--store", str(store),
+                     "--baseline-loss-factor", "0.02"]) == 0
+        predictions.append({"frequency_hz": f, "acceleration_g": 5.0, "fill_percent": fill,
+                            "material": "acrylic", "measured": (low + high) / 2,
+                            "measured_stderr": 0.02, "predicted": (low + high) / 2,
+                            "low95": low, "high95": high, "low95_without_stderr": low + 0.01,
+                            "high95_without_stderr": high - 0.01})
+    cal = tmp_path / "calibration.json"
+    cal.write_text(json.dumps({"parameters": {"fixture_mass_kg": {
+        "median": 0.2, "low95": 0.1, "high95": 0.3}}, "predictions": predictions}),
+        encoding="utf-8")
+    return store, cal
+
+
+def _report_with_sheets(store, cal, out, *extra) -> int:
+    # the stores the app's Compare page joins: its store's runs, then the reference's
+    return main(["report", "--store", str(store), "--dem-store", str(store), "--dem-store",
+                 str(DEM_STORE), "--calibration", str(cal), "--format", "csv", "--case-sheets",
+                 *extra, "--out", str(out)])
+
+
+def _compare_page_sheets(store, cal) -> dict[str, bytes]:
+    """Each load case's sheet as the Compare page prints it from the same store and
+    calibration (the page's own functions: entries, groups, view, calibrated verdict, title),
+    by load case key."""
+    from pidcore.report import case_view as views
+    from pidcore.report.case_sheet import members_calibrated_case
+    from pidcore.store.listing import list_dem_runs, saved_analyses
+
+    saved = saved_analyses(store)
+    entries = views.matched_specimens(views.saved_entries(store, saved), saved)
+    calibrations = [(load_calibration(cal), str(cal))]  # the app labels a file by its path
+    out = {}
+    for group in views.group_entries(entries):
+        members = [entries[i] for i in group]
+        view = views.case_view(members, list_dem_runs(store, DEM_STORE), load_paper_table3(),
+                               (store, DEM_STORE))
+        shown = members_calibrated_case(calibrations, view["comparison"], members)
+        out[view["comparison"].load_case.key] = case_pdf(
+            view, title=views.case_title(entries, group), calibrated=shown)
+    return out
+
+
+@pytest.mark.usefixtures("undrawn_report_figures")
+def test_report_case_sheets_agree_with_the_report_rows_and_the_compare_page(
+        tmp_path, monkeypatch):
+    from pidcore.loadcase import parse_key
+    from pidcore.report.table import MEASURED_EQ10_COLUMN
+
+    monkeypatch.chdir(tmp_path)
+    store, cal = _two_case_store(tmp_path)
+    out = tmp_path / "report"
+    assert _report_with_sheets(store, cal, out) == 0
+    table = pd.read_csv(out / "report.csv", keep_default_na=False, na_values=[""])
+    rows = table[table[MEASURED_EQ11_COLUMN].notna()]
+    sheets = sorted((out / "cases").iterdir())
+    # one sheet per measured row, nothing else in the folder
+    assert len(rows) == len(sheets) == len(TWO_CASES)
+    assert all(p.suffix == ".pdf" for p in sheets)
+    provenance = (out / "report.provenance.txt").read_text(encoding="utf-8")
+    page = _compare_page_sheets(store, cal)
+    verdicts = set()
+    for path in sheets:
+        case = parse_key(path.stem)
+        (row,) = rows[rows["packing ratio [%]"] == case.fill_percent].to_dict("records")
+        data = path.read_bytes()
+        text = _pdf_text(data)
+        # the row's numbers as the sheet prints them: its DEM SDC in the headline beside the
+        # like-for-like measured one, the Eq. 11 SDC the band judges, the calibrated SDC, band
+        # and verdict (the CSV keeps every digit; the sheet prints the display rounding of
+        # the very same numbers, so equal text is equal numbers to that rounding)
+        dem = display_value_with_error(row["SDC DEM (ours) [-]"], row["SDC DEM stderr [-]"])
+        assert _words(f"vs our DEM {dem}") in text
+        # the headline's measured SDC is the row's like-for-like one, to its last printed
+        # digit (half a unit of it)
+        printed = re.search(r"measured SDC \(Eq\. 10 \(DEM m_c\)\) ([0-9.]+)", text).group(1)
+        assert abs(float(printed) - row[MEASURED_EQ10_COLUMN]) <= 0.5 * 10.0 ** -len(
+            printed.partition(".")[2])
+        taken = row[MEASURED_BASELINE_COLUMN]
+        assert taken > 0  # each test had the empty coupon's damping taken off
+        assert _words("measured SDC (Eq. 11) " + display_value_with_error(
+            row[MEASURED_EQ11_COLUMN], row[MEASURED_EQ11_STDERR_COLUMN])
+            + f", the empty coupon's damping (SDC {sdc_text(taken)}) taken off") in text
+        band = band_text(row[CALIBRATED_LOW_COLUMN], row[CALIBRATED_HIGH_COLUMN])
+        assert _words(f"calibrated DEM ({cal}): SDC (Eq. 11) {sdc_text(row[CALIBRATED_COLUMN])}, "
+                      f"95 % band {band} [-]") in text
+        assert f"{CALIBRATED_INSIDE_COLUMN}: {row[CALIBRATED_INSIDE_COLUMN]}" in text
+        verdicts.add(row[CALIBRATED_INSIDE_COLUMN])
+        # listed in the report's provenance with the hash of the bytes written
+        assert re.search(rf"case sheet: cases/{re.escape(path.name)} \(.*\(1 file\(s\)\)\) "
+                         rf"sha256 {hashlib.sha256(data).hexdigest()}", provenance)
+        # the Compare page's sheet of the same case says the same, word for word
+        assert _pdf_text(page[path.stem]) == text
+    assert verdicts == {"yes", "no"}
+
+
+@pytest.mark.usefixtures("undrawn_report_figures")
+def test_report_case_sheets_are_written_whole_or_not_at_all(tmp_path, monkeypatch, capsys):
+    import pidcore.report.case_sheet as case_sheet
+
+    monkeypatch.chdir(tmp_path)
+    store, cal = _two_case_store(tmp_path)
+    out = tmp_path / "report"
+    assert _report_with_sheets(store, cal, out) == 0
+    # an earlier report with its sheets is an earlier report: replaced, not refused
+    assert _report_with_sheets(store, cal, out) == 0
+    before = {p.relative_to(out): p.read_bytes() for p in out.rglob("*") if p.is_file()}
+    assert sum(p.parts[0] == "cases" for p in before) == len(TWO_CASES)
+    drawn = case_sheet.case_pdf
+
+    def interrupted_on_the_second(view, **kwargs):
+        if interrupted_on_the_second.calls:
+            raise KeyboardInterrupt
+        interrupted_on_the_second.calls += 1
+        return drawn(view, **kwargs)
+
+    interrupted_on_the_second.calls = 0
+    monkeypatch.setattr(case_sheet, "case_pdf", interrupted_on_the_second)
+    capsys.readouterr()
+    assert _report_with_sheets(store, cal, out) == 130
+    assert "is as it was (a report is written whole or not at all)" in capsys.readouterr().err
+    assert {p.relative_to(out): p.read_bytes() for p in out.rglob("*") if p.is_file()} == before
+    assert sorted(p.name for p in tmp_path.iterdir() if p.name.startswith(".")) == []
+    # pooled rows are not the page's cases: refused in one line, nothing written
+    monkeypatch.setattr(case_sheet, "case_pdf", drawn)
+    pooled = tmp_path / "pooled"
+    assert _report_with_sheets(store, cal, pooled, "--pool") == 2
+    (line,) = capsys.readouterr().err.strip().splitlines()
+    assert "--case-sheets: not with --pool" in line
+    assert not pooled.exists()
+
+
+@pytest.mark.usefixtures("undrawn_report_figures")
+def test_the_case_sheets_file_table_names_its_sdcs_as_the_report_does(tmp_path, monkeypatch):
+    # the sheet's page 2 (and the Compare page's table) headed the report's "SDC measured
+    # (Eq. 11) [-]" as "SDC [-]": one measured SDC, two names, one of them the DEM's too
+    from pidcore.report.table import MEASURED_EQ10_COLUMN
+
+    monkeypatch.chdir(tmp_path)
+    store = _store(tmp_path, 0.0)
+    row = _report_row(tmp_path, store)
+    _, view = _compare_view(store)
+    table = view["comparison"].measured
+    # the bundled DEM case has an m_c: the Eq. 10 SDC is a column too
+    names = (MEASURED_EQ11_COLUMN, MEASURED_EQ11_STDERR_COLUMN, MEASURED_EQ10_COLUMN)
+    assert set(names) <= set(table.columns)
+    assert not {"SDC [-]", "SDC stderr [-]", "SDC, E of Eq. 10 [-]"} & set(table.columns)
+    # one file: its numbers are the row's (the CSV keeps every digit: rel 1e-12)
+    (shown,) = table.to_dict("records")
+    assert [shown[n] for n in names] == pytest.approx([row[n] for n in names], rel=1e-12)
+    # page 1 says "measured SDC (Eq. 11)" in its lines: these names are page 2's headers
+    text = _pdf_text(case_pdf(view, title=TITLE))
+    assert all(_words(n) in text for n in names)
+    assert "SDC stderr [-]" not in text

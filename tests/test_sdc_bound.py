@@ -164,7 +164,7 @@ def test_analyze_keeps_a_heavy_particle_sdc_above_2_pi_and_calibrate_keeps_it(
     # the same bound as the file's (equal by construction), said to come from the record
     assert alone.sdc_bound == point.sdc_bound and alone.sdc_bound.origin == RECORDED_BOUND_ORIGIN
     # the app's Compare page judges the saved record as analyze did, file known or not
-    from pidcore.app.workbench import saved_entries
+    from pidcore.report.case_view import saved_entries
     from pidcore.store.listing import saved_analyses
 
     (entry,) = saved_entries(store, saved_analyses(store), [heavy_specimen()])
@@ -400,9 +400,9 @@ def test_calibrate_store_and_compare_say_why_a_stored_bound_was_ignored(
     # report --store said "the SDC bound stored with the record ... ignored"; calibrate
     # --store (and the app's Calibrate page) and the app's Compare page judged the record at
     # 2 pi alike, and said nothing of why
-    from pidcore.app.workbench import case_view, saved_entries
     from pidcore.calibrate.data import measured_from_store
     from pidcore.compare.case import paper_table
+    from pidcore.report.case_view import case_view, saved_entries
     from pidcore.store import Store
     from pidcore.store.listing import saved_analyses
 

@@ -251,8 +251,8 @@ def test_a_store_saved_before_the_hash_reads_by_name(two_panels, tmp_path):
 
 
 def test_app_compare_groups_two_files_of_one_name_apart(two_panels, analysed):
-    from pidcore.app.workbench import group_entries, group_name
     from pidcore.compare.case import MeasuredEntry
+    from pidcore.report.case_view import group_entries, group_name
     from pidcore.store.listing import saved_analyses
 
     saved = saved_analyses(two_panels.tests)

@@ -91,7 +91,7 @@ def test_many_analyses_are_read_through_one_opening_of_the_store(tmp_path, monke
 def test_the_app_reads_the_saved_analyses_through_a_fixed_number_of_openings(tmp_path,
                                                                               monkeypatch):
     """The Compare page's entries (one get_analysis per row: one opening each)."""
-    from pidcore.app.workbench import saved_entries
+    from pidcore.report.case_view import saved_entries
 
     path = tmp_path / "s.h5"
     store = _store(path, n_runs=0, n_analyses=0)

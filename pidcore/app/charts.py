@@ -1,5 +1,5 @@
 """Vega-Lite charts of the app, as JSON specs: layout only; they draw the frames of the library
-(:func:`pidcore.compare.case.sdc_points`, :func:`pidcore.app.workbench.loop_frame`,
+(:func:`pidcore.compare.case.sdc_points`, :func:`pidcore.report.case_view.loop_frame`,
 :meth:`pidcore.compare.case.MeasuredEntry.spectrum`), the same data the report's matplotlib
 figures draw.
 
@@ -116,7 +116,7 @@ def sdc_chart(data: pd.DataFrame) -> dict[str, Any]:
 def loop_chart(frame: pd.DataFrame) -> dict[str, Any]:
     """Force-displacement loops overlaid, displacement in µm (a coupon moves micrometres).
 
-    ``frame`` is :func:`pidcore.app.workbench.loop_frame` (SI). Legend labels are the loops'
+    ``frame`` is :func:`pidcore.report.case_view.loop_frame` (SI). Legend labels are the loops'
     names only (the page prints their energies per cycle below), so none is cut.
     """
     series = list(dict.fromkeys(frame["series"]))

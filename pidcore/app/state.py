@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import streamlit as st
 
-from pidcore.app import charts, uploads, workbench
+from pidcore.app import charts, uploads
+from pidcore.report import case_view as views
 
 _CACHE_ENTRIES = 64
 #: Parsed uploads kept in memory (each can be up to the upload limit).
@@ -96,7 +97,7 @@ def saved_entries(keys: tuple[str, ...], stamp: tuple, _stores, _rows,
                   known_hashes: tuple[str, ...] = (), _known=()):
     """Measured entries of saved analyses (phasors read once per store state), judged against
     the SDC bound of the specimen files the page knows (``_known``, keyed by their hashes)."""
-    return workbench.saved_entries(_stores.path, _rows, _known)
+    return views.saved_entries(_stores.path, _rows, _known)
 
 
 @st.cache_data(show_spinner=False)
@@ -114,8 +115,9 @@ def case_view(group_key: str, stamp: tuple, _entries, _stores) -> dict:
     Keyed by the records' identity and the stores' state; specs are built once per case so a
     revisit only sends them (the tests validate them against the Vega-Lite schema).
     """
-    view = workbench.case_view(_entries, store_listing("dem_runs", stamp, _stores), paper(),
-                               (_stores.path, _stores.dem_reference))
+    # the library's view, which `pidcore report --case-sheets` prints too
+    view = views.case_view(_entries, store_listing("dem_runs", stamp, _stores), paper(),
+                           (_stores.path, _stores.dem_reference))
     view["sdc_spec"] = charts.sdc_chart(view["sdc_points"])
     view["loop_spec"] = charts.loop_chart(view["loops"])
     view["spectrum_spec"] = charts.spectrum_chart(view["spectrum"])

@@ -71,6 +71,7 @@ COMMAND_FLAGS: dict[str, dict[str, str]] = {
         "store=": "--store ", "dem_store=": "--dem-store ", "dem_store": "--dem-store",
         "calibration=": "--calibration ", "calibration_key=": "--calibration-key ",
         "calibration_key": "--calibration-key", "pool=True": "--pool", "out_dir": "--out",
+        "case_sheets=True": "--case-sheets",
         # --calibration names the file `pidcore calibrate --out` writes, not the Python call
         # (longer, so matched before its "out_dir")
         "write_outputs(result, out_dir)": "pidcore calibrate --out",

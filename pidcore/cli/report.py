@@ -93,6 +93,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--calibration-key", metavar="KEY", default=None,
                    help="which calibration of the --calibration store (cal_...; a store "
                         "holding one needs none)")
+    p.add_argument("--case-sheets", action="store_true",
+                   help="also write the PDF sheet of every measured load case into "
+                        "DIR/cases/<load case>.pdf, as the app's Compare page prints it "
+                        "(headline, measured Eq. 11 SDC, the --calibration's prediction, band "
+                        "and verdict as the report's row, plots, each file's corrections); "
+                        "not with --pool")
     p.add_argument("--no-progress", action="store_true",
                    help="no progress bars (drawn only on a terminal)")
     # a FILE may be a pidcore HDF5 store of several measurements, whose refusal says
@@ -126,7 +132,8 @@ def run(args: argparse.Namespace) -> int:
             specimen=specimen, pool=args.pool, calibration=args.calibration,
             calibration_key=args.calibration_key,
             accept_implausible=args.accept_implausible, progress=progress_wanted(args),
-            wording=lambda text: cli_words(text, "report"), key=args.key)
+            wording=lambda text: cli_words(text, "report"), key=args.key,
+            case_sheets=args.case_sheets)
         print(short_table(result.table))
         for note in result.notes:  # in the command's words (wording=)
             print(f"note: {note}")

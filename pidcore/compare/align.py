@@ -57,6 +57,10 @@ DEM_COLUMNS: tuple[str, ...] = ("frequency_hz", "acceleration_g", "fill_percent"
 MEASURED_EQ11_COLUMN = "SDC measured (Eq. 11) [-]"
 MEASURED_EQ11_STDERR_COLUMN = "SDC measured (Eq. 11) stderr [-]"
 MEASURED_EQ11_DOF_COLUMN = "SDC measured (Eq. 11) stderr dof [-]"
+#: Measured energy per cycle over the DEM case's E = m_c a^2 / (2 w^2) (Eq. 10): the like-for-like
+#: counterpart of our DEM SDC. The Eq. 11 SDC divides by Im(P_c)/w instead, the reactive energy,
+#: which is smaller than Eq. 10's E whenever particles fly free of the cell walls.
+MEASURED_EQ10_COLUMN = "SDC measured, E of Eq. 10 [-]"
 #: The part of the measured Eq. 11 SDC that its analysis took off as the empty coupon's damping
 #: (``analyze --baseline-loss-factor``; pooled as the SDC is; 0 where none was taken off, NaN
 #: where a record did but its SDC before that is not known): the calibrated DEM predicts the SDC

@@ -18,6 +18,9 @@ from .. import defaults
 from ..errors import ParameterError, PidcoreError
 from ..units import display_sigmas
 from .align import (
+    MEASURED_EQ10_COLUMN,
+    MEASURED_EQ11_COLUMN,
+    MEASURED_EQ11_STDERR_COLUMN,
     PACKING_RATIO_COLUMN,
     Aligner,
     Tolerances,
@@ -131,8 +134,10 @@ class CaseComparison:
         Mean measured frequency [Hz] and acceleration [g] of the records, stated fill,
         material and direction.
     measured : pandas.DataFrame
-        One row per record: ``file``, ``packing ratio [%]``, ``SDC [-]``, ``SDC stderr [-]``
-        (Eq. 11) and, with a DEM m_c, ``SDC, E of Eq. 10 [-]``.
+        One row per record: ``file``, ``packing ratio [%]``, its Eq. 11 SDC and standard error
+        (:data:`~pidcore.compare.align.MEASURED_EQ11_COLUMN`,
+        :data:`~pidcore.compare.align.MEASURED_EQ11_STDERR_COLUMN`) and, with a DEM m_c, its
+        Eq. 10 one (:data:`~pidcore.compare.align.MEASURED_EQ10_COLUMN`): the report's names.
     measured_sdc, measured_stderr : float
         Eq. 11 SDC of the records pooled (:func:`pidcore.compare.pooled_mean`), [-].
     measured_stderr_dof : float
@@ -269,7 +274,7 @@ class MeasuredEntry:
     specimen_note : str
         Where a record without its file's hash was matched by name only to its name's one
         file (``specimen_sha256`` is then that file's), or kept apart since the name means
-        several files, the note saying so (:func:`pidcore.app.workbench.matched_specimens`);
+        several files, the note saying so (:func:`pidcore.report.case_view.matched_specimens`);
         empty otherwise.
     bound_note : str
         Where the SDC bound stored with a saved record is not one and was ignored (judged at
@@ -512,11 +517,12 @@ def compare_case(records: Sequence[MeasuredEntry],
         "specimen": [_specimen_shown(r) for r in records],
         "corrections": [r.corrections for r in records],
         PACKING_RATIO_COLUMN: [r.load_case.fill_percent for r in records],
-        "SDC [-]": [r.sdc for r in records],
-        "SDC stderr [-]": [r.sdc_stderr for r in records],
+        # the report's names: "SDC [-]" here was the report's "SDC measured (Eq. 11) [-]"
+        MEASURED_EQ11_COLUMN: [r.sdc for r in records],
+        MEASURED_EQ11_STDERR_COLUMN: [r.sdc_stderr for r in records],
     })
-    values = measured["SDC [-]"].to_numpy(float)
-    errors = measured["SDC stderr [-]"].to_numpy(float)
+    values = measured[MEASURED_EQ11_COLUMN].to_numpy(float)
+    errors = measured[MEASURED_EQ11_STDERR_COLUMN].to_numpy(float)
     sdc, stderr = pooled_mean(values, errors)
     stderr_dof = pooled_stderr_dof(values, errors, np.array([r.sdc_stderr_dof for r in records]))
     baseline_sdc = pooled_baseline_sdc(values, errors, [r.baseline_sdc for r in records])
@@ -603,7 +609,7 @@ def compare_case(records: Sequence[MeasuredEntry],
         vibrated_mass_kg=m_c)
     stderr10_dof = math.nan
     if math.isfinite(m_c):
-        measured["SDC, E of Eq. 10 [-]"] = eq10
+        measured[MEASURED_EQ10_COLUMN] = eq10
         stderr10_dof = pooled_stderr_dof(eq10, errors * eq10 / values,
                                          np.array([r.sdc_stderr_dof for r in records]))
     return CaseComparison(case, measured, sdc, stderr, aligned, dem_points, paper_points,

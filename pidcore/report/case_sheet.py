@@ -3,13 +3,17 @@ verdict (as the report's row of the case gives them), SDC against fill, the loop
 corrections each file was analysed with.
 
 Drawn with matplotlib from the same frames the app's charts draw
-(:func:`pidcore.compare.case.sdc_points`, :func:`pidcore.app.workbench.loop_frame`).
+(:func:`pidcore.compare.case.sdc_points`, :func:`pidcore.report.case_view.loop_frame`). The
+Compare page prints one case's sheet; ``pidcore report --case-sheets`` writes every measured
+case's (:func:`case_sheets`), both from :func:`pidcore.report.case_view.case_view`.
 """
 
 from __future__ import annotations
 
 import io
 import math
+import os
+import re
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -22,8 +26,9 @@ from ..calibrate.prediction import (
     sdc_text,
 )
 from ..compare.align import CALIBRATED_INSIDE_COLUMN, PACKING_RATIO_COLUMN
-from ..compare.case import CaseComparison
+from ..compare.case import CaseComparison, MeasuredEntry
 from ..units import display_value_with_error
+from .case_view import case_title, case_view, group_entries
 
 #: Page size of the sheet, inches (A4 landscape).
 PAGE_IN = (11.69, 8.27)
@@ -98,6 +103,17 @@ def calibrated_case(calibrations: Sequence[tuple[object | None, str]],
         pools_implausible=implausible))
 
 
+def members_calibrated_case(calibrations: Sequence[tuple[object | None, str]],
+                            comparison: CaseComparison,
+                            members: Sequence[MeasuredEntry]) -> CalibratedCase:
+    """:func:`calibrated_case` of a load case's pooled ``members``: of their specimen (one:
+    :func:`pidcore.report.case_view.group_entries` never pools two) and file, not judged where
+    one of them is implausible (as the report's row)."""
+    return calibrated_case(calibrations, comparison, members[0].specimen,
+                           implausible=any(e.implausible for e in members),
+                           specimen_sha256=members[0].specimen_sha256)
+
+
 _NO_CALIBRATION = CalibratedCase()
 
 
@@ -117,7 +133,7 @@ def plot_sdc_points(points: pd.DataFrame, ax) -> None:
 
 
 def plot_loops(loops: pd.DataFrame, ax) -> None:
-    """Force-displacement loops of a :func:`pidcore.app.workbench.loop_frame`, in µm and N."""
+    """Force-displacement loops of a :func:`pidcore.report.case_view.loop_frame`, in µm and N."""
     for series, group in loops.groupby("series", sort=False):
         ax.plot(group["displacement [m]"].to_numpy(float) * 1e6,
                 group["force [N]"].to_numpy(float), label=series)
@@ -163,8 +179,8 @@ def sheet_lines(view: dict, *, title: str, calibrated: CalibratedCase | None = N
 
 
 def case_pdf(view: dict, *, title: str, calibrated: CalibratedCase | None = None) -> bytes:
-    """PDF bytes of one load case from the app's case view
-    (:func:`pidcore.app.workbench.case_view`: ``comparison``, ``headline``, ``sdc_points``,
+    """PDF bytes of one load case from the Compare page's case view
+    (:func:`pidcore.report.case_view.case_view`: ``comparison``, ``headline``, ``sdc_points``,
     ``loops``, ``energies``, ``notes``) and the calibrated DEM beside it (``calibrated``, see
     :func:`sheet_lines`)."""
     from matplotlib.backends.backend_pdf import PdfPages
@@ -197,3 +213,57 @@ def case_pdf(view: dict, *, title: str, calibrated: CalibratedCase | None = None
         cells.auto_set_column_width(list(range(len(table.columns))))
         pdf.savefig(fig)
     return buffer.getvalue()
+
+
+def case_sheet_stem(comparison: CaseComparison, members: Sequence[MeasuredEntry]) -> str:
+    """The file name (without ``.pdf``) of a load case's sheet: its load-case key, and where
+    its tests name a specimen, that specimen as labels name it (name and start of its file's
+    hash), in characters any file system keeps, e.g.
+    ``'f100Hz_a5g_fill50pct_acrylic_z_steel_6mm_3e945a'``: two specimens' sheets of one load
+    case are two files."""
+    from ..specimen import tested_label
+
+    label = tested_label(members[0].specimen, members[0].specimen_sha256)
+    safe = re.sub(r"[^A-Za-z0-9._+-]+", "_", label).strip("_.")
+    return f"{comparison.load_case.key}_{safe}" if safe else comparison.load_case.key
+
+
+@dataclass(frozen=True)
+class CaseSheet:
+    """One load case's PDF sheet (:func:`case_sheets`): ``name`` the file's
+    (:func:`case_sheet_stem` and ``.pdf``), ``title`` its first line, ``pdf`` its bytes."""
+
+    name: str
+    title: str
+    pdf: bytes
+
+
+def case_sheets(entries: Sequence[MeasuredEntry], dem_runs: pd.DataFrame | None,
+                paper: pd.DataFrame, store_paths: Sequence[str | os.PathLike | None],
+                calibrations: Sequence[tuple[object | None, str]] = ()) -> list[CaseSheet]:
+    """The sheet of every load case of ``entries``, as the Compare page prints each: grouped
+    (:func:`pidcore.report.case_view.group_entries`), viewed
+    (:func:`pidcore.report.case_view.case_view` with the DEM runs ``dem_runs`` of the stores
+    ``store_paths`` and Table 3 ``paper``), judged by ``calibrations`` ([(calibration,
+    label)], :func:`members_calibrated_case`; empty: no calibration given, said on the
+    sheet) and titled (:func:`pidcore.report.case_view.case_title`). ``entries``: each
+    measured data set once (:func:`pidcore.compare.case.unique_entries`), specimens matched
+    (:func:`pidcore.report.case_view.matched_specimens`). In the order of the groups; a file
+    name two cases would share gets ``_2``, ``_3``, ... ."""
+    sheets: list[CaseSheet] = []
+    taken: set[str] = set()
+    for group in group_entries(entries):
+        members = [entries[i] for i in group]
+        view = case_view(members, dem_runs, paper, store_paths)
+        comparison = view["comparison"]
+        title = case_title(entries, group)
+        stem = case_sheet_stem(comparison, members)
+        name, n = f"{stem}.pdf", 1
+        while name in taken:
+            n += 1
+            name = f"{stem}_{n}.pdf"
+        taken.add(name)
+        sheets.append(CaseSheet(name, title, case_pdf(
+            view, title=title,
+            calibrated=members_calibrated_case(calibrations, comparison, members))))
+    return sheets

@@ -34,6 +34,7 @@ from ..io import display_path
 from ..loadcase import refuse_identical_contents_stating_apart
 from .provenance import calibration_provenance, collect_provenance
 from .render import (
+    CASE_SHEETS_FOLDER,
     check_out_dir,
     parse_formats,
     restore_previous_report,
@@ -43,11 +44,13 @@ from .render import (
 from .table import SPECIMEN_SHA256_COLUMN, add_calibration_columns, report_table_and_aligner
 
 if TYPE_CHECKING:  # pragma: no cover
+    from ..compare.case import MeasuredEntry
     from ..file_settings import FileSettings
     from ..loop import ForceDisplacementLoop
     from ..measure import AnalysisOptions, AnalyzedRecord
     from ..specimen import Specimen
     from ..store import Store
+    from .case_sheet import CaseSheet
 
 # pidcore.measure (readers, signal analysis) is imported where used: `import pidcore.report`
 # stays light for the app, which only renders stored results.
@@ -109,7 +112,8 @@ class ReportResult:
     Attributes
     ----------
     paths : dict of str to Path
-        Files written (format -> path, ``figure:<name>`` -> path).
+        Files written (format -> path, ``figure:<name>`` -> path, ``case:<name>.pdf`` -> a
+        load case's sheet, with ``case_sheets``).
     table : pandas.DataFrame
         The report table.
     measured : list of MeasuredResult
@@ -687,6 +691,61 @@ def _joined_dem_runs(stores: list) -> pd.DataFrame | None:
     return list_dem_runs(*(s.path for s in stores))
 
 
+def report_entries(results: Sequence[MeasuredResult], analyses: pd.DataFrame,
+                   store: Store | None, specimen: Specimen | None = None,
+                   ) -> list[MeasuredEntry]:
+    """The report's measured records as the app's Compare page takes them
+    (:class:`pidcore.compare.case.MeasuredEntry`): with a ``store``, the stored analyses
+    ``analyses`` reports (their keys) read back as the page reads its store's, judged against
+    the SDC bound of ``specimen`` where they are its tests; without, the files analysed now
+    (``results``) as the page takes an unsaved upload. Each data set once, a record saved
+    without its file's hash matched to its specimen's file over the store's records
+    (:func:`pidcore.report.case_view.matched_specimens`)."""
+    from ..compare.case import MeasuredEntry, unique_entries
+    from ..compare.plausibility import stated_sdc_bounds
+    from ..specimen import MEASURED_SHA256_FIELD
+    from ..store.listing import saved_analyses
+    from .case_view import matched_specimens, saved_entries
+
+    if store is not None:
+        listing = saved_analyses(store.path)
+        if listing.empty or analyses.empty or "key" not in analyses.columns:
+            return []
+        rows = listing[listing["key"].isin(set(analyses["key"].astype(str)))]
+        known = (specimen,) if specimen is not None else ()
+        entries, _ = unique_entries(saved_entries(store.path, rows, known))
+        return matched_specimens(entries, listing)
+    entries = []
+    for r in results:
+        fields = r.fields()
+        entries.append(MeasuredEntry.from_record(
+            r.analyzed, r.load_case, specimen=str(fields.get("specimen", "")),
+            options=r.settings.options if r.settings is not None else None,
+            specimen_sha256=str(fields.get(MEASURED_SHA256_FIELD, "")),
+            sdc_bound=stated_sdc_bounds([r.stated], [r.settings], specimen)[0]))
+    return matched_specimens(unique_entries(entries)[0])
+
+
+def report_case_sheets(results: Sequence[MeasuredResult], analyses: pd.DataFrame,
+                       store: Store | None, dem_runs: pd.DataFrame | None,
+                       dem_paths: Sequence[Path], specimen: Specimen | None,
+                       calibration) -> list[CaseSheet]:
+    """The PDF sheet of every measured load case of a report
+    (:func:`pidcore.report.case_sheet.case_sheets`), as the app's Compare page prints it
+    from the same records (:func:`report_entries`), DEM runs (``dem_runs`` of the stores
+    ``dem_paths``, joined as the page joins its stores') and ``calibration`` (the report's
+    :func:`pidcore.calibrate.prediction.load_calibration`; None: none given, said on each
+    sheet), the calibration named as the report's provenance names it."""
+    from ..model import load_paper_table3
+    from .case_sheet import case_sheets
+    from .provenance import calibration_source
+
+    calibrations = ([(calibration, calibration_source(calibration))]
+                    if calibration is not None else [])
+    return case_sheets(report_entries(results, analyses, store, specimen), dem_runs,
+                       load_paper_table3(), list(dem_paths), calibrations)
+
+
 def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
                 store: str | Path | None = None,
                 dem_store: str | Path | Sequence[str | Path] | None = None,
@@ -701,7 +760,7 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
                 calibration_key: str | None = None,
                 accept_implausible: bool = False, progress: bool = False,
                 wording: Callable[[str], str] | None = None,
-                key: str | None = None) -> ReportResult:
+                key: str | None = None, case_sheets: bool = False) -> ReportResult:
     """Analyse files, store them, align with DEM and the paper, and write the report.
 
     Parameters
@@ -754,6 +813,11 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
     key : str, optional
         Which measurement of a pidcore HDF5 store among ``files`` to read, where it holds
         several (its refusal lists them; :func:`analyze_files`).
+    case_sheets : bool
+        Also write the PDF sheet of every measured load case into ``out_dir/cases``, as the
+        app's Compare page prints it (:func:`report_case_sheets`), judged by ``calibration``
+        as the rows are; listed in the provenance. Not with ``pool`` (the page never pools
+        specimens, so its sheets would not be the rows).
     wording : callable, optional
         The notes (the table's, its rows' and the report's) in a front-end's words: it names
         the parameters the library names by keyword (``structure_mass_kg``) as its own
@@ -767,6 +831,10 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
     from ..measure import AnalysisOptions, refuse_store_among_inputs, save_analyses
 
     formats = parse_formats(formats)
+    if case_sheets and pool:
+        raise ParameterError("case_sheets=True: not with pool=True (a sheet is one load case of "
+                             "one specimen, as the app's Compare page prints it; a pooled row "
+                             "has no such sheet)")
     calibrated = None
     if calibration is not None:  # checked before anything is analysed or written
         from ..calibrate.prediction import load_calibration
@@ -896,7 +964,7 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         if whole:
             notes.append(whole)
 
-    dem_runs = _joined_dem_runs(dems)
+    dem_runs = joined_runs = _joined_dem_runs(dems)
     if not results:  # the stored records' own settings, not the unused options' defaults
         parameters = stored_parameters(analyses)
     from ..calibrate.persist import calibration_design_runs
@@ -926,6 +994,8 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
                 isinstance(s, float) and math.isnan(s))]
         stores = [p for p in dict.fromkeys((*([Path(store)] if store else []), *dem_paths))
                   if p.exists()]
+        sheets = report_case_sheets(results, analyses, main, joined_runs, dem_paths, specimen,
+                                    calibrated) if case_sheets else []
         provenance = collect_provenance(
             parameters={**parameters,
                         "frequency_rtol": tolerances.frequency_rtol,
@@ -934,8 +1004,10 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
             seeds=seeds, inputs=[r.path for r in results],
             input_hashes={str(r.path): getattr(r.measurement, "sha256", "") for r in results},
             stores=stores, notes=notes, specimens=specimen_provenance(specimen),
-            calibrations=calibration_provenance(calibrated))
-        paths = write_report(table, figures, provenance, out_dir, formats, progress=progress)
+            calibrations=calibration_provenance(calibrated),
+            case_sheets=[(f"{CASE_SHEETS_FOLDER}/{s.name}", s.title, s.pdf) for s in sheets])
+        paths = write_report(table, figures, provenance, out_dir, formats, progress=progress,
+                             case_sheets={s.name: s.pdf for s in sheets})
     finally:
         for fig in figures.values():  # bare Figures: drop references to free Agg buffers
             fig.clear()

@@ -92,6 +92,9 @@ class Provenance:
         calibration.json, or a store and its key), the SHA-256 of its ``calibration.json``
         text, and its calibrated specimen's name and hash with the file it was calibrated
         from (:func:`calibration_provenance`).
+    case_sheets : tuple of (str, str, str)
+        The load-case PDF sheets written with the report (``pidcore report --case-sheets``):
+        the file's path in the report folder, its title (the load case) and its SHA-256.
     """
 
     versions: Mapping[str, str]
@@ -103,6 +106,7 @@ class Provenance:
     notes: tuple[str, ...] = ()
     specimens: tuple[tuple[str, str], ...] = ()
     calibrations: tuple[tuple[str, str, str], ...] = ()
+    case_sheets: tuple[tuple[str, str, str], ...] = ()
 
     def lines(self) -> list[str]:
         """The provenance as plain text lines (the footer of every format)."""
@@ -120,6 +124,8 @@ class Provenance:
             out.append(f"store: {name} sha256 {digest}")
         for name, digest in self.inputs:
             out.append(f"input: {name} sha256 {digest}")
+        for name, title, digest in self.case_sheets:
+            out.append(f"case sheet: {name} ({title}) sha256 {digest}")
         out.extend(f"note: {n}" for n in self.notes)
         return out
 
@@ -129,7 +135,8 @@ class Provenance:
                 "seeds": list(self.seeds), "inputs": [list(i) for i in self.inputs],
                 "stores": [list(s) for s in self.stores], "created_utc": self.created_utc,
                 "notes": list(self.notes), "specimens": [list(s) for s in self.specimens],
-                "calibrations": [list(c) for c in self.calibrations]}
+                "calibrations": [list(c) for c in self.calibrations],
+                "case_sheets": [list(c) for c in self.case_sheets]}
 
 
 def collect_provenance(*, parameters: Mapping[str, object] | None = None,
@@ -138,7 +145,8 @@ def collect_provenance(*, parameters: Mapping[str, object] | None = None,
                        stores: Iterable[str | Path] = (), notes: Iterable[str] = (),
                        created_utc: datetime | None = None,
                        specimens: Iterable[tuple[str, str]] = (),
-                       calibrations: Iterable[tuple[str, str, str]] = ()) -> Provenance:
+                       calibrations: Iterable[tuple[str, str, str]] = (),
+                       case_sheets: Iterable[tuple[str, str, bytes]] = ()) -> Provenance:
     """Collect versions, hashes and a time stamp into a :class:`Provenance`.
 
     Parameters
@@ -160,6 +168,9 @@ def collect_provenance(*, parameters: Mapping[str, object] | None = None,
         (label, SHA-256) of each specimen compared.
     calibrations : iterable of (str, str, str)
         The calibration of the calibrated columns (:func:`calibration_provenance`).
+    case_sheets : iterable of (str, str, bytes)
+        (path in the report folder, title, PDF bytes) of each load-case sheet written with
+        the report; its bytes are hashed here.
     """
     from .. import __version__
 
@@ -181,7 +192,10 @@ def collect_provenance(*, parameters: Mapping[str, object] | None = None,
                       notes=tuple(map(display_path, notes)),
                       specimens=tuple((display_path(n), h) for n, h in specimens),
                       calibrations=tuple((display_path(n), h, display_path(c))
-                                         for n, h, c in calibrations))
+                                         for n, h, c in calibrations),
+                      case_sheets=tuple((display_path(n), display_path(t),
+                                         hashlib.sha256(pdf).hexdigest())
+                                        for n, t, pdf in case_sheets))
 
 
 def calibration_provenance(calibration) -> list[tuple[str, str, str]]:
@@ -197,9 +211,7 @@ def calibration_provenance(calibration) -> list[tuple[str, str, str]]:
         digest = hashlib.sha256(calibration.document_text.encode("utf-8")).hexdigest()
     else:
         digest = sha256_file(calibration.path)
-    where = f"{calibration.path}" if not calibration.store_key else \
-        f"{str(calibration.path).removesuffix(':' + calibration.store_key)} key " \
-        f"{calibration.store_key}"
+    where = calibration_source(calibration)
     specimen = calibration.calibrated_specimen()
     if specimen is None:
         said = "calibrated specimen unknown (no calibrated_specimen.toml beside it)"
@@ -210,3 +222,12 @@ def calibration_provenance(calibration) -> list[tuple[str, str, str]]:
             said += (f", calibrated from {source.calibrated_from_name} sha256 "
                      f"{source.calibrated_from_sha256}")
     return [(where, digest, said)]
+
+
+def calibration_source(calibration) -> str:
+    """Where a calibration (:class:`pidcore.calibrate.prediction.Calibration`) was read from,
+    as a report names it: its calibration.json, or its store and key."""
+    if not calibration.store_key:
+        return f"{calibration.path}"
+    return (f"{str(calibration.path).removesuffix(':' + calibration.store_key)} key "
+            f"{calibration.store_key}")

@@ -52,6 +52,8 @@ from .table import (
 REPORT_MARKER = ".pidcore-report"
 #: Base name of the table files (``report.csv``, ``report.md``...).
 REPORT_STEM = "report"
+#: Folder of a report's load-case PDF sheets (``pidcore report --case-sheets``).
+CASE_SHEETS_FOLDER = "cases"
 #: Columns shown in the PDF table (the full table is in every other format).
 #: The like-for-like measured SDC (Eq. 10's E) and its difference stand beside our DEM: with
 #: the Eq. 11 SDC alone the PDF set 1.14 against our 0.61 where the like-for-like 0.62 agrees;
@@ -344,19 +346,22 @@ def check_out_dir(out_dir: Path) -> None:
 
 def _not_written_by_a_report(out_dir: Path) -> str:
     """The first entry of an earlier report folder that a report does not write ("" if
-    none): its files, the CSV's notes, the marker, and PNG/SVG files in ``figures``."""
-    ours = {REPORT_MARKER, "figures", f"{REPORT_STEM}{CSV_NOTES_SUFFIX}",
+    none): its files, the CSV's notes, the marker, PNG/SVG files in ``figures`` and PDF
+    sheets in :data:`CASE_SHEETS_FOLDER`."""
+    folders = {"figures": (".png", ".svg"), CASE_SHEETS_FOLDER: (".pdf",)}
+    ours = {REPORT_MARKER, *folders, f"{REPORT_STEM}{CSV_NOTES_SUFFIX}",
             *(f"{REPORT_STEM}.{ext}" for ext in REPORT_FORMATS)}
     for entry in sorted(out_dir.iterdir()):
-        if entry.name not in ours or (entry.name == "figures") != entry.is_dir() \
+        if entry.name not in ours or (entry.name in folders) != entry.is_dir() \
                 or entry.is_symlink():
             return display_path(entry.name)
-    figures = out_dir / "figures"
-    if figures.is_dir():
-        for entry in sorted(figures.iterdir()):
-            if entry.suffix not in (".png", ".svg") or not entry.is_file() \
-                    or entry.is_symlink():
-                return display_path(f"figures/{entry.name}")
+    for name, suffixes in folders.items():
+        folder = out_dir / name
+        if folder.is_dir():
+            for entry in sorted(folder.iterdir()):
+                if entry.suffix not in suffixes or not entry.is_file() \
+                        or entry.is_symlink():
+                    return display_path(f"{name}/{entry.name}")
     return ""
 
 
@@ -383,7 +388,8 @@ def restored_report_note(out_dir: str | Path) -> str:
 
 def write_report(table: pd.DataFrame, figures: Mapping[str, object], provenance: Provenance,
                  out_dir: str | Path, formats: str | Iterable[str] = REPORT_FORMATS,
-                 *, progress: bool = False) -> dict[str, Path]:
+                 *, progress: bool = False,
+                 case_sheets: Mapping[str, bytes] | None = None) -> dict[str, Path]:
     """Write the report into ``out_dir``, atomically.
 
     Parameters
@@ -402,12 +408,16 @@ def write_report(table: pd.DataFrame, figures: Mapping[str, object], provenance:
     progress : bool
         A bar over the figures and formats written, on stderr (the figures and the PDF are
         most of a report's time).
+    case_sheets : mapping of str to bytes, optional
+        Load-case PDF sheets by file name (:func:`pidcore.report.case_sheet.case_sheets`),
+        written into :data:`CASE_SHEETS_FOLDER` with the rest, atomically.
 
     Returns
     -------
     dict of str to Path
         Format name -> file, ``"csv_provenance"`` -> the CSV's provenance and notes sidecar
-        (with csv), and ``"figure:<stem>.png"`` / ``".svg"`` -> figure file.
+        (with csv), ``"figure:<stem>.png"`` / ``".svg"`` -> figure file and
+        ``"case:<name>.pdf"`` -> load-case sheet.
 
     Raises
     ------
@@ -415,6 +425,10 @@ def write_report(table: pd.DataFrame, figures: Mapping[str, object], provenance:
         Unknown format, or ``out_dir`` is an unrelated non-empty folder.
     """
     formats = parse_formats(formats)
+    case_sheets = dict(case_sheets or {})
+    for name in case_sheets:  # a name is the caller's: never a path out of the folder
+        if Path(name).name != name or not name.endswith(".pdf") or name.startswith("."):
+            raise ParameterError(f"case sheet {name!r}: expected a file name ending in .pdf")
     out_dir = Path(out_dir)
     restore_previous_report(out_dir)  # before the check: a hidden report is the earlier one
     check_out_dir(out_dir)
@@ -425,7 +439,8 @@ def write_report(table: pd.DataFrame, figures: Mapping[str, object], provenance:
     if progress:
         from tqdm import tqdm
 
-        bar = tqdm(total=len(figures) + len(formats), unit="file", desc="writing report",
+        bar = tqdm(total=len(figures) + len(formats) + len(case_sheets), unit="file",
+                   desc="writing report",
                    leave=False, dynamic_ncols=True)
     try:
         pngs: dict[str, Path] = {}
@@ -434,6 +449,13 @@ def write_report(table: pd.DataFrame, figures: Mapping[str, object], provenance:
             pngs[stem] = png
             written[f"figure:{png.name}"] = png
             written[f"figure:{svg.name}"] = svg
+            if bar is not None:
+                bar.update(1)
+        for name, pdf in case_sheets.items():
+            path = tmp / CASE_SHEETS_FOLDER / name
+            path.parent.mkdir(exist_ok=True)
+            path.write_bytes(pdf)
+            written[f"case:{name}"] = path
             if bar is not None:
                 bar.update(1)
         for name in formats:

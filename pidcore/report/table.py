@@ -35,6 +35,7 @@ from ..compare.align import (
     CALIBRATED_LOW_COLUMN,
     MEASURED_BASELINE_COLUMN,
     MEASURED_COLUMNS_RENAMED,
+    MEASURED_EQ10_COLUMN,
     MEASURED_EQ11_COLUMN,
     MEASURED_EQ11_DOF_COLUMN,
     MEASURED_EQ11_STDERR_COLUMN,
@@ -70,10 +71,6 @@ from ..specimen import (
 )
 from ..units import g_to_si
 
-#: Measured energy per cycle over the DEM case's E = m_c a^2 / (2 w^2) (Eq. 10): the like-for-like
-#: counterpart of our DEM SDC. The Eq. 11 SDC divides by Im(P_c)/w instead, the reactive energy,
-#: which is smaller than Eq. 10's E whenever particles fly free of the cell walls.
-MEASURED_EQ10_COLUMN = "SDC measured, E of Eq. 10 [-]"
 #: Measured (Eq. 10 energy, as :data:`MEASURED_EQ10_COLUMN`) minus our DEM SDC: the same SDC on
 #: both sides. NaN where the DEM case's m_c is unknown (no like-for-like value).
 DIFFERENCE_COLUMN = "difference measured (E of Eq. 10) - ours [-]"

@@ -19,7 +19,13 @@ from pidcore.app.vocabulary import page_terms
 from pidcore.calibrate.prediction import band_text, sdc_text
 from pidcore.compare.case import equivalent_dampers
 from pidcore.constants import BAND_VERDICTS
-from pidcore.report.case_sheet import CalibratedCase, calibrated_case
+from pidcore.report.case_sheet import (
+    CalibratedCase,
+    case_pdf,
+    case_sheet_stem,
+    members_calibrated_case,
+)
+from pidcore.report.case_view import case_title, group_entries, matched_specimens
 
 
 def _entries(stores, session_files):
@@ -72,7 +78,7 @@ def _entries(stores, session_files):
     for note in notes:
         st.caption(note)
     # a record saved without its file's hash is grouped as calibrate and report group it
-    return workbench.matched_specimens(entries, listing)
+    return matched_specimens(entries, listing)
 
 
 def _specimen_option(name: str) -> str:
@@ -137,7 +143,7 @@ def render(stores, session_files: list, calibrations: list) -> None:
                 "(or the filters exclude them), and nothing is analysed in this session. "
                 "Upload and save measurements on the Analyse tab.")
         return
-    groups = workbench.group_entries(entries)
+    groups = group_entries(entries)
     # The choice is the group's load case, not its position: saving re-sorts the groups, and a
     # position would then show another load case's numbers under the chosen one's label. The
     # page address keeps it by the store's load-case key and the specimen
@@ -147,8 +153,7 @@ def render(stores, session_files: list, calibrations: list) -> None:
     if len(by_name) < len(groups):  # two groups whose keys agree: apart by position
         by_name = {f"{workbench.case_address(entries, g)} #{n}" if n else
                    workbench.case_address(entries, g): g for n, g in enumerate(groups)}
-    labels = {name: f"{workbench.group_name(entries, g)} ({len(g)} file(s))"
-              for name, g in by_name.items()}
+    labels = {name: case_title(entries, g) for name, g in by_name.items()}
     names = list(by_name)
 
     def resolve(address: str) -> str | None:
@@ -206,10 +211,8 @@ def render(stores, session_files: list, calibrations: list) -> None:
             column.metric(label, value)
         if paper_caption:
             st.caption(paper_caption)
-    calibrated = calibrated_case(
-        calibrations, comp, members[0].specimen,
-        implausible=any(e.implausible for e in members),
-        specimen_sha256=members[0].specimen_sha256)
+    # the rule `pidcore report --case-sheets` judges its sheets by
+    calibrated = members_calibrated_case(calibrations, comp, members)
     _calibrated(calibrated, comp, head)
     for note in view["notes"]:
         st.caption(f"note: {note}")
@@ -235,8 +238,6 @@ def render(stores, session_files: list, calibrations: list) -> None:
     st.dataframe(comp.measured, hide_index=True, width="stretch", key="compare_measured",
                  placeholder="")
     if st.button("PDF of this load case (plots and corrections)", key="case_pdf"):
-        from pidcore.report.case_sheet import case_pdf
-
         # keyed by the calibration's verdict too: another calibration chosen since made the
         # sheet of the same files another one
         st.session_state["case_pdf_bytes"] = ((_group_key(members), calibrated), case_pdf(
@@ -244,7 +245,7 @@ def render(stores, session_files: list, calibrations: list) -> None:
     made = st.session_state.get("case_pdf_bytes")
     if made and made[0] == (_group_key(members), calibrated):
         st.download_button("Download the load case PDF", made[1], mime="application/pdf",
-                           file_name=f"pidcore_{comp.load_case.key}.pdf",
+                           file_name=f"pidcore_{case_sheet_stem(comp, members)}.pdf",
                            key="case_pdf_download")
     # Warm the cache for the other load cases after this one is on screen, so that switching
     # to any of them is a cache hit.
