@@ -455,3 +455,26 @@ def test_own_specimen_section_sets_the_dem_beside_the_like_for_like_measured_col
             "(Eq. 11)`") in paragraph
     for name in ("SDC DEM (ours)", "SDC measured, E of Eq. 10", "SDC measured (Eq. 11)"):
         assert f"{name} [-]" in PDF_COLUMNS, name
+
+
+def test_readme_specimen_section_counts_the_commands_it_lists():
+    # "given as `--specimen FILE` to the six commands below" sat over a table of seven (model
+    # damper and figures joined it); the number written must be the table's row count
+    words = {"five": 5, "six": 6, "seven": 7, "eight": 8, "nine": 9, "ten": 10}
+    text = " ".join(_specimen_section().split())
+    said = re.search(r"given as `--specimen FILE` to the (\w+) commands below", text)
+    assert said is not None
+    rows = _table(_specimen_section(), "| command | what `--specimen FILE` does there |")
+    assert words.get(said.group(1)) == len(rows)
+
+
+def test_readme_sweep_json_names_every_stored_result_of_a_case():
+    # `dem sweep --json` gives each case SWEEP_CASE_FIELDS from its stored run; the README's
+    # list of "the stored results" left out `sdc_stderr_dof`, which a script needs to judge
+    # the run's standard error (Student's t of cells - 1)
+    from pidcore.dem.sweep import SWEEP_CASE_FIELDS
+
+    text = " ".join(README.read_text(encoding="utf-8").split())
+    listed = re.search(r"and the stored results \((.*?), as the text output's summary line", text)
+    assert listed is not None
+    assert set(re.findall(r"`(\w+)`", listed.group(1))) == set(SWEEP_CASE_FIELDS)
