@@ -8,6 +8,7 @@ from __future__ import annotations
 import argparse
 import re
 import shlex
+import subprocess
 from pathlib import Path
 
 import pytest
@@ -22,8 +23,26 @@ from pidcore.specimen import PAIR_NAMES, SCHEMA
 
 ROOT = Path(__file__).resolve().parents[1]
 README = ROOT / "README.md"
-DOCS = sorted((ROOT / "docs").rglob("*.md"))
-SAMPLE_NOTES = sorted((ROOT / "data_samples").rglob("README.md"))
+
+
+def _shipped(paths: list[Path]) -> list[Path]:
+    """``paths`` less those git ignores: a study script's output (docs/physics_audit's
+    report.md, written by run_all.sh into an ignored folder) is no page of the project, and a
+    link it holds to files of its run was checked as one."""
+    if not paths or not (ROOT / ".git").exists():
+        return paths
+    try:
+        listed = subprocess.run(["git", "check-ignore", "--stdin"], cwd=ROOT, text=True,
+                                capture_output=True, timeout=60,
+                                input="\n".join(str(p.relative_to(ROOT)) for p in paths))
+    except (OSError, subprocess.SubprocessError):
+        return paths  # no git: a clean checkout holds no ignored output anyway
+    ignored = {ROOT / line for line in listed.stdout.splitlines() if line}
+    return [p for p in paths if p not in ignored]
+
+
+DOCS = _shipped(sorted((ROOT / "docs").rglob("*.md")))
+SAMPLE_NOTES = _shipped(sorted((ROOT / "data_samples").rglob("README.md")))
 PAGES = [README, *DOCS, *SAMPLE_NOTES]
 
 
