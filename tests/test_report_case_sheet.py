@@ -44,10 +44,16 @@ def _pdf_text(data: bytes) -> str:
     """The text of a matplotlib PDF, its lines joined by spaces (a wrapped line is split at a
     space): the strings of every text object's TJ/Tj operators, in the order drawn."""
     lines = []
-    for stream in re.finditer(rb"stream\r?\n(.*?)\r?\nendstream", data, re.S):
+    # the end-of-line before "endstream" is left to zlib, which stops at the end of its
+    # data: a compressed page ending in a \r byte lost that byte to the pattern's \r?, and
+    # with it the whole page (a sheet's first page read as empty)
+    for stream in re.finditer(rb"stream\r?\n(.*?)endstream", data, re.S):
+        unpack = zlib.decompressobj()
         try:
-            content = zlib.decompress(stream.group(1))
+            content = unpack.decompress(stream.group(1))
         except zlib.error:  # an image or a font program, not a page's content
+            continue
+        if not unpack.eof:  # cut short: not one whole stream
             continue
         for block in re.findall(rb"BT(.*?)ET", content, re.S):
             # literal strings, with PDF's escapes: \( \) \\ and \ddd octal
