@@ -32,6 +32,7 @@ from pidcore.compare.align import (
 )
 from pidcore.model import load_paper_table3
 from pidcore.report.case_sheet import calibrated_case, case_pdf, sheet_lines
+from pidcore.store import Store
 from pidcore.units import display_value_with_error
 
 TITLE = "100 Hz, 5 g, 50 %, acrylic, z (1 file(s))"
@@ -379,3 +380,109 @@ def test_the_case_sheets_file_table_names_its_sdcs_as_the_report_does(tmp_path, 
     text = _pdf_text(case_pdf(view, title=TITLE))
     assert all(_words(n) in text for n in names)
     assert "SDC stderr [-]" not in text
+
+
+# --- every option that changes the report's rows: each sheet is one row's -------------------
+
+#: The bundled run of 100 Hz, 5 g, 50 % (the paper's coupon), copied as another specimen's.
+GRID_RUN = "f100Hz_a5g_fill50pct_acrylic_z_seed12345_cells8_3e35b5c9af"
+#: The SDC given to that copy: far from the bundled run's 0.894 (and both far above the 0.3
+#: of the tests), so that a sheet showing the wrong specimen's run shows the wrong number.
+OWN_RUN_SDC = 0.5
+
+
+def _own_specimen(tmp_path):
+    """A specimen file other than the paper's coupon (a heavier fixture), named own_coupon,
+    and a store of one DEM run of it at 100 Hz, 5 g, 50 % (the bundled run's numbers but its
+    SDC, :data:`OWN_RUN_SDC`, and its specimen)."""
+    from pidcore.specimen import Specimen, paper_specimen
+    from pidcore.store import Store
+
+    text = paper_specimen().with_values({"coupon.fixture_mass_kg": 0.05}).to_toml()
+    own = Specimen.from_text(text.replace('name = "paper_coupon"', 'name = "own_coupon"'))
+    assert own.name == "own_coupon" and not own.is_paper()
+    path = tmp_path / "own.toml"
+    path.write_text(own.to_toml(), encoding="utf-8")
+    run = Store(DEM_STORE).get_dem_run(GRID_RUN)
+    record = {**run.record, "sdc": OWN_RUN_SDC, "specimen_name": own.name,
+              "specimen_sha256": own.hash, "specimen_is_paper": 0}
+    parameters = {**run.parameters, "specimen_text": own.text, "specimen_sha256": own.hash,
+                  "specimen_name": own.name}
+    store = tmp_path / "own_runs.h5"
+    Store(store).add_dem_run(GRID_RUN.replace("3e35b5c9af", "0000000own"), record,
+                             arrays=run.arrays, parameters=parameters)
+    return path, store
+
+
+def _tests(tmp_path, cases) -> list[Path]:
+    """Mass-damper exports of ``cases`` [(file, frequency, acceleration, loss factor)]; the
+    names hold no 'fi' (the sheet's font draws it as one glyph: a name with it is not found
+    in the PDF's text)."""
+    from _app_samples import mass_damper_csv
+
+    paths = []
+    for seed, (name, f, a, eta) in enumerate(cases, start=1):
+        path = tmp_path / name
+        path.write_bytes(mass_damper_csv(frequency_hz=f, acceleration_g=a, loss_factor=eta,
+                                         seed=seed))
+        paths.append(path)
+    return paths
+
+
+def _rows_and_sheets(out) -> list[tuple[dict, str]]:
+    """(measured row of report.csv, text of its sheet) for every measured row; each sheet
+    found by the files the row pools (its title counts them, page 2 names them) and every
+    sheet one row's."""
+    table = pd.read_csv(out / "report.csv", keep_default_na=False, na_values=[""])
+    rows = table[table[MEASURED_EQ11_COLUMN].notna()].to_dict("records")
+    texts = {p.name: _pdf_text(p.read_bytes()) for p in (out / "cases").iterdir()}
+    assert len(texts) == len(rows), (sorted(texts), [r["source file(s)"] for r in rows])
+    found = []
+    for row in rows:
+        files = [Path(s).name for s in str(row["source file(s)"]).split("; ")]
+        (name,) = [n for n, text in texts.items()
+                   if f"({len(files)} file(s))" in text and all(f in text for f in files)]
+        found.append((row, texts.pop(name)))
+    return found
+
+
+def _dem_agrees(row: dict, text: str) -> None:
+    """The sheet's DEM SDC is the row's (as displayed), or, where the row has none, none."""
+    dem = row["SDC DEM (ours) [-]"]
+    if pd.isna(dem):
+        assert "vs our DEM" not in text and "no DEM value at this case" in text, text[:600]
+    else:
+        shown = display_value_with_error(dem, row["SDC DEM stderr [-]"])
+        assert _words(f"vs our DEM {shown}") in text, text[:600]
+
+
+@pytest.mark.usefixtures("undrawn_report_figures")
+@pytest.mark.parametrize("of_own", [True, False])
+def test_a_case_sheet_meets_only_the_dem_runs_the_report_compares(tmp_path, monkeypatch,
+                                                                   of_own):
+    # a report compares the runs of its specimen (--specimen, default the paper's coupon);
+    # the sheets met every stored run: a test naming another specimen showed that
+    # specimen's DEM SDC on its sheet beside a row saying the report has no run of it
+    monkeypatch.chdir(tmp_path)
+    own, runs = _own_specimen(tmp_path)
+    files = _tests(tmp_path, [("pa_50pct.csv", 100.0, 5.0, 0.05),
+                              ("ow_50pct.csv", 100.0, 5.0, 0.06)])
+    sidecar = tmp_path / "specimens.csv"
+    sidecar.write_text("file,specimen\npa_50pct.csv,paper_coupon\now_50pct.csv,own_coupon\n",
+                       encoding="utf-8")
+    out = tmp_path / "report"
+    assert main(["report", *map(str, files), "--sidecar", str(sidecar), "--dem-store",
+                 str(runs), "--dem-store", str(DEM_STORE), "--format", "csv", "--case-sheets",
+                 *(["--specimen", str(own)] if of_own else []), "--out", str(out)]) == 0
+    found = _rows_and_sheets(out)
+    assert len(found) == 2  # a row (and a sheet) per specimen
+    bundled = Store(DEM_STORE).get_dem_run(GRID_RUN).record["sdc"]
+    for row, text in found:
+        _dem_agrees(row, text)
+        # the report's specimen's test meets its run; the other's none
+        if (row["specimen"] == "own_coupon") == of_own:
+            # the CSV keeps every digit of the stored SDC: rel 1e-12
+            assert row["SDC DEM (ours) [-]"] == pytest.approx(
+                OWN_RUN_SDC if of_own else bundled, rel=1e-12)
+        else:
+            assert pd.isna(row["SDC DEM (ours) [-]"])

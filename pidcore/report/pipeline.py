@@ -732,17 +732,23 @@ def report_case_sheets(results: Sequence[MeasuredResult], analyses: pd.DataFrame
                        calibration) -> list[CaseSheet]:
     """The PDF sheet of every measured load case of a report
     (:func:`pidcore.report.case_sheet.case_sheets`), as the app's Compare page prints it
-    from the same records (:func:`report_entries`), DEM runs (``dem_runs`` of the stores
-    ``dem_paths``, joined as the page joins its stores') and ``calibration`` (the report's
-    :func:`pidcore.calibrate.prediction.load_calibration`; None: none given, said on each
-    sheet), the calibration named as the report's provenance names it."""
+    from the same records (:func:`report_entries`), DEM runs and ``calibration`` (the
+    report's :func:`pidcore.calibrate.prediction.load_calibration`; None: none given, said on
+    each sheet), the calibration named as the report's provenance names it.
+
+    ``dem_runs``: every run of the stores ``dem_paths``, joined as the page joins its stores';
+    the sheets meet only those the report's rows meet, of ``specimen``
+    (:func:`specimen_dem_runs`; default the paper's coupon). The page meets each test's own
+    specimen's runs: a test naming another specimen got its runs' SDC on its sheet beside a
+    row saying the report has no DEM run of it."""
     from ..model import load_paper_table3
     from .case_sheet import case_sheets
     from .provenance import calibration_source
 
     calibrations = ([(calibration, calibration_source(calibration))]
                     if calibration is not None else [])
-    return case_sheets(report_entries(results, analyses, store, specimen), dem_runs,
+    compared, _ = specimen_dem_runs(dem_runs, specimen)
+    return case_sheets(report_entries(results, analyses, store, specimen), compared,
                        load_paper_table3(), list(dem_paths), calibrations)
 
 
