@@ -486,3 +486,40 @@ def test_a_case_sheet_meets_only_the_dem_runs_the_report_compares(tmp_path, monk
                 OWN_RUN_SDC if of_own else bundled, rel=1e-12)
         else:
             assert pd.isna(row["SDC DEM (ours) [-]"])
+
+
+#: The bundled calibration of the paper's coupon (it predicts 100 Hz, 5 g, 50 %).
+PAPER_CALIBRATION = DEM_STORE.parent / "paper_calibration" / "calibration.json"
+
+
+@pytest.mark.usefixtures("undrawn_report_figures")
+def test_a_test_of_another_specimen_gets_no_verdict_of_the_paper_coupons_calibration(
+        tmp_path, monkeypatch):
+    # a report of the paper's coupon judged a test naming own_coupon (no DEM run in its row)
+    # against the paper coupon's calibrated band; its sheet said no calibration is of it
+    monkeypatch.chdir(tmp_path)
+    files = _tests(tmp_path, [("pa_50pct.csv", 100.0, 5.0, 0.05),
+                              ("ow_50pct.csv", 100.0, 5.0, 0.06)])
+    sidecar = tmp_path / "specimens.csv"
+    sidecar.write_text("file,specimen\npa_50pct.csv,paper_coupon\now_50pct.csv,own_coupon\n",
+                       encoding="utf-8")
+    out = tmp_path / "report"
+    assert main(["report", *map(str, files), "--sidecar", str(sidecar), "--dem-store",
+                 str(DEM_STORE), "--calibration", str(PAPER_CALIBRATION), "--format", "csv",
+                 "--case-sheets", "--out", str(out)]) == 0
+    verdicts = {}
+    for row, text in _rows_and_sheets(out):
+        verdict = row[CALIBRATED_INSIDE_COLUMN]
+        verdicts[row["specimen"]] = verdict
+        if verdict == "not compared":
+            assert pd.isna(row[CALIBRATED_COLUMN])
+            assert "it calibrates specimen paper_coupon, not own_coupon" in row["note"]
+            assert "calibrated DEM: no calibrated verdict (No calibration is of specimen " \
+                   "own_coupon" in text and "95 % band" not in text
+        else:
+            band = band_text(row[CALIBRATED_LOW_COLUMN], row[CALIBRATED_HIGH_COLUMN])
+            assert _words(f"SDC (Eq. 11) {sdc_text(row[CALIBRATED_COLUMN])}, 95 % band {band}"
+                          ) in text
+            assert f"{CALIBRATED_INSIDE_COLUMN}: {verdict}" in text
+    # the paper coupon's test is judged (0.314 inside its band of ~0.06 .. 0.47), the other not
+    assert verdicts == {"paper_coupon": "yes", "own_coupon": "not compared"}

@@ -737,6 +737,23 @@ def _finite_or_nan(value) -> float:
     return number if math.isfinite(number) else math.nan
 
 
+def calibration_row_refusal(calibration, specimen: str, sha256: object = "") -> str:
+    """Why ``calibration`` predicts nothing for a row of tests of ``specimen`` (its name as
+    the row's ``specimen`` column gives it; "": not named) whose file's hash is ``sha256``
+    (:data:`SPECIMEN_SHA256_COLUMN`; "": unknown); "" where it may
+    (:meth:`~pidcore.calibrate.prediction.Calibration.speaks_for`, the Compare page's rule).
+
+    A report of the paper's coupon (the default) judged a test naming another specimen, with
+    no DEM run in its row, against the paper coupon's calibrated band; its sheet, as the
+    Compare page, said that no calibration is of that specimen."""
+    # the row's tests recorded their specimen file: a calibration of another file of that
+    # name (an edited x.toml) does not predict them
+    other = calibration.other_file_reason(sha256, specimen)
+    if other or calibration.speaks_for(specimen, sha256):
+        return other
+    return f"it calibrates specimen {calibration.specimen_name}, not {specimen}"
+
+
 def add_calibration_columns(table: pd.DataFrame, calibration, *,
                             tolerances=None, specimen=None, paper: bool = False) -> pd.DataFrame:
     """A copy of a report table with the calibrated DEM's prediction beside each row.
@@ -786,10 +803,8 @@ def add_calibration_columns(table: pd.DataFrame, calibration, *,
             reasons[case.material] = calibration.other_specimen_reason(of_row)
         other = reasons[case.material]
         if not other:
-            # the row's tests recorded their specimen file: a calibration of another file of
-            # that name (an edited x.toml) does not predict them
-            other = calibration.other_file_reason(row.get(SPECIMEN_SHA256_COLUMN, ""),
-                                                  str(row.get("specimen", "") or ""))
+            other = calibration_row_refusal(calibration, str(row.get("specimen", "") or ""),
+                                            row.get(SPECIMEN_SHA256_COLUMN, ""))
         hit = None if other else calibration.lookup(case, tolerances=tolerances)
         if hit is None:
             sdc.append(math.nan)
