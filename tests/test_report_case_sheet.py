@@ -440,8 +440,10 @@ def _rows_and_sheets(out) -> list[tuple[dict, str]]:
     found = []
     for row in rows:
         files = [Path(s).name for s in str(row["source file(s)"]).split("; ")]
-        (name,) = [n for n, text in texts.items()
-                   if f"({len(files)} file(s))" in text and all(f in text for f in files)]
+        names = [n for n, text in texts.items()
+                 if f"({len(files)} file(s))" in text and all(f in text for f in files)]
+        assert len(names) == 1, (files, sorted(texts))  # the row's one sheet
+        name = names[0]
         found.append((row, texts.pop(name)))
     return found
 
@@ -523,3 +525,35 @@ def test_a_test_of_another_specimen_gets_no_verdict_of_the_paper_coupons_calibra
             assert f"{CALIBRATED_INSIDE_COLUMN}: {verdict}" in text
     # the paper coupon's test is judged (0.314 inside its band of ~0.06 .. 0.47), the other not
     assert verdicts == {"paper_coupon": "yes", "own_coupon": "not compared"}
+
+
+def _measured_agrees(row: dict, text: str) -> None:
+    """The sheet's pooled Eq. 11 SDC is the row's (as displayed)."""
+    shown = display_value_with_error(row[MEASURED_EQ11_COLUMN], row[MEASURED_EQ11_STDERR_COLUMN])
+    assert _words(f"measured SDC (Eq. 11) {shown}") in text, text[:600]
+
+
+@pytest.mark.usefixtures("undrawn_report_figures")
+def test_each_case_sheet_pools_the_records_its_report_row_pools(tmp_path, monkeypatch):
+    # the sheets grouped records as the Compare page does (within the tolerances of each
+    # other), the report by the DEM case they meet, or off the grid by load case key: tests at
+    # 4.8 g and 5.2 g (each within 5 % of the 5 g run, not of each other) were one row and two
+    # sheets, two tests at 2000 Hz (no run there) two rows and one sheet
+    monkeypatch.chdir(tmp_path)
+    files = _tests(tmp_path, [("low_50pct.csv", 100.0, 4.8, 0.05),
+                              ("high_50pct.csv", 100.0, 5.2, 0.06),
+                              ("one_50pct.csv", 2000.0, 5.0, 0.05),
+                              ("two_50pct.csv", 2000.0, 5.0, 0.06)])
+    out = tmp_path / "report"
+    assert main(["report", *map(str, files), "--dem-store", str(DEM_STORE), "--format", "csv",
+                 "--case-sheets", "--out", str(out)]) == 0
+    found = _rows_and_sheets(out)  # one sheet per measured row, of the row's files
+    pooled = {row["source file(s)"].count(";") + 1 for row, _ in found}
+    assert len(found) == 3 and pooled == {1, 2}
+    for row, text in found:
+        _dem_agrees(row, text)
+        _measured_agrees(row, text)
+        if ";" in row["source file(s)"]:  # the pair met the 5 g run
+            assert row["SDC DEM (ours) [-]"] == pytest.approx(
+                Store(DEM_STORE).get_dem_run(GRID_RUN).record["sdc"], rel=1e-12)
+

@@ -240,7 +240,8 @@ class CaseSheet:
 
 def case_sheets(entries: Sequence[MeasuredEntry], dem_runs: pd.DataFrame | None,
                 paper: pd.DataFrame, store_paths: Sequence[str | os.PathLike | None],
-                calibrations: Sequence[tuple[object | None, str]] = ()) -> list[CaseSheet]:
+                calibrations: Sequence[tuple[object | None, str]] = (), *,
+                groups: Sequence[Sequence[int]] | None = None) -> list[CaseSheet]:
     """The sheet of every load case of ``entries``, as the Compare page prints each: grouped
     (:func:`pidcore.report.case_view.group_entries`), viewed
     (:func:`pidcore.report.case_view.case_view` with the DEM runs ``dem_runs`` of the stores
@@ -249,10 +250,14 @@ def case_sheets(entries: Sequence[MeasuredEntry], dem_runs: pd.DataFrame | None,
     sheet) and titled (:func:`pidcore.report.case_view.case_title`). ``entries``: each
     measured data set once (:func:`pidcore.compare.case.unique_entries`), specimens matched
     (:func:`pidcore.report.case_view.matched_specimens`). In the order of the groups; a file
-    name two cases would share gets ``_2``, ``_3``, ... ."""
+    name two cases would share gets ``_2``, ``_3``, ... .
+
+    ``groups``: the indices of ``entries`` each sheet pools, of one specimen each (a report's
+    rows, :func:`pidcore.report.pipeline.report_case_sheets`); default the page's groups."""
     sheets: list[CaseSheet] = []
     taken: set[str] = set()
-    for group in group_entries(entries):
+    groups = group_entries(entries) if groups is None else groups
+    for group in groups:
         members = [entries[i] for i in group]
         view = case_view(members, dem_runs, paper, store_paths)
         comparison = view["comparison"]

@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 import os
 import re
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import pandas as pd
@@ -58,14 +58,16 @@ def saved_entries(path: str | os.PathLike, rows: pd.DataFrame,
 
 
 def matched_specimens(entries: Sequence[MeasuredEntry],
-                      listing: pd.DataFrame | None = None) -> list[MeasuredEntry]:
+                      listing: pd.DataFrame | None = None, *,
+                      given: Mapping[str, str] | None = None) -> list[MeasuredEntry]:
     """``entries`` with each record saved without its file's hash (an older pidcore's) met
     as ``pidcore calibrate --store`` and reports meet it
     (:func:`pidcore.specimen.match_hashless_records`): given the hash of its name's one file,
     or kept apart where the name means two, with :attr:`MeasuredEntry.specimen_note` saying
     which. Decided over the entries and every record of ``listing`` (the store's saved
     analyses before the page's filters), so that a filter does not change which file a
-    record is of."""
+    record is of. ``given``: name -> hash of the specimen files given (a report's
+    ``--specimen``), as its rows match them."""
     from dataclasses import replace
 
     from ..specimen import MEASURED_SHA256_FIELD, match_hashless_records
@@ -76,7 +78,8 @@ def matched_specimens(entries: Sequence[MeasuredEntry],
             MEASURED_SHA256_FIELD, pd.Series([""] * len(listing), index=listing.index)),
             strict=True))
     matched = match_hashless_records([e.specimen for e in entries],
-                                     [e.specimen_sha256 for e in entries], others=others)
+                                     [e.specimen_sha256 for e in entries], given=given,
+                                     others=others)
     return [replace(e, specimen_sha256=sha256, specimen_note=note) if note else e
             for e, sha256, note in zip(entries, matched.sha256, matched.notes, strict=True)]
 

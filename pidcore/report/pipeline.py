@@ -695,26 +695,32 @@ def report_entries(results: Sequence[MeasuredResult], analyses: pd.DataFrame,
                    store: Store | None, specimen: Specimen | None = None,
                    ) -> list[MeasuredEntry]:
     """The report's measured records as the app's Compare page takes them
-    (:class:`pidcore.compare.case.MeasuredEntry`): with a ``store``, the stored analyses
-    ``analyses`` reports (their keys) read back as the page reads its store's, judged against
-    the SDC bound of ``specimen`` where they are its tests; without, the files analysed now
-    (``results``) as the page takes an unsaved upload. Each data set once, a record saved
-    without its file's hash matched to its specimen's file over the store's records
-    (:func:`pidcore.report.case_view.matched_specimens`)."""
-    from ..compare.case import MeasuredEntry, unique_entries
+    (:class:`pidcore.compare.case.MeasuredEntry`), one per row of ``analyses`` and in its
+    order (the positions of :data:`pidcore.report.table.MEASURED_RECORDS_ATTR`): with a
+    ``store``, the stored analyses ``analyses`` reports (their keys) read back as the page
+    reads its store's, judged against the SDC bound of ``specimen`` where they are its tests;
+    without, the files analysed now (``results``, whose records ``analyses`` are) as the page
+    takes an unsaved upload. A record saved without its file's hash is matched to its
+    specimen's file over the store's records and ``specimen``'s file, as the report's rows
+    match it (:func:`pidcore.report.case_view.matched_specimens`)."""
+    from ..compare.case import MeasuredEntry
     from ..compare.plausibility import stated_sdc_bounds
-    from ..specimen import MEASURED_SHA256_FIELD
+    from ..specimen import MEASURED_SHA256_FIELD, measured_specimen_name, measured_specimen_sha256
     from ..store.listing import saved_analyses
     from .case_view import matched_specimens, saved_entries
 
+    given = ({measured_specimen_name(specimen): measured_specimen_sha256(specimen)}
+             if specimen is not None else None)
     if store is not None:
-        listing = saved_analyses(store.path)
-        if listing.empty or analyses.empty or "key" not in analyses.columns:
+        if analyses.empty or "key" not in analyses.columns:
             return []
-        rows = listing[listing["key"].isin(set(analyses["key"].astype(str)))]
+        # every analysis stating a fill, not only each measurement's newest: the report's
+        # records by their keys, whichever it chose
+        listing = saved_analyses(store.path, latest_only=False)
+        rows = listing.set_index("key", drop=False).loc[
+            analyses["key"].astype(str)].reset_index(drop=True)
         known = (specimen,) if specimen is not None else ()
-        entries, _ = unique_entries(saved_entries(store.path, rows, known))
-        return matched_specimens(entries, listing)
+        return matched_specimens(saved_entries(store.path, rows, known), listing, given=given)
     entries = []
     for r in results:
         fields = r.fields()
@@ -723,18 +729,25 @@ def report_entries(results: Sequence[MeasuredResult], analyses: pd.DataFrame,
             options=r.settings.options if r.settings is not None else None,
             specimen_sha256=str(fields.get(MEASURED_SHA256_FIELD, "")),
             sdc_bound=stated_sdc_bounds([r.stated], [r.settings], specimen)[0]))
-    return matched_specimens(unique_entries(entries)[0])
+    return matched_specimens(entries, given=given)
 
 
 def report_case_sheets(results: Sequence[MeasuredResult], analyses: pd.DataFrame,
                        store: Store | None, dem_runs: pd.DataFrame | None,
                        dem_paths: Sequence[Path], specimen: Specimen | None,
-                       calibration) -> list[CaseSheet]:
-    """The PDF sheet of every measured load case of a report
-    (:func:`pidcore.report.case_sheet.case_sheets`), as the app's Compare page prints it
-    from the same records (:func:`report_entries`), DEM runs and ``calibration`` (the
+                       calibration, table: pd.DataFrame) -> list[CaseSheet]:
+    """The PDF sheet of every measured row of the report ``table``
+    (:func:`pidcore.report.case_sheet.case_sheets`), as the app's Compare page prints a load
+    case from the same records (:func:`report_entries`), DEM runs and ``calibration`` (the
     report's :func:`pidcore.calibrate.prediction.load_calibration`; None: none given, said on
     each sheet), the calibration named as the report's provenance names it.
+
+    Each sheet pools the records its row pools (:data:`pidcore.report.table.
+    MEASURED_RECORDS_ATTR`), in the table's order, which is not always the page's grouping:
+    the page groups records within the tolerances of each other, the report by the DEM case
+    they meet (tests at 4.8 g and 5.2 g both meet the 5 g run: one row, where the page shows
+    two cases) or, off the grid, by load case key (two tests at 2000 Hz: two rows, where the
+    page pools them).
 
     ``dem_runs``: every run of the stores ``dem_paths``, joined as the page joins its stores';
     the sheets meet only those the report's rows meet, of ``specimen``
@@ -744,12 +757,15 @@ def report_case_sheets(results: Sequence[MeasuredResult], analyses: pd.DataFrame
     from ..model import load_paper_table3
     from .case_sheet import case_sheets
     from .provenance import calibration_source
+    from .table import MEASURED_RECORDS_ATTR
 
     calibrations = ([(calibration, calibration_source(calibration))]
                     if calibration is not None else [])
+    # a DEM-only row pools no records: no measured load case, no sheet
+    groups = [list(pooled) for pooled in table.attrs.get(MEASURED_RECORDS_ATTR, []) if pooled]
     compared, _ = specimen_dem_runs(dem_runs, specimen)
     return case_sheets(report_entries(results, analyses, store, specimen), compared,
-                       load_paper_table3(), list(dem_paths), calibrations)
+                       load_paper_table3(), list(dem_paths), calibrations, groups=groups)
 
 
 def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
@@ -1001,7 +1017,7 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         stores = [p for p in dict.fromkeys((*([Path(store)] if store else []), *dem_paths))
                   if p.exists()]
         sheets = report_case_sheets(results, analyses, main, joined_runs, dem_paths, specimen,
-                                    calibrated) if case_sheets else []
+                                    calibrated, table) if case_sheets else []
         provenance = collect_provenance(
             parameters={**parameters,
                         "frequency_rtol": tolerances.frequency_rtol,

@@ -108,6 +108,10 @@ REPORT_COLUMNS: tuple[str, ...] = (
 #: load case fields the report pipeline stores in each record).
 ANALYSIS_COLUMNS: tuple[str, ...] = ("frequency_hz", "acceleration_g", "fill_percent", "sdc",
                                      "sdc_stderr")
+#: ``table.attrs`` key of :func:`build_report_table`'s table: per row, the positions in the
+#: analyses table of the records its measured columns pool (empty for a DEM-only row), so
+#: that a load case's sheet (``pidcore report --case-sheets``) pools exactly its row's records.
+MEASURED_RECORDS_ATTR = "measured_records"
 
 
 class _Measured(NamedTuple):
@@ -127,6 +131,8 @@ class _Measured(NamedTuple):
     #: the part of sdc taken off as the empty coupon's damping
     #: (:func:`pidcore.signal.power.baseline_sdc_taken_off`; NaN: taken off, amount unknown)
     baseline_sdc: float = 0.0
+    #: its position in the analyses table (:data:`MEASURED_RECORDS_ATTR`)
+    position: int = -1
 
 
 @dataclass
@@ -150,8 +156,9 @@ class _Row:
     no_mass_reason: str = ""
 
 
-def _measured_rows(analyses: pd.DataFrame | None, notes: list[str]) -> list[tuple[LoadCase,
-                                                                                  pd.Series]]:
+def _measured_rows(analyses: pd.DataFrame | None,
+                   notes: list[str]) -> list[tuple[LoadCase, pd.Series, int]]:
+    """(load case, record, its position in ``analyses``) of each analysis stating a fill."""
     if analyses is None or analyses.empty:
         return []
     missing = [c for c in ANALYSIS_COLUMNS if c not in analyses.columns]
@@ -162,7 +169,7 @@ def _measured_rows(analyses: pd.DataFrame | None, notes: list[str]) -> list[tupl
         raise LoadCaseError(f"analyses table: missing columns {missing}; expected "
                             f"{list(ANALYSIS_COLUMNS)}")
     out = []
-    for _, row in analyses.iterrows():
+    for position, (_, row) in enumerate(analyses.iterrows()):
         source = str(row.get("source", "") or row.get("key", ""))
         fill = float(row["fill_percent"]) if row["fill_percent"] is not None else math.nan
         if not math.isfinite(fill):
@@ -172,7 +179,7 @@ def _measured_rows(analyses: pd.DataFrame | None, notes: list[str]) -> list[tupl
         direction = row.get("direction") or "z"
         case = LoadCase(float(row["frequency_hz"]), float(row["acceleration_g"]), fill,
                         str(material), str(direction))
-        out.append((case, row))
+        out.append((case, row, position))
     return out
 
 
@@ -344,7 +351,7 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
     measured_rows = _measured_rows(analyses, notes)
     # of stored runs that are one simulation, the one nearest the measured fill is counted
     # and names the row (a 50.2 % duplicate beside 50 % runs must not label a 50 % row)
-    fills = [case.fill_percent for case, _ in measured_rows]
+    fills = [case.fill_percent for case, _, _ in measured_rows]
     aligner = Aligner.from_tables(dem_runs, paper, model=model, tolerances=tolerances,
                                   pool_settings=pool, reference_fills=fills)
     rows: dict[str, list[_Row]] = {}
@@ -362,15 +369,15 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
     # stays apart (by name) where the name means two: calibrate and Compare decide alike
     # (a store's listing holds NaN where a record names no specimen and another does)
     matched = match_hashless_records(
-        ["" if pool else rec.get("specimen", "") for _, rec in measured_rows],
-        [rec.get(MEASURED_SHA256_FIELD, "") for _, rec in measured_rows],
+        ["" if pool else rec.get("specimen", "") for _, rec, _ in measured_rows],
+        [rec.get(MEASURED_SHA256_FIELD, "") for _, rec, _ in measured_rows],
         given=tested_files, others=[] if pool or store_analyses is None
         or "specimen" not in store_analyses.columns else list(zip(
             store_analyses["specimen"], store_analyses.get(
                 MEASURED_SHA256_FIELD, pd.Series([""] * len(store_analyses),
                                                  index=store_analyses.index)), strict=True)))
-    for (case, rec), sha256, name_note in zip(measured_rows, matched.sha256, matched.notes,
-                                              strict=True):
+    for (case, rec, position), sha256, name_note in zip(measured_rows, matched.sha256,
+                                                        matched.notes, strict=True):
         named = rec.get("specimen", "")
         specimen = "" if pool or not isinstance(named, str) else named
         met_note, refused, met_calibrated = "", False, ""
@@ -413,7 +420,7 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
                           float(rec.get("energy_per_cycle_j", math.nan)), specimen,
                           found[0].message if found else "",
                           stored_stderr_dof(rec.get("sdc_stderr_dof")),
-                          baseline_sdc_taken_off(rec))
+                          baseline_sdc_taken_off(rec), position)
         base = None
         if aligned.status == "grid" and aligned.grid_case is not None:
             dem = aligned.grid_case
@@ -471,6 +478,7 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
             row.notes.append(met_calibrated)
 
     records = []
+    members: list[tuple[int, ...]] = []  # MEASURED_RECORDS_ATTR, in the order of records
     unconverged_rows: list[str] = []
     duplicate_rows: list[str] = []
     for row in (r for group in rows.values() for r in group):
@@ -528,6 +536,7 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
         if row.measured and math.isfinite(row.sdc_dem) and not math.isfinite(sdc_m10):
             note.append("no DEM m_c: no like-for-like difference"
                         + (f" ({row.no_mass_reason})" if row.no_mass_reason else ""))
+        members.append(tuple(m.position for m in row.measured))
         records.append({
             **lc.columns(),
             "particles per cell [-]": (row.dem.particles_per_cell if row.dem
@@ -559,7 +568,10 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
     table["DEM runs [-]"] = table["DEM runs [-]"].astype(int)
     # a count: whole numbers in every format (the CSV wrote 18.0), empty where no DEM ran
     table["particles per cell [-]"] = table["particles per cell [-]"].astype("Int64")
+    # the positions travel with their rows through the sort, then into attrs
+    table["__records"] = members
     table = _sort_like_table3(table, aligner, paper, tolerances)
+    members = table.pop("__records").tolist()
     if unconverged_rows:
         # named here: the console's short table has no note column
         notes.append(f"{len(unconverged_rows)} row(s) rest on DEM runs that did not converge "
@@ -576,6 +588,7 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
     if counted:
         notes.append(counted)
     table.attrs["notes"] = notes
+    table.attrs[MEASURED_RECORDS_ATTR] = members
     return table, aligner
 
 
