@@ -557,3 +557,30 @@ def test_each_case_sheet_pools_the_records_its_report_row_pools(tmp_path, monkey
             assert row["SDC DEM (ours) [-]"] == pytest.approx(
                 Store(DEM_STORE).get_dem_run(GRID_RUN).record["sdc"], rel=1e-12)
 
+
+@pytest.mark.usefixtures("undrawn_report_figures")
+def test_a_calibration_of_another_specimen_than_the_reports_judges_no_sheet(tmp_path,
+                                                                           monkeypatch):
+    # a report of --specimen own predicts no row from the paper coupon's calibration (it is
+    # of another specimen); the sheet of its test naming paper_coupon was judged by it,
+    # "yes" beside the row's "not compared"
+    monkeypatch.chdir(tmp_path)
+    own, runs = _own_specimen(tmp_path)
+    files = _tests(tmp_path, [("pa_50pct.csv", 100.0, 5.0, 0.05),
+                              ("ow_50pct.csv", 100.0, 5.0, 0.06)])
+    sidecar = tmp_path / "specimens.csv"
+    sidecar.write_text("file,specimen\npa_50pct.csv,paper_coupon\n", encoding="utf-8")
+    out = tmp_path / "report"
+    assert main(["report", *map(str, files), "--sidecar", str(sidecar), "--specimen", str(own),
+                 "--dem-store", str(runs), "--dem-store", str(DEM_STORE), "--calibration",
+                 str(PAPER_CALIBRATION), "--format", "csv", "--case-sheets",
+                 "--out", str(out)]) == 0
+    found = _rows_and_sheets(out)
+    assert {row["specimen"] for row, _ in found} == {"paper_coupon", "own_coupon"}
+    for row, text in found:
+        assert row[CALIBRATED_INSIDE_COLUMN] == "not compared"
+        assert "it calibrates specimen paper_coupon, not own_coupon" in row["note"]
+        assert _words("calibrated DEM: no calibrated verdict (not predicted by the "
+                      f"calibration {PAPER_CALIBRATION}: it calibrates specimen paper_coupon, "
+                      "not own_coupon") in text
+        assert "95 % band" not in text and f"{CALIBRATED_INSIDE_COLUMN}:" not in text

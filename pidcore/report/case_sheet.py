@@ -241,7 +241,9 @@ class CaseSheet:
 def case_sheets(entries: Sequence[MeasuredEntry], dem_runs: pd.DataFrame | None,
                 paper: pd.DataFrame, store_paths: Sequence[str | os.PathLike | None],
                 calibrations: Sequence[tuple[object | None, str]] = (), *,
-                groups: Sequence[Sequence[int]] | None = None) -> list[CaseSheet]:
+                groups: Sequence[Sequence[int]] | None = None,
+                group_calibrations: Sequence[Sequence[tuple[object | None, str]]] | None = None,
+                ) -> list[CaseSheet]:
     """The sheet of every load case of ``entries``, as the Compare page prints each: grouped
     (:func:`pidcore.report.case_view.group_entries`), viewed
     (:func:`pidcore.report.case_view.case_view` with the DEM runs ``dem_runs`` of the stores
@@ -253,11 +255,13 @@ def case_sheets(entries: Sequence[MeasuredEntry], dem_runs: pd.DataFrame | None,
     name two cases would share gets ``_2``, ``_3``, ... .
 
     ``groups``: the indices of ``entries`` each sheet pools, of one specimen each (a report's
-    rows, :func:`pidcore.report.pipeline.report_case_sheets`); default the page's groups."""
+    rows, :func:`pidcore.report.pipeline.report_case_sheets`); default the page's groups.
+    ``group_calibrations``: per group, the calibrations judging it in place of
+    ``calibrations``."""
     sheets: list[CaseSheet] = []
     taken: set[str] = set()
     groups = group_entries(entries) if groups is None else groups
-    for group in groups:
+    for k, group in enumerate(groups):
         members = [entries[i] for i in group]
         view = case_view(members, dem_runs, paper, store_paths)
         comparison = view["comparison"]
@@ -270,5 +274,7 @@ def case_sheets(entries: Sequence[MeasuredEntry], dem_runs: pd.DataFrame | None,
         taken.add(name)
         sheets.append(CaseSheet(name, title, case_pdf(
             view, title=title,
-            calibrated=members_calibrated_case(calibrations, comparison, members))))
+            calibrated=members_calibrated_case(
+                calibrations if group_calibrations is None else group_calibrations[k],
+                comparison, members))))
     return sheets

@@ -753,19 +753,35 @@ def report_case_sheets(results: Sequence[MeasuredResult], analyses: pd.DataFrame
     the sheets meet only those the report's rows meet, of ``specimen``
     (:func:`specimen_dem_runs`; default the paper's coupon). The page meets each test's own
     specimen's runs: a test naming another specimen got its runs' SDC on its sheet beside a
-    row saying the report has no DEM run of it."""
+    row saying the report has no DEM run of it. Likewise a calibration of another specimen
+    than the report's (:func:`pidcore.report.table.report_calibration_specimen`) predicts no
+    row and judges no sheet."""
     from ..model import load_paper_table3
     from .case_sheet import case_sheets
     from .provenance import calibration_source
-    from .table import MEASURED_RECORDS_ATTR
+    from .table import MEASURED_RECORDS_ATTR, report_calibration_specimen
 
-    calibrations = ([(calibration, calibration_source(calibration))]
-                    if calibration is not None else [])
-    # a DEM-only row pools no records: no measured load case, no sheet
-    groups = [list(pooled) for pooled in table.attrs.get(MEASURED_RECORDS_ATTR, []) if pooled]
+    label = calibration_source(calibration) if calibration is not None else ""
+    groups: list[list[int]] = []
+    calibrations: list[list[tuple[object | None, str]]] = []
+    for pooled, (_, row) in zip(table.attrs.get(MEASURED_RECORDS_ATTR, []), table.iterrows(),
+                                strict=True):
+        if not pooled:  # a DEM-only row: no measured load case
+            continue
+        groups.append(list(pooled))
+        if calibration is None:
+            calibrations.append([])
+            continue
+        # the report's rule first (the calibration must be of the report's specimen), then
+        # the page's (of the tests' specimen, members_calibrated_case)
+        refused = calibration.other_specimen_reason(report_calibration_specimen(
+            str(row["material"]), specimen, paper=specimen is None))
+        calibrations.append([(None, f"not predicted by the calibration {label}: {refused}")]
+                            if refused else [(calibration, label)])
     compared, _ = specimen_dem_runs(dem_runs, specimen)
     return case_sheets(report_entries(results, analyses, store, specimen), compared,
-                       load_paper_table3(), list(dem_paths), calibrations, groups=groups)
+                       load_paper_table3(), list(dem_paths), groups=groups,
+                       group_calibrations=calibrations)
 
 
 def make_report(files: Sequence[str | Path], *, out_dir: str | Path,

@@ -750,6 +750,19 @@ def _finite_or_nan(value) -> float:
     return number if math.isfinite(number) else math.nan
 
 
+def report_calibration_specimen(material: str, specimen=None, *, paper: bool = False):
+    """The specimen a report's calibration must be of for a row of particle ``material``
+    (:func:`add_calibration_columns`): the report's ``specimen``; without one and with
+    ``paper`` (the default report), the paper's coupon with that table material; None (not
+    checked) otherwise."""
+    from ..constants import PARTICLE_MATERIALS
+    from ..specimen import paper_specimen
+
+    if specimen is None and paper and material in PARTICLE_MATERIALS:
+        return paper_specimen(material)
+    return specimen
+
+
 def calibration_row_refusal(calibration, specimen: str, sha256: object = "") -> str:
     """Why ``calibration`` predicts nothing for a row of tests of ``specimen`` (its name as
     the row's ``specimen`` column gives it; "": not named) whose file's hash is ``sha256``
@@ -798,8 +811,6 @@ def add_calibration_columns(table: pd.DataFrame, calibration, *,
         Neither: unchecked.
     """
     from ..calibrate.prediction import judge_measurement, uninformative_count_text
-    from ..constants import PARTICLE_MATERIALS
-    from ..specimen import paper_specimen
 
     out = table.copy()
     sdc, low, high, inside, notes = [], [], [], [], []
@@ -810,10 +821,8 @@ def add_calibration_columns(table: pd.DataFrame, calibration, *,
                         float(row[PACKING_RATIO_COLUMN]),
                         str(row.get("material") or defaults.COMPARE_DEFAULT_MATERIAL))
         if case.material not in reasons:
-            of_row = specimen
-            if of_row is None and paper and case.material in PARTICLE_MATERIALS:
-                of_row = paper_specimen(case.material)
-            reasons[case.material] = calibration.other_specimen_reason(of_row)
+            reasons[case.material] = calibration.other_specimen_reason(
+                report_calibration_specimen(case.material, specimen, paper=paper))
         other = reasons[case.material]
         if not other:
             other = calibration_row_refusal(calibration, str(row.get("specimen", "") or ""),
