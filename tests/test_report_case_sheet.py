@@ -584,3 +584,54 @@ def test_a_calibration_of_another_specimen_than_the_reports_judges_no_sheet(tmp_
                       f"calibration {PAPER_CALIBRATION}: it calibrates specimen paper_coupon, "
                       "not own_coupon") in text
         assert "95 % band" not in text and f"{CALIBRATED_INSIDE_COLUMN}:" not in text
+
+
+#: What Windows refuses in a file name (and a name ending in a dot or space), and the device
+#: names it refuses as a name's stem.
+WINDOWS_FORBIDDEN = re.compile(r'[<>:"/\\|?*\x00-\x1f]|[. ]$')
+WINDOWS_RESERVED = {"con", "prn", "aux", "nul", *(f"com{i}" for i in range(1, 10)),
+                    *(f"lpt{i}" for i in range(1, 10))}
+
+
+@pytest.mark.usefixtures("undrawn_report_figures")
+# a 300-character specimen name leaves page 2's table no room to lay out (said, not an error):
+# the names are tested here, not the page
+@pytest.mark.filterwarnings("ignore:constrained_layout not applied:UserWarning")
+def test_case_sheet_file_names_are_windows_safe_short_and_never_shared(tmp_path, monkeypatch):
+    # sheets are handed on and unpacked on Windows: "x_Own.pdf" and "x_own.pdf" are one file
+    # there, and a specimen named at length in a sidecar gave a name over 255 characters
+    # ("File name too long", a traceback); specimens whose names differ only in characters a
+    # file name cannot keep ("a/b:c*?", "a_b_c") share a stem
+    from _app_samples import mass_damper_csv
+
+    from pidcore.report.case_sheet import MAX_SHEET_STEM
+
+    monkeypatch.chdir(tmp_path)
+    long = "coupon_" + "x" * 300
+    named = {"s1_50pct.csv": "Own", "s2_50pct.csv": "own", "s3_50pct.csv": "a/b:c*?",
+             "s4_50pct.csv": "a_b_c", "s5_50pct.csv": long, "s6_50pct.csv": long + "y"}
+    files = []
+    for k, name in enumerate(named):
+        # one noise seed: the same measured frequency and acceleration, so one load case key
+        files.append(tmp_path / name)
+        files[-1].write_bytes(mass_damper_csv(frequency_hz=100.0, acceleration_g=5.0,
+                                              loss_factor=0.05 + 0.01 * k, seed=1))
+    sidecar = tmp_path / "specimens.csv"
+    sidecar.write_text("file,specimen\n" + "".join(f'{f},"{s}"\n' for f, s in named.items()),
+                       encoding="utf-8")
+    out = tmp_path / "report"
+    assert main(["report", *map(str, files), "--sidecar", str(sidecar), "--dem-store",
+                 str(DEM_STORE), "--format", "csv", "--case-sheets", "--out", str(out)]) == 0
+    names = sorted(p.name for p in (out / "cases").iterdir())
+    # a sheet per specimen, of one load case key
+    assert len(names) == len(named) and len({n.split("_fill50pct")[0] for n in names}) == 1
+    assert len({n.casefold() for n in names}) == len(names), names
+    for name in names:
+        stem = name.removesuffix(".pdf")
+        assert name.endswith(".pdf") and not WINDOWS_FORBIDDEN.search(stem), name
+        assert stem.split(".")[0].casefold() not in WINDOWS_RESERVED
+        # the stem's limit and a "_NN" of a shared one
+        assert len(stem) <= MAX_SHEET_STEM + 3, name
+    for row, text in _rows_and_sheets(out):  # and each is its row's
+        _dem_agrees(row, text)
+        _measured_agrees(row, text)

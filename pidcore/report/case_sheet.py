@@ -10,6 +10,7 @@ case's (:func:`case_sheets`), both from :func:`pidcore.report.case_view.case_vie
 
 from __future__ import annotations
 
+import hashlib
 import io
 import math
 import os
@@ -215,17 +216,29 @@ def case_pdf(view: dict, *, title: str, calibrated: CalibratedCase | None = None
     return buffer.getvalue()
 
 
+#: Most characters of a sheet's file name before ``.pdf`` (:func:`case_sheet_stem`). A report
+#: is handed on and unpacked on Windows, whose paths end at 260 characters (MAX_PATH) with
+#: the folder's; a specimen named in a sidecar has no length limit, and its sheet's name
+#: failed with "File name too long" (255) and a traceback.
+MAX_SHEET_STEM = 96
+
+
 def case_sheet_stem(comparison: CaseComparison, members: Sequence[MeasuredEntry]) -> str:
     """The file name (without ``.pdf``) of a load case's sheet: its load-case key, and where
     its tests name a specimen, that specimen as labels name it (name and start of its file's
     hash), in characters any file system keeps, e.g.
     ``'f100Hz_a5g_fill50pct_acrylic_z_steel_6mm_3e945a'``: two specimens' sheets of one load
-    case are two files."""
+    case are two files. A name longer than :data:`MAX_SHEET_STEM` is cut there, ending in
+    8 hex digits of the whole name's sha256 (two long names that begin alike stay two)."""
     from ..specimen import tested_label
 
     label = tested_label(members[0].specimen, members[0].specimen_sha256)
     safe = re.sub(r"[^A-Za-z0-9._+-]+", "_", label).strip("_.")
-    return f"{comparison.load_case.key}_{safe}" if safe else comparison.load_case.key
+    stem = f"{comparison.load_case.key}_{safe}" if safe else comparison.load_case.key
+    if len(stem) <= MAX_SHEET_STEM:
+        return stem
+    digest = hashlib.sha256(stem.encode("utf-8")).hexdigest()[:8]
+    return f"{stem[:MAX_SHEET_STEM - len(digest) - 1].rstrip('_.')}_{digest}"
 
 
 @dataclass(frozen=True)
@@ -252,13 +265,16 @@ def case_sheets(entries: Sequence[MeasuredEntry], dem_runs: pd.DataFrame | None,
     sheet) and titled (:func:`pidcore.report.case_view.case_title`). ``entries``: each
     measured data set once (:func:`pidcore.compare.case.unique_entries`), specimens matched
     (:func:`pidcore.report.case_view.matched_specimens`). In the order of the groups; a file
-    name two cases would share gets ``_2``, ``_3``, ... .
+    name two cases would share (as Windows compares names: case-folded) gets ``_2``,
+    ``_3``, ... .
 
     ``groups``: the indices of ``entries`` each sheet pools, of one specimen each (a report's
     rows, :func:`pidcore.report.pipeline.report_case_sheets`); default the page's groups.
     ``group_calibrations``: per group, the calibrations judging it in place of
     ``calibrations``."""
     sheets: list[CaseSheet] = []
+    # compared case-folded: Windows and macOS keep "x_Own.pdf" and "x_own.pdf" as one file,
+    # so unpacked there one sheet replaced the other
     taken: set[str] = set()
     groups = group_entries(entries) if groups is None else groups
     for k, group in enumerate(groups):
@@ -268,10 +284,10 @@ def case_sheets(entries: Sequence[MeasuredEntry], dem_runs: pd.DataFrame | None,
         title = case_title(entries, group)
         stem = case_sheet_stem(comparison, members)
         name, n = f"{stem}.pdf", 1
-        while name in taken:
+        while name.casefold() in taken:
             n += 1
             name = f"{stem}_{n}.pdf"
-        taken.add(name)
+        taken.add(name.casefold())
         sheets.append(CaseSheet(name, title, case_pdf(
             view, title=title,
             calibrated=members_calibrated_case(
