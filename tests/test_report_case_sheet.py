@@ -635,3 +635,25 @@ def test_case_sheet_file_names_are_windows_safe_short_and_never_shared(tmp_path,
     for row, text in _rows_and_sheets(out):  # and each is its row's
         _dem_agrees(row, text)
         _measured_agrees(row, text)
+
+
+@pytest.mark.usefixtures("undrawn_report_figures")
+def test_case_sheets_are_refused_with_tolerances_the_compare_page_does_not_use(tmp_path):
+    # a test at 103 Hz met the 100 Hz run within a frequency tolerance of 5 % (its row: the
+    # run's SDC), while its sheet, the Compare page's, met runs within the default 1 % and
+    # showed an SDC interpolated between 100 and 500 Hz
+    from pidcore.compare.align import Tolerances
+    from pidcore.errors import ParameterError
+    from pidcore.report import make_report
+
+    (path,) = _tests(tmp_path, [("at103_50pct.csv", 103.0, 5.0, 0.05)])
+    out = tmp_path / "report"
+    with pytest.raises(ParameterError, match=r"^case_sheets=True: not with tolerances="
+                                             r"Tolerances\(frequency_rtol=0.05"):
+        make_report([path], out_dir=out, dem_store=DEM_STORE, formats="csv",
+                    tolerances=Tolerances(frequency_rtol=0.05), case_sheets=True)
+    assert not out.exists()
+    # the defaults, stated, are the page's
+    make_report([path], out_dir=out, dem_store=DEM_STORE, formats="csv",
+                tolerances=Tolerances(), case_sheets=True)
+    assert len(list((out / "cases").iterdir())) == 1

@@ -855,7 +855,8 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         Also write the PDF sheet of every measured load case into ``out_dir/cases``, as the
         app's Compare page prints it (:func:`report_case_sheets`), judged by ``calibration``
         as the rows are; listed in the provenance. Not with ``pool`` (the page never pools
-        specimens, so its sheets would not be the rows).
+        specimens, so its sheets would not be the rows), nor with ``tolerances`` other than
+        the defaults (the page's).
     wording : callable, optional
         The notes (the table's, its rows' and the report's) in a front-end's words: it names
         the parameters the library names by keyword (``structure_mass_kg``) as its own
@@ -873,6 +874,12 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         raise ParameterError("case_sheets=True: not with pool=True (a sheet is one load case of "
                              "one specimen, as the app's Compare page prints it; a pooled row "
                              "has no such sheet)")
+    if case_sheets and tolerances is not None and tolerances != Tolerances():
+        # the page meets a case's DEM run within the default tolerances: a row met within
+        # wider ones (103 Hz at the 100 Hz run) had an interpolated DEM SDC on its sheet
+        raise ParameterError(f"case_sheets=True: not with tolerances={tolerances} (a sheet is "
+                             "the app's Compare page's, which meets DEM runs within the "
+                             f"default {Tolerances()}; its DEM value would not be the row's)")
     calibrated = None
     if calibration is not None:  # checked before anything is analysed or written
         from ..calibrate.prediction import load_calibration
