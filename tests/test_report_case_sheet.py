@@ -657,3 +657,31 @@ def test_case_sheets_are_refused_with_tolerances_the_compare_page_does_not_use(t
     make_report([path], out_dir=out, dem_store=DEM_STORE, formats="csv",
                 tolerances=Tolerances(), case_sheets=True)
     assert len(list((out / "cases").iterdir())) == 1
+
+
+@pytest.mark.usefixtures("undrawn_report_figures")
+def test_a_case_sheet_shows_table_3_only_where_the_report_compares_it(tmp_path, monkeypatch):
+    # a report of --specimen own compares no Table 3 (not the paper's coupon), on any row;
+    # the sheet of its test naming paper_coupon drew Table 3's points and pchip curve
+    monkeypatch.chdir(tmp_path)
+    own, runs = _own_specimen(tmp_path)
+    files = _tests(tmp_path, [("pa_50pct.csv", 100.0, 5.0, 0.05)])
+    sidecar = tmp_path / "specimens.csv"
+    sidecar.write_text("file,specimen\npa_50pct.csv,paper_coupon\n", encoding="utf-8")
+
+    def sheet(*extra):
+        out = tmp_path / f"report{len(extra)}"
+        assert main(["report", *map(str, files), "--sidecar", str(sidecar), "--dem-store",
+                     str(runs), "--dem-store", str(DEM_STORE), "--format", "csv",
+                     "--case-sheets", *extra, "--out", str(out)]) == 0
+        ((row, text),) = _rows_and_sheets(out)
+        return row, text
+
+    legend = ("pchip model (paper Table 3 DEM)", "paper DEM", "paper measured")
+    row, text = sheet()  # the default: of the paper's coupon, Table 3 beside its test
+    assert pd.notna(row["SDC DEM (paper) [-]"]) and all(w in text for w in legend)
+    row, text = sheet("--specimen", str(own))
+    assert pd.isna(row["SDC DEM (paper) [-]"]) and pd.isna(row["SDC measured (paper) [-]"])
+    assert not any(w in text for w in legend), text
+    assert "note: specimen own_coupon is not the paper's coupon: the paper's Table 3 is not " \
+           "compared" in text

@@ -256,7 +256,7 @@ def case_sheets(entries: Sequence[MeasuredEntry], dem_runs: pd.DataFrame | None,
                 calibrations: Sequence[tuple[object | None, str]] = (), *,
                 groups: Sequence[Sequence[int]] | None = None,
                 group_calibrations: Sequence[Sequence[tuple[object | None, str]]] | None = None,
-                ) -> list[CaseSheet]:
+                notes: Sequence[str] = ()) -> list[CaseSheet]:
     """The sheet of every load case of ``entries``, as the Compare page prints each: grouped
     (:func:`pidcore.report.case_view.group_entries`), viewed
     (:func:`pidcore.report.case_view.case_view` with the DEM runs ``dem_runs`` of the stores
@@ -271,7 +271,7 @@ def case_sheets(entries: Sequence[MeasuredEntry], dem_runs: pd.DataFrame | None,
     ``groups``: the indices of ``entries`` each sheet pools, of one specimen each (a report's
     rows, :func:`pidcore.report.pipeline.report_case_sheets`); default the page's groups.
     ``group_calibrations``: per group, the calibrations judging it in place of
-    ``calibrations``."""
+    ``calibrations``. ``notes``: said on every sheet (once)."""
     sheets: list[CaseSheet] = []
     # compared case-folded: Windows and macOS keep "x_Own.pdf" and "x_own.pdf" as one file,
     # so unpacked there one sheet replaced the other
@@ -280,6 +280,7 @@ def case_sheets(entries: Sequence[MeasuredEntry], dem_runs: pd.DataFrame | None,
     for k, group in enumerate(groups):
         members = [entries[i] for i in group]
         view = case_view(members, dem_runs, paper, store_paths)
+        view["notes"] = list(dict.fromkeys([*view["notes"], *notes]))
         comparison = view["comparison"]
         title = case_title(entries, group)
         stem = case_sheet_stem(comparison, members)

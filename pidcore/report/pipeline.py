@@ -735,7 +735,8 @@ def report_entries(results: Sequence[MeasuredResult], analyses: pd.DataFrame,
 def report_case_sheets(results: Sequence[MeasuredResult], analyses: pd.DataFrame,
                        store: Store | None, dem_runs: pd.DataFrame | None,
                        dem_paths: Sequence[Path], specimen: Specimen | None,
-                       calibration, table: pd.DataFrame) -> list[CaseSheet]:
+                       calibration, table: pd.DataFrame,
+                       paper: pd.DataFrame | None) -> list[CaseSheet]:
     """The PDF sheet of every measured row of the report ``table``
     (:func:`pidcore.report.case_sheet.case_sheets`), as the app's Compare page prints a load
     case from the same records (:func:`report_entries`), DEM runs and ``calibration`` (the
@@ -755,7 +756,10 @@ def report_case_sheets(results: Sequence[MeasuredResult], analyses: pd.DataFrame
     specimen's runs: a test naming another specimen got its runs' SDC on its sheet beside a
     row saying the report has no DEM run of it. Likewise a calibration of another specimen
     than the report's (:func:`pidcore.report.table.report_calibration_specimen`) predicts no
-    row and judges no sheet."""
+    row and judges no sheet. ``paper``: the Table 3 the report compares (None: none, a
+    report of a specimen that is not the paper's coupon), said on each sheet as in the
+    report's notes: a test naming the paper's coupon had Table 3 in its sheet's chart beside
+    a row without it."""
     from ..model import load_paper_table3
     from .case_sheet import case_sheets
     from .provenance import calibration_source
@@ -778,10 +782,18 @@ def report_case_sheets(results: Sequence[MeasuredResult], analyses: pd.DataFrame
             str(row["material"]), specimen, paper=specimen is None))
         calibrations.append([(None, f"not predicted by the calibration {label}: {refused}")]
                             if refused else [(calibration, label)])
+    said = []
+    if paper is None:
+        from ..specimen import PAPER_SPECIMEN_NAME, measured_specimen_name
+
+        paper = load_paper_table3().iloc[0:0]
+        said.append(NOT_PAPER_SPECIMEN_NOTE.format(
+            name=measured_specimen_name(specimen) if specimen is not None
+            else PAPER_SPECIMEN_NAME))
     compared, _ = specimen_dem_runs(dem_runs, specimen)
-    return case_sheets(report_entries(results, analyses, store, specimen), compared,
-                       load_paper_table3(), list(dem_paths), groups=groups,
-                       group_calibrations=calibrations)
+    return case_sheets(report_entries(results, analyses, store, specimen), compared, paper,
+                       list(dem_paths), groups=groups, group_calibrations=calibrations,
+                       notes=said)
 
 
 def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
@@ -1040,7 +1052,7 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         stores = [p for p in dict.fromkeys((*([Path(store)] if store else []), *dem_paths))
                   if p.exists()]
         sheets = report_case_sheets(results, analyses, main, joined_runs, dem_paths, specimen,
-                                    calibrated, table) if case_sheets else []
+                                    calibrated, table, built.paper) if case_sheets else []
         provenance = collect_provenance(
             parameters={**parameters,
                         "frequency_rtol": tolerances.frequency_rtol,
