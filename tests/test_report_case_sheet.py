@@ -538,22 +538,27 @@ def test_each_case_sheet_pools_the_records_its_report_row_pools(tmp_path, monkey
     # the sheets grouped records as the Compare page does (within the tolerances of each
     # other), the report by the DEM case they meet, or off the grid by load case key: tests at
     # 4.8 g and 5.2 g (each within 5 % of the 5 g run, not of each other) were one row and two
-    # sheets, two tests at 2000 Hz (no run there) two rows and one sheet
+    # sheets. Off the grid the report now groups as the page does: two tests at 2000 Hz, 5 g
+    # (no run there), apart only by noise, were two rows; now one row and one sheet, and a
+    # test at 2000 Hz, 6 g (20 % away, beyond the 5 % tolerance) a row and sheet of its own
     monkeypatch.chdir(tmp_path)
     files = _tests(tmp_path, [("low_50pct.csv", 100.0, 4.8, 0.05),
                               ("high_50pct.csv", 100.0, 5.2, 0.06),
                               ("one_50pct.csv", 2000.0, 5.0, 0.05),
-                              ("two_50pct.csv", 2000.0, 5.0, 0.06)])
+                              ("two_50pct.csv", 2000.0, 5.0, 0.06),
+                              ("far_50pct.csv", 2000.0, 6.0, 0.05)])
     out = tmp_path / "report"
     assert main(["report", *map(str, files), "--dem-store", str(DEM_STORE), "--format", "csv",
                  "--case-sheets", "--out", str(out)]) == 0
     found = _rows_and_sheets(out)  # one sheet per measured row, of the row's files
-    pooled = {row["source file(s)"].count(";") + 1 for row, _ in found}
-    assert len(found) == 3 and pooled == {1, 2}
+    sources = sorted(sorted(Path(s).name for s in row["source file(s)"].split("; "))
+                     for row, _ in found)
+    assert sources == [["far_50pct.csv"], ["high_50pct.csv", "low_50pct.csv"],
+                       ["one_50pct.csv", "two_50pct.csv"]]
     for row, text in found:
         _dem_agrees(row, text)
         _measured_agrees(row, text)
-        if ";" in row["source file(s)"]:  # the pair met the 5 g run
+        if row["frequency [Hz]"] == 100.0:  # the pair met the 5 g run
             assert row["SDC DEM (ours) [-]"] == pytest.approx(
                 Store(DEM_STORE).get_dem_run(GRID_RUN).record["sdc"], rel=1e-12)
 

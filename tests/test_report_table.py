@@ -157,6 +157,73 @@ def test_repeated_measurements_at_one_case_are_pooled():
     assert row["measured frequency [Hz]"] == pytest.approx(50.0)
 
 
+def _analyses(cases) -> pd.DataFrame:
+    """Analyses of ``cases`` [(file, frequency, acceleration, fill, sdc, stderr)]."""
+    return pd.DataFrame(cases, columns=["source", "frequency_hz", "acceleration_g",
+                                        "fill_percent", "sdc", "sdc_stderr"])
+
+
+def test_repeated_measurements_off_the_grid_are_pooled_as_on_the_grid():
+    # two tests at 70 Hz, 3 g, 40 % (off the grid) differing only by noise were two rows, each
+    # its own SDC, where the same two tests on the grid (50 Hz, 1 g, 25 %) were one pooled row
+    # and the Compare page pooled both pairs
+    from pidcore.compare import pooled_mean
+
+    dem = pd.DataFrame([{**i["record"], "case_key": i["case_key"]} for i in _dem_items()])
+    sdcs, errors = (0.2, 0.3), (0.001, 0.002)
+    analyses = _analyses([
+        ("off_a.csv", 70.0, 2.99998, 40.0, sdcs[0], errors[0]),
+        ("off_b.csv", 70.0, 3.00002, 40.0, sdcs[1], errors[1]),
+        ("on_a.csv", 50.0, 0.99998, 25.0, sdcs[0], errors[0]),
+        ("on_b.csv", 50.0, 1.00002, 25.0, sdcs[1], errors[1])])
+    t = build_report_table(dem, analyses, None)
+    measured = t[t["source file(s)"] != ""]
+    assert sorted(measured["source file(s)"]) == ["off_a.csv; off_b.csv", "on_a.csv; on_b.csv"]
+    off = measured[measured["source file(s)"] == "off_a.csv; off_b.csv"].iloc[0]
+    on = measured[measured["source file(s)"] == "on_a.csv; on_b.csv"].iloc[0]
+    assert (off[ALIGNMENT_COLUMN], on[ALIGNMENT_COLUMN]) == ("interpolated", "grid")
+    # the project's pooling of the two analyses, as the grid row pools them: same numbers in,
+    # same operations, so equal to rounding (rel 1e-12)
+    expected = pooled_mean(np.array(sdcs), np.array(errors))
+    for row in (off, on):
+        assert (row["SDC measured (Eq. 11) [-]"], row["SDC measured (Eq. 11) stderr [-]"]) \
+            == pytest.approx(expected, rel=1e-12)
+    assert off["measured acceleration [g]"] == pytest.approx(3.0, rel=1e-12)
+    # the row is the pooled load case, its DEM value interpolated there, as the Compare page
+    # interpolates it for the pair (pchip of the same runs at the same point: rel 1e-12)
+    assert off["acceleration [g]"] == pytest.approx(3.0, rel=1e-12)
+    alone = build_report_table(dem, _analyses([("one.csv", 70.0, 3.0, 40.0, 0.2, 0.001)]), None)
+    assert off["SDC DEM (ours) [-]"] == pytest.approx(
+        alone[alone["source file(s)"] == "one.csv"].iloc[0]["SDC DEM (ours) [-]"], rel=1e-12)
+    assert "2 measurements pooled" in off["note"]
+
+
+@pytest.mark.parametrize("axis", ["frequency_hz", "acceleration_g", "fill_percent"])
+def test_off_grid_measurements_further_apart_than_the_tolerance_are_separate_rows(axis):
+    # the grouping is the grid match's tolerance: just inside it one row, just outside two
+    from pidcore.compare import Tolerances
+
+    tol = Tolerances()
+    dem = pd.DataFrame([{**i["record"], "case_key": i["case_key"]} for i in _dem_items()])
+    base = {"frequency_hz": 70.0, "acceleration_g": 3.0, "fill_percent": 40.0}
+    step = {"frequency_hz": tol.frequency_rtol * 70.0,
+            "acceleration_g": tol.acceleration_rtol * 3.0,
+            "fill_percent": tol.fill_atol_percent}[axis]
+    for factor, rows in ((0.9, 1), (1.1, 2)):  # 10 % of the tolerance either side of its edge
+        other = {**base, axis: base[axis] + factor * step}
+        analyses = _analyses([
+            ("a.csv", base["frequency_hz"], base["acceleration_g"], base["fill_percent"],
+             0.2, 0.001),
+            ("b.csv", other["frequency_hz"], other["acceleration_g"], other["fill_percent"],
+             0.3, 0.001)])
+        t = build_report_table(dem, analyses, None)
+        measured = t[t["source file(s)"] != ""]
+        assert len(measured) == rows, (axis, factor, list(measured["source file(s)"]))
+        assert set(measured[ALIGNMENT_COLUMN]) == {"interpolated"}
+        if rows == 2:  # each its own SDC, unpooled
+            assert sorted(measured["SDC measured (Eq. 11) [-]"]) == [0.2, 0.3]
+
+
 def test_analyses_without_fill_are_left_out_with_a_note():
     analyses = pd.DataFrame({"frequency_hz": [50.0], "acceleration_g": [1.0], "sdc": [0.2],
                              "sdc_stderr": [0.01], "source": ["x.csv"]})

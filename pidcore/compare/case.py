@@ -103,9 +103,14 @@ def stated_case(name: str, sidecar: pd.DataFrame | None = None,
         f"{'file name' if 'direction' in found else 'default'}")
 
 
-def group_load_cases(cases: Sequence[LoadCase]) -> list[list[int]]:
-    """Indices of ``cases`` grouped into one load case each (within :class:`Tolerances`)."""
-    tol = Tolerances()
+def group_load_cases(cases: Sequence[LoadCase],
+                     tolerances: Tolerances | None = None) -> list[list[int]]:
+    """Indices of ``cases`` grouped into one load case each: a case joins the first group
+    whose first case it matches within ``tolerances`` (default :class:`Tolerances`, the
+    Compare page's). The report groups its off-grid records by this rule too
+    (:func:`pidcore.report.table.build_report_table`), each group at
+    :func:`pooled_load_case`."""
+    tol = tolerances or Tolerances()
     groups: list[list[int]] = []
     for i, case in enumerate(cases):
         for members in groups:
@@ -115,6 +120,18 @@ def group_load_cases(cases: Sequence[LoadCase]) -> list[list[int]]:
         else:
             groups.append([i])
     return groups
+
+
+def pooled_load_case(cases: Sequence[LoadCase]) -> LoadCase:
+    """The load case of repeated tests (a group of :func:`group_load_cases`): their mean
+    measured frequency and acceleration, the first one's stated fill, material and
+    direction (the fills of one group are within the fill tolerance)."""
+    if not cases:
+        raise ParameterError("pooled_load_case: no load cases given")
+    first = cases[0]
+    return LoadCase(float(np.mean([c.frequency_hz for c in cases])),
+                    float(np.mean([c.acceleration_g for c in cases])),
+                    first.fill_percent, first.material, first.direction)
 
 
 def paper_table() -> pd.DataFrame:
@@ -506,10 +523,7 @@ def compare_case(records: Sequence[MeasuredEntry],
 
     if not records:
         raise ParameterError("compare_case: no records given")
-    first = records[0].load_case
-    case = LoadCase(float(np.mean([r.load_case.frequency_hz for r in records])),
-                    float(np.mean([r.load_case.acceleration_g for r in records])),
-                    first.fill_percent, first.material, first.direction)
+    case = pooled_load_case([r.load_case for r in records])
     measured = pd.DataFrame({
         "file": [r.file for r in records],
         "origin": [r.origin for r in records],

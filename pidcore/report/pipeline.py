@@ -745,10 +745,10 @@ def report_case_sheets(results: Sequence[MeasuredResult], analyses: pd.DataFrame
 
     Each sheet pools the records its row pools (:data:`pidcore.report.table.
     MEASURED_RECORDS_ATTR`), in the table's order, which is not always the page's grouping:
-    the page groups records within the tolerances of each other, the report by the DEM case
-    they meet (tests at 4.8 g and 5.2 g both meet the 5 g run: one row, where the page shows
-    two cases) or, off the grid, by load case key (two tests at 2000 Hz: two rows, where the
-    page pools them).
+    on the grid the report groups records by the DEM case they meet (tests at 4.8 g and 5.2 g
+    both meet the 5 g run: one row, where the page shows two cases); off the grid it groups
+    them as the page does, within the tolerances of each other
+    (:func:`pidcore.compare.case.group_load_cases`).
 
     ``dem_runs``: every run of the stores ``dem_paths``, joined as the page joins its stores';
     the sheets meet only those the report's rows meet, of ``specimen``

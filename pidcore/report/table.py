@@ -1,8 +1,10 @@
 """The report's main table: our DEM, our measurements and the paper, per load case (Table 3 style).
 
 Rows are the union of our DEM grid cases and the measured cases. A measured case that matches a
-DEM grid case (:mod:`pidcore.compare.align`) shares its row; one that does not gets its own row
-with our DEM value interpolated by the pchip model (or none, out of range). Numbers are copied
+DEM grid case (:mod:`pidcore.compare.align`) shares its row; those that do not are grouped as
+the Compare page groups them (:func:`pidcore.compare.case.group_load_cases`, within the
+tolerances of each other), each group a row of its own at its pooled load case with our DEM
+value interpolated there by the pchip model (or none, out of range). Numbers are copied
 from the inputs unchanged; only runs of one case and settings (seeds) and measurements of one
 case and specimen are pooled (:func:`pidcore.compare.pooled_mean`); stored runs that are the
 same simulation (:func:`pidcore.compare.align.simulation_identity`) count once, which the row's
@@ -54,6 +56,7 @@ from ..compare.align import (
     same_count_note,
     stored_stderr_dof,
 )
+from ..compare.case import group_load_cases, pooled_load_case
 from ..compare.loadcase import LoadCase, LoadCaseError
 from ..compare.plausibility import stored_findings
 from ..compare.specimens import (
@@ -376,30 +379,52 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
             store_analyses["specimen"], store_analyses.get(
                 MEASURED_SHA256_FIELD, pd.Series([""] * len(store_analyses),
                                                  index=store_analyses.index)), strict=True)))
-    for (case, rec, position), sha256, name_note in zip(measured_rows, matched.sha256,
-                                                        matched.notes, strict=True):
-        named = rec.get("specimen", "")
-        specimen = "" if pool or not isinstance(named, str) else named
-        met_note, refused, met_calibrated = "", False, ""
+    def meet(case: LoadCase, specimen: str, sha256: str
+             ) -> tuple[Aligner, pd.DataFrame | None, str, bool, str]:
+        """The aligner of the DEM runs a test of ``specimen`` at ``case`` meets, its runs,
+        the note on them, whether they were refused, and whose runs a calibrated file met."""
         if pool or dem_runs is None or dem_runs.empty:
-            own, own_runs = aligner, dem_runs
-        else:
-            which = (specimen, case.material, case.direction, sha256)
-            if which not in aligners:
-                met = runs_for_measurement(dem_runs, *which)
-                # the row's specimen column names the test's specimen: say whose runs it met
-                calibrated = (f"a test of {met.calibrated_from} compared with the DEM runs of "
-                              f"{met.specimen}, the file pidcore calibrate made from it"
-                              if met.calibrated_from else "")
-                aligners[which] = (Aligner.from_tables(met.runs, paper, model=model,
-                                                       tolerances=tolerances,
-                                                       reference_fills=fills),
-                                   met.note if met.runs is None else "", met.refused,
-                                   calibrated)
-                aligner_runs[which] = met.runs
-            own, met_note, refused, met_calibrated = aligners[which]
-            own_runs = aligner_runs[which]
-        aligned = own.align(case)
+            return aligner, dem_runs, "", False, ""
+        which = (specimen, case.material, case.direction, sha256)
+        if which not in aligners:
+            met = runs_for_measurement(dem_runs, *which)
+            # the row's specimen column names the test's specimen: say whose runs it met
+            calibrated = (f"a test of {met.calibrated_from} compared with the DEM runs of "
+                          f"{met.specimen}, the file pidcore calibrate made from it"
+                          if met.calibrated_from else "")
+            aligners[which] = (Aligner.from_tables(met.runs, paper, model=model,
+                                                   tolerances=tolerances,
+                                                   reference_fills=fills),
+                               met.note if met.runs is None else "", met.refused,
+                               calibrated)
+            aligner_runs[which] = met.runs
+        own, met_note, refused, met_calibrated = aligners[which]
+        return own, aligner_runs[which], met_note, refused, met_calibrated
+
+    specimens = ["" if pool or not isinstance(rec.get("specimen", ""), str)
+                 else rec.get("specimen", "") for _, rec, _ in measured_rows]
+    met_runs = [meet(case, specimen, sha256) for (case, _, _), specimen, sha256
+                in zip(measured_rows, specimens, matched.sha256, strict=True)]
+    # repeated tests off the DEM grid differ by noise (2000 Hz at 4.99998 g and 5.00002 g):
+    # keyed by their own load cases they were rows of their own, where a grid case pools such
+    # tests and the Compare page pools them too. They are grouped by the page's rule, per
+    # specimen and the runs they meet, and each group aligned at its pooled load case.
+    row_cases = [case for case, _, _ in measured_rows]
+    off_grid: dict[tuple[int, str, str], list[int]] = {}
+    for i, (case, specimen, sha256, met) in enumerate(zip(
+            row_cases, specimens, matched.sha256, met_runs, strict=True)):
+        if met[0].grid_case(case) is None:
+            off_grid.setdefault((id(met[0]), specimen, sha256), []).append(i)
+    for members in off_grid.values():
+        for group in group_load_cases([row_cases[i] for i in members], tolerances):
+            pooled_case = pooled_load_case([row_cases[members[j]] for j in group])
+            for j in group:
+                row_cases[members[j]] = pooled_case
+    for (case, rec, position), specimen, sha256, name_note, row_case, met in zip(
+            measured_rows, specimens, matched.sha256, matched.notes, row_cases, met_runs,
+            strict=True):
+        own, own_runs, met_note, refused, met_calibrated = met
+        aligned = own.align(row_case)
         if aligned.status == "no_dem_runs" and not refused:
             # name whose runs are missing and whose the store holds there instead: another
             # specimen's, never compared with this measurement ("of ours" alone misled when a
@@ -433,7 +458,7 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
                 base = _Row(dem.load_case, "grid", dem, dem.sdc, dem.sdc_stderr,
                             *match_paper(dem.load_case, paper, tolerances=tolerances)[:2])
         if base is None:
-            group = rows.setdefault(case.key, [])
+            group = rows.setdefault(row_case.key, [])
             # Table 3 describes the paper's coupon: a test of another specimen showed its
             # values (and the paper's measurement) as if they were that coupon's
             paper_values = (aligned.sdc_paper_dem, aligned.sdc_paper_experimental)
@@ -444,14 +469,15 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
             if not is_paper_coupon(specimen) and np.isfinite(paper_values).any():
                 paper_values = (math.nan, math.nan)
                 not_paper = [NOT_PAPER_SPECIMEN_NOTE.format(name=specimen)]
-            base = _Row(case, aligned.status, None, aligned.sdc_dem, aligned.sdc_dem_stderr,
+            base = _Row(row_case, aligned.status, None, aligned.sdc_dem,
+                        aligned.sdc_dem_stderr,
                         *paper_values,
                         notes=[aligned.message] + ([met_note] if met_note else []) + not_paper,
                         unconverged_nodes=aligned.unconverged_nodes)
             if aligned.status == "interpolated":
                 # the specimen and fill fix its count and m_c, as a DEM run there would
                 (base.particles_per_cell, base.vibrated_mass_kg,
-                 base.no_mass_reason) = interpolated_count_and_mass(own_runs, case)
+                 base.no_mass_reason) = interpolated_count_and_mass(own_runs, row_case)
         # two files of one name are two specimens: their tests are not pooled
         row = next((r for r in group if r.dem is base.dem and r.specimen == specimen
                     and r.specimen_sha256 == sha256), None)
