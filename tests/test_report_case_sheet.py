@@ -391,6 +391,18 @@ GRID_RUN = "f100Hz_a5g_fill50pct_acrylic_z_seed12345_cells8_3e35b5c9af"
 OWN_RUN_SDC = 0.5
 
 
+def _paper_and_own_tests(tmp_path, *, own_named: bool):
+    """:func:`_own_specimen`, two tests at its run's load case (SDC 0.05 and 0.06) and a
+    sidecar naming the first paper_coupon and, where ``own_named``, the second own_coupon."""
+    own, runs = _own_specimen(tmp_path)
+    files = _tests(tmp_path, [("pa_50pct.csv", 100.0, 5.0, 0.05),
+                              ("ow_50pct.csv", 100.0, 5.0, 0.06)])
+    sidecar = tmp_path / "specimens.csv"
+    sidecar.write_text("file,specimen\npa_50pct.csv,paper_coupon\n"
+                       + ("ow_50pct.csv,own_coupon\n" if own_named else ""), encoding="utf-8")
+    return own, runs, files, sidecar
+
+
 def _own_specimen(tmp_path):
     """A specimen file other than the paper's coupon (a heavier fixture), named own_coupon,
     and a store of one DEM run of it at 100 Hz, 5 g, 50 % (the bundled run's numbers but its
@@ -466,12 +478,7 @@ def test_a_case_sheet_meets_only_the_dem_runs_the_report_compares(tmp_path, monk
     # the sheets met every stored run: a test naming another specimen showed that
     # specimen's DEM SDC on its sheet beside a row saying the report has no run of it
     monkeypatch.chdir(tmp_path)
-    own, runs = _own_specimen(tmp_path)
-    files = _tests(tmp_path, [("pa_50pct.csv", 100.0, 5.0, 0.05),
-                              ("ow_50pct.csv", 100.0, 5.0, 0.06)])
-    sidecar = tmp_path / "specimens.csv"
-    sidecar.write_text("file,specimen\npa_50pct.csv,paper_coupon\now_50pct.csv,own_coupon\n",
-                       encoding="utf-8")
+    own, runs, files, sidecar = _paper_and_own_tests(tmp_path, own_named=True)
     out = tmp_path / "report"
     assert main(["report", *map(str, files), "--sidecar", str(sidecar), "--dem-store",
                  str(runs), "--dem-store", str(DEM_STORE), "--format", "csv", "--case-sheets",
@@ -570,11 +577,7 @@ def test_a_calibration_of_another_specimen_than_the_reports_judges_no_sheet(tmp_
     # of another specimen); the sheet of its test naming paper_coupon was judged by it,
     # "yes" beside the row's "not compared"
     monkeypatch.chdir(tmp_path)
-    own, runs = _own_specimen(tmp_path)
-    files = _tests(tmp_path, [("pa_50pct.csv", 100.0, 5.0, 0.05),
-                              ("ow_50pct.csv", 100.0, 5.0, 0.06)])
-    sidecar = tmp_path / "specimens.csv"
-    sidecar.write_text("file,specimen\npa_50pct.csv,paper_coupon\n", encoding="utf-8")
+    own, runs, files, sidecar = _paper_and_own_tests(tmp_path, own_named=False)
     out = tmp_path / "report"
     assert main(["report", *map(str, files), "--sidecar", str(sidecar), "--specimen", str(own),
                  "--dem-store", str(runs), "--dem-store", str(DEM_STORE), "--calibration",
