@@ -78,6 +78,19 @@ def test_damper_options(tmp_path):
         _run(["model", "damper", "--out", str(tmp_path), "--format", "xlsx"])
 
 
+def test_damper_value_typed_twice_gives_one_row_and_says_so(tmp_path, capsys):
+    # a FEM lookup table needs each (f, a, fill) key once: 2 distinct fills x 1 x 1 = 2 rows
+    assert _run(["model", "damper", "--out", str(tmp_path), "--format", "csv", "--fills",
+                 "50,75,50", "--accelerations", "5,5", "--frequencies", "100"]) == 0
+    table = pd.read_csv(tmp_path / "equivalent_damper.csv")
+    assert table["packing ratio [%]"].tolist() == [50.0, 75.0]
+    assert not table.duplicated(["frequency [Hz]", "acceleration [g]",
+                                 "packing ratio [%]"]).any()
+    err = capsys.readouterr().err
+    assert "--fills 50,75,50: each value once (50,75)" in err
+    assert "--accelerations 5,5: each value once (5)" in err
+
+
 def test_damper_from_store_runs(tmp_path, monkeypatch):
     base = load_paper_table3().dropna(subset=["sdc_dem"]).rename(columns={"sdc_dem": "sdc"})
     runs = pd.concat([base.assign(sdc=base.sdc * 0.9), base.assign(sdc=base.sdc * 1.1)])
