@@ -663,3 +663,24 @@ def test_stored_runs_of_one_fill_are_refused_naming_the_store(tmp_path, monkeypa
                    "column fill_percent has 1 distinct value(s) (50); the model needs at "
                    "least 2 per axis\n")
     assert not (tmp_path / "out").exists()
+
+
+PAPER = Path("/work/shared/reference/seed-paper.md")
+
+
+@pytest.mark.skipif(not PAPER.is_file(), reason="the paper's text is not on this machine")
+def test_model_help_cites_the_sections_where_the_paper_proposes_the_pchip_model():
+    # each section the help cites for the interpolation model must speak of it: Sect. 4
+    # (particle and coupon properties) was cited, though the paper proposes the model in 5.1
+    parser = argparse.ArgumentParser(prog="pidcore")
+    model_cli.register(parser.add_subparsers())
+    help_text = parser._subparsers._group_actions[0].choices["model"].description
+    cited = re.search(r"paper Sect\. ([\d., ]+)\)", help_text).group(1)
+    sections = [s.strip() for s in cited.split(",")]
+    text = PAPER.read_text(encoding="utf-8")
+    heading = re.compile(r"^(\d+(?:\.\d+)?) [A-Z]", re.MULTILINE)
+    starts = [(m.group(1), m.start()) for m in heading.finditer(text)]
+    bodies = {num: text[start:(starts[k + 1][1] if k + 1 < len(starts) else len(text))]
+              for k, (num, start) in enumerate(starts)}
+    for section in sections:
+        assert "interpolation" in bodies[section], section

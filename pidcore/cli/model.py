@@ -67,7 +67,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p = subparsers.add_parser(
         "model", help="SDC interpolation model, equivalent damper, figures",
         description="Multivariate pchip model of SDC over fill, acceleration and frequency "
-                    "(paper Sect. 4, 8), its equivalent viscous damper and figures.")
+                    "(paper Sect. 5.1, 8), its equivalent viscous damper and figures.")
     sub = p.add_subparsers(dest="model_command", metavar="ACTION", required=True)
 
     d = sub.add_parser("damper", help="equivalent viscous damper table (CSV/JSON)",

@@ -1,4 +1,4 @@
-"""Multivariate pchip model of the specific damping capacity (paper Sect. 4 and 8).
+"""Multivariate pchip model of the specific damping capacity (paper Sect. 5.1 and 8).
 
 The paper interpolates its Table 3 with a "pchip" interpolant in fill fraction, acceleration
 amplitude and drive frequency. :class:`SdcModel` is that interpolant: a tensor-product of
