@@ -332,6 +332,35 @@ def test_load_cases_group_within_the_compare_tolerances(options):
     assert group_load_cases(cases) == [[0, 1], [2], [3]]
 
 
+def test_load_cases_group_alike_in_any_order():
+    # a chain of tests each within 5 % of the next, not of the one after (4.8 and 5.2 g are
+    # 8 % apart): matched against the first case of a group, 5.0 g given first took both
+    # (one case), 4.8 g given first only 5.0 g (two cases), so the Compare page's cases and
+    # the report's off-grid rows hung on the order the files were given in
+    from itertools import permutations
+
+    from pidcore.compare.align import Tolerances
+    from pidcore.compare.loadcase import LoadCase
+
+    tol = Tolerances(frequency_rtol=0.01, acceleration_rtol=0.05, fill_atol_percent=1.0)
+    chain = [LoadCase(2000.0, a, 50.0, "acrylic", "z") for a in (4.8, 5.0, 5.2, 5.0)]
+    seen = set()
+    for order in permutations(range(len(chain))):
+        given = [chain[k] for k in order]
+        groups = group_load_cases(given, tol)
+        # every case once, the groups listed by their first index, each ascending
+        assert sorted(i for g in groups for i in g) == list(range(len(chain)))
+        assert groups == sorted(sorted(g) for g in groups)
+        # each member within the tolerance of its group's first case, the rule's promise
+        assert all(tol.matches(given[i], given[g[0]]) or tol.matches(given[g[0]], given[i])
+                   for g in groups for i in g)
+        seen.add(tuple(sorted(tuple(sorted(given[i].acceleration_g for i in g))
+                              for g in groups)))
+    # the same groups from all 24 orders: 4.8 g and both 5.0 g (0.2 g <= 5 % of 4.8 g =
+    # 0.24 g), 5.2 g alone (0.4 g from 4.8 g)
+    assert seen == {((4.8, 5.0, 5.0), (5.2,))}
+
+
 def test_a_load_case_address_names_its_case_when_files_are_saved_to_it_later(good_csv,
                                                                                options):
     # The Compare page's address held the case's label, which counts its files: a file saved

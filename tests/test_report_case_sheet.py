@@ -31,7 +31,7 @@ from pidcore.compare.align import (
     MEASURED_EQ11_STDERR_COLUMN,
 )
 from pidcore.model import load_paper_table3
-from pidcore.report.case_sheet import calibrated_case, case_pdf, sheet_lines
+from pidcore.report.case_sheet import calibrated_case, case_pdf, sheet_lines, sheet_stem
 from pidcore.store import Store
 from pidcore.units import display_value_with_error
 
@@ -250,7 +250,8 @@ def _report_with_sheets(store, cal, out, *extra) -> int:
 def _compare_page_sheets(store, cal) -> dict[str, bytes]:
     """Each load case's sheet as the Compare page prints it from the same store and
     calibration (the page's own functions: entries, groups, view, calibrated verdict, title),
-    by load case key."""
+    by fill (one case each: the report names a sheet by its row's grid key, the page by the
+    tests' measured one)."""
     from pidcore.report import case_view as views
     from pidcore.report.case_sheet import members_calibrated_case
     from pidcore.store.listing import list_dem_runs, saved_analyses
@@ -264,7 +265,7 @@ def _compare_page_sheets(store, cal) -> dict[str, bytes]:
         view = views.case_view(members, list_dem_runs(store, DEM_STORE), load_paper_table3(),
                                (store, DEM_STORE))
         shown = members_calibrated_case(calibrations, view["comparison"], members)
-        out[view["comparison"].load_case.key] = case_pdf(
+        out[view["comparison"].load_case.fill_percent] = case_pdf(
             view, title=views.case_title(entries, group), calibrated=shown)
     return out
 
@@ -318,7 +319,9 @@ def test_report_case_sheets_agree_with_the_report_rows_and_the_compare_page(
         assert re.search(rf"case sheet: cases/{re.escape(path.name)} \(.*\(1 file\(s\)\)\) "
                          rf"sha256 {hashlib.sha256(data).hexdigest()}", provenance)
         # the Compare page's sheet of the same case says the same, word for word
-        assert _pdf_text(page[path.stem]) == text
+        assert _pdf_text(page[case.fill_percent]) == text
+        # named by its row's load case: report.csv finds it
+        assert path.name == f"{row['load case']}.pdf"
     assert verdicts == {"yes", "no"}
 
 
@@ -460,6 +463,40 @@ def _rows_and_sheets(out) -> list[tuple[dict, str]]:
     return found
 
 
+def _label(value) -> str:
+    """A label column of report.csv as written ("" where empty: read back as NaN)."""
+    return value if isinstance(value, str) else ""
+
+
+def _sheets_named_by_rows(out) -> list[tuple[dict, str]]:
+    """(measured row of report.csv, text of its sheet) for every measured row, each sheet
+    found by the name the README's join rule derives from the row alone: ``cases/`` + its
+    ``load case`` (+ ``_`` and its specimen, :func:`sheet_stem`) + ``.pdf``, ``_2``, ``_3``,
+    ... where an earlier row's name is the same as Windows compares names (case-folded)."""
+    table = pd.read_csv(out / "report.csv", keep_default_na=False, na_values=[""])
+    taken: set[str] = set()
+    found = []
+    for row in table[table[MEASURED_EQ11_COLUMN].notna()].to_dict("records"):
+        stem = sheet_stem(row["load case"], _label(row["specimen"]),
+                          _label(row["specimen sha256"]))
+        name, n = f"{stem}.pdf", 1
+        while name.casefold() in taken:
+            n += 1
+            name = f"{stem}_{n}.pdf"
+        taken.add(name.casefold())
+        path = out / "cases" / name
+        assert path.is_file(), (name, sorted(p.name for p in (out / "cases").iterdir()))
+        found.append((row, _pdf_text(path.read_bytes())))
+    return found
+
+
+def _found_by_name_as_by_content(out) -> None:
+    """Every measured row's sheet found by name (:func:`_sheets_named_by_rows`) is the one
+    its files and count find (:func:`_rows_and_sheets`), and every sheet is found."""
+    by_name = [(row["source file(s)"], text) for row, text in _sheets_named_by_rows(out)]
+    assert by_name == [(row["source file(s)"], text) for row, text in _rows_and_sheets(out)]
+
+
 def _dem_agrees(row: dict, text: str) -> None:
     """The sheet's DEM SDC is the row's (as displayed), or, where the row has none, none."""
     dem = row["SDC DEM (ours) [-]"]
@@ -568,6 +605,13 @@ def test_each_case_sheet_pools_the_records_its_report_row_pools(tmp_path, monkey
         if row["frequency [Hz]"] == 100.0:  # the pair met the 5 g run
             assert row["SDC DEM (ours) [-]"] == pytest.approx(
                 Store(DEM_STORE).get_dem_run(GRID_RUN).record["sdc"], rel=1e-12)
+    # each row finds its sheet by name: the pooled grid row by the 5 g run's key (its sheet
+    # was named by the tests' mean, 100 Hz at 5.0 g give or take noise, a name no row
+    # showed), the pooled off-grid row by its pooled case, the lone far test by its own
+    keys = sorted(row["load case"] for row, _ in found)
+    assert sorted(p.name for p in (out / "cases").iterdir()) == [f"{k}.pdf" for k in keys]
+    assert any(k.startswith("f100Hz_a5g_fill50pct_") for k in keys), keys
+    _found_by_name_as_by_content(out)
 
 
 @pytest.mark.usefixtures("undrawn_report_figures")
@@ -643,6 +687,7 @@ def test_case_sheet_file_names_are_windows_safe_short_and_never_shared(tmp_path,
     for row, text in _rows_and_sheets(out):  # and each is its row's
         _dem_agrees(row, text)
         _measured_agrees(row, text)
+    _found_by_name_as_by_content(out)  # which its row finds by name
 
 
 @pytest.mark.usefixtures("undrawn_report_figures")

@@ -223,28 +223,38 @@ def case_pdf(view: dict, *, title: str, calibrated: CalibratedCase | None = None
 MAX_SHEET_STEM = 96
 
 
-def case_sheet_stem(comparison: CaseComparison, members: Sequence[MeasuredEntry]) -> str:
-    """The file name (without ``.pdf``) of a load case's sheet: its load-case key, and where
-    its tests name a specimen, that specimen as labels name it (name and start of its file's
-    hash), in characters any file system keeps, e.g.
+def sheet_stem(key: str, specimen: str = "", specimen_sha256: str = "") -> str:
+    """The file name (without ``.pdf``) of a load case's sheet: the load-case ``key``, and
+    where its tests name a ``specimen``, that specimen as labels name it (name and start of
+    its file's hash ``specimen_sha256``), in characters any file system keeps, e.g.
     ``'f100Hz_a5g_fill50pct_acrylic_z_steel_6mm_3e945a'``: two specimens' sheets of one load
     case are two files. A name longer than :data:`MAX_SHEET_STEM` is cut there, ending in
-    8 hex digits of the whole name's sha256 (two long names that begin alike stay two)."""
+    8 hex digits of the whole name's sha256 (two long names that begin alike stay two).
+
+    A report's sheet is named from its row (``load case``, ``specimen``, ``specimen sha256``
+    of ``report.csv``), so that the row finds it (:func:`case_sheets`)."""
     from ..specimen import tested_label
 
-    label = tested_label(members[0].specimen, members[0].specimen_sha256)
+    label = tested_label(specimen, specimen_sha256)
     safe = re.sub(r"[^A-Za-z0-9._+-]+", "_", label).strip("_.")
-    stem = f"{comparison.load_case.key}_{safe}" if safe else comparison.load_case.key
+    stem = f"{key}_{safe}" if safe else key
     if len(stem) <= MAX_SHEET_STEM:
         return stem
     digest = hashlib.sha256(stem.encode("utf-8")).hexdigest()[:8]
     return f"{stem[:MAX_SHEET_STEM - len(digest) - 1].rstrip('_.')}_{digest}"
 
 
+def case_sheet_stem(comparison: CaseComparison, members: Sequence[MeasuredEntry]) -> str:
+    """:func:`sheet_stem` of a load case the Compare page shows: its measured load-case key
+    and its tests' specimen."""
+    return sheet_stem(comparison.load_case.key, members[0].specimen,
+                      members[0].specimen_sha256)
+
+
 @dataclass(frozen=True)
 class CaseSheet:
     """One load case's PDF sheet (:func:`case_sheets`): ``name`` the file's
-    (:func:`case_sheet_stem` and ``.pdf``), ``title`` its first line, ``pdf`` its bytes."""
+    (:func:`sheet_stem` and ``.pdf``), ``title`` its first line, ``pdf`` its bytes."""
 
     name: str
     title: str
@@ -256,6 +266,7 @@ def case_sheets(entries: Sequence[MeasuredEntry], dem_runs: pd.DataFrame | None,
                 calibrations: Sequence[tuple[object | None, str]] = (), *,
                 groups: Sequence[Sequence[int]] | None = None,
                 group_calibrations: Sequence[Sequence[tuple[object | None, str]]] | None = None,
+                group_keys: Sequence[str] | None = None,
                 notes: Sequence[str] = ()) -> list[CaseSheet]:
     """The sheet of every load case of ``entries``, as the Compare page prints each: grouped
     (:func:`pidcore.report.case_view.group_entries`), viewed
@@ -271,7 +282,11 @@ def case_sheets(entries: Sequence[MeasuredEntry], dem_runs: pd.DataFrame | None,
     ``groups``: the indices of ``entries`` each sheet pools, of one specimen each (a report's
     rows, :func:`pidcore.report.pipeline.report_case_sheets`); default the page's groups.
     ``group_calibrations``: per group, the calibrations judging it in place of
-    ``calibrations``. ``notes``: said on every sheet (once)."""
+    ``calibrations``. ``group_keys``: per group, the load-case key its file is named by (a
+    report's rows: the row's ``load case``, the DEM grid case a row on the grid shows, where
+    its tests' mean measured case named the sheet and no row of ``report.csv`` found it);
+    default each group's measured one (:func:`case_sheet_stem`, the page's).
+    ``notes``: said on every sheet (once)."""
     sheets: list[CaseSheet] = []
     # compared case-folded: Windows and macOS keep "x_Own.pdf" and "x_own.pdf" as one file,
     # so unpacked there one sheet replaced the other
@@ -283,7 +298,8 @@ def case_sheets(entries: Sequence[MeasuredEntry], dem_runs: pd.DataFrame | None,
         view["notes"] = list(dict.fromkeys([*view["notes"], *notes]))
         comparison = view["comparison"]
         title = case_title(entries, group)
-        stem = case_sheet_stem(comparison, members)
+        stem = (case_sheet_stem(comparison, members) if group_keys is None else
+                sheet_stem(group_keys[k], members[0].specimen, members[0].specimen_sha256))
         name, n = f"{stem}.pdf", 1
         while name.casefold() in taken:
             n += 1

@@ -748,7 +748,9 @@ def report_case_sheets(results: Sequence[MeasuredResult], analyses: pd.DataFrame
     on the grid the report groups records by the DEM case they meet (tests at 4.8 g and 5.2 g
     both meet the 5 g run: one row, where the page shows two cases); off the grid it groups
     them as the page does, within the tolerances of each other
-    (:func:`pidcore.compare.case.group_load_cases`).
+    (:func:`pidcore.compare.case.group_load_cases`). Each sheet is named by its row
+    (:func:`pidcore.report.case_sheet.sheet_stem` of its ``load case``, the grid case a row on
+    the grid shows, and its specimen), so that ``report.csv`` finds it by name.
 
     ``dem_runs``: every run of the stores ``dem_paths``, joined as the page joins its stores';
     the sheets meet only those the report's rows meet, of ``specimen``
@@ -767,12 +769,14 @@ def report_case_sheets(results: Sequence[MeasuredResult], analyses: pd.DataFrame
 
     label = calibration_source(calibration) if calibration is not None else ""
     groups: list[list[int]] = []
+    keys: list[str] = []  # each sheet is named by its row's load case, which finds it
     calibrations: list[list[tuple[object | None, str]]] = []
     for pooled, (_, row) in zip(table.attrs.get(MEASURED_RECORDS_ATTR, []), table.iterrows(),
                                 strict=True):
         if not pooled:  # a DEM-only row: no measured load case
             continue
         groups.append(list(pooled))
+        keys.append(str(row["load case"]))
         if calibration is None:
             calibrations.append([])
             continue
@@ -793,7 +797,7 @@ def report_case_sheets(results: Sequence[MeasuredResult], analyses: pd.DataFrame
     compared, _ = specimen_dem_runs(dem_runs, specimen)
     return case_sheets(report_entries(results, analyses, store, specimen), compared, paper,
                        list(dem_paths), groups=groups, group_calibrations=calibrations,
-                       notes=said)
+                       group_keys=keys, notes=said)
 
 
 def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
