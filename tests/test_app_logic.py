@@ -361,6 +361,29 @@ def test_load_cases_group_alike_in_any_order():
     assert seen == {((4.8, 5.0, 5.0), (5.2,))}
 
 
+def test_a_pooled_load_case_is_the_same_in_any_order():
+    # stated fills within the fill tolerance (50 and 50.4 %) pooled as the first file's: the
+    # row's load case and its sheet's name hung on the order the files were given in
+    from itertools import permutations
+
+    from pidcore.compare.case import pooled_load_case
+    from pidcore.compare.loadcase import LoadCase
+
+    tests = [LoadCase(2000.0, 5.0, 50.4, "acrylic", "z"),
+             LoadCase(2000.2, 4.9, 50.0, "acrylic", "z"),
+             LoadCase(1999.9, 5.1, 50.4, "acrylic", "z")]
+    pooled = {pooled_load_case([tests[k] for k in order])
+              for order in permutations(range(len(tests)))}
+    assert len(pooled) == 1
+    case, = pooled
+    # the mean frequency and acceleration (float sums may differ by order: to 1e-12)
+    assert case.frequency_hz == pytest.approx(np.mean([t.frequency_hz for t in tests]),
+                                              rel=1e-12)
+    assert case.acceleration_g == pytest.approx(5.0, rel=1e-12)
+    # the stated fill of the first in load-case order (frequency first): 1999.9 Hz's
+    assert case.fill_percent == 50.4
+
+
 def test_a_load_case_address_names_its_case_when_files_are_saved_to_it_later(good_csv,
                                                                                options):
     # The Compare page's address held the case's label, which counts its files: a file saved

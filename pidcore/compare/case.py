@@ -116,9 +116,7 @@ def group_load_cases(cases: Sequence[LoadCase],
     # matched against a group's first case, a chain of cases each within the tolerance of
     # the next (4.8, 5.0, 5.2 g at 5 %) split where the order of the records put its first
     # case: the Compare page's cases and the report's rows hung on the order files were given
-    ordered = sorted(range(len(cases)), key=lambda i: (
-        cases[i].frequency_hz, cases[i].acceleration_g, cases[i].fill_percent,
-        cases[i].material, cases[i].direction))
+    ordered = sorted(range(len(cases)), key=lambda i: _load_case_order(cases[i]))
     groups: list[list[int]] = []
     for i in ordered:
         for members in groups:
@@ -130,13 +128,19 @@ def group_load_cases(cases: Sequence[LoadCase],
     return sorted(sorted(members) for members in groups)
 
 
+def _load_case_order(case: LoadCase) -> tuple:
+    return (case.frequency_hz, case.acceleration_g, case.fill_percent, case.material,
+            case.direction)
+
+
 def pooled_load_case(cases: Sequence[LoadCase]) -> LoadCase:
     """The load case of repeated tests (a group of :func:`group_load_cases`): their mean
-    measured frequency and acceleration, the first one's stated fill, material and
-    direction (the fills of one group are within the fill tolerance)."""
+    measured frequency and acceleration, and the stated fill, material and direction of the
+    first in load-case order (the fills of one group are within the fill tolerance; taken
+    from the first given, 50 and 50.4 % pooled as either by the order of the files)."""
     if not cases:
         raise ParameterError("pooled_load_case: no load cases given")
-    first = cases[0]
+    first = min(cases, key=_load_case_order)
     return LoadCase(float(np.mean([c.frequency_hz for c in cases])),
                     float(np.mean([c.acceleration_g for c in cases])),
                     first.fill_percent, first.material, first.direction)
