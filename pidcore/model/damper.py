@@ -110,7 +110,10 @@ DAMPER_COLUMN_MEANINGS: dict[str, str] = {
                               "factor of another panel (its mass differs); use "
                               "c_eq_per_treated_area there",
     "coupon_damping_ratio [-]": "-ln(1 - SDC)/(4 pi) of the coupon, relative to its own m_c "
-                                "(empty where SDC >= 1)",
+                                "(empty where SDC >= 1): the free decay's ratio, whose cycle "
+                                "loses SDC of its energy; not the ratio c_eq/(2 m_c w) = "
+                                "SDC/(4 pi) of the damper c_eq (near it at small SDC, 2 x it "
+                                "at SDC 0.8): an FEM model with c_eq damps at that one",
     "coupon_vibrated_mass [kg]": "m_c of Eq. 10 the SDC is taken over (provenance "
                                  "vibrated_mass: which masses)",
     "coupon_area [m^2]": "face area (one face) of the coupon c_eq_per_coupon is of: its "
