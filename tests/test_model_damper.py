@@ -142,6 +142,16 @@ def test_damper_table_content(model):
         [90.0, 1.0, 1000.0]]
 
 
+def test_damper_table_takes_a_value_given_twice_once(model):
+    # an FEM lookup needs each (f, a, fill) key once; the Python call gave two identical rows
+    # where pidcore model damper gave one (the CLI had deduplicated its options itself)
+    once = equivalent_damper_table(model, fills_percent=[50, 75], accelerations_g=[5],
+                                   frequencies_hz=[100], vibrated_mass_kg=0.03)
+    twice = equivalent_damper_table(model, fills_percent=[50, 75, 50], accelerations_g=[5, 5],
+                                    frequencies_hz=[100], vibrated_mass_kg=0.03)
+    pd.testing.assert_frame_equal(twice, once)
+
+
 def test_damper_table_refuses_out_of_range(model):
     with pytest.raises(ParameterError, match="outside the model range"):
         equivalent_damper_table(model, fills_percent=[50], accelerations_g=[20],

@@ -215,15 +215,13 @@ def run_damper(args: argparse.Namespace) -> int:
     )
 
     check_out_folder(args.out)
-    # a value typed twice gave two identical rows, which a FEM table lookup of strictly
-    # increasing keys refuses; dem sweep runs each value once too
+    # the table takes a value typed twice once (equivalent_damper_table): said here
     for option in ("fills", "accelerations", "frequencies"):
         given = getattr(args, option)
         once = list(dict.fromkeys(given)) if given else given
         if given and len(once) < len(given):
             print(f"pidcore model damper: note: --{option} {','.join(f'{v:g}' for v in given)}:"
                   f" each value once ({','.join(f'{v:g}' for v in once)})", file=sys.stderr)
-            setattr(args, option, once)
     model, runs = build_model(args)
     if runs is not None and args.vibrated_mass is not None:
         raise ParameterError(

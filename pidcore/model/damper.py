@@ -546,7 +546,8 @@ def equivalent_damper_table(model: SdcModel, *, fills_percent: Sequence[float] |
     model : SdcModel
         SDC model.
     fills_percent, accelerations_g, frequencies_hz : sequence of float
-        Values in %, g and Hz; the table is their Cartesian product.
+        Values in %, g and Hz; the table is their Cartesian product, each value once (in the
+        order given).
     vibrated_mass_kg : float or callable
         m_c [kg] of Eq. 10, or a function of fill [%] returning it (the particle mass grows
         with fill). A number more than :data:`VIBRATED_MASS_LIMIT` times outside the paper
@@ -589,6 +590,10 @@ def equivalent_damper_table(model: SdcModel, *, fills_percent: Sequence[float] |
     accelerations = _one_name("accelerations_g", accelerations_g, "accelerations",
                               accelerations)
     frequencies = _one_name("frequencies_hz", frequencies_hz, "frequencies", frequencies)
+    # each value once, in the order given: a value typed twice gave two identical rows, which
+    # an FEM table lookup of strictly increasing keys refuses (dem sweep runs each once too)
+    fills, accelerations, frequencies = (list(dict.fromkeys(map(float, axis)))
+                                         for axis in (fills, accelerations, frequencies))
     grid = pd.MultiIndex.from_product(
         [np.asarray(frequencies, float), np.asarray(accelerations, float),
          np.asarray(fills, float)], names=["f", "a", "p"]).to_frame(index=False)
