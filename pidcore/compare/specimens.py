@@ -146,6 +146,12 @@ def run_origins(runs: pd.DataFrame) -> pd.Series:
                      dtype=object)
 
 
+def are_calibration_variants(runs: pd.DataFrame) -> pd.Series:
+    """Per run of a listing, whether it says it is a calibration's variant of a file
+    (:func:`run_origin` a :class:`CalibrationVariant`)."""
+    return run_origins(runs).map(lambda origin: isinstance(origin, CalibrationVariant))
+
+
 def run_specimen_descriptions(runs: pd.DataFrame) -> pd.Series:
     """Per run, its specimen as lists of runs name it: its :func:`specimen_label`, and for a
     calibration's variant of a file what it is (``"mycoupon [7167f7]: calibration variant of
@@ -266,10 +272,9 @@ def _other_files_words(runs: pd.DataFrame, specimen: str, own_file: str) -> str:
     not the test's: "" where each is a calibration's variant (their description in the list
     says so); for runs of another file as given, another file of that name; for runs that
     do not say (stored before pidcore recorded it), either."""
-    origins = run_origins(runs)
-    if origins.map(lambda o: isinstance(o, CalibrationVariant)).all():
+    if are_calibration_variants(runs).all():
         return ""
-    if (origins == UNSTATED).any():
+    if (run_origins(runs) == UNSTATED).any():
         return (f"runs named {specimen} hold other content than the test's file (its "
                 f"sha256 starts {own_file[:6]}): another file of that name, or a "
                 "calibration's variants of one, stored before pidcore recorded which")
@@ -388,7 +393,7 @@ def _paper_runs(runs: pd.DataFrame, labels: pd.Series, paper) -> SpecimenRuns:
     note = ""
     if len(others):
         # a calibration's variant of the coupon is described as such in the list
-        not_variant = ~run_origins(runs).map(lambda o: isinstance(o, CalibrationVariant))
+        not_variant = ~are_calibration_variants(runs)
         same_name = ((_names(runs, labels) == PAPER_SPECIMEN_NAME) & not_variant)[~paper].any()
         note = (f"DEM runs of other specimens not compared: {_listed(runs[~paper])} (the paper's "
                 f"coupon is compared, as in pidcore report"

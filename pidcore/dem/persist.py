@@ -451,19 +451,19 @@ def other_files_runs_note(store_path: str | os.PathLike[str], cases: Iterable[Lo
         return ""
     from ..compare.specimens import (
         AS_GIVEN,
-        CalibrationVariant,
+        are_calibration_variants,
         run_origins,
         run_specimen_descriptions,
     )
 
     # a calibration's variants by what they stored: "an earlier version of this file" was
     # said of runs pidcore knew a calibration had made
-    origins = run_origins(others)
-    variants = origins.map(lambda o: isinstance(o, CalibrationVariant))
     files = ", ".join(dict.fromkeys(run_specimen_descriptions(others)))
     whose, origin = (
-        ("of a calibration's variants", "its design points") if variants.all()
-        else ("by other files", "an earlier version of this file") if (origins == AS_GIVEN).all()
+        ("of a calibration's variants", "its design points")
+        if are_calibration_variants(others).all()
+        else ("by other files", "an earlier version of this file")
+        if (run_origins(others) == AS_GIVEN).all()
         else ("by other files", "an earlier version of this file, or a calibration's design "
                                 "points"))
     return (f"{store_path} holds {len(others)} run(s) of these load cases (seed {config.seed}, "

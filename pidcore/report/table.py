@@ -198,8 +198,7 @@ def no_runs_note(of: str, material: str, direction: str, store_runs: pd.DataFram
     name of the specimen the report is of (its runs are chosen by hash: runs of ``of`` left
     out of a report of a file named ``of`` are another file's of that name)."""
     from ..compare.specimens import (
-        CalibrationVariant,
-        run_origins,
+        are_calibration_variants,
         run_specimen_labels,
         runs_per_specimen_text,
     )
@@ -232,8 +231,7 @@ def no_runs_note(of: str, material: str, direction: str, store_runs: pd.DataFram
     if own and of != PAPER_SPECIMEN_NAME and report_of == of:
         named_of = there[there["specimen_name"] == of] if "specimen_name" in there.columns \
             else there.iloc[:0]
-        if not named_of.empty and run_origins(named_of).map(
-                lambda o: isinstance(o, CalibrationVariant)).all():
+        if not named_of.empty and are_calibration_variants(named_of).all():
             return (f"{note} among this report's runs (the store has {listed}: a "
                     f"calibration's variants, not a file named {of} as given; "
                     f"{choose_another})")
