@@ -298,8 +298,8 @@ def case_sheets(entries: Sequence[MeasuredEntry], dem_runs: pd.DataFrame | None,
         view["notes"] = list(dict.fromkeys([*view["notes"], *notes]))
         comparison = view["comparison"]
         title = case_title(entries, group)
-        stem = (case_sheet_stem(comparison, members) if group_keys is None else
-                sheet_stem(group_keys[k], members[0].specimen, members[0].specimen_sha256))
+        stem = sheet_stem(comparison.load_case.key if group_keys is None else group_keys[k],
+                          members[0].specimen, members[0].specimen_sha256)
         name, n = f"{stem}.pdf", 1
         while name.casefold() in taken:
             n += 1
