@@ -738,3 +738,19 @@ def test_a_case_sheet_shows_table_3_only_where_the_report_compares_it(tmp_path, 
     assert not any(w in text for w in legend), text
     assert "note: specimen own_coupon is not the paper's coupon: the paper's Table 3 is not " \
            "compared" in text
+
+
+@pytest.mark.usefixtures("undrawn_report_figures")
+def test_the_case_sheets_are_counted_on_the_reports_progress_bar(tmp_path, capsys):
+    # each sheet takes about a second to draw, before the report's writing bar starts: a report
+    # of many measured cases sat silent for most of a minute
+    from pidcore.report import make_report
+
+    paths = _tests(tmp_path, [("a_50pct.csv", 100.0, 5.0, 0.05),
+                              ("b_50pct.csv", 500.0, 5.0, 0.05)])
+    make_report(paths, out_dir=tmp_path / "report", dem_store=DEM_STORE, formats="csv",
+                case_sheets=True, progress=True)
+    err = capsys.readouterr().err
+    # tqdm's last state of the bar: both sheets drawn, counted in its own unit
+    assert "load case sheets" in err and "2/2" in err.split("load case sheets")[-1]
+    assert len(list((tmp_path / "report" / "cases").iterdir())) == 2

@@ -736,7 +736,8 @@ def report_case_sheets(results: Sequence[MeasuredResult], analyses: pd.DataFrame
                        store: Store | None, dem_runs: pd.DataFrame | None,
                        dem_paths: Sequence[Path], specimen: Specimen | None,
                        calibration, table: pd.DataFrame,
-                       paper: pd.DataFrame | None) -> list[CaseSheet]:
+                       paper: pd.DataFrame | None, *,
+                       progress: bool = False) -> list[CaseSheet]:
     """The PDF sheet of every measured row of the report ``table``
     (:func:`pidcore.report.case_sheet.case_sheets`), as the app's Compare page prints a load
     case from the same records (:func:`report_entries`), DEM runs and ``calibration`` (the
@@ -797,7 +798,7 @@ def report_case_sheets(results: Sequence[MeasuredResult], analyses: pd.DataFrame
     compared, _ = specimen_dem_runs(dem_runs, specimen)
     return case_sheets(report_entries(results, analyses, store, specimen), compared, paper,
                        list(dem_paths), groups=groups, group_calibrations=calibrations,
-                       group_keys=keys, notes=said)
+                       group_keys=keys, notes=said, progress=progress)
 
 
 def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
@@ -1056,7 +1057,8 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         stores = [p for p in dict.fromkeys((*([Path(store)] if store else []), *dem_paths))
                   if p.exists()]
         sheets = report_case_sheets(results, analyses, main, joined_runs, dem_paths, specimen,
-                                    calibrated, table, built.paper) if case_sheets else []
+                                    calibrated, table, built.paper,
+                                    progress=progress) if case_sheets else []
         provenance = collect_provenance(
             parameters={**parameters,
                         "frequency_rtol": tolerances.frequency_rtol,
