@@ -290,9 +290,9 @@ def measured_from_store(store_path: str | os.PathLike, *,
     """
     from ..specimen import MEASURED_SHA256_FIELD, match_hashless_records
     from ..store import Store
-    from ..store.listing import latest_per_measurement
+    from ..store.listing import checked_analyses, latest_per_measurement
 
-    frame = Store(store_path).list_analyses()
+    frame = checked_analyses(Store(store_path).list_analyses(), store_path)
     need = {"frequency_hz", "sdc"}
     if frame.empty or not need <= set(frame.columns):
         raise InputFileError(f"{store_path}: no analysed measurements with frequency_hz and sdc")

@@ -937,8 +937,12 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
             open_verified_store(p, must_exist=True, progress=progress) for p in dem_paths]
     dem_path = " and ".join(map(str, dem_paths)) or None  # as the notes name the runs' stores
 
+    from ..store.listing import checked_analyses
+
     if main is not None:
         refuse_store_among_inputs(main, files)  # before reading (it may hold many measurements)
+        # a damaged record is refused before the files are analysed into the store
+        checked_analyses(main.list_analyses(), main.path)
         if files:  # their analyses are added to it
             main.check_writable()
     from ..compare.plausibility import (
@@ -948,6 +952,7 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         stored_record_name,
     )
     from ..file_settings import assumed, files_assumption_notes, stored_assumption_notes
+    from ..store.listing import checked_analyses
 
     options = options or AnalysisOptions()
     results = analyze_files(

@@ -4,16 +4,65 @@ with their load cases, filtered.
 
 from __future__ import annotations
 
+import math
 import os
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
+from ..errors import StoreError
 from .store import Store
 
 #: Columns a saved analysis needs to be placed in a load case.
 LOAD_CASE_FIELDS = ("frequency_hz", "acceleration_g", "fill_percent", "material", "direction")
+
+
+#: Result fields of an analysis and what a stored value must be: a hand-edited or damaged
+#: record with a negative standard error crashed the report's figures, one of 1e308
+#: overflowed the pooled error, and a NaN or infinite SDC was averaged into a load case; each
+#: is refused naming the store and the record. 1e6 is no physical limit but far above any
+#: SDC an analysis saves (the plausibility bound of a dense tungsten bed is ~40) and far below
+#: where squares and sums overflow.
+_MAGNITUDE_LIMIT = 1e6
+_RESULT_FIELDS = {
+    "frequency_hz": ("a positive finite number", lambda v: math.isfinite(v) and v > 0),
+    "acceleration_g": ("a positive finite number", lambda v: math.isfinite(v) and v > 0),
+    "sdc": (f"a number of magnitude at most {_MAGNITUDE_LIMIT:g}",
+            lambda v: abs(v) <= _MAGNITUDE_LIMIT),
+    "loss_factor": (f"a number of magnitude at most {_MAGNITUDE_LIMIT:g}",
+                    lambda v: abs(v) <= _MAGNITUDE_LIMIT),
+    # NaN: unknown (one block), as the analysis saves it
+    "sdc_stderr": (f"a number from 0 to {_MAGNITUDE_LIMIT:g}, or empty (unknown)",
+                   lambda v: math.isnan(v) or 0 <= v <= _MAGNITUDE_LIMIT),
+    "loss_factor_stderr": (f"a number from 0 to {_MAGNITUDE_LIMIT:g}, or empty (unknown)",
+                           lambda v: math.isnan(v) or 0 <= v <= _MAGNITUDE_LIMIT),
+}
+
+
+def checked_analyses(analyses: pd.DataFrame, where: str | os.PathLike) -> pd.DataFrame:
+    """``analyses`` (a :meth:`Store.list_analyses` listing of the store ``where``) if every
+    result field holds what an analysis saves, else :class:`StoreError` naming the store,
+    the record, the field, its value and what was expected."""
+    for field, (expected, holds) in _RESULT_FIELDS.items():
+        if field not in analyses.columns:
+            continue
+        for _, row in analyses.iterrows():
+            value = row[field]
+            if value is None:  # saved as null: the analysis did not give it
+                continue
+            try:
+                number = math.nan if isinstance(value, bool | str) else float(value)
+            except (TypeError, ValueError):
+                number = math.nan
+            valid = holds(number) and not isinstance(value, bool | str)
+            if not valid:
+                name = Path(str(row.get("source", "") or "")).name or row.get("key", "")
+                raise StoreError(f"{where}: analysis {row.get('key', '')} ({name}): record "
+                                 f"field {field} = {value!r} is not {expected}; it was "
+                                 "changed or damaged outside pidcore (analyse the file again "
+                                 "into a fresh store)")
+    return analyses
 
 
 def list_dem_runs(*paths: str | os.PathLike | None) -> pd.DataFrame:
@@ -54,7 +103,7 @@ def saved_analyses(path: str | os.PathLike, *, latest_only: bool = True) -> pd.D
     """
     if not Path(path).is_file():
         return pd.DataFrame()
-    analyses = Store(path).list_analyses()
+    analyses = checked_analyses(Store(path).list_analyses(), path)
     if analyses.empty or "fill_percent" not in analyses.columns:
         return analyses.iloc[0:0]
     fill = pd.to_numeric(analyses["fill_percent"], errors="coerce")
