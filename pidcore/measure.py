@@ -25,6 +25,7 @@ Examples
 
 from __future__ import annotations
 
+import json
 import math
 import os
 from collections.abc import Mapping, Sequence
@@ -550,6 +551,12 @@ def analyze_file(path: str | os.PathLike, options: AnalysisOptions | None = None
     return analyze_measurement(measurement, options)
 
 
+def stored_parameters(result: AnalyzedRecord, parameters: Mapping) -> dict:
+    """The parameters an analysis is stored (and keyed) with: ``parameters`` and the
+    channels it used."""
+    return {**parameters, "channels": result.channels_used}
+
+
 def store_analysis(store: Store, result: AnalyzedRecord, parameters: Mapping, *,
                    fields: Mapping | None = None) -> str:
     """Add one analysed record and its measurement to an open :class:`~pidcore.store.Store`.
@@ -567,7 +574,7 @@ def store_analysis(store: Store, result: AnalyzedRecord, parameters: Mapping, *,
     units = {**ANALYSIS_UNITS, **RECORDED_BOUND_UNITS}
     return store.add_analysis(
         measurement_key, record, arrays=arrays,
-        parameters={**parameters, "channels": result.channels_used},
+        parameters=stored_parameters(result, parameters),
         units={k: v for k, v in units.items() if k in record or k in arrays})
 
 
@@ -676,8 +683,9 @@ def save_analyses(store: Store | str | os.PathLike, results: Sequence[AnalyzedRe
         before = store.list_analyses()
         notes = replacement_notes(before, [
             (name, measurement_key(r.measurement),
-             case.full_label() if case is not None else NO_LOAD_CASE)
-            for r, (name, case, _) in zip(results, stated, strict=True)])
+             case.full_label() if case is not None else NO_LOAD_CASE,
+             stored_parameters(r, o.parameters()), r.analysis.sdc)
+            for r, o, (name, case, _) in zip(results, per_result, stated, strict=True)])
         keys = [store_analysis(store, r, o.parameters(), fields={
                     **(case.as_record(origin) if case is not None else {}), **(more or {})})
                 for r, o, (_, case, origin), more in zip(results, per_result, stated, extra,
@@ -789,30 +797,80 @@ def _stored_case_label(row) -> str:
 
 
 def replacement_notes(analyses: pd.DataFrame,
-                      incoming: Sequence[tuple[str, str, str]]) -> list[str]:
-    """Which saved records (file name, load case) saving ``incoming`` replaces.
+                      incoming: Sequence[tuple]) -> list[str]:
+    """Which saved records (file name, load case, settings) saving ``incoming`` replaces.
 
     ``incoming``: per file to be saved, (file name, measurement key
-    (:func:`pidcore.records.measurement_key`), load case in words). The store keeps a
-    measurement by its contents, so a byte-identical file under another name, or a second copy
-    in the same save, is the same record and only the last one saved is kept: each such
-    replacement of another name or load case is said, never silent. ``analyses`` is
+    (:func:`pidcore.records.measurement_key`), load case in words), optionally followed by
+    the analysis parameters (:meth:`AnalysisOptions.parameters`) and the new SDC. The store
+    keeps a measurement by its contents, so a byte-identical file under another name, or a
+    second copy in the same save, is the same record and only the last one saved is kept:
+    each such replacement of another name or load case is said, never silent. A file saved
+    again with other settings (another vibrometer delay, mass below the gauge, baseline) is
+    a new analysis of the same measurement, and the newest is the one reports and
+    calibrations use: that too is said, with the settings that differ and both SDCs (a
+    forgotten settings table silently replaced a delay-corrected result). ``analyses`` is
     :meth:`pidcore.store.Store.list_analyses` before the save.
     """
     notes = []
-    saved = {}  # measurement key -> (file, load case) it holds now
+    saved = {}  # measurement key -> (file, load case, parameters, SDC) it holds now
     if not analyses.empty and {"measurement_key", "created_utc"} <= set(analyses.columns):
         for _, row in analyses.sort_values("created_utc", kind="stable").iterrows():
-            saved[str(row["measurement_key"])] = (Path(str(row.get("source", ""))).name,
-                                                  _stored_case_label(row))
-    for name, key, case in incoming:
+            saved[str(row["measurement_key"])] = (
+                Path(str(row.get("source", ""))).name, _stored_case_label(row),
+                _parameters_of(row.get("parameters_json")), _number(row.get("sdc")))
+    for item in incoming:
+        name, key, case = item[:3]
+        parameters = None if len(item) < 4 else _parameters_of(item[3])
+        sdc = math.nan if len(item) < 5 else _number(item[4])
         if key in saved:
-            old_name, old_case = saved[key]
+            old_name, old_case, old_parameters, old_sdc = saved[key]
+            changed = _changed_settings(old_parameters, parameters)
             if (old_name, old_case) != (name, case):
                 notes.append(f"{name} has the same contents as the saved record {old_name} "
-                             f"({old_case}); saved as one record: {name} ({case}) replaces it")
-        saved[key] = (name, case)
+                             f"({old_case}); saved as one record: {name} ({case}) replaces it"
+                             + (f" (other settings: {changed})" if changed else ""))
+            elif changed:
+                notes.append(f"{name} was saved before with other settings ({changed}; "
+                             f"SDC {_shown(old_sdc)}); this analysis (SDC {_shown(sdc)}) is "
+                             "the one reports and calibrations use now, the earlier is kept "
+                             "in the store")
+        saved[key] = (name, case, parameters if parameters is not None else
+                      saved.get(key, (None,) * 4)[2], sdc)
     return notes
+
+
+def _parameters_of(value: object) -> dict | None:
+    """Analysis parameters as the store's canonical JSON reads back (None: not known)."""
+    if isinstance(value, Mapping):
+        return json.loads(json.dumps(value, sort_keys=True))
+    if isinstance(value, str) and value:
+        try:
+            loaded = json.loads(value)
+        except ValueError:
+            return None
+        return loaded if isinstance(loaded, dict) else None
+    return None
+
+
+def _number(value: object) -> float:
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        return math.nan
+
+
+def _shown(sdc: float) -> str:
+    return f"{sdc:.4g}" if math.isfinite(sdc) else "not known"
+
+
+def _changed_settings(old: dict | None, new: dict | None) -> str:
+    """``"velocity_delay_s 5e-05 -> 0.0"`` for each parameter that differs ("" where either
+    is not known: a record of an older pidcore, or a caller that gave none)."""
+    if old is None or new is None:
+        return ""
+    return ", ".join(f"{name} {json.dumps(old.get(name))} -> {json.dumps(new.get(name))}"
+                     for name in sorted({*old, *new}) if old.get(name) != new.get(name))
 
 
 #: Units of the scalar fields stored per analysis.

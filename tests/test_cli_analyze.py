@@ -169,6 +169,33 @@ def test_a_stated_load_case_is_saved_so_that_a_store_report_places_it(tmp_path, 
         "_fill75pct_acrylic_z" in doc["records"][0]["load_case"]
 
 
+def test_a_file_saved_again_with_other_settings_says_which_result_reports_use_now(
+        tmp_path, capsys):
+    # the newest analysis of a measurement is the one report --store and calibrate --store
+    # take: saved again without the vibrometer delay of the first save, it replaced a
+    # delay-corrected SDC and "saved 1 record(s)" was all that was said
+    from pidcore.store.listing import latest_per_measurement
+
+    named = export(tmp_path / "coupon_fill50_acrylic.csv", fmt="csv")
+    store_path = tmp_path / "s.h5"
+    argv = ["analyze", str(named), "--store", str(store_path)]
+    assert main([*argv, "--velocity-delay", "5e-5"]) == 0
+    capsys.readouterr()
+    assert main(argv) == 0
+    out = capsys.readouterr().out
+    listed = Store(store_path).list_analyses().sort_values("created_utc")
+    first, second = (f"{v:.4g}" for v in listed["sdc"])
+    assert first != second  # a 50 us delay at 100 Hz moves the phase by 1.8 degrees
+    assert (f"note: coupon_fill50_acrylic.csv was saved before with other settings "
+            f"(velocity_delay_s 5e-05 -> 0.0; SDC {first}); this analysis (SDC {second}) is "
+            "the one reports and calibrations use now") in out
+    newest = latest_per_measurement(Store(store_path).list_analyses())
+    assert f"{float(newest['sdc'].iloc[0]):.4g}" == second  # what the note says is used
+    # the same settings again: nothing replaced, nothing said
+    assert main(argv) == 0
+    assert "saved before with other settings" not in capsys.readouterr().out
+
+
 def test_identical_files_stating_different_load_cases_are_refused_before_saving(tmp_path,
                                                                                 capsys):
     a = export(tmp_path / "a_fill50.csv", fmt="csv")
