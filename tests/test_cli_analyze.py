@@ -41,7 +41,7 @@ def export(path: Path, *, fmt: str, force_unit_scale: float = 1.0, binary: bool 
     velocity = rec.velocity_m_s.copy()
     if corrupt_velocity:
         velocity[100] = np.nan
-    write_force_velocity(path, rec.force_n, velocity, FS, fmt, binary=binary)
+    write_force_velocity(path, rec.force_n * force_unit_scale, velocity, FS, fmt, binary=binary)
     return path
 
 
@@ -194,6 +194,30 @@ def test_a_file_saved_again_with_other_settings_says_which_result_reports_use_no
     # the same settings again: nothing replaced, nothing said
     assert main(argv) == 0
     assert "saved before with other settings" not in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("scale", [1e-3, 1e3])
+def test_a_force_in_another_unit_than_its_header_is_refused_by_the_vibrated_mass(
+        tmp_path, capsys, scale):
+    # a force in kN under a header of N keeps the Eq. 11 loss factor (a ratio) but makes the
+    # energy per cycle 1000 x small: a report pooled Eq. 10 SDCs 1000 x apart with no word.
+    # The record's vibrated mass, Im(P_c)/(omega |V|^2/2), is the rigid 0.25 kg x scale,
+    # against the paper coupon's 22.15 g (a fill-named file is of the paper's coupon)
+    path = export(tmp_path / "coupon_fill50_acrylic.csv", fmt="csv", force_unit_scale=scale)
+    assert main(["analyze", str(path), "--no-store"]) == 2
+    err = capsys.readouterr().err
+    shown_g = float(err.split("(omega |V|^2/2) = ")[1].split(" g")[0])
+    # the fundamental's mass: the drive is one sine; 0.5 % for the record's noise and the
+    # friction's harmonics
+    assert shown_g == pytest.approx(MASS * scale * 1e3, rel=5e-3)
+    assert "another unit than its header" in err and "22.15 g" in err
+    # stated in its unit, it is the true record: the energy per cycle of the unscaled file
+    unit = "kN" if scale == 1e-3 else "mN"
+    doc = run_json([str(path), "--force-unit", unit, "--no-store"], capsys)
+    truth = run_json([str(export(tmp_path / "true_fill50_acrylic.csv", fmt="csv")),
+                      "--no-store"], capsys)
+    assert doc["records"][0]["energy_per_cycle_j"] == pytest.approx(
+        truth["records"][0]["energy_per_cycle_j"], rel=1e-9)  # one scale, exactly undone
 
 
 def test_identical_files_stating_different_load_cases_are_refused_before_saving(tmp_path,

@@ -278,6 +278,26 @@ def check_analysis(analysis, *, bound: SdcBound | None = None
                           "the loss factor to zero")
         out.append(PlausibilityWarning("negative_loss_factor",
                                        f"negative loss factor {eta:.4g} (SDC {sdc:.4g})", cause))
+    vibrated_kg = _vibrated_mass_kg(analysis)
+    if bound.known and math.isfinite(vibrated_kg):
+        from ..signal.power import MIN_STRUCTURE_SHARE, UNIT_SLIP_SHARE
+
+        # the Eq. 11 loss factor is a ratio and survives a force or velocity channel in
+        # another unit than its header says; the energy per cycle (Eq. 10, the like-for-like
+        # comparison with the DEM) does not: a force in kN under "N" pooled SDCs 1000 x apart.
+        # The vibrated mass Im(P_c) shows is then 1000 x off the specimen's coupon and fixture,
+        # by the bounds the structure-mass correction judges a typed mass by
+        share = bound.structure_mass_kg / vibrated_kg
+        if not MIN_STRUCTURE_SHARE <= share <= UNIT_SLIP_SHARE:
+            out.append(PlausibilityWarning(
+                "vibrated_mass_off",
+                f"the vibrated mass the record shows, Im(P_c)/(omega |V|^2/2) = "
+                f"{vibrated_kg * 1e3:.4g} g, is {'below half' if share > 1 else 'over 100 x'} "
+                f"the specimen's coupon and fixture ({bound.structure_mass_kg * 1e3:.4g} g)",
+                "a force or velocity channel whose values are in another unit than its header "
+                "says (kN under 'N', mm/s under 'm/s': check the channel units or give "
+                "--force-unit/--velocity-unit), "
+                "or another specimen than the one assumed"))
     if math.isfinite(sdc) and sdc > bound.sdc:
         out.append(PlausibilityWarning(
             "sdc_above_bound", f"SDC {sdc:.4g} is above {bound.words(eta)}",
@@ -294,6 +314,18 @@ def check_analysis(analysis, *, bound: SdcBound | None = None
                "(without it the bound is 2 pi; with it, 8 m_p/m_s: give its specimen file, "
                "specimen=FILE)")))
     return tuple(out)
+
+
+def _vibrated_mass_kg(analysis) -> float:
+    """The mass-like reactive power's mass, Im(P_c) / (omega |V_1|^2 / 2), kg (NaN where the
+    record has no such amplitude or force leads nothing): the fundamental's, which the drive
+    is; harmonics of the velocity add under 1 % at the bundled records."""
+    power = complex(analysis.complex_power_w)
+    omega = float(getattr(analysis, "omega_rad_s", math.nan))
+    speed = float(getattr(analysis, "velocity_amplitude_m_s", math.nan))
+    if not (power.imag > 0 and omega > 0 and math.isfinite(speed) and speed > 0):
+        return math.nan
+    return power.imag / (0.5 * omega * speed ** 2)
 
 
 #: Standard errors within which a negative loss factor is read as zero damping (an empty
