@@ -196,6 +196,32 @@ def test_csv_unit_conversion_and_delimiters(tmp_path):
         assert force.sample_rate_hz == 1000.0, name
 
 
+@pytest.mark.parametrize(("sep", "decimal"), [(",", "."), (";", ",")])
+def test_a_spreadsheets_empty_rows_after_the_data_are_left_out_and_said(tmp_path, sep,
+                                                                          decimal):
+    # Excel writes rows of bare delimiters (",,," or ";;;") below the data; they were refused
+    # as "the time column holds non-finite values", naming no row
+    written = _measurement()
+    path = tmp_path / "excel.csv"
+    write_measurement(written, path, "csv")
+    body = path.read_text(encoding="utf-8")
+    if sep != ",":  # as a spreadsheet of a decimal-comma locale saves it
+        body = body.replace(",", ";").replace(".", decimal)
+    width = len(written.channels) + 1
+    path.write_text(body + (sep * (width - 1) + "\n") * 3, encoding="utf-8")
+    read = read_measurement(path)
+    # the samples are the written ones: %.17g is exact, a decimal comma read back exactly
+    _assert_same(read, written, rtol=0.0)
+    assert any("3 row(s) after the last data row hold only delimiters" in note
+               for note in read.metadata["reader_notes"])
+    # an empty row inside the data is a gap in the record, still refused
+    lines = body.splitlines()
+    lines.insert(len(lines) // 2, sep * (width - 1))
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    with pytest.raises(InputFileError, match="non-finite"):
+        read_measurement(path)
+
+
 @pytest.mark.parametrize("cell,name,unit,quantity,scale", [
     # two units in one cell that read differently: the last brackets were taken (kN) for a
     # column of newtons, a silent x1000; now no unit, which the analysis asks for

@@ -369,6 +369,7 @@ def read_csv(path: str | os.PathLike[str], *, sample_rate_hz: float | None = Non
         first_line = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         raise InputFileError(f"{where}: not a numeric delimited table ({first_line}); expected "
                              "one header row of names and units followed by numbers") from None
+    _drop_trailing_empty_rows(columns, where, notes)
     # A trailing delimiter makes an empty last column; drop it.
     while header_cells and not header_cells[-1].strip() and len(columns) == len(header_cells) \
             and np.all(np.isnan(columns[-1])):
@@ -502,6 +503,26 @@ def _numeric_columns(path: str | os.PathLike[str], *, sep: str, decimal: str, sk
         # holds its samples only
         column.resize(filled, refcheck=False)
     return columns
+
+
+def _drop_trailing_empty_rows(columns: list[np.ndarray], where: str, notes: list[str]) -> None:
+    """Cut the rows after the last that holds a value in any column, in place, and say so:
+    a spreadsheet writes rows of bare delimiters (``,,,``, ``;;;``) below its data, which were
+    refused as "the time column holds non-finite values". An empty row inside the data stays
+    (a gap in the record is refused where it is)."""
+    if not columns or columns[0].size == 0:
+        return
+    filled = np.zeros(columns[0].size, dtype=bool)
+    for column in columns:
+        filled |= ~np.isnan(column)
+    given = np.flatnonzero(filled)
+    rows = int(given[-1]) + 1 if given.size else 0
+    if rows == columns[0].size or rows == 0:
+        return
+    for column in columns:
+        column.resize(rows, refcheck=False)
+    notes.append(f"{where}: {filled.size - rows} row(s) after the last data row hold only "
+                 "delimiters (a spreadsheet's empty rows); not read")
 
 
 def _in_seconds(times: np.ndarray, factor: float) -> np.ndarray:
