@@ -91,6 +91,30 @@ def test_explicit_sidecar_and_options_override(tmp_path):
     assert stated.origin == "fill: option; material: option; direction: option"
 
 
+def test_a_value_overriding_another_statement_is_said_and_an_agreeing_one_is_not(tmp_path):
+    # a typo in a sidecar row (75 for 50) moved a test named ..._fill50_acrylic to the 75 %
+    # load case, and --fill over the sidecar's value, both said only by "(fill: ...)"
+    side = tmp_path / "my.csv"
+    side.write_text("file,fill_percent,material,direction\n"
+                    "run_fill50_acrylic.uff,75,aluminium,z\n", encoding="utf-8")
+    stated = resolve_load_case(tmp_path / "run_fill50_acrylic.uff", sidecar=side)
+    assert stated.notes == (
+        "run_fill50_acrylic.uff: fill 75 % (my.csv) overrides 50 % of the file name",
+        "run_fill50_acrylic.uff: material 'aluminium' (my.csv) overrides 'acrylic' of the "
+        "file name")
+    stated = resolve_load_case(tmp_path / "run_fill50_acrylic.uff", sidecar=side,
+                               fill_percent=60, direction="z")
+    assert stated.fill_percent == 60.0
+    assert stated.notes[-1] == "run_fill50_acrylic.uff: fill 60 % (fill_percent=) overrides " \
+                               "75 % of my.csv"
+    assert not any("direction" in n for n in stated.notes)  # z over z: nothing overridden
+    # statements that agree (and a default replaced) say nothing
+    side.write_text("file,fill_percent,material\nrun_fill50_acrylic.uff,50,acrylic\n",
+                    encoding="utf-8")
+    assert resolve_load_case(tmp_path / "run_fill50_acrylic.uff", sidecar=side,
+                             direction="x").notes == ()
+
+
 def test_sidecar_errors_name_the_file(tmp_path):
     bad = _write_sidecar(tmp_path, "name,fill\nx.uff,50\n")
     with pytest.raises(LoadCaseError, match=r"loadcases\.csv.*'file'"):

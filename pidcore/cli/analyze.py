@@ -154,7 +154,10 @@ def _print_results(args: argparse.Namespace, results: list, cases: list, stated:
     records were new (``breakdown``: :meth:`SavedAnalyses.breakdown`)."""
     from ..file_settings import assumed, assumption_notes, files_assumption_notes
 
-    overrides = [note for fs in settings for note in (*fs.notes, fs.unmatched) if note]
+    overrides = [note for st, fs in zip(stated, settings, strict=True)
+                 for note in (*(cli_words(n) for n in (st.notes if st is not None else ())),
+                              *fs.notes, fs.unmatched)
+                 if note]
     # what no statement gave (the paper's coupon and its acrylic): with each record in JSON
     assumptions = [assumed(st, fs.specimen, specimen)
                    for st, fs in zip(stated, settings, strict=True)]
@@ -169,11 +172,12 @@ def _print_results(args: argparse.Namespace, results: list, cases: list, stated:
                                 "assumed": a,
                                 "parameters": fs.options.parameters(),
                                 "settings_from": dict(fs.sources),
-                                "overridden": list(fs.notes),
+                                "overridden": [*(cli_words(n) for n in (
+                                    st.notes if st is not None else ())), *fs.notes],
                                 "sidecar_row_missing": fs.unmatched or None}
-                               for r, c, fs, a, words in zip(results, cases, settings,
-                                                             assumptions, said_assumed,
-                                                             strict=True)],
+                               for r, c, st, fs, a, words in zip(
+                                   results, cases, stated, settings, assumptions, said_assumed,
+                                   strict=True)],
                    "notes": [*overrides, *replaced,
                              *([f"saved {breakdown}"] if breakdown else [])]}, sys.stdout)
         sys.stdout.write("\n")

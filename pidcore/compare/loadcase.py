@@ -150,12 +150,16 @@ class StatedLoadCase:
         Particle material and drive direction.
     origin : str
         Where each value came from, e.g. ``"fill: file name; material: default; ..."``.
+    notes : tuple of str
+        Each value a later statement overrode with another (a sidecar's 75 % over the file
+        name's 50 %, ``--fill`` over the sidecar), in words naming the file.
     """
 
     fill_percent: float
     material: str
     direction: str
     origin: str
+    notes: tuple[str, ...] = ()
 
     def load_case(self, frequency_hz: float, acceleration_g: float) -> LoadCase:
         """The full load case with the measured frequency (Hz) and acceleration (g)."""
@@ -581,8 +585,19 @@ def resolve_load_case(
     values: dict[str, float | str] = {}
     origin: dict[str, str] = {}
 
+    overrides: list[str] = []
+    stated_in = {"file name"}  # the statements a later one overrides with a note
+
     def take(found: dict[str, float | str], where: str) -> None:
         for name, value in found.items():
+            earlier = origin.get(name)
+            if earlier in stated_in and values[name] != value:
+                # a typo in a sidecar row moved a test to another load case, named only by
+                # "(fill: loadcases.csv)" in its origin
+                overrides.append(f"{path.name}: {_STATED_WORDS[name]} {_stated(name, value)} "
+                                 f"({f'{name}=' if where == 'option' else where}) overrides "
+                                 f"{_stated(name, values[name])} of "
+                                 f"{'the file name' if earlier == 'file name' else earlier}")
             values[name] = value
             origin[name] = where
 
@@ -597,6 +612,7 @@ def resolve_load_case(
     row = sidecar_row(path, sidecar, tables=tables)
     if row is not None:
         take(_sidecar_entry(row, known), row.name)
+        stated_in.add(row.name)
     stated_by_user = {"file name"} | ({row.name} if row is not None else set())
     if origin.get("material") not in stated_by_user and material is None:
         _refuse_untabulated_material(path, known, specimen_material)
@@ -616,4 +632,12 @@ def resolve_load_case(
     text = "; ".join(f"{name.split('_')[0]}: {origin.get(name, 'default')}"
                      for name in ("fill_percent", "material", "direction"))
     return StatedLoadCase(float(values["fill_percent"]), str(values["material"]),
-                          str(values["direction"]), text)
+                          str(values["direction"]), text, tuple(overrides))
+
+
+#: How a load case's stated values are named in notes.
+_STATED_WORDS = {"fill_percent": "fill", "material": "material", "direction": "direction"}
+
+
+def _stated(name: str, value: float | str) -> str:
+    return f"{value:g} %" if name == "fill_percent" else repr(value)

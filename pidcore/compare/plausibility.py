@@ -296,7 +296,7 @@ def check_analysis(analysis, *, bound: SdcBound | None = None
                 f"the specimen's coupon and fixture ({bound.structure_mass_kg * 1e3:.4g} g)",
                 "a force or velocity channel whose values are in another unit than its header "
                 "says (kN under 'N', mm/s under 'm/s': check the channel units or give "
-                "--force-unit/--velocity-unit), "
+                "force_unit=UNIT or velocity_unit=UNIT), "
                 "or another specimen than the one assumed"))
     if math.isfinite(sdc) and sdc > bound.sdc:
         out.append(PlausibilityWarning(

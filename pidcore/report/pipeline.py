@@ -973,6 +973,7 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         notes.extend(f"{display_path(r.path.name)}: {n}"
                      for n in plausibility_notes(r.analyzed.analysis, bound=stated_sdc_bounds(
                          [r.stated], [r.settings], specimen)[0]))
+        notes.extend(r.stated.notes)
         if r.settings is not None:
             notes.extend(r.settings.notes)
             if r.settings.unmatched:
