@@ -405,8 +405,14 @@ def particles_for_fill(fill_percent: float, full: int, *, what: str = "fill_perc
         # that holds a particle (1e-9 as 1e-7 % holds none either)
         hint = (f"; was {as_given(fill_percent)} meant as {fill_percent * 100:g} %?"
                 if 0 < fill_percent <= 1.0 and round(fill_percent * full) >= 1 else "")
+        expected = f">= {least:.2f} %"
+        if typed and least <= MAX_AMBIGUOUS_FILL_PERCENT:
+            # "expected >= 0.15 %" sent the user to 0.15, then refused as read as a fraction
+            expected = (f"> {MAX_AMBIGUOUS_FILL_PERCENT:g} % (a smaller one reads as a "
+                        "fraction; for so few particles a specimen file states [particles] "
+                        "count_per_cell)")
         raise ParameterError(f"{what} {as_given(fill_percent)} % of {full} particles rounds to "
-                             f"none; expected >= {least:.2f} %{hint}")
+                             f"none; expected {expected}{hint}")
     if typed and fill_percent <= MAX_AMBIGUOUS_FILL_PERCENT:
         # in a cell of more than 50 particles 0.7 (70 % as a fraction) holds one or more, and
         # ran silently at 3 of 441 particles where 309 were meant

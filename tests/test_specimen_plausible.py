@@ -182,6 +182,29 @@ def test_a_fill_of_no_particle_is_refused_by_check_as_by_dem_run():
     assert describe(ok)["particles_per_cell"] == 1
 
 
+def test_a_typed_fill_of_no_particle_names_a_fill_that_is_then_accepted(tmp_path):
+    # a cell of 600+ particles: "--fill 0.1" said "expected >= 0.09 %", and 0.15 was then
+    # refused as a fraction typed for a percentage (at most 1 %); the bound it names now is
+    # the one a typed fill must pass
+    import re
+
+    from pidcore.specimen import MAX_AMBIGUOUS_FILL_PERCENT, particles_for_fill
+
+    full = 700
+    said = str(pytest.raises(ParameterError, particles_for_fill, 0.05, full,
+                             typed=True).value)
+    assert "count_per_cell" in said
+    bound = float(re.search(r"expected > ([0-9.]+) %", said).group(1))
+    assert bound == MAX_AMBIGUOUS_FILL_PERCENT
+    assert particles_for_fill(bound + 0.01, full, typed=True) >= 1
+    with pytest.raises(ParameterError, match="reads as a fraction"):
+        particles_for_fill(bound, full, typed=True)
+    # not typed (a count's own share), the least fill holding a particle stays the bound
+    said = str(pytest.raises(ParameterError, particles_for_fill, 0.05, full).value)
+    least = float(re.search(r">= ([0-9.]+) %", said).group(1))
+    assert particles_for_fill(least, full) == 1
+
+
 def test_a_table_material_with_other_inline_properties_is_kept_and_said():
     # kept (a calibration fits such fields, e.g. --fit particles.youngs_modulus_pa), but the
     # name then claims one material and the numbers another: check and every run say so
