@@ -189,8 +189,8 @@ APP_MAX_DEM_CASES = 12
 #: Most cells of one DEM run the app's DEM and Calibrate tabs start (the pages' bound, not
 #: the library's: the library refuses only what memory cannot hold).
 APP_MAX_DEM_CELLS = 64
-#: Fill (packing ratio, %) the app proposes for an upload whose name states none (the paper's
-#: experiments were all at 50 %).
+#: Fill (packing ratio, %) of the paper's experiments (all at 50 %), which the app's fill column
+#: names as an example for an upload whose name states none (never filled in for it).
 APP_DEFAULT_FILL_PERCENT = 50.0
 #: Folders (relative to the working folder) the app searches for specimen files: the DEM page
 #: offers them, and their particle materials are materials a measurement may state.

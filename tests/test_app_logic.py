@@ -21,7 +21,6 @@ from pidcore import defaults
 from pidcore.app import jobs, stores, uploads
 from pidcore.app.uploads import AnalysedFile
 from pidcore.compare.case import (
-    PROPOSED_FILL_PERCENT,
     MeasuredEntry,
     compare_case,
     group_load_cases,
@@ -278,15 +277,74 @@ def test_the_settings_grid_edits_numbers_as_text_and_pidcore_reads_them_as_typed
     with pytest.raises(SettingsTableError, match=r"column mass below gauge \[g\]: '-2' is "
                                                  r"negative"):
         uploads.options_of({**row, "mass below gauge [g]": "-2"})
-    for fill in ("12,5", "-30", ""):
+    for fill in ("12,5", "-30"):
         with pytest.raises(LoadCaseError, match=re.escape("a_fill50.csv, column fill [%]: ")):
             uploads.fill_of({**row, "fill [%]": fill})
-    # a cell cleared in the grid is None (or blank text): said empty, not "fill None"
+    # a cell cleared in the grid is None (or blank text): no fill stated, the file has no
+    # load case (as a sidecar's empty fill cell to `pidcore analyze`), not "fill None"
     for cleared in (None, "", "  ", math.nan):
-        with pytest.raises(LoadCaseError) as refused:
-            uploads.fill_of({**row, "fill [%]": cleared})
-        assert str(refused.value) == ("a_fill50.csv, column fill [%]: empty; expected a "
-                                      "packing ratio in (0, 100] %")
+        assert uploads.fill_of({**row, "fill [%]": cleared}) is None
+
+
+def test_a_file_stating_no_fill_gets_an_empty_fill_cell_not_a_proposed_one():
+    # the grid held 50 for a file whose name states no fill ("50 % proposed"), and Save
+    # saved it as a load case "stated in the app"; `pidcore analyze` saves it without one
+    names = ["nofill_f100Hz_a5g.csv", "run_fill75.csv"]
+    settings = uploads.editor_settings(uploads.merge_settings(
+        names, [stated_case(n) for n in names], None))
+    assert settings["fill [%]"].tolist() == ["", "75"]
+    assert [uploads.fill_of(row) for _, row in settings.iterrows()] == [None, 75.0]
+    # the template downloaded from it states none either (an empty sidecar cell)
+    template = uploads.settings_template(settings).decode().splitlines()
+    assert template[1].startswith("nofill_f100Hz_a5g.csv,,")
+
+
+def test_a_fill_of_no_particle_of_the_papers_coupon_is_refused_at_entry_as_the_cli_does(
+        tmp_path, capsys):
+    # 0.5 typed in the grid's fill cell for the paper's acrylic (22 particles a cell) showed a
+    # load case "500 Hz, 1 g, 0.5 %" and was refused only at Save; `pidcore analyze --fill
+    # 0.5` refuses it before any analysis: the app's card now refuses it in the same words
+    from pidcore.cli import main
+    from pidcore.loadcase import LoadCaseError
+    from pidcore.specimen import NamedSpecimen
+
+    path = tmp_path / "run_f500Hz.csv"
+    path.write_bytes(mass_damper_csv(frequency_hz=500.0, acceleration_g=1.0,
+                                     sample_rate_hz=20000))
+    assert main(["analyze", str(path), "--fill", "0.5", "--no-store"]) == 2
+    said = "fill 0.5 % of 22 particles rounds to none; expected >= 2.28 %; was 0.5 meant as 50 %?"
+    assert said in capsys.readouterr().err
+    unnamed = NamedSpecimen("", "")  # no specimen named: the paper's coupon
+    with pytest.raises(LoadCaseError) as refused:
+        uploads.check_specimen_fill(path.name, 0.5, "acrylic", unnamed, None)
+    assert str(refused.value) == f"{path.name}, column fill [%]: {said}"
+    # 22 x 2.28 % = 0.5 rounds to 1 particle (the least fill holding one), and 50 % to 11
+    uploads.check_specimen_fill(path.name, 2.28, "acrylic", unnamed, None)
+    uploads.check_specimen_fill(path.name, 50.0, "acrylic", unnamed, None)
+    # no fill stated, or a specimen known by its name only (its cell not at hand): no rule
+    uploads.check_specimen_fill(path.name, None, "acrylic", unnamed, None)
+    uploads.check_specimen_fill(path.name, 0.5, "acrylic", NamedSpecimen("panel_B", ""), None)
+
+
+def test_a_file_without_a_load_case_is_saved_without_one_and_said(tmp_path, good_csv,
+                                                                  options):
+    # what `pidcore analyze FILE --store S` saves for a file stating no fill: no fill, no load
+    # case key, no origin claiming the app stated one; and the save says so
+    from pidcore.store import Store
+
+    rec = _record(good_csv, options, name="nofill.csv")
+    store_file = tmp_path / "store.h5"
+    saved = uploads.save_records(store_file, [AnalysedFile(rec, None, options, "")])
+    assert saved.notes == (uploads.no_fill_note("nofill.csv"),)
+    assert "saved without one" in saved.notes[0]
+    row = Store(store_file).list_analyses().iloc[0]
+    for field in ("fill_percent", "load_case_key", "load_case_origin"):
+        assert field not in row.index or pd.isna(row[field]), (field, row[field])
+    # neither listed as a load case beside the saved ones nor compared in the report
+    unplaced = uploads.results_table([AnalysedFile(rec, None, options, "")])
+    assert unplaced["load case"].tolist() == ["no load case"]
+    assert "nofill.csv" in uploads.unplaced_note([AnalysedFile(rec, None, options, "")])
+    assert uploads.unplaced_note([_file(rec, options)]) == ""
 
 
 def test_an_own_specimens_material_is_offered_once_its_dem_runs_are_stored():
@@ -986,13 +1044,14 @@ def test_stores_come_from_the_environment_or_the_bundled_samples(tmp_path):
     assert app_stores.stamp() != before  # a rewritten store invalidates cached listings
 
 
-def test_load_case_is_proposed_from_the_name_or_a_fill_proposed():
+def test_load_case_is_taken_from_the_name_and_no_fill_is_proposed_for_a_name_stating_none():
     by_name = stated_case("run_fill75_aluminum_dirx.csv")
     assert (by_name.fill_percent, by_name.material, by_name.direction) == (75.0, "aluminium",
                                                                            "x")
+    # no fill stated: none proposed in its place (a proposed 50 % was saved as stated)
     unstated = stated_case("plain.csv")
-    assert unstated.fill_percent == PROPOSED_FILL_PERCENT
-    assert "not stated" in unstated.origin
+    assert math.isnan(unstated.fill_percent)
+    assert "fill: not stated" in unstated.origin
     # a material the table lacks is not passed off as acrylic: the row says what to set, and
     # the fill the name states is kept; with a steel specimen known it is steel
     steel = stated_case("coupon_fill20_steel.csv")
@@ -1511,8 +1570,9 @@ def test_specimen_files_offer_their_material_and_an_unknown_one_says_how(tmp_pat
         uploads.read_settings_table("settings_brass.csv", table)
     row = {"fill [%]": 50.0, "material": "acrylic"}
     stated = stated_case("coupon.csv")
-    assert uploads.assumed_note(stated, row) == ("fill: not stated, 50 % proposed; "
-                                                 "material: not stated, acrylic assumed")
+    assert uploads.assumed_note(stated, row) == "material: not stated, acrylic assumed"
+    # a row stating no fill has no load case, hence no material (uploads.no_fill_note)
+    assert uploads.assumed_note(stated, {**row, "fill [%]": ""}) == ""
     assert uploads.assumed_note(stated, {"fill [%]": 62.0, "material": "steel"}) == ""
 
 

@@ -2283,6 +2283,58 @@ def test_a_fill_of_no_particle_of_the_uploaded_specimens_cell_is_refused_as_the_
     assert at.button(key="save").disabled  # nothing to save: no test without particles
 
 
+def test_a_file_stating_no_fill_is_saved_without_a_load_case_as_the_cli_saves_it(
+        store_file, tmp_path, capsys):
+    # the card said "fill: not stated, 50 % proposed" and Save saved fill 50 as "stated in
+    # the app": `pidcore report --store` compared it in the 50 % row. `pidcore analyze FILE
+    # --store S` saves it without a load case and says so; the app now does the same
+    from pidcore.cli import main
+    from pidcore.store import Store
+
+    name = "nofill_f100Hz_a5g.csv"
+    data = mass_damper_csv(frequency_hz=100.0, acceleration_g=5.0)
+    (tmp_path / name).write_bytes(data)
+    cli_store = tmp_path / "cli_store.h5"
+    assert main(["analyze", str(tmp_path / name), "--store", str(cli_store)]) == 0
+    assert "no fill stated: saved without a load case" in capsys.readouterr().out
+    at = _upload(_app(), [(name, data)])
+    assert uploads.no_fill_note(name) in [i.value for i in at.info]
+    assert not [i.value for i in at.info if "proposed" in i.value]
+    assert _table(at, "load case")["load case"].tolist() == ["no load case"]
+    at.button(key="save").click().run()
+    assert not at.exception, at.exception
+    assert [w.value for w in at.warning if w.value.startswith(name)] == [
+        uploads.no_fill_note(name)]
+    case_fields = ("fill_percent", "load_case_key", "load_case_origin", "material")
+    app_row, cli_row = (Store(path).list_analyses().iloc[0] for path in (store_file, cli_store))
+    for row in (app_row, cli_row):  # none saved by either (absent, or the listing's empty)
+        assert all(f not in row.index or pd.isna(row[f]) for f in case_fields), row
+    assert app_row["sdc"] == cli_row["sdc"]  # one analysis of one file by both
+    # Compare leaves it out, saying why, as it leaves out the saved record
+    assert any(name in c.value and "not compared" in c.value for c in at.caption)
+
+
+def test_a_fill_of_no_particle_of_the_papers_coupon_is_refused_on_the_card_not_at_save(
+        store_file, tmp_path, capsys):
+    # 0.5 for the paper's acrylic (22 particles a cell) showed the load case "500 Hz, 1 g,
+    # 0.5 %" with its SDC and offered Save, which refused it; `pidcore analyze --fill 0.5`
+    # refuses it at once: the card now does, as it refuses a fill of -10 or 'abc'
+    from pidcore.cli import main
+
+    data = mass_damper_csv(frequency_hz=500.0, acceleration_g=1.0, sample_rate_hz=20000)
+    (tmp_path / "run_f500Hz.csv").write_bytes(data)
+    assert main(["analyze", str(tmp_path / "run_f500Hz.csv"), "--fill", "0.5",
+                 "--no-store"]) == 2
+    said = "fill 0.5 % of 22 particles rounds to none; expected >= 2.28 %; was 0.5 meant as 50 %?"
+    assert said in capsys.readouterr().err
+    table = b"file,fill_percent\nrun_f500Hz.csv,0.5\n"
+    at = _upload(_app(), [("run_f500Hz.csv", data), ("settings.csv", table)])
+    assert [e.value for e in at.error] == [
+        f"run_f500Hz.csv, column fill [%]: {said}; set it in the settings table"]
+    assert not _metric(at, "SDC ± stderr [-]")
+    assert at.button(key="save").disabled
+
+
 def test_a_heavy_particle_sdc_above_2_pi_is_no_implausible_result_of_its_specimen(
         store_file, tmp_path):
     """Was: the Analyse card warned 'Implausible: SDC 9.4 is above the physical bound 6.28' for

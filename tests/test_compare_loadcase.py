@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import pytest
 
 from pidcore.compare import (
@@ -190,8 +192,9 @@ def test_an_own_material_in_the_file_name_is_recognised_when_known():
     stated = stated_case(name, materials=("steel",))
     assert (stated.material, unstated_note(stated)) == ("steel", "")
     plain = stated_case("coupon_500Hz.csv")
-    assert unstated_note(plain) == "fill: not stated, 50 % proposed; material: not stated, " \
-                                   "acrylic assumed"
+    assert math.isnan(plain.fill_percent)  # no fill proposed in its place: none stated
+    assert assumed_note(plain, {"fill [%]": 50.0, "material": plain.material}) == \
+        "material: not stated, acrylic assumed"
 
 
 def test_the_apps_column_labels_read_as_the_sidecars_columns(tmp_path):

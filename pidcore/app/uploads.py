@@ -510,13 +510,26 @@ def file_specimen(typed: str, material: str, known: Sequence[Specimen], *,
                          "settings table")
 
 
-def check_specimen_fill(name: str, fill_percent: float, material: str,
-                        named: NamedSpecimen, given: Specimen | None) -> None:
-    """Refuse the fill of the file ``name`` where it rounds to no particle of the cell of the
-    specimen file uploaded with it (``given``, the record's specimen ``named``), as ``pidcore
-    analyze --specimen`` refuses it: 0.5 typed for 50 % was saved as a test without particles,
-    a load case no DEM run of the specimen can match (a file of the paper's coupon is refused
-    so at Save).
+def tested_specimen(named: NamedSpecimen, candidates: Iterable[Specimen | None]
+                    ) -> Specimen | None:
+    """The specimen file among ``candidates`` (the one uploaded with the exports, the known
+    ones) whose hash is the one a record is saved with (``named``); None where it names
+    none or only a name."""
+    from ..specimen import measured_specimen_sha256
+
+    return next((s for s in candidates if s is not None and named.sha256
+                 and measured_specimen_sha256(s) == named.sha256), None)
+
+
+def check_specimen_fill(name: str, fill_percent: float | None, material: str,
+                        named: NamedSpecimen, tested: Specimen | None) -> None:
+    """Refuse the fill of the file ``name`` where it rounds to no particle of the cell it
+    was tested in, as ``pidcore analyze`` refuses it before any analysis: ``tested``'s (the
+    specimen file of the record's specimen ``named``, :func:`tested_specimen`), the paper's
+    coupon's where ``named`` names no specimen. 0.5 typed for 50 % was shown as a load case
+    "0.5 %" and refused only at Save (at all for a specimen file: saved as a test without
+    particles, a load case no DEM run can match). A specimen known by its name only, whose
+    cell is not at hand, and no fill (None) are left alone.
 
     Raises
     ------
@@ -525,16 +538,16 @@ def check_specimen_fill(name: str, fill_percent: float, material: str,
     """
     from ..dem.simulate import particles_of_stated_fill
     from ..loadcase import LoadCaseError
-    from ..specimen import measured_specimen_sha256
 
-    if given is None or not named.sha256 or named.sha256 != measured_specimen_sha256(given):
+    if fill_percent is None or (named.name and tested is None):
         return
     try:
-        particles_of_stated_fill(fill_percent, material, specimen=given, what="fill",
+        particles_of_stated_fill(fill_percent, material, specimen=tested, what="fill",
                                  typed=True)
     except PidcoreError as exc:
-        raise LoadCaseError(f"{name}, column fill [%]: {exc} (the cell of specimen "
-                            f"{given.name}, {given.source})") from None
+        cell = (f" (the cell of specimen {tested.name}, {tested.source})"
+                if tested is not None else "")
+        raise LoadCaseError(f"{name}, column fill [%]: {exc}{cell}") from None
 
 
 def restate_default_material(previous: pd.DataFrame | None, before: Mapping[str, str],
@@ -768,9 +781,10 @@ def assumed_note(stated, row: Mapping, given: Iterable[str] = ()) -> str:
     assumed."""
     given = set(given)
     parts = []
-    if "fill: not stated" in stated.origin and "fill [%]" not in given and _same_number(
-            row.get("fill [%]"), stated.fill_percent):
-        parts.append(f"fill: not stated, {stated.fill_percent:g} % proposed")
+    # a row stating no fill has no load case, hence no material (no_fill_note says so), as
+    # `pidcore analyze` assumes none for it
+    if _blank(row.get("fill [%]")):
+        return ""
     if "material" not in given and str(row.get("material", "")) == stated.material:
         said = next((part for part in stated.origin.split("; ")
                      if part.startswith("material: ")), "")
@@ -821,6 +835,11 @@ def _row_or_none(table: pd.DataFrame, name: str, shown: str) -> int | None:
 
 def _empty(value) -> bool:
     return value is None or value == "" or (isinstance(value, float) and math.isnan(value))
+
+
+def _blank(value) -> bool:
+    """Empty as a cell typed in the grid may be (spaces only)."""
+    return _empty(value.strip() if isinstance(value, str) else value)
 
 
 def _same_number(value, number: float) -> bool:
@@ -882,20 +901,28 @@ def _cell_text(value) -> str:
     return text[:-2] if text.endswith(".0") else text
 
 
-def fill_of(row: Mapping) -> float:
+def fill_of(row: Mapping) -> float | None:
     """The fill [%] of one file's settings row as typed in the page's editor (text) or given
-    by a settings table (a number): a :class:`pidcore.loadcase.LoadCaseError` naming the
+    by a settings table (a number); None for an empty cell (no fill stated: the file has no
+    load case, :func:`no_fill_note`); a :class:`pidcore.loadcase.LoadCaseError` naming the
     file and the column for anything but a number in (0, 100]."""
-    from ..loadcase import LoadCaseError, check_fill
+    from ..loadcase import check_fill
 
     value = row.get("fill [%]")
-    value = value.strip() if isinstance(value, str) else value
-    where = f"{row['file']}, column fill [%]"
-    if _empty(value):
-        # a cell cleared in the grid comes back as None: "fill None is not a number" named
-        # Python's word for nothing on the page
-        raise LoadCaseError(f"{where}: empty; expected a packing ratio in (0, 100] %")
-    return check_fill(value, where)
+    # a cell cleared in the grid comes back as None (or NaN from a table): nothing stated
+    if _blank(value):
+        return None
+    return check_fill(value.strip() if isinstance(value, str) else value,
+                      f"{row['file']}, column fill [%]")
+
+
+def no_fill_note(name: str) -> str:
+    """What the page says of the file ``name`` whose row states no fill: it is shown and
+    saved without a load case, as ``pidcore analyze`` saves a file stating none (a fill the
+    page proposed was saved as stated, and the report compared it in that fill's row)."""
+    return (f"{name}: fill not stated: no load case; saved without one, as `pidcore analyze` "
+            "saves it (type its fill [%] in the settings table for Compare and `pidcore report "
+            "--store` to place it)")
 
 
 def settings_template(settings: pd.DataFrame) -> bytes:
@@ -975,7 +1002,8 @@ class AnalysedFile:
     """One successfully analysed upload with everything needed to show and save it."""
 
     record: AnalyzedRecord
-    load_case: LoadCase
+    #: None: its row states no fill (:func:`no_fill_note`), saved without a load case
+    load_case: LoadCase | None
     options: AnalysisOptions
     specimen: str
     warnings: tuple = ()
@@ -996,7 +1024,7 @@ def results_table(files: Sequence[AnalysedFile]) -> pd.DataFrame:
             # with material and direction, as Compare lists it: a file set to aluminium
             # read the same as its acrylic twin
             "file": Path(f.record.measurement.source).name,
-            "load case": f.load_case.full_label(),
+            "load case": _case_words(f),
             "specimen": f.specimen, "frequency [Hz]": a.frequency_hz,
             "acceleration [g]": a.acceleration_g, "loss factor [-]": a.loss_factor,
             "SDC [-]": a.sdc, "SDC stderr [-]": a.sdc_stderr,
@@ -1006,6 +1034,22 @@ def results_table(files: Sequence[AnalysedFile]) -> pd.DataFrame:
             "warnings": "; ".join(w.check for w in f.warnings),
         })
     return pd.DataFrame(rows, columns=list(RESULT_COLUMNS))
+
+
+def unplaced_note(files: Sequence[AnalysedFile]) -> str:
+    """Which of this session's analysed ``files`` Compare leaves out: those stating no fill
+    (no load case, :func:`no_fill_note`); "" where none."""
+    names = [Path(f.record.measurement.source).name for f in files if f.load_case is None]
+    if not names:
+        return ""
+    return (f"not compared (fill not stated, no load case): {', '.join(names)}; type their "
+            "fill [%] in the settings table on the Analyse tab")
+
+
+def _case_words(f: AnalysedFile) -> str:
+    from ..measure import NO_LOAD_CASE
+
+    return f.load_case.full_label() if f.load_case is not None else NO_LOAD_CASE
 
 
 def format_sdc(sdc: float, stderr: float) -> str:
@@ -1035,11 +1079,12 @@ def check_one_load_case_per_content(files: Sequence[AnalysedFile]) -> None:
     from ..records import measurement_key
 
     def words(f: AnalysedFile) -> str:
-        return f.load_case.full_label() + (f" on {f.specimen}" if f.specimen else "")
+        return _case_words(f) + (f" on {f.specimen}" if f.specimen else "")
 
     refuse_identical_contents_stating_apart(
         ((Path(f.record.measurement.source).name, measurement_key(f.record.measurement),
-          (f.load_case.key, f.specimen, f.specimen_sha256), words(f)) for f in files),
+          (f.load_case.key if f.load_case is not None else None, f.specimen,
+           f.specimen_sha256), words(f)) for f in files),
         remedy="one measurement is one record: state one load case, or remove one of the files")
 
 
@@ -1065,8 +1110,9 @@ def save_records(path: str | os.PathLike, files: Sequence[AnalysedFile], *,
     """Save analysed files with their load cases to the store in one locked transaction.
 
     Each file's own corrections are its analysis parameters (with its channel mapping); the
-    load case fields and the specimen (its name, and its file's sha256 where known) go into its
-    record. A file with plausibility warnings is
+    load case fields (stated in the app; a file whose row states no fill is saved without a
+    load case and a note says so, :func:`no_fill_note`) and the specimen (its name, and its
+    file's sha256 where known) go into its record. A file with plausibility warnings is
     only saved with ``confirm_implausible`` (the user's explicit confirmation). The notes say
     which saved record each byte-identical file replaces: :func:`pidcore.measure.save_analyses`,
     the save of ``pidcore analyze`` and ``pidcore report``.
@@ -1085,8 +1131,8 @@ def save_records(path: str | os.PathLike, files: Sequence[AnalysedFile], *,
         path, [f.record for f in files],
         # the channel mapping is the record's (channels used), not an analysis parameter
         [replace(f.options, force=None, velocity=None, acceleration=None) for f in files],
-        [(Path(f.record.measurement.source).name, f.load_case, "stated in the app")
-         for f in files],
+        [(Path(f.record.measurement.source).name, f.load_case,
+          "stated in the app" if f.load_case is not None else "") for f in files],
         fields=[{**({"specimen": f.specimen} if f.specimen else {}),
                  **({MEASURED_SHA256_FIELD: f.specimen_sha256}
                     if f.specimen and f.specimen_sha256 else {}),
@@ -1095,4 +1141,6 @@ def save_records(path: str | os.PathLike, files: Sequence[AnalysedFile], *,
                  # as `pidcore analyze` keeps it: judged alike where the file is not at hand
                  **(f.sdc_bound.as_record() if f.sdc_bound is not None else {})}
                 for f in files])
-    return SavedRecords(saved.keys, tuple(saved.notes), saved.breakdown())
+    unplaced = [no_fill_note(Path(f.record.measurement.source).name) for f in files
+                if f.load_case is None]
+    return SavedRecords(saved.keys, (*unplaced, *saved.notes), saved.breakdown())

@@ -38,8 +38,9 @@ from .align import (
 from .loadcase import LoadCase, StatedLoadCase
 from .settings_columns import describe_corrections
 
-#: Fill (packing ratio, %) proposed for a file whose name states none; the user confirms or
-#: corrects it.
+#: Fill (packing ratio, %) the app names as the paper's (its help of the fill column) for a
+#: file whose name states none; never taken as stated: such a file has no load case until the
+#: user types its fill (it was put in the grid and saved as "stated in the app").
 PROPOSED_FILL_PERCENT = defaults.APP_DEFAULT_FILL_PERCENT
 
 
@@ -61,8 +62,9 @@ def stated_case(name: str, sidecar: pd.DataFrame | None = None,
     specimens: ``..._steel.csv``). ``specimen_material``: the particles of the specimen file
     given for the files (``pidcore analyze --specimen``, the Analyse tab's uploaded one): the
     material of a file that states none (origin ``material: specimen``), as the CLI takes it.
-    Without a stated fill, :data:`PROPOSED_FILL_PERCENT` is proposed; the origin says so, and
-    which values are defaults.
+    Without a stated fill, the fill is NaN and the origin says ``fill: not stated``: nothing is
+    proposed in its place, as ``pidcore analyze`` saves such a file without a load case (a
+    proposed 50 % was saved as stated); the origin says which other values are defaults.
     """
     from ..constants import PARTICLE_MATERIALS
     from .loadcase import (
@@ -94,11 +96,10 @@ def stated_case(name: str, sidecar: pd.DataFrame | None = None,
                 else "file name" if "material" in found
                 else "specimen" if specimen_material else "default")
     return StatedLoadCase(
-        float(fill) if untabulated and fill is not None else PROPOSED_FILL_PERCENT,
+        float(fill) if untabulated and fill is not None else math.nan,
         str(found.get("material", specimen_material or defaults.COMPARE_DEFAULT_MATERIAL)),
         str(found.get("direction", defaults.COMPARE_DEFAULT_DIRECTION)),
-        ("fill: file name" if untabulated and fill is not None else
-         f"fill: not stated, {PROPOSED_FILL_PERCENT:g} % proposed")
+        ("fill: file name" if untabulated and fill is not None else "fill: not stated")
         + f"; material: {material}; direction: "
         f"{'file name' if 'direction' in found else 'default'}")
 

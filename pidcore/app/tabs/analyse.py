@@ -26,7 +26,7 @@ def _settings_editor(measurements, tables: dict[str, pd.DataFrame], channel_name
     """The editable per-file settings table; returns the edited frame. ``specimen_material``:
     the particles of the specimen file uploaded with the exports, the material of a file that
     states none."""
-    from pidcore.compare.case import stated_case
+    from pidcore.compare.case import PROPOSED_FILL_PERCENT, stated_case
 
     names = [u.name for u in measurements]
     sig = (tuple((u.name, state.upload_sha256(u)) for u in measurements), tuple(sorted(tables)),
@@ -58,7 +58,10 @@ def _settings_editor(measurements, tables: dict[str, pd.DataFrame], channel_name
         uploads.editor_settings(ss["settings_base"]), key=key, hide_index=True,
         num_rows="fixed", width="stretch", disabled=["file"],
         column_config={
-            "fill [%]": st.column_config.TextColumn(help="packing ratio, 0 < fill <= 100"),
+            "fill [%]": st.column_config.TextColumn(
+                help=f"packing ratio, 0 < fill <= 100 (the paper's tests: "
+                     f"{PROPOSED_FILL_PERCENT:g}); empty: not stated, the file is saved "
+                     "without a load case"),
             "material": st.column_config.SelectboxColumn(
                 options=list(materials), required=True,
                 help="the table's materials, those of the specimen files and of the store's "
@@ -114,7 +117,6 @@ def _card(upload, row, sample_rate_hz, time_unit, materials, given=(), known=(),
     from pidcore.compare.case import load_case_of, stated_case
     from pidcore.compare.plausibility import implausible_findings, tested_sdc_bound
     from pidcore.errors import PidcoreError
-    from pidcore.specimen import measured_specimen_sha256
 
     name = upload.name
     with st.container(border=True):
@@ -155,19 +157,24 @@ def _card(upload, row, sample_rate_hz, time_unit, materials, given=(), known=(),
         except PidcoreError as exc:  # names the file and the column itself
             st.error(f"{exc}; set it in the settings table")
             return None
-        try:
-            case = load_case_of(record, fill_percent=fill, material=str(row["material"]),
-                                direction=str(row["direction"]))
+        try:  # no fill stated: no load case, as `pidcore analyze` saves such a file
+            case = None if fill is None else load_case_of(
+                record, fill_percent=fill, material=str(row["material"]),
+                direction=str(row["direction"]))
         except (PidcoreError, ValueError, TypeError) as exc:
             st.error(f"{name}: no valid load case ({exc}); set it in the settings table")
             return None
-        named = uploads.file_specimen(str(row.get("specimen", "") or ""), case.material, known,
+        material = case.material if case is not None else str(row["material"])
+        named = uploads.file_specimen(str(row.get("specimen", "") or ""), material, known,
                                       given=specimen, every_file=every_file)
-        try:  # before its numbers, as `pidcore analyze --specimen` refuses it before any
-            uploads.check_specimen_fill(name, fill, case.material, named, specimen)
+        tested = uploads.tested_specimen(named, (specimen, *known))
+        try:  # before its numbers, as `pidcore analyze` refuses it before any
+            uploads.check_specimen_fill(name, fill, material, named, tested)
         except PidcoreError as exc:
             st.error(f"{exc}; set it in the settings table")
             return None
+        if case is None:
+            st.info(uploads.no_fill_note(name))
         a = record.analysis
         m1, m2, m3, m4 = st.columns([1, 1, 1, 1.6])  # the SDC ± stderr needs the room
         m1.metric("frequency [Hz]", f"{a.frequency_hz:.3f}")
@@ -178,11 +185,9 @@ def _card(upload, row, sample_rate_hz, time_unit, materials, given=(), known=(),
         # warning to confirm
         # judged against the bound of the specimen tested (its particles' mass on its coupon
         # at this fill), as `pidcore analyze` judges it; 2 pi where its file is not at hand
-        tested = next((s for s in (specimen, *known) if s is not None and named.sha256
-                       and measured_specimen_sha256(s) == named.sha256), specimen)
-        bound = tested_sdc_bound(fill_percent=case.fill_percent, material=case.material,
+        bound = tested_sdc_bound(fill_percent=fill, material=case.material if case else None,
                                  specimen_name=named.name, specimen_sha256=named.sha256,
-                                 given=tested)
+                                 given=tested or specimen)
         warnings, zero_notes = implausible_findings(a, bound=bound)
         for w in warnings:
             # in the page's words: the library's keywords (specimen=FILE) showed as written

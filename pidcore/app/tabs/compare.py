@@ -68,11 +68,15 @@ def _entries(stores, session_files):
     include = st.checkbox("include this session's unsaved analyses", value=True,
                           key="include_session", bind=ADDRESS_BINDING)
     if include:
+        # a file stating no fill has no load case to be compared in, as its saved record
+        unplaced = uploads.unplaced_note(session_files)
+        if unplaced:
+            st.caption(unplaced)
         entries += [MeasuredEntry.from_record(f.record, f.load_case, specimen=f.specimen,
                                               options=f.options,
                                               specimen_sha256=f.specimen_sha256,
                                               sdc_bound=f.sdc_bound)
-                    for f in session_files]
+                    for f in session_files if f.load_case is not None]
     # one data set counted once (a saved file uploaded again, or under another name)
     entries, notes = unique_entries(entries)
     for note in notes:
@@ -140,7 +144,7 @@ def render(stores, session_files: list, calibrations: list) -> None:
         return
     if not entries:
         st.info(f"No analysed records: {stores.path} holds no saved analyses with a load case "
-                "(or the filters exclude them), and nothing is analysed in this session. "
+                "(or the filters exclude them), and nothing analysed in this session has one. "
                 "Upload and save measurements on the Analyse tab.")
         return
     groups = group_entries(entries)
