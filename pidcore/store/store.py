@@ -265,6 +265,36 @@ def _write_entry(parent: h5py.Group, key: str, entry: _PreparedEntry, *, layout:
         dataset.attrs["unit"] = entry.units.get(name, "")
 
 
+def _holds_entry(group: h5py.Group, entry: _PreparedEntry,
+                 link_attrs: Mapping[str, str]) -> bool:
+    """Whether ``group`` holds exactly what :func:`_write_entry` would write of ``entry`` (its
+    creation time aside), bit for bit, by this pidcore version."""
+    def same(stored: Any, value: Any) -> bool:
+        stored, value = np.asarray(stored), np.asarray(value)
+        return stored.dtype == value.dtype and stored.shape == value.shape and \
+            stored.tobytes() == value.tobytes()
+
+    try:
+        attrs = group.attrs
+        if (_text(attrs.get("pidcore_version", "")) != __version__
+                or _text(attrs.get("parameters_json", "")) != entry.parameters_json
+                or _text(attrs.get("null_fields_json", "")) != json.dumps(
+                    list(entry.null_fields))
+                or any(_text(attrs.get(k, "")) != v for k, v in link_attrs.items())):
+            return False
+        record, units, arrays = group["record"].attrs, group["units"].attrs, group["arrays"]
+        if (set(record) != set(entry.values) or set(units) != set(entry.units)
+                or set(arrays) != set(entry.arrays)):
+            return False
+        return (all(isinstance(record[k], bytes | str) == isinstance(v, bytes | str)
+                    and (_text(record[k]) == _text(v) if isinstance(v, bytes | str)
+                         else same(record[k], v)) for k, v in entry.values.items())
+                and all(_text(units[k]) == v for k, v in entry.units.items())
+                and all(same(arrays[k][()], v) for k, v in entry.arrays.items()))
+    except (KeyError, TypeError, ValueError, OSError):  # a damaged entry: written anew
+        return False
+
+
 def _read_entry(group: h5py.Group, key: str, *, where: str) -> StoredEntry:
     """The entry ``group`` as written by :func:`_write_entry`; one damaged in its layout (a
     subgroup missing, a JSON attribute that is not JSON, a record field that is not a scalar,
@@ -859,6 +889,13 @@ class Store:
                                  "add the measurement first")
             parent = h5[_ANALYSES]
             if key in parent:
+                if _holds_entry(parent[key], entry, {"measurement_key": measurement_key}):
+                    # the same analysis saved again: rewriting it grew the file by the space
+                    # HDF5 does not give back (1.53 -> 1.59 MB over 12 identical saves). Its
+                    # time is renewed in place: the newest save of a measurement is the one
+                    # reports use (saved with a delay, without, then with it again)
+                    parent[key].attrs["created_utc"] = _utc_now()
+                    return key
                 del parent[key]
             self._check_room_to_write(h5, entry.nbytes, what=f"analysis {key!r}")
             _write_entry(parent, key, entry, layout=_LAYOUT_ANALYSIS,
