@@ -1530,6 +1530,28 @@ def test_a_byte_identical_file_under_another_name_says_what_it_replaces(tmp_path
         "the name saved last) and counted once"]
 
 
+def test_a_file_saved_again_with_another_delay_says_its_new_sdc_is_the_one_used(
+        tmp_path, good_csv):
+    # a second session uploaded the file without its settings table (delay 0 µs) and Save
+    # said only "saved 1 analysis record(s)": Compare and Report moved to its SDC
+    from pidcore.measure import AnalysisOptions
+    from pidcore.store.listing import saved_analyses
+
+    store_file = tmp_path / "s.h5"
+    delayed = AnalysisOptions(velocity_delay_s=2e-5)
+    first = _record(good_csv, delayed, name="a_fill50.csv")
+    assert uploads.save_records(store_file, [_file(first, delayed)]).notes == ()
+    plain = AnalysisOptions()
+    again = _record(good_csv, plain, name="a_fill50.csv")
+    (note,) = uploads.save_records(store_file, [_file(again, plain)]).notes
+    assert note == (f"a_fill50.csv was saved before with other settings (velocity_delay_s "
+                    f"2e-05 -> 0.0; SDC {first.analysis.sdc:.4g}); this analysis (SDC "
+                    f"{again.analysis.sdc:.4g}) is the one reports and calibrations use now, "
+                    "the earlier is kept in the store")
+    assert f"{first.analysis.sdc:.4g}" != f"{again.analysis.sdc:.4g}"  # 0.72 deg at 100 Hz
+    assert saved_analyses(store_file)["sdc"].tolist() == [again.analysis.sdc]
+
+
 def test_identical_contents_are_pooled_once(tmp_path, good_csv, options):
     # the saved a.csv and this session's b.csv (same bytes) and a second session copy: one
     # measurement; pooling them would count the data three times (stderr / sqrt(3))
