@@ -510,18 +510,21 @@ def _drop_trailing_empty_rows(columns: list[np.ndarray], where: str, notes: list
     a spreadsheet writes rows of bare delimiters (``,,,``, ``;;;``) below its data, which were
     refused as "the time column holds non-finite values". An empty row inside the data stays
     (a gap in the record is refused where it is)."""
-    if not columns or columns[0].size == 0:
-        return
-    filled = np.zeros(columns[0].size, dtype=bool)
-    for column in columns:
-        filled |= ~np.isnan(column)
-    given = np.flatnonzero(filled)
-    rows = int(given[-1]) + 1 if given.size else 0
-    if rows == columns[0].size or rows == 0:
-        return
+    if not columns or columns[0].size == 0 or not all(np.isnan(c[-1]) for c in columns):
+        return  # the usual file: its last row holds a value (nothing allocated for it)
+    rows = 0
+    for column in columns:  # each column's last value, from the end in blocks
+        for end in range(column.size, 0, -_CSV_CHUNK_ROWS):
+            given = np.flatnonzero(~np.isnan(column[max(end - _CSV_CHUNK_ROWS, 0):end]))
+            if given.size:
+                rows = max(rows, max(end - _CSV_CHUNK_ROWS, 0) + int(given[-1]) + 1)
+                break
+    if rows == 0:
+        return  # no value at all: refused as such below
+    total = columns[0].size
     for column in columns:
         column.resize(rows, refcheck=False)
-    notes.append(f"{where}: {filled.size - rows} row(s) after the last data row hold only "
+    notes.append(f"{where}: {total - rows} row(s) after the last data row hold only "
                  "delimiters (a spreadsheet's empty rows); not read")
 
 
