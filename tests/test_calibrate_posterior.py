@@ -293,3 +293,44 @@ def test_the_monte_carlo_error_of_chain_samples_counts_the_chains_effective_draw
     # formula leaves out the picking's finite-population term (-n/length: 3 % of the variance)
     assert np.mean(errors) == pytest.approx(scatter, rel=0.15)
     assert np.mean(iid) < 0.7 * scatter  # the old error: 1.7x too small here
+
+
+def test_a_measured_sdc_below_zero_within_its_noise_is_inside_its_band():
+    # zero damping measured with noise: -0.057 +- 0.13 (7 degrees of freedom) beside a model
+    # SDC of 0.002. The band's draws were cut at 0 after the measurement's own error was
+    # added: band 0 .. 0.31, verdict "no" in-sample and leave-one-out, and every measurement
+    # below 0 (half of them here) outside. The model's SDC is fixed (baseline prior 0..1e-6,
+    # no discrepancy or floor): the band is that SDC + 0.13 t_7 exactly
+    from scipy import stats
+
+    from pidcore.calibrate.calibrate import _row
+    from pidcore.calibrate.posterior import predictive
+    from pidcore.calibrate.prediction import row_verdict
+    from pidcore.compare.plausibility import UNKNOWN_SPECIMEN_BOUND
+
+    stderr, dof = 0.13, 7.0
+    surrogate = LinearSurrogate(1e-5, np.zeros(0))
+    specs = (ParameterSpec("baseline_loss_factor", "observation", 0.0, 0.0, 1e-6, "eta"),)
+    points = (MeasuredPoint(100.0, 1.0, 50.0, -0.057, stderr, sdc_stderr_dof=dof),
+              MeasuredPoint(100.0, 1.0, 50.0, 0.05, stderr, sdc_stderr_dof=1.0))
+    model = Model(specs, (surrogate,) * 2, points,
+                  {"fixture_mass_kg": 0.0, "model_discrepancy": 0.0}, 0.0)
+    samples = sample_posterior(model, [0, 1], seed=1, method="grid").samples
+    band = predictive(model, samples, 0, rng=np.random.default_rng(0))
+    sdc = 2 * math.pi * 1e-5 / (REACTIVE_KG + COUPON_KG)
+    # the baseline's prior, up to 1e-6, adds at most 2 pi 1e-6 m_s / (m_p + m_s) = 5e-6
+    assert band["predicted"] == pytest.approx(sdc, abs=5.2e-6)
+    half = stats.t.ppf(0.975, dof) * stderr  # 0.307
+    # the 2.5 % and 97.5 % points of 4000 t_7 draws scatter by ~0.07 t = 0.009: 4 sd
+    assert band["low95"] == pytest.approx(sdc - half, abs=0.04)
+    assert band["high95"] == pytest.approx(sdc + half, abs=0.04)
+    # the verdict of the calibration's rows (in-sample and leave-one-out alike)
+    assert row_verdict(_row(points[0], band), UNKNOWN_SPECIMEN_BOUND) == "yes"
+    # held-out measurements drawn from the error model: 95 % inside (binomial, 3.3 sd)
+    y = sdc + stderr * np.random.default_rng(5).standard_t(dof, 4000)
+    inside = np.mean((band["low95"] <= y) & (y <= band["high95"]))
+    assert abs(inside - 0.95) < 3.3 * math.sqrt(0.95 * 0.05 / 4000)
+    # a measurement of 1 degree of freedom (t = 12.7): below -3 stderr it is refused as energy
+    # created beyond its noise, so its band stops there (P(t_1 < -3) = 10 % of the draws)
+    noisy = predictive(model, samples, 1, rng=np.random.default_rng(0))
+    assert noisy["low95"] == -3 * stderr

@@ -622,7 +622,8 @@ def test_a_band_spanning_every_plausible_sdc_is_uninformative_and_not_counted(tm
     # 0.121 .. 0.860 about 0.492. Two records pooled there (stderr 1.795 of 1 degree of
     # freedom, t = 12.71) widen it to 0.492 -/+ hypot(0.37, 22.8): below 0 and past the paper
     # coupon's SDC bound at 50 % (8 m_p/m_s = 16.9: 46.8 g of spheres on 22.2 g), so cut to
-    # 0 .. 16.9, every SDC that coupon can give. The row read "yes" and the report "inside 1
+    # -5.385 .. 16.9 (below, -3 stderr: a measurement lower is refused as energy created
+    # beyond its noise), every SDC that coupon can give. The row read "yes" and the report "inside 1
     # of 1"; a precise measurement at 50 Hz is still judged, as before.
     from pidcore.compare.plausibility import UNKNOWN_SPECIMEN_BOUND, sdc_bound
     from pidcore.constants import BAND_VERDICTS
@@ -635,20 +636,20 @@ def test_a_band_spanning_every_plausible_sdc_is_uninformative_and_not_counted(tm
     cal = load_calibration(_write(tmp_path / "calibration.json",
                                   [pooled, _prediction(50, 5, 50, 0.24, 0.05, 0.43)]))
     hit = cal.lookup(LoadCase(500, 5, 50))
-    assert hit.band(1.795, 1.0) == (0.0, bound.sdc)
+    assert hit.band(1.795, 1.0) == (-3 * 1.795, bound.sdc)
     reason = hit.uninformative_reason(1.795, 1.0)
-    assert reason.startswith("uninformative: the calibrated 95 % band 0 .. 16.91 spans every "
+    assert reason.startswith("uninformative: the calibrated 95 % band -5.385 .. 16.91 spans every "
                              "plausible SDC (0 to 16.91, the bound of the specimen's particles; "
                              "this measurement's own scatter widens it)")
     # a band cut at 0 only, or at the bound only, still tests the model
     assert hit.uninformative_reason(0.0, 1.0) == ""
     assert hit.uninformative_reason(0.3, 1.0) == ""   # 0.492 - hypot(0.371, 3.81) < 0 only
-    assert hit.band(0.3, 1.0)[0] == 0.0 and hit.band(0.3, 1.0)[1] < bound.sdc
+    assert hit.band(0.3, 1.0)[0] == -3 * 0.3 and hit.band(0.3, 1.0)[1] < bound.sdc
     # where the specimen is not known the bound is 2 pi, and the same rule holds there
     unknown = dataclasses.replace(hit, sdc_bound=UNKNOWN_SPECIMEN_BOUND)
-    assert unknown.band(1.795, 1.0) == (0.0, 2 * math.pi)
+    assert unknown.band(1.795, 1.0) == (-3 * 1.795, 2 * math.pi)
     assert unknown.uninformative_reason(1.795, 1.0).startswith(
-        "uninformative: the calibrated 95 % band 0 .. 6.283 spans every plausible SDC (0 to "
+        "uninformative: the calibrated 95 % band -5.385 .. 6.283 spans every plausible SDC (0 to "
         "2 pi; this measurement's own scatter widens it)")
     table = pd.DataFrame({
         "frequency [Hz]": [500.0, 50.0, 500.0], "acceleration [g]": [5.0, 5.0, 5.0],
@@ -662,7 +663,7 @@ def test_a_band_spanning_every_plausible_sdc_is_uninformative_and_not_counted(tm
     assert UNINFORMATIVE in BAND_VERDICTS and f"/{UNINFORMATIVE}]" in CALIBRATED_INSIDE_COLUMN
     assert out["note"].iloc[0].startswith("pooled 2 records; " + reason)
     assert (out[CALIBRATED_LOW_COLUMN].iloc[0], out[CALIBRATED_HIGH_COLUMN].iloc[0]) == (
-        0.0, bound.sdc)
+        -3 * 1.795, bound.sdc)
     summary = out.attrs["notes"][-1]
     assert summary.endswith("inside the 95 % band at 2 of 2 measured row(s) (1 more "
                             "uninformative: a band of 0 .. the SDC bound, spanning every "
@@ -701,7 +702,7 @@ def test_the_report_files_show_the_uninformative_verdict(tmp_path):
     for fmt in ("md", "html"):
         text = written[fmt].read_text(encoding="utf-8")
         # the row note: the paper coupon's bound at 50 %, 8 m_p/m_s (46.8 g on 22.2 g)
-        assert f"{UNINFORMATIVE}: the calibrated 95 % band 0 .. 16.91" in text
+        assert f"{UNINFORMATIVE}: the calibrated 95 % band -5.385 .. 16.91" in text
         assert "(1 more uninformative: a band of 0 .. the SDC bound" in text  # the report's note
     labels, rows = pdf_table_cells(table)
     shown = {label.replace("\n", " "): cell for label, cell in zip(labels, rows[0], strict=True)}
@@ -731,8 +732,9 @@ def test_every_page_writes_the_band_as_band_text_beside_its_verdict(tmp_path):
                         "fill_percent": [50.0] * 3, "material": ["acrylic"] * 3,
                         "direction": ["z"] * 3, "sdc": [0.55, 0.3, 0.4],
                         "sdc_stderr": [0.01] * 3, "case_key": ["b", "c", "d"]})
-    # two records pooled at 500 Hz (stderr 1.795 of 1 dof): the band 0 .. the paper coupon's
-    # bound at 50 %, 16.91; a measurement at 50 Hz with the fitted point's stderr 0: its band
+    # two records pooled at 500 Hz (stderr 1.795 of 1 dof): the band -5.385 (-3 stderr) .. the
+    # paper coupon's bound at 50 %, 16.91; a measurement at 50 Hz with the fitted point's
+    # stderr 0: its band
     analyses = pd.DataFrame({"frequency_hz": [500.0, 50.0], "acceleration_g": [5.0, 5.0],
                              "fill_percent": [50.0, 50.0], "sdc": [2.295, 0.3],
                              "sdc_stderr": [1.795, 0.0], "sdc_stderr_dof": [1.0, math.nan],
@@ -743,12 +745,12 @@ def test_every_page_writes_the_band_as_band_text_beside_its_verdict(tmp_path):
     assert by_f.loc[50.0, CALIBRATED_INSIDE_COLUMN] == "yes"
     # the bound 16.91 (8 m_p/m_s: 46.8 g of spheres on 22.2 g) and the file's band, 4 digits;
     # the 100 Hz row is not predicted: no band
-    expected = {500.0: "0 .. 16.91", 50.0: "0.1235 .. 0.5679", 100.0: ""}
+    expected = {500.0: "-5.385 .. 16.91", 50.0: "0.1235 .. 0.5679", 100.0: ""}
     shown = with_band_text(table)
     assert CALIBRATED_LOW_COLUMN not in shown and CALIBRATED_HIGH_COLUMN not in shown
     assert dict(zip(shown["frequency [Hz]"], shown[CALIBRATED_BAND_COLUMN],
                     strict=True)) == expected
-    assert f"{UNINFORMATIVE}: the calibrated 95 % band 0 .. 16.91 spans" in \
+    assert f"{UNINFORMATIVE}: the calibrated 95 % band -5.385 .. 16.91 spans" in \
         by_f.loc[500.0, "note"]  # the note's words are the cell's
     # the app's Report grid
     grid = report_display(table)
@@ -766,7 +768,7 @@ def test_every_page_writes_the_band_as_band_text_beside_its_verdict(tmp_path):
     assert "calibrated 95 % band [-]" in text[0]
     assert "measured in calibrated 95 % band" in text[0]
     (row,) = [line for line in text[2:] if line.split()[0] == "500"]
-    assert "0 .. 16.91" in row and row.split().count(UNINFORMATIVE) == 1
+    assert "-5.385 .. 16.91" in row and row.split().count(UNINFORMATIVE) == 1
     (row,) = [line for line in text[2:] if line.split()[0] == "50"]
     assert "0.1235 .. 0.5679" in row and "yes" in row.split()
 
@@ -961,3 +963,30 @@ def test_a_measurement_with_a_baseline_taken_off_is_judged_at_its_sdc_before_it(
     (row,) = table[table["SDC measured (Eq. 11) [-]"].notna()].to_dict("records")
     assert row[MEASURED_BASELINE_COLUMN] == 0.0 and row[CALIBRATED_INSIDE_COLUMN] == "yes"
     assert "judged at the measured SDC before" not in str(row["note"])
+
+
+def test_a_negative_measured_sdc_within_its_noise_is_judged_by_a_band_reaching_below_zero(
+        tmp_path):
+    # zero damping measured with noise, -0.057 +- 0.13 of 7 dof, beside a calibrated SDC of
+    # 0.044 (band without measurement error 0.020 .. 0.080): the widened band was cut at 0 and
+    # the measurement judged "no" by the report, the app and the case sheet. Widened in
+    # quadrature it is 0.044 - hypot(0.024, t_7 0.13) = -0.264 .. 0.353: inside
+    from scipy import stats
+
+    from pidcore.calibrate.prediction import judge_measurement
+
+    row = {**_prediction(100, 1, 50, 0.044, 0.020, 0.080), "measured_stderr": 0.0,
+           "low95_without_stderr": 0.020, "high95_without_stderr": 0.080}
+    hit = load_calibration(_write(tmp_path / "calibration.json", [row])).lookup(
+        LoadCase(100, 1, 50))
+    q = stats.t.ppf(0.975, 7)
+    judged = judge_measurement(hit, -0.057, 0.13, 7.0)
+    assert judged.verdict == "yes"
+    assert judged.low == pytest.approx(0.044 - math.hypot(0.024, q * 0.13), rel=1e-9)
+    # a precise negative one is outside (and refused where it is read: 3 stderr below 0)
+    assert judge_measurement(hit, -0.057, 0.01, 7.0).verdict == "no"
+    # 1 degree of freedom (t = 12.7): the band stops at -3 stderr, the lowest measurement
+    # that is kept (pidcore.compare.plausibility.lowest_kept_sdc), as its top at the SDC bound
+    assert hit.band(0.13, 1.0)[0] == -3 * 0.13
+    # without a stderr a negative SDC is not kept: the band stops at 0, as it did
+    assert hit.band(0.0)[0] == 0.020

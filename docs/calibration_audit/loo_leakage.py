@@ -119,7 +119,8 @@ def main() -> int:
         # the closed form itself (the GP surrogate interpolates 5 design runs of it)
         s = closed_form_sdc(i, x[:, 0], x[:, 1], x[:, 2], coupon)
         surrogate_error = float(np.median(s)) / row["predicted"] - 1
-        # (c) the band from the same samples, computed here (cut at 0), without the
+        # (c) the band from the same samples, computed here (cut at -3 stderr, below which a
+        # measurement is refused), without the
         # surrogate's variance (2 % standard errors on d and m_p: small beside tau s)
         tau = x[:, 3]
         sd = np.sqrt(points[i].sdc_stderr ** 2 + (tau * s) ** 2 + FLOOR**2)
@@ -127,7 +128,9 @@ def main() -> int:
         def cdf(v, s=s, sd=sd):
             return float(np.mean(special.ndtr((v - s) / sd)))
 
-        band = [0.0 if cdf(0.0) >= p else optimize.brentq(lambda v, p=p: cdf(v) - p, 0, 20)
+        lowest = -3.0 * points[i].sdc_stderr
+        band = [lowest if cdf(lowest) >= p
+                else optimize.brentq(lambda v, p=p: cdf(v) - p, lowest, 20)
                 for p in (0.025, 0.975)]
         width = band[1] - band[0]
         # 2.5 % tails of 4000 draws: ~2 % of the width; the surrogate's small variance

@@ -9,7 +9,8 @@ Independent computation: midpoint quadrature on (theta, m_f, eta, log tau) (log 
 the log-uniform prior, so no Jacobian is needed), coarse pass over the prior box then a fine
 pass over the box holding all nodes within e^-25 of the peak; marginal quantiles from the
 cumulative sum (linear inside a cell); posterior-predictive quantiles of a held-out case by
-solving sum_j w_j Phi((q - s_j) / sigma_j) = p (an SDC cut at 0, as documented).
+solving sum_j w_j Phi((q - s_j) / sigma_j) = p (a measured SDC cut at -3 sdc_stderr, below
+which a measurement is refused, as documented).
 
 Run: PYTHONPATH=. python docs/calibration_audit/posterior_quadrature.py
 """
@@ -78,10 +79,11 @@ def predictive_quantiles(problem, x, w, case, q=(2.5, 97.5)):
     def cdf(v):
         return float(np.sum(w * special.ndtr((v - s) / sd)))
 
+    lowest = -3.0 * float(problem.stderr[case])  # a measurement below it is refused
     out = []
     for p in np.asarray(q) / 100.0:
-        out.append(0.0 if cdf(0.0) >= p else optimize.brentq(
-            lambda v, p=p: cdf(v) - p, 0.0, 10.0))
+        out.append(lowest if cdf(lowest) >= p else optimize.brentq(
+            lambda v, p=p: cdf(v) - p, lowest, 10.0))
     return out, float(np.sum(w * s))
 
 

@@ -48,9 +48,10 @@ def main(method: str = "grid", trials: int = 300, fit: str = "all") -> int:
         covered.append((low <= fitted_truth) & (fitted_truth <= high))
         ranks.append(np.mean(samples < fitted_truth, axis=0))
         band = predictive(model, samples, 11, rng=rng)
-        # the band is that of max(SDC, 0) (documented: cut at SDC = 0); tau up to 2 draws
-        # negative synthetic SDCs, which the cut band holds as 0
-        band_hits.append(band["low95"] <= max(y[11], 0.0) <= band["high95"])
+        # the band is cut at -3 stderr, below which a measurement is refused (documented);
+        # tau up to 2 draws synthetic SDCs below it, which the cut band holds as that
+        lowest = -3.0 * float(problem.stderr[11])
+        band_hits.append(band["low95"] <= max(y[11], lowest) <= band["high95"])
         negative += y[11] < 0
     covered = np.array(covered)
     tol = 3 * math.sqrt(0.95 * 0.05 / trials)

@@ -26,6 +26,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ..compare.plausibility import lowest_kept_sdc
 from ..errors import ParameterError
 from .data import MeasuredPoint
 from .likelihood import log_density
@@ -370,11 +371,14 @@ def predictive(model: Model, samples: np.ndarray, index: int, *,
     SDC (its mean: no measurement error or discrepancy; RMS errors are of it), and ``low95``
     / ``high95``, the posterior-predictive 95 % band of a measurement there (parameters,
     surrogate variance, discrepancy, floor and the point's own ``sdc_stderr``: what a
-    measured value is checked against); ``predicted_low95`` / ``predicted_high95``: the 95 %
-    band of the model's SDC alone; ``low95_without_stderr`` / ``high95_without_stderr``: the
-    band of a measurement without measurement error (all of the above but ``sdc_stderr``),
-    which :meth:`pidcore.calibrate.prediction.CalibratedPrediction.band` widens by another
-    measurement's own stderr.
+    measured value is checked against; not cut at 0, since a measurement of a small SDC lies
+    below it by its noise, but at :func:`~pidcore.compare.plausibility.lowest_kept_sdc` of
+    the point's stderr, below which a measurement is refused: 0 without a stderr);
+    ``predicted_low95`` / ``predicted_high95``: the 95 % band of the model's SDC alone (>= 0);
+    ``low95_without_stderr`` / ``high95_without_stderr``: the band of a measurement without
+    measurement error (all of the above but ``sdc_stderr``; uncut, its bottom below 0 where
+    the discrepancy's normal tail reaches there), which :meth:`pidcore.calibrate.prediction.
+    CalibratedPrediction.band` widens by another measurement's own stderr.
 
     Where the point's stderr states its degrees of freedom (``sdc_stderr_dof``, e.g. 7 of an
     8-block analysis), its measurement error is drawn from Student's t with them, scaled by
@@ -395,9 +399,16 @@ def predictive(model: Model, samples: np.ndarray, index: int, *,
         draws = error_free + stderr * rng.standard_t(point.sdc_stderr_dof, size=sdc.shape)
     else:  # unknown degrees of freedom: normal (the bundled calibration's draws, unchanged)
         draws = sdc + normal * np.sqrt(variance)
-    # an SDC is >= 0 (dissipation): the normal error model's tail below 0 is cut there
-    low, high = np.percentile(np.maximum(draws, 0.0), [2.5, 97.5])
-    low0, high0 = np.percentile(np.maximum(error_free, 0.0), [2.5, 97.5])
+    # the model's SDC is >= 0 as it is (d > 0, eta_0 >= 0), and nothing else is cut at 0: a
+    # measurement holds its own error, and one of a small SDC lies below 0 as often as its
+    # noise says (-0.057 +- 0.13 of 7 dof was judged outside a band cut to 0 .. 0.46, its
+    # draws' -0.25 .. 0.46). The measurement's band is cut only where a measurement is
+    # refused, below 0 beyond its noise (lowest_kept_sdc: 0 without a stderr, as before), as
+    # its top is at the SDC bound. The band without measurement error is not cut at all: it
+    # is what CalibratedPrediction.band widens by another stderr, and its draws' tail below
+    # 0 cut off narrowed that band's bottom (the likelihood's errors are not cut either)
+    low, high = np.percentile(np.maximum(draws, lowest_kept_sdc(stderr)), [2.5, 97.5])
+    low0, high0 = np.percentile(error_free, [2.5, 97.5])
     return {"predicted": float(np.median(sdc)), "low95": float(low), "high95": float(high),
             "predicted_low95": float(np.percentile(sdc, 2.5)),
             "predicted_high95": float(np.percentile(sdc, 97.5)),

@@ -37,6 +37,7 @@ from ..compare.plausibility import (
     SDC_UPPER_BOUND,
     UNKNOWN_SPECIMEN_BOUND,
     SdcBound,
+    lowest_kept_sdc,
 )
 from ..constants import BAND_VERDICTS
 from ..errors import ParameterError, instance_of, real_number
@@ -200,8 +201,8 @@ class CalibratedPrediction:
         are that point's, ``stderr`` is unknown (NaN) or they cannot be told apart (an older
         calibration.json); else the band without measurement error widened by ``stderr``
         (each side's distance from :attr:`sdc` and q ``stderr`` added in quadrature, q the
-        :func:`band_quantile` of ``dof``: Student's t where known, 1.96 where not; cut at 0):
-        a precise new measurement is not judged by the wider band of a noisy fitted one, nor
+        :func:`band_quantile` of ``dof``: Student's t where known, 1.96 where not): a
+        precise new measurement is not judged by the wider band of a noisy fitted one, nor
         a noisy one by a narrow band. The quadrature is exact for normal errors; with the
         t's quantile it is at most ~1 % wider than the exact quantile of normal + t (e.g.
         3.07 for 3.05 where both parts are equal: on the safe side), and exact where either
@@ -217,6 +218,13 @@ class CalibratedPrediction:
         of the measurements that can be kept wherever at most half the model's draws lie
         above the bound ((0.975 - p) / (1 - p) >= 0.95 for p <= 0.5); :meth:`band_note`
         says it was cut, and that the model does not constrain the SDC there.
+
+        The lower bound is not cut at 0: a measurement holds its own error, and one of a small
+        SDC lies below 0 as often as its noise says (-0.057 +- 0.13 of 7 degrees of freedom,
+        zero damping measured with noise, was judged outside a band cut to 0 .. 0.46). It is
+        cut only at :func:`~pidcore.compare.plausibility.lowest_kept_sdc` of ``stderr``
+        (-3 ``stderr``; 0 without one), below which a measurement is refused as energy
+        created beyond its noise, as the top is cut where one is refused.
         """
         low, high = self.model_band(stderr, dof)
         # a model median above the bound leaves no band below it: [bound, bound], noted
@@ -226,7 +234,9 @@ class CalibratedPrediction:
     def model_band(self, stderr: float = math.nan, dof: float = math.nan) -> tuple[float, float]:
         """:meth:`band` before its upper bound is cut at :attr:`sdc_bound`: the
         posterior-predictive band as the normal error model gives it (:meth:`band_note` says
-        where it reaches beyond)."""
+        where it reaches beyond), its bottom cut at the lowest SDC a measurement of ``stderr``
+        is kept at (the fitted point's band was cut there when drawn:
+        :func:`pidcore.calibrate.posterior.predictive`)."""
         stderr = real_number("stderr", stderr)
         q = band_quantile(dof)  # checks dof before any early return
         if self._fitted_band_applies(stderr, dof):
@@ -239,7 +249,7 @@ class CalibratedPrediction:
         if not math.isfinite(high):  # a stderr near 1e308: its band has no finite bound
             raise ParameterError(f"stderr {stderr!r}: no finite 95 % band; expected a "
                                  "standard error of an SDC")
-        return max(low, 0.0), high
+        return max(low, lowest_kept_sdc(stderr)), high
 
     def band_note(self, stderr: float = math.nan, dof: float = math.nan) -> str:
         """Where :meth:`model_band` reaches above :attr:`sdc_bound`: that it was cut
@@ -293,6 +303,8 @@ class CalibratedPrediction:
         "inside 1 of 1"."""
         low, high = self.band(stderr, dof)
         bound = self.sdc_bound.sdc
+        # every SDC the coupon can have, 0 .. the bound: a bottom below 0 (a noisy
+        # measurement's, cut at lowest_kept_sdc) holds no more of them
         if not (low <= 0.0 and high >= bound):
             return ""
         widening = self._measurement_widening(stderr, dof)
@@ -301,7 +313,7 @@ class CalibratedPrediction:
                  "the calibration does not constrain the SDC here")
         upper = ("2 pi" if bound <= SDC_UPPER_BOUND else
                  f"{bound:.4g}, the bound of the specimen's particles")
-        return (f"uninformative: the calibrated 95 % band {band_text(0.0, bound)} spans every "
+        return (f"uninformative: the calibrated 95 % band {band_text(low, high)} spans every "
                 f"plausible SDC (0 to {upper}; {cause}), so it cannot test the model: not "
                 "judged and not counted as inside")
 

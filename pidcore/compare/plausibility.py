@@ -333,6 +333,19 @@ def _vibrated_mass_kg(analysis) -> float:
 NEGATIVE_WITHIN_STDERRS = 3.0
 
 
+def lowest_kept_sdc(stderr: float) -> float:
+    """The lowest measured SDC kept as zero damping measured with noise: -
+    :data:`NEGATIVE_WITHIN_STDERRS` x its standard error ``stderr`` (0 where none is known:
+    0, NaN or not a standard error). Below it a measurement is energy created beyond its
+    noise, refused as implausible (:func:`implausible_findings`, a ``calibrate --data``
+    row), and a calibrated 95 % band of a measurement is cut there, as its top is cut at the
+    SDC bound (:meth:`pidcore.calibrate.prediction.CalibratedPrediction.band`)."""
+    stderr = float(stderr)
+    if not (math.isfinite(stderr) and stderr > 0):
+        return 0.0
+    return -NEGATIVE_WITHIN_STDERRS * stderr
+
+
 def implausible_findings(analysis, *, bound: SdcBound | None = None
                          ) -> tuple[tuple[PlausibilityWarning, ...], tuple[str, ...]]:
     """(warnings beyond noise, notes) of one analysis: :func:`check_analysis`'s warnings
@@ -345,8 +358,7 @@ def implausible_findings(analysis, *, bound: SdcBound | None = None
     power = complex(analysis.complex_power_w)
     warnings, notes = [], []
     for w in check_analysis(analysis, bound=bound):
-        if (w.check == "negative_loss_factor" and math.isfinite(stderr)
-                and analysis.sdc + NEGATIVE_WITHIN_STDERRS * stderr >= 0):
+        if w.check == "negative_loss_factor" and analysis.sdc >= lowest_kept_sdc(stderr):
             notes.append(f"SDC {analysis.sdc:.3g} is zero within its uncertainty "
                          f"({NEGATIVE_WITHIN_STDERRS:g} x its standard error {stderr:.2g}): "
                          "no damping resolved")
