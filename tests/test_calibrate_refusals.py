@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import dataclasses
 import importlib
+import math
 from pathlib import Path
 
 import numpy as np
@@ -453,14 +454,57 @@ def test_a_scripts_measured_point_is_held_to_the_tables_rules(tmp_path, keywords
 
 def test_a_negative_measured_sdc_is_refused_in_a_table_and_kept_for_a_synthetic_study(tmp_path):
     # the docs' calibration audit fits noise draws below 0 as they are; a measured table
-    # (what `pidcore calibrate --data` reads) holds no negative SDC
+    # (what `pidcore calibrate --data` reads) without a standard error holds no negative SDC
     from pidcore.calibrate import read_measured_table
     from pidcore.errors import InputFileError
 
     assert MeasuredPoint(500.0, 5.0, 50.0, -0.01, 0.02).sdc == -0.01
     table = _table(tmp_path, HEADER + "500,5,50,-0.01\n1000,5,50,0.6\n500,1,50,0.2\n")
-    with pytest.raises(InputFileError, match=r"m\.csv, line 2: sdc -0\.01: expected >= 0$"):
+    with pytest.raises(InputFileError, match=r"m\.csv, line 2: sdc -0\.01: expected >= 0 "
+                       r"without an sdc_stderr \(a negative SDC within 3 standard errors of 0 "
+                       r"is zero damping measured with noise: give its sdc_stderr\)$"):
         read_measured_table(table)
+
+
+# (SDC, its stderr, kept): zero damping measured with noise, -0.0569 +- 0.13 (an analysis's,
+# 7 dof), was refused by `calibrate --data` and fitted by `calibrate --store`; exactly 3
+# stderr below 0 is still noise (pidcore.compare.plausibility.NEGATIVE_WITHIN_STDERRS); beyond
+# it, or negative with no stderr, energy created: refused from a table, left out of a store
+@pytest.mark.parametrize(("sdc", "stderr", "kept"), [(-0.0569, 0.13, True), (-0.3, 0.1, True),
+                                                     (-0.5, 0.1, False), (-0.01, 0.0, False)])
+def test_a_table_and_a_store_keep_the_same_negative_sdcs(tmp_path, monkeypatch, sdc, stderr,
+                                                          kept):
+    import pandas as pd
+
+    from pidcore.calibrate import measured_from_store, read_measured_table
+    from pidcore.errors import InputFileError
+    from pidcore.store import Store
+
+    table = _table(tmp_path, "frequency_hz,acceleration_g,fill_percent,sdc,sdc_stderr,"
+                   f"sdc_stderr_dof\n100,1,50,{sdc},{stderr},7\n500,1,50,0.2,0.01,7\n")
+    # the same measurement as a stored analysis: Re P / Im P = SDC / 2 pi
+    imag = 0.1
+    real = [sdc / (2 * math.pi) * imag, 0.2 / (2 * math.pi) * imag]
+    frame = pd.DataFrame({"frequency_hz": [100.0, 500.0], "acceleration_g": [1.0, 1.0],
+                          "fill_percent": [50.0, 50.0], "sdc": [sdc, 0.2],
+                          "sdc_stderr": [stderr, 0.01], "sdc_stderr_dof": [7.0, 7.0],
+                          "complex_power_real_w": real, "complex_power_imag_w": [imag] * 2,
+                          "loss_factor": [r / imag for r in real],
+                          "source": ["neg.csv", "pos.csv"]})
+    monkeypatch.setattr(Store, "list_analyses", lambda self: frame)
+    left_out: list[str] = []
+    stored = measured_from_store(tmp_path / "s.h5", left_out=left_out)
+    if kept:
+        (point, _) = read_measured_table(table)
+        assert (point.sdc, point.sdc_stderr) == (sdc, stderr)
+        assert [(p.sdc, p.sdc_stderr) for p in stored if p.frequency_hz == 100.0] == \
+            [(sdc, stderr)]
+        assert not left_out
+    else:
+        with pytest.raises(InputFileError, match=rf"m\.csv, line 2: sdc {sdc}: "):
+            read_measured_table(table)
+        assert [p.frequency_hz for p in stored] == [500.0]
+        assert len(left_out) == 1 and left_out[0].startswith("neg.csv: left out, implausible")
 
 
 @pytest.mark.parametrize(("keywords", "said"), [

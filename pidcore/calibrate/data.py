@@ -101,7 +101,8 @@ class MeasuredPoint:
                                  "unknown")
         object.__setattr__(self, "sdc_stderr_dof", dof)
         # a negative sdc is a draw of noise around a small one, which a synthetic study
-        # (docs/calibration_audit) fits as it is; a measured table refuses it
+        # (docs/calibration_audit) fits as it is; a measured table refuses one beyond its
+        # noise (_check_not_negative_beyond_noise)
         bound = self.sdc_bound
         if self.sdc > bound.sdc:
             # a fit to it runs to the end and only says its posterior piles at a bound
@@ -137,7 +138,8 @@ def read_measured_table(path: str | os.PathLike, *,
     A row without a ``material`` takes ``default_material`` (the calibrated specimen's when
     one is given, as a measurement compared with a specimen does; else the paper's acrylic).
     An SDC above its specimen's bound is refused (:func:`_point_sdc_bound`: ``specimen``,
-    the file calibrated, or the paper's coupon).
+    the file calibrated, or the paper's coupon), and one below 0 beyond its noise
+    (:func:`_check_not_negative_beyond_noise`, the rule of :func:`measured_from_store`).
     """
     from ..tables import line_where, read_text_table_file
 
@@ -167,8 +169,6 @@ def read_measured_table(path: str | os.PathLike, *,
                 values[column] = float(raw)
             except (TypeError, ValueError):
                 raise InputFileError(f"{where}: {column} {raw!r} is not a number") from None
-        if values["sdc"] < 0:
-            raise InputFileError(f"{where}: sdc {as_given(values['sdc'])}: expected >= 0")
         raw_dof = row.get("sdc_stderr_dof", "")
         raw_dof = "" if raw_dof is None or (isinstance(raw_dof, float) and math.isnan(raw_dof)) \
             else raw_dof
@@ -183,11 +183,14 @@ def read_measured_table(path: str | os.PathLike, *,
             material = normalize_material(_text_cell(row.get("material"), default_material),
                                           "material", known=None)
             named = _text_cell(row.get("specimen"), "")
-            points.append(MeasuredPoint(material=material, specimen=named,
-                                        source=str(path), row=int(line), **values,
-                                        sdc_bound=_point_sdc_bound(
-                                            values["fill_percent"], material, named, "",
-                                            specimen)[0]))
+            point = MeasuredPoint(material=material, specimen=named, source=str(path),
+                                  row=int(line), **values,
+                                  sdc_bound=_point_sdc_bound(values["fill_percent"], material,
+                                                             named, "", specimen)[0])
+            # the store's rule (its records refused beyond their noise are left out): zero
+            # damping measured with noise is kept, energy created beyond it is not
+            _check_not_negative_beyond_noise(point)
+            points.append(point)
         except ParameterError as exc:  # the row's values, named by their columns
             raise InputFileError(f"{where}: {exc}") from None
     if not points:
@@ -203,6 +206,29 @@ def read_measured_table(path: str | os.PathLike, *,
                                  "SDC of repeated tests and its standard error)")
         seen[key] = p.row
     return points
+
+
+def _check_not_negative_beyond_noise(point: MeasuredPoint) -> None:
+    """Refuse a measured SDC below 0 beyond its noise (:func:`pidcore.compare.plausibility.
+    lowest_kept_sdc` of its standard error: -3 ``sdc_stderr``, 0 without one), the rule that
+    leaves a stored record out of ``calibrate --store`` (:func:`measured_from_store`): more
+    energy out of the coupon than in, which no passive damper gives. One within it is zero
+    damping measured with noise, fitted as it is (-0.057 +- 0.13 was refused from a table
+    and fitted from the store)."""
+    from ..compare.plausibility import NEGATIVE_WITHIN_STDERRS, lowest_kept_sdc
+
+    lowest = lowest_kept_sdc(point.sdc_stderr)
+    if point.sdc >= lowest:
+        return
+    if lowest == 0.0:
+        raise ParameterError(
+            f"sdc {as_given(point.sdc)}: expected >= 0 without an sdc_stderr (a negative SDC "
+            f"within {NEGATIVE_WITHIN_STDERRS:g} standard errors of 0 is zero damping measured "
+            "with noise: give its sdc_stderr)")
+    raise ParameterError(
+        f"sdc {as_given(point.sdc)}: below 0 beyond its noise ({NEGATIVE_WITHIN_STDERRS:g} x "
+        f"sdc_stderr {as_given(point.sdc_stderr)} = {-lowest:.4g}): more energy out than in, "
+        f"impossible for a passive damper; expected >= {lowest:.4g}")
 
 
 def _point_sdc_bound(fill_percent: float, material: str, specimen_name: str,
