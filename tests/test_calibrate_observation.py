@@ -66,6 +66,23 @@ def test_a_bed_pulling_against_the_walls_is_observed_not_refused():
         analyze_power(arrays["wall_force_n"], velocity, FS_HZ, frequency_hz=F_HZ)
 
 
+def test_a_run_giving_back_energy_over_its_window_is_named_in_the_calibrations_notes():
+    # a run that never reached steady state can show Re P < 0 over its window (the bed gave
+    # back stored energy); the surrogate takes its damping as 0 within its error, which was
+    # silent. A damper of negative c is such a window: d = c / w exactly, < 0
+    from pidcore.calibrate.calibrate import nonpositive_dissipation_notes
+
+    w = 2 * math.pi * F_HZ
+    giving = observation_from_run(*_synthetic(0.0153, -0.5)[:2])
+    taking = observation_from_run(*_synthetic(0.0153, 2.7)[:2])
+    assert giving.dissipative_mass_kg == pytest.approx(-0.5 / w, rel=1e-9)
+    (note,) = nonpositive_dissipation_notes(["100 Hz, 5 g, 50 %", "200 Hz, 5 g, 50 %"],
+                                            [[taking, giving], [taking]])
+    assert note.startswith("100 Hz, 5 g, 50 %: 1 of 2 DEM run(s) dissipate nothing over their "
+                           f"window (Re P <= 0, dissipative mass {-0.5 / w:.3g} +- ")
+    assert nonpositive_dissipation_notes(["a"], [[taking]]) == []
+
+
 def test_fixture_mass_and_baseline_equal_eq11_of_the_whole_shaker_force():
     # a structure of mass m_s with loss factor eta_0 is a mass plus a damper eta_0 w m_s; the
     # observation model must give what Eq. 11 (analyze_power) gives for the total gauge force

@@ -553,6 +553,7 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: str | Sequence[str],
                          f"{label} ({len(shares)}: "
                          + ", ".join("?" if share is None else f"{share:+.1%}" for share in shares)
                          + ")" for label, shares in unsteady.items()))
+    notes.extend(nonpositive_dissipation_notes([p.label() for p in points], observations))
     surrogates = tuple(build_surrogate(obs, design, dem_specs) for obs in observations)
     fitted = [s.name for s in specs]
     fixed = {name: parameter_spec(name, specimen).default for name in CATALOGUE
@@ -642,6 +643,28 @@ def _released_share(record: dict) -> float | None:
     except (KeyError, TypeError, ValueError):
         return None
     return None if math.isnan(share) else share
+
+
+def nonpositive_dissipation_notes(labels: Sequence[str],
+                                  observations: Sequence[Sequence[Observation]]) -> list[str]:
+    """A note per measured point whose DEM runs give no positive particle dissipation over
+    their window (Re P <= 0: the bed gave back stored energy there, a window that is no
+    steady state). The surrogate takes such a run's dissipative mass as zero within its
+    standard error; that was silent, and a prediction of the baseline alone (0.024 where the
+    run's dissipation tally said 0.14) read as the model's."""
+    notes = []
+    for label, runs in zip(labels, observations, strict=True):
+        found = [o for o in runs if not o.dissipative_mass_kg > 0]
+        if found:
+            notes.append(
+                f"{label}: {len(found)} of {len(runs)} DEM run(s) dissipate nothing over their "
+                "window (Re P <= 0, dissipative mass "
+                + ", ".join(f"{o.dissipative_mass_kg:.3g} +- {o.dissipative_mass_stderr_kg:.2g}"
+                            for o in found)
+                + " kg: the bed gave back stored energy, no steady state); the surrogate "
+                "takes their particle damping as 0 within that error, so the prediction there "
+                "may be low: give the runs more steady cycles or more cells")
+    return notes
 
 
 def _not_converged_note(diagnostics: SamplerDiagnostics) -> str:
