@@ -61,9 +61,13 @@ def test_each_file_is_read_in_the_unit_of_its_row(tmp_path, capsys):
 
 
 def test_a_time_unit_given_for_every_file_that_agrees_is_taken(tmp_path, capsys):
-    records = analysed(batch(tmp_path, ("", "ms")), capsys, "--time-unit", "msec")
-    # 'msec' reads as the row's 'ms': no refusal, no override said; the file in s is read
-    # in ms as given (its frequency 1000 x up), which is what the user said of it
+    paths = batch(tmp_path, ("", "ms"))
+    # 'msec' reads as the row's 'ms': no refusal of the unit, no override said; the file in s
+    # is read in ms as given (its frequency 1000 x up), which is what the user said of it,
+    # and its vibrated mass is then 1000 x the coupon's: implausible, kept only when asked
+    err = refusal(["analyze", *map(str, paths), "--no-store", "--time-unit", "msec"], capsys)
+    assert "a_fill50.csv: implausible: the vibrated mass the record shows" in err
+    records = analysed(paths, capsys, "--time-unit", "msec", "--accept-implausible")
     assert records[1]["frequency_hz"] == pytest.approx(DRIVE_HZ, rel=1e-6)
     assert records[0]["frequency_hz"] == pytest.approx(1000 * DRIVE_HZ, rel=1e-6)
     assert not any("overrides" in n for r in records for n in r["notes"])
