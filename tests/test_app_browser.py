@@ -197,7 +197,15 @@ def _open(page, url: str) -> None:
 
 def _metric_texts(page, label: str) -> list[str]:
     metric = page.locator('[data-testid="stMetric"]').filter(has_text=label)
-    metric.first.wait_for(timeout=RESULT_TIMEOUT_MS)
+    try:
+        metric.first.wait_for(timeout=RESULT_TIMEOUT_MS)
+    except Exception:
+        # what the page showed instead: a CI log said only "Timeout 90000ms exceeded"
+        ARTIFACTS.mkdir(exist_ok=True)
+        page.screenshot(path=str(ARTIFACTS / "app_e2e_metric_missing.png"), full_page=True)
+        shown = page.locator('[data-testid="stMain"]').first.inner_text()[:1500]
+        raise AssertionError(f"no metric {label!r} at {page.url}; the page showed: "
+                             f"{shown!r}") from None
     return [metric.nth(i).inner_text() for i in range(metric.count())]
 
 
