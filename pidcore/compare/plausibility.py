@@ -156,14 +156,16 @@ def sdc_bound(*, fill_percent: float | None, material: str | None = None,
     from ..errors import PidcoreError
     from ..specimen import paper_specimen
 
-    if fill_percent is None or not math.isfinite(float(fill_percent)) or fill_percent <= 0:
-        return UNKNOWN_SPECIMEN_BOUND
     if specimen is not None and (not material or material == specimen.particles.material):
         tested = specimen
     elif not material or material in PARTICLE_MATERIALS:
         tested = paper_specimen(material or "acrylic")
     else:  # an own material without its specimen file: no cell, no particle mass
         return UNKNOWN_SPECIMEN_BOUND
+    if fill_percent is None or not math.isfinite(float(fill_percent)) or fill_percent <= 0:
+        # the bound is 2 pi, but the structure is known without the fill: a unit slip is
+        # judged by it (a force in kN under "N" of a file stating no fill was saved)
+        return SdcBound(SDC_UPPER_BOUND, math.nan, tested.coupon.moving_mass_kg)
     try:
         per_cell, _ = particles_per_cell(float(fill_percent), specimen=tested)
     except PidcoreError:  # a fill the DEM refuses (its own message says so elsewhere)
@@ -279,14 +281,15 @@ def check_analysis(analysis, *, bound: SdcBound | None = None
         out.append(PlausibilityWarning("negative_loss_factor",
                                        f"negative loss factor {eta:.4g} (SDC {sdc:.4g})", cause))
     vibrated_kg = _vibrated_mass_kg(analysis)
-    if bound.known and math.isfinite(vibrated_kg):
+    if math.isfinite(bound.structure_mass_kg) and math.isfinite(vibrated_kg):
         # the Eq. 11 loss factor is a ratio and survives a force or velocity channel in
         # another unit than its header says; the energy per cycle (Eq. 10, the like-for-like
         # comparison with the DEM) does not: a force in kN under "N" pooled SDCs 1000 x apart.
         # The vibrated mass Im(P_c) shows is then 1000 x off what the specimen can show
         low = bound.structure_mass_kg / VIBRATED_MASS_SLIP_FACTOR
+        # without the fill, the particles' mass is not known: no upper limit
         high = (bound.structure_mass_kg + bound.particle_mass_kg) * VIBRATED_MASS_SLIP_FACTOR
-        if not low <= vibrated_kg <= high:
+        if vibrated_kg < low or vibrated_kg > high:
             out.append(PlausibilityWarning(
                 "vibrated_mass_off",
                 f"the vibrated mass the record shows, Im(P_c)/(omega |V|^2/2) = "
