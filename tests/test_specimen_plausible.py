@@ -199,6 +199,14 @@ def test_a_typed_fill_of_no_particle_names_a_fill_that_is_then_accepted(tmp_path
     assert particles_for_fill(bound + 0.01, full, typed=True) >= 1
     with pytest.raises(ParameterError, match="reads as a fraction"):
         particles_for_fill(bound, full, typed=True)
+    # a specimen stating its count gave the untyped message first (the count's check)
+    # (0.5 mm spheres: a cell of several hundred, whose least fill holding one is < 1 %)
+    counted = Specimen.from_text(_edit("fill_percent = 50.0", "count_per_cell = 8",
+                                       _edit("radius_m = 1.0e-3", "radius_m = 0.5e-3")))
+    assert counted.capacity_per_cell() > 100
+    said = str(pytest.raises(ParameterError, particles_per_cell, 0.05, specimen=counted,
+                             fill_reference="capacity", typed=True).value)
+    assert "rounds to none; expected > 1 %" in said
     # not typed (a count's own share), the least fill holding a particle stays the bound
     said = str(pytest.raises(ParameterError, particles_for_fill, 0.05, full).value)
     least = float(re.search(r">= ([0-9.]+) %", said).group(1))

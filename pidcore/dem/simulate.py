@@ -300,10 +300,16 @@ def particles_per_cell(fill_percent: float, material_name: str | None = None, *,
                              f"got {fill_reference!r}")
     # a specimen stating count_per_cell confirms a small typed fill of that count (1 of 441
     # particles is 0.23 %, which reads as a fraction otherwise)
-    confirmed = (typed and fill_reference == "capacity"
-                 and specimen.particles.count_per_cell is not None
-                 and particles_for_fill(fill_percent, full, what=what)
-                 == specimen.particles.count_per_cell)
+    confirmed = False
+    if (typed and fill_reference == "capacity"
+            and specimen.particles.count_per_cell is not None):
+        try:
+            confirmed = (particles_for_fill(fill_percent, full, what=what)
+                         == specimen.particles.count_per_cell)
+        except ParameterError:
+            # refused below as a typed fill, naming the fill a typed one must pass: refused
+            # here, untyped, it named one (0.15 %) that was then refused as a fraction
+            confirmed = False
     return particles_for_fill(fill_percent, full, what=what,
                               typed=typed and not confirmed), full
 
