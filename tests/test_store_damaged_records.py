@@ -41,7 +41,8 @@ def _damaged(analysed_store: Path, tmp_path: Path, field: str, value: float) -> 
 
 @pytest.mark.parametrize(("field", "value"), [
     ("sdc_stderr", -0.5), ("sdc_stderr", 1e308), ("sdc_stderr", math.inf),
-    ("sdc", math.nan), ("sdc", -math.inf), ("frequency_hz", 0.0)])
+    ("sdc", math.nan), ("sdc", -math.inf), ("frequency_hz", 0.0), ("sdc", -5.0),
+    ("energy_per_cycle_j", 1e308)])
 def test_a_damaged_result_field_is_refused_by_report_calibrate_and_the_listing(
         analysed_store, tmp_path, capsys, field, value):
     store = _damaged(analysed_store, tmp_path, field, value)

@@ -121,7 +121,8 @@ def _draw_sdc_rows(ax, rows: pd.DataFrame, several_materials: bool) -> None:
     sdc11_se = rows[MEASURED_EQ11_STDERR_COLUMN].astype(float).to_numpy()
     sdc10 = rows[MEASURED_EQ10_COLUMN].astype(float).to_numpy()
     with np.errstate(divide="ignore", invalid="ignore"):
-        sdc10_se = sdc11_se * sdc10 / sdc11
+        # a standard error is >= 0 whatever the signs (a negative SDC within its noise)
+        sdc10_se = np.abs(sdc11_se * sdc10 / sdc11)
     has10 = np.isfinite(sdc10)
     # a series without a finite value is not drawn, so the legend names only what is drawn
     if has10.any():

@@ -32,6 +32,9 @@ _RESULT_FIELDS = {
             lambda v: abs(v) <= _MAGNITUDE_LIMIT),
     "loss_factor": (f"a number of magnitude at most {_MAGNITUDE_LIMIT:g}",
                     lambda v: abs(v) <= _MAGNITUDE_LIMIT),
+    # J per cycle of a coupon on a shaker: far below 1e6 J; 1e308 gave an Eq. 10 SDC of inf
+    "energy_per_cycle_j": (f"a number of magnitude at most {_MAGNITUDE_LIMIT:g} J, or empty",
+                           lambda v: math.isnan(v) or abs(v) <= _MAGNITUDE_LIMIT),
     # NaN: unknown (one block), as the analysis saves it
     "sdc_stderr": (f"a number from 0 to {_MAGNITUDE_LIMIT:g}, or empty (unknown)",
                    lambda v: math.isnan(v) or 0 <= v <= _MAGNITUDE_LIMIT),
@@ -62,7 +65,27 @@ def checked_analyses(analyses: pd.DataFrame, where: str | os.PathLike) -> pd.Dat
                                  f"field {field} = {value!r} is not {expected}; it was "
                                  "changed or damaged outside pidcore (analyse the file again "
                                  "into a fresh store)")
+    if {"sdc", "loss_factor"} <= set(analyses.columns):
+        # an analysis saves sdc = 2 pi loss_factor (Eq. 9) to the last bit: an SDC edited to
+        # -5 beside its loss factor 0.65 was calibrated against without a word
+        for _, row in analyses.iterrows():
+            sdc, loss = _float(row["sdc"]), _float(row["loss_factor"])
+            if math.isfinite(sdc) and math.isfinite(loss) and not math.isclose(
+                    sdc, 2 * math.pi * loss, rel_tol=1e-9, abs_tol=1e-15):
+                name = Path(str(row.get("source", "") or "")).name or row.get("key", "")
+                raise StoreError(f"{where}: analysis {row.get('key', '')} ({name}): record "
+                                 f"field sdc = {sdc!r} is not 2 pi x its loss_factor "
+                                 f"{loss!r} ({2 * math.pi * loss:.6g}), as an analysis saves "
+                                 "it; it was changed or damaged outside pidcore (analyse the "
+                                 "file again into a fresh store)")
     return analyses
+
+
+def _float(value: object) -> float:
+    try:
+        return math.nan if isinstance(value, bool | str) or value is None else float(value)
+    except (TypeError, ValueError):
+        return math.nan
 
 
 def list_dem_runs(*paths: str | os.PathLike | None) -> pd.DataFrame:
