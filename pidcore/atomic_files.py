@@ -41,6 +41,16 @@ from pathlib import Path
 TEMPORARY_SUFFIX = ".tmp"
 
 
+def file_in_the_way(path: str | os.PathLike[str]) -> Path | None:
+    """The nearest existing ancestor of ``path`` where it is no folder (a file), else None:
+    a folder cannot be made under it (``--out afile/sub`` raised FileExistsError with a
+    traceback from a mkdir, after a report had saved its records)."""
+    for parent in Path(path).absolute().parents:
+        if parent.exists():
+            return None if parent.is_dir() else parent
+    return None
+
+
 def new_file_mode() -> int:
     """The permissions a new file gets here: 0o666 less the process's umask."""
     return 0o666 & ~_process_umask()

@@ -255,7 +255,9 @@ def test_an_analysis_in_the_store_keeps_n_blocks_minus_1(tmp_path, monkeypatch):
     assert math.isnan(old.sdc_stderr_dof) and old.sdc_stderr == point.sdc_stderr
     # repeated tests: the stderr of their mean has repeats - 1
     twice = pd.concat([frame, frame.assign(key="k2", measurement_key="m2",
-                                           sdc=frame["sdc"] * 1.1)], ignore_index=True)
+                                           sdc=frame["sdc"] * 1.1,
+                                           loss_factor=frame["loss_factor"] * 1.1)],
+                      ignore_index=True)
     monkeypatch.setattr(Store, "list_analyses", lambda self: twice)
     (pooled,) = measured_from_store(store)
     assert pooled.sdc_stderr_dof == 1.0

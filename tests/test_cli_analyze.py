@@ -253,6 +253,19 @@ def test_saving_the_same_analyses_again_does_not_grow_the_store_and_the_newest_s
     capsys.readouterr()
 
 
+def test_a_force_in_kn_under_n_of_a_file_stating_no_fill_is_refused_too(tmp_path, capsys):
+    # without a fill the particles' mass is unknown, but the assumed coupon's structure is
+    # not: such a file was saved with its energy per cycle 1000 x small
+    path = export(tmp_path / "rec.csv", fmt="csv", force_unit_scale=1e-3)
+    assert main(["analyze", str(path), "--store", str(tmp_path / "s.h5")]) == 2
+    err = capsys.readouterr().err
+    assert "below 1/20 of the specimen's coupon and fixture (22.15 g)" in err
+    assert not (tmp_path / "s.h5").exists()
+    # the true record (0.25 kg, over 20 x the coupon but with particles of unknown mass: no
+    # upper limit without the fill) is taken
+    assert main(["analyze", str(export(tmp_path / "true.csv", fmt="csv")), "--no-store"]) == 0
+
+
 def test_identical_files_stating_different_load_cases_are_refused_before_saving(tmp_path,
                                                                                 capsys):
     a = export(tmp_path / "a_fill50.csv", fmt="csv")

@@ -684,3 +684,27 @@ def test_model_help_cites_the_sections_where_the_paper_proposes_the_pchip_model(
               for k, (num, start) in enumerate(starts)}
     for section in sections:
         assert "interpolation" in bodies[section], section
+
+
+@pytest.mark.parametrize("argv", [
+    ["model", "damper", "--fills", "50"],
+    ["model", "figures"],
+    ["report", "--dem-store", "data_samples/dem_table3.h5", "--store", "{tmp}/s.h5"],
+])
+def test_an_out_folder_under_a_file_is_refused_in_one_line_before_any_work(tmp_path, capsys,
+                                                                           argv):
+    # `--out afile/sub` raised FileExistsError / NotADirectoryError with a traceback (exit 1)
+    # from a mkdir, after `report FILES --store` had saved its records
+    from pidcore.cli import main
+
+    blocking = tmp_path / "afile"
+    blocking.write_text("not a folder\n")
+    root = Path(__file__).resolve().parents[1]
+    given = [a.replace("{tmp}", str(tmp_path)) for a in argv]
+    given = [str(root / a) if a.startswith("data_samples") else a for a in given]
+    files = [str(root / "data_samples" / "exports" / "synthetic_f50Hz_a5g_fill50_acrylic.uff")] \
+        if argv[0] == "report" else []
+    assert main([*given, *files, "--out", str(blocking / "sub")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and f"{blocking} is a file, not a folder" in err
+    assert not (tmp_path / "s.h5").exists()  # nothing saved before the refusal

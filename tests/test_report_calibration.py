@@ -414,6 +414,27 @@ def test_a_missing_calibration_names_the_command_that_writes_one(tmp_path, capsy
         load_calibration(path)
 
 
+@pytest.mark.parametrize(("edit", "said"), [
+    (lambda row: row.update(fill_percent="fifty"),
+     "predictions[5]['fill_percent'] must be a finite number, got 'fifty'"),
+    (lambda row: row.pop("frequency_hz"),
+     "predictions[5] must have the keys 'frequency_hz', 'acceleration_g', 'fill_percent'"),
+])
+def test_a_bad_calibration_json_is_named_by_its_keys_not_the_clis_flags(tmp_path, capsys,
+                                                                         edit, said):
+    # "predictions[5].--fill must be a finite number": a key no calibration.json has, for a
+    # user fixing the file by hand
+    doc = json.loads((ROOT / "data_samples" / "paper_calibration" / "calibration.json")
+                     .read_text(encoding="utf-8"))
+    edit(doc["predictions"][5])
+    path = tmp_path / "calibration.json"
+    path.write_text(json.dumps(doc), encoding="utf-8")
+    rc = main(["report", "--dem-store", str(ROOT / "data_samples" / "dem_table3.h5"),
+               "--calibration", str(path), "--out", str(tmp_path / "report")])
+    err = capsys.readouterr().err
+    assert rc == 2 and said in err and "--fill" not in err and "--frequency" not in err
+
+
 def test_an_edited_file_of_the_same_name_is_not_the_calibrated_one(calibration_file):
     # x.toml calibrated, then edited (another coupon mass) and saved under its name: the
     # calibration's [provenance] names the earlier file's hash, and the name alone (with the

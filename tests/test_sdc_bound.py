@@ -408,7 +408,8 @@ def test_calibrate_store_and_compare_say_why_a_stored_bound_was_ignored(
 
     store, key = _saved_heavy_record(tmp_path, heavy_file)
     _edit_record(store, key, **{RECORDED_BOUND_FIELD: stored},
-                 **({} if sdc is None else {"sdc": sdc}))
+                 # an analysis saves sdc = 2 pi loss_factor; an edit of one alone is refused
+                 **({} if sdc is None else {"sdc": sdc, "loss_factor": sdc / (2 * math.pi)}))
     note = recorded_sdc_bound(Store(store).list_analyses().iloc[0])[1]
     assert note.startswith(f"the SDC bound stored with the record ({RECORDED_BOUND_FIELD} "
                            f"{stored:.4g}) is ") and note.endswith(": ignored, judged as "

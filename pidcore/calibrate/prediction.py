@@ -858,15 +858,18 @@ def calibration_from_json(text: str | bytes, source: str | os.PathLike, *,
     predictions = []
     for i, row in enumerate(doc["predictions"]):
         if not isinstance(row, dict) or any(k not in row for k in _REQUIRED):
-            raise ParameterError(f"{path}: predictions[{i}] must have {', '.join(_REQUIRED)}")
-        f, a, fill, sdc, low, high = (_number(row[k], f"predictions[{i}].{k}", path)
+            # keys quoted: the CLI names a keyword as its flag, and "predictions[5].--fill"
+            # named a key no calibration.json has
+            raise ParameterError(f"{path}: predictions[{i}] must have the keys "
+                                 f"{', '.join(map(repr, _REQUIRED))}")
+        f, a, fill, sdc, low, high = (_number(row[k], f"predictions[{i}][{k!r}]", path)
                                       for k in _REQUIRED)
         if not low <= sdc <= high:
             raise ParameterError(f"{path}: predictions[{i}]: expected low95 <= predicted <= "
                                  f"high95, got {low} / {sdc} / {high}")
         material = row.get("material") or defaults.COMPARE_DEFAULT_MATERIAL
         measured, measured_stderr, low0, high0 = (
-            _optional(row.get(k), f"predictions[{i}].{k}", path)
+            _optional(row.get(k), f"predictions[{i}][{k!r}]", path)
             for k in ("measured", "measured_stderr", "low95_without_stderr",
                       "high95_without_stderr"))
         if math.isfinite(low0) != math.isfinite(high0) or (

@@ -73,8 +73,13 @@ def add_load_case_options(p: argparse._ActionsContainer, *, what: str) -> None:
 def check_out_folder(out: Path) -> None:
     """``--out`` must be a folder or not exist yet (a file there would be half-overwritten);
     checked before any work, so a long run is not thrown away at the end."""
+    from ..atomic_files import file_in_the_way
+
     if out.exists() and not out.is_dir():
         raise ParameterError(f"--out {out}: exists and is not a folder")
+    blocking = file_in_the_way(out)
+    if blocking is not None:
+        raise ParameterError(f"--out {out}: {blocking} is a file, not a folder")
 
 
 def add_store_option(p: argparse.ArgumentParser, *, flag: str = "--store",

@@ -327,7 +327,14 @@ def save_figure_files(fig: object, folder: Path, stem: str, *,
 
 
 def check_out_dir(out_dir: Path) -> None:
-    """Refuse an output path that is a file or an unrelated non-empty folder (never replaced)."""
+    """Refuse an output path that is a file or an unrelated non-empty folder (never replaced),
+    or one under a file (no folder can be made there)."""
+    from ..atomic_files import file_in_the_way
+
+    blocking = file_in_the_way(out_dir)
+    if blocking is not None:
+        raise ParameterError(f"{out_dir}: {blocking} is a file, not a folder; expected a "
+                             "report output folder under a folder")
     if out_dir.exists():
         if not out_dir.is_dir():
             raise ParameterError(f"{out_dir}: report output exists and is not a folder")
