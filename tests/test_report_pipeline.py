@@ -429,3 +429,23 @@ def test_report_files_without_a_store_keep_only_the_channels_used(tmp_path):
     assert whole.measurement.channel_names == ["Force", "Mic", "Velocity"]
     assert lean.measurement.channel_names == ["Force", "Velocity"]
     assert lean.analyzed.to_dict() == whole.analyzed.to_dict()
+
+
+@pytest.mark.usefixtures("undrawn_report_figures")
+def test_the_load_case_table_a_report_read_is_listed_with_its_hash(tmp_path, dem_store):
+    # the sidecar sets each file's load case and settings (a 50 us delay moves the bundled
+    # 500 Hz SDC from 2.81 to 4.09), but the provenance listed only the exports and stores
+    file = _write_measurement(tmp_path / "coupon1.csv")
+    table = tmp_path / "cases.csv"
+    table.write_text("file,fill_percent,velocity_delay_us\ncoupon1.csv,50,20\n",
+                     encoding="utf-8")
+    make_report([file], out_dir=tmp_path / "r", dem_store=dem_store, formats="csv",
+                sidecar=table)
+    text = (tmp_path / "r" / "report.provenance.txt").read_text(encoding="utf-8")
+    assert f"input: cases.csv sha256 {sha256_file(table)}" in text
+    # one beside the files, read by default, is listed as well
+    beside = tmp_path / "loadcases.csv"
+    beside.write_text("file,fill_percent\ncoupon1.csv,50\n", encoding="utf-8")
+    make_report([file], out_dir=tmp_path / "r2", dem_store=dem_store, formats="csv")
+    text = (tmp_path / "r2" / "report.provenance.txt").read_text(encoding="utf-8")
+    assert f"input: loadcases.csv sha256 {sha256_file(beside)}" in text
