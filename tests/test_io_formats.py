@@ -216,9 +216,10 @@ def test_a_spreadsheets_empty_rows_after_the_data_are_left_out_and_said(tmp_path
                for note in read.metadata["reader_notes"])
     # an empty row inside the data is a gap in the record, still refused
     lines = body.splitlines()
-    lines.insert(len(lines) // 2, sep * (width - 1))
+    at = len(lines) // 2  # lines[0] is the header: data sample `at` is the empty row
+    lines.insert(at, sep * (width - 1))
     path.write_text("\n".join(lines) + "\n", encoding="utf-8")
-    with pytest.raises(InputFileError, match="non-finite"):
+    with pytest.raises(InputFileError, match=f"non-finite values, first at sample {at} of "):
         read_measurement(path)
 
 

@@ -172,7 +172,10 @@ def rate_from_times(times: np.ndarray, *, what: str, with_note: bool = False):
     if t.ndim != 1 or t.size < 2:
         raise InputFileError(f"{what}: a time base needs at least 2 samples, found {t.size}")
     if not np.all(np.isfinite(t)):
-        raise InputFileError(f"{what}: the time column holds non-finite values")
+        # which sample: an empty row inside a spreadsheet's data was refused naming none
+        first = int(np.argmin(np.isfinite(t)))
+        raise InputFileError(f"{what}: the time column holds non-finite values, first at "
+                             f"sample {first + 1} of {t.size} (an empty or non-numeric cell)")
     dt = (t[-1] - t[0]) / (t.size - 1)
     if not dt > 0:
         # as numbers: numpy 2's repr says "np.float64(0.0005)"
