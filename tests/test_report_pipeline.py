@@ -449,3 +449,18 @@ def test_the_load_case_table_a_report_read_is_listed_with_its_hash(tmp_path, dem
     make_report([file], out_dir=tmp_path / "r2", dem_store=dem_store, formats="csv")
     text = (tmp_path / "r2" / "report.provenance.txt").read_text(encoding="utf-8")
     assert f"input: loadcases.csv sha256 {sha256_file(beside)}" in text
+
+
+@pytest.mark.usefixtures("undrawn_report_figures")
+def test_what_the_reader_corrected_is_said_in_the_report_as_analyze_says_it(tmp_path,
+                                                                             dem_store):
+    # a spreadsheet's empty rows after the data were left out with a note that `analyze`
+    # printed and the report did not
+    file = _write_measurement(tmp_path / "coupon1_fill50_acrylic.csv")
+    file.write_text(file.read_text(encoding="utf-8") + ",,\n" * 2, encoding="utf-8")
+    result = make_report([file], out_dir=tmp_path / "r", dem_store=dem_store, formats="csv")
+    said = [n for n in result.notes if "hold only delimiters" in n]
+    assert said == ["coupon1_fill50_acrylic.csv: 2 row(s) after the last data row hold only "
+                    "delimiters (a spreadsheet's empty rows); not read"]
+    text = (tmp_path / "r" / "report.provenance.txt").read_text(encoding="utf-8")
+    assert said[0] in text

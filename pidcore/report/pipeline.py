@@ -982,6 +982,10 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         said = r.settings.summary() if r.settings is not None else ""
         notes.append(f"{display_path(r.path.name)}: load case {r.load_case.key} ({r.stated.origin})"
                      + (f"; {said}" if said else ""))
+        # what the reader corrected or assumed (a time column without a unit taken as s, a
+        # spreadsheet's empty rows left out), as `analyze` prints it: the report said nothing
+        notes.extend(str(n).replace(str(r.path), display_path(r.path.name))
+                     for n in r.measurement.metadata.get("reader_notes", ()) or ())
         # what the plausibility checks found (a result kept as asked, or zero within noise)
         notes.extend(f"{display_path(r.path.name)}: {n}"
                      for n in plausibility_notes(r.analyzed.analysis, bound=stated_sdc_bounds(
