@@ -797,12 +797,12 @@ def _stored_case_label(row) -> str:
 
 
 def replacement_notes(analyses: pd.DataFrame,
-                      incoming: Sequence[tuple]) -> list[str]:
+                      incoming: Sequence[tuple[str, str, str, Mapping, float]]) -> list[str]:
     """Which saved records (file name, load case, settings) saving ``incoming`` replaces.
 
     ``incoming``: per file to be saved, (file name, measurement key
-    (:func:`pidcore.records.measurement_key`), load case in words), optionally followed by
-    the analysis parameters (:meth:`AnalysisOptions.parameters`) and the new SDC. The store
+    (:func:`pidcore.records.measurement_key`), load case in words, the parameters it is
+    stored with (:func:`stored_parameters`), the new SDC). The store
     keeps a measurement by its contents, so a byte-identical file under another name, or a
     second copy in the same save, is the same record and only the last one saved is kept:
     each such replacement of another name or load case is said, never silent. A file saved
@@ -819,10 +819,8 @@ def replacement_notes(analyses: pd.DataFrame,
             saved[str(row["measurement_key"])] = (
                 Path(str(row.get("source", ""))).name, _stored_case_label(row),
                 _parameters_of(row.get("parameters_json")), _number(row.get("sdc")))
-    for item in incoming:
-        name, key, case = item[:3]
-        parameters = None if len(item) < 4 else _parameters_of(item[3])
-        sdc = math.nan if len(item) < 5 else _number(item[4])
+    for name, key, case, given, sdc in incoming:
+        parameters = _parameters_of(given)
         if key in saved:
             old_name, old_case, old_parameters, old_sdc = saved[key]
             changed = _changed_settings(old_parameters, parameters)
@@ -835,8 +833,7 @@ def replacement_notes(analyses: pd.DataFrame,
                              f"SDC {_shown(old_sdc)}); this analysis (SDC {_shown(sdc)}) is "
                              "the one reports and calibrations use now, the earlier is kept "
                              "in the store")
-        saved[key] = (name, case, parameters if parameters is not None else
-                      saved.get(key, (None,) * 4)[2], sdc)
+        saved[key] = (name, case, parameters, sdc)
     return notes
 
 
@@ -866,7 +863,7 @@ def _shown(sdc: float) -> str:
 
 def _changed_settings(old: dict | None, new: dict | None) -> str:
     """``"velocity_delay_s 5e-05 -> 0.0"`` for each parameter that differs ("" where either
-    is not known: a record of an older pidcore, or a caller that gave none)."""
+    is not known: a record whose parameters_json is not read)."""
     if old is None or new is None:
         return ""
     return ", ".join(f"{name} {json.dumps(old.get(name))} -> {json.dumps(new.get(name))}"
