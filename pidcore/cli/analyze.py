@@ -154,10 +154,11 @@ def _print_results(args: argparse.Namespace, results: list, cases: list, stated:
     records were new (``breakdown``: :meth:`SavedAnalyses.breakdown`)."""
     from ..file_settings import assumed, assumption_notes, files_assumption_notes
 
-    overrides = [note for st, fs in zip(stated, settings, strict=True)
-                 for note in (*(cli_words(n) for n in (st.notes if st is not None else ())),
-                              *fs.notes, fs.unmatched)
-                 if note]
+    # each file's load case overridden, then its settings (the JSON lists both per record)
+    overridden = [[*(cli_words(n) for n in (st.notes if st is not None else ())), *fs.notes]
+                  for st, fs in zip(stated, settings, strict=True)]
+    overrides = [note for said, fs in zip(overridden, settings, strict=True)
+                 for note in (*said, fs.unmatched) if note]
     # what no statement gave (the paper's coupon and its acrylic): with each record in JSON
     assumptions = [assumed(st, fs.specimen, specimen)
                    for st, fs in zip(stated, settings, strict=True)]
@@ -172,12 +173,11 @@ def _print_results(args: argparse.Namespace, results: list, cases: list, stated:
                                 "assumed": a,
                                 "parameters": fs.options.parameters(),
                                 "settings_from": dict(fs.sources),
-                                "overridden": [*(cli_words(n) for n in (
-                                    st.notes if st is not None else ())), *fs.notes],
+                                "overridden": said,
                                 "sidecar_row_missing": fs.unmatched or None}
-                               for r, c, st, fs, a, words in zip(
-                                   results, cases, stated, settings, assumptions, said_assumed,
-                                   strict=True)],
+                               for r, c, said, fs, a, words in zip(
+                                   results, cases, overridden, settings, assumptions,
+                                   said_assumed, strict=True)],
                    "notes": [*overrides, *replaced,
                              *([f"saved {breakdown}"] if breakdown else [])]}, sys.stdout)
         sys.stdout.write("\n")

@@ -952,10 +952,11 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
 
     from ..store.listing import checked_analyses
 
+    held = None  # the store's records before this report saves any
     if main is not None:
         refuse_store_among_inputs(main, files)  # before reading (it may hold many measurements)
         # a damaged record is refused before the files are analysed into the store
-        checked_analyses(main.list_analyses(), main.path)
+        held = checked_analyses(main.list_analyses(), main.path)
         if files:  # their analyses are added to it
             main.check_writable()
     from ..compare.plausibility import (
@@ -965,7 +966,6 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         stored_record_name,
     )
     from ..file_settings import assumed, files_assumption_notes, stored_assumption_notes
-    from ..store.listing import checked_analyses
 
     options = options or AnalysisOptions()
     results = analyze_files(
@@ -1029,7 +1029,7 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         analyses = listed[listed["key"].isin(keys)]
         analyses = analyses.set_index("key").loc[keys].reset_index()  # order of the files
     elif main is not None:
-        listed = main.list_analyses()
+        listed = held  # nothing saved since it was read
         analyses = latest_per_measurement(listed)
         # what analyze assumed for them (the paper's acrylic, its coupon) is said again here
         notes.extend(stored_assumption_notes(analyses))
