@@ -31,6 +31,11 @@ MIN_PERIODS = 10
 #: Longest velocity (vibrometer) delay accepted, in drive periods: real output delays are tens of
 #: µs to a few ms (under 4 periods up to ~2 kHz); longer is a unit slip.
 MAX_VELOCITY_DELAY_PERIODS = 4
+#: Shortest velocity delay taken without a note, s: an output delay under 1 µs is no
+#: vibrometer's (decoders take µs to ms), and is what a delay in ms typed where µs are asked
+#: gives (0.05 for 50 µs): 1000 x too small, it turns the phase by nothing while the delay
+#: meant moves the loss factor by ~2 pi f tau (0.16 at 500 Hz and 50 µs).
+MIN_NOTED_VELOCITY_DELAY_S = 1e-6
 #: Number of blocks of whole periods for the standard error of the SDC.
 N_UNCERTAINTY_BLOCKS = 8
 #: Whole drive periods between the knots of the cubic spline that takes up the drift of a

@@ -444,6 +444,20 @@ def _check_delay(velocity_delay_s: float, frequency_hz: float, duration_s: float
             "(e.g. 2e-4)")
 
 
+def _short_delay_note(velocity_delay_s: float, frequency_hz: float) -> str:
+    """A note for a vibrometer delay too short to be one (a value in ms given as µs), with
+    what it turns the velocity's phase by and what 1000 x it would: taken as given, since no
+    rule tells a slip from a deliberate tiny correction, but never without a word."""
+    tau = abs(float(velocity_delay_s))
+    if not 0.0 < tau < defaults.MIN_NOTED_VELOCITY_DELAY_S:
+        return ""
+    turn = 2 * math.pi * frequency_hz * tau
+    return (f"vibrometer delay {velocity_delay_s * 1e6:.3g} µs is shorter than any vibrometer's "
+            f"output delay (µs to ms): it turns the velocity's phase at {frequency_hz:.6g} Hz "
+            f"by {turn:.2g} rad, 1000 x it (the value read in ms) by {1000 * turn:.3g} rad; "
+            "check the delay's unit")
+
+
 def _check_start_offset(start_offset_delay_s: float, sample_rate_hz: float,
                         source: str = "", name: str = "start_offset_delay_s") -> None:
     # what is left of a start offset once whole samples are cut: half a sample at most (a
@@ -639,6 +653,7 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
         raise SignalError(f"{what}: {n_periods:.2f} drive periods of {freq:.6g} Hz in "
                           f"{n_samples} samples, expected at least {min_periods}")
     _check_delay(velocity_delay_s, freq, n_samples / sample_rate_hz, source)
+    delay_note = _short_delay_note(velocity_delay_s, freq)
     max_harm = int(defaults.HARMONIC_MAX_FRACTION_OF_NYQUIST * 0.5 * sample_rate_hz / freq)
     n_harm = min(int(n_harmonics), max_harm)
     if n_harm < 1:
@@ -801,7 +816,7 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
         uncertainty_note=uncertainty_note,
         corrections=corrections,
         notes=tuple(n for n in (zeta_note, uncertainty_note, baseline_note, drift_note,
-                                harmonics_note) if n),
+                                harmonics_note, delay_note) if n),
     )
 
 
