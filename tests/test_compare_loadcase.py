@@ -107,8 +107,17 @@ def test_a_value_overriding_another_statement_is_said_and_an_agreeing_one_is_not
     stated = resolve_load_case(tmp_path / "run_fill50_acrylic.uff", sidecar=side,
                                fill_percent=60, direction="z")
     assert stated.fill_percent == 60.0
-    assert stated.notes[-1] == "run_fill50_acrylic.uff: fill 60 % (fill_percent=) overrides " \
-                               "75 % of my.csv"
+    # the value that stands is said once with each it replaced: the sidecar's 75 % was said
+    # as overriding the file name although the option's 60 % stood
+    assert stated.notes == (
+        "run_fill50_acrylic.uff: fill 60 % (fill_percent=) overrides 75 % of my.csv and 50 % "
+        "of the file name",
+        "run_fill50_acrylic.uff: material 'aluminium' (my.csv) overrides 'acrylic' of the "
+        "file name")
+    # an option back to the file name's value overrides only the sidecar's
+    assert resolve_load_case(tmp_path / "run_fill50_acrylic.uff", sidecar=side,
+                             fill_percent=50).notes[0] == \
+        "run_fill50_acrylic.uff: fill 50 % (fill_percent=) overrides 75 % of my.csv"
     assert not any("direction" in n for n in stated.notes)  # z over z: nothing overridden
     # statements that agree (and a default replaced) say nothing
     side.write_text("file,fill_percent,material\nrun_fill50_acrylic.uff,50,acrylic\n",

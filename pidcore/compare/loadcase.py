@@ -585,19 +585,16 @@ def resolve_load_case(
     values: dict[str, float | str] = {}
     origin: dict[str, str] = {}
 
-    overrides: list[str] = []
+    # per name, the statements a later one replaced, in order: said once, by the value that
+    # stands (a chain file name < sidecar < option said the sidecar's value as standing)
+    overridden: dict[str, list[tuple[float | str, str]]] = {}
     stated_in = {"file name"}  # the statements a later one overrides with a note
 
     def take(found: dict[str, float | str], where: str) -> None:
         for name, value in found.items():
             earlier = origin.get(name)
-            if earlier in stated_in and values[name] != value:
-                # a typo in a sidecar row moved a test to another load case, named only by
-                # "(fill: loadcases.csv)" in its origin
-                overrides.append(f"{path.name}: {_STATED_WORDS[name]} {_stated(name, value)} "
-                                 f"({f'{name}=' if where == 'option' else where}) overrides "
-                                 f"{_stated(name, values[name])} of "
-                                 f"{'the file name' if earlier == 'file name' else earlier}")
+            if earlier in stated_in:
+                overridden.setdefault(name, []).append((values[name], earlier))
             values[name] = value
             origin[name] = where
 
@@ -632,7 +629,27 @@ def resolve_load_case(
     text = "; ".join(f"{name.split('_')[0]}: {origin.get(name, 'default')}"
                      for name in ("fill_percent", "material", "direction"))
     return StatedLoadCase(float(values["fill_percent"]), str(values["material"]),
-                          str(values["direction"]), text, tuple(overrides))
+                          str(values["direction"]), text,
+                          _override_notes(path.name, values, origin, overridden))
+
+
+def _override_notes(name_of_file: str, values: dict[str, float | str], origin: dict[str, str],
+                    overridden: dict[str, list[tuple[float | str, str]]]) -> tuple[str, ...]:
+    """One note per stated value that replaced others that differ from it: a typo in a sidecar
+    row moved a test to another load case, named only by "(fill: loadcases.csv)"."""
+    notes = []
+    for name, replaced in overridden.items():
+        final = values[name]
+        differing = [(value, where) for value, where in reversed(replaced) if value != final]
+        if not differing:
+            continue
+        where = origin[name]
+        of = " and ".join(f"{_stated(name, value)} of "
+                          f"{'the file name' if earlier == 'file name' else earlier}"
+                          for value, earlier in differing)
+        notes.append(f"{name_of_file}: {_STATED_WORDS[name]} {_stated(name, final)} "
+                     f"({f'{name}=' if where == 'option' else where}) overrides {of}")
+    return tuple(notes)
 
 
 #: How a load case's stated values are named in notes.
