@@ -303,6 +303,19 @@ def test_newer_store_version_is_refused(store):
         store.list_dem_runs()
 
 
+@pytest.mark.parametrize("version", [np.float64(1.5), "1"])
+def test_a_store_version_that_is_no_whole_number_is_refused_and_the_store_left_alone(store,
+                                                                                    version):
+    # int(1.5) is 1: a version no pidcore writes was read as this one's and written to
+    store.add_dem_run("c", {"sdc": 0.1})
+    with h5py.File(store.path, "r+") as h5:
+        h5.attrs["pidcore_store_version"] = version
+    before = store.path.read_bytes()
+    with pytest.raises(StoreError, match=r"pidcore_store_version .* is not an integer"):
+        store.add_dem_run("d", {"sdc": 0.2})
+    assert store.path.read_bytes() == before
+
+
 # A field's name ends in the unit it holds (guide: every output column names its unit); the
 # suffixes and the unit each one promises.
 _SUFFIX_UNITS = {"_hz": "Hz", "_w": "W", "_j": "J", "_n": "N", "_m_s": "m/s", "_m_s2": "m/s^2",

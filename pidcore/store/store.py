@@ -524,10 +524,15 @@ class Store:
         version = h5.attrs.get("pidcore_store_version")
         if version is None:
             raise self._unreadable("HDF5 file without the root attribute pidcore_store_version")
+        stated = from_attribute(version)
         try:
-            version = int(from_attribute(version))
+            version = int(stated)
+            # int() cuts 1.5 to 1: a version no pidcore wrote was read and written to
+            whole = version == stated
         except (TypeError, ValueError):
-            raise self._unreadable(f"pidcore_store_version {version!r} is not an integer") from None
+            whole = False
+        if not whole:
+            raise self._unreadable(f"pidcore_store_version {stated!r} is not an integer")
         if version < 1:  # no pidcore wrote it: another program's file (or a damaged one)
             raise self._unreadable(f"pidcore_store_version {version} is not one pidcore "
                                    f"writes (1 to {STORE_VERSION})")
