@@ -419,8 +419,10 @@ def test_table3_sdc_is_not_put_over_another_materials_mass(tmp_path):
     gives back each SDC's energy: c_eq = dE / (pi w X^2) with dE = SDC m_c a^2 / (2 w^2)."""
     out = tmp_path / "al"
     with pytest.raises(ParameterError, match=r"--material aluminium: the paper's Table 3 "
-                                             r"holds the SDC of acrylic particles only"):
+                                             r"holds the SDC of acrylic particles only") as no:
         _run(["model", "damper", "--out", str(out), "--material", "aluminium"])
+    # the refusal names each way on, the m_c given (run below) included
+    assert "give that m_c with --vibrated-mass" in str(no.value)
     assert not out.exists()
     _run(["model", "damper", "--out", str(tmp_path / "ac"), "--material", "acrylic",
           "--format", "csv"])

@@ -255,8 +255,9 @@ def run_damper(args: argparse.Namespace) -> int:
         raise ParameterError(
             f"--material {args.material}: the paper's Table 3 holds the SDC of {table3} "
             f"particles only, taken over an m_c holding {table3} spheres, which c_eq = SDC "
-            f"m_c w / (2 pi) must use; leave --material out, or run the DEM with --material "
-            f"{args.material} (pidcore dem sweep) and use --table store")
+            f"m_c w / (2 pi) must use; leave --material out, give that m_c with --vibrated-mass, "
+            f"or run the DEM with --material {args.material} (pidcore dem sweep) and use "
+            "--table store")
     if runs is not None:
         for option, column, given in (("--mass-convention", "vibrated_mass_convention",
                                        args.mass_convention),
