@@ -804,6 +804,13 @@ def test_print_command_names_the_stores_the_app_would_serve(tmp_path, monkeypatc
     assert main(["app", "--dem-store", "missing.h5", "--print-command"]) == 2
     out, err = capsys.readouterr()
     assert out == "" and err.count("\n") == 1 and "--dem-store missing.h5" in err
+    # the bundled reference runs found here are named absolutely: the app looked for them
+    # relative to its own folder, so the line run elsewhere served none
+    (tmp_path / stores.BUNDLED_DEM_STORE).parent.mkdir()
+    (tmp_path / stores.BUNDLED_DEM_STORE).write_bytes(b"")
+    assert main(["app", "--print-command"]) == 0
+    words = shlex.split(capsys.readouterr().out)
+    assert words[1] == f"{stores.DEM_STORE_ENV_VAR}={tmp_path / stores.BUNDLED_DEM_STORE}"
 
 
 @pytest.mark.parametrize("script", ["pidcore/app/entry.py", "app/pidcore_app.py"])

@@ -89,10 +89,21 @@ def printed_command(command: list[str], env: dict[str, str]) -> str:
     return " ".join([*assignments, shlex.join(command)])
 
 
+def _dem_store(given: Path | None) -> Path | None:
+    """``--dem-store``, else the bundled one found here, named to the app absolutely: the app
+    looked for it relative to its own working folder, so a printed line run elsewhere served
+    no reference runs."""
+    from ..app.stores import BUNDLED_DEM_STORE, DEM_STORE_ENV_VAR, path_from_env_or_bundled
+
+    if given is not None or os.environ.get(DEM_STORE_ENV_VAR, "").strip():
+        return given  # one the user named (the environment's is passed on as it is)
+    return path_from_env_or_bundled(DEM_STORE_ENV_VAR, BUNDLED_DEM_STORE, environ={})
+
+
 def run(args: argparse.Namespace) -> int:
     command = streamlit_command(args.port)
     # the environment first: --print-command refuses a missing --dem-store as a start does
-    env = app_environment(args.store, args.dem_store)
+    env = app_environment(args.store, _dem_store(args.dem_store))
     if args.print_command:
         print(printed_command(command, env))
         return 0
