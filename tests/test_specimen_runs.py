@@ -341,6 +341,8 @@ def test_report_names_its_specimen_in_the_table_and_its_hash_in_the_provenance(
     text = (default / "report.provenance.txt").read_text(encoding="utf-8")
     assert f"specimen: paper_coupon (the default, acrylic particles) sha256 " \
            f"{paper_specimen('acrylic').hash}" in text
+    # only the material its rows hold: the aluminium coupon was named, never compared
+    assert "aluminium particles" not in text
     assert pd.read_csv(default / "report.csv", keep_default_na=False)["specimen"].tolist() == [""]
 
 

@@ -122,7 +122,7 @@ def report_files(path: str | os.PathLike, dem_store: str | os.PathLike | None = 
                     "acceleration_rtol": tol.acceleration_rtol,
                     "fill_atol_percent": tol.fill_atol_percent, "pool": pool},
         seeds=seeds, stores=stores, notes=table.attrs.get("notes", []),
-        specimens=specimen_provenance(specimen),
+        specimens=specimen_provenance(specimen, table),
         calibrations=calibration_provenance(calibration))
     figures = {"sdc_per_load_case": plot_sdc_comparison(table)}
     try:

@@ -350,16 +350,20 @@ def _measured_loops(results: list[MeasuredResult], analyses: pd.DataFrame, store
     return loops
 
 
-def specimen_provenance(specimen) -> list[tuple[str, str]]:
-    """(label, SHA-256) of the specimen(s) whose DEM runs a report compares."""
+def specimen_provenance(specimen, table: pd.DataFrame | None = None) -> list[tuple[str, str]]:
+    """(label, SHA-256) of the specimen(s) whose DEM runs a report compares: the paper's
+    coupon with the particle materials of ``table``'s rows (each, without a table)."""
     from ..constants import PARTICLE_MATERIALS
     from ..specimen import paper_specimen
 
     if specimen is not None:
         return [(f"{specimen.name} ({specimen.source})", specimen.hash)]
-    # the default compares the paper's coupon with either of its particle materials
+    # the default compares the paper's coupon with either of its particle materials: named
+    # are those the rows hold (an acrylic report named the aluminium coupon it never used)
+    used = set(table["material"].dropna().astype(str)) \
+        if table is not None and "material" in table.columns else set(PARTICLE_MATERIALS)
     return [(f"{paper_specimen(m).name} (the default, {m} particles)", paper_specimen(m).hash)
-            for m in PARTICLE_MATERIALS]
+            for m in PARTICLE_MATERIALS if m in used]
 
 
 def _other_specimens(stored: pd.DataFrame, kept: pd.DataFrame) -> str:
@@ -1091,7 +1095,7 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
             # bundled 500 Hz sample's SDC is 4.09 with its 50 µs delay, 2.81 without)
             seeds=seeds, inputs=[*(r.path for r in results), *_tables_read(results, sidecar)],
             input_hashes={str(r.path): getattr(r.measurement, "sha256", "") for r in results},
-            stores=stores, notes=notes, specimens=specimen_provenance(specimen),
+            stores=stores, notes=notes, specimens=specimen_provenance(specimen, table),
             calibrations=calibration_provenance(calibrated),
             case_sheets=[(f"{CASE_SHEETS_FOLDER}/{s.name}", s.title, s.pdf) for s in sheets])
         paths = write_report(table, figures, provenance, out_dir, formats, progress=progress,
