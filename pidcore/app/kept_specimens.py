@@ -99,6 +99,12 @@ def kept_specimens_folder(store_path: str | os.PathLike) -> Path:
     return Path(f"{store_path}{KEPT_FOLDER_SUFFIX}")
 
 
+def kept_specimen_file(store_path: str | os.PathLike, sha256: str) -> Path:
+    """Where the app keeps the uploaded specimen file of ``sha256`` beside the store
+    ``store_path`` (which may not exist)."""
+    return kept_specimens_folder(store_path) / f"{sha256}{_DATA_SUFFIX}"
+
+
 @dataclass(frozen=True)
 class KeptSpecimen:
     """An uploaded specimen file: the ``name`` it was uploaded under, its specimen's

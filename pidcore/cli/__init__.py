@@ -18,7 +18,7 @@ from ..errors import PidcoreError
 
 #: Sub-command modules, each exposing ``register(subparsers) -> None``.
 _COMMAND_MODULES = ("analyze", "dem", "specimen", "bench", "report", "model", "app",
-                    "samples", "calibrate")
+                    "samples", "calibrate", "store")
 
 
 class _OneLineParser(argparse.ArgumentParser):

@@ -98,6 +98,7 @@ COMMAND_FLAGS: dict[str, dict[str, str]] = {
         "^cells": "--cells", "^seed": "--seed",
     },
     "bench signal": {"n_samples": "--samples"},
+    "store remove": {"with_dependents=True": "--with-dependents"},
     # commands that read a --specimen file (or FILE) and no other library keyword
     "model damper": CALIBRATION_WRITER, "model figures": CALIBRATION_WRITER,
     "specimen check": CALIBRATION_WRITER,

@@ -155,14 +155,12 @@ def open_verified_store(path: str | Path, *, must_exist: bool,
     progress : bool
         A bar over the store's entries on stderr while they are verified.
     """
-    from ..store import Store
+    from ..store import Store, existing_store
 
     path = Path(path)
-    if not path.exists():
-        if must_exist:
-            raise StoreError(f"{path}: store not found")
+    if not path.exists() and not must_exist:
         return Store(path)
-    store = Store(path)
+    store = existing_store(path)
     if progress:  # every array of the store is read: a minute or more for years of tests
         from tqdm import tqdm
 

@@ -1126,6 +1126,34 @@ class Store:
             h5.visititems(visit)  # hard links only: a link to another file is never followed
         return found
 
+    # --- removal -------------------------------------------------------------------------------
+
+    def remove_entries(self, entries: Iterable[tuple[str, str]]) -> None:
+        """Remove the entries ``(section, key)`` (section: ``measurements``, ``analyses``,
+        ``dem_runs`` or ``calibrations``) in one transaction (all or none; inside an open
+        :meth:`transaction` they join it). What other entries need them is not checked here:
+        :func:`pidcore.store.manage.remove_records` removes with what depends on them. The
+        file keeps its size: HDF5 does not give back the space of a removed group.
+
+        Raises
+        ------
+        StoreError
+            A section that is none of the store's, or an entry that is not stored (nothing
+            removed).
+        """
+        entries = list(entries)
+        for section, key in entries:
+            if section not in _SECTIONS:
+                raise StoreError(f"{self.path}: {section!r} is no section of a store (one of "
+                                 f"{', '.join(_SECTIONS)})")
+            check_name(key, what="key", where=str(self.path))
+        with self.transaction() as h5:
+            for section, key in entries:
+                if self._stored_entry(h5, section, key) is None:
+                    raise StoreError(f"{self.path}: no entry {key!r} in /{section}; nothing "
+                                     "was removed")
+                del h5[section][key]
+
     # --- shared reading helpers ----------------------------------------------------------------
 
     def _get_entry(self, section: str, key: str, what: str, *,

@@ -1,0 +1,132 @@
+"""Removing records from a store (pidcore.store.manage): one commit, what depends on a record
+goes with it or the removal is refused, every other record left bit for bit."""
+
+from __future__ import annotations
+
+import pytest
+from _shaker_files import file_sha256
+from _store_records import contents, records_store, without
+
+from pidcore.calibrate.persist import calibration_design_runs, stored_calibrations
+from pidcore.errors import StoreError
+from pidcore.store import Store, manage
+from pidcore.store.listing import list_dem_runs, saved_analyses
+from pidcore.store.manage import remove_records, store_contents
+
+
+@pytest.fixture(scope="module")
+def cache(tmp_path_factory):
+    return tmp_path_factory.mktemp("calibrated")
+
+
+@pytest.fixture
+def made(cache, tmp_path):
+    path = tmp_path / "s.h5"
+    return path, records_store(cache, path)
+
+
+def test_removing_a_measurement_takes_its_analyses_and_leaves_every_other_record_bit_for_bit(
+        made):
+    path, keys = made
+    first = keys["measurements"][0]
+    before = contents(path)
+    removal = remove_records(path, [first])
+    assert [(r.section, r.key, r.because) for r in removal.records] == [
+        ("measurements", first, ""),
+        ("analyses", keys["older"], f"an analysis of measurement {first}"),
+        ("analyses", keys["newer"], f"an analysis of measurement {first}")]
+    # what report --store reads no longer holds them; the other measurement's does
+    assert list(saved_analyses(path)["key"]) == [keys["other"]]
+    listed = store_contents(path)
+    assert list(listed["measurements"]["key"]) == [keys["measurements"][1]]
+    assert list(listed["analyses"]["key"]) == [keys["other"]]
+    after = contents(path)
+    assert after == without(before, f"/measurements/{first}", f"/analyses/{keys['older']}",
+                            f"/analyses/{keys['newer']}")
+    assert Store(path).verify() == []
+
+
+def test_removing_the_newest_analysis_says_the_earlier_one_reports_take_now(made):
+    path, keys = made
+    assert list(saved_analyses(path)["key"]) == [keys["other"], keys["newer"]]
+    removal = remove_records(path, [keys["newer"]])
+    assert [r.key for r in removal.records] == [keys["newer"]]
+    assert len(removal.notes) == 1 and f"its analysis {keys['older']}" in removal.notes[0]
+    assert set(saved_analyses(path)["key"]) == {keys["other"], keys["older"]}
+
+
+def test_a_design_run_of_a_stored_calibration_is_refused_and_nothing_is_removed(made):
+    path, keys = made
+    run, calibration = keys["design"][1], keys["calibration"]
+    digest = file_sha256(path)
+    with pytest.raises(StoreError, match=f"DEM run {run} is a design run of calibration "
+                                         f"{calibration} .*nothing was removed"):
+        remove_records(path, [keys["own_run"], run])  # the removable one is kept too
+    assert file_sha256(path) == digest
+
+
+def test_with_dependents_the_calibration_fitted_on_the_run_goes_with_it(made):
+    path, keys = made
+    run, calibration = keys["design"][1], keys["calibration"]
+    before = contents(path)
+    removal = remove_records(path, [run], with_dependents=True)
+    assert [(r.section, r.key, r.because) for r in removal.records] == [
+        ("dem_runs", run, ""), ("calibrations", calibration, f"fitted on DEM run {run}")]
+    assert stored_calibrations(path) == []
+    runs = list_dem_runs(path)
+    assert run not in set(runs["case_key"]) and calibration_design_runs(runs, [path]) == {}
+    assert contents(path) == without(before, f"/dem_runs/{run}",
+                                     f"/calibrations/{calibration}")
+
+
+def test_naming_the_calibration_with_its_run_needs_no_option(made):
+    path, keys = made
+    run, calibration = keys["design"][0], keys["calibration"]
+    removal = remove_records(path, [run, calibration])
+    assert {(r.section, r.key) for r in removal.records} == {("dem_runs", run),
+                                                           ("calibrations", calibration)}
+
+
+def test_an_interrupted_removal_leaves_the_store_byte_identical(made, monkeypatch):
+    path, keys = made
+    digest = file_sha256(path)
+
+    def interrupted() -> None:
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(manage, "_removed_before_commit", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        remove_records(path, [keys["measurements"][0], keys["own_run"]])
+    assert file_sha256(path) == digest
+    assert sorted(p.name for p in path.parent.iterdir()) == ["s.h5"]  # no copy, no lock
+
+
+def test_an_unknown_key_is_refused_and_nothing_is_removed(made):
+    path, keys = made
+    digest = file_sha256(path)
+    with pytest.raises(StoreError, match="no record 'nope' in this store; nothing was removed"
+                                         r" \(`pidcore store list`"):
+        remove_records(path, [keys["own_run"], "nope"])
+    assert file_sha256(path) == digest
+
+
+def test_a_dry_run_lists_exactly_what_the_removal_removes_and_leaves_the_file(made):
+    path, keys = made
+    digest = file_sha256(path)
+    named = [keys["measurements"][1], keys["design"][2]]
+    planned = remove_records(path, named, with_dependents=True, dry_run=True)
+    assert planned.dry_run and file_sha256(path) == digest
+    done = remove_records(path, named, with_dependents=True)
+    assert planned.records == done.records and len(done.records) == 4
+
+
+def test_a_section_key_names_a_record_of_that_section(made):
+    path, keys = made
+    removal = remove_records(path, [f"dem_runs/{keys['own_run']}"])
+    assert [(r.section, r.key) for r in removal.records] == [("dem_runs", keys["own_run"])]
+
+
+def test_a_missing_store_is_refused_not_read_as_empty(tmp_path):
+    with pytest.raises(StoreError, match="nope.h5: store not found"):
+        remove_records(tmp_path / "nope.h5", ["x"], dry_run=True)
+    assert not (tmp_path / "nope.h5").exists()
