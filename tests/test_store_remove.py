@@ -130,3 +130,28 @@ def test_a_missing_store_is_refused_not_read_as_empty(tmp_path):
     with pytest.raises(StoreError, match="nope.h5: store not found"):
         remove_records(tmp_path / "nope.h5", ["x"], dry_run=True)
     assert not (tmp_path / "nope.h5").exists()
+
+
+def test_a_calibrations_run_of_its_variant_of_the_start_specimen_is_refused_too(made):
+    # fitting a DEM parameter, a calibration runs variants of its start specimen (other
+    # hashes); they are inputs of its fit as much as the start's runs, and were removed
+    path, keys = made
+    store = Store(path)
+    start = str(store.list_calibrations()["specimen_hash"].iloc[0])
+    run = store.get_dem_run(keys["design"][0])
+    assert run.record["specimen_sha256"] == start
+    variant = {**run.parameters, "calibration_variant": {
+        "of_name": "paper_coupon", "of_sha256": start, "values": [["fixture_mass_kg", 0.1]]}}
+    store.add_dem_run("variant_run", {**run.record, "specimen_sha256": "f" * 64},
+                      arrays=run.arrays, units=run.units, parameters=variant)
+    digest = file_sha256(path)
+    with pytest.raises(StoreError, match=f"DEM run variant_run is a design run of calibration "
+                                         f"{keys['calibration']} .*nothing was removed"):
+        remove_records(path, ["variant_run"])
+    assert file_sha256(path) == digest
+    # a run of another file (no variant of the start) stays removable
+    store.add_dem_run("other_file_run", {**run.record, "specimen_sha256": "e" * 64},
+                      arrays=run.arrays, units=run.units,
+                      parameters={**run.parameters, "calibration_variant": None})
+    assert [r.key for r in remove_records(path, ["other_file_run"]).records] == \
+        ["other_file_run"]

@@ -337,7 +337,8 @@ def stored_settings(parameters_json: object) -> dict:
 
 
 def calibration_design_runs(runs: pd.DataFrame | None,
-                            store_paths: Sequence[str | os.PathLike | None]) -> dict[str, str]:
+                            store_paths: Sequence[str | os.PathLike | None], *,
+                            variants: bool = False) -> dict[str, str]:
     """The DEM runs of ``runs`` (a :func:`pidcore.store.listing.list_dem_runs` listing) that
     are the design runs of a calibration saved in one of ``store_paths``: run key ->
     calibration key.
@@ -350,6 +351,11 @@ def calibration_design_runs(runs: pd.DataFrame | None,
     and its load case (frequency, acceleration, fill, material) is one the calibration
     predicts: the inputs its cache key is made of, read from what the store holds of both,
     so the calibrations saved before this existed are recognised too.
+
+    With ``variants``, also the runs of its variants of the start specimen (their stored
+    :func:`~pidcore.compare.specimens.run_origin` names the start's hash): inputs of the fit
+    too, which what removes runs must know of, while reports leave them out already as
+    other specimens.
     """
     import numpy as np
 
@@ -360,6 +366,15 @@ def calibration_design_runs(runs: pd.DataFrame | None,
     if runs is None or runs.empty or not needed <= set(runs.columns):
         return {}
     found: dict[str, str] = {}
+    origins = runs["specimen_sha256"]
+    if variants:
+        import pandas as pd
+
+        from ..compare.specimens import CalibrationVariant, run_origins
+
+        origins = pd.Series([o.of_sha256 if isinstance(o, CalibrationVariant) else own
+                             for o, own in zip(run_origins(runs), runs["specimen_sha256"],
+                                               strict=True)], index=runs.index)
     for path in dict.fromkeys(Path(p) for p in store_paths if p is not None):
         if not path.is_file():
             continue
@@ -377,7 +392,7 @@ def calibration_design_runs(runs: pd.DataFrame | None,
                 continue  # a calibration that does not state its runs' settings
             if calibration is None:
                 continue
-            same = runs[(runs["specimen_sha256"] == record.get("specimen_hash"))
+            same = runs[(origins == record.get("specimen_hash"))
                         & (runs["cells_simulated"] == cells) & (runs["seed"] == seed)]
             for p in calibration.predictions:
                 case = p.load_case

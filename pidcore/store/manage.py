@@ -126,7 +126,7 @@ def _contents(store: Store, section: str) -> pd.DataFrame:
 
         frame = store.list_dem_runs().rename(columns={"case_key": "key"})
         design = calibration_design_runs(frame.rename(columns={"key": "case_key"}),
-                                         [store.path])
+                                         [store.path], variants=True)
         frame["specimen"] = _specimens(_column(frame, "specimen_name"),
                                        _column(frame, "specimen_sha256"))
         frame["cells"] = _column(frame, "cells_simulated", None)
