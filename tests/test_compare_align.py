@@ -103,6 +103,97 @@ def test_out_of_range_note_names_the_axis_outside_and_each_range_with_its_unit(
     assert cli_words(message, "report") == message  # no keyword left for the CLI to rewrite
 
 
+@pytest.mark.parametrize(("frequency", "acceleration"), [
+    (49.9995, 1.0),       # 1e-5 below 50 Hz (the 1 % tolerance is 0.5 Hz)
+    (50.0, 0.99999),      # 1e-5 below 1 g (the 5 % tolerance is 0.05 g)
+    (49.99998, 0.999992),  # both, as a lab batch measured them
+    (100.004, 5.00003),   # above the grid's other corner
+])
+def test_a_case_within_the_tolerances_of_the_grids_edge_is_taken_at_the_edge(
+        aligner, frequency, acceleration):
+    # a noise-free 49.9995 Hz, 1 g export was out_of_range with "acceleration 1 g outside
+    # 1-10 g, frequency 49.9995 Hz outside 50-1000 Hz" where 50.0005 Hz was interpolated,
+    # and the Compare page's curve took 49.999998 Hz as the 50 Hz case
+    out = aligner.align(LoadCase(frequency, acceleration, 37.5))
+    assert out.status == "interpolated"
+    f_edge, a_edge = min(max(frequency, 50.0), 100.0), min(max(acceleration, 1.0), 5.0)
+    # the model at the edge reproduces the linear field there to round-off (trilinear, as in
+    # the off-grid test); at the measured point it would differ by 2.5e-7 or 2e-5 (>> 1e-12)
+    assert out.sdc_dem == pytest.approx(linear_sdc(37.5, a_edge, f_edge), rel=1e-12)
+    assert out.load_case == LoadCase(frequency, acceleration, 37.5)  # the measured case kept
+    assert (f"model evaluated at {f_edge:g} Hz, {a_edge:g} g: the case ({frequency:.8g} Hz, "
+            f"{acceleration:.8g} g) lies at the edge of its range, within the grid "
+            "tolerance") in out.message
+
+
+def test_a_case_beyond_the_tolerance_of_the_edge_stays_out_of_range_saying_so(aligner):
+    out = aligner.align(LoadCase(45.0, 0.99999, 37.5))  # 10 % below 50 Hz
+    assert out.status == "out_of_range" and math.isnan(out.sdc_dem)
+    # 0.99999 g is the 1 g edge: the note names the frequency alone as outside
+    assert "(frequency 45 Hz outside 50-100 Hz; fill 25-50 %, acceleration 1-5 g)" \
+        in out.message
+    # a fill outside stays outside though the frequency is taken at the edge
+    fill = aligner.align(LoadCase(49.9995, 1.0, 60.0))
+    assert fill.status == "out_of_range"
+    assert "(fill 60 % outside 25-50 %; acceleration 1-5 g, frequency 50-100 Hz)" \
+        in fill.message
+
+
+def test_an_out_of_range_note_never_prints_a_value_rounded_onto_the_range():
+    # without tolerance 49.9999999 Hz is outside 50-100 Hz; printed to 6 digits it read
+    # "frequency 50 Hz outside 50-100 Hz"
+    strict = Aligner.from_tables(dem_grid(), tolerances=Tolerances(frequency_rtol=0.0,
+                                                                   acceleration_rtol=0.0))
+    out = strict.align(LoadCase(49.9999999, 0.9999999, 37.5))
+    assert out.status == "out_of_range"
+    assert ("(acceleration 0.9999999 g outside 1-5 g, frequency 49.9999999 Hz outside "
+            "50-100 Hz; fill 25-50 %)") in out.message
+
+
+def test_an_interior_case_is_interpolated_where_it_was_measured(aligner):
+    # only a case outside the grid's box is taken at its edge: 50.0005 Hz, 1.00001 g lies
+    # inside and is evaluated there, not at 50 Hz, 1 g (the linear field tells them apart by
+    # 2.5e-7 + 2e-7, far above the 1e-12 round-off)
+    out = aligner.align(LoadCase(50.0005, 1.00001, 37.5))
+    assert out.status == "interpolated"
+    assert out.sdc_dem == pytest.approx(linear_sdc(37.5, 1.00001, 50.0005), rel=1e-12)
+    assert "model evaluated at" not in out.message
+    # and between grid points nothing is snapped
+    mid = aligner.align(LoadCase(73.0, 2.7, 37.5))
+    assert mid.sdc_dem == pytest.approx(linear_sdc(37.5, 2.7, 73.0), rel=1e-12)
+    assert "model evaluated at" not in mid.message
+
+
+@pytest.mark.parametrize(("frequency", "acceleration"), [(49.9995, 1.0), (50.0, 0.99999),
+                                                         (45.0, 1.0)])
+def test_the_report_and_the_compare_pages_case_agree_at_the_grids_edge(
+        frequency, acceleration):
+    # the report dropped the DEM value of a 49.9995 Hz test the Compare page's curve took
+    # at 50 Hz: one rule (pidcore.compare.align.model_point) decides both
+    from pidcore.compare.case import MeasuredEntry, compare_case
+    from pidcore.report import ALIGNMENT_COLUMN, build_report_table
+
+    case = LoadCase(frequency, acceleration, 37.5)
+    entry = MeasuredEntry(
+        key="upload:x", file="edge.csv", origin="this session (unsaved)", load_case=case,
+        frequency_hz=frequency, acceleration_m_s2=acceleration * 9.80665, loss_factor=0.05,
+        sdc=0.3, sdc_stderr=0.01, energy_per_cycle_j=1e-3, harmonics=np.array([1]),
+        force_phasors_n=np.array([1j]), velocity_phasors_m_s=np.array([1.0]),
+        specimen="paper_coupon")
+    compared = compare_case([entry], dem_grid(), load_paper_table3()).aligned
+    analyses = pd.DataFrame([{"frequency_hz": frequency, "acceleration_g": acceleration,
+                              "fill_percent": 37.5, "material": "acrylic", "direction": "z",
+                              "sdc": 0.3, "sdc_stderr": 0.01, "source": "edge.csv",
+                              "specimen": "paper_coupon"}])
+    table = build_report_table(dem_grid(), analyses, load_paper_table3())
+    (row,) = table[table["source file(s)"] == "edge.csv"].to_dict("records")
+    assert row[ALIGNMENT_COLUMN] == compared.status
+    assert compared.status == ("out_of_range" if frequency == 45.0 else "interpolated")
+    # the same number (NaN for both out of range), and the same words
+    np.testing.assert_equal(row["SDC DEM (ours) [-]"], compared.sdc_dem)
+    assert compared.message in row["note"]
+
+
 def test_an_interpolated_value_resting_on_a_filled_grid_point_says_so(aligner):
     # an interrupted sweep: no run at 50 Hz, 1 g, 25 %; the model holds the 50 % run's SDC
     # there (nearest fill) and the row was labelled "interpolated" with no word of it

@@ -466,6 +466,33 @@ def test_an_interpolated_row_gets_the_count_and_eq10_sdc_of_its_specimen_and_fil
     assert "no DEM m_c" not in row["note"]
 
 
+def test_a_row_measured_a_hair_outside_the_grids_edge_is_compared_at_the_edge():
+    # a lab batch's 49.99998 Hz, 0.999992 g tests were out_of_range: no DEM value, and the
+    # "SDC measured, E of Eq. 10" column went blank with it, though the report states a 1 %
+    # frequency and 5 % acceleration tolerance
+    from pidcore.compare import Aligner, LoadCase
+    from pidcore.specimen import paper_specimen
+
+    runs = _runs_of(paper_specimen("acrylic").to_toml())
+    energy = 3.0e-6
+    analysis = _off_grid_analysis(energy).assign(frequency_hz=49.99998,
+                                                 acceleration_g=0.999992)
+    table = build_report_table(runs, analysis, None)
+    row = table[table["source file(s)"] == "off_grid_fill40.csv"].iloc[0]
+    assert row[ALIGNMENT_COLUMN] == "interpolated"
+    # the value at 50 Hz, 1 g, 40 % (a point inside the grid), bit for bit
+    at_edge = Aligner.from_tables(runs).align(LoadCase(50.0, 1.0, 40.0))
+    assert row["SDC DEM (ours) [-]"] == at_edge.sdc_dem
+    assert "model evaluated at 50 Hz, 1 g: the case (49.99998 Hz, 0.999992 g)" in row["note"]
+    # the Eq. 10 SDC divides by the measured a and w (as the interpolated row's test above
+    # works it by hand: 9 spheres per cell at 40 %)
+    sphere = 4.0 / 3.0 * math.pi * 1.25e-3**3 * 1180.0
+    m_c = 0.0221534 + 441 * 9 * sphere
+    omega, accel = 2 * math.pi * 49.99998, 0.999992 * 9.80665
+    assert row["SDC measured, E of Eq. 10 [-]"] == pytest.approx(
+        energy / (m_c * accel**2 / (2 * omega**2)), rel=1e-9)  # rel: as the test above
+
+
 def test_an_interpolated_row_without_one_specimen_or_convention_says_why():
     from pidcore.specimen import paper_specimen
 

@@ -10,7 +10,9 @@ compared with our DEM in one of three ways, named by :data:`AlignmentStatus`:
     direction; its runs' mean SDC is used.
 ``"interpolated"``
     No such DEM case; the pchip model (:class:`pidcore.model.SdcModel`) over our DEM cases is
-    evaluated at the measured point, which lies inside the model's grid box.
+    evaluated at the measured point, which lies inside the model's grid box, or at the box's
+    edge where the frequency or acceleration lies outside it within the tolerances above (a
+    measured 49.9995 Hz is the 50 Hz edge: :func:`model_point`; the message says so).
 ``"out_of_range"``
     Outside the model's box, or no model can be built: no value, a message says why. The model is
     never extrapolated.
@@ -1019,21 +1021,88 @@ _AXIS_WORDS: dict[str, tuple[str, str]] = {"fill_percent": ("fill", "%"),
                                            "frequency_hz": ("frequency", "Hz")}
 
 
-def model_range_text(model: object, point: tuple[float, float, float]) -> str:
+def _edge_value(value: float, lo: float, hi: float, rtol: float) -> float | None:
+    """``value`` taken into ``[lo, hi]``: itself inside, the nearest edge where it lies outside
+    by no more than ``rtol`` of that edge (a measurement's noise, as a grid point's
+    tolerance), None where it lies further out."""
+    edge = min(max(value, lo), hi)
+    return edge if abs(edge - value) <= rtol * edge else None
+
+
+def model_point(model: object, tolerances: Tolerances, acceleration_g: float,
+                frequency_hz: float, *, done: str = "drawn"
+                ) -> tuple[float, float, str] | None:
+    """(acceleration, frequency, note) to evaluate ``model`` at: the case itself, the model's
+    grid point the case lies within the grid-match tolerance of (500.0005 Hz, 4.99967 g is the
+    500 Hz, 5 g case, as the report aligns it), or the nearest edge of the model's range where
+    the case lies outside it by no more than that tolerance (49.999998 Hz is the 50 Hz case).
+    None where it lies further out. The note (``""`` for the case itself) says where the
+    model was taken, ``done`` naming how: "model drawn at 50 Hz, 1 g: ...".
+
+    The one rule of the Compare page's paper curve and of :meth:`Aligner.align` (the report's
+    and the Compare page's DEM value): a measured 49.9995 Hz was the 50 Hz case on the one
+    and out of range on the other."""
+    a_lo, a_hi = model.bounds["acceleration_g"]
+    f_lo, f_hi = model.bounds["frequency_hz"]
+    a = _edge_value(acceleration_g, a_lo, a_hi, tolerances.acceleration_rtol)
+    f = _edge_value(frequency_hz, f_lo, f_hi, tolerances.frequency_rtol)
+    if a is None or f is None:
+        return None
+    edge = (a, f) != (acceleration_g, frequency_hz)
+    # drawn between grid points, the curve of a case at 500.0005 Hz leant on the 1000 Hz
+    # points (by a part in a million), and its note named a 1000 Hz, 1 g gap on a 500 Hz, 5 g
+    # sheet
+    a = _grid_value(model.axes[1], a, tolerances.acceleration_rtol)
+    f = _grid_value(model.axes[2], f, tolerances.frequency_rtol)
+    note = ""
+    if (a, f) != (acceleration_g, frequency_hz):
+        where = ("lies at the edge of its range" if edge else
+                 "lies at that grid point of the model")
+        note = (f"model {done} at {f:.6g} Hz, {a:.4g} g: the case ({frequency_hz:.8g} Hz, "
+                f"{acceleration_g:.8g} g) {where}, within the grid tolerance")
+    return a, f, note
+
+
+def _grid_value(axis: np.ndarray, value: float, rtol: float) -> float:
+    """The grid value of ``axis`` nearest ``value`` where within ``rtol`` of it, else
+    ``value``."""
+    nearest = float(axis[np.argmin(np.abs(np.asarray(axis, dtype=float) - value))])
+    return nearest if abs(nearest - value) <= rtol * abs(nearest) else value
+
+
+def _outside_text(value: float, lo: float, hi: float) -> str:
+    """``value`` to as many significant digits as show it outside ``[lo, hi]`` (6 at least):
+    "1 g outside 1-10 g" was printed for 0.9999999999999644 g."""
+    for digits in range(6, 18):
+        text = f"{value:.{digits}g}"
+        if not lo <= float(text) <= hi:
+            return text
+    return repr(value)
+
+
+def model_range_text(model: object, point: tuple[float, float, float],
+                     tolerances: Tolerances | None = None) -> str:
     """The model's range per axis in words with units, the axes ``point`` (fill %,
     acceleration g, frequency Hz) lies outside first, e.g. ``"fill 95 % outside 25-90 %;
-    acceleration 1-10 g, frequency 50-1000 Hz"``.
+    acceleration 1-10 g, frequency 50-1000 Hz"``. With ``tolerances``, an acceleration or
+    frequency within them of the range's edge lies inside (:func:`model_point` takes it at
+    the edge).
 
     The keywords (``fill_percent in [25, 90]``) named no unit, and the command line's wording
     turned two of them into its flags (``--fill in [25, 90], acceleration_g in [1, 10],
     --frequency in [50, 1000]``) in report.csv's note."""
     bounds = getattr(model, "bounds", {}) or {}
+    rtol = {"acceleration_g": tolerances.acceleration_rtol,
+            "frequency_hz": tolerances.frequency_rtol} if tolerances is not None else {}
     outside, inside = [], []
     for (name, (lo, hi)), value in zip(bounds.items(), point, strict=False):
         word, unit = _AXIS_WORDS.get(name, (name, ""))
         span = f"{lo:g}-{hi:g} {unit}".rstrip()
+        taken = _edge_value(value, lo, hi, rtol[name]) if name in rtol else None
+        value = value if taken is None else taken
         if value < lo or value > hi:
-            outside.append(f"{word} {value:g} {unit} outside {span}".replace("  ", " "))
+            outside.append(f"{word} {_outside_text(value, lo, hi)} {unit} outside {span}"
+                           .replace("  ", " "))
         else:
             inside.append(f"{word} {span}")
     return "; ".join(part for part in (", ".join(outside), ", ".join(inside)) if part)
@@ -1127,16 +1196,30 @@ class Aligner:
             return AlignedCase(case, "out_of_range", **common, message=model)
         point = (case.fill_percent, case.acceleration_g, case.frequency_hz)
         source = getattr(model, "source", "") or "pchip model"
+        taken_note = ""
         if not model.contains(point):
-            return AlignedCase(case, "out_of_range", **common,
-                               message=f"{case.label()} lies outside the range of {source} "
-                                       f"({model_range_text(model, point)}); not "
-                                       "extrapolated")
+            # a measured 49.9995 Hz or 0.99999 g is the grid's 50 Hz or 1 g edge within the
+            # tolerances, as the grid match and the Compare page take it; an interior point
+            # is evaluated where it was measured
+            taken = model_point(model, self.tolerances, case.acceleration_g,
+                                case.frequency_hz, done="evaluated")
+            if taken is not None:
+                point = (case.fill_percent, taken[0], taken[1])
+                taken_note = taken[2]
+            if taken is None or not model.contains(point):
+                return AlignedCase(
+                    case, "out_of_range", **common,
+                    message=f"{case.label()} lies outside the range of {source} "
+                            f"({model_range_text(model, point, self.tolerances)}); not "
+                            "extrapolated")
         value = float(np.asarray(model(*point)))
-        unconverged = self._unconverged_nodes(case) if self.model is None else ()
+        at = replace(case, acceleration_g=point[1], frequency_hz=point[2])
+        unconverged = self._unconverged_nodes(at) if self.model is None else ()
         # the row's empty "SDC DEM stderr" cell was left unexplained
         message = (f"pchip interpolation over {source} (no DEM stderr: the model interpolates "
                    "the runs' SDCs, not their errors)")
+        if taken_note:
+            message += f"; {taken_note}"
         if unconverged:
             # a grid row on such a run says so; the value interpolated from it said nothing
             message += ("; it rests on DEM runs that did not converge (no steady state before "

@@ -28,6 +28,7 @@ from .align import (
     consistency_chi2,
     filled_corners,
     interpolated_count_and_mass,
+    model_point,
     pooled_baseline_sdc,
     pooled_mean,
     pooled_sdc_eq10,
@@ -222,42 +223,6 @@ class CaseComparison:
     measured_stderr_eq10_dof: float = math.nan
     vibrated_mass_kg: float = math.nan
     measured_baseline_sdc: float = 0.0
-
-
-def _model_point(model, tol: Tolerances, acceleration_g: float,
-                 frequency_hz: float) -> tuple[float, float, str] | None:
-    """(acceleration, frequency) to evaluate the model at: the case itself, the model's grid
-    point the case lies within the grid-match tolerance of (500.0005 Hz, 4.99967 g is the
-    500 Hz, 5 g case, as the report aligns it), or the nearest edge of the model's range where
-    the case lies outside it by no more than that tolerance (49.999998 Hz is the 50 Hz case).
-    None where it lies further out."""
-    a_lo, a_hi = model.bounds["acceleration_g"]
-    f_lo, f_hi = model.bounds["frequency_hz"]
-    a = min(max(acceleration_g, a_lo), a_hi)
-    f = min(max(frequency_hz, f_lo), f_hi)
-    if abs(a - acceleration_g) > tol.acceleration_rtol * a \
-            or abs(f - frequency_hz) > tol.frequency_rtol * f:
-        return None
-    edge = (a, f) != (acceleration_g, frequency_hz)
-    # drawn between grid points, the curve of a case at 500.0005 Hz leant on the 1000 Hz
-    # points (by a part in a million), and its note named a 1000 Hz, 1 g gap on a 500 Hz, 5 g
-    # sheet
-    a = _grid_value(model.axes[1], a, tol.acceleration_rtol)
-    f = _grid_value(model.axes[2], f, tol.frequency_rtol)
-    note = ""
-    if (a, f) != (acceleration_g, frequency_hz):
-        where = ("lies at the edge of its range" if edge else
-                 "lies at that grid point of the model")
-        note = (f"model drawn at {f:.6g} Hz, {a:.4g} g: the case ({frequency_hz:.8g} Hz, "
-                f"{acceleration_g:.6g} g) {where}, within the grid tolerance")
-    return a, f, note
-
-
-def _grid_value(axis: np.ndarray, value: float, rtol: float) -> float:
-    """The grid value of ``axis`` nearest ``value`` where within ``rtol`` of it, else
-    ``value``."""
-    nearest = float(axis[np.argmin(np.abs(np.asarray(axis, dtype=float) - value))])
-    return nearest if abs(nearest - value) <= rtol * abs(nearest) else value
 
 
 @dataclass(frozen=True)
@@ -600,7 +565,7 @@ def compare_case(records: Sequence[MeasuredEntry],
             "SDC DEM (paper) [-]": rows["sdc_dem"].to_numpy(float),
             "SDC measured (paper) [-]": rows["sdc_experimental"].to_numpy(float)})
         model = SdcModel.from_table(paper, value="sdc_dem", source="paper Table 3 (DEM)")
-        point = _model_point(model, tol, case.acceleration_g, case.frequency_hz)
+        point = model_point(model, tol, case.acceleration_g, case.frequency_hz)
         if point is None:
             notes.append(f"{case.label()} lies outside the range of the paper's pchip model; "
                          "no model curve (never extrapolated)")
