@@ -7,6 +7,7 @@ import math
 import sys
 from pathlib import Path
 
+import h5py
 import numpy as np
 import pytest
 from _shaker_files import file_sha256, write_force_velocity
@@ -245,11 +246,20 @@ def test_saving_the_same_analyses_again_does_not_grow_the_store_and_the_newest_s
     # saved with a delay, without, then with it again: the last save is the one used, though
     # its analysis was held already
     argv = ["analyze", files[0], "--store", str(store_path)]
+    times = []
     for delay in ("5e-5", "0", "5e-5"):
         assert main([*argv, "--velocity-delay", delay]) == 0
+        listing = Store(store_path).list_analyses()
+        times.append(dict(zip(listing["key"], listing["created_utc"], strict=True)))
     newest = latest_per_measurement(Store(store_path).list_analyses())
     used = newest[newest["source"] == files[0]]
     assert json.loads(used["parameters_json"].iloc[0])["velocity_delay_s"] == 5e-5
+    # its first save's time is kept beside the renewed one (it was overwritten: the
+    # provenance lost when the result was first made)
+    key = used["key"].iloc[0]
+    with h5py.File(store_path, "r") as h5:
+        attrs = h5[f"analyses/{key}"].attrs
+        assert attrs["first_created_utc"] == times[0][key] < attrs["created_utc"]
     capsys.readouterr()
 
 

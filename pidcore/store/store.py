@@ -7,6 +7,8 @@ Layout (every group explains itself through its attributes)::
                                + attrs imported_utc, pidcore_version, key_basis
     /analyses/<key>            attrs: pidcore_layout="analysis", measurement_key, created_utc,
                                       pidcore_version, parameters_json, null_fields_json
+                                      (first_created_utc where saved again since: created_utc
+                                      is its newest save, which reports take)
     /analyses/<key>/record     one attribute per scalar field
     /analyses/<key>/units      one attribute per field or array: its unit
     /analyses/<key>/arrays/<name>   dataset (complex allowed), attr unit; fletcher32, and
@@ -898,8 +900,12 @@ class Store:
                     # the same analysis saved again: rewriting it grew the file by the space
                     # HDF5 does not give back (1.53 -> 1.59 MB over 12 identical saves). Its
                     # time is renewed in place: the newest save of a measurement is the one
-                    # reports use (saved with a delay, without, then with it again)
-                    parent[key].attrs["created_utc"] = _utc_now()
+                    # reports use (saved with a delay, without, then with it again); the
+                    # first save's time is kept beside it, the provenance of the result
+                    attrs = parent[key].attrs
+                    if "first_created_utc" not in attrs:
+                        attrs["first_created_utc"] = attrs.get("created_utc", "")
+                    attrs["created_utc"] = _utc_now()
                     return key
                 del parent[key]
             self._check_room_to_write(h5, entry.nbytes, what=f"analysis {key!r}")
