@@ -172,6 +172,14 @@ DEM_MAX_SETTLE_TIME_S = 1.0
 DEM_DAMPING_COEFFICIENT = "eq3"
 #: Impact speed at which "calibrated" damping matches the table's restitution, m/s.
 DEM_CALIBRATION_SPEED_M_S = 0.3
+#: Seconds a ``--scheduler`` address is given, after dask's connect timeout
+#: (``distributed.comm.timeouts.connect``, 30 s, which a scheduler still starting needs), to
+#: answer as a dask.distributed scheduler before it is refused: dask waits for that answer
+#: without a limit, so a port that accepts and never replies (an HTTP server reading a request
+#: line) hung the sweep for ever. A scheduler answers from its event loop in milliseconds, and
+#: dask itself warns when that loop stalls over 3 s (``distributed.admin.tick.limit``): 10 s
+#: leaves a busy scheduler room.
+DEM_SCHEDULER_ANSWER_TIMEOUT_S = 10.0
 
 # --- Coupon (paper Sect. 2, Table 2) ---------------------------------------------------------
 # The DEM reads the coupon from its specimen file (pidcore/data/specimens/paper_coupon.toml,

@@ -183,6 +183,84 @@ def test_an_unreachable_scheduler_is_one_line_exit_2_and_nothing_stored(tmp_path
     assert not store.exists() or not Store(store).list_dem_runs().shape[0]
 
 
+def _listener(reply: bytes | None) -> int:
+    """Port of a local TCP listener that accepts every connection and sends ``reply`` to
+    each (then closes it), or nothing ever (``None``: the connections are held open)."""
+    import socket
+    import threading
+
+    server = socket.create_server(("127.0.0.1", 0))
+    held = []
+
+    def serve() -> None:
+        while True:
+            conn, _ = server.accept()
+            if reply is None:
+                held.append(conn)
+                continue
+            conn.recv(4096)  # the client's handshake, as an HTTP server reads a request
+            conn.sendall(reply)
+            conn.close()
+
+    threading.Thread(target=serve, daemon=True).start()
+    return server.getsockname()[1]
+
+
+@pytest.mark.timeout(60)  # the old code waited for an answer for ever: fail, not hang
+@pytest.mark.parametrize(("reply", "said"), [
+    (None, "the connection was accepted but no dask.distributed scheduler answered within "
+           "1.5 s"),
+    (b"HTTP/1.0 400 Bad Request\r\nContent-Length: 0\r\n\r\n",
+     "something other than a dask.distributed scheduler answered there"),
+])
+def test_an_address_where_no_scheduler_answers_is_refused_in_one_line_within_the_limit(
+        tmp_path, capsys, monkeypatch, reply, said):
+    """`--scheduler` at a port that accepts and never answers waited for ever; at an HTTP
+    server, dask read "HTTP/1.0" as a count of frames and the line passed on numpy's "Unable
+    to allocate 3.07 EiB"."""
+    pytest.importorskip("distributed")
+    import time
+
+    import dask
+
+    from pidcore import defaults
+    from pidcore.cli import main
+
+    monkeypatch.setattr(defaults, "DEM_SCHEDULER_ANSWER_TIMEOUT_S", 0.5, raising=False)
+    address = f"tcp://127.0.0.1:{_listener(reply)}"
+    store = tmp_path / "s.h5"
+    start = time.perf_counter()
+    with dask.config.set({"distributed.comm.timeouts.connect": "1s"}):  # 1 s + 0.5 s
+        code = main(["dem", "sweep", "--frequencies", "1000", "--accelerations", "5",
+                     "--fills", "25", "--cells", "1", "--cycles", "2", "--no-progress",
+                     "--scheduler", address, "--store", str(store)])
+    elapsed = time.perf_counter() - start
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2
+    assert len(err) == 1 and f"--scheduler {address}: {said}" in err[0], err
+    assert "tcp://host:8786" in err[0] and "EiB" not in err[0], err
+    # the 1.5 s limit and the CLI's own setup (a fraction of a second; 10 s for a loaded
+    # machine), not the minutes of a hang
+    assert elapsed < 1.5 + 10.0
+    assert not store.exists()
+
+
+def test_a_dask_worker_is_not_taken_for_the_scheduler_and_the_scheduler_is(tmp_path):
+    """Refused by what the address answers as (its identity), not by where it listens."""
+    distributed = pytest.importorskip("distributed")
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
+                                  dashboard_address=None) as cluster:
+        worker = next(iter(cluster.scheduler.workers))
+        with pytest.raises(ParameterError, match=f"scheduler {worker}: a dask.distributed "
+                                                 "Worker answered there, not a scheduler"):
+            run_sweep(CASES[:1], CONFIG, store_path=tmp_path / "w.h5", scheduler=worker,
+                      progress=False)
+        assert not (tmp_path / "w.h5").exists()
+        summary = run_sweep(CASES[:1], CONFIG, store_path=tmp_path / "s.h5",
+                            scheduler=cluster.scheduler_address, progress=False)
+    assert summary.completed == [run_key(CASES[0], CONFIG)]
+
+
 def test_a_killed_pool_worker_is_one_error_not_a_traceback():
     """A DEM worker killed from outside (OOM killer, kill -9) ended `pidcore dem sweep` and
     `calibrate` with concurrent.futures' BrokenProcessPool traceback, exit 1."""

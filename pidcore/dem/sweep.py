@@ -20,6 +20,7 @@ from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from .. import defaults
 from ..constants import DriveDirection, ParticleMaterial
 from ..errors import ParameterError, SimulationError, instance_of, whole_number
 from ..interrupt import raise_if_stopped, stop_processes
@@ -428,7 +429,8 @@ def run_sweep(cases: Sequence[LoadCase], config: DemConfig, *,
         Local processes (default: all cores). Ignored with ``scheduler``.
     scheduler : str, optional
         Address of a dask.distributed scheduler (``tcp://host:8786``); needs the
-        ``distributed`` extra.
+        ``distributed`` extra. Refused (:class:`ParameterError`) unless a scheduler answers
+        there within dask's connect timeout and ``DEM_SCHEDULER_ANSWER_TIMEOUT_S`` more.
     progress : bool
         tqdm bar on stderr.
     on_case : callable, optional
@@ -494,6 +496,8 @@ def run_sweep(cases: Sequence[LoadCase], config: DemConfig, *,
     bar = None
     if todo:
         store.check_writable()  # before the simulations, not at the first commit
+        if scheduler:
+            _check_scheduler(scheduler)  # before the bar: a refusal is its one line
     if progress:
         from tqdm import tqdm
 
@@ -577,13 +581,90 @@ def _run_local(todo: Iterable[tuple[LoadCase, str]], config: DemConfig, workers:
     run_pooled(run_case_unless_stored, calls, workers=workers, finish=finish)
 
 
-def _run_dask(todo: Iterable[tuple[LoadCase, str]], config: DemConfig, scheduler: str,
-              finish: Callable[[CaseOutcome], None], specimen: Specimen | None) -> None:
+#: How a ``--scheduler`` refusal names what it expected.
+_EXPECTED_SCHEDULER = ("expected the address of a running scheduler, e.g. tcp://host:8786 (a "
+                       "scheduler's usual port; 8787 is usually its dashboard, which speaks "
+                       "HTTP)")
+
+
+def _check_scheduler(scheduler: str) -> None:
+    """Refuse ``scheduler`` unless a dask.distributed scheduler answers there as one.
+
+    ``Client(address)`` waits for the answer to its handshake without a limit: a port that
+    accepts and never replies (an HTTP server reading a request line) hung the sweep for ever,
+    and an HTTP reply (a scheduler's dashboard) came out as numpy's "Unable to allocate 3.07
+    EiB" (dask read "HTTP/1.0" as a count of frames). Asked here, as the Client connects, for
+    its identity within dask's connect timeout and ``DEM_SCHEDULER_ANSWER_TIMEOUT_S`` more.
+
+    Raises
+    ------
+    ParameterError
+        One line naming the address and what was expected.
+    """
     try:
-        from distributed import Client, as_completed
+        import asyncio
+
+        import dask
+        from dask.utils import parse_timedelta
+        from distributed import Security
+        from distributed.comm.core import FatalCommClosedError
+        from distributed.core import rpc
     except ImportError:
         raise ParameterError("scheduler: needs dask.distributed: "
                              "pip install 'pidcore[distributed]'") from None
+    connect_s = parse_timedelta(dask.config.get("distributed.comm.timeouts.connect"),
+                                default="seconds")
+    limit = connect_s + defaults.DEM_SCHEDULER_ANSWER_TIMEOUT_S
+    # the TLS settings of dask's configuration, as the Client takes them
+    connection_args = Security().get_connection_args("client")
+
+    async def identity() -> object:
+        async with rpc(scheduler, connection_args=connection_args) as remote:
+            return await remote.identity()
+
+    outcome: dict[str, object] = {}
+
+    def ask() -> None:
+        # a thread and event loop of its own: a caller's running loop (a notebook's) is
+        # left alone, as the Client leaves it
+        try:
+            outcome["identity"] = asyncio.run(asyncio.wait_for(identity(), limit))
+        except BaseException as exc:  # noqa: BLE001 - every failure is the caller's one line
+            outcome["error"] = exc
+
+    thread = threading.Thread(target=ask, name="pidcore-scheduler-probe", daemon=True)
+    thread.start()
+    thread.join(limit + 5.0)  # the cancelled probe's own clean-up, not waited for without end
+    error = outcome.get("error")
+    # dask's connect retries until its timeout and then raises a plain OSError (refused, no
+    # such host); a bad address is a ValueError, tls:// without a TLS configuration a
+    # TypeError, a failed TLS handshake fatal: dask's words say which
+    if type(error) is OSError or isinstance(error, (ValueError, TypeError,
+                                                    FatalCommClosedError)):
+        raise ParameterError(f"scheduler {scheduler}: cannot connect to a dask.distributed "
+                             f"scheduler there ({' '.join(str(error).split())}); "
+                             f"{_EXPECTED_SCHEDULER}")
+    if thread.is_alive() or isinstance(error, asyncio.TimeoutError):
+        raise ParameterError(f"scheduler {scheduler}: the connection was accepted but no "
+                             f"dask.distributed scheduler answered within {limit:g} s; "
+                             f"{_EXPECTED_SCHEDULER}")
+    answer = outcome.get("identity")
+    kind = answer.get("type") if isinstance(answer, dict) else None
+    # after the connection, anything (MemoryError for an HTTP reply, the stream closed, an
+    # error reply) is something else answering
+    if error is not None or not isinstance(kind, str):
+        raise ParameterError(f"scheduler {scheduler}: something other than a dask.distributed "
+                             f"scheduler answered there (an HTTP server?); "
+                             f"{_EXPECTED_SCHEDULER}")
+    if kind != "Scheduler":
+        raise ParameterError(f"scheduler {scheduler}: a dask.distributed {kind} answered "
+                             f"there, not a scheduler; {_EXPECTED_SCHEDULER}")
+
+
+def _run_dask(todo: Iterable[tuple[LoadCase, str]], config: DemConfig, scheduler: str,
+              finish: Callable[[CaseOutcome], None], specimen: Specimen | None) -> None:
+    from distributed import Client, as_completed  # there: _check_scheduler asked it
+
     try:
         client = Client(scheduler)
     # refused or timed out (OSError), a bad address (ValueError), and whatever else the
