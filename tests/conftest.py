@@ -179,6 +179,22 @@ def paper_table():
 
 
 @pytest.fixture(scope="session")
+def _store_records_cache(tmp_path_factory):
+    """Folder of the one store of every section's records the store tests copy (its tiny
+    calibration takes ~30 s: made once per session)."""
+    return tmp_path_factory.mktemp("store_records")
+
+
+@pytest.fixture
+def records_store_copy(_store_records_cache, tmp_path):
+    """(path, keys by role) of a fresh copy of the store of ``tests/_store_records.py``."""
+    from _store_records import records_store
+
+    path = tmp_path / "s.h5"
+    return path, records_store(_store_records_cache, path)
+
+
+@pytest.fixture(scope="session")
 def paper_model(paper_table):
     """The pchip SDC model over the paper's Table 3 DEM values (a pidcore.model.SdcModel)."""
     from pidcore.model import SdcModel

@@ -7,29 +7,16 @@ import json
 import os
 
 import h5py
-import pytest
 from _cli_runs import refusal
 from _shaker_files import file_sha256
-from _store_records import records_store
 
 from pidcore.cli import main
 from pidcore.store import Store, manage
 from pidcore.store.lock import exclusive_lock
 
 
-@pytest.fixture(scope="module")
-def cache(tmp_path_factory):
-    return tmp_path_factory.mktemp("calibrated")
-
-
-@pytest.fixture
-def made(cache, tmp_path):
-    path = tmp_path / "s.h5"
-    return path, records_store(cache, path)
-
-
-def test_list_names_every_record_by_key_with_units_in_the_headers(made, capsys):
-    path, keys = made
+def test_list_names_every_record_by_key_with_units_in_the_headers(records_store_copy, capsys):
+    path, keys = records_store_copy
     assert main(["store", "list", "--store", str(path), "--json"]) == 0
     listed = json.loads(capsys.readouterr().out)
     assert [r["key"] for r in listed["measurements"]] == keys["measurements"]
@@ -45,8 +32,8 @@ def test_list_names_every_record_by_key_with_units_in_the_headers(made, capsys):
                                    "SDC [-]", "saved [UTC]"))
 
 
-def test_verify_exits_0_when_sound_and_1_with_the_problems_when_damaged(made, capsys):
-    path, keys = made
+def test_verify_exits_0_when_sound_and_1_with_the_problems_when_damaged(records_store_copy, capsys):
+    path, keys = records_store_copy
     assert main(["store", "verify", "--store", str(path), "--no-progress"]) == 0
     assert "sound (2 measurement(s), 3 analysis(es), 4 DEM run(s), 1 calibration(s)" in \
         capsys.readouterr().out
@@ -57,8 +44,8 @@ def test_verify_exits_0_when_sound_and_1_with_the_problems_when_damaged(made, ca
     assert f"refers to measurement '{keys['measurements'][1]}', which is not stored" in out
 
 
-def test_remove_prints_what_went_and_why(made, capsys):
-    path, keys = made
+def test_remove_prints_what_went_and_why(records_store_copy, capsys):
+    path, keys = records_store_copy
     first = keys["measurements"][0]
     assert main(["store", "remove", first, "--store", str(path)]) == 0
     out = capsys.readouterr().out.splitlines()
@@ -69,8 +56,8 @@ def test_remove_prints_what_went_and_why(made, capsys):
     assert len(Store(path).list_analyses()) == 1
 
 
-def test_a_dry_run_prints_what_would_go_and_removes_nothing(made, capsys):
-    path, keys = made
+def test_a_dry_run_prints_what_would_go_and_removes_nothing(records_store_copy, capsys):
+    path, keys = records_store_copy
     digest = file_sha256(path)
     run, calibration = keys["design"][0], keys["calibration"]
     assert main(["store", "remove", run, "--store", str(path), "--dry-run",
@@ -81,8 +68,8 @@ def test_a_dry_run_prints_what_would_go_and_removes_nothing(made, capsys):
     assert "nothing was removed" in out[-1] and file_sha256(path) == digest
 
 
-def test_a_design_run_is_refused_in_one_line_naming_the_option(made, capsys):
-    path, keys = made
+def test_a_design_run_is_refused_in_one_line_naming_the_option(records_store_copy, capsys):
+    path, keys = records_store_copy
     digest = file_sha256(path)
     err = refusal(["store", "remove", keys["design"][0], "--store", str(path)], capsys)
     assert f"is a design run of calibration {keys['calibration']}" in err
@@ -90,8 +77,8 @@ def test_a_design_run_is_refused_in_one_line_naming_the_option(made, capsys):
     assert file_sha256(path) == digest
 
 
-def test_an_unknown_key_exits_2_naming_it_and_where_to_look(made, capsys):
-    path, _ = made
+def test_an_unknown_key_exits_2_naming_it_and_where_to_look(records_store_copy, capsys):
+    path, _ = records_store_copy
     digest = file_sha256(path)
     err = refusal(["store", "remove", "nope", "--store", str(path)], capsys)
     assert err == (f"pidcore store remove: error: {path}: no record 'nope' in this store; "
@@ -99,8 +86,9 @@ def test_an_unknown_key_exits_2_naming_it_and_where_to_look(made, capsys):
     assert file_sha256(path) == digest
 
 
-def test_ctrl_c_during_the_removal_exits_130_and_commits_nothing(made, capsys, monkeypatch):
-    path, keys = made
+def test_ctrl_c_during_the_removal_exits_130_and_commits_nothing(records_store_copy, capsys,
+                                                                 monkeypatch):
+    path, keys = records_store_copy
     digest = file_sha256(path)
 
     def interrupted() -> None:
@@ -114,8 +102,8 @@ def test_ctrl_c_during_the_removal_exits_130_and_commits_nothing(made, capsys, m
 
 
 def test_missing_foreign_read_only_and_locked_stores_give_pidcores_one_line_errors(
-        made, capsys, monkeypatch, tmp_path):
-    path, keys = made
+        records_store_copy, capsys, monkeypatch, tmp_path):
+    path, keys = records_store_copy
     missing = tmp_path / "nope.h5"
     for command in (["list"], ["verify"], ["remove", "k"]):
         err = refusal(["store", *command, "--store", str(missing)], capsys)

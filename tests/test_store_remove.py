@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import pytest
 from _shaker_files import file_sha256
-from _store_records import contents, records_store, without
+from _store_records import contents, without
 
 from pidcore.calibrate.persist import calibration_design_runs, stored_calibrations
 from pidcore.errors import StoreError
@@ -14,20 +14,9 @@ from pidcore.store.listing import list_dem_runs, saved_analyses
 from pidcore.store.manage import remove_records, store_contents
 
 
-@pytest.fixture(scope="module")
-def cache(tmp_path_factory):
-    return tmp_path_factory.mktemp("calibrated")
-
-
-@pytest.fixture
-def made(cache, tmp_path):
-    path = tmp_path / "s.h5"
-    return path, records_store(cache, path)
-
-
 def test_removing_a_measurement_takes_its_analyses_and_leaves_every_other_record_bit_for_bit(
-        made):
-    path, keys = made
+        records_store_copy):
+    path, keys = records_store_copy
     first = keys["measurements"][0]
     before = contents(path)
     removal = remove_records(path, [first])
@@ -46,8 +35,8 @@ def test_removing_a_measurement_takes_its_analyses_and_leaves_every_other_record
     assert Store(path).verify() == []
 
 
-def test_removing_the_newest_analysis_says_the_earlier_one_reports_take_now(made):
-    path, keys = made
+def test_removing_the_newest_analysis_says_the_earlier_one_reports_take_now(records_store_copy):
+    path, keys = records_store_copy
     assert list(saved_analyses(path)["key"]) == [keys["other"], keys["newer"]]
     removal = remove_records(path, [keys["newer"]])
     assert [r.key for r in removal.records] == [keys["newer"]]
@@ -55,8 +44,8 @@ def test_removing_the_newest_analysis_says_the_earlier_one_reports_take_now(made
     assert set(saved_analyses(path)["key"]) == {keys["other"], keys["older"]}
 
 
-def test_a_design_run_of_a_stored_calibration_is_refused_and_nothing_is_removed(made):
-    path, keys = made
+def test_a_design_run_of_a_stored_calibration_is_refused_and_nothing_is_removed(records_store_copy):
+    path, keys = records_store_copy
     run, calibration = keys["design"][1], keys["calibration"]
     digest = file_sha256(path)
     with pytest.raises(StoreError, match=f"DEM run {run} is a design run of calibration "
@@ -65,8 +54,8 @@ def test_a_design_run_of_a_stored_calibration_is_refused_and_nothing_is_removed(
     assert file_sha256(path) == digest
 
 
-def test_with_dependents_the_calibration_fitted_on_the_run_goes_with_it(made):
-    path, keys = made
+def test_with_dependents_the_calibration_fitted_on_the_run_goes_with_it(records_store_copy):
+    path, keys = records_store_copy
     run, calibration = keys["design"][1], keys["calibration"]
     before = contents(path)
     removal = remove_records(path, [run], with_dependents=True)
@@ -79,16 +68,16 @@ def test_with_dependents_the_calibration_fitted_on_the_run_goes_with_it(made):
                                      f"/calibrations/{calibration}")
 
 
-def test_naming_the_calibration_with_its_run_needs_no_option(made):
-    path, keys = made
+def test_naming_the_calibration_with_its_run_needs_no_option(records_store_copy):
+    path, keys = records_store_copy
     run, calibration = keys["design"][0], keys["calibration"]
     removal = remove_records(path, [run, calibration])
     assert {(r.section, r.key) for r in removal.records} == {("dem_runs", run),
                                                            ("calibrations", calibration)}
 
 
-def test_an_interrupted_removal_leaves_the_store_byte_identical(made, monkeypatch):
-    path, keys = made
+def test_an_interrupted_removal_leaves_the_store_byte_identical(records_store_copy, monkeypatch):
+    path, keys = records_store_copy
     digest = file_sha256(path)
 
     def interrupted() -> None:
@@ -101,8 +90,8 @@ def test_an_interrupted_removal_leaves_the_store_byte_identical(made, monkeypatc
     assert sorted(p.name for p in path.parent.iterdir()) == ["s.h5"]  # no copy, no lock
 
 
-def test_an_unknown_key_is_refused_and_nothing_is_removed(made):
-    path, keys = made
+def test_an_unknown_key_is_refused_and_nothing_is_removed(records_store_copy):
+    path, keys = records_store_copy
     digest = file_sha256(path)
     with pytest.raises(StoreError, match="no record 'nope' in this store; nothing was removed"
                                          r" \(`pidcore store list`"):
@@ -110,8 +99,8 @@ def test_an_unknown_key_is_refused_and_nothing_is_removed(made):
     assert file_sha256(path) == digest
 
 
-def test_a_dry_run_lists_exactly_what_the_removal_removes_and_leaves_the_file(made):
-    path, keys = made
+def test_a_dry_run_lists_exactly_what_the_removal_removes_and_leaves_the_file(records_store_copy):
+    path, keys = records_store_copy
     digest = file_sha256(path)
     named = [keys["measurements"][1], keys["design"][2]]
     planned = remove_records(path, named, with_dependents=True, dry_run=True)
@@ -120,8 +109,8 @@ def test_a_dry_run_lists_exactly_what_the_removal_removes_and_leaves_the_file(ma
     assert planned.records == done.records and len(done.records) == 4
 
 
-def test_a_section_key_names_a_record_of_that_section(made):
-    path, keys = made
+def test_a_section_key_names_a_record_of_that_section(records_store_copy):
+    path, keys = records_store_copy
     removal = remove_records(path, [f"dem_runs/{keys['own_run']}"])
     assert [(r.section, r.key) for r in removal.records] == [("dem_runs", keys["own_run"])]
 
@@ -132,10 +121,10 @@ def test_a_missing_store_is_refused_not_read_as_empty(tmp_path):
     assert not (tmp_path / "nope.h5").exists()
 
 
-def test_a_calibrations_run_of_its_variant_of_the_start_specimen_is_refused_too(made):
+def test_a_calibrations_run_of_its_variant_of_the_start_specimen_is_refused_too(records_store_copy):
     # fitting a DEM parameter, a calibration runs variants of its start specimen (other
     # hashes); they are inputs of its fit as much as the start's runs, and were removed
-    path, keys = made
+    path, keys = records_store_copy
     store = Store(path)
     start = str(store.list_calibrations()["specimen_hash"].iloc[0])
     run = store.get_dem_run(keys["design"][0])

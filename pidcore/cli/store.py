@@ -111,21 +111,11 @@ def _table(frame: pd.DataFrame) -> str:
 
 
 def run_verify(args: argparse.Namespace) -> int:
-    from ..store.manage import existing_store
+    from ..store.manage import existing_store, verify_with_progress
 
     store = existing_store(args.store)
-    if progress_wanted(args):  # every array is read: a minute or more for years of tests
-        from tqdm import tqdm
-
-        with tqdm(unit="entry", desc=f"verifying {args.store}", leave=False,
-                  dynamic_ncols=True) as bar:
-            def advance(done: int, total: int) -> None:
-                bar.total = total
-                bar.update(done - bar.n)
-
-            problems = store.verify(progress=advance)
-    else:
-        problems = store.verify()
+    problems = verify_with_progress(store, progress=progress_wanted(args),
+                                    label=f"verifying {args.store}")
     summary = store.summary()
     if args.json:
         print(json.dumps({"store": str(args.store), "sound": not problems,

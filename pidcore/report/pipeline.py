@@ -156,23 +156,13 @@ def open_verified_store(path: str | Path, *, must_exist: bool,
         A bar over the store's entries on stderr while they are verified.
     """
     from ..store import Store, existing_store
+    from ..store.manage import verify_with_progress
 
     path = Path(path)
     if not path.exists() and not must_exist:
         return Store(path)
     store = existing_store(path)
-    if progress:  # every array of the store is read: a minute or more for years of tests
-        from tqdm import tqdm
-
-        with tqdm(unit="entry", desc=f"verifying {path.name}", leave=False,
-                  dynamic_ncols=True) as bar:
-            def advance(done: int, total: int) -> None:
-                bar.total = total
-                bar.update(done - bar.n)
-
-            problems = store.verify(progress=advance)
-    else:
-        problems = store.verify()
+    problems = verify_with_progress(store, progress=progress, label=f"verifying {path.name}")
     if problems:
         more = f" (and {len(problems) - 1} more problem(s))" if len(problems) > 1 else ""
         raise StoreError(f"{path}: corrupt or partial store, no report written: "

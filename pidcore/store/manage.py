@@ -65,6 +65,21 @@ def existing_store(path: str | os.PathLike) -> Store:
     return Store(path)
 
 
+def verify_with_progress(store: Store, *, progress: bool, label: str) -> list[str]:
+    """:meth:`Store.verify`, with a bar ``label`` over the store's entries on stderr where
+    ``progress``: every array is read, a minute or more for years of tests."""
+    if not progress:
+        return store.verify()
+    from tqdm import tqdm
+
+    with tqdm(unit="entry", desc=label, leave=False, dynamic_ncols=True) as bar:
+        def advance(done: int, total: int) -> None:
+            bar.total = total
+            bar.update(done - bar.n)
+
+        return store.verify(progress=advance)
+
+
 def _column(frame: pd.DataFrame, name: str, default: object = "") -> pd.Series:
     return frame[name] if name in frame.columns else pd.Series([default] * len(frame),
                                                                index=frame.index)
