@@ -305,3 +305,21 @@ def test_select_runs_refuses_mixed_conditions():
         select_runs(runs, where={"material": "steel"})
     with pytest.raises(ParameterError, match="no column 'seed'"):
         select_runs(runs, where={"seed": "1"})
+
+
+def test_a_point_a_hair_outside_the_model_is_named_as_given(model):
+    # 1000.001 Hz was refused as "frequency_hz=1000 Hz is outside ... [50, 1000]" (:g), a
+    # message naming a value inside the range; in the damper table too
+    from pidcore.model import equivalent_damper_table
+
+    said = "(fill_percent=90 %, acceleration_g=10 g, frequency_hz=1000.001 Hz) is outside"
+    with pytest.raises(ParameterError) as refused:
+        model(90, 10, 1000.001)
+    assert said in str(refused.value)
+    with pytest.raises(ParameterError) as in_table:
+        equivalent_damper_table(model, fills_percent=[90], accelerations_g=[10],
+                                frequencies_hz=[1000.001], vibrated_mass_kg=0.15)
+    assert said in str(in_table.value)
+    with pytest.raises(ParameterError, match=r"\(fill_percent=100.0000001 %, .*\) is no load "
+                                             r"case"):
+        model.evaluate(100.0000001, 5, 100, clip_to_range=True)

@@ -321,7 +321,7 @@ class SdcModel:
             possible = (coords[0] > 0) & (coords[0] <= 100) & (coords[1] > 0) & (coords[2] > 0)
             if not np.all(possible):
                 i = int(np.argmin(possible))
-                bad = ", ".join(f"{n}={c[i]:g} {_AXIS_UNITS[n]}"
+                bad = ", ".join(f"{n}={as_given(c[i])} {_AXIS_UNITS[n]}"
                                 for n, c in zip(AXIS_NAMES, coords, strict=True))
                 raise ParameterError(f"SdcModel: point ({bad}) is no load case (expected "
                                      "fill_percent in (0, 100] %, acceleration_g and "
@@ -332,9 +332,10 @@ class SdcModel:
             inside = self._inside(*coords)
             if not np.all(inside):
                 i = int(np.argmin(inside))
-                bad = ", ".join(f"{n}={c[i]:g} {_AXIS_UNITS[n]}"
+                bad = ", ".join(f"{n}={as_given(c[i])} {_AXIS_UNITS[n]}"
                                 for n, c in zip(AXIS_NAMES, coords, strict=True))
-                rng = ", ".join(f"{n} in [{lo:g}, {hi:g}]" for n, (lo, hi) in self.bounds.items())
+                rng = ", ".join(f"{n} in [{as_given(lo)}, {as_given(hi)}]"
+                                for n, (lo, hi) in self.bounds.items())
                 raise ParameterError(f"SdcModel: point ({bad}) is outside the model range "
                                      f"({rng}); pass clip_to_range=True to hold edge values")
             coords = [np.clip(c, ax[0], ax[-1]) for c, ax in zip(coords, self.axes, strict=True)]
