@@ -67,11 +67,11 @@ def test_damper_writes_the_paper_grid(tmp_path):
 
 
 def test_damper_options(tmp_path):
-    _run(["model", "damper", "--out", str(tmp_path), "--format", "csv", "--fills", "30,60",
+    _run(["model", "damper", "--out", str(tmp_path), "--format", "csv", "--fills", "30",
           "--accelerations", "2", "--frequencies", "75,300", "--vibrated-mass", "0.5"])
     assert not (tmp_path / "equivalent_damper.json").exists()
     table = pd.read_csv(tmp_path / "equivalent_damper.csv")
-    assert len(table) == 4 and set(table["coupon_vibrated_mass [kg]"]) == {0.5}
+    assert len(table) == 2 and set(table["coupon_vibrated_mass [kg]"]) == {0.5}
     with pytest.raises(ParameterError, match="--fills 95: outside the model's range 25 .. 90"):
         _run(["model", "damper", "--out", str(tmp_path), "--fills", "95"])
     with pytest.raises(SystemExit):
@@ -361,7 +361,8 @@ def test_a_vibrated_mass_in_grams_is_refused(tmp_path):
     grams = 1000 * paper_vibrated_mass("coupon_plus_particles", "acrylic")(50.0)
     with pytest.raises(ParameterError, match=r"--vibrated-mass .* kg is .* x the paper "
                                              r"coupon's vibrated masses .*was it grams\?"):
-        _run(["model", "damper", "--out", str(tmp_path / "g"), "--vibrated-mass", f"{grams}"])
+        _run(["model", "damper", "--out", str(tmp_path / "g"), "--vibrated-mass", f"{grams}",
+              "--fills", "50"])
     assert not (tmp_path / "g").exists()
     # the same mass in kg, and one with a fixture 10 x the coupon's m_c, are taken; c_eq is
     # proportional to the m_c given (c_eq = SDC m_c w / (2 pi))
@@ -369,7 +370,7 @@ def test_a_vibrated_mass_in_grams_is_refused(tmp_path):
     for mass in (grams / 1000, 10 * grams / 1000):
         out = tmp_path / f"{mass:g}"
         _run(["model", "damper", "--out", str(out), "--vibrated-mass", f"{mass}",
-              "--format", "csv"])
+              "--fills", "50", "--format", "csv"])
         tables[mass] = pd.read_csv(out / "equivalent_damper.csv")[
             "c_eq_per_coupon [N s/m]"].to_numpy()
     small, large = tables.values()
@@ -436,7 +437,7 @@ def test_table3_sdc_is_not_put_over_another_materials_mass(tmp_path):
                                rtol=1e-12)
     # an explicit m_c is the user's: the material then only sets its unit-slip range
     assert _run(["model", "damper", "--out", str(tmp_path / "m"), "--material", "aluminium",
-                 "--vibrated-mass", "0.1", "--format", "csv"]) == 0
+                 "--vibrated-mass", "0.1", "--fills", "50", "--format", "csv"]) == 0
 
 
 def test_the_damper_says_per_what_along_which_direction_and_gives_the_velocity(tmp_path):
@@ -710,3 +711,49 @@ def test_an_out_folder_under_a_file_is_refused_in_one_line_before_any_work(tmp_p
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and f"{blocking} is a file, not a folder" in err
     assert not (tmp_path / "s.h5").exists()  # nothing saved before the refusal
+
+
+def test_one_vibrated_mass_for_several_fills_is_refused_naming_them(tmp_path):
+    # `--vibrated-mass 0.0988` (the 50 % m_c) went to the 25, 50, 75 and 90 % rows alike: each
+    # Table 3 SDC was divided by its own fill's m_c, so c_eq was 1.63 x too high at 25 % and
+    # 0.62 x too low at 90 %, without a word
+    for fills in ([], ["--fills", "25,90"]):
+        out = tmp_path / f"refused{len(fills)}"
+        with pytest.raises(ParameterError) as refused:
+            _run(["model", "damper", "--out", str(out), "--vibrated-mass", "0.0988", *fills])
+        message = str(refused.value)
+        assert message.startswith("--vibrated-mass 0.0988 kg: one m_c for the fills "
+                                  + ("25, 50, 75, 90 %" if not fills else "25, 90 %"))
+        assert "give one fill per m_c (--fills F)" in message and "\n" not in message
+        assert not out.exists()
+    # the fill that m_c is of: its rows carry it, and c_eq = SDC m_c w / (2 pi) of it (the
+    # CSV's 17 digits, one product: 1e-14)
+    _run(["model", "damper", "--out", str(tmp_path / "one"), "--vibrated-mass", "0.0988",
+          "--fills", "50", "--format", "csv"])
+    table = pd.read_csv(tmp_path / "one" / "equivalent_damper.csv")
+    assert set(table["packing ratio [%]"]) == {50.0}
+    np.testing.assert_allclose(table["c_eq_per_coupon [N s/m]"],
+                               table["sdc [-]"] * 0.0988 * table["frequency [Hz]"], rtol=1e-14)
+
+
+def test_a_material_given_with_the_vibrated_mass_is_said_to_set_only_its_unit_check(tmp_path,
+                                                                                      capsys):
+    # `--material aluminium --vibrated-mass 0.2` ran, its provenance saying acrylic without
+    # a word on the aluminium typed: the SDC is Table 3's acrylic one, the material only
+    # sets the range the m_c given is checked against
+    assert _run(["model", "damper", "--out", str(tmp_path), "--fills", "50", "--material",
+                 "aluminium", "--vibrated-mass", "0.2"]) == 0
+    said = ("--material aluminium: the SDC is the paper's Table 3, of acrylic particles; "
+            "aluminium sets only the range the m_c given (--vibrated-mass) is checked against "
+            "for a unit slip")
+    assert f"pidcore model damper: note: {said}" in capsys.readouterr().err
+    provenance = json.loads((tmp_path / "equivalent_damper.json").read_text())["provenance"]
+    assert provenance["particle_material"] == "acrylic"
+    assert provenance["particle_material_note"] == said
+    # Table 3's own material, or none: nothing to say
+    assert _run(["model", "damper", "--out", str(tmp_path / "ac"), "--fills", "50",
+                 "--material", "acrylic", "--vibrated-mass", "0.2"]) == 0
+    assert "--material" not in capsys.readouterr().err
+    provenance = json.loads((tmp_path / "ac" / "equivalent_damper.json").read_text())[
+        "provenance"]
+    assert "particle_material_note" not in provenance

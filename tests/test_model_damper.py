@@ -25,6 +25,7 @@ from pidcore.model import (
     equivalent_damping_coefficient,
     loss_factor,
     paper_particles_mass_kg,
+    paper_vibrated_mass,
     sdc_from_damping_coefficient,
     write_damper_table,
 )
@@ -145,10 +146,11 @@ def test_damper_table_content(model):
 def test_damper_table_takes_a_value_given_twice_once(model):
     # an FEM lookup needs each (f, a, fill) key once; the Python call gave two identical rows
     # where pidcore model damper gave one (the CLI had deduplicated its options itself)
+    # m_c as a function of fill: one number for two fills is refused
     once = equivalent_damper_table(model, fills_percent=[50, 75], accelerations_g=[5],
-                                   frequencies_hz=[100], vibrated_mass_kg=0.03)
+                                   frequencies_hz=[100], vibrated_mass_kg=paper_vibrated_mass())
     twice = equivalent_damper_table(model, fills_percent=[50, 75, 50], accelerations_g=[5, 5],
-                                    frequencies_hz=[100], vibrated_mass_kg=0.03)
+                                    frequencies_hz=[100], vibrated_mass_kg=paper_vibrated_mass())
     pd.testing.assert_frame_equal(twice, once)
 
 
@@ -179,7 +181,8 @@ def test_written_files_round_trip(tmp_path):
     t["sdc"] = np.linspace(1e-7, 1.0, len(t))  # includes SDC = 1: damping ratio undefined
     m = SdcModel.from_table(t, value="sdc", source="synthetic")
     table = equivalent_damper_table(m, fills_percent=[25, 90], accelerations_g=[1, 10],
-                                    frequencies_hz=[50, 1000], vibrated_mass_kg=0.1)
+                                    frequencies_hz=[50, 1000],
+                                    vibrated_mass_kg=lambda fill: 0.02 + fill / 1000)
     paths = write_damper_table(table, tmp_path, provenance={"sdc_source": m.source})
     assert [p.name for p in paths] == ["equivalent_damper.csv", "equivalent_damper.json"]
     back = pd.read_csv(paths[0])
@@ -280,7 +283,7 @@ def test_c_eq_per_cell_is_the_coupons_c_eq_shared_by_its_cells(model, tmp_path):
     from pidcore.specimen import Specimen
 
     grid = dict(fills_percent=[25, 90], accelerations_g=[1, 5], frequencies_hz=[100, 1000],
-                vibrated_mass_kg=0.0988)
+                vibrated_mass_kg=paper_vibrated_mass())
     paper = equivalent_damper_table(model, **grid)
     text = (Path(__file__).parents[1] / "data_samples" / "specimens"
             / "steel_6mm.toml").read_text()
@@ -357,3 +360,25 @@ def test_a_held_sdc_at_a_flat_edge_is_said_unknown():
                                       frequencies_hz=[100], vibrated_mass_kg=0.1,
                                       clip_to_range=True)[SDC_HELD_ERROR_COLUMN]
     assert said == "unknown"
+
+
+def test_one_vibrated_mass_for_several_fills_is_refused_as_each_fills_sdc_is_over_its_own(model):
+    # vibrated_mass_kg=0.0988 (the 50 % m_c) put every fill's SDC over it: Table 3's 25 % SDC
+    # was divided by 0.0605 kg, so c_eq = SDC m_c w / (2 pi) was 1.63 x too high there
+    with pytest.raises(ParameterError, match=r"^vibrated_mass_kg 0.0988 kg: one m_c for the "
+                                             r"fills 25, 90 %, but each fill's SDC was divided "
+                                             r"by that fill's own m_c .*function of fill"):
+        equivalent_damper_table(model, fills_percent=[25, 90], accelerations_g=[5],
+                                frequencies_hz=[100], vibrated_mass_kg=0.0988)
+    # each fill with its own m_c, one table per fill, is the table of m_c as a function of
+    # fill: the same products, so equal
+    by_fill = equivalent_damper_table(model, fills_percent=[25, 90], accelerations_g=[5],
+                                      frequencies_hz=[100],
+                                      vibrated_mass_kg=paper_vibrated_mass())
+    for fill in (25.0, 90.0):
+        (row,) = equivalent_damper_table(model, fills_percent=[fill], accelerations_g=[5],
+                                         frequencies_hz=[100],
+                                         vibrated_mass_kg=paper_vibrated_mass()(fill)
+                                         ).to_dict(orient="records")
+        (same,) = by_fill[by_fill["packing ratio [%]"] == fill].to_dict(orient="records")
+        assert row == same

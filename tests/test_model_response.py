@@ -447,3 +447,50 @@ def test_a_fill_outside_the_model_or_beyond_100_percent_is_refused_by_name(model
             "harmonic_response: fill_percent 95 % outside the SDC model range [25, 90] %;")
     with pytest.raises(ParameterError, match=r"^time_domain_response: fill_percent 95 %"):
         time_domain_response(model, beyond, frequency_hz=300.0, force_amplitude_n=5.0)
+
+
+@pytest.mark.parametrize(("typed", "said"), [
+    (98.8, r"^TreatedMode: coupon_vibrated_mass_kg 98.8 kg is 1000 x the paper coupon's "
+           r"vibrated masses \(0.0222 .. 0.0988 kg over every convention at 50 % fill, "
+           r"acrylic particles\); expected m_c in kg; was it grams\?$"),
+    (9.88e-5, r"^TreatedMode: coupon_vibrated_mass_kg 9.88e-05 kg is 0.00446 x .*was it in "
+              r"another unit\?$"),
+])
+def test_a_coupon_vibrated_mass_in_grams_is_refused_by_the_damper_tables_rule(model, mode, typed,
+                                                                              said):
+    # coupon_vibrated_mass_kg=98.8 (the 50 % m_c, 0.0988 kg, typed in g) gave a c_pd 1000 x
+    # too large (27108 N s/m, not 27) without a word, or a refusal blaming the force, while
+    # equivalent_damper_table and `pidcore model damper --vibrated-mass` refused that m_c
+    with pytest.raises(ParameterError, match=said):
+        dataclasses.replace(mode, coupon_vibrated_mass_kg=typed)
+
+
+def test_treated_mode_and_the_damper_table_take_the_same_vibrated_masses(model, mode):
+    # one rule: just inside and just outside each bound of VIBRATED_MASS_LIMIT x the paper
+    # coupon's m_c at the mode's fill, both take or both refuse (1e-6: far from round-off,
+    # far inside the limit's 100 x)
+    from pidcore.constants import VIBRATED_MASS_CONVENTIONS
+    from pidcore.model import equivalent_damper_table, paper_vibrated_mass
+    from pidcore.model.damper import VIBRATED_MASS_LIMIT
+
+    masses = [paper_vibrated_mass(c)(50.0) for c in VIBRATED_MASS_CONVENTIONS]
+    low, high = min(masses) / VIBRATED_MASS_LIMIT, max(masses) * VIBRATED_MASS_LIMIT
+    for typed, taken in ((low * (1 + 1e-6), True), (low * (1 - 1e-6), False),
+                         (high * (1 - 1e-6), True), (high * (1 + 1e-6), False)):
+        def table(m=typed):
+            return equivalent_damper_table(model, fills_percent=[50], accelerations_g=[5],
+                                           frequencies_hz=[300], vibrated_mass_kg=m)
+
+        def treated(m=typed):
+            return dataclasses.replace(mode, coupon_vibrated_mass_kg=m)
+
+        for make in (table, treated):
+            if taken:
+                make()
+            else:
+                with pytest.raises(ParameterError, match="x the paper coupon's vibrated"):
+                    make()
+    # the mass taken is the one used: c_pd = SDC m_c w / (2 pi) x A_t / A_c, one product
+    r = harmonic_response(model, mode, frequencies_hz=[300.0], force_amplitude_n=FORCE_N)
+    expected = float(r.sdc[0]) * mode.coupon_vibrated_mass_kg * 300.0 * 0.2 / 0.01
+    assert r.particle_damping_n_s_m[0] == pytest.approx(expected, rel=1e-12)

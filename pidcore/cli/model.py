@@ -93,9 +93,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         "unless --vibrated-mass gives m_c, whose unit-slip check it sets); "
                         "--table store: the runs' own")
     d.add_argument("--vibrated-mass", metavar="KG", type=_positive_float, default=None,
-                   help="explicit m_c, kg (overrides --mass-convention; --table paper only: "
-                        "stored runs divided their SDC by their own m_c; more than 100 x "
-                        "outside the paper coupon's m_c is refused as a unit slip)")
+                   help="explicit m_c, kg, of one fill: give that fill alone with --fills "
+                        "(each fill's SDC was divided by its own m_c; several fills are "
+                        "refused); overrides --mass-convention; --table paper only: stored "
+                        "runs divided their SDC by their own m_c; more than 100 x outside the "
+                        "paper coupon's m_c at that fill is refused as a unit slip")
     d.add_argument("--area", metavar="M2", type=_positive_float, default=None,
                    help="coupon area for c_eq per area, m^2 (default: the specimen's [coupon] "
                         "face_area_m2, the paper's 0.1 m x 0.1 m, else its cells' "
@@ -270,13 +272,24 @@ def run_damper(args: argparse.Namespace) -> int:
                 raise ParameterError(
                     f"{option} {given}: the DEM runs in {args.store} are {', '.join(stated)}"
                     f"{why}; leave {option} out or select runs with --where")
+    fills = args.fills if args.fills else model.axes[0]
+    material_note = ""
     if args.vibrated_mass is not None:
-        from ..model.damper import check_vibrated_mass
+        from ..model.damper import check_one_fill_per_mass, check_vibrated_mass
 
-        check_vibrated_mass(args.vibrated_mass, model.axes[0],
+        check_vibrated_mass(args.vibrated_mass, fills,
                             args.material or defaults.MODEL_PARTICLE_MATERIAL, "--vibrated-mass")
+        # the one m_c typed went to every fill of the model's grid without a word
+        check_one_fill_per_mass(args.vibrated_mass, fills, "--vibrated-mass",
+                                "give one fill per m_c (--fills F), or leave --vibrated-mass "
+                                "out for the paper coupon's m_c at each fill")
         mass = args.vibrated_mass
         mass_text = f"{mass} kg (given)"
+        if runs is None and args.material not in (None, table3):
+            # the provenance said acrylic only, the aluminium typed not mentioned
+            material_note = (f"--material {args.material}: the SDC is the paper's Table 3, of "
+                             f"{table3} particles; {args.material} sets only the range the "
+                             "m_c given (--vibrated-mass) is checked against for a unit slip")
     elif runs is not None:
         mass = runs_vibrated_mass(runs)
         mass_text = (f"{runs['vibrated_mass_convention'].iloc[0]}: the m_c the DEM runs "
@@ -323,7 +336,7 @@ def run_damper(args: argparse.Namespace) -> int:
                              "it a percentage?")
     try:
         table = equivalent_damper_table(
-            model, fills_percent=args.fills if args.fills else model.axes[0],
+            model, fills_percent=fills,
             accelerations_g=args.accelerations if args.accelerations else model.axes[1],
             frequencies_hz=args.frequencies if args.frequencies else model.axes[2],
             vibrated_mass_kg=mass, area_m2=area, specimen=specimen,
@@ -347,6 +360,8 @@ def run_damper(args: argparse.Namespace) -> int:
         else ", ".join(sorted(runs["material"].dropna().astype(str).unique())),
         "filled_grid_points": model.filled_points().to_dict(orient="records"),
     }
+    if material_note:
+        provenance["particle_material_note"] = material_note
     if args.panel_areal_mass is not None:
         provenance["panel"] = (
             f"{args.panel_areal_mass:g} kg/m^2 with its particles, "
@@ -367,6 +382,8 @@ def run_damper(args: argparse.Namespace) -> int:
     for path in paths:
         print(path)
     print(f"pidcore model damper: note: coupon area {area_text}", file=sys.stderr)
+    if material_note:
+        print(f"pidcore model damper: note: {material_note}", file=sys.stderr)
     if undefined:
         print(f"pidcore model damper: note: {why} in {undefined} of {len(table)} row(s)",
               file=sys.stderr)

@@ -36,7 +36,7 @@ from .. import __version__
 from .. import defaults as D
 from ..atomic_files import write_atomically
 from ..constants import PACKING_RATIO_COLUMN, STANDARD_GRAVITY, VIBRATED_MASS_CONVENTIONS
-from ..errors import ParameterError
+from ..errors import ParameterError, as_given
 from ..specimen import MAX_FACE_TO_CELLS_AREA
 from .sdc_model import SdcModel
 from .sdc_model import held_error as held_error_of
@@ -381,11 +381,14 @@ def check_area(area_m2: float, specimen, what: str = "area_m2") -> None:
 VIBRATED_MASS_LIMIT = 100.0
 
 
-def check_vibrated_mass(mass_kg: float, fills: Sequence[float], material: str,
+def check_vibrated_mass(mass_kg: float, fills: Sequence[float],
+                        material: str = D.MODEL_PARTICLE_MATERIAL,
                         what: str = "vibrated_mass_kg") -> None:
     """Refuse an explicit m_c more than :data:`VIBRATED_MASS_LIMIT` times outside the range of
     the paper coupon's m_c over ``fills`` [%] (every convention, ``material`` particles) as a
-    unit slip (``what``: the option as messages name it)."""
+    unit slip (``what``: the option as messages name it). The one check of a given m_c:
+    :func:`equivalent_damper_table`, ``pidcore model damper --vibrated-mass`` and
+    :class:`~pidcore.model.TreatedMode` all refuse by it."""
     masses = [paper_vibrated_mass(convention, material)(float(fill))
               for convention in VIBRATED_MASS_CONVENTIONS for fill in fills]
     low, high = min(m for m in masses if m > 0), max(masses)
@@ -393,10 +396,41 @@ def check_vibrated_mass(mass_kg: float, fills: Sequence[float], material: str,
     if low / VIBRATED_MASS_LIMIT <= mass <= high * VIBRATED_MASS_LIMIT:
         return
     hint = "was it grams?" if mass > high else "was it in another unit?"
+    ratio = _three_digits(mass / (high if mass > high else low))
     raise ParameterError(
-        f"{what} {mass:g} kg is {mass / (high if mass > high else low):.3g} x the paper "
-        f"coupon's vibrated masses ({low:.3g} .. {high:.3g} kg over every convention and "
-        f"fill, {material} particles); expected m_c in kg; {hint}")
+        f"{what} {as_given(mass)} kg is {ratio} x the paper coupon's vibrated masses "
+        f"({low:.3g} .. {high:.3g} kg over every convention at {_fills_text(fills)} % fill, "
+        f"{material} particles); expected m_c in kg; {hint}")
+
+
+def check_one_fill_per_mass(mass_kg: float, fills: Sequence[float],
+                            what: str = "vibrated_mass_kg",
+                            instead: str = "give one fill per m_c (fills_percent=[F]), or "
+                                           "vibrated_mass_kg as a function of fill (e.g. "
+                                           "paper_vibrated_mass())") -> None:
+    """Refuse one explicit m_c for several fills (``what``: the option as messages name it,
+    ``instead``: the ways on in their words).
+
+    Each SDC of the model was divided by the m_c of its own fill (Eq. 10), which grows with
+    the particles: c_eq = SDC m_c w / (2 pi) over one m_c at every fill was 1.63 x too high at
+    25 % and 0.62 x too low at 90 % for the paper coupon's 50 % m_c."""
+    distinct = list(dict.fromkeys(float(f) for f in fills))
+    if len(distinct) > 1:
+        raise ParameterError(
+            f"{what} {as_given(float(mass_kg))} kg: one m_c for the fills "
+            f"{', '.join(as_given(f) for f in distinct)} %, but each fill's SDC was divided by "
+            f"that fill's own m_c (Eq. 10, the particles' mass grows with fill); {instead}")
+
+
+def _three_digits(ratio: float) -> str:
+    # 1000 read "1e+03 x" (:.3g) in the very message of a mass typed in grams
+    return f"{float(f'{ratio:.3g}'):g}"
+
+
+def _fills_text(fills: Sequence[float]) -> str:
+    values = sorted({float(f) for f in fills})
+    return as_given(values[0]) if len(values) == 1 else \
+        f"{as_given(values[0])} .. {as_given(values[-1])}"
 
 
 def coupon_vibrated_mass_kg(*, particles_mass_kg: float = 0.0,
@@ -550,9 +584,11 @@ def equivalent_damper_table(model: SdcModel, *, fills_percent: Sequence[float] |
         order given).
     vibrated_mass_kg : float or callable
         m_c [kg] of Eq. 10, or a function of fill [%] returning it (the particle mass grows
-        with fill). A number more than :data:`VIBRATED_MASS_LIMIT` times outside the paper
-        coupon's m_c is refused as a unit slip (grams typed for kg), as ``pidcore model
-        damper --vibrated-mass`` refuses it.
+        with fill, and each fill's SDC was divided by its own m_c): a number is the m_c of
+        one fill, and is refused with several ``fills_percent``. A number more than
+        :data:`VIBRATED_MASS_LIMIT` times outside the paper coupon's m_c at that fill is
+        refused as a unit slip (grams typed for kg), as ``pidcore model damper
+        --vibrated-mass`` and :class:`~pidcore.model.TreatedMode` refuse it.
     area_m2 : float, optional
         Coupon area for the per-area damper; default :func:`specimen_area_m2` (the
         specimen's ``[coupon] face_area_m2``, the paper's 0.01 m^2, else its cells'
@@ -601,14 +637,6 @@ def equivalent_damper_table(model: SdcModel, *, fills_percent: Sequence[float] |
         raise ParameterError("equivalent_damper_table: fills, accelerations and frequencies "
                              "must each hold at least one value")
     f, a_g, p = (grid[c].to_numpy() for c in ("f", "a", "p"))
-    if callable(vibrated_mass_kg):
-        mass = np.array([float(vibrated_mass_kg(x)) for x in p])
-    else:
-        # 69 (g) for 0.069 kg gave a c_eq 1000 x too large without a word; the CLI refused it
-        check_vibrated_mass(float(_positive("vibrated_mass_kg", vibrated_mass_kg)),
-                            model.axes[0], D.MODEL_PARTICLE_MATERIAL)
-        mass = np.full(p.shape, float(vibrated_mass_kg))
-    mass = _positive("vibrated_mass_kg", mass)
     if specimen is None:
         from ..specimen import paper_specimen
 
@@ -619,7 +647,17 @@ def equivalent_damper_table(model: SdcModel, *, fills_percent: Sequence[float] |
         # 100 (cm^2) for 0.01 m^2 gave a c_eq per area 1e4 x too small; only --area was checked
         area = float(_positive("area_m2", area_m2))
         check_area(area, specimen)
+    # the points first: m_c is checked at their fills, which a fill of 150 % is none of
     sdc = model.evaluate(p, a_g, f, clip_to_range=clip_to_range)
+    if callable(vibrated_mass_kg):
+        mass = np.array([float(vibrated_mass_kg(x)) for x in p])
+    else:
+        # 69 (g) for 0.069 kg gave a c_eq 1000 x too large without a word; the CLI refused it
+        check_vibrated_mass(float(_positive("vibrated_mass_kg", vibrated_mass_kg)), fills)
+        # the 50 % m_c at 25 and 90 % gave a c_eq 1.63 x too high and 0.62 x too low
+        check_one_fill_per_mass(vibrated_mass_kg, fills)
+        mass = np.full(p.shape, float(vibrated_mass_kg))
+    mass = _positive("vibrated_mass_kg", mass)
     # a 20 g row carried the 10 g SDC and a c_eq from it, like a modelled one
     edges = [model.held_edges(*point) for point in zip(p, a_g, f, strict=True)]
     held = np.array([bool(e) for e in edges], dtype=bool)

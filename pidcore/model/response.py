@@ -53,7 +53,12 @@ from scipy.optimize import brentq
 
 from ..constants import STANDARD_GRAVITY
 from ..errors import ParameterError, as_given, instance_of, real_number, whole_number
-from .damper import check_area, equivalent_damping_coefficient, specimen_area_m2
+from .damper import (
+    check_area,
+    check_vibrated_mass,
+    equivalent_damping_coefficient,
+    specimen_area_m2,
+)
 from .sdc_model import SdcModel
 
 if TYPE_CHECKING:  # a name for the hints only
@@ -89,7 +94,10 @@ class TreatedMode:
         and by the convention the SDC was divided by: ``paper_vibrated_mass()(fill_percent)``
         for the paper's Table 3, ``runs_vibrated_mass(runs)(fill_percent)`` for stored DEM
         runs. Not ``coupon_vibrated_mass_kg()`` alone, which leaves the particles out (c_pd
-        4.5 x low at 50 % fill).
+        4.5 x low at 50 % fill). More than
+        :data:`~pidcore.model.damper.VIBRATED_MASS_LIMIT` times outside the paper coupon's
+        m_c at ``fill_percent`` (every convention) is refused as a unit slip (grams typed
+        for kg), as :func:`~pidcore.model.equivalent_damper_table` refuses it.
     coupon_area_m2 : float, optional
         A_c [m^2] of those coupons; default (None) the area ``pidcore model damper`` takes
         for ``coupon_specimen`` (:func:`~pidcore.model.damper.specimen_area_m2`: the face
@@ -142,6 +150,10 @@ class TreatedMode:
         if not np.isfinite(self.structural_damping_ratio) or self.structural_damping_ratio < 0:
             raise ParameterError(f"TreatedMode: structural_damping_ratio must be >= 0, got "
                                  f"{self.structural_damping_ratio!r}")
+        # 98.8 (g) for m_c = 0.0988 kg gave a c_pd 1000 x too large without a word, or a
+        # refusal blaming the force; the damper table refused it
+        check_vibrated_mass(self.coupon_vibrated_mass_kg, (self.fill_percent,),
+                            what="TreatedMode: coupon_vibrated_mass_kg")
         object.__setattr__(self, "treated_regions", self._checked_regions())
         # 100 (cm^2) for A_c = 0.01 m^2 gave a c_pd 1e4 x too small without a word
         check_area(self.coupon_area_m2, self.coupon_specimen or paper_specimen(),
