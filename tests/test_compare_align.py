@@ -202,7 +202,7 @@ def test_an_interpolated_value_resting_on_a_filled_grid_point_says_so(aligner):
                    & (runs.fill_percent == 25))]
     out = Aligner.from_tables(holed).align(LoadCase(73.0, 2.7, 37.5))
     assert out.status == "interpolated"
-    assert "no DEM run at 50 Hz, 1 g, 25 %, a corner of its grid cell" in out.message
+    assert "no DEM run at 50 Hz, 1 g, 25 %, a grid point its pchip value rests on" in out.message
     # the held value, not the linear field's: the note is about a real difference
     assert out.sdc_dem != pytest.approx(linear_sdc(37.5, 2.7, 73.0), rel=1e-6)
     # with every corner run there is no such note

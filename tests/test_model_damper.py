@@ -15,6 +15,7 @@ from pidcore.errors import ParameterError
 from pidcore.model import (
     DAMPER_COLUMNS,
     SDC_FILLED_COLUMN,
+    SDC_FILLED_NOTE,
     SDC_HELD_COLUMN,
     SDC_HELD_ERROR_COLUMN,
     SdcModel,
@@ -382,3 +383,25 @@ def test_one_vibrated_mass_for_several_fills_is_refused_as_each_fills_sdc_is_ove
                                          ).to_dict(orient="records")
         (same,) = by_fill[by_fill["packing ratio [%]"] == fill].to_dict(orient="records")
         assert row == same
+
+
+def test_damper_rows_resting_on_the_held_hole_are_flagged(model):
+    # only the hole's own row (90 %, 1 g, 1000 Hz) was flagged, though (90 %, 1.5 g, 1000 Hz)
+    # moves by +0.116 and (90 %, 1 g, 900 Hz) by +0.129 with the hole set to 0.95
+    t = equivalent_damper_table(model, fills_percent=[25, 80, 85, 90],
+                                accelerations_g=[1, 1.5, 3, 5], frequencies_hz=[50, 900, 1000],
+                                vibrated_mass_kg=0.03)
+    key = t.set_index(["packing ratio [%]", "acceleration [g]", "frequency [Hz]"])
+    flag = key[SDC_FILLED_COLUMN]
+    for point in [(90, 1.5, 1000), (90, 1, 900), (90, 1, 1000), (85, 3, 900)]:
+        assert flag[point], point
+    # far from it, and a grid point beside it (exact at its own data), are not
+    for point in [(25, 5, 50), (25, 1, 1000), (90, 5, 1000), (90, 1, 50)]:
+        assert not flag[point], point
+    # the flag is the model's own test, and the note names the hole and the rows
+    dependence = model.filled_dependence(t["packing ratio [%]"], t["acceleration [g]"],
+                                         t["frequency [Hz]"])
+    np.testing.assert_array_equal(t[SDC_FILLED_COLUMN], dependence.any)
+    note = t.attrs[SDC_FILLED_NOTE]
+    assert note.startswith(f"{int(flag.sum())} row(s) rest on the filled grid value at "
+                           "1000 Hz, 1 g, 90 % (0.8078")

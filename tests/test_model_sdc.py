@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 from pathlib import Path
 
@@ -323,3 +324,103 @@ def test_a_point_a_hair_outside_the_model_is_named_as_given(model):
     with pytest.raises(ParameterError, match=r"\(fill_percent=100.0000001 %, .*\) is no load "
                                              r"case"):
         model.evaluate(100.0000001, 5, 100, clip_to_range=True)
+
+
+# --------------------------------------------------------------------------- resting on a hole
+_HOLE = (3, 0, 3)  # Table 3's 90 %, 1 g, 1000 Hz in the grid's (fill, acceleration, frequency)
+
+
+def _with_hole_at(model: SdcModel, value: float) -> SdcModel:
+    values = model.values.copy()
+    values[_HOLE] = value
+    return dataclasses.replace(model, values=values)
+
+
+def test_values_resting_on_the_held_hole_are_flagged_not_only_the_hole(model):
+    # the damper table flagged (90 %, 1 g, 1000 Hz) alone, though the hole set to 0.95 moves
+    # (90 %, 1.5 g, 1000 Hz) by +0.116 and (90 %, 1 g, 900 Hz) by +0.129
+    points = np.array([(90, 1.5, 1000), (90, 1, 900), (90, 1, 1000), (85, 1, 1000),
+                       (25, 5, 50), (90, 10, 1000), (75, 1, 1000), (50, 8.18, 800)], float).T
+    dep = model.filled_dependence(*points)
+    assert dep.points[["fill_percent", "acceleration_g", "frequency_hz"]].values.tolist() == [
+        [90.0, 1.0, 1000.0]]
+    assert dep.depends.shape == (8, 1)
+    assert dep.any.tolist() == [True, True, True, True, False, False, False, False]
+    moved = _with_hole_at(model, 0.95)(*points) - model(*points)
+    np.testing.assert_allclose(moved[:2], [0.1156, 0.1293], atol=5e-5)  # the trial's numbers
+    # the hole itself is its own value: SDC moves 1:1 with it
+    assert dep.slope_rising[2, 0] == pytest.approx(1.0, abs=1e-9)
+    # 85 % lies where the held value (equal to the 75 % one) makes pchip's fill slope turn:
+    # the SDC moves faster as the hole rises than as it falls, and the note says both
+    assert dep.slope_rising[3, 0] > 2 * dep.slope_falling[3, 0] > 0
+    assert "per unit it rises" in dep.summary() and "1000 Hz, 1 g, 90 %" in dep.summary()
+
+
+def test_a_value_not_flagged_is_the_same_bit_for_bit_whatever_the_held_value(model):
+    # the dependence test must be exact, not a neighbourhood: where it says no, the derivative
+    # with respect to the hole is 0 (no change at all, not a small one, even in round-off)
+    rng = np.random.default_rng(11)
+    random = [rng.uniform(ax[0], ax[-1], 3000) for ax in model.axes]
+    grid = [g.ravel() for g in np.meshgrid(*model.axes, indexing="ij")]
+    points = [np.concatenate([r, g]) for r, g in zip(random, grid, strict=True)]
+    dep = model.filled_dependence(*points)
+    flagged = dep.any
+    assert 0 < flagged.sum() < flagged.size - grid[0].size
+    assert np.all(dep.slope_rising[~flagged] == 0) and np.all(dep.slope_falling[~flagged] == 0)
+    base = model(*points)
+    moved = np.zeros(flagged.shape, dtype=bool)
+    # hole values other than the method's own probes, over the SDC's range and beyond
+    for value in (*rng.uniform(-1, 2, 16), 0.95, 1.5):
+        other = _with_hole_at(model, value)(*points)
+        np.testing.assert_array_equal(other[~flagged], base[~flagged])
+        moved |= other != base
+    # and where it says yes the value moves for some of them (points where pchip turns
+    # for every hole value stay unflagged: 1 in 25 of these would be flagged by the stencil)
+    assert np.all(moved[flagged])
+    # of the grid points, only the hole rests on the hole
+    on_grid = flagged[-grid[0].size:].reshape(model.values.shape)
+    np.testing.assert_array_equal(on_grid, model.filled)
+
+
+def test_the_slopes_given_are_the_model_s_own(model):
+    # one-sided differences of 1e-4 on the hole, against the method's 1e-6 ones: the value is
+    # smooth in the hole on either side of the turn, so the two differ by curvature x 1e-4
+    # (the SDC's second derivative in the hole is O(1..10) here): 1e-3 covers it
+    points = np.array([(90, 1.5, 1000), (90, 1, 900), (85, 1, 1000), (80, 3, 950)], float).T
+    dep = model.filled_dependence(*points)
+    base, step = model(*points), 1e-4
+    up = (_with_hole_at(model, 0.8078 + step)(*points) - base) / step
+    down = (base - _with_hole_at(model, 0.8078 - step)(*points)) / step
+    np.testing.assert_allclose(dep.slope_rising[:, 0], up, atol=1e-3)
+    np.testing.assert_allclose(dep.slope_falling[:, 0], down, atol=1e-3)
+
+
+def test_select_runs_compares_numbers_as_numbers():
+    # --where fill_percent=50 matched none of the 12 runs stored at 50.0 %, fixture_mass_kg=0
+    # none at 0.0 (compared as text), though fill_percent=50.0 did
+    from pidcore.model import select_runs
+
+    rng = np.random.default_rng(8)
+    t = _synthetic_table(rng, shape=(2, 2, 2))
+    fills = sorted(t.fill_percent.unique())
+    t = t.assign(fill_percent=t.fill_percent.map({fills[0]: 50.0, fills[1]: 75.0}),
+                 fixture_mass_kg=0.0, material="acrylic")
+    for wanted in ("50", "50.0", "5e1"):
+        chosen = select_runs(t, where={"fill_percent": wanted})
+        assert len(chosen) == 4 and set(chosen.fill_percent) == {50.0}
+    assert len(select_runs(t, where={"fixture_mass_kg": "0"})) == 8
+    with pytest.raises(ParameterError, match="none match"):
+        select_runs(t, where={"fill_percent": "50.5"})
+    # text stays text
+    assert len(select_runs(t, where={"material": "acrylic"})) == 8
+
+
+def test_readme_says_what_holds_between_grid_lines(model):
+    # it said the model is "monotone with the data between them": at 50 %, 8.18 g the SDC
+    # falls from 500 to 1000 Hz though the four data around it rise
+    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text()
+    assert "monotone with the data between them" not in readme
+    sdc = model(50.0, 8.18, np.array([500.0, 1000.0]))
+    corners = model.values[1, 1:3][:, [2, 3]]  # 50 %, 5 and 10 g, 500 and 1000 Hz
+    assert np.all(corners[:, 1] > corners[:, 0]) and sdc[1] < sdc[0]
+    assert f"falls from {sdc[0]:.3f} at 500 Hz to {sdc[1]:.3f} at 1000 Hz" in readme

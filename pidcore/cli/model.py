@@ -57,8 +57,9 @@ def _add_model_source(p: argparse.ArgumentParser) -> None:
                         "(default paper)")
     add_store_option(p, help=f"HDF5 store for --table store (default ./{defaults.STORE_PATH})")
     p.add_argument("--where", metavar="COLUMN=VALUE", action="append", default=[],
-                   help="with --table store: keep runs whose COLUMN equals VALUE (repeatable), "
-                        "e.g. --where material=acrylic")
+                   help="with --table store: keep runs whose COLUMN equals VALUE (repeatable; "
+                        "numbers as numbers: fill_percent=50 is 50.0), e.g. --where "
+                        "material=acrylic")
     p.add_argument("--log-frequency", action="store_true", default=defaults.MODEL_LOG_FREQUENCY,
                    help="interpolate in log(frequency)")
 
@@ -206,6 +207,8 @@ def _cli_where(message: str, where: dict) -> str:
 
 def run_damper(args: argparse.Namespace) -> int:
     from ..model.damper import (
+        SDC_FILLED_COLUMN,
+        SDC_FILLED_NOTE,
         area_override_note,
         check_area,
         equivalent_damper_table,
@@ -373,6 +376,10 @@ def run_damper(args: argparse.Namespace) -> int:
         table = table.drop(columns=["c_eq_per_cell [N s/m]", "coupon_cells [-]"])
         provenance["cells"] = ("not stored with the DEM runs (an older store): no "
                                "c_eq_per_cell and coupon_cells columns")
+    # only the hole's own row was flagged; the rows interpolated from it said nothing
+    filled_note = table.attrs.get(SDC_FILLED_NOTE, "")
+    if filled_note:
+        provenance["filled_rows"] = f"{filled_note} ({SDC_FILLED_COLUMN} True)"
     undefined = int((table["sdc [-]"] >= 1.0).sum())
     why = ("damping ratio -ln(1 - SDC) / (4 pi) is undefined where SDC >= 1 (a free decay "
            "would lose all its energy within a cycle): left empty")
@@ -386,6 +393,9 @@ def run_damper(args: argparse.Namespace) -> int:
         print(f"pidcore model damper: note: {material_note}", file=sys.stderr)
     if undefined:
         print(f"pidcore model damper: note: {why} in {undefined} of {len(table)} row(s)",
+              file=sys.stderr)
+    if filled_note:
+        print(f"pidcore model damper: note: {filled_note} (flagged {SDC_FILLED_COLUMN})",
               file=sys.stderr)
     return 0
 

@@ -993,26 +993,21 @@ def complete_grid(table: pd.DataFrame) -> tuple[pd.DataFrame, str]:
     return rows, "; ".join(words)
 
 
-def filled_corners(model: object, point: tuple[float, float, float]) -> tuple[str, ...]:
-    """Labels (``"500 Hz, 5 g, 90 %"``) of the model's grid points at the corners of the
-    grid cell holding ``point`` (fill %, acceleration g, frequency Hz) whose value no data
-    gave: :attr:`pidcore.model.SdcModel.filled`. Empty for a model that flags none."""
+def filled_corners(model: object, point: tuple[float, float, float] | tuple[np.ndarray, ...]
+                   ) -> tuple[str, ...]:
+    """Labels (``"500 Hz, 5 g, 90 %"``) of the model's grid points whose value no data gave
+    (:attr:`pidcore.model.SdcModel.filled`) that the SDC at ``point`` (fill %, acceleration
+    g, frequency Hz; arrays for several points) rests on, as
+    :meth:`pidcore.model.SdcModel.filled_dependence` decides it: not only its grid cell's
+    corners, a pchip slope takes the next grid point too. Empty for a model that flags none."""
     filled = getattr(model, "filled", None)
-    axes = getattr(model, "axes", None)
-    if filled is None or axes is None or not np.any(filled):
+    if filled is None or not np.any(filled) or not hasattr(model, "filled_dependence"):
         return ()
-    indices = []
-    for axis, x in zip(axes, point, strict=True):
-        below = int(np.clip(np.searchsorted(axis, x, side="right") - 1, 0, axis.size - 1))
-        above = int(np.clip(np.searchsorted(axis, x, side="left"), 0, axis.size - 1))
-        indices.append(sorted({below, above}))
-    labels = []
-    for i in indices[0]:
-        for j in indices[1]:
-            for k in indices[2]:
-                if filled[i, j, k]:
-                    labels.append(f"{axes[2][k]:g} Hz, {axes[1][j]:g} g, {axes[0][i]:g} %")
-    return tuple(labels)
+    dependence = model.filled_dependence(*point, clip_to_range=True)
+    rests = dependence.depends.reshape(-1, len(dependence.points)).any(axis=0)
+    return tuple(f"{row.frequency_hz:g} Hz, {row.acceleration_g:g} g, {row.fill_percent:g} %"
+                 for row, on in zip(dependence.points.itertuples(index=False), rests,
+                                    strict=True) if on)
 
 
 #: Words and units of the pchip model's axes as a report's note names them.
@@ -1229,7 +1224,8 @@ class Aligner:
         if filled:
             # an interrupted sweep left 500 Hz, 5 g, 90 % unrun: the model held the 75 % SDC
             # there, and a measurement at 85 % got that held value as "interpolated"
-            message += (f"; no DEM run at {'; '.join(filled)}, a corner of its grid cell: the "
+            message += (f"; no DEM run at {'; '.join(filled)}, a grid point its pchip value "
+                        "rests on: the "
                         "model fills it along fill from the runs at that frequency and "
                         "acceleration (pchip between runs, the nearest run's SDC held beyond "
                         "the last), so the SDC here rests partly on no run")

@@ -577,8 +577,7 @@ def compare_case(records: Sequence[MeasuredEntry],
                 notes.append(point[2])
             # at 1000 Hz, 1 g the curve's 75-90 % stretch is Table 3's gap held flat: it was
             # drawn as the paper's model with no word
-            held = sorted({label for fill in model.axes[0]
-                           for label in filled_corners(model, (fill, point[0], point[1]))})
+            held = sorted(filled_corners(model, (model_x, point[0], point[1])))
             if held:
                 notes.append(f"the paper's pchip curve has no Table 3 DEM value at "
                              f"{'; '.join(held)}: the model holds the nearest printed fill's "

@@ -14,6 +14,9 @@ SdcModel, AXIS_NAMES
 HeldEdge, HELD_ERRORS
     ``SdcModel.held_edges(point)``: the axes a point lies beyond, the model's slope at each
     edge and which way holding the edge SDC errs there.
+FilledDependence
+    ``SdcModel.filled_dependence(points)``: which filled holes of the grid (the paper's
+    1000 Hz, 1 g, 90 %) the SDC at each point rests on, and how far it moves with each.
 select_runs, DEM_CONDITION_COLUMNS
     The stored DEM runs of one set of conditions, to build a model from.
 equivalent_damper_table, write_damper_table, DAMPER_COLUMNS, DAMPER_COLUMN_MEANINGS
@@ -22,8 +25,9 @@ equivalent_damper_table, write_damper_table, DAMPER_COLUMNS, DAMPER_COLUMN_MEANI
     files.
 DAMPER_COLUMNS_RENAMED
     The older names of its columns -> the present ones (``.rename(columns=...)``).
-SDC_FILLED_COLUMN, SDC_HELD_COLUMN, SDC_HELD_ERROR_COLUMN
-    Its flags: SDC at a filled hole of the grid, SDC held at the grid's edge, and which way
+SDC_FILLED_COLUMN, SDC_FILLED_NOTE, SDC_HELD_COLUMN, SDC_HELD_ERROR_COLUMN
+    Its flags: SDC resting on a filled hole of the grid (and, in ``attrs``, on which and how
+    far it moves with it), SDC held at the grid's edge, and which way
     that errs (SdcModel.held_edges: the model's slope at the edge).
 loss_factor, damping_ratio, energy_per_cycle, sdc_from_energy_per_cycle, displacement_amplitude
     SDC to loss factor, damping ratio, energy per cycle (Eq. 8-10) and back.
@@ -49,6 +53,7 @@ from .damper import (
     DAMPER_COLUMNS_RENAMED,
     PANEL_COLUMNS,
     SDC_FILLED_COLUMN,
+    SDC_FILLED_NOTE,
     SDC_HELD_COLUMN,
     SDC_HELD_ERROR_COLUMN,
     coupon_area_m2,
@@ -79,6 +84,7 @@ from .sdc_model import (
     AXIS_NAMES,
     DEM_CONDITION_COLUMNS,
     HELD_ERRORS,
+    FilledDependence,
     HeldEdge,
     SdcModel,
     select_runs,
@@ -88,8 +94,8 @@ from .table3 import TABLE3_COLUMNS, load_paper_table3
 __all__ = [
     "AXIS_NAMES", "DAMPER_COLUMN_MEANINGS", "DAMPER_COLUMNS",
     "DAMPER_COLUMNS_RENAMED", "PANEL_COLUMNS", "panel_loss_factor", "DEM_CONDITION_COLUMNS",
-    "HELD_ERRORS", "HarmonicResponse", "HeldEdge",
-    "SDC_FILLED_COLUMN", "SDC_HELD_COLUMN", "SDC_HELD_ERROR_COLUMN", "SdcModel",
+    "FilledDependence", "HELD_ERRORS", "HarmonicResponse", "HeldEdge",
+    "SDC_FILLED_COLUMN", "SDC_FILLED_NOTE", "SDC_HELD_COLUMN", "SDC_HELD_ERROR_COLUMN", "SdcModel",
     "TABLE3_COLUMNS", "TimeDomainSteadyState", "TreatedMode", "coupon_area_m2",
     "coupon_vibrated_mass_kg", "damping_ratio", "displacement_amplitude", "energy_per_cycle",
     "equivalent_damper_table", "equivalent_damping_coefficient", "harmonic_response",

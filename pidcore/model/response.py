@@ -249,6 +249,10 @@ class HarmonicResponse:
         SDC taken at the edge of the model range (only with ``clip_to_range=True``).
     multiple_solutions : ndarray of bool
         More than one amplitude balances the force; the largest is reported.
+    sdc_filled : ndarray of bool
+        An SDC taken at that frequency (of any treated region) rests on a filled hole of the
+        model grid (:meth:`SdcModel.filled_dependence`): the paper's 1000 Hz, 1 g, 90 %
+        value, held at the 75 % one, reaches well beyond its own point.
     mode_shape_note : str
         What the particle damper assumed of the mode shape over the treated area
         (:attr:`TreatedMode.mode_shape_note`).
@@ -259,6 +263,9 @@ class HarmonicResponse:
         where it falls, understates it. A frequency beyond the model's range is judged
         alike by the model's slope along frequency at its edge; where a slope is flat the
         note says the direction is unknown.
+    filled_note : str
+        What the ``sdc_filled`` rows rest on and how far their SDC moves per unit of that
+        filled value ("" where none does).
     """
 
     frequency_hz: np.ndarray
@@ -270,17 +277,20 @@ class HarmonicResponse:
     amplitude_untreated_m: np.ndarray
     clipped: np.ndarray
     multiple_solutions: np.ndarray
+    sdc_filled: np.ndarray
     force_amplitude_n: float
     clipped_note: str = ""
     mode_shape_note: str = ""
+    filled_note: str = ""
 
     def to_pandas(self) -> pd.DataFrame:
         """One row per drive frequency, each column naming its unit.
 
         Columns ``frequency [Hz]``, ``amplitude [m]``, ``phase [rad]``, ``acceleration [g]``,
         ``sdc [-]``, ``particle damping [N s/m]``, ``amplitude untreated [m]``,
-        ``clipped [True/False]``, ``multiple solutions [True/False]``; ``attrs`` hold
-        ``force_amplitude_n``, ``clipped_note`` and ``mode_shape_note``.
+        ``clipped [True/False]``, ``multiple solutions [True/False]``, ``sdc filled
+        [True/False]``; ``attrs`` hold ``force_amplitude_n``, ``clipped_note``,
+        ``mode_shape_note`` and ``filled_note``.
         """
         frame = pd.DataFrame({
             "frequency [Hz]": np.asarray(self.frequency_hz, dtype=float),
@@ -292,10 +302,12 @@ class HarmonicResponse:
             "amplitude untreated [m]": np.asarray(self.amplitude_untreated_m, dtype=float),
             "clipped [True/False]": np.asarray(self.clipped, dtype=bool),
             "multiple solutions [True/False]": np.asarray(self.multiple_solutions, dtype=bool),
+            "sdc filled [True/False]": np.asarray(self.sdc_filled, dtype=bool),
         })
         frame.attrs["force_amplitude_n"] = float(self.force_amplitude_n)
         frame.attrs["clipped_note"] = self.clipped_note
         frame.attrs["mode_shape_note"] = self.mode_shape_note
+        frame.attrs["filled_note"] = self.filled_note
         return frame
 
     def plot(self, ax: Any = None) -> Any:
@@ -424,6 +436,26 @@ def _clipped_note(rows: list[tuple[float, float, str, str, str, float]]) -> str:
     return "; ".join(parts)
 
 
+def _filled(model: SdcModel, fill_percent: float, points: list[tuple[float, float, float]]
+            ) -> tuple[np.ndarray, str]:
+    """Per (frequency [Hz], acceleration [g], row) at which an SDC was taken: whether its row
+    rests on a filled hole of the model's grid, and the note saying which and how far the SDC
+    moves with it ("" where none does). Frequency and acceleration are held at the grid's
+    edge as the SDC took them."""
+    rows = max((int(r) for _, _, r in points), default=-1) + 1
+    flagged = np.zeros(rows, dtype=bool)
+    if not points:
+        return flagged, ""
+    f, acc, row = (np.array(c) for c in zip(*points, strict=True))
+    dependence = model.filled_dependence(fill_percent, acc, f, clip_to_range=True)
+    np.logical_or.at(flagged, row.astype(int), dependence.any)
+    if not flagged.any():
+        return flagged, ""
+    frequencies = sorted({float(x) for x, on in zip(f, dependence.any, strict=True) if on})
+    return flagged, (f"{_span(frequencies, 'g')} Hz ({int(flagged.sum())} row(s)): "
+                     + dependence.summary().replace("point(s)", "SDC(s) taken"))
+
+
 def particle_damping_n_s_m(sdc: np.ndarray | float, mode: TreatedMode,
                            frequency_hz: float, *, area_m2: float | None = None) -> np.ndarray:
     """c_pd [N s/m] of the treated area (or of ``area_m2`` of it) for a given SDC, on that
@@ -499,6 +531,9 @@ def harmonic_response(model: SdcModel, mode: TreatedMode, *, frequencies_hz: np.
     # a 0.3 g response took the 1 g SDC, flagged but not which way that errs
     clip_rows: list[tuple[float, float, str, str, str, float]] = []
     phi_top, phi_low = _largest_amplitude(mode), _smallest_moving_amplitude(mode)
+    f_lo, f_hi = model.bounds["frequency_hz"]
+    # (frequency, acceleration, row) of every SDC taken at a solution, for _filled
+    taken: list[tuple[float, float, float]] = []
     for i, f in enumerate(freqs):
         w = 2.0 * np.pi * f
         sdc_of, freq_clipped, section = _sdc_section(model, mode, f, clip_to_range)
@@ -561,6 +596,9 @@ def harmonic_response(model: SdcModel, mode: TreatedMode, *, frequencies_hz: np.
                               _held_frequency_error(model, mode.fill_percent,
                                                     float(np.clip(held_acc, a_lo, a_hi)), f),
                               *_held_edge_error(section, held_acc, (a_lo, a_hi))))
+        taken.extend((float(np.clip(f, f_lo, f_hi)),
+                      float(np.clip(w**2 * abs(phi) * x / STANDARD_GRAVITY, a_lo, a_hi)), i)
+                     for _, phi in mode.regions if phi != 0.0)
         cp = float(c_pd(np.array(x)))
         out["x"][i] = x
         out["phase"][i] = -np.angle(k - m * w**2 + 1j * w * (c_s + cp))
@@ -568,14 +606,15 @@ def harmonic_response(model: SdcModel, mode: TreatedMode, *, frequencies_hz: np.
         out["sdc"][i] = float(sdc_of(np.array(acc)))
         out["c_pd"][i] = cp
         out["x0"][i] = x_untreated
+    sdc_filled, filled_note = _filled(model, mode.fill_percent, taken)
     return HarmonicResponse(frequency_hz=freqs, amplitude_m=out["x"], phase_rad=out["phase"],
                             acceleration_g=out["acc"], sdc=out["sdc"],
                             particle_damping_n_s_m=out["c_pd"],
                             amplitude_untreated_m=out["x0"], clipped=clipped,
-                            multiple_solutions=multiple,
+                            multiple_solutions=multiple, sdc_filled=sdc_filled,
                             force_amplitude_n=float(force_amplitude_n),
                             clipped_note=_clipped_note(clip_rows),
-                            mode_shape_note=mode.mode_shape_note)
+                            mode_shape_note=mode.mode_shape_note, filled_note=filled_note)
 
 
 @dataclass(frozen=True)
@@ -585,6 +624,8 @@ class TimeDomainSteadyState:
     ``clipped``: the frequency or the steady acceleration amplitude lies outside the SDC
     model's range and the edge SDC was held there (only with ``clip_to_range=True``);
     ``clipped_note`` says which way that errs, as :attr:`HarmonicResponse.clipped_note`.
+    ``sdc_filled`` and ``filled_note``: the steady SDC rests on a filled hole of the model's
+    grid, as :attr:`HarmonicResponse.sdc_filled` and ``filled_note``.
     """
 
     frequency_hz: float
@@ -594,6 +635,8 @@ class TimeDomainSteadyState:
     settle_time_s: float
     clipped: bool = False
     clipped_note: str = ""
+    sdc_filled: bool = False
+    filled_note: str = ""
 
 
 def time_domain_response(model: SdcModel, mode: TreatedMode, *, frequency_hz: float,
@@ -686,6 +729,12 @@ def time_domain_response(model: SdcModel, mode: TreatedMode, *, frequency_hz: fl
             f"time_domain_response: at {as_given(frequency_hz)} Hz the steady acceleration "
             f"{acceleration_g:.3g} g is outside the SDC model range [{a_lo:g}, {a_hi:g}] g; "
             "change the force or pass clip_to_range=True to hold the edge SDC")
+    f_lo, f_hi = model.bounds["frequency_hz"]
+    sdc_filled, filled_note = _filled(
+        model, mode.fill_percent,
+        [(float(np.clip(frequency_hz, f_lo, f_hi)),
+          float(np.clip(w**2 * phi * float(abs(coef)) / STANDARD_GRAVITY, a_lo, a_hi)), 0)
+         for _, phi in regions])
     return TimeDomainSteadyState(frequency_hz=frequency_hz, amplitude_m=float(abs(coef)),
                                  phase_rad=float(np.angle(coef)),
                                  peak_amplitude_m=float(0.5 * (x.max() - x.min())),
@@ -699,4 +748,5 @@ def time_domain_response(model: SdcModel, mode: TreatedMode, *, frequency_hz: fl
                                            frequency_hz),
                                        *_held_edge_error(section, acceleration_g,
                                                          (a_lo, a_hi)))]
-                                     if acceleration_outside or frequency_clipped else []))
+                                     if acceleration_outside or frequency_clipped else []),
+                                 sdc_filled=bool(sdc_filled.any()), filled_note=filled_note)

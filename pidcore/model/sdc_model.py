@@ -35,7 +35,8 @@ gives 0.92, the ratio from the 500 Hz line gives 1.06 (beyond the physical limit
 other (frequency, acceleration) of Table 3 SDC rises from 75 % to 90 %, so holding the 75 %
 value is a lower bound: it under-predicts damping there, the conservative side for a response
 prediction. Filled points are flagged (:attr:`SdcModel.filled`, :meth:`SdcModel.filled_points`)
-so reports can say so.
+so reports can say so, and so is every value resting on one (:meth:`SdcModel.filled_dependence`:
+a pchip slope at a grid point takes its neighbours, so a hole reaches beyond its own cell).
 """
 
 from __future__ import annotations
@@ -67,6 +68,18 @@ _EDGE_STEP = 1e-8
 #: flat: pchip sets an edge slope to exactly 0 where the data turn, and the difference then
 #: holds only the curvature x step (about 1e-8 of it).
 _FLAT_SLOPE = 1e-5
+#: Step of the one-sided differences of :meth:`SdcModel.filled_dependence`, relative to the
+#: model's largest |SDC| (at least 1): on either side of the turns of pchip's slopes the value
+#: is smooth in a grid value (Hermite cubics of harmonic-mean slopes), so a difference's error
+#: is its curvature x step (~1e-6) and round-off 1e-16 / 1e-6 = 1e-10, below the 3 digits a
+#: note prints.
+_FILLED_STEP = 1e-6
+#: Values a filled grid value is set to, evenly over the SDC's range [0, 1] (widened to the
+#: data's) and once its width beyond either end, besides +-:data:`_FILLED_STEP` about it, to
+#: tell whether a value moves with it at all (:meth:`SdcModel.filled_dependence`): a value
+#: still for all of them is taken not to rest on it (Table 3 has values that move only for a
+#: hole above 1.06; a dependence only within a 3/127 gap between them would be missed).
+_FILLED_PROBES = 128
 
 
 @dataclass(frozen=True)
@@ -105,6 +118,70 @@ def held_error(edges: Sequence[HeldEdge]) -> str:
     return errors.pop() if len(errors) == 1 else "unknown"
 
 
+@dataclass(frozen=True)
+class FilledDependence:
+    """Which filled holes of a model's grid the SDC at some points rests on
+    (:meth:`SdcModel.filled_dependence`).
+
+    Attributes
+    ----------
+    points : pandas.DataFrame
+        The filled grid points (:meth:`SdcModel.filled_points`), one row per filled value.
+    depends : ndarray of bool
+        Shape ``(*points' shape, len(points))``: the SDC at the point rests on that value.
+    slope_rising, slope_falling : ndarray
+        Same shape: d SDC / d (that filled value) [-] as the value rises above / falls below
+        the one filled in (they differ where pchip's slope turns there, as at a value held
+        equal to its neighbour); exactly 0 where ``depends`` is False.
+    """
+
+    points: pd.DataFrame
+    depends: np.ndarray
+    slope_rising: np.ndarray
+    slope_falling: np.ndarray
+
+    @property
+    def any(self) -> np.ndarray:
+        """Per point: the SDC rests on at least one filled value."""
+        return self.depends.any(axis=-1)
+
+    def summary(self) -> str:
+        """One line: per filled value, how many of the points rest on it and how far their SDC
+        moves per unit it rises and falls (ranges over those points); "" where none does,
+        e.g. ``"2 point(s) rest on the filled grid value at 1000 Hz, 1 g, 90 % (0.8078, no
+        data: filled along fill): their SDC moves +0.67 .. +0.941 per unit it rises, +0.67 ..
+        +0.941 per unit it falls"``."""
+        if self.points.empty or not self.depends.any():
+            return ""
+        depends = self.depends.reshape(-1, len(self.points))
+        rising = self.slope_rising.reshape(depends.shape)
+        falling = self.slope_falling.reshape(depends.shape)
+        parts = []
+        for h, row in enumerate(self.points.itertuples(index=False)):
+            at = depends[:, h]
+            if not at.any():
+                continue
+            up, down = (_span(slope[at, h]) for slope in (rising, falling))
+            moves = f"{up} per unit of it" if up == down else \
+                f"{up} per unit it rises, {down} per unit it falls"
+            parts.append(f"{int(at.sum())} point(s) rest on {filled_label(row)}: their SDC "
+                         f"moves {moves}")
+        return "; ".join(parts)
+
+
+def _span(values: np.ndarray) -> str:
+    low, high = (format(float(v), "+.3g") for v in (np.min(values), np.max(values)))
+    return low if low == high else f"{low} .. {high}"
+
+
+def filled_label(row: tuple) -> str:
+    """``"the filled grid value at 1000 Hz, 1 g, 90 % (0.8078, no data: filled along
+    fill)"`` of a row of :meth:`SdcModel.filled_points`."""
+    value = row[-1]
+    return (f"the filled grid value at {row.frequency_hz:g} Hz, {row.acceleration_g:g} g, "
+            f"{row.fill_percent:g} % ({value:.4g}, no data: filled along fill)")
+
+
 def _pchip_select(x: np.ndarray, y: np.ndarray, xq: np.ndarray, *,
                   shared: bool = False) -> np.ndarray:
     """pchip along axis 0 of ``y``, each query point on its own column.
@@ -127,7 +204,41 @@ def _pchip_select(x: np.ndarray, y: np.ndarray, xq: np.ndarray, *,
     out = coeffs[0]
     for k in range(1, coeffs.shape[0]):
         out = out * dx + coeffs[k]
+    # the last node is the end of the last interval, its cubic evaluated at dx = its width:
+    # its own value up to round-off of its neighbours', which made a grid point (90 %, 10 g,
+    # 1000 Hz) move by 1e-16 with the hole at 1 g; taken as given, as every other node is
+    # (dx = 0 leaves the constant coefficient, the value itself, exactly)
+    at_end = xq == x[-1]
+    if np.any(at_end):
+        last = y[-1][..., np.newaxis] if shared else y[-1]
+        out[..., at_end] = np.broadcast_to(last, out.shape)[..., at_end]
     return out
+
+
+def _support_select(x: np.ndarray, depends: np.ndarray, xq: np.ndarray, *,
+                    shared: bool = False) -> np.ndarray:
+    """Which results of :func:`_pchip_select` (same arguments, ``depends`` a bool array of
+    ``y``'s shape) depend on a node value flagged in ``depends``.
+
+    pchip's cubic on interval k takes the values and slopes at its two ends; the slope at a
+    node takes that node's two neighbours (at an end, its two inward ones), so interval k
+    rests on the values k-1 .. k+2 and on no other. A query on a node is that node's value
+    alone (:func:`_pchip_select` returns it as given). The rule is the interpolant's own
+    stencil, so a value not flagged is bit for bit the same whatever the flagged values are.
+    """
+    n = len(x)
+    stencil = np.stack([depends[max(k - 1, 0):min(k + 3, n)].any(axis=0)
+                        for k in range(n - 1)])
+    interval = np.clip(np.searchsorted(x, xq, side="right") - 1, 0, n - 2)
+    node = np.where(xq == x[interval], interval, np.where(xq == x[-1], n - 1, -1))
+    if shared:
+        inside = np.moveaxis(stencil[interval], 0, -1)
+        on_node = np.moveaxis(depends[node], 0, -1)
+    else:
+        cols = np.arange(xq.size)
+        inside = np.moveaxis(stencil[interval, ..., cols], 0, -1)
+        on_node = np.moveaxis(depends[node, ..., cols], 0, -1)
+    return np.where(node >= 0, on_node, inside)
 
 
 def _fill_holes_along_fill(values: np.ndarray, axes: tuple[np.ndarray, ...]
@@ -307,6 +418,16 @@ class SdcModel:
         numpy.ndarray
             SDC with the broadcast shape of the inputs.
         """
+        coords, shape = self._query(fill_percent, acceleration_g, frequency_hz, clip_to_range)
+        if coords[0].size == 0:
+            return np.zeros(shape)
+        return self._passes(self.values, coords, _pchip_select).reshape(shape)
+
+    def _query(self, fill_percent: float | np.ndarray, acceleration_g: float | np.ndarray,
+               frequency_hz: float | np.ndarray, clip_to_range: bool
+               ) -> tuple[list[np.ndarray], tuple[int, ...]]:
+        """The points as :meth:`evaluate` takes them: flat, checked, clamped onto the grid box
+        (refused outside it unless ``clip_to_range``); and their broadcast shape."""
         coords = [np.asarray(c, dtype=float) for c in (fill_percent, acceleration_g, frequency_hz)]
         shape = np.broadcast_shapes(*(c.shape for c in coords))
         coords = [np.broadcast_to(c, shape).ravel() for c in coords]
@@ -339,17 +460,80 @@ class SdcModel:
                 raise ParameterError(f"SdcModel: point ({bad}) is outside the model range "
                                      f"({rng}); pass clip_to_range=True to hold edge values")
             coords = [np.clip(c, ax[0], ax[-1]) for c, ax in zip(coords, self.axes, strict=True)]
+        return coords, shape
+
+    def _passes(self, grid: np.ndarray, coords: list[np.ndarray], select) -> np.ndarray:
+        """The three 1-D passes over ``grid`` (the values, or flags with :func:`_support_select`)
+        at flat, clamped points; shape (N,)."""
         fill, acc, freq = coords
-        if fill.size == 0:
-            return np.zeros(shape)
         fq = np.log10(freq) if self.log_frequency else freq
         # pass 1: frequency -> (n_fill, n_acc, N)
-        v = _pchip_select(self._freq_nodes, np.moveaxis(self.values, 2, 0), fq, shared=True)
+        v = select(self._freq_nodes, np.moveaxis(grid, 2, 0), fq, shared=True)
         # pass 2: fill -> (n_acc, N)
-        v = _pchip_select(self.axes[0], v, fill)
+        v = select(self.axes[0], v, fill)
         # pass 3: acceleration -> (N,)
-        v = _pchip_select(self.axes[1], v, acc)
-        return v.reshape(shape)
+        return select(self.axes[1], v, acc)
+
+    def filled_dependence(self, fill_percent: float | np.ndarray,
+                          acceleration_g: float | np.ndarray, frequency_hz: float | np.ndarray,
+                          *, clip_to_range: bool = False) -> FilledDependence:
+        """Which filled grid values the SDC at each point rests on, and how much it moves with
+        each.
+
+        Points as :meth:`evaluate` takes them. pchip is local: the value at a point takes the
+        grid values of a few neighbouring nodes per axis only (:func:`_support_select`), so
+        most points do not depend on a filled hole at all, and some away from its grid cell
+        do (a slope at a node takes both neighbours). Within those, a value rests on the hole
+        where it changes at all, by any amount, when the hole is set to another value
+        (:data:`_FILLED_PROBES` of them over [-1, 2], and the held value +- a step); where
+        pchip turns (a slope set to 0, an end slope clamped) it may change for none. Where
+        the test says no, the value is the same bit for bit for every hole value probed, and
+        for any outside the stencil.
+
+        Returns
+        -------
+        FilledDependence
+            Per point and filled value (in the order of :meth:`filled_points`): whether the
+            SDC rests on it, and d SDC / d (that value) as it rises and as it falls.
+        """
+        coords, shape = self._query(fill_percent, acceleration_g, frequency_hz, clip_to_range)
+        holes = np.argwhere(self.filled)
+        depends = np.zeros((coords[0].size, len(holes)), dtype=bool)
+        slopes = np.zeros((2, *depends.shape))
+        step = _FILLED_STEP * max(float(np.max(np.abs(self.values))), 1.0)
+        low = min(0.0, float(np.min(self.values)))
+        high = max(1.0, float(np.max(self.values)))
+        low, high = low - (high - low), high + (high - low)
+        for h, index in enumerate(map(tuple, holes)):
+            flag = np.zeros(self.values.shape, dtype=bool)
+            flag[index] = True
+            # the stencil: outside it the value is bit for bit the same whatever the hole holds
+            stencil = self._passes(flag, coords, _support_select)
+            if not stencil.any():
+                continue
+            points = [c[stencil] for c in coords]
+
+            def at(value: float, index: tuple = index, points: list = points) -> np.ndarray:
+                grid = self.values.copy()
+                grid[index] = value
+                return self._passes(grid, points, _pchip_select)
+
+            held = float(self.values[index])
+            base = at(held)
+            # inside it a turn of pchip's slopes (set to 0, or an end slope clamped) can leave
+            # a value still for every hole value: 1 in 25 of random points of Table 3 never
+            # moves. Moved: changed at all (no tolerance: a slope set to 0 is exactly 0)
+            rising, falling = at(held + step), at(held - step)
+            moved = (rising != base) | (falling != base)
+            for value in np.linspace(low, high, _FILLED_PROBES):
+                moved |= at(float(value)) != base
+            depends[stencil, h] = moved
+            slopes[0, stencil, h] = np.where(moved, (rising - base) / step, 0.0)
+            slopes[1, stencil, h] = np.where(moved, (base - falling) / step, 0.0)
+        full = (*shape, len(holes))
+        return FilledDependence(points=self.filled_points(), depends=depends.reshape(full),
+                                slope_rising=slopes[0].reshape(full),
+                                slope_falling=slopes[1].reshape(full))
 
     def held_edges(self, fill_percent: float, acceleration_g: float, frequency_hz: float
                    ) -> tuple[HeldEdge, ...]:
@@ -436,8 +620,9 @@ DEM_CONDITION_COLUMNS: tuple[str, ...] = (
 
 
 def select_runs(runs: pd.DataFrame, *, where: Mapping[str, str] | None = None) -> pd.DataFrame:
-    """Runs matching ``where`` (column -> value, compared as text; a ``*sha256`` column also by
-    its first 6 or more digits), checked to be homogeneous.
+    """Runs matching ``where`` (column -> value, compared as numbers where the stored value and
+    the one given both read as one, else as text; a ``*sha256`` column also by its first 6 or
+    more digits), checked to be homogeneous.
 
     Raises :class:`ParameterError` if a column of ``where`` is missing, nothing matches, or the
     remaining runs are of several specimens, differ in a :data:`DEM_CONDITION_COLUMNS`
@@ -461,7 +646,7 @@ def select_runs(runs: pd.DataFrame, *, where: Mapping[str, str] | None = None) -
         # a hash may be given by its first digits, as `specimen check` and labels show it
         hashed = column.endswith("sha256") and len(str(wanted)) >= 6
         selected = selected[text.str.startswith(str(wanted)) if hashed
-                            else text == str(wanted)]
+                            else _matches(text, str(wanted), column)]
     if selected.empty:
         raise ParameterError(f"DEM runs: none match {dict(where or {})}")
     _check_one_specimen(selected)  # first: a specimen fixes the material and more
@@ -481,6 +666,25 @@ def select_runs(runs: pd.DataFrame, *, where: Mapping[str, str] | None = None) -
                 f"where={{'settings_hash': {counts.index[0]!r}}} (CLI: --where "
                 f"settings_hash={counts.index[0]})")
     return selected
+
+
+def _number(text: str) -> float | None:
+    try:
+        return float(text)
+    except ValueError:
+        return None
+
+
+def _matches(stored: pd.Series, wanted: str, column: str) -> pd.Series:
+    """``stored == wanted`` of :func:`select_runs`: as numbers where both parse as one
+    (``fill_percent=50`` matched none of the runs stored at 50.0 %, ``fixture_mass_kg=0`` none
+    at 0.0), as text otherwise. Exact: a stored number is the one typed for its run, and
+    float() of "50" and of "50.0" are the same. Hashes stay text: a hex digest of digits and
+    one "e" reads as a number."""
+    if column.endswith(("sha256", "hash")) or (number := _number(wanted)) is None:
+        return stored == wanted
+    numbers = stored.map(_number)
+    return numbers.map(lambda v: v is not None and v == number).astype(bool) | (stored == wanted)
 
 
 def _settings_difference(runs: pd.DataFrame, counts: pd.Series) -> str:
