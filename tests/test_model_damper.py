@@ -390,7 +390,7 @@ def test_damper_rows_resting_on_the_held_hole_are_flagged(model):
     # moves by +0.116 and (90 %, 1 g, 900 Hz) by +0.129 with the hole set to 0.95
     t = equivalent_damper_table(model, fills_percent=[25, 80, 85, 90],
                                 accelerations_g=[1, 1.5, 3, 5], frequencies_hz=[50, 900, 1000],
-                                vibrated_mass_kg=0.03)
+                                vibrated_mass_kg=paper_vibrated_mass())
     key = t.set_index(["packing ratio [%]", "acceleration [g]", "frequency [Hz]"])
     flag = key[SDC_FILLED_COLUMN]
     for point in [(90, 1.5, 1000), (90, 1, 900), (90, 1, 1000), (85, 3, 900)]:
