@@ -324,5 +324,5 @@ def _notes(analyses: pd.DataFrame, chosen: set[tuple[str, str]]) -> tuple[str, .
         if row["key"] not in before:
             notes.append(f"measurement {row['measurement_key']} ({row['file']}): its analysis "
                          f"{row['key']} (saved {str(row['created_utc'])[:19]}) is now its "
-                         "newest, which report --store and calibrate --store take")
+                         "newest, the one reports and calibrations of the store take")
     return tuple(notes)
