@@ -76,6 +76,10 @@ DEM_TIME_STEP_S = 2e-6
 DEM_MIN_STEPS_PER_CONTACT = 10
 DEM_CELLS = 8
 DEM_MIN_STEADY_CYCLES = 80
+#: Most steady cycles a run takes: 10 000 is 125 x the default, 200 s simulated at 50 Hz (hours
+#: of one core for a bed); beyond it is a slip (1e9 was taken: 10^7 s simulated, its ETA read
+#: as minutes until the samples, 128 per cycle, outgrew memory).
+DEM_MAX_STEADY_CYCLES = 10_000
 DEM_MAX_OVERLAP_FRACTION = 0.05
 DEM_SEED = 12345
 #: Time step used when ``time_step="auto"``: min(DEM_TIME_STEP_S, t_contact / steps per contact).

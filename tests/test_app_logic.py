@@ -2787,3 +2787,14 @@ def test_calibrate_points_display_writes_sdc_and_stderr_by_the_one_rule():
     # the column sits where the SDC was; the rest of points_table is kept
     assert list(table.columns)[3] == MEASURED_EQ11_WITH_ERROR_COLUMN
     assert table["SDC measured (Eq. 11) stderr dof [-]"].tolist()[:2] == [7.0, 7.0]
+
+
+def test_the_dem_pages_steady_cycles_are_capped_as_the_cli_caps_them():
+    # 1e9 typed was queued (10^7 s simulated, an ETA of minutes); the field names its cap
+    from pidcore import defaults
+    from pidcore.app.tabs import dem as dem_page
+
+    with pytest.raises(ParameterError, match=r"^steady cycles \(0 = automatic\): '1e9', "
+                                             rf"expected 0 to {defaults.DEM_MAX_STEADY_CYCLES}$"):
+        dem_page._config("1", "0", "1e9")
+    assert dem_page._config("1", "0", "10000").steady_cycles == defaults.DEM_MAX_STEADY_CYCLES

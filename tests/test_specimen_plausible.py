@@ -7,6 +7,7 @@ from pathlib import Path
 
 import pytest
 
+from pidcore import defaults
 from pidcore.cli import main
 from pidcore.dem.geometry import (
     MAX_PACKING_GRID_POINTS,
@@ -14,7 +15,7 @@ from pidcore.dem.geometry import (
     check_packing_size,
     drop_packing,
 )
-from pidcore.dem.simulate import particles_per_cell
+from pidcore.dem.simulate import DemConfig, particles_per_cell
 from pidcore.errors import ParameterError
 from pidcore.specimen import (
     PAPER_SPECIMEN_NAME,
@@ -263,11 +264,20 @@ def test_check_names_pairs_among_the_tables_and_says_what_the_hash_covers(tmp_pa
             "which no DEM run simulates)") in out
 
 
-def test_dem_run_cycles_0_names_the_option(capsys):
+@pytest.mark.parametrize("cycles", [0, 10_001, 1_000_000_000])
+def test_dem_run_cycles_out_of_range_names_the_option(capsys, tmp_path, cycles):
+    # 1e9 steady cycles was taken (10^7 s simulated, an ETA read as minutes, until its 128
+    # samples per cycle outgrew memory); 0 and the cap are refused naming the flag typed
+    store = tmp_path / "s.h5"
     assert main(["dem", "run", "--frequency", "100", "--acceleration", "5", "--fill", "50",
-                 "--cycles", "0", "--no-progress"]) == 2
+                 "--cycles", str(cycles), "--store", str(store), "--no-progress"]) == 2
     err = capsys.readouterr().err
-    assert "--cycles 0: expected a whole number >= 1" in err and "steady_cycles" not in err
+    assert f"--cycles: expected 1 .. {defaults.DEM_MAX_STEADY_CYCLES} cycles, got {cycles}" \
+        in err and "steady_cycles" not in err
+    assert not store.exists()
+    with pytest.raises(ParameterError, match="steady_cycles: expected 1 .. 10000"):
+        DemConfig(steady_cycles=cycles)
+    assert DemConfig(steady_cycles=defaults.DEM_MAX_STEADY_CYCLES).steady_cycles == 10_000
 
 
 def test_a_file_not_in_utf8_is_one_line_and_a_byte_order_mark_is_accepted(tmp_path, capsys):

@@ -84,6 +84,7 @@ COMMAND_FLAGS: dict[str, dict[str, str]] = {
         "fill_reference": "--fill-reference", "time_step": "--time-step",
         "^cells": "--cells", "frequency_hz": "--frequency", "acceleration_g": "--acceleration",
         "^material": "--material", "^direction": "--direction", "^seed": "--seed",
+        "^steady_cycles": "--cycles",
         **CALIBRATION_WRITER,
     },
     "calibrate": {
@@ -95,7 +96,7 @@ COMMAND_FLAGS: dict[str, dict[str, str]] = {
         "specimen=": "--specimen ", "read_measured_table": "--data",
         "write_outputs(result, out_dir)": "pidcore calibrate --out",
         # the DEM runs' own refusals (more cells than memory holds, a seed past 2^63)
-        "^cells": "--cells", "^seed": "--seed",
+        "^cells": "--cells", "^seed": "--seed", "^steady_cycles": "--steady-cycles",
     },
     "bench signal": {"n_samples": "--samples"},
     "store remove": {"with_dependents=True": "--with-dependents"},

@@ -169,9 +169,6 @@ def _register_sweep(sub: argparse._SubParsersAction) -> None:
 def _config(args: argparse.Namespace):
     from ..dem import DemConfig
 
-    if args.cycles is not None and args.cycles < 1:
-        # DemConfig would name its field, steady_cycles, which the user never typed
-        raise ParameterError(f"--cycles {args.cycles}: expected a whole number >= 1")
     return DemConfig(cells=args.cells, seed=args.seed, time_step=args.time_step,
                      normal_damping_mode=args.damping_mode,
                      damping_coefficient=args.damping_coefficient,

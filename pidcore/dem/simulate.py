@@ -168,8 +168,10 @@ class DemConfig:
                                      f"got {self.time_step!r}")
         elif not self.time_step > 0:
             raise ParameterError(f"time_step: expected > 0 s, got {self.time_step}")
-        if self.steady_cycles is not None and self.steady_cycles < 1:
-            raise ParameterError(f"steady_cycles: expected >= 1, got {self.steady_cycles}")
+        if self.steady_cycles is not None and not (
+                1 <= self.steady_cycles <= defaults.DEM_MAX_STEADY_CYCLES):
+            raise ParameterError(f"steady_cycles: expected 1 .. {defaults.DEM_MAX_STEADY_CYCLES}"
+                                 f" cycles, got {self.steady_cycles}")
         if self.block_cycles < 1 or self.max_transient_cycles < 0:
             raise ParameterError("block_cycles >= 1 and max_transient_cycles >= 0 expected")
         if not (math.isfinite(self.max_transient_s) and self.max_transient_s >= 0):

@@ -36,7 +36,8 @@ CANCEL_WAIT_S = 1.5
 def _config(cells: str, seed: str, steady_cycles: str):
     from pidcore.dem import DemConfig
 
-    steady = parse_count(steady_cycles, name="steady cycles (0 = automatic)")
+    steady = parse_count(steady_cycles, name="steady cycles (0 = automatic)",
+                         maximum=defaults.DEM_MAX_STEADY_CYCLES)
     return DemConfig(cells=parse_count(cells, name="cells simulated", minimum=1,
                                        maximum=MAX_CELLS),
                      seed=parse_count(seed, name="seed"),
