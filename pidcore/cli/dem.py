@@ -93,7 +93,8 @@ def _add_config_options(p: argparse.ArgumentParser) -> None:
                         "default z)")
     p.add_argument("--cycles", metavar="N", type=int, default=None,
                    help=f"steady-state cycles measured, at least (default "
-                        f"{defaults.DEM_MIN_STEADY_CYCLES}); the DEM runs whole blocks of "
+                        f"{defaults.DEM_MIN_STEADY_CYCLES}, at most "
+                        f"{defaults.DEM_MAX_STEADY_CYCLES}); the DEM runs whole blocks of "
                         f"{defaults.DEM_STEADY_BLOCK_CYCLES} cycles and measures the two that "
                         "detect the steady state, so more may be measured (noted)")
     p.add_argument("--time-step", metavar="S", type=_time_step,
