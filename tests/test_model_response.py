@@ -8,6 +8,7 @@ import itertools
 import numpy as np
 import pandas as pd
 import pytest
+from scipy.optimize import brentq
 
 from pidcore.constants import STANDARD_GRAVITY
 from pidcore.errors import ParameterError
@@ -19,6 +20,7 @@ from pidcore.model import (
     harmonic_response,
     load_paper_table3,
     paper_particles_mass_kg,
+    paper_vibrated_mass,
     time_domain_response,
 )
 
@@ -133,8 +135,11 @@ def test_multiple_solutions_flagged_and_largest_returned():
     mode = TreatedMode(natural_frequency_hz=300.0, modal_mass_kg=2.0,
                        structural_damping_ratio=0.002, treated_area_m2=0.2, fill_percent=50.0,
                        coupon_vibrated_mass_kg=0.1)
-    with pytest.raises(ParameterError, match="outside the SDC model range"):
-        harmonic_response(dip, mode, frequencies_hz=[300.0], force_amplitude_n=5.0)
+    # by default the root inside the range is the answer, the one beyond it named as such
+    inside = harmonic_response(dip, mode, frequencies_hz=[300.0], force_amplitude_n=5.0)
+    assert inside.multiple_solutions[0] and not inside.clipped[0]
+    assert 1 <= inside.acceleration_g[0] <= 10
+    assert "not conservative: a larger stable one lies beyond the range" in inside.multiple_note
     r = harmonic_response(dip, mode, frequencies_hz=[300.0], force_amplitude_n=5.0,
                           clip_to_range=True)
     assert r.multiple_solutions[0] and r.clipped[0] and r.acceleration_g[0] > 10
@@ -150,6 +155,92 @@ def test_multiple_solutions_flagged_and_largest_returned():
     above = residual(np.geomspace(r.amplitude_m[0] * (1 + 1e-6), x_hi, 20000))
     assert np.any(np.diff(np.sign(below)) != 0)  # a smaller root exists
     assert np.all(above > 0)  # none larger than the one returned
+
+
+def _trial_jump_mode() -> TreatedMode:
+    # 50 Hz mode, 25 % fill, 2 m^2 treated, structural zeta 0.0005: driven at 22.908 N on
+    # resonance the paper's SDC dips enough for 5.48 g and 9.88 g to balance the force, and
+    # 10.5 g with the 10 g SDC held beyond the model's edge
+    return TreatedMode(natural_frequency_hz=50.0, modal_mass_kg=1.0,
+                       structural_damping_ratio=0.0005, treated_area_m2=2.0, fill_percent=25.0,
+                       coupon_vibrated_mass_kg=paper_vibrated_mass()(25.0))
+
+
+def test_a_jump_region_is_answered_inside_the_model_and_names_every_steady_amplitude(model):
+    # the default refused "10.5 g outside the model range", a root that only the held 10 g
+    # SDC makes, though 5.48 g and 9.88 g inside the range balance the force
+    mode, force, f = _trial_jump_mode(), 22.908, 50.0
+    w = 2 * np.pi * f
+
+    def needed_force(x):  # X |D(X)|: the force amplitude X takes, SDC at its own acceleration
+        a = np.clip(w**2 * x / STANDARD_GRAVITY, 1.0, 10.0)
+        c = (mode.structural_damping_n_s_m + model(25.0, a, f) * mode.coupon_vibrated_mass_kg
+             * f / mode.coupon_area_m2 * mode.treated_area_m2)
+        return x * np.abs(mode.stiffness_n_m - mode.modal_mass_kg * w**2 + 1j * w * c)
+
+    # an independent root search, on the model's own 1-10 g only (no SDC held)
+    xs = np.geomspace(1.0, 10.0, 20001) * STANDARD_GRAVITY / w**2
+    excess = needed_force(xs) - force
+    roots = [brentq(lambda x: needed_force(x) - force, xs[j], xs[j + 1], xtol=1e-16,
+                    rtol=1e-14)
+             for j in np.flatnonzero(np.sign(excess[:-1]) != np.sign(excess[1:]))]
+    accelerations = [w**2 * x / STANDARD_GRAVITY for x in roots]
+    assert [round(a, 2) for a in accelerations] == [5.48, 9.88]
+    # at resonance a root is stable where the force it needs rises with X (the averaged
+    # equations' determinant; their trace then is negative too)
+    rising = [needed_force(x * (1 + 1e-6)) > needed_force(x * (1 - 1e-6)) for x in roots]
+    assert rising == [True, False]
+    # beyond 10 g the held SDC is constant: the force needed is linear in X there
+    x_20g = 20 * STANDARD_GRAVITY / w**2
+    held = force / (needed_force(x_20g) / x_20g)
+    held_g = w**2 * held / STANDARD_GRAVITY
+    assert held_g > 10
+
+    r = harmonic_response(model, mode, frequencies_hz=[f], force_amplitude_n=force)
+    # the largest stable root inside the range, to brentq's tolerance (1e-9 covers both
+    # searches' xtol/rtol on X of ~5e-4 m)
+    assert r.acceleration_g[0] == pytest.approx(accelerations[0], rel=1e-9)
+    assert r.multiple_solutions[0] and not r.clipped[0] and r.clipped_note == ""
+    assert r.multiple_note == r.to_pandas().attrs["multiple_note"]
+    assert r.multiple_note.startswith(
+        f"50 Hz: 3 steady amplitudes balance the force, {accelerations[0]:.3g} g (stable), "
+        f"{accelerations[1]:.3g} g (unstable: the force it needs falls as it grows), "
+        f"{held_g:.3g} g (stable; beyond the model's [1, 10] g, found with the edge SDC held: "
+        "the model does not tell whether it exists")
+    assert r.multiple_note.endswith(
+        f"{accelerations[0]:.3g} g returned (the largest stable one inside the model's range, "
+        "not conservative: a larger stable one lies beyond the range)")
+    # clip_to_range takes the held root, as documented (the largest), and names the others
+    clipped = harmonic_response(model, mode, frequencies_hz=[f], force_amplitude_n=force,
+                                clip_to_range=True)
+    assert clipped.acceleration_g[0] == pytest.approx(held_g, rel=1e-9)
+    assert clipped.clipped[0] and clipped.multiple_note.endswith(
+        f"{held_g:.3g} g returned (the largest stable one)")
+
+
+def test_time_domain_response_says_harmonic_balance_has_other_steady_amplitudes(model):
+    # from rest it settled on 5.48 g without a word of 9.88 g and the one beyond 10 g
+    mode = _trial_jump_mode()
+    hb = harmonic_response(model, mode, frequencies_hz=[50.0], force_amplitude_n=22.908)
+    td = time_domain_response(model, mode, frequency_hz=50.0, force_amplitude_n=22.908)
+    acc = (2 * np.pi * 50.0) ** 2 * td.amplitude_m / STANDARD_GRAVITY
+    assert td.multiple_solutions
+    listed = hb.multiple_note.split("; 5.48 g returned")[0]
+    assert td.multiple_note == (f"{listed}; this integration from rest settled on {acc:.3g} g, "
+                                "another start can settle on another")
+    assert f"{acc:.3g} g (stable)" in listed
+
+
+def test_a_single_steady_amplitude_is_unchanged_bit_for_bit_and_says_nothing(model, mode):
+    r = harmonic_response(model, mode, frequencies_hz=[250.0, 300.0, 360.0],
+                          force_amplitude_n=FORCE_N)
+    # the amplitudes and phases before several roots were told apart, to the last bit
+    before_m = ["0x1.3446ad85b6123p-18", "0x1.31f2c940cd901p-16", "0x1.a906df152bd43p-19"]
+    before_rad = ["-0x1.25ba41a7cad42p-4", "-0x1.921fb54442d18p+0", "-0x1.801f98fe79f6dp+1"]
+    assert [float(v).hex() for v in r.amplitude_m] == before_m
+    assert [float(v).hex() for v in r.phase_rad] == before_rad
+    assert not r.multiple_solutions.any()
+    assert r.multiple_note == "" and r.to_pandas().attrs["multiple_note"] == ""
 
 
 @pytest.mark.parametrize(("keywords", "said"), [

@@ -33,11 +33,17 @@ First-order harmonic balance gives the amplitude as the root of
 Since ``c_pd >= 0`` every root lies between the response with the largest particle damping and
 the response without particles; the bracket is scanned on a log grid for sign changes and each
 one is refined with :func:`scipy.optimize.brentq`. The SDC dips at high acceleration, so
-several roots (jumps) can exist; the largest amplitude is returned (conservative) and flagged.
+several roots (jumps) can exist; the largest stable amplitude is returned (conservative),
+flagged, and all of them are listed with their stability (``multiple_note``). A root is stable
+where the averaged equations of amplitude and phase about it are: the force it needs rises
+with the amplitude, and the damping ``c = c_s + c_pd`` falls no faster than ``1/X^2``.
 
 Outside the model range (acceleration amplitude or frequency beyond the SDC grid) the solver
 refuses with :class:`~pidcore.errors.ParameterError` unless ``clip_to_range=True``, which holds
-the SDC at the nearest edge of the grid and flags the point.
+the SDC at the nearest edge of the grid and flags the point. The scan holds the edge SDC
+beyond the range all the same, so it can find roots there; by default they are not the
+model's: the largest stable root inside the range is returned, the others named in the note,
+and only a response with no root inside the range is refused.
 """
 
 from __future__ import annotations
@@ -70,6 +76,8 @@ _SCAN_POINTS = 400
 _ZERO_RESIDUAL = 1e-12
 #: Relative slack when deciding whether a solution's acceleration is inside the model range.
 _RANGE_RTOL = 1e-9
+#: Step in log(X) of the differences that judge a root's stability (pchip is smooth on it).
+_STABILITY_STEP = 1e-6
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -248,7 +256,9 @@ class HarmonicResponse:
     clipped : ndarray of bool
         SDC taken at the edge of the model range (only with ``clip_to_range=True``).
     multiple_solutions : ndarray of bool
-        More than one amplitude balances the force; the largest is reported.
+        More than one amplitude balances the force (a jump region: which one a structure
+        shows depends on where it came from); the largest stable one is reported, inside
+        the model's range unless ``clip_to_range=True``, and ``multiple_note`` lists them all.
     sdc_filled : ndarray of bool
         An SDC taken at that frequency (of any treated region) rests on a filled hole of the
         model grid (:meth:`SdcModel.filled_dependence`): the paper's 1000 Hz, 1 g, 90 %
@@ -266,6 +276,12 @@ class HarmonicResponse:
     filled_note : str
         What the ``sdc_filled`` rows rest on and how far their SDC moves per unit of that
         filled value ("" where none does).
+    multiple_note : str
+        Per ``multiple_solutions`` row, every amplitude balancing the force (as the
+        acceleration of ``acceleration_g``), each stable or why not (the averaged equations
+        about it: unstable where the force it needs falls as it grows, or where its damping
+        falls faster than 1/X^2), those beyond the model's range found with the edge SDC
+        held, and which one was returned ("" where no row has several).
     """
 
     frequency_hz: np.ndarray
@@ -282,6 +298,7 @@ class HarmonicResponse:
     clipped_note: str = ""
     mode_shape_note: str = ""
     filled_note: str = ""
+    multiple_note: str = ""
 
     def to_pandas(self) -> pd.DataFrame:
         """One row per drive frequency, each column naming its unit.
@@ -290,7 +307,7 @@ class HarmonicResponse:
         ``sdc [-]``, ``particle damping [N s/m]``, ``amplitude untreated [m]``,
         ``clipped [True/False]``, ``multiple solutions [True/False]``, ``sdc filled
         [True/False]``; ``attrs`` hold ``force_amplitude_n``, ``clipped_note``,
-        ``mode_shape_note`` and ``filled_note``.
+        ``mode_shape_note``, ``filled_note`` and ``multiple_note``.
         """
         frame = pd.DataFrame({
             "frequency [Hz]": np.asarray(self.frequency_hz, dtype=float),
@@ -308,6 +325,7 @@ class HarmonicResponse:
         frame.attrs["clipped_note"] = self.clipped_note
         frame.attrs["mode_shape_note"] = self.mode_shape_note
         frame.attrs["filled_note"] = self.filled_note
+        frame.attrs["multiple_note"] = self.multiple_note
         return frame
 
     def plot(self, ax: Any = None) -> Any:
@@ -493,6 +511,120 @@ def _smallest_moving_amplitude(mode: TreatedMode) -> float:
     return min(moving) if moving else math.nan
 
 
+@dataclass(frozen=True)
+class _SteadyRoot:
+    """One amplitude that balances the force (:func:`_balance_roots`)."""
+
+    log_x: float
+    #: acceleration [g] of the treated region moving most
+    acceleration_g: float
+    #: the regions' accelerations [g] outside the model's range (the SDC held there)
+    outside: list[float]
+    #: "" where stable, else why not
+    unstable: str
+
+    @property
+    def stable(self) -> bool:
+        return not self.unstable
+
+
+def _balance_roots(model: SdcModel, mode: TreatedMode, sdc_of, f: float,
+                   force_amplitude_n: float, caller: str = "harmonic_response"
+                   ) -> tuple[list[_SteadyRoot], float]:
+    """Every amplitude that balances the force at ``f`` (module docstring), ascending, with
+    its stability, and the amplitude without particles."""
+    k, m, c_s = mode.stiffness_n_m, mode.modal_mass_kg, mode.structural_damping_n_s_m
+    w = 2.0 * np.pi * f
+
+    def damping(x: np.ndarray) -> np.ndarray:
+        return c_s + _modal_particle_damping(mode, sdc_of, f, x)
+
+    def residual(log_x: np.ndarray) -> np.ndarray:
+        x = np.exp(log_x)
+        return x * np.abs(k - m * w**2 + 1j * w * damping(x)) / force_amplitude_n - 1.0
+
+    with np.errstate(divide="ignore"):  # undamped at its natural frequency: inf
+        x_untreated = force_amplitude_n / abs(k - m * w**2 + 1j * w * c_s)
+    sdc_max, sdc_min = float(np.max(model.values)), float(np.min(model.values))
+    c_max, c_min = (float(_modal_particle_damping(mode, lambda _a, s=s: np.asarray(s), f,
+                                                  np.asarray(1.0)))
+                    for s in (max(sdc_max, 0.0), max(sdc_min, 0.0)))
+    # the least damping the model can give bounds the amplitude from above: with no
+    # structural damping at the natural frequency the untreated bound was 1/0, and the
+    # scan from it ran on NaN ("response acceleration nan g")
+    lightest = abs(k - m * w**2 + 1j * w * (c_s + c_min))
+    if lightest == 0.0:
+        raise ParameterError(
+            f"{caller}: at {f:g} Hz (the natural frequency) nothing bounds the "
+            "response: structural_damping_ratio is 0 and the SDC model reaches 0; give "
+            "the mode's structural damping ratio (> 0)")
+    x_hi = force_amplitude_n / lightest
+    x_lo = force_amplitude_n / abs(k - m * w**2 + 1j * w * (c_s + c_max))
+    if x_hi <= x_lo * (1 + 1e-14):
+        roots = [np.log(x_hi)]
+    else:
+        grid = np.linspace(np.log(x_lo), np.log(x_hi), _SCAN_POINTS)
+        r = residual(grid)
+        # the residual is relative to F0: |r| below round-off is a root on the scan grid
+        # (e.g. at x_hi when the SDC is 0 there)
+        zero = np.abs(r) <= _ZERO_RESIDUAL
+        roots = list(grid[zero])
+        for j in np.flatnonzero((np.sign(r[:-1]) * np.sign(r[1:]) < 0)
+                                & ~zero[:-1] & ~zero[1:]):
+            roots.append(brentq(residual, grid[j], grid[j + 1], xtol=1e-14, rtol=1e-13))
+        if not roots:  # residual >= 0 at x_lo within round-off: the bracket edge is the root
+            roots = [grid[int(np.argmin(np.abs(r)))]]
+    a_lo, a_hi = model.bounds["acceleration_g"]
+    phi_top, phi_low = _largest_amplitude(mode), _smallest_moving_amplitude(mode)
+    found: list[_SteadyRoot] = []
+    # roots closer than 1e-9 in log(X) are one root found twice (the largest of them kept)
+    for log_x in sorted(roots, reverse=True):
+        if found and round(float(log_x), 9) == round(found[-1].log_x, 9):
+            continue
+        x = float(np.exp(log_x))
+        acc = w**2 * phi_top * x / STANDARD_GRAVITY
+        # the regions moving most and least take the highest and lowest accelerations
+        extremes = sorted({acc, w**2 * phi_low * x / STANDARD_GRAVITY})
+        outside = [a for a in extremes
+                   if not a_lo * (1 - _RANGE_RTOL) <= a <= a_hi * (1 + _RANGE_RTOL)]
+        # the averaged (slow-flow) equations of a', theta' about the root: their Jacobian's
+        # determinant has the sign of d(force)/dX, its trace that of -(2 c + dc/dln X)
+        steps = float(log_x) + np.array([-_STABILITY_STEP, _STABILITY_STEP])
+        force_slope = float(np.diff(residual(steps))[0])
+        c_here = float(damping(np.array(x)))
+        c_slope = float(np.diff(damping(np.exp(steps)))[0]) / (2 * _STABILITY_STEP)
+        unstable = ("" if force_slope > 0 and 2 * c_here + c_slope > 0
+                    else "unstable: the force it needs falls as it grows" if force_slope <= 0
+                    else "unstable: its damping falls faster than 1/X^2, the amplitude "
+                         "oscillates away from it")
+        found.append(_SteadyRoot(log_x=float(log_x), acceleration_g=acc, outside=outside,
+                                 unstable=unstable))
+    return found[::-1], x_untreated
+
+
+def _chosen_root(roots: list[_SteadyRoot], clip_to_range: bool) -> _SteadyRoot:
+    """The root returned: the largest stable one (conservative), inside the model's range
+    unless ``clip_to_range``; where none is stable, the largest; where none is inside, the
+    largest of all (refused by the caller)."""
+    candidates = roots if clip_to_range else [r for r in roots if not r.outside]
+    if not candidates:
+        return roots[-1]
+    return ([r for r in candidates if r.stable] or candidates)[-1]
+
+
+def _multiple_note(roots: list[_SteadyRoot], model: SdcModel, f: float,
+                   clip_to_range: bool) -> str:
+    """The steady amplitudes at ``f``, each with its stability and whether the SDC was held
+    beyond the model's edge to find it."""
+    a_lo, a_hi = model.bounds["acceleration_g"]
+    held = (f"beyond the model's [{a_lo:g}, {a_hi:g}] g, found with the edge SDC held"
+            + ("" if clip_to_range else ": the model does not tell whether it exists "
+               "(clip_to_range=True takes it)"))
+    described = [f"{r.acceleration_g:.3g} g ({r.unstable or 'stable'}"
+                 + (f"; {held})" if r.outside else ")") for r in roots]
+    return f"{f:g} Hz: {len(roots)} steady amplitudes balance the force, {', '.join(described)}"
+
+
 def harmonic_response(model: SdcModel, mode: TreatedMode, *, frequencies_hz: np.ndarray,
                       force_amplitude_n: float, clip_to_range: bool = False
                       ) -> HarmonicResponse:
@@ -523,66 +655,35 @@ def harmonic_response(model: SdcModel, mode: TreatedMode, *, frequencies_hz: np.
         raise ParameterError("frequencies_hz must be finite and > 0")
     k, m, c_s = mode.stiffness_n_m, mode.modal_mass_kg, mode.structural_damping_n_s_m
     a_lo, a_hi = model.bounds["acceleration_g"]
-    sdc_max, sdc_min = float(np.max(model.values)), float(np.min(model.values))
     out = {name: np.empty(freqs.shape) for name in
            ("x", "phase", "acc", "sdc", "c_pd", "x0")}
     clipped = np.zeros(freqs.shape, dtype=bool)
     multiple = np.zeros(freqs.shape, dtype=bool)
     # a 0.3 g response took the 1 g SDC, flagged but not which way that errs
     clip_rows: list[tuple[float, float, str, str, str, float]] = []
-    phi_top, phi_low = _largest_amplitude(mode), _smallest_moving_amplitude(mode)
+    # several steady amplitudes at one frequency: the one returned was picked without a word
+    multiple_rows: list[str] = []
+    phi_top = _largest_amplitude(mode)
     f_lo, f_hi = model.bounds["frequency_hz"]
     # (frequency, acceleration, row) of every SDC taken at a solution, for _filled
     taken: list[tuple[float, float, float]] = []
     for i, f in enumerate(freqs):
         w = 2.0 * np.pi * f
         sdc_of, freq_clipped, section = _sdc_section(model, mode, f, clip_to_range)
-
-        def c_pd(x: np.ndarray, sdc_of=sdc_of, f=f) -> np.ndarray:
-            return _modal_particle_damping(mode, sdc_of, f, x)
-
-        def residual(log_x: np.ndarray, c_pd=c_pd, w=w) -> np.ndarray:
-            x = np.exp(log_x)
-            return x * np.abs(k - m * w**2 + 1j * w * (c_s + c_pd(x))) / force_amplitude_n - 1.0
-
-        with np.errstate(divide="ignore"):  # undamped at its natural frequency: inf
-            x_untreated = force_amplitude_n / abs(k - m * w**2 + 1j * w * c_s)
-        c_max, c_min = (float(_modal_particle_damping(mode, lambda _a, s=s: np.asarray(s), f,
-                                                      np.asarray(1.0)))
-                        for s in (max(sdc_max, 0.0), max(sdc_min, 0.0)))
-        # the least damping the model can give bounds the amplitude from above: with no
-        # structural damping at the natural frequency the untreated bound was 1/0, and the
-        # scan from it ran on NaN ("response acceleration nan g")
-        lightest = abs(k - m * w**2 + 1j * w * (c_s + c_min))
-        if lightest == 0.0:
-            raise ParameterError(
-                f"harmonic_response: at {f:g} Hz (the natural frequency) nothing bounds the "
-                "response: structural_damping_ratio is 0 and the SDC model reaches 0; give "
-                "the mode's structural damping ratio (> 0)")
-        x_hi = force_amplitude_n / lightest
-        x_lo = force_amplitude_n / abs(k - m * w**2 + 1j * w * (c_s + c_max))
-        if x_hi <= x_lo * (1 + 1e-14):
-            roots = [np.log(x_hi)]
-        else:
-            grid = np.linspace(np.log(x_lo), np.log(x_hi), _SCAN_POINTS)
-            r = residual(grid)
-            # the residual is relative to F0: |r| below round-off is a root on the scan grid
-            # (e.g. at x_hi when the SDC is 0 there)
-            zero = np.abs(r) <= _ZERO_RESIDUAL
-            roots = list(grid[zero])
-            for j in np.flatnonzero((np.sign(r[:-1]) * np.sign(r[1:]) < 0)
-                                    & ~zero[:-1] & ~zero[1:]):
-                roots.append(brentq(residual, grid[j], grid[j + 1], xtol=1e-14, rtol=1e-13))
-            if not roots:  # residual >= 0 at x_lo within round-off: the bracket edge is the root
-                roots = [grid[int(np.argmin(np.abs(r)))]]
-        x = float(np.exp(max(roots)))
-        # roots closer than 1e-9 in log(X) are one root found twice
-        multiple[i] = np.unique(np.round(np.asarray(roots), 9)).size > 1
+        roots, x_untreated = _balance_roots(model, mode, sdc_of, f, force_amplitude_n)
+        root = _chosen_root(roots, clip_to_range)
+        x = float(np.exp(root.log_x))
+        multiple[i] = len(roots) > 1
+        if multiple[i]:
+            chosen = ("none is stable: the largest" if not root.stable
+                      else "the largest stable one" + ("" if clip_to_range
+                                                       else " inside the model's range"))
+            if any(r.stable and r.outside and r.log_x > root.log_x for r in roots):
+                chosen += ", not conservative: a larger stable one lies beyond the range"
+            multiple_rows.append(f"{_multiple_note(roots, model, f, clip_to_range)}; "
+                                 f"{root.acceleration_g:.3g} g returned ({chosen})")
         acc = w**2 * phi_top * x / STANDARD_GRAVITY
-        # the regions moving most and least take the highest and lowest accelerations
-        extremes = sorted({acc, w**2 * phi_low * x / STANDARD_GRAVITY})
-        outside = [a for a in extremes
-                   if not a_lo * (1 - _RANGE_RTOL) <= a <= a_hi * (1 + _RANGE_RTOL)]
+        outside = root.outside
         if outside and not clip_to_range:
             which = "" if len(mode.regions) == 1 else (
                 " of the treated region moving " + ("most" if outside[-1] == acc else "least"))
@@ -599,7 +700,7 @@ def harmonic_response(model: SdcModel, mode: TreatedMode, *, frequencies_hz: np.
         taken.extend((float(np.clip(f, f_lo, f_hi)),
                       float(np.clip(w**2 * abs(phi) * x / STANDARD_GRAVITY, a_lo, a_hi)), i)
                      for _, phi in mode.regions if phi != 0.0)
-        cp = float(c_pd(np.array(x)))
+        cp = float(_modal_particle_damping(mode, sdc_of, f, np.array(x)))
         out["x"][i] = x
         out["phase"][i] = -np.angle(k - m * w**2 + 1j * w * (c_s + cp))
         out["acc"][i] = acc
@@ -614,7 +715,8 @@ def harmonic_response(model: SdcModel, mode: TreatedMode, *, frequencies_hz: np.
                             multiple_solutions=multiple, sdc_filled=sdc_filled,
                             force_amplitude_n=float(force_amplitude_n),
                             clipped_note=_clipped_note(clip_rows),
-                            mode_shape_note=mode.mode_shape_note, filled_note=filled_note)
+                            mode_shape_note=mode.mode_shape_note, filled_note=filled_note,
+                            multiple_note="; ".join(multiple_rows))
 
 
 @dataclass(frozen=True)
@@ -626,6 +728,9 @@ class TimeDomainSteadyState:
     ``clipped_note`` says which way that errs, as :attr:`HarmonicResponse.clipped_note`.
     ``sdc_filled`` and ``filled_note``: the steady SDC rests on a filled hole of the model's
     grid, as :attr:`HarmonicResponse.sdc_filled` and ``filled_note``.
+    ``multiple_solutions`` and ``multiple_note``: harmonic balance has several steady
+    amplitudes at this frequency (as :attr:`HarmonicResponse.multiple_note`); the one
+    integrated from rest is one of them, another start can settle on another.
     """
 
     frequency_hz: float
@@ -637,6 +742,8 @@ class TimeDomainSteadyState:
     clipped_note: str = ""
     sdc_filled: bool = False
     filled_note: str = ""
+    multiple_solutions: bool = False
+    multiple_note: str = ""
 
 
 def time_domain_response(model: SdcModel, mode: TreatedMode, *, frequency_hz: float,
@@ -649,7 +756,8 @@ def time_domain_response(model: SdcModel, mode: TreatedMode, *, frequency_hz: fl
     ``A = sqrt(x^2 + (v / w)^2)``, which equals X in steady harmonic motion. The harmonic-balance
     solution is therefore an exact periodic solution of this ODE; the comparison checks the
     root finding, the assembly of c_pd from the model and the units, and that the solution
-    is the one the system settles on from rest. It does not check the equivalent-damper idea
+    is the one the system settles on from rest (where harmonic balance has several, the
+    result's ``multiple_note`` lists them). It does not check the equivalent-damper idea
     against DEM. SDC is held at the model edge while A(t) is outside the range (transients);
     a frequency, or a steady acceleration amplitude, outside the model range is refused as
     :func:`harmonic_response` refuses it, unless ``clip_to_range=True`` (then flagged
@@ -684,6 +792,10 @@ def time_domain_response(model: SdcModel, mode: TreatedMode, *, frequency_hz: fl
     # 2000 Hz ran on the 1000 Hz SDC without a word, though harmonic_response refused it
     sdc_of, frequency_clipped, section = _sdc_section(model, mode, frequency_hz,
                                                       clip_to_range, "time_domain_response")
+    # 5.48 g from rest was returned alone where 9.88 g (unstable) and one beyond 10 g also
+    # balance the force: which one settles depends on the start
+    roots, _ = _balance_roots(model, mode, sdc_of, frequency_hz, force_amplitude_n,
+                              "time_domain_response")
     wn = 2.0 * np.pi * mode.natural_frequency_hz
     if settle_cycles is None:
         zeta = max(mode.structural_damping_ratio, 1e-3)
@@ -749,4 +861,10 @@ def time_domain_response(model: SdcModel, mode: TreatedMode, *, frequency_hz: fl
                                        *_held_edge_error(section, acceleration_g,
                                                          (a_lo, a_hi)))]
                                      if acceleration_outside or frequency_clipped else []),
-                                 sdc_filled=bool(sdc_filled.any()), filled_note=filled_note)
+                                 sdc_filled=bool(sdc_filled.any()), filled_note=filled_note,
+                                 multiple_solutions=len(roots) > 1,
+                                 multiple_note=(
+                                     f"{_multiple_note(roots, model, frequency_hz, clip_to_range)}"
+                                     f"; this integration from rest settled on "
+                                     f"{acceleration_g:.3g} g, another start can settle on "
+                                     "another" if len(roots) > 1 else ""))
