@@ -333,3 +333,54 @@ def test_an_analysis_note_names_the_pages_column_not_a_cli_option():
     assert outcome.ok, outcome.error
     assert "channel 'Force' inverted ('inverted channels' column)" in outcome.record.notes
     assert not any("--" in n for n in outcome.record.notes), outcome.record.notes
+
+
+def test_the_apps_report_files_hold_the_notes_and_figures_of_the_clis_store_report(
+        tmp_path, capsys):
+    # the app's report files of a store said nothing of the paper's coupon assumed for its
+    # records (`pidcore report --store` does) and held the SDC figure alone, without the
+    # records' force-displacement loops the CLI draws
+    import io
+    import zipfile
+
+    from pidcore.compare.case import load_case_of
+    from pidcore.measure import AnalysisOptions
+    from pidcore.report.downloads import report_files, store_report_table
+    from pidcore.store import Store
+
+    store = tmp_path / "s.h5"
+    options = AnalysisOptions()
+    files = []
+    for seed, fill in ((1, 50), (2, 75)):
+        record = uploads.analyze_upload(f"m_fill{fill}.csv", mass_damper_csv(seed=seed),
+                                        options).record
+        files.append(uploads.AnalysedFile(
+            record, load_case_of(record, fill_percent=fill, material="acrylic"), options, ""))
+    uploads.save_records(store, files)
+    Store(store).add_dem_run("at50", _dem_record(0.20, 50.0))  # one record meets a DEM run
+    assert main(["report", "--store", str(store), "--dem-store", str(store),
+                 "--out", str(tmp_path / "cli")]) == 0
+    capsys.readouterr()
+    cli = tmp_path / "cli"
+    app = report_files(store, store)
+
+    def notes(text: str) -> list[str]:
+        return [line for line in text.splitlines() if line.startswith("note: ")]
+
+    cli_notes = notes((cli / "report.provenance.txt").read_text())
+    assert any("name no specimen, the paper's coupon (paper_coupon) assumed: "
+               "m_fill50.csv, m_fill75.csv" in n for n in cli_notes), cli_notes
+    assert notes(app["csv_provenance"][1].decode()) == cli_notes
+    # the Report tab's notes under its table too (those of the table, not of its figures)
+    assert cli_notes[0].removeprefix("note: ") in store_report_table(store, store).attrs["notes"]
+    # and in the formats a reader opens (the LaTeX escapes the names' underscores)
+    for fmt, names in (("md", "m_fill50.csv, m_fill75.csv"), ("html", "m_fill50.csv, m_fill75.csv"),
+                       ("tex", r"m\_fill50.csv, m\_fill75.csv")):
+        assert names in app[fmt][1].decode(), fmt
+    with zipfile.ZipFile(io.BytesIO(app["zip"][1])) as archive:
+        figures = sorted(n.removeprefix("figures/") for n in archive.namelist()
+                         if n.startswith("figures/"))
+    assert figures == sorted(p.name for p in (cli / "figures").iterdir())
+    # one loop per record, as PNG and SVG
+    assert sorted(n.split("_f")[0] for n in figures if n.startswith("loop_")) == [
+        "loop_00", "loop_00", "loop_01", "loop_01"], figures

@@ -21,6 +21,7 @@ from ..errors import ParameterError
 if TYPE_CHECKING:  # pragma: no cover
     from ..calibrate.prediction import Calibration
     from ..specimen import Specimen
+    from .pipeline import SpecimenTable
 
 #: MIME type of each report format (:data:`pidcore.constants.REPORT_FORMATS`).
 REPORT_MIME_TYPES: dict[str, str] = {
@@ -57,16 +58,21 @@ def store_report_table(path: str | os.PathLike, dem_store: str | os.PathLike | N
 def _store_report(path: str | os.PathLike, dem_store: str | os.PathLike | None, *,
                   analysis_keys: list[str] | None, pool: bool, calibration: Calibration | None,
                   specimen: Specimen | None
-                  ) -> tuple[pd.DataFrame, pd.DataFrame | None, pd.DataFrame]:
-    """(:func:`store_report_table`, the DEM runs of the specimen it chose from: None for
-    none, the saved analyses it reports)."""
-    from ..store.listing import list_dem_runs, saved_analyses
-    from .pipeline import specimen_report_table
+                  ) -> tuple[pd.DataFrame, SpecimenTable | None, pd.DataFrame]:
+    """(:func:`store_report_table`, what :func:`pidcore.report.pipeline.specimen_report_table`
+    built it from: None for nothing to report, the saved analyses it reports)."""
+    from ..store import Store
+    from ..store.listing import checked_analyses, list_dem_runs
+    from .pipeline import latest_per_measurement, specimen_report_table, stored_records_notes
     from .table import add_calibration_columns
 
-    analyses = store_analyses = saved_analyses(path)
+    # the store's records, and those reported, chosen and ordered as `pidcore report --store`
+    # chooses them: the notes name them and the loop figures are numbered in that order
+    listed = checked_analyses(Store(path).list_analyses(), path) if Path(path).is_file() \
+        else pd.DataFrame()
+    analyses = latest_per_measurement(listed)
     if analysis_keys is not None and not analyses.empty:
-        analyses = analyses[analyses["key"].isin(analysis_keys)]
+        analyses = analyses[analyses["key"].isin(analysis_keys)].reset_index(drop=True)
     dem_runs = list_dem_runs(path, dem_store)
     if analyses.empty and dem_runs.empty:
         return pd.DataFrame(), None, analyses
@@ -80,10 +86,14 @@ def _store_report(path: str | os.PathLike, dem_store: str | os.PathLike | None, 
                                   choose_another=CHOOSE_SPECIMEN_APP,
                                   design_runs=calibration_design_runs(dem_runs,
                                                                       [path, dem_store]),
-                                  store_analyses=store_analyses)
+                                  store_analyses=listed)
     table = built.table if calibration is None else add_calibration_columns(
         built.table, calibration, specimen=specimen, paper=specimen is None)
-    return table, built.dem_runs, analyses
+    # what `pidcore report --store` says of the records before the table's notes (the
+    # specimen and particles assumed for them): the page and the files said none of it
+    table.attrs["notes"] = [*stored_records_notes(listed, analyses, specimen),
+                            *table.attrs.get("notes", [])]
+    return table, built, analyses
 
 
 def report_files(path: str | os.PathLike, dem_store: str | os.PathLike | None = None, *,
@@ -98,20 +108,31 @@ def report_files(path: str | os.PathLike, dem_store: str | os.PathLike | None = 
     nothing is written.
     """
     from ..compare import Tolerances
-    from .comparison_figures import plot_sdc_comparison
-    from .pipeline import open_verified_store, specimen_provenance, stored_parameters
+    from .pipeline import (
+        measured_loops,
+        open_verified_store,
+        report_figures,
+        specimen_provenance,
+        stored_parameters,
+    )
     from .provenance import calibration_provenance, collect_provenance
     from .render import write_report
 
     stores = [Path(p) for p in (path, dem_store) if p is not None and Path(p).is_file()]
-    for p in stores:
-        open_verified_store(p, must_exist=True)
-    table, runs, analyses = _store_report(path, dem_store, analysis_keys=analysis_keys,
-                                          pool=pool, calibration=calibration,
-                                          specimen=specimen)
-    if table.empty:
+    opened = [open_verified_store(p, must_exist=True) for p in stores]
+    table, built, analyses = _store_report(path, dem_store, analysis_keys=analysis_keys,
+                                           pool=pool, calibration=calibration,
+                                           specimen=specimen)
+    if table.empty or built is None:
         raise ParameterError("nothing to report: the stores hold no saved analyses with a "
                              "load case and no DEM runs")
+    runs = built.dem_runs
+    notes = list(table.attrs.get("notes", []))
+    # the figures `pidcore report --store` draws, from the same stores: the force-displacement
+    # loops of the stored records, each with its DEM run's where one is held
+    main = opened[0] if stores and stores[0] == Path(path) else None
+    figures = report_figures(table, runs, built.aligner,
+                             measured_loops([], analyses, main, notes), opened, notes)
     tol = Tolerances()
     # the seeds of the specimen's runs, those the table compared from
     seeds = sorted({int(s) for s in runs["seed"].dropna()}) \
@@ -121,10 +142,9 @@ def report_files(path: str | os.PathLike, dem_store: str | os.PathLike | None = 
         parameters={**stored_parameters(analyses), "frequency_rtol": tol.frequency_rtol,
                     "acceleration_rtol": tol.acceleration_rtol,
                     "fill_atol_percent": tol.fill_atol_percent, "pool": pool},
-        seeds=seeds, stores=stores, notes=table.attrs.get("notes", []),
+        seeds=seeds, stores=stores, notes=notes,
         specimens=specimen_provenance(specimen, table),
         calibrations=calibration_provenance(calibration))
-    figures = {"sdc_per_load_case": plot_sdc_comparison(table)}
     try:
         with tempfile.TemporaryDirectory(prefix="pidcore_report_") as folder:
             paths = write_report(table, figures, provenance, Path(folder) / "report",

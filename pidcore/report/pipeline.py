@@ -311,10 +311,38 @@ def latest_per_measurement(analyses: pd.DataFrame) -> pd.DataFrame:
     return newest(with_fill).reset_index(drop=True)
 
 
-def _measured_loops(results: list[MeasuredResult], analyses: pd.DataFrame, store,
-                    notes: list[str]) -> list[tuple[str, LoadCase, ForceDisplacementLoop]]:
-    """(name, load case, loop) per measurement: from the fresh analyses, else from the store's
-    harmonic phasors (store-only reports)."""
+def stored_records_notes(listed: pd.DataFrame, analyses: pd.DataFrame,
+                         specimen: Specimen | None = None) -> list[str]:
+    """What a report of a store's records says of them, before its table's notes: what
+    ``pidcore analyze`` assumed for the records reported, ``analyses`` (the paper's acrylic,
+    its coupon), a result of theirs saved as implausible, and how many measurements of the
+    store's records ``listed`` have no analysis stating a fill (in no table). ``pidcore report
+    --store`` and the app's Report tab both say them: the tab said none."""
+    from ..compare.plausibility import stored_plausibility_notes, stored_record_name
+    from ..file_settings import stored_assumption_notes
+
+    # what analyze assumed for them is said again here
+    notes = stored_assumption_notes(analyses)
+    # a stored result kept as implausible is said again here, as when it was saved
+    for _, record in analyses.iterrows():
+        notes.extend(f"{stored_record_name(record)}: "
+                     f"{n}" for n in stored_plausibility_notes(record, given=specimen))
+    if not listed.empty:
+        # of the store, not of the records chosen (the app reports some of them)
+        left_out = (listed["measurement_key"].nunique()
+                    - latest_per_measurement(listed)["measurement_key"].nunique())
+        if left_out:
+            notes.append(f"{left_out} stored measurement(s) have no analysis stating a fill; "
+                         "not in the table (re-run with the files and fill_percent)")
+    return notes
+
+
+def measured_loops(results: Sequence[MeasuredResult], analyses: pd.DataFrame,
+                   store: Store | None, notes: list[str]
+                   ) -> list[tuple[str, LoadCase, ForceDisplacementLoop]]:
+    """(name, load case, loop) per measurement: from the fresh analyses ``results``, else from
+    the harmonic phasors of ``store``'s records ``analyses`` (store-only reports; a record
+    without them is named in ``notes``)."""
     from .comparison_figures import loop_from_phasors
 
     if results:
@@ -627,9 +655,14 @@ def specimen_report_table(stored_runs: pd.DataFrame | None, analyses: pd.DataFra
     return SpecimenTable(table, dem_runs, paper, aligner)
 
 
-def _figures(table: pd.DataFrame, dem_runs: pd.DataFrame | None, aligner: Aligner,
-             loops: list[tuple[str, LoadCase, ForceDisplacementLoop]], dem_stores: list,
-             notes: list[str]) -> dict[str, object]:
+def report_figures(table: pd.DataFrame, dem_runs: pd.DataFrame | None, aligner: Aligner,
+                   loops: list[tuple[str, LoadCase, ForceDisplacementLoop]],
+                   dem_stores: Sequence[Store], notes: list[str]) -> dict[str, object]:
+    """The report's figures by name: SDC per load case, the DEM models' SDC against
+    acceleration and frequency, and the first :data:`MAX_LOOP_FIGURES` of ``loops``
+    (:func:`measured_loops`) with the DEM run's loop of ``dem_stores`` at their grid case
+    overlaid; what was drawn without it is said in ``notes``. ``pidcore report`` and the app's
+    report files draw these."""
     from .comparison_figures import dem_loop_from_arrays, plot_loop_overlay, plot_sdc_comparison
 
     figures: dict[str, object] = {}
@@ -951,13 +984,8 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         held = checked_analyses(main.list_analyses(), main.path)
         if files:  # their analyses are added to it
             main.check_writable()
-    from ..compare.plausibility import (
-        plausibility_notes,
-        stated_sdc_bounds,
-        stored_plausibility_notes,
-        stored_record_name,
-    )
-    from ..file_settings import assumed, files_assumption_notes, stored_assumption_notes
+    from ..compare.plausibility import plausibility_notes, stated_sdc_bounds
+    from ..file_settings import assumed, files_assumption_notes
 
     options = options or AnalysisOptions()
     results = analyze_files(
@@ -1023,17 +1051,7 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
     elif main is not None:
         listed = held  # nothing saved since it was read
         analyses = latest_per_measurement(listed)
-        # what analyze assumed for them (the paper's acrylic, its coupon) is said again here
-        notes.extend(stored_assumption_notes(analyses))
-        # a stored result kept as implausible is said again here, as when it was saved
-        for _, record in analyses.iterrows():
-            notes.extend(f"{stored_record_name(record)}: "
-                         f"{n}" for n in stored_plausibility_notes(record, given=specimen))
-        if not listed.empty:
-            left_out = listed["measurement_key"].nunique() - analyses["measurement_key"].nunique()
-            if left_out:
-                notes.append(f"{left_out} stored measurement(s) have no analysis stating a fill; "
-                             "not in the table (re-run with the files and fill_percent)")
+        notes.extend(stored_records_notes(listed, analyses, specimen))
     else:
         analyses = measured_frame(results)
         # not stored: the analyses' own corrections say how the baseline went off
@@ -1055,8 +1073,8 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         table = add_calibration_columns(table, calibrated, tolerances=tolerances,
                                         specimen=specimen, paper=specimen is None)
     notes.extend(table.attrs.get("notes", []))
-    loops = _measured_loops(results, analyses, main, notes)
-    figures = _figures(table, dem_runs, aligner, loops, dems, notes)
+    loops = measured_loops(results, analyses, main, notes)
+    figures = report_figures(table, dem_runs, aligner, loops, dems, notes)
     if wording is not None:
         notes = [wording(n) for n in notes]
         attrs = {**table.attrs, "notes": [wording(n) for n in table.attrs.get("notes", [])]}
