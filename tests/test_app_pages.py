@@ -943,6 +943,32 @@ def test_calibrate_page_calibrates_a_chosen_specimen_file_on_its_own_measurement
                in c.value for c in at.caption)
 
 
+def test_calibrate_page_names_a_file_taking_the_paper_coupons_name_by_its_hash(
+        store_file, tmp_path):
+    # a steel specimen file named "paper_coupon" was "No saved measurement is of specimen
+    # paper_coupon (steel particles)", the paper's coupon's name, where the DEM and Report
+    # tabs and its saved tests name it "paper_coupon [f849cf]"
+    from pidcore.specimen import load_specimen
+
+    folder = tmp_path / "data_samples" / "specimens"  # the app runs in tmp_path
+    folder.mkdir(parents=True)
+    text = (REPO / "data_samples" / "specimens" / "steel_6mm.toml").read_text()
+    (folder / "mine.toml").write_text(text.replace('name = "steel_6mm"',
+                                                   'name = "paper_coupon"'))
+    short = load_specimen(folder / "mine.toml").hash[:6]
+    at = _upload(_app(), [("a_fill50.csv", mass_damper_csv())])  # acrylic: not its tests
+    at.button(key="save").click()
+    at.run()
+    at.run()
+    box = at.selectbox(key="calibration_specimen")
+    box.set_value(next(o for o in box.options if o.endswith("mine.toml")))
+    at.run()
+    assert not at.exception
+    said = [i.value for i in at.info if i.value.startswith("No saved measurement is of")]
+    assert said == [f"No saved measurement is of specimen paper_coupon [{short}] (steel "
+                    "particles) or of an unnamed specimen of them."], [i.value for i in at.info]
+
+
 def test_report_chooses_among_the_saved_records(store_file):
     files = [("a_fill50.csv", mass_damper_csv(frequency_hz=100.0)),
              ("b_fill75.csv", mass_damper_csv(frequency_hz=100.0, seed=3))]

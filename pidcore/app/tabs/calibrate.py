@@ -33,7 +33,7 @@ from pidcore.app.tabs import (
     specimen_choice,
 )
 from pidcore.loadcase import parse_count
-from pidcore.specimen import calibrated_name
+from pidcore.specimen import calibrated_name, measured_specimen_name
 
 #: Seconds between refreshes of the calibration's state while it runs.
 REFRESH_S = 2.0
@@ -200,7 +200,9 @@ def _form(stores, api, points: list, left_out: list[str]) -> str:
             st.caption(note)
             left_out = [*left_out, note]
         if not points:
-            st.info(f"No saved measurement is of specimen {specimen.name} "
+            # named as its tests are saved and its DEM runs labelled: a file taking the paper
+            # coupon's name with other content is "paper_coupon [f849cf]", not the paper's
+            st.info(f"No saved measurement is of specimen {measured_specimen_name(specimen)} "
                     f"({specimen.particles.material} particles) or of an unnamed specimen of "
                     "them.")
             return chosen_label
