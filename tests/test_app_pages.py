@@ -1825,6 +1825,52 @@ def _app_at(address: dict) -> AppTest:
     return at
 
 
+def _default_and_state_set(monkeypatch) -> list[str]:
+    """The keys of the widgets that get a default value and one set through the session state
+    (the condition of Streamlit's "created with a default value but also had its value set
+    via the Session State API" warning, logged with a stack trace by a served app, not under
+    AppTest, which runs without a runtime), as they are drawn."""
+    from streamlit.elements.lib import policies
+    from streamlit.runtime.state import get_session_state
+
+    found: list[str] = []
+    original = policies.check_session_state_rules
+
+    def recording(default_value, key, writes_allowed=True):
+        if key is not None and default_value is not None \
+                and get_session_state().is_new_state_value(key):
+            found.append(key)
+        return original(default_value, key, writes_allowed)
+
+    monkeypatch.setattr(policies, "check_session_state_rules", recording)
+    return found
+
+
+def test_no_field_restored_from_the_page_address_has_its_value_from_two_places(
+        store_file, monkeypatch):
+    # server.log: 'The widget with key "dem_freqs" was created with a default value but also
+    # had its value set via the Session State API' with a stack trace, on a reload of the DEM
+    # form: Streamlit seeds a bound field from the address into the session state, and a run
+    # ended by st.rerun (here: the DEM jobs saved since the session's last look, which a fresh
+    # session has not had) keeps it there into the next run, where the field's default met it
+    from pidcore.dem import DemConfig
+
+    (case,) = jobs.plan_dem_cases([50.0], [5.0], [50.0], material="acrylic", direction="z")
+    saved = jobs.DemJob("job0001", case, DemConfig(cells=1), "k", state="saved")
+    jobs.write_journal(jobs.journal_path(store_file), [saved])
+    both = _default_and_state_set(monkeypatch)
+    at = _app_at({"dem_freqs": "50, 200", "dem_accs": "2", "dem_fills": "", "dem_cells": "3",
+                  "dem_seed": "7", "dem_steady": "12", "calibration_cells": "3",
+                  "calibration_design": "5", "include_session": "false"})
+    assert both == [], both
+    # and each field still comes back from the address, an emptied one empty
+    got = {k: at.text_input(key=k).value for k in
+           ("dem_freqs", "dem_accs", "dem_fills", "dem_cells", "dem_seed", "dem_steady")}
+    assert got == {"dem_freqs": "50, 200", "dem_accs": "2", "dem_fills": "", "dem_cells": "3",
+                   "dem_seed": "7", "dem_steady": "12"}
+    assert at.checkbox(key="include_session").value is False
+
+
 def test_the_dem_form_comes_back_from_the_page_address_and_bad_values_are_refused(store_file):
     # a reload reset the twelve fields to their defaults: they are bound to the page address
     # now, and what comes back from it is read, or refused, as typed text

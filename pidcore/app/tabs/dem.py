@@ -75,11 +75,14 @@ def _job_table(stores, polling: bool) -> None:
         st.caption("jobs: " + ", ".join(f"{n} {s}" for s, n in counts.items())
                    + (" · refreshing every second" if busy else ""))
     # A job that finished since the last look changes the store: let the other tabs re-read.
+    # A session's first look has none before it (its tabs read the store this run), and a
+    # rerun then kept the fields Streamlit had just filled from the page address in the session
+    # state into the next run, beside their defaults: a warning with a stack trace in the log
     done = sum(r["state"] == "saved" for r in rows)
-    if st.session_state.get("_dem_saved_seen", 0) != done:
-        st.session_state["_dem_saved_seen"] = done
-        if done:
-            st.rerun(scope="app")
+    seen = st.session_state.get("_dem_saved_seen")
+    st.session_state["_dem_saved_seen"] = done
+    if seen is not None and seen != done and done:
+        st.rerun(scope="app")
     if polling and not busy:  # the last job ended: draw the page again, without the timer
         st.rerun(scope="app")
 
