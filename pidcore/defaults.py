@@ -185,6 +185,17 @@ DEM_CALIBRATION_SPEED_M_S = 0.3
 #: leaves a busy scheduler room.
 DEM_SCHEDULER_ANSWER_TIMEOUT_S = 10.0
 
+# --- Calibration (pidcore.calibrate, pidcore calibrate) -------------------------------------
+#: Most design points of a calibration (``design_size``, ``--design-size``, the Calibrate
+#: page's "design points"): each is one DEM run per load case. 200 is 4 x the largest default
+#: (49, all twelve DEM parameters: :func:`pidcore.calibrate.surrogate.default_design_size`) and
+#: 40 x the docs' 5 points; at 12 load cases it is 2400 DEM runs, 40 x the docs' 60 that take
+#: 1-4 min on two cores (docs/calibration.md): one to three hours. Beyond it is a slip: 100000
+#: was taken, and merely building its 500000 run requests held the app's Cancel for minutes
+#: before any DEM run (each load case's Gaussian process would then invert a 100000-square
+#: matrix, 80 GB).
+CALIBRATION_MAX_DESIGN_SIZE = 200
+
 # --- Coupon (paper Sect. 2, Table 2) ---------------------------------------------------------
 # The DEM reads the coupon from its specimen file (pidcore/data/specimens/paper_coupon.toml,
 # written from these values); these remain for the paper-table model (pidcore.model).

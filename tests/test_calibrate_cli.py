@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 import math
 import re
+import threading
 from pathlib import Path
 
 import numpy as np
@@ -571,6 +572,89 @@ def test_design_size_0_and_workers_0_are_refused_not_taken_as_defaults(capsys, t
         calibrate(read_measured_table(table), fit=["friction"], design_size=0,
                   store_path=tmp_path / "dem.h5")
     assert not (tmp_path / "dem.h5").exists()
+
+
+class _StopAfter(threading.Event):
+    """A stop that is found set once it has been looked at ``checks`` times: a Cancel clicked
+    while the calibration is still being set up."""
+
+    def __init__(self, checks: int) -> None:
+        super().__init__()
+        self.left = checks
+
+    def is_set(self) -> bool:
+        self.left -= 1
+        return self.left < 0 or super().is_set()
+
+
+def test_a_design_size_over_the_cap_is_refused_before_anything_is_made(capsys, tmp_path):
+    """`--design-size 100000 --fit friction` was taken: 500000 run requests were built (over
+    30 s, and the app's Cancel unheard) before any DEM run."""
+    from pidcore import defaults
+    from pidcore.calibrate.data import read_measured_table
+    from pidcore.errors import ParameterError
+    from pidcore.interrupt import StopRequested
+
+    cap = defaults.CALIBRATION_MAX_DESIGN_SIZE
+    table = _table(tmp_path)
+    _refused(capsys, tmp_path, ["--data", str(table), "--fit", "friction", "--design-size",
+                                str(cap + 1)],
+             f"--design-size: expected at most {cap} design points (each is one DEM run per "
+             f"load case), got {cap + 1}")
+    points = read_measured_table(table)
+    with pytest.raises(ParameterError, match=rf"^design_size: expected at most {cap} "):
+        calibrate(points, fit=["friction"], design_size=100_000, store_path=tmp_path / "d.h5")
+    # the cap itself is taken: a stop set from the start ends it, not a refusal
+    with pytest.raises(StopRequested):
+        calibrate(points, fit=["friction"], design_size=cap, store_path=tmp_path / "d.h5",
+                  progress=False, stop=_StopAfter(0))
+    assert not (tmp_path / "d.h5").exists()
+
+
+def test_a_stop_while_the_design_is_built_ends_the_calibration_before_its_requests_are(
+        tmp_path, monkeypatch):
+    """The app's Cancel was looked at only once every run request of the design was made
+    (~0.6 ms a variant): minutes for a large design, the page saying 'cancelling' meanwhile."""
+    import importlib
+
+    from pidcore import defaults
+    from pidcore.calibrate.data import read_measured_table
+    from pidcore.interrupt import StopRequested
+
+    pipeline = importlib.import_module("pidcore.calibrate.calibrate")  # the package's function
+    made, told = [], []
+    real = pipeline.specimen_with
+    monkeypatch.setattr(pipeline, "specimen_with",
+                        lambda specimen, values: made.append(values) or real(specimen, values))
+    monkeypatch.setattr(pipeline, "run_requests",
+                        lambda *a, **kw: pytest.fail("no DEM run was to be asked for"))
+    n_design = defaults.CALIBRATION_MAX_DESIGN_SIZE
+    with pytest.raises(StopRequested, match="calibration stopped"):
+        calibrate(read_measured_table(_table(tmp_path)), fit=["friction"],
+                  design_size=n_design, store_path=tmp_path / "d.h5", progress=False,
+                  on_design=told.append, stop=_StopAfter(5))
+    # the stop is looked at before each variant: found set at the 6th look, after 5 of the
+    # 200 variants were made, never after all of them
+    assert len(made) == 5
+    assert not told and not (tmp_path / "d.h5").exists()
+
+
+def test_a_stop_while_the_run_keys_are_looked_up_ends_before_the_rest(tmp_path, monkeypatch):
+    """run_requests hashed every request's key and asked the store for it before it first
+    looked at its stop."""
+    from pidcore.interrupt import StopRequested
+
+    keys = []
+    real = RunRequest.key
+    monkeypatch.setattr(RunRequest, "key", lambda self: keys.append(1) or real(self))
+    specimen = paper_specimen()
+    requests = [RunRequest(LoadCase(100.0 + i, 5.0, 50.0, "acrylic"), specimen,
+                           DemConfig(cells=2)) for i in range(50)]
+    with pytest.raises(StopRequested, match="stopped before any started"):
+        run_requests(requests, store_path=tmp_path / "d.h5", progress=False,
+                     stop=_StopAfter(3))
+    assert len(keys) == 3  # looked at before each key: the 4th look found it set
+    assert not (tmp_path / "d.h5").exists()
 
 
 def test_an_empty_data_table_suggests_the_measured_sdc_header(capsys, tmp_path):

@@ -293,10 +293,11 @@ def _public(row: dict) -> dict:
 
 
 def _requests(points: Sequence[MeasuredPoint], dem_specs: Sequence[ParameterSpec],
-              design: np.ndarray, config: DemConfig,
-              specimen: Specimen) -> list[list[RunRequest]]:
+              design: np.ndarray, config: DemConfig, specimen: Specimen, *,
+              stop: threading.Event | None = None) -> list[list[RunRequest]]:
     specimens = []
     for row in design:
+        raise_if_stopped(stop, _STOPPED)  # each variant is a specimen made and hashed
         values = {s.name: float(v) for s, v in zip(dem_specs, row, strict=True)}
         try:
             variant = specimen_with(specimen, values)
@@ -311,6 +312,7 @@ def _requests(points: Sequence[MeasuredPoint], dem_specs: Sequence[ParameterSpec
                 "priors=") from None
     out = []
     for point in points:
+        raise_if_stopped(stop, _STOPPED)
         case = LoadCase(point.frequency_hz, point.acceleration_g, point.fill_percent,
                         point.material)
         out.append([RunRequest(case, s, config, variant) for s, variant in specimens])
@@ -513,13 +515,23 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: str | Sequence[str],
     n_design = default_design_size(len(dem_specs)) if design_size is None else design_size
     if dem_specs and n_design < 2:
         raise ParameterError(f"design_size: expected >= 2 with DEM parameters, got {n_design}")
+    if n_design > defaults.CALIBRATION_MAX_DESIGN_SIZE:
+        raise ParameterError(f"design_size: expected at most "
+                             f"{defaults.CALIBRATION_MAX_DESIGN_SIZE} design points (each is one "
+                             f"DEM run per load case), got {n_design}")
     design = design_points(dem_specs, n_design, seed=seed)
     config = dataclasses.replace(dem_config or DemConfig(), cells=cells, seed=seed,
                                  steady_cycles=steady_cycles)
     check_point_fills(points, specimen, config)
-    requests = _requests(points, dem_specs, design, config, specimen)
+    # a stop is heard while the design's requests and keys are made too: that takes a
+    # fraction of a ms per request, seconds for a large design, before any DEM run starts
+    requests = _requests(points, dem_specs, design, config, specimen, stop=stop)
     if on_design is not None:
-        on_design([r.key() for row in requests for r in row])
+        keys = []
+        for row in requests:
+            raise_if_stopped(stop, _STOPPED)
+            keys += [r.key() for r in row]
+        on_design(keys)
     # on_done only where asked for: the call is otherwise the CLI's as before
     told = {} if on_run_done is None else {"on_done": on_run_done}
     if stop is not None:

@@ -19,7 +19,7 @@ from pathlib import Path
 
 from ..dem.persist import dem_run_entry, run_key, save_dem_entry, stored_keys
 from ..dem.simulate import DemConfig, LoadCase, simulate_load_case
-from ..interrupt import untouched
+from ..interrupt import raise_if_stopped, untouched
 from ..specimen import Specimen
 from .parameters import friction_paths
 
@@ -142,6 +142,9 @@ def run_requests(requests: Sequence[RunRequest], *, store_path: str | os.PathLik
     exists = store.path.exists()
     todo, seen = [], set()
     for request in requests:
+        # a key is a hash of the run's inputs, and the store is asked for each: a stop set
+        # meanwhile is not kept waiting for the whole list
+        raise_if_stopped(stop, _STOPPED)
         key = request.key()
         if key not in seen and not (exists and store.has_dem_run(key)):
             todo.append(request)
@@ -177,6 +180,10 @@ def run_requests(requests: Sequence[RunRequest], *, store_path: str | os.PathLik
         if bar is not None:
             bar.close()
     return {"computed": len(todo), "cached": cached, "wall_s": time.perf_counter() - start}
+
+
+#: What a stop before any DEM run says (:func:`pidcore.interrupt.raise_if_stopped`).
+_STOPPED = "the DEM runs were stopped before any started; the runs stored before are kept"
 
 
 @dataclass

@@ -64,7 +64,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--design-size", metavar="N", type=positive_int, default=None,
                    help=f"DEM design points (default {default_design_size(1)} for one DEM "
                         f"parameter, {default_design_size(2) - default_design_size(1)} more per "
-                        "further one; none fitted: one run per load case)")
+                        "further one; none fitted: one run per load case; at most "
+                        f"{defaults.CALIBRATION_MAX_DESIGN_SIZE}, each is one DEM run per load "
+                        "case)")
     p.add_argument("--seed", type=non_negative_int, default=defaults.DEM_SEED,
                    help=f"DEM seed (default {defaults.DEM_SEED})")
     p.add_argument("--workers", metavar="N", type=positive_int, default=2,

@@ -60,7 +60,8 @@ def _task(stores, chosen: str, polling: bool) -> None:
         if task.runs_total:
             st.progress((task.runs_stored_before + task.runs_done) / task.runs_total)
         if task.cancel_requested:
-            st.caption("cancelling: the running DEM run(s) are being stopped")
+            st.caption("cancelling: the running DEM run(s) are being stopped" if task.runs_total
+                       else "cancelling: the design is being set up, no DEM run started yet")
         else:
             st.button("Cancel calibration", key="calibration_cancel",
                       on_click=runner_for(stores.path).cancel,
@@ -258,7 +259,8 @@ def _form(stores, api, points: list, left_out: list[str]) -> str:
     cells = c2.text_input("cells per DEM run", "4", key="calibration_cells",
                           help=f"2 to {defaults.APP_MAX_DEM_CELLS}", bind=ADDRESS_BINDING)
     design = c3.text_input("design points (0 = default)", "0", key="calibration_design",
-                           bind=ADDRESS_BINDING)
+                           help=f"at most {defaults.CALIBRATION_MAX_DESIGN_SIZE}: each is one "
+                                "DEM run per load case", bind=ADDRESS_BINDING)
     wanted = [*chosen, *(n.strip() for n in extra.split(",") if n.strip())]
     too_few = bool(wanted) and len(points) < points_needed(wanted)
     if too_few:
@@ -269,7 +271,8 @@ def _form(stores, api, points: list, left_out: list[str]) -> str:
             fit = api.parse_fit(wanted, specimen)
             n_cells = parse_count(cells, name="cells per DEM run", minimum=2,
                                   maximum=defaults.APP_MAX_DEM_CELLS)
-            n_design = parse_count(design, name="design points (0 = default)")
+            n_design = parse_count(design, name="design points (0 = default)",
+                                   maximum=defaults.CALIBRATION_MAX_DESIGN_SIZE)
             started = runner_for(stores.path).start(api, points, fit=fit, cells=n_cells,
                                                     design_size=n_design or None,
                                                     specimen=specimen, notes=left_out)
