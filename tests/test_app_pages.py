@@ -1950,6 +1950,34 @@ def test_the_calibrate_form_comes_back_from_the_page_address_and_bad_values_are_
     assert not at.error
 
 
+def test_the_calibrate_pages_design_points_are_capped_before_run_as_the_cli_caps_them(
+        store_file, monkeypatch):
+    # 100000 design points were started: the page said "calibrating ..." for minutes while
+    # the design's 500000 run requests were built, its Cancel unheard
+    import sys
+
+    from pidcore import defaults
+
+    calls: list = []
+    monkeypatch.setitem(sys.modules, "pidcore.calibrate", _fake_calibrate_module(calls))
+    files = [(f"c{f:g}_fill50.csv", mass_damper_csv(frequency_hz=f, seed=int(f)))
+             for f in (100.0, 200.0, 400.0)]
+    at = _upload(_app(), files)
+    at.button(key="save").click()
+    at.run()
+    cap = defaults.CALIBRATION_MAX_DESIGN_SIZE
+    at = _app_at({"calibration_fit": "baseline_loss_factor", "calibration_design": "100000"})
+    at.button(key="calibration_run").click()
+    at.run()
+    assert not at.exception
+    assert [e.value for e in at.error] == [
+        f"design points (0 = default): '100000', expected 0 to {cap}"]
+    assert calls == []  # refused on the page: nothing started
+    at.text_input(key="calibration_design").input(str(cap))
+    _run_calibration(at, store_file)
+    assert calls == [(3, ("baseline_loss_factor",), 4)]  # the cap itself is taken
+
+
 def test_the_calibrate_pages_measurements_table_names_every_numbers_unit(store_file):
     # the degrees of freedom of the standard error were headed by the field name,
     # "sdc_stderr_dof", without a unit
