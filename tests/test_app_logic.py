@@ -2798,3 +2798,77 @@ def test_the_dem_pages_steady_cycles_are_capped_as_the_cli_caps_them():
                                              rf"expected 0 to {defaults.DEM_MAX_STEADY_CYCLES}$"):
         dem_page._config("1", "0", "1e9")
     assert dem_page._config("1", "0", "10000").steady_cycles == defaults.DEM_MAX_STEADY_CYCLES
+
+
+def test_a_calibration_a_stop_of_the_app_ended_is_said_after_a_restart_with_its_kept_runs(
+        tmp_path):
+    # the DEM tab lists its jobs a stop of the app ended as interrupted; a calibration it ended
+    # vanished from the Calibrate page, though the DEM runs it had saved were kept
+    import threading
+    import types
+
+    from pidcore.app import jobs
+    from pidcore.app.calibration import (
+        CalibrationRunner,
+        calibration_journal_path,
+        dismiss_interrupted_calibrations,
+        interrupted_calibrations,
+    )
+    from pidcore.calibrate import MeasuredPoint
+    from pidcore.interrupt import raise_if_stopped
+    from pidcore.store import Store
+
+    store = tmp_path / "s.h5"
+    record = {"frequency_hz": 500.0, "acceleration_g": 5.0, "fill_percent": 50.0,
+              "material": "acrylic", "direction": "z", "sdc": 0.1, "sdc_stderr": 0.01}
+    Store(store).add_dem_run("run_a", record)  # the one design run saved before the stop
+    designed = threading.Event()
+
+    def calibrate(points, *, on_design, stop, **kwargs):  # the library, stopped mid-runs
+        on_design(["run_a", "run_b", "run_c", "run_a"])
+        designed.set()
+        stop.wait(30)
+        raise_if_stopped(stop, "calibration stopped")
+
+    api = types.SimpleNamespace(calibrate=calibrate)
+    points = [MeasuredPoint(500, 5, 50, 0.6), MeasuredPoint(1000, 5, 50, 0.6),
+              MeasuredPoint(500, 1, 50, 0.2)]
+
+    def started(runner: CalibrationRunner):
+        task = runner.start(api, points, fit=["fixture_mass_kg"], cells=2, design_size=7)
+        assert designed.wait(30)
+        designed.clear()
+        return task
+
+    runner = CalibrationRunner(store)
+    started(runner)
+    assert interrupted_calibrations(store) == []  # running on a live server: its own page says
+    runner.stop_and_wait(10, at_exit=True)  # the app's exit (SIGTERM, Ctrl-C) stops it
+    assert runner.task.state == "cancelled"
+    assert interrupted_calibrations(store) == []  # the server still runs
+    jobs._LIVE_RUNNERS.discard(runner.owner.runner)  # the server's process is gone
+    [said] = interrupted_calibrations(store)
+    # run_a is kept (3 distinct runs in the design): counted from the store itself
+    assert (said.fit, said.n_points, said.runs_total, said.runs_kept) == \
+        (("fixture_mass_kg",), 3, 3, 1)
+    when = time.strftime("%Y-%m-%d %H:%M", time.localtime(runner.task.started))
+    assert said.text("s.h5") == (
+        f"The calibration of paper_coupon (fixture_mass_kg; 3 load case(s), 2 cells per DEM "
+        f"run, 7 design points) started {when} was interrupted by a stop of the app; no "
+        "calibration was saved. Its 1 finished DEM run(s) of 3 are kept in s.h5: running the "
+        "same calibration again reuses them and computes the other 2.")
+    # the restarted server's own calibration, cancelled by its user, leaves nothing to say
+    # later, and leaves the interrupted one as it was
+    again = CalibrationRunner(store)
+    started(again)
+    assert again.cancel()
+    deadline = time.monotonic() + 10
+    while again.task.state == "running":
+        assert time.monotonic() < deadline
+        time.sleep(0.02)
+    jobs._LIVE_RUNNERS.discard(again.owner.runner)
+    assert interrupted_calibrations(store) == [said]
+    dismiss_interrupted_calibrations(store)
+    assert interrupted_calibrations(store) == []
+    assert not calibration_journal_path(store).exists()
+    assert Store(store).has_dem_run("run_a")  # its runs stay

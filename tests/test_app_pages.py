@@ -1978,6 +1978,26 @@ def test_the_calibrate_pages_design_points_are_capped_before_run_as_the_cli_caps
     assert calls == [(3, ("baseline_loss_factor",), 4)]  # the cap itself is taken
 
 
+def test_the_calibrate_page_says_a_calibration_a_stop_of_the_app_interrupted(store_file):
+    # a calibration running when the app stopped vanished from the page after the restart
+    from pidcore.app import calibration, jobs
+
+    dead = jobs.JournalOwner.of_this_process()  # a runner token no live runner holds
+    calibration._change_journal(store_file, dead, {
+        "specimen": "paper_coupon", "fit": ["friction"], "n_points": 5, "cells": 2,
+        "design_size": None, "started": 0.0, "run_keys": []})
+    at = _app()
+    said = [w.value for w in at.warning if "interrupted by a stop of the app" in w.value]
+    assert said == [calibration.interrupted_calibrations(store_file)[0].text(store_file.name)]
+    assert said[0].startswith("The calibration of paper_coupon (friction; 5 load case(s), 2 "
+                              "cells per DEM run, the default design) started ")
+    assert said[0].endswith("no calibration was saved; it had started no DEM run.")
+    at.button(key="calibration_dismiss_interrupted").click()
+    at.run()
+    assert not [w for w in at.warning if "interrupted by a stop of the app" in w.value]
+    assert not calibration.calibration_journal_path(store_file).exists()
+
+
 def test_the_calibrate_pages_measurements_table_names_every_numbers_unit(store_file):
     # the degrees of freedom of the standard error were headed by the field name,
     # "sdc_stderr_dof", without a unit

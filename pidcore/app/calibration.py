@@ -36,6 +36,8 @@ from ..interrupt import StopRequested
 if TYPE_CHECKING:  # pragma: no cover
     import pandas as pd
 
+    from .jobs import JournalOwner
+
 #: Module the page wraps.
 CALIBRATE_MODULE = "pidcore.calibrate"
 #: Functions and tables the page needs from it.
@@ -254,6 +256,9 @@ class CalibrationTask:
     stop: threading.Event = field(default_factory=threading.Event, repr=False, compare=False)
     #: The calibration is being saved in the store: too late for a cancel.
     saving: bool = False
+    #: Stopped by the app's exit, not by a Cancel: its journal entry is left for the restarted
+    #: app to say (:func:`interrupted_calibrations`).
+    stopped_at_exit: bool = False
 
     def elapsed_s(self) -> float:
         """Seconds since the start (to the end once finished)."""
@@ -295,10 +300,15 @@ class CalibrationRunner:
     """One calibration at a time for one store, in a background thread."""
 
     def __init__(self, store_path: str | Path) -> None:
+        from .jobs import JournalOwner
+
         self.store_path = Path(store_path)
         self._lock = threading.Lock()
         self.task: CalibrationTask | None = None
         self._thread: threading.Thread | None = None
+        #: This runner in the calibration journal (:func:`interrupted_calibrations`).
+        self.owner = JournalOwner.live_of_this_process()
+        self._entry: dict = {}  # the running calibration's journal entry
 
     def start(self, api, points: Sequence, *, fit: Sequence[str], cells: int,
               design_size: int | None, specimen=None,
@@ -314,6 +324,12 @@ class CalibrationRunner:
                 return None
             task = self.task = CalibrationTask(tuple(fit), len(points),
                                                specimen_label(specimen))
+            # kept beside the store while it runs: a restarted app says it was interrupted
+            self._entry = {"specimen": task.specimen, "fit": list(task.fit),
+                           "n_points": task.n_points, "cells": cells,
+                           "design_size": design_size, "started": task.started,
+                           "run_keys": []}
+            _change_journal(self.store_path, self.owner, self._entry)
             _stop_at_exit_registered()
             _STARTED.add(self)
             self._thread = threading.Thread(
@@ -323,21 +339,23 @@ class CalibrationRunner:
             self._thread.start()
         return task
 
-    def cancel(self) -> bool:
+    def cancel(self, *, at_exit: bool = False) -> bool:
         """Ask the running calibration to stop (True if one runs): its running DEM runs are
         stopped within a fraction of a second and discarded, every saved run is kept for a
-        later calibration to reuse, and no calibration is saved."""
+        later calibration to reuse, and no calibration is saved. ``at_exit``: the app is
+        stopping, no one cancelled: the restarted app says it was interrupted."""
         with self._lock:
             if self.task is None or self.task.state != "running" or self.task.saving:
                 return False
             self.task.cancel_requested = True
+            self.task.stopped_at_exit = self.task.stopped_at_exit or at_exit
             self.task.stop.set()
             return True
 
-    def stop_and_wait(self, timeout_s: float) -> None:
+    def stop_and_wait(self, timeout_s: float, *, at_exit: bool = False) -> None:
         """Cancel the running calibration and wait up to ``timeout_s`` for its thread to end
         (its DEM workers then are gone)."""
-        self.cancel()
+        self.cancel(at_exit=at_exit)
         thread = self._thread
         if thread is not None and thread is not threading.current_thread():
             thread.join(timeout_s)
@@ -361,7 +379,7 @@ class CalibrationRunner:
             result = api.calibrate(
                 points, fit=fit, store_path=self.store_path, cells=cells,
                 design_size=design_size, progress=False,
-                on_design=lambda keys: task.design(keys, self.store_path),
+                on_design=lambda keys: self._design(task, keys),
                 on_run_done=task.run_done, stop=task.stop, **given)
             if notes:
                 result.notes = [*notes, *result.notes]
@@ -390,6 +408,142 @@ class CalibrationRunner:
         with self._lock:
             task.outputs, task.state, task.message = outputs, state, message
             task.store_key, task.finished = key, time.time()
+        if not task.stopped_at_exit:  # ended here and said here: nothing left to say later
+            _change_journal(self.store_path, self.owner, None)
+
+    def _design(self, task: CalibrationTask, keys: Sequence[str]) -> None:
+        """``calibrate(on_design=)``: the design's run keys in the journal entry (what an
+        interrupted calibration kept is counted from them), then the task told."""
+        self._entry = {**self._entry, "run_keys": list(dict.fromkeys(keys))}
+        _change_journal(self.store_path, self.owner, self._entry)
+        task.design(keys, self.store_path)
+
+
+#: The journal of a store's running calibrations: ``<store>`` + this suffix, beside the store
+#: as the DEM jobs' (:data:`pidcore.app.jobs.JOURNAL_SUFFIX`), and changed under that one's
+#: lock. A calibration lives in its server's memory: without it, one a stop of the app ended
+#: vanished from the Calibrate page, though the DEM runs it saved are kept.
+CALIBRATION_JOURNAL_SUFFIX = ".calibrations.json"
+#: Layout version written into the calibration journal.
+_CALIBRATION_JOURNAL_VERSION = 1
+
+
+def calibration_journal_path(store_path: str | Path) -> Path:
+    """The journal of a store's running calibrations: ``<store>.calibrations.json``."""
+    path = Path(store_path)
+    return path.with_name(path.name + CALIBRATION_JOURNAL_SUFFIX)
+
+
+def _journal_calibrations(path: Path) -> list[tuple[dict, object]]:
+    """The entries of a calibration journal with the owner each names (None: none); none
+    where there is no journal or it cannot be read (it is rewritten by the next change)."""
+    import json
+
+    from .jobs import JournalOwner
+
+    try:
+        doc = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return []
+    if not isinstance(doc, dict) or doc.get("pidcore_calibrations_version") != \
+            _CALIBRATION_JOURNAL_VERSION or not isinstance(doc.get("calibrations"), list):
+        return []
+    return [(entry, JournalOwner.from_document(entry.get("owner")))
+            for entry in doc["calibrations"] if isinstance(entry, dict)]
+
+
+def _change_journal(store_path: str | Path, owner: JournalOwner | None, entry: dict | None, *,
+                    keep=lambda other: True) -> None:
+    """Replace ``owner``'s entry of the store's calibration journal with ``entry`` (None:
+    remove it; an owner of None: the entries naming none), keeping the others that ``keep``
+    keeps; the file is removed once it holds
+    none. A journal that cannot be changed costs the notice after a restart, never the
+    calibration: nothing is raised."""
+    import json
+
+    from ..atomic_files import write_atomically
+    from ..errors import PidcoreError
+    from .jobs import exclusive_journal_lock
+
+    path = calibration_journal_path(store_path)
+    try:
+        with exclusive_journal_lock(store_path):  # two servers on one store: one at a time
+            others = [e for e, o in _journal_calibrations(path) if o != owner and keep(e)]
+            if entry is not None:
+                others.append({**entry, "owner": owner.document()})
+            if others:
+                write_atomically(path, json.dumps(
+                    {"pidcore_calibrations_version": _CALIBRATION_JOURNAL_VERSION,
+                     "calibrations": others}, indent=1))
+            else:
+                path.unlink(missing_ok=True)
+    except (OSError, PidcoreError, TypeError, ValueError):
+        pass
+
+
+@dataclass(frozen=True)
+class InterruptedCalibration:
+    """A calibration that was running when its app server stopped (read from the store's
+    calibration journal): no calibration was saved, the DEM runs it saved are kept."""
+
+    specimen: str
+    fit: tuple[str, ...]
+    n_points: int
+    cells: object
+    design_size: object
+    started: float
+    runs_total: int
+    runs_kept: int
+
+    def text(self, store_name: str) -> str:
+        """What the Calibrate page says of it."""
+        when = time.strftime("%Y-%m-%d %H:%M", time.localtime(self.started))
+        design = (f"{self.design_size} design points" if self.design_size
+                  else "the default design")
+        what = (f"The calibration of {self.specimen or 'the paper coupon'} "
+                f"({', '.join(self.fit)}; {self.n_points} load case(s), {self.cells} cells per "
+                f"DEM run, {design}) started {when} was interrupted by a stop of the app; no "
+                "calibration was saved")
+        if not self.runs_total:
+            return f"{what}; it had started no DEM run."
+        return (f"{what}. Its {self.runs_kept} finished DEM run(s) of {self.runs_total} are "
+                f"kept in {store_name}: running the same calibration again reuses them and "
+                f"computes the other {self.runs_total - self.runs_kept}.")
+
+
+def interrupted_calibrations(store_path: str | Path) -> list[InterruptedCalibration]:
+    """The calibrations of the store's journal whose app server stopped (or crashed) while
+    they ran, oldest first; those of a server still running (this one's included) are not."""
+    from ..dem.persist import stored_keys
+    from ..errors import PidcoreError
+    from .jobs import _still_runs
+
+    found = []
+    for entry, owner in _journal_calibrations(calibration_journal_path(store_path)):
+        if _still_runs(owner):
+            continue
+        try:
+            keys = [k for k in entry.get("run_keys") or () if isinstance(k, str)]
+            kept = len(stored_keys(store_path, keys)) if keys and Path(store_path).is_file() \
+                else 0
+            started = float(entry.get("started"))
+            found.append(InterruptedCalibration(
+                str(entry.get("specimen") or ""), tuple(str(n) for n in entry.get("fit") or ()),
+                int(entry.get("n_points") or 0), entry.get("cells"), entry.get("design_size"),
+                started if math.isfinite(started) else 0.0, len(keys), kept))
+        except (TypeError, ValueError, OverflowError, PidcoreError):
+            continue  # a damaged entry (or store): dismissed with the others
+    return sorted(found, key=lambda c: c.started)
+
+
+def dismiss_interrupted_calibrations(store_path: str | Path) -> None:
+    """Forget the interrupted calibrations of the store's journal (their runs stay stored);
+    the running ones' entries are kept."""
+    from .jobs import JournalOwner, _still_runs
+
+    _change_journal(store_path, None, None,
+                    keep=lambda entry: _still_runs(JournalOwner.from_document(
+                        entry.get("owner"))))
 
 
 def _save(api, result, store_path: Path) -> tuple[str, str]:
@@ -447,9 +601,9 @@ def _stop_at_exit_registered() -> None:
 def _stop_calibrations_at_exit() -> None:
     runners = list(_STARTED)
     for runner in runners:  # every stop first: they end side by side
-        runner.cancel()
+        runner.cancel(at_exit=True)
     for runner in runners:
-        runner.stop_and_wait(EXIT_STOP_WAIT_S)
+        runner.stop_and_wait(EXIT_STOP_WAIT_S, at_exit=True)
 
 
 def runner_for(store_path: str | Path) -> CalibrationRunner:

@@ -258,6 +258,15 @@ class JournalOwner:
         return cls(socket.gethostname(), os.getpid(), psutil.Process().create_time(),
                    secrets.token_hex(8))
 
+    @classmethod
+    def live_of_this_process(cls) -> JournalOwner:
+        """A new owner of this process that is :meth:`alive` as long as the process runs: a
+        runner's (the DEM jobs', a calibration's), whose entries another server, or this one
+        after a restart, reads as interrupted once the process is gone."""
+        owner = cls.of_this_process()
+        _LIVE_RUNNERS.add(owner.runner)
+        return owner
+
     def document(self) -> dict:
         """The owner as the journal stores it."""
         return dataclasses.asdict(self)
@@ -320,8 +329,7 @@ class DemJobRunner:
         self._wake = threading.Condition(self._lock)
         self._cancel: set[str] = set()
         #: This runner in the journal (:class:`JournalOwner`).
-        self.owner = JournalOwner.of_this_process()
-        _LIVE_RUNNERS.add(self.owner.runner)
+        self.owner = JournalOwner.live_of_this_process()
         #: Why the journal could not be read or written ("" : all well).
         self.journal_problem = ""
         self._jobs: list[DemJob] = []

@@ -108,8 +108,27 @@ def render(stores, stored) -> None:
     if api is None:
         st.info(f"Calibration is not available: {reason}.")
         return
+    _interrupted(stores)
     _calibrate(stores, api)
     _saved(stored)  # also where nothing can be calibrated now (no measurement saved yet)
+
+
+def _interrupted(stores) -> None:
+    """The calibrations a stop of the app ended (as the DEM tab lists its interrupted
+    jobs): what each was, and that the DEM runs it saved are kept for a re-run."""
+    from pidcore.app.calibration import (
+        dismiss_interrupted_calibrations,
+        interrupted_calibrations,
+    )
+
+    found = interrupted_calibrations(stores.path)
+    for calibration in found:
+        st.warning(calibration.text(stores.path.name))
+    if found and st.button(f"Dismiss interrupted ({len(found)})",
+                           key="calibration_dismiss_interrupted",
+                           help="its saved DEM runs stay in the store"):
+        dismiss_interrupted_calibrations(stores.path)
+        st.rerun()
 
 
 def _calibrate(stores, api) -> None:
