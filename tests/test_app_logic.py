@@ -2843,7 +2843,9 @@ def test_a_calibration_a_stop_of_the_app_ended_is_said_after_a_restart_with_its_
     runner = CalibrationRunner(store)
     started(runner)
     assert interrupted_calibrations(store) == []  # running on a live server: its own page says
-    runner.stop_and_wait(10, at_exit=True)  # the app's exit (SIGTERM, Ctrl-C) stops it
+    # the app's exit (SIGTERM, Ctrl-C) stops it, as its exit hook does: every stop, then waits
+    assert runner.cancel(at_exit=True)
+    runner.stop_and_wait(10, at_exit=True)
     assert runner.task.state == "cancelled"
     assert interrupted_calibrations(store) == []  # the server still runs
     jobs._LIVE_RUNNERS.discard(runner.owner.runner)  # the server's process is gone
@@ -2857,11 +2859,12 @@ def test_a_calibration_a_stop_of_the_app_ended_is_said_after_a_restart_with_its_
         f"run, 7 design points) started {when} was interrupted by a stop of the app; no "
         "calibration was saved. Its 1 finished DEM run(s) of 3 are kept in s.h5: running the "
         "same calibration again reuses them and computes the other 2.")
-    # the restarted server's own calibration, cancelled by its user, leaves nothing to say
-    # later, and leaves the interrupted one as it was
+    # the restarted server's own calibration, cancelled by its user (and then the app
+    # stopped), leaves nothing to say later, and leaves the interrupted one as it was
     again = CalibrationRunner(store)
     started(again)
     assert again.cancel()
+    again.cancel(at_exit=True)
     deadline = time.monotonic() + 10
     while again.task.state == "running":
         assert time.monotonic() < deadline

@@ -347,8 +347,10 @@ class CalibrationRunner:
         with self._lock:
             if self.task is None or self.task.state != "running" or self.task.saving:
                 return False
+            # a Cancel clicked before the exit's stop is the user's: nothing to say later
+            self.task.stopped_at_exit = self.task.stopped_at_exit or (
+                at_exit and not self.task.cancel_requested)
             self.task.cancel_requested = True
-            self.task.stopped_at_exit = self.task.stopped_at_exit or at_exit
             self.task.stop.set()
             return True
 
