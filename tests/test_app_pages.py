@@ -1914,17 +1914,23 @@ def test_the_dem_form_comes_back_from_the_page_address_and_bad_values_are_refuse
     assert [e.value for e in at.error] == want[:1]
 
 
-def test_the_calibrate_form_comes_back_from_the_page_address_and_bad_values_are_refused(
-        store_file, monkeypatch):
+def _three_load_cases_saved_for_a_fake_calibration(monkeypatch) -> list:
+    """Three load cases saved through the page, the calibration library faked: the calls it
+    records (cells, fit, load cases)."""
     import sys
 
     calls: list = []
     monkeypatch.setitem(sys.modules, "pidcore.calibrate", _fake_calibrate_module(calls))
-    files = [(f"c{f:g}_fill50.csv", mass_damper_csv(frequency_hz=f, seed=int(f)))
-             for f in (100.0, 200.0, 400.0)]
-    at = _upload(_app(), files)
+    at = _upload(_app(), [(f"c{f:g}_fill50.csv", mass_damper_csv(frequency_hz=f, seed=int(f)))
+                          for f in (100.0, 200.0, 400.0)])
     at.button(key="save").click()
     at.run()
+    return calls
+
+
+def test_the_calibrate_form_comes_back_from_the_page_address_and_bad_values_are_refused(
+        store_file, monkeypatch):
+    calls = _three_load_cases_saved_for_a_fake_calibration(monkeypatch)
     # the reload: a new session at the address the form wrote
     at = _app_at({"calibration_fit": "baseline_loss_factor", "calibration_cells": "3",
                   "calibration_design": "6"})
@@ -1954,17 +1960,9 @@ def test_the_calibrate_pages_design_points_are_capped_before_run_as_the_cli_caps
         store_file, monkeypatch):
     # 100000 design points were started: the page said "calibrating ..." for minutes while
     # the design's 500000 run requests were built, its Cancel unheard
-    import sys
-
     from pidcore import defaults
 
-    calls: list = []
-    monkeypatch.setitem(sys.modules, "pidcore.calibrate", _fake_calibrate_module(calls))
-    files = [(f"c{f:g}_fill50.csv", mass_damper_csv(frequency_hz=f, seed=int(f)))
-             for f in (100.0, 200.0, 400.0)]
-    at = _upload(_app(), files)
-    at.button(key="save").click()
-    at.run()
+    calls = _three_load_cases_saved_for_a_fake_calibration(monkeypatch)
     cap = defaults.CALIBRATION_MAX_DESIGN_SIZE
     at = _app_at({"calibration_fit": "baseline_loss_factor", "calibration_design": "100000"})
     at.button(key="calibration_run").click()
