@@ -86,9 +86,10 @@ def _column(frame: pd.DataFrame, name: str, default: object = "") -> pd.Series:
 
 
 def _specimens(names: pd.Series, hashes: pd.Series) -> list[str]:
-    from ..specimen import hashed_name
+    # the one labelling of a recorded name and hash (a name already hashed kept as it is)
+    from ..specimen import tested_label
 
-    return [hashed_name(str(n or ""), h) if isinstance(h, str) and h else str(n or "")
+    return [tested_label(str(n or ""), h if isinstance(h, str) else "")
             for n, h in zip(names.fillna(""), hashes, strict=True)]
 
 
