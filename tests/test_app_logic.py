@@ -2875,3 +2875,14 @@ def test_a_calibration_a_stop_of_the_app_ended_is_said_after_a_restart_with_its_
     assert interrupted_calibrations(store) == []
     assert not calibration_journal_path(store).exists()
     assert Store(store).has_dem_run("run_a")  # its runs stay
+
+
+def test_a_calibration_journal_nested_past_the_stack_is_read_as_none(tmp_path):
+    # its own reader caught OSError and ValueError only: JSON nested deeper than Python's
+    # stack (json.loads is recursive) raised RecursionError through the Calibrate page; it is
+    # read by the DEM jobs' reader now, which refuses a damaged journal as a whole
+    from pidcore.app.calibration import calibration_journal_path, interrupted_calibrations
+
+    store = tmp_path / "s.h5"
+    calibration_journal_path(store).write_text("[" * 100_000 + "]" * 100_000)
+    assert interrupted_calibrations(store) == []

@@ -432,26 +432,21 @@ _CALIBRATION_JOURNAL_VERSION = 1
 
 def calibration_journal_path(store_path: str | Path) -> Path:
     """The journal of a store's running calibrations: ``<store>.calibrations.json``."""
-    path = Path(store_path)
-    return path.with_name(path.name + CALIBRATION_JOURNAL_SUFFIX)
+    from .jobs import journal_path
+
+    return journal_path(store_path, CALIBRATION_JOURNAL_SUFFIX)
 
 
 def _journal_calibrations(path: Path) -> list[tuple[dict, object]]:
     """The entries of a calibration journal with the owner each names (None: none); none
-    where there is no journal or it cannot be read (it is rewritten by the next change)."""
-    import json
+    where there is no journal or it cannot be read (it is rewritten by the next change): the
+    DEM jobs' reader, whose refusals of a damaged journal (JSON nested past the stack
+    included) hold for this one too."""
+    from .jobs import _journal_entries
 
-    from .jobs import JournalOwner
-
-    try:
-        doc = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        return []
-    if not isinstance(doc, dict) or doc.get("pidcore_calibrations_version") != \
-            _CALIBRATION_JOURNAL_VERSION or not isinstance(doc.get("calibrations"), list):
-        return []
-    return [(entry, JournalOwner.from_document(entry.get("owner")))
-            for entry in doc["calibrations"] if isinstance(entry, dict)]
+    entries, _ = _journal_entries(path, kind="calibrations",
+                                  version=_CALIBRATION_JOURNAL_VERSION)
+    return [(entry, owner) for entry, owner in entries if isinstance(entry, dict)]
 
 
 def _change_journal(store_path: str | Path, owner: JournalOwner | None, entry: dict | None, *,

@@ -773,10 +773,11 @@ def _settle_saved_before_stop(jobs: Sequence[DemJob], store_path: Path) -> None:
                        "store, not run again")
 
 
-def journal_path(store_path: str | Path) -> Path:
-    """The journal of a store's jobs: ``<store>.jobs.json`` beside it."""
+def journal_path(store_path: str | Path, suffix: str = JOURNAL_SUFFIX) -> Path:
+    """The journal of a store's jobs: ``<store>.jobs.json`` beside it (``suffix``: another
+    journal of the store's, e.g. its running calibrations')."""
     path = Path(store_path)
-    return path.with_name(path.name + JOURNAL_SUFFIX)
+    return path.with_name(path.name + suffix)
 
 
 def journal_lock_path(store_path: str | Path) -> Path:
@@ -962,23 +963,25 @@ _UNREADABLE = (OSError, ValueError, TypeError, KeyError, AttributeError, Recursi
                OverflowError, PidcoreError)
 
 
-def _journal_entries(path: Path) -> tuple[list[tuple[object, JournalOwner | None]], str]:
-    """The entries of a journal with the owner each names (None: none), and "" ; no journal:
-    ``([], "")``. One that cannot be read gives no entry and says why (it is JSON, parsed,
-    never executed; it is replaced by the next change)."""
+def _journal_entries(path: Path, *, kind: str = "jobs", version: int = _JOURNAL_VERSION
+                     ) -> tuple[list[tuple[object, JournalOwner | None]], str]:
+    """The entries of a journal beside a store with the owner each names (None: none), and
+    "" ; no journal: ``([], "")``. One that cannot be read gives no entry and says why (it is
+    JSON, parsed, never executed; it is replaced by the next change). ``kind``: its list's
+    key, ``"jobs"`` (the DEM jobs') or ``"calibrations"`` (the running calibrations' of
+    :mod:`pidcore.app.calibration`), of the layout ``version``."""
     if not path.is_file():
         return [], ""
     try:
         doc = json.loads(path.read_text(encoding="utf-8"))
-        if not isinstance(doc, dict) or doc.get("pidcore_jobs_version") != _JOURNAL_VERSION \
-                or not isinstance(doc.get("jobs"), list):
-            raise ValueError("not a pidcore job journal of version "
-                             f"{_JOURNAL_VERSION}")
+        if not isinstance(doc, dict) or doc.get(f"pidcore_{kind}_version") != version \
+                or not isinstance(doc.get(kind), list):
+            raise ValueError(f"not a pidcore {kind} journal of version {version}")
     except _UNREADABLE as exc:
         return [], (f"the job table of the last run of the app ({path}) cannot be read "
                     f"({type(exc).__name__}: {exc}); its saved runs are in the store")
     return [(entry, JournalOwner.from_document(entry.get("owner"))
-             if isinstance(entry, dict) else None) for entry in doc["jobs"]], ""
+             if isinstance(entry, dict) else None) for entry in doc[kind]], ""
 
 
 def read_journal(path: Path) -> tuple[list[DemJob], str]:
