@@ -641,9 +641,7 @@ def _check_scheduler(scheduler: str) -> None:
     # TypeError, a failed TLS handshake fatal: dask's words say which
     if type(error) is OSError or isinstance(error, (ValueError, TypeError,
                                                     FatalCommClosedError)):
-        raise ParameterError(f"scheduler {scheduler}: cannot connect to a dask.distributed "
-                             f"scheduler there ({' '.join(str(error).split())}); "
-                             f"{_EXPECTED_SCHEDULER}")
+        raise _cannot_connect(scheduler, error)
     if thread.is_alive() or isinstance(error, asyncio.TimeoutError):
         raise ParameterError(f"scheduler {scheduler}: the connection was accepted but no "
                              f"dask.distributed scheduler answered within {limit:g} s; "
@@ -661,6 +659,13 @@ def _check_scheduler(scheduler: str) -> None:
                              f"there, not a scheduler; {_EXPECTED_SCHEDULER}")
 
 
+def _cannot_connect(scheduler: str, error: BaseException) -> ParameterError:
+    """The one line of a connection to ``scheduler`` that failed, in dask's words."""
+    return ParameterError(f"scheduler {scheduler}: cannot connect to a dask.distributed "
+                          f"scheduler there ({' '.join(str(error).split())}); "
+                          f"{_EXPECTED_SCHEDULER}")
+
+
 def _run_dask(todo: Iterable[tuple[LoadCase, str]], config: DemConfig, scheduler: str,
               finish: Callable[[CaseOutcome], None], specimen: Specimen | None) -> None:
     from distributed import Client, as_completed  # there: _check_scheduler asked it
@@ -671,9 +676,7 @@ def _run_dask(todo: Iterable[tuple[LoadCase, str]], config: DemConfig, scheduler
     # connection raises: tls:// without a TLS configuration is a TypeError, which came out
     # as a traceback
     except Exception as exc:  # noqa: BLE001 - every failure to connect is one line
-        raise ParameterError(f"scheduler {scheduler}: cannot connect to a dask.distributed "
-                             f"scheduler there ({' '.join(str(exc).split())}); expected the "
-                             f"address of a running scheduler, e.g. tcp://host:8786") from None
+        raise _cannot_connect(scheduler, exc) from None
     try:
         futures = [client.submit(run_case, case, config, specimen, key=f"pidcore-{key}",
                                  pure=False)
