@@ -729,6 +729,26 @@ def test_report_downloads_hold_the_saved_numbers(tmp_path, good_csv, options):
     assert b"\\begin{" in files["tex"][1]
 
 
+
+def test_report_downloads_say_the_pool_choice_as_the_page_names_it(tmp_path, good_csv, options):
+    from pidcore.app.tabs.report import page_terms
+
+    rec = _record(good_csv, options, name="coupon.csv")
+    store_file = tmp_path / "store.h5"
+    uploads.save_records(store_file, [_file(rec, options)])
+    plain = report_files(store_file, pool=True)
+    files = report_files(store_file, pool=True, wording=page_terms)
+    # the library's keyword was in the files the app offered, where the page has a checkbox
+    assert b"pool=True" in plain["csv"][1]
+    for fmt in ("csv", "md", "html", "csv_provenance"):
+        assert b"pool=True" not in files[fmt][1], fmt
+    assert b"'pool DEM settings and specimens'" in files["csv"][1]
+    # only the words changed: the numbers are the same bytes
+    import io
+
+    assert pd.read_csv(io.BytesIO(files["csv"][1])).drop(columns="note").equals(
+        pd.read_csv(io.BytesIO(plain["csv"][1])).drop(columns="note"))
+
 # --- launching ---------------------------------------------------------------------------------
 
 def test_one_streamlit_config_matching_the_defaults():

@@ -10,6 +10,7 @@ import io
 import os
 import tempfile
 import zipfile
+from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -99,13 +100,15 @@ def _store_report(path: str | os.PathLike, dem_store: str | os.PathLike | None, 
 def report_files(path: str | os.PathLike, dem_store: str | os.PathLike | None = None, *,
                  analysis_keys: list[str] | None = None, pool: bool = False,
                  calibration: Calibration | None = None, specimen: Specimen | None = None,
+                 wording: Callable[[str], str] | None = None,
                  ) -> dict[str, tuple[str, bytes, str]]:
     """The report of :func:`store_report_table` as downloads: format -> (file name, bytes,
     MIME type), plus ``"csv_provenance"`` (the CSV's notes sidecar) and ``"zip"``: all of
     them with the ``figures/`` folder that the Markdown and LaTeX files link.
 
     Stores are verified first: a corrupt store raises :class:`pidcore.errors.StoreError` and
-    nothing is written.
+    nothing is written. ``wording``: the notes in the front-end's words, as
+    :func:`pidcore.report.make_report`'s (the app's: ``pool=True`` is its checkbox).
     """
     from ..compare import Tolerances
     from .pipeline import (
@@ -114,6 +117,7 @@ def report_files(path: str | os.PathLike, dem_store: str | os.PathLike | None = 
         report_figures,
         specimen_provenance,
         stored_parameters,
+        worded,
     )
     from .provenance import calibration_provenance, collect_provenance
     from .render import write_report
@@ -133,6 +137,8 @@ def report_files(path: str | os.PathLike, dem_store: str | os.PathLike | None = 
     main = opened[0] if stores and stores[0] == Path(path) else None
     figures = report_figures(table, runs, built.aligner,
                              measured_loops([], analyses, main, notes), opened, notes)
+    if wording is not None:
+        table, notes = worded(table, notes, wording)
     tol = Tolerances()
     # the seeds of the specimen's runs, those the table compared from
     seeds = sorted({int(s) for s in runs["seed"].dropna()}) \

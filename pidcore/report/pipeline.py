@@ -567,6 +567,19 @@ class SpecimenTable:
     aligner: Aligner
 
 
+def worded(table: pd.DataFrame, notes: Sequence[str], wording: Callable[[str], str]
+           ) -> tuple[pd.DataFrame, list[str]]:
+    """``table`` (its rows' ``note`` column and ``attrs["notes"]``) and ``notes`` in a
+    front-end's words (``wording``: :func:`pidcore.cli._vocabulary.cli_words` for the CLI,
+    :func:`pidcore.app.vocabulary.page_terms` for the app), as the report files say them."""
+    attrs = {**table.attrs, "notes": [wording(n) for n in table.attrs.get("notes", [])]}
+    if "note" in table.columns:
+        table = table.assign(note=[wording(n) if isinstance(n, str) else n
+                                   for n in table["note"]])
+    table.attrs = attrs
+    return table, [wording(n) for n in notes]
+
+
 def specimen_report_table(stored_runs: pd.DataFrame | None, analyses: pd.DataFrame | None, *,
                           specimen: Specimen | None = None, where: str | Path | None = None,
                           tolerances: Tolerances | None = None, pool: bool = False,
@@ -1076,12 +1089,7 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
     loops = measured_loops(results, analyses, main, notes)
     figures = report_figures(table, dem_runs, aligner, loops, dems, notes)
     if wording is not None:
-        notes = [wording(n) for n in notes]
-        attrs = {**table.attrs, "notes": [wording(n) for n in table.attrs.get("notes", [])]}
-        if "note" in table.columns:
-            table = table.assign(note=[wording(n) if isinstance(n, str) else n
-                                       for n in table["note"]])
-        table.attrs = attrs
+        table, notes = worded(table, notes, wording)
     try:
         seeds = []
         if dem_runs is not None and "seed" in dem_runs.columns:

@@ -126,7 +126,8 @@ def render(stores, calibrations: list) -> None:
         st.session_state["report_build"] = start_report_build(
             made, lambda: report_files(stores.path, stores.dem_reference, pool=pool,
                                        analysis_keys=None if keys is None else list(keys),
-                                       calibration=calibration, specimen=specimen),
+                                       calibration=calibration, specimen=specimen,
+                                       wording=page_terms),
             st.session_state.get("report_build"))
     build = st.session_state.get("report_build")
     if build is not None and build.of == made:  # files of an older state are not offered
