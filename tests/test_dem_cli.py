@@ -33,6 +33,16 @@ def test_readable_summary_names_units_and_particle_count(capsys):
     out = capsys.readouterr().out
     assert "11 of 22 acrylic particles per cell" in out and "J/cycle" in out and "[-]" in out
     assert "friction stick_slip, normal damping literal, start dense packing rest" in out
+    assert "filled" not in out  # 11 of 22 is the 50 % asked
+
+
+def test_the_summary_says_the_share_a_rounded_count_makes_of_the_cell(capsys):
+    # 75 % of 22 is 16.5 particles, run as 16 (round half to even, as the bundled grid):
+    # the summary said "fill 75 %" beside 16 of 22 without the 72.7 % they are
+    args = [a if a != "50" else "75" for a in ARGS]
+    assert main(args) == 0
+    out = capsys.readouterr().out
+    assert "fill 75 % (16 of 22 acrylic particles per cell, 72.7 % filled, reference" in out
 
 
 def test_one_cell_has_no_standard_error_and_says_why(capsys):

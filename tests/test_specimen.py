@@ -327,3 +327,30 @@ def test_a_utf16_file_behind_its_byte_order_mark_is_the_same_specimen(tmp_path, 
     path.write_bytes(text.encode("utf-16-le"))
     with pytest.raises(ParameterError, match=r"^.*notepad\.toml: not valid TOML"):
         load_specimen(path)
+
+
+@pytest.mark.parametrize(("fill", "count", "shown"), [(25.0, 6, "27.3 % filled"),
+                                                      (75.0, 16, "72.7 % filled"),
+                                                      (50.0, 11, None)])
+def test_a_stated_fill_the_rounded_count_does_not_make_is_shown_beside_its_share(
+        tmp_path, capsys, fill, count, shown):
+    # 25 % and 75 % of the 22 that fit are 5.5 and 16.5 particles: rounded to the even count
+    # (6 and 16, the counts of the bundled grid), two shares the check did not print
+    import json
+
+    from pidcore.cli import main
+    from pidcore.specimen import describe
+
+    path = tmp_path / "filled.toml"
+    path.write_text(PAPER.to_toml().replace("[particles]\n",
+                                            f"[particles]\nfill_percent = {fill}\n", 1))
+    facts = describe(load_specimen(path))
+    assert facts["capacity_per_cell"] == 22 and facts["particles_per_cell"] == count
+    assert facts["fill_percent"] == fill
+    assert facts["filled_percent"] == pytest.approx(100 * count / 22, rel=1e-15)
+    assert main(["specimen", "check", str(path)]) == 0
+    particles = next(line for line in capsys.readouterr().out.splitlines()
+                     if line.startswith("particles "))
+    assert (shown in particles) if shown else ("filled" not in particles), particles
+    assert main(["specimen", "check", str(path), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["filled_percent"] == facts["filled_percent"]

@@ -461,7 +461,7 @@ def _tangential_stiffness_model(result) -> str:
 def format_summary(result, *, reused: bool = False) -> str:
     """Readable multi-line summary with units."""
     from ..dem.result import stderr_from_batches
-    from ..specimen import hashed_name
+    from ..specimen import filled_share, hashed_name
     from ..units import display_value_with_error
 
     c = result.case
@@ -470,7 +470,9 @@ def format_summary(result, *, reused: bool = False) -> str:
     lines = [
         f"DEM load case   {c.frequency_hz:g} Hz, {c.acceleration_g:g} g, fill "
         f"{c.fill_percent:g} % ({result.particles_per_cell} of {result.particles_full_cell} "
-        f"{material} particles per cell, reference {result.config.fill_reference}), "
+        f"{material} particles per cell"
+        f"{filled_share(c.fill_percent, result.particles_per_cell, result.particles_full_cell)}, "
+        f"reference {result.config.fill_reference}), "
         f"drive along {c.direction}",
     ]
     if s is not None:

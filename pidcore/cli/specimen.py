@@ -128,7 +128,8 @@ def format_facts(f: dict, source: str) -> str:
         "model damper) is per",
         f"gaps            wall to wall {f['wall_to_wall_gap_m'] * 1e3:.4g} mm, floor to "
         f"ceiling {f['floor_to_ceiling_gap_m'] * 1e3:.4g} mm beside one particle",
-        f"particles       {f['particles_per_cell']} per cell ({f['particles_per_cell_basis']}), "
+        f"particles       {f['particles_per_cell']} per cell ({f['particles_per_cell_basis']}"
+        f"{_share(f)}), "
         f"radius {f['particle_radius_m'] * 1e3:.4g} mm (diameter "
         f"{2 * f['particle_radius_m'] * 1e3:.4g} mm), {f['particle_mass_kg'] * 1e3:.4g} g "
         f"each, {f['particles_mass_kg'] * 1e3:.4g} g in the coupon",
@@ -152,6 +153,15 @@ def format_facts(f: dict, source: str) -> str:
         "that as dt)",
         *(f"note: {note}" for note in f["notes"]),
     ])
+
+
+def _share(f: dict) -> str:
+    # a stated fill that the rounded count does not make (75 % of 22 is 16: 72.7 %)
+    if f["particles_per_cell_basis"] != "fill_percent":
+        return ""
+    from ..specimen import filled_share
+
+    return filled_share(f["fill_percent"], f["particles_per_cell"], f["capacity_per_cell"])
 
 
 def _reference_case(f: dict) -> str:
