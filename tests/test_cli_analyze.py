@@ -271,9 +271,19 @@ def test_a_force_in_kn_under_n_of_a_file_stating_no_fill_is_refused_too(tmp_path
     err = capsys.readouterr().err
     assert "below 1/20 of the specimen's coupon and fixture (22.15 g)" in err
     assert not (tmp_path / "s.h5").exists()
-    # the true record (0.25 kg, over 20 x the coupon but with particles of unknown mass: no
-    # upper limit without the fill) is taken
+    # the true record (0.25 kg, over 20 x the coupon but within 20 x the coupon with every
+    # cell full of particles: the fill could explain it) is taken
     assert main(["analyze", str(export(tmp_path / "true.csv", fmt="csv")), "--no-store"]) == 0
+    # a force in N under "kN" (250 kg shown) had no upper limit without the fill, and was
+    # saved; full cells of the paper's coupon hold 22 x 441 acrylic spheres of r 1.25 mm
+    # (Table 1's 1180 kg/m^3) beside its 22.15 g structure
+    full_g = 1e3 * (22 * 441 * 4 / 3 * math.pi * 1.25e-3**3 * 1180 + 0.0221534)
+    path = export(tmp_path / "mn.csv", fmt="csv", force_unit_scale=1e3)
+    assert main(["analyze", str(path), "--store", str(tmp_path / "s.h5")]) == 2
+    err = capsys.readouterr().err
+    assert (f"over 20 x the specimen's coupon, fixture and particles of full cells (no fill "
+            f"stated) ({full_g:.4g} g)") in err
+    assert not (tmp_path / "s.h5").exists()
 
 
 def test_identical_files_stating_different_load_cases_are_refused_before_saving(tmp_path,

@@ -89,6 +89,10 @@ class SdcBound:
     #: words for it (:func:`recorded_sdc_bound`); not part of the bound's value, so that the
     #: bound stored with a record equals its file's
     origin: str = field(default="", compare=False)
+    #: the particles of every cell full (kg) where the fill is not known but the specimen is:
+    #: the most a unit slip is judged against (a force in N under "kN" of a file stating no
+    #: fill showed a 50 kg vibrated mass on a 22 g coupon, and was saved); NaN otherwise
+    full_particle_mass_kg: float = field(default=math.nan, compare=False)
 
     @property
     def known(self) -> bool:
@@ -165,7 +169,9 @@ def sdc_bound(*, fill_percent: float | None, material: str | None = None,
     if fill_percent is None or not math.isfinite(float(fill_percent)) or fill_percent <= 0:
         # the bound is 2 pi, but the structure is known without the fill: a unit slip is
         # judged by it (a force in kN under "N" of a file stating no fill was saved)
-        return SdcBound(SDC_UPPER_BOUND, math.nan, tested.coupon.moving_mass_kg)
+        full = tested.capacity_per_cell() * tested.cell.count * tested.particles.mass_kg
+        return SdcBound(SDC_UPPER_BOUND, math.nan, tested.coupon.moving_mass_kg,
+                        full_particle_mass_kg=full)
     try:
         per_cell, _ = particles_per_cell(float(fill_percent), specimen=tested)
     except PidcoreError:  # a fill the DEM refuses (its own message says so elsewhere)
@@ -287,8 +293,10 @@ def check_analysis(analysis, *, bound: SdcBound | None = None
         # comparison with the DEM) does not: a force in kN under "N" pooled SDCs 1000 x apart.
         # The vibrated mass Im(P_c) shows is then 1000 x off what the specimen can show
         low = bound.structure_mass_kg / VIBRATED_MASS_SLIP_FACTOR
-        # without the fill, the particles' mass is not known: no upper limit
-        high = (bound.structure_mass_kg + bound.particle_mass_kg) * VIBRATED_MASS_SLIP_FACTOR
+        # without the fill, the particles' mass is at most a full cell's
+        stated = math.isfinite(bound.particle_mass_kg)
+        particles = bound.particle_mass_kg if stated else bound.full_particle_mass_kg
+        high = (bound.structure_mass_kg + particles) * VIBRATED_MASS_SLIP_FACTOR
         if vibrated_kg < low or vibrated_kg > high:
             out.append(PlausibilityWarning(
                 "vibrated_mass_off",
@@ -297,7 +305,8 @@ def check_analysis(analysis, *, bound: SdcBound | None = None
                 + (f"below 1/{VIBRATED_MASS_SLIP_FACTOR:g} of the specimen's coupon and "
                    f"fixture ({bound.structure_mass_kg * 1e3:.4g} g)" if vibrated_kg < low else
                    f"over {VIBRATED_MASS_SLIP_FACTOR:g} x the specimen's coupon, fixture and "
-                   f"particles ({(high / VIBRATED_MASS_SLIP_FACTOR) * 1e3:.4g} g)"),
+                   + ("particles" if stated else "particles of full cells (no fill stated)")
+                   + f" ({(high / VIBRATED_MASS_SLIP_FACTOR) * 1e3:.4g} g)"),
                 "a force, velocity or time in another unit than its header says (kN under "
                 "'N', mm/s under 'm/s', ms under 's': check the channel units or give "
                 "force_unit=UNIT, velocity_unit=UNIT or time_unit=UNIT), or another "
