@@ -282,3 +282,32 @@ def test_a_58b_record_declaring_more_samples_than_its_block_holds_is_refused(tmp
     with pytest.raises(InputFileError, match=r"num_pts\.uff: record 1 holds 10240 of its 10340 "
                                              r"samples; the file is truncated or corrupt"):
         read_measurement(bad)
+
+
+def test_a_metadata_block_longer_than_the_first_read_is_read_past(tmp_path, monkeypatch):
+    # 68 kB of '#' metadata lines before the header (a Testlab export with its channel
+    # table) was refused as "no rows of numbers in its 65 lines" of a file of ~1000 lines
+    import numpy as np
+
+    from pidcore.io import delimited
+
+    rows = "\n".join(f"{k / 1000},{np.sin(k / 7):.9g},{np.cos(k / 7):.9g}" for k in range(1000))
+    table = "Time [s],Force [N],Velocity [m/s]\n" + rows + "\n"
+    plain = tmp_path / "plain.csv"
+    plain.write_text(table)
+    meta = "".join(f"# channel {i}: sensitivity {i * 1.01:.4f} mV/N, serial {i:08d} "
+                   f"{'x' * 40}\n" for i in range(700))
+    assert len(meta.encode()) > 4 * 2**14  # past the 64 KiB first read
+    long = tmp_path / "long_meta.csv"
+    long.write_text(meta + table)
+    expected = read_measurement(plain).channels
+    got = read_measurement(long).channels
+    for a, b in zip(got, expected, strict=True):
+        assert (a.name, a.quantity, a.sample_rate_hz) == (b.name, b.quantity, b.sample_rate_hz)
+        np.testing.assert_array_equal(a.data, b.data)  # the same numbers, bit for bit
+    # beyond the most read, the refusal says that it read the first part only (the count of
+    # lines was of the first 64 KiB, though the file held ten times more)
+    monkeypatch.setattr(delimited, "_HEAD_MAX_BYTES", 2**16)
+    with pytest.raises(InputFileError, match=r"no rows of numbers in the first 0\.0625 MiB of "
+                                             r"the file, its first \d+ lines"):
+        read_measurement(long)

@@ -63,6 +63,9 @@ _LINE_BREAK = re.compile(r"\r\n|\n|\r")
 #: this allows some 400 000 columns; pandas' tokenizer holds a whole line in memory several
 #: times over, and a 500 MB file of one line took 1.6 GB before it was refused.
 MAX_LINE_BYTES = 16 * 2**20
+#: Most bytes read to find the first rows of numbers: a header line as long as a line may be
+#: and a MiB of lines around it.
+_HEAD_MAX_BYTES = MAX_LINE_BYTES + 2**20
 _SCAN_CHUNK_BYTES = 1 << 20
 
 
@@ -227,8 +230,17 @@ def _looks_like_unit(cell: str) -> bool:
     return not text or text.lower() in {"-", "1", "none"} or _unit_key(text) is not None
 
 
-def _layout(lines: list[str], where: str) -> tuple[int, str, list[str], list[str], str]:
-    """Index of the first data line, delimiter, names, units and decimal mark."""
+class _HeadTooShort(Exception):
+    """The head read holds no three rows of numbers yet, and more of the file can be read."""
+
+
+def _layout(lines: list[str], where: str, *, read_bytes: int | None = None,
+            more: bool = False) -> tuple[int, str, list[str], list[str], str]:
+    """Index of the first data line, delimiter, names, units and decimal mark.
+
+    ``read_bytes``: the lines are the first that many bytes of a longer file (None: all of
+    it); ``more``: a longer head can be read, so a head without rows of numbers raises
+    :class:`_HeadTooShort` rather than refusing the file."""
     candidates = [i for i, ln in enumerate(lines) if ln.strip()]
     first = None
     for pos, i in enumerate(candidates):
@@ -237,15 +249,19 @@ def _layout(lines: list[str], where: str) -> tuple[int, str, list[str], list[str
         if all(_is_numeric_row(ln, delimiter) for ln in window):
             first = i
             break
+    if first is None and more:
+        raise _HeadTooShort
     if first is None:  # a bad cell in the first rows: let the parser name it
         first = next((i for i in candidates if _is_numeric_row(lines[i], _delimiter([lines[i]]))),
                      None)
     if first is None:
+        lines_of = "its" if read_bytes is None else (
+            f"the first {read_bytes / 2**20:.3g} MiB of the file, its first")
         # "header but no data rows" was said of any text without a row of numbers: a report
         # CSV, a TOML file, a load-case table of 40 rows
         # the first line quoted whole up to 60 characters (62 with its quotes)
         what = "header but no data rows" if len(candidates) == 1 else \
-            f"no rows of numbers in its {len(candidates)} lines (the first: " \
+            f"no rows of numbers in {lines_of} {len(candidates)} lines (the first: " \
             f"{clipped(repr(lines[candidates[0]].strip()), 62)})" if candidates \
             else "no rows of numbers"
         raise InputFileError(f"{where}: {what}; expected a header row such as "
@@ -345,21 +361,33 @@ def read_csv(path: str | os.PathLike[str], *, sample_rate_hz: float | None = Non
     """
     where = str(path)
     given_time = given_time_unit(time_unit)
-    with open(path, "rb") as fh:
-        head = fh.read(_HEAD_BYTES)
-        complete = not fh.read(1)
-    if not head.strip():
-        raise InputFileError(f"{where}: empty file; expected a header row such as "
-                             "'Time [s],Force [N],Velocity [m/s]' and data rows")
-    encoding = _encoding(head)
-    if "\x00" in head[:4096].decode("latin-1") and not encoding.startswith("utf-16"):
-        raise InputFileError(f"{where}: binary content; expected delimited text")
-    text = codecs.getincrementaldecoder(encoding)(errors="replace").decode(head, final=complete)
-    lines = _LINE_BREAK.split(text)
-    if not complete:
-        lines = lines[:-1]  # possibly cut
-    first, delimiter, header_cells, unit_cells, decimal = _layout(lines, where)
     _check_line_lengths(path, where)
+    # the head grows until it holds the first rows of numbers: a metadata block of 68 kB
+    # (or one header line of 5 MB) before them was refused as "no rows of numbers in its
+    # 65 lines" of a file of 3961 lines
+    size = _HEAD_BYTES
+    while True:
+        with open(path, "rb") as fh:
+            head = fh.read(size)
+            complete = not fh.read(1)
+        if not head.strip():
+            raise InputFileError(f"{where}: empty file; expected a header row such as "
+                                 "'Time [s],Force [N],Velocity [m/s]' and data rows")
+        encoding = _encoding(head)
+        if "\x00" in head[:4096].decode("latin-1") and not encoding.startswith("utf-16"):
+            raise InputFileError(f"{where}: binary content; expected delimited text")
+        text = codecs.getincrementaldecoder(encoding)(errors="replace").decode(head,
+                                                                             final=complete)
+        lines = _LINE_BREAK.split(text)
+        if not complete:
+            lines = lines[:-1]  # possibly cut
+        try:
+            first, delimiter, header_cells, unit_cells, decimal = _layout(
+                lines, where, read_bytes=None if complete else len(head),
+                more=not complete and size < _HEAD_MAX_BYTES)
+            break
+        except _HeadTooShort:
+            size *= 4
     notes: list[str] = []
     try:
         # skiprows skips raw lines (blank ones included), as counted by _LINE_BREAK
