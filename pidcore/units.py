@@ -359,6 +359,10 @@ def why_not_a_time_unit(text: str) -> str | None:
     reading = read_unit(text)
     if reading.info is not None and reading.info.quantity == "time":
         return None
+    if reading.quantity not in (None, "time"):
+        # a unit of another quantity: 'furlong' was refused as "not a plausible displacement
+        # unit (expected 1e-12 to 1 m per unit)", rules the user never gave a unit for
+        return ""
     return f": {reading.problem}" if reading.problem else ""
 
 

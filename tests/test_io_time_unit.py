@@ -133,6 +133,14 @@ def test_a_time_unit_that_is_no_time_is_refused(tmp_path, capsys):
     assert err == ("pidcore analyze: error: --time-unit 'MS': not a unit of time: 'MS' is "
                    "ambiguous: unit prefixes are case-sensitive, and it reads as ms (0.001 s) "
                    "or Ms (1e+06 s); expected s, ms or us")
+    # a unit of another quantity is only that: 'furlong' was refused with the plausible range
+    # of a displacement unit, which the user never gave
+    with pytest.raises(ParameterError) as info:
+        read_measurement(SAMPLE_UFF, time_unit="furlong")
+    assert str(info.value) == "time_unit='furlong': not a unit of time; expected s, ms or us"
+    # an implausible unit of time still says why (an hour per sample)
+    with pytest.raises(ParameterError, match=r"'h' is 3600 s, not a plausible time unit"):
+        read_measurement(SAMPLE_UFF, time_unit="h")
 
 
 # --- CSV, MATLAB and HDF5 time bases -------------------------------------------------------
