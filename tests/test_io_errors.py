@@ -311,3 +311,164 @@ def test_a_metadata_block_longer_than_the_first_read_is_read_past(tmp_path, monk
     with pytest.raises(InputFileError, match=r"no rows of numbers in the first 0\.0625 MiB of "
                                              r"the file, its first \d+ lines"):
         read_measurement(long)
+
+
+#: 100 Hz at 5 kHz: 50 samples a period, 205 periods in 10 250 samples, which fill neither
+#: a 6E13.5 nor a 4E20.12 last line (2 values in each).
+_FS, _F, _N = 5000.0, 100.0, 10250
+#: Velocity lagging the force by 80 deg: the loss factor is cot(80 deg) (paper Eq. 11,
+#: P_c = 1/2 F0 V0 e^{j phi}).
+_PHI = np.radians(80.0)
+
+
+def _force_and_velocity() -> Measurement:
+    t = np.arange(_N) / _FS
+    return Measurement("m", (
+        Channel("Force", "force", 10.0 * np.sin(2 * np.pi * _F * t), _FS, "N"),
+        Channel("Velocity", "velocity", 0.05 * np.sin(2 * np.pi * _F * t - _PHI), _FS, "m/s")))
+
+
+def _loss_factor(path) -> float:
+    from pidcore.measure import analyze_measurement
+
+    return analyze_measurement(read_measurement(path)).analysis.loss_factor
+
+
+def _write_ascii_uff(path, ord_data_type: int) -> list[str]:
+    """The force and velocity as ASCII UFF 58 lines: ordinate data type 2 (6E13.5 a line) or
+    4 (4E20.12 a line)."""
+    import pyuff
+
+    from pidcore.io.uff import _dataset_58
+
+    sets = []
+    for i, ch in enumerate(_force_and_velocity().channels):
+        d = _dataset_58(ch, i)
+        d["ord_data_type"] = ord_data_type
+        sets.append(d)
+    pyuff.UFF(str(path)).write_sets(sets, mode="add", force_double=ord_data_type == 4)
+    return path.read_text().splitlines(keepends=True)
+
+
+def _data_lines(lines: list[str], record: int) -> range:
+    """Indices of the data lines of ``record`` (from 0): after its 13 header lines (the
+    opening '-1' and '58' included), before its closing '-1'."""
+    tags = [k for k, line in enumerate(lines) if line.strip() == "-1"]
+    return range(tags[2 * record] + 13, tags[2 * record + 1])
+
+
+# 6 significant digits a sample (E13.5, relative rounding 5e-6): the phase is off by some
+# 5e-6 rad at most, cot(80 deg) by 5e-6 / sin^2(80 deg) of 0.18, 3e-5 of it; 1e-4 is far
+# below the 87 % and 128 % errors of a shifted record
+_ASCII_LF_RTOL = 1e-4
+
+
+@pytest.mark.parametrize(("ord_data_type", "per_line"), [(2, 6), (4, 4)],
+                         ids=["E13.5", "E20.12"])
+def test_a_uff_record_holding_a_line_more_than_its_header_states_is_refused(
+        tmp_path, ord_data_type, per_line):
+    good = tmp_path / "good.uff"
+    lines = _write_ascii_uff(good, ord_data_type)
+    assert _loss_factor(good) == pytest.approx(1 / np.tan(_PHI), rel=_ASCII_LF_RTOL)
+    # one line of the velocity written twice: its values were cut to num_pts, the rest of
+    # the record read shifted by a line (a loss factor of 0.0067 for 0.05), unsaid
+    middle = _data_lines(lines, 1)[len(_data_lines(lines, 1)) // 2]
+    bad = tmp_path / "twice.uff"
+    bad.write_text("".join(lines[:middle + 1] + lines[middle:]))
+    with pytest.raises(InputFileError) as info:
+        read_measurement(bad)
+    said = str(info.value)
+    assert said == (f"{bad}: record 2 holds {_N + per_line} samples where its header states "
+                    f"{_N} (record 7, field 2); only zeros padding its last line may follow "
+                    "them; the file is corrupt"), said
+
+
+@pytest.mark.parametrize(("ord_data_type", "per_line", "field"),
+                         [(2, 6, "%13.5e"), (4, 4, "%20.11e")], ids=["E13.5", "E20.12"])
+def test_only_zeros_filling_the_last_line_of_a_uff_record_are_dropped(
+        tmp_path, ord_data_type, per_line, field):
+    lines = _write_ascii_uff(tmp_path / "good.uff", ord_data_type)
+    fill = per_line - _N % per_line  # 4 fields of E13.5, 2 of E20.12
+
+    def padded(with_value: float, count: int) -> list[str]:
+        out = list(lines)
+        for record in (0, 1):
+            last = _data_lines(out, record)[-1]
+            out[last] = out[last].rstrip("\n") + field % with_value * count + "\n"
+        return out
+
+    # zeros to the end of the last line, as UFFFiles.jl's real force record has them
+    zeros = tmp_path / "zeros.uff"
+    zeros.write_text("".join(padded(0.0, fill)))
+    assert [c.n_samples for c in read_measurement(zeros).channels] == [_N, _N]
+    assert _loss_factor(zeros) == pytest.approx(1 / np.tan(_PHI), rel=_ASCII_LF_RTOL)
+    # a value that is not zero is a sample the header does not count: no padding
+    ones = tmp_path / "ones.uff"
+    ones.write_text("".join(padded(1.0, fill)))
+    with pytest.raises(InputFileError, match=rf"ones\.uff: record 1 holds {_N + fill} samples "
+                                             rf"where its header states {_N} "):
+        read_measurement(ones)
+    # nor are zeros a whole line holds (a silent stretch written twice): no last line's fill
+    line = tmp_path / "line.uff"
+    line.write_text("".join(padded(0.0, fill + per_line)))
+    with pytest.raises(InputFileError, match=rf"line\.uff: record 1 holds "
+                                             rf"{_N + fill + per_line} samples where"):
+        read_measurement(line)
+
+
+def _binary_force_block(tmp_path) -> tuple[bytes, int, int]:
+    """The force and velocity as 58b (float64): the file's bytes and the first and end byte
+    of the force record's samples, which its closing '    -1' follows at once."""
+    good = tmp_path / "good.uff"
+    write_measurement(_force_and_velocity(), good, "uff", binary=True)
+    raw = good.read_bytes()
+    start = 0
+    for _ in range(13):  # the header lines, its opening '-1' included
+        start = raw.index(b"\n", start) + 1
+    end = start + 8 * _N
+    assert b"    58b" in raw[:start] and raw[end:end + 7] == b"    -1\n"
+    # float64 samples, noise-free: 1e-9 of the analytic loss factor
+    assert _loss_factor(good) == pytest.approx(1 / np.tan(_PHI), rel=1e-9)
+    return raw, start, end
+
+
+@pytest.mark.parametrize(("change", "found"), [("short", 8 * _N - 24), ("long", 8 * _N + 24)])
+def test_a_58b_block_of_another_size_than_its_id_line_states_is_refused(tmp_path, change,
+                                                                       found):
+    raw, start, end = _binary_force_block(tmp_path)
+    middle = (start + end) // 2
+    # 24 bytes lost or written twice: the samples were read from the header on as if whole,
+    # shifted past that point (a loss factor 13 % low, 31 % high), unsaid
+    bad = tmp_path / f"{change}.uff"
+    bad.write_bytes(raw[:middle] + raw[middle + 24:] if change == "short"
+                    else raw[:middle] + raw[middle:middle + 24] + raw[middle:])
+    with pytest.raises(InputFileError) as info:
+        read_measurement(bad)
+    said = str(info.value)
+    assert said == (f"{bad}: record 1 ('Force') holds {found} bytes of binary samples before "
+                    f"its closing '    -1' where its ID line states {8 * _N}; the file is "
+                    "truncated or corrupt"), said
+
+
+@pytest.mark.parametrize("between", [b"\r\n", b"\n", b"  \r\n"], ids=["CRLF", "LF", "blanks"])
+def test_line_breaks_between_58b_samples_and_their_closing_tag_are_read_past(tmp_path,
+                                                                            between):
+    # MPSTD's DAQ writes CR LF there (the real fixture, pyuff's fix_58b case)
+    raw, _, end = _binary_force_block(tmp_path)
+    path = tmp_path / "breaks.uff"
+    path.write_bytes(raw[:end] + between + raw[end:])
+    assert [c.n_samples for c in read_measurement(path).channels] == [_N, _N]
+    assert _loss_factor(path) == pytest.approx(1 / np.tan(_PHI), rel=1e-9)
+
+
+def test_a_58b_id_line_counting_more_bytes_than_num_pts_samples_is_refused(tmp_path):
+    # block and ID line agree on 3 samples more than record 7's num_pts: the 3 were dropped
+    raw, _, end = _binary_force_block(tmp_path)
+    stated = f"{8 * _N:12d}".encode()
+    assert raw.count(stated) >= 1 and raw.index(stated) < end
+    bad = tmp_path / "more.uff"
+    bad.write_bytes((raw[:end] + raw[end - 24:end] + raw[end:]).replace(
+        stated, f"{8 * _N + 24:12d}".encode(), 1))
+    with pytest.raises(InputFileError, match=rf"more\.uff: record 1 holds {_N + 3} samples "
+                                             rf"where its header states {_N} "):
+        read_measurement(bad)

@@ -21,8 +21,10 @@ pyuff reads them, bit for bit) instead of through Python lists. What this module
   (8, 9, 11, 12, 13, 15) with the dataset 164 unit factors of the file (SI when the file has no
   dataset 164), noted; otherwise (a label no table reads: ``"V^2"``, ``"lb"``) the channel keeps
   its values with quantity ``"unknown"``, whose unit the analysis asks for.
-* Quirks handled: the zero padding of the last data line (values beyond ``num_pts`` are
-  dropped), an extra CR LF after 58b binary data (pyuff ignores the stray bytes), E13.5 fields
+* Quirks handled: the zero padding of the last data line (zeros beyond ``num_pts``, fewer
+  than a line holds, are dropped; more values, or others, are refused as corrupt), blanks and
+  line breaks between 58b binary data and its closing ``-1`` (an extra CR LF; a block of
+  another size than its ID line states is refused), E13.5 fields
   without separating blanks and 3-digit exponents (pyuff reads fixed columns), header text
   that is not UTF-8 (read as Windows-1252, as Windows exporters write ``µm/s`` and
   ``Prüfling``: decoded with replacement, the unit was refused and the name could not be
@@ -203,12 +205,30 @@ def _describe(set_types: list[int], func_types: list[int]) -> str:
     return f"datasets {', '.join(str(t) for t in seen)} ({', '.join(words)})"
 
 
+def _last_line_padding(dset: dict, extra: np.ndarray) -> bool:
+    """Whether the values past a record's ``num_pts`` are the zeros that fill its last ASCII
+    line (``UFFFiles.jl``'s force record: 4098 values for 4096 samples, 6 to a line): fewer
+    than a line holds. A binary record has no lines to fill."""
+    width = _ASCII_58_WIDTHS.get(int(dset.get("ord_data_type", 0) or 0))
+    if dset.get("binary") or width is None:
+        return False
+    if int(dset.get("abscissa_spacing", 1)) != 1:
+        width += _ASCII_58_WIDTHS[2]  # (abscissa E13.5, ordinate) pairs
+    return extra.size < _ASCII_58_LINE_COLUMNS // width and not np.any(extra)
+
+
 def _record_channel(dset: dict, index: int, where: str, unit_factors: tuple[float, float],
                     time_unit: UnitReading | None) -> Channel:
     num_pts = int(dset["num_pts"])
     if num_pts < 1:  # values[:num_pts] would keep all but |num_pts| samples, or none
         raise InputFileError(f"{where}: record {index + 1} declares {num_pts} samples (record "
                              "7, field 2); expected a positive number of samples")
+    if "binary_block_bytes" in dset:
+        stated, found = dset["binary_block_bytes"]
+        raise InputFileError(f"{where}: record {index + 1} ({_channel_name(dset, index)!r}) "
+                             f"holds {found} bytes of binary samples before its closing "
+                             f"'    -1' where its ID line states {stated}; the file is "
+                             "truncated or corrupt")
     values = np.asarray(dset["data"])
     if np.iscomplexobj(values):
         raise InputFileError(f"{where}: record {index + 1} is a time record with complex "
@@ -216,7 +236,12 @@ def _record_channel(dset: dict, index: int, where: str, unit_factors: tuple[floa
     if values.size < num_pts:
         raise InputFileError(f"{where}: record {index + 1} holds {values.size} of its "
                              f"{num_pts} samples; the file is truncated or corrupt")
-    # Writers pad the last E13.5 line with zeros; the header's num_pts is authoritative.
+    if values.size > num_pts and not _last_line_padding(dset, values[num_pts:]):
+        # a line written twice or a num_pts too small: cut to num_pts, the record read on
+        # shifted (a loss factor of 0.0067 for 0.05) where the rest was dropped unsaid
+        raise InputFileError(f"{where}: record {index + 1} holds {values.size} samples where "
+                             f"its header states {num_pts} (record 7, field 2); only zeros "
+                             "padding its last line may follow them; the file is corrupt")
     values = values[:num_pts].astype(np.float64, copy=False)
     time_factor = _time_factor(
         dset, f"{where}: record {index + 1} ({_channel_name(dset, index)!r})", time_unit)
@@ -355,10 +380,13 @@ def _utf8_text(raw: bytes) -> str:
         return raw.decode("cp1252", errors="replace")
 
 
-def _binary_58_record(path: str | os.PathLike[str], start: int) -> dict | None:
-    """The dataset 58b record whose block starts at byte ``start``: its header parsed by
-    pyuff, its samples read straight from the file into one array. None for a record this
-    does not read (ASCII, complex, uneven abscissa): pyuff reads those whole.
+def _binary_58_record(path: str | os.PathLike[str], start: int, end: int) -> dict | None:
+    """The dataset 58b record whose block starts at byte ``start`` and whose closing
+    ``'    -1'`` is at byte ``end``: its header parsed by pyuff, its samples read straight
+    from the file into one array. None for an ASCII record and for one this does not read
+    (complex, uneven abscissa): pyuff reads those whole. A record whose binary block is not
+    the size its ID line states comes back with its header and ``binary_block_bytes``
+    (stated, found) instead of samples, for :func:`_record_channel` to refuse.
 
     pyuff unpacks 58b samples into a tuple of Python floats (32 bytes a sample) and keeps
     the abscissa as a second float64 array: reading a 10-minute export of two channels at
@@ -376,17 +404,49 @@ def _binary_58_record(path: str | os.PathLike[str], start: int) -> dict | None:
         dtype = _BINARY_DTYPES.get((int(dset.get("ord_data_type", 0)),
                                     int(dset.get("byte_ordering", 0))))
         num_pts = int(dset.get("num_pts", 0))
-        if dtype is None or int(dset.get("abscissa_spacing", 0)) != 1 or num_pts < 1:
+        readable = dtype is not None and int(dset.get("abscissa_spacing", 0)) == 1 \
+            and num_pts >= 1
+        # the block's bytes as the ID line states them (field 6), else as num_pts does
+        stated = int(dset.get("n_bytes", 0) or 0)
+        if stated <= 0 and readable:
+            stated = num_pts * np.dtype(dtype).itemsize
+        if stated > 0:
+            # a block 24 bytes short or long was read from the header on as if whole,
+            # silently (a loss factor 13 % low or 31 % high): the closing tag tells
+            found = _binary_block_misfit(fh, fh.tell(), end, stated)
+            if found is not None:
+                dset["binary_block_bytes"] = (stated, found)
+                return dset
+        if not readable:
             return None
-        # no further than the block's binary bytes the ID line states (field 6), which is
-        # where pyuff ends the block: a num_pts (record 7) larger than they hold read the
-        # next dataset's header as samples (1e-157 ...), silently kept where that record
-        # was not the last of the file; a short read is refused by _record_channel
-        n_bytes = int(dset.get("n_bytes", 0) or 0)
-        count = num_pts if n_bytes <= 0 else min(num_pts, n_bytes // np.dtype(dtype).itemsize)
-        values = np.fromfile(fh, dtype=dtype, count=count)
+        # all the block holds: samples beyond num_pts (an ID line's count above it) are
+        # refused by _record_channel, as fewer are
+        values = np.fromfile(fh, dtype=dtype, count=stated // np.dtype(dtype).itemsize)
     dset["data"] = values.astype(np.float64, copy=False)
     return dset
+
+
+#: Blanks and line breaks allowed between 58b data and its closing tag: the format puts the
+#: tag right after the data, MPSTD's DAQ writes CR LF first (pyuff's fix_58b case).
+_BLOCK_END_BLANKS = b" \r\n"
+#: Bytes before a 58b closing tag looked at for those blanks and line breaks.
+_BLOCK_END_LOOKBACK = 256
+
+
+def _binary_block_misfit(fh, data_start: int, tag: int, stated: int) -> int | None:
+    """None where the 58b data from byte ``data_start`` ends ``stated`` bytes on with only
+    blanks and line breaks up to its closing tag at byte ``tag``; else the bytes found
+    before the tag, those blanks and line breaks not counted. ``fh`` is left at
+    ``data_start``."""
+    gap = tag - data_start
+    look = max(0, min(gap, _BLOCK_END_LOOKBACK))
+    fh.seek(tag - look)
+    tail = fh.read(look)
+    fh.seek(data_start)
+    # data may end in bytes that read as blanks (a float whose last byte is 0x20): the
+    # stated end need only fall among the blanks and line breaks before the tag
+    found = gap - (len(tail) - len(tail.rstrip(_BLOCK_END_BLANKS)))
+    return None if found <= stated <= gap else max(found, 0)
 
 
 #: Bytes an ASCII dataset 58 holds in its data lines where pidcore parses them (digits,
@@ -395,6 +455,8 @@ _ASCII_58_DATA_BYTES = np.zeros(256, dtype=bool)
 _ASCII_58_DATA_BYTES[list(b"0123456789+-.Ee \r\n")] = True
 #: Field width of ASCII 58 real ordinates by ordinate data type: 2 E13.5, 4 E20.12.
 _ASCII_58_WIDTHS = {2: 13, 4: 20}
+#: Columns of an ASCII 58 data line: 6E13.5, 4E20.12, 2(E13.5,E20.12) fill at most 80.
+_ASCII_58_LINE_COLUMNS = 80
 #: Bytes of data lines read and parsed at a time (their masks: some 5x this, transient).
 _ASCII_58_CHUNK_BYTES = 1 << 18
 
@@ -557,7 +619,8 @@ def read_uff(path: str | os.PathLike[str], *, time_unit: str | None = None) -> M
         try:
             dset = None
             if set_type == 58 and hasattr(uff, "_block_ind"):  # pyuff's block offsets
-                dset = _binary_58_record(path, int(uff._block_ind[i][0])) \
+                dset = _binary_58_record(path, int(uff._block_ind[i][0]),
+                                         int(uff._block_ind[i][1]) + 1) \
                     or _ascii_58_record(path, int(uff._block_ind[i][0]),
                                         int(uff._block_ind[i][1]))
             if dset is None:
