@@ -416,6 +416,85 @@ def test_mat_lms_testlab_signal_struct(tmp_path):
         np.testing.assert_array_equal(ch.data, col)
 
 
+def _testlab_signal(name: str, values: np.ndarray, quantity: dict) -> dict:
+    return {"x_values": {"start_value": 0.0, "increment": 1 / 1024.0,
+                         "number_of_values": values.size},
+            "y_values": {"values": values, "quantity": quantity},
+            "function_record": {"name": name}}
+
+
+def _testlab_mat(path, *signals: dict):
+    cell = np.empty((1, len(signals)), dtype=object)
+    for i, signal in enumerate(signals):
+        cell[0, i] = signal
+    scipy.io.savemat(path, {"Signal": cell})
+    return path
+
+
+def test_mat_lms_testlab_values_stored_in_si_and_shown_in_g_are_read_in_si_and_said(tmp_path):
+    # Test.Lab stores SI and shows the label's unit, display = SI x factor: read as g, the
+    # acceleration was 9.8 x too large (49 g for 5 g), silently
+    acc = 49.03325 * np.sin(np.arange(64) / 3.0)  # 5 g in m/s^2
+    vel = 0.078 * np.cos(np.arange(64) / 3.0)  # m/s
+    path = _testlab_mat(tmp_path / "shown.mat",
+                        _testlab_signal("Point1:+Z", acc, {"label": "g", "unit_transformation": {
+                            "factor": 0.10197, "offset": 0.0, "log_reference": 1.0}}),
+                        _testlab_signal("LDV", vel, {"label": "mm/s", "unit_transformation": {
+                            "factor": 1000.0, "offset": 0.0}}))
+    m = read_measurement(path)
+    # the values as stored, bit for bit: the SI unit's factor is exactly 1
+    np.testing.assert_array_equal(m.channel("Point1:+Z").data, acc)
+    np.testing.assert_array_equal(m.channel("LDV").data, vel)
+    assert [(c.quantity, c.source_unit) for c in m.channels] == [("acceleration", "m/s^2"),
+                                                                 ("velocity", "m/s")]
+    assert m.metadata["reader_notes"] == [
+        f"{path}: Signal(1) ('Point1:+Z'): y_values: values read in m/s^2: the file stores them "
+        "in SI and shows them in 'g' (label; unit_transformation.factor 0.10197 = 1/9.80665)",
+        f"{path}: Signal(2) ('LDV'): y_values: values read in m/s: the file stores them in SI "
+        "and shows them in 'mm/s' (label; unit_transformation.factor 1000 = 1/0.001)"]
+    # a factor of 1 says the values are in the label's unit, as before
+    same = read_measurement(_testlab_mat(tmp_path / "in_g.mat", _testlab_signal(
+        "Point1:+Z", acc, {"label": "g", "unit_transformation": {"factor": 1.0}})))
+    np.testing.assert_allclose(same.channels[0].data, acc * STANDARD_GRAVITY, rtol=1e-15)
+    assert "reader_notes" not in same.metadata
+
+
+@pytest.mark.parametrize(("quantity", "said", "expected"), [
+    ({"label": "g", "unit_transformation": {"factor": 0.5}}, "'g' (label) with "
+     "unit_transformation factor 0.5 and offset 0",
+     "factor 1 (values in 'g') or factor 0.101972 (values in SI, shown in 'g')"),
+    ({"label": "g", "unit_transformation": {"factor": 0.10197, "offset": 1.0}}, "'g' (label) "
+     "with unit_transformation factor 0.10197 and offset 1",
+     "factor 1 (values in 'g') or factor 0.101972 (values in SI, shown in 'g') and offset 0"),
+    # a bare quantity name is its SI unit: no factor but 1 shows it otherwise
+    ({"label": "Acceleration", "unit_transformation": {"factor": 0.10197}}, "'m/s^2' (label "
+     "'Acceleration') with unit_transformation factor 0.10197 and offset 0",
+     "factor 1 (values in 'm/s^2')"),
+    ({"label": "N", "unit": "g", "unit_transformation": {"factor": 0.10197}}, "'g' (unit) and "
+     "'N' (label) with unit_transformation factor 0.10197 and offset 0",
+     "units of one quantity"),
+], ids=["factor of neither reading", "offset", "quantity name shown otherwise",
+        "units of two quantities"])
+def test_mat_lms_testlab_transformation_of_neither_reading_is_refused(tmp_path, quantity, said,
+                                                                      expected):
+    path = _testlab_mat(tmp_path / "odd.mat", _testlab_signal("Acc", np.ones(16), quantity))
+    with pytest.raises(InputFileError) as info:
+        read_measurement(path)
+    assert str(info.value) == (f"{path}: Signal(1) ('Acc'): y_values: quantity states {said}; "
+                               f"expected {expected}")
+
+
+def test_mat_lms_testlab_temperature_with_an_offset_is_kept_as_read(tmp_path):
+    # a unit pidcore does not read is never taken as SI (no role takes it without an option):
+    # its offset (degC shown from K) refuses nothing
+    temperature = np.full(16, 296.15)
+    path = _testlab_mat(tmp_path / "temp.mat", _testlab_signal("Temp", temperature, {
+        "label": "degC", "unit_transformation": {"factor": 1.0, "offset": -273.15}}))
+    (ch,) = read_measurement(path).channels
+    assert (ch.quantity, ch.source_unit) == ("unknown", "degC")
+    np.testing.assert_array_equal(ch.data, temperature)
+
+
 def test_mat_v73_hdf5_simple_layout(tmp_path):
     """A v7.3 file is HDF5 behind a 512-byte MATLAB text header; arrays are column-major."""
     path = tmp_path / "v73.mat"

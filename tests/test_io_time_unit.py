@@ -240,6 +240,23 @@ def test_a_testlab_increment_in_ms_is_read_in_ms(tmp_path):
     assert read_measurement(seconds).channels[0].sample_rate_hz == pytest.approx(RATE_HZ / 1e3)
 
 
+def test_a_testlab_increment_stored_in_s_and_shown_in_ms_is_read_in_s(tmp_path):
+    # Test.Lab stores SI and shows the label's unit (display = SI x factor): an increment in s
+    # under 'ms' with factor 1000 read as ms gave a rate 1000 x too high
+    force = np.loadtxt(SAMPLE_CSV, delimiter=",", skiprows=1)[:, 1]
+    path = tmp_path / "shown_ms.mat"
+    scipy.io.savemat(path, {"Signal": {
+        "x_values": {"start_value": 0.0, "increment": 1 / RATE_HZ, "number_of_values": force.size,
+                     "quantity": {"label": "ms", "unit_transformation": {"factor": 1000.0}}},
+        "y_values": {"values": force, "quantity": {"label": "N"}},
+        "function_record": {"name": "Force"}}})
+    m = read_measurement(path)
+    assert m.channels[0].sample_rate_hz == pytest.approx(RATE_HZ, rel=1e-12)
+    assert m.metadata["reader_notes"] == [
+        f"{path}: Signal(1): x_values: values read in s: the file stores them in SI and shows "
+        "them in 'ms' (label; unit_transformation.factor 1000 = 1/0.001)"]
+
+
 def test_a_testlab_increment_of_no_time_unit_is_refused_until_given(tmp_path):
     path = exported_testlab_mat(tmp_path / "msek.mat", {"label": "Time", "unit": "msek"})
     with pytest.raises(InputFileError) as info:

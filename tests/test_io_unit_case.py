@@ -263,6 +263,28 @@ def test_matlab_units_struct_keeps_its_case(tmp_path):
                                                                                  "Mm/s")
 
 
+def test_a_testlab_label_keeps_its_case(tmp_path):
+    # the label was lowercased before it was read: 'mN' refused as ambiguous ('mn': mN or
+    # MN), 'N' read as a corrected 'n' and stored so; only a bare quantity name ignores case
+    def read(label):
+        path = tmp_path / "label.mat"
+        scipy.io.savemat(path, {"Signal": {
+            "x_values": {"start_value": 0.0, "increment": 1e-3, "number_of_values": 8},
+            "y_values": {"values": np.full(8, 2.0), "quantity": {"label": label}},
+            "function_record": {"name": "Ch"}}})
+        return read_measurement(path)
+
+    milli = read("mN")
+    assert (milli.channels[0].quantity, milli.channels[0].source_unit) == ("force", "mN")
+    np.testing.assert_allclose(milli.channels[0].data, 2e-3, rtol=1e-15)
+    newton = read("N")
+    assert newton.channels[0].source_unit == "N" and "reader_notes" not in newton.metadata
+    for name in ("Acceleration", "ACCELERATION", "acceleration"):
+        ch = read(name).channels[0]
+        assert (ch.quantity, ch.source_unit) == ("acceleration", "m/s^2")
+        np.testing.assert_array_equal(ch.data, 2.0)  # SI, as Test.Lab exports
+
+
 # --- the spellings exporters write, against factors from their definitions -----------------
 
 INCH_M = 0.0254  # exact by definition (1959)

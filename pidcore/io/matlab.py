@@ -11,8 +11,15 @@ Three layouts are understood, tried in this order:
    ``y_values.values`` (one column per channel) and, where present,
    ``function_record.name`` (channel name; a cell of names for several columns) and the unit in
    ``y_values.quantity`` (fields ``unit``/``units``/``unit_label``, a unit struct
-   ``unit.label``, or ``quantity_terms(k).unit.label`` with exponents; only a bare ``label``
-   such as ``'Acceleration'`` is taken as that quantity in SI, the unit Test.Lab exports in).
+   ``unit.label``, or ``quantity_terms(k).unit.label`` with exponents, else ``label``, its
+   case kept: ``mN`` is no ``MN``; only a bare quantity name such as ``'Acceleration'``, in
+   any case, is taken as that quantity in SI, the unit Test.Lab exports in). Test.Lab may
+   store SI values and show them in the label's unit, ``quantity.unit_transformation.factor``
+   taking one to the other (display = SI x factor: ``'g'`` with 0.10197, ``'mm/s'`` with
+   1000): a factor that is the reciprocal of a stated unit's SI factor (within 1e-4) reads
+   the values in SI, with a note; a factor of 1, or none, reads them in the stated unit;
+   another factor, or an offset, on a unit pidcore reads is refused (a unit it does not
+   read, a temperature's, stays unknown). The same holds for ``x_values``.
    v7.3 struct *arrays* (``Signal(1)``, ``Signal(2)``, ...) are read like v5 ones.
 3. **simple layout**: a time vector ``time`` or ``t`` (s) plus one numeric vector per channel
    (the variable name is the channel name), optionally ``units`` as a struct
@@ -296,20 +303,84 @@ def _terms_unit(terms: object) -> str:
     return "*".join(parts)
 
 
-def _lms_unit(quantity_struct: object) -> str:
+#: Relative distance within which a Test.Lab ``unit_transformation.factor`` is 1, or the
+#: reciprocal of the SI factor of the unit it shows: Test.Lab writes 1/9.80665 as 0.10197
+#: (2e-5 off). A unit whose SI factor is within it of 1 reads alike either way.
+TRANSFORMATION_TOLERANCE = 1e-4
+
+
+def _lms_units(quantity_struct: object) -> list[tuple[str, str]]:
+    """The units a Test.Lab ``quantity`` states, as (field, unit), in the order they are taken:
+    a unit field, ``quantity_terms``, then ``label``. A label keeps its case (``mN`` is no
+    ``MN``); only a bare quantity name (``'Acceleration'``, any case) is no unit: it is the SI
+    unit of that quantity, the unit Test.Lab exports in (``'Time'`` is kept: the caller reads
+    the time axis)."""
     if not isinstance(quantity_struct, Mapping):
-        return _text(quantity_struct)
+        text = _text(quantity_struct).strip()
+        return [("quantity", text)] if text else []
+    units = []
     for key in ("unit", "units", "unit_label", "unit_name"):
         text = _unit_text(quantity_struct.get(key))
         if text:
-            return text
+            units.append((key, text))
+            break
     text = _terms_unit(quantity_struct.get("quantity_terms"))
     if text:
-        return text
-    label = _text(quantity_struct.get("label")).strip().lower()
-    if label in SI_UNITS and label not in ("unknown", "time"):
-        return SI_UNITS[label]  # Test.Lab exports values in SI; the label names the quantity
-    return label
+        units.append(("quantity_terms", text))
+    label = _text(quantity_struct.get("label")).strip()
+    if label.lower() in SI_UNITS and label.lower() not in ("unknown", "time"):
+        units.append((f"label {label!r}", SI_UNITS[label.lower()]))
+    elif label:
+        units.append(("label", label))
+    return units
+
+
+def _lms_unit(quantity_struct: object, what: str, notes: list[str]) -> str:
+    """The unit of a Test.Lab quantity's values, after its ``unit_transformation``.
+
+    Test.Lab may store values in SI and show them in the unit of its label, the factor
+    taking one to the other (display = SI x factor: ``'g'`` with 0.10197, ``'mm/s'`` with
+    1000); read as g, an acceleration was 9.8 x too large. Where the factor is the reciprocal
+    of a stated unit's SI factor the values are SI (said in ``notes``); where it is 1 (or
+    absent) they are in the stated unit. Any other factor, or an offset, on a unit pidcore
+    reads is refused: the values could be in either unit. A unit pidcore does not read (a
+    temperature's ``'°C'``) is returned as stated: such a channel is never taken as SI.
+    """
+    units = _lms_units(quantity_struct)
+    stated = units[0][1] if units else ""
+    transformation = (quantity_struct.get("unit_transformation")
+                      if isinstance(quantity_struct, Mapping) else None)
+    if not isinstance(transformation, Mapping):
+        return stated
+    field = f"{what}: quantity.unit_transformation"
+    factor = real_scalar(transformation.get("factor", 1.0), where=f"{field}.factor")
+    offset = real_scalar(transformation.get("offset", 0.0), where=f"{field}.offset")
+    readings = [(key, text, info) for key, text in units
+                if (info := read_unit(text).info) is not None]
+    if not readings or (offset == 0.0 and abs(factor - 1.0) <= TRANSFORMATION_TOLERANCE):
+        return stated
+    shown = next(((key, text, info) for key, text, info in readings if offset == 0.0
+                  and abs(info.factor * factor - 1.0) <= TRANSFORMATION_TOLERANCE), None)
+    quantities = {info.quantity for _, _, info in readings}
+    if shown is not None and len(quantities) == 1:
+        key, text, info = shown
+        notes.append(f"{what}: values read in {info.si_unit}: the file stores them in SI and "
+                     f"shows them in {text!r} ({key}; unit_transformation.factor {factor:.6g} "
+                     f"= 1/{info.factor:.6g})")
+        return info.si_unit
+    said = " and ".join(f"{text!r} ({key})" for key, text, _ in readings)
+    if len(quantities) > 1:
+        expected = "units of one quantity"
+    else:
+        expected = " or ".join(dict.fromkeys(
+            [f"factor 1 (values in {readings[0][1]!r})"]
+            + [f"factor {1.0 / info.factor:.6g} (values in SI, shown in {text!r})"
+               for _, text, info in readings
+               if abs(info.factor - 1.0) > TRANSFORMATION_TOLERANCE]))
+        # a unit pidcore reads is a pure scale factor: an offset is no reading of it
+        expected += " and offset 0" if offset != 0.0 else ""
+    raise InputFileError(f"{what}: quantity states {said} with unit_transformation factor "
+                         f"{factor:.6g} and offset {offset:.6g}; expected {expected}")
 
 
 def _lms_seconds_per_unit(x_values: Mapping, what: str, given: UnitReading | None,
@@ -317,7 +388,11 @@ def _lms_seconds_per_unit(x_values: Mapping, what: str, given: UnitReading | Non
     """Seconds per unit of a Test.Lab signal's ``x_values``: the unit its ``quantity``
     states (the increment is in it: ms read as s gave a rate 1000 x too low), seconds where
     it states none (Test.Lab's unit of time), ``given`` (the user's time_unit) over both."""
-    stated = _lms_unit(x_values.get("quantity"))
+    quantity = x_values.get("quantity")
+    if given is not None:  # the user's unit overrides the file's, its transformation too
+        stated = next((text for _, text in _lms_units(quantity)), "")
+    else:
+        stated = _lms_unit(quantity, f"{what}: x_values", notes)
     if stated.strip().lower() == "time":  # a bare label names the quantity, not a unit
         stated = ""
     reading = read_unit(stated)
@@ -376,11 +451,13 @@ def _lms_layout(signal: object, where: str, given_time: UnitReading | None = Non
                                      f"{n} samples; the file is truncated")
             values = values[:n]
         record = sig.get("function_record", {})
-        names = [_text(v) for v in _as_list(record.get("name") if isinstance(record, Mapping)
-                                            else None)]
-        unit = _lms_unit(y.get("quantity") if isinstance(y, Mapping) else None)
-        for j in range(values.shape[1]):
-            name = names[j] if j < len(names) and names[j] else f"Signal {k + 1}.{j + 1}"
+        given_names = [_text(v) for v in _as_list(record.get("name")
+                                                  if isinstance(record, Mapping) else None)]
+        names = [given_names[j] if j < len(given_names) and given_names[j]
+                 else f"Signal {k + 1}.{j + 1}" for j in range(values.shape[1])]
+        unit = _lms_unit(y.get("quantity") if isinstance(y, Mapping) else None,
+                         f"{what} ({', '.join(map(repr, names))}): y_values", notes)
+        for j, name in enumerate(names):
             channels.append(make_channel(name, values[:, j], sample_rate_hz=1.0 / increment,
                                          unit=unit, start_time_s=start))
     return channels
