@@ -399,6 +399,32 @@ def test_mat_simple_layout_with_units_struct_and_cell(tmp_path):
     np.testing.assert_allclose(m.channels[0].data, STANDARD_GRAVITY)
 
 
+def test_mat_units_cell_of_another_length_than_the_channel_variables_is_refused(tmp_path):
+    # paired by position, a helper vector ('window') taken as a channel shifted the units: the
+    # window got 'N', the force 'mm/s', and the refusal blamed a "purely resistive load"
+    n = 64
+    path = tmp_path / "win.mat"
+    scipy.io.savemat(path, {"fs": 5120.0, "window": np.hanning(16), "Force": np.ones(n),
+                            "Velocity": np.ones(n), "units": np.array(["N", "mm/s"],
+                                                                      dtype=object)})
+    with pytest.raises(InputFileError) as info:
+        read_measurement(path)
+    assert str(info.value) == (
+        f"{path}: the cell 'units' holds 2 units for 3 channel variables ('window', 'Force', "
+        "'Velocity'); expected one unit per channel variable, in their order, or a struct "
+        "'units' naming each channel (units.Force = 'N')")
+    # beside a time vector a vector of another length is no channel, and is named: a cell
+    # that gives it a unit would pair the rest one off
+    timed = tmp_path / "timed.mat"
+    scipy.io.savemat(timed, {"t": np.arange(n) / 5120.0, "window": np.hanning(16),
+                             "Force": np.ones(n), "Velocity": np.ones(n),
+                             "units": np.array(["1", "N", "mm/s"], dtype=object)})
+    with pytest.raises(InputFileError, match=r"holds 3 units for 2 channel variables \('Force', "
+                                             r"'Velocity'; left out, of another length than "
+                                             r"'t': 'window'\)"):
+        read_measurement(timed)
+
+
 def test_mat_lms_testlab_signal_struct(tmp_path):
     n, rate = 400, 1024.0
     values = np.column_stack([np.arange(n, dtype=float), -np.arange(n, dtype=float)])

@@ -22,10 +22,12 @@ Three layouts are understood, tried in this order:
    read, a temperature's, stays unknown). The same holds for ``x_values``.
    v7.3 struct *arrays* (``Signal(1)``, ``Signal(2)``, ...) are read like v5 ones.
 3. **simple layout**: a time vector ``time`` or ``t`` (s) plus one numeric vector per channel
-   (the variable name is the channel name), optionally ``units`` as a struct
-   (``units.Force = 'kN'``) or a cell of unit strings in the order of the channel variables.
-   Without a time vector, a scalar ``sample_rate_hz`` / ``fs`` or the reader's
-   ``sample_rate_hz`` argument gives the time base.
+   (the variable name is the channel name; beside a time vector only vectors of its length),
+   optionally ``units`` as a struct (``units.Force = 'kN'``) or a cell of unit strings, one
+   per channel variable in their order: a cell of another length is refused, naming the
+   variables taken as channels (a helper vector such as ``window`` counts as one, and
+   shifted every unit after it). Without a time vector, a scalar ``sample_rate_hz`` /
+   ``fs`` or the reader's ``sample_rate_hz`` argument gives the time base.
 
 Nothing in a ``.mat`` file is executed or unpickled: loadmat reads plain arrays and structs;
 MATLAB objects (``MCOS``) are ignored.
@@ -513,13 +515,26 @@ def _simple_layout(variables: Mapping, where: str, sample_rate_hz: float | None,
                      f"{sample_rate_hz:.9g} Hz (sample_rate_hz)")
         rate = float(sample_rate_hz)
     skip = {time_key, rate_key, "units"}
-    vectors = {k: _numeric_vector(v) for k, v in public.items() if k not in skip}
-    vectors = {k: v for k, v in vectors.items() if v is not None and (n is None or v.size == n)}
+    numeric = {k: vector for k, value in public.items()
+               if k not in skip and (vector := _numeric_vector(value)) is not None}
+    vectors = {k: v for k, v in numeric.items() if n is None or v.size == n}
     units_var = public.get("units")
     if isinstance(units_var, Mapping):
         units = {k: _text(units_var.get(k)) for k in vectors}
     else:
         unit_list = [_text(u) for u in _as_list(units_var)]
+        if unit_list and len(unit_list) != len(vectors):
+            # a cell pairs units with channels by position only: a helper vector ('window',
+            # 'calib') taken as a channel, or one the cell leaves out, shifted every unit after
+            # it onto the next channel (the velocity's 'mm/s' on the force)
+            left_out = [k for k in numeric if k not in vectors]
+            raise InputFileError(
+                f"{where}: the cell 'units' holds {len(unit_list)} units for "
+                f"{len(vectors)} channel variables ({', '.join(map(repr, vectors)) or 'none'}"
+                + (f"; left out, of another length than {time_key!r}: "
+                   f"{', '.join(map(repr, left_out))}" if left_out else "")
+                + "); expected one unit per channel variable, in their order, or a struct "
+                "'units' naming each channel (units.Force = 'N')")
         units = {k: (unit_list[i] if i < len(unit_list) else "")
                  for i, k in enumerate(vectors)}
     return [make_channel(k, v, sample_rate_hz=rate, unit=units[k], start_time_s=start)
