@@ -150,6 +150,7 @@ from .constants import (
     FILL_REFERENCES,
     TANGENTIAL_STIFFNESS_MODELS,
     CellShape,
+    NormalDampingMode,
     TangentialStiffnessModel,
 )
 from .errors import MAX_SHOWN_CHARS, ParameterError, apart, as_given, clipped, real_number
@@ -1867,7 +1868,8 @@ DESCRIBE_FREQUENCY_HZ = 50.0
 DESCRIBE_ACCELERATION_G = 10.0
 
 
-def describe(specimen: Specimen) -> dict[str, Any]:
+def describe(specimen: Specimen, *,
+             damping_mode: NormalDampingMode | None = None) -> dict[str, Any]:
     """What follows from a specimen (units in the keys): capacity, masses, contact numbers.
 
     Particle counts and masses are for the specimen's stated fill (``count_per_cell`` or
@@ -1883,10 +1885,18 @@ def describe(specimen: Specimen) -> dict[str, Any]:
     DEM_TANGENTIAL_REFERENCE_SPEED_M_S impact); with ``tangential_stiffness_model = "mindlin"``
     ``mindlin_tangential_stiffness_*_n_m`` is k_t = 8 G* sqrt(R* delta) at the Hertz overlap
     ``reference_impact_overlap_*_m`` of that hardest impact (None for ``"constant"``).
+
+    ``restitution_*_stated`` is each pair's e_n, ``restitution_*_simulated`` what a head-on
+    impact through the kernel gives with Eq. 3's alpha in ``damping_mode`` (the DEM's default
+    by default) at DEM_CALIBRATION_SPEED_M_S (``restitution_impact_speed_m_s``) and step
+    ``time_step_s``: clipped damping (``no_attraction``) gives more than stated, the more the
+    lower e_n; a note names the pairs off by more than RESTITUTION_NOTE_GAP
+    (:func:`restitution_note`).
     """
     from . import defaults
     from .constants import PARTICLE_MATERIALS
-    from .dem.contact import maximum_overlap
+    from .dem.contact import check_damping_mode, maximum_overlap
+    from .dem.impact import measure_restitution
     from .dem.simulate import LoadCase, choose_time_step, max_impact_speed
     from .model.damper import specimen_area_m2
 
@@ -1912,6 +1922,14 @@ def describe(specimen: Specimen) -> dict[str, Any]:
     k_t_mindlin = {name: float(pair.mindlin_factor * math.sqrt(overlap[name])) if mindlin
                    else None
                    for name, pair in (("pp", law.pair_particle), ("pw", law.pair_wall))}
+    mode = defaults.DEM_NORMAL_DAMPING_MODE if damping_mode is None else damping_mode
+    check_damping_mode(mode)
+    dt = choose_time_step(case, law, geometry, "auto", defaults.DEM_TANGENTIAL_MODEL)
+    v_cal = defaults.DEM_CALIBRATION_SPEED_M_S
+    stated = {"pp": law.pair_particle.restitution, "pw": law.pair_wall.restitution}
+    simulated = {name: measure_restitution(pair=pair, impact_speed_m_s=v_cal, dt_s=dt,
+                                           mode=mode, law=law, geometry=geometry)
+                 for name, pair in (("pp", "particle"), ("pw", "wall"))}
     return {
         "name": specimen.name, "sha256": specimen.hash, "is_paper": specimen.is_paper(),
         # the file a calibrated one was made from ([provenance]; None: not recorded)
@@ -1920,7 +1938,8 @@ def describe(specimen: Specimen) -> dict[str, Any]:
         "calibrated_from_sha256": None if specimen.provenance is None
         else specimen.provenance.calibrated_from_sha256,
         "notes": [*table_overrides(specimen), *heavy_fixture_note(specimen, count),
-                  *_no_fixture_note(specimen), *column_note(specimen, capacity)],
+                  *_no_fixture_note(specimen), *column_note(specimen, capacity),
+                  *restitution_note(stated, simulated, mode)],
         "cell_shape": specimen.cell.shape, "cells_per_coupon": specimen.cell.count,
         "cells_area_m2": specimen.cells_area_m2(geometry),
         # the area pidcore model damper's c_eq per treated area is per, and why that one
@@ -1955,9 +1974,34 @@ def describe(specimen: Specimen) -> dict[str, Any]:
         "reference_impact_speed_m_s": speed,
         "contact_time_s": law.contact_time(speed),
         "tangential_period_s": law.tangential_period(),
-        "time_step_s": choose_time_step(case, law, geometry, "auto",
-                                        defaults.DEM_TANGENTIAL_MODEL),
+        "time_step_s": dt,
+        "restitution_pp_stated": stated["pp"], "restitution_pw_stated": stated["pw"],
+        "restitution_pp_simulated": simulated["pp"],
+        "restitution_pw_simulated": simulated["pw"],
+        "restitution_damping_mode": mode, "restitution_impact_speed_m_s": v_cal,
     }
+
+
+def restitution_note(stated: dict[str, float], simulated: dict[str, float],
+                     mode: NormalDampingMode) -> tuple[str, ...]:
+    """A note naming the pairs (``"pp"``, ``"pw"``) whose head-on impact through the kernel
+    gives a restitution more than RESTITUTION_NOTE_GAP from the stated one, and the options
+    that give the stated value: a run with Eq. 3's alpha simulates a livelier bed than the
+    file says, and nothing else said so."""
+    from . import defaults
+
+    names = {"pp": "particle-particle", "pw": "particle-wall"}
+    off = [f"{names[k]} {simulated[k]:.3f} for the stated {stated[k]:g}" for k in names
+           if abs(simulated[k] - stated[k]) > defaults.RESTITUTION_NOTE_GAP]
+    if not off:
+        return ()
+    cures = "`dem run --damping-coefficient calibrated` tunes alpha to give the stated value"
+    if mode != "literal":
+        cures += (", or `--damping-mode literal` (Eq. 3's alpha is exact for damping that may "
+                  "pull at the contact's end)")
+    return (f"restitution in {mode} damping mode with Eq. 3's alpha: the kernel gives "
+            f"{', '.join(off)} (head-on at {defaults.DEM_CALIBRATION_SPEED_M_S:g} m/s); "
+            f"{cures}",)
 
 
 #: A fixture this many times the coupon (its particles left out) is named in `specimen

@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 from pathlib import Path
 
@@ -242,14 +243,19 @@ def test_calibrated_damping_accepts_mindlin_and_calibrates_the_same_head_on_impa
     monkeypatch.setattr(impact, "calibrate_damping_coefficient", record)
     config = DemConfig(cells=1, steady_cycles=4, time_step=8e-7,
                        damping_coefficient="calibrated")
-    for specimen in (PAPER, MINDLIN):
+    own = MINDLIN.with_values({"pairs.particle_wall.restitution": 0.5})
+    for specimen in (PAPER, MINDLIN, own):
         with pytest.raises(Reached):
             simulate_load_case(CASE, config, specimen=specimen)
-    assert len(calls) == 2 and calls[0] == calls[1]
-    # a specimen whose contact differs from the tables' is still refused
-    with pytest.raises(ParameterError, match="calibrated'"):
-        simulate_load_case(CASE, config, specimen=MINDLIN.with_values(
-            {"pairs.particle_wall.restitution": 0.5}))
+    assert len(calls) == 3
+    # the same target, step, mode and cell; the laws tried differ in the k_t model alone
+    assert calls[0][0] == calls[1][0]
+    assert calls[0][1]["geometry"] == calls[1][1]["geometry"]
+    laws = [kwargs["law"](0.3) for _, kwargs in calls]
+    assert dataclasses.replace(laws[1], tangential_stiffness_model="constant") == laws[0]
+    # a specimen whose contact differs from the tables' is calibrated to its own e_n (it
+    # was refused while the calibration knew the tables' laws only)
+    assert calls[2][0][:2] == (0.5, "wall") and laws[2].pair_wall.restitution == 0.5
 
 
 def test_the_sdc_model_does_not_average_mindlin_with_constant_runs():

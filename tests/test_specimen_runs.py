@@ -10,6 +10,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
+from pidcore import defaults
 from pidcore.cli import main
 from pidcore.dem import persist
 from pidcore.dem.persist import (
@@ -22,6 +23,7 @@ from pidcore.dem.persist import (
 from pidcore.dem.simulate import (
     DemConfig,
     LoadCase,
+    calibrated_contact_law,
     choose_time_step,
     drive_sampling,
     simulate_load_case,
@@ -564,24 +566,81 @@ def test_heavy_particles_do_not_hide_a_fixture_typed_in_grams(tmp_path):
     assert not [n for n in describe(calibrated)["notes"] if "fixture_mass_kg" in n]
 
 
-def test_a_calibrated_damping_coefficient_is_refused_for_an_own_material_naming_the_option(
+def test_calibrated_damping_runs_an_own_specimen_and_its_json_says_the_alpha_used(
         capsys, tmp_path):
-    """`--damping-coefficient calibrated` with the steel specimen was refused as "--material:
-    unknown material 'steel'", an option the user never gave (the tables were asked for the
-    specimen's material before the specimen was checked against them)."""
+    """`--damping-coefficient calibrated` with an own specimen was refused ("only for table
+    particles with the tables' contact pairs"), so a file stating e = 0.3 ran at 0.40 with
+    nothing to cure it. It now calibrates each pair to the file's own restitution in the
+    file's own cell, and the run's record says the alphas it used."""
+    specimen = load_specimen(STEEL).with_values({"pairs.particle_particle.restitution": 0.3,
+                                                  "pairs.particle_wall.restitution": 0.3})
+    path = tmp_path / "steel_e03.toml"
+    path.write_text(specimen.to_toml())
     store = tmp_path / "runs.h5"
-    for command in ("run", "sweep"):
-        load_case = (["--frequency", "500", "--acceleration", "5"] if command == "run" else
-                     ["--frequencies", "500", "--accelerations", "5", "--fills", "50"])
-        code = main(["dem", command, "--specimen", str(STEEL), *load_case, "--cells", "1",
-                     "--cycles", "10", "--damping-coefficient", "calibrated",
-                     "--store", str(store), "--no-progress"])
-        err = capsys.readouterr().err.strip()
-        assert code == 2 and len(err.splitlines()) == 1, err
-        assert "--material" not in err
-        assert "damping_coefficient='calibrated': only for table particles" in err
-        assert "not specimen 'steel_6mm'; use 'eq3'" in err
-        assert not store.exists()
+    docs = {}
+    for coefficient in ("eq3", "calibrated"):
+        assert main(["dem", "run", "--specimen", str(path), "--frequency", "500",
+                     "--acceleration", "5", "--cells", "1", "--cycles", "4",
+                     "--damping-coefficient", coefficient, "--store", str(store),
+                     "--no-progress", "--json"]) == 0
+        docs[coefficient] = json.loads(capsys.readouterr().out)
+    eq3 = contact_law(specimen)
+    assert (docs["eq3"]["alpha_pp"], docs["eq3"]["alpha_pw"]) == (eq3.pair_particle.alpha,
+                                                                  eq3.pair_wall.alpha)
+    calibrated = calibrated_contact_law(specimen, DemConfig(damping_coefficient="calibrated"),
+                                        docs["calibrated"]["time_step_s"])
+    # the same calibration at the run's step, so the same alphas to the last bit; clipped
+    # damping needs more than Eq. 3's to give the stated e
+    assert (docs["calibrated"]["alpha_pp"], docs["calibrated"]["alpha_pw"]) == (
+        calibrated.pair_particle.alpha, calibrated.pair_wall.alpha)
+    assert docs["calibrated"]["alpha_pw"] > eq3.pair_wall.alpha
+    assert docs["calibrated"]["sdc"] != docs["eq3"]["sdc"]
+    # the stored run reads back with them
+    run = load_dem_result(Store(store).get_dem_run(docs["calibrated"]["store_key"]))
+    assert run.alpha_pw == docs["calibrated"]["alpha_pw"]
+
+
+def test_specimen_check_says_the_restitution_the_kernel_gives_and_how_to_get_the_stated(
+        capsys, tmp_path):
+    """A file stating e = 0.3 runs at 0.40 in the default (no_attraction) mode, and `specimen
+    check` said nothing of it. It now prints per pair the restitution of a head-on impact
+    through the kernel beside the stated one, with a note naming the cures where they differ
+    by more than 0.01, and no note where they do not."""
+    def check(e: float, *mode: str) -> tuple[dict, str]:
+        path = tmp_path / f"steel_{e}.toml"
+        path.write_text(load_specimen(STEEL).with_values(
+            {"pairs.particle_particle.restitution": e,
+             "pairs.particle_wall.restitution": e}).to_toml())
+        assert main(["specimen", "check", str(path), *mode, "--json"]) == 0
+        facts = json.loads(capsys.readouterr().out)
+        assert main(["specimen", "check", str(path), *mode]) == 0
+        return facts, capsys.readouterr().out
+
+    facts, out = check(0.3)
+    for pair in ("pp", "pw"):
+        assert facts[f"restitution_{pair}_stated"] == 0.3
+        # 0.40 measured (0.3998 at 1e-6 s); 0.01 holds the grid step's error
+        assert facts[f"restitution_{pair}_simulated"] == pytest.approx(0.40, abs=0.01)
+    assert facts["restitution_damping_mode"] == "no_attraction"
+    assert facts["restitution_impact_speed_m_s"] == defaults.DEM_CALIBRATION_SPEED_M_S
+    assert (f"restitution     particle-particle 0.3 stated, "
+            f"{facts['restitution_pp_simulated']:.4g} simulated; particle-wall 0.3 stated, "
+            f"{facts['restitution_pw_simulated']:.4g} simulated") in out
+    (note,) = [n for n in facts["notes"] if n.startswith("restitution")]
+    assert f"particle-particle {facts['restitution_pp_simulated']:.3f} for the stated 0.3" \
+        in note
+    assert "--damping-coefficient calibrated" in note and "--damping-mode literal" in note
+    assert f"note: {note}" in out
+    # Eq. 3 is exact for damping that may pull: literal mode gives the stated e (to the
+    # step's error, below the note's 0.01), and no note
+    facts, out = check(0.3, "--damping-mode", "literal")
+    assert facts["restitution_pw_simulated"] == pytest.approx(0.3, abs=0.01)
+    assert not [n for n in facts["notes"] if n.startswith("restitution")]
+    assert "literal damping" in out and "note: restitution" not in out
+    # at e = 0.9 the clipped end of the contact is small: 0.902, within 0.01, and no note
+    facts, out = check(0.9)
+    assert facts["restitution_pp_simulated"] == pytest.approx(0.9, abs=0.01)
+    assert "note: restitution" not in out
 
 
 def test_a_sweeps_json_and_summary_name_each_runs_specimen_file(capsys, tmp_path):

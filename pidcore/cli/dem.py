@@ -111,7 +111,8 @@ def _add_config_options(p: argparse.ArgumentParser) -> None:
                         f"{defaults.DEM_NORMAL_DAMPING_MODE})")
     p.add_argument("--damping-coefficient", choices=("eq3", "calibrated"),
                    default=defaults.DEM_DAMPING_COEFFICIENT,
-                   help="alpha by Eq. 3, or calibrated to the table's restitution (default "
+                   help="alpha by Eq. 3, or calibrated so that a head-on impact gives the "
+                        "stated restitution of each pair (tables' or specimen's; default "
                         f"{defaults.DEM_DAMPING_COEFFICIENT})")
     p.add_argument("--mass-convention", choices=VIBRATED_MASS_CONVENTIONS,
                    default=defaults.DEM_VIBRATED_MASS_CONVENTION,
@@ -514,6 +515,9 @@ def format_summary(result, *, reused: bool = False) -> str:
         f"{result.config.normal_damping_mode}, start {result.config.start_packing} packing "
         f"{result.config.start_protocol.replace('_', ' ')}, k_t "
         f"{_tangential_stiffness_model(result)}",
+        *([f"damping         alpha of Eq. 2 {result.alpha_pp:.4g} particle-particle, "
+           f"{result.alpha_pw:.4g} particle-wall ({result.config.damping_coefficient})"]
+          if math.isfinite(result.alpha_pp) else []),  # NaN: stored before it was kept
         # "30.4 s wall, 1.74e+07 particle-steps/s" for 1.9e7 particle-steps: the wall time
         # holds the settle and a first Numba compile, the rate only the kernel's own calls
         f"numerics        dt {result.time_step_s:.4g} s, {result.steps} driven steps, "

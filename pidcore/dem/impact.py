@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Callable
 
 import numpy as np
 from scipy.optimize import brentq
@@ -18,8 +19,13 @@ from .. import defaults
 from ..constants import ImpactPair, NormalDampingMode, TangentialModel
 from ..errors import ParameterError
 from .contact import ContactLaw, check_damping_mode
-from .geometry import CellGeometry
+from .geometry import CellGeometry, check_sphere_fits
 from .state import CellsState, KernelSettings, advance, energies
+
+
+class StillInContact(ParameterError):
+    """The bodies of an impact still touch after 3 contact times (a contact so damped that it
+    hardly rebounds)."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -46,6 +52,7 @@ def simulate_impact(*, pair: ImpactPair = "wall", impact_speed_m_s: float, dt_s:
                     wall: str = "floor", alpha: float | None = None,
                     law: ContactLaw | None = None,
                     tangential_model: TangentialModel = defaults.DEM_TANGENTIAL_MODEL,
+                    geometry: CellGeometry | None = None,
                     ) -> ImpactOutcome:
     """One impact without gravity through :func:`pidcore.dem.kernel.advance_cells`.
 
@@ -55,6 +62,9 @@ def simulate_impact(*, pair: ImpactPair = "wall", impact_speed_m_s: float, dt_s:
     about the axis normal to both. ``pair="particle"``: two particles approach along z at
     relative speed ``impact_speed_m_s`` (each at half of it). ``alpha`` overrides Eq. 3 for
     this contact; ``tangential_model`` picks the friction law (:mod:`pidcore.dem.contact`).
+    ``law`` replaces the tables' law of ``material`` (e.g. a specimen's,
+    :func:`pidcore.specimen.contact_law`); ``geometry`` is the cell the impact happens in (the
+    paper's by default): the particle hits its wall centred on it, the pair meets along z.
     """
     from .geometry import WALL_NAMES
 
@@ -63,11 +73,20 @@ def simulate_impact(*, pair: ImpactPair = "wall", impact_speed_m_s: float, dt_s:
         raise ParameterError(f"pair: expected 'wall' or 'particle', got {pair!r}")
     if not impact_speed_m_s > 0:
         raise ParameterError(f"impact_speed: expected > 0 m/s, got {impact_speed_m_s}")
-    geometry = CellGeometry()
+    geometry = geometry or CellGeometry()
     if law is None:
         law = ContactLaw.for_material(material, alpha_pw=alpha if pair == "wall" else None,
                                       alpha_pp=alpha if pair == "particle" else None)
     r = law.radius_m
+    # a particle that does not fit the cell would touch other walls than the one it hits (a
+    # large own particle in the paper's default cell): no head-on impact, a wrong number
+    check_sphere_fits(geometry, r)
+    if pair == "particle" and geometry.height_m < 5 * r:
+        # the walls take no part in a particle pair's impact; a cell too low to hold the pair
+        # one above the other (a monolayer's) gets room for it, half a radius to spare at
+        # floor and ceiling (the pair moves apart by microns after the impact), so that no
+        # wall touches it
+        geometry = dataclasses.replace(geometry, height_m=5 * r)
     if pair == "wall":
         w = WALL_NAMES.index(wall)
         n = geometry.wall_normals[w]
@@ -109,14 +128,14 @@ def simulate_impact(*, pair: ImpactPair = "wall", impact_speed_m_s: float, dt_s:
     if pair == "wall":
         v_after = state.vel[:, 0, 0]
         if np.dot(geometry.wall_normals[w], state.pos[:, 0, 0]) + geometry.wall_offsets[w] <= r:
-            raise ParameterError("impact: particle still in contact after 3 contact times")
+            raise StillInContact("impact: particle still in contact after 3 contact times")
         vn_after = float(np.dot(v_after, n))
         vt_before = tangential_speed_m_s
         vt_after = float(np.dot(v_after, t_dir))
     else:
         rel = state.vel[:, 0, 1] - state.vel[:, 0, 0]
         if np.linalg.norm(state.pos[:, 0, 1] - state.pos[:, 0, 0]) <= 2 * r:
-            raise ParameterError("impact: particles still in contact after 3 contact times")
+            raise StillInContact("impact: particles still in contact after 3 contact times")
         vn_after = float(rel[2])
         vt_before = -tangential_speed_m_s
         vt_after = float(rel[0])
@@ -129,16 +148,25 @@ def simulate_impact(*, pair: ImpactPair = "wall", impact_speed_m_s: float, dt_s:
 
 def measure_restitution(*, pair: ImpactPair = "wall", impact_speed_m_s: float, dt_s: float,
                         mode: NormalDampingMode = "no_attraction", material: str = "acrylic",
-                        alpha: float | None = None) -> float:
-    """Normal restitution the kernel really gives in a head-on impact [-]."""
+                        alpha: float | None = None, law: ContactLaw | None = None,
+                        geometry: CellGeometry | None = None) -> float:
+    """Normal restitution the kernel really gives in a head-on impact [-] (``law`` and
+    ``geometry`` as :func:`simulate_impact` takes them)."""
     return simulate_impact(pair=pair, impact_speed_m_s=impact_speed_m_s, dt_s=dt_s,
-                           mode=mode, material=material, alpha=alpha).restitution
+                           mode=mode, material=material, alpha=alpha, law=law,
+                           geometry=geometry).restitution
 
 
 def calibrate_damping_coefficient(target_e: float, pair: ImpactPair, impact_speed: float,
                                   dt: float, mode: NormalDampingMode = "no_attraction", *,
-                                  material: str = "acrylic") -> float:
+                                  material: str = "acrylic",
+                                  law: Callable[[float], ContactLaw] | None = None,
+                                  geometry: CellGeometry | None = None) -> float:
     """alpha of Eq. 2 that makes the simulated head-on impact give exactly ``target_e``.
+
+    The contact is the tables' of ``material``, or ``law(alpha)``: any contact law with that
+    alpha on ``pair`` (e.g. ``lambda a: contact_law(specimen, alpha_pw=a)``), in the cell
+    ``geometry`` (the paper's by default; a specimen's own, :meth:`Specimen.geometry`).
 
     Root-finds (Brent, alpha in [0, 5]) on :func:`measure_restitution`. Hertz + Tsuji
     restitution is speed-independent in the continuum, so the alpha holds approximately at
@@ -152,8 +180,17 @@ def calibrate_damping_coefficient(target_e: float, pair: ImpactPair, impact_spee
         raise ParameterError(f"target_e: expected 0 < e < 1, got {target_e}")
 
     def miss(alpha: float) -> float:
-        return measure_restitution(pair=pair, impact_speed_m_s=impact_speed, dt_s=dt,
-                                   mode=mode, material=material, alpha=alpha) - target_e
+        try:
+            e = measure_restitution(pair=pair, impact_speed_m_s=impact_speed, dt_s=dt,
+                                    mode=mode, material=material, alpha=alpha,
+                                    law=None if law is None else law(alpha),
+                                    geometry=geometry)
+        except StillInContact:
+            # so damped that it has not left after 3 contact times (alpha near the bracket's
+            # top, for 2 mm steel on aluminium): a rebound of no speed to speak of, below any
+            # target, which is all the root-finder needs from it
+            e = 0.0
+        return e - target_e
 
     hi = 5.0
     if miss(hi) > 0:

@@ -206,6 +206,9 @@ def load_dem_result(entry: StoredEntry) -> DemResult:
     values.setdefault("coupon_cells", specimen.cell.count)
     # stored before the degrees of freedom were kept: unknown (readers assume cells - 1)
     values.setdefault("sdc_stderr_dof", float("nan"))
+    # stored before the damping constants used were kept: unknown
+    values.setdefault("alpha_pp", float("nan"))
+    values.setdefault("alpha_pw", float("nan"))
     if "energy_dissipated_rolling_j" not in record and not any(
             pair.rolling_friction for pair in (specimen.pairs.particle_particle,
                                                specimen.pairs.particle_wall)):

@@ -39,7 +39,7 @@ UNITS: dict[str, str] = {
     "sample_rate_hz": "Hz", "work_walls_j": "J", "dissipated_total_j": "J",
     "mechanical_energy_change_j": "J", "dissipation_per_cell_cycle_j": "J",
     "coupon_cells": COUNT_UNIT, "samples_per_cycle": COUNT_UNIT, "fixture_mass_kg": "kg",
-    "particle_mass_kg": "kg",
+    "particle_mass_kg": "kg", "alpha_pp": RATIO_UNIT, "alpha_pw": RATIO_UNIT,
 }
 
 
@@ -80,6 +80,11 @@ class DemResult:
     agree (a periodic motion: no scatter to take an error from); so is a run of one cell
     (:func:`stderr_from_batches`). Runs stored before the degrees of freedom were kept read NaN
     (unknown).
+
+    ``alpha_pp`` and ``alpha_pw`` are the damping constants of Eq. 2 the run used
+    (particle-particle, particle-wall): Eq. 3's of the stated restitution, the config's
+    override, or the ones ``damping_coefficient="calibrated"`` found; NaN for runs stored
+    before they were kept.
     """
 
     case: LoadCase
@@ -122,6 +127,8 @@ class DemResult:
     specimen: Specimen | None = None
     coupon_cells: int = defaults.COUPON_CELLS
     sdc_stderr_dof: float = math.nan
+    alpha_pp: float = math.nan
+    alpha_pw: float = math.nan
 
     @classmethod
     def from_run(cls, *, case: LoadCase, config: DemConfig, law: ContactLaw,
@@ -200,7 +207,8 @@ class DemResult:
             sample_rate_hz=1.0 / h, sample_time_s=0.5 * (t0 + t1), wall_force_n=wall_n,
             shaker_force_n=moving_mass_kg * acc + wall_n, velocity_m_s=vel,
             samples_per_cycle=int(spc), specimen=specimen, coupon_cells=int(n_coupon),
-            sdc_stderr_dof=stderr_dof,
+            sdc_stderr_dof=stderr_dof, alpha_pp=float(law.pair_particle.alpha),
+            alpha_pw=float(law.pair_wall.alpha),
         )
 
     @property
@@ -379,7 +387,8 @@ class DemResult:
                      "work_walls_j", "dissipated_total_j", "mechanical_energy_change_j",
                      "steps", "wall_s", "particle_steps_per_s", "time_step_s",
                      "steady_start_cycle", "steady_detected", "steady_cycles",
-                     "settle_time_s", "sample_rate_hz", "samples_per_cycle"):
+                     "settle_time_s", "sample_rate_hz", "samples_per_cycle",
+                     "alpha_pp", "alpha_pw"):
             value = getattr(self, name)
             if isinstance(value, float) and not math.isfinite(value):
                 value = None

@@ -265,6 +265,34 @@ def choose_time_step(case: LoadCase, law: ContactLaw, geometry: CellGeometry,
     return float(requested)
 
 
+def calibrated_contact_law(specimen: Specimen, config: DemConfig, dt_s: float) -> ContactLaw:
+    """The specimen's contact law with each pair's alpha calibrated to its stated restitution
+    (:func:`pidcore.dem.impact.calibrate_damping_coefficient`): a head-on impact at
+    DEM_CALIBRATION_SPEED_M_S in the specimen's cell, at the run's step ``dt_s`` and damping
+    mode, gives the stated e_n. An alpha the config states (``alpha_pp``, ``alpha_pw``) is kept.
+
+    Any specimen's: the paper's coupon's law and cell are the tables' and the default cell bit
+    for bit, so its alphas are those of the tables' material.
+    """
+    from .impact import calibrate_damping_coefficient
+
+    geometry = specimen.geometry()
+    stated = contact_law(specimen)
+    v_cal = defaults.DEM_CALIBRATION_SPEED_M_S
+    mode = config.normal_damping_mode
+    return contact_law(
+        specimen,
+        alpha_pw=config.alpha_pw if config.alpha_pw is not None else
+        calibrate_damping_coefficient(
+            stated.pair_wall.restitution, "wall", v_cal, dt_s, mode, geometry=geometry,
+            law=lambda a: contact_law(specimen, alpha_pp=config.alpha_pp, alpha_pw=a)),
+        alpha_pp=config.alpha_pp if config.alpha_pp is not None else
+        calibrate_damping_coefficient(
+            stated.pair_particle.restitution, "particle", v_cal, dt_s, mode,
+            geometry=geometry,
+            law=lambda a: contact_law(specimen, alpha_pp=a, alpha_pw=config.alpha_pw)))
+
+
 def particles_per_cell(fill_percent: float, material_name: str | None = None, *,
                        specimen: Specimen | None = None,
                        geometry: CellGeometry | None = None,
@@ -784,31 +812,7 @@ def simulate_load_case(case: LoadCase, config: DemConfig | None = None, *,
     steps_per_cycle = sample_every * spc_samples
     check_drive_sampling(case, dt_s=dt, contact_step_s=dt_req, samples_per_cycle=spc_samples)
     if config.damping_coefficient == "calibrated":
-        from .impact import calibrate_damping_coefficient
-
-        # the impact calibration builds its law from the tables by material name: refuse a
-        # specimen whose law differs from that (it would calibrate another contact); the k_t
-        # model may differ, the calibrating impact is head-on (no tangential spring). A
-        # material the tables do not hold is refused before the tables are asked for it (that
-        # refusal named --material, which an own specimen's user never gave)
-        if (case.material != specimen.particles.material
-                or case.material not in PARTICLE_MATERIALS
-                or law != ContactLaw.for_material(
-                    case.material, alpha_pp=config.alpha_pp, alpha_pw=config.alpha_pw,
-                    tangential_stiffness_model=law.tangential_stiffness_model)):
-            raise ParameterError(
-                f"damping_coefficient='calibrated': only for table particles with the "
-                f"tables' contact pairs, not specimen {specimen.name!r}; use 'eq3'")
-
-        v_cal = defaults.DEM_CALIBRATION_SPEED_M_S
-        law = contact_law(
-            specimen,
-            alpha_pw=config.alpha_pw if config.alpha_pw is not None else
-            calibrate_damping_coefficient(law.pair_wall.restitution, "wall", v_cal, dt,
-                                          config.normal_damping_mode, material=case.material),
-            alpha_pp=config.alpha_pp if config.alpha_pp is not None else
-            calibrate_damping_coefficient(law.pair_particle.restitution, "particle", v_cal, dt,
-                                          config.normal_damping_mode, material=case.material))
+        law = calibrated_contact_law(specimen, config, dt)
 
     rng = np.random.default_rng(config.seed)
     positions = np.stack([random_packing(geometry, law.radius_m, n, rng)
@@ -941,6 +945,7 @@ def config_parameters(case: LoadCase, config: DemConfig) -> dict:
 
 
 __all__ = ["LoadCase", "DemConfig", "simulate_load_case", "resolve_specimen", "choose_time_step",
+           "calibrated_contact_law",
            "drive_sampling",
            "particles_of_stated_fill", "particles_per_cell", "vibrated_mass_kg",
            "coupon_mass_kg", "max_impact_speed",
