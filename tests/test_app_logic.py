@@ -1571,12 +1571,27 @@ def test_a_file_saved_again_with_another_delay_says_its_new_sdc_is_the_one_used(
     plain = AnalysisOptions()
     again = _record(good_csv, plain, name="a_fill50.csv")
     (note,) = uploads.save_records(store_file, [_file(again, plain)]).notes
-    assert note == (f"a_fill50.csv was saved before with other settings (velocity_delay_s "
-                    f"2e-05 -> 0.0; SDC {first.analysis.sdc:.4g}); this analysis (SDC "
+    # the page's field and unit (the library's words, "velocity_delay_s 2e-05 -> 0.0", are
+    # the CLI's: tests/test_cli_analyze.py)
+    assert note == (f"a_fill50.csv was saved before with other settings ('vibrometer delay "
+                    f"[µs]' 20 -> 0 µs; SDC {first.analysis.sdc:.4g}); this analysis (SDC "
                     f"{again.analysis.sdc:.4g}) is the one reports and calibrations use now, "
                     "the earlier is kept in the store")
     assert f"{first.analysis.sdc:.4g}" != f"{again.analysis.sdc:.4g}"  # 0.72 deg at 100 Hz
     assert saved_analyses(store_file)["sdc"].tolist() == [again.analysis.sdc]
+
+
+def test_the_page_says_a_changed_setting_in_its_field_and_unit():
+    # the Analyse page's warning after a save said "velocity_delay_s 5e-05 -> 0.0" beside a
+    # settings column in µs; null is a setting not given (a structure mass left at 0)
+    from pidcore.app.vocabulary import page_terms
+
+    said = page_terms("a.uff was saved before with other settings (baseline_loss_factor 0.0 "
+                      "-> 0.02, mass_below_gauge_kg 0.0 -> 0.005, structure_mass_kg null -> "
+                      "0.0483, velocity_delay_s 5e-05 -> 0.0; SDC 1.139)")
+    assert said == ("a.uff was saved before with other settings ('baseline loss factor [-]' "
+                    "0.0 -> 0.02, 'mass below gauge [g]' 0 -> 5 g, 'structure mass [g]' none "
+                    "-> 48.3 g, 'vibrometer delay [µs]' 50 -> 0 µs; SDC 1.139)")
 
 
 def test_identical_contents_are_pooled_once(tmp_path, good_csv, options):

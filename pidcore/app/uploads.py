@@ -1115,7 +1115,8 @@ def save_records(path: str | os.PathLike, files: Sequence[AnalysedFile], *,
     file's sha256 where known) go into its record. A file with plausibility warnings is
     only saved with ``confirm_implausible`` (the user's explicit confirmation). The notes say
     which saved record each byte-identical file replaces: :func:`pidcore.measure.save_analyses`,
-    the save of ``pidcore analyze`` and ``pidcore report``.
+    the save of ``pidcore analyze`` and ``pidcore report``, in the page's words
+    (:func:`app_words`).
     """
     from ..measure import save_analyses
     from ..specimen import MEASURED_SHA256_FIELD
@@ -1141,6 +1142,9 @@ def save_records(path: str | os.PathLike, files: Sequence[AnalysedFile], *,
                  # as `pidcore analyze` keeps it: judged alike where the file is not at hand
                  **(f.sdc_bound.as_record() if f.sdc_bound is not None else {})}
                 for f in files])
-    unplaced = [no_fill_note(Path(f.record.measurement.source).name) for f in files
+    names = [Path(f.record.measurement.source).name for f in files]
+    unplaced = [no_fill_note(name) for name, f in zip(names, files, strict=True)
                 if f.load_case is None]
-    return SavedRecords(saved.keys, (*unplaced, *saved.notes), saved.breakdown())
+    # the settings that changed since a file's last save, as the settings table names them
+    return SavedRecords(saved.keys, (*unplaced, *(app_words(n, names=names)
+                                                  for n in saved.notes)), saved.breakdown())

@@ -72,12 +72,22 @@ _PATTERNS = tuple(
     for k, label in sorted(LABEL_OF_KEYWORD.items(), key=lambda kv: -len(kv[0])))
 
 
-_NUMBER = r"(?P<number>[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)"
+_AMOUNT = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
+_NUMBER = f"(?P<number>{_AMOUNT})"
 _WITH_UNIT = tuple(
     (re.compile(KEYWORD_NOT_BEFORE + re.escape(k) + r"(?P<colon>:?) " + _NUMBER + " "
                 + re.escape(si) + r"(?![\w/])"),
      LABEL_OF_KEYWORD[k], scale, page_unit)
     for k, (si, page_unit, scale) in _PAGE_UNIT.items())
+# a setting changed, as a note on a file saved before with other settings writes it
+# (pidcore.measure.other_settings_note: "velocity_delay_s 5e-05 -> 0.0", JSON values, null for
+# none given): in the field's unit ("'vibrometer delay [µs]' 50 -> 0 µs"), not in SI beside a
+# label in µs
+_CHANGED = tuple(
+    (re.compile(KEYWORD_NOT_BEFORE + re.escape(k) + f" (?P<old>{_AMOUNT}|null) -> "
+                f"(?P<new>{_AMOUNT}|null)" + r"(?![\w.])"),
+     LABEL_OF_KEYWORD[k], scale, page_unit)
+    for k, (_, page_unit, scale) in _PAGE_UNIT.items())
 
 
 def page_terms(message: str, *, names: Iterable[str] = ()) -> str:
@@ -99,6 +109,13 @@ def _in_page_terms(message: str) -> str:
             pass
         return f"{named} ({value})"
 
+    def amount(value: str, scale: float) -> str:
+        return "none" if value == "null" else f"{float(value) * scale:g}"
+
+    for pattern, named, scale, unit in _CHANGED:
+        message = pattern.sub(
+            lambda m, n=named, s=scale, u=unit:
+            f"{n} {amount(m['old'], s)} -> {amount(m['new'], s)} {u}", message)
     for pattern, named, scale, unit in _WITH_UNIT:
         message = pattern.sub(
             lambda m, n=named, s=scale, u=unit:
