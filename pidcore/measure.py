@@ -738,7 +738,7 @@ def _analyzed_records(results: object) -> list[AnalyzedRecord]:
 
 #: Fields of :class:`AnalysisOptions` that name channels: a record keeps the channels it used
 #: (the app saves its options without them), so these may differ from the analysis's.
-_CHANNEL_FIELDS = ("force", "velocity", "acceleration")
+CHANNEL_FIELDS = ("force", "velocity", "acceleration")
 
 
 def _refuse_other_settings(result: AnalyzedRecord, given: AnalysisOptions) -> None:
@@ -751,7 +751,7 @@ def _refuse_other_settings(result: AnalyzedRecord, given: AnalysisOptions) -> No
         return  # a record made by hand: its options are the caller's word
     differ = [f"{name} {getattr(given, name)!r} (analysed with {getattr(used, name)!r})"
               for name in (f.name for f in fields(AnalysisOptions))
-              if name not in _CHANNEL_FIELDS and getattr(given, name) != getattr(used, name)]
+              if name not in CHANNEL_FIELDS and getattr(given, name) != getattr(used, name)]
     if differ:
         raise ParameterError(f"options: {result.measurement.source} would be saved with "
                              f"{'; '.join(differ)}; give the options it was analysed with, or "
@@ -829,12 +829,27 @@ def replacement_notes(analyses: pd.DataFrame,
                              f"({old_case}); saved as one record: {name} ({case}) replaces it"
                              + (f" (other settings: {changed})" if changed else ""))
             elif changed:
-                notes.append(f"{name} was saved before with other settings ({changed}; "
-                             f"SDC {_shown(old_sdc)}); this analysis (SDC {_shown(sdc)}) is "
-                             "the one reports and calibrations use now, the earlier is kept "
-                             "in the store")
+                notes.append(other_settings_note(name, old_parameters, parameters, old_sdc,
+                                                 sdc))
         saved[key] = (name, case, parameters, sdc)
     return notes
+
+
+def other_settings_note(name: str, old: Mapping | None, new: Mapping | None,
+                        old_sdc: float, new_sdc: float, *, saved_as: str = "",
+                        this: str = "this analysis",
+                        now: str = "the one reports and calibrations use now, the earlier is "
+                                   "kept in the store") -> str:
+    """That ``name`` was saved before (``saved_as``: under that other name) with other
+    analysis settings: the parameters that differ (``old`` -> ``new``, as stored:
+    :func:`stored_parameters`), the saved SDC, and ``this`` analysis's SDC and what it is
+    ``now``; "" where the settings are the same or either is not known (None)."""
+    changed = _changed_settings(_parameters_of(old), _parameters_of(new))
+    if not changed:
+        return ""
+    return (f"{name} was saved before{f' as {saved_as}' if saved_as else ''} with other "
+            f"settings ({changed}; SDC {_shown(old_sdc)}); {this} (SDC {_shown(new_sdc)}) is "
+            f"{now}")
 
 
 def _parameters_of(value: object) -> dict | None:

@@ -1594,6 +1594,45 @@ def test_the_page_says_a_changed_setting_in_its_field_and_unit():
                     "-> 48.3 g, 'vibrometer delay [µs]' 50 -> 0 µs; SDC 1.139)")
 
 
+def test_a_session_reanalysis_with_other_settings_is_compared_in_place_of_the_saved_one(
+        tmp_path, good_csv):
+    # the trial saved a file with a 50 µs delay and uploaded it again with 0 µs: Analyse showed
+    # SDC 1.038, Compare the saved 1.139 (its Eq. 10 too) with "left out, this session"
+    from pidcore.compare.case import unique_entries
+    from pidcore.measure import AnalysisOptions
+    from pidcore.report.case_view import saved_entries
+    from pidcore.store.listing import saved_analyses
+
+    store_file = tmp_path / "s.h5"
+    delayed = AnalysisOptions(velocity_delay_s=2e-5)
+    first = _record(good_csv, delayed, name="a_fill50.csv")
+    uploads.save_records(store_file, [_file(first, delayed)])
+    saved = saved_entries(store_file, saved_analyses(store_file))
+    # the app's channel mapping (a column of its table, saved as the channels used) is no
+    # other setting
+    plain = AnalysisOptions(force="Force")
+    again = _record(good_csv, plain, name="a_fill50.csv")
+    kept, notes = unique_entries([*saved, _entry(again, options=plain)])
+    (shown,) = kept
+    assert (shown.origin, shown.sdc) == ("this session (unsaved)", again.analysis.sdc)
+    assert f"{first.analysis.sdc:.4g}" != f"{again.analysis.sdc:.4g}"  # 0.72 deg at 100 Hz
+    assert notes == [
+        f"a_fill50.csv was saved before with other settings (velocity_delay_s 2e-05 -> 0.0; "
+        f"SDC {first.analysis.sdc:.4g}); this session's unsaved analysis (SDC "
+        f"{again.analysis.sdc:.4g}) is the one compared, the saved one is left out (the same "
+        "data are counted once); Save makes it the one reports and calibrations use"]
+    # as the Compare tab says it, and the same data under another name: counted once
+    assert "('vibrometer delay [µs]' 20 -> 0 µs; SDC " in uploads.app_words(notes[0])
+    kept, notes = unique_entries([*saved, _entry(
+        _record(good_csv, plain, name="b_fill50.csv"), options=plain)])
+    assert [(e.file, e.sdc) for e in kept] == [("b_fill50.csv", again.analysis.sdc)]
+    assert notes[0].startswith("b_fill50.csv was saved before as a_fill50.csv with other "
+                               "settings (velocity_delay_s 2e-05 -> 0.0; ")
+    # the settings saved: the saved record is compared, as before
+    kept, notes = unique_entries([*saved, _entry(first, options=delayed)])
+    assert [e.origin for e in kept] == ["store"] and notes == []
+
+
 def test_identical_contents_are_pooled_once(tmp_path, good_csv, options):
     # the saved a.csv and this session's b.csv (same bytes) and a second session copy: one
     # measurement; pooling them would count the data three times (stderr / sqrt(3))

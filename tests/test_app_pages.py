@@ -463,6 +463,34 @@ def test_an_identical_file_under_another_name_is_compared_once(store_file):
     assert not any(c.startswith("a_fill50.csv left out") for c in said)  # its own saved copy
 
 
+def test_compare_shows_this_sessions_reanalysis_with_another_delay_not_the_saved_one(
+        store_file):
+    # the trial saved a file with a 50 µs delay, uploaded it again with 0 µs: Analyse said SDC
+    # 1.038, Compare the saved record's 1.139, the unsaved analysis "left out"
+    data = mass_damper_csv(frequency_hz=100.0)
+    at = _upload(_app(), [("a_fill50.csv", data),
+                          ("setup.csv", b"file,velocity_delay_us\na_fill50.csv,20\n")])
+    saved = _metric(at, "SDC ± stderr [-]")
+    at.button(key="save").click()
+    at.run()
+    zero = ("setup.csv", b"file,velocity_delay_us\na_fill50.csv,0\n")
+    at = _upload(at, [("a_fill50.csv", data), zero])
+    analysed = _metric(at, "SDC ± stderr [-]")
+    assert analysed != saved  # 20 µs is 0.72 deg at 100 Hz
+    assert _metric(at, "SDC measured, Eq. 11 ± stderr [-]") == analysed
+    said = " ".join(c.value for c in at.caption)
+    assert ("a_fill50.csv was saved before with other settings ('vibrometer delay [µs]' 20 -> "
+            "0 µs; SDC ") in said, said
+    assert "a_fill50.csv left out" not in said
+    # saved, it is the store's newest record: compared without a word
+    at.button(key="save").click()
+    at.run()
+    assert any("('vibrometer delay [µs]' 20 -> 0 µs; SDC " in w.value for w in at.warning)
+    at = _upload(at, [("a_fill50.csv", data), zero])
+    assert _metric(at, "SDC measured, Eq. 11 ± stderr [-]") == analysed
+    assert "saved before" not in " ".join(c.value for c in at.caption)
+
+
 def test_the_same_file_selected_twice_is_analysed_once(store_file):
     # the uploader took the same file twice: the settings table had one row for two uploads
     # and the page raised (zip strict) on every tab

@@ -255,8 +255,9 @@ class MeasuredEntry:
         The corrections the analysis ran with, e.g. ``"vibrometer delay 50 µs, mass below
         gauge 0 g, baseline loss factor 0"`` (empty where unknown).
     settings : dict
-        The analysis's parameters (stored ``parameters_json``, or the options of an unsaved
-        analysis): how its corrections went, e.g. the baseline off the whole vibrated mass
+        The analysis's parameters (stored ``parameters_json``, or those an unsaved analysis
+        would be stored with: :func:`pidcore.measure.stored_parameters`): how its corrections
+        went, e.g. the baseline off the whole vibrated mass
         (:func:`pidcore.report.pipeline.whole_mass_baseline_note`); empty where unknown.
     measurement_key : str
         The store's key of the measured data (:func:`pidcore.store.measurement_key`): equal
@@ -317,6 +318,7 @@ class MeasuredEntry:
         ``specimen_sha256``: the specimen file's hash as it would be saved ("": none);
         ``sdc_bound``: the SDC bound of its specimen
         (:func:`pidcore.compare.plausibility.tested_sdc_bound`; None: 2 pi)."""
+        from ..measure import stored_parameters
         from ..records import measurement_key
         from ..signal.power import baseline_sdc_taken_off
         from ..specimen import deciding_sha256
@@ -336,7 +338,7 @@ class MeasuredEntry:
                    np.asarray(a.velocity_phasors_m_s), specimen,
                    corrections=describe_corrections(vars(options)) if options else "",
                    measurement_key=content, implausible=found[0].message if found else "",
-                   settings=dict(vars(options)) if options else {},
+                   settings=stored_parameters(record, options.parameters()) if options else {},
                    sdc_stderr_dof=a.sdc_stderr_dof,
                    specimen_sha256=deciding_sha256(specimen_sha256) if specimen else "",
                    baseline_sdc=baseline_sdc_taken_off(a))
@@ -415,17 +417,27 @@ def unique_entries(entries: Sequence[MeasuredEntry]) -> tuple[list[MeasuredEntry
     error by about sqrt(2). The first entry of each :attr:`MeasuredEntry.measurement_key` is
     kept (list saved records first: the store's copy is the one Compare and Report share);
     entries without a key are all kept. An entry that is the saved copy of itself (same file
-    and SDC: an upload still in the session after Save) is left out without a note.
+    and SDC: an upload still in the session after Save) is left out without a note. An
+    unsaved analysis of a saved measurement with other settings (a corrected vibrometer
+    delay) takes the saved record's place, as its Save would make it the one reports and
+    calibrations use; the note names the settings that differ and both SDCs
+    (:func:`pidcore.measure.other_settings_note`).
     """
     kept: list[MeasuredEntry] = []
     notes: list[str] = []
-    first: dict[str, MeasuredEntry] = {}
+    first: dict[str, int] = {}  # measurement key -> its entry's index in kept
     for e in entries:
-        other = first.get(e.measurement_key) if e.measurement_key else None
-        if other is None:
+        at = first.get(e.measurement_key) if e.measurement_key else None
+        if at is None:
             if e.measurement_key:
-                first[e.measurement_key] = e
+                first[e.measurement_key] = len(kept)
             kept.append(e)
+            continue
+        other = kept[at]
+        reanalysed = _reanalysis_note(other, e)
+        if reanalysed:
+            kept[at] = e
+            notes.append(reanalysed)
             continue
         if (e.file, e.sdc) == (other.file, other.sdc):
             continue  # the saved copy of this very analysis: nothing to say
@@ -433,6 +445,27 @@ def unique_entries(entries: Sequence[MeasuredEntry]) -> tuple[list[MeasuredEntry
         notes.append(f"{e.file} left out, {e.origin}: the same contents as {other.file} "
                      f"({where}); the same data are counted once")
     return kept, notes
+
+
+def _reanalysis_note(saved: MeasuredEntry, session: MeasuredEntry) -> str:
+    """Where ``session`` is an unsaved analysis of the measurement of the record ``saved``
+    with other settings, the note that it is compared in the saved one's place; else "".
+    The channel names asked for are not compared (the app saves none, ``pidcore analyze``
+    those given): the channels used are, under ``channels``."""
+    from ..measure import CHANNEL_FIELDS, other_settings_note
+
+    if saved.origin != "store" or session.origin == "store":
+        return ""
+    if not (saved.settings and session.settings):  # not known: an earlier pidcore's record
+        return ""
+    old, new = ({k: v for k, v in e.settings.items() if k not in CHANNEL_FIELDS}
+                for e in (saved, session))
+    return other_settings_note(
+        session.file, old, new, saved.sdc, session.sdc,
+        saved_as=saved.file if saved.file != session.file else "",
+        this="this session's unsaved analysis",
+        now="the one compared, the saved one is left out (the same data are counted once); "
+            "Save makes it the one reports and calibrations use")
 
 
 def _specimen_of(row) -> str:

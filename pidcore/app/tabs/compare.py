@@ -78,9 +78,10 @@ def _entries(stores, session_files):
                                               sdc_bound=f.sdc_bound)
                     for f in session_files if f.load_case is not None]
     # one data set counted once (a saved file uploaded again, or under another name)
+    files = [e.file for e in entries]
     entries, notes = unique_entries(entries)
-    for note in notes:
-        st.caption(note)
+    for note in notes:  # a settings change named as the table's columns name it
+        st.caption(uploads.app_words(note, names=files))
     # a record saved without its file's hash is grouped as calibrate and report group it
     return matched_specimens(entries, listing)
 
