@@ -1995,10 +1995,10 @@ def restitution_note(stated: dict[str, float], simulated: dict[str, float],
            if abs(simulated[k] - stated[k]) > defaults.RESTITUTION_NOTE_GAP]
     if not off:
         return ()
-    cures = "`dem run --damping-coefficient calibrated` tunes alpha to give the stated value"
+    cures = "damping_coefficient='calibrated' (DemConfig) tunes alpha to give the stated value"
     if mode != "literal":
-        cures += (", or `--damping-mode literal` (Eq. 3's alpha is exact for damping that may "
-                  "pull at the contact's end)")
+        cures += (", or normal_damping_mode='literal' (Eq. 3's alpha is exact for damping that "
+                  "may pull at the contact's end)")
     return (f"restitution in {mode} damping mode with Eq. 3's alpha: the kernel gives "
             f"{', '.join(off)} (head-on at {defaults.DEM_CALIBRATION_SPEED_M_S:g} m/s); "
             f"{cures}",)

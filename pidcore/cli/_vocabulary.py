@@ -102,7 +102,13 @@ COMMAND_FLAGS: dict[str, dict[str, str]] = {
     "store remove": {"with_dependents=True": "--with-dependents"},
     # commands that read a --specimen file (or FILE) and no other library keyword
     "model damper": CALIBRATION_WRITER, "model figures": CALIBRATION_WRITER,
-    "specimen check": CALIBRATION_WRITER,
+    "specimen check": {
+        **CALIBRATION_WRITER,
+        # the cures of a simulated restitution off the stated one (restitution_note)
+        "damping_coefficient='calibrated' (DemConfig)":
+            "pidcore dem run --damping-coefficient calibrated",
+        "normal_damping_mode='literal'": "pidcore dem run --damping-mode literal",
+    },
 }
 COMMAND_FLAGS["dem sweep"] = {
     **COMMAND_FLAGS["dem run"],

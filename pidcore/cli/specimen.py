@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING
 from .. import defaults
 from ..constants import NORMAL_DAMPING_MODES
 from ._options import add_json_option, add_store_option, path_argument
+from ._vocabulary import cli_words
 
 if TYPE_CHECKING:
     from ..app.kept_specimens import KeptFolder
@@ -74,6 +75,7 @@ def run_check(args: argparse.Namespace) -> int:
     from ..specimen import describe, load_specimen
 
     facts = describe(load_specimen(args.file), damping_mode=args.damping_mode)
+    facts["notes"] = [cli_words(note, "specimen check") for note in facts["notes"]]
     if args.json:
         print(json.dumps(facts))
         return 0
