@@ -110,8 +110,9 @@ CellSpec, CouponSpec, ParticleSpec, PairSpec, PairsSpec
 describe, heavy_fixture_note, column_note
     What follows from it: capacity, masses, contact numbers, time step; the notes a run of it
     repeats (a fixture far heavier than the coupon, spheres that fit only as a column).
-particles_for_fill
-    Particles per cell of a fill percentage (the one rounding rule).
+particles_for_fill, same_particles_per_cell
+    Particles per cell of a fill percentage (the one rounding rule); whether two fills are
+    the same particles per cell, so one DEM simulation.
 cell_geometry, contact_law
     The DEM's cell geometry and contact law of a specimen.
 numeric_fields
@@ -1181,7 +1182,7 @@ def fill_override_note(specimen: Specimen | None, fills_percent,
     if stated is None:
         return ""
     overriding = [f for f in sorted(set(map(float, fills_percent)))
-                  if not _same_particle_count(f, stated[0], specimen, fill_reference)]
+                  if not same_particles_per_cell(f, stated[0], specimen, fill_reference)]
     if not overriding:
         return ""
     shown = [apart(f, stated[0]) for f in overriding]
@@ -1192,11 +1193,12 @@ def fill_override_note(specimen: Specimen | None, fills_percent,
             f"states ({stated[1]})")
 
 
-def _same_particle_count(fill_percent: float, stated_percent: float, specimen: Specimen,
-                         fill_reference: str | None) -> bool:
+def same_particles_per_cell(fill_percent: float, stated_percent: float, specimen: Specimen,
+                            fill_reference: str | None = None) -> bool:
     """Whether two fills of ``specimen`` are the same particles per cell
-    (:func:`particles_for_fill` of the count ``fill_reference`` takes as 100 %); a fill that
-    rounds to none, or an unknown reference, is refused by the run itself, not here."""
+    (:func:`particles_for_fill` of the count ``fill_reference`` takes as 100 %; None: the
+    default, :data:`pidcore.defaults.DEM_FILL_REFERENCE`), so one DEM simulation; a fill
+    that rounds to none, or an unknown reference, is refused by the run itself, not here."""
     from . import defaults
 
     # relative 1e-9: a count's share of the capacity typed back as a percentage is the same fill
@@ -2090,5 +2092,5 @@ __all__ = ["CellSpec", "CouponSpec", "PairSpec", "PairsSpec", "ParticleSpec", "S
            "resolve_specimen_name", "numeric_fields", "same_tested_file", "bundled_face_area",
            "provenance_test_name", "tabulated_by_paper",
            "match_hashless_records", "NameMatch",
-           "paper_specimen", "particles_for_fill"]
+           "paper_specimen", "particles_for_fill", "same_particles_per_cell"]
 

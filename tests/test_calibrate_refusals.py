@@ -615,3 +615,45 @@ def test_a_dotted_sliding_friction_past_the_static_one_names_the_alias_moving_bo
                             "together)")
     # the alias named fits the same range
     build_specs(["friction_pw"], ["friction_pw=0.1:0.2"])
+
+
+def test_fills_of_the_same_particles_per_cell_are_one_load_case_refused_naming_both_lines(
+        capsys, tmp_path, monkeypatch):
+    # a table of a load case at 50 % and again at 52 % (both 11 of the paper coupon's 22
+    # spheres) ran two bit-identical DEM runs as two load cases, and leave-one-out kept each
+    # one's twin in the fit that held it out: 7/7 inside where the outlier alone was out
+    def no_dem_run(*args, **kwargs):
+        raise AssertionError("a DEM run was asked for")
+
+    monkeypatch.setattr(calibrate_module, "run_requests", no_dem_run)
+    table = _table(tmp_path, HEADER + ROWS + "500,5,52,0.6\n")
+    _refused(capsys, tmp_path, ["--data", str(table), "--fit", "fixture_mass_kg"],
+             "m.csv, lines 2 and 5 (500 Hz, 5 g, 50 %, acrylic; 500 Hz, 5 g, 52 %, acrylic) "
+             "state the same load case: fills 50 % and 52 % are both 11 of 22 particles per "
+             "cell of specimen paper_coupon, one DEM simulation; give one row per load case")
+
+
+@pytest.mark.parametrize(("fill", "same"), [(52.0, True), (47.8, True), (47.6, False),
+                                            (45.0, False)])
+def test_fills_are_one_load_case_exactly_where_they_round_to_one_particle_count(
+        tmp_path, monkeypatch, fill, same):
+    # 11 of 22 spheres are the fills from 10.5/22 = 47.73 % up (half to even: 10.5 -> 10):
+    # 47.8 % is 10.52 -> 11, the same run as 50 %; 47.6 % is 10.47 -> 10, another one
+    class DemRunsAsked(Exception):
+        pass
+
+    def dem_runs(*args, **kwargs):
+        raise DemRunsAsked
+
+    monkeypatch.setattr(calibrate_module, "run_requests", dem_runs)
+    points = [MeasuredPoint(500, 5, 50.0, 0.6, 0.01), MeasuredPoint(500, 5, fill, 0.6, 0.01),
+              MeasuredPoint(1000, 5, 50.0, 0.6, 0.01)]
+    if same:
+        with pytest.raises(ParameterError, match=rf"fills 50 % and {fill:g} % are both 11 of "
+                                                 "22 particles per cell"):
+            calibrate(points, fit="fixture_mass_kg", discrepancy=0.2,
+                      store_path=tmp_path / "dem.h5", progress=False, workers=1)
+    else:
+        with pytest.raises(DemRunsAsked):  # two load cases: on to their DEM runs
+            calibrate(points, fit="fixture_mass_kg", discrepancy=0.2,
+                      store_path=tmp_path / "dem.h5", progress=False, workers=1)

@@ -34,7 +34,7 @@ from ..specimen import (
     paper_specimen,
     uncalibrated_name,
 )
-from .data import MeasuredPoint, check_enough_points
+from .data import MeasuredPoint, check_enough_points, measured_provenance
 from .likelihood import NORMAL_ABOVE_DOF, uses_student_t
 from .observation import Observation, observation_from_run
 from .parameters import (
@@ -367,9 +367,49 @@ def check_point_fills(points: Sequence[MeasuredPoint], specimen: Specimen,
             particles_per_cell(p.fill_percent, specimen=specimen,
                                fill_reference=config.fill_reference, what="fill", typed=True)
         except ParameterError as exc:
-            where = f"{p.source}, line {p.row}" if p.row is not None else \
-                (p.source or "measured point")
-            raise ParameterError(f"{where} ({p.label()}): fill_percent: {exc}") from None
+            raise ParameterError(f"{_where(p)} ({p.label()}): fill_percent: {exc}") from None
+
+
+def _where(point: MeasuredPoint) -> str:
+    """Where a measured point was read: its table and line, else its store (or none)."""
+    if point.row is not None:
+        return f"{point.source}, line {point.row}"
+    return point.source or "measured point"
+
+
+def check_repeated_simulations(points: Sequence[MeasuredPoint], specimen: Specimen,
+                               config: DemConfig) -> None:
+    """Refuse two points that are one DEM simulation: the same frequency and acceleration
+    and fills of the same particles per cell of ``specimen``
+    (:func:`pidcore.specimen.same_particles_per_cell`, as ``dem sweep`` and the app run such
+    fills once). They are one load case measured twice, not two: fitted apart, the case
+    weighed twice, and leave-one-out kept its twin in the fit of the fold that held it out
+    (bit-identical DEM runs, and an outlier scored inside its band). Points of other
+    specimen labels count too: every point left is of ``specimen``
+    (:func:`check_point_specimens`)."""
+    from ..dem.simulate import particles_per_cell
+    from ..specimen import same_particles_per_cell
+
+    for i, first in enumerate(points):
+        for second in points[i + 1:]:
+            if (first.frequency_hz, first.acceleration_g, first.material) != \
+                    (second.frequency_hz, second.acceleration_g, second.material) \
+                    or not same_particles_per_cell(first.fill_percent, second.fill_percent,
+                                                   specimen, config.fill_reference):
+                continue
+            count, full = particles_per_cell(first.fill_percent, specimen=specimen,
+                                             fill_reference=config.fill_reference)
+            if first.source == second.source and first.row is not None \
+                    and second.row is not None:
+                where = f"{first.source}, lines {first.row} and {second.row}"
+            else:
+                where = f"{_where(first)} and {_where(second)}"
+            raise ParameterError(
+                f"{where} ({first.label()}; {second.label()}) state the same load case: "
+                f"fills {first.fill_percent:g} % and {second.fill_percent:g} % are both "
+                f"{count} of {full} particles per cell of specimen {specimen.name}, one DEM "
+                "simulation; give one row per load case (the mean SDC of repeated tests and "
+                "its standard error)")
 
 
 def check_point_specimens(points: Sequence[MeasuredPoint], specimen: Specimen) -> None:
@@ -523,6 +563,7 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: str | Sequence[str],
     config = dataclasses.replace(dem_config or DemConfig(), cells=cells, seed=seed,
                                  steady_cycles=steady_cycles)
     check_point_fills(points, specimen, config)
+    check_repeated_simulations(points, specimen, config)
     # a stop is heard while the design's requests and keys are made too: that takes a
     # fraction of a ms per request, seconds for a large design, before any DEM run starts
     requests = _requests(points, dem_specs, design, config, specimen, stop=stop)
@@ -629,7 +670,10 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: str | Sequence[str],
                 "steady_cycles": steady_cycles, "design_size": n_design, "method": method,
                 "method_used": posterior.method,
                 "discrepancy_fixed": discrepancy, "discrepancy_floor": discrepancy_floor,
-                "cross_validate": cross_validate, "store": str(store_path)}
+                "cross_validate": cross_validate, "store": str(store_path),
+                # the tests it was fitted to: a table's path and sha256, a store's path and
+                # the analyses pooled (the DEM cache above is not where they came from)
+                "measured": measured_provenance(points)}
     if posterior.diagnostics is not None:  # emcee's: acceptance, autocorrelation, sample size
         settings["sampler"] = posterior.diagnostics.to_dict()
     raise_if_stopped(stop, _STOPPED)

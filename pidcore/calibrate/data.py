@@ -33,6 +33,7 @@ from ..compare.plausibility import (
     stored_record_name,
 )
 from ..errors import InputFileError, ParameterError, as_given, real_number
+from ..io._common import file_sha256
 from ..loadcase import normalize_material
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -66,6 +67,11 @@ class MeasuredPoint:
     # part of the point's identity
     source: str = field(default="", compare=False)
     row: int | None = field(default=None, compare=False)
+    # what the calibration was fitted to, so that it leads back to its tests
+    # (:func:`measured_provenance`): the sha256 of a table's file, the keys of a store's
+    # analyses pooled into the point
+    source_sha256: str = field(default="", compare=False)
+    analyses: tuple[str, ...] = field(default=(), compare=False)
     # the sha256 of the specimen file its tests recorded (a store's ``specimen_sha256``): two
     # files of one name are two specimens; "" where only the name is known (a table, an older
     # record), or the paper's coupon's (pidcore.specimen.deciding_sha256)
@@ -150,6 +156,9 @@ def read_measured_table(path: str | os.PathLike, *,
     # Latin-1, '#' lines are comments, rows named by their line in the file
     frame = read_text_table_file(path, numeric=(*REQUIRED_COLUMNS, *OPTIONAL_COLUMNS),
                                  example=",".join(REQUIRED_COLUMNS), row="load case")
+    # of the bytes read, as a store keeps a measurement's file: the calibration names the
+    # table it was fitted to by it (measured_provenance)
+    sha256 = file_sha256(path)
     missing = [c for c in REQUIRED_COLUMNS if c not in frame.columns]
     if missing:
         raise InputFileError(f"{path}: missing column(s) {', '.join(missing)}; expected "
@@ -184,7 +193,7 @@ def read_measured_table(path: str | os.PathLike, *,
                                           "material", known=None)
             named = _text_cell(row.get("specimen"), "")
             point = MeasuredPoint(material=material, specimen=named, source=str(path),
-                                  row=int(line), **values,
+                                  row=int(line), source_sha256=sha256, **values,
                                   sdc_bound=_point_sdc_bound(values["fill_percent"], material,
                                                              named, "", specimen)[0])
             # the store's rule (its records refused beyond their noise are left out): zero
@@ -378,7 +387,10 @@ def measured_from_store(store_path: str | os.PathLike, *,
     points = []
     keys = ["frequency_hz", "acceleration_g", "fill_percent", "material", "specimen",
             "specimen_sha256", "specimen_ambiguous"]
-    for (f, a, p, material, named, sha256, ambiguous), group in frame.groupby(keys):
+    groups, pooled = _pool_same_simulations(list(frame.groupby(keys)), specimen)
+    if left_out is not None:
+        left_out.extend(pooled)
+    for (f, a, p, material, named, sha256, ambiguous), group in groups:
         sdc = group["sdc"].to_numpy(float)
         if len(sdc) > 1:
             se = float(np.std(sdc, ddof=1) / math.sqrt(len(sdc)))
@@ -390,6 +402,8 @@ def measured_from_store(store_path: str | os.PathLike, *,
         points.append(MeasuredPoint(float(f), float(a), float(p), float(sdc.mean()), se,
                                     str(material), str(named), sdc_stderr_dof=dof,
                                     source=str(store_path), specimen_sha256=str(sha256),
+                                    analyses=tuple(sorted(map(str, group.get(
+                                        "key", pd.Series([], dtype=object))))),
                                     specimen_ambiguous=bool(ambiguous),
                                     # one specimen and fill: one bound
                                     sdc_bound=group["sdc_bound"].iloc[0]))
@@ -408,6 +422,108 @@ def measured_from_store(store_path: str | os.PathLike, *,
                 f"saved as accepted (first: {dropped[0]}); a fit takes none of them")
         raise InputFileError(f"{store_path}: no analysed measurement has a complete load case")
     return points
+
+
+def _pool_same_simulations(groups: list[tuple[tuple, pd.DataFrame]],
+                           given: Specimen | None) -> tuple[list[tuple[tuple, pd.DataFrame]],
+                                                            list[str]]:
+    """(groups, notes): a store's records grouped per load case (keys: frequency,
+    acceleration, fill, material, specimen label, sha256, ambiguous), with the groups whose
+    fills are the same particles per cell of the specimen they are calibrated with
+    (:func:`pidcore.specimen.same_particles_per_cell`) pooled into one, as repeated tests of
+    one load case at the fill most of its records state (the lowest of a tie); a note says
+    each pool. Tests labelled 50 % and 50.4 % of 10 of 20 particles were two load cases, one
+    DEM simulation (calibrate refuses such points: :func:`~pidcore.calibrate.calibrate.
+    check_repeated_simulations`); a table states its repeats as one row, a store cannot."""
+    from ..dem.simulate import particles_per_cell
+    from ..specimen import same_particles_per_cell
+
+    pools: list[tuple[tuple, list[pd.DataFrame], Specimen | None]] = []
+    for keys, group in groups:
+        counting = _counting_specimen(keys, given)
+        for pool_keys, members, pool_counting in pools:
+            if counting is not None and pool_counting is not None \
+                    and pool_counting.hash == counting.hash \
+                    and pool_keys[:2] + pool_keys[3:] == keys[:2] + keys[3:] \
+                    and same_particles_per_cell(keys[2], pool_keys[2], counting):
+                members.append(group)
+                break
+        else:
+            pools.append((keys, [group], counting))
+    out, notes = [], []
+    for keys, members, counting in pools:
+        if len(members) == 1:
+            out.append((keys, members[0]))
+            continue
+        stated = {float(m["fill_percent"].iloc[0]): len(m) for m in members}
+        fill = max(sorted(stated), key=stated.__getitem__)
+        count, full = particles_per_cell(fill, specimen=counting)
+        out.append(((*keys[:2], fill, *keys[3:]),
+                    pd.concat(members).assign(fill_percent=fill)))
+        label = MeasuredPoint(keys[0], keys[1], fill, 0.0, material=keys[3],
+                              specimen=keys[4], specimen_sha256=keys[5]).label()
+        notes.append(f"{label}: tests stated at fills "
+                     + ", ".join(f"{f:g} % ({n})" for f, n in sorted(stated.items()))
+                     + f" are all {count} of {full} particles per cell of specimen "
+                     f"{counting.name}, one DEM simulation: pooled as repeated tests of one "
+                     f"load case at {fill:g} %")
+    return out, notes
+
+
+def _counting_specimen(keys: tuple, given: Specimen | None) -> Specimen | None:
+    """The specimen whose particles per cell a store's group of tests (``keys`` as
+    :func:`_pool_same_simulations` takes them) is counted in: ``given`` where
+    :func:`points_for_specimen` keeps its tests, the paper's coupon of their particles where
+    no specimen is given and :func:`points_for_paper` keeps them; None where neither (they
+    are left out of the fit, or their particles are not in the materials table)."""
+    from ..specimen import paper_specimen
+
+    probe = MeasuredPoint(keys[0], keys[1], keys[2], 0.0, material=keys[3], specimen=keys[4],
+                          specimen_sha256=keys[5], specimen_ambiguous=bool(keys[6]))
+    if given is not None:
+        return given if points_for_specimen([probe], given)[0] else None
+    if not points_for_paper([probe])[0]:
+        return None
+    try:
+        return paper_specimen(keys[3])
+    except ParameterError:
+        return None
+
+
+def measured_provenance(points: Sequence[MeasuredPoint]) -> list[dict[str, Any]]:
+    """What a calibration was fitted to, one entry per source in the order read
+    (calibration.json's ``settings.measured``): a table by its path and the sha256 of its
+    bytes (``kind`` ``table``), a store by its path and the keys of the analyses pooled
+    (``store``), points made in code (no source) by their number alone (``points``)."""
+    out: dict[tuple[str, str], dict[str, Any]] = {}
+    for p in points:
+        kind = "table" if p.row is not None else "store" if p.source else "points"
+        entry = out.setdefault((kind, p.source), {"kind": kind, "source": p.source,
+                                                  "points": 0})
+        entry["points"] += 1
+        if kind == "table":
+            entry["sha256"] = p.source_sha256
+        elif kind == "store":
+            entry.setdefault("analyses", []).extend(p.analyses)
+    return list(out.values())
+
+
+def measured_words(measured: Sequence[Mapping[str, Any]]) -> str:
+    """:func:`measured_provenance` in words, the summary's and the calibrated file's line:
+    ``"Measured: 6 load cases of table m.csv (sha256 9a19...)."``."""
+    said = []
+    for entry in measured:
+        n = f"{entry.get('points', 0)} load case(s)"
+        if entry.get("kind") == "table":
+            said.append(f"{n} of table {entry.get('source')} (sha256 "
+                        f"{entry.get('sha256') or 'unknown'})")
+        elif entry.get("kind") == "store":
+            keys = entry.get("analyses") or []
+            said.append(f"{n} of store {entry.get('source')} ({len(keys)} analyses"
+                        + (f": {', '.join(keys)}" if keys else "") + ")")
+        else:
+            said.append(f"{n} given in code")
+    return "Measured: " + "; ".join(said) + "." if said else ""
 
 
 def points_for_specimen(points: Sequence[MeasuredPoint], specimen) -> tuple[list, str]:

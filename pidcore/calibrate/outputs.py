@@ -3,9 +3,11 @@ Markdown/HTML summary, written into one directory (each file complete or absent)
 
 from __future__ import annotations
 
+import dataclasses
 import html
 import json
 import os
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -21,6 +23,7 @@ from ..records import json_safe
 from ..specimen import CALIBRATED_SPECIMEN_FILE
 from ..units import display_number
 from .calibrate import CalibrationResult
+from .data import measured_words
 from .posterior import summary_texts
 
 #: The calibrated specimen's file among the outputs (one name with the specimen loader's, which
@@ -56,6 +59,9 @@ def specimen_text(result: CalibrationResult) -> str:
     if result.loo_rms is not None:
         lines.append(f"# leave-one-out RMS of the SDC: {rms_text(result.loo_rms)}")
     lines.append(f"# in-sample RMS of the SDC: {rms_text(result.rms)}")
+    measured = measured_words(result.settings.get("measured") or [])
+    if measured:  # the tests it speaks for, by file and hash or by analysis keys
+        lines.append(f"# {measured}")
     lines += [f"# note: {note}" for note in result.notes]  # e.g. a value set by its prior
     return "\n".join(lines) + "\n" + result.calibrated_specimen().to_toml()
 
@@ -244,6 +250,9 @@ def _summary_tables(result: CalibrationResult) -> list[tuple[str, list[str], lis
 def summary_markdown(result: CalibrationResult) -> str:
     """Markdown summary: parameters, correlations, predictions, LOO table, energy check."""
     lines = ["# Calibration summary", "", _fitted_words(result), "", specimen_words(result)]
+    measured = measured_words(result.settings.get("measured") or [])
+    if measured:
+        lines += ["", measured]
     for heading, head, rows in _summary_tables(result):
         if heading.startswith("Posterior correlations"):
             lines += ["", f"{heading}:"]
@@ -271,6 +280,9 @@ def summary_html(result: CalibrationResult) -> str:
              "table{border-collapse:collapse}</style></head><body><h1>Calibration summary</h1>",
              f"<p>{html.escape(_fitted_words(result))}</p>",
              f"<p>{html.escape(specimen_words(result))}</p>"]
+    measured = measured_words(result.settings.get("measured") or [])
+    if measured:
+        parts.append(f"<p>{html.escape(measured)}</p>")
     for heading, head, rows in _summary_tables(result):
         if heading:
             parts.append(f"<h2>{html.escape(heading)}</h2>")
@@ -449,8 +461,15 @@ def finish_interrupted_outputs(out_dir: str | os.PathLike) -> str:
     return finished_moves_note(out_dir, kind="calibration")
 
 
-def write_outputs(result: CalibrationResult, out_dir: str | os.PathLike) -> list[Path]:
+def write_outputs(result: CalibrationResult, out_dir: str | os.PathLike, *,
+                  wording: Callable[[str], str] | None = None) -> list[Path]:
     """Write every output into ``out_dir`` (created); returns the paths written.
+
+    ``wording``: the notes of summary.md, summary.html and the calibrated specimen's header
+    in the front-end's words, as it prints them (the CLI's
+    :func:`pidcore.cli._vocabulary.cli_words`: ``--prior``, not ``priors=``), as
+    :func:`pidcore.report.pipeline.make_report` takes it; calibration.json keeps the
+    library's, the words the store keeps it in.
 
     All or nothing, as the store commits: the files are made in a hidden folder beside
     ``out_dir`` and moved into it in one step that Ctrl-C cannot cut in two
@@ -466,12 +485,14 @@ def write_outputs(result: CalibrationResult, out_dir: str | os.PathLike) -> list
     from .. import interrupt
 
     out = Path(out_dir)
+    said = result if wording is None else \
+        dataclasses.replace(result, notes=[wording(note) for note in result.notes])
     # every text first: one that cannot be made (a calibrated specimen outside the domain)
     # refuses before any folder is created, not after, leaving it empty
     texts = (("calibration.json", document_json(result.full_document())),
-             (SPECIMEN_FILE, specimen_text(result)),
-             ("summary.md", summary_markdown(result)),
-             ("summary.html", summary_html(result)))
+             (SPECIMEN_FILE, specimen_text(said)),
+             ("summary.md", summary_markdown(said)),
+             ("summary.html", summary_html(said)))
     out.parent.mkdir(parents=True, exist_ok=True)
     finish_interrupted_outputs(out)  # before this write's: the earlier set whole, then replaced
     # beside out_dir: on its file system, so that the moves below are renames

@@ -81,12 +81,25 @@ def calibration_key(document: dict, calibrated_specimen_text: str | None = None)
         what["units"] = {k: v for k, v in what["units"].items() if k not in _DERIVED_UNITS}
     settings = dict(what.get("settings") or {})
     settings.pop("store", None)
+    # where its tests were read (paths, a table's sha256, the analyses' keys): the measured
+    # values themselves are in the rows keyed above, and the same fit of a table moved to
+    # another folder, or saved before these were recorded, is the same calibration
+    settings.pop("measured", None)
     what["settings"] = settings
     text = json.dumps(json.loads(document_json(what)), sort_keys=True, separators=(",", ":"))
     if calibrated_specimen_text is not None:
         # a separator no JSON text holds: the document's end cannot pass for the specimen's
         text += "\x00" + calibrated_specimen_text
     return _KEY_PREFIX + hashlib.sha256(text.encode("utf-8")).hexdigest()[:16]
+
+
+def measured_record(measured: Sequence[dict]) -> dict[str, str]:
+    """The listing record's ``measured_source`` (each table's or store's path, ``"; "``
+    between them) and ``measured_sha256`` (each table's sha256, "" for a store) of
+    calibration.json's ``settings.measured``
+    (:func:`pidcore.calibrate.data.measured_provenance`)."""
+    return {"measured_source": "; ".join(str(e.get("source", "")) for e in measured),
+            "measured_sha256": "; ".join(str(e.get("sha256", "")) for e in measured)}
 
 
 class SavedCalibration(NamedTuple):
@@ -124,6 +137,9 @@ def _record(result) -> tuple[dict, dict]:
                     # calibrated file (by an earlier or later pidcore) is found by it
                     "document_key": calibration_key(result.full_document()),
                     "fit": ",".join(result.settings["fit"]),
+                    # the tests it was fitted to, as a measurement's record names its file
+                    # (source, sha256); the analyses' keys are in its settings
+                    **measured_record(result.settings.get("measured") or []),
                     "method_used": str(result.settings.get("method_used", "")),
                     "n_points": len(result.predictions), "rms_in_sample": result.rms,
                     "loo_rms": result.loo_rms, "loo_coverage95": result.loo_coverage,

@@ -143,7 +143,9 @@ def run(args: argparse.Namespace) -> int:
         result.notes = [*left_out, *own_notes]
         fitted = True
         if args.out is not None:
-            write_outputs(result, args.out)  # all or nothing
+            # all or nothing; its notes in the words printed below (--prior, not priors=)
+            write_outputs(result, args.out,
+                          wording=lambda text: cli_words(text, "calibrate"))
             written = True
         # beside the DEM runs it was made from (one transaction, after --out so that a Ctrl-C
         # while the figures are drawn commits nothing): reports and the app read it from there
