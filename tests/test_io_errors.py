@@ -157,22 +157,61 @@ def test_a_one_column_csv_is_that_column_and_a_wider_header_still_says_so(tmp_pa
         read_measurement(wider)
 
 
-def test_a_csv_channel_shorter_than_its_time_column_says_where_it_ends(tmp_path, capsys):
-    # 'Velocity' ends at row 4 of 6 (trailing empty cells): was "channel 'Velocity': 2
-    # non-finite samples (NaN/inf), first at index 4", which did not say the column is short
+def test_a_csv_channel_shorter_than_its_time_column_is_read_to_its_end_and_said(tmp_path):
+    # 'Velocity' ends at row 4 of 6 (trailing empty cells): it was refused, and with it the
+    # whole file where the short column was one no role needs (a microphone)
+    import numpy as np
+
     rows = [f"{k / 1000},{k},{'' if k >= 4 else k}" for k in range(6)]
     path = tmp_path / "short_fill50.csv"
     path.write_text("Time [s],Force [N],Velocity [m/s]\n" + "\n".join(rows) + "\n")
+    m = read_measurement(path)
+    force, velocity = m.channels
+    np.testing.assert_array_equal(force.data, [0, 1, 2, 3, 4, 5])
+    np.testing.assert_array_equal(velocity.data, [0, 1, 2, 3])  # its values, none invented
+    assert velocity.start_time_s == force.start_time_s == 0.0
     # the 4th row's time: 3 ms, from the 1 kHz time column
-    said = (f"{path}: channel 'Velocity' ends early, at data row 4 of 6 (t = 0.003 s): the 2 "
-            "rows after it hold no value; expected a value in every row its time column has")
-    _refused_alike_by_reader_and_cli(path, said, tmp_path, capsys)
+    assert m.metadata["reader_notes"] == [
+        f"{path}: channel 'Velocity' ends early, at data row 4 of 6 (t = 0.003 s): the 2 rows "
+        "after it hold no value; read to there"]
     empty = tmp_path / "empty_column.csv"
     empty.write_text("Time [s],Force [N],Velocity [m/s]\n"
                      + "\n".join(f"{k / 1000},{k}," for k in range(6)) + "\n")
     with pytest.raises(InputFileError, match=r"channel 'Velocity' holds no value in any of "
                                              r"its 6 rows; expected a value in every row$"):
         read_measurement(empty)
+
+
+def test_an_unused_channel_ending_early_leaves_the_analysis_as_without_it(tmp_path, capsys):
+    # a microphone column that stopped after 1 s refused the whole 2 s record
+    import json
+
+    import numpy as np
+
+    from pidcore.cli import main
+    from pidcore.signal.synthetic import synthesize_shaker_record
+
+    rec = synthesize_shaker_record(mass_kg=0.05, acceleration_amplitude_m_s2=49.0,
+                                   frequency_hz=100.0, sample_rate_hz=5120.0, n_periods=200,
+                                   viscous_damping_n_s_m=1.5, snr_db=60.0, seed=3)
+    f, v = rec.force_n.tolist(), rec.velocity_m_s.tolist()
+    t = (np.arange(len(f)) / 5120.0).tolist()
+    plain = tmp_path / "plain.csv"
+    plain.write_text("Time [s],Force [N],Velocity [m/s]\n" + "\n".join(
+        f"{a!r},{b!r},{c!r}" for a, b, c in zip(t, f, v, strict=True)) + "\n")
+    mic = tmp_path / "mic.csv"
+    mic.write_text("Time [s],Force [N],Velocity [m/s],Mic [Pa]\n" + "\n".join(
+        f"{a!r},{b!r},{c!r}," + (f"{np.sin(k):.6f}" if a < 1.0 else "")
+        for k, (a, b, c) in enumerate(zip(t, f, v, strict=True))) + "\n")
+
+    def analysed(path):
+        assert main(["analyze", str(path), "--no-store", "--json"]) == 0
+        return json.loads(capsys.readouterr().out)["records"][0]
+
+    without, with_mic = analysed(plain), analysed(mic)
+    for key in ("loss_factor", "sdc", "energy_per_cycle_j", "frequency_hz"):
+        assert with_mic[key] == without[key], key  # the same samples: the same bits
+    assert any("channel 'Mic' ends early" in n for n in with_mic["notes"])
 
 
 def test_a_long_first_line_is_quoted_by_its_start_and_size(tmp_path):

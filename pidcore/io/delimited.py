@@ -470,7 +470,9 @@ def read_csv(path: str | os.PathLike[str], *, sample_rate_hz: float | None = Non
                              main=(rate, start_time, n_rows),
                              given_rate=sample_rate_hz, notes=notes, given_time=given_time)
     for name, i in zip(names, keep, strict=True):
-        _refuse_a_channel_ending_early(columns[i][:bases[i][2]], name, bases[i], where)
+        ended = _channel_end(columns[i][:bases[i][2]], name, bases[i], where, notes)
+        if ended < bases[i][2]:
+            bases[i] = (bases[i][0], bases[i][1], ended)
     # each column is an array of its own: a channel holds its column, not the whole table
     # (time column and all) as a view of pandas' block did
     channels = tuple(make_channel(n, columns[i][:bases[i][2]], sample_rate_hz=bases[i][0],
@@ -562,23 +564,24 @@ def _in_seconds(times: np.ndarray, factor: float) -> np.ndarray:
     return times if factor == 1.0 else times * factor
 
 
-def _refuse_a_channel_ending_early(column: np.ndarray, name: str,
-                                   base: tuple[float, float, int], where: str) -> None:
-    """Refuse a channel whose last cells are empty while its time column goes on, saying
-    where it ends: it was refused as "892 non-finite samples (NaN/inf), first at index 3000",
-    which does not say that the column is short."""
+def _channel_end(column: np.ndarray, name: str, base: tuple[float, float, int], where: str,
+                 notes: list[str]) -> int:
+    """Rows of a channel up to its last value: a column whose last cells are empty while its
+    time column goes on ends there, said in a note (the analysis cuts the channels it uses to
+    their common span, and says so). A whole file was refused for an unused microphone column
+    that ended after 1 s. A column of no value at all is refused."""
     if column.size == 0 or not np.isnan(column[-1]):
-        return
+        return column.size
     given = np.flatnonzero(~np.isnan(column))
     last = int(given[-1]) if given.size else -1
     if last < 0:
         raise InputFileError(f"{where}: channel {name!r} holds no value in any of its "
                              f"{column.size} rows; expected a value in every row")
     rate, start, rows = base
-    raise InputFileError(
-        f"{where}: channel {name!r} ends early, at data row {last + 1} of {rows} (t = "
-        f"{start + last / rate:.9g} s): the {rows - last - 1} rows after it hold no value; "
-        "expected a value in every row its time column has")
+    notes.append(f"{where}: channel {name!r} ends early, at data row {last + 1} of {rows} "
+                 f"(t = {start + last / rate:.9g} s): the {rows - last - 1} rows after it hold "
+                 "no value; read to there")
+    return last + 1
 
 
 def _pair_time_columns(cells: list[tuple[str, str]], time_index: int | None,
