@@ -25,7 +25,6 @@ Examples
 
 from __future__ import annotations
 
-import json
 import math
 import os
 from collections.abc import Mapping, Sequence
@@ -37,6 +36,13 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from . import defaults
+from .compare.settings_columns import (
+    CHANNEL_FIELDS,
+    _changed_settings,
+    _parameters_of,
+    other_settings_note,
+    stored_parameters,
+)
 from .constants import COUNT_UNIT, RATIO_UNIT
 from .errors import (
     ChannelError,
@@ -551,12 +557,6 @@ def analyze_file(path: str | os.PathLike, options: AnalysisOptions | None = None
     return analyze_measurement(measurement, options)
 
 
-def stored_parameters(result: AnalyzedRecord, parameters: Mapping) -> dict:
-    """The parameters an analysis is stored (and keyed) with: ``parameters`` and the
-    channels it used."""
-    return {**parameters, "channels": result.channels_used}
-
-
 def store_analysis(store: Store, result: AnalyzedRecord, parameters: Mapping, *,
                    fields: Mapping | None = None) -> str:
     """Add one analysed record and its measurement to an open :class:`~pidcore.store.Store`.
@@ -736,11 +736,6 @@ def _analyzed_records(results: object) -> list[AnalyzedRecord]:
     return list(results)
 
 
-#: Fields of :class:`AnalysisOptions` that name channels: a record keeps the channels it used
-#: (the app saves its options without them), so these may differ from the analysis's.
-CHANNEL_FIELDS = ("force", "velocity", "acceleration")
-
-
 def _refuse_other_settings(result: AnalyzedRecord, given: AnalysisOptions) -> None:
     """Refuse to save ``result`` with options whose analysis settings differ from those it
     was analysed with: its record would say a delay, mass or baseline it was not made with
@@ -835,54 +830,11 @@ def replacement_notes(analyses: pd.DataFrame,
     return notes
 
 
-def other_settings_note(name: str, old: Mapping | None, new: Mapping | None,
-                        old_sdc: float, new_sdc: float, *, saved_as: str = "",
-                        this: str = "this analysis",
-                        now: str = "the one reports and calibrations use now, the earlier is "
-                                   "kept in the store") -> str:
-    """That ``name`` was saved before (``saved_as``: under that other name) with other
-    analysis settings: the parameters that differ (``old`` -> ``new``, as stored:
-    :func:`stored_parameters`), the saved SDC, and ``this`` analysis's SDC and what it is
-    ``now``; "" where the settings are the same or either is not known (None)."""
-    changed = _changed_settings(_parameters_of(old), _parameters_of(new))
-    if not changed:
-        return ""
-    return (f"{name} was saved before{f' as {saved_as}' if saved_as else ''} with other "
-            f"settings ({changed}; SDC {_shown(old_sdc)}); {this} (SDC {_shown(new_sdc)}) is "
-            f"{now}")
-
-
-def _parameters_of(value: object) -> dict | None:
-    """Analysis parameters as the store's canonical JSON reads back (None: not known)."""
-    if isinstance(value, Mapping):
-        return json.loads(json.dumps(value, sort_keys=True))
-    if isinstance(value, str) and value:
-        try:
-            loaded = json.loads(value)
-        except ValueError:
-            return None
-        return loaded if isinstance(loaded, dict) else None
-    return None
-
-
 def _number(value: object) -> float:
     try:
         return float(value)
     except (TypeError, ValueError):
         return math.nan
-
-
-def _shown(sdc: float) -> str:
-    return f"{sdc:.4g}" if math.isfinite(sdc) else "not known"
-
-
-def _changed_settings(old: dict | None, new: dict | None) -> str:
-    """``"velocity_delay_s 5e-05 -> 0.0"`` for each parameter that differs ("" where either
-    is not known: a record whose parameters_json is not read)."""
-    if old is None or new is None:
-        return ""
-    return ", ".join(f"{name} {json.dumps(old.get(name))} -> {json.dumps(new.get(name))}"
-                     for name in sorted({*old, *new}) if old.get(name) != new.get(name))
 
 
 #: Units of the scalar fields stored per analysis.

@@ -80,9 +80,9 @@ _WITH_UNIT = tuple(
      LABEL_OF_KEYWORD[k], scale, page_unit)
     for k, (si, page_unit, scale) in _PAGE_UNIT.items())
 # a setting changed, as a note on a file saved before with other settings writes it
-# (pidcore.measure.other_settings_note: "velocity_delay_s 5e-05 -> 0.0", JSON values, null for
-# none given): in the field's unit ("'vibrometer delay [µs]' 50 -> 0 µs"), not in SI beside a
-# label in µs
+# (pidcore.compare.settings_columns.other_settings_note: "velocity_delay_s 5e-05 -> 0.0",
+# JSON values, null for none given): in the field's unit ("'vibrometer delay [µs]' 50 -> 0
+# µs"), not in SI beside a label in µs
 _CHANGED = tuple(
     (re.compile(KEYWORD_NOT_BEFORE + re.escape(k) + f" (?P<old>{_AMOUNT}|null) -> "
                 f"(?P<new>{_AMOUNT}|null)" + r"(?![\w.])"),

@@ -256,8 +256,9 @@ class MeasuredEntry:
         gauge 0 g, baseline loss factor 0"`` (empty where unknown).
     settings : dict
         The analysis's parameters (stored ``parameters_json``, or those an unsaved analysis
-        would be stored with: :func:`pidcore.measure.stored_parameters`): how its corrections
-        went, e.g. the baseline off the whole vibrated mass
+        would be stored with:
+        :func:`pidcore.compare.settings_columns.stored_parameters`): how its corrections went,
+        e.g. the baseline off the whole vibrated mass
         (:func:`pidcore.report.pipeline.whole_mass_baseline_note`); empty where unknown.
     measurement_key : str
         The store's key of the measured data (:func:`pidcore.store.measurement_key`): equal
@@ -318,11 +319,11 @@ class MeasuredEntry:
         ``specimen_sha256``: the specimen file's hash as it would be saved ("": none);
         ``sdc_bound``: the SDC bound of its specimen
         (:func:`pidcore.compare.plausibility.tested_sdc_bound`; None: 2 pi)."""
-        from ..measure import stored_parameters
         from ..records import measurement_key
         from ..signal.power import baseline_sdc_taken_off
         from ..specimen import deciding_sha256
         from .plausibility import implausible_findings
+        from .settings_columns import stored_parameters
 
         a = record.analysis
         found, _ = implausible_findings(a, bound=sdc_bound)
@@ -421,7 +422,7 @@ def unique_entries(entries: Sequence[MeasuredEntry]) -> tuple[list[MeasuredEntry
     unsaved analysis of a saved measurement with other settings (a corrected vibrometer
     delay) takes the saved record's place, as its Save would make it the one reports and
     calibrations use; the note names the settings that differ and both SDCs
-    (:func:`pidcore.measure.other_settings_note`).
+    (:func:`pidcore.compare.settings_columns.other_settings_note`).
     """
     kept: list[MeasuredEntry] = []
     notes: list[str] = []
@@ -452,7 +453,7 @@ def _reanalysis_note(saved: MeasuredEntry, session: MeasuredEntry) -> str:
     with other settings, the note that it is compared in the saved one's place; else "".
     The channel names asked for are not compared (the app saves none, ``pidcore analyze``
     those given): the channels used are, under ``channels``."""
-    from ..measure import CHANNEL_FIELDS, other_settings_note
+    from .settings_columns import CHANNEL_FIELDS, other_settings_note
 
     if saved.origin != "store" or session.origin == "store":
         return ""

@@ -22,8 +22,11 @@ describe_corrections
 
 from __future__ import annotations
 
+import json
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import Any
 
 from .loadcase import SPECIMEN_COLUMN
 
@@ -169,3 +172,60 @@ def describe_corrections(parameters: Mapping[str, object]) -> str:
            f" (of a {setting_phrase('structure_mass_kg', structure_kg)})" if structure_kg > 0
            else " (off the whole vibrated mass)")
     return said + how
+
+
+# --- an analysis saved again with other settings (pidcore analyze, the app's Save and Compare)
+
+#: Fields of :class:`pidcore.measure.AnalysisOptions` that name channels: a record keeps the
+#: channels it used (the app saves its options without them), so these may differ from the
+#: analysis's.
+CHANNEL_FIELDS = ("force", "velocity", "acceleration")
+
+
+def stored_parameters(result: Any, parameters: Mapping) -> dict:
+    """The parameters an analysis is stored (and keyed) with: ``parameters`` and the
+    channels it used (``result``: a :class:`pidcore.measure.AnalyzedRecord`)."""
+    return {**parameters, "channels": result.channels_used}
+
+
+def other_settings_note(name: str, old: Mapping | None, new: Mapping | None,
+                        old_sdc: float, new_sdc: float, *, saved_as: str = "",
+                        this: str = "this analysis",
+                        now: str = "the one reports and calibrations use now, the earlier is "
+                                   "kept in the store") -> str:
+    """That ``name`` was saved before (``saved_as``: under that other name) with other
+    analysis settings: the parameters that differ (``old`` -> ``new``, as stored:
+    :func:`stored_parameters`), the saved SDC, and ``this`` analysis's SDC and what it is
+    ``now``; "" where the settings are the same or either is not known (None)."""
+    changed = _changed_settings(_parameters_of(old), _parameters_of(new))
+    if not changed:
+        return ""
+    return (f"{name} was saved before{f' as {saved_as}' if saved_as else ''} with other "
+            f"settings ({changed}; SDC {_shown(old_sdc)}); {this} (SDC {_shown(new_sdc)}) is "
+            f"{now}")
+
+
+def _parameters_of(value: object) -> dict | None:
+    """Analysis parameters as the store's canonical JSON reads back (None: not known)."""
+    if isinstance(value, Mapping):
+        return json.loads(json.dumps(value, sort_keys=True))
+    if isinstance(value, str) and value:
+        try:
+            loaded = json.loads(value)
+        except ValueError:
+            return None
+        return loaded if isinstance(loaded, dict) else None
+    return None
+
+
+def _shown(sdc: float) -> str:
+    return f"{sdc:.4g}" if math.isfinite(sdc) else "not known"
+
+
+def _changed_settings(old: dict | None, new: dict | None) -> str:
+    """``"velocity_delay_s 5e-05 -> 0.0"`` for each parameter that differs ("" where either
+    is not known: a record whose parameters_json is not read)."""
+    if old is None or new is None:
+        return ""
+    return ", ".join(f"{name} {json.dumps(old.get(name))} -> {json.dumps(new.get(name))}"
+                     for name in sorted({*old, *new}) if old.get(name) != new.get(name))
