@@ -40,8 +40,8 @@ from .compare.settings_columns import (
     CHANNEL_FIELDS,
     _changed_settings,
     _parameters_of,
+    analysis_parameters_to_store,
     other_settings_note,
-    stored_parameters,
 )
 from .constants import COUNT_UNIT, RATIO_UNIT
 from .errors import (
@@ -574,7 +574,7 @@ def store_analysis(store: Store, result: AnalyzedRecord, parameters: Mapping, *,
     units = {**ANALYSIS_UNITS, **RECORDED_BOUND_UNITS}
     return store.add_analysis(
         measurement_key, record, arrays=arrays,
-        parameters=stored_parameters(result, parameters),
+        parameters=analysis_parameters_to_store(result, parameters),
         units={k: v for k, v in units.items() if k in record or k in arrays})
 
 
@@ -684,7 +684,7 @@ def save_analyses(store: Store | str | os.PathLike, results: Sequence[AnalyzedRe
         notes = replacement_notes(before, [
             (name, measurement_key(r.measurement),
              case.full_label() if case is not None else NO_LOAD_CASE,
-             stored_parameters(r, o.parameters()), r.analysis.sdc)
+             analysis_parameters_to_store(r, o.parameters()), r.analysis.sdc)
             for r, o, (name, case, _) in zip(results, per_result, stated, strict=True)])
         keys = [store_analysis(store, r, o.parameters(), fields={
                     **(case.as_record(origin) if case is not None else {}), **(more or {})})
@@ -797,7 +797,8 @@ def replacement_notes(analyses: pd.DataFrame,
 
     ``incoming``: per file to be saved, (file name, measurement key
     (:func:`pidcore.records.measurement_key`), load case in words, the parameters it is
-    stored with (:func:`stored_parameters`), the new SDC). The store
+    stored with (:func:`~pidcore.compare.settings_columns.analysis_parameters_to_store`), the
+    new SDC). The store
     keeps a measurement by its contents, so a byte-identical file under another name, or a
     second copy in the same save, is the same record and only the last one saved is kept:
     each such replacement of another name or load case is said, never silent. A file saved

@@ -257,8 +257,8 @@ class MeasuredEntry:
     settings : dict
         The analysis's parameters (stored ``parameters_json``, or those an unsaved analysis
         would be stored with:
-        :func:`pidcore.compare.settings_columns.stored_parameters`): how its corrections went,
-        e.g. the baseline off the whole vibrated mass
+        :func:`pidcore.compare.settings_columns.analysis_parameters_to_store`): how its
+        corrections went, e.g. the baseline off the whole vibrated mass
         (:func:`pidcore.report.pipeline.whole_mass_baseline_note`); empty where unknown.
     measurement_key : str
         The store's key of the measured data (:func:`pidcore.store.measurement_key`): equal
@@ -323,7 +323,7 @@ class MeasuredEntry:
         from ..signal.power import baseline_sdc_taken_off
         from ..specimen import deciding_sha256
         from .plausibility import implausible_findings
-        from .settings_columns import stored_parameters
+        from .settings_columns import analysis_parameters_to_store
 
         a = record.analysis
         found, _ = implausible_findings(a, bound=sdc_bound)
@@ -339,7 +339,8 @@ class MeasuredEntry:
                    np.asarray(a.velocity_phasors_m_s), specimen,
                    corrections=describe_corrections(vars(options)) if options else "",
                    measurement_key=content, implausible=found[0].message if found else "",
-                   settings=stored_parameters(record, options.parameters()) if options else {},
+                   settings=(analysis_parameters_to_store(record, options.parameters())
+                             if options else {}),
                    sdc_stderr_dof=a.sdc_stderr_dof,
                    specimen_sha256=deciding_sha256(specimen_sha256) if specimen else "",
                    baseline_sdc=baseline_sdc_taken_off(a))

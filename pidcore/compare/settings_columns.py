@@ -182,7 +182,7 @@ def describe_corrections(parameters: Mapping[str, object]) -> str:
 CHANNEL_FIELDS = ("force", "velocity", "acceleration")
 
 
-def stored_parameters(result: Any, parameters: Mapping) -> dict:
+def analysis_parameters_to_store(result: Any, parameters: Mapping) -> dict:
     """The parameters an analysis is stored (and keyed) with: ``parameters`` and the
     channels it used (``result``: a :class:`pidcore.measure.AnalyzedRecord`)."""
     return {**parameters, "channels": result.channels_used}
@@ -195,7 +195,7 @@ def other_settings_note(name: str, old: Mapping | None, new: Mapping | None,
                                    "kept in the store") -> str:
     """That ``name`` was saved before (``saved_as``: under that other name) with other
     analysis settings: the parameters that differ (``old`` -> ``new``, as stored:
-    :func:`stored_parameters`), the saved SDC, and ``this`` analysis's SDC and what it is
+    :func:`analysis_parameters_to_store`), the saved SDC, and ``this`` analysis's SDC and what it is
     ``now``; "" where the settings are the same or either is not known (None)."""
     changed = _changed_settings(_parameters_of(old), _parameters_of(new))
     if not changed:
