@@ -299,7 +299,7 @@ def test_the_apps_calibration_holds_its_uploaded_file_while_it_runs(app_store):
         during["found"] = prune_kept_specimens(store_path, remove=True, recent_hours=0)
         raise PidcoreError("stopped by the test")
 
-    api = types.SimpleNamespace(calibrate=calibrate, write_outputs=lambda r, f: [])
+    api = types.SimpleNamespace(calibrate=calibrate, write_outputs=lambda r, f, wording=None: [])
     task = CalibrationTask(("fixture_mass_kg",), 3)
     CalibrationRunner(store_path)._run(api, task, [], ["fixture_mass_kg"], 2, None,
                                        unused.specimen)

@@ -2189,8 +2189,9 @@ def test_the_pages_calibration_keeps_what_it_left_out_in_its_outputs(tmp_path):
 
     written = {}
 
-    def write_outputs(result, folder):
+    def write_outputs(result, folder, *, wording=None):
         written["notes"] = list(result.notes)
+        written["wording"] = wording
         return []
 
     api = types.SimpleNamespace(
@@ -2202,6 +2203,13 @@ def test_the_pages_calibration_keeps_what_it_left_out_in_its_outputs(tmp_path):
                                               None, [left])
     assert task.state == "done"
     assert written["notes"] == [left, "the fit's own note"]
+    # the downloaded summary said the library's keywords (priors=...), which the page has
+    # no field of; it says the notes as the page shows them
+    note = "widen the prior (priors=model_discrepancy=LOW:HIGH)"
+    from pidcore.app.calibration import page_words
+
+    assert written["wording"] is not None and written["wording"](note) == page_words(note)
+    assert "priors=" not in written["wording"](note)
 
 
 def test_the_report_tab_defaults_to_the_newest_calibration_of_the_specimen_reported(tmp_path):
@@ -2673,7 +2681,7 @@ def test_a_cancel_after_the_dem_runs_saves_no_calibration(tmp_path):
     task = runner.task = CalibrationTask(("friction",), 3)
     saved = []
 
-    def write_outputs(result, folder):  # the user's click while the outputs are written
+    def write_outputs(result, folder, *, wording=None):  # the user's click meanwhile
         assert runner.cancel()
         (Path(folder) / "summary.md").write_text("# summary\n")
         return [Path(folder) / "summary.md"]

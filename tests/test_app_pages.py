@@ -858,7 +858,7 @@ def _fake_calibrate_module(calls: list):
                         if specimen is not None else ()))
         return types.SimpleNamespace(fit=fit, notes=[])  # the library's result has notes
 
-    def write_outputs(result, out_dir):
+    def write_outputs(result, out_dir, *, wording=None):
         out = Path(out_dir)
         module.written_notes = list(result.notes)  # what the downloaded summary says
         (out / "summary.md").write_text("# Calibration summary\n\nfixture_mass_kg: 0.01\n")

@@ -386,7 +386,9 @@ class CalibrationRunner:
             if notes:
                 result.notes = [*notes, *result.notes]
             with tempfile.TemporaryDirectory(prefix="pidcore_calibration_") as folder:
-                paths = api.write_outputs(result, folder)
+                # the downloads say the notes as the page does ('parameters to fit', not
+                # the library's priors=), as `pidcore calibrate --out` says its flags
+                paths = api.write_outputs(result, folder, wording=page_words)
                 outputs = {Path(p).name: Path(p).read_bytes() for p in paths}
             state, message = "done", f"{len(points)} load case(s), fitted {', '.join(fit)}"
             with self._lock:  # a cancel that came while the outputs were written wins
