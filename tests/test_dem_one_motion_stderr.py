@@ -14,6 +14,7 @@ import pytest
 
 from pidcore.cli.dem import format_summary
 from pidcore.compare.align import dem_cases
+from pidcore.dem.contact import ContactLaw
 from pidcore.dem.persist import load_dem_result, save_dem_result
 from pidcore.dem.result import DemResult, batch_means_agree, batch_means_stderr
 from pidcore.dem.simulate import DemConfig, simulate_load_case
@@ -58,7 +59,8 @@ def _from_tally(sdc_cell_cycle: np.ndarray, *, transient: int, block_cycles: int
     tally[:, :, 0] = tally[:, :, 1]  # the walls' work supplies the dissipation
     spc = 4
     return DemResult.from_run(
-        case=case, config=DemConfig(cells=k, block_cycles=block_cycles), law=None,
+        case=case, config=DemConfig(cells=k, block_cycles=block_cycles),
+        law=ContactLaw.for_material("acrylic"),  # its damping alphas are recorded
         tally=tally, wall_force=np.zeros((k, (transient + cycles) * spc)),
         steady_start_cycle=transient, steady_detected=True, particles_per_cell=1,
         full_count=23, vibrated_mass_kg=m_c, moving_mass_kg=0.1, dt_s=1e-2 / spc,
