@@ -90,3 +90,19 @@ def without(objects: dict[str, tuple], *entries: str) -> dict[str, tuple]:
     """``objects`` less the entries ``/section/key`` and everything under them."""
     return {k: v for k, v in objects.items()
             if not any(k == e or k.startswith(e + "/") for e in entries)}
+
+
+def second_calibration(path: Path) -> str:
+    """A second calibration fitted into the store at ``path`` on the same design runs (the
+    same rows, cells and seed, another ``--fit``: every run reused from the store, none
+    simulated); returns its key."""
+    from pidcore.cli import main
+
+    table = path.parent / "m.csv"
+    table.write_text(ROWS)
+    before = set(Store(path).list_calibrations()["key"])
+    assert main(["calibrate", "--data", str(table), "--fit", "baseline_loss_factor",
+                 "--dem-store", str(path), *TINY]) == 0
+    added = set(Store(path).list_calibrations()["key"]) - before
+    assert len(added) == 1
+    return added.pop()

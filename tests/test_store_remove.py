@@ -3,12 +3,14 @@ goes with it or the removal is refused, every other record left bit for bit."""
 
 from __future__ import annotations
 
+import h5py
 import pytest
 from _shaker_files import file_sha256
-from _store_records import contents, without
+from _store_records import contents, second_calibration, without
 
 from pidcore.calibrate.persist import calibration_design_runs, stored_calibrations
 from pidcore.errors import StoreError
+from pidcore.report.pipeline import without_design_runs
 from pidcore.store import Store, manage
 from pidcore.store.listing import list_dem_runs, saved_analyses
 from pidcore.store.manage import remove_records, store_contents
@@ -144,3 +146,56 @@ def test_a_calibrations_run_of_its_variant_of_the_start_specimen_is_refused_too(
                       parameters={**run.parameters, "calibration_variant": None})
     assert [r.key for r in remove_records(path, ["other_file_run"]).records] == \
         ["other_file_run"]
+
+
+def test_a_run_two_calibrations_were_fitted_on_is_removed_with_both_or_refused(
+        records_store_copy):
+    # a second fit on the same runs reuses them: each calibration depends on every run, and
+    # a run mapped to one of them was removed with it, the other left naming a run gone
+    path, keys = records_store_copy
+    first, run = keys["calibration"], keys["design"][0]
+    second = second_calibration(path)
+    both = f"{first}, {second}"  # oldest first
+    digest = file_sha256(path)
+    with pytest.raises(StoreError, match=f"DEM run {run} is a design run of calibrations "
+                                         f"{both} .*nothing was removed"):
+        remove_records(path, [run])
+    # naming one of them leaves the other, which is refused by name
+    with pytest.raises(StoreError, match=f"design run of calibration {second} .*nothing"):
+        remove_records(path, [run, first])
+    assert file_sha256(path) == digest
+    removal = remove_records(path, [run], with_dependents=True)
+    assert [(r.section, r.key, r.because) for r in removal.records] == [
+        ("dem_runs", run, ""), *[("calibrations", c, f"fitted on DEM run {run}")
+                                 for c in (first, second)]]
+    assert stored_calibrations(path) == [] and Store(path).verify() == []
+
+
+def test_list_and_reports_name_every_calibration_a_run_is_a_design_run_of(records_store_copy):
+    path, keys = records_store_copy
+    first, second = keys["calibration"], second_calibration(path)
+    listed = store_contents(path, ["dem-runs"])["dem-runs"].set_index("key")["design_of"]
+    assert listed.to_dict() == {**dict.fromkeys(keys["design"], f"{first}, {second}"),
+                                keys["own_run"]: ""}
+    runs = list_dem_runs(path)
+    design = calibration_design_runs(runs, [path, path])  # one store given twice: once each
+    assert design == dict.fromkeys(keys["design"], (first, second))
+    # the report's note on the design runs it leaves out names both fits they are inputs of
+    _, note = without_design_runs(runs, design)
+    assert f"calibration(s) {', '.join(sorted((first, second)))} (2 cells per run)" in note
+
+
+def test_verify_names_a_calibration_whose_design_run_is_gone_and_the_run(records_store_copy):
+    # what the removal of a shared run with one calibration left: the other calibration
+    # fitted on a run the store no longer holds, which verify called sound
+    path, keys = records_store_copy
+    run = keys["design"][0]
+    assert Store(path).verify() == []
+    with h5py.File(path, "r+") as h5:  # damage done outside pidcore
+        del h5["dem_runs"][run]
+    problems = Store(path).verify()
+    case = run.split("_seed")[0]
+    assert len(problems) == 1
+    assert problems[0].startswith(f"{path}:/calibrations/{keys['calibration']}: fitted on "
+                                  f"the DEM run(s) {case}_seed")
+    assert "none of which is stored" in problems[0]

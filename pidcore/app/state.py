@@ -56,10 +56,11 @@ def store_listing(what: str, stamp: tuple, _stores):
 
 
 @st.cache_data(max_entries=4, show_spinner=False)
-def design_runs(stamp: tuple, _stores) -> dict[str, str]:
-    """Which of the stores' DEM runs are a saved calibration's design runs (run key ->
-    calibration key, :func:`pidcore.calibrate.persist.calibration_design_runs`), re-read only
-    when a store file changed: it opens the stores and reads every calibration."""
+def design_runs(stamp: tuple, _stores) -> dict[str, tuple[str, ...]]:
+    """Which of the stores' DEM runs are a saved calibration's design runs (run key -> the
+    keys of every calibration fitted on it,
+    :func:`pidcore.calibrate.persist.calibration_design_runs`), re-read only when a store
+    file changed: it opens the stores and reads every calibration."""
     from pidcore.calibrate.persist import calibration_design_runs
 
     return calibration_design_runs(store_listing("dem_runs", stamp, _stores),

@@ -15,7 +15,9 @@ reports and the app (which then survive a restart and travel with the store's DE
 * :func:`readable_calibrations`: those that can be read, and what is wrong with the others;
 * :func:`stored_calibration`: one of them, by key (a store holding one needs none);
 * :func:`calibration_design_runs`: which stored DEM runs are a calibration's design runs (inputs
-  of its fit, kept apart from a report's predictions);
+  of its fit, kept apart from a report's predictions), each with every calibration fitted on it;
+* :func:`missing_design_runs`: the calibrations of a store whose design runs it no longer holds
+  (``pidcore store verify``);
 * :func:`is_store_file`: whether a ``--calibration`` path names a store rather than a JSON file;
 * :func:`stored_settings`: the settings (cells, seed, ...) a calibration's listing record states.
 """
@@ -36,6 +38,7 @@ from .prediction import Calibration, calibration_from_json
 if TYPE_CHECKING:  # pragma: no cover
     import pandas as pd
 
+    from ..loadcase import LoadCase
     from .calibrate import CalibrationResult
 
 #: Fields of calibration.json that describe how a calibration was made, not what it is: the
@@ -354,10 +357,12 @@ def stored_settings(parameters_json: object) -> dict:
 
 def calibration_design_runs(runs: pd.DataFrame | None,
                             store_paths: Sequence[str | os.PathLike | None], *,
-                            variants: bool = False) -> dict[str, str]:
+                            variants: bool = False) -> dict[str, tuple[str, ...]]:
     """The DEM runs of ``runs`` (a :func:`pidcore.store.listing.list_dem_runs` listing) that
-    are the design runs of a calibration saved in one of ``store_paths``: run key ->
-    calibration key.
+    are the design runs of a calibration saved in one of ``store_paths``: run key -> the keys
+    of every such calibration (oldest first). Two calibrations fitted on the same runs (other
+    ``--fit``, the runs reused from the store) share them: each is a dependent of the run, and
+    mapping a run to one calibration removed the run under the other without a word.
 
     A calibration runs its start specimen (and, fitting DEM parameters, variants of it with
     other hashes, which reports leave out as other specimens) at its measured load cases with
@@ -373,6 +378,61 @@ def calibration_design_runs(runs: pd.DataFrame | None,
     too, which what removes runs must know of, while reports leave them out already as
     other specimens.
     """
+    found: dict[str, tuple[str, ...]] = {}
+    for path in dict.fromkeys(Path(p) for p in store_paths if p is not None):
+        for design in _design_runs_by_case(runs, path, variants=variants):
+            for key in design.runs:
+                # a calibration met twice (one store given under two names) is one dependent
+                found[key] = tuple(dict.fromkeys((*found.get(key, ()), design.calibration)))
+    return found
+
+
+class DesignCase(NamedTuple):
+    """One load case a stored calibration was fitted at: ``calibration`` (its key), the
+    ``case`` (a :class:`~pidcore.loadcase.LoadCase`), ``specimen_hash``, ``cells`` and
+    ``seed`` its runs were made with, and the keys of those of ``runs`` that are its design
+    runs there (empty: none is stored)."""
+
+    calibration: str
+    case: LoadCase
+    specimen_hash: str
+    cells: int
+    seed: int
+    runs: tuple[str, ...]
+
+
+def missing_design_runs(path: str | os.PathLike) -> list[str]:
+    """A line per load case at which a calibration stored at ``path`` was fitted while the
+    store holds none of its design runs there (``pidcore store verify``): such a run removed
+    without the calibration left a fit whose inputs are gone, and reports could no longer
+    tell them apart from predictions. Runs and calibrations are read as
+    :func:`calibration_design_runs` reads them (one rule), variants of the start included;
+    a calibration stating no cells or seed, or unreadable, is not checked here (the entry's
+    own check says what is wrong with it)."""
+    from ..store import Store
+
+    path = Path(path)
+    runs = Store(path).list_dem_runs()
+    lines = []
+    for design in _design_runs_by_case(runs, path, variants=True, every_calibration=True):
+        if design.runs:
+            continue
+        case = design.case
+        lines.append(
+            f"{path}:/calibrations/{design.calibration}: fitted on the DEM run(s) "
+            f"{case.key}_seed{design.seed}_cells{design.cells}_* of specimen "
+            f"{design.specimen_hash[:6]} ({case.frequency_hz:g} Hz, {case.acceleration_g:g} g, "
+            f"fill {case.fill_percent:g} %), none of which is stored (a design run removed "
+            "without its calibration)")
+    return lines
+
+
+def _design_runs_by_case(runs: pd.DataFrame | None, path: Path, *, variants: bool,
+                         every_calibration: bool = False) -> list[DesignCase]:
+    """Each load case of each calibration stored at ``path`` with its design runs among
+    ``runs`` (the rule :func:`calibration_design_runs` states). Without
+    ``every_calibration`` nothing where ``runs`` holds none (reports of a store of runs
+    only)."""
     import numpy as np
 
     from ..store import Store
@@ -380,10 +440,18 @@ def calibration_design_runs(runs: pd.DataFrame | None,
     needed = {"case_key", "specimen_sha256", "cells_simulated", "seed", "frequency_hz",
               "acceleration_g", "fill_percent", "material"}
     if runs is None or runs.empty or not needed <= set(runs.columns):
-        return {}
-    found: dict[str, str] = {}
+        if not every_calibration:
+            return []
+        import pandas as pd
+
+        runs = pd.DataFrame(columns=sorted(needed))
+    if not path.is_file():
+        return []
+    listing = Store(path).list_calibrations()
+    if listing.empty:
+        return []
     origins = runs["specimen_sha256"]
-    if variants:
+    if variants and not runs.empty:
         import pandas as pd
 
         from ..compare.specimens import CalibrationVariant, run_origins
@@ -391,33 +459,31 @@ def calibration_design_runs(runs: pd.DataFrame | None,
         origins = pd.Series([o.of_sha256 if isinstance(o, CalibrationVariant) else own
                              for o, own in zip(run_origins(runs), runs["specimen_sha256"],
                                                strict=True)], index=runs.index)
-    for path in dict.fromkeys(Path(p) for p in store_paths if p is not None):
-        if not path.is_file():
+    calibrations, _ = readable_calibrations(path, listing=listing)  # damaged: said elsewhere
+    by_key = {c.store_key: c for c in calibrations}
+    found = []
+    for _, record in listing.iterrows():
+        calibration = by_key.get(record["key"])
+        settings = stored_settings(record.get("parameters_json"))
+        try:
+            cells, seed = int(settings["cells"]), int(settings["seed"])
+        except (KeyError, TypeError, ValueError):
+            continue  # a calibration that does not state its runs' settings
+        if calibration is None:
             continue
-        listing = Store(path).list_calibrations()
-        if listing.empty:
-            continue
-        calibrations, _ = readable_calibrations(path, listing=listing)  # damaged: said elsewhere
-        by_key = {c.store_key: c for c in calibrations}
-        for _, record in listing.iterrows():
-            calibration = by_key.get(record["key"])
-            settings = stored_settings(record.get("parameters_json"))
-            try:
-                cells, seed = int(settings["cells"]), int(settings["seed"])
-            except (KeyError, TypeError, ValueError):
-                continue  # a calibration that does not state its runs' settings
-            if calibration is None:
-                continue
-            same = runs[(origins == record.get("specimen_hash"))
-                        & (runs["cells_simulated"] == cells) & (runs["seed"] == seed)]
-            for p in calibration.predictions:
-                case = p.load_case
-                # the calibration made these runs from the cases it predicts: the same
-                # numbers, so only float noise of a round trip through the store is allowed
+        sha = str(record.get("specimen_hash") or "")
+        same = runs[(origins == sha) & (runs["cells_simulated"] == cells)
+                    & (runs["seed"] == seed)]
+        for p in calibration.predictions:
+            case = p.load_case
+            # the calibration made these runs from the cases it predicts: the same
+            # numbers, so only float noise of a round trip through the store is allowed
+            keys: tuple[str, ...] = ()
+            if not same.empty:
                 at = (np.isclose(same["frequency_hz"], case.frequency_hz, rtol=1e-9)
                       & np.isclose(same["acceleration_g"], case.acceleration_g, rtol=1e-9)
                       & np.isclose(same["fill_percent"], case.fill_percent, rtol=1e-9)
                       & (same["material"] == case.material))
-                for key in same.loc[at, "case_key"]:
-                    found.setdefault(str(key), str(record["key"]))
+                keys = tuple(str(k) for k in same.loc[at, "case_key"])
+            found.append(DesignCase(str(record["key"]), case, sha, cells, seed, keys))
     return found

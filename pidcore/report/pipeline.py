@@ -436,7 +436,7 @@ def specimen_dem_runs(stored: pd.DataFrame | None, specimen=None, *,
     return kept, notes
 
 
-def without_design_runs(runs: pd.DataFrame, design_runs: Mapping[str, str], *,
+def without_design_runs(runs: pd.DataFrame, design_runs: Mapping[str, Sequence[str]], *,
                         poolable: bool = True) -> tuple[pd.DataFrame | None, str]:
     """``runs`` without the calibrations' design runs that another run of their specimen and
     load case stands beside, and the note naming the design runs ("" where there were none);
@@ -463,7 +463,7 @@ def without_design_runs(runs: pd.DataFrame, design_runs: Mapping[str, str], *,
     replaced = np.array([d and w in covered for w, d in zip(where, design, strict=True)],
                         bool)
     design_keys = runs.loc[design, "case_key"]
-    calibrations = sorted({design_runs[k] for k in design_keys})
+    calibrations = sorted({c for k in design_keys for c in design_runs[k]})
     cells = sorted({int(c) for c in runs.loc[design, "cells_simulated"].dropna()}) \
         if "cells_simulated" in runs.columns else []
     of_cells = f" ({' or '.join(map(str, cells))} cells per run)" if cells else ""
@@ -584,7 +584,7 @@ def specimen_report_table(stored_runs: pd.DataFrame | None, analyses: pd.DataFra
                           specimen: Specimen | None = None, where: str | Path | None = None,
                           tolerances: Tolerances | None = None, pool: bool = False,
                           choose_another: str = CHOOSE_SPECIMEN_CLI,
-                          design_runs: Mapping[str, str] | None = None,
+                          design_runs: Mapping[str, Sequence[str]] | None = None,
                           store_analyses: pd.DataFrame | None = None) -> SpecimenTable:
     """The report table of one specimen's DEM runs (:func:`specimen_dem_runs`) beside the
     analyses, as ``pidcore report`` and the app's Report tab show it.
@@ -599,7 +599,7 @@ def specimen_report_table(stored_runs: pd.DataFrame | None, analyses: pd.DataFra
     names the runs of other specimens the store holds there. The default (the paper's coupon)
     leaves the column empty, as the bundled report always had it.
 
-    ``design_runs``: run key -> calibration key of the runs that are calibrations' design runs
+    ``design_runs``: run key -> calibration keys of the runs that are calibrations' design runs
     (:func:`pidcore.calibrate.persist.calibration_design_runs`); unless ``pool``, they are left
     out of the rows, and a note says so. ``store_analyses``: every analysis of the store
     ``analyses`` are chosen from, deciding with them which file a record saved without its

@@ -102,7 +102,7 @@ def store_contents(path: str | os.PathLike,
     Analyses: ``reports`` is ``newest`` for the newest analysis of its measurement, the one
     ``pidcore report --store`` and ``calibrate --store`` take (the one rule of
     :func:`pidcore.store.listing.latest_per_measurement`), else ``superseded``. DEM runs:
-    ``design_of`` names the calibration whose fit it is an input of
+    ``design_of`` names every calibration whose fit it is an input of, ``", "``-separated
     (:func:`pidcore.calibrate.persist.calibration_design_runs`).
 
     Raises
@@ -119,6 +119,8 @@ def store_contents(path: str | os.PathLike,
     for section in wanted:
         name = SECTIONS[section]
         table = _contents(store, name)
+        if "design_of" in table.columns:
+            table["design_of"] = [", ".join(keys) for keys in table["design_of"]]
         out[section] = table.reindex(columns=_COLUMNS[name]).reset_index(drop=True)
     return out
 
@@ -146,7 +148,8 @@ def _contents(store: Store, section: str) -> pd.DataFrame:
         frame["specimen"] = _specimens(_column(frame, "specimen_name"),
                                        _column(frame, "specimen_sha256"))
         frame["cells"] = _column(frame, "cells_simulated", None)
-        frame["design_of"] = [design.get(k, "") for k in frame["key"]]
+        # every calibration fitted on the run (a tuple; store_contents writes them as text)
+        frame["design_of"] = [design.get(k, ()) for k in frame["key"]]
         return frame
     frame = store.list_calibrations()
     frame["specimen"] = _specimens(_column(frame, "specimen"), _column(frame, "specimen_hash"))
@@ -264,16 +267,20 @@ def _plan(store: Store, keys: Sequence[str], *,
     for section, key in list(named):
         if section != "dem_runs":
             continue
-        calibration = runs.loc[runs["key"] == key, "design_of"].iloc[0]
-        if not calibration or ("calibrations", calibration) in chosen:
-            continue
-        if not with_dependents:
+        # every calibration fitted on the run: one left behind names a run that is gone
+        left = [c for c in runs.loc[runs["key"] == key, "design_of"].iloc[0]
+                if ("calibrations", c) not in chosen]
+        if left and not with_dependents:
+            several = len(left) > 1
             raise StoreError(
-                f"{store.path}: DEM run {key} is a design run of calibration {calibration} "
-                "(an input of its fit, which reports tell apart from predictions by it); "
-                "nothing was removed (name the calibration too, or with_dependents=True "
-                "removes it with the run)")
-        chosen[("calibrations", calibration)] = f"fitted on DEM run {key}"
+                f"{store.path}: DEM run {key} is a design run of calibration"
+                f"{'s' if several else ''} {', '.join(left)} (an input of "
+                f"{'their fits' if several else 'its fit'}, which reports tell apart from "
+                f"predictions by it); nothing was removed (name "
+                f"{'them' if several else 'the calibration'} too, or with_dependents=True "
+                f"removes {'them' if several else 'it'} with the run)")
+        for calibration in left:
+            chosen[("calibrations", calibration)] = f"fitted on DEM run {key}"
     records = tuple(RemovedRecord(section, key, labels[section][key], because)
                     for (section, key), because in chosen.items())
     return records, _notes(analyses, {(s, k) for s, k in chosen})

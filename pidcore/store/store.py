@@ -1239,7 +1239,9 @@ class Store:
 
         Checks the root attributes, that every measurement, analysis and DEM run has its
         provenance attributes and readable datasets (checksummed arrays are read in full), that
-        keys match their contents and that every analysis refers to a stored measurement.
+        keys match their contents, that every analysis refers to a stored measurement and that
+        every calibration's design runs are stored
+        (:func:`pidcore.calibrate.persist.missing_design_runs`).
 
         ``progress``, where given, is called with (entries checked, entries in all) after
         each entry: every array is read, a minute for some 3000 entries, more with long
@@ -1285,7 +1287,19 @@ class Store:
                         problems.append(f"{where}: unreadable ({type(exc).__name__}: {exc})")
         finally:
             h5.close()
-        return problems
+        return problems + self._missing_design_runs()
+
+    def _missing_design_runs(self) -> list[str]:
+        """A calibration whose design runs were removed without it (a run shared by two
+        calibrations removed with one of them): its fit names inputs that are gone, and
+        reports take what is left of them for predictions. Not checked where the listings
+        cannot be read: the entries' own problems are said above."""
+        from ..calibrate.persist import missing_design_runs
+
+        try:
+            return missing_design_runs(self.path)
+        except StoreError:
+            return []
 
     def _verify_entry(self, h5: h5py.File, section: str, key: str, where: str) -> list[str]:
         group = h5[section][key]

@@ -199,8 +199,9 @@ def render(stores) -> None:
         # listed as the store holds them, but said: Compare and Report leave them out
         design = state.design_runs(stamp, stores)
         if design:
+            calibrations = sorted({c for keys in design.values() for c in keys})
             st.caption(f"{len(design)} of these run(s) are the design runs of calibration(s) "
-                       f"{', '.join(sorted(set(design.values())))}: inputs of its fit, not "
+                       f"{', '.join(calibrations)}: inputs of its fit, not "
                        "predictions of the specimen; the Compare and Report tabs leave them "
                        "out where another run of the specimen stands at their load case")
         unconverged = int(table["steady state"].str.startswith("NOT").sum())
