@@ -128,3 +128,26 @@ def test_missing_foreign_read_only_and_locked_stores_give_pidcores_one_line_erro
     assert "could not take the write lock" in err and "another pidcore process is writing" \
         in err
     assert keys["own_run"] in set(Store(path).list_dem_runs()["case_key"])
+
+
+def test_a_record_hdf5_cannot_read_inside_a_removal_is_one_line_naming_it(records_store_copy,
+                                                                          capsys, monkeypatch):
+    # a bad metadata checksum (bit rot) makes h5py raise RuntimeError when the record's
+    # attributes are read; inside the removal's transaction it came out as a traceback
+    path, keys = records_store_copy
+    digest = file_sha256(path)
+    damaged = keys["other"]
+    own_child = Store._own_child
+
+    def rotten(self, group, name):
+        if group.name == f"/analyses/{damaged}":
+            raise RuntimeError("Error iterating over attributes (incorrect metadata checksum "
+                               "after all read attempts)")
+        return own_child(self, group, name)
+
+    monkeypatch.setattr(Store, "_own_child", rotten)
+    err = refusal(["store", "remove", keys["own_run"], "--store", str(path)], capsys)
+    assert err == (f"pidcore store remove: error: {path}: not a readable pidcore store "
+                   f"(/analyses/{damaged}: Error iterating over attributes (incorrect "
+                   "metadata checksum after all read attempts))")
+    assert file_sha256(path) == digest

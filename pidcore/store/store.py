@@ -604,7 +604,12 @@ class Store:
         the loops of 2000 stored analyses (one ``get_analysis`` each) take over 40 minutes.
         """
         if self._in_transaction():
-            yield self._active
+            try:
+                yield self._active
+            except (OSError, RuntimeError) as exc:
+                # a damaged object read from the working copy: the one line of a read
+                # outside a transaction (analyze and remove printed h5py's traceback)
+                raise self._unreadable(exc) from None
             return
         if not self.path.exists():
             yield None
@@ -1158,7 +1163,12 @@ class Store:
                 if self._stored_entry(h5, section, key) is None:
                     raise StoreError(f"{self.path}: no entry {key!r} in /{section}; nothing "
                                      "was removed")
-                del h5[section][key]
+                try:
+                    del h5[section][key]
+                except (OSError, RuntimeError) as exc:
+                    # HDF5 reads an entry's metadata to delete it (a bad checksum fails it)
+                    raise StoreError(f"{self.path}: cannot remove /{section}/{key} "
+                                     f"({_one_line(exc)}); nothing was removed") from None
 
     # --- shared reading helpers ----------------------------------------------------------------
 
@@ -1218,14 +1228,17 @@ class Store:
         rows = []
         fields: dict[str, None] = {}  # ordered set of field names over all entries
         for key, group in ({} if h5 is None else h5.get(section, {})).items():
-            row: dict[str, Any] = {"key": key, **link(group),
-                                   "created_utc": _text(group.attrs.get("created_utc", ""))}
-            record = self._own_child(group, "record")
-            for name, value in ({} if record is None else record.attrs).items():
-                row[name] = from_attribute(value)
-                fields[name] = None
-            row["parameters_json"] = _text(group.attrs.get("parameters_json", "{}"))
-            row["pidcore_version"] = _text(group.attrs.get("pidcore_version", ""))
+            try:
+                row: dict[str, Any] = {"key": key, **link(group),
+                                       "created_utc": _text(group.attrs.get("created_utc", ""))}
+                record = self._own_child(group, "record")
+                for name, value in ({} if record is None else record.attrs).items():
+                    row[name] = from_attribute(value)
+                    fields[name] = None
+                row["parameters_json"] = _text(group.attrs.get("parameters_json", "{}"))
+                row["pidcore_version"] = _text(group.attrs.get("pidcore_version", ""))
+            except (OSError, RuntimeError) as exc:  # a bad checksum: say which record
+                raise self._unreadable(f"/{section}/{key}: {_one_line(exc)}") from None
             rows.append(row)
         leading = ["key", *[c for c in leading if c != "key"], "created_utc"]
         columns = [*leading, *fields, "parameters_json", "pidcore_version"]
