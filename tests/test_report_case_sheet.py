@@ -656,7 +656,7 @@ def test_case_sheet_file_names_are_windows_safe_short_and_never_shared(tmp_path,
     # file name cannot keep ("a/b:c*?", "a_b_c") share a stem
     from _app_samples import mass_damper_csv
 
-    from pidcore.report.case_sheet import MAX_SHEET_STEM
+    from pidcore.report.render import MAX_SHEET_STEM
 
     monkeypatch.chdir(tmp_path)
     long = "coupon_" + "x" * 300

@@ -10,7 +10,6 @@ case's (:func:`case_sheets`), both from :func:`pidcore.report.case_view.case_vie
 
 from __future__ import annotations
 
-import hashlib
 import io
 import math
 import os
@@ -30,6 +29,7 @@ from ..compare.align import CALIBRATED_INSIDE_COLUMN, PACKING_RATIO_COLUMN
 from ..compare.case import CaseComparison, MeasuredEntry
 from ..units import display_value_with_error
 from .case_view import case_title, case_view, group_entries
+from .render import bounded_stem
 
 #: Page size of the sheet, inches (A4 landscape).
 PAGE_IN = (11.69, 8.27)
@@ -216,11 +216,6 @@ def case_pdf(view: dict, *, title: str, calibrated: CalibratedCase | None = None
     return buffer.getvalue()
 
 
-#: Most characters of a sheet's file name before ``.pdf`` (:func:`case_sheet_stem`). A report
-#: is handed on and unpacked on Windows, whose paths end at 260 characters (MAX_PATH) with
-#: the folder's; a specimen named in a sidecar has no length limit, and its sheet's name
-#: failed with "File name too long" (255) and a traceback.
-MAX_SHEET_STEM = 96
 
 
 def sheet_stem(key: str, specimen: str = "", specimen_sha256: str = "") -> str:
@@ -228,8 +223,9 @@ def sheet_stem(key: str, specimen: str = "", specimen_sha256: str = "") -> str:
     where its tests name a ``specimen``, that specimen as labels name it (name and start of
     its file's hash ``specimen_sha256``), in characters any file system keeps, e.g.
     ``'f100Hz_a5g_fill50pct_acrylic_z_steel_6mm_3e945a'``: two specimens' sheets of one load
-    case are two files. A name longer than :data:`MAX_SHEET_STEM` is cut there, ending in
-    8 hex digits of the whole name's sha256 (two long names that begin alike stay two).
+    case are two files. A name longer than :data:`pidcore.report.render.MAX_SHEET_STEM` is
+    cut there (:func:`pidcore.report.render.bounded_stem`), ending in 8 hex digits of the
+    whole name's sha256 (two long names that begin alike stay two).
 
     A report's sheet is named from its row (``load case``, ``specimen``, ``specimen sha256``
     of ``report.csv``), so that the row finds it (:func:`case_sheets`)."""
@@ -238,10 +234,7 @@ def sheet_stem(key: str, specimen: str = "", specimen_sha256: str = "") -> str:
     label = tested_label(specimen, specimen_sha256)
     safe = re.sub(r"[^A-Za-z0-9._+-]+", "_", label).strip("_.")
     stem = f"{key}_{safe}" if safe else key
-    if len(stem) <= MAX_SHEET_STEM:
-        return stem
-    digest = hashlib.sha256(stem.encode("utf-8")).hexdigest()[:8]
-    return f"{stem[:MAX_SHEET_STEM - len(digest) - 1].rstrip('_.')}_{digest}"
+    return bounded_stem(stem)
 
 
 def case_sheet_stem(comparison: CaseComparison, members: Sequence[MeasuredEntry]) -> str:

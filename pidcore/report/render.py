@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import base64
 import csv
+import hashlib
 import html
 import math
 import os
@@ -308,9 +309,27 @@ RENDERERS: dict[str, Callable[..., Path]] = {
 }
 
 
+#: Most characters of a report's file name before its extension (a figure, a load case's
+#: sheet). A report is handed on and unpacked on Windows, whose paths end at 260 characters
+#: (MAX_PATH) with the folder's; a specimen named in a sidecar has no length limit, and its
+#: sheet's name failed with "File name too long" (255) and a traceback, as a figure named by
+#: a stored material of 4 KiB did.
+MAX_SHEET_STEM = 96
+
+
+def bounded_stem(stem: str, most: int = MAX_SHEET_STEM) -> str:
+    """``stem`` where it has at most ``most`` characters, else cut there, ending in 8 hex
+    digits of the whole stem's sha256 (two long names that begin alike stay two files)."""
+    if len(stem) <= most:
+        return stem
+    digest = hashlib.sha256(stem.encode("utf-8")).hexdigest()[:8]
+    return f"{stem[:most - len(digest) - 1].rstrip('_.')}_{digest}"
+
+
 def save_figure_files(fig: object, folder: Path, stem: str, *,
                       dpi: int = defaults.REPORT_FIGURE_DPI) -> tuple[Path, Path]:
-    """Save a matplotlib figure as ``<stem>.png`` and ``<stem>.svg`` in ``folder``.
+    """Save a matplotlib figure as ``<stem>.png`` and ``<stem>.svg`` in ``folder`` (a stem
+    longer than :data:`MAX_SHEET_STEM` cut by :func:`bounded_stem`).
 
     The figure's layout is solved once, for the PNG, and then kept (the figure's layout
     engine is set to none): the SVG, and the report's PDF page of the same figure, reuse it
@@ -319,6 +338,7 @@ def save_figure_files(fig: object, folder: Path, stem: str, *,
     that measures a little wider in another format is never cut at the edge.
     """
     folder.mkdir(parents=True, exist_ok=True)
+    stem = bounded_stem(stem)
     png, svg = folder / f"{stem}.png", folder / f"{stem}.svg"
     fig.savefig(png, dpi=dpi, bbox_inches="tight")
     fig.set_layout_engine("none")

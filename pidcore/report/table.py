@@ -180,8 +180,14 @@ def _measured_rows(analyses: pd.DataFrame | None,
             continue
         material = row.get("material") or "acrylic"
         direction = row.get("direction") or "z"
-        case = LoadCase(float(row["frequency_hz"]), float(row["acceleration_g"]), fill,
-                        str(material), str(direction))
+        try:
+            case = LoadCase(float(row["frequency_hz"]), float(row["acceleration_g"]), fill,
+                            str(material), str(direction))
+        except LoadCaseError as exc:
+            # a stored material 'x/../../pwned' said "load case: particle material ... is not a
+            # name", naming neither the record nor its file
+            key = row.get("key")
+            raise LoadCaseError(f"{source}{f' (analysis {key})' if key else ''}: {exc}") from None
         out.append((case, row, position))
     return out
 

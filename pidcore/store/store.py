@@ -71,6 +71,7 @@ from ..io.hdf5_layout import read_measurement_group, write_measurement_group
 from ..records import Measurement
 from ..records import measurement_key_and_basis as _measurement_key
 from .lock import exclusive_lock, lock_path_for
+from .schema import ANALYSIS, DEM_RUN, array_problems, record_problems
 from .values import (
     RESERVED_FIELDS,
     Scalar,
@@ -103,6 +104,10 @@ _MEASUREMENT_ATTRS = ("pidcore_layout", "source", "sha256", "file_format", "meta
 _ENTRY_ATTRS = ("pidcore_layout", "created_utc", "pidcore_version", "parameters_json",
                 "null_fields_json")
 _DEM_ITEM_FIELDS = frozenset({"case_key", "record", "arrays", "parameters", "units"})
+#: The schema (:mod:`pidcore.store.schema`) each section's entries are checked against.
+_SCHEMA_OF = {_ANALYSES: ANALYSIS, _DEM_RUNS: DEM_RUN}
+#: Refusals of a damaged entry end with the way out.
+_DAMAGED = "it was changed or damaged outside pidcore (save it again into a fresh store)"
 
 
 @dataclass(frozen=True)
@@ -297,11 +302,16 @@ def _holds_entry(group: h5py.Group, entry: _PreparedEntry,
         return False
 
 
-def _read_entry(group: h5py.Group, key: str, *, where: str) -> StoredEntry:
-    """The entry ``group`` as written by :func:`_write_entry`; one damaged in its layout (a
-    subgroup missing, a JSON attribute that is not JSON, a record field that is not a scalar,
-    a dangling soft link) is a one-line :class:`StoreError` naming ``where``: a KeyError or
-    JSONDecodeError traceback before (report --calibration, the app's Compare page)."""
+def _read_entry(group: h5py.Group, key: str, *, where: str, section: str) -> StoredEntry:
+    """The entry ``group`` of ``section`` as written by :func:`_write_entry`; one damaged in
+    its layout (a subgroup missing or not a group, a JSON attribute that is not JSON, a record
+    field that is not a scalar, a dangling soft link) or against its schema
+    (:mod:`pidcore.store.schema`: a field, unit or array that is not what pidcore stores) is a
+    one-line :class:`StoreError` naming ``where``: a KeyError or JSONDecodeError traceback
+    before (report --calibration, the app's Compare page), or a ValueError deep in a report."""
+    for name in ("record", "units", "arrays"):
+        if not isinstance(group.get(name), h5py.Group):
+            raise StoreError(f"{where}: damaged entry ({name} is not a group)")
     try:
         attrs = {name: from_attribute(value) for name, value in group.attrs.items()}
         nulls = set(json.loads(_text(group.attrs.get("null_fields_json", "[]"))))
@@ -309,6 +319,8 @@ def _read_entry(group: h5py.Group, key: str, *, where: str) -> StoredEntry:
                   for name, value in group["record"].attrs.items()}
         units = {name: _text(value) for name, value in group["units"].attrs.items()}
         arrays = {name: dataset[()] for name, dataset in group["arrays"].items()}
+        array_units = {name: _text(dataset.attrs.get("unit", ""))
+                       for name, dataset in group["arrays"].items()}
         parameters = json.loads(_text(group.attrs.get("parameters_json", "{}")))
     except (KeyError, TypeError, ValueError, AttributeError, RecursionError) as exc:
         raise StoreError(f"{where}: damaged entry ({type(exc).__name__}: "
@@ -319,6 +331,11 @@ def _read_entry(group: h5py.Group, key: str, *, where: str) -> StoredEntry:
         what = f"record field {odd[0]!r} is not a scalar" if odd else \
             "parameters_json is not a JSON object"
         raise StoreError(f"{where}: damaged entry ({what})")
+    layout = _SCHEMA_OF.get(section, "")
+    problems = [*record_problems(layout, record, units),
+                *array_problems(layout, record, arrays, array_units)]
+    if problems:
+        raise StoreError(f"{where}: damaged entry ({'; '.join(problems)}); {_DAMAGED}")
     return StoredEntry(key=key, record=record, arrays=arrays, parameters=parameters, attrs=attrs,
                        units=units)
 
@@ -1187,7 +1204,8 @@ class Store:
         with self._reading(every_entry=False) as h5:
             for key in keys:
                 group = self._entry_group(h5, section, key, what)
-                entries.append(_read_entry(group, key, where=f"{self.path}:{group.name}"))
+                entries.append(_read_entry(group, key, where=f"{self.path}:{group.name}",
+                                           section=section))
         return entries
 
     def _entry_group(self, h5: h5py.File | None, section: str, key: str, what: str) -> h5py.Group:
@@ -1232,9 +1250,20 @@ class Store:
                 row: dict[str, Any] = {"key": key, **link(group),
                                        "created_utc": _text(group.attrs.get("created_utc", ""))}
                 record = self._own_child(group, "record")
-                for name, value in ({} if record is None else record.attrs).items():
-                    row[name] = from_attribute(value)
-                    fields[name] = None
+                values = {name: from_attribute(value)
+                          for name, value in ({} if record is None else record.attrs).items()}
+                # what a report turns into numbers is checked here, as every get_ checks it (the
+                # arrays aside: only get_ reads them); an SDC of 'abc' was a ValueError in report
+                units = self._own_child(group, "units")
+                problems = record_problems(
+                    _SCHEMA_OF.get(section, ""), values,
+                    {} if not isinstance(units, h5py.Group) else
+                    {name: _text(unit) for name, unit in units.attrs.items()})
+                if problems:
+                    raise StoreError(f"{self.path}:/{section}/{key}: damaged entry "
+                                     f"({'; '.join(problems)}); {_DAMAGED}")
+                row.update(values)
+                fields.update(dict.fromkeys(values))
                 row["parameters_json"] = _text(group.attrs.get("parameters_json", "{}"))
                 row["pidcore_version"] = _text(group.attrs.get("pidcore_version", ""))
             except (OSError, RuntimeError) as exc:  # a bad checksum: say which record
@@ -1343,7 +1372,7 @@ class Store:
         if problems:
             return problems
         try:  # reads every array, so checksums are checked
-            entry = _read_entry(group, key, where=where)
+            entry = _read_entry(group, key, where=where, section=section)
         except StoreError as exc:
             return [*problems, str(exc)]
         if section == _ANALYSES:

@@ -33,14 +33,24 @@ _ARRAY_KINDS = frozenset("biufc")
 
 _INT64_MIN, _INT64_MAX = -(2**63), 2**63 - 1
 
+#: Longest name of an HDF5 group, dataset or attribute the store writes, characters.
+MAX_NAME_CHARS = 255
+#: Longest text of a record field, characters: a name (a material, a channel, a specimen) is
+#: at most :data:`MAX_NAME_CHARS`, a note of the analysis a sentence of a few hundred. A
+#: material of 4 KiB put into a figure's file name failed the report with "File name too
+#: long", one of 40 KiB took 3 minutes in the messages quoting it; such a field is refused
+#: where it is written and where it is read.
+MAX_TEXT_CHARS = 4 * MAX_NAME_CHARS
+
 
 def check_name(name: object, *, what: str, where: str) -> str:
     """``name`` if it can be an HDF5 group, dataset or attribute name, else :class:`StoreError`."""
     if (not isinstance(name, str) or not name or "/" in name or name in {".", ".."}
-            or name != name.strip() or any(ord(c) < 32 for c in name) or len(name) > 255):
+            or name != name.strip() or any(ord(c) < 32 for c in name)
+            or len(name) > MAX_NAME_CHARS):
         raise StoreError(f"{where}: {what} {name!r} is not valid (expected a non-empty "
-                         "string of at most 255 characters without '/', control characters "
-                         "or surrounding spaces)")
+                         f"string of at most {MAX_NAME_CHARS} characters without '/', control "
+                         "characters or surrounding spaces)")
     return name
 
 
@@ -69,6 +79,9 @@ def to_attribute(value: object, *, field: str, where: str) -> tuple[Any, bool]:
         except UnicodeEncodeError:
             raise StoreError(f"{where}: record field {field!r} = {value!r} is not valid "
                              "Unicode (a lone surrogate); expected text UTF-8 can hold") from None
+        if len(value) > MAX_TEXT_CHARS:
+            raise StoreError(f"{where}: record field {field!r} is text of {len(value)} "
+                             f"characters; expected at most {MAX_TEXT_CHARS}")
         return value, False
     raise StoreError(f"{where}: record field {field!r} has type {type(value).__name__}; expected a "
                      "scalar (str, int, float, bool, complex or None); put arrays in arrays=")
