@@ -36,11 +36,12 @@ _INT64_MIN, _INT64_MAX = -(2**63), 2**63 - 1
 #: Longest name of an HDF5 group, dataset or attribute the store writes, characters.
 MAX_NAME_CHARS = 255
 #: Longest text of a record field, characters: a name (a material, a channel, a specimen) is
-#: at most :data:`MAX_NAME_CHARS`, a note of the analysis a sentence of a few hundred. A
-#: material of 4 KiB put into a figure's file name failed the report with "File name too
-#: long", one of 40 KiB took 3 minutes in the messages quoting it; such a field is refused
+#: at most :data:`MAX_NAME_CHARS`, a note of the analysis a sentence of a few hundred, the
+#: longest a file's path (``source``), which Linux allows up to PATH_MAX, 4096 bytes. A
+#: material of 40 KiB took 3 minutes in the messages quoting it (their cost grows with the
+#: square of its length; 4 KiB: seconds), one of 1 MiB did not end; such a field is refused
 #: where it is written and where it is read.
-MAX_TEXT_CHARS = 4 * MAX_NAME_CHARS
+MAX_TEXT_CHARS = 4096
 
 
 def check_name(name: object, *, what: str, where: str) -> str:
