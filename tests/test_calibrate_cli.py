@@ -1193,6 +1193,12 @@ def test_a_calibration_records_the_table_it_was_fitted_to_in_its_files_and_store
     assert listing.loc[key, "measured_source"] == str(table)
     assert listing.loc[key, "measured_sha256"] == sha256
     assert stored_settings(listing.loc[key, "parameters_json"])["measured"] == measured
+    # and `pidcore store list`, whose calibrations showed neither (the README says it does)
+    assert main(["store", "list", "--store", str(tiny_store), "--section", "calibrations",
+                 "--json"]) == 0
+    (row,) = [r for r in json.loads(capsys.readouterr().out)["calibrations"]
+              if r["key"] == key]
+    assert (row["measured_source"], row["measured_sha256"]) == (str(table), sha256)
     # where the tests were read is not what the calibration is: the same fit of the table
     # moved elsewhere (or saved before this was recorded) keeps its key
     moved = {**document, "settings": {k: v for k, v in document["settings"].items()

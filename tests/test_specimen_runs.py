@@ -594,6 +594,8 @@ def test_calibrated_damping_runs_an_own_specimen_and_its_json_says_the_alpha_use
     assert (docs["calibrated"]["alpha_pp"], docs["calibrated"]["alpha_pw"]) == (
         calibrated.pair_particle.alpha, calibrated.pair_wall.alpha)
     assert docs["calibrated"]["alpha_pw"] > eq3.pair_wall.alpha
+    # which of the two made the alphas: two runs of one case looked alike in --json
+    assert [docs[c]["damping_coefficient"] for c in docs] == ["eq3", "calibrated"]
     assert docs["calibrated"]["sdc"] != docs["eq3"]["sdc"]
     # the stored run reads back with them
     run = load_dem_result(Store(store).get_dem_run(docs["calibrated"]["store_key"]))

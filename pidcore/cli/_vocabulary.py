@@ -85,6 +85,8 @@ COMMAND_FLAGS: dict[str, dict[str, str]] = {
         "^cells": "--cells", "frequency_hz": "--frequency", "acceleration_g": "--acceleration",
         "^material": "--material", "^direction": "--direction", "^seed": "--seed",
         "^steady_cycles": "--cycles",
+        "damping_coefficient='calibrated'": "--damping-coefficient calibrated",
+        "normal_damping_mode='literal'": "--damping-mode literal",
         **CALIBRATION_WRITER,
     },
     "calibrate": {

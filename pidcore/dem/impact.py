@@ -81,12 +81,15 @@ def simulate_impact(*, pair: ImpactPair = "wall", impact_speed_m_s: float, dt_s:
     # a particle that does not fit the cell would touch other walls than the one it hits (a
     # large own particle in the paper's default cell): no head-on impact, a wrong number
     check_sphere_fits(geometry, r)
-    if pair == "particle" and geometry.height_m < 5 * r:
-        # the walls take no part in a particle pair's impact; a cell too low to hold the pair
-        # one above the other (a monolayer's) gets room for it, half a radius to spare at
-        # floor and ceiling (the pair moves apart by microns after the impact), so that no
-        # wall touches it
-        geometry = dataclasses.replace(geometry, height_m=5 * r)
+    # only the contact measured may touch: a cell too low to hold a particle pair one above
+    # the other (a monolayer's) gets room for it, half a radius to spare at floor and
+    # ceiling, and one whose opposite wall is closer than that to a particle rebounding from
+    # its wall gets that room beyond it (0.5 µm above a bounce off the floor, the ceiling was
+    # hit: a restitution of -0.16), the particle moving microns in the impact's time
+    across = "inscribed_diameter_m" if pair == "wall" and not wall.startswith(
+        ("floor", "ceiling")) else "height_m"
+    if getattr(geometry, across) < 5 * r:
+        geometry = dataclasses.replace(geometry, **{across: 5 * r})
     if pair == "wall":
         w = WALL_NAMES.index(wall)
         n = geometry.wall_normals[w]
@@ -168,7 +171,8 @@ def calibrate_damping_coefficient(target_e: float, pair: ImpactPair, impact_spee
     alpha on ``pair`` (e.g. ``lambda a: contact_law(specimen, alpha_pw=a)``), in the cell
     ``geometry`` (the paper's by default; a specimen's own, :meth:`Specimen.geometry`).
 
-    Root-finds (Brent, alpha in [0, 5]) on :func:`measure_restitution`. Hertz + Tsuji
+    Root-finds (Brent, alpha in [0, 5]) on :func:`measure_restitution`; ``target_e`` 1 is
+    alpha 0 (no damping). Hertz + Tsuji
     restitution is speed-independent in the continuum, so the alpha holds approximately at
     other speeds (the time discretisation adds a weak speed dependence).
 
@@ -176,8 +180,10 @@ def calibrate_damping_coefficient(target_e: float, pair: ImpactPair, impact_spee
     --------
     >>> a = calibrate_damping_coefficient(0.7, "wall", 0.3, 1e-6)  # doctest: +SKIP
     """
-    if not 0 < target_e < 1:
-        raise ParameterError(f"target_e: expected 0 < e < 1, got {target_e}")
+    if not 0 < target_e <= 1:
+        raise ParameterError(f"target_e: expected 0 < e <= 1, got {target_e}")
+    if target_e == 1:  # a specimen may state elastic contacts: no damping is what gives them
+        return 0.0
 
     def miss(alpha: float) -> float:
         try:
@@ -193,6 +199,13 @@ def calibrate_damping_coefficient(target_e: float, pair: ImpactPair, impact_spee
         return e - target_e
 
     hi = 5.0
-    if miss(hi) > 0:
-        raise ParameterError(f"target_e {target_e} below what alpha <= {hi} can reach")
+    least = miss(hi)
+    if least > 0:
+        # the cure the refusal names must work: literal damping reaches any e (Eq. 3 exact)
+        raise ParameterError(
+            f"{'particle-wall' if pair == 'wall' else 'particle-particle'} restitution "
+            f"{target_e:g}: below the {least + target_e:.3g} that the strongest damping tried "
+            f"(alpha {hi:g}) gives in {mode} damping; expected a restitution it reaches"
+            + (", or normal_damping_mode='literal' (Eq. 3's alpha gives any e exactly there)"
+               if mode != "literal" else ""))
     return float(brentq(miss, 0.0, hi, xtol=1e-10, rtol=1e-10))

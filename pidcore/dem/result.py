@@ -360,6 +360,8 @@ class DemResult:
                          else self.case.material),
             "direction": self.case.direction,
             "normal_damping_mode": self.config.normal_damping_mode,
+            # eq3 or calibrated: beside the alphas, which of the two made them
+            "damping_coefficient": self.config.damping_coefficient,
             "vibrated_mass_convention": self.config.vibrated_mass,
             "start_protocol": self.config.start_protocol,
             "start_packing": self.config.start_packing,

@@ -280,17 +280,21 @@ def calibrated_contact_law(specimen: Specimen, config: DemConfig, dt_s: float) -
     stated = contact_law(specimen)
     v_cal = defaults.DEM_CALIBRATION_SPEED_M_S
     mode = config.normal_damping_mode
-    return contact_law(
-        specimen,
-        alpha_pw=config.alpha_pw if config.alpha_pw is not None else
-        calibrate_damping_coefficient(
-            stated.pair_wall.restitution, "wall", v_cal, dt_s, mode, geometry=geometry,
-            law=lambda a: contact_law(specimen, alpha_pp=config.alpha_pp, alpha_pw=a)),
-        alpha_pp=config.alpha_pp if config.alpha_pp is not None else
-        calibrate_damping_coefficient(
-            stated.pair_particle.restitution, "particle", v_cal, dt_s, mode,
-            geometry=geometry,
-            law=lambda a: contact_law(specimen, alpha_pp=a, alpha_pw=config.alpha_pw)))
+    try:
+        return contact_law(
+            specimen,
+            alpha_pw=config.alpha_pw if config.alpha_pw is not None else
+            calibrate_damping_coefficient(
+                stated.pair_wall.restitution, "wall", v_cal, dt_s, mode, geometry=geometry,
+                law=lambda a: contact_law(specimen, alpha_pp=config.alpha_pp, alpha_pw=a)),
+            alpha_pp=config.alpha_pp if config.alpha_pp is not None else
+            calibrate_damping_coefficient(
+                stated.pair_particle.restitution, "particle", v_cal, dt_s, mode,
+                geometry=geometry,
+                law=lambda a: contact_law(specimen, alpha_pp=a, alpha_pw=config.alpha_pw)))
+    except ParameterError as exc:  # which file's restitution, and which setting asked
+        raise ParameterError(f"damping_coefficient='calibrated', specimen {specimen.name!r}: "
+                             f"{exc}") from None
 
 
 def particles_per_cell(fill_percent: float, material_name: str | None = None, *,

@@ -37,7 +37,7 @@ COLUMN_HEADERS = {
     "fill_percent": "fill [%]", "material": "material", "specimen": "specimen",
     "sdc": "SDC [-]", "reports": "of its measurement", "cells": "cells [-]", "seed": "seed [-]",
     "design_of": "design run of", "fit": "fitted", "n_points": "points [-]",
-    "loo_rms": "LOO RMS [-]",
+    "loo_rms": "LOO RMS [-]", "measured_source": "fitted to", "measured_sha256": "its sha256",
 }
 _COLUMNS = {
     "measurements": ["key", "file", "file_format", "n_channels", "n_analyses",
@@ -46,7 +46,10 @@ _COLUMNS = {
                  "fill_percent", "material", "specimen", "sdc", "reports", "created_utc"],
     "dem_runs": ["key", "specimen", "frequency_hz", "acceleration_g", "fill_percent",
                  "material", "cells", "seed", "sdc", "design_of", "created_utc"],
-    "calibrations": ["key", "specimen", "fit", "n_points", "loo_rms", "created_utc"],
+    # the tests a calibration was fitted to (a table and its sha256, or a store), as the
+    # README's listing promises
+    "calibrations": ["key", "specimen", "fit", "n_points", "loo_rms", "measured_source",
+                     "measured_sha256", "created_utc"],
 }
 
 
