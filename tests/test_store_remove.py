@@ -185,6 +185,35 @@ def test_list_and_reports_name_every_calibration_a_run_is_a_design_run_of(record
     assert f"calibration(s) {', '.join(sorted((first, second)))} (2 cells per run)" in note
 
 
+def test_a_run_of_a_design_case_with_another_direction_or_steady_cycles_is_no_design_run(
+        records_store_copy):
+    # a run of the calibration's load case along x, or with 30 steady cycles (the fit ran
+    # 10), made after the fit, was listed as its design run: remove refused it, and verify
+    # called the store sound once the real design run was gone (the look-alike matched)
+    import json
+
+    path, keys = records_store_copy
+    store = Store(path)
+    run = store.get_dem_run(keys["design"][0])
+    looks = {"along_x": ({**run.record, "direction": "x"}, run.parameters),
+             "cycles_30": (run.record, {**run.parameters, "config_steady_cycles": 30})}
+    for key, (record, parameters) in looks.items():
+        store.add_dem_run(key, record, arrays=run.arrays, units=run.units,
+                          parameters=parameters)
+    assert json.loads(list_dem_runs(path).set_index("case_key").loc[
+        "cycles_30", "parameters_json"])["config_steady_cycles"] == 30
+    listed = store_contents(path, ["dem-runs"])["dem-runs"].set_index("key")["design_of"]
+    assert listed["along_x"] == listed["cycles_30"] == ""
+    assert listed[keys["design"][0]] == keys["calibration"]
+    assert [r.key for r in remove_records(path, list(looks)).records] == list(looks)
+    for key, (record, parameters) in looks.items():  # back, then the real run goes
+        store.add_dem_run(key, record, arrays=run.arrays, units=run.units,
+                          parameters=parameters)
+    with h5py.File(path, "r+") as h5:  # damage done outside pidcore
+        del h5["dem_runs"][keys["design"][0]]
+    assert any("none of which is stored" in p for p in Store(path).verify())
+
+
 def test_verify_names_a_calibration_whose_design_run_is_gone_and_the_run(records_store_copy):
     # what the removal of a shared run with one calibration left: the other calibration
     # fitted on a run the store no longer holds, which verify called sound

@@ -427,6 +427,17 @@ def missing_design_runs(path: str | os.PathLike) -> list[str]:
     return lines
 
 
+def _steady_cycles(value: object) -> int | None:
+    """Steady cycles a run was asked for, as a calibration's settings and a run's
+    ``config_steady_cycles`` state them (None, "" or absent: the automatic count)."""
+    if value is None or value == "":
+        return None
+    try:
+        return int(value)
+    except (TypeError, ValueError):
+        return None
+
+
 def _design_runs_by_case(runs: pd.DataFrame | None, path: Path, *, variants: bool,
                          every_calibration: bool = False) -> list[DesignCase]:
     """Each load case of each calibration stored at ``path`` with its design runs among
@@ -460,6 +471,14 @@ def _design_runs_by_case(runs: pd.DataFrame | None, path: Path, *, variants: boo
                              for o, own in zip(run_origins(runs), runs["specimen_sha256"],
                                                strict=True)], index=runs.index)
     calibrations, _ = readable_calibrations(path, listing=listing)  # damaged: said elsewhere
+    import pandas as pd
+
+    from ..compare.align import stored_parameters
+
+    steady_of_runs = pd.Series(
+        [_steady_cycles((stored_parameters(p) or {}).get("config_steady_cycles"))
+         for p in (runs["parameters_json"] if "parameters_json" in runs.columns
+                   else [None] * len(runs))], index=runs.index, dtype=object)
     by_key = {c.store_key: c for c in calibrations}
     found = []
     for _, record in listing.iterrows():
@@ -473,7 +492,11 @@ def _design_runs_by_case(runs: pd.DataFrame | None, path: Path, *, variants: boo
             continue
         sha = str(record.get("specimen_hash") or "")
         same = runs[(origins == sha) & (runs["cells_simulated"] == cells)
-                    & (runs["seed"] == seed)]
+                    & (runs["seed"] == seed)
+                    # a run of the case along x, or with other steady cycles, made after the
+                    # fit, was claimed as its design run: remove refused it, verify missed
+                    # the real one gone
+                    & (steady_of_runs == _steady_cycles(settings.get("steady_cycles")))]
         for p in calibration.predictions:
             case = p.load_case
             # the calibration made these runs from the cases it predicts: the same
@@ -483,7 +506,9 @@ def _design_runs_by_case(runs: pd.DataFrame | None, path: Path, *, variants: boo
                 at = (np.isclose(same["frequency_hz"], case.frequency_hz, rtol=1e-9)
                       & np.isclose(same["acceleration_g"], case.acceleration_g, rtol=1e-9)
                       & np.isclose(same["fill_percent"], case.fill_percent, rtol=1e-9)
-                      & (same["material"] == case.material))
+                      & (same["material"] == case.material)
+                      & (same["direction"] == case.direction if "direction" in same.columns
+                         else True))
                 keys = tuple(str(k) for k in same.loc[at, "case_key"])
             found.append(DesignCase(str(record["key"]), case, sha, cells, seed, keys))
     return found
