@@ -64,6 +64,10 @@ def test_a_damaged_result_field_is_refused_by_report_calibrate_and_the_listing(
     assert rc == 2 and f"record field {field} = " in err
     with pytest.raises(StoreError, match=f"record field {field} = "):
         saved_analyses(store)  # what the app's Compare and Report tabs list
+    # and verify, which called such a store sound (exit 0) while report refused it
+    assert main(["store", "verify", "--store", str(store), "--no-progress"]) == 1
+    said = capsys.readouterr().out
+    assert SAMPLE.name in said and f"record field {field} = " in said
     # read only: the store is as it was
     assert hashlib.sha256(store.read_bytes()).hexdigest() == before
 
@@ -74,6 +78,9 @@ def test_an_undamaged_store_and_an_unknown_stderr_are_read(analysed_store, tmp_p
     listed = saved_analyses(store)
     assert len(listed) == 1 and math.isnan(float(listed["sdc_stderr"].iloc[0]))
     assert len(saved_analyses(analysed_store)) == 1
+    from pidcore.store import Store
+
+    assert Store(store).verify() == [] and Store(analysed_store).verify() == []
 
 
 # --- an entry checked against what pidcore stores (pidcore.store.schema) -------------------

@@ -47,31 +47,38 @@ def checked_analyses(analyses: pd.DataFrame, where: str | os.PathLike) -> pd.Dat
     """``analyses`` (a :meth:`Store.list_analyses` listing of the store ``where``) if every
     result field holds what an analysis saves, else :class:`StoreError` naming the store,
     the record, the field, its value and what was expected."""
-    fields = [field for field in _RESULT_FIELDS if field in analyses.columns]
-    both = {"sdc", "loss_factor"} <= set(analyses.columns)
     for _, row in analyses.iterrows():
-        for field in fields:
-            value = row[field]
-            if value is None:  # saved as null: the analysis did not give it
-                continue
-            expected, holds = _RESULT_FIELDS[field]
-            # text is no number, even where NaN (unknown) would be
-            if isinstance(value, bool | str) or not holds(_float(value)):
-                raise _damaged(where, row, f"record field {field} = {value!r} is not "
-                                           f"{expected}")
-        if both:
-            # an analysis saves sdc = 2 pi loss_factor (Eq. 9) to the last bit: an SDC edited
-            # to -5 beside its loss factor 0.65 was calibrated against without a word
-            sdc, loss = _float(row["sdc"]), _float(row["loss_factor"])
-            if math.isfinite(sdc) and math.isfinite(loss) and not math.isclose(
-                    sdc, 2 * math.pi * loss, rel_tol=1e-9, abs_tol=1e-15):
-                raise _damaged(where, row, f"record field sdc = {sdc!r} is not 2 pi x its "
-                                           f"loss_factor {loss!r} ({2 * math.pi * loss:.6g}), "
-                                           "as an analysis saves it")
+        problems = analysis_row_problems(row)
+        if problems:
+            raise damaged_analysis(where, row, problems[0])
     return analyses
 
 
-def _damaged(where: str | os.PathLike, row: pd.Series, what: str) -> StoreError:
+def analysis_row_problems(row: pd.Series) -> list[str]:
+    """What a stored analysis's result fields (a row of :meth:`Store.list_analyses`) hold
+    that no analysis saves: a value out of its range, an SDC other than 2 pi x its loss
+    factor. The one rule of :func:`checked_analyses` (report, calibrate) and
+    :meth:`Store.verify`, which called such a record sound."""
+    problems = []
+    for field, (expected, holds) in _RESULT_FIELDS.items():
+        value = row.get(field)
+        if value is None:  # absent, or saved as null: the analysis did not give it
+            continue
+        # text is no number, even where NaN (unknown) would be
+        if isinstance(value, bool | str) or not holds(_float(value)):
+            problems.append(f"record field {field} = {value!r} is not {expected}")
+    if "sdc" in row.index and "loss_factor" in row.index:
+        # an analysis saves sdc = 2 pi loss_factor (Eq. 9) to the last bit: an SDC edited
+        # to -5 beside its loss factor 0.65 was calibrated against without a word
+        sdc, loss = _float(row["sdc"]), _float(row["loss_factor"])
+        if math.isfinite(sdc) and math.isfinite(loss) and not math.isclose(
+                sdc, 2 * math.pi * loss, rel_tol=1e-9, abs_tol=1e-15):
+            problems.append(f"record field sdc = {sdc!r} is not 2 pi x its loss_factor "
+                            f"{loss!r} ({2 * math.pi * loss:.6g}), as an analysis saves it")
+    return problems
+
+
+def damaged_analysis(where: str | os.PathLike, row: pd.Series, what: str) -> StoreError:
     """The refusal of a record changed outside pidcore, naming the store and the record."""
     name = Path(str(row.get("source", "") or "")).name or row.get("key", "")
     return StoreError(f"{where}: analysis {row.get('key', '')} ({name}): {what}; it was "

@@ -1329,7 +1329,22 @@ class Store:
                         problems.append(f"{where}: unreadable ({type(exc).__name__}: {exc})")
         finally:
             h5.close()
-        return problems + self._missing_design_runs()
+        return problems + self._analysis_values() + self._missing_design_runs()
+
+    def _analysis_values(self) -> list[str]:
+        """Analyses whose result fields hold what no analysis saves (an SDC of NaN or not
+        2 pi x its loss factor, a negative frequency): refused by report and calibrate
+        (:func:`pidcore.store.listing.analysis_row_problems`), called sound here before.
+        Not checked where the listing cannot be read: the entries' own problems are said
+        above."""
+        from .listing import analysis_row_problems, damaged_analysis
+
+        try:
+            analyses = self.list_analyses()
+        except StoreError:
+            return []
+        return [str(damaged_analysis(self.path, row, problem))
+                for _, row in analyses.iterrows() for problem in analysis_row_problems(row)]
 
     def _missing_design_runs(self) -> list[str]:
         """A calibration whose design runs were removed without it (a run shared by two
