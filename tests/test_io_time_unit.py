@@ -141,6 +141,14 @@ def test_a_time_unit_that_is_no_time_is_refused(tmp_path, capsys):
     # an implausible unit of time still says why (an hour per sample)
     with pytest.raises(ParameterError, match=r"'h' is 3600 s, not a plausible time unit"):
         read_measurement(SAMPLE_UFF, time_unit="h")
+    # nor in a CSV header's time unit, which said the displacement range too
+    csv = tmp_path / "furlong.csv"
+    csv.write_text("Time [furlong],Force [N],Velocity [m/s]\n"
+                   + "".join(f"{k},{k},{k}\n" for k in range(4)))
+    with pytest.raises(InputFileError) as info:
+        read_measurement(csv)
+    assert "header cell 'Time [furlong]' not read: 'furlong' is no unit of time such as s, " \
+        "ms;" in str(info.value) and "displacement" not in str(info.value)
 
 
 # --- CSV, MATLAB and HDF5 time bases -------------------------------------------------------

@@ -41,7 +41,13 @@ import pandas as pd
 from ..atomic_files import atomic_path
 from ..errors import InputFileError, ParameterError, a_or_an, clipped
 from ..records import Measurement
-from ..units import UnitReading, given_time_unit, overrides_stated_time, read_unit
+from ..units import (
+    UnitReading,
+    given_time_unit,
+    overrides_stated_time,
+    read_unit,
+    why_not_a_time_unit,
+)
 from ._common import (
     file_sha256,
     interpret_unit,
@@ -617,7 +623,9 @@ def _unread_time_header(header_cells: list[str]) -> tuple[int, str] | None:
         parts = _TIME_HEADER_SPLIT.split(text, maxsplit=1)
         if len(parts) == 2 and parts[0].lower() in _TIME_NAMES - {"x"}:
             unit = parts[1].rstrip("])").strip()
-            why = read_unit(unit).problem or f"{unit!r} is no unit of time such as s, ms"
+            # the one reason of a time unit's refusal ('furlong' named a displacement's range)
+            why = (why_not_a_time_unit(unit) or "").removeprefix(": ") \
+                or f"{unit!r} is no unit of time such as s, ms"
             return i, f" (header cell {text!r} not read: {why}; give its unit with time_unit=UNIT)"
     return None
 

@@ -48,7 +48,13 @@ from ..atomic_files import atomic_path
 from ..constants import SI_UNITS
 from ..errors import InputFileError, ParameterError
 from ..records import Channel, Measurement
-from ..units import UnitReading, given_time_unit, overrides_stated_time, read_unit
+from ..units import (
+    UnitReading,
+    given_time_unit,
+    overrides_stated_time,
+    read_unit,
+    why_not_a_time_unit,
+)
 from ._common import (
     HDF5_SIGNATURE,
     file_sha256,
@@ -407,7 +413,8 @@ def _lms_seconds_per_unit(x_values: Mapping, what: str, given: UnitReading | Non
         return 1.0
     if reading.info is not None and reading.quantity == "time":
         return reading.info.factor
-    why = reading.problem or f"{stated!r} is no unit of time pidcore reads"
+    why = (why_not_a_time_unit(stated) or "").removeprefix(": ") \
+        or f"{stated!r} is no unit of time pidcore reads"
     raise InputFileError(f"{what}: x_values unit {why}; expected a unit of time such as s or "
                          "ms (x_values.increment is in it, so it sets the sample rate); give "
                          "it with time_unit=UNIT")
