@@ -40,8 +40,9 @@ def _fill(store: Store, n_measurements: int, n_analyses: int, n_dem_runs: int) -
         for i in range(n_analyses):
             store.add_analysis(keys[i % len(keys)], {
                 "frequency_hz": 100.0, "acceleration_g": 5.0, "fill_percent": 50.0,
-                "material": "acrylic", "direction": "z", "sdc": 0.5, "sdc_stderr": 0.01,
-                "loss_factor": 0.08},
+                # sdc = 2 pi loss_factor, as an analysis saves it (verify checks it)
+                "material": "acrylic", "direction": "z", "sdc": 2 * np.pi * 0.08,
+                "sdc_stderr": 0.01, "loss_factor": 0.08},
                 arrays={"harmonics": np.arange(1, 6),
                         "force_phasors_n": np.ones(5, complex),
                         "velocity_phasors_m_s": np.ones(5, complex)},
