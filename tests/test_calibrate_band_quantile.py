@@ -295,3 +295,47 @@ def test_the_report_widens_by_the_t_quantile_and_says_so(tmp_path):
     assert out["note"][1].endswith("normal quantile 1.96, the degrees of freedom of the "
                                    "stderr unknown")
 
+
+
+def test_tests_driven_along_x_are_no_load_case_of_the_calibrations_z_runs(tmp_path,
+                                                                         monkeypatch):
+    # an x-drive test of SDC 0.2 was pooled with a z-drive one of 0.02 as two repeats (0.11
+    # +- 0.09) and fitted against a z-drive DEM run; report kept them apart
+    from _shaker_files import write_force_velocity
+
+    from pidcore.calibrate import measured_from_store, read_measured_table
+    from pidcore.cli import main
+    from pidcore.constants import STANDARD_GRAVITY
+    from pidcore.errors import InputFileError
+    from pidcore.signal.synthetic import synthesize_shaker_record
+    from pidcore.store import Store
+
+    rec = synthesize_shaker_record(mass_kg=0.25, acceleration_amplitude_m_s2=5 * STANDARD_GRAVITY,
+                                   frequency_hz=500.0, sample_rate_hz=25_600.0, n_periods=40.3,
+                                   viscous_damping_n_s_m=2.0, snr_db=50, seed=3)
+    path = write_force_velocity(tmp_path / "run_fill50_acrylic.csv", rec.force_n,
+                                rec.velocity_m_s, 25_600.0, "csv")
+    store = tmp_path / "s.h5"
+    assert main(["analyze", str(path), "--store", str(store)]) == 0
+    frame = Store(store).list_analyses()
+    (alone,) = measured_from_store(store)
+    both = pd.concat([frame, frame.assign(key="k2", measurement_key="m2", direction="x",
+                                          source="xdrive_fill50_acrylic.csv",
+                                          sdc=frame["sdc"] * 10,
+                                          loss_factor=frame["loss_factor"] * 10)],
+                     ignore_index=True)
+    monkeypatch.setattr(Store, "list_analyses", lambda self: both)
+    said: list[str] = []
+    (point,) = measured_from_store(store, left_out=said)
+    assert point.sdc == alone.sdc and point.analyses == alone.analyses  # the z test alone
+    assert any("xdrive_fill50_acrylic.csv: left out, driven along x: the calibration's DEM "
+               "runs drive along z" in s for s in said), said
+    # a table's row of another direction is refused, naming its line
+    table = tmp_path / "m.csv"
+    table.write_text("frequency_hz,acceleration_g,fill_percent,sdc,direction\n"
+                     "500,5,50,0.2,z\n500,5,75,0.2,x\n")
+    with pytest.raises(InputFileError, match=r"m\.csv, line 3: direction 'x': the "
+                                             r"calibration's DEM runs drive along z"):
+        read_measured_table(table)
+    table.write_text("frequency_hz,acceleration_g,fill_percent,sdc,direction\n500,5,50,0.2,Z\n")
+    assert len(read_measured_table(table)) == 1

@@ -42,6 +42,18 @@ if TYPE_CHECKING:  # pragma: no cover
 REQUIRED_COLUMNS = ("frequency_hz", "acceleration_g", "fill_percent", "sdc")
 OPTIONAL_COLUMNS = ("sdc_stderr", "sdc_stderr_dof", "energy_per_cycle_j", "material",
                     "specimen")
+#: The drive direction of every DEM run a calibration makes (the paper's, :class:`LoadCase`'s
+#: default): tests driven along another axis are not its load cases.
+CALIBRATION_DIRECTION = "z"
+
+
+def _other_direction(value: object) -> str:
+    """The direction a table cell or a record states where it is not the calibration's
+    (``"x"``), else "" (``"z"``, empty or absent)."""
+    text = _text_cell(value, CALIBRATION_DIRECTION).strip().lower()
+    return "" if text == CALIBRATION_DIRECTION else text
+
+
 #: Material of a measurement that states none (the paper's particles).
 DEFAULT_MATERIAL = defaults.COMPARE_DEFAULT_MATERIAL
 
@@ -185,6 +197,12 @@ def read_measured_table(path: str | os.PathLike, *,
             values["sdc_stderr_dof"] = math.nan if raw_dof == "" else float(raw_dof)
         except (TypeError, ValueError):
             raise InputFileError(f"{where}: sdc_stderr_dof {raw_dof!r} is not a number") from None
+        other = _other_direction(row.get("direction"))
+        if other:
+            # an x-drive test was fitted against z-drive DEM runs without a word
+            raise InputFileError(f"{where}: direction {other!r}: the calibration's DEM runs "
+                                 f"drive along {CALIBRATION_DIRECTION} (the paper's axis); "
+                                 f"expected {CALIBRATION_DIRECTION} or no direction")
         try:
             # as the sidecar reads it: 'Acrylic', 'PMMA' or 'Tungsten_Carbide' typed in a
             # spreadsheet are the canonical names, which a point was compared with verbatim
@@ -359,6 +377,16 @@ def measured_from_store(store_path: str | os.PathLike, *,
                         f"{found[0].message}"
                         for name, found in zip(names, implausible, strict=True) if found)
     frame = frame[[not found for found in implausible]]
+    # tests driven along x or y are no load case of the calibration's z-drive DEM runs: they
+    # were averaged with the z tests of their case as repeats (report keeps them apart)
+    other = [_other_direction(v) for v in frame.get(
+        "direction", pd.Series([None] * len(frame), index=frame.index))]
+    if left_out is not None:
+        left_out.extend(f"{stored_record_name(row)}: left out, driven along {axis}: the "
+                        f"calibration's DEM runs drive along {CALIBRATION_DIRECTION}"
+                        for (_, row), axis in zip(frame.iterrows(), other, strict=True)
+                        if axis)
+    frame = frame[[not axis for axis in other]]
     frame = _before_baseline(frame, left_out)
     # measured frequency and acceleration scatter about the nominal ones: a load case is the
     # frequency to 3 significant digits, the acceleration to 2 (e.g. 50.02 Hz, 4.97 g -> 50, 5)
