@@ -105,6 +105,19 @@ def _table():
     })
 
 
+def test_a_row_driven_along_x_is_not_given_the_z_calibrations_prediction(calibration_file):
+    # the x row of a load case the calibration predicts (its runs drive along z) showed the
+    # z prediction and an in-band verdict
+    table = _table().iloc[:1]
+    table = pd.concat([table.assign(direction="z"), table.assign(direction="x")],
+                      ignore_index=True)
+    out = add_calibration_columns(table, load_calibration(calibration_file))
+    assert out[CALIBRATED_COLUMN].iloc[0] == 0.24 and math.isnan(out[CALIBRATED_COLUMN].iloc[1])
+    assert out[CALIBRATED_INSIDE_COLUMN].tolist() == ["yes", NOT_COMPARED]
+    assert "driven along x, where the calibration's DEM runs drive along z" in \
+        out["note"].iloc[1]
+
+
 def test_calibration_columns_per_row(calibration_file):
     out = add_calibration_columns(_table(), load_calibration(calibration_file))
     assert out[CALIBRATED_COLUMN].iloc[0] == 0.24
