@@ -339,3 +339,23 @@ def test_tests_driven_along_x_are_no_load_case_of_the_calibrations_z_runs(tmp_pa
         read_measured_table(table)
     table.write_text("frequency_hz,acceleration_g,fill_percent,sdc,direction\n500,5,50,0.2,Z\n")
     assert len(read_measured_table(table)) == 1
+
+
+def test_the_error_model_note_quotes_the_quantile_of_the_points_own_degrees_of_freedom():
+    # it said "t_0.975,7 = 2.365" beside points whose standard error had 1 degree of freedom
+    # (two repeated tests), whose quantile is 12.71
+    from scipy.stats import t
+
+    from pidcore.calibrate.calibrate import error_model_notes
+    from pidcore.calibrate.data import MeasuredPoint
+
+    def point(dof: float) -> MeasuredPoint:
+        return MeasuredPoint(500.0, 5.0, 50.0, 0.3, 0.02, sdc_stderr_dof=dof)
+
+    (note,) = error_model_notes([point(1.0), point(7.0)])
+    assert f"(1, 7) is sdc_stderr times Student's t with them (t_0.975,1 = " \
+        f"{t.ppf(0.975, 1):.4g}, not 1.96" in note
+    assert "12.71" in note
+    (note,) = error_model_notes([point(7.0)])
+    assert "t_0.975,7 = 2.365" in note
+    assert error_model_notes([point(math.nan)]) == []  # unknown: normal, nothing to say

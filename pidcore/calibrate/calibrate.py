@@ -471,6 +471,29 @@ def check_point_specimens(points: Sequence[MeasuredPoint], specimen: Specimen) -
                          "leave those rows out")
 
 
+def error_model_notes(points: Sequence[MeasuredPoint]) -> list[str]:
+    """Which error model the fit and the 95 % bands use for the points' measurement error (it
+    sets how much an outlying point pulls the fit and how wide the measurement's part of a
+    band is), with the Student quantile of the fewest degrees of freedom stated (it said
+    t_0.975,7 = 2.365 beside points of 1)."""
+    import scipy.stats
+
+    with_dof = sorted({p.sdc_stderr_dof for p in points
+                       if p.sdc_stderr > 0 and math.isfinite(p.sdc_stderr_dof)})
+    if not with_dof:
+        return []
+    t_dof = [d for d in with_dof if uses_student_t(1.0, d)]
+    return ["likelihood and 95 % bands: the measurement error of a point whose sdc_stderr "
+            "states its degrees of freedom (" + ", ".join(f"{d:g}" for d in with_dof)
+            + f") is sdc_stderr times Student's t with them (t_0.975,{with_dof[0]:g} = "
+            f"{float(scipy.stats.t.ppf(0.975, with_dof[0])):.4g}, not 1.96; an outlying "
+            "point pulls the fit less than under a normal error)"
+            + ("" if len(t_dof) == len(with_dof) else
+               f"; above {NORMAL_ABOVE_DOF:g} degrees of freedom the likelihood takes it as "
+               "normal")
+            + "; of a point without them, normal"]
+
+
 def calibrate(points: Sequence[MeasuredPoint], *, fit: str | Sequence[str],
               store_path: str | os.PathLike, priors: str | Sequence[str] = (),
               discrepancy: float | None = None,
@@ -531,21 +554,7 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: str | Sequence[str],
     if all(p.sdc_stderr == 0 for p in points):
         notes.append("no sdc_stderr in the data: measurement error is carried by the "
                      "model-discrepancy term alone")
-    with_dof = sorted({p.sdc_stderr_dof for p in points
-                       if p.sdc_stderr > 0 and math.isfinite(p.sdc_stderr_dof)})
-    if with_dof:
-        # which error model the fit and the 95 % bands used: it sets how much an outlying
-        # point pulls the fit and how wide the measurement's part of a band is
-        t_dof = [d for d in with_dof if uses_student_t(1.0, d)]
-        notes.append("likelihood and 95 % bands: the measurement error of a point whose "
-                     "sdc_stderr states its degrees of freedom (" + ", ".join(
-                         f"{d:g}" for d in with_dof)
-                     + ") is sdc_stderr times Student's t with them (t_0.975,7 = 2.365, not "
-                     "1.96; an outlying point pulls the fit less than under a normal error)"
-                     + ("" if len(t_dof) == len(with_dof) else
-                        f"; above {NORMAL_ABOVE_DOF:g} degrees of freedom the likelihood takes "
-                        "it as normal")
-                     + "; of a point without them, normal")
+    notes.extend(error_model_notes(points))
     dem_specs = [s for s in specs if s.kind == "dem"]
     if not dem_specs and design_size not in (None, 1):
         # nothing varies between DEM runs: one run per load case, whatever the design asks

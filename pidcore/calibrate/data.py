@@ -386,7 +386,8 @@ def measured_from_store(store_path: str | os.PathLike, *,
                         f"calibration's DEM runs drive along {CALIBRATION_DIRECTION}"
                         for (_, row), axis in zip(frame.iterrows(), other, strict=True)
                         if axis)
-    frame = frame[[not axis for axis in other]]
+    # a boolean Series: a list, empty where every record was left out above, picks columns
+    frame = frame[pd.Series([not axis for axis in other], index=frame.index, dtype=bool)]
     frame = _before_baseline(frame, left_out)
     # measured frequency and acceleration scatter about the nominal ones: a load case is the
     # frequency to 3 significant digits, the acceleration to 2 (e.g. 50.02 Hz, 4.97 g -> 50, 5)
