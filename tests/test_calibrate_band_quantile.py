@@ -227,14 +227,13 @@ def test_calibration_frame_names_the_measured_sdc_as_align_measured_and_the_repo
             plt.close("all")
 
 
-def test_an_analysis_in_the_store_keeps_n_blocks_minus_1(tmp_path, monkeypatch):
+def _one_analysis_store(tmp_path):
+    """A store of one analysed 500 Hz, 5 g record (a viscous mass, 50 % fill, acrylic)."""
     from _shaker_files import write_force_velocity
 
-    from pidcore.calibrate import measured_from_store
     from pidcore.cli import main
     from pidcore.constants import STANDARD_GRAVITY
     from pidcore.signal.synthetic import synthesize_shaker_record
-    from pidcore.store import Store
 
     rec = synthesize_shaker_record(mass_kg=0.25, acceleration_amplitude_m_s2=5 * STANDARD_GRAVITY,
                                    frequency_hz=500.0, sample_rate_hz=25_600.0, n_periods=40.3,
@@ -243,6 +242,14 @@ def test_an_analysis_in_the_store_keeps_n_blocks_minus_1(tmp_path, monkeypatch):
                                 rec.velocity_m_s, 25_600.0, "csv")
     store = tmp_path / "s.h5"
     assert main(["analyze", str(path), "--store", str(store)]) == 0
+    return store
+
+
+def test_an_analysis_in_the_store_keeps_n_blocks_minus_1(tmp_path, monkeypatch):
+    from pidcore.calibrate import measured_from_store
+    from pidcore.store import Store
+
+    store = _one_analysis_store(tmp_path)
     analyses = Store(store).list_analyses()
     assert analyses["sdc_stderr_dof"].tolist() == [N_BLOCKS - 1]  # the default 8 blocks
     (point,) = measured_from_store(store)
@@ -301,22 +308,11 @@ def test_tests_driven_along_x_are_no_load_case_of_the_calibrations_z_runs(tmp_pa
                                                                          monkeypatch):
     # an x-drive test of SDC 0.2 was pooled with a z-drive one of 0.02 as two repeats (0.11
     # +- 0.09) and fitted against a z-drive DEM run; report kept them apart
-    from _shaker_files import write_force_velocity
-
     from pidcore.calibrate import measured_from_store, read_measured_table
-    from pidcore.cli import main
-    from pidcore.constants import STANDARD_GRAVITY
     from pidcore.errors import InputFileError
-    from pidcore.signal.synthetic import synthesize_shaker_record
     from pidcore.store import Store
 
-    rec = synthesize_shaker_record(mass_kg=0.25, acceleration_amplitude_m_s2=5 * STANDARD_GRAVITY,
-                                   frequency_hz=500.0, sample_rate_hz=25_600.0, n_periods=40.3,
-                                   viscous_damping_n_s_m=2.0, snr_db=50, seed=3)
-    path = write_force_velocity(tmp_path / "run_fill50_acrylic.csv", rec.force_n,
-                                rec.velocity_m_s, 25_600.0, "csv")
-    store = tmp_path / "s.h5"
-    assert main(["analyze", str(path), "--store", str(store)]) == 0
+    store = _one_analysis_store(tmp_path)
     frame = Store(store).list_analyses()
     (alone,) = measured_from_store(store)
     both = pd.concat([frame, frame.assign(key="k2", measurement_key="m2", direction="x",
