@@ -850,3 +850,22 @@ def test_dem_run_baseline_note_does_not_put_the_structure_in_a_particles_only_m_
     (note,) = [n for n in json.loads(capsys.readouterr().out)["notes"]
                if "baseline_loss_factor" in n]
     assert " kg of m_c = " in note
+
+
+def test_elastic_contacts_that_cannot_settle_a_dense_start_say_why_and_what_works(
+        capsys, tmp_path):
+    # restitution 1 for both pairs passed specimen check, then dem run ended in "settling:
+    # kinetic energy still 2.55e-10 J ..." naming no cause: the dense start settles without
+    # friction first, and undamped contacts never come to rest
+    from pidcore.specimen import paper_specimen
+
+    specimen = paper_specimen().with_values({"pairs.particle_particle.restitution": 1.0,
+                                             "pairs.particle_wall.restitution": 1.0})
+    path = tmp_path / "elastic.toml"
+    path.write_text(specimen.to_toml())
+    assert main(["dem", "run", "--specimen", str(path), "--frequency", "500",
+                 "--acceleration", "5", "--fill", "50", "--cells", "2", "--cycles", "5",
+                 "--no-progress"]) == 2
+    err = capsys.readouterr().err
+    assert "no contact is damped (restitution 1 for both pairs)" in err
+    assert "start with --packing loose" in err and len(err.strip().splitlines()) == 1

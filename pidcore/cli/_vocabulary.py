@@ -87,6 +87,7 @@ COMMAND_FLAGS: dict[str, dict[str, str]] = {
         "^steady_cycles": "--cycles",
         "damping_coefficient='calibrated'": "--damping-coefficient calibrated",
         "normal_damping_mode='literal'": "--damping-mode literal",
+        "start_packing='loose'": "--packing loose",
         **CALIBRATION_WRITER,
     },
     "calibrate": {

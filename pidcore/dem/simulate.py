@@ -482,9 +482,15 @@ def settle(state: CellsState, settings: KernelSettings, *,
             state.vel[:] = 0.0
             state.omg[:] = 0.0
         if elapsed > max_time_s:
+            # elastic contacts (restitution 1 for both pairs) settled without friction, as the
+            # dense start's first stage does, never come to rest: the refusal named no cause
+            undamped = law.pair_particle.alpha == 0 and law.pair_wall.alpha == 0
             raise SimulationError(
                 f"settling: kinetic energy still {e[:, 0].max():.3g} J > {threshold:.3g} J "
-                f"after {elapsed:.3g} s")
+                f"after {elapsed:.3g} s"
+                + ("; no contact is damped (restitution 1 for both pairs), so a bed settled "
+                   "without friction keeps moving: state a restitution below 1, or start "
+                   "with start_packing='loose'" if undamped else ""))
 
 
 #: Beds settled without friction, keyed by everything that settling reads (see
