@@ -228,3 +228,18 @@ def test_verify_names_a_calibration_whose_design_run_is_gone_and_the_run(records
     assert problems[0].startswith(f"{path}:/calibrations/{keys['calibration']}: fitted on "
                                   f"the DEM run(s) {case}_seed")
     assert "none of which is stored" in problems[0]
+
+
+def test_a_calibration_asked_for_the_automatic_steady_cycles_by_number_keeps_its_runs():
+    # a run asked for --steady-cycles 80 (the automatic count of 10-cycle blocks) is stored
+    # as unstated (""), while the calibration's settings keep 80: compared by value, the
+    # calibration of --steady-cycles 80 had no design run, and verify would call it damaged
+    from pidcore import defaults
+    from pidcore.calibrate.persist import asked_steady_cycles
+
+    automatic = defaults.dem_automatic_steady_cycles(10)
+    assert asked_steady_cycles("", 10) == asked_steady_cycles(None, 10) \
+        == asked_steady_cycles(automatic, 10) == automatic
+    assert asked_steady_cycles(10, 10) == 10 != asked_steady_cycles("", 10)
+    # a run of other blocks runs another automatic count
+    assert asked_steady_cycles("", 100) == defaults.dem_automatic_steady_cycles(100)

@@ -31,6 +31,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, NamedTuple
 
+from .. import defaults
 from ..errors import ParameterError
 from .outputs import document_json, specimen_text
 from .prediction import Calibration, calibration_from_json
@@ -427,15 +428,21 @@ def missing_design_runs(path: str | os.PathLike) -> list[str]:
     return lines
 
 
-def _steady_cycles(value: object) -> int | None:
-    """Steady cycles a run was asked for, as a calibration's settings and a run's
-    ``config_steady_cycles`` state them (None, "" or absent: the automatic count)."""
+def asked_steady_cycles(value: object,
+                        block_cycles: object = defaults.DEM_STEADY_BLOCK_CYCLES) -> int:
+    """Steady cycles a run measures, from what a calibration's settings or a run's
+    ``config_steady_cycles`` state (None, "" or absent: the automatic count of its blocks,
+    :func:`pidcore.defaults.dem_automatic_steady_cycles`). A run asked for the automatic
+    count by number is stored as unstated (:func:`pidcore.compare.align.stored_parameters`),
+    so a calibration of ``steady_cycles=80`` would not find its own runs by the value."""
+    block = block_cycles if isinstance(block_cycles, int) and not isinstance(
+        block_cycles, bool) else defaults.DEM_STEADY_BLOCK_CYCLES
     if value is None or value == "":
-        return None
+        return defaults.dem_automatic_steady_cycles(block)
     try:
         return int(value)
     except (TypeError, ValueError):
-        return None
+        return defaults.dem_automatic_steady_cycles(block)
 
 
 def _design_runs_by_case(runs: pd.DataFrame | None, path: Path, *, variants: bool,
@@ -475,10 +482,12 @@ def _design_runs_by_case(runs: pd.DataFrame | None, path: Path, *, variants: boo
 
     from ..compare.align import stored_parameters
 
+    params = [stored_parameters(p) or {} for p in (
+        runs["parameters_json"] if "parameters_json" in runs.columns else [None] * len(runs))]
     steady_of_runs = pd.Series(
-        [_steady_cycles((stored_parameters(p) or {}).get("config_steady_cycles"))
-         for p in (runs["parameters_json"] if "parameters_json" in runs.columns
-                   else [None] * len(runs))], index=runs.index, dtype=object)
+        [asked_steady_cycles(p.get("config_steady_cycles"),
+                             p.get("config_block_cycles", defaults.DEM_STEADY_BLOCK_CYCLES))
+         for p in params], index=runs.index, dtype=object)
     by_key = {c.store_key: c for c in calibrations}
     found = []
     for _, record in listing.iterrows():
@@ -496,7 +505,7 @@ def _design_runs_by_case(runs: pd.DataFrame | None, path: Path, *, variants: boo
                     # a run of the case along x, or with other steady cycles, made after the
                     # fit, was claimed as its design run: remove refused it, verify missed
                     # the real one gone
-                    & (steady_of_runs == _steady_cycles(settings.get("steady_cycles")))]
+                    & (steady_of_runs == asked_steady_cycles(settings.get("steady_cycles")))]
         for p in calibration.predictions:
             case = p.load_case
             # the calibration made these runs from the cases it predicts: the same
