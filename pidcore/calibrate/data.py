@@ -47,7 +47,7 @@ OPTIONAL_COLUMNS = ("sdc_stderr", "sdc_stderr_dof", "energy_per_cycle_j", "mater
 CALIBRATION_DIRECTION = "z"
 
 
-def _other_direction(value: object) -> str:
+def other_direction(value: object) -> str:
     """The direction a table cell or a record states where it is not the calibration's
     (``"x"``), else "" (``"z"``, empty or absent)."""
     text = _text_cell(value, CALIBRATION_DIRECTION).strip().lower()
@@ -197,7 +197,7 @@ def read_measured_table(path: str | os.PathLike, *,
             values["sdc_stderr_dof"] = math.nan if raw_dof == "" else float(raw_dof)
         except (TypeError, ValueError):
             raise InputFileError(f"{where}: sdc_stderr_dof {raw_dof!r} is not a number") from None
-        other = _other_direction(row.get("direction"))
+        other = other_direction(row.get("direction"))
         if other:
             # an x-drive test was fitted against z-drive DEM runs without a word
             raise InputFileError(f"{where}: direction {other!r}: the calibration's DEM runs "
@@ -379,7 +379,7 @@ def measured_from_store(store_path: str | os.PathLike, *,
     frame = frame[[not found for found in implausible]]
     # tests driven along x or y are no load case of the calibration's z-drive DEM runs: they
     # were averaged with the z tests of their case as repeats (report keeps them apart)
-    other = [_other_direction(v) for v in frame.get(
+    other = [other_direction(v) for v in frame.get(
         "direction", pd.Series([None] * len(frame), index=frame.index))]
     if left_out is not None:
         left_out.extend(f"{stored_record_name(row)}: left out, driven along {axis}: the "

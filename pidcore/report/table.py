@@ -840,7 +840,7 @@ def add_calibration_columns(table: pd.DataFrame, calibration, *,
         material (the default report), each checked against the calibration's specimen.
         Neither: unchecked.
     """
-    from ..calibrate.data import CALIBRATION_DIRECTION
+    from ..calibrate.data import CALIBRATION_DIRECTION, other_direction
     from ..calibrate.prediction import judge_measurement, uninformative_count_text
 
     out = table.copy()
@@ -858,8 +858,8 @@ def add_calibration_columns(table: pd.DataFrame, calibration, *,
         if not other:
             other = calibration_row_refusal(calibration, str(row.get("specimen", "") or ""),
                                             row.get(SPECIMEN_SHA256_COLUMN, ""))
-        axis = str(row.get("direction") or CALIBRATION_DIRECTION).strip().lower()
-        if not other and axis != CALIBRATION_DIRECTION:
+        axis = other_direction(row.get("direction"))
+        if not other and axis:
             # an x-drive row was given the z-drive prediction and an in-band verdict
             other = (f"driven along {axis}, where the calibration's DEM runs drive along "
                      f"{CALIBRATION_DIRECTION}")
