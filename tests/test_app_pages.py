@@ -916,6 +916,13 @@ def test_calibrate_page_runs_the_library_on_the_stores_measurements(store_file, 
     assert "calibrated specimen (TOML)" in labels
 
 
+def _choose_file(at, key: str, file_name: str) -> None:
+    """Set the specimen choice ``key`` to the option of the file ``file_name`` (the options
+    name files by their path)."""
+    box = at.selectbox(key=key)
+    box.set_value(next(o for o in box.options if o.endswith(file_name)))
+
+
 def test_calibrate_page_calibrates_a_chosen_specimen_file_on_its_own_measurements(
         store_file, tmp_path, monkeypatch):
     # it calibrated the paper's coupon only and sent steel measurements to the command line
@@ -937,8 +944,7 @@ def test_calibrate_page_calibrates_a_chosen_specimen_file_on_its_own_measurement
     at.button(key="save").click()
     at.run()
     at.run()
-    box = at.selectbox(key="calibration_specimen")
-    box.set_value(next(o for o in box.options if o.endswith("steel_6mm.toml")))
+    _choose_file(at, "calibration_specimen", "steel_6mm.toml")
     at.run()
     assert not at.exception
     # only the steel measurement of this specimen; the acrylic one is named as left out
@@ -988,8 +994,7 @@ def test_calibrate_page_names_a_file_taking_the_paper_coupons_name_by_its_hash(
     at.button(key="save").click()
     at.run()
     at.run()
-    box = at.selectbox(key="calibration_specimen")
-    box.set_value(next(o for o in box.options if o.endswith("mine.toml")))
+    _choose_file(at, "calibration_specimen", "mine.toml")
     at.run()
     assert not at.exception
     said = [i.value for i in at.info if i.value.startswith("No saved measurement is of")]
@@ -1053,8 +1058,7 @@ def test_a_calibrated_specimen_file_left_half_moved_is_refused_in_the_pages_word
 
     monkeypatch.setattr(atomic_files, "_finish_moves", refused)
     at = _app()
-    box = at.selectbox(key="dem_specimen")
-    box.set_value(next(o for o in box.options if o.endswith("calibrated_specimen.toml")))
+    _choose_file(at, "dem_specimen", "calibrated_specimen.toml")
     at.run()
     assert not at.exception
     [message] = [e.value for e in at.error if "half-moved" in e.value]
@@ -1079,8 +1083,7 @@ def test_dem_page_runs_the_specimens_own_fill_when_the_fills_field_is_empty(
 
     monkeypatch.setattr(jobs.DemJobRunner, "submit", submit)
     at = _app()
-    box = at.selectbox(key="dem_specimen")
-    box.set_value(next(o for o in box.options if o.endswith("steel_6mm.toml")))
+    _choose_file(at, "dem_specimen", "steel_6mm.toml")
     at.text_input(key="dem_fills").set_value("")
     at.run()
     at.button(key="dem_run").click()
