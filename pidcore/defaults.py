@@ -178,7 +178,7 @@ DEM_DAMPING_COEFFICIENT = "eq3"
 DEM_CALIBRATION_SPEED_M_S = 0.3
 #: `specimen check` names a pair whose head-on impact through the kernel gives a restitution
 #: this far from the stated one [-] (no_attraction with Eq. 3: 0.902 for 0.9, 0.718 for 0.7,
-#: 0.55 for 0.5, 0.40 for 0.3). The time step's own error at the grid's smallest step (10
+#: 0.556 for 0.5, 0.40 for 0.3). The time step's own error at the grid's smallest step (10
 #: steps per contact) reaches it near e = 0.7 (0.711 in literal mode): said too, calibrated
 #: damping removes that as well.
 RESTITUTION_NOTE_GAP = 0.01

@@ -513,6 +513,35 @@ def test_files_of_a_specimens_particles_are_saved_as_its_tests(tmp_path, capsys)
     assert doc["records"][0]["specimen"] == "rig_c"
 
 
+def test_store_list_tells_apart_the_tests_of_two_edited_files_of_one_specimen_name(
+        tmp_path, capsys):
+    # two edits of one file are two specimens whose tests are never pooled; `store list`
+    # showed both sets of tests under the bare name (the DEM runs' listing hashes them)
+    from pidcore.specimen import hashed_name, load_specimen, measured_specimen_sha256
+    from pidcore.store.manage import store_contents
+
+    first = tmp_path / "a" / "panel.toml"
+    second = tmp_path / "b" / "panel.toml"
+    for path, count in ((first, 10), (second, 12)):
+        path.parent.mkdir()
+        path.write_text(STEEL_SPECIMEN.replace("count_per_cell = 10",
+                                               f"count_per_cell = {count}"))
+    store = tmp_path / "s.h5"
+    # other formats: other bytes, so two measurements
+    for path, name in ((first, "a_fill20_steel.csv"), (second, "b_fill20_steel.mat")):
+        assert main(["analyze", str(export(tmp_path / name, fmt=name[-3:])), "--specimen",
+                     str(path), "--store", str(store)]) == 0
+    capsys.readouterr()
+    listed = store_contents(store, ["analyses"])["analyses"]
+    expected = {name: hashed_name("my_steel", measured_specimen_sha256(load_specimen(p)))
+                for p, name in ((first, "a_fill20_steel.csv"), (second, "b_fill20_steel.mat"))}
+    assert dict(zip(listed["file"], listed["specimen"], strict=True)) == expected
+    assert len(set(expected.values())) == 2
+    assert main(["store", "list", "--store", str(store), "--section", "analyses"]) == 0
+    out = capsys.readouterr().out
+    assert all(label in out for label in expected.values())
+
+
 def test_a_file_stating_no_fill_is_saved_as_a_test_of_the_specimen_given(tmp_path, capsys):
     # `analyze run7.csv --specimen panel.toml` (no fill in the name): saved unnamed, and the
     # output said "no specimen named, the paper's coupon assumed ... name another with

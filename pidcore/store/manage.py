@@ -137,10 +137,16 @@ def _contents(store: Store, section: str) -> pd.DataFrame:
         frame["n_analyses"] = [int(counts.get(k, 0)) for k in frame["key"]]
         return frame
     if section == "analyses":
+        from ..specimen import MEASURED_SHA256_FIELD
+
         frame = store.list_analyses()
         newest = set(latest_per_measurement(frame)["key"])
         frame["file"] = [Path(str(s)).name for s in frame["source"]]
         frame["reports"] = ["newest" if k in newest else "superseded" for k in frame["key"]]
+        # two edited files of one name are two specimens whose tests are never pooled: the
+        # listing tells them apart as the DEM runs' and calibrations' listings do
+        frame["specimen"] = _specimens(_column(frame, "specimen"),
+                                       _column(frame, MEASURED_SHA256_FIELD))
         return frame
     if section == "dem_runs":
         from ..calibrate.persist import calibration_design_runs
