@@ -237,3 +237,81 @@ def test_a_static_friction_raised_to_a_pairs_sliding_friction_is_stated_as_run()
     plain = {"static_friction": 0.5}
     assert variant_provenance(start, specimen_with(start, plain), plain)["values"] == \
         [["static_friction", 0.5]]
+
+
+def test_a_variant_run_is_a_design_run_only_of_the_calibration_whose_design_made_it(
+        variants, tmp_path):
+    # a fit of observation parameters alone (no DEM design, no variant) at the same load case,
+    # cells and seed was named a dependent of every variant of its start: store list said
+    # "design run of" it, remove refused the runs for it and --with-dependents took it along
+    import shutil
+
+    import h5py
+
+    from pidcore.calibrate.persist import calibration_design_runs, save_calibration
+    from pidcore.errors import StoreError
+    from pidcore.store.manage import remove_records
+
+    source, mine, result = variants
+    store = tmp_path / "dem.h5"
+    shutil.copyfile(source, store)
+    designed = save_calibration(result, store).key
+    point = MeasuredPoint(CASE.frequency_hz, CASE.acceleration_g, CASE.fill_percent, 0.5,
+                          0.01, specimen="mycoupon", specimen_sha256=mine.hash)
+    observed = save_calibration(calibrate(
+        [point], fit=["baseline_loss_factor"], discrepancy=0.3, store_path=store,
+        cells=CONFIG.cells, steady_cycles=CONFIG.steady_cycles, dem_config=CONFIG,
+        workers=1, progress=False, specimen=mine), store).key
+    variant_keys = list(Store(source).list_dem_runs()["case_key"])
+    runs = Store(store).list_dem_runs()
+    start_key = next(k for k, sha in zip(runs["case_key"], runs["specimen_sha256"],
+                                         strict=True) if sha == mine.hash)
+    # a variant of the same file another design made (another rolling friction): no run of
+    # either calibration here
+    other = Store(store).get_dem_run(variant_keys[0])
+    stated = {**other.parameters["calibration_variant"],
+              "values": [["rolling_friction", 0.0777]]}
+    Store(store).add_dem_run("other_design_run", {**other.record, "specimen_sha256": "f" * 64},
+                             arrays=other.arrays, units=other.units,
+                             parameters={**other.parameters, "calibration_variant": stated})
+    design = calibration_design_runs(Store(store).list_dem_runs(), [store], variants=True)
+    assert {k: design[k] for k in variant_keys} == dict.fromkeys(variant_keys, (designed,))
+    assert "other_design_run" not in design and observed in design[start_key]
+    # what the store's commands make of it: the other design's variant goes alone, a real
+    # variant is refused for its own calibration only and takes that one alone with it
+    assert [r.key for r in remove_records(store, ["other_design_run"]).records] == \
+        ["other_design_run"]
+    with pytest.raises(StoreError, match=f"DEM run {variant_keys[0]} is a design run of "
+                                         f"calibration {designed} .*nothing was removed"):
+        remove_records(store, [variant_keys[0]])
+    removal = remove_records(store, [variant_keys[0]], with_dependents=True, dry_run=True)
+    assert [(r.section, r.key) for r in removal.records] == [
+        ("dem_runs", variant_keys[0]), ("calibrations", designed)]
+    # verify: every run of both fits gone, the other design's look-alike (put back) stands in
+    # for neither
+    Store(store).add_dem_run("other_design_run", {**other.record, "specimen_sha256": "f" * 64},
+                             arrays=other.arrays, units=other.units,
+                             parameters={**other.parameters, "calibration_variant": stated})
+    assert Store(store).verify() == []
+    with h5py.File(store, "r+") as h5:  # damage done outside pidcore
+        for key in [*variant_keys, start_key]:
+            del h5["dem_runs"][key]
+    problems = Store(store).verify()
+    assert sorted(p.split(": fitted on")[0] for p in problems) == sorted(
+        f"{store}:/calibrations/{key}" for key in (designed, observed))
+
+
+def test_a_design_point_of_a_raised_static_friction_is_known_by_the_run_it_made():
+    # a static friction below a pair's sliding friction is stated per pair as run: the
+    # design point (0.12) is found from the run's own specimen, and not another point's
+    from pidcore.calibrate.runner import is_design_variant, variant_provenance
+    from pidcore.compare.specimens import run_origin
+
+    start = paper_specimen()
+    names, points = ["static_friction"], [[0.5], [0.12]]
+    variant = specimen_with(start, {"static_friction": 0.12})
+    origin = run_origin(json.dumps({"calibration_variant": variant_provenance(
+        start, variant, {"static_friction": 0.12})}))
+    assert is_design_variant(origin.values, names, points, variant)
+    assert not is_design_variant(origin.values, names, [[0.5], [0.13]], variant)
+    assert not is_design_variant(origin.values, [], [[]], variant)  # no design: no variant

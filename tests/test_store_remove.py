@@ -123,29 +123,27 @@ def test_a_missing_store_is_refused_not_read_as_empty(tmp_path):
     assert not (tmp_path / "nope.h5").exists()
 
 
-def test_a_calibrations_run_of_its_variant_of_the_start_specimen_is_refused_too(records_store_copy):
-    # fitting a DEM parameter, a calibration runs variants of its start specimen (other
-    # hashes); they are inputs of its fit as much as the start's runs, and were removed
+def test_a_variant_of_the_start_no_design_of_the_calibration_made_is_no_run_of_it(
+        records_store_copy):
+    # fitting the fixture mass alone, a calibration makes no variant of its start specimen
+    # (its design names no DEM parameter): another fit's variant of the same file at its load
+    # case, cells and seed was refused as its design run, and --with-dependents took it along
+    # (a variant its design did make is refused: test_calibration_variant_runs)
     path, keys = records_store_copy
     store = Store(path)
     start = str(store.list_calibrations()["specimen_hash"].iloc[0])
     run = store.get_dem_run(keys["design"][0])
     assert run.record["specimen_sha256"] == start
     variant = {**run.parameters, "calibration_variant": {
-        "of_name": "paper_coupon", "of_sha256": start, "values": [["fixture_mass_kg", 0.1]]}}
+        "of_name": "paper_coupon", "of_sha256": start, "values": [["rolling_friction", 0.05]]}}
     store.add_dem_run("variant_run", {**run.record, "specimen_sha256": "f" * 64},
                       arrays=run.arrays, units=run.units, parameters=variant)
-    digest = file_sha256(path)
-    with pytest.raises(StoreError, match=f"DEM run variant_run is a design run of calibration "
-                                         f"{keys['calibration']} .*nothing was removed"):
-        remove_records(path, ["variant_run"])
-    assert file_sha256(path) == digest
-    # a run of another file (no variant of the start) stays removable
-    store.add_dem_run("other_file_run", {**run.record, "specimen_sha256": "e" * 64},
-                      arrays=run.arrays, units=run.units,
-                      parameters={**run.parameters, "calibration_variant": None})
-    assert [r.key for r in remove_records(path, ["other_file_run"]).records] == \
-        ["other_file_run"]
+    listed = store_contents(path, ["dem-runs"])["dem-runs"].set_index("key")["design_of"]
+    assert listed["variant_run"] == "" and listed[keys["design"][0]] == keys["calibration"]
+    removal = remove_records(path, ["variant_run"], with_dependents=True, dry_run=True)
+    assert [r.key for r in removal.records] == ["variant_run"]
+    assert [r.key for r in remove_records(path, ["variant_run"]).records] == ["variant_run"]
+    assert Store(path).verify() == []
 
 
 def test_a_run_two_calibrations_were_fitted_on_is_removed_with_both_or_refused(

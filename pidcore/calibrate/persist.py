@@ -375,9 +375,11 @@ def calibration_design_runs(runs: pd.DataFrame | None,
     so the calibrations saved before this existed are recognised too.
 
     With ``variants``, also the runs of its variants of the start specimen (their stored
-    :func:`~pidcore.compare.specimens.run_origin` names the start's hash): inputs of the fit
-    too, which what removes runs must know of, while reports leave them out already as
-    other specimens.
+    :func:`~pidcore.compare.specimens.run_origin` names the start's hash) that its design
+    made (their stated values are one of the design points its calibration.json states):
+    inputs of the fit too, which what removes runs must know of, while reports leave them
+    out already as other specimens. Another calibration's variants of the same file (another
+    design, or a fit of observation parameters alone, which makes none) are not its runs.
     """
     found: dict[str, tuple[str, ...]] = {}
     for path in dict.fromkeys(Path(p) for p in store_paths if p is not None):
@@ -452,7 +454,10 @@ def _design_runs_by_case(runs: pd.DataFrame | None, path: Path, *, variants: boo
     ``every_calibration`` nothing where ``runs`` holds none (reports of a store of runs
     only)."""
     import numpy as np
+    import pandas as pd
 
+    from ..compare.align import stored_parameters
+    from ..compare.specimens import CalibrationVariant, run_origins
     from ..store import Store
 
     needed = {"case_key", "specimen_sha256", "cells_simulated", "seed", "frequency_hz",
@@ -460,8 +465,6 @@ def _design_runs_by_case(runs: pd.DataFrame | None, path: Path, *, variants: boo
     if runs is None or runs.empty or not needed <= set(runs.columns):
         if not every_calibration:
             return []
-        import pandas as pd
-
         runs = pd.DataFrame(columns=sorted(needed))
     if not path.is_file():
         return []
@@ -469,21 +472,16 @@ def _design_runs_by_case(runs: pd.DataFrame | None, path: Path, *, variants: boo
     if listing.empty:
         return []
     origins = runs["specimen_sha256"]
+    kinds = pd.Series([None] * len(runs), index=runs.index, dtype=object)
     if variants and not runs.empty:
-        import pandas as pd
-
-        from ..compare.specimens import CalibrationVariant, run_origins
-
+        kinds = run_origins(runs)
         origins = pd.Series([o.of_sha256 if isinstance(o, CalibrationVariant) else own
-                             for o, own in zip(run_origins(runs), runs["specimen_sha256"],
-                                               strict=True)], index=runs.index)
+                             for o, own in zip(kinds, runs["specimen_sha256"], strict=True)],
+                            index=runs.index)
     calibrations, _ = readable_calibrations(path, listing=listing)  # damaged: said elsewhere
-    import pandas as pd
-
-    from ..compare.align import stored_parameters
-
-    params = [stored_parameters(p) or {} for p in (
-        runs["parameters_json"] if "parameters_json" in runs.columns else [None] * len(runs))]
+    params = pd.Series([stored_parameters(p) or {} for p in (
+        runs["parameters_json"] if "parameters_json" in runs.columns else [None] * len(runs))],
+        index=runs.index, dtype=object)
     steady_of_runs = pd.Series(
         [asked_steady_cycles(p.get("config_steady_cycles"),
                              p.get("config_block_cycles", defaults.DEM_STEADY_BLOCK_CYCLES))
@@ -506,6 +504,14 @@ def _design_runs_by_case(runs: pd.DataFrame | None, path: Path, *, variants: boo
                     # fit, was claimed as its design run: remove refused it, verify missed
                     # the real one gone
                     & (steady_of_runs == asked_steady_cycles(settings.get("steady_cycles")))]
+        if not same.empty:
+            # a variant of the start is an input of this fit only where its design made it:
+            # a fit of observation parameters alone (no design) was named a dependent of
+            # another fit's variants, and store remove refused them for it
+            design = _design_of(calibration)
+            made = [not isinstance(kinds[i], CalibrationVariant) or design is None
+                    or _made_by(kinds[i], params[i], design) for i in same.index]
+            same = same[made]
         for p in calibration.predictions:
             case = p.load_case
             # the calibration made these runs from the cases it predicts: the same
@@ -521,3 +527,38 @@ def _design_runs_by_case(runs: pd.DataFrame | None, path: Path, *, variants: boo
                 keys = tuple(str(k) for k in same.loc[at, "case_key"])
             found.append(DesignCase(str(record["key"]), case, sha, cells, seed, keys))
     return found
+
+
+def _design_of(calibration: Calibration) -> tuple[list[str], list[list[float]]] | None:
+    """The fitted DEM parameters' names and design points its calibration.json states
+    (``design``: no names where it fitted none); None where the document states no readable
+    design: then any variant of its start may be its run, as one cannot tell (a removal is
+    refused rather than the fit's inputs lost)."""
+    try:
+        design = json.loads(calibration.document_text)["design"]
+        names = [str(n) for n in design["names"]]
+        points = [[float(v) for v in point] for point in design["points"]]
+    except (KeyError, TypeError, ValueError):
+        return None
+    return names, points
+
+
+def _made_by(origin, parameters: dict, design: tuple[list[str], list[list[float]]]) -> bool:
+    """Whether a variant run (its :class:`~pidcore.compare.specimens.CalibrationVariant`
+    ``origin`` and stored ``parameters``) is one of ``design``'s points
+    (:func:`pidcore.calibrate.runner.is_design_variant`)."""
+    from ..errors import PidcoreError
+    from ..specimen import Specimen
+    from .runner import is_design_variant
+
+    names, points = design
+    if is_design_variant(origin.values, names, points):
+        return True
+    text = parameters.get("specimen_text")
+    if not names or not isinstance(text, str) or not text:
+        return False
+    try:  # its own specimen says which static friction a pair was raised to
+        variant = Specimen.from_text(text, source="stored run")
+    except PidcoreError:
+        return False
+    return is_design_variant(origin.values, names, points, variant)

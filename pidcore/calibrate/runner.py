@@ -19,6 +19,7 @@ from pathlib import Path
 
 from ..dem.persist import dem_run_entry, run_key, save_dem_entry, stored_keys
 from ..dem.simulate import DemConfig, LoadCase, simulate_load_case
+from ..errors import ParameterError
 from ..interrupt import raise_if_stopped, untouched
 from ..specimen import Specimen
 from .parameters import friction_paths
@@ -118,6 +119,36 @@ def _values_as_set(variant: Specimen, values: Mapping[str, float]) -> list[tuple
         else:
             out.extend((f"pairs.{pair}.static_friction", v) for pair, v in held.items())
     return out
+
+
+def is_design_variant(stated: Sequence[tuple[str, float]], names: Sequence[str],
+                      points: Sequence[Sequence[float]], variant: Specimen | None = None
+                      ) -> bool:
+    """Whether a run of a calibration's variant that states ``stated`` (the ``values`` of
+    :func:`variant_provenance`) is a variant of one of the design ``points`` of the fitted DEM
+    parameters ``names`` (a calibration.json's ``design``): a point's values as
+    :func:`variant_provenance` states them. ``variant``: the run's specimen, without which a
+    static friction raised to a pair's sliding friction (stated per pair, the value asked for
+    lost) is not recognised: with it, such a point is one that states the same and, set on
+    the variant, changes nothing.
+
+    Both are the design's floats through JSON, compared exactly: any other variant of the same
+    file (another calibration's design) is not this calibration's run."""
+    wanted = [(str(name), float(value)) for name, value in stated]
+    for point in points:
+        if len(point) != len(names) or not names:
+            continue
+        values = {str(n): float(v) for n, v in zip(names, point, strict=True)}
+        if list(values.items()) == wanted:
+            return True
+        # stated per pair as run: the same statement and the point setting nothing anew
+        if variant is not None and _values_as_set(variant, values) == wanted:
+            try:
+                if specimen_with(variant, values).hash == variant.hash:
+                    return True
+            except ParameterError:
+                continue  # a point outside the variant's domain did not make it
+    return False
 
 
 def run_requests(requests: Sequence[RunRequest], *, store_path: str | os.PathLike,
