@@ -2614,6 +2614,46 @@ def test_a_cancelled_calibration_stops_at_its_next_run_and_keeps_the_saved_ones(
     assert not runner.cancel()  # nothing runs any more
 
 
+def test_a_cancel_after_every_dem_run_finished_says_none_was_running(tmp_path):
+    # clicked as the last run was saved ("25 of 25 DEM runs (5 from the store)"), the page
+    # said "20 DEM run(s) computed ...; the running ones were stopped and nothing of them
+    # saved" though no run was left to stop
+    import pidcore.calibrate as api
+    from pidcore.app.calibration import CalibrationRunner, CalibrationTask
+    from pidcore.calibrate import MeasuredPoint
+    from pidcore.store import Store
+
+    store = tmp_path / "s.h5"
+    points = [MeasuredPoint(500, 5, 50, 0.6), MeasuredPoint(1000, 5, 50, 0.6),
+              MeasuredPoint(500, 1, 50, 0.2)]
+    # the first point's run stored before (by an earlier fit of the same tests): 1 of 3
+    api.calibrate(points[:1], fit=["baseline_loss_factor"], discrepancy=0.2, store_path=store,
+                  cells=2, progress=False, workers=1)
+    runner = CalibrationRunner(store)
+    task = runner.task = CalibrationTask(("fixture_mass_kg",), len(points))
+    counted = task.run_done
+
+    def cancel_at_the_last_run(key: str) -> None:  # the user's click as the last run ends
+        if task.runs_stored_before + task.runs_done + 1 == task.runs_total:
+            assert runner.cancel()
+        counted(key)
+
+    task.run_done = cancel_at_the_last_run
+    runner._run(api, task, points, ["fixture_mass_kg"], 2, None, None)
+    assert (task.state, task.runs_total, task.runs_stored_before, task.runs_done) == \
+        ("cancelled", 3, 1, 2)
+    assert task.message == (
+        "every one of its 3 DEM runs had finished (1 from the store before) and none was "
+        "running: 2 DEM run(s) computed before the cancel are kept in s.h5, and the fit was "
+        "stopped before a calibration was saved; run the same calibration again to fit on the "
+        "stored runs (no DEM run is computed again)")
+    saved = Store(store)
+    assert len(saved.list_dem_runs()) == 3 and saved.list_calibrations().empty
+    # before the design was made no run had started, and none is said to have been stopped
+    assert CalibrationTask(("friction",), 3).cancelled_text("s.h5") == (
+        "cancelled before its DEM runs started; s.h5 holds nothing new of it")
+
+
 def test_cancel_stops_the_running_calibration_runs_within_seconds(tmp_path, monkeypatch):
     # Cancel stopped a calibration only when its next DEM run was saved: a minute or more
     # with a run going. Here each run but the quick ones takes 60 s (_pool_probe), so only a

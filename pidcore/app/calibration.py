@@ -295,6 +295,25 @@ class CalibrationTask:
                if self.runs_done > 0 and left > 0 else "")
         return f"{done} of {self.runs_total} DEM runs{stored}, {elapsed:.0f} s elapsed{eta}"
 
+    def cancelled_text(self, store_name: str) -> str:
+        """What a cancel kept: the DEM runs computed and whether any was still to run (stopped
+        and discarded). A cancel after the last run (while the posterior was sampled) said
+        "the running ones were stopped" of runs that had all finished."""
+        if self.runs_total <= 0:
+            return (f"cancelled before its DEM runs started; {store_name} holds nothing "
+                    "new of it")
+        computed = f"{self.runs_done} DEM run(s) computed before the cancel are kept in " \
+                   f"{store_name}"
+        if self.runs_stored_before + self.runs_done < self.runs_total:
+            return (f"{computed}; the running ones were stopped and nothing of them saved; "
+                    "run the same calibration again to resume (stored runs are reused)")
+        stored = f" ({self.runs_stored_before} from the store before)" \
+            if self.runs_stored_before else ""
+        return (f"every one of its {self.runs_total} DEM runs had finished{stored} and none "
+                f"was running: {computed}, and the fit was stopped before a calibration was "
+                "saved; run the same calibration again to fit on the stored runs (no DEM run "
+                "is computed again)")
+
 
 class CalibrationRunner:
     """One calibration at a time for one store, in a background thread."""
@@ -399,10 +418,7 @@ class CalibrationRunner:
             message += saved
         except StopRequested:
             outputs, state, key = {}, "cancelled", ""
-            message = (f"{task.runs_done} DEM run(s) computed before the cancel are kept in "
-                       f"{self.store_path.name}; the running ones were stopped and nothing "
-                       "of them saved; run the same calibration again to resume (stored "
-                       "runs are reused)")
+            message = task.cancelled_text(self.store_path.name)
         except Exception as exc:  # noqa: BLE001 - shown on the page as the task's error
             # a library refusal is its one line (the class name is no news to a user); an
             # unexpected error keeps its name, without which "KeyError: 'x'" says nothing
