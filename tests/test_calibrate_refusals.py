@@ -657,3 +657,40 @@ def test_fills_are_one_load_case_exactly_where_they_round_to_one_particle_count(
         with pytest.raises(DemRunsAsked):  # two load cases: on to their DEM runs
             calibrate(points, fit="fixture_mass_kg", discrepancy=0.2,
                       store_path=tmp_path / "dem.h5", progress=False, workers=1)
+
+
+@pytest.mark.parametrize("fit", ["fixture_mass_kg,coupon.mass_kg", "coupon.mass_kg"])
+def test_the_coupon_mass_is_refused_as_a_fit_parameter_naming_the_fixture_mass(
+        capsys, tmp_path, fit):
+    # fitted beside fixture_mass_kg (or alone) as a DEM parameter, it cost a design of DEM
+    # runs that all came out alike, and its posterior was its prior
+    _refused(capsys, tmp_path, ["--data", str(_table(tmp_path)), "--fit", fit],
+             "fit: coupon.mass_kg cannot be fitted", "coupon + fixture mass", "fixture_mass_kg")
+
+
+def test_the_coupon_mass_moves_no_particle_and_the_fit_observes_the_start_specimens():
+    # the refusal's reason: two coupons of other masses give the bit-identical wall force of
+    # the particles (the drive is prescribed), so their observations (Eq. 11) agree exactly;
+    # only the Eq. 10 SDC the DEM states, normalised by the vibrated mass, differs
+    from pidcore.calibrate.observation import observation_from_run
+    from pidcore.dem.persist import dem_run_entry
+    from pidcore.dem.simulate import DemConfig, LoadCase, simulate_load_case
+
+    config = DemConfig(cells=2, steady_cycles=10, block_cycles=5, max_transient_cycles=5)
+    case = LoadCase(500.0, 5.0, 50.0)
+    start = paper_specimen()
+    heavier = start.with_values({"coupon.mass_kg": 1.5 * start.coupon.mass_kg})
+    entries = [dem_run_entry(simulate_load_case(case, config, specimen=s))
+               for s in (start, heavier)]
+    assert np.array_equal(entries[0]["arrays"]["wall_force_n"],
+                          entries[1]["arrays"]["wall_force_n"])
+    assert entries[0]["record"]["sdc"] != entries[1]["record"]["sdc"]
+    seen = [observation_from_run(e["record"], e["arrays"], coupon_mass_kg=start.coupon.mass_kg)
+            for e in entries]
+    assert (seen[0].dissipative_mass_kg, seen[0].reactive_mass_kg) == \
+        (seen[1].dissipative_mass_kg, seen[1].reactive_mass_kg)
+    # the app's Run goes through the same library function
+    import pidcore.calibrate as api
+
+    with pytest.raises(ParameterError, match=r"^fit: coupon\.mass_kg cannot be fitted"):
+        api.parse_fit(["fixture_mass_kg", "coupon.mass_kg"], start)

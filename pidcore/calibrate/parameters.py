@@ -156,6 +156,11 @@ OBSERVATION_PATHS = {"coupon.fixture_mass_kg": "fixture_mass_kg",
 
 DEFAULT_FIT = ("fixture_mass_kg", "baseline_loss_factor")
 
+#: The coupon's own mass: no DEM parameter (the cells follow the prescribed drive whatever
+#: the coupon weighs) and in the measured SDC (Eq. 11, :mod:`pidcore.calibrate.observation`)
+#: only beside the fixture's, as their sum: :func:`parse_fit` refuses it.
+COUPON_MASS_PATH = "coupon.mass_kg"
+
 
 #: Unit of a specimen field by the suffix of its name (the schema's naming rule: SI, the unit
 #: in the name); a field without one (ratios, coefficients) is dimensionless.
@@ -245,6 +250,15 @@ def parse_fit(text: str | Sequence[str] | None, specimen: Specimen | None = None
         if name == DISCREPANCY:
             raise ParameterError(f"fit: {DISCREPANCY} is always fitted (fix it with "
                                  "discrepancy=TAU)")
+        if name == COUPON_MASS_PATH:
+            # fitted as a DEM parameter it cost a design of DEM runs that all came out alike,
+            # and its posterior was its prior, beside or instead of fixture_mass_kg
+            raise ParameterError(
+                f"fit: {COUPON_MASS_PATH} cannot be fitted: the coupon's rigid mass moves no "
+                "particle in the DEM (its cells follow the prescribed drive) and enters the "
+                "measured SDC (Eq. 11) only as coupon + fixture mass, as fixture_mass_kg does, "
+                "so the tests cannot tell the two apart; fit fixture_mass_kg (no DEM run) and "
+                f"state the coupon's mass in the specimen file")
         parameter_spec(name, specimen)
         _refuse_whole_number(name, specimen)
     if len(set(names)) != len(names):
