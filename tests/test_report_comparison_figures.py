@@ -189,3 +189,16 @@ def test_sdc_comparison_sets_the_eq10_measured_sdc_beside_our_dem(one_measured_c
     bars = next(c for c in ax.containers if c.get_label() == eq10[0]).lines[2][0]
     (lo, hi), = [seg[:, 1] for seg in bars.get_segments()]
     assert (hi - lo) / 2 == pytest.approx(0.1 / 4.3 * row[MEASURED_EQ10_COLUMN], rel=1e-12)
+
+
+def test_sdc_comparison_ticks_of_one_load_case_name_the_settings_they_differ_in():
+    """A 2-cell DEM run stored beside the 8-cell grid's run at 100 Hz, 5 g, 50 % drew two
+    ticks reading "100 Hz 5 g 50 %" over SDCs 0.71 and 0.89; each now names its settings,
+    and only those two ticks (the others stay three lines)."""
+    from test_report_render import _two_settings_table
+
+    table = _two_settings_table()
+    ax = plot_sdc_comparison(table).axes[0]
+    labels = [t.get_text() for t in ax.get_xticklabels()]
+    assert labels == ["100 Hz\n5 g\n50 %\ncells 2", "100 Hz\n5 g\n50 %\ncells 8",
+                      "1000 Hz\n1 g\n90 %"]

@@ -634,10 +634,96 @@ def test_every_page_writes_an_sdc_beside_its_stderr_by_the_one_rule(tmp_path, pr
         paths["html"].read_text(encoding="utf-8"))
     assert "8.16812 & 0.00030" in paths["tex"].read_text(encoding="utf-8")
     labels, rows = pdf_table_cells(table)
-    cols = [c for c in render.PDF_COLUMNS if c in table.columns]
+    cols = render.pdf_columns(table)
     shown = dict(zip(cols, rows[0], strict=True))
     assert (shown["SDC DEM (ours) [-]"], shown["SDC DEM stderr [-]"]) == ("8.16812", "0.00030")
     assert (shown[MEASURED_EQ11_COLUMN], shown[MEASURED_EQ11_STDERR_COLUMN]) == (
         "0.250000", "<0.000001")
     header, _, row = short_table(table).splitlines()[:3]
     assert row.split()[3] == "8.16812"  # our DEM's SDC, rounded at its error's place
+
+
+def _two_settings_table():
+    """Two DEM runs of one load case at other settings (a 2-cell smoke run beside the 8-cell
+    grid's run, ``pidcore dem run --cells 2`` stored beside the bundled Table 3 runs), and
+    Table 3's 1000 Hz, 1 g, 90 %, whose paper DEM cell is empty for a reason the row's note
+    gives."""
+    dem = pd.DataFrame({"frequency_hz": [100.0, 100.0, 1000.0],
+                        "acceleration_g": [5.0, 5.0, 1.0], "fill_percent": [50.0, 50.0, 90.0],
+                        "material": ["acrylic"] * 3, "direction": ["z"] * 3,
+                        "sdc": [0.71, 0.89, 2.7], "sdc_stderr": [0.12, 0.06, 0.3],
+                        "cells_simulated": [2, 8, 8]})
+    return build_report_table(dem, None, load_paper_table3())
+
+
+def test_pdf_table_tells_rows_of_one_load_case_apart_and_numbers_their_notes(tmp_path,
+                                                                             provenance):
+    """Two rows "100 | 5 | 50" of SDCs 0.71 and 0.89 with nothing saying which run is which,
+    and blank cells with no reason: the PDF showed neither the DEM settings nor the notes
+    that every other format has. The settings the rows differ in are a column, the ones they
+    share a line under the title, and each note is numbered in its row and written under the
+    table; the PDF's own text is read back."""
+    from test_report_case_sheet import _pdf_text
+
+    from pidcore.report.render import numbered_notes, pdf_table_cells
+
+    table = _two_settings_table()
+    labels, rows = pdf_table_cells(table)
+    heads = [label.replace("\n", " ") for label in labels]
+    cells = [dict(zip(heads, row, strict=True)) for row in rows]
+    assert [(c["SDC DEM (ours) [-]"], c["DEM settings"]) for c in cells] == [
+        ("0.71", "cells 2"), ("0.890", "cells 8"), ("2.70", "cells 8")]  # at their errors
+    # material and direction are the same in every row: no column, said once
+    assert "material" not in heads and "direction" not in heads
+    note = table["note"].iloc[2]
+    assert note.startswith("the paper's Table 3 prints no DEM value at 1000 Hz, 1 g, 90 %")
+    assert [c["note"] for c in cells] == ["", "", "1"]
+    assert numbered_notes(table["note"]) == (["", "", "1"], [note])
+    text = _pdf_text(write_report(table, {}, provenance, tmp_path / "r", "pdf")["pdf"]
+                     .read_bytes())
+    assert "Every row that states it: material acrylic; direction z" in text
+    assert "cells 2" in text and "cells 8" in text
+    # up to "difference": the PDF draws its "ff" as a glyph of its own, not a letter of the text
+    assert "1. the paper's Table 3 prints no DEM value at 1000 Hz, 1 g, 90 %: no paper DEM" in text
+
+
+def test_numbered_notes_give_one_note_one_number_in_the_order_rows_first_name_it():
+    from pidcore.report.render import numbered_notes
+
+    marks, notes = numbered_notes(["b", "", "a", "b", float("nan"), "a"])
+    assert marks == ["1", "", "2", "1", "", "2"] and notes == ["b", "a"]
+
+
+def test_pdf_table_pages_hold_their_rows_and_the_notes_they_number(tmp_path, provenance):
+    """48 rows, each a note of ~300 characters of its own: each page's table and the notes it
+    numbers fit on the page (none past its bottom edge), and every note is written."""
+    from test_report_case_sheet import _pdf_text
+
+    from pidcore.report.render import (
+        _PDF_TABLE_ROOM,
+        _pdf_height,
+        _pdf_pages,
+        _pdf_row_height,
+        numbered_notes,
+        pdf_table_cells,
+    )
+
+    table = build_report_table(pd.DataFrame({
+        "frequency_hz": np.repeat([50.0, 100.0, 500.0, 1000.0], 12),
+        "acceleration_g": np.tile(np.repeat([1.0, 5.0, 10.0], 4), 4),
+        "fill_percent": np.tile([25.0, 50.0, 75.0, 90.0], 12), "material": ["acrylic"] * 48,
+        "direction": ["z"] * 48, "sdc": np.linspace(0.01, 3.0, 48),
+        "sdc_stderr": [0.01] * 48}), None, None)
+    table["note"] = [f"row {i}: " + "a long reason " * 22 for i in range(48)]
+    labels, rows = pdf_table_cells(table)
+    marks, notes = numbered_notes(table["note"])
+    header = max(label.count("\n") + 1 for label in labels)
+    pages = _pdf_pages(rows, marks, notes, header)
+    assert [i for page in pages for i in page] == list(range(48)) and len(pages) > 2
+    for page in pages:
+        used = _pdf_row_height(header) + sum(_pdf_height(rows[i], marks[i], notes, set())
+                                             for i in page)
+        assert used <= _PDF_TABLE_ROOM
+    text = _pdf_text(write_report(table, {}, provenance, tmp_path / "r", "pdf")["pdf"]
+                     .read_bytes())
+    assert all(f"{k}. row {k - 1}:" in text for k in range(1, 49))

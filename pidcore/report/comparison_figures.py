@@ -12,6 +12,7 @@ The model families (paper Figs. 8-14) are in :mod:`pidcore.report.figures`.
 
 from __future__ import annotations
 
+import textwrap
 from collections.abc import Mapping
 
 import numpy as np
@@ -25,6 +26,8 @@ from .table import (
     MEASURED_EQ11_COLUMN,
     MEASURED_EQ11_STDERR_COLUMN,
     PACKING_RATIO_COLUMN,
+    SPECIMEN_SHA256_COLUMN,
+    differing_columns,
 )
 
 #: Force arrays looked for in a DEM run, in order: the force a shaker's gauge would measure
@@ -81,11 +84,9 @@ def plot_sdc_comparison(table: pd.DataFrame, *, ax=None):
     """
     drawn = np.column_stack([table[c].astype(float).to_numpy() for c in _DRAWN_COLUMNS])
     rows = table[np.isfinite(drawn).any(axis=1)]
-    # the material only where rows differ in it: else two ticks could read the same
-    # (an acrylic measurement beside a steel DEM run at one frequency, acceleration and fill)
-    several = "material" in rows and rows["material"].nunique() > 1
+    labels = sdc_tick_labels(rows)
     if ax is not None:
-        _draw_sdc_rows(ax, rows, several)
+        _draw_sdc_rows(ax, rows, labels)
         axes = [ax]
     else:
         # the paper's 48 load cases in one row of ticks made a 37-inch strip, unreadable in the
@@ -95,7 +96,8 @@ def plot_sdc_comparison(table: pd.DataFrame, *, ax=None):
         fig = _new_figure(max(6.4, 0.65 * per_panel + 2.0) + 3.6, 4.2 * n_panels)
         axes = list(fig.subplots(n_panels, 1, squeeze=False)[:, 0])
         for i, panel in enumerate(axes):
-            _draw_sdc_rows(panel, rows.iloc[i * per_panel:(i + 1) * per_panel], several)
+            part = slice(i * per_panel, (i + 1) * per_panel)
+            _draw_sdc_rows(panel, rows.iloc[part], labels[part])
     axes[0].set_title("SDC per load case (ours: dissipated energy over Eq. 10's E)")
     handles: dict[str, object] = {}
     for panel in axes:  # a series may be drawn on a later panel only
@@ -108,15 +110,38 @@ def plot_sdc_comparison(table: pd.DataFrame, *, ax=None):
     return axes[0].figure
 
 
-def _draw_sdc_rows(ax, rows: pd.DataFrame, several_materials: bool) -> None:
-    """One panel of :func:`plot_sdc_comparison`: a tick per row, the row's values beside it."""
+#: Characters of a line of a tick label's setting (:func:`sdc_tick_labels`): about a tick's
+#: width at the labels' size.
+_TICK_LINE = 14
+
+
+def sdc_tick_labels(rows: pd.DataFrame) -> list[str]:
+    """The tick label of each row of :func:`plot_sdc_comparison`: its frequency, acceleration
+    and fill; its material where the rows differ in it (an acrylic measurement beside a steel
+    DEM run at one load case); and where two labels would still read the same, the settings
+    those rows differ in (:func:`~pidcore.report.table.differing_columns`: two DEM runs of
+    one load case at other settings had two identical ticks of different SDCs)."""
+    several = "material" in differing_columns(rows)
+    labels = [f"{r['frequency [Hz]']:.4g} Hz\n{r['acceleration [g]']:.3g} g\n"
+              f"{r[PACKING_RATIO_COLUMN]:.3g} %" + (f"\n{r['material']}" if several else "")
+              for _, r in rows.iterrows()]
+    for label in {label for label in labels if labels.count(label) > 1}:
+        alike = [i for i, other in enumerate(labels) if other == label]
+        for column in differing_columns(rows.iloc[alike]):
+            for i in alike:
+                value = str(rows.iloc[i][column] or "")
+                if column == SPECIMEN_SHA256_COLUMN and value:
+                    value = f"sha256 {value[:8]}"  # 64 digits: the first tell files apart
+                labels[i] += "".join(f"\n{line}" for line in textwrap.wrap(value, _TICK_LINE))
+    return labels
+
+
+def _draw_sdc_rows(ax, rows: pd.DataFrame, labels: list[str]) -> None:
+    """One panel of :func:`plot_sdc_comparison`: a tick per row (``labels``), the row's values
+    beside it."""
     n = len(rows)
     x = np.arange(n, dtype=float)
     width = 0.15
-    labels = [f"{r['frequency [Hz]']:.4g} Hz\n{r['acceleration [g]']:.3g} g\n"
-              f"{r[PACKING_RATIO_COLUMN]:.3g} %"
-              + (f"\n{r['material']}" if several_materials else "")
-              for _, r in rows.iterrows()]
     sdc11 = rows[MEASURED_EQ11_COLUMN].astype(float).to_numpy()
     sdc11_se = rows[MEASURED_EQ11_STDERR_COLUMN].astype(float).to_numpy()
     sdc10 = rows[MEASURED_EQ10_COLUMN].astype(float).to_numpy()

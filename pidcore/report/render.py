@@ -47,6 +47,7 @@ from .table import (
     MEASURED_EQ11_COLUMN,
     MEASURED_EQ11_STDERR_COLUMN,
     PACKING_RATIO_COLUMN,
+    differing_columns,
 )
 
 #: File written into every report folder; only folders holding it are ever replaced.
@@ -248,17 +249,132 @@ def _write_tex(table: pd.DataFrame, figures: Mapping[str, Path], prov: Provenanc
     return path
 
 
-def pdf_table_cells(table: pd.DataFrame) -> tuple[list[str], list[list[str]]]:
-    """The PDF table's header labels (wrapped) and its rows' display text, of the
-    :data:`PDF_COLUMNS` the table has (the calibrated band in one cell, as
-    :func:`~pidcore.report.table.with_band_text` writes it)."""
+def numbered_notes(notes: Iterable[object]) -> tuple[list[str], list[str]]:
+    """Each row's note number as text ("" for a row without a note) and the notes in the
+    order of their numbers, 1 first: rows of one note share its number. The PDF and the LaTeX
+    table carry the number in the row and the note under the table (a note of 230-390
+    characters in a cell made the row unreadable or was left out)."""
+    numbers: dict[str, int] = {}
+    marks = []
+    for note in notes:
+        text = note if isinstance(note, str) else ""
+        if text:
+            marks.append(str(numbers.setdefault(text, len(numbers) + 1)))
+        else:
+            marks.append("")
+    return marks, list(numbers)
+
+
+#: Characters of one line of a text cell of the PDF table, and most characters of the cell
+#: (:func:`bounded_stem` cuts a longer one, ending in its hash: two long names that begin
+#: alike still read apart). "cells 8, steady cycles auto, settings hash b277b3" on one line
+#: took a sixth of the page's width.
+_PDF_CELL_LINE = 22
+_PDF_CELL_MOST = 3 * _PDF_CELL_LINE
+
+
+def _pdf_text_cell(text: str) -> str:
+    return "\n".join(textwrap.wrap(bounded_stem(text, _PDF_CELL_MOST), _PDF_CELL_LINE)) \
+        or text
+
+
+def pdf_columns(table: pd.DataFrame) -> list[str]:
+    """The columns of the PDF table: the :data:`PDF_COLUMNS` the table has, then those of
+    :data:`~pidcore.report.table.ROW_IDENTITY_COLUMNS` in which its rows differ
+    (:func:`~pidcore.report.table.differing_columns`; a value every row shares is said once
+    under the title, :func:`pdf_shared_line`), then ``note`` (its rows' numbers,
+    :func:`numbered_notes`). Two DEM runs of one load case at other settings read as two
+    identical rows of different SDCs: the PDF showed none of these columns."""
     from .table import with_band_text
 
+    shown = list(with_band_text(table.iloc[:0]).columns)
+    cols = [c for c in PDF_COLUMNS if c in shown] + differing_columns(table)
+    return cols + (["note"] if "note" in table.columns else [])
+
+
+def pdf_shared_line(table: pd.DataFrame) -> str:
+    """What every row of ``table`` that states it shares of the row identity columns the PDF
+    leaves out (e.g. "material acrylic; direction z; DEM settings cells 8, ..."); "" where
+    none. A constant column tells no row apart and costs A4 width beside the SDC columns, but
+    its value is still the reader's to know."""
+    from .table import ROW_IDENTITY_COLUMNS
+
+    parts = []
+    for column in ROW_IDENTITY_COLUMNS:
+        if column in table.columns and column not in differing_columns(table):
+            values = {v for v in table[column] if isinstance(v, str) and v}
+            if values:
+                parts.append(f"{column} {values.pop()}")
+    return f"Every row that states it: {'; '.join(parts)}" if parts else ""
+
+
+def pdf_table_cells(table: pd.DataFrame) -> tuple[list[str], list[list[str]]]:
+    """The PDF table's header labels (wrapped) and its rows' display text, of
+    :func:`pdf_columns` (the calibrated band in one cell, as
+    :func:`~pidcore.report.table.with_band_text` writes it; a long text cell wrapped; the note
+    as its number, :func:`numbered_notes`, the note under the table)."""
+    from .table import ROW_IDENTITY_COLUMNS, with_band_text
+
+    cols = pdf_columns(table)
     table = with_band_text(table)
-    cols = [c for c in PDF_COLUMNS if c in table.columns]
     labels = ["\n".join(textwrap.wrap(PDF_LABELS.get(c, c.split(" [grid/")[0]), 12))
               for c in cols]
-    return labels, display_rows(table, cols)
+    rows = display_rows(table, [c for c in cols if c != "note"])
+    wrapped = [i for i, c in enumerate(cols) if c in ROW_IDENTITY_COLUMNS]
+    for row in rows:
+        for i in wrapped:
+            row[i] = _pdf_text_cell(row[i])
+    if "note" in cols:
+        for row, mark in zip(rows, numbered_notes(table["note"])[0], strict=True):
+            row.append(mark)
+    return labels, rows
+
+
+#: The PDF table's page (A4 landscape, inches) and what is laid out on it, in inches: a line
+#: of a cell's text (6.5 pt, matplotlib's 1.2 line spacing), a cell's padding, a line of a
+#: note (6 pt), and the height the header, the rows and the notes share (the page less the
+#: title and the margins).
+_PDF_PAGE = (11.69, 8.27)
+_PDF_ROW_LINE = 6.5 / 72 * 1.2
+_PDF_ROW_PAD = 0.09
+_PDF_NOTE_LINE = 6 / 72 * 1.25
+_PDF_TABLE_ROOM = 6.9
+#: Characters of a line of a note under the PDF table.
+_PDF_NOTE_WIDTH = 190
+
+
+def _note_lines(number: int, note: str) -> list[str]:
+    return textwrap.wrap(f"{number}. {note}", _PDF_NOTE_WIDTH, subsequent_indent="    ")
+
+
+def _pdf_pages(rows: list[list[str]], marks: list[str], notes: list[str],
+               header_lines: int) -> list[range]:
+    """The rows of each page of the PDF table: as many as fit with the notes they number
+    (each page lists the notes of its own rows under its table)."""
+    room = _PDF_TABLE_ROOM - _pdf_row_height(header_lines)
+    pages: list[range] = []
+    start, used, listed = 0, 0.0, set()
+    for i, row in enumerate(rows):
+        if i > start and used + _pdf_height(row, marks[i], notes, listed) > room:
+            pages.append(range(start, i))
+            start, used, listed = i, 0.0, set()
+        used += _pdf_height(row, marks[i], notes, listed)
+        listed.add(marks[i])
+    pages.append(range(start, len(rows)))
+    return pages
+
+
+def _pdf_row_height(lines: int) -> float:
+    return lines * _PDF_ROW_LINE + _PDF_ROW_PAD
+
+
+def _pdf_height(row: list[str], mark: str, notes: list[str], listed: set[str]) -> float:
+    """Inches a row takes on its page: its lines, and its note's where the page lists it
+    first."""
+    height = _pdf_row_height(max(cell.count("\n") + 1 for cell in row))
+    if mark and mark not in listed:
+        height += len(_note_lines(int(mark), notes[int(mark) - 1])) * _PDF_NOTE_LINE
+    return height
 
 
 def _write_pdf(table: pd.DataFrame, figures: Mapping[str, Path], prov: Provenance,
@@ -268,31 +384,46 @@ def _write_pdf(table: pd.DataFrame, figures: Mapping[str, Path], prov: Provenanc
 
     path = folder / f"{REPORT_STEM}.pdf"
     labels, rows = pdf_table_cells(table)
-    per_page = 28
+    marks, notes = numbered_notes(table["note"]) if "note" in table.columns \
+        else ([""] * len(rows), [])
+    shared = pdf_shared_line(table)
+    header_lines = max(label.count("\n") + 1 for label in labels)
     with PdfPages(path) as pdf:
-        for start in range(0, max(len(rows), 1), per_page):
-            fig, ax = plt.subplots(figsize=(11.69, 8.27))  # A4 landscape, inches
+        for n, page in enumerate(_pdf_pages(rows, marks, notes, header_lines)):
+            fig, ax = plt.subplots(figsize=_PDF_PAGE)
             ax.axis("off")
-            ax.set_title(_TITLE if start == 0 else f"{_TITLE} (continued)", fontsize=10)
-            chunk = rows[start:start + per_page] or [[""] * len(labels)]
+            title = _TITLE if n == 0 else f"{_TITLE} (continued)"
+            ax.set_title("\n".join([title, *textwrap.wrap(shared, 200)]), fontsize=10)
+            chunk = [rows[i] for i in page] or [[""] * len(labels)]
             tab = ax.table(cellText=chunk, colLabels=labels, loc="upper center",
                            cellLoc="right")
             tab.auto_set_font_size(False)
             tab.set_fontsize(6.5)
-            tab.scale(1.0, 1.3)
-            # up to 15 columns on A4: each as wide as its widest text, none cut at its edge
+            # each column as wide as its widest text, none cut at its edge
             tab.auto_set_column_width(list(range(len(labels))))
-            lines = max(label.count("\n") + 1 for label in labels)
+            # each row as high as its cell of most lines (in axes units, as cells are sized)
+            inches = _PDF_PAGE[1] * ax.get_position().height
+            heights = [_pdf_row_height(header_lines)] + [
+                _pdf_row_height(max(c.count("\n") + 1 for c in row)) for row in chunk]
             for (row, _), cell in tab.get_celld().items():
-                if row == 0:  # room for the longest header's lines
-                    cell.set_height(cell.get_height() * (0.9 * lines))
+                cell.set_height(heights[row] / inches)
+            listed = list(dict.fromkeys(int(marks[i]) for i in page if marks[i]))
+            if listed:
+                # under the table as drawn: its height follows its rows' lines
+                fig.draw_without_rendering()
+                bottom = ax.transAxes.inverted().transform(
+                    tab.get_window_extent().get_points())[0][1]
+                text = [line for k in sorted(listed) for line in _note_lines(k, notes[k - 1])]
+                ax.text(0.0, bottom - 0.02, "Notes (the number in a row's note column):\n"
+                        + "\n".join(text), transform=ax.transAxes, va="top", ha="left",
+                        fontsize=6)
             pdf.savefig(fig)
             plt.close(fig)
         for fig in (figure_objects or {}).values():
             # cropped to the drawing like the PNG and SVG: the layout kept from the PNG
             # (see save_figure_files) would put a legend past a fixed page's edge
             pdf.savefig(fig, bbox_inches="tight")
-        fig = plt.figure(figsize=(11.69, 8.27))
+        fig = plt.figure(figsize=_PDF_PAGE)
         lines = [part for line in prov.lines()
                  for part in textwrap.wrap(line, 150, subsequent_indent="    ") or [""]]
         fig.text(0.03, 0.97, "Provenance\n\n" + "\n".join(lines), va="top",

@@ -107,6 +107,24 @@ REPORT_COLUMNS: tuple[str, ...] = (
     "difference ours - paper DEM [-]", DIFFERENCE_COLUMN, CONSISTENCY_COLUMN, ALIGNMENT_COLUMN,
     "DEM settings", "specimen", SPECIMEN_SHA256_COLUMN, "source file(s)", "load case", "note",
 )
+#: Columns besides the load case's numbers that give a row of its own (:func:`build_report_table`
+#: keeps another material, drive axis, DEM settings, specimen or specimen file apart, and sorts
+#: by them): what tells two rows of one frequency, acceleration and fill apart.
+ROW_IDENTITY_COLUMNS: tuple[str, ...] = ("material", "direction", "DEM settings", "specimen",
+                                         SPECIMEN_SHA256_COLUMN)
+
+
+def differing_columns(table: pd.DataFrame) -> list[str]:
+    """Those :data:`ROW_IDENTITY_COLUMNS` of ``table`` in which its rows hold more than one
+    value, an empty cell not counted (a measured row without DEM runs has no DEM settings: it
+    differs from a DEM row in its alignment, not its settings)."""
+    out = []
+    for column in ROW_IDENTITY_COLUMNS:
+        if column in table.columns:
+            values = {str(v) for v in table[column] if isinstance(v, str) and v}
+            if len(values) > 1:
+                out.append(column)
+    return out
 #: Columns an analyses table needs (as :meth:`pidcore.store.Store.list_analyses` gives, with the
 #: load case fields the report pipeline stores in each record).
 ANALYSIS_COLUMNS: tuple[str, ...] = ("frequency_hz", "acceleration_g", "fill_percent", "sdc",
