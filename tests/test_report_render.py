@@ -727,3 +727,73 @@ def test_pdf_table_pages_hold_their_rows_and_the_notes_they_number(tmp_path, pro
     text = _pdf_text(write_report(table, {}, provenance, tmp_path / "r", "pdf")["pdf"]
                      .read_bytes())
     assert all(f"{k}. row {k - 1}:" in text for k in range(1, 49))
+
+
+def test_latex_tables_fit_the_page_at_their_own_size_with_the_notes_numbered_below(
+        tmp_path, provenance):
+    """All ~32 columns in one tabular inside \\resizebox{\\textwidth}, a 300-character note and
+    the source files among them: rows ~1200 characters wide, scaled to 0.12 (1.2 pt text).
+    Now no table is scaled (\\scriptsize, 7 pt), each table's columns add up to at most the
+    text width, and each note is an item under the tables, its number in its row."""
+    from pidcore.report.render import _TEX_PAD, _TEX_TEXT_WIDTH, numbered_notes
+
+    table = build_report_table(pd.DataFrame({
+        "frequency_hz": np.repeat([50.0, 100.0, 500.0, 1000.0], 12),
+        "acceleration_g": np.tile(np.repeat([1.0, 5.0, 10.0], 4), 4),
+        "fill_percent": np.tile([25.0, 50.0, 75.0, 90.0], 12), "material": ["acrylic"] * 48,
+        "direction": ["z"] * 48, "sdc": np.linspace(0.01, 3.0, 48),
+        "sdc_stderr": [0.01] * 48}), None, load_paper_table3())
+    table["note"] = [f"row {i % 5}: " + "a long reason " * 22 for i in range(48)]
+    table["source file(s)"] = "data_samples/exports/synthetic_f1000Hz_a5g_fill50_acrylic.h5"
+    text = write_report(table, {}, provenance, tmp_path / "r", "tex")["tex"].read_text(
+        encoding="utf-8")
+    assert r"\resizebox" not in text
+    specs = re.findall(r"\\begin\{longtable\}\{(.*)\}$", text, re.M)
+    assert len(specs) >= 2  # the numbers split over tables, the text by row beside
+    for spec in specs:
+        widths = [float(w) for w in re.findall(r"p\{([0-9.]+)cm\}", spec)]
+        # the widths are written to 2 decimals: 0.005 cm each at most
+        assert sum(widths) + _TEX_PAD * len(widths) <= _TEX_TEXT_WIDTH + 0.005 * len(widths)
+    marks, notes = numbered_notes(table["note"])
+    assert len(notes) == 5
+    items = re.findall(r"^\\item (row \d: .*)$", text, re.M)
+    assert items == notes  # in the order of their numbers
+    # the note's number ends the row's line in the text table, never the note itself
+    rows = [ln for ln in text.splitlines() if ln.endswith(r"\\") and "a long reason" in ln]
+    assert rows == []
+    by_row = {int(m.group(1)): m.group(2) for m in re.finditer(
+        r"^(\d+) & f\S+ & .* & (\d+) \\\\$", text, re.M)}
+    assert by_row == {i + 1: mark for i, mark in enumerate(marks)}
+
+
+def test_latex_writes_a_name_past_latin1_so_that_pdflatex_reads_it(tmp_path, provenance):
+    """A specimen named "Ω-купон 試験" was written raw under inputenc's utf8 and T1, and
+    pdflatex stopped at "Unicode character Ω not set up for use with LaTeX". Every character
+    past Latin-1 is now a command every engine reads: a symbol's (Ω, ω, ≤, σ), else the
+    preamble's \\pidcorechar{code}{character}, the character under xelatex and lualatex and
+    its code point under pdflatex, which never reads the character itself."""
+    from pidcore.report.render import tex_escape
+
+    name = "Ω-купон 試験"
+    table = _two_settings_table()
+    table["specimen"] = [name, "", ""]
+    table["note"] = ["|measured − DEM| ≤ 2 σ at ω — said", "", ""]
+    text = write_report(table, {}, provenance, tmp_path / "r", "tex")["tex"].read_text(
+        encoding="utf-8")
+    assert tex_escape(name) == (r"\ensuremath{\Omega}-\pidcorechar{043A}{к}\pidcorechar{0443}{у}"
+                                r"\pidcorechar{043F}{п}\pidcorechar{043E}{о}"
+                                r"\pidcorechar{043D}{н} \pidcorechar{8A66}{試}"
+                                r"\pidcorechar{9A13}{験}")
+    assert tex_escape(name) in text
+    assert r"\item |measured \ensuremath{-} DEM| \ensuremath{\leq} 2 \ensuremath{\sigma} at " \
+           r"\ensuremath{\omega} --- said" in text
+    # what pdflatex reads: no character past Latin-1 outside \pidcorechar's second argument
+    read = re.sub(r"\\pidcorechar\{([0-9A-F]{4,6})\}\{(.)\}",
+                  lambda m: "" if int(m.group(1), 16) == ord(m.group(2)) else m.group(0), text)
+    assert max(map(ord, read)) <= 0xFF
+    # the engines' branches of the preamble
+    preamble = text[:text.index(r"\begin{document}")]
+    assert re.search(r"\\iftutex\s+\\usepackage\{fontspec\}\s+\\newcommand\{\\pidcorechar\}"
+                     r"\[2\]\{#2\}\s+\\else\s+\\usepackage\[utf8\]\{inputenc\}\s+"
+                     r"\\usepackage\[T1\]\{fontenc\}\s+\\newcommand\{\\pidcorechar\}\[2\]"
+                     r"\{\\texttt\{\[U\+#1\]\}\}\s+\\fi", preamble)

@@ -2,8 +2,8 @@
 
 * :func:`build_report_table` (:mod:`.table`) - Table 3-style comparison of our DEM, our
   measurements and the paper.
-* :func:`write_report` (:mod:`.render`) - CSV, Markdown, self-contained HTML, LaTeX (booktabs)
-  and PDF, figures as PNG and SVG, written atomically.
+* :func:`write_report` (:mod:`.render`) - CSV, Markdown, self-contained HTML, LaTeX (booktabs,
+  longtable) and PDF, figures as PNG and SVG, written atomically.
 * :func:`collect_provenance` (:mod:`.provenance`) - versions, parameters, seeds, hashes.
 * :func:`make_report` (:mod:`.pipeline`) - everything ``pidcore report`` does.
 * Figures: :mod:`.figures` (model families, paper Figs. 8-14) and :mod:`.comparison_figures`.

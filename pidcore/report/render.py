@@ -18,6 +18,7 @@ import hashlib
 import html
 import math
 import os
+import re
 import shutil
 import textwrap
 from collections.abc import Callable, Iterable, Mapping, Sequence
@@ -47,6 +48,7 @@ from .table import (
     MEASURED_EQ11_COLUMN,
     MEASURED_EQ11_STDERR_COLUMN,
     PACKING_RATIO_COLUMN,
+    SPECIMEN_SHA256_COLUMN,
     differing_columns,
 )
 
@@ -215,27 +217,188 @@ def _write_html(table: pd.DataFrame, figures: Mapping[str, Path], prov: Provenan
 _TEX_SPECIAL = {"\\": r"\textbackslash{}", "&": r"\&", "%": r"\%", "$": r"\$", "#": r"\#",
                 "_": r"\_", "{": r"\{", "}": r"\}", "~": r"\textasciitilde{}",
                 "^": r"\textasciicircum{}"}
+#: Characters past Latin-1 that pidcore's own notes and verdicts write (ω of Eq. 10, σ, ≤,
+#: the dashes and −), as commands every engine typesets. pdflatex with inputenc's utf8 stops
+#: at a character it has not set up ("Unicode character Ω not set up for use with LaTeX").
+_TEX_SYMBOLS = {"—": "---", "–": "--", "−": r"\ensuremath{-}", "…": r"\dots{}",
+                "‘": "`", "’": "'", "“": "``", "”": "''", "≤": r"\ensuremath{\leq}",
+                "≥": r"\ensuremath{\geq}", "≈": r"\ensuremath{\approx}",
+                "≠": r"\ensuremath{\neq}", "→": r"\ensuremath{\rightarrow}",
+                "∞": r"\ensuremath{\infty}", "√": r"\ensuremath{\surd}",
+                "Γ": r"\ensuremath{\Gamma}", "Δ": r"\ensuremath{\Delta}",
+                "Θ": r"\ensuremath{\Theta}", "Λ": r"\ensuremath{\Lambda}",
+                "Ξ": r"\ensuremath{\Xi}", "Π": r"\ensuremath{\Pi}", "Σ": r"\ensuremath{\Sigma}",
+                "Φ": r"\ensuremath{\Phi}", "Ψ": r"\ensuremath{\Psi}", "Ω": r"\ensuremath{\Omega}",
+                **{chr(0x3B1 + i): rf"\ensuremath{{\{name}}}" for i, name in enumerate(
+                    "alpha beta gamma delta epsilon zeta eta theta iota kappa lambda mu nu xi "
+                    "omicron pi rho varsigma sigma tau upsilon phi chi psi omega".split())
+                   if name != "omicron"}}
+#: A character past Latin-1 that is none of :data:`_TEX_SYMBOLS` (a specimen named in
+#: Cyrillic or CJK): the command of the .tex's preamble, which typesets the character itself
+#: under XeLaTeX and LuaLaTeX (fontspec) and its code point, ``[U+03A9]``, under pdflatex,
+#: whose fonts have no such glyph; the character, its second argument, is never read there.
+_TEX_CHAR_COMMAND = "pidcorechar"
+_TEX_PREAMBLE = (
+    r"% pdflatex, xelatex or lualatex: a character past Latin-1 in a name (a specimen in"
+    "\n"
+    r"% Cyrillic or CJK) is \pidcorechar{code point}{character}, set as the character under"
+    "\n"
+    r"% xelatex and lualatex (fontspec; a font with its glyph: \setmainfont) and as its code"
+    "\n"
+    r"% point under pdflatex, which has no such glyph",
+    r"\usepackage{iftex}",
+    r"\iftutex",
+    r"  \usepackage{fontspec}",
+    rf"  \newcommand{{\{_TEX_CHAR_COMMAND}}}[2]{{#2}}",
+    r"\else",
+    r"  \usepackage[utf8]{inputenc}",
+    r"  \usepackage[T1]{fontenc}",
+    rf"  \newcommand{{\{_TEX_CHAR_COMMAND}}}[2]{{\texttt{{[U+#1]}}}}",
+    r"\fi",
+)
 
 
 def tex_escape(text: str) -> str:
-    """Escape LaTeX special characters."""
-    return "".join(_TEX_SPECIAL.get(ch, ch) for ch in text)
+    r"""Escape LaTeX special characters; a character past Latin-1 written so that pdflatex
+    too reads it (:data:`_TEX_SYMBOLS`, else the preamble's ``\pidcorechar``), a control
+    character as a space."""
+    out = []
+    for ch in text:
+        if ch in _TEX_SPECIAL:
+            out.append(_TEX_SPECIAL[ch])
+        elif ch in _TEX_SYMBOLS:
+            out.append(_TEX_SYMBOLS[ch])
+        elif ord(ch) > 0xFF:
+            out.append(rf"\{_TEX_CHAR_COMMAND}{{{ord(ch):04X}}}{{{ch}}}")
+        elif ord(ch) < 0x20 or 0x7F <= ord(ch) < 0xA0:
+            out.append(" ")  # a blank line in a cell ends a paragraph inside the tabular
+        else:
+            out.append(ch)
+    return "".join(out)
+
+
+#: Columns of long text (a note of 230-390 characters, the source files, a sha256), set out of
+#: the LaTeX table's numbers: in one line of the tabular they made rows ~1200 characters wide,
+#: scaled to 0.12 (1.2 pt text). The LaTeX writes them in a table of their own, by row number,
+#: the notes numbered below it (:func:`numbered_notes`).
+TEX_TEXT_COLUMNS: tuple[str, ...] = ("load case", "DEM settings", "specimen",
+                                     SPECIMEN_SHA256_COLUMN, "source file(s)", "note")
+#: The LaTeX tables' geometry: the text width of A4 landscape with 1.5 cm margins, the width
+#: of a character of ``\scriptsize`` (7 pt: a digit is 0.5 em, 0.12 cm; the widest header
+#: words, "measured" and "out_of_range/", need 0.145 cm a letter) and the padding of a column
+#: (2 x ``\tabcolsep`` of 3 pt), all in cm.
+_TEX_TEXT_WIDTH = 29.7 - 2 * 1.5
+_TEX_CHAR = 0.15
+_TEX_PAD = 2 * 3 / 72.27 * 2.54
+
+
+def _tex_breakable(text: str, most: int) -> str:
+    """``text`` escaped, a line break allowed in a word of more than ``most`` characters (a
+    file name or a sha256 has no space to break at in a narrow column) after each of its
+    ``_ / . , -`` and every ``most`` characters."""
+    words = []
+    for word in re.split(r"(\s+)", text):
+        if len(word) <= most:
+            words.append(tex_escape(word))
+            continue
+        out, run = [], 0
+        for ch in word:
+            out.append(tex_escape(ch))
+            run += 1
+            if ch in "_/.,-" or run >= most:
+                out.append(r"\allowbreak{}")
+                run = 0
+        words.append("".join(out))
+    return "".join(words)
+
+
+def _tex_header(name: str) -> str:
+    # a break allowed after each "/" of "[grid/interpolated/...]"
+    return tex_escape(name).replace("/", r"/\allowbreak{}")
+
+
+def _tex_longtable(columns: Sequence[str], widths: Sequence[float], numeric: Sequence[bool],
+                   rows: Sequence[Sequence[str]]) -> list[str]:
+    """A longtable (broken across pages, its header on each) of p columns of ``widths`` cm,
+    numbers set right; ``rows`` already escaped."""
+    spec = "".join(rf">{{\{'raggedleft' if n else 'raggedright'}\arraybackslash}}p{{{w:.2f}cm}}"
+                   for w, n in zip(widths, numeric, strict=True))
+    return [r"{\scriptsize", rf"\begin{{longtable}}{{@{{}}{spec}@{{}}}}", r"\toprule",
+            " & ".join(_tex_header(c) for c in columns) + r" \\", r"\midrule", r"\endhead",
+            *(" & ".join(row) + r" \\" for row in rows), r"\bottomrule", r"\end{longtable}}"]
+
+
+def _tex_parts(columns: Sequence[str], texts: Sequence[Sequence[str]]) -> list[list[int]]:
+    """The positions of ``columns`` in each LaTeX table of numbers: as many as fit the text
+    width beside the row number, in order, an SDC beside its standard error
+    (:data:`VALUE_STDERR_COLUMNS`)."""
+    room = _TEX_TEXT_WIDTH - _tex_width(["row"], [[str(len(texts))]])[0] - _TEX_PAD
+    widths = _tex_width(columns, texts)
+    parts: list[list[int]] = [[]]
+    used = 0.0
+    for i, column in enumerate(columns):
+        paired = i > 0 and VALUE_STDERR_COLUMNS.get(columns[i - 1]) == column
+        if parts[-1] and not paired and used + widths[i] + _TEX_PAD > room:
+            parts.append([])
+            used = 0.0
+        parts[-1].append(i)
+        used += widths[i] + _TEX_PAD
+    return parts
+
+
+def _tex_width(columns: Sequence[str], texts: Sequence[Sequence[str]]) -> list[float]:
+    """Each column's width in cm: its longest cell, or its header's longest word (the header
+    wraps at its spaces and slashes)."""
+    out = []
+    for i, column in enumerate(columns):
+        words = column.replace("/", "/ ").split()
+        # at least 5: the capitals of "DEM" are as wide as 5 digits
+        chars = max([len(row[i]) for row in texts] + [max(map(len, words)), 5])
+        out.append(chars * _TEX_CHAR)
+    return out
 
 
 def _write_tex(table: pd.DataFrame, figures: Mapping[str, Path], prov: Provenance,
                folder: Path) -> Path:
     path = folder / f"{REPORT_STEM}.tex"
-    numeric = [pd.api.types.is_numeric_dtype(table[c]) for c in table.columns]
-    spec = "".join("r" if n else "l" for n in numeric)
-    lines = [r"\documentclass[a4paper,landscape]{article}",
+    number_columns = [c for c in table.columns if c not in TEX_TEXT_COLUMNS]
+    text_columns = [c for c in TEX_TEXT_COLUMNS if c in table.columns and c != "note"
+                    and any(isinstance(v, str) and v for v in table[c])]
+    numbers = display_rows(table, number_columns)
+    ids = [str(i) for i in range(1, len(table) + 1)]
+    marks, notes = numbered_notes(table["note"]) if "note" in table.columns \
+        else ([""] * len(table), [])
+    lines = [r"\documentclass[a4paper,landscape]{article}", *_TEX_PREAMBLE,
              r"\usepackage[margin=1.5cm]{geometry}", r"\usepackage{booktabs}",
-             r"\usepackage{graphicx}", r"\usepackage[utf8]{inputenc}",
-             r"\usepackage[T1]{fontenc}", r"\begin{document}",
-             rf"\section*{{{tex_escape(_TITLE)}}}", r"\begin{table}[ht]\centering",
-             r"\resizebox{\textwidth}{!}{%", rf"\begin{{tabular}}{{{spec}}}", r"\toprule",
-             " & ".join(tex_escape(c) for c in table.columns) + r" \\", r"\midrule"]
-    lines += [" & ".join(tex_escape(v) for v in row) + r" \\" for row in display_rows(table)]
-    lines += [r"\bottomrule", r"\end{tabular}}", r"\end{table}"]
+             r"\usepackage{longtable}", r"\usepackage{array}", r"\usepackage{graphicx}",
+             r"\setlength{\tabcolsep}{3pt}", r"\begin{document}",
+             rf"\section*{{{tex_escape(_TITLE)}}}"]
+    numeric = {c: pd.api.types.is_numeric_dtype(table[c]) for c in table.columns}
+    row_width = _tex_width(["row"], [[ids[-1] if ids else "1"]])
+    for part in _tex_parts(number_columns, numbers):
+        columns = ["row", *(number_columns[i] for i in part)]
+        rows = [[n, *(tex_escape(row[i]) for i in part)] for n, row in zip(ids, numbers,
+                                                                            strict=True)]
+        lines += _tex_longtable(columns, row_width + _tex_width(
+            [number_columns[i] for i in part], [[row[i] for i in part] for row in numbers]),
+            [True] + [numeric[number_columns[i]] for i in part], rows)
+    # the text by row: the columns share the width left by the row and note numbers, each
+    # as much as its longest cell asks (up to 60 characters) of it
+    texts = display_rows(table, text_columns)
+    asked = [max([min(len(row[i]), 60) for row in texts] + [len(c) // 2, 6])
+             for i, c in enumerate(text_columns)]
+    room = _TEX_TEXT_WIDTH - 2 * (row_width[0] + _TEX_PAD) - _TEX_PAD * len(text_columns)
+    widths = [room * a / sum(asked) for a in asked]
+    rows = [[n, *(_tex_breakable(v, int(w / _TEX_CHAR)) for v, w in zip(row, widths,
+                                                                         strict=True)), mark]
+            for n, row, mark in zip(ids, texts, marks, strict=True)]
+    lines += _tex_longtable(["row", *text_columns, "note"], [*row_width, *widths, *row_width],
+                            [True] + [False] * len(text_columns) + [True], rows)
+    if notes:
+        lines += [r"\paragraph{Notes} (the number in a row's note column)",
+                  r"{\footnotesize\begin{enumerate}"]
+        lines += [rf"\item {tex_escape(note)}" for note in notes]
+        lines += [r"\end{enumerate}}"]
     for stem, png in figures.items():
         # the base name braced off its extension: graphicx before 2019 took the first dot of
         # a load case's name (loop_00_f62.5Hz_...) as the extension's and did not compile
