@@ -315,3 +315,55 @@ def test_a_design_point_of_a_raised_static_friction_is_known_by_the_run_it_made(
     assert is_design_variant(origin.values, names, points, variant)
     assert not is_design_variant(origin.values, names, [[0.5], [0.13]], variant)
     assert not is_design_variant(origin.values, [], [[]], variant)  # no design: no variant
+
+
+def test_a_run_of_the_start_is_a_design_run_only_of_a_calibration_whose_design_ran_it(
+        variants, tmp_path):
+    # a design of variants alone (rolling frictions 0.25, 0.75: none the start's 0) claimed
+    # another fit's run of the start at its load case, cells and seed: store remove named it
+    # a dependent of that run, and verify took the run for its own when its variants were gone
+    import shutil
+
+    import h5py
+    import numpy as np
+
+    from pidcore.calibrate.persist import calibration_design_runs, save_calibration
+    from pidcore.calibrate.runner import is_design_start
+    from pidcore.errors import StoreError
+    from pidcore.store.manage import remove_records
+
+    source, mine, result = variants
+    assert not is_design_start(mine, ["rolling_friction"], result.design.tolist())
+    store = tmp_path / "dem.h5"
+    shutil.copyfile(source, store)
+    designed = save_calibration(result, store).key
+    point = MeasuredPoint(CASE.frequency_hz, CASE.acceleration_g, CASE.fill_percent, 0.5,
+                          0.01, specimen="mycoupon", specimen_sha256=mine.hash)
+    observed = save_calibration(calibrate(
+        [point], fit=["baseline_loss_factor"], discrepancy=0.3, store_path=store,
+        cells=CONFIG.cells, steady_cycles=CONFIG.steady_cycles, dem_config=CONFIG,
+        workers=1, progress=False, specimen=mine), store).key
+    variant_keys = list(Store(source).list_dem_runs()["case_key"])
+    runs = Store(store).list_dem_runs()
+    start_key = next(k for k, sha in zip(runs["case_key"], runs["specimen_sha256"],
+                                         strict=True) if sha == mine.hash)
+    assert calibration_design_runs(runs, [store], variants=True)[start_key] == (observed,)
+    with pytest.raises(StoreError, match=f"DEM run {start_key} is a design run of "
+                                         f"calibration {observed} \\(an input of its fit"):
+        remove_records(store, [start_key])
+    removal = remove_records(store, [start_key], with_dependents=True, dry_run=True)
+    assert [(r.section, r.key) for r in removal.records] == [
+        ("dem_runs", start_key), ("calibrations", observed)]
+    # a design one of whose points is the start's own rolling friction ran the start itself:
+    # its run is that calibration's as well (the point [0.0] rebuilds the file exactly)
+    with_start = save_calibration(dataclasses.replace(
+        result, design=np.array([[0.0], *result.design.tolist()])), store).key
+    assert calibration_design_runs(Store(store).list_dem_runs(), [store],
+                                   variants=True)[start_key] == (observed, with_start)
+    # verify: the variants gone, the start's run (kept) stands in for neither design
+    with h5py.File(store, "r+") as h5:  # damage done outside pidcore
+        for key in variant_keys:
+            del h5["dem_runs"][key]
+    problems = Store(store).verify()
+    assert sorted(p.split(": fitted on")[0] for p in problems) == [
+        f"{store}:/calibrations/{designed}"]

@@ -365,14 +365,19 @@ def calibration_design_runs(runs: pd.DataFrame | None,
     ``--fit``, the runs reused from the store) share them: each is a dependent of the run, and
     mapping a run to one calibration removed the run under the other without a word.
 
-    A calibration runs its start specimen (and, fitting DEM parameters, variants of it with
-    other hashes, which reports leave out as other specimens) at its measured load cases with
-    its own cells per run and seed, usually fewer cells than a prediction would use: such a
-    run is an input of the fit, not a prediction of the specimen. A run is one where its
-    specimen's hash is the calibration's, its cells and seed are the calibration's settings,
-    and its load case (frequency, acceleration, fill, material) is one the calibration
-    predicts: the inputs its cache key is made of, read from what the store holds of both,
-    so the calibrations saved before this existed are recognised too.
+    A calibration runs its start specimen (fitting DEM parameters, variants of it with other
+    hashes instead, which reports leave out as other specimens, and the start only where a
+    design point is it) at its measured load cases with its own cells per run and seed,
+    usually fewer cells than a prediction would use: such a run is an input of the fit, not a
+    prediction of the specimen. A run is one where its specimen's hash is the calibration's,
+    its cells and seed are the calibration's settings, and its load case (frequency,
+    acceleration, fill, material) is one the calibration predicts: the inputs its cache key
+    is made of, read from what the store holds of both, so the calibrations saved before
+    this existed are recognised too; and, the calibration's design fitting DEM parameters,
+    one of its points is the start itself (:func:`pidcore.calibrate.runner.is_design_start`,
+    the start rebuilt from the run's stored specimen): a run of the file by another fit
+    (``--fit fixture_mass_kg,baseline_loss_factor``) at the same cases is not its run. A
+    calibration whose calibration.json states no readable design may have run either.
 
     With ``variants``, also the runs of its variants of the start specimen (their stored
     :func:`~pidcore.compare.specimens.run_origin` names the start's hash) that its design
@@ -509,8 +514,14 @@ def _design_runs_by_case(runs: pd.DataFrame | None, path: Path, *, variants: boo
             # a fit of observation parameters alone (no design) was named a dependent of
             # another fit's variants, and store remove refused them for it
             design = _design_of(calibration)
-            made = [not isinstance(kinds[i], CalibrationVariant) or design is None
-                    or _made_by(kinds[i], params[i], design) for i in same.index]
+            # so is a run of the start itself: a design of variants alone claimed another
+            # fit's run of the file (remove named it a dependent, verify took it for its own)
+            plain = [i for i in same.index if not isinstance(kinds[i], CalibrationVariant)]
+            start_made = design is None or not plain or _made_start(
+                [params[i] for i in plain], sha, design)
+            made = [(start_made if not isinstance(kinds[i], CalibrationVariant)
+                     else design is None or _made_by(kinds[i], params[i], design))
+                    for i in same.index]
             same = same[made]
         for p in calibration.predictions:
             case = p.load_case
@@ -532,8 +543,8 @@ def _design_runs_by_case(runs: pd.DataFrame | None, path: Path, *, variants: boo
 def _design_of(calibration: Calibration) -> tuple[list[str], list[list[float]]] | None:
     """The fitted DEM parameters' names and design points its calibration.json states
     (``design``: no names where it fitted none); None where the document states no readable
-    design: then any variant of its start may be its run, as one cannot tell (a removal is
-    refused rather than the fit's inputs lost)."""
+    design: then any run of its start or of a variant of it may be its run, as one cannot
+    tell (a removal is refused rather than the fit's inputs lost)."""
     try:
         design = json.loads(calibration.document_text)["design"]
         names = [str(n) for n in design["names"]]
@@ -562,3 +573,27 @@ def _made_by(origin, parameters: dict, design: tuple[list[str], list[list[float]
     except PidcoreError:
         return False
     return is_design_variant(origin.values, names, points, variant)
+
+
+def _made_start(parameters: Sequence[dict], sha: str,
+                design: tuple[list[str], list[list[float]]]) -> bool:
+    """Whether ``design`` ran its start specimen (hash ``sha``) itself
+    (:func:`pidcore.calibrate.runner.is_design_start`), the start rebuilt from the first of
+    its runs' stored ``parameters`` whose specimen text reads back as that hash; True where
+    none does (which it ran cannot be told: a removal is refused rather than its inputs
+    lost)."""
+    from ..errors import PidcoreError
+    from ..specimen import Specimen
+    from .runner import is_design_start
+
+    for params in parameters:
+        text = params.get("specimen_text")
+        if not isinstance(text, str) or not text:
+            continue
+        try:
+            start = Specimen.from_text(text, source="stored run")
+        except PidcoreError:
+            continue
+        if start.hash == sha:
+            return is_design_start(start, *design)
+    return True

@@ -151,6 +151,28 @@ def is_design_variant(stated: Sequence[tuple[str, float]], names: Sequence[str],
     return False
 
 
+def is_design_start(start: Specimen, names: Sequence[str],
+                    points: Sequence[Sequence[float]]) -> bool:
+    """Whether one of the design ``points`` of the fitted DEM parameters ``names`` (a
+    calibration.json's ``design``) is ``start`` itself: set on it (:func:`specimen_with`), a
+    point that changes nothing, whose runs are the file's own (:func:`variant_provenance`
+    None). A fit of no DEM parameter has one such point (no values); a design whose points
+    all vary the file runs none of it, and a run of the file is no run of that design.
+
+    The design's floats through JSON are the ones the runner set, so a point rebuilds its
+    specimen exactly."""
+    for point in points:
+        if len(point) != len(names):
+            continue
+        values = {str(n): float(v) for n, v in zip(names, point, strict=True)}
+        try:
+            if specimen_with(start, values).hash == start.hash:
+                return True
+        except ParameterError:
+            continue  # a point outside the file's domain did not make it
+    return False
+
+
 def run_requests(requests: Sequence[RunRequest], *, store_path: str | os.PathLike,
                  workers: int = 2, progress: bool = True,
                  on_done: Callable[[str], None] | None = None,
