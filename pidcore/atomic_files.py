@@ -222,6 +222,36 @@ def new_temporary_folder_for(target: str | os.PathLike[str]) -> Path:
     return work
 
 
+def check_folder_can_be_made(target: str | os.PathLike[str], *, label: str = "") -> None:
+    """Refuse, before any work is done for it, an output ``target`` no folder can be made
+    beside: a build folder (:func:`new_temporary_folder_for`'s name) is created there and
+    removed again, in ``target``'s parent or, where that is still to be made, in its nearest
+    existing ancestor (where the first missing folder would be made). A report or a
+    calibration computed for minutes first and then ended in a traceback at its write
+    (``--out /sys/x``: "Operation not permitted"; ``/proc/x``: "No such file or directory").
+
+    Raises
+    ------
+    ParameterError
+        One line: ``label`` (default: ``target``), the folder and the system's reason.
+    """
+    from .errors import ParameterError
+
+    place = Path(target).absolute()
+    while not place.parent.exists() and place.parent != place:
+        place = place.parent
+    probe = temporary_folder_path_for(place)
+    try:
+        probe.mkdir()
+    except OSError as exc:
+        raise ParameterError(
+            f"{label or target}: no folder can be made in {place.parent} "
+            f"({exc.strerror or exc}); expected an output folder where pidcore may write "
+            "(choose another)") from None
+    with suppress(OSError):  # made, so removable: one left would be removed as stale
+        probe.rmdir()
+
+
 #: Marks an earlier folder moved aside (``.<name>.<16 hex>.old``) while :func:`replace_folder`
 #: renames its replacement into place, where the system cannot swap the two in one step.
 PREVIOUS_FOLDER_SUFFIX = ".old"

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import os
+from pathlib import Path
+
 import h5py
 import numpy as np
 import pandas as pd
@@ -18,6 +21,7 @@ from pidcore.report.table import ALIGNMENT_COLUMN
 from pidcore.signal import synthesize_shaker_record
 from pidcore.store import Store
 
+ROOT = Path(__file__).resolve().parents[1]
 FREQ_HZ = 500.0
 ACC_G = 5.0
 RATE_HZ = 20000.0
@@ -464,3 +468,47 @@ def test_what_the_reader_corrected_is_said_in_the_report_as_analyze_says_it(tmp_
                     "delimiters (a spreadsheet's empty rows); not read"]
     text = (tmp_path / "r" / "report.provenance.txt").read_text(encoding="utf-8")
     assert said[0] in text
+
+
+@pytest.mark.skipif(not Path("/proc/self").is_dir(), reason="needs Linux's /proc, where no "
+                    "folder can be made, not even by root")
+def test_an_output_folder_that_cannot_be_made_is_refused_in_one_line_before_any_analysis(
+        tmp_path, dem_store, capsys):
+    # /proc/x: a FileNotFoundError traceback at the write, after the files were analysed
+    # and saved; chmod cannot stand in, as root may write a read-only folder
+    file = _write_measurement(tmp_path / "coupon_fill50.csv")
+    store = tmp_path / "store.h5"
+    code = main(["report", str(file), "--store", str(store), "--dem-store", str(dem_store),
+                 "--out", "/proc/pidcore_report", "--format", "csv"])
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("\n") == 1, err
+    assert "/proc/pidcore_report" in err and "No such file or directory" in err
+    assert not store.exists()  # refused before the analysis was saved
+    for command in (["model", "figures", "--out", "/proc/pidcore_out"],
+                    ["samples", "make", "--skip-sweep", "--out", "/proc/pidcore_out"]):
+        assert main(command) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and "/proc/pidcore_out" in err, err
+
+
+def test_a_report_past_a_file_size_limit_is_one_line_and_leaves_no_part_of_it(tmp_path,
+                                                                              dem_store):
+    # a full disk fails the same writes (ENOSPC) as a file size limit (EFBIG, Python ignores
+    # SIGXFSZ): an OSError traceback after the whole computation, where the README promises
+    # one line, exit 2; 20 kB holds the CSV but no report's figure PNG (a few 10 kB each)
+    import resource
+    import subprocess
+    import sys
+
+    def limit() -> None:
+        resource.setrlimit(resource.RLIMIT_FSIZE, (20_000, 20_000))
+
+    out = tmp_path / "report"
+    run = subprocess.run([sys.executable, "-m", "pidcore", "report", "--dem-store",
+                          str(dem_store), "--out", str(out), "--format", "csv"],
+                         capture_output=True, text=True, timeout=300, preexec_fn=limit,
+                         env={**os.environ, "PYTHONPATH": str(ROOT), "MPLBACKEND": "Agg"})
+    assert run.returncode == 2, run.stderr[-2000:]
+    assert run.stderr.count("\n") == 1 and "File too large" in run.stderr, run.stderr
+    assert f"{out} not created" in run.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == []  # nor a build folder beside it

@@ -70,16 +70,23 @@ def add_load_case_options(p: argparse._ActionsContainer, *, what: str) -> None:
                         f"{SIDECAR_NAME} beside each file")
 
 
-def check_out_folder(out: Path) -> None:
-    """``--out`` must be a folder or not exist yet (a file there would be half-overwritten);
-    checked before any work, so a long run is not thrown away at the end."""
-    from ..atomic_files import file_in_the_way
+def check_out_folder(out: Path, *, built_beside: bool = False) -> None:
+    """``--out`` must be a folder or not exist yet (a file there would be half-overwritten),
+    and one pidcore may write: its files are written in it, where it exists, else it is made
+    beside its siblings; ``built_beside``, its files are also built in a folder beside it
+    (:func:`pidcore.atomic_files.new_temporary_folder_for`). Checked before any work, so a
+    long run is not thrown away at the end."""
+    from ..atomic_files import check_folder_can_be_made, file_in_the_way
 
     if out.exists() and not out.is_dir():
         raise ParameterError(f"--out {out}: exists and is not a folder")
     blocking = file_in_the_way(out)
     if blocking is not None:
         raise ParameterError(f"--out {out}: {blocking} is a file, not a folder")
+    if out.is_dir():  # a build folder's name in it: its files' temporaries are made there
+        check_folder_can_be_made(out / "out", label=f"--out {out}")
+    if built_beside or not out.is_dir():
+        check_folder_can_be_made(out, label=f"--out {out}")
 
 
 def add_store_option(p: argparse.ArgumentParser, *, flag: str = "--store",

@@ -97,7 +97,7 @@ def run(args: argparse.Namespace) -> int:
     from ..specimen import load_specimen
 
     if args.out is not None:  # said before the DEM runs and the fit, not after them
-        check_out_folder(args.out)
+        check_out_folder(args.out, built_beside=True)
         # a killed run's half-moved outputs completed first: said now, and the earlier set
         # this run replaces is then whole
         finished = finish_interrupted_outputs(args.out)

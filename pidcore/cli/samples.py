@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ._options import path_argument, positive_int, progress_wanted
+from ._options import check_out_folder, path_argument, positive_int, progress_wanted
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -34,6 +34,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 def _make(args: argparse.Namespace) -> int:
     from ..samples import make_samples
 
+    check_out_folder(args.out)  # before the sweep, not after it
     for name, path in make_samples(args.out, run_sweep=not args.skip_sweep,
                                    workers=args.workers,
                                    progress=progress_wanted(args)).items():
