@@ -512,3 +512,38 @@ def test_a_report_past_a_file_size_limit_is_one_line_and_leaves_no_part_of_it(tm
     assert run.stderr.count("\n") == 1 and "File too large" in run.stderr, run.stderr
     assert f"{out} not created" in run.stderr
     assert sorted(p.name for p in tmp_path.iterdir()) == []  # nor a build folder beside it
+
+
+def _with_smoke_run(tmp_path, dem_store, sdc=9.0):
+    """A copy of ``dem_store`` with a 2-cell run beside its 8-cell run at 500 Hz, 5 g, 50 %."""
+    import shutil
+
+    store = tmp_path / "dem.h5"
+    shutil.copy(dem_store, store)
+    Store(store).add_dem_run("smoke", {
+        "frequency_hz": FREQ_HZ, "acceleration_g": ACC_G, "fill_percent": 50.0,
+        "material": "acrylic", "direction": "z", "sdc": sdc, "sdc_stderr": 0.5,
+        "cells_simulated": 2, "seed": 11},
+        parameters={"config_cells": 2, "config_seed": 11, "config_steady_cycles": 4})
+    return store
+
+
+def test_the_model_figures_mark_only_the_runs_their_caption_says_the_model_rests_on(
+        tmp_path, dem_store):
+    # the 2-cell run's 9.0 was drawn as a data point of the model whose caption says the
+    # runs of other settings at that load case are left out of it
+    from pidcore.report.pipeline import report_figures, specimen_report_table
+
+    runs = Store(_with_smoke_run(tmp_path, dem_store)).list_dem_runs()
+    built = specimen_report_table(runs, None)
+    notes: list[str] = []
+    figures = report_figures(built.table, built.dem_runs, built.aligner, [], [], notes)
+    for name in ("sdc_vs_acceleration_acrylic_z", "sdc_vs_frequency_acrylic_z"):
+        fig = figures[name]
+        assert "runs of other settings left out" in fig._suptitle.get_text()
+        marked = [float(y) for ax in fig.axes for line in ax.get_lines()
+                  if line.get_label().endswith(" data") for y in line.get_ydata()]
+        # every 8-cell run is marked (8 grid points, each drawn in one panel), the 2-cell
+        # one's value exactly never (the grid's SDCs are below 0.5)
+        assert len(marked) == 8 and 9.0 not in marked, (name, marked)
+        fig.clear()

@@ -1149,6 +1149,28 @@ class Aligner:
                           reference_fills=reference_fills)
         return cls(cases, paper, model, tolerances)
 
+    def model_run_keys(self, material: str, direction: str) -> frozenset[str]:
+        """Store keys of the runs the model of ``material`` and ``direction`` was built on:
+        at each load case those of the preferred settings (:func:`_one_case_per_point`), at
+        the points its grid holds data for (:func:`complete_grid` may leave some out); empty
+        where it has no model. A figure of the model marked every run as its data, the
+        2-cell run its caption said was left out among them."""
+        model = self._models.get((material, direction))
+        if model is None or isinstance(model, str):
+            return frozenset()
+        members, _ = _one_case_per_point([c for c in self.cases
+                                          if (c.load_case.material, c.load_case.direction)
+                                          == (material, direction)])
+        data = model.data_points()
+        keys: set[str] = set()
+        for c in members:
+            on = (np.isclose(data["fill_percent"], c.load_case.fill_percent)
+                  & np.isclose(data["acceleration_g"], c.load_case.acceleration_g)
+                  & np.isclose(data["frequency_hz"], c.load_case.frequency_hz))
+            if on.any():
+                keys.update(c.run_keys)
+        return frozenset(keys)
+
     def grid_case(self, case: LoadCase) -> DemCase | None:
         """Our DEM case nearest to ``case`` within the tolerances, or None.
 

@@ -688,8 +688,10 @@ def report_figures(table: pd.DataFrame, dem_runs: pd.DataFrame | None, aligner: 
         from .figures import plot_sdc_vs_acceleration, plot_sdc_vs_frequency
 
         for (material, direction), model in models.items():
-            sub = dem_runs[(dem_runs["material"] == material)
-                           & (dem_runs["direction"] == direction)]
+            # its own runs only: those of other settings at a load case are left out of it,
+            # as its caption says, and drawn as its data they contradicted it
+            sub = dem_runs[dem_runs["case_key"].isin(aligner.model_run_keys(material,
+                                                                            direction))]
             suffix = f"{material}_{direction}"
             figures[f"sdc_vs_acceleration_{suffix}"] = plot_sdc_vs_acceleration(
                 model, table=sub, value="sdc")
