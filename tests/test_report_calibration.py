@@ -1024,3 +1024,28 @@ def test_a_negative_measured_sdc_within_its_noise_is_judged_by_a_band_reaching_b
     assert hit.band(0.13, 1.0)[0] == -3 * 0.13
     # without a stderr a negative SDC is not kept: the band stops at 0, as it did
     assert hit.band(0.0)[0] == 0.020
+
+
+def test_a_row_of_other_dem_settings_names_the_row_its_load_cases_measurement_is_judged_on(
+        calibration_file):
+    # two DEM settings at 500 Hz, 5 g, 50 %: the measurement is on the 8-cell row, and the
+    # 2-cell row said "no Eq. 11 measurement" although the load case has one
+    table = pd.DataFrame({
+        "frequency [Hz]": [500.0, 500.0, 50.0],
+        "acceleration [g]": [5.0] * 3, "packing ratio [%]": [50.0] * 3,
+        "material": ["acrylic"] * 3,
+        "SDC measured (Eq. 11) [-]": [math.nan, 0.30, math.nan],
+        "SDC measured (Eq. 11) stderr [-]": [math.nan, 0.01, math.nan],
+        "DEM settings": ["cells 2, settings hash aaaaaa", "cells 8, settings hash bbbbbb",
+                         "cells 8, settings hash bbbbbb"],
+        "specimen": [""] * 3, "specimen sha256": [""] * 3,
+        "load case": ["f500Hz_a5g_fill50pct_acrylic_z"] * 2 + ["f50Hz_a5g_fill50pct_acrylic_z"],
+        "note": [""] * 3,
+    })
+    out = add_calibration_columns(table, load_calibration(calibration_file))
+    assert out[CALIBRATED_INSIDE_COLUMN].tolist() == [NOT_COMPARED, "yes", NOT_COMPARED]
+    assert out["note"].iloc[0] == ("the measurement at this load case is compared with the "
+                                   "calibrated band on the row of DEM settings cells 8, "
+                                   "settings hash bbbbbb")
+    # a load case measured nowhere still says so
+    assert out["note"].iloc[2] == "no Eq. 11 measurement to compare with the calibrated band"

@@ -347,6 +347,10 @@ POOLS_IMPLAUSIBLE_REASON = ("it pools an implausible result, so the calibrated b
                             "judge it")
 
 
+#: Why a row without a measured SDC is not judged (:func:`judge_measurement`).
+NO_MEASUREMENT_REASON = "no Eq. 11 measurement to compare with the calibrated band"
+
+
 @dataclass(frozen=True)
 class MeasurementJudgement:
     """The calibrated prediction beside one measured Eq. 11 SDC, and its verdict
@@ -417,8 +421,7 @@ def judge_measurement(hit: CalibratedPrediction, measured: float, stderr: float,
                                     f"{exc}")
     cut = hit.band_note(own_stderr, dof)
     if not math.isfinite(measured):
-        return MeasurementJudgement(hit.sdc, low, high, not_compared,
-                                    "no Eq. 11 measurement to compare with the calibrated band",
+        return MeasurementJudgement(hit.sdc, low, high, not_compared, NO_MEASUREMENT_REASON,
                                     cut=cut)
     if not math.isfinite(baseline_sdc):
         return MeasurementJudgement(

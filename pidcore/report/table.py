@@ -828,6 +828,23 @@ def calibration_row_refusal(calibration, specimen: str, sha256: object = "") -> 
     return f"it calibrates specimen {calibration.specimen_name}, not {specimen}"
 
 
+def _place(row: pd.Series) -> tuple[str, str, str]:
+    """A report row's load case and specimen: rows of several DEM settings share it."""
+    return (str(row.get("load case", "") or ""), str(row.get("specimen", "") or ""),
+            str(row.get(SPECIMEN_SHA256_COLUMN, "") or ""))
+
+
+def _measured_row_settings(table: pd.DataFrame) -> dict[tuple[str, str, str], str]:
+    """Per :func:`_place`, the DEM settings of the row carrying its measured Eq. 11 SDC
+    ("DEM settings ..."; "the DEM row" where the runs record none)."""
+    if MEASURED_EQ11_COLUMN not in table.columns:
+        return {}
+    return {_place(row): (f"DEM settings {row['DEM settings']}"
+                          if str(row.get("DEM settings", "") or "") else "the DEM row")
+            for _, row in table.iterrows()
+            if math.isfinite(_finite_or_nan(row.get(MEASURED_EQ11_COLUMN)))}
+
+
 def add_calibration_columns(table: pd.DataFrame, calibration, *,
                             tolerances=None, specimen=None, paper: bool = False) -> pd.DataFrame:
     """A copy of a report table with the calibrated DEM's prediction beside each row.
@@ -859,10 +876,17 @@ def add_calibration_columns(table: pd.DataFrame, calibration, *,
         Neither: unchecked.
     """
     from ..calibrate.data import CALIBRATION_DIRECTION, other_direction
-    from ..calibrate.prediction import judge_measurement, uninformative_count_text
+    from ..calibrate.prediction import (
+        NO_MEASUREMENT_REASON,
+        judge_measurement,
+        uninformative_count_text,
+    )
 
     out = table.copy()
     sdc, low, high, inside, notes = [], [], [], [], []
+    # the measurement of a load case is on one row of its DEM settings (the most cells): the
+    # others' "no Eq. 11 measurement" was untrue beside it
+    measured_on = _measured_row_settings(out)
     reasons: dict[str, str] = {}  # per material: why the calibration is of another specimen
     for _, row in out.iterrows():
         note = str(row.get("note", "") or "")
@@ -900,6 +924,11 @@ def add_calibration_columns(table: pd.DataFrame, calibration, *,
                 _finite_or_nan(row.get(MEASURED_EQ11_DOF_COLUMN)),
                 _finite_or_nan(row.get(MEASURED_BASELINE_COLUMN, 0.0)),
                 pools_implausible=IMPLAUSIBLE_ROW_NOTE in note)
+            settings = measured_on.get(_place(row))
+            if judged.reason == NO_MEASUREMENT_REASON and settings is not None:
+                judged = replace(judged, reason=(
+                    "the measurement at this load case is compared with the calibrated band "
+                    f"on the row of {settings}"))
             sdc.append(judged.sdc)
             low.append(judged.low)
             high.append(judged.high)
