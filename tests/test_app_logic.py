@@ -742,7 +742,7 @@ def test_report_downloads_say_the_pool_choice_as_the_page_names_it(tmp_path, goo
     assert b"pool=True" in plain["csv"][1]
     for fmt in ("csv", "md", "html", "csv_provenance"):
         assert b"pool=True" not in files[fmt][1], fmt
-    assert b"'pool DEM settings and specimens'" in files["csv"][1]
+    assert b"'pool DEM settings'" in files["csv"][1]
     # only the words changed: the numbers are the same bytes
     import io
 

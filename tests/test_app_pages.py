@@ -2083,7 +2083,7 @@ def test_the_report_tab_says_a_calibrations_design_runs_are_left_out_in_its_own_
     # the page's checkbox, not the library's keyword (the notes were shown as the library
     # wrote them, though the grid's row notes were put in the page's terms)
     assert len(notes) == 1
-    assert "'pool DEM settings and specimens' pools them with the other runs; 2 DEM run(s)" \
+    assert "'pool DEM settings' pools them with the other runs; 2 DEM run(s)" \
         in notes[0]
     assert not any("pool=True" in c.value for c in at.caption)
 
@@ -2148,7 +2148,7 @@ def test_a_report_checkbox_or_file_the_page_address_cannot_hold_is_refused(store
     assert [e.value for e in at.error] == [
         "measurements in the report: 'a.csv' (from the page address) is not offered (there "
         "is nothing to choose yet); none is chosen instead",
-        "pool DEM settings and specimens: 'maybe' (from the page address) is not one of "
+        "pool DEM settings: 'maybe' (from the page address) is not one of "
         "true, false; false is chosen instead"]
     assert at.checkbox(key="report_pool").value is False
     at = _app_at({"report_pool": "TRUE"})  # Streamlit's reading: any case

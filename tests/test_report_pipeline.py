@@ -547,3 +547,29 @@ def test_the_model_figures_mark_only_the_runs_their_caption_says_the_model_rests
         # one's value exactly never (the grid's SDCs are below 0.5)
         assert len(marked) == 8 and 9.0 not in marked, (name, marked)
         fig.clear()
+
+
+def test_a_pooled_report_keeps_each_tests_specimen_and_the_runs_it_meets(tmp_path, dem_store):
+    # tests of a specimen of one's own (steel particles) lost their specimen under pool=True
+    # and were said to have "no DEM runs of paper_coupon"; they are compared as without it
+    from pidcore.report.pipeline import specimen_report_table
+
+    runs = Store(_with_smoke_run(tmp_path, dem_store)).list_dem_runs()
+    analyses = pd.DataFrame({
+        "frequency_hz": [FREQ_HZ] * 2, "acceleration_g": [ACC_G] * 2, "fill_percent": [50.0] * 2,
+        "material": ["steel", "acrylic"], "direction": ["z"] * 2, "sdc": [0.4, 0.6],
+        "sdc_stderr": [0.01, 0.01], "energy_per_cycle_j": [1e-5] * 2,
+        "source": ["own.csv", "paper.csv"], "specimen": ["own", ""]})
+    apart, pooled = (specimen_report_table(runs, analyses, pool=pool).table
+                     for pool in (False, True))
+    for table in (apart, pooled):
+        own = table[table["source file(s)"] == "own.csv"]
+        assert own["specimen"].tolist() == ["own"], table
+        assert own["alignment [grid/interpolated/out_of_range/no_dem_runs]"].tolist() == \
+            ["no_dem_runs"]
+        assert "own" in own["note"].iloc[0] and "paper_coupon for steel" not in \
+            own["note"].iloc[0], own["note"].iloc[0]
+    # the specimens' tests are never one row; the DEM settings are, pooled
+    assert pooled["source file(s)"].tolist().count("own.csv") == 1
+    paper = pooled[pooled["source file(s)"] == "paper.csv"].iloc[0]
+    assert paper["DEM runs [-]"] == 2 and "(pool=True)" in paper["note"]

@@ -45,7 +45,7 @@ LABEL_OF_KEYWORD: dict[str, str] = {
     "acceleration_unit": "`pidcore analyze --acceleration-unit`",
     "key=": "`pidcore analyze --key`",
     "dem_store": "the DEM store",
-    "pool=True": "'pool DEM settings and specimens'",
+    "pool=True": "'pool DEM settings'",
     "calibration_key=": "`pidcore report --calibration-key`",
     # the call that writes a calibration folder, named by the refusal of a half-moved one
     # (pidcore.specimen.finish_calibration_moves): the page writes no folder, the CLI does

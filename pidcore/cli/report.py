@@ -82,9 +82,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         "its particles whose sidecar names no specimen are its tests (saved "
                         "as such to --store)")
     p.add_argument("--pool", action="store_true",
-                   help="pool DEM runs of different numerical settings and measurements of "
-                        "different specimens at one load case into one row (default: a row "
-                        "each)")
+                   help="pool DEM runs of different numerical settings at one load case "
+                        "into one row (default: a row each); tests of different specimens "
+                        "are rows of their own either way")
     p.add_argument("--calibration", metavar="FILE", type=path_argument, default=None,
                    help="calibration.json of pidcore calibrate (or the --out folder holding "
                         "it), or an HDF5 store it saved calibrations in (its --dem-store): add "

@@ -591,8 +591,8 @@ def specimen_report_table(stored_runs: pd.DataFrame | None, analyses: pd.DataFra
     """The report table of one specimen's DEM runs (:func:`specimen_dem_runs`) beside the
     analyses, as ``pidcore report`` and the app's Report tab show it.
 
-    The paper's Table 3 is compared only for the paper's coupon. With a ``specimen`` (and not
-    ``pool``) the ``specimen`` column names it on every row of its particle material that
+    The paper's Table 3 is compared only for the paper's coupon. With a ``specimen`` the
+    ``specimen`` column names it on every row of its particle material that
     does not name its own (its DEM runs', and the files given as its tests), and the
     ``specimen sha256`` column its file's hash where the row has none (the paper's coupon's
     stays empty: matched by name, :func:`pidcore.specimen.deciding_sha256`); a measurement of
@@ -653,7 +653,7 @@ def specimen_report_table(stored_runs: pd.DataFrame | None, analyses: pd.DataFra
         whole = whole_mass_baseline_note(parsed(p) for p in analyses["parameters_json"])
         if whole:
             notes.append(whole)
-    if specimen is not None and not pool:
+    if specimen is not None:
         # every DEM row is this specimen's (runs_of_specimen) and the files of its particle
         # material are its tests; a measurement of another material cannot be (its specimen
         # is unknown: left empty), and one stored with a specimen of its own (the app's
@@ -906,8 +906,9 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
         Only DEM runs of this specimen are compared (default: the paper's coupon); the
         paper's Table 3 only when it is the paper's coupon.
     pool : bool
-        Pool DEM runs of different settings and measurements of different specimens at one
-        load case (default: separate rows; see :func:`pidcore.report.build_report_table`).
+        Pool DEM runs of different settings at one load case (default: separate rows; see
+        :func:`pidcore.report.build_report_table`); tests of different specimens are never
+        pooled.
     calibration : path, optional
         A ``calibration.json`` of ``pidcore calibrate``, or a store holding calibrations
         (:mod:`pidcore.calibrate.persist`): each row it predicts gets the calibrated DEM's

@@ -9,8 +9,8 @@ from the inputs unchanged; only runs of one case and settings (seeds) and measur
 case and specimen are pooled (:func:`pidcore.compare.pooled_mean`); stored runs that are the
 same simulation (:func:`pidcore.compare.align.simulation_identity`) count once, which the row's
 note says. DEM runs of different
-numerical settings and measurements of different specimens get rows of their own unless
-``pool=True`` (``pidcore report --pool``), which the row's note then says.
+numerical settings get rows of their own unless ``pool=True`` (``pidcore report --pool``),
+which the row's note then says; measurements of different specimens always do.
 
 The difference column compares like with like: the measured energy per cycle over the DEM
 case's E = m_c a^2 / (2 w^2) (Eq. 10), as our DEM SDC is defined, minus our DEM SDC.
@@ -309,8 +309,8 @@ def build_report_table(dem_runs: pd.DataFrame | None, analyses: pd.DataFrame | N
     tolerances : Tolerances, optional
         Grid-match tolerances (default from :mod:`pidcore.defaults`).
     pool : bool
-        Pool DEM runs of different numerical settings and measurements of different specimens
-        at one load case (default: separate rows).
+        Pool DEM runs of different numerical settings at one load case (default: separate
+        rows); measurements of different specimens stay rows of their own either way.
     store_runs : pandas.DataFrame, optional
         Every DEM run of the store, ``dem_runs`` being one specimen's of them: a measured row
         with no run of its specimen at its material and direction (alignment ``no_dem_runs``)
@@ -394,9 +394,9 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
     # stays apart (by name) where the name means two: calibrate and Compare decide alike
     # (a store's listing holds NaN where a record names no specimen and another does)
     matched = match_hashless_records(
-        ["" if pool else rec.get("specimen", "") for _, rec, _ in measured_rows],
+        [rec.get("specimen", "") for _, rec, _ in measured_rows],
         [rec.get(MEASURED_SHA256_FIELD, "") for _, rec, _ in measured_rows],
-        given=tested_files, others=[] if pool or store_analyses is None
+        given=tested_files, others=[] if store_analyses is None
         or "specimen" not in store_analyses.columns else list(zip(
             store_analyses["specimen"], store_analyses.get(
                 MEASURED_SHA256_FIELD, pd.Series([""] * len(store_analyses),
@@ -405,7 +405,7 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
              ) -> tuple[Aligner, pd.DataFrame | None, str, bool, str]:
         """The aligner of the DEM runs a test of ``specimen`` at ``case`` meets, its runs,
         the note on them, whether they were refused, and whose runs a calibrated file met."""
-        if pool or dem_runs is None or dem_runs.empty:
+        if dem_runs is None or dem_runs.empty:
             return aligner, dem_runs, "", False, ""
         which = (specimen, case.material, case.direction, sha256)
         if which not in aligners:
@@ -415,7 +415,7 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
                           f"{met.specimen}, the file pidcore calibrate made from it"
                           if met.calibrated_from else "")
             aligners[which] = (Aligner.from_tables(met.runs, paper, model=model,
-                                                   tolerances=tolerances,
+                                                   tolerances=tolerances, pool_settings=pool,
                                                    reference_fills=fills),
                                met.note if met.runs is None else "", met.refused,
                                calibrated)
@@ -423,7 +423,9 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
         own, met_note, refused, met_calibrated = aligners[which]
         return own, aligner_runs[which], met_note, refused, met_calibrated
 
-    specimens = ["" if pool or not isinstance(rec.get("specimen", ""), str)
+    # pool=True pools DEM settings, never tests of different specimens: a pooled test of
+    # another specimen lost its name and met the report's specimen's runs
+    specimens = ["" if not isinstance(rec.get("specimen", ""), str)
                  else rec.get("specimen", "") for _, rec, _ in measured_rows]
     met_runs = [meet(case, specimen, sha256) for (case, _, _), specimen, sha256
                 in zip(measured_rows, specimens, matched.sha256, strict=True)]
@@ -576,7 +578,7 @@ def report_table_and_aligner(dem_runs: pd.DataFrame | None, analyses: pd.DataFra
             unconverged_rows.append(f"{lc.label()} (interpolated from "
                                     f"{'; '.join(row.unconverged_nodes)})")
         if pool:
-            note.append("pooled across specimens and DEM settings (pool=True)")
+            note.append("DEM runs of different settings pooled (pool=True)")
         if math.isnan(row.paper_dem) and is_paper_coupon(row.specimen or ""):
             gap = _paper_dem_gap(lc, paper, tolerances)
             if gap:

@@ -56,11 +56,11 @@ def render(stores, calibrations: list) -> None:
     chosen = c1.multiselect("measurements in the report (all when none chosen)", files,
                             key="report_filter_files", bind=ADDRESS_BINDING)
     with c2:
-        refuse_address_flag("report_pool", "pool DEM settings and specimens")
-    pool = c2.checkbox("pool DEM settings and specimens", value=False, key="report_pool",
+        refuse_address_flag("report_pool", "pool DEM settings")
+    pool = c2.checkbox("pool DEM settings", value=False, key="report_pool",
                        bind=ADDRESS_BINDING,
-                       help="one row per load case (default: a row per DEM setting and per "
-                            "specimen)")
+                       help="one row per load case and specimen (default: a row per DEM "
+                            "setting too); tests of different specimens are never pooled")
     keys = (tuple(saved[saved["file"].isin(chosen)]["key"]) if chosen and not saved.empty
             else None)
     # the DEM runs of one specimen, as `pidcore report [--specimen FILE]` compares them; the
