@@ -80,8 +80,9 @@ ReportFormat = Literal["csv", "md", "html", "tex", "pdf"]
 #: What 100 % fill is: the cell's capacity (dense drop packing) or the paper's 36 particles.
 FillReference = Literal["capacity", "paper"]
 #: How a measured case was matched with our DEM (:mod:`pidcore.compare.align`): at a grid
-#: point of the runs, interpolated by the pchip model, outside its range, or no runs at all.
-AlignmentStatus = Literal["grid", "interpolated", "out_of_range", "no_dem_runs"]
+#: point of the runs, interpolated by the pchip model, outside its range, runs over which no
+#: pchip model can be built (one fill only, say), or no runs at all.
+AlignmentStatus = Literal["grid", "interpolated", "out_of_range", "no_model", "no_dem_runs"]
 #: What a single-impact run hits (:mod:`pidcore.dem.impact`): a wall or another particle.
 ImpactPair = Literal["wall", "particle"]
 #: Normal damping constant: "eq3" = alpha from the table's e_n by Eq. 3; "calibrated" = alpha

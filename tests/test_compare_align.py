@@ -8,7 +8,15 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from pidcore.compare import Aligner, LoadCase, Tolerances, align_measured, dem_cases, pooled_mean
+from pidcore.compare import (
+    ALIGNMENT_STATUSES,
+    Aligner,
+    LoadCase,
+    Tolerances,
+    align_measured,
+    dem_cases,
+    pooled_mean,
+)
 from pidcore.model import load_paper_table3
 
 
@@ -232,11 +240,15 @@ def test_no_dem_runs_gives_no_dem_runs_with_a_reason():
     assert out.status == "no_dem_runs" and "no DEM runs" in out.message
 
 
-def test_grid_that_cannot_be_modelled_says_why():
+def test_grid_that_cannot_be_modelled_is_labelled_no_model_and_says_why():
+    # labelled out_of_range beside "no pchip model ... fill_percent has 1 distinct value":
+    # the label contradicted its own note (the point lies inside the runs' span here)
     one_fill = dem_grid()
     one_fill = one_fill[one_fill.fill_percent == 50]
     out = Aligner.from_tables(one_fill).align(LoadCase(75.0, 3.0, 50.0))
-    assert out.status == "out_of_range" and "fill_percent" in out.message
+    assert out.status == "no_model" and "no_model" in ALIGNMENT_STATUSES
+    assert "no pchip model" in out.message and "fill_percent" in out.message
+    assert math.isnan(out.sdc_dem)
 
 
 def test_pooled_mean_of_repeated_runs():

@@ -565,8 +565,7 @@ def test_a_pooled_report_keeps_each_tests_specimen_and_the_runs_it_meets(tmp_pat
     for table in (apart, pooled):
         own = table[table["source file(s)"] == "own.csv"]
         assert own["specimen"].tolist() == ["own"], table
-        assert own["alignment [grid/interpolated/out_of_range/no_dem_runs]"].tolist() == \
-            ["no_dem_runs"]
+        assert own[ALIGNMENT_COLUMN].tolist() == ["no_dem_runs"]
         assert "own" in own["note"].iloc[0] and "paper_coupon for steel" not in \
             own["note"].iloc[0], own["note"].iloc[0]
     # the specimens' tests are never one row; the DEM settings are, pooled

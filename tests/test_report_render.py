@@ -322,6 +322,7 @@ def test_pdf_table_sets_the_like_for_like_measured_sdc_beside_ours():
     # 0.019; nor did it show the calibrated prediction or the band verdict
     from pidcore.report.render import pdf_table_cells
     from pidcore.report.table import (
+        ALIGNMENT_COLUMN,
         CALIBRATED_COLUMN,
         CALIBRATED_INSIDE_COLUMN,
         DIFFERENCE_COLUMN,
@@ -335,7 +336,7 @@ def test_pdf_table_sets_the_like_for_like_measured_sdc_beside_ours():
                 MEASURED_EQ10_COLUMN: 0.6239845632800883,
                 DIFFERENCE_COLUMN: 0.6239845632800883 - 0.6054300359935463,
                 CALIBRATED_COLUMN: 0.2399096, CALIBRATED_INSIDE_COLUMN: "no",
-                "alignment [grid/interpolated/out_of_range/no_dem_runs]": "grid"})
+                ALIGNMENT_COLUMN: "grid"})
     labels, rows = pdf_table_cells(pd.DataFrame([row]))
     shown = {label.replace("\n", " "): cell for label, cell in zip(labels, rows[0], strict=True)}
     assert shown["SDC DEM (ours) [-]"] == "0.6054"

@@ -15,7 +15,7 @@ StatedLoadCase, resolve_load_case, parse_file_name, read_sidecar
 SIDECAR_NAME, SIDECAR_COLUMNS, FILL_PATTERN, MATERIAL_PATTERN, DIRECTION_PATTERN
     The sidecar table's name and load-case columns; what a file name may state.
 Aligner, align_measured, AlignedCase, AlignmentStatus, ALIGNMENT_STATUSES
-    Measured cases beside our DEM (grid point, interpolated, out of range, no runs).
+    Measured cases beside our DEM (grid point, interpolated, out of range, no model, no runs).
 Tolerances
     When two load cases are the same grid point.
 dem_cases, DemCase, pooled_mean, simulation_identity

@@ -1,7 +1,7 @@
 """Align measured load cases with our DEM results and with the paper's Table 3.
 
 A measured case (frequency and acceleration measured, fill/material/direction stated) is
-compared with our DEM in one of three ways, named by :data:`AlignmentStatus`:
+compared with our DEM in one of these ways, named by :data:`AlignmentStatus`:
 
 ``"grid"``
     A DEM case of ours lies within the tolerances of :mod:`pidcore.defaults`
@@ -14,8 +14,11 @@ compared with our DEM in one of three ways, named by :data:`AlignmentStatus`:
     edge where the frequency or acceleration lies outside it within the tolerances above (a
     measured 49.9995 Hz is the 50 Hz edge: :func:`model_point`; the message says so).
 ``"out_of_range"``
-    Outside the model's box, or no model can be built: no value, a message says why. The model is
-    never extrapolated.
+    Outside the model's box: no value, a message says why. The model is never extrapolated.
+``"no_model"``
+    Off the DEM grid, and the runs at the case's material and direction give no pchip model
+    (fewer than two distinct values along an axis: one fill run, say): no value, the message
+    says why. It was labelled ``out_of_range``, which the message contradicted.
 ``"no_dem_runs"``
     No DEM run of ours at the case's material and direction at all (of the specimen compared):
     nothing to interpolate, so "out of range" would mislead; a message says which runs the store
@@ -1209,8 +1212,8 @@ class Aligner:
             return AlignedCase(case, "no_dem_runs", **common,
                                message=f"no DEM runs of ours for {case.material}, direction "
                                        f"{case.direction}")
-        if isinstance(model, str):
-            return AlignedCase(case, "out_of_range", **common, message=model)
+        if isinstance(model, str):  # runs there, but too few to build a model over
+            return AlignedCase(case, "no_model", **common, message=model)
         point = (case.fill_percent, case.acceleration_g, case.frequency_hz)
         source = getattr(model, "source", "") or "pchip model"
         taken_note = ""
