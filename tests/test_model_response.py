@@ -613,3 +613,75 @@ def test_a_response_far_from_the_hole_is_not_flagged(model, mode):
     r = harmonic_response(model, mode, frequencies_hz=np.array([280.0, 300.0, 320.0]),
                           force_amplitude_n=FORCE_N)
     assert not r.sdc_filled.any() and r.filled_note == ""
+
+
+#: An own specimen unlike the paper's coupon: 7150 cells of 6.35 mm, a 12.7 mm core, 2 mm
+#: tungsten carbide spheres (46 fit a cell, as `pidcore specimen check` prints), 0.9 kg coupon.
+WC_PANEL = """schema_version = 1
+name = "wc_panel"
+[cell]
+shape = "hexagonal"
+inscribed_diameter_m = 6.35e-3
+height_m = 12.7e-3
+count = 7150
+wall_material = "aluminium_wall"
+[coupon]
+mass_kg = 0.9
+[particles]
+material = "tungsten_carbide"
+radius_m = 1.0e-3
+density_kg_m3 = 15600.0
+youngs_modulus_pa = 600e9
+poisson_ratio = 0.22
+[pairs.particle_particle]
+restitution = 0.8
+sliding_friction = 0.3
+[pairs.particle_wall]
+restitution = 0.8
+sliding_friction = 0.3
+"""
+
+
+def test_an_own_specimens_vibrated_mass_is_checked_against_its_own_masses(model, mode):
+    # 0.9 kg + 7150 x 23 x 65.35 mg = 11.646 kg, the right m_c of that panel at 50 % fill,
+    # was refused as "118 x the paper coupon's vibrated masses ... was it grams?"
+    from pidcore.model import equivalent_damper_table
+    from pidcore.model.damper import VIBRATED_MASS_LIMIT
+    from pidcore.specimen import Specimen
+
+    panel = Specimen.from_text(WC_PANEL, source="wc_panel.toml")
+    sphere = 15600.0 * 4.0 / 3.0 * np.pi * 1e-3**3
+    m_c = 0.9 + 7150 * 23 * sphere
+    assert m_c == pytest.approx(11.646, abs=5e-4)
+    own = dataclasses.replace(mode, coupon_vibrated_mass_kg=m_c, coupon_specimen=panel,
+                              coupon_area_m2=None)
+    assert own.coupon_vibrated_mass_kg == m_c
+    table = equivalent_damper_table(model, fills_percent=[50], accelerations_g=[5],
+                                    frequencies_hz=[300], vibrated_mass_kg=m_c, specimen=panel)
+    assert table["coupon_vibrated_mass [kg]"].iloc[0] == m_c
+    # the range is the panel's: one sphere in each cell alone (0.467 kg, the particles
+    # convention's least; lighter than its empty 0.9 kg coupon) to its cells full, 46 spheres
+    # each; each bound with the paper's 100 x margin, 1e-6 either side (far from round-off)
+    low, high = min(0.9, 7150 * sphere), 0.9 + 7150 * 46 * sphere
+    for typed, taken in ((low / VIBRATED_MASS_LIMIT * (1 + 1e-6), True),
+                         (low / VIBRATED_MASS_LIMIT * (1 - 1e-6), False),
+                         (high * VIBRATED_MASS_LIMIT * (1 - 1e-6), True),
+                         (high * VIBRATED_MASS_LIMIT * (1 + 1e-6), False)):
+        for make in (lambda m=typed: dataclasses.replace(own, coupon_vibrated_mass_kg=m),
+                     lambda m=typed: equivalent_damper_table(
+                         model, fills_percent=[50], accelerations_g=[5], frequencies_hz=[300],
+                         vibrated_mass_kg=m, specimen=panel)):
+            if taken:
+                make()
+            else:
+                with pytest.raises(ParameterError, match="x specimen wc_panel's vibrated"):
+                    make()
+    # the same mass typed in grams is still a unit slip, named against the panel's masses
+    with pytest.raises(ParameterError) as caught:
+        dataclasses.replace(own, coupon_vibrated_mass_kg=11646.0)
+    assert str(caught.value).startswith(
+        f"TreatedMode: coupon_vibrated_mass_kg 11646 kg is {11646.0 / high:.3g} x ")
+    assert (f"x specimen wc_panel's vibrated masses ({low:.3g} .. {high:.3g} kg from one "
+            "particle per cell to its 7150 cells full, 46 tungsten_carbide particles each"
+            in str(caught.value))
+    assert str(caught.value).endswith("was it grams?")

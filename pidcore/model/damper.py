@@ -378,33 +378,69 @@ def check_area(area_m2: float, specimen, what: str = "area_m2") -> None:
         f"coupon's face area in m^2; {hint}")
 
 
-#: Most an explicit m_c may lie outside the range of the paper coupon's own m_c (every
-#: convention, every fill of the model) before it is refused as a unit slip: grams typed for
-#: kilograms are 1000 x off, while a heavy fixture (the paper calibration's 0.26 kg beside the
-#: 0.02-0.2 kg of coupon and particles) stays well within it.
+#: Most an explicit m_c may lie outside the range of its coupon's own m_c (the paper coupon's:
+#: every convention, every fill of the model; another specimen's: its empty coupon to its
+#: cells full) before it is refused as a unit slip: grams typed for kilograms are 1000 x off,
+#: while a heavy fixture (the paper calibration's 0.26 kg beside the 0.02-0.2 kg of coupon and
+#: particles) stays well within it.
 VIBRATED_MASS_LIMIT = 100.0
 
 
 def check_vibrated_mass(mass_kg: float, fills: Sequence[float],
                         material: str = D.MODEL_PARTICLE_MATERIAL,
-                        what: str = "vibrated_mass_kg") -> None:
+                        what: str = "vibrated_mass_kg",
+                        specimen: Specimen | None = None) -> None:
     """Refuse an explicit m_c more than :data:`VIBRATED_MASS_LIMIT` times outside the range of
-    the paper coupon's m_c over ``fills`` [%] (every convention, ``material`` particles) as a
-    unit slip (``what``: the option as messages name it). The one check of a given m_c:
-    :func:`equivalent_damper_table`, ``pidcore model damper --vibrated-mass`` and
-    :class:`~pidcore.model.TreatedMode` all refuse by it."""
-    masses = [paper_vibrated_mass(convention, material)(float(fill))
-              for convention in VIBRATED_MASS_CONVENTIONS for fill in fills]
-    low, high = min(m for m in masses if m > 0), max(masses)
+    its coupon's own m_c as a unit slip (``what``: the option as messages name it). The one
+    check of a given m_c: :func:`equivalent_damper_table`, ``pidcore model damper
+    --vibrated-mass`` and :class:`~pidcore.model.TreatedMode` all refuse by it.
+
+    The range is :func:`vibrated_mass_range`: the paper coupon's m_c over ``fills`` [%] (every
+    convention, ``material`` particles) where ``specimen`` is None or the paper's coupon, else
+    ``specimen``'s own, from its empty coupon to its cells full."""
+    low, high, whose = vibrated_mass_range(fills, material, specimen)
     mass = float(mass_kg)
     if low / VIBRATED_MASS_LIMIT <= mass <= high * VIBRATED_MASS_LIMIT:
         return
     hint = "was it grams?" if mass > high else "was it in another unit?"
     ratio = _three_digits(mass / (high if mass > high else low))
     raise ParameterError(
-        f"{what} {as_given(mass)} kg is {ratio} x the paper coupon's vibrated masses "
-        f"({low:.3g} .. {high:.3g} kg over every convention at {_fills_text(fills)} % fill, "
-        f"{material} particles); expected m_c in kg; {hint}")
+        f"{what} {as_given(mass)} kg is {ratio} x {whose[0]} ({low:.3g} .. {high:.3g} kg "
+        f"{whose[1]}); expected m_c in kg; {hint}")
+
+
+def vibrated_mass_range(fills: Sequence[float], material: str = D.MODEL_PARTICLE_MATERIAL,
+                        specimen: Specimen | None = None
+                        ) -> tuple[float, float, tuple[str, str]]:
+    """(least, most m_c [kg], (whose masses, how they span) in words) an m_c of Eq. 10 of the
+    coupon tests may be, before :data:`VIBRATED_MASS_LIMIT`'s margin.
+
+    The paper's coupon (``specimen`` None or :meth:`~pidcore.specimen.Specimen.is_paper`):
+    its m_c over ``fills`` [%] by every convention with the paper's count of ``material``
+    particles (:func:`paper_vibrated_mass`). Any other specimen: its own masses, from one
+    particle in each cell alone (the ``particles`` convention's least) or its empty coupon
+    and fixture, whichever is lighter, to coupon, fixture and every cell full (its
+    :meth:`~pidcore.specimen.Specimen.capacity_per_cell`): the paper coupon's 0.02-0.2 kg
+    took the 11.6 kg of a 7150-cell tungsten carbide panel for grams."""
+    if specimen is not None and not specimen.is_paper():
+        from ..specimen import vibrated_mass_by_convention
+
+        rigid = specimen.coupon.moving_mass_kg
+        full = specimen.capacity_per_cell()
+        one_each = specimen.cell.count * specimen.particles.mass_kg
+        low = min(rigid, one_each)
+        high = vibrated_mass_by_convention("coupon_plus_particles", rigid_kg=rigid,
+                                           particles_kg=full * one_each)
+        return low, high, (
+            f"specimen {specimen.name}'s vibrated masses",
+            f"from {'its empty coupon' if rigid <= one_each else 'one particle per cell'} "
+            f"to its {specimen.cell.count} cells full, {full} {specimen.particles.material} "
+            "particles each, over every convention")
+    masses = [paper_vibrated_mass(convention, material)(float(fill))
+              for convention in VIBRATED_MASS_CONVENTIONS for fill in fills]
+    return min(m for m in masses if m > 0), max(masses), (
+        "the paper coupon's vibrated masses",
+        f"over every convention at {_fills_text(fills)} % fill, {material} particles")
 
 
 def check_one_fill_per_mass(mass_kg: float, fills: Sequence[float],
@@ -590,9 +626,11 @@ def equivalent_damper_table(model: SdcModel, *, fills_percent: Sequence[float] |
         m_c [kg] of Eq. 10, or a function of fill [%] returning it (the particle mass grows
         with fill, and each fill's SDC was divided by its own m_c): a number is the m_c of
         one fill, and is refused with several ``fills_percent``. A number more than
-        :data:`VIBRATED_MASS_LIMIT` times outside the paper coupon's m_c at that fill is
-        refused as a unit slip (grams typed for kg), as ``pidcore model damper
-        --vibrated-mass`` and :class:`~pidcore.model.TreatedMode` refuse it.
+        :data:`VIBRATED_MASS_LIMIT` times outside ``specimen``'s own m_c
+        (:func:`vibrated_mass_range`: the paper coupon's at that fill, another specimen's
+        from its empty coupon to its cells full) is refused as a unit slip (grams typed for
+        kg), as ``pidcore model damper --vibrated-mass`` and
+        :class:`~pidcore.model.TreatedMode` refuse it.
     area_m2 : float, optional
         Coupon area for the per-area damper; default :func:`specimen_area_m2` (the
         specimen's ``[coupon] face_area_m2``, the paper's 0.01 m^2, else its cells'
@@ -602,7 +640,8 @@ def equivalent_damper_table(model: SdcModel, *, fills_percent: Sequence[float] |
     specimen : pidcore.specimen.Specimen, optional
         The coupon the SDC and m_c are of (default: the paper's,
         :func:`pidcore.specimen.paper_specimen`; for stored DEM runs :func:`runs_specimen`):
-        ``area_m2`` is checked against its cells, ``c_eq_per_cell`` divides by their count.
+        ``area_m2`` is checked against its cells, a number ``vibrated_mass_kg`` against its
+        masses, ``c_eq_per_cell`` divides by their count.
     clip_to_range : bool
         Passed to :meth:`SdcModel.evaluate` (default: refuse points outside the model); the
         points it held at the edge are flagged in :data:`SDC_HELD_COLUMN`.
@@ -659,7 +698,8 @@ def equivalent_damper_table(model: SdcModel, *, fills_percent: Sequence[float] |
         mass = np.array([float(vibrated_mass_kg(x)) for x in p])
     else:
         # 69 (g) for 0.069 kg gave a c_eq 1000 x too large without a word; the CLI refused it
-        check_vibrated_mass(float(_positive("vibrated_mass_kg", vibrated_mass_kg)), fills)
+        check_vibrated_mass(float(_positive("vibrated_mass_kg", vibrated_mass_kg)), fills,
+                            specimen=specimen)
         # the 50 % m_c at 25 and 90 % gave a c_eq 1.63 x too high and 0.62 x too low
         check_one_fill_per_mass(vibrated_mass_kg, fills)
         mass = np.full(p.shape, float(vibrated_mass_kg))

@@ -103,9 +103,11 @@ class TreatedMode:
         for the paper's Table 3, ``runs_vibrated_mass(runs)(fill_percent)`` for stored DEM
         runs. Not ``coupon_vibrated_mass_kg()`` alone, which leaves the particles out (c_pd
         4.5 x low at 50 % fill). More than
-        :data:`~pidcore.model.damper.VIBRATED_MASS_LIMIT` times outside the paper coupon's
-        m_c at ``fill_percent`` (every convention) is refused as a unit slip (grams typed
-        for kg), as :func:`~pidcore.model.equivalent_damper_table` refuses it.
+        :data:`~pidcore.model.damper.VIBRATED_MASS_LIMIT` times outside the m_c of
+        ``coupon_specimen`` (:func:`~pidcore.model.damper.vibrated_mass_range`: the paper
+        coupon's at ``fill_percent``, every convention; another specimen's from its empty
+        coupon to its cells full) is refused as a unit slip (grams typed for kg), as
+        :func:`~pidcore.model.equivalent_damper_table` refuses it.
     coupon_area_m2 : float, optional
         A_c [m^2] of those coupons; default (None) the area ``pidcore model damper`` takes
         for ``coupon_specimen`` (:func:`~pidcore.model.damper.specimen_area_m2`: the face
@@ -115,7 +117,8 @@ class TreatedMode:
         ``coupon_specimen`` is refused as a unit slip (cm^2 or mm^2 typed for m^2).
     coupon_specimen : pidcore.specimen.Specimen, optional
         Those coupons (default: the paper's; for stored DEM runs
-        :func:`~pidcore.model.damper.runs_specimen`), to check ``coupon_area_m2`` against.
+        :func:`~pidcore.model.damper.runs_specimen`), to check ``coupon_area_m2`` and
+        ``coupon_vibrated_mass_kg`` against.
     treated_regions : sequence of (area_m2, mode_shape_amplitude), optional
         The treated area split into regions (cells, patches, FE element groups), each with its
         area [m^2] and the mode's amplitude phi_i [-] there, in the scaling the modal mass is
@@ -161,7 +164,8 @@ class TreatedMode:
         # 98.8 (g) for m_c = 0.0988 kg gave a c_pd 1000 x too large without a word, or a
         # refusal blaming the force; the damper table refused it
         check_vibrated_mass(self.coupon_vibrated_mass_kg, (self.fill_percent,),
-                            what="TreatedMode: coupon_vibrated_mass_kg")
+                            what="TreatedMode: coupon_vibrated_mass_kg",
+                            specimen=self.coupon_specimen)
         object.__setattr__(self, "treated_regions", self._checked_regions())
         # 100 (cm^2) for A_c = 0.01 m^2 gave a c_pd 1e4 x too small without a word
         check_area(self.coupon_area_m2, self.coupon_specimen or paper_specimen(),
