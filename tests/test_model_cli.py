@@ -668,6 +668,57 @@ def test_stored_runs_of_one_fill_are_refused_naming_the_store(tmp_path, monkeypa
     assert not (tmp_path / "out").exists()
 
 
+def test_a_run_off_the_grid_is_left_out_of_the_stored_model_and_named(tmp_path, monkeypatch,
+                                                                      capsys):
+    # one run at 300 Hz, 5 g beside a full grid made `model damper/figures --table store`
+    # exit 2 "SDC table: no value at any fill for 1 g, 300 Hz", naming neither the store nor
+    # the run, and --where cannot leave a frequency out: the report's rule (complete_grid)
+    # models the complete grid and the output names what it left out
+    from matplotlib.figure import Figure
+
+    from pidcore.cli import main
+
+    grid = _specimen_runs("steel_6mm", "a" * 64, coupon_kg=0.05, fixture_kg=0.12,
+                          sdc_scale=0.5)
+    stray = grid[(grid["frequency_hz"] == 500.0) & (grid["acceleration_g"] == 5.0)
+                 & (grid["fill_percent"] == 50.0)].assign(frequency_hz=300.0,
+                                                          case_key="stray-300Hz")
+    _fake_store(monkeypatch, lambda: pd.concat([grid, stray]))
+    store = tmp_path / "s.h5"
+    argv = ["--table", "store", "--store", str(store)]
+    capsys.readouterr()
+    assert main(["model", "damper", "--out", str(tmp_path / "d"), *argv, "--area", "0.02"]) == 0
+    err = capsys.readouterr().err
+    assert (f"pidcore model damper: note: DEM runs of steel_6mm [aaaaaa] in {store}: left out "
+            "of the SDC model, off its complete frequency x acceleration grid: 300 Hz (not run "
+            "at every acceleration); 1 run(s): stray-300Hz\n") in err
+    table = pd.read_csv(tmp_path / "d" / "equivalent_damper.csv")
+    # the model's grid is the complete one, each of its runs' SDC given back (to rounding)
+    assert sorted(set(table["frequency [Hz]"])) == [50.0, 100.0, 500.0, 1000.0]
+    at_grid = table.merge(grid, left_on=["frequency [Hz]", "acceleration [g]",
+                                         "packing ratio [%]"],
+                          right_on=["frequency_hz", "acceleration_g", "fill_percent"])
+    assert len(at_grid) == len(grid) == 47
+    np.testing.assert_allclose(at_grid["sdc [-]"], at_grid["sdc"], rtol=1e-12)
+    provenance = json.loads((tmp_path / "d" / "equivalent_damper.json").read_text())
+    assert provenance["provenance"]["sdc_source"].endswith(
+        "the complete grid; left out: 300 Hz (not run at every acceleration)")
+    monkeypatch.setattr(Figure, "savefig", lambda fig, path, **_: None)
+    assert main(["model", "figures", "--out", str(tmp_path / "f"), *argv]) == 0
+    assert "pidcore model figures: note: DEM runs of steel_6mm [aaaaaa] in " \
+        f"{store}: left out of the SDC model" in capsys.readouterr().err
+    # no complete grid left: the refusal names the store and the pairs without a value
+    diagonal = grid[((grid["frequency_hz"] == 50.0) & (grid["acceleration_g"] == 1.0))
+                    | ((grid["frequency_hz"] == 100.0) & (grid["acceleration_g"] == 5.0))]
+    _fake_store(monkeypatch, lambda: diagonal)
+    assert main(["model", "damper", "--out", str(tmp_path / "x"), *argv]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"pidcore model damper: error: DEM runs of steel_6mm [aaaaaa] in "
+                          f"{store}: no value at any fill at 50 Hz, 5 g; 100 Hz, 1 g (a pchip "
+                          "model needs one at every frequency x acceleration pair)")
+    assert not (tmp_path / "x").exists()
+
+
 PAPER = Path("/work/shared/reference/seed-paper.md")
 
 

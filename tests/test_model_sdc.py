@@ -206,6 +206,32 @@ def test_a_line_without_any_value_is_named_by_its_acceleration_and_frequency():
         SdcModel.from_table(t, value="sdc")
 
 
+def test_a_run_without_a_value_stays_a_filled_hole_when_an_off_grid_run_is_left_out():
+    # the complete grid kept only the runs with a value: a run that gave none (the only one at
+    # 90 %) lost the 90 % fill from the model once a stray 300 Hz run was left out, while the
+    # same runs without the stray one keep it as a hole, filled along fill and flagged
+    from pidcore.model.sdc_model import complete_grid_model
+
+    grid = pd.DataFrame(list(itertools.product([30.0, 60.0], [2.0, 8.0], [100.0, 500.0])),
+                        columns=["fill_percent", "acceleration_g", "frequency_hz"])
+    grid["sdc"] = 0.001 * grid["fill_percent"] + 0.01 * grid["acceleration_g"]
+    failed = pd.DataFrame({"fill_percent": [90.0], "acceleration_g": [2.0],
+                           "frequency_hz": [100.0], "sdc": [np.nan]})
+    stray = pd.DataFrame({"fill_percent": [30.0], "acceleration_g": [2.0],
+                          "frequency_hz": [300.0], "sdc": [0.5]})
+    plain, _, none = complete_grid_model(pd.concat([grid, failed]))
+    model, kept, left_out = complete_grid_model(pd.concat([grid, failed, stray]))
+    assert none == "" and left_out == "300 Hz (not run at every acceleration)"
+    assert len(kept) == len(grid) + 1 and 300.0 not in set(kept["frequency_hz"])
+    for axis_kept, axis_plain in zip(model.axes, plain.axes, strict=True):
+        np.testing.assert_array_equal(axis_kept, axis_plain)
+    # same data, same construction: bit for bit
+    np.testing.assert_array_equal(model.values, plain.values)
+    np.testing.assert_array_equal(model.filled, plain.filled)
+    assert model.filled_points()[["fill_percent", "acceleration_g", "frequency_hz"]
+                                 ].values.tolist()[0] == [90.0, 2.0, 100.0]
+
+
 # --------------------------------------------------------------------------- range handling
 @pytest.mark.parametrize("point", [(24.9, 5, 100), (95, 5, 100), (50, 0.5, 100), (50, 11, 100),
                                    (50, 5, 40), (50, 5, 1001)])

@@ -170,8 +170,25 @@ def build_model(args: argparse.Namespace):
     specimen = run_specimen_labels(runs).iloc[0]
     text = f"DEM runs of {specimen} in {args.store}" + (
         " where " + ", ".join(f"{k}={v}" for k, v in where.items()) if where else "")
-    return SdcModel.from_table(runs, value="sdc", log_frequency=args.log_frequency,
-                               source=text), runs
+    from ..model.sdc_model import complete_grid_model
+
+    # one run off the grid (300 Hz at 2 g only) refused the whole store, naming neither it
+    # nor the run, and --where cannot leave a value out: the report's rule, said
+    runs = runs.reset_index(drop=True)  # the runs left out are named by their rows
+    model, kept, left_out = complete_grid_model(runs, value="sdc",
+                                                log_frequency=args.log_frequency, source=text)
+    if left_out:
+        print(f"pidcore model {args.model_command}: note: {text}: left out of the SDC model, "
+              f"off its complete frequency x acceleration grid: {left_out}; "
+              f"{_runs_named(runs.drop(kept.index))}", file=sys.stderr)
+    return model, kept
+
+
+def _runs_named(runs) -> str:
+    """``"2 run(s): f300Hz_..., f300Hz_..."`` (the first few keys), for a note."""
+    keys = [str(k) for k in runs["case_key"]] if "case_key" in runs.columns else []
+    shown = ", ".join(keys[:5]) + (f", ... ({len(keys) - 5} more)" if len(keys) > 5 else "")
+    return f"{len(runs)} run(s)" + (f": {shown}" if shown else "")
 
 
 def _runs_of_specimen_file(runs, path, store):

@@ -922,7 +922,7 @@ def build_dem_models(cases: list[DemCase]) -> dict[tuple[str, str], object]:
         ``{(material, direction): SdcModel or str}``; the string says why no model could be built
         (for example fewer than two distinct values on an axis).
     """
-    from ..model import SdcModel
+    from ..model.sdc_model import complete_grid_model
 
     models: dict[tuple[str, str], object] = {}
     by_kind: dict[tuple[str, str], list[DemCase]] = {}
@@ -941,59 +941,14 @@ def build_dem_models(cases: list[DemCase]) -> dict[tuple[str, str], object]:
             source += (f"; at {other_settings} load case(s) the runs of other settings left "
                        "out (those with the most cells kept, as for a grid case)")
         try:
-            models[kind] = SdcModel.from_table(table, value="sdc", source=source)
-        except ParameterError as exc:
-            models[kind] = f"no pchip model over our DEM runs ({kind[0]}, {kind[1]}): {exc}"
             # one extra run (the app's DEM tab runs any frequency) leaves its frequency
             # without a value at the grid's other accelerations, which refused the model for
-            # every off-grid measurement: model the complete grid and say what is left out
-            kept, left_out = complete_grid(table)
-            if left_out:
-                try:
-                    models[kind] = SdcModel.from_table(
-                        kept, value="sdc",
-                        source=f"{source}, the complete grid; left out: {left_out}")
-                except ParameterError:
-                    pass
+            # every off-grid measurement: the complete grid is modelled, its source saying
+            # what is left out
+            models[kind] = complete_grid_model(table, value="sdc", source=source)[0]
+        except ParameterError as exc:
+            models[kind] = f"no pchip model over our DEM runs ({kind[0]}, {kind[1]}): {exc}"
     return models
-
-
-def complete_grid(table: pd.DataFrame) -> tuple[pd.DataFrame, str]:
-    """The rows of ``table`` (``frequency_hz``, ``acceleration_g``, ``sdc``) on the largest
-    frequency x acceleration grid every pair of which has a finite value, and the values left
-    out in words ("" when none is).
-
-    A pchip model needs a value at every (frequency, acceleration) pair (holes along fill are
-    filled). The value of either axis that lacks the largest share of its pairs is left out,
-    one at a time (of equal shares, the one with the fewest runs): a frequency run at one
-    acceleration only goes, the grid around it stays.
-    """
-    rows = table[np.isfinite(pd.to_numeric(table["sdc"], errors="coerce"))]
-    left = {"frequency_hz": [], "acceleration_g": []}
-    while True:
-        pairs = set(zip(rows["frequency_hz"], rows["acceleration_g"], strict=True))
-        axes = {"frequency_hz": sorted(set(rows["frequency_hz"])),
-                "acceleration_g": sorted(set(rows["acceleration_g"]))}
-        worst = None
-        for name, other in (("frequency_hz", "acceleration_g"),
-                            ("acceleration_g", "frequency_hz")):
-            for value in axes[name]:
-                missing = sum((value, o) not in pairs if name == "frequency_hz"
-                              else (o, value) not in pairs for o in axes[other])
-                if missing:
-                    rank = (missing / len(axes[other]), -int((rows[name] == value).sum()))
-                    if worst is None or rank > worst[0]:
-                        worst = (rank, name, value)
-        if worst is None:
-            break
-        _, name, value = worst
-        left[name].append(value)
-        rows = rows[rows[name] != value]
-    words = [f"{', '.join(f'{v:g}' for v in sorted(values))} {unit} (not run at every "
-             f"{other})" for values, unit, other in (
-                 (left["frequency_hz"], "Hz", "acceleration"),
-                 (left["acceleration_g"], "g", "frequency")) if values]
-    return rows, "; ".join(words)
 
 
 def filled_corners(model: object, point: tuple[float, float, float] | tuple[np.ndarray, ...]

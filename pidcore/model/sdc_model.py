@@ -610,6 +610,85 @@ class SdcModel:
         return t[t["filled"]].drop(columns="filled").reset_index(drop=True)
 
 
+def complete_grid(table: pd.DataFrame, value: str = "sdc") -> tuple[pd.DataFrame, str]:
+    """The rows of ``table`` (``frequency_hz``, ``acceleration_g``, ``value``) on the largest
+    frequency x acceleration grid every pair of which has a finite value at some fill, and the
+    values left out in words ("" when none is).
+
+    A pchip model needs a value at every (frequency, acceleration) pair (holes along fill are
+    filled). The value of either axis that lacks the largest share of its pairs is left out,
+    one at a time (of equal shares, the one with the fewest runs): a frequency run at one
+    acceleration only goes, the grid around it stays. The rows kept are every row at the
+    values kept, those without a finite value too: a run that gave none is a hole of the grid,
+    filled and flagged, as it is in a grid that needs nothing left out.
+    """
+    finite = np.isfinite(pd.to_numeric(table[value], errors="coerce"))
+    rows = table[finite]
+    left: dict[str, list[float]] = {"frequency_hz": [], "acceleration_g": []}
+    while True:
+        pairs = set(zip(rows["frequency_hz"], rows["acceleration_g"], strict=True))
+        axes = {"frequency_hz": sorted(set(rows["frequency_hz"])),
+                "acceleration_g": sorted(set(rows["acceleration_g"]))}
+        worst = None
+        for name, other in (("frequency_hz", "acceleration_g"),
+                            ("acceleration_g", "frequency_hz")):
+            for v in axes[name]:
+                missing = sum((v, o) not in pairs if name == "frequency_hz"
+                              else (o, v) not in pairs for o in axes[other])
+                if missing:
+                    rank = (missing / len(axes[other]), -int((rows[name] == v).sum()))
+                    if worst is None or rank > worst[0]:
+                        worst = (rank, name, v)
+        if worst is None:
+            break
+        _, name, v = worst
+        left[name].append(v)
+        rows = rows[rows[name] != v]
+    kept = table[~table["frequency_hz"].isin(left["frequency_hz"])
+                 & ~table["acceleration_g"].isin(left["acceleration_g"])]
+    words = [f"{', '.join(f'{v:g}' for v in sorted(values))} {unit} (not run at every "
+             f"{other})" for values, unit, other in (
+                 (left["frequency_hz"], "Hz", "acceleration"),
+                 (left["acceleration_g"], "g", "frequency")) if values]
+    return kept, "; ".join(words)
+
+
+def complete_grid_model(table: pd.DataFrame, *, value: str = "sdc", log_frequency: bool = False,
+                        source: str = "") -> tuple[SdcModel, pd.DataFrame, str]:
+    """(model, rows it is built on, values left out in words: "" where none is) of ``table``
+    over its complete frequency x acceleration grid (:func:`complete_grid`): the model of
+    every row where they make one (:meth:`SdcModel.from_table`), else that of the complete
+    grid, its ``source`` naming what was left out. The one rule of the report's model of
+    stored DEM runs and of ``pidcore model damper/figures --table store``: one run off the
+    grid (the app's DEM tab runs any case) refused the model of every other.
+
+    Where no complete grid is left to model either, the refusal names ``source`` and the
+    frequency x acceleration pairs without a value at any fill.
+    """
+    try:
+        return (SdcModel.from_table(table, value=value, log_frequency=log_frequency,
+                                    source=source), table, "")
+    except ParameterError as exc:
+        kept, left_out = complete_grid(table, value)
+        if not left_out:
+            raise
+        first = exc
+    named = f"{source}, the complete grid; left out: {left_out}"
+    try:
+        return (SdcModel.from_table(kept, value=value, log_frequency=log_frequency,
+                                    source=named), kept, left_out)
+    except ParameterError as exc:
+        why = str(exc).removeprefix(f"{named}: ")
+        finite = table[np.isfinite(pd.to_numeric(table[value], errors="coerce"))]
+        pairs = set(zip(finite["frequency_hz"], finite["acceleration_g"], strict=True))
+        missing = [f"{f:g} Hz, {a:g} g" for f in sorted(set(table["frequency_hz"]))
+                   for a in sorted(set(table["acceleration_g"])) if (f, a) not in pairs]
+        raise ParameterError(
+            f"{source or 'SDC table'}: no value at any fill at {'; '.join(missing)} (a pchip "
+            "model needs one at every frequency x acceleration pair), and no complete grid "
+            f"is left without {left_out}: {why}") from first
+
+
 #: Columns of stored DEM runs that define the simulated conditions besides the three axes.
 #: Runs differing in any of them are not averaged into one model.
 DEM_CONDITION_COLUMNS: tuple[str, ...] = (
