@@ -808,3 +808,38 @@ def test_a_material_given_with_the_vibrated_mass_is_said_to_set_only_its_unit_ch
     provenance = json.loads((tmp_path / "ac" / "equivalent_damper.json").read_text())[
         "provenance"]
     assert "particle_material_note" not in provenance
+
+
+def test_a_panel_lighter_than_its_own_particles_is_refused_naming_both(tmp_path):
+    # --panel-areal-mass 0.5 at 50 % fill was taken, though the paper coupon's particles alone
+    # are 441 x 18 acrylic spheres (r 1.25 mm, 1180 kg/m^3) over 0.01 m^2 = 7.66 kg/m^2: its
+    # panel_loss_factor was of a panel lighter than what it carries
+    sphere = 1180.0 * 4.0 / 3.0 * np.pi * 1.25e-3**3
+    carried = 441 * 18 * sphere / 0.01
+    argv = ["model", "damper", "--format", "csv", "--fills", "50", "--accelerations", "5",
+            "--frequencies", "100"]
+    with pytest.raises(ParameterError) as caught:
+        _run([*argv, "--out", str(tmp_path / "a"), "--panel-areal-mass", "0.5"])
+    assert str(caught.value) == (
+        "--panel-areal-mass 0.5 kg/m^2 is less than its particles' own 7.66 kg/m^2 at 50 % "
+        "fill (0.0766 kg in the coupon's 0.01 m^2 x treated fraction 1); expected the panel's "
+        "mass per m^2 with its particles")
+    assert not (tmp_path / "a").exists()
+    # the bound is the particles' own areal mass, x the share of the panel they fill: 1e-6
+    # either side of it (far from round-off, far inside any real panel's margin)
+    for fraction, mu, taken in ((1.0, carried * (1 + 1e-6), True),
+                                (1.0, carried * (1 - 1e-6), False),
+                                (0.5, carried / 2 * (1 + 1e-6), True),
+                                (0.5, carried / 2 * (1 - 1e-6), False)):
+        run = [*argv, "--out", str(tmp_path / "b"), "--panel-areal-mass", repr(mu),
+               "--panel-treated-fraction", repr(fraction)]
+        if taken:
+            assert _run(run) == 0
+        else:
+            with pytest.raises(ParameterError, match="less than its particles' own"):
+                _run(run)
+    # over the model's fills the panel is checked at the most (90 %: 441 x 32 spheres)
+    with pytest.raises(ParameterError) as caught:
+        _run(["model", "damper", "--out", str(tmp_path / "c"), "--panel-areal-mass", "8"])
+    assert (f"8 kg/m^2 is less than its particles' own {441 * 32 * sphere / 0.01:.3g} kg/m^2 "
+            "at 90 % fill, the most of the fills 25 .. 90 %") in str(caught.value)

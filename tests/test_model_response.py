@@ -685,3 +685,48 @@ def test_an_own_specimens_vibrated_mass_is_checked_against_its_own_masses(model,
             "particle per cell to its 7150 cells full, 46 tungsten_carbide particles each"
             in str(caught.value))
     assert str(caught.value).endswith("was it grams?")
+
+
+@pytest.mark.parametrize("typed", [2.0, 1.0])
+def test_a_structural_damping_ratio_of_critical_or_more_is_refused_as_a_percentage(mode, typed):
+    # structural_damping_ratio=2.0 ("2 %" typed for 0.02) was taken: an over-critical mode
+    # that does not resonate, damped 100 x too much
+    with pytest.raises(ParameterError) as caught:
+        dataclasses.replace(mode, structural_damping_ratio=typed)
+    assert str(caught.value) == (
+        f"TreatedMode: structural_damping_ratio {typed:g} is critical damping or more (no "
+        f"resonant mode); expected a fraction of critical, e.g. {typed / 100:g} for {typed:g} %")
+    assert dataclasses.replace(mode, structural_damping_ratio=0.999).structural_damping_ratio \
+        == 0.999
+
+
+def test_a_treated_area_whose_particles_outweigh_the_mode_100_times_is_refused(mode):
+    # treated_area_m2=500 (0.05 m^2 typed in cm^2) gave a c_pd 1e4 x too high: 3830 kg of the
+    # paper coupon's particles (441 x 18 acrylic spheres per 0.01 m^2 at 50 % fill) on a
+    # 2 kg mode
+    from pidcore.model.response import PARTICLE_TO_MODAL_MASS_LIMIT
+
+    sphere = 1180.0 * 4.0 / 3.0 * np.pi * 1.25e-3**3
+    areal = 441 * 18 * sphere / 0.01
+    with pytest.raises(ParameterError) as caught:
+        dataclasses.replace(mode, treated_area_m2=500.0)
+    message = str(caught.value)
+    assert message.startswith(
+        f"TreatedMode: treated_area_m2 500 m^2 carries {500 * areal:.3g} kg of particles at "
+        f"50 % fill ({areal:.3g} kg/m^2: the coupon's 0.0766 kg over its 0.01 m^2), "
+        f"{500 * areal / 2:.3g} x the modal mass 2 kg")
+    assert message.endswith("(was it cm^2?) and the modal mass in kg")
+    # the bound: the particles' modal mass, areal mass x sum A_i phi_i^2, at 100 x the modal
+    # mass; 1e-6 either side (far from round-off), one region at amplitude 1 and two at 1
+    # and 0.5 (sum A phi^2 = A (1 + 0.25) / 2)
+    edge = PARTICLE_TO_MODAL_MASS_LIMIT * 2.0 / areal
+    for area, regions in ((edge, ()), (edge / 0.625, "halves")):
+        for factor, taken in ((1 - 1e-6, True), (1 + 1e-6, False)):
+            a = area * factor
+            kw = dict(treated_area_m2=a, treated_regions=((a / 2, 1.0), (a / 2, 0.5))
+                      if regions else ())
+            if taken:
+                dataclasses.replace(mode, **kw)
+            else:
+                with pytest.raises(ParameterError, match="kg of particles"):
+                    dataclasses.replace(mode, **kw)

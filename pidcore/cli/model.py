@@ -115,7 +115,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help="mass per m^2 of your panel, with its particles, kg/m^2: adds "
                         "panel_loss_factor, the loss factor the particles add to it moving as "
                         "the coupon did (one amplitude everywhere; not a mode's); more than "
-                        "100 x outside the coupons' own m_c / area is refused as a unit slip")
+                        "100 x outside the coupons' own m_c / area is refused as a unit slip, "
+                        "and so is less than its particles' own mass per m^2 (the coupon's "
+                        "at the largest fill x --panel-treated-fraction)")
     d.add_argument("--panel-treated-fraction", metavar="F", type=_positive_float, default=None,
                    help="with --panel-areal-mass: share of the panel's area filled, in (0, 1] "
                         "(default 1)")
@@ -230,9 +232,11 @@ def run_damper(args: argparse.Namespace) -> int:
         check_area,
         equivalent_damper_table,
         paper_vibrated_mass,
+        runs_particles_mass,
         runs_specimen,
         runs_vibrated_mass,
         specimen_area_m2,
+        specimen_particles_mass,
         write_damper_table,
     )
 
@@ -361,7 +365,12 @@ def run_damper(args: argparse.Namespace) -> int:
             frequencies_hz=args.frequencies if args.frequencies else model.axes[2],
             vibrated_mass_kg=mass, area_m2=area, specimen=specimen,
             panel_areal_mass_kg_m2=args.panel_areal_mass,
-            panel_treated_fraction=args.panel_treated_fraction or 1.0)
+            panel_treated_fraction=args.panel_treated_fraction or 1.0,
+            # the particles the m_c holds: Table 3's count (of --material's spheres where
+            # --vibrated-mass gives m_c), or the runs' own
+            particles_mass_kg=specimen_particles_mass(
+                None, args.material or defaults.MODEL_PARTICLE_MATERIAL) if runs is None
+            else runs_particles_mass(runs))
     except ParameterError as exc:  # the option as typed, not the library's keyword
         raise ParameterError(str(exc).replace("panel_areal_mass_kg_m2", "--panel-areal-mass")
                              ) from None

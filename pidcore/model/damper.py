@@ -546,23 +546,34 @@ def paper_vibrated_mass(convention: str = D.MODEL_VIBRATED_MASS_CONVENTION,
     return mass
 
 
+def specimen_particles_mass(specimen: Specimen | None = None,
+                            material: str = D.MODEL_PARTICLE_MATERIAL
+                            ) -> Callable[[float], float]:
+    """The particles' mass [kg] in the whole coupon against fill [%]: the paper's coupon
+    (``specimen`` None or :meth:`~pidcore.specimen.Specimen.is_paper`) by Table 3's count of
+    ``material`` spheres (:func:`paper_particles_mass_kg`, the count its m_c holds), another
+    specimen's cells at its capacity as 100 % (the DEM's default fill reference,
+    :meth:`~pidcore.specimen.Specimen.capacity_per_cell`). Stored DEM runs:
+    :func:`runs_particles_mass`."""
+    if specimen is None or specimen.is_paper():
+        material = specimen.particles.material if specimen is not None else material
+        return lambda fill_percent: paper_particles_mass_kg(float(fill_percent), material)
+    from ..specimen import particles_for_fill
+
+    per_particle = specimen.cell.count * specimen.particles.mass_kg
+    full = specimen.capacity_per_cell()
+    return lambda fill_percent: per_particle * particles_for_fill(float(fill_percent), full)
+
+
 #: Columns of a DEM-run listing that fix m_c(fill) as the runs normalised their SDC.
 RUN_MASS_COLUMNS: tuple[str, ...] = (
     "vibrated_mass_convention", "coupon_mass_kg", "fixture_mass_kg", "coupon_cells",
     "particle_mass_kg", "particles_full_cell")
 
 
-def runs_vibrated_mass(runs: pd.DataFrame) -> Callable[[float], float]:
-    """m_c [kg] of Eq. 10 against fill [%], as the DEM runs of one specimen normalised their SDC.
-
-    c_eq = SDC m_c w / (2 pi) recovers the dissipated energy only with the m_c the SDC was
-    divided by. The runs' own specimen fixes it (their coupon and fixture masses, cell count,
-    particle mass and the count taken as 100 % fill); the result is checked against each
-    run's stored ``vibrated_mass_kg`` (a run of another specimen, or of a store written
-    before these columns meant what they mean now, is refused, not mixed in).
-    """
-    from ..specimen import particles_for_fill, vibrated_mass_by_convention
-
+def _runs_masses(runs: pd.DataFrame) -> tuple[str, float, float, int]:
+    """(m_c convention, coupon + fixture [kg], one particle in each cell [kg], particles
+    taken as 100 % fill) of the DEM runs of one specimen, from their stored columns."""
     missing = [c for c in (*RUN_MASS_COLUMNS, "fill_percent", "vibrated_mass_kg")
                if c not in runs.columns]
     if missing:
@@ -577,16 +588,39 @@ def runs_vibrated_mass(runs: pd.DataFrame) -> Callable[[float], float]:
                 "vibrated mass m_c needs the runs of one specimen (select with --where)")
         values[column] = distinct[0]
     convention = str(values["vibrated_mass_convention"])
-    rigid = float(values["coupon_mass_kg"]) + float(values["fixture_mass_kg"])
-    per_particle = int(values["coupon_cells"]) * float(values["particle_mass_kg"])
-    full = int(values["particles_full_cell"])
     if convention not in VIBRATED_MASS_CONVENTIONS:
         raise ParameterError(f"DEM runs: unknown vibrated_mass_convention {convention!r}")
+    return (convention, float(values["coupon_mass_kg"]) + float(values["fixture_mass_kg"]),
+            int(values["coupon_cells"]) * float(values["particle_mass_kg"]),
+            int(values["particles_full_cell"]))
+
+
+def runs_particles_mass(runs: pd.DataFrame) -> Callable[[float], float]:
+    """The particles' mass [kg] in the whole coupon against fill [%], as the DEM runs of one
+    specimen simulated it (their cell count, particle mass and count taken as 100 %)."""
+    from ..specimen import particles_for_fill
+
+    _, _, per_particle, full = _runs_masses(runs)
+    return lambda fill_percent: per_particle * particles_for_fill(float(fill_percent), full)
+
+
+def runs_vibrated_mass(runs: pd.DataFrame) -> Callable[[float], float]:
+    """m_c [kg] of Eq. 10 against fill [%], as the DEM runs of one specimen normalised their SDC.
+
+    c_eq = SDC m_c w / (2 pi) recovers the dissipated energy only with the m_c the SDC was
+    divided by. The runs' own specimen fixes it (their coupon and fixture masses, cell count,
+    particle mass and the count taken as 100 % fill); the result is checked against each
+    run's stored ``vibrated_mass_kg`` (a run of another specimen, or of a store written
+    before these columns meant what they mean now, is refused, not mixed in).
+    """
+    from ..specimen import vibrated_mass_by_convention
+
+    convention, rigid, _, _ = _runs_masses(runs)
+    particles = runs_particles_mass(runs)
 
     def mass(fill_percent: float) -> float:
-        return vibrated_mass_by_convention(
-            convention, rigid_kg=rigid,
-            particles_kg=per_particle * particles_for_fill(float(fill_percent), full))
+        return vibrated_mass_by_convention(convention, rigid_kg=rigid,
+                                           particles_kg=particles(fill_percent))
 
     stored = runs["vibrated_mass_kg"].to_numpy(float)
     rebuilt = np.array([mass(f) for f in runs["fill_percent"].to_numpy(float)])
@@ -610,6 +644,7 @@ def equivalent_damper_table(model: SdcModel, *, fills_percent: Sequence[float] |
                             clip_to_range: bool = False,
                             panel_areal_mass_kg_m2: float | None = None,
                             panel_treated_fraction: float = 1.0,
+                            particles_mass_kg: Callable[[float], float] | None = None,
                             fills: Sequence[float] | None = None,
                             accelerations: Sequence[float] | None = None,
                             frequencies: Sequence[float] | None = None) -> pd.DataFrame:
@@ -652,6 +687,12 @@ def equivalent_damper_table(model: SdcModel, *, fills_percent: Sequence[float] |
         unit slip (g/m^2 typed for kg/m^2).
     panel_treated_fraction : float
         The share of that panel's area filled (default 1: all of it), in (0, 1].
+    particles_mass_kg : callable, optional
+        The particles' mass [kg] in the coupon against fill [%] (default
+        :func:`specimen_particles_mass` of ``specimen``; for stored DEM runs
+        :func:`runs_particles_mass`): a ``panel_areal_mass_kg_m2`` below that mass over the
+        coupon area times ``panel_treated_fraction`` (a panel lighter than its own particles)
+        is refused, naming both.
     fills, accelerations, frequencies : sequence of float, optional
         The names of pidcore 0.2, without their units (a ``DeprecationWarning``); giving
         both names of one axis is refused.
@@ -746,6 +787,20 @@ def equivalent_damper_table(model: SdcModel, *, fills_percent: Sequence[float] |
                 f"panel_areal_mass_kg_m2 {mu:g} kg/m^2 is {mu / (high if mu > high else low):.3g}"
                 f" x the coupons' own areal mass ({low:.3g} .. {high:.3g} kg/m^2, m_c / "
                 f"coupon area); expected the panel's mass per m^2 in kg/m^2; {hint}")
+        # 0.5 kg/m^2 at 50 % fill was taken, though the particles alone are 7.66 kg per m^2
+        # of the paper coupon: its loss factor was of a panel lighter than what it carries
+        particles = particles_mass_kg or specimen_particles_mass(specimen)
+        fraction = float(panel_treated_fraction)
+        top = max(fills)  # the most particles: the areal mass grows with fill
+        carried = particles(top) / area * fraction
+        if mu < carried:
+            several = f", the most of the fills {_fills_text(fills)} %" if len(fills) > 1 else ""
+            raise ParameterError(
+                f"panel_areal_mass_kg_m2 {as_given(mu)} kg/m^2 is less than its particles' "
+                f"own {carried:.3g} kg/m^2 at {as_given(top)} % fill{several} "
+                f"({particles(top):.3g} kg in the coupon's {area:.4g} m^2 x treated fraction "
+                f"{fraction:g}); expected the panel's mass per m^2 with its particles"
+                + (", at the fills it holds" if several else ""))
         out["panel_areal_mass [kg/m^2]"] = mu
         out["panel_treated_fraction [-]"] = float(panel_treated_fraction)
         out["panel_loss_factor [-]"] = panel_loss_factor(

@@ -64,6 +64,7 @@ from .damper import (
     check_vibrated_mass,
     equivalent_damping_coefficient,
     specimen_area_m2,
+    specimen_particles_mass,
 )
 from .sdc_model import SdcModel
 
@@ -78,6 +79,12 @@ _ZERO_RESIDUAL = 1e-12
 _RANGE_RTOL = 1e-9
 #: Step in log(X) of the differences that judge a root's stability (pchip is smooth on it).
 _STABILITY_STEP = 1e-6
+#: Most the particles of the treated area may weigh in the mode (their mass per m^2 of coupon
+#: x sum A_i phi_i^2) against its modal mass before the area is refused as a unit slip: a mode
+#: carries its particles, and a modal mass given without them may be a few times lighter (2 mm
+#: tungsten carbide fills a 0.9 kg panel with 12 x its own mass), while cm^2 typed for m^2 is
+#: 1e4 x off (500 for 0.05 m^2: 3830 kg of the paper's particles on a 2 kg mode).
+PARTICLE_TO_MODAL_MASS_LIMIT = 100.0
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -91,10 +98,14 @@ class TreatedMode:
     modal_mass_kg : float
         Modal mass m [kg].
     structural_damping_ratio : float
-        Viscous damping ratio of the untreated mode zeta_s [-] (loss factor / 2 at resonance).
+        Viscous damping ratio of the untreated mode zeta_s [-] (loss factor / 2 at resonance),
+        in [0, 1): 1 or more (critical: no resonance; 2 for 2 % typed) is refused.
     treated_area_m2 : float
         Area A_t filled with particles [m^2]; without ``treated_regions`` all of it moves with
-        the modal coordinate.
+        the modal coordinate. One whose particles (the coupon's per m^2 of its face at
+        ``fill_percent``, :func:`~pidcore.model.damper.specimen_particles_mass`, x sum
+        A_i phi_i^2) weigh more than :data:`PARTICLE_TO_MODAL_MASS_LIMIT` x ``modal_mass_kg``
+        is refused as a unit slip (cm^2 typed for m^2).
     fill_percent : float
         Fill of the treated cells [%].
     coupon_vibrated_mass_kg : float
@@ -161,6 +172,14 @@ class TreatedMode:
         if not np.isfinite(self.structural_damping_ratio) or self.structural_damping_ratio < 0:
             raise ParameterError(f"TreatedMode: structural_damping_ratio must be >= 0, got "
                                  f"{self.structural_damping_ratio!r}")
+        if self.structural_damping_ratio >= 1:
+            # 2.0 (2 % typed as a percentage) was taken: an over-critical "mode" that does not
+            # resonate, its response 100 x damped
+            raise ParameterError(
+                f"TreatedMode: structural_damping_ratio {as_given(self.structural_damping_ratio)}"
+                " is critical damping or more (no resonant mode); expected a fraction of "
+                f"critical, e.g. {self.structural_damping_ratio / 100:g} for "
+                f"{as_given(self.structural_damping_ratio)} %")
         # 98.8 (g) for m_c = 0.0988 kg gave a c_pd 1000 x too large without a word, or a
         # refusal blaming the force; the damper table refused it
         check_vibrated_mass(self.coupon_vibrated_mass_kg, (self.fill_percent,),
@@ -170,6 +189,27 @@ class TreatedMode:
         # 100 (cm^2) for A_c = 0.01 m^2 gave a c_pd 1e4 x too small without a word
         check_area(self.coupon_area_m2, self.coupon_specimen or paper_specimen(),
                    "TreatedMode: coupon_area_m2")
+        self._check_particles_against_modal_mass()
+
+    def _check_particles_against_modal_mass(self) -> None:
+        """Refuse a treated area whose particles weigh more than
+        :data:`PARTICLE_TO_MODAL_MASS_LIMIT` times the modal mass in the mode: 500 (cm^2)
+        for A_t = 0.05 m^2 gave a c_pd 1e4 x too high without a word."""
+        particles = specimen_particles_mass(self.coupon_specimen)(self.fill_percent)
+        areal = particles / self.coupon_area_m2
+        modal = areal * math.fsum(a * phi**2 for a, phi in self.regions)
+        if modal <= PARTICLE_TO_MODAL_MASS_LIMIT * self.modal_mass_kg:
+            return
+        weighted = " (x phi_i^2 of treated_regions)" if self.treated_regions else ""
+        raise ParameterError(
+            f"TreatedMode: treated_area_m2 {as_given(self.treated_area_m2)} m^2 carries "
+            f"{modal:.3g} kg of particles{weighted} at {as_given(self.fill_percent)} % fill "
+            f"({areal:.3g} kg/m^2: the coupon's {particles:.3g} kg over its "
+            f"{self.coupon_area_m2:.4g} m^2), {modal / self.modal_mass_kg:.3g} x the modal mass "
+            f"{as_given(self.modal_mass_kg)} kg; a mode carries its particles (a modal mass "
+            f"given without them may be lighter, not {PARTICLE_TO_MODAL_MASS_LIMIT:g} x "
+            "lighter); expected the treated area in m^2 (was it cm^2?) and the modal mass "
+            "in kg")
 
     def _checked_regions(self) -> tuple[tuple[float, float], ...]:
         try:
