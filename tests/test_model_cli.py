@@ -843,3 +843,53 @@ def test_a_panel_lighter_than_its_own_particles_is_refused_naming_both(tmp_path)
         _run(["model", "damper", "--out", str(tmp_path / "c"), "--panel-areal-mass", "8"])
     assert (f"8 kg/m^2 is less than its particles' own {441 * 32 * sphere / 0.01:.3g} kg/m^2 "
             "at 90 % fill, the most of the fills 25 .. 90 %") in str(caught.value)
+
+
+def test_the_out_folder_holds_one_runs_outputs_alone_and_foreign_files_are_refused(
+        tmp_path, monkeypatch, capsys):
+    # `model damper --out DIR --format csv --fills 50` then `--format json --fills 75` left
+    # the 50 % CSV beside the 75 % JSON, and `model figures` of a 2-fill store left the
+    # paper's other fills' figures beside its own: each run replaces the folder's outputs whole
+    from matplotlib.figure import Figure
+
+    from pidcore.cli import main
+
+    out = tmp_path / "d"
+    grid = ["--accelerations", "5", "--frequencies", "100"]
+    assert main(["model", "damper", "--out", str(out), "--format", "csv", "--fills", "50",
+                 *grid]) == 0
+    assert main(["model", "damper", "--out", str(out), "--format", "json", "--fills", "75",
+                 *grid]) == 0
+    assert sorted(p.name for p in out.iterdir()) == ["equivalent_damper.json"]
+    records = json.loads((out / "equivalent_damper.json").read_text())["records"]
+    assert [r["packing ratio [%]"] for r in records] == [75.0]
+    # no build folder left beside it
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["d"]
+
+    monkeypatch.setattr(Figure, "savefig", lambda fig, target, **_: target.write(b"x"))
+    figures = tmp_path / "f"
+    assert main(["model", "figures", "--out", str(figures)]) == 0
+    assert len(list(figures.iterdir())) == 2 * (4 + 3)  # Table 3: 4 fills, 3 accelerations
+    two_fills = _specimen_runs("steel_6mm", "a" * 64, coupon_kg=0.05, fixture_kg=0.12,
+                               sdc_scale=0.5)
+    _fake_store(monkeypatch, lambda: two_fills[two_fills["fill_percent"].isin([25.0, 50.0])])
+    assert main(["model", "figures", "--out", str(figures), "--table", "store", "--store",
+                 str(tmp_path / "s.h5")]) == 0
+    assert sorted(p.name for p in figures.iterdir() if p.suffix == ".png") == [
+        "sdc_vs_acceleration_fill25.png", "sdc_vs_acceleration_fill50.png",
+        "sdc_vs_frequency_10g.png", "sdc_vs_frequency_1g.png", "sdc_vs_frequency_5g.png"]
+    capsys.readouterr()
+
+    # a file the command does not write is never deleted: the folder is refused, before any
+    # work, naming it; so is the other command's output
+    (out / "notes.txt").write_text("keep me")
+    assert main(["model", "damper", "--out", str(out), "--fills", "50", *grid]) == 2
+    assert capsys.readouterr().err == (
+        f"pidcore model damper: error: --out {out}: holds 'notes.txt', which pidcore model "
+        "damper does not write and replacing its earlier outputs whole would delete; move it "
+        "out or choose a new or empty folder for --out\n")
+    assert (out / "notes.txt").read_text() == "keep me"
+    assert (out / "equivalent_damper.json").is_file()
+    assert main(["model", "figures", "--out", str(tmp_path / "d")]) == 2
+    assert "holds 'equivalent_damper.json', which pidcore model figures does not write" \
+        in capsys.readouterr().err

@@ -2,7 +2,8 @@
 
 ``pidcore model damper --out DIR [--table paper|store] [--store FILE] [--format csv,json]``
 writes the equivalent-damper table; ``pidcore model figures --out DIR`` writes the SDC figure
-families (paper Figs. 8-14) as PNG and SVG. All logic is in :mod:`pidcore.model` and
+families (paper Figs. 8-14) as PNG and SVG. Each replaces its ``--out`` folder's outputs
+whole, as ``report --out`` does (:mod:`._out_folder`). All logic is in :mod:`pidcore.model` and
 :mod:`pidcore.report.figures`.
 """
 
@@ -17,6 +18,7 @@ from .. import defaults
 from ..constants import PARTICLE_MATERIALS, VIBRATED_MASS_CONVENTIONS
 from ..errors import ParameterError, as_given
 from ._options import add_store_option, check_out_folder, path_argument
+from ._out_folder import check_replaceable, write_folder_whole
 
 
 def _float_list(text: str) -> list[float]:
@@ -51,7 +53,9 @@ def _formats(text: str) -> list[str]:
 
 
 def _add_model_source(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--out", metavar="DIR", type=path_argument, required=True, help="output folder")
+    p.add_argument("--out", metavar="DIR", type=path_argument, required=True,
+                   help="output folder, its earlier outputs replaced whole (one holding other "
+                        "files is refused)")
     p.add_argument("--table", choices=("paper", "store"), default="paper",
                    help="SDC data: the paper's Table 3 DEM column or the store's DEM runs "
                         "(default paper)")
@@ -224,6 +228,24 @@ def _cli_where(message: str, where: dict) -> str:
     return message
 
 
+#: The files ``model damper`` writes into ``--out`` (:func:`write_damper_table`'s stem):
+#: the folder holds these alone, replaced whole by each run.
+DAMPER_STEM = "equivalent_damper"
+
+
+def _damper_file(name: str) -> bool:
+    return name in {f"{DAMPER_STEM}.csv", f"{DAMPER_STEM}.json"}
+
+
+def _figure_file(name: str) -> bool:
+    """A figure ``model figures`` writes (``sdc_vs_acceleration_fill50.png``,
+    ``sdc_vs_frequency_5g.svg``)."""
+    import re
+
+    return re.fullmatch(r"sdc_vs_(acceleration_fill|frequency_)[^/]*\.(png|svg)", name) \
+        is not None
+
+
 def run_damper(args: argparse.Namespace) -> int:
     from ..model.damper import (
         SDC_FILLED_COLUMN,
@@ -241,6 +263,9 @@ def run_damper(args: argparse.Namespace) -> int:
     )
 
     check_out_folder(args.out)
+    # a CSV of an earlier run at 50 % was left beside this run's JSON at 75 %: the folder is
+    # replaced whole, and one holding other files refused before any work
+    check_replaceable(args.out, _damper_file, "model damper")
     # the table takes a value typed twice once (equivalent_damper_table): said here
     for option in ("fills", "accelerations", "frequencies"):
         given = getattr(args, option)
@@ -411,7 +436,10 @@ def run_damper(args: argparse.Namespace) -> int:
            "would lose all its energy within a cycle): left empty")
     if undefined:
         provenance["damping_ratio"] = why
-    paths = write_damper_table(table, args.out, formats=args.format, provenance=provenance)
+    paths = write_folder_whole(
+        args.out, _damper_file, "model damper",
+        lambda folder: write_damper_table(table, folder, formats=args.format, stem=DAMPER_STEM,
+                                          provenance=provenance))
     for path in paths:
         print(path)
     print(f"pidcore model damper: note: coupon area {area_text}", file=sys.stderr)
@@ -464,6 +492,8 @@ def run_figures(args: argparse.Namespace) -> int:
     from ..report.figures import plot_sdc_vs_acceleration, plot_sdc_vs_frequency, save_figure
 
     check_out_folder(args.out)
+    # the figures of fills an earlier model had stayed beside this one's
+    check_replaceable(args.out, _figure_file, "model figures")
     if args.specimen is not None and args.table == "paper":
         raise ParameterError(f"--specimen {args.specimen}: selects DEM runs: use it with "
                              "--table store (--table paper draws the paper's coupon)")
@@ -476,13 +506,17 @@ def run_figures(args: argparse.Namespace) -> int:
 
     frequencies = curves(defaults.MODEL_FIGURE_FREQUENCIES_HZ, model.axes[2])
     fills = curves(defaults.MODEL_FIGURE_FILLS_PERCENT, model.axes[0])
-    paths = []
-    for fill in model.axes[0]:
-        fig = plot_sdc_vs_acceleration(model, fills=[fill], frequencies=frequencies)
-        paths += save_figure(fig, args.out, f"sdc_vs_acceleration_fill{fill:g}")
-    for acc in model.axes[1]:
-        fig = plot_sdc_vs_frequency(model, accelerations=[acc], fills=fills)
-        paths += save_figure(fig, args.out, f"sdc_vs_frequency_{acc:g}g")
+    def draw(folder: Path) -> list[Path]:
+        paths = []
+        for fill in model.axes[0]:
+            fig = plot_sdc_vs_acceleration(model, fills=[fill], frequencies=frequencies)
+            paths += save_figure(fig, folder, f"sdc_vs_acceleration_fill{fill:g}")
+        for acc in model.axes[1]:
+            fig = plot_sdc_vs_frequency(model, accelerations=[acc], fills=fills)
+            paths += save_figure(fig, folder, f"sdc_vs_frequency_{acc:g}g")
+        return paths
+
+    paths = write_folder_whole(args.out, _figure_file, "model figures", draw)
     for path in paths:
         print(path)
     return 0
