@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+import threading
+
 import numpy as np
 import pytest
 
 from pidcore.dem.simulate import DemConfig, LoadCase
-from pidcore.dem.sweep import GRIDS, grid_cases, run_key, run_sweep
+from pidcore.dem.sweep import GRIDS, grid_cases, run_case, run_key, run_sweep
 from pidcore.errors import ParameterError
 from pidcore.store import Store
 
@@ -259,6 +261,72 @@ def test_a_dask_worker_is_not_taken_for_the_scheduler_and_the_scheduler_is(tmp_p
         summary = run_sweep(CASES[:1], CONFIG, store_path=tmp_path / "s.h5",
                             scheduler=cluster.scheduler_address, progress=False)
     assert summary.completed == [run_key(CASES[0], CONFIG)]
+
+
+#: Set once the scheduler is gone: the cases after the first wait for it
+#: (:func:`_first_case_then_held`).
+_HELD = threading.Event()
+
+
+def _first_case_then_held(case, config, specimen=None):
+    """:func:`~pidcore.dem.sweep.run_case`, every case but the first only once :data:`_HELD`
+    is set, so that none of them can finish before the scheduler is gone however fast the
+    machine is (a function of the module: dask pickles it, by reference)."""
+    if case != CASES[0]:
+        _HELD.wait(60)
+    return run_case(case, config, specimen)
+
+
+@pytest.mark.timeout(120)  # dask's client tries to reconnect for 30 s: fail, not wait
+def test_a_scheduler_lost_mid_sweep_is_one_error_naming_it_and_the_runs_stored_are_kept(
+        tmp_path, monkeypatch):
+    """The dask scheduler killed after the first run was stored ended `pidcore dem sweep` with
+    dask's FutureCancelledError traceback (scheduler-connection-lost) and its logged ERROR,
+    exit 1, where a killed local worker is one line (exit 2) saying what is kept."""
+    import contextlib
+    import logging
+
+    import pidcore.dem.sweep as sweep_module
+    from pidcore.errors import SimulationError
+
+    distributed = pytest.importorskip("distributed")
+    _HELD.clear()
+    monkeypatch.setattr(sweep_module, "run_case", _first_case_then_held)
+    store = tmp_path / "s.h5"
+    seen: list[str] = []
+    # over TCP, as a real scheduler: the client's attempts to reconnect then fail as they do
+    # on a killed one (refused), and dask logged their end
+    cluster = distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
+                                       protocol="tcp", dashboard_address=None)
+    address = cluster.scheduler_address
+
+    def lose_the_scheduler(outcome) -> None:
+        seen.append(outcome.key)
+        # it drops the client's connection as a killed one does
+        cluster.sync(cluster.scheduler.close)
+
+    # dask's loggers write to the stderr they found when imported (not the test's): their
+    # records are read at the logger all of them hand theirs to
+    logged: list[logging.LogRecord] = []
+    catch = logging.Handler(logging.ERROR)
+    catch.emit = logged.append
+    logging.getLogger("distributed").addHandler(catch)
+    try:
+        with pytest.raises(SimulationError, match=f"^scheduler {address}: the connection to "
+                                                  "the dask.distributed scheduler was lost"):
+            run_sweep(CASES, CONFIG, store_path=store, scheduler=address, progress=False,
+                      on_case=lose_the_scheduler)
+    finally:
+        logging.getLogger("distributed").removeHandler(catch)
+        _HELD.set()
+        # a cluster whose scheduler is closed waits out dask's 30 s for it to say so
+        with contextlib.suppress(Exception):
+            cluster.close(timeout=2)
+    assert seen == [run_key(CASES[0], CONFIG)]
+    stored = Store(store)
+    assert stored.verify() == [] and list(stored.list_dem_runs()["case_key"]) == seen
+    # no ERROR of dask's (its client's reconnection, cancelled) after the CLI's one line
+    assert [record.getMessage() for record in logged] == []
 
 
 def test_a_killed_pool_worker_is_one_error_not_a_traceback():

@@ -17,6 +17,7 @@ import os
 import threading
 import time
 from collections.abc import Callable, Iterable, Iterator, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -669,6 +670,8 @@ def _cannot_connect(scheduler: str, error: BaseException) -> ParameterError:
 def _run_dask(todo: Iterable[tuple[LoadCase, str]], config: DemConfig, scheduler: str,
               finish: Callable[[CaseOutcome], None], specimen: Specimen | None) -> None:
     from distributed import Client, as_completed  # there: _check_scheduler asked it
+    from distributed.client import FutureCancelledError
+    from distributed.comm.core import CommClosedError
 
     try:
         client = Client(scheduler)
@@ -677,6 +680,7 @@ def _run_dask(todo: Iterable[tuple[LoadCase, str]], config: DemConfig, scheduler
     # as a traceback
     except Exception as exc:  # noqa: BLE001 - every failure to connect is one line
         raise _cannot_connect(scheduler, exc) from None
+    lost = False
     try:
         futures = [client.submit(run_case, case, config, specimen, key=f"pidcore-{key}",
                                  pure=False)
@@ -684,8 +688,53 @@ def _run_dask(todo: Iterable[tuple[LoadCase, str]], config: DemConfig, scheduler
         try:
             for future in as_completed(futures):
                 finish(future.result())
+        except (FutureCancelledError, CommClosedError) as exc:
+            if not _connection_lost(client, exc):
+                client.cancel(futures)
+                raise
+            # the scheduler stopped (killed, its machine gone) or the network failed: dask
+            # cancels every future with a two-line reason, which came out as a 65-line
+            # traceback and exit 1 saying nothing of the runs already stored
+            lost = True
+            raise SimulationError(
+                f"scheduler {scheduler}: the connection to the dask.distributed scheduler "
+                "was lost while the sweep ran (the scheduler stopped, or the network "
+                "failed?); the cases finished before are kept") from None
         except BaseException:
             client.cancel(futures)
             raise
     finally:
-        client.close()
+        if lost:
+            # closing ends the client's attempts to reconnect, which dask logs as an ERROR
+            # (asyncio's CancelledError with its traceback, or "Failed to reconnect") after
+            # the one line
+            with _distributed_silenced():
+                client.close()
+        else:
+            client.close()
+
+
+def _connection_lost(client, error: BaseException) -> bool:
+    """Whether ``error``, raised by a future of ``client``, is the lost connection to its
+    scheduler (dask's reason ``scheduler-connection-lost``, or the client no longer running),
+    not a cancellation of one run by someone else."""
+    return (getattr(error, "reason", None) == "scheduler-connection-lost"
+            or getattr(client, "status", "running") != "running")
+
+
+@contextmanager
+def _distributed_silenced() -> Iterator[None]:
+    """Drop every record of dask.distributed's loggers meanwhile (each set its own level, so
+    the parent's level does not reach them)."""
+    import logging
+
+    loggers = [logging.getLogger(name) for name in list(logging.root.manager.loggerDict)
+               if name == "distributed" or name.startswith("distributed.")]
+    was = [logger.disabled for logger in loggers]
+    for logger in loggers:
+        logger.disabled = True
+    try:
+        yield
+    finally:
+        for logger, disabled in zip(loggers, was, strict=True):
+            logger.disabled = disabled
