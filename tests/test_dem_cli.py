@@ -244,6 +244,48 @@ def test_sweep_json_names_the_unit_of_every_number(tmp_path, capsys):
         "wall_s": "s"}
 
 
+def test_sweep_states_each_cases_sdc_energy_balance_and_steady_state_as_dem_run_does(
+        tmp_path, capsys):
+    """A sweep's text output was one summary line (no SDC, energy balance or steady state of
+    any run) and its --json no energy_balance_error, where the README says every run reports
+    an energy balance. Each case's line must say what `dem run` says of the same stored run,
+    in its words."""
+    import re
+
+    store = tmp_path / "s.h5"
+    stored = ["--store", str(store), "--cells", "2", "--cycles", "2", "--no-progress"]
+    assert main(["dem", "run", "--frequency", "500", "--acceleration", "5", "--fill", "50",
+                 *stored]) == 0
+    said = capsys.readouterr().out.splitlines()
+    sdc = re.match(r"SDC +(.+?) \[-\]", next(line for line in said
+                                             if line.startswith("SDC "))).group(1)
+    assert "±" in sdc  # two cells: an SDC with its error
+    balance = next(line for line in said
+                   if line.startswith("energy balance ")).removeprefix("energy balance").strip()
+    steady = re.search(r"\((detected|NOT converged, transient cap)\)",
+                       next(line for line in said if line.startswith("steady state "))).group(1)
+    assert main(["dem", "run", "--frequency", "500", "--acceleration", "5", "--fill", "50",
+                 *stored, "--json"]) == 0  # the same run, reused
+    run_doc = json.loads(capsys.readouterr().out)
+    sweep = ["dem", "sweep", "--frequencies", "500,1000", "--accelerations", "5", "--fills",
+             "50", "--workers", "1", *stored]
+    assert main(sweep) == 0  # 500 Hz reused, 1000 Hz simulated now
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0] == (f"500 Hz, 5 g, fill 50 %: SDC {sdc} [-], energy balance {balance}, "
+                        f"steady state {steady} (reused: already stored)"), lines
+    assert re.fullmatch(r"1000 Hz, 5 g, fill 50 %: SDC \S+ ± \S+ \[-\], energy balance "
+                        r"closure error -?[0-9.]+%, steady state (detected|NOT converged, "
+                        r"transient cap) \(simulated now\)", lines[1]), lines
+    assert lines[2].startswith(f"1 case(s) simulated and saved, 1 already in {store}")
+    assert main([*sweep, "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    case = next(c for c in doc["cases"] if c["frequency_hz"] == 500)
+    # the stored run's own number, under dem run --json's name and unit
+    assert case["energy_balance_error"] == run_doc["energy_balance_error"]
+    assert doc["units"]["energy_balance_error"] == run_doc["units"]["energy_balance_error"]
+    assert all(isinstance(c["energy_balance_error"], float) for c in doc["cases"])
+
+
 def test_sweep_runs_the_values_given_in_place_of_the_grids(tmp_path, capsys):
     from pidcore.loadcase import parse_key
     from pidcore.store import Store
@@ -782,15 +824,18 @@ def test_sweep_says_what_it_saved_not_what_another_sweep_saved(tmp_path, monkeyp
 
     def stored_by_another(cases, config, *, store_path, specimen, **kwargs):
         return SweepSummary(skipped=["k"], store_path=str(store_path),
-                            cases=[{"store_key": "k", "status": STORED_MEANWHILE}])
+                            cases=[{"frequency_hz": 1000.0, "acceleration_g": 5.0,
+                                    "fill_percent": 25.0, "store_key": "k",
+                                    "status": STORED_MEANWHILE}])
 
     monkeypatch.setattr(pidcore.dem.sweep, "run_sweep", stored_by_another)
     store = tmp_path / "s.h5"
     assert main(["dem", "sweep", "--frequencies", "1000", "--accelerations", "5", "--fills",
                  "25", "--no-progress", "--store", str(store)]) == 0
-    out = capsys.readouterr().out
-    assert out.startswith(f"0 case(s) simulated and saved, 1 already in {store} (1 of them "
-                          "saved meanwhile by another process"), out
+    case, summary = capsys.readouterr().out.splitlines()
+    assert case.endswith(f"(reused: {STORED_MEANWHILE})"), case
+    assert summary.startswith(f"0 case(s) simulated and saved, 1 already in {store} (1 of "
+                              "them saved meanwhile by another process"), summary
 
 
 def test_a_far_too_short_time_step_is_refused_before_any_work(capsys, tmp_path):

@@ -298,13 +298,17 @@ def _sweep_specimens(cases: list[dict]) -> str:
 
 
 def _print_sweep(args: argparse.Namespace, summary) -> None:
-    """What a finished sweep did: its JSON document, or the counts and the cases it found
-    to be the same simulation as another."""
+    """What a finished sweep did: its JSON document, or each case's results (as ``dem run``
+    states them) and how its run was got, the counts, and the cases it found to be the same
+    simulation as another."""
     if args.json:
         print(json.dumps(summary.to_dict()))
     else:
         from ..dem.sweep import STORED_MEANWHILE
 
+        # a case each: the summary line alone gave no SDC, energy balance or steady state
+        for case in summary.cases:
+            print(_sweep_case_line(case))
         meanwhile = sum(case["status"] == STORED_MEANWHILE for case in summary.cases)
         # what this sweep saved: a run another process stored first is not counted as ours
         print(f"{len(summary.completed)} case(s) simulated and saved, {len(summary.skipped)} "
@@ -318,6 +322,44 @@ def _print_sweep(args: argparse.Namespace, summary) -> None:
                       f"{case['acceleration_g']:g} g): {case['status']} ("
                       f"{case.get('particles_per_cell', '?')} particles per cell, the same "
                       f"seed and settings), not simulated again: {case['store_key']}")
+
+
+def _sweep_case_line(case: dict) -> str:
+    """One case of a sweep (a dict of :attr:`~pidcore.dem.sweep.SweepSummary.cases`): its load
+    case, its stored run's SDC, energy balance and steady state in ``dem run``'s words, and
+    whether its run was simulated now or reused."""
+    how = ("simulated now" if case["status"] == "simulated" else
+           f"reused: {case['status']}")
+    where = (f"{case['frequency_hz']:g} Hz, {case['acceleration_g']:g} g, fill "
+             f"{case['fill_percent']:g} %: ")
+    if case.get("sdc") is None:  # not stored (a run stored without an SDC reads so too)
+        return f"{where}no stored result ({how})"
+    stderr, balance = case.get("sdc_stderr"), case.get("energy_balance_error")
+    steady = case.get("steady_detected")
+    return (where + f"SDC {_sdc_text(case['sdc'], stderr)} [-]"
+            # one cell, or cells of one motion (dem run's note says which)
+            + (" (no standard error)" if stderr is None else "") + ", energy balance "
+            + ("not stored" if balance is None else _balance_text(balance))
+            + ", steady state "
+            + ("not stored" if steady is None else _steady_text(steady)) + f" ({how})")
+
+
+def _sdc_text(sdc: float, stderr: float | None) -> str:
+    """An SDC with its standard error, as analyze and the app write them (the SDC alone where
+    it has none: one cell, one motion, or null in a document)."""
+    from ..units import display_value_with_error
+
+    return display_value_with_error(sdc, math.nan if stderr is None else stderr)
+
+
+def _balance_text(error: float) -> str:
+    """The energy balance's closure error (a ratio) in percent."""
+    return f"closure error {error:.2%}"
+
+
+def _steady_text(detected: bool) -> str:
+    """Whether a run's steady state was detected, or its transient hit the cap."""
+    return "detected" if detected else "NOT converged, transient cap"
 
 
 def _check_fill(fill: float, option: str, args: argparse.Namespace, specimen,
@@ -463,7 +505,6 @@ def format_summary(result, *, reused: bool = False) -> str:
     """Readable multi-line summary with units."""
     from ..dem.result import stderr_from_batches
     from ..specimen import filled_share, hashed_name
-    from ..units import display_value_with_error
 
     c = result.case
     s = result.specimen
@@ -488,7 +529,7 @@ def format_summary(result, *, reused: bool = False) -> str:
         ]
     lines += [
         # as analyze and the app write an SDC with its error (it printed 0.2635 +- 0.0038)
-        (f"SDC             {display_value_with_error(result.sdc, result.sdc_stderr)} [-] "
+        (f"SDC             {_sdc_text(result.sdc, result.sdc_stderr)} [-] "
          f"(loss factor "
          f"{result.loss_factor:.4g} [-]) over {result.cells_simulated} "
          f"{'cell' if result.cells_simulated == 1 else 'cells'}"
@@ -507,9 +548,9 @@ def format_summary(result, *, reused: bool = False) -> str:
         f"{result.energy_dissipated_rolling_j:.4g} J",
         f"E (Eq. 10)      {result.max_kinetic_energy_j:.4g} J with m_c = "
         f"{result.vibrated_mass_kg:.4g} kg ({result.config.vibrated_mass})",
-        f"energy balance  closure error {result.energy_balance_error:.2%}",
+        f"energy balance  {_balance_text(result.energy_balance_error)}",
         f"steady state    from cycle {result.steady_start_cycle} "
-        f"({'detected' if result.steady_detected else 'NOT converged, transient cap'}), "
+        f"({_steady_text(result.steady_detected)}), "
         f"{result.steady_cycles} cycles measured",
         f"model           friction {result.config.tangential_model}, normal damping "
         f"{result.config.normal_damping_mode}, start {result.config.start_packing} packing "

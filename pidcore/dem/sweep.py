@@ -344,6 +344,8 @@ SWEEP_CASE_STATUSES = ("simulated", "already stored",
 #: ``pidcore dem run --json`` names them, read from the stored run.
 SWEEP_CASE_FIELDS = ("sdc", "sdc_stderr", "sdc_stderr_dof", "loss_factor", "particles_per_cell",
                      "cells_simulated", "seed", "steady_detected",
+                     # the README's "every run reports an energy balance": a sweep's did not
+                     "energy_balance_error",
                      # whose run it is, as stored: --json named no specimen, so a sweep's
                      # document could not tell the runs of two files of one name apart
                      "specimen_name", "specimen_sha256")
