@@ -167,6 +167,14 @@ SCHEMA_VERSION = 1
 DEFAULT_TANGENTIAL_STIFFNESS_MODEL: TangentialStiffnessModel = "constant"
 #: The paper's coupon, bundled with the package.
 PAPER_SPECIMEN_NAME = "paper_coupon"
+#: What a specimen's sha256 (:attr:`Specimen.hash`) is of, and how to see it, for notes: it
+#: was said to be "its file's sha256" and runs reused "for the same file content", though
+#: ``sha256sum`` of the file gives another value and a comment or ``5e-2`` for ``0.050``
+#: changes no run.
+HASH_OF_WHAT = ("the sha256 of its canonical text: every value as resolved, its name and "
+                "description included; not comments, layout, number formatting (0.050 or "
+                "5e-2) or the file's name (pidcore specimen check FILE --json prints it as "
+                "sha256)")
 #: Largest specimen file read, bytes. A specimen is ~1 kB (the bundled files 1-2 kB with their
 #: comments); 256 KiB is a 3000-line file. Beyond it the file is not a specimen: a 4 MB file of
 #: one array took 12 s to parse before its key was refused, and /dev/zero was read until
@@ -1738,7 +1746,7 @@ def match_hashless_records(names: Sequence[object], sha256s: Sequence[object], *
             continue
         stored = files[n]
         mine = given.get(n, "")
-        how_many = f"{counts[n]} record(s) of specimen {n} saved without its file's sha256"
+        how_many = f"{counts[n]} record(s) of specimen {n} saved without its specimen's sha256"
         if len(stored) == 1 and mine in ("", stored[0]):
             out_hashes[i] = stored[0]
             notes[i] = (f"{how_many} (an older pidcore, or no file given) matched by name only "
@@ -1789,7 +1797,7 @@ def resolve_specimen_name(typed: str, known: Sequence[Specimen]) -> NamedSpecime
         labels = ", ".join(sorted(hashed_name(s.name, s.hash) for s in found.values()))
         return NamedSpecimen(typed, "", f"specimen {typed}: {len(found)} known files of that "
                              f"name ({labels}); saved by name only: name one as shown to "
-                             "save its file's sha256")
+                             "save its specimen's sha256")
     return NamedSpecimen(typed, "", f"specimen {typed}: no known specimen file of that name; "
                          "saved by name only (its DEM runs are met by name)")
 
@@ -2079,8 +2087,9 @@ def _capacity(shape: str, inscribed_diameter_m: float, height_m: float, radius_m
     return cell_capacity(cell_geometry(cell), radius_m)
 
 
-__all__ = ["CellSpec", "CouponSpec", "PairSpec", "PairsSpec", "ParticleSpec", "Specimen",
-           "ProvenanceSpec", "calibrated_name", "calibrated_provenance", "uncalibrated_name",
+__all__ = ["HASH_OF_WHAT", "CellSpec", "CouponSpec", "PairSpec", "PairsSpec", "ParticleSpec",
+           "Specimen", "ProvenanceSpec", "calibrated_name", "calibrated_provenance",
+           "uncalibrated_name",
            "cell_geometry", "column_note", "contact_law", "describe", "hashed_name",
            "heavy_fixture_note",
            "is_paper_coupon",

@@ -106,7 +106,7 @@ def test_a_run_of_another_file_as_given_is_still_another_file(variants, tmp_path
     met = runs_for_measurement(runs, "mycoupon", "acrylic", "z", mine.hash)
     assert met.runs is None
     assert (f"runs named mycoupon are of another file of that name than the test's (its "
-            f"specimen file's sha256 starts {mine.hash[:6]})") in met.note
+            f"specimen's sha256 starts {mine.hash[:6]})") in met.note
     assert "calibration variant" not in met.note
 
 

@@ -75,7 +75,7 @@ def test_a_hashless_record_joins_its_names_one_file_in_one_calibration_point(
     assert point.sdc == pytest.approx(sdc.mean(), rel=1e-12)
     assert point.sdc_stderr == pytest.approx(np.std(sdc, ddof=1) / math.sqrt(3), rel=1e-12)
     assert point.sdc_stderr_dof == 2
-    assert left_out == [f"1 record(s) of specimen panel saved without its file's sha256 (an "
+    assert left_out == [f"1 record(s) of specimen panel saved without its specimen's sha256 (an "
                         f"older pidcore, or no file given) matched by name only to panel "
                         f"[{first.hash[:6]}], the one file of that name its other tests "
                         "recorded"]
@@ -105,18 +105,18 @@ def test_a_hashless_record_of_a_name_of_two_files_is_kept_apart_and_said(
     assert hashless.specimen_ambiguous
     labels = sorted(f"panel [{h[:6]}]" for h in (first.hash, second.hash))
     assert len(left_out) == 1 and left_out[0].startswith(
-        "1 record(s) of specimen panel saved without its file's sha256 kept apart")
+        "1 record(s) of specimen panel saved without its specimen's sha256 kept apart")
     assert all(label in left_out[0] for label in labels)
     # a calibration of either file does not take it by its name
     kept, note = points_for_specimen(points, first)
     assert [p.specimen_sha256 for p in kept] == [first.hash]
-    assert "panel saved without its file's sha256 (the name means several files)" in note
+    assert "panel saved without its specimen's sha256 (the name means several files)" in note
     # nor does the library fit it when a script passes it (a second point of the case)
     from pidcore.calibrate.calibrate import check_point_specimens
     from pidcore.errors import ParameterError
 
     with pytest.raises(ParameterError, match=r"name specimen \"panel \(saved without its "
-                       r"file's sha256; several files of that name\)\", not 'panel'"):
+                       r"specimen's sha256; several files of that name\)\", not 'panel'"):
         check_point_specimens([by_hash[first.hash], hashless], first)
     check_point_specimens([by_hash[first.hash]], first)
     assert _digest(store) == before

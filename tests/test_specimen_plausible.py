@@ -260,8 +260,9 @@ def test_check_names_pairs_among_the_tables_and_says_what_the_hash_covers(tmp_pa
     assert "[particles], [pairs], [pairs.particle_particle]" in capsys.readouterr().err
     assert main(["specimen", "check", str(STEEL)]) == 0
     out = capsys.readouterr().out
-    assert ("(of every value, name and description included, but [coupon] face_area_m2, "
-            "which no DEM run simulates)") in out
+    assert ("starts the sha256 of its canonical text (of every value, name and description "
+            "included, but [coupon] face_area_m2, which no DEM run simulates; not of the file's "
+            "bytes") in out
 
 
 @pytest.mark.parametrize("cycles", [0, 10_001, 1_000_000_000])

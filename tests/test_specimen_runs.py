@@ -741,6 +741,32 @@ def test_dem_run_numerics_line_says_what_its_wall_time_and_rate_count(tmp_path, 
     assert int(steps) * 11 / float(rate) <= float(wall) + 0.05  # 0.05: the wall's 0.1 s print
 
 
+def test_a_specimens_sha256_is_of_its_canonical_text_not_the_files_bytes_as_the_docs_say(
+        tmp_path, capsys):
+    """README said each record keeps "its file's sha256" and a run is reused "for the same file
+    content": `sha256sum` of the file gives another value, and a comment, spacing, number
+    formatting or another file name change neither the hash nor which runs are reused."""
+    import hashlib
+
+    relaid = tmp_path / "another_name.toml"
+    relaid.write_text("# a comment of my own\n" + STEEL.read_text(encoding="utf-8")
+                      .replace("mass_kg = 0.0333", "mass_kg   =   3.33e-2")
+                      .replace("radius_m = 1.0e-3", "radius_m = 0.001"), encoding="utf-8")
+    steel, same = load_specimen(STEEL), load_specimen(relaid)
+    assert same.hash == steel.hash == hashlib.sha256(steel.text.encode("utf-8")).hexdigest()
+    # not the bytes' sha256 (what sha256sum prints), of either file
+    assert steel.hash not in {hashlib.sha256(path.read_bytes()).hexdigest()
+                              for path in (STEEL, relaid)}
+    # the command the words name prints it
+    assert main(["specimen", "check", str(relaid), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["sha256"] == steel.hash
+    readme = " ".join((REPO / "README.md").read_text(encoding="utf-8").split())
+    assert "its file's sha256" not in readme and "same file content" not in readme
+    assert ("The hash is that of the canonical text, not of the file's bytes (`sha256sum x.toml` "
+            "gives another value)") in readme
+    assert "`pidcore specimen check FILE --json` prints it (`sha256`)" in readme
+
+
 def test_runs_of_an_edited_file_of_the_same_name_are_said_not_reused(tmp_path, monkeypatch,
                                                                      capsys):
     # a specimen file edited after its runs were stored (even its description) is another
@@ -757,7 +783,11 @@ def test_runs_of_an_edited_file_of_the_same_name_are_said_not_reused(tmp_path, m
     note = persist.other_files_runs_note(store, [case], TINY, edited)
     assert note.startswith(f"{store} holds 1 run(s) of these load cases (seed 12345, 1 cells) "
                            f"by other files named steel_6mm (steel_6mm [{steel.hash[:6]}]:")
-    assert f"this file is steel_6mm [{edited.hash[:6]}] (any edit" in note
+    assert f"this file is steel_6mm [{edited.hash[:6]}] (any changed value" in note
+    # it said "reused only for the same file content", though the hash is of the canonical
+    # text (a comment or 5e-2 for 0.050 changes no run): what is hashed, and where to see it
+    assert "by the sha256 of its canonical text" in note and "file content" not in note
+    assert "pidcore specimen check FILE --json prints it" in note
     # nothing to say: the file's own run, another load case, another cell count, another name
     assert persist.other_files_runs_note(store, [case], TINY, steel) == ""
     assert persist.other_files_runs_note(

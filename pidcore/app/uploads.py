@@ -1112,7 +1112,7 @@ def save_records(path: str | os.PathLike, files: Sequence[AnalysedFile], *,
     Each file's own corrections are its analysis parameters (with its channel mapping); the
     load case fields (stated in the app; a file whose row states no fill is saved without a
     load case and a note says so, :func:`no_fill_note`) and the specimen (its name, and its
-    file's sha256 where known) go into its record. A file with plausibility warnings is
+    specimen's sha256 where known) go into its record. A file with plausibility warnings is
     only saved with ``confirm_implausible`` (the user's explicit confirmation). The notes say
     which saved record each byte-identical file replaces: :func:`pidcore.measure.save_analyses`,
     the save of ``pidcore analyze`` and ``pidcore report``, in the page's words

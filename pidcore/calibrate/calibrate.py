@@ -444,7 +444,8 @@ def check_point_specimens(points: Sequence[MeasuredPoint], specimen: Specimen) -
         if p.specimen_ambiguous:
             # its name is this file's and another's (match_hashless_records): by name it
             # was a second point of its load case beside this file's own tests
-            named = f"{p.specimen} (saved without its file's sha256; several files of that name)"
+            named = (f"{p.specimen} (saved without its specimen's sha256; several files of "
+                     "that name)")
             others.setdefault((p.source, named), []).append(p.row)
         elif of_another(p.specimen, p.specimen_sha256):
             named = p.specimen if not p.specimen_sha256 or p.specimen.endswith("]") \

@@ -591,7 +591,7 @@ def points_for_specimen(points: Sequence[MeasuredPoint], specimen) -> tuple[list
         elif p.specimen_ambiguous:
             # by name it is this file's, and just as much another's: fitted beside this
             # file's own tests it was a second point of one load case
-            label = (f"{p.specimen} saved without its file's sha256 (the name means several "
+            label = (f"{p.specimen} saved without its specimen's sha256 (the name means several "
                      "files)")
             other_specimen[label] = other_specimen.get(label, 0) + 1
         else:

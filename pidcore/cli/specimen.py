@@ -127,8 +127,9 @@ def format_facts(f: dict, source: str) -> str:
     # the label the app, reports and dem run/sweep show (16 hex digits here matched none)
     return "\n".join([
         f"specimen        {hashed_name(f['name'], f['sha256'])} ({source}): OK, {kind}; "
-        "[...] starts its sha256 (of every value, name and description included, but "
-        "[coupon] face_area_m2, which no DEM run simulates)",
+        "[...] starts the sha256 of its canonical text (of every value, name and description "
+        "included, but [coupon] face_area_m2, which no DEM run simulates; not of the file's "
+        "bytes: comments, layout and number formatting leave it; --json prints it whole)",
         *([f"calibrated from {hashed_name(f['calibrated_from_name'], f['calibrated_from_sha256'])}"
            ": the tests it models are that file's"]
           if f.get("calibrated_from_sha256") else []),

@@ -279,7 +279,7 @@ def _other_files_words(runs: pd.DataFrame, specimen: str, own_file: str) -> str:
                 f"sha256 starts {own_file[:6]}): another file of that name, or a "
                 "calibration's variants of one, stored before pidcore recorded which")
     return (f"runs named {specimen} are of another file of that name than the test's "
-            f"(its specimen file's sha256 starts {own_file[:6]})")
+            f"(its specimen's sha256 starts {own_file[:6]})")
 
 
 def runs_for_measurement(runs: pd.DataFrame | None, specimen: str, material: str,

@@ -28,7 +28,7 @@ import numpy as np
 from ..compare.align import CALIBRATION_VARIANT_FIELD, parameters_digest
 from ..errors import StoreError
 from ..loadcase import key_0_1
-from ..specimen import Specimen, hashed_name, is_paper_coupon, paper_specimen
+from ..specimen import HASH_OF_WHAT, Specimen, hashed_name, is_paper_coupon, paper_specimen
 from .result import UNITS, DemResult
 from .simulate import (
     DemConfig,
@@ -431,9 +431,10 @@ def other_files_runs_note(store_path: str | os.PathLike[str], cases: Iterable[Lo
     other specimen files of ``specimen``'s name (an edited ``x.toml``, or a calibration's
     design points): "" where it holds none.
 
-    A run is reused only for the same file content (:attr:`Specimen.hash`), so a file edited
-    after its runs were stored, even its description, simulates every case again; ``dem
-    run`` and ``dem sweep`` did so saying "0 already in STORE", as if the store held none."""
+    A run is reused only for the same specimen (:attr:`Specimen.hash`, of its canonical text:
+    :data:`~pidcore.specimen.HASH_OF_WHAT`), so a file whose values, name or description
+    changed after its runs were stored simulates every case again; ``dem run`` and ``dem
+    sweep`` did so saying "0 already in STORE", as if the store held none."""
     from ..store import Store
 
     cases = list(cases)
@@ -471,9 +472,9 @@ def other_files_runs_note(store_path: str | os.PathLike[str], cases: Iterable[Lo
                                 "points"))
     return (f"{store_path} holds {len(others)} run(s) of these load cases (seed {config.seed}, "
             f"{config.cells} cells) {whose} named {own.name} ({files}: {origin}); "
-            f"not reused: a run is reused only for the same file content, and this file is "
-            f"{hashed_name(own.name, own.hash)} (any edit, its description too, makes another "
-            "specimen)")
+            f"not reused: a run is reused only for the same specimen, by {HASH_OF_WHAT}; this "
+            f"file is {hashed_name(own.name, own.hash)} (any changed value, its description "
+            "too, makes another specimen)")
 
 
 __all__ = ["DEM_CODE_VERSION", "cached_run", "CachedRun", "dem_run_entry", "load_dem_result",

@@ -68,7 +68,7 @@ def _settings_editor(measurements, tables: dict[str, pd.DataFrame], channel_name
                      "DEM runs (own specimens)"),
             "specimen": st.column_config.TextColumn(
                 help="a specimen file's name (or 'name [3e945a]' where two files share it), "
-                     "as the DEM tab offers them: saved with the file's sha256; another name "
+                     "as the DEM tab offers them: saved with the specimen's sha256; another name "
                      "is saved by name only"),
             "direction": st.column_config.SelectboxColumn(options=list(DRIVE_DIRECTIONS),
                                                           required=True),
