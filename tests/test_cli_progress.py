@@ -95,7 +95,8 @@ def test_a_scheduler_address_dask_cannot_use_is_one_line_exit_2(tmp_path, capsys
     traceback and exit 1."""
     pytest.importorskip("distributed")
     store = tmp_path / "s.h5"
-    code = main([*SWEEP, "--no-progress", "--scheduler", "tls://127.0.0.1:1",
+    # without --workers, which is refused beside --scheduler
+    code = main([*SWEEP[:-2], "--no-progress", "--scheduler", "tls://127.0.0.1:1",
                  "--store", str(store)])
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 2

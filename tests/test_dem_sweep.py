@@ -185,6 +185,40 @@ def test_an_unreachable_scheduler_is_one_line_exit_2_and_nothing_stored(tmp_path
     assert not store.exists() or not Store(store).list_dem_runs().shape[0]
 
 
+def test_local_workers_given_with_a_scheduler_are_refused_in_one_line_before_anything(
+        tmp_path, capsys):
+    """`dem sweep --workers 2 --scheduler ADDR` ran on the cluster and ignored --workers
+    without a word."""
+    import contextlib
+
+    from pidcore.cli import main
+
+    store = tmp_path / "s.h5"
+    # the refusal needs no dask; the old code went on to the (absent) scheduler: refused
+    # within 1 s for another reason (or for want of dask)
+    try:
+        import dask
+    except ImportError:
+        quick = contextlib.nullcontext()
+    else:
+        quick = dask.config.set({"distributed.comm.timeouts.connect": "1s"})
+    with quick:
+        code = main(["dem", "sweep", "--frequencies", "1000", "--accelerations", "5",
+                     "--fills", "25", "--cells", "1", "--cycles", "2", "--no-progress",
+                     "--workers", "2", "--scheduler", "tcp://127.0.0.1:1",
+                     "--store", str(store)])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2
+    assert len(err) == 1 and err[0].startswith("pidcore dem sweep: error: --workers 2: "), err
+    assert "tcp://127.0.0.1:1" in err[0] and err[0].endswith("not both"), err
+    assert not store.exists()
+    # a library caller is refused so too
+    with pytest.raises(ParameterError, match="^workers 1: .* not both$"):
+        run_sweep(CASES[:1], CONFIG, store_path=store, workers=1,
+                  scheduler="tcp://127.0.0.1:1", progress=False)
+    assert not store.exists()
+
+
 def _listener(reply: bytes | None) -> int:
     """Port of a local TCP listener that accepts every connection and sends ``reply`` to
     each (then closes it), or nothing ever (``None``: the connections are held open)."""

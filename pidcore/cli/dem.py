@@ -160,7 +160,7 @@ def _register_sweep(sub: argparse._SubParsersAction) -> None:
                                if flag == "--fills" else ""))
     _add_config_options(p)
     p.add_argument("--workers", metavar="N", type=positive_int, default=None,
-                   help="local processes (default: all cores)")
+                   help="local processes (default: all cores); not with --scheduler")
     p.add_argument("--scheduler", metavar="ADDR", type=scheduler_address, default=None,
                    help="dask.distributed scheduler address (needs the 'distributed' extra)")
     add_store_option(p)
@@ -223,10 +223,18 @@ def _interrupted(command: str, saved: int, store, *, left: int = 1) -> int:
 def sweep(args: argparse.Namespace) -> int:
     from ..dem.persist import run_key, stored_keys
     from ..dem.simulate import check_drive
-    from ..dem.sweep import cross_cases, grid_axes, run_sweep, sweep_fills
+    from ..dem.sweep import (
+        check_workers_or_scheduler,
+        cross_cases,
+        grid_axes,
+        run_sweep,
+        sweep_fills,
+    )
     from ..loadcase import parse_values
     from ..specimen import fill_override_note
 
+    # before any note or file is read: its one line alone
+    check_workers_or_scheduler(args.workers, args.scheduler)
     axes = grid_axes(args.grid)
     values = [axes[axis] if given is None else parse_values(given, name=flag)
               for axis, given, flag in (("frequency_hz", args.frequencies, "--frequencies"),

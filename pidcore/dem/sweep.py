@@ -429,7 +429,8 @@ def run_sweep(cases: Sequence[LoadCase], config: DemConfig, *,
     store_path : path
         HDF5 store; finished cases found there are skipped (resume).
     workers : int, optional
-        Local processes (default: all cores). Ignored with ``scheduler``.
+        Local processes (default: all cores). Refused with ``scheduler``
+        (:func:`check_workers_or_scheduler`).
     scheduler : str, optional
         Address of a dask.distributed scheduler (``tcp://host:8786``); needs the
         ``distributed`` extra. Refused (:class:`ParameterError`) unless a scheduler answers
@@ -458,6 +459,7 @@ def run_sweep(cases: Sequence[LoadCase], config: DemConfig, *,
                 hint="read a file with pidcore.specimen.load_specimen(path)")
     if workers is not None and whole_number("workers", workers) < 1:
         raise ParameterError(f"workers: expected a positive number of processes, got {workers}")
+    check_workers_or_scheduler(workers, scheduler)
     start = time.perf_counter()
     store = Store(store_path)
     summary = SweepSummary(store_path=str(Path(store_path)))
@@ -549,6 +551,16 @@ def run_sweep(cases: Sequence[LoadCase], config: DemConfig, *,
         summary.wall_s = time.perf_counter() - start
     summary.fill_results(store)
     return summary
+
+
+def check_workers_or_scheduler(workers: int | None, scheduler: str | None) -> None:
+    """Refuse a number of local ``workers`` given with a ``scheduler``: the cluster's workers
+    run the cases, and the number was ignored without a word (``dem sweep --workers 2
+    --scheduler ADDR``)."""
+    if workers is not None and scheduler:
+        raise ParameterError(f"workers {workers}: a number of local processes, which a sweep "
+                             f"on the dask.distributed scheduler {scheduler} does not use (its "
+                             "cluster's workers run the cases); give one of them, not both")
 
 
 def _stored_meanwhile(summary: SweepSummary, key: str) -> None:
