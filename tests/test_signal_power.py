@@ -318,6 +318,28 @@ def test_too_few_periods_for_blocks_gives_nan_with_note():
     assert res.to_dict()["sdc_stderr"] is None
 
 
+@pytest.mark.parametrize("fs, f, periods", [(5120.0, 440.0, 12.4), (5120.0, 965.0, 14.3)])
+def test_blocks_shorter_than_the_fits_parameters_give_no_standard_error_not_a_crash(
+        fs, f, periods):
+    """One period of 11.6 (5.3) samples holds fewer than the 12 (6) parameters of the blocks'
+    fit (5 (2) harmonics, DC and trend): its phasors were NaN, and comparing their reactive
+    power ended in an IndexError. The result stands, without a standard error, saying why;
+    noise-free, its loss factor is the analytic c / (m w) to the fit's round-off (1e-9 is
+    far above it and far below any real error)."""
+    m, eta = 0.1, 0.05
+    w = 2 * np.pi * f
+    t = np.arange(int(periods * fs / f)) / fs
+    v = 5 * G / w * np.cos(w * t)
+    force = -m * 5 * G * np.sin(w * t) + eta * m * w * v
+    res = analyze_power(force, v, fs)
+    n_harm = int(0.9 * 0.5 * fs / f)
+    assert math.isnan(res.loss_factor_stderr) and res.n_blocks == 0
+    assert res.uncertainty_note.startswith(
+        f"no standard error: blocks of {int(fs / f)} samples")
+    assert f"fit's {2 * n_harm + 2} parameters" in res.uncertainty_note
+    assert res.loss_factor == pytest.approx(eta, abs=1e-9)
+
+
 def test_block_that_is_not_mass_like_gives_nan_with_note():
     # 40 periods in 8 blocks; the first 5 periods are a stiff spring (Im(P) < 0), the rest a
     # mass with a damper, so the record as a whole is mass-like. The first block's loss

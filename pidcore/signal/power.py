@@ -682,6 +682,16 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
         edges = np.append(edges.astype(np.int64), n_samples) if edges[-1] < n_samples else \
             edges.astype(np.int64)
         uncertainty_note = ""
+        # a block of fewer samples than the fit's parameters (harmonics, DC and trend) has no
+        # phasors (NaN): one period of 11.6 samples at 5 harmonics holds 11 for 12
+        shortest = int(np.min(np.diff(edges[:k_blocks + 1])))
+        if shortest < 2 * n_harm + 2:
+            edges = np.array([0, n_samples], dtype=np.int64)
+            uncertainty_note = (f"no standard error: blocks of {shortest} samples "
+                                f"({per_block} period(s) each of {k_blocks}) hold fewer than "
+                                f"the fit's {2 * n_harm + 2} parameters ({n_harm} harmonics, DC "
+                                "and trend)")
+            k_blocks = 0
     else:
         edges = np.array([0, n_samples], dtype=np.int64)
         uncertainty_note = (f"no standard error: {whole} whole periods cannot make "
@@ -764,7 +774,7 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
         else:
             # such a block is not mass-like (a transient, a resonance passed): its loss
             # factor means nothing, and a scatter taken over it would be a wrong error bar
-            bad = int(np.flatnonzero(p_blocks.imag <= 0)[0])
+            bad = int(np.flatnonzero(~(p_blocks.imag > 0))[0])
             uncertainty_note = (f"no standard error: block {bad + 1} of {k_blocks} has "
                                 "reactive power Im(P) <= 0")
     zeta, zeta_note = _damping_ratio(sdc, loss)
