@@ -77,7 +77,7 @@ from ..errors import ChannelError, ParameterError, SignalError, as_given, real_n
 from ..loop import ForceDisplacementLoop
 from ..records import Channel
 from . import validate
-from .frequency import estimate_drive_frequency
+from .frequency import estimate_drive_frequency, refine_frequency
 from .harmonics import fit_harmonics
 
 
@@ -501,6 +501,50 @@ def _check_acceleration_sign(acceleration_phasor: complex, velocity_phasor: comp
         "inverted channel (or the vibrometer delay is far from corrected)")
 
 
+def _check_stationary_drive(motion: np.ndarray, block_phasors: np.ndarray, edges: np.ndarray,
+                            sample_rate_hz: float, frequency_hz: float, *, what: str) -> str:
+    """Refuse a drive whose frequency moves over the record (a slow sweep, a controller hunting),
+    or return a note where it moves less but beyond noise ("" where it does not).
+
+    The phasors of the record are one fit at one frequency; a drive line whose phase moves
+    between the blocks adds up incoherently in it, so the acceleration and the energy per
+    cycle came out low without a word (a 0.3 % sweep over 2 s at 500 Hz: 23 % and 40 % low),
+    and a faster sweep was refused as a purely resistive load. ``block_phasors`` (blocks,
+    harmonics) are the motion channel's in the blocks of the standard error: the loss is
+    ``1 - |mean of the fundamentals| / mean of their amplitudes``, which an amplitude change
+    alone (a beat) leaves at 0. Noise makes some: a block of L samples with residual variance
+    s^2 scatters its phasor by ``4 s^2 / L`` relative to |V_1|^2, and the loss is about a
+    quarter of that; the residual is each block's variance less its harmonics' power."""
+    fundamentals = block_phasors[:, 0]
+    amplitudes = np.abs(fundamentals)
+    if fundamentals.size < 2 or not np.all(amplitudes > 0):
+        return ""
+    mean_amplitude = float(np.mean(amplitudes))
+    loss = 1.0 - float(abs(np.mean(fundamentals))) / mean_amplitude
+    if loss <= defaults.DRIVE_COHERENCE_NOTED_LOSS:
+        return ""
+    scatter = []
+    for b in range(fundamentals.size):
+        block = motion[edges[b]:edges[b + 1]]
+        residual = float(np.var(block)) - 0.5 * float(np.sum(np.abs(block_phasors[b]) ** 2))
+        scatter.append(4 * max(residual, 0.0) / (block.size * amplitudes[b] ** 2))
+    # the median: a block the drive has left (a fast sweep) holds its power in its residual
+    if loss <= defaults.DRIVE_PHASE_NOISE_FACTOR * float(np.median(scatter)):
+        return ""
+    first, last = (refine_frequency(motion[edges[i]:edges[i + 1]], sample_rate_hz, frequency_hz)
+                   for i in (0, fundamentals.size - 1))
+    said = (f"the drive line's phase moves between the {fundamentals.size} blocks of the record "
+            f"(from {first:.6g} Hz in the first to {last:.6g} Hz in the last), which takes "
+            f"{100 * loss:.3g} % or more off the fitted amplitude at {frequency_hz:.6g} Hz and "
+            "twice that off the energy per cycle (the loss factor, a ratio, keeps)")
+    if loss <= defaults.DRIVE_COHERENCE_MAX_LOSS:
+        return f"drive frequency not quite stationary: {said}"
+    raise SignalError(
+        f"{what}: drive frequency not stationary: {said}; "
+        f"{100 * defaults.DRIVE_COHERENCE_MAX_LOSS:g} % allowed: analyse a stretch at "
+        "constant frequency")
+
+
 def _drift_knots(whole: int, n_samples: int, sample_rate_hz: float,
                  frequency_hz: float) -> np.ndarray | None:
     """Knots of the drift's cubic spline: every ``DRIFT_KNOT_PERIODS`` whole periods, the
@@ -708,6 +752,9 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
                       f"{defaults.DRIFT_KNOT_PERIODS}, so a slow wander that is not linear over "
                       "the record is not removed")
     fit = fit_harmonics(f_data, motion, theta, n_harm, edges, drift_knots=drift_knots)
+    stationary_note = (_check_stationary_drive(motion, fit.phasors[1, :k_blocks], edges,
+                                               sample_rate_hz, freq, what=what)
+                       if k_blocks else "")
     a_fit = None
     if acc_data is not None and velocity is not None:
         a_fit = fit_harmonics(acc_data, None, theta, n_harm, edges, drift_knots=drift_knots)
@@ -826,7 +873,7 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
         uncertainty_note=uncertainty_note,
         corrections=corrections,
         notes=tuple(n for n in (zeta_note, uncertainty_note, baseline_note, drift_note,
-                                harmonics_note, delay_note) if n),
+                                harmonics_note, delay_note, stationary_note) if n),
     )
 
 
