@@ -403,3 +403,31 @@ def test_the_paper_curve_of_a_case_within_tolerance_of_a_grid_point_is_that_poin
     by_fill = dict(zip(printed["fill_percent"], printed["sdc_dem"], strict=True))
     assert (comp.model_sdc[0], comp.model_sdc[-1]) == pytest.approx(
         (by_fill[25.0], by_fill[90.0]), rel=1e-12)
+
+
+@pytest.mark.parametrize("quantity", ["acceleration", "displacement"])
+def test_a_velocity_channel_holding_another_quantity_is_named_before_the_sign_or_delay(
+        quantity):
+    """A rigid 0.1 kg mass at 500 Hz, loss factor 0.05, whose 'Velocity [m/s]' column holds
+    its acceleration (read inverted, as --invert after the first refusal) or displacement:
+    P turns by 90 degrees, a loss factor of -1/0.05 = -20, which was refused as 'a vibrometer
+    delay of about 484 µs'. The vibrated mass Im(P)/(w |V|^2 / 2) is then eta m / w = 1.6 mg
+    or eta m w = 15.7 kg, off the paper coupon's by far more than the factor 20 allowed: the
+    first finding, the one a refusal names, is that unit slip."""
+    from pidcore.compare.plausibility import sdc_bound
+
+    f, m, eta = 500.0, 0.1, 0.05
+    w = 2 * math.pi * f
+    t = np.arange(20000) / 51200.0
+    v = 5 * 9.80665 / w * np.cos(w * t)
+    force = -m * 5 * 9.80665 * np.sin(w * t) + eta * m * w * v
+    motion = (5 * 9.80665 * np.sin(w * t) if quantity == "acceleration"  # -a
+              else 5 * 9.80665 / w**2 * np.sin(w * t))  # x
+    csv = "Time [s],Force [N],Velocity [m/s]\n" + "".join(
+        f"{a:.17g},{b:.17g},{c:.17g}\n" for a, b, c in zip(t, force, motion, strict=True))
+    analysis = _analysis(csv.encode()).analysis
+    assert analysis.loss_factor == pytest.approx(-1 / eta, rel=1e-6)
+    found = check_analysis(analysis, bound=sdc_bound(fill_percent=50.0))
+    assert found[0].check == "vibrated_mass_off"
+    assert "negative_loss_factor" in [w.check for w in found[1:]]
+    assert "a velocity channel that holds an acceleration or a displacement" in str(found[0])

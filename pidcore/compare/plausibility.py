@@ -254,6 +254,39 @@ def check_analysis(analysis, *, bound: SdcBound | None = None
     sdc = float(analysis.sdc)
     omega = float(analysis.omega_rad_s)
     out = []
+    # first: a velocity channel that holds an acceleration or a displacement (m/s^2 or m
+    # under "m/s") shows a vibrated mass off by omega, and turns the phase by 90 degrees,
+    # which the sign and phase findings below would take for an inverted channel or a
+    # vibrometer delay (a "loss factor -20" explained by "a delay of 484 µs more"): the
+    # refusal names the first finding, so the quantity or unit slip comes first
+    vibrated_kg = _vibrated_mass_kg(analysis)
+    if math.isfinite(bound.structure_mass_kg) and math.isfinite(vibrated_kg):
+        # the Eq. 11 loss factor is a ratio and survives a force or velocity channel in
+        # another unit than its header says; the energy per cycle (Eq. 10, the like-for-like
+        # comparison with the DEM) does not: a force in kN under "N" pooled SDCs 1000 x apart.
+        # The vibrated mass Im(P_c) shows is then 1000 x off what the specimen can show
+        low = bound.structure_mass_kg / VIBRATED_MASS_SLIP_FACTOR
+        # without the fill, the particles' mass is at most a full cell's
+        stated = math.isfinite(bound.particle_mass_kg)
+        particles = bound.particle_mass_kg if stated else bound.full_particle_mass_kg
+        high = (bound.structure_mass_kg + particles) * VIBRATED_MASS_SLIP_FACTOR
+        if vibrated_kg < low or vibrated_kg > high:
+            out.append(PlausibilityWarning(
+                "vibrated_mass_off",
+                f"the vibrated mass the record shows, Im(P_c)/(omega |V|^2/2) = "
+                f"{vibrated_kg * 1e3:.4g} g, is "
+                + (f"below 1/{VIBRATED_MASS_SLIP_FACTOR:g} of the specimen's coupon and "
+                   f"fixture ({bound.structure_mass_kg * 1e3:.4g} g)" if vibrated_kg < low else
+                   f"over {VIBRATED_MASS_SLIP_FACTOR:g} x the specimen's coupon, fixture and "
+                   + ("particles" if stated else "particles of full cells (no fill stated)")
+                   + f" ({(high / VIBRATED_MASS_SLIP_FACTOR) * 1e3:.4g} g)"),
+                "a force, velocity or time in another unit than its header says (kN under "
+                "'N', mm/s under 'm/s', ms under 's': check the channel units or give "
+                "force_unit=UNIT, velocity_unit=UNIT or time_unit=UNIT), or another "
+                "specimen than the one assumed; or a velocity channel that holds an "
+                "acceleration or a displacement (its vibrated mass is then omega times off, "
+                "and its loss factor about -1/eta: no vibrometer delay or inverted channel "
+                "mends it)"))
     if p.imag < 0:
         phase = math.degrees(math.atan2(p.imag, p.real))
         out.append(PlausibilityWarning(
@@ -286,31 +319,6 @@ def check_analysis(analysis, *, bound: SdcBound | None = None
                           "the loss factor to zero")
         out.append(PlausibilityWarning("negative_loss_factor",
                                        f"negative loss factor {eta:.4g} (SDC {sdc:.4g})", cause))
-    vibrated_kg = _vibrated_mass_kg(analysis)
-    if math.isfinite(bound.structure_mass_kg) and math.isfinite(vibrated_kg):
-        # the Eq. 11 loss factor is a ratio and survives a force or velocity channel in
-        # another unit than its header says; the energy per cycle (Eq. 10, the like-for-like
-        # comparison with the DEM) does not: a force in kN under "N" pooled SDCs 1000 x apart.
-        # The vibrated mass Im(P_c) shows is then 1000 x off what the specimen can show
-        low = bound.structure_mass_kg / VIBRATED_MASS_SLIP_FACTOR
-        # without the fill, the particles' mass is at most a full cell's
-        stated = math.isfinite(bound.particle_mass_kg)
-        particles = bound.particle_mass_kg if stated else bound.full_particle_mass_kg
-        high = (bound.structure_mass_kg + particles) * VIBRATED_MASS_SLIP_FACTOR
-        if vibrated_kg < low or vibrated_kg > high:
-            out.append(PlausibilityWarning(
-                "vibrated_mass_off",
-                f"the vibrated mass the record shows, Im(P_c)/(omega |V|^2/2) = "
-                f"{vibrated_kg * 1e3:.4g} g, is "
-                + (f"below 1/{VIBRATED_MASS_SLIP_FACTOR:g} of the specimen's coupon and "
-                   f"fixture ({bound.structure_mass_kg * 1e3:.4g} g)" if vibrated_kg < low else
-                   f"over {VIBRATED_MASS_SLIP_FACTOR:g} x the specimen's coupon, fixture and "
-                   + ("particles" if stated else "particles of full cells (no fill stated)")
-                   + f" ({(high / VIBRATED_MASS_SLIP_FACTOR) * 1e3:.4g} g)"),
-                "a force, velocity or time in another unit than its header says (kN under "
-                "'N', mm/s under 'm/s', ms under 's': check the channel units or give "
-                "force_unit=UNIT, velocity_unit=UNIT or time_unit=UNIT), or another "
-                "specimen than the one assumed"))
     if math.isfinite(sdc) and sdc > bound.sdc:
         out.append(PlausibilityWarning(
             "sdc_above_bound", f"SDC {sdc:.4g} is above {bound.words(eta)}",
