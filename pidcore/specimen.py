@@ -91,6 +91,8 @@ is_paper_coupon, measured_specimen_name, models_paper_coupon, hashed_name, teste
     file's name with its hash, ``"name [45d792]"``, and a test's saved specimen so labelled.
 tabulated_by_paper
     Whether Table 3 is compared with a specimen file's tests (as with a row of them).
+HASH_OF_WHAT
+    What a specimen's sha256 is of (its canonical text, not the file's bytes), for notes.
 measured_specimen_sha256, MEASURED_SHA256_FIELD, deciding_sha256, same_tested_file
     The file's hash saved beside that name (record field ``specimen_sha256``), and how a
     measurement's recorded hash meets a DEM run's or a calibration's: by hash where both
@@ -173,7 +175,7 @@ PAPER_SPECIMEN_NAME = "paper_coupon"
 #: changes no run.
 HASH_OF_WHAT = ("the sha256 of its canonical text: every value as resolved, its name and "
                 "description included; not comments, layout, number formatting (0.050 or "
-                "5e-2) or the file's name (pidcore specimen check FILE --json prints it as "
+                "5e-2) or the file's name (the JSON of pidcore specimen check prints it as "
                 "sha256)")
 #: Largest specimen file read, bytes. A specimen is ~1 kB (the bundled files 1-2 kB with their
 #: comments); 256 KiB is a 3000-line file. Beyond it the file is not a specimen: a 4 MB file of

@@ -787,7 +787,7 @@ def test_runs_of_an_edited_file_of_the_same_name_are_said_not_reused(tmp_path, m
     # it said "reused only for the same file content", though the hash is of the canonical
     # text (a comment or 5e-2 for 0.050 changes no run): what is hashed, and where to see it
     assert "by the sha256 of its canonical text" in note and "file content" not in note
-    assert "pidcore specimen check FILE --json prints it" in note
+    assert "the JSON of pidcore specimen check prints it" in note
     # nothing to say: the file's own run, another load case, another cell count, another name
     assert persist.other_files_runs_note(store, [case], TINY, steel) == ""
     assert persist.other_files_runs_note(
