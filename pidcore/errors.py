@@ -22,6 +22,8 @@ InputFileError, ChannelError, SignalError, ParameterError
     What was wrong: the file, a channel, the record, a parameter.
 SettingsTableError, StoreError, SimulationError
     A settings table (sidecar), the store, a DEM run.
+DependencyError
+    An installed library older than pidcore needs (the installation, not the user's data).
 whole_number, real_number, instance_of, as_given
     The checks of a value's type, and a number shown as the user gave it.
 clipped
@@ -70,6 +72,12 @@ class StoreError(PidcoreError):
 
 class SimulationError(PidcoreError):
     """A DEM run became unphysical (excess overlap, particle escaped) or was refused."""
+
+
+class DependencyError(PidcoreError):
+    """An installed library lacks what pidcore calls (older than pidcore's requirement): the
+    message names the library, its version and the version needed, so that an installation
+    is not blamed on the user's file."""
 
 
 def as_given(value: float) -> str:
@@ -230,7 +238,7 @@ KEYWORD_NOT_BEFORE = r"(?<![\w'=-])(?<!\] )(?<!column )(?<!attribute )(?<!field 
 KEYWORD_NOT_AFTER_WORD = r"(?![\w'])(?! column)"
 
 
-__all__ = ["ChannelError", "InputFileError", "KEYWORD_NOT_AFTER_WORD", "KEYWORD_NOT_BEFORE",
-           "ParameterError", "PidcoreError",
+__all__ = ["ChannelError", "DependencyError", "InputFileError", "KEYWORD_NOT_AFTER_WORD",
+           "KEYWORD_NOT_BEFORE", "ParameterError", "PidcoreError",
            "SettingsTableError", "SignalError", "SimulationError", "StoreError", "as_given",
            "clipped", "instance_of", "outside_user_names", "real_number", "whole_number"]

@@ -511,3 +511,44 @@ def test_a_58b_id_line_counting_more_bytes_than_num_pts_samples_is_refused(tmp_p
     with pytest.raises(InputFileError, match=rf"more\.uff: record 1 holds {_N + 3} samples "
                                              rf"where its header states {_N} "):
         read_measurement(bad)
+
+
+@pytest.mark.parametrize("binary", [True, False], ids=["58b", "ASCII 58"])
+def test_a_pyuff_without_header_only_is_named_as_the_installation_not_a_corrupt_file(
+        tmp_path, monkeypatch, binary):
+    # pyuff 2.4 to 2.4.4: _extract58 takes no header_only, and a sound 58b export was refused
+    # as "dataset 58 (block 1) is corrupt (_extract58() got an unexpected keyword argument
+    # 'header_only')", blaming the user's file for pidcore's dependency
+    import pyuff
+    from pyuff.datasets import dataset_58
+
+    from pidcore.errors import DependencyError
+
+    real = dataset_58._extract58
+
+    def extract58_of_pyuff_2_4_4(block_data):  # that release's signature
+        return real(block_data)
+
+    path = tmp_path / "sound.uff"
+    write_measurement(_measurement(), path, "uff", binary=binary)
+    monkeypatch.setattr(dataset_58, "_extract58", extract58_of_pyuff_2_4_4)
+    monkeypatch.setattr(pyuff, "__version__", "2.4.4")
+    with pytest.raises(DependencyError) as info:
+        read_measurement(path)
+    said = str(info.value)
+    assert said == (f"{path}: not read: pyuff 2.4.4 does not support reading a dataset 58 "
+                    "header alone (_extract58's header_only); pidcore needs pyuff >= 2.4.5 "
+                    "(pip install 'pyuff>=2.4.5')"), said
+    assert not isinstance(info.value, InputFileError)  # not counted among unreadable files
+
+
+def test_the_pyuff_bound_pidcore_states_is_the_first_release_its_reader_runs_on():
+    # pyproject.toml asked for pyuff>=2.4, whose 2.4 to 2.4.4 lack _extract58's header_only
+    import tomllib
+    from pathlib import Path
+
+    from pidcore.io.uff import PYUFF_MIN_VERSION
+
+    project = tomllib.loads((Path(__file__).parents[1] / "pyproject.toml").read_text())
+    assert f"pyuff>={PYUFF_MIN_VERSION}" in project["project"]["dependencies"]
+    assert PYUFF_MIN_VERSION == "2.4.5"

@@ -47,7 +47,7 @@ import pyuff
 
 from ..atomic_files import atomic_path
 from ..constants import SI_UNITS
-from ..errors import InputFileError, ParameterError, a_or_an
+from ..errors import DependencyError, InputFileError, ParameterError, a_or_an
 from ..records import Channel, Measurement
 from ..units import (
     UnitReading,
@@ -380,6 +380,30 @@ def _utf8_text(raw: bytes) -> str:
         return raw.decode("cp1252", errors="replace")
 
 
+#: The first pyuff whose ``_extract58`` parses a dataset 58 header alone (``header_only``),
+#: which both record readers below call: pyproject.toml's lower bound of pyuff.
+PYUFF_MIN_VERSION = "2.4.5"
+
+
+def _header_58(header: bytes) -> dict:
+    """A dataset 58 record's header fields, parsed by pyuff's ``_extract58`` alone (no data).
+
+    Its ``header_only`` keyword is pyuff's since 2.4.5: with an older pyuff the call raised a
+    TypeError, which the reader reported as the user's file being corrupt. The keyword is
+    looked for first, so that a TypeError of pyuff's parsing itself still reads as a bad
+    record."""
+    import inspect
+
+    from pyuff.datasets.dataset_58 import _extract58
+
+    if "header_only" not in inspect.signature(_extract58).parameters:
+        raise DependencyError(
+            f"pyuff {getattr(pyuff, '__version__', '(version unknown)')} does not support "
+            "reading a dataset 58 header alone (_extract58's header_only); pidcore needs "
+            f"pyuff >= {PYUFF_MIN_VERSION} (pip install 'pyuff>={PYUFF_MIN_VERSION}')")
+    return _extract58(_utf8_header(header), header_only=True)
+
+
 def _binary_58_record(path: str | os.PathLike[str], start: int, end: int) -> dict | None:
     """The dataset 58b record whose block starts at byte ``start`` and whose closing
     ``'    -1'`` is at byte ``end``: its header parsed by pyuff, its samples read straight
@@ -392,15 +416,13 @@ def _binary_58_record(path: str | os.PathLike[str], start: int, end: int) -> dic
     the abscissa as a second float64 array: reading a 10-minute export of two channels at
     51.2 kHz (469 MiB of samples) took 2.9 GiB and 2.5 minutes.
     """
-    from pyuff.datasets.dataset_58 import _extract58
-
     with open(path, "rb") as fh:
         fh.seek(start)
         header = b"".join(fh.readline() for _ in range(_HEADER_LINES_58))
         lines = header.splitlines()
         if len(lines) < _HEADER_LINES_58 or lines[1][6:7].lower() != b"b":
             return None
-        dset = _extract58(_utf8_header(header), header_only=True)
+        dset = _header_58(header)
         dtype = _BINARY_DTYPES.get((int(dset.get("ord_data_type", 0)),
                                     int(dset.get("byte_ordering", 0))))
         num_pts = int(dset.get("num_pts", 0))
@@ -485,8 +507,6 @@ def _ascii_58_record(path: str | os.PathLike[str], first: int, last: int) -> dic
     of Python floats: some 5x the block, 13x the samples of an E20.12 record, beside the
     channels read before it.
     """
-    from pyuff.datasets.dataset_58 import _extract58
-
     with open(path, "rb") as fh:
         fh.seek(first)
         header = b"".join(fh.readline() for _ in range(_HEADER_LINES_58))
@@ -497,7 +517,7 @@ def _ascii_58_record(path: str | os.PathLike[str], first: int, last: int) -> dic
                 or lines[1][6:7].lower() == b"b" or len(header.decode(
                     "utf-8", "replace").splitlines(True)) != _HEADER_LINES_58:
             return None
-        dset = _extract58(_utf8_header(header), header_only=True)
+        dset = _header_58(header)
         width = _ASCII_58_WIDTHS.get(int(dset.get("ord_data_type", 0)))
         if width is None or int(dset.get("abscissa_spacing", 0)) != 1:
             return None
@@ -625,6 +645,8 @@ def read_uff(path: str | os.PathLike[str], *, time_unit: str | None = None) -> M
                                         int(uff._block_ind[i][1]))
             if dset is None:
                 dset = uff.read_sets(i)
+        except DependencyError as exc:  # the installation, not this file: said as such
+            raise DependencyError(f"{where}: not read: {exc}") from None
         except Exception as exc:
             reraise_interrupt(exc)
             raw = Path(path).read_bytes()
