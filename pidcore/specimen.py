@@ -83,8 +83,10 @@ addressable by a dotted path (``"pairs.particle_wall.static_friction"``, ``"part
 Public API
 ----------
 load_specimen, paper_specimen, Specimen
-    A specimen from a TOML file, the bundled paper coupon; ``Specimen.from_text``,
-    ``with_values``, ``to_toml``, ``capacity_per_cell``.
+    A specimen from a TOML file (or a bundled one by its name), the bundled paper coupon;
+    ``Specimen.from_text``, ``with_values``, ``to_toml``, ``capacity_per_cell``.
+bundled_specimen_names
+    The specimen files bundled with the package, which :func:`load_specimen` takes by name.
 is_paper_coupon, measured_specimen_name, models_paper_coupon, hashed_name, tested_label
     Whether a specimen (by hash, else by name) is the paper's coupon: the one rule; the name
     a measurement of a specimen file is saved under; whether a file models the coupon; a
@@ -1449,6 +1451,10 @@ def _finish_calibration_moves(path: Path) -> str:
 def load_specimen(path: str | os.PathLike[str]) -> Specimen:
     """Read and check a specimen file; a bad file is one ParameterError line naming it.
 
+    A bare name of a bundled specimen (``paper_coupon``: :func:`bundled_specimen_names`) where
+    no file of that name exists is that bundled file, the note saying so (below); a file of
+    that name is read as any other.
+
     A calibrated specimen file (``calibrated_specimen.toml`` of ``pidcore calibrate --out``)
     whose calibration was killed while its outputs were moved into the folder is read after
     those moves are finished, as the calibration's readers do: the file is then the same
@@ -1457,13 +1463,40 @@ def load_specimen(path: str | os.PathLike[str]) -> Specimen:
     folder where they cannot be finished (read-only) is refused (ParameterError).
     """
     path = Path(path)
-    note = _finish_calibration_moves(path)
-    specimen = _read_specimen_file(path)
+    bundled = _bundled_in_place_of(path)
+    if bundled is not None:
+        note = (f"specimen {str(path)!r}: no file of that name in the current folder; the "
+                f"bundled specimen {path.name} is taken ({bundled})")
+        specimen = _read_specimen_file(bundled)
+    else:
+        note = _finish_calibration_moves(path)
+        specimen = _read_specimen_file(path)
     if not note:
         return specimen
     for hear in _READ_NOTE_HEARERS.get():
         hear(note)
     return dataclasses.replace(specimen, read_note=note)
+
+
+def _bundled_folder() -> Path:
+    """Where the specimen files bundled with the package lie (site-packages once installed)."""
+    return Path(str(resources.files("pidcore") / "data" / "specimens"))
+
+
+def bundled_specimen_names() -> tuple[str, ...]:
+    """The names of the specimen files bundled with the package (``paper_coupon``), each of
+    which :func:`load_specimen` takes by its name alone where no file of that name exists."""
+    return tuple(sorted(p.stem for p in _bundled_folder().glob("*.toml")))
+
+
+def _bundled_in_place_of(path: Path) -> Path | None:
+    """The bundled file a bare ``path`` names (``paper_coupon``: its folder is site-packages
+    once installed, which no user types); None where a file or folder of that name exists (a
+    path given always wins) or the path has a folder or suffix of its own."""
+    if path.parent != Path(".") or path.suffix or path.exists() \
+            or path.name not in bundled_specimen_names():
+        return None
+    return _bundled_folder() / f"{path.name}.toml"
 
 
 def _read_specimen_file(path: Path) -> Specimen:
@@ -1473,14 +1506,19 @@ def _read_specimen_file(path: Path) -> Specimen:
             # device or pipe that never ends is not read to the end
             data = file.read(MAX_SPECIMEN_FILE_BYTES + 1)
     except OSError as exc:
-        raise ParameterError(f"{path}: cannot read specimen file ({exc.strerror})") from None
+        # the bundled files lie in site-packages once installed: a name that is not one of
+        # them learns which are and where
+        bundled = (f"; a bundled specimen is taken by its name alone "
+                   f"({', '.join(bundled_specimen_names())}, in {_bundled_folder()})"
+                   if isinstance(exc, FileNotFoundError) else "")
+        raise ParameterError(f"{path}: cannot read specimen file ({exc.strerror})"
+                             f"{bundled}") from None
     return Specimen.from_bytes(data, source=str(path))
 
 
 @functools.cache
 def _paper_text() -> str:
-    ref = resources.files("pidcore") / "data" / "specimens" / f"{PAPER_SPECIMEN_NAME}.toml"
-    return ref.read_text(encoding="utf-8")
+    return (_bundled_folder() / f"{PAPER_SPECIMEN_NAME}.toml").read_text(encoding="utf-8")
 
 
 @functools.cache
@@ -2096,7 +2134,8 @@ __all__ = ["HASH_OF_WHAT", "CellSpec", "CouponSpec", "PairSpec", "PairsSpec", "P
            "heavy_fixture_note",
            "is_paper_coupon",
            "tested_label",
-           "load_specimen", "hearing_read_notes", "CALIBRATED_SPECIMEN_FILE",
+           "load_specimen", "bundled_specimen_names", "hearing_read_notes",
+           "CALIBRATED_SPECIMEN_FILE",
            "finish_calibration_moves",
            "MEASURED_SHA256_FIELD", "deciding_sha256", "measured_specimen_name",
            "measured_specimen_sha256", "models_paper_coupon", "NamedSpecimen",

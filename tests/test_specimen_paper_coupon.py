@@ -4,6 +4,7 @@ DEM runs, measurements and specimen files, by hash where the content is known, e
 from __future__ import annotations
 
 import dataclasses
+import json
 import math
 import re
 from pathlib import Path
@@ -567,3 +568,62 @@ def test_a_report_of_a_calibrated_file_and_a_row_of_its_tests_agree_on_table3(
         assert all(math.isnan(v) for v in (row_dem, row_measured, file_dem, file_measured))
         assert f"specimen {name} is not the paper's coupon" in row_note
         assert f"note: specimen {name} is not the paper's coupon" in said
+
+
+BUNDLED = Path(__file__).resolve().parents[1] / "pidcore" / "data" / "specimens"
+
+
+def test_the_bundled_coupon_is_named_by_its_name_where_no_file_of_that_name_exists(
+        tmp_path, monkeypatch, capsys):
+    # `pidcore specimen check paper_coupon` was "cannot read specimen file (No such file or
+    # directory)": after a wheel install the file lies in site-packages alone
+    monkeypatch.chdir(tmp_path)
+    named = load_specimen("paper_coupon")
+    # the bundled file itself: the same canonical text (its sha256), face area included
+    assert named == PAPER and named.hash == PAPER.hash and named.is_paper()
+    assert named.source == str(BUNDLED / "paper_coupon.toml")
+    assert named.read_note == ("specimen 'paper_coupon': no file of that name in the current "
+                               "folder; the bundled specimen paper_coupon is taken "
+                               f"({BUNDLED / 'paper_coupon.toml'})")
+    assert main(["specimen", "check", "paper_coupon"]) == 0
+    said = capsys.readouterr()
+    assert said.err == f"pidcore specimen check: note: {named.read_note}\n"
+    assert said.out.startswith(f"specimen        paper_coupon [{PAPER.hash[:6]}] "
+                               f"({BUNDLED / 'paper_coupon.toml'}): OK, the paper's coupon")
+
+
+def test_a_file_of_a_bundled_specimens_name_is_read_as_given(tmp_path, monkeypatch):
+    # a path given always wins: a file named paper_coupon in the current folder is that file
+    monkeypatch.chdir(tmp_path)
+    steel = REPO / "data_samples" / "specimens" / "steel_6mm.toml"
+    Path("paper_coupon").write_bytes(steel.read_bytes())
+    given = load_specimen("paper_coupon")
+    assert given.hash == load_specimen(steel).hash != PAPER.hash
+    assert given.source == "paper_coupon" and given.read_note == ""
+
+
+def test_a_missing_specimen_file_is_refused_naming_the_bundled_specimens_and_where(
+        tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    for typed in ("paper_coupn", "specimens/paper_coupon", "paper_coupon.toml"):
+        assert main(["specimen", "check", typed]) == 2
+        assert capsys.readouterr().err == (
+            f"pidcore specimen check: error: {typed}: cannot read specimen file (No such file "
+            f"or directory); a bundled specimen is taken by its name alone (paper_coupon, in "
+            f"{BUNDLED})\n")
+
+
+def test_dem_run_by_the_bundled_name_is_the_run_of_the_bundled_file(tmp_path, monkeypatch,
+                                                                     capsys):
+    # the one loader every --specimen goes through: named, the run is the file's, reused
+    monkeypatch.chdir(tmp_path)
+    common = ["dem", "run", "--frequency", "1000", "--acceleration", "5", "--cells", "1",
+              "--fill", "50", "--cycles", "4", "--no-progress", "--json", "--store", "s.h5"]
+    assert main([*common, "--specimen", str(BUNDLED / "paper_coupon.toml")]) == 0
+    by_path = json.loads(capsys.readouterr().out)
+    assert main([*common, "--specimen", "paper_coupon"]) == 0
+    said = capsys.readouterr()
+    by_name = json.loads(said.out)
+    assert by_name["reused_from_store"] is True and by_path["reused_from_store"] is False
+    assert by_name["store_key"] == by_path["store_key"] and by_name["sdc"] == by_path["sdc"]
+    assert "the bundled specimen paper_coupon is taken" in said.err

@@ -74,12 +74,14 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 def run_check(args: argparse.Namespace) -> int:
     from ..specimen import describe, load_specimen
 
-    facts = describe(load_specimen(args.file), damping_mode=args.damping_mode)
+    specimen = load_specimen(args.file)
+    facts = describe(specimen, damping_mode=args.damping_mode)
     facts["notes"] = [cli_words(note, "specimen check") for note in facts["notes"]]
     if args.json:
         print(json.dumps(facts))
         return 0
-    print(format_facts(facts, str(args.file)))
+    # the file read: a bundled specimen named by its name alone is read from site-packages
+    print(format_facts(facts, specimen.source))
     return 0
 
 
