@@ -136,6 +136,25 @@ def test_a_store_of_several_calibrations_needs_a_key(calibrated, capsys, tmp_pat
     assert not out.exists()
 
 
+def test_the_report_command_calibrate_prints_names_a_store_of_any_name_as_one_word(
+        calibrated, capsys, tmp_path):
+    # `report --calibration store % [1].h5 --calibration-key ...` was printed bare: pasted,
+    # the shell split the path into three words and globbed the brackets
+    import re
+    import shlex
+
+    folder, store = calibrated
+    copy = tmp_path / "store % [1].h5"
+    copy.write_bytes(store.read_bytes())
+    said = _calibrate(folder, copy, "0.3", capsys)
+    new_key = (set(Store(copy).list_calibrations()["key"])
+               - {Store(store).list_calibrations()["key"].iloc[0]}).pop()
+    (line,) = re.findall(r"\((pidcore report [^()]*)\)$", said, re.M)
+    # the shell's reading of the printed line is the command that reads the new calibration
+    assert shlex.split(line) == ["pidcore", "report", "--calibration", str(copy),
+                                 "--calibration-key", new_key]
+
+
 def _calibration_columns(folder) -> pd.DataFrame:
     table = pd.read_csv(folder / "report.csv")
     columns = [c for c in table.columns if "calibrated" in c and "note" not in c]

@@ -151,3 +151,24 @@ def test_a_record_hdf5_cannot_read_inside_a_removal_is_one_line_naming_it(record
                    f"(/analyses/{damaged}: Error iterating over attributes (incorrect "
                    "metadata checksum after all read attempts))")
     assert file_sha256(path) == digest
+
+
+def test_the_specimen_kept_command_a_removal_points_to_names_the_store_as_one_word(tmp_path):
+    # "`pidcore specimen kept --remove --store runs % [1].h5` removes them" was printed bare:
+    # pasted, the shell split the store's path into three words and globbed the brackets
+    import re
+    import shlex
+
+    from pidcore.app.kept_specimens import kept_specimen_file
+    from pidcore.cli.store import format_removal
+
+    store = tmp_path / "runs % [1].h5"
+    sha = "ab" * 32
+    kept = kept_specimen_file(store, sha)
+    kept.parent.mkdir(parents=True)
+    kept.write_bytes(b"kept")
+    said = format_removal(manage.Removal(store=store, records=(), dry_run=False,
+                                         unnamed_sha256=(sha,)))
+    (line,) = re.findall(r"`(pidcore specimen kept [^`]*)` removes them", said)
+    assert shlex.split(line) == ["pidcore", "specimen", "kept", "--remove", "--store",
+                                 str(store)]

@@ -280,6 +280,25 @@ def test_damper_of_stored_runs_takes_the_face_of_the_specimen_file_given(tmp_pat
         _run_model(["model", "damper", "--out", str(tmp_path / "p"), "--specimen", str(path)])
 
 
+def test_the_sweep_a_refused_specimen_file_is_pointed_to_names_each_path_as_one_word(
+        tmp_path, monkeypatch):
+    # "run them with pidcore dem sweep --specimen my coupon.toml --store runs % [1].h5" was
+    # printed bare: pasted, the shell split both paths and globbed the brackets
+    import shlex
+
+    runs = _steel_runs(load_specimen(_steel_with_face(tmp_path)))
+    _store_of_runs(monkeypatch, runs)
+    own = tmp_path / "my coupon.toml"
+    own.write_bytes(PAPER_FILE.read_bytes())
+    store = tmp_path / "runs % [1].h5"
+    with pytest.raises(ParameterError) as caught:
+        _run_model(["model", "damper", "--out", str(tmp_path / "out"), "--table", "store",
+                    "--store", str(store), "--specimen", str(own)])
+    line = str(caught.value).split("; run them with ", 1)[1]
+    assert shlex.split(line) == ["pidcore", "dem", "sweep", "--specimen", str(own), "--store",
+                                 str(store)]
+
+
 def test_the_old_rule_gave_a_copy_of_the_papers_cells_its_face_whatever_its_file():
     # one rule now: a file of the paper's cells that states no face (a copy, or a calibrated
     # file written before the key) is taken over its cells, as any other file is

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import argparse
+import os
+import shlex
 import sys
 from pathlib import Path
 
@@ -12,6 +14,14 @@ from ..measure import AnalysisOptions
 
 #: Help of ``--store`` where it names the default store.
 STORE_HELP = f"HDF5 store (default ./{defaults.STORE_PATH})"
+
+
+def command_line(*words: str | os.PathLike[str]) -> str:
+    """``words`` as one shell line that runs them as given, each quoted where a shell would
+    read it otherwise (:func:`shlex.quote`): every command line pidcore prints for the user
+    to run. A next step naming ``store % [1].h5`` bare was three words and a glob; a plain
+    path (``runs.h5``) stays as it is."""
+    return shlex.join(os.fspath(word) for word in words)
 
 
 def _whole_number(text: str, minimum: int) -> int:

@@ -13,7 +13,7 @@ from pathlib import Path
 
 from .. import defaults
 from ..errors import ParameterError
-from ._options import add_store_option
+from ._options import add_store_option, command_line
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -86,7 +86,7 @@ def printed_command(command: list[str], env: dict[str, str]) -> str:
 
     assignments = [f"{name}={shlex.quote(env[name])}"
                    for name in (STORE_ENV_VAR, DEM_STORE_ENV_VAR) if name in env]
-    return " ".join([*assignments, shlex.join(command)])
+    return " ".join([*assignments, command_line(*command)])
 
 
 def _dem_store(given: Path | None) -> Path | None:

@@ -9,6 +9,7 @@ from pathlib import Path
 from .. import defaults, interrupt
 from ._options import (
     check_out_folder,
+    command_line,
     non_negative_int,
     path_argument,
     positive_int,
@@ -218,8 +219,9 @@ def _saved_words(saved, store: Path) -> str:
     key, added = saved[0], saved[1]
     superseded = tuple(saved[2]) if len(saved) > 2 else ()
     if added:  # the key in the command: it still reads this one once the store holds more
-        words = (f"; saved calibration {key} in {store} (report --calibration {store} "
-                 f"--calibration-key {key})")
+        then = command_line("pidcore", "report", "--calibration", store,
+                            "--calibration-key", key)
+        words = f"; saved calibration {key} in {store} ({then})"
         if superseded:
             # "stored already" gave the earlier file: say that one is there, and why not it
             words += (f"; the same fit was stored before as {'; '.join(superseded)}: kept as "

@@ -17,7 +17,7 @@ from pathlib import Path
 from .. import defaults
 from ..constants import PARTICLE_MATERIALS, VIBRATED_MASS_CONVENTIONS
 from ..errors import ParameterError, as_given
-from ._options import add_store_option, check_out_folder, path_argument
+from ._options import add_store_option, check_out_folder, command_line, path_argument
 from ._out_folder import check_replaceable, write_folder_whole
 
 
@@ -211,7 +211,8 @@ def _runs_of_specimen_file(runs, path, store):
         raise ParameterError(
             f"--specimen {path}: {store} holds no DEM runs of "
             f"{hashed_name(given.name, given.hash)} (it holds {runs_per_specimen_text(runs)}); "
-            f"run them with pidcore dem sweep --specimen {path} --store {store}")
+            "run them with "
+            + command_line("pidcore", "dem", "sweep", "--specimen", path, "--store", store))
     return mine
 
 

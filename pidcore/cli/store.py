@@ -9,7 +9,13 @@ import math
 import sys
 from typing import TYPE_CHECKING
 
-from ._options import STORE_HELP, add_json_option, add_store_option, progress_wanted
+from ._options import (
+    STORE_HELP,
+    add_json_option,
+    add_store_option,
+    command_line,
+    progress_wanted,
+)
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -156,8 +162,9 @@ def format_removal(removal: Removal) -> str:
             if kept_specimen_file(removal.store, sha).is_file()]
     if kept:  # the app keeps an uploaded file while a record names it
         lines.append(f"note: no record names the specimen file(s) {', '.join(kept)} kept in "
-                     f"{kept_specimens_folder(removal.store)} any more; `pidcore specimen kept "
-                     f"--remove --store {removal.store}` removes them")
+                     f"{kept_specimens_folder(removal.store)} any more; `"
+                     + command_line("pidcore", "specimen", "kept", "--remove", "--store",
+                                    removal.store) + "` removes them")
     n = len(removal.records)
     lines.append(f"{removal.store}: {n} record(s) would be removed (--dry-run: nothing was "
                  "removed)" if removal.dry_run else
