@@ -6,9 +6,12 @@ from __future__ import annotations
 import contextlib
 import os
 import resource
+import shutil
 import signal
+import stat
 import subprocess
 import sys
+import tempfile
 import textwrap
 import time
 from pathlib import Path
@@ -455,6 +458,96 @@ def test_a_numba_cache_that_cannot_be_written_costs_a_compile_not_the_run(tmp_pa
                        env={**os.environ, "PYTHONPATH": str(ROOT),
                             "NUMBA_CACHE_DIR": str(tmp_path / "cache")})
     assert (p.returncode, p.stdout, p.stderr) == (0, "True\n", "")
+
+
+def _run_with_no_writable_numba_cache(tmp_path: Path, code: str) -> subprocess.CompletedProcess:
+    """Run ``code`` on a copy of pidcore where Numba's own cache places cannot be made, even by
+    root (for whom a read-only folder is writable): every ``__pycache__`` of the copy is a
+    file, HOME is a file (no ~/.cache/numba), NUMBA_CACHE_DIR unset; TMPDIR is tmp_path/tmp."""
+    site = tmp_path / "site"
+    if not site.exists():
+        shutil.copytree(ROOT / "pidcore", site / "pidcore",
+                        ignore=shutil.ignore_patterns("__pycache__"))
+        for folder in [site / "pidcore", *(site / "pidcore").rglob("*")]:
+            if folder.is_dir():
+                (folder / "__pycache__").write_text("")
+        (tmp_path / "home").write_text("")
+        (tmp_path / "tmp").mkdir(exist_ok=True)
+    env = {k: v for k, v in os.environ.items()
+           if k not in ("NUMBA_CACHE_DIR", "XDG_CACHE_HOME", "PYTHONPATH")}
+    env.update(PYTHONPATH=str(site), HOME=str(tmp_path / "home"), TMPDIR=str(tmp_path / "tmp"),
+               PYTHONDONTWRITEBYTECODE="1")
+    return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          timeout=120, env=env, cwd=tmp_path)
+
+
+_SCAN_AND_COUNT = textwrap.dedent("""
+    import numpy as np
+    import pidcore.signal
+    from pidcore.signal.validate import _scan
+    min_step, crossings, starts, lengths = _scan(np.sin(np.arange(1000.0)), 5, 10)
+    print(crossings > 0, len(_scan.stats.cache_hits), len(_scan.stats.cache_misses),
+          type(_scan._cache).__name__)
+""")
+
+
+@pytest.mark.slow
+def test_a_user_who_can_write_neither_site_packages_nor_home_gets_a_private_temp_cache(tmp_path):
+    # A wheel in a root-owned site-packages run by a service account (HOME=/nonexistent):
+    # Numba found no place for the cache and raised "cannot cache function
+    # '_project_segments': no locator available" at import, so not even --version ran; with
+    # a read-only site-packages the kernel was compiled at every run (`specimen check` 1m34).
+    first = _run_with_no_writable_numba_cache(tmp_path, _SCAN_AND_COUNT)
+    assert (first.returncode, first.stdout, first.stderr) == (0, "True 0 1 FunctionCache\n", "")
+    root = tmp_path / "tmp" / f"pidcore-numba-cache-{os.geteuid()}"
+    assert stat.S_IMODE(root.stat().st_mode) == 0o700
+    assert list(root.rglob("validate._scan-*.nbi"))  # the index of the saved machine code
+    # the next run loads the code saved there instead of compiling it again
+    second = _run_with_no_writable_numba_cache(tmp_path, _SCAN_AND_COUNT)
+    assert (second.returncode, second.stdout, second.stderr) == (0, "True 1 0 FunctionCache\n", "")
+
+
+@pytest.mark.slow
+def test_a_temp_cache_folder_another_user_could_write_is_not_used_and_the_code_runs_uncached(
+        tmp_path):
+    # Another user creating /tmp/pidcore-numba-cache-UID first (open to all) could plant
+    # machine code there that this user would load: the folder is left alone and the function
+    # compiled for this run only.
+    (tmp_path / "tmp").mkdir()
+    planted = tmp_path / "tmp" / f"pidcore-numba-cache-{os.geteuid()}"
+    planted.mkdir()
+    planted.chmod(0o777)
+    p = _run_with_no_writable_numba_cache(tmp_path, _SCAN_AND_COUNT)
+    # compiled (a miss) by a dispatcher without a cache to save it to
+    assert (p.returncode, p.stdout, p.stderr) == (0, "True 0 1 NullCache\n", "")
+    assert list(planted.iterdir()) == []
+
+
+def test_the_private_temp_cache_folder_is_refused_unless_it_is_a_folder_only_its_user_writes(
+        tmp_path, monkeypatch):
+    from pidcore import _numba_cache
+
+    monkeypatch.setattr(tempfile, "gettempdir", lambda: str(tmp_path))
+    uid = os.geteuid()
+    made = _numba_cache.private_temp_cache_root()
+    assert made == str(tmp_path / f"pidcore-numba-cache-{uid}")
+    assert stat.S_IMODE(os.stat(made).st_mode) == 0o700
+    assert _numba_cache.private_temp_cache_root() == made  # found again as it was left
+    os.chmod(made, 0o770)
+    assert _numba_cache.private_temp_cache_root() is None  # the group could plant code
+    os.rmdir(made)
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir(mode=0o700)
+    os.symlink(elsewhere, made)  # a link planted under the name: not followed
+    assert _numba_cache.private_temp_cache_root() is None
+    os.unlink(made)
+    # a folder of another user's (this test's folder, seen by a process of another uid)
+    os.mkdir(tmp_path / f"pidcore-numba-cache-{uid + 1}", 0o700)
+    monkeypatch.setattr(os, "geteuid", lambda: uid + 1)
+    assert _numba_cache.private_temp_cache_root() is None
+    # nowhere to make it: none, the caller compiles uncached
+    monkeypatch.setattr(tempfile, "gettempdir", lambda: str(tmp_path / "missing"))
+    assert _numba_cache.private_temp_cache_root() is None
 
 
 def test_a_sigterm_ignored_by_whoever_started_pidcore_stays_ignored():

@@ -32,8 +32,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                     "table material with inline properties that differ from the table's keeps "
                     "them, and a note names each value that overrides the table's. Each pair's "
                     "restitution is simulated by a head-on impact through the DEM kernel: the "
-                    "first check after an install compiles the kernel (minutes, once; Numba "
-                    "caches it).")
+                    "first check after an install compiles the kernel (minutes, once: Numba "
+                    "caches it beside pidcore, else in ~/.cache/numba, else in a folder of the "
+                    "user's under the system's temporary folder; NUMBA_CACHE_DIR first).")
     check.add_argument("file", metavar="FILE", type=path_argument, help="specimen TOML file")
     check.add_argument("--damping-mode", choices=NORMAL_DAMPING_MODES,
                        default=defaults.DEM_NORMAL_DAMPING_MODE,

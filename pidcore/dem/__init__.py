@@ -16,8 +16,9 @@ Benchmarks (kernel throughput, a grid sweep into a temporary store) are in
 :mod:`pidcore.dem.bench`.
 """
 
-from .. import interrupt
-from .._numba_cache import tolerate_unwritable_cache
+# _numba_cache first: it sets up Numba's cache (where it lives, saves that fail) at its import,
+# and Numba chooses a function's cache place when the modules below decorate it
+from .. import _numba_cache, interrupt  # noqa: F401
 from .contact import ContactLaw, PairLaw
 from .geometry import CellGeometry, cell_capacity
 from .impact import calibrate_damping_coefficient, measure_restitution, simulate_impact
@@ -25,8 +26,6 @@ from .materials import MaterialProperties, PairParameters
 from .result import DemResult
 from .simulate import DemConfig, LoadCase, particles_per_cell, simulate_load_case
 
-# before the first call of any cache=True function of this package (compiled, then saved)
-tolerate_unwritable_cache()
 interrupt.defer_while_compiling()
 
 __all__ = ["CellGeometry", "ContactLaw", "DemConfig", "DemResult", "LoadCase",

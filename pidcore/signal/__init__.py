@@ -16,14 +16,13 @@ synthesize_shaker_record, SyntheticRecord
     Synthetic records with an analytic answer, and the record they return.
 """
 
-from .. import interrupt
-from .._numba_cache import tolerate_unwritable_cache
+# _numba_cache first: it sets up Numba's cache (where it lives, saves that fail) at its import,
+# and Numba chooses a function's cache place when the modules below decorate it
+from .. import _numba_cache, interrupt  # noqa: F401
 from .frequency import estimate_drive_frequency
 from .power import PowerAnalysis, analyze_channels, analyze_power, baseline_sdc_taken_off
 from .synthetic import SyntheticRecord, synthesize_shaker_record
 
-# before the first call of any cache=True function of this package (compiled, then saved)
-tolerate_unwritable_cache()
 interrupt.defer_while_compiling()
 
 __all__ = ["PowerAnalysis", "SyntheticRecord", "analyze_channels", "analyze_power",
