@@ -31,6 +31,7 @@ import os
 import re
 import secrets
 import stat
+import sys
 import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager, suppress
@@ -100,6 +101,21 @@ def temporary_path_for(target: str | os.PathLike[str]) -> Path:
     the rename over ``target`` stays on one file system."""
     target = Path(target)
     return target.with_name(f".{target.name}.{secrets.token_hex(8)}{TEMPORARY_SUFFIX}")
+
+
+def longest_name_with_a_temporary(target: str | os.PathLike[str]) -> int:
+    """The most bytes ``target``'s name may have for :func:`temporary_path_for`'s name beside
+    it to fit its folder's limit on a name's length (NAME_MAX, 255 bytes on most file systems;
+    the temporary name adds 22 to the target's)."""
+    target = Path(target)
+    try:
+        name_max = os.pathconf(target.parent, "PC_NAME_MAX")
+    except (OSError, ValueError):  # no such folder (yet), or a system without the query
+        name_max = 255
+    if name_max < 0:  # the system states no limit
+        return sys.maxsize
+    added = len(os.fsencode(temporary_path_for(target).name)) - len(os.fsencode(target.name))
+    return name_max - added
 
 
 def temporary_name_pattern(target: str | os.PathLike[str]) -> re.Pattern[str]:

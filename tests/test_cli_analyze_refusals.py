@@ -4,6 +4,7 @@ the CLI flag, exit 2, the store byte-identical."""
 from __future__ import annotations
 
 import math
+import os
 import re
 from pathlib import Path
 
@@ -467,3 +468,17 @@ def test_a_per_file_refusal_of_an_option_names_the_file(tmp_path, capsys, option
     second = _export_without_velocity(tmp_path / "acc_only.csv")
     err = _refused([str(first), str(second), *option, "--no-progress"], store, capsys)
     assert f"{tmp_path / refused_file}: {said}" in err, err
+
+
+def test_a_store_name_too_long_for_its_working_copy_is_refused_before_any_analysis(tmp_path,
+                                                                                   capsys):
+    # 235 + 3 bytes: the working copy's name (+22 bytes) is over 255; refused after the
+    # analyses, as "OSError: [Errno 36] File name too long" from the copy's removal
+    path = export(tmp_path / "rec.csv")
+    store = tmp_path / ("s" * 235 + ".h5")
+    assert main(["analyze", str(path), "--store", str(store)]) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and len(err.strip().splitlines()) == 1, err
+    assert f"{store.name}: the store's name is 238 bytes, too long for the working copy" in err
+    assert "at most 233 bytes" in err
+    assert os.listdir(tmp_path) == ["rec.csv"]

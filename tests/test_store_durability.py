@@ -460,6 +460,27 @@ def test_a_numba_cache_that_cannot_be_written_costs_a_compile_not_the_run(tmp_pa
     assert (p.returncode, p.stdout, p.stderr) == (0, "True\n", "")
 
 
+def test_a_store_name_leaving_no_room_for_its_working_copys_name_is_refused_in_one_line(
+        tmp_path):
+    # The working copy is named .NAME.<16 hex>.tmp beside the store: a 238-byte store name
+    # made it 260 bytes, over the 255 a name may have, and the removal of the copy that was
+    # never made raised "[Errno 36] File name too long" itself, over the StoreError.
+    assert os.pathconf(tmp_path, "PC_NAME_MAX") == 255  # ext4, tmpfs, xfs, btrfs
+    longest = "s" * (255 - 22 - 3) + ".h5"
+    Store(tmp_path / longest).add_dem_run("kept", {"sdc": 0.25})
+    assert list(Store(tmp_path / longest).list_dem_runs()["case_key"]) == ["kept"]
+    # bytes, not characters: 119 characters, 235 bytes
+    for name in ["s" * (255 - 22 - 2) + ".h5", "é" * 116 + ".h5"]:
+        store = Store(tmp_path / name)
+        said = (rf"name is {len(name.encode())} bytes, too long for the working copy .* "
+                r"at most 233 bytes")
+        with pytest.raises(StoreError, match=said):
+            store.check_writable()
+        with pytest.raises(StoreError, match=said):
+            store.add_dem_run("new", {"sdc": 0.2})
+    assert os.listdir(tmp_path) == [longest]
+
+
 def _run_with_no_writable_numba_cache(tmp_path: Path, code: str) -> subprocess.CompletedProcess:
     """Run ``code`` on a copy of pidcore where Numba's own cache places cannot be made, even by
     root (for whom a read-only folder is writable): every ``__pycache__`` of the copy is a

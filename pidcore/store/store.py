@@ -61,6 +61,7 @@ import pandas as pd
 from .. import __version__, defaults, interrupt
 from ..atomic_files import (
     fsync_path,
+    longest_name_with_a_temporary,
     new_file_mode,
     remove_stale_temporaries,
     temporary_path_for,
@@ -463,6 +464,7 @@ class Store:
         StoreError
             One line naming the store, what is read-only and the way out.
         """
+        self._check_name_length()
         directory = self._file.parent
         # no write bit for anyone (chmod 444) is read-only for root too, whom os.access lets
         # write anything: the store marked read-only was replaced by the commit's copy
@@ -486,6 +488,16 @@ class Store:
         removed while the lock is taken."""
         with suppress(StoreError, OSError), exclusive_lock(self._file, timeout_s=0):
             self._remove_stale_temporaries()
+
+    def _check_name_length(self) -> None:
+        """Refuse a store whose name leaves no room for its working copy's name beside it: the
+        copy could not be made, after the work to save was done (an analysis, a DEM run)."""
+        size, most = len(os.fsencode(self._file.name)), longest_name_with_a_temporary(self._file)
+        if size > most:
+            raise StoreError(
+                f"{self.path}: the store's name is {size} bytes, too long for the working "
+                "copy every save writes beside it (.NAME.<16 hex>.tmp, within the folder's "
+                f"limit on a name's length); expected a name of at most {most} bytes")
 
     def _check_single_link(self) -> None:
         """Refuse a store file with more than one name (a hard link): a save replaces the
@@ -677,6 +689,7 @@ class Store:
         directory = target.parent
         if not directory.is_dir():
             raise StoreError(f"{self.path}: directory {directory} does not exist")
+        self._check_name_length()
         with exclusive_lock(target, timeout_s=self.lock_timeout_s):
             self._remove_stale_temporaries()
             exists = target.exists()
@@ -718,7 +731,9 @@ class Store:
                     fsync_path(directory, directory=True)
                 interrupt.raise_if_interrupted()  # one that came during the commit
             except BaseException:
-                tmp.unlink(missing_ok=True)
+                # a failure to remove the copy must not hide why the transaction failed
+                with suppress(OSError):
+                    tmp.unlink(missing_ok=True)
                 raise
 
     def _check_room_to_write(self, h5: h5py.File, nbytes: int, *, what: str) -> None:
