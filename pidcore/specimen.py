@@ -1513,7 +1513,9 @@ def _read_specimen_file(path: Path) -> Specimen:
                    if isinstance(exc, FileNotFoundError) else "")
         raise ParameterError(f"{path}: cannot read specimen file ({exc.strerror})"
                              f"{bundled}") from None
-    return Specimen.from_bytes(data, source=str(path))
+    from .io import display_path  # lazily: the readers are not needed to read a specimen
+
+    return Specimen.from_bytes(data, source=display_path(path))
 
 
 @functools.cache

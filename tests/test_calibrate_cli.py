@@ -5,7 +5,10 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import re
+import subprocess
+import sys
 import threading
 from pathlib import Path
 
@@ -100,6 +103,33 @@ def test_fewer_load_cases_than_parameters_are_refused(capsys, tmp_path):
 @pytest.fixture(scope="module")
 def tiny_store(tmp_path_factory):
     return tmp_path_factory.mktemp("cal") / "dem.h5"
+
+
+@pytest.mark.slow
+def test_non_ascii_paths_under_an_ascii_locale_are_written_as_their_names(tmp_path):
+    # LC_ALL=C with PYTHONUTF8=0: Python holds the UTF-8 bytes of "é" in a path as surrogates,
+    # which the UTF-8 outputs could not encode (UnicodeEncodeError: surrogates not allowed,
+    # after the DEM runs) and calibration.json held as "\udcc3\udca9"
+    folder = tmp_path / "dir é Ω"
+    folder.mkdir()
+    data = _table(folder).rename(folder / "measured é.csv")
+    specimen = folder / "coupon é.toml"
+    specimen.write_text((REPO / "pidcore/data/specimens/paper_coupon.toml").read_text())
+    env = {**os.environ, "PYTHONPATH": str(REPO), "LC_ALL": "C", "PYTHONUTF8": "0",
+           "PYTHONCOERCECLOCALE": "0", "MPLBACKEND": "Agg"}
+    p = subprocess.run([sys.executable, "-m", "pidcore", "calibrate", "--data", str(data),
+                        "--specimen", str(specimen), "--fit", "fixture_mass_kg",
+                        "--discrepancy", "0.2", "--dem-store", str(folder / "dem é.h5"),
+                        "--out", str(folder / "out"), *TINY],
+                       capture_output=True, env=env, timeout=300)
+    assert p.returncode == 0, p.stderr.decode("ascii", "backslashreplace")[-2000:]
+    # each name read back from the files as it is on disk (a round trip of the bytes)
+    document = json.loads((folder / "out" / "calibration.json").read_text(encoding="utf-8"))
+    assert [m["source"] for m in document["settings"]["measured"]] == [str(data)]
+    summary = (folder / "out" / "summary.md").read_text(encoding="utf-8")
+    assert str(data) in summary and str(specimen) in summary
+    calibrated = (folder / "out" / "calibrated_specimen.toml").read_text(encoding="utf-8")
+    assert f"table {data} (sha256" in calibrated
 
 
 def test_json_document(capsys, tmp_path, tiny_store):

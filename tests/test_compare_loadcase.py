@@ -250,3 +250,18 @@ def test_a_file_named_in_cp1252_finds_its_row_of_a_cp1252_table(tmp_path):
     assert stated.fill_percent == 75.0 and "fill: loadcases.csv" in stated.origin
     # a UTF-8 name is only itself
     assert name_spellings("Prüfung.uff") == ("Prüfung.uff",)
+
+
+def test_a_utf8_file_name_under_an_ascii_locale_finds_its_row(tmp_path):
+    # LC_ALL=C (PYTHONUTF8=0): Python holds the UTF-8 bytes of "é" as two surrogates, so the
+    # row of the UTF-8 table was not found, and the file's fill silently taken from elsewhere
+    from pidcore.compare import resolve_load_case
+    from pidcore.compare.loadcase import name_spellings
+
+    (tmp_path / "essai é_fill50.uff").write_bytes(b"")
+    as_held = "essai é_fill50.uff".encode().decode("ascii", "surrogateescape")
+    (tmp_path / "loadcases.csv").write_text("file,fill_percent\nessai é_fill50.uff,75\n",
+                                            encoding="utf-8")
+    assert name_spellings(as_held) == (as_held, "essai é_fill50.uff")
+    stated = resolve_load_case(tmp_path / as_held, sidecar=None)
+    assert stated.fill_percent == 75.0 and "fill: loadcases.csv" in stated.origin

@@ -33,6 +33,7 @@ from ..compare.plausibility import (
     stored_record_name,
 )
 from ..errors import InputFileError, ParameterError, as_given, real_number
+from ..io import display_path
 from ..io._common import file_sha256
 from ..loadcase import normalize_material
 
@@ -210,7 +211,7 @@ def read_measured_table(path: str | os.PathLike, *,
             material = normalize_material(_text_cell(row.get("material"), default_material),
                                           "material", known=None)
             named = _text_cell(row.get("specimen"), "")
-            point = MeasuredPoint(material=material, specimen=named, source=str(path),
+            point = MeasuredPoint(material=material, specimen=named, source=display_path(path),
                                   row=int(line), source_sha256=sha256, **values,
                                   sdc_bound=_point_sdc_bound(values["fill_percent"], material,
                                                              named, "", specimen)[0])
@@ -430,7 +431,7 @@ def measured_from_store(store_path: str | os.PathLike, *,
                 if se > 0 else math.nan
         points.append(MeasuredPoint(float(f), float(a), float(p), float(sdc.mean()), se,
                                     str(material), str(named), sdc_stderr_dof=dof,
-                                    source=str(store_path), specimen_sha256=str(sha256),
+                                    source=display_path(store_path), specimen_sha256=str(sha256),
                                     analyses=tuple(sorted(map(str, group.get(
                                         "key", pd.Series([], dtype=object))))),
                                     specimen_ambiguous=bool(ambiguous),

@@ -409,13 +409,17 @@ def name_spellings(name: str) -> tuple[str, ...]:
     """``name`` as the file system gives it, and, where its bytes are not UTF-8 (a file named
     on Windows, ``Prüfung.uff`` in cp1252, copied to Linux: Python holds the byte 0xFC as a
     lone surrogate), as cp1252 reads them: the spelling a settings table saved by a Windows
-    spreadsheet (read as cp1252, :mod:`pidcore.tables`) has in its ``file`` cell."""
+    spreadsheet (read as cp1252, :mod:`pidcore.tables`) has in its ``file`` cell. Under an
+    ASCII locale (``LC_ALL=C``) Python holds even UTF-8 bytes as surrogates: their UTF-8
+    spelling is the one a table read as UTF-8 has."""
     import os
 
     spellings = [name]
     raw = os.fsencode(name)
     try:
-        raw.decode("utf-8")
+        as_utf8 = raw.decode("utf-8")
+        if as_utf8 != name:
+            spellings.append(as_utf8)
     except UnicodeDecodeError:
         for encoding in ("cp1252", "latin-1"):
             try:
